@@ -1,0 +1,120 @@
+# hfvis - plain Makefile. Variables: CC, CXX, CFLAGS, config=release|debug|test|sanitize|coverage,
+# werror=1, PREFIX (install), FUZZ_SECONDS (fuzz).
+CC ?= cc
+CXX ?= c++
+config ?= release
+werror ?= 0
+PREFIX ?= /usr/local
+FUZZ_SECONDS ?= 30
+FUZZ_CC ?= clang
+
+WARN := -std=c99 -pedantic -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes \
+        -Wundef -Wvla -Wcast-qual -Wdouble-promotion -Wfloat-conversion \
+        -Wimplicit-fallthrough -Wmissing-field-initializers
+BASEFLAGS := $(WARN) -ffp-contract=off
+
+ifeq ($(config),release)
+  BUILD := build
+  OPT := -O2
+else ifeq ($(config),debug)
+  BUILD := build/debug
+  OPT := -O0 -g -DHFVIS_ENABLE_ASSERTS
+else ifeq ($(config),test)
+  BUILD := build/test
+  OPT := -O2 -g -DHFVIS_ENABLE_ASSERTS
+else ifeq ($(config),sanitize)
+  BUILD := build/sanitize
+  OPT := -O1 -g -DHFVIS_ENABLE_ASSERTS -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+else ifeq ($(config),coverage)
+  BUILD := build/coverage
+  OPT := -O0 -g --coverage
+else
+  $(error unknown config '$(config)': use release, debug, test, sanitize or coverage)
+endif
+ifeq ($(werror),1)
+  OPT += -Werror
+endif
+
+ALL_CFLAGS := $(BASEFLAGS) $(OPT) $(CFLAGS)
+LDLIBS := -lm
+
+LIBSRC := hfvis.c ssao.c voxel.c
+LIBOBJ := $(LIBSRC:%.c=$(BUILD)/obj/%.o)
+LIB := $(BUILD)/libhfvis.a
+EXAMPLES := $(patsubst examples/%.c,$(BUILD)/examples/%,$(filter-out examples/hfvis_cli.c examples/bench.c examples/common.c,$(wildcard examples/*.c)))
+CLI := $(BUILD)/hfvis
+BENCH := $(BUILD)/bench
+TESTS := $(patsubst test/%.c,$(BUILD)/test/%,$(wildcard test/test_*.c))
+FUZZERS := $(patsubst test/fuzz/%.c,%,$(wildcard test/fuzz/fuzz_*.c))
+
+.PHONY: all lib examples test check sanitize fuzz bench demo install symbols cxx update-golden clean run-tests
+all: $(LIB) $(CLI) $(EXAMPLES)
+lib: $(LIB)
+examples: $(EXAMPLES) $(CLI)
+
+$(BUILD)/obj/%.o: %.c hfvis.h
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -c $< -o $@
+$(LIB): $(LIBOBJ)
+	@rm -f $@
+	ar rcs $@ $^
+$(BUILD)/examples/%: examples/%.c examples/common.h $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -I. $< $(LIB) $(LDLIBS) -o $@
+$(CLI): examples/hfvis_cli.c examples/common.h $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -I. $< $(LIB) $(LDLIBS) -o $@
+$(BENCH): examples/bench.c examples/common.h $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -I. $< $(LIB) $(LDLIBS) -o $@
+$(BUILD)/test/%: test/%.c test/test.h $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -I. $< $(LIB) $(LDLIBS) -o $@
+
+# make test: -Werror, every test program, the examples as smoke tests, the C++ header compile
+# and the symbol-prefix check; the last line is "tests: N passed, M failed".
+test check:
+	@$(MAKE) --no-print-directory config=test werror=1 run-tests
+sanitize:
+	@$(MAKE) --no-print-directory config=sanitize werror=1 run-tests
+run-tests: $(TESTS) $(EXAMPLES) $(CLI)
+	@sh test/run.sh $(BUILD) "$(CXX)"
+
+symbols: $(LIB)
+	@bad=$$(nm -g --defined-only $(LIB) | awk 'NF==3 && $$2 ~ /[TDBRC]/ {print $$3}' | grep -v '^hfvis_' || true); \
+	if [ -n "$$bad" ]; then echo "symbols: unprefixed exported symbols:"; echo "$$bad"; exit 1; fi; \
+	echo "symbols: all exported symbols start with hfvis_"
+cxx:
+	$(CXX) -std=c++11 -Wall -Wextra -Werror -pedantic -fsyntax-only -I. test/cxx_header.cpp
+
+bench:
+	@$(MAKE) --no-print-directory config=release $(BENCH)
+	@build/bench $(BENCH_ARGS)
+
+demo: 
+	@$(MAKE) --no-print-directory config=release all
+	@mkdir -p out
+	@for e in $(patsubst examples/%.c,build/examples/%,$(filter-out examples/hfvis_cli.c examples/bench.c,$(wildcard examples/*.c))); do \
+	  echo "demo: $$e"; $$e out || exit 1; done
+	@echo "demo: gallery written to out/"; ls out
+
+update-golden:
+	@$(MAKE) --no-print-directory config=test $(TESTS)
+	@for t in $(TESTS); do $$t --update-golden || exit 1; done
+
+fuzz:
+	@mkdir -p build/fuzz
+	@for f in $(FUZZERS); do \
+	  $(FUZZ_CC) -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -I. test/fuzz/$$f.c hfvis.c ssao.c voxel.c -lm -o build/fuzz/$$f || exit 1; \
+	  mkdir -p build/fuzz/corpus_$$f; \
+	  build/fuzz/$$f -max_total_time=$(FUZZ_SECONDS) -max_len=4096 build/fuzz/corpus_$$f test/fuzz/seeds/$${f#fuzz_} || exit 1; \
+	done
+
+install: $(LIB)
+	mkdir -p $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/lib/pkgconfig
+	cp hfvis.h $(DESTDIR)$(PREFIX)/include/
+	cp $(LIB) $(DESTDIR)$(PREFIX)/lib/
+	printf 'prefix=%s\nincludedir=$${prefix}/include\nlibdir=$${prefix}/lib\n\nName: hfvis\nDescription: height-field and screen-space visibility reference\nVersion: 0.1.0\nCflags: -I$${includedir}\nLibs: -L$${libdir} -lhfvis -lm\n' '$(PREFIX)' > $(DESTDIR)$(PREFIX)/lib/pkgconfig/hfvis.pc
+
+clean:
+	rm -rf build out

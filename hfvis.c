@@ -1,0 +1,1524 @@
+/* hfvis.c - height fields. Part of hfvis (see hfvis.h for the conventions and the API).
+ *
+ * Contents
+ *   1. Common: status strings, allocation, checked sizes, PRNG
+ *   2. Codecs: PGM (P2/P5) and PFM (Pf/PF) in memory, file wrappers
+ *   3. Analytic test fields (spec heightfield §12)
+ *   4. Bilinear sampling and normals ([P1] §4, §7 "quad sum"; spec §3.2, §5.1)
+ *   5. The sweep lattice ([P1] §4, Fig. 2; spec §3.2)
+ *   6. The P1 hull stack along one line ([P1] §5 Alg. 1, App. A.1; spec §4)
+ *   7. The sweep driver: sampled lattice, four-way symmetry, borders, gather (spec §3.3-3.6)
+ *   8. Horizon outputs and the ray-march oracles (spec §6)
+ *   9. Light: uniform sky ([P1] Eq. 4-5), sky-view factor, sun visibility
+ *  10. Environment light: prefix integrals and the L_p table ([P1] Eq. 6-7; spec §5.4),
+ *      the hemisphere-integration oracle
+ *
+ * Paper references: [P1] Timonen & Westerholm, "Scalable Height Field Self-Shadowing",
+ * CGF 29(2), 2010 (thesis appendix A.1). "spec" is the project's restatement
+ * spec/heightfield-p1-p2.md, which fixes the paper's errata.
+ */
+#include "hfvis.h"
+
+#include <float.h>
+#include <limits.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#ifndef HFVIS_NO_STDIO
+#include <stdio.h>
+#endif
+
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#endif
+
+#ifndef HFVIS_ASSERT
+#ifdef HFVIS_ENABLE_ASSERTS
+#include <assert.h>
+#define HFVIS_ASSERT(x) assert(x)
+#else
+#define HFVIS_ASSERT(x) ((void)0)
+#endif
+#endif
+
+#define HF_NAN ((double)NAN)
+#define HF_INF ((double)INFINITY)
+#define HF_PI 3.14159265358979323846
+#define HF_HALF_PI 1.57079632679489661923
+
+/* ========================================================================================== */
+/* 1. Common                                                                                  */
+/* ========================================================================================== */
+
+const char *hfvis_status_string(hfvis_status status)
+{
+    switch (status) {
+    case HFVIS_OK: return "HFVIS_OK: success";
+    case HFVIS_ERR_INVALID_ARGUMENT: return "HFVIS_ERR_INVALID_ARGUMENT: invalid argument";
+    case HFVIS_ERR_OUT_OF_MEMORY: return "HFVIS_ERR_OUT_OF_MEMORY: out of memory";
+    case HFVIS_ERR_FORMAT: return "HFVIS_ERR_FORMAT: malformed data";
+    case HFVIS_ERR_LIMIT: return "HFVIS_ERR_LIMIT: size exceeds a documented limit";
+    case HFVIS_ERR_BUFFER_TOO_SMALL: return "HFVIS_ERR_BUFFER_TOO_SMALL: output buffer too small";
+    case HFVIS_ERR_IO: return "HFVIS_ERR_IO: file could not be read or written";
+    }
+    return "HFVIS_ERR_UNKNOWN: unknown status code";
+}
+
+static void *hf_alloc(const hfvis_allocator *a, size_t bytes)
+{
+    if (bytes == 0) return NULL;
+    if (a && a->alloc) return a->alloc(a->user, bytes);
+    return malloc(bytes);
+}
+
+static void hf_free(const hfvis_allocator *a, void *p)
+{
+    if (!p) return;
+    if (a && a->alloc) {
+        if (a->free) a->free(a->user, p);
+        return;
+    }
+    free(p);
+}
+
+void hfvis_free(const hfvis_allocator *alloc, void *ptr) { hf_free(alloc, ptr); }
+
+/* a*b without overflow (stb's mul2sizes_valid). */
+static int hf_mul_size(size_t a, size_t b, size_t *out)
+{
+    if (a != 0 && b > SIZE_MAX / a) return 0;
+    *out = a * b;
+    return 1;
+}
+
+/* Allocates count elements of elem bytes, or NULL on overflow or failure. */
+static void *hf_alloc_array(const hfvis_allocator *a, size_t count, size_t elem)
+{
+    size_t bytes;
+    if (!hf_mul_size(count, elem, &bytes)) return NULL;
+    return hf_alloc(a, bytes);
+}
+
+static int hf_grid_valid(const hfvis_grid *g)
+{
+    return g && g->z && g->width >= 1 && g->height >= 1 && g->stride >= g->width &&
+           isfinite(g->cell_size) && g->cell_size > 0.0 &&
+           (size_t)g->height <= SIZE_MAX / (size_t)g->stride;
+}
+
+/* width*height as size_t (valid grids only). */
+static size_t hf_grid_count(const hfvis_grid *g) { return (size_t)g->width * (size_t)g->height; }
+
+static int hf_border_valid(hfvis_border b) { return b >= HFVIS_BORDER_DEFAULT && b <= HFVIS_BORDER_WRAP; }
+
+/* splitmix64: the library's only PRNG / hash (fixed, seeded, no global state). */
+static uint64_t hf_mix64(uint64_t x)
+{
+    x += 0x9E3779B97F4A7C15ull;
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+    return x ^ (x >> 31);
+}
+
+/* CODEC-FRAGMENT */
+
+/* ========================================================================================== */
+/* 3. Analytic test fields (spec heightfield §12)                                             */
+/* ========================================================================================== */
+
+/* Value noise in [-1, 1] at (x, y) for one octave: hashed lattice values with the quintic fade,
+ * so the surface is C2 and any bilinear grid sampling of it is a fair test terrain. */
+static double hf_value_noise(uint64_t seed, double x, double y)
+{
+    double fx0 = floor(x), fy0 = floor(y);
+    double fx = x - fx0, fy = y - fy0;
+    int64_t ix = (int64_t)fx0, iy = (int64_t)fy0;
+    double v[4];
+    int c;
+    for (c = 0; c < 4; c++) {
+        uint64_t hx = (uint64_t)(ix + (c & 1)), hy = (uint64_t)(iy + (c >> 1));
+        uint64_t h = hf_mix64(seed ^ hf_mix64(hx * 0x9E3779B97F4A7C15ull ^ hf_mix64(hy)));
+        v[c] = (double)(h >> 11) * (2.0 / 9007199254740992.0) - 1.0;
+    }
+    fx = fx * fx * fx * (fx * (fx * 6.0 - 15.0) + 10.0);
+    fy = fy * fy * fy * (fy * (fy * 6.0 - 15.0) + 10.0);
+    return (v[0] * (1.0 - fx) + v[1] * fx) * (1.0 - fy) + (v[2] * (1.0 - fx) + v[3] * fx) * fy;
+}
+
+static int hf_field_valid(const hfvis_field *f)
+{
+    if (!f) return 0;
+    if (!(isfinite(f->x0) && isfinite(f->y0) && isfinite(f->height) && isfinite(f->slope) &&
+          isfinite(f->slope_x) && isfinite(f->slope_y) && isfinite(f->radius) &&
+          isfinite(f->amplitude) && isfinite(f->wavelength) && isfinite(f->persistence)))
+        return 0;
+    switch (f->kind) {
+    case HFVIS_FIELD_PLANE: case HFVIS_FIELD_TILTED_PLANE: case HFVIS_FIELD_V_VALLEY:
+    case HFVIS_FIELD_L1_PIT: case HFVIS_FIELD_LINF_PIT: case HFVIS_FIELD_CONE:
+    case HFVIS_FIELD_STEP:
+        return 1;
+    case HFVIS_FIELD_HEMISPHERE: return f->radius > 0.0;
+    case HFVIS_FIELD_SINUSOID: return f->wavelength > 0.0;
+    case HFVIS_FIELD_FBM:
+        return f->wavelength > 0.0 && f->octaves >= 0 && f->octaves <= 30 && f->persistence >= 0.0;
+    }
+    return 0;
+}
+
+double hfvis_field_height(void *field, double x, double y)
+{
+    const hfvis_field *f = (const hfvis_field *)field;
+    double dx, dy, r;
+    if (!hf_field_valid(f) || !isfinite(x) || !isfinite(y)) return HF_NAN;
+    dx = x - f->x0;
+    dy = y - f->y0;
+    switch (f->kind) {
+    case HFVIS_FIELD_PLANE: return f->height;
+    case HFVIS_FIELD_TILTED_PLANE: return f->height + f->slope_x * dx + f->slope_y * dy;
+    case HFVIS_FIELD_V_VALLEY: return f->height + f->slope * fabs(dx);
+    case HFVIS_FIELD_L1_PIT: return f->height + f->slope * (fabs(dx) + fabs(dy));
+    case HFVIS_FIELD_LINF_PIT: return f->height + f->slope * fmax(fabs(dx), fabs(dy));
+    case HFVIS_FIELD_CONE: return f->height + f->slope * sqrt(dx * dx + dy * dy);
+    case HFVIS_FIELD_HEMISPHERE:
+        r = sqrt(dx * dx + dy * dy) / f->radius;
+        return r < 1.0 ? f->height + f->amplitude * sqrt(1.0 - r * r) : f->height;
+    case HFVIS_FIELD_STEP: return dx >= 0.0 ? f->height + f->amplitude : f->height;
+    case HFVIS_FIELD_SINUSOID:
+        return f->height + f->amplitude * sin(2.0 * HF_PI * x / f->wavelength) *
+                               sin(2.0 * HF_PI * y / f->wavelength);
+    case HFVIS_FIELD_FBM: {
+        int octaves = f->octaves ? f->octaves : 8, o;
+        double gain = f->persistence > 0.0 ? f->persistence : 0.5;
+        double amp = 1.0, freq = 1.0 / f->wavelength, sum = 0.0, norm = 0.0;
+        for (o = 0; o < octaves; o++) {
+            sum += amp * hf_value_noise(f->seed + (uint64_t)o * 0x632BE59BD9B4E019ull, x * freq, y * freq);
+            norm += amp;
+            amp *= gain;
+            freq *= 2.0;
+        }
+        return f->height + f->amplitude * (norm > 0.0 ? sum / norm : 0.0);
+    }
+    }
+    return HF_NAN;
+}
+
+hfvis_status hfvis_field_generate(const hfvis_field *field, int width, int height,
+                                  ptrdiff_t stride, float *out)
+{
+    int x, y;
+    if (!hf_field_valid(field) || !out || width < 1 || height < 1 || stride < width ||
+        (size_t)height > SIZE_MAX / (size_t)stride)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    for (y = 0; y < height; y++)
+        for (x = 0; x < width; x++)
+            out[(ptrdiff_t)y * stride + x] =
+                (float)hfvis_field_height((void *)(uintptr_t)field, (double)x, (double)y);
+    return HFVIS_OK;
+}
+
+/* ========================================================================================== */
+/* 4. Bilinear sampling and normals                                                           */
+/* ========================================================================================== */
+
+/* Bilinear height at (x, y) inside [0, W-1] x [0, H-1] (spec §3.2: x0 = min(floor x, W-2),
+ * 1-D for W or H = 1). A tap with zero weight is never read into the sum, so a hole beside an
+ * exact sample position does not leak into it. */
+static double hf_bilerp(const float *z, ptrdiff_t stride, int W, int H, double x, double y)
+{
+    int x0, y0;
+    double fx, fy, r0, r1;
+    const float *p;
+    if (W > 1) {
+        double f = floor(x);
+        x0 = f >= (double)(W - 2) ? W - 2 : (int)f;
+        fx = x - (double)x0;
+    } else {
+        x0 = 0;
+        fx = 0.0;
+    }
+    if (H > 1) {
+        double f = floor(y);
+        y0 = f >= (double)(H - 2) ? H - 2 : (int)f;
+        fy = y - (double)y0;
+    } else {
+        y0 = 0;
+        fy = 0.0;
+    }
+    p = z + (ptrdiff_t)y0 * stride + x0;
+    if (fx == 0.0) {
+        r0 = (double)p[0];
+        r1 = fy != 0.0 ? (double)p[stride] : 0.0;
+    } else if (fx == 1.0) {
+        r0 = (double)p[1];
+        r1 = fy != 0.0 ? (double)p[stride + 1] : 0.0;
+    } else {
+        r0 = (double)p[0] * (1.0 - fx) + (double)p[1] * fx;
+        r1 = fy != 0.0 ? (double)p[stride] * (1.0 - fx) + (double)p[stride + 1] * fx : 0.0;
+    }
+    if (fy == 0.0) return r0;
+    if (fy == 1.0) return r1;
+    return r0 * (1.0 - fy) + r1 * fy;
+}
+
+static double hf_clampd(double v, double lo, double hi) { return v < lo ? lo : v > hi ? hi : v; }
+
+double hfvis_grid_sample(const hfvis_grid *grid, double x, double y)
+{
+    if (!hf_grid_valid(grid) || isnan(x) || isnan(y)) return HF_NAN;
+    return hf_bilerp(grid->z, grid->stride, grid->width, grid->height,
+                     hf_clampd(x, 0.0, (double)(grid->width - 1)),
+                     hf_clampd(y, 0.0, (double)(grid->height - 1)));
+}
+
+/* One gradient component along an axis: central difference in the interior, one-sided at the
+ * border or beside a hole, 0 if both neighbours are missing. [P1] §7 sums the unnormalised
+ * normals of the four quads around the sample; that sum equals this central difference
+ * (spec §5.1), and at the border it is exactly the one-sided difference. */
+static double hf_slope_1d(double hm, double h0, double hp, int has_m, int has_p)
+{
+    has_m = has_m && isfinite(hm);
+    has_p = has_p && isfinite(hp);
+    if (has_m && has_p) return (hm - hp) * 0.5;
+    if (has_p) return h0 - hp;
+    if (has_m) return hm - h0;
+    return 0.0;
+}
+
+static void hf_normal_at(const hfvis_grid *g, int x, int y, double n[3])
+{
+    const float *p = g->z + (ptrdiff_t)y * g->stride + x;
+    double h0 = (double)*p, gx, gy, len;
+    if (!isfinite(h0)) {
+        n[0] = n[1] = n[2] = HF_NAN;
+        return;
+    }
+    gx = hf_slope_1d(x > 0 ? (double)p[-1] : 0.0, h0, x + 1 < g->width ? (double)p[1] : 0.0,
+                     x > 0, x + 1 < g->width);
+    gy = hf_slope_1d(y > 0 ? (double)p[-g->stride] : 0.0, h0,
+                     y + 1 < g->height ? (double)p[g->stride] : 0.0, y > 0, y + 1 < g->height);
+    gx /= g->cell_size;
+    gy /= g->cell_size;
+    len = sqrt(gx * gx + gy * gy + 1.0);
+    n[0] = gx / len;
+    n[1] = gy / len;
+    n[2] = 1.0 / len;
+}
+
+hfvis_status hfvis_normals_compute(const hfvis_grid *grid, float *out)
+{
+    int x, y;
+    if (!hf_grid_valid(grid) || !out || hf_grid_count(grid) > SIZE_MAX / 3)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    for (y = 0; y < grid->height; y++)
+        for (x = 0; x < grid->width; x++) {
+            double n[3];
+            float *o = out + ((size_t)y * (size_t)grid->width + (size_t)x) * 3;
+            hf_normal_at(grid, x, y, n);
+            o[0] = (float)n[0];
+            o[1] = (float)n[1];
+            o[2] = (float)n[2];
+        }
+    return HFVIS_OK;
+}
+
+/* ========================================================================================== */
+/* 5. The sweep lattice                                                                       */
+/* ========================================================================================== */
+
+#define HF_LATTICE_EPS 1e-9 /* spec §3.2: nodes within 1e-9 cell of the border are inside */
+
+/* Fill the lattice for a given sweep vector u (unit; v = (-u.y, u.x)). Directions are stored
+ * as look azimuth psi with u = -(cos psi, sin psi) (spec §1: a sweep along u yields the horizon
+ * toward -u). */
+static hfvis_status hf_lattice_from_u(hfvis_lattice *L, int W, int H, double ux, double uy)
+{
+    double cx[4], cy[4], umin = DBL_MAX, umax = -DBL_MAX, vmin = DBL_MAX, vmax = -DBL_MAX;
+    double rows, cols;
+    int c;
+    L->ux = ux;
+    L->uy = uy;
+    L->vx = -uy;
+    L->vy = ux;
+    L->width = W;
+    L->height = H;
+    L->azimuth_rad = atan2(-uy, -ux);
+    cx[0] = 0.0; cy[0] = 0.0;
+    cx[1] = (double)(W - 1); cy[1] = 0.0;
+    cx[2] = 0.0; cy[2] = (double)(H - 1);
+    cx[3] = (double)(W - 1); cy[3] = (double)(H - 1);
+    for (c = 0; c < 4; c++) {
+        double a = cx[c] * L->ux + cy[c] * L->uy, b = cx[c] * L->vx + cy[c] * L->vy;
+        umin = fmin(umin, a);
+        umax = fmax(umax, a);
+        vmin = fmin(vmin, b);
+        vmax = fmax(vmax, b);
+    }
+    L->i_min = (int)ceil(umin - HF_LATTICE_EPS);
+    L->i_max = (int)floor(umax + HF_LATTICE_EPS);
+    L->j_min = (int)ceil(vmin - HF_LATTICE_EPS);
+    L->j_max = (int)floor(vmax + HF_LATTICE_EPS);
+    rows = (double)L->j_max - (double)L->j_min + 1.0;
+    cols = (double)L->i_max - (double)L->i_min + 1.0;
+    if (rows * cols > 2147483647.0) return HFVIS_ERR_LIMIT;
+    return HFVIS_OK;
+}
+
+/* Unit sweep vector of look azimuth psi, snapped on the axes (spec §3.2). */
+static void hf_sweep_vector(double psi, double *ux, double *uy)
+{
+    double x = -cos(psi), y = -sin(psi);
+    if (fabs(x) < 1e-12) { x = 0.0; y = y > 0.0 ? 1.0 : -1.0; }
+    if (fabs(y) < 1e-12) { y = 0.0; x = x > 0.0 ? 1.0 : -1.0; }
+    *ux = x;
+    *uy = y;
+}
+
+hfvis_status hfvis_lattice_init(hfvis_lattice *lattice, int width, int height, double azimuth_rad)
+{
+    hfvis_lattice L;
+    double ux, uy;
+    hfvis_status s;
+    if (!lattice || width < 1 || height < 1 || !isfinite(azimuth_rad))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    hf_sweep_vector(azimuth_rad, &ux, &uy);
+    s = hf_lattice_from_u(&L, width, height, ux, uy);
+    if (s != HFVIS_OK) return s;
+    L.azimuth_rad = azimuth_rad;
+    *lattice = L;
+    return HFVIS_OK;
+}
+
+size_t hfvis_lattice_size(const hfvis_lattice *L)
+{
+    if (!L || L->j_max < L->j_min || L->i_max < L->i_min) return 0;
+    return ((size_t)(L->j_max - L->j_min) + 1) * ((size_t)(L->i_max - L->i_min) + 1);
+}
+
+/* Position of node (i, j). Written as i*u + j*v with the two products summed, so a lattice
+ * turned by a quarter turn (u' = v, v' = -u) yields bit-identical positions (spec §3.6). */
+static void hf_node_pos(const hfvis_lattice *L, int i, int j, double *x, double *y)
+{
+    *x = (double)i * L->ux + (double)j * L->vx;
+    *y = (double)i * L->uy + (double)j * L->vy;
+}
+
+static int hf_node_inside(const hfvis_lattice *L, int i, int j)
+{
+    double x, y;
+    hf_node_pos(L, i, j, &x, &y);
+    return x >= -HF_LATTICE_EPS && x <= (double)(L->width - 1) + HF_LATTICE_EPS &&
+           y >= -HF_LATTICE_EPS && y <= (double)(L->height - 1) + HF_LATTICE_EPS;
+}
+
+int hfvis_lattice_line(const hfvis_lattice *L, int j, int *i_first, int *i_last)
+{
+    double lo = -DBL_MAX, hi = DBL_MAX;
+    double u[2], v[2], len[2];
+    int a, first, last;
+    if (!L || j < L->j_min || j > L->j_max) return 0;
+    u[0] = L->ux; u[1] = L->uy;
+    v[0] = L->vx; v[1] = L->vy;
+    len[0] = (double)(L->width - 1);
+    len[1] = (double)(L->height - 1);
+    /* Slab test per axis (spec §3.2) gives the range to within rounding ... */
+    for (a = 0; a < 2; a++) {
+        double off = (double)j * v[a];
+        if (u[a] != 0.0) {
+            double t0 = (0.0 - off) / u[a], t1 = (len[a] - off) / u[a];
+            lo = fmax(lo, fmin(t0, t1));
+            hi = fmin(hi, fmax(t0, t1));
+        } else if (off < -HF_LATTICE_EPS || off > len[a] + HF_LATTICE_EPS) {
+            return 0;
+        }
+    }
+    lo = fmax(lo, (double)L->i_min - 1.0);
+    hi = fmin(hi, (double)L->i_max + 1.0);
+    if (lo > hi + 2.0) return 0;
+    first = (int)ceil(lo - HF_LATTICE_EPS);
+    last = (int)floor(hi + HF_LATTICE_EPS);
+    /* ... and the per-node position test decides exactly, so every lattice and its quarter
+     * turns agree on which nodes exist (spec §11 item 10). The in-domain set of a line is an
+     * interval (a line meets a rectangle in a segment). */
+    if (first < L->i_min) first = L->i_min;
+    if (last > L->i_max) last = L->i_max;
+    while (first > L->i_min && hf_node_inside(L, first - 1, j)) first--;
+    while (first <= last && !hf_node_inside(L, first, j)) first++;
+    while (last < L->i_max && hf_node_inside(L, last + 1, j)) last++;
+    while (last >= first && !hf_node_inside(L, last, j)) last--;
+    if (first > last) return 0;
+    if (i_first) *i_first = first;
+    if (i_last) *i_last = last;
+    return last - first + 1;
+}
+
+/* ========================================================================================== */
+/* 6. The P1 hull stack along one line                                                        */
+/* ========================================================================================== */
+
+/* [P1] Alg. 1 / App. A.1 (spec §4.2). The caster of the highest horizon of p_i is the vertex
+ * before p_i on the upper hull of p_0..p_i ([P1] Eq. 2). Pop while the second entry b is seen at
+ * least as high as the top a: (h_b - h)(d - d_a) >= (h_a - h)(d - d_b), P1's
+ * h(v2) d(v1) >= h(v1) d(v2) ("ties pop", so on a plane the caster is the previous sample).
+ * The A.1 erratum (the second point's horizon read after pushing it) cannot occur here: every
+ * sample reads the stack top before it is pushed. */
+hfvis_status hfvis_line_horizons(const double *distance, const double *height, int n,
+                                 double *tan_out, int *caster_out, int *stack)
+{
+    int i, top = 0;
+    if (!distance || !height || !tan_out || !stack || n < 0) return HFVIS_ERR_INVALID_ARGUMENT;
+    for (i = 1; i < n; i++)
+        if (!(distance[i] > distance[i - 1])) return HFVIS_ERR_INVALID_ARGUMENT;
+    for (i = 0; i < n; i++) {
+        double d = distance[i], h = height[i];
+        if (!isfinite(h)) { /* a hole never occludes and receives no value */
+            tan_out[i] = HF_NAN;
+            if (caster_out) caster_out[i] = -1;
+            continue;
+        }
+        while (top >= 2) {
+            int a = stack[top - 1], b = stack[top - 2];
+            if ((height[b] - h) * (d - distance[a]) >= (height[a] - h) * (d - distance[b])) top--;
+            else break;
+        }
+        if (top == 0) {
+            tan_out[i] = -HF_INF;
+            if (caster_out) caster_out[i] = -1;
+        } else {
+            int a = stack[top - 1];
+            tan_out[i] = (height[a] - h) / (d - distance[a]);
+            if (caster_out) caster_out[i] = a;
+        }
+        stack[top++] = i;
+    }
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_line_horizons_naive(const double *distance, const double *height, int n,
+                                       double *tan_out, int *caster_out)
+{
+    int i, j;
+    if (!distance || !height || !tan_out || n < 0) return HFVIS_ERR_INVALID_ARGUMENT;
+    for (i = 1; i < n; i++)
+        if (!(distance[i] > distance[i - 1])) return HFVIS_ERR_INVALID_ARGUMENT;
+    for (i = 0; i < n; i++) {
+        double best = -HF_INF;
+        int caster = -1;
+        if (!isfinite(height[i])) {
+            tan_out[i] = HF_NAN;
+            if (caster_out) caster_out[i] = -1;
+            continue;
+        }
+        for (j = 0; j < i; j++) {
+            double t;
+            if (!isfinite(height[j])) continue;
+            t = (height[j] - height[i]) / (distance[i] - distance[j]);
+            if (t >= best) { /* >=: the nearest of equal casters, as the hull's ties pop */
+                best = t;
+                caster = j;
+            }
+        }
+        tan_out[i] = best;
+        if (caster_out) caster_out[i] = caster;
+    }
+    return HFVIS_OK;
+}
+
+/* ========================================================================================== */
+/* 7. The sweep driver                                                                        */
+/* ========================================================================================== */
+
+/* Scratch for all the sweeps of one call, carved out of a single allocation (one block per
+ * call, freed before return). The base lattice of a direction group is sampled once; its four
+ * quarter turns psi + m pi/2 visit the same nodes (spec §3.6) and are traversed as
+ *   m = 0: rows, increasing i      m = 1: columns, increasing j
+ *   m = 2: rows, decreasing i      m = 3: columns, decreasing j
+ * (turning u by +pi/2 gives u' = v, v' = -u, so node (i', j') of psi + pi/2 is node (-j', i')). */
+typedef struct hf_sweep {
+    const hfvis_grid *g;
+    hfvis_border border;
+    int preroll;                /* cells of CLAMP/WRAP pre-roll before each line (spec §3.4) */
+    int want_normals;
+    int channels;               /* of the lattice accumulator */
+    hfvis_lattice L;            /* base lattice of the current group */
+    int rows, cols;
+    int *row_first, *row_last;  /* per row: in-domain column range (buffer indices) */
+    int *col_first, *col_last;  /* per column: in-domain row range */
+    double *h;                  /* rows*cols heights in cell units, NaN outside or at holes */
+    float *nrm;                 /* rows*cols*3 node normals (want_normals) */
+    double *lat;                /* rows*cols*channels output / accumulator */
+    double *lh, *lt;            /* one line: heights and tangents, pre-roll first */
+    int *stk;                   /* hull stack */
+    float *grid_nrm;            /* width*height*3 grid normals (want_normals) */
+    double *gacc;               /* width*height*channels grid accumulator (fused light) */
+    void *block;
+    const hfvis_allocator *alloc;
+} hf_sweep;
+
+static size_t hf_align_add(size_t *total, size_t count, size_t elem, int *ok)
+{
+    size_t bytes, off = (*total + 15u) & ~(size_t)15u;
+    if (off < *total || !hf_mul_size(count, elem, &bytes) || bytes > SIZE_MAX - off) {
+        *ok = 0;
+        return 0;
+    }
+    *total = off + bytes;
+    return off;
+}
+
+static int hf_opts_valid(const hfvis_sweep_options *o)
+{
+    return !o || (hf_border_valid(o->border) && o->border_cells >= 0 && isfinite(o->azimuth0_rad) &&
+                  o->direction_begin >= 0 && o->direction_end >= 0);
+}
+
+/* Resolved options (NULL or zero fields = defaults). */
+static hfvis_sweep_options hf_opts_resolve(const hfvis_grid *g, const hfvis_sweep_options *o)
+{
+    hfvis_sweep_options r = hfvis_sweep_options_default();
+    if (o) r = *o;
+    if (r.border == HFVIS_BORDER_DEFAULT) r.border = HFVIS_BORDER_OPEN;
+    if (r.border_cells == 0) r.border_cells = g->width > g->height ? g->width : g->height;
+    return r;
+}
+
+hfvis_sweep_options hfvis_sweep_options_default(void)
+{
+    hfvis_sweep_options o;
+    memset(&o, 0, sizeof o);
+    o.border = HFVIS_BORDER_OPEN;
+    return o;
+}
+
+/* Lattice extent bound over all directions: the grid diagonal plus slack. */
+static int hf_lattice_bound(const hfvis_grid *g)
+{
+    double d = sqrt((double)(g->width - 1) * (double)(g->width - 1) +
+                    (double)(g->height - 1) * (double)(g->height - 1));
+    return (int)d + 3;
+}
+
+static hfvis_status hf_sweep_alloc(hf_sweep *sw, const hfvis_grid *g, const hfvis_sweep_options *o,
+                                   int want_normals, int channels, int want_gacc)
+{
+    size_t total = 0, nodes, gridn, off_rf, off_rl, off_cf, off_cl, off_h, off_n = 0, off_lat,
+           off_lh, off_lt, off_stk, off_gn = 0, off_ga = 0, linelen;
+    int ok = 1, D = hf_lattice_bound(g);
+    unsigned char *b;
+    memset(sw, 0, sizeof *sw);
+    sw->g = g;
+    sw->border = o->border;
+    sw->preroll = o->border == HFVIS_BORDER_OPEN ? 0 : o->border_cells;
+    sw->want_normals = want_normals;
+    sw->channels = channels;
+    sw->alloc = o->alloc;
+    if ((double)D * (double)D > 2147483647.0 || (double)D + (double)sw->preroll > 2147483647.0)
+        return HFVIS_ERR_LIMIT;
+    nodes = (size_t)D * (size_t)D;
+    gridn = hf_grid_count(g);
+    linelen = (size_t)D + (size_t)sw->preroll;
+    off_rf = hf_align_add(&total, (size_t)D, sizeof(int), &ok);
+    off_rl = hf_align_add(&total, (size_t)D, sizeof(int), &ok);
+    off_cf = hf_align_add(&total, (size_t)D, sizeof(int), &ok);
+    off_cl = hf_align_add(&total, (size_t)D, sizeof(int), &ok);
+    off_h = hf_align_add(&total, nodes, sizeof(double), &ok);
+    if (want_normals) off_n = hf_align_add(&total, nodes, 3 * sizeof(float), &ok);
+    off_lat = hf_align_add(&total, nodes, (size_t)channels * sizeof(double), &ok);
+    off_lh = hf_align_add(&total, linelen, sizeof(double), &ok);
+    off_lt = hf_align_add(&total, linelen, sizeof(double), &ok);
+    off_stk = hf_align_add(&total, linelen, sizeof(int), &ok);
+    if (want_normals) off_gn = hf_align_add(&total, gridn, 3 * sizeof(float), &ok);
+    if (want_gacc) off_ga = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
+    if (!ok) return HFVIS_ERR_LIMIT;
+    b = (unsigned char *)hf_alloc(o->alloc, total);
+    if (!b) return HFVIS_ERR_OUT_OF_MEMORY;
+    sw->block = b;
+    sw->row_first = (int *)(void *)(b + off_rf);
+    sw->row_last = (int *)(void *)(b + off_rl);
+    sw->col_first = (int *)(void *)(b + off_cf);
+    sw->col_last = (int *)(void *)(b + off_cl);
+    sw->h = (double *)(void *)(b + off_h);
+    sw->nrm = want_normals ? (float *)(void *)(b + off_n) : NULL;
+    sw->lat = (double *)(void *)(b + off_lat);
+    sw->lh = (double *)(void *)(b + off_lh);
+    sw->lt = (double *)(void *)(b + off_lt);
+    sw->stk = (int *)(void *)(b + off_stk);
+    sw->grid_nrm = want_normals ? (float *)(void *)(b + off_gn) : NULL;
+    sw->gacc = want_gacc ? (double *)(void *)(b + off_ga) : NULL;
+    if (want_normals) {
+        int x, y;
+        for (y = 0; y < g->height; y++)
+            for (x = 0; x < g->width; x++) {
+                double n[3];
+                float *p = sw->grid_nrm + ((size_t)y * (size_t)g->width + (size_t)x) * 3;
+                hf_normal_at(g, x, y, n);
+                p[0] = (float)n[0];
+                p[1] = (float)n[1];
+                p[2] = (float)n[2];
+            }
+    }
+    if (want_gacc) memset(sw->gacc, 0, gridn * (size_t)channels * sizeof(double));
+    return HFVIS_OK;
+}
+
+static void hf_sweep_free(hf_sweep *sw) { hf_free(sw->alloc, sw->block); }
+
+/* Bilinear sample of the grid normals at an in-domain position, renormalised ([P1] §7:
+ * "normals are bilinearly filtered"). NaN if a tap with non-zero weight is a hole. */
+static void hf_normal_bilerp(const hf_sweep *sw, double x, double y, float out[3])
+{
+    const hfvis_grid *g = sw->g;
+    double fx = 0.0, fy = 0.0, acc[3] = {0.0, 0.0, 0.0}, len;
+    int x0 = 0, y0 = 0, dx, dy, c;
+    if (g->width > 1) {
+        double f = floor(x);
+        x0 = f >= (double)(g->width - 2) ? g->width - 2 : (int)f;
+        fx = x - (double)x0;
+    }
+    if (g->height > 1) {
+        double f = floor(y);
+        y0 = f >= (double)(g->height - 2) ? g->height - 2 : (int)f;
+        fy = y - (double)y0;
+    }
+    for (dy = 0; dy < 2; dy++)
+        for (dx = 0; dx < 2; dx++) {
+            double w = (dx ? fx : 1.0 - fx) * (dy ? fy : 1.0 - fy);
+            const float *p;
+            if (w == 0.0) continue;
+            p = sw->grid_nrm + ((size_t)(y0 + dy) * (size_t)g->width + (size_t)(x0 + dx)) * 3;
+            for (c = 0; c < 3; c++) acc[c] += w * (double)p[c];
+        }
+    len = sqrt(acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2]);
+    for (c = 0; c < 3; c++) out[c] = (float)(acc[c] / len);
+}
+
+/* Height (world units) at any position under the border rule: CLAMP clamps to the grid,
+ * WRAP treats the field as periodic with period width x height (spec §3.4). */
+static double hf_sample_border(const hfvis_grid *g, hfvis_border border, double x, double y)
+{
+    if (border == HFVIS_BORDER_WRAP) {
+        double W = (double)g->width, H = (double)g->height, fx, fy, r0, r1;
+        int x0, y0, x1, y1;
+        const float *z = g->z;
+        ptrdiff_t s = g->stride;
+        x = x - W * floor(x / W);
+        y = y - H * floor(y / H);
+        x0 = (int)floor(x);
+        y0 = (int)floor(y);
+        if (x0 >= g->width) x0 = g->width - 1;
+        if (y0 >= g->height) y0 = g->height - 1;
+        fx = x - (double)x0;
+        fy = y - (double)y0;
+        x1 = x0 + 1 == g->width ? 0 : x0 + 1;
+        y1 = y0 + 1 == g->height ? 0 : y0 + 1;
+        r0 = fx == 0.0 ? (double)z[y0 * s + x0]
+                       : (double)z[y0 * s + x0] * (1.0 - fx) + (double)z[y0 * s + x1] * fx;
+        if (fy == 0.0) return r0;
+        r1 = fx == 0.0 ? (double)z[y1 * s + x0]
+                       : (double)z[y1 * s + x0] * (1.0 - fx) + (double)z[y1 * s + x1] * fx;
+        return r0 * (1.0 - fy) + r1 * fy;
+    }
+    return hf_bilerp(g->z, g->stride, g->width, g->height,
+                     hf_clampd(x, 0.0, (double)(g->width - 1)),
+                     hf_clampd(y, 0.0, (double)(g->height - 1)));
+}
+
+/* Set up the base lattice of sweep vector u for the current group: line ranges per row and
+ * column, and the heights (cell units) at every in-domain node. */
+static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
+{
+    const hfvis_grid *g = sw->g;
+    hfvis_lattice *L = &sw->L;
+    size_t nodes;
+    int j, i, c;
+    double inv_cs = 1.0 / g->cell_size;
+    hf_lattice_from_u(L, g->width, g->height, ux, uy); /* within the bound, cannot fail */
+    sw->rows = L->j_max - L->j_min + 1;
+    sw->cols = L->i_max - L->i_min + 1;
+    HFVIS_ASSERT(sw->rows <= hf_lattice_bound(g) && sw->cols <= hf_lattice_bound(g));
+    nodes = (size_t)sw->rows * (size_t)sw->cols;
+    for (c = 0; c < sw->cols; c++) {
+        sw->col_first[c] = INT_MAX;
+        sw->col_last[c] = -1;
+    }
+    for (j = 0; j < sw->rows; j++) {
+        int first, last;
+        double *hr = sw->h + (size_t)j * (size_t)sw->cols;
+        for (i = 0; i < sw->cols; i++) hr[i] = HF_NAN;
+        if (!hfvis_lattice_line(L, j + L->j_min, &first, &last)) {
+            sw->row_first[j] = 1;
+            sw->row_last[j] = 0;
+            continue;
+        }
+        first -= L->i_min;
+        last -= L->i_min;
+        sw->row_first[j] = first;
+        sw->row_last[j] = last;
+        for (i = first; i <= last; i++) {
+            double x, y;
+            hf_node_pos(L, i + L->i_min, j + L->j_min, &x, &y);
+            x = hf_clampd(x, 0.0, (double)(g->width - 1));
+            y = hf_clampd(y, 0.0, (double)(g->height - 1));
+            hr[i] = hf_bilerp(g->z, g->stride, g->width, g->height, x, y) * inv_cs;
+            if (sw->want_normals) hf_normal_bilerp(sw, x, y, sw->nrm + ((size_t)j * (size_t)sw->cols + (size_t)i) * 3);
+            if (j < sw->col_first[i]) sw->col_first[i] = j;
+            if (j > sw->col_last[i]) sw->col_last[i] = j;
+        }
+    }
+    (void)nodes;
+}
+
+/* The traversal of orientation m (see hf_sweep): line number `line` (a row for even m, a
+ * column for odd m). Returns the node count n, the first node's buffer index and the index step;
+ * and the lattice coordinates (i, j) of the first node with the lattice step (di, dj) per node. */
+static int hf_line_span(const hf_sweep *sw, int m, int line, ptrdiff_t *node0, ptrdiff_t *step,
+                        int *i0, int *j0, int *di, int *dj)
+{
+    int first, last;
+    if ((m & 1) == 0) {
+        first = sw->row_first[line];
+        last = sw->row_last[line];
+        if (first > last) return 0;
+        *dj = 0;
+        *j0 = line;
+        if (m == 0) { *i0 = first; *di = 1; *step = 1; }
+        else { *i0 = last; *di = -1; *step = -1; }
+        *node0 = (ptrdiff_t)line * sw->cols + *i0;
+    } else {
+        first = sw->col_first[line];
+        last = sw->col_last[line];
+        if (first > last) return 0;
+        *di = 0;
+        *i0 = line;
+        if (m == 1) { *j0 = first; *dj = 1; *step = sw->cols; }
+        else { *j0 = last; *dj = -1; *step = -(ptrdiff_t)sw->cols; }
+        *node0 = (ptrdiff_t)*j0 * sw->cols + line;
+    }
+    return last - first + 1;
+}
+
+/* The hull stack of spec §4.2 on unit-spaced samples h[0..n-1] (distance = index, cell units),
+ * tangents into t. Same arithmetic as hfvis_line_horizons with distance[i] = i. */
+static void hf_hull_unit(const double *h, int n, double *t, int *stk)
+{
+    int i, top = 0;
+    for (i = 0; i < n; i++) {
+        double hi = h[i];
+        if (isnan(hi)) {
+            t[i] = HF_NAN;
+            continue;
+        }
+        while (top >= 2) {
+            int a = stk[top - 1], b = stk[top - 2];
+            if ((h[b] - hi) * (double)(i - a) >= (h[a] - hi) * (double)(i - b)) top--;
+            else break;
+        }
+        t[i] = top ? (h[stk[top - 1]] - hi) / (double)(i - stk[top - 1]) : -HF_INF;
+        stk[top++] = i;
+    }
+}
+
+/* Oracle twin of hf_hull_unit: the brute-force maximum (spec §6 item 2). */
+static void hf_brute_unit(const double *h, int n, double *t)
+{
+    int i, j;
+    for (i = 0; i < n; i++) {
+        double best = -HF_INF;
+        if (isnan(h[i])) {
+            t[i] = HF_NAN;
+            continue;
+        }
+        for (j = 0; j < i; j++) {
+            double s;
+            if (isnan(h[j])) continue;
+            s = (h[j] - h[i]) / (double)(i - j);
+            if (s > best) best = s;
+        }
+        t[i] = best;
+    }
+}
+
+/* Per-line consumer: receives the tangents t[0..n-1] of the in-domain nodes of one line of
+ * orientation m, starting at buffer index node0 with index step `step`. */
+typedef void (*hf_line_fn)(hf_sweep *sw, void *ctx, int m, ptrdiff_t node0, ptrdiff_t step,
+                           int n, const double *t);
+
+/* Run orientation m of the current group: copy each line (with its pre-roll) out of the
+ * sampled lattice, find the horizons, hand them to fn. brute = 1 uses the oracle. */
+static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, void *ctx)
+{
+    int nlines = (m & 1) ? sw->cols : sw->rows, line;
+    const hfvis_lattice *L = &sw->L;
+    int R = sw->preroll;
+    for (line = 0; line < nlines; line++) {
+        ptrdiff_t node0, step, p;
+        int i0, j0, di, dj, n, s, r;
+        n = hf_line_span(sw, m, line, &node0, &step, &i0, &j0, &di, &dj);
+        if (n == 0) continue;
+        /* Pre-roll (spec §3.4): R lattice nodes before the first in-domain node, sampled with
+         * the border rule; they occlude but receive nothing. */
+        for (r = 0; r < R; r++) {
+            double x, y, z;
+            int back = R - r;
+            hf_node_pos(L, i0 - back * di + L->i_min, j0 - back * dj + L->j_min, &x, &y);
+            z = hf_sample_border(sw->g, sw->border, x, y);
+            sw->lh[r] = z / sw->g->cell_size;
+        }
+        for (s = 0, p = node0; s < n; s++, p += step) sw->lh[R + s] = sw->h[p];
+        if (brute) hf_brute_unit(sw->lh, R + n, sw->lt);
+        else hf_hull_unit(sw->lh, R + n, sw->lt, sw->stk);
+        fn(sw, ctx, m, node0, step, n, sw->lt + R);
+    }
+}
+
+/* Look direction of orientation m of the current group: l = -u_m, u_0 = u, u_1 = v,
+ * u_2 = -u, u_3 = -v (exact sign/swap operations). */
+static void hf_look_dir(const hf_sweep *sw, int m, double *lx, double *ly)
+{
+    const hfvis_lattice *L = &sw->L;
+    switch (m & 3) {
+    case 0: *lx = -L->ux; *ly = -L->uy; break;
+    case 1: *lx = -L->vx; *ly = -L->vy; break;
+    case 2: *lx = L->ux; *ly = L->uy; break;
+    default: *lx = L->vx; *ly = L->vy; break;
+    }
+}
+
+/* Direction k of K -> the sweep vector of its group's base lattice and its quarter turn m
+ * (spec §3.6: with K % 4 == 0, psi_{k + m K/4} is psi_k turned by m quarter turns). */
+static void hf_direction_base(int K, int k, double azimuth0, double *ux, double *uy, int *m)
+{
+    int base = k;
+    *m = 0;
+    if (K % 4 == 0) {
+        base = k % (K / 4);
+        *m = k / (K / 4);
+    }
+    hf_sweep_vector(azimuth0 + 2.0 * HF_PI * (double)base / (double)K, ux, uy);
+}
+
+/* Gather (spec §3.3): the value at grid point (x, y) from a lattice buffer, bilinear over the
+ * four surrounding nodes using only finite ones, renormalised; if none is finite, the nearest
+ * finite node within two cells; else NaN. Exact for axis directions (integer coordinates). */
+static void hf_gather_point(const hf_sweep *sw, const double *buf, int ch, int x, int y, double *out)
+{
+    const hfvis_lattice *L = &sw->L;
+    double a = (double)x * L->ux + (double)y * L->uy, b = (double)x * L->vx + (double)y * L->vy;
+    double fa = floor(a), fb = floor(b), wa = a - fa, wb = b - fb, wsum = 0.0;
+    int ia = (int)fa - L->i_min, jb = (int)fb - L->j_min, dx, dy, c;
+    for (c = 0; c < ch; c++) out[c] = 0.0;
+    for (dy = 0; dy < 2; dy++)
+        for (dx = 0; dx < 2; dx++) {
+            double w = (dx ? wa : 1.0 - wa) * (dy ? wb : 1.0 - wb);
+            int i = ia + dx, j = jb + dy;
+            const double *p;
+            if (w == 0.0 || i < 0 || j < 0 || i >= sw->cols || j >= sw->rows) continue;
+            p = buf + ((size_t)j * (size_t)sw->cols + (size_t)i) * (size_t)ch;
+            if (!isfinite(p[0])) continue;
+            for (c = 0; c < ch; c++) out[c] += w * p[c];
+            wsum += w;
+        }
+    if (wsum > 0.0) {
+        if (wsum != 1.0)
+            for (c = 0; c < ch; c++) out[c] /= wsum;
+        return;
+    }
+    {
+        double best = DBL_MAX;
+        const double *bp = NULL;
+        for (dy = -1; dy <= 2; dy++)
+            for (dx = -1; dx <= 2; dx++) {
+                int i = ia + dx, j = jb + dy;
+                double ex = (double)dx - wa, ey = (double)dy - wb, d2 = ex * ex + ey * ey;
+                const double *p;
+                if (i < 0 || j < 0 || i >= sw->cols || j >= sw->rows) continue;
+                p = buf + ((size_t)j * (size_t)sw->cols + (size_t)i) * (size_t)ch;
+                if (isfinite(p[0]) && d2 < best) {
+                    best = d2;
+                    bp = p;
+                }
+            }
+        for (c = 0; c < ch; c++) out[c] = bp ? bp[c] : HF_NAN;
+    }
+}
+
+static int hf_is_hole(const hfvis_grid *g, int x, int y)
+{
+    return !isfinite(g->z[(ptrdiff_t)y * g->stride + x]);
+}
+
+/* Gather one scalar lattice buffer into a float plane (holes NaN). */
+static void hf_gather_plane(const hf_sweep *sw, const double *buf, float *out, ptrdiff_t out_stride)
+{
+    const hfvis_grid *g = sw->g;
+    int x, y;
+    for (y = 0; y < g->height; y++)
+        for (x = 0; x < g->width; x++) {
+            double v;
+            if (hf_is_hole(g, x, y)) v = HF_NAN;
+            else hf_gather_point(sw, buf, 1, x, y, &v);
+            out[(ptrdiff_t)y * out_stride + x] = (float)v;
+        }
+}
+
+/* Gather the lattice accumulator into the grid accumulator. */
+static void hf_gather_accumulate(hf_sweep *sw)
+{
+    const hfvis_grid *g = sw->g;
+    int x, y, c, ch = sw->channels;
+    double v[4];
+    for (y = 0; y < g->height; y++)
+        for (x = 0; x < g->width; x++) {
+            double *acc = sw->gacc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)ch;
+            if (hf_is_hole(g, x, y)) continue;
+            hf_gather_point(sw, sw->lat, ch, x, y, v);
+            for (c = 0; c < ch; c++) acc[c] += v[c];
+        }
+}
+
+static void hf_lattice_fill(hf_sweep *sw, double value)
+{
+    size_t i, n = (size_t)sw->rows * (size_t)sw->cols * (size_t)sw->channels;
+    for (i = 0; i < n; i++) sw->lat[i] = value;
+}
+
+/* ========================================================================================== */
+/* 8. Horizon outputs and the ray-march oracles                                               */
+/* ========================================================================================== */
+
+static double hf_tan_to_elevation(double t)
+{
+    if (isnan(t)) return HF_NAN;
+    if (t == -HF_INF) return -HF_HALF_PI;
+    return atan(t);
+}
+
+/* Consumer: elevation angle at each node of the line. */
+static void hf_store_elevation(hf_sweep *sw, void *ctx, int m, ptrdiff_t node0, ptrdiff_t step,
+                               int n, const double *t)
+{
+    int s;
+    (void)ctx;
+    (void)m;
+    for (s = 0; s < n; s++, node0 += step) sw->lat[node0] = hf_tan_to_elevation(t[s]);
+}
+
+static hfvis_status hf_check_common(const hfvis_grid *grid, const hfvis_sweep_options *opts)
+{
+    if (!hf_grid_valid(grid) || !hf_opts_valid(opts)) return HFVIS_ERR_INVALID_ARGUMENT;
+    return HFVIS_OK;
+}
+
+static hfvis_status hf_horizon_lattice_impl(const hfvis_grid *grid, double azimuth_rad,
+                                            const hfvis_sweep_options *opts, float *out, int brute)
+{
+    hfvis_sweep_options o;
+    hf_sweep sw;
+    hfvis_status s;
+    double ux, uy;
+    size_t i, n;
+    if (hf_check_common(grid, opts) != HFVIS_OK || !out || !isfinite(azimuth_rad))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    o = hf_opts_resolve(grid, opts);
+    if ((s = hf_sweep_alloc(&sw, grid, &o, 0, 1, 0)) != HFVIS_OK) return s;
+    hf_sweep_vector(azimuth_rad, &ux, &uy);
+    hf_sweep_group(&sw, ux, uy);
+    hf_lattice_fill(&sw, HF_NAN);
+    hf_sweep_orientation(&sw, 0, brute, hf_store_elevation, NULL);
+    n = (size_t)sw.rows * (size_t)sw.cols;
+    for (i = 0; i < n; i++) out[i] = (float)sw.lat[i];
+    hf_sweep_free(&sw);
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_horizon_lattice(const hfvis_grid *grid, double azimuth_rad,
+                                   const hfvis_sweep_options *opts, float *out)
+{
+    return hf_horizon_lattice_impl(grid, azimuth_rad, opts, out, 0);
+}
+
+hfvis_status hfvis_horizon_lattice_naive(const hfvis_grid *grid, double azimuth_rad,
+                                         const hfvis_sweep_options *opts, float *out)
+{
+    return hf_horizon_lattice_impl(grid, azimuth_rad, opts, out, 1);
+}
+
+static void hf_progress(const hfvis_sweep_options *o, int done, int total)
+{
+    if (o->progress) o->progress(o->progress_user, done, total);
+}
+
+hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, int k,
+                                     const hfvis_sweep_options *opts, float *out,
+                                     ptrdiff_t out_stride)
+{
+    hfvis_sweep_options o;
+    hf_sweep sw;
+    hfvis_status s;
+    double ux, uy;
+    int m;
+    if (hf_check_common(grid, opts) != HFVIS_OK || !out || K < 1 || k < 0 || k >= K ||
+        out_stride < grid->width)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    o = hf_opts_resolve(grid, opts);
+    if ((s = hf_sweep_alloc(&sw, grid, &o, 0, 1, 0)) != HFVIS_OK) return s;
+    hf_direction_base(K, k, o.azimuth0_rad, &ux, &uy, &m);
+    hf_sweep_group(&sw, ux, uy);
+    hf_lattice_fill(&sw, HF_NAN);
+    hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL);
+    hf_gather_plane(&sw, sw.lat, out, out_stride);
+    hf_sweep_free(&sw);
+    hf_progress(&o, 1, 1);
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
+                               float *out)
+{
+    hfvis_sweep_options o;
+    hf_sweep sw;
+    hfvis_status s;
+    size_t plane = 0, total;
+    int groups, per, gidx, m, done = 0;
+    if (hf_check_common(grid, opts) != HFVIS_OK || !out || K < 1) return HFVIS_ERR_INVALID_ARGUMENT;
+    plane = hf_grid_count(grid);
+    if (!hf_mul_size(plane, (size_t)K, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
+    o = hf_opts_resolve(grid, opts);
+    if ((s = hf_sweep_alloc(&sw, grid, &o, 0, 1, 0)) != HFVIS_OK) return s;
+    per = K % 4 == 0 ? 4 : 1;
+    groups = K / per;
+    for (gidx = 0; gidx < groups; gidx++) {
+        double ux, uy;
+        int m0;
+        hf_direction_base(K, gidx, o.azimuth0_rad, &ux, &uy, &m0);
+        hf_sweep_group(&sw, ux, uy);
+        for (m = 0; m < per; m++) {
+            int k = gidx + m * groups;
+            hf_lattice_fill(&sw, HF_NAN);
+            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL);
+            hf_gather_plane(&sw, sw.lat, out + (size_t)k * plane, grid->width);
+            hf_progress(&o, ++done, K);
+        }
+    }
+    hf_sweep_free(&sw);
+    return HFVIS_OK;
+}
+
+static int hf_march_valid(const hfvis_march_options *m)
+{
+    return !m || (isfinite(m->step_cells) && m->step_cells >= 0.0 &&
+                  isfinite(m->max_distance_cells) && m->max_distance_cells >= 0.0);
+}
+
+/* The surface an oracle marches over: a grid (with its border rule) or an analytic function. */
+typedef struct hf_surface {
+    const hfvis_grid *g;       /* or NULL for fn */
+    hfvis_height_fn fn;
+    void *user;
+    int width, height;
+    double cell_size;
+    hfvis_border border;
+    double reach;              /* how far beyond the grid the march continues (cells) */
+} hf_surface;
+
+static double hf_surface_height(const hf_surface *S, double x, double y)
+{
+    if (S->fn) return S->fn(S->user, x, y);
+    if (x >= 0.0 && y >= 0.0 && x <= (double)(S->width - 1) && y <= (double)(S->height - 1))
+        return hf_bilerp(S->g->z, S->g->stride, S->width, S->height, x, y);
+    return hf_sample_border(S->g, S->border, x, y);
+}
+
+/* Per-receiver march (spec §6 item 1; P2's "naive method"): samples at p + s*step*l,
+ * s = 1, 2, ..., while inside the grid (plus the border reach), keeping the largest slope. */
+static double hf_march_tan(const hf_surface *S, double px, double py, double h0, double lx,
+                           double ly, double step, double max_dist)
+{
+    double best = -HF_INF, xmin = -S->reach - HF_LATTICE_EPS, ymin = xmin;
+    double xmax = (double)(S->width - 1) + S->reach + HF_LATTICE_EPS;
+    double ymax = (double)(S->height - 1) + S->reach + HF_LATTICE_EPS;
+    double inv = 1.0 / S->cell_size;
+    long s;
+    for (s = 1;; s++) {
+        double d = (double)s * step, x = px + d * lx, y = py + d * ly, h, t;
+        if (max_dist > 0.0 && d > max_dist + HF_LATTICE_EPS) break;
+        if (x < xmin || y < ymin || x > xmax || y > ymax) break;
+        x = x < 0.0 && x > -HF_LATTICE_EPS ? 0.0 : x;
+        y = y < 0.0 && y > -HF_LATTICE_EPS ? 0.0 : y;
+        h = hf_surface_height(S, x, y);
+        if (!isfinite(h)) continue;
+        t = (h - h0) * inv / d;
+        if (t > best) best = t;
+    }
+    return best;
+}
+
+static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0,
+                                     const hfvis_march_options *march, const float *points,
+                                     size_t count, float *out)
+{
+    double step = march && march->step_cells > 0.0 ? march->step_cells : 1.0;
+    double maxd = march ? march->max_distance_cells : 0.0;
+    size_t i;
+    int k;
+    for (i = 0; i < count; i++) {
+        double px = (double)points[2 * i], py = (double)points[2 * i + 1], h0;
+        h0 = isfinite(px) && isfinite(py) ? hf_surface_height(S, px, py) : HF_NAN;
+        for (k = 0; k < K; k++) {
+            double ux, uy, t;
+            if (!isfinite(h0)) {
+                out[i * (size_t)K + (size_t)k] = HF_NAN;
+                continue;
+            }
+            hf_sweep_vector(azimuth0 + 2.0 * HF_PI * (double)k / (double)K, &ux, &uy);
+            t = hf_march_tan(S, px, py, h0, -ux, -uy, step, maxd);
+            out[i * (size_t)K + (size_t)k] = (float)hf_tan_to_elevation(t);
+        }
+    }
+    return HFVIS_OK;
+}
+
+static int hf_points_valid(const float *points, size_t count, int K, const float *out)
+{
+    return (count == 0 || (points && out)) && K >= 1 && count <= SIZE_MAX / (size_t)K;
+}
+
+hfvis_status hfvis_horizon_reference(const hfvis_grid *grid, int K,
+                                     const hfvis_sweep_options *opts,
+                                     const hfvis_march_options *march, const float *points,
+                                     size_t count, float *out)
+{
+    hfvis_sweep_options o;
+    hf_surface S;
+    if (hf_check_common(grid, opts) != HFVIS_OK || !hf_march_valid(march) ||
+        !hf_points_valid(points, count, K, out))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    o = hf_opts_resolve(grid, opts);
+    memset(&S, 0, sizeof S);
+    S.g = grid;
+    S.width = grid->width;
+    S.height = grid->height;
+    S.cell_size = grid->cell_size;
+    S.border = o.border;
+    S.reach = o.border == HFVIS_BORDER_OPEN ? 0.0 : (double)o.border_cells;
+    return hf_reference_run(&S, K, o.azimuth0_rad, march, points, count, out);
+}
+
+hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user, int width, int height,
+                                        double cell_size, int K, const hfvis_sweep_options *opts,
+                                        const hfvis_march_options *march, const float *points,
+                                        size_t count, float *out)
+{
+    hf_surface S;
+    if (!fn || width < 1 || height < 1 || !isfinite(cell_size) || cell_size <= 0.0 ||
+        !hf_opts_valid(opts) || !hf_march_valid(march) || !hf_points_valid(points, count, K, out) ||
+        (opts && opts->border != HFVIS_BORDER_DEFAULT && opts->border != HFVIS_BORDER_OPEN))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    memset(&S, 0, sizeof S);
+    S.fn = fn;
+    S.user = user;
+    S.width = width;
+    S.height = height;
+    S.cell_size = cell_size;
+    S.border = HFVIS_BORDER_OPEN;
+    return hf_reference_run(&S, K, opts ? opts->azimuth0_rad : 0.0, march, points, count, out);
+}
+
+/* ========================================================================================== */
+/* 9. Light: uniform sky, sky-view factor, sun visibility                                     */
+/* ========================================================================================== */
+
+/* [P1] Eq. 5 re-derived (spec §5.3): the phi-integral of the cosine term over the sector
+ * [psi_k - pi/K, psi_k + pi/K] is exact (2 sin(pi/K)); the b_k term integrates to zero. */
+double hfvis_sector_weight(int K, double nz, double a, double theta)
+{
+    if (K < 1) return HF_NAN;
+    return nz / (double)K * sin(theta) * sin(theta) +
+           sin(HF_PI / (double)K) / HF_PI * a * (theta - 0.5 * sin(2.0 * theta));
+}
+
+/* S_k from the horizon tangent t, in slope space (spec §5.2): the tangent-plane clamp
+ * theta_k = min(theta_h, pi/2 + atan2(a, Nz)) is t' = max(t, -a/Nz) (Nz > 0 for height
+ * fields), then sin^2 theta = 1/(1+t'^2), sin 2theta = 2t'/(1+t'^2), theta = pi/2 - atan t'. */
+static double hf_sky_term(double t, double nz, double a, double inv_k, double lobe)
+{
+    double tc = -a / nz, q, theta;
+    if (t > tc) tc = t;
+    q = 1.0 / (1.0 + tc * tc);
+    theta = HF_HALF_PI - atan(tc);
+    return nz * inv_k * q + lobe * a * (theta - tc * q);
+}
+
+/* The common head of every fused consumer's context. */
+typedef struct hf_fused {
+    int K, k;
+    double lx, ly;          /* look direction of direction k */
+} hf_fused;
+
+static hfvis_status hf_direction_range(const hfvis_sweep_options *o, int K, int *begin, int *end)
+{
+    if (o->direction_begin == 0 && o->direction_end == 0) {
+        *begin = 0;
+        *end = K;
+        return HFVIS_OK;
+    }
+    if (o->direction_begin >= o->direction_end || o->direction_end > K) return HFVIS_ERR_INVALID_ARGUMENT;
+    *begin = o->direction_begin;
+    *end = o->direction_end;
+    return HFVIS_OK;
+}
+
+/* The fused pipeline of [P1] §7 ("lighting computed in lattice space ... fused"): for each
+ * group, sample the lattice once, run the quarter turns in [begin, end), accumulate the
+ * consumer's per-node term in the lattice accumulator, gather it once into sw->gacc.
+ * On HFVIS_OK the caller reads sw->gacc and calls hf_sweep_free. */
+static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
+                                 const hfvis_sweep_options *o, int channels, int want_normals,
+                                 hf_line_fn fn, hf_fused *ctx)
+{
+    hfvis_status s;
+    int begin, end, per, groups, gidx, m, done = 0;
+    if ((s = hf_direction_range(o, K, &begin, &end)) != HFVIS_OK) return s;
+    if ((s = hf_sweep_alloc(sw, grid, o, want_normals, channels, 1)) != HFVIS_OK) return s;
+    per = K % 4 == 0 ? 4 : 1;
+    groups = K / per;
+    for (gidx = 0; gidx < groups; gidx++) {
+        double ux, uy;
+        int m0, any = 0;
+        size_t i, n;
+        for (m = 0; m < per; m++) {
+            int k = gidx + m * groups;
+            any |= k >= begin && k < end;
+        }
+        if (!any) continue;
+        hf_direction_base(K, gidx, o->azimuth0_rad, &ux, &uy, &m0);
+        hf_sweep_group(sw, ux, uy);
+        n = (size_t)sw->rows * (size_t)sw->cols;
+        for (i = 0; i < n; i++) {
+            int c;
+            for (c = 0; c < channels; c++) sw->lat[i * (size_t)channels + (size_t)c] = isnan(sw->h[i]) ? HF_NAN : 0.0;
+        }
+        for (m = 0; m < per; m++) {
+            int k = gidx + m * groups;
+            if (k < begin || k >= end) continue;
+            ctx->K = K;
+            ctx->k = k;
+            hf_look_dir(sw, m, &ctx->lx, &ctx->ly);
+            hf_sweep_orientation(sw, m, 0, fn, ctx);
+            hf_progress(o, ++done, end - begin);
+        }
+        hf_gather_accumulate(sw);
+    }
+    return HFVIS_OK;
+}
+
+/* Write the grid accumulator times scale to out (holes NaN). */
+static void hf_fused_output(const hf_sweep *sw, double scale, double offset, float *out,
+                            ptrdiff_t out_stride, int channels)
+{
+    const hfvis_grid *g = sw->g;
+    int x, y, c;
+    for (y = 0; y < g->height; y++)
+        for (x = 0; x < g->width; x++) {
+            const double *a = sw->gacc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)channels;
+            float *o = out + ((ptrdiff_t)y * out_stride + x) * channels;
+            int hole = hf_is_hole(g, x, y);
+            for (c = 0; c < channels; c++) o[c] = (float)(hole ? HF_NAN : offset + scale * a[c]);
+        }
+}
+
+typedef struct hf_sky_ctx {
+    hf_fused f;
+    double inv_k, lobe;
+} hf_sky_ctx;
+
+static void hf_sky_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdiff_t step, int n,
+                        const double *t)
+{
+    const hf_sky_ctx *c = (const hf_sky_ctx *)vctx;
+    int s;
+    (void)m;
+    for (s = 0; s < n; s++, node0 += step) {
+        const float *nr = sw->nrm + node0 * 3;
+        double a = (double)nr[0] * c->f.lx + (double)nr[1] * c->f.ly;
+        if (isnan(t[s])) continue;
+        sw->lat[node0] += hf_sky_term(t[s], (double)nr[2], a, c->inv_k, c->lobe);
+    }
+}
+
+static int hf_light_args_valid(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
+                               const void *out, ptrdiff_t out_stride)
+{
+    return hf_check_common(grid, opts) == HFVIS_OK && out && K >= 1 && out_stride >= grid->width;
+}
+
+hfvis_status hfvis_sky_light(const hfvis_grid *grid, int K, float sky, float albedo,
+                             const hfvis_sweep_options *opts, float *out, ptrdiff_t out_stride)
+{
+    hfvis_sweep_options o;
+    hf_sweep sw;
+    hf_sky_ctx ctx;
+    hfvis_status s;
+    if (!hf_light_args_valid(grid, K, opts, out, out_stride) || !isfinite(sky) || !isfinite(albedo))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    o = hf_opts_resolve(grid, opts);
+    memset(&ctx, 0, sizeof ctx);
+    ctx.inv_k = 1.0 / (double)K;
+    ctx.lobe = sin(HF_PI / (double)K) / HF_PI;
+    if ((s = hf_fused_run(&sw, grid, K, &o, 1, 1, hf_sky_line, &ctx.f)) != HFVIS_OK) return s;
+    hf_fused_output(&sw, (double)sky * (double)albedo, 0.0, out, out_stride, 1);
+    hf_sweep_free(&sw);
+    return HFVIS_OK;
+}
+
+static int hf_map_args_valid(const hfvis_grid *grid, int K, const float *map, const void *out,
+                             ptrdiff_t out_stride)
+{
+    size_t total;
+    return hf_grid_valid(grid) && K >= 1 && map && out && out_stride >= grid->width &&
+           hf_mul_size(hf_grid_count(grid), (size_t)K, &total);
+}
+
+/* tan of a stored elevation; -pi/2 (or below) means no occluder. */
+static double hf_elevation_to_tan(double alpha)
+{
+    if (isnan(alpha)) return HF_NAN;
+    if (alpha <= -HF_HALF_PI) return -HF_INF;
+    if (alpha >= HF_HALF_PI) return HF_INF;
+    return tan(alpha);
+}
+
+hfvis_status hfvis_sky_light_from_map(const hfvis_grid *grid, int K, double map_azimuth0_rad,
+                                      const float *map, float sky, float albedo,
+                                      const hfvis_allocator *alloc, float *out,
+                                      ptrdiff_t out_stride)
+{
+    double *dirs, inv_k, lobe;
+    size_t plane;
+    int x, y, k;
+    if (!hf_map_args_valid(grid, K, map, out, out_stride) || !isfinite(map_azimuth0_rad) ||
+        !isfinite(sky) || !isfinite(albedo))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    dirs = (double *)hf_alloc_array(alloc, (size_t)K, 2 * sizeof(double));
+    if (!dirs) return HFVIS_ERR_OUT_OF_MEMORY;
+    for (k = 0; k < K; k++) {
+        double psi = map_azimuth0_rad + 2.0 * HF_PI * (double)k / (double)K;
+        dirs[2 * k] = cos(psi);
+        dirs[2 * k + 1] = sin(psi);
+    }
+    plane = hf_grid_count(grid);
+    inv_k = 1.0 / (double)K;
+    lobe = sin(HF_PI / (double)K) / HF_PI;
+    for (y = 0; y < grid->height; y++)
+        for (x = 0; x < grid->width; x++) {
+            size_t idx = (size_t)y * (size_t)grid->width + (size_t)x;
+            double n[3], sum = 0.0;
+            hf_normal_at(grid, x, y, n);
+            for (k = 0; k < K && !isnan(sum); k++) {
+                double t = hf_elevation_to_tan((double)map[(size_t)k * plane + idx]);
+                sum += hf_sky_term(t, n[2], n[0] * dirs[2 * k] + n[1] * dirs[2 * k + 1], inv_k, lobe);
+            }
+            out[(ptrdiff_t)y * out_stride + x] = (float)((double)sky * (double)albedo * sum);
+        }
+    hf_free(alloc, dirs);
+    return HFVIS_OK;
+}
+
+/* Sky-view factor term per direction: sin(max(alpha, 0)) = t/sqrt(1+t^2) for t > 0. */
+static double hf_svf_term(double t) { return t > 0.0 ? t / sqrt(1.0 + t * t) : 0.0; }
+
+static void hf_svf_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdiff_t step, int n,
+                        const double *t)
+{
+    int s;
+    (void)vctx;
+    (void)m;
+    for (s = 0; s < n; s++, node0 += step)
+        if (!isnan(t[s])) sw->lat[node0] += hf_svf_term(t[s]);
+}
+
+hfvis_status hfvis_sky_view_factor(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
+                                   float *out, ptrdiff_t out_stride)
+{
+    hfvis_sweep_options o;
+    hf_sweep sw;
+    hf_fused ctx;
+    hfvis_status s;
+    int begin, end;
+    if (!hf_light_args_valid(grid, K, opts, out, out_stride)) return HFVIS_ERR_INVALID_ARGUMENT;
+    o = hf_opts_resolve(grid, opts);
+    memset(&ctx, 0, sizeof ctx);
+    if ((s = hf_direction_range(&o, K, &begin, &end)) != HFVIS_OK) return s;
+    if ((s = hf_fused_run(&sw, grid, K, &o, 1, 0, hf_svf_line, &ctx)) != HFVIS_OK) return s;
+    /* A partial range returns its share of 1 - (1/K) sum, so partial results add up to SVF. */
+    hf_fused_output(&sw, -1.0 / (double)K, (double)(end - begin) / (double)K, out, out_stride, 1);
+    hf_sweep_free(&sw);
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_sky_view_factor_from_map(const hfvis_grid *grid, int K, const float *map,
+                                            float *out, ptrdiff_t out_stride)
+{
+    size_t plane;
+    int x, y, k;
+    if (!hf_map_args_valid(grid, K, map, out, out_stride)) return HFVIS_ERR_INVALID_ARGUMENT;
+    plane = hf_grid_count(grid);
+    for (y = 0; y < grid->height; y++)
+        for (x = 0; x < grid->width; x++) {
+            size_t idx = (size_t)y * (size_t)grid->width + (size_t)x;
+            double sum = 0.0;
+            if (hf_is_hole(grid, x, y)) sum = HF_NAN;
+            for (k = 0; k < K; k++) {
+                double a = (double)map[(size_t)k * plane + idx];
+                sum += a > 0.0 ? sin(a) : (isnan(a) ? HF_NAN : 0.0);
+            }
+            out[(ptrdiff_t)y * out_stride + x] = (float)(1.0 - sum / (double)K);
+        }
+    return HFVIS_OK;
+}
+
+/* Visible fraction of a sun disc of angular radius r centred at elevation e above a horizon
+ * line at elevation alpha: the circular-segment area, 1 - (acos d - d sqrt(1 - d^2))/pi,
+ * d = (e - alpha)/r clamped to [-1, 1] (the horizon is taken straight across the small disc). */
+static double hf_sun_fraction(double e, double r, double alpha)
+{
+    double d;
+    if (isnan(alpha)) return HF_NAN;
+    if (r <= 0.0) return e > alpha ? 1.0 : 0.0;
+    d = hf_clampd((e - alpha) / r, -1.0, 1.0);
+    return 1.0 - (acos(d) - d * sqrt(1.0 - d * d)) / HF_PI;
+}
+
+hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad,
+                                  double sun_elevation_rad, double sun_radius_rad,
+                                  const hfvis_sweep_options *opts, float *out, ptrdiff_t out_stride)
+{
+    hfvis_sweep_options o;
+    hf_sweep sw;
+    hfvis_status s;
+    double ux, uy;
+    int x, y;
+    if (hf_check_common(grid, opts) != HFVIS_OK || !out || out_stride < grid->width ||
+        !isfinite(sun_azimuth_rad) || !isfinite(sun_elevation_rad) || !isfinite(sun_radius_rad) ||
+        sun_radius_rad < 0.0 || sun_elevation_rad < -HF_HALF_PI || sun_elevation_rad > HF_HALF_PI)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    o = hf_opts_resolve(grid, opts);
+    if ((s = hf_sweep_alloc(&sw, grid, &o, 0, 1, 0)) != HFVIS_OK) return s;
+    hf_sweep_vector(sun_azimuth_rad, &ux, &uy);
+    hf_sweep_group(&sw, ux, uy);
+    hf_lattice_fill(&sw, HF_NAN);
+    hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL);
+    for (y = 0; y < grid->height; y++)
+        for (x = 0; x < grid->width; x++) {
+            double alpha;
+            if (hf_is_hole(grid, x, y)) alpha = HF_NAN;
+            else hf_gather_point(&sw, sw.lat, 1, x, y, &alpha);
+            out[(ptrdiff_t)y * out_stride + x] =
+                (float)hf_sun_fraction(sun_elevation_rad, sun_radius_rad, alpha);
+        }
+    hf_sweep_free(&sw);
+    hf_progress(&o, 1, 1);
+    return HFVIS_OK;
+}
+
+/* ENV-FRAGMENT */

@@ -1,0 +1,532 @@
+/* hfvis.h - height-field and screen-space visibility: the authoritative CPU reference.
+ * Version 0.1.0. MIT licence (see LICENSE).
+ *
+ * hfvis computes horizon maps, sky light, sun shadows and environment light on height fields
+ * with the line-sweep convex-hull algorithm of Timonen & Westerholm 2010 ([P1], "Scalable
+ * Height Field Self-Shadowing"), and ships a brute-force oracle beside every fast routine so a
+ * GPU port can be checked against hfvis, and hfvis against first principles.
+ *
+ * History
+ *   0.1.0  PGM/PFM codecs, analytic fields, sweep lattice, P1 hull horizons, uniform sky,
+ *          sky-view factor, sun visibility, environment light (prefix and L_p table), oracles.
+ *
+ * ------------------------------------------------------------------------------------------
+ * QUICK START
+ *
+ *     float *z; hfvis_image_info info;
+ *     if (hfvis_image_load("dem.pfm", NULL, &z, &info) != HFVIS_OK) return 1;
+ *     hfvis_grid g = { z, info.width, info.height, info.width, 30.0 };   // 30 m cells
+ *     float *svf = malloc(sizeof(float) * (size_t)info.width * (size_t)info.height);
+ *     hfvis_status s = hfvis_sky_view_factor(&g, 32, NULL, svf, info.width);
+ *     if (s != HFVIS_OK) fprintf(stderr, "%s\n", hfvis_status_string(s));
+ *     hfvis_pfm_save("svf.pfm", svf, info.width, info.height, 1, info.width);
+ *     hfvis_free(NULL, z); free(svf);
+ *
+ * ------------------------------------------------------------------------------------------
+ * CONVENTIONS (the whole API)
+ *
+ * Grids. A height field is hfvis_grid: sample (x, y) is z[y*stride + x], x = column (fastest),
+ *   y = row, stride counted in elements (stride >= width). Sample (x, y) lies at world position
+ *   (x*cell_size, y*cell_size, z): samples sit at integer grid positions, row 0 is the top of an
+ *   image and the north edge of a map. Heights and cell_size share one world unit. Between the
+ *   samples the surface is bilinear (the GPU implementations of [P1] sample it so).
+ * Angles are radians. Azimuth psi is measured in the grid plane from +x (increasing column,
+ *   east) toward +y (increasing row, south): psi = 0 east, pi/2 south. GIS compass bearings
+ *   (0 = north, clockwise) convert as psi = bearing - pi/2. With K directions,
+ *   psi_k = azimuth0 + 2*pi*k/K. "The horizon toward psi" is what a receiver sees when it looks
+ *   toward psi.
+ * Horizon values are elevation angles alpha in [-pi/2, pi/2] above the horizontal plane: the
+ *   largest elevation under which the receiver sees terrain toward psi. A receiver that sees no
+ *   terrain in that direction (open border) gets alpha = -pi/2. Internally the sweep keeps the
+ *   tangent t = tan(alpha) in double.
+ * Borders. HFVIS_BORDER_OPEN (default, as in the papers): nothing exists outside the grid.
+ *   HFVIS_BORDER_CLAMP: edge heights extend outward. HFVIS_BORDER_WRAP: the field is periodic
+ *   with period width x height (tileable fields).
+ * No-data. A non-finite height (NaN, +-Inf) marks a hole. A hole never occludes, receives no
+ *   value (output NaN) and a bilinear sample touching a hole with non-zero weight is a hole.
+ * Obscurance and light. Obscurance outputs lie in [0, 1] (0 = nothing blocks). Lighting outputs
+ *   are radiance with the Lambertian convention L_o = albedo/pi * Int L_i V (n.w) dw, so an
+ *   unoccluded flat receiver under a uniform sky of radiance c with albedo 1 returns c.
+ *   Sky-view factor (Zaksek et al. 2011, as RVT and GRASS r.skyview):
+ *   SVF = 1 - (1/K) sum_k sin(max(alpha_k, 0)).
+ * Numbers. Public arrays are float; hull tests, slopes and integrals are double, rounded to
+ *   float once at the output.
+ * Errors. Every fallible function returns hfvis_status (HFVIS_OK == 0) and writes results
+ *   through out-pointers. On any error the outputs are left untouched. The library never
+ *   prints, never exits, never aborts on input, and has no global mutable state: every
+ *   function is reentrant and may run concurrently on different outputs.
+ * Memory. The caller owns every output and sizes it with the documented formula or a *_size()
+ *   query. Scratch comes from the optional allocator in the options (NULL = malloc/free); each
+ *   function documents how many blocks it allocates. The library keeps no pointer after a call.
+ * Options. NULL and a zero-initialised options struct both mean the documented defaults; zero is
+ *   never a valid non-default value. hfvis_*_options_default() returns the defaults filled in.
+ *
+ * What is and is not guaranteed
+ *   - Same input and same binary: bit-identical output (build with -ffp-contract=off; FMA
+ *     contraction changes the last bits; never build with -ffast-math).
+ *   - Exact: the hull sweep equals the per-line brute force on the same lattice samples
+ *     (hfvis_horizon_lattice_naive) bit for bit; axis directions reproduce the grid exactly.
+ *   - Within tolerance: gathered (non-axis) directions against the per-receiver ray march
+ *     (bilinear resampling of the lattice, spec heightfield §3.3); libm differences across C
+ *     libraries (sin, cos, atan) at the 1e-15 relative level.
+ *   - Not guaranteed: agreement with GPU implementations that use fp16 heights or 8-bit angles
+ *     ([P1] §7); expect differences of about 1e-3 rad there.
+ */
+#ifndef HFVIS_H
+#define HFVIS_H
+
+#define HFVIS_VERSION_MAJOR 0
+#define HFVIS_VERSION_MINOR 1
+#define HFVIS_VERSION_PATCH 0
+#define HFVIS_VERSION (HFVIS_VERSION_MAJOR * 10000 + HFVIS_VERSION_MINOR * 100 + HFVIS_VERSION_PATCH)
+
+/* Configuration macros (all #ifndef-guarded):
+ *   HFVIS_API           decoration for every public function (default empty).
+ *   HFVIS_EXPERIMENTAL  reserved for functions whose signature may still change (default empty).
+ *   HFVIS_NO_STDIO      define when compiling the .c files to remove the file wrappers
+ *                       (hfvis_*_load / hfvis_*_save); the in-memory codecs remain.
+ *   HFVIS_ENABLE_ASSERTS / HFVIS_ASSERT(x)  internal invariant checks in the .c files only. */
+#ifndef HFVIS_API
+#define HFVIS_API
+#endif
+#ifndef HFVIS_EXPERIMENTAL
+#define HFVIS_EXPERIMENTAL
+#endif
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ========================================================================================== */
+/* Status codes                                                                               */
+/* ========================================================================================== */
+
+typedef enum hfvis_status {
+    HFVIS_OK = 0,                    /* success */
+    HFVIS_ERR_INVALID_ARGUMENT = 1,  /* NULL where not allowed, bad size, non-finite parameter,
+                                        unknown enum value; outputs untouched */
+    HFVIS_ERR_OUT_OF_MEMORY = 2,     /* an allocation failed; nothing leaked, outputs untouched */
+    HFVIS_ERR_FORMAT = 3,            /* malformed file or buffer contents */
+    HFVIS_ERR_LIMIT = 4,             /* a size exceeds a documented limit */
+    HFVIS_ERR_BUFFER_TOO_SMALL = 5,  /* the caller's output buffer is too small */
+    HFVIS_ERR_IO = 6                 /* a file could not be opened, read or written */
+} hfvis_status;
+
+/* Name of a status code ("HFVIS_OK", ...) followed by a short explanation; never NULL. */
+HFVIS_API const char *hfvis_status_string(hfvis_status status);
+
+/* ========================================================================================== */
+/* Allocator and shared types                                                                 */
+/* ========================================================================================== */
+
+/* Per-call allocator. alloc returns NULL on failure; free accepts NULL. */
+typedef struct hfvis_allocator {
+    void *(*alloc)(void *user, size_t size);
+    void (*free)(void *user, void *ptr);
+    void *user;
+} hfvis_allocator;
+
+/* Release memory that a hfvis function allocated for the caller (hfvis_image_load) with the
+ * same allocator (NULL = free). ptr may be NULL. */
+HFVIS_API void hfvis_free(const hfvis_allocator *alloc, void *ptr);
+
+/* A height field. See CONVENTIONS. */
+typedef struct hfvis_grid {
+    const float *z;        /* heights, z[y*stride + x]; non-finite = hole */
+    int width;             /* samples per row, >= 1 */
+    int height;            /* rows, >= 1 */
+    ptrdiff_t stride;      /* elements between rows, >= width */
+    double cell_size;      /* world distance between adjacent samples, > 0, same unit as z */
+} hfvis_grid;
+
+/* What lies outside the grid. 0 is the default (OPEN). */
+typedef enum hfvis_border {
+    HFVIS_BORDER_DEFAULT = 0,
+    HFVIS_BORDER_OPEN = 1,   /* nothing outside (the papers) */
+    HFVIS_BORDER_CLAMP = 2,  /* edge heights extend outward */
+    HFVIS_BORDER_WRAP = 3    /* periodic field, period width x height */
+} hfvis_border;
+
+/* Progress callback: called after each unit of work (a direction) with done in 1..total. */
+typedef void (*hfvis_progress_fn)(void *user, int done, int total);
+
+/* An analytic height surface for oracles: height at grid position (x, y) (grid units, may lie
+ * outside [0, width-1] x [0, height-1]), in world units. Return NaN for a hole. */
+typedef double (*hfvis_height_fn)(void *user, double x, double y);
+
+/* ========================================================================================== */
+/* hfvis.c - codecs                                                                           */
+/* ========================================================================================== */
+
+/* Largest width or height a decoder accepts, and the largest width*height*channels. */
+#define HFVIS_IMAGE_MAX_DIM 1048576
+#define HFVIS_IMAGE_MAX_VALUES ((size_t)1 << 28)
+
+typedef enum hfvis_image_format {
+    HFVIS_FORMAT_UNKNOWN = 0,
+    HFVIS_FORMAT_PGM = 1,      /* P2 (ASCII) or P5 (binary), maxval 1..65535 */
+    HFVIS_FORMAT_PFM = 2       /* Pf (grey) or PF (RGB), either byte order */
+} hfvis_image_format;
+
+typedef struct hfvis_image_info {
+    hfvis_image_format format;
+    int width, height;
+    int channels;              /* 1, or 3 for PF */
+    int maxval;                /* PGM only: 1..65535 */
+    int big_endian;            /* PFM only: 1 if the file's scale was positive */
+} hfvis_image_info;
+
+/* Read the header of a PGM or PFM held in memory (format detected from the magic number).
+ * Returns HFVIS_OK, HFVIS_ERR_INVALID_ARGUMENT if data or info is NULL, HFVIS_ERR_FORMAT on a
+ * bad magic, non-numeric or truncated header or truncated pixel data, HFVIS_ERR_LIMIT if a
+ * dimension exceeds HFVIS_IMAGE_MAX_DIM or the value count HFVIS_IMAGE_MAX_VALUES. */
+HFVIS_API hfvis_status hfvis_image_info_read(const void *data, size_t size, hfvis_image_info *info);
+
+/* Decode a PGM or PFM from memory into floats, row 0 = top, channels interleaved.
+ * PGM values are returned as the integers 0..maxval (no scaling); PFM values as stored (the
+ * file's scale magnitude is not applied, as netpbm). PFM rows are stored bottom-to-top on disk
+ * and flipped here. out must hold width*height*channels floats (out_count); info may be NULL.
+ * Returns the errors of hfvis_image_info_read, or HFVIS_ERR_BUFFER_TOO_SMALL. */
+HFVIS_API hfvis_status hfvis_image_decode(const void *data, size_t size, float *out,
+                                          size_t out_count, hfvis_image_info *info);
+
+/* Bytes needed to encode a width x height image: PFM (channels 1 or 3) or 16-bit binary PGM.
+ * Returns 0 for invalid sizes. */
+HFVIS_API size_t hfvis_pfm_encode_size(int width, int height, int channels);
+HFVIS_API size_t hfvis_pgm_encode_size(int width, int height, int maxval);
+
+/* Encode a little-endian PFM (scale -1). pixels[y*stride*channels ... ] with stride in pixels.
+ * out must hold hfvis_pfm_encode_size() bytes (out_capacity); *written receives the count.
+ * Returns HFVIS_ERR_INVALID_ARGUMENT or HFVIS_ERR_BUFFER_TOO_SMALL on error. */
+HFVIS_API hfvis_status hfvis_pfm_encode(const float *pixels, int width, int height, int channels,
+                                        ptrdiff_t stride, void *out, size_t out_capacity,
+                                        size_t *written);
+
+/* Encode a binary PGM (P5; 8-bit if maxval <= 255, else 16-bit big-endian). Each value v maps
+ * to round((v - lo) / (hi - lo) * maxval), clamped to [0, maxval]; non-finite values map to 0.
+ * Requires lo < hi, both finite, and 1 <= maxval <= 65535. */
+HFVIS_API hfvis_status hfvis_pgm_encode(const float *pixels, int width, int height,
+                                        ptrdiff_t stride, float lo, float hi, int maxval,
+                                        void *out, size_t out_capacity, size_t *written);
+
+/* File wrappers (absent with HFVIS_NO_STDIO). load reads PGM or PFM, allocates *pixels with
+ * alloc (NULL = malloc; release with hfvis_free) and fills info. save writes to a temporary
+ * file beside path and renames it, so path is either complete or untouched.
+ * Returns the decoder's errors, HFVIS_ERR_IO if the file cannot be read or written, or
+ * HFVIS_ERR_OUT_OF_MEMORY. */
+HFVIS_API hfvis_status hfvis_image_load(const char *path, const hfvis_allocator *alloc,
+                                        float **pixels, hfvis_image_info *info);
+HFVIS_API hfvis_status hfvis_pfm_save(const char *path, const float *pixels, int width,
+                                      int height, int channels, ptrdiff_t stride);
+HFVIS_API hfvis_status hfvis_pgm_save(const char *path, const float *pixels, int width,
+                                      int height, ptrdiff_t stride, float lo, float hi,
+                                      int maxval);
+
+/* ========================================================================================== */
+/* hfvis.c - analytic test fields (spec heightfield §12)                                      */
+/* ========================================================================================== */
+
+typedef enum hfvis_field_kind {
+    HFVIS_FIELD_PLANE = 1,        /* z = height                                                */
+    HFVIS_FIELD_TILTED_PLANE = 2, /* z = height + slope_x*(x-x0) + slope_y*(y-y0)              */
+    HFVIS_FIELD_V_VALLEY = 3,     /* z = height + slope*|x-x0|   (valley along y)               */
+    HFVIS_FIELD_L1_PIT = 4,       /* z = height + slope*(|x-x0| + |y-y0|)  (pyramid pit)        */
+    HFVIS_FIELD_LINF_PIT = 5,     /* z = height + slope*max(|x-x0|, |y-y0|)                     */
+    HFVIS_FIELD_CONE = 6,         /* z = height + slope*r,  r = |(x,y)-(x0,y0)|  (cone pit)     */
+    HFVIS_FIELD_HEMISPHERE = 7,   /* z = height + amplitude*sqrt(1 - (r/radius)^2) for r < radius,
+                                     else height; amplitude = radius*cell_size is a true
+                                     hemisphere (spec §12.8)                                   */
+    HFVIS_FIELD_STEP = 8,         /* z = height for x < x0, height + amplitude for x >= x0 (a
+                                     wall facing -x; sampled on the grid the rise is the bilinear
+                                     ramp over [x0-1, x0])                                      */
+    HFVIS_FIELD_SINUSOID = 9,     /* z = height + amplitude*sin(2pi x/wavelength)*sin(2pi y/wavelength) */
+    HFVIS_FIELD_FBM = 10          /* seeded fractional Brownian motion: octaves of value noise,
+                                     base wavelength 'wavelength' cells, gain 'persistence',
+                                     lacunarity 2, scaled by amplitude                          */
+} hfvis_field_kind;
+
+/* Parameters of an analytic field. Positions, radius and wavelength are in grid units (cells);
+ * heights, slopes (rise per cell) and amplitude are in world units (per cell). */
+typedef struct hfvis_field {
+    hfvis_field_kind kind;
+    double x0, y0;          /* centre / kink / wall position */
+    double height;          /* base height */
+    double slope;           /* V_VALLEY, L1_PIT, LINF_PIT, CONE */
+    double slope_x, slope_y;/* TILTED_PLANE */
+    double radius;          /* HEMISPHERE (> 0) */
+    double amplitude;       /* HEMISPHERE, STEP, SINUSOID, FBM */
+    double wavelength;      /* SINUSOID, FBM (> 0) */
+    double persistence;     /* FBM: amplitude ratio between octaves, 0 = 0.5 */
+    int octaves;            /* FBM: 0 = 8 */
+    uint64_t seed;          /* FBM */
+} hfvis_field;
+
+/* Height of the field at grid position (x, y), in world units; NaN for an invalid field.
+ * Matches hfvis_height_fn, so it can drive the analytic oracles with user = (void *)field. */
+HFVIS_API double hfvis_field_height(void *field, double x, double y);
+
+/* Sample the field at the integer grid positions into out[y*stride + x].
+ * Returns HFVIS_ERR_INVALID_ARGUMENT for NULL, sizes < 1, stride < width, an unknown kind or
+ * non-finite parameters. Cost O(width*height*octaves). */
+HFVIS_API hfvis_status hfvis_field_generate(const hfvis_field *field, int width, int height,
+                                           ptrdiff_t stride, float *out);
+
+/* ========================================================================================== */
+/* hfvis.c - sampling, normals and the sweep lattice ([P1] §4, §7; spec heightfield §3, §5.1) */
+/* ========================================================================================== */
+
+/* Bilinear height at grid position (x, y), clamped to the grid, in world units; NaN if a tap
+ * with non-zero weight is a hole or the grid is invalid. Pure helper. */
+HFVIS_API double hfvis_grid_sample(const hfvis_grid *grid, double x, double y);
+
+/* Unit normals, 3 floats per sample (x, y, z with z up), out[(y*width + x)*3 + c].
+ * [P1] §7: the sum of the unnormalised normals of the four quads around a sample, which equals
+ * the central difference N ~ (h(x-1)-h(x+1), h(y-1)-h(y+1), 2*cell_size)/norm; one-sided at the
+ * border and beside holes; NaN at holes. out must hold 3*width*height floats.
+ * Returns HFVIS_OK or HFVIS_ERR_INVALID_ARGUMENT. Cost O(width*height). */
+HFVIS_API hfvis_status hfvis_normals_compute(const hfvis_grid *grid, float *out);
+
+/* The parallel-line lattice of one look direction (spec heightfield §3.2). Sweep direction
+ * u = -(cos psi, sin psi), line offset v = (-u.y, u.x); node (i, j) lies at grid position
+ * i*u + j*v; line j is traversed in increasing i. Lattice buffers are row-major with
+ * rows j - j_min and columns i - i_min: rows = j_max-j_min+1, cols = i_max-i_min+1. */
+typedef struct hfvis_lattice {
+    double azimuth_rad;         /* look direction psi */
+    double ux, uy, vx, vy;      /* unit vectors, snapped to exact 0/+-1 on the axes */
+    int i_min, i_max, j_min, j_max;
+    int width, height;          /* of the grid */
+} hfvis_lattice;
+
+/* Set up the lattice of look direction azimuth_rad over a width x height grid.
+ * Returns HFVIS_ERR_INVALID_ARGUMENT for NULL, sizes < 1 or a non-finite azimuth, and
+ * HFVIS_ERR_LIMIT if the lattice would exceed 2^31 nodes. */
+HFVIS_API hfvis_status hfvis_lattice_init(hfvis_lattice *lattice, int width, int height,
+                                          double azimuth_rad);
+
+/* Number of nodes of the lattice buffer, rows*cols. */
+HFVIS_API size_t hfvis_lattice_size(const hfvis_lattice *lattice);
+
+/* The in-domain node range [*i_first, *i_last] of line j; returns the count (0 if empty). */
+HFVIS_API int hfvis_lattice_line(const hfvis_lattice *lattice, int j, int *i_first, int *i_last);
+
+/* ========================================================================================== */
+/* hfvis.c - P1 horizons ([P1] §5 Alg. 1, App. A.1; spec heightfield §4)                      */
+/* ========================================================================================== */
+
+/* Options shared by every sweep (horizons, sky light, sky-view factor, shadows, environment). */
+typedef struct hfvis_sweep_options {
+    hfvis_border border;            /* default HFVIS_BORDER_OPEN */
+    int border_cells;               /* CLAMP/WRAP: lines start this many cells outside the grid;
+                                       0 = max(width, height) */
+    double azimuth0_rad;            /* psi_0 of direction 0 */
+    const hfvis_allocator *alloc;   /* scratch; NULL = malloc/free */
+    int direction_begin;            /* fused light/SVF only: process directions [begin, end) of */
+    int direction_end;              /* the K and return that partial sum; 0, 0 = all K */
+    hfvis_progress_fn progress;     /* optional, called once per direction */
+    void *progress_user;
+} hfvis_sweep_options;
+
+HFVIS_API hfvis_sweep_options hfvis_sweep_options_default(void);
+
+/* The P1 hull stack along one line (Alg. 1 with the A.1 erratum fixed; ties pop).
+ * For samples (distance[i], height[i]) with strictly increasing distance, writes
+ * tan_out[i] = max_{j<i} (height[j]-height[i])/(distance[i]-distance[j]) (-INFINITY for i = 0)
+ * and caster_out[i] = the maximising j (-1 for i = 0). Non-finite heights are holes: they
+ * never occlude and get tan NaN, caster -1. caster_out may be NULL. stack must hold n ints.
+ * Returns HFVIS_ERR_INVALID_ARGUMENT on NULL, n < 0 or non-increasing distances.
+ * Cost: at most 2n comparisons. Exactly equal to hfvis_line_horizons_naive on generic input. */
+HFVIS_API hfvis_status hfvis_line_horizons(const double *distance, const double *height, int n,
+                                           double *tan_out, int *caster_out, int *stack);
+
+/* Oracle: the O(n^2) brute-force maximum of the same slopes. Same contract, no scratch. */
+HFVIS_API hfvis_status hfvis_line_horizons_naive(const double *distance, const double *height,
+                                                 int n, double *tan_out, int *caster_out);
+
+/* Raw lattice output of one direction, for GPU-port diffing: the horizon elevation angle at
+ * every lattice node of hfvis_lattice_init(width, height, azimuth_rad); NaN at nodes outside the
+ * grid and at holes. out must hold hfvis_lattice_size() floats.
+ * Allocates 2 blocks (line samples and stack). Cost O(width*height). */
+HFVIS_API hfvis_status hfvis_horizon_lattice(const hfvis_grid *grid, double azimuth_rad,
+                                             const hfvis_sweep_options *opts, float *out);
+
+/* Oracle for hfvis_horizon_lattice: every node scans all earlier samples of its line
+ * (spec heightfield §6 item 2). Bit-identical to the sweep. Cost O(width*height*N). */
+HFVIS_API hfvis_status hfvis_horizon_lattice_naive(const hfvis_grid *grid, double azimuth_rad,
+                                                   const hfvis_sweep_options *opts, float *out);
+
+/* Horizon elevation toward direction k of K (psi_k = azimuth0 + 2 pi k/K) at every grid point:
+ * the lattice gathered back with renormalised bilinear weights (spec heightfield §3.3; exact for
+ * axis directions). When K % 4 == 0, direction k is computed on the lattice of direction
+ * k mod K/4 turned by whole quarter turns (spec §3.6), exactly as hfvis_horizon_map does, so
+ * plane k of the map equals this output bit for bit; use it to split directions across threads
+ * or machines. out[y*out_stride + x], out_stride >= width. Cost O(width*height). */
+HFVIS_API hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, int k,
+                                               const hfvis_sweep_options *opts, float *out,
+                                               ptrdiff_t out_stride);
+
+/* The full horizon map: K planes, plane k = out[k*width*height + y*width + x], the elevation
+ * toward psi_k. out must hold K*width*height floats (check the product for overflow; it is
+ * large: K = 64 at 1024^2 is 256 MiB; prefer the fused lighting calls). When K % 4 == 0 the
+ * four directions psi, psi+pi/2, psi+pi, psi+3pi/2 share one sampled lattice (spec §3.6).
+ * Returns HFVIS_ERR_INVALID_ARGUMENT for K < 1. Cost O(K*width*height). */
+HFVIS_API hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K,
+                                         const hfvis_sweep_options *opts, float *out);
+
+/* Options of the per-receiver ray-march oracle. */
+typedef struct hfvis_march_options {
+    double step_cells;      /* march step along the ray in cells; 0 = 1 (the papers' naive
+                               method takes unit steps, spec heightfield §6 item 1) */
+    double max_distance_cells; /* stop after this distance; 0 = until the ray leaves the grid
+                               (or border_cells beyond it for CLAMP/WRAP) */
+} hfvis_march_options;
+
+/* Oracle: per-receiver bilinear ray march on the grid. For every receiver point (x_i, y_i)
+ * (grid units; points[2*i], points[2*i+1]) and each of the K directions, samples the surface at
+ * p + s*step*(cos psi_k, sin psi_k), s = 1, 2, ... and keeps the largest elevation.
+ * out[i*K + k] = elevation angle. Border as in opts. Use it for all grid points, or for a
+ * subset of receivers (the bench does). Cost O(count*K*N). No allocation. */
+HFVIS_API hfvis_status hfvis_horizon_reference(const hfvis_grid *grid, int K,
+                                               const hfvis_sweep_options *opts,
+                                               const hfvis_march_options *march,
+                                               const float *points, size_t count, float *out);
+
+/* Same oracle on an analytic surface (spec heightfield §12.5-12.8): heights come from
+ * fn(user, x, y) in world units, the domain is [0, width-1] x [0, height-1] in grid units and
+ * one cell is cell_size world units. Only HFVIS_BORDER_OPEN is meaningful here. */
+HFVIS_API hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user, int width,
+                                                  int height, double cell_size, int K,
+                                                  const hfvis_sweep_options *opts,
+                                                  const hfvis_march_options *march,
+                                                  const float *points, size_t count,
+                                                  float *out);
+
+/* ========================================================================================== */
+/* hfvis.c - P1 light ([P1] §6 Eq. 3-7; spec heightfield §5)                                  */
+/* ========================================================================================== */
+
+/* [P1] Eq. 5 per sector: S_k(theta) = (Nz/K) sin^2 theta + (sin(pi/K)/pi) a (theta - sin 2theta / 2),
+ * where a = Nx cos psi_k + Ny sin psi_k and theta the (tangent-clamped) horizon zenith angle.
+ * Pure helper; the uniform-sky radiance is c * sum_k S_k. */
+HFVIS_API double hfvis_sector_weight(int K, double nz, double a, double theta);
+
+/* Uniform sky, fused into the sweep ([P1] §6.1 Eq. 4-5 with the clamp correction of spec §5.2):
+ * out = albedo * sky * sum_k S_k(theta_k) at every grid point, computed in lattice space with
+ * bilinearly sampled normals and gathered (the paper's pipeline, [P1] §7). No horizon map is
+ * stored: memory O(width*height). NaN at holes. Allocates 5 blocks. Cost O(K*width*height). */
+HFVIS_API hfvis_status hfvis_sky_light(const hfvis_grid *grid, int K, float sky, float albedo,
+                                       const hfvis_sweep_options *opts, float *out,
+                                       ptrdiff_t out_stride);
+
+/* The same from a stored horizon map (hfvis_horizon_map layout), evaluated at grid points with
+ * grid normals. map_azimuth0_rad is the psi_0 the map was made with. Allocates 1 block. */
+HFVIS_API hfvis_status hfvis_sky_light_from_map(const hfvis_grid *grid, int K,
+                                                double map_azimuth0_rad, const float *map,
+                                                float sky, float albedo,
+                                                const hfvis_allocator *alloc, float *out,
+                                                ptrdiff_t out_stride);
+
+/* Sky-view factor SVF = 1 - (1/K) sum_k sin(max(alpha_k, 0)), fused into the sweep (the term is
+ * accumulated on the lattice and gathered), memory O(width*height). NaN at holes. */
+HFVIS_API hfvis_status hfvis_sky_view_factor(const hfvis_grid *grid, int K,
+                                             const hfvis_sweep_options *opts, float *out,
+                                             ptrdiff_t out_stride);
+
+/* Sky-view factor from a stored horizon map (K planes). */
+HFVIS_API hfvis_status hfvis_sky_view_factor_from_map(const hfvis_grid *grid, int K,
+                                                      const float *map, float *out,
+                                                      ptrdiff_t out_stride);
+
+/* Sun visibility in [0, 1] from one exact sweep toward the sun's azimuth (look direction
+ * sun_azimuth_rad, DESIGN convention) and its elevation. sun_radius_rad = 0 gives a hard shadow
+ * (1 if the sun centre is above the horizon, else 0); > 0 gives the visible fraction of a sun
+ * disc of that angular radius above the horizon line, 1 - (acos(d) - d sqrt(1-d^2))/pi with
+ * d = clamp((elevation - alpha)/radius, -1, 1). Self-shadowing by the receiver's own tangent
+ * plane is not included (multiply by max(n.l, 0) for lighting). NaN at holes.
+ * Allocates 3 blocks. Cost O(width*height). */
+HFVIS_API hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad,
+                                            double sun_elevation_rad, double sun_radius_rad,
+                                            const hfvis_sweep_options *opts, float *out,
+                                            ptrdiff_t out_stride);
+
+/* A lat-long environment ("PF map"): radiance[(t*n_phi + p)*channels + c]. Row t is the band
+ * theta in [t*pi/n_theta, (t+1)*pi/n_theta) measured from the zenith (+z), so row 0 is the
+ * zenith and the last row the nadir: the whole sphere, since horizons can lie below the
+ * horizontal ([P1] §6.2). Column p is the azimuth band phi in [2pi p/n_phi, 2pi (p+1)/n_phi),
+ * phi measured like psi (from +x toward +y). Radiance is constant within a texel. */
+typedef struct hfvis_env {
+    const float *radiance;
+    int n_theta, n_phi;      /* >= 1 */
+    int channels;            /* 1..4 */
+} hfvis_env;
+
+typedef enum hfvis_env_method {
+    HFVIS_ENV_DEFAULT = 0,
+    HFVIS_ENV_PREFIX = 1,    /* exact prefix integrals A_k, B_k, C_k (spec heightfield §5.4) */
+    HFVIS_ENV_LP_TABLE = 2   /* the paper's L_p table, [P1] Eq. 6-7, bilinear in (theta_n, theta_h) */
+} hfvis_env_method;
+
+typedef struct hfvis_env_options {
+    hfvis_env_method method;  /* default HFVIS_ENV_PREFIX */
+    int lp_normal_res;        /* L_p table theta_n samples, odd; 0 = 15 ([P1] §6.2: 16 is "safe") */
+    int lp_horizon_res;       /* L_p table theta_h samples; 0 = 256 ([P1]'s theta_N) */
+} hfvis_env_options;
+
+HFVIS_API hfvis_env_options hfvis_env_options_default(void);
+
+/* Floats of the per-direction environment tables for method and K (0 on invalid input). */
+HFVIS_API size_t hfvis_env_table_size(const hfvis_env *env, int K, const hfvis_env_options *eopts);
+
+/* Build the per-direction tables (prefix integrals or the L_p table) for directions psi_k =
+ * azimuth0_rad + 2 pi k / K. table must hold hfvis_env_table_size() floats. Cost: prefix
+ * O(K*n_theta*n_phi); L_p table O(K*lp_normal_res*lp_horizon_res*n_phi). */
+HFVIS_API hfvis_status hfvis_env_table_build(const hfvis_env *env, int K, double azimuth0_rad,
+                                             const hfvis_env_options *eopts, float *table);
+
+/* Environment light, fused into the sweep: out[(y*out_stride + x)*channels + c] =
+ * albedo/pi * sum_k [Nz A_k + a_k B_k + b_k C_k](theta_k) (prefix) or
+ * albedo * sum_k |N_p| L_p^k(theta_n, theta_h) ([P1] Eq. 6), in lattice space, gathered.
+ * out_stride in pixels. Allocates the tables and 5 lattice blocks. */
+HFVIS_API hfvis_status hfvis_env_light(const hfvis_grid *grid, int K, const hfvis_env *env,
+                                       float albedo, const hfvis_sweep_options *opts,
+                                       const hfvis_env_options *eopts, float *out,
+                                       ptrdiff_t out_stride);
+
+/* Environment light from a stored horizon map at grid points with grid normals. */
+HFVIS_API hfvis_status hfvis_env_light_from_map(const hfvis_grid *grid, int K,
+                                                double map_azimuth0_rad, const float *map,
+                                                const hfvis_env *env, float albedo,
+                                                const hfvis_env_options *eopts,
+                                                const hfvis_allocator *alloc, float *out,
+                                                ptrdiff_t out_stride);
+
+/* Options of the hemisphere-integration oracle. */
+typedef struct hfvis_hemisphere_options {
+    int azimuth_samples;      /* azimuths integrated (midpoint rule); 0 = 256 */
+    int zenith_samples;       /* zenith steps over [0, pi] (midpoint rule); 0 = 512 */
+} hfvis_hemisphere_options;
+
+/* Oracle for all light paths: at receiver points[2i], points[2i+1] (grid units), numerically
+ * integrates L_o = albedo/pi * Int L_i(w) V(w) max(n.w, 0) dw over the sphere, with V from the
+ * exact horizon of the per-receiver ray march (hfvis_horizon_reference with the march options)
+ * at every integration azimuth, and n the normal given in normals[3i..3i+2] (unit, z up).
+ * env NULL means a uniform sky of radiance 1 (one channel). out[i*channels + c].
+ * Cost O(count*(azimuth_samples*(N + zenith_samples))). No allocation. */
+HFVIS_API hfvis_status hfvis_light_reference(const hfvis_grid *grid, const hfvis_env *env,
+                                             float albedo, const hfvis_sweep_options *opts,
+                                             const hfvis_march_options *march,
+                                             const hfvis_hemisphere_options *hopts,
+                                             const float *points, const float *normals,
+                                             size_t count, float *out);
+
+/* ========================================================================================== */
+/* ssao.c - screen space (later issues)                                                       */
+/* voxel.c - meshes and volumes (later issues)                                                */
+/* ========================================================================================== */
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* HFVIS_H */

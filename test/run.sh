@@ -1,0 +1,33 @@
+#!/bin/sh
+# Runs every test program in $1/test, the examples (smoke tests, images into a scratch folder),
+# the C++ header compile and the symbol check; prints "tests: N passed, M failed" last.
+build=$1; cxx=${2:-c++}
+passed=0; failed=0
+scratch=$(mktemp -d 2>/dev/null || echo "$build/scratch"); mkdir -p "$scratch"
+for t in "$build"/test/test_*; do
+  [ -x "$t" ] || continue
+  echo "== $t"
+  "$t" > "$scratch/log" 2>&1; rc=$?
+  cat "$scratch/log"
+  line=$(grep '^RESULT ' "$scratch/log" | tail -n 1)
+  if [ -z "$line" ]; then failed=$((failed + 1)); echo "FAIL $t crashed or printed no RESULT (exit $rc)"; continue; fi
+  n=$(echo "$line" | sed 's/.*tests=\([0-9]*\).*/\1/'); f=$(echo "$line" | sed 's/.*failed=\([0-9]*\).*/\1/')
+  passed=$((passed + n - f)); failed=$((failed + f))
+  if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then failed=$((failed + 1)); echo "FAIL $t exit $rc"; fi
+done
+for e in "$build"/examples/*; do
+  [ -x "$e" ] || continue
+  if "$e" "$scratch" > "$scratch/log" 2>&1; then passed=$((passed + 1)); echo "ok   example $(basename "$e")"
+  else failed=$((failed + 1)); cat "$scratch/log"; echo "FAIL example $(basename "$e")"; fi
+done
+if [ -f test/cli_test.sh ] && [ -x "$build/hfvis" ]; then
+  if sh test/cli_test.sh "$build/hfvis" "$scratch" > "$scratch/log" 2>&1; then passed=$((passed + 1)); echo "ok   cli"
+  else failed=$((failed + 1)); cat "$scratch/log"; echo "FAIL cli"; fi
+fi
+if $cxx -std=c++11 -Wall -Wextra -Werror -pedantic -fsyntax-only -I. test/cxx_header.cpp; then
+  passed=$((passed + 1)); echo "ok   cxx header"; else failed=$((failed + 1)); echo "FAIL cxx header"; fi
+bad=$(nm -g --defined-only "$build/libhfvis.a" | awk 'NF==3 && $2 ~ /[TDBRC]/ {print $3}' | grep -v '^hfvis_')
+if [ -z "$bad" ]; then passed=$((passed + 1)); echo "ok   symbols"; else failed=$((failed + 1)); echo "FAIL symbols: $bad"; fi
+rm -rf "$scratch"
+echo "tests: $passed passed, $failed failed"
+[ "$failed" -eq 0 ]

@@ -1,0 +1,36 @@
+/* test.h - the whole test harness: CHECK macros, TEST registration, a summary line.
+ * Each test program defines tests with TEST(name) { ... } and lists them in main via RUN(name).
+ * The last line a program prints is "RESULT tests=N failed=M checks=C" (read by test/run.sh). */
+#ifndef HFVIS_TEST_H
+#define HFVIS_TEST_H
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static int test_checks, test_check_failures, test_failed_tests, test_run_tests;
+static int test_current_failed;
+static int test_update_golden;
+
+#define CHECK(cond) do { test_checks++; if (!(cond)) { test_check_failures++; test_current_failed = 1; \
+    fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond); } } while (0)
+#define CHECK_EQ_STATUS(got, want) do { int g_ = (int)(got), w_ = (int)(want); test_checks++; \
+    if (g_ != w_) { test_check_failures++; test_current_failed = 1; \
+    fprintf(stderr, "%s:%d: status %d (%s), want %d (%s)\n", __FILE__, __LINE__, g_, \
+            hfvis_status_string((hfvis_status)g_), w_, hfvis_status_string((hfvis_status)w_)); } } while (0)
+/* |got - want| <= abs_tol + rel_tol*|want|; NaN never passes unless both are NaN. */
+#define CHECK_NEAR(got, want, abs_tol, rel_tol) do { double g_ = (double)(got), w_ = (double)(want); \
+    test_checks++; if (!((isnan(g_) && isnan(w_)) || fabs(g_ - w_) <= (abs_tol) + (rel_tol) * fabs(w_))) { \
+    test_check_failures++; test_current_failed = 1; \
+    fprintf(stderr, "%s:%d: %s = %.17g, want %.17g (diff %.3g, tol %.3g + %.3g rel)\n", __FILE__, __LINE__, \
+            #got, g_, w_, g_ - w_, (double)(abs_tol), (double)(rel_tol)); } } while (0)
+
+#define TEST(name) static void test_##name(void)
+#define RUN(name) do { test_current_failed = 0; test_run_tests++; test_##name(); \
+    if (test_current_failed) { test_failed_tests++; fprintf(stderr, "FAIL %s\n", #name); } \
+    else printf("ok   %s\n", #name); fflush(stdout); } while (0)
+#define TEST_INIT(argc, argv) do { int a_; for (a_ = 1; a_ < (argc); a_++) \
+    if (strcmp((argv)[a_], "--update-golden") == 0) test_update_golden = 1; } while (0)
+#define TEST_DONE() (printf("DONE: %d checks, %d failed\nRESULT tests=%d failed=%d checks=%d\n", \
+    test_checks, test_check_failures, test_run_tests, test_failed_tests, test_checks), \
+    test_failed_tests ? 1 : 0)
+#endif
