@@ -899,25 +899,49 @@ static void hf_direction_base(int K, int k, double azimuth0, double *ux, double 
 
 /* Gather (spec §3.3): the value at grid point (x, y) from a lattice buffer, bilinear over the
  * four surrounding nodes using only finite ones, renormalised; if none is finite, the nearest
- * finite node within two cells; else NaN. Exact for axis directions (integer coordinates). */
-static void hf_gather_point(const hf_sweep *sw, const double *buf, int ch, int x, int y, double *out)
+ * finite node within two cells; else NaN. Exact for axis directions (integer coordinates).
+ * The weights are set up once per grid point and applied to every channel; all channels of a
+ * node share its finiteness (they are NaN exactly where the lattice height is). */
+typedef struct hf_gather {
+    ptrdiff_t node[4];      /* buffer node of each tap, -1 if unused (zero weight or outside) */
+    double w[4];
+    double wa, wb;
+    int ia, jb;
+} hf_gather;
+
+static void hf_gather_setup(const hf_sweep *sw, int x, int y, hf_gather *G)
 {
     const hfvis_lattice *L = &sw->L;
     double a = (double)x * L->ux + (double)y * L->uy, b = (double)x * L->vx + (double)y * L->vy;
-    double fa = floor(a), fb = floor(b), wa = a - fa, wb = b - fb, wsum = 0.0;
-    int ia = (int)fa - L->i_min, jb = (int)fb - L->j_min, dx, dy, c;
+    double fa = floor(a), fb = floor(b);
+    int q;
+    G->wa = a - fa;
+    G->wb = b - fb;
+    G->ia = (int)fa - L->i_min;
+    G->jb = (int)fb - L->j_min;
+    for (q = 0; q < 4; q++) {
+        int dx = q & 1, dy = q >> 1, i = G->ia + dx, j = G->jb + dy;
+        double w = (dx ? G->wa : 1.0 - G->wa) * (dy ? G->wb : 1.0 - G->wb);
+        G->w[q] = w;
+        G->node[q] = (w == 0.0 || i < 0 || j < 0 || i >= sw->cols || j >= sw->rows)
+                         ? -1 : (ptrdiff_t)j * sw->cols + i;
+    }
+}
+
+static void hf_gather_apply(const hf_sweep *sw, const double *buf, int ch, const hf_gather *G,
+                            double *out)
+{
+    double wsum = 0.0;
+    int q, c, dx, dy;
     for (c = 0; c < ch; c++) out[c] = 0.0;
-    for (dy = 0; dy < 2; dy++)
-        for (dx = 0; dx < 2; dx++) {
-            double w = (dx ? wa : 1.0 - wa) * (dy ? wb : 1.0 - wb);
-            int i = ia + dx, j = jb + dy;
-            const double *p;
-            if (w == 0.0 || i < 0 || j < 0 || i >= sw->cols || j >= sw->rows) continue;
-            p = buf + ((size_t)j * (size_t)sw->cols + (size_t)i) * (size_t)ch;
-            if (!isfinite(p[0])) continue;
-            for (c = 0; c < ch; c++) out[c] += w * p[c];
-            wsum += w;
-        }
+    for (q = 0; q < 4; q++) {
+        const double *p;
+        if (G->node[q] < 0) continue;
+        p = buf + G->node[q] * ch;
+        if (!isfinite(p[0])) continue;
+        for (c = 0; c < ch; c++) out[c] += G->w[q] * p[c];
+        wsum += G->w[q];
+    }
     if (wsum > 0.0) {
         if (wsum != 1.0)
             for (c = 0; c < ch; c++) out[c] /= wsum;
@@ -928,8 +952,8 @@ static void hf_gather_point(const hf_sweep *sw, const double *buf, int ch, int x
         const double *bp = NULL;
         for (dy = -1; dy <= 2; dy++)
             for (dx = -1; dx <= 2; dx++) {
-                int i = ia + dx, j = jb + dy;
-                double ex = (double)dx - wa, ey = (double)dy - wb, d2 = ex * ex + ey * ey;
+                int i = G->ia + dx, j = G->jb + dy;
+                double ex = (double)dx - G->wa, ey = (double)dy - G->wb, d2 = ex * ex + ey * ey;
                 const double *p;
                 if (i < 0 || j < 0 || i >= sw->cols || j >= sw->rows) continue;
                 p = buf + ((size_t)j * (size_t)sw->cols + (size_t)i) * (size_t)ch;
@@ -947,17 +971,25 @@ static int hf_is_hole(const hfvis_grid *g, int x, int y)
     return !isfinite(g->z[(ptrdiff_t)y * g->stride + x]);
 }
 
-/* Gather one scalar lattice buffer into a float plane (holes NaN). */
-static void hf_gather_plane(const hf_sweep *sw, const double *buf, float *out, ptrdiff_t out_stride)
+/* Gather the ch-channel lattice output into ch float planes (holes NaN): channel c goes to
+ * out + c*plane_step, row stride out_stride. */
+static void hf_gather_planes(const hf_sweep *sw, int ch, float *out, size_t plane_step,
+                             ptrdiff_t out_stride)
 {
     const hfvis_grid *g = sw->g;
-    int x, y;
+    int x, y, c;
+    double v[4];
+    hf_gather G;
     for (y = 0; y < g->height; y++)
         for (x = 0; x < g->width; x++) {
-            double v;
-            if (hf_is_hole(g, x, y)) v = HF_NAN;
-            else hf_gather_point(sw, buf, 1, x, y, &v);
-            out[(ptrdiff_t)y * out_stride + x] = (float)v;
+            ptrdiff_t o = (ptrdiff_t)y * out_stride + x;
+            if (hf_is_hole(g, x, y)) {
+                for (c = 0; c < ch; c++) out[(size_t)c * plane_step + (size_t)o] = (float)HF_NAN;
+                continue;
+            }
+            hf_gather_setup(sw, x, y, &G);
+            hf_gather_apply(sw, sw->lat, ch, &G, v);
+            for (c = 0; c < ch; c++) out[(size_t)c * plane_step + (size_t)o] = (float)v[c];
         }
 }
 
@@ -967,11 +999,13 @@ static void hf_gather_accumulate(hf_sweep *sw)
     const hfvis_grid *g = sw->g;
     int x, y, c, ch = sw->channels;
     double v[4];
+    hf_gather G;
     for (y = 0; y < g->height; y++)
         for (x = 0; x < g->width; x++) {
             double *acc = sw->gacc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)ch;
             if (hf_is_hole(g, x, y)) continue;
-            hf_gather_point(sw, sw->lat, ch, x, y, v);
+            hf_gather_setup(sw, x, y, &G);
+            hf_gather_apply(sw, sw->lat, ch, &G, v);
             for (c = 0; c < ch; c++) acc[c] += v[c];
         }
 }
@@ -993,14 +1027,15 @@ static double hf_tan_to_elevation(double t)
     return atan(t);
 }
 
-/* Consumer: elevation angle at each node of the line. */
+/* Consumer: elevation angle at each node of the line, into channel m of a 4-channel lattice
+ * (the four quarter turns of hfvis_horizon_map) or the only channel. */
 static void hf_store_elevation(hf_sweep *sw, void *ctx, int m, ptrdiff_t node0, ptrdiff_t step,
                                int n, const double *t)
 {
-    int s;
+    int s, ch = sw->channels;
+    double *lat = sw->lat + (ch == 1 ? 0 : m);
     (void)ctx;
-    (void)m;
-    for (s = 0; s < n; s++, node0 += step) sw->lat[node0] = hf_tan_to_elevation(t[s]);
+    for (s = 0; s < n; s++, node0 += step) lat[node0 * ch] = hf_tan_to_elevation(t[s]);
 }
 
 static hfvis_status hf_check_common(const hfvis_grid *grid, const hfvis_sweep_options *opts)
@@ -1066,7 +1101,7 @@ hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, int k,
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HF_NAN);
     hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL);
-    hf_gather_plane(&sw, sw.lat, out, out_stride);
+    hf_gather_planes(&sw, 1, out, 0, out_stride);
     hf_sweep_free(&sw);
     hf_progress(&o, 1, 1);
     return HFVIS_OK;
@@ -1084,21 +1119,21 @@ hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_
     plane = hf_grid_count(grid);
     if (!hf_mul_size(plane, (size_t)K, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
-    if ((s = hf_sweep_alloc(&sw, grid, &o, 0, 1, 0)) != HFVIS_OK) return s;
     per = K % 4 == 0 ? 4 : 1;
     groups = K / per;
+    if ((s = hf_sweep_alloc(&sw, grid, &o, 0, per, 0)) != HFVIS_OK) return s;
     for (gidx = 0; gidx < groups; gidx++) {
         double ux, uy;
         int m0;
         hf_direction_base(K, gidx, o.azimuth0_rad, &ux, &uy, &m0);
         hf_sweep_group(&sw, ux, uy);
+        hf_lattice_fill(&sw, HF_NAN);
         for (m = 0; m < per; m++) {
-            int k = gidx + m * groups;
-            hf_lattice_fill(&sw, HF_NAN);
             hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL);
-            hf_gather_plane(&sw, sw.lat, out + (size_t)k * plane, grid->width);
             hf_progress(&o, ++done, K);
         }
+        /* plane k = gidx + m*groups: channel m lands m*groups planes further on */
+        hf_gather_planes(&sw, per, out + (size_t)gidx * plane, (size_t)groups * plane, grid->width);
     }
     hf_sweep_free(&sw);
     return HFVIS_OK;
@@ -1511,8 +1546,12 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
     for (y = 0; y < grid->height; y++)
         for (x = 0; x < grid->width; x++) {
             double alpha;
+            hf_gather G;
             if (hf_is_hole(grid, x, y)) alpha = HF_NAN;
-            else hf_gather_point(&sw, sw.lat, 1, x, y, &alpha);
+            else {
+                hf_gather_setup(&sw, x, y, &G);
+                hf_gather_apply(&sw, sw.lat, 1, &G, &alpha);
+            }
             out[(ptrdiff_t)y * out_stride + x] =
                 (float)hf_sun_fraction(sun_elevation_rad, sun_radius_rad, alpha);
         }
