@@ -547,8 +547,8 @@ typedef struct hf_sweep {
     double *h;                  /* rows*cols heights in cell units, NaN outside or at holes */
     float *nrm;                 /* rows*cols*3 node normals (want_normals) */
     double *lat;                /* rows*cols*channels output / accumulator */
-    double *lh, *lt;            /* one line: heights and tangents, pre-roll first */
-    int *stk;                   /* hull stack */
+    double *lh, *lt;            /* one line: stack heights (or the oracle's copy), tangents */
+    double *sd;                 /* hull stack distances (heights in lh) */
     float *grid_nrm;            /* width*height*3 grid normals (want_normals) */
     double *gacc;               /* width*height*channels grid accumulator (fused light) */
     void *block;
@@ -626,7 +626,7 @@ static hfvis_status hf_sweep_alloc(hf_sweep *sw, const hfvis_grid *g, const hfvi
     off_lat = hf_align_add(&total, nodes, (size_t)channels * sizeof(double), &ok);
     off_lh = hf_align_add(&total, linelen, sizeof(double), &ok);
     off_lt = hf_align_add(&total, linelen, sizeof(double), &ok);
-    off_stk = hf_align_add(&total, linelen, sizeof(int), &ok);
+    off_stk = hf_align_add(&total, linelen, sizeof(double), &ok);
     if (want_normals) off_gn = hf_align_add(&total, gridn, 3 * sizeof(float), &ok);
     if (want_gacc) off_ga = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
     if (!ok) return HFVIS_ERR_LIMIT;
@@ -642,7 +642,7 @@ static hfvis_status hf_sweep_alloc(hf_sweep *sw, const hfvis_grid *g, const hfvi
     sw->lat = (double *)(void *)(b + off_lat);
     sw->lh = (double *)(void *)(b + off_lh);
     sw->lt = (double *)(void *)(b + off_lt);
-    sw->stk = (int *)(void *)(b + off_stk);
+    sw->sd = (double *)(void *)(b + off_stk);
     sw->grid_nrm = want_normals ? (float *)(void *)(b + off_gn) : NULL;
     sw->gacc = want_gacc ? (double *)(void *)(b + off_ga) : NULL;
     if (want_normals) {
@@ -662,35 +662,6 @@ static hfvis_status hf_sweep_alloc(hf_sweep *sw, const hfvis_grid *g, const hfvi
 }
 
 static void hf_sweep_free(hf_sweep *sw) { hf_free(sw->alloc, sw->block); }
-
-/* Bilinear sample of the grid normals at an in-domain position, renormalised ([P1] §7:
- * "normals are bilinearly filtered"). NaN if a tap with non-zero weight is a hole. */
-static void hf_normal_bilerp(const hf_sweep *sw, double x, double y, float out[3])
-{
-    const hfvis_grid *g = sw->g;
-    double fx = 0.0, fy = 0.0, acc[3] = {0.0, 0.0, 0.0}, len;
-    int x0 = 0, y0 = 0, dx, dy, c;
-    if (g->width > 1) {
-        double f = floor(x);
-        x0 = f >= (double)(g->width - 2) ? g->width - 2 : (int)f;
-        fx = x - (double)x0;
-    }
-    if (g->height > 1) {
-        double f = floor(y);
-        y0 = f >= (double)(g->height - 2) ? g->height - 2 : (int)f;
-        fy = y - (double)y0;
-    }
-    for (dy = 0; dy < 2; dy++)
-        for (dx = 0; dx < 2; dx++) {
-            double w = (dx ? fx : 1.0 - fx) * (dy ? fy : 1.0 - fy);
-            const float *p;
-            if (w == 0.0) continue;
-            p = sw->grid_nrm + ((size_t)(y0 + dy) * (size_t)g->width + (size_t)(x0 + dx)) * 3;
-            for (c = 0; c < 3; c++) acc[c] += w * (double)p[c];
-        }
-    len = sqrt(acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2]);
-    for (c = 0; c < 3; c++) out[c] = (float)(acc[c] / len);
-}
 
 /* Height (world units) at any position under the border rule: CLAMP clamps to the grid,
  * WRAP treats the field as periodic with period width x height (spec §3.4). */
@@ -729,14 +700,12 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
 {
     const hfvis_grid *g = sw->g;
     hfvis_lattice *L = &sw->L;
-    size_t nodes;
     int j, i, c;
     double inv_cs = 1.0 / g->cell_size;
     hf_lattice_from_u(L, g->width, g->height, ux, uy); /* within the bound, cannot fail */
     sw->rows = L->j_max - L->j_min + 1;
     sw->cols = L->i_max - L->i_min + 1;
     HFVIS_ASSERT(sw->rows <= hf_lattice_bound(g) && sw->cols <= hf_lattice_bound(g));
-    nodes = (size_t)sw->rows * (size_t)sw->cols;
     for (c = 0; c < sw->cols; c++) {
         sw->col_first[c] = INT_MAX;
         sw->col_last[c] = -1;
@@ -755,17 +724,50 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
         sw->row_first[j] = first;
         sw->row_last[j] = last;
         for (i = first; i <= last; i++) {
-            double x, y;
+            double x, y, fx = 0.0, fy = 0.0, w[4];
+            int x0 = 0, y0 = 0, q;
             hf_node_pos(L, i + L->i_min, j + L->j_min, &x, &y);
             x = hf_clampd(x, 0.0, (double)(g->width - 1));
             y = hf_clampd(y, 0.0, (double)(g->height - 1));
+            /* Bilinear taps (spec §3.2), shared by the height and, for lighting, the normal
+             * ([P1] §7: normals bilinearly filtered, then renormalised). Zero-weight taps are
+             * never read, so holes do not leak into exact sample positions. */
+            if (g->width > 1) {
+                double f = floor(x);
+                x0 = f >= (double)(g->width - 2) ? g->width - 2 : (int)f;
+                fx = x - (double)x0;
+            }
+            if (g->height > 1) {
+                double f = floor(y);
+                y0 = f >= (double)(g->height - 2) ? g->height - 2 : (int)f;
+                fy = y - (double)y0;
+            }
+            w[0] = (1.0 - fx) * (1.0 - fy);
+            w[1] = fx * (1.0 - fy);
+            w[2] = (1.0 - fx) * fy;
+            w[3] = fx * fy;
             hr[i] = hf_bilerp(g->z, g->stride, g->width, g->height, x, y) * inv_cs;
-            if (sw->want_normals) hf_normal_bilerp(sw, x, y, sw->nrm + ((size_t)j * (size_t)sw->cols + (size_t)i) * 3);
+            if (sw->want_normals) {
+                double n0 = 0.0, n1 = 0.0, n2 = 0.0, inv;
+                float *no = sw->nrm + ((size_t)j * (size_t)sw->cols + (size_t)i) * 3;
+                const float *np = sw->grid_nrm + ((size_t)y0 * (size_t)g->width + (size_t)x0) * 3;
+                for (q = 0; q < 4; q++) {
+                    const float *t3;
+                    if (w[q] == 0.0) continue;
+                    t3 = np + ((q >> 1) * (ptrdiff_t)g->width + (q & 1)) * 3;
+                    n0 += w[q] * (double)t3[0];
+                    n1 += w[q] * (double)t3[1];
+                    n2 += w[q] * (double)t3[2];
+                }
+                inv = 1.0 / sqrt(n0 * n0 + n1 * n1 + n2 * n2);
+                no[0] = (float)(n0 * inv);
+                no[1] = (float)(n1 * inv);
+                no[2] = (float)(n2 * inv);
+            }
             if (j < sw->col_first[i]) sw->col_first[i] = j;
             if (j > sw->col_last[i]) sw->col_last[i] = j;
         }
     }
-    (void)nodes;
 }
 
 /* The traversal of orientation m (see hf_sweep): line number `line` (a row for even m, a
@@ -797,28 +799,8 @@ static int hf_line_span(const hf_sweep *sw, int m, int line, ptrdiff_t *node0, p
     return last - first + 1;
 }
 
-/* The hull stack of spec §4.2 on unit-spaced samples h[0..n-1] (distance = index, cell units),
- * tangents into t. Same arithmetic as hfvis_line_horizons with distance[i] = i. */
-static void hf_hull_unit(const double *h, int n, double *t, int *stk)
-{
-    int i, top = 0;
-    for (i = 0; i < n; i++) {
-        double hi = h[i];
-        if (isnan(hi)) {
-            t[i] = HF_NAN;
-            continue;
-        }
-        while (top >= 2) {
-            int a = stk[top - 1], b = stk[top - 2];
-            if ((h[b] - hi) * (double)(i - a) >= (h[a] - hi) * (double)(i - b)) top--;
-            else break;
-        }
-        t[i] = top ? (h[stk[top - 1]] - hi) / (double)(i - stk[top - 1]) : -HF_INF;
-        stk[top++] = i;
-    }
-}
-
-/* Oracle twin of hf_hull_unit: the brute-force maximum (spec §6 item 2). */
+/* The brute-force maximum on unit-spaced samples (spec §6 item 2): the oracle twin of the
+ * hull in hf_sweep_orientation. */
 static void hf_brute_unit(const double *h, int n, double *t)
 {
     int i, j;
@@ -849,25 +831,53 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
 {
     int nlines = (m & 1) ? sw->cols : sw->rows, line;
     const hfvis_lattice *L = &sw->L;
-    int R = sw->preroll;
+    const int R = sw->preroll;
+    const double inv_cs = 1.0 / sw->g->cell_size;
+    double *sd = sw->sd, *sh = sw->lh, *t = sw->lt;
     for (line = 0; line < nlines; line++) {
         ptrdiff_t node0, step, p;
-        int i0, j0, di, dj, n, s, r;
+        int i0, j0, di, dj, n, s, r, top = 0;
         n = hf_line_span(sw, m, line, &node0, &step, &i0, &j0, &di, &dj);
         if (n == 0) continue;
-        /* Pre-roll (spec §3.4): R lattice nodes before the first in-domain node, sampled with
-         * the border rule; they occlude but receive nothing. */
-        for (r = 0; r < R; r++) {
-            double x, y, z;
-            int back = R - r;
-            hf_node_pos(L, i0 - back * di + L->i_min, j0 - back * dj + L->j_min, &x, &y);
-            z = hf_sample_border(sw->g, sw->border, x, y);
-            sw->lh[r] = z / sw->g->cell_size;
+        if (brute) {
+            /* Oracle: copy the line (pre-roll first) and scan it (spec §6 item 2). */
+            for (r = 0; r < R; r++) {
+                double x, y;
+                hf_node_pos(L, i0 - (R - r) * di + L->i_min, j0 - (R - r) * dj + L->j_min, &x, &y);
+                sh[r] = hf_sample_border(sw->g, sw->border, x, y) * inv_cs;
+            }
+            for (s = 0, p = node0; s < n; s++, p += step) sh[R + s] = sw->h[p];
+            hf_brute_unit(sh, R + n, t);
+            fn(sw, ctx, m, node0, step, n, t + R);
+            continue;
         }
-        for (s = 0, p = node0; s < n; s++, p += step) sw->lh[R + s] = sw->h[p];
-        if (brute) hf_brute_unit(sw->lh, R + n, sw->lt);
-        else hf_hull_unit(sw->lh, R + n, sw->lt, sw->stk);
-        fn(sw, ctx, m, node0, step, n, sw->lt + R);
+        /* Pre-roll (spec §3.4): R lattice nodes before the first in-domain node, sampled with
+         * the border rule, at distances -R..-1; they occlude but receive nothing. */
+        for (r = 0; r < R; r++) {
+            double x, y, h, d = (double)(r - R);
+            hf_node_pos(L, i0 - (R - r) * di + L->i_min, j0 - (R - r) * dj + L->j_min, &x, &y);
+            h = hf_sample_border(sw->g, sw->border, x, y) * inv_cs;
+            if (isnan(h)) continue;
+            while (top >= 2 && (sh[top - 2] - h) * (d - sd[top - 1]) >= (sh[top - 1] - h) * (d - sd[top - 2]))
+                top--;
+            sd[top] = d;
+            sh[top++] = h;
+        }
+        /* The hull stack of spec §4.2 (same arithmetic as hfvis_line_horizons with
+         * distance = node index): pop while the second entry is seen at least as high. */
+        for (s = 0, p = node0; s < n; s++, p += step) {
+            double h = sw->h[p], d = (double)s;
+            if (isnan(h)) {
+                t[s] = HF_NAN;
+                continue;
+            }
+            while (top >= 2 && (sh[top - 2] - h) * (d - sd[top - 1]) >= (sh[top - 1] - h) * (d - sd[top - 2]))
+                top--;
+            t[s] = top ? (sh[top - 1] - h) / (d - sd[top - 1]) : -HF_INF;
+            sd[top] = d;
+            sh[top++] = h;
+        }
+        fn(sw, ctx, m, node0, step, n, t);
     }
 }
 

@@ -1,0 +1,143 @@
+/* bench.c - `make bench`: each fast routine beside its oracle/baseline in one run, reporting
+ * ns per receiver-direction, the ratio, and peak scratch memory. Usage: bench [quick] */
+#define _POSIX_C_SOURCE 200809L
+#include "hfvis.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double now_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
+}
+
+/* An allocator that records the peak number of bytes live (library scratch only). */
+typedef struct { size_t live, peak; } tracker;
+typedef struct { size_t size; double align; } block_head;
+static void *track_alloc(void *user, size_t size)
+{
+    tracker *t = (tracker *)user;
+    block_head *b = (block_head *)malloc(sizeof(block_head) + size);
+    if (!b) return NULL;
+    b->size = size;
+    t->live += size;
+    if (t->live > t->peak) t->peak = t->live;
+    return b + 1;
+}
+static void track_free(void *user, void *p)
+{
+    tracker *t = (tracker *)user;
+    block_head *b;
+    if (!p) return;
+    b = (block_head *)p - 1;
+    t->live -= b->size;
+    free(b);
+}
+
+static void die(const char *what, hfvis_status s)
+{
+    fprintf(stderr, "bench: %s: %s\n", what, hfvis_status_string(s));
+    exit(1);
+}
+
+static void *xmalloc(size_t n)
+{
+    void *p = malloc(n);
+    if (!p) {
+        fprintf(stderr, "bench: out of memory (%zu bytes)\n", n);
+        exit(1);
+    }
+    memset(p, 0, n); /* touch the pages so first-touch faults are not timed */
+    return p;
+}
+
+/* Receivers for the oracle: a fixed pseudo-random subset (xorshift, seed 1). */
+static float *sample_points(int n, int count)
+{
+    float *p = (float *)xmalloc(sizeof(float) * 2 * (size_t)count);
+    unsigned s = 2463534242u;
+    int i;
+    for (i = 0; i < 2 * count; i++) {
+        s ^= s << 13;
+        s ^= s >> 17;
+        s ^= s << 5;
+        p[i] = (float)(s % (unsigned)n);
+    }
+    return p;
+}
+
+static void make_terrain(float *z, int n)
+{
+    hfvis_field f;
+    hfvis_status s;
+    memset(&f, 0, sizeof f);
+    f.kind = HFVIS_FIELD_FBM;
+    f.amplitude = (double)n / 8.0;
+    f.wavelength = (double)n / 4.0;
+    f.seed = 3;
+    if ((s = hfvis_field_generate(&f, n, n, n, z)) != HFVIS_OK) die("field", s);
+}
+
+int main(int argc, char **argv)
+{
+    int quick = argc > 1 && strcmp(argv[1], "quick") == 0;
+    int sizes[2] = {512, 1024}, Ks[3] = {16, 64, 256}, si, ki, nsizes = quick ? 1 : 2;
+    int nk = quick ? 1 : 3;
+    printf("hfvis bench (ns per receiver-direction; oracle = per-receiver ray march, unit steps,\n"
+           "on a fixed random subset of receivers; scratch = peak library allocation)\n\n");
+    printf("%-6s %4s | %-10s %9s %9s | %-10s %9s %9s | %10s %8s %8s\n", "size", "K", "map",
+           "ns/rd", "scratch", "sky", "ns/rd", "scratch", "oracle", "map x", "sky x");
+    for (si = 0; si < nsizes; si++) {
+        int n = sizes[si];
+        size_t cells = (size_t)n * (size_t)n;
+        float *z = (float *)xmalloc(sizeof(float) * cells);
+        float *light = (float *)xmalloc(sizeof(float) * cells);
+        hfvis_grid g;
+        make_terrain(z, n);
+        g.z = z;
+        g.width = n;
+        g.height = n;
+        g.stride = n;
+        g.cell_size = 1.0;
+        for (ki = 0; ki < nk; ki++) {
+            int K = Ks[ki], P = quick ? 64 : 256;
+            float *map = (float *)xmalloc(sizeof(float) * cells * (size_t)K);
+            float *pts = sample_points(n, P), *ref = (float *)xmalloc(sizeof(float) * (size_t)P * (size_t)K);
+            tracker tm = {0, 0}, ts = {0, 0};
+            hfvis_allocator am = {track_alloc, track_free, NULL}, as = {track_alloc, track_free, NULL};
+            hfvis_sweep_options om = hfvis_sweep_options_default(), os = om;
+            double t0, t_map, t_sky, t_ref, rd = (double)cells * (double)K;
+            hfvis_status s;
+            am.user = &tm;
+            as.user = &ts;
+            om.alloc = &am;
+            os.alloc = &as;
+            t0 = now_s();
+            if ((s = hfvis_horizon_map(&g, K, &om, map)) != HFVIS_OK) die("horizon map", s);
+            t_map = now_s() - t0;
+            t0 = now_s();
+            if ((s = hfvis_sky_light(&g, K, 1.0f, 1.0f, &os, light, n)) != HFVIS_OK) die("sky", s);
+            t_sky = now_s() - t0;
+            t0 = now_s();
+            if ((s = hfvis_horizon_reference(&g, K, NULL, NULL, pts, (size_t)P, ref)) != HFVIS_OK)
+                die("reference", s);
+            t_ref = (now_s() - t0) * 1e9 / ((double)P * (double)K);
+            printf("%4d^2 %4d | %-10s %9.2f %8.1fM | %-10s %9.2f %8.1fM | %10.1f %7.0fx %7.0fx\n", n, K,
+                   "", t_map * 1e9 / rd, (double)tm.peak / 1048576.0, "", t_sky * 1e9 / rd,
+                   (double)ts.peak / 1048576.0, t_ref, t_ref / (t_map * 1e9 / rd),
+                   t_ref / (t_sky * 1e9 / rd));
+            fflush(stdout);
+            free(map);
+            free(pts);
+            free(ref);
+        }
+        free(z);
+        free(light);
+    }
+    return 0;
+}
