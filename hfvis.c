@@ -696,33 +696,45 @@ static double hf_sample_border(const hfvis_grid *g, hfvis_border border, double 
 
 /* Set up the base lattice of sweep vector u for the current group: line ranges per row and
  * column, and the heights (cell units) at every in-domain node. */
+#define HF_TILE 32 /* lattice and grid loops run in tiles so both sides stay in cache */
+
 static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
 {
     const hfvis_grid *g = sw->g;
     hfvis_lattice *L = &sw->L;
-    int j, i, c;
+    int j, i, c, tj, ti;
     double inv_cs = 1.0 / g->cell_size;
+    size_t n, nodes;
     hf_lattice_from_u(L, g->width, g->height, ux, uy); /* within the bound, cannot fail */
     sw->rows = L->j_max - L->j_min + 1;
     sw->cols = L->i_max - L->i_min + 1;
     HFVIS_ASSERT(sw->rows <= hf_lattice_bound(g) && sw->cols <= hf_lattice_bound(g));
+    nodes = (size_t)sw->rows * (size_t)sw->cols;
+    for (n = 0; n < nodes; n++) sw->h[n] = HF_NAN;
     for (c = 0; c < sw->cols; c++) {
         sw->col_first[c] = INT_MAX;
         sw->col_last[c] = -1;
     }
     for (j = 0; j < sw->rows; j++) {
         int first, last;
-        double *hr = sw->h + (size_t)j * (size_t)sw->cols;
-        for (i = 0; i < sw->cols; i++) hr[i] = HF_NAN;
         if (!hfvis_lattice_line(L, j + L->j_min, &first, &last)) {
             sw->row_first[j] = 1;
             sw->row_last[j] = 0;
             continue;
         }
-        first -= L->i_min;
-        last -= L->i_min;
-        sw->row_first[j] = first;
-        sw->row_last[j] = last;
+        sw->row_first[j] = first - L->i_min;
+        sw->row_last[j] = last - L->i_min;
+        for (i = sw->row_first[j]; i <= sw->row_last[j]; i++) {
+            if (j < sw->col_first[i]) sw->col_first[i] = j;
+            if (j > sw->col_last[i]) sw->col_last[i] = j;
+        }
+    }
+    for (tj = 0; tj < sw->rows; tj += HF_TILE)
+        for (ti = 0; ti < sw->cols; ti += HF_TILE)
+    for (j = tj; j < sw->rows && j < tj + HF_TILE; j++) {
+        double *hr = sw->h + (size_t)j * (size_t)sw->cols;
+        int first = sw->row_first[j] > ti ? sw->row_first[j] : ti;
+        int last = sw->row_last[j] < ti + HF_TILE - 1 ? sw->row_last[j] : ti + HF_TILE - 1;
         for (i = first; i <= last; i++) {
             double x, y, fx = 0.0, fy = 0.0, w[4];
             int x0 = 0, y0 = 0, q;
@@ -764,8 +776,6 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
                 no[1] = (float)(n1 * inv);
                 no[2] = (float)(n2 * inv);
             }
-            if (j < sw->col_first[i]) sw->col_first[i] = j;
-            if (j > sw->col_last[i]) sw->col_last[i] = j;
         }
     }
 }
@@ -990,8 +1000,11 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, float *out, size_t plan
     int x, y, c;
     double v[4];
     hf_gather G;
-    for (y = 0; y < g->height; y++)
-        for (x = 0; x < g->width; x++) {
+    int tx, ty;
+    for (ty = 0; ty < g->height; ty += HF_TILE)
+        for (tx = 0; tx < g->width; tx += HF_TILE)
+    for (y = ty; y < g->height && y < ty + HF_TILE; y++)
+        for (x = tx; x < g->width && x < tx + HF_TILE; x++) {
             ptrdiff_t o = (ptrdiff_t)y * out_stride + x;
             if (hf_is_hole(g, x, y)) {
                 for (c = 0; c < ch; c++) out[(size_t)c * plane_step + (size_t)o] = (float)HF_NAN;
@@ -1010,8 +1023,11 @@ static void hf_gather_accumulate(hf_sweep *sw)
     int x, y, c, ch = sw->channels;
     double v[4];
     hf_gather G;
-    for (y = 0; y < g->height; y++)
-        for (x = 0; x < g->width; x++) {
+    int tx, ty;
+    for (ty = 0; ty < g->height; ty += HF_TILE)
+        for (tx = 0; tx < g->width; tx += HF_TILE)
+    for (y = ty; y < g->height && y < ty + HF_TILE; y++)
+        for (x = tx; x < g->width && x < tx + HF_TILE; x++) {
             double *acc = sw->gacc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)ch;
             if (hf_is_hole(g, x, y)) continue;
             hf_gather_setup(sw, x, y, &G);
