@@ -1586,4 +1586,712 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
     return HFVIS_OK;
 }
 
-/* ENV-FRAGMENT */
+/* ==========================================================================================
+ * 10. Environment light tables and evaluation, the hemisphere-integration oracle
+ * [P1] §6 Eq. 3-7; spec heightfield §5.2-5.4, §11 items 2, 3, 15, 16, 17, §12.12.
+
+ *
+ * Contents
+ *   1. constants, argument resolution
+ *   2. sector phi-integrals of the lat-long texels, band theta-weights
+ *   3. table layouts and hfvis_env_table_size / hfvis_env_table_build
+ *   4. hf_env_eval: per node and direction evaluation (the fused sweep calls this)
+ *   5. hfvis_env_light_from_map
+ *   6. hfvis_light_reference (hemisphere-integration oracle)
+ *
+ * Table layouts (floats; C = env->channels, T = env->n_theta, K directions):
+ *   HFVIS_ENV_PREFIX: 6*K*(T+1)*C floats. Record (k, b), b = 0..T, is 6*C floats at
+ *     table[((k*(T+1) + b)*6 + q)*C + c], q = 0..5:
+ *       q = 0,1,2: A_k, B_k, C_k of spec §5.4 at the band edge theta_b = b*pi/T (prefix over
+ *                  bands 0..b-1; record 0 is zero, record T is the whole sphere);
+ *       q = 3,4,5: the sector phi-integrals of band b, Int_sector L dphi,
+ *                  Int_sector L cos(phi-psi_k) dphi, Int_sector L sin(phi-psi_k) dphi
+ *                  (zero in record T), so that inside band b
+ *                  A_k(theta) = A_k(theta_b) + [q3] * (sin^2 theta - sin^2 theta_b)/2,
+ *                  B_k(theta) = B_k(theta_b) + [q4] * (G(theta) - G(theta_b)), G = (theta - sin 2theta/2)/2,
+ *                  C_k likewise with [q5].
+ *     Everything is accumulated in double and rounded to float once at the store (relative
+ *     error ~6e-8 per entry; the prefix is not split into hi/lo floats: the sums stay O(1) per
+ *     sector and the evaluator's double arithmetic adds no further error of that size).
+ *   HFVIS_ENV_LP_TABLE: K*M*Th*C floats, M = lp_normal_res (odd), Th = lp_horizon_res,
+ *     table[((k*M + i)*Th + j)*C + c] = L_p^k(theta_n_i, theta_h_j),
+ *     theta_n_i = pi*(i/(M-1) - 1/2) in [-pi/2, pi/2] (i = (M-1)/2 is exactly 0),
+ *     theta_h_j = pi*j/(Th-1) in [0, pi] (spec §11 item 16). Already includes 1/pi.
+ * ========================================================================================== */
+
+/* ---------------------------------------------------------------- 1. constants, resolution */
+
+
+/* Defaults of hfvis_env_options ([P1] §6.2: theta_n resolution 16 is "safe", odd counts make
+ * N = up exact; theta_h resolution = the paper's theta_N = 256). */
+#define HF_ENV_DEFAULT_LP_NORMAL_RES 15
+#define HF_ENV_DEFAULT_LP_HORIZON_RES 256
+/* Hemisphere oracle defaults (header). */
+#define HF_ENV_DEFAULT_AZIMUTH_SAMPLES 256
+#define HF_ENV_DEFAULT_ZENITH_SAMPLES 512
+/* Floats per (sector, band edge) record of the prefix table. */
+#define HF_ENV_PREFIX_RECORD 6
+
+hfvis_env_options hfvis_env_options_default(void)
+{
+    hfvis_env_options o;
+    o.method = HFVIS_ENV_PREFIX;
+    o.lp_normal_res = HF_ENV_DEFAULT_LP_NORMAL_RES;
+    o.lp_horizon_res = HF_ENV_DEFAULT_LP_HORIZON_RES;
+    return o;
+}
+
+/* Resolved options and the table size. */
+typedef struct hf_env_resolved {
+    hfvis_env_method method;
+    int lp_normal_res, lp_horizon_res;
+    size_t table_floats;
+} hf_env_resolved;
+
+/* Checks the environment's shape (not its radiance pointer: hfvis_env_table_size can be asked
+ * before the map is loaded), K and the options; resolves defaults and the table size.
+ * lp_normal_res must be odd and >= 3 (M = 1 leaves no theta_n interval to interpolate). */
+static hfvis_status hf_env_resolve(const hfvis_env *env, int K, const hfvis_env_options *eopts,
+                                   hf_env_resolved *r)
+{
+    hfvis_env_options o;
+    size_t n, bytes;
+    if (env == NULL || K < 1 || env->n_theta < 1 || env->n_phi < 1 || env->channels < 1 ||
+        env->channels > 4)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    o = hfvis_env_options_default();
+    if (eopts != NULL) {
+        if (eopts->method != HFVIS_ENV_DEFAULT) o.method = eopts->method;
+        if (eopts->lp_normal_res != 0) o.lp_normal_res = eopts->lp_normal_res;
+        if (eopts->lp_horizon_res != 0) o.lp_horizon_res = eopts->lp_horizon_res;
+    }
+    if (o.method != HFVIS_ENV_PREFIX && o.method != HFVIS_ENV_LP_TABLE)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.method == HFVIS_ENV_LP_TABLE) {
+        /* the L_p resolutions are validated only when the L_p table is used */
+        if (o.lp_normal_res < 3 || o.lp_normal_res % 2 == 0 || o.lp_horizon_res < 2)
+            return HFVIS_ERR_INVALID_ARGUMENT;
+        if (!hf_mul_size((size_t)K, (size_t)o.lp_normal_res, &n) ||
+            !hf_mul_size(n, (size_t)o.lp_horizon_res, &n) ||
+            !hf_mul_size(n, (size_t)env->channels, &n))
+            return HFVIS_ERR_INVALID_ARGUMENT;
+    } else {
+        if (!hf_mul_size((size_t)K, (size_t)env->n_theta + 1u, &n) ||
+            !hf_mul_size(n, (size_t)HF_ENV_PREFIX_RECORD * (size_t)env->channels, &n))
+            return HFVIS_ERR_INVALID_ARGUMENT;
+    }
+    /* every table index is later formed in size_t; bytes must be representable too */
+    if (!hf_mul_size(n, sizeof(float), &bytes)) return HFVIS_ERR_INVALID_ARGUMENT;
+    r->method = o.method;
+    r->lp_normal_res = o.lp_normal_res;
+    r->lp_horizon_res = o.lp_horizon_res;
+    r->table_floats = n;
+    return HFVIS_OK;
+}
+
+size_t hfvis_env_table_size(const hfvis_env *env, int K, const hfvis_env_options *eopts)
+{
+    hf_env_resolved r;
+    if (hf_env_resolve(env, K, eopts, &r) != HFVIS_OK) return 0;
+    return r.table_floats;
+}
+
+/* ------------------------------------ 2. sector phi-integrals, band theta-weights (spec §5.4) */
+
+/* The sector [psi_k - pi/K, psi_k + pi/K] as an unwrapped interval [start, start + width]
+ * with start reduced to [0, 2pi); the centre start + pi/K is psi_k modulo 2pi. */
+typedef struct hf_env_sector {
+    double start, width, centre;
+} hf_env_sector;
+
+static hf_env_sector hf_env_sector_of(int K, double azimuth0_rad, int k)
+{
+    hf_env_sector s;
+    double psi = azimuth0_rad + (2.0 * HF_PI) * (double)k / (double)K;
+    double st = fmod(psi - HF_PI / (double)K, (2.0 * HF_PI));
+    if (st < 0.0) st += (2.0 * HF_PI);
+    if (st >= (2.0 * HF_PI)) st = 0.0; /* -tiny + 2pi may round up to 2pi */
+    s.start = st;
+    s.width = (2.0 * HF_PI) / (double)K;
+    s.centre = st + HF_PI / (double)K;
+    return s;
+}
+
+/* Sector phi-integrals of texel row t (spec §5.4 "inner phi-integrals ... closed-form"):
+ * a0[c] = Int L dphi, a1[c] = Int L cos(phi - psi) dphi, a2[c] = Int L sin(phi - psi) dphi
+ * over the sector, the texels being constant. Columns are visited as unwrapped intervals
+ * [2pi p'/P, 2pi (p'+1)/P) with p' from just below the sector start up to 2P, column p' mod P,
+ * so a sector that wraps past 2pi, or is narrower or wider than a column, is covered exactly.
+ * a2 may be NULL (the L_p table drops the C term, spec §5.4). */
+static void hf_env_band_sector(const hfvis_env *env, int t, const hf_env_sector *s, double *a0,
+                               double *a1, double *a2)
+{
+    const int P = env->n_phi, C = env->channels;
+    const double end = s->start + s->width;
+    const float *row = env->radiance + (size_t)t * (size_t)P * (size_t)C;
+    int p = (int)floor(s->start * (double)P / (2.0 * HF_PI)) - 1, c;
+    for (c = 0; c < C; c++) {
+        a0[c] = 0.0;
+        a1[c] = 0.0;
+        if (a2 != NULL) a2[c] = 0.0;
+    }
+    for (;; p++) {
+        double lo = (2.0 * HF_PI) * (double)p / (double)P;
+        double hi = (2.0 * HF_PI) * (double)(p + 1) / (double)P;
+        double f1, f2, len, wc, ws;
+        const float *px;
+        if (lo >= end) break;
+        f1 = lo > s->start ? lo : s->start;
+        f2 = hi < end ? hi : end;
+        if (!(f2 > f1)) continue;
+        len = f2 - f1;
+        /* Int cos(phi - psi) = sin(u2) - sin(u1), Int sin(phi - psi) = cos(u1) - cos(u2),
+         * u relative to the sector centre so |u| <= pi/K */
+        wc = sin(f2 - s->centre) - sin(f1 - s->centre);
+        ws = cos(f1 - s->centre) - cos(f2 - s->centre);
+        px = row + (size_t)(((p % P) + P) % P) * (size_t)C;
+        for (c = 0; c < C; c++) {
+            double L = (double)px[c];
+            a0[c] += L * len;
+            a1[c] += L * wc;
+            if (a2 != NULL) a2[c] += L * ws;
+        }
+    }
+}
+
+/* Theta-weights between theta0 and theta (spec §5.2/§5.4 antiderivatives):
+ * *wa = Int sin cos = (sin^2 theta - sin^2 theta0)/2 = sin(d) sin(s)/2,
+ * *wb = Int sin^2   = (d - (sin 2theta - sin 2theta0)/2)/2 = (d - cos(s) sin(d))/2,
+ * d = theta - theta0, s = theta + theta0 (difference forms: no cancellation inside a band). */
+static void hf_env_theta_weights(double theta, double theta0, double *wa, double *wb)
+{
+    double d = theta - theta0, s = theta + theta0, sd = sin(d);
+    *wa = 0.5 * sd * sin(s);
+    *wb = 0.5 * (d - cos(s) * sd);
+}
+
+/* Band edge theta_b = b*pi/T; the build and the evaluator must use this same expression. */
+static double hf_env_band_edge(int b, int T)
+{
+    return HF_PI * (double)b / (double)T;
+}
+
+/* ---------------------------------------------------------- 3. hfvis_env_table_build */
+
+/* Running prefix A_k, B_k (and C_k) over the bands, for the L_p build: evaluated at
+ * non-decreasing cutoffs theta in [0, pi] (spec §5.4 prefix form, band-partial exact). */
+typedef struct hf_env_prefix_walk {
+    const hfvis_env *env;
+    hf_env_sector sector;
+    int band;                 /* current band t */
+    double pa[4], pb[4];      /* A_k, B_k at theta_t */
+    double a0[4], a1[4];      /* phi-integrals of band t */
+} hf_env_prefix_walk;
+
+static void hf_env_walk_start(hf_env_prefix_walk *w, const hfvis_env *env,
+                              const hf_env_sector *s)
+{
+    int c;
+    w->env = env;
+    w->sector = *s;
+    w->band = 0;
+    for (c = 0; c < 4; c++) w->pa[c] = w->pb[c] = 0.0;
+    hf_env_band_sector(env, 0, s, w->a0, w->a1, NULL);
+}
+
+/* A_k(theta), B_k(theta) into A[c], B[c]; theta must not decrease between calls. */
+static void hf_env_walk_eval(hf_env_prefix_walk *w, double theta, double *A, double *B)
+{
+    const int T = w->env->n_theta, C = w->env->channels;
+    double wa, wb;
+    int c;
+    while (w->band < T - 1 && theta >= hf_env_band_edge(w->band + 1, T)) {
+        hf_env_theta_weights(hf_env_band_edge(w->band + 1, T), hf_env_band_edge(w->band, T),
+                             &wa, &wb);
+        for (c = 0; c < C; c++) {
+            w->pa[c] += w->a0[c] * wa;
+            w->pb[c] += w->a1[c] * wb;
+        }
+        w->band++;
+        hf_env_band_sector(w->env, w->band, &w->sector, w->a0, w->a1, NULL);
+    }
+    hf_env_theta_weights(theta, hf_env_band_edge(w->band, T), &wa, &wb);
+    for (c = 0; c < C; c++) {
+        A[c] = w->pa[c] + w->a0[c] * wa;
+        B[c] = w->pb[c] + w->a1[c] * wb;
+    }
+}
+
+/* L_p axes (spec §11 item 16); the build and the evaluator use these expressions. */
+static double hf_env_lp_normal_angle(int i, int M)
+{
+    return HF_PI * ((double)i / (double)(M - 1) - 0.5);
+}
+static double hf_env_lp_horizon_angle(int j, int Th)
+{
+    return HF_PI * (double)j / (double)(Th - 1);
+}
+/* Eq. 7 upper limit theta_n + pi/2, clamped to [0, pi] against rounding at i = 0 and M-1. */
+static double hf_env_lp_cutoff(int i, int M)
+{
+    double c = hf_env_lp_normal_angle(i, M) + HF_HALF_PI;
+    return c < 0.0 ? 0.0 : (c > HF_PI ? HF_PI : c);
+}
+
+/* L_p table of one direction ([P1] Eq. 7 in its Eq. 5-consistent form, spec §5.4):
+ * L_p(theta_n, theta_h) = (1/pi)[cos theta_n A_k(c) + sin theta_n B_k(c)],
+ * c = min(theta_h, theta_n + pi/2). Entries with theta_h_j < theta_n_i + pi/2 need A, B at
+ * theta_h_j (shared by all i): one walk over j. The others need A, B at theta_n_i + pi/2
+ * (shared by all j): a second walk over i. Both walks are O(T * columns + Th + M). */
+static void hf_env_build_lp_direction(const hfvis_env *env, const hf_env_sector *s, int M,
+                                      int Th, float *tab)
+{
+    const int C = env->channels;
+    hf_env_prefix_walk w;
+    double A[4], B[4];
+    int i, j, c;
+    hf_env_walk_start(&w, env, s);
+    for (j = 0; j < Th; j++) {
+        double th = hf_env_lp_horizon_angle(j, Th);
+        hf_env_walk_eval(&w, th, A, B);
+        for (i = 0; i < M; i++) {
+            double tn = hf_env_lp_normal_angle(i, M), cn = cos(tn), sn = sin(tn);
+            float *e;
+            if (!(th < hf_env_lp_cutoff(i, M))) continue; /* second walk */
+            e = tab + ((size_t)i * (size_t)Th + (size_t)j) * (size_t)C;
+            for (c = 0; c < C; c++) e[c] = (float)((cn * A[c] + sn * B[c]) / HF_PI);
+        }
+    }
+    hf_env_walk_start(&w, env, s);
+    for (i = 0; i < M; i++) {
+        double tn = hf_env_lp_normal_angle(i, M), cn = cos(tn), sn = sin(tn);
+        double cut = hf_env_lp_cutoff(i, M);
+        hf_env_walk_eval(&w, cut, A, B);
+        for (j = 0; j < Th; j++) {
+            float *e;
+            if (hf_env_lp_horizon_angle(j, Th) < cut) continue; /* first walk */
+            e = tab + ((size_t)i * (size_t)Th + (size_t)j) * (size_t)C;
+            for (c = 0; c < C; c++) e[c] = (float)((cn * A[c] + sn * B[c]) / HF_PI);
+        }
+    }
+}
+
+/* Prefix records of one direction (layout at the top of this fragment). */
+static void hf_env_build_prefix_direction(const hfvis_env *env, const hf_env_sector *s,
+                                          float *tab)
+{
+    const int T = env->n_theta, C = env->channels;
+    double pa[4] = {0.0, 0.0, 0.0, 0.0}, pb[4] = {0.0, 0.0, 0.0, 0.0},
+           pc[4] = {0.0, 0.0, 0.0, 0.0};
+    double a0[4], a1[4], a2[4], wa, wb;
+    int t, c;
+    for (t = 0; t <= T; t++) {
+        float *rec = tab + (size_t)t * HF_ENV_PREFIX_RECORD * (size_t)C;
+        if (t < T) {
+            hf_env_band_sector(env, t, s, a0, a1, a2);
+        } else {
+            for (c = 0; c < C; c++) a0[c] = a1[c] = a2[c] = 0.0;
+        }
+        for (c = 0; c < C; c++) {
+            rec[0 * C + c] = (float)pa[c];
+            rec[1 * C + c] = (float)pb[c];
+            rec[2 * C + c] = (float)pc[c];
+            rec[3 * C + c] = (float)a0[c];
+            rec[4 * C + c] = (float)a1[c];
+            rec[5 * C + c] = (float)a2[c];
+        }
+        if (t == T) break;
+        /* the prefix runs in double; only the stored copy is rounded */
+        hf_env_theta_weights(hf_env_band_edge(t + 1, T), hf_env_band_edge(t, T), &wa, &wb);
+        for (c = 0; c < C; c++) {
+            pa[c] += a0[c] * wa;
+            pb[c] += a1[c] * wb;
+            pc[c] += a2[c] * wb;
+        }
+    }
+}
+
+/* Radiance values are not validated: a non-finite texel propagates into the sectors it
+ * overlaps. Cost: prefix O(K*T*(P/K + 2)*C); L_p O(K*(T*(P/K + 2) + M*Th)*C), i.e. cheaper
+ * than the header's O(K*M*Th*P) since A_k, B_k at the Th + M sorted cutoffs come from two
+ * monotone walks over the bands. No allocation. */
+hfvis_status hfvis_env_table_build(const hfvis_env *env, int K, double azimuth0_rad,
+                                             const hfvis_env_options *eopts, float *table)
+{
+    hf_env_resolved r;
+    hfvis_status st = hf_env_resolve(env, K, eopts, &r);
+    int k;
+    if (st != HFVIS_OK) return st;
+    if (env->radiance == NULL || table == NULL || !isfinite(azimuth0_rad))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    for (k = 0; k < K; k++) {
+        hf_env_sector s = hf_env_sector_of(K, azimuth0_rad, k);
+        if (r.method == HFVIS_ENV_LP_TABLE) {
+            size_t per = (size_t)r.lp_normal_res * (size_t)r.lp_horizon_res *
+                         (size_t)env->channels;
+            hf_env_build_lp_direction(env, &s, r.lp_normal_res, r.lp_horizon_res,
+                                      table + (size_t)k * per);
+        } else {
+            size_t per = ((size_t)env->n_theta + 1u) * HF_ENV_PREFIX_RECORD *
+                         (size_t)env->channels;
+            hf_env_build_prefix_direction(env, &s, table + (size_t)k * per);
+        }
+    }
+    return HFVIS_OK;
+}
+
+/* ------------------------------------------------------------ 4. per-node evaluation */
+
+typedef struct hf_env_eval {
+    const hfvis_env *env;
+    hfvis_env_method method;
+    int K;
+    int channels;
+    int lp_normal_res, lp_horizon_res;
+    const float *table;
+} hf_env_eval;
+
+/* Validate and resolve defaults; table must have been built by hfvis_env_table_build with
+ * the same env, K and eopts. env->radiance is not read by the evaluator. */
+static hfvis_status hf_env_eval_init(hf_env_eval *e, const hfvis_env *env, int K,
+                                     const hfvis_env_options *eopts, const float *table)
+{
+    hf_env_resolved r;
+    hfvis_status st;
+    if (e == NULL || table == NULL) return HFVIS_ERR_INVALID_ARGUMENT;
+    st = hf_env_resolve(env, K, eopts, &r);
+    if (st != HFVIS_OK) return st;
+    e->env = env;
+    e->method = r.method;
+    e->K = K;
+    e->channels = env->channels;
+    e->lp_normal_res = r.lp_normal_res;
+    e->lp_horizon_res = r.lp_horizon_res;
+    e->table = table;
+    return HFVIS_OK;
+}
+
+/* Adds direction k's contribution (including 1/pi, excluding albedo) to acc[0..channels-1].
+ * (cos_psi, sin_psi): look direction psi_k; (nx, ny, nz): unit normal, z up; tan_h: tangent
+ * of the horizon elevation, -INFINITY = no occluder, +INFINITY = zenith blocked. A NaN tan_h
+ * or normal adds NaN.
+ * PREFIX ([P1] Eq. 4 with spec §5.2's clamp, §5.4 prefix form):
+ *   theta = min(theta_h, pi/2 + atan2(a, nz)) clamped to [0, pi], theta_h = pi/2 - atan(tan_h),
+ *   acc += (1/pi)[nz A_k(theta) + a B_k(theta) + b C_k(theta)],
+ *   a = nx cos psi + ny sin psi, b = -nx sin psi + ny cos psi.
+ * LP_TABLE ([P1] Eq. 6): acc += |N_p| L_p^k(theta_n, theta_h), |N_p| = sqrt(a^2 + nz^2),
+ *   theta_n = atan2(a, nz) clamped to [-pi/2, pi/2] (height-field normals have nz > 0),
+ *   bilinear in (theta_n, theta_h). Because L_p is constant in theta_h beyond theta_n + pi/2
+ *   (Eq. 7's upper limit; spec §11 item 16), a lookup with theta_h >= theta_n + pi/2 is made
+ *   at theta_h = pi, an exact table column: an open horizon then carries only the theta_n
+ *   interpolation error, and N = up with theta_h >= pi/2 is exact (spec §12.12). */
+static void hf_env_accumulate(const hf_env_eval *e, int k, double cos_psi, double sin_psi,
+                              double nx, double ny, double nz, double tan_h, double *acc)
+{
+    const int C = e->channels;
+    const double a = nx * cos_psi + ny * sin_psi;
+    double theta_h = HF_HALF_PI - atan(tan_h);
+    int c;
+    if (isnan(theta_h) || isnan(a) || isnan(nz)) {
+        for (c = 0; c < C; c++) acc[c] += HF_NAN;
+        return;
+    }
+    if (theta_h < 0.0) theta_h = 0.0;
+    if (theta_h > HF_PI) theta_h = HF_PI;
+    if (e->method == HFVIS_ENV_LP_TABLE) {
+        const int M = e->lp_normal_res, Th = e->lp_horizon_res;
+        double np = sqrt(a * a + nz * nz), tn = atan2(a, nz), fi, fj, u, v;
+        int i0, j0;
+        const float *t00, *t01, *t10, *t11;
+        if (tn < -HF_HALF_PI) tn = -HF_HALF_PI;
+        if (tn > HF_HALF_PI) tn = HF_HALF_PI;
+        if (theta_h >= tn + HF_HALF_PI) theta_h = HF_PI;
+        fi = (tn / HF_PI + 0.5) * (double)(M - 1); /* (M-1)/2 exactly for tn = 0 */
+        fj = theta_h / HF_PI * (double)(Th - 1);
+        i0 = (int)fi;
+        if (i0 > M - 2) i0 = M - 2;
+        if (i0 < 0) i0 = 0;
+        j0 = (int)fj;
+        if (j0 > Th - 2) j0 = Th - 2;
+        if (j0 < 0) j0 = 0;
+        u = fi - (double)i0;
+        v = fj - (double)j0;
+        t00 = e->table + (((size_t)k * (size_t)M + (size_t)i0) * (size_t)Th + (size_t)j0) *
+                             (size_t)C;
+        t01 = t00 + C;                        /* (i0, j0+1) */
+        t10 = t00 + (size_t)Th * (size_t)C;   /* (i0+1, j0) */
+        t11 = t10 + C;
+        for (c = 0; c < C; c++) {
+            double lo = (1.0 - v) * (double)t00[c] + v * (double)t01[c];
+            double hi = (1.0 - v) * (double)t10[c] + v * (double)t11[c];
+            acc[c] += np * ((1.0 - u) * lo + u * hi);
+        }
+    } else {
+        const int T = e->env->n_theta;
+        const double b = -nx * sin_psi + ny * cos_psi;
+        double theta = theta_h, tc = HF_HALF_PI + atan2(a, nz), wa, wb;
+        const float *rec;
+        int band;
+        if (tc < theta) theta = tc;
+        if (theta <= 0.0) return; /* every prefix integral is 0 at theta = 0 */
+        band = (int)(theta * (double)T / HF_PI);
+        if (band > T - 1) band = T - 1;
+        hf_env_theta_weights(theta, hf_env_band_edge(band, T), &wa, &wb);
+        rec = e->table + ((size_t)k * ((size_t)T + 1u) + (size_t)band) * HF_ENV_PREFIX_RECORD *
+                             (size_t)C;
+        for (c = 0; c < C; c++) {
+            double A = (double)rec[0 * C + c] + (double)rec[3 * C + c] * wa;
+            double B = (double)rec[1 * C + c] + (double)rec[4 * C + c] * wb;
+            double Cs = (double)rec[2 * C + c] + (double)rec[5 * C + c] * wb;
+            acc[c] += (nz * A + a * B + b * Cs) / HF_PI;
+        }
+    }
+}
+
+/* Allocate (1 block from alloc), build and bind the tables of one call; *table receives the
+ * block for hf_free. For the lead's hfvis_env_light. */
+static hfvis_status hf_env_tables_create(const hfvis_env *env, int K, double azimuth0_rad,
+                                         const hfvis_env_options *eopts,
+                                         const hfvis_allocator *alloc, float **table,
+                                         hf_env_eval *e)
+{
+    hf_env_resolved r;
+    hfvis_status st = hf_env_resolve(env, K, eopts, &r);
+    float *t;
+    if (st != HFVIS_OK) return st;
+    if (env->radiance == NULL || !isfinite(azimuth0_rad)) return HFVIS_ERR_INVALID_ARGUMENT;
+    t = (float *)hf_alloc(alloc, r.table_floats * sizeof(float));
+    if (t == NULL) return HFVIS_ERR_OUT_OF_MEMORY;
+    st = hfvis_env_table_build(env, K, azimuth0_rad, eopts, t);
+    if (st == HFVIS_OK) st = hf_env_eval_init(e, env, K, eopts, t);
+    if (st != HFVIS_OK) {
+        hf_free(alloc, t);
+        return st;
+    }
+    *table = t;
+    return HFVIS_OK;
+}
+
+/* ------------------------------------------------------------ 5. from a stored horizon map */
+
+/* Full environment check for the routines that read radiance. */
+static int hf_env_valid(const hfvis_env *env)
+{
+    return env != NULL && env->radiance != NULL && env->n_theta >= 1 && env->n_phi >= 1 &&
+           env->channels >= 1 && env->channels <= 4;
+}
+
+hfvis_status hfvis_env_light_from_map(const hfvis_grid *grid, int K,
+                                                double map_azimuth0_rad, const float *map,
+                                                const hfvis_env *env, float albedo,
+                                                const hfvis_env_options *eopts,
+                                                const hfvis_allocator *alloc, float *out,
+                                                ptrdiff_t out_stride)
+{
+    size_t plane, last, mapn, n3;
+    float *normals, *table;
+    hf_env_eval e;
+    hf_env_resolved r;
+    hfvis_status st;
+    int x, y, k, c, C;
+    if (!hf_grid_valid(grid) || K < 1 || !isfinite(map_azimuth0_rad) || map == NULL ||
+        !hf_env_valid(env) || !isfinite(albedo) || out == NULL ||
+        out_stride < (ptrdiff_t)grid->width)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    st = hf_env_resolve(env, K, eopts, &r);
+    if (st != HFVIS_OK) return st;
+    C = env->channels;
+    /* map holds K planes of W*H; out's last index and the normal buffer must be addressable */
+    if (!hf_mul_size((size_t)grid->width, (size_t)grid->height, &plane) ||
+        !hf_mul_size(plane, (size_t)K, &mapn) || !hf_mul_size(plane, 3u * sizeof(float), &n3) ||
+        !hf_mul_size((size_t)out_stride, (size_t)grid->height, &last) ||
+        !hf_mul_size(last, (size_t)C, &last))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    normals = (float *)hf_alloc(alloc, n3);
+    if (normals == NULL) return HFVIS_ERR_OUT_OF_MEMORY;
+    st = hf_env_tables_create(env, K, map_azimuth0_rad, eopts, alloc, &table, &e);
+    if (st != HFVIS_OK) {
+        hf_free(alloc, normals);
+        return st;
+    }
+    st = hfvis_normals_compute(grid, normals);
+    if (st != HFVIS_OK) {
+        hf_free(alloc, table);
+        hf_free(alloc, normals);
+        return st;
+    }
+    for (y = 0; y < grid->height; y++) {
+        for (x = 0; x < grid->width; x++) {
+            size_t g = (size_t)y * (size_t)grid->width + (size_t)x;
+            float *o = out + ((size_t)y * (size_t)out_stride + (size_t)x) * (size_t)C;
+            const float *n = normals + 3u * g;
+            double acc[4] = {0.0, 0.0, 0.0, 0.0};
+            int hole = !isfinite(grid->z[(size_t)y * (size_t)grid->stride + (size_t)x]);
+            for (k = 0; k < K && !hole; k++) {
+                double alpha = (double)map[(size_t)k * plane + g];
+                double psi = map_azimuth0_rad + (2.0 * HF_PI) * (double)k / (double)K;
+                if (!isfinite(alpha)) {
+                    hole = 1;
+                    break;
+                }
+                hf_env_accumulate(&e, k, cos(psi), sin(psi), (double)n[0], (double)n[1],
+                                  (double)n[2], hf_elevation_to_tan(alpha), acc);
+            }
+            for (c = 0; c < C; c++)
+                o[c] = (float)(hole ? HF_NAN : (double)albedo * acc[c]);
+        }
+    }
+    hf_free(alloc, table);
+    hf_free(alloc, normals);
+    return HFVIS_OK;
+}
+
+/* ------------------------------------------------ 6. hemisphere-integration oracle */
+
+/* L_o = albedo/pi Int L_i V max(n.w, 0) dw ([P1] Eq. 3, the header's Lambertian convention)
+ * by the midpoint rule: azimuths phi_m = 2pi (m + 1/2)/A, zenith angles
+ * theta_j = pi (j + 1/2)/Z over the whole sphere [0, pi] (horizons may lie below the
+ * horizontal, spec §11 item 15), dw = sin theta dtheta dphi. V = 1 iff the elevation
+ * pi/2 - theta_j exceeds the exact horizon alpha(phi_m) of hfvis_horizon_reference.
+ * Each azimuth is one call with K = 1 and azimuth0 = phi_m, so no scratch and no limit on A
+ * (the header promises "no allocation"); opts->azimuth0_rad is therefore not used, and
+ * opts->progress is not called. L_i is the texel containing (theta, phi) (nearest, as
+ * piecewise-constant texels are defined). The normal is used as given. A receiver whose
+ * bilinear height is a hole, whose normal is not finite or whose horizon is NaN gets NaN. */
+hfvis_status hfvis_light_reference(const hfvis_grid *grid, const hfvis_env *env,
+                                             float albedo, const hfvis_sweep_options *opts,
+                                             const hfvis_march_options *march,
+                                             const hfvis_hemisphere_options *hopts,
+                                             const float *points, const float *normals,
+                                             size_t count, float *out)
+{
+    static const float one = 1.0f;
+    hfvis_env uniform;
+    hfvis_sweep_options so;
+    int A = HF_ENV_DEFAULT_AZIMUTH_SAMPLES, Z = HF_ENV_DEFAULT_ZENITH_SAMPLES, C, T, P;
+    size_t i, tmp;
+    double scale;
+    if (!hf_grid_valid(grid) || !isfinite(albedo) || (env != NULL && !hf_env_valid(env)))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (opts != NULL && ((int)opts->border < (int)HFVIS_BORDER_DEFAULT ||
+                         (int)opts->border > (int)HFVIS_BORDER_WRAP || opts->border_cells < 0))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (march != NULL &&
+        (!isfinite(march->step_cells) || march->step_cells < 0.0 ||
+         !isfinite(march->max_distance_cells) || march->max_distance_cells < 0.0))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (hopts != NULL) {
+        if (hopts->azimuth_samples < 0 || hopts->zenith_samples < 0)
+            return HFVIS_ERR_INVALID_ARGUMENT;
+        if (hopts->azimuth_samples != 0) A = hopts->azimuth_samples;
+        if (hopts->zenith_samples != 0) Z = hopts->zenith_samples;
+    }
+    if (env == NULL) {
+        uniform.radiance = &one;
+        uniform.n_theta = uniform.n_phi = uniform.channels = 1;
+        env = &uniform;
+    }
+    C = env->channels;
+    T = env->n_theta;
+    P = env->n_phi;
+    if (count == 0) return HFVIS_OK;
+    if (points == NULL || normals == NULL || out == NULL || !hf_mul_size(count, 3u, &tmp) ||
+        !hf_mul_size(count, (size_t)C, &tmp))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    /* validated up front so that the per-receiver march cannot fail half-way */
+    for (i = 0; i < 2u * count; i++)
+        if (!isfinite(points[i])) return HFVIS_ERR_INVALID_ARGUMENT;
+    so = opts != NULL ? *opts : hfvis_sweep_options_default();
+    so.progress = NULL;
+    so.progress_user = NULL;
+    scale = ((2.0 * HF_PI) / (double)A) * (HF_PI / (double)Z) * (double)albedo / HF_PI;
+    for (i = 0; i < count; i++) {
+        const double nx = (double)normals[3u * i], ny = (double)normals[3u * i + 1u],
+                     nz = (double)normals[3u * i + 2u];
+        double acc[4] = {0.0, 0.0, 0.0, 0.0};
+        int m, j, c, bad = !isfinite(nx) || !isfinite(ny) || !isfinite(nz) ||
+                           isnan(hfvis_grid_sample(grid, (double)points[2u * i],
+                                                   (double)points[2u * i + 1u]));
+        for (m = 0; m < A && !bad; m++) {
+            double phi = (2.0 * HF_PI) * ((double)m + 0.5) / (double)A;
+            double cp = cos(phi), sp = sin(phi), limit;
+            int col = (int)(phi * (double)P / (2.0 * HF_PI));
+            float alpha;
+            hfvis_status st;
+            if (col > P - 1) col = P - 1;
+            so.azimuth0_rad = phi;
+            st = hfvis_horizon_reference(grid, 1, &so, march, points + 2u * i, 1, &alpha);
+            if (st != HFVIS_OK) return st;
+            if (isnan(alpha)) {
+                bad = 1;
+                break;
+            }
+            /* visible iff pi/2 - theta > alpha, i.e. theta < pi/2 - alpha */
+            limit = HF_HALF_PI - (double)alpha;
+            for (j = 0; j < Z; j++) {
+                double theta = HF_PI * ((double)j + 0.5) / (double)Z;
+                double st_ = sin(theta), cosine;
+                const float *L;
+                int row;
+                if (!(theta < limit)) break;
+                cosine = st_ * (nx * cp + ny * sp) + nz * cos(theta);
+                if (!(cosine > 0.0)) continue;
+                row = (int)(theta * (double)T / HF_PI);
+                if (row > T - 1) row = T - 1;
+                L = env->radiance + ((size_t)row * (size_t)P + (size_t)col) * (size_t)C;
+                for (c = 0; c < C; c++) acc[c] += (double)L[c] * cosine * st_;
+            }
+        }
+        for (c = 0; c < C; c++)
+            out[i * (size_t)C + (size_t)c] = (float)(bad ? HF_NAN : acc[c] * scale);
+    }
+    return HFVIS_OK;
+}
+
+/* Environment light fused into the sweep ([P1] §7 "packing and lighting": the per-direction
+ * light is evaluated in lattice space with bilinearly filtered normals and gathered). */
+typedef struct hf_env_ctx {
+    hf_fused f;
+    const hf_env_eval *e;
+} hf_env_ctx;
+
+static void hf_env_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdiff_t step, int n,
+                        const double *t)
+{
+    const hf_env_ctx *c = (const hf_env_ctx *)vctx;
+    int s, ch = sw->channels;
+    (void)m;
+    for (s = 0; s < n; s++, node0 += step) {
+        const float *nr = sw->nrm + node0 * 3;
+        if (isnan(t[s])) continue;
+        hf_env_accumulate(c->e, c->f.k, c->f.lx, c->f.ly, (double)nr[0], (double)nr[1],
+                          (double)nr[2], t[s], sw->lat + node0 * ch);
+    }
+}
+
+hfvis_status hfvis_env_light(const hfvis_grid *grid, int K, const hfvis_env *env, float albedo,
+                             const hfvis_sweep_options *opts, const hfvis_env_options *eopts,
+                             float *out, ptrdiff_t out_stride)
+{
+    hfvis_sweep_options o;
+    hf_sweep sw;
+    hf_env_ctx ctx;
+    hf_env_eval eval;
+    float *table = NULL;
+    hfvis_status s;
+    if (!hf_light_args_valid(grid, K, opts, out, out_stride) || !hf_env_valid(env) ||
+        !isfinite(albedo))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    o = hf_opts_resolve(grid, opts);
+    s = hf_env_tables_create(env, K, o.azimuth0_rad, eopts, o.alloc, &table, &eval);
+    if (s != HFVIS_OK) return s;
+    memset(&ctx, 0, sizeof ctx);
+    ctx.e = &eval;
+    s = hf_fused_run(&sw, grid, K, &o, env->channels, 1, hf_env_line, &ctx.f);
+    if (s == HFVIS_OK) {
+        hf_fused_output(&sw, (double)albedo, 0.0, out, out_stride, env->channels);
+        hf_sweep_free(&sw);
+    }
+    hf_free(o.alloc, table);
+    return s;
+}

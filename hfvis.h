@@ -348,7 +348,7 @@ HFVIS_API hfvis_status hfvis_line_horizons_naive(const double *distance, const d
 /* Raw lattice output of one direction, for GPU-port diffing: the horizon elevation angle at
  * every lattice node of hfvis_lattice_init(width, height, azimuth_rad); NaN at nodes outside the
  * grid and at holes. out must hold hfvis_lattice_size() floats.
- * Allocates 2 blocks (line samples and stack). Cost O(width*height). */
+ * Allocates 1 block of about 8*(W^2+H^2) bytes (the sampled lattice). Cost O(width*height). */
 HFVIS_API hfvis_status hfvis_horizon_lattice(const hfvis_grid *grid, double azimuth_rad,
                                              const hfvis_sweep_options *opts, float *out);
 
@@ -415,13 +415,15 @@ HFVIS_API double hfvis_sector_weight(int K, double nz, double a, double theta);
 /* Uniform sky, fused into the sweep ([P1] §6.1 Eq. 4-5 with the clamp correction of spec §5.2):
  * out = albedo * sky * sum_k S_k(theta_k) at every grid point, computed in lattice space with
  * bilinearly sampled normals and gathered (the paper's pipeline, [P1] §7). No horizon map is
- * stored: memory O(width*height). NaN at holes. Allocates 5 blocks. Cost O(K*width*height). */
+ * stored: one block of about 48*(W^2+H^2) bytes, O(width*height). NaN at holes.
+ * opts->direction_begin/end select a partial sum of the K directions. Cost O(K*width*height). */
 HFVIS_API hfvis_status hfvis_sky_light(const hfvis_grid *grid, int K, float sky, float albedo,
                                        const hfvis_sweep_options *opts, float *out,
                                        ptrdiff_t out_stride);
 
 /* The same from a stored horizon map (hfvis_horizon_map layout), evaluated at grid points with
- * grid normals. map_azimuth0_rad is the psi_0 the map was made with. Allocates 1 block. */
+ * grid normals. map_azimuth0_rad is the psi_0 the map was made with. Allocates 1 block (2K
+ * doubles). */
 HFVIS_API hfvis_status hfvis_sky_light_from_map(const hfvis_grid *grid, int K,
                                                 double map_azimuth0_rad, const float *map,
                                                 float sky, float albedo,
@@ -445,7 +447,7 @@ HFVIS_API hfvis_status hfvis_sky_view_factor_from_map(const hfvis_grid *grid, in
  * disc of that angular radius above the horizon line, 1 - (acos(d) - d sqrt(1-d^2))/pi with
  * d = clamp((elevation - alpha)/radius, -1, 1). Self-shadowing by the receiver's own tangent
  * plane is not included (multiply by max(n.l, 0) for lighting). NaN at holes.
- * Allocates 3 blocks. Cost O(width*height). */
+ * Allocates 1 block (the sampled lattice). Cost O(width*height). */
 HFVIS_API hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad,
                                             double sun_elevation_rad, double sun_radius_rad,
                                             const hfvis_sweep_options *opts, float *out,
@@ -470,8 +472,9 @@ typedef enum hfvis_env_method {
 
 typedef struct hfvis_env_options {
     hfvis_env_method method;  /* default HFVIS_ENV_PREFIX */
-    int lp_normal_res;        /* L_p table theta_n samples, odd; 0 = 15 ([P1] §6.2: 16 is "safe") */
-    int lp_horizon_res;       /* L_p table theta_h samples; 0 = 256 ([P1]'s theta_N) */
+    int lp_normal_res;        /* L_p table theta_n samples, odd and >= 3; 0 = 15 ([P1] §6.2:
+                                 16 is "safe"; odd so that theta_n = 0 is a sample) */
+    int lp_horizon_res;       /* L_p table theta_h samples, >= 2; 0 = 256 ([P1]'s theta_N) */
 } hfvis_env_options;
 
 HFVIS_API hfvis_env_options hfvis_env_options_default(void);
@@ -480,21 +483,28 @@ HFVIS_API hfvis_env_options hfvis_env_options_default(void);
 HFVIS_API size_t hfvis_env_table_size(const hfvis_env *env, int K, const hfvis_env_options *eopts);
 
 /* Build the per-direction tables (prefix integrals or the L_p table) for directions psi_k =
- * azimuth0_rad + 2 pi k / K. table must hold hfvis_env_table_size() floats. Cost: prefix
- * O(K*n_theta*n_phi); L_p table O(K*lp_normal_res*lp_horizon_res*n_phi). */
+ * azimuth0_rad + 2 pi k / K. table must hold hfvis_env_table_size() floats.
+ * Prefix layout: 6*K*(n_theta+1)*channels floats, table[((k*(n_theta+1) + b)*6 + q)*C + c]:
+ * q = 0..2 are A_k, B_k, C_k at the band edge b*pi/n_theta; q = 3..5 band b's sector
+ * phi-integrals of L, L cos(phi - psi_k), L sin(phi - psi_k) (for partial bands).
+ * L_p layout: K*M*T*channels floats, table[((k*M + i)*T + j)*C + c] = L_p^k(theta_n_i, theta_h_j)
+ * with theta_n_i = pi (i/(M-1) - 1/2), theta_h_j = pi j/(T-1), 1/pi included.
+ * Cost: O(K*(n_theta*(n_phi/K + 2) + M*T)*channels). */
 HFVIS_API hfvis_status hfvis_env_table_build(const hfvis_env *env, int K, double azimuth0_rad,
                                              const hfvis_env_options *eopts, float *table);
 
 /* Environment light, fused into the sweep: out[(y*out_stride + x)*channels + c] =
  * albedo/pi * sum_k [Nz A_k + a_k B_k + b_k C_k](theta_k) (prefix) or
  * albedo * sum_k |N_p| L_p^k(theta_n, theta_h) ([P1] Eq. 6), in lattice space, gathered.
- * out_stride in pixels. Allocates the tables and 5 lattice blocks. */
+ * out_stride in pixels. Allocates 2 blocks: the tables (hfvis_env_table_size floats) and the
+ * lattice scratch of hfvis_sky_light (plus channels-1 doubles per node). */
 HFVIS_API hfvis_status hfvis_env_light(const hfvis_grid *grid, int K, const hfvis_env *env,
                                        float albedo, const hfvis_sweep_options *opts,
                                        const hfvis_env_options *eopts, float *out,
                                        ptrdiff_t out_stride);
 
-/* Environment light from a stored horizon map at grid points with grid normals. */
+/* Environment light from a stored horizon map at grid points with grid normals.
+ * Allocates 2 blocks (normals, tables). NaN at holes and where a map value is NaN. */
 HFVIS_API hfvis_status hfvis_env_light_from_map(const hfvis_grid *grid, int K,
                                                 double map_azimuth0_rad, const float *map,
                                                 const hfvis_env *env, float albedo,
@@ -512,7 +522,9 @@ typedef struct hfvis_hemisphere_options {
  * integrates L_o = albedo/pi * Int L_i(w) V(w) max(n.w, 0) dw over the sphere, with V from the
  * exact horizon of the per-receiver ray march (hfvis_horizon_reference with the march options)
  * at every integration azimuth, and n the normal given in normals[3i..3i+2] (unit, z up).
- * env NULL means a uniform sky of radiance 1 (one channel). out[i*channels + c].
+ * env NULL means a uniform sky of radiance 1 (one channel). out[i*channels + c]. Integration
+ * azimuths are absolute (phi_m = 2 pi (m + 1/2)/A): opts->azimuth0_rad and progress are not
+ * used. NaN where the receiver, its normal or its horizon is not finite.
  * Cost O(count*(azimuth_samples*(N + zenith_samples))). No allocation. */
 HFVIS_API hfvis_status hfvis_light_reference(const hfvis_grid *grid, const hfvis_env *env,
                                              float albedo, const hfvis_sweep_options *opts,

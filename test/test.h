@@ -27,7 +27,8 @@ static int test_update_golden;
 #define TEST(name) static void test_##name(void)
 #define RUN(name) do { test_current_failed = 0; test_run_tests++; test_##name(); \
     if (test_current_failed) { test_failed_tests++; fprintf(stderr, "FAIL %s\n", #name); } \
-    else printf("ok   %s\n", #name); fflush(stdout); } while (0)
+    else { printf("ok   %s\n", #name); } \
+    fflush(stdout); } while (0)
 #define TEST_INIT(argc, argv) do { int a_; for (a_ = 1; a_ < (argc); a_++) \
     if (strcmp((argv)[a_], "--update-golden") == 0) test_update_golden = 1; } while (0)
 #define TEST_DONE() (printf("DONE: %d checks, %d failed\nRESULT tests=%d failed=%d checks=%d\n", \
