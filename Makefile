@@ -105,7 +105,7 @@ update-golden:
 fuzz:
 	@mkdir -p build/fuzz
 	@for f in $(FUZZERS); do \
-	  $(FUZZ_CC) -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -I. test/fuzz/$$f.c hfvis.c ssao.c voxel.c -lm -o build/fuzz/$$f || exit 1; \
+	  $(FUZZ_CC) -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. test/fuzz/$$f.c hfvis.c ssao.c voxel.c -lm -o build/fuzz/$$f || exit 1; \
 	  mkdir -p build/fuzz/corpus_$$f; \
 	  build/fuzz/$$f -max_total_time=$(FUZZ_SECONDS) -max_len=4096 build/fuzz/corpus_$$f test/fuzz/seeds/$${f#fuzz_} || exit 1; \
 	done

@@ -121,7 +121,566 @@ static uint64_t hf_mix64(uint64_t x)
     return x ^ (x >> 31);
 }
 
-/* CODEC-FRAGMENT */
+/* ========================================================================================== */
+/* 2. Codecs: PGM (netpbm pgm(5), P2/P5) and PFM (netpbm pfm(5), Pf/PF), in memory and files */
+/* ========================================================================================== */
+/* Header syntax shared by both formats (pgm(5)): tokens are separated by whitespace (space, \t,
+ * \n, \v, \f, \r) and '#' comments, which run to the next CR or LF; numbers are unsigned
+ * decimal and end at whitespace, '#' or the end of the data; binary data starts right after
+ * exactly one whitespace byte following the last header token. PFM writers never emit comments,
+ * but accepting them costs nothing. P2 samples may be separated by comments too, as libnetpbm
+ * reads them.
+ *
+ * hf_img_parse validates everything a decode depends on (header, limits, data length, and every
+ * sample of a P2 file or of a P5 file whose maxval is not 255 or 65535) before anything is
+ * written, so hfvis_image_info_read succeeds exactly when hfvis_image_decode succeeds with a
+ * large enough buffer, and a failed call leaves its outputs untouched. */
+
+#if FLT_RADIX != 2 || FLT_MANT_DIG != 24 || FLT_MAX_EXP != 128
+#error "hfvis: the PFM codec needs IEEE-754 binary32 float"
+#endif
+typedef char hf_img_float_is_4_bytes[sizeof(float) == 4 ? 1 : -1];
+
+typedef struct hf_img_header {
+    hfvis_image_info info;
+    int ascii;            /* P2 */
+    size_t data_offset;   /* first byte of the pixel data (P2: first byte after maxval) */
+    size_t values;        /* width*height*channels */
+} hf_img_header;
+
+static int hf_img_is_space(unsigned char c)
+{
+    return c == ' ' || c == '\t' || c == '\n' || c == '\v' || c == '\f' || c == '\r';
+}
+
+static int hf_img_is_digit(unsigned char c)
+{
+    return c >= '0' && c <= '9';
+}
+
+/* First index at or after i that is neither whitespace nor inside a comment. */
+static size_t hf_img_skip(const unsigned char *p, size_t n, size_t i)
+{
+    while (i < n) {
+        if (p[i] == '#') {
+            while (i < n && p[i] != '\n' && p[i] != '\r') i++;
+        } else if (hf_img_is_space(p[i])) {
+            i++;
+        } else {
+            break;
+        }
+    }
+    return i;
+}
+
+/* Reads the unsigned decimal that follows p[*i] after at least one separator byte. Values above
+ * cap saturate at cap + 1 so the caller can reject them. Returns 0 on a missing separator or
+ * digit (including the end of the data) or a number glued to another character ("12x"). */
+static int hf_img_number(const unsigned char *p, size_t n, size_t *i, unsigned long cap,
+                         unsigned long *value)
+{
+    size_t j = hf_img_skip(p, n, *i);
+    unsigned long v = 0;
+    if (j == *i || j >= n || !hf_img_is_digit(p[j])) return 0;
+    for (; j < n && hf_img_is_digit(p[j]); j++) {
+        unsigned long d = (unsigned long)(p[j] - '0');
+        v = (v > cap || d > cap || v > (cap - d) / 10) ? cap + 1 : v * 10 + d;
+    }
+    if (j < n && !hf_img_is_space(p[j]) && p[j] != '#') return 0;
+    *i = j;
+    *value = v;
+    return 1;
+}
+
+/* Reads the PFM scale after at least one separator byte: [+-] digits [. digits] (or . digits),
+ * optional e[+-]digits, converted from its first 17 significant digits, which is enough to tell
+ * its sign and whether it is zero or overflows a double. Locale-independent (no strtod). */
+static int hf_img_scale(const unsigned char *p, size_t n, size_t *i, double *scale)
+{
+    size_t j = hf_img_skip(p, n, *i);
+    double m = 0.0;
+    long exp10 = 0, e = 0;
+    int negative = 0, e_negative = 0, digits = 0, significant = 0;
+    if (j == *i || j >= n) return 0;
+    if (p[j] == '+' || p[j] == '-') negative = p[j++] == '-';
+    for (; j < n && hf_img_is_digit(p[j]); j++, digits++) {
+        if (significant < 17) {
+            m = m * 10.0 + (double)(p[j] - '0');
+            significant += m != 0.0;
+        } else if (exp10 < 100000) {
+            exp10++;
+        }
+    }
+    if (j < n && p[j] == '.') {
+        for (j++; j < n && hf_img_is_digit(p[j]); j++, digits++) {
+            if (significant < 17 && exp10 > -100000) {
+                m = m * 10.0 + (double)(p[j] - '0');
+                significant += m != 0.0;
+                exp10--;
+            }
+        }
+    }
+    if (digits == 0) return 0;
+    if (j < n && (p[j] == 'e' || p[j] == 'E')) {
+        j++;
+        if (j < n && (p[j] == '+' || p[j] == '-')) e_negative = p[j++] == '-';
+        if (j >= n || !hf_img_is_digit(p[j])) return 0;
+        for (; j < n && hf_img_is_digit(p[j]); j++)
+            if (e < 100000) e = e * 10 + (long)(p[j] - '0');
+    }
+    exp10 += e_negative ? -e : e;
+    if (exp10 > 400) exp10 = 400;
+    if (exp10 < -400) exp10 = -400;
+    /* Two half-size powers: 10^exp10 alone could overflow or underflow where m*10^exp10 does not. */
+    m = m * pow(10.0, (double)(exp10 / 2)) * pow(10.0, (double)(exp10 - exp10 / 2));
+    *i = j;
+    *scale = negative ? -m : m;
+    return 1;
+}
+
+/* P2 samples from p[i]: checks count numbers <= maxval and stores them when out != NULL. */
+static int hf_img_p2_samples(const unsigned char *p, size_t n, size_t i, size_t count,
+                             unsigned long maxval, float *out)
+{
+    size_t k;
+    unsigned long v;
+    for (k = 0; k < count; k++) {
+        if (!hf_img_number(p, n, &i, maxval, &v) || v > maxval) return 0;
+        if (out) out[k] = (float)v;
+    }
+    return 1;
+}
+
+/* P5 samples at p (1 byte each if maxval < 256, else 2 bytes big-endian): checks them against
+ * maxval and stores them when out != NULL. */
+static int hf_img_p5_samples(const unsigned char *p, size_t count, unsigned maxval, float *out)
+{
+    size_t k;
+    for (k = 0; k < count; k++) {
+        unsigned v = maxval < 256 ? p[k] : ((unsigned)p[2 * k] << 8) | p[2 * k + 1];
+        if (v > maxval) return 0;
+        if (out) out[k] = (float)v;
+    }
+    return 1;
+}
+
+/* PFM rows: the file stores the bottom row first (pfm(5)); row 0 of out is the top. */
+static void hf_img_pfm_rows(const unsigned char *p, const hf_img_header *h, float *out)
+{
+    size_t row = (size_t)h->info.width * (size_t)h->info.channels, x;
+    int y;
+    for (y = 0; y < h->info.height; y++) {
+        const unsigned char *src = p + (size_t)(h->info.height - 1 - y) * row * 4;
+        float *dst = out + (size_t)y * row;
+        for (x = 0; x < row; x++, src += 4) {
+            uint32_t u = h->info.big_endian
+                ? ((uint32_t)src[0] << 24) | ((uint32_t)src[1] << 16) | ((uint32_t)src[2] << 8) | src[3]
+                : ((uint32_t)src[3] << 24) | ((uint32_t)src[2] << 16) | ((uint32_t)src[1] << 8) | src[0];
+            memcpy(&dst[x], &u, 4);
+        }
+    }
+}
+
+/* Parses and validates a whole PGM/PFM held in p[0..n); see the section comment. */
+static hfvis_status hf_img_parse(const unsigned char *p, size_t n, hf_img_header *out)
+{
+    hf_img_header h;
+    unsigned long w, ht, maxval = 0;
+    size_t i = 2, bytes;
+    memset(&h, 0, sizeof h);
+    if (n < 2 || p[0] != 'P') return HFVIS_ERR_FORMAT;
+    if (p[1] == '2' || p[1] == '5') {
+        h.info.format = HFVIS_FORMAT_PGM;
+        h.info.channels = 1;
+        h.ascii = p[1] == '2';
+    } else if (p[1] == 'f' || p[1] == 'F') {
+        h.info.format = HFVIS_FORMAT_PFM;
+        h.info.channels = p[1] == 'F' ? 3 : 1;
+    } else {
+        return HFVIS_ERR_FORMAT;
+    }
+    if (!hf_img_number(p, n, &i, INT_MAX, &w) || !hf_img_number(p, n, &i, INT_MAX, &ht))
+        return HFVIS_ERR_FORMAT;
+    if (w > INT_MAX || ht > INT_MAX || w == 0 || ht == 0) return HFVIS_ERR_FORMAT;
+    if (h.info.format == HFVIS_FORMAT_PGM) {
+        if (!hf_img_number(p, n, &i, 65535, &maxval) || maxval < 1 || maxval > 65535)
+            return HFVIS_ERR_FORMAT;
+        h.info.maxval = (int)maxval;
+    } else {
+        double scale;
+        if (!hf_img_scale(p, n, &i, &scale) || !isfinite(scale) || scale == 0.0)
+            return HFVIS_ERR_FORMAT;
+        h.info.big_endian = scale > 0.0;
+    }
+    if (!h.ascii) {
+        if (i >= n || !hf_img_is_space(p[i])) return HFVIS_ERR_FORMAT;
+        i++;
+    }
+    if (w > HFVIS_IMAGE_MAX_DIM || ht > HFVIS_IMAGE_MAX_DIM) return HFVIS_ERR_LIMIT;
+    h.info.width = (int)w;
+    h.info.height = (int)ht;
+    if (!hf_mul_size((size_t)w, (size_t)ht, &h.values)
+        || !hf_mul_size(h.values, (size_t)h.info.channels, &h.values)
+        || h.values > HFVIS_IMAGE_MAX_VALUES)
+        return HFVIS_ERR_LIMIT;
+    h.data_offset = i;
+    if (h.ascii) {
+        if (!hf_img_p2_samples(p, n, i, h.values, maxval, NULL)) return HFVIS_ERR_FORMAT;
+    } else {
+        size_t bytes_per_value = h.info.format == HFVIS_FORMAT_PFM ? 4 : maxval < 256 ? 1 : 2;
+        if (!hf_mul_size(h.values, bytes_per_value, &bytes) || n - i < bytes)
+            return HFVIS_ERR_FORMAT;
+        if (h.info.format == HFVIS_FORMAT_PGM && maxval != 255 && maxval != 65535
+            && !hf_img_p5_samples(p + i, h.values, (unsigned)maxval, NULL))
+            return HFVIS_ERR_FORMAT;
+    }
+    *out = h;
+    return HFVIS_OK;
+}
+
+/* Writes the pixels of a file that hf_img_parse accepted. */
+static void hf_img_write_pixels(const unsigned char *p, size_t n, const hf_img_header *h,
+                                float *out)
+{
+    if (h->info.format == HFVIS_FORMAT_PFM)
+        hf_img_pfm_rows(p + h->data_offset, h, out);
+    else if (h->ascii)
+        (void)hf_img_p2_samples(p, n, h->data_offset, h->values, (unsigned long)h->info.maxval, out);
+    else
+        (void)hf_img_p5_samples(p + h->data_offset, h->values, (unsigned)h->info.maxval, out);
+}
+
+HFVIS_API hfvis_status hfvis_image_info_read(const void *data, size_t size, hfvis_image_info *info)
+{
+    hf_img_header h;
+    hfvis_status s;
+    if (!data || !info) return HFVIS_ERR_INVALID_ARGUMENT;
+    s = hf_img_parse((const unsigned char *)data, size, &h);
+    if (s != HFVIS_OK) return s;
+    *info = h.info;
+    return HFVIS_OK;
+}
+
+HFVIS_API hfvis_status hfvis_image_decode(const void *data, size_t size, float *out,
+                                          size_t out_count, hfvis_image_info *info)
+{
+    hf_img_header h;
+    hfvis_status s;
+    if (!data || !out) return HFVIS_ERR_INVALID_ARGUMENT;
+    s = hf_img_parse((const unsigned char *)data, size, &h);
+    if (s != HFVIS_OK) return s;
+    if (out_count < h.values) return HFVIS_ERR_BUFFER_TOO_SMALL;
+    hf_img_write_pixels((const unsigned char *)data, size, &h, out);
+    if (info) *info = h.info;
+    return HFVIS_OK;
+}
+
+/* Header "P5\n<w> <h>\n<maxval>\n" (maxval > 0) or "Pf\n<w> <h>\n-1.0\n" / "PF..." (maxval 0,
+ * channels 1 or 3), into buf; returns its length, at most HF_IMG_HEADER_MAX bytes. */
+#define HF_IMG_HEADER_MAX 31 /* "P5\n" + 10 digits + ' ' + 10 digits + '\n' + "65535\n" */
+static size_t hf_img_header_text(unsigned char *buf, int width, int height, int channels,
+                                 int maxval)
+{
+    unsigned long fields[3];
+    size_t len = 0, f;
+    fields[0] = (unsigned long)width;
+    fields[1] = (unsigned long)height;
+    fields[2] = (unsigned long)maxval;
+    buf[len++] = 'P';
+    buf[len++] = (unsigned char)(maxval > 0 ? '5' : channels == 3 ? 'F' : 'f');
+    buf[len++] = '\n';
+    for (f = 0; f < (maxval > 0 ? 3u : 2u); f++) {
+        unsigned char digits[12];
+        size_t nd = 0;
+        unsigned long v = fields[f];
+        do {
+            digits[nd++] = (unsigned char)('0' + v % 10);
+            v /= 10;
+        } while (v != 0);
+        while (nd > 0) buf[len++] = digits[--nd];
+        buf[len++] = (unsigned char)(f == 0 ? ' ' : '\n');
+    }
+    if (maxval == 0) {
+        memcpy(buf + len, "-1.0\n", 5);
+        len += 5;
+    }
+    return len;
+}
+
+/* Header plus bytes_per_value*width*height*channels, or 0 if invalid or overflowing. */
+static size_t hf_img_encode_size(int width, int height, int channels, int maxval,
+                                 size_t bytes_per_value)
+{
+    unsigned char header[HF_IMG_HEADER_MAX];
+    size_t values, bytes, head;
+    if (width < 1 || height < 1) return 0;
+    head = hf_img_header_text(header, width, height, channels, maxval);
+    if (!hf_mul_size((size_t)width, (size_t)height, &values)
+        || !hf_mul_size(values, (size_t)channels, &values)
+        || !hf_mul_size(values, bytes_per_value, &bytes) || bytes > SIZE_MAX - head)
+        return 0;
+    return head + bytes;
+}
+
+HFVIS_API size_t hfvis_pfm_encode_size(int width, int height, int channels)
+{
+    if (channels != 1 && channels != 3) return 0;
+    return hf_img_encode_size(width, height, channels, 0, 4);
+}
+
+HFVIS_API size_t hfvis_pgm_encode_size(int width, int height, int maxval)
+{
+    if (maxval < 1 || maxval > 65535) return 0;
+    return hf_img_encode_size(width, height, 1, maxval, maxval < 256 ? 1 : 2);
+}
+
+/* Row y of the caller's image starts at pixels + y*stride*channels: stride >= width, and the
+ * offset of the last row must fit a ptrdiff_t (otherwise no such array can exist). */
+static int hf_img_stride_ok(int width, int height, int channels, ptrdiff_t stride)
+{
+    size_t last;
+    if (stride < width) return 0;
+    return hf_mul_size((size_t)(height - 1), (size_t)stride, &last)
+        && hf_mul_size(last, (size_t)channels, &last) && last <= (size_t)PTRDIFF_MAX;
+}
+
+HFVIS_API hfvis_status hfvis_pfm_encode(const float *pixels, int width, int height, int channels,
+                                        ptrdiff_t stride, void *out, size_t out_capacity,
+                                        size_t *written)
+{
+    unsigned char *dst = (unsigned char *)out;
+    size_t need = hfvis_pfm_encode_size(width, height, channels), row, x;
+    int y;
+    if (!pixels || !out || !written || need == 0
+        || !hf_img_stride_ok(width, height, channels, stride))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (out_capacity < need) return HFVIS_ERR_BUFFER_TOO_SMALL;
+    dst += hf_img_header_text(dst, width, height, channels, 0);
+    row = (size_t)width * (size_t)channels;
+    /* Little-endian (scale -1), bottom row first (pfm(5)). */
+    for (y = height - 1; y >= 0; y--) {
+        const float *src = pixels + (ptrdiff_t)y * stride * channels;
+        for (x = 0; x < row; x++) {
+            uint32_t u;
+            memcpy(&u, &src[x], 4);
+            *dst++ = (unsigned char)(u & 0xffu);
+            *dst++ = (unsigned char)((u >> 8) & 0xffu);
+            *dst++ = (unsigned char)((u >> 16) & 0xffu);
+            *dst++ = (unsigned char)(u >> 24);
+        }
+    }
+    *written = need;
+    return HFVIS_OK;
+}
+
+HFVIS_API hfvis_status hfvis_pgm_encode(const float *pixels, int width, int height,
+                                        ptrdiff_t stride, float lo, float hi, int maxval,
+                                        void *out, size_t out_capacity, size_t *written)
+{
+    unsigned char *dst = (unsigned char *)out;
+    size_t need = hfvis_pgm_encode_size(width, height, maxval);
+    double dlo = (double)lo, range = (double)hi - (double)lo, top = (double)maxval;
+    int x, y;
+    if (!pixels || !out || !written || need == 0 || !isfinite(lo) || !isfinite(hi) || !(lo < hi)
+        || !hf_img_stride_ok(width, height, 1, stride))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (out_capacity < need) return HFVIS_ERR_BUFFER_TOO_SMALL;
+    dst += hf_img_header_text(dst, width, height, 1, maxval);
+    for (y = 0; y < height; y++) {
+        const float *src = pixels + (ptrdiff_t)y * stride;
+        for (x = 0; x < width; x++) {
+            double t = ((double)src[x] - dlo) / range * top;
+            unsigned q;
+            if (!isfinite(src[x]) || !(t > 0.0)) q = 0;
+            else if (t >= top) q = (unsigned)maxval;
+            else q = (unsigned)round(t);
+            if (maxval > 255) *dst++ = (unsigned char)(q >> 8);
+            *dst++ = (unsigned char)(q & 0xffu);
+        }
+    }
+    *written = need;
+    return HFVIS_OK;
+}
+
+#ifndef HFVIS_NO_STDIO
+/* A regular file's size from fseek/ftell is only a first guess for the buffer: special files
+ * (pipes, /proc, directories on some file systems) report 0, fail, or report absurd sizes, so
+ * guesses above this are ignored and the buffer grows by doubling instead. */
+#define HF_IMG_MAX_SIZE_GUESS ((size_t)1 << 31)
+#define HF_IMG_FIRST_CHUNK ((size_t)1 << 16)
+
+/* Reads the whole file into a block from alloc. */
+static hfvis_status hf_img_read_file(const char *path, const hfvis_allocator *alloc,
+                                     unsigned char **data, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    unsigned char *buf;
+    size_t cap = HF_IMG_FIRST_CHUNK, len = 0;
+    long end;
+    if (!f) return HFVIS_ERR_IO;
+    if (fseek(f, 0, SEEK_END) == 0) {
+        end = ftell(f);
+        if (end >= 0 && (unsigned long)end < HF_IMG_MAX_SIZE_GUESS)
+            cap = (size_t)end + 1; /* + 1: the read that meets end of file needs room */
+        if (fseek(f, 0, SEEK_SET) != 0) {
+            fclose(f);
+            return HFVIS_ERR_IO;
+        }
+    } else {
+        clearerr(f); /* unseekable (a pipe): nothing was consumed */
+    }
+    buf = (unsigned char *)hf_alloc(alloc, cap);
+    if (!buf) {
+        fclose(f);
+        return HFVIS_ERR_OUT_OF_MEMORY;
+    }
+    for (;;) {
+        size_t want = cap - len, got = fread(buf + len, 1, want, f);
+        len += got;
+        if (got < want) break;
+        if (len == cap) {
+            unsigned char *bigger;
+            if (cap > SIZE_MAX / 2) {
+                bigger = NULL;
+            } else {
+                bigger = (unsigned char *)hf_alloc(alloc, cap * 2);
+            }
+            if (!bigger) {
+                hf_free(alloc, buf);
+                fclose(f);
+                return HFVIS_ERR_OUT_OF_MEMORY;
+            }
+            memcpy(bigger, buf, len);
+            hf_free(alloc, buf);
+            buf = bigger;
+            cap *= 2;
+        }
+    }
+    if (ferror(f)) {
+        hf_free(alloc, buf);
+        fclose(f);
+        return HFVIS_ERR_IO;
+    }
+    fclose(f);
+    *data = buf;
+    *size = len;
+    return HFVIS_OK;
+}
+
+HFVIS_API hfvis_status hfvis_image_load(const char *path, const hfvis_allocator *alloc,
+                                        float **pixels, hfvis_image_info *info)
+{
+    unsigned char *data;
+    size_t size, bytes;
+    float *px;
+    hf_img_header h;
+    hfvis_status s;
+    if (!path || !pixels || !info) return HFVIS_ERR_INVALID_ARGUMENT;
+    s = hf_img_read_file(path, alloc, &data, &size);
+    if (s != HFVIS_OK) return s;
+    s = hf_img_parse(data, size, &h);
+    if (s == HFVIS_OK) {
+        px = hf_mul_size(h.values, sizeof(float), &bytes) ? (float *)hf_alloc(alloc, bytes) : NULL;
+        if (px) {
+            hf_img_write_pixels(data, size, &h, px);
+            *pixels = px;
+            *info = h.info;
+        } else {
+            s = HFVIS_ERR_OUT_OF_MEMORY;
+        }
+    }
+    hf_free(alloc, data);
+    return s;
+}
+
+/* Writes bytes to "<path>.tmp<8 hex digits>" beside path, then renames it onto path. The
+ * suffix hashes the addresses of the buffer and of a local, which differ between concurrent
+ * calls in one process (and usually between processes); a name already taken is skipped.
+ * On any failure the temporary file is removed and path is untouched. */
+static hfvis_status hf_img_write_file(const char *path, const unsigned char *bytes, size_t n)
+{
+    static const char hex[] = "0123456789abcdef";
+    size_t len = strlen(path), k;
+    const void *addrs[2];
+    unsigned char raw[sizeof addrs];
+    uint32_t tag = 2166136261u; /* FNV-1a */
+    char *tmp;
+    FILE *f = NULL;
+    int attempt, ok;
+    if (len > SIZE_MAX - 16) return HFVIS_ERR_IO;
+    tmp = (char *)hf_alloc(NULL, len + 16);
+    if (!tmp) return HFVIS_ERR_OUT_OF_MEMORY;
+    addrs[0] = bytes;
+    addrs[1] = &len;
+    memcpy(raw, addrs, sizeof raw);
+    for (k = 0; k < sizeof raw; k++) tag = (uint32_t)((tag ^ raw[k]) * 16777619u);
+    memcpy(tmp, path, len);
+    memcpy(tmp + len, ".tmp", 4);
+    tmp[len + 12] = '\0';
+    for (attempt = 0; attempt < 16; attempt++, tag += 0x9e3779b9u) {
+        FILE *existing;
+        for (k = 0; k < 8; k++) tmp[len + 4 + k] = hex[(tag >> (28 - 4 * k)) & 15u];
+        existing = fopen(tmp, "rb");
+        if (!existing) break;
+        fclose(existing);
+    }
+    if (attempt < 16) f = fopen(tmp, "wb");
+    if (!f) {
+        hf_free(NULL, tmp);
+        return HFVIS_ERR_IO;
+    }
+    ok = fwrite(bytes, 1, n, f) == n;
+    ok = (fflush(f) == 0) && ok;
+    ok = (fclose(f) == 0) && ok;
+    if (ok && rename(tmp, path) != 0) {
+#if defined(_WIN32)
+        /* Windows' rename does not replace an existing file: replace non-atomically. */
+        ok = remove(path) == 0 && rename(tmp, path) == 0;
+#else
+        ok = 0;
+#endif
+    }
+    if (!ok) remove(tmp);
+    hf_free(NULL, tmp);
+    return ok ? HFVIS_OK : HFVIS_ERR_IO;
+}
+
+HFVIS_API hfvis_status hfvis_pfm_save(const char *path, const float *pixels, int width,
+                                      int height, int channels, ptrdiff_t stride)
+{
+    size_t need = hfvis_pfm_encode_size(width, height, channels), written = 0;
+    unsigned char *buf;
+    hfvis_status s;
+    if (!path || !pixels || need == 0 || !hf_img_stride_ok(width, height, channels, stride))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    buf = (unsigned char *)hf_alloc(NULL, need);
+    if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
+    s = hfvis_pfm_encode(pixels, width, height, channels, stride, buf, need, &written);
+    if (s == HFVIS_OK) s = hf_img_write_file(path, buf, written);
+    hf_free(NULL, buf);
+    return s;
+}
+
+HFVIS_API hfvis_status hfvis_pgm_save(const char *path, const float *pixels, int width,
+                                      int height, ptrdiff_t stride, float lo, float hi,
+                                      int maxval)
+{
+    size_t need = hfvis_pgm_encode_size(width, height, maxval), written = 0;
+    unsigned char *buf;
+    hfvis_status s;
+    if (!path || !pixels || need == 0 || !isfinite(lo) || !isfinite(hi) || !(lo < hi)
+        || !hf_img_stride_ok(width, height, 1, stride))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    buf = (unsigned char *)hf_alloc(NULL, need);
+    if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
+    s = hfvis_pgm_encode(pixels, width, height, stride, lo, hi, maxval, buf, need, &written);
+    if (s == HFVIS_OK) s = hf_img_write_file(path, buf, written);
+    hf_free(NULL, buf);
+    return s;
+}
+#undef HF_IMG_MAX_SIZE_GUESS
+#undef HF_IMG_FIRST_CHUNK
+#endif /* HFVIS_NO_STDIO */
 
 /* ========================================================================================== */
 /* 3. Analytic test fields (spec heightfield §12)                                             */

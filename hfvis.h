@@ -193,8 +193,9 @@ HFVIS_API hfvis_status hfvis_image_info_read(const void *data, size_t size, hfvi
 HFVIS_API hfvis_status hfvis_image_decode(const void *data, size_t size, float *out,
                                           size_t out_count, hfvis_image_info *info);
 
-/* Bytes needed to encode a width x height image: PFM (channels 1 or 3) or 16-bit binary PGM.
- * Returns 0 for invalid sizes. */
+/* Bytes needed to encode a width x height image: PFM (channels 1 or 3) or binary PGM (8-bit
+ * samples for maxval <= 255, else 16-bit). Returns 0 for invalid sizes. The encoders do not
+ * apply the decoders' HFVIS_IMAGE_MAX_* limits. */
 HFVIS_API size_t hfvis_pfm_encode_size(int width, int height, int channels);
 HFVIS_API size_t hfvis_pgm_encode_size(int width, int height, int maxval);
 
