@@ -848,6 +848,120 @@ TEST(files_teardown)
 /* main: one RUN line per test, grouped by section                                            */
 /* ========================================================================================== */
 
+/* ========================================================================================== */
+/* Failing-allocator sweep over every allocating height-field routine                         */
+/* ========================================================================================== */
+
+#define SWEEP_W 23
+#define SWEEP_H 17
+#define SWEEP_K 8
+static float sweep_z[SWEEP_W * SWEEP_H];
+static float sweep_map[SWEEP_K * SWEEP_W * SWEEP_H];
+static float sweep_env_radiance[4 * 8 * 3];
+
+static hfvis_grid sweep_grid(void)
+{
+    hfvis_grid g;
+    hfvis_field f;
+    memset(&f, 0, sizeof f);
+    f.kind = HFVIS_FIELD_FBM;
+    f.amplitude = 4.0;
+    f.wavelength = 6.0;
+    f.seed = 11;
+    hfvis_field_generate(&f, SWEEP_W, SWEEP_H, SWEEP_W, sweep_z);
+    sweep_z[5 * SWEEP_W + 7] = (float)NAN; /* a hole, so the hole paths run too */
+    g.z = sweep_z;
+    g.width = SWEEP_W;
+    g.height = SWEEP_H;
+    g.stride = SWEEP_W;
+    g.cell_size = 1.5;
+    return g;
+}
+
+static hfvis_env sweep_env(void)
+{
+    hfvis_env e;
+    size_t i;
+    for (i = 0; i < sizeof sweep_env_radiance / sizeof sweep_env_radiance[0]; i++)
+        sweep_env_radiance[i] = 0.25f + 0.01f * (float)(i % 17);
+    e.radiance = sweep_env_radiance;
+    e.n_theta = 4;
+    e.n_phi = 8;
+    e.channels = 3;
+    return e;
+}
+
+/* One allocating call: runs routine r with allocator a, writing into out (capacity floats). */
+static hfvis_status sweep_call(int r, const hfvis_allocator *a, float *out)
+{
+    hfvis_grid g = sweep_grid();
+    hfvis_env env = sweep_env();
+    hfvis_sweep_options o = hfvis_sweep_options_default();
+    hfvis_env_options lp = hfvis_env_options_default();
+    lp.method = HFVIS_ENV_LP_TABLE;
+    o.alloc = a;
+    o.border = (r % 2) ? HFVIS_BORDER_CLAMP : HFVIS_BORDER_OPEN;
+    switch (r) {
+    case 0: return hfvis_horizon_lattice(&g, 0.7, &o, out);
+    case 1: return hfvis_horizon_lattice_naive(&g, 0.7, &o, out);
+    case 2: return hfvis_horizon_direction(&g, SWEEP_K, 3, &o, out, SWEEP_W);
+    case 3: return hfvis_horizon_map(&g, SWEEP_K, &o, out);
+    case 4: return hfvis_sky_light(&g, SWEEP_K, 1.0f, 0.5f, &o, out, SWEEP_W);
+    case 5: return hfvis_sky_light_from_map(&g, SWEEP_K, 0.0, sweep_map, 1.0f, 1.0f, a, out, SWEEP_W);
+    case 6: return hfvis_sky_view_factor(&g, SWEEP_K, &o, out, SWEEP_W);
+    case 7: return hfvis_sun_visibility(&g, 1.0, 0.3, 0.01, &o, out, SWEEP_W);
+    case 8: return hfvis_env_light(&g, SWEEP_K, &env, 1.0f, &o, NULL, out, SWEEP_W);
+    case 9: return hfvis_env_light(&g, SWEEP_K, &env, 1.0f, &o, &lp, out, SWEEP_W);
+    case 10: return hfvis_env_light_from_map(&g, SWEEP_K, 0.0, sweep_map, &env, 1.0f, &lp, a, out, SWEEP_W);
+    default: return HFVIS_ERR_INVALID_ARGUMENT;
+    }
+}
+#define SWEEP_ROUTINES 11
+#define SWEEP_OUT_FLOATS (SWEEP_K * SWEEP_W * SWEEP_H * 4)
+
+TEST(sweeps_failing_allocator)
+{
+    static float out[SWEEP_OUT_FLOATS];
+    hfvis_grid g = sweep_grid();
+    int r;
+    CHECK_EQ_STATUS(hfvis_horizon_map(&g, SWEEP_K, NULL, sweep_map), HFVIS_OK);
+    for (r = 0; r < SWEEP_ROUTINES; r++) {
+        count_alloc state;
+        hfvis_allocator a = count_allocator(&state, 0);
+        long total, k;
+        /* Count the allocations of a successful call; each must be released. */
+        CHECK_EQ_STATUS(sweep_call(r, &a, out), HFVIS_OK);
+        total = state.calls;
+        CHECK(total >= 1);
+        CHECK(state.live == 0);
+        /* Fail allocation k for every k: HFVIS_ERR_OUT_OF_MEMORY, nothing leaked, output untouched. */
+        for (k = 1; k <= total; k++) {
+            hfvis_allocator f = count_allocator(&state, k);
+            memset(out, SENTINEL_BYTE, sizeof out);
+            CHECK_EQ_STATUS(sweep_call(r, &f, out), HFVIS_ERR_OUT_OF_MEMORY);
+            CHECK(state.live == 0);
+            CHECK(all_bytes(out, sizeof out, SENTINEL_BYTE));
+        }
+    }
+}
+
+TEST(oracles_allocate_nothing)
+{
+    /* The ray-march and hemisphere oracles are documented as allocation-free: an allocator that
+     * fails every call must not change their result. */
+    hfvis_grid g = sweep_grid();
+    count_alloc state;
+    hfvis_allocator a = count_allocator(&state, 1);
+    hfvis_sweep_options o = hfvis_sweep_options_default();
+    float pts[4] = {3.0f, 4.0f, 10.5f, 8.25f}, nrm[6] = {0, 0, 1, 0, 0, 1}, out[2 * SWEEP_K], ref[2 * SWEEP_K];
+    o.alloc = &a;
+    CHECK_EQ_STATUS(hfvis_horizon_reference(&g, SWEEP_K, &o, NULL, pts, 2, out), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_horizon_reference(&g, SWEEP_K, NULL, NULL, pts, 2, ref), HFVIS_OK);
+    CHECK(memcmp(out, ref, sizeof out) == 0);
+    CHECK_EQ_STATUS(hfvis_light_reference(&g, NULL, 1.0f, &o, NULL, NULL, pts, nrm, 2, out), HFVIS_OK);
+    CHECK(state.calls == 0);
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
@@ -873,5 +987,8 @@ int main(int argc, char **argv)
     RUN(files_errors);
     RUN(files_load_failing_allocator);
     RUN(files_teardown);
+    /* Height-field routines */
+    RUN(sweeps_failing_allocator);
+    RUN(oracles_allocate_nothing);
     return TEST_DONE();
 }
