@@ -1550,16 +1550,66 @@ static int hf_is_hole(const hfvis_grid *g, int x, int y)
     return !isfinite(g->z[(ptrdiff_t)y * g->stride + x]);
 }
 
-/* Gather the ch-channel lattice output into ch float planes (holes NaN): channel c goes to
- * out + c*plane_step, row stride out_stride. */
-static void hf_gather_planes(const hf_sweep *sw, int ch, float *out, size_t plane_step,
-                             ptrdiff_t out_stride)
+/* Gather of elevation angles. Channel by channel, nodes without a caster (alpha = -pi/2: the
+ * first node of each line, which sees nothing) take part only when no neighbouring node has a
+ * caster: a receiver between a line start and its successor lies inside the grid and does see
+ * terrain ahead, and averaging -pi/2 into its angle is the border artefact spec §3.3 warns of.
+ * Otherwise as hf_gather_apply. */
+static void hf_gather_elevations(const hf_sweep *sw, int ch, const hf_gather *G, double *out)
+{
+    const double *buf = sw->lat;
+    int q, c;
+    for (c = 0; c < ch; c++) {
+        double sum = 0.0, wsum = 0.0, v;
+        int any = 0;
+        for (q = 0; q < 4; q++) {
+            if (G->node[q] < 0) continue;
+            v = buf[G->node[q] * ch + c];
+            if (!isfinite(v)) continue;
+            any = 1;
+            if (v <= -HF_HALF_PI) continue;
+            sum += G->w[q] * v;
+            wsum += G->w[q];
+        }
+        if (wsum > 0.0) out[c] = wsum != 1.0 ? sum / wsum : sum;
+        else if (any) {
+            /* Only line starts around: the nearest node with a caster within two cells (near
+             * corners), else -pi/2. */
+            double best = DBL_MAX;
+            int dx, dy;
+            out[c] = -HF_HALF_PI;
+            for (dy = -1; dy <= 2; dy++)
+                for (dx = -1; dx <= 2; dx++) {
+                    int i = G->ia + dx, j = G->jb + dy;
+                    double ex = (double)dx - G->wa, ey = (double)dy - G->wb, d2 = ex * ex + ey * ey;
+                    if (i < 0 || j < 0 || i >= sw->cols || j >= sw->rows) continue;
+                    v = buf[((ptrdiff_t)j * sw->cols + i) * ch + c];
+                    if (isfinite(v) && v > -HF_HALF_PI && d2 < best) {
+                        best = d2;
+                        out[c] = v;
+                    }
+                }
+        } else {
+            double nv[4];
+            hf_gather_apply(sw, buf, ch, G, nv); /* the nearest-node fallback */
+            out[c] = nv[c];
+        }
+    }
+}
+
+/* Gather the ch-channel lattice elevations into ch float planes (holes NaN): channel c holds
+ * quarter turn m_first + c and goes to out + c*plane_step, row stride out_stride. With the open
+ * border a receiver whose first unit step toward the look direction leaves the grid sees no
+ * terrain: -pi/2, exactly as the per-receiver march decides it (spec §6 item 1). */
+static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out,
+                             size_t plane_step, ptrdiff_t out_stride)
 {
     const hfvis_grid *g = sw->g;
-    int x, y, c;
-    double v[4];
+    int x, y, c, tx, ty;
+    double v[4], lx[4], ly[4];
+    double xmax = (double)(g->width - 1) + HF_LATTICE_EPS, ymax = (double)(g->height - 1) + HF_LATTICE_EPS;
     hf_gather G;
-    int tx, ty;
+    for (c = 0; c < ch; c++) hf_look_dir(sw, m_first + c, &lx[c], &ly[c]);
     for (ty = 0; ty < g->height; ty += HF_TILE)
         for (tx = 0; tx < g->width; tx += HF_TILE)
     for (y = ty; y < g->height && y < ty + HF_TILE; y++)
@@ -1570,8 +1620,15 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, float *out, size_t plan
                 continue;
             }
             hf_gather_setup(sw, x, y, &G);
-            hf_gather_apply(sw, sw->lat, ch, &G, v);
-            for (c = 0; c < ch; c++) out[(size_t)c * plane_step + (size_t)o] = (float)v[c];
+            hf_gather_elevations(sw, ch, &G, v);
+            for (c = 0; c < ch; c++) {
+                if (sw->border == HFVIS_BORDER_OPEN) {
+                    double nx = (double)x + lx[c], ny = (double)y + ly[c];
+                    if (nx < -HF_LATTICE_EPS || ny < -HF_LATTICE_EPS || nx > xmax || ny > ymax)
+                        v[c] = -HF_HALF_PI;
+                }
+                out[(size_t)c * plane_step + (size_t)o] = (float)v[c];
+            }
         }
 }
 
@@ -1686,7 +1743,7 @@ hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, int k,
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HF_NAN);
     hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL);
-    hf_gather_planes(&sw, 1, out, 0, out_stride);
+    hf_gather_planes(&sw, 1, m, out, 0, out_stride);
     hf_sweep_free(&sw);
     hf_progress(&o, 1, 1);
     return HFVIS_OK;
@@ -1718,7 +1775,7 @@ hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_
             hf_progress(&o, ++done, K);
         }
         /* plane k = gidx + m*groups: channel m lands m*groups planes further on */
-        hf_gather_planes(&sw, per, out + (size_t)gidx * plane, (size_t)groups * plane, grid->width);
+        hf_gather_planes(&sw, per, 0, out + (size_t)gidx * plane, (size_t)groups * plane, grid->width);
     }
     hf_sweep_free(&sw);
     return HFVIS_OK;
@@ -2128,17 +2185,11 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HF_NAN);
     hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL);
+    hf_gather_planes(&sw, 1, 0, out, 0, out_stride);
     for (y = 0; y < grid->height; y++)
         for (x = 0; x < grid->width; x++) {
-            double alpha;
-            hf_gather G;
-            if (hf_is_hole(grid, x, y)) alpha = HF_NAN;
-            else {
-                hf_gather_setup(&sw, x, y, &G);
-                hf_gather_apply(&sw, sw.lat, 1, &G, &alpha);
-            }
-            out[(ptrdiff_t)y * out_stride + x] =
-                (float)hf_sun_fraction(sun_elevation_rad, sun_radius_rad, alpha);
+            float *p = out + (ptrdiff_t)y * out_stride + x;
+            *p = (float)hf_sun_fraction(sun_elevation_rad, sun_radius_rad, (double)*p);
         }
     hf_sweep_free(&sw);
     hf_progress(&o, 1, 1);
