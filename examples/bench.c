@@ -83,6 +83,93 @@ static void make_terrain(float *z, int n)
     if ((s = hfvis_field_generate(&f, n, n, n, z)) != HFVIS_OK) die("field", s);
 }
 
+/* Other routines at 512^2 beside their oracles: per-line brute force, ray march, hemisphere. */
+static void bench_others(int n)
+{
+    size_t cells = (size_t)n * (size_t)n;
+    float *z = (float *)xmalloc(sizeof(float) * cells), *out = (float *)xmalloc(sizeof(float) * cells * 3);
+    float *lat, *pts, *ref, *nrm, env_rad[64 * 128 * 3];
+    hfvis_grid g;
+    hfvis_lattice L;
+    hfvis_env env;
+    hfvis_env_options lp = hfvis_env_options_default();
+    hfvis_hemisphere_options ho;
+    double t0, t_fast, t_slow;
+    int i, K = 16, P = 64;
+    size_t nodes;
+    hfvis_status s;
+    make_terrain(z, n);
+    g.z = z;
+    g.width = n;
+    g.height = n;
+    g.stride = n;
+    g.cell_size = 1.0;
+    printf("\n%-38s%4d^2 %12s %12s %9s\n", "other routines at", n, "fast", "baseline", "ratio");
+    /* P1 hull vs the per-line brute force on the same lattice (one direction, 30 deg). */
+    hfvis_lattice_init(&L, n, n, 0.5235987755982988);
+    nodes = hfvis_lattice_size(&L);
+    lat = (float *)xmalloc(sizeof(float) * nodes);
+    t0 = now_s();
+    if ((s = hfvis_horizon_lattice(&g, 0.5235987755982988, NULL, lat)) != HFVIS_OK) die("lattice", s);
+    t_fast = (now_s() - t0) * 1e9 / (double)cells;
+    t0 = now_s();
+    if ((s = hfvis_horizon_lattice_naive(&g, 0.5235987755982988, NULL, lat)) != HFVIS_OK) die("lattice naive", s);
+    t_slow = (now_s() - t0) * 1e9 / (double)cells;
+    printf("%-44s %9.2f ns %9.0f ns %8.0fx\n", "hull lattice vs per-line brute force, /node", t_fast, t_slow, t_slow / t_fast);
+    pts = sample_points(n, P);
+    ref = (float *)xmalloc(sizeof(float) * (size_t)P * (size_t)K);
+    t0 = now_s();
+    if ((s = hfvis_horizon_reference(&g, K, NULL, NULL, pts, (size_t)P, ref)) != HFVIS_OK) die("reference", s);
+    t_slow = (now_s() - t0) * 1e9 / ((double)P * (double)K);
+    t0 = now_s();
+    if ((s = hfvis_sky_view_factor(&g, K, NULL, out, n)) != HFVIS_OK) die("svf", s);
+    t_fast = (now_s() - t0) * 1e9 / ((double)cells * (double)K);
+    printf("%-44s %9.2f ns %9.0f ns %8.0fx\n", "sky-view factor K=16 vs ray march, /rd", t_fast, t_slow, t_slow / t_fast);
+    t0 = now_s();
+    if ((s = hfvis_sun_visibility(&g, 0.7, 0.3, 0.0046, NULL, out, n)) != HFVIS_OK) die("sun", s);
+    t_fast = (now_s() - t0) * 1e9 / (double)cells;
+    printf("%-44s %9.2f ns %9.0f ns %8.0fx\n", "sun visibility (1 sweep) vs ray march, /rcv", t_fast, t_slow, t_slow / t_fast);
+    /* Environment light against the hemisphere oracle (256 azimuths x 512 zenith steps). */
+    for (i = 0; i < 64 * 128 * 3; i++) env_rad[i] = 0.2f + 0.8f * (float)((i / 3) % 128) / 128.0f;
+    env.radiance = env_rad;
+    env.n_theta = 64;
+    env.n_phi = 128;
+    env.channels = 3;
+    nrm = (float *)xmalloc(sizeof(float) * cells * 3);
+    hfvis_normals_compute(&g, nrm);
+    {
+        float *pn = (float *)xmalloc(sizeof(float) * 3 * (size_t)P);
+        int p;
+        for (p = 0; p < P; p++) {
+            size_t idx = (size_t)pts[2 * p + 1] * (size_t)n + (size_t)pts[2 * p];
+            pn[3 * p] = nrm[3 * idx];
+            pn[3 * p + 1] = nrm[3 * idx + 1];
+            pn[3 * p + 2] = nrm[3 * idx + 2];
+        }
+        memset(&ho, 0, sizeof ho);
+        t0 = now_s();
+        if ((s = hfvis_light_reference(&g, &env, 1.0f, NULL, NULL, &ho, pts, pn, (size_t)P, ref)) != HFVIS_OK)
+            die("light reference", s);
+        t_slow = (now_s() - t0) * 1e9 / (double)P;
+        free(pn);
+    }
+    t0 = now_s();
+    if ((s = hfvis_env_light(&g, K, &env, 1.0f, NULL, NULL, out, n)) != HFVIS_OK) die("env", s);
+    t_fast = (now_s() - t0) * 1e9 / (double)cells;
+    printf("%-44s %9.0f ns %9.0f ns %8.0fx\n", "env light prefix K=16 vs hemisphere, /rcv", t_fast, t_slow, t_slow / t_fast);
+    lp.method = HFVIS_ENV_LP_TABLE;
+    t0 = now_s();
+    if ((s = hfvis_env_light(&g, K, &env, 1.0f, NULL, &lp, out, n)) != HFVIS_OK) die("env lp", s);
+    t_fast = (now_s() - t0) * 1e9 / (double)cells;
+    printf("%-44s %9.0f ns %9.0f ns %8.0fx\n", "env light L_p K=16 vs hemisphere, /rcv", t_fast, t_slow, t_slow / t_fast);
+    free(z);
+    free(out);
+    free(lat);
+    free(pts);
+    free(ref);
+    free(nrm);
+}
+
 int main(int argc, char **argv)
 {
     int quick = argc > 1 && strcmp(argv[1], "quick") == 0;
@@ -139,5 +226,6 @@ int main(int argc, char **argv)
         free(z);
         free(light);
     }
+    bench_others(quick ? 256 : 512);
     return 0;
 }
