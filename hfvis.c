@@ -815,9 +815,9 @@ static double hf_bilerp(const float *z, ptrdiff_t stride, int W, int H, double x
         r0 = (double)p[0] * (1.0 - fx) + (double)p[1] * fx;
         r1 = fy != 0.0 ? (double)p[stride] * (1.0 - fx) + (double)p[stride + 1] * fx : 0.0;
     }
-    if (fy == 0.0) return r0;
-    if (fy == 1.0) return r1;
-    return r0 * (1.0 - fy) + r1 * fy;
+    if (fy == 0.0) r1 = r0;
+    else if (fy != 1.0) r1 = r0 * (1.0 - fy) + r1 * fy;
+    return isfinite(r1) ? r1 : HF_NAN; /* a +-Inf tap is a hole too */
 }
 
 static double hf_clampd(double v, double lo, double hi) { return v < lo ? lo : v > hi ? hi : v; }
@@ -1243,10 +1243,12 @@ static double hf_sample_border(const hfvis_grid *g, hfvis_border border, double 
         y1 = y0 + 1 == g->height ? 0 : y0 + 1;
         r0 = fx == 0.0 ? (double)z[y0 * s + x0]
                        : (double)z[y0 * s + x0] * (1.0 - fx) + (double)z[y0 * s + x1] * fx;
-        if (fy == 0.0) return r0;
-        r1 = fx == 0.0 ? (double)z[y1 * s + x0]
-                       : (double)z[y1 * s + x0] * (1.0 - fx) + (double)z[y1 * s + x1] * fx;
-        return r0 * (1.0 - fy) + r1 * fy;
+        if (fy != 0.0) {
+            r1 = fx == 0.0 ? (double)z[y1 * s + x0]
+                           : (double)z[y1 * s + x0] * (1.0 - fx) + (double)z[y1 * s + x1] * fx;
+            r0 = r0 * (1.0 - fy) + r1 * fy;
+        }
+        return isfinite(r0) ? r0 : HF_NAN;
     }
     return hf_bilerp(g->z, g->stride, g->width, g->height,
                      hf_clampd(x, 0.0, (double)(g->width - 1)),
