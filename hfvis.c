@@ -2237,7 +2237,7 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
 /* Defaults of hfvis_env_options ([P1] §6.2: theta_n resolution 16 is "safe", odd counts make
  * N = up exact; theta_h resolution = the paper's theta_N = 256). */
 #define HF_ENV_DEFAULT_LP_NORMAL_RES 15
-#define HF_ENV_DEFAULT_LP_HORIZON_RES 256
+#define HF_ENV_DEFAULT_LP_HORIZON_RES 257
 /* Hemisphere oracle defaults (header). */
 #define HF_ENV_DEFAULT_AZIMUTH_SAMPLES 256
 #define HF_ENV_DEFAULT_ZENITH_SAMPLES 512
@@ -2617,7 +2617,6 @@ static void hf_env_accumulate(const hf_env_eval *e, int k, double cos_psi, doubl
         const float *t00, *t01, *t10, *t11;
         if (tn < -HF_HALF_PI) tn = -HF_HALF_PI;
         if (tn > HF_HALF_PI) tn = HF_HALF_PI;
-        if (theta_h >= tn + HF_HALF_PI) theta_h = HF_PI;
         fi = (tn / HF_PI + 0.5) * (double)(M - 1); /* (M-1)/2 exactly for tn = 0 */
         fj = theta_h / HF_PI * (double)(Th - 1);
         i0 = (int)fi;

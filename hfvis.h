@@ -475,7 +475,9 @@ typedef struct hfvis_env_options {
     hfvis_env_method method;  /* default HFVIS_ENV_PREFIX */
     int lp_normal_res;        /* L_p table theta_n samples, odd and >= 3; 0 = 15 ([P1] §6.2:
                                  16 is "safe"; odd so that theta_n = 0 is a sample) */
-    int lp_horizon_res;       /* L_p table theta_h samples, >= 2; 0 = 256 ([P1]'s theta_N) */
+    int lp_horizon_res;       /* L_p table theta_h samples, >= 2; 0 = 257 ([P1]'s theta_N = 256
+                                 intervals; odd so that theta_h = pi/2 is a sample and a flat
+                                 receiver is exact, spec §12.12) */
 } hfvis_env_options;
 
 HFVIS_API hfvis_env_options hfvis_env_options_default(void);
