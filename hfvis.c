@@ -12,6 +12,8 @@
  *   9. Light: uniform sky ([P1] Eq. 4-5), sky-view factor, sun visibility
  *  10. Environment light: prefix integrals and the L_p table ([P1] Eq. 6-7; spec §5.4),
  *      the hemisphere-integration oracle
+ *  11. P2: the convex-hull tree ([P2] Alg. 1-3, App. A.2; spec §7), visible sets (spec §8),
+ *      intervisibility sweeps, visibility index, indirect light and bounces (spec §9)
  *
  * Paper references: [P1] Timonen & Westerholm, "Scalable Height Field Self-Shadowing",
  * CGF 29(2), 2010 (thesis appendix A.1). "spec" is the project's restatement
@@ -1110,6 +1112,8 @@ typedef struct hf_sweep {
     double *sd;                 /* hull stack distances (heights in lh) */
     float *grid_nrm;            /* width*height*3 grid normals (want_normals) */
     double *gacc;               /* width*height*channels grid accumulator (fused light) */
+    unsigned char *extra;       /* extra_size bytes for the caller (the P2 tree and line data) */
+    size_t extra_size;
     void *block;
     const hfvis_allocator *alloc;
 } hf_sweep;
@@ -1157,10 +1161,11 @@ static int hf_lattice_bound(const hfvis_grid *g)
     return (int)d + 3;
 }
 
-static hfvis_status hf_sweep_alloc(hf_sweep *sw, const hfvis_grid *g, const hfvis_sweep_options *o,
-                                   int want_normals, int channels, int want_gacc)
+static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
+                                         const hfvis_sweep_options *o, int want_normals,
+                                         int channels, int want_gacc, size_t extra_size)
 {
-    size_t total = 0, nodes, gridn, off_rf, off_rl, off_cf, off_cl, off_h, off_n = 0, off_lat,
+    size_t total = 0, off_x = 0, nodes, gridn, off_rf, off_rl, off_cf, off_cl, off_h, off_n = 0, off_lat,
            off_lh, off_lt, off_stk, off_gn = 0, off_ga = 0, linelen;
     int ok = 1, D = hf_lattice_bound(g);
     unsigned char *b;
@@ -1188,6 +1193,7 @@ static hfvis_status hf_sweep_alloc(hf_sweep *sw, const hfvis_grid *g, const hfvi
     off_stk = hf_align_add(&total, linelen, sizeof(double), &ok);
     if (want_normals) off_gn = hf_align_add(&total, gridn, 3 * sizeof(float), &ok);
     if (want_gacc) off_ga = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
+    if (extra_size) off_x = hf_align_add(&total, extra_size, 1, &ok);
     if (!ok) return HFVIS_ERR_LIMIT;
     b = (unsigned char *)hf_alloc(o->alloc, total);
     if (!b) return HFVIS_ERR_OUT_OF_MEMORY;
@@ -1204,6 +1210,8 @@ static hfvis_status hf_sweep_alloc(hf_sweep *sw, const hfvis_grid *g, const hfvi
     sw->sd = (double *)(void *)(b + off_stk);
     sw->grid_nrm = want_normals ? (float *)(void *)(b + off_gn) : NULL;
     sw->gacc = want_gacc ? (double *)(void *)(b + off_ga) : NULL;
+    sw->extra = extra_size ? b + off_x : NULL;
+    sw->extra_size = extra_size;
     if (want_normals) {
         int x, y;
         for (y = 0; y < g->height; y++)
@@ -1218,6 +1226,12 @@ static hfvis_status hf_sweep_alloc(hf_sweep *sw, const hfvis_grid *g, const hfvi
     }
     if (want_gacc) memset(sw->gacc, 0, gridn * (size_t)channels * sizeof(double));
     return HFVIS_OK;
+}
+
+static hfvis_status hf_sweep_alloc(hf_sweep *sw, const hfvis_grid *g, const hfvis_sweep_options *o,
+                                   int want_normals, int channels, int want_gacc)
+{
+    return hf_sweep_alloc_extra(sw, g, o, want_normals, channels, want_gacc, 0);
 }
 
 static void hf_sweep_free(hf_sweep *sw) { hf_free(sw->alloc, sw->block); }
@@ -1932,6 +1946,10 @@ static double hf_sky_term(double t, double nz, double a, double inv_k, double lo
 typedef struct hf_fused {
     int K, k;
     double lx, ly;          /* look direction of direction k */
+    size_t extra_size;      /* extra scratch bytes the consumer needs (sw->extra) */
+    /* optional hooks: after a group's lattice is sampled, and instead of the P1 line walk */
+    void (*group)(hf_sweep *sw, struct hf_fused *ctx);
+    void (*orient)(hf_sweep *sw, int m, struct hf_fused *ctx);
 } hf_fused;
 
 static hfvis_status hf_direction_range(const hfvis_sweep_options *o, int K, int *begin, int *end)
@@ -1958,7 +1976,8 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
     hfvis_status s;
     int begin, end, per, groups, gidx, m, done = 0;
     if ((s = hf_direction_range(o, K, &begin, &end)) != HFVIS_OK) return s;
-    if ((s = hf_sweep_alloc(sw, grid, o, want_normals, channels, 1)) != HFVIS_OK) return s;
+    if ((s = hf_sweep_alloc_extra(sw, grid, o, want_normals, channels, 1, ctx->extra_size)) != HFVIS_OK)
+        return s;
     per = K % 4 == 0 ? 4 : 1;
     groups = K / per;
     for (gidx = 0; gidx < groups; gidx++) {
@@ -1977,13 +1996,15 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
             int c;
             for (c = 0; c < channels; c++) sw->lat[i * (size_t)channels + (size_t)c] = isnan(sw->h[i]) ? HF_NAN : 0.0;
         }
+        if (ctx->group) ctx->group(sw, ctx);
         for (m = 0; m < per; m++) {
             int k = gidx + m * groups;
             if (k < begin || k >= end) continue;
             ctx->K = K;
             ctx->k = k;
             hf_look_dir(sw, m, &ctx->lx, &ctx->ly);
-            hf_sweep_orientation(sw, m, 0, fn, ctx);
+            if (ctx->orient) ctx->orient(sw, m, ctx);
+            else hf_sweep_orientation(sw, m, 0, fn, ctx);
             hf_progress(o, ++done, end - begin);
         }
         hf_gather_accumulate(sw);
@@ -2904,5 +2925,833 @@ hfvis_status hfvis_env_light(const hfvis_grid *grid, int K, const hfvis_env *env
         hf_sweep_free(&sw);
     }
     hf_free(o.alloc, table);
+    return s;
+}
+
+/* ========================================================================================== */
+/* 11. P2: the convex-hull tree, intervisibility, indirect light                              */
+/* ========================================================================================== */
+/* [P2] Timonen, "Low-Complexity Intervisibility in Height Fields", CGF 31(8), 2012 (thesis
+ * appendix A.2); spec §7-9. Terms: samples p_0..p_n pushed in order of increasing distance,
+ * R = p_n the receiver; "convex" = a cap (p_i above the chord of its neighbours, [P2] Eq. 1);
+ * a segment starts where a convex section follows a concave one. The tree is the union of the
+ * upper hulls S_j from every segment start j to R ([P2] Eq. 2); the root is R and its children,
+ * farthest first, are the horizons. */
+
+struct hfvis_hull_tree {
+    int cap, n;                 /* capacity and samples pushed */
+    hfvis_tree_order order;
+    int safe_zone, zone_steps;
+    long long iterations;
+    double *d, *h;              /* the samples */
+    int *fc, *ns, *ps;          /* first child, next and previous sibling (spec §7.7) */
+    signed char *seg, *cls;     /* segment-start flag; convexity class +1 cap, -1 cup */
+    int *pc, *pp;               /* pending (child, parent) tests: stack or ring queue */
+    /* SafeZoneUpdate state ([P2] Alg. 3): a chord below every root child's line gc -> c */
+    int zone_valid;
+    double zone_b1, zone_b2, zone_h1, zone_h2, zone_scale;
+};
+
+
+static size_t hf_tree_header(void) { return (sizeof(struct hfvis_hull_tree) + 15u) & ~(size_t)15u; }
+
+size_t hfvis_hull_tree_size(int max_samples)
+{
+    size_t n, per, total;
+    if (max_samples < 1) return 0;
+    n = (size_t)max_samples;
+    per = 2 * sizeof(double) + 5 * sizeof(int) + 2 * sizeof(signed char);
+    if (!hf_mul_size(n, per, &total) || total > SIZE_MAX - hf_tree_header() - 64) return 0;
+    return hf_tree_header() + total + 64; /* + alignment slack between the arrays */
+}
+
+hfvis_status hfvis_hull_tree_init(void *mem, size_t mem_size, int max_samples,
+                                  const hfvis_tree_options *opts, hfvis_hull_tree **tree)
+{
+    struct hfvis_hull_tree *t;
+    unsigned char *p;
+    size_t need = hfvis_hull_tree_size(max_samples), n;
+    if (!mem || !tree || need == 0 || ((uintptr_t)mem & 7u) != 0) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (opts && (opts->order < HFVIS_TREE_DEFAULT || opts->order > HFVIS_TREE_BREADTH_FIRST ||
+                 opts->safe_zone < 0 || opts->safe_zone > 1 || opts->safe_zone_steps < 0))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (mem_size < need) return HFVIS_ERR_BUFFER_TOO_SMALL;
+    n = (size_t)max_samples;
+    t = (struct hfvis_hull_tree *)mem;
+    memset(t, 0, sizeof *t);
+    t->cap = max_samples;
+    t->order = opts && opts->order ? opts->order : HFVIS_TREE_DEPTH_FIRST;
+    t->safe_zone = opts ? opts->safe_zone : 0;
+    t->zone_steps = opts && opts->safe_zone_steps ? opts->safe_zone_steps : 4;
+    p = (unsigned char *)mem + hf_tree_header();
+    t->d = (double *)(void *)p;
+    p += n * sizeof(double);
+    t->h = (double *)(void *)p;
+    p += n * sizeof(double);
+    t->fc = (int *)(void *)p;
+    p += n * sizeof(int);
+    t->ns = (int *)(void *)p;
+    p += n * sizeof(int);
+    t->ps = (int *)(void *)p;
+    p += n * sizeof(int);
+    t->pc = (int *)(void *)p;
+    p += n * sizeof(int);
+    t->pp = (int *)(void *)p;
+    p += n * sizeof(int);
+    t->seg = (signed char *)p;
+    p += n;
+    t->cls = (signed char *)p;
+    *tree = t;
+    return HFVIS_OK;
+}
+
+void hfvis_hull_tree_reset(hfvis_hull_tree *tree)
+{
+    if (!tree) return;
+    tree->n = 0;
+    tree->iterations = 0;
+    tree->zone_valid = 0;
+}
+
+int hfvis_hull_tree_count(const hfvis_hull_tree *tree) { return tree ? tree->n : 0; }
+
+long long hfvis_hull_tree_iterations(const hfvis_hull_tree *tree) { return tree ? tree->iterations : 0; }
+
+/* convex(c -> p -> r): p strictly above the chord c-r (spec §7.3; strict, so collinear points
+ * are not kept: the tree then matches the naive rule with >=, spec §7.6). */
+static int hf_tree_convex(const hfvis_hull_tree *t, int c, int p, int r)
+{
+    return (t->h[p] - t->h[c]) * (t->d[r] - t->d[c]) > (t->h[r] - t->h[c]) * (t->d[p] - t->d[c]);
+}
+
+/* Unlink node x from the root list of root r. */
+static void hf_tree_unlink(hfvis_hull_tree *t, int x, int r)
+{
+    if (t->ps[x] >= 0) t->ns[t->ps[x]] = t->ns[x];
+    else t->fc[r] = t->ns[x];
+    if (t->ns[x] >= 0) t->ps[t->ns[x]] = t->ps[x];
+}
+
+/* SafeZoneUpdate ([P2] Alg. 3; spec §7.10): over the window [b1, b2] starting at the current
+ * distance, the lowest of the lines gc -> c (c a root child, gc its first child) at both ends;
+ * the chord between them lies below all those lines on the window (a minimum of lines is
+ * concave). */
+static void hf_tree_zone_refresh(hfvis_hull_tree *t, int r)
+{
+    double step = r > 0 ? t->d[r] - t->d[r - 1] : 1.0, h1 = HF_INF, h2 = HF_INF, scale = 0.0;
+    int c;
+    t->zone_b1 = t->d[r];
+    t->zone_b2 = t->d[r] + step * (double)t->zone_steps;
+    for (c = t->fc[r]; c >= 0; c = t->ns[c]) {
+        int gc = t->fc[c];
+        double slope;
+        if (gc < 0) continue;
+        slope = (t->h[c] - t->h[gc]) / (t->d[c] - t->d[gc]);
+        h1 = fmin(h1, t->h[c] + slope * (t->zone_b1 - t->d[c]));
+        h2 = fmin(h2, t->h[c] + slope * (t->zone_b2 - t->d[c]));
+        scale = fmax(scale, fabs(t->h[c]) + fabs(slope * (t->zone_b2 - t->d[c])));
+    }
+    t->zone_scale = scale;
+    t->zone_h1 = h1;
+    t->zone_h2 = h2;
+    t->zone_valid = 1;
+}
+
+/* The shortcut applies when the new sample r only replaces the old root o: the last child of o
+ * fails its test (so every child fails, spec §7.3), and r lies strictly below every line
+ * gc -> c (so every first grandchild passes). Never when o is a segment start: its leaf would be
+ * lost (spec §7.10). */
+static int hf_tree_zone_applies(hfvis_hull_tree *t, int o, int r)
+{
+    int last = t->fc[o], chord_ok;
+    double x = t->d[r];
+    if (!t->zone_valid || t->seg[o] || last < 0) return 0;
+    if (x < t->zone_b1 || x > t->zone_b2) return 0;
+    if (isinf(t->zone_h1) || isinf(t->zone_h2)) chord_ok = 1; /* no grandchild anywhere */
+    else {
+        double w = t->zone_b2 > t->zone_b1 ? (x - t->zone_b1) / (t->zone_b2 - t->zone_b1) : 0.0;
+        double chord = t->zone_h1 + (t->zone_h2 - t->zone_h1) * w;
+        /* The chord is built from rounded slopes: keep a margin far above their rounding error
+         * (~1e-15 of the largest term), so a sample on or near a line (a tie, which the exact
+         * test would not call convex) never takes the shortcut. */
+        chord_ok = t->h[r] < chord - 1e-9 * (t->zone_scale + fabs(t->h[r]) + 1.0);
+    }
+    if (!chord_ok) return 0;
+    while (t->ns[last] >= 0) last = t->ns[last];
+    t->iterations++;
+    return !hf_tree_convex(t, last, o, r);
+}
+
+hfvis_status hfvis_hull_tree_push(hfvis_hull_tree *t, double distance, double height,
+                                  int *horizon_count)
+{
+    int k, o, r, i, top = 0, head = 0, tail = 0;
+    if (!t || !isfinite(distance) || !isfinite(height)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (t->n > 0 && !(distance > t->d[t->n - 1])) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (t->n >= t->cap) return HFVIS_ERR_LIMIT;
+    k = t->n++;
+    t->d[k] = distance;
+    t->h[k] = height;
+    t->fc[k] = t->ns[k] = t->ps[k] = -1;
+    t->seg[k] = 0;
+    t->cls[k] = 1;
+    if (k == 0) { /* p_0 is a segment start, a permanent leaf */
+        t->seg[0] = 1;
+        if (horizon_count) *horizon_count = 0;
+        return HFVIS_OK;
+    }
+    o = k - 1;
+    r = k;
+    if (k >= 2) {
+        /* [P2] Eq. 1 for p_i, i = k-1, now that p_{i+1} is known (non-uniform spacing form of
+         * spec §7.1); collinear inherits the previous class. */
+        double lhs, rhs;
+        i = k - 1;
+        lhs = (t->h[i] - t->h[i - 1]) * (t->d[i + 1] - t->d[i - 1]);
+        rhs = (t->h[i + 1] - t->h[i - 1]) * (t->d[i] - t->d[i - 1]);
+        t->cls[i] = lhs > rhs ? 1 : lhs < rhs ? -1 : t->cls[i - 1];
+        /* spec §7.4 (b): mark the segment start before RecConvexity, so the leaf stays in the
+         * root list when orphaned and is among this step's horizons */
+        if (t->cls[i] == 1 && t->cls[i - 1] == -1) t->seg[i] = 1;
+    }
+    if (t->safe_zone && hf_tree_zone_applies(t, o, r)) {
+        /* The new root adopts the old root's children; nothing deeper changes. */
+        t->fc[r] = t->fc[o];
+        t->fc[o] = -1;
+    } else {
+        t->fc[r] = o;
+        t->ns[o] = t->ps[o] = -1;
+        if (t->fc[o] >= 0) {
+            t->pc[0] = t->fc[o];
+            t->pp[0] = o;
+            top = tail = 1;
+        }
+        /* RecConvexity ([P2] Alg. 1) with an explicit stack (LIFO) or queue (FIFO, Alg. 2's
+         * breadth-first order); at most one pending test per root child, so cap entries do. */
+        while (t->order == HFVIS_TREE_BREADTH_FIRST ? head != tail : top > 0) {
+            int c, p, next;
+            if (t->order == HFVIS_TREE_BREADTH_FIRST) {
+                c = t->pc[head];
+                p = t->pp[head];
+                head = head + 1 == t->cap ? 0 : head + 1;
+            } else {
+                top--;
+                c = t->pc[top];
+                p = t->pp[top];
+            }
+            t->iterations++;
+            if (hf_tree_convex(t, c, p, r)) continue;
+            /* detach c, p's first child (the sibling is saved first: A.2 erratum, spec §7.5) */
+            next = t->ns[c];
+            t->fc[p] = next;
+            if (next >= 0) t->ps[next] = -1;
+            /* insert c into the root list just before p */
+            t->ps[c] = t->ps[p];
+            t->ns[c] = p;
+            if (t->ps[p] >= 0) t->ns[t->ps[p]] = c;
+            else t->fc[r] = c;
+            t->ps[p] = c;
+            if (t->fc[p] >= 0) { /* step wider */
+                if (t->order == HFVIS_TREE_BREADTH_FIRST) {
+                    t->pc[tail] = t->fc[p];
+                    t->pp[tail] = p;
+                    tail = tail + 1 == t->cap ? 0 : tail + 1;
+                } else {
+                    t->pc[top] = t->fc[p];
+                    t->pp[top++] = p;
+                }
+            } else if (!t->seg[p]) {
+                hf_tree_unlink(t, p, r); /* delete the orphan; segment starts stay as leaves */
+            }
+            if (t->fc[c] >= 0) { /* step deeper */
+                if (t->order == HFVIS_TREE_BREADTH_FIRST) {
+                    t->pc[tail] = t->fc[c];
+                    t->pp[tail] = c;
+                    tail = tail + 1 == t->cap ? 0 : tail + 1;
+                } else {
+                    t->pc[top] = t->fc[c];
+                    t->pp[top++] = c;
+                }
+            }
+        }
+        if (t->safe_zone) hf_tree_zone_refresh(t, r);
+    }
+    if (t->safe_zone && t->zone_valid && t->d[r] > t->zone_b2) hf_tree_zone_refresh(t, r);
+    if (horizon_count) {
+        int m = 0, c;
+        for (c = t->fc[r]; c >= 0; c = t->ns[c]) m++;
+        *horizon_count = m;
+    }
+    return HFVIS_OK;
+}
+
+/* Elevation slope of sample q seen from receiver s. */
+static double hf_slope_from(const double *d, const double *h, int s, int q)
+{
+    return (h[q] - h[s]) / (d[s] - d[q]);
+}
+
+int hfvis_hull_tree_horizons(const hfvis_hull_tree *tree, int minimal, int *out, int cap)
+{
+    int r, c, m = 0;
+    if (!tree || (cap > 0 && !out) || cap < 0) return -1;
+    if (tree->n < 2) return 0;
+    r = tree->n - 1;
+    for (c = tree->fc[r]; c >= 0; c = tree->ns[c]) {
+        /* spec §7.6: a root child whose predecessor is visible too is a segment start seen from
+         * above, not a tangent point; the filter keeps c = 0 or a hidden predecessor */
+        if (minimal && c > 0 &&
+            !(hf_slope_from(tree->d, tree->h, r, c - 1) < hf_slope_from(tree->d, tree->h, r, c)))
+            continue;
+        if (m < cap) out[m] = c;
+        m++;
+    }
+    return m;
+}
+
+/* Enumerate the visible samples from a horizon list (spec §8), farthest first, skipping holes.
+ * The q < next guard keeps runs of spurious horizons from overlapping. */
+static int hf_visible_from_horizons(const double *d, const double *h, int s, const int *H, int m,
+                                    int *out, int cap)
+{
+    int r, count = 0;
+    for (r = 0; r < m; r++) {
+        int next = r + 1 < m ? H[r + 1] : s, q = H[r];
+        double lim = r + 1 < m ? hf_slope_from(d, h, s, H[r + 1]) : -HF_INF;
+        for (; q < next; q++) {
+            if (!isfinite(h[q])) continue;
+            if (q != H[r] && !(hf_slope_from(d, h, s, q) >= lim)) break;
+            if (count < cap) out[count] = q;
+            count++;
+        }
+    }
+    return count;
+}
+
+static int hf_line_args_ok(const double *distance, const double *height, int receiver, int cap,
+                           const int *out)
+{
+    return distance && height && receiver >= 0 && cap >= 0 && (cap == 0 || out);
+}
+
+int hfvis_line_visible_from_horizons(const double *distance, const double *height, int receiver,
+                                     const int *horizons, int m, int *out, int cap)
+{
+    int r;
+    if (!hf_line_args_ok(distance, height, receiver, cap, out) || m < 0 || (m > 0 && !horizons))
+        return -1;
+    for (r = 0; r < m; r++)
+        if (horizons[r] < 0 || horizons[r] >= receiver || (r > 0 && horizons[r] <= horizons[r - 1]))
+            return -1;
+    return hf_visible_from_horizons(distance, height, receiver, horizons, m, out, cap);
+}
+
+/* The naive visible set (spec §8): walking outward from the receiver, a sample is visible when
+ * its slope is >= the running maximum. Written near to far into tmp order reversed on output. */
+static int hf_visible_naive(const double *d, const double *h, int s, int *out, int cap)
+{
+    double best = -HF_INF;
+    int q, count = 0, i;
+    for (q = s - 1; q >= 0; q--) {
+        double t;
+        if (!isfinite(h[q])) continue;
+        t = hf_slope_from(d, h, s, q);
+        if (t >= best) {
+            best = t;
+            count++;
+        }
+    }
+    /* second pass writes farthest first without scratch */
+    i = count;
+    best = -HF_INF;
+    for (q = s - 1; q >= 0; q--) {
+        double t;
+        if (!isfinite(h[q])) continue;
+        t = hf_slope_from(d, h, s, q);
+        if (t >= best) {
+            best = t;
+            i--;
+            if (i < cap) out[i] = q;
+        }
+    }
+    return count;
+}
+
+int hfvis_line_visible_naive(const double *distance, const double *height, int receiver, int *out,
+                             int cap)
+{
+    if (!hf_line_args_ok(distance, height, receiver, cap, out)) return -1;
+    return hf_visible_naive(distance, height, receiver, out, cap);
+}
+
+int hfvis_line_local_horizons_naive(const double *distance, const double *height, int receiver,
+                                    int *out, int cap)
+{
+    double best = -HF_INF;
+    int q, count = 0, prev_visible = 0, i;
+    if (!hf_line_args_ok(distance, height, receiver, cap, out)) return -1;
+    /* visible flags near to far; a horizon is a visible sample whose farther neighbour (the next
+     * finite sample outward) is not visible, or the farthest finite sample if visible */
+    for (i = 0; i < 2; i++) {
+        int k = count;
+        best = -HF_INF;
+        prev_visible = 0;
+        count = 0;
+        for (q = receiver - 1; q >= -1; q--) {
+            int vis = 0;
+            if (q >= 0) {
+                double t;
+                if (!isfinite(height[q])) continue;
+                t = hf_slope_from(distance, height, receiver, q);
+                if (t >= best) {
+                    best = t;
+                    vis = 1;
+                }
+            }
+            if (prev_visible && !vis) {
+                /* the previous visible sample (nearer to the receiver) was a horizon */
+                if (i == 1) {
+                    k--;
+                    if (k < cap) out[k] = prev_visible - 1;
+                }
+                count++;
+            }
+            prev_visible = vis ? q + 1 : 0;
+        }
+    }
+    return count;
+}
+
+/* ---- The field sweep with the tree ([P2] §3: the same lattice and gather as P1) ---------- */
+
+typedef struct hf_p2_ctx hf_p2_ctx;
+/* Per-receiver consumer: node = lattice buffer index of the receiver, s = its index in the
+ * line arrays, vis[0..nv-1] its visible samples farthest first. */
+typedef void (*hf_p2_fn)(hf_sweep *sw, hf_p2_ctx *c, ptrdiff_t node, int s, const int *vis, int nv,
+                         const int *hz, int nh);
+
+struct hf_p2_ctx {
+    hf_fused f;
+    int naive;                  /* 1 = naive visible sets (the oracle) */
+    const hfvis_tree_options *tree_opts;
+    hf_p2_fn fn;
+    /* line data, carved out of sw->extra */
+    int len;                    /* capacity: longest line + pre-roll */
+    hfvis_hull_tree *tree;
+    double *ld, *lh;            /* pushed samples: distance (cells), height (cells) */
+    double *wd, *wh;            /* the same in world units (callback events) */
+    double *le;                 /* exit radiance of the pushed samples, channels each */
+    int *vis, *hz;
+    double *lat_exit;           /* per group: exit radiance at the lattice nodes */
+    int npre;                   /* pre-roll samples pushed on the current line */
+    /* consumers */
+    const float *exit;          /* grid exit radiance, channels interleaved (indirect) */
+    int channels;
+    double sky, inv_k, lobe;
+    hfvis_visibility_fn user_fn;
+    void *user;
+    hfvis_visibility_stats st;
+};
+
+static size_t hf_p2_extra_size(const hfvis_grid *g, const hfvis_sweep_options *o, int channels,
+                               int *len_out, int *ok)
+{
+    size_t total = 0, D = (size_t)hf_lattice_bound(g), len, tree;
+    len = D + (size_t)(o->border == HFVIS_BORDER_OPEN ? 0 : o->border_cells);
+    if (len > (size_t)INT_MAX / 2 || D * D / D != D) {
+        *ok = 0;
+        return 0;
+    }
+    tree = hfvis_hull_tree_size((int)len);
+    if (tree == 0) *ok = 0;
+    hf_align_add(&total, tree, 1, ok);
+    hf_align_add(&total, len, 4 * sizeof(double), ok);
+    hf_align_add(&total, len, (size_t)channels * sizeof(double), ok);
+    hf_align_add(&total, len, 2 * sizeof(int), ok);
+    if (channels) hf_align_add(&total, D * D, (size_t)channels * sizeof(double), ok);
+    *len_out = (int)len;
+    return total;
+}
+
+static void hf_p2_carve(hf_sweep *sw, hf_p2_ctx *c)
+{
+    size_t total = 0, o_tree, o_line, o_exit, o_int, o_lat = 0, len = (size_t)c->len;
+    size_t D = (size_t)hf_lattice_bound(sw->g);
+    int ok = 1;
+    size_t tree = hfvis_hull_tree_size(c->len);
+    o_tree = hf_align_add(&total, tree, 1, &ok);
+    o_line = hf_align_add(&total, len, 4 * sizeof(double), &ok);
+    o_exit = hf_align_add(&total, len, (size_t)c->channels * sizeof(double), &ok);
+    o_int = hf_align_add(&total, len, 2 * sizeof(int), &ok);
+    if (c->channels) o_lat = hf_align_add(&total, D * D, (size_t)c->channels * sizeof(double), &ok);
+    HFVIS_ASSERT(ok && total <= sw->extra_size);
+    hfvis_hull_tree_init(sw->extra + o_tree, tree, c->len, c->tree_opts, &c->tree);
+    c->ld = (double *)(void *)(sw->extra + o_line);
+    c->lh = c->ld + len;
+    c->wd = c->lh + len;
+    c->wh = c->wd + len;
+    c->le = (double *)(void *)(sw->extra + o_exit);
+    c->vis = (int *)(void *)(sw->extra + o_int);
+    c->hz = c->vis + len;
+    c->lat_exit = c->channels ? (double *)(void *)(sw->extra + o_lat) : NULL;
+}
+
+/* Bilinear sample of a channels-interleaved grid array at an in-domain position (or under the
+ * border rule outside), like the heights. */
+static void hf_sample_channels(const hfvis_grid *g, hfvis_border border, const float *a, int ch,
+                               double x, double y, double *out)
+{
+    int c;
+    double fx, fy, w[4];
+    int xi[2], yi[2], q;
+    double W = (double)g->width, H = (double)g->height;
+    if (border == HFVIS_BORDER_WRAP) {
+        x = x - W * floor(x / W);
+        y = y - H * floor(y / H);
+        xi[0] = (int)floor(x);
+        yi[0] = (int)floor(y);
+        if (xi[0] >= g->width) xi[0] = g->width - 1;
+        if (yi[0] >= g->height) yi[0] = g->height - 1;
+        fx = x - (double)xi[0];
+        fy = y - (double)yi[0];
+        xi[1] = xi[0] + 1 == g->width ? 0 : xi[0] + 1;
+        yi[1] = yi[0] + 1 == g->height ? 0 : yi[0] + 1;
+    } else {
+        x = hf_clampd(x, 0.0, W - 1.0);
+        y = hf_clampd(y, 0.0, H - 1.0);
+        xi[0] = g->width > 1 ? (int)floor(x) : 0;
+        yi[0] = g->height > 1 ? (int)floor(y) : 0;
+        if (xi[0] > g->width - 2) xi[0] = g->width > 1 ? g->width - 2 : 0;
+        if (yi[0] > g->height - 2) yi[0] = g->height > 1 ? g->height - 2 : 0;
+        fx = g->width > 1 ? x - (double)xi[0] : 0.0;
+        fy = g->height > 1 ? y - (double)yi[0] : 0.0;
+        xi[1] = g->width > 1 ? xi[0] + 1 : 0;
+        yi[1] = g->height > 1 ? yi[0] + 1 : 0;
+    }
+    w[0] = (1.0 - fx) * (1.0 - fy);
+    w[1] = fx * (1.0 - fy);
+    w[2] = (1.0 - fx) * fy;
+    w[3] = fx * fy;
+    for (c = 0; c < ch; c++) out[c] = 0.0;
+    for (q = 0; q < 4; q++) {
+        const float *p;
+        if (w[q] == 0.0) continue;
+        p = a + ((size_t)yi[q >> 1] * (size_t)g->width + (size_t)xi[q & 1]) * (size_t)ch;
+        for (c = 0; c < ch; c++) out[c] += w[q] * (double)p[c];
+    }
+}
+
+/* Group hook: exit radiance at the lattice nodes (bilinear, as the heights). */
+static void hf_p2_group(hf_sweep *sw, hf_fused *f)
+{
+    hf_p2_ctx *c = (hf_p2_ctx *)(void *)f;
+    const hfvis_lattice *L = &sw->L;
+    int j, i;
+    if (!c->tree) hf_p2_carve(sw, c);
+    if (!c->channels) return;
+    for (j = 0; j < sw->rows; j++)
+        for (i = sw->row_first[j]; i <= sw->row_last[j]; i++) {
+            double x, y;
+            hf_node_pos(L, i + L->i_min, j + L->j_min, &x, &y);
+            hf_sample_channels(sw->g, HFVIS_BORDER_CLAMP, c->exit, c->channels, x, y,
+                               c->lat_exit + ((size_t)j * (size_t)sw->cols + (size_t)i) * (size_t)c->channels);
+        }
+}
+
+/* Orientation hook: walk each line of quarter turn m, push its samples into the tree (or keep
+ * them for the naive scan) and hand every receiver's visible set to the consumer. */
+static void hf_p2_orient(hf_sweep *sw, int m, hf_fused *f)
+{
+    hf_p2_ctx *c = (hf_p2_ctx *)(void *)f;
+    const hfvis_lattice *L = &sw->L;
+    const int R = sw->preroll, ch = c->channels;
+    const double cs = sw->g->cell_size, inv_cs = 1.0 / cs;
+    int nlines = (m & 1) ? sw->cols : sw->rows, line;
+    for (line = 0; line < nlines; line++) {
+        ptrdiff_t node0, step, p;
+        int i0, j0, di, dj, n, s, r, k = 0, q;
+        n = hf_line_span(sw, m, line, &node0, &step, &i0, &j0, &di, &dj);
+        if (n == 0) continue;
+        hfvis_hull_tree_reset(c->tree);
+        for (r = 0; r < R; r++) {
+            double x, y, h;
+            hf_node_pos(L, i0 - (R - r) * di + L->i_min, j0 - (R - r) * dj + L->j_min, &x, &y);
+            h = hf_sample_border(sw->g, sw->border, x, y) * inv_cs;
+            if (isnan(h)) continue;
+            c->ld[k] = (double)(r - R);
+            c->lh[k] = h;
+            c->wd[k] = c->ld[k] * cs;
+            c->wh[k] = h * cs;
+            if (ch) hf_sample_channels(sw->g, sw->border, c->exit, ch, x, y, c->le + (size_t)k * (size_t)ch);
+            k++;
+        }
+        c->npre = k;
+        if (!c->naive)
+            for (q = 0; q < k; q++) hfvis_hull_tree_push(c->tree, c->ld[q], c->lh[q], NULL);
+        for (s = 0, p = node0; s < n; s++, p += step) {
+            int nh = 0, nv;
+            double h = sw->h[p];
+            if (isnan(h)) continue;
+            c->ld[k] = (double)s;
+            c->lh[k] = h;
+            c->wd[k] = c->ld[k] * cs;
+            c->wh[k] = h * cs;
+            if (ch) memcpy(c->le + (size_t)k * (size_t)ch, c->lat_exit + (size_t)p * (size_t)ch, sizeof(double) * (size_t)ch);
+            if (c->naive) {
+                nv = hf_visible_naive(c->ld, c->lh, k, c->vis, c->len);
+                c->st.iterations += (double)k;
+            } else {
+                long long before = c->tree->iterations;
+                hfvis_hull_tree_push(c->tree, c->ld[k], c->lh[k], &nh);
+                c->st.iterations += (double)(c->tree->iterations - before);
+                c->st.horizons += (double)nh;
+                nh = hfvis_hull_tree_horizons(c->tree, 0, c->hz, c->len);
+                nv = hf_visible_from_horizons(c->ld, c->lh, k, c->hz, nh, c->vis, c->len);
+            }
+            c->st.receivers += 1.0;
+            c->fn(sw, c, p, k, c->vis, nv, c->hz, nh);
+            k++;
+        }
+    }
+}
+
+static hfvis_status hf_p2_run(hf_sweep *sw, const hfvis_grid *grid, int K, hfvis_sweep_options *o,
+                              int out_channels, int want_normals, hf_p2_ctx *c)
+{
+    int ok = 1;
+    if (c->tree_opts && (c->tree_opts->order < HFVIS_TREE_DEFAULT ||
+                         c->tree_opts->order > HFVIS_TREE_BREADTH_FIRST || c->tree_opts->safe_zone < 0 ||
+                         c->tree_opts->safe_zone > 1 || c->tree_opts->safe_zone_steps < 0))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    c->f.extra_size = hf_p2_extra_size(grid, o, c->channels, &c->len, &ok);
+    if (!ok) return HFVIS_ERR_LIMIT;
+    c->f.group = hf_p2_group;
+    c->f.orient = hf_p2_orient;
+    return hf_fused_run(sw, grid, K, o, out_channels, want_normals, NULL, &c->f);
+}
+
+/* Consumer: visible in-grid samples per receiver (the visibility index). */
+static void hf_p2_count(hf_sweep *sw, hf_p2_ctx *c, ptrdiff_t node, int s, const int *vis, int nv,
+                        const int *hz, int nh)
+{
+    int i, n = 0;
+    (void)s;
+    (void)hz;
+    (void)nh;
+    for (i = 0; i < nv; i++) n += vis[i] >= c->npre;
+    c->st.visible += (double)nv;
+    sw->lat[node] += (double)n;
+}
+
+/* Consumer: the user's callback with the receiver's minimal horizons and visible samples. */
+static void hf_p2_event(hf_sweep *sw, hf_p2_ctx *c, ptrdiff_t node, int s, const int *vis, int nv,
+                        const int *hz, int nh)
+{
+    hfvis_visibility_event e;
+    int i, m = 0;
+    const int cols = sw->cols;
+    c->st.visible += (double)nv;
+    for (i = 0; i < nh; i++) /* the minimal filter of spec §7.6 */
+        if (hz[i] == 0 || hf_slope_from(c->ld, c->lh, s, hz[i] - 1) < hf_slope_from(c->ld, c->lh, s, hz[i]))
+            c->hz[m++] = hz[i];
+    e.k = c->f.k;
+    hf_node_pos(&sw->L, (int)(node % cols) + sw->L.i_min, (int)(node / cols) + sw->L.j_min, &e.x, &e.y);
+    e.distance = c->wd;
+    e.height = c->wh;
+    e.receiver = s;
+    e.horizons = c->hz;
+    e.horizon_count = m;
+    e.visible = vis;
+    e.visible_count = nv;
+    c->user_fn(c->user, &e);
+}
+
+/* Consumer: indirect light by the band rule of spec §9. With W(t) the tangent-clamped [P1]
+ * Eq. 5 sector integral up to the zenith angle of slope t (hf_sky_term), the visible samples
+ * s_1..s_M (far to near, slopes non-increasing) own the bands [W(t_j), W(t_{j+1})], the last up
+ * to the tangent plane W(-inf); the sky owns [0, W(t_1)]. The sum telescopes: uniform radiance c
+ * everywhere gives c W(-inf) = c S_k(c_k), the furnace identity (spec §12.10). */
+static void hf_p2_indirect(hf_sweep *sw, hf_p2_ctx *c, ptrdiff_t node, int s, const int *vis,
+                           int nv, const int *hz, int nh)
+{
+    const float *nr = sw->nrm + node * 3;
+    double nz = (double)nr[2], a = (double)nr[0] * c->f.lx + (double)nr[1] * c->f.ly;
+    double w_prev, acc[4] = {0.0, 0.0, 0.0, 0.0};
+    int j, ch = c->channels, q;
+    (void)hz;
+    (void)nh;
+    c->st.visible += (double)nv;
+    if (isnan(nz)) {
+        for (q = 0; q < ch; q++) sw->lat[node * ch + q] += HF_NAN;
+        return;
+    }
+    w_prev = nv ? hf_sky_term(hf_slope_from(c->ld, c->lh, s, vis[0]), nz, a, c->inv_k, c->lobe)
+                : hf_sky_term(-HF_INF, nz, a, c->inv_k, c->lobe);
+    for (q = 0; q < ch; q++) acc[q] = c->sky * w_prev;
+    for (j = 0; j < nv; j++) {
+        double w_next = j + 1 < nv
+                            ? hf_sky_term(hf_slope_from(c->ld, c->lh, s, vis[j + 1]), nz, a, c->inv_k, c->lobe)
+                            : hf_sky_term(-HF_INF, nz, a, c->inv_k, c->lobe);
+        const double *L = c->le + (size_t)vis[j] * (size_t)ch;
+        for (q = 0; q < ch; q++) acc[q] += L[q] * (w_next - w_prev);
+        w_prev = w_next;
+    }
+    for (q = 0; q < ch; q++) sw->lat[node * ch + q] += acc[q];
+}
+
+static int hf_tree_opts_valid(const hfvis_tree_options *t)
+{
+    return !t || (t->order >= HFVIS_TREE_DEFAULT && t->order <= HFVIS_TREE_BREADTH_FIRST &&
+                  t->safe_zone >= 0 && t->safe_zone <= 1 && t->safe_zone_steps >= 0);
+}
+
+hfvis_status hfvis_intervisibility(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
+                                   const hfvis_tree_options *tree_opts, hfvis_visibility_fn fn,
+                                   void *user, hfvis_visibility_stats *stats)
+{
+    hfvis_sweep_options o;
+    hf_sweep sw;
+    hf_p2_ctx c;
+    hfvis_status s;
+    if (hf_check_common(grid, opts) != HFVIS_OK || K < 1 || !fn || !hf_tree_opts_valid(tree_opts))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    o = hf_opts_resolve(grid, opts);
+    memset(&c, 0, sizeof c);
+    c.tree_opts = tree_opts;
+    c.fn = hf_p2_event;
+    c.user_fn = fn;
+    c.user = user;
+    if ((s = hf_p2_run(&sw, grid, K, &o, 1, 0, &c)) != HFVIS_OK) return s;
+    hf_sweep_free(&sw);
+    if (stats) *stats = c.st;
+    return HFVIS_OK;
+}
+
+static hfvis_status hf_visibility_count(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
+                                        const hfvis_tree_options *tree_opts, int naive, float *out,
+                                        ptrdiff_t out_stride, hfvis_visibility_stats *stats)
+{
+    hfvis_sweep_options o;
+    hf_sweep sw;
+    hf_p2_ctx c;
+    hfvis_status s;
+    if (!hf_light_args_valid(grid, K, opts, out, out_stride) || !hf_tree_opts_valid(tree_opts))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    o = hf_opts_resolve(grid, opts);
+    memset(&c, 0, sizeof c);
+    c.tree_opts = tree_opts;
+    c.naive = naive;
+    c.fn = hf_p2_count;
+    if ((s = hf_p2_run(&sw, grid, K, &o, 1, 0, &c)) != HFVIS_OK) return s;
+    hf_fused_output(&sw, 1.0, 0.0, out, out_stride, 1);
+    hf_sweep_free(&sw);
+    if (stats) *stats = c.st;
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_visibility_count(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
+                                    const hfvis_tree_options *tree_opts, float *out,
+                                    ptrdiff_t out_stride, hfvis_visibility_stats *stats)
+{
+    return hf_visibility_count(grid, K, opts, tree_opts, 0, out, out_stride, stats);
+}
+
+hfvis_status hfvis_visibility_count_naive(const hfvis_grid *grid, int K,
+                                          const hfvis_sweep_options *opts, float *out,
+                                          ptrdiff_t out_stride, hfvis_visibility_stats *stats)
+{
+    return hf_visibility_count(grid, K, opts, NULL, 1, out, out_stride, stats);
+}
+
+static hfvis_status hf_indirect(const hfvis_grid *grid, int K, const float *exit_radiance,
+                                int channels, float sky, float albedo, const hfvis_sweep_options *opts,
+                                const hfvis_tree_options *tree_opts, int naive, float *out,
+                                ptrdiff_t out_stride)
+{
+    hfvis_sweep_options o;
+    hf_sweep sw;
+    hf_p2_ctx c;
+    hfvis_status s;
+    if (!hf_light_args_valid(grid, K, opts, out, out_stride) || !hf_tree_opts_valid(tree_opts) ||
+        !exit_radiance || channels < 1 || channels > 4 || !isfinite(sky) || !isfinite(albedo))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    o = hf_opts_resolve(grid, opts);
+    memset(&c, 0, sizeof c);
+    c.tree_opts = tree_opts;
+    c.naive = naive;
+    c.fn = hf_p2_indirect;
+    c.exit = exit_radiance;
+    c.channels = channels;
+    c.sky = (double)sky;
+    c.inv_k = 1.0 / (double)K;
+    c.lobe = sin(HF_PI / (double)K) / HF_PI;
+    if ((s = hf_p2_run(&sw, grid, K, &o, channels, 1, &c)) != HFVIS_OK) return s;
+    hf_fused_output(&sw, (double)albedo, 0.0, out, out_stride, channels);
+    hf_sweep_free(&sw);
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_indirect_light(const hfvis_grid *grid, int K, const float *exit_radiance,
+                                  int channels, float sky, float albedo,
+                                  const hfvis_sweep_options *opts,
+                                  const hfvis_tree_options *tree_opts, float *out,
+                                  ptrdiff_t out_stride)
+{
+    return hf_indirect(grid, K, exit_radiance, channels, sky, albedo, opts, tree_opts, 0, out, out_stride);
+}
+
+hfvis_status hfvis_indirect_light_naive(const hfvis_grid *grid, int K, const float *exit_radiance,
+                                        int channels, float sky, float albedo,
+                                        const hfvis_sweep_options *opts, float *out,
+                                        ptrdiff_t out_stride)
+{
+    return hf_indirect(grid, K, exit_radiance, channels, sky, albedo, opts, NULL, 1, out, out_stride);
+}
+
+hfvis_status hfvis_terrain_gi(const hfvis_grid *grid, int K, const float *direct,
+                              const float *emission, const float *albedo_map, float albedo_value,
+                              int channels, int bounces, const hfvis_sweep_options *opts,
+                              const hfvis_tree_options *tree_opts, float *out)
+{
+    size_t n, i, total;
+    float *exit_b, *ind;
+    const hfvis_allocator *alloc = opts ? opts->alloc : NULL;
+    int b, c;
+    hfvis_status s = HFVIS_OK;
+    if (!hf_grid_valid(grid) || !direct || !out || channels < 1 || channels > 4 || bounces < 0 ||
+        K < 1 || !isfinite(albedo_value) || !hf_opts_valid(opts) || !hf_tree_opts_valid(tree_opts))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!hf_mul_size(hf_grid_count(grid), (size_t)channels, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
+    n = hf_grid_count(grid);
+    exit_b = (float *)hf_alloc_array(alloc, total, sizeof(float));
+    ind = (float *)hf_alloc_array(alloc, total, sizeof(float));
+    if (!exit_b || !ind) {
+        hf_free(alloc, ind);
+        hf_free(alloc, exit_b);
+        return HFVIS_ERR_OUT_OF_MEMORY;
+    }
+    /* L_0 = emission + albedo * direct */
+    for (i = 0; i < n; i++)
+        for (c = 0; c < channels; c++) {
+            size_t q = i * (size_t)channels + (size_t)c;
+            double rho = albedo_map ? (double)albedo_map[q] : (double)albedo_value;
+            exit_b[q] = (float)((emission ? (double)emission[q] : 0.0) + rho * (double)direct[q]);
+        }
+    /* L_{b+1} = emission + albedo * (direct + I[L_b]) ([P2] §10.1: repeat the indirect pass
+     * with the previous output as the surface radiance) */
+    for (b = 0; b < bounces && s == HFVIS_OK; b++) {
+        s = hf_indirect(grid, K, exit_b, channels, 0.0f, 1.0f, opts, tree_opts, 0, ind, grid->width);
+        if (s != HFVIS_OK) break;
+        for (i = 0; i < n; i++)
+            for (c = 0; c < channels; c++) {
+                size_t q = i * (size_t)channels + (size_t)c;
+                double rho = albedo_map ? (double)albedo_map[q] : (double)albedo_value;
+                double e = emission ? (double)emission[q] : 0.0;
+                exit_b[q] = (float)(e + rho * ((double)direct[q] + (double)ind[q]));
+            }
+    }
+    if (s == HFVIS_OK) memcpy(out, exit_b, total * sizeof(float));
+    hf_free(alloc, ind);
+    hf_free(alloc, exit_b);
     return s;
 }

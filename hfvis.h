@@ -537,6 +537,173 @@ HFVIS_API hfvis_status hfvis_light_reference(const hfvis_grid *grid, const hfvis
                                              size_t count, float *out);
 
 /* ========================================================================================== */
+/* hfvis.c - P2 intervisibility ([P2] §4-8, Alg. 1-3, App. A.2; spec heightfield §7-8)        */
+/* ========================================================================================== */
+
+/* The convex-hull tree along one line ([P2] §5): samples are pushed in order of increasing
+ * distance; after each push the tree's root children are the local visibility horizons of the
+ * newest sample (the receiver), from which its visible samples follow. RecConvexity ([P2]
+ * Alg. 1) runs iteratively on arrays indexed by sample (spec §7.7) with the errata of spec
+ * §7.4-7.5 fixed (the segment-start leaf is marked before the step's horizons are read; the
+ * convexity test is Eq. 1's, strict). Lives in caller memory: no allocation. */
+typedef struct hfvis_hull_tree hfvis_hull_tree;
+
+typedef enum hfvis_tree_order {
+    HFVIS_TREE_DEFAULT = 0,
+    HFVIS_TREE_DEPTH_FIRST = 1,   /* pending tests on a LIFO stack ("step deeper" first) */
+    HFVIS_TREE_BREADTH_FIRST = 2  /* FIFO: all siblings of a level first, the order of [P2]
+                                     Alg. 2 (OptimizedConvexity); same output */
+} hfvis_tree_order;
+
+typedef struct hfvis_tree_options {
+    hfvis_tree_order order;   /* default HFVIS_TREE_DEPTH_FIRST */
+    int safe_zone;            /* 1 = SafeZoneUpdate shortcut ([P2] Alg. 3): when the new sample
+                                 only replaces the root, skip the tests; same output; 0 = off */
+    int safe_zone_steps;      /* window length b2 - b1 in samples; 0 = 4 (spec §7.10) */
+} hfvis_tree_options;
+
+/* Bytes of caller memory for a tree of up to max_samples samples (0 if max_samples < 1 or the
+ * size overflows). The memory must be aligned for double (malloc'd memory is). */
+HFVIS_API size_t hfvis_hull_tree_size(int max_samples);
+
+/* Set up a tree in mem (mem_size >= hfvis_hull_tree_size(max_samples)); opts may be NULL.
+ * *tree points into mem; nothing is allocated; no cleanup is needed.
+ * Returns HFVIS_ERR_INVALID_ARGUMENT (NULL, bad options) or HFVIS_ERR_BUFFER_TOO_SMALL. */
+HFVIS_API hfvis_status hfvis_hull_tree_init(void *mem, size_t mem_size, int max_samples,
+                                           const hfvis_tree_options *opts, hfvis_hull_tree **tree);
+
+/* Empty the tree for a new line (keeps capacity and options; the iteration count restarts). */
+HFVIS_API void hfvis_hull_tree_reset(hfvis_hull_tree *tree);
+
+/* Push the next sample (distance strictly greater than the previous one, finite height) and
+ * update the tree ([P2] Alg. 1). *horizon_count (may be NULL) receives the number of root
+ * children. Returns HFVIS_ERR_INVALID_ARGUMENT for a non-finite value or a non-increasing
+ * distance, HFVIS_ERR_LIMIT when max_samples samples are already in the tree.
+ * Cost: amortised O(m) for m horizons; t <= 2m + n tests over a line ([P2] §6). */
+HFVIS_API hfvis_status hfvis_hull_tree_push(hfvis_hull_tree *tree, double distance, double height,
+                                           int *horizon_count);
+
+/* The horizons of the newest sample, farthest first, as sample indices (push order) into out
+ * (capacity cap). minimal = 0 gives the root children as the tree holds them, which are a
+ * superset of the local horizons (spec §7.6); minimal = 1 keeps only true local horizons
+ * (sample 0, or a sample whose predecessor is hidden). Returns the count (which may exceed cap:
+ * then only cap are written), or -1 on NULL. */
+HFVIS_API int hfvis_hull_tree_horizons(const hfvis_hull_tree *tree, int minimal, int *out, int cap);
+
+/* Number of samples pushed, and RecConvexity tests made since the last reset (the paper's
+ * iteration count t; t <= 2m + n). */
+HFVIS_API int hfvis_hull_tree_count(const hfvis_hull_tree *tree);
+HFVIS_API long long hfvis_hull_tree_iterations(const hfvis_hull_tree *tree);
+
+/* Visible samples of receiver index `receiver` on a line (distance increasing), enumerated
+ * from its horizon list (farthest first) as spec §8: out receives the sample indices farthest
+ * first (elevation seen from the receiver non-increasing). A sample is visible when its
+ * elevation is >= that of every sample between it and the receiver (grazing counts). Holes
+ * (non-finite heights) are never visible and never occlude. Returns the count (written up to
+ * cap), or -1 on invalid input. Cost O(visible). */
+HFVIS_API int hfvis_line_visible_from_horizons(const double *distance, const double *height,
+                                               int receiver, const int *horizons, int m,
+                                               int *out, int cap);
+
+/* Oracles: the naive visible set (walk from the receiver outward keeping the running maximum,
+ * spec §8), farthest first, and the naive local horizons (visible samples whose predecessor is
+ * not visible), farthest first. Same return convention. Cost O(receiver). */
+HFVIS_API int hfvis_line_visible_naive(const double *distance, const double *height, int receiver,
+                                       int *out, int cap);
+HFVIS_API int hfvis_line_local_horizons_naive(const double *distance, const double *height,
+                                              int receiver, int *out, int cap);
+
+/* One receiver-direction of a field sweep, handed to a visibility callback. The line arrays
+ * hold the samples from the line's start (negative distances: the CLAMP/WRAP pre-roll) up to
+ * and including the receiver; distances and heights in world units. */
+typedef struct hfvis_visibility_event {
+    int k;                     /* direction index; the receiver looks toward psi_k */
+    double x, y;               /* receiver position, grid units (a lattice node) */
+    const double *distance;
+    const double *height;
+    int receiver;              /* index of the receiver in the line arrays */
+    const int *horizons;       /* local horizons, farthest first (minimal set) */
+    int horizon_count;
+    const int *visible;        /* visible samples, farthest first */
+    int visible_count;
+} hfvis_visibility_event;
+
+typedef void (*hfvis_visibility_fn)(void *user, const hfvis_visibility_event *event);
+
+/* Counters of a field sweep ([P2] Tables 1-2: visible points, horizons m_a, iterations t_a). */
+typedef struct hfvis_visibility_stats {
+    double receivers;          /* receiver-directions visited */
+    double visible;            /* visible samples, summed */
+    double horizons;           /* tree root children (the paper's m), summed */
+    double iterations;         /* RecConvexity tests (tree) or samples scanned (naive), summed */
+} hfvis_visibility_stats;
+
+/* Intervisibility over the whole field: for each of the K directions, every lattice line is
+ * swept with the hull tree and the callback receives each receiver's horizons and visible
+ * samples as they are found (nothing is stored: the output can be O(N) per receiver). Border
+ * and hole rules as for the horizon sweeps. opts->alloc serves the scratch (one block).
+ * stats may be NULL. Cost O(K * (W*H + total horizons + total visible)). */
+HFVIS_API hfvis_status hfvis_intervisibility(const hfvis_grid *grid, int K,
+                                             const hfvis_sweep_options *opts,
+                                             const hfvis_tree_options *tree_opts,
+                                             hfvis_visibility_fn fn, void *user,
+                                             hfvis_visibility_stats *stats);
+
+/* Visibility index ("total viewshed"): the number of samples each grid point sees along the K
+ * directions, sum over k of the visible samples of its line (gathered from the lattice like the
+ * light paths). Pre-roll samples outside the grid are not counted. NaN at holes. */
+HFVIS_API hfvis_status hfvis_visibility_count(const hfvis_grid *grid, int K,
+                                              const hfvis_sweep_options *opts,
+                                              const hfvis_tree_options *tree_opts, float *out,
+                                              ptrdiff_t out_stride, hfvis_visibility_stats *stats);
+
+/* Oracle: the same counts from the naive visible sets (spec §6 item 1 on the same lattice).
+ * Equal to hfvis_visibility_count exactly. Cost O(K*W*H*N). */
+HFVIS_API hfvis_status hfvis_visibility_count_naive(const hfvis_grid *grid, int K,
+                                                    const hfvis_sweep_options *opts, float *out,
+                                                    ptrdiff_t out_stride,
+                                                    hfvis_visibility_stats *stats);
+
+/* Indirect light from visible terrain ([P2] §10.1 with the band rule of spec §9): for each
+ * receiver and direction, the visible samples s_1..s_M (far to near) each own the band of
+ * zenith angles between themselves and the next nearer visible sample; the receiver reflects
+ * out = albedo/pi * [ sky * S^(theta(s_1)) + sum_j L_exit(s_j) (S^(theta(s_{j+1})) - S^(theta(s_j))) ]
+ * summed over k, with S^ the tangent-clamped sector integral of [P1] Eq. 5 (so the sky part is
+ * exactly the uniform-sky light of hfvis_sky_light, and uniform exit radiance c with sky c gives
+ * c * sum_k S_k: the furnace identity, spec §12.10). exit_radiance[(y*width + x)*channels + c]
+ * is the surface's exit radiance (bilinear between samples, border rule outside), channels 1..4;
+ * sky is the uniform sky radiance above the horizon (0 for terrain light only).
+ * out[(y*out_stride + x)*channels + c]; NaN at holes. One block of scratch. */
+HFVIS_API hfvis_status hfvis_indirect_light(const hfvis_grid *grid, int K,
+                                            const float *exit_radiance, int channels, float sky,
+                                            float albedo, const hfvis_sweep_options *opts,
+                                            const hfvis_tree_options *tree_opts, float *out,
+                                            ptrdiff_t out_stride);
+
+/* Oracle: the same gather from the naive visible sets; equal to hfvis_indirect_light up to float
+ * rounding (the same bands are summed in the same order). */
+HFVIS_API hfvis_status hfvis_indirect_light_naive(const hfvis_grid *grid, int K,
+                                                  const float *exit_radiance, int channels,
+                                                  float sky, float albedo,
+                                                  const hfvis_sweep_options *opts, float *out,
+                                                  ptrdiff_t out_stride);
+
+/* Direct + indirect light with bounces ([P2] §10.1; spec §9):
+ *   L_0 = emission + albedo * direct,  L_{b+1} = emission + albedo * (direct + I[L_b]),
+ * where I[L] is hfvis_indirect_light of exit radiance L with sky 0 and albedo 1, and direct is
+ * the caller's direct light as reflected radiance for albedo 1 (e.g. hfvis_sky_light plus sun
+ * E_sun/pi * max(n.l, 0) * visibility). out = L_B, the exit radiance after `bounces` bounces
+ * (0 = direct light and emission only). albedo is per sample (albedo_map, channels values per
+ * sample) or constant (albedo_map NULL: albedo_value). emission may be NULL.
+ * direct, emission, albedo_map: [(y*width + x)*channels + c]. out likewise (width stride).
+ * Allocates the bounce buffers (2 blocks) and each sweep's scratch. */
+HFVIS_API hfvis_status hfvis_terrain_gi(const hfvis_grid *grid, int K, const float *direct,
+                                        const float *emission, const float *albedo_map,
+                                        float albedo_value, int channels, int bounces,
+                                        const hfvis_sweep_options *opts,
+                                        const hfvis_tree_options *tree_opts, float *out);
+
+/* ========================================================================================== */
 /* ssao.c - screen space (later issues)                                                       */
 /* voxel.c - meshes and volumes (later issues)                                                */
 /* ========================================================================================== */
