@@ -723,6 +723,7 @@ static int hf_field_valid(const hfvis_field *f)
     case HFVIS_FIELD_SINUSOID: return f->wavelength > 0.0;
     case HFVIS_FIELD_FBM:
         return f->wavelength > 0.0 && f->octaves >= 0 && f->octaves <= 30 && f->persistence >= 0.0;
+    case HFVIS_FIELD_BRICKS: return f->wavelength > 0.0 && f->radius >= 0.0;
     }
     return 0;
 }
@@ -759,6 +760,17 @@ double hfvis_field_height(void *field, double x, double y)
             freq *= 2.0;
         }
         return f->height + f->amplitude * (norm > 0.0 ? sum / norm : 0.0);
+    }
+    case HFVIS_FIELD_BRICKS: {
+        double bw = f->wavelength, bh = 0.5 * f->wavelength, mortar = f->radius > 0.0 ? f->radius : 1.0;
+        double row = floor(dy / bh), shift = fmod(row, 2.0) != 0.0 ? 0.5 * bw : 0.0;
+        double col = floor((dx + shift) / bw);
+        double u = dx + shift - col * bw, v = dy - row * bh;
+        uint64_t id = hf_mix64(f->seed ^ hf_mix64((uint64_t)(int64_t)col * 0x9E3779B97F4A7C15ull ^
+                                                  (uint64_t)(int64_t)row));
+        double jitter = ((double)(id >> 11) * (1.0 / 9007199254740992.0) - 0.5) * 0.1;
+        if (u < mortar || v < mortar) return f->height - f->amplitude;
+        return f->height + f->amplitude * jitter;
     }
     }
     return HF_NAN;
@@ -3753,5 +3765,66 @@ hfvis_status hfvis_terrain_gi(const hfvis_grid *grid, int K, const float *direct
     if (s == HFVIS_OK) memcpy(out, exit_b, total * sizeof(float));
     hf_free(alloc, ind);
     hf_free(alloc, exit_b);
+    return s;
+}
+
+/* Direct light (see hfvis.h): the sun's Lambert term times its visibility, plus the sky. */
+hfvis_status hfvis_direct_light(const hfvis_grid *grid, int K, const hfvis_sun *sun, float sky,
+                                const hfvis_env *env, int channels, const hfvis_sweep_options *opts,
+                                float *out)
+{
+    const hfvis_allocator *alloc = opts ? opts->alloc : NULL;
+    size_t n, i, total;
+    float *plane;
+    hfvis_status s;
+    int c;
+    if (!hf_grid_valid(grid) || K < 1 || !out || channels < 1 || channels > 4 || !isfinite(sky) ||
+        !hf_opts_valid(opts) || (env && (!hf_env_valid(env) || env->channels != channels)))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (sun) {
+        if (!isfinite(sun->azimuth_rad) || !isfinite(sun->elevation_rad) || !isfinite(sun->radius_rad) ||
+            sun->radius_rad < 0.0 || fabs(sun->elevation_rad) > HF_HALF_PI)
+            return HFVIS_ERR_INVALID_ARGUMENT;
+        for (c = 0; c < channels; c++)
+            if (!isfinite(sun->irradiance[c])) return HFVIS_ERR_INVALID_ARGUMENT;
+    }
+    n = hf_grid_count(grid);
+    if (!hf_mul_size(n, (size_t)channels, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
+    plane = (float *)hf_alloc_array(alloc, total, sizeof(float));
+    if (!plane) return HFVIS_ERR_OUT_OF_MEMORY;
+    /* sky part, written to plane first so that out stays untouched on failure */
+    if (env) s = hfvis_env_light(grid, K, env, 1.0f, opts, NULL, plane, grid->width);
+    else {
+        s = hfvis_sky_light(grid, K, sky, 1.0f, opts, plane, grid->width);
+        for (i = n; s == HFVIS_OK && i-- > 0;) /* spread the one channel, back to front */
+            for (c = channels - 1; c >= 0; c--) plane[i * (size_t)channels + (size_t)c] = plane[i];
+    }
+    if (s == HFVIS_OK && sun) {
+        float *vis = (float *)hf_alloc_array(alloc, n, sizeof(float));
+        if (!vis) s = HFVIS_ERR_OUT_OF_MEMORY;
+        else {
+            s = hfvis_sun_visibility(grid, sun->azimuth_rad, sun->elevation_rad, sun->radius_rad, opts,
+                                     vis, grid->width);
+            if (s == HFVIS_OK) {
+                double lx = cos(sun->elevation_rad) * cos(sun->azimuth_rad);
+                double ly = cos(sun->elevation_rad) * sin(sun->azimuth_rad), lz = sin(sun->elevation_rad);
+                int x, y;
+                for (y = 0; y < grid->height; y++)
+                    for (x = 0; x < grid->width; x++) {
+                        double nrm[3], cosl;
+                        size_t q = (size_t)y * (size_t)grid->width + (size_t)x;
+                        hf_normal_at(grid, x, y, nrm);
+                        cosl = nrm[0] * lx + nrm[1] * ly + nrm[2] * lz;
+                        if (cosl < 0.0) cosl = 0.0;
+                        for (c = 0; c < channels; c++)
+                            plane[q * (size_t)channels + (size_t)c] +=
+                                (float)((double)sun->irradiance[c] / HF_PI * cosl * (double)vis[q]);
+                    }
+            }
+            hf_free(alloc, vis);
+        }
+    }
+    if (s == HFVIS_OK) memcpy(out, plane, total * sizeof(float));
+    hf_free(alloc, plane);
     return s;
 }

@@ -244,9 +244,14 @@ typedef enum hfvis_field_kind {
                                      wall facing -x; sampled on the grid the rise is the bilinear
                                      ramp over [x0-1, x0])                                      */
     HFVIS_FIELD_SINUSOID = 9,     /* z = height + amplitude*sin(2pi x/wavelength)*sin(2pi y/wavelength) */
-    HFVIS_FIELD_FBM = 10          /* seeded fractional Brownian motion: octaves of value noise,
+    HFVIS_FIELD_FBM = 10,         /* seeded fractional Brownian motion: octaves of value noise,
                                      base wavelength 'wavelength' cells, gain 'persistence',
                                      lacunarity 2, scaled by amplitude                          */
+    HFVIS_FIELD_BRICKS = 11       /* a brick wall seen from above ([P2] Fig. 7 "brick surface"):
+                                     bricks of wavelength x wavelength/2 cells in running bond,
+                                     top at height, mortar joints `radius` cells wide and
+                                     `amplitude` deep, brick tops jittered by seed (+-5% of
+                                     amplitude)                                                 */
 } hfvis_field_kind;
 
 /* Parameters of an analytic field. Positions, radius and wavelength are in grid units (cells);
@@ -257,7 +262,7 @@ typedef struct hfvis_field {
     double height;          /* base height */
     double slope;           /* V_VALLEY, L1_PIT, LINF_PIT, CONE */
     double slope_x, slope_y;/* TILTED_PLANE */
-    double radius;          /* HEMISPHERE (> 0) */
+    double radius;          /* HEMISPHERE (> 0); BRICKS: mortar width in cells (0 = 1) */
     double amplitude;       /* HEMISPHERE, STEP, SINUSOID, FBM */
     double wavelength;      /* SINUSOID, FBM (> 0) */
     double persistence;     /* FBM: amplitude ratio between octaves, 0 = 0.5 */
@@ -702,6 +707,23 @@ HFVIS_API hfvis_status hfvis_terrain_gi(const hfvis_grid *grid, int K, const flo
                                         float albedo_value, int channels, int bounces,
                                         const hfvis_sweep_options *opts,
                                         const hfvis_tree_options *tree_opts, float *out);
+
+/* A sun: a disc of angular radius radius_rad at (azimuth_rad, elevation_rad) (look direction,
+ * DESIGN convention) giving irradiance[c] on a surface facing it. */
+typedef struct hfvis_sun {
+    double azimuth_rad, elevation_rad, radius_rad;
+    float irradiance[4];
+} hfvis_sun;
+
+/* Direct light ([P1]) as reflected radiance for albedo 1, the `direct` input of
+ * hfvis_terrain_gi: sun part E/pi * max(n.l, 0) * V_sun (hfvis_sun_visibility; l the sun
+ * centre's direction) plus sky part: env NULL gives sky * sum_k S_k (hfvis_sky_light, every
+ * channel), else the environment light (hfvis_env_light, env->channels must equal channels).
+ * sun may be NULL. out[(y*width + x)*channels + c]. Allocates the scratch of the calls it makes
+ * plus one plane. */
+HFVIS_API hfvis_status hfvis_direct_light(const hfvis_grid *grid, int K, const hfvis_sun *sun,
+                                          float sky, const hfvis_env *env, int channels,
+                                          const hfvis_sweep_options *opts, float *out);
 
 /* ========================================================================================== */
 /* ssao.c - screen space (later issues)                                                       */
