@@ -170,6 +170,138 @@ static void bench_others(int n)
     free(nrm);
 }
 
+/* P2 intervisibility: the hull tree against the naive per-receiver scan on the same lattice,
+ * per direction (K = 4, one lattice group), on fBm and brick fields; the paper's figures are
+ * [P2] Tables 2-3 (1024^2, GTX 480). Then the scaling exponent of visible points per receiver
+ * for "more extent" (fixed feature size) and "more detail" (features scale with N). */
+static void make_field(float *z, int n, hfvis_field_kind kind, double wavelength, double amplitude)
+{
+    hfvis_field f;
+    hfvis_status s;
+    memset(&f, 0, sizeof f);
+    f.kind = kind;
+    f.amplitude = amplitude;
+    f.wavelength = wavelength;
+    f.seed = 3;
+    if ((s = hfvis_field_generate(&f, n, n, n, z)) != HFVIS_OK) die("field", s);
+}
+
+static void bench_p2(int quick)
+{
+    int sizes[3] = {256, 512, 1024}, si, fi, K = 4, ns = quick ? 1 : 3;
+    double vis_extent[3], vis_detail[3];
+    printf("\nP2 intervisibility, per direction (K = 4): tree vs naive scan on the same lattice\n");
+    printf("%-7s %-7s | %9s %9s %9s | %9s %9s | %9s %9s %8s\n", "field", "size", "visible", "m_a",
+           "t_a", "naive it", "t_a/nv", "tree ms", "naive ms", "speedup");
+    for (fi = 0; fi < 2; fi++)
+        for (si = 0; si < ns; si++) {
+            int n = sizes[si];
+            size_t cells = (size_t)n * (size_t)n;
+            float *z = (float *)xmalloc(sizeof(float) * cells), *out = (float *)xmalloc(sizeof(float) * cells);
+            hfvis_grid g;
+            hfvis_visibility_stats st, sn;
+            hfvis_status s;
+            double t0, tt, tn, r;
+            if (fi == 0) make_field(z, n, HFVIS_FIELD_FBM, (double)n / 4.0, (double)n / 8.0);
+            else make_field(z, n, HFVIS_FIELD_BRICKS, 16.0, 2.0);
+            g.z = z;
+            g.width = n;
+            g.height = n;
+            g.stride = n;
+            g.cell_size = 1.0;
+            t0 = now_s();
+            if ((s = hfvis_visibility_count(&g, K, NULL, NULL, out, n, &st)) != HFVIS_OK) die("visibility", s);
+            tt = (now_s() - t0) * 1e3 / (double)K;
+            t0 = now_s();
+            if ((s = hfvis_visibility_count_naive(&g, K, NULL, out, n, &sn)) != HFVIS_OK) die("visibility naive", s);
+            tn = (now_s() - t0) * 1e3 / (double)K;
+            r = st.receivers;
+            printf("%-7s %5d^2 | %9.2f %9.2f %9.2f | %9.1f %8.2f%% | %9.1f %9.1f %7.1fx\n",
+                   fi == 0 ? "fBm" : "bricks", n, st.visible / r, st.horizons / r, st.iterations / r,
+                   sn.iterations / r, 100.0 * st.iterations / sn.iterations, tt, tn, tn / tt);
+            fflush(stdout);
+            free(z);
+            free(out);
+        }
+    printf("paper (1024^2, K = 256): fractal terrain m_a 9.25 t_a 11.7 (2.4%% of naive 484), "
+           "brick 3.06 / 4.80 (0.99%%); speed-up 2.4x / 4.2x\n");
+    /* scaling of visible points per receiver-direction */
+    for (si = 0; si < 3; si++) {
+        int n = sizes[si];
+        size_t cells = (size_t)n * (size_t)n;
+        float *z = (float *)xmalloc(sizeof(float) * cells), *out = (float *)xmalloc(sizeof(float) * cells);
+        hfvis_grid g;
+        hfvis_visibility_stats st;
+        hfvis_status s;
+        g.z = z;
+        g.width = n;
+        g.height = n;
+        g.stride = n;
+        g.cell_size = 1.0;
+        make_field(z, n, HFVIS_FIELD_FBM, 64.0, 8.0); /* more extent: same features, more of them */
+        if ((s = hfvis_visibility_count(&g, K, NULL, NULL, out, n, &st)) != HFVIS_OK) die("visibility", s);
+        vis_extent[si] = st.visible / st.receivers;
+        make_field(z, n, HFVIS_FIELD_FBM, (double)n / 4.0, (double)n / 8.0); /* more detail */
+        if ((s = hfvis_visibility_count(&g, K, NULL, NULL, out, n, &st)) != HFVIS_OK) die("visibility", s);
+        vis_detail[si] = st.visible / st.receivers;
+        free(z);
+        free(out);
+        if (quick) break;
+    }
+    if (!quick) {
+        /* least-squares slope of log(visible) against log(N) over the three sizes */
+        double e[2], *v[2];
+        int q, i;
+        v[0] = vis_extent;
+        v[1] = vis_detail;
+        for (q = 0; q < 2; q++) {
+            double sx = 0, sy = 0, sxx = 0, sxy = 0;
+            for (i = 0; i < 3; i++) {
+                double x = log((double)sizes[i]), y = log(v[q][i]);
+                sx += x;
+                sy += y;
+                sxx += x * x;
+                sxy += x * y;
+            }
+            e[q] = (3.0 * sxy - sx * sy) / (3.0 * sxx - sx * sx);
+        }
+        printf("visible points per receiver-direction at 256/512/1024: extent %.2f %.2f %.2f -> N^%.2f; "
+               "detail %.2f %.2f %.2f -> N^%.2f (paper: N^0.01 and N^0.65)\n",
+               vis_extent[0], vis_extent[1], vis_extent[2], e[0], vis_detail[0], vis_detail[1],
+               vis_detail[2], e[1]);
+    }
+}
+
+/* Indirect gather cost per receiver-direction, tree vs naive visible sets. */
+static void bench_indirect(int n)
+{
+    size_t cells = (size_t)n * (size_t)n, i;
+    float *z = (float *)xmalloc(sizeof(float) * cells), *ex = (float *)xmalloc(sizeof(float) * cells),
+          *out = (float *)xmalloc(sizeof(float) * cells);
+    hfvis_grid g;
+    hfvis_status s;
+    double t0, tt, tn, rd;
+    int K = 16;
+    make_field(z, n, HFVIS_FIELD_FBM, (double)n / 4.0, (double)n / 8.0);
+    for (i = 0; i < cells; i++) ex[i] = 0.5f;
+    g.z = z;
+    g.width = n;
+    g.height = n;
+    g.stride = n;
+    g.cell_size = 1.0;
+    rd = (double)cells * (double)K;
+    t0 = now_s();
+    if ((s = hfvis_indirect_light(&g, K, ex, 1, 1.0f, 1.0f, NULL, NULL, out, n)) != HFVIS_OK) die("indirect", s);
+    tt = (now_s() - t0) * 1e9 / rd;
+    t0 = now_s();
+    if ((s = hfvis_indirect_light_naive(&g, K, ex, 1, 1.0f, 1.0f, NULL, out, n)) != HFVIS_OK) die("indirect naive", s);
+    tn = (now_s() - t0) * 1e9 / rd;
+    printf("indirect gather %d^2 K=16: tree %.1f ns/rd, naive %.1f ns/rd, %.1fx\n", n, tt, tn, tn / tt);
+    free(z);
+    free(ex);
+    free(out);
+}
+
 int main(int argc, char **argv)
 {
     int quick = argc > 1 && strcmp(argv[1], "quick") == 0;
@@ -227,5 +359,7 @@ int main(int argc, char **argv)
         free(light);
     }
     bench_others(quick ? 256 : 512);
+    bench_p2(quick);
+    bench_indirect(quick ? 256 : 512);
     return 0;
 }
