@@ -2997,22 +2997,14 @@ hfvis_status hfvis_hull_tree_init(void *mem, size_t mem_size, int max_samples,
     t->zone_steps = opts && opts->safe_zone_steps ? opts->safe_zone_steps : 4;
     p = (unsigned char *)mem + hf_tree_header();
     t->d = (double *)(void *)p;
-    p += n * sizeof(double);
-    t->h = (double *)(void *)p;
-    p += n * sizeof(double);
-    t->fc = (int *)(void *)p;
-    p += n * sizeof(int);
-    t->ns = (int *)(void *)p;
-    p += n * sizeof(int);
-    t->ps = (int *)(void *)p;
-    p += n * sizeof(int);
-    t->pc = (int *)(void *)p;
-    p += n * sizeof(int);
-    t->pp = (int *)(void *)p;
-    p += n * sizeof(int);
-    t->seg = (signed char *)p;
-    p += n;
-    t->cls = (signed char *)p;
+    t->h = t->d + n;
+    t->fc = (int *)(void *)(t->h + n);
+    t->ns = t->fc + n;
+    t->ps = t->ns + n;
+    t->pc = t->ps + n;
+    t->pp = t->pc + n;
+    t->seg = (signed char *)(void *)(t->pp + n);
+    t->cls = t->seg + n;
     *tree = t;
     return HFVIS_OK;
 }
@@ -3094,6 +3086,16 @@ static int hf_tree_zone_applies(hfvis_hull_tree *t, int o, int r)
     return !hf_tree_convex(t, last, o, r);
 }
 
+/* Queue the test of parent p's first child: on the stack (depth first) or at the tail of the
+ * ring queue (breadth first). */
+static void hf_tree_pend(hfvis_hull_tree *t, int p, int *top, int *tail)
+{
+    int at = t->order == HFVIS_TREE_BREADTH_FIRST ? (*tail)++ : (*top)++;
+    if (*tail == t->cap) *tail = 0;
+    t->pc[at] = t->fc[p];
+    t->pp[at] = p;
+}
+
 hfvis_status hfvis_hull_tree_push(hfvis_hull_tree *t, double distance, double height,
                                   int *horizon_count)
 {
@@ -3133,11 +3135,7 @@ hfvis_status hfvis_hull_tree_push(hfvis_hull_tree *t, double distance, double he
     } else {
         t->fc[r] = o;
         t->ns[o] = t->ps[o] = -1;
-        if (t->fc[o] >= 0) {
-            t->pc[0] = t->fc[o];
-            t->pp[0] = o;
-            top = tail = 1;
-        }
+        if (t->fc[o] >= 0) hf_tree_pend(t, o, &top, &tail);
         /* RecConvexity ([P2] Alg. 1) with an explicit stack (LIFO) or queue (FIFO, Alg. 2's
          * breadth-first order); at most one pending test per root child, so cap entries do. */
         while (t->order == HFVIS_TREE_BREADTH_FIRST ? head != tail : top > 0) {
@@ -3163,28 +3161,9 @@ hfvis_status hfvis_hull_tree_push(hfvis_hull_tree *t, double distance, double he
             if (t->ps[p] >= 0) t->ns[t->ps[p]] = c;
             else t->fc[r] = c;
             t->ps[p] = c;
-            if (t->fc[p] >= 0) { /* step wider */
-                if (t->order == HFVIS_TREE_BREADTH_FIRST) {
-                    t->pc[tail] = t->fc[p];
-                    t->pp[tail] = p;
-                    tail = tail + 1 == t->cap ? 0 : tail + 1;
-                } else {
-                    t->pc[top] = t->fc[p];
-                    t->pp[top++] = p;
-                }
-            } else if (!t->seg[p]) {
-                hf_tree_unlink(t, p, r); /* delete the orphan; segment starts stay as leaves */
-            }
-            if (t->fc[c] >= 0) { /* step deeper */
-                if (t->order == HFVIS_TREE_BREADTH_FIRST) {
-                    t->pc[tail] = t->fc[c];
-                    t->pp[tail] = c;
-                    tail = tail + 1 == t->cap ? 0 : tail + 1;
-                } else {
-                    t->pc[top] = t->fc[c];
-                    t->pp[top++] = c;
-                }
-            }
+            if (t->fc[p] >= 0) hf_tree_pend(t, p, &top, &tail); /* step wider */
+            else if (!t->seg[p]) hf_tree_unlink(t, p, r); /* delete the orphan; segment starts stay */
+            if (t->fc[c] >= 0) hf_tree_pend(t, c, &top, &tail); /* step deeper */
         }
         if (t->safe_zone) hf_tree_zone_refresh(t, r);
     }
