@@ -672,8 +672,9 @@ HFVIS_API hfvis_status hfvis_visibility_count_naive(const hfvis_grid *grid, int 
 /* Indirect light from visible terrain ([P2] §10.1 with the band rule of spec §9): for each
  * receiver and direction, the visible samples s_1..s_M (far to near) each own the band of
  * zenith angles between themselves and the next nearer visible sample; the receiver reflects
- * out = albedo/pi * [ sky * S^(theta(s_1)) + sum_j L_exit(s_j) (S^(theta(s_{j+1})) - S^(theta(s_j))) ]
- * summed over k, with S^ the tangent-clamped sector integral of [P1] Eq. 5 (so the sky part is
+ * out = albedo * [ sky * S^(theta(s_1)) + sum_j L_exit(s_j) (S^(theta(s_{j+1})) - S^(theta(s_j))) ]
+ * summed over k, with S^ the tangent-clamped sector integral of [P1] Eq. 5, 1/pi included,
+ * and theta(s_{M+1}) the tangent plane (so the sky part is
  * exactly the uniform-sky light of hfvis_sky_light, and uniform exit radiance c with sky c gives
  * c * sum_k S_k: the furnace identity, spec §12.10). exit_radiance[(y*width + x)*channels + c]
  * is the surface's exit radiance (bilinear between samples, border rule outside), channels 1..4;

@@ -3042,6 +3042,1311 @@ static void run_env_tests(void)
 
 
 
+/* test_p2.c - P2 intervisibility tests (spec heightfield §7-9, §11, §12.1, §12.3, §12.9-12.11):
+ * the convex-hull tree against the naive visible sets, the field sweeps against their oracles,
+ * indirect light (band rule, furnace identity), terrain GI and direct light. */
+
+/* Own xorshift64 so the sequence does not depend on other tests' use of the shared PRNG. */
+static uint64_t p2t_rng_state = 1;
+static void p2t_seed(uint64_t s) { p2t_rng_state = s ? s : 0x9E3779B97F4A7C15ULL; }
+static uint64_t p2t_next(void)
+{
+    p2t_rng_state ^= p2t_rng_state << 13;
+    p2t_rng_state ^= p2t_rng_state >> 7;
+    p2t_rng_state ^= p2t_rng_state << 17;
+    return p2t_rng_state;
+}
+static double p2t_unit(void) { return (double)(p2t_next() >> 11) * (1.0 / 9007199254740992.0); }
+static int p2t_int(int n) { return (int)(p2t_next() % (uint64_t)n); }
+
+/* ---------------------------------------------------------------------------------------- */
+/* 1. The hull tree against the naive visible sets (spec §7.6, §7.8, §8, §12.9, §12.11)      */
+/* ---------------------------------------------------------------------------------------- */
+
+#define P2T_NMAX 300
+#define P2T_LINES 10800
+#define P2T_CONFIGS 5
+
+enum {
+    P2T_RANDOM, P2T_INTS, P2T_PLATEAU, P2T_MONOTONE, P2T_SINE, P2T_WORST, P2T_DOME, P2T_BOWL,
+    P2T_KINDS
+};
+
+/* Line `kind` with n samples. Distances: unit spacing, or (nonuniform) random spacing in
+ * [0.5, 1.5) - small integers 1..3 for the exact-tie kinds, so every product stays exact. */
+static void p2t_make_line(int kind, int n, int nonuniform, double *d, double *h)
+{
+    int i;
+    double c = (double)(n - 1) * 0.5, a = 0.05 + p2t_unit(), ph = 6.3 * p2t_unit();
+    int exact = kind == P2T_INTS || kind == P2T_PLATEAU || kind == P2T_WORST || kind == P2T_DOME ||
+                kind == P2T_BOWL;
+    for (i = 0; i < n; i++) {
+        if (i == 0) d[i] = !nonuniform ? 0.0 : exact ? -(double)p2t_int(50) : -50.0 * p2t_unit();
+        else if (!nonuniform) d[i] = d[i - 1] + 1.0;
+        else d[i] = d[i - 1] + (exact ? (double)(1 + p2t_int(3)) : 0.5 + p2t_unit());
+    }
+    for (i = 0; i < n; i++) {
+        double x = (double)i - c, e = exact && nonuniform ? d[i] - d[0] - c : x;
+        switch (kind) {
+        case P2T_RANDOM: h[i] = 10.0 * (p2t_unit() - 0.5); break;
+        case P2T_INTS: h[i] = (double)p2t_int(5); break;
+        case P2T_PLATEAU: h[i] = i > 0 && p2t_int(4) != 0 ? h[i - 1] : (double)p2t_int(7); break;
+        case P2T_MONOTONE: h[i] = (i ? h[i - 1] : 0.0) + (a > 0.5 ? 1.0 : -1.0) * 3.0 * p2t_unit(); break;
+        case P2T_SINE: h[i] = 5.0 * sin(0.13 * a * (double)i + ph) + 0.3 * (p2t_unit() - 0.5); break;
+        /* spec §12.9: bowl with every other sample lowered: O(n^2) iterations. Lowered by
+         * 2|e| + 8 so every lowered sample is a cup at any position (a fixed 0.5 on e^2 is too
+         * shallow: t stays ~n; measured t = 14756 at n = 300 here) */
+        case P2T_WORST: h[i] = e * e - ((i & 1) ? 2.0 * fabs(e) + 8.0 : 0.0); break;
+        case P2T_DOME: h[i] = -e * e; break; /* strictly concave: only the neighbour is seen */
+        default: h[i] = e * e; break;        /* strictly convex bowl: all visible, horizon p_0 */
+        }
+    }
+}
+
+static int p2t_same_ints(const int *a, int na, const int *b, int nb)
+{
+    return na == nb && (na == 0 || memcmp(a, b, sizeof(int) * (size_t)na) == 0);
+}
+
+TEST(p2t_tree_vs_naive)
+{
+    static const hfvis_tree_options cfg[P2T_CONFIGS] = {
+        {HFVIS_TREE_DEPTH_FIRST, 0, 0}, {HFVIS_TREE_BREADTH_FIRST, 0, 0},
+        {HFVIS_TREE_DEPTH_FIRST, 1, 0}, {HFVIS_TREE_BREADTH_FIRST, 1, 0},
+        {HFVIS_TREE_DEFAULT, 1, 16}};
+    size_t sz = hfvis_hull_tree_size(P2T_NMAX);
+    void *mem[P2T_CONFIGS];
+    hfvis_hull_tree *tree[P2T_CONFIGS];
+    static int hz0[P2T_NMAX][P2T_NMAX];
+    static int nhz0[P2T_NMAX];
+    double d[P2T_NMAX], h[P2T_NMAX];
+    int hz[P2T_NMAX], vis_t[P2T_NMAX], vis_n[P2T_NMAX], loc_n[P2T_NMAX];
+    int line, c, bad_vis = 0, bad_min = 0, bad_cfg = 0, bad_bound = 0, bad_status = 0, bad_shape = 0;
+    long long receivers = 0, worst_t = 0, worst_n = 0;
+    double sum_t = 0, sum_m = 0, sum_min = 0;
+    for (c = 0; c < P2T_CONFIGS; c++) {
+        mem[c] = malloc(sz);
+        CHECK(mem[c] != NULL);
+        if (!mem[c]) return;
+        CHECK_EQ_STATUS(hfvis_hull_tree_init(mem[c], sz, P2T_NMAX, &cfg[c], &tree[c]), HFVIS_OK);
+    }
+    p2t_seed(20120811);
+    for (line = 0; line < P2T_LINES; line++) {
+        int kind = line % P2T_KINDS, nonuni = (line / P2T_KINDS) % 3 == 2;
+        int n = 2 + p2t_int(P2T_NMAX - 1), k;
+        if (kind >= P2T_WORST && line % 5 == 0) n = P2T_NMAX; /* the size where O(n^2) shows */
+        p2t_make_line(kind, n, nonuni, d, h);
+        for (c = 0; c < P2T_CONFIGS; c++) {
+            long long msum = 0, t;
+            hfvis_hull_tree_reset(tree[c]);
+            for (k = 0; k < n; k++) {
+                int m = -7, nh;
+                if (hfvis_hull_tree_push(tree[c], d[k], h[k], &m) != HFVIS_OK) bad_status++;
+                nh = hfvis_hull_tree_horizons(tree[c], 0, hz, P2T_NMAX);
+                if (nh != m || (k == 0 && m != 0)) bad_shape++;
+                msum += m;
+                if (c == 0) {
+                    int nv, nvn, nl, nmin, mins[P2T_NMAX];
+                    memcpy(hz0[k], hz, sizeof(int) * (size_t)nh);
+                    nhz0[k] = nh;
+                    nv = hfvis_line_visible_from_horizons(d, h, k, hz, nh, vis_t, P2T_NMAX);
+                    nvn = hfvis_line_visible_naive(d, h, k, vis_n, P2T_NMAX);
+                    if (!p2t_same_ints(vis_t, nv, vis_n, nvn)) {
+                        if (bad_vis++ < 3)
+                            fprintf(stderr, "  line %d kind %d n=%d k=%d: tree visible %d, naive %d\n",
+                                    line, kind, n, k, nv, nvn);
+                    }
+                    nmin = hfvis_hull_tree_horizons(tree[c], 1, mins, P2T_NMAX);
+                    nl = hfvis_line_local_horizons_naive(d, h, k, loc_n, P2T_NMAX);
+                    if (!p2t_same_ints(mins, nmin, loc_n, nl)) {
+                        if (bad_min++ < 3)
+                            fprintf(stderr, "  line %d kind %d n=%d k=%d: minimal %d, naive %d\n", line,
+                                    kind, n, k, nmin, nl);
+                    }
+                    sum_min += nmin;
+                    receivers++;
+                    /* spec §12.9 shapes */
+                    if (k >= 1 && kind == P2T_DOME && (nvn != 1 || vis_n[0] != k - 1 || m != 1)) bad_shape++;
+                    if (k >= 1 && kind == P2T_BOWL && (nvn != k || nl != 1 || loc_n[0] != 0 || m != 1))
+                        bad_shape++;
+                } else if (!p2t_same_ints(hz, nh, hz0[k], nhz0[k])) {
+                    if (bad_cfg++ < 3)
+                        fprintf(stderr, "  line %d kind %d n=%d k=%d config %d: %d horizons, config 0 %d\n",
+                                line, kind, n, k, c, nh, nhz0[k]);
+                }
+            }
+            t = hfvis_hull_tree_iterations(tree[c]);
+            CHECK(hfvis_hull_tree_count(tree[c]) == n);
+            /* [P2] §6 (spec §7.8): t <= 2m + n, n the steps of the line */
+            if (t > 2 * msum + n) {
+                if (bad_bound++ < 3)
+                    fprintf(stderr, "  line %d kind %d n=%d config %d: t=%lld > 2m+n = %lld\n", line, kind,
+                            n, c, t, 2 * msum + n);
+            }
+            if (c == 0) {
+                sum_t += (double)t;
+                sum_m += (double)msum;
+                if (kind == P2T_WORST && n == P2T_NMAX) worst_t = t, worst_n = n;
+                /* dome: m = 1 per step, t = O(n) */
+                if (kind == P2T_DOME && t > 2 * (long long)n) bad_shape++;
+            }
+        }
+    }
+    CHECK(bad_status == 0);
+    CHECK(bad_vis == 0);
+    CHECK(bad_min == 0);
+    CHECK(bad_cfg == 0);
+    CHECK(bad_bound == 0);
+    CHECK(bad_shape == 0);
+    /* the worst case is quadratic: at n = 300 the spec's n = 201 rate (39.8 tests per step,
+     * spec §7.6) gives ~12000; a linear algorithm would stay near 2-3 n */
+    CHECK(worst_n == P2T_NMAX && worst_t > (long long)P2T_NMAX * P2T_NMAX / 10);
+    printf("  tree: %lld receivers, t/step %.2f, m/step %.2f, minimal/step %.2f, worst t=%lld (n=%lld)\n",
+           receivers, sum_t / (double)receivers, sum_m / (double)receivers, sum_min / (double)receivers,
+           worst_t, worst_n);
+    for (c = 0; c < P2T_CONFIGS; c++) free(mem[c]);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* 2. Tree and line API: errors, capacities, holes                                          */
+/* ---------------------------------------------------------------------------------------- */
+
+TEST(p2t_tree_api_errors)
+{
+    size_t sz = hfvis_hull_tree_size(8);
+    double *mem = (double *)malloc(sz + 64), d[4] = {0.0, 1.0, 2.0, 3.0}, h[4] = {3.0, 0.0, 1.0, 0.0};
+    hfvis_hull_tree *t, *sentinel = (hfvis_hull_tree *)(void *)&sz, *t2 = sentinel;
+    hfvis_tree_options bad;
+    int m = -7, out[8], i, k;
+    CHECK(mem != NULL);
+    if (!mem) return;
+    CHECK(hfvis_hull_tree_size(0) == 0);
+    CHECK(hfvis_hull_tree_size(-5) == 0);
+    CHECK(sz >= 8 * (2 * sizeof(double) + 2 * sizeof(int)));
+    {   /* 2^31 - 1 samples: overflows a 32-bit size_t (then 0), else at least the samples */
+        size_t big = hfvis_hull_tree_size(2147483647);
+        if ((double)SIZE_MAX < 1e12) CHECK(big == 0);
+        else CHECK(big >= (size_t)2147483647 * 2 * sizeof(double));
+    }
+    CHECK_EQ_STATUS(hfvis_hull_tree_init(NULL, sz, 8, NULL, &t2), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_hull_tree_init(mem, sz, 8, NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_hull_tree_init((char *)mem + 4, sz, 8, NULL, &t2), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_hull_tree_init(mem, sz, 0, NULL, &t2), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_hull_tree_init(mem, sz - 1, 8, NULL, &t2), HFVIS_ERR_BUFFER_TOO_SMALL);
+    CHECK_EQ_STATUS(hfvis_hull_tree_init(mem, 0, 8, NULL, &t2), HFVIS_ERR_BUFFER_TOO_SMALL);
+    memset(&bad, 0, sizeof bad);
+    bad.order = (hfvis_tree_order)9;
+    CHECK_EQ_STATUS(hfvis_hull_tree_init(mem, sz, 8, &bad, &t2), HFVIS_ERR_INVALID_ARGUMENT);
+    bad.order = (hfvis_tree_order)-1;
+    CHECK_EQ_STATUS(hfvis_hull_tree_init(mem, sz, 8, &bad, &t2), HFVIS_ERR_INVALID_ARGUMENT);
+    bad.order = HFVIS_TREE_DEFAULT;
+    bad.safe_zone = 2;
+    CHECK_EQ_STATUS(hfvis_hull_tree_init(mem, sz, 8, &bad, &t2), HFVIS_ERR_INVALID_ARGUMENT);
+    bad.safe_zone = -1;
+    CHECK_EQ_STATUS(hfvis_hull_tree_init(mem, sz, 8, &bad, &t2), HFVIS_ERR_INVALID_ARGUMENT);
+    bad.safe_zone = 1;
+    bad.safe_zone_steps = -1;
+    CHECK_EQ_STATUS(hfvis_hull_tree_init(mem, sz, 8, &bad, &t2), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK(t2 == sentinel);
+    /* a valid tree of capacity 4 */
+    CHECK_EQ_STATUS(hfvis_hull_tree_init(mem, sz, 4, NULL, &t), HFVIS_OK);
+    CHECK(hfvis_hull_tree_count(t) == 0 && hfvis_hull_tree_iterations(t) == 0);
+    CHECK(hfvis_hull_tree_horizons(t, 0, out, 8) == 0);
+    CHECK_EQ_STATUS(hfvis_hull_tree_push(NULL, 0.0, 0.0, &m), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_hull_tree_push(t, (double)NAN, 0.0, &m), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_hull_tree_push(t, 0.0, (double)INFINITY, &m), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK(m == -7 && hfvis_hull_tree_count(t) == 0);
+    CHECK_EQ_STATUS(hfvis_hull_tree_push(t, d[0], h[0], NULL), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_hull_tree_push(t, d[0], h[1], &m), HFVIS_ERR_INVALID_ARGUMENT); /* equal */
+    CHECK_EQ_STATUS(hfvis_hull_tree_push(t, -1.0, h[1], &m), HFVIS_ERR_INVALID_ARGUMENT); /* smaller */
+    CHECK_EQ_STATUS(hfvis_hull_tree_push(t, -(double)INFINITY, h[1], &m), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_hull_tree_push(t, d[1], (double)NAN, &m), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK(m == -7 && hfvis_hull_tree_count(t) == 1);
+    for (k = 1; k < 4; k++) CHECK_EQ_STATUS(hfvis_hull_tree_push(t, d[k], h[k], &m), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_hull_tree_push(t, 4.0, 0.0, &m), HFVIS_ERR_LIMIT);
+    CHECK(hfvis_hull_tree_count(t) == 4);
+    /* receiver 3 (h 0) sees 2 (h 1) and 0 (h 3) over 1: horizons {0, 2} */
+    for (i = 0; i < 8; i++) out[i] = -9;
+    CHECK(hfvis_hull_tree_horizons(t, 1, out, 8) == 2 && out[0] == 0 && out[1] == 2 && out[2] == -9);
+    for (i = 0; i < 8; i++) out[i] = -9;
+    CHECK(hfvis_hull_tree_horizons(t, 1, out, 1) == 2 && out[0] == 0 && out[1] == -9);
+    CHECK(hfvis_hull_tree_horizons(t, 1, NULL, 0) == 2);
+    CHECK(hfvis_hull_tree_horizons(t, 0, NULL, 1) == -1);
+    CHECK(hfvis_hull_tree_horizons(t, 0, out, -1) == -1);
+    CHECK(hfvis_hull_tree_horizons(NULL, 0, out, 8) == -1);
+    CHECK(hfvis_hull_tree_count(NULL) == 0 && hfvis_hull_tree_iterations(NULL) == 0);
+    hfvis_hull_tree_reset(NULL); /* no-op */
+    hfvis_hull_tree_reset(t);
+    CHECK(hfvis_hull_tree_count(t) == 0 && hfvis_hull_tree_iterations(t) == 0);
+    CHECK_EQ_STATUS(hfvis_hull_tree_push(t, -10.0, 0.0, &m), HFVIS_OK); /* a new line may start anywhere */
+    CHECK(m == 0);
+    /* line functions */
+    {
+        int hzs[2] = {0, 2}, bad1[2] = {2, 0}, bad2[1] = {3}, bad3[1] = {-1};
+        CHECK(hfvis_line_visible_naive(d, h, 3, out, 8) == 2 && out[0] == 0 && out[1] == 2);
+        for (i = 0; i < 8; i++) out[i] = -9;
+        CHECK(hfvis_line_visible_naive(d, h, 3, out, 1) == 2 && out[0] == 0 && out[1] == -9);
+        CHECK(hfvis_line_visible_naive(d, h, 3, NULL, 0) == 2);
+        CHECK(hfvis_line_visible_naive(d, h, 0, out, 8) == 0);
+        CHECK(hfvis_line_visible_naive(NULL, h, 3, out, 8) == -1);
+        CHECK(hfvis_line_visible_naive(d, NULL, 3, out, 8) == -1);
+        CHECK(hfvis_line_visible_naive(d, h, -1, out, 8) == -1);
+        CHECK(hfvis_line_visible_naive(d, h, 3, NULL, 8) == -1);
+        CHECK(hfvis_line_visible_naive(d, h, 3, out, -1) == -1);
+        CHECK(hfvis_line_local_horizons_naive(d, h, 3, out, 8) == 2 && out[0] == 0 && out[1] == 2);
+        for (i = 0; i < 8; i++) out[i] = -9;
+        CHECK(hfvis_line_local_horizons_naive(d, h, 3, out, 1) == 2 && out[0] == 0 && out[1] == -9);
+        CHECK(hfvis_line_local_horizons_naive(NULL, h, 3, out, 8) == -1);
+        CHECK(hfvis_line_local_horizons_naive(d, NULL, 3, out, 8) == -1);
+        CHECK(hfvis_line_local_horizons_naive(d, h, -2, out, 8) == -1);
+        CHECK(hfvis_line_local_horizons_naive(d, h, 3, NULL, 8) == -1);
+        CHECK(hfvis_line_local_horizons_naive(d, h, 3, out, -1) == -1);
+        CHECK(hfvis_line_visible_from_horizons(d, h, 3, hzs, 2, out, 8) == 2 && out[0] == 0 && out[1] == 2);
+        for (i = 0; i < 8; i++) out[i] = -9;
+        CHECK(hfvis_line_visible_from_horizons(d, h, 3, hzs, 2, out, 1) == 2 && out[0] == 0 && out[1] == -9);
+        CHECK(hfvis_line_visible_from_horizons(d, h, 3, hzs, 0, out, 8) == 0);
+        CHECK(hfvis_line_visible_from_horizons(NULL, h, 3, hzs, 2, out, 8) == -1);
+        CHECK(hfvis_line_visible_from_horizons(d, NULL, 3, hzs, 2, out, 8) == -1);
+        CHECK(hfvis_line_visible_from_horizons(d, h, -1, hzs, 2, out, 8) == -1);
+        CHECK(hfvis_line_visible_from_horizons(d, h, 3, NULL, 2, out, 8) == -1);
+        CHECK(hfvis_line_visible_from_horizons(d, h, 3, hzs, -1, out, 8) == -1);
+        CHECK(hfvis_line_visible_from_horizons(d, h, 3, hzs, 2, NULL, 8) == -1);
+        CHECK(hfvis_line_visible_from_horizons(d, h, 3, hzs, 2, out, -1) == -1);
+        CHECK(hfvis_line_visible_from_horizons(d, h, 3, bad1, 2, out, 8) == -1); /* not farthest first */
+        CHECK(hfvis_line_visible_from_horizons(d, h, 3, bad2, 1, out, 8) == -1); /* the receiver itself */
+        CHECK(hfvis_line_visible_from_horizons(d, h, 3, bad3, 1, out, 8) == -1);
+    }
+    free(mem);
+}
+
+/* Holes in the line arrays (spec §11, hfvis.h: never visible, never occlude): the naive and
+ * from-horizons results on a line with holes equal those of the line with the holes removed,
+ * indices mapped back; the horizons come from a tree fed the compacted line. */
+TEST(p2t_line_holes)
+{
+    size_t sz = hfvis_hull_tree_size(P2T_NMAX);
+    void *mem = malloc(sz);
+    hfvis_hull_tree *t;
+    double d[P2T_NMAX], h[P2T_NMAX], cd[P2T_NMAX], ch[P2T_NMAX];
+    int map[P2T_NMAX], hz[P2T_NMAX], a[P2T_NMAX], b[P2T_NMAX], line, bad = 0, holes = 0, tested = 0;
+    CHECK(mem != NULL);
+    if (!mem) return;
+    CHECK_EQ_STATUS(hfvis_hull_tree_init(mem, sz, P2T_NMAX, NULL, &t), HFVIS_OK);
+    p2t_seed(77);
+    for (line = 0; line < 400; line++) {
+        int kind = line % P2T_KINDS, n = 2 + p2t_int(120), i, nc = 0, k;
+        p2t_make_line(kind, n, line % 3 == 2, d, h);
+        for (i = 0; i < n; i++) {
+            int r = p2t_int(6);
+            if (r == 0 || (i == 0 && line % 4 == 0)) {
+                h[i] = (line & 1) ? (double)NAN : (r & 1 ? (double)INFINITY : -(double)INFINITY);
+                holes++;
+            }
+        }
+        hfvis_hull_tree_reset(t);
+        for (k = 0; k < n; k++) {
+            int na, nb, nh, j;
+            if (!isfinite(h[k])) continue;
+            cd[nc] = d[k];
+            ch[nc] = h[k];
+            map[nc] = k;
+            if (hfvis_hull_tree_push(t, cd[nc], ch[nc], NULL) != HFVIS_OK) bad++;
+            nc++;
+            /* naive on the holey line vs naive on the compacted line */
+            na = hfvis_line_visible_naive(d, h, k, a, P2T_NMAX);
+            nb = hfvis_line_visible_naive(cd, ch, nc - 1, b, P2T_NMAX);
+            for (j = 0; j < nb; j++) b[j] = map[b[j]];
+            if (!p2t_same_ints(a, na, b, nb)) bad++;
+            na = hfvis_line_local_horizons_naive(d, h, k, a, P2T_NMAX);
+            nb = hfvis_line_local_horizons_naive(cd, ch, nc - 1, b, P2T_NMAX);
+            for (j = 0; j < nb; j++) b[j] = map[b[j]];
+            if (!p2t_same_ints(a, na, b, nb)) bad++;
+            /* from horizons on the holey line, with the tree's horizons mapped back */
+            nh = hfvis_hull_tree_horizons(t, 0, hz, P2T_NMAX);
+            for (j = 0; j < nh; j++) hz[j] = map[hz[j]];
+            na = hfvis_line_visible_from_horizons(d, h, k, hz, nh, a, P2T_NMAX);
+            nb = hfvis_line_visible_naive(d, h, k, b, P2T_NMAX);
+            if (!p2t_same_ints(a, na, b, nb)) {
+                if (bad++ < 3) fprintf(stderr, "  holes line %d k=%d: from horizons %d, naive %d\n", line, k, na, nb);
+            }
+            tested++;
+        }
+    }
+    CHECK(bad == 0);
+    CHECK(holes > 1000 && tested > 10000);
+    free(mem);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* 3. Field sweeps: visibility count and intervisibility against the naive oracle           */
+/* ---------------------------------------------------------------------------------------- */
+
+#define P2T_W 41
+#define P2T_H 34
+#define P2T_PAD 3 /* extra output columns, checked untouched */
+/* The full count and each one-direction count are rounded to float once (2^-24 relative each,
+ * all terms >= 0, so the sum of the parts is <= the full count): 2 * 2^-24, plus margin. */
+/* Tree and naive feed the same visible sets to the same band sums, so they differ at most by
+ * the float rounding of the output: one float ulp (2^-23 relative) with margin. */
+#define P2T_IND_REL (2.0 / 8388608.0)
+/* Furnace: the band sum telescopes in double (~1e-16) and is rounded to float once: 2^-24
+ * relative (measured max 5.95e-8 = 2^-24); bound 2 * 2^-24. The absolute term covers sectors
+ * whose S_k is ~0 (normal tilted away), where the relative error is meaningless. */
+#define P2T_FURNACE_REL (2.0 / 16777216.0)
+#define P2T_FURNACE_ABS 1e-12
+/* Sky only: the same lattice normals, horizon slope and sector term as hfvis_sky_light, both
+ * rounded to float once: 2 float ulps (2^-22 relative) allow different summation paths. */
+#define P2T_SKY_REL (1.0 / 4194304.0)
+/* V-valley bottom: indirect, sky light and furnace (values <= 2.5) are each rounded to float
+ * once (<= 1.5e-7 each): 1e-6 absolute. */
+#define P2T_VALLEY_ABS 1e-6
+/* GI monotonicity per sample: the increment rho * I[L_b - L_{b-1}] is >= 0 in exact arithmetic;
+ * each bounce rounds to float, so allow 2^-22 relative. */
+#define P2T_GI_REL (1.0 / 4194304.0)
+/* Direct light: sky (rounded to float) plus the sun term (rounded to float), added in float:
+ * at most 3 roundings of 2^-24 relative; bound 4 * 2^-24. */
+#define P2T_DIRECT_REL (4.0 / 16777216.0)
+#define P2T_PART_REL (3.0 / 16777216.0)
+
+/* A test field: 0 fBm, 1 bricks ([P2] Fig. 7), 2 flat, 3 tilted plane (spec §12.2, normals
+ * constant); holes: about 1 in 30 samples NaN. */
+static void p2t_field(int kind, int W, int H, uint64_t seed, int holes, float *z)
+{
+    hfvis_field f;
+    int i;
+    memset(&f, 0, sizeof f);
+    if (kind == 0) {
+        f.kind = HFVIS_FIELD_FBM;
+        f.amplitude = 6.0;
+        f.wavelength = 12.0;
+        f.octaves = 5;
+        f.seed = seed;
+    } else if (kind == 1) {
+        f.kind = HFVIS_FIELD_BRICKS;
+        f.height = 10.0;
+        f.amplitude = 2.0;
+        f.wavelength = 8.0;
+        f.radius = 1.0;
+        f.seed = seed;
+    } else if (kind == 2) {
+        f.kind = HFVIS_FIELD_PLANE;
+        f.height = 3.0;
+    } else {
+        f.kind = HFVIS_FIELD_TILTED_PLANE;
+        f.height = 3.0;
+        f.slope_x = 0.5;
+        f.slope_y = -0.75;
+    }
+    if (hfvis_field_generate(&f, W, H, W, z) != HFVIS_OK) {
+        for (i = 0; i < W * H; i++) z[i] = NAN;
+        return;
+    }
+    if (holes) {
+        p2t_seed(seed * 31u + 5u);
+        for (i = 0; i < W * H; i++)
+            if (p2t_int(30) == 0) z[i] = NAN;
+    }
+}
+
+TEST(p2t_visibility_count)
+{
+    static float z[P2T_W * P2T_H], a[P2T_H * (P2T_W + P2T_PAD)], b[P2T_H * (P2T_W + P2T_PAD)];
+    static float part[P2T_H * (P2T_W + P2T_PAD)];
+    static const int Ks[3] = {3, 4, 8};
+    static const hfvis_border borders[3] = {HFVIS_BORDER_OPEN, HFVIS_BORDER_CLAMP, HFVIS_BORDER_WRAP};
+    const ptrdiff_t os = P2T_W + P2T_PAD;
+    const size_t n_out = (size_t)P2T_H * (size_t)os;
+    hfvis_grid g;
+    int kind, ki, bi, holes, i, k, runs = 0, mismatch = 0;
+    double tree_it = 0, naive_it = 0;
+    g.z = z;
+    g.width = P2T_W;
+    g.height = P2T_H;
+    g.stride = P2T_W;
+    g.cell_size = 1.5;
+    for (kind = 0; kind < 2; kind++)
+        for (holes = 0; holes < 2; holes++) {
+            p2t_field(kind, P2T_W, P2T_H, (uint64_t)(11 + kind), holes, z);
+            for (ki = 0; ki < 3; ki++)
+                for (bi = 0; bi < 3; bi++) {
+                    hfvis_sweep_options o = hfvis_sweep_options_default();
+                    hfvis_tree_options to;
+                    hfvis_visibility_stats st, sn;
+                    hfvis_status s1, s2;
+                    int K = Ks[ki];
+                    memset(&to, 0, sizeof to);
+                    to.order = (runs & 1) ? HFVIS_TREE_BREADTH_FIRST : HFVIS_TREE_DEPTH_FIRST;
+                    to.safe_zone = (runs >> 1) & 1;
+                    o.border = borders[bi];
+                    if (bi == 1) o.border_cells = 7;
+                    o.azimuth0_rad = ki == 0 ? 0.3 : 0.0;
+                    for (i = 0; i < (int)n_out; i++) a[i] = b[i] = -5.0f;
+                    s1 = hfvis_visibility_count(&g, K, &o, &to, a, os, &st);
+                    s2 = hfvis_visibility_count_naive(&g, K, &o, b, os, &sn);
+                    CHECK_EQ_STATUS(s1, HFVIS_OK);
+                    CHECK_EQ_STATUS(s2, HFVIS_OK);
+                    if (memcmp(a, b, sizeof(float) * n_out) != 0) {
+                        if (mismatch++ < 3) {
+                            for (i = 0; i < (int)n_out && !(a[i] != b[i] && !(isnan(a[i]) && isnan(b[i]))); i++) {}
+                            fprintf(stderr, "  kind %d holes %d K %d border %d: first diff at %d: %g vs %g\n", kind,
+                                    holes, K, bi, i, i < (int)n_out ? (double)a[i] : 0.0,
+                                    i < (int)n_out ? (double)b[i] : 0.0);
+                        }
+                    }
+                    for (i = 0; i < P2T_H; i++) { /* padding untouched, holes NaN */
+                        int x;
+                        for (x = P2T_W; x < os; x++) CHECK(a[i * os + x] == -5.0f);
+                        for (x = 0; x < P2T_W; x++)
+                            if (isnan(z[i * P2T_W + x]) != isnan(a[i * os + x])) {
+                                if (mismatch++ < 3)
+                                    fprintf(stderr, "  kind %d holes %d K %d border %d: (%d,%d) z %g count %g\n", kind,
+                                            holes, K, bi, x, i, (double)z[i * P2T_W + x], (double)a[i * os + x]);
+                            }
+                    }
+                    CHECK(st.receivers == sn.receivers && st.visible == sn.visible);
+                    CHECK(st.horizons >= 1.0 && sn.horizons == 0.0);
+                    tree_it += st.iterations;
+                    naive_it += sn.iterations;
+                    /* per-direction partial sums add up to the full count: exactly on the axis
+                     * directions (integer counts), to float rounding when the gather mixes nodes */
+                    if ((K == 8 || K == 4) && bi == 2) {
+                        static double acc[P2T_W * P2T_H];
+                        for (i = 0; i < P2T_W * P2T_H; i++) acc[i] = 0.0;
+                        for (k = 0; k < K; k++) {
+                            o.direction_begin = k;
+                            o.direction_end = k + 1;
+                            CHECK_EQ_STATUS(hfvis_visibility_count(&g, K, &o, &to, part, os, NULL), HFVIS_OK);
+                            for (i = 0; i < P2T_H; i++) {
+                                int x;
+                                for (x = 0; x < P2T_W; x++) acc[i * P2T_W + x] += (double)part[i * os + x];
+                            }
+                        }
+                        for (i = 0; i < P2T_H; i++) {
+                            int x;
+                            for (x = 0; x < P2T_W; x++) {
+                                double u = (double)a[i * os + x], v = acc[i * P2T_W + x];
+                                double tol = K == 4 ? 0.0 : P2T_PART_REL * u;
+                                if (!(fabs(u - v) <= tol || (isnan(u) && isnan(v)))) {
+                                    if (mismatch++ < 3)
+                                        fprintf(stderr, "  kind %d holes %d K %d: (%d,%d) full %.9g, sum of directions %.9g\n",
+                                                kind, holes, K, x, i, u, v);
+                                }
+                            }
+                        }
+                        o.direction_begin = o.direction_end = 0;
+                    }
+                    runs++;
+                }
+        }
+    CHECK(mismatch == 0);
+    /* [P2] Table 1: the tree's iterations are a small fraction of the naive scan (measured
+     * ratio 0.075; 1/5 leaves a margin of 2.7) */
+    CHECK(tree_it * 5.0 < naive_it);
+    printf("  visibility count: %d runs, iterations tree %.0f naive %.0f (ratio %.3f)\n", runs, tree_it,
+           naive_it, tree_it / naive_it);
+}
+
+/* Flat field: every sample before the receiver on its line is visible (ties count, spec §7.6). */
+TEST(p2t_visibility_flat)
+{
+    static float z[P2T_W * P2T_H], out[P2T_W * P2T_H];
+    hfvis_grid g;
+    hfvis_sweep_options o = hfvis_sweep_options_default();
+    int x, y, bad = 0, bi;
+    p2t_field(2, P2T_W, P2T_H, 1, 0, z);
+    g.z = z;
+    g.width = P2T_W;
+    g.height = P2T_H;
+    g.stride = P2T_W;
+    g.cell_size = 0.7;
+    for (bi = 0; bi < 3; bi++) {
+        o.border = bi == 0 ? HFVIS_BORDER_OPEN : bi == 1 ? HFVIS_BORDER_CLAMP : HFVIS_BORDER_WRAP;
+        /* K = 1, psi = 0: looking toward +x, the samples x+1..W-1 (pre-roll not counted) */
+        CHECK_EQ_STATUS(hfvis_visibility_count(&g, 1, &o, NULL, out, P2T_W, NULL), HFVIS_OK);
+        for (y = 0; y < P2T_H; y++)
+            for (x = 0; x < P2T_W; x++)
+                if (out[y * P2T_W + x] != (float)(P2T_W - 1 - x)) bad++;
+        /* K = 4 axis directions: W-1-x + x + H-1-y + y */
+        CHECK_EQ_STATUS(hfvis_visibility_count(&g, 4, &o, NULL, out, P2T_W, NULL), HFVIS_OK);
+        for (y = 0; y < P2T_H; y++)
+            for (x = 0; x < P2T_W; x++)
+                if (out[y * P2T_W + x] != (float)(P2T_W + P2T_H - 2)) bad++;
+    }
+    CHECK(bad == 0);
+}
+
+/* The callback's lists against the oracles on the event's own arrays. */
+typedef struct p2t_iv {
+    int K, axis, W, H;
+    const hfvis_grid *g;
+    double events, visible;
+    int bad_vis, bad_hz, bad_arr, bad_pos;
+    int kseen[8];
+} p2t_iv;
+
+static void p2t_iv_fn(void *user, const hfvis_visibility_event *e)
+{
+    p2t_iv *u = (p2t_iv *)user;
+    static int buf[4096];
+    int n, i;
+    u->events += 1.0;
+    u->visible += (double)e->visible_count;
+    if (e->k < 0 || e->k >= u->K || e->receiver < 0 || e->receiver >= 4096) {
+        u->bad_arr++;
+        return;
+    }
+    u->kseen[e->k & 7] = 1;
+    for (i = 1; i <= e->receiver; i++)
+        if (!(e->distance[i] > e->distance[i - 1]) || !isfinite(e->height[i - 1])) u->bad_arr++;
+    if (!isfinite(e->height[e->receiver])) u->bad_arr++;
+    n = hfvis_line_visible_naive(e->distance, e->height, e->receiver, buf, 4096);
+    if (!p2t_same_ints(e->visible, e->visible_count, buf, n)) u->bad_vis++;
+    n = hfvis_line_local_horizons_naive(e->distance, e->height, e->receiver, buf, 4096);
+    if (!p2t_same_ints(e->horizons, e->horizon_count, buf, n)) u->bad_hz++;
+    /* the receiver is a lattice node in the grid; on the axis directions a grid point whose
+     * height is the grid's (cell_size a power of two: the cell-unit round trip is exact) */
+    if (e->x < -1e-9 || e->y < -1e-9 || e->x > (double)(u->W - 1) + 1e-9 || e->y > (double)(u->H - 1) + 1e-9)
+        u->bad_pos++;
+    else if (u->axis) {
+        int xi = (int)floor(e->x + 0.5), yi = (int)floor(e->y + 0.5);
+        if ((double)xi != e->x || (double)yi != e->y ||
+            e->height[e->receiver] != (double)u->g->z[yi * u->g->stride + xi])
+            u->bad_pos++;
+    }
+}
+
+TEST(p2t_intervisibility)
+{
+    static float z[P2T_W * P2T_H];
+    static const int Ks[3] = {4, 3, 8};
+    hfvis_grid g;
+    int kind, ki, bi, k;
+    g.z = z;
+    g.width = P2T_W;
+    g.height = P2T_H;
+    g.stride = P2T_W;
+    g.cell_size = 2.0;
+    for (kind = 0; kind < 2; kind++) {
+        p2t_field(kind, P2T_W, P2T_H, (uint64_t)(21 + kind), kind, z);
+        for (ki = 0; ki < 3; ki++)
+            for (bi = 0; bi < 3; bi++) {
+                hfvis_sweep_options o = hfvis_sweep_options_default();
+                hfvis_tree_options to;
+                hfvis_visibility_stats st;
+                p2t_iv u;
+                memset(&u, 0, sizeof u);
+                memset(&to, 0, sizeof to);
+                to.order = bi == 1 ? HFVIS_TREE_BREADTH_FIRST : HFVIS_TREE_DEFAULT;
+                to.safe_zone = ki == 2;
+                u.K = Ks[ki];
+                u.axis = ki == 0;
+                u.W = P2T_W;
+                u.H = P2T_H;
+                u.g = &g;
+                o.border = bi == 0 ? HFVIS_BORDER_OPEN : bi == 1 ? HFVIS_BORDER_CLAMP : HFVIS_BORDER_WRAP;
+                o.border_cells = 9;
+                o.azimuth0_rad = ki == 1 ? 0.4 : 0.0;
+                CHECK_EQ_STATUS(hfvis_intervisibility(&g, u.K, &o, &to, p2t_iv_fn, &u, &st), HFVIS_OK);
+                CHECK(u.bad_vis == 0 && u.bad_hz == 0 && u.bad_arr == 0 && u.bad_pos == 0);
+                if (u.bad_vis || u.bad_hz || u.bad_arr || u.bad_pos)
+                    fprintf(stderr, "  kind %d K %d border %d: bad vis %d hz %d arrays %d pos %d\n", kind, u.K, bi,
+                            u.bad_vis, u.bad_hz, u.bad_arr, u.bad_pos);
+                CHECK(u.events == st.receivers && u.visible == st.visible && u.events > 0.0);
+                for (k = 0; k < u.K; k++) CHECK(u.kseen[k]);
+                /* stats may be NULL */
+                if (ki == 0 && bi == 0)
+                    CHECK_EQ_STATUS(hfvis_intervisibility(&g, u.K, &o, NULL, p2t_iv_fn, &u, NULL), HFVIS_OK);
+            }
+    }
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* 4. Indirect light (spec §9 band rule, §12.3, §12.10)                                     */
+/* ---------------------------------------------------------------------------------------- */
+
+TEST(p2t_indirect_vs_naive)
+{
+    static float z[P2T_W * P2T_H], ex[P2T_W * P2T_H * 3];
+    static float a[P2T_H * (P2T_W + P2T_PAD) * 3], b[P2T_H * (P2T_W + P2T_PAD) * 3];
+    const ptrdiff_t os = P2T_W + P2T_PAD;
+    hfvis_grid g;
+    int ch, bi, i, holes, bad = 0, exact = 0, total = 0;
+    double maxrel = 0.0;
+    g.z = z;
+    g.width = P2T_W;
+    g.height = P2T_H;
+    g.stride = P2T_W;
+    g.cell_size = 1.0;
+    p2t_seed(4242);
+    for (i = 0; i < P2T_W * P2T_H * 3; i++) ex[i] = (float)(2.0 * p2t_unit());
+    for (holes = 0; holes < 2; holes++) {
+        p2t_field(0, P2T_W, P2T_H, 31, holes, z);
+        for (ch = 1; ch <= 3; ch += 2)
+            for (bi = 0; bi < 3; bi++) {
+                hfvis_sweep_options o = hfvis_sweep_options_default();
+                int K = bi == 1 ? 5 : 8, x, y, c;
+                size_t n = (size_t)P2T_H * (size_t)os * (size_t)ch;
+                o.border = bi == 0 ? HFVIS_BORDER_OPEN : bi == 1 ? HFVIS_BORDER_CLAMP : HFVIS_BORDER_WRAP;
+                o.azimuth0_rad = 0.1 * (double)bi;
+                for (i = 0; i < (int)n; i++) a[i] = b[i] = -5.0f;
+                CHECK_EQ_STATUS(hfvis_indirect_light(&g, K, ex, ch, 0.6f, 0.8f, &o, NULL, a, os), HFVIS_OK);
+                CHECK_EQ_STATUS(hfvis_indirect_light_naive(&g, K, ex, ch, 0.6f, 0.8f, &o, b, os), HFVIS_OK);
+                for (y = 0; y < P2T_H; y++)
+                    for (x = 0; x < (int)os; x++)
+                        for (c = 0; c < ch; c++) {
+                            size_t q = ((size_t)y * (size_t)os + (size_t)x) * (size_t)ch + (size_t)c;
+                            double u = (double)a[q], v = (double)b[q];
+                            if (x >= P2T_W) {
+                                if (u != -5.0 || v != -5.0) bad++;
+                                continue;
+                            }
+                            if (isnan(z[y * P2T_W + x]) != isnan(u) || isnan(u) != isnan(v)) {
+                                bad++;
+                                continue;
+                            }
+                            if (isnan(u)) continue;
+                            total++;
+                            exact += u == v;
+                            if (fabs(u - v) > maxrel * fabs(v)) maxrel = fabs(u - v) / fabs(v);
+                            if (!(fabs(u - v) <= P2T_IND_REL * fabs(v))) bad++;
+                        }
+            }
+    }
+    CHECK(bad == 0);
+    printf("  indirect tree vs naive: %d of %d values bit-identical, max rel diff %.3g\n", exact, total, maxrel);
+}
+
+/* sum_k S_k(c_k) at grid point (x, y) from the grid normals ([P1] Eq. 5 with the clamp
+ * c_k = pi/2 + atan2(a_k, N_z), spec §5.2), directions psi_k = 2 pi k / K, k in [k0, k1).
+ * The normal is renormalised and rounded to float as the lattice does with its bilinear
+ * normals (at a grid point the bilinear weight is 1). */
+static double p2t_furnace(const float *nrm, int W, int x, int y, int K, int k0, int k1)
+{
+    const float *n = nrm + ((size_t)y * (size_t)W + (size_t)x) * 3;
+    double sum = 0.0, len = sqrt((double)n[0] * (double)n[0] + (double)n[1] * (double)n[1] + (double)n[2] * (double)n[2]);
+    int k;
+    for (k = k0; k < k1; k++) {
+        double psi = 2.0 * 3.14159265358979323846 * (double)k / (double)K;
+        double nx = (double)(float)((double)n[0] / len), ny = (double)(float)((double)n[1] / len);
+        double nz = (double)(float)((double)n[2] / len), ak = nx * cos(psi) + ny * sin(psi);
+        sum += hfvis_sector_weight(K, nz, ak, 1.57079632679489661923 + atan2(ak, nz));
+    }
+    return sum;
+}
+
+/* Furnace (spec §12.10): exit radiance == sky == c gives c * sum_k S_k(c_k) whatever the
+ * geometry; flat field: exactly c. On the axis directions the lattice nodes are grid points and
+ * the lattice normals the grid normals, so the identity holds to float rounding per point
+ * (each axis direction alone via direction_begin/end). The diagonal lattices of K = 8 have
+ * nodes between grid points (bilinear normals, then the gather), so there the closed form holds
+ * on a tilted plane (one normal everywhere) and only approximately on fBm (printed). */
+TEST(p2t_indirect_furnace)
+{
+    static float z[P2T_W * P2T_H], ex[P2T_W * P2T_H * 2], out[P2T_W * P2T_H * 2], nrm[P2T_W * P2T_H * 3];
+    static const int Ks[2] = {4, 8};
+    const float cval = 1.75f;
+    hfvis_grid g;
+    int kind, ki, bi, i, x, y, bad = 0;
+    double maxrel = 0.0, maxrel_diag = 0.0;
+    g.z = z;
+    g.width = P2T_W;
+    g.height = P2T_H;
+    g.stride = P2T_W;
+    g.cell_size = 1.0;
+    for (i = 0; i < P2T_W * P2T_H * 2; i++) ex[i] = cval;
+    for (kind = 0; kind < 4; kind++) {
+        if (kind == 1) continue;
+        p2t_field(kind, P2T_W, P2T_H, 41, 0, z);
+        CHECK_EQ_STATUS(hfvis_normals_compute(&g, nrm), HFVIS_OK);
+        for (ki = 0; ki < 2; ki++)
+            for (bi = 0; bi < 3; bi++) {
+                hfvis_sweep_options o = hfvis_sweep_options_default();
+                int K = Ks[ki], k;
+                o.border = bi == 0 ? HFVIS_BORDER_OPEN : bi == 1 ? HFVIS_BORDER_CLAMP : HFVIS_BORDER_WRAP;
+                /* every axis direction alone (for K = 8 the diagonals are checked below) */
+                for (k = 0; k < K; k += K / 4) {
+                    o.direction_begin = k;
+                    o.direction_end = k + 1;
+                    CHECK_EQ_STATUS(hfvis_indirect_light(&g, K, ex, 2, cval, 1.0f, &o, NULL, out, P2T_W), HFVIS_OK);
+                    for (y = 0; y < P2T_H; y++)
+                        for (x = 0; x < P2T_W; x++) {
+                            double want = (double)cval * p2t_furnace(nrm, P2T_W, x, y, K, k, k + 1);
+                            double got0 = (double)out[(y * P2T_W + x) * 2], got1 = (double)out[(y * P2T_W + x) * 2 + 1];
+                            double e = fmax(fabs(got0 - want), fabs(got1 - want));
+                            if (e > maxrel * fabs(want)) maxrel = e / fabs(want);
+                            if (!(e <= P2T_FURNACE_ABS + P2T_FURNACE_REL * fabs(want))) {
+                                if (bad++ < 3)
+                                    fprintf(stderr, "  furnace kind %d K %d k %d (%d,%d): %.9g want %.9g\n", kind, K, k,
+                                            x, y, got0, want);
+                            }
+                        }
+                }
+                /* all K directions */
+                o.direction_begin = o.direction_end = 0;
+                CHECK_EQ_STATUS(hfvis_indirect_light(&g, K, ex, 2, cval, 1.0f, &o, NULL, out, P2T_W), HFVIS_OK);
+                for (y = 0; y < P2T_H; y++)
+                    for (x = 0; x < P2T_W; x++) {
+                        double want = (double)cval * p2t_furnace(nrm, P2T_W, x, y, K, 0, K);
+                        double got = (double)out[(y * P2T_W + x) * 2];
+                        double e = fabs(got - want);
+                        if (kind == 2) { /* flat: exactly c for any K */
+                            if (!(fabs(got - (double)cval) <= P2T_FURNACE_REL * (double)cval)) bad++;
+                        } else if (K == 4 || kind == 3) {
+                            if (!(e <= P2T_FURNACE_ABS + P2T_FURNACE_REL * fabs(want))) {
+                                if (bad++ < 3)
+                                    fprintf(stderr, "  furnace kind %d K %d (%d,%d): %.9g want %.9g\n", kind, K, x, y,
+                                            got, want);
+                            }
+                        } else if (e > maxrel_diag * fabs(want)) {
+                            maxrel_diag = e / fabs(want);
+                        }
+                    }
+            }
+    }
+    CHECK(bad == 0);
+    printf("  furnace: axis directions max rel err %.3g; K=8 all directions (diagonal lattice normals "
+           "bilinear, gathered) max rel diff %.3g from the grid-normal sum\n", maxrel, maxrel_diag);
+}
+
+/* Sky only (exit radiance 0): the sky band is the P1 term, so the result is hfvis_sky_light. */
+TEST(p2t_indirect_sky_only)
+{
+    static float z[P2T_W * P2T_H], ex[P2T_W * P2T_H * 2], a[P2T_W * P2T_H * 2], b[P2T_W * P2T_H];
+    hfvis_grid g;
+    int holes, ki, bi, i, bad = 0, exact = 0, total = 0;
+    double maxrel = 0.0;
+    g.z = z;
+    g.width = P2T_W;
+    g.height = P2T_H;
+    g.stride = P2T_W;
+    g.cell_size = 0.5;
+    for (i = 0; i < P2T_W * P2T_H * 2; i++) ex[i] = 0.0f;
+    for (holes = 0; holes < 2; holes++) {
+        p2t_field(holes, P2T_W, P2T_H, 51, holes, z);
+        for (ki = 0; ki < 3; ki++)
+            for (bi = 0; bi < 3; bi++) {
+                hfvis_sweep_options o = hfvis_sweep_options_default();
+                int K = ki == 0 ? 3 : ki == 1 ? 4 : 8;
+                o.border = bi == 0 ? HFVIS_BORDER_OPEN : bi == 1 ? HFVIS_BORDER_CLAMP : HFVIS_BORDER_WRAP;
+                o.azimuth0_rad = ki == 0 ? 0.2 : 0.0;
+                CHECK_EQ_STATUS(hfvis_indirect_light(&g, K, ex, 2, 1.3f, 0.7f, &o, NULL, a, P2T_W), HFVIS_OK);
+                CHECK_EQ_STATUS(hfvis_sky_light(&g, K, 1.3f, 0.7f, &o, b, P2T_W), HFVIS_OK);
+                for (i = 0; i < P2T_W * P2T_H; i++) {
+                    double u0 = (double)a[2 * i], u1 = (double)a[2 * i + 1], v = (double)b[i];
+                    if (isnan(v) || isnan(u0) || isnan(u1)) {
+                        if (!(isnan(v) && isnan(u0) && isnan(u1))) bad++;
+                        continue;
+                    }
+                    total++;
+                    exact += u0 == v && u1 == v;
+                    if (fabs(u0 - v) > maxrel * fabs(v)) maxrel = fabs(u0 - v) / fabs(v);
+                    if (!(fabs(u0 - v) <= P2T_SKY_REL * fabs(v)) || u1 != u0) bad++;
+                }
+            }
+    }
+    CHECK(bad == 0);
+    printf("  sky only vs hfvis_sky_light: %d of %d bit-identical, max rel diff %.3g\n", exact, total, maxrel);
+}
+
+/* Spec §12.3: V-valley h = s|x - x0| (s = 1), emissive L_s, black sky: at the bottom the
+ * receiver gets L_s (1 - V_K), V_K the sky light with sky 1 there.
+ * K = 4 (axis lattices, nodes on grid points): closed form V_4 = (1/4)(1/2 + 1 + 1/2 + 1) = 3/4
+ * (t = s|cos psi|) and indirect = L_s/4, to float rounding. K = 8, 16: each axis direction alone
+ * has its closed form L_s (1/K)(1 - 1/(1 + cos^2 psi)); the sum over all K obeys the band
+ * identity indirect = L_s (F - V_K) with F the lattice furnace sum (exit = sky = 1) to float
+ * rounding. F is 1 only where the lattice normal is up: the diagonal lattices' nodes lie off
+ * the bottom and their bilinear normals tilt, so L_s (1 - V_K) holds there only up to the
+ * gather (printed, spec §12.3 notes the same kink interpolation for V). */
+TEST(p2t_indirect_valley)
+{
+    enum { W = 33, H = 29 };
+    static float z[W * H], ex[W * H], one[W * H], ind[W * H], sky[W * H], fur[W * H], part[W * H];
+    const float Ls = 2.5f;
+    hfvis_field f;
+    hfvis_grid g;
+    int ki, y, i, k;
+    memset(&f, 0, sizeof f);
+    f.kind = HFVIS_FIELD_V_VALLEY;
+    f.x0 = 16.0;
+    f.slope = 1.0;
+    CHECK_EQ_STATUS(hfvis_field_generate(&f, W, H, W, z), HFVIS_OK);
+    g.z = z;
+    g.width = W;
+    g.height = H;
+    g.stride = W;
+    g.cell_size = 1.0;
+    for (i = 0; i < W * H; i++) ex[i] = Ls, one[i] = 1.0f;
+    for (ki = 0; ki < 3; ki++) {
+        int K = ki == 0 ? 4 : ki == 1 ? 8 : 16;
+        hfvis_sweep_options o = hfvis_sweep_options_default();
+        CHECK_EQ_STATUS(hfvis_indirect_light(&g, K, ex, 1, 0.0f, 1.0f, NULL, NULL, ind, W), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_indirect_light(&g, K, one, 1, 1.0f, 1.0f, NULL, NULL, fur, W), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_sky_light(&g, K, 1.0f, 1.0f, NULL, sky, W), HFVIS_OK);
+        for (y = 8; y < H - 8; y++) { /* away from the ends of the valley */
+            double got = (double)ind[y * W + 16], vk = (double)sky[y * W + 16], F = (double)fur[y * W + 16];
+            CHECK_NEAR(got, (double)Ls * (F - vk), P2T_VALLEY_ABS, 0.0);
+            if (K == 4) {
+                CHECK_NEAR(vk, 0.75, P2T_VALLEY_ABS, 0.0);
+                CHECK_NEAR(F, 1.0, P2T_VALLEY_ABS, 0.0);
+                CHECK_NEAR(got, (double)Ls * (1.0 - vk), P2T_VALLEY_ABS, 0.0);
+            }
+        }
+        for (k = 0; k < K; k += K / 4) { /* axis directions alone */
+            double c = cos(2.0 * 3.14159265358979323846 * (double)k / (double)K);
+            o.direction_begin = k;
+            o.direction_end = k + 1;
+            CHECK_EQ_STATUS(hfvis_indirect_light(&g, K, ex, 1, 0.0f, 1.0f, &o, NULL, part, W), HFVIS_OK);
+            for (y = 8; y < H - 8; y++)
+                CHECK_NEAR((double)part[y * W + 16], (double)Ls / (double)K * (1.0 - 1.0 / (1.0 + c * c)),
+                           P2T_VALLEY_ABS, 0.0);
+        }
+        {
+            double vk_exact = 0.0, got = (double)ind[14 * W + 16];
+            for (k = 0; k < K; k++) {
+                double c = cos(2.0 * 3.14159265358979323846 * (double)k / (double)K);
+                vk_exact += 1.0 / (1.0 + c * c) / (double)K;
+            }
+            printf("  valley K=%d bottom: V_K sky light %.7f (closed form %.7f), furnace F %.7f, indirect %.7f, "
+                   "L_s(1-V_K) %.7f, L_s(1-V_K closed) %.7f\n",
+                   K, (double)sky[14 * W + 16], vk_exact, (double)fur[14 * W + 16], got,
+                   (double)Ls * (1.0 - (double)sky[14 * W + 16]), (double)Ls * (1.0 - vk_exact));
+        }
+    }
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* 5. Terrain GI with bounces (spec §9 multi-bounce)                                        */
+/* ---------------------------------------------------------------------------------------- */
+
+/* Counting allocator: fail_at = the 1-based allocation that fails (0 = never). */
+typedef struct p2t_counting {
+    int allocs, frees, live, fail_at;
+} p2t_counting;
+static void *p2t_alloc(void *user, size_t n)
+{
+    p2t_counting *c = (p2t_counting *)user;
+    void *p;
+    c->allocs++;
+    if (c->fail_at != 0 && c->allocs == c->fail_at) return NULL;
+    p = malloc(n);
+    if (p) c->live++;
+    return p;
+}
+static void p2t_free(void *user, void *p)
+{
+    p2t_counting *c = (p2t_counting *)user;
+    if (!p) return;
+    c->frees++;
+    c->live--;
+    free(p);
+}
+
+TEST(p2t_terrain_gi)
+{
+    enum { W = 27, H = 23, C = 3 };
+    static float z[W * H], direct[W * H * C], emis[W * H * C], amap[W * H * C], out[W * H * C],
+        out2[W * H * C], prev[W * H * C];
+    const float rho = 0.8f;
+    hfvis_grid g;
+    hfvis_field f;
+    int i, b, x, y, bounces, bad = 0;
+    double E[6];
+    g.z = z;
+    g.width = W;
+    g.height = H;
+    g.stride = W;
+    g.cell_size = 1.0;
+    p2t_seed(99);
+    for (i = 0; i < W * H * C; i++) {
+        direct[i] = (float)(0.5 + p2t_unit());
+        emis[i] = (i % 7 == 0) ? (float)(3.0 * p2t_unit()) : 0.0f;
+        amap[i] = rho;
+    }
+    /* flat field: the surface occupies no solid angle (spec §12.1), no indirect for any bounce;
+     * bounces = 0 on any field: emission + albedo * direct, as the library rounds it */
+    p2t_field(2, W, H, 1, 0, z);
+    for (bounces = 0; bounces <= 3; bounces++) {
+        CHECK_EQ_STATUS(hfvis_terrain_gi(&g, 8, direct, emis, NULL, rho, C, bounces, NULL, NULL, out), HFVIS_OK);
+        for (i = 0; i < W * H * C; i++)
+            if (out[i] != (float)((double)emis[i] + (double)rho * (double)direct[i])) bad++;
+    }
+    CHECK(bad == 0);
+    p2t_field(0, W, H, 5, 0, z);
+    CHECK_EQ_STATUS(hfvis_terrain_gi(&g, 8, direct, NULL, NULL, rho, C, 0, NULL, NULL, out), HFVIS_OK);
+    for (i = 0; i < W * H * C; i++)
+        if (out[i] != (float)((double)rho * (double)direct[i])) bad++;
+    CHECK(bad == 0);
+    /* a constant albedo map is the constant path, bit for bit */
+    CHECK_EQ_STATUS(hfvis_terrain_gi(&g, 5, direct, emis, NULL, rho, C, 2, NULL, NULL, out), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_terrain_gi(&g, 5, direct, emis, amap, 0.123f, C, 2, NULL, NULL, out2), HFVIS_OK);
+    CHECK(memcmp(out, out2, sizeof out) == 0);
+    /* one bounce is L_1 = e + rho (direct + I[L_0]) with I = hfvis_indirect_light(sky 0, albedo 1) */
+    {
+        static float l0[W * H * C], ind[W * H * C];
+        double maxd = 0.0;
+        CHECK_EQ_STATUS(hfvis_terrain_gi(&g, 5, direct, emis, NULL, rho, C, 0, NULL, NULL, l0), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_indirect_light(&g, 5, l0, C, 0.0f, 1.0f, NULL, NULL, ind, W), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_terrain_gi(&g, 5, direct, emis, NULL, rho, C, 1, NULL, NULL, out), HFVIS_OK);
+        for (i = 0; i < W * H * C; i++) {
+            float want = (float)((double)emis[i] + (double)rho * ((double)direct[i] + (double)ind[i]));
+            maxd = fmax(maxd, fabs((double)out[i] - (double)want));
+        }
+        CHECK(maxd == 0.0);
+    }
+    /* V-valley: the exit radiance grows with every bounce (the band weights are >= 0) and the
+     * increments shrink (rho < 1 and the valley sees itself over less than the hemisphere) */
+    memset(&f, 0, sizeof f);
+    f.kind = HFVIS_FIELD_V_VALLEY;
+    f.x0 = 13.0;
+    f.slope = 1.5;
+    CHECK_EQ_STATUS(hfvis_field_generate(&f, W, H, W, z), HFVIS_OK);
+    for (b = 0; b <= 5; b++) {
+        CHECK_EQ_STATUS(hfvis_terrain_gi(&g, 8, direct, NULL, NULL, rho, C, b, NULL, NULL, out), HFVIS_OK);
+        E[b] = 0.0;
+        for (y = 0; y < H; y++)
+            for (x = 0; x < W; x++)
+                for (i = 0; i < C; i++) {
+                    size_t q = ((size_t)y * W + (size_t)x) * C + (size_t)i;
+                    E[b] += (double)out[q];
+                    if (b > 0 && !((double)out[q] >= (double)prev[q] * (1.0 - P2T_GI_REL))) bad++;
+                }
+        memcpy(prev, out, sizeof out);
+    }
+    CHECK(bad == 0);
+    for (b = 1; b <= 5; b++) CHECK(E[b] > E[b - 1]);
+    CHECK(E[5] - E[4] < E[2] - E[1]);
+    CHECK(E[5] - E[4] < 0.5 * (E[1] - E[0]));
+    printf("  gi V-valley energy: %.6g %.6g %.6g %.6g %.6g %.6g\n", E[0], E[1], E[2], E[3], E[4], E[5]);
+}
+
+TEST(p2t_terrain_gi_oom)
+{
+    enum { W = 15, H = 12 };
+    static float z[W * H], direct[W * H * 2], out[W * H * 2];
+    hfvis_grid g;
+    hfvis_allocator al;
+    hfvis_sweep_options o = hfvis_sweep_options_default();
+    p2t_counting cnt;
+    int n, k, i, untouched = 1;
+    g.z = z;
+    g.width = W;
+    g.height = H;
+    g.stride = W;
+    g.cell_size = 1.0;
+    p2t_field(0, W, H, 3, 0, z);
+    for (i = 0; i < W * H * 2; i++) direct[i] = 1.0f;
+    memset(&cnt, 0, sizeof cnt);
+    al.alloc = p2t_alloc;
+    al.free = p2t_free;
+    al.user = &cnt;
+    o.alloc = &al;
+    CHECK_EQ_STATUS(hfvis_terrain_gi(&g, 4, direct, NULL, NULL, 0.5f, 2, 2, &o, NULL, out), HFVIS_OK);
+    n = cnt.allocs;
+    CHECK(n >= 4 && cnt.live == 0); /* 2 bounce buffers + one scratch per bounce */
+    for (k = 1; k <= n; k++) {
+        memset(&cnt, 0, sizeof cnt);
+        cnt.fail_at = k;
+        for (i = 0; i < W * H * 2; i++) out[i] = -3.0f;
+        CHECK_EQ_STATUS(hfvis_terrain_gi(&g, 4, direct, NULL, NULL, 0.5f, 2, 2, &o, NULL, out),
+                        HFVIS_ERR_OUT_OF_MEMORY);
+        CHECK(cnt.live == 0);
+        for (i = 0; i < W * H * 2; i++) untouched &= out[i] == -3.0f;
+    }
+    CHECK(untouched);
+    printf("  gi: %d allocations, each failure reported without leak\n", n);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* 6. Direct light ([P1]: sun Lambert term times visibility, plus sky or environment)       */
+/* ---------------------------------------------------------------------------------------- */
+
+TEST(p2t_direct_light)
+{
+    enum { W = 40, H = 9, C = 3 };
+    static float z[W * H], out[W * H * C], sky[W * H * C], ref[W * H * C];
+    static float envrad[8 * 16 * 2];
+    const double pi = 3.14159265358979323846;
+    hfvis_grid g;
+    hfvis_field f;
+    hfvis_sun sun;
+    hfvis_env env;
+    int x, y, c, i, bad = 0;
+    g.z = z;
+    g.width = W;
+    g.height = H;
+    g.stride = W;
+    g.cell_size = 1.0;
+    memset(&sun, 0, sizeof sun);
+    sun.irradiance[0] = 3.0f;
+    sun.irradiance[1] = 2.0f;
+    sun.irradiance[2] = 0.5f;
+    /* sun overhead on a flat field: E/pi + sky */
+    p2t_field(2, W, H, 1, 0, z);
+    sun.elevation_rad = pi / 2.0;
+    sun.azimuth_rad = 1.0;
+    CHECK_EQ_STATUS(hfvis_direct_light(&g, 8, &sun, 0.4f, NULL, C, NULL, out), HFVIS_OK);
+    for (i = 0; i < W * H; i++)
+        for (c = 0; c < C; c++) {
+            double want = (double)sun.irradiance[c] / pi + 0.4;
+            if (!(fabs((double)out[i * C + c] - want) <= P2T_DIRECT_REL * want)) bad++;
+        }
+    CHECK(bad == 0);
+    /* a wall of height 10 at x0 = 30 (rise over [29, 30]), sun toward +x at 20 degrees: the ground
+     * at x = 10..27 (delta = 3..20 < 10/tan 20deg = 27.5) is in shadow: sky only, exactly */
+    memset(&f, 0, sizeof f);
+    f.kind = HFVIS_FIELD_STEP;
+    f.x0 = 30.0;
+    f.amplitude = 10.0;
+    CHECK_EQ_STATUS(hfvis_field_generate(&f, W, H, W, z), HFVIS_OK);
+    sun.azimuth_rad = 0.0;
+    sun.elevation_rad = 20.0 * pi / 180.0;
+    CHECK_EQ_STATUS(hfvis_direct_light(&g, 8, &sun, 0.4f, NULL, C, NULL, out), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_direct_light(&g, 8, NULL, 0.4f, NULL, C, NULL, sky), HFVIS_OK);
+    for (y = 0; y < H; y++) {
+        for (x = 10; x <= 27; x++)
+            for (c = 0; c < C; c++)
+                if (out[(y * W + x) * C + c] != sky[(y * W + x) * C + c]) bad++;
+        for (x = 31; x < W; x++) /* on top of the wall: lit, flat normal */
+            for (c = 0; c < C; c++) {
+                double want = (double)sky[(y * W + x) * C + c] + (double)sun.irradiance[c] / pi * sin(sun.elevation_rad);
+                if (!(fabs((double)out[(y * W + x) * C + c] - want) <= P2T_DIRECT_REL * want)) bad++;
+            }
+        for (x = 0; x < W; x++) /* every channel of the sky-only output is the same sky light */
+            if (sky[(y * W + x) * C] != sky[(y * W + x) * C + 1] || sky[(y * W + x) * C] != sky[(y * W + x) * C + 2])
+                bad++;
+    }
+    CHECK(bad == 0);
+    /* sky part = hfvis_sky_light(albedo 1), spread over the channels */
+    CHECK_EQ_STATUS(hfvis_sky_light(&g, 8, 0.4f, 1.0f, NULL, ref, W), HFVIS_OK);
+    for (i = 0; i < W * H; i++) bad += sky[i * C] != ref[i];
+    CHECK(bad == 0);
+    /* environment path = hfvis_env_light (albedo 1) */
+    p2t_seed(12);
+    for (i = 0; i < 8 * 16 * 2; i++) envrad[i] = (float)p2t_unit();
+    env.radiance = envrad;
+    env.n_theta = 8;
+    env.n_phi = 16;
+    env.channels = 2;
+    p2t_field(0, W, H, 9, 0, z);
+    CHECK_EQ_STATUS(hfvis_direct_light(&g, 8, NULL, 0.0f, &env, 2, NULL, out), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_env_light(&g, 8, &env, 1.0f, NULL, NULL, ref, W), HFVIS_OK);
+    CHECK(memcmp(out, ref, sizeof(float) * W * H * 2) == 0);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* 7. Bad arguments: HFVIS_ERR_INVALID_ARGUMENT, outputs untouched                          */
+/* ---------------------------------------------------------------------------------------- */
+
+static int p2t_calls;
+static void p2t_count_fn(void *user, const hfvis_visibility_event *e)
+{
+    (void)user;
+    (void)e;
+    p2t_calls++;
+}
+
+#define P2T_BW 9
+#define P2T_BH 7
+#define P2T_BN (P2T_BW * P2T_BH * 4)
+static float p2t_bout[P2T_BN];
+static void p2t_bfill(void)
+{
+    int i;
+    for (i = 0; i < P2T_BN; i++) p2t_bout[i] = -7.0f;
+}
+static int p2t_buntouched(void)
+{
+    int i;
+    for (i = 0; i < P2T_BN; i++)
+        if (p2t_bout[i] != -7.0f) return 0;
+    return 1;
+}
+/* status INVALID_ARGUMENT, the output and the stats untouched, the callback never called */
+#define P2T_BAD(call) do { hfvis_status s_; p2t_bfill(); st.visible = -1.0; p2t_calls = 0; s_ = (call); \
+    CHECK_EQ_STATUS(s_, HFVIS_ERR_INVALID_ARGUMENT); CHECK(p2t_buntouched()); \
+    CHECK(st.visible == -1.0 && p2t_calls == 0); } while (0)
+
+TEST(p2t_bad_arguments)
+{
+    static float z[P2T_BW * P2T_BH], ex[P2T_BN];
+    hfvis_grid g, gb;
+    hfvis_visibility_stats st;
+    hfvis_sweep_options o = hfvis_sweep_options_default(), ob;
+    hfvis_tree_options t9, ts2, tneg;
+    hfvis_sun sun, sb;
+    hfvis_env env, eb;
+    float envrad[4 * 4 * 2];
+    const float nanf_ = (float)NAN, inff = (float)INFINITY;
+    const int W = P2T_BW;
+    int i;
+    float *out = p2t_bout;
+    g.z = z;
+    g.width = P2T_BW;
+    g.height = P2T_BH;
+    g.stride = P2T_BW;
+    g.cell_size = 1.0;
+    p2t_field(0, P2T_BW, P2T_BH, 2, 0, z);
+    for (i = 0; i < P2T_BN; i++) ex[i] = 1.0f;
+    for (i = 0; i < 4 * 4 * 2; i++) envrad[i] = 1.0f;
+    memset(&st, 0, sizeof st);
+    memset(&t9, 0, sizeof t9);
+    t9.order = (hfvis_tree_order)9;
+    memset(&ts2, 0, sizeof ts2);
+    ts2.safe_zone = 2;
+    memset(&tneg, 0, sizeof tneg);
+    tneg.safe_zone = 1;
+    tneg.safe_zone_steps = -3;
+    memset(&sun, 0, sizeof sun);
+    sun.elevation_rad = 0.5;
+    sun.irradiance[0] = sun.irradiance[1] = 1.0f;
+    env.radiance = envrad;
+    env.n_theta = 4;
+    env.n_phi = 4;
+    env.channels = 2;
+
+    /* sanity: the valid calls succeed */
+    CHECK_EQ_STATUS(hfvis_intervisibility(&g, 4, &o, NULL, p2t_count_fn, NULL, &st), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_visibility_count(&g, 4, &o, NULL, out, W, &st), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_indirect_light(&g, 4, ex, 2, 1.0f, 1.0f, &o, NULL, out, W), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_terrain_gi(&g, 4, ex, NULL, NULL, 0.5f, 2, 1, &o, NULL, out), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_direct_light(&g, 4, &sun, 1.0f, &env, 2, &o, out), HFVIS_OK);
+
+    /* every function: NULL grid, bad grids, K = 0, bad sweep options */
+    for (i = 0; i < 6; i++) {
+        const hfvis_grid *gp = &gb;
+        gb = g;
+        if (i == 0) gp = NULL;
+        else if (i == 1) gb.width = 0;
+        else if (i == 2) gb.stride = gb.width - 1;
+        else if (i == 3) gb.cell_size = 0.0;
+        else if (i == 4) gb.cell_size = (double)NAN;
+        else gb.z = NULL;
+        P2T_BAD(hfvis_intervisibility(gp, 4, &o, NULL, p2t_count_fn, NULL, &st));
+        P2T_BAD(hfvis_visibility_count(gp, 4, &o, NULL, out, W, &st));
+        P2T_BAD(hfvis_visibility_count_naive(gp, 4, &o, out, W, &st));
+        P2T_BAD(hfvis_indirect_light(gp, 4, ex, 2, 1.0f, 1.0f, &o, NULL, out, W));
+        P2T_BAD(hfvis_indirect_light_naive(gp, 4, ex, 2, 1.0f, 1.0f, &o, out, W));
+        P2T_BAD(hfvis_terrain_gi(gp, 4, ex, NULL, NULL, 0.5f, 2, 1, &o, NULL, out));
+        P2T_BAD(hfvis_direct_light(gp, 4, &sun, 1.0f, NULL, 2, &o, out));
+    }
+    for (i = -1; i <= 0; i++) {
+        P2T_BAD(hfvis_intervisibility(&g, i, &o, NULL, p2t_count_fn, NULL, &st));
+        P2T_BAD(hfvis_visibility_count(&g, i, &o, NULL, out, W, &st));
+        P2T_BAD(hfvis_visibility_count_naive(&g, i, &o, out, W, &st));
+        P2T_BAD(hfvis_indirect_light(&g, i, ex, 2, 1.0f, 1.0f, &o, NULL, out, W));
+        P2T_BAD(hfvis_indirect_light_naive(&g, i, ex, 2, 1.0f, 1.0f, &o, out, W));
+        P2T_BAD(hfvis_terrain_gi(&g, i, ex, NULL, NULL, 0.5f, 2, 1, &o, NULL, out));
+        P2T_BAD(hfvis_direct_light(&g, i, &sun, 1.0f, NULL, 2, &o, out));
+    }
+    for (i = 0; i < 3; i++) {
+        ob = o;
+        if (i == 0) ob.border = (hfvis_border)9;
+        else if (i == 1) ob.border_cells = -1;
+        else ob.azimuth0_rad = (double)NAN;
+        P2T_BAD(hfvis_intervisibility(&g, 4, &ob, NULL, p2t_count_fn, NULL, &st));
+        P2T_BAD(hfvis_visibility_count(&g, 4, &ob, NULL, out, W, &st));
+        P2T_BAD(hfvis_visibility_count_naive(&g, 4, &ob, out, W, &st));
+        P2T_BAD(hfvis_indirect_light(&g, 4, ex, 2, 1.0f, 1.0f, &ob, NULL, out, W));
+        P2T_BAD(hfvis_indirect_light_naive(&g, 4, ex, 2, 1.0f, 1.0f, &ob, out, W));
+        P2T_BAD(hfvis_terrain_gi(&g, 4, ex, NULL, NULL, 0.5f, 2, 1, &ob, NULL, out));
+        P2T_BAD(hfvis_direct_light(&g, 4, &sun, 1.0f, NULL, 2, &ob, out));
+    }
+    /* direction range: begin >= end, end > K */
+    ob = o;
+    ob.direction_begin = 2;
+    ob.direction_end = 2;
+    P2T_BAD(hfvis_visibility_count(&g, 4, &ob, NULL, out, W, &st));
+    P2T_BAD(hfvis_indirect_light(&g, 4, ex, 2, 1.0f, 1.0f, &ob, NULL, out, W));
+    ob.direction_begin = 0;
+    ob.direction_end = 5;
+    P2T_BAD(hfvis_visibility_count(&g, 4, &ob, NULL, out, W, &st));
+    P2T_BAD(hfvis_visibility_count_naive(&g, 4, &ob, out, W, &st));
+    P2T_BAD(hfvis_indirect_light_naive(&g, 4, ex, 2, 1.0f, 1.0f, &ob, out, W));
+    /* bad tree options */
+    P2T_BAD(hfvis_intervisibility(&g, 4, &o, &t9, p2t_count_fn, NULL, &st));
+    P2T_BAD(hfvis_intervisibility(&g, 4, &o, &ts2, p2t_count_fn, NULL, &st));
+    P2T_BAD(hfvis_intervisibility(&g, 4, &o, &tneg, p2t_count_fn, NULL, &st));
+    P2T_BAD(hfvis_visibility_count(&g, 4, &o, &t9, out, W, &st));
+    P2T_BAD(hfvis_visibility_count(&g, 4, &o, &ts2, out, W, &st));
+    P2T_BAD(hfvis_visibility_count(&g, 4, &o, &tneg, out, W, &st));
+    P2T_BAD(hfvis_indirect_light(&g, 4, ex, 2, 1.0f, 1.0f, &o, &t9, out, W));
+    P2T_BAD(hfvis_indirect_light(&g, 4, ex, 2, 1.0f, 1.0f, &o, &ts2, out, W));
+    P2T_BAD(hfvis_indirect_light(&g, 4, ex, 2, 1.0f, 1.0f, &o, &tneg, out, W));
+    P2T_BAD(hfvis_terrain_gi(&g, 4, ex, NULL, NULL, 0.5f, 2, 1, &o, &t9, out));
+    P2T_BAD(hfvis_terrain_gi(&g, 4, ex, NULL, NULL, 0.5f, 2, 1, &o, &ts2, out));
+    P2T_BAD(hfvis_terrain_gi(&g, 4, ex, NULL, NULL, 0.5f, 2, 1, &o, &tneg, out));
+    /* NULL outputs and callbacks, strides */
+    P2T_BAD(hfvis_intervisibility(&g, 4, &o, NULL, NULL, NULL, &st));
+    P2T_BAD(hfvis_visibility_count(&g, 4, &o, NULL, NULL, W, &st));
+    P2T_BAD(hfvis_visibility_count(&g, 4, &o, NULL, out, W - 1, &st));
+    P2T_BAD(hfvis_visibility_count_naive(&g, 4, &o, NULL, W, &st));
+    P2T_BAD(hfvis_visibility_count_naive(&g, 4, &o, out, W - 1, &st));
+    P2T_BAD(hfvis_indirect_light(&g, 4, ex, 2, 1.0f, 1.0f, &o, NULL, NULL, W));
+    P2T_BAD(hfvis_indirect_light(&g, 4, ex, 2, 1.0f, 1.0f, &o, NULL, out, W - 1));
+    P2T_BAD(hfvis_indirect_light_naive(&g, 4, ex, 2, 1.0f, 1.0f, &o, NULL, W));
+    P2T_BAD(hfvis_terrain_gi(&g, 4, ex, NULL, NULL, 0.5f, 2, 1, &o, NULL, NULL));
+    P2T_BAD(hfvis_direct_light(&g, 4, &sun, 1.0f, NULL, 2, &o, NULL));
+    /* exit radiance, channels, non-finite sky and albedo */
+    P2T_BAD(hfvis_indirect_light(&g, 4, NULL, 2, 1.0f, 1.0f, &o, NULL, out, W));
+    P2T_BAD(hfvis_indirect_light_naive(&g, 4, NULL, 2, 1.0f, 1.0f, &o, out, W));
+    for (i = 0; i < 2; i++) {
+        int ch = i ? 5 : 0;
+        P2T_BAD(hfvis_indirect_light(&g, 4, ex, ch, 1.0f, 1.0f, &o, NULL, out, W));
+        P2T_BAD(hfvis_indirect_light_naive(&g, 4, ex, ch, 1.0f, 1.0f, &o, out, W));
+        P2T_BAD(hfvis_terrain_gi(&g, 4, ex, NULL, NULL, 0.5f, ch, 1, &o, NULL, out));
+        P2T_BAD(hfvis_direct_light(&g, 4, &sun, 1.0f, NULL, ch, &o, out));
+    }
+    P2T_BAD(hfvis_indirect_light(&g, 4, ex, 2, nanf_, 1.0f, &o, NULL, out, W));
+    P2T_BAD(hfvis_indirect_light(&g, 4, ex, 2, inff, 1.0f, &o, NULL, out, W));
+    P2T_BAD(hfvis_indirect_light(&g, 4, ex, 2, 1.0f, nanf_, &o, NULL, out, W));
+    P2T_BAD(hfvis_indirect_light_naive(&g, 4, ex, 2, nanf_, 1.0f, &o, out, W));
+    P2T_BAD(hfvis_indirect_light_naive(&g, 4, ex, 2, 1.0f, -inff, &o, out, W));
+    P2T_BAD(hfvis_terrain_gi(&g, 4, ex, NULL, NULL, nanf_, 2, 1, &o, NULL, out));
+    P2T_BAD(hfvis_terrain_gi(&g, 4, ex, NULL, NULL, inff, 2, 1, &o, NULL, out));
+    P2T_BAD(hfvis_direct_light(&g, 4, &sun, nanf_, NULL, 2, &o, out));
+    P2T_BAD(hfvis_direct_light(&g, 4, &sun, inff, NULL, 2, &o, out));
+    /* terrain GI: NULL direct, negative bounces */
+    P2T_BAD(hfvis_terrain_gi(&g, 4, NULL, NULL, NULL, 0.5f, 2, 1, &o, NULL, out));
+    P2T_BAD(hfvis_terrain_gi(&g, 4, ex, NULL, NULL, 0.5f, 2, -1, &o, NULL, out));
+    /* direct light: bad sun, bad environment */
+    for (i = 0; i < 6; i++) {
+        sb = sun;
+        if (i == 0) sb.azimuth_rad = (double)NAN;
+        else if (i == 1) sb.elevation_rad = (double)INFINITY;
+        else if (i == 2) sb.elevation_rad = 2.0;
+        else if (i == 3) sb.radius_rad = -0.01;
+        else if (i == 4) sb.radius_rad = (double)NAN;
+        else sb.irradiance[1] = (float)NAN;
+        P2T_BAD(hfvis_direct_light(&g, 4, &sb, 1.0f, NULL, 2, &o, out));
+    }
+    for (i = 0; i < 4; i++) {
+        eb = env;
+        if (i == 0) eb.channels = 3; /* != channels */
+        else if (i == 1) eb.n_theta = 0;
+        else if (i == 2) eb.radiance = NULL;
+        else eb.n_phi = -1;
+        P2T_BAD(hfvis_direct_light(&g, 4, &sun, 1.0f, &eb, 2, &o, out));
+    }
+}
+
+static void run_p2_tests(void)
+{
+    RUN(p2t_tree_vs_naive);
+    RUN(p2t_tree_api_errors);
+    RUN(p2t_line_holes);
+    RUN(p2t_visibility_count);
+    RUN(p2t_visibility_flat);
+    RUN(p2t_intervisibility);
+    RUN(p2t_indirect_vs_naive);
+    RUN(p2t_indirect_furnace);
+    RUN(p2t_indirect_sky_only);
+    RUN(p2t_indirect_valley);
+    RUN(p2t_terrain_gi);
+    RUN(p2t_terrain_gi_oom);
+    RUN(p2t_direct_light);
+    RUN(p2t_bad_arguments);
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
@@ -3064,5 +4369,6 @@ int main(int argc, char **argv)
     RUN(bad_arguments);
     run_part2_tests();
     run_env_tests();
+    run_p2_tests();
     return TEST_DONE();
 }
