@@ -24,6 +24,18 @@ one='\000\000\200\077'  # 1.0f little-endian
 { printf 'Pf\n4 2\n-1\n'; i=0; while [ $i -lt 8 ]; do printf "$one"; i=$((i + 1)); done; } > "$dir/env1.pfm"
 { printf 'PF\n4 2\n-1\n'; i=0; while [ $i -lt 24 ]; do printf "$one"; i=$((i + 1)); done; } > "$dir/env3.pfm"
 printf 'hello, I am not an image\n' > "$dir/garbage.pgm"
+# Maps of flat.pgm's size (8 x 6) for indirect: alb51.pgm all 51/255 = 0.2; emit1.pfm radiance 1;
+# emit3.pfm RGB radiance 1; neg.pfm one value -1; nanrow.pfm NaN at (0, 0) (the first sample
+# of the last stored row: PFM rows go bottom to top); flat7.pgm flat.pgm with 7 at (0, 0).
+awk 'BEGIN { print "P2 8 6 255"; for (i = 0; i < 48; i++) print 51 }' > "$dir/alb51.pgm"
+awk 'BEGIN { print "P2 8 6 255"; print 7; for (i = 1; i < 48; i++) print 100 }' > "$dir/flat7.pgm"
+nan='\000\000\300\177'  # quiet NaN, little-endian
+mone='\000\000\200\277' # -1.0f little-endian
+{ printf 'Pf\n8 6\n-1\n'; i=0; while [ $i -lt 48 ]; do printf "$one"; i=$((i + 1)); done; } > "$dir/emit1.pfm"
+{ printf 'PF\n8 6\n-1\n'; i=0; while [ $i -lt 144 ]; do printf "$one"; i=$((i + 1)); done; } > "$dir/emit3.pfm"
+{ printf 'Pf\n8 6\n-1\n'; printf "$mone"; i=1; while [ $i -lt 48 ]; do printf "$one"; i=$((i + 1)); done; } > "$dir/neg.pfm"
+{ printf 'Pf\n8 6\n-1\n'; i=0; while [ $i -lt 40 ]; do printf "$one"; i=$((i + 1)); done
+  printf "$nan"; i=41; while [ $i -lt 48 ]; do printf "$one"; i=$((i + 1)); done; } > "$dir/nanrow.pfm"
 { printf 'Pf\n4 4\n-1\n'; printf "$one$one$one"; } > "$dir/truncated.pfm"
 
 little_endian=0
@@ -70,6 +82,23 @@ expect_last_float() {
   if awk -v g="$got" -v w="$3" -v t="$4" 'BEGIN { d = g - w; if (d < 0) d = -d; exit !(d <= t) }'
   then ok "$1 ($got)"; else bad "$1: got '$got', want $3 +- $4"; fi
 }
+# expect_floats NAME FILE FROM_END TOL WANT...: the little-endian floats starting FROM_END bytes
+# before the end of FILE are the WANTs, each +- TOL ("nan" matches any NaN).
+expect_floats() {
+  [ "$little_endian" = 1 ] || { ok "$1: skipped (big-endian host)"; return; }
+  name=$1; file=$2; from_end=$3; tol=$4; shift 4
+  size=$(wc -c < "$file" | tr -d ' ')
+  got=$(od -An -v -tf4 -j $((size - from_end)) -N $((4 * $#)) "$file" | tr -s ' \n' '  ' | sed 's/^ *//; s/ *$//')
+  if echo "$got" | awk -v want="$*" -v t="$tol" '{ n = split(want, w, " "); if (NF != n) exit 1
+       for (i = 1; i <= n; i++) { g = $i
+         if (w[i] == "nan") { if (g !~ /nan/) exit 1; continue }
+         if (g ~ /nan/) exit 1; d = g - w[i]; if (d < 0) d = -d; if (d > t) exit 1 } }'
+  then ok "$name"; else bad "$name: got '$got', want '$*' +- $tol"; fi
+}
+# expect_stdout NAME LINE: the last run's stdout has exactly this line.
+expect_stdout() {
+  if grep -qxF "$2" "$dir/stdout"; then ok "$1"; else bad "$1: no line '$2' in: $(cat "$dir/stdout")"; fi
+}
 expect_line2() { # NAME FILE WANT: the second header line (PFM dimensions)
   got=$(head -n 2 "$2" | tail -n 1)
   if [ "$got" = "$3" ]; then ok "$1"; else bad "$1: header line 2 '$got', want '$3'"; fi
@@ -78,7 +107,7 @@ expect_line2() { # NAME FILE WANT: the second header line (PFM dimensions)
 # ---- help ---------------------------------------------------------------------------------
 if "$hfvis" --help > "$dir/stdout" 2> "$dir/stderr" && grep -q '^usage: hfvis' "$dir/stdout" && [ ! -s "$dir/stderr" ]
 then ok "--help"; else bad "--help"; fi
-for c in horizon skyview sky shadow light normals; do
+for c in horizon skyview sky shadow light normals indirect visibility; do
   if "$hfvis" $c --help > "$dir/stdout" 2>&1 && grep -q "^usage: hfvis $c" "$dir/stdout"
   then ok "$c --help"; else bad "$c --help"; fi
 done
@@ -106,6 +135,18 @@ head -n 1 "$dir/n.pfm" | grep -q '^PF' && ok "normals writes PF" || bad "normals
 expect_ok "normals pgm" "$dir/n.pgm" normals "$h" -o "$dir/n.pgm"
 expect_ok "--quiet, -- before IN" "$dir/q.pfm" skyview --quiet -o "$dir/q.pfm" -- "$h"
 expect_ok "a PFM input (the tool's own output)" "$dir/svf2.pfm" skyview "$dir/svf.pfm" -o "$dir/svf2.pfm"
+expect_ok "indirect, defaults" "$dir/i.pfm" indirect "$h" -o "$dir/i.pfm"
+head -n 1 "$dir/i.pfm" | grep -q '^Pf' && ok "indirect grey writes Pf" || bad "indirect grey writes Pf"
+expect_ok "indirect, sun and 3 bounces" "$dir/is.pfm" indirect "$h" --sun-azimuth 135 --sun-elevation 20 --sun-radius 0.27 --sun-irradiance 5 --sky 0.2 --albedo 0.6 --bounces 3 --dirs 8 -o "$dir/is.pfm"
+expect_ok "indirect --math --output indirect pgm" "$dir/is.pgm" indirect "$h" --math --sun-azimuth 45 --sun-elevation 30 --output indirect --border wrap --dirs 3 -o "$dir/is.pgm"
+expect_ok "indirect rgb env" "$dir/ie.pfm" indirect "$h" --env "$dir/env3.pfm" --albedo 0.5 -o "$dir/ie.pfm"
+head -n 1 "$dir/ie.pfm" | grep -q '^PF' && ok "indirect rgb env writes PF" || bad "indirect rgb env writes PF"
+expect_ok "indirect --albedo-map pgm --emission" "$dir/im.pfm" indirect "$h" --albedo-map "$h" --emission "$dir/svf.pfm" --output direct -o "$dir/im.pfm"
+expect_ok "visibility pfm" "$dir/v.pfm" visibility "$h" --dirs 8 -o "$dir/v.pfm"
+expect_ok "visibility pgm --fraction --border clamp" "$dir/v.pgm" visibility "$h" --fraction --border clamp -o "$dir/v.pgm"
+expect_ok "visibility --stats --fraction" "$dir/vs.pfm" visibility "$h" --stats --fraction --compass -o "$dir/vs.pfm"
+grep -q '^iterations per receiver-direction (t_a): ' "$dir/stdout" && grep -q '^visible/tested: 0\.' "$dir/stdout" \
+  && ok "visibility --stats prints t_a and visible/tested" || bad "visibility --stats: $(cat "$dir/stdout")"
 
 # ---- closed forms on a flat field, 8 x 6 ---------------------------------------------------
 # The last pixel of a PGM file is (7, 5), the south-east corner; of a PFM (rows stored bottom
@@ -136,6 +177,43 @@ expect_ok "sky flat" "$dir/fk.pfm" sky "$f" --sky 2 --albedo 0.25 -o "$dir/fk.pf
 expect_last_float "sky flat = albedo * sky" "$dir/fk.pfm" 0.5 1e-4
 expect_ok "--nodata makes holes" "$dir/fnd.pfm" skyview "$f" --nodata 100 -o "$dir/fnd.pfm"
 expect_bytes "--nodata hole is NaN" "$dir/fnd.pfm" 4 "00 00 c0 7f" "00 00 c0 ff"
+# indirect: a flat field sends no light to itself, so any number of bounces gives exactly the
+# direct light L_0 = emission + albedo * D, and --output indirect is exactly 0.
+expect_ok "indirect flat, 2 bounces" "$dir/fi2.pfm" indirect "$f" --albedo 0.5 --bounces 2 -o "$dir/fi2.pfm"
+expect_ok "indirect flat, --output direct" "$dir/fi0.pfm" indirect "$f" --albedo 0.5 --output direct -o "$dir/fi0.pfm"
+cmp -s "$dir/fi2.pfm" "$dir/fi0.pfm" && ok "indirect flat: bounces = direct, bit for bit" || bad "indirect flat: bounces differ from direct"
+expect_floats "indirect flat under sky 1, albedo 0.5 = 0.5" "$dir/fi2.pfm" 8 1e-4 0.5 0.5
+expect_ok "indirect flat, --output indirect" "$dir/fii.pfm" indirect "$f" --bounces 3 --output indirect -o "$dir/fii.pfm"
+expect_floats "indirect flat: L_B - L_0 = 0" "$dir/fii.pfm" 16 0 0 0 0 0
+expect_ok "indirect flat, zenith sun" "$dir/fz.pfm" indirect "$f" --sky 0 --sun-azimuth 0 --sun-elevation 90 --sun-irradiance 6.2831853 --albedo 0.25 -o "$dir/fz.pfm"
+expect_floats "indirect flat, zenith sun: albedo * E/pi = 0.5" "$dir/fz.pfm" 8 1e-4 0.5 0.5
+expect_ok "indirect flat, sun 30 deg high, default E = pi" "$dir/f30.pfm" indirect "$f" --sun-azimuth 200 --sun-elevation 30 --albedo 0.5 -o "$dir/f30.pfm"
+expect_floats "indirect flat, sun 30 deg: 0.5 * (sin 30 deg + sky 1) = 0.75" "$dir/f30.pfm" 8 1e-4 0.75 0.75
+expect_ok "indirect flat, PGM albedo map" "$dir/fa.pfm" indirect "$f" --albedo-map "$dir/alb51.pgm" -o "$dir/fa.pfm"
+expect_floats "indirect flat: PGM albedo 51/255 = 0.2" "$dir/fa.pfm" 8 1e-4 0.2 0.2
+expect_ok "indirect flat, emission" "$dir/fe.pfm" indirect "$f" --sky 0 --emission "$dir/emit1.pfm" --albedo 0.5 -o "$dir/fe.pfm"
+expect_floats "indirect flat: emission 1, no light = 1" "$dir/fe.pfm" 8 1e-6 1 1
+expect_ok "indirect flat, RGB emission, grey albedo map" "$dir/fe3.pfm" indirect "$f" --emission "$dir/emit3.pfm" --albedo-map "$dir/alb51.pgm" -o "$dir/fe3.pfm"
+expect_floats "indirect flat: RGB 1 + 0.2 * sky 1 = 1.2" "$dir/fe3.pfm" 12 1e-4 1.2 1.2 1.2
+expect_ok "indirect, NaN in a map at a hole of IN" "$dir/fh.pfm" indirect "$dir/flat7.pgm" --nodata 7 --emission "$dir/nanrow.pfm" -o "$dir/fh.pfm"
+expect_floats "indirect: the hole is NaN, its neighbour is lit" "$dir/fh.pfm" 32 1e-4 nan 2 2 2 2 2 2 2
+# visibility: on a flat field every earlier sample of a line is seen. --dirs 1 looks east:
+# column x of the 8-wide row sees 7 - x samples; --dirs 4: (7-x) + x + (5-y) + y = 12 everywhere;
+# --compass --dirs 1 looks north: row y sees y samples (the first stored PFM row is y = 5).
+expect_ok "visibility flat east" "$dir/fv1.pfm" visibility "$f" --dirs 1 -o "$dir/fv1.pfm"
+expect_floats "visibility flat east: 7 - x" "$dir/fv1.pfm" 32 0 7 6 5 4 3 2 1 0
+expect_ok "visibility flat, 4 directions" "$dir/fv4.pfm" visibility "$f" --dirs 4 --stats -o "$dir/fv4.pfm"
+expect_floats "visibility flat, 4 directions: 12" "$dir/fv4.pfm" 32 0 12 12 12 12 12 12 12 12
+expect_floats "visibility flat, 4 directions: 12 (first row)" "$dir/fv4.pfm" 192 0 12 12 12 12 12 12 12 12
+expect_stdout "visibility --stats: receiver-directions" "receiver-directions: 192"
+expect_stdout "visibility --stats: visible" "visible per receiver-direction: 3"
+expect_ok "visibility flat north" "$dir/fvn.pfm" visibility "$f" --dirs 1 --compass -o "$dir/fvn.pfm"
+expect_floats "visibility flat north: y" "$dir/fvn.pfm" 192 0 5 5 5 5 5 5 5 5
+expect_floats "visibility flat north: y (last row)" "$dir/fvn.pfm" 32 0 0 0 0 0 0 0 0 0
+expect_ok "visibility flat --fraction" "$dir/fvf.pfm" visibility "$f" --dirs 1 --fraction -o "$dir/fvf.pfm"
+expect_floats "visibility flat --fraction: 1, 0 where nothing lies behind" "$dir/fvf.pfm" 32 0 1 1 1 1 1 1 1 0
+expect_ok "visibility with a hole" "$dir/fv7.pfm" visibility "$dir/flat7.pgm" --nodata 7 --dirs 1 -o "$dir/fv7.pfm"
+expect_floats "visibility: the hole is NaN and never seen" "$dir/fv7.pfm" 32 0 nan 6 5 4 3 2 1 0
 
 # ---- failures: one line, non-zero exit, nothing written -----------------------------------
 o=$fdir/out.pfm
@@ -180,6 +258,34 @@ expect_fail "light without --env" 2 light "$h" -o "$o"
 expect_fail "light --method foo" 2 light "$h" --env "$dir/env1.pfm" --method foo -o "$o"
 expect_fail "light, missing env" 1 light "$h" --env "$dir/no-such-env.pfm" -o "$o"
 expect_fail "light, garbage env" 1 light "$h" --env "$dir/garbage.pgm" -o "$o"
+for v in -1 1.5 x 1001 ''; do
+  expect_fail "indirect --bounces '$v'" 2 indirect "$h" --bounces "$v" -o "$o"
+done
+expect_fail "indirect --albedo-map of another size" 1 indirect "$h" --albedo-map "$f" -o "$o"
+expect_fail "indirect --emission of another size" 1 indirect "$h" --emission "$dir/emit1.pfm" -o "$o"
+expect_fail "indirect --sun-azimuth without --sun-elevation" 2 indirect "$h" --sun-azimuth 90 -o "$o"
+expect_fail "indirect --sun-elevation without --sun-azimuth" 2 indirect "$h" --sun-elevation 20 -o "$o"
+expect_fail "indirect --sun-radius without a sun" 2 indirect "$h" --sun-radius 1 -o "$o"
+expect_fail "indirect --sun-irradiance without a sun" 2 indirect "$h" --sun-irradiance 2 -o "$o"
+expect_fail "indirect --sun-irradiance -1" 2 indirect "$h" --sun-azimuth 90 --sun-elevation 20 --sun-irradiance -1 -o "$o"
+expect_fail "indirect --sun-elevation 100" 2 indirect "$h" --sun-azimuth 90 --sun-elevation 100 -o "$o"
+expect_fail "indirect --albedo with --albedo-map" 2 indirect "$f" --albedo 0.5 --albedo-map "$dir/alb51.pgm" -o "$o"
+expect_fail "indirect --sky with --env" 2 indirect "$h" --sky 2 --env "$dir/env1.pfm" -o "$o"
+expect_fail "indirect --albedo -0.5" 2 indirect "$h" --albedo -0.5 -o "$o"
+expect_fail "indirect --output direct --bounces 2" 2 indirect "$h" --output direct --bounces 2 -o "$o"
+expect_fail "indirect --output indirect --bounces 0" 2 indirect "$h" --output indirect --bounces 0 -o "$o"
+expect_fail "indirect --output foo" 2 indirect "$h" --output foo -o "$o"
+expect_fail "indirect --method" 2 indirect "$h" --method lp -o "$o"
+expect_fail "indirect, missing albedo map" 1 indirect "$h" --albedo-map "$dir/no-such-map.pgm" -o "$o"
+expect_fail "indirect, garbage emission" 1 indirect "$h" --emission "$dir/garbage.pgm" -o "$o"
+expect_fail "indirect, negative map value" 1 indirect "$f" --emission "$dir/neg.pfm" -o "$o"
+expect_fail "indirect, NaN map value off the holes" 1 indirect "$f" --albedo-map "$dir/nanrow.pfm" -o "$o"
+expect_fail "indirect, garbage env" 1 indirect "$h" --env "$dir/garbage.pgm" -o "$o"
+expect_fail "visibility --dirs 0" 2 visibility "$h" --dirs 0 -o "$o"
+expect_fail "visibility --fraction=1" 2 visibility "$h" --fraction=1 -o "$o"
+expect_fail "visibility --albedo" 2 visibility "$h" --albedo 1 -o "$o"
+expect_fail "visibility --stats, garbage input" 1 visibility "$dir/garbage.pgm" --stats -o "$o"
+[ ! -s "$dir/stdout" ] && ok "visibility --stats prints nothing on failure" || bad "visibility --stats printed on failure"
 expect_fail "horizon over the size limit" 1 horizon "$dir/big.pgm" --dirs 65536 -o "$o"
 grep -q 'HFVIS_ERR_LIMIT' "$dir/stderr" && ok "horizon limit names HFVIS_ERR_LIMIT" || bad "horizon limit names HFVIS_ERR_LIMIT"
 
