@@ -727,6 +727,75 @@ HFVIS_API hfvis_status hfvis_direct_light(const hfvis_grid *grid, int K, const h
                                           const hfvis_sweep_options *opts, float *out);
 
 /* ========================================================================================== */
+/* hfvis.c - viewshed of one observer (Franklin & Ray 1994, R2)                               */
+/* ========================================================================================== */
+
+/* Options of hfvis_viewshed and its oracle. NULL or a zero struct: eye and targets on the
+ * surface, unlimited range. */
+typedef struct hfvis_viewshed_options {
+    double observer_height;   /* eye height above the surface at the observer, world units, >= 0 */
+    double target_height;     /* height above the surface of each target, world units, >= 0 */
+    double max_distance;      /* horizontal range in world units, >= 0; 0 = unlimited */
+    const hfvis_allocator *alloc; /* reserved: neither viewshed function allocates */
+} hfvis_viewshed_options;
+
+/* Viewshed of one observer: which grid points an eye at (observer_x, observer_y) sees.
+ * The eye is at surface(observer) + observer_height, the target of grid point (x, y) at
+ * z(x, y) + target_height, the terrain is the bilinear surface (CONVENTIONS; holes never
+ * occlude) and grazing counts as visible, to within rounding (every occluder is lowered by
+ * 32*DBL_EPSILON times the largest height involved, so an eye on a plane sees all of it).
+ * out[y*out_stride + x] = 1 where the target is visible,
+ * 0 where it is hidden, NaN at holes, beyond max_distance (horizontal distance from the observer,
+ * world units), and everywhere if the surface under the observer is a hole. A grid point the
+ * observer stands on exactly is visible. Visibility does not depend on cell_size (it scales all
+ * slopes alike); cell_size only converts max_distance to cells.
+ * Method: R2 of Franklin & Ray 1994 ("Higher isn't necessarily better: visibility algorithms
+ * and experiments"), the standard fast approximation used by GIS viewshed tools. One ray goes to
+ * every grid point on the border of the grid (of its intersection with the bounding square of
+ * the max_distance circle when the range is limited); each ray is walked one cell at a time along
+ * its major axis, sampling the surface where it crosses each grid column (row), and keeps the
+ * running maximum of the terrain slopes (h - h_eye)/d; the target above a sample is visible iff
+ * its slope is >= the maximum over the earlier samples of that ray. Each grid point takes the
+ * decision of the sample nearest to it on its column (row) among the rays crossing within half
+ * a cell (ties: the earlier ray, in the order of the top and bottom border rows, then the left
+ * and right columns); a grid point that no sample decides (beside holes, whose samples decide
+ * nothing) is decided by the exact line of sight of hfvis_viewshed_reference (step 0.5).
+ * How it differs from exact LOS: R2 decides a grid point with a ray that passes up to half a cell
+ * beside it, tests the target above that crossing point (interpolated height) rather than above
+ * the grid point, and sees the terrain only at one crossing per cell. The decisions agree with
+ * hfvis_viewshed_reference except at grid points whose sight line nearly grazes the terrain, i.e.
+ * along the boundaries of the visible regions (R2 mostly errs towards visible: a ridge between
+ * two crossings is missed). Measured against the oracle: 0.4-1.9% of the grid points of a rough
+ * 128^2 fBm (97-100% of them next to a visibility boundary), 0.4% (eye 1.5) and 1.5% (eye 100)
+ * on a 1024^2 fBm; none on a wall seen along the rays' major axis.
+ * out must hold (height-1)*out_stride + width floats, out_stride >= width, and must not overlap
+ * grid->z. opts may be NULL (defaults). out is used as scratch during the call.
+ * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT if grid is NULL or invalid, out is NULL,
+ * out_stride < width, the observer is non-finite or outside [0, width-1] x [0, height-1], or an
+ * option is negative or non-finite (outputs untouched). No allocation.
+ * Cost: O((W+H) * max(W, H)) = O(W*H) for a square grid (about 2(W+H) rays of at most max(W, H)
+ * samples), plus O(max(W, H)) per grid point left to the exact fallback (beside holes).
+ * Determinism: bit-exact on one build; see CONVENTIONS. */
+HFVIS_API hfvis_status hfvis_viewshed(const hfvis_grid *grid, double observer_x, double observer_y,
+                                      const hfvis_viewshed_options *opts, float *out,
+                                      ptrdiff_t out_stride);
+
+/* Oracle: the exact line of sight from the eye to every target. For the grid point (x, y) at
+ * horizontal distance D (cells) from the observer, the bilinear surface is sampled along the
+ * straight horizontal path to it at distances d = k*step_cells, k = 1, 2, ..., d < D, and the
+ * target is hidden iff some sample's slope (h - h_eye)/d exceeds the target's slope
+ * (z(x, y) + target_height - h_eye)/D (holes skipped). Same output, options, NaN rules and
+ * errors as hfvis_viewshed, plus HFVIS_ERR_INVALID_ARGUMENT for a negative or non-finite
+ * step_cells. step_cells = 0 means 0.5. The march is exact up to features narrower than the step
+ * (a ridge crossed between two samples is seen at the lower of them).
+ * Cost O(W*H*N/step_cells), N = max(W, H). No allocation. */
+HFVIS_API hfvis_status hfvis_viewshed_reference(const hfvis_grid *grid, double observer_x,
+                                                double observer_y,
+                                                const hfvis_viewshed_options *opts,
+                                                double step_cells, float *out,
+                                                ptrdiff_t out_stride);
+
+/* ========================================================================================== */
 /* ssao.c - screen space (later issues)                                                       */
 /* voxel.c - meshes and volumes (later issues)                                                */
 /* ========================================================================================== */

@@ -30,9 +30,10 @@
 #define CLI_RUN (-1)                              /* parse_args: go on and run the command */
 
 enum { CMD_HORIZON, CMD_SKYVIEW, CMD_SKY, CMD_SHADOW, CMD_LIGHT, CMD_NORMALS, CMD_INDIRECT,
-       CMD_VISIBILITY, CMD_COUNT };
+       CMD_VISIBILITY, CMD_VIEWSHED, CMD_COUNT };
 static const char *const cli_cmd_names[CMD_COUNT] = {
-    "horizon", "skyview", "sky", "shadow", "light", "normals", "indirect", "visibility"
+    "horizon", "skyview", "sky", "shadow", "light", "normals", "indirect", "visibility",
+    "viewshed"
 };
 
 /* indirect --output */
@@ -48,6 +49,8 @@ typedef struct cli_args {
     int compass, degrees, quiet, math, fraction, stats;
     int has_nodata, has_range, has_sun_azimuth, has_sun_elevation, has_sun_radius;
     int has_sun_irradiance, has_sky, has_albedo, has_bounces;
+    double observer_x, observer_y, observer_height, target_height, max_distance;
+    int has_observer, exact;
 } cli_args;
 
 /* ------------------------------------------------------------------------------------------ */
@@ -70,7 +73,8 @@ static const char cli_usage[] =
     "  light       environment light from a lat-long PFM map\n"
     "  normals     unit surface normals (x east, y south, z up) as a 3-channel PFM\n"
     "  indirect    sun and sky light with interreflections between terrain points ([P2])\n"
-    "  visibility  visibility index: the grid samples each point sees along K directions\n";
+    "  visibility  visibility index: the grid samples each point sees along K directions\n"
+    "  viewshed    which samples an observer at one point sees (line of sight)\n";
 
 static const char cli_shared_help[] =
     "\n"
@@ -190,7 +194,24 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "               receiver-direction (lattice node and direction), as [P2] Tables 1-2:\n"
     "               visible samples, horizons m_a and tree iterations t_a; with --fraction also\n"
     "               the samples tested (the naive scan's iterations) and the ratios\n"
-    "Default PGM range 0:the largest count (0:1 with --fraction).\n"
+    "Default PGM range 0:the largest count (0:1 with --fraction).\n",
+
+    "usage: hfvis viewshed IN --observer X,Y -o OUT [--observer-height H] [--target-height T]\n"
+    "         [--max-distance D] [--exact]\n"
+    "The viewshed of one observer: 1 where the observer's eye sees the target above a sample,\n"
+    "0 where terrain hides it, NaN at holes and beyond --max-distance (0 in PGM). The terrain\n"
+    "is the bilinear surface through the samples; a sight line that grazes it counts as\n"
+    "visible. Method: R2 of Franklin & Ray 1994 (rays to every border sample, running maximum\n"
+    "slope), O(W*H); it differs from the exact line of sight only at samples whose sight line\n"
+    "nearly grazes the terrain (about 0.4%% of a rough 1024 x 1024 terrain).\n"
+    "  --observer X,Y        the observer's column and row, reals in [0, W-1] x [0, H-1] (required)\n"
+    "  --observer-height H   eye height above the surface, height units, >= 0 (default 0)\n"
+    "  --target-height T     target height above each sample, >= 0 (default 0)\n"
+    "  --max-distance D      horizontal range in height units (--cell applies), >= 0;\n"
+    "                        0 = unlimited (default)\n"
+    "  --exact               the exact line-of-sight oracle instead (half-cell march per\n"
+    "                        sample): O(W*H*max(W, H)), 4 s at 1024 x 1024\n"
+    "--dirs, --azimuth0, --compass, --degrees and --border do not apply. Default PGM range 0:1.\n"
 };
 
 /* ------------------------------------------------------------------------------------------ */
@@ -327,7 +348,10 @@ static const cli_flag cli_flags[] = {
     { "--sun-irradiance", 1, CLI_ONLY(CMD_INDIRECT) }, { "--albedo-map", 1, CLI_ONLY(CMD_INDIRECT) },
     { "--emission", 1, CLI_ONLY(CMD_INDIRECT) },  { "--bounces", 1, CLI_ONLY(CMD_INDIRECT) },
     { "--output", 1, CLI_ONLY(CMD_INDIRECT) },
-    { "--fraction", 0, CLI_ONLY(CMD_VISIBILITY) }, { "--stats", 0, CLI_ONLY(CMD_VISIBILITY) }
+    { "--fraction", 0, CLI_ONLY(CMD_VISIBILITY) }, { "--stats", 0, CLI_ONLY(CMD_VISIBILITY) },
+    { "--observer", 1, CLI_ONLY(CMD_VIEWSHED) },  { "--observer-height", 1, CLI_ONLY(CMD_VIEWSHED) },
+    { "--target-height", 1, CLI_ONLY(CMD_VIEWSHED) }, { "--max-distance", 1, CLI_ONLY(CMD_VIEWSHED) },
+    { "--exact", 0, CLI_ONLY(CMD_VIEWSHED) }
 };
 
 /* Apply one recognised flag; returns 0 or CLI_EXIT_USAGE (message printed). */
@@ -422,6 +446,26 @@ static int cli_set(cli_args *a, const char *f, const char *v)
         return cli_real(f, v, 0.0, 0, 90.0, "degrees in 0..90", &a->sun_radius);
     }
     if (!strcmp(f, "--env")) { a->env = v; return 0; }
+    if (!strcmp(f, "--observer")) {
+        char buf[256];
+        const char *comma = strchr(v, ',');
+        size_t n = comma ? (size_t)(comma - v) : 0;
+        if (!comma || n >= sizeof buf)
+            return cli_error(CLI_EXIT_USAGE, f, "expected X,Y (column,row), got '%s'", v);
+        memcpy(buf, v, n);
+        buf[n] = '\0';
+        if (!cli_parse_real(buf, &a->observer_x) || !cli_parse_real(comma + 1, &a->observer_y))
+            return cli_error(CLI_EXIT_USAGE, f, "expected X,Y (column,row), got '%s'", v);
+        a->has_observer = 1;
+        return 0;
+    }
+    if (!strcmp(f, "--observer-height"))
+        return cli_real(f, v, 0.0, 0, DBL_MAX, "a height >= 0", &a->observer_height);
+    if (!strcmp(f, "--target-height"))
+        return cli_real(f, v, 0.0, 0, DBL_MAX, "a height >= 0", &a->target_height);
+    if (!strcmp(f, "--max-distance"))
+        return cli_real(f, v, 0.0, 0, DBL_MAX, "a distance >= 0", &a->max_distance);
+    if (!strcmp(f, "--exact")) { a->exact = 1; return 0; }
     /* --method */
     if (!strcmp(v, "prefix")) a->method = HFVIS_ENV_PREFIX;
     else if (!strcmp(v, "lp")) a->method = HFVIS_ENV_LP_TABLE;
@@ -497,6 +541,8 @@ static int cli_parse(int argc, char **argv, cli_args *a)
         return cli_error(CLI_EXIT_USAGE, "shadow", "missing --sun-azimuth DEG");
     if (a->cmd == CMD_SHADOW && !a->has_sun_elevation)
         return cli_error(CLI_EXIT_USAGE, "shadow", "missing --sun-elevation DEG");
+    if (a->cmd == CMD_VIEWSHED && !a->has_observer)
+        return cli_error(CLI_EXIT_USAGE, "viewshed", "missing --observer X,Y");
     if (a->cmd == CMD_LIGHT && !a->env)
         return cli_error(CLI_EXIT_USAGE, "light", "missing --env ENV.pfm");
     if (a->cmd == CMD_INDIRECT) {
@@ -864,6 +910,24 @@ static int cli_run(const cli_args *a)
         s = hfvis_sun_visibility(&grid, bearing_or_psi * (CLI_PI / 180.0),
                                  a->sun_elevation * (CLI_PI / 180.0),
                                  a->sun_radius * (CLI_PI / 180.0), &opts, out, w);
+        break;
+    }
+    case CMD_VIEWSHED: {
+        hfvis_viewshed_options vopts;
+        memset(&vopts, 0, sizeof vopts);
+        vopts.observer_height = a->observer_height;
+        vopts.target_height = a->target_height;
+        vopts.max_distance = a->max_distance;
+        if (a->observer_x < 0.0 || a->observer_x > w - 1 || a->observer_y < 0.0 ||
+            a->observer_y > h - 1) {
+            rc = cli_error(CLI_EXIT_ERROR, "--observer", "%g,%g is outside the grid [0, %d] x [0, %d]",
+                           a->observer_x, a->observer_y, w - 1, h - 1);
+            goto done;
+        }
+        if (a->exact)
+            s = hfvis_viewshed_reference(&grid, a->observer_x, a->observer_y, &vopts, 0.0, out, w);
+        else
+            s = hfvis_viewshed(&grid, a->observer_x, a->observer_y, &vopts, out, w);
         break;
     }
     case CMD_LIGHT: {

@@ -107,7 +107,7 @@ expect_line2() { # NAME FILE WANT: the second header line (PFM dimensions)
 # ---- help ---------------------------------------------------------------------------------
 if "$hfvis" --help > "$dir/stdout" 2> "$dir/stderr" && grep -q '^usage: hfvis' "$dir/stdout" && [ ! -s "$dir/stderr" ]
 then ok "--help"; else bad "--help"; fi
-for c in horizon skyview sky shadow light normals indirect visibility; do
+for c in horizon skyview sky shadow light normals indirect visibility viewshed; do
   if "$hfvis" $c --help > "$dir/stdout" 2>&1 && grep -q "^usage: hfvis $c" "$dir/stdout"
   then ok "$c --help"; else bad "$c --help"; fi
 done
@@ -202,6 +202,16 @@ expect_floats "indirect: the hole is NaN, its neighbour is lit" "$dir/fh.pfm" 32
 # --compass --dirs 1 looks north: row y sees y samples (the first stored PFM row is y = 5).
 expect_ok "visibility flat east" "$dir/fv1.pfm" visibility "$f" --dirs 1 -o "$dir/fv1.pfm"
 expect_floats "visibility flat east: 7 - x" "$dir/fv1.pfm" 32 0 7 6 5 4 3 2 1 0
+# viewshed: an eye on a flat field sees all of it (grazing counts); --max-distance cuts it off.
+expect_ok "viewshed flat" "$dir/vsf.pfm" viewshed "$f" --observer 0,0 -o "$dir/vsf.pfm"
+expect_floats "viewshed flat: the last row is seen" "$dir/vsf.pfm" 32 0 1 1 1 1 1 1 1 1
+expect_ok "viewshed flat, exact oracle" "$dir/vse.pfm" viewshed "$f" --observer 0,0 --exact -o "$dir/vse.pfm"
+cmp -s "$dir/vsf.pfm" "$dir/vse.pfm" && ok "viewshed flat: R2 = exact, bit for bit" || bad "viewshed flat: R2 differs from exact"
+expect_ok "viewshed --max-distance" "$dir/vsm.pfm" viewshed "$f" --observer 7,0 --max-distance 2 --cell 1 -o "$dir/vsm.pfm"
+expect_floats "viewshed --max-distance: NaN beyond 2 cells" "$dir/vsm.pfm" 32 0 nan nan nan nan nan 1 1 1
+expect_ok "viewshed hill pgm, eye and target heights" "$dir/vsh.pgm" viewshed "$h" --observer 3.5,2 --observer-height 1.5 --target-height 0.5 -o "$dir/vsh.pgm"
+expect_ok "viewshed with a hole" "$dir/vs7.pfm" viewshed "$dir/flat7.pgm" --nodata 7 --observer 7,5 -o "$dir/vs7.pfm"
+expect_floats "viewshed: the hole is NaN" "$dir/vs7.pfm" 32 0 nan 1 1 1 1 1 1 1
 expect_ok "visibility flat, 4 directions" "$dir/fv4.pfm" visibility "$f" --dirs 4 --stats -o "$dir/fv4.pfm"
 expect_floats "visibility flat, 4 directions: 12" "$dir/fv4.pfm" 32 0 12 12 12 12 12 12 12 12
 expect_floats "visibility flat, 4 directions: 12 (first row)" "$dir/fv4.pfm" 192 0 12 12 12 12 12 12 12 12
@@ -286,6 +296,13 @@ expect_fail "visibility --fraction=1" 2 visibility "$h" --fraction=1 -o "$o"
 expect_fail "visibility --albedo" 2 visibility "$h" --albedo 1 -o "$o"
 expect_fail "visibility --stats, garbage input" 1 visibility "$dir/garbage.pgm" --stats -o "$o"
 [ ! -s "$dir/stdout" ] && ok "visibility --stats prints nothing on failure" || bad "visibility --stats printed on failure"
+expect_fail "viewshed without --observer" 2 viewshed "$h" -o "$o"
+expect_fail "viewshed --observer 3" 2 viewshed "$h" --observer 3 -o "$o"
+expect_fail "viewshed --observer x,1" 2 viewshed "$h" --observer x,1 -o "$o"
+expect_fail "viewshed observer outside the grid" 1 viewshed "$h" --observer 24,0 -o "$o"
+expect_fail "viewshed --observer-height -1" 2 viewshed "$h" --observer 1,1 --observer-height -1 -o "$o"
+expect_fail "viewshed --sky" 2 viewshed "$h" --observer 1,1 --sky 1 -o "$o"
+expect_fail "shadow --observer" 2 shadow "$h" --observer 1,1 --sun-azimuth 1 --sun-elevation 1 -o "$o"
 expect_fail "horizon over the size limit" 1 horizon "$dir/big.pgm" --dirs 65536 -o "$o"
 grep -q 'HFVIS_ERR_LIMIT' "$dir/stderr" && ok "horizon limit names HFVIS_ERR_LIMIT" || bad "horizon limit names HFVIS_ERR_LIMIT"
 
