@@ -797,8 +797,165 @@ HFVIS_API hfvis_status hfvis_viewshed_reference(const hfvis_grid *grid, double o
 
 /* ========================================================================================== */
 /* ssao.c - screen space (later issues)                                                       */
-/* voxel.c - meshes and volumes (later issues)                                                */
 /* ========================================================================================== */
+
+/* ========================================================================================== */
+/* voxel.c - meshes: type, OBJ codec, analytic meshes                                          */
+/* ========================================================================================== */
+
+/* A triangle mesh (DESIGN §2): vertex v is (xyz[3v], xyz[3v+1], xyz[3v+2]); triangle t has the
+ * vertices indices[3t..3t+2], counter-clockwise seen from the side its normal points to
+ * (n = (v1 - v0) x (v2 - v0)). A triangle soup is allowed (shared vertices not required, no
+ * watertightness assumed) except by hfvis_voxelize_solid, which says so. Valid when every index
+ * is < vertex_count and every coordinate is finite; functions that take a mesh check this
+ * (O(V + T)) and return HFVIS_ERR_INVALID_ARGUMENT otherwise. Degenerate (zero-area) triangles
+ * are allowed and never hit, rasterized or voxelized. */
+typedef struct hfvis_mesh {
+    const float *xyz;
+    size_t vertex_count;
+    const uint32_t *indices;
+    size_t triangle_count;
+} hfvis_mesh;
+
+/* "No triangle" in triangle-id outputs (rasterizer, ray queries). */
+#define HFVIS_NO_TRIANGLE 0xFFFFFFFFu
+
+/* Release the arrays of a mesh that a hfvis function allocated (decoders, generators) with the
+ * same allocator (NULL = free), and zero the struct. mesh may be NULL. */
+HFVIS_API void hfvis_mesh_free(const hfvis_allocator *alloc, hfvis_mesh *mesh);
+
+/* ========================================================================================== */
+/* voxel.c - views: GL-convention matrices, shared by the rasterizer and incremental voxelizer */
+/* ========================================================================================== */
+
+/* A view of the world (spec voxel §0): 4x4 matrices in double, column-major as OpenGL
+ * (element (row r, column c) is m[c*4 + r]), world -> eye (view, rigid) and eye -> clip (proj).
+ * Eye space looks down -z; NDC z in [-1, 1]; window depth zw = (z_ndc + 1)/2 in [0, 1].
+ * Images are width x height pixels, row 0 at the TOP (as image files): pixel (x, y) has its
+ * centre at NDC (2(x + 0.5)/width - 1, 1 - 2(y + 0.5)/height). Perspective views come from
+ * hfvis_mat4_perspective (glm/gluPerspective), orthographic ones from hfvis_mat4_ortho (glOrtho);
+ * `orthographic` tells which (it selects the depth linearisation). near/far are the positive
+ * distances of the clip planes used to build proj. */
+typedef struct hfvis_view {
+    double view[16];
+    double proj[16];
+    int width, height;
+    double near_plane, far_plane;
+    int orthographic;
+} hfvis_view;
+
+/* Matrices (column-major double[16], OpenGL conventions; see hfvis_view). */
+
+/* out = a * b (apply b first). out may alias a or b. */
+HFVIS_API void hfvis_mat4_multiply(const double a[16], const double b[16], double out[16]);
+/* out = inverse of m (Gauss-Jordan, partial pivoting). HFVIS_ERR_INVALID_ARGUMENT if m is singular
+ * (a pivot below 1e-300) or not finite; out untouched then. out may alias m. */
+HFVIS_API hfvis_status hfvis_mat4_invert(const double m[16], double out[16]);
+/* World -> eye of a camera at eye looking at target, up the approximate up direction
+ * (gluLookAt). HFVIS_ERR_INVALID_ARGUMENT if eye == target, up is parallel to the view
+ * direction, or a value is not finite. */
+HFVIS_API hfvis_status hfvis_mat4_look_at(const double eye[3], const double target[3],
+                                          const double up[3], double out[16]);
+/* Perspective projection (gluPerspective): vertical field of view fov_y_rad in (0, pi), aspect =
+ * width/height > 0, 0 < near_plane < far_plane. HFVIS_ERR_INVALID_ARGUMENT otherwise. */
+HFVIS_API hfvis_status hfvis_mat4_perspective(double fov_y_rad, double aspect, double near_plane,
+                                              double far_plane, double out[16]);
+/* Orthographic projection (glOrtho): left < right, bottom < top, near_plane < far_plane.
+ * HFVIS_ERR_INVALID_ARGUMENT otherwise. */
+HFVIS_API hfvis_status hfvis_mat4_ortho(double left, double right, double bottom, double top,
+                                        double near_plane, double far_plane, double out[16]);
+/* A perspective hfvis_view in one call: look_at(eye, target, up) and
+ * perspective(fov_y_rad, width/height, near_plane, far_plane). Errors as those, plus width or
+ * height < 1. */
+HFVIS_API hfvis_status hfvis_view_perspective(hfvis_view *view, const double eye[3],
+                                              const double target[3], const double up[3],
+                                              double fov_y_rad, int width, int height,
+                                              double near_plane, double far_plane);
+/* An orthographic hfvis_view: look_at(eye, target, up) and ortho(-half_height*aspect,
+ * half_height*aspect, -half_height, half_height, near_plane, far_plane), aspect = width/height,
+ * half_height > 0. */
+HFVIS_API hfvis_status hfvis_view_orthographic(hfvis_view *view, const double eye[3],
+                                               const double target[3], const double up[3],
+                                               double half_height, int width, int height,
+                                               double near_plane, double far_plane);
+/* Eye-space z of a window depth zw in [0, 1] (thesis eq. 16 with its sign restored, spec voxel
+ * §4.2): perspective z_e = -n f / (f - zw (f - n)), orthographic z_e = -(n + zw (f - n));
+ * zw = 0 gives -n, zw = 1 gives -f. The linear view depth is -z_e. */
+HFVIS_API double hfvis_depth_to_eye_z(double zw, double near_plane, double far_plane,
+                                      int orthographic);
+/* Inverse of hfvis_depth_to_eye_z: the window depth of eye-space z (z < 0 in front). */
+HFVIS_API double hfvis_eye_z_to_depth(double z_eye, double near_plane, double far_plane,
+                                      int orthographic);
+
+/* ========================================================================================== */
+/* voxel.c - volumes and the Volume Buffer                                                     */
+/* ========================================================================================== */
+
+/* A voxel grid (spec voxel §0): voxel (i, j, k) covers [origin + cell*(i, j, k),
+ * origin + cell*(i+1, j+1, k+1)) (half-open), linear index (k*dims[1] + j)*dims[0] + i
+ * (x fastest). Valid when every dims[a] >= 1, every cell[a] > 0 and finite, origin finite, and
+ * dims[0]*dims[1]*dims[2] <= HFVIS_VOLUME_MAX_VOXELS. */
+typedef struct hfvis_volume_grid {
+    double origin[3];
+    double cell[3];
+    int dims[3];
+} hfvis_volume_grid;
+
+#define HFVIS_VOLUME_MAX_VOXELS ((size_t)1 << 31) /* 2^31 voxels (2048^3 / 4) */
+#define HFVIS_VOLUME_MAX_CHANNELS 32              /* 32 floats = 1024 bits, the thesis' maximum */
+
+/* How a written value combines with the stored one (the Volume Buffer's blend equation, thesis
+ * §6.3; GL_MAX for every attachment on the GPU). */
+typedef enum hfvis_blend {
+    HFVIS_BLEND_MAX = 0,      /* default (the thesis' GPU behaviour) */
+    HFVIS_BLEND_REPLACE = 1,
+    HFVIS_BLEND_MIN = 2,
+    HFVIS_BLEND_ADD = 3
+} hfvis_blend;
+
+/* The Volume Buffer (thesis ch. 6, spec voxel §3.3): `channels` floats per voxel, interleaved,
+ * data[lin*channels + c], caller-owned (hfvis_volume_size floats), each channel with its blend. */
+typedef struct hfvis_volume {
+    hfvis_volume_grid grid;
+    int channels;                                /* 1..HFVIS_VOLUME_MAX_CHANNELS */
+    float *data;
+    hfvis_blend blend[HFVIS_VOLUME_MAX_CHANNELS];
+} hfvis_volume;
+
+/* Fit a grid around a mesh (spec voxel §3.2): the longest axis of the mesh's bounding box,
+ * enlarged by `padding` (a fraction of the longest extent, >= 0, on every side), gets
+ * `resolution` voxels. cubic = 0: N_a = max(1, round(resolution*ext_a/ext_max)) and
+ * cell_a = ext_a/N_a (near-cubic voxels covering the box exactly; the thesis' Table 3 sizes);
+ * cubic != 0: cell = ext_max/resolution on every axis, N_a = max(1, ceil(ext_a/cell)), the box
+ * centred in the grid. A zero extent (flat mesh) gets the cell of the longest axis and one voxel.
+ * Returns HFVIS_ERR_INVALID_ARGUMENT for a NULL or invalid mesh, no triangles, resolution < 1,
+ * negative or non-finite padding or an all-zero extent; HFVIS_ERR_LIMIT past
+ * HFVIS_VOLUME_MAX_VOXELS. */
+HFVIS_API hfvis_status hfvis_volume_grid_fit(const hfvis_mesh *mesh, int resolution,
+                                             double padding, int cubic, hfvis_volume_grid *out);
+
+/* Floats a volume of `channels` channels needs: dims[0]*dims[1]*dims[2]*channels; 0 if grid is
+ * NULL or invalid or channels is outside 1..HFVIS_VOLUME_MAX_CHANNELS. */
+HFVIS_API size_t hfvis_volume_size(const hfvis_volume_grid *grid, int channels);
+
+/* Set up vol over caller storage of hfvis_volume_size(grid, channels) floats, every channel
+ * blending with `blend`, every value 0. Returns HFVIS_ERR_INVALID_ARGUMENT for NULL, an invalid
+ * grid, channels outside 1..32 or an unknown blend. */
+HFVIS_API hfvis_status hfvis_volume_init(hfvis_volume *vol, const hfvis_volume_grid *grid,
+                                         int channels, float *storage, hfvis_blend blend);
+
+/* Set every value of every channel to `value`. vol must have been set up by hfvis_volume_init. */
+HFVIS_API void hfvis_volume_clear(hfvis_volume *vol, float value);
+
+/* Blend values[0..channels) into voxel (i, j, k): data = op_c(data, values[c]) per channel.
+ * Returns HFVIS_ERR_INVALID_ARGUMENT for NULL or a voxel outside the grid (nothing written). */
+HFVIS_API hfvis_status hfvis_volume_write(hfvis_volume *vol, int i, int j, int k,
+                                          const float *values);
+
+/* Merge src into dst voxel by voxel with dst's per-channel blend (the thesis' MAX merge of the
+ * three axis passes, ch. 5 Alg. 4). The grids' dims and the channel counts must be equal.
+ * Returns HFVIS_ERR_INVALID_ARGUMENT otherwise. */
+HFVIS_API hfvis_status hfvis_volume_merge(hfvis_volume *dst, const hfvis_volume *src);
 
 #ifdef __cplusplus
 }
