@@ -15,6 +15,8 @@
  *  11. P2: the convex-hull tree ([P2] Alg. 1-3, App. A.2; spec §7), visible sets (spec §8),
  *      intervisibility sweeps, visibility index, indirect light and bounces (spec §9)
  *  12. Viewshed of one observer (Franklin & Ray 1994, R2) and its exact line-of-sight oracle
+ *  13. Nowrouzezahrai-Snyder GI, math layer: real SH of order 4, zonal lobes, environment
+ *      projection, normalized Legendre polynomials, Appendix-A wedge matrices ([NS09]; spec GI B)
  *
  * Paper references: [P1] Timonen & Westerholm, "Scalable Height Field Self-Shadowing",
  * CGF 29(2), 2010 (thesis appendix A.1). "spec" is the project's restatement
@@ -4063,6 +4065,747 @@ hfvis_status hfvis_viewshed_reference(const hfvis_grid *grid, double observer_x,
             if (!isnan(o[x]))
                 o[x] = hf_vs_los(grid, observer_x, observer_y, h_eye, tol, (double)x, (double)y,
                                  (double)zr[x] + tgt_h, step) ? 1.0f : 0.0f;
+    }
+    return HFVIS_OK;
+}
+
+/* ========================================================================================== */
+/* 13. Nowrouzezahrai-Snyder GI: SH, Legendre, wedge matrices                                 */
+/* ========================================================================================== */
+/* The math layer of [NS09] D. Nowrouzezahrai, J. Snyder, "Fast Global Illumination on Dynamic
+ * Height Fields", CGF 28(4), 2009: real SH of order 4 (§7), normalized Legendre polynomials and
+ * the closed-form 1-D projections of visibility and indirect radiance (§4, Eq. 9-13), the
+ * Appendix-A wedge matrices and the Z-rotation that turn per-azimuth NLP vectors into SH
+ * (§6, Eq. 18-24), the BRDF / light ZH lobes (§7, spec B.7-B.8) and the tangent-plane minimum
+ * blocking angle (§3). "spec" is spec/raycast-ao-and-hf-gi.md part B, which fixes the errata.
+ *
+ * Contents
+ *   1. Real SH basis: Cartesian evaluation and the separable form K * P_l^mu(z) * Phi_m(phi)
+ *   2. Exact polynomial / trigonometric integrals shared by the projections
+ *   3. SH operations: Z-rotation, dot, triple-product tensor and product, ZH lobes
+ *   4. Projection of a lat-long environment (exact per-texel integrals)
+ *   5. Normalized Legendre polynomials and the 1-D projections (Eq. 10-13)
+ *   6. Appendix-A wedge matrices and the accumulation of Eq. 21
+ *   7. The tangent-plane minimum blocking angle (§3, spec B.2 erratum)
+ *
+ * SH convention (DESIGN §2): real, orthonormal, no Condon-Shortley phase, index l(l+1)+m,
+ *   Y_lm = K_l^|m| * Pt_l^|m|(cos theta) * Phi_m(phi),  K_l^mu = sqrt((2l+1)/(4 pi) (l-mu)!/(l+mu)!),
+ *   Pt_l^mu(z) = (1-z^2)^(mu/2) d^mu P_l/dz^mu (no (-1)^mu),
+ *   Phi_m = sqrt2 cos(m phi) (m > 0), 1 (m = 0), sqrt2 sin(|m| phi) (m < 0),
+ * with theta from +z and phi measured like psi (from +x toward +y). Compared with the spec's
+ * tables (written with the Condon-Shortley phase) every value with odd |m| changes sign
+ * (spec B.7 "library-wide alignment"); shaded values do not.
+ *
+ * Errata of [NS09] applied here (spec B.2-B.7): the P^_2, P^_3 constants (sqrt10/4, sqrt14/4);
+ * the limits of Eq. 10 (z from -1 to sin sigma) and of Eq. 12 (z over [-1, 1]); Eq. 12's
+ * "u(t_(i+1)) = 0 when i+1 >= |T|"; the canonical wedge alpha = phi/dphi of Eq. 18; m wedges on a
+ * full circle (Eq. 21); M_bspl is 16x16, not 16x32; the Phong vector is a set of multipliers
+ * Ahat; omega_min in the exact atan2 form by default. */
+
+#define NS_SH_N 16          /* order-4 SH coefficients */
+#define NS_NLP_N 4          /* order-4 NLP coefficients */
+#define NS_SQRT2 1.41421356237309504880
+#define NS_TWO_PI 6.28318530717958647692
+
+/* ------------------------------------------------------------------------ 1. the SH basis */
+
+/* Cartesian constants of the basis (K_l^|m| times sqrt2 for m != 0 and the polynomial's
+ * leading factor), spec B.7 table without the Condon-Shortley signs. */
+#define NS_C00 0.28209479177387814   /* 1/(2 sqrt(pi)) */
+#define NS_C1 0.4886025119029199     /* sqrt(3/(4 pi)) */
+#define NS_C2A 1.0925484305920792    /* sqrt(15/pi)/2: xy, yz, xz */
+#define NS_C20 0.31539156525252005   /* sqrt(5/pi)/4: 3z^2 - 1 */
+#define NS_C22 0.5462742152960396    /* sqrt(15/pi)/4: x^2 - y^2 */
+#define NS_C33 0.5900435899266435    /* sqrt(35/(2 pi))/4: y(3x^2 - y^2), x(x^2 - 3y^2) */
+#define NS_C3M2 2.890611442640554    /* sqrt(105/pi)/2: xyz */
+#define NS_C31 0.4570457994644658    /* sqrt(21/(2 pi))/4: y(5z^2 - 1), x(5z^2 - 1) */
+#define NS_C30 0.3731763325901154    /* sqrt(7/pi)/4: z(5z^2 - 3) */
+#define NS_C32 1.445305721320277     /* sqrt(105/pi)/4: z(x^2 - y^2) */
+
+/* Y at a unit direction (x, y, z). */
+static void ns_sh_eval_unit(double x, double y, double z, double *Y)
+{
+    double x2 = x * x, y2 = y * y, z2 = z * z;
+    Y[0] = NS_C00;
+    Y[1] = NS_C1 * y;
+    Y[2] = NS_C1 * z;
+    Y[3] = NS_C1 * x;
+    Y[4] = NS_C2A * x * y;
+    Y[5] = NS_C2A * y * z;
+    Y[6] = NS_C20 * (3.0 * z2 - 1.0);
+    Y[7] = NS_C2A * x * z;
+    Y[8] = NS_C22 * (x2 - y2);
+    Y[9] = NS_C33 * y * (3.0 * x2 - y2);
+    Y[10] = NS_C3M2 * x * y * z;
+    Y[11] = NS_C31 * y * (5.0 * z2 - 1.0);
+    Y[12] = NS_C30 * z * (5.0 * z2 - 3.0);
+    Y[13] = NS_C31 * x * (5.0 * z2 - 1.0);
+    Y[14] = NS_C32 * z * (x2 - y2);
+    Y[15] = NS_C33 * x * (x2 - 3.0 * y2);
+}
+
+/* Normalises a finite non-zero 3-vector; 0 if it is not one. */
+static int ns_unit(const double *v, double *u)
+{
+    double n;
+    if (!isfinite(v[0]) || !isfinite(v[1]) || !isfinite(v[2])) return 0;
+    n = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (!(n > 0.0) || !isfinite(n)) return 0;
+    u[0] = v[0] / n;
+    u[1] = v[1] / n;
+    u[2] = v[2] / n;
+    return 1;
+}
+
+hfvis_status hfvis_sh_eval(const double dir[3], double Y[16])
+{
+    double u[3];
+    if (dir == NULL || Y == NULL || !ns_unit(dir, u)) return HFVIS_ERR_INVALID_ARGUMENT;
+    ns_sh_eval_unit(u[0], u[1], u[2], Y);
+    return HFVIS_OK;
+}
+
+/* Ascending coefficients of d^mu P_l / dz^mu (degree l - mu <= 3), Legendre P_0..P_3. */
+static void ns_legendre_deriv(int l, int mu, double q[4])
+{
+    static const double P[4][4] = {
+        {1.0, 0.0, 0.0, 0.0}, {0.0, 1.0, 0.0, 0.0}, {-0.5, 0.0, 1.5, 0.0}, {0.0, -1.5, 0.0, 2.5}};
+    int i, d;
+    for (i = 0; i < 4; i++) q[i] = P[l][i];
+    for (d = 0; d < mu; d++) {
+        for (i = 0; i < 3; i++) q[i] = (double)(i + 1) * q[i + 1];
+        q[3] = 0.0;
+    }
+}
+
+/* K_l^mu of the separable form (without the sqrt2 of Phi_m). */
+static double ns_sh_norm(int l, int mu)
+{
+    double r = 1.0;
+    int i;
+    for (i = l - mu + 1; i <= l + mu; i++) r /= (double)i;   /* (l-mu)!/(l+mu)! */
+    return sqrt((double)(2 * l + 1) / (4.0 * HF_PI) * r);
+}
+
+/* ------------------------------------------- 2. exact polynomial and trigonometric integrals */
+
+/* Product of ascending polynomials a (degree da) and b (degree db) into r (degree da + db <= 8). */
+static int ns_poly_mul(const double *a, int da, const double *b, int db, double *r)
+{
+    int i, j;
+    for (i = 0; i <= da + db; i++) r[i] = 0.0;
+    for (i = 0; i <= da; i++)
+        for (j = 0; j <= db; j++) r[i + j] += a[i] * b[j];
+    return da + db;
+}
+
+/* (1 - z^2)^e * q for e = 0, 1 (q of degree <= 3), into r; returns the degree. */
+static int ns_poly_one_minus_z2(int e, const double *q, int dq, double *r)
+{
+    static const double w[3] = {1.0, 0.0, -1.0};
+    int i;
+    if (e == 0) {
+        for (i = 0; i <= dq; i++) r[i] = q[i];
+        return dq;
+    }
+    return ns_poly_mul(w, 2, q, dq, r);
+}
+
+/* C_k(theta) = Int_0^theta cos^k t dt for k = 0..kmax (kmax <= 9), by the reduction formula
+ * C_k = cos^(k-1) sin / k + (k-1)/k C_(k-2). */
+static void ns_cos_power_integrals(double theta, int kmax, double *C)
+{
+    double c = cos(theta), s = sin(theta), ck1 = 1.0;   /* cos^(k-1) */
+    int k;
+    C[0] = theta;
+    if (kmax >= 1) C[1] = s;
+    for (k = 2; k <= kmax; k++) {
+        ck1 *= c;
+        C[k] = ck1 * s / (double)k + (double)(k - 1) / (double)k * C[k - 2];
+    }
+}
+
+/* Int_{theta0}^{theta1} Pt_l^mu(cos t) * p(cos t) * sin t dt for a polynomial p of degree dp
+ * (p = 1 for the SH projection, p = NLP P^_k for the wedge matrices), exactly:
+ *   mu even: the integrand is a polynomial in z = cos t: Int_{cos theta1}^{cos theta0} dz;
+ *   mu odd:  it is sin^2 t * R(cos t) with R polynomial, and Int cos^k sin^2 = C_k - C_(k+2). */
+static double ns_alp_band_integral(int l, int mu, const double *p, int dp, double theta0,
+                                   double theta1)
+{
+    double q[4], a[9], r[9], C0[12], C1[12], sum = 0.0;
+    int dq = l - mu, da, dr, k;
+    ns_legendre_deriv(l, mu, q);
+    da = ns_poly_one_minus_z2(mu / 2, q, dq, a);   /* (1-z^2)^floor(mu/2) d^mu P_l */
+    dr = ns_poly_mul(a, da, p, dp, r);
+    if (mu % 2 == 0) {
+        double z0 = cos(theta0), z1 = cos(theta1), p0 = z0, p1 = z1;
+        for (k = 0; k <= dr; k++) {
+            sum += r[k] * (p0 - p1) / (double)(k + 1);
+            p0 *= z0;
+            p1 *= z1;
+        }
+        return sum;
+    }
+    ns_cos_power_integrals(theta0, dr + 2, C0);
+    ns_cos_power_integrals(theta1, dr + 2, C1);
+    for (k = 0; k <= dr; k++) sum += r[k] * ((C1[k] - C1[k + 2]) - (C0[k] - C0[k + 2]));
+    return sum;
+}
+
+/* mc[p] = Int_0^1 a^p cos(c a) da and ms[p] = Int_0^1 a^p sin(c a) da, p = 0..3, c >= 0: the
+ * power series for c <= 2 (the by-parts recurrence divides by c^p and would lose digits there),
+ * the recurrence above (its error growth p!/c^p is below 1). */
+static void ns_trig_moments(double c, double *mc, double *ms)
+{
+    int p;
+    if (c <= 2.0) {
+        for (p = 0; p < 4; p++) {
+            double term = 1.0, sc = 0.0, ss = 0.0;   /* term = c^n / n! */
+            int n;
+            for (n = 0; n < 40; n++) {
+                double t = term / (double)(n + p + 1);
+                switch (n % 4) {
+                case 0: sc += t; break;
+                case 1: ss += t; break;
+                case 2: sc -= t; break;
+                default: ss -= t; break;
+                }
+                term *= c / (double)(n + 1);
+            }
+            mc[p] = sc;
+            ms[p] = ss;
+        }
+        return;
+    }
+    mc[0] = sin(c) / c;
+    ms[0] = (1.0 - cos(c)) / c;
+    for (p = 1; p < 4; p++) {
+        mc[p] = sin(c) / c - (double)p / c * ms[p - 1];
+        ms[p] = -cos(c) / c + (double)p / c * mc[p - 1];
+    }
+}
+
+/* ------------------------------------------------------------------------ 3. SH operations */
+
+hfvis_status hfvis_sh_rotate_z(const double in[16], double angle_rad, double out[16])
+{
+    double t[NS_SH_N];
+    int l, m, i;
+    if (in == NULL || out == NULL || !isfinite(angle_rad)) return HFVIS_ERR_INVALID_ARGUMENT;
+    for (i = 0; i < NS_SH_N; i++) t[i] = in[i];
+    /* spec B.6: active rotation f'(phi) = f(phi - a); the (m, -m) pair turns by m a */
+    for (m = 1; m <= 3; m++) {
+        double c = cos((double)m * angle_rad), s = sin((double)m * angle_rad);
+        for (l = m; l <= 3; l++) {
+            int ip = l * (l + 1) + m, im = l * (l + 1) - m;
+            double cp = t[ip], cm = t[im];
+            t[ip] = cp * c - cm * s;
+            t[im] = cp * s + cm * c;
+        }
+    }
+    for (i = 0; i < NS_SH_N; i++) out[i] = t[i];
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_sh_dot(const double a[16], const double b[16], double *out)
+{
+    double s = 0.0;
+    int i;
+    if (a == NULL || b == NULL || out == NULL) return HFVIS_ERR_INVALID_ARGUMENT;
+    for (i = 0; i < NS_SH_N; i++) s += a[i] * b[i];
+    *out = s;
+    return HFVIS_OK;
+}
+
+/* Gauss-Legendre nodes and weights on [-1, 1], 8 points (exact to degree 15). */
+static const double ns_gl8_x[8] = {
+    -0.96028985649753623168, -0.79666647741362673959, -0.52553240991632898582,
+    -0.18343464249564980494, 0.18343464249564980494, 0.52553240991632898582,
+    0.79666647741362673959, 0.96028985649753623168};
+static const double ns_gl8_w[8] = {
+    0.10122853629037625915, 0.22238103445337447054, 0.31370664587788728734,
+    0.36268378337836198297, 0.36268378337836198297, 0.31370664587788728734,
+    0.22238103445337447054, 0.10122853629037625915};
+
+/* Smallest |Gamma| kept (the non-zero entries are >= 0.058; the quadrature's rounding noise on
+ * the zero ones is ~1e-17). */
+#define NS_GAMMA_ZERO 1e-12
+
+hfvis_status hfvis_sh_product_tensor(double *gamma)
+{
+    /* spec B.7: Gamma_ijk = Int Y_i Y_j Y_k. The integrand is a trigonometric polynomial of
+     * degree <= 9 in phi (uniform 16-point rule exact) and, once phi is integrated, a
+     * polynomial of degree <= 9 in z (8-point Gauss-Legendre exact to degree 15). */
+    int a, b, i, j, k;
+    if (gamma == NULL) return HFVIS_ERR_INVALID_ARGUMENT;
+    for (i = 0; i < NS_SH_N * NS_SH_N * NS_SH_N; i++) gamma[i] = 0.0;
+    /* accumulate i <= j <= k only, then copy to the 6 permutations: exactly symmetric */
+    for (a = 0; a < 8; a++) {
+        double z = ns_gl8_x[a], s = sqrt(1.0 - z * z);
+        for (b = 0; b < 16; b++) {
+            double phi = NS_TWO_PI * (double)b / 16.0, Y[NS_SH_N];
+            double w = ns_gl8_w[a] * NS_TWO_PI / 16.0;
+            ns_sh_eval_unit(s * cos(phi), s * sin(phi), z, Y);
+            for (i = 0; i < NS_SH_N; i++)
+                for (j = i; j < NS_SH_N; j++) {
+                    double wij = w * Y[i] * Y[j];
+                    for (k = j; k < NS_SH_N; k++) gamma[(i * NS_SH_N + j) * NS_SH_N + k] += wij * Y[k];
+                }
+        }
+    }
+    for (i = 0; i < NS_SH_N; i++)
+        for (j = i; j < NS_SH_N; j++)
+            for (k = j; k < NS_SH_N; k++) {
+                double g = gamma[(i * NS_SH_N + j) * NS_SH_N + k];
+                if (fabs(g) < NS_GAMMA_ZERO) g = 0.0;
+                gamma[(i * NS_SH_N + j) * NS_SH_N + k] = g;
+                gamma[(i * NS_SH_N + k) * NS_SH_N + j] = g;
+                gamma[(j * NS_SH_N + i) * NS_SH_N + k] = g;
+                gamma[(j * NS_SH_N + k) * NS_SH_N + i] = g;
+                gamma[(k * NS_SH_N + i) * NS_SH_N + j] = g;
+                gamma[(k * NS_SH_N + j) * NS_SH_N + i] = g;
+            }
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_sh_product(const double *gamma, const double a[16], const double b[16],
+                              double out[16])
+{
+    double t[NS_SH_N];
+    int i, j, k;
+    if (gamma == NULL || a == NULL || b == NULL || out == NULL) return HFVIS_ERR_INVALID_ARGUMENT;
+    for (k = 0; k < NS_SH_N; k++) t[k] = 0.0;
+    for (i = 0; i < NS_SH_N; i++) {
+        if (a[i] == 0.0) continue;
+        for (j = 0; j < NS_SH_N; j++) {
+            const double *g = gamma + (i * NS_SH_N + j) * NS_SH_N;
+            double ab = a[i] * b[j];
+            for (k = 0; k < NS_SH_N; k++)
+                if (g[k] != 0.0) t[k] += g[k] * ab;
+        }
+    }
+    for (k = 0; k < NS_SH_N; k++) out[k] = t[k];
+    return HFVIS_OK;
+}
+
+static int ns_ahat_valid(const double *Ahat)
+{
+    int l;
+    for (l = 0; l < NS_NLP_N; l++)
+        if (!isfinite(Ahat[l])) return 0;
+    return 1;
+}
+
+hfvis_status hfvis_sh_convolve_zh(const double in[16], const double Ahat[4], double out[16])
+{
+    int l, i;
+    if (in == NULL || Ahat == NULL || out == NULL || !ns_ahat_valid(Ahat))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    /* Funk-Hecke: a circularly symmetric kernel scales band l by Ahat_l (spec B.7) */
+    for (l = 0; l < 4; l++)
+        for (i = l * l; i < (l + 1) * (l + 1); i++) out[i] = Ahat[l] * in[i];
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_sh_from_zh(const double Ahat[4], const double axis[3], double out[16])
+{
+    double u[3], Y[NS_SH_N];
+    int l, i;
+    if (Ahat == NULL || axis == NULL || out == NULL || !ns_ahat_valid(Ahat) || !ns_unit(axis, u))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    /* spec B.7: F_lm = Ahat_l Y_lm(a) = sqrt(4 pi/(2l+1)) z_l Y_lm(a) ([NS09] §7, [SLS05]) */
+    ns_sh_eval_unit(u[0], u[1], u[2], Y);
+    for (l = 0; l < 4; l++)
+        for (i = l * l; i < (l + 1) * (l + 1); i++) out[i] = Ahat[l] * Y[i];
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_sh_shade_zh(const double Ahat[4], const double axis[3], const double I[16],
+                               double *out)
+{
+    double F[NS_SH_N], s = 0.0;
+    int i;
+    if (I == NULL || out == NULL) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (hfvis_sh_from_zh(Ahat, axis, F) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    for (i = 0; i < NS_SH_N; i++) s += F[i] * I[i];
+    *out = s;
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_zh_diffuse(double Ahat[4])
+{
+    if (Ahat == NULL) return HFVIS_ERR_INVALID_ARGUMENT;
+    /* 2 pi Int_0^1 z P_l(z) dz: the clamped cosine's raw ZH (sqrt(pi)/2, sqrt(pi/3),
+     * sqrt(5 pi)/8, 0) of [NS09] §7 times sqrt(4 pi/(2l+1)) (spec B.7) */
+    Ahat[0] = HF_PI;
+    Ahat[1] = 2.0 * HF_PI / 3.0;
+    Ahat[2] = HF_PI / 4.0;
+    Ahat[3] = 0.0;
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_zh_phong(double S, double Ahat[4])
+{
+    int l;
+    if (Ahat == NULL || !isfinite(S) || !(S > 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
+    /* [NS09] §7 citing [RH02]: e^(-l^2/(2S)); spec B.7 erratum: these are multipliers Ahat */
+    for (l = 0; l < 4; l++) Ahat[l] = exp(-(double)(l * l) / (2.0 * S));
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_zh_cap(double half_angle_rad, double Ahat[4])
+{
+    double c, P[5];
+    int l;
+    if (Ahat == NULL || !isfinite(half_angle_rad) || half_angle_rad < 0.0 || half_angle_rad > HF_PI)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    /* spec B.8: Ahat_l = 2 pi Int_c^1 P_l = 2 pi (P_(l-1)(c) - P_(l+1)(c))/(2l+1), P_-1 := 1 */
+    c = cos(half_angle_rad);
+    P[0] = 1.0;
+    P[1] = c;
+    P[2] = (3.0 * c * c - 1.0) / 2.0;
+    P[3] = (5.0 * c * c - 3.0) * c / 2.0;
+    P[4] = ((35.0 * c * c - 30.0) * c * c + 3.0) / 8.0;
+    Ahat[0] = NS_TWO_PI * (1.0 - c);
+    for (l = 1; l < 4; l++) Ahat[l] = NS_TWO_PI * (P[l - 1] - P[l + 1]) / (double)(2 * l + 1);
+    return HFVIS_OK;
+}
+
+/* ------------------------------------------------- 4. lat-long environment projection (B.8) */
+
+/* Columns whose phi-integrals are held at once (a block of 64 x 7 doubles on the stack): the
+ * trigonometric calls then cost O(n_phi) per map and the theta-integrals O(n_theta) per block. */
+#define NS_ENV_BLOCK 64
+
+/* Phi-integrals of Phi_m over the columns p0 .. p0+nb-1 of a map with P columns (column p is
+ * [2 pi p/P, 2 pi (p+1)/P]): F[b][m + 3], m = -3..3. Each edge's sines and cosines are taken once
+ * and shared by the two columns that meet there. */
+static void ns_env_phi_block(int p0, int nb, int P, double (*F)[7])
+{
+    double sl[3], cl[3], sr[3], cr[3], phl, phr;
+    int b, m;
+    phl = NS_TWO_PI * (double)p0 / (double)P;
+    for (m = 1; m <= 3; m++) {
+        sl[m - 1] = sin((double)m * phl);
+        cl[m - 1] = cos((double)m * phl);
+    }
+    for (b = 0; b < nb; b++) {
+        phr = NS_TWO_PI * (double)(p0 + b + 1) / (double)P;
+        F[b][3] = phr - phl;
+        for (m = 1; m <= 3; m++) {
+            sr[m - 1] = sin((double)m * phr);
+            cr[m - 1] = cos((double)m * phr);
+            F[b][3 + m] = NS_SQRT2 * (sr[m - 1] - sl[m - 1]) / (double)m;
+            F[b][3 - m] = NS_SQRT2 * (cl[m - 1] - cr[m - 1]) / (double)m;
+            sl[m - 1] = sr[m - 1];
+            cl[m - 1] = cr[m - 1];
+        }
+        phl = phr;
+    }
+}
+
+hfvis_status hfvis_sh_project_env(const hfvis_env *env, double *out)
+{
+    static const double one[1] = {1.0};
+    double acc[4][NS_SH_N], F[NS_ENV_BLOCK][7];
+    size_t n;
+    int T, P, C, t, p0, nb, b, c, l, m, i;
+    if (env == NULL || out == NULL || env->radiance == NULL || env->n_theta < 1 ||
+        env->n_phi < 1 || env->channels < 1 || env->channels > 4 ||
+        !hf_mul_size((size_t)env->n_theta, (size_t)env->n_phi, &n) ||
+        !hf_mul_size(n, (size_t)env->channels, &n))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    T = env->n_theta;
+    P = env->n_phi;
+    C = env->channels;
+    for (c = 0; c < C; c++)
+        for (i = 0; i < NS_SH_N; i++) acc[c][i] = 0.0;
+    /* Int_texel Y_lm = K_l^|m| [Int Pt_l^|m|(cos t) sin t dt] [Int Phi_m dphi], both exact */
+    for (p0 = 0; p0 < P; p0 += NS_ENV_BLOCK) {
+        nb = P - p0 < NS_ENV_BLOCK ? P - p0 : NS_ENV_BLOCK;
+        ns_env_phi_block(p0, nb, P, F);
+        for (t = 0; t < T; t++) {
+            double th0 = HF_PI * (double)t / (double)T, th1 = HF_PI * (double)(t + 1) / (double)T;
+            double row[4][7], band[4][4];
+            const float *L = env->radiance + ((size_t)t * (size_t)P + (size_t)p0) * (size_t)C;
+            for (c = 0; c < C; c++)
+                for (m = 0; m < 7; m++) row[c][m] = 0.0;
+            for (b = 0; b < nb; b++)
+                for (c = 0; c < C; c++) {
+                    double v = (double)L[(size_t)b * (size_t)C + (size_t)c];
+                    for (m = 0; m < 7; m++) row[c][m] += v * F[b][m];
+                }
+            for (l = 0; l < 4; l++)
+                for (m = 0; m <= l; m++)
+                    band[l][m] = ns_sh_norm(l, m) * ns_alp_band_integral(l, m, one, 0, th0, th1);
+            for (c = 0; c < C; c++)
+                for (l = 0; l < 4; l++)
+                    for (m = -l; m <= l; m++)
+                        acc[c][l * (l + 1) + m] += band[l][m < 0 ? -m : m] * row[c][m + 3];
+        }
+    }
+    for (c = 0; c < C; c++)
+        for (i = 0; i < NS_SH_N; i++) out[c * NS_SH_N + i] = acc[c][i];
+    return HFVIS_OK;
+}
+
+/* ------------------------------------------------------- 5. normalized Legendre polynomials */
+
+/* sqrt((2l+1)/2), the NLP normalisation (spec B.3). */
+#define NS_NLP0 0.70710678118654752440   /* sqrt(1/2) */
+#define NS_NLP1 1.22474487139158904910   /* sqrt(3/2) */
+#define NS_NLP2 1.58113883008418966600   /* sqrt(5/2) */
+#define NS_NLP3 1.87082869338697069279   /* sqrt(7/2) */
+
+/* Ascending coefficients of P^_k (degree k), spec B.3 erratum (sqrt10/4, sqrt14/4). */
+static void ns_nlp_poly(int k, double q[4])
+{
+    static const double norm[4] = {NS_NLP0, NS_NLP1, NS_NLP2, NS_NLP3};
+    int i;
+    ns_legendre_deriv(k, 0, q);
+    for (i = 0; i < 4; i++) q[i] *= norm[k];
+}
+
+hfvis_status hfvis_nlp_eval(double z, double P[4])
+{
+    if (P == NULL || !isfinite(z) || z < -1.0 || z > 1.0) return HFVIS_ERR_INVALID_ARGUMENT;
+    P[0] = NS_NLP0;
+    P[1] = NS_NLP1 * z;
+    P[2] = NS_NLP2 * (3.0 * z * z - 1.0) / 2.0;
+    P[3] = NS_NLP3 * (5.0 * z * z - 3.0) * z / 2.0;
+    return HFVIS_OK;
+}
+
+/* vbar(sigma) = Int_{-1}^{sin sigma} P^(z) dz ([NS09] Eq. 10 with the limits of spec B.3),
+ * from Int_{-1}^s P_l = (P_(l+1)(s) - P_(l-1)(s))/(2l+1); sigma is clamped to [-pi/2, pi/2]. */
+static void ns_vbar(double sigma, double *v)
+{
+    double s, s2;
+    if (sigma <= -HF_HALF_PI) s = -1.0;
+    else if (sigma >= HF_HALF_PI) s = 1.0;
+    else s = sin(sigma);
+    s2 = s * s;
+    v[0] = NS_NLP0 * (s + 1.0);
+    v[1] = NS_NLP1 * (s2 - 1.0) / 2.0;
+    v[2] = NS_NLP2 * (s2 - 1.0) * s / 2.0;
+    v[3] = NS_NLP3 * (5.0 * s2 - 1.0) * (s2 - 1.0) / 8.0;
+}
+
+hfvis_status hfvis_nlp_occlusion(double sigma_rad, double out[4])
+{
+    if (out == NULL || !isfinite(sigma_rad)) return HFVIS_ERR_INVALID_ARGUMENT;
+    ns_vbar(sigma_rad, out);
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_nlp_visibility(double omega_lo_rad, double omega_hi_rad, double out[4])
+{
+    double lo, hi, a[4], b[4];
+    int k;
+    if (out == NULL || !isfinite(omega_lo_rad) || !isfinite(omega_hi_rad))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    lo = omega_lo_rad < -HF_HALF_PI ? -HF_HALF_PI : omega_lo_rad;
+    hi = omega_hi_rad > HF_HALF_PI ? HF_HALF_PI : omega_hi_rad;
+    if (!(hi > lo)) {
+        for (k = 0; k < 4; k++) out[k] = 0.0;
+        return HFVIS_OK;
+    }
+    /* [NS09] Eq. 11, and §6's restriction to [l_min, l_max] */
+    ns_vbar(hi, b);
+    ns_vbar(lo, a);
+    for (k = 0; k < 4; k++) out[k] = b[k] - a[k];
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_nlp_radiance(int K, const double *omega_rad, const double *u,
+                                double omega_min_rad, double out[4])
+{
+    double c[4], v[4];
+    int i, k;
+    if (out == NULL || K < 0 || !isfinite(omega_min_rad) ||
+        (K > 0 && (omega_rad == NULL || u == NULL)))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    for (i = 0; i < K; i++)
+        if (!isfinite(omega_rad[i]) || !isfinite(u[i]) ||
+            omega_rad[i] < (i == 0 ? omega_min_rad : omega_rad[i - 1]))
+            return HFVIS_ERR_INVALID_ARGUMENT;
+    for (k = 0; k < 4; k++) c[k] = 0.0;
+    /* [NS09] Eq. 12 with the errata of spec B.3: the integral covers z in [-1, 1] and
+     * u(t_(i+1)) = 0 once i + 1 >= |T| */
+    for (i = 0; i < K; i++) {
+        double du = u[i] - (i + 1 < K ? u[i + 1] : 0.0);
+        ns_vbar(omega_rad[i], v);
+        for (k = 0; k < 4; k++) c[k] += du * v[k];
+    }
+    if (K > 0) {
+        ns_vbar(omega_min_rad, v);
+        for (k = 0; k < 4; k++) c[k] -= u[0] * v[k];
+    }
+    for (k = 0; k < 4; k++) out[k] = c[k];
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_nlp_reconstruct(const double c[4], double omega_rad, double *out)
+{
+    double P[4];
+    if (c == NULL || out == NULL || !isfinite(omega_rad)) return HFVIS_ERR_INVALID_ARGUMENT;
+    /* [NS09] Eq. 13 with z = cos theta = sin omega */
+    (void)hfvis_nlp_eval(sin(omega_rad), P);
+    *out = c[0] * P[0] + c[1] * P[1] + c[2] * P[2] + c[3] * P[3];
+    return HFVIS_OK;
+}
+
+/* -------------------------------------------------------- 6. Appendix-A wedge matrices (B.6) */
+
+/* Ascending coefficients in alpha of the interpolation kernels beta_s (spec B.6). */
+static const double ns_beta_lin[2][4] = {{1.0, -1.0, 0.0, 0.0}, {0.0, 1.0, 0.0, 0.0}};
+static const double ns_beta_bspl[4][4] = {
+    {1.0 / 6.0, -3.0 / 6.0, 3.0 / 6.0, -1.0 / 6.0},   /* (1-a)^3/6 */
+    {4.0 / 6.0, 0.0, -6.0 / 6.0, 3.0 / 6.0},          /* (3a^3 - 6a^2 + 4)/6 */
+    {1.0 / 6.0, 3.0 / 6.0, 3.0 / 6.0, -3.0 / 6.0},    /* (-3a^3 + 3a^2 + 3a + 1)/6 */
+    {0.0, 0.0, 0.0, 1.0 / 6.0}};                      /* a^3/6 */
+
+int hfvis_ns_wedge_columns(hfvis_ns_interp interp)
+{
+    if (interp == HFVIS_NS_INTERP_DEFAULT || interp == HFVIS_NS_INTERP_LINEAR) return 8;
+    if (interp == HFVIS_NS_INTERP_BSPLINE) return 16;
+    return 0;
+}
+
+hfvis_status hfvis_ns_wedge_matrix(hfvis_ns_interp interp, double dphi_rad, double *M)
+{
+    /* spec B.6 separable closed form: M[(l,m); (s,k)] = K_l^|m| A_(l,|m|,k) B_(m,s)(D) with
+     * A = Int_{-1}^{1} Pt_l^|m| P^_k dz (exact, section 2) and
+     * B = Int_0^D beta_s(phi/D) Phi_m(phi) dphi = D Sum_p beta_(s,p) Int_0^1 a^p Phi_m(D a) da. */
+    const double (*beta)[4];
+    double A[4][4][4], Bm[7][4], q[4];
+    int ns, cols, l, mu, k, m, s, p;
+    cols = hfvis_ns_wedge_columns(interp);
+    if (M == NULL || cols == 0 || !isfinite(dphi_rad) || !(dphi_rad > 0.0) ||
+        dphi_rad > NS_TWO_PI)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    ns = cols / 4;
+    beta = ns == 2 ? ns_beta_lin : ns_beta_bspl;
+    for (l = 0; l < 4; l++)
+        for (mu = 0; mu <= l; mu++)
+            for (k = 0; k < 4; k++) {
+                ns_nlp_poly(k, q);
+                A[l][mu][k] = ns_alp_band_integral(l, mu, q, k, 0.0, HF_PI);
+            }
+    for (m = -3; m <= 3; m++) {
+        double mc[4], ms[4], mom[4];
+        int mu_ = m < 0 ? -m : m;
+        if (m == 0) {
+            for (p = 0; p < 4; p++) mom[p] = 1.0 / (double)(p + 1);
+        } else {
+            ns_trig_moments((double)mu_ * dphi_rad, mc, ms);
+            for (p = 0; p < 4; p++) mom[p] = NS_SQRT2 * (m > 0 ? mc[p] : ms[p]);
+        }
+        for (s = 0; s < ns; s++) {
+            double b = 0.0;
+            for (p = 0; p < 4; p++) b += beta[s][p] * mom[p];
+            Bm[m + 3][s] = dphi_rad * b;
+        }
+    }
+    for (l = 0; l < 4; l++)
+        for (m = -l; m <= l; m++) {
+            int r = l * (l + 1) + m, mu_ = m < 0 ? -m : m;
+            double K = ns_sh_norm(l, mu_);
+            for (s = 0; s < ns; s++)
+                for (k = 0; k < 4; k++) M[r * cols + s * 4 + k] = K * A[l][mu_][k] * Bm[m + 3][s];
+        }
+    return HFVIS_OK;
+}
+
+static hfvis_status ns_wedges_init(hfvis_ns_wedges *set, hfvis_ns_interp interp, int m,
+                                   int full_circle, double phi0_rad, double dphi_rad)
+{
+    hfvis_ns_wedges w;
+    if (hfvis_ns_wedge_matrix(interp, dphi_rad, w.matrix) != HFVIS_OK)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    w.interp = interp == HFVIS_NS_INTERP_DEFAULT ? HFVIS_NS_INTERP_LINEAR : interp;
+    w.samples = m;
+    w.full_circle = full_circle;
+    w.phi0_rad = phi0_rad;
+    w.dphi_rad = dphi_rad;
+    *set = w;
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_ns_wedges_full(hfvis_ns_wedges *set, hfvis_ns_interp interp, int m,
+                                  double phi0_rad)
+{
+    if (set == NULL || m < 1 || !isfinite(phi0_rad)) return HFVIS_ERR_INVALID_ARGUMENT;
+    /* spec B.6 erratum on Eq. 21: a full circle has m wedges, the last one wrapping to sample 0 */
+    return ns_wedges_init(set, interp, m, 1, phi0_rad, NS_TWO_PI / (double)m);
+}
+
+hfvis_status hfvis_ns_wedges_partial(hfvis_ns_wedges *set, hfvis_ns_interp interp, int m,
+                                     double phi_a_rad, double phi_b_rad)
+{
+    if (set == NULL || m < 2 || !isfinite(phi_a_rad) || !isfinite(phi_b_rad) ||
+        !(phi_b_rad > phi_a_rad) || phi_b_rad - phi_a_rad > NS_TWO_PI)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    return ns_wedges_init(set, interp, m, 0, phi_a_rad, (phi_b_rad - phi_a_rad) / (double)(m - 1));
+}
+
+hfvis_status hfvis_ns_wedges_to_sh(const hfvis_ns_wedges *set, const double *w, double out[16])
+{
+    double acc[NS_SH_N];
+    int cols, ns, nw, m, j, s, r, i;
+    if (set == NULL || w == NULL || out == NULL) return HFVIS_ERR_INVALID_ARGUMENT;
+    cols = hfvis_ns_wedge_columns(set->interp);
+    m = set->samples;
+    if (cols == 0 || m < (set->full_circle ? 1 : 2) ||
+        !isfinite(set->phi0_rad) || !isfinite(set->dphi_rad))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    ns = cols / 4;
+    nw = set->full_circle ? m : m - 1;
+    for (i = 0; i < NS_SH_N; i++) acc[i] = 0.0;
+    for (j = 0; j < nw; j++) {
+        /* [NS09] Eq. 20 (linear: w_j, w_(j+1)) or the B-spline form (w_(j-1) .. w_(j+2)), indices
+         * wrapped on a full circle and clamped to the end samples otherwise (spec B.6) */
+        double x[16], Wj[NS_SH_N], R[NS_SH_N];
+        for (s = 0; s < ns; s++) {
+            int idx = j + s - (ns == 4 ? 1 : 0);
+            const double *src;
+            if (set->full_circle) idx = ((idx % m) + m) % m;
+            else idx = idx < 0 ? 0 : (idx > m - 1 ? m - 1 : idx);
+            src = w + (size_t)idx * 4u;
+            for (i = 0; i < 4; i++) x[s * 4 + i] = src[i];
+        }
+        for (r = 0; r < NS_SH_N; r++) {
+            double v = 0.0;
+            for (i = 0; i < cols; i++) v += set->matrix[r * cols + i] * x[i];
+            Wj[r] = v;
+        }
+        /* Eq. 21: rotate the canonical wedge [0, D] to [phi_j, phi_j + D] */
+        (void)hfvis_sh_rotate_z(Wj, set->phi0_rad + (double)j * set->dphi_rad, R);
+        for (r = 0; r < NS_SH_N; r++) acc[r] += R[r];
+    }
+    for (r = 0; r < NS_SH_N; r++) out[r] = acc[r];
+    return HFVIS_OK;
+}
+
+/* ------------------------------------------------- 7. tangent-plane minimum blocking angle */
+
+hfvis_status hfvis_ns_min_blocking_angle(const double normal[3], double phi_rad,
+                                         hfvis_ns_omega_min form, double *out)
+{
+    double n[3], d;
+    if (normal == NULL || out == NULL || !isfinite(phi_rad) || !ns_unit(normal, n) ||
+        (form != HFVIS_NS_OMEGA_MIN_DEFAULT && form != HFVIS_NS_OMEGA_MIN_EXACT &&
+         form != HFVIS_NS_OMEGA_MIN_PAPER))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    d = n[0] * cos(phi_rad) + n[1] * sin(phi_rad);
+    if (form == HFVIS_NS_OMEGA_MIN_PAPER) {
+        /* [NS09] §3 as printed: exact only when N lies in the slice's vertical plane */
+        if (d > 1.0) d = 1.0;
+        if (d < -1.0) d = -1.0;
+        *out = -asin(d);
+    } else {
+        /* spec B.2 erratum: the tangent plane's horizon in azimuth phi */
+        *out = atan2(-d, n[2]);
     }
     return HFVIS_OK;
 }

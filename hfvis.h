@@ -796,6 +796,245 @@ HFVIS_API hfvis_status hfvis_viewshed_reference(const hfvis_grid *grid, double o
                                                 ptrdiff_t out_stride);
 
 /* ========================================================================================== */
+/* hfvis.c - Nowrouzezahrai-Snyder GI, math layer ([NS09] §4, §6, §7, App. A; spec GI B.2-B.8) */
+/* ========================================================================================== */
+/* [NS09] D. Nowrouzezahrai, J. Snyder, "Fast Global Illumination on Dynamic Height Fields",
+ * CGF 28(4), 2009. "spec GI" is spec/raycast-ao-and-hf-gi.md part B, which fixes its errata.
+ *
+ * Spherical harmonics (SH). Order 4: 16 real, orthonormal coefficients, index l(l+1)+m
+ *   (l = 0..3, m = -l..l), NO Condon-Shortley phase: Y_1,-1 = +0.4886 y, Y_1,0 = +0.4886 z,
+ *   Y_1,1 = +0.4886 x. Directions are in the grid's world frame (x east = increasing column,
+ *   y = increasing row, z up); the azimuth phi is measured like psi (from +x toward +y) and theta
+ *   from +z. Separable form: Y_lm = K_l^|m| Pt_l^|m|(cos theta) Phi_m(phi) with
+ *   Pt_l^mu = (1-z^2)^(mu/2) d^mu P_l/dz^mu, Phi_m = sqrt2 cos(m phi) (m > 0), 1 (m = 0),
+ *   sqrt2 sin(|m| phi) (m < 0). Tables in spec GI (A, M_lin, M_bspl, Cartesian constants) use the
+ *   Condon-Shortley phase: their entries with odd |m| have the opposite sign here.
+ * Zonal lobes are stored as convolution multipliers Ahat_l = sqrt(4 pi/(2l+1)) z_l (z_l the raw
+ *   ZH coefficients Int g Y_l0), for every lobe (spec GI B.7 erratum on the Phong vector).
+ * Normalized Legendre polynomials (NLP): P^_l(z) = sqrt((2l+1)/2) P_l(z), orthonormal on
+ *   [-1, 1], l = 0..3, with the corrected constants of spec GI B.3 (sqrt10/4 and sqrt14/4, not the
+ *   5 sqrt2/4 and 7 sqrt2/4 printed in [NS09] §4). Along a slice the variable is
+ *   z = cos theta = sin omega, omega the elevation (blocking angle) above the horizontal plane.
+ * Precision. Everything here is double: these are the building blocks of the GI pipeline and of
+ *   the checks a port makes against it. All functions are pure (no allocation, no state) and
+ *   return HFVIS_ERR_INVALID_ARGUMENT, with the outputs untouched, for a NULL pointer or a
+ *   non-finite or out-of-range parameter. */
+
+#define HFVIS_SH_COEFFS 16   /* order-4 SH vector length */
+#define HFVIS_NLP_COEFFS 4   /* order-4 NLP vector length */
+
+/* Evaluate the 16 SH basis functions at a direction.
+ * dir need not be unit length (it is normalised); Y receives Y_i(dir), i = l(l+1)+m.
+ * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL, a non-finite or zero dir.
+ * Cost: about 40 flops. */
+HFVIS_API hfvis_status hfvis_sh_eval(const double dir[3], double Y[16]);
+
+/* Rotate an SH vector about +z by angle_rad (active, counter-clockwise seen from +z, i.e. from
+ * +x toward +y): the result f' satisfies f'(R_z(a) d) = f(d), i.e. f'(theta, phi) =
+ * f(theta, phi - a). Each pair (l, +m), (l, -m) turns by m*a (spec GI B.6):
+ *   c'_(+m) = c_(+m) cos(ma) - c_(-m) sin(ma),  c'_(-m) = c_(+m) sin(ma) + c_(-m) cos(ma);
+ * m = 0 coefficients are unchanged. [NS09] Eq. 21 uses it to place each wedge.
+ * out may equal in. Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL or a non-finite
+ * angle. Cost: 6 trigonometric calls and 24 multiply-adds. */
+HFVIS_API hfvis_status hfvis_sh_rotate_z(const double in[16], double angle_rad, double out[16]);
+
+/* *out = Sum_i a_i b_i, the integral over the sphere of the product of the two functions
+ * ([NS09] §7 "double product integral"). Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL. */
+HFVIS_API hfvis_status hfvis_sh_dot(const double a[16], const double b[16], double *out);
+
+/* Fill the SH triple-product tensor gamma[(i*16 + j)*16 + k] = Int Y_i Y_j Y_k dw (spec GI B.7),
+ * HFVIS_SH_COEFFS^3 = 4096 doubles. Computed exactly (up to rounding) with an 8-point
+ * Gauss-Legendre rule in z and a 16-point uniform rule in phi; entries below 1e-12 in magnitude
+ * are set to exactly 0 (the true non-zeros are >= 0.058), which leaves 353 non-zeros.
+ * Build it once and pass it to hfvis_sh_product. Returns HFVIS_OK, or
+ * HFVIS_ERR_INVALID_ARGUMENT if gamma is NULL. Cost: about 0.5 M multiply-adds, no allocation. */
+HFVIS_API hfvis_status hfvis_sh_product_tensor(double *gamma);
+
+/* SH product truncated to order 4: out_k = Sum_ij gamma_ijk a_i b_j, the projection of the
+ * pointwise product of the two functions ([NS09] §7: incident radiance = L * V). gamma comes
+ * from hfvis_sh_product_tensor. out may equal a or b. Returns HFVIS_OK, or
+ * HFVIS_ERR_INVALID_ARGUMENT for NULL. Cost: at most 4096 multiply-adds (zeros skipped). */
+HFVIS_API hfvis_status hfvis_sh_product(const double *gamma, const double a[16],
+                                        const double b[16], double out[16]);
+
+/* Convolve an SH vector with a zonal lobe given by its multipliers Ahat (Funk-Hecke):
+ * out_lm = Ahat_l in_lm. With the diffuse Ahat, evaluating out at N gives the irradiance
+ * E(N) = Int L(w) max(N.w, 0) dw. out may equal in. Returns HFVIS_OK, or
+ * HFVIS_ERR_INVALID_ARGUMENT for NULL or a non-finite Ahat. */
+HFVIS_API hfvis_status hfvis_sh_convolve_zh(const double in[16], const double Ahat[4],
+                                            double out[16]);
+
+/* Rotate a zonal lobe to an axis: out_lm = Ahat_l Y_lm(axis) = sqrt(4 pi/(2l+1)) z_l Y_lm(axis)
+ * ([NS09] §7 F(w_o), spec GI B.7). axis need not be unit length. Then Sum out_i I_i is the lobe
+ * applied to the incident radiance I. Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL, a
+ * non-finite Ahat or a non-finite or zero axis. */
+HFVIS_API hfvis_status hfvis_sh_from_zh(const double Ahat[4], const double axis[3],
+                                        double out[16]);
+
+/* Shade: *out = Sum_lm Ahat_l Y_lm(axis) I_lm ([NS09] §7: F(w_o) . I). With the diffuse Ahat and
+ * axis = N this is the irradiance E(N); the library's exit radiance is (albedo/pi) E (spec GI
+ * B.7 [choice]: [NS09] omits albedo/pi). With the Phong Ahat and axis = reflect(view, N) it is
+ * the reflected radiance of a lobe with unit specular albedo. Errors as hfvis_sh_from_zh. */
+HFVIS_API hfvis_status hfvis_sh_shade_zh(const double Ahat[4], const double axis[3],
+                                         const double I[16], double *out);
+
+/* The clamped-cosine (diffuse) lobe: Ahat = (pi, 2pi/3, pi/4, 0), from the raw ZH
+ * (sqrt(pi)/2, sqrt(pi/3), sqrt(5 pi)/8, 0) = (0.886227, 1.02333, 0.495416, 0) of [NS09] §7.
+ * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT if Ahat is NULL. */
+HFVIS_API hfvis_status hfvis_zh_diffuse(double Ahat[4]);
+
+/* The Phong lobe of exponent S ([NS09] §7 citing Ramamoorthi-Hanrahan 2002):
+ * Ahat_l = exp(-l^2/(2S)). These are the multipliers of the normalised lobe
+ * ((S+1)/(2 pi)) cos^S about the reflection vector (spec GI B.7 erratum; Ahat_0 = 1, so a uniform
+ * unit environment reflects 1), in the Gaussian approximation of [RH02], accurate for large S.
+ * S > 0 and finite. Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL or a bad S. */
+HFVIS_API hfvis_status hfvis_zh_phong(double S, double Ahat[4]);
+
+/* The indicator of a circular cap of angular radius half_angle_rad in [0, pi] about +z
+ * (spec GI B.8 key lights): Ahat_l = 2 pi Int_c^1 P_l(z) dz, c = cos(half_angle); Ahat_0 is the
+ * cap's solid angle 2 pi (1 - c). A uniform cap of radiance L0 about axis a is L0 times
+ * hfvis_sh_from_zh(Ahat, a). Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL or a
+ * half-angle outside [0, pi] or non-finite. */
+HFVIS_API hfvis_status hfvis_zh_cap(double half_angle_rad, double Ahat[4]);
+
+/* Project a lat-long environment (hfvis_env: row t = theta in [pi t/T, pi (t+1)/T) from the
+ * zenith, column p = phi in [2 pi p/P, 2 pi (p+1)/P)) onto the SH basis:
+ * out[c*16 + i] = Sum_texels L_c Int_texel Y_i dw, channel c in 0..channels-1 (16*channels
+ * doubles). Radiance is constant within a texel (the hfvis_env convention), and each texel's
+ * integral is exact: Int Phi_m dphi in closed form, and Int Pt_l^mu(cos t) sin t dt as a
+ * polynomial antiderivative in z = cos t (even mu) or through Int cos^k t sin^2 t dt (odd mu) -
+ * no quadrature, so a constant map L gives out_0 = 2 sqrt(pi) L and 0 elsewhere up to rounding
+ * (spec GI B.8 suggests sin(theta) dtheta dphi texel weights instead; those are only
+ * approximate). Non-finite radiance propagates into the output.
+ * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL (env, env->radiance, out), n_theta or
+ * n_phi < 1, channels outside 1..4, or a texel count that overflows size_t.
+ * Cost: O(n_theta*n_phi*channels*7) multiply-adds, 6 trigonometric calls per column and 4 per
+ * row and block of 64 columns. No allocation. */
+HFVIS_API hfvis_status hfvis_sh_project_env(const hfvis_env *env, double *out);
+
+/* Evaluate the 4 NLPs at z in [-1, 1]: P = (1/sqrt2, sqrt(3/2) z, (sqrt10/4)(3z^2 - 1),
+ * (sqrt14/4)(5z^3 - 3z)) ([NS09] §4 with the spec GI B.3 erratum). Returns HFVIS_OK, or
+ * HFVIS_ERR_INVALID_ARGUMENT for NULL or z non-finite or outside [-1, 1]. */
+HFVIS_API hfvis_status hfvis_nlp_eval(double z, double P[4]);
+
+/* Occlusion vector vbar(sigma) = Int_{-1}^{sin sigma} P^(z) dz ([NS09] Eq. 10, limits as in spec
+ * GI B.3): the NLP projection of the step that is 1 for elevations omega <= sigma. Closed form
+ * with s = sin sigma: ((s+1)/sqrt2, sqrt(3/2)(s^2-1)/2, sqrt(5/2)(s^3-s)/2,
+ * sqrt(7/2)(5s^4-6s^2+1)/8). sigma_rad is clamped to [-pi/2, pi/2] (vbar(-pi/2) = 0,
+ * vbar(pi/2) = (sqrt2, 0, 0, 0)). Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL or a
+ * non-finite sigma. */
+HFVIS_API hfvis_status hfvis_nlp_occlusion(double sigma_rad, double out[4]);
+
+/* Visibility vector of the elevation interval (omega_lo, omega_hi], both clamped to
+ * [-pi/2, pi/2]: vbar(hi) - vbar(lo) if hi > lo, else 0.
+ *   [NS09] Eq. 11 (environment): lo = omega_max, hi = pi/2.
+ *   [NS09] §6 (key light with elevation range [l_min, l_max]): lo = max(omega_max, l_min),
+ *   hi = l_max. Clamping below the tangent plane is the caller's choice: lo = max(omega_max,
+ *   omega_min) (spec GI B.3 [choice]).
+ * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL or a non-finite angle. */
+HFVIS_API hfvis_status hfvis_nlp_visibility(double omega_lo_rad, double omega_hi_rad,
+                                            double out[4]);
+
+/* NLP vector of the indirect radiance along one slice ([NS09] Eq. 8 and 12 with the spec GI B.3
+ * errata: the integral covers z in [-1, 1], u(t_(i+1)) = 0 once i+1 >= |T|):
+ *   u(omega) = u[k] for omega_rad[k-1] <= omega < omega_rad[k] (omega_rad[-1] := omega_min_rad),
+ *   0 below omega_min and above omega_rad[K-1];
+ *   out = Sum_k (u[k] - u[k+1]) vbar(omega_rad[k]) - u[0] vbar(omega_min), u[K] := 0.
+ * K is the casting-set size (>= 0; K = 0 gives 0 and the arrays may be NULL); omega_rad holds its
+ * blocking angles in increasing t, which must be non-decreasing and >= omega_min_rad; u holds one
+ * channel of exit radiance per element (call once per channel). Angles are clamped to
+ * [-pi/2, pi/2] as in hfvis_nlp_occlusion. Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL,
+ * K < 0, a non-finite value or a decreasing angle sequence. Cost: O(K). */
+HFVIS_API hfvis_status hfvis_nlp_radiance(int K, const double *omega_rad, const double *u,
+                                          double omega_min_rad, double out[4]);
+
+/* Reconstruct an elevation function from its NLP vector: *out = c . P^(sin omega)
+ * ([NS09] Eq. 13). The order-4 truncation rings (spec GI B.3: values < 0 or > 1 occur).
+ * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL or a non-finite omega. */
+HFVIS_API hfvis_status hfvis_nlp_reconstruct(const double c[4], double omega_rad, double *out);
+
+/* Azimuthal interpolation of the NLP vectors across a wedge ([NS09] §6, App. A). */
+typedef enum hfvis_ns_interp {
+    HFVIS_NS_INTERP_DEFAULT = 0,  /* = LINEAR */
+    HFVIS_NS_INTERP_LINEAR = 1,   /* (1-a) w_j + a w_(j+1): M_lin is 16x8 ([NS09] Eq. 20, 24) */
+    HFVIS_NS_INTERP_BSPLINE = 2   /* uniform cubic B-spline on w_(j-1)..w_(j+2): M_bspl is 16x16
+                                     (spec GI B.6 erratum: not the 16x32 of [NS09] §1) */
+} hfvis_ns_interp;
+
+/* Largest wedge matrix, in doubles (16x16). */
+#define HFVIS_NS_WEDGE_MATRIX_MAX 256
+
+/* Columns of the wedge matrix: 8 (linear, default) or 16 (B-spline); 0 for an unknown value. */
+HFVIS_API int hfvis_ns_wedge_columns(hfvis_ns_interp interp);
+
+/* The Appendix-A wedge matrix for a wedge of width dphi_rad in (0, 2 pi], row-major,
+ * M[r*cols + s*4 + k], r = SH index, s = sample of the wedge (0..1 linear: w_j, w_(j+1);
+ * 0..3 B-spline: w_(j-1), w_j, w_(j+1), w_(j+2)), k = NLP index. The wedge is canonical,
+ * phi in [0, dphi], alpha = phi/dphi (spec GI B.6 erratum on Eq. 18), so
+ *   M[(l,m); (s,k)] = Int_0^dphi Int_0^pi beta_s(alpha) P^_k(cos t) Y_lm(t, phi) sin t dt dphi.
+ * Derivation (spec GI B.6 separable form, computed at run time, no table):
+ * M = K_l^|m| A_(l,|m|,k) B_(m,s)(dphi) with A = Int_{-1}^{1} Pt_l^|m| P^_k dz from exact
+ * polynomial / Int cos^k sin^2 antiderivatives, and B = Int_0^dphi beta_s(phi/dphi) Phi_m(phi)
+ * dphi from the moments Int_0^1 a^p cos(c a) da, Int_0^1 a^p sin(c a) da (power series for
+ * c <= 2, integration by parts above). Each m = 0 row (l, 0) of M_lin is dphi/(2 sqrt(2 pi)) at
+ * the columns (s, k = l) and 0 elsewhere (spec GI B.13-13).
+ * M must hold 16*hfvis_ns_wedge_columns(interp) doubles. Returns HFVIS_OK, or
+ * HFVIS_ERR_INVALID_ARGUMENT for NULL, an unknown interp, or dphi non-finite or outside (0, 2 pi].
+ * Cost: about 2000 flops and 12 trigonometric calls. */
+HFVIS_API hfvis_status hfvis_ns_wedge_matrix(hfvis_ns_interp interp, double dphi_rad, double *M);
+
+/* A set of m azimuthal samples phi_j = phi0_rad + j*dphi_rad and its wedge matrix. Fill it with
+ * hfvis_ns_wedges_full or hfvis_ns_wedges_partial; it holds no pointers and may be copied. */
+typedef struct hfvis_ns_wedges {
+    hfvis_ns_interp interp;    /* LINEAR or BSPLINE (DEFAULT is resolved to LINEAR) */
+    int samples;               /* m */
+    int full_circle;           /* 1: m wedges, the last one from phi_(m-1) back to phi_0 */
+    double phi0_rad;           /* azimuth of sample 0 */
+    double dphi_rad;           /* wedge width */
+    double matrix[HFVIS_NS_WEDGE_MATRIX_MAX];  /* hfvis_ns_wedge_matrix(interp, dphi_rad) */
+} hfvis_ns_wedges;
+
+/* Full circle (environment visibility, indirect radiance): m >= 1 samples, dphi = 2 pi/m,
+ * m wedges including the wrap-around wedge (spec GI B.6 erratum: [NS09] Eq. 21's sum to m-1 is
+ * the partial case). B-spline indices wrap modulo m. Returns HFVIS_OK, or
+ * HFVIS_ERR_INVALID_ARGUMENT for NULL, m < 1, an unknown interp or a non-finite phi0. */
+HFVIS_API hfvis_status hfvis_ns_wedges_full(hfvis_ns_wedges *set, hfvis_ns_interp interp, int m,
+                                            double phi0_rad);
+
+/* Partial extent [phi_a, phi_b] (key lights, [NS09] §6): m >= 2 samples, dphi =
+ * (phi_b - phi_a)/(m-1), m-1 wedges; B-spline indices are clamped to the end samples (spec GI
+ * B.6 [choice]). phi_b > phi_a and phi_b - phi_a <= 2 pi (an extent crossing 0 is given as, e.g.,
+ * [-0.3, 0.2]). Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL, m < 2, an unknown interp
+ * or a bad extent. */
+HFVIS_API hfvis_status hfvis_ns_wedges_partial(hfvis_ns_wedges *set, hfvis_ns_interp interp,
+                                               int m, double phi_a_rad, double phi_b_rad);
+
+/* From slices to SH ([NS09] Eq. 20-21, spec GI B.6 SLICES_TO_SH): w[j*4 + k] is the NLP vector
+ * of sample j (j = 0..m-1, from hfvis_nlp_visibility or hfvis_nlp_radiance at azimuth phi_j);
+ * out = Sum_wedges Rot_z(M x_j, phi_j). One channel per call. Returns HFVIS_OK, or
+ * HFVIS_ERR_INVALID_ARGUMENT for NULL or a set whose interp or sample count is invalid.
+ * Cost: per wedge 128 (linear) or 256 (B-spline) multiply-adds plus one hfvis_sh_rotate_z. */
+HFVIS_API hfvis_status hfvis_ns_wedges_to_sh(const hfvis_ns_wedges *set, const double *w,
+                                             double out[16]);
+
+/* Which formula gives the tangent plane's minimum blocking angle. */
+typedef enum hfvis_ns_omega_min {
+    HFVIS_NS_OMEGA_MIN_DEFAULT = 0,  /* = EXACT */
+    HFVIS_NS_OMEGA_MIN_EXACT = 1,    /* atan2(-(N_x cos phi + N_y sin phi), N_z) (spec GI B.2) */
+    HFVIS_NS_OMEGA_MIN_PAPER = 2     /* -asin(N_x cos phi + N_y sin phi) ([NS09] §3), exact only
+                                        when N lies in the slice's vertical plane */
+} hfvis_ns_omega_min;
+
+/* The elevation of the receiver's tangent plane in azimuth phi_rad, in [-pi/2, pi/2] for an
+ * upward normal: the minimum blocking angle omega_min of [NS09] §3 (it seeds the casting set).
+ * Example: N = (1,1,1)/sqrt3, phi = 0 gives -45 deg (exact) and -35.26 deg (paper); with the
+ * paper's form a tilted plane admits its own surface into the casting set (spec GI B.13-10).
+ * normal need not be unit length. Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL, a
+ * zero or non-finite normal, a non-finite phi or an unknown form. */
+HFVIS_API hfvis_status hfvis_ns_min_blocking_angle(const double normal[3], double phi_rad,
+                                                   hfvis_ns_omega_min form, double *out);
+
+/* ========================================================================================== */
 /* ssao.c - screen space (later issues)                                                       */
 /* ========================================================================================== */
 
