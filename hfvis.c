@@ -514,9 +514,14 @@ HFVIS_API hfvis_status hfvis_pgm_encode(const float *pixels, int width, int heig
 #define HF_IMG_MAX_SIZE_GUESS ((size_t)1 << 31)
 #define HF_IMG_FIRST_CHUNK ((size_t)1 << 16)
 
-/* Reads the whole file into a block from alloc. */
-static hfvis_status hf_img_read_file(const char *path, const hfvis_allocator *alloc,
-                                     unsigned char **data, size_t *size)
+/* Internal, shared with voxel.c (not API; declared again there). */
+hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, unsigned char **data,
+                             size_t *size);
+hfvis_status hfvis__write_file(const char *path, const unsigned char *bytes, size_t n);
+
+/* Reads the whole file into a block from alloc (hfvis__read_file). */
+hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, unsigned char **data,
+                             size_t *size)
 {
     FILE *f = fopen(path, "rb");
     unsigned char *buf;
@@ -581,7 +586,7 @@ HFVIS_API hfvis_status hfvis_image_load(const char *path, const hfvis_allocator 
     hf_img_header h;
     hfvis_status s;
     if (!path || !pixels || !info) return HFVIS_ERR_INVALID_ARGUMENT;
-    s = hf_img_read_file(path, alloc, &data, &size);
+    s = hfvis__read_file(path, alloc, &data, &size);
     if (s != HFVIS_OK) return s;
     s = hf_img_parse(data, size, &h);
     if (s == HFVIS_OK) {
@@ -602,7 +607,7 @@ HFVIS_API hfvis_status hfvis_image_load(const char *path, const hfvis_allocator 
  * suffix hashes the addresses of the buffer and of a local, which differ between concurrent
  * calls in one process (and usually between processes); a name already taken is skipped.
  * On any failure the temporary file is removed and path is untouched. */
-static hfvis_status hf_img_write_file(const char *path, const unsigned char *bytes, size_t n)
+hfvis_status hfvis__write_file(const char *path, const unsigned char *bytes, size_t n)
 {
     static const char hex[] = "0123456789abcdef";
     size_t len = strlen(path), k;
@@ -661,7 +666,7 @@ HFVIS_API hfvis_status hfvis_pfm_save(const char *path, const float *pixels, int
     buf = (unsigned char *)hf_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_pfm_encode(pixels, width, height, channels, stride, buf, need, &written);
-    if (s == HFVIS_OK) s = hf_img_write_file(path, buf, written);
+    if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
     hf_free(NULL, buf);
     return s;
 }
@@ -679,7 +684,7 @@ HFVIS_API hfvis_status hfvis_pgm_save(const char *path, const float *pixels, int
     buf = (unsigned char *)hf_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_pgm_encode(pixels, width, height, stride, lo, hi, maxval, buf, need, &written);
-    if (s == HFVIS_OK) s = hf_img_write_file(path, buf, written);
+    if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
     hf_free(NULL, buf);
     return s;
 }
