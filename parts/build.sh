@@ -22,16 +22,25 @@ for p in $order; do
   esac
 done
 mv "$out/voxel_dev.c.tmp" "$out/voxel_dev.c"
+WARN="-std=c99 -pedantic -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wundef -Wvla -Wcast-qual -Wdouble-promotion -Wfloat-conversion -Wimplicit-fallthrough -Wmissing-field-initializers -ffp-contract=off -Werror"
+if [ -n "$SAN" ]; then OPT="-O1 -g -DHFVIS_ENABLE_ASSERTS -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
+else OPT="-O2 -g -DHFVIS_ENABLE_ASSERTS"; fi
+if [ -n "$BENCH" ]; then OPT="-O2"; src=parts/bench_$name.c; else src=parts/test_$name.c; fi
+# hfvis.c parts (pasted at the end of hfvis.c): gi2
+cp hfvis.c "$out/hfvis.c.tmp"
+for p in gi2; do
+  case "$want" in *" $p "*)
+    printf '\n/* ---- parts/%s.c ---- */\n' "$p" >> "$out/hfvis.c.tmp"
+    cat "parts/$p.c" >> "$out/hfvis.c.tmp"
+    [ -f "parts/${p}_decl.h" ] && decls="$decls parts/${p}_decl.h";;
+  esac
+done
+mv "$out/hfvis.c.tmp" "$out/hfvis.c"
 # header: everything before the final "#ifdef __cplusplus" + decls + the tail
 n=$(grep -n '^#ifdef __cplusplus' hfvis.h | tail -n 1 | cut -d: -f1)
 head -n $((n - 1)) hfvis.h > "$out/hfvis.h"
 for d in $decls; do cat "$d" >> "$out/hfvis.h"; done
 tail -n +"$n" hfvis.h >> "$out/hfvis.h"
-WARN="-std=c99 -pedantic -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes -Wundef -Wvla -Wcast-qual -Wdouble-promotion -Wfloat-conversion -Wimplicit-fallthrough -Wmissing-field-initializers -ffp-contract=off -Werror"
-if [ -n "$SAN" ]; then OPT="-O1 -g -DHFVIS_ENABLE_ASSERTS -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
-else OPT="-O2 -g -DHFVIS_ENABLE_ASSERTS"; fi
-if [ -n "$BENCH" ]; then OPT="-O2"; src=parts/bench_$name.c; else src=parts/test_$name.c; fi
-cp hfvis.c "$out/hfvis.c"
 ${CC:-gcc} $WARN $OPT $CFLAGS_EXTRA -I"$out" -Itest -Iexamples "$src" "$out/hfvis.c" "$out/voxel_dev.c" -lm -o "$out/prog"
 echo "built $out/prog"
 "$out/prog"
