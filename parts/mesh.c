@@ -645,7 +645,7 @@ HFVIS_API hfvis_status hfvis_mesh_teapot(const hfvis_allocator *alloc, int n, hf
         vx_mesh_catmull(vx_mesh_teapot_profile, VX_MESH_TEAPOT_PROFILE_N,
                         (double)(VX_MESH_TEAPOT_PROFILE_N - 1) * (double)i / (double)m, pt);
         prof[i] = (i == 0 || i == m) ? 0.0 : fabs(pt[0]);
-        prof[m + 1 + i] = pt[1];
+        prof[m + 1 + i] = pt[1] > 0.0 ? pt[1] : 0.0; /* the spline dips below the flat base */
     }
     s = vx_mesh_builder_init(&b, alloc, nv, nt);
     if (s != HFVIS_OK) {
@@ -701,3 +701,440 @@ HFVIS_API hfvis_status hfvis_mesh_bounds(const hfvis_mesh *mesh, double lo[3], d
     }
     return HFVIS_OK;
 }
+
+/* ---- 1d. OBJ decoder -------------------------------------------------------------------- */
+/* Wavefront OBJ subset (DESIGN §4): `v x y z [w | r g b ...]` and `f` lines; every other
+ * statement is ignored. Two passes over the bytes with the same parser: pass 1 validates and
+ * counts, pass 2 fills arrays of exactly the counted sizes (forward vertex references are
+ * range-checked there). */
+
+/* 10^0 .. 10^22: exact in double. */
+static const double vx_obj_pow10[23] = {
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11,
+    1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22
+};
+
+/* d * 10^e, |e| small (<= ~70 here): steps of exact powers, multiplying for e > 0 and dividing
+ * for e < 0, so each step rounds once (<= 4 steps: within 2 ulp of double in all). */
+static double vx_obj_scale10(double d, long e)
+{
+    while (e > 22) {
+        d *= 1e22;
+        e -= 22;
+    }
+    while (e < -22) {
+        d /= 1e22;
+        e += 22;
+    }
+    return e >= 0 ? d * vx_obj_pow10[e] : d / vx_obj_pow10[-e];
+}
+
+static int vx_obj_digit(unsigned char c) { return c >= '0' && c <= '9'; }
+
+/* Parse the whole token [s, e) as a decimal number, locale-independently:
+ * [+-] (digits [. digits*] | . digits) [(e|E) [+-] digits]. No inf/nan/hex. The first 19
+ * significant digits are kept exactly (later ones are dropped), the value is mant * 10^exp in
+ * double (within 3 ulp of double), then rounded once to float. Returns 0 for a malformed token
+ * or a value outside the float range (|v| rounds to infinity); values below the smallest
+ * subnormal become (signed) zero. */
+static int vx_obj_parse_float(const unsigned char *s, const unsigned char *e, float *out)
+{
+    uint64_t mant = 0;
+    long long dexp = 0, ex = 0, e10;
+    int neg = 0, eneg = 0, nd = 0, any = 0;
+    double d;
+    float f;
+    if (s < e && (*s == '+' || *s == '-')) neg = *s++ == '-';
+    for (; s < e && vx_obj_digit(*s); s++) {
+        any = 1;
+        if (mant == 0 && *s == '0') continue; /* leading zero */
+        if (nd < 19) {
+            mant = mant * 10u + (uint64_t)(*s - '0');
+            nd++;
+        } else {
+            dexp++; /* dropped integer digit */
+        }
+    }
+    if (s < e && *s == '.') {
+        for (s++; s < e && vx_obj_digit(*s); s++) {
+            any = 1;
+            if (mant == 0 && *s == '0') {
+                dexp--;
+            } else if (nd < 19) {
+                mant = mant * 10u + (uint64_t)(*s - '0');
+                nd++;
+                dexp--;
+            }
+        }
+    }
+    if (!any) return 0;
+    if (s < e && (*s == 'e' || *s == 'E')) {
+        s++;
+        if (s < e && (*s == '+' || *s == '-')) eneg = *s++ == '-';
+        if (s >= e || !vx_obj_digit(*s)) return 0;
+        for (; s < e && vx_obj_digit(*s); s++)
+            if (ex < 1000000000000000LL) ex = ex * 10 + (*s - '0');
+    }
+    if (s != e) return 0;
+    if (mant == 0) {
+        *out = neg ? -0.0f : 0.0f;
+        return 1;
+    }
+    e10 = dexp + (eneg ? -ex : ex);
+    /* mant has nd digits: the value lies in [10^(e10+nd-1), 10^(e10+nd)) */
+    if (e10 + nd - 1 > 38) return 0;          /* >= 1e39 > FLT_MAX */
+    if (e10 + nd < -46) {                     /* < 1e-46: below half the smallest subnormal */
+        *out = neg ? -0.0f : 0.0f;
+        return 1;
+    }
+    d = vx_obj_scale10((double)mant, (long)e10);
+    f = (float)d;
+    if (!isfinite(f)) return 0;
+    *out = neg ? -f : f;
+    return 1;
+}
+
+/* One signed, non-zero OBJ index [+-]digits at *s (saturating at 2^40); advances *s. */
+static int vx_obj_parse_index(const unsigned char **sp, const unsigned char *e, long long *out)
+{
+    const unsigned char *s = *sp;
+    long long v = 0;
+    int neg = 0;
+    if (s < e && (*s == '+' || *s == '-')) neg = *s++ == '-';
+    if (s >= e || !vx_obj_digit(*s)) return 0;
+    for (; s < e && vx_obj_digit(*s); s++)
+        if (v < (1LL << 40)) v = v * 10 + (*s - '0');
+    if (v == 0) return 0;
+    *out = neg ? -v : v;
+    *sp = s;
+    return 1;
+}
+
+static int vx_obj_space(unsigned char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; }
+
+typedef struct vx_obj_pass {
+    int fill;          /* 0: validate and count; 1: write */
+    size_t nv, nt;     /* vertices / triangles so far */
+    size_t total_v;    /* pass 2: the vertex count of pass 1 */
+    float *xyz;
+    uint32_t *idx;
+} vx_obj_pass;
+
+/* A face vertex token: i, i/t, i//n or i/t/n (t, n checked for syntax only: they are not
+ * used). Resolves i to a 0-based vertex (negative = relative to the vertices read so far). */
+static hfvis_status vx_obj_face_ref(const vx_obj_pass *ps, const unsigned char *s,
+                                    const unsigned char *e, size_t *vout)
+{
+    long long i, t;
+    if (!vx_obj_parse_index(&s, e, &i)) return HFVIS_ERR_FORMAT;
+    if (s < e) {
+        if (*s++ != '/') return HFVIS_ERR_FORMAT;
+        if (s < e && *s == '/') {
+            s++;
+            if (!vx_obj_parse_index(&s, e, &t)) return HFVIS_ERR_FORMAT; /* i//n */
+        } else {
+            if (!vx_obj_parse_index(&s, e, &t)) return HFVIS_ERR_FORMAT; /* i/t */
+            if (s < e) {
+                if (*s++ != '/') return HFVIS_ERR_FORMAT;
+                if (!vx_obj_parse_index(&s, e, &t)) return HFVIS_ERR_FORMAT; /* i/t/n */
+            }
+        }
+        if (s != e) return HFVIS_ERR_FORMAT;
+    }
+    if (i < 0) {
+        if ((unsigned long long)(-i) > (unsigned long long)ps->nv) return HFVIS_ERR_FORMAT;
+        *vout = ps->nv - (size_t)(-i);
+    } else {
+        if ((unsigned long long)i > (unsigned long long)HFVIS_MESH_MAX_VERTICES)
+            return HFVIS_ERR_FORMAT; /* beyond any vertex a file may hold */
+        if (ps->fill && (size_t)i > ps->total_v) return HFVIS_ERR_FORMAT;
+        *vout = (size_t)(i - 1);
+    }
+    return HFVIS_OK;
+}
+
+/* One pass over the whole buffer. Lines end at '\n' or '\r' (so CRLF and CR files work);
+ * '#' starts a comment anywhere; tokens are separated by blanks and tabs. */
+static hfvis_status vx_obj_run(vx_obj_pass *ps, const unsigned char *p, const unsigned char *end)
+{
+    while (p < end) {
+        const unsigned char *le = p, *ce, *q, *ks;
+        while (le < end && *le != '\n' && *le != '\r') le++;
+        for (ce = p; ce < le && *ce != '#'; ce++) {}
+        q = p;
+        p = le < end ? le + 1 : le;
+        while (q < ce && vx_obj_space(*q)) q++;
+        if (q == ce) continue;
+        ks = q;
+        while (q < ce && !vx_obj_space(*q)) q++;
+        if (q - ks == 1 && *ks == 'v') {
+            float c[3];
+            int n = 0;
+            for (;;) {
+                const unsigned char *ts;
+                float f;
+                while (q < ce && vx_obj_space(*q)) q++;
+                if (q == ce) break;
+                ts = q;
+                while (q < ce && !vx_obj_space(*q)) q++;
+                if (!vx_obj_parse_float(ts, q, &f)) return HFVIS_ERR_FORMAT;
+                if (n < 3) c[n] = f;
+                n++;
+            }
+            if (n < 3) return HFVIS_ERR_FORMAT;
+            if (ps->nv >= HFVIS_MESH_MAX_VERTICES) return HFVIS_ERR_LIMIT;
+            if (ps->fill) memcpy(ps->xyz + 3 * ps->nv, c, sizeof c);
+            ps->nv++;
+        } else if (q - ks == 1 && *ks == 'f') {
+            size_t first = 0, prev = 0, v;
+            int n = 0;
+            for (;;) {
+                const unsigned char *ts;
+                hfvis_status s;
+                while (q < ce && vx_obj_space(*q)) q++;
+                if (q == ce) break;
+                ts = q;
+                while (q < ce && !vx_obj_space(*q)) q++;
+                s = vx_obj_face_ref(ps, ts, q, &v);
+                if (s != HFVIS_OK) return s;
+                if (n >= 2) { /* fan: (v0, v_{k-1}, v_k) */
+                    if (ps->nt >= HFVIS_MESH_MAX_TRIANGLES) return HFVIS_ERR_LIMIT;
+                    if (ps->fill) {
+                        ps->idx[3 * ps->nt] = (uint32_t)first;
+                        ps->idx[3 * ps->nt + 1] = (uint32_t)prev;
+                        ps->idx[3 * ps->nt + 2] = (uint32_t)v;
+                    }
+                    ps->nt++;
+                }
+                if (n == 0) first = v;
+                prev = v;
+                n++;
+            }
+            if (n < 3) return HFVIS_ERR_FORMAT;
+        }
+        /* any other statement (vt, vn, vp, o, g, s, usemtl, mtllib, l, p, ...) is ignored */
+    }
+    return HFVIS_OK;
+}
+
+HFVIS_API hfvis_status hfvis_obj_decode(const void *data, size_t size,
+                                        const hfvis_allocator *alloc, hfvis_mesh *out)
+{
+    const unsigned char *p = (const unsigned char *)data;
+    vx_obj_pass ps;
+    vx_mesh_builder b;
+    hfvis_status s;
+    if (!out || (!data && size > 0)) return HFVIS_ERR_INVALID_ARGUMENT;
+    memset(&ps, 0, sizeof ps);
+    s = vx_obj_run(&ps, p, p + size);
+    if (s != HFVIS_OK) return s;
+    s = vx_mesh_builder_init(&b, alloc, ps.nv, ps.nt);
+    if (s != HFVIS_OK) return s;
+    ps.total_v = ps.nv;
+    ps.nv = ps.nt = 0;
+    ps.fill = 1;
+    ps.xyz = b.xyz;
+    ps.idx = b.idx;
+    s = vx_obj_run(&ps, p, p + size);
+    if (s != HFVIS_OK) {
+        vx_mesh_builder_free(&b, alloc);
+        return s;
+    }
+    HFVIS_ASSERT(ps.nv == b.cap_v && ps.nt == b.cap_t);
+    b.nv = ps.nv;
+    b.nt = ps.nt;
+    return vx_mesh_builder_finish(&b, alloc, out);
+}
+
+/* ---- 1e. OBJ encoder, file wrappers ----------------------------------------------------- */
+
+#define VX_OBJ_FLOAT_MAX 16 /* longest number written: "-1.23456789e-38" is 15 */
+
+/* The decimal digits of n (>= 0) into buf; returns the count. */
+static size_t vx_obj_utoa(uint64_t n, char *buf)
+{
+    char tmp[24];
+    size_t k = 0, i;
+    do {
+        tmp[k++] = (char)('0' + (int)(n % 10u));
+        n /= 10u;
+    } while (n != 0);
+    for (i = 0; i < k; i++) buf[i] = tmp[k - 1 - i];
+    return k;
+}
+
+/* N (exactly p digits) * 10^(k - p + 1) as the shorter of plain and scientific notation. */
+static size_t vx_obj_layout(int neg, uint64_t N, int p, int k, char *buf)
+{
+    char dig[12], sci[VX_OBJ_FLOAT_MAX + 8], fix[64];
+    size_t ns = 0, nf = 0;
+    int i;
+    vx_obj_utoa(N, dig);
+    /* scientific: d[.ddd]e[-]k */
+    if (neg) sci[ns++] = '-';
+    sci[ns++] = dig[0];
+    if (p > 1) {
+        sci[ns++] = '.';
+        for (i = 1; i < p; i++) sci[ns++] = dig[i];
+    }
+    sci[ns++] = 'e';
+    if (k < 0) sci[ns++] = '-';
+    ns += vx_obj_utoa((uint64_t)(k < 0 ? -k : k), sci + ns);
+    /* plain */
+    if (neg) fix[nf++] = '-';
+    if (k < 0) {
+        fix[nf++] = '0';
+        fix[nf++] = '.';
+        for (i = 0; i < -k - 1; i++) fix[nf++] = '0';
+        for (i = 0; i < p; i++) fix[nf++] = dig[i];
+    } else {
+        for (i = 0; i < p || i <= k; i++) {
+            if (i == k + 1) fix[nf++] = '.';
+            fix[nf++] = i < p ? dig[i] : '0';
+        }
+    }
+    if (nf <= ns) {
+        memcpy(buf, fix, nf);
+        return nf;
+    }
+    memcpy(buf, sci, ns);
+    return ns;
+}
+
+/* The shortest decimal (1..9 significant digits) that vx_obj_parse_float reads back as f, bit
+ * for bit (9 digits always do: a 9-digit decimal is within 5e-9 relative of f, far from the
+ * midpoints to the neighbouring floats, at least 3e-8 relative away). f finite. */
+static size_t vx_obj_format_float(float f, char *buf)
+{
+    double x = fabs((double)f);
+    int neg = signbit(f) != 0, p, k0;
+    if (x == 0.0) {
+        if (neg) {
+            buf[0] = '-';
+            buf[1] = '0';
+            return 2;
+        }
+        buf[0] = '0';
+        return 1;
+    }
+    k0 = (int)floor(log10(x));
+    for (p = 1; p <= 9; p++) {
+        uint64_t N = 0, lo = 1, hi;
+        int k = k0, it, q;
+        size_t n;
+        float back;
+        for (q = 1; q < p; q++) lo *= 10u;
+        hi = lo * 10u;
+        /* N = round(x * 10^(p-1-k)) in [10^(p-1), 10^p): k0 from log10 may be one off, and
+         * rounding up to 10^p moves to the next decade (where N rounds to 10^(p-1)) */
+        for (it = 0; it < 3; it++) {
+            N = (uint64_t)floor(vx_obj_scale10(x, (long)(p - 1 - k)) + 0.5);
+            if (N >= hi) k++;
+            else if (N < lo) k--;
+            else break;
+        }
+        if (N < lo || N >= hi) continue;
+        n = vx_obj_layout(neg, N, p, k, buf);
+        if (vx_obj_parse_float((const unsigned char *)buf, (const unsigned char *)buf + n, &back)
+            && memcmp(&back, &f, sizeof f) == 0)
+            return n;
+    }
+    HFVIS_ASSERT(0); /* unreachable: 9 digits always round-trip */
+    return vx_obj_layout(neg, 0, 1, 0, buf);
+}
+
+/* Emit (or only count, out == NULL) the encoding; returns the byte count, 0 on overflow. */
+static size_t vx_obj_emit(const hfvis_mesh *m, unsigned char *out)
+{
+    char line[4 * 24 + 3 * VX_OBJ_FLOAT_MAX];
+    size_t total = 0, i, n;
+    int k;
+    /* header: "# hfvis mesh: V vertices, T triangles\n" */
+    n = 0;
+    memcpy(line, "# hfvis mesh: ", 14);
+    n = 14;
+    n += vx_obj_utoa((uint64_t)m->vertex_count, line + n);
+    memcpy(line + n, " vertices, ", 11);
+    n += 11;
+    n += vx_obj_utoa((uint64_t)m->triangle_count, line + n);
+    memcpy(line + n, " triangles\n", 11);
+    n += 11;
+    if (out) memcpy(out, line, n);
+    total = n;
+    for (i = 0; i < m->vertex_count; i++) {
+        line[0] = 'v';
+        n = 1;
+        for (k = 0; k < 3; k++) {
+            line[n++] = ' ';
+            n += vx_obj_format_float(m->xyz[3 * i + (size_t)k], line + n);
+        }
+        line[n++] = '\n';
+        if (total > SIZE_MAX - n) return 0;
+        if (out) memcpy(out + total, line, n);
+        total += n;
+    }
+    for (i = 0; i < m->triangle_count; i++) {
+        line[0] = 'f';
+        n = 1;
+        for (k = 0; k < 3; k++) {
+            line[n++] = ' ';
+            n += vx_obj_utoa((uint64_t)m->indices[3 * i + (size_t)k] + 1u, line + n);
+        }
+        line[n++] = '\n';
+        if (total > SIZE_MAX - n) return 0;
+        if (out) memcpy(out + total, line, n);
+        total += n;
+    }
+    return total;
+}
+
+HFVIS_API size_t hfvis_obj_encode_size(const hfvis_mesh *mesh)
+{
+    if (vx_mesh_check(mesh) != HFVIS_OK) return 0;
+    return vx_obj_emit(mesh, NULL);
+}
+
+HFVIS_API hfvis_status hfvis_obj_encode(const hfvis_mesh *mesh, void *out, size_t out_capacity,
+                                        size_t *written)
+{
+    size_t need;
+    if (!out || !written || vx_mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    need = vx_obj_emit(mesh, NULL);
+    if (need == 0) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (out_capacity < need) return HFVIS_ERR_BUFFER_TOO_SMALL;
+    vx_obj_emit(mesh, (unsigned char *)out);
+    *written = need;
+    return HFVIS_OK;
+}
+
+#ifndef HFVIS_NO_STDIO
+HFVIS_API hfvis_status hfvis_mesh_load(const char *path, const hfvis_allocator *alloc,
+                                       hfvis_mesh *out)
+{
+    unsigned char *data = NULL;
+    size_t size = 0;
+    hfvis_status s;
+    if (!path || !out) return HFVIS_ERR_INVALID_ARGUMENT;
+    s = hfvis__read_file(path, alloc, &data, &size);
+    if (s != HFVIS_OK) return s;
+    s = hfvis_obj_decode(data, size, alloc, out);
+    vx_free(alloc, data);
+    return s;
+}
+
+HFVIS_API hfvis_status hfvis_mesh_save(const char *path, const hfvis_mesh *mesh)
+{
+    size_t need, written = 0;
+    unsigned char *buf;
+    hfvis_status s;
+    if (!path || vx_mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    need = vx_obj_emit(mesh, NULL);
+    if (need == 0) return HFVIS_ERR_INVALID_ARGUMENT;
+    buf = (unsigned char *)vx_alloc(NULL, need);
+    if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
+    written = vx_obj_emit(mesh, buf);
+    s = hfvis__write_file(path, buf, written);
+    vx_free(NULL, buf);
+    return s;
+}
+#endif /* HFVIS_NO_STDIO */

@@ -120,3 +120,55 @@ HFVIS_API hfvis_status hfvis_mesh_teapot(const hfvis_allocator *alloc, int n, hf
  * (exact: each is one of the floats). Returns HFVIS_ERR_INVALID_ARGUMENT for NULL, an invalid
  * mesh (hfvis_mesh) or a mesh without vertices; lo, hi untouched then. */
 HFVIS_API hfvis_status hfvis_mesh_bounds(const hfvis_mesh *mesh, double lo[3], double hi[3]);
+
+/* Decode a Wavefront OBJ held in memory into a new mesh (arrays from alloc, NULL = malloc;
+ * release with hfvis_mesh_free(alloc, out)). Read: `v x y z` (further numbers on the line, a w
+ * or colour values, are checked and ignored) and `f` with 3 or more vertex references `i`,
+ * `i/t`, `i//n` or `i/t/n` (t and n are checked for syntax only and ignored); i >= 1 is a
+ * 1-based vertex index (forward references to later `v` lines are allowed), i <= -1 refers to
+ * the i-th most recent vertex before the line. A polygon v0 v1 ... vk is fanned into
+ * (v0, v_{j-1}, v_j), j = 2..k, in file order. Every other statement (vt, vn, vp, o, g, s,
+ * usemtl, mtllib, l, p, ...) is ignored. Lines end at LF, CR or CRLF; `#` starts a comment
+ * anywhere on a line; tokens are separated by blanks or tabs; no line continuation (`\`).
+ * Numbers: [+-] digits [. digits] [e [+-] digits] (also ".5", "5."), parsed without the C
+ * locale (no strtod): the first 19 significant digits are exact, the value is formed in double
+ * within 3 ulp and rounded once to float, so the result is the nearest float except for
+ * decimals within ~4e-16 (relative) of a midpoint between two floats; every float written
+ * with 9 significant digits (as hfvis_obj_encode does) reads back bit for bit. Magnitudes
+ * below 1e-46 read as (signed) zero. Two passes (validate and count, then fill): exact sizes,
+ * two allocations.
+ * Returns HFVIS_OK (an OBJ without v or f lines gives an empty mesh with no arrays),
+ * HFVIS_ERR_INVALID_ARGUMENT if out is NULL or data is NULL with size > 0, HFVIS_ERR_FORMAT for
+ * a malformed number (also inf, nan, hex) or one whose magnitude exceeds FLT_MAX, fewer than 3
+ * numbers on a v line, fewer than 3 references on an f line, a malformed reference, an index 0
+ * or out of range; HFVIS_ERR_LIMIT past HFVIS_MESH_MAX_VERTICES / _TRIANGLES (after fanning);
+ * HFVIS_ERR_OUT_OF_MEMORY. On error nothing is leaked and *out is untouched.
+ * Cost O(size). */
+HFVIS_API hfvis_status hfvis_obj_decode(const void *data, size_t size,
+                                        const hfvis_allocator *alloc, hfvis_mesh *out);
+
+/* Exact bytes hfvis_obj_encode writes for mesh; 0 if mesh is NULL or invalid (hfvis_mesh) or the
+ * size overflows size_t. Cost O(V + T) (it formats every number). */
+HFVIS_API size_t hfvis_obj_encode_size(const hfvis_mesh *mesh);
+
+/* Encode mesh as OBJ text: a comment line "# hfvis mesh: V vertices, T triangles", one
+ * "v x y z" line per vertex, one "f a b c" line per triangle (1-based indices), LF line ends.
+ * Each coordinate is the shortest decimal of at most 9 significant digits that
+ * hfvis_obj_decode reads back as the same float bit for bit (-0 stays -0), in plain or
+ * exponent notation, whichever is shorter (ties: plain), written by the library's own code
+ * (locale-independent, no printf). Decoding the output gives the same mesh bit for bit.
+ * out must hold hfvis_obj_encode_size(mesh) bytes (out_capacity); *written receives the count.
+ * The decoder's HFVIS_MESH_MAX_* limits are not applied. Returns HFVIS_OK,
+ * HFVIS_ERR_INVALID_ARGUMENT for NULL or an invalid mesh, HFVIS_ERR_BUFFER_TOO_SMALL (out
+ * untouched). Allocates nothing. */
+HFVIS_API hfvis_status hfvis_obj_encode(const hfvis_mesh *mesh, void *out, size_t out_capacity,
+                                        size_t *written);
+
+/* File wrappers (absent with HFVIS_NO_STDIO). load reads the whole file with alloc and decodes
+ * it (hfvis_obj_decode; three allocations, the file buffer freed before returning). save encodes
+ * into a malloc'ed buffer and writes a temporary file beside path, then renames it, so path is
+ * either complete or untouched. Returns the decoder's / encoder's errors, HFVIS_ERR_IO if the
+ * file cannot be read or written (e.g. path is a directory), HFVIS_ERR_OUT_OF_MEMORY. */
+HFVIS_API hfvis_status hfvis_mesh_load(const char *path, const hfvis_allocator *alloc,
+                                       hfvis_mesh *out);
+HFVIS_API hfvis_status hfvis_mesh_save(const char *path, const hfvis_mesh *mesh);

@@ -416,6 +416,757 @@ TEST(generators_alloc_failure)
     }
 }
 
+
+/* ---- more generator checks ------------------------------------------------------------ */
+
+/* Kahler's base icosahedron and the first subdivision's face order (the construction the spec
+ * voxel §3.13 counts were made with). */
+TEST(icosphere_construction)
+{
+    const double c[3] = {0.0, 0.0, 0.0}, t = (1.0 + sqrt(5.0)) / 2.0;
+    static const double base[12][3] = {{-1, 1, 0}, {1, 1, 0}, {-1, -1, 0}, {1, -1, 0},
+                                       {0, -1, 1}, {0, 1, 1}, {0, -1, -1}, {0, 1, -1},
+                                       {1, 0, -1}, {1, 0, 1}, {-1, 0, -1}, {-1, 0, 1}};
+    static const uint32_t f0[12] = {0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10};
+    static const uint32_t s1[12] = {0, 12, 14, 11, 13, 12, 5, 14, 13, 12, 13, 14};
+    hfvis_mesh m;
+    int v, k;
+    CHECK_EQ_STATUS(hfvis_mesh_icosphere(NULL, c, 1.0, 0, &m), HFVIS_OK);
+    for (v = 0; v < 12; v++) {
+        double p[3], len;
+        p[0] = base[v][0] * (v >= 8 ? t : 1.0);
+        p[1] = base[v][1] * (v < 4 ? t : 1.0);
+        p[2] = base[v][2] * (v >= 4 && v < 8 ? t : 1.0);
+        len = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+        for (k = 0; k < 3; k++) CHECK(m.xyz[3 * v + k] == (float)(p[k] / len));
+    }
+    CHECK(memcmp(m.indices, f0, sizeof f0) == 0);
+    hfvis_mesh_free(NULL, &m);
+    CHECK_EQ_STATUS(hfvis_mesh_icosphere(NULL, c, 1.0, 1, &m), HFVIS_OK);
+    CHECK(memcmp(m.indices, s1, sizeof s1) == 0);
+    /* vertex 12 = normalised midpoint of vertices 0 and 11 */
+    {
+        double a[3], b[3], mid[3], len;
+        vtx(&m, 0, a);
+        vtx(&m, 11, b);
+        for (k = 0; k < 3; k++) mid[k] = a[k] + b[k];
+        len = sqrt(mid[0] * mid[0] + mid[1] * mid[1] + mid[2] * mid[2]);
+        for (k = 0; k < 3; k++) CHECK_NEAR(m.xyz[36 + k], mid[k] / len, 1e-7, 0.0);
+    }
+    hfvis_mesh_free(NULL, &m);
+}
+
+/* The pixel-centre dominant-axis rule of spec voxel §3.4 (as the spec's prototype; no ties occur
+ * on this mesh), counting voxels of a 64^3 unit grid: reproduces the spec §3.13 test 4 numbers
+ * with this icosphere (dominant 4147, all three axes 4183). */
+static long proto_voxel_count(const hfvis_mesh *m, int all_axes)
+{
+    enum { N = 64 };
+    unsigned char *vol = (unsigned char *)calloc(N * N * N, 1);
+    long cnt = 0;
+    size_t t;
+    int i;
+    for (t = 0; t < m->triangle_count; t++) {
+        double g[3][3], nrm[3], cc[3];
+        int a, k, dom = 0;
+        for (i = 0; i < 3; i++) vtx(m, m->indices[3 * t + (size_t)i], g[i]);
+        tri_normal(m, t, nrm, cc);
+        if (fabs(nrm[1]) > fabs(nrm[dom])) dom = 1;
+        if (fabs(nrm[2]) > fabs(nrm[dom])) dom = 2;
+        for (a = 0; a < 3; a++) {
+            int u = (a + 1) % 3, w = (a + 2) % 3, pu, pw, u0, u1, w0, w1;
+            double P[3][2], Z[3], area;
+            if ((!all_axes && a != dom) || nrm[a] == 0.0) continue;
+            for (i = 0; i < 3; i++) {
+                P[i][0] = g[i][u];
+                P[i][1] = g[i][w];
+                Z[i] = g[i][a];
+            }
+            area = (P[1][0] - P[0][0]) * (P[2][1] - P[0][1]) - (P[1][1] - P[0][1]) * (P[2][0] - P[0][0]);
+            u0 = (int)floor(fmin(P[0][0], fmin(P[1][0], P[2][0])));
+            u1 = (int)floor(fmax(P[0][0], fmax(P[1][0], P[2][0])));
+            w0 = (int)floor(fmin(P[0][1], fmin(P[1][1], P[2][1])));
+            w1 = (int)floor(fmax(P[0][1], fmax(P[1][1], P[2][1])));
+            for (pu = u0; pu <= u1; pu++)
+                for (pw = w0; pw <= w1; pw++) {
+                    double cu = pu + 0.5, cw = pw + 0.5, b[3], z;
+                    int v[3];
+                    if (pu < 0 || pw < 0 || pu >= N || pw >= N) continue;
+                    for (i = 0; i < 3; i++) {
+                        int j = (i + 1) % 3, l = (i + 2) % 3;
+                        b[i] = ((P[l][0] - P[j][0]) * (cw - P[j][1]) - (P[l][1] - P[j][1]) * (cu - P[j][0])) / area;
+                    }
+                    if (b[0] < 0.0 || b[1] < 0.0 || b[2] < 0.0) continue;
+                    z = b[0] * Z[0] + b[1] * Z[1] + b[2] * Z[2];
+                    k = (int)floor(z);
+                    if (k < 0 || k >= N) continue;
+                    v[a] = k;
+                    v[u] = pu;
+                    v[w] = pw;
+                    vol[(v[2] * N + v[1]) * N + v[0]] = 1;
+                }
+        }
+    }
+    for (i = 0; i < N * N * N; i++) cnt += vol[i];
+    free(vol);
+    return cnt;
+}
+
+TEST(icosphere_spec_counts)
+{
+    const double c[3] = {32.1, 31.7, 32.3};
+    hfvis_mesh m;
+    CHECK_EQ_STATUS(hfvis_mesh_icosphere(NULL, c, 20.0, 5, &m), HFVIS_OK);
+    CHECK(m.triangle_count == 20480);
+    CHECK(proto_voxel_count(&m, 0) == 4147);
+    CHECK(proto_voxel_count(&m, 1) == 4183);
+    hfvis_mesh_free(NULL, &m);
+}
+
+/* No vertex of the (2,3) knot tube lies closer than the tube radius (minus the polygon sag) to
+ * any point of the centre line: the tube does not intersect itself. */
+TEST(torus_knot_embedded)
+{
+    enum { SEG = 400, SIDES = 8, DENSE = 20000 };
+    const double c[3] = {0.0, 0.0, 0.0}, tube = HFVIS_TORUS_KNOT_TUBE;
+    static double line[DENSE][3];
+    hfvis_mesh m;
+    double dmin = 1e9;
+    size_t v;
+    int i;
+    for (i = 0; i < DENSE; i++) {
+        double tt = 2.0 * PI * i / DENSE, rho = 1.0 + 0.5 * cos(3.0 * tt);
+        line[i][0] = rho * cos(2.0 * tt);
+        line[i][1] = rho * sin(2.0 * tt);
+        line[i][2] = 0.5 * sin(3.0 * tt);
+    }
+    CHECK_EQ_STATUS(hfvis_mesh_torus_knot(NULL, c, 1.0, 2, 3, SEG, SIDES, &m), HFVIS_OK);
+    for (v = 0; v < m.vertex_count; v++) {
+        double p[3];
+        vtx(&m, v, p);
+        for (i = 0; i < DENSE; i++) {
+            double dx = p[0] - line[i][0], dy = p[1] - line[i][1], dz = p[2] - line[i][2];
+            double d = sqrt(dx * dx + dy * dy + dz * dz);
+            if (d < dmin) dmin = d;
+        }
+    }
+    printf("  torus knot (2,3): closest vertex-to-centre-line distance %.6f (tube %.2f)\n", dmin, tube);
+    CHECK(dmin > tube * 0.999 && dmin < tube * 1.0001);
+    CHECK(edge_defects(&m, NULL) == 0 && mesh_volume(&m, c) > 0.0);
+    hfvis_mesh_free(NULL, &m);
+    /* the tube's volume converges to (centre line length) * pi * tube^2 (Pappus for tubes) */
+    CHECK_EQ_STATUS(hfvis_mesh_torus_knot(NULL, c, 1.0, 2, 3, 2500, 64, &m), HFVIS_OK);
+    {
+        double L = 0.0;
+        for (i = 0; i < DENSE; i++) {
+            int j = (i + 1) % DENSE;
+            double dx = line[j][0] - line[i][0], dy = line[j][1] - line[i][1], dz = line[j][2] - line[i][2];
+            L += sqrt(dx * dx + dy * dy + dz * dz);
+        }
+        CHECK_NEAR(mesh_volume(&m, c), L * PI * tube * tube, 0.0, T_CONVERGE);
+        CHECK_NEAR(mesh_area(&m), L * 2.0 * PI * tube, 0.0, T_CONVERGE);
+    }
+    hfvis_mesh_free(NULL, &m);
+}
+
+TEST(from_grid_holes)
+{
+    enum { W = 6, H = 5 };
+    float z[W * H];
+    hfvis_grid g;
+    hfvis_mesh m;
+    int x, y, kept = 0;
+    size_t t;
+    for (y = 0; y < H; y++)
+        for (x = 0; x < W; x++) z[y * W + x] = (float)(x + 10 * y);
+    z[1 * W + 2] = NAN;       /* interior hole: drops its 6 triangles */
+    z[4 * W + 5] = INFINITY;  /* corner hole: drops both triangles of the last cell */
+    g.z = z;
+    g.width = W;
+    g.height = H;
+    g.stride = W;
+    g.cell_size = 2.0;
+    for (y = 0; y + 1 < H; y++)
+        for (x = 0; x + 1 < W; x++) {
+            int a = isfinite(z[y * W + x]), b = isfinite(z[y * W + x + 1]);
+            int cc = isfinite(z[(y + 1) * W + x]), d = isfinite(z[(y + 1) * W + x + 1]);
+            kept += (a && b && d) + (a && d && cc);
+        }
+    CHECK(kept == 2 * 5 * 4 - 6 - 2);
+    CHECK_EQ_STATUS(hfvis_mesh_from_grid(NULL, &g, &m), HFVIS_OK);
+    CHECK(m.triangle_count == (size_t)kept && mesh_valid(&m) && unused_vertices(&m) == 0);
+    /* the two holes' vertices are dropped, the rest kept in row-major order */
+    CHECK(m.vertex_count == W * H - 2);
+    for (t = 0; t < m.vertex_count; t++) {
+        double p[3];
+        int sx, sy;
+        vtx(&m, t, p);
+        sx = (int)(p[0] / 2.0);
+        sy = (int)(p[1] / 2.0);
+        CHECK(p[0] == sx * 2.0 && p[1] == sy * 2.0 && p[2] == (double)z[sy * W + sx]);
+    }
+    for (t = 0; t < m.triangle_count; t++) {
+        double n[3], cc[3];
+        tri_normal(&m, t, n, cc);
+        CHECK(n[2] > 0.0);
+    }
+    hfvis_mesh_free(NULL, &m);
+    /* the split diagonal: a 2x2 grid gives (a, b, d), (a, d, c) */
+    {
+        static const float z4[4] = {0.0f, 1.0f, 2.0f, 5.0f};
+        static const uint32_t want[6] = {0, 1, 3, 0, 3, 2};
+        g.z = z4;
+        g.width = g.height = 2;
+        g.stride = 2;
+        g.cell_size = 1.0;
+        CHECK_EQ_STATUS(hfvis_mesh_from_grid(NULL, &g, &m), HFVIS_OK);
+        CHECK(m.triangle_count == 2 && memcmp(m.indices, want, sizeof want) == 0);
+        hfvis_mesh_free(NULL, &m);
+    }
+    /* 1 x N: no triangles, no vertices, no arrays */
+    g.width = 1;
+    g.height = 2;
+    g.stride = 1;
+    CHECK_EQ_STATUS(hfvis_mesh_from_grid(NULL, &g, &m), HFVIS_OK);
+    CHECK(m.vertex_count == 0 && m.triangle_count == 0 && m.xyz == NULL && m.indices == NULL);
+    /* all holes: empty too */
+    {
+        float zh[4] = {NAN, NAN, NAN, 1.0f};
+        g.z = zh;
+        g.width = g.height = g.stride = 2;
+        CHECK_EQ_STATUS(hfvis_mesh_from_grid(NULL, &g, &m), HFVIS_OK);
+        CHECK(m.vertex_count == 0 && m.triangle_count == 0);
+    }
+}
+
+TEST(room_layout)
+{
+    const double room_c[3] = {0.5, 0.5, 0.5};
+    hfvis_mesh m;
+    size_t t, bnd = 0;
+    CHECK_EQ_STATUS(hfvis_mesh_room(NULL, &m), HFVIS_OK);
+    for (t = 0; t < 30; t++) {
+        double n[3], cc[3], ref[3], len;
+        tri_normal(&m, t, n, cc);
+        len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        CHECK(len > 0.0);
+        if (t < 10) { /* walls look into the room: normal toward the room's centre */
+            CHECK(n[0] * (room_c[0] - cc[0]) + n[1] * (room_c[1] - cc[1]) + n[2] * (room_c[2] - cc[2]) > 0.0);
+        } else {     /* boxes outward: away from their vertical axis / up for the top */
+            ref[0] = t < 20 ? 0.66 : 0.34;
+            ref[1] = t < 20 ? 0.33 : 0.62;
+            ref[2] = t < 20 ? 0.15 : 0.3;
+            CHECK(n[0] * (cc[0] - ref[0]) + n[1] * (cc[1] - ref[1]) + n[2] * (cc[2] - ref[2]) > 0.0);
+            CHECK(fabs(n[2]) < 1e-6 * len || n[2] > 0.0); /* no bottom faces */
+        }
+    }
+    /* boundary: the front opening (4 edges) and the two boxes' bottom rectangles (4 each) */
+    edge_defects(&m, &bnd);
+    CHECK(bnd == 12);
+    /* the short box's first edge direction is rotated by -17 degrees, the tall box's +17 */
+    {
+        double a[3], b[3];
+        vtx(&m, 8, a);
+        vtx(&m, 9, b);
+        CHECK_NEAR(atan2(b[1] - a[1], b[0] - a[0]), -17.0 * PI / 180.0, 1e-6, 0.0);
+        vtx(&m, 16, a);
+        vtx(&m, 17, b);
+        CHECK_NEAR(atan2(b[1] - a[1], b[0] - a[0]), 17.0 * PI / 180.0, 1e-6, 0.0);
+    }
+    hfvis_mesh_free(NULL, &m);
+}
+
+TEST(teapot_shape)
+{
+    hfvis_mesh m, m2;
+    double lo[3], hi[3];
+    size_t bnd = 0;
+    int n = 3;
+    CHECK_EQ_STATUS(hfvis_mesh_teapot(NULL, n, &m), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_mesh_teapot(NULL, n, &m2), HFVIS_OK);
+    CHECK(m.vertex_count == m2.vertex_count
+          && memcmp(m.xyz, m2.xyz, 3 * m.vertex_count * sizeof(float)) == 0
+          && memcmp(m.indices, m2.indices, 3 * m.triangle_count * sizeof(uint32_t)) == 0);
+    /* body closed; the tubes' 4 end rings (6n edges each) are the only boundary */
+    edge_defects(&m, &bnd);
+    CHECK(bnd == (size_t)(4 * 6 * n));
+    CHECK_EQ_STATUS(hfvis_mesh_bounds(&m, lo, hi), HFVIS_OK);
+    CHECK(lo[2] >= -1e-6 && hi[2] <= 1.42 + 1e-6 && hi[2] > 1.41);
+    printf("  teapot n=3: %zu vertices, %zu triangles, bounds (%.3f %.3f %.3f)-(%.3f %.3f %.3f)\n",
+           m.vertex_count, m.triangle_count, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+    hfvis_mesh_free(NULL, &m);
+    hfvis_mesh_free(NULL, &m2);
+}
+
+TEST(generator_bad_arguments)
+{
+    const double c[3] = {0, 0, 0}, lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, flat[3] = {1, 0, 1};
+    const double nanc[3] = {0, NAN, 0}, big[3] = {3e38, 0, 0};
+    float z[4] = {0, 0, 0, 0};
+    hfvis_grid g;
+    hfvis_mesh m;
+    memset(&m, 0x5A, sizeof m);
+#define BAD(call) CHECK_EQ_STATUS(call, HFVIS_ERR_INVALID_ARGUMENT)
+    BAD(hfvis_mesh_box(NULL, lo, hi, NULL));
+    BAD(hfvis_mesh_box(NULL, NULL, hi, &m));
+    BAD(hfvis_mesh_box(NULL, lo, NULL, &m));
+    BAD(hfvis_mesh_box(NULL, lo, flat, &m));
+    BAD(hfvis_mesh_box(NULL, hi, lo, &m));
+    BAD(hfvis_mesh_box(NULL, nanc, hi, &m));
+    BAD(hfvis_mesh_uv_sphere(NULL, c, 1.0, 8, 4, NULL));
+    BAD(hfvis_mesh_uv_sphere(NULL, NULL, 1.0, 8, 4, &m));
+    BAD(hfvis_mesh_uv_sphere(NULL, c, 0.0, 8, 4, &m));
+    BAD(hfvis_mesh_uv_sphere(NULL, c, -1.0, 8, 4, &m));
+    BAD(hfvis_mesh_uv_sphere(NULL, c, NAN, 8, 4, &m));
+    BAD(hfvis_mesh_uv_sphere(NULL, c, INFINITY, 8, 4, &m));
+    BAD(hfvis_mesh_uv_sphere(NULL, c, 1.0, 2, 4, &m));
+    BAD(hfvis_mesh_uv_sphere(NULL, c, 1.0, 8, 1, &m));
+    BAD(hfvis_mesh_uv_sphere(NULL, nanc, 1.0, 8, 4, &m));
+    BAD(hfvis_mesh_uv_sphere(NULL, big, 1e38, 8, 4, &m)); /* 3e38 + 1e38 overflows float */
+    BAD(hfvis_mesh_uv_sphere(NULL, c, 1e300, 8, 4, &m));
+    BAD(hfvis_mesh_icosphere(NULL, c, 1.0, 1, NULL));
+    BAD(hfvis_mesh_icosphere(NULL, NULL, 1.0, 1, &m));
+    BAD(hfvis_mesh_icosphere(NULL, c, 0.0, 1, &m));
+    BAD(hfvis_mesh_icosphere(NULL, c, 1.0, -1, &m));
+    BAD(hfvis_mesh_icosphere(NULL, c, 1.0, 11, &m));
+    BAD(hfvis_mesh_icosphere(NULL, big, 1e38, 0, &m));
+    BAD(hfvis_mesh_torus(NULL, c, 2.0, 1.0, 8, 4, NULL));
+    BAD(hfvis_mesh_torus(NULL, c, 1.0, 1.0, 8, 4, &m));
+    BAD(hfvis_mesh_torus(NULL, c, 1.0, 2.0, 8, 4, &m));
+    BAD(hfvis_mesh_torus(NULL, c, 2.0, 0.0, 8, 4, &m));
+    BAD(hfvis_mesh_torus(NULL, c, 2.0, 1.0, 2, 4, &m));
+    BAD(hfvis_mesh_torus(NULL, c, 2.0, 1.0, 8, 2, &m));
+    BAD(hfvis_mesh_torus(NULL, c, NAN, 1.0, 8, 4, &m));
+    BAD(hfvis_mesh_torus_knot(NULL, c, 1.0, 2, 3, 8, 4, NULL));
+    BAD(hfvis_mesh_torus_knot(NULL, NULL, 1.0, 2, 3, 8, 4, &m));
+    BAD(hfvis_mesh_torus_knot(NULL, c, 0.0, 2, 3, 8, 4, &m));
+    BAD(hfvis_mesh_torus_knot(NULL, c, 1.0, 2, 4, 8, 4, &m)); /* not coprime: a link */
+    BAD(hfvis_mesh_torus_knot(NULL, c, 1.0, 0, 3, 8, 4, &m));
+    BAD(hfvis_mesh_torus_knot(NULL, c, 1.0, 2, -3, 8, 4, &m));
+    BAD(hfvis_mesh_torus_knot(NULL, c, 1.0, 2, 3, 2, 4, &m));
+    BAD(hfvis_mesh_torus_knot(NULL, c, 1.0, 2, 3, 8, 2, &m));
+    BAD(hfvis_mesh_torus_knot(NULL, c, INFINITY, 2, 3, 8, 4, &m));
+    g.z = z;
+    g.width = g.height = 2;
+    g.stride = 2;
+    g.cell_size = 1.0;
+    BAD(hfvis_mesh_from_grid(NULL, &g, NULL));
+    BAD(hfvis_mesh_from_grid(NULL, NULL, &m));
+    g.z = NULL;
+    BAD(hfvis_mesh_from_grid(NULL, &g, &m));
+    g.z = z;
+    g.width = 0;
+    BAD(hfvis_mesh_from_grid(NULL, &g, &m));
+    g.width = 2;
+    g.height = -1;
+    BAD(hfvis_mesh_from_grid(NULL, &g, &m));
+    g.height = 2;
+    g.stride = 1;
+    BAD(hfvis_mesh_from_grid(NULL, &g, &m));
+    g.stride = 2;
+    g.cell_size = 0.0;
+    BAD(hfvis_mesh_from_grid(NULL, &g, &m));
+    g.cell_size = NAN;
+    BAD(hfvis_mesh_from_grid(NULL, &g, &m));
+    g.cell_size = 1e300; /* x*cell overflows float */
+    BAD(hfvis_mesh_from_grid(NULL, &g, &m));
+    BAD(hfvis_mesh_room(NULL, NULL));
+    BAD(hfvis_mesh_teapot(NULL, 1, NULL));
+    BAD(hfvis_mesh_teapot(NULL, 0, &m));
+    BAD(hfvis_mesh_teapot(NULL, -5, &m));
+    CHECK(m.vertex_count == (size_t)0x5A5A5A5A5A5A5A5Aull);
+    /* limits: counts past HFVIS_MESH_MAX_* return LIMIT before allocating anything */
+    CHECK_EQ_STATUS(hfvis_mesh_torus(NULL, c, 2.0, 1.0, 65536, 8192, &m), HFVIS_ERR_LIMIT);
+    CHECK_EQ_STATUS(hfvis_mesh_torus_knot(NULL, c, 1.0, 2, 3, 1 << 20, 1 << 10, &m), HFVIS_ERR_LIMIT);
+    CHECK_EQ_STATUS(hfvis_mesh_uv_sphere(NULL, c, 1.0, 1 << 15, 1 << 14, &m), HFVIS_ERR_LIMIT);
+    CHECK_EQ_STATUS(hfvis_mesh_teapot(NULL, 2000, &m), HFVIS_ERR_LIMIT);
+    CHECK_EQ_STATUS(hfvis_mesh_teapot(NULL, 1 << 30, &m), HFVIS_ERR_LIMIT);
+    g.width = 1 << 15;
+    g.height = 1 << 14;
+    g.stride = 1 << 15;
+    g.cell_size = 1.0;
+    CHECK_EQ_STATUS(hfvis_mesh_from_grid(NULL, &g, &m), HFVIS_ERR_LIMIT); /* z never read */
+    CHECK(m.vertex_count == (size_t)0x5A5A5A5A5A5A5A5Aull);
+    /* bounds */
+    {
+        hfvis_mesh e, bad;
+        float xyz[3] = {0, 0, 0};
+        uint32_t idx[3] = {0, 0, 1};
+        double l[3] = {7, 7, 7}, h[3] = {7, 7, 7};
+        memset(&e, 0, sizeof e);
+        BAD(hfvis_mesh_bounds(NULL, l, h));
+        BAD(hfvis_mesh_bounds(&e, l, h)); /* no vertices */
+        bad.xyz = xyz;
+        bad.vertex_count = 1;
+        bad.indices = idx;
+        bad.triangle_count = 1; /* index 1 >= vertex_count */
+        BAD(hfvis_mesh_bounds(&bad, l, h));
+        bad.triangle_count = 0;
+        BAD(hfvis_mesh_bounds(&bad, NULL, h));
+        BAD(hfvis_mesh_bounds(&bad, l, NULL));
+        xyz[1] = NAN;
+        BAD(hfvis_mesh_bounds(&bad, l, h));
+        CHECK(l[0] == 7 && h[2] == 7);
+    }
+#undef BAD
+}
+
+/* ---- OBJ codec ------------------------------------------------------------------------------ */
+
+static int same_mesh(const hfvis_mesh *a, const hfvis_mesh *b)
+{
+    return a->vertex_count == b->vertex_count && a->triangle_count == b->triangle_count
+           && (a->vertex_count == 0 || memcmp(a->xyz, b->xyz, 3 * a->vertex_count * sizeof(float)) == 0)
+           && (a->triangle_count == 0
+               || memcmp(a->indices, b->indices, 3 * a->triangle_count * sizeof(uint32_t)) == 0);
+}
+
+static int round_trip(const hfvis_mesh *m)
+{
+    size_t need = hfvis_obj_encode_size(m), written = 0;
+    unsigned char *buf = (unsigned char *)malloc(need + 1);
+    hfvis_mesh back;
+    int ok;
+    if (need == 0 || !buf) return 0;
+    ok = hfvis_obj_encode(m, buf, need, &written) == HFVIS_OK && written == need;
+    ok = ok && hfvis_obj_decode(buf, written, NULL, &back) == HFVIS_OK;
+    if (ok) {
+        ok = same_mesh(m, &back);
+        hfvis_mesh_free(NULL, &back);
+    }
+    /* one byte short */
+    ok = ok && hfvis_obj_encode(m, buf, need - 1, &written) == HFVIS_ERR_BUFFER_TOO_SMALL;
+    free(buf);
+    return ok;
+}
+
+TEST(obj_round_trip_generators)
+{
+    int which;
+    for (which = 0; which < 8; which++) {
+        hfvis_mesh m;
+        CHECK_EQ_STATUS(gen_call(which, NULL, &m), HFVIS_OK);
+        CHECK(round_trip(&m));
+        hfvis_mesh_free(NULL, &m);
+    }
+    {
+        const double c[3] = {-12.5, 3.25e-3, 1e5};
+        hfvis_mesh m;
+        CHECK_EQ_STATUS(hfvis_mesh_torus_knot(NULL, c, 7.3, 2, 3, 2500, 20, &m), HFVIS_OK);
+        CHECK(round_trip(&m));
+        hfvis_mesh_free(NULL, &m);
+        CHECK_EQ_STATUS(hfvis_mesh_icosphere(NULL, c, 1e-30, 3, &m), HFVIS_OK);
+        CHECK(round_trip(&m));
+        hfvis_mesh_free(NULL, &m);
+    }
+}
+
+static uint64_t rng_state = 0x1234567887654321ull;
+static uint64_t rng_next(void)
+{
+    uint64_t z = (rng_state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+/* Every float class round-trips bit for bit through encode/decode, with the fewest significant
+ * digits that round-trip through the C library's strtof (correctly rounded on glibc). */
+TEST(obj_float_round_trip)
+{
+    enum { NF = 60000 };
+    static float xyz[3 * NF];
+    static const float special[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.1f, 1e-45f, -1e-45f, 1.17549435e-38f,
+                                    1.1754942e-38f, 3.40282347e38f, -3.40282347e38f, 123456789.0f,
+                                    1e10f, 1e-10f, 0.3f, 2.5f, 16777216.0f, 16777215.0f, 9.999999e-5f,
+                                    100000.0f, 1e8f, 0.5f, 1.5e-44f};
+    hfvis_mesh m;
+    size_t i, need, written, nspecial = sizeof special / sizeof special[0];
+    unsigned char *buf;
+    hfvis_mesh back;
+    int longer = 0, shorter = 0;
+    for (i = 0; i < 3 * NF; i++) {
+        uint32_t bits;
+        float f;
+        do {
+            bits = (uint32_t)rng_next();
+            if (i % 3 == 1) bits = (bits & 0x807FFFFFu) | ((uint32_t)(100 + rng_next() % 54) << 23); /* ~1e-8..1e8 */
+            memcpy(&f, &bits, sizeof f);
+        } while (!isfinite(f));
+        xyz[i] = i < nspecial ? special[i] : f;
+    }
+    m.xyz = xyz;
+    m.vertex_count = NF;
+    m.indices = NULL;
+    m.triangle_count = 0;
+    need = hfvis_obj_encode_size(&m);
+    buf = (unsigned char *)malloc(need);
+    CHECK_EQ_STATUS(hfvis_obj_encode(&m, buf, need, &written), HFVIS_OK);
+    CHECK(written == need);
+    CHECK_EQ_STATUS(hfvis_obj_decode(buf, written, NULL, &back), HFVIS_OK);
+    CHECK(back.vertex_count == NF && memcmp(back.xyz, xyz, sizeof xyz) == 0);
+    hfvis_mesh_free(NULL, &back);
+    /* digit counts against the shortest %.*e that strtof reads back */
+    {
+        const char *p = (const char *)buf;
+        size_t v = 0;
+        p = strchr(p, '\n') + 1; /* header */
+        for (v = 0; v < 3 * NF; v++) {
+            const char *tok;
+            int ours = 0, best, k;
+            char tmp[64];
+            if (v % 3 == 0) p += 2; /* "v " */
+            tok = p;
+            while (*p != ' ' && *p != '\n') p++;
+            for (k = 0; tok + k < p && tok[k] != 'e'; k++)
+                if (tok[k] >= '1' && tok[k] <= '9') break;
+            /* significant digits: from the first non-zero digit to the last digit before 'e' */
+            {
+                const char *q = tok + k, *end = tok;
+                while (end < p && *end != 'e') end++;
+                for (; q < end; q++) if (*q >= '0' && *q <= '9') ours++;
+                /* trailing zeros of an integer are not significant */
+                q = end;
+                while (q > tok + k && (q[-1] == '0' || q[-1] == '.')) {
+                    if (q[-1] == '0') ours--;
+                    q--;
+                }
+            }
+            if (xyz[v] == 0.0f) ours = 1;
+            for (best = 1; best <= 9; best++) {
+                snprintf(tmp, sizeof tmp, "%.*e", best - 1, (double)xyz[v]);
+                if (strtof(tmp, NULL) == xyz[v]) break;
+            }
+            if (ours > best) longer++;
+            if (ours < best) shorter++;
+            p++; /* ' ' or '\n' */
+        }
+    }
+    printf("  %d floats: %d written with more digits than the shortest, %d with fewer\n", 3 * NF,
+           longer, shorter);
+    CHECK(longer == 0 && shorter == 0);
+    free(buf);
+}
+
+/* The decoder's number parser against strtof on random decimal strings (C locale). */
+TEST(obj_number_parser)
+{
+    int i, mismatch = 0;
+    for (i = 0; i < 200000; i++) {
+        char s[96], line[128];
+        int nd = 1 + (int)(rng_next() % 17), k, n = 0, e = (int)(rng_next() % 90) - 50;
+        hfvis_mesh m;
+        float want;
+        if (rng_next() % 2) s[n++] = '-';
+        for (k = 0; k < nd; k++) {
+            if (k == 1) s[n++] = '.';
+            s[n++] = (char)('0' + (int)(rng_next() % 10));
+        }
+        n += snprintf(s + n, sizeof s - (size_t)n, "e%d", e);
+        want = strtof(s, NULL);
+        if (!isfinite(want)) continue;
+        snprintf(line, sizeof line, "v %s 0 0\n", s);
+        if (hfvis_obj_decode(line, strlen(line), NULL, &m) != HFVIS_OK) {
+            mismatch++;
+            continue;
+        }
+        if (memcmp(&m.xyz[0], &want, sizeof want) != 0) {
+            if (mismatch < 5) fprintf(stderr, "  %s: got %.9g want %.9g\n", s, (double)m.xyz[0], (double)want);
+            mismatch++;
+        }
+        hfvis_mesh_free(NULL, &m);
+    }
+    printf("  200000 random decimals: %d differ from strtof\n", mismatch);
+    CHECK(mismatch == 0);
+}
+
+TEST(obj_syntax)
+{
+    static const char text[] =
+        "# comment line\r\n"
+        "mtllib scene.mtl\n"
+        "o thing\n"
+        "\n"
+        "   \t\n"
+        "v 0 0 0\r\n"
+        "v 1.5 -2 +3.25e1 1.0\n"          /* w ignored */
+        "v\t.5 5. -0 0.2 0.3 0.4\n"      /* colour values ignored; tabs */
+        "vt 0.5 0.5\n"
+        "vn 0 0 1\n"
+        "g group\n"
+        "s off\n"
+        "usemtl red\n"
+        "v 1E2 1e-2 -1.25E+1   # trailing comment\n"
+        "f 1 2 3\n"
+        "f 1/1 2/1 3/1\n"
+        "f 1//1 2//1 4//1\n"
+        "f 1/1/1 3/1/1 4/1/1 2/1/1\n"     /* quad: fanned (1,3,4), (1,4,2) */
+        "f -4 -3 -2 -1 5\n"              /* relative + forward reference to vertex 5 */
+        "l 1 2\n"
+        "p 3\n"
+        "vp 0.1\n"
+        "v 7 8 9\r"                      /* CR only line end */
+        "f 5 4 3";                       /* no final newline */
+    static const float want_v[15] = {0, 0, 0, 1.5f, -2, 32.5f, 0.5f, 5, -0.0f, 100, 0.01f, -12.5f, 7, 8, 9};
+    static const uint32_t want_t[] = {0, 1, 2, 0, 1, 2, 0, 1, 3, 0, 2, 3, 0, 3, 1,
+                                      0, 1, 2, 0, 2, 3, 0, 3, 4, 4, 3, 2};
+    hfvis_mesh m;
+    CHECK_EQ_STATUS(hfvis_obj_decode(text, sizeof text - 1, NULL, &m), HFVIS_OK);
+    CHECK(m.vertex_count == 5 && m.triangle_count == 9);
+    if (m.vertex_count == 5) CHECK(memcmp(m.xyz, want_v, sizeof want_v) == 0);
+    if (m.triangle_count == 9) CHECK(memcmp(m.indices, want_t, sizeof want_t) == 0);
+    CHECK(signbit(m.xyz[8]));
+    hfvis_mesh_free(NULL, &m);
+    /* empty input and comment-only input: an empty mesh */
+    memset(&m, 0x11, sizeof m);
+    CHECK_EQ_STATUS(hfvis_obj_decode(NULL, 0, NULL, &m), HFVIS_OK);
+    CHECK(m.vertex_count == 0 && m.triangle_count == 0 && m.xyz == NULL && m.indices == NULL);
+    CHECK_EQ_STATUS(hfvis_obj_decode("# x\nvt 1 2\n", 11, NULL, &m), HFVIS_OK);
+    CHECK(m.vertex_count == 0 && m.triangle_count == 0);
+    /* long mantissas and far exponents */
+    {
+        static const char t2[] = "v 0.000000000000000000000000000000000000000000000000123456789012345678901234e47 "
+                                 "123456789012345678901234567890e-29 1e-46\n";
+        CHECK_EQ_STATUS(hfvis_obj_decode(t2, sizeof t2 - 1, NULL, &m), HFVIS_OK);
+        CHECK(m.xyz[0] == strtof("0.000000000000000000000000000000000000000000000000123456789012345678901234e47", NULL));
+        CHECK(m.xyz[1] == 1.23456789f && m.xyz[2] == 0.0f);
+        hfvis_mesh_free(NULL, &m);
+    }
+}
+
+TEST(obj_errors)
+{
+    static const char *const bad[] = {
+        "v 1 2\n", "v 1 2 x\n", "v 1 2 inf\n", "v nan 1 2\n", "v 1e39 0 0\n", "v -3.5e38 0 0\n",
+        "v 0x1p3 0 0\n", "v 1 2 3e\n", "v 1 2 3e+\n", "v . 1 2\n", "v - 1 2\n", "v 1..2 0 0\n",
+        "v 1 2 3 q\n", "v 1,5 2 3\n", "v 1 2 3\nf 1 2\n", "v 1 2 3\nf 0 1 1\n",
+        "v 1 2 3\nf 1 1 2\n", "v 1 2 3\nf -2 1 1\n", "v 1 2 3\nf 1/ 1 1\n", "v 1 2 3\nf 1/1/ 1 1\n",
+        "v 1 2 3\nf 1//1/1 1 1\n", "v 1 2 3\nf a b c\n", "v 1 2 3\nf 1/1/1/1 1 1\n",
+        "v 1 2 3\nf 1 1 1x\n", "v 1 2 3\nf 1 1 99999999999999999999\n", "f 1 2 3\n",
+        "v 1 2 3\nf 1 1 -99999999999999999999\n", "v 1 2 3\nf 1/0 1 1\n", "v 1 2 3\nf 1//0 1 1\n",
+        "v 1 2 3\nf\n", "v 1 2 3\nf +0 1 1\n", "v 1 2 3\nf -0 1 1\n", "v 1 2 3\nf 1 // 1\n"};
+    size_t i;
+    for (i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        hfvis_mesh m;
+        hfvis_status s;
+        memset(&m, 0x33, sizeof m);
+        s = hfvis_obj_decode(bad[i], strlen(bad[i]), NULL, &m);
+        if (s != HFVIS_ERR_FORMAT) fprintf(stderr, "  case %u: \"%s\"\n", (unsigned)i, bad[i]);
+        CHECK_EQ_STATUS(s, HFVIS_ERR_FORMAT);
+        CHECK(m.vertex_count == (size_t)0x3333333333333333ull);
+    }
+    {
+        hfvis_mesh m;
+        CHECK_EQ_STATUS(hfvis_obj_decode(NULL, 5, NULL, &m), HFVIS_ERR_INVALID_ARGUMENT);
+        CHECK_EQ_STATUS(hfvis_obj_decode("v 1 2 3\n", 8, NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    }
+    /* encoder arguments */
+    {
+        hfvis_mesh bm;
+        float xyz[3] = {0, INFINITY, 0};
+        unsigned char buf[64];
+        size_t w = 77;
+        bm.xyz = xyz;
+        bm.vertex_count = 1;
+        bm.indices = NULL;
+        bm.triangle_count = 0;
+        CHECK(hfvis_obj_encode_size(&bm) == 0);
+        CHECK(hfvis_obj_encode_size(NULL) == 0);
+        CHECK_EQ_STATUS(hfvis_obj_encode(&bm, buf, sizeof buf, &w), HFVIS_ERR_INVALID_ARGUMENT);
+        xyz[1] = 0.0f;
+        CHECK_EQ_STATUS(hfvis_obj_encode(&bm, NULL, sizeof buf, &w), HFVIS_ERR_INVALID_ARGUMENT);
+        CHECK_EQ_STATUS(hfvis_obj_encode(&bm, buf, sizeof buf, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+        CHECK(w == 77);
+        CHECK_EQ_STATUS(hfvis_obj_encode(&bm, buf, sizeof buf, &w), HFVIS_OK);
+        CHECK(w == hfvis_obj_encode_size(&bm) && memcmp(buf, "# hfvis mesh: 1 vertices, 0 triangles\nv 0 0 0\n", w) == 0);
+        CHECK_EQ_STATUS(hfvis_mesh_save("/tmp/x.obj", NULL), HFVIS_ERR_INVALID_ARGUMENT);
+        CHECK_EQ_STATUS(hfvis_mesh_save(NULL, &bm), HFVIS_ERR_INVALID_ARGUMENT);
+        CHECK_EQ_STATUS(hfvis_mesh_load(NULL, NULL, &bm), HFVIS_ERR_INVALID_ARGUMENT);
+        CHECK_EQ_STATUS(hfvis_mesh_load("/tmp/x.obj", NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    }
+}
+
+TEST(obj_alloc_failure)
+{
+    static const char text[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3 4\nf 1 3 2\n";
+    counting cnt;
+    hfvis_allocator a;
+    hfvis_mesh m, ref;
+    int k;
+    CHECK_EQ_STATUS(hfvis_obj_decode(text, sizeof text - 1, NULL, &ref), HFVIS_OK);
+    for (k = 1; k <= 2; k++) {
+        a = counting_allocator(&cnt);
+        cnt.fail_at = k;
+        memset(&m, 0x44, sizeof m);
+        CHECK_EQ_STATUS(hfvis_obj_decode(text, sizeof text - 1, &a, &m), HFVIS_ERR_OUT_OF_MEMORY);
+        CHECK(cnt.live == 0 && m.vertex_count == (size_t)0x4444444444444444ull);
+    }
+    a = counting_allocator(&cnt);
+    CHECK_EQ_STATUS(hfvis_obj_decode(text, sizeof text - 1, &a, &m), HFVIS_OK);
+    CHECK(cnt.allocs == 2 && same_mesh(&m, &ref));
+    hfvis_mesh_free(&a, &m);
+    CHECK(cnt.live == 0);
+    /* load: file buffer + 2 */
+    {
+        const char *path = "build/test_mesh_alloc.obj";
+        FILE *f = fopen(path, "wb");
+        int n;
+        CHECK(f != NULL);
+        if (!f) return;
+        fwrite(text, 1, sizeof text - 1, f);
+        fclose(f);
+        a = counting_allocator(&cnt);
+        CHECK_EQ_STATUS(hfvis_mesh_load(path, &a, &m), HFVIS_OK);
+        CHECK(same_mesh(&m, &ref));
+        n = cnt.allocs;
+        CHECK(n == 3);
+        hfvis_mesh_free(&a, &m);
+        CHECK(cnt.live == 0);
+        for (k = 1; k <= n; k++) {
+            a = counting_allocator(&cnt);
+            cnt.fail_at = k;
+            memset(&m, 0x44, sizeof m);
+            CHECK_EQ_STATUS(hfvis_mesh_load(path, &a, &m), HFVIS_ERR_OUT_OF_MEMORY);
+            CHECK(cnt.live == 0 && m.vertex_count == (size_t)0x4444444444444444ull);
+        }
+        remove(path);
+    }
+    hfvis_mesh_free(NULL, &ref);
+}
+
+TEST(obj_files)
+{
+    const char *path = "build/test_mesh_file.obj";
+    const double c[3] = {1, 2, 3};
+    hfvis_mesh m, back;
+    FILE *f;
+    char first[8] = {0};
+    CHECK_EQ_STATUS(hfvis_mesh_icosphere(NULL, c, 2.0, 2, &m), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_mesh_save(path, &m), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_mesh_load(path, NULL, &back), HFVIS_OK);
+    CHECK(same_mesh(&m, &back));
+    hfvis_mesh_free(NULL, &back);
+    /* saving to a directory fails and leaves it alone; a failing save leaves the old file */
+    CHECK_EQ_STATUS(hfvis_mesh_save("build", &m), HFVIS_ERR_IO);
+    CHECK_EQ_STATUS(hfvis_mesh_save("build/no_such_dir/x.obj", &m), HFVIS_ERR_IO);
+    f = fopen(path, "rb");
+    CHECK(f != NULL);
+    if (f) {
+        CHECK(fread(first, 1, 7, f) == 7 && memcmp(first, "# hfvis", 7) == 0);
+        fclose(f);
+    }
+    CHECK_EQ_STATUS(hfvis_mesh_load("build/no_such_file.obj", NULL, &back), HFVIS_ERR_IO);
+    /* a malformed file: FORMAT, nothing leaked */
+    f = fopen(path, "wb");
+    if (f) {
+        fputs("v 1 2 3\nf 1 2 3\n", f);
+        fclose(f);
+    }
+    CHECK_EQ_STATUS(hfvis_mesh_load(path, NULL, &back), HFVIS_ERR_FORMAT);
+    remove(path);
+    hfvis_mesh_free(NULL, &m);
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
@@ -428,5 +1179,19 @@ int main(int argc, char **argv)
     RUN(room);
     RUN(teapot);
     RUN(generators_alloc_failure);
+    RUN(icosphere_construction);
+    RUN(icosphere_spec_counts);
+    RUN(torus_knot_embedded);
+    RUN(from_grid_holes);
+    RUN(room_layout);
+    RUN(teapot_shape);
+    RUN(generator_bad_arguments);
+    RUN(obj_round_trip_generators);
+    RUN(obj_float_round_trip);
+    RUN(obj_number_parser);
+    RUN(obj_syntax);
+    RUN(obj_errors);
+    RUN(obj_alloc_failure);
+    RUN(obj_files);
     return TEST_DONE();
 }
