@@ -1,0 +1,767 @@
+/* ========================================================================================== */
+/* 3a. Surface voxelization into the Volume Buffer                                            */
+/*     [G12] ch. 6 (§6.4.1 Alg. 5 geometry-shader triangle slicing, §6.4.2 Alg. 6 pixel-shader */
+/*     fragment clipping, §6.6 output-vertex limit), ch. 5 §5.5.1 Alg. 4 (three axial passes   */
+/*     merged with MAX); spec voxel §3.4-3.8, §3.12-3.13                                       */
+/* ========================================================================================== */
+/*
+ * Everything happens in grid space g = (p - origin)/cell, where a voxel is a unit cube. A pass
+ * along axis a sees the triangle projected onto the (u, w) = (a+1, a+2 mod 3) plane; its pixel
+ * (pu, pw) has centre (pu + 0.5, pw + 0.5) and the voxel column of that pixel is cut into slabs
+ * [k, k+1) along a (the GPU's layers).
+ *
+ * Exactness. The fast routines and the oracle evaluate the same predicates with the same
+ * floating-point expressions:
+ *   inside(c) = every edge function > 0, or == 0 on a top-left edge;
+ *   slab(c)   = floor(clamp(depth(c), zlo, zhi)).
+ * For a fixed row (fixed cw) every edge function, and the depth, is a composition of rounded
+ * subtractions and multiplications by constants of cu, hence monotone in cu (IEEE rounding is
+ * monotone). So each predicate holds on a prefix or a suffix of the row, the covered pixels of a
+ * row are one interval and the slab is monotone along it: the fast path finds the interval ends
+ * and the slab changes by a guessed-then-verified search (about two predicate evaluations each)
+ * and writes every fragment between them without testing it again. The oracle tests every voxel
+ * of the bounding box directly. Both therefore select exactly the same voxels.
+ */
+
+#define VX_VOX_MAX_COORD 1e150 /* beyond: products of coordinates could overflow double */
+#define VX_VOX_MAX_SLOPE 1e100 /* beyond: the triangle is edge-on to the pass (to precision) */
+
+/* One directed edge A -> B of a counter-clockwise polygon in the (u, w) plane. The edge function
+ * is evaluated from the lexicographically smaller endpoint `l` with d = (larger - smaller) and
+ * multiplied by sign = +1 (A is the smaller) or -1, so the two directions of one segment give
+ * exactly opposite values (a shared edge of two triangles never covers a pixel twice or not at
+ * all). E(c) > 0 left of A -> B, i.e. inside. */
+typedef struct vx_vox_edge {
+    double lu, lw, du, dw, sign;
+    int owned; /* top-left rule: centres exactly on the edge are inside */
+    int skip;  /* zero-length edge (duplicate polygon vertex): no constraint */
+} vx_vox_edge;
+
+static void vx_vox_edge_init(vx_vox_edge *e, double au, double aw, double bu, double bw)
+{
+    int a_small = au < bu || (au == bu && aw < bw);
+    double su = a_small ? au : bu, sw = a_small ? aw : bw;
+    double gu = a_small ? bu : au, gw = a_small ? bw : aw;
+    double tu, tw;
+    e->lu = su;
+    e->lw = sw;
+    e->du = gu - su;
+    e->dw = gw - sw;
+    e->sign = a_small ? 1.0 : -1.0;
+    e->skip = au == bu && aw == bw;
+    /* traversal direction B - A (exact sign of the rounded difference) */
+    tu = e->sign * e->du;
+    tw = e->sign * e->dw;
+    /* counter-clockwise with w up: a "left" edge goes down, a "top" edge goes left */
+    e->owned = tw < 0.0 || (tw == 0.0 && tu < 0.0);
+}
+
+static double vx_vox_edge_value(const vx_vox_edge *e, double cu, double cw)
+{
+    return e->sign * (e->du * (cw - e->lw) - e->dw * (cu - e->lu));
+}
+
+static int vx_vox_edge_pass(const vx_vox_edge *e, double cu, double cw)
+{
+    double v;
+    if (e->skip) return 1;
+    v = vx_vox_edge_value(e, cu, cw);
+    return v > 0.0 || (v == 0.0 && e->owned);
+}
+
+/* A triangle prepared for voxelization (grid space, double). */
+typedef struct vx_vox_tri {
+    uint32_t id;
+    double v[3][3];  /* world vertices */
+    double g[3][3];  /* grid-space vertices */
+    double n[3];     /* grid-space normal (g1 - g0) x (g2 - g0) */
+    float normal[3]; /* unit world normal (only filled when fragments are delivered) */
+} vx_vox_tri;
+
+/* The triangle in the pass along axis a. */
+typedef struct vx_vox_pass {
+    int a, u, w;
+    double U[3], W[3], Z[3]; /* projected vertices (original order) and depths */
+    double area2;            /* n[a]: twice the signed projected area */
+    vx_vox_edge e[3];        /* counter-clockwise edges */
+    double q[3][3];          /* counter-clockwise vertices (U, W, Z) */
+    double dzdu, dzdw;       /* depth slopes of the plane */
+    double zlo, zhi;         /* depth range */
+    double kmin;             /* floor(zlo): the slab the geometry shader starts from */
+    int bu0, bu1, bw0, bw1;  /* pixel bounding box of the triangle within the grid */
+    int k0, k1;              /* slabs floor(zlo) .. floor(zhi) within the grid (and the cap) */
+} vx_vox_pass;
+
+/* Pixel range [*i0, *i1] whose centres i + 0.5 lie in [lo, hi], within [0, n); 0 if empty. */
+static int vx_vox_pixel_range(double lo, double hi, int n, int *i0, int *i1)
+{
+    double a = ceil(lo - 0.5), b = floor(hi - 0.5);
+    if (a < 0.0) a = 0.0;
+    if (b > (double)(n - 1)) b = (double)(n - 1);
+    if (!(a <= b)) return 0;
+    *i0 = (int)a;
+    *i1 = (int)b;
+    return 1;
+}
+
+/* Grid-space setup of triangle t; 0 if it is degenerate or out of range (skipped). */
+static int vx_vox_tri_setup(vx_vox_tri *T, const hfvis_mesh *m, const hfvis_volume_grid *g,
+                            size_t t, int want_normal)
+{
+    int i, a;
+    double e1[3], e2[3];
+    T->id = (uint32_t)t;
+    for (i = 0; i < 3; i++) {
+        const float *p = m->xyz + 3 * (size_t)m->indices[3 * t + (size_t)i];
+        for (a = 0; a < 3; a++) {
+            T->v[i][a] = (double)p[a];
+            T->g[i][a] = ((double)p[a] - g->origin[a]) / g->cell[a];
+            if (!(fabs(T->g[i][a]) <= VX_VOX_MAX_COORD)) return 0;
+        }
+    }
+    for (a = 0; a < 3; a++) {
+        e1[a] = T->g[1][a] - T->g[0][a];
+        e2[a] = T->g[2][a] - T->g[0][a];
+    }
+    T->n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    T->n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    T->n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    if (T->n[0] == 0.0 && T->n[1] == 0.0 && T->n[2] == 0.0) return 0;
+    if (want_normal) {
+        double w1[3], w2[3], nw[3], len;
+        for (a = 0; a < 3; a++) {
+            w1[a] = T->v[1][a] - T->v[0][a];
+            w2[a] = T->v[2][a] - T->v[0][a];
+        }
+        nw[0] = w1[1] * w2[2] - w1[2] * w2[1];
+        nw[1] = w1[2] * w2[0] - w1[0] * w2[2];
+        nw[2] = w1[0] * w2[1] - w1[1] * w2[0];
+        len = sqrt(nw[0] * nw[0] + nw[1] * nw[1] + nw[2] * nw[2]);
+        for (a = 0; a < 3; a++) T->normal[a] = len > 0.0 ? (float)(nw[a] / len) : 0.0f;
+    }
+    return 1;
+}
+
+/* Dominant axis of the grid-space normal (spec §3.4, §3.12: ties -> lowest index). */
+static int vx_vox_dominant(const double n[3])
+{
+    int a = 0;
+    if (fabs(n[1]) > fabs(n[a])) a = 1;
+    if (fabs(n[2]) > fabs(n[a])) a = 2;
+    return a;
+}
+
+/* Set up the pass of T along axis a; max_slices > 0 caps the slabs at kmin + max_slices - 1.
+ * Returns 0 when the pass writes nothing (edge-on, outside the grid). */
+static int vx_vox_pass_setup(vx_vox_pass *p, const vx_vox_tri *T, int a, const int dims[3],
+                             int max_slices)
+{
+    int i, swap;
+    double ulo, uhi, wlo, whi, k0, k1;
+    p->a = a;
+    p->u = (a + 1) % 3;
+    p->w = (a + 2) % 3;
+    p->area2 = T->n[a];
+    if (p->area2 == 0.0) return 0;
+    for (i = 0; i < 3; i++) {
+        p->U[i] = T->g[i][p->u];
+        p->W[i] = T->g[i][p->w];
+        p->Z[i] = T->g[i][a];
+    }
+    p->dzdu = -T->n[p->u] / T->n[a];
+    p->dzdw = -T->n[p->w] / T->n[a];
+    if (!(fabs(p->dzdu) <= VX_VOX_MAX_SLOPE) || !(fabs(p->dzdw) <= VX_VOX_MAX_SLOPE)) return 0;
+    p->zlo = p->Z[0], p->zhi = p->Z[0];
+    ulo = uhi = p->U[0];
+    wlo = whi = p->W[0];
+    for (i = 1; i < 3; i++) {
+        if (p->Z[i] < p->zlo) p->zlo = p->Z[i];
+        if (p->Z[i] > p->zhi) p->zhi = p->Z[i];
+        if (p->U[i] < ulo) ulo = p->U[i];
+        if (p->U[i] > uhi) uhi = p->U[i];
+        if (p->W[i] < wlo) wlo = p->W[i];
+        if (p->W[i] > whi) whi = p->W[i];
+    }
+    p->kmin = floor(p->zlo);
+    k0 = p->kmin;
+    k1 = floor(p->zhi);
+    if (max_slices > 0 && k1 > p->kmin + (double)(max_slices - 1)) k1 = p->kmin + (double)(max_slices - 1);
+    if (k0 < 0.0) k0 = 0.0;
+    if (k1 > (double)(dims[a] - 1)) k1 = (double)(dims[a] - 1);
+    if (!(k0 <= k1)) return 0;
+    p->k0 = (int)k0;
+    p->k1 = (int)k1;
+    if (!vx_vox_pixel_range(ulo, uhi, dims[p->u], &p->bu0, &p->bu1)) return 0;
+    if (!vx_vox_pixel_range(wlo, whi, dims[p->w], &p->bw0, &p->bw1)) return 0;
+    /* counter-clockwise order in the (u, w) plane */
+    swap = p->area2 < 0.0;
+    for (i = 0; i < 3; i++) {
+        int s = swap ? (3 - i) % 3 : i; /* 0, 2, 1 when clockwise */
+        p->q[i][0] = p->U[s];
+        p->q[i][1] = p->W[s];
+        p->q[i][2] = p->Z[s];
+    }
+    for (i = 0; i < 3; i++) {
+        int j = (i + 1) % 3;
+        vx_vox_edge_init(&p->e[i], p->q[i][0], p->q[i][1], p->q[j][0], p->q[j][1]);
+    }
+    return 1;
+}
+
+/* The plane's depth at pixel centre (cu, cw), clamped to the triangle's depth range (a no-op in
+ * exact arithmetic; it keeps floor(z) inside the slabs the triangle spans). Monotone in cu. */
+static double vx_vox_depth(const vx_vox_pass *p, double cu, double cw)
+{
+    double z = (p->Z[0] + p->dzdw * (cw - p->W[0])) + p->dzdu * (cu - p->U[0]);
+    if (z < p->zlo) z = p->zlo;
+    if (z > p->zhi) z = p->zhi;
+    return z;
+}
+
+static int vx_vox_inside(const vx_vox_edge *e, int ne, double cu, double cw)
+{
+    int i;
+    for (i = 0; i < ne; i++)
+        if (!vx_vox_edge_pass(&e[i], cu, cw)) return 0;
+    return 1;
+}
+
+/* ---- GS slicing: the slab piece (Alg. 5; Sutherland-Hodgman against both slab planes) ---- */
+
+#define VX_VOX_PIECE_MAX 8
+
+/* Crossing of the original edge (A, B) with the plane z = c, A.z != B.z, c strictly between:
+ * computed from the lower-depth endpoint, so every piece and every triangle sharing the edge
+ * gets the same point. */
+static void vx_vox_cross(const double *A, const double *B, double c, double out[2])
+{
+    const double *P = A[2] < B[2] ? A : B, *Q = A[2] < B[2] ? B : A;
+    double t = (c - P[2]) / (Q[2] - P[2]);
+    out[0] = P[0] + t * (Q[0] - P[0]);
+    out[1] = P[1] + t * (Q[1] - P[1]);
+}
+
+/* The piece of the pass's triangle in slab [k, k+1] (closed), counter-clockwise, as (u, w)
+ * points: each edge Qi -> Qj contributes Qi if it lies in the slab, then its crossings with the
+ * planes k and k+1 strictly between Qi.z and Qj.z, in order along the edge. This is the
+ * Sutherland-Hodgman clip of the triangle by the two planes with every crossing taken from an
+ * original edge. Returns the vertex count and its edges; 0 if the piece has no area. */
+static int vx_vox_piece(const vx_vox_pass *p, double k, vx_vox_edge *edges, double *bb)
+{
+    double pt[VX_VOX_PIECE_MAX][2], area2 = 0.0;
+    int n = 0, i;
+    for (i = 0; i < 3; i++) {
+        const double *A = p->q[i], *B = p->q[(i + 1) % 3];
+        double c0 = A[2] < B[2] ? k : k + 1.0, c1 = A[2] < B[2] ? k + 1.0 : k;
+        if (A[2] >= k && A[2] <= k + 1.0) {
+            pt[n][0] = A[0];
+            pt[n][1] = A[1];
+            n++;
+        }
+        if ((A[2] < c0 && c0 < B[2]) || (B[2] < c0 && c0 < A[2])) vx_vox_cross(A, B, c0, pt[n++]);
+        if ((A[2] < c1 && c1 < B[2]) || (B[2] < c1 && c1 < A[2])) vx_vox_cross(A, B, c1, pt[n++]);
+    }
+    if (n < 3) return 0;
+    for (i = 0; i < n; i++) {
+        int j = (i + 1) % n;
+        area2 += (pt[i][0] - pt[0][0]) * (pt[j][1] - pt[0][1])
+                 - (pt[j][0] - pt[0][0]) * (pt[i][1] - pt[0][1]);
+    }
+    if (!(area2 > 0.0)) return 0;
+    bb[0] = bb[1] = pt[0][0];
+    bb[2] = bb[3] = pt[0][1];
+    for (i = 0; i < n; i++) {
+        int j = (i + 1) % n;
+        vx_vox_edge_init(&edges[i], pt[i][0], pt[i][1], pt[j][0], pt[j][1]);
+        if (pt[i][0] < bb[0]) bb[0] = pt[i][0];
+        if (pt[i][0] > bb[1]) bb[1] = pt[i][0];
+        if (pt[i][1] < bb[2]) bb[2] = pt[i][1];
+        if (pt[i][1] > bb[3]) bb[3] = pt[i][1];
+    }
+    return n;
+}
+
+/* ---- the fragment sink: occupancy bytes or the Volume Buffer with its blends ------------- */
+
+typedef struct vx_vox_sink {
+    const hfvis_volume_grid *grid;
+    hfvis_volume *vol;  /* or NULL */
+    uint8_t *occ;       /* or NULL */
+    hfvis_voxel_fragment_fn fn;
+    void *user;
+    size_t count;
+    size_t stride[3];   /* linear-index step per axis */
+    const vx_vox_tri *tri;
+} vx_vox_sink;
+
+/* The fragment of pixel centre (cu, cw) of pass p written to voxel v. */
+static void vx_vox_fragment_fill(hfvis_voxel_fragment *f, const vx_vox_tri *T,
+                                 const vx_vox_pass *p, const int v[3])
+{
+    double cu = (double)v[p->u] + 0.5, cw = (double)v[p->w] + 0.5, b[3];
+    int i, a;
+    for (i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3; /* edge opposite vertex i: j -> k */
+        b[i] = ((p->U[k] - p->U[j]) * (cw - p->W[j]) - (p->W[k] - p->W[j]) * (cu - p->U[j]))
+               / p->area2;
+    }
+    for (a = 0; a < 3; a++) {
+        f->voxel[a] = v[a];
+        f->barycentric[a] = (float)b[a];
+        f->position[a] = (float)(b[0] * T->v[0][a] + b[1] * T->v[1][a] + b[2] * T->v[2][a]);
+        f->normal[a] = T->normal[a];
+    }
+    f->axis = p->a;
+    f->triangle = T->id;
+}
+
+/* Write pixels u0..u1 of row pw into slab k. */
+static void vx_vox_emit(vx_vox_sink *s, const vx_vox_pass *p, int pw, int u0, int u1, int k)
+{
+    int v[3], pu;
+    size_t lin, step = s->stride[p->u];
+    v[p->a] = k;
+    v[p->w] = pw;
+    v[p->u] = u0;
+    lin = ((size_t)v[2] * (size_t)s->grid->dims[1] + (size_t)v[1]) * (size_t)s->grid->dims[0]
+          + (size_t)v[0];
+    s->count += (size_t)(u1 - u0 + 1);
+    if (s->occ) {
+        for (pu = u0; pu <= u1; pu++, lin += step) s->occ[lin] = 1;
+    } else if (!s->fn) {
+        size_t C = (size_t)s->vol->channels;
+        float *d = s->vol->data;
+        hfvis_blend op = s->vol->blend[0];
+        for (pu = u0; pu <= u1; pu++, lin += step) d[lin * C] = vx_blend_apply(op, d[lin * C], 1.0f);
+    } else {
+        int C = s->vol->channels, c;
+        float values[HFVIS_VOLUME_MAX_CHANNELS];
+        hfvis_voxel_fragment f;
+        for (pu = u0; pu <= u1; pu++, lin += step) {
+            float *d = s->vol->data + lin * (size_t)C;
+            v[p->u] = pu;
+            vx_vox_fragment_fill(&f, s->tri, p, v);
+            memset(values, 0, sizeof values);
+            s->fn(&f, values, s->user);
+            for (c = 0; c < C; c++) d[c] = vx_blend_apply(s->vol->blend[c], d[c], values[c]);
+        }
+    }
+}
+
+/* ---- monotone searches along a row ------------------------------------------------------ */
+
+/* A predicate of the pixel column pu in a fixed row, nondecreasing in pu (false...true):
+ * edge != NULL: edge pass (negate: its negation); else depth(cu) >= thr (negate: < thr). */
+typedef struct vx_vox_pred {
+    const vx_vox_edge *edge;
+    const vx_vox_pass *p;
+    double cw, thr;
+    int negate;
+} vx_vox_pred;
+
+static int vx_vox_pred_eval(const vx_vox_pred *r, int pu)
+{
+    double cu = (double)pu + 0.5;
+    int t = r->edge ? vx_vox_edge_pass(r->edge, cu, r->cw) : vx_vox_depth(r->p, cu, r->cw) >= r->thr;
+    return r->negate ? !t : t;
+}
+
+/* Smallest pu in [lo, hi] where the nondecreasing predicate holds (hi + 1 if none), starting
+ * from the estimate `guess` (a pixel coordinate; any value, NaN included, is safe). Galloping
+ * from the guess, then bisection: O(1) evaluations when the guess is within a pixel. */
+static int vx_vox_first_true(const vx_vox_pred *r, int lo, int hi, double guess)
+{
+    int g, t, f, step = 1;
+    if (lo > hi) return lo;
+    if (!(guess > (double)lo)) g = lo;
+    else if (!(guess < (double)hi)) g = hi;
+    else g = (int)ceil(guess);
+    if (vx_vox_pred_eval(r, g)) { /* answer <= g */
+        t = g;
+        for (;;) {
+            if (t - lo < step) { f = lo - 1; break; }
+            f = t - step;
+            if (!vx_vox_pred_eval(r, f)) break;
+            t = f;
+            if (step < (1 << 29)) step *= 2;
+        }
+    } else { /* answer > g */
+        f = g;
+        for (;;) {
+            if (hi - f < step) { t = hi + 1; break; }
+            t = f + step;
+            if (vx_vox_pred_eval(r, t)) break;
+            f = t;
+            if (step < (1 << 29)) step *= 2;
+        }
+    }
+    while (t - f > 1) {
+        int mid = f + (t - f) / 2;
+        if (vx_vox_pred_eval(r, mid)) t = mid;
+        else f = mid;
+    }
+    return t;
+}
+
+/* The pixels [*L, *R] of row cw within [lo, hi] inside every edge; 0 if none. */
+static int vx_vox_row_span(const vx_vox_edge *e, int ne, double cw, int lo, int hi, int *L, int *R)
+{
+    int i;
+    vx_vox_pred r;
+    r.p = NULL;
+    r.cw = cw;
+    r.thr = 0.0;
+    for (i = 0; i < ne && lo <= hi; i++) {
+        const vx_vox_edge *ed = &e[i];
+        double slope, guess;
+        if (ed->skip) continue;
+        slope = -ed->sign * ed->dw; /* dE/dcu */
+        if (slope == 0.0) {         /* constant along the row */
+            if (!vx_vox_edge_pass(ed, (double)lo + 0.5, cw)) return 0;
+            continue;
+        }
+        guess = ed->lu + ed->du * (cw - ed->lw) / ed->dw - 0.5; /* the root, as a pixel index */
+        r.edge = ed;
+        if (slope > 0.0) { /* inside on a suffix */
+            r.negate = 0;
+            lo = vx_vox_first_true(&r, lo, hi, guess);
+        } else {           /* inside on a prefix */
+            r.negate = 1;
+            hi = vx_vox_first_true(&r, lo, hi, guess) - 1;
+        }
+    }
+    *L = lo;
+    *R = hi;
+    return lo <= hi;
+}
+
+/* Pixel estimate where depth reaches thr along row cw. */
+static double vx_vox_depth_guess(const vx_vox_pass *p, double cw, double thr)
+{
+    double row = p->Z[0] + p->dzdw * (cw - p->W[0]);
+    return p->U[0] + (thr - row) / p->dzdu - 0.5;
+}
+
+/* Write the pixels L..R of row pw (all inside the triangle) whose slab lies in [s0, s1], each
+ * into its slab: the runs of constant slab are found by searching the slab boundaries. */
+static void vx_vox_row_slabs(vx_vox_sink *s, const vx_vox_pass *p, int pw, int L, int R, int s0,
+                             int s1)
+{
+    double cw = (double)pw + 0.5;
+    vx_vox_pred r;
+    int cur;
+    r.edge = NULL;
+    r.p = p;
+    r.cw = cw;
+    if (p->dzdu == 0.0) { /* depth constant along the row */
+        double k = floor(vx_vox_depth(p, (double)L + 0.5, cw));
+        if (k >= (double)s0 && k <= (double)s1) vx_vox_emit(s, p, pw, L, R, (int)k);
+        return;
+    }
+    if (p->dzdu > 0.0) { /* slab nondecreasing along the row */
+        r.negate = 0;
+        r.thr = (double)s0;
+        L = vx_vox_first_true(&r, L, R, vx_vox_depth_guess(p, cw, r.thr));
+        r.thr = (double)s1 + 1.0;
+        R = vx_vox_first_true(&r, L, R, vx_vox_depth_guess(p, cw, r.thr)) - 1;
+        for (cur = L; cur <= R;) {
+            double k = floor(vx_vox_depth(p, (double)cur + 0.5, cw));
+            int nxt;
+            r.thr = k + 1.0;
+            nxt = vx_vox_first_true(&r, cur + 1, R, vx_vox_depth_guess(p, cw, r.thr));
+            vx_vox_emit(s, p, pw, cur, nxt - 1, (int)k);
+            cur = nxt;
+        }
+    } else { /* slab nonincreasing along the row */
+        r.negate = 1;
+        r.thr = (double)s1 + 1.0;
+        L = vx_vox_first_true(&r, L, R, vx_vox_depth_guess(p, cw, r.thr));
+        r.thr = (double)s0;
+        R = vx_vox_first_true(&r, L, R, vx_vox_depth_guess(p, cw, r.thr)) - 1;
+        for (cur = L; cur <= R;) {
+            double k = floor(vx_vox_depth(p, (double)cur + 0.5, cw));
+            int nxt;
+            r.thr = k; /* first pixel with depth < k */
+            nxt = vx_vox_first_true(&r, cur + 1, R, vx_vox_depth_guess(p, cw, r.thr));
+            vx_vox_emit(s, p, pw, cur, nxt - 1, (int)k);
+            cur = nxt;
+        }
+    }
+}
+
+/* ---- the three methods, fast (row spans) ------------------------------------------------- */
+
+/* Pixel rule (spec §3.4): every covered pixel of the pass into the slab of its depth. */
+static void vx_vox_fast_pixel_rule(vx_vox_sink *s, const vx_vox_pass *p)
+{
+    int pw, L, R;
+    for (pw = p->bw0; pw <= p->bw1; pw++)
+        if (vx_vox_row_span(p->e, 3, (double)pw + 0.5, p->bu0, p->bu1, &L, &R))
+            vx_vox_row_slabs(s, p, pw, L, R, p->k0, p->k1);
+}
+
+/* Fragment clipping ([G12] Alg. 6): for each slab (lowest first, capped), the whole triangle is
+ * rasterised again and only the fragments whose depth lies in [k, k+1) are kept. */
+static void vx_vox_fast_fragment_clipping(vx_vox_sink *s, const vx_vox_pass *p)
+{
+    int k, pw, L, R;
+    for (k = p->k0; k <= p->k1; k++)
+        for (pw = p->bw0; pw <= p->bw1; pw++)
+            if (vx_vox_row_span(p->e, 3, (double)pw + 0.5, p->bu0, p->bu1, &L, &R))
+                vx_vox_row_slabs(s, p, pw, L, R, k, k);
+}
+
+/* GS slicing ([G12] Alg. 5): the slab pieces (lowest first, capped), each rasterised into its
+ * slab with the pixel-centre rule on its own edges. */
+static void vx_vox_fast_gs_slicing(vx_vox_sink *s, const vx_vox_pass *p, const int dims[3])
+{
+    vx_vox_edge pe[VX_VOX_PIECE_MAX];
+    double bb[4];
+    int k, n, pw, u0, u1, w0, w1, L, R;
+    for (k = p->k0; k <= p->k1; k++) {
+        n = vx_vox_piece(p, (double)k, pe, bb);
+        if (n == 0 || !vx_vox_pixel_range(bb[0], bb[1], dims[p->u], &u0, &u1)
+            || !vx_vox_pixel_range(bb[2], bb[3], dims[p->w], &w0, &w1))
+            continue;
+        for (pw = w0; pw <= w1; pw++)
+            if (vx_vox_row_span(pe, n, (double)pw + 0.5, u0, u1, &L, &R))
+                vx_vox_emit(s, p, pw, L, R, k);
+    }
+}
+
+/* ---- the oracle (per voxel of the bounding box) ------------------------------------------ */
+
+static void vx_vox_reference_pass(vx_vox_sink *s, const vx_vox_pass *p, hfvis_voxelize_method method,
+                                  const int dims[3])
+{
+    int k, pu, pw;
+    for (k = p->k0; k <= p->k1; k++) {
+        if (method == HFVIS_VOXELIZE_GS_SLICING) {
+            vx_vox_edge pe[VX_VOX_PIECE_MAX];
+            double bb[4];
+            int n = vx_vox_piece(p, (double)k, pe, bb), u0, u1, w0, w1;
+            if (n == 0 || !vx_vox_pixel_range(bb[0], bb[1], dims[p->u], &u0, &u1)
+                || !vx_vox_pixel_range(bb[2], bb[3], dims[p->w], &w0, &w1))
+                continue;
+            for (pw = w0; pw <= w1; pw++)
+                for (pu = u0; pu <= u1; pu++)
+                    if (vx_vox_inside(pe, n, (double)pu + 0.5, (double)pw + 0.5))
+                        vx_vox_emit(s, p, pw, pu, pu, k);
+        } else {
+            for (pw = p->bw0; pw <= p->bw1; pw++)
+                for (pu = p->bu0; pu <= p->bu1; pu++) {
+                    double cu = (double)pu + 0.5, cw = (double)pw + 0.5, z;
+                    if (!vx_vox_inside(p->e, 3, cu, cw)) continue;
+                    z = vx_vox_depth(p, cu, cw);
+                    if ((double)k <= z && z < (double)k + 1.0) vx_vox_emit(s, p, pw, pu, pu, k);
+                }
+        }
+    }
+}
+
+/* ---- driver ------------------------------------------------------------------------------ */
+
+typedef struct vx_vox_cfg {
+    hfvis_voxelize_method method;
+    hfvis_voxelize_axes axes;
+    int max_slices; /* 0 = unlimited */
+    hfvis_voxel_fragment_fn fn;
+    void *user;
+} vx_vox_cfg;
+
+static hfvis_status vx_vox_resolve(const hfvis_voxelize_options *o, vx_vox_cfg *c)
+{
+    hfvis_voxelize_options d;
+    memset(&d, 0, sizeof d);
+    if (!o) o = &d;
+    if (o->method != HFVIS_VOXELIZE_PIXEL_RULE && o->method != HFVIS_VOXELIZE_GS_SLICING
+        && o->method != HFVIS_VOXELIZE_FRAGMENT_CLIPPING)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o->axes != HFVIS_AXES_DOMINANT && o->axes != HFVIS_AXES_ALL && o->axes != HFVIS_AXES_ONLY_X
+        && o->axes != HFVIS_AXES_ONLY_Y && o->axes != HFVIS_AXES_ONLY_Z)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o->max_output_vertices < 0) return HFVIS_ERR_INVALID_ARGUMENT;
+    c->max_slices = 0;
+    if (o->max_output_vertices > 0) {
+        if (o->method == HFVIS_VOXELIZE_PIXEL_RULE) return HFVIS_ERR_INVALID_ARGUMENT;
+        c->max_slices = hfvis_gs_max_slices(o->max_output_vertices,
+                                            o->method == HFVIS_VOXELIZE_FRAGMENT_CLIPPING);
+        if (c->max_slices < 1) return HFVIS_ERR_INVALID_ARGUMENT;
+    }
+    c->method = o->method;
+    c->axes = o->axes;
+    c->fn = o->fragment;
+    c->user = o->user;
+    return HFVIS_OK;
+}
+
+static void vx_vox_run(const hfvis_mesh *m, const vx_vox_cfg *c, vx_vox_sink *s, int reference)
+{
+    const hfvis_volume_grid *g = s->grid;
+    int npass = c->axes == HFVIS_AXES_ALL ? 3 : 1, pass;
+    size_t t;
+    vx_vox_tri T;
+    vx_vox_pass P;
+    s->stride[0] = 1;
+    s->stride[1] = (size_t)g->dims[0];
+    s->stride[2] = (size_t)g->dims[0] * (size_t)g->dims[1];
+    s->tri = &T;
+    for (pass = 0; pass < npass; pass++)
+        for (t = 0; t < m->triangle_count; t++) {
+            int a;
+            if (!vx_vox_tri_setup(&T, m, g, t, s->fn != NULL)) continue;
+            switch (c->axes) {
+            case HFVIS_AXES_DOMINANT: a = vx_vox_dominant(T.n); break;
+            case HFVIS_AXES_ONLY_X: a = 0; break;
+            case HFVIS_AXES_ONLY_Y: a = 1; break;
+            case HFVIS_AXES_ONLY_Z: a = 2; break;
+            case HFVIS_AXES_ALL:
+            default: a = pass; break;
+            }
+            if (!vx_vox_pass_setup(&P, &T, a, g->dims,
+                                   c->method == HFVIS_VOXELIZE_PIXEL_RULE ? 0 : c->max_slices))
+                continue;
+            if (reference) vx_vox_reference_pass(s, &P, c->method, g->dims);
+            else if (c->method == HFVIS_VOXELIZE_GS_SLICING) vx_vox_fast_gs_slicing(s, &P, g->dims);
+            else if (c->method == HFVIS_VOXELIZE_FRAGMENT_CLIPPING) vx_vox_fast_fragment_clipping(s, &P);
+            else vx_vox_fast_pixel_rule(s, &P);
+        }
+    s->tri = NULL; /* T is local */
+}
+
+static hfvis_status vx_vox_surface(const hfvis_mesh *mesh, hfvis_volume *vol,
+                                   const hfvis_voxelize_options *opts, size_t *fragments_written,
+                                   int reference)
+{
+    vx_vox_cfg cfg;
+    vx_vox_sink s;
+    int c;
+    hfvis_status st;
+    if (vx_mesh_check(mesh) != HFVIS_OK || !vol || !vol->data || !vx_grid_valid(&vol->grid)
+        || vol->channels < 1 || vol->channels > HFVIS_VOLUME_MAX_CHANNELS)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    for (c = 0; c < vol->channels; c++)
+        if (!vx_blend_valid(vol->blend[c])) return HFVIS_ERR_INVALID_ARGUMENT;
+    st = vx_vox_resolve(opts, &cfg);
+    if (st != HFVIS_OK) return st;
+    memset(&s, 0, sizeof s);
+    s.grid = &vol->grid;
+    s.vol = vol;
+    s.fn = cfg.fn;
+    s.user = cfg.user;
+    vx_vox_run(mesh, &cfg, &s, reference);
+    if (fragments_written) *fragments_written = s.count;
+    return HFVIS_OK;
+}
+
+HFVIS_API hfvis_voxelize_options hfvis_voxelize_options_default(void)
+{
+    hfvis_voxelize_options o;
+    memset(&o, 0, sizeof o);
+    o.method = HFVIS_VOXELIZE_PIXEL_RULE;
+    o.axes = HFVIS_AXES_DOMINANT;
+    o.max_output_vertices = 0;
+    o.fragment = NULL;
+    o.user = NULL;
+    o.alloc = NULL;
+    return o;
+}
+
+HFVIS_API int hfvis_gs_max_slices(int max_output_vertices, int pixel_clipping)
+{
+    int v = max_output_vertices;
+    if (pixel_clipping) return v >= 3 ? v / 3 : 0;   /* 3n vertices for n slabs */
+    return v >= 7 ? (v - 3) / 4 : 0;                  /* 3 + 4n vertices for n slabs */
+}
+
+HFVIS_API hfvis_status hfvis_voxelize_surface(const hfvis_mesh *mesh, hfvis_volume *vol,
+                                              const hfvis_voxelize_options *opts,
+                                              size_t *fragments_written)
+{
+    return vx_vox_surface(mesh, vol, opts, fragments_written, 0);
+}
+
+HFVIS_API hfvis_status hfvis_voxelize_surface_reference(const hfvis_mesh *mesh, hfvis_volume *vol,
+                                                        const hfvis_voxelize_options *opts,
+                                                        size_t *fragments_written)
+{
+    return vx_vox_surface(mesh, vol, opts, fragments_written, 1);
+}
+
+HFVIS_API hfvis_status hfvis_voxelize_occupancy(const hfvis_mesh *mesh,
+                                                const hfvis_volume_grid *grid,
+                                                const hfvis_voxelize_options *opts, uint8_t *occ)
+{
+    vx_vox_cfg cfg;
+    vx_vox_sink s;
+    hfvis_status st;
+    if (vx_mesh_check(mesh) != HFVIS_OK || !vx_grid_valid(grid) || !occ)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    st = vx_vox_resolve(opts, &cfg);
+    if (st != HFVIS_OK) return st;
+    memset(occ, 0, vx_grid_voxels(grid));
+    memset(&s, 0, sizeof s);
+    s.grid = grid;
+    s.occ = occ;
+    vx_vox_run(mesh, &cfg, &s, 0);
+    return HFVIS_OK;
+}
+
+/* ---- ready-made attribute callbacks ([G12] §6.5; spec §3.8) ------------------------------- */
+
+HFVIS_API void hfvis_voxel_fragment_occupancy(const hfvis_voxel_fragment *f, float *values,
+                                              void *user)
+{
+    (void)f;
+    (void)user;
+    values[0] = 1.0f;
+}
+
+HFVIS_API void hfvis_voxel_fragment_normal_occupancy(const hfvis_voxel_fragment *f, float *values,
+                                                     void *user)
+{
+    (void)user;
+    values[0] = 1.0f;
+    values[1] = f->normal[0];
+    values[2] = f->normal[1];
+    values[3] = f->normal[2];
+}
+
+HFVIS_API int hfvis_voxel_attribute_channel(unsigned flags, unsigned attribute)
+{
+    static const unsigned order[4] = { HFVIS_VOXEL_ATTR_OCCUPANCY, HFVIS_VOXEL_ATTR_NORMAL,
+                                       HFVIS_VOXEL_ATTR_ALBEDO, HFVIS_VOXEL_ATTR_RADIANCE };
+    int c = 0, i;
+    if (flags == 0) flags = HFVIS_VOXEL_ATTR_OCCUPANCY;
+    for (i = 0; i < 4; i++) {
+        if (!(flags & order[i])) continue;
+        if (attribute == order[i]) return c;
+        c += i == 0 ? 1 : 3;
+    }
+    return attribute == 0 ? c : -1;
+}
+
+HFVIS_API void hfvis_voxel_fragment_attributes(const hfvis_voxel_fragment *f, float *values,
+                                               void *user)
+{
+    const hfvis_voxel_attributes *at = (const hfvis_voxel_attributes *)user;
+    unsigned flags = at->flags ? at->flags : HFVIS_VOXEL_ATTR_OCCUPANCY;
+    float alb[3] = { 1.0f, 1.0f, 1.0f };
+    int c = 0, i;
+    if (at->albedo)
+        for (i = 0; i < 3; i++) alb[i] = at->albedo[3 * (size_t)f->triangle + (size_t)i];
+    if (flags & HFVIS_VOXEL_ATTR_OCCUPANCY) values[c++] = 1.0f;
+    if (flags & HFVIS_VOXEL_ATTR_NORMAL)
+        for (i = 0; i < 3; i++) values[c++] = f->normal[i];
+    if (flags & HFVIS_VOXEL_ATTR_ALBEDO)
+        for (i = 0; i < 3; i++) values[c++] = alb[i];
+    if (flags & HFVIS_VOXEL_ATTR_RADIANCE) {
+        float e[3] = { 0.0f, 0.0f, 0.0f };
+        if (at->irradiance) at->irradiance(f->position, f->normal, e, at->irradiance_user);
+        for (i = 0; i < 3; i++) {
+            double L = (double)alb[i] * (double)e[i] / VX_PI;
+            if (at->emission) L += (double)at->emission[3 * (size_t)f->triangle + (size_t)i];
+            values[c++] = (float)L;
+        }
+    }
+}
