@@ -46,8 +46,8 @@ HFVIS_API hfvis_status hfvis_mesh_uv_sphere(const hfvis_allocator *alloc, const 
  * order, creating the midpoint of (v1,v2), (v2,v3), (v3,v1) on first use (appended, shared by the
  * two faces of the edge, normalised in double: m = (p+q)/|p+q|), and replaces face t by (v1,a,c),
  * (v2,b,a), (v3,c,b), (a,b,c) at positions 4t..4t+3. Finally vertex = c + r*unit, rounded to
- * float. Five allocations (three temporary: unit positions in double and the edge map, about
- * 56*4^s bytes... s = 10 needs about 1 GiB in all). */
+ * float. Five allocations (three temporary: unit positions in double, 24 bytes per vertex, and
+ * the edge map, <= 360*4^s bytes); s = 10 needs about 1 GiB in all. */
 HFVIS_API hfvis_status hfvis_mesh_icosphere(const hfvis_allocator *alloc, const double c[3],
                                             double r, int subdivisions, hfvis_mesh *out);
 
@@ -104,16 +104,18 @@ HFVIS_API hfvis_status hfvis_mesh_from_grid(const hfvis_allocator *alloc, const 
 HFVIS_API hfvis_status hfvis_mesh_room(const hfvis_allocator *alloc, hfvis_mesh *out);
 
 /* A teapot-like test mesh (deterministic; n >= 1 sets the tessellation), z up, standing on
- * z = 0, height 1.42 (knob top), body radius <= 1: a body of revolution (a Catmull-Rom profile
- * through body, shoulder, lid and knob, revolved into 12n meridians x 8n bands, closed, like the
- * UV sphere) plus two open tubes: the spout (a quadratic Bezier centre line from (0.55, 0,
- * 0.30) inside the body to its open mouth at (1.6, 0, 1.05), radius 0.17 tapering to 0.08) and
- * the handle (a cubic Bezier from (-0.70, 0, 0.88) to (-0.72, 0, 0.30), both ends inside the
- * body, radius 0.075), each 8n+1 rings of 6n vertices. NOT watertight: the tubes' end rings
- * are boundary edges and the tubes pierce the body (no boolean union), so do not use it with
- * solid (parity) voxelization. Vertices 96n^2 + 96n^2 - 12n + 2 ... exactly
- * (8n-1)*12n + 2 + 2*(8n+1)*6n; triangles 2*12n*(8n-1) + 4*8n*6n. n > 4096 returns
- * HFVIS_ERR_LIMIT. Three allocations (one temporary). */
+ * z = 0: a body of revolution about the z axis (a Catmull-Rom profile through base, belly
+ * (radius 1 at z ~ 0.48), shoulder, lid and knob up to the top pole at z = 1.42, revolved into
+ * 12n meridians x 8n bands, closed, vertex layout as the UV sphere) plus two open tubes in the
+ * plane y = 0: the spout (quadratic Bezier centre line from (0.55, 0, 0.30) inside the body to
+ * its open mouth at (1.6, 0, 1.05), radius 0.17 tapering to 0.08) and the handle (cubic Bezier
+ * from (-0.70, 0, 0.88) to (-0.72, 0, 0.30), both ends inside the body, radius 0.075), each
+ * 8n+1 rings of 6n vertices. Bounds about [-1.47, 1.68] x [-1, 1] x [0, 1.42].
+ * NOT watertight: the four tube end rings (24n edges) are boundary edges and the tubes pierce
+ * the body (no boolean union), so do not use it with solid (parity) voxelization; the body
+ * alone is closed and every triangle faces outward. 192n^2 + 2 vertices, 384n^2 - 24n
+ * triangles. n > 4096 returns HFVIS_ERR_LIMIT (as do counts past HFVIS_MESH_MAX_*). Three
+ * allocations (one temporary). */
 HFVIS_API hfvis_status hfvis_mesh_teapot(const hfvis_allocator *alloc, int n, hfvis_mesh *out);
 
 /* Axis-aligned bounds of every vertex of a mesh (also vertices no triangle uses), as doubles
