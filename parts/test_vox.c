@@ -325,6 +325,624 @@ TEST(icosphere_counts)
     hfvis_mesh_free(NULL, &m);
 }
 
+
+/* ---- fast == oracle, bit for bit ---------------------------------------------------------- */
+
+#define VOX_CB_CHANNELS 11
+
+/* A callback whose values depend on every fragment field; channels blend with MAX, REPLACE,
+ * MIN, ADD in turn, so equal volumes mean equal fragments in the same per-voxel order. */
+static void vox_cb_all(const hfvis_voxel_fragment *f, float *v, void *user)
+{
+    size_t *calls = (size_t *)user;
+    (*calls)++;
+    v[0] = 1.0f;
+    v[1] = (float)(f->triangle + 1u);
+    v[2] = f->barycentric[0];
+    v[3] = f->barycentric[1] - f->barycentric[2];
+    v[4] = f->position[0];
+    v[5] = f->position[1];
+    v[6] = f->position[2];
+    v[7] = f->normal[0] + 2.0f * f->normal[1] + 4.0f * f->normal[2];
+    v[8] = (float)f->axis + 1.0f;
+    v[9] = (float)(f->voxel[0] + 7 * f->voxel[1] + 49 * f->voxel[2]);
+    v[10] = (float)f->triangle * 0.001f + f->barycentric[2];
+    v[20] = 123.0f; /* beyond the channels: ignored, in bounds */
+}
+
+/* Runs the fast routine and the oracle with vox_cb_all into two volumes of VOX_CB_CHANNELS mixed-
+ * blend channels (cleared to 0.5) and returns 1 if volumes, counts and callback calls agree. */
+static int vox_same(const hfvis_mesh *m, const hfvis_volume_grid *g, const hfvis_voxelize_options *oin,
+                    size_t *frags)
+{
+    static const hfvis_blend bl[4] = { HFVIS_BLEND_MAX, HFVIS_BLEND_REPLACE, HFVIS_BLEND_MIN, HFVIS_BLEND_ADD };
+    size_t n = hfvis_volume_size(g, VOX_CB_CHANNELS), fa = 0, fb = 0, ca = 0, cb = 0;
+    float *a = vox_storage(g, VOX_CB_CHANNELS), *b = vox_storage(g, VOX_CB_CHANNELS);
+    hfvis_volume va, vb;
+    hfvis_voxelize_options o = *oin;
+    int c, ok;
+    hfvis_volume_init(&va, g, VOX_CB_CHANNELS, a, HFVIS_BLEND_MAX);
+    hfvis_volume_init(&vb, g, VOX_CB_CHANNELS, b, HFVIS_BLEND_MAX);
+    for (c = 0; c < VOX_CB_CHANNELS; c++) va.blend[c] = vb.blend[c] = bl[c % 4];
+    hfvis_volume_clear(&va, 0.5f);
+    hfvis_volume_clear(&vb, 0.5f);
+    o.fragment = vox_cb_all;
+    o.user = &ca;
+    ok = hfvis_voxelize_surface(m, &va, &o, &fa) == HFVIS_OK;
+    o.user = &cb;
+    ok = ok && hfvis_voxelize_surface_reference(m, &vb, &o, &fb) == HFVIS_OK;
+    ok = ok && fa == fb && ca == fa && cb == fb && memcmp(a, b, n * sizeof(float)) == 0;
+    if (frags) *frags = fa;
+    free(a);
+    free(b);
+    return ok;
+}
+
+/* Random soup: mode 0 generic float positions, sizes from 0.05 to 2x the grid, some poking out
+ * of the grid; mode 1 tie-heavy (quarter-voxel coordinates on a unit grid: pixel centres on
+ * edges and vertices, depths on slab boundaries); mode 2 degenerate and extreme triangles. */
+static void vox_random_soup(vox_soup *s, size_t n, int mode, double N)
+{
+    size_t t;
+    for (t = 0; t < n; t++) {
+        double p[3][3], c[3], size = N * pow(2.0, -6.0 * vox_unit() + 1.0);
+        int i, a;
+        for (a = 0; a < 3; a++) c[a] = -0.1 * N + 1.2 * N * vox_unit();
+        for (i = 0; i < 3; i++)
+            for (a = 0; a < 3; a++) {
+                p[i][a] = c[a] + size * (vox_unit() - 0.5);
+                if (mode == 1) p[i][a] = floor(4.0 * p[i][a]) / 4.0;
+            }
+        if (mode == 2) {
+            int kind = (int)(vox_unit() * 5.0);
+            if (kind == 0) for (a = 0; a < 3; a++) p[2][a] = p[0][a] + 0.37 * (p[1][a] - p[0][a]); /* collinear-ish */
+            if (kind == 1) for (a = 0; a < 3; a++) p[2][a] = p[1][a];                             /* repeated */
+            if (kind == 2) for (i = 0; i < 3; i++) p[i][2] = p[0][2];                             /* axis-parallel */
+            if (kind == 3) for (i = 0; i < 3; i++) p[i][0] = c[0] + 1e-3 * vox_unit();            /* near edge-on */
+            if (kind == 4) for (i = 0; i < 3; i++) for (a = 0; a < 3; a++) p[i][a] = 40.0 * N * (vox_unit() - 0.5); /* huge */
+        }
+        vox_soup_tri(s, p[0], p[1], p[2]);
+    }
+}
+
+TEST(fast_equals_reference_soups)
+{
+    static const hfvis_voxelize_axes axes[5] = { HFVIS_AXES_DOMINANT, HFVIS_AXES_ALL, HFVIS_AXES_ONLY_X,
+                                                 HFVIS_AXES_ONLY_Y, HFVIS_AXES_ONLY_Z };
+    int trial, mi, ai, bad = 0, runs = 0;
+    size_t total = 0;
+    for (trial = 0; trial < 12; trial++) {
+        int mode = trial % 3;
+        vox_soup s;
+        hfvis_volume_grid g;
+        double N;
+        vox_seed(1000 + (uint64_t)trial);
+        if (mode == 1) {
+            int n = 8 + (int)(vox_unit() * 17.0);
+            g = vox_unit_grid(n);
+            N = (double)n;
+        } else {
+            g = vox_grid(5 + (int)(vox_unit() * 20.0), 5 + (int)(vox_unit() * 20.0), 5 + (int)(vox_unit() * 20.0),
+                         vox_unit() - 0.5, vox_unit() - 0.5, vox_unit() - 0.5, 0.5 + vox_unit(),
+                         0.5 + vox_unit(), 0.5 + vox_unit());
+            N = 14.0;
+        }
+        vox_soup_init(&s, 60);
+        vox_random_soup(&s, 60, mode, N);
+        for (mi = 0; mi < 3; mi++)
+            for (ai = 0; ai < 5; ai++) {
+                hfvis_voxelize_options o = vox_opts(vox_methods[mi], axes[ai], 0);
+                size_t f = 0;
+                runs++;
+                if (!vox_same(vox_soup_mesh(&s), &g, &o, &f)) bad++;
+                total += f;
+                if (mi > 0) { /* capped */
+                    o.max_output_vertices = mi == 1 ? 7 + 4 * (trial % 3) : 3 + 3 * (trial % 3);
+                    runs++;
+                    if (!vox_same(vox_soup_mesh(&s), &g, &o, &f)) bad++;
+                }
+            }
+        vox_soup_free(&s);
+    }
+    printf("  %d runs on 12 random soups (generic, tie-heavy, degenerate), %zu fragments: %d mismatches\n",
+           runs, total, bad);
+    CHECK(bad == 0);
+    CHECK(total > 10000);
+}
+
+/* Generator meshes at several resolutions, fitted grids with fractional origin offsets and
+ * non-cubic cells. */
+TEST(fast_equals_reference_meshes)
+{
+    const double c0[3] = { 0.1, -0.2, 0.3 };
+    hfvis_mesh ms[5];
+    const char *names[5] = { "icosphere", "torus", "torus knot", "teapot", "room" };
+    int mi, k, ri, bad = 0, runs = 0;
+    size_t total = 0;
+    CHECK_EQ_STATUS(hfvis_mesh_icosphere(NULL, c0, 1.0, 3, &ms[0]), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_mesh_torus(NULL, c0, 1.0, 0.35, 40, 16, &ms[1]), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_mesh_torus_knot(NULL, c0, 1.0, 2, 3, 160, 8, &ms[2]), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_mesh_teapot(NULL, 2, &ms[3]), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_mesh_room(NULL, &ms[4]), HFVIS_OK);
+    vox_seed(77);
+    for (k = 0; k < 5; k++)
+        for (ri = 0; ri < 3; ri++) {
+            static const int res[3] = { 16, 37, 64 };
+            hfvis_volume_grid g;
+            int a;
+            CHECK_EQ_STATUS(hfvis_volume_grid_fit(&ms[k], res[ri], 0.05, ri == 1, &g), HFVIS_OK);
+            for (a = 0; a < 3; a++) g.origin[a] += (vox_unit() - 0.5) * g.cell[a];
+            for (mi = 0; mi < 3; mi++) {
+                hfvis_voxelize_options o = vox_opts(vox_methods[mi], HFVIS_AXES_DOMINANT, 0);
+                size_t f = 0;
+                runs += 2;
+                if (!vox_same(&ms[k], &g, &o, &f)) bad++, printf("  mismatch %s res %d method %d\n", names[k], res[ri], mi);
+                total += f;
+                o.axes = HFVIS_AXES_ALL;
+                if (!vox_same(&ms[k], &g, &o, &f)) bad++, printf("  mismatch %s res %d method %d all\n", names[k], res[ri], mi);
+                if (mi > 0) {
+                    o.max_output_vertices = mi == 1 ? 7 : 3;
+                    runs++;
+                    if (!vox_same(&ms[k], &g, &o, &f)) bad++;
+                }
+            }
+        }
+    printf("  %d runs on 5 generator meshes x 3 resolutions, %zu fragments: %d mismatches\n", runs, total, bad);
+    CHECK(bad == 0);
+    for (k = 0; k < 5; k++) hfvis_mesh_free(NULL, &ms[k]);
+}
+
+/* ---- the methods against each other ------------------------------------------------------- */
+
+/* Without a limit fragment clipping is the pixel rule exactly (same predicate per fragment). */
+TEST(fragment_clipping_is_pixel_rule)
+{
+    const double c0[3] = { 0.0, 0.0, 0.0 };
+    hfvis_mesh m;
+    hfvis_volume_grid g;
+    int trial, bad = 0;
+    CHECK_EQ_STATUS(hfvis_mesh_torus_knot(NULL, c0, 1.0, 2, 3, 300, 10, &m), HFVIS_OK);
+    for (trial = 0; trial < 4; trial++) {
+        static const int res[4] = { 20, 48, 96, 150 };
+        size_t n, fa, fb;
+        float *a, *b;
+        hfvis_volume va, vb;
+        hfvis_voxelize_options o = vox_opts(HFVIS_VOXELIZE_PIXEL_RULE, trial & 1 ? HFVIS_AXES_ALL : HFVIS_AXES_DOMINANT, 0);
+        hfvis_voxelize_options f = o;
+        size_t ca = 0, cb = 0;
+        f.method = HFVIS_VOXELIZE_FRAGMENT_CLIPPING;
+        CHECK_EQ_STATUS(hfvis_volume_grid_fit(&m, res[trial], 0.02, 0, &g), HFVIS_OK);
+        n = hfvis_volume_size(&g, VOX_CB_CHANNELS);
+        a = vox_storage(&g, VOX_CB_CHANNELS);
+        b = vox_storage(&g, VOX_CB_CHANNELS);
+        hfvis_volume_init(&va, &g, VOX_CB_CHANNELS, a, HFVIS_BLEND_ADD);
+        hfvis_volume_init(&vb, &g, VOX_CB_CHANNELS, b, HFVIS_BLEND_ADD);
+        o.fragment = f.fragment = vox_cb_all;
+        o.user = &ca, f.user = &cb;
+        CHECK_EQ_STATUS(hfvis_voxelize_surface(&m, &va, &o, &fa), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_voxelize_surface(&m, &vb, &f, &fb), HFVIS_OK);
+        if (fa != fb || memcmp(a, b, n * sizeof(float)) != 0) bad++;
+        free(a);
+        free(b);
+    }
+    CHECK(bad == 0);
+    hfvis_mesh_free(NULL, &m);
+}
+
+/* Distance (in voxels) from pixel centre (pu, pw) of the pass along a to the nearest projected
+ * edge line of triangle p, or from its depth to the nearest slab boundary (unit grid). */
+static double vox_tie_distance(const float *p0, const float *p1, const float *p2, int a, int pu, int pw)
+{
+    int u = (a + 1) % 3, w = (a + 2) % 3, i;
+    const float *P[3];
+    double cu = pu + 0.5, cw = pw + 0.5, best = 1e300, n[3], e1[3], e2[3], z;
+    P[0] = p0, P[1] = p1, P[2] = p2;
+    for (i = 0; i < 3; i++) {
+        const float *A = P[i], *B = P[(i + 1) % 3];
+        double du = (double)B[u] - (double)A[u], dw = (double)B[w] - (double)A[w];
+        double len = sqrt(du * du + dw * dw);
+        double d = len > 0 ? fabs(du * (cw - (double)A[w]) - dw * (cu - (double)A[u])) / len : 0.0;
+        if (d < best) best = d;
+    }
+    for (i = 0; i < 3; i++) e1[i] = (double)p1[i] - (double)p0[i], e2[i] = (double)p2[i] - (double)p0[i];
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    z = (double)p0[a] - (n[u] * (cu - (double)p0[u]) + n[w] * (cw - (double)p0[w])) / n[a];
+    if (fabs(z - floor(z + 0.5)) < best) best = fabs(z - floor(z + 0.5));
+    return best;
+}
+
+/* GS slicing rasterises the Sutherland-Hodgman pieces on their own (rounded) vertices, so it
+ * may differ from the pixel rule only at near ties ([G12] Fig. 65's "rasterisation details");
+ * per triangle, every differing voxel must be within VOX_NEAR_TIE of a tie. */
+TEST(gs_slicing_vs_pixel_rule)
+{
+    int trial, far = 0;
+    size_t diffs = 0, voxels = 0, tris = 0;
+    for (trial = 0; trial < 4; trial++) {
+        int N = 24, mode = trial & 1;
+        hfvis_volume_grid g = vox_unit_grid(N);
+        size_t n = (size_t)N * N * N, t, i;
+        uint8_t *a = (uint8_t *)malloc(n), *b = (uint8_t *)malloc(n);
+        vox_soup s;
+        hfvis_voxelize_options pr = vox_opts(HFVIS_VOXELIZE_PIXEL_RULE, HFVIS_AXES_DOMINANT, 0);
+        hfvis_voxelize_options gs = vox_opts(HFVIS_VOXELIZE_GS_SLICING, HFVIS_AXES_DOMINANT, 0);
+        vox_seed(500 + (uint64_t)trial);
+        vox_soup_init(&s, 80);
+        vox_random_soup(&s, 80, mode, (double)N);
+        for (t = 0; t < s.nt; t++) {
+            hfvis_mesh one;
+            const float *p0 = s.xyz + 9 * t, *p1 = p0 + 3, *p2 = p0 + 6;
+            double e1[3], e2[3], nn[3];
+            int ax = 0, k;
+            one.xyz = s.xyz;
+            one.vertex_count = s.nv;
+            one.indices = s.idx + 3 * t;
+            one.triangle_count = 1;
+            CHECK_EQ_STATUS(hfvis_voxelize_occupancy(&one, &g, &pr, a), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_voxelize_occupancy(&one, &g, &gs, b), HFVIS_OK);
+            for (k = 0; k < 3; k++) e1[k] = (double)p1[k] - (double)p0[k], e2[k] = (double)p2[k] - (double)p0[k];
+            nn[0] = e1[1] * e2[2] - e1[2] * e2[1];
+            nn[1] = e1[2] * e2[0] - e1[0] * e2[2];
+            nn[2] = e1[0] * e2[1] - e1[1] * e2[0];
+            if (fabs(nn[1]) > fabs(nn[ax])) ax = 1;
+            if (fabs(nn[2]) > fabs(nn[ax])) ax = 2;
+            tris++;
+            for (i = 0; i < n; i++) {
+                int v[3];
+                voxels += a[i];
+                if (a[i] == b[i]) continue;
+                diffs++;
+                v[0] = (int)(i % (size_t)N), v[1] = (int)(i / (size_t)N % (size_t)N), v[2] = (int)(i / ((size_t)N * N));
+                if (vox_tie_distance(p0, p1, p2, ax, v[(ax + 1) % 3], v[(ax + 2) % 3]) > VOX_NEAR_TIE) far++;
+            }
+        }
+        vox_soup_free(&s);
+        free(a);
+        free(b);
+    }
+    printf("  GS slicing vs pixel rule: %zu triangles, %zu voxels, %zu differ (all at ties: %s)\n", tris,
+           voxels, diffs, far ? "NO" : "yes");
+    CHECK(far == 0);
+}
+
+/* ALL_AXES contains the dominant pass (superset) and equals Alg. 4's three per-axis volumes
+ * merged with MAX (hfvis_volume_merge), with attribute values, bit for bit. */
+TEST(all_axes_superset_and_max_merge)
+{
+    hfvis_mesh m;
+    int mi, r;
+    CHECK_EQ_STATUS(hfvis_mesh_teapot(NULL, 3, &m), HFVIS_OK);
+    for (r = 0; r < 2; r++)
+        for (mi = 0; mi < 3; mi++) {
+            hfvis_volume_grid g;
+            size_t n, i, sub = 0, extra = 0, calls = 0;
+            float *all, *dom, *ax[3];
+            hfvis_volume vall, vdom, vax[3];
+            hfvis_voxelize_options o = vox_opts(vox_methods[mi], HFVIS_AXES_ALL, 0);
+            int a, merged_equal;
+            CHECK_EQ_STATUS(hfvis_volume_grid_fit(&m, r ? 70 : 31, 0.03, 1, &g), HFVIS_OK);
+            n = hfvis_volume_size(&g, VOX_CB_CHANNELS);
+            all = vox_storage(&g, VOX_CB_CHANNELS);
+            dom = vox_storage(&g, VOX_CB_CHANNELS);
+            hfvis_volume_init(&vall, &g, VOX_CB_CHANNELS, all, HFVIS_BLEND_MAX);
+            hfvis_volume_init(&vdom, &g, VOX_CB_CHANNELS, dom, HFVIS_BLEND_MAX);
+            o.fragment = vox_cb_all;
+            o.user = &calls;
+            CHECK_EQ_STATUS(hfvis_voxelize_surface(&m, &vall, &o, NULL), HFVIS_OK);
+            o.axes = HFVIS_AXES_DOMINANT;
+            CHECK_EQ_STATUS(hfvis_voxelize_surface(&m, &vdom, &o, NULL), HFVIS_OK);
+            for (i = 0; i < n; i += VOX_CB_CHANNELS) {
+                if (dom[i] != 0.0f && all[i] == 0.0f) sub++;
+                if (dom[i] == 0.0f && all[i] != 0.0f) extra++;
+            }
+            CHECK(sub == 0);
+            CHECK(extra > 0);
+            for (a = 0; a < 3; a++) {
+                ax[a] = vox_storage(&g, VOX_CB_CHANNELS);
+                hfvis_volume_init(&vax[a], &g, VOX_CB_CHANNELS, ax[a], HFVIS_BLEND_MAX);
+                o.axes = (hfvis_voxelize_axes)(HFVIS_AXES_ONLY_X + a);
+                CHECK_EQ_STATUS(hfvis_voxelize_surface(&m, &vax[a], &o, NULL), HFVIS_OK);
+            }
+            CHECK_EQ_STATUS(hfvis_volume_merge(&vax[0], &vax[1]), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_volume_merge(&vax[0], &vax[2]), HFVIS_OK);
+            merged_equal = memcmp(ax[0], all, n * sizeof(float)) == 0;
+            CHECK(merged_equal);
+            if (r == 1 && mi == 0)
+                printf("  teapot %dx%dx%d: all-axes adds %zu voxels to the dominant set; MAX merge of X, Y, Z "
+                       "passes %s all-axes\n", g.dims[0], g.dims[1], g.dims[2], extra, merged_equal ? "==" : "!=");
+            for (a = 0; a < 3; a++) free(ax[a]);
+            free(all);
+            free(dom);
+        }
+    hfvis_mesh_free(NULL, &m);
+}
+
+/* ---- Volume Buffer blends and attributes ------------------------------------------------- */
+
+static void vox_cb_id(const hfvis_voxel_fragment *f, float *v, void *user)
+{
+    (void)user;
+    v[0] = (float)(f->triangle + 1u);
+    v[1] = 1.0f;
+}
+
+/* §3.13.7: two triangles writing the same voxels: MAX keeps the maximum, ADD sums, MIN the
+ * minimum, REPLACE the last (triangle order). */
+TEST(blend_ops)
+{
+    const double a[3] = { 1.2, 1.3, 3.4 }, b[3] = { 9.7, 1.1, 3.6 }, c[3] = { 1.4, 9.8, 3.5 };
+    const double d[3] = { 0.9, 0.8, 3.45 }, e[3] = { 10.1, 0.7, 3.55 }, f[3] = { 0.6, 10.3, 3.5 };
+    static const hfvis_blend ops[4] = { HFVIS_BLEND_MAX, HFVIS_BLEND_ADD, HFVIS_BLEND_MIN, HFVIS_BLEND_REPLACE };
+    static const float want_both[4] = { 2.0f, 3.0f, 1.0f, 2.0f };
+    hfvis_volume_grid g = vox_unit_grid(12);
+    vox_soup s;
+    int oi, mi, r;
+    vox_soup_init(&s, 2);
+    vox_soup_tri(&s, a, b, c); /* triangle 0 (value 1) */
+    vox_soup_tri(&s, d, e, f); /* triangle 1 (value 2) covers most of it, same slab 3 */
+    for (oi = 0; oi < 4; oi++)
+        for (mi = 0; mi < 3; mi++)
+            for (r = 0; r < 2; r++) {
+                float *st = vox_storage(&g, 2);
+                hfvis_volume v;
+                hfvis_voxelize_options o = vox_opts(vox_methods[mi], HFVIS_AXES_DOMINANT, 0);
+                size_t i, n = hfvis_volume_size(&g, 1), both = 0, one = 0, bad = 0, frags = 0;
+                hfvis_volume_init(&v, &g, 2, st, ops[oi]);
+                v.blend[1] = HFVIS_BLEND_ADD; /* channel 1 counts the fragments per voxel */
+                if (ops[oi] == HFVIS_BLEND_MIN)
+                    for (i = 0; i < n; i++) st[2 * i] = 100.0f;
+                o.fragment = vox_cb_id;
+                if (r) CHECK_EQ_STATUS(hfvis_voxelize_surface_reference(vox_soup_mesh(&s), &v, &o, &frags), HFVIS_OK);
+                else CHECK_EQ_STATUS(hfvis_voxelize_surface(vox_soup_mesh(&s), &v, &o, &frags), HFVIS_OK);
+                for (i = 0; i < n; i++) {
+                    if (st[2 * i + 1] == 2.0f) {
+                        both++;
+                        if (st[2 * i] != want_both[oi]) bad++;
+                    } else if (st[2 * i + 1] == 1.0f) {
+                        one++;
+                        if (st[2 * i] != 1.0f && st[2 * i] != 2.0f) bad++; /* one triangle: its value */
+                    } else if (st[2 * i + 1] != 0.0f) bad++;
+                }
+                CHECK(bad == 0);
+                CHECK(both >= 36 && one > 0);
+                CHECK(frags == 2 * both + one);
+                free(st);
+            }
+    vox_soup_free(&s);
+}
+
+/* No pixel centre is covered twice or missed by a triangulated sheet: quads with vertices on
+ * pixel centres (every centre is a vertex or on an edge: all ties) and random diagonals; an ADD
+ * channel sums the fragments of each column to exactly 1 inside the footprint (top-left rule:
+ * the left and top borders are inside, the right and bottom ones not). Flat and tilted sheets,
+ * every method. */
+TEST(watertight_shared_edges)
+{
+    enum { Q = 9, N = 14 };
+    hfvis_volume_grid g = vox_unit_grid(N);
+    int tilt, mi, i, j, k;
+    vox_seed(4242);
+    for (tilt = 0; tilt < 2; tilt++) {
+        vox_soup s;
+        vox_soup_init(&s, 2 * Q * Q);
+        for (j = 0; j < Q; j++)
+            for (i = 0; i < Q; i++) {
+                double p[4][3];
+                int c;
+                for (c = 0; c < 4; c++) {
+                    p[c][0] = 2.5 + i + (c & 1);
+                    p[c][1] = 2.5 + j + (c >> 1);
+                    p[c][2] = tilt ? 3.3 + 0.25 * p[c][0] + 0.125 * p[c][1] : 5.25;
+                }
+                if (vox_unit() < 0.5) {
+                    vox_soup_tri(&s, p[0], p[1], p[3]);
+                    vox_soup_tri(&s, p[0], p[3], p[2]);
+                } else {
+                    vox_soup_tri(&s, p[0], p[1], p[2]);
+                    vox_soup_tri(&s, p[1], p[3], p[2]);
+                }
+            }
+        for (mi = 0; mi < 3; mi++) {
+            float *st = vox_storage(&g, 1);
+            hfvis_volume v;
+            hfvis_voxelize_options o = vox_opts(vox_methods[mi], HFVIS_AXES_DOMINANT, 0);
+            int bad = 0;
+            size_t frags = 0;
+            hfvis_volume_init(&v, &g, 1, st, HFVIS_BLEND_ADD);
+            CHECK_EQ_STATUS(hfvis_voxelize_surface(vox_soup_mesh(&s), &v, &o, &frags), HFVIS_OK);
+            for (j = 0; j < N; j++)
+                for (i = 0; i < N; i++) {
+                    float sum = 0.0f, want;
+                    for (k = 0; k < N; k++) sum += st[vox_lin(&g, i, j, k)];
+                    /* centres x = i + 0.5 in [2.5, 2.5 + Q): left border in; y in (2.5, 2.5 + Q] */
+                    want = (i >= 2 && i < 2 + Q && j >= 3 && j <= 2 + Q) ? 1.0f : 0.0f;
+                    if (sum != want) bad++;
+                }
+            CHECK(bad == 0);
+            CHECK(frags == (size_t)Q * Q);
+            free(st);
+        }
+        vox_soup_free(&s);
+    }
+}
+
+/* Fragment contents (spec §3.8): barycentrics, world position at the pixel centre on the
+ * triangle, unit normal, axis, triangle id, voxel; non-cubic cells and an offset origin. */
+typedef struct vox_cb_check {
+    const hfvis_mesh *m;
+    const hfvis_volume_grid *g;
+    int dominant_only, method;
+    size_t calls, bad_bary, bad_pos, bad_normal, bad_axis;
+} vox_cb_check;
+
+static void vox_cb_verify(const hfvis_voxel_fragment *f, float *v, void *user)
+{
+    vox_cb_check *c = (vox_cb_check *)user;
+    const float *P[3];
+    double e1[3], e2[3], n[3], len, gpos[3], dot;
+    int i, a = f->axis, u = (a + 1) % 3, w = (a + 2) % 3, dom = 0;
+    c->calls++;
+    for (i = 0; i < 3; i++) P[i] = c->m->xyz + 3 * c->m->indices[3 * (size_t)f->triangle + (size_t)i];
+    for (i = 0; i < 3; i++) e1[i] = (double)P[1][i] - (double)P[0][i], e2[i] = (double)P[2][i] - (double)P[0][i];
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (fabs((double)f->barycentric[0] + (double)f->barycentric[1] + (double)f->barycentric[2] - 1.0) > VOX_BARY_TOL)
+        c->bad_bary++;
+    for (i = 0; i < 3; i++)
+        if ((double)f->barycentric[i] < -VOX_BARY_TOL || (double)f->barycentric[i] > 1.0 + VOX_BARY_TOL) c->bad_bary++;
+    for (i = 0; i < 3; i++) gpos[i] = ((double)f->position[i] - c->g->origin[i]) / c->g->cell[i];
+    if (fabs(gpos[u] - (f->voxel[u] + 0.5)) > VOX_POS_TOL || fabs(gpos[w] - (f->voxel[w] + 0.5)) > VOX_POS_TOL)
+        c->bad_pos++;
+    if (c->method != HFVIS_VOXELIZE_GS_SLICING && (gpos[a] < f->voxel[a] - VOX_POS_TOL || gpos[a] > f->voxel[a] + 1 + VOX_POS_TOL))
+        c->bad_pos++;
+    dot = ((double)f->normal[0] * n[0] + (double)f->normal[1] * n[1] + (double)f->normal[2] * n[2]) / len;
+    if (fabs(dot - 1.0) > VOX_BARY_TOL) c->bad_normal++;
+    /* dominant axis of the grid-space normal n_a / (cell_u cell_w) ~ n_a * cell_a */
+    for (i = 0; i < 3; i++) n[i] *= c->g->cell[i];
+    if (fabs(n[1]) > fabs(n[dom])) dom = 1;
+    if (fabs(n[2]) > fabs(n[dom])) dom = 2;
+    if (c->dominant_only && a != dom && fabs(fabs(n[a]) - fabs(n[dom])) > 1e-9 * fabs(n[dom])) c->bad_axis++;
+    for (i = 0; i < 3; i++)
+        if (f->voxel[i] < 0 || f->voxel[i] >= c->g->dims[i]) c->bad_axis++;
+    v[0] = 1.0f;
+}
+
+TEST(fragment_contents)
+{
+    hfvis_volume_grid g = vox_grid(23, 17, 29, -0.37, 0.21, -0.13, 0.83, 1.21, 0.67);
+    vox_soup s;
+    int mi, ai;
+    vox_seed(31337);
+    vox_soup_init(&s, 150);
+    vox_random_soup(&s, 150, 0, 16.0);
+    for (mi = 0; mi < 3; mi++)
+        for (ai = 0; ai < 2; ai++) {
+            vox_cb_check c;
+            float *st = vox_storage(&g, 1);
+            hfvis_volume v;
+            hfvis_voxelize_options o = vox_opts(vox_methods[mi], ai ? HFVIS_AXES_ALL : HFVIS_AXES_DOMINANT, 0);
+            size_t frags = 0;
+            memset(&c, 0, sizeof c);
+            c.m = vox_soup_mesh(&s);
+            c.g = &g;
+            c.dominant_only = !ai;
+            c.method = (int)vox_methods[mi];
+            o.fragment = vox_cb_verify;
+            o.user = &c;
+            hfvis_volume_init(&v, &g, 1, st, HFVIS_BLEND_MAX);
+            CHECK_EQ_STATUS(hfvis_voxelize_surface(c.m, &v, &o, &frags), HFVIS_OK);
+            CHECK(c.calls == frags && frags > 1000);
+            CHECK(c.bad_bary == 0);
+            CHECK(c.bad_pos == 0);
+            CHECK(c.bad_normal == 0);
+            CHECK(c.bad_axis == 0);
+            free(st);
+        }
+    vox_soup_free(&s);
+}
+
+static void vox_irr(const float position[3], const float normal[3], float rgb[3], void *user)
+{
+    const float *k = (const float *)user;
+    (void)normal;
+    rgb[0] = k[0];
+    rgb[1] = k[1] * position[0];
+    rgb[2] = k[2];
+}
+
+/* The ready-made callbacks and the attribute packing. */
+TEST(attribute_callbacks)
+{
+    const double a[3] = { 1.2, 1.3, 2.4 }, b[3] = { 6.7, 1.1, 2.6 }, c[3] = { 1.4, 6.8, 2.5 };
+    const float albedo[3] = { 0.25f, 0.5f, 0.75f }, emission[3] = { 0.0f, 0.125f, 2.0f };
+    const float irr[3] = { 3.14159265f, 2.0f, 0.0f };
+    hfvis_volume_grid g = vox_unit_grid(8);
+    hfvis_voxel_attributes at;
+    vox_soup s;
+    float *st;
+    hfvis_volume v;
+    hfvis_voxelize_options o = hfvis_voxelize_options_default();
+    size_t i, n = hfvis_volume_size(&g, 1), hit = 0, bad = 0, frags = 0;
+    int nc, ch_occ, ch_n, ch_alb, ch_rad;
+    hfvis_voxel_fragment fr;
+    float vals[HFVIS_VOLUME_MAX_CHANNELS];
+    /* packing */
+    CHECK(hfvis_voxel_attribute_channel(0, 0) == 1);
+    CHECK(hfvis_voxel_attribute_channel(0, HFVIS_VOXEL_ATTR_OCCUPANCY) == 0);
+    CHECK(hfvis_voxel_attribute_channel(0, HFVIS_VOXEL_ATTR_NORMAL) == -1);
+    CHECK(hfvis_voxel_attribute_channel(HFVIS_VOXEL_ATTR_NORMAL | HFVIS_VOXEL_ATTR_RADIANCE, HFVIS_VOXEL_ATTR_RADIANCE) == 3);
+    CHECK(hfvis_voxel_attribute_channel(HFVIS_VOXEL_ATTR_NORMAL | HFVIS_VOXEL_ATTR_RADIANCE, 0) == 6);
+    CHECK(hfvis_voxel_attribute_channel(15u, 0) == 10);
+    CHECK(hfvis_voxel_attribute_channel(15u, HFVIS_VOXEL_ATTR_ALBEDO) == 4);
+    /* direct calls */
+    memset(&fr, 0, sizeof fr);
+    fr.normal[0] = 0.6f, fr.normal[2] = 0.8f;
+    memset(vals, 0, sizeof vals);
+    hfvis_voxel_fragment_occupancy(&fr, vals, NULL);
+    CHECK(vals[0] == 1.0f && vals[1] == 0.0f);
+    hfvis_voxel_fragment_normal_occupancy(&fr, vals, NULL);
+    CHECK(vals[0] == 1.0f && vals[1] == 0.6f && vals[2] == 0.0f && vals[3] == 0.8f && vals[4] == 0.0f);
+    memset(&at, 0, sizeof at);
+    memset(vals, 0, sizeof vals);
+    hfvis_voxel_fragment_attributes(&fr, vals, &at); /* zero struct: occupancy only */
+    CHECK(vals[0] == 1.0f && vals[1] == 0.0f);
+    /* through the voxelizer: one triangle, all four attributes */
+    vox_soup_init(&s, 1);
+    vox_soup_tri(&s, a, b, c);
+    at.flags = HFVIS_VOXEL_ATTR_OCCUPANCY | HFVIS_VOXEL_ATTR_NORMAL | HFVIS_VOXEL_ATTR_ALBEDO | HFVIS_VOXEL_ATTR_RADIANCE;
+    at.albedo = albedo;
+    at.emission = emission;
+    at.irradiance = vox_irr;
+    at.irradiance_user = (void *)(uintptr_t)irr; /* read only */
+    nc = hfvis_voxel_attribute_channel(at.flags, 0);
+    ch_occ = hfvis_voxel_attribute_channel(at.flags, HFVIS_VOXEL_ATTR_OCCUPANCY);
+    ch_n = hfvis_voxel_attribute_channel(at.flags, HFVIS_VOXEL_ATTR_NORMAL);
+    ch_alb = hfvis_voxel_attribute_channel(at.flags, HFVIS_VOXEL_ATTR_ALBEDO);
+    ch_rad = hfvis_voxel_attribute_channel(at.flags, HFVIS_VOXEL_ATTR_RADIANCE);
+    CHECK(nc == 10 && ch_occ == 0 && ch_n == 1 && ch_alb == 4 && ch_rad == 7);
+    st = vox_storage(&g, nc);
+    hfvis_volume_init(&v, &g, nc, st, HFVIS_BLEND_REPLACE);
+    o.fragment = hfvis_voxel_fragment_attributes;
+    o.user = &at;
+    CHECK_EQ_STATUS(hfvis_voxelize_surface(vox_soup_mesh(&s), &v, &o, &frags), HFVIS_OK);
+    for (i = 0; i < n; i++) {
+        const float *d = st + i * (size_t)nc;
+        double x = (double)(i % 8) + 0.5, nz;
+        if (d[ch_occ] == 0.0f) continue;
+        hit++;
+        /* normal of (a, b, c): z up, slightly tilted */
+        nz = (double)d[ch_n + 2];
+        if (!(nz > 0.99 && fabs((double)d[ch_n] * (double)d[ch_n] + (double)d[ch_n + 1] * (double)d[ch_n + 1] + nz * nz - 1.0)
+                               < VOX_BARY_TOL))
+            bad++;
+        if (d[ch_alb] != 0.25f || d[ch_alb + 1] != 0.5f || d[ch_alb + 2] != 0.75f) bad++;
+        /* radiance = albedo E / pi + emission with E = (pi, 2 x, 0) */
+        if (fabs((double)d[ch_rad] - 0.25 * (double)irr[0] / 3.14159265358979) > VOX_RAD_TOL) bad++;
+        if (fabs((double)d[ch_rad + 1] - (0.5 * 2.0 * x / 3.14159265358979 + 0.125)) > VOX_POS_TOL) bad++;
+        if (d[ch_rad + 2] != 2.0f) bad++;
+    }
+    CHECK(hit == frags && hit > 10);
+    CHECK(bad == 0);
+    /* NULL callback: channel 0 = 1, the other channels untouched */
+    hfvis_volume_clear(&v, 0.5f);
+    CHECK_EQ_STATUS(hfvis_voxelize_surface(vox_soup_mesh(&s), &v, NULL, &frags), HFVIS_OK);
+    for (i = 0, bad = 0, hit = 0; i < n; i++) {
+        const float *d = st + i * (size_t)nc;
+        int k;
+        if (d[0] == 1.0f) hit++;
+        else if (d[0] != 0.5f) bad++;
+        for (k = 1; k < nc; k++)
+            if (d[k] != 0.5f) bad++;
+    }
+    CHECK(bad == 0 && hit == frags);
+    free(st);
+    vox_soup_free(&s);
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
@@ -334,5 +952,14 @@ int main(int argc, char **argv)
     RUN(box_410);
     RUN(triangle_36);
     RUN(icosphere_counts);
+    RUN(fast_equals_reference_soups);
+    RUN(fast_equals_reference_meshes);
+    RUN(fragment_clipping_is_pixel_rule);
+    RUN(gs_slicing_vs_pixel_rule);
+    RUN(all_axes_superset_and_max_merge);
+    RUN(blend_ops);
+    RUN(watertight_shared_edges);
+    RUN(fragment_contents);
+    RUN(attribute_callbacks);
     return TEST_DONE();
 }
