@@ -96,12 +96,13 @@ static hfvis_status vx_raster_check(const hfvis_mesh *mesh, const hfvis_view *vi
 static void vx_raster_clear(const hfvis_raster_outputs *out, size_t pixels)
 {
     size_t i;
-    for (i = 0; i < pixels; i++) {
-        if (out->linear_depth) out->linear_depth[i] = (float)HUGE_VAL;
-        if (out->window_depth) out->window_depth[i] = 1.0f;
-        if (out->triangle_id) out->triangle_id[i] = HFVIS_NO_TRIANGLE;
-        if (out->coverage_count) out->coverage_count[i] = 0;
-    }
+    if (out->linear_depth)
+        for (i = 0; i < pixels; i++) out->linear_depth[i] = (float)HUGE_VAL;
+    if (out->window_depth)
+        for (i = 0; i < pixels; i++) out->window_depth[i] = 1.0f;
+    if (out->triangle_id)
+        for (i = 0; i < pixels; i++) out->triangle_id[i] = HFVIS_NO_TRIANGLE;
+    if (out->coverage_count) memset(out->coverage_count, 0, pixels * sizeof(uint32_t));
     if (out->normal) memset(out->normal, 0, 3 * pixels * sizeof(float));
     if (out->barycentric) memset(out->barycentric, 0, 2 * pixels * sizeof(float));
 }
@@ -140,6 +141,20 @@ static int vx_raster_normal(const float *a, const float *b, const float *c, cons
     return 1;
 }
 
+/* 1 when triangle (a, b, c) has zero area in world space ((b-a) x (c-a) == 0 exactly, as
+ * vx_raster_normal decides it). */
+static int vx_raster_degenerate(const float *a, const float *b, const float *c)
+{
+    double e1[3], e2[3];
+    int i;
+    for (i = 0; i < 3; i++) {
+        e1[i] = (double)b[i] - (double)a[i];
+        e2[i] = (double)c[i] - (double)a[i];
+    }
+    return e1[1] * e2[2] - e1[2] * e2[1] == 0.0 && e1[2] * e2[0] - e1[0] * e2[2] == 0.0
+           && e1[0] * e2[1] - e1[1] * e2[0] == 0.0;
+}
+
 /* ---- fragments ---------------------------------------------------------------------------- */
 
 /* One covered pixel centre (x, y) of triangle t: depth range, coverage count, depth test LESS,
@@ -160,7 +175,7 @@ static void vx_raster_fragment(const vx_raster_ctx *ctx, const vx_raster_tri *t,
         double a0 = t->r[0] * px + t->r[1] * py + t->r[2];
         double a1 = t->r[3] * px + t->r[4] * py + t->r[5];
         double a2 = t->r[6] * px + t->r[7] * py + t->r[8];
-        double s = a0 + a1 + a2, b0 = a0 / s, b1 = a1 / s, b2 = a2 / s;
+        double s = 1.0 / (a0 + a1 + a2), b0 = a0 * s, b1 = a1 * s, b2 = a2 * s;
         if (o->linear_depth)
             o->linear_depth[i] = (float)-(b0 * t->ze[0] + b1 * t->ze[1] + b2 * t->ze[2]);
         if (o->barycentric) {
@@ -291,21 +306,25 @@ static int vx_raster_snap(const double c[4], int width, int height, int64_t *X, 
     return 1;
 }
 
+/* Per-vertex cache: clip x y z w, eye z, and (inside the near plane and the guard band only)
+ * the snapped window coordinates as exact doubles, else NaN. */
+#define VX_RASTER_VSTRIDE 7
+
 /* One mesh triangle: trivial reject, facing and cull, interpolation setup, clipping, scan. */
 static void vx_raster_triangle(const vx_raster_ctx *ctx, const hfvis_mesh *mesh,
                                const hfvis_view *view, const hfvis_raster_options *opt,
-                               const double *vclip, uint32_t tid, double gx, double gy)
+                               const double *vcache, uint32_t tid, double gx, double gy)
 {
     const uint32_t *ix = mesh->indices + 3 * (size_t)tid;
     const double *c[3];
     double poly[2][VX_RASTER_MAX_POLY][4], det;
     vx_raster_tri t;
     int64_t X[VX_RASTER_MAX_POLY], Y[VX_RASTER_MAX_POLY];
-    int j, k, n, cur, plane, outside = 0, facing_front;
+    int j, k, n, cur, plane, outside = 0, facing_front, snapped = 1;
     unsigned codes_and = 0x3F;
     for (j = 0; j < 3; j++) {
         unsigned code = 0;
-        c[j] = vclip + 5 * (size_t)ix[j];
+        c[j] = vcache + VX_RASTER_VSTRIDE * (size_t)ix[j];
         if (c[j][0] > c[j][3]) code |= 1;
         if (c[j][0] < -c[j][3]) code |= 2;
         if (c[j][1] > c[j][3]) code |= 4;
@@ -314,6 +333,7 @@ static void vx_raster_triangle(const vx_raster_ctx *ctx, const hfvis_mesh *mesh,
         if (c[j][2] < -c[j][3]) code |= 32;
         codes_and &= code;
         if (!vx_all_finite(c[j], 5)) return;
+        if (!(c[j][5] == c[j][5])) snapped = 0; /* NaN: needs clipping */
     }
     if (codes_and) return; /* all three outside one frustum plane */
     /* homogeneous edge vectors r_j = c_{j+1} x c_{j+2} over (x, y, w) */
@@ -332,15 +352,24 @@ static void vx_raster_triangle(const vx_raster_ctx *ctx, const hfvis_mesh *mesh,
     {
         const float *v0 = mesh->xyz + 3 * (size_t)ix[0], *v1 = mesh->xyz + 3 * (size_t)ix[1],
                     *v2 = mesh->xyz + 3 * (size_t)ix[2];
-        if (!vx_raster_normal(v0, v1, v2, view->view, opt->normal_space,
-                              opt->normal_toward_viewer && !facing_front, t.normal))
-            return; /* zero area in world space */
+        if (ctx->out->normal) {
+            if (!vx_raster_normal(v0, v1, v2, view->view, opt->normal_space,
+                                  opt->normal_toward_viewer && !facing_front, t.normal))
+                return; /* zero area in world space */
+        } else if (vx_raster_degenerate(v0, v1, v2)) {
+            return;
+        }
     }
     for (k = 0; k < 3; k++) {
         t.zp[k] = (t.r[k] * c[0][2] + t.r[3 + k] * c[1][2] + t.r[6 + k] * c[2][2]) / det;
         t.ze[k] = c[k][4];
     }
     t.id = tid;
+    if (snapped) { /* fast path: every vertex in front of the near plane, inside the guard band */
+        for (j = 0; j < 3; j++) X[j] = (int64_t)c[j][5], Y[j] = (int64_t)c[j][6];
+        vx_raster_subtriangle(ctx, &t, X, Y);
+        return;
+    }
     /* clipping: near plane always checked, guard-band planes only where a vertex leaves them */
     for (j = 0; j < 3; j++)
         for (k = 0; k < 4; k++) poly[0][j][k] = c[j][k];
@@ -372,7 +401,7 @@ HFVIS_API hfvis_status hfvis_rasterize(const hfvis_mesh *mesh, const hfvis_view 
     hfvis_raster_options opt;
     hfvis_status s = vx_raster_check(mesh, view, opts, out, &opt);
     size_t pixels, n_doubles, vcount, i;
-    double *block, *vclip, *ndc_x, *ndc_y, gx, gy;
+    double *block, *vcache, *ndc_x, *ndc_y, gx, gy;
     vx_raster_ctx ctx;
     uint32_t tid;
     if (s != HFVIS_OK) return s;
@@ -381,8 +410,8 @@ HFVIS_API hfvis_status hfvis_rasterize(const hfvis_mesh *mesh, const hfvis_view 
         return HFVIS_OK;
     pixels = (size_t)view->width * (size_t)view->height;
     vcount = mesh->vertex_count;
-    /* one block: depth buffer, column and row NDC, 5 doubles per vertex (clip x y z w, eye z) */
-    if (!vx_mul_size(vcount, 5, &n_doubles) || n_doubles > SIZE_MAX - pixels
+    /* one block: depth buffer, column and row NDC, the vertex cache */
+    if (!vx_mul_size(vcount, VX_RASTER_VSTRIDE, &n_doubles) || n_doubles > SIZE_MAX - pixels
         || n_doubles + pixels > SIZE_MAX - (size_t)view->width - (size_t)view->height)
         return HFVIS_ERR_OUT_OF_MEMORY;
     n_doubles += pixels + (size_t)view->width + (size_t)view->height;
@@ -390,19 +419,32 @@ HFVIS_API hfvis_status hfvis_rasterize(const hfvis_mesh *mesh, const hfvis_view 
     if (!block) return HFVIS_ERR_OUT_OF_MEMORY;
     ndc_x = block + pixels;
     ndc_y = ndc_x + view->width;
-    vclip = ndc_y + view->height;
+    vcache = ndc_y + view->height;
+    /* guard band in NDC: window coordinates within HFVIS_RASTER_GUARD_PIXELS of the centre */
+    gx = 2.0 * HFVIS_RASTER_GUARD_PIXELS / (double)view->width;
+    gy = 2.0 * HFVIS_RASTER_GUARD_PIXELS / (double)view->height;
     for (i = 0; i < pixels; i++) block[i] = HUGE_VAL;
     for (i = 0; i < (size_t)view->width; i++) ndc_x[i] = vx_raster_ndc_x((int)i, view->width);
     for (i = 0; i < (size_t)view->height; i++) ndc_y[i] = vx_raster_ndc_y((int)i, view->height);
     for (i = 0; i < vcount; i++) {
-        double p[4], e[4];
+        double p[4], e[4], *vc = vcache + VX_RASTER_VSTRIDE * i;
+        int64_t X, Y;
+        int plane, inside = 1;
         p[0] = (double)mesh->xyz[3 * i];
         p[1] = (double)mesh->xyz[3 * i + 1];
         p[2] = (double)mesh->xyz[3 * i + 2];
         p[3] = 1.0;
         vx_mat4_apply(view->view, p, e);
-        vx_mat4_apply(view->proj, e, vclip + 5 * i);
-        vclip[5 * i + 4] = e[2];
+        vx_mat4_apply(view->proj, e, vc);
+        vc[4] = e[2];
+        for (plane = 0; plane < 5; plane++)
+            if (!(vx_raster_plane(vc, plane, gx, gy) >= 0.0)) inside = 0;
+        if (inside && vx_raster_snap(vc, view->width, view->height, &X, &Y)) {
+            vc[5] = (double)X; /* |X|, |Y| < 2^29: exact */
+            vc[6] = (double)Y;
+        } else {
+            vc[5] = vc[6] = NAN;
+        }
     }
     vx_raster_clear(out, pixels);
     ctx.out = out;
@@ -412,11 +454,8 @@ HFVIS_API hfvis_status hfvis_rasterize(const hfvis_mesh *mesh, const hfvis_view 
     ctx.width = view->width;
     ctx.height = view->height;
     ctx.want_attr = out->linear_depth || out->normal || out->barycentric;
-    /* guard band in NDC: window coordinates within HFVIS_RASTER_GUARD_PIXELS of the centre */
-    gx = 2.0 * HFVIS_RASTER_GUARD_PIXELS / (double)view->width;
-    gy = 2.0 * HFVIS_RASTER_GUARD_PIXELS / (double)view->height;
     for (tid = 0; (size_t)tid < mesh->triangle_count; tid++)
-        vx_raster_triangle(&ctx, mesh, view, &opt, vclip, tid, gx, gy);
+        vx_raster_triangle(&ctx, mesh, view, &opt, vcache, tid, gx, gy);
     vx_free(opt.alloc, block);
     return HFVIS_OK;
 }

@@ -94,8 +94,8 @@ typedef struct hfvis_raster_outputs {
  * normal_toward_viewer not 0/1; HFVIS_ERR_LIMIT if width or height > HFVIS_RASTER_MAX_SIZE or
  * triangle_count >= HFVIS_NO_TRIANGLE; HFVIS_ERR_OUT_OF_MEMORY if the scratch allocation fails.
  * On error the outputs are untouched.
- * Memory: one scratch block of 8*(width*height + width + height + 5*vertex_count) bytes (the
- * double depth buffer and the clip-space vertices), none when every plane is NULL.
+ * Memory: one scratch block of 8*(width*height + width + height + 7*vertex_count) bytes (the
+ * double depth buffer and the clip-space and snapped vertices), none when every plane is NULL.
  * Cost: O(V + T + covered bounding-box pixels). Deterministic (bit-exact on one build). */
 HFVIS_API hfvis_status hfvis_rasterize(const hfvis_mesh *mesh, const hfvis_view *view,
                                        const hfvis_raster_options *opts,

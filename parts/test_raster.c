@@ -530,6 +530,36 @@ TEST(near_plane_clipping)
         planes_free(&p);
     }
     hfvis_mesh_free(NULL, &m);
+    /* a closed sphere cut open by the near plane: clipped triangles stay watertight (counts equal
+     * the oracle's hits away from edges and the cut line: 1 inside the cut, 2 around it) */
+    {
+        const double c0[3] = {0.0, 0.0, 0.0}, e2[3] = {0.2, -2.2, 0.3};
+        hfvis_view v;
+        cmp_stats st;
+        planes p;
+        size_t i;
+        int ones = 0, twos = 0, more = 0;
+        memset(&m, 0, sizeof m);
+        CHECK_EQ_STATUS(hfvis_mesh_icosphere(NULL, c0, 1.0, 3, &m), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_view_perspective(&v, e2, c0, up, 1.2, 64, 48, 1.3, 10.0), HFVIS_OK);
+        planes_alloc(&p, 64, 48);
+        {
+            hfvis_raster_outputs o = planes_out(&p);
+            CHECK_EQ_STATUS(hfvis_rasterize(&m, &v, NULL, &o), HFVIS_OK);
+        }
+        for (i = 0; i < 64 * 48; i++) {
+            ones += p.cnt[i] == 1;
+            twos += p.cnt[i] == 2;
+            more += p.cnt[i] > 2;
+        }
+        printf("  cut sphere: %d pixels see 1 layer (inside the cut), %d see 2, %d more\n", ones, twos, more);
+        CHECK(ones > 200 && twos > 200 && more == 0);
+        memset(&st, 0, sizeof st);
+        compare_view(&m, &v, NULL, &st);
+        report("cut sphere", &st);
+        planes_free(&p);
+        hfvis_mesh_free(NULL, &m);
+    }
 }
 
 /* Orthographic views: linear depth is affine in the pixel position on a plane, and window depth
@@ -747,6 +777,64 @@ TEST(guard_band_and_degenerate)
     planes_free(&p);
 }
 
+/* Each plane alone equals the same plane of an all-planes run (bit for bit), runs repeat bit for
+ * bit, and coplanar duplicate triangles resolve to the lower id (equal zw: LESS keeps the
+ * first drawn) in both the rasterizer and the oracle. */
+TEST(planes_independent_and_ties)
+{
+    const double c0[3] = {0.0, 0.0, 0.0}, eye[3] = {1.0, -2.5, 1.5}, up[3] = {0.0, 0.0, 1.0};
+    hfvis_mesh m, d;
+    hfvis_view v;
+    planes a, b;
+    hfvis_raster_outputs oa, ob;
+    size_t n, k;
+    float *xyz;
+    uint32_t *idx;
+    int pl;
+    memset(&m, 0, sizeof m);
+    CHECK_EQ_STATUS(hfvis_mesh_torus(NULL, c0, 1.0, 0.4, 16, 10, &m), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_view_perspective(&v, eye, c0, up, 1.0, 40, 30, 0.1, 10.0), HFVIS_OK);
+    n = 40 * 30;
+    planes_alloc(&a, 40, 30);
+    planes_alloc(&b, 40, 30);
+    oa = planes_out(&a);
+    CHECK_EQ_STATUS(hfvis_rasterize(&m, &v, NULL, &oa), HFVIS_OK);
+    for (pl = 0; pl < 7; pl++) {
+        memset(&ob, 0, sizeof ob);
+        if (pl == 0) ob.linear_depth = b.lin;
+        if (pl == 1) ob.window_depth = b.zw;
+        if (pl == 2) ob.normal = b.nrm;
+        if (pl == 3) ob.triangle_id = b.id;
+        if (pl == 4) ob.barycentric = b.bary;
+        if (pl == 5) ob.coverage_count = b.cnt;
+        if (pl == 6) ob = planes_out(&b);
+        CHECK_EQ_STATUS(hfvis_rasterize(&m, &v, NULL, &ob), HFVIS_OK);
+        if (pl == 0 || pl == 6) CHECK(memcmp(a.lin, b.lin, n * 4) == 0);
+        if (pl == 1 || pl == 6) CHECK(memcmp(a.zw, b.zw, n * 4) == 0);
+        if (pl == 2 || pl == 6) CHECK(memcmp(a.nrm, b.nrm, 3 * n * 4) == 0);
+        if (pl == 3 || pl == 6) CHECK(memcmp(a.id, b.id, n * 4) == 0);
+        if (pl == 4 || pl == 6) CHECK(memcmp(a.bary, b.bary, 2 * n * 4) == 0);
+        if (pl == 5 || pl == 6) CHECK(memcmp(a.cnt, b.cnt, n * 4) == 0);
+    }
+    /* the mesh twice (second copy's triangles have ids T..2T-1, same vertices): ids < T win */
+    xyz = (float *)malloc(m.vertex_count * 3 * sizeof(float));
+    idx = (uint32_t *)malloc(m.triangle_count * 6 * sizeof(uint32_t));
+    memcpy(xyz, m.xyz, m.vertex_count * 3 * sizeof(float));
+    memcpy(idx, m.indices, m.triangle_count * 3 * sizeof(uint32_t));
+    memcpy(idx + 3 * m.triangle_count, m.indices, m.triangle_count * 3 * sizeof(uint32_t));
+    d.xyz = xyz, d.vertex_count = m.vertex_count, d.indices = idx, d.triangle_count = 2 * m.triangle_count;
+    ob = planes_out(&b);
+    CHECK_EQ_STATUS(hfvis_rasterize(&d, &v, NULL, &ob), HFVIS_OK);
+    CHECK(memcmp(a.id, b.id, n * 4) == 0 && memcmp(a.lin, b.lin, n * 4) == 0);
+    for (k = 0; k < n; k++) CHECK(b.cnt[k] == 2 * a.cnt[k]);
+    CHECK_EQ_STATUS(hfvis_rasterize_reference(&d, &v, NULL, &ob), HFVIS_OK);
+    for (k = 0; k < n; k++) CHECK(b.id[k] == HFVIS_NO_TRIANGLE || b.id[k] < (uint32_t)m.triangle_count);
+    free(xyz), free(idx);
+    planes_free(&a);
+    planes_free(&b);
+    hfvis_mesh_free(NULL, &m);
+}
+
 static int is_untouched(const float *f, size_t n)
 {
     size_t i;
@@ -908,6 +996,7 @@ int main(int argc, char **argv)
     RUN(far_plane);
     RUN(facing_and_normals);
     RUN(guard_band_and_degenerate);
+    RUN(planes_independent_and_ties);
     RUN(bad_arguments);
     RUN(alloc_failures);
     return TEST_DONE();
