@@ -1003,11 +1003,19 @@ static size_t vx_obj_layout(int neg, uint64_t N, int p, int k, char *buf)
 
 /* The shortest decimal (1..9 significant digits) that vx_obj_parse_float reads back as f, bit
  * for bit (9 digits always do: a 9-digit decimal is within 5e-9 relative of f, far from the
- * midpoints to the neighbouring floats, at least 3e-8 relative away). f finite. */
+ * midpoints to the neighbouring floats, at least 3e-8 relative away). f finite.
+ * With X = |f| 10^(8-k) in [10^8, 10^9) (k = the decimal exponent of f), for p = 1, 2, ...:
+ * N = round(X / 10^(9-p)) (p digits), accepted when N 10^(9-p) lies inside f's rounding
+ * interval [L, H] (the midpoints to the neighbouring floats, exact in double, scaled alike).
+ * The test runs in double (X, L, H within 4 ulp); where it is too close to call (within
+ * 1e-12 relative) the candidate is parsed back instead, so the answer is exact. */
 static size_t vx_obj_format_float(float f, char *buf)
 {
-    double x = fabs((double)f);
-    int neg = signbit(f) != 0, p, k0;
+    float af = fabsf(f), fm = nextafterf(af, 0.0f), fp = nextafterf(af, INFINITY);
+    double x = (double)af, lo = 0.5 * (x + (double)fm);
+    double hi = isfinite(fp) ? 0.5 * (x + (double)fp) : x + 0.5 * (x - (double)fm);
+    double X = 0.0, L, H;
+    int neg = signbit(f) != 0, p, k, it;
     if (x == 0.0) {
         if (neg) {
             buf[0] = '-';
@@ -1017,24 +1025,29 @@ static size_t vx_obj_format_float(float f, char *buf)
         buf[0] = '0';
         return 1;
     }
-    k0 = (int)floor(log10(x));
+    k = (int)floor(log10(x)); /* may be one off: adjust */
+    for (it = 0; it < 3; it++) {
+        X = vx_obj_scale10(x, (long)(8 - k));
+        if (X >= 1e9) k++;
+        else if (X < 1e8) k--;
+        else break;
+    }
+    L = vx_obj_scale10(lo, (long)(8 - k));
+    H = vx_obj_scale10(hi, (long)(8 - k));
     for (p = 1; p <= 9; p++) {
-        uint64_t N = 0, lo = 1, hi;
-        int k = k0, it, q;
+        double s = vx_obj_pow10[9 - p], dN = floor(X / s + 0.5), Lp = L / s, Hp = H / s;
+        double tol = 1e-12 * vx_obj_pow10[p];
+        uint64_t N = (uint64_t)dN;
+        int kk = k;
         size_t n;
         float back;
-        for (q = 1; q < p; q++) lo *= 10u;
-        hi = lo * 10u;
-        /* N = round(x * 10^(p-1-k)) in [10^(p-1), 10^p): k0 from log10 may be one off, and
-         * rounding up to 10^p moves to the next decade (where N rounds to 10^(p-1)) */
-        for (it = 0; it < 3; it++) {
-            N = (uint64_t)floor(vx_obj_scale10(x, (long)(p - 1 - k)) + 0.5);
-            if (N >= hi) k++;
-            else if (N < lo) k--;
-            else break;
+        if (dN < Lp - tol || dN > Hp + tol) continue; /* certainly outside */
+        if (N >= (uint64_t)vx_obj_pow10[p]) { /* rounded up to 10^p: 1 0..0 one decade up */
+            N /= 10u;
+            kk++;
         }
-        if (N < lo || N >= hi) continue;
-        n = vx_obj_layout(neg, N, p, k, buf);
+        n = vx_obj_layout(neg, N, p, kk, buf);
+        if (dN > Lp + tol && dN < Hp - tol) return n; /* certainly inside */
         if (vx_obj_parse_float((const unsigned char *)buf, (const unsigned char *)buf + n, &back)
             && memcmp(&back, &f, sizeof f) == 0)
             return n;

@@ -937,6 +937,9 @@ TEST(obj_float_round_trip)
                 snprintf(tmp, sizeof tmp, "%.*e", best - 1, (double)xyz[v]);
                 if (strtof(tmp, NULL) == xyz[v]) break;
             }
+            if (ours != best && longer + shorter < 5)
+                fprintf(stderr, "  %.*s (%d digits) for %.9g: strtof needs %d\n", (int)(p - tok), tok, ours,
+                        (double)xyz[v], best);
             if (ours > best) longer++;
             if (ours < best) shorter++;
             p++; /* ' ' or '\n' */
