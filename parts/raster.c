@@ -3,14 +3,14 @@
 /* Reference rasterizer (issue 4 "mesh infrastructure"; spec voxel §0 view conventions)       */
 /* ========================================================================================== */
 /* The fixed-function GPU pipeline on the CPU, as the thesis' ch. 7 camera and light views render
- * their depth and G-buffer images ([G12] §7.2-7.3, Listings 7.1-7.2 read them):
+ * their depth and G-buffer images ([G12] §7.4.1-7.4.2; Listings 7.1-7.2 read them):
  *   vertex stage   c = proj * view * v (double), eye z kept for the linear depth;
  *   clipping       homogeneous Sutherland-Hodgman (Sutherland & Hodgman 1974) against the near
  *                  plane z = -w, and against guard-band planes only where needed;
  *   setup          snap to 1/256 pixel; orientation by the signed area;
  *   coverage       integer edge functions (Pineda 1988) at pixel centres, D3D top-left rule;
  *   interpolation  homogeneous 2D barycentrics of the unclipped triangle (Olano & Greer 1997,
- *                  "Triangle scan conversion using 2D homogeneous coordinates", eq. 5-7):
+ *                  "Triangle scan conversion using 2D homogeneous coordinates"):
  *                  for clip-space columns c_j = (x_j, y_j, w_j), r_j = c_{j+1} x c_{j+2},
  *                  a_j(p) = r_j . p / det with p = (x_ndc, y_ndc, 1) and det = r_0 . c_0;
  *                  b_j = a_j / sum a (perspective-correct), z_ndc = sum a_j z_j (affine in
@@ -83,7 +83,8 @@ static hfvis_status vx_raster_check(const hfvis_mesh *mesh, const hfvis_view *vi
     if (!vx_all_finite(view->view, 16) || !vx_all_finite(view->proj, 16))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (!isfinite(view->near_plane) || !isfinite(view->far_plane)
-        || !(view->near_plane < view->far_plane) || (!view->orthographic && !(view->near_plane > 0.0)))
+        || !(view->near_plane < view->far_plane)
+        || (!view->orthographic && !(view->near_plane > 0.0)))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (view->width > HFVIS_RASTER_MAX_SIZE || view->height > HFVIS_RASTER_MAX_SIZE)
         return HFVIS_ERR_LIMIT;
@@ -519,7 +520,8 @@ HFVIS_API hfvis_status hfvis_rasterize_reference(const hfvis_mesh *mesh, const h
                 sum = sv[0] + sv[1] + sv[2]; /* = d . ((v1 - v0) x (v2 - v0)) */
                 if (sum == 0.0 || !isfinite(sum)) continue; /* parallel ray or degenerate */
                 front = sum < 0.0;
-                if ((opt.cull == HFVIS_CULL_BACK && !front) || (opt.cull == HFVIS_CULL_FRONT && front))
+                if ((opt.cull == HFVIS_CULL_BACK && !front)
+                    || (opt.cull == HFVIS_CULL_FRONT && front))
                     continue;
                 for (j = 0; j < 3; j++) {
                     double p[4], ev[4];

@@ -45,8 +45,8 @@ HFVIS_API hfvis_raster_options hfvis_raster_options_default(void);
  * written at every pixel; "empty" pixels (no fragment) get the values in brackets. */
 typedef struct hfvis_raster_outputs {
     float *linear_depth;      /* positive linear view depth -z_eye of the visible surface, world
-                                 units (perspective: along the view axis, not the ray length)
-                                 [+INFINITY] */
+                                 units (perspective: along the view axis, not the ray length;
+                                 orthographic with near <= 0: may be <= 0) [+INFINITY] */
     float *window_depth;      /* GL window depth zw = (z_ndc + 1)/2 in [0, 1]; the depth test
                                  runs on it in double [1] */
     float *normal;            /* 3 floats per pixel: the unit geometric face normal
