@@ -853,7 +853,7 @@ TEST(t_range)
         n++;
         q = r; /* t_max just below the closest hit: nothing */
         q.t_max = nextafterf(h0.t, 0.0f);
-        if (q.t_max >= q.t_min) {
+        if (q.t_max < h0.t) {
             hfvis_bvh_closest_hit(&b, &m, &q, &h);
             if (h.triangle != HFVIS_NO_TRIANGLE) bad++;
             hfvis_bvh_any_hit(&b, &m, &q, &h);
@@ -979,8 +979,8 @@ TEST(build_structure)
     }
 }
 
-/* SAH would peel one triangle per level off an exponentially spread set (all centroids but the
- * last in the first bin): the median fallback keeps the depth <= HFVIS_BVH_MAX_DEPTH, and
+/* SAH would peel one triangle per level off an exponentially spread set (with 2 bins, all
+ * centroids but the largest fall into the first bin): the median fallback keeps the depth <= HFVIS_BVH_MAX_DEPTH, and
  * identical triangles (all centroids equal) are split at the median by index. */
 TEST(depth_bound)
 {
@@ -989,16 +989,18 @@ TEST(depth_bound)
     const int n = 400;
     hfvis_mesh m = soup_alloc(3 * (size_t)n, (size_t)n, &xyz, &idx);
     hfvis_bvh b;
+    hfvis_bvh_options o = hfvis_bvh_options_default();
     double lo[3], hi[3];
     int t, k, bad;
     for (t = 0; t < n; t++) {
-        float s = (float)ldexp(1.0, t / 4 - 50); /* 2^-50 .. 2^49 */
-        float x = s * (float)(1 + t % 4);
+        float s = (float)ldexp(1.0, t / 2 - 100); /* 2^-100 .. 2^99, two per scale */
+        float x = s * (float)(1 + t % 2);
         const float p[9] = {x, 0, 0, x + s, 0, 0, x, s, 0.5f};
         for (k = 0; k < 9; k++) xyz[9 * t + k] = p[k];
         for (k = 0; k < 3; k++) idx[3 * t + k] = (uint32_t)(3 * t + k);
     }
-    CHECK_EQ_STATUS(hfvis_bvh_build(&m, NULL, &b), HFVIS_OK);
+    o.bins = 2; /* each split: the largest centroid alone on one side */
+    CHECK_EQ_STATUS(hfvis_bvh_build(&m, &o, &b), HFVIS_OK);
     CHECK(check_structure(&b, &m, 4) == 0);
     CHECK(b.depth > HFVIS_BVH_SAH_DEPTH && b.depth <= HFVIS_BVH_SAH_DEPTH + 10);
     printf("  exponential soup of %d triangles: depth %d (SAH limit %d)\n", n, b.depth, HFVIS_BVH_SAH_DEPTH);
@@ -1023,7 +1025,7 @@ TEST(depth_bound)
     CHECK(check_structure(&b, &m, 4) == 0);
     CHECK(b.depth <= 9);
     {
-        hfvis_ray r = make_ray(0.25 * ldexp(1.0, -50), 0.25 * ldexp(1.0, -50), 1, 0, 0, -1);
+        hfvis_ray r = make_ray(1.25 * ldexp(1.0, -100), 0.25 * ldexp(1.0, -100), 1, 0, 0, -1);
         hfvis_hit h;
         hfvis_bvh_closest_hit(&b, &m, &r, &h);
         CHECK(h.triangle == 0);
