@@ -943,6 +943,504 @@ TEST(attribute_callbacks)
     vox_soup_free(&s);
 }
 
+
+/* ---- output-vertex limit: the thesis' holes (spec §3.7, §3.13.6; [G12] Fig. 66) ------------ */
+
+/* Pixels of the pass along axis a whose column holds no voxel although its centre lies in the
+ * projected triangle (the PR voxelization tells which centres are covered: one voxel each). */
+static size_t vox_holes(const uint8_t *full, const uint8_t *capped, const hfvis_volume_grid *g, int a)
+{
+    int u = (a + 1) % 3, w = (a + 2) % 3, pu, pw, k;
+    size_t holes = 0;
+    for (pw = 0; pw < g->dims[w]; pw++)
+        for (pu = 0; pu < g->dims[u]; pu++) {
+            int inf = 0, inc = 0, v[3];
+            for (k = 0; k < g->dims[a]; k++) {
+                size_t l;
+                v[a] = k, v[u] = pu, v[w] = pw;
+                l = vox_lin(g, v[0], v[1], v[2]);
+                inf |= full[l], inc |= capped[l];
+            }
+            if (inf && !inc) holes++;
+        }
+    return holes;
+}
+
+/* A 45-degree triangle (plane z = x, |n_x| = |n_z|: dominant x by the tie rule) spanning the 8
+ * slabs x in [1.2, 8.9]: with max_slices = 2 only the two lowest slabs 1, 2 remain; the voxel
+ * count never decreases with V and equals the unlimited one once the limit covers 8 slabs;
+ * unlimited output has no holes, small limits do. */
+TEST(vertex_limit_steep_triangle)
+{
+    const double a[3] = { 1.2, 1.3, 1.2 }, b[3] = { 8.9, 1.3, 8.9 }, c[3] = { 1.2, 9.6, 1.2 };
+    hfvis_volume_grid g = vox_unit_grid(12);
+    size_t n = 12 * 12 * 12, full_n, i;
+    uint8_t full[12 * 12 * 12], cap[12 * 12 * 12];
+    vox_soup s;
+    int m, S;
+    vox_soup_init(&s, 1);
+    vox_soup_tri(&s, a, b, c);
+    {
+        hfvis_voxelize_options o = vox_opts(HFVIS_VOXELIZE_PIXEL_RULE, HFVIS_AXES_DOMINANT, 0);
+        full_n = vox_count(vox_soup_mesh(&s), &g, &o, full);
+    }
+    CHECK(vox_holes(full, full, &g, 0) == 0);
+    for (m = 1; m < 3; m++) {
+        size_t prev = 0, prev_holes = (size_t)-1;
+        printf("  %s:", m == 1 ? "GS slicing V" : "FC V");
+        for (S = 1; S <= 9; S++) {
+            int V = m == 1 ? 3 + 4 * S : 3 * S, bad = 0;
+            hfvis_voxelize_options o = vox_opts(vox_methods[m], HFVIS_AXES_DOMINANT, V);
+            size_t cnt = vox_count(vox_soup_mesh(&s), &g, &o, cap), holes = vox_holes(full, cap, &g, 0);
+            CHECK(hfvis_gs_max_slices(V, m == 2) == S);
+            for (i = 0; i < n; i++) {
+                int x = (int)(i % 12);
+                if (cap[i] != (full[i] && x <= S)) bad++; /* the S lowest slabs 1..S */
+            }
+            CHECK(bad == 0);
+            CHECK(cnt >= prev);
+            CHECK(holes <= prev_holes);
+            CHECK((cnt == full_n) == (S >= 8));
+            CHECK((holes == 0) == (S >= 8));
+            if (S == 2) CHECK(holes > 0);
+            printf(" %d: %zu voxels %zu holes;", V, cnt, holes);
+            prev = cnt, prev_holes = holes;
+        }
+        printf(" unlimited %zu\n", full_n);
+    }
+    vox_soup_free(&s);
+}
+
+/* [G12] Fig. 66 on a coarse closed mesh (icosphere of 80 triangles, r = 20 in 48^3): the voxel
+ * count grows with V and reaches the complete voxelization; every capped set is a subset. */
+TEST(vertex_limit_mesh_holes)
+{
+    const double c[3] = { 24.13, 23.71, 24.37 };
+    hfvis_volume_grid g = vox_unit_grid(48);
+    hfvis_mesh m;
+    size_t n = 48 * 48 * 48, i, full_n;
+    uint8_t *full = (uint8_t *)malloc(n), *cap = (uint8_t *)malloc(n);
+    int mi, S;
+    CHECK_EQ_STATUS(hfvis_mesh_icosphere(NULL, c, 20.0, 1, &m), HFVIS_OK);
+    {
+        hfvis_voxelize_options o = vox_opts(HFVIS_VOXELIZE_PIXEL_RULE, HFVIS_AXES_DOMINANT, 0);
+        full_n = vox_count(&m, &g, &o, full);
+    }
+    for (mi = 1; mi < 3; mi++) {
+        size_t prev = 0;
+        int reached = 0;
+        printf("  icosphere(80) 48^3 %s:", mi == 1 ? "GS V" : "FC V");
+        for (S = 1; S <= 12; S++) {
+            int V = mi == 1 ? 3 + 4 * S : 3 * S, sub = 1;
+            hfvis_voxelize_options o = vox_opts(vox_methods[mi], HFVIS_AXES_DOMINANT, V);
+            size_t cnt = vox_count(&m, &g, &o, cap);
+            for (i = 0; i < n; i++)
+                if (cap[i] && !full[i]) sub = 0;
+            CHECK(sub);
+            CHECK(cnt >= prev);
+            if (S == 1) CHECK(cnt < full_n);
+            if (cnt == full_n) reached = 1;
+            if (S <= 4 || cnt == full_n) printf(" %d:%zu", V, cnt);
+            prev = cnt;
+            if (reached) break;
+        }
+        printf(" (complete %zu)\n", full_n);
+        CHECK(reached);
+    }
+    hfvis_mesh_free(NULL, &m);
+    free(full);
+    free(cap);
+}
+
+/* ---- no holes: 6-separation of the three-axis variant ------------------------------------- */
+
+/* inside[v] = 1 when the centre of voxel v lies inside the closed mesh (unit grid): parity of the
+ * crossings of the vertical line through the column centre, below the voxel centre. */
+static void vox_inside_centres(const hfvis_mesh *m, const hfvis_volume_grid *g, uint8_t *inside)
+{
+    int N0 = g->dims[0], N1 = g->dims[1], N2 = g->dims[2], i, j, k;
+    double *zs = (double *)malloc(sizeof(double) * (m->triangle_count + 1));
+    memset(inside, 0, (size_t)N0 * N1 * N2);
+    for (j = 0; j < N1; j++)
+        for (i = 0; i < N0; i++) {
+            double x = i + 0.5, y = j + 0.5;
+            size_t t, nz = 0, q;
+            for (t = 0; t < m->triangle_count; t++) {
+                double P[3][3], d0, d1, d2, A, z;
+                int v, x2;
+                for (v = 0; v < 3; v++)
+                    for (x2 = 0; x2 < 3; x2++) P[v][x2] = (double)m->xyz[3 * m->indices[3 * t + (size_t)v] + (size_t)x2];
+                d0 = (P[1][0] - P[0][0]) * (y - P[0][1]) - (P[1][1] - P[0][1]) * (x - P[0][0]);
+                d1 = (P[2][0] - P[1][0]) * (y - P[1][1]) - (P[2][1] - P[1][1]) * (x - P[1][0]);
+                d2 = (P[0][0] - P[2][0]) * (y - P[2][1]) - (P[0][1] - P[2][1]) * (x - P[2][0]);
+                A = d0 + d1 + d2;
+                if (!((d0 > 0 && d1 > 0 && d2 > 0) || (d0 < 0 && d1 < 0 && d2 < 0))) continue;
+                z = (d1 * P[0][2] + d2 * P[1][2] + d0 * P[2][2]) / A;
+                zs[nz++] = z;
+            }
+            for (k = 0; k < N2; k++) {
+                int below = 0;
+                for (q = 0; q < nz; q++)
+                    if (zs[q] < k + 0.5) below++;
+                inside[vox_lin(g, i, j, k)] = (uint8_t)(below & 1);
+            }
+        }
+    free(zs);
+}
+
+/* Empty voxels 6-connected to the grid border whose centre is inside the mesh: 0 means the
+ * voxelization separates inside from outside for 6-paths (no 6-tunnel). */
+static size_t vox_leaks(const uint8_t *occ, const uint8_t *inside, const hfvis_volume_grid *g)
+{
+    int N0 = g->dims[0], N1 = g->dims[1], N2 = g->dims[2], i, j, k, d;
+    size_t n = (size_t)N0 * N1 * N2, head = 0, tail = 0, leaks = 0;
+    size_t *q = (size_t *)malloc(sizeof(size_t) * n);
+    uint8_t *seen = (uint8_t *)calloc(n, 1);
+    for (k = 0; k < N2; k++)
+        for (j = 0; j < N1; j++)
+            for (i = 0; i < N0; i++)
+                if ((i == 0 || j == 0 || k == 0 || i == N0 - 1 || j == N1 - 1 || k == N2 - 1)
+                    && !occ[vox_lin(g, i, j, k)]) {
+                    seen[vox_lin(g, i, j, k)] = 1;
+                    q[tail++] = vox_lin(g, i, j, k);
+                }
+    while (head < tail) {
+        size_t l = q[head++];
+        int v[3];
+        v[0] = (int)(l % (size_t)N0), v[1] = (int)(l / (size_t)N0 % (size_t)N1), v[2] = (int)(l / ((size_t)N0 * N1));
+        if (inside[l]) leaks++;
+        for (d = 0; d < 6; d++) {
+            int w[3], a = d >> 1;
+            size_t nl;
+            w[0] = v[0], w[1] = v[1], w[2] = v[2];
+            w[a] += d & 1 ? 1 : -1;
+            if (w[a] < 0 || w[a] >= g->dims[a]) continue;
+            nl = vox_lin(g, w[0], w[1], w[2]);
+            if (seen[nl] || occ[nl]) continue;
+            seen[nl] = 1;
+            q[tail++] = nl;
+        }
+    }
+    free(q);
+    free(seen);
+    return leaks;
+}
+
+/* Property tested: for a closed mesh inside the grid, the three-axis variant (Alg. 4) is
+ * 6-separating: no 6-connected path of empty voxels joins a voxel whose centre is outside to
+ * one whose centre is inside. Reason: a 6-path step from centre c to c + e_a that crosses the
+ * surface crosses it at a point p of a triangle with n_a != 0; the pass along a samples exactly
+ * that pixel centre (c_u, c_w) and p_a lies in [c_a, c_a + 1], so it writes c or c + e_a.
+ * The dominant-only pass lacks this guarantee (printed, not required); small vertex limits
+ * break it (the thesis' holes). */
+TEST(three_axes_six_separating)
+{
+    const double c[3] = { 24.137, 23.711, 24.373 };
+    hfvis_volume_grid g = vox_unit_grid(48);
+    size_t n = 48 * 48 * 48;
+    uint8_t *occ = (uint8_t *)malloc(n), *inside = (uint8_t *)malloc(n);
+    hfvis_mesh ms[4];
+    int k, mi;
+    size_t capped_leaks = 0;
+    CHECK_EQ_STATUS(hfvis_mesh_icosphere(NULL, c, 17.3, 3, &ms[0]), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_mesh_torus(NULL, c, 14.1, 5.3, 48, 20, &ms[1]), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_mesh_torus_knot(NULL, c, 11.3, 2, 3, 240, 12, &ms[2]), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_mesh_icosphere(NULL, c, 21.7, 1, &ms[3]), HFVIS_OK);
+    for (k = 0; k < 4; k++) {
+        size_t inside_n = 0, i, ld;
+        vox_inside_centres(&ms[k], &g, inside);
+        for (i = 0; i < n; i++) inside_n += inside[i];
+        CHECK(inside_n > 1000);
+        for (mi = 0; mi < 3; mi++) {
+            hfvis_voxelize_options o = vox_opts(vox_methods[mi], HFVIS_AXES_ALL, 0);
+            CHECK_EQ_STATUS(hfvis_voxelize_occupancy(&ms[k], &g, &o, occ), HFVIS_OK);
+            CHECK(vox_leaks(occ, inside, &g) == 0);
+        }
+        {
+            hfvis_voxelize_options o = vox_opts(HFVIS_VOXELIZE_PIXEL_RULE, HFVIS_AXES_DOMINANT, 0);
+            CHECK_EQ_STATUS(hfvis_voxelize_occupancy(&ms[k], &g, &o, occ), HFVIS_OK);
+            ld = vox_leaks(occ, inside, &g);
+        }
+        {
+            hfvis_voxelize_options o = vox_opts(HFVIS_VOXELIZE_FRAGMENT_CLIPPING, HFVIS_AXES_ALL, 3);
+            size_t lc;
+            CHECK_EQ_STATUS(hfvis_voxelize_occupancy(&ms[k], &g, &o, occ), HFVIS_OK);
+            lc = vox_leaks(occ, inside, &g);
+            capped_leaks += lc;
+            printf("  closed mesh %d (%zu tris, %zu inside centres): 6-leaks all-axes 0 (PR, GS, FC), "
+                   "dominant %zu, all-axes FC V=3 %zu\n", k, ms[k].triangle_count, inside_n, ld, lc);
+        }
+    }
+    CHECK(capped_leaks > 0);
+    for (k = 0; k < 4; k++) hfvis_mesh_free(NULL, &ms[k]);
+    free(occ);
+    free(inside);
+}
+
+/* ---- invariance, degenerate input ---------------------------------------------------------- */
+
+/* §3.13.8: translating the mesh by whole voxels translates the voxel set (dyadic coordinates,
+ * exact in float and in the grid transform). */
+TEST(translation_invariance)
+{
+    const int sh[3] = { 3, -2, 5 };
+    hfvis_volume_grid g = vox_unit_grid(32);
+    size_t n = 32 * 32 * 32, t;
+    uint8_t *a = (uint8_t *)malloc(n), *b = (uint8_t *)malloc(n);
+    vox_soup s1, s2;
+    int mi, ai, i, j, k, bad = 0;
+    vox_seed(9);
+    vox_soup_init(&s1, 120);
+    vox_soup_init(&s2, 120);
+    for (t = 0; t < 120; t++) {
+        double p[3][3], q[3][3], ctr[3];
+        int v, x;
+        for (x = 0; x < 3; x++) ctr[x] = 5.0 + 14.0 * vox_unit();
+        for (v = 0; v < 3; v++)
+            for (x = 0; x < 3; x++) {
+                p[v][x] = ctr[x] + floor(64.0 * 6.0 * (vox_unit() - 0.5)) / 64.0;
+                q[v][x] = p[v][x] + sh[x];
+            }
+        vox_soup_tri(&s1, p[0], p[1], p[2]);
+        vox_soup_tri(&s2, q[0], q[1], q[2]);
+    }
+    for (mi = 0; mi < 3; mi++)
+        for (ai = 0; ai < 2; ai++) {
+            hfvis_voxelize_options o = vox_opts(vox_methods[mi], ai ? HFVIS_AXES_ALL : HFVIS_AXES_DOMINANT, 0);
+            size_t ca = 0, cb = 0;
+            CHECK_EQ_STATUS(hfvis_voxelize_occupancy(vox_soup_mesh(&s1), &g, &o, a), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_voxelize_occupancy(vox_soup_mesh(&s2), &g, &o, b), HFVIS_OK);
+            for (k = 0; k < 32; k++)
+                for (j = 0; j < 32; j++)
+                    for (i = 0; i < 32; i++) {
+                        int i2 = i + sh[0], j2 = j + sh[1], k2 = k + sh[2];
+                        ca += a[vox_lin(&g, i, j, k)];
+                        cb += b[vox_lin(&g, i, j, k)];
+                        if (i2 < 0 || j2 < 0 || k2 < 0 || i2 >= 32 || j2 >= 32 || k2 >= 32) continue;
+                        if (a[vox_lin(&g, i, j, k)] != b[vox_lin(&g, i2, j2, k2)]) bad++;
+                    }
+            CHECK(ca == cb && ca > 400);
+        }
+    CHECK(bad == 0);
+    vox_soup_free(&s1);
+    vox_soup_free(&s2);
+    free(a);
+    free(b);
+}
+
+TEST(degenerate_and_extreme_triangles)
+{
+    hfvis_volume_grid g = vox_unit_grid(10);
+    vox_soup s;
+    hfvis_voxelize_options o = hfvis_voxelize_options_default();
+    uint8_t occ[1000];
+    size_t i, cnt;
+    int mi;
+    vox_soup_init(&s, 8);
+    {
+        const double a[3] = { 1, 1, 1 }, b[3] = { 5, 5, 5 }, c[3] = { 3, 3, 3 }; /* collinear */
+        const double d[3] = { 2.2, 3.3, 4.4 };                                   /* a point */
+        const double f[3] = { 50, 50, 50 }, gg[3] = { 60, 50, 50 }, h[3] = { 50, 60, 50 }; /* outside */
+        vox_soup_tri(&s, a, b, c);
+        vox_soup_tri(&s, d, d, d);
+        vox_soup_tri(&s, a, a, b);
+        vox_soup_tri(&s, f, gg, h);
+    }
+    for (mi = 0; mi < 3; mi++) {
+        o = vox_opts(vox_methods[mi], HFVIS_AXES_ALL, 0);
+        CHECK(vox_count(vox_soup_mesh(&s), &g, &o, NULL) == 0);
+    }
+    /* a huge triangle covering the grid's whole z slab 3 (coordinates 1e6 voxels away) */
+    {
+        const double a[3] = { -1e6, -1e6, 3.5 }, b[3] = { 3e6, -1e6, 3.5 }, c[3] = { -1e6, 3e6, 3.5 };
+        vox_soup_tri(&s, a, b, c);
+    }
+    for (mi = 0; mi < 3; mi++) {
+        o = vox_opts(vox_methods[mi], HFVIS_AXES_ALL, 0);
+        cnt = vox_count(vox_soup_mesh(&s), &g, &o, occ);
+        CHECK(cnt == 100);
+        for (i = 0; i < 1000; i++)
+            if (occ[i] != (i / 100 == 3)) break;
+        CHECK(i == 1000);
+    }
+    /* a huge tilted triangle: every column of the dominant pass gets exactly one voxel where the
+     * plane z = 0.3 x + 0.2 y + 1.1 passes inside the grid */
+    s.nt = 0, s.nv = 0;
+    {
+        double p[3][3] = { { -1e5, -1e5, 0 }, { 3e5, -1e5, 0 }, { -1e5, 3e5, 0 } };
+        int v, j, k;
+        for (v = 0; v < 3; v++) p[v][2] = 0.3 * p[v][0] + 0.2 * p[v][1] + 1.1;
+        vox_soup_tri(&s, p[0], p[1], p[2]);
+        o = vox_opts(HFVIS_VOXELIZE_PIXEL_RULE, HFVIS_AXES_DOMINANT, 0);
+        cnt = vox_count(vox_soup_mesh(&s), &g, &o, occ);
+        for (j = 0, i = 0; j < 10; j++)
+            for (v = 0; v < 10; v++) {
+                double z = 0.3 * (v + 0.5) + 0.2 * (j + 0.5) + 1.1;
+                int col = 0;
+                for (k = 0; k < 10; k++) col += occ[vox_lin(&g, v, j, k)];
+                if (col != (z < 10.0 ? 1 : 0)) i++;
+            }
+        CHECK(i == 0);
+        CHECK(cnt == 100);
+    }
+    /* grid coordinates beyond 1e150 voxels: skipped */
+    {
+        hfvis_volume_grid tiny = vox_grid(4, 4, 4, 0, 0, 0, 1e-200, 1e-200, 1e-200);
+        uint8_t o4[64];
+        o = hfvis_voxelize_options_default();
+        CHECK_EQ_STATUS(hfvis_voxelize_occupancy(vox_soup_mesh(&s), &tiny, &o, o4), HFVIS_OK);
+        for (i = 0; i < 64; i++) CHECK(o4[i] == 0);
+    }
+    /* empty mesh */
+    s.nt = 0;
+    CHECK(vox_count(vox_soup_mesh(&s), &g, &o, NULL) == 0);
+    vox_soup_free(&s);
+}
+
+/* ---- bad arguments, allocator ------------------------------------------------------------- */
+
+typedef struct vox_counting {
+    int allocs, frees;
+} vox_counting;
+static void *vox_alloc(void *user, size_t n)
+{
+    ((vox_counting *)user)->allocs++;
+    return malloc(n);
+}
+static void vox_free(void *user, void *p)
+{
+    if (p) ((vox_counting *)user)->frees++;
+    free(p);
+}
+
+TEST(bad_arguments)
+{
+    const double a[3] = { 1.2, 1.3, 2.5 }, b[3] = { 6.7, 1.1, 2.6 }, c[3] = { 1.4, 6.8, 2.5 };
+    hfvis_volume_grid g = vox_unit_grid(8), bg = g;
+    vox_soup s;
+    float st[8 * 8 * 8 * 2];
+    uint8_t occ[512];
+    hfvis_volume v;
+    hfvis_mesh m, bm;
+    hfvis_voxelize_options o;
+    size_t frags = 777, i;
+    int f, bad = 0;
+    vox_soup_init(&s, 1);
+    vox_soup_tri(&s, a, b, c);
+    m = *vox_soup_mesh(&s);
+    hfvis_volume_init(&v, &g, 2, st, HFVIS_BLEND_MAX);
+    hfvis_volume_clear(&v, 0.25f);
+    memset(occ, 9, sizeof occ);
+    for (f = 0; f < 2; f++) {
+        hfvis_status (*fn)(const hfvis_mesh *, hfvis_volume *, const hfvis_voxelize_options *, size_t *) =
+            f ? hfvis_voxelize_surface_reference : hfvis_voxelize_surface;
+        hfvis_volume bv = v;
+        CHECK_EQ_STATUS(fn(NULL, &v, NULL, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        CHECK_EQ_STATUS(fn(&m, NULL, NULL, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        bv.data = NULL;
+        CHECK_EQ_STATUS(fn(&m, &bv, NULL, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        bv = v, bv.channels = 0;
+        CHECK_EQ_STATUS(fn(&m, &bv, NULL, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        bv = v, bv.channels = 33;
+        CHECK_EQ_STATUS(fn(&m, &bv, NULL, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        bv = v, bv.blend[1] = (hfvis_blend)7;
+        CHECK_EQ_STATUS(fn(&m, &bv, NULL, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        bv = v, bv.blend[5] = (hfvis_blend)7; /* unused channel: fine */
+        CHECK_EQ_STATUS(fn(&m, &bv, NULL, NULL), HFVIS_OK);
+        hfvis_volume_clear(&v, 0.25f);
+        bv = v, bv.grid.dims[2] = 0;
+        CHECK_EQ_STATUS(fn(&m, &bv, NULL, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        bv = v, bv.grid.cell[0] = -1.0;
+        CHECK_EQ_STATUS(fn(&m, &bv, NULL, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        bv = v, bv.grid.origin[1] = NAN;
+        CHECK_EQ_STATUS(fn(&m, &bv, NULL, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        bm = m, bm.xyz = NULL;
+        CHECK_EQ_STATUS(fn(&bm, &v, NULL, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        bm = m, bm.indices = NULL;
+        CHECK_EQ_STATUS(fn(&bm, &v, NULL, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        bm = m, bm.vertex_count = 2;
+        CHECK_EQ_STATUS(fn(&bm, &v, NULL, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        s.xyz[4] = NAN;
+        CHECK_EQ_STATUS(fn(&m, &v, NULL, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        s.xyz[4] = INFINITY;
+        CHECK_EQ_STATUS(fn(&m, &v, NULL, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        s.xyz[4] = (float)b[1];
+        o = hfvis_voxelize_options_default(), o.method = (hfvis_voxelize_method)3;
+        CHECK_EQ_STATUS(fn(&m, &v, &o, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        o = hfvis_voxelize_options_default(), o.method = (hfvis_voxelize_method)-1;
+        CHECK_EQ_STATUS(fn(&m, &v, &o, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        o = hfvis_voxelize_options_default(), o.axes = (hfvis_voxelize_axes)5;
+        CHECK_EQ_STATUS(fn(&m, &v, &o, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        o = vox_opts(HFVIS_VOXELIZE_GS_SLICING, HFVIS_AXES_DOMINANT, -1);
+        CHECK_EQ_STATUS(fn(&m, &v, &o, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        o = vox_opts(HFVIS_VOXELIZE_PIXEL_RULE, HFVIS_AXES_DOMINANT, 9);
+        CHECK_EQ_STATUS(fn(&m, &v, &o, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        o = vox_opts(HFVIS_VOXELIZE_GS_SLICING, HFVIS_AXES_DOMINANT, 6);
+        CHECK_EQ_STATUS(fn(&m, &v, &o, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        o = vox_opts(HFVIS_VOXELIZE_FRAGMENT_CLIPPING, HFVIS_AXES_DOMINANT, 2);
+        CHECK_EQ_STATUS(fn(&m, &v, &o, &frags), HFVIS_ERR_INVALID_ARGUMENT);
+        o = vox_opts(HFVIS_VOXELIZE_GS_SLICING, HFVIS_AXES_DOMINANT, 7);
+        CHECK_EQ_STATUS(fn(&m, &v, &o, NULL), HFVIS_OK);
+        hfvis_volume_clear(&v, 0.25f);
+    }
+    CHECK(frags == 777);
+    for (i = 0; i < 8 * 8 * 8 * 2; i++)
+        if (st[i] != 0.25f) bad++;
+    CHECK(bad == 0);
+    /* occupancy */
+    o = hfvis_voxelize_options_default();
+    CHECK_EQ_STATUS(hfvis_voxelize_occupancy(NULL, &g, &o, occ), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_voxelize_occupancy(&m, NULL, &o, occ), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_voxelize_occupancy(&m, &g, &o, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    bg.dims[0] = -3;
+    CHECK_EQ_STATUS(hfvis_voxelize_occupancy(&m, &bg, &o, occ), HFVIS_ERR_INVALID_ARGUMENT);
+    bg = g, bg.dims[0] = bg.dims[1] = bg.dims[2] = 2048; /* 2^33 voxels > HFVIS_VOLUME_MAX_VOXELS */
+    CHECK_EQ_STATUS(hfvis_voxelize_occupancy(&m, &bg, &o, occ), HFVIS_ERR_INVALID_ARGUMENT);
+    o.axes = (hfvis_voxelize_axes)99;
+    CHECK_EQ_STATUS(hfvis_voxelize_occupancy(&m, &g, &o, occ), HFVIS_ERR_INVALID_ARGUMENT);
+    o = vox_opts(HFVIS_VOXELIZE_PIXEL_RULE, HFVIS_AXES_DOMINANT, 3);
+    CHECK_EQ_STATUS(hfvis_voxelize_occupancy(&m, &g, &o, occ), HFVIS_ERR_INVALID_ARGUMENT);
+    for (i = 0; i < sizeof occ; i++)
+        if (occ[i] != 9) bad++;
+    CHECK(bad == 0);
+    CHECK_EQ_STATUS(hfvis_voxelize_occupancy(&m, &g, NULL, occ), HFVIS_OK);
+    vox_soup_free(&s);
+}
+
+/* The surface voxelizers allocate nothing: the options' allocator is never called (there is no
+ * allocation site to fail). */
+TEST(no_allocation)
+{
+    const double c0[3] = { 0.0, 0.0, 0.0 };
+    vox_counting cnt = { 0, 0 };
+    hfvis_allocator al;
+    hfvis_mesh m;
+    hfvis_volume_grid g;
+    hfvis_volume v;
+    float *st;
+    uint8_t *occ;
+    int mi, ai;
+    al.alloc = vox_alloc, al.free = vox_free, al.user = &cnt;
+    CHECK_EQ_STATUS(hfvis_mesh_torus(NULL, c0, 1.0, 0.4, 24, 12, &m), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_volume_grid_fit(&m, 24, 0.05, 0, &g), HFVIS_OK);
+    st = vox_storage(&g, 4);
+    occ = (uint8_t *)malloc(hfvis_volume_size(&g, 1));
+    hfvis_volume_init(&v, &g, 4, st, HFVIS_BLEND_ADD);
+    for (mi = 0; mi < 3; mi++)
+        for (ai = 0; ai < 2; ai++) {
+            hfvis_voxelize_options o = vox_opts(vox_methods[mi], ai ? HFVIS_AXES_ALL : HFVIS_AXES_DOMINANT, mi ? 9 : 0);
+            o.alloc = &al;
+            o.fragment = hfvis_voxel_fragment_normal_occupancy;
+            CHECK_EQ_STATUS(hfvis_voxelize_surface(&m, &v, &o, NULL), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_voxelize_surface_reference(&m, &v, &o, NULL), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_voxelize_occupancy(&m, &g, &o, occ), HFVIS_OK);
+        }
+    CHECK(cnt.allocs == 0 && cnt.frees == 0);
+    free(st);
+    free(occ);
+    hfvis_mesh_free(NULL, &m);
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
@@ -961,5 +1459,12 @@ int main(int argc, char **argv)
     RUN(watertight_shared_edges);
     RUN(fragment_contents);
     RUN(attribute_callbacks);
+    RUN(vertex_limit_steep_triangle);
+    RUN(vertex_limit_mesh_holes);
+    RUN(three_axes_six_separating);
+    RUN(translation_invariance);
+    RUN(degenerate_and_extreme_triangles);
+    RUN(bad_arguments);
+    RUN(no_allocation);
     return TEST_DONE();
 }
