@@ -1,0 +1,1116 @@
+/* hfvis_cli.c - the `hfvis` command-line tool (DESIGN.md §4): horizon maps, sky-view factor,
+ * uniform-sky light, sun shadows, environment light, normals, interreflected light, the
+ * visibility index and viewsheds of PGM/PFM height fields; voxelization of OBJ meshes.
+ * Every file is read and written through the library's codecs (hfvis_image_load, hfvis_*_save),
+ * so the tool exercises exactly what a vendoring user gets. Errors: one line
+ * "hfvis: <what>: <why>" on stderr, exit 1 (2 for usage errors); exit 0 means OUT is complete. */
+#define _POSIX_C_SOURCE 200809L /* isatty() under -std=c99 */
+#include <ctype.h>
+#include <errno.h>
+#include <float.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#if defined(__unix__) || (defined(__APPLE__) && defined(__MACH__))
+#include <unistd.h>
+#define CLI_HAVE_ISATTY 1
+#endif
+#include "common.h"
+
+#define CLI_PI 3.14159265358979323846
+#define CLI_FLT_MAX ((double)FLT_MAX)                 /* largest value a float flag may take */
+#define CLI_MAX_DIRS 65536                        /* --dirs upper bound */
+#define CLI_HORIZON_MAX_VALUES HFVIS_IMAGE_MAX_VALUES /* K*W*H limit of `horizon` (2^28 floats, 1 GiB) */
+#define CLI_MAX_BOUNCES 1000                      /* --bounces upper bound (one sweep each) */
+#define CLI_EXIT_ERROR 1
+#define CLI_EXIT_USAGE 2
+#define CLI_RUN (-1)                              /* parse_args: go on and run the command */
+
+enum { CMD_HORIZON, CMD_SKYVIEW, CMD_SKY, CMD_SHADOW, CMD_LIGHT, CMD_NORMALS, CMD_INDIRECT,
+       CMD_VISIBILITY, CMD_VIEWSHED, CMD_VOXELIZE, CMD_COUNT };
+static const char *const cli_cmd_names[CMD_COUNT] = {
+    "horizon", "skyview", "sky", "shadow", "light", "normals", "indirect", "visibility",
+    "viewshed", "voxelize"
+};
+
+/* voxelize --mode, --axis, --method */
+enum { VOX_SURFACE, VOX_CONSERVATIVE, VOX_SOLID };
+enum { AXIS_DEFAULT, AXIS_DOMINANT, AXIS_ALL, AXIS_X, AXIS_Y, AXIS_Z };
+#define CLI_MAX_RES 2048 /* --res upper bound (the grid limit is 2^31 voxels) */
+
+/* indirect --output */
+enum { OUT_TOTAL, OUT_DIRECT, OUT_INDIRECT };
+
+typedef struct cli_args {
+    int cmd;
+    const char *in, *out, *env, *albedo_map, *emission;
+    int out_pgm;
+    double cell, zscale, azimuth0, nodata, range_lo, range_hi;
+    double sky, albedo, sun_azimuth, sun_elevation, sun_radius, sun_irradiance;
+    int dirs, border, border_cells, method, bounces, output;
+    int compass, degrees, quiet, math, fraction, stats;
+    int has_nodata, has_range, has_sun_azimuth, has_sun_elevation, has_sun_radius;
+    int has_sun_irradiance, has_sky, has_albedo, has_bounces;
+    double observer_x, observer_y, observer_height, target_height, max_distance;
+    int has_observer, exact;
+    int res, vox_mode, vox_axis, vox_method, max_vertices, open_mesh, out_binvox;
+    double padding;
+} cli_args;
+
+/* ------------------------------------------------------------------------------------------ */
+/* help                                                                                       */
+/* ------------------------------------------------------------------------------------------ */
+
+static const char cli_usage[] =
+    "usage: hfvis COMMAND IN [options] -o OUT\n"
+    "       hfvis COMMAND --help\n"
+    "\n"
+    "Visibility and light on height fields with the line-sweep horizon algorithm of\n"
+    "Timonen & Westerholm 2010. IN is a height field: PGM (P2/P5, 8 or 16 bit, raw values)\n"
+    "or grey PFM (Pf). Row 0 is the north edge, x (columns) runs east, y (rows) south.\n"
+    "\n"
+    "commands:\n"
+    "  horizon     horizon elevation angle toward K directions (K planes in one image)\n"
+    "  skyview     sky-view factor 1 - (1/K) sum_k sin(max(alpha_k, 0)), in [0, 1]\n"
+    "  sky         uniform-sky light, [P1] Eq. 5 (cosine-weighted and slope-aware)\n"
+    "  shadow      sun visibility in [0, 1] from one exact sweep toward the sun\n"
+    "  light       environment light from a lat-long PFM map\n"
+    "  normals     unit surface normals (x east, y south, z up) as a 3-channel PFM\n"
+    "  indirect    sun and sky light with interreflections between terrain points ([P2])\n"
+    "  visibility  visibility index: the grid samples each point sees along K directions\n"
+    "  viewshed    which samples an observer at one point sees (line of sight)\n"
+    "  voxelize    voxels of an OBJ mesh: surface, conservative or solid (.binvox or .raw)\n";
+
+static const char cli_shared_help[] =
+    "\n"
+    "shared options (every command accepts them and ignores those it does not use):\n"
+    "  -o OUT            output file, required: *.pfm writes PFM floats, *.pgm a 16-bit PGM;\n"
+    "                    a PGM of a 3-channel result stacks the channels as planes, top to bottom\n"
+    "  --range LO:HI     .pgm only: the values mapped to 0 and 65535 (default per command)\n"
+    "  --cell S          distance between samples, in height units (default 1)\n"
+    "  --zscale Z        multiply input values by Z, non-zero (default 1)\n"
+    "  --nodata V        input values equal to V are holes: no occlusion, output NaN (0 in PGM)\n"
+    "  --dirs K          number of azimuth directions, 1..65536 (default 16)\n"
+    "  --azimuth0 RAD    azimuth of direction 0 in radians, from east toward south (default 0);\n"
+    "                    direction k is psi_k = azimuth0 + 2 pi k/K\n"
+    "  --compass         direction k looks toward the compass bearing 360k/K degrees, clockwise\n"
+    "                    from north (psi_k = 2 pi k/K - pi/2); --azimuth0 is then the bearing of\n"
+    "                    direction 0 in radians (psi_0 = azimuth0 - pi/2)\n"
+    "  --degrees         angle outputs in degrees instead of radians\n"
+    "  --border MODE     open (nothing outside the grid, default), clamp (edge heights extend\n"
+    "                    outward) or wrap (periodic field)\n"
+    "  --border-cells N  clamp/wrap: lines start N cells outside the grid, 1..1048576\n"
+    "                    (default max(width, height))\n"
+    "  --quiet           no progress bar (shown on stderr only when it is a terminal)\n"
+    "  -h, --help        this help; 'hfvis COMMAND --help' describes one command\n"
+    "\n"
+    "Options take their value as the next argument or as --option=value.\n"
+    "Exit status: 0 = OUT is complete, 1 = error, 2 = usage error; an error is one line\n"
+    "\"hfvis: <what>: <why>\" on stderr, and OUT is then left untouched.\n";
+
+static const char *const cli_cmd_help[CMD_COUNT] = {
+    "usage: hfvis horizon IN -o OUT [options]\n"
+    "The horizon elevation angle alpha in [-pi/2, pi/2] toward each direction psi_k: the largest\n"
+    "elevation under which the sample sees terrain that way; -pi/2 where it sees none (open\n"
+    "border). OUT holds the K planes stacked top to bottom: plane k is rows k*H .. k*H+H-1 of a\n"
+    "W x (K*H) image. K*W*H may not exceed 2^28 values (1 GiB) and K*H not 1048576 rows; for\n"
+    "larger inputs use skyview, sky or light, which keep no horizon map.\n"
+    "  --degrees         alpha in degrees\n"
+    "Default PGM range -1.5707963:1.5707963 (-90:90 with --degrees).\n",
+
+    "usage: hfvis skyview IN -o OUT [options]\n"
+    "The sky-view factor SVF = 1 - (1/K) sum_k sin(max(alpha_k, 0)) (Zaksek et al. 2011, as RVT\n"
+    "and GRASS r.skyview): 1 on open flat ground, lower in valleys. Default PGM range 0:1.\n",
+
+    "usage: hfvis sky IN -o OUT [--sky C] [--albedo A] [options]\n"
+    "Light reflected under a uniform sky of radiance C, [P1] Eq. 5: cosine-weighted and aware\n"
+    "of the surface slope; an open flat receiver returns A*C (Lambertian, albedo A).\n"
+    "  --sky C           sky radiance, >= 0 (default 1)\n"
+    "  --albedo A        surface albedo, >= 0 (default 1)\n"
+    "Default PGM range 0:A*C (0:1 if A*C is 0).\n",
+
+    "usage: hfvis shadow IN --sun-azimuth DEG --sun-elevation DEG [--sun-radius DEG] -o OUT\n"
+    "Sun visibility in [0, 1] from one exact sweep toward the sun: 1 lit, 0 in shadow. The\n"
+    "receiver's own tangent plane is not applied; multiply by max(n.l, 0) for shading.\n"
+    "  --sun-azimuth DEG     compass bearing of the sun, degrees clockwise from north (required)\n"
+    "  --math                --sun-azimuth is psi instead: degrees from east toward south\n"
+    "  --sun-elevation DEG   sun elevation above the horizontal, -90..90 (required)\n"
+    "  --sun-radius DEG      angular radius of the sun disc, 0..90 (default 0: hard shadow);\n"
+    "                        > 0 gives the visible fraction of the disc (the real sun: 0.27)\n"
+    "Default PGM range 0:1.\n",
+
+    "usage: hfvis light IN --env ENV.pfm -o OUT [--albedo A] [--method prefix|lp] [options]\n"
+    "Light reflected from a lat-long environment map ([P1] §6.2), Lambertian with albedo A.\n"
+    "ENV (PF colour or Pf grey; any image the codecs read) covers the whole sphere: row 0 is\n"
+    "the zenith, the last row the nadir; column p is the azimuth band [2 pi p/n, 2 pi (p+1)/n)\n"
+    "measured like psi, from east toward south (--compass does not change it). OUT has the\n"
+    "channels of ENV (PF or Pf).\n"
+    "  --env ENV.pfm     the environment map (required)\n"
+    "  --albedo A        surface albedo, >= 0 (default 1)\n"
+    "  --method M        prefix (exact prefix integrals, default) or lp (the paper's L_p table)\n"
+    "Default PGM range 0:the largest output value.\n",
+
+    "usage: hfvis normals IN -o OUT [options]\n"
+    "Unit surface normals ([P1] §7: sum of the four quad normals around a sample), 3 channels\n"
+    "(x east, y south, z up); NaN at holes. Uses --cell, --zscale and --nodata only.\n"
+    "Default PGM range -1:1 (the x, y and z planes stacked top to bottom).\n",
+
+    "usage: hfvis indirect IN -o OUT [--albedo A | --albedo-map MAP] [--bounces B]\n"
+    "         [--sun-azimuth DEG --sun-elevation DEG [--sun-radius DEG] [--sun-irradiance E]]\n"
+    "         [--sky C | --env ENV.pfm] [--emission EMIT] [--output total|direct|indirect]\n"
+    "Light with interreflections between terrain points ([P2] §10.1). The direct light D (sun\n"
+    "and uniform sky or environment, [P1]; reflected radiance for albedo 1) gives the exit\n"
+    "radiance L_0 = EMIT + A*D, and each bounce gathers the light of the terrain samples every\n"
+    "point sees along the K directions (hull-tree intervisibility, [P2] §5-8):\n"
+    "L_(b+1) = EMIT + A*(D + I[L_b]). Lambertian radiance: an open flat receiver under a sky C\n"
+    "with albedo A returns A*C. Default: no sun, sky 1, albedo 1, one bounce.\n"
+    "  --albedo A            constant albedo, >= 0 (default 1)\n"
+    "  --albedo-map MAP      per-sample albedo, a map of IN's size (instead of --albedo)\n"
+    "  --bounces B           interreflection bounces, 0..1000 (default 1); one sweep each\n"
+    "  --sun-azimuth DEG     compass bearing of the sun, degrees clockwise from north\n"
+    "  --math                --sun-azimuth is psi instead: degrees from east toward south\n"
+    "  --sun-elevation DEG   sun elevation above the horizontal, -90..90 (with --sun-azimuth)\n"
+    "  --sun-radius DEG      angular radius of the sun disc, 0..90 (default 0: hard shadows)\n"
+    "  --sun-irradiance E    irradiance on a surface facing the sun, >= 0 (default pi: a flat\n"
+    "                        receiver under a zenith sun reflects E/pi = 1 with albedo 1)\n"
+    "  --sky C               uniform sky radiance, >= 0 (default 1; 0 for the sun alone)\n"
+    "  --env ENV.pfm         lat-long environment instead of the uniform sky (see 'light')\n"
+    "  --emission EMIT       emitted radiance per sample, a map of IN's size (default 0)\n"
+    "  --output WHAT         total: L_B, the exit radiance after B bounces (default);\n"
+    "                        direct: L_0 = EMIT + A*D, no bounce (--bounces not allowed);\n"
+    "                        indirect: L_B - L_0, the light that came from other terrain\n"
+    "                        (needs B >= 1)\n"
+    "Maps (MAP, EMIT) are PGM or PFM images of IN's size: PGM values are divided by the file's\n"
+    "maxval (0..1), PFM values are used as stored; they must be finite and >= 0 wherever IN\n"
+    "has no hole. OUT has 3 channels (PF) if ENV, MAP or EMIT has 3, else 1 (Pf); a one-channel\n"
+    "input then applies to all three. NaN at holes. Default PGM range 0:the largest output value.\n",
+
+    "usage: hfvis visibility IN -o OUT [--fraction] [--stats] [options]\n"
+    "The visibility index: the number of grid samples each point sees along its K lines, from\n"
+    "the hull-tree intervisibility sweep ([P2] §5-8). A sample is seen when no sample between\n"
+    "it and the point rises above the sight line (grazing counts); the point itself is not\n"
+    "counted, nor samples outside the grid (also with --border clamp/wrap), nor holes. On a\n"
+    "flat field with --dirs 1, column x of a W-wide row sees W-1-x samples. NaN at holes.\n"
+    "  --fraction   divide by the samples the point could see: the same count on a flat field\n"
+    "               with IN's holes, where every sample is seen; in [0, 1], 0 where the point's\n"
+    "               lines hold no sample. Runs a second sweep in which every sample is visible,\n"
+    "               O(K*W*H*N): 15 s at 1024 x 1024, K = 16 on one core\n"
+    "  --stats      after writing OUT, print the sweep's counters to stdout as averages per\n"
+    "               receiver-direction (lattice node and direction), as [P2] Tables 1-2:\n"
+    "               visible samples, horizons m_a and tree iterations t_a; with --fraction also\n"
+    "               the samples tested (the naive scan's iterations) and the ratios\n"
+    "Default PGM range 0:the largest count (0:1 with --fraction).\n",
+
+    "usage: hfvis viewshed IN --observer X,Y -o OUT [--observer-height H] [--target-height T]\n"
+    "         [--max-distance D] [--exact]\n"
+    "The viewshed of one observer: 1 where the observer's eye sees the target above a sample,\n"
+    "0 where terrain hides it, NaN at holes and beyond --max-distance (0 in PGM). The terrain\n"
+    "is the bilinear surface through the samples; a sight line that grazes it counts as\n"
+    "visible. Method: R2 of Franklin & Ray 1994 (rays to every border sample, running maximum\n"
+    "slope), O(W*H); it differs from the exact line of sight only at samples whose sight line\n"
+    "nearly grazes the terrain (about 0.4%% of a rough 1024 x 1024 terrain).\n"
+    "  --observer X,Y        the observer's column and row, reals in [0, W-1] x [0, H-1] (required)\n"
+    "  --observer-height H   eye height above the surface, height units, >= 0 (default 0)\n"
+    "  --target-height T     target height above each sample, >= 0 (default 0)\n"
+    "  --max-distance D      horizontal range in height units (--cell applies), >= 0;\n"
+    "                        0 = unlimited (default)\n"
+    "  --exact               the exact line-of-sight oracle instead (half-cell march per\n"
+    "                        sample): O(W*H*max(W, H)), 4 s at 1024 x 1024\n"
+    "--dirs, --azimuth0, --compass, --degrees and --border do not apply. Default PGM range 0:1.\n",
+
+    "usage: hfvis voxelize MESH.obj --res N [--mode surface|conservative|solid] [--axis A]\n"
+    "         [--method pixel|slicing|clipping] [--max-vertices V] [--padding F] [--open]\n"
+    "         -o OUT.binvox|OUT.raw\n"
+    "Voxels of a triangle mesh (Wavefront OBJ: v and f lines, polygons fanned). The grid has\n"
+    "cubic voxels, N of them along the longest side of the mesh's bounding box (enlarged by F\n"
+    "times that side on every side), the other sides rounded up and centred.\n"
+    "  --res N           voxels along the longest side, 1..2048 (required)\n"
+    "  --mode M          surface (default): the voxels that hold a pixel-centre sample of a\n"
+    "                    triangle in the sweep along its dominant axis ([G12] ch. 6, 6-separating\n"
+    "                    with --axis all); conservative: every voxel a triangle touches (exact\n"
+    "                    triangle-box overlap); solid: the voxels whose centre is inside the\n"
+    "                    mesh, by ray parity (the mesh must be closed unless --open)\n"
+    "  --axis A          surface: dominant (default), all (three sweeps merged, [G12] Alg. 4) or\n"
+    "                    x, y, z (one sweep); solid: the parity ray direction x, y or z (default z)\n"
+    "  --method M        surface: pixel (the pixel-centre rule, default), slicing (geometry-shader\n"
+    "                    triangle slicing, [G12] Alg. 5) or clipping (fragment clipping, Alg. 6)\n"
+    "  --max-vertices V  slicing/clipping: the geometry shader's output-vertex limit; triangles\n"
+    "                    spanning more slabs than it allows leave holes, as in the thesis\n"
+    "                    (slicing V >= 7, clipping V >= 3; default unlimited)\n"
+    "  --padding F       empty margin around the mesh, a fraction of its longest side, 0..1\n"
+    "                    (default 0)\n"
+    "  --open            solid: leave columns that cross an open mesh an odd number of times\n"
+    "                    empty instead of failing\n"
+    "OUT: *.binvox (the binvox format of viewvox/binvox: a cube of the largest side, run-length\n"
+    "coded, translate and scale of the grid) or *.raw (one byte per voxel, 0 or 1, x fastest,\n"
+    "then y, then z; the dimensions are printed). Prints the grid and the voxel count unless\n"
+    "--quiet. Only -o and --quiet of the shared options apply.\n"
+};
+
+/* ------------------------------------------------------------------------------------------ */
+/* errors and progress                                                                        */
+/* ------------------------------------------------------------------------------------------ */
+
+static int cli_bar_open; /* a progress line is on stderr without its newline yet */
+
+/* Print the one error line "hfvis: <what>: <why>" and return code. */
+static int cli_error(int code, const char *what, const char *fmt, ...)
+{
+    char why[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(why, sizeof why, fmt, ap);
+    va_end(ap);
+    if (cli_bar_open) { fputc('\n', stderr); cli_bar_open = 0; }
+    ex_error(what, why);
+    return code;
+}
+
+/* A failed library call; for I/O errors the C library's reason is added when there is one. */
+static int cli_status(const char *what, hfvis_status s, int saved_errno)
+{
+    if (s == HFVIS_ERR_IO && saved_errno != 0)
+        return cli_error(CLI_EXIT_ERROR, what, "%s (%s)", hfvis_status_string(s),
+                         strerror(saved_errno));
+    return cli_error(CLI_EXIT_ERROR, what, "%s", hfvis_status_string(s));
+}
+
+/* One progress bar over several library calls: each call reports its own done/total, the bar
+ * shows base + done out of the run's total (its units are directions; 0 = each call's total). */
+typedef struct cli_progress_state {
+    const char *label;
+    long long base;   /* units finished by the calls before the current one */
+    long long total;  /* units of the whole run */
+} cli_progress_state;
+
+/* hfvis_progress_fn: "\r<command> [#####.....] done/total" on stderr. */
+static void cli_progress(void *user, int done, int total)
+{
+    enum { BAR = 32 };
+    cli_progress_state *p = (cli_progress_state *)user;
+    long long all = p->total > 0 ? p->total : total, now = p->total > 0 ? p->base + done : done;
+    char bar[BAR + 1];
+    int i, fill;
+    if (now > all) now = all;
+    fill = all > 0 ? (int)(now * BAR / all) : BAR;
+    for (i = 0; i < BAR; i++) bar[i] = i < fill ? '#' : '.';
+    bar[BAR] = '\0';
+    fprintf(stderr, "\r%s [%s] %lld/%lld", p->label, bar, now, all);
+    cli_bar_open = now < all;
+    if (!cli_bar_open) fputc('\n', stderr);
+    fflush(stderr);
+    if (done >= total) p->base += total;
+}
+
+static int cli_stderr_is_terminal(void)
+{
+#ifdef CLI_HAVE_ISATTY
+    return isatty(STDERR_FILENO);
+#else
+    return 0;
+#endif
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* argument parsing                                                                           */
+/* ------------------------------------------------------------------------------------------ */
+
+/* A finite number with nothing else in s (no leading space, no trailing characters). */
+static int cli_parse_real(const char *s, double *out)
+{
+    char *end;
+    double v;
+    if (s[0] == '\0' || isspace((unsigned char)s[0])) return 0;
+    errno = 0;
+    v = strtod(s, &end);
+    if (*end != '\0' || !isfinite(v)) return 0;
+    *out = v;
+    return 1;
+}
+
+/* flag's value as a real in [lo, hi] (lo excluded when lo_open); "expect" words the rule. */
+static int cli_real(const char *flag, const char *s, double lo, int lo_open, double hi,
+                    const char *expect, double *out)
+{
+    double v;
+    if (!cli_parse_real(s, &v) || v < lo || (lo_open && v == lo) || v > hi)
+        return cli_error(CLI_EXIT_USAGE, flag, "expected %s, got '%s'", expect, s);
+    *out = v;
+    return 0;
+}
+
+static int cli_int(const char *flag, const char *s, long lo, long hi, const char *expect, int *out)
+{
+    char *end;
+    long v;
+    if (s[0] == '\0' || isspace((unsigned char)s[0]))
+        return cli_error(CLI_EXIT_USAGE, flag, "expected %s, got '%s'", expect, s);
+    errno = 0;
+    v = strtol(s, &end, 10);
+    if (*end != '\0' || errno == ERANGE || v < lo || v > hi)
+        return cli_error(CLI_EXIT_USAGE, flag, "expected %s, got '%s'", expect, s);
+    *out = (int)v;
+    return 0;
+}
+
+/* Case-insensitive "does s end in ext". */
+static int cli_ends_with(const char *s, const char *ext)
+{
+    size_t n = strlen(s), m = strlen(ext), i;
+    if (n <= m) return 0;
+    for (i = 0; i < m; i++)
+        if (tolower((unsigned char)s[n - m + i]) != tolower((unsigned char)ext[i])) return 0;
+    return 1;
+}
+
+#define CLI_ALL ((1u << CMD_COUNT) - 1u)
+#define CLI_ONLY(c) (1u << (c))
+#define CLI_SUN (CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_INDIRECT)) /* the sun flags */
+typedef struct cli_flag { const char *name; int has_value; unsigned commands; } cli_flag;
+static const cli_flag cli_flags[] = {
+    { "-o", 1, CLI_ALL },           { "--range", 1, CLI_ALL },       { "--cell", 1, CLI_ALL },
+    { "--zscale", 1, CLI_ALL },     { "--nodata", 1, CLI_ALL },      { "--dirs", 1, CLI_ALL },
+    { "--azimuth0", 1, CLI_ALL },   { "--compass", 0, CLI_ALL },     { "--degrees", 0, CLI_ALL },
+    { "--border", 1, CLI_ALL },     { "--border-cells", 1, CLI_ALL }, { "--quiet", 0, CLI_ALL },
+    { "--sky", 1, CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) },
+    { "--albedo", 1, CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) },
+    { "--sun-azimuth", 1, CLI_SUN },              { "--sun-elevation", 1, CLI_SUN },
+    { "--sun-radius", 1, CLI_SUN },               { "--math", 0, CLI_SUN },
+    { "--env", 1, CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) },
+    { "--method", 1, CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VOXELIZE) },
+    { "--sun-irradiance", 1, CLI_ONLY(CMD_INDIRECT) }, { "--albedo-map", 1, CLI_ONLY(CMD_INDIRECT) },
+    { "--emission", 1, CLI_ONLY(CMD_INDIRECT) },  { "--bounces", 1, CLI_ONLY(CMD_INDIRECT) },
+    { "--output", 1, CLI_ONLY(CMD_INDIRECT) },
+    { "--fraction", 0, CLI_ONLY(CMD_VISIBILITY) }, { "--stats", 0, CLI_ONLY(CMD_VISIBILITY) },
+    { "--observer", 1, CLI_ONLY(CMD_VIEWSHED) },  { "--observer-height", 1, CLI_ONLY(CMD_VIEWSHED) },
+    { "--target-height", 1, CLI_ONLY(CMD_VIEWSHED) }, { "--max-distance", 1, CLI_ONLY(CMD_VIEWSHED) },
+    { "--exact", 0, CLI_ONLY(CMD_VIEWSHED) },
+    { "--res", 1, CLI_ONLY(CMD_VOXELIZE) },       { "--mode", 1, CLI_ONLY(CMD_VOXELIZE) },
+    { "--axis", 1, CLI_ONLY(CMD_VOXELIZE) },  
+    { "--max-vertices", 1, CLI_ONLY(CMD_VOXELIZE) }, { "--padding", 1, CLI_ONLY(CMD_VOXELIZE) },
+    { "--open", 0, CLI_ONLY(CMD_VOXELIZE) }
+};
+
+/* Apply one recognised flag; returns 0 or CLI_EXIT_USAGE (message printed). */
+static int cli_set(cli_args *a, const char *f, const char *v)
+{
+    if (!strcmp(f, "-o") && a->cmd == CMD_VOXELIZE) {
+        if (cli_ends_with(v, ".binvox")) a->out_binvox = 1;
+        else if (cli_ends_with(v, ".raw")) a->out_binvox = 0;
+        else return cli_error(CLI_EXIT_USAGE, v, "unknown output type (use a .binvox or .raw name)");
+        a->out = v;
+        return 0;
+    }
+    if (!strcmp(f, "-o")) {
+        if (cli_ends_with(v, ".pfm")) a->out_pgm = 0;
+        else if (cli_ends_with(v, ".pgm")) a->out_pgm = 1;
+        else return cli_error(CLI_EXIT_USAGE, v, "unknown output type (use a .pfm or .pgm name)");
+        a->out = v;
+        return 0;
+    }
+    if (!strcmp(f, "--range")) {
+        char buf[256];
+        const char *colon = strchr(v, ':');
+        size_t n = colon ? (size_t)(colon - v) : 0;
+        if (!colon || n >= sizeof buf)
+            return cli_error(CLI_EXIT_USAGE, f, "expected LO:HI, got '%s'", v);
+        memcpy(buf, v, n);
+        buf[n] = '\0';
+        if (!cli_parse_real(buf, &a->range_lo) || !cli_parse_real(colon + 1, &a->range_hi) ||
+            fabs(a->range_lo) > CLI_FLT_MAX || fabs(a->range_hi) > CLI_FLT_MAX ||
+            !((float)a->range_lo < (float)a->range_hi))
+            return cli_error(CLI_EXIT_USAGE, f, "expected LO:HI with finite LO < HI, got '%s'", v);
+        a->has_range = 1;
+        return 0;
+    }
+    if (!strcmp(f, "--cell")) return cli_real(f, v, 0.0, 1, DBL_MAX, "a number > 0", &a->cell);
+    if (!strcmp(f, "--zscale")) {
+        if (cli_real(f, v, -CLI_FLT_MAX, 0, CLI_FLT_MAX, "a non-zero number", &a->zscale)) return CLI_EXIT_USAGE;
+        if ((float)a->zscale == 0.0f)
+            return cli_error(CLI_EXIT_USAGE, f, "expected a non-zero number, got '%s'", v);
+        return 0;
+    }
+    if (!strcmp(f, "--nodata")) {
+        a->has_nodata = 1;
+        return cli_real(f, v, -CLI_FLT_MAX, 0, CLI_FLT_MAX, "a finite number", &a->nodata);
+    }
+    if (!strcmp(f, "--dirs")) return cli_int(f, v, 1, CLI_MAX_DIRS, "an integer 1..65536", &a->dirs);
+    if (!strcmp(f, "--azimuth0"))
+        return cli_real(f, v, -DBL_MAX, 0, DBL_MAX, "a finite angle in radians", &a->azimuth0);
+    if (!strcmp(f, "--compass")) { a->compass = 1; return 0; }
+    if (!strcmp(f, "--degrees")) { a->degrees = 1; return 0; }
+    if (!strcmp(f, "--quiet")) { a->quiet = 1; return 0; }
+    if (!strcmp(f, "--math")) { a->math = 1; return 0; }
+    if (!strcmp(f, "--border")) {
+        if (!strcmp(v, "open")) a->border = HFVIS_BORDER_OPEN;
+        else if (!strcmp(v, "clamp")) a->border = HFVIS_BORDER_CLAMP;
+        else if (!strcmp(v, "wrap")) a->border = HFVIS_BORDER_WRAP;
+        else return cli_error(CLI_EXIT_USAGE, f, "expected open, clamp or wrap, got '%s'", v);
+        return 0;
+    }
+    if (!strcmp(f, "--border-cells"))
+        return cli_int(f, v, 1, HFVIS_IMAGE_MAX_DIM, "an integer 1..1048576", &a->border_cells);
+    if (!strcmp(f, "--sky")) {
+        a->has_sky = 1;
+        return cli_real(f, v, 0.0, 0, CLI_FLT_MAX, "a radiance >= 0", &a->sky);
+    }
+    if (!strcmp(f, "--albedo")) {
+        a->has_albedo = 1;
+        return cli_real(f, v, 0.0, 0, CLI_FLT_MAX, "an albedo >= 0", &a->albedo);
+    }
+    if (!strcmp(f, "--sun-irradiance")) {
+        a->has_sun_irradiance = 1;
+        return cli_real(f, v, 0.0, 0, CLI_FLT_MAX, "an irradiance >= 0", &a->sun_irradiance);
+    }
+    if (!strcmp(f, "--albedo-map")) { a->albedo_map = v; return 0; }
+    if (!strcmp(f, "--emission")) { a->emission = v; return 0; }
+    if (!strcmp(f, "--bounces")) {
+        a->has_bounces = 1;
+        return cli_int(f, v, 0, CLI_MAX_BOUNCES, "an integer 0..1000", &a->bounces);
+    }
+    if (!strcmp(f, "--output")) {
+        if (!strcmp(v, "total")) a->output = OUT_TOTAL;
+        else if (!strcmp(v, "direct")) a->output = OUT_DIRECT;
+        else if (!strcmp(v, "indirect")) a->output = OUT_INDIRECT;
+        else return cli_error(CLI_EXIT_USAGE, f, "expected total, direct or indirect, got '%s'", v);
+        return 0;
+    }
+    if (!strcmp(f, "--fraction")) { a->fraction = 1; return 0; }
+    if (!strcmp(f, "--stats")) { a->stats = 1; return 0; }
+    if (!strcmp(f, "--sun-azimuth")) {
+        a->has_sun_azimuth = 1;
+        return cli_real(f, v, -DBL_MAX, 0, DBL_MAX, "a finite angle in degrees", &a->sun_azimuth);
+    }
+    if (!strcmp(f, "--sun-elevation")) {
+        a->has_sun_elevation = 1;
+        return cli_real(f, v, -90.0, 0, 90.0, "degrees in -90..90", &a->sun_elevation);
+    }
+    if (!strcmp(f, "--sun-radius")) {
+        a->has_sun_radius = 1;
+        return cli_real(f, v, 0.0, 0, 90.0, "degrees in 0..90", &a->sun_radius);
+    }
+    if (!strcmp(f, "--env")) { a->env = v; return 0; }
+    if (!strcmp(f, "--observer")) {
+        char buf[256];
+        const char *comma = strchr(v, ',');
+        size_t n = comma ? (size_t)(comma - v) : 0;
+        if (!comma || n >= sizeof buf)
+            return cli_error(CLI_EXIT_USAGE, f, "expected X,Y (column,row), got '%s'", v);
+        memcpy(buf, v, n);
+        buf[n] = '\0';
+        if (!cli_parse_real(buf, &a->observer_x) || !cli_parse_real(comma + 1, &a->observer_y))
+            return cli_error(CLI_EXIT_USAGE, f, "expected X,Y (column,row), got '%s'", v);
+        a->has_observer = 1;
+        return 0;
+    }
+    if (!strcmp(f, "--observer-height"))
+        return cli_real(f, v, 0.0, 0, DBL_MAX, "a height >= 0", &a->observer_height);
+    if (!strcmp(f, "--target-height"))
+        return cli_real(f, v, 0.0, 0, DBL_MAX, "a height >= 0", &a->target_height);
+    if (!strcmp(f, "--max-distance"))
+        return cli_real(f, v, 0.0, 0, DBL_MAX, "a distance >= 0", &a->max_distance);
+    if (!strcmp(f, "--exact")) { a->exact = 1; return 0; }
+    if (!strcmp(f, "--res")) return cli_int(f, v, 1, CLI_MAX_RES, "an integer 1..2048", &a->res);
+    if (!strcmp(f, "--max-vertices"))
+        return cli_int(f, v, 1, 1000000, "an integer 1..1000000", &a->max_vertices);
+    if (!strcmp(f, "--padding")) return cli_real(f, v, 0.0, 0, 1.0, "a fraction in 0..1", &a->padding);
+    if (!strcmp(f, "--open")) { a->open_mesh = 1; return 0; }
+    if (!strcmp(f, "--mode")) {
+        if (!strcmp(v, "surface")) a->vox_mode = VOX_SURFACE;
+        else if (!strcmp(v, "conservative")) a->vox_mode = VOX_CONSERVATIVE;
+        else if (!strcmp(v, "solid")) a->vox_mode = VOX_SOLID;
+        else return cli_error(CLI_EXIT_USAGE, f, "expected surface, conservative or solid, got '%s'", v);
+        return 0;
+    }
+    if (!strcmp(f, "--axis")) {
+        static const char *const names[] = {"", "dominant", "all", "x", "y", "z"};
+        int k;
+        for (k = AXIS_DOMINANT; k <= AXIS_Z; k++)
+            if (!strcmp(v, names[k])) { a->vox_axis = k; return 0; }
+        return cli_error(CLI_EXIT_USAGE, f, "expected dominant, all, x, y or z, got '%s'", v);
+    }
+    if (a->cmd == CMD_VOXELIZE) { /* --method of voxelize */
+        if (!strcmp(v, "pixel")) a->vox_method = HFVIS_VOXELIZE_PIXEL_RULE;
+        else if (!strcmp(v, "slicing")) a->vox_method = HFVIS_VOXELIZE_GS_SLICING;
+        else if (!strcmp(v, "clipping")) a->vox_method = HFVIS_VOXELIZE_FRAGMENT_CLIPPING;
+        else return cli_error(CLI_EXIT_USAGE, f, "expected pixel, slicing or clipping, got '%s'", v);
+        return 0;
+    }
+    /* --method */
+    if (!strcmp(v, "prefix")) a->method = HFVIS_ENV_PREFIX;
+    else if (!strcmp(v, "lp")) a->method = HFVIS_ENV_LP_TABLE;
+    else return cli_error(CLI_EXIT_USAGE, f, "expected prefix or lp, got '%s'", v);
+    return 0;
+}
+
+/* Returns CLI_RUN, or the exit status after printing help (0) or a usage error (2). */
+static int cli_parse(int argc, char **argv, cli_args *a)
+{
+    int i, c, positional_only = 0;
+    memset(a, 0, sizeof *a);
+    a->cell = 1.0; a->zscale = 1.0; a->dirs = 16; a->sky = 1.0; a->albedo = 1.0;
+    a->border = HFVIS_BORDER_OPEN; a->method = HFVIS_ENV_PREFIX;
+    a->bounces = 1; a->sun_irradiance = CLI_PI; a->output = OUT_TOTAL;
+    if (argc < 2) return cli_error(CLI_EXIT_USAGE, "usage", "missing COMMAND (try 'hfvis --help')");
+    if (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help") || !strcmp(argv[1], "help")) {
+        if (argc > 2 && strcmp(argv[1], "help") == 0) {
+            for (c = 0; c < CMD_COUNT; c++)
+                if (!strcmp(argv[2], cli_cmd_names[c])) {
+                    printf("%s%s", cli_cmd_help[c], cli_shared_help);
+                    return 0;
+                }
+            return cli_error(CLI_EXIT_USAGE, argv[2], "unknown command (try 'hfvis --help')");
+        }
+        printf("%s%s", cli_usage, cli_shared_help);
+        return 0;
+    }
+    for (c = 0; c < CMD_COUNT && strcmp(argv[1], cli_cmd_names[c]); c++) {}
+    if (c == CMD_COUNT) return cli_error(CLI_EXIT_USAGE, argv[1], "unknown command (try 'hfvis --help')");
+    a->cmd = c;
+    for (i = 2; i < argc; i++) {
+        const char *arg = argv[i], *value = NULL, *eq;
+        char name[64];
+        size_t n, k;
+        if (positional_only || arg[0] != '-' || arg[1] == '\0') {
+            if (a->in) return cli_error(CLI_EXIT_USAGE, arg, "unexpected argument (only one IN)");
+            a->in = arg;
+            continue;
+        }
+        if (!strcmp(arg, "--")) { positional_only = 1; continue; }
+        if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) {
+            printf("%s%s", cli_cmd_help[a->cmd], cli_shared_help);
+            return 0;
+        }
+        eq = strchr(arg, '=');
+        n = eq ? (size_t)(eq - arg) : strlen(arg);
+        if (n >= sizeof name) n = sizeof name - 1;
+        memcpy(name, arg, n);
+        name[n] = '\0';
+        for (k = 0; k < sizeof cli_flags / sizeof cli_flags[0]; k++)
+            if (!strcmp(name, cli_flags[k].name)) break;
+        if (k == sizeof cli_flags / sizeof cli_flags[0])
+            return cli_error(CLI_EXIT_USAGE, name, "unknown option (see 'hfvis %s --help')",
+                             cli_cmd_names[a->cmd]);
+        if (!(cli_flags[k].commands & CLI_ONLY(a->cmd)))
+            return cli_error(CLI_EXIT_USAGE, name, "not an option of '%s' (see 'hfvis %s --help')",
+                             cli_cmd_names[a->cmd], cli_cmd_names[a->cmd]);
+        if (cli_flags[k].has_value) {
+            if (eq) value = eq + 1;
+            else if (i + 1 < argc) value = argv[++i];
+            else return cli_error(CLI_EXIT_USAGE, name, "missing value");
+        } else if (eq) {
+            return cli_error(CLI_EXIT_USAGE, name, "takes no value");
+        }
+        if (cli_set(a, name, value)) return CLI_EXIT_USAGE;
+    }
+    if (!a->in) return cli_error(CLI_EXIT_USAGE, cli_cmd_names[a->cmd], "missing input file IN");
+    if (!a->out) return cli_error(CLI_EXIT_USAGE, cli_cmd_names[a->cmd], "missing -o OUT");
+    if (a->has_range && !a->out_pgm)
+        return cli_error(CLI_EXIT_USAGE, "--range", "applies only to .pgm output");
+    if (a->cmd == CMD_SHADOW && !a->has_sun_azimuth)
+        return cli_error(CLI_EXIT_USAGE, "shadow", "missing --sun-azimuth DEG");
+    if (a->cmd == CMD_SHADOW && !a->has_sun_elevation)
+        return cli_error(CLI_EXIT_USAGE, "shadow", "missing --sun-elevation DEG");
+    if (a->cmd == CMD_VIEWSHED && !a->has_observer)
+        return cli_error(CLI_EXIT_USAGE, "viewshed", "missing --observer X,Y");
+    if (a->cmd == CMD_VOXELIZE) {
+        const char *m = a->vox_mode == VOX_SOLID ? "solid" : "conservative";
+        if (!a->res) return cli_error(CLI_EXIT_USAGE, "voxelize", "missing --res N");
+        if (a->vox_mode != VOX_SURFACE && (a->vox_method != HFVIS_VOXELIZE_PIXEL_RULE || a->max_vertices))
+            return cli_error(CLI_EXIT_USAGE, a->max_vertices ? "--max-vertices" : "--method",
+                             "applies only to --mode surface, not %s", m);
+        if (a->vox_mode == VOX_CONSERVATIVE && a->vox_axis != AXIS_DEFAULT)
+            return cli_error(CLI_EXIT_USAGE, "--axis", "does not apply to --mode conservative");
+        if (a->vox_mode == VOX_SOLID && (a->vox_axis == AXIS_DOMINANT || a->vox_axis == AXIS_ALL))
+            return cli_error(CLI_EXIT_USAGE, "--axis", "--mode solid takes x, y or z");
+        if (a->open_mesh && a->vox_mode != VOX_SOLID)
+            return cli_error(CLI_EXIT_USAGE, "--open", "applies only to --mode solid");
+        if (a->max_vertices && a->vox_method == HFVIS_VOXELIZE_PIXEL_RULE)
+            return cli_error(CLI_EXIT_USAGE, "--max-vertices", "needs --method slicing or clipping");
+    }
+    if (a->cmd == CMD_LIGHT && !a->env)
+        return cli_error(CLI_EXIT_USAGE, "light", "missing --env ENV.pfm");
+    if (a->cmd == CMD_INDIRECT) {
+        int sun = a->has_sun_azimuth || a->has_sun_elevation;
+        if (a->has_sun_azimuth && !a->has_sun_elevation)
+            return cli_error(CLI_EXIT_USAGE, "--sun-azimuth", "needs --sun-elevation DEG");
+        if (a->has_sun_elevation && !a->has_sun_azimuth)
+            return cli_error(CLI_EXIT_USAGE, "--sun-elevation", "needs --sun-azimuth DEG");
+        if (!sun && (a->has_sun_radius || a->has_sun_irradiance || a->math))
+            return cli_error(CLI_EXIT_USAGE, a->has_sun_radius ? "--sun-radius" :
+                             a->has_sun_irradiance ? "--sun-irradiance" : "--math",
+                             "needs a sun (--sun-azimuth and --sun-elevation)");
+        if (a->has_albedo && a->albedo_map)
+            return cli_error(CLI_EXIT_USAGE, "--albedo-map", "cannot be combined with --albedo");
+        if (a->has_sky && a->env)
+            return cli_error(CLI_EXIT_USAGE, "--env", "cannot be combined with --sky");
+        if (a->output == OUT_DIRECT && a->has_bounces)
+            return cli_error(CLI_EXIT_USAGE, "--bounces", "has no effect with --output direct");
+        if (a->output == OUT_INDIRECT && a->bounces < 1)
+            return cli_error(CLI_EXIT_USAGE, "--output indirect", "needs --bounces >= 1");
+    }
+    return CLI_RUN;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* running a command                                                                          */
+/* ------------------------------------------------------------------------------------------ */
+
+/* Load IN as a one-channel height field; --nodata values become NaN, the rest are scaled. */
+static int cli_load_heights(const cli_args *a, float **z, int *w, int *h)
+{
+    hfvis_image_info info;
+    float *px = NULL, zscale = (float)a->zscale, nodata = (float)a->nodata;
+    size_t i, n;
+    hfvis_status s;
+    errno = 0;
+    s = hfvis_image_load(a->in, NULL, &px, &info);
+    if (s != HFVIS_OK) return cli_status(a->in, s, errno);
+    if (info.channels != 1) {
+        hfvis_free(NULL, px);
+        return cli_error(CLI_EXIT_ERROR, a->in, "a height field has one channel, this image has %d",
+                         info.channels);
+    }
+    n = (size_t)info.width * (size_t)info.height; /* <= HFVIS_IMAGE_MAX_VALUES (decoder limit) */
+    for (i = 0; i < n; i++) {
+        if (a->has_nodata && px[i] == nodata) px[i] = (float)NAN;
+        else px[i] *= zscale;
+    }
+    *z = px; *w = info.width; *h = info.height;
+    return 0;
+}
+
+/* Allocate count floats, count = a*b*c with overflow check. */
+static float *cli_alloc(size_t a, size_t b, size_t c)
+{
+    if (a == 0 || b == 0 || c == 0 || a > SIZE_MAX / b || a * b > SIZE_MAX / c ||
+        a * b * c > SIZE_MAX / sizeof(float))
+        return NULL;
+    return (float *)malloc(a * b * c * sizeof(float));
+}
+
+/* Write OUT: PFM with its channels, or a 16-bit PGM with the channel planes stacked. */
+static int cli_save(const cli_args *a, const float *px, int w, int h, int channels, double lo,
+                    double hi)
+{
+    hfvis_status s;
+    errno = 0;
+    if (!a->out_pgm) {
+        s = hfvis_pfm_save(a->out, px, w, h, channels, w);
+    } else {
+        if (a->has_range) { lo = a->range_lo; hi = a->range_hi; }
+        if (channels == 1) {
+            s = hfvis_pgm_save(a->out, px, w, h, w, (float)lo, (float)hi, 65535);
+        } else {
+            size_t n = (size_t)w * (size_t)h, i;
+            int c;
+            float *planes = cli_alloc(n, (size_t)channels, 1);
+            if (!planes) return cli_status(a->out, HFVIS_ERR_OUT_OF_MEMORY, 0);
+            for (c = 0; c < channels; c++)
+                for (i = 0; i < n; i++) planes[(size_t)c * n + i] = px[i * (size_t)channels + (size_t)c];
+            if ((long long)h * channels > INT_MAX) s = HFVIS_ERR_LIMIT;
+            else s = hfvis_pgm_save(a->out, planes, w, h * channels, w, (float)lo, (float)hi, 65535);
+            free(planes);
+        }
+    }
+    if (s != HFVIS_OK) return cli_status(a->out, s, errno);
+    return 0;
+}
+
+/* Load a lat-long environment map (any image the codecs read). */
+static int cli_load_env(const char *path, float **px, hfvis_env *env)
+{
+    hfvis_image_info info;
+    hfvis_status s;
+    errno = 0;
+    s = hfvis_image_load(path, NULL, px, &info);
+    if (s != HFVIS_OK) return cli_status(path, s, errno);
+    env->radiance = *px; env->n_theta = info.height; env->n_phi = info.width;
+    env->channels = info.channels;
+    return 0;
+}
+
+/* Load a per-sample map of the height field's size (indirect --albedo-map, --emission): PGM
+ * values divided by the file's maxval, PFM values as stored; every value finite and >= 0
+ * wherever the height field has no hole. */
+static int cli_load_map(const char *path, const hfvis_grid *grid, float **px, int *channels)
+{
+    hfvis_image_info info;
+    float *m = NULL;
+    size_t i, n = (size_t)grid->width * (size_t)grid->height;
+    int c;
+    hfvis_status s;
+    errno = 0;
+    s = hfvis_image_load(path, NULL, &m, &info);
+    if (s != HFVIS_OK) return cli_status(path, s, errno);
+    if (info.width != grid->width || info.height != grid->height) {
+        hfvis_free(NULL, m);
+        return cli_error(CLI_EXIT_ERROR, path, "%d x %d samples, but IN has %d x %d", info.width,
+                         info.height, grid->width, grid->height);
+    }
+    for (i = 0; i < n; i++)
+        for (c = 0; c < info.channels; c++) {
+            float *v = m + i * (size_t)info.channels + (size_t)c;
+            if (info.format == HFVIS_FORMAT_PGM) *v = (float)((double)*v / (double)info.maxval);
+            if (isfinite(grid->z[i]) && !(isfinite(*v) && *v >= 0.0f)) {
+                double bad = (double)*v;
+                hfvis_free(NULL, m);
+                return cli_error(CLI_EXIT_ERROR, path, "value %g at column %d, row %d is not a "
+                                 "finite number >= 0", bad, (int)(i % (size_t)grid->width),
+                                 (int)(i / (size_t)grid->width));
+            }
+        }
+    *px = m;
+    *channels = info.channels;
+    return 0;
+}
+
+/* Give a one-channel array of n samples `channels` channels (each a copy), replacing *px. */
+static int cli_widen(float **px, size_t n, int channels)
+{
+    size_t i;
+    int c;
+    float *w = cli_alloc(n, (size_t)channels, 1);
+    if (!w) return cli_status("indirect", HFVIS_ERR_OUT_OF_MEMORY, 0);
+    for (i = 0; i < n; i++)
+        for (c = 0; c < channels; c++) w[i * (size_t)channels + (size_t)c] = (*px)[i];
+    hfvis_free(NULL, *px);
+    *px = w;
+    return 0;
+}
+
+/* Largest finite value of px[0..n), or fallback if none is > 0: the top of a default PGM range. */
+static double cli_top(const float *px, size_t n, double fallback)
+{
+    size_t i;
+    double top = 0.0;
+    for (i = 0; i < n; i++)
+        if (isfinite(px[i]) && (double)px[i] > top) top = (double)px[i];
+    return (float)top > 0.0f ? top : fallback;
+}
+
+/* indirect: direct light (hfvis_direct_light), then hfvis_terrain_gi. */
+static int cli_run_indirect(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
+                            cli_progress_state *prog)
+{
+    const char *cmd = "indirect";
+    const int w = grid->width, h = grid->height, K = a->dirs;
+    const size_t n = (size_t)w * (size_t)h;
+    const int has_sun = a->has_sun_azimuth;
+    const int bounces = a->output == OUT_DIRECT ? 0 : a->bounces;
+    float *env_px = NULL, *albedo = NULL, *emit = NULL, *direct = NULL, *out = NULL, *base = NULL;
+    int env_ch = 1, albedo_ch = 1, emit_ch = 1, channels, direct_ch, rc = 0, c;
+    hfvis_env env;
+    hfvis_sun sun;
+    hfvis_status s;
+    size_t i;
+
+    memset(&env, 0, sizeof env);
+    memset(&sun, 0, sizeof sun);
+    if (a->env) {
+        if ((rc = cli_load_env(a->env, &env_px, &env)) != 0) goto done;
+        env_ch = env.channels;
+    }
+    if (a->albedo_map && (rc = cli_load_map(a->albedo_map, grid, &albedo, &albedo_ch)) != 0) goto done;
+    if (a->emission && (rc = cli_load_map(a->emission, grid, &emit, &emit_ch)) != 0) goto done;
+    /* Output channels: the most of any input; one-channel inputs apply to every channel. */
+    channels = env_ch > albedo_ch ? env_ch : albedo_ch;
+    if (emit_ch > channels) channels = emit_ch;
+    {
+        const char *names[3] = { a->env, a->albedo_map, a->emission };
+        const int counts[3] = { env_ch, albedo_ch, emit_ch };
+        for (c = 0; c < 3; c++)
+            if (names[c] && counts[c] != 1 && counts[c] != channels) {
+                rc = cli_error(CLI_EXIT_ERROR, names[c], "%d channels, but another input has %d "
+                               "(inputs need 1 channel or the same count)", counts[c], channels);
+                goto done;
+            }
+    }
+    if (albedo && albedo_ch < channels && (rc = cli_widen(&albedo, n, channels)) != 0) goto done;
+    if (emit && emit_ch < channels && (rc = cli_widen(&emit, n, channels)) != 0) goto done;
+    direct = cli_alloc(n, (size_t)channels, 1);
+    out = cli_alloc(n, (size_t)channels, 1);
+    if (a->output == OUT_INDIRECT) base = cli_alloc(n, (size_t)channels, 1);
+    if (!direct || !out || (a->output == OUT_INDIRECT && !base)) {
+        rc = cli_status(cmd, HFVIS_ERR_OUT_OF_MEMORY, 0);
+        goto done;
+    }
+    if (has_sun) {
+        double psi_deg = a->math ? a->sun_azimuth : a->sun_azimuth - 90.0;
+        sun.azimuth_rad = psi_deg * (CLI_PI / 180.0);
+        sun.elevation_rad = a->sun_elevation * (CLI_PI / 180.0);
+        sun.radius_rad = a->sun_radius * (CLI_PI / 180.0);
+        for (c = 0; c < 4; c++) sun.irradiance[c] = (float)a->sun_irradiance;
+    }
+    /* one bar: the sky or environment sweep (K), the sun sweep (1), K per bounce */
+    prog->total = (long long)K * (1 + bounces) + (has_sun ? 1 : 0);
+
+    /* D: the sky part has the environment's channels (1 for the uniform sky) */
+    direct_ch = a->env ? env_ch : 1;
+    s = hfvis_direct_light(grid, K, has_sun ? &sun : NULL, (float)a->sky, a->env ? &env : NULL,
+                           direct_ch, opts, direct);
+    if (s != HFVIS_OK) { rc = cli_status(cmd, s, 0); goto done; }
+    if (direct_ch < channels) /* spread the one channel, back to front (in place) */
+        for (i = n; i-- > 0;)
+            for (c = channels - 1; c >= 0; c--) direct[i * (size_t)channels + (size_t)c] = direct[i];
+
+    s = hfvis_terrain_gi(grid, K, direct, emit, albedo, (float)a->albedo, channels, bounces, opts,
+                         NULL, out);
+    if (s == HFVIS_OK && a->output == OUT_INDIRECT) { /* L_B - L_0 */
+        s = hfvis_terrain_gi(grid, K, direct, emit, albedo, (float)a->albedo, channels, 0, opts,
+                             NULL, base);
+        for (i = 0; s == HFVIS_OK && i < n * (size_t)channels; i++)
+            out[i] = (float)((double)out[i] - (double)base[i]);
+    }
+    if (s != HFVIS_OK) { rc = cli_status(cmd, s, 0); goto done; }
+    rc = cli_save(a, out, w, h, channels, 0.0, cli_top(out, n * (size_t)channels, 1.0));
+done:
+    free(base);
+    free(out);
+    free(direct);
+    hfvis_free(NULL, emit);
+    hfvis_free(NULL, albedo);
+    hfvis_free(NULL, env_px);
+    return rc;
+}
+
+/* visibility: hfvis_visibility_count; --fraction divides by the count on a flat field with the
+ * same holes (where every sample is visible); --stats prints the counters after OUT is written. */
+static int cli_run_visibility(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
+                              cli_progress_state *prog)
+{
+    const char *cmd = "visibility";
+    const int w = grid->width, h = grid->height, K = a->dirs;
+    const size_t n = (size_t)w * (size_t)h;
+    float *out = cli_alloc(n, 1, 1), *flat_z = NULL, *tested = NULL;
+    hfvis_visibility_stats st, flat_st;
+    hfvis_status s;
+    size_t i;
+    int rc;
+
+    memset(&flat_st, 0, sizeof flat_st);
+    if (!out) return cli_status(cmd, HFVIS_ERR_OUT_OF_MEMORY, 0);
+    prog->total = (long long)K * (a->fraction ? 2 : 1);
+    s = hfvis_visibility_count(grid, K, opts, NULL, out, w, &st);
+    if (s == HFVIS_OK && a->fraction) {
+        hfvis_grid flat = *grid;
+        flat_z = cli_alloc(n, 1, 1);
+        tested = cli_alloc(n, 1, 1);
+        if (!flat_z || !tested) s = HFVIS_ERR_OUT_OF_MEMORY;
+        else {
+            for (i = 0; i < n; i++) flat_z[i] = isfinite(grid->z[i]) ? 0.0f : (float)NAN;
+            flat.z = flat_z;
+            s = hfvis_visibility_count(&flat, K, opts, NULL, tested, w, &flat_st);
+        }
+        for (i = 0; s == HFVIS_OK && i < n; i++)
+            if (!isnan(out[i])) out[i] = tested[i] > 0.0f ? (float)((double)out[i] / (double)tested[i]) : 0.0f;
+    }
+    if (s != HFVIS_OK) rc = cli_status(cmd, s, 0);
+    else rc = cli_save(a, out, w, h, 1, 0.0, a->fraction ? 1.0 : cli_top(out, n, 1.0));
+    if (rc == 0 && a->stats) {
+        double r = st.receivers > 0.0 ? st.receivers : 1.0; /* 0 receivers: print zeros */
+        printf("receiver-directions: %.0f\n", st.receivers);
+        printf("visible per receiver-direction: %.6g\n", st.visible / r);
+        printf("horizons per receiver-direction (m_a): %.6g\n", st.horizons / r);
+        printf("iterations per receiver-direction (t_a): %.6g\n", st.iterations / r);
+        if (a->fraction) {
+            double t = flat_st.visible > 0.0 ? flat_st.visible : 1.0;
+            printf("tested per receiver-direction: %.6g\n", flat_st.visible / r);
+            printf("visible/tested: %.6g\n", st.visible / t);
+            printf("t_a/tested: %.6g\n", st.iterations / t);
+        }
+        if (fflush(stdout) != 0) rc = cli_error(CLI_EXIT_ERROR, "stdout", "%s", strerror(errno));
+    }
+    free(tested);
+    free(flat_z);
+    free(out);
+    return rc;
+}
+
+/* voxelize: MESH.obj -> a cubic-voxel grid fitted to the mesh -> .binvox or .raw. */
+static int cli_run_voxelize(const cli_args *a)
+{
+    hfvis_mesh mesh;
+    hfvis_volume_grid grid;
+    uint8_t *occ = NULL;
+    size_t voxels, count = 0, i;
+    hfvis_status s;
+    int rc = 0;
+    errno = 0;
+    s = hfvis_mesh_load(a->in, NULL, &mesh);
+    if (s != HFVIS_OK) return cli_status(a->in, s, errno);
+    s = hfvis_volume_grid_fit(&mesh, a->res, a->padding, 1, &grid);
+    if (s == HFVIS_ERR_INVALID_ARGUMENT && mesh.triangle_count == 0) {
+        rc = cli_error(CLI_EXIT_ERROR, a->in, "the mesh has no triangles");
+        goto done;
+    }
+    if (s != HFVIS_OK) { rc = cli_status("voxelize", s, 0); goto done; }
+    voxels = (size_t)grid.dims[0] * (size_t)grid.dims[1] * (size_t)grid.dims[2];
+    occ = (uint8_t *)malloc(voxels);
+    if (!occ) { rc = cli_status("voxelize", HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
+    if (a->vox_mode == VOX_SURFACE) {
+        hfvis_voxelize_options o = hfvis_voxelize_options_default();
+        static const hfvis_voxelize_axes axes[] = {HFVIS_AXES_DOMINANT, HFVIS_AXES_DOMINANT,
+                                                   HFVIS_AXES_ALL, HFVIS_AXES_ONLY_X,
+                                                   HFVIS_AXES_ONLY_Y, HFVIS_AXES_ONLY_Z};
+        o.method = (hfvis_voxelize_method)a->vox_method;
+        o.axes = axes[a->vox_axis];
+        o.max_output_vertices = a->max_vertices;
+        if (a->max_vertices && hfvis_gs_max_slices(a->max_vertices,
+                                                   o.method == HFVIS_VOXELIZE_FRAGMENT_CLIPPING) == 0) {
+            rc = cli_error(CLI_EXIT_USAGE, "--max-vertices", "%d vertices hold no slab (slicing "
+                           "needs >= 7, clipping >= 3)", a->max_vertices);
+            goto done;
+        }
+        s = hfvis_voxelize_occupancy(&mesh, &grid, &o, occ);
+        for (i = 0; s == HFVIS_OK && i < voxels; i++) count += occ[i];
+    } else {
+        hfvis_binary_voxel_options o = hfvis_binary_voxel_options_default();
+        if (a->vox_mode == VOX_CONSERVATIVE) {
+            s = hfvis_voxelize_conservative(&mesh, &grid, &o, occ, &count);
+        } else {
+            o.axis = a->vox_axis == AXIS_X ? HFVIS_PARITY_AXIS_X
+                     : a->vox_axis == AXIS_Y ? HFVIS_PARITY_AXIS_Y : HFVIS_PARITY_AXIS_Z;
+            o.allow_open = a->open_mesh;
+            s = hfvis_voxelize_solid(&mesh, &grid, &o, occ, &count);
+            if (s == HFVIS_ERR_FORMAT) {
+                rc = cli_error(CLI_EXIT_ERROR, a->in, "the mesh is not closed (a parity ray "
+                               "crosses it an odd number of times); use --open or --mode surface");
+                goto done;
+            }
+        }
+    }
+    if (s != HFVIS_OK) { rc = cli_status("voxelize", s, 0); goto done; }
+    errno = 0;
+    s = a->out_binvox ? hfvis_binvox_save(a->out, &grid, occ) : hfvis_voxels_raw_save(a->out, &grid, occ);
+    if (s != HFVIS_OK) { rc = cli_status(a->out, s, errno); goto done; }
+    if (!a->quiet)
+        printf("voxelize: %zu triangles -> %d x %d x %d voxels of %.6g (origin %.6g %.6g %.6g), "
+               "%zu set\n", mesh.triangle_count, grid.dims[0], grid.dims[1], grid.dims[2],
+               grid.cell[0], grid.origin[0], grid.origin[1], grid.origin[2], count);
+done:
+    free(occ);
+    hfvis_mesh_free(NULL, &mesh);
+    return rc;
+}
+
+static int cli_run(const cli_args *a)
+{
+    const char *cmd = cli_cmd_names[a->cmd];
+    cli_progress_state prog;
+    float *z = NULL, *out = NULL, *env_px = NULL;
+    int w = 0, h = 0, rc, channels = 1, planes = 1;
+    double lo = 0.0, hi = 1.0;
+    hfvis_grid grid;
+    hfvis_sweep_options opts = hfvis_sweep_options_default();
+    hfvis_env env;
+    hfvis_status s = HFVIS_OK;
+
+    if (a->cmd == CMD_VOXELIZE) return cli_run_voxelize(a);
+    memset(&env, 0, sizeof env);
+    if ((rc = cli_load_heights(a, &z, &w, &h)) != 0) return rc;
+    grid.z = z; grid.width = w; grid.height = h; grid.stride = w; grid.cell_size = a->cell;
+    opts.border = (hfvis_border)a->border;
+    opts.border_cells = a->border_cells;
+    opts.azimuth0_rad = a->compass ? a->azimuth0 - CLI_PI / 2.0 : a->azimuth0;
+    prog.label = cmd; prog.base = 0; prog.total = 0;
+    if (!a->quiet && cli_stderr_is_terminal()) {
+        opts.progress = cli_progress;
+        opts.progress_user = &prog;
+    }
+    rc = 0;
+    if (a->cmd == CMD_INDIRECT) { rc = cli_run_indirect(a, &grid, &opts, &prog); goto done; }
+    if (a->cmd == CMD_VISIBILITY) { rc = cli_run_visibility(a, &grid, &opts, &prog); goto done; }
+    if (a->cmd == CMD_HORIZON) {
+        size_t values = (size_t)w * (size_t)h; /* <= 2^28, so the product below cannot overflow */
+        planes = a->dirs;
+        if ((size_t)planes > CLI_HORIZON_MAX_VALUES / values ||
+            (long long)planes * h > HFVIS_IMAGE_MAX_DIM) {
+            rc = cli_error(CLI_EXIT_ERROR, cmd, "%s: %d planes of %d x %d exceed the limit of "
+                           "2^28 values and %d rows; use fewer --dirs, or skyview/sky/light",
+                           hfvis_status_string(HFVIS_ERR_LIMIT), planes, w, h, HFVIS_IMAGE_MAX_DIM);
+            goto done;
+        }
+        lo = -CLI_PI / 2.0; hi = CLI_PI / 2.0;
+    } else if (a->cmd == CMD_NORMALS) {
+        channels = 3; lo = -1.0;
+    } else if (a->cmd == CMD_LIGHT) {
+        if ((rc = cli_load_env(a->env, &env_px, &env)) != 0) goto done;
+        channels = env.channels;
+    }
+    out = cli_alloc((size_t)w * (size_t)h, (size_t)planes, (size_t)channels);
+    if (!out) { rc = cli_status(cmd, HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
+
+    switch (a->cmd) {
+    case CMD_HORIZON:
+        s = hfvis_horizon_map(&grid, a->dirs, &opts, out);
+        if (s == HFVIS_OK && a->degrees) {
+            size_t i, n = (size_t)w * (size_t)h * (size_t)planes;
+            for (i = 0; i < n; i++) out[i] = (float)((double)out[i] * (180.0 / CLI_PI));
+            lo = -90.0; hi = 90.0;
+        }
+        break;
+    case CMD_SKYVIEW:
+        s = hfvis_sky_view_factor(&grid, a->dirs, &opts, out, w);
+        break;
+    case CMD_SKY:
+        s = hfvis_sky_light(&grid, a->dirs, (float)a->sky, (float)a->albedo, &opts, out, w);
+        if (a->sky * a->albedo <= CLI_FLT_MAX && (float)(a->sky * a->albedo) > 0.0f)
+            hi = a->sky * a->albedo;
+        break;
+    case CMD_SHADOW: {
+        double bearing_or_psi = a->math ? a->sun_azimuth : a->sun_azimuth - 90.0;
+        s = hfvis_sun_visibility(&grid, bearing_or_psi * (CLI_PI / 180.0),
+                                 a->sun_elevation * (CLI_PI / 180.0),
+                                 a->sun_radius * (CLI_PI / 180.0), &opts, out, w);
+        break;
+    }
+    case CMD_VIEWSHED: {
+        hfvis_viewshed_options vopts;
+        memset(&vopts, 0, sizeof vopts);
+        vopts.observer_height = a->observer_height;
+        vopts.target_height = a->target_height;
+        vopts.max_distance = a->max_distance;
+        if (a->observer_x < 0.0 || a->observer_x > w - 1 || a->observer_y < 0.0 ||
+            a->observer_y > h - 1) {
+            rc = cli_error(CLI_EXIT_ERROR, "--observer", "%g,%g is outside the grid [0, %d] x [0, %d]",
+                           a->observer_x, a->observer_y, w - 1, h - 1);
+            goto done;
+        }
+        if (a->exact)
+            s = hfvis_viewshed_reference(&grid, a->observer_x, a->observer_y, &vopts, 0.0, out, w);
+        else
+            s = hfvis_viewshed(&grid, a->observer_x, a->observer_y, &vopts, out, w);
+        break;
+    }
+    case CMD_LIGHT: {
+        hfvis_env_options eopts = hfvis_env_options_default();
+        eopts.method = (hfvis_env_method)a->method;
+        s = hfvis_env_light(&grid, a->dirs, &env, (float)a->albedo, &opts, &eopts, out, w);
+        if (s == HFVIS_OK) hi = cli_top(out, (size_t)w * (size_t)h * (size_t)channels, 1.0);
+        break;
+    }
+    default: /* CMD_NORMALS */
+        s = hfvis_normals_compute(&grid, out);
+        break;
+    }
+    if (s != HFVIS_OK) { rc = cli_status(cmd, s, 0); goto done; }
+    rc = cli_save(a, out, w, h * planes, channels, lo, hi);
+done:
+    if (cli_bar_open) { fputc('\n', stderr); cli_bar_open = 0; } /* a bar that fell short */
+    free(out);
+    hfvis_free(NULL, env_px);
+    hfvis_free(NULL, z);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    cli_args a;
+    int rc = cli_parse(argc, argv, &a);
+    if (rc != CLI_RUN) return rc;
+    return cli_run(&a);
+}
