@@ -709,14 +709,14 @@ HFVIS_API hfvis_status hfvis_mesh_bounds(const hfvis_mesh *mesh, double lo[3], d
  * range-checked there). */
 
 /* 10^0 .. 10^22: exact in double. */
-static const double vx_obj_pow10[23] = {
+static const double vx_mesh_obj_pow10[23] = {
     1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11,
     1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22
 };
 
 /* d * 10^e, |e| small (<= ~70 here): steps of exact powers, multiplying for e > 0 and dividing
  * for e < 0, so each step rounds once (<= 4 steps: within 2 ulp of double in all). */
-static double vx_obj_scale10(double d, long e)
+static double vx_mesh_obj_scale10(double d, long e)
 {
     while (e > 22) {
         d *= 1e22;
@@ -726,10 +726,10 @@ static double vx_obj_scale10(double d, long e)
         d /= 1e22;
         e += 22;
     }
-    return e >= 0 ? d * vx_obj_pow10[e] : d / vx_obj_pow10[-e];
+    return e >= 0 ? d * vx_mesh_obj_pow10[e] : d / vx_mesh_obj_pow10[-e];
 }
 
-static int vx_obj_digit(unsigned char c) { return c >= '0' && c <= '9'; }
+static int vx_mesh_obj_digit(unsigned char c) { return c >= '0' && c <= '9'; }
 
 /* Parse the whole token [s, e) as a decimal number, locale-independently:
  * [+-] (digits [. digits*] | . digits) [(e|E) [+-] digits]. No inf/nan/hex. The first 19
@@ -737,7 +737,7 @@ static int vx_obj_digit(unsigned char c) { return c >= '0' && c <= '9'; }
  * double (within 3 ulp of double), then rounded once to float. Returns 0 for a malformed token
  * or a value outside the float range (|v| rounds to infinity); values below the smallest
  * subnormal become (signed) zero. */
-static int vx_obj_parse_float(const unsigned char *s, const unsigned char *e, float *out)
+static int vx_mesh_obj_parse_float(const unsigned char *s, const unsigned char *e, float *out)
 {
     uint64_t mant = 0;
     long long dexp = 0, ex = 0, e10;
@@ -745,7 +745,7 @@ static int vx_obj_parse_float(const unsigned char *s, const unsigned char *e, fl
     double d;
     float f;
     if (s < e && (*s == '+' || *s == '-')) neg = *s++ == '-';
-    for (; s < e && vx_obj_digit(*s); s++) {
+    for (; s < e && vx_mesh_obj_digit(*s); s++) {
         any = 1;
         if (mant == 0 && *s == '0') continue; /* leading zero */
         if (nd < 19) {
@@ -756,7 +756,7 @@ static int vx_obj_parse_float(const unsigned char *s, const unsigned char *e, fl
         }
     }
     if (s < e && *s == '.') {
-        for (s++; s < e && vx_obj_digit(*s); s++) {
+        for (s++; s < e && vx_mesh_obj_digit(*s); s++) {
             any = 1;
             if (mant == 0 && *s == '0') {
                 dexp--;
@@ -771,8 +771,8 @@ static int vx_obj_parse_float(const unsigned char *s, const unsigned char *e, fl
     if (s < e && (*s == 'e' || *s == 'E')) {
         s++;
         if (s < e && (*s == '+' || *s == '-')) eneg = *s++ == '-';
-        if (s >= e || !vx_obj_digit(*s)) return 0;
-        for (; s < e && vx_obj_digit(*s); s++)
+        if (s >= e || !vx_mesh_obj_digit(*s)) return 0;
+        for (; s < e && vx_mesh_obj_digit(*s); s++)
             if (ex < 1000000000000000LL) ex = ex * 10 + (*s - '0');
     }
     if (s != e) return 0;
@@ -787,7 +787,7 @@ static int vx_obj_parse_float(const unsigned char *s, const unsigned char *e, fl
         *out = neg ? -0.0f : 0.0f;
         return 1;
     }
-    d = vx_obj_scale10((double)mant, (long)e10);
+    d = vx_mesh_obj_scale10((double)mant, (long)e10);
     f = (float)d;
     if (!isfinite(f)) return 0;
     *out = neg ? -f : f;
@@ -795,14 +795,14 @@ static int vx_obj_parse_float(const unsigned char *s, const unsigned char *e, fl
 }
 
 /* One signed, non-zero OBJ index [+-]digits at *s (saturating at 2^40); advances *s. */
-static int vx_obj_parse_index(const unsigned char **sp, const unsigned char *e, long long *out)
+static int vx_mesh_obj_parse_index(const unsigned char **sp, const unsigned char *e, long long *out)
 {
     const unsigned char *s = *sp;
     long long v = 0;
     int neg = 0;
     if (s < e && (*s == '+' || *s == '-')) neg = *s++ == '-';
-    if (s >= e || !vx_obj_digit(*s)) return 0;
-    for (; s < e && vx_obj_digit(*s); s++)
+    if (s >= e || !vx_mesh_obj_digit(*s)) return 0;
+    for (; s < e && vx_mesh_obj_digit(*s); s++)
         if (v < (1LL << 40)) v = v * 10 + (*s - '0');
     if (v == 0) return 0;
     *out = neg ? -v : v;
@@ -810,33 +810,33 @@ static int vx_obj_parse_index(const unsigned char **sp, const unsigned char *e, 
     return 1;
 }
 
-static int vx_obj_space(unsigned char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; }
+static int vx_mesh_obj_space(unsigned char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; }
 
-typedef struct vx_obj_pass {
+typedef struct vx_mesh_obj_pass {
     int fill;          /* 0: validate and count; 1: write */
     size_t nv, nt;     /* vertices / triangles so far */
     size_t total_v;    /* pass 2: the vertex count of pass 1 */
     float *xyz;
     uint32_t *idx;
-} vx_obj_pass;
+} vx_mesh_obj_pass;
 
 /* A face vertex token: i, i/t, i//n or i/t/n (t, n checked for syntax only: they are not
  * used). Resolves i to a 0-based vertex (negative = relative to the vertices read so far). */
-static hfvis_status vx_obj_face_ref(const vx_obj_pass *ps, const unsigned char *s,
+static hfvis_status vx_mesh_obj_face_ref(const vx_mesh_obj_pass *ps, const unsigned char *s,
                                     const unsigned char *e, size_t *vout)
 {
     long long i, t;
-    if (!vx_obj_parse_index(&s, e, &i)) return HFVIS_ERR_FORMAT;
+    if (!vx_mesh_obj_parse_index(&s, e, &i)) return HFVIS_ERR_FORMAT;
     if (s < e) {
         if (*s++ != '/') return HFVIS_ERR_FORMAT;
         if (s < e && *s == '/') {
             s++;
-            if (!vx_obj_parse_index(&s, e, &t)) return HFVIS_ERR_FORMAT; /* i//n */
+            if (!vx_mesh_obj_parse_index(&s, e, &t)) return HFVIS_ERR_FORMAT; /* i//n */
         } else {
-            if (!vx_obj_parse_index(&s, e, &t)) return HFVIS_ERR_FORMAT; /* i/t */
+            if (!vx_mesh_obj_parse_index(&s, e, &t)) return HFVIS_ERR_FORMAT; /* i/t */
             if (s < e) {
                 if (*s++ != '/') return HFVIS_ERR_FORMAT;
-                if (!vx_obj_parse_index(&s, e, &t)) return HFVIS_ERR_FORMAT; /* i/t/n */
+                if (!vx_mesh_obj_parse_index(&s, e, &t)) return HFVIS_ERR_FORMAT; /* i/t/n */
             }
         }
         if (s != e) return HFVIS_ERR_FORMAT;
@@ -855,7 +855,7 @@ static hfvis_status vx_obj_face_ref(const vx_obj_pass *ps, const unsigned char *
 
 /* One pass over the whole buffer. Lines end at '\n' or '\r' (so CRLF and CR files work);
  * '#' starts a comment anywhere; tokens are separated by blanks and tabs. */
-static hfvis_status vx_obj_run(vx_obj_pass *ps, const unsigned char *p, const unsigned char *end)
+static hfvis_status vx_mesh_obj_run(vx_mesh_obj_pass *ps, const unsigned char *p, const unsigned char *end)
 {
     while (p < end) {
         const unsigned char *le = p, *ce, *q, *ks;
@@ -863,21 +863,21 @@ static hfvis_status vx_obj_run(vx_obj_pass *ps, const unsigned char *p, const un
         for (ce = p; ce < le && *ce != '#'; ce++) {}
         q = p;
         p = le < end ? le + 1 : le;
-        while (q < ce && vx_obj_space(*q)) q++;
+        while (q < ce && vx_mesh_obj_space(*q)) q++;
         if (q == ce) continue;
         ks = q;
-        while (q < ce && !vx_obj_space(*q)) q++;
+        while (q < ce && !vx_mesh_obj_space(*q)) q++;
         if (q - ks == 1 && *ks == 'v') {
             float c[3];
             int n = 0;
             for (;;) {
                 const unsigned char *ts;
                 float f;
-                while (q < ce && vx_obj_space(*q)) q++;
+                while (q < ce && vx_mesh_obj_space(*q)) q++;
                 if (q == ce) break;
                 ts = q;
-                while (q < ce && !vx_obj_space(*q)) q++;
-                if (!vx_obj_parse_float(ts, q, &f)) return HFVIS_ERR_FORMAT;
+                while (q < ce && !vx_mesh_obj_space(*q)) q++;
+                if (!vx_mesh_obj_parse_float(ts, q, &f)) return HFVIS_ERR_FORMAT;
                 if (n < 3) c[n] = f;
                 n++;
             }
@@ -891,11 +891,11 @@ static hfvis_status vx_obj_run(vx_obj_pass *ps, const unsigned char *p, const un
             for (;;) {
                 const unsigned char *ts;
                 hfvis_status s;
-                while (q < ce && vx_obj_space(*q)) q++;
+                while (q < ce && vx_mesh_obj_space(*q)) q++;
                 if (q == ce) break;
                 ts = q;
-                while (q < ce && !vx_obj_space(*q)) q++;
-                s = vx_obj_face_ref(ps, ts, q, &v);
+                while (q < ce && !vx_mesh_obj_space(*q)) q++;
+                s = vx_mesh_obj_face_ref(ps, ts, q, &v);
                 if (s != HFVIS_OK) return s;
                 if (n >= 2) { /* fan: (v0, v_{k-1}, v_k) */
                     if (ps->nt >= HFVIS_MESH_MAX_TRIANGLES) return HFVIS_ERR_LIMIT;
@@ -921,12 +921,12 @@ HFVIS_API hfvis_status hfvis_obj_decode(const void *data, size_t size,
                                         const hfvis_allocator *alloc, hfvis_mesh *out)
 {
     const unsigned char *p = (const unsigned char *)data;
-    vx_obj_pass ps;
+    vx_mesh_obj_pass ps;
     vx_mesh_builder b;
     hfvis_status s;
     if (!out || (!data && size > 0)) return HFVIS_ERR_INVALID_ARGUMENT;
     memset(&ps, 0, sizeof ps);
-    s = vx_obj_run(&ps, p, p + size);
+    s = vx_mesh_obj_run(&ps, p, p + size);
     if (s != HFVIS_OK) return s;
     s = vx_mesh_builder_init(&b, alloc, ps.nv, ps.nt);
     if (s != HFVIS_OK) return s;
@@ -935,7 +935,7 @@ HFVIS_API hfvis_status hfvis_obj_decode(const void *data, size_t size,
     ps.fill = 1;
     ps.xyz = b.xyz;
     ps.idx = b.idx;
-    s = vx_obj_run(&ps, p, p + size);
+    s = vx_mesh_obj_run(&ps, p, p + size);
     if (s != HFVIS_OK) {
         vx_mesh_builder_free(&b, alloc);
         return s;
@@ -948,10 +948,10 @@ HFVIS_API hfvis_status hfvis_obj_decode(const void *data, size_t size,
 
 /* ---- 1e. OBJ encoder, file wrappers ----------------------------------------------------- */
 
-#define VX_OBJ_FLOAT_MAX 16 /* longest number written: "-1.23456789e-38" is 15 */
+#define VX_MESH_OBJ_FLOAT_MAX 16 /* longest number written: "-1.23456789e-38" is 15 */
 
 /* The decimal digits of n (>= 0) into buf; returns the count. */
-static size_t vx_obj_utoa(uint64_t n, char *buf)
+static size_t vx_mesh_obj_utoa(uint64_t n, char *buf)
 {
     char tmp[24];
     size_t k = 0, i;
@@ -964,12 +964,12 @@ static size_t vx_obj_utoa(uint64_t n, char *buf)
 }
 
 /* N (exactly p digits) * 10^(k - p + 1) as the shorter of plain and scientific notation. */
-static size_t vx_obj_layout(int neg, uint64_t N, int p, int k, char *buf)
+static size_t vx_mesh_obj_layout(int neg, uint64_t N, int p, int k, char *buf)
 {
-    char dig[12], sci[VX_OBJ_FLOAT_MAX + 8], fix[64];
+    char dig[12], sci[VX_MESH_OBJ_FLOAT_MAX + 8], fix[64];
     size_t ns = 0, nf = 0;
     int i;
-    vx_obj_utoa(N, dig);
+    vx_mesh_obj_utoa(N, dig);
     /* scientific: d[.ddd]e[-]k */
     if (neg) sci[ns++] = '-';
     sci[ns++] = dig[0];
@@ -979,7 +979,7 @@ static size_t vx_obj_layout(int neg, uint64_t N, int p, int k, char *buf)
     }
     sci[ns++] = 'e';
     if (k < 0) sci[ns++] = '-';
-    ns += vx_obj_utoa((uint64_t)(k < 0 ? -k : k), sci + ns);
+    ns += vx_mesh_obj_utoa((uint64_t)(k < 0 ? -k : k), sci + ns);
     /* plain */
     if (neg) fix[nf++] = '-';
     if (k < 0) {
@@ -1001,7 +1001,7 @@ static size_t vx_obj_layout(int neg, uint64_t N, int p, int k, char *buf)
     return ns;
 }
 
-/* The shortest decimal (1..9 significant digits) that vx_obj_parse_float reads back as f, bit
+/* The shortest decimal (1..9 significant digits) that vx_mesh_obj_parse_float reads back as f, bit
  * for bit (9 digits always do: a 9-digit decimal is within 5e-9 relative of f, far from the
  * midpoints to the neighbouring floats, at least 3e-8 relative away). f finite.
  * With X = |f| 10^(8-k) in [10^8, 10^9) (k = the decimal exponent of f), for p = 1, 2, ...:
@@ -1009,7 +1009,7 @@ static size_t vx_obj_layout(int neg, uint64_t N, int p, int k, char *buf)
  * interval [L, H] (the midpoints to the neighbouring floats, exact in double, scaled alike).
  * The test runs in double (X, L, H within 4 ulp); where it is too close to call (within
  * 1e-12 relative) the candidate is parsed back instead, so the answer is exact. */
-static size_t vx_obj_format_float(float f, char *buf)
+static size_t vx_mesh_obj_format_float(float f, char *buf)
 {
     float af = fabsf(f), fm = nextafterf(af, 0.0f), fp = nextafterf(af, INFINITY);
     double x = (double)af, lo = 0.5 * (x + (double)fm);
@@ -1027,49 +1027,49 @@ static size_t vx_obj_format_float(float f, char *buf)
     }
     k = (int)floor(log10(x)); /* may be one off: adjust */
     for (it = 0; it < 3; it++) {
-        X = vx_obj_scale10(x, (long)(8 - k));
+        X = vx_mesh_obj_scale10(x, (long)(8 - k));
         if (X >= 1e9) k++;
         else if (X < 1e8) k--;
         else break;
     }
-    L = vx_obj_scale10(lo, (long)(8 - k));
-    H = vx_obj_scale10(hi, (long)(8 - k));
+    L = vx_mesh_obj_scale10(lo, (long)(8 - k));
+    H = vx_mesh_obj_scale10(hi, (long)(8 - k));
     for (p = 1; p <= 9; p++) {
-        double s = vx_obj_pow10[9 - p], dN = floor(X / s + 0.5), Lp = L / s, Hp = H / s;
-        double tol = 1e-12 * vx_obj_pow10[p];
+        double s = vx_mesh_obj_pow10[9 - p], dN = floor(X / s + 0.5), Lp = L / s, Hp = H / s;
+        double tol = 1e-12 * vx_mesh_obj_pow10[p];
         uint64_t N = (uint64_t)dN;
         int kk = k;
         size_t n;
         float back;
         if (dN < Lp - tol || dN > Hp + tol) continue; /* certainly outside */
-        if (N >= (uint64_t)vx_obj_pow10[p]) { /* rounded up to 10^p: 1 0..0 one decade up */
+        if (N >= (uint64_t)vx_mesh_obj_pow10[p]) { /* rounded up to 10^p: 1 0..0 one decade up */
             N /= 10u;
             kk++;
         }
-        n = vx_obj_layout(neg, N, p, kk, buf);
+        n = vx_mesh_obj_layout(neg, N, p, kk, buf);
         if (dN > Lp + tol && dN < Hp - tol) return n; /* certainly inside */
-        if (vx_obj_parse_float((const unsigned char *)buf, (const unsigned char *)buf + n, &back)
+        if (vx_mesh_obj_parse_float((const unsigned char *)buf, (const unsigned char *)buf + n, &back)
             && memcmp(&back, &f, sizeof f) == 0)
             return n;
     }
     HFVIS_ASSERT(0); /* unreachable: 9 digits always round-trip */
-    return vx_obj_layout(neg, 0, 1, 0, buf);
+    return vx_mesh_obj_layout(neg, 0, 1, 0, buf);
 }
 
 /* Emit (or only count, out == NULL) the encoding; returns the byte count, 0 on overflow. */
-static size_t vx_obj_emit(const hfvis_mesh *m, unsigned char *out)
+static size_t vx_mesh_obj_emit(const hfvis_mesh *m, unsigned char *out)
 {
-    char line[4 * 24 + 3 * VX_OBJ_FLOAT_MAX];
+    char line[4 * 24 + 3 * VX_MESH_OBJ_FLOAT_MAX];
     size_t total = 0, i, n;
     int k;
     /* header: "# hfvis mesh: V vertices, T triangles\n" */
     n = 0;
     memcpy(line, "# hfvis mesh: ", 14);
     n = 14;
-    n += vx_obj_utoa((uint64_t)m->vertex_count, line + n);
+    n += vx_mesh_obj_utoa((uint64_t)m->vertex_count, line + n);
     memcpy(line + n, " vertices, ", 11);
     n += 11;
-    n += vx_obj_utoa((uint64_t)m->triangle_count, line + n);
+    n += vx_mesh_obj_utoa((uint64_t)m->triangle_count, line + n);
     memcpy(line + n, " triangles\n", 11);
     n += 11;
     if (out) memcpy(out, line, n);
@@ -1079,7 +1079,7 @@ static size_t vx_obj_emit(const hfvis_mesh *m, unsigned char *out)
         n = 1;
         for (k = 0; k < 3; k++) {
             line[n++] = ' ';
-            n += vx_obj_format_float(m->xyz[3 * i + (size_t)k], line + n);
+            n += vx_mesh_obj_format_float(m->xyz[3 * i + (size_t)k], line + n);
         }
         line[n++] = '\n';
         if (total > SIZE_MAX - n) return 0;
@@ -1091,7 +1091,7 @@ static size_t vx_obj_emit(const hfvis_mesh *m, unsigned char *out)
         n = 1;
         for (k = 0; k < 3; k++) {
             line[n++] = ' ';
-            n += vx_obj_utoa((uint64_t)m->indices[3 * i + (size_t)k] + 1u, line + n);
+            n += vx_mesh_obj_utoa((uint64_t)m->indices[3 * i + (size_t)k] + 1u, line + n);
         }
         line[n++] = '\n';
         if (total > SIZE_MAX - n) return 0;
@@ -1104,7 +1104,7 @@ static size_t vx_obj_emit(const hfvis_mesh *m, unsigned char *out)
 HFVIS_API size_t hfvis_obj_encode_size(const hfvis_mesh *mesh)
 {
     if (vx_mesh_check(mesh) != HFVIS_OK) return 0;
-    return vx_obj_emit(mesh, NULL);
+    return vx_mesh_obj_emit(mesh, NULL);
 }
 
 HFVIS_API hfvis_status hfvis_obj_encode(const hfvis_mesh *mesh, void *out, size_t out_capacity,
@@ -1112,10 +1112,10 @@ HFVIS_API hfvis_status hfvis_obj_encode(const hfvis_mesh *mesh, void *out, size_
 {
     size_t need;
     if (!out || !written || vx_mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
-    need = vx_obj_emit(mesh, NULL);
+    need = vx_mesh_obj_emit(mesh, NULL);
     if (need == 0) return HFVIS_ERR_INVALID_ARGUMENT;
     if (out_capacity < need) return HFVIS_ERR_BUFFER_TOO_SMALL;
-    vx_obj_emit(mesh, (unsigned char *)out);
+    vx_mesh_obj_emit(mesh, (unsigned char *)out);
     *written = need;
     return HFVIS_OK;
 }
@@ -1141,11 +1141,11 @@ HFVIS_API hfvis_status hfvis_mesh_save(const char *path, const hfvis_mesh *mesh)
     unsigned char *buf;
     hfvis_status s;
     if (!path || vx_mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
-    need = vx_obj_emit(mesh, NULL);
+    need = vx_mesh_obj_emit(mesh, NULL);
     if (need == 0) return HFVIS_ERR_INVALID_ARGUMENT;
     buf = (unsigned char *)vx_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
-    written = vx_obj_emit(mesh, buf);
+    written = vx_mesh_obj_emit(mesh, buf);
     s = hfvis__write_file(path, buf, written);
     vx_free(NULL, buf);
     return s;

@@ -537,14 +537,10 @@ HFVIS_API hfvis_status hfvis_rasterize_reference(const hfvis_mesh *mesh, const h
                 if (!(wc > 0.0)) continue;
                 zw = 0.5 * (zc / wc) + 0.5;
                 if (!(zw >= 0.0 && zw <= 1.0)) continue;
-                {
-                    float nn[3];
-                    const float *v0 = mesh->xyz + 3 * (size_t)ix[0];
-                    if (!vx_raster_normal(v0, mesh->xyz + 3 * (size_t)ix[1],
-                                          mesh->xyz + 3 * (size_t)ix[2], view->view,
-                                          HFVIS_NORMAL_WORLD, 0, nn))
-                        continue; /* zero area in world space */
-                }
+                if (vx_raster_degenerate(mesh->xyz + 3 * (size_t)ix[0],
+                                         mesh->xyz + 3 * (size_t)ix[1],
+                                         mesh->xyz + 3 * (size_t)ix[2]))
+                    continue; /* zero area in world space */
                 count++;
                 if (zw < best) {
                     best = zw;

@@ -12,6 +12,10 @@
 #define T_FLOAT_REL 1e-6     /* area/volume of float-rounded vertices vs double closed form */
 #define T_SPHERE_S5 3e-4     /* icosphere s=5 area vs the spec's 5025.0 (rounded to 0.1) */
 #define T_CONVERGE 2e-3      /* fine tessellations vs the smooth surface's area/volume */
+#define T_COORD 1e-6         /* float rounding of O(1) coordinates (2^-23 = 1.2e-7 relative) */
+#define T_ANGLE 1e-6         /* angle from two float-rounded O(1) points, 0.15 apart */
+#define T_UNIT 1e-7          /* a unit vector's components rounded to float (half ulp 6e-8) */
+#define T_TUBE_REL 1e-3      /* tube vertices sit at the tube radius up to float rounding */
 
 /* ---- helpers ----------------------------------------------------------------------------- */
 
@@ -306,7 +310,7 @@ TEST(torus_knot)
     CHECK(mesh_valid(&m) && edge_defects(&m, NULL) == 0 && unused_vertices(&m) == 0);
     CHECK(mesh_volume(&m, c) > 0.0);
     CHECK_EQ_STATUS(hfvis_mesh_bounds(&m, lo, hi), HFVIS_OK);
-    CHECK(hi[0] <= 1.75 + 1e-6 && lo[0] >= -1.75 - 1e-6 && hi[2] <= 0.75 + 1e-6);
+    CHECK(hi[0] <= 1.75 + T_COORD && lo[0] >= -1.75 - T_COORD && hi[2] <= 0.75 + T_COORD);
     hfvis_mesh_free(NULL, &m);
 }
 
@@ -451,7 +455,7 @@ TEST(icosphere_construction)
         vtx(&m, 11, b);
         for (k = 0; k < 3; k++) mid[k] = a[k] + b[k];
         len = sqrt(mid[0] * mid[0] + mid[1] * mid[1] + mid[2] * mid[2]);
-        for (k = 0; k < 3; k++) CHECK_NEAR(m.xyz[36 + k], mid[k] / len, 1e-7, 0.0);
+        for (k = 0; k < 3; k++) CHECK_NEAR(m.xyz[36 + k], mid[k] / len, T_UNIT, 0.0);
     }
     hfvis_mesh_free(NULL, &m);
 }
@@ -551,7 +555,7 @@ TEST(torus_knot_embedded)
         }
     }
     printf("  torus knot (2,3): closest vertex-to-centre-line distance %.6f (tube %.2f)\n", dmin, tube);
-    CHECK(dmin > tube * 0.999 && dmin < tube * 1.0001);
+    CHECK(dmin > tube * (1.0 - T_TUBE_REL) && dmin < tube * (1.0 + T_TUBE_REL));
     CHECK(edge_defects(&m, NULL) == 0 && mesh_volume(&m, c) > 0.0);
     hfvis_mesh_free(NULL, &m);
     /* the tube's volume converges to (centre line length) * pi * tube^2 (Pappus for tubes) */
@@ -657,7 +661,7 @@ TEST(room_layout)
             ref[1] = t < 20 ? 0.33 : 0.62;
             ref[2] = t < 20 ? 0.15 : 0.3;
             CHECK(n[0] * (cc[0] - ref[0]) + n[1] * (cc[1] - ref[1]) + n[2] * (cc[2] - ref[2]) > 0.0);
-            CHECK(fabs(n[2]) < 1e-6 * len || n[2] > 0.0); /* no bottom faces */
+            CHECK(fabs(n[2]) < T_COORD * len || n[2] > 0.0); /* no bottom faces */
         }
     }
     /* boundary: the front opening (4 edges) and the two boxes' bottom rectangles (4 each) */
@@ -668,10 +672,10 @@ TEST(room_layout)
         double a[3], b[3];
         vtx(&m, 8, a);
         vtx(&m, 9, b);
-        CHECK_NEAR(atan2(b[1] - a[1], b[0] - a[0]), -17.0 * PI / 180.0, 1e-6, 0.0);
+        CHECK_NEAR(atan2(b[1] - a[1], b[0] - a[0]), -17.0 * PI / 180.0, T_ANGLE, 0.0);
         vtx(&m, 16, a);
         vtx(&m, 17, b);
-        CHECK_NEAR(atan2(b[1] - a[1], b[0] - a[0]), 17.0 * PI / 180.0, 1e-6, 0.0);
+        CHECK_NEAR(atan2(b[1] - a[1], b[0] - a[0]), 17.0 * PI / 180.0, T_ANGLE, 0.0);
     }
     hfvis_mesh_free(NULL, &m);
 }
@@ -691,7 +695,7 @@ TEST(teapot_shape)
     edge_defects(&m, &bnd);
     CHECK(bnd == (size_t)(4 * 6 * n));
     CHECK_EQ_STATUS(hfvis_mesh_bounds(&m, lo, hi), HFVIS_OK);
-    CHECK(lo[2] >= -1e-6 && hi[2] <= 1.42 + 1e-6 && hi[2] > 1.41);
+    CHECK(lo[2] == 0.0 && hi[2] <= 1.42 + T_COORD && hi[2] > 1.41);
     printf("  teapot n=3: %zu vertices, %zu triangles, bounds (%.3f %.3f %.3f)-(%.3f %.3f %.3f)\n",
            m.vertex_count, m.triangle_count, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
     hfvis_mesh_free(NULL, &m);

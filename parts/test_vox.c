@@ -106,14 +106,6 @@ static float *vox_storage(const hfvis_volume_grid *g, int channels)
     return (float *)malloc(sizeof(float) * (n ? n : 1));
 }
 
-static size_t vox_count_ch0(const hfvis_volume *v)
-{
-    size_t n = hfvis_volume_size(&v->grid, 1), i, c = 0;
-    for (i = 0; i < n; i++)
-        if (v->data[i * (size_t)v->channels] != 0.0f) c++;
-    return c;
-}
-
 static hfvis_voxelize_options vox_opts(hfvis_voxelize_method m, hfvis_voxelize_axes ax, int V)
 {
     hfvis_voxelize_options o = hfvis_voxelize_options_default();
