@@ -81,8 +81,10 @@ HFVIS_API hfvis_status hfvis_mesh_torus_knot(const hfvis_allocator *alloc, const
 /* A height field as a mesh: sample (x, y) becomes vertex (x*cell_size, y*cell_size, z) (DESIGN
  * §2), and each cell with corners a = (x,y), b = (x+1,y), c = (x,y+1), d = (x+1,y+1) is split
  * along the diagonal a-d into (a, b, d) and (a, d, c), whose normals point to +z (up) for a
- * flat field. (hfvis.c's surface is bilinear, which no triangulation reproduces; the a-d split
- * equals it on every bilinear-exact field that is linear along that diagonal, e.g. planes.)
+ * flat field. hfvis.c's surface is bilinear (hfvis_grid_sample), which no triangulation
+ * reproduces: the two agree along every grid line (cell edges are linear in both) and on cells
+ * whose corners are coplanar (z_a + z_d = z_b + z_c); at a cell centre the bilinear height
+ * exceeds the mesh's (z_a + z_d)/2 by (z_b + z_c - z_a - z_d)/4.
  * A triangle with a non-finite corner (a hole) is left out; only the vertices some kept
  * triangle uses are stored, in row-major order (without holes vertex y*width + x is sample
  * (x, y)). Up to 2*(width-1)*(height-1) triangles; a 1-wide or 1-high grid gives an empty mesh

@@ -187,6 +187,15 @@ static void revolution_forms(const double *rho, const double *z, int m, int n, d
     *vol = V;
 }
 
+static uint64_t rng_state = 0x1234567887654321ull;
+static uint64_t rng_next(void)
+{
+    uint64_t z = (rng_state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
 /* ---- generators ---------------------------------------------------------------------------- */
 
 TEST(box)
@@ -643,6 +652,40 @@ TEST(from_grid_holes)
     }
 }
 
+/* The split against hfvis.c's bilinear surface: equal along grid lines, and at a cell centre
+ * bilinear - mesh = (z_b + z_c - z_a - z_d)/4 (the documented difference). */
+TEST(from_grid_vs_bilinear)
+{
+    enum { W = 9, H = 7 };
+    float z[W * H];
+    hfvis_grid g;
+    hfvis_mesh m;
+    int x, y, bad = 0;
+    for (x = 0; x < W * H; x++) z[x] = (float)(rng_next() % 1000) / 64.0f; /* exact sums */
+    g.z = z;
+    g.width = W;
+    g.height = H;
+    g.stride = W;
+    g.cell_size = 1.0;
+    CHECK_EQ_STATUS(hfvis_mesh_from_grid(NULL, &g, &m), HFVIS_OK);
+    for (y = 0; y + 1 < H; y++)
+        for (x = 0; x + 1 < W; x++) {
+            double za = z[y * W + x], zb = z[y * W + x + 1], zc = z[(y + 1) * W + x];
+            double zd = z[(y + 1) * W + x + 1];
+            /* the mesh at the centre lies on the a-d diagonal of triangles 2t, 2t+1 */
+            size_t t = 2 * (size_t)(y * (W - 1) + x);
+            double pa[3], pd[3], centre_mesh;
+            vtx(&m, m.indices[3 * t], pa);
+            vtx(&m, m.indices[3 * t + 2], pd);
+            centre_mesh = 0.5 * (pa[2] + pd[2]);
+            if (hfvis_grid_sample(&g, x + 0.5, y + 0.5) - centre_mesh != (zb + zc - za - zd) / 4.0) bad++;
+            if (hfvis_grid_sample(&g, x + 0.5, y) != 0.5 * (za + zb)) bad++; /* edge a-b */
+            if (hfvis_grid_sample(&g, x, y + 0.5) != 0.5 * (za + zc)) bad++; /* edge a-c */
+        }
+    CHECK(bad == 0);
+    hfvis_mesh_free(NULL, &m);
+}
+
 TEST(room_layout)
 {
     const double room_c[3] = {0.5, 0.5, 0.5};
@@ -863,15 +906,6 @@ TEST(obj_round_trip_generators)
         CHECK(round_trip(&m));
         hfvis_mesh_free(NULL, &m);
     }
-}
-
-static uint64_t rng_state = 0x1234567887654321ull;
-static uint64_t rng_next(void)
-{
-    uint64_t z = (rng_state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
 }
 
 /* Every float class round-trips bit for bit through encode/decode, with the fewest significant
@@ -1190,6 +1224,7 @@ int main(int argc, char **argv)
     RUN(icosphere_spec_counts);
     RUN(torus_knot_embedded);
     RUN(from_grid_holes);
+    RUN(from_grid_vs_bilinear);
     RUN(room_layout);
     RUN(teapot_shape);
     RUN(generator_bad_arguments);
