@@ -444,7 +444,7 @@ HFVIS_API hfvis_status hfvis_rasterize(const hfvis_mesh *mesh, const hfvis_view 
             vc[5] = (double)X; /* |X|, |Y| < 2^29: exact */
             vc[6] = (double)Y;
         } else {
-            vc[5] = vc[6] = NAN;
+            vc[5] = vc[6] = (double)NAN;
         }
     }
     vx_raster_clear(out, pixels);

@@ -912,13 +912,13 @@ TEST(bad_arguments)
         CHECK_EQ_STATUS(fn(&m, &vb, NULL, &out), HFVIS_ERR_LIMIT);
         vb = v, vb.proj[5] = HUGE_VAL;
         CHECK_EQ_STATUS(fn(&m, &vb, NULL, &out), HFVIS_ERR_INVALID_ARGUMENT);
-        vb = v, vb.view[12] = NAN;
+        vb = v, vb.view[12] = (double)NAN;
         CHECK_EQ_STATUS(fn(&m, &vb, NULL, &out), HFVIS_ERR_INVALID_ARGUMENT);
         vb = v, vb.near_plane = 0.0;
         CHECK_EQ_STATUS(fn(&m, &vb, NULL, &out), HFVIS_ERR_INVALID_ARGUMENT);
         vb = v, vb.far_plane = 0.05;
         CHECK_EQ_STATUS(fn(&m, &vb, NULL, &out), HFVIS_ERR_INVALID_ARGUMENT);
-        vb = v, vb.far_plane = NAN;
+        vb = v, vb.far_plane = (double)NAN;
         CHECK_EQ_STATUS(fn(&m, &vb, NULL, &out), HFVIS_ERR_INVALID_ARGUMENT);
         o = hfvis_raster_options_default(), o.cull = (hfvis_cull_mode)3;
         CHECK_EQ_STATUS(fn(&m, &v, &o, &out), HFVIS_ERR_INVALID_ARGUMENT);
