@@ -7,6 +7,8 @@
 #include <stdlib.h>
 
 #define PI 3.14159265358979323846
+#define DNAN ((double)NAN)
+#define DINF ((double)INFINITY)
 
 /* Tolerances */
 #define T_FLOAT_REL 1e-6     /* area/volume of float-rounded vertices vs double closed form */
@@ -670,8 +672,8 @@ TEST(from_grid_vs_bilinear)
     CHECK_EQ_STATUS(hfvis_mesh_from_grid(NULL, &g, &m), HFVIS_OK);
     for (y = 0; y + 1 < H; y++)
         for (x = 0; x + 1 < W; x++) {
-            double za = z[y * W + x], zb = z[y * W + x + 1], zc = z[(y + 1) * W + x];
-            double zd = z[(y + 1) * W + x + 1];
+            double za = (double)z[y * W + x], zb = (double)z[y * W + x + 1], zc = (double)z[(y + 1) * W + x];
+            double zd = (double)z[(y + 1) * W + x + 1];
             /* the mesh at the centre lies on the a-d diagonal of triangles 2t, 2t+1 */
             size_t t = 2 * (size_t)(y * (W - 1) + x);
             double pa[3], pd[3], centre_mesh;
@@ -748,7 +750,7 @@ TEST(teapot_shape)
 TEST(generator_bad_arguments)
 {
     const double c[3] = {0, 0, 0}, lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, flat[3] = {1, 0, 1};
-    const double nanc[3] = {0, NAN, 0}, big[3] = {3e38, 0, 0};
+    const double nanc[3] = {0, DNAN, 0}, big[3] = {3e38, 0, 0};
     float z[4] = {0, 0, 0, 0};
     hfvis_grid g;
     hfvis_mesh m;
@@ -764,8 +766,8 @@ TEST(generator_bad_arguments)
     BAD(hfvis_mesh_uv_sphere(NULL, NULL, 1.0, 8, 4, &m));
     BAD(hfvis_mesh_uv_sphere(NULL, c, 0.0, 8, 4, &m));
     BAD(hfvis_mesh_uv_sphere(NULL, c, -1.0, 8, 4, &m));
-    BAD(hfvis_mesh_uv_sphere(NULL, c, NAN, 8, 4, &m));
-    BAD(hfvis_mesh_uv_sphere(NULL, c, INFINITY, 8, 4, &m));
+    BAD(hfvis_mesh_uv_sphere(NULL, c, DNAN, 8, 4, &m));
+    BAD(hfvis_mesh_uv_sphere(NULL, c, DINF, 8, 4, &m));
     BAD(hfvis_mesh_uv_sphere(NULL, c, 1.0, 2, 4, &m));
     BAD(hfvis_mesh_uv_sphere(NULL, c, 1.0, 8, 1, &m));
     BAD(hfvis_mesh_uv_sphere(NULL, nanc, 1.0, 8, 4, &m));
@@ -783,7 +785,7 @@ TEST(generator_bad_arguments)
     BAD(hfvis_mesh_torus(NULL, c, 2.0, 0.0, 8, 4, &m));
     BAD(hfvis_mesh_torus(NULL, c, 2.0, 1.0, 2, 4, &m));
     BAD(hfvis_mesh_torus(NULL, c, 2.0, 1.0, 8, 2, &m));
-    BAD(hfvis_mesh_torus(NULL, c, NAN, 1.0, 8, 4, &m));
+    BAD(hfvis_mesh_torus(NULL, c, DNAN, 1.0, 8, 4, &m));
     BAD(hfvis_mesh_torus_knot(NULL, c, 1.0, 2, 3, 8, 4, NULL));
     BAD(hfvis_mesh_torus_knot(NULL, NULL, 1.0, 2, 3, 8, 4, &m));
     BAD(hfvis_mesh_torus_knot(NULL, c, 0.0, 2, 3, 8, 4, &m));
@@ -792,7 +794,7 @@ TEST(generator_bad_arguments)
     BAD(hfvis_mesh_torus_knot(NULL, c, 1.0, 2, -3, 8, 4, &m));
     BAD(hfvis_mesh_torus_knot(NULL, c, 1.0, 2, 3, 2, 4, &m));
     BAD(hfvis_mesh_torus_knot(NULL, c, 1.0, 2, 3, 8, 2, &m));
-    BAD(hfvis_mesh_torus_knot(NULL, c, INFINITY, 2, 3, 8, 4, &m));
+    BAD(hfvis_mesh_torus_knot(NULL, c, DINF, 2, 3, 8, 4, &m));
     g.z = z;
     g.width = g.height = 2;
     g.stride = 2;
@@ -813,7 +815,7 @@ TEST(generator_bad_arguments)
     g.stride = 2;
     g.cell_size = 0.0;
     BAD(hfvis_mesh_from_grid(NULL, &g, &m));
-    g.cell_size = NAN;
+    g.cell_size = DNAN;
     BAD(hfvis_mesh_from_grid(NULL, &g, &m));
     g.cell_size = 1e300; /* x*cell overflows float */
     BAD(hfvis_mesh_from_grid(NULL, &g, &m));
