@@ -15,6 +15,7 @@ mkdir -p "$out"
 cp voxel.c "$out/voxel_dev.c.tmp"
 decls=""
 for p in $order; do
+  [ -f "parts/$p.c" ] || continue # already merged into voxel.c
   case "$want" in *" $p "*)
     printf '\n/* ---- parts/%s.c ---- */\n' "$p" >> "$out/voxel_dev.c.tmp"
     cat "parts/$p.c" >> "$out/voxel_dev.c.tmp"
@@ -29,6 +30,7 @@ if [ -n "$BENCH" ]; then OPT="-O2"; src=parts/bench_$name.c; else src=parts/test
 # hfvis.c parts (pasted at the end of hfvis.c): gi2
 cp hfvis.c "$out/hfvis.c.tmp"
 for p in gi2; do
+  [ -f "parts/$p.c" ] || continue # already merged into hfvis.c
   case "$want" in *" $p "*)
     printf '\n/* ---- parts/%s.c ---- */\n' "$p" >> "$out/hfvis.c.tmp"
     cat "parts/$p.c" >> "$out/hfvis.c.tmp"
