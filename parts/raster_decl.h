@@ -56,7 +56,9 @@ typedef struct hfvis_raster_outputs {
     float *barycentric;       /* 2 floats per pixel: (b1, b2), the perspective-correct
                                  barycentric coordinates of the visible point with respect to v1
                                  and v2 of its triangle (point = (1-b1-b2) v0 + b1 v1 + b2 v2,
-                                 as ray-tracing u, v) [0, 0] */
+                                 as ray-tracing u, v); exact at the pixel centre, so at a
+                                 centre within the 1/256-pixel snapping of an edge they may lie
+                                 outside [0, 1] by that much [0, 0] */
     uint32_t *coverage_count; /* fragments per pixel: how many non-culled triangles cover the
                                  pixel within the depth range, before the depth test (the depth
                                  complexity; watertightness checks) [0] */
