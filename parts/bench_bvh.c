@@ -226,7 +226,7 @@ static void bench_bvh(int quick)
     bench_bvh_line("AO (16/pt, t<=0.1 diag) closest", nao, sec, hits, naive_closest_ao);
     sec = bench_bvh_run(&b, &m, ao, nao, HFVIS_RAY_ANY, &hits);
     bench_bvh_line("AO (16/pt, t<=0.1 diag) any-hit", nao, sec, hits, naive_any_ao);
-    printf("  (single thread; naive = hfvis_ray_intersect_naive on every %dth ray)\n", quick ? 50 : 200);
+    printf("  (single thread; naive = hfvis_ray_intersect_naive on %d evenly spaced rays of each set)\n", quick ? 50 : 200);
 
     free(prim);
     free(ao);

@@ -19,6 +19,12 @@
 /* Node boxes are padded by 2^-18 of their largest coordinate magnitude or extent: covers the
  * off-plane rounding of a computed hit point (about gamma * box size) near box faces. */
 #define VX_BVH_PAD 0x1p-18
+/* The two inner-loop tests are forced inline (GCC/Clang), else left to the compiler. */
+#if defined(__GNUC__)
+#define VX_BVH_INLINE inline __attribute__((always_inline))
+#else
+#define VX_BVH_INLINE inline
+#endif
 /* SAH constants (spec raycast A.9.2: C_trav = C_tri = 1). */
 #define VX_BVH_C_TRAV 1.0
 #define VX_BVH_C_TRI 1.0
@@ -148,8 +154,8 @@ static int vx_bvh_zero_area(const float *a, const float *b, const float *c)
 
 /* Woop et al. Fig. 2-3 for one triangle, hits accepted with t in [t_min, t_hi] (t_hi <= t_max:
  * callers pass their current best). Returns 1 and fills h (all but triangle) on a hit. */
-static int vx_bvh_tri(const vx_bvh_ray *r, const float *p0, const float *p1, const float *p2,
-                      float t_hi, hfvis_hit *h)
+static VX_BVH_INLINE int vx_bvh_tri(const vx_bvh_ray *r, const float *p0, const float *p1, const float *p2,
+                                      float t_hi, hfvis_hit *h)
 {
     const int kx = r->kx, ky = r->ky, kz = r->kz;
     float ax, ay, az, bx, by, bz, cx, cy, cz, Ax, Ay, Bx, By, Cx, Cy, U, V, W, det, T, t;
@@ -643,7 +649,7 @@ HFVIS_API void hfvis_bvh_free(const hfvis_allocator *alloc, hfvis_bvh *bvh)
  * min(far planes) * VX_BVH_SLACK; a NaN from 0 * infinity (ray in a slab's plane, zero
  * direction component) is ignored by the comparisons, which is the right answer for a ray on
  * the (closed) slab boundary. Hit when entry <= exit and entry <= t_hi (the widened best). */
-static int vx_bvh_box(const hfvis_bvh_node *n, const vx_bvh_ray *r, float t_hi, float *entry)
+static VX_BVH_INLINE int vx_bvh_box(const hfvis_bvh_node *n, const vx_bvh_ray *r, float t_hi, float *entry)
 {
     float tn = r->t_min, tf = INFINITY, t0, t1;
     t0 = ((r->neg[0] ? n->hi[0] : n->lo[0]) - r->org[0]) * r->inv[0];

@@ -270,7 +270,7 @@ typedef struct vx_cons_tri {
     double n[3], rn;   /* normal f0 x f1 and its radius sum h|n_a| */
     double L[3][3][2]; /* [a][j]: edge axis e_a x f_j as (L_u, L_w) */
     double r[3][3];    /* [a][j]: its radius */
-    int D;             /* dominant axis: argmax |n_a|, ties to the lower axis */
+    int D, U, W;       /* dominant axis argmax |n_a| (ties to the lower axis); U = D+1, W = D+2 */
 } vx_cons_tri;
 
 static const double vx_cons_half[3] = {0.5, 0.5, 0.5};
@@ -289,7 +289,7 @@ static int vx_cons_setup(vx_cons_tri *T)
     if (T->n[0] == 0.0 && T->n[1] == 0.0 && T->n[2] == 0.0) return 0;
     T->rn = vx_cons_plane_radius(T->n, vx_cons_half);
     for (a = 0; a < 3; a++) {
-        int u = (a + 1) % 3, w = (a + 2) % 3;
+        int u = a == 2 ? 0 : a + 1, w = a == 0 ? 2 : a - 1;
         for (j = 0; j < 3; j++) {
             double Lu = -f[j][w], Lw = f[j][u];
             T->L[a][j][0] = Lu;
@@ -300,125 +300,211 @@ static int vx_cons_setup(vx_cons_tri *T)
     T->D = 0;
     if (fabs(T->n[1]) > fabs(T->n[T->D])) T->D = 1;
     if (fabs(T->n[2]) > fabs(T->n[T->D])) T->D = 2;
+    T->U = T->D == 2 ? 0 : T->D + 1;
+    T->W = T->D == 0 ? 2 : T->D - 1;
     return 1;
 }
 
-/* The three edge axes of projection a at a voxel whose vertex offsets are t[k][.]. Returns 1
- * when one of them separates. */
-static int vx_cons_sep_proj(const vx_cons_tri *T, int a, double t[3][3])
+/* The three edge axes of projection a (in-plane axes u, w) at a voxel whose vertex offsets are
+ * t[k][.]: exactly the expressions of hfvis_triangle_box_overlap. 1 when one separates. */
+static int vx_cons_sep_proj(const vx_cons_tri *T, int a, int u, int w, double t[3][3])
 {
-    int u = (a + 1) % 3, w = (a + 2) % 3, j;
-    for (j = 0; j < 3; j++) {
-        int o = (j + 2) % 3;
-        if (vx_cons_sep2(T->L[a][j][0], T->L[a][j][1], T->r[a][j], t[j][u], t[j][w], t[o][u],
-                         t[o][w]))
-            return 1;
-    }
-    return 0;
+    return vx_cons_sep2(T->L[a][0][0], T->L[a][0][1], T->r[a][0], t[0][u], t[0][w], t[2][u], t[2][w])
+        || vx_cons_sep2(T->L[a][1][0], T->L[a][1][1], T->r[a][1], t[1][u], t[1][w], t[0][u], t[0][w])
+        || vx_cons_sep2(T->L[a][2][0], T->L[a][2][1], T->r[a][2], t[2][u], t[2][w], t[1][u], t[1][w]);
 }
 
-/* Which side of the plane slab voxel layer k of the current column lies on, signed so that
- * +1 = below the interval (k too small), -1 = above, 0 = inside: sgn(n_D) * (d > r ? 1 : d < -r ? -1 : 0).
- * t[.][D] is overwritten with the offsets of layer k. */
-static int vx_cons_plane_side(const vx_cons_tri *T, double t[3][3], int k)
+/* The SAT of layer k of a column whose offsets t[.][U], t[.][W] are set and whose dominant
+ * projection's axes (and, inside the bounding-box range, the box axes) do not separate: the plane
+ * axis and the six edge axes of the two other projections, with the SAT's expressions.
+ * Returns 1 when none separates, i.e. hfvis_triangle_box_overlap would return 1. */
+static int vx_cons_layer_ok(const vx_cons_tri *T, double t[3][3], int k)
 {
-    int D = T->D, s;
-    double c = (double)k + 0.5, d;
-    t[0][D] = T->v[0][D] - c;
-    d = T->n[0] * t[0][0] + T->n[1] * t[0][1] + T->n[2] * t[0][2];
-    s = d > T->rn ? 1 : (d < -T->rn ? -1 : 0);
-    return T->n[D] > 0.0 ? s : -s;
-}
-
-/* Offsets of layer k along D for all three vertices. */
-static void vx_cons_layer(const vx_cons_tri *T, double t[3][3], int k)
-{
-    int D = T->D;
+    int D = T->D, U = T->U, W = T->W;
     double c = (double)k + 0.5;
     t[0][D] = T->v[0][D] - c;
     t[1][D] = T->v[1][D] - c;
     t[2][D] = T->v[2][D] - c;
+    return !vx_cons_sep_plane(T->n, T->rn, t[0]) && !vx_cons_sep_proj(T, U, W, D, t)
+        && !vx_cons_sep_proj(T, W, D, U, t);
 }
 
-/* Clamp a double to [lo, hi] and convert (lo <= hi, ints). NaN goes to lo. */
-static int vx_cons_clampi(double x, int lo, int hi)
+/* ceil(x) clamped to [lo, hi + 1] (hi + 1 = "empty"), floor(x) clamped to [lo - 1, hi]; x may be
+ * any double but NaN (lo >= 0). */
+static int vx_cons_ceil_in(double x, int lo, int hi)
 {
-    if (!(x > (double)lo)) return lo;
-    if (x > (double)hi) return hi;
-    return (int)x;
+    int i;
+    if (!(x > (double)lo - 1.0)) return lo;
+    if (x > (double)hi) return hi + 1;
+    i = (int)x; /* x > -1: truncation, then up when x had a fraction */
+    return i + ((double)i < x);
 }
 
-/* Voxelizes one set-up triangle whose bounding-box voxel ranges are lo..hi. Per column (iu, iw)
- * of the dominant projection D: (1) the three 2D edge axes of that projection, once; (2) the
- * layers k where the plane axis does not separate: an interval (d is monotone in k in floating
- * point, since each rounding is monotone), estimated from the plane equation and moved to its
- * exact ends with the very expression of the SAT; (3) the six other edge axes are monotone in k
- * as well, so the voxels that pass everything form an interval too: it is shrunk from both
- * ends, and every layer between the two passing ends passes without a test. Returns the number
- * of voxels newly set. */
-static size_t vx_cons_fast_tri(const vx_cons_tri *T, const int lo[3], const int hi[3],
-                               const size_t stride[3], uint8_t *occ)
+static int vx_cons_floor_in(double x, int lo, int hi)
 {
-    int D = T->D, u = (D + 1) % 3, w = (D + 2) % 3, iu, iw, k;
-    int a1 = u, a2 = w;
-    double t[3][3], nD = T->n[D];
+    if (!(x < (double)hi + 1.0)) return hi;
+    if (x < (double)lo) return lo - 1;
+    return (int)x; /* x >= lo >= 0 */
+}
+
+/* The fast path's scratch occupancy: bits in 4x4x4 bricks, one uint64 per brick (brick
+ * (bx, by, bz) at (bz*nb[1] + by)*nb[0] + bx, voxel bit (z&3)*16 + (y&3)*4 + (x&3)), so the few
+ * voxels one triangle touches share a handful of words in cache; the byte output is written
+ * from it at the end. */
+typedef struct vx_cons_bricks {
+    uint64_t *w;
+    size_t nb[3];  /* bricks per axis */
+    size_t bs[3];  /* brick stride per axis: 1, nb[0], nb[0]*nb[1] */
+} vx_cons_bricks;
+
+static size_t vx_cons_brick_of(const vx_cons_bricks *B, const int p[3], unsigned *bit)
+{
+    *bit = (unsigned)(((p[2] & 3) << 4) | ((p[1] & 3) << 2) | (p[0] & 3));
+    return (size_t)(p[0] >> 2) * B->bs[0] + (size_t)(p[1] >> 2) * B->bs[1]
+           + (size_t)(p[2] >> 2) * B->bs[2];
+}
+
+/* Voxelizes one set-up triangle whose bounding-box voxel ranges are lo..hi into the bricks;
+ * returns the number of voxels newly set. The decisions are those of
+ * hfvis_triangle_box_overlap on every voxel of the range, bit for bit, reached without calling
+ * it on most voxels:
+ *  - a voxel already set needs no decision (the result is a union);
+ *  - per column (iU, iW) of the dominant projection D, the plane slab's layers come from the
+ *    plane equation, k in kc -+ rn/|n_D| with kc linear in (iU, iW) (Schwarz & Seidel's plane
+ *    test solved for the column). Layers farther than EPS outside that interval fail the SAT's
+ *    plane axis for certain: EPS (2^-30 of the coordinate scale, in layers) is far above the
+ *    rounding of both the SAT's expression and this estimate (about 2^-46 of the scale), so
+ *    these "candidates" contain every voxel the SAT accepts;
+ *  - when every candidate voxel of a column is already set the column is done; otherwise the
+ *    column's three 2D axes of projection D are tested once (the SAT's expressions), and the
+ *    plane + six remaining axes are tested from the two ends of the candidate interval inward
+ *    (skipping set voxels) until a voxel passes: every axis value is monotone along the column
+ *    in floating point (each rounding is monotone), so the layers that pass the SAT form an
+ *    interval and every unset voxel between the lowest and highest passing one passes.
+ * A bounding box of one voxel: the triangle lies in the voxel's closed cube, every offset
+ * |t| <= h, and then no axis of the SAT can separate (|fl(L.t)| <= fl(h |L|) term by term, since
+ * rounding is monotone and the radii are summed in the same order), so the voxel is set. */
+static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
+                               vx_cons_bricks *B)
+{
+    const int D = T->D, U = T->U, W = T->W;
+    const unsigned sh = D == 0 ? 0u : (D == 1 ? 2u : 4u);
+    const size_t sD = B->bs[D];
+    double t[3][3], aU, aW, K0, hwid, eps, scale;
     size_t n = 0;
-    for (iw = lo[w]; iw <= hi[w]; iw++) {
-        double cw = (double)iw + 0.5;
-        t[0][w] = T->v[0][w] - cw;
-        t[1][w] = T->v[1][w] - cw;
-        t[2][w] = T->v[2][w] - cw;
-        for (iu = lo[u]; iu <= hi[u]; iu++) {
-            double cu = (double)iu + 0.5, B, e0, e1, tmp;
-            int klo, khi;
-            uint8_t *col;
-            t[0][u] = T->v[0][u] - cu;
-            t[1][u] = T->v[1][u] - cu;
-            t[2][u] = T->v[2][u] - cu;
-            if (vx_cons_sep_proj(T, D, t)) continue;
-            /* plane slab in this column: |B + n_D (v0_D - k - 0.5)| <= rn in exact arithmetic */
-            B = T->n[u] * t[0][u] + T->n[w] * t[0][w];
-            e0 = (B - T->rn) / nD + T->v[0][D] - 0.5;
-            e1 = (B + T->rn) / nD + T->v[0][D] - 0.5;
-            if (e0 > e1) {
-                tmp = e0;
-                e0 = e1;
-                e1 = tmp;
+    int iU, iW, k, a, p[3];
+    if (lo[0] == hi[0] && lo[1] == hi[1] && lo[2] == hi[2]) {
+        unsigned bit;
+        uint64_t *w = B->w + vx_cons_brick_of(B, lo, &bit), m = (uint64_t)1 << bit;
+        n = (*w & m) == 0;
+        *w |= m;
+        return n;
+    }
+    /* the plane slab per column: kc(iU, iW) = K0 - aU iU - aW iW, half width rn/|n_D| */
+    aU = T->n[U] / T->n[D];
+    aW = T->n[W] / T->n[D];
+    K0 = T->v[0][D] - 0.5
+         + (T->n[U] * (T->v[0][U] - 0.5) + T->n[W] * (T->v[0][W] - 0.5)) / T->n[D];
+    hwid = T->rn / fabs(T->n[D]);
+    scale = 4.0;
+    for (a = 0; a < 3; a++) {
+        double m = vx_cons_max3(fabs(T->v[0][a]), fabs(T->v[1][a]), fabs(T->v[2][a]));
+        scale += m + (double)hi[a];
+    }
+    eps = scale * 9.313225746154785e-10; /* 2^-30 */
+    for (iW = lo[W]; iW <= hi[W]; iW++) {
+        double cW = (double)iW + 0.5, krow = K0 - aW * (double)iW;
+        t[0][W] = T->v[0][W] - cW;
+        t[1][W] = T->v[1][W] - cW;
+        t[2][W] = T->v[2][W] - cW;
+        p[W] = iW;
+        for (iU = lo[U]; iU <= hi[U]; iU++) {
+            double kc = krow - aU * (double)iU, cU;
+            int ka = vx_cons_ceil_in(kc - hwid - eps, lo[D], hi[D]);
+            int kb = vx_cons_floor_in(kc + hwid + eps, lo[D], hi[D]);
+            int k1, k2;
+            size_t base;
+            unsigned bU;
+            if (ka > kb) continue;
+            /* bits of the column's voxels: word base + (k >> 2)*sD, bit bU | (k & 3) << sh */
+            p[U] = iU;
+            p[D] = 0;
+            base = vx_cons_brick_of(B, p, &bU);
+#define VX_CONS_WORD(kk) B->w[base + (size_t)((kk) >> 2) * sD]
+#define VX_CONS_MASK(kk) ((uint64_t)1 << (bU | ((unsigned)((kk) & 3) << sh)))
+            while (ka <= kb && (VX_CONS_WORD(ka) & VX_CONS_MASK(ka))) ka++;
+            if (ka > kb) continue; /* every candidate already set */
+            while (VX_CONS_WORD(kb) & VX_CONS_MASK(kb)) kb--;
+            cU = (double)iU + 0.5;
+            t[0][U] = T->v[0][U] - cU;
+            t[1][U] = T->v[1][U] - cU;
+            t[2][U] = T->v[2][U] - cU;
+            if (vx_cons_sep_proj(T, D, U, W, t)) continue;
+            /* lowest and highest unset layers that pass */
+            for (k1 = ka; k1 <= kb; k1++)
+                if (!(VX_CONS_WORD(k1) & VX_CONS_MASK(k1)) && vx_cons_layer_ok(T, t, k1)) break;
+            if (k1 > kb) continue;
+            for (k2 = kb; k2 > k1; k2--)
+                if (!(VX_CONS_WORD(k2) & VX_CONS_MASK(k2)) && vx_cons_layer_ok(T, t, k2)) break;
+            for (k = k1; k <= k2; k++) {
+                uint64_t m = VX_CONS_MASK(k);
+                n += !(VX_CONS_WORD(k) & m);
+                VX_CONS_WORD(k) |= m;
             }
-            klo = vx_cons_clampi(ceil(e0), lo[D], hi[D]);
-            khi = vx_cons_clampi(floor(e1), lo[D], hi[D]);
-            /* exact lower end: the first layer whose side is <= 0 */
-            if (vx_cons_plane_side(T, t, klo) <= 0) {
-                while (klo > lo[D] && vx_cons_plane_side(T, t, klo - 1) <= 0) klo--;
-            } else {
-                while (klo < hi[D] && vx_cons_plane_side(T, t, klo) > 0) klo++;
-                if (vx_cons_plane_side(T, t, klo) > 0) continue;
-            }
-            /* exact upper end: the last layer whose side is >= 0 */
-            if (khi < klo) khi = klo;
-            if (vx_cons_plane_side(T, t, khi) >= 0) {
-                while (khi < hi[D] && vx_cons_plane_side(T, t, khi + 1) >= 0) khi++;
-            } else {
-                while (khi > klo && vx_cons_plane_side(T, t, khi) < 0) khi--;
-                if (vx_cons_plane_side(T, t, khi) < 0) continue;
-            }
-            /* the other two projections: shrink from both ends */
-            for (; klo <= khi; klo++) {
-                vx_cons_layer(T, t, klo);
-                if (!vx_cons_sep_proj(T, a1, t) && !vx_cons_sep_proj(T, a2, t)) break;
-            }
-            for (; khi > klo; khi--) {
-                vx_cons_layer(T, t, khi);
-                if (!vx_cons_sep_proj(T, a1, t) && !vx_cons_sep_proj(T, a2, t)) break;
-            }
-            col = occ + (size_t)iu * stride[u] + (size_t)iw * stride[w];
-            for (k = klo; k <= khi; k++) {
-                uint8_t *o = col + (size_t)k * stride[D];
-                n += (size_t)(*o == 0);
-                *o = 1;
-            }
+#undef VX_CONS_WORD
+#undef VX_CONS_MASK
         }
     }
+    return n;
+}
+
+/* Allocates the brick scratch (zeroed) for a valid grid; NULL on failure. */
+static uint64_t *vx_cons_bricks_init(vx_cons_bricks *B, const hfvis_volume_grid *grid,
+                                     const hfvis_allocator *alloc)
+{
+    size_t words;
+    int a;
+    for (a = 0; a < 3; a++) B->nb[a] = ((size_t)grid->dims[a] + 3) / 4;
+    B->bs[0] = 1;
+    B->bs[1] = B->nb[0];
+    B->bs[2] = B->nb[0] * B->nb[1];
+    words = B->bs[2] * B->nb[2]; /* about voxels / 64: no overflow for a valid grid */
+    B->w = (uint64_t *)vx_alloc_array(alloc, words, sizeof(uint64_t));
+    if (B->w) memset(B->w, 0, words * sizeof(uint64_t));
+    return B->w;
+}
+
+/* Index of the lowest set bit of m != 0. */
+static unsigned vx_cons_ctz64(uint64_t m)
+{
+    unsigned b = 0;
+    if (!(m & 0xffffffffu)) { m >>= 32; b += 32; }
+    if (!(m & 0xffffu)) { m >>= 16; b += 16; }
+    if (!(m & 0xffu)) { m >>= 8; b += 8; }
+    if (!(m & 0xfu)) { m >>= 4; b += 4; }
+    if (!(m & 0x3u)) { m >>= 2; b += 2; }
+    return b + (unsigned)!(m & 1u);
+}
+
+/* Clears occ and sets the voxels of the bricks' set bits; returns their number. */
+static size_t vx_cons_bricks_emit(const vx_cons_bricks *B, const hfvis_volume_grid *grid,
+                                  uint8_t *occ)
+{
+    size_t nx = (size_t)grid->dims[0], nxy = nx * (size_t)grid->dims[1], n = 0, b0, b1, b2;
+    const uint64_t *w = B->w;
+    memset(occ, 0, vx_grid_voxels(grid));
+    for (b2 = 0; b2 < B->nb[2]; b2++)
+        for (b1 = 0; b1 < B->nb[1]; b1++)
+            for (b0 = 0; b0 < B->nb[0]; b0++) {
+                uint64_t m = *w++;
+                while (m) {
+                    unsigned bit = vx_cons_ctz64(m);
+                    m &= m - 1;
+                    occ[(b2 * 4 + (bit >> 4)) * nxy + (b1 * 4 + ((bit >> 2) & 3u)) * nx + b0 * 4
+                        + (bit & 3u)] = 1;
+                    n++;
+                }
+            }
     return n;
 }
 
@@ -428,27 +514,31 @@ HFVIS_API hfvis_status hfvis_voxelize_conservative(const hfvis_mesh *mesh,
                                                    uint8_t *occ, size_t *count)
 {
     const hfvis_allocator *alloc = opts ? opts->alloc : NULL;
-    size_t t, v, n = 0, stride[3];
+    size_t t, v, n;
     double *gv;
+    vx_cons_bricks B;
     hfvis_status s = vx_cons_args(mesh, grid, occ);
     if (s != HFVIS_OK) return s;
-    /* one scratch block: every vertex in grid space, transformed once */
+    /* scratch: every vertex in grid space (transformed once), and the brick bits */
     gv = (double *)vx_alloc_array(alloc, mesh->vertex_count, 3 * sizeof(double));
     if (!gv && mesh->vertex_count) return HFVIS_ERR_OUT_OF_MEMORY;
+    if (!vx_cons_bricks_init(&B, grid, alloc)) {
+        vx_free(alloc, gv);
+        return HFVIS_ERR_OUT_OF_MEMORY;
+    }
     for (v = 0; v < mesh->vertex_count; v++) vx_cons_gvert(mesh, grid, (uint32_t)v, gv + 3 * v);
-    memset(occ, 0, vx_grid_voxels(grid));
-    stride[0] = 1;
-    stride[1] = (size_t)grid->dims[0];
-    stride[2] = stride[1] * (size_t)grid->dims[1];
     for (t = 0; t < mesh->triangle_count; t++) {
         vx_cons_tri T;
         int lo[3], hi[3], a, k;
         for (k = 0; k < 3; k++)
-            for (a = 0; a < 3; a++) T.v[k][a] = gv[3 * (size_t)mesh->indices[3 * t + (size_t)k] + (size_t)a];
+            for (a = 0; a < 3; a++)
+                T.v[k][a] = gv[3 * (size_t)mesh->indices[3 * t + (size_t)k] + (size_t)a];
         if (!vx_cons_bbox(T.v[0], T.v[1], T.v[2], grid, lo, hi)) continue;
         if (!vx_cons_setup(&T)) continue;
-        n += vx_cons_fast_tri(&T, lo, hi, stride, occ);
+        vx_cons_fast_tri(&T, lo, hi, &B);
     }
+    n = vx_cons_bricks_emit(&B, grid, occ);
+    vx_free(alloc, B.w);
     vx_free(alloc, gv);
     if (count) *count = n;
     return HFVIS_OK;

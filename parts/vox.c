@@ -33,6 +33,7 @@
  * all). E(c) > 0 left of A -> B, i.e. inside. */
 typedef struct vx_vox_edge {
     double lu, lw, du, dw, sign;
+    double root_du; /* du/dw (0 when dw == 0): d(root u)/d(row w), only for search estimates */
     int owned; /* top-left rule: centres exactly on the edge are inside */
     int skip;  /* zero-length edge (duplicate polygon vertex): no constraint */
 } vx_vox_edge;
@@ -49,6 +50,7 @@ static void vx_vox_edge_init(vx_vox_edge *e, double au, double aw, double bu, do
     e->dw = gw - sw;
     e->sign = a_small ? 1.0 : -1.0;
     e->skip = au == bu && aw == bw;
+    e->root_du = e->dw != 0.0 ? e->du / e->dw : 0.0;
     /* traversal direction B - A (exact sign of the rounded difference) */
     tu = e->sign * e->du;
     tw = e->sign * e->dw;
@@ -86,6 +88,7 @@ typedef struct vx_vox_pass {
     vx_vox_edge e[3];        /* counter-clockwise edges */
     double q[3][3];          /* counter-clockwise vertices (U, W, Z) */
     double dzdu, dzdw;       /* depth slopes of the plane */
+    double dudz;             /* 1/dzdu (0 if dzdu == 0), only for search estimates */
     double zlo, zhi;         /* depth range */
     double kmin;             /* floor(zlo): the slab the geometry shader starts from */
     int bu0, bu1, bw0, bw1;  /* pixel bounding box of the triangle within the grid */
@@ -171,6 +174,7 @@ static int vx_vox_pass_setup(vx_vox_pass *p, const vx_vox_tri *T, int a, const i
     p->dzdu = -T->n[p->u] / T->n[a];
     p->dzdw = -T->n[p->w] / T->n[a];
     if (!(fabs(p->dzdu) <= VX_VOX_MAX_SLOPE) || !(fabs(p->dzdw) <= VX_VOX_MAX_SLOPE)) return 0;
+    p->dudz = p->dzdu != 0.0 ? 1.0 / p->dzdu : 0.0;
     p->zlo = p->Z[0], p->zhi = p->Z[0];
     ulo = uhi = p->U[0];
     wlo = whi = p->W[0];
@@ -420,7 +424,7 @@ static int vx_vox_row_span(const vx_vox_edge *e, int ne, double cw, int lo, int 
             if (!vx_vox_edge_pass(ed, (double)lo + 0.5, cw)) return 0;
             continue;
         }
-        guess = ed->lu + ed->du * (cw - ed->lw) / ed->dw - 0.5; /* the root, as a pixel index */
+        guess = ed->lu + ed->root_du * (cw - ed->lw) - 0.5; /* the root, as a pixel index */
         r.edge = ed;
         if (slope > 0.0) { /* inside on a suffix */
             r.negate = 0;
@@ -439,7 +443,7 @@ static int vx_vox_row_span(const vx_vox_edge *e, int ne, double cw, int lo, int 
 static double vx_vox_depth_guess(const vx_vox_pass *p, double cw, double thr)
 {
     double row = p->Z[0] + p->dzdw * (cw - p->W[0]);
-    return p->U[0] + (thr - row) / p->dzdu - 0.5;
+    return p->U[0] + (thr - row) * p->dudz - 0.5;
 }
 
 /* Write the pixels L..R of row pw (all inside the triangle) whose slab lies in [s0, s1], each
@@ -491,24 +495,47 @@ static void vx_vox_row_slabs(vx_vox_sink *s, const vx_vox_pass *p, int pw, int L
 
 /* ---- the three methods, fast (row spans) ------------------------------------------------- */
 
+/* Rows at most this many pixels wide are tested pixel by pixel with the oracle's predicate:
+ * cheaper than the boundary search for the small triangles of dense meshes, and identical. */
+#define VX_VOX_DIRECT_WIDTH 6
+
+/* Row pw, pixels lo..hi, tested one by one: inside the triangle and slab in [s0, s1]. */
+static void vx_vox_row_direct(vx_vox_sink *s, const vx_vox_pass *p, int pw, int lo, int hi, int s0,
+                              int s1)
+{
+    double cw = (double)pw + 0.5;
+    int pu;
+    for (pu = lo; pu <= hi; pu++) {
+        double cu = (double)pu + 0.5, k;
+        if (!vx_vox_inside(p->e, 3, cu, cw)) continue;
+        k = floor(vx_vox_depth(p, cu, cw));
+        if (k >= (double)s0 && k <= (double)s1) vx_vox_emit(s, p, pw, pu, pu, (int)k);
+    }
+}
+
+/* The pixels of row pw in slabs [s0, s1]. */
+static void vx_vox_row(vx_vox_sink *s, const vx_vox_pass *p, int pw, int s0, int s1)
+{
+    int L, R;
+    if (p->bu1 - p->bu0 < VX_VOX_DIRECT_WIDTH) vx_vox_row_direct(s, p, pw, p->bu0, p->bu1, s0, s1);
+    else if (vx_vox_row_span(p->e, 3, (double)pw + 0.5, p->bu0, p->bu1, &L, &R))
+        vx_vox_row_slabs(s, p, pw, L, R, s0, s1);
+}
+
 /* Pixel rule (spec §3.4): every covered pixel of the pass into the slab of its depth. */
 static void vx_vox_fast_pixel_rule(vx_vox_sink *s, const vx_vox_pass *p)
 {
-    int pw, L, R;
-    for (pw = p->bw0; pw <= p->bw1; pw++)
-        if (vx_vox_row_span(p->e, 3, (double)pw + 0.5, p->bu0, p->bu1, &L, &R))
-            vx_vox_row_slabs(s, p, pw, L, R, p->k0, p->k1);
+    int pw;
+    for (pw = p->bw0; pw <= p->bw1; pw++) vx_vox_row(s, p, pw, p->k0, p->k1);
 }
 
 /* Fragment clipping ([G12] Alg. 6): for each slab (lowest first, capped), the whole triangle is
  * rasterised again and only the fragments whose depth lies in [k, k+1) are kept. */
 static void vx_vox_fast_fragment_clipping(vx_vox_sink *s, const vx_vox_pass *p)
 {
-    int k, pw, L, R;
+    int k, pw;
     for (k = p->k0; k <= p->k1; k++)
-        for (pw = p->bw0; pw <= p->bw1; pw++)
-            if (vx_vox_row_span(p->e, 3, (double)pw + 0.5, p->bu0, p->bu1, &L, &R))
-                vx_vox_row_slabs(s, p, pw, L, R, k, k);
+        for (pw = p->bw0; pw <= p->bw1; pw++) vx_vox_row(s, p, pw, k, k);
 }
 
 /* GS slicing ([G12] Alg. 5): the slab pieces (lowest first, capped), each rasterised into its
@@ -523,9 +550,15 @@ static void vx_vox_fast_gs_slicing(vx_vox_sink *s, const vx_vox_pass *p, const i
         if (n == 0 || !vx_vox_pixel_range(bb[0], bb[1], dims[p->u], &u0, &u1)
             || !vx_vox_pixel_range(bb[2], bb[3], dims[p->w], &w0, &w1))
             continue;
-        for (pw = w0; pw <= w1; pw++)
-            if (vx_vox_row_span(pe, n, (double)pw + 0.5, u0, u1, &L, &R))
+        for (pw = w0; pw <= w1; pw++) {
+            if (u1 - u0 < VX_VOX_DIRECT_WIDTH) {
+                int pu;
+                for (pu = u0; pu <= u1; pu++)
+                    if (vx_vox_inside(pe, n, (double)pu + 0.5, (double)pw + 0.5))
+                        vx_vox_emit(s, p, pw, pu, pu, k);
+            } else if (vx_vox_row_span(pe, n, (double)pw + 0.5, u0, u1, &L, &R))
                 vx_vox_emit(s, p, pw, L, R, k);
+        }
     }
 }
 
