@@ -38,11 +38,22 @@ for p in gi2; do
   esac
 done
 mv "$out/hfvis.c.tmp" "$out/hfvis.c"
+# ssao.c parts (pasted at the end of ssao.c): ssao
+cp ssao.c "$out/ssao_dev.c.tmp"
+for p in ssao; do
+  [ -f "parts/$p.c" ] || continue # already merged into ssao.c
+  case "$want" in *" $p "*)
+    printf '\n/* ---- parts/%s.c ---- */\n' "$p" >> "$out/ssao_dev.c.tmp"
+    cat "parts/$p.c" >> "$out/ssao_dev.c.tmp"
+    [ -f "parts/${p}_decl.h" ] && decls="$decls parts/${p}_decl.h";;
+  esac
+done
+mv "$out/ssao_dev.c.tmp" "$out/ssao_dev.c"
 # header: everything before the final "#ifdef __cplusplus" + decls + the tail
 n=$(grep -n '^#ifdef __cplusplus' hfvis.h | tail -n 1 | cut -d: -f1)
 head -n $((n - 1)) hfvis.h > "$out/hfvis.h"
 for d in $decls; do cat "$d" >> "$out/hfvis.h"; done
 tail -n +"$n" hfvis.h >> "$out/hfvis.h"
-${CC:-gcc} $WARN $OPT $CFLAGS_EXTRA -I"$out" -Itest -Iexamples "$src" "$out/hfvis.c" "$out/voxel_dev.c" -lm -o "$out/prog"
+${CC:-gcc} $WARN $OPT $CFLAGS_EXTRA -I"$out" -Itest -Iexamples "$src" "$out/hfvis.c" "$out/ssao_dev.c" "$out/voxel_dev.c" -lm -o "$out/prog"
 echo "built $out/prog"
 "$out/prog"
