@@ -38,17 +38,10 @@ for p in gi2; do
   esac
 done
 mv "$out/hfvis.c.tmp" "$out/hfvis.c"
-# ssao.c parts (pasted at the end of ssao.c): ssao
-cp ssao.c "$out/ssao_dev.c.tmp"
-for p in ssao; do
-  [ -f "parts/$p.c" ] || continue # already merged into ssao.c
-  case "$want" in *" $p "*)
-    printf '\n/* ---- parts/%s.c ---- */\n' "$p" >> "$out/ssao_dev.c.tmp"
-    cat "parts/$p.c" >> "$out/ssao_dev.c.tmp"
-    [ -f "parts/${p}_decl.h" ] && decls="$decls parts/${p}_decl.h";;
-  esac
-done
-mv "$out/ssao_dev.c.tmp" "$out/ssao_dev.c"
+# ssao.c part: parts/ssao.c is the whole new ssao.c (used instead of ssao.c when "ssao" is listed)
+case " $name $* " in *" ssao "*) [ -f parts/ssao.c ] && cp parts/ssao.c "$out/ssao_dev.c" || cp ssao.c "$out/ssao_dev.c"
+  [ -f parts/ssao_decl.h ] && decls="$decls parts/ssao_decl.h";;
+*) cp ssao.c "$out/ssao_dev.c";; esac
 # header: everything before the final "#ifdef __cplusplus" + decls + the tail
 n=$(grep -n '^#ifdef __cplusplus' hfvis.h | tail -n 1 | cut -d: -f1)
 head -n $((n - 1)) hfvis.h > "$out/hfvis.h"
