@@ -434,10 +434,11 @@ HFVIS_API hfvis_status hfvis_bvh_build(const hfvis_mesh *mesh, const hfvis_bvh_o
     if (!out || max_leaf < 1 || max_leaf > HFVIS_BVH_MAX_LEAF_SIZE || bins < 2
         || bins > HFVIS_BVH_MAX_BINS)
         return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!mesh) return HFVIS_ERR_INVALID_ARGUMENT;
+    n = mesh->triangle_count;
+    if (n > HFVIS_BVH_MAX_TRIANGLES) return HFVIS_ERR_LIMIT; /* before reading the arrays */
     st = vx_mesh_check(mesh);
     if (st != HFVIS_OK) return st;
-    n = mesh->triangle_count;
-    if (n > HFVIS_BVH_MAX_TRIANGLES) return HFVIS_ERR_LIMIT;
     if (n == 0) {
         memset(out, 0, sizeof *out);
         out->max_leaf_size = max_leaf;

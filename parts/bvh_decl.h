@@ -156,10 +156,10 @@ HFVIS_API hfvis_bvh_options hfvis_bvh_options_default(void);
  * On success *out owns two blocks from opts->alloc (nodes, tri_order); free them with
  * hfvis_bvh_free(opts->alloc, out). The build allocates four blocks in all (the two above,
  * 24 bytes per triangle of bounds and 2n-1 nodes of scratch, freed before returning).
- * Returns HFVIS_OK; HFVIS_ERR_INVALID_ARGUMENT for NULL mesh or out, an invalid mesh
- * (hfvis_mesh), max_leaf_size or bins out of range; HFVIS_ERR_LIMIT for more than
- * HFVIS_BVH_MAX_TRIANGLES triangles; HFVIS_ERR_OUT_OF_MEMORY. On error *out is untouched and
- * nothing is leaked. */
+ * Returns HFVIS_OK; HFVIS_ERR_INVALID_ARGUMENT for NULL mesh or out, max_leaf_size or bins out
+ * of range, an invalid mesh (hfvis_mesh); HFVIS_ERR_LIMIT for more than HFVIS_BVH_MAX_TRIANGLES
+ * triangles (checked before the mesh's arrays are read); HFVIS_ERR_OUT_OF_MEMORY. On error *out
+ * is untouched and nothing is leaked. */
 HFVIS_API hfvis_status hfvis_bvh_build(const hfvis_mesh *mesh, const hfvis_bvh_options *opts,
                                        hfvis_bvh *out);
 
@@ -179,9 +179,12 @@ HFVIS_API void hfvis_bvh_free(const hfvis_allocator *alloc, hfvis_bvh *bvh);
  * accepted hit, not necessarily the closest). hit receives the result, miss values on a miss.
  * Returns HFVIS_OK; HFVIS_ERR_INVALID_ARGUMENT for NULL bvh, mesh, ray or hit, an invalid ray,
  * an unknown query, a bvh whose triangle_count differs from the mesh's or whose depth exceeds
- * HFVIS_BVH_MAX_DEPTH, or a visited triangle with an index >= vertex_count (hit untouched).
- * The mesh's coordinates are not re-checked (hfvis_bvh_build did). Allocates nothing;
- * reentrant. Cost: O(log n) nodes for typical scenes. */
+ * HFVIS_BVH_MAX_DEPTH, a visited triangle with an index >= vertex_count, or a corrupted bvh met
+ * during the traversal (a child index not after its parent or past node_count, a leaf range
+ * past tri_order, a stack overflow); hit is untouched then. Memory-safe for any bvh whose
+ * arrays have node_count and triangle_count entries. The mesh's coordinates are not re-checked
+ * (hfvis_bvh_build did). Allocates nothing; reentrant. Cost: O(log n) nodes for typical
+ * scenes. */
 HFVIS_API hfvis_status hfvis_bvh_intersect(const hfvis_bvh *bvh, const hfvis_mesh *mesh,
                                            const hfvis_ray *ray, hfvis_ray_query query,
                                            hfvis_hit_filter filter, void *user, hfvis_hit *hit);
