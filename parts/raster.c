@@ -160,12 +160,13 @@ static int vx_raster_degenerate(const float *a, const float *b, const float *c)
 
 /* One covered pixel centre (x, y) of triangle t: depth range, coverage count, depth test LESS,
  * writes. */
-static void vx_raster_fragment(const vx_raster_ctx *ctx, const vx_raster_tri *t, int x, int y)
+static void vx_raster_fragment(const vx_raster_ctx *ctx, const vx_raster_tri *t, int x, int y,
+                               double zrow)
 {
     const hfvis_raster_outputs *o = ctx->out;
     size_t i = (size_t)y * (size_t)ctx->width + (size_t)x;
-    double px = ctx->ndc_x[x], py = ctx->ndc_y[y];
-    double zw = 0.5 * (t->zp[0] * px + t->zp[1] * py + t->zp[2]) + 0.5;
+    double px = ctx->ndc_x[x];
+    double zw = 0.5 * (t->zp[0] * px + zrow) + 0.5; /* zrow = zp[1] * py + zp[2] */
     if (!(zw >= 0.0 && zw <= 1.0)) return; /* beyond the far plane, or before the near plane */
     if (o->coverage_count) o->coverage_count[i]++;
     if (!(zw < ctx->zbuf[i])) return;
@@ -173,6 +174,7 @@ static void vx_raster_fragment(const vx_raster_ctx *ctx, const vx_raster_tri *t,
     if (o->window_depth) o->window_depth[i] = (float)zw;
     if (o->triangle_id) o->triangle_id[i] = t->id;
     if (ctx->want_attr) {
+        double py = ctx->ndc_y[y];
         double a0 = t->r[0] * px + t->r[1] * py + t->r[2];
         double a1 = t->r[3] * px + t->r[4] * py + t->r[5];
         double a2 = t->r[6] * px + t->r[7] * py + t->r[8];
@@ -247,9 +249,10 @@ static void vx_raster_subtriangle(const vx_raster_ctx *ctx, const vx_raster_tri 
         dy[k] *= VX_RASTER_SUB;
     }
     for (yy = ys; yy <= ye; yy++) {
+        double zrow = t->zp[1] * ctx->ndc_y[yy] + t->zp[2];
         F[0] = Frow[0], F[1] = Frow[1], F[2] = Frow[2];
         for (xx = xs; xx <= xe; xx++) {
-            if ((F[0] | F[1] | F[2]) >= 0) vx_raster_fragment(ctx, t, (int)xx, (int)yy);
+            if ((F[0] | F[1] | F[2]) >= 0) vx_raster_fragment(ctx, t, (int)xx, (int)yy, zrow);
             F[0] -= dy[0], F[1] -= dy[1], F[2] -= dy[2];
         }
         Frow[0] += dx[0], Frow[1] += dx[1], Frow[2] += dx[2];
