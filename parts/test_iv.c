@@ -55,6 +55,18 @@ static void iv_grid(hfvis_volume_grid *g, int nx, int ny, int nz, double ox, dou
     g->cell[0] = cx, g->cell[1] = cy, g->cell[2] = cz;
 }
 
+/* Random grid: dims in [nlo, nhi], origin o0 + ospan * U, cells c0 + cspan * U (random calls in
+ * a fixed order, whatever the compiler's argument evaluation order). */
+static void iv_random_grid(hfvis_volume_grid *g, int nlo, int nhi, double o0, double ospan,
+                           double c0, double cspan)
+{
+    int a;
+    memset(g, 0, sizeof *g);
+    for (a = 0; a < 3; a++) g->dims[a] = iv_int(nlo, nhi);
+    for (a = 0; a < 3; a++) g->origin[a] = o0 + ospan * iv_unit();
+    for (a = 0; a < 3; a++) g->cell[a] = c0 + cspan * iv_unit();
+}
+
 static size_t iv_lin(const hfvis_volume_grid *g, int i, int j, int k)
 {
     return ((size_t)k * (size_t)g->dims[1] + (size_t)j) * (size_t)g->dims[0] + (size_t)i;
@@ -561,8 +573,7 @@ TEST(iv_passes_match_oracle)
         iv_scene sc;
         size_t cls[4] = {0, 0, 0, 0}, nv, i;
         int nimg = iv_int(1, 3), C = iv_int(1, 3), single = trial % 2, t, inplace = (trial / 2) % 2;
-        iv_grid(&g, iv_int(3, 20), iv_int(3, 20), iv_int(3, 20), -1.0 + iv_unit(), -1.0 + iv_unit(),
-                -0.5 * iv_unit(), 0.05 + 0.1 * iv_unit(), 0.05 + 0.1 * iv_unit(), 0.05 + 0.1 * iv_unit());
+        iv_random_grid(&g, 3, 20, -1.0, 1.0, 0.05, 0.1);
         nv = (size_t)g.dims[0] * (size_t)g.dims[1] * (size_t)g.dims[2];
         iv_random_scene(&sc, &g);
         o.footprint = (trial / 4) % 2 ? HFVIS_IV_FOOTPRINT_CONSERVATIVE : HFVIS_IV_FOOTPRINT_CENTER;
@@ -574,8 +585,11 @@ TEST(iv_passes_match_oracle)
             int a, w = iv_int(8, 64), h = iv_int(8, 64), p;
             for (a = 0; a < 3; a++) target[a] = g.origin[a] + g.cell[a] * (double)g.dims[a] * iv_unit();
             iv_random_dir(dir);
-            iv_orbit_view(&v[t], target, dir, 0.5 + 3.0 * iv_unit(), iv_int(0, 3) == 0, w, h,
-                          0.5 + 1.5 * iv_unit());
+            {
+                double dist = 0.5 + 3.0 * iv_unit();
+                int ortho = iv_int(0, 3) == 0;
+                iv_orbit_view(&v[t], target, dir, dist, ortho, w, h, 0.5 + 1.5 * iv_unit());
+            }
             iv_render(&v[t], &sc, depth[t]);
             for (p = 0; p < w * h; p++) {
                 double r = iv_unit();
@@ -1164,8 +1178,7 @@ TEST(iv_metric_analytic_and_oracle)
     iv_seed(11);
     for (trial = 0; trial < 25; trial++) {
         int nt = iv_int(1, 40), nvox = 0;
-        iv_grid(&g, iv_int(2, 16), iv_int(2, 16), iv_int(2, 16), -1.0, -1.0, -1.0, 0.1 + 0.1 * iv_unit(),
-                0.1 + 0.1 * iv_unit(), 0.1 + 0.1 * iv_unit());
+        iv_random_grid(&g, 2, 16, -1.0, 0.0, 0.1, 0.1);
         for (i = 0; i < 9 * nt; i++) xyz[i] = (float)(2.5 * iv_unit() - 1.0);
         for (i = 0; i < 3 * nt; i++) idx[i] = (uint32_t)i;
         if (nt > 2) memcpy(xyz + 3, xyz, 3 * sizeof(float)); /* triangle 0 degenerate */
