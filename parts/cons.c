@@ -543,3 +543,868 @@ HFVIS_API hfvis_status hfvis_voxelize_conservative(const hfvis_mesh *mesh,
     if (count) *count = n;
     return HFVIS_OK;
 }
+
+/* ---- 5c. exact 2D orientation and the watertight pixel-centre coverage rule ------------- */
+
+/* The rounding error of the product p = fl(a*b): a*b - p exactly (Dekker's TwoProduct with
+ * Veltkamp's split; needs round-to-nearest double arithmetic without contraction, which the
+ * build's -ffp-contract=off gives, and no overflow/underflow, which VX_CONS_MAX_COORD and the
+ * grid-space ranges give). */
+static double vx_cons_product_error(double a, double b, double p)
+{
+    const double split = 134217729.0; /* 2^27 + 1 */
+    double ca = split * a, cb = split * b;
+    double ah = ca - (ca - a), al = a - ah, bh = cb - (cb - b), bl = b - bh;
+    return ((ah * bh - p) + ah * bl + al * bh) + al * bl;
+}
+
+/* Exact sign of a*b - c*d. Rounding is monotone, so fl(a*b) > fl(c*d) implies a*b > c*d; only
+ * when the rounded products are equal do their exact errors decide. */
+static int vx_cons_det_sign(double a, double b, double c, double d)
+{
+    double p = a * b, q = c * d, ep, eq;
+    if (p > q) return 1;
+    if (p < q) return -1;
+    ep = vx_cons_product_error(a, b, p);
+    eq = vx_cons_product_error(c, d, q);
+    return ep > eq ? 1 : (ep < eq ? -1 : 0);
+}
+
+/* Coverage of the point (cu, cw) by a triangle projected to (pu[k], pw[k]) (spec §3.4, §3.9:
+ * the pixel-centre rule with a watertight tie rule). The vertices are moved to the point first,
+ * q_k = fl(p_k - c) (shared vertices give the same q in every triangle), and the three edge
+ * functions E_k = q_{k+1} x q_{k+2} are evaluated with their EXACT sign (vx_cons_det_sign), so
+ * the two triangles of an edge see exactly opposite signs. The point is inside when no two signs
+ * are opposite and not all are zero; the triangle's orientation s is then the common non-zero
+ * sign. An edge whose E is 0 passes the point on it exactly: it includes it when the point
+ * moved by (eps, eps^2) (eps -> 0+) would be strictly inside, i.e. when the edge, oriented by s,
+ * has direction d with d_w < 0, or d_w == 0 and d_u > 0 (a "top-left" rule). This equals exact
+ * coverage of that infinitesimally moved point by the triangle of the q's, so on a closed mesh
+ * every line through a point crosses the surface an even number of times, and a shared edge or
+ * vertex is counted once where the surface passes through and 0 or 2 times where it folds
+ * (silhouettes). Returns 1 inside, 0 outside; *e receives fl(E_k) (unnormalised barycentrics,
+ * for depth interpolation). */
+static int vx_cons_cover(const double pu[3], const double pw[3], double cu, double cw,
+                         double e[3])
+{
+    double qu[3], qw[3];
+    int s[3], k, pos = 0, neg = 0, orient;
+    for (k = 0; k < 3; k++) {
+        qu[k] = pu[k] - cu;
+        qw[k] = pw[k] - cw;
+    }
+    for (k = 0; k < 3; k++) {
+        int a = k == 2 ? 0 : k + 1, b = k == 0 ? 2 : k - 1;
+        double x = qu[a] * qw[b], y = qw[a] * qu[b];
+        e[k] = x - y;
+        s[k] = x > y ? 1 : (x < y ? -1 : vx_cons_det_sign(qu[a], qw[b], qw[a], qu[b]));
+        pos |= s[k] > 0;
+        neg |= s[k] < 0;
+    }
+    if (pos == neg) return 0; /* opposite signs, or all zero (degenerate) */
+    orient = pos ? 1 : -1;
+    for (k = 0; k < 3; k++) {
+        if (s[k] == 0) {
+            int a = k == 2 ? 0 : k + 1, b = k == 0 ? 2 : k - 1;
+            double du = qu[b] - qu[a], dw = qw[b] - qw[a];
+            if (orient < 0) {
+                du = -du;
+                dw = -dw;
+            }
+            if (!(dw < 0.0 || (dw == 0.0 && du > 0.0))) return 0;
+        }
+    }
+    return 1;
+}
+
+/* Depth (grid units along the projection axis) of the covered point from the unnormalised
+ * barycentrics e and the vertex depths pz, clamped to the vertices' range. */
+static double vx_cons_depth(const double e[3], const double pz[3])
+{
+    double sum = e[0] + e[1] + e[2];
+    double lo = vx_cons_min3(pz[0], pz[1], pz[2]), hi = vx_cons_max3(pz[0], pz[1], pz[2]), z;
+    if (sum == 0.0) return lo; /* rounding-dominated sliver: any depth of the triangle */
+    z = (e[0] * pz[0] + e[1] * pz[1] + e[2] * pz[2]) / sum;
+    return z < lo ? lo : (z > hi ? hi : z);
+}
+
+/* Column range [*lo, *hi] of the pixel centres c + 0.5 inside [mn, mx], clipped to [0, n-1];
+ * 0 when empty. */
+static int vx_cons_centre_range(double mn, double mx, int n, int *lo, int *hi)
+{
+    double l = ceil(mn - 0.5), h = floor(mx - 0.5);
+    if (l < 0.0) l = 0.0;
+    if (h > (double)(n - 1)) h = (double)(n - 1);
+    if (l > h) return 0;
+    *lo = (int)l;
+    *hi = (int)h;
+    return 1;
+}
+
+/* Visits every pixel centre (iu, iw) of projection a (u = a+1, w = a+2) covered by grid-space
+ * triangle v under vx_cons_cover, with its depth z along a. */
+typedef void (*vx_cons_pixel_fn)(void *ctx, int iu, int iw, double z);
+
+static void vx_cons_raster(double v[3][3], int a, const int dims[3], vx_cons_pixel_fn fn,
+                           void *ctx)
+{
+    int u = a == 2 ? 0 : a + 1, w = a == 0 ? 2 : a - 1, ul, uh, wl, wh, iu, iw;
+    double pu[3], pw[3], pz[3], e[3];
+    int k;
+    for (k = 0; k < 3; k++) {
+        pu[k] = v[k][u];
+        pw[k] = v[k][w];
+        pz[k] = v[k][a];
+    }
+    if (!vx_cons_centre_range(vx_cons_min3(pu[0], pu[1], pu[2]), vx_cons_max3(pu[0], pu[1], pu[2]),
+                              dims[u], &ul, &uh)
+        || !vx_cons_centre_range(vx_cons_min3(pw[0], pw[1], pw[2]),
+                                 vx_cons_max3(pw[0], pw[1], pw[2]), dims[w], &wl, &wh))
+        return;
+    for (iw = wl; iw <= wh; iw++)
+        for (iu = ul; iu <= uh; iu++)
+            if (vx_cons_cover(pu, pw, (double)iu + 0.5, (double)iw + 0.5, e))
+                fn(ctx, iu, iw, vx_cons_depth(e, pz));
+}
+
+/* ---- 5d. solid voxelization by parity -------------------------------------------------- */
+
+/* Options resolved: the parity axis as 0, 1, 2; -1 for an unknown value. */
+static int vx_cons_parity_axis(const hfvis_binary_voxel_options *opts)
+{
+    if (!opts || opts->axis == HFVIS_PARITY_AXIS_DEFAULT) return 2;
+    switch (opts->axis) {
+    case HFVIS_PARITY_AXIS_X: return 0;
+    case HFVIS_PARITY_AXIS_Y: return 1;
+    case HFVIS_PARITY_AXIS_Z: return 2;
+    default: return -1;
+    }
+}
+
+/* First layer k whose centre k + 0.5 lies strictly above depth z, clipped to [0, n]. */
+static int vx_cons_first_above(double z, int n)
+{
+    double f;
+    int k;
+    if (!(z >= 0.5)) return 0; /* also z < 0.5 => layer 0's centre is above */
+    if (z >= (double)n - 0.5) return n;
+    f = floor(z - 0.5);
+    k = (int)f + 1;
+    /* fix the rounding of z - 0.5 with exact comparisons (k + 0.5 is exact) */
+    while (k > 0 && (double)(k - 1) + 0.5 > z) k--;
+    while (k < n && !((double)k + 0.5 > z)) k++;
+    return k;
+}
+
+typedef struct vx_cons_solid_ctx {
+    uint8_t *colpar; /* per column: parity of its crossings */
+    uint8_t *occ;    /* NULL in the checking pass */
+    size_t stride_u, stride_w, stride_a;
+    int nu, na;
+} vx_cons_solid_ctx;
+
+static void vx_cons_solid_pixel(void *ctx, int iu, int iw, double z)
+{
+    vx_cons_solid_ctx *c = (vx_cons_solid_ctx *)ctx;
+    c->colpar[(size_t)iw * (size_t)c->nu + (size_t)iu] ^= 1;
+    if (c->occ) {
+        int k0 = vx_cons_first_above(z, c->na);
+        if (k0 < c->na)
+            c->occ[(size_t)iu * c->stride_u + (size_t)iw * c->stride_w + (size_t)k0 * c->stride_a] ^= 1;
+    }
+}
+
+/* Rasterizes every non-degenerate triangle of the mesh into projection a. */
+static void vx_cons_raster_mesh(const hfvis_mesh *mesh, const hfvis_volume_grid *grid, int a,
+                                vx_cons_pixel_fn fn, void *ctx)
+{
+    size_t t;
+    for (t = 0; t < mesh->triangle_count; t++) {
+        double v[3][3];
+        int k;
+        for (k = 0; k < 3; k++) vx_cons_gvert(mesh, grid, mesh->indices[3 * t + (size_t)k], v[k]);
+        if (vx_cons_degenerate(v[0], v[1], v[2])) continue;
+        vx_cons_raster(v, a, grid->dims, fn, ctx);
+    }
+}
+
+HFVIS_API hfvis_status hfvis_voxelize_solid(const hfvis_mesh *mesh, const hfvis_volume_grid *grid,
+                                            const hfvis_binary_voxel_options *opts, uint8_t *occ,
+                                            size_t *count)
+{
+    const hfvis_allocator *alloc = opts ? opts->alloc : NULL;
+    int a = vx_cons_parity_axis(opts), u, w, allow_open = opts && opts->allow_open;
+    size_t ncol, stride[3], i, n = 0, nvox;
+    vx_cons_solid_ctx c;
+    hfvis_status s;
+    if (a < 0) return HFVIS_ERR_INVALID_ARGUMENT;
+    s = vx_cons_args(mesh, grid, occ);
+    if (s != HFVIS_OK) return s;
+    u = a == 2 ? 0 : a + 1;
+    w = a == 0 ? 2 : a - 1;
+    stride[0] = 1;
+    stride[1] = (size_t)grid->dims[0];
+    stride[2] = stride[1] * (size_t)grid->dims[1];
+    ncol = (size_t)grid->dims[u] * (size_t)grid->dims[w];
+    memset(&c, 0, sizeof c);
+    c.colpar = (uint8_t *)vx_alloc(alloc, ncol);
+    if (!c.colpar) return HFVIS_ERR_OUT_OF_MEMORY;
+    memset(c.colpar, 0, ncol);
+    c.nu = grid->dims[u];
+    c.na = grid->dims[a];
+    c.stride_u = stride[u];
+    c.stride_w = stride[w];
+    c.stride_a = stride[a];
+    if (!allow_open) {
+        /* pass 1: every column must be crossed an even number of times (a closed surface) */
+        vx_cons_raster_mesh(mesh, grid, a, vx_cons_solid_pixel, &c);
+        for (i = 0; i < ncol; i++)
+            if (c.colpar[i]) {
+                vx_free(alloc, c.colpar);
+                return HFVIS_ERR_FORMAT;
+            }
+    }
+    /* pass 2 (Chen & Fang; Eisemann & Decoret 2008): each crossing toggles the first voxel whose
+     * centre lies above it; a prefix XOR along the axis then gives the parity of the crossings
+     * below every voxel centre. */
+    nvox = vx_grid_voxels(grid);
+    memset(occ, 0, nvox);
+    c.occ = occ;
+    vx_cons_raster_mesh(mesh, grid, a, vx_cons_solid_pixel, &c);
+    if (a == 0) {
+        size_t row, nrows = nvox / stride[1];
+        for (row = 0; row < nrows; row++) {
+            uint8_t *r = occ + row * stride[1], acc = 0;
+            int x;
+            for (x = 0; x < grid->dims[0]; x++) r[x] = acc ^= r[x];
+        }
+    } else {
+        /* layers along a are planes (a = 2) or rows inside each z plane (a = 1) */
+        size_t plane = a == 2 ? stride[2] : stride[1], blocks = a == 2 ? 1 : (size_t)grid->dims[2];
+        size_t blk, layer;
+        for (blk = 0; blk < blocks; blk++) {
+            uint8_t *base = occ + blk * stride[2];
+            for (layer = 1; layer < (size_t)grid->dims[a]; layer++) {
+                uint8_t *cur = base + layer * plane;
+                const uint8_t *prev = cur - plane;
+                for (i = 0; i < plane; i++) cur[i] ^= prev[i];
+            }
+        }
+    }
+    if (allow_open) {
+        /* columns crossed an odd number of times (an open mesh) are left empty */
+        int iu, iw, k;
+        for (iw = 0; iw < grid->dims[w]; iw++)
+            for (iu = 0; iu < grid->dims[u]; iu++)
+                if (c.colpar[(size_t)iw * (size_t)c.nu + (size_t)iu])
+                    for (k = 0; k < grid->dims[a]; k++)
+                        occ[(size_t)iu * stride[u] + (size_t)iw * stride[w] + (size_t)k * stride[a]] = 0;
+    }
+    for (i = 0; i < nvox; i++) n += occ[i];
+    vx_free(alloc, c.colpar);
+    if (count) *count = n;
+    return HFVIS_OK;
+}
+
+/* Solid angle of triangle (a, b, c) seen from the origin, signed by orientation (Van Oosterom &
+ * Strackee 1983): tan(Omega/2) = a.(b x c) / (|a||b||c| + (a.b)|c| + (a.c)|b| + (b.c)|a|). */
+static double vx_cons_solid_angle(const double a[3], const double b[3], const double c[3])
+{
+    double la = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    double lb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+    double lc = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    double det = a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2])
+                 + a[2] * (b[0] * c[1] - b[1] * c[0]);
+    double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    double ac = a[0] * c[0] + a[1] * c[1] + a[2] * c[2];
+    double bc = b[0] * c[0] + b[1] * c[1] + b[2] * c[2];
+    return 2.0 * atan2(det, la * lb * lc + ab * lc + ac * lb + bc * la);
+}
+
+HFVIS_API hfvis_status hfvis_voxelize_solid_reference(const hfvis_mesh *mesh,
+                                                      const hfvis_volume_grid *grid,
+                                                      const hfvis_binary_voxel_options *opts,
+                                                      uint8_t *occ, size_t *count)
+{
+    size_t n = 0, t, idx = 0;
+    int i, j, k;
+    hfvis_status s;
+    if (vx_cons_parity_axis(opts) < 0) return HFVIS_ERR_INVALID_ARGUMENT;
+    s = vx_cons_args(mesh, grid, occ);
+    if (s != HFVIS_OK) return s;
+    for (k = 0; k < grid->dims[2]; k++)
+        for (j = 0; j < grid->dims[1]; j++)
+            for (i = 0; i < grid->dims[0]; i++, idx++) {
+                double c[3], wsum = 0.0, wn;
+                c[0] = (double)i + 0.5;
+                c[1] = (double)j + 0.5;
+                c[2] = (double)k + 0.5;
+                for (t = 0; t < mesh->triangle_count; t++) {
+                    double v[3][3];
+                    int q, a;
+                    for (q = 0; q < 3; q++) {
+                        vx_cons_gvert(mesh, grid, mesh->indices[3 * t + (size_t)q], v[q]);
+                        for (a = 0; a < 3; a++) v[q][a] -= c[a];
+                    }
+                    wsum += vx_cons_solid_angle(v[0], v[1], v[2]);
+                }
+                /* generalized winding number (Jacobson et al. 2013); parity of its rounding */
+                wn = floor(fabs(wsum) / (4.0 * VX_PI) + 0.5);
+                occ[idx] = (uint8_t)(fmod(wn, 2.0) == 1.0);
+                n += occ[idx];
+            }
+    if (count) *count = n;
+    return HFVIS_OK;
+}
+
+/* ---- 5e. watertightness of the index structure ----------------------------------------- */
+
+static int vx_cons_key_cmp(const void *x, const void *y)
+{
+    uint64_t a = *(const uint64_t *)x, b = *(const uint64_t *)y;
+    return a < b ? -1 : (a > b);
+}
+
+HFVIS_API hfvis_status hfvis_mesh_is_watertight(const hfvis_mesh *mesh,
+                                                const hfvis_allocator *alloc, int *result)
+{
+    uint64_t *keys;
+    size_t t, m, i;
+    int ok = 1;
+    if (!result || vx_mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (mesh->triangle_count == 0) {
+        *result = 1;
+        return HFVIS_OK;
+    }
+    /* every directed edge a -> b as the key a << 32 | b */
+    keys = (uint64_t *)vx_alloc_array(alloc, mesh->triangle_count, 3 * sizeof(uint64_t));
+    if (!keys) return HFVIS_ERR_OUT_OF_MEMORY;
+    m = 3 * mesh->triangle_count;
+    for (t = 0; t < mesh->triangle_count && ok; t++) {
+        const uint32_t *v = mesh->indices + 3 * t;
+        int k;
+        for (k = 0; k < 3; k++) {
+            uint32_t a = v[k], b = v[k == 2 ? 0 : k + 1];
+            if (a == b) ok = 0; /* a repeated index: not a 2-manifold triangle */
+            keys[3 * t + (size_t)k] = ((uint64_t)a << 32) | b;
+        }
+    }
+    if (ok) qsort(keys, m, sizeof *keys, vx_cons_key_cmp);
+    /* closed and consistently oriented <=> every directed edge occurs once and its reverse too */
+    for (i = 0; ok && i < m; i++) {
+        uint64_t rev = (keys[i] << 32) | (keys[i] >> 32);
+        if (i + 1 < m && keys[i + 1] == keys[i]) ok = 0;
+        else if (!bsearch(&rev, keys, m, sizeof *keys, vx_cons_key_cmp)) ok = 0;
+    }
+    vx_free(alloc, keys);
+    *result = ok;
+    return HFVIS_OK;
+}
+
+/* ---- 5f. bitmask voxelization (three-axis OR, slicemap layout) ------------------------- */
+
+HFVIS_API size_t hfvis_bitmask_words(const hfvis_volume_grid *grid)
+{
+    if (!vx_grid_valid(grid)) return 0;
+    /* <= voxels/32 + columns: no overflow for a valid grid */
+    return (size_t)grid->dims[0] * (size_t)grid->dims[1] * (((size_t)grid->dims[2] + 31) / 32);
+}
+
+typedef struct vx_cons_bits_ctx {
+    uint32_t *bits;
+    size_t nx, words; /* words per (i, j) column */
+    int a, dims[3];
+} vx_cons_bits_ctx;
+
+static void vx_cons_bits_pixel(void *ctx, int iu, int iw, double z)
+{
+    vx_cons_bits_ctx *c = (vx_cons_bits_ctx *)ctx;
+    int p[3], k;
+    if (!(z >= 0.0) || z >= (double)c->dims[c->a]) return; /* outside the grid's slabs */
+    k = (int)z; /* floor: a depth on a slab boundary goes to the upper slab */
+    p[c->a] = k;
+    p[c->a == 2 ? 0 : c->a + 1] = iu;
+    p[c->a == 0 ? 2 : c->a - 1] = iw;
+    c->bits[((size_t)p[1] * c->nx + (size_t)p[0]) * c->words + (size_t)(p[2] >> 5)]
+        |= (uint32_t)1 << (p[2] & 31);
+}
+
+static unsigned vx_cons_popcount32(uint32_t x)
+{
+    x = x - ((x >> 1) & 0x55555555u);
+    x = (x & 0x33333333u) + ((x >> 2) & 0x33333333u);
+    x = (x + (x >> 4)) & 0x0f0f0f0fu;
+    return (unsigned)((x * 0x01010101u) >> 24);
+}
+
+HFVIS_API hfvis_status hfvis_voxelize_bitmask(const hfvis_mesh *mesh, const hfvis_volume_grid *grid,
+                                              const hfvis_binary_voxel_options *opts, uint32_t *bits,
+                                              size_t *count)
+{
+    vx_cons_bits_ctx c;
+    size_t nw, i, n = 0;
+    int a;
+    hfvis_status s = vx_cons_args(mesh, grid, bits);
+    (void)opts;
+    if (s != HFVIS_OK) return s;
+    nw = hfvis_bitmask_words(grid);
+    memset(bits, 0, nw * sizeof *bits);
+    c.bits = bits;
+    c.nx = (size_t)grid->dims[0];
+    c.words = ((size_t)grid->dims[2] + 31) / 32;
+    for (a = 0; a < 3; a++) c.dims[a] = grid->dims[a];
+    /* Eisemann & Decoret 2006 from three viewpoints: every pass rasterizes every triangle with
+     * the pixel-centre rule and ORs the bit of the slab holding its depth */
+    for (a = 0; a < 3; a++) {
+        c.a = a;
+        vx_cons_raster_mesh(mesh, grid, a, vx_cons_bits_pixel, &c);
+    }
+    for (i = 0; i < nw; i++) n += vx_cons_popcount32(bits[i]);
+    if (count) *count = n;
+    return HFVIS_OK;
+}
+
+HFVIS_API hfvis_status hfvis_bitmask_to_occupancy(const hfvis_volume_grid *grid,
+                                                  const uint32_t *bits, uint8_t *occ)
+{
+    size_t nx, ny, nz, words, i, j, k;
+    if (!bits || !occ || !vx_grid_valid(grid)) return HFVIS_ERR_INVALID_ARGUMENT;
+    nx = (size_t)grid->dims[0];
+    ny = (size_t)grid->dims[1];
+    nz = (size_t)grid->dims[2];
+    words = (nz + 31) / 32;
+    for (k = 0; k < nz; k++)
+        for (j = 0; j < ny; j++)
+            for (i = 0; i < nx; i++)
+                occ[(k * ny + j) * nx + i]
+                    = (uint8_t)((bits[(j * nx + i) * words + (k >> 5)] >> (k & 31)) & 1u);
+    return HFVIS_OK;
+}
+
+/* ---- 5g. .binvox codec and the raw writer ---------------------------------------------- */
+/* binvox (P. Min's voxelizer and viewvox; format by M. Kazhdan): an ASCII header
+ *   "#binvox 1\n" "dim D D D\n" "translate tx ty tz\n" "scale s\n" "data\n"
+ * then run-length pairs of bytes (value, count), count 1..255, over the D^3 voxels in the order
+ * x slowest, then z, then y fastest (index x*D*D + z*D + y); voxel (x, y, z) spans
+ * translate + scale*[x, x+1]/D (and likewise y, z). Numbers are written and read without the C
+ * library (locale-independent). */
+
+/* Decimal number parser: [+-] digits [. digits] [(e|E) [+-] digits], or [+-] . digits ...
+ * Exactly rounded when at most 19 significant digits form a mantissa <= 2^53 and the decimal
+ * exponent is within +-22 (Clinger's fast path: m and 10^|e| are exact doubles, one rounding);
+ * otherwise within a few ulps. Advances *i; returns 0 on a malformed or non-finite number. */
+static int vx_cons_parse_number(const unsigned char *p, size_t n, size_t *i, double *out)
+{
+    static const double pow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                     1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                     1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+    size_t j = *i;
+    uint64_t m = 0;
+    long e10 = 0, ex = 0;
+    int neg = 0, digits = 0, sig = 0, eneg = 0;
+    double v;
+    if (j < n && (p[j] == '+' || p[j] == '-')) neg = p[j++] == '-';
+    for (; j < n && p[j] >= '0' && p[j] <= '9'; j++, digits++) {
+        if (sig < 19) {
+            m = m * 10u + (unsigned)(p[j] - '0');
+            sig += m != 0;
+        } else if (e10 < 100000) {
+            e10++;
+        }
+    }
+    if (j < n && p[j] == '.') {
+        for (j++; j < n && p[j] >= '0' && p[j] <= '9'; j++, digits++) {
+            if (sig < 19) {
+                m = m * 10u + (unsigned)(p[j] - '0');
+                sig += m != 0;
+                e10--;
+            }
+        }
+    }
+    if (digits == 0) return 0;
+    if (j < n && (p[j] == 'e' || p[j] == 'E')) {
+        j++;
+        if (j < n && (p[j] == '+' || p[j] == '-')) eneg = p[j++] == '-';
+        if (j >= n || p[j] < '0' || p[j] > '9') return 0;
+        for (; j < n && p[j] >= '0' && p[j] <= '9'; j++)
+            if (ex < 100000) ex = ex * 10 + (long)(p[j] - '0');
+    }
+    e10 += eneg ? -ex : ex;
+    if (m == 0) {
+        v = 0.0;
+    } else if (m <= ((uint64_t)1 << 53) && e10 >= -22 && e10 <= 22) {
+        v = e10 >= 0 ? (double)m * pow10[e10] : (double)m / pow10[-e10];
+    } else {
+        if (e10 > 400) e10 = 400;
+        if (e10 < -400) e10 = -400;
+        v = (double)m * pow(10.0, (double)(e10 / 2)) * pow(10.0, (double)(e10 - e10 / 2));
+    }
+    if (!isfinite(v)) return 0;
+    *out = neg ? -v : v;
+    *i = j;
+    return 1;
+}
+
+/* Writes finite x in at most 25 characters (no terminator): the fewest significant digits
+ * (1..15) that vx_cons_parse_number reads back as exactly x, else 17 digits (within a few
+ * ulps). Plain notation for decimal exponents -5..15, else d.ddde+XX. Returns the length. */
+static size_t vx_cons_format_number(double x, char *out)
+{
+    static const double pow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                     1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                     1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+    char dig[24], buf[40];
+    size_t len = 0;
+    int prec, e10, nd = 0, k;
+    double ax = fabs(x);
+    if (ax == 0.0) {
+        out[0] = '0';
+        return 1;
+    }
+    e10 = (int)floor(log10(ax));
+    for (prec = 1; prec <= 17; prec++) {
+        /* q = round(ax * 10^(prec-1-e10)) (approximately), so ax ~ q * 10^(e10-prec+1) */
+        int sh = prec - 1 - e10, lead;
+        double m;
+        uint64_t q;
+        if (prec == 16) continue;
+        if (sh >= 0 && sh <= 22) m = ax * pow10[sh];
+        else if (sh < 0 && sh >= -22) m = ax / pow10[-sh];
+        else m = ax * pow(10.0, (double)(sh / 2)) * pow(10.0, (double)(sh - sh / 2));
+        m = floor(m + 0.5);
+        if (m >= 1e17) { /* only when log10 misjudged the exponent: drop a digit */
+            m = floor(m / 10.0 + 0.5);
+            sh--;
+        }
+        if (m < 1.0) m = 1.0;
+        q = (uint64_t)m;
+        nd = 0;
+        while (q) {
+            dig[nd++] = (char)('0' + (int)(q % 10u));
+            q /= 10u;
+        }
+        lead = nd - 1 - sh; /* power of ten of the leading digit dig[nd-1] */
+        while (nd > 1 && dig[0] == '0') { /* trailing zeros of the digit string */
+            for (k = 0; k + 1 < nd; k++) dig[k] = dig[k + 1];
+            nd--;
+        }
+        len = 0;
+        if (x < 0.0) buf[len++] = '-';
+        if (lead >= -5 && lead <= 15) {
+            int place;
+            if (lead < 0) {
+                buf[len++] = '0';
+                buf[len++] = '.';
+                for (place = -1; place > lead; place--) buf[len++] = '0';
+            }
+            for (k = 0; k < nd; k++) {
+                place = lead - k;
+                buf[len++] = dig[nd - 1 - k];
+                if (place == 0 && k + 1 < nd) buf[len++] = '.';
+            }
+            for (place = lead - nd; place >= 0; place--) buf[len++] = '0';
+        } else {
+            int ee = lead < 0 ? -lead : lead;
+            buf[len++] = dig[nd - 1];
+            if (nd > 1) {
+                buf[len++] = '.';
+                for (k = 1; k < nd; k++) buf[len++] = dig[nd - 1 - k];
+            }
+            buf[len++] = 'e';
+            buf[len++] = lead < 0 ? '-' : '+';
+            if (ee >= 100) buf[len++] = (char)('0' + ee / 100);
+            buf[len++] = (char)('0' + ee / 10 % 10);
+            buf[len++] = (char)('0' + ee % 10);
+        }
+        if (prec <= 15) {
+            size_t at = 0;
+            double back;
+            if (vx_cons_parse_number((const unsigned char *)buf, len, &at, &back) && at == len
+                && back == x)
+                break;
+        }
+    }
+    memcpy(out, buf, len);
+    return len;
+}
+
+/* The binvox header of a grid padded to the cube of side d, into out (NULL: only measure).
+ * translate = origin, scale = d * max(cell): binvox has one scale, so non-cubic voxels are
+ * written with the largest cell (documented). */
+static size_t vx_cons_binvox_header(const hfvis_volume_grid *g, int d, char *out)
+{
+    char tmp[256];
+    size_t len = 0, k;
+    int a;
+    double cell = vx_cons_max3(g->cell[0], g->cell[1], g->cell[2]);
+    char num[12];
+    int nn = 0, q = d;
+    static const char head[] = "#binvox 1\ndim ";
+    memcpy(tmp, head, sizeof head - 1);
+    len = sizeof head - 1;
+    do {
+        num[nn++] = (char)('0' + q % 10);
+        q /= 10;
+    } while (q);
+    for (a = 0; a < 3; a++) {
+        for (k = 0; k < (size_t)nn; k++) tmp[len++] = num[nn - 1 - (int)k];
+        tmp[len++] = a < 2 ? ' ' : '\n';
+    }
+    memcpy(tmp + len, "translate ", 10);
+    len += 10;
+    for (a = 0; a < 3; a++) {
+        len += vx_cons_format_number(g->origin[a], tmp + len);
+        tmp[len++] = a < 2 ? ' ' : '\n';
+    }
+    memcpy(tmp + len, "scale ", 6);
+    len += 6;
+    len += vx_cons_format_number((double)d * cell, tmp + len);
+    memcpy(tmp + len, "\ndata\n", 6);
+    len += 6;
+    if (out) memcpy(out, tmp, len);
+    return len;
+}
+
+/* Side of the binvox cube for a valid grid; 0 when d^3 exceeds HFVIS_VOLUME_MAX_VOXELS. */
+static int vx_cons_binvox_side(const hfvis_volume_grid *g)
+{
+    int d = g->dims[0] > g->dims[1] ? g->dims[0] : g->dims[1];
+    size_t dd = 1;
+    if (g->dims[2] > d) d = g->dims[2];
+    if (!vx_mul_size(dd, (size_t)d, &dd) || !vx_mul_size(dd, (size_t)d, &dd)
+        || !vx_mul_size(dd, (size_t)d, &dd) || dd > HFVIS_VOLUME_MAX_VOXELS)
+        return 0;
+    return d;
+}
+
+/* Runs the binvox RLE over the padded cube; writes pairs into out when not NULL. Returns the
+ * number of bytes of the pairs. */
+static size_t vx_cons_binvox_rle(const hfvis_volume_grid *g, const uint8_t *occ, int d,
+                                 unsigned char *out)
+{
+    size_t nx = (size_t)g->dims[0], ny = (size_t)g->dims[1], nz = (size_t)g->dims[2], bytes = 0;
+    size_t x, y, z, D = (size_t)d;
+    unsigned run = 0, cur = 0;
+    for (x = 0; x < D; x++)
+        for (z = 0; z < D; z++)
+            for (y = 0; y < D; y++) {
+                unsigned v = (x < nx && y < ny && z < nz) ? occ[(z * ny + y) * nx + x] != 0 : 0u;
+                if (run > 0 && (v != cur || run == 255)) {
+                    if (out) {
+                        out[bytes] = (unsigned char)cur;
+                        out[bytes + 1] = (unsigned char)run;
+                    }
+                    bytes += 2;
+                    run = 0;
+                }
+                cur = v;
+                run++;
+            }
+    if (out) {
+        out[bytes] = (unsigned char)cur;
+        out[bytes + 1] = (unsigned char)run;
+    }
+    return bytes + 2;
+}
+
+HFVIS_API size_t hfvis_binvox_encode_size(const hfvis_volume_grid *grid, const uint8_t *occ)
+{
+    int d;
+    if (!occ || !vx_grid_valid(grid) || (d = vx_cons_binvox_side(grid)) == 0) return 0;
+    return vx_cons_binvox_header(grid, d, NULL) + vx_cons_binvox_rle(grid, occ, d, NULL);
+}
+
+HFVIS_API hfvis_status hfvis_binvox_encode(const hfvis_volume_grid *grid, const uint8_t *occ,
+                                           void *out, size_t capacity, size_t *written)
+{
+    size_t head, need;
+    int d;
+    if (!occ || !out || !written || !vx_grid_valid(grid)) return HFVIS_ERR_INVALID_ARGUMENT;
+    d = vx_cons_binvox_side(grid);
+    if (d == 0) return HFVIS_ERR_LIMIT;
+    need = hfvis_binvox_encode_size(grid, occ);
+    if (capacity < need) return HFVIS_ERR_BUFFER_TOO_SMALL;
+    head = vx_cons_binvox_header(grid, d, (char *)out);
+    vx_cons_binvox_rle(grid, occ, d, (unsigned char *)out + head);
+    *written = need;
+    return HFVIS_OK;
+}
+
+/* Skips blanks (space, tab) from p[*i]. */
+static void vx_cons_skip_blank(const unsigned char *p, size_t n, size_t *i)
+{
+    while (*i < n && (p[*i] == ' ' || p[*i] == '\t')) (*i)++;
+}
+
+/* The end of a header line: optional blanks, optional '\r', then '\n'. */
+static int vx_cons_line_end(const unsigned char *p, size_t n, size_t *i)
+{
+    vx_cons_skip_blank(p, n, i);
+    if (*i < n && p[*i] == '\r') (*i)++;
+    if (*i >= n || p[*i] != '\n') return 0;
+    (*i)++;
+    return 1;
+}
+
+/* A keyword at p[*i] followed by a blank or the line end. */
+static int vx_cons_keyword(const unsigned char *p, size_t n, size_t *i, const char *kw)
+{
+    size_t len = strlen(kw);
+    if (n - *i < len || memcmp(p + *i, kw, len) != 0) return 0;
+    if (*i + len < n && p[*i + len] != ' ' && p[*i + len] != '\t' && p[*i + len] != '\r'
+        && p[*i + len] != '\n')
+        return 0;
+    *i += len;
+    return 1;
+}
+
+/* Unsigned decimal after blanks (at least one blank first); values above cap saturate at
+ * cap + 1. */
+static int vx_cons_parse_uint(const unsigned char *p, size_t n, size_t *i, unsigned long cap,
+                              unsigned long *out)
+{
+    size_t j = *i;
+    unsigned long v = 0;
+    vx_cons_skip_blank(p, n, &j);
+    if (j == *i || j >= n || p[j] < '0' || p[j] > '9') return 0;
+    for (; j < n && p[j] >= '0' && p[j] <= '9'; j++) {
+        unsigned long dg = (unsigned long)(p[j] - '0');
+        v = (v > (cap - dg) / 10) ? cap + 1 : v * 10 + dg;
+    }
+    *i = j;
+    *out = v;
+    return 1;
+}
+
+/* A number after at least one blank. */
+static int vx_cons_parse_field(const unsigned char *p, size_t n, size_t *i, double *out)
+{
+    size_t j = *i;
+    vx_cons_skip_blank(p, n, &j);
+    if (j == *i) return 0;
+    if (!vx_cons_parse_number(p, n, &j, out)) return 0;
+    if (j < n && p[j] != ' ' && p[j] != '\t' && p[j] != '\r' && p[j] != '\n') return 0;
+    *i = j;
+    return 1;
+}
+
+HFVIS_API hfvis_status hfvis_binvox_decode(const void *data, size_t size,
+                                           const hfvis_allocator *alloc, hfvis_volume_grid *grid,
+                                           uint8_t **occ)
+{
+    const unsigned char *p = (const unsigned char *)data;
+    size_t i = 0, total, got = 0, j, D, DD;
+    unsigned long version, dims[3];
+    double translate[3] = {0.0, 0.0, 0.0}, scale = 1.0;
+    int have_dim = 0, have_t = 0, have_s = 0, a;
+    hfvis_volume_grid g;
+    uint8_t *o;
+    if (!data || !grid || !occ) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!vx_cons_keyword(p, size, &i, "#binvox") || !vx_cons_parse_uint(p, size, &i, 9, &version)
+        || (version != 1 && version != 2) || !vx_cons_line_end(p, size, &i))
+        return HFVIS_ERR_FORMAT;
+    for (;;) {
+        if (vx_cons_keyword(p, size, &i, "data")) {
+            if (!vx_cons_line_end(p, size, &i)) return HFVIS_ERR_FORMAT;
+            break;
+        } else if (vx_cons_keyword(p, size, &i, "dim")) {
+            if (have_dim) return HFVIS_ERR_FORMAT;
+            for (a = 0; a < 3; a++)
+                if (!vx_cons_parse_uint(p, size, &i, (unsigned long)INT_MAX, &dims[a]) || dims[a] == 0)
+                    return HFVIS_ERR_FORMAT;
+            have_dim = 1;
+        } else if (vx_cons_keyword(p, size, &i, "translate")) {
+            if (have_t) return HFVIS_ERR_FORMAT;
+            for (a = 0; a < 3; a++)
+                if (!vx_cons_parse_field(p, size, &i, &translate[a])) return HFVIS_ERR_FORMAT;
+            have_t = 1;
+        } else if (vx_cons_keyword(p, size, &i, "scale")) {
+            if (have_s || !vx_cons_parse_field(p, size, &i, &scale) || !(scale > 0.0))
+                return HFVIS_ERR_FORMAT;
+            have_s = 1;
+        } else {
+            return HFVIS_ERR_FORMAT; /* unknown line, blank line or end of data */
+        }
+        if (!vx_cons_line_end(p, size, &i)) return HFVIS_ERR_FORMAT;
+    }
+    if (!have_dim || dims[0] != dims[1] || dims[1] != dims[2]) return HFVIS_ERR_FORMAT;
+    if (dims[0] > (unsigned long)INT_MAX) return HFVIS_ERR_LIMIT;
+    D = (size_t)dims[0];
+    if (!vx_mul_size(D, D, &DD) || !vx_mul_size(DD, D, &total) || total > HFVIS_VOLUME_MAX_VOXELS)
+        return HFVIS_ERR_LIMIT;
+    for (a = 0; a < 3; a++) {
+        g.dims[a] = (int)D;
+        g.origin[a] = translate[a];
+        g.cell[a] = scale / (double)D;
+    }
+    if (!vx_grid_valid(&g)) return HFVIS_ERR_FORMAT; /* e.g. a scale that underflows */
+    /* validate the runs before allocating: pairs, values, counts, exact total, no trailing byte */
+    if ((size - i) % 2 != 0) return HFVIS_ERR_FORMAT;
+    for (j = i; j < size; j += 2) {
+        if ((version == 1 && p[j] > 1) || p[j + 1] == 0 || got >= total) return HFVIS_ERR_FORMAT;
+        got += p[j + 1];
+        if (got > total) return HFVIS_ERR_FORMAT;
+    }
+    if (got != total) return HFVIS_ERR_FORMAT;
+    o = (uint8_t *)vx_alloc(alloc, total);
+    if (!o) return HFVIS_ERR_OUT_OF_MEMORY;
+    {
+        size_t x = 0, y = 0, z = 0; /* binvox order: y fastest, then z, then x */
+        for (j = i; j < size; j += 2) {
+            unsigned c = p[j + 1];
+            while (c--) {
+                o[(z * D + y) * D + x] = p[j];
+                if (++y == D) {
+                    y = 0;
+                    if (++z == D) {
+                        z = 0;
+                        x++;
+                    }
+                }
+            }
+        }
+    }
+    *grid = g;
+    *occ = o;
+    return HFVIS_OK;
+}
+
+#ifndef HFVIS_NO_STDIO
+HFVIS_API hfvis_status hfvis_binvox_save(const char *path, const hfvis_volume_grid *grid,
+                                         const uint8_t *occ)
+{
+    size_t need, written = 0;
+    unsigned char *buf;
+    hfvis_status s;
+    if (!path || !occ || !vx_grid_valid(grid)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (vx_cons_binvox_side(grid) == 0) return HFVIS_ERR_LIMIT;
+    need = hfvis_binvox_encode_size(grid, occ);
+    buf = (unsigned char *)vx_alloc(NULL, need);
+    if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
+    s = hfvis_binvox_encode(grid, occ, buf, need, &written);
+    if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
+    vx_free(NULL, buf);
+    return s;
+}
+
+HFVIS_API hfvis_status hfvis_binvox_load(const char *path, const hfvis_allocator *alloc,
+                                         hfvis_volume_grid *grid, uint8_t **occ)
+{
+    unsigned char *data = NULL;
+    size_t size = 0;
+    hfvis_status s;
+    if (!path || !grid || !occ) return HFVIS_ERR_INVALID_ARGUMENT;
+    s = hfvis__read_file(path, alloc, &data, &size);
+    if (s != HFVIS_OK) return s;
+    s = hfvis_binvox_decode(data, size, alloc, grid, occ);
+    vx_free(alloc, data);
+    return s;
+}
+
+HFVIS_API hfvis_status hfvis_voxels_raw_save(const char *path, const hfvis_volume_grid *grid,
+                                             const uint8_t *voxels)
+{
+    if (!path || !voxels || !vx_grid_valid(grid)) return HFVIS_ERR_INVALID_ARGUMENT;
+    return hfvis__write_file(path, voxels, vx_grid_voxels(grid));
+}
+#endif /* HFVIS_NO_STDIO */

@@ -393,15 +393,39 @@ static void hf_ns_axis(double u, int n, int wrap, int *i0, int *i1, double *f)
     *f = u - fl;
 }
 
+/* Clamped bilinear tap of coordinate u on n texels (OPEN, CLAMP): (int) truncation is floor for
+ * u > 0, and u beyond the last texel gives weight 1 on it. */
+static inline void hf_ns_axis_clamped(double u, int n, int *i0, double *f)
+{
+    int i;
+    if (n == 1 || u <= 0.0) {
+        *i0 = 0;
+        *f = 0.0;
+        return;
+    }
+    i = (int)u;
+    if (i > n - 2) i = n - 2;
+    *i0 = i;
+    *f = u - (double)i;
+    if (*f > 1.0) *f = 1.0;
+}
+
 /* One channel (heights): bilinear at grid position (x, y); a tap with zero weight is never read
  * (as hf_bilerp), so a hole beside an exact sample position does not leak in. NaN = hole. */
-static double hf_ns_sample1(const hf_ns_level *L, int wrap, double x, double y)
+static inline double hf_ns_sample1(const hf_ns_level *L, int wrap, double x, double y)
 {
     int x0, x1, y0, y1;
-    double fx, fy, r0 = 0.0, r1 = 0.0;
+    double fx, fy, r0 = 0.0, r1;
     const float *p0, *p1;
-    hf_ns_axis(x * L->a + L->b, L->w, wrap, &x0, &x1, &fx);
-    hf_ns_axis(y * L->a + L->b, L->h, wrap, &y0, &y1, &fy);
+    if (wrap) {
+        hf_ns_axis(x * L->a + L->b, L->w, 1, &x0, &x1, &fx);
+        hf_ns_axis(y * L->a + L->b, L->h, 1, &y0, &y1, &fy);
+    } else {
+        hf_ns_axis_clamped(x * L->a + L->b, L->w, &x0, &fx);
+        hf_ns_axis_clamped(y * L->a + L->b, L->h, &y0, &fy);
+        x1 = L->w > 1 ? x0 + 1 : x0;
+        y1 = L->h > 1 ? y0 + 1 : y0;
+    }
     p0 = L->img + (size_t)y0 * (size_t)L->w;
     p1 = L->img + (size_t)y1 * (size_t)L->w;
     if (fy != 1.0) {
@@ -421,8 +445,15 @@ static int hf_ns_sampleC(const hf_ns_level *L, int C, int wrap, double x, double
     int x0, x1, y0, y1, c, q;
     double fx, fy, wt[4];
     const float *tp[4];
-    hf_ns_axis(x * L->a + L->b, L->w, wrap, &x0, &x1, &fx);
-    hf_ns_axis(y * L->a + L->b, L->h, wrap, &y0, &y1, &fy);
+    if (wrap) {
+        hf_ns_axis(x * L->a + L->b, L->w, 1, &x0, &x1, &fx);
+        hf_ns_axis(y * L->a + L->b, L->h, 1, &y0, &y1, &fy);
+    } else {
+        hf_ns_axis_clamped(x * L->a + L->b, L->w, &x0, &fx);
+        hf_ns_axis_clamped(y * L->a + L->b, L->h, &y0, &fy);
+        x1 = L->w > 1 ? x0 + 1 : x0;
+        y1 = L->h > 1 ? y0 + 1 : y0;
+    }
     wt[0] = (1.0 - fx) * (1.0 - fy);
     wt[1] = fx * (1.0 - fy);
     wt[2] = (1.0 - fx) * fy;
@@ -849,12 +880,15 @@ static int hf_ns_place(const hf_ns_ctx *c, double *x, double *y)
 static int hf_ns_scan(const hf_ns_ctx *c, const hf_ns_recv *r, double cph, double sph, double t_seed,
                       double *tv, hf_ns_cast *cast, int *ncast)
 {
+    const double W1 = (double)(c->W - 1), H1 = (double)(c->H - 1);
     double run = t_seed;
     int i, nv = 0, K = 0;
     for (i = 0; i < c->n; i++) {
         const int l = c->lv_i[i];
         double x = r->x + c->tau[i] * cph, y = r->y + c->tau[i] * sph, hp = r->hl[l], hq, t;
-        if (!hf_ns_place(c, &x, &y)) break; /* OPEN: the ray has left the grid for good */
+        if (x < 0.0 || x > W1 || y < 0.0 || y > H1) {
+            if (!hf_ns_place(c, &x, &y)) break; /* OPEN: the ray has left the grid for good */
+        }
         if (isnan(hp)) continue;
         hq = hf_ns_sample1(&c->hp[l], c->wrap, x, y);
         if (isnan(hq)) continue; /* a hole never occludes and never casts */

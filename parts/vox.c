@@ -86,25 +86,37 @@ typedef struct vx_vox_pass {
     double U[3], W[3], Z[3]; /* projected vertices (original order) and depths */
     double area2;            /* n[a]: twice the signed projected area */
     vx_vox_edge e[3];        /* counter-clockwise edges */
+    int edir[3];             /* sign of d(edge function)/du: +1 inside on a row suffix, -1 prefix */
     double q[3][3];          /* counter-clockwise vertices (U, W, Z) */
     double dzdu, dzdw;       /* depth slopes of the plane */
     double dudz;             /* 1/dzdu (0 if dzdu == 0), only for search estimates */
     double zlo, zhi;         /* depth range */
-    double kmin;             /* floor(zlo): the slab the geometry shader starts from */
     int bu0, bu1, bw0, bw1;  /* pixel bounding box of the triangle within the grid */
     int k0, k1;              /* slabs floor(zlo) .. floor(zhi) within the grid (and the cap) */
 } vx_vox_pass;
 
-/* Pixel range [*i0, *i1] whose centres i + 0.5 lie in [lo, hi], within [0, n); 0 if empty. */
+/* floor / ceil of x as int, for |x| < 2^31 (callers clamp first; libm's floor is a call on
+ * baseline x86-64). */
+static int vx_vox_ifloor(double x)
+{
+    int i = (int)x;
+    return (double)i > x ? i - 1 : i;
+}
+static int vx_vox_iceil(double x)
+{
+    int i = (int)x;
+    return (double)i < x ? i + 1 : i;
+}
+
+/* Pixel range [*i0, *i1] whose centres i + 0.5 lie in [lo, hi], within [0, n); 0 if empty:
+ * i0 = max(0, ceil(lo - 0.5)), i1 = min(n - 1, floor(hi - 0.5)). */
 static int vx_vox_pixel_range(double lo, double hi, int n, int *i0, int *i1)
 {
-    double a = ceil(lo - 0.5), b = floor(hi - 0.5);
-    if (a < 0.0) a = 0.0;
-    if (b > (double)(n - 1)) b = (double)(n - 1);
-    if (!(a <= b)) return 0;
-    *i0 = (int)a;
-    *i1 = (int)b;
-    return 1;
+    double a = lo - 0.5, b = hi - 0.5;
+    if (!(b >= 0.0) || !(a <= (double)(n - 1))) return 0;
+    *i0 = a <= 0.0 ? 0 : vx_vox_iceil(a);
+    *i1 = b >= (double)(n - 1) ? n - 1 : vx_vox_ifloor(b);
+    return *i0 <= *i1;
 }
 
 /* Grid-space setup of triangle t; 0 if it is degenerate or out of range (skipped). */
@@ -116,12 +128,14 @@ static int vx_vox_tri_setup(vx_vox_tri *T, const hfvis_mesh *m, const hfvis_volu
     T->id = (uint32_t)t;
     for (i = 0; i < 3; i++) {
         const float *p = m->xyz + 3 * (size_t)m->indices[3 * t + (size_t)i];
-        for (a = 0; a < 3; a++) {
-            T->v[i][a] = (double)p[a];
-            T->g[i][a] = ((double)p[a] - g->origin[a]) / g->cell[a];
-            if (!(fabs(T->g[i][a]) <= VX_VOX_MAX_COORD)) return 0;
-        }
+        for (a = 0; a < 3; a++) T->g[i][a] = ((double)p[a] - g->origin[a]) / g->cell[a];
+        if (want_normal)
+            for (a = 0; a < 3; a++) T->v[i][a] = (double)p[a];
     }
+    for (i = 0; i < 3; i++)
+        if (!(fabs(T->g[i][0]) <= VX_VOX_MAX_COORD && fabs(T->g[i][1]) <= VX_VOX_MAX_COORD
+              && fabs(T->g[i][2]) <= VX_VOX_MAX_COORD))
+            return 0;
     for (a = 0; a < 3; a++) {
         e1[a] = T->g[1][a] - T->g[0][a];
         e2[a] = T->g[2][a] - T->g[0][a];
@@ -160,7 +174,7 @@ static int vx_vox_pass_setup(vx_vox_pass *p, const vx_vox_tri *T, int a, const i
                              int max_slices)
 {
     int i, swap;
-    double ulo, uhi, wlo, whi, k0, k1;
+    double ulo, uhi, wlo, whi;
     p->a = a;
     p->u = (a + 1) % 3;
     p->w = (a + 2) % 3;
@@ -171,32 +185,34 @@ static int vx_vox_pass_setup(vx_vox_pass *p, const vx_vox_tri *T, int a, const i
         p->W[i] = T->g[i][p->w];
         p->Z[i] = T->g[i][a];
     }
-    p->dzdu = -T->n[p->u] / T->n[a];
-    p->dzdw = -T->n[p->w] / T->n[a];
-    if (!(fabs(p->dzdu) <= VX_VOX_MAX_SLOPE) || !(fabs(p->dzdw) <= VX_VOX_MAX_SLOPE)) return 0;
-    p->dudz = p->dzdu != 0.0 ? 1.0 / p->dzdu : 0.0;
-    p->zlo = p->Z[0], p->zhi = p->Z[0];
+    /* cheap rejections first: most triangles of a dense mesh cover no pixel centre */
     ulo = uhi = p->U[0];
     wlo = whi = p->W[0];
+    p->zlo = p->zhi = p->Z[0];
     for (i = 1; i < 3; i++) {
-        if (p->Z[i] < p->zlo) p->zlo = p->Z[i];
-        if (p->Z[i] > p->zhi) p->zhi = p->Z[i];
         if (p->U[i] < ulo) ulo = p->U[i];
         if (p->U[i] > uhi) uhi = p->U[i];
         if (p->W[i] < wlo) wlo = p->W[i];
         if (p->W[i] > whi) whi = p->W[i];
+        if (p->Z[i] < p->zlo) p->zlo = p->Z[i];
+        if (p->Z[i] > p->zhi) p->zhi = p->Z[i];
     }
-    p->kmin = floor(p->zlo);
-    k0 = p->kmin;
-    k1 = floor(p->zhi);
-    if (max_slices > 0 && k1 > p->kmin + (double)(max_slices - 1)) k1 = p->kmin + (double)(max_slices - 1);
-    if (k0 < 0.0) k0 = 0.0;
-    if (k1 > (double)(dims[a] - 1)) k1 = (double)(dims[a] - 1);
-    if (!(k0 <= k1)) return 0;
-    p->k0 = (int)k0;
-    p->k1 = (int)k1;
     if (!vx_vox_pixel_range(ulo, uhi, dims[p->u], &p->bu0, &p->bu1)) return 0;
     if (!vx_vox_pixel_range(wlo, whi, dims[p->w], &p->bw0, &p->bw1)) return 0;
+    /* slabs floor(zlo) .. floor(zhi) within [0, dims[a]); with a cap at most max_slices from
+     * floor(zlo), the geometry shader's first slab even when it lies outside the grid */
+    if (!(p->zhi >= 0.0) || !(p->zlo < (double)dims[a])) return 0;
+    p->k0 = p->zlo <= 0.0 ? 0 : vx_vox_ifloor(p->zlo);
+    p->k1 = p->zhi >= (double)(dims[a] - 1) ? dims[a] - 1 : vx_vox_ifloor(p->zhi);
+    if (max_slices > 0) {
+        double kmin = floor(p->zlo), k1 = kmin + (double)(max_slices - 1);
+        if (k1 < (double)p->k1) p->k1 = k1 < 0.0 ? -1 : (int)k1;
+        if (p->k0 > p->k1) return 0;
+    }
+    p->dzdu = -T->n[p->u] / T->n[a];
+    p->dzdw = -T->n[p->w] / T->n[a];
+    if (!(fabs(p->dzdu) <= VX_VOX_MAX_SLOPE) || !(fabs(p->dzdw) <= VX_VOX_MAX_SLOPE)) return 0;
+    p->dudz = p->dzdu != 0.0 ? 1.0 / p->dzdu : 0.0;
     /* counter-clockwise order in the (u, w) plane */
     swap = p->area2 < 0.0;
     for (i = 0; i < 3; i++) {
@@ -207,7 +223,10 @@ static int vx_vox_pass_setup(vx_vox_pass *p, const vx_vox_tri *T, int a, const i
     }
     for (i = 0; i < 3; i++) {
         int j = (i + 1) % 3;
+        double slope;
         vx_vox_edge_init(&p->e[i], p->q[i][0], p->q[i][1], p->q[j][0], p->q[j][1]);
+        slope = -p->e[i].sign * p->e[i].dw;
+        p->edir[i] = slope > 0.0 ? 1 : slope < 0.0 ? -1 : 0;
     }
     return 1;
 }
@@ -352,174 +371,239 @@ static void vx_vox_emit(vx_vox_sink *s, const vx_vox_pass *p, int pw, int u0, in
     }
 }
 
-/* ---- monotone searches along a row ------------------------------------------------------ */
+/* ---- rows: hoisted row constants and monotone boundary searches ------------------------- */
 
-/* A predicate of the pixel column pu in a fixed row, nondecreasing in pu (false...true):
- * edge != NULL: edge pass (negate: its negation); else depth(cu) >= thr (negate: < thr). */
-typedef struct vx_vox_pred {
-    const vx_vox_edge *edge;
+/* One pixel row (centre cw) of a polygon: the non-degenerate edges with the row's constant
+ * part of each edge function, K = du (cw - lw), and of the depth, zrow = Z0 + dz/dw (cw - W0).
+ * The per-pixel values below use the same operations in the same order as vx_vox_edge_value
+ * and vx_vox_depth, so they are bit-identical to the oracle's. */
+typedef struct vx_vox_row_ctx {
+    const vx_vox_edge *e[VX_VOX_PIECE_MAX];
+    double K[VX_VOX_PIECE_MAX];
+    int ne;
+    double cw, zrow;
     const vx_vox_pass *p;
-    double cw, thr;
-    int negate;
-} vx_vox_pred;
+} vx_vox_row_ctx;
 
-static int vx_vox_pred_eval(const vx_vox_pred *r, int pu)
-{
-    double cu = (double)pu + 0.5;
-    int t = r->edge ? vx_vox_edge_pass(r->edge, cu, r->cw) : vx_vox_depth(r->p, cu, r->cw) >= r->thr;
-    return r->negate ? !t : t;
-}
-
-/* Smallest pu in [lo, hi] where the nondecreasing predicate holds (hi + 1 if none), starting
- * from the estimate `guess` (a pixel coordinate; any value, NaN included, is safe). Galloping
- * from the guess, then bisection: O(1) evaluations when the guess is within a pixel. */
-static int vx_vox_first_true(const vx_vox_pred *r, int lo, int hi, double guess)
-{
-    int g, t, f, step = 1;
-    if (lo > hi) return lo;
-    if (!(guess > (double)lo)) g = lo;
-    else if (!(guess < (double)hi)) g = hi;
-    else g = (int)ceil(guess);
-    if (vx_vox_pred_eval(r, g)) { /* answer <= g */
-        t = g;
-        for (;;) {
-            if (t - lo < step) { f = lo - 1; break; }
-            f = t - step;
-            if (!vx_vox_pred_eval(r, f)) break;
-            t = f;
-            if (step < (1 << 29)) step *= 2;
-        }
-    } else { /* answer > g */
-        f = g;
-        for (;;) {
-            if (hi - f < step) { t = hi + 1; break; }
-            t = f + step;
-            if (vx_vox_pred_eval(r, t)) break;
-            f = t;
-            if (step < (1 << 29)) step *= 2;
-        }
-    }
-    while (t - f > 1) {
-        int mid = f + (t - f) / 2;
-        if (vx_vox_pred_eval(r, mid)) t = mid;
-        else f = mid;
-    }
-    return t;
-}
-
-/* The pixels [*L, *R] of row cw within [lo, hi] inside every edge; 0 if none. */
-static int vx_vox_row_span(const vx_vox_edge *e, int ne, double cw, int lo, int hi, int *L, int *R)
+static void vx_vox_row_init(vx_vox_row_ctx *r, const vx_vox_edge *e, int ne, const vx_vox_pass *p,
+                            double cw)
 {
     int i;
-    vx_vox_pred r;
-    r.p = NULL;
-    r.cw = cw;
-    r.thr = 0.0;
-    for (i = 0; i < ne && lo <= hi; i++) {
-        const vx_vox_edge *ed = &e[i];
-        double slope, guess;
-        if (ed->skip) continue;
-        slope = -ed->sign * ed->dw; /* dE/dcu */
-        if (slope == 0.0) {         /* constant along the row */
-            if (!vx_vox_edge_pass(ed, (double)lo + 0.5, cw)) return 0;
+    r->ne = 0;
+    for (i = 0; i < ne; i++)
+        if (!e[i].skip) {
+            r->e[r->ne] = &e[i];
+            r->K[r->ne++] = e[i].du * (cw - e[i].lw);
+        }
+    r->cw = cw;
+    r->p = p;
+    r->zrow = p->Z[0] + p->dzdw * (cw - p->W[0]);
+}
+
+static int vx_vox_row_edge_pass(const vx_vox_edge *e, double K, double cu)
+{
+    double v = e->sign * (K - e->dw * (cu - e->lu));
+    return v > 0.0 || (v == 0.0 && e->owned);
+}
+
+static int vx_vox_row_inside(const vx_vox_row_ctx *r, double cu)
+{
+    int i;
+    for (i = 0; i < r->ne; i++)
+        if (!vx_vox_row_edge_pass(r->e[i], r->K[i], cu)) return 0;
+    return 1;
+}
+
+static double vx_vox_row_depth(const vx_vox_row_ctx *r, double cu)
+{
+    const vx_vox_pass *p = r->p;
+    double z = r->zrow + p->dzdu * (cu - p->U[0]);
+    if (z < p->zlo) z = p->zlo;
+    if (z > p->zhi) z = p->zhi;
+    return z;
+}
+
+/* Galloping search body: the first x in [lo, hi] where PRED(x) holds, PRED nondecreasing in x
+ * (false ... true), hi + 1 if none, starting from the estimate `guess` (a pixel coordinate; any
+ * value, NaN included, is safe). O(1) evaluations when the estimate is within a pixel, O(log)
+ * otherwise. */
+#define VX_VOX_GALLOP(PRED)                                                                    \
+    int g, t, f, step = 1;                                                                     \
+    if (lo > hi) return lo;                                                                    \
+    if (!(guess > (double)lo)) g = lo;                                                         \
+    else if (!(guess < (double)hi)) g = hi;                                                    \
+    else g = vx_vox_iceil(guess);                                                              \
+    if (PRED(g)) {                                                                             \
+        for (t = g;;) {                                                                        \
+            if (t - lo < step) { f = lo - 1; break; }                                          \
+            f = t - step;                                                                      \
+            if (!PRED(f)) break;                                                               \
+            t = f;                                                                             \
+            if (step < (1 << 29)) step *= 2;                                                   \
+        }                                                                                      \
+    } else {                                                                                   \
+        for (f = g;;) {                                                                        \
+            if (hi - f < step) { t = hi + 1; break; }                                          \
+            t = f + step;                                                                      \
+            if (PRED(t)) break;                                                                \
+            f = t;                                                                             \
+            if (step < (1 << 29)) step *= 2;                                                   \
+        }                                                                                      \
+    }                                                                                          \
+    while (t - f > 1) {                                                                        \
+        int mid = f + (t - f) / 2;                                                             \
+        if (PRED(mid)) t = mid;                                                                \
+        else f = mid;                                                                          \
+    }                                                                                          \
+    return t
+
+/* First pixel in [lo, hi] where the edge test equals `want` (monotone that way). */
+static int vx_vox_edge_first(const vx_vox_edge *e, double K, int want, int lo, int hi, double guess)
+{
+#define VX_VOX_PRED_EDGE(x) (vx_vox_row_edge_pass(e, K, (double)(x) + 0.5) == want)
+    VX_VOX_GALLOP(VX_VOX_PRED_EDGE);
+#undef VX_VOX_PRED_EDGE
+}
+
+/* First pixel in [lo, hi] where (depth >= thr) equals `want` (monotone that way). */
+static int vx_vox_depth_first(const vx_vox_row_ctx *r, double thr, int want, int lo, int hi,
+                              double guess)
+{
+#define VX_VOX_PRED_DEPTH(x) ((vx_vox_row_depth(r, (double)(x) + 0.5) >= thr) == want)
+    VX_VOX_GALLOP(VX_VOX_PRED_DEPTH);
+#undef VX_VOX_PRED_DEPTH
+}
+
+/* The pixels [*L, *R] of the row within [lo, hi] inside every edge; 0 if none. Each edge
+ * function is monotone along the row, so each edge bounds the span on one side. */
+static int vx_vox_row_span(const vx_vox_row_ctx *r, int lo, int hi, int *L, int *R)
+{
+    int i;
+    for (i = 0; i < r->ne && lo <= hi; i++) {
+        const vx_vox_edge *e = r->e[i];
+        double slope = -e->sign * e->dw; /* dE/dcu */
+        if (slope == 0.0) {              /* constant along the row */
+            if (!vx_vox_row_edge_pass(e, r->K[i], (double)lo + 0.5)) return 0;
             continue;
         }
-        guess = ed->lu + ed->root_du * (cw - ed->lw) - 0.5; /* the root, as a pixel index */
-        r.edge = ed;
-        if (slope > 0.0) { /* inside on a suffix */
-            r.negate = 0;
-            lo = vx_vox_first_true(&r, lo, hi, guess);
-        } else {           /* inside on a prefix */
-            r.negate = 1;
-            hi = vx_vox_first_true(&r, lo, hi, guess) - 1;
-        }
+        /* estimate: the root u = lu + (du/dw)(cw - lw), as a pixel index */
+        if (slope > 0.0) /* inside on a suffix */
+            lo = vx_vox_edge_first(e, r->K[i], 1, lo, hi, e->lu + e->root_du * (r->cw - e->lw) - 0.5);
+        else             /* inside on a prefix */
+            hi = vx_vox_edge_first(e, r->K[i], 0, lo, hi, e->lu + e->root_du * (r->cw - e->lw) - 0.5) - 1;
     }
     *L = lo;
     *R = hi;
     return lo <= hi;
 }
 
-/* Pixel estimate where depth reaches thr along row cw. */
-static double vx_vox_depth_guess(const vx_vox_pass *p, double cw, double thr)
+/* Pixel estimate where the depth reaches thr along the row. */
+static double vx_vox_depth_guess(const vx_vox_row_ctx *r, double thr)
 {
-    double row = p->Z[0] + p->dzdw * (cw - p->W[0]);
-    return p->U[0] + (thr - row) * p->dudz - 0.5;
+    return r->p->U[0] + (thr - r->zrow) * r->p->dudz - 0.5;
 }
 
 /* Write the pixels L..R of row pw (all inside the triangle) whose slab lies in [s0, s1], each
- * into its slab: the runs of constant slab are found by searching the slab boundaries. */
-static void vx_vox_row_slabs(vx_vox_sink *s, const vx_vox_pass *p, int pw, int L, int R, int s0,
+ * into its slab: the runs of constant slab are delimited by searching the slab boundaries. */
+static void vx_vox_row_slabs(vx_vox_sink *s, const vx_vox_row_ctx *r, int pw, int L, int R, int s0,
                              int s1)
 {
-    double cw = (double)pw + 0.5;
-    vx_vox_pred r;
+    const vx_vox_pass *p = r->p;
+    double lo_thr = (double)s0, hi_thr = (double)s1 + 1.0;
     int cur;
-    r.edge = NULL;
-    r.p = p;
-    r.cw = cw;
     if (p->dzdu == 0.0) { /* depth constant along the row */
-        double k = floor(vx_vox_depth(p, (double)L + 0.5, cw));
-        if (k >= (double)s0 && k <= (double)s1) vx_vox_emit(s, p, pw, L, R, (int)k);
+        double z = vx_vox_row_depth(r, (double)L + 0.5);
+        if (z >= lo_thr && z < hi_thr) vx_vox_emit(s, p, pw, L, R, vx_vox_ifloor(z));
         return;
     }
     if (p->dzdu > 0.0) { /* slab nondecreasing along the row */
-        r.negate = 0;
-        r.thr = (double)s0;
-        L = vx_vox_first_true(&r, L, R, vx_vox_depth_guess(p, cw, r.thr));
-        r.thr = (double)s1 + 1.0;
-        R = vx_vox_first_true(&r, L, R, vx_vox_depth_guess(p, cw, r.thr)) - 1;
+        /* restrict to [s0, s1] only where the row's ends leave it (grid border, cap, slab) */
+        if (!(vx_vox_row_depth(r, (double)L + 0.5) >= lo_thr))
+            L = vx_vox_depth_first(r, lo_thr, 1, L, R, vx_vox_depth_guess(r, lo_thr));
+        if (L <= R && !(vx_vox_row_depth(r, (double)R + 0.5) < hi_thr))
+            R = vx_vox_depth_first(r, hi_thr, 1, L, R, vx_vox_depth_guess(r, hi_thr)) - 1;
         for (cur = L; cur <= R;) {
-            double k = floor(vx_vox_depth(p, (double)cur + 0.5, cw));
-            int nxt;
-            r.thr = k + 1.0;
-            nxt = vx_vox_first_true(&r, cur + 1, R, vx_vox_depth_guess(p, cw, r.thr));
-            vx_vox_emit(s, p, pw, cur, nxt - 1, (int)k);
+            int k = vx_vox_ifloor(vx_vox_row_depth(r, (double)cur + 0.5)), nxt;
+            double thr = (double)k + 1.0;
+            if (!(vx_vox_row_depth(r, (double)R + 0.5) >= thr)) nxt = R + 1; /* one run to R */
+            else nxt = vx_vox_depth_first(r, thr, 1, cur + 1, R, vx_vox_depth_guess(r, thr));
+            vx_vox_emit(s, p, pw, cur, nxt - 1, k);
             cur = nxt;
         }
     } else { /* slab nonincreasing along the row */
-        r.negate = 1;
-        r.thr = (double)s1 + 1.0;
-        L = vx_vox_first_true(&r, L, R, vx_vox_depth_guess(p, cw, r.thr));
-        r.thr = (double)s0;
-        R = vx_vox_first_true(&r, L, R, vx_vox_depth_guess(p, cw, r.thr)) - 1;
+        if (!(vx_vox_row_depth(r, (double)L + 0.5) < hi_thr))
+            L = vx_vox_depth_first(r, hi_thr, 0, L, R, vx_vox_depth_guess(r, hi_thr));
+        if (L <= R && !(vx_vox_row_depth(r, (double)R + 0.5) >= lo_thr))
+            R = vx_vox_depth_first(r, lo_thr, 0, L, R, vx_vox_depth_guess(r, lo_thr)) - 1;
         for (cur = L; cur <= R;) {
-            double k = floor(vx_vox_depth(p, (double)cur + 0.5, cw));
-            int nxt;
-            r.thr = k; /* first pixel with depth < k */
-            nxt = vx_vox_first_true(&r, cur + 1, R, vx_vox_depth_guess(p, cw, r.thr));
-            vx_vox_emit(s, p, pw, cur, nxt - 1, (int)k);
+            int k = vx_vox_ifloor(vx_vox_row_depth(r, (double)cur + 0.5)), nxt;
+            double thr = (double)k; /* first pixel with depth < k */
+            if (vx_vox_row_depth(r, (double)R + 0.5) >= thr) nxt = R + 1; /* one run to R */
+            else nxt = vx_vox_depth_first(r, thr, 0, cur + 1, R, vx_vox_depth_guess(r, thr));
+            vx_vox_emit(s, p, pw, cur, nxt - 1, k);
             cur = nxt;
         }
     }
 }
 
-/* ---- the three methods, fast (row spans) ------------------------------------------------- */
+/* ---- the three methods, fast ------------------------------------------------------------- */
 
-/* Rows at most this many pixels wide are tested pixel by pixel with the oracle's predicate:
- * cheaper than the boundary search for the small triangles of dense meshes, and identical. */
-#define VX_VOX_DIRECT_WIDTH 6
+/* Rows at most this many pixels wide are tested pixel by pixel (with the same predicate):
+ * cheaper than the boundary search for the small triangles of dense meshes. */
+#define VX_VOX_DIRECT_WIDTH 4
 
-/* Row pw, pixels lo..hi, tested one by one: inside the triangle and slab in [s0, s1]. */
-static void vx_vox_row_direct(vx_vox_sink *s, const vx_vox_pass *p, int pw, int lo, int hi, int s0,
-                              int s1)
+/* The first pixel of [lo, hi] where an edge monotone along the row passes (inc != 0: it passes
+ * on a suffix) or fails (inc == 0: it passes on a prefix), hi + 1 if none; `est` is the root
+ * estimate. Most rows are settled by two evaluations at the estimate; otherwise gallop. */
+static int vx_vox_edge_threshold(const vx_vox_edge *e, double K, int inc, int lo, int hi, double est)
 {
-    double cw = (double)pw + 0.5;
-    int pu;
-    for (pu = lo; pu <= hi; pu++) {
-        double cu = (double)pu + 0.5, k;
-        if (!vx_vox_inside(p->e, 3, cu, cw)) continue;
-        k = floor(vx_vox_depth(p, cu, cw));
-        if (k >= (double)s0 && k <= (double)s1) vx_vox_emit(s, p, pw, pu, pu, (int)k);
-    }
+    int g;
+    if (!(est > (double)lo)) g = lo;
+    else if (!(est < (double)hi)) g = hi;
+    else g = vx_vox_iceil(est);
+    if ((vx_vox_row_edge_pass(e, K, (double)g + 0.5) == inc)
+        && (g == lo || (vx_vox_row_edge_pass(e, K, (double)g - 0.5) != inc)))
+        return g;
+    return vx_vox_edge_first(e, K, inc, lo, hi, est);
 }
 
-/* The pixels of row pw in slabs [s0, s1]. */
+/* The pixels of row pw of the pass's triangle whose slab lies in [s0, s1]. */
 static void vx_vox_row(vx_vox_sink *s, const vx_vox_pass *p, int pw, int s0, int s1)
 {
-    int L, R;
-    if (p->bu1 - p->bu0 < VX_VOX_DIRECT_WIDTH) vx_vox_row_direct(s, p, pw, p->bu0, p->bu1, s0, s1);
-    else if (vx_vox_row_span(p->e, 3, (double)pw + 0.5, p->bu0, p->bu1, &L, &R))
-        vx_vox_row_slabs(s, p, pw, L, R, s0, s1);
+    vx_vox_row_ctx r;
+    int i, L = p->bu0, R = p->bu1;
+    r.cw = (double)pw + 0.5;
+    r.p = p;
+    r.ne = 3;
+    for (i = 0; i < 3; i++) {
+        r.e[i] = &p->e[i];
+        r.K[i] = p->e[i].du * (r.cw - p->e[i].lw);
+    }
+    r.zrow = p->Z[0] + p->dzdw * (r.cw - p->W[0]);
+    if (R - L < VX_VOX_DIRECT_WIDTH) { /* narrow: test each pixel */
+        int pu;
+        for (pu = L; pu <= R; pu++) {
+            double cu = (double)pu + 0.5, z;
+            if (!vx_vox_row_edge_pass(&p->e[0], r.K[0], cu) || !vx_vox_row_edge_pass(&p->e[1], r.K[1], cu)
+                || !vx_vox_row_edge_pass(&p->e[2], r.K[2], cu))
+                continue;
+            z = vx_vox_row_depth(&r, cu); /* slab floor(z) in [s0, s1] */
+            if (z >= (double)s0 && z < (double)s1 + 1.0) vx_vox_emit(s, p, pw, pu, pu, vx_vox_ifloor(z));
+        }
+        return;
+    }
+    for (i = 0; i < 3 && L <= R; i++) { /* a triangle's edges are never degenerate */
+        const vx_vox_edge *e = &p->e[i];
+        double est;
+        if (p->edir[i] == 0) { /* constant along the row */
+            if (!vx_vox_row_edge_pass(e, r.K[i], (double)L + 0.5)) return;
+            continue;
+        }
+        est = e->lu + e->root_du * (r.cw - e->lw) - 0.5; /* root, as a pixel index */
+        if (p->edir[i] > 0) L = vx_vox_edge_threshold(e, r.K[i], 1, L, R, est);
+        else R = vx_vox_edge_threshold(e, r.K[i], 0, L, R, est) - 1;
+    }
+    if (L <= R) vx_vox_row_slabs(s, &r, pw, L, R, s0, s1);
 }
 
 /* Pixel rule (spec §3.4): every covered pixel of the pass into the slab of its depth. */
@@ -543,20 +627,20 @@ static void vx_vox_fast_fragment_clipping(vx_vox_sink *s, const vx_vox_pass *p)
 static void vx_vox_fast_gs_slicing(vx_vox_sink *s, const vx_vox_pass *p, const int dims[3])
 {
     vx_vox_edge pe[VX_VOX_PIECE_MAX];
+    vx_vox_row_ctx r;
     double bb[4];
-    int k, n, pw, u0, u1, w0, w1, L, R;
+    int k, n, pw, pu, u0, u1, w0, w1, L, R;
     for (k = p->k0; k <= p->k1; k++) {
         n = vx_vox_piece(p, (double)k, pe, bb);
         if (n == 0 || !vx_vox_pixel_range(bb[0], bb[1], dims[p->u], &u0, &u1)
             || !vx_vox_pixel_range(bb[2], bb[3], dims[p->w], &w0, &w1))
             continue;
         for (pw = w0; pw <= w1; pw++) {
+            vx_vox_row_init(&r, pe, n, p, (double)pw + 0.5);
             if (u1 - u0 < VX_VOX_DIRECT_WIDTH) {
-                int pu;
                 for (pu = u0; pu <= u1; pu++)
-                    if (vx_vox_inside(pe, n, (double)pu + 0.5, (double)pw + 0.5))
-                        vx_vox_emit(s, p, pw, pu, pu, k);
-            } else if (vx_vox_row_span(pe, n, (double)pw + 0.5, u0, u1, &L, &R))
+                    if (vx_vox_row_inside(&r, (double)pu + 0.5)) vx_vox_emit(s, p, pw, pu, pu, k);
+            } else if (vx_vox_row_span(&r, u0, u1, &L, &R))
                 vx_vox_emit(s, p, pw, L, R, k);
         }
     }
