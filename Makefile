@@ -41,7 +41,7 @@ LDLIBS := -lm
 LIBSRC := hfvis.c ssao.c voxel.c
 LIBOBJ := $(LIBSRC:%.c=$(BUILD)/obj/%.o)
 LIB := $(BUILD)/libhfvis.a
-EXAMPLES := $(patsubst examples/%.c,$(BUILD)/examples/%,$(filter-out examples/hfvis_cli.c examples/bench.c examples/common.c,$(wildcard examples/*.c)))
+EXAMPLES := $(patsubst examples/%.c,$(BUILD)/examples/%,$(filter-out examples/hfvis_cli.c examples/bench%.c examples/common.c,$(wildcard examples/*.c)))
 CLI := $(BUILD)/hfvis
 BENCH := $(BUILD)/bench
 TESTS := $(patsubst test/%.c,$(BUILD)/test/%,$(wildcard test/test_*.c))
@@ -64,9 +64,9 @@ $(BUILD)/examples/%: examples/%.c examples/common.h $(LIB)
 $(CLI): examples/hfvis_cli.c examples/common.h $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -I. $< $(LIB) $(LDLIBS) -o $@
-$(BENCH): examples/bench.c examples/common.h $(LIB)
+$(BENCH): examples/bench.c $(wildcard examples/bench_*.c) examples/bench.h examples/common.h $(LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(ALL_CFLAGS) -I. $< $(LIB) $(LDLIBS) -o $@
+	$(CC) $(ALL_CFLAGS) -I. examples/bench.c $(wildcard examples/bench_*.c) $(LIB) $(LDLIBS) -o $@
 $(BUILD)/test/%: test/%.c test/test.h $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -I. $< $(LIB) $(LDLIBS) -o $@
@@ -77,7 +77,7 @@ test check:
 	@$(MAKE) --no-print-directory config=test werror=1 run-tests
 sanitize:
 	@$(MAKE) --no-print-directory config=sanitize werror=1 run-tests
-run-tests: $(TESTS) $(EXAMPLES) $(CLI)
+run-tests: $(TESTS) $(EXAMPLES) $(CLI) $(BENCH)
 	@sh test/run.sh $(BUILD) "$(CXX)"
 
 symbols: $(LIB)
@@ -94,7 +94,7 @@ bench:
 demo: 
 	@$(MAKE) --no-print-directory config=release all
 	@mkdir -p out
-	@for e in $(patsubst examples/%.c,build/examples/%,$(filter-out examples/hfvis_cli.c examples/bench.c,$(wildcard examples/*.c))); do \
+	@for e in $(patsubst examples/%.c,build/examples/%,$(filter-out examples/hfvis_cli.c examples/bench%.c,$(wildcard examples/*.c))); do \
 	  echo "demo: $$e"; $$e out || exit 1; done
 	@echo "demo: gallery written to out/"; ls out
 

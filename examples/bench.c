@@ -1,6 +1,9 @@
 /* bench.c - `make bench`: each fast routine beside its oracle/baseline in one run, reporting
- * ns per receiver-direction, the ratio, and peak scratch memory. Usage: bench [quick] */
+ * ns per receiver-direction, the ratio, and peak scratch memory.
+ * Usage: bench [quick] [SECTION...]   sections: horizon p2 indirect gi mesh raster ...
+ * (BENCH_ARGS="quick raster" make bench); no section = all. */
 #define _POSIX_C_SOURCE 200809L
+#include "bench.h"
 #include "hfvis.h"
 
 #include <math.h>
@@ -358,9 +361,41 @@ static void bench_gi_viewshed(int n)
     free(z); free(d); free(l); free(g2); free(tmp);
 }
 
+/* The sections of examples/bench_*.c (bench.h). */
+static const struct { const char *name; void (*run)(int quick); } module_sections[] = {
+    {"mesh", bench_mesh}, {"raster", bench_raster}
+};
+
+static int wanted(int argc, char **argv, int first, const char *name)
+{
+    int i;
+    if (first >= argc) return 1;
+    for (i = first; i < argc; i++)
+        if (strcmp(argv[i], name) == 0) return 1;
+    return 0;
+}
+
+static void bench_horizon(int quick);
+
 int main(int argc, char **argv)
 {
-    int quick = argc > 1 && strcmp(argv[1], "quick") == 0;
+    int quick = argc > 1 && strcmp(argv[1], "quick") == 0, first = quick ? 2 : 1;
+    size_t m;
+    if (wanted(argc, argv, first, "horizon")) bench_horizon(quick);
+    if (wanted(argc, argv, first, "p2")) {
+        bench_others(quick ? 256 : 512);
+        bench_p2(quick);
+    }
+    if (wanted(argc, argv, first, "indirect")) bench_indirect(quick ? 256 : 512);
+    if (wanted(argc, argv, first, "gi")) bench_gi_viewshed(quick ? 256 : 1024);
+    for (m = 0; m < sizeof module_sections / sizeof module_sections[0]; m++)
+        if (wanted(argc, argv, first, module_sections[m].name)) module_sections[m].run(quick);
+    return 0;
+}
+
+/* P1: horizon map and fused sky beside the ray-march oracle. */
+static void bench_horizon(int quick)
+{
     int sizes[2] = {512, 1024}, Ks[3] = {16, 64, 256}, si, ki, nsizes = quick ? 1 : 2;
     int nk = quick ? 1 : 3;
     printf("hfvis bench (ns per receiver-direction; oracle = per-receiver ray march, unit steps,\n"
@@ -414,9 +449,4 @@ int main(int argc, char **argv)
         free(z);
         free(light);
     }
-    bench_others(quick ? 256 : 512);
-    bench_p2(quick);
-    bench_indirect(quick ? 256 : 512);
-    bench_gi_viewshed(quick ? 256 : 1024);
-    return 0;
 }

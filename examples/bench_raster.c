@@ -1,6 +1,7 @@
 /* bench_raster.c - the reference rasterizer on the issue's benchmark mesh (100k-triangle torus
  * knot) at 1280x720, beside its ray-per-pixel oracle (timed on a crop, extrapolated per pixel). */
 #define _POSIX_C_SOURCE 199309L
+#include "bench.h"
 #include "hfvis.h"
 
 #include <stdio.h>
@@ -80,7 +81,7 @@ static double bench_raster_reference(const hfvis_mesh *m, const hfvis_view *v,
     return bench_raster_now() - t0;
 }
 
-static void bench_raster(int quick)
+void bench_raster(int quick)
 {
     const double c0[3] = {0.0, 0.0, 0.0};
     const int W = 1280, H = 720, frames = quick ? 2 : 10;
@@ -160,10 +161,4 @@ static void bench_raster(int quick)
 done:
     free(lin), free(zw), free(nrm), free(bary), free(id), free(cnt), free(rlin), free(rid);
     hfvis_mesh_free(NULL, &m);
-}
-
-int main(void)
-{
-    bench_raster(0);
-    return 0;
 }

@@ -1,6 +1,7 @@
 /* bench_mesh.c - mesh generators and the OBJ codec on the issue's 100k-triangle torus knot;
  * the codec's own number parsing/formatting beside the C library's strtof / snprintf("%.9g"). */
 #define _POSIX_C_SOURCE 199309L
+#include "bench.h"
 #include "hfvis.h"
 
 #include <stdio.h>
@@ -104,7 +105,7 @@ static double bench_mesh_printf(const hfvis_mesh *m, int reps)
     return (bench_mesh_now() - t0) / reps;
 }
 
-static void bench_mesh(int quick)
+void bench_mesh(int quick)
 {
     int reps = quick ? 1 : 5;
     hfvis_mesh m;
@@ -129,10 +130,4 @@ static void bench_mesh(int quick)
            1e3 * tdl, td / tdl, sink == 0.5 ? " " : "");
     free(buf);
     hfvis_mesh_free(NULL, &m);
-}
-
-int main(void)
-{
-    bench_mesh(0);
-    return 0;
 }

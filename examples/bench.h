@@ -1,0 +1,7 @@
+/* bench.h - the benchmark sections of `make bench` that live in examples/bench_*.c, one file per
+ * library module; examples/bench.c's main calls each (quick = the short `bench quick` run). */
+#ifndef HFVIS_BENCH_H
+#define HFVIS_BENCH_H
+void bench_mesh(int quick);
+void bench_raster(int quick);
+#endif
