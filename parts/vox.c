@@ -25,6 +25,9 @@
 
 #define VX_VOX_MAX_COORD 1e150 /* beyond: products of coordinates could overflow double */
 #define VX_VOX_MAX_SLOPE 1e100 /* beyond: the triangle is edge-on to the pass (to precision) */
+/* Rows whose candidate span is narrower than this are tested pixel by pixel (with the same
+ * predicate): cheaper than the boundary search for the small triangles of dense meshes. */
+#define VX_VOX_DIRECT_WIDTH 4
 
 /* One directed edge A -> B of a counter-clockwise polygon in the (u, w) plane. The edge function
  * is evaluated from the lexicographically smaller endpoint `l` with d = (larger - smaller) and
@@ -40,6 +43,7 @@ typedef struct vx_vox_edge {
 
 static void vx_vox_edge_init(vx_vox_edge *e, double au, double aw, double bu, double bw)
 {
+    /* (root_du is filled by vx_vox_edge_root, only for rows wide enough to be searched) */
     int a_small = au < bu || (au == bu && aw < bw);
     double su = a_small ? au : bu, sw = a_small ? aw : bw;
     double gu = a_small ? bu : au, gw = a_small ? bw : aw;
@@ -50,12 +54,18 @@ static void vx_vox_edge_init(vx_vox_edge *e, double au, double aw, double bu, do
     e->dw = gw - sw;
     e->sign = a_small ? 1.0 : -1.0;
     e->skip = au == bu && aw == bw;
-    e->root_du = e->dw != 0.0 ? e->du / e->dw : 0.0;
+    e->root_du = 0.0;
     /* traversal direction B - A (exact sign of the rounded difference) */
     tu = e->sign * e->du;
     tw = e->sign * e->dw;
     /* counter-clockwise with w up: a "left" edge goes down, a "top" edge goes left */
     e->owned = tw < 0.0 || (tw == 0.0 && tu < 0.0);
+}
+
+/* The search estimate's slope du/dw of an edge (rows searched, not tested pixel by pixel). */
+static void vx_vox_edge_root(vx_vox_edge *e)
+{
+    e->root_du = e->dw != 0.0 ? e->du / e->dw : 0.0;
 }
 
 static double vx_vox_edge_value(const vx_vox_edge *e, double cu, double cw)
@@ -190,12 +200,12 @@ static int vx_vox_pass_setup(vx_vox_pass *p, const vx_vox_tri *T, int a, const i
     wlo = whi = p->W[0];
     p->zlo = p->zhi = p->Z[0];
     for (i = 1; i < 3; i++) {
-        if (p->U[i] < ulo) ulo = p->U[i];
-        if (p->U[i] > uhi) uhi = p->U[i];
-        if (p->W[i] < wlo) wlo = p->W[i];
-        if (p->W[i] > whi) whi = p->W[i];
-        if (p->Z[i] < p->zlo) p->zlo = p->Z[i];
-        if (p->Z[i] > p->zhi) p->zhi = p->Z[i];
+        ulo = p->U[i] < ulo ? p->U[i] : ulo;
+        uhi = p->U[i] > uhi ? p->U[i] : uhi;
+        wlo = p->W[i] < wlo ? p->W[i] : wlo;
+        whi = p->W[i] > whi ? p->W[i] : whi;
+        p->zlo = p->Z[i] < p->zlo ? p->Z[i] : p->zlo;
+        p->zhi = p->Z[i] > p->zhi ? p->Z[i] : p->zhi;
     }
     if (!vx_vox_pixel_range(ulo, uhi, dims[p->u], &p->bu0, &p->bu1)) return 0;
     if (!vx_vox_pixel_range(wlo, whi, dims[p->w], &p->bw0, &p->bw1)) return 0;
@@ -212,7 +222,7 @@ static int vx_vox_pass_setup(vx_vox_pass *p, const vx_vox_tri *T, int a, const i
     p->dzdu = -T->n[p->u] / T->n[a];
     p->dzdw = -T->n[p->w] / T->n[a];
     if (!(fabs(p->dzdu) <= VX_VOX_MAX_SLOPE) || !(fabs(p->dzdw) <= VX_VOX_MAX_SLOPE)) return 0;
-    p->dudz = p->dzdu != 0.0 ? 1.0 / p->dzdu : 0.0;
+    p->dudz = 0.0;
     /* counter-clockwise order in the (u, w) plane */
     swap = p->area2 < 0.0;
     for (i = 0; i < 3; i++) {
@@ -227,6 +237,10 @@ static int vx_vox_pass_setup(vx_vox_pass *p, const vx_vox_tri *T, int a, const i
         vx_vox_edge_init(&p->e[i], p->q[i][0], p->q[i][1], p->q[j][0], p->q[j][1]);
         slope = -p->e[i].sign * p->e[i].dw;
         p->edir[i] = slope > 0.0 ? 1 : slope < 0.0 ? -1 : 0;
+    }
+    if (p->bu1 - p->bu0 >= VX_VOX_DIRECT_WIDTH) { /* rows are searched: their estimates */
+        for (i = 0; i < 3; i++) vx_vox_edge_root(&p->e[i]);
+        p->dudz = p->dzdu != 0.0 ? 1.0 / p->dzdu : 0.0;
     }
     return 1;
 }
@@ -296,10 +310,11 @@ static int vx_vox_piece(const vx_vox_pass *p, double k, vx_vox_edge *edges, doub
     for (i = 0; i < n; i++) {
         int j = (i + 1) % n;
         vx_vox_edge_init(&edges[i], pt[i][0], pt[i][1], pt[j][0], pt[j][1]);
-        if (pt[i][0] < bb[0]) bb[0] = pt[i][0];
-        if (pt[i][0] > bb[1]) bb[1] = pt[i][0];
-        if (pt[i][1] < bb[2]) bb[2] = pt[i][1];
-        if (pt[i][1] > bb[3]) bb[3] = pt[i][1];
+        vx_vox_edge_root(&edges[i]);
+        bb[0] = pt[i][0] < bb[0] ? pt[i][0] : bb[0];
+        bb[1] = pt[i][0] > bb[1] ? pt[i][0] : bb[1];
+        bb[2] = pt[i][1] < bb[2] ? pt[i][1] : bb[2];
+        bb[3] = pt[i][1] > bb[3] ? pt[i][1] : bb[3];
     }
     return n;
 }
@@ -548,9 +563,6 @@ static void vx_vox_row_slabs(vx_vox_sink *s, const vx_vox_row_ctx *r, int pw, in
 
 /* ---- the three methods, fast ------------------------------------------------------------- */
 
-/* Rows at most this many pixels wide are tested pixel by pixel (with the same predicate):
- * cheaper than the boundary search for the small triangles of dense meshes. */
-#define VX_VOX_DIRECT_WIDTH 4
 
 /* The first pixel of [lo, hi] where an edge monotone along the row passes (inc != 0: it passes
  * on a suffix) or fails (inc == 0: it passes on a prefix), hi + 1 if none; `est` is the root
