@@ -364,6 +364,17 @@ static size_t vx_cons_brick_of(const vx_cons_bricks *B, const int p[3], unsigned
            + (size_t)(p[2] >> 2) * B->bs[2];
 }
 
+/* 1 when every vertex lies in the closed cube of voxel p (a one-voxel range can also come from
+ * clipping a larger triangle at the grid's border). */
+static int vx_cons_inside_voxel(const vx_cons_tri *T, const int p[3])
+{
+    int k, a;
+    for (k = 0; k < 3; k++)
+        for (a = 0; a < 3; a++)
+            if (!(T->v[k][a] >= (double)p[a] && T->v[k][a] <= (double)p[a] + 1.0)) return 0;
+    return 1;
+}
+
 /* Voxelizes one set-up triangle whose bounding-box voxel ranges are lo..hi into the bricks;
  * returns the number of voxels newly set. The decisions are those of
  * hfvis_triangle_box_overlap on every voxel of the range, bit for bit, reached without calling
@@ -381,7 +392,7 @@ static size_t vx_cons_brick_of(const vx_cons_bricks *B, const int p[3], unsigned
  *    (skipping set voxels) until a voxel passes: every axis value is monotone along the column
  *    in floating point (each rounding is monotone), so the layers that pass the SAT form an
  *    interval and every unset voxel between the lowest and highest passing one passes.
- * A bounding box of one voxel: the triangle lies in the voxel's closed cube, every offset
+ * A triangle inside one voxel's closed cube (not merely clipped to one): every offset
  * |t| <= h, and then no axis of the SAT can separate (|fl(L.t)| <= fl(h |L|) term by term, since
  * rounding is monotone and the radii are summed in the same order), so the voxel is set. */
 static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
@@ -393,7 +404,7 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
     double t[3][3], aU, aW, K0, hwid, eps, scale;
     size_t n = 0;
     int iU, iW, k, a, p[3];
-    if (lo[0] == hi[0] && lo[1] == hi[1] && lo[2] == hi[2]) {
+    if (lo[0] == hi[0] && lo[1] == hi[1] && lo[2] == hi[2] && vx_cons_inside_voxel(T, lo)) {
         unsigned bit;
         uint64_t *w = B->w + vx_cons_brick_of(B, lo, &bit), m = (uint64_t)1 << bit;
         n = (*w & m) == 0;
