@@ -52,7 +52,9 @@ typedef enum hfvis_ray_cull {
 typedef struct hfvis_ray {
     float origin[3];
     float direction[3];   /* finite, not all zero; need not be unit length */
-    float t_min;          /* >= 0, finite; hits with t >= t_min count */
+    float t_min;          /* >= 0, finite; hits with t >= t_min count (for the open interval
+                             (0, L] of AO rays use the smallest positive float, or an offset
+                             that skips the receiver's own triangle) */
     float t_max;          /* >= t_min, may be INFINITY; hits with t <= t_max count */
     hfvis_ray_cull cull;  /* default (0) HFVIS_RAY_CULL_NONE */
 } hfvis_ray;
