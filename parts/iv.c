@@ -197,21 +197,48 @@ static int vx_iv_texel_ok(float zw)
     return zw >= 0.0f && zw <= 1.0f;
 }
 
-/* Eq. 17 for a point with eye z `ez` and clip (X, Y, W): the three zones of Fig. 70 (spec voxel
- * §4.3). Writes the texel and its z_e (eq. 16) when one is read. */
-static hfvis_iv_class vx_iv_decide(const vx_iv_img *im, double b, double ez, double X, double Y,
-                                   double W, int *opx, int *opy, double *oze)
+/* Eq. 17 against one valid texel zw, for a point of eye z ez: CLEARED if ez > z_e + b, else
+ * KEPT for a background texel (zw = 1) or ez < z_e - b, else BAND; z_e by eq. 16 (sign restored,
+ * hfvis_depth_to_eye_z) in double. The decision is that literal comparison; for perspective views
+ * it is usually reached without the division of eq. 16: with D = f - zw (f - n) > 0,
+ * ez - b - z_e = ((ez - b) D + n f) / D, so the sign of P = (ez - b) D + n f decides unless |P| is
+ * within t = 1e-12 ((|ez| + b) D + 2 n f) - about 10^4 times the rounding of both forms - and
+ * likewise Q = (ez + b) D + n f for the band; inside t the literal form is evaluated. */
+static hfvis_iv_class vx_iv_zone(const vx_iv_img *im, double b, double ez, float zw)
 {
-    double nx, ny, sx, sy, ze;
+    double ze;
+    if (!im->ortho) {
+        double D = im->f - (double)zw * (im->f - im->n), nf = im->n * im->f;
+        double P = (ez - b) * D + nf, Q = (ez + b) * D + nf;
+        double t = 1e-12 * ((fabs(ez) + b) * D + 2.0 * nf);
+        if (P > t) return HFVIS_IV_CLEARED;
+        if (P < -t) {
+            if (zw == 1.0f || Q < -t) return HFVIS_IV_KEPT;
+            if (Q > t) return HFVIS_IV_BAND;
+        }
+    }
+    ze = hfvis_depth_to_eye_z((double)zw, im->n, im->f, im->ortho); /* eq. 16, sign restored */
+    if (ez > ze + b) return HFVIS_IV_CLEARED; /* eq. 17: in front of the recorded surface (v1) */
+    if (zw == 1.0f) return HFVIS_IV_KEPT;     /* background: nothing to update */
+    if (ez < ze - b) return HFVIS_IV_KEPT;    /* behind the surface (v3) */
+    return HFVIS_IV_BAND;                     /* surface band (v2) */
+}
+
+/* The classification of a point with eye z `ez` and clip (X, Y, W) (spec voxel §4.3): UNSEEN
+ * without information, else the zone of its texel. Writes the texel read (or -1, -1). */
+static hfvis_iv_class vx_iv_decide(const vx_iv_img *im, double b, double ez, double X, double Y,
+                                   double W, int *opx, int *opy)
+{
+    double inv, nx, ny, sx, sy;
     int px, py;
     float zw;
     *opx = -1;
     *opy = -1;
-    *oze = (double)NAN;
     /* behind the camera, or nearer than the near plane (NDC z < -1; no information) [C] */
     if (!(W > 0.0) || !(ez <= -im->n)) return HFVIS_IV_UNSEEN;
-    nx = X / W;
-    ny = Y / W;
+    inv = 1.0 / W;
+    nx = X * inv;
+    ny = Y * inv;
     if (!(nx >= -1.0 && nx <= 1.0 && ny >= -1.0 && ny <= 1.0)) return HFVIS_IV_UNSEEN;
     /* nearest texel, row 0 at the top: (floor((ndc_x+1)/2 W), floor((1-ndc_y)/2 H)), clamped */
     sx = (nx + 1.0) * 0.5 * (double)im->w;
@@ -224,12 +251,7 @@ static hfvis_iv_class vx_iv_decide(const vx_iv_img *im, double b, double ez, dou
     *opy = py;
     zw = im->depth[(size_t)py * (size_t)im->w + (size_t)px];
     if (!vx_iv_texel_ok(zw)) return HFVIS_IV_UNSEEN;
-    ze = hfvis_depth_to_eye_z((double)zw, im->n, im->f, im->ortho); /* eq. 16, sign restored */
-    *oze = ze;
-    if (ez > ze + b) return HFVIS_IV_CLEARED; /* eq. 17: in front of the recorded surface */
-    if (zw == 1.0f) return HFVIS_IV_KEPT;     /* background: nothing to update */
-    if (ez < ze - b) return HFVIS_IV_KEPT;    /* behind the surface (v3) */
-    return HFVIS_IV_BAND;                     /* surface band (v2) */
+    return vx_iv_zone(im, b, ez, zw);
 }
 
 /* Offsets of the 8 corners of a voxel about its centre in one row: +-(r[0] hx), ... */
@@ -273,7 +295,8 @@ static float vx_iv_pyr_min(const vx_iv_img *im, int x0, int x1, int y0, int y1)
  * centre lies in the bounding box of the projected corners that is no-data or does not clear
  * (p'_z > z_e + b fails). With a pyramid, a rectangle whose minimum depth clears is accepted
  * without a scan: z_e(zw) falls as zw grows (every step of eq. 16 is monotone), so the minimum
- * clearing implies every texel clears, and the answer is the scan's bit for bit. */
+ * clearing implies every texel clears (vx_iv_zone decides exactly as the literal form, whose
+ * every step is monotone in zw), and the answer is the scan's bit for bit. */
 static int vx_iv_veto(const vx_iv_img *im, const vx_iv_corner_rows *cr, double b, double ez,
                       double X, double Y, double W)
 {
@@ -312,15 +335,14 @@ static int vx_iv_veto(const vx_iv_img *im, const vx_iv_corner_rows *cr, double b
     y1 = (int)fy1;
     if (im->pyr && (x1 - x0 > 1 || y1 - y0 > 1)) {
         float m = vx_iv_pyr_min(im, x0, x1, y0, y1);
-        if (m >= 0.0f && ez > hfvis_depth_to_eye_z((double)m, im->n, im->f, im->ortho) + b)
-            return 0;
+        if (m >= 0.0f && vx_iv_zone(im, b, ez, m) == HFVIS_IV_CLEARED) return 0;
     }
     for (y = y0; y <= y1; y++) {
         const float *row = im->depth + (size_t)y * (size_t)im->w;
         for (x = x0; x <= x1; x++) {
             float zw = row[x];
             if (!vx_iv_texel_ok(zw)) return 1;
-            if (!(ez > hfvis_depth_to_eye_z((double)zw, im->n, im->f, im->ortho) + b)) return 1;
+            if (vx_iv_zone(im, b, ez, zw) != HFVIS_IV_CLEARED) return 1;
         }
     }
     return 0;
@@ -376,9 +398,14 @@ static void vx_iv_pyr_build(vx_iv_img *im, float *store)
     }
 }
 
-static void vx_iv_sample_set(hfvis_iv_sample *out, hfvis_iv_class cls, int px, int py, double ez,
-                             double ze)
+static void vx_iv_sample_set(const vx_iv_img *im, hfvis_iv_sample *out, hfvis_iv_class cls, int px,
+                             int py, double ez)
 {
+    double ze = (double)NAN;
+    if (px >= 0) {
+        float zw = im->depth[(size_t)py * (size_t)im->w + (size_t)px];
+        if (vx_iv_texel_ok(zw)) ze = hfvis_depth_to_eye_z((double)zw, im->n, im->f, im->ortho);
+    }
     out->cls = cls;
     out->pixel_x = px;
     out->pixel_y = py;
@@ -390,7 +417,7 @@ HFVIS_API hfvis_status hfvis_iv_classify(const hfvis_depth_image *image, const d
                                          double bias, hfvis_iv_sample *out)
 {
     vx_iv_img im;
-    double ez, X, Y, W, ze;
+    double ez, X, Y, W;
     int px, py;
     hfvis_iv_class cls;
     if (!out || !point || !vx_all_finite(point, 3) || !isfinite(bias) || !(bias >= 0.0))
@@ -400,8 +427,8 @@ HFVIS_API hfvis_status hfvis_iv_classify(const hfvis_depth_image *image, const d
     X = vx_iv_row(im.cx, point[0], point[1], point[2]);
     Y = vx_iv_row(im.cy, point[0], point[1], point[2]);
     W = vx_iv_row(im.cw, point[0], point[1], point[2]);
-    cls = vx_iv_decide(&im, bias, ez, X, Y, W, &px, &py, &ze);
-    vx_iv_sample_set(out, cls, px, py, ez, ze);
+    cls = vx_iv_decide(&im, bias, ez, X, Y, W, &px, &py);
+    vx_iv_sample_set(&im, out, cls, px, py, ez);
     return HFVIS_OK;
 }
 
@@ -418,7 +445,7 @@ HFVIS_API hfvis_status hfvis_iv_classify_voxel(const hfvis_depth_image *image,
 {
     vx_iv_img im;
     vx_iv_opt o;
-    double x, y, z, ez, X, Y, W, ze;
+    double x, y, z, ez, X, Y, W;
     int px, py;
     hfvis_iv_class cls;
     if (!out || !vx_grid_valid(grid) || i < 0 || j < 0 || k < 0 || i >= grid->dims[0]
@@ -433,13 +460,13 @@ HFVIS_API hfvis_status hfvis_iv_classify_voxel(const hfvis_depth_image *image,
     X = vx_iv_row(im.cx, x, y, z);
     Y = vx_iv_row(im.cy, x, y, z);
     W = vx_iv_row(im.cw, x, y, z);
-    cls = vx_iv_decide(&im, o.bias, ez, X, Y, W, &px, &py, &ze);
+    cls = vx_iv_decide(&im, o.bias, ez, X, Y, W, &px, &py);
     if (cls == HFVIS_IV_CLEARED && o.conservative) {
         vx_iv_corner_rows cr;
         vx_iv_corner_setup(&im, grid, &cr);
         if (vx_iv_veto(&im, &cr, o.bias, ez, X, Y, W)) cls = HFVIS_IV_KEPT;
     }
-    vx_iv_sample_set(out, cls, px, py, ez, ze);
+    vx_iv_sample_set(&im, out, cls, px, py, ez);
     return HFVIS_OK;
 }
 
@@ -453,6 +480,26 @@ static int vx_iv_empty(const float *v, int channels)
     return 1;
 }
 
+/* First index >= i of a voxel of the row (n voxels, C channels) that is not empty, or n. Blocks
+ * of 8 floats are tested without branches (a cleanup pass over a surface volume spends most of
+ * its time here). */
+static int vx_iv_next_nonempty(const float *row, int i, int n, int C)
+{
+    if (C == 1) {
+        while (i + 8 <= n) {
+            const float *v = row + i;
+            int z = (v[0] == 0.0f) & (v[1] == 0.0f) & (v[2] == 0.0f) & (v[3] == 0.0f)
+                    & (v[4] == 0.0f) & (v[5] == 0.0f) & (v[6] == 0.0f) & (v[7] == 0.0f);
+            if (!z) break;
+            i += 8;
+        }
+        while (i < n && row[i] == 0.0f) i++;
+        return i;
+    }
+    while (i < n && vx_iv_empty(row + (size_t)i * (size_t)C, C)) i++;
+    return i;
+}
+
 /* Per-call counters. */
 typedef struct vx_iv_count {
     size_t cls[4];
@@ -460,13 +507,16 @@ typedef struct vx_iv_count {
 } vx_iv_count;
 
 /* One image over the whole volume: src -> dst (src == dst in place). single: turn on the band
- * (§7.4.3), else cleanup only (Alg. 7 Cleanup). map: attribute -> channel for the band. */
+ * (§7.4.3), else cleanup only (Alg. 7 Cleanup). map: attribute -> channel for the band. Row by
+ * row: the row is copied once (ping-pong), then only voxels that can change are visited (cleanup:
+ * the non-empty ones; an empty voxel stays empty). The affine rows are hoisted per slab and row in
+ * the order of vx_iv_row, so every voxel sees exactly hfvis_iv_classify_voxel's numbers. */
 static void vx_iv_pass(const float *src, float *dst, const hfvis_volume_grid *g, int C,
                        const vx_iv_img *im, const vx_iv_opt *o, int single, const int *map,
                        vx_iv_count *cnt)
 {
     const int nx = g->dims[0], ny = g->dims[1], nz = g->dims[2];
-    const size_t cs = (size_t)C;
+    const size_t cs = (size_t)C, row = (size_t)nx * cs;
     vx_iv_corner_rows cr;
     int i, j, k, c;
     size_t lin = 0;
@@ -475,46 +525,48 @@ static void vx_iv_pass(const float *src, float *dst, const hfvis_volume_grid *g,
         double z = vx_iv_centre(g, 2, k);
         double kez = im->ez[3] + im->ez[2] * z, kX = im->cx[3] + im->cx[2] * z;
         double kY = im->cy[3] + im->cy[2] * z, kW = im->cw[3] + im->cw[2] * z;
-        for (j = 0; j < ny; j++) {
+        for (j = 0; j < ny; j++, lin += (size_t)nx) {
             double y = vx_iv_centre(g, 1, j);
             double jez = kez + im->ez[1] * y, jX = kX + im->cx[1] * y;
             double jY = kY + im->cy[1] * y, jW = kW + im->cw[1] * y;
-            for (i = 0; i < nx; i++, lin++) {
-                const float *s = src + lin * cs;
-                float *d = dst + lin * cs;
-                double x, ez, X, Y, W, ze;
-                int px, py, empty = vx_iv_empty(s, C);
+            const float *srow = src + lin * cs;
+            float *drow = dst + lin * cs;
+            if (drow != srow) memcpy(drow, srow, row * sizeof(float));
+            for (i = 0; i < nx; i++) {
+                float *d;
+                double x, ez, X, Y, W;
+                int px, py, empty;
                 hfvis_iv_class cls;
-                if (empty && !single) {
-                    if (d != s)
-                        for (c = 0; c < C; c++) d[c] = 0.0f;
-                    continue;
+                if (!single) { /* cleanup: an empty voxel stays empty */
+                    i = vx_iv_next_nonempty(drow, i, nx, C);
+                    if (i >= nx) break;
                 }
+                d = drow + (size_t)i * cs; /* holds the source values now */
+                empty = single ? vx_iv_empty(d, C) : 0;
                 x = vx_iv_centre(g, 0, i);
                 ez = jez + im->ez[0] * x;
                 X = jX + im->cx[0] * x;
                 Y = jY + im->cy[0] * x;
                 W = jW + im->cw[0] * x;
-                cls = vx_iv_decide(im, o->bias, ez, X, Y, W, &px, &py, &ze);
+                cls = vx_iv_decide(im, o->bias, ez, X, Y, W, &px, &py);
                 if (cls == HFVIS_IV_CLEARED && o->conservative
                     && vx_iv_veto(im, &cr, o->bias, ez, X, Y, W))
                     cls = HFVIS_IV_KEPT;
                 cnt->cls[cls]++;
                 if (cls == HFVIS_IV_CLEARED) {
-                    for (c = 0; c < C; c++) d[c] = 0.0f;
-                    if (!empty) cnt->off++;
-                    continue;
-                }
-                if (d != s)
-                    for (c = 0; c < C; c++) d[c] = s[c];
-                if (cls == HFVIS_IV_BAND && single) {
+                    if (!empty) {
+                        for (c = 0; c < C; c++) d[c] = 0.0f;
+                        cnt->off++;
+                    }
+                } else if (cls == HFVIS_IV_BAND && single) {
                     /* turn on / update with the centre texel's attributes (replace) */
-                    const float *a = im->attr ? im->attr + ((size_t)py * (size_t)im->w
-                                                            + (size_t)px) * (size_t)im->nattr
-                                              : NULL;
                     int t;
-                    for (t = 0; t < im->nattr; t++)
-                        if (map[t] >= 0) d[map[t]] = a[t];
+                    if (im->nattr > 0) {
+                        const float *a = im->attr + ((size_t)py * (size_t)im->w + (size_t)px)
+                                                        * (size_t)im->nattr;
+                        for (t = 0; t < im->nattr; t++)
+                            if (map[t] >= 0) d[map[t]] = a[t];
+                    }
                     if (o->occ >= 0) d[o->occ] = 1.0f;
                     if (empty && !vx_iv_empty(d, C)) cnt->on++;
                 }

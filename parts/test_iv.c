@@ -557,6 +557,68 @@ static void iv_oracle_apply(float *vol, const hfvis_volume_grid *g, int C,
             }
 }
 
+/* The eq. 17 decision is the literal comparison p'_z > z_e + b (and p'_z < z_e - b for the band)
+ * with z_e by eq. 16, even where the perspective fast path (no division) decides: points within
+ * a few ulps of both zone boundaries, against the literal form on the sample's own numbers. */
+TEST(iv_zone_filter_is_exact)
+{
+    enum { W = 48, H = 40 };
+    static float depth[W * H];
+    hfvis_view v;
+    hfvis_depth_image im;
+    iv_scene sc;
+    double m[16], inv[16];
+    int trial, bad = 0, ties = 0, cls_seen[4] = {0, 0, 0, 0};
+    hfvis_volume_grid g;
+    iv_seed(17);
+    iv_grid(&g, 8, 8, 8, -1, -1, -1, 0.25, 0.25, 0.25);
+    for (trial = 0; trial < 4000; trial++) {
+        double o[3], d[3], ezo, ezd, target, t, p[3], b, dir[3], tgt[3] = {0, 0, 0};
+        int x, y, a, pix;
+        hfvis_iv_sample s;
+        if (trial % 200 == 0) {
+            double dist = 2.0 + 6.0 * iv_unit();
+            int ortho = (trial / 200) % 4 == 3;
+            iv_random_scene(&sc, &g);
+            iv_random_dir(dir);
+            iv_orbit_view(&v, tgt, dir, dist, ortho, W, H, 0.9);
+            iv_render(&v, &sc, depth);
+            iv_image(&im, &v, depth, NULL, 0);
+            hfvis_mat4_multiply(v.proj, v.view, m);
+            CHECK_EQ_STATUS(hfvis_mat4_invert(m, inv), HFVIS_OK);
+        }
+        x = iv_int(0, W - 1);
+        y = iv_int(0, H - 1);
+        pix = y * W + x;
+        if (depth[pix] >= 1.0f) continue;
+        b = iv_int(0, 3) == 0 ? 0.0 : 0.3 * iv_unit();
+        iv_pixel_ray(&v, inv, x, y, o, d);
+        ezo = v.view[2] * o[0] + v.view[6] * o[1] + v.view[10] * o[2] + v.view[14];
+        ezd = v.view[2] * (o[0] + d[0]) + v.view[6] * (o[1] + d[1]) + v.view[10] * (o[2] + d[2]) + v.view[14];
+        target = hfvis_depth_to_eye_z((double)depth[pix], v.near_plane, v.far_plane, v.orthographic);
+        target += (iv_int(0, 1) ? b : -b) * (1.0 + 1e-15 * (iv_unit() - 0.5));
+        t = (target - ezo) / (ezd - ezo);
+        for (a = 0; a < 3; a++) p[a] = o[a] + t * d[a];
+        CHECK_EQ_STATUS(hfvis_iv_classify(&im, p, b, &s), HFVIS_OK);
+        if (s.pixel_x < 0 || isnan(s.depth_eye_z)) continue;
+        {
+            hfvis_iv_class want;
+            float zw = depth[s.pixel_y * W + s.pixel_x];
+            if (s.eye_z > s.depth_eye_z + b) want = HFVIS_IV_CLEARED;
+            else if (zw == 1.0f || s.eye_z < s.depth_eye_z - b) want = HFVIS_IV_KEPT;
+            else want = HFVIS_IV_BAND;
+            if (s.cls != want) bad++;
+            cls_seen[s.cls]++;
+            if (fabs(s.eye_z - (s.depth_eye_z + b)) < 1e-13 * fabs(s.depth_eye_z)
+                || fabs(s.eye_z - (s.depth_eye_z - b)) < 1e-13 * fabs(s.depth_eye_z))
+                ties++;
+        }
+    }
+    CHECK(bad == 0);
+    CHECK(ties > 1000);
+    CHECK(cls_seen[HFVIS_IV_CLEARED] > 100 && cls_seen[HFVIS_IV_BAND] > 100 && cls_seen[HFVIS_IV_KEPT] > 100);
+}
+
 TEST(iv_passes_match_oracle)
 {
     enum { MAXV = 20 * 20 * 20 * 3, MAXP = 64 * 64 };
@@ -1836,6 +1898,7 @@ int main(int argc, char **argv)
     RUN(iv_spec_cleanup_counts);
     RUN(iv_spec_single_pass);
     RUN(iv_spec_injection);
+    RUN(iv_zone_filter_is_exact);
     RUN(iv_passes_match_oracle);
     RUN(iv_conservative_guarantee);
     RUN(iv_moved_object_analytic);
