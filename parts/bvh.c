@@ -1,13 +1,14 @@
 /* ========================================================================================== */
 /* 2a. BVH and ray casting (issue 4; the scene-space caster of spec raycast A.9.2 / A.10)      */
 /*     Watertight test: S. Woop, C. Benthin, I. Wald, "Watertight Ray/Triangle Intersection",  */
-/*     JCGT 2(1), 2013, Fig. 1 (ray setup) and Fig. 2-3 (shear, edge functions, double         */
-/*     fallback). Slab test: T. Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013 (eq. 11:      */
-/*     t_far * (1 + 2 gamma_3)). SAH: MacDonald & Booth 1990, binned as I. Wald, RT 2007.     */
+/*     JCGT 2(1), 2013: its pseudo-code listing (ray setup, shear, edge functions U V W, the   */
+/*     double-precision recomputation of zero edge functions), quoted line by line below.     */
+/*     Slab test: T. Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013 (t_far * (1 + 2 gamma_3)).*/
+/*     SAH: MacDonald & Booth 1990, binned as I. Wald, IEEE RT 2007.                           */
 /* ========================================================================================== */
 /* Contents
- *   2a.1 rays: validation and the per-ray setup of Woop et al. Fig. 1
- *   2a.2 the watertight ray-triangle test (Fig. 2-3) and the exact zero-area test
+ *   2a.1 rays: validation and the per-ray setup of Woop et al.
+ *   2a.2 the watertight ray-triangle test and the exact zero-area test
  *   2a.3 naive oracle (every triangle in index order)
  *   2a.4 binned SAH build (explicit stack, median fallback, padded boxes)
  *   2a.5 traversal (robust slab test, nearer child first, explicit stack) */
@@ -31,7 +32,9 @@
 
 /* ---- 2a.1 rays ------------------------------------------------------------------------------ */
 
-/* A ray prepared once per query (Woop et al. Fig. 1). */
+/* A ray prepared once per query (Woop et al.: "calculate dimension where the ray direction is
+ * maximal", "swap kx and ky dimension to preserve winding direction of triangles", "calculate
+ * shear constants"). */
 typedef struct vx_bvh_ray {
     float org[3], dir[3];
     float inv[3];      /* 1/dir; a zero component gives +-infinity with the zero's sign */
@@ -57,7 +60,7 @@ static int vx_bvh_ray_valid(const hfvis_ray *r)
     return 1;
 }
 
-/* Fig. 1: kz = dimension of the largest |direction| component (first on ties), kx and ky the
+/* kz = dimension of the largest |direction| component (first on ties), kx and ky the
  * next two cyclically, swapped when dir[kz] < 0 to keep the winding; shear constants. */
 static void vx_bvh_ray_setup(const hfvis_ray *r, vx_bvh_ray *p)
 {
@@ -104,7 +107,8 @@ static void vx_bvh_miss(hfvis_hit *h)
 /* Exact test: is p[0] + ... + p[5] == 0? The p are exact products of two floats (double). A
  * floating-point filter (the rounded sum's error is below 5 u sum|p| < 2^-50 sum|p|) decides
  * almost always; otherwise Shewchuk's GROW-EXPANSION with Knuth's TWO-SUM and zero
- * elimination ("Adaptive precision floating-point arithmetic", 1997, Fig. 6): the sum is zero
+ * elimination ("Adaptive Precision Floating-Point Arithmetic and Fast Robust Geometric
+ * Predicates", 1997): the sum is zero
  * iff no component survives. */
 static int vx_bvh_sum6_is_zero(const double p[6])
 {
@@ -152,14 +156,14 @@ static int vx_bvh_zero_area(const float *a, const float *b, const float *c)
     return 1;
 }
 
-/* Woop et al. Fig. 2-3 for one triangle, hits accepted with t in [t_min, t_hi] (t_hi <= t_max:
+/* Woop et al.'s listing for one triangle, hits accepted with t in [t_min, t_hi] (t_hi <= t_max:
  * callers pass their current best). Returns 1 and fills h (all but triangle) on a hit. */
-static VX_BVH_INLINE int vx_bvh_tri(const vx_bvh_ray *r, const float *p0, const float *p1, const float *p2,
-                                      float t_hi, hfvis_hit *h)
+static VX_BVH_INLINE int vx_bvh_tri(const vx_bvh_ray *r, const float *p0, const float *p1,
+                                     const float *p2, float t_hi, hfvis_hit *h)
 {
     const int kx = r->kx, ky = r->ky, kz = r->kz;
     float ax, ay, az, bx, by, bz, cx, cy, cz, Ax, Ay, Bx, By, Cx, Cy, U, V, W, det, T, t;
-    /* vertices relative to the ray origin (Fig. 2 "A = tri.A - org" ...) */
+    /* "calculate vertices relative to ray origin": A = tri.A - org, ... */
     ax = p0[kx] - r->org[kx];
     ay = p0[ky] - r->org[ky];
     az = p0[kz] - r->org[kz];
@@ -180,9 +184,10 @@ static VX_BVH_INLINE int vx_bvh_tri(const vx_bvh_ray *r, const float *p0, const 
     U = Cx * By - Cy * Bx;
     V = Ax * Cy - Ay * Cx;
     W = Bx * Ay - By * Ax;
-    /* Fig. 3: an edge function that is exactly 0 is recomputed in double, where the products of
-     * two floats are exact and the difference is correctly rounded, so its sign is exact. (The
-     * float value's sign, when nonzero, is already exact: rounding is monotonic.) */
+    /* "fallback to test against edges using double precision": an edge function that is exactly
+     * 0 is recomputed in double, where the products of two floats are exact and the difference
+     * is correctly rounded, so its sign is exact. (The float value's sign, when nonzero, is
+     * already exact: rounding is monotonic.) */
     if (U == 0.0f || V == 0.0f || W == 0.0f) goto exact_path;
     /* inside iff U, V, W share a sign ("if ((U<0 || V<0 || W<0) && (U>0 || V>0 || W>0))
      * return"); a NaN (two overflowed products) passes here and is resolved below */
@@ -362,6 +367,16 @@ static int vx_bvh_less(const vx_bvh_prim *prims, uint32_t x, uint32_t y, int a)
     return cx < cy || (cx == cy && x < y);
 }
 
+/* Swap *x and *y unless *x comes first. */
+static void vx_bvh_order2(const vx_bvh_prim *prims, uint32_t *x, uint32_t *y, int a)
+{
+    if (vx_bvh_less(prims, *y, *x, a)) {
+        uint32_t t = *x;
+        *x = *y;
+        *y = t;
+    }
+}
+
 /* Rearrange idx[0..n) so that idx[k] holds the k-th smallest key and smaller keys come before
  * it (deterministic quickselect, median-of-three pivot, Lomuto partition). */
 static void vx_bvh_select(const vx_bvh_prim *prims, uint32_t *idx, size_t n, size_t k, int a)
@@ -371,9 +386,9 @@ static void vx_bvh_select(const vx_bvh_prim *prims, uint32_t *idx, size_t n, siz
         size_t mid = lo + (hi - lo) / 2, i, store;
         uint32_t tmp, piv;
         /* median of three into position hi */
-        if (vx_bvh_less(prims, idx[mid], idx[lo], a)) { tmp = idx[mid]; idx[mid] = idx[lo]; idx[lo] = tmp; }
-        if (vx_bvh_less(prims, idx[hi], idx[lo], a)) { tmp = idx[hi]; idx[hi] = idx[lo]; idx[lo] = tmp; }
-        if (vx_bvh_less(prims, idx[mid], idx[hi], a)) { tmp = idx[mid]; idx[mid] = idx[hi]; idx[hi] = tmp; }
+        vx_bvh_order2(prims, idx + lo, idx + mid, a);
+        vx_bvh_order2(prims, idx + lo, idx + hi, a);
+        vx_bvh_order2(prims, idx + hi, idx + mid, a); /* lo <= hi <= mid: pivot idx[hi] */
         piv = idx[hi];
         store = lo;
         for (i = lo; i < hi; i++)
@@ -548,7 +563,8 @@ HFVIS_API hfvis_status hfvis_bvh_build(const hfvis_mesh *mesh, const hfvis_bvh_o
                         if (bin[b].count) vx_bvh_grow(llo, lhi, bin[b].lo, bin[b].hi);
                         lc += bin[b].count;
                         if (lc == 0 || right_count[b] == 0) continue;
-                        cost = vx_bvh_area(llo, lhi) * (double)lc + right_area[b] * (double)right_count[b];
+                        cost = vx_bvh_area(llo, lhi) * (double)lc
+                               + right_area[b] * (double)right_count[b];
                         if (cost < best) {
                             best = cost;
                             best_axis = a;
@@ -650,7 +666,8 @@ HFVIS_API void hfvis_bvh_free(const hfvis_allocator *alloc, hfvis_bvh *bvh)
  * min(far planes) * VX_BVH_SLACK; a NaN from 0 * infinity (ray in a slab's plane, zero
  * direction component) is ignored by the comparisons, which is the right answer for a ray on
  * the (closed) slab boundary. Hit when entry <= exit and entry <= t_hi (the widened best). */
-static VX_BVH_INLINE int vx_bvh_box(const hfvis_bvh_node *n, const vx_bvh_ray *r, float t_hi, float *entry)
+static VX_BVH_INLINE int vx_bvh_box(const hfvis_bvh_node *n, const vx_bvh_ray *r, float t_hi,
+                                     float *entry)
 {
     float tn = r->t_min, tf = INFINITY, t0, t1;
     t0 = ((r->neg[0] ? n->hi[0] : n->lo[0]) - r->org[0]) * r->inv[0];
@@ -731,7 +748,8 @@ HFVIS_API hfvis_status hfvis_bvh_intersect(const hfvis_bvh *bvh, const hfvis_mes
             float e0, e1;
             int h0, h1;
             /* children follow their parent (so every path ends) and lie inside the array */
-            if (left <= ni || (size_t)left + 1 >= bvh->node_count) return HFVIS_ERR_INVALID_ARGUMENT;
+            if (left <= ni || (size_t)left + 1 >= bvh->node_count)
+                return HFVIS_ERR_INVALID_ARGUMENT;
             h0 = vx_bvh_box(nodes + left, &r, t_hi, &e0);
             h1 = vx_bvh_box(nodes + left + 1, &r, t_hi, &e1);
             if (h0 && h1) {
