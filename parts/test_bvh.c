@@ -791,6 +791,48 @@ TEST(bvh_matches_naive)
     for (mi = 0; mi < 6; mi++) hfvis_mesh_free(NULL, &meshes[mi]);
 }
 
+/* Huge and tiny scales, far from the origin: an icosphere scaled by 2^k (k = -100 .. 100) and
+ * moved away by 2^10 radii or more (coarse float vertices, degenerate triangles). BVH == naive,
+ * and rays from the centre always hit (where the scale leaves the sphere closed). */
+TEST(scales)
+{
+    const double c0[3] = {0, 0, 0};
+    const int ks[6] = {-100, -40, -10, 10, 40, 100};
+    hfvis_mesh base;
+    int i, j, bad = 0, miss = 0;
+    CHECK(gen_ok(hfvis_mesh_icosphere(NULL, c0, 1.0, 2, &base)));
+    for (i = 0; i < 6; i++)
+        for (j = 0; j < 3; j++) {
+            float *xyz;
+            uint32_t *idx;
+            hfvis_mesh m = soup_alloc(base.vertex_count, base.triangle_count, &xyz, &idx);
+            double sc = ldexp(1.0, ks[i]), off = j == 0 ? 0.0 : sc * (j == 1 ? 1024.0 : 3.0e6);
+            hfvis_bvh b;
+            size_t v;
+            int k;
+            for (v = 0; v < 3 * base.vertex_count; v++) xyz[v] = (float)(D(base.xyz[v]) * sc + off);
+            memcpy(idx, base.indices, sizeof(uint32_t) * 3 * base.triangle_count);
+            CHECK_EQ_STATUS(hfvis_bvh_build(&m, NULL, &b), HFVIS_OK);
+            CHECK(check_structure(&b, &m, 4) == 0);
+            bad += compare_rays(&b, &m, 1500, (uint64_t)(500 + 10 * i + j), NULL);
+            if (j < 2) /* still a closed sphere in float: rays from the centre hit */
+                for (k = 0; k < 300; k++) {
+                    double d[3];
+                    hfvis_ray r;
+                    hfvis_hit h;
+                    rng_dir(d);
+                    r = make_ray(off, off, off, d[0], d[1], d[2]);
+                    hfvis_bvh_closest_hit(&b, &m, &r, &h);
+                    if (h.triangle == HFVIS_NO_TRIANGLE) miss++;
+                }
+            hfvis_bvh_free(NULL, &b);
+            hfvis_mesh_free(NULL, &m);
+        }
+    CHECK(bad == 0);
+    CHECK(miss == 0);
+    hfvis_mesh_free(NULL, &base);
+}
+
 /* Exactly equal t goes to the lowest triangle index, in BVH and naive alike. */
 TEST(tie_lowest_index)
 {
@@ -1219,6 +1261,7 @@ int main(int argc, char **argv)
     RUN(watertight_vertices_edges);
     RUN(watertight_interior);
     RUN(bvh_matches_naive);
+    RUN(scales);
     RUN(tie_lowest_index);
     RUN(t_range);
     RUN(filter);
