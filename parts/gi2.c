@@ -486,6 +486,9 @@ typedef struct hf_ns_key {
     double *cph, *sph;         /* key_directions azimuths (partial extent) */
     double *G;                 /* 64*key_directions sample matrices (partial extent) */
     double *T;                 /* C*256: the product matrix of L_key */
+    double Ls[NS_SH_N];        /* L_key per unit irradiance (RATIO) */
+    double E0[4];              /* irradiance per channel (RATIO) */
+    double box;                /* Ls . V_box: the unoccluded restricted visibility's (RATIO) */
 } hf_ns_key;
 
 typedef struct hf_ns_dir {
@@ -571,7 +574,7 @@ hfvis_status hfvis_ns_gi_options_resolve(const hfvis_grid *grid, const hfvis_ns_
         hfvis_ns_wedge_columns(o.interp) == 0 ||
         !hf_ns_range((int)o.omega_min, 0, 2) || !hf_ns_range((int)o.omega_max, 0, 2) ||
         !hf_ns_range(o.clamp_to_tangent, 0, 1) || !hf_ns_range((int)o.directional, 0, 3) ||
-        !hf_ns_range((int)o.key_mode, 0, 2) || !hf_ns_range((int)o.glossy, 0, 2) ||
+        !hf_ns_range((int)o.key_mode, 0, 3) || !hf_ns_range((int)o.glossy, 0, 2) ||
         !isfinite(o.view_dir[0]) || !isfinite(o.view_dir[1]) || !isfinite(o.view_dir[2]) ||
         !hf_border_valid(o.border) || !isfinite(o.azimuth0_rad))
         return HFVIS_ERR_INVALID_ARGUMENT;
@@ -664,7 +667,7 @@ static hfvis_status hf_ns_setup(hf_ns_ctx *c, const hfvis_grid *grid, const hfvi
         for (ch = 0; ch < c->C; ch++)
             if (!isfinite(L->irradiance[ch])) return HFVIS_ERR_INVALID_ARGUMENT;
         if (L->radius_rad == 0.0) c->ndir++;
-        else if (c->o.key_mode == HFVIS_NS_KEY_SEPARATE) c->nkey++;
+        else if (c->o.key_mode != HFVIS_NS_KEY_ENVIRONMENT) c->nkey++;
     }
     if (!hf_ns_map_valid(grid, sc->albedo_map, c->C) || !hf_ns_map_valid(grid, sc->emission, c->C))
         return HFVIS_ERR_INVALID_ARGUMENT;
@@ -700,7 +703,7 @@ static hfvis_status hf_ns_setup(hf_ns_ctx *c, const hfvis_grid *grid, const hfvi
     c->env_scan = c->env || want_vis;
     for (i = 0; i < sc->light_count; i++) {
         const hfvis_sun *L = &sc->lights[i];
-        if (L->radius_rad > 0.0 && c->o.key_mode == HFVIS_NS_KEY_SEPARATE &&
+        if (L->radius_rad > 0.0 && c->o.key_mode != HFVIS_NS_KEY_ENVIRONMENT &&
             !(L->radius_rad < HF_HALF_PI - fabs(L->elevation_rad)))
             c->env_scan = 1; /* a cap holding the zenith uses the environment slices */
     }
@@ -1031,8 +1034,17 @@ static void hf_ns_incident(const hf_ns_ctx *c, const double *rec, int ch, int sh
     int q, i;
     for (i = 0; i < NS_SH_N; i++) I[i] = 0.0;
     if (c->env) hf_ns_matvec_add(c->T_env + (size_t)ch * 256u, rec, I);
-    for (q = 0; q < c->nkey; q++)
-        hf_ns_matvec_add(c->keys[q].T + (size_t)ch * 256u, rec + NS_SH_N * (1 + q), I);
+    for (q = 0; q < c->nkey; q++) {
+        const hf_ns_key *K = &c->keys[q];
+        if (c->o.key_mode == HFVIS_NS_KEY_RATIO) {
+            /* the visible share of the light's SH energy, Int L V_key / Int L V_box, times L */
+            double f = K->box > 0.0 ? hf_ns_dot16(K->Ls, rec + NS_SH_N * (1 + q)) / K->box : 0.0;
+            f = f < 0.0 ? 0.0 : f > 1.0 ? 1.0 : f;
+            for (i = 0; i < NS_SH_N; i++) I[i] += f * K->E0[ch] * K->Ls[i];
+        } else {
+            hf_ns_matvec_add(K->T + (size_t)ch * 256u, rec + NS_SH_N * (1 + q), I);
+        }
+    }
     if (sh_dirs)
         for (q = 0; q < c->ndir; q++) {
             const double f = c->dirs[q].E0[ch] * rec[NS_SH_N * (1 + c->nkey) + q];
@@ -1404,8 +1416,9 @@ static void hf_ns_tables(hf_ns_ctx *c)
             double *dst;
             (void)hfvis_zh_cap(L->radius_rad, Ah);
             (void)hfvis_sh_from_zh(Ah, a, F);
-            if (c->o.key_mode == HFVIS_NS_KEY_SEPARATE) {
+            if (c->o.key_mode != HFVIS_NS_KEY_ENVIRONMENT) {
                 hf_ns_key *K = &c->keys[kk++];
+                double vb[4], Vbox[NS_SH_N];
                 double lmin = e - L->radius_rad, lmax = e + L->radius_rad, Lk[4 * NS_SH_N];
                 if (lmin < -HF_HALF_PI) lmin = -HF_HALF_PI;
                 if (lmax > HF_HALF_PI) lmax = HF_HALF_PI;
@@ -1424,6 +1437,16 @@ static void hf_ns_tables(hf_ns_ctx *c)
                         for (i = nb * 4; i < 64; i++) K->G[(size_t)j * 64u + (size_t)i] = 0.0;
                     }
                 }
+                /* RATIO: L per unit irradiance and its overlap with the unoccluded box */
+                for (i = 0; i < NS_SH_N; i++) {
+                    K->Ls[i] = i < nb ? F[i] / (HF_PI * sa * sa) : 0.0;
+                    Vbox[i] = 0.0;
+                }
+                for (ch = 0; ch < 4; ch++) K->E0[ch] = ch < C ? (double)L->irradiance[ch] : 0.0;
+                hf_ns_vis(K->sin_lmin, K->sin_lmax, vb);
+                for (j = 0; j < (K->full ? c->m : c->mk); j++)
+                    hf_ns_acc(Vbox, (K->full ? c->G_env : K->G) + (size_t)j * 64u, vb);
+                K->box = hf_ns_dot16(K->Ls, Vbox);
                 dst = Lk;
                 for (ch = 0; ch < C; ch++)
                     for (i = 0; i < NS_SH_N; i++)
