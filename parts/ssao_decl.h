@@ -1,0 +1,274 @@
+
+/* ------------------------------------------------------------------------------------------
+ * Screen space conventions (spec screenspace-p3-p4 §2.1; [P3] = Timonen, "Line-Sweep Ambient
+ * Obscurance", EGSR 2013; [P4] = Timonen, "Screen-Space Far-Field Ambient Obscurance", HPG 2013)
+ *
+ * Buffers. A depth buffer is width x height floats (the FULL buffer W0 x H0, guard band
+ *   included), texel (x, y) at depth[y*stride + x], row 0 at the top. Values are positive
+ *   linear view-space depth: the distance along the camera's forward axis (not the ray length,
+ *   not NDC). A texel is BACKGROUND when its depth is not finite, <= 0, or >= the camera's
+ *   far_depth: background never occludes (like a height-field hole) and receives obscurance 0.
+ *   Normal buffers hold 3 floats per texel, normals[3*(y*stride + x) + c], view space, unit,
+ *   facing the camera; (0, 0, 0) marks "no normal".
+ * Pixels. Texel (x, y) covers [x, x+1) x [y, y+1); its centre is (x + 0.5, y + 0.5). Screen
+ *   positions (u, v) are continuous in these units over the whole buffer.
+ * View space. Right-handed, eye at the origin looking down -Z, +X right, +Y up:
+ *   perspective   P(u, v, z) = ((u - cx) z / fx, -(v - cy) z / fy, -z)
+ *   orthographic  P(u, v, z) = ((u - cx) sx, -(v - cy) sy, -z)   (zenith = +Z everywhere)
+ * Guard band. guard_x / guard_y pixels per side are occluders only: AO outputs cover the inner
+ *   (width - 2 guard_x) x (height - 2 guard_y) pixels, ao[y*ao_stride + x] for inner pixel
+ *   (x, y) = buffer texel (x + guard_x, y + guard_y). P3's "1280(+256) x 720(+144), 20 % guard
+ *   band" is guard_x = 128, guard_y = 72.
+ * Directions. A screen direction D = (dx, dy) is in pixels, +x right, +y DOWN; its azimuth is
+ *   atan2(dy, dx) (DESIGN §2: from +x toward +y).
+ * Obscurance. Every AO output is obscurance in [0, 1], 0 = nothing blocks. Two integrands exist
+ *   (spec §1.2): HBAO and LSAO weight by solid angle per azimuthal slice ("SA", the zenith is
+ *   the direction to the eye, not the normal), the ray-traced reference is cosine-weighted
+ *   around the normal (P4 Eq. 1, "COS"). They give different numbers for the same scene.
+ * ------------------------------------------------------------------------------------------ */
+
+struct hfvis_view; /* declared with the views below (voxel.c) */
+
+/* Largest width or height of a screen-space buffer, and the largest direction count. */
+#define HFVIS_SSAO_MAX_SIZE 65536
+#define HFVIS_SSAO_MAX_DIRECTIONS 4096
+
+/* ---- camera ------------------------------------------------------------------------------ */
+
+typedef enum hfvis_camera_projection {
+    HFVIS_CAMERA_PERSPECTIVE = 1,
+    HFVIS_CAMERA_ORTHOGRAPHIC = 2   /* test mode (spec §6): camera at infinity, zenith +Z */
+} hfvis_camera_projection;
+
+/* A screen-space camera. Not an options struct: projection 0 is invalid. */
+typedef struct hfvis_camera {
+    int width, height;          /* full buffer W0 x H0 (guard band included), 1..HFVIS_SSAO_MAX_SIZE */
+    ptrdiff_t stride;           /* elements between depth rows; 0 = width (normals: 3*stride) */
+    int guard_x, guard_y;       /* guard band per side, >= 0, 2*guard < width (height) */
+    hfvis_camera_projection projection;
+    double fx, fy;              /* perspective: focal lengths in pixels, > 0 */
+    double cx, cy;              /* principal point in continuous pixel coordinates of the full
+                                   buffer (both projections; symmetric: width/2, height/2) */
+    double scale_x, scale_y;    /* orthographic: view units per pixel, > 0 */
+    double far_depth;           /* depth >= far_depth is background; 0 = no far limit */
+} hfvis_camera;
+
+/* HFVIS_OK if the camera is valid; HFVIS_ERR_INVALID_ARGUMENT for NULL, sizes < 1, a negative
+ * stride or 0 < stride < width, guard bands < 0 or leaving no inner pixel, an unknown
+ * projection, non-finite or non-positive focal lengths / scales (only those of the chosen
+ * projection are read), a non-finite principal point, far_depth < 0 or NaN; HFVIS_ERR_LIMIT
+ * when width or height exceeds HFVIS_SSAO_MAX_SIZE or 3*stride*height overflows. */
+HFVIS_API hfvis_status hfvis_camera_check(const hfvis_camera *cam);
+
+/* A symmetric perspective camera: the VISIBLE (inner) image of (width - 2 guard_x) x (height -
+ * 2 guard_y) pixels spans the vertical field of view fov_y_rad in (0, pi), square pixels
+ * (fx = fy = inner_height / (2 tan(fov_y/2))), principal point at the buffer centre, no far
+ * limit, stride 0. The guard band keeps the focal length of the visible image (spec §1.3).
+ * Returns the errors of hfvis_camera_check, or HFVIS_ERR_INVALID_ARGUMENT for a bad fov. */
+HFVIS_API hfvis_status hfvis_camera_perspective(hfvis_camera *cam, int width, int height,
+                                                int guard_x, int guard_y, double fov_y_rad);
+
+/* An orthographic camera with square pixels of pixel_size view units, principal point at the
+ * buffer centre. Errors as hfvis_camera_perspective (pixel_size must be finite, > 0). */
+HFVIS_API hfvis_status hfvis_camera_orthographic(hfvis_camera *cam, int width, int height,
+                                                 int guard_x, int guard_y, double pixel_size);
+
+/* The camera of a hfvis_view (the rasterizer's, voxel.c): width/height are the view's (the
+ * full guard-banded buffer), focal lengths, principal point or scales follow from the GL
+ * projection matrix (perspective: fx = P00 W/2, fy = P11 H/2, cx = W/2 (1 - P02),
+ * cy = H/2 (1 + P12); orthographic: sx = 2/(W P00), sy = 2/(H P11), cx = W/2 (1 + P03),
+ * cy = H/2 (1 - P13)), far_depth = the view's far plane (GL clears depth to it). The linear
+ * depth output of hfvis_rasterize is then this camera's depth buffer (empty pixels +INFINITY
+ * are background). HFVIS_ERR_INVALID_ARGUMENT for NULL, a projection matrix that is not of
+ * the GL perspective / orthographic form, or the errors of hfvis_camera_check. */
+HFVIS_API hfvis_status hfvis_camera_from_view(hfvis_camera *cam, const struct hfvis_view *view,
+                                              int guard_x, int guard_y);
+
+/* View-space point of screen position (u, v) at linear depth (see the conventions).
+ * HFVIS_ERR_INVALID_ARGUMENT for an invalid camera, NULL out or non-finite input. */
+HFVIS_API hfvis_status hfvis_camera_unproject(const hfvis_camera *cam, double u, double v,
+                                              double depth, double out[3]);
+
+/* Screen position and linear depth of view-space point p (inverse of unproject).
+ * HFVIS_ERR_INVALID_ARGUMENT for an invalid camera, NULL pointers, non-finite p or (perspective)
+ * a point not in front of the eye (p[2] >= 0). */
+HFVIS_API hfvis_status hfvis_camera_project(const hfvis_camera *cam, const double p[3],
+                                            double *u, double *v, double *depth);
+
+/* ---- hardware depth ---------------------------------------------------------------------- */
+
+typedef enum hfvis_depth_encoding {
+    HFVIS_DEPTH_GL = 1,                /* GL window depth d in [0, 1] (glDepthRange(0, 1)); a GL
+                                          projection gives the same d as D3D: z = n f/(f - d(f - n)) */
+    HFVIS_DEPTH_GL_NDC = 2,            /* GL NDC depth in [-1, 1]: d_window = (d + 1)/2 */
+    HFVIS_DEPTH_D3D = 3,               /* D3D depth in [0, 1]: d = f (z - n)/(z (f - n)) */
+    HFVIS_DEPTH_REVERSED_Z = 4,        /* reversed Z in [0, 1] (1 at near): z = n f/(n + d(f - n)) */
+    HFVIS_DEPTH_INFINITE_FAR = 5,      /* far plane at infinity, d = 1 - n/z in [0, 1) */
+    HFVIS_DEPTH_REVERSED_INFINITE = 6  /* reversed Z with infinite far, d = n/z in (0, 1] */
+} hfvis_depth_encoding;
+
+/* Linear view depth of one hardware depth value. Orthographic projections are linear:
+ * z = n + d (f - n) (GL, GL_NDC after mapping, D3D), z = f - d (f - n) (REVERSED_Z); the
+ * infinite-far encodings have no orthographic form. Returns +INFINITY (background) for d
+ * outside the encoding's range, non-finite d, or d on the infinite far plane; the far plane
+ * itself (d = 1 in GL/D3D) gives far_plane, which a camera with far_depth = far_plane treats
+ * as background. Returns NaN for an unknown encoding, orthographic not 0/1, an orthographic
+ * infinite-far encoding, or planes not 0 < near < far (near > 0 finite for infinite far; the
+ * orthographic forms accept 0 <= near). Pure; computed in double. */
+HFVIS_API double hfvis_depth_linear(double d, hfvis_depth_encoding encoding, int orthographic,
+                                    double near_plane, double far_plane);
+
+/* Inverse of hfvis_depth_linear: the hardware depth of linear depth z (z in [near, far]; other
+ * z give values outside the range). NaN for invalid parameters or z <= 0 in perspective. */
+HFVIS_API double hfvis_depth_hardware(double z, hfvis_depth_encoding encoding, int orthographic,
+                                      double near_plane, double far_plane);
+
+/* hfvis_depth_linear over a width x height buffer: out[y*out_stride + x] from
+ * in[y*in_stride + x], rounded to float. out may equal in (same stride); other overlaps are
+ * not allowed. HFVIS_ERR_INVALID_ARGUMENT for NULL buffers, sizes < 1, strides < width, or the
+ * parameters hfvis_depth_linear rejects (outputs untouched). Allocates nothing. */
+HFVIS_API hfvis_status hfvis_depth_linearize(const float *in, int width, int height,
+                                             ptrdiff_t in_stride, hfvis_depth_encoding encoding,
+                                             int orthographic, double near_plane,
+                                             double far_plane, float *out, ptrdiff_t out_stride);
+
+/* Normals from depth (spec §2.1 [R]): for each texel, the view-space points of the left/right
+ * and upper/lower neighbours; on each axis the side whose depth differs less from the centre
+ * (ties: right, lower; only one side if the other is background or outside the buffer) gives a
+ * one-sided difference, and the normal is the normalised cross product of the two, turned to
+ * face the eye (n . -P > 0; orthographic n.z > 0). With no usable neighbour on an axis the
+ * normal is the direction to the eye (-P/|P|; orthographic +Z). Background texels get (0,0,0).
+ * normals: 3 floats per texel in the camera's layout (3*stride per row; entries between rows
+ * are not written). Exact for planes (up to rounding). HFVIS_ERR_INVALID_ARGUMENT for an
+ * invalid camera or NULL buffers. Allocates nothing. Cost O(width*height). */
+HFVIS_API hfvis_status hfvis_depth_normals(const hfvis_camera *cam, const float *depth,
+                                           float *normals);
+
+/* The azimuthal plane of a screen line (spec §2.2): the plane through the eye and the screen
+ * line through reference view point ref with screen direction (du, dv). e1 is the unit 3D
+ * direction of the line at constant depth, normalize(du/fx, -dv/fy, 0) (orthographic:
+ * normalize(du sx, -dv sy, 0)); yhat is the unit vector in the plane perpendicular to e1 on the
+ * camera side (yhat.z > 0; orthographic (0, 0, 1)). (Q.e1, Q.yhat) is an isometry of the plane
+ * with the eye at the origin and Q.yhat = Q.z / yhat.z. HFVIS_ERR_INVALID_ARGUMENT for an
+ * invalid camera, NULL pointers, non-finite values, a zero direction or (perspective) ref not
+ * in front of the eye. */
+HFVIS_API hfvis_status hfvis_camera_line_plane(const hfvis_camera *cam, const double ref[3],
+                                               double du, double dv, double e1[3],
+                                               double yhat[3]);
+
+/* ---- falloff ----------------------------------------------------------------------------- */
+
+typedef enum hfvis_falloff_kind {
+    HFVIS_FALLOFF_DEFAULT = 0,        /* = NONE */
+    HFVIS_FALLOFF_NONE = 1,           /* rho = 1: pure obscurance over the whole buffer */
+    HFVIS_FALLOFF_INV_QUADRATIC = 2,  /* rho = r/(r + d^2), r = param (length^2) [P3 Eq. 2] */
+    HFVIS_FALLOFF_HBAO = 3,           /* rho = max(0, r(1 + C)/(r + d^2) - C), r = param,
+                                         C = hbao_c (0 = 0.3); zero from sqrt(r/C) [P3 Eq. 3] */
+    HFVIS_FALLOFF_EXPONENTIAL = 4,    /* rho = exp(-d/lambda), lambda = param */
+    HFVIS_FALLOFF_STEP = 5,           /* rho = 1 for d < R, else 0, R = param (pure AO) */
+    HFVIS_FALLOFF_CUSTOM = 6          /* rho = fn(user, d) clamped to [0, 1] (NaN -> 0); param =
+                                         its support (rho = 0 from there on, fn not called;
+                                         0 = unbounded) */
+} hfvis_falloff_kind;
+
+typedef double (*hfvis_falloff_fn)(void *user, double distance);
+
+/* A falloff rho(d) of the view-space distance d to the occluder: monotonically decreasing by
+ * intent, rho(0) = 1 (spec §1.1). A zero struct is NONE. */
+typedef struct hfvis_falloff {
+    hfvis_falloff_kind kind;
+    double param;                 /* r, lambda, R or the custom support (see the kinds) */
+    double hbao_c;                /* HBAO's C, > 0; 0 = 0.3 */
+    hfvis_falloff_fn fn;          /* CUSTOM only */
+    void *user;                   /* CUSTOM only */
+} hfvis_falloff;
+
+/* HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL, an unknown kind, a param that is not finite
+ * and > 0 where the kind needs one (INV_QUADRATIC, HBAO, EXPONENTIAL, STEP), hbao_c < 0 or not
+ * finite, a CUSTOM falloff without fn or with a negative / non-finite param. */
+HFVIS_API hfvis_status hfvis_falloff_check(const hfvis_falloff *f);
+/* rho(distance) in double (distance >= 0; NULL f = NONE). NaN for an invalid falloff. Pure
+ * (CUSTOM calls fn). */
+HFVIS_API double hfvis_falloff_eval(const hfvis_falloff *f, double distance);
+/* The distance from which rho is 0: sqrt(r/C) for HBAO, R for STEP, the custom param, and
+ * +INFINITY for unbounded falloffs; NaN for an invalid falloff. */
+HFVIS_API double hfvis_falloff_support(const hfvis_falloff *f);
+
+/* ---- directions and the line lattice ([P3] §5.1-5.2, [P4] §6; spec §2.3, §3.5) ------------ */
+
+/* One azimuthal direction of a line sweep. */
+typedef struct hfvis_ssao_direction {
+    double dx, dy;            /* unit screen direction D (pixels; +y down) */
+    double step_x, step_y;    /* step vector along a line, pixels: step*(dx, dy); exact
+                                 integers for box patterns, so snapped samples keep one
+                                 pattern for every receiver ([P3] §5.2) */
+    double step;              /* D_S = |step vector|, pixels */
+    double spacing;           /* D_L, distance between adjacent lines, pixels */
+    double weight;            /* azimuthal coverage / 2 pi; a direction set sums to 1 */
+} hfvis_ssao_direction;
+
+/* K uniform directions psi_k = azimuth0 + 2 pi k/K, D = (cos psi, sin psi) (components within
+ * 1e-15 of 0 or +-1 snapped to them, so axis directions are exact), step vector step*D,
+ * weights 1/K. HFVIS_ERR_INVALID_ARGUMENT for NULL out, K outside 1..HFVIS_SSAO_MAX_DIRECTIONS,
+ * a non-finite azimuth, step or spacing not finite in [1/64, HFVIS_SSAO_MAX_SIZE]. */
+HFVIS_API hfvis_status hfvis_ssao_directions_uniform(int K, double azimuth0_rad, double step,
+                                                     double spacing, hfvis_ssao_direction *out);
+
+/* The K = 8n box-pattern directions of [P3] §5.2, Fig. 10: the vectors from the centre of a
+ * (2n+1) x (2n+1) texel template to the centres of its outer ring, times the integer scale m,
+ * ordered by azimuth from +x (direction 0 = +x). The four axis directions use the mean length
+ * of the others rounded to an integer (the paper's "average of the rest", kept integral so the
+ * snapped pattern stays the same for every receiver: n = 1..4 give axis steps 1, 2, 4, 5 at
+ * m = 1). Weights are the azimuthal coverages w_k = (phi_{k+1} - phi_{k-1})/(4 pi) ([P3] §5.2;
+ * n = 2: 26.57 deg axes, 22.5 deg (2,1)-type, 18.43 deg diagonals). out must hold 8n entries.
+ * HFVIS_ERR_INVALID_ARGUMENT for NULL out, n < 1, m < 1, 8n > HFVIS_SSAO_MAX_DIRECTIONS,
+ * n*m > 4096 or spacing not finite in [1/64, HFVIS_SSAO_MAX_SIZE]. */
+HFVIS_API hfvis_status hfvis_ssao_directions_box(int n, int scale, double spacing,
+                                                 hfvis_ssao_direction *out);
+
+/* The line lattice of one direction over the full buffer (spec §2.3 BuildLattice): lines
+ * parallel to D, spacing D_L apart along P = (-dy, dx) and centred in the texel-centre rectangle
+ * [0.5, W0 - 0.5] x [0.5, H0 - 0.5] (the leftover split evenly at both sides); all lines share
+ * the along-line origin t_min, so step i of every line lies at along-line coordinate
+ * t_min + i*D_S (P4's interval alignment). Line j passes through s_j = s_first + j*D_L;
+ * its samples are the steps i = first .. first + count - 1 inside the rectangle (tolerance
+ * 1e-7 px), at (x0 + i*step_x, y0 + i*step_y). Samples are stored line after line: sample i of
+ * line j has index lines[j].offset + i - lines[j].first in every lattice buffer. */
+typedef struct hfvis_ssao_lattice {
+    hfvis_ssao_direction dir;
+    double px, py;            /* P = (-dy, dx) */
+    double s_first;           /* perpendicular coordinate c.P of line 0 */
+    double t_min;             /* along-line coordinate c.D of step 0 */
+    int line_count;
+    int max_line_samples;     /* longest line */
+    size_t sample_count;      /* all samples of all lines */
+} hfvis_ssao_lattice;
+
+typedef struct hfvis_ssao_line {
+    double x0, y0;            /* screen position of step i = 0 (may lie outside the buffer) */
+    int first, count;         /* steps first .. first + count - 1; count may be 0 */
+    size_t offset;            /* lattice-buffer index of step `first` */
+} hfvis_ssao_line;
+
+/* Set up the lattice of direction dir over the camera's buffer (counts only; O(lines)).
+ * HFVIS_ERR_INVALID_ARGUMENT for an invalid camera or direction (NULL, non-unit or non-finite
+ * D, step or spacing outside [1/64, HFVIS_SSAO_MAX_SIZE], step vector not step*D within 1e-9);
+ * HFVIS_ERR_LIMIT if a direction would have more than 2^31 - 1 samples. */
+HFVIS_API hfvis_status hfvis_ssao_lattice_init(const hfvis_camera *cam,
+                                               const hfvis_ssao_direction *dir,
+                                               hfvis_ssao_lattice *lat);
+
+/* Fill lines[0 .. lat->line_count - 1] for a lattice from hfvis_ssao_lattice_init with the same
+ * camera. HFVIS_ERR_INVALID_ARGUMENT for NULL pointers or an invalid camera. */
+HFVIS_API hfvis_status hfvis_ssao_lattice_lines(const hfvis_camera *cam,
+                                                const hfvis_ssao_lattice *lat,
+                                                hfvis_ssao_line *lines);
+
+/* The lattice sample nearest to screen position (u, v) in lattice coordinates (spec §2.3):
+ * line j = round((c.P - s_first)/D_L) clamped to the lines, step i = round((c.D - t_min)/D_S)
+ * clamped to that line's steps; an empty line is replaced by the nearest non-empty one.
+ * Returns 1 and writes *line, *step, or 0 when the lattice has no sample or an argument is
+ * NULL / non-finite. Within sqrt((D_S/2)^2 + (D_L/2)^2) of (u, v) away from the borders. */
+HFVIS_API int hfvis_ssao_lattice_nearest(const hfvis_ssao_lattice *lat,
+                                         const hfvis_ssao_line *lines, double u, double v,
+                                         int *line, int *step);
