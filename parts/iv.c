@@ -278,6 +278,7 @@ static float vx_iv_pyr_min(const vx_iv_img *im, int x0, int x1, int y0, int y1)
     int L = 1, x, y;
     float m = 2.0f;
     while (L < im->levels && (((x1 >> L) - (x0 >> L)) > 1 || ((y1 >> L) - (y0 >> L)) > 1)) L++;
+    HFVIS_ASSERT(L < im->levels); /* the top level is 1 x 1 */
     {
         const float *lev = im->pyr + im->lev_off[L];
         int lw = im->lev_w[L];
@@ -1038,7 +1039,7 @@ static hfvis_status vx_iv_metric_init(vx_iv_metric *M, const hfvis_mesh *mesh,
     M->samples = opts && opts->sample_count ? opts->sample_count : 100000;
     M->seed = opts ? opts->seed : 0u;
     M->alloc = opts ? opts->alloc : NULL;
-    if (mesh->triangle_count > (size_t)UINT32_MAX) return HFVIS_ERR_LIMIT;
+    if (mesh->triangle_count > (size_t)UINT32_MAX / 2) return HFVIS_ERR_LIMIT;
     for (a = 0; a < 3; a++) lo[a] = HUGE_VAL, hi[a] = -HUGE_VAL;
     for (t = 0; t < mesh->triangle_count; t++) {
         double p[3][3], u[3], w[3], n[3];
@@ -1058,7 +1059,7 @@ static hfvis_status vx_iv_metric_init(vx_iv_metric *M, const hfvis_mesh *mesh,
     nv = vx_grid_voxels(grid);
     for (v = 0; v < nv; v++) np += occ[v] != 0;
     if (nt == 0 || np == 0) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (np > SIZE_MAX / 3) return HFVIS_ERR_LIMIT;
+    if (np > (size_t)UINT32_MAX / 2 || np > SIZE_MAX / 6 || nt > SIZE_MAX / 6) return HFVIS_ERR_LIMIT;
     for (a = 0; a < 3; a++) {
         double m1 = fabs(lo[a]) > fabs(hi[a]) ? fabs(lo[a]) : fabs(hi[a]);
         double g0 = fabs(grid->origin[a]), g1 = fabs(grid->origin[a] + grid->cell[a] * (double)grid->dims[a]);

@@ -105,8 +105,9 @@ typedef struct hfvis_iv_stats {
     size_t cleared, band, kept, unseen; /* classifications performed, summed over images: cleanup
                                            classifies the voxels non-empty at that moment, single
                                            pass every voxel */
-    size_t turned_off;                  /* voxels non-empty before the call and empty after */
-    size_t turned_on;                   /* voxels empty before the call and non-empty after */
+    size_t turned_off;                  /* clears of non-empty voxels (per image; with one image:
+                                           the voxels non-empty before and empty after) */
+    size_t turned_on;                   /* single pass: turn-ons of empty voxels (per image) */
     size_t points_injected;             /* injection points written into a voxel */
     size_t points_background;           /* points on background (zw = 1) or no-data pixels */
     size_t points_outside;              /* points whose world position lies outside the grid */
@@ -131,10 +132,14 @@ HFVIS_API hfvis_status hfvis_iv_bias(const hfvis_volume_grid *grid, const hfvis_
                                      double *out);
 
 /* Classify a world point against one depth image with bias b (spec voxel §4.3): project with
- * proj*view; UNSEEN if clip w <= 0, p'_z > -near_plane, |ndc x| > 1 or |ndc y| > 1; texel
- * (floor((ndc_x+1)/2*W), floor((1-ndc_y)/2*H)) clamped to W-1, H-1; UNSEEN for a no-data texel;
- * then CLEARED / BAND / KEPT by eq. 17 in eye space (double). The affine rows are evaluated as
- * ((m[12+r] + m[8+r] z) + m[4+r] y) + m[r] x, the order hfvis_iv_cleanup uses.
+ * proj*view; UNSEEN if clip w <= 0, p'_z > -near_plane, |ndc x| > 1 or |ndc y| > 1 (ndc =
+ * clip.xy * (1/clip.w)); texel (floor((ndc_x+1)/2*W), floor((1-ndc_y)/2*H)) clamped to W-1, H-1;
+ * UNSEEN for a no-data texel; then CLEARED / BAND / KEPT by eq. 17 in eye space, in double,
+ * exactly as the literal comparisons p'_z > z_e + b and p'_z < z_e - b decide them (for
+ * perspective views a division-free test with a rounding margin settles all but near-ties,
+ * which fall back to the literal form). The affine rows are evaluated as
+ * ((m[12+r] + m[8+r] z) + m[4+r] y) + m[r] x, the order hfvis_iv_cleanup uses. out gets the class,
+ * the texel, p'_z and the texel's z_e.
  * Returns HFVIS_ERR_INVALID_ARGUMENT for NULL, an invalid image (see hfvis_depth_image), a
  * non-finite point, or a negative or non-finite bias. No allocation. */
 HFVIS_API hfvis_status hfvis_iv_classify(const hfvis_depth_image *image, const double point[3],
@@ -154,8 +159,10 @@ HFVIS_API hfvis_status hfvis_iv_classify_voxel(const hfvis_depth_image *image,
 
 /* Cleanup phase (Alg. 7 "Cleanup", Listing 7.1, eq. 17): for every image in order and every voxel
  * of prev non-empty at that moment, CLEARED sets all channels of curr to 0, any other class copies
- * prev's values (the decision is hfvis_iv_classify_voxel's). Sequential images are equivalent to
- * the thesis' per-image ping-pong. image_count may be 0 (a copy). stats may be NULL.
+ * prev's values (the decision is hfvis_iv_classify_voxel's). Empty voxels stay empty and are not
+ * classified (on the GPU every voxel is; the result is the same), so the cost over a surface
+ * volume is mostly one pass over memory. Sequential images are equivalent to the thesis'
+ * per-image ping-pong. image_count may be 0 (a copy). stats may be NULL.
  * Errors: HFVIS_ERR_INVALID_ARGUMENT for NULL prev/curr/data, images NULL with image_count > 0,
  * an invalid image, unequal grids or channel counts, bad options; HFVIS_ERR_OUT_OF_MEMORY.
  * Allocates nothing with the centre footprint; with the conservative one 1 block of about
@@ -218,7 +225,8 @@ HFVIS_API hfvis_status hfvis_iv_occupancy(const hfvis_volume *vol, int channel, 
                                           size_t *count);
 
 /* Exact Euclidean distance from p to the triangle (a, b, c), all in double (closest point by
- * Voronoi regions of the triangle, Ericson 2005 §5.1.5; a degenerate triangle is its segments). */
+ * Voronoi regions of the triangle, Ericson 2005 §5.1.5; a degenerate triangle is its segments).
+ * NaN if a pointer is NULL. */
 HFVIS_API double hfvis_point_triangle_distance(const double p[3], const double a[3],
                                                const double b[3], const double c[3]);
 
@@ -249,8 +257,8 @@ typedef struct hfvis_distance_metrics {
  * are ignored (never sampled, never nearest). Accelerated by two bounding-volume hierarchies
  * (triangles, voxel centres) with exact pruning: equal bit for bit to
  * hfvis_voxel_distance_metrics_naive. Errors: HFVIS_ERR_INVALID_ARGUMENT for NULL, an invalid
- * mesh or grid, a mesh without positive-area triangles, an empty voxel set;
- * HFVIS_ERR_OUT_OF_MEMORY. Allocates 6 blocks (O(T + voxels + sample_count)). Cost about
+ * mesh or grid, a mesh without positive-area triangles, an empty voxel set; HFVIS_ERR_LIMIT past
+ * 2^31 triangles or voxels; HFVIS_ERR_OUT_OF_MEMORY. Allocates 6 blocks (O(T + voxels + sample_count)). Cost about
  * O((voxels + samples) log). */
 HFVIS_API hfvis_status hfvis_voxel_distance_metrics(const hfvis_mesh *mesh,
                                                     const hfvis_volume_grid *grid,
