@@ -1068,7 +1068,8 @@ static size_t vx_cons_format_number(double x, char *out)
     size_t len = 0;
     int prec, e10, nd = 0, k;
     double ax = fabs(x);
-    if (ax == 0.0) {
+    HFVIS_ASSERT(isfinite(x));
+    if (ax == 0.0 || !isfinite(x)) {
         out[0] = '0';
         return 1;
     }
@@ -1176,14 +1177,16 @@ static size_t vx_cons_binvox_header(const hfvis_volume_grid *g, int d, char *out
     return len;
 }
 
-/* Side of the binvox cube for a valid grid; 0 when d^3 exceeds HFVIS_VOLUME_MAX_VOXELS. */
+/* Side of the binvox cube for a valid grid; 0 when d^3 exceeds HFVIS_VOLUME_MAX_VOXELS or the
+ * scale d * max(cell) overflows a double. */
 static int vx_cons_binvox_side(const hfvis_volume_grid *g)
 {
     int d = g->dims[0] > g->dims[1] ? g->dims[0] : g->dims[1];
     size_t dd = 1;
     if (g->dims[2] > d) d = g->dims[2];
     if (!vx_mul_size(dd, (size_t)d, &dd) || !vx_mul_size(dd, (size_t)d, &dd)
-        || !vx_mul_size(dd, (size_t)d, &dd) || dd > HFVIS_VOLUME_MAX_VOXELS)
+        || !vx_mul_size(dd, (size_t)d, &dd) || dd > HFVIS_VOLUME_MAX_VOXELS
+        || !isfinite((double)d * vx_cons_max3(g->cell[0], g->cell[1], g->cell[2])))
         return 0;
     return d;
 }

@@ -168,12 +168,13 @@ HFVIS_API hfvis_status hfvis_bitmask_to_occupancy(const hfvis_volume_grid *grid,
  * exactly (up to 15), else 17 digits. Any nonzero occupancy byte is written as 1. */
 
 /* Exact size in bytes of the encoding of (grid, occ) (scans occ for the runs); 0 for NULL, an
- * invalid grid or a cube of more than HFVIS_VOLUME_MAX_VOXELS voxels. */
+ * invalid grid, a cube of more than HFVIS_VOLUME_MAX_VOXELS voxels or a scale D*cell that
+ * overflows a double. */
 HFVIS_API size_t hfvis_binvox_encode_size(const hfvis_volume_grid *grid, const uint8_t *occ);
 
 /* Encodes into out (capacity bytes); *written = bytes written. Returns HFVIS_ERR_INVALID_ARGUMENT
  * for NULL or an invalid grid, HFVIS_ERR_LIMIT when the padded cube exceeds
- * HFVIS_VOLUME_MAX_VOXELS, HFVIS_ERR_BUFFER_TOO_SMALL below hfvis_binvox_encode_size. */
+ * HFVIS_VOLUME_MAX_VOXELS or its scale overflows, HFVIS_ERR_BUFFER_TOO_SMALL below hfvis_binvox_encode_size. */
 HFVIS_API hfvis_status hfvis_binvox_encode(const hfvis_volume_grid *grid, const uint8_t *occ,
                                            void *out, size_t capacity, size_t *written);
 

@@ -927,6 +927,10 @@ TEST(binvox_raw_files)
         CHECK(hfvis_binvox_encode_size(&big, occ) == 0);
         CHECK_EQ_STATUS(hfvis_binvox_encode(&big, occ, raw, sizeof raw, &w), HFVIS_ERR_LIMIT);
         CHECK_EQ_STATUS(hfvis_binvox_save(pb, &big, occ), HFVIS_ERR_LIMIT);
+        big = tc_grid(4, 4, 4); /* scale 4 * 1e308 overflows */
+        big.cell[1] = 1e308;
+        CHECK(hfvis_binvox_encode_size(&big, occ) == 0);
+        CHECK_EQ_STATUS(hfvis_binvox_encode(&big, occ, raw, sizeof raw, &w), HFVIS_ERR_LIMIT);
     }
 }
 
