@@ -525,7 +525,7 @@ HFVIS_API hfvis_status hfvis_bvh_build(const hfvis_mesh *mesh, const hfvis_bvh_o
                 vx_bvh_bin bin[HFVIS_BVH_MAX_BINS];
                 double right_area[HFVIS_BVH_MAX_BINS];
                 uint32_t right_count[HFVIS_BVH_MAX_BINS];
-                double best = INFINITY, scale_best = 0.0;
+                double best = HUGE_VAL, scale_best = 0.0;
                 int best_axis = -1, best_bin = -1, b;
                 for (a = 0; a < 3; a++) {
                     double scale;

@@ -215,8 +215,8 @@ static void mesh_bounds_f(const hfvis_mesh *m, double lo[3], double hi[3])
     size_t i;
     int a;
     for (a = 0; a < 3; a++) {
-        lo[a] = INFINITY;
-        hi[a] = -INFINITY;
+        lo[a] = HUGE_VAL;
+        hi[a] = -HUGE_VAL;
     }
     for (i = 0; i < 3 * m->triangle_count; i++) {
         const float *p = m->xyz + 3 * (size_t)m->indices[i];
