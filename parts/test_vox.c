@@ -1289,6 +1289,53 @@ TEST(degenerate_and_extreme_triangles)
     vox_soup_free(&s);
 }
 
+/* Search estimates far off: a triangle 8e9 voxels wide whose depth rises by 2^-20 across it
+ * (slope 1.2e-16 per voxel) and crosses the slab boundary z = 3 at x = 0, in the middle of a
+ * 64-wide grid: the rounding of the depth (1 ulp of 3 = 4.4e-16) moves the crossing by pixels
+ * either way, so the boundary search falls back to galloping up and down and to bisection
+ * (checked with an instrumented build); it must still equal the oracle,
+ * and every column holds exactly one voxel (slab 2 or 3, nondecreasing along x). A second,
+ * tilted copy in y exercises the decreasing direction. */
+TEST(pathological_estimates)
+{
+    const double d = 1.0 / 4194304.0; /* 2^-22 */
+    hfvis_volume_grid g = vox_grid(64, 16, 8, -32.0, 0.0, 0.0, 1.0, 1.0, 1.0);
+    vox_soup s;
+    int mi, dir;
+    vox_soup_init(&s, 1);
+    for (dir = 0; dir < 4; dir++) {
+        double A[3] = { -2e9, -2e9, 3.0 - d }, B[3] = { 6e9, -2e9, 3.0 + 3.0 * d }, C[3] = { -2e9, 6e9, 3.0 - d };
+        uint8_t occ[64 * 16 * 8];
+        int i, j, k, bad = 0;
+        if (dir & 1) { /* depth decreasing along x */
+            A[2] = 3.0 + d, B[2] = 3.0 - 3.0 * d, C[2] = 3.0 + d;
+        }
+        g.origin[1] = dir & 2 ? 1e6 + 0.25 : 0.0; /* other rows: other rounding */
+        g.origin[0] = dir & 2 ? -31.5 : -32.0;
+        s.nt = s.nv = 0;
+        vox_soup_tri(&s, A, B, C);
+        for (mi = 0; mi < 3; mi++) {
+            hfvis_voxelize_options o = vox_opts(vox_methods[mi], HFVIS_AXES_DOMINANT, 0);
+            CHECK(vox_same(vox_soup_mesh(&s), &g, &o, NULL));
+            CHECK(vox_count(vox_soup_mesh(&s), &g, &o, occ) == 1024);
+            o.axes = HFVIS_AXES_ALL;
+            CHECK(vox_same(vox_soup_mesh(&s), &g, &o, NULL));
+        }
+        for (j = 0; j < 16; j++) {
+            int prev = dir & 1 ? 9 : -1;
+            for (i = 0; i < 64; i++) {
+                int n = 0, kk = -1;
+                for (k = 0; k < 8; k++)
+                    if (occ[vox_lin(&g, i, j, k)]) n++, kk = k;
+                if (n != 1 || (kk != 2 && kk != 3) || (dir & 1 ? kk > prev : kk < prev)) bad++;
+                prev = kk;
+            }
+        }
+        CHECK(bad == 0);
+    }
+    vox_soup_free(&s);
+}
+
 /* ---- bad arguments, allocator ------------------------------------------------------------- */
 
 typedef struct vox_counting {
@@ -1456,6 +1503,7 @@ int main(int argc, char **argv)
     RUN(three_axes_six_separating);
     RUN(translation_invariance);
     RUN(degenerate_and_extreme_triangles);
+    RUN(pathological_estimates);
     RUN(bad_arguments);
     RUN(no_allocation);
     return TEST_DONE();
