@@ -96,8 +96,8 @@ static int vx_iv_same_grid(const hfvis_volume_grid *a, const hfvis_volume_grid *
     return 1;
 }
 
-/* Options against a volume of `channels` channels (channels 0: no volume, e.g. classify).
- * need_bias: resolve the bias for grid. */
+/* Options against a volume of `channels` channels (channels 0: no volume, e.g. classify); the
+ * bias is resolved for grid. */
 static hfvis_status vx_iv_resolve(const hfvis_iv_options *opts, const hfvis_volume_grid *grid,
                                   int channels, vx_iv_opt *o)
 {

@@ -71,10 +71,14 @@ typedef enum hfvis_iv_footprint {
                                            voxel about its centre, a voxel containing a surface
                                            point that lies on any pixel-centre ray is then never
                                            cleared (the first hit on that ray is not farther than
-                                           the point), so voxels of geometry that stays put are
-                                           never lost and the set converges monotonically; the
-                                           centre rule can clear such voxels at silhouettes. Needs
-                                           b >= the half diagonal for this guarantee. */
+                                           the point). Needs b >= the half diagonal. So static
+                                           geometry's voxels are not lost at silhouettes, as they
+                                           are with the centre rule, and the set converges
+                                           monotonically up to "slivers": a voxel whose surface
+                                           part no pixel ray of a view meets can still be cleared
+                                           by that view (and re-injected by another). Costs a
+                                           pyramid (see hfvis_iv_cleanup) and a footprint scan per
+                                           vetoed clear. */
 } hfvis_iv_footprint;
 
 #define HFVIS_IV_NO_CHANNEL (-1)
