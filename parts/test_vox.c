@@ -882,6 +882,9 @@ TEST(attribute_callbacks)
     memset(vals, 0, sizeof vals);
     hfvis_voxel_fragment_attributes(&fr, vals, &at); /* zero struct: occupancy only */
     CHECK(vals[0] == 1.0f && vals[1] == 0.0f);
+    memset(vals, 0, sizeof vals);
+    hfvis_voxel_fragment_attributes(&fr, vals, NULL); /* no layout: occupancy only */
+    CHECK(vals[0] == 1.0f && vals[1] == 0.0f);
     /* through the voxelizer: one triangle, all four attributes */
     vox_soup_init(&s, 1);
     vox_soup_tri(&s, a, b, c);

@@ -563,7 +563,6 @@ static void vx_vox_row_slabs(vx_vox_sink *s, const vx_vox_row_ctx *r, int pw, in
 
 /* ---- the three methods, fast ------------------------------------------------------------- */
 
-
 /* The first pixel of [lo, hi] where an edge monotone along the row passes (inc != 0: it passes
  * on a suffix) or fails (inc == 0: it passes on a prefix), hi + 1 if none; `est` is the root
  * estimate. Most rows are settled by two evaluations at the estimate; otherwise gallop. */
@@ -874,9 +873,14 @@ HFVIS_API void hfvis_voxel_fragment_attributes(const hfvis_voxel_fragment *f, fl
                                                void *user)
 {
     const hfvis_voxel_attributes *at = (const hfvis_voxel_attributes *)user;
-    unsigned flags = at->flags ? at->flags : HFVIS_VOXEL_ATTR_OCCUPANCY;
+    unsigned flags;
     float alb[3] = { 1.0f, 1.0f, 1.0f };
     int c = 0, i;
+    if (!at) { /* no layout: occupancy only */
+        values[0] = 1.0f;
+        return;
+    }
+    flags = at->flags ? at->flags : HFVIS_VOXEL_ATTR_OCCUPANCY;
     if (at->albedo)
         for (i = 0; i < 3; i++) alb[i] = at->albedo[3 * (size_t)f->triangle + (size_t)i];
     if (flags & HFVIS_VOXEL_ATTR_OCCUPANCY) values[c++] = 1.0f;

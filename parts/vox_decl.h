@@ -196,7 +196,7 @@ HFVIS_API int hfvis_voxel_attribute_channel(unsigned flags, unsigned attribute);
  * ((const hfvis_voxel_attributes *)user)->flags, packed from channel 0 (see
  * hfvis_voxel_attribute_channel): occupancy 1, the unit normal, the triangle's albedo, and
  * radiance = albedo * E(position, normal) / pi + emission (the thesis' "direct lighting with
- * shadows and emission", [G12] §6.5, ch. 5 §5.5.1). user must not be NULL; the per-triangle
- * arrays must hold 3 floats for every triangle of the mesh voxelized. */
+ * shadows and emission", [G12] §6.5, ch. 5 §5.5.1). user NULL = occupancy only. The
+ * per-triangle arrays must hold 3 floats for every triangle of the mesh voxelized. */
 HFVIS_API void hfvis_voxel_fragment_attributes(const hfvis_voxel_fragment *f, float *values,
                                                void *user);
