@@ -26,17 +26,21 @@
  * when the ray meets the side the normal (v1 - v0) x (v2 - v0) points to (direction.n < 0;
  * det > 0), 0 otherwise. A hit needs t in [t_min, t_max] and t finite.
  *
- * Exactness: hfvis_ray_triangle is a pure function of the ray and the three float vertices
- * (bit-identical on one build; with SSE2-style float arithmetic and no FMA contraction, on any
- * IEEE-754 build). The closest hit is the candidate of smallest t; exactly equal t go to the
- * LOWEST triangle index. The BVH queries return exactly what their naive oracles return (same
- * t, triangle, u, v, front bits; for any-hit the same verdict), because both apply the same
- * test and the same ordering and the BVH prunes conservatively: node boxes are padded (see
+ * Exactness: hfvis_ray_triangle is a pure function of the ray and the three float vertices,
+ * bit-identical across IEEE-754 builds that evaluate float in float (FLT_EVAL_METHOD 0: SSE2,
+ * ARM) without FMA contraction. The closest hit is the candidate of smallest t; exactly equal t
+ * go to the LOWEST triangle index. The BVH queries return exactly what their naive oracles
+ * return (same t, triangle, u, v, front bits; for any-hit the same verdict): both apply the
+ * same test and the same order, and the BVH prunes conservatively - node boxes are padded (see
  * hfvis_bvh_node) and the slab test widens the far distance and the current best distance by
- * the factor (1 + 2^-16), above T. Ize's 1 + 2 gamma_3 ("Robust BVH Ray Traversal", JCGT 2(2),
- * 2013). Not guaranteed: a computed hit distance can stray further than that margin outside its
- * box only for rays within about 1e-4 rad of grazing a triangle near its box's boundary
- * (ill-conditioned t); no such case occurs in the tests' 10^5+ rays.
+ * the factor (1 + 2^-16), above the 1 + 2 gamma_3 of T. Ize, "Robust BVH Ray Traversal", JCGT
+ * 2(2), 2013. What is not guaranteed: the margins cover the rounding of the slab test and of
+ * the hit distance of well-conditioned hits; for a ray grazing a triangle (angle below about
+ * 1e-4 rad) t is ill-conditioned and could in principle fall outside the padded box, and the
+ * BVH would then lose that hit only if a competing hit at almost the same distance (or t_min /
+ * t_max) prunes the box. Never observed: 0 mismatches in the tests (over 2e5 rays, incl. rays
+ * through edges, vertices and face planes), in 1.9e6 more seeded rays, and in 4.8e6
+ * adversarial rays grazing triangle corners at 1e-3 .. 1e-8 rad.
  * Range: every vertex - origin difference and the sheared coordinates must stay in float range
  * (|coordinates| below about 1e37); beyond that a triangle may be missed (never a crash). */
 
