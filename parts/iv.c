@@ -481,24 +481,21 @@ static int vx_iv_empty(const float *v, int channels)
     return 1;
 }
 
-/* First index >= i of a voxel of the row (n voxels, C channels) that is not empty, or n. Blocks
- * of 8 floats are tested without branches (a cleanup pass over a surface volume spends most of
- * its time here). */
+/* First index in [i, n) of a non-empty voxel of the row (C channels per voxel), or n: the first
+ * non-zero float from voxel i on, tested in branch-free blocks of 8 floats (a cleanup pass over a
+ * surface volume spends most of its time here). */
 static int vx_iv_next_nonempty(const float *row, int i, int n, int C)
 {
-    if (C == 1) {
-        while (i + 8 <= n) {
-            const float *v = row + i;
-            int z = (v[0] == 0.0f) & (v[1] == 0.0f) & (v[2] == 0.0f) & (v[3] == 0.0f)
-                    & (v[4] == 0.0f) & (v[5] == 0.0f) & (v[6] == 0.0f) & (v[7] == 0.0f);
-            if (!z) break;
-            i += 8;
-        }
-        while (i < n && row[i] == 0.0f) i++;
-        return i;
+    size_t f = (size_t)i * (size_t)C, end = (size_t)n * (size_t)C;
+    while (f + 8 <= end) {
+        const float *v = row + f;
+        int z = (v[0] == 0.0f) & (v[1] == 0.0f) & (v[2] == 0.0f) & (v[3] == 0.0f)
+                & (v[4] == 0.0f) & (v[5] == 0.0f) & (v[6] == 0.0f) & (v[7] == 0.0f);
+        if (!z) break;
+        f += 8;
     }
-    while (i < n && vx_iv_empty(row + (size_t)i * (size_t)C, C)) i++;
-    return i;
+    while (f < end && row[f] == 0.0f) f++;
+    return (int)(f / (size_t)C);
 }
 
 /* Per-call counters. */
