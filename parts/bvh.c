@@ -54,8 +54,8 @@ static int vx_bvh_ray_valid(const hfvis_ray *r)
     if (r->direction[0] == 0.0f && r->direction[1] == 0.0f && r->direction[2] == 0.0f) return 0;
     if (!(r->t_min >= 0.0f) || !isfinite(r->t_min)) return 0; /* NaN fails the first test */
     if (!(r->t_max >= r->t_min)) return 0;                    /* NaN fails; +inf allowed */
-    if (r->cull != HFVIS_RAY_CULL_NONE && r->cull != HFVIS_RAY_CULL_BACK
-        && r->cull != HFVIS_RAY_CULL_FRONT)
+    if (r->cull != HFVIS_CULL_NONE && r->cull != HFVIS_CULL_BACK
+        && r->cull != HFVIS_CULL_FRONT)
         return 0;
     return 1;
 }
@@ -194,8 +194,8 @@ static VX_BVH_INLINE int vx_bvh_tri(const vx_bvh_ray *r, const float *p0, const 
     if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return 0;
     det = U + V + W;
     if (!(fabsf(det) <= FLT_MAX)) goto exact_path; /* overflow or NaN: redo in double */
-    if (r->cull == HFVIS_RAY_CULL_BACK && det < 0.0f) return 0;
-    if (r->cull == HFVIS_RAY_CULL_FRONT && det > 0.0f) return 0;
+    if (r->cull == HFVIS_CULL_BACK && det < 0.0f) return 0;
+    if (r->cull == HFVIS_CULL_FRONT && det > 0.0f) return 0;
     /* scaled hit distance ("Az = Sz*A[kz]" ..., "T = U*Az + V*Bz + W*Cz") and t = T/det */
     T = U * (r->sz * az) + V * (r->sz * bz) + W * (r->sz * cz);
     t = T / det;
@@ -215,8 +215,8 @@ exact_path: {
         if ((Ud < 0.0 || Vd < 0.0 || Wd < 0.0) && (Ud > 0.0 || Vd > 0.0 || Wd > 0.0)) return 0;
         dd = Ud + Vd + Wd;
         if (dd == 0.0 || !(fabs(dd) <= DBL_MAX)) return 0; /* edge-on (or not finite) */
-        if (r->cull == HFVIS_RAY_CULL_BACK && dd < 0.0) return 0;
-        if (r->cull == HFVIS_RAY_CULL_FRONT && dd > 0.0) return 0;
+        if (r->cull == HFVIS_CULL_BACK && dd < 0.0) return 0;
+        if (r->cull == HFVIS_CULL_FRONT && dd > 0.0) return 0;
         Td = Ud * ((double)r->sz * (double)az) + Vd * ((double)r->sz * (double)bz)
              + Wd * ((double)r->sz * (double)cz);
         td = Td / dd;

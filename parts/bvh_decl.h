@@ -8,7 +8,7 @@
  * A ray is the segment origin + t*direction, t in [t_min, t_max] (both ends included), in the
  * mesh's world units; direction need not be unit length (t is then in units of |direction|).
  * Valid when origin and direction are finite, direction != 0, 0 <= t_min <= t_max (t_min
- * finite, t_max may be +INFINITY) and cull is one of the hfvis_ray_cull values.
+ * finite, t_max may be +INFINITY) and cull is one of the hfvis_cull_mode values.
  *
  * Triangles are tested with the watertight algorithm of S. Woop, C. Benthin, I. Wald,
  * "Watertight Ray/Triangle Intersection", JCGT 2(1), 2013 (hfvis_ray_triangle): the vertices
@@ -44,15 +44,8 @@
  * Range: every vertex - origin difference and the sheared coordinates must stay in float range
  * (|coordinates| below about 1e37); beyond that a triangle may be missed (never a crash). */
 
-/* Which faces a ray ignores (the convention of the rasterizer: front = the side the normal
- * (v1 - v0) x (v2 - v0) points to). */
-typedef enum hfvis_ray_cull {
-    HFVIS_RAY_CULL_NONE = 0,  /* default: both sides hit */
-    HFVIS_RAY_CULL_BACK = 1,  /* ignore triangles seen from behind (direction . n > 0), as the
-                                 one-sided AO rays of Laine & Karras */
-    HFVIS_RAY_CULL_FRONT = 2  /* ignore triangles seen from the front (direction . n < 0) */
-} hfvis_ray_cull;
-
+/* A ray (see above). A zero-initialised struct is invalid (direction 0); t_max = INFINITY and
+ * cull = HFVIS_CULL_NONE are the usual choices. */
 typedef struct hfvis_ray {
     float origin[3];
     float direction[3];   /* finite, not all zero; need not be unit length */
@@ -60,7 +53,11 @@ typedef struct hfvis_ray {
                              (0, L] of AO rays use the smallest positive float, or an offset
                              that skips the receiver's own triangle) */
     float t_max;          /* >= t_min, may be INFINITY; hits with t <= t_max count */
-    hfvis_ray_cull cull;  /* default (0) HFVIS_RAY_CULL_NONE */
+    hfvis_cull_mode cull; /* the rasterizer's enum: HFVIS_CULL_NONE (default, 0) both sides
+                             hit; HFVIS_CULL_BACK ignores triangles seen from behind
+                             (direction . n > 0, n = (v1 - v0) x (v2 - v0)), as the one-sided
+                             AO rays of Laine & Karras; HFVIS_CULL_FRONT ignores those seen from
+                             the front (direction . n < 0) */
 } hfvis_ray;
 
 /* A ray query's result. On a miss: t = +INFINITY, triangle = HFVIS_NO_TRIANGLE, u = v = 0,

@@ -95,7 +95,7 @@ static hfvis_ray make_ray(double ox, double oy, double oz, double dx, double dy,
     r.direction[2] = (float)dz;
     r.t_min = 0.0f;
     r.t_max = INFINITY;
-    r.cull = HFVIS_RAY_CULL_NONE;
+    r.cull = HFVIS_CULL_NONE;
     return r;
 }
 
@@ -300,7 +300,7 @@ static hfvis_ray random_ray(const hfvis_mesh *m, const double lo[3], const doubl
         }
     }
     a = (int)(rng_u32() % 10);
-    r.cull = a < 2 ? HFVIS_RAY_CULL_BACK : a < 3 ? HFVIS_RAY_CULL_FRONT : HFVIS_RAY_CULL_NONE;
+    r.cull = a < 2 ? HFVIS_CULL_BACK : a < 3 ? HFVIS_CULL_FRONT : HFVIS_CULL_NONE;
     return r;
 }
 
@@ -426,8 +426,8 @@ static int compare_rays(const hfvis_bvh *b, const hfvis_mesh *m, int count, uint
         if (hn.triangle != HFVIS_NO_TRIANGLE) {
             hits++;
             if (!(hn.t >= r.t_min && hn.t <= r.t_max)) bad++;
-            if (r.cull == HFVIS_RAY_CULL_BACK && !hn.front) bad++;
-            if (r.cull == HFVIS_RAY_CULL_FRONT && hn.front) bad++;
+            if (r.cull == HFVIS_CULL_BACK && !hn.front) bad++;
+            if (r.cull == HFVIS_CULL_FRONT && hn.front) bad++;
         } else if (!(hn.t == INFINITY && hn.u == 0.0f && hn.v == 0.0f && hn.front == 0)) {
             bad++;
         }
@@ -466,14 +466,14 @@ TEST(ray_triangle_analytic)
     CHECK_EQ_STATUS(hfvis_ray_triangle(&r, a, b, c, &h), HFVIS_OK);
     CHECK(h.triangle == 0 && h.front == 0);
     CHECK_NEAR(h.t, 3.0, T_ANALYTIC, 0);
-    r.cull = HFVIS_RAY_CULL_BACK;
+    r.cull = HFVIS_CULL_BACK;
     CHECK_EQ_STATUS(hfvis_ray_triangle(&r, a, b, c, &h), HFVIS_OK);
     CHECK(h.triangle == HFVIS_NO_TRIANGLE && h.t == INFINITY);
-    r.cull = HFVIS_RAY_CULL_FRONT;
+    r.cull = HFVIS_CULL_FRONT;
     CHECK_EQ_STATUS(hfvis_ray_triangle(&r, a, b, c, &h), HFVIS_OK);
     CHECK(h.triangle == 0);
     r = make_ray(0.25, 0.5, 2, 0, 0, -1);
-    r.cull = HFVIS_RAY_CULL_FRONT;
+    r.cull = HFVIS_CULL_FRONT;
     CHECK_EQ_STATUS(hfvis_ray_triangle(&r, a, b, c, &h), HFVIS_OK);
     CHECK(h.triangle == HFVIS_NO_TRIANGLE);
     /* edges and vertices belong to the triangle (edge functions exactly 0: double path) */
@@ -859,10 +859,10 @@ TEST(tie_lowest_index)
         hfvis_bvh_closest_hit(&b, &m, &r, &h);
         hfvis_ray_closest_naive(&m, &r, &hn);
         if (h.triangle != 0 || !hit_equal(&h, &hn)) bad++;
-        r.cull = HFVIS_RAY_CULL_BACK; /* odd triangles are reversed: back faces from above */
+        r.cull = HFVIS_CULL_BACK; /* odd triangles are reversed: back faces from above */
         hfvis_bvh_closest_hit(&b, &m, &r, &h);
         if (h.triangle != 0) bad++;
-        r.cull = HFVIS_RAY_CULL_FRONT;
+        r.cull = HFVIS_CULL_FRONT;
         hfvis_bvh_closest_hit(&b, &m, &r, &h);
         hfvis_ray_closest_naive(&m, &r, &hn);
         if (h.triangle != 1 || !hit_equal(&h, &hn)) bad++;
@@ -889,7 +889,7 @@ TEST(t_range)
         hfvis_hit h0, h, hn;
         r.t_min = 0.0f;
         r.t_max = INFINITY;
-        r.cull = HFVIS_RAY_CULL_NONE;
+        r.cull = HFVIS_CULL_NONE;
         hfvis_bvh_closest_hit(&b, &m, &r, &h0);
         if (h0.triangle == HFVIS_NO_TRIANGLE) continue;
         n++;
@@ -1149,8 +1149,8 @@ TEST(bad_arguments)
         case 7: q.t_max = NAN; break;
         case 8: q.t_min = 2.0f; q.t_max = 1.0f; break;
         case 9: q.t_min = INFINITY; break;
-        case 10: q.cull = (hfvis_ray_cull)3; break;
-        case 11: q.cull = (hfvis_ray_cull)-1; break;
+        case 10: q.cull = (hfvis_cull_mode)3; break;
+        case 11: q.cull = (hfvis_cull_mode)-1; break;
         default: q.direction[0] = q.direction[1] = 0.0f; q.direction[2] = -0.0f; break;
         }
         h = hs;
