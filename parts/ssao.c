@@ -947,3 +947,764 @@ int hfvis_ssao_lattice_nearest(const hfvis_ssao_lattice *lat, const hfvis_ssao_l
     if (!(lat->dir.spacing > 0.0) || !(lat->dir.step > 0.0)) return 0;
     return ss_nearest(lat, lines, u, v, line, step);
 }
+
+/* ========================================================================================== */
+/* 5. P3 line-sweep ambient obscurance ([P3] §4-5, Alg. 1; spec §3)                           */
+/* ========================================================================================== */
+
+#define SS_LSAO_DEFAULT_K 16
+#define SS_DEFAULT_SIN_T (-0.85)   /* [P3] §4.1: "fix all tangents to sin(t) = -0.85" */
+#define SS_DEFAULT_REJECT_DEPTH 0.03 /* spec §3.6 [R], from P4's box filter */
+#define SS_DEFAULT_REJECT_NORMAL 0.5
+#define SS_COINCIDENT 1e-12        /* |h| <= 1e-12 |p|: the same point (spec §3.9 item 3) */
+
+/* Resolved LSAO/HBAO parameters in the form the loops use. */
+typedef struct ss_cfg {
+    ss_fall fall;
+    int tangent, sampling, exact, ties, gather;
+    double fixed;
+    double rej_z;      /* < 0: off */
+    double rej_n;      /* -inf: off */
+} ss_cfg;
+
+hfvis_lsao_options hfvis_lsao_options_default(void)
+{
+    hfvis_lsao_options o;
+    memset(&o, 0, sizeof o);
+    o.directions = SS_LSAO_DEFAULT_K;
+    o.pattern = HFVIS_SSAO_PATTERN_BOX;
+    o.box_scale = 1;
+    o.step = 1.0;
+    o.spacing = 0.0; /* depends on K: hfvis_lsao_options_resolve fills it in */
+    o.falloff.kind = HFVIS_FALLOFF_NONE;
+    o.tangent = HFVIS_SSAO_TANGENT_FIXED;
+    o.fixed_sin_t = SS_DEFAULT_SIN_T;
+    o.sampling = HFVIS_SSAO_SAMPLING_NEAREST;
+    o.plane = HFVIS_SSAO_PLANE_PAPER;
+    o.pop = HFVIS_LSAO_POP_TIES;
+    o.gather = HFVIS_SSAO_GATHER_NEAREST;
+    o.reject_depth = SS_DEFAULT_REJECT_DEPTH;
+    o.reject_normal = SS_DEFAULT_REJECT_NORMAL;
+    return o;
+}
+
+/* Mean |step| of the non-axis box vectors of n (the paper's D_S of a box pattern). */
+static double ss_box_mean(int n, int m)
+{
+    double s = 0.0;
+    int i, cnt = 0;
+    /* ring vectors (n, j) for j = 1..n-1 and (n, n), times 8 symmetric copies: the mean over one
+     * octant-symmetric set equals the mean over the ring without axes */
+    for (i = 1; i <= n; i++) {
+        double l = sqrt((double)n * (double)n + (double)i * (double)i);
+        int mult = i == n ? 4 : 8;
+        s += l * (double)mult;
+        cnt += mult;
+    }
+    return (double)m * s / (double)cnt;
+}
+
+hfvis_status hfvis_lsao_options_resolve(const hfvis_lsao_options *in, hfvis_lsao_options *out)
+{
+    hfvis_lsao_options o;
+    int K, k;
+    if (!out) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (in) o = *in;
+    else memset(&o, 0, sizeof o);
+    K = o.directions ? o.directions : SS_LSAO_DEFAULT_K;
+    if (K < 1 || K > HFVIS_SSAO_MAX_DIRECTIONS) return HFVIS_ERR_INVALID_ARGUMENT;
+    o.directions = K;
+    if (o.pattern == HFVIS_SSAO_PATTERN_DEFAULT) o.pattern = HFVIS_SSAO_PATTERN_BOX;
+    if (o.box_scale < 0 || !ss_finite(o.step) || !ss_finite(o.spacing) ||
+        !ss_finite(o.azimuth0_rad))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.box_scale == 0) o.box_scale = 1;
+    if (o.step == 0.0) o.step = 1.0;
+    if (!ss_step_ok(o.step)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.spacing != 0.0 && !ss_step_ok(o.spacing)) return HFVIS_ERR_INVALID_ARGUMENT;
+    switch (o.pattern) {
+    case HFVIS_SSAO_PATTERN_BOX:
+        if (K % 8 != 0 || o.box_scale > 4096 / (K / 8)) return HFVIS_ERR_INVALID_ARGUMENT;
+        if (o.spacing == 0.0) o.spacing = (double)K / (4.0 * ss_box_mean(K / 8, o.box_scale));
+        break;
+    case HFVIS_SSAO_PATTERN_UNIFORM:
+        if (o.spacing == 0.0) o.spacing = (double)K / (4.0 * o.step);
+        break;
+    case HFVIS_SSAO_PATTERN_CUSTOM: {
+        double ws = 0.0;
+        if (!o.custom_directions) return HFVIS_ERR_INVALID_ARGUMENT;
+        for (k = 0; k < K; k++) {
+            const hfvis_ssao_direction *d = &o.custom_directions[k];
+            if (!ss_dir_ok(d) || !ss_finite(d->weight) || d->weight < 0.0)
+                return HFVIS_ERR_INVALID_ARGUMENT;
+            ws += d->weight;
+        }
+        if (!(ws > 0.0) || !ss_finite(ws)) return HFVIS_ERR_INVALID_ARGUMENT;
+        break;
+    }
+    default:
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    }
+    if (o.spacing != 0.0 && o.spacing < SS_MIN_STEP) o.spacing = SS_MIN_STEP;
+    if (o.falloff.kind == HFVIS_FALLOFF_DEFAULT) o.falloff.kind = HFVIS_FALLOFF_NONE;
+    if (hfvis_falloff_check(&o.falloff) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.falloff.kind == HFVIS_FALLOFF_HBAO && o.falloff.hbao_c == 0.0) o.falloff.hbao_c = 0.3;
+    if (o.tangent == HFVIS_SSAO_TANGENT_DEFAULT) o.tangent = HFVIS_SSAO_TANGENT_FIXED;
+    if (o.tangent < HFVIS_SSAO_TANGENT_FIXED || o.tangent > HFVIS_SSAO_TANGENT_FIXED_HULL_REAL_EVAL)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.fixed_sin_t == 0.0) o.fixed_sin_t = SS_DEFAULT_SIN_T;
+    if (!(o.fixed_sin_t >= -1.0 && o.fixed_sin_t <= 1.0)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.sampling == HFVIS_SSAO_SAMPLING_DEFAULT) o.sampling = HFVIS_SSAO_SAMPLING_NEAREST;
+    if (o.sampling != HFVIS_SSAO_SAMPLING_NEAREST && o.sampling != HFVIS_SSAO_SAMPLING_BILINEAR)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.plane == HFVIS_SSAO_PLANE_DEFAULT) o.plane = HFVIS_SSAO_PLANE_PAPER;
+    if (o.plane != HFVIS_SSAO_PLANE_PAPER && o.plane != HFVIS_SSAO_PLANE_EXACT)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.pop == HFVIS_LSAO_POP_DEFAULT) o.pop = HFVIS_LSAO_POP_TIES;
+    if (o.pop != HFVIS_LSAO_POP_TIES && o.pop != HFVIS_LSAO_POP_STRICT)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.gather == HFVIS_SSAO_GATHER_DEFAULT) o.gather = HFVIS_SSAO_GATHER_NEAREST;
+    if (o.gather != HFVIS_SSAO_GATHER_NEAREST && o.gather != HFVIS_SSAO_GATHER_BILINEAR)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.reject_depth != o.reject_depth || o.reject_normal != o.reject_normal ||
+        o.reject_normal > 1.0)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.reject_depth == 0.0) o.reject_depth = SS_DEFAULT_REJECT_DEPTH;
+    if (o.reject_normal == 0.0) o.reject_normal = SS_DEFAULT_REJECT_NORMAL;
+    *out = o;
+    return HFVIS_OK;
+}
+
+/* Directions of resolved options into out[K], weights normalised. */
+static void ss_lsao_dirs(const hfvis_lsao_options *o, hfvis_ssao_direction *out)
+{
+    int K = o->directions, k;
+    double ws = 0.0;
+    switch (o->pattern) {
+    case HFVIS_SSAO_PATTERN_BOX:
+        hfvis_ssao_directions_box(K / 8, o->box_scale, o->spacing, out);
+        break;
+    case HFVIS_SSAO_PATTERN_UNIFORM:
+        hfvis_ssao_directions_uniform(K, o->azimuth0_rad, o->step, o->spacing, out);
+        break;
+    default:
+        memcpy(out, o->custom_directions, sizeof *out * (size_t)K);
+        break;
+    }
+    for (k = 0; k < K; k++) ws += out[k].weight;
+    for (k = 0; k < K; k++) out[k].weight /= ws;
+}
+
+hfvis_status hfvis_lsao_directions(const hfvis_lsao_options *opts, hfvis_ssao_direction *out)
+{
+    hfvis_lsao_options o;
+    if (!out || hfvis_lsao_options_resolve(opts, &o) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_lsao_dirs(&o, out);
+    return HFVIS_OK;
+}
+
+static void ss_cfg_from_lsao(const hfvis_lsao_options *o, ss_cfg *g)
+{
+    memset(g, 0, sizeof *g);
+    ss_fall_load(&o->falloff, &g->fall);
+    g->tangent = (int)o->tangent;
+    g->sampling = (int)o->sampling;
+    g->exact = o->plane == HFVIS_SSAO_PLANE_EXACT;
+    g->ties = o->pop == HFVIS_LSAO_POP_TIES;
+    g->gather = (int)o->gather;
+    g->fixed = o->fixed_sin_t;
+    g->rej_z = o->reject_depth;
+    g->rej_n = o->reject_normal;
+}
+
+/* Occ of point (hx, hy) = occluder - receiver seen along zenith (ux, uy) with tangent st
+ * ([P3] Alg. 1 l.25-29); *sin_out = Sin(h) (-inf for a coincident point, which casts st). */
+static double ss_occ(const ss_fall *f, double hx, double hy, double ux, double uy, double st,
+                     double tiny, double *sin_out)
+{
+    double len = sqrt(hx * hx + hy * hy), s;
+    if (!(len > tiny)) {
+        *sin_out = -SS_INF;
+        return st;
+    }
+    s = (hx * ux + hy * uy) / len;
+    *sin_out = s;
+    return s > st ? st + (s - st) * ss_rho(f, len) : st;
+}
+
+/* The obscurity hull along one line ([P3] Alg. 1, spec §3.3). */
+static void ss_hull_line(const double *x, const double *y, const double *stc, const double *ste,
+                         int n, int persp, double fixed, const ss_fall *f, int ties, int *stack,
+                         double *out)
+{
+    int top = 0, i;
+    for (i = 0; i < n; i++) {
+        double px = x[i], py = y[i], r, ux, uy, sc, se, tiny, o1 = 0.0, s1 = 0.0, o2, s2;
+        if (!ss_finite(px) || !ss_finite(py)) {
+            out[i] = SS_NAN;
+            continue;
+        }
+        r = sqrt(px * px + py * py);
+        if (persp) {
+            if (!(r > 0.0)) {
+                out[i] = SS_NAN;
+                continue;
+            }
+            ux = -px / r; /* l.7: unit vector towards the camera */
+            uy = -py / r;
+        } else {
+            ux = 0.0;
+            uy = 1.0;
+        }
+        tiny = SS_COINCIDENT * (fabs(px) + fabs(py));
+        sc = stc ? stc[i] : fixed;
+        se = ste ? ste[i] : fixed;
+        if (top >= 1) {
+            int a = stack[top - 1];
+            o1 = ss_occ(f, x[a] - px, y[a] - py, ux, uy, sc, tiny, &s1);
+        }
+        while (top >= 2) { /* l.12-18 */
+            int b = stack[top - 2];
+            o2 = ss_occ(f, x[b] - px, y[b] - py, ux, uy, sc, tiny, &s2);
+            if ((ties ? o1 <= o2 : o1 < o2) && s1 < s2) {
+                top--;
+                o1 = o2;
+                s1 = s2;
+            } else {
+                break;
+            }
+        }
+        if (top == 0) {
+            out[i] = se; /* no occluder yet: rho = 0 (spec §3.9 item 1) */
+        } else if (se == sc) {
+            out[i] = o1; /* l.20 */
+        } else {
+            int a = stack[top - 1];
+            double s;
+            out[i] = ss_occ(f, x[a] - px, y[a] - py, ux, uy, se, tiny, &s);
+        }
+        if (top == 0 || s1 != -SS_INF) stack[top++] = i; /* l.21 (coincident points skipped) */
+    }
+}
+
+/* Brute-force oracle (spec §4.2). */
+static void ss_hull_line_naive(const double *x, const double *y, const double *stc,
+                               const double *ste, int n, int persp, double fixed,
+                               const ss_fall *f, double *out)
+{
+    int i, j;
+    for (i = 0; i < n; i++) {
+        double px = x[i], py = y[i], r, ux, uy, sc, se, tiny, maxs = -SS_INF, bo = 0.0, bs = 0.0;
+        int best = -1;
+        if (!ss_finite(px) || !ss_finite(py)) {
+            out[i] = SS_NAN;
+            continue;
+        }
+        r = sqrt(px * px + py * py);
+        if (persp) {
+            if (!(r > 0.0)) {
+                out[i] = SS_NAN;
+                continue;
+            }
+            ux = -px / r;
+            uy = -py / r;
+        } else {
+            ux = 0.0;
+            uy = 1.0;
+        }
+        tiny = SS_COINCIDENT * (fabs(px) + fabs(py));
+        sc = stc ? stc[i] : fixed;
+        se = ste ? ste[i] : fixed;
+        for (j = i - 1; j >= 0; j--) {
+            double s, o;
+            if (!ss_finite(x[j]) || !ss_finite(y[j])) continue;
+            if (persp && !(x[j] * x[j] + y[j] * y[j] > 0.0)) continue;
+            o = ss_occ(f, x[j] - px, y[j] - py, ux, uy, sc, tiny, &s);
+            if (!(s > maxs)) continue; /* hidden behind a nearer point */
+            maxs = s;
+            if (best < 0 || o > bo || (o == bo && s > bs)) {
+                best = j;
+                bo = o;
+                bs = s;
+            }
+        }
+        if (best < 0) {
+            out[i] = se;
+        } else if (se == sc) {
+            out[i] = bo;
+        } else {
+            double s;
+            out[i] = ss_occ(f, x[best] - px, y[best] - py, ux, uy, se, tiny, &s);
+        }
+    }
+}
+
+static hfvis_status ss_line_args(const double *x, const double *y, int n, int ortho,
+                                 const hfvis_lsao_options *opts, hfvis_lsao_options *o)
+{
+    if (n < 0 || (n > 0 && (!x || !y)) || (ortho != 0 && ortho != 1))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    return hfvis_lsao_options_resolve(opts, o) == HFVIS_OK ? HFVIS_OK : HFVIS_ERR_INVALID_ARGUMENT;
+}
+
+hfvis_status hfvis_lsao_line(const double *x, const double *y, const double *sin_t_cull,
+                             const double *sin_t_eval, int n, int orthographic,
+                             const hfvis_lsao_options *opts, int *stack, double *out)
+{
+    hfvis_lsao_options o;
+    ss_cfg g;
+    if (ss_line_args(x, y, n, orthographic, opts, &o) != HFVIS_OK || (n > 0 && (!stack || !out)))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_cfg_from_lsao(&o, &g);
+    ss_hull_line(x, y, sin_t_cull, sin_t_eval, n, !orthographic, g.fixed, &g.fall, g.ties, stack,
+                 out);
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_lsao_line_naive(const double *x, const double *y, const double *sin_t_cull,
+                                   const double *sin_t_eval, int n, int orthographic,
+                                   const hfvis_lsao_options *opts, double *out)
+{
+    hfvis_lsao_options o;
+    ss_cfg g;
+    if (ss_line_args(x, y, n, orthographic, opts, &o) != HFVIS_OK || (n > 0 && !out))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_cfg_from_lsao(&o, &g);
+    ss_hull_line_naive(x, y, sin_t_cull, sin_t_eval, n, !orthographic, g.fixed, &g.fall, out);
+    return HFVIS_OK;
+}
+
+/* Depth at screen position (u, v): NEAREST reads texel (tx, ty) (already snapped by the
+ * caller) and returns its centre in (*qu, *qv); BILINEAR interpolates at (u, v) (NaN if a tap
+ * with non-zero weight is background). Background -> NaN. */
+static double ss_sample(const ss_cam *c, const float *depth, int bilinear, double u, double v,
+                        int tx, int ty, double *qu, double *qv)
+{
+    double z;
+    if (!bilinear) {
+        z = ss_tex(c, depth, tx, ty);
+        *qu = (double)tx + 0.5;
+        *qv = (double)ty + 0.5;
+        return ss_bg(c, z) ? SS_NAN : z;
+    } else {
+        double a = u - 0.5, b = v - 0.5, fa, fb, z00, z10, z01, z11;
+        int x0, y0, x1, y1;
+        if (a < 0.0) a = 0.0;
+        if (b < 0.0) b = 0.0;
+        if (a > (double)(c->W - 1)) a = (double)(c->W - 1);
+        if (b > (double)(c->H - 1)) b = (double)(c->H - 1);
+        x0 = (int)a;
+        y0 = (int)b;
+        if (x0 > c->W - 2) x0 = c->W > 1 ? c->W - 2 : 0;
+        if (y0 > c->H - 2) y0 = c->H > 1 ? c->H - 2 : 0;
+        fa = a - (double)x0;
+        fb = b - (double)y0;
+        x1 = c->W > 1 ? x0 + 1 : x0;
+        y1 = c->H > 1 ? y0 + 1 : y0;
+        z00 = ss_tex(c, depth, x0, y0);
+        z10 = ss_tex(c, depth, x1, y0);
+        z01 = ss_tex(c, depth, x0, y1);
+        z11 = ss_tex(c, depth, x1, y1);
+        *qu = u;
+        *qv = v;
+        if ((fa < 1.0 && fb < 1.0 && ss_bg(c, z00)) || (fa > 0.0 && fb < 1.0 && ss_bg(c, z10)) ||
+            (fa < 1.0 && fb > 0.0 && ss_bg(c, z01)) || (fa > 0.0 && fb > 0.0 && ss_bg(c, z11)))
+            return SS_NAN;
+        if (fa == 0.0) z10 = z00, z11 = z01; /* zero weights never touch a background tap */
+        if (fb == 0.0) z01 = z00, z11 = z10;
+        if (fa == 1.0) z00 = z10, z01 = z11;
+        if (fb == 1.0) z00 = z01, z10 = z11;
+        z = (1.0 - fb) * ((1.0 - fa) * z00 + fa * z10) + fb * ((1.0 - fa) * z01 + fa * z11);
+        return z;
+    }
+}
+
+static int ss_clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
+
+static int ss_texel(double p, int n)
+{
+    double f = floor(p);
+    if (!(f >= 0.0)) return 0;
+    if (f > (double)(n - 1)) return n - 1;
+    return (int)f;
+}
+
+/* sin t of the real tangent of a sample ([P3] §4.1, spec §3.4): normal of texel (tx, ty)
+ * projected into the plane, t = side*(-n2.y, n2.x) (side +1: toward the occluders behind, as
+ * LSAO; -1: ahead, as HBAO), sin t = t.u/|t|; the fixed value without a usable normal. */
+static double ss_real_sin_t(const ss_cam *c, const float *normals, int tx, int ty,
+                            const double e1[3], const double yh[3], int exact, double ux,
+                            double uy, double side, double fixed)
+{
+    const float *np = normals + 3 * ((ptrdiff_t)ty * c->stride + tx);
+    double n[3], n2x, n2y, tx2, ty2, l;
+    n[0] = (double)np[0];
+    n[1] = (double)np[1];
+    n[2] = (double)np[2];
+    n2x = ss_dot3(n, e1);
+    n2y = exact ? ss_dot3(n, yh) : n[2];
+    tx2 = -side * n2y;
+    ty2 = side * n2x;
+    l = sqrt(tx2 * tx2 + ty2 * ty2);
+    if (!(l > 1e-12) || !ss_finite(l)) return fixed;
+    return (tx2 * ux + ty2 * uy) / l;
+}
+
+/* The 2D samples of one lattice line: x, y (NaN at holes), real-tangent sines (if wanted),
+ * sample depths. */
+static void ss_line_points(const ss_cam *c, const ss_cfg *g, const float *depth,
+                           const float *normals, const hfvis_ssao_lattice *L,
+                           const hfvis_ssao_line *ln, double *x, double *y, double *st_real,
+                           float *zs)
+{
+    const hfvis_ssao_direction *d = &L->dir;
+    double e1[3], yh[3], ref[3], fx0 = 0.0, fy0 = 0.0;
+    int bil = g->sampling == HFVIS_SSAO_SAMPLING_BILINEAR, k, tx0 = 0, ty0 = 0;
+    int integral = d->step_x == floor(d->step_x) && d->step_y == floor(d->step_y) &&
+                   fabs(d->step_x) < 1e9 && fabs(d->step_y) < 1e9;
+    ss_plane_e1(c, d->dx, d->dy, e1);
+    if (ln->count > 0) {
+        int mid = ln->first + ln->count / 2;
+        ss_unproject(c, ln->x0 + (double)mid * d->step_x, ln->y0 + (double)mid * d->step_y, 1.0,
+                     ref);
+        ss_plane_yhat(c, e1, ref, yh);
+        tx0 = ss_texel(ln->x0 + (double)ln->first * d->step_x, c->W);
+        ty0 = ss_texel(ln->y0 + (double)ln->first * d->step_y, c->H);
+        fx0 = ln->x0 + (double)ln->first * d->step_x - (double)tx0;
+        fy0 = ln->y0 + (double)ln->first * d->step_y - (double)ty0;
+    }
+    for (k = 0; k < ln->count; k++) {
+        int i = ln->first + k, tx, ty;
+        double u = ln->x0 + (double)i * d->step_x, v = ln->y0 + (double)i * d->step_y, qu, qv, z,
+               Q[3];
+        if (integral) { /* box patterns: integer offsets from the first texel ([P3] §5.2) */
+            tx = ss_clampi(tx0 + k * (int)d->step_x, 0, c->W - 1);
+            ty = ss_clampi(ty0 + k * (int)d->step_y, 0, c->H - 1);
+            if (bil) { /* integer part exact, the same fraction at every step */
+                u = (double)(tx0 + k * (int)d->step_x) + fx0;
+                v = (double)(ty0 + k * (int)d->step_y) + fy0;
+            }
+        } else {
+            tx = ss_texel(u, c->W);
+            ty = ss_texel(v, c->H);
+        }
+        z = ss_sample(c, depth, bil, u, v, tx, ty, &qu, &qv);
+        if (zs) zs[k] = (float)z;
+        if (z != z) {
+            x[k] = y[k] = SS_NAN;
+            if (st_real) st_real[k] = g->fixed;
+            continue;
+        }
+        ss_unproject(c, qu, qv, z, Q);
+        x[k] = ss_dot3(Q, e1);
+        y[k] = g->exact ? ss_dot3(Q, yh) : Q[2];
+        if (st_real) {
+            double ux = 0.0, uy = 1.0;
+            if (c->persp) {
+                double r = sqrt(x[k] * x[k] + y[k] * y[k]);
+                ux = -x[k] / r;
+                uy = -y[k] / r;
+            }
+            st_real[k] = ss_real_sin_t(c, normals, tx, ty, e1, yh, g->exact, ux, uy, 1.0, g->fixed);
+        }
+    }
+}
+
+/* Sweep (or brute-force) every line of a direction into values / sample depths.
+ * scratch: 4*M doubles (x, y, sin t, out), stack: M ints. */
+static void ss_lsao_sweep_dir(const ss_cam *c, const ss_cfg *g, const float *depth,
+                              const float *normals, const hfvis_ssao_lattice *L,
+                              const hfvis_ssao_line *lines, double *scratch, int *stack,
+                              int naive, float *values, float *sdepth)
+{
+    int M = L->max_line_samples, j, k;
+    double *x = scratch, *y = scratch + M, *st = scratch + 2 * (size_t)M,
+           *out = scratch + 3 * (size_t)M;
+    int real = g->tangent != HFVIS_SSAO_TANGENT_FIXED;
+    for (j = 0; j < L->line_count; j++) {
+        const hfvis_ssao_line *ln = &lines[j];
+        const double *stc, *ste;
+        if (ln->count < 1) continue;
+        ss_line_points(c, g, depth, normals, L, ln, x, y, real ? st : NULL,
+                       sdepth ? sdepth + ln->offset : NULL);
+        stc = g->tangent == HFVIS_SSAO_TANGENT_REAL ? st : NULL;
+        ste = real ? st : NULL;
+        if (naive)
+            ss_hull_line_naive(x, y, stc, ste, ln->count, c->persp, g->fixed, &g->fall, out);
+        else
+            ss_hull_line(x, y, stc, ste, ln->count, c->persp, g->fixed, &g->fall, g->ties, stack,
+                         out);
+        for (k = 0; k < ln->count; k++) values[ln->offset + (size_t)k] = (float)out[k];
+    }
+}
+
+static hfvis_status ss_lsao_direction(const hfvis_camera *cam, const float *depth,
+                                      const float *normals, const hfvis_lsao_options *opts,
+                                      const hfvis_ssao_lattice *lat, const hfvis_ssao_line *lines,
+                                      float *values, float *sample_depth, int naive)
+{
+    ss_cam c;
+    ss_cfg g;
+    hfvis_lsao_options o;
+    size_t M, bytes, nb = 0;
+    void *blk;
+    float *nrm = NULL;
+    if (ss_cam_load(cam, &c) != HFVIS_OK || hfvis_lsao_options_resolve(opts, &o) != HFVIS_OK ||
+        !depth || !lat || !lines || !values || !ss_dir_ok(&lat->dir) || lat->line_count < 0 ||
+        lat->max_line_samples < 0)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_cfg_from_lsao(&o, &g);
+    M = (size_t)lat->max_line_samples;
+    if (M == 0) return HFVIS_OK;
+    bytes = ss_bytes3(M, 1, 4 * sizeof(double) + sizeof(int));
+    if (!bytes) return HFVIS_ERR_OUT_OF_MEMORY;
+    if (g.tangent != HFVIS_SSAO_TANGENT_FIXED && !normals) {
+        nb = ss_bytes3((size_t)c.stride, (size_t)c.H, 3 * sizeof(float));
+        nrm = (float *)ss_alloc(o.alloc, nb);
+        if (!nrm) return HFVIS_ERR_OUT_OF_MEMORY;
+        ss_normals_fill(&c, depth, nrm);
+        normals = nrm;
+    }
+    blk = ss_alloc(o.alloc, bytes);
+    if (!blk) {
+        ss_free(o.alloc, nrm);
+        return HFVIS_ERR_OUT_OF_MEMORY;
+    }
+    ss_lsao_sweep_dir(&c, &g, depth, normals, lat, lines, (double *)blk,
+                      (int *)((double *)blk + 4 * M), naive, values, sample_depth);
+    ss_free(o.alloc, blk);
+    ss_free(o.alloc, nrm);
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_lsao_direction(const hfvis_camera *cam, const float *depth,
+                                  const float *normals, const hfvis_lsao_options *opts,
+                                  const hfvis_ssao_lattice *lat, const hfvis_ssao_line *lines,
+                                  float *values, float *sample_depth)
+{
+    return ss_lsao_direction(cam, depth, normals, opts, lat, lines, values, sample_depth, 0);
+}
+
+hfvis_status hfvis_lsao_direction_naive(const hfvis_camera *cam, const float *depth,
+                                        const float *normals, const hfvis_lsao_options *opts,
+                                        const hfvis_ssao_lattice *lat,
+                                        const hfvis_ssao_line *lines, float *values,
+                                        float *sample_depth)
+{
+    return ss_lsao_direction(cam, depth, normals, opts, lat, lines, values, sample_depth, 1);
+}
+
+/* Is lattice sample (j, i) acceptable for receiver depth zc / normal nc? Writes its value. */
+static int ss_accept(const ss_cam *c, const ss_cfg *g, const float *normals,
+                     const hfvis_ssao_lattice *L, const hfvis_ssao_line *ln, int i,
+                     const float *values, const float *sdepth, double zc, const float *nc,
+                     double *val)
+{
+    size_t idx;
+    double v, zs;
+    if (i < ln->first || i >= ln->first + ln->count) return 0;
+    idx = ln->offset + (size_t)(i - ln->first);
+    v = (double)values[idx];
+    zs = (double)sdepth[idx];
+    if (v != v || zs != zs) return 0;
+    if (g->rej_z >= 0.0 && fabs(zs - zc) > g->rej_z * zc) return 0;
+    if (normals && g->rej_n > -1.0) {
+        int tx = ss_texel(ln->x0 + (double)i * L->dir.step_x, c->W);
+        int ty = ss_texel(ln->y0 + (double)i * L->dir.step_y, c->H);
+        const float *ns = normals + 3 * ((ptrdiff_t)ty * c->stride + tx);
+        double dot = (double)ns[0] * (double)nc[0] + (double)ns[1] * (double)nc[1] +
+                     (double)ns[2] * (double)nc[2];
+        if (!(dot >= g->rej_n)) return 0;
+    }
+    *val = v;
+    return 1;
+}
+
+/* The nearest accepted sample within radius R2 (squared) of (u, v) (spec §3.6 fallback). */
+static int ss_fallback(const ss_cam *c, const ss_cfg *g, const float *normals,
+                       const hfvis_ssao_lattice *L, const hfvis_ssao_line *lines,
+                       const float *values, const float *sdepth, double u, double v, double zc,
+                       const float *nc, double R, double *val)
+{
+    const hfvis_ssao_direction *d = &L->dir;
+    double jf = (u * L->px + v * L->py - L->s_first) / d->spacing;
+    double tf = (u * d->dx + v * d->dy - L->t_min) / d->step;
+    int a = (int)ceil(R / d->spacing), b = (int)ceil(R / d->step), j0 = (int)floor(jf + 0.5),
+        i0 = (int)floor(tf + 0.5), j, i, found = 0;
+    double best = R * R, bv = 0.0;
+    for (j = j0 - a; j <= j0 + a; j++) {
+        const hfvis_ssao_line *ln;
+        if (j < 0 || j >= L->line_count) continue;
+        ln = &lines[j];
+        for (i = i0 - b; i <= i0 + b; i++) {
+            double su = ln->x0 + (double)i * d->step_x - u, sv = ln->y0 + (double)i * d->step_y - v;
+            double dd = su * su + sv * sv, vv;
+            if (dd > best || (found && dd == best)) continue;
+            if (!ss_accept(c, g, normals, L, ln, i, values, sdepth, zc, nc, &vv)) continue;
+            best = dd;
+            bv = vv;
+            found = 1;
+        }
+    }
+    *val = bv;
+    return found;
+}
+
+/* Gather one direction into sum / weight (inner pixels, row-major W). */
+static void ss_gather_dir(const ss_cam *c, const ss_cfg *g, const float *depth,
+                          const float *normals, const hfvis_ssao_lattice *L,
+                          const hfvis_ssao_line *lines, const float *values, const float *sdepth,
+                          double *sum, double *wsum)
+{
+    const hfvis_ssao_direction *d = &L->dir;
+    int W = c->W - 2 * c->gx, x, y, nlines = L->line_count;
+    double w = d->weight, ids = 1.0 / d->step, idl = 1.0 / d->spacing;
+    double R2 = 2.0 * sqrt(0.25 * d->step * d->step + 0.25 * d->spacing * d->spacing);
+    if (nlines < 1) return;
+    for (y = c->gy; y < c->H - c->gy; y++) {
+        double v = (double)y + 0.5;
+        for (x = c->gx; x < c->W - c->gx; x++) {
+            double u = (double)x + 0.5, zc = ss_tex(c, depth, x, y), val = 0.0;
+            const float *nc = normals ? normals + 3 * ((ptrdiff_t)y * c->stride + x) : NULL;
+            double jf, tf;
+            int ok = 0;
+            size_t o;
+            if (ss_bg(c, zc)) continue;
+            jf = (u * L->px + v * L->py - L->s_first) * idl;
+            tf = (u * d->dx + v * d->dy - L->t_min) * ids;
+            if (g->gather == HFVIS_SSAO_GATHER_NEAREST) {
+                int j, i;
+                if (ss_nearest(L, lines, u, v, &j, &i))
+                    ok = ss_accept(c, g, normals, L, &lines[j], i, values, sdepth, zc, nc, &val);
+            } else {
+                double fj = floor(jf), fi = floor(tf), aj = jf - fj, ai = tf - fi, ws = 0.0,
+                       vs = 0.0;
+                int dj, di;
+                for (dj = 0; dj < 2; dj++)
+                    for (di = 0; di < 2; di++) {
+                        double wt = (dj ? aj : 1.0 - aj) * (di ? ai : 1.0 - ai), vv;
+                        double jj = fj + (double)dj, ii = fi + (double)di;
+                        if (!(wt > 0.0) || jj < 0.0 || jj >= (double)nlines) continue;
+                        if (!ss_accept(c, g, normals, L, &lines[(int)jj], (int)ii, values,
+                                       sdepth, zc, nc, &vv))
+                            continue;
+                        ws += wt;
+                        vs += wt * vv;
+                    }
+                if (ws > 0.0) {
+                    val = vs / ws;
+                    ok = 1;
+                }
+            }
+            if (!ok)
+                ok = ss_fallback(c, g, normals, L, lines, values, sdepth, u, v, zc, nc, R2, &val);
+            if (!ok) continue;
+            o = (size_t)(y - c->gy) * (size_t)W + (size_t)(x - c->gx);
+            sum[o] += w * val;
+            wsum[o] += w;
+        }
+    }
+}
+
+hfvis_status hfvis_lsao_gather(const hfvis_camera *cam, const float *depth, const float *normals,
+                               const hfvis_lsao_options *opts, const hfvis_ssao_lattice *lat,
+                               const hfvis_ssao_line *lines, const float *values,
+                               const float *sample_depth, double *sum, double *weight)
+{
+    ss_cam c;
+    ss_cfg g;
+    hfvis_lsao_options o;
+    if (ss_cam_load(cam, &c) != HFVIS_OK || hfvis_lsao_options_resolve(opts, &o) != HFVIS_OK ||
+        !depth || !lat || !lines || !values || !sample_depth || !sum || !weight ||
+        !ss_dir_ok(&lat->dir) || !ss_finite(lat->dir.weight))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_cfg_from_lsao(&o, &g);
+    ss_gather_dir(&c, &g, depth, normals, lat, lines, values, sample_depth, sum, weight);
+    return HFVIS_OK;
+}
+
+/* Final AO of accumulators into ao (inner pixels). */
+static void ss_finish(const ss_cam *c, const float *depth, const double *sum, const double *wsum,
+                      float *ao, ptrdiff_t ao_stride)
+{
+    int W = c->W - 2 * c->gx, H = c->H - 2 * c->gy, x, y;
+    for (y = 0; y < H; y++)
+        for (x = 0; x < W; x++) {
+            size_t o = (size_t)y * (size_t)W + (size_t)x;
+            double a = 0.0;
+            if (!ss_bg(c, ss_tex(c, depth, x + c->gx, y + c->gy)) && wsum[o] > 0.0) {
+                a = sum[o] / wsum[o];
+                a = a > 0.0 ? (a < 1.0 ? a : 1.0) : 0.0;
+            }
+            ao[(ptrdiff_t)y * ao_stride + x] = (float)a;
+        }
+}
+
+hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth, const float *normals,
+                        const hfvis_lsao_options *opts, float *ao, ptrdiff_t ao_stride)
+{
+    ss_cam c;
+    ss_cfg g;
+    hfvis_lsao_options o;
+    hfvis_ssao_direction *dirs = NULL;
+    hfvis_ssao_lattice lat;
+    hfvis_ssao_line *lines = NULL;
+    float *nrm = NULL, *vals = NULL;
+    double *scratch = NULL, *acc = NULL;
+    size_t maxs = 0, npix, b;
+    int K, k, maxl = 0, maxm = 0, W, H;
+    hfvis_status s = HFVIS_OK;
+    if (ss_cam_load(cam, &c) != HFVIS_OK || hfvis_lsao_options_resolve(opts, &o) != HFVIS_OK ||
+        !depth || !ao)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    W = c.W - 2 * c.gx;
+    H = c.H - 2 * c.gy;
+    if (ao_stride < W) return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_cfg_from_lsao(&o, &g);
+    K = o.directions;
+    npix = (size_t)W * (size_t)H;
+    dirs = (hfvis_ssao_direction *)ss_alloc(o.alloc, sizeof *dirs * (size_t)K);
+    if (!dirs) return HFVIS_ERR_OUT_OF_MEMORY;
+    ss_lsao_dirs(&o, dirs);
+    for (k = 0; k < K; k++) {
+        s = ss_lattice_init(&c, &dirs[k], &lat);
+        if (s != HFVIS_OK) goto done;
+        if (lat.line_count > maxl) maxl = lat.line_count;
+        if (lat.max_line_samples > maxm) maxm = lat.max_line_samples;
+        if (lat.sample_count > maxs) maxs = lat.sample_count;
+    }
+    s = HFVIS_ERR_OUT_OF_MEMORY;
+    if (g.tangent != HFVIS_SSAO_TANGENT_FIXED && !normals) {
+        b = ss_bytes3((size_t)c.stride, (size_t)c.H, 3 * sizeof(float));
+        if (!b || !(nrm = (float *)ss_alloc(o.alloc, b))) goto done;
+        ss_normals_fill(&c, depth, nrm);
+    }
+    if (!(lines = (hfvis_ssao_line *)ss_alloc(o.alloc, sizeof *lines * (size_t)(maxl > 0 ? maxl : 1))))
+        goto done;
+    b = ss_bytes3(maxs > 0 ? maxs : 1, 2, sizeof(float));
+    if (!b || !(vals = (float *)ss_alloc(o.alloc, b))) goto done;
+    b = ss_bytes3((size_t)(maxm > 0 ? maxm : 1), 1, 4 * sizeof(double) + sizeof(int));
+    if (!b || !(scratch = (double *)ss_alloc(o.alloc, b))) goto done;
+    b = ss_bytes3(npix, 2, sizeof(double));
+    if (!b || !(acc = (double *)ss_alloc(o.alloc, b))) goto done;
+    for (b = 0; b < 2 * npix; b++) acc[b] = 0.0;
+    for (k = 0; k < K; k++) {
+        ss_lattice_init(&c, &dirs[k], &lat);
+        ss_lattice_fill(&c, &lat, lines);
+        ss_lsao_sweep_dir(&c, &g, depth, nrm ? nrm : normals, &lat, lines, scratch,
+                          (int *)(scratch + 4 * (size_t)(maxm > 0 ? maxm : 1)), 0, vals,
+                          vals + (maxs > 0 ? maxs : 1));
+        ss_gather_dir(&c, &g, depth, normals, &lat, lines, vals, vals + (maxs > 0 ? maxs : 1),
+                      acc, acc + npix);
+    }
+    ss_finish(&c, depth, acc, acc + npix, ao, ao_stride);
+    s = HFVIS_OK;
+done:
+    ss_free(o.alloc, acc);
+    ss_free(o.alloc, scratch);
+    ss_free(o.alloc, vals);
+    ss_free(o.alloc, lines);
+    ss_free(o.alloc, nrm);
+    ss_free(o.alloc, dirs);
+    return s;
+}

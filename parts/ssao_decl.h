@@ -272,3 +272,195 @@ HFVIS_API hfvis_status hfvis_ssao_lattice_lines(const hfvis_camera *cam,
 HFVIS_API int hfvis_ssao_lattice_nearest(const hfvis_ssao_lattice *lat,
                                          const hfvis_ssao_line *lines, double u, double v,
                                          int *line, int *step);
+
+/* ---- P3 line-sweep ambient obscurance (LSAO) ---------------------------------------------- */
+
+typedef enum hfvis_ssao_pattern {
+    HFVIS_SSAO_PATTERN_DEFAULT = 0,  /* = BOX */
+    HFVIS_SSAO_PATTERN_BOX = 1,      /* hfvis_ssao_directions_box(K/8, box_scale, spacing) */
+    HFVIS_SSAO_PATTERN_UNIFORM = 2,  /* hfvis_ssao_directions_uniform(K, azimuth0, step, spacing) */
+    HFVIS_SSAO_PATTERN_CUSTOM = 3    /* the caller's K directions (custom_directions) */
+} hfvis_ssao_pattern;
+
+/* The tangent plane of Eq. 1, used to decide what the hull culls and to evaluate the result
+ * ([P3] §4.1, Fig. 7; spec §3.4). */
+typedef enum hfvis_ssao_tangent {
+    HFVIS_SSAO_TANGENT_DEFAULT = 0,            /* LSAO: FIXED; HBAO: REAL */
+    HFVIS_SSAO_TANGENT_FIXED = 1,              /* sin t = fixed_sin_t everywhere (P3's choice) */
+    HFVIS_SSAO_TANGENT_REAL = 2,               /* the receiver's tangent for both (strategy 1) */
+    HFVIS_SSAO_TANGENT_FIXED_HULL_REAL_EVAL = 3 /* fixed for the hull, real for the value (2) */
+} hfvis_ssao_tangent;
+
+/* How depth is read along a line ([P3] §5.2, spec §2.4). */
+typedef enum hfvis_ssao_sampling {
+    HFVIS_SSAO_SAMPLING_DEFAULT = 0,   /* LSAO, HBAO: NEAREST; ray tracer: see its options */
+    HFVIS_SSAO_SAMPLING_NEAREST = 1,   /* snap to the texel centre, deproject there (as HBAO) */
+    HFVIS_SSAO_SAMPLING_BILINEAR = 2   /* bilinear depth (continuous height-field assumption),
+                                          deprojected at the continuous position; a tap with
+                                          non-zero weight on background makes a hole */
+} hfvis_ssao_sampling;
+
+/* The 2D coordinates of a line's azimuthal plane (spec §2.2). */
+typedef enum hfvis_ssao_plane {
+    HFVIS_SSAO_PLANE_DEFAULT = 0,  /* LSAO: PAPER; HBAO: EXACT */
+    HFVIS_SSAO_PLANE_PAPER = 1,    /* (Q.e1, Q.z) as [P3] Alg. 1 l.4 (with e1 normalised and
+                                      screen y flipped); exact only for lines through the
+                                      principal point */
+    HFVIS_SSAO_PLANE_EXACT = 2     /* (Q.e1, Q.yhat): an isometry of the line's plane */
+} hfvis_ssao_plane;
+
+/* The hull's pop test ([P3] Alg. 1 l.12; spec §3.3 tie rule). */
+typedef enum hfvis_lsao_pop {
+    HFVIS_LSAO_POP_DEFAULT = 0,  /* = TIES */
+    HFVIS_LSAO_POP_TIES = 1,     /* pop when occ(top) <= occ(second) and the second is higher */
+    HFVIS_LSAO_POP_STRICT = 2    /* the paper's literal occ(top) < occ(second): sticks on deep
+                                    points behind depth steps (spec §3.3: 5x the error) */
+} hfvis_lsao_pop;
+
+/* How a pixel reads a direction's lattice values ([P3] §5.1, spec §3.6). */
+typedef enum hfvis_ssao_gather {
+    HFVIS_SSAO_GATHER_DEFAULT = 0,   /* = NEAREST */
+    HFVIS_SSAO_GATHER_NEAREST = 1,   /* the nearest lattice sample (the paper) */
+    HFVIS_SSAO_GATHER_BILINEAR = 2   /* the 2 x 2 lattice neighbours (lines j, j+1, steps i, i+1)
+                                        weighted bilinearly, rejected ones dropped and the rest
+                                        renormalised (P1/P2's rotate-and-blend) */
+} hfvis_ssao_gather;
+
+/* Options of the LSAO routines. NULL or a zero struct = the defaults in brackets. */
+typedef struct hfvis_lsao_options {
+    const hfvis_allocator *alloc;        /* scratch; NULL = malloc/free */
+    int directions;                      /* K [16]; BOX needs K % 8 == 0 */
+    hfvis_ssao_pattern pattern;          /* [BOX] */
+    int box_scale;                       /* BOX: integer scale m [1] */
+    double step;                         /* UNIFORM: D_S in pixels [1] */
+    double spacing;                      /* D_L in pixels [K / (4 D_S)]: 4 evaluations per pixel as
+                                            P3 Table 2 (D_S = the mean non-axis step for BOX,
+                                            so K = 8, 16, 24, 32 give 1.41, 1.64, 1.69, 1.70) */
+    double azimuth0_rad;                 /* UNIFORM: psi_0 [0] */
+    const hfvis_ssao_direction *custom_directions; /* CUSTOM: K directions; weights are
+                                            normalised to sum 1 (finite, >= 0, positive sum) */
+    hfvis_falloff falloff;               /* [NONE] */
+    hfvis_ssao_tangent tangent;          /* [FIXED] */
+    double fixed_sin_t;                  /* sin t of the fixed tangent, in [-1, 1] [-0.85]; 0
+                                            cannot be chosen exactly (use 1e-300) */
+    hfvis_ssao_sampling sampling;        /* [NEAREST] */
+    hfvis_ssao_plane plane;              /* [PAPER] */
+    hfvis_lsao_pop pop;                  /* [TIES] */
+    hfvis_ssao_gather gather;            /* [NEAREST] */
+    double reject_depth;                 /* gather: reject a sample whose depth differs from the
+                                            receiver's by more than this fraction of it [0.03];
+                                            negative = no depth test */
+    double reject_normal;                /* gather, only with caller-supplied normals: reject a
+                                            sample whose texel normal has dot < this with the
+                                            receiver's [0.5]; -1 = accept all */
+} hfvis_lsao_options;
+
+HFVIS_API hfvis_lsao_options hfvis_lsao_options_default(void);
+
+/* The options with every default filled in (directions, spacing, enums, thresholds), so a GPU
+ * port can print the exact parameters. HFVIS_ERR_INVALID_ARGUMENT for NULL out, K outside
+ * 1..HFVIS_SSAO_MAX_DIRECTIONS, BOX with K % 8 != 0, box_scale < 0, step/spacing not finite or
+ * (when given) outside [1/64, HFVIS_SSAO_MAX_SIZE], a non-finite azimuth, CUSTOM without
+ * directions or with an invalid one or bad weights, an unknown enum value, fixed_sin_t outside
+ * [-1, 1], a NaN threshold, reject_normal > 1, an invalid falloff. in may be NULL. */
+HFVIS_API hfvis_status hfvis_lsao_options_resolve(const hfvis_lsao_options *in,
+                                                  hfvis_lsao_options *out);
+
+/* The K directions LSAO uses (out must hold opts->directions, or 16 for NULL/0), with the
+ * resolved spacing and the weights normalised. Errors of hfvis_lsao_options_resolve. */
+HFVIS_API hfvis_status hfvis_lsao_directions(const hfvis_lsao_options *opts,
+                                             hfvis_ssao_direction *out);
+
+/* The obscurity hull along one line in 2D line space ([P3] §4.2, Alg. 1; spec §3.3):
+ * points (x[i], y[i]) in sweep order (y grows toward the camera; the eye at the origin in
+ * perspective; orthographic 1: the zenith is +y everywhere). For each receiver i the zenith is
+ * u = -p/|p| (orthographic (0, 1)) and, with Sin(h) = h.u/|h| and
+ *     Occ(h, st) = st + max(0, Sin(h) - st) * rho(|h|)                      (Alg. 1 l.25-29)
+ * the stack of earlier points is popped while Occ(top - p, st_cull) <= Occ(second - p, st_cull)
+ * (POP_STRICT: <) and Sin(top - p) < Sin(second - p); then
+ *     out[i] = st_eval (empty stack) or Occ(top - p, st_eval)
+ * and p is pushed (unless it coincides with the top: |h| <= 1e-12 |p|; a coincident point has
+ * no elevation and never occludes). st_cull = sin_t_cull[i], st_eval = sin_t_eval[i], either
+ * array NULL = opts' fixed_sin_t. A non-finite x or y (or the eye itself in perspective) is a
+ * hole: never pushed, out NaN. Uses opts' falloff, pop rule and fixed_sin_t (NULL = defaults).
+ * The result is the per-direction term of [P3] Eq. 1 (not clamped; may be negative). stack
+ * must hold n ints. Cost: at most 2n pop tests. HFVIS_ERR_INVALID_ARGUMENT for n < 0, NULL
+ * arrays with n > 0, orthographic not 0/1, or options hfvis_lsao_options_resolve rejects. */
+HFVIS_API hfvis_status hfvis_lsao_line(const double *x, const double *y, const double *sin_t_cull,
+                                       const double *sin_t_eval, int n, int orthographic,
+                                       const hfvis_lsao_options *opts, int *stack, double *out);
+
+/* Oracle of hfvis_lsao_line (spec §4.2; the [P3] Fig. 7 reference): for each receiver, walk
+ * back over the earlier points; point j is visible iff Sin(p_j - p_i) exceeds every Sin seen
+ * nearer to i; among the visible points take the largest Occ(., st_cull) (ties: the higher,
+ * i.e. farther visible point) and return its Occ(., st_eval) (st_eval if none). Same contract,
+ * no scratch, cost O(n^2). Exact mode: with HFVIS_FALLOFF_NONE, Occ is monotonic in Sin, the
+ * obscurity hull is the P1 convex hull and hfvis_lsao_line equals this oracle (bit for bit on
+ * generic input); with a falloff the hull can miss the largest occluder in degenerate cases
+ * ([P3] §4.1: 0.02-0.3 % average error in the final AO). */
+HFVIS_API hfvis_status hfvis_lsao_line_naive(const double *x, const double *y,
+                                             const double *sin_t_cull, const double *sin_t_eval,
+                                             int n, int orthographic,
+                                             const hfvis_lsao_options *opts, double *out);
+
+/* Raw per-direction LSAO output for GPU-port diffing: sweeps every line of lattice lat (from
+ * hfvis_ssao_lattice_init / _lines with the same camera and a direction of these options) in
+ * increasing step order - so the values describe occluders in azimuth -D - and writes the
+ * Eq. 1 term of every sample to values[lattice index] (float, unclamped; NaN at holes: a
+ * background sample, or under BILINEAR a tap on background) and, if sample_depth is not NULL,
+ * the depth read at the sample (NaN at holes). Per sample: the depth at the snapped texel
+ * centre (NEAREST; box-pattern steps are integer texel offsets from the line's first texel) or
+ * bilinear at the sample (BILINEAR), deprojected, projected into the line's plane (PAPER: e1 of
+ * the direction, y = Q.z; EXACT: e1, yhat through the line's middle sample ray), then
+ * hfvis_lsao_line. Real tangents: the normal of the sample's texel projected into the plane,
+ * t = (-n.y, n.x) (toward the occluders), sin t = t.u/|t| (fixed_sin_t where the normal is
+ * (0,0,0) or perpendicular to the plane); normals NULL: reconstructed with
+ * hfvis_depth_normals. Allocates 1 block of 44*max_line_samples bytes (+ 12*stride*height
+ * for reconstructed normals). HFVIS_ERR_INVALID_ARGUMENT for invalid camera/options, NULL
+ * depth/lat/lines/values, a lattice whose direction is invalid; HFVIS_ERR_OUT_OF_MEMORY. */
+HFVIS_API hfvis_status hfvis_lsao_direction(const hfvis_camera *cam, const float *depth,
+                                            const float *normals, const hfvis_lsao_options *opts,
+                                            const hfvis_ssao_lattice *lat,
+                                            const hfvis_ssao_line *lines, float *values,
+                                            float *sample_depth);
+
+/* Oracle of hfvis_lsao_direction: the same samples through hfvis_lsao_line_naive. Equal to the
+ * sweep in exact mode (falloff NONE); cost O(sum of squared line lengths). Same contract. */
+HFVIS_API hfvis_status hfvis_lsao_direction_naive(const hfvis_camera *cam, const float *depth,
+                                                  const float *normals,
+                                                  const hfvis_lsao_options *opts,
+                                                  const hfvis_ssao_lattice *lat,
+                                                  const hfvis_ssao_line *lines, float *values,
+                                                  float *sample_depth);
+
+/* Gather one direction's lattice values into per-pixel accumulators ([P3] §5.1, spec §3.6):
+ * for every non-background inner pixel c (buffer texel (x + guard_x, y + guard_y), centre
+ * + 0.5), the nearest lattice sample (GATHER_NEAREST) or the 2 x 2 neighbours (BILINEAR) are
+ * accepted when their value is not NaN, |sample_depth - z_c| <= reject_depth * z_c and (normals
+ * given) n_sample . n_c >= reject_normal. When none is accepted, the nearest accepted sample
+ * within 2 sqrt((D_S/2)^2 + (D_L/2)^2) is used instead; when there is none the direction is
+ * dropped for that pixel. An accepted value v adds w*v to sum[y*W + x] and w to weight[y*W + x]
+ * (W = inner width, w = lat->dir.weight). The final AO is clamp(sum/weight, 0, 1) (0 where
+ * weight is 0), as hfvis_lsao computes it. HFVIS_ERR_INVALID_ARGUMENT for NULL pointers
+ * (normals may be NULL) or invalid camera/options. Allocates nothing. */
+HFVIS_API hfvis_status hfvis_lsao_gather(const hfvis_camera *cam, const float *depth,
+                                         const float *normals, const hfvis_lsao_options *opts,
+                                         const hfvis_ssao_lattice *lat,
+                                         const hfvis_ssao_line *lines, const float *values,
+                                         const float *sample_depth, double *sum, double *weight);
+
+/* P3 line-sweep ambient obscurance ([P3] Eq. 1, Alg. 1, §5): per direction, the lattice, the
+ * sweep (hfvis_lsao_direction) and the gather (hfvis_lsao_gather), then
+ *   ao = clamp( sum_k w_k v_k / sum_k w_k , 0, 1 )
+ * over the directions accepted at the pixel (background receivers 0). ao[y*ao_stride + x] for
+ * the inner (width - 2 guard_x) x (height - 2 guard_y) pixels, obscurance (SA convention,
+ * spec §1.2), the falloff over view-space distance. Work is O(K W0 H0 / (D_S D_L)) for the
+ * sweeps and O(K W H) for the gathers, independent of the falloff radius; memory O(W0 H0)
+ * whatever K is (one direction at a time). Allocates 5 blocks (directions, lines, the lattice
+ * buffers 8 bytes/sample, the line scratch, the 16-byte/pixel accumulators) plus 1 for
+ * reconstructed normals (real tangents without normals). HFVIS_ERR_INVALID_ARGUMENT for an
+ * invalid camera or options, NULL depth/ao, ao_stride < inner width; HFVIS_ERR_LIMIT for a
+ * lattice over 2^31 samples; HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on error. */
+HFVIS_API hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth,
+                                  const float *normals, const hfvis_lsao_options *opts,
+                                  float *ao, ptrdiff_t ao_stride);

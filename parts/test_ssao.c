@@ -559,6 +559,564 @@ TEST(lattice)
     }
 }
 
+
+/* ========================================================================================== */
+/* 3. P3 line-sweep AO                                                                        */
+/* ========================================================================================== */
+
+/* a random profile rarely produces hull degeneracies: spec §6 T2 asks for >= ~88 % of the
+ * receivers to agree and a mean |error| <~ 1e-3 with the tie rule */
+#define T2_MIN_AGREE 0.88
+#define T2_MAX_MEAN_ERR 1e-3
+
+/* Random smooth depth with steps and background holes, W x H, stride st. */
+static void random_depth(float *d, int W, int H, int st, double z0, int holes, uint64_t seed)
+{
+    double a[6], p[6];
+    int x, y, k;
+    rng_seed(seed);
+    for (k = 0; k < 6; k++) {
+        a[k] = (0.5 + rng_unit()) * z0 * 0.08;
+        p[k] = 2.0 * PI * rng_unit();
+    }
+    for (y = 0; y < H; y++)
+        for (x = 0; x < W; x++) {
+            double z = z0 + a[0] * sin(0.21 * x + p[0]) + a[1] * cos(0.17 * y + p[1]) +
+                       a[2] * sin(0.05 * (x + y) + p[2]) + a[3] * cos(0.33 * x - 0.27 * y + p[3]);
+            if ((x * 7 + y * 3) % 41 < 9) z -= a[4] * 3.0;        /* raised blocks */
+            if (((x / 9) + (y / 7)) % 5 == 0) z += a[5] * 4.0;    /* pits */
+            z += 0.02 * z0 * (rng_unit() - 0.5);                  /* roughness */
+            d[y * st + x] = (float)z;
+        }
+    for (k = 0; k < holes; k++) d[(int)(rng_unit() * H) * st + (int)(rng_unit() * W)] = (float)INFINITY;
+}
+
+/* T2: a straight line of points gives the adjacent point; a spike gives the spike while it
+ * dominates; a rising profile with rho = 1 gives the global horizon of the P1 hull
+ * (hfvis_line_horizons, hfvis.c) */
+TEST(lsao_line_exact_cases)
+{
+    enum { N = 40 };
+    double x[N], y[N], out[N], nv[N], dist[N], ht[N], tn[N];
+    int stack[N], hs[N], i;
+    hfvis_lsao_options o = hfvis_lsao_options_default();
+    double r = 9.0, st = -0.85;
+    o.falloff.kind = HFVIS_FALLOFF_INV_QUADRATIC;
+    o.falloff.param = r;
+    /* ortho straight line rising at slope 0.3: every receiver gets its neighbour, which lies
+     * below it: s = -0.3/sqrt(1.09) */
+    for (i = 0; i < N; i++) { x[i] = 0.5 * i; y[i] = 0.3 * x[i] - 4.0; }
+    CHECK_EQ_STATUS(hfvis_lsao_line(x, y, NULL, NULL, N, 1, &o, stack, out), HFVIS_OK);
+    CHECK(out[0] == st);
+    for (i = 1; i < N; i++) {
+        double dd = sqrt(0.25 + 0.0225), sn = -0.15 / dd;
+        CHECK_NEAR(out[i], st + (sn - st) * r / (r + dd * dd), 1e-14, 0.0);
+    }
+    /* a spike at index 10 of height 5 over a flat line: it dominates while its Occ is larger */
+    for (i = 0; i < N; i++) { x[i] = (double)i; y[i] = i == 10 ? 5.0 : 0.0; }
+    CHECK_EQ_STATUS(hfvis_lsao_line(x, y, NULL, NULL, N, 1, &o, stack, out), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_lsao_line_naive(x, y, NULL, NULL, N, 1, &o, nv), HFVIS_OK);
+    for (i = 11; i < N; i++) {
+        double dx = (double)(i - 10), d = sqrt(dx * dx + 25.0);
+        double spike = st + (5.0 / d - st) * r / (r + d * d), adj = st + (0.0 - st) * r / (r + 1.0);
+        if (i == 11) adj = st; /* the spike is the only visible point */
+        CHECK_NEAR(out[i], spike > adj ? spike : adj, 1e-14, 0.0);
+        CHECK(out[i] == nv[i]);
+    }
+    /* rising convex/concave profile, rho = 1, ortho: out = st + max(0, sin(alpha) - st) with alpha
+     * the P1 global horizon */
+    o.falloff.kind = HFVIS_FALLOFF_NONE;
+    rng_seed(5);
+    for (i = 0; i < N; i++) {
+        dist[i] = (double)i + 0.3 * rng_unit();
+        ht[i] = 3.0 * sin(0.4 * dist[i]) + 0.1 * dist[i] + rng_unit();
+        x[i] = dist[i];
+        y[i] = ht[i];
+    }
+    CHECK_EQ_STATUS(hfvis_line_horizons(dist, ht, N, tn, NULL, hs), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_lsao_line(x, y, NULL, NULL, N, 1, &o, stack, out), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_lsao_line_naive(x, y, NULL, NULL, N, 1, &o, nv), HFVIS_OK);
+    for (i = 1; i < N; i++) {
+        /* the P1 horizon looks toward decreasing distance; Sin = sin(atan(tan)) */
+        double sn = tn[i] / sqrt(1.0 + tn[i] * tn[i]);
+        CHECK_NEAR(out[i], st + (sn > st ? sn - st : 0.0), 1e-14, 1e-14);
+    }
+    /* holes: NaN out, never occlude; coincident points never occlude */
+    x[5] = (double)NAN;
+    y[7] = (double)INFINITY;
+    x[9] = x[8]; y[9] = y[8];
+    CHECK_EQ_STATUS(hfvis_lsao_line(x, y, NULL, NULL, N, 1, &o, stack, out), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_lsao_line_naive(x, y, NULL, NULL, N, 1, &o, nv), HFVIS_OK);
+    CHECK(isnan(out[5]) && isnan(out[7]) && isnan(nv[5]) && isnan(nv[7]));
+    for (i = 0; i < N; i++) CHECK((isnan(out[i]) && isnan(nv[i])) || out[i] == nv[i]);
+    /* perspective: the eye is a hole */
+    x[0] = 0.0; y[0] = 0.0;
+    CHECK_EQ_STATUS(hfvis_lsao_line(x, y, NULL, NULL, 1, 0, &o, stack, out), HFVIS_OK);
+    CHECK(isnan(out[0]));
+    /* n = 0 is fine with NULL arrays; bad arguments */
+    CHECK_EQ_STATUS(hfvis_lsao_line(NULL, NULL, NULL, NULL, 0, 0, NULL, NULL, NULL), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_lsao_line(x, y, NULL, NULL, -1, 0, NULL, stack, out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_lsao_line(x, y, NULL, NULL, 3, 2, NULL, stack, out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_lsao_line(x, y, NULL, NULL, 3, 0, NULL, NULL, out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_lsao_line(x, NULL, NULL, NULL, 3, 0, NULL, stack, out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_lsao_line_naive(x, y, NULL, NULL, 3, 0, NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    o.pop = (hfvis_lsao_pop)3;
+    CHECK_EQ_STATUS(hfvis_lsao_line(x, y, NULL, NULL, 3, 0, &o, stack, out), HFVIS_ERR_INVALID_ARGUMENT);
+}
+
+/* T2 random profiles (spec §3.3 setup: perspective profiles, smooth depth plus 4 depth steps):
+ * with falloff NONE the hull equals the oracle exactly; with rho_q the tie rule agrees on
+ * >= 88 % of receivers with mean |error| <= 1e-3, and the paper's strict '<' is clearly worse
+ * (the regression test for the tie rule). */
+TEST(lsao_line_random_profiles)
+{
+    enum { N = 1500, P = 60 };
+    static double x[N], y[N], a[N], b[N];
+    static int stack[N];
+    hfvis_lsao_options o = hfvis_lsao_options_default();
+    double err_ties = 0.0, err_strict = 0.0;
+    long agree = 0, total = 0, exact_bad = 0;
+    int p, i, rr;
+    for (p = 0; p < P; p++) {
+        double f = 800.0, steps[4], ph = 6.0 * rng_unit();
+        int k;
+        rng_seed(100 + (uint64_t)p);
+        for (k = 0; k < 4; k++) steps[k] = (double)N * rng_unit();
+        for (i = 0; i < N; i++) {
+            double u = (double)i - 0.5 * N, z = 20.0 + 4.0 * sin(0.004 * i + ph) + 1.5 * sin(0.031 * i + 2.0 * ph) +
+                       0.3 * sin(0.17 * i);
+            for (k = 0; k < 4; k++)
+                if ((double)i > steps[k]) z += (k % 2 ? 3.0 : -2.5);
+            if (z < 2.0) z = 2.0;
+            x[i] = u * z / f;
+            y[i] = -z;
+        }
+        o.falloff.kind = HFVIS_FALLOFF_NONE;
+        o.pop = HFVIS_LSAO_POP_TIES;
+        CHECK_EQ_STATUS(hfvis_lsao_line(x, y, NULL, NULL, N, 0, &o, stack, a), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_lsao_line_naive(x, y, NULL, NULL, N, 0, &o, b), HFVIS_OK);
+        for (i = 0; i < N; i++)
+            if (a[i] != b[i]) exact_bad++;
+        for (rr = 0; rr < 3; rr++) {
+            o.falloff.kind = HFVIS_FALLOFF_INV_QUADRATIC;
+            o.falloff.param = rr == 0 ? 0.5 : (rr == 1 ? 4.0 : 30.0);
+            o.pop = HFVIS_LSAO_POP_TIES;
+            CHECK_EQ_STATUS(hfvis_lsao_line(x, y, NULL, NULL, N, 0, &o, stack, a), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_lsao_line_naive(x, y, NULL, NULL, N, 0, &o, b), HFVIS_OK);
+            for (i = 0; i < N; i++) {
+                double e = fabs(a[i] - b[i]);
+                err_ties += e;
+                agree += e < 1e-12;
+                total++;
+            }
+            o.pop = HFVIS_LSAO_POP_STRICT;
+            CHECK_EQ_STATUS(hfvis_lsao_line(x, y, NULL, NULL, N, 0, &o, stack, a), HFVIS_OK);
+            for (i = 0; i < N; i++) err_strict += fabs(a[i] - b[i]);
+        }
+    }
+    printf("  T2: exact mode mismatches %ld; rho_q: agree %.4f, mean |err| ties %.3g, strict %.3g\n",
+           exact_bad, (double)agree / (double)total, err_ties / (double)total, err_strict / (double)total);
+    CHECK(exact_bad == 0);
+    CHECK((double)agree / (double)total >= T2_MIN_AGREE);
+    CHECK(err_ties / (double)total <= T2_MAX_MEAN_ERR);
+    CHECK(err_strict > 2.0 * err_ties);
+}
+
+/* Sweep of whole depth buffers against the per-receiver brute force over the same line samples:
+ * bit-identical in exact mode (falloff NONE) for every sampling, plane, tangent, pattern and
+ * projection; with a falloff the T2 statistics. */
+TEST(lsao_direction_vs_oracle)
+{
+    enum { W = 61, H = 47, ST = 64 };
+    static float depth[ST * H];
+    hfvis_camera cam;
+    int cfg, k, exact_bad = 0;
+    double err = 0.0;
+    long n_err = 0;
+    for (cfg = 0; cfg < 12; cfg++) {
+        hfvis_lsao_options o = hfvis_lsao_options_default();
+        hfvis_ssao_direction dirs[24];
+        int K, persp = cfg % 2 == 0;
+        if (persp) CHECK_EQ_STATUS(hfvis_camera_perspective(&cam, W, H, 4, 3, 1.1), HFVIS_OK);
+        else CHECK_EQ_STATUS(hfvis_camera_orthographic(&cam, W, H, 4, 3, 0.3), HFVIS_OK);
+        cam.stride = ST;
+        random_depth(depth, W, H, ST, 12.0, 15, 1000 + (uint64_t)cfg);
+        o.pattern = (cfg / 2) % 3 == 0 ? HFVIS_SSAO_PATTERN_UNIFORM : HFVIS_SSAO_PATTERN_BOX;
+        o.directions = o.pattern == HFVIS_SSAO_PATTERN_BOX ? ((cfg / 2) % 3 == 1 ? 8 : 16) : 7;
+        o.step = 1.3;
+        o.azimuth0_rad = 0.1;
+        o.sampling = cfg % 4 < 2 ? HFVIS_SSAO_SAMPLING_NEAREST : HFVIS_SSAO_SAMPLING_BILINEAR;
+        o.plane = cfg % 3 == 0 ? HFVIS_SSAO_PLANE_EXACT : HFVIS_SSAO_PLANE_PAPER;
+        o.tangent = (hfvis_ssao_tangent)(1 + cfg % 3);
+        K = o.directions;
+        CHECK_EQ_STATUS(hfvis_lsao_directions(&o, dirs), HFVIS_OK);
+        for (k = 0; k < K; k++) {
+            hfvis_ssao_lattice L;
+            hfvis_ssao_line *lines;
+            float *v1, *v2, *z1, *z2;
+            size_t i;
+            int f;
+            CHECK_EQ_STATUS(hfvis_ssao_lattice_init(&cam, &dirs[k], &L), HFVIS_OK);
+            lines = (hfvis_ssao_line *)malloc(sizeof *lines * (size_t)L.line_count);
+            v1 = (float *)malloc(sizeof(float) * L.sample_count * 4);
+            v2 = v1 + L.sample_count;
+            z1 = v2 + L.sample_count;
+            z2 = z1 + L.sample_count;
+            CHECK_EQ_STATUS(hfvis_ssao_lattice_lines(&cam, &L, lines), HFVIS_OK);
+            for (f = 0; f < 2; f++) {
+                o.falloff.kind = f == 0 ? HFVIS_FALLOFF_NONE : HFVIS_FALLOFF_INV_QUADRATIC;
+                o.falloff.param = 2.0;
+                CHECK_EQ_STATUS(hfvis_lsao_direction(&cam, depth, NULL, &o, &L, lines, v1, z1), HFVIS_OK);
+                CHECK_EQ_STATUS(hfvis_lsao_direction_naive(&cam, depth, NULL, &o, &L, lines, v2, z2), HFVIS_OK);
+                CHECK(memcmp(z1, z2, sizeof(float) * L.sample_count) == 0);
+                for (i = 0; i < L.sample_count; i++) {
+                    int both_nan = isnan(v1[i]) && isnan(v2[i]);
+                    if (f == 0) {
+                        if (!both_nan && v1[i] != v2[i]) exact_bad++;
+                    } else if (!both_nan) {
+                        err += fabs((double)v1[i] - (double)v2[i]);
+                        n_err++;
+                    }
+                }
+            }
+            free(v1);
+            free(lines);
+        }
+    }
+    printf("  depth buffers: exact-mode mismatches %d, rho_q mean |err| %.3g over %ld samples\n", exact_bad,
+           err / (double)n_err, n_err);
+    CHECK(exact_bad == 0);
+    CHECK(err / (double)n_err <= T2_MAX_MEAN_ERR);
+}
+
+/* Unclamped per-pixel average of hfvis_lsao: the gather accumulators. */
+static void lsao_raw(const hfvis_camera *cam, const float *depth, const float *normals,
+                     const hfvis_lsao_options *o, double *raw)
+{
+    hfvis_ssao_direction dirs[64];
+    int K = o->directions, k, W = cam->width - 2 * cam->guard_x, H = cam->height - 2 * cam->guard_y;
+    size_t n = (size_t)W * (size_t)H, i;
+    double *sum = (double *)calloc(2 * n, sizeof(double)), *wt = sum + n;
+    CHECK_EQ_STATUS(hfvis_lsao_directions(o, dirs), HFVIS_OK);
+    for (k = 0; k < K; k++) {
+        hfvis_ssao_lattice L;
+        hfvis_ssao_line *lines;
+        float *v;
+        CHECK_EQ_STATUS(hfvis_ssao_lattice_init(cam, &dirs[k], &L), HFVIS_OK);
+        lines = (hfvis_ssao_line *)malloc(sizeof *lines * (size_t)L.line_count);
+        v = (float *)malloc(sizeof(float) * 2 * L.sample_count);
+        CHECK_EQ_STATUS(hfvis_ssao_lattice_lines(cam, &L, lines), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_lsao_direction(cam, depth, normals, o, &L, lines, v, v + L.sample_count), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_lsao_gather(cam, depth, normals, o, &L, lines, v, v + L.sample_count, sum, wt), HFVIS_OK);
+        free(v);
+        free(lines);
+    }
+    for (i = 0; i < n; i++) raw[i] = wt[i] > 0.0 ? sum[i] / wt[i] : (double)NAN;
+    free(sum);
+}
+
+/* hfvis_lsao is exactly the composition lattice -> direction -> gather -> clamp. */
+TEST(lsao_composition)
+{
+    enum { W = 50, H = 40 };
+    static float depth[W * H], ao[(W - 6) * (H - 4)];
+    static double raw[(W - 6) * (H - 4)];
+    hfvis_camera cam;
+    hfvis_lsao_options o = hfvis_lsao_options_default();
+    int i, bad = 0, pos = 0;
+    CHECK_EQ_STATUS(hfvis_camera_perspective(&cam, W, H, 3, 2, 1.0), HFVIS_OK);
+    random_depth(depth, W, H, W, 8.0, 10, 77);
+    o.falloff.kind = HFVIS_FALLOFF_INV_QUADRATIC;
+    o.falloff.param = 1.0;
+    o.directions = 8;
+    CHECK_EQ_STATUS(hfvis_lsao(&cam, depth, NULL, &o, ao, W - 6), HFVIS_OK);
+    lsao_raw(&cam, depth, NULL, &o, raw);
+    for (i = 0; i < (W - 6) * (H - 4); i++) {
+        double r = isnan(raw[i]) ? 0.0 : raw[i], e = r < 0.0 ? 0.0 : (r > 1.0 ? 1.0 : r);
+        int x = i % (W - 6), y = i / (W - 6);
+        float zc = depth[(y + 2) * W + x + 3];
+        if (!(zc < INFINITY)) e = 0.0;
+        if (ao[i] != (float)e) bad++;
+        pos += ao[i] > 0.0f;
+    }
+    CHECK(bad == 0);
+    printf("  %d of %d pixels obscured\n", pos, (W - 6) * (H - 4));
+    CHECK(pos > (W - 6) * (H - 4) / 10);
+}
+
+/* T3: fixed tangent, fronto-parallel plane, perspective, full pipeline. With K = 4 dense axis
+ * lines every pixel is a lattice sample in every direction and the raw average is exactly
+ * -0.85 (1 - rho(delta)), delta = Z0 |step| / f; the clamped output is 0. Past sigma > 0.85
+ * (a very wide field of view) a grazing plane shows positive AO (documented behaviour). */
+#define T3_TOL 1e-6 /* float lattice values of a double computation of order 1 */
+TEST(lsao_t3_fronto_plane)
+{
+    enum { W = 40, H = 30 };
+    static float depth[W * H], ao[W * H];
+    static double raw[W * H];
+    hfvis_camera cam;
+    hfvis_lsao_options o = hfvis_lsao_options_default();
+    const double Z0 = 5.0, r = 0.004;
+    int i, bad = 0, m;
+    for (m = 0; m < 2; m++) {
+        double delta, want;
+        CHECK_EQ_STATUS(hfvis_camera_perspective(&cam, W, H, 2, 2, 1.0), HFVIS_OK);
+        for (i = 0; i < W * H; i++) depth[i] = (float)Z0;
+        o.pattern = HFVIS_SSAO_PATTERN_UNIFORM;
+        o.directions = 4;
+        o.step = 1.0;
+        o.spacing = 1.0;
+        o.falloff.kind = HFVIS_FALLOFF_INV_QUADRATIC;
+        o.falloff.param = r;
+        o.sampling = m ? HFVIS_SSAO_SAMPLING_BILINEAR : HFVIS_SSAO_SAMPLING_NEAREST;
+        o.plane = m ? HFVIS_SSAO_PLANE_EXACT : HFVIS_SSAO_PLANE_PAPER;
+        lsao_raw(&cam, depth, NULL, &o, raw);
+        delta = Z0 / cam.fx;
+        want = -0.85 * delta * delta / (r + delta * delta);
+        for (i = 0; i < (W - 4) * (H - 4); i++)
+            if (!(fabs(raw[i] - want) <= T3_TOL)) bad++;
+        CHECK_EQ_STATUS(hfvis_lsao(&cam, depth, NULL, &o, ao, W - 4), HFVIS_OK);
+        for (i = 0; i < (W - 4) * (H - 4); i++)
+            if (ao[i] != 0.0f) bad++;
+    }
+    CHECK(bad == 0);
+    /* one opposite pair of horizontal directions at 170 degrees: the left and right columns see
+     * the plane at grazing |sigma| > 0.85, so the pair gives -1.7 + (|sigma| + 0.85) rho > 0 */
+    {
+        hfvis_ssao_direction d2[2];
+        CHECK_EQ_STATUS(hfvis_ssao_directions_uniform(2, 0.0, 1.0, 1.0, d2), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_camera_perspective(&cam, W, H, 0, 0, 170.0 * PI / 180.0), HFVIS_OK);
+        o.falloff.param = 1e6;
+        o.pattern = HFVIS_SSAO_PATTERN_CUSTOM;
+        o.directions = 2;
+        o.custom_directions = d2;
+        CHECK_EQ_STATUS(hfvis_lsao(&cam, depth, NULL, &o, ao, W), HFVIS_OK);
+        CHECK(ao[(H / 2) * W + 1] > 0.0f && ao[(H / 2) * W + W - 2] > 0.0f && ao[(H / 2) * W + W / 2] == 0.0f);
+    }
+}
+
+/* T1: real tangent on a tilted plane: each opposite pair cancels, AO_raw ~ 0. */
+#define T1_TOL 2e-6 /* float values of sin t of order 1 */
+TEST(lsao_t1_real_tangent_plane)
+{
+    enum { W = 36, H = 28 };
+    static float depth[W * H];
+    static double raw[W * H];
+    hfvis_camera cam;
+    hfvis_lsao_options o = hfvis_lsao_options_default();
+    double n0[3] = {0.4, 0.3, 0.866};
+    int i, bad = 0;
+    CHECK_EQ_STATUS(hfvis_camera_orthographic(&cam, W, H, 2, 2, 0.2), HFVIS_OK);
+    plane_depth(&cam, n0, -6.0, depth);
+    o.pattern = HFVIS_SSAO_PATTERN_UNIFORM;
+    o.directions = 4;
+    o.spacing = 1.0;
+    o.tangent = HFVIS_SSAO_TANGENT_REAL;
+    o.falloff.kind = HFVIS_FALLOFF_INV_QUADRATIC;
+    o.falloff.param = 0.5;
+    o.reject_depth = -1.0;
+    lsao_raw(&cam, depth, NULL, &o, raw);
+    for (i = 0; i < (W - 4) * (H - 4); i++)
+        if (!(fabs(raw[i]) <= T1_TOL)) bad++;
+    CHECK(bad == 0);
+}
+
+/* T5, LSAO closed form (ortho, fixed tangent, K = 4 axis directions, nearest, the cliff between
+ * texel columns): toward the cliff v = max(-0.85 + 0.85 rho(d), -0.85 + (H/D' + 0.85) rho(D')),
+ * the other three directions -0.85 + 0.85 rho(d) each (spec §6 T5). */
+TEST(lsao_t5_step_closed_form)
+{
+    enum { W = 48, H = 20, X0 = 30 };
+    static float depth[W * H];
+    static double raw[W * H];
+    hfvis_camera cam;
+    hfvis_lsao_options o = hfvis_lsao_options_default();
+    const double px = 0.25, Hs = 1.5, Z0 = 10.0, r = 0.8;
+    int x, y, bad = 0;
+    CHECK_EQ_STATUS(hfvis_camera_orthographic(&cam, W, H, 1, 1, px), HFVIS_OK);
+    for (y = 0; y < H; y++)
+        for (x = 0; x < W; x++) depth[y * W + x] = (float)(x < X0 ? Z0 : Z0 - Hs);
+    o.pattern = HFVIS_SSAO_PATTERN_UNIFORM;
+    o.directions = 4;
+    o.spacing = 1.0;
+    o.falloff.kind = HFVIS_FALLOFF_INV_QUADRATIC;
+    o.falloff.param = r;
+    o.reject_depth = -1.0;
+    lsao_raw(&cam, depth, NULL, &o, raw);
+    for (y = 1; y < H - 1; y++)
+        for (x = 2; x < X0 - 1; x++) {
+            double l = (X0 - x) * px, Dp = sqrt(Hs * Hs + l * l), rd = r / (r + px * px), rD = r / (r + Dp * Dp);
+            double flat = -0.85 + 0.85 * rd, edge = -0.85 + (Hs / Dp + 0.85) * rD, v = edge > flat ? edge : flat;
+            double want = (3.0 * flat + v) / 4.0;
+            if (!(fabs(raw[(y - 1) * (W - 2) + (x - 1)] - want) <= T3_TOL)) bad++;
+        }
+    CHECK(bad == 0);
+}
+
+/* Edge-aware gather: with values = the depth of each sample, every accepted value is within
+ * reject_depth of the receiver; without rejection the far side leaks in next to the edge. */
+TEST(lsao_gather_rejection)
+{
+    enum { W = 40, H = 30 };
+    static float depth[W * H], nrm[3 * W * H];
+    static double sum[W * H], wt[W * H];
+    hfvis_camera cam;
+    hfvis_lsao_options o = hfvis_lsao_options_default();
+    hfvis_ssao_direction dirs[16];
+    int k, i, x, y, m, bad = 0, leak = 0;
+    CHECK_EQ_STATUS(hfvis_camera_perspective(&cam, W, H, 2, 2, 1.0), HFVIS_OK);
+    for (y = 0; y < H; y++)
+        for (x = 0; x < W; x++) depth[y * W + x] = (float)((x - 0.7 * y) > 10.0 ? 9.0 : 4.0 + 0.01 * x);
+    CHECK_EQ_STATUS(hfvis_depth_normals(&cam, depth, nrm), HFVIS_OK);
+    for (m = 0; m < 3; m++) {
+        o.directions = 16;
+        o.gather = m == 1 ? HFVIS_SSAO_GATHER_BILINEAR : HFVIS_SSAO_GATHER_NEAREST;
+        o.reject_depth = m == 2 ? -1.0 : 0.0;
+        CHECK_EQ_STATUS(hfvis_lsao_directions(&o, dirs), HFVIS_OK);
+        memset(sum, 0, sizeof sum);
+        memset(wt, 0, sizeof wt);
+        for (k = 0; k < 16; k++) {
+            hfvis_ssao_lattice L;
+            hfvis_ssao_line *lines;
+            float *v;
+            CHECK_EQ_STATUS(hfvis_ssao_lattice_init(&cam, &dirs[k], &L), HFVIS_OK);
+            lines = (hfvis_ssao_line *)malloc(sizeof *lines * (size_t)L.line_count);
+            v = (float *)malloc(sizeof(float) * 2 * L.sample_count);
+            CHECK_EQ_STATUS(hfvis_ssao_lattice_lines(&cam, &L, lines), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_lsao_direction(&cam, depth, NULL, &o, &L, lines, v, v + L.sample_count), HFVIS_OK);
+            memcpy(v, v + L.sample_count, sizeof(float) * L.sample_count); /* values := sample depth */
+            CHECK_EQ_STATUS(hfvis_lsao_gather(&cam, depth, m == 1 ? nrm : NULL, &o, &L, lines, v, v + L.sample_count, sum, wt), HFVIS_OK);
+            free(v);
+            free(lines);
+        }
+        for (i = 0; i < (W - 4) * (H - 4); i++) {
+            double zc = depth[(i / (W - 4) + 2) * W + i % (W - 4) + 2], g = sum[i] / wt[i];
+            if (m < 2 && !(fabs(g - zc) <= 0.03 * zc + 1e-6)) bad++;
+            if (m < 2 && !(fabs(wt[i] - 1.0) < 1e-9)) bad++; /* every direction found a sample */
+            if (m == 2 && fabs(g - zc) > 0.03 * zc) leak++;
+        }
+    }
+    CHECK(bad == 0);
+    CHECK(leak > 0);
+}
+
+/* Bad arguments and allocation failure at every site of the LSAO entry points. */
+TEST(lsao_bad_args_and_oom)
+{
+    enum { W = 30, H = 24 };
+    static float depth[W * H], ao[W * H], keep[W * H], nrm[3 * W * H];
+    hfvis_camera cam, bc;
+    hfvis_lsao_options o = hfvis_lsao_options_default(), b, r;
+    hfvis_allocator al;
+    counting cnt;
+    int k, tangent;
+    CHECK_EQ_STATUS(hfvis_camera_perspective(&cam, W, H, 2, 2, 1.0), HFVIS_OK);
+    random_depth(depth, W, H, W, 6.0, 5, 3);
+    for (k = 0; k < W * H; k++) ao[k] = keep[k] = 42.0f;
+    /* options */
+    CHECK_EQ_STATUS(hfvis_lsao_options_resolve(NULL, &r), HFVIS_OK);
+    CHECK(r.directions == 16 && r.pattern == HFVIS_SSAO_PATTERN_BOX && r.fixed_sin_t == -0.85);
+    CHECK_NEAR(r.spacing, 16.0 / (4.0 * (8.0 * sqrt(5.0) + 4.0 * sqrt(8.0)) / 12.0), 1e-12, 0.0);
+    CHECK_EQ_STATUS(hfvis_lsao_options_resolve(&o, &b), HFVIS_OK);
+    CHECK(memcmp(&b, &r, sizeof r) == 0);
+    CHECK_EQ_STATUS(hfvis_lsao_options_resolve(NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+#define BAD_OPT(stmt) do { b = o; stmt; CHECK_EQ_STATUS(hfvis_lsao_options_resolve(&b, &r), HFVIS_ERR_INVALID_ARGUMENT); \
+        CHECK_EQ_STATUS(hfvis_lsao(&cam, depth, NULL, &b, ao, W), HFVIS_ERR_INVALID_ARGUMENT); } while (0)
+    BAD_OPT(b.directions = -1);
+    BAD_OPT(b.directions = HFVIS_SSAO_MAX_DIRECTIONS + 1);
+    BAD_OPT(b.directions = 12);                         /* BOX needs K % 8 == 0 */
+    BAD_OPT(b.pattern = (hfvis_ssao_pattern)4);
+    BAD_OPT(b.pattern = HFVIS_SSAO_PATTERN_CUSTOM);     /* no directions */
+    BAD_OPT(b.box_scale = -2);
+    BAD_OPT(b.step = (double)NAN);
+    BAD_OPT(b.pattern = HFVIS_SSAO_PATTERN_UNIFORM; b.step = 1e-3);
+    BAD_OPT(b.spacing = -1.0);
+    BAD_OPT(b.azimuth0_rad = (double)INFINITY);
+    BAD_OPT(b.falloff.kind = HFVIS_FALLOFF_STEP);       /* param 0 */
+    BAD_OPT(b.tangent = (hfvis_ssao_tangent)4);
+    BAD_OPT(b.fixed_sin_t = -1.5);
+    BAD_OPT(b.sampling = (hfvis_ssao_sampling)3);
+    BAD_OPT(b.plane = (hfvis_ssao_plane)3);
+    BAD_OPT(b.pop = (hfvis_lsao_pop)3);
+    BAD_OPT(b.gather = (hfvis_ssao_gather)3);
+    BAD_OPT(b.reject_depth = (double)NAN);
+    BAD_OPT(b.reject_normal = 1.5);
+    {
+        hfvis_ssao_direction d[8];
+        CHECK_EQ_STATUS(hfvis_ssao_directions_uniform(8, 0.0, 1.0, 1.0, d), HFVIS_OK);
+        d[3].weight = -1.0;
+        BAD_OPT(b.pattern = HFVIS_SSAO_PATTERN_CUSTOM; b.directions = 8; b.custom_directions = d);
+        d[3].weight = 0.0;
+        d[3].dx = 2.0;
+        BAD_OPT(b.pattern = HFVIS_SSAO_PATTERN_CUSTOM; b.directions = 8; b.custom_directions = d);
+    }
+    CHECK_EQ_STATUS(hfvis_lsao(NULL, depth, NULL, &o, ao, W), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_lsao(&cam, NULL, NULL, &o, ao, W), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_lsao(&cam, depth, NULL, &o, NULL, W), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_lsao(&cam, depth, NULL, &o, ao, W - 5), HFVIS_ERR_INVALID_ARGUMENT);
+    bc = cam;
+    bc.fx = -1.0;
+    CHECK_EQ_STATUS(hfvis_lsao(&bc, depth, NULL, &o, ao, W), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK(memcmp(ao, keep, sizeof ao) == 0);
+    /* allocation failure at every site: hfvis_lsao (fixed tangent: 5 blocks; real tangent
+     * without normals: 6), hfvis_lsao_direction (1 or 2) */
+    al.alloc = cnt_alloc;
+    al.free = cnt_free;
+    al.user = &cnt;
+    o.alloc = &al;
+    o.directions = 8;
+    for (tangent = 1; tangent <= 2; tangent++) {
+        int n_allocs, fail;
+        static float ref[W * H];
+        o.tangent = (hfvis_ssao_tangent)tangent;
+        memset(&cnt, 0, sizeof cnt);
+        CHECK_EQ_STATUS(hfvis_lsao(&cam, depth, NULL, &o, ref, W), HFVIS_OK);
+        n_allocs = cnt.allocs;
+        CHECK(cnt.live == 0 && n_allocs == (tangent == 1 ? 5 : 6));
+        for (fail = 1; fail <= n_allocs; fail++) {
+            memset(&cnt, 0, sizeof cnt);
+            cnt.fail_at = fail;
+            CHECK_EQ_STATUS(hfvis_lsao(&cam, depth, NULL, &o, ao, W), HFVIS_ERR_OUT_OF_MEMORY);
+            CHECK(cnt.live == 0 && cnt.allocs == fail);
+            CHECK(memcmp(ao, keep, sizeof ao) == 0);
+        }
+        /* with normals given, no normal block */
+        memset(&cnt, 0, sizeof cnt);
+        CHECK_EQ_STATUS(hfvis_depth_normals(&cam, depth, nrm), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_lsao(&cam, depth, nrm, &o, ao, W), HFVIS_OK);
+        CHECK(cnt.allocs == 5 && cnt.live == 0);
+        for (k = 0; k < W * H; k++) ao[k] = keep[k];
+        {
+            hfvis_ssao_direction d[8];
+            hfvis_ssao_lattice L;
+            hfvis_ssao_line lines[200];
+            static float v[4000], vk[4000];
+            CHECK_EQ_STATUS(hfvis_lsao_directions(&o, d), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_ssao_lattice_init(&cam, &d[1], &L), HFVIS_OK);
+            CHECK(L.line_count <= 200 && L.sample_count <= 4000);
+            CHECK_EQ_STATUS(hfvis_ssao_lattice_lines(&cam, &L, lines), HFVIS_OK);
+            for (k = 0; k < 4000; k++) v[k] = vk[k] = 3.0f;
+            for (fail = 1; fail <= tangent; fail++) {
+                memset(&cnt, 0, sizeof cnt);
+                cnt.fail_at = fail;
+                CHECK_EQ_STATUS(hfvis_lsao_direction(&cam, depth, NULL, &o, &L, lines, v, NULL), HFVIS_ERR_OUT_OF_MEMORY);
+                CHECK(cnt.live == 0);
+                memset(&cnt, 0, sizeof cnt);
+                cnt.fail_at = fail;
+                CHECK_EQ_STATUS(hfvis_lsao_direction_naive(&cam, depth, NULL, &o, &L, lines, v, NULL), HFVIS_ERR_OUT_OF_MEMORY);
+                CHECK(cnt.live == 0);
+                CHECK(memcmp(v, vk, sizeof v) == 0);
+            }
+            CHECK_EQ_STATUS(hfvis_lsao_direction(&cam, NULL, NULL, &o, &L, lines, v, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+            CHECK_EQ_STATUS(hfvis_lsao_direction(&cam, depth, NULL, &o, NULL, lines, v, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+            CHECK_EQ_STATUS(hfvis_lsao_direction(&cam, depth, NULL, &o, &L, NULL, v, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+            CHECK_EQ_STATUS(hfvis_lsao_direction(&cam, depth, NULL, &o, &L, lines, NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+            CHECK_EQ_STATUS(hfvis_lsao_gather(&cam, depth, NULL, &o, &L, lines, v, NULL, NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+            CHECK(memcmp(v, vk, sizeof v) == 0);
+        }
+    }
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
@@ -571,5 +1129,14 @@ int main(int argc, char **argv)
     RUN(falloff);
     RUN(directions);
     RUN(lattice);
+    RUN(lsao_line_exact_cases);
+    RUN(lsao_line_random_profiles);
+    RUN(lsao_direction_vs_oracle);
+    RUN(lsao_composition);
+    RUN(lsao_t3_fronto_plane);
+    RUN(lsao_t1_real_tangent_plane);
+    RUN(lsao_t5_step_closed_form);
+    RUN(lsao_gather_rejection);
+    RUN(lsao_bad_args_and_oom);
     return TEST_DONE();
 }
