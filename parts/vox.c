@@ -142,10 +142,12 @@ static int vx_vox_tri_setup(vx_vox_tri *T, const hfvis_mesh *m, const hfvis_volu
         if (want_normal)
             for (a = 0; a < 3; a++) T->v[i][a] = (double)p[a];
     }
-    for (i = 0; i < 3; i++)
-        if (!(fabs(T->g[i][0]) <= VX_VOX_MAX_COORD && fabs(T->g[i][1]) <= VX_VOX_MAX_COORD
-              && fabs(T->g[i][2]) <= VX_VOX_MAX_COORD))
-            return 0;
+    {
+        double big = 0.0; /* largest |coordinate| (NaN-free: the mesh and grid are finite) */
+        for (i = 0; i < 3; i++)
+            for (a = 0; a < 3; a++) big = fabs(T->g[i][a]) > big ? fabs(T->g[i][a]) : big;
+        if (!(big <= VX_VOX_MAX_COORD)) return 0;
+    }
     for (a = 0; a < 3; a++) {
         e1[a] = T->g[1][a] - T->g[0][a];
         e2[a] = T->g[2][a] - T->g[0][a];
@@ -186,8 +188,8 @@ static int vx_vox_pass_setup(vx_vox_pass *p, const vx_vox_tri *T, int a, const i
     int i, swap;
     double ulo, uhi, wlo, whi;
     p->a = a;
-    p->u = (a + 1) % 3;
-    p->w = (a + 2) % 3;
+    p->u = a == 2 ? 0 : a + 1;
+    p->w = a == 0 ? 2 : a - 1;
     p->area2 = T->n[a];
     if (p->area2 == 0.0) return 0;
     for (i = 0; i < 3; i++) {
@@ -226,13 +228,13 @@ static int vx_vox_pass_setup(vx_vox_pass *p, const vx_vox_tri *T, int a, const i
     /* counter-clockwise order in the (u, w) plane */
     swap = p->area2 < 0.0;
     for (i = 0; i < 3; i++) {
-        int s = swap ? (3 - i) % 3 : i; /* 0, 2, 1 when clockwise */
+        int s = swap && i ? 3 - i : i; /* 0, 2, 1 when clockwise */
         p->q[i][0] = p->U[s];
         p->q[i][1] = p->W[s];
         p->q[i][2] = p->Z[s];
     }
     for (i = 0; i < 3; i++) {
-        int j = (i + 1) % 3;
+        int j = i == 2 ? 0 : i + 1;
         double slope;
         vx_vox_edge_init(&p->e[i], p->q[i][0], p->q[i][1], p->q[j][0], p->q[j][1]);
         slope = -p->e[i].sign * p->e[i].dw;
