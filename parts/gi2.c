@@ -140,45 +140,52 @@ static double hf_ns_ang(const double *t, double *w, int i)
     return w[i];
 }
 
-/* Eq. 16 on the tangents t[0..n-1] (n >= 1): the same value as hfvis_ns_bspline_max of their
- * angles, but atan is taken only in the windows that can beat the running best: a knot or
- * midpoint value is a convex combination of its window's angles, so a window whose largest
- * tangent is below tan(best) cannot exceed best. w: n doubles of scratch. */
-static double hf_ns_omax_bspline(const double *t, int n, double *w)
+/* A cheap atan with |error| <= 1.51e-3 rad (Rajan et al. 2006 on [-1, 1], reflected outside),
+ * used only to find which B-spline windows can hold the maximum. */
+#define HF_NS_FATAN_ERR 1.6e-3
+static double hf_ns_fatan(double t)
 {
-    double best, thr;
-    int i, j, am = 0;
+    double a = fabs(t), r;
+    if (a <= 1.0) return 0.78539816339744831 * t - t * (a - 1.0) * (0.2447 + 0.0663 * a);
+    r = 1.0 / t;
+    a = fabs(r);
+    return (t > 0.0 ? HF_HALF_PI : -HF_HALF_PI) - (0.78539816339744831 * r - r * (a - 1.0) * (0.2447 + 0.0663 * a));
+}
+
+/* Eq. 16 on the tangents t[0..n-1] (n >= 1): the value hfvis_ns_bspline_max gives for their
+ * angles. A knot or midpoint value is a convex combination of its window's angles, so with the
+ * cheap atan every window's value is known to within HF_NS_FATAN_ERR; only the windows that can
+ * still hold the maximum are evaluated with atan. w: n doubles of scratch, ap: 3n. */
+static double hf_ns_omax_bspline(const double *t, int n, double *w, double *ap)
+{
+    double amax = -HF_INF, best = -HF_INF, thr, *sk = ap + n;
+    int i, j;
     for (i = 0; i < n; i++) {
         w[i] = 3.0;
-        if (t[i] > t[am]) am = i;
+        ap[i] = hf_ns_fatan(t[i]);
     }
-    /* start from the knot at the raw maximum */
-    {
-        int a = am > 0 ? am - 1 : 0, b = am + 1 < n ? am + 1 : n - 1;
-        best = (hf_ns_ang(t, w, a) + 4.0 * hf_ns_ang(t, w, am) + hf_ns_ang(t, w, b)) / 6.0;
+    /* sk[2j] = approximate knot value, sk[2j+1] = approximate midpoint value */
+    for (j = 0; j < n; j++) {
+        double v = hf_ns_bs_knot(ap, n, j);
+        sk[2 * j] = v;
+        if (v > amax) amax = v;
+        if (j + 1 < n) {
+            v = hf_ns_bs_mid(ap, n, j);
+            sk[2 * j + 1] = v;
+            if (v > amax) amax = v;
+        }
     }
-    thr = tan(best);
-    thr -= 1e-9 * (1.0 + fabs(thr));
+    thr = amax - 2.0 * HF_NS_FATAN_ERR;
     for (j = 0; j < n; j++) {
         int a = j > 0 ? j - 1 : 0, b = j + 1 < n ? j + 1 : n - 1, d = j + 2 < n ? j + 2 : n - 1;
-        double mk = t[a] > t[j] ? t[a] : t[j];
-        if (t[b] > mk) mk = t[b];
-        if (mk >= thr) {
+        if (sk[2 * j] >= thr) {
             double v = (hf_ns_ang(t, w, a) + 4.0 * hf_ns_ang(t, w, j) + hf_ns_ang(t, w, b)) / 6.0;
-            if (v > best) {
-                best = v;
-                thr = tan(best);
-                thr -= 1e-9 * (1.0 + fabs(thr));
-            }
+            if (v > best) best = v;
         }
-        if (j + 1 < n && (mk >= thr || t[d] >= thr)) {
+        if (j + 1 < n && sk[2 * j + 1] >= thr) {
             double v = (hf_ns_ang(t, w, a) + 23.0 * hf_ns_ang(t, w, j) + 23.0 * hf_ns_ang(t, w, b) +
                         hf_ns_ang(t, w, d)) / 48.0;
-            if (v > best) {
-                best = v;
-                thr = tan(best);
-                thr -= 1e-9 * (1.0 + fabs(thr));
-            }
+            if (v > best) best = v;
         }
     }
 #ifdef HFVIS_ENABLE_ASSERTS
@@ -186,7 +193,7 @@ static double hf_ns_omax_bspline(const double *t, int n, double *w)
         double full;
         for (i = 0; i < n; i++) (void)hf_ns_ang(t, w, i);
         (void)hfvis_ns_bspline_max(n, w, &full);
-        HFVIS_ASSERT(fabs(full - best) <= 1e-15);
+        HFVIS_ASSERT(full == best);
     }
 #endif
     return best;
@@ -412,7 +419,7 @@ static inline void hf_ns_axis_clamped(double u, int n, int *i0, double *f)
 
 /* One channel (heights): bilinear at grid position (x, y); a tap with zero weight is never read
  * (as hf_bilerp), so a hole beside an exact sample position does not leak in. NaN = hole. */
-static inline double hf_ns_sample1(const hf_ns_level *L, int wrap, double x, double y)
+static inline double hf_ns_sample1(const hf_ns_level *L, int wrap, int holes, double x, double y)
 {
     int x0, x1, y0, y1;
     double fx, fy, r0 = 0.0, r1;
@@ -428,6 +435,9 @@ static inline double hf_ns_sample1(const hf_ns_level *L, int wrap, double x, dou
     }
     p0 = L->img + (size_t)y0 * (size_t)L->w;
     p1 = L->img + (size_t)y1 * (size_t)L->w;
+    if (!holes) /* every tap finite: the plain form gives the same value */
+        return ((double)p0[x0] * (1.0 - fx) + (double)p0[x1] * fx) * (1.0 - fy) +
+               ((double)p1[x0] * (1.0 - fx) + (double)p1[x1] * fx) * fy;
     if (fy != 1.0) {
         r0 = fx == 0.0 ? (double)p0[x0] : fx == 1.0 ? (double)p0[x1]
                                                     : (double)p0[x0] * (1.0 - fx) + (double)p0[x1] * fx;
@@ -507,7 +517,7 @@ typedef struct hf_ns_ctx {
     const hfvis_ns_scene *sc;
     hfvis_ns_gi_options o;     /* resolved */
     int W, H, C, m, mk, k, n, ov, ou, order, s, Rw, Rh, B;
-    int border, wrap, open;
+    int border, wrap, open, holes;
     int Lv, Lu;                /* levels built: heights, radiance */
     int nkey, ndir;            /* separate key lights, directional lights */
     int env, env_scan;         /* an environment (T_env) exists; the m environment slices run */
@@ -520,7 +530,7 @@ typedef struct hf_ns_ctx {
     hf_ns_key *keys;
     hf_ns_dir *dirs;
     hf_ns_level *hp, *dp, *ip;
-    double *tv, *wc, *smax, *hl, *ub, *vb, *Iq, *rtmp, *vtmp;
+    double *tv, *wc, *wa, *smax, *hl, *ub, *vb, *Iq, *rtmp, *vtmp;
     hf_ns_cast *cast;
     /* block 2: height pyramid and normals; block 3: two receiver rows; block 4: bounces */
     float *normals;
@@ -783,6 +793,7 @@ static void hf_ns_carve(hf_ns_ctx *c, hf_ns_arena *A)
     c->row = (double *)hf_ns_take(t, mw, ((size_t)c->Cmax + 1u) * sizeof(double));
     c->tv = (double *)hf_ns_take(t, n, sizeof(double));
     c->wc = (double *)hf_ns_take(t, n, sizeof(double));
+    c->wa = (double *)hf_ns_take(t, n, 3u * sizeof(double));
     c->smax = (double *)hf_ns_take(t, m, sizeof(double));
     c->hl = (double *)hf_ns_take(t, (size_t)c->Lv, sizeof(double));
     c->ub = (double *)hf_ns_take(t, n, C * sizeof(double));
@@ -893,7 +904,7 @@ static int hf_ns_scan(const hf_ns_ctx *c, const hf_ns_recv *r, double cph, doubl
             if (!hf_ns_place(c, &x, &y)) break; /* OPEN: the ray has left the grid for good */
         }
         if (isnan(hp)) continue;
-        hq = hf_ns_sample1(&c->hp[l], c->wrap, x, y);
+        hq = hf_ns_sample1(&c->hp[l], c->wrap, c->holes, x, y);
         if (isnan(hq)) continue; /* a hole never occludes and never casts */
         t = (hq - hp) * c->inv_dist[i];
         if (tv) tv[nv] = t;
@@ -924,7 +935,7 @@ static double hf_ns_smax(hf_ns_ctx *c, int nv)
             if (c->tv[i] > t) t = c->tv[i];
         return hf_ns_sine(t);
     }
-    return sin(hf_ns_omax_bspline(c->tv, nv, c->wc));
+    return sin(hf_ns_omax_bspline(c->tv, nv, c->wc, c->wa));
 }
 
 /* omega_min of the receiver normal N toward (cph, sph) as tangent and sine ([NS09] §3 with the
@@ -956,7 +967,7 @@ static int hf_ns_recv_at(hf_ns_ctx *c, double X, double Y, const double *N, hf_n
     r->n[1] = N[1];
     r->n[2] = N[2];
     r->hl = c->hl;
-    for (l = 0; l < c->Lv; l++) r->hl[l] = hf_ns_sample1(&c->hp[l], c->wrap, X, Y);
+    for (l = 0; l < c->Lv; l++) r->hl[l] = hf_ns_sample1(&c->hp[l], c->wrap, c->holes, X, Y);
     return !isnan(r->hl[0]);
 }
 
@@ -1523,6 +1534,7 @@ hfvis_status hfvis_ns_gi(const hfvis_grid *grid, const hfvis_ns_scene *scene,
         for (x = 0; x < c.W; x++) {
             float z = grid->z[(ptrdiff_t)y * grid->stride + x];
             c.hp[0].img[(size_t)y * (size_t)c.W + (size_t)x] = isfinite(z) ? z : (float)HF_NAN;
+            if (!isfinite(z)) c.holes = 1;
         }
     hf_ns_pyr_build(c.hp, c.Lv, c.k, 1, c.border, c.kern, c.row);
     if (c.need_normals) (void)hfvis_normals_compute(grid, c.normals);
