@@ -73,7 +73,7 @@ static void bench_vox_line(const hfvis_mesh *m, hfvis_volume *vol, const bench_v
     o.max_output_vertices = row->V;
     t = bench_vox_time(m, vol, &o, 0, reps, &frags);
     occ = bench_vox_occupied(vol);
-    if (with_ref && row->with_ref) tr = bench_vox_time(m, vol, &o, 1, 1, &rfrags);
+    if (with_ref && row->with_ref) tr = bench_vox_time(m, vol, &o, 1, reps > 1 ? 2 : 1, &rfrags);
     printf("%-21s %-11s %8.2f %7.1f %7.2f %9zu %7.1f %6.1f %8zu | ", row->name, gname, 1e3 * t, 1e9 * t / T,
            1e-6 * T / t, frags, 1e-6 * (double)frags / t, frags ? 1e9 * t / (double)frags : 0.0, occ);
     if (tr > 0.0) printf("%9.2f %6.1fx%s\n", 1e3 * tr, tr / t, rfrags == frags ? "" : " (count differs!)");
@@ -91,7 +91,7 @@ static void bench_vox(int quick)
     static const int res[3] = { 128, 256, 512 };
     const double c0[3] = { 0.0, 0.0, 0.0 };
     hfvis_mesh m;
-    int ri, k, nres = quick ? 1 : 3, reps = quick ? 1 : 3;
+    int ri, k, nres = quick ? 1 : 3, reps = quick ? 1 : 5;
     if (hfvis_mesh_torus_knot(NULL, c0, 1.0, 2, 3, 2500, 20, &m) != HFVIS_OK) {
         printf("bench_vox: mesh generation failed\n");
         return;

@@ -28,6 +28,9 @@
 /* Rows whose candidate span is narrower than this are tested pixel by pixel (with the same
  * predicate): cheaper than the boundary search for the small triangles of dense meshes. */
 #define VX_VOX_DIRECT_WIDTH 4
+/* Rows whose depth changes by more than this per pixel (runs of constant slab shorter than
+ * 1/VX_VOX_STEEP pixels) get each pixel's slab evaluated (same formula) instead of searched. */
+#define VX_VOX_STEEP 0.25
 
 /* One directed edge A -> B of a counter-clockwise polygon in the (u, w) plane. The edge function
  * is evaluated from the lexicographically smaller endpoint `l` with d = (larger - smaller) and
@@ -531,6 +534,20 @@ static void vx_vox_row_slabs(vx_vox_sink *s, const vx_vox_row_ctx *r, int pw, in
     if (p->dzdu == 0.0) { /* depth constant along the row */
         double z = vx_vox_row_depth(r, (double)L + 0.5);
         if (z >= lo_thr && z < hi_thr) vx_vox_emit(s, p, pw, L, R, vx_vox_ifloor(z));
+        return;
+    }
+    if (fabs(p->dzdu) > VX_VOX_STEEP) { /* short runs: the slab of each pixel, grouped in runs */
+        int k = 0, start = -1, pu;
+        for (pu = L; pu <= R; pu++) {
+            double z = vx_vox_row_depth(r, (double)pu + 0.5);
+            int kk = z >= lo_thr && z < hi_thr ? vx_vox_ifloor(z) : -1;
+            if (start >= 0 && kk != k) {
+                vx_vox_emit(s, p, pw, start, pu - 1, k);
+                start = -1;
+            }
+            if (kk >= 0 && start < 0) start = pu, k = kk;
+        }
+        if (start >= 0) vx_vox_emit(s, p, pw, start, R, k);
         return;
     }
     if (p->dzdu > 0.0) { /* slab nondecreasing along the row */
