@@ -19,8 +19,12 @@
  * monotone). So each predicate holds on a prefix or a suffix of the row, the covered pixels of a
  * row are one interval and the slab is monotone along it: the fast path finds the interval ends
  * and the slab changes by a guessed-then-verified search (about two predicate evaluations each)
- * and writes every fragment between them without testing it again. The oracle tests every voxel
- * of the bounding box directly. Both therefore select exactly the same voxels.
+ * and writes every fragment between them without testing it again (rows narrower than
+ * VX_VOX_DIRECT_WIDTH are tested pixel by pixel, and on rows steeper than VX_VOX_STEEP each
+ * pixel's slab is evaluated: cheaper there, and the same expressions). The oracle tests every
+ * voxel of the bounding box directly. Both therefore select exactly the same voxels, and since
+ * within one triangle and pass no voxel is written twice and triangles are processed in the
+ * same order, the blended values agree bit for bit too.
  */
 
 #define VX_VOX_MAX_COORD 1e150 /* beyond: products of coordinates could overflow double */

@@ -121,10 +121,16 @@ HFVIS_API int hfvis_gs_max_slices(int max_output_vertices, int pixel_clipping);
  * NULL vol or vol->data, an invalid vol->grid, channels outside 1..32, an unknown blend in a
  * used channel, an unknown method or axes, max_output_vertices < 0, > 0 with the pixel rule,
  * or too small for one slab (hfvis_gs_max_slices == 0); vol and *fragments_written are
- * untouched then. Allocates nothing. Cost: O(T + rows + fragments) per pass (edge functions
- * are solved per pixel row, then every fragment of a row is written without re-testing);
- * fragment clipping O(T + slabs*rows + fragments); never O(grid volume).
- * Exact: equals hfvis_voxelize_surface_reference bit for bit (same voxels, values, count). */
+ * untouched then. Allocates nothing. Cost: O(T + rows + fragments) per pass, never
+ * O(grid volume): per pixel row the covered span is found from the edge functions (each is
+ * monotone along the row, so about two evaluations per edge settle its end; rows narrower than
+ * 4 pixels are simply tested pixel by pixel) and the slab changes along it likewise (or per
+ * pixel when the depth slope exceeds 1/4), then the row's fragments are written without being
+ * tested again. Fragment clipping re-rasterises the rows once per slab spanned (Alg. 6's cost);
+ * GS slicing rasterises each slab piece over its own rows (Alg. 5's).
+ * Exact: equals hfvis_voxelize_surface_reference bit for bit (same voxels, values, count),
+ * given IEEE double arithmetic without excess precision (FLT_EVAL_METHOD 0, as on SSE2 and
+ * AArch64) and without FMA contraction (-ffp-contract=off). */
 HFVIS_API hfvis_status hfvis_voxelize_surface(const hfvis_mesh *mesh, hfvis_volume *vol,
                                               const hfvis_voxelize_options *opts,
                                               size_t *fragments_written);
