@@ -1708,3 +1708,614 @@ done:
     ss_free(o.alloc, dirs);
     return s;
 }
+
+/* ========================================================================================== */
+/* 6. HBAO (Bavoil, Sainz, Dimitrov 2008; thesis l.466, [P4] l.1988; spec §4.1)               */
+/* ========================================================================================== */
+
+#define SS_HBAO_DEFAULT_K 8
+
+hfvis_hbao_options hfvis_hbao_options_default(void)
+{
+    hfvis_hbao_options o;
+    memset(&o, 0, sizeof o);
+    o.directions = SS_HBAO_DEFAULT_K;
+    o.variant = HFVIS_HBAO_INCREMENTAL;
+    o.step_px = 1.0;
+    o.falloff.kind = HFVIS_FALLOFF_NONE;
+    o.tangent = HFVIS_SSAO_TANGENT_REAL;
+    o.fixed_sin_t = SS_DEFAULT_SIN_T;
+    o.sampling = HFVIS_SSAO_SAMPLING_NEAREST;
+    o.plane = HFVIS_SSAO_PLANE_EXACT;
+    o.jitter = HFVIS_HBAO_JITTER_NONE;
+    return o;
+}
+
+hfvis_status hfvis_hbao_options_resolve(const hfvis_hbao_options *in, hfvis_hbao_options *out)
+{
+    hfvis_hbao_options o;
+    int K, k;
+    if (!out) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (in) o = *in;
+    else memset(&o, 0, sizeof o);
+    K = o.directions ? o.directions : SS_HBAO_DEFAULT_K;
+    if (K < 1 || K > HFVIS_SSAO_MAX_DIRECTIONS || !ss_finite(o.azimuth0_rad))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    o.directions = K;
+    if (o.custom_directions) {
+        double ws = 0.0;
+        for (k = 0; k < K; k++) {
+            const hfvis_ssao_direction *d = &o.custom_directions[k];
+            if (!ss_dir_ok(d) || !ss_finite(d->weight) || d->weight < 0.0)
+                return HFVIS_ERR_INVALID_ARGUMENT;
+            ws += d->weight;
+        }
+        if (!(ws > 0.0) || !ss_finite(ws)) return HFVIS_ERR_INVALID_ARGUMENT;
+    }
+    if (o.variant == HFVIS_HBAO_DEFAULT) o.variant = HFVIS_HBAO_INCREMENTAL;
+    if (o.variant < HFVIS_HBAO_INCREMENTAL || o.variant > HFVIS_HBAO_LARGEST_OCCLUDER)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.steps < 0 || !ss_finite(o.step_px) || !ss_finite(o.radius) || o.radius < 0.0 ||
+        !ss_finite(o.max_radius_px) || o.max_radius_px < 0.0)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.step_px == 0.0) o.step_px = 1.0;
+    if (!ss_step_ok(o.step_px)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.falloff.kind == HFVIS_FALLOFF_DEFAULT) o.falloff.kind = HFVIS_FALLOFF_NONE;
+    if (hfvis_falloff_check(&o.falloff) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.falloff.kind == HFVIS_FALLOFF_HBAO && o.falloff.hbao_c == 0.0) o.falloff.hbao_c = 0.3;
+    if (o.tangent == HFVIS_SSAO_TANGENT_DEFAULT) o.tangent = HFVIS_SSAO_TANGENT_REAL;
+    if (o.tangent != HFVIS_SSAO_TANGENT_REAL && o.tangent != HFVIS_SSAO_TANGENT_FIXED)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.fixed_sin_t == 0.0) o.fixed_sin_t = SS_DEFAULT_SIN_T;
+    if (!(o.fixed_sin_t >= -1.0 && o.fixed_sin_t <= 1.0)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.sampling == HFVIS_SSAO_SAMPLING_DEFAULT) o.sampling = HFVIS_SSAO_SAMPLING_NEAREST;
+    if (o.sampling != HFVIS_SSAO_SAMPLING_NEAREST && o.sampling != HFVIS_SSAO_SAMPLING_BILINEAR)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.plane == HFVIS_SSAO_PLANE_DEFAULT) o.plane = HFVIS_SSAO_PLANE_EXACT;
+    if (o.plane != HFVIS_SSAO_PLANE_PAPER && o.plane != HFVIS_SSAO_PLANE_EXACT)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.jitter == HFVIS_HBAO_JITTER_DEFAULT) o.jitter = HFVIS_HBAO_JITTER_NONE;
+    if (o.jitter < HFVIS_HBAO_JITTER_NONE || o.jitter > HFVIS_HBAO_JITTER_ROTATION_STEP)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.custom_directions && o.jitter != HFVIS_HBAO_JITTER_NONE)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    *out = o;
+    return HFVIS_OK;
+}
+
+/* One HBAO pixel (spec §4.1 HbaoPixel). dirs: the custom directions or NULL; the result is
+ * divided by the weight sum, which normalises custom weights. */
+static double ss_hbao_pixel(const ss_cam *c, const hfvis_hbao_options *o, const ss_fall *f,
+                            const hfvis_ssao_direction *dirs, const float *depth,
+                            const float *normals, int x, int y, double support)
+{
+    int K = o->directions, k, bil = o->sampling == HFVIS_SSAO_SAMPLING_BILINEAR;
+    int exact = o->plane == HFVIS_SSAO_PLANE_EXACT, custom = o->custom_directions != NULL;
+    double u0 = (double)x + 0.5, v0 = (double)y + 0.5, zc = ss_tex(c, depth, x, y), P[3];
+    double rot = 0.0, xi = 1.0, sum = 0.0, wsum = 0.0, maxr;
+    ss_unproject(c, u0, v0, zc, P);
+    maxr = o->max_radius_px > 0.0 ? o->max_radius_px
+                                   : sqrt((double)c->W * (double)c->W + (double)c->H * (double)c->H);
+    if (o->jitter != HFVIS_HBAO_JITTER_NONE)
+        rot = 2.0 * SS_PI / (double)K * ss_hash01((uint32_t)x, (uint32_t)y, 0u, o->seed);
+    if (o->jitter == HFVIS_HBAO_JITTER_ROTATION_STEP)
+        xi = 1.0 - ss_hash01((uint32_t)x, (uint32_t)y, 1u, o->seed); /* (0, 1] */
+    for (k = 0; k < K; k++) {
+        double dx, dy, sx, sy, e1[3], yh[3], px, py, r, ux, uy, st, rpx, L, w, maxs, acc = 0.0,
+               best, hdist = 0.0, tiny;
+        int N, s, found = 0;
+        if (custom) {
+            dx = dirs[k].dx;
+            dy = dirs[k].dy;
+            w = dirs[k].weight;
+        } else {
+            double psi = o->azimuth0_rad + 2.0 * SS_PI * (double)k / (double)K + rot;
+            dx = ss_snap_unit(cos(psi));
+            dy = ss_snap_unit(sin(psi));
+            w = 1.0 / (double)K;
+        }
+        ss_plane_e1(c, dx, dy, e1);
+        ss_plane_yhat(c, e1, P, yh);
+        px = ss_dot3(P, e1);
+        py = exact ? ss_dot3(P, yh) : P[2];
+        r = sqrt(px * px + py * py);
+        if (c->persp) {
+            ux = -px / r;
+            uy = -py / r;
+        } else {
+            ux = 0.0;
+            uy = 1.0;
+        }
+        tiny = SS_COINCIDENT * (fabs(px) + fabs(py));
+        st = o->tangent == HFVIS_SSAO_TANGENT_REAL
+                 ? ss_real_sin_t(c, normals, x, y, e1, yh, exact, ux, uy, -1.0, o->fixed_sin_t)
+                 : o->fixed_sin_t;
+        /* screen radius of the view-space radius along e1 at the receiver's depth */
+        if (support < SS_INF) {
+            double a = c->persp ? zc * sqrt(dx * c->ifx * dx * c->ifx + dy * c->ify * dy * c->ify)
+                                : sqrt(dx * c->sx * dx * c->sx + dy * c->sy * dy * c->sy);
+            rpx = support / a;
+            if (!(rpx < maxr)) rpx = maxr;
+        } else {
+            rpx = maxr;
+        }
+        if (custom) {
+            sx = dirs[k].step_x;
+            sy = dirs[k].step_y;
+            N = o->steps > 0 ? o->steps : (int)ceil(rpx / dirs[k].step);
+        } else {
+            N = o->steps > 0 ? o->steps : (int)ceil(rpx / o->step_px);
+            if (N < 1) N = 1;
+            L = rpx / (double)N;
+            sx = L * dx;
+            sy = L * dy;
+        }
+        maxs = st;
+        best = st;
+        for (s = 1; s <= N; s++) {
+            double t = custom ? (double)s : (double)s - 1.0 + xi, u = u0 + t * sx, v = v0 + t * sy;
+            double qu, qv, z, Q[3], hx, hy, len, sh;
+            if (!(u >= 0.0 && v >= 0.0 && u < (double)c->W && v < (double)c->H)) break;
+            z = ss_sample(c, depth, bil, u, v, ss_texel(u, c->W), ss_texel(v, c->H), &qu, &qv);
+            if (z != z) continue;
+            ss_unproject(c, qu, qv, z, Q);
+            hx = ss_dot3(Q, e1) - px;
+            hy = (exact ? ss_dot3(Q, yh) : Q[2]) - py;
+            len = sqrt(hx * hx + hy * hy);
+            if (!(len > tiny)) continue;
+            sh = (hx * ux + hy * uy) / len;
+            if (!(sh > maxs)) continue;
+            switch (o->variant) {
+            case HFVIS_HBAO_INCREMENTAL:
+                acc += ss_rho(f, len) * (sh - maxs);
+                break;
+            case HFVIS_HBAO_SINGLE_HORIZON:
+                hdist = len;
+                found = 1;
+                break;
+            default: {
+                double oc = st + (sh - st) * ss_rho(f, len);
+                if (oc > best) best = oc;
+                break;
+            }
+            }
+            maxs = sh;
+        }
+        if (o->variant == HFVIS_HBAO_SINGLE_HORIZON) acc = found ? ss_rho(f, hdist) * (maxs - st) : 0.0;
+        else if (o->variant == HFVIS_HBAO_LARGEST_OCCLUDER) acc = best;
+        sum += w * acc;
+        wsum += w;
+    }
+    return wsum > 0.0 ? sum / wsum : 0.0;
+}
+
+hfvis_status hfvis_hbao(const hfvis_camera *cam, const float *depth, const float *normals,
+                        const hfvis_hbao_options *opts, float *ao, ptrdiff_t ao_stride)
+{
+    ss_cam c;
+    ss_fall f;
+    hfvis_hbao_options o;
+    float *nrm = NULL;
+    double support;
+    int x, y, W;
+    if (ss_cam_load(cam, &c) != HFVIS_OK || hfvis_hbao_options_resolve(opts, &o) != HFVIS_OK ||
+        !depth || !ao)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    W = c.W - 2 * c.gx;
+    if (ao_stride < W) return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_fall_load(&o.falloff, &f);
+    support = o.radius > 0.0 ? o.radius : f.support;
+    if (o.tangent == HFVIS_SSAO_TANGENT_REAL && !normals) {
+        size_t b = ss_bytes3((size_t)c.stride, (size_t)c.H, 3 * sizeof(float));
+        if (!b || !(nrm = (float *)ss_alloc(o.alloc, b))) return HFVIS_ERR_OUT_OF_MEMORY;
+        ss_normals_fill(&c, depth, nrm);
+        normals = nrm;
+    }
+    for (y = c.gy; y < c.H - c.gy; y++)
+        for (x = c.gx; x < c.W - c.gx; x++) {
+            double a = 0.0;
+            if (!ss_bg(&c, ss_tex(&c, depth, x, y))) {
+                a = ss_hbao_pixel(&c, &o, &f, o.custom_directions, depth, normals, x, y, support);
+                a = a > 0.0 ? (a < 1.0 ? a : 1.0) : 0.0;
+            }
+            ao[(ptrdiff_t)(y - c.gy) * ao_stride + (x - c.gx)] = (float)a;
+        }
+    ss_free(o.alloc, nrm);
+    return HFVIS_OK;
+}
+
+/* ========================================================================================== */
+/* 7. The screen-space ray-traced reference ([P4] §8; spec §5.11)                             */
+/* ========================================================================================== */
+
+#define SS_RT_DEFAULT_RAYS 256
+#define SS_RT_DEFAULT_STEP 0.5
+#define SS_RT_DEFAULT_REFINE 12
+#define SS_RT_DEFAULT_BIAS 1e-3
+#define SS_RT_DEFAULT_MAX_STEPS 65536
+
+hfvis_ssao_rt_options hfvis_ssao_rt_options_default(void)
+{
+    hfvis_ssao_rt_options o;
+    memset(&o, 0, sizeof o);
+    o.rays = SS_RT_DEFAULT_RAYS;
+    o.step_px = SS_RT_DEFAULT_STEP;
+    o.falloff.kind = HFVIS_FALLOFF_NONE;
+    o.sampling = HFVIS_SSAO_SAMPLING_BILINEAR;
+    o.refine_iterations = SS_RT_DEFAULT_REFINE;
+    o.bias = SS_RT_DEFAULT_BIAS;
+    o.max_steps = SS_RT_DEFAULT_MAX_STEPS;
+    return o;
+}
+
+hfvis_status hfvis_ssao_rt_options_resolve(const hfvis_ssao_rt_options *in,
+                                           hfvis_ssao_rt_options *out)
+{
+    hfvis_ssao_rt_options o;
+    if (!out) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (in) o = *in;
+    else memset(&o, 0, sizeof o);
+    if (o.rays < 0 || o.refine_iterations < 0 || o.refine_iterations > 64 || o.max_steps < 0 ||
+        !ss_finite(o.step_px) || o.step_px < 0.0 || !ss_finite(o.thickness) || o.thickness < 0.0 ||
+        !ss_finite(o.bias) || o.bias < 0.0 || !ss_finite(o.max_distance) || o.max_distance < 0.0)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.rays == 0) o.rays = SS_RT_DEFAULT_RAYS;
+    if (o.step_px == 0.0) o.step_px = SS_RT_DEFAULT_STEP;
+    if (o.step_px < SS_MIN_STEP || o.step_px > 64.0) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.refine_iterations == 0) o.refine_iterations = SS_RT_DEFAULT_REFINE;
+    if (o.bias == 0.0) o.bias = SS_RT_DEFAULT_BIAS;
+    if (o.max_steps == 0) o.max_steps = SS_RT_DEFAULT_MAX_STEPS;
+    if (o.sampling == HFVIS_SSAO_SAMPLING_DEFAULT)
+        o.sampling = o.thickness > 0.0 ? HFVIS_SSAO_SAMPLING_NEAREST : HFVIS_SSAO_SAMPLING_BILINEAR;
+    if (o.sampling != HFVIS_SSAO_SAMPLING_NEAREST && o.sampling != HFVIS_SSAO_SAMPLING_BILINEAR)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.falloff.kind == HFVIS_FALLOFF_DEFAULT) o.falloff.kind = HFVIS_FALLOFF_NONE;
+    if (hfvis_falloff_check(&o.falloff) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.falloff.kind == HFVIS_FALLOFF_HBAO && o.falloff.hbao_c == 0.0) o.falloff.hbao_c = 0.3;
+    *out = o;
+    return HFVIS_OK;
+}
+
+/* Radical inverse in base 2 of r (van der Corput). */
+static double ss_radical2(uint32_t r)
+{
+    r = (r << 16) | (r >> 16);
+    r = ((r & 0x00ff00ffu) << 8) | ((r & 0xff00ff00u) >> 8);
+    r = ((r & 0x0f0f0f0fu) << 4) | ((r & 0xf0f0f0f0u) >> 4);
+    r = ((r & 0x33333333u) << 2) | ((r & 0xccccccccu) >> 2);
+    r = ((r & 0x55555555u) << 1) | ((r & 0xaaaaaaaau) >> 1);
+    return (double)r * (1.0 / 4294967296.0);
+}
+
+typedef struct ss_rt {
+    const ss_cam *c;
+    const float *depth;
+    const hfvis_ssao_rt_options *o;
+    const ss_fall *f;
+    double zmin, zmax, maxdist;
+    int bil;
+} ss_rt;
+
+/* Is view point X inside the depth field? -1: outside the buffer or behind the eye (a miss),
+ * 0: outside the field, 1: inside. */
+static int ss_rt_inside(const ss_rt *t, const double X[3], double *d_out)
+{
+    const ss_cam *c = t->c;
+    double d = -X[2], u, v, zb, qu, qv;
+    *d_out = d;
+    if (c->persp) {
+        if (!(d > 0.0)) return -1;
+        u = c->cx + c->fx * X[0] / d;
+        v = c->cy - c->fy * X[1] / d;
+    } else {
+        u = c->cx + X[0] / c->sx;
+        v = c->cy - X[1] / c->sy;
+    }
+    if (!(u >= 0.0 && v >= 0.0 && u < (double)c->W && v < (double)c->H)) return -1;
+    zb = ss_sample(c, t->depth, t->bil, u, v, ss_texel(u, c->W), ss_texel(v, c->H), &qu, &qv);
+    if (zb != zb) return 0;
+    if (!(d > zb)) return 0;
+    return t->o->thickness > 0.0 ? d < zb + t->o->thickness : 1;
+}
+
+/* Step length at X along w: step_px of screen motion, at most half the thickness in depth. */
+static double ss_rt_step(const ss_rt *t, const double X[3], const double w[3], double s, double zc)
+{
+    const ss_cam *c = t->c;
+    double speed, ds;
+    if (c->persp) {
+        double d = -X[2], a = c->fx * (w[0] * d + X[0] * w[2]), b = c->fy * (w[1] * d + X[1] * w[2]);
+        speed = sqrt(a * a + b * b) / (d * d);
+    } else {
+        double a = w[0] / c->sx, b = w[1] / c->sy;
+        speed = sqrt(a * a + b * b);
+    }
+    ds = speed > 0.0 ? t->o->step_px / speed : SS_INF;
+    if (t->o->thickness > 0.0 && fabs(w[2]) > 0.0 && ds * fabs(w[2]) > 0.5 * t->o->thickness)
+        ds = 0.5 * t->o->thickness / fabs(w[2]);
+    /* large steps only where the ray barely moves on screen: let them grow geometrically */
+    if (ds > (s > zc ? s : zc)) ds = s > zc ? s : zc;
+    if (ds < 1e-9 * zc) ds = 1e-9 * zc;
+    return ds;
+}
+
+/* Distance to the first hit of the ray O + s w, or -1 for a miss. */
+static double ss_rt_ray(const ss_rt *t, const double O[3], const double w[3], double zc)
+{
+    double s_prev = 0.0, s, X[3], d;
+    int n, in, it;
+    s = ss_rt_step(t, O, w, 0.0, zc);
+    for (n = 0; n < t->o->max_steps; n++) {
+        if (s > t->maxdist) return -1.0;
+        X[0] = O[0] + s * w[0];
+        X[1] = O[1] + s * w[1];
+        X[2] = O[2] + s * w[2];
+        if (!ss_finite(X[0]) || !ss_finite(X[1]) || !ss_finite(X[2])) return -1.0;
+        in = ss_rt_inside(t, X, &d);
+        if (in < 0) return -1.0;
+        if (in) {
+            double lo = s_prev, hi = s;
+            for (it = 0; it < t->o->refine_iterations; it++) {
+                double mid = 0.5 * (lo + hi), Y[3], dm;
+                Y[0] = O[0] + mid * w[0];
+                Y[1] = O[1] + mid * w[1];
+                Y[2] = O[2] + mid * w[2];
+                if (ss_rt_inside(t, Y, &dm) > 0) hi = mid;
+                else lo = mid;
+            }
+            return 0.5 * (lo + hi);
+        }
+        /* rising above every depth, or sinking below every depth plus the thickness */
+        if (w[2] > 0.0 && d < t->zmin) return -1.0;
+        if (w[2] < 0.0 && t->o->thickness > 0.0 && d > t->zmax + t->o->thickness) return -1.0;
+        s_prev = s;
+        s += ss_rt_step(t, X, w, s, zc);
+    }
+    return -1.0;
+}
+
+hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth, const float *normals,
+                                 const hfvis_ssao_rt_options *opts, float *ao, ptrdiff_t ao_stride)
+{
+    ss_cam c;
+    ss_fall f;
+    ss_rt t;
+    hfvis_ssao_rt_options o;
+    float *nrm = NULL;
+    int x, y, W, r;
+    if (ss_cam_load(cam, &c) != HFVIS_OK || hfvis_ssao_rt_options_resolve(opts, &o) != HFVIS_OK ||
+        !depth || !ao)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    W = c.W - 2 * c.gx;
+    if (ao_stride < W) return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_fall_load(&o.falloff, &f);
+    if (!normals) {
+        size_t b = ss_bytes3((size_t)c.stride, (size_t)c.H, 3 * sizeof(float));
+        if (!b || !(nrm = (float *)ss_alloc(o.alloc, b))) return HFVIS_ERR_OUT_OF_MEMORY;
+        ss_normals_fill(&c, depth, nrm);
+        normals = nrm;
+    }
+    t.c = &c;
+    t.depth = depth;
+    t.o = &o;
+    t.f = &f;
+    t.bil = o.sampling == HFVIS_SSAO_SAMPLING_BILINEAR;
+    t.maxdist = o.max_distance > 0.0 ? o.max_distance : f.support;
+    t.zmin = SS_INF;
+    t.zmax = 0.0;
+    for (y = 0; y < c.H; y++)
+        for (x = 0; x < c.W; x++) {
+            double z = ss_tex(&c, depth, x, y);
+            if (ss_bg(&c, z)) continue;
+            if (z < t.zmin) t.zmin = z;
+            if (z > t.zmax) t.zmax = z;
+        }
+    for (y = c.gy; y < c.H - c.gy; y++)
+        for (x = c.gx; x < c.W - c.gx; x++) {
+            double zc = ss_tex(&c, depth, x, y), acc = 0.0, a = 0.0;
+            if (!ss_bg(&c, zc)) {
+                const float *np = normals + 3 * ((ptrdiff_t)y * c.stride + x);
+                double P[3], n[3], O[3], T[3], B[3], sg, aa, bb, xi1, xi2;
+                ss_unproject(&c, (double)x + 0.5, (double)y + 0.5, zc, P);
+                n[0] = (double)np[0];
+                n[1] = (double)np[1];
+                n[2] = (double)np[2];
+                if (!ss_normalize3(n)) {
+                    if (c.persp) {
+                        n[0] = -P[0];
+                        n[1] = -P[1];
+                        n[2] = -P[2];
+                        ss_normalize3(n);
+                    } else {
+                        n[0] = n[1] = 0.0;
+                        n[2] = 1.0;
+                    }
+                }
+                /* orthonormal basis (Duff et al. 2017) */
+                sg = n[2] >= 0.0 ? 1.0 : -1.0;
+                aa = -1.0 / (sg + n[2]);
+                bb = n[0] * n[1] * aa;
+                T[0] = 1.0 + sg * n[0] * n[0] * aa;
+                T[1] = sg * bb;
+                T[2] = -sg * n[0];
+                B[0] = bb;
+                B[1] = sg + n[1] * n[1] * aa;
+                B[2] = -n[1];
+                O[0] = P[0] + o.bias * zc * n[0];
+                O[1] = P[1] + o.bias * zc * n[1];
+                O[2] = P[2] + o.bias * zc * n[2];
+                xi1 = ss_hash01((uint32_t)x, (uint32_t)y, 1u, o.seed);
+                xi2 = ss_hash01((uint32_t)x, (uint32_t)y, 2u, o.seed);
+                for (r = 0; r < o.rays; r++) {
+                    double u1 = (double)r / (double)o.rays + xi1, u2 = ss_radical2((uint32_t)r) + xi2;
+                    double rr, ph, lx, ly, lz, w[3], hit;
+                    if (u1 >= 1.0) u1 -= 1.0;
+                    if (u2 >= 1.0) u2 -= 1.0;
+                    rr = sqrt(u1);
+                    ph = 2.0 * SS_PI * u2;
+                    lx = rr * cos(ph);
+                    ly = rr * sin(ph);
+                    lz = sqrt(1.0 - u1 > 0.0 ? 1.0 - u1 : 0.0);
+                    w[0] = lx * T[0] + ly * B[0] + lz * n[0];
+                    w[1] = lx * T[1] + ly * B[1] + lz * n[1];
+                    w[2] = lx * T[2] + ly * B[2] + lz * n[2];
+                    hit = ss_rt_ray(&t, O, w, zc);
+                    if (hit >= 0.0) acc += ss_rho(&f, hit);
+                }
+                a = acc / (double)o.rays;
+            }
+            ao[(ptrdiff_t)(y - c.gy) * ao_stride + (x - c.gx)] = (float)a;
+        }
+    ss_free(o.alloc, nrm);
+    return HFVIS_OK;
+}
+
+/* ========================================================================================== */
+/* 8. Analytic depth buffers (spec §6 T1-T7)                                                  */
+/* ========================================================================================== */
+
+static int ss_scene_ok(const hfvis_ssao_scene *s)
+{
+    if (!s || !ss_finite(s->base_depth) || !(s->base_depth > 0.0)) return 0;
+    switch (s->kind) {
+    case HFVIS_SSAO_SCENE_PLANE:
+        return ss_finite(s->slope_x) && ss_finite(s->slope_y);
+    case HFVIS_SSAO_SCENE_STEP:
+        return ss_finite(s->x0) && ss_finite(s->height) && s->base_depth - s->height > 0.0;
+    case HFVIS_SSAO_SCENE_VGROOVE:
+        return ss_finite(s->x0) && s->angle > 0.0 && s->angle < 0.5 * SS_PI;
+    case HFVIS_SSAO_SCENE_PIT:
+        return ss_finite(s->x0) && ss_finite(s->y0) && ss_finite(s->radius) && s->radius > 0.0;
+    }
+    return 0;
+}
+
+/* Keep candidate t if valid and smaller. */
+static void ss_take(double t, int ok, double *best, int *which, int id)
+{
+    if (ok && t > 0.0 && ss_finite(t) && t < *best) {
+        *best = t;
+        *which = id;
+    }
+}
+
+/* First surface along the pixel ray: depth (+inf for a miss) and normal. Orthographic rays are
+ * vertical through (rx, ry); perspective rays are t (rx, ry, -1). */
+static double ss_scene_hit(const hfvis_ssao_scene *s, int persp, double rx, double ry, double n[3])
+{
+    double Z0 = s->base_depth, best = SS_INF, x;
+    int which = -1;
+    n[0] = n[1] = 0.0;
+    n[2] = 1.0;
+    switch (s->kind) {
+    case HFVIS_SSAO_SCENE_PLANE: {
+        double a = s->slope_x, b = s->slope_y, l = sqrt(a * a + b * b + 1.0);
+        if (persp) {
+            double den = 1.0 + a * rx + b * ry;
+            ss_take(Z0 / den, den > 0.0, &best, &which, 0);
+        } else {
+            ss_take(Z0 - (a * rx + b * ry), 1, &best, &which, 0);
+        }
+        n[0] = -a / l;
+        n[1] = -b / l;
+        n[2] = 1.0 / l;
+        break;
+    }
+    case HFVIS_SSAO_SCENE_STEP: {
+        double h = s->height, lo = Z0 - h < Z0 ? Z0 - h : Z0, hi = Z0 - h < Z0 ? Z0 : Z0 - h;
+        if (persp) {
+            ss_take(Z0, Z0 * rx < s->x0, &best, &which, 0);
+            ss_take(Z0 - h, (Z0 - h) * rx >= s->x0, &best, &which, 1);
+            if (rx != 0.0) {
+                double t = s->x0 / rx;
+                ss_take(t, t >= lo && t <= hi, &best, &which, 2);
+            }
+        } else {
+            ss_take(rx < s->x0 ? Z0 : Z0 - h, 1, &best, &which, rx < s->x0 ? 0 : 1);
+        }
+        if (which == 2) {
+            n[0] = h > 0.0 ? -1.0 : 1.0;
+            n[2] = 0.0;
+        }
+        break;
+    }
+    case HFVIS_SSAO_SCENE_VGROOVE: {
+        double tb = tan(s->angle), l = sqrt(1.0 + tb * tb);
+        if (persp) {
+            double d1 = 1.0 + rx * tb, d2 = 1.0 - rx * tb, t1 = (Z0 + s->x0 * tb) / d1,
+                   t2 = (Z0 - s->x0 * tb) / d2;
+            ss_take(t1, d1 > 0.0 && t1 * rx >= s->x0, &best, &which, 0);
+            ss_take(t2, d2 > 0.0 && t2 * rx < s->x0, &best, &which, 1);
+            x = best * rx;
+        } else {
+            x = rx;
+            ss_take(Z0 - fabs(rx - s->x0) * tb, 1, &best, &which, rx >= s->x0 ? 0 : 1);
+        }
+        if (which >= 0 && x != s->x0) {
+            n[0] = (x > s->x0 ? -tb : tb) / l;
+            n[2] = 1.0 / l;
+        }
+        break;
+    }
+    default: { /* PIT */
+        double R = s->radius, dx, dy, C[3], X[3];
+        if (persp) {
+            dx = Z0 * rx - s->x0;
+            dy = Z0 * ry - s->y0;
+            if (dx * dx + dy * dy >= R * R) {
+                ss_take(Z0, 1, &best, &which, 0);
+            } else {
+                double rr = rx * rx + ry * ry + 1.0, rc = rx * s->x0 + ry * s->y0 + Z0;
+                double cc = s->x0 * s->x0 + s->y0 * s->y0 + Z0 * Z0 - R * R, disc = rc * rc - rr * cc;
+                if (disc < 0.0) disc = 0.0;
+                ss_take((rc + sqrt(disc)) / rr, 1, &best, &which, 1);
+            }
+            X[0] = best * rx;
+            X[1] = best * ry;
+        } else {
+            dx = rx - s->x0;
+            dy = ry - s->y0;
+            X[0] = rx;
+            X[1] = ry;
+            if (dx * dx + dy * dy >= R * R) ss_take(Z0, 1, &best, &which, 0);
+            else ss_take(Z0 + sqrt(R * R - dx * dx - dy * dy), 1, &best, &which, 1);
+        }
+        if (which == 1) {
+            C[0] = s->x0;
+            C[1] = s->y0;
+            C[2] = -Z0;
+            X[2] = -best;
+            n[0] = (C[0] - X[0]) / R;
+            n[1] = (C[1] - X[1]) / R;
+            n[2] = (C[2] - X[2]) / R;
+            ss_normalize3(n);
+        }
+        break;
+    }
+    }
+    if (which < 0) n[0] = n[1] = n[2] = 0.0;
+    return best;
+}
+
+hfvis_status hfvis_ssao_scene_render(const hfvis_camera *cam, const hfvis_ssao_scene *scene,
+                                     float *depth, float *normals)
+{
+    ss_cam c;
+    int x, y;
+    if (ss_cam_load(cam, &c) != HFVIS_OK || !ss_scene_ok(scene) || !depth)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    for (y = 0; y < c.H; y++)
+        for (x = 0; x < c.W; x++) {
+            double P[3], n[3], z;
+            ptrdiff_t o = (ptrdiff_t)y * c.stride + x;
+            ss_unproject(&c, (double)x + 0.5, (double)y + 0.5, 1.0, P);
+            z = ss_scene_hit(scene, c.persp, P[0], P[1], n);
+            depth[o] = (float)z;
+            if (normals) {
+                normals[3 * o] = (float)n[0];
+                normals[3 * o + 1] = (float)n[1];
+                normals[3 * o + 2] = (float)n[2];
+            }
+        }
+    return HFVIS_OK;
+}

@@ -464,3 +464,177 @@ HFVIS_API hfvis_status hfvis_lsao_gather(const hfvis_camera *cam, const float *d
 HFVIS_API hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth,
                                   const float *normals, const hfvis_lsao_options *opts,
                                   float *ao, ptrdiff_t ao_stride);
+
+/* ---- HBAO (Bavoil, Sainz, Dimitrov 2008, as the thesis describes it; spec §4.1) ----------- */
+
+typedef enum hfvis_hbao_variant {
+    HFVIS_HBAO_DEFAULT = 0,           /* = INCREMENTAL */
+    HFVIS_HBAO_INCREMENTAL = 1,       /* P4's description: each sample rising above the running
+                                         horizon adds rho(|h|) (sin h - max) - the SA integral
+                                         with "geometry between visible samples at the higher
+                                         one's distance" */
+    HFVIS_HBAO_SINGLE_HORIZON = 2,    /* the thesis summary: rho(dist of the highest sample) *
+                                         (sin h - sin t) */
+    HFVIS_HBAO_LARGEST_OCCLUDER = 3   /* [P3] Eq. 1 by brute force over the visible samples: the
+                                         largest Occ(h, sin t) (the P3 Fig. 7 reference) */
+} hfvis_hbao_variant;
+
+typedef enum hfvis_hbao_jitter {
+    HFVIS_HBAO_JITTER_DEFAULT = 0,    /* = NONE */
+    HFVIS_HBAO_JITTER_NONE = 1,
+    HFVIS_HBAO_JITTER_ROTATION = 2,   /* the K directions rotated per pixel by xi 2 pi/K (P4's
+                                         setup: "randomly rotated per pixel") */
+    HFVIS_HBAO_JITTER_ROTATION_STEP = 3 /* and the march offset by a per-pixel fraction of a step */
+} hfvis_hbao_jitter;
+
+/* Options of hfvis_hbao. NULL or a zero struct = the defaults in brackets. */
+typedef struct hfvis_hbao_options {
+    const hfvis_allocator *alloc;     /* reconstructed normals only; NULL = malloc/free */
+    int directions;                   /* K [8] (uniform azimuths azimuth0 + 2 pi k/K) */
+    double azimuth0_rad;              /* [0] */
+    const hfvis_ssao_direction *custom_directions; /* K directions to march instead (weights
+                                         normalised), stepping by their step vectors: integer
+                                         box steps visit texels at the same offsets for every
+                                         receiver, as LSAO's box patterns [NULL] */
+    hfvis_hbao_variant variant;       /* [INCREMENTAL] */
+    int steps;                        /* N samples per direction; 0 = ceil(R_px / step_px)
+                                         (custom directions: ceil(R_px / |step vector|)) [0] */
+    double step_px;                   /* the auto step length in pixels [1] */
+    double radius;                    /* march radius R in view units; the screen radius is
+                                         R_px = R / (z |(dx/fx, dy/fy)|) (orthographic
+                                         R / |(dx sx, dy sy)|) [the falloff's support; the whole
+                                         buffer for unbounded falloffs] */
+    double max_radius_px;             /* cap on R_px [the buffer diagonal] */
+    hfvis_falloff falloff;            /* [NONE] */
+    hfvis_ssao_tangent tangent;       /* REAL or FIXED [REAL] */
+    double fixed_sin_t;               /* [-0.85], as hfvis_lsao_options */
+    hfvis_ssao_sampling sampling;     /* [NEAREST]: snapped texels (BSD08) */
+    hfvis_ssao_plane plane;           /* [EXACT] */
+    hfvis_hbao_jitter jitter;         /* [NONE]; custom directions allow only NONE */
+    uint32_t seed;                    /* jitter seed */
+} hfvis_hbao_options;
+
+HFVIS_API hfvis_hbao_options hfvis_hbao_options_default(void);
+
+/* The options with every default filled in (radius and max_radius_px stay 0 = per buffer).
+ * HFVIS_ERR_INVALID_ARGUMENT for NULL out, K outside 1..HFVIS_SSAO_MAX_DIRECTIONS, invalid
+ * custom directions or weights, steps < 0, step_px / radius / max_radius_px negative or not
+ * finite (step_px in [1/64, HFVIS_SSAO_MAX_SIZE] when given), an unknown enum value,
+ * FIXED_HULL_REAL_EVAL (not an HBAO strategy), fixed_sin_t outside [-1, 1], jitter with custom
+ * directions, an invalid falloff. in may be NULL. */
+HFVIS_API hfvis_status hfvis_hbao_options_resolve(const hfvis_hbao_options *in,
+                                                  hfvis_hbao_options *out);
+
+/* Horizon-based ambient obscurance by ray marching (spec §4.1 HbaoPixel): for every inner
+ * non-background pixel c with view point P and each direction D_k (looking TOWARD +D, so the
+ * direction set should be symmetric to compare with LSAO), the samples
+ *   uniform: c + (s - 1 + xi) (R_px/N) D, s = 1..N (xi = 1 without step jitter)
+ *   custom:  c + s (step_x, step_y)
+ * until one leaves the buffer, read as in LSAO (NEAREST: the snapped texel centre), deprojected
+ * and put in the plane of P and D (EXACT: (Q.e1, Q.yhat) with yhat through P; PAPER: (Q.e1,
+ * Q.z)); h = q - p, zenith u = -p/|p| (orthographic +y), Sin(h) = h.u/|h|; background samples
+ * and samples coincident with P are skipped. The tangent: REAL = the receiver's normal in the
+ * plane, t = (n2.y, -n2.x) (ahead), sin t = t.u/|t|; FIXED = fixed_sin_t. Per direction the
+ * variant's value (INCREMENTAL sum, SINGLE_HORIZON, LARGEST_OCCLUDER, see the enum; the
+ * running horizon starts at sin t), then
+ *   ao = clamp( sum_k w_k value_k / sum_k w_k , 0, 1 ),   w_k = 1/K or the custom weights.
+ * INCREMENTAL with falloff NONE and the real tangent is the SA obscurance of spec §1.2.
+ * ao[y*ao_stride + x], inner pixels; background receivers 0. normals NULL: reconstructed with
+ * hfvis_depth_normals when the tangent is REAL (1 block of 12*stride*height bytes; nothing is
+ * allocated otherwise). Cost O(K N W H). Deterministic for a seed.
+ * HFVIS_ERR_INVALID_ARGUMENT for invalid camera/options, NULL depth/ao, ao_stride < inner
+ * width; HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on error. */
+HFVIS_API hfvis_status hfvis_hbao(const hfvis_camera *cam, const float *depth,
+                                  const float *normals, const hfvis_hbao_options *opts,
+                                  float *ao, ptrdiff_t ao_stride);
+
+/* ---- the screen-space ray-traced reference ([P4] §8; spec §5.11) --------------------------- */
+
+/* Options of hfvis_ssao_raytrace. NULL or a zero struct = the defaults in brackets. */
+typedef struct hfvis_ssao_rt_options {
+    const hfvis_allocator *alloc;     /* reconstructed normals only; NULL = malloc/free */
+    int rays;                         /* rays per pixel [256] */
+    double step_px;                   /* march step: at most this many pixels of screen motion
+                                         per step [0.5] */
+    double thickness;                 /* depth-field thickness in view units; 0 = infinite (the
+                                         continuous depth field of [P4] up to §11) [0] */
+    hfvis_falloff falloff;            /* rho of the hit distance [NONE] */
+    hfvis_ssao_sampling sampling;     /* depth reads [BILINEAR when thickness is 0, NEAREST
+                                         otherwise: a finite-thickness field is not
+                                         interpolated, [P4] §11] */
+    int refine_iterations;            /* bisection steps on a hit [12] */
+    double bias;                      /* ray origin P + bias z n, as a fraction of the receiver
+                                         depth [1e-3] */
+    double max_distance;              /* view units; rays go no farther (a miss) [the falloff's
+                                         support; unbounded: until they leave the buffer] */
+    int max_steps;                    /* per ray, then a miss [65536] */
+    uint32_t seed;                    /* the per-pixel Cranley-Patterson shift */
+} hfvis_ssao_rt_options;
+
+HFVIS_API hfvis_ssao_rt_options hfvis_ssao_rt_options_default(void);
+
+/* The options with the defaults filled in (sampling resolved from thickness).
+ * HFVIS_ERR_INVALID_ARGUMENT for NULL out, rays < 0, refine_iterations < 0 or > 64,
+ * max_steps < 0, step_px, thickness, bias or max_distance negative or not finite (step_px in
+ * [1/64, 64] when given), an unknown sampling, an invalid falloff. in may be NULL. */
+HFVIS_API hfvis_status hfvis_ssao_rt_options_resolve(const hfvis_ssao_rt_options *in,
+                                                     hfvis_ssao_rt_options *out);
+
+/* Screen-space ray-traced obscurance, the yardstick of [P4] §8 ("the best any method can do
+ * with the screen-space data"): for every inner non-background pixel, R cosine-weighted rays
+ * about the normal n (directions from the Hammersley set (r/R, radical inverse of r) shifted
+ * per pixel by a hash of (x, y, seed), mod 1; r = sqrt(u1), phi = 2 pi u2), from
+ * O = P + bias z n, are marched in view space with steps of at most step_px pixels of screen
+ * motion (and half the thickness in depth). A ray is inside the depth field at X when its depth
+ * -X.z exceeds the depth read at its projection (and is less than it plus the thickness, if
+ * finite); background never blocks. The first inside point is refined by bisection and the ray
+ * adds rho(hit distance). A ray that leaves the buffer, passes behind the eye, rises above every
+ * depth, sinks below every depth plus the thickness (finite thickness), exceeds max_distance or
+ * max_steps is a miss (unknown geometry counts as empty). ao = (1/R) sum rho: a Monte-Carlo
+ * estimate of [P4] Eq. 1, (1/pi) Int rho(d) max(0, n.w) dw - the COS convention (spec §1.2) -
+ * which converges as R grows (stratified, faster than 1/sqrt(R)). ao[y*ao_stride + x], inner
+ * pixels; background receivers 0. normals NULL: reconstructed with hfvis_depth_normals (1 block
+ * of 12*stride*height bytes; nothing is allocated otherwise). Deterministic for a seed. Cost
+ * O(W H R (steps per ray)). HFVIS_ERR_INVALID_ARGUMENT for invalid camera/options, NULL
+ * depth/ao, ao_stride < inner width; HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on error. */
+HFVIS_API hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth,
+                                           const float *normals,
+                                           const hfvis_ssao_rt_options *opts, float *ao,
+                                           ptrdiff_t ao_stride);
+
+/* ---- analytic depth buffers (spec §6 T1-T7) ---------------------------------------------- */
+
+/* Height fields H(x, y) over the view-space plane z = -base_depth (x, y in view units, H toward
+ * the camera), for the closed-form tests of spec §6. The orthographic camera sees them as true
+ * height fields (zenith +Z); a perspective camera looking down -Z sees them in perspective
+ * (vertical faces included). */
+typedef enum hfvis_ssao_scene_kind {
+    HFVIS_SSAO_SCENE_PLANE = 1,   /* T1: H = slope_x x + slope_y y */
+    HFVIS_SSAO_SCENE_STEP = 2,    /* T4/T5: H = 0 for x < x0, height for x >= x0 (a cliff; with
+                                     a large height, the wall of T4); the face at x = x0 */
+    HFVIS_SSAO_SCENE_VGROOVE = 3, /* T6: H = |x - x0| tan(angle), apex line x = x0 */
+    HFVIS_SSAO_SCENE_PIT = 4      /* T7: H = -sqrt(radius^2 - r^2) within radius of (x0, y0),
+                                     else 0: a hemispherical pit, bottom at depth base + radius */
+} hfvis_ssao_scene_kind;
+
+typedef struct hfvis_ssao_scene {
+    hfvis_ssao_scene_kind kind;
+    double base_depth;        /* linear depth of the H = 0 plane, > 0 */
+    double slope_x, slope_y;  /* PLANE */
+    double x0, y0;            /* STEP / VGROOVE: the edge / apex x; PIT: the centre */
+    double height;            /* STEP: the plateau height, base_depth - height > 0 */
+    double angle;             /* VGROOVE: wall angle beta in (0, pi/2) */
+    double radius;            /* PIT: > 0 */
+} hfvis_ssao_scene;
+
+/* Render a scene into a depth buffer (linear depth of the first surface along each pixel-centre
+ * ray, exact in double, rounded to float; +INFINITY where a ray misses, e.g. a plane seen edge-on)
+ * and, if normals is not NULL, its analytic unit normals facing the camera: PLANE
+ * (-sx, -sy, 1)/|.|, STEP floor and plateau (0, 0, 1), face (-sign(height), 0, 0), VGROOVE
+ * (-+tan, 0, 1)/|.| ((0, 0, 1) exactly on the apex), PIT (C - X)/radius inside (C the centre at
+ * depth base_depth). Layout as the camera says (guard band included). Points on the step's
+ * edge x = x0 belong to the plateau. HFVIS_ERR_INVALID_ARGUMENT for an invalid camera, NULL
+ * scene or depth, an unknown kind, a non-finite parameter or one outside its range. */
+HFVIS_API hfvis_status hfvis_ssao_scene_render(const hfvis_camera *cam,
+                                               const hfvis_ssao_scene *scene, float *depth,
+                                               float *normals);
