@@ -522,6 +522,7 @@ typedef struct hf_ns_ctx {
     int nkey, ndir;            /* separate key lights, directional lights */
     int env, env_scan;         /* an environment (T_env) exists; the m environment slices run */
     int gloss, gvec, need_normals, want_vis;
+    int cwords, cfilled;       /* casting-set cache: words per slice, filled by a pass */
     int rec_d, rec_b, rec_max, Cmax;
     double cell, rho_s, S, Ad[4], Ap[4], view[3];
     /* tables (block 1) */
@@ -536,6 +537,7 @@ typedef struct hf_ns_ctx {
     float *normals;
     double *win;
     float *exitbuf, *ibuf;
+    uint64_t *cmask;           /* casting-set cache: Rw*Rh*m*cwords words, or NULL */
 } hf_ns_ctx;
 
 hfvis_ns_gi_options hfvis_ns_gi_options_default(void)
@@ -557,6 +559,7 @@ hfvis_ns_gi_options hfvis_ns_gi_options_default(void)
     o.directional = HFVIS_NS_DIRECTIONAL_HARD;
     o.key_mode = HFVIS_NS_KEY_SEPARATE;
     o.glossy = HFVIS_NS_GLOSSY_VECTOR;
+    o.cast_cache = HFVIS_NS_CACHE_ON;
     o.view_dir[0] = 0.0;
     o.view_dir[1] = 0.0;
     o.view_dir[2] = 1.0;
@@ -585,6 +588,7 @@ hfvis_status hfvis_ns_gi_options_resolve(const hfvis_grid *grid, const hfvis_ns_
         !hf_ns_range((int)o.omega_min, 0, 2) || !hf_ns_range((int)o.omega_max, 0, 2) ||
         !hf_ns_range(o.clamp_to_tangent, 0, 1) || !hf_ns_range((int)o.directional, 0, 3) ||
         !hf_ns_range((int)o.key_mode, 0, 3) || !hf_ns_range((int)o.glossy, 0, 2) ||
+        !hf_ns_range((int)o.cast_cache, 0, 2) ||
         !isfinite(o.view_dir[0]) || !isfinite(o.view_dir[1]) || !isfinite(o.view_dir[2]) ||
         !hf_border_valid(o.border) || !isfinite(o.azimuth0_rad))
         return HFVIS_ERR_INVALID_ARGUMENT;
@@ -614,6 +618,7 @@ hfvis_status hfvis_ns_gi_options_resolve(const hfvis_grid *grid, const hfvis_ns_
     if (o.directional == HFVIS_NS_DIRECTIONAL_DEFAULT) o.directional = d.directional;
     if (o.key_mode == HFVIS_NS_KEY_DEFAULT) o.key_mode = d.key_mode;
     if (o.glossy == HFVIS_NS_GLOSSY_DEFAULT) o.glossy = d.glossy;
+    if (o.cast_cache == HFVIS_NS_CACHE_DEFAULT) o.cast_cache = d.cast_cache;
     if (o.border == HFVIS_BORDER_DEFAULT) o.border = d.border;
     if (o.levels == 0) {
         /* the last step tau_(n-1) = 2^((n-1)/k) reaches the grid's diagonal (spec B.4: the natural
@@ -721,6 +726,7 @@ static hfvis_status hf_ns_setup(hf_ns_ctx *c, const hfvis_grid *grid, const hfvi
     c->rec_b = NS_SH_N * c->C;
     c->rec_max = c->rec_d > c->rec_b ? c->rec_d : c->rec_b;
     c->Cmax = c->gvec ? NS_SH_N * c->C : c->C;
+    c->cwords = bounces > 0 && c->o.cast_cache == HFVIS_NS_CACHE_ON ? (c->n + 63) / 64 : 0;
     c->rho_s = (double)sc->specular;
     c->S = (double)sc->shininess;
     return HFVIS_OK;
@@ -825,6 +831,11 @@ static void hf_ns_carve(hf_ns_ctx *c, hf_ns_arena *A)
     c->win = (double *)hf_ns_take(&A[2], 2u * (size_t)c->Rw, (size_t)c->rec_max * sizeof(double));
     /* block 4: the bounces' buffers and pyramids */
     if (c->B > 0) {
+        size_t words = 0;
+        if (c->cwords > 0 && (!hf_mul_size((size_t)c->Rw * (size_t)c->Rh, m, &words) ||
+                              !hf_mul_size(words, (size_t)c->cwords, &words)))
+            A[3].overflow = 1;
+        c->cmask = c->cwords > 0 ? (uint64_t *)hf_ns_take(&A[3], words, sizeof(uint64_t)) : NULL;
         c->exitbuf = (float *)hf_ns_take(&A[3], hf_grid_count(c->g), C * sizeof(float));
         hf_ns_pyr_carve(&A[3], c->dp, c->Lu, c->k, c->W, c->H, 1.0, c->C);
         if (c->gvec) {
@@ -890,9 +901,10 @@ static int hf_ns_place(const hf_ns_ctx *c, double *x, double *y)
 
 /* [NS09] Eq. 14-15, 17 along the slice (cph, sph) from receiver r: the tangents of the valid
  * steps into tv (if not NULL; returns their count) and, if cast is not NULL, the casting set
- * seeded with tan(omega_min) = t_seed into cast (*ncast elements, strictly increasing omega). */
+ * seeded with tan(omega_min) = t_seed into cast (*ncast elements, strictly increasing omega), and
+ * their step indices as bits into bits (zeroed by the caller) if it is not NULL. */
 static int hf_ns_scan(const hf_ns_ctx *c, const hf_ns_recv *r, double cph, double sph, double t_seed,
-                      double *tv, hf_ns_cast *cast, int *ncast)
+                      double *tv, hf_ns_cast *cast, int *ncast, uint64_t *bits)
 {
     const double W1 = (double)(c->W - 1), H1 = (double)(c->H - 1);
     double run = t_seed;
@@ -918,6 +930,7 @@ static int hf_ns_scan(const hf_ns_ctx *c, const hf_ns_recv *r, double cph, doubl
             cast[K].dz = hq - hp;
             K++;
             run = t;
+            if (bits) bits[i >> 6] |= (uint64_t)1 << (i & 63);
         }
     }
     if (ncast) *ncast = K;
@@ -975,7 +988,7 @@ static int hf_ns_recv_at(hf_ns_ctx *c, double X, double Y, const double *N, hf_n
 
 /* Record of the direct pass at (X, Y): V_env (16), V_key (16 per separate key light), the shadow
  * factor of each directional light; rec[0] = NaN for a hole. */
-static void hf_ns_direct_rec(hf_ns_ctx *c, double X, double Y, const double *N, double *rec)
+static void hf_ns_direct_rec(hf_ns_ctx *c, double X, double Y, const double *N, double *rec, uint64_t *mask)
 {
     hf_ns_recv r;
     double *V = rec, *Vk = rec + NS_SH_N, *dv = rec + NS_SH_N * (1 + c->nkey);
@@ -987,14 +1000,16 @@ static void hf_ns_direct_rec(hf_ns_ctx *c, double X, double Y, const double *N, 
     }
     if (c->env_scan)
         for (j = 0; j < c->m; j++) {
-            double sm, v[4], tmin, smin;
-            nv = hf_ns_scan(c, &r, c->ecos[j], c->esin[j], 0.0, c->tv, NULL, NULL);
+            double sm, v[4], tmin = 0.0, smin = -1.0;
+            uint64_t *bits = mask ? mask + (size_t)j * (size_t)c->cwords : NULL;
+            int K;
+            if (bits || c->o.clamp_to_tangent) hf_ns_omega_min(c, N, c->ecos[j], c->esin[j], &tmin, &smin);
+            for (q = 0; bits && q < c->cwords; q++) bits[q] = 0;
+            /* the casting set for the bounces comes with the visibility scan (spec B.9 [choice]) */
+            nv = hf_ns_scan(c, &r, c->ecos[j], c->esin[j], tmin, c->tv, bits ? c->cast : NULL, &K, bits);
             sm = hf_ns_smax(c, nv);
             c->smax[j] = sm;
-            if (c->o.clamp_to_tangent) {
-                hf_ns_omega_min(c, N, c->ecos[j], c->esin[j], &tmin, &smin);
-                if (smin > sm) sm = smin;
-            }
+            if (c->o.clamp_to_tangent && smin > sm) sm = smin;
             hf_ns_vis(sm, 1.0, v); /* Eq. 11: v = vbar(pi/2) - vbar(omega_max) */
             hf_ns_acc(V, c->G_env + (size_t)j * 64u, v);
         }
@@ -1007,7 +1022,7 @@ static void hf_ns_direct_rec(hf_ns_ctx *c, double X, double Y, const double *N, 
             double sp = K->full ? c->esin[j] : K->sph[j];
             if (K->full) sm = c->smax[j];
             else {
-                nv = hf_ns_scan(c, &r, cp, sp, 0.0, c->tv, NULL, NULL);
+                nv = hf_ns_scan(c, &r, cp, sp, 0.0, c->tv, NULL, NULL, NULL);
                 sm = hf_ns_smax(c, nv);
             }
             /* [NS09] §6: the intersection of [omega_max, pi/2] and [l_min, l_max] */
@@ -1023,7 +1038,7 @@ static void hf_ns_direct_rec(hf_ns_ctx *c, double X, double Y, const double *N, 
     for (q = 0; q < c->ndir; q++) {
         const hf_ns_dir *D = &c->dirs[q];
         double sm;
-        nv = hf_ns_scan(c, &r, D->cph, D->sph, 0.0, c->tv, NULL, NULL);
+        nv = hf_ns_scan(c, &r, D->cph, D->sph, 0.0, c->tv, NULL, NULL, NULL);
         sm = hf_ns_smax(c, nv);
         if (c->o.directional == HFVIS_NS_DIRECTIONAL_SOFT) {
             /* spec B.8 soft: clamp(v(phi_L) . P^(sin omega_L), 0, 1) */
@@ -1094,9 +1109,39 @@ static int hf_ns_normal_interp(const hf_ns_ctx *c, double x, double y, double *N
     return 1;
 }
 
+/* The casting set of a slice from its cached step indices: the same steps, heights and tangents as
+ * hf_ns_scan found them, without scanning the others. */
+static int hf_ns_cast_cached(hf_ns_ctx *c, const hf_ns_recv *r, double cph, double sph, const uint64_t *bits)
+{
+    int w, K = 0;
+    for (w = 0; w < c->cwords; w++) {
+        uint64_t b = bits[w];
+        while (b) {
+            int bit = 0, i, l;
+            double x, y, hq;
+            while (!((b >> bit) & 1u)) bit++;
+            b &= b - 1u;
+            i = w * 64 + bit;
+            l = c->lv_i[i];
+            x = r->x + c->tau[i] * cph;
+            y = r->y + c->tau[i] * sph;
+            if (x < 0.0 || x > (double)(c->W - 1) || y < 0.0 || y > (double)(c->H - 1))
+                (void)hf_ns_place(c, &x, &y);
+            hq = hf_ns_sample1(&c->hp[l], c->wrap, c->holes, x, y);
+            c->cast[K].i = i;
+            c->cast[K].t = (hq - r->hl[l]) * c->inv_dist[i];
+            c->cast[K].x = x;
+            c->cast[K].y = y;
+            c->cast[K].dz = hq - r->hl[l];
+            K++;
+        }
+    }
+    return K;
+}
+
 /* Record of bounce pass at (X, Y): U (16 per channel) from the casting sets (Eq. 12) and the
  * exit radiance of the previous bounce; rec[0] = NaN for a hole. */
-static void hf_ns_bounce_rec(hf_ns_ctx *c, double X, double Y, const double *N, double *rec)
+static void hf_ns_bounce_rec(hf_ns_ctx *c, double X, double Y, const double *N, double *rec, uint64_t *mask)
 {
     hf_ns_recv r;
     const int C = c->C;
@@ -1110,7 +1155,13 @@ static void hf_ns_bounce_rec(hf_ns_ctx *c, double X, double Y, const double *N, 
         const double cph = c->ecos[j], sph = c->esin[j];
         double tmin, smin, vm[4];
         hf_ns_omega_min(c, N, cph, sph, &tmin, &smin);
-        (void)hf_ns_scan(c, &r, cph, sph, tmin, NULL, c->cast, &K);
+        if (mask && c->cfilled) {
+            K = hf_ns_cast_cached(c, &r, cph, sph, mask + (size_t)j * (size_t)c->cwords);
+        } else {
+            uint64_t *bits = mask ? mask + (size_t)j * (size_t)c->cwords : NULL;
+            for (i = 0; bits && i < c->cwords; i++) bits[i] = 0;
+            (void)hf_ns_scan(c, &r, cph, sph, tmin, NULL, c->cast, &K, bits);
+        }
         if (K == 0) continue; /* spec B.3: an empty casting set gives u = 0 */
         for (q = 0; q < K; q++) {
             const hf_ns_cast *e = &c->cast[q];
@@ -1260,8 +1311,8 @@ static void hf_ns_shade_row(hf_ns_ctx *c, int b, int y, const hfvis_ns_gi_output
         hf_normal_at(c->g, x, y, N);
         r = hf_ns_upsample(c, x, y, rec, c->rtmp);
         if (r == NULL) { /* no receiver around: this texel is a receiver of its own */
-            if (b == 0) hf_ns_direct_rec(c, (double)x, (double)y, N, c->rtmp);
-            else hf_ns_bounce_rec(c, (double)x, (double)y, N, c->rtmp);
+            if (b == 0) hf_ns_direct_rec(c, (double)x, (double)y, N, c->rtmp, NULL);
+            else hf_ns_bounce_rec(c, (double)x, (double)y, N, c->rtmp, NULL);
             r = c->rtmp;
         }
         /* [NS09] §7: F(w_o) = the lobe rotated to N (diffuse) or to R = reflect(view, N) (Phong) */
@@ -1330,8 +1381,9 @@ static void hf_ns_pass(hf_ns_ctx *c, int b, const hfvis_ns_gi_outputs *out, int 
             double X, Y, N[3], *r = row + (size_t)i * (size_t)rec;
             const size_t ri = (size_t)j * (size_t)c->Rw + (size_t)i;
             if (hf_ns_recv_pos(c, i, j, &X, &Y, N)) {
-                if (b == 0) hf_ns_direct_rec(c, X, Y, N, r);
-                else hf_ns_bounce_rec(c, X, Y, N, r);
+                uint64_t *mask = c->cmask ? c->cmask + ri * (size_t)c->m * (size_t)c->cwords : NULL;
+                if (b == 0) hf_ns_direct_rec(c, X, Y, N, r, c->env_scan ? mask : NULL);
+                else hf_ns_bounce_rec(c, X, Y, N, r, mask);
             } else {
                 for (q = 0; q < rec; q++) r[q] = 0.0;
                 r[0] = HF_NAN;
@@ -1540,6 +1592,7 @@ hfvis_status hfvis_ns_gi(const hfvis_grid *grid, const hfvis_ns_scene *scene,
     if (c.need_normals) (void)hfvis_normals_compute(grid, c.normals);
     total = c.Rh * (1 + c.B);
     hf_ns_pass(&c, 0, out, &done, total);
+    c.cfilled = c.env_scan; /* the direct pass scanned the casting sets with the visibility */
     for (b = 1; b <= c.B; b++) {
         /* [NS09] §5.3: the radiance pyramid of bounce b-1 (and the glossy SH pyramid) */
         memcpy(c.dp[0].img, c.exitbuf, plane * sizeof(float));
@@ -1549,6 +1602,7 @@ hfvis_status hfvis_ns_gi(const hfvis_grid *grid, const hfvis_ns_scene *scene,
             hf_ns_pyr_build(c.ip, c.Lu, c.k, c.C * NS_SH_N, c.border, c.kern, c.row);
         }
         hf_ns_pass(&c, b, out, &done, total);
+        c.cfilled = 1;
     }
     for (q = 3; q >= 0; q--) hf_free(alloc, blk[q]);
     return HFVIS_OK;

@@ -99,6 +99,17 @@ typedef enum hfvis_ns_glossy {
                                       glossy): [NS09] §5.3's "mixture" approximation */
 } hfvis_ns_glossy;
 
+/* Keeping the casting sets between passes (spec B.9 [choice] "cache cast sets for bounces"). */
+typedef enum hfvis_ns_cache {
+    HFVIS_NS_CACHE_DEFAULT = 0,    /* = ON */
+    HFVIS_NS_CACHE_ON = 1,         /* the first scan of each slice (the visibility scan of the direct
+                                      pass, or the first bounce) records its casting set as a bit
+                                      mask of steps; later bounces re-read only those steps: same
+                                      result, bit for bit, at ceil(n/64)*8 bytes per receiver and
+                                      slice (1024^2, m = 32, n <= 64: 256 MiB; 2x2: 64 MiB) */
+    HFVIS_NS_CACHE_OFF = 2         /* every bounce scans every slice again */
+} hfvis_ns_cache;
+
 /* level_offset_v / level_offset_u value for "no offset" (0 octaves; 0 itself means the default). */
 #define HFVIS_NS_NO_OFFSET (-1)
 
@@ -138,6 +149,7 @@ typedef struct hfvis_ns_gi_options {
     hfvis_ns_directional directional; /* default HARD */
     hfvis_ns_key_mode key_mode;       /* default SEPARATE */
     hfvis_ns_glossy glossy;           /* default VECTOR */
+    hfvis_ns_cache cast_cache;        /* default ON (only used with bounces) */
     double view_dir[3];      /* unit vector from the surface toward the viewer (distant
                                 viewer; normalised here); 0,0,0 = (0, 0, 1), looking straight down.
                                 Only the glossy terms depend on it. */

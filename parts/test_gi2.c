@@ -128,6 +128,7 @@ TEST(ns_options)
     CHECK(d.interp == HFVIS_NS_INTERP_LINEAR && d.omega_min == HFVIS_NS_OMEGA_MIN_EXACT);
     CHECK(d.omega_max == HFVIS_NS_OMEGA_MAX_BSPLINE && d.directional == HFVIS_NS_DIRECTIONAL_HARD);
     CHECK(d.key_mode == HFVIS_NS_KEY_SEPARATE && d.glossy == HFVIS_NS_GLOSSY_VECTOR);
+    CHECK(d.cast_cache == HFVIS_NS_CACHE_ON);
     CHECK(d.view_dir[0] == 0.0 && d.view_dir[1] == 0.0 && d.view_dir[2] == 1.0);
     CHECK(d.border == HFVIS_BORDER_OPEN && d.alloc == NULL);
     /* NULL = zero struct = defaults; levels = 1 + ceil(4 log2(255 sqrt2)) = 1 + ceil(33.98) = 35 */
@@ -1235,7 +1236,7 @@ TEST(ns_bad_args)
         map[7] = NS_SENTINEL;
     }
     /* options */
-    for (cs = 0; cs < 26; cs++) {
+    for (cs = 0; cs < 27; cs++) {
         ob = o;
         switch (cs) {
         case 0: ob.directions = -1; break;
@@ -1263,6 +1264,7 @@ TEST(ns_bad_args)
         case 22: ob.view_dir[0] = 1e300; ob.view_dir[1] = 1e300; break;
         case 23: ob.border = (hfvis_border)4; break;
         case 24: ob.azimuth0_rad = INFINITY; break;
+        case 25: ob.cast_cache = (hfvis_ns_cache)3; break;
         default: ob.omega_min = (hfvis_ns_omega_min)-1; break;
         }
         NS_BAD(&g, &sc, &ob, &out);
@@ -1385,8 +1387,19 @@ TEST(ns_alloc_failures)
         CHECK(ns_untouched(d, W * H * C) && ns_untouched(t, W * H * C) && ns_untouched(b, B * W * H * C) &&
               ns_untouched(v, 16 * W * H));
     }
-    /* same inputs, same bits (DESIGN determinism), and the progress callback counts rows */
+    /* same inputs, same bits (DESIGN determinism); the casting-set cache changes no bit, whether
+     * the direct pass fills it (environment) or the first bounce does (emission only) */
     o.alloc = NULL;
+    CHECK_EQ_STATUS(hfvis_ns_gi(&g, &sc, &o, &out), HFVIS_OK);
+    CHECK(memcmp(ref, t, sizeof ref) == 0);
+    o.cast_cache = HFVIS_NS_CACHE_OFF;
+    CHECK_EQ_STATUS(hfvis_ns_gi(&g, &sc, &o, &out), HFVIS_OK);
+    CHECK(memcmp(ref, t, sizeof ref) == 0);
+    sc.env_sh = NULL;
+    sc.light_count = 0;
+    CHECK_EQ_STATUS(hfvis_ns_gi(&g, &sc, &o, &out), HFVIS_OK);
+    memcpy(ref, t, sizeof ref);
+    o.cast_cache = HFVIS_NS_CACHE_ON;
     CHECK_EQ_STATUS(hfvis_ns_gi(&g, &sc, &o, &out), HFVIS_OK);
     CHECK(memcmp(ref, t, sizeof ref) == 0);
 }
