@@ -4,4 +4,7 @@
 #define HFVIS_BENCH_H
 void bench_mesh(int quick);
 void bench_raster(int quick);
+void bench_vox(int quick);
+void bench_iv(int quick);
+void bench_bvh(int quick);
 #endif

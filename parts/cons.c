@@ -27,6 +27,9 @@
  * are refused with HFVIS_ERR_LIMIT. 2^60 cells is far outside any grid. */
 #define VX_CONS_MAX_COORD 1152921504606846976.0 /* 2^60 */
 
+/* C99 inline for the few hot helpers of the fast path (no effect on results). */
+#define VX_CONS_INLINE inline
+
 /* Grid-space coordinate of world coordinate x on axis a. The ONE expression every binary
  * voxelizer and its reference uses, so they see the same doubles. */
 static double vx_cons_gc(const hfvis_volume_grid *g, int a, float x)
@@ -330,21 +333,27 @@ static int vx_cons_layer_ok(const vx_cons_tri *T, double t[3][3], int k)
 }
 
 /* ceil(x) clamped to [lo, hi + 1] (hi + 1 = "empty"), floor(x) clamped to [lo - 1, hi]; x may be
- * any double but NaN (lo >= 0). */
-static int vx_cons_ceil_in(double x, int lo, int hi)
+ * any double but NaN (lo >= 0). Branch-free: clamp in double, truncate, correct. */
+static VX_CONS_INLINE int vx_cons_ceil_in(double x, int lo, int hi)
 {
+    double l = (double)lo - 1.0, h = (double)hi + 1.0;
     int i;
-    if (!(x > (double)lo - 1.0)) return lo;
-    if (x > (double)hi) return hi + 1;
-    i = (int)x; /* x > -1: truncation, then up when x had a fraction */
-    return i + ((double)i < x);
+    x = x > l ? x : l;
+    x = x < h ? x : h;
+    i = (int)x; /* x >= -1: truncation, then up when x had a fraction */
+    i += (double)i < x;
+    return i < lo ? lo : i;
 }
 
-static int vx_cons_floor_in(double x, int lo, int hi)
+static VX_CONS_INLINE int vx_cons_floor_in(double x, int lo, int hi)
 {
-    if (!(x < (double)hi + 1.0)) return hi;
-    if (x < (double)lo) return lo - 1;
-    return (int)x; /* x >= lo >= 0 */
+    double l = (double)lo - 1.0, h = (double)hi + 1.0;
+    int i;
+    x = x > l ? x : l;
+    x = x < h ? x : h;
+    i = (int)x;
+    i -= (double)i > x; /* truncation of x in (-1, 0) gives 0 */
+    return i > hi ? hi : i;
 }
 
 /* The fast path's scratch occupancy: bits in 4x4x4 bricks, one uint64 per brick (brick
@@ -357,7 +366,7 @@ typedef struct vx_cons_bricks {
     size_t bs[3];  /* brick stride per axis: 1, nb[0], nb[0]*nb[1] */
 } vx_cons_bricks;
 
-static size_t vx_cons_brick_of(const vx_cons_bricks *B, const int p[3], unsigned *bit)
+static VX_CONS_INLINE size_t vx_cons_brick_of(const vx_cons_bricks *B, const int p[3], unsigned *bit)
 {
     *bit = (unsigned)(((p[2] & 3) << 4) | ((p[1] & 3) << 2) | (p[0] & 3));
     return (size_t)(p[0] >> 2) * B->bs[0] + (size_t)(p[1] >> 2) * B->bs[1]
@@ -375,98 +384,259 @@ static int vx_cons_inside_voxel(const vx_cons_tri *T, const int p[3])
     return 1;
 }
 
-/* Voxelizes one set-up triangle whose bounding-box voxel ranges are lo..hi into the bricks;
- * returns the number of voxels newly set. The decisions are those of
- * hfvis_triangle_box_overlap on every voxel of the range, bit for bit, reached without calling
- * it on most voxels:
- *  - a voxel already set needs no decision (the result is a union);
- *  - per column (iU, iW) of the dominant projection D, the plane slab's layers come from the
- *    plane equation, k in kc -+ rn/|n_D| with kc linear in (iU, iW) (Schwarz & Seidel's plane
- *    test solved for the column). Layers farther than EPS outside that interval fail the SAT's
- *    plane axis for certain: EPS (2^-30 of the coordinate scale, in layers) is far above the
- *    rounding of both the SAT's expression and this estimate (about 2^-46 of the scale), so
- *    these "candidates" contain every voxel the SAT accepts;
- *  - when every candidate voxel of a column is already set the column is done; otherwise the
- *    column's three 2D axes of projection D are tested once (the SAT's expressions), and the
- *    plane + six remaining axes are tested from the two ends of the candidate interval inward
- *    (skipping set voxels) until a voxel passes: every axis value is monotone along the column
- *    in floating point (each rounding is monotone), so the layers that pass the SAT form an
- *    interval and every unset voxel between the lowest and highest passing one passes.
- * A triangle inside one voxel's closed cube (not merely clipped to one): every offset
- * |t| <= h, and then no axis of the SAT can separate (|fl(L.t)| <= fl(h |L|) term by term, since
- * rounding is monotone and the radii are summed in the same order), so the voxel is set. */
+/* vx_cons_bbox, exactly, without libm calls: on each axis lo = max(0, ceil(min) - 1),
+ * hi = min(n - 1, floor(max)); the coordinates are clamped first (which keeps the result) so
+ * the int conversions are exact. */
+static VX_CONS_INLINE int vx_cons_bbox_fast(const vx_cons_tri *T, const hfvis_volume_grid *grid,
+                                            int lo[3], int hi[3])
+{
+    int a;
+    for (a = 0; a < 3; a++) {
+        double mn = vx_cons_min3(T->v[0][a], T->v[1][a], T->v[2][a]);
+        double mx = vx_cons_max3(T->v[0][a], T->v[1][a], T->v[2][a]);
+        double top = (double)grid->dims[a] + 1.0;
+        int i;
+        mn = mn > -1.0 ? mn : -1.0;
+        mn = mn < top ? mn : top;
+        mx = mx > -1.0 ? mx : -1.0;
+        mx = mx < top ? mx : top;
+        i = (int)mn; /* truncation; ceil */
+        i += (double)i < mn;
+        lo[a] = i - 1 > 0 ? i - 1 : 0;
+        i = (int)mx; /* floor (mx >= -1) */
+        i -= (double)i > mx;
+        hi[a] = i < grid->dims[a] - 1 ? i : grid->dims[a] - 1;
+        if (lo[a] > hi[a]) return 0;
+    }
+    return 1;
+}
+
+/* One SAT edge axis as a bound on a linear form of two voxel-centre coordinates x, y: in exact
+ * arithmetic the axis does not separate iff lo <= A x + B y <= hi (the SAT's p = Q - L.c of the
+ * axis' two vertices, Q = L.v: lo = min Q - r, hi = max Q + r, r = (|A| + |B|)/2). With A != 0
+ * that is x in [x1(y), x2(y)], x1,2 = c1,2 - m y (c = lo/A, hi/A in order, m = B/A), kept as
+ * four linear forms c[i] - m y: the candidates (the interval widened by the margin dk = dl/|A|)
+ * and the certain range (narrowed by dk); dl = eps (|A| + |B|) is the margin in value units.
+ * A == 0 (the axis does not depend on x): lo, hi, dl are kept to test y. */
+typedef struct vx_cons_bound {
+    double c[4], m;
+    double B, lo, hi, dl; /* A == 0 only */
+    int flat;             /* A == 0 */
+} vx_cons_bound;
+
+/* The bound of axis (A, B) whose two vertices have coordinates (xj, yj), (xo, yo). */
+static VX_CONS_INLINE void vx_cons_bound_init(vx_cons_bound *b, double A, double B, double xj,
+                                              double yj, double xo, double yo, double eps)
+{
+    double qa = A * xj + B * yj, qb = A * xo + B * yo, r = 0.5 * (fabs(A) + fabs(B));
+    double lo = (qa < qb ? qa : qb) - r, hi = (qa < qb ? qb : qa) + r, dl = 2.0 * eps * r;
+    b->flat = A == 0.0;
+    if (!b->flat) {
+        double inv = 1.0 / A, dk = dl * fabs(inv), c1 = lo * inv, c2 = hi * inv;
+        if (inv < 0.0) {
+            double tmp = c1;
+            c1 = c2;
+            c2 = tmp;
+        }
+        b->m = B * inv;
+        b->c[0] = c1 - dk;
+        b->c[1] = c2 + dk;
+        b->c[2] = c1 + dk;
+        b->c[3] = c2 - dk;
+    } else {
+        b->B = B;
+        b->lo = lo;
+        b->hi = hi;
+        b->dl = dl;
+    }
+}
+
+/* Narrows r = {candidate lo, candidate hi, certain lo, certain hi} of x, given y, by one bound:
+ * x inside the certain range passes the SAT's axis for certain, x outside the candidate range
+ * fails it for certain. A flat bound: the whole line certainly fails (candidates emptied),
+ * certainly passes, or is undecided (certain range emptied). */
+static VX_CONS_INLINE void vx_cons_bound_apply(const vx_cons_bound *b, double y, double r[4])
+{
+    if (!b->flat) {
+        double my = b->m * y, x;
+        x = b->c[0] - my;
+        r[0] = r[0] > x ? r[0] : x;
+        x = b->c[1] - my;
+        r[1] = r[1] < x ? r[1] : x;
+        x = b->c[2] - my;
+        r[2] = r[2] > x ? r[2] : x;
+        x = b->c[3] - my;
+        r[3] = r[3] < x ? r[3] : x;
+    } else {
+        double rem = b->B * y;
+        if (rem < b->lo - b->dl || rem > b->hi + b->dl) r[0] = HUGE_VAL;
+        else if (!(rem >= b->lo + b->dl && rem <= b->hi - b->dl)) r[2] = HUGE_VAL;
+    }
+}
+
+/* Voxelizes one triangle (grid-space vertices T->v, normal n != 0 with dominant axis D, U = D+1,
+ * W = D+2; bounding-box voxel ranges lo..hi) into the bricks. The result is, bit for bit, the
+ * set of voxels of the range on which hfvis_triangle_box_overlap returns 1, found without
+ * calling it on most voxels (Schwarz & Seidel 2010's per-triangle decomposition, made exact):
+ *  - the work is done in the frame (x, y, z) = (U, W, D), a cyclic permutation, in which the
+ *    SAT's axes keep their form: the edge axes of projection a are e_a x f_j with in-plane axes
+ *    (a+1, a+2). Each edge axis is a two-sided bound on two centre coordinates (vx_cons_bound):
+ *    the three axes of projection z bound the columns x of each row y; the three of projection x
+ *    bound the layers z of each row y; the three of projection y bound the layers z of each
+ *    column index x; the plane axis bounds the layers of each column (x, y) to
+ *    |kc - z| <= rn/|n_z| with kc linear in (x, y) (Schwarz & Seidel's plane test solved for
+ *    the column); the box axes always pass inside the bounding-box range (|t| <= h there, also
+ *    in floating point). So the voxels of a column form an interval computed from these bounds;
+ *  - the bounds are evaluated in double with a margin eps = 2^-30 of the coordinate scale
+ *    (times |A| + |B| of the axis, or in layers for the plane): the rounding of the SAT's own
+ *    expressions and of these bounds is about 2^-50 of that, so a voxel inside every bound by
+ *    its margin passes every axis of the SAT for certain, and one outside a bound by its margin
+ *    fails it for certain. Voxels within a margin of an end (exact ties such as faces on voxel
+ *    boundaries, or 1e-9-close calls) are decided with the SAT's own expressions in the
+ *    original frame (vx_cons_sep_proj, vx_cons_layer_ok; set up lazily), which makes the
+ *    result identical to the reference;
+ *  - a triangle inside one voxel's closed cube (not merely clipped to one): every offset
+ *    |t| <= h, and then no axis of the SAT can separate (|fl(L.t)| <= fl(h |L|) term by term,
+ *    since rounding is monotone and the radii are summed in the same order): the voxel is set.
+ * Returns the number of columns decided with the SAT's expressions (a statistic). */
 static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
                                vx_cons_bricks *B)
 {
+    enum { NTAB = 32 };
     const int D = T->D, U = T->U, W = T->W;
+    const int x0 = lo[U], x1 = hi[U], y0 = lo[W], y1 = hi[W], z0 = lo[D], z1 = hi[D];
     const unsigned sh = D == 0 ? 0u : (D == 1 ? 2u : 4u);
-    const size_t sD = B->bs[D];
-    double t[3][3], aU, aW, K0, hwid, eps, scale;
-    size_t n = 0;
-    int iU, iW, k, a, p[3];
-    if (lo[0] == hi[0] && lo[1] == hi[1] && lo[2] == hi[2] && vx_cons_inside_voxel(T, lo)) {
+    const size_t sD = B->bs[D], sU = B->bs[U], sW = B->bs[W];
+    double P[3][3], f[3][3], nx, ny, nz, ax, ay, K0, hwid, eps, scale, tab[NTAB][4], t[3][3];
+    vx_cons_bound bz[3], bx[3], by[3];
+    size_t slow = 0;
+    int ix, iy, k, j, ntab, have_sat = 0;
+    if (x0 == x1 && y0 == y1 && z0 == z1 && vx_cons_inside_voxel(T, lo)) {
         unsigned bit;
-        uint64_t *w = B->w + vx_cons_brick_of(B, lo, &bit), m = (uint64_t)1 << bit;
-        n = (*w & m) == 0;
-        *w |= m;
-        return n;
+        B->w[vx_cons_brick_of(B, lo, &bit)] |= (uint64_t)1 << bit;
+        return 0;
     }
-    /* the plane slab per column: kc(iU, iW) = K0 - aU iU - aW iW, half width rn/|n_D| */
-    aU = T->n[U] / T->n[D];
-    aW = T->n[W] / T->n[D];
-    K0 = T->v[0][D] - 0.5
-         + (T->n[U] * (T->v[0][U] - 0.5) + T->n[W] * (T->v[0][W] - 0.5)) / T->n[D];
-    hwid = T->rn / fabs(T->n[D]);
-    scale = 4.0;
-    for (a = 0; a < 3; a++) {
-        double m = vx_cons_max3(fabs(T->v[0][a]), fabs(T->v[1][a]), fabs(T->v[2][a]));
-        scale += m + (double)hi[a];
+    for (k = 0; k < 3; k++) {
+        P[k][0] = T->v[k][U];
+        P[k][1] = T->v[k][W];
+        P[k][2] = T->v[k][D];
     }
+    for (j = 0; j < 3; j++) {
+        const int e = j == 2 ? 0 : j + 1;
+        f[j][0] = P[e][0] - P[j][0];
+        f[j][1] = P[e][1] - P[j][1];
+        f[j][2] = P[e][2] - P[j][2];
+    }
+    nx = T->n[U];
+    ny = T->n[W];
+    nz = T->n[D];
+    /* the plane slab per column: kc(x, y) = K0 - ax x - ay y (layer of the centre), |ax|, |ay|
+     * <= 1, half width rn/|n_z| <= 1.5 */
+    ax = nx / nz;
+    ay = ny / nz;
+    K0 = P[0][2] - 0.5 + (nx * (P[0][0] - 0.5) + ny * (P[0][1] - 0.5)) / nz;
+    hwid = 0.5 * (fabs(nx) + fabs(ny) + fabs(nz)) / fabs(nz);
+    scale = 4.0 + (double)(x1 + y1 + z1);
+    for (k = 0; k < 3; k++) scale += fabs(P[k][0]) + fabs(P[k][1]) + fabs(P[k][2]);
     eps = scale * 9.313225746154785e-10; /* 2^-30 */
-    for (iW = lo[W]; iW <= hi[W]; iW++) {
-        double cW = (double)iW + 0.5, krow = K0 - aW * (double)iW;
-        t[0][W] = T->v[0][W] - cW;
-        t[1][W] = T->v[1][W] - cW;
-        t[2][W] = T->v[2][W] - cW;
-        p[W] = iW;
-        for (iU = lo[U]; iU <= hi[U]; iU++) {
-            double kc = krow - aU * (double)iU, cU;
-            int ka = vx_cons_ceil_in(kc - hwid - eps, lo[D], hi[D]);
-            int kb = vx_cons_floor_in(kc + hwid + eps, lo[D], hi[D]);
-            int k1, k2;
-            size_t base;
-            unsigned bU;
-            if (ka > kb) continue;
-            /* bits of the column's voxels: word base + (k >> 2)*sD, bit bU | (k & 3) << sh */
-            p[U] = iU;
-            p[D] = 0;
-            base = vx_cons_brick_of(B, p, &bU);
-#define VX_CONS_WORD(kk) B->w[base + (size_t)((kk) >> 2) * sD]
-#define VX_CONS_MASK(kk) ((uint64_t)1 << (bU | ((unsigned)((kk) & 3) << sh)))
-            while (ka <= kb && (VX_CONS_WORD(ka) & VX_CONS_MASK(ka))) ka++;
-            if (ka > kb) continue; /* every candidate already set */
-            while (VX_CONS_WORD(kb) & VX_CONS_MASK(kb)) kb--;
-            cU = (double)iU + 0.5;
-            t[0][U] = T->v[0][U] - cU;
-            t[1][U] = T->v[1][U] - cU;
-            t[2][U] = T->v[2][U] - cU;
-            if (vx_cons_sep_proj(T, D, U, W, t)) continue;
-            /* lowest and highest unset layers that pass */
-            for (k1 = ka; k1 <= kb; k1++)
-                if (!(VX_CONS_WORD(k1) & VX_CONS_MASK(k1)) && vx_cons_layer_ok(T, t, k1)) break;
-            if (k1 > kb) continue;
-            for (k2 = kb; k2 > k1; k2--)
-                if (!(VX_CONS_WORD(k2) & VX_CONS_MASK(k2)) && vx_cons_layer_ok(T, t, k2)) break;
-            for (k = k1; k <= k2; k++) {
-                uint64_t m = VX_CONS_MASK(k);
-                n += !(VX_CONS_WORD(k) & m);
-                VX_CONS_WORD(k) |= m;
+    /* the nine edge axes: projection z (x = cx, y = cy), x (x = cz, y = cy), y (x = cz,
+     * y = cx); vertex pairs (j, o) = (0, 2), (1, 0), (2, 1) */
+    for (j = 0; j < 3; j++) {
+        const int o = j == 0 ? 2 : j - 1;
+        vx_cons_bound_init(&bz[j], -f[j][1], f[j][0], P[j][0], P[j][1], P[o][0], P[o][1], eps);
+        vx_cons_bound_init(&bx[j], f[j][1], -f[j][2], P[j][2], P[j][1], P[o][2], P[o][1], eps);
+        vx_cons_bound_init(&by[j], -f[j][0], f[j][2], P[j][2], P[j][0], P[o][2], P[o][0], eps);
+    }
+    /* layer bounds of projection y per column index x (they do not depend on y) */
+    ntab = x1 - x0 < NTAB ? x1 - x0 + 1 : 0;
+    for (ix = 0; ix < ntab; ix++) {
+        double *r = tab[ix], cx = (double)(x0 + ix) + 0.5;
+        r[0] = r[2] = -HUGE_VAL;
+        r[1] = r[3] = HUGE_VAL;
+        vx_cons_bound_apply(&by[0], cx, r);
+        vx_cons_bound_apply(&by[1], cx, r);
+        vx_cons_bound_apply(&by[2], cx, r);
+    }
+    for (iy = y0; iy <= y1; iy++) {
+        double cy = (double)iy + 0.5, krow = K0 - ay * (double)iy + 0.5, rc[4], rk[4];
+        int ca0, ca1, cc0, cc1, p[3];
+        size_t rowbase;
+        unsigned rowbit;
+        /* the row's columns (projection z) and its layer bounds (projection x), on centres */
+        rc[0] = rc[2] = rk[0] = rk[2] = -HUGE_VAL;
+        rc[1] = rc[3] = rk[1] = rk[3] = HUGE_VAL;
+        for (j = 0; j < 3; j++) {
+            vx_cons_bound_apply(&bz[j], cy, rc);
+            vx_cons_bound_apply(&bx[j], cy, rk);
+        }
+        ca0 = vx_cons_ceil_in(rc[0] - 0.5, x0, x1);
+        ca1 = vx_cons_floor_in(rc[1] - 0.5, x0, x1);
+        if (ca0 > ca1) continue;
+        /* the certain range is the candidate one unless a bound is within its margin of a
+         * centre: ceil(rc[2] - .5) == ca0 iff ca0 >= rc[2] - .5 (rc[2] >= rc[0]) */
+        cc0 = (double)ca0 >= rc[2] - 0.5 ? ca0 : vx_cons_ceil_in(rc[2] - 0.5, x0, x1);
+        cc1 = (double)ca1 <= rc[3] - 0.5 ? ca1 : vx_cons_floor_in(rc[3] - 0.5, x0, x1);
+        p[U] = 0;
+        p[W] = iy;
+        p[D] = 0;
+        rowbase = vx_cons_brick_of(B, p, &rowbit);
+        for (ix = ca0; ix <= ca1; ix++) {
+            double kc = krow - ax * (double)ix, r[4];
+            int ka, kb, kA, kB;
+            size_t base = rowbase + (size_t)(ix >> 2) * sU;
+            unsigned bit0 = rowbit | (unsigned)(ix & 3) << (U == 0 ? 0 : (U == 1 ? 2 : 4));
+            /* layer bounds on the centre: plane, projection x (row), projection y (column) */
+            r[0] = kc - hwid - eps;
+            r[1] = kc + hwid + eps;
+            r[2] = kc - hwid + eps;
+            r[3] = kc + hwid - eps;
+            if (ntab) {
+                const double *q = tab[ix - x0];
+                r[0] = r[0] > q[0] ? r[0] : q[0];
+                r[1] = r[1] < q[1] ? r[1] : q[1];
+                r[2] = r[2] > q[2] ? r[2] : q[2];
+                r[3] = r[3] < q[3] ? r[3] : q[3];
+            } else {
+                for (j = 0; j < 3; j++) vx_cons_bound_apply(&by[j], (double)ix + 0.5, r);
             }
-#undef VX_CONS_WORD
-#undef VX_CONS_MASK
+            r[0] = r[0] > rk[0] ? r[0] : rk[0];
+            r[1] = r[1] < rk[1] ? r[1] : rk[1];
+            r[2] = r[2] > rk[2] ? r[2] : rk[2];
+            r[3] = r[3] < rk[3] ? r[3] : rk[3];
+            ka = vx_cons_ceil_in(r[0] - 0.5, z0, z1);
+            kb = vx_cons_floor_in(r[1] - 0.5, z0, z1);
+            if (ka > kb) continue;
+            kA = (double)ka >= r[2] - 0.5 ? ka : vx_cons_ceil_in(r[2] - 0.5, z0, z1);
+            kB = (double)kb <= r[3] - 0.5 ? kb : vx_cons_floor_in(r[3] - 0.5, z0, z1);
+#define VX_CONS_SET(kk) (B->w[base + (size_t)((kk) >> 2) * sD] \
+                         |= (uint64_t)1 << (bit0 | ((unsigned)((kk) & 3) << sh)))
+            if (ka == kA && kb == kB && ix >= cc0 && ix <= cc1) {
+                for (k = ka; k <= kb; k++) VX_CONS_SET(k); /* certain: the common case */
+                continue;
+            }
+            /* within a margin of an end: the SAT's own expressions decide */
+            slow++;
+            if (!have_sat) {
+                vx_cons_setup(T);
+                have_sat = 1;
+            }
+            {
+                double cu = (double)ix + 0.5;
+                t[0][U] = T->v[0][U] - cu;
+                t[1][U] = T->v[1][U] - cu;
+                t[2][U] = T->v[2][U] - cu;
+                t[0][W] = T->v[0][W] - cy;
+                t[1][W] = T->v[1][W] - cy;
+                t[2][W] = T->v[2][W] - cy;
+            }
+            if ((ix < cc0 || ix > cc1) && vx_cons_sep_proj(T, D, U, W, t)) continue;
+            for (k = ka; k <= kb; k++)
+                if ((k >= kA && k <= kB) || vx_cons_layer_ok(T, t, k)) VX_CONS_SET(k);
+#undef VX_CONS_SET
         }
     }
-    return n;
+    (void)sW;
+    return slow;
 }
 
 /* Allocates the brick scratch (zeroed) for a valid grid; NULL on failure. */
@@ -541,11 +711,27 @@ HFVIS_API hfvis_status hfvis_voxelize_conservative(const hfvis_mesh *mesh,
     for (t = 0; t < mesh->triangle_count; t++) {
         vx_cons_tri T;
         int lo[3], hi[3], a, k;
-        for (k = 0; k < 3; k++)
-            for (a = 0; a < 3; a++)
-                T.v[k][a] = gv[3 * (size_t)mesh->indices[3 * t + (size_t)k] + (size_t)a];
-        if (!vx_cons_bbox(T.v[0], T.v[1], T.v[2], grid, lo, hi)) continue;
-        if (!vx_cons_setup(&T)) continue;
+        for (k = 0; k < 3; k++) {
+            const double *g = gv + 3 * (size_t)mesh->indices[3 * t + (size_t)k];
+            T.v[k][0] = g[0];
+            T.v[k][1] = g[1];
+            T.v[k][2] = g[2];
+        }
+        if (!vx_cons_bbox_fast(&T, grid, lo, hi)) continue;
+        {
+            double f0[3], f1[3];
+            for (a = 0; a < 3; a++) {
+                f0[a] = T.v[1][a] - T.v[0][a];
+                f1[a] = T.v[2][a] - T.v[1][a];
+            }
+            vx_cons_normal(f0, f1, T.n); /* the SAT's normal: degenerate iff it is zero */
+        }
+        if (T.n[0] == 0.0 && T.n[1] == 0.0 && T.n[2] == 0.0) continue;
+        T.D = 0;
+        if (fabs(T.n[1]) > fabs(T.n[T.D])) T.D = 1;
+        if (fabs(T.n[2]) > fabs(T.n[T.D])) T.D = 2;
+        T.U = T.D == 2 ? 0 : T.D + 1;
+        T.W = T.D == 0 ? 2 : T.D - 1;
         vx_cons_fast_tri(&T, lo, hi, &B);
     }
     n = vx_cons_bricks_emit(&B, grid, occ);

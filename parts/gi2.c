@@ -449,8 +449,9 @@ static inline double hf_ns_sample1(const hf_ns_level *L, int wrap, int holes, do
     return r0 * (1.0 - fy) + r1 * fy;
 }
 
-/* C channels at grid position (x, y) into out; 0 if the sample is a hole. */
-static int hf_ns_sampleC(const hf_ns_level *L, int C, int wrap, double x, double y, double *out)
+/* C channels at grid position (x, y) into out; 0 if the sample is a hole. holes = 0 promises that
+ * no texel is one (then the plain weighted sum, same value). */
+static int hf_ns_sampleC(const hf_ns_level *L, int C, int wrap, int holes, double x, double y, double *out)
 {
     int x0, x1, y0, y1, c, q;
     double fx, fy, wt[4];
@@ -472,6 +473,12 @@ static int hf_ns_sampleC(const hf_ns_level *L, int C, int wrap, double x, double
     tp[1] = L->img + ((size_t)y0 * (size_t)L->w + (size_t)x1) * (size_t)C;
     tp[2] = L->img + ((size_t)y1 * (size_t)L->w + (size_t)x0) * (size_t)C;
     tp[3] = L->img + ((size_t)y1 * (size_t)L->w + (size_t)x1) * (size_t)C;
+    if (!holes) { /* every texel finite */
+        for (c = 0; c < C; c++)
+            out[c] = wt[0] * (double)tp[0][c] + wt[1] * (double)tp[1][c] + wt[2] * (double)tp[2][c] +
+                     wt[3] * (double)tp[3][c];
+        return 1;
+    }
     for (c = 0; c < C; c++) out[c] = 0.0;
     for (q = 0; q < 4; q++) {
         if (wt[q] == 0.0) continue;
@@ -1168,7 +1175,7 @@ static void hf_ns_bounce_rec(hf_ns_ctx *c, double X, double Y, const double *N, 
             const int lu = c->lu_i[e->i];
             double *u = c->ub + (size_t)q * (size_t)C;
             /* [NS09] §5.3: u(tau) from the radiance pyramid at level l_u(i) (spec B.5) */
-            if (!hf_ns_sampleC(&c->dp[lu], C, c->wrap, e->x, e->y, u))
+            if (!hf_ns_sampleC(&c->dp[lu], C, c->wrap, c->holes, e->x, e->y, u))
                 for (ch = 0; ch < C; ch++) u[ch] = 0.0;
             if (c->gvec) {
                 /* glossy: u += specular F_q(s) . I_(b-1)(q), s from q toward the receiver */
@@ -1178,7 +1185,7 @@ static void hf_ns_bounce_rec(hf_ns_ctx *c, double X, double Y, const double *N, 
                 s3[2] = -e->dz;
                 len = sqrt(s3[0] * s3[0] + s3[1] * s3[1] + s3[2] * s3[2]);
                 if (len > 0.0 && hf_ns_normal_interp(c, e->x, e->y, Nq) &&
-                    hf_ns_sampleC(&c->ip[lu], NS_SH_N * C, c->wrap, e->x, e->y, c->Iq)) {
+                    hf_ns_sampleC(&c->ip[lu], NS_SH_N * C, c->wrap, c->holes, e->x, e->y, c->Iq)) {
                     for (i = 0; i < 3; i++) s3[i] /= len;
                     ns = Nq[0] * s3[0] + Nq[1] * s3[1] + Nq[2] * s3[2];
                     if (ns > 0.0) { /* the receiver is above q's tangent plane */

@@ -1117,6 +1117,296 @@ TEST(lsao_bad_args_and_oom)
     }
 }
 
+/* ========================================================================================== */
+/* 4. Analytic scenes, closed forms (spec §6), HBAO and the ray-traced reference              */
+/* ========================================================================================== */
+
+/* S(x) = acos(x) - x sqrt(1 - x^2) for 0 <= x < 1, 0 for x >= 1 (spec §6 symbols) */
+static double S_fn(double x) { return x >= 1.0 ? 0.0 : acos(x) - x * sqrt(1.0 - x * x); }
+/* T5 COS, receiver on the floor at L from a cliff of height H (T4 wall: H -> infinity) */
+static double cos_step_none(double L, double H) { return 0.5 * (1.0 - L / sqrt(L * L + H * H)); }
+static double cos_step_q(double L, double H, double r)
+{
+    double D = sqrt(L * L + H * H), k = L / sqrt(r), m = D / sqrt(r);
+    return 0.5 * (1.0 - L / D) + k * (k - m) + k * (sqrt(1.0 + m * m) - sqrt(1.0 + k * k));
+}
+static double cos_step_R(double L, double H, double R)
+{
+    double D = sqrt(L * L + H * H);
+    return (S_fn(L / R) - (L / D) * S_fn(D / R)) / PI;
+}
+/* T7 COS, receiver at the bottom of a hemispherical pit of radius Rb */
+static double cos_pit_q(double Rb, double r) { return r / (4.0 * Rb * Rb) * log(1.0 + 2.0 * Rb * Rb / r); }
+static double cos_pit_R(double Rb, double R) { double v = (R / (2.0 * Rb)) * (R / (2.0 * Rb)); return v < 0.5 ? v : 0.5; }
+
+TEST(closed_forms_consistent)
+{
+    /* the spec's numerical checks: H -> infinity of the step is the wall; step/pit limits */
+    CHECK_NEAR(cos_step_none(1.0, 1e9), 0.5, 1e-9, 0.0);
+    CHECK_NEAR(cos_step_q(1.3, 1e7, 2.0), 0.5 + 0.8450 - 0.919239 * sqrt(1.0 + 0.845), 1e-5, 0.0);
+    CHECK_NEAR(cos_step_R(1.0, 1e9, 2.0), S_fn(0.5) / PI, 1e-9, 0.0);
+    CHECK_NEAR(cos_step_q(1.0, 2.0, 1e12), cos_step_none(1.0, 2.0), 1e-6, 0.0);
+    CHECK_NEAR(cos_step_R(1.0, 2.0, 1e9), cos_step_none(1.0, 2.0), 1e-6, 0.0);
+    CHECK_NEAR(cos_pit_q(1.0, 1e12), 0.5, 1e-6, 0.0);
+}
+
+/* Scene renderer: ortho height fields are exact; perspective depths lie on the surfaces. */
+TEST(scene_render)
+{
+    enum { W = 31, H = 21 };
+    static float d[W * H], n[3 * W * H];
+    hfvis_camera c;
+    hfvis_ssao_scene sc;
+    int x, y, bad = 0;
+    memset(&sc, 0, sizeof sc);
+    CHECK_EQ_STATUS(hfvis_camera_orthographic(&c, W, H, 0, 0, 0.5), HFVIS_OK);
+    sc.kind = HFVIS_SSAO_SCENE_VGROOVE;
+    sc.base_depth = 20.0;
+    sc.angle = 0.6;
+    sc.x0 = 0.0; /* the apex on the column of the principal point's pixel centre */
+    CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, d, n), HFVIS_OK);
+    for (y = 0; y < H; y++)
+        for (x = 0; x < W; x++) {
+            double X = (x + 0.5 - 15.5) * 0.5;
+            if (d[y * W + x] != (float)(20.0 - fabs(X) * tan(0.6))) bad++;
+        }
+    CHECK(n[3 * (5 * W + 15) + 2] == 1.0f && n[3 * (5 * W + 15)] == 0.0f);
+    CHECK_NEAR(n[3 * (5 * W + 20)], -sin(0.6), 1e-7, 0.0);
+    /* perspective pit seen from above: every depth is on the sphere or the rim plane */
+    CHECK_EQ_STATUS(hfvis_camera_perspective(&c, W, H, 0, 0, 1.2), HFVIS_OK);
+    sc.kind = HFVIS_SSAO_SCENE_PIT;
+    sc.base_depth = 10.0;
+    sc.radius = 3.0;
+    sc.x0 = 0.5;
+    sc.y0 = -0.3;
+    CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, d, n), HFVIS_OK);
+    for (y = 0; y < H; y++)
+        for (x = 0; x < W; x++) {
+            double P[3], dx, dy, dz, rr;
+            hfvis_camera_unproject(&c, x + 0.5, y + 0.5, (double)d[y * W + x], P);
+            dx = P[0] - 0.5;
+            dy = P[1] + 0.3;
+            dz = P[2] + 10.0;
+            rr = dx * dx + dy * dy;
+            if (fabs(dz) < 1e-5) { if (rr < 9.0 - 1e-3) bad++; }
+            else if (fabs(sqrt(rr + dz * dz) - 3.0) > 1e-5 || dz > 0.0) bad++;
+        }
+    /* perspective step: some pixels see the face, whose normal faces -x */
+    sc.kind = HFVIS_SSAO_SCENE_STEP;
+    sc.x0 = 1.0;
+    sc.height = 4.0;
+    CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, d, n), HFVIS_OK);
+    {
+        int face = 0;
+        for (x = 0; x < W * H; x++)
+            if (n[3 * x] == -1.0f) {
+                double P[3];
+                face++;
+                hfvis_camera_unproject(&c, x % W + 0.5, x / W + 0.5, (double)d[x], P);
+                if (fabs(P[0] - 1.0) > 1e-5 || -P[2] < 6.0 - 1e-5 || -P[2] > 10.0 + 1e-5) bad++;
+            }
+        CHECK(face > 0);
+    }
+    CHECK(bad == 0);
+    sc.height = 10.0; /* plateau at the eye */
+    CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, d, n), HFVIS_ERR_INVALID_ARGUMENT);
+    sc.kind = (hfvis_ssao_scene_kind)9;
+    CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, d, n), HFVIS_ERR_INVALID_ARGUMENT);
+    sc.kind = HFVIS_SSAO_SCENE_VGROOVE;
+    sc.angle = 0.5 * PI;
+    CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, d, n), HFVIS_ERR_INVALID_ARGUMENT);
+    sc.angle = 0.3;
+    CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, NULL, d, n), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, NULL, n), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, d, NULL), HFVIS_OK);
+}
+
+/* Monte-Carlo bound: 3 sigma of an unstratified estimate of a mean of [0,1] values from n rays
+ * (the Hammersley set does better; this is an upper bound) */
+static double mc3(double a, double n) { return 3.0 * sqrt((a * (1.0 - a) > 1e-4 ? a * (1.0 - a) : 1e-4) / n); }
+
+/* Mean of the inner AO column x (all inner rows). */
+static double col_mean(const float *ao, int w, int h, int x)
+{
+    double s = 0.0;
+    int y;
+    for (y = 0; y < h; y++) s += (double)ao[y * w + x];
+    return s / (double)h;
+}
+
+/* T5 / T4: the ray tracer against the COS closed forms of a cliff, ortho and perspective, for
+ * rho = 1, rho_q and rho_R (spec §6 T9: within 3 sigma). */
+TEST(raytrace_step_cos)
+{
+    enum { W0 = 200, H0 = 400, GX = 98, GY = 198, IW = 4, IH = 4, RAYS = 1024 };
+    static float depth[W0 * H0], nrm[3 * W0 * H0], ao[IW * IH];
+    hfvis_camera c;
+    hfvis_ssao_scene sc;
+    hfvis_ssao_rt_options o = hfvis_ssao_rt_options_default();
+    int f, x, m;
+    memset(&sc, 0, sizeof sc);
+    for (m = 0; m < 2; m++) {
+        double px = 0.1, Hs = 1.5;
+        if (m == 0) {
+            CHECK_EQ_STATUS(hfvis_camera_orthographic(&c, W0, H0, GX, GY, px), HFVIS_OK);
+            sc.x0 = (110.0 - 100.0) * px; /* the cliff on the boundary of texel column 110 */
+        } else {
+            CHECK_EQ_STATUS(hfvis_camera_perspective(&c, W0, H0, GX, GY, 1.6), HFVIS_OK);
+            sc.x0 = 1.2;
+        }
+        sc.kind = HFVIS_SSAO_SCENE_STEP;
+        sc.base_depth = 20.0;
+        sc.height = Hs;
+        CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, depth, nrm), HFVIS_OK);
+        o.rays = RAYS;
+        o.sampling = HFVIS_SSAO_SAMPLING_NEAREST; /* the face is a texel boundary */
+        for (f = 0; f < 3; f++) {
+            o.falloff.kind = f == 0 ? HFVIS_FALLOFF_NONE : (f == 1 ? HFVIS_FALLOFF_INV_QUADRATIC : HFVIS_FALLOFF_STEP);
+            o.falloff.param = f == 1 ? 0.8 : 2.0;
+            CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, nrm, &o, ao, IW), HFVIS_OK);
+            for (x = 0; x < IW; x++) {
+                double P[3], L, want, got = col_mean(ao, IW, IH, x);
+                hfvis_camera_unproject(&c, GX + x + 0.5, GY + 0.5, (double)depth[GY * W0 + GX + x], P);
+                L = sc.x0 - P[0];
+                want = f == 0 ? cos_step_none(L, Hs) : (f == 1 ? cos_step_q(L, Hs, 0.8) : cos_step_R(L, Hs, 2.0));
+                if (x == 0) printf("  RT step %s rho%d L=%.3f: %.5f closed %.5f (3 sigma %.4f)\n", m ? "persp" : "ortho", f, L, got, want, mc3(want, RAYS * IH));
+                CHECK_NEAR(got, want, mc3(want, RAYS * IH), 0.0);
+            }
+        }
+    }
+}
+
+/* T6 / T7: V-groove apex 1 - cos(beta) and the hemispherical pit, ortho and perspective. */
+TEST(raytrace_groove_pit_cos)
+{
+    enum { W0 = 161, H0 = 161, G = 79, IW = 3, RAYS = 2048 };
+    static float depth[W0 * H0], nrm[3 * W0 * H0], ao[IW * IW];
+    hfvis_camera c;
+    hfvis_ssao_scene sc;
+    hfvis_ssao_rt_options o = hfvis_ssao_rt_options_default();
+    int m, f;
+    for (m = 0; m < 2; m++) {
+        double got, want, Rb;
+        if (m == 0) CHECK_EQ_STATUS(hfvis_camera_orthographic(&c, W0, H0, G, G, 0.05), HFVIS_OK);
+        else CHECK_EQ_STATUS(hfvis_camera_perspective(&c, W0, H0, G, G, 1.0), HFVIS_OK);
+        /* groove apex through the central pixel (x0 = 0 is the principal point's column) */
+        memset(&sc, 0, sizeof sc);
+        sc.kind = HFVIS_SSAO_SCENE_VGROOVE;
+        sc.base_depth = 10.0;
+        sc.angle = 0.7;
+        CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, depth, nrm), HFVIS_OK);
+        o.rays = RAYS;
+        o.falloff.kind = HFVIS_FALLOFF_NONE;
+        CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, nrm, &o, ao, IW), HFVIS_OK);
+        got = (double)ao[1 * IW + 1];
+        want = 1.0 - cos(0.7);
+        printf("  RT groove %s: %.5f closed %.5f\n", m ? "persp" : "ortho", got, want);
+        CHECK_NEAR(got, want, mc3(want, RAYS), 0.0);
+        /* pit bottom under the central pixel */
+        sc.kind = HFVIS_SSAO_SCENE_PIT;
+        Rb = m == 0 ? 2.0 : 1.5;
+        sc.radius = Rb;
+        sc.x0 = sc.y0 = 0.0;
+        CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, depth, nrm), HFVIS_OK);
+        for (f = 0; f < 3; f++) {
+            o.falloff.kind = f == 0 ? HFVIS_FALLOFF_NONE : (f == 1 ? HFVIS_FALLOFF_INV_QUADRATIC : HFVIS_FALLOFF_STEP);
+            o.falloff.param = f == 1 ? 1.0 : 2.0;
+            CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, nrm, &o, ao, IW), HFVIS_OK);
+            got = (double)ao[1 * IW + 1];
+            want = f == 0 ? 0.5 : (f == 1 ? cos_pit_q(Rb, 1.0) : cos_pit_R(Rb, 2.0));
+            printf("  RT pit %s rho%d: %.5f closed %.5f\n", m ? "persp" : "ortho", f, got, want);
+            CHECK_NEAR(got, want, mc3(want, RAYS), 0.0);
+        }
+    }
+}
+
+/* The ray tracer on a plane: T1, COS = 0 exactly for any rho (rays above the tangent escape). */
+TEST(raytrace_plane_zero)
+{
+    enum { W0 = 40, H0 = 30 };
+    static float depth[W0 * H0], ao[W0 * H0];
+    hfvis_camera c;
+    hfvis_ssao_scene sc;
+    hfvis_ssao_rt_options o = hfvis_ssao_rt_options_default();
+    int i, m, bad = 0;
+    memset(&sc, 0, sizeof sc);
+    sc.kind = HFVIS_SSAO_SCENE_PLANE;
+    sc.base_depth = 8.0;
+    sc.slope_x = 0.4;
+    sc.slope_y = -0.2;
+    o.rays = 64;
+    for (m = 0; m < 2; m++) {
+        if (m == 0) CHECK_EQ_STATUS(hfvis_camera_orthographic(&c, W0, H0, 2, 2, 0.1), HFVIS_OK);
+        else CHECK_EQ_STATUS(hfvis_camera_perspective(&c, W0, H0, 2, 2, 1.0), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, depth, NULL), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, NULL, &o, ao, W0 - 4), HFVIS_OK);
+        for (i = 0; i < (W0 - 4) * (H0 - 4); i++) if (ao[i] != 0.0f) bad++;
+    }
+    CHECK(bad == 0);
+}
+
+/* HBAO against the SA closed forms (spec §6): T5 cliff with K = 4 axis directions exactly
+ * H/sqrt(H^2 + l^2)/4 (l = L + px/2: the first plateau texel centre); T6 groove K = 4:
+ * sin(beta)/2 exactly; T7 pit: sin 45 deg and, with rho_q, the integral of rho(2 Rb s). */
+#define HBAO_PIT_TOL 0.01 /* the discrete march samples the pit wall and rim at texel centres */
+TEST(hbao_sa_closed_forms)
+{
+    enum { W0 = 121, H0 = 81, G = 58, GY = 38, IW = W0 - 2 * G, IH = H0 - 2 * GY };
+    static float depth[W0 * H0], nrm[3 * W0 * H0], ao[IW * IH];
+    hfvis_camera c;
+    hfvis_ssao_scene sc;
+    hfvis_hbao_options o = hfvis_hbao_options_default();
+    double px = 0.1, Hs = 1.5;
+    int x, bad = 0;
+    CHECK_EQ_STATUS(hfvis_camera_orthographic(&c, W0, H0, G, GY, px), HFVIS_OK);
+    memset(&sc, 0, sizeof sc);
+    sc.kind = HFVIS_SSAO_SCENE_STEP;
+    sc.base_depth = 20.0;
+    sc.height = Hs;
+    sc.x0 = (70.0 - 60.5) * px; /* boundary of texel column 70 */
+    CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, depth, nrm), HFVIS_OK);
+    o.directions = 4;
+    CHECK_EQ_STATUS(hfvis_hbao(&c, depth, nrm, &o, ao, IW), HFVIS_OK);
+    for (x = 0; x < IW; x++) {
+        double l = (70 - (G + x) - 0.5 + 0.5) * px, want = Hs / sqrt(Hs * Hs + l * l) / 4.0;
+        if (!(fabs((double)ao[x] - want) <= TOL_FLOAT)) bad++;
+    }
+    CHECK(bad == 0);
+    /* large K tends to beta/pi (discretisation ~ px/L) */
+    o.directions = 64;
+    CHECK_EQ_STATUS(hfvis_hbao(&c, depth, nrm, &o, ao, IW), HFVIS_OK);
+    {
+        double L = sc.x0 - (G + 0.5 - 60.5) * px, want = atan(Hs / L) / PI;
+        printf("  HBAO step K=64: %.5f, beta/pi %.5f\n", (double)ao[0], want);
+        CHECK_NEAR((double)ao[0], want, 0.5 * px / L * want + 0.005, 0.0);
+    }
+    /* T6 groove */
+    sc.kind = HFVIS_SSAO_SCENE_VGROOVE;
+    sc.x0 = 0.0;
+    sc.angle = 0.7;
+    CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, depth, nrm), HFVIS_OK);
+    o.directions = 4;
+    CHECK_EQ_STATUS(hfvis_hbao(&c, depth, nrm, &o, ao, IW), HFVIS_OK);
+    CHECK_NEAR((double)ao[(IH / 2) * IW + 60 - G], sin(0.7) / 2.0, TOL_FLOAT, 0.0);
+    /* T7 pit */
+    sc.kind = HFVIS_SSAO_SCENE_PIT;
+    sc.x0 = sc.y0 = 0.0;
+    sc.radius = 2.0;
+    CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, depth, nrm), HFVIS_OK);
+    o.directions = 16;
+    CHECK_EQ_STATUS(hfvis_hbao(&c, depth, nrm, &o, ao, IW), HFVIS_OK);
+    printf("  HBAO pit SA: %.5f, sin 45 = %.5f\n", (double)ao[(IH / 2) * IW + 60 - G], sqrt(0.5));
+    CHECK_NEAR((double)ao[(IH / 2) * IW + 60 - G], sqrt(0.5), HBAO_PIT_TOL, 0.0);
+    o.falloff.kind = HFVIS_FALLOFF_INV_QUADRATIC;
+    o.falloff.param = 1.0;
+    CHECK_EQ_STATUS(hfvis_hbao(&c, depth, nrm, &o, ao, IW), HFVIS_OK);
+    {
+        double want = 1.0 / 4.0 * atan(sqrt(2.0) * 2.0); /* (sqrt r/(2Rb)) atan(sqrt2 Rb/sqrt r) */
+        printf("  HBAO pit incremental rho_q: %.5f, closed %.5f\n", (double)ao[(IH / 2) * IW + 60 - G], want);
+        CHECK_NEAR((double)ao[(IH / 2) * IW + 60 - G], want, HBAO_PIT_TOL, 0.0);
+    }
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
@@ -1138,5 +1428,11 @@ int main(int argc, char **argv)
     RUN(lsao_t5_step_closed_form);
     RUN(lsao_gather_rejection);
     RUN(lsao_bad_args_and_oom);
+    RUN(closed_forms_consistent);
+    RUN(scene_render);
+    RUN(raytrace_step_cos);
+    RUN(raytrace_groove_pit_cos);
+    RUN(raytrace_plane_zero);
+    RUN(hbao_sa_closed_forms);
     return TEST_DONE();
 }
