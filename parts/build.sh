@@ -8,7 +8,7 @@
 set -e
 cd "$(dirname "$0")/.."
 name=$1; shift
-order="mesh raster bvh vox cons iv"
+order="mesh raster bvh vox cons iv vf volgi"
 want=" $name $* "
 out=build/dev/$name${SAN:+_san}${BENCH:+_bench}
 mkdir -p "$out"
@@ -42,6 +42,15 @@ mv "$out/hfvis.c.tmp" "$out/hfvis.c"
 case " $name $* " in *" ssao "*) [ -f parts/ssao.c ] && cp parts/ssao.c "$out/ssao_dev.c" || cp ssao.c "$out/ssao_dev.c"
   [ -f parts/ssao_decl.h ] && decls="$decls parts/ssao_decl.h";;
 *) cp ssao.c "$out/ssao_dev.c";; esac
+# ssao.c appended parts: lk (Laine-Karras)
+for p in lk; do
+  [ -f "parts/$p.c" ] || continue
+  case "$want" in *" $p "*)
+    printf '\n/* ---- parts/%s.c ---- */\n' "$p" >> "$out/ssao_dev.c"
+    cat "parts/$p.c" >> "$out/ssao_dev.c"
+    [ -f "parts/${p}_decl.h" ] && decls="$decls parts/${p}_decl.h";;
+  esac
+done
 # header: everything before the final "#ifdef __cplusplus" + decls + the tail
 n=$(grep -n '^#ifdef __cplusplus' hfvis.h | tail -n 1 | cut -d: -f1)
 head -n $((n - 1)) hfvis.h > "$out/hfvis.h"

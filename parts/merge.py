@@ -4,7 +4,7 @@ hfvis.c, declarations before the closing extern-C block of hfvis.h, tests into t
 targets into test/fuzz/. Usage: python3 parts/merge.py [part ...] (default: all present)."""
 import os, sys, shutil, re
 os.chdir(os.path.join(os.path.dirname(os.path.abspath(__file__)), '..'))
-VOX = ['mesh', 'raster', 'bvh', 'vox', 'cons', 'iv']
+VOX = ['mesh', 'raster', 'bvh', 'vox', 'cons', 'iv', 'vf', 'volgi']
 HF = ['gi2']
 FUZZ = {'mesh': 'obj', 'cons': 'binvox'}
 want = sys.argv[1:] or [p for p in VOX + HF if os.path.exists('parts/%s.c' % p)]
