@@ -213,7 +213,7 @@ static void bench_gi2(int quick)
     printf("\nNowrouzezahrai-Snyder GI (m 32, k 4, o 2; sky + hard sun, albedo 0.5) beside the exact P1+P2 "
            "pipeline (K %d)\n", BENCH_GI2_K);
     printf("%-6s %-4s %8s | %-27s | %-27s | %-17s | %s\n", "HF", "sub", "mem MB", "NS ms/frame, 1 2 3 bounces",
-           "exact ms/frame, 1 2 3", "speed-up 1 2 3", "RMS error 1 2 3 (% of mean)");
+           "exact ms/frame, 1 2 3", "speed-up 1 2 3", "RMS error 0 1 2 3 bounces (% of mean)");
     for (si = 0; si < nsizes; si++) {
         const int n = sizes[si];
         const size_t cells = (size_t)n * (size_t)n;
@@ -232,8 +232,10 @@ static void bench_gi2(int quick)
         bench_gi2_exact(&g, L, te, &peak_e);
         for (k = 0; k < 3; k++) {
             const int s = subs[k], B = (n >= 1024 && s == 1) ? 1 : BENCH_GI2_B;
-            char row[3][3][32];
+            char row[3][3][32], e0[32];
+            double mean0;
             bench_gi2_ns(&g, s, B, T, tn, &peak_n, &query);
+            snprintf(e0, sizeof e0, "%.2f%%", 100.0 * bench_gi2_rms(T, L, cells, &mean0) / mean0);
             for (b = 1; b <= BENCH_GI2_B; b++) {
                 double mean, e, tb = b <= B ? tn[b] : tn[B] + (double)(b - B) * (tn[B] - tn[B - 1]);
                 snprintf(row[0][b - 1], sizeof row[0][b - 1], "%s%.0f", b <= B ? "" : "~", tb * 1e3);
@@ -245,9 +247,9 @@ static void bench_gi2(int quick)
                     snprintf(row[2][b - 1], sizeof row[2][b - 1], "-");
                 }
             }
-            printf("%4d^2 %2dx  %8.1f | %8s %8s %8s    | %8.0f %8.0f %8.0f    | %5s %5s %5s | %s %s %s\n", n, s,
+            printf("%4d^2 %2dx  %8.1f | %8s %8s %8s    | %8.0f %8.0f %8.0f    | %5s %5s %5s | %s %s %s %s\n", n, s,
                    (double)peak_n / 1048576.0, row[0][0], row[0][1], row[0][2], te[1] * 1e3, te[2] * 1e3,
-                   te[3] * 1e3, row[1][0], row[1][1], row[1][2], row[2][0], row[2][1], row[2][2]);
+                   te[3] * 1e3, row[1][0], row[1][1], row[1][2], e0, row[2][0], row[2][1], row[2][2]);
             if (query != peak_n) printf("  (scratch query %lu != peak %lu)\n", (unsigned long)query, (unsigned long)peak_n);
             if (s == 1)
                 printf("       NS direct pass %.1f ns per receiver-direction (%d + 1 sun slices), bounce "

@@ -232,9 +232,16 @@ typedef struct hfvis_ns_gi_outputs {
  * non-finite albedo_map / emission value at a sample that is not a hole, bounces < 0, or sizes that
  * overflow size_t; HFVIS_ERR_OUT_OF_MEMORY (nothing written, nothing leaked).
  * Allocates at most 4 blocks (hfvis_ns_gi_scratch_size bytes): tables, height pyramid and
- * normals, two receiver rows, and (with bounces) the radiance pyramids.
- * Cost: O(rw rh (m + key samples) n) for the direct pass and O(rw rh m (n + K C)) per bounce
- * (K the casting-set size; x16 with VECTOR glossy), plus O(W H C 256) shading. Deterministic. */
+ * normals, two receiver rows, and (with bounces) the casting-set cache and radiance pyramids.
+ * Cost: O(rw rh (m + key samples + directional lights) n) for the direct pass (about 20 ns per
+ * step on one 2020s core) and O(rw rh m K C) per bounce with the cache (K the casting-set size;
+ * x16 with VECTOR glossy), plus O(W H C 256) shading. Deterministic.
+ * Accuracy (measured, test_gi2.c and the bench, fBm terrains): with the defaults, the direct light
+ * of a uniform sky is within 1.4-2.3% RMS of P1's (hfvis_sky_light), of which about 1.8% is the
+ * order-4 SH truncation itself (the SH projection of the exact horizons is that far from P1); one
+ * bounce is within 0.016 (unit sky) RMS of P2's hfvis_indirect_light; hard sun shadows differ from
+ * hfvis_sun_visibility at 3-4% of the pixels (exponential steps miss thin ridges; P1 itself differs
+ * from a fine ray march at 4.7%). Full-frame RMS against the exact pipeline: 5-7% of the mean. */
 HFVIS_API hfvis_status hfvis_ns_gi(const hfvis_grid *grid, const hfvis_ns_scene *scene,
                                    const hfvis_ns_gi_options *opts,
                                    const hfvis_ns_gi_outputs *out);
