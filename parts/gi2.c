@@ -143,7 +143,7 @@ static double hf_ns_ang(const double *t, double *w, int i)
 /* A cheap atan with |error| <= 1.51e-3 rad (Rajan et al. 2006 on [-1, 1], reflected outside),
  * used only to find which B-spline windows can hold the maximum. */
 #define HF_NS_FATAN_ERR 1.6e-3
-static double hf_ns_fatan(double t)
+static inline double hf_ns_fatan(double t)
 {
     double a = fabs(t), r;
     if (a <= 1.0) return 0.78539816339744831 * t - t * (a - 1.0) * (0.2447 + 0.0663 * a);
@@ -164,18 +164,20 @@ static double hf_ns_omax_bspline(const double *t, int n, double *w, double *ap)
         w[i] = 3.0;
         ap[i] = hf_ns_fatan(t[i]);
     }
-    /* sk[2j] = approximate knot value, sk[2j+1] = approximate midpoint value */
+    /* sk[2j] = approximate knot value, sk[2j+1] = approximate midpoint value (the constants'
+     * rounding is far inside the bound) */
     for (j = 0; j < n; j++) {
-        double v = hf_ns_bs_knot(ap, n, j);
+        const double p = ap[j > 0 ? j - 1 : 0], c0 = ap[j], nx = ap[j + 1 < n ? j + 1 : n - 1];
+        double v = (p + 4.0 * c0 + nx) * (1.0 / 6.0);
         sk[2 * j] = v;
         if (v > amax) amax = v;
         if (j + 1 < n) {
-            v = hf_ns_bs_mid(ap, n, j);
+            v = (p + 23.0 * (c0 + nx) + ap[j + 2 < n ? j + 2 : n - 1]) * (1.0 / 48.0);
             sk[2 * j + 1] = v;
             if (v > amax) amax = v;
         }
     }
-    thr = amax - 2.0 * HF_NS_FATAN_ERR;
+    thr = amax - 2.0 * HF_NS_FATAN_ERR - 1e-12;
     for (j = 0; j < n; j++) {
         int a = j > 0 ? j - 1 : 0, b = j + 1 < n ? j + 1 : n - 1, d = j + 2 < n ? j + 2 : n - 1;
         if (sk[2 * j] >= thr) {
