@@ -9,7 +9,7 @@
 /* ========================================================================================== */
 /* Contents
  *   5a. grid space, ranges and the SAT predicate (hfvis_triangle_box_overlap)
- *   5b. conservative voxelization: per-voxel SAT reference and the column-interval fast path
+ *   5b. conservative voxelization: per-voxel SAT reference and the certified-bounds fast path
  *   5c. exact 2D orientation signs and the watertight pixel-centre coverage rule
  *   5d. solid voxelization by parity (fast: toggles + prefix XOR; reference: winding number)
  *   5e. watertightness of the index structure
@@ -26,6 +26,10 @@
  * lose their guarantees (overflow of the exact 2D orientation, int conversions): such meshes
  * are refused with HFVIS_ERR_LIMIT. 2^60 cells is far outside any grid. */
 #define VX_CONS_MAX_COORD 1152921504606846976.0 /* 2^60 */
+
+#ifndef VX_CONS_SMALL_BOX
+#define VX_CONS_SMALL_BOX 16 /* bounding boxes of at most this many voxels: direct SAT */
+#endif
 
 /* C99 inline for the few hot helpers of the fast path (no effect on results). */
 #define VX_CONS_INLINE inline
@@ -474,6 +478,16 @@ static VX_CONS_INLINE void vx_cons_bound_apply(const vx_cons_bound *b, double y,
     }
 }
 
+/* Bits of layers l0..l1 (0..3) of one column inside a brick, for layer strides 1, 4, 16 bits
+ * (dominant axis x, y, z), before the shift by the column's bit. */
+static const uint64_t vx_cons_layer_masks[3][4][4] = {
+    {{0x1, 0x3, 0x7, 0xf}, {0, 0x2, 0x6, 0xe}, {0, 0, 0x4, 0xc}, {0, 0, 0, 0x8}},
+    {{0x1, 0x11, 0x111, 0x1111}, {0, 0x10, 0x110, 0x1110}, {0, 0, 0x100, 0x1100}, {0, 0, 0, 0x1000}},
+    {{0x1, 0x10001, 0x100010001ull, 0x1000100010001ull},
+     {0, 0x10000, 0x100010000ull, 0x1000100010000ull},
+     {0, 0, 0x100000000ull, 0x1000100000000ull},
+     {0, 0, 0, 0x1000000000000ull}}};
+
 /* Voxelizes one triangle (grid-space vertices T->v, normal n != 0 with dominant axis D, U = D+1,
  * W = D+2; bounding-box voxel ranges lo..hi) into the bricks. The result is, bit for bit, the
  * set of voxels of the range on which hfvis_triangle_box_overlap returns 1, found without
@@ -502,18 +516,34 @@ static VX_CONS_INLINE void vx_cons_bound_apply(const vx_cons_bound *b, double y,
 static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
                                vx_cons_bricks *B)
 {
-    enum { NTAB = 32 };
     const int D = T->D, U = T->U, W = T->W;
     const int x0 = lo[U], x1 = hi[U], y0 = lo[W], y1 = hi[W], z0 = lo[D], z1 = hi[D];
     const unsigned sh = D == 0 ? 0u : (D == 1 ? 2u : 4u);
     const size_t sD = B->bs[D], sU = B->bs[U], sW = B->bs[W];
-    double P[3][3], f[3][3], nx, ny, nz, ax, ay, K0, hwid, eps, scale, tab[NTAB][4], t[3][3];
+    double P[3][3], f[3][3], nx, ny, nz, ax, ay, K0, hwid, eps, scale, t[3][3];
     vx_cons_bound bz[3], bx[3], by[3];
     size_t slow = 0;
-    int ix, iy, k, j, ntab, have_sat = 0;
+    int ix, iy, k, j, have_sat = 0, have_xy = 0;
     if (x0 == x1 && y0 == y1 && z0 == z1 && vx_cons_inside_voxel(T, lo)) {
         unsigned bit;
         B->w[vx_cons_brick_of(B, lo, &bit)] |= (uint64_t)1 << bit;
+        return 0;
+    }
+    if ((x1 - x0 + 1) * (y1 - y0 + 1) * (z1 - z0 + 1) <= VX_CONS_SMALL_BOX) {
+        /* a small box: the SAT itself on the voxels not yet set (the result is a union) */
+        int q[3];
+        for (q[2] = lo[2]; q[2] <= hi[2]; q[2]++)
+            for (q[1] = lo[1]; q[1] <= hi[1]; q[1]++)
+                for (q[0] = lo[0]; q[0] <= hi[0]; q[0]++) {
+                    unsigned bit;
+                    uint64_t *w = B->w + vx_cons_brick_of(B, q, &bit), m = (uint64_t)1 << bit;
+                    double c[3];
+                    if (*w & m) continue;
+                    c[0] = (double)q[0] + 0.5;
+                    c[1] = (double)q[1] + 0.5;
+                    c[2] = (double)q[2] + 0.5;
+                    if (hfvis_triangle_box_overlap(c, vx_cons_half, T->v[0], T->v[1], T->v[2])) *w |= m;
+                }
         return 0;
     }
     for (k = 0; k < 3; k++) {
@@ -540,35 +570,21 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
     for (k = 0; k < 3; k++) scale += fabs(P[k][0]) + fabs(P[k][1]) + fabs(P[k][2]);
     eps = scale * 9.313225746154785e-10; /* 2^-30 */
     /* the nine edge axes: projection z (x = cx, y = cy), x (x = cz, y = cy), y (x = cz,
-     * y = cx); vertex pairs (j, o) = (0, 2), (1, 0), (2, 1) */
+     * y = cx); vertex pairs (j, o) = (0, 2), (1, 0), (2, 1). Projections x and y are only set
+     * up when some candidate voxel is not set yet. */
     for (j = 0; j < 3; j++) {
         const int o = j == 0 ? 2 : j - 1;
         vx_cons_bound_init(&bz[j], -f[j][1], f[j][0], P[j][0], P[j][1], P[o][0], P[o][1], eps);
-        vx_cons_bound_init(&bx[j], f[j][1], -f[j][2], P[j][2], P[j][1], P[o][2], P[o][1], eps);
-        vx_cons_bound_init(&by[j], -f[j][0], f[j][2], P[j][2], P[j][0], P[o][2], P[o][0], eps);
-    }
-    /* layer bounds of projection y per column index x (they do not depend on y) */
-    ntab = x1 - x0 < NTAB ? x1 - x0 + 1 : 0;
-    for (ix = 0; ix < ntab; ix++) {
-        double *r = tab[ix], cx = (double)(x0 + ix) + 0.5;
-        r[0] = r[2] = -HUGE_VAL;
-        r[1] = r[3] = HUGE_VAL;
-        vx_cons_bound_apply(&by[0], cx, r);
-        vx_cons_bound_apply(&by[1], cx, r);
-        vx_cons_bound_apply(&by[2], cx, r);
     }
     for (iy = y0; iy <= y1; iy++) {
         double cy = (double)iy + 0.5, krow = K0 - ay * (double)iy + 0.5, rc[4], rk[4];
-        int ca0, ca1, cc0, cc1, p[3];
+        int ca0, ca1, cc0, cc1, p[3], have_rk = 0;
         size_t rowbase;
         unsigned rowbit;
-        /* the row's columns (projection z) and its layer bounds (projection x), on centres */
-        rc[0] = rc[2] = rk[0] = rk[2] = -HUGE_VAL;
-        rc[1] = rc[3] = rk[1] = rk[3] = HUGE_VAL;
-        for (j = 0; j < 3; j++) {
-            vx_cons_bound_apply(&bz[j], cy, rc);
-            vx_cons_bound_apply(&bx[j], cy, rk);
-        }
+        /* the row's columns (projection z), on centres */
+        rc[0] = rc[2] = -HUGE_VAL;
+        rc[1] = rc[3] = HUGE_VAL;
+        for (j = 0; j < 3; j++) vx_cons_bound_apply(&bz[j], cy, rc);
         ca0 = vx_cons_ceil_in(rc[0] - 0.5, x0, x1);
         ca1 = vx_cons_floor_in(rc[1] - 0.5, x0, x1);
         if (ca0 > ca1) continue;
@@ -585,20 +601,47 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
             int ka, kb, kA, kB;
             size_t base = rowbase + (size_t)(ix >> 2) * sU;
             unsigned bit0 = rowbit | (unsigned)(ix & 3) << (U == 0 ? 0 : (U == 1 ? 2 : 4));
-            /* layer bounds on the centre: plane, projection x (row), projection y (column) */
+#define VX_CONS_WORD(kk) B->w[base + (size_t)((kk) >> 2) * sD]
+#define VX_CONS_MASK(kk) ((uint64_t)1 << (bit0 | ((unsigned)((kk) & 3) << sh)))
+            /* the plane's candidate layers; done if they are all set already */
             r[0] = kc - hwid - eps;
             r[1] = kc + hwid + eps;
+            ka = vx_cons_ceil_in(r[0] - 0.5, z0, z1);
+            kb = vx_cons_floor_in(r[1] - 0.5, z0, z1);
+            if (ka > kb) continue;
+            if (kb - ka <= 4) {
+                /* at most two bricks: masks of the layers in each (vx_cons_layer_masks) */
+                int kc3 = ka | 3, last = kb < kc3 ? kb : kc3;
+                uint64_t m1 = vx_cons_layer_masks[sh >> 1][ka & 3][last & 3] << bit0, m2 = 0, w2 = 0;
+                if (kb > kc3) {
+                    m2 = vx_cons_layer_masks[sh >> 1][0][kb & 3] << bit0;
+                    w2 = VX_CONS_WORD(kb);
+                }
+                if ((VX_CONS_WORD(ka) & m1) == m1 && (w2 & m2) == m2) continue;
+            } else {
+                for (k = ka; k <= kb && (VX_CONS_WORD(k) & VX_CONS_MASK(k)); k++) {}
+                if (k > kb) continue;
+            }
+            /* layer bounds on the centre: plane, projection x (row), projection y (column) */
+            if (!have_xy) {
+                for (j = 0; j < 3; j++) {
+                    const int o = j == 0 ? 2 : j - 1;
+                    vx_cons_bound_init(&bx[j], f[j][1], -f[j][2], P[j][2], P[j][1], P[o][2],
+                                       P[o][1], eps);
+                    vx_cons_bound_init(&by[j], -f[j][0], f[j][2], P[j][2], P[j][0], P[o][2],
+                                       P[o][0], eps);
+                }
+                have_xy = 1;
+            }
+            if (!have_rk) {
+                rk[0] = rk[2] = -HUGE_VAL;
+                rk[1] = rk[3] = HUGE_VAL;
+                for (j = 0; j < 3; j++) vx_cons_bound_apply(&bx[j], cy, rk);
+                have_rk = 1;
+            }
             r[2] = kc - hwid + eps;
             r[3] = kc + hwid - eps;
-            if (ntab) {
-                const double *q = tab[ix - x0];
-                r[0] = r[0] > q[0] ? r[0] : q[0];
-                r[1] = r[1] < q[1] ? r[1] : q[1];
-                r[2] = r[2] > q[2] ? r[2] : q[2];
-                r[3] = r[3] < q[3] ? r[3] : q[3];
-            } else {
-                for (j = 0; j < 3; j++) vx_cons_bound_apply(&by[j], (double)ix + 0.5, r);
-            }
+            for (j = 0; j < 3; j++) vx_cons_bound_apply(&by[j], (double)ix + 0.5, r);
             r[0] = r[0] > rk[0] ? r[0] : rk[0];
             r[1] = r[1] < rk[1] ? r[1] : rk[1];
             r[2] = r[2] > rk[2] ? r[2] : rk[2];
@@ -608,10 +651,8 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
             if (ka > kb) continue;
             kA = (double)ka >= r[2] - 0.5 ? ka : vx_cons_ceil_in(r[2] - 0.5, z0, z1);
             kB = (double)kb <= r[3] - 0.5 ? kb : vx_cons_floor_in(r[3] - 0.5, z0, z1);
-#define VX_CONS_SET(kk) (B->w[base + (size_t)((kk) >> 2) * sD] \
-                         |= (uint64_t)1 << (bit0 | ((unsigned)((kk) & 3) << sh)))
             if (ka == kA && kb == kB && ix >= cc0 && ix <= cc1) {
-                for (k = ka; k <= kb; k++) VX_CONS_SET(k); /* certain: the common case */
+                for (k = ka; k <= kb; k++) VX_CONS_WORD(k) |= VX_CONS_MASK(k); /* certain */
                 continue;
             }
             /* within a margin of an end: the SAT's own expressions decide */
@@ -631,8 +672,9 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
             }
             if ((ix < cc0 || ix > cc1) && vx_cons_sep_proj(T, D, U, W, t)) continue;
             for (k = ka; k <= kb; k++)
-                if ((k >= kA && k <= kB) || vx_cons_layer_ok(T, t, k)) VX_CONS_SET(k);
-#undef VX_CONS_SET
+                if ((k >= kA && k <= kB) || vx_cons_layer_ok(T, t, k)) VX_CONS_WORD(k) |= VX_CONS_MASK(k);
+#undef VX_CONS_WORD
+#undef VX_CONS_MASK
         }
     }
     (void)sW;

@@ -55,16 +55,20 @@ HFVIS_API int hfvis_triangle_box_overlap(const double center[3], const double ha
  * every triangle; 26-separating, a superset of the pixel-centre voxelizations (spec §3.4, §3.9).
  * Only the voxels of the triangle's bounding-box range are candidates: along each axis
  * i = max(0, ceil(min) - 1) .. min(dims-1, floor(max)) (the voxels whose closed extent meets
- * the triangle's); the result is EXACTLY the set hfvis_voxelize_conservative_reference gives.
- * Method (Schwarz & Seidel 2010): per triangle, the normal, the plane's radius and the nine
- * edge axes are set up once; per column of the dominant projection the three 2D edge axes are
- * tested once, the interval of layers inside the plane slab is found from the plane equation
- * and fixed up with the SAT's own expressions, and only the two ends of that interval are
- * tested against the six remaining axes (every axis is monotone along the column in floating
- * point, so the passing layers form an interval). Cost O(T + columns + voxels written) plus
- * clearing occ. occ: vx = dims[0]*dims[1]*dims[2] bytes, overwritten. count (may be NULL):
- * occupied voxels. opts: only alloc is used. One allocation (vertex_count*24 bytes).
- * Errors: see the section comment. */
+ * the triangle's); the result is EXACTLY the set hfvis_voxelize_conservative_reference gives,
+ * voxel for voxel, including ties (faces on voxel boundaries, vertices on voxel corners).
+ * Method (Schwarz & Seidel 2010, made exact): per triangle, in the frame of its dominant axis,
+ * each of the nine edge axes becomes a bound on two voxel-centre coordinates and the plane axis
+ * a bound on the layers of each column; rows of columns, then the layer interval of each
+ * column, follow from these bounds evaluated in double with a safety margin (2^-30 of the
+ * coordinate scale, far above the rounding of either side), so a voxel decided by the margin
+ * is decided as the SAT decides it, and the few voxels within a margin of a bound are decided
+ * by the SAT's own expressions. Bounding boxes of at most 16 voxels use the SAT directly on
+ * the voxels not set yet. Cost O(T + rows + columns + voxels written) plus O(grid volume / 64)
+ * to clear and emit; the baseline is O(sum of bounding-box voxels). occ: dims[0]*dims[1]*dims[2]
+ * bytes, overwritten. count (may be NULL): occupied voxels. opts: only alloc is used. Two
+ * allocations: vertex_count*24 bytes (vertices in grid space) and ceil(dims/4)^3 * 8 bytes (a
+ * bit per voxel in 4x4x4 bricks). Errors: see the section comment. */
 HFVIS_API hfvis_status hfvis_voxelize_conservative(const hfvis_mesh *mesh,
                                                    const hfvis_volume_grid *grid,
                                                    const hfvis_binary_voxel_options *opts,

@@ -343,6 +343,32 @@ TEST(conservative_fast_equals_reference)
         for (mi = 0; mi < 5; mi++) hfvis_mesh_free(NULL, &meshes[mi]);
     }
     {
+        /* giant triangles (vertices up to 1e12 cells away) crossing a small grid: the fast
+         * path's margins grow with the coordinates and its candidate ranges get long */
+        hfvis_volume_grid g = tc_grid(20, 18, 22);
+        tc_soup s;
+        size_t t;
+        int a;
+        tc_seed(77);
+        tc_soup_alloc(&s, 40);
+        for (t = 0; t < 40; t++) {
+            /* centroid c inside the grid: v0 = c + big d0, v1 = c + big d1, v2 = c - big (d0 + d1) */
+            double big = pow(10.0, 2.0 + 10.0 * tc_unit()), c[3], d0[3], d1[3];
+            for (a = 0; a < 3; a++) {
+                c[a] = 2.0 + 16.0 * tc_unit();
+                d0[a] = 2.0 * tc_unit() - 1.0;
+                d1[a] = 2.0 * tc_unit() - 1.0;
+            }
+            for (a = 0; a < 3; a++) {
+                s.xyz[9 * t + (size_t)a] = (float)(c[a] + big * d0[a]);
+                s.xyz[9 * t + 3 + (size_t)a] = (float)(c[a] + big * d1[a]);
+                s.xyz[9 * t + 6 + (size_t)a] = (float)(c[a] - big * (d0[a] + d1[a]));
+            }
+        }
+        tc_cons_check(&s.m, &g, &bad);
+        tc_soup_free(&s);
+    }
+    {
         /* a box whose faces lie exactly on voxel faces: every face voxel layer on both sides */
         double lo[3] = {2.0, 3.0, 4.0}, hi[3] = {9.0, 8.0, 10.0};
         hfvis_volume_grid g = tc_grid(14, 13, 15);
