@@ -1929,22 +1929,18 @@ hfvis_status hfvis_hbao(const hfvis_camera *cam, const float *depth, const float
 /* ========================================================================================== */
 
 #define SS_RT_DEFAULT_RAYS 256
-#define SS_RT_DEFAULT_STEP 0.5
-#define SS_RT_DEFAULT_REFINE 12
-#define SS_RT_DEFAULT_BIAS 1e-3
-#define SS_RT_DEFAULT_MAX_STEPS 65536
+#define SS_RT_DEFAULT_REFINE 20
+#define SS_RT_DEFAULT_BIAS 1e-5
 
 hfvis_ssao_rt_options hfvis_ssao_rt_options_default(void)
 {
     hfvis_ssao_rt_options o;
     memset(&o, 0, sizeof o);
     o.rays = SS_RT_DEFAULT_RAYS;
-    o.step_px = SS_RT_DEFAULT_STEP;
     o.falloff.kind = HFVIS_FALLOFF_NONE;
     o.sampling = HFVIS_SSAO_SAMPLING_BILINEAR;
     o.refine_iterations = SS_RT_DEFAULT_REFINE;
     o.bias = SS_RT_DEFAULT_BIAS;
-    o.max_steps = SS_RT_DEFAULT_MAX_STEPS;
     return o;
 }
 
@@ -1955,16 +1951,13 @@ hfvis_status hfvis_ssao_rt_options_resolve(const hfvis_ssao_rt_options *in,
     if (!out) return HFVIS_ERR_INVALID_ARGUMENT;
     if (in) o = *in;
     else memset(&o, 0, sizeof o);
-    if (o.rays < 0 || o.refine_iterations < 0 || o.refine_iterations > 64 || o.max_steps < 0 ||
-        !ss_finite(o.step_px) || o.step_px < 0.0 || !ss_finite(o.thickness) || o.thickness < 0.0 ||
+    if (o.rays < 0 || o.refine_iterations < 0 || o.refine_iterations > 64 ||
+        !ss_finite(o.thickness) || o.thickness < 0.0 ||
         !ss_finite(o.bias) || o.bias < 0.0 || !ss_finite(o.max_distance) || o.max_distance < 0.0)
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (o.rays == 0) o.rays = SS_RT_DEFAULT_RAYS;
-    if (o.step_px == 0.0) o.step_px = SS_RT_DEFAULT_STEP;
-    if (o.step_px < SS_MIN_STEP || o.step_px > 64.0) return HFVIS_ERR_INVALID_ARGUMENT;
     if (o.refine_iterations == 0) o.refine_iterations = SS_RT_DEFAULT_REFINE;
     if (o.bias == 0.0) o.bias = SS_RT_DEFAULT_BIAS;
-    if (o.max_steps == 0) o.max_steps = SS_RT_DEFAULT_MAX_STEPS;
     if (o.sampling == HFVIS_SSAO_SAMPLING_DEFAULT)
         o.sampling = o.thickness > 0.0 ? HFVIS_SSAO_SAMPLING_NEAREST : HFVIS_SSAO_SAMPLING_BILINEAR;
     if (o.sampling != HFVIS_SSAO_SAMPLING_NEAREST && o.sampling != HFVIS_SSAO_SAMPLING_BILINEAR)
@@ -1991,87 +1984,174 @@ typedef struct ss_rt {
     const ss_cam *c;
     const float *depth;
     const hfvis_ssao_rt_options *o;
-    const ss_fall *f;
     double zmin, zmax, maxdist;
     int bil;
 } ss_rt;
 
-/* Is view point X inside the depth field? -1: outside the buffer or behind the eye (a miss),
- * 0: outside the field, 1: inside. */
-static int ss_rt_inside(const ss_rt *t, const double X[3], double *d_out)
+/* The ray parameter s >= 0 at which the screen coordinate `axis` (0: u, 1: v) of O + s w
+ * equals k; +inf when the ray never gets there. */
+static double ss_rt_cross(const ss_cam *c, const double O[3], const double w[3], int axis,
+                          double k)
+{
+    double num, den, s;
+    if (c->persp) { /* u = cx + fx X/d, v = cy - fy Y/d, d = d0 - s w.z */
+        double d0 = -O[2];
+        if (axis == 0) {
+            num = (k - c->cx) * d0 - c->fx * O[0];
+            den = c->fx * w[0] + (k - c->cx) * w[2];
+        } else {
+            num = (k - c->cy) * d0 + c->fy * O[1];
+            den = -c->fy * w[1] + (k - c->cy) * w[2];
+        }
+    } else {
+        if (axis == 0) {
+            num = (k - c->cx) * c->sx - O[0];
+            den = w[0];
+        } else {
+            num = -(k - c->cy) * c->sy - O[1];
+            den = w[1];
+        }
+    }
+    if (den == 0.0) return SS_INF;
+    s = num / den;
+    /* the screen coordinate is monotone along the ray: a crossing behind the origin means the
+     * coordinate tends to an asymptote (the vanishing point) short of k */
+    return s >= 0.0 ? s : SS_INF;
+}
+
+/* Screen position of O + s w. */
+static void ss_rt_screen(const ss_cam *c, const double O[3], const double w[3], double s,
+                         double *u, double *v)
+{
+    double X = O[0] + s * w[0], Y = O[1] + s * w[1], d = -(O[2] + s * w[2]);
+    if (c->persp) {
+        *u = c->cx + c->fx * X / d;
+        *v = c->cy - c->fy * Y / d;
+    } else {
+        *u = c->cx + X / c->sx;
+        *v = c->cy - Y / c->sy;
+    }
+}
+
+/* Bilinear depth of cell (ix, iy) (centres ix+0.5 .. ix+1.5) at (u, v); NaN on background. */
+static double ss_rt_bilinear(const ss_rt *t, int ix, int iy, double u, double v)
 {
     const ss_cam *c = t->c;
-    double d = -X[2], u, v, zb, qu, qv;
-    *d_out = d;
-    if (c->persp) {
-        if (!(d > 0.0)) return -1;
-        u = c->cx + c->fx * X[0] / d;
-        v = c->cy - c->fy * X[1] / d;
-    } else {
-        u = c->cx + X[0] / c->sx;
-        v = c->cy - X[1] / c->sy;
-    }
-    if (!(u >= 0.0 && v >= 0.0 && u < (double)c->W && v < (double)c->H)) return -1;
-    zb = ss_sample(c, t->depth, t->bil, u, v, ss_texel(u, c->W), ss_texel(v, c->H), &qu, &qv);
-    if (zb != zb) return 0;
-    if (!(d > zb)) return 0;
+    double a = u - ((double)ix + 0.5), b = v - ((double)iy + 0.5);
+    double z00 = ss_tex(c, t->depth, ix, iy), z10 = ss_tex(c, t->depth, ix + 1, iy);
+    double z01 = ss_tex(c, t->depth, ix, iy + 1), z11 = ss_tex(c, t->depth, ix + 1, iy + 1);
+    if (ss_bg(c, z00) || ss_bg(c, z10) || ss_bg(c, z01) || ss_bg(c, z11)) return SS_NAN;
+    a = a < 0.0 ? 0.0 : (a > 1.0 ? 1.0 : a);
+    b = b < 0.0 ? 0.0 : (b > 1.0 ? 1.0 : b);
+    return (1.0 - b) * ((1.0 - a) * z00 + a * z10) + b * ((1.0 - a) * z01 + a * z11);
+}
+
+/* Is ray depth d inside the field of depth zb? */
+static int ss_rt_in(const ss_rt *t, double d, double zb)
+{
+    if (zb != zb || !(d > zb)) return 0;
     return t->o->thickness > 0.0 ? d < zb + t->o->thickness : 1;
 }
 
-/* Step length at X along w: step_px of screen motion, at most half the thickness in depth. */
-static double ss_rt_step(const ss_rt *t, const double X[3], const double w[3], double s, double zc)
+/* Distance to the first hit of the ray O + s w (spec §5.11), or -1 for a miss. The ray is
+ * traversed cell by cell in screen space (a DDA whose cell boundaries are solved exactly in s):
+ * texels under NEAREST, where the depth along the ray is linear and the field constant, so the
+ * first inside point is exact; the cells between texel centres under BILINEAR, where each cell
+ * is tested at its entry, middle and exit and a hit refined by bisection. */
+static double ss_rt_ray(const ss_rt *t, const double O[3], const double w[3])
 {
     const ss_cam *c = t->c;
-    double speed, ds;
+    double off = t->bil ? 0.5 : 0.0, u, v, s = 0.0, d0 = -O[2], s_eye = SS_INF;
+    double thick = t->o->thickness;
+    int ix, iy, su, sv, nx = t->bil ? c->W - 1 : c->W, ny = t->bil ? c->H - 1 : c->H;
     if (c->persp) {
-        double d = -X[2], a = c->fx * (w[0] * d + X[0] * w[2]), b = c->fy * (w[1] * d + X[1] * w[2]);
-        speed = sqrt(a * a + b * b) / (d * d);
+        double du = w[0] * d0 + O[0] * w[2], dv = -(w[1] * d0 + O[1] * w[2]);
+        su = du > 0.0 ? 1 : (du < 0.0 ? -1 : 0);
+        sv = dv > 0.0 ? 1 : (dv < 0.0 ? -1 : 0);
+        if (w[2] > 0.0) s_eye = d0 / w[2] * (1.0 - 1e-12); /* behind the eye past this */
     } else {
-        double a = w[0] / c->sx, b = w[1] / c->sy;
-        speed = sqrt(a * a + b * b);
+        su = w[0] > 0.0 ? 1 : (w[0] < 0.0 ? -1 : 0);
+        sv = w[1] < 0.0 ? 1 : (w[1] > 0.0 ? -1 : 0);
     }
-    ds = speed > 0.0 ? t->o->step_px / speed : SS_INF;
-    if (t->o->thickness > 0.0 && fabs(w[2]) > 0.0 && ds * fabs(w[2]) > 0.5 * t->o->thickness)
-        ds = 0.5 * t->o->thickness / fabs(w[2]);
-    /* large steps only where the ray barely moves on screen: let them grow geometrically */
-    if (ds > (s > zc ? s : zc)) ds = s > zc ? s : zc;
-    if (ds < 1e-9 * zc) ds = 1e-9 * zc;
-    return ds;
-}
-
-/* Distance to the first hit of the ray O + s w, or -1 for a miss. */
-static double ss_rt_ray(const ss_rt *t, const double O[3], const double w[3], double zc)
-{
-    double s_prev = 0.0, s, X[3], d;
-    int n, in, it;
-    s = ss_rt_step(t, O, w, 0.0, zc);
-    for (n = 0; n < t->o->max_steps; n++) {
-        if (s > t->maxdist) return -1.0;
-        X[0] = O[0] + s * w[0];
-        X[1] = O[1] + s * w[1];
-        X[2] = O[2] + s * w[2];
-        if (!ss_finite(X[0]) || !ss_finite(X[1]) || !ss_finite(X[2])) return -1.0;
-        in = ss_rt_inside(t, X, &d);
-        if (in < 0) return -1.0;
-        if (in) {
-            double lo = s_prev, hi = s;
-            for (it = 0; it < t->o->refine_iterations; it++) {
-                double mid = 0.5 * (lo + hi), Y[3], dm;
-                Y[0] = O[0] + mid * w[0];
-                Y[1] = O[1] + mid * w[1];
-                Y[2] = O[2] + mid * w[2];
-                if (ss_rt_inside(t, Y, &dm) > 0) hi = mid;
-                else lo = mid;
-            }
-            return 0.5 * (lo + hi);
+    ss_rt_screen(c, O, w, 0.0, &u, &v);
+    if (!(u - off >= 0.0 && v - off >= 0.0)) return -1.0;
+    ix = (int)floor(u - off);
+    iy = (int)floor(v - off);
+    if (ix >= nx || iy >= ny) return -1.0;
+    for (;;) {
+        double s_u = su > 0 ? ss_rt_cross(c, O, w, 0, (double)(ix + 1) + off)
+                            : (su < 0 ? ss_rt_cross(c, O, w, 0, (double)ix + off) : SS_INF);
+        double s_v = sv > 0 ? ss_rt_cross(c, O, w, 1, (double)(iy + 1) + off)
+                            : (sv < 0 ? ss_rt_cross(c, O, w, 1, (double)iy + off) : SS_INF);
+        double s_next = s_u < s_v ? s_u : s_v, s_end = s_next, da, db;
+        int last = 0;
+        if (!(s_end >= s)) s_end = s;
+        if (s_end >= t->maxdist) { s_end = t->maxdist; last = 1; }
+        if (s_end >= s_eye) { s_end = s_eye; last = 1; }
+        if (s_end == SS_INF) { /* the ray stays in this cell: the field is constant along it */
+            double zb, qu, qv;
+            if (w[2] >= 0.0) return -1.0;
+            zb = t->bil ? ss_rt_bilinear(t, ix, iy, u, v)
+                        : ss_sample(c, t->depth, 0, u, v, ix, iy, &qu, &qv);
+            da = d0 - s * w[2];
+            if (zb != zb) return -1.0;
+            if (ss_rt_in(t, da, zb)) return s;
+            if (thick > 0.0 && da >= zb + thick) return -1.0;
+            da = (d0 - zb) / w[2]; /* where the descending ray reaches the depth */
+            return da > s ? da : s;
         }
+        da = d0 - s * w[2];
+        db = d0 - s_end * w[2];
+        if (!t->bil) {
+            double zb = ss_tex(c, t->depth, ix, iy);
+            if (!ss_bg(c, zb)) {
+                if (ss_rt_in(t, da, zb)) return s;
+                if (db > da && da <= zb && db > zb) { /* entering from above */
+                    double sh = (d0 - zb) / w[2];
+                    return sh > s ? sh : s;
+                }
+                if (thick > 0.0 && db < da && da >= zb + thick && db < zb + thick) {
+                    double sh = (d0 - zb - thick) / w[2];
+                    return sh > s ? sh : s;
+                }
+            }
+        } else {
+            double ss3[3], lo = s, hi = -1.0;
+            int m, it;
+            ss3[0] = s;
+            ss3[1] = 0.5 * (s + s_end);
+            ss3[2] = s_end;
+            for (m = 0; m < 3; m++) {
+                double uu, vv, zb;
+                ss_rt_screen(c, O, w, ss3[m], &uu, &vv);
+                zb = ss_rt_bilinear(t, ix, iy, uu, vv);
+                if (ss_rt_in(t, d0 - ss3[m] * w[2], zb)) {
+                    hi = ss3[m];
+                    break;
+                }
+                lo = ss3[m];
+            }
+            if (hi >= 0.0) {
+                if (hi == s) return s;
+                for (it = 0; it < t->o->refine_iterations; it++) {
+                    double mid = 0.5 * (lo + hi), uu, vv;
+                    ss_rt_screen(c, O, w, mid, &uu, &vv);
+                    if (ss_rt_in(t, d0 - mid * w[2], ss_rt_bilinear(t, ix, iy, uu, vv))) hi = mid;
+                    else lo = mid;
+                }
+                return 0.5 * (lo + hi);
+            }
+        }
+        if (last) return -1.0;
         /* rising above every depth, or sinking below every depth plus the thickness */
-        if (w[2] > 0.0 && d < t->zmin) return -1.0;
-        if (w[2] < 0.0 && t->o->thickness > 0.0 && d > t->zmax + t->o->thickness) return -1.0;
-        s_prev = s;
-        s += ss_rt_step(t, X, w, s, zc);
+        if (w[2] > 0.0 && db < t->zmin) return -1.0;
+        if (w[2] < 0.0 && thick > 0.0 && db > t->zmax + thick) return -1.0;
+        if (s_u <= s_v) ix += su;
+        if (s_v <= s_u) iy += sv;
+        if (ix < 0 || iy < 0 || ix >= nx || iy >= ny) return -1.0;
+        s = s_end;
+        if (t->bil) ss_rt_screen(c, O, w, s, &u, &v);
     }
-    return -1.0;
 }
 
 hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth, const float *normals,
@@ -2098,7 +2178,6 @@ hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth, co
     t.c = &c;
     t.depth = depth;
     t.o = &o;
-    t.f = &f;
     t.bil = o.sampling == HFVIS_SSAO_SAMPLING_BILINEAR;
     t.maxdist = o.max_distance > 0.0 ? o.max_distance : f.support;
     t.zmin = SS_INF;
@@ -2159,7 +2238,7 @@ hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth, co
                     w[0] = lx * T[0] + ly * B[0] + lz * n[0];
                     w[1] = lx * T[1] + ly * B[1] + lz * n[1];
                     w[2] = lx * T[2] + ly * B[2] + lz * n[2];
-                    hit = ss_rt_ray(&t, O, w, zc);
+                    hit = ss_rt_ray(&t, O, w);
                     if (hit >= 0.0) acc += ss_rho(&f, hit);
                 }
                 a = acc / (double)o.rays;

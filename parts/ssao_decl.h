@@ -554,49 +554,51 @@ HFVIS_API hfvis_status hfvis_hbao(const hfvis_camera *cam, const float *depth,
 typedef struct hfvis_ssao_rt_options {
     const hfvis_allocator *alloc;     /* reconstructed normals only; NULL = malloc/free */
     int rays;                         /* rays per pixel [256] */
-    double step_px;                   /* march step: at most this many pixels of screen motion
-                                         per step [0.5] */
     double thickness;                 /* depth-field thickness in view units; 0 = infinite (the
                                          continuous depth field of [P4] up to §11) [0] */
     hfvis_falloff falloff;            /* rho of the hit distance [NONE] */
-    hfvis_ssao_sampling sampling;     /* depth reads [BILINEAR when thickness is 0, NEAREST
-                                         otherwise: a finite-thickness field is not
+    hfvis_ssao_sampling sampling;     /* the depth field [BILINEAR when thickness is 0,
+                                         NEAREST otherwise: a finite-thickness field is not
                                          interpolated, [P4] §11] */
-    int refine_iterations;            /* bisection steps on a hit [12] */
+    int refine_iterations;            /* bisection steps on a BILINEAR hit [20] */
     double bias;                      /* ray origin P + bias z n, as a fraction of the receiver
-                                         depth [1e-3] */
+                                         depth (covers float depth rounding) [1e-5] */
     double max_distance;              /* view units; rays go no farther (a miss) [the falloff's
                                          support; unbounded: until they leave the buffer] */
-    int max_steps;                    /* per ray, then a miss [65536] */
     uint32_t seed;                    /* the per-pixel Cranley-Patterson shift */
 } hfvis_ssao_rt_options;
 
 HFVIS_API hfvis_ssao_rt_options hfvis_ssao_rt_options_default(void);
 
 /* The options with the defaults filled in (sampling resolved from thickness).
- * HFVIS_ERR_INVALID_ARGUMENT for NULL out, rays < 0, refine_iterations < 0 or > 64,
- * max_steps < 0, step_px, thickness, bias or max_distance negative or not finite (step_px in
- * [1/64, 64] when given), an unknown sampling, an invalid falloff. in may be NULL. */
+ * HFVIS_ERR_INVALID_ARGUMENT for NULL out, rays < 0, refine_iterations < 0 or > 64, thickness,
+ * bias or max_distance negative or not finite, an unknown sampling, an invalid falloff. in may
+ * be NULL. */
 HFVIS_API hfvis_status hfvis_ssao_rt_options_resolve(const hfvis_ssao_rt_options *in,
                                                      hfvis_ssao_rt_options *out);
 
 /* Screen-space ray-traced obscurance, the yardstick of [P4] §8 ("the best any method can do
  * with the screen-space data"): for every inner non-background pixel, R cosine-weighted rays
  * about the normal n (directions from the Hammersley set (r/R, radical inverse of r) shifted
- * per pixel by a hash of (x, y, seed), mod 1; r = sqrt(u1), phi = 2 pi u2), from
- * O = P + bias z n, are marched in view space with steps of at most step_px pixels of screen
- * motion (and half the thickness in depth). A ray is inside the depth field at X when its depth
- * -X.z exceeds the depth read at its projection (and is less than it plus the thickness, if
- * finite); background never blocks. The first inside point is refined by bisection and the ray
- * adds rho(hit distance). A ray that leaves the buffer, passes behind the eye, rises above every
- * depth, sinks below every depth plus the thickness (finite thickness), exceeds max_distance or
- * max_steps is a miss (unknown geometry counts as empty). ao = (1/R) sum rho: a Monte-Carlo
- * estimate of [P4] Eq. 1, (1/pi) Int rho(d) max(0, n.w) dw - the COS convention (spec §1.2) -
- * which converges as R grows (stratified, faster than 1/sqrt(R)). ao[y*ao_stride + x], inner
- * pixels; background receivers 0. normals NULL: reconstructed with hfvis_depth_normals (1 block
- * of 12*stride*height bytes; nothing is allocated otherwise). Deterministic for a seed. Cost
- * O(W H R (steps per ray)). HFVIS_ERR_INVALID_ARGUMENT for invalid camera/options, NULL
- * depth/ao, ao_stride < inner width; HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on error. */
+ * per pixel by a hash of (x, y, seed), mod 1; disk radius sqrt(u1), azimuth 2 pi u2), from
+ * O = P + bias z n. A ray is inside the depth field at X when its depth -X.z exceeds the field's
+ * depth at its projection (and is less than it plus the thickness, if finite); background never
+ * blocks. Instead of fixed-size march steps (which cut corners: about 2 % too little
+ * obscurance at a cliff at 0.5 px steps), each ray is traversed exactly cell by cell in screen
+ * space, the cell boundaries solved in closed form for the ray parameter: under NEAREST the
+ * cells are texels, the field is constant and the ray depth linear in each, and the first
+ * inside point is exact; under BILINEAR the cells lie between texel centres (the field is
+ * known only there), each is tested at its entry, middle and exit, and a hit is refined by
+ * bisection. The ray adds rho(distance from O to the first inside point). A ray that leaves
+ * the buffer, passes behind the eye, rises above every depth, sinks below every depth plus the
+ * thickness (finite thickness) or exceeds max_distance is a miss (unknown geometry counts as
+ * empty). ao = (1/R) sum rho: a quasi-Monte-Carlo estimate of [P4] Eq. 1,
+ * (1/pi) Int rho(d) max(0, n.w) dw - the COS convention (spec §1.2) - converging as R grows.
+ * ao[y*ao_stride + x], inner pixels; background receivers 0. normals NULL: reconstructed with
+ * hfvis_depth_normals (1 block of 12*stride*height bytes; nothing is allocated otherwise).
+ * Deterministic for a seed. Cost O(W H R (W0 + H0)) at worst (cells per ray).
+ * HFVIS_ERR_INVALID_ARGUMENT for invalid camera/options, NULL depth/ao, ao_stride < inner
+ * width; HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on error. */
 HFVIS_API hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth,
                                            const float *normals,
                                            const hfvis_ssao_rt_options *opts, float *ao,
