@@ -526,7 +526,8 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
     int ix, iy, k, j, have_sat = 0, have_xy = 0;
     if (x0 == x1 && y0 == y1 && z0 == z1 && vx_cons_inside_voxel(T, lo)) {
         unsigned bit;
-        B->w[vx_cons_brick_of(B, lo, &bit)] |= (uint64_t)1 << bit;
+        size_t wi = vx_cons_brick_of(B, lo, &bit); /* sequenced before bit is read */
+        B->w[wi] |= (uint64_t)1 << bit;
         return 0;
     }
     if ((x1 - x0 + 1) * (y1 - y0 + 1) * (z1 - z0 + 1) <= VX_CONS_SMALL_BOX) {
@@ -536,8 +537,10 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
             for (q[1] = lo[1]; q[1] <= hi[1]; q[1]++)
                 for (q[0] = lo[0]; q[0] <= hi[0]; q[0]++) {
                     unsigned bit;
-                    uint64_t *w = B->w + vx_cons_brick_of(B, q, &bit), m = (uint64_t)1 << bit;
+                    uint64_t *w, m;
                     double c[3];
+                    w = B->w + vx_cons_brick_of(B, q, &bit);
+                    m = (uint64_t)1 << bit;
                     if (*w & m) continue;
                     c[0] = (double)q[0] + 0.5;
                     c[1] = (double)q[1] + 0.5;
