@@ -1938,7 +1938,7 @@ hfvis_ssao_rt_options hfvis_ssao_rt_options_default(void)
     memset(&o, 0, sizeof o);
     o.rays = SS_RT_DEFAULT_RAYS;
     o.falloff.kind = HFVIS_FALLOFF_NONE;
-    o.sampling = HFVIS_SSAO_SAMPLING_BILINEAR;
+    o.sampling = HFVIS_SSAO_SAMPLING_DEFAULT; /* resolved from the thickness */
     o.refine_iterations = SS_RT_DEFAULT_REFINE;
     o.bias = SS_RT_DEFAULT_BIAS;
     return o;

@@ -1439,6 +1439,201 @@ TEST(hbao_sa_closed_forms)
     }
 }
 
+/* Finite thickness: a thick-enough field equals the continuous one (same sampling); a thin
+ * floating plate lets rays pass under it. Deterministic for a seed, different across seeds. */
+TEST(raytrace_thickness_and_seed)
+{
+    enum { W0 = 60, H0 = 40, G = 2, IW = W0 - 2 * G, IH = H0 - 2 * G };
+    static float depth[W0 * H0], nrm[3 * W0 * H0], a1[IW * IH], a2[IW * IH], a3[IW * IH];
+    hfvis_camera c;
+    hfvis_ssao_rt_options o = hfvis_ssao_rt_options_default();
+    int x, y, i, bad = 0, less = 0, diff = 0;
+    CHECK_EQ_STATUS(hfvis_camera_orthographic(&c, W0, H0, G, G, 0.1), HFVIS_OK);
+    for (y = 0; y < H0; y++)
+        for (x = 0; x < W0; x++) {
+            int plate = x >= 30 && x < 45 && y >= 10 && y < 30;
+            depth[y * W0 + x] = (float)(plate ? 8.0 : 10.0);
+            nrm[3 * (y * W0 + x)] = nrm[3 * (y * W0 + x) + 1] = 0.0f;
+            nrm[3 * (y * W0 + x) + 2] = 1.0f;
+        }
+    o.rays = 64;
+    o.sampling = HFVIS_SSAO_SAMPLING_NEAREST;
+    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, nrm, &o, a1, IW), HFVIS_OK);
+    o.thickness = 1e6;
+    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, nrm, &o, a2, IW), HFVIS_OK);
+    CHECK(memcmp(a1, a2, sizeof a1) == 0);
+    o.thickness = 0.3;
+    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, nrm, &o, a2, IW), HFVIS_OK);
+    for (i = 0; i < IW * IH; i++) {
+        if (a2[i] > a1[i]) bad++;
+        if (a2[i] < a1[i]) less++;
+    }
+    CHECK(bad == 0 && less > 50);
+    /* seeds */
+    o.thickness = 0.0;
+    o.seed = 1;
+    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, nrm, &o, a2, IW), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, nrm, &o, a3, IW), HFVIS_OK);
+    CHECK(memcmp(a2, a3, sizeof a2) == 0);
+    o.seed = 2;
+    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, nrm, &o, a3, IW), HFVIS_OK);
+    for (i = 0; i < IW * IH; i++) diff += a2[i] != a3[i];
+    CHECK(diff > 0);
+}
+
+/* Bad arguments and allocation failure of HBAO and the ray tracer (one block each, only for
+ * reconstructed normals). */
+TEST(hbao_rt_bad_args_and_oom)
+{
+    enum { W = 24, H = 20 };
+    static float depth[W * H], nrm[3 * W * H], ao[W * H], keep[W * H], ref[W * H];
+    hfvis_camera cam;
+    hfvis_hbao_options h = hfvis_hbao_options_default(), hb, hr;
+    hfvis_ssao_rt_options r = hfvis_ssao_rt_options_default(), rb, rr;
+    hfvis_allocator al;
+    counting cnt;
+    hfvis_ssao_direction d[8];
+    int i;
+    CHECK_EQ_STATUS(hfvis_camera_perspective(&cam, W, H, 1, 1, 1.0), HFVIS_OK);
+    random_depth(depth, W, H, W, 6.0, 4, 9);
+    CHECK_EQ_STATUS(hfvis_depth_normals(&cam, depth, nrm), HFVIS_OK);
+    for (i = 0; i < W * H; i++) ao[i] = keep[i] = -3.0f;
+    CHECK_EQ_STATUS(hfvis_hbao_options_resolve(NULL, &hr), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_hbao_options_resolve(&h, &hb), HFVIS_OK);
+    CHECK(memcmp(&hr, &hb, sizeof hr) == 0 && hr.directions == 8 && hr.tangent == HFVIS_SSAO_TANGENT_REAL);
+    CHECK_EQ_STATUS(hfvis_ssao_rt_options_resolve(NULL, &rr), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_ssao_rt_options_resolve(&r, &rb), HFVIS_OK);
+    CHECK(memcmp(&rr, &rb, sizeof rr) == 0 && rr.rays == 256 && rr.sampling == HFVIS_SSAO_SAMPLING_BILINEAR);
+    rb = r;
+    rb.thickness = 1.0;
+    CHECK_EQ_STATUS(hfvis_ssao_rt_options_resolve(&rb, &rr), HFVIS_OK);
+    CHECK(rr.sampling == HFVIS_SSAO_SAMPLING_NEAREST);
+    CHECK_EQ_STATUS(hfvis_ssao_directions_box(1, 1, 1.0, d), HFVIS_OK);
+#define BAD_H(stmt) do { hb = h; stmt; CHECK_EQ_STATUS(hfvis_hbao_options_resolve(&hb, &hr), HFVIS_ERR_INVALID_ARGUMENT); \
+        CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, nrm, &hb, ao, W), HFVIS_ERR_INVALID_ARGUMENT); } while (0)
+#define BAD_R(stmt) do { rb = r; stmt; CHECK_EQ_STATUS(hfvis_ssao_rt_options_resolve(&rb, &rr), HFVIS_ERR_INVALID_ARGUMENT); \
+        CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, nrm, &rb, ao, W), HFVIS_ERR_INVALID_ARGUMENT); } while (0)
+    BAD_H(hb.directions = -2);
+    BAD_H(hb.directions = HFVIS_SSAO_MAX_DIRECTIONS + 1);
+    BAD_H(hb.azimuth0_rad = (double)NAN);
+    BAD_H(hb.variant = (hfvis_hbao_variant)4);
+    BAD_H(hb.steps = -1);
+    BAD_H(hb.step_px = 1e-4);
+    BAD_H(hb.radius = -1.0);
+    BAD_H(hb.max_radius_px = (double)INFINITY);
+    BAD_H(hb.falloff.kind = HFVIS_FALLOFF_EXPONENTIAL);
+    BAD_H(hb.tangent = HFVIS_SSAO_TANGENT_FIXED_HULL_REAL_EVAL);
+    BAD_H(hb.fixed_sin_t = 2.0);
+    BAD_H(hb.sampling = (hfvis_ssao_sampling)5);
+    BAD_H(hb.plane = (hfvis_ssao_plane)5);
+    BAD_H(hb.jitter = (hfvis_hbao_jitter)4);
+    BAD_H(hb.directions = 8; hb.custom_directions = d; hb.jitter = HFVIS_HBAO_JITTER_ROTATION);
+    d[2].weight = -0.5;
+    BAD_H(hb.directions = 8; hb.custom_directions = d);
+    d[2].weight = 0.125;
+    BAD_R(rb.rays = -1);
+    BAD_R(rb.refine_iterations = 65);
+    BAD_R(rb.thickness = -1.0);
+    BAD_R(rb.bias = (double)NAN);
+    BAD_R(rb.max_distance = -2.0);
+    BAD_R(rb.sampling = (hfvis_ssao_sampling)3);
+    BAD_R(rb.falloff.kind = HFVIS_FALLOFF_CUSTOM);
+    CHECK_EQ_STATUS(hfvis_hbao(NULL, depth, nrm, &h, ao, W), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_hbao(&cam, NULL, nrm, &h, ao, W), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, nrm, &h, NULL, W), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, nrm, &h, ao, W - 3), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_ssao_raytrace(NULL, depth, nrm, &r, ao, W), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, NULL, nrm, &r, ao, W), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, nrm, &r, NULL, W), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, nrm, &r, ao, W - 3), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK(memcmp(ao, keep, sizeof ao) == 0);
+    al.alloc = cnt_alloc;
+    al.free = cnt_free;
+    al.user = &cnt;
+    h.alloc = &al;
+    r.alloc = &al;
+    r.rays = 8;
+    /* normals given or a fixed tangent: nothing allocated */
+    memset(&cnt, 0, sizeof cnt);
+    CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, nrm, &h, ref, W), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, nrm, &r, ref, W), HFVIS_OK);
+    hb = h;
+    hb.tangent = HFVIS_SSAO_TANGENT_FIXED;
+    CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, NULL, &hb, ref, W), HFVIS_OK);
+    CHECK(cnt.allocs == 0);
+    /* reconstructed normals: one block, equal results */
+    CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, nrm, &h, ref, W), HFVIS_OK);
+    memset(ao, 0, sizeof ao); /* cells outside the inner region are not written */
+    memset(ref, 0, sizeof ref);
+    CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, nrm, &h, ref, W), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, NULL, &h, ao, W), HFVIS_OK);
+    CHECK(cnt.allocs == 1 && cnt.live == 0 && memcmp(ao, ref, sizeof ao) == 0);
+    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, nrm, &r, ref, W), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, NULL, &r, ao, W), HFVIS_OK);
+    CHECK(cnt.allocs == 2 && cnt.live == 0 && memcmp(ao, ref, sizeof ao) == 0);
+    for (i = 0; i < W * H; i++) ao[i] = keep[i];
+    memset(&cnt, 0, sizeof cnt);
+    cnt.fail_at = 1;
+    CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, NULL, &h, ao, W), HFVIS_ERR_OUT_OF_MEMORY);
+    CHECK(cnt.live == 0);
+    memset(&cnt, 0, sizeof cnt);
+    cnt.fail_at = 1;
+    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, NULL, &r, ao, W), HFVIS_ERR_OUT_OF_MEMORY);
+    CHECK(cnt.live == 0);
+    CHECK(memcmp(ao, keep, sizeof ao) == 0);
+}
+
+/* HBAO details: jitter is deterministic per seed; the three variants are ordered as the
+ * spec's definitions imply on a pit with rho = 1 (INCREMENTAL = SINGLE_HORIZON: the sum of
+ * the rises is the top minus sin t); a radius limits the march. */
+TEST(hbao_variants_jitter)
+{
+    enum { W0 = 41, H0 = 41, G = 10, IW = W0 - 2 * G };
+    static float depth[W0 * H0], nrm[3 * W0 * H0], a1[IW * IW], a2[IW * IW], a3[IW * IW];
+    hfvis_camera c;
+    hfvis_ssao_scene sc;
+    hfvis_hbao_options o = hfvis_hbao_options_default();
+    int i, diff = 0, bad = 0;
+    CHECK_EQ_STATUS(hfvis_camera_perspective(&c, W0, H0, G, G, 1.0), HFVIS_OK);
+    memset(&sc, 0, sizeof sc);
+    sc.kind = HFVIS_SSAO_SCENE_PIT;
+    sc.base_depth = 10.0;
+    sc.radius = 2.0;
+    CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, depth, nrm), HFVIS_OK);
+    o.variant = HFVIS_HBAO_INCREMENTAL;
+    CHECK_EQ_STATUS(hfvis_hbao(&c, depth, nrm, &o, a1, IW), HFVIS_OK);
+    o.variant = HFVIS_HBAO_SINGLE_HORIZON;
+    CHECK_EQ_STATUS(hfvis_hbao(&c, depth, nrm, &o, a2, IW), HFVIS_OK);
+    for (i = 0; i < IW * IW; i++) if (fabs((double)a1[i] - (double)a2[i]) > TOL_FLOAT) bad++;
+    CHECK(bad == 0);
+    /* with a falloff, the single horizon weights the whole rise by the farthest distance */
+    o.falloff.kind = HFVIS_FALLOFF_INV_QUADRATIC;
+    o.falloff.param = 1.0;
+    o.variant = HFVIS_HBAO_INCREMENTAL;
+    CHECK_EQ_STATUS(hfvis_hbao(&c, depth, nrm, &o, a1, IW), HFVIS_OK);
+    o.variant = HFVIS_HBAO_SINGLE_HORIZON;
+    CHECK_EQ_STATUS(hfvis_hbao(&c, depth, nrm, &o, a2, IW), HFVIS_OK);
+    for (i = 0; i < IW * IW; i++) if (a2[i] > a1[i] + 1e-6f) bad++;
+    CHECK(bad == 0);
+    /* jitter */
+    o.jitter = HFVIS_HBAO_JITTER_ROTATION_STEP;
+    o.seed = 5;
+    CHECK_EQ_STATUS(hfvis_hbao(&c, depth, nrm, &o, a1, IW), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_hbao(&c, depth, nrm, &o, a2, IW), HFVIS_OK);
+    CHECK(memcmp(a1, a2, sizeof a1) == 0);
+    o.seed = 6;
+    CHECK_EQ_STATUS(hfvis_hbao(&c, depth, nrm, &o, a3, IW), HFVIS_OK);
+    for (i = 0; i < IW * IW; i++) diff += a1[i] != a3[i];
+    CHECK(diff > 0);
+    /* a radius shorter than the pit's distances from the bottom sees nothing there */
+    o.jitter = HFVIS_HBAO_JITTER_NONE;
+    o.falloff.kind = HFVIS_FALLOFF_NONE;
+    o.variant = HFVIS_HBAO_INCREMENTAL;
+    o.radius = 1e-3;
+    CHECK_EQ_STATUS(hfvis_hbao(&c, depth, nrm, &o, a1, IW), HFVIS_OK);
+    CHECK(a1[(IW / 2) * IW + IW / 2] == 0.0f);
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
@@ -1466,5 +1661,8 @@ int main(int argc, char **argv)
     RUN(raytrace_groove_pit_cos);
     RUN(raytrace_plane_zero);
     RUN(hbao_sa_closed_forms);
+    RUN(raytrace_thickness_and_seed);
+    RUN(hbao_rt_bad_args_and_oom);
+    RUN(hbao_variants_jitter);
     return TEST_DONE();
 }
