@@ -509,6 +509,10 @@ static const uint64_t vx_cons_layer_masks[3][4][4] = {
  *    boundaries, or 1e-9-close calls) are decided with the SAT's own expressions in the
  *    original frame (vx_cons_sep_proj, vx_cons_layer_ok; set up lazily), which makes the
  *    result identical to the reference;
+ *  - a voxel already set needs no decision (the result is a union): a column whose plane
+ *    candidates are all set is skipped before the other projections' bounds are even set up
+ *    (they are set up once per triangle, when first needed); a bounding box of at most
+ *    VX_CONS_SMALL_BOX voxels is decided by calling the SAT on its voxels not yet set;
  *  - a triangle inside one voxel's closed cube (not merely clipped to one): every offset
  *    |t| <= h, and then no axis of the SAT can separate (|fl(L.t)| <= fl(h |L|) term by term,
  *    since rounding is monotone and the radii are summed in the same order): the voxel is set.
