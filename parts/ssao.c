@@ -588,7 +588,21 @@ static hfvis_status ss_fall_load(const hfvis_falloff *f, ss_fall *o)
     return HFVIS_OK;
 }
 
+static double ss_rho_general(const ss_fall *f, double d);
+
+/* rho(d): the rational falloffs inline, the rest out of line. */
 static double ss_rho(const ss_fall *f, double d)
+{
+    if (f->kind == HFVIS_FALLOFF_INV_QUADRATIC) return f->a / (f->a + d * d);
+    if (f->kind == HFVIS_FALLOFF_HBAO) {
+        double v = f->r1c / (f->a + d * d) - f->c;
+        return v > 0.0 ? v : 0.0;
+    }
+    if (f->kind == HFVIS_FALLOFF_NONE) return 1.0;
+    return ss_rho_general(f, d);
+}
+
+static double ss_rho_general(const ss_fall *f, double d)
 {
     double v;
     switch (f->kind) {
@@ -1388,7 +1402,14 @@ static void ss_line_points(const ss_cam *c, const ss_cfg *g, const float *depth,
             tx = ss_texel(u, c->W);
             ty = ss_texel(v, c->H);
         }
-        z = ss_sample(c, depth, bil, u, v, tx, ty, &qu, &qv);
+        if (bil) {
+            z = ss_sample(c, depth, 1, u, v, tx, ty, &qu, &qv);
+        } else { /* ss_sample's NEAREST branch, inline */
+            z = ss_tex(c, depth, tx, ty);
+            if (ss_bg(c, z)) z = SS_NAN;
+            qu = (double)tx + 0.5;
+            qv = (double)ty + 0.5;
+        }
         if (zs) zs[k] = (float)z;
         if (z != z) {
             x[k] = y[k] = SS_NAN;
@@ -1574,6 +1595,23 @@ static void ss_gather_dir(const ss_cam *c, const ss_cfg *g, const float *depth,
             tf = (u * d->dx + v * d->dy - L->t_min) * ids;
             if (g->gather == HFVIS_SSAO_GATHER_NEAREST) {
                 int j, i;
+                /* fast path of ss_nearest: the rounded line and step lie inside the lattice */
+                if (jf > -0.5 && jf < (double)nlines - 0.5 && tf > -0.5 && tf < 2147483647.0) {
+                    const hfvis_ssao_line *ln;
+                    j = (int)(jf + 0.5);
+                    i = (int)(tf + 0.5);
+                    ln = &lines[j];
+                    if (i >= ln->first && i < ln->first + ln->count) {
+                        size_t idx = ln->offset + (size_t)(i - ln->first);
+                        double zs = (double)sdepth[idx];
+                        val = (double)values[idx];
+                        ok = val == val && zs == zs &&
+                             (g->rej_z < 0.0 || fabs(zs - zc) <= g->rej_z * zc);
+                        if (ok && nc)
+                            ok = ss_accept(c, g, normals, L, ln, i, values, sdepth, zc, nc, &val);
+                        goto have;
+                    }
+                }
                 if (ss_nearest(L, lines, u, v, &j, &i))
                     ok = ss_accept(c, g, normals, L, &lines[j], i, values, sdepth, zc, nc, &val);
             } else {
@@ -1596,6 +1634,7 @@ static void ss_gather_dir(const ss_cam *c, const ss_cfg *g, const float *depth,
                     ok = 1;
                 }
             }
+        have:
             if (!ok)
                 ok = ss_fallback(c, g, normals, L, lines, values, sdepth, u, v, zc, nc, R2, &val);
             if (!ok) continue;
