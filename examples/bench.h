@@ -7,4 +7,6 @@ void bench_raster(int quick);
 void bench_vox(int quick);
 void bench_iv(int quick);
 void bench_bvh(int quick);
+void bench_gi2(int quick);
+void bench_cons(int quick);
 #endif

@@ -134,7 +134,7 @@ static void bench_ssao(int quick)
     static const int res[3][2] = {{800, 600}, {1280, 720}, {1920, 1080}};
     /* falloff supports in view units (the knot is ~6 units away: at 1280x720, 1 unit ~ 125 px
      * there); 40 units covers the whole screen from every pixel */
-    static const double radii[4] = {0.25, 1.0, 4.0, 40.0};
+    static const double radii[5] = {0.1, 0.25, 1.0, 4.0, 40.0};
     int ri, ki, ri2;
     printf("P3 line-sweep AO vs HBAO (matching quality: same box directions and texel steps, "
            "brute-force largest occluder)\n");
@@ -158,8 +158,8 @@ static void bench_ssao(int quick)
         }
         for (ki = 0; ki < 2; ki++) {
             int K = ki ? 16 : 8;
-            double lsao_t[4];
-            for (ri2 = 0; ri2 < 4; ri2++) {
+            double lsao_t[5];
+            for (ri2 = 0; ri2 < 5; ri2++) {
                 hfvis_lsao_options lo = hfvis_lsao_options_default();
                 hfvis_hbao_options ho = hfvis_hbao_options_default();
                 hfvis_ssao_direction dirs[16];
@@ -197,7 +197,7 @@ static void bench_ssao(int quick)
             }
             {
                 double lo_t = lsao_t[0], hi_t = lsao_t[0];
-                for (ri2 = 1; ri2 < 4; ri2++) {
+                for (ri2 = 1; ri2 < 5; ri2++) {
                     if (lsao_t[ri2] < lo_t) lo_t = lsao_t[ri2];
                     if (lsao_t[ri2] > hi_t) hi_t = lsao_t[ri2];
                 }
