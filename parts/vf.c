@@ -105,34 +105,35 @@ static double vx_vf_dot(const double q[3], const double u[3])
 }
 
 /* Nearest sample to q (finite, not zero): radial projection onto the octahedron face of q's
- * hemisphere, the 3 x 3 lattice points around it, ranked by q . u in index order (strictly
- * greater wins). A winner on the equator of the lower hemisphere is returned as its upper copy
- * (same point and dot product, lower index: the oracle's tie rule). */
+ * hemisphere, the 3 x 3 lattice points around it, ranked by q . u; equal dot products go to the
+ * lower index, where an equator point counts with its upper copy's index (same point, same dot
+ * product, lower index): the oracle's rule exactly. */
 static size_t vx_vf_nearest(int n, const double q[3])
 {
-    int h = q[2] < 0.0, ra, rb, a, b, best_a = 0, best_b = 0, found = 0;
+    int h = q[2] < 0.0, ra, rb, a, b, found = 0;
     double qz = fabs(q[2]), s = fabs(q[0]) + fabs(q[1]) + qz, best = -HUGE_VAL, u[3];
     double ox = q[0] / s * (double)n, oy = q[1] / s * (double)n;
+    size_t best_k = 0;
     ra = (int)floor(ox + 0.5);
     rb = (int)floor(oy + 0.5);
     for (b = rb - 1; b <= rb + 1; b++) {
         if (b < -n || b > n) continue;
         for (a = ra - 1; a <= ra + 1; a++) {
             double dd;
+            size_t kk;
             if (abs(a) + abs(b) > n) continue;
             vx_vf_oct_dir(n, a, b, h, u);
             dd = vx_vf_dot(q, u);
-            if (!found || dd > best) {
+            kk = vx_vf_encode_index(n, abs(a) + abs(b) == n ? 0 : h, a, b);
+            if (!found || dd > best || (dd == best && kk < best_k)) {
                 best = dd;
-                best_a = a;
-                best_b = b;
+                best_k = kk;
                 found = 1;
             }
         }
     }
     HFVIS_ASSERT(found);
-    if (h && abs(best_a) + abs(best_b) == n) h = 0; /* equator: the upper copy */
-    return vx_vf_encode_index(n, h, best_a, best_b);
+    return best_k;
 }
 
 static int vx_vf_vec_ok(const double v[3])

@@ -43,7 +43,7 @@
  *   R * (covering angle, ~79 deg / n) and the 8-bit step R/127; the tests report hit/miss
  *   disagreement and mean distance error against ray casting (the oracle) per (K, D). */
 
-#define HFVIS_VISFIELD_MAX_N 1024          /* positions_n: 1..1024 (K <= 2,099,202 maps) */
+#define HFVIS_VISFIELD_MAX_N 1024          /* positions_n: 1..1024 (K <= 4,198,402 maps) */
 #define HFVIS_VISFIELD_MAX_DIR_RES 4096    /* dir_res D: 1..4096 */
 #define HFVIS_VISFIELD_U8_SCALE 254        /* 8-bit distance code q = round(254 th/(2R)), 0..254 */
 #define HFVIS_VISFIELD_U8_MISS 255         /* 8-bit miss code */
