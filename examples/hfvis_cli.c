@@ -1,6 +1,6 @@
 /* hfvis_cli.c - the `hfvis` command-line tool (DESIGN.md §4): horizon maps, sky-view factor,
- * uniform-sky light, sun shadows, environment light, normals, interreflected light and the
- * visibility index of PGM/PFM height fields.
+ * uniform-sky light, sun shadows, environment light, normals, interreflected light, the
+ * visibility index and viewsheds of PGM/PFM height fields; voxelization of OBJ meshes.
  * Every file is read and written through the library's codecs (hfvis_image_load, hfvis_*_save),
  * so the tool exercises exactly what a vendoring user gets. Errors: one line
  * "hfvis: <what>: <why>" on stderr, exit 1 (2 for usage errors); exit 0 means OUT is complete. */
@@ -30,11 +30,16 @@
 #define CLI_RUN (-1)                              /* parse_args: go on and run the command */
 
 enum { CMD_HORIZON, CMD_SKYVIEW, CMD_SKY, CMD_SHADOW, CMD_LIGHT, CMD_NORMALS, CMD_INDIRECT,
-       CMD_VISIBILITY, CMD_VIEWSHED, CMD_COUNT };
+       CMD_VISIBILITY, CMD_VIEWSHED, CMD_VOXELIZE, CMD_GI, CMD_COUNT };
 static const char *const cli_cmd_names[CMD_COUNT] = {
     "horizon", "skyview", "sky", "shadow", "light", "normals", "indirect", "visibility",
-    "viewshed"
+    "viewshed", "voxelize", "gi"
 };
+
+/* voxelize --mode, --axis, --method */
+enum { VOX_SURFACE, VOX_CONSERVATIVE, VOX_SOLID };
+enum { AXIS_DEFAULT, AXIS_DOMINANT, AXIS_ALL, AXIS_X, AXIS_Y, AXIS_Z };
+#define CLI_MAX_RES 2048 /* --res upper bound (the grid limit is 2^31 voxels) */
 
 /* indirect --output */
 enum { OUT_TOTAL, OUT_DIRECT, OUT_INDIRECT };
@@ -51,7 +56,48 @@ typedef struct cli_args {
     int has_sun_irradiance, has_sky, has_albedo, has_bounces;
     double observer_x, observer_y, observer_height, target_height, max_distance;
     int has_observer, exact;
+    int res, vox_mode, vox_axis, vox_method, max_vertices, open_mesh, out_binvox;
+    double padding;
+    int order, subsample, has_dirs, has_specular, has_shininess;
+    double specular, shininess;
 } cli_args;
+
+#define CLI_GI_HELP                                                                                  \
+    "usage: hfvis gi IN -o OUT [--dirs K] [--order O] [--subsample S] [--bounces B] [--albedo A]\n"  \
+    "         [--specular S --shininess N] [--sun-azimuth DEG --sun-elevation DEG [--sun-radius DEG]\n" \
+    "         [--sun-irradiance E]] [--sky C | --env ENV.pfm] [--output total|direct|indirect]\n"    \
+    "Direct light and interreflections with the multi-resolution method of Nowrouzezahrai &\n"     \
+    "Snyder 2009: per receiver, K azimuthal slices are scanned over a height pyramid with steps\n"  \
+    "growing by 2^(1/4); each slice's visibility and indirect light become Legendre vectors and\n"  \
+    "order-O spherical harmonics, shaded with the pixel's own normal. An approximation of\n"        \
+    "'indirect' (soft: order-4 SH), faster with --subsample 2 or 4. Lambertian radiance: an open\n" \
+    "flat receiver under a sky C with albedo A returns A*C. Default: sky 1, albedo 1, one bounce.\n" \
+    "  --dirs K              azimuthal slices, 1..4096 (default 32, the paper's)\n"                  \
+    "  --order O             SH order 1..4 (default 4)\n"                                             \
+    "  --subsample S         visibility and bounces per S x S block, 1..64 (default 1; 2 is the\n"   \
+    "                        paper's recommended trade-off)\n"                                        \
+    "  --bounces B           interreflection bounces, 0..1000 (default 1)\n"                          \
+    "  --albedo A            diffuse albedo, >= 0 (default 1)\n"                                      \
+    "  --specular S          Phong specular weight, >= 0 (default 0), seen from straight above\n"     \
+    "  --shininess N         Phong exponent, > 0 (default 32; with --specular)\n"                     \
+    "  --sun-azimuth DEG     compass bearing of the sun, degrees clockwise from north\n"              \
+    "  --math                --sun-azimuth is psi instead: degrees from east toward south\n"          \
+    "  --sun-elevation DEG   sun elevation above the horizontal, -90..90 (with --sun-azimuth)\n"      \
+    "  --sun-radius DEG      0 (default): a directional sun, hard shadows; 0..90: a key light\n"      \
+    "                        (a disc with soft SH shadows from its own restricted visibility)\n"      \
+    "  --sun-irradiance E    irradiance on a surface facing the sun, >= 0 (default pi)\n"             \
+    "  --sky C               uniform sky radiance, >= 0 (default 1; 0 for the sun alone)\n"           \
+    "  --env ENV.pfm         lat-long environment instead of the uniform sky (see 'light')\n"         \
+    "  --output WHAT         total: direct + all bounces (default); direct: no bounce (--bounces\n"   \
+    "                        not allowed); indirect: the bounces only (needs B >= 1)\n"               \
+    "--azimuth0 and --compass place the slices, --border applies to the slices and the pyramid.\n"  \
+    "OUT has the environment's channels (1 for --sky). NaN at holes. Default PGM range 0:the\n"     \
+    "largest output value.\n"
+
+#define CLI_GI_FLAGS                                                                         \
+    { "--order", 1, CLI_ONLY(CMD_GI) }, { "--subsample", 1, CLI_ONLY(CMD_GI) },              \
+    { "--specular", 1, CLI_ONLY(CMD_GI) }, { "--shininess", 1, CLI_ONLY(CMD_GI) }
+
 
 /* ------------------------------------------------------------------------------------------ */
 /* help                                                                                       */
@@ -73,8 +119,10 @@ static const char cli_usage[] =
     "  light       environment light from a lat-long PFM map\n"
     "  normals     unit surface normals (x east, y south, z up) as a 3-channel PFM\n"
     "  indirect    sun and sky light with interreflections between terrain points ([P2])\n"
+    "  gi          multi-resolution GI (Nowrouzezahrai & Snyder): sky, sun, bounces, gloss\n"
     "  visibility  visibility index: the grid samples each point sees along K directions\n"
-    "  viewshed    which samples an observer at one point sees (line of sight)\n";
+    "  viewshed    which samples an observer at one point sees (line of sight)\n"
+    "  voxelize    voxels of an OBJ mesh: surface, conservative or solid (.binvox or .raw)\n";
 
 static const char cli_shared_help[] =
     "\n"
@@ -211,7 +259,37 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "                        0 = unlimited (default)\n"
     "  --exact               the exact line-of-sight oracle instead (half-cell march per\n"
     "                        sample): O(W*H*max(W, H)), 4 s at 1024 x 1024\n"
-    "--dirs, --azimuth0, --compass, --degrees and --border do not apply. Default PGM range 0:1.\n"
+    "--dirs, --azimuth0, --compass, --degrees and --border do not apply. Default PGM range 0:1.\n",
+
+    "usage: hfvis voxelize MESH.obj --res N [--mode surface|conservative|solid] [--axis A]\n"
+    "         [--method pixel|slicing|clipping] [--max-vertices V] [--padding F] [--open]\n"
+    "         -o OUT.binvox|OUT.raw\n"
+    "Voxels of a triangle mesh (Wavefront OBJ: v and f lines, polygons fanned). The grid has\n"
+    "cubic voxels, N of them along the longest side of the mesh's bounding box (enlarged by F\n"
+    "times that side on every side), the other sides rounded up and centred.\n"
+    "  --res N           voxels along the longest side, 1..2048 (required)\n"
+    "  --mode M          surface (default): the voxels that hold a pixel-centre sample of a\n"
+    "                    triangle in the sweep along its dominant axis ([G12] ch. 6, 6-separating\n"
+    "                    with --axis all); conservative: every voxel a triangle touches (exact\n"
+    "                    triangle-box overlap); solid: the voxels whose centre is inside the\n"
+    "                    mesh, by ray parity (the mesh must be closed unless --open)\n"
+    "  --axis A          surface: dominant (default), all (three sweeps merged, [G12] Alg. 4) or\n"
+    "                    x, y, z (one sweep); solid: the parity ray direction x, y or z (default z)\n"
+    "  --method M        surface: pixel (the pixel-centre rule, default), slicing (geometry-shader\n"
+    "                    triangle slicing, [G12] Alg. 5) or clipping (fragment clipping, Alg. 6)\n"
+    "  --max-vertices V  slicing/clipping: the geometry shader's output-vertex limit; triangles\n"
+    "                    spanning more slabs than it allows leave holes, as in the thesis\n"
+    "                    (slicing V >= 7, clipping V >= 3; default unlimited)\n"
+    "  --padding F       empty margin around the mesh, a fraction of its longest side, 0..1\n"
+    "                    (default 0)\n"
+    "  --open            solid: leave columns that cross an open mesh an odd number of times\n"
+    "                    empty instead of failing\n"
+    "OUT: *.binvox (the binvox format of viewvox/binvox: a cube of the largest side, run-length\n"
+    "coded, translate and scale of the grid) or *.raw (one byte per voxel, 0 or 1, x fastest,\n"
+    "then y, then z; the dimensions are printed). Prints the grid and the voxel count unless\n"
+    "--quiet. Only -o and --quiet of the shared options apply.\n",
+
+    CLI_GI_HELP
 };
 
 /* ------------------------------------------------------------------------------------------ */
@@ -330,33 +408,85 @@ static int cli_ends_with(const char *s, const char *ext)
     return 1;
 }
 
+/* The flags only `gi` has; -1 if f is none of them. */
+static int cli_set_gi(cli_args *a, const char *f, const char *v)
+{
+    if (!strcmp(f, "--order")) return cli_int(f, v, 1, 4, "an integer 1..4", &a->order);
+    if (!strcmp(f, "--subsample"))
+        return cli_int(f, v, 1, HFVIS_NS_MAX_SUBSAMPLE, "an integer 1..64", &a->subsample);
+    if (!strcmp(f, "--specular")) {
+        a->has_specular = 1;
+        return cli_real(f, v, 0.0, 0, CLI_FLT_MAX, "a weight >= 0", &a->specular);
+    }
+    if (!strcmp(f, "--shininess")) {
+        a->has_shininess = 1;
+        return cli_real(f, v, 0.0, 1, CLI_FLT_MAX, "an exponent > 0", &a->shininess);
+    }
+    return -1;
+}
+
+/* Combinations `gi` rejects; returns 0 or CLI_EXIT_USAGE (message printed). */
+static int cli_check_gi(const cli_args *a)
+{
+    int sun = a->has_sun_azimuth || a->has_sun_elevation;
+    if (a->has_sun_azimuth && !a->has_sun_elevation)
+        return cli_error(CLI_EXIT_USAGE, "--sun-azimuth", "needs --sun-elevation DEG");
+    if (a->has_sun_elevation && !a->has_sun_azimuth)
+        return cli_error(CLI_EXIT_USAGE, "--sun-elevation", "needs --sun-azimuth DEG");
+    if (!sun && (a->has_sun_radius || a->has_sun_irradiance || a->math))
+        return cli_error(CLI_EXIT_USAGE, a->has_sun_radius ? "--sun-radius" :
+                         a->has_sun_irradiance ? "--sun-irradiance" : "--math",
+                         "needs a sun (--sun-azimuth and --sun-elevation)");
+    if (a->has_shininess && !a->has_specular)
+        return cli_error(CLI_EXIT_USAGE, "--shininess", "needs --specular S");
+    if (a->has_sky && a->env)
+        return cli_error(CLI_EXIT_USAGE, "--env", "cannot be combined with --sky");
+    if (a->output == OUT_DIRECT && a->has_bounces)
+        return cli_error(CLI_EXIT_USAGE, "--bounces", "has no effect with --output direct");
+    if (a->output == OUT_INDIRECT && a->bounces < 1)
+        return cli_error(CLI_EXIT_USAGE, "--output indirect", "needs --bounces >= 1");
+    return 0;
+}
+
 #define CLI_ALL ((1u << CMD_COUNT) - 1u)
 #define CLI_ONLY(c) (1u << (c))
-#define CLI_SUN (CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_INDIRECT)) /* the sun flags */
+#define CLI_SUN (CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI)) /* the sun flags */
 typedef struct cli_flag { const char *name; int has_value; unsigned commands; } cli_flag;
 static const cli_flag cli_flags[] = {
     { "-o", 1, CLI_ALL },           { "--range", 1, CLI_ALL },       { "--cell", 1, CLI_ALL },
     { "--zscale", 1, CLI_ALL },     { "--nodata", 1, CLI_ALL },      { "--dirs", 1, CLI_ALL },
     { "--azimuth0", 1, CLI_ALL },   { "--compass", 0, CLI_ALL },     { "--degrees", 0, CLI_ALL },
     { "--border", 1, CLI_ALL },     { "--border-cells", 1, CLI_ALL }, { "--quiet", 0, CLI_ALL },
-    { "--sky", 1, CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) },
-    { "--albedo", 1, CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) },
+    { "--sky", 1, CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
+    { "--albedo", 1, CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
     { "--sun-azimuth", 1, CLI_SUN },              { "--sun-elevation", 1, CLI_SUN },
     { "--sun-radius", 1, CLI_SUN },               { "--math", 0, CLI_SUN },
-    { "--env", 1, CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) },
-    { "--method", 1, CLI_ONLY(CMD_LIGHT) },
-    { "--sun-irradiance", 1, CLI_ONLY(CMD_INDIRECT) }, { "--albedo-map", 1, CLI_ONLY(CMD_INDIRECT) },
-    { "--emission", 1, CLI_ONLY(CMD_INDIRECT) },  { "--bounces", 1, CLI_ONLY(CMD_INDIRECT) },
-    { "--output", 1, CLI_ONLY(CMD_INDIRECT) },
+    { "--env", 1, CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
+    { "--method", 1, CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VOXELIZE) },
+    { "--sun-irradiance", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) }, { "--albedo-map", 1, CLI_ONLY(CMD_INDIRECT) },
+    { "--emission", 1, CLI_ONLY(CMD_INDIRECT) },  { "--bounces", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
+    { "--output", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
     { "--fraction", 0, CLI_ONLY(CMD_VISIBILITY) }, { "--stats", 0, CLI_ONLY(CMD_VISIBILITY) },
     { "--observer", 1, CLI_ONLY(CMD_VIEWSHED) },  { "--observer-height", 1, CLI_ONLY(CMD_VIEWSHED) },
     { "--target-height", 1, CLI_ONLY(CMD_VIEWSHED) }, { "--max-distance", 1, CLI_ONLY(CMD_VIEWSHED) },
-    { "--exact", 0, CLI_ONLY(CMD_VIEWSHED) }
+    { "--exact", 0, CLI_ONLY(CMD_VIEWSHED) },
+    { "--res", 1, CLI_ONLY(CMD_VOXELIZE) },       { "--mode", 1, CLI_ONLY(CMD_VOXELIZE) },
+    { "--axis", 1, CLI_ONLY(CMD_VOXELIZE) },  
+    { "--max-vertices", 1, CLI_ONLY(CMD_VOXELIZE) }, { "--padding", 1, CLI_ONLY(CMD_VOXELIZE) },
+    { "--open", 0, CLI_ONLY(CMD_VOXELIZE) },
+    CLI_GI_FLAGS
 };
 
 /* Apply one recognised flag; returns 0 or CLI_EXIT_USAGE (message printed). */
 static int cli_set(cli_args *a, const char *f, const char *v)
 {
+    if (!strcmp(f, "-o") && a->cmd == CMD_VOXELIZE) {
+        if (cli_ends_with(v, ".binvox")) a->out_binvox = 1;
+        else if (cli_ends_with(v, ".raw")) a->out_binvox = 0;
+        else return cli_error(CLI_EXIT_USAGE, v, "unknown output type (use a .binvox or .raw name)");
+        a->out = v;
+        return 0;
+    }
     if (!strcmp(f, "-o")) {
         if (cli_ends_with(v, ".pfm")) a->out_pgm = 0;
         else if (cli_ends_with(v, ".pgm")) a->out_pgm = 1;
@@ -390,6 +520,7 @@ static int cli_set(cli_args *a, const char *f, const char *v)
         a->has_nodata = 1;
         return cli_real(f, v, -CLI_FLT_MAX, 0, CLI_FLT_MAX, "a finite number", &a->nodata);
     }
+    if (!strcmp(f, "--dirs")) a->has_dirs = 1;
     if (!strcmp(f, "--dirs")) return cli_int(f, v, 1, CLI_MAX_DIRS, "an integer 1..65536", &a->dirs);
     if (!strcmp(f, "--azimuth0"))
         return cli_real(f, v, -DBL_MAX, 0, DBL_MAX, "a finite angle in radians", &a->azimuth0);
@@ -466,6 +597,36 @@ static int cli_set(cli_args *a, const char *f, const char *v)
     if (!strcmp(f, "--max-distance"))
         return cli_real(f, v, 0.0, 0, DBL_MAX, "a distance >= 0", &a->max_distance);
     if (!strcmp(f, "--exact")) { a->exact = 1; return 0; }
+    if (!strcmp(f, "--res")) return cli_int(f, v, 1, CLI_MAX_RES, "an integer 1..2048", &a->res);
+    if (!strcmp(f, "--max-vertices"))
+        return cli_int(f, v, 1, 1000000, "an integer 1..1000000", &a->max_vertices);
+    if (!strcmp(f, "--padding")) return cli_real(f, v, 0.0, 0, 1.0, "a fraction in 0..1", &a->padding);
+    if (!strcmp(f, "--open")) { a->open_mesh = 1; return 0; }
+    if (!strcmp(f, "--mode")) {
+        if (!strcmp(v, "surface")) a->vox_mode = VOX_SURFACE;
+        else if (!strcmp(v, "conservative")) a->vox_mode = VOX_CONSERVATIVE;
+        else if (!strcmp(v, "solid")) a->vox_mode = VOX_SOLID;
+        else return cli_error(CLI_EXIT_USAGE, f, "expected surface, conservative or solid, got '%s'", v);
+        return 0;
+    }
+    if (!strcmp(f, "--axis")) {
+        static const char *const names[] = {"", "dominant", "all", "x", "y", "z"};
+        int k;
+        for (k = AXIS_DOMINANT; k <= AXIS_Z; k++)
+            if (!strcmp(v, names[k])) { a->vox_axis = k; return 0; }
+        return cli_error(CLI_EXIT_USAGE, f, "expected dominant, all, x, y or z, got '%s'", v);
+    }
+    {
+        int r = cli_set_gi(a, f, v);
+        if (r >= 0) return r;
+    }
+    if (a->cmd == CMD_VOXELIZE) { /* --method of voxelize */
+        if (!strcmp(v, "pixel")) a->vox_method = HFVIS_VOXELIZE_PIXEL_RULE;
+        else if (!strcmp(v, "slicing")) a->vox_method = HFVIS_VOXELIZE_GS_SLICING;
+        else if (!strcmp(v, "clipping")) a->vox_method = HFVIS_VOXELIZE_FRAGMENT_CLIPPING;
+        else return cli_error(CLI_EXIT_USAGE, f, "expected pixel, slicing or clipping, got '%s'", v);
+        return 0;
+    }
     /* --method */
     if (!strcmp(v, "prefix")) a->method = HFVIS_ENV_PREFIX;
     else if (!strcmp(v, "lp")) a->method = HFVIS_ENV_LP_TABLE;
@@ -481,6 +642,7 @@ static int cli_parse(int argc, char **argv, cli_args *a)
     a->cell = 1.0; a->zscale = 1.0; a->dirs = 16; a->sky = 1.0; a->albedo = 1.0;
     a->border = HFVIS_BORDER_OPEN; a->method = HFVIS_ENV_PREFIX;
     a->bounces = 1; a->sun_irradiance = CLI_PI; a->output = OUT_TOTAL;
+    a->order = 4; a->subsample = 1;
     if (argc < 2) return cli_error(CLI_EXIT_USAGE, "usage", "missing COMMAND (try 'hfvis --help')");
     if (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help") || !strcmp(argv[1], "help")) {
         if (argc > 2 && strcmp(argv[1], "help") == 0) {
@@ -543,6 +705,21 @@ static int cli_parse(int argc, char **argv, cli_args *a)
         return cli_error(CLI_EXIT_USAGE, "shadow", "missing --sun-elevation DEG");
     if (a->cmd == CMD_VIEWSHED && !a->has_observer)
         return cli_error(CLI_EXIT_USAGE, "viewshed", "missing --observer X,Y");
+    if (a->cmd == CMD_VOXELIZE) {
+        const char *m = a->vox_mode == VOX_SOLID ? "solid" : "conservative";
+        if (!a->res) return cli_error(CLI_EXIT_USAGE, "voxelize", "missing --res N");
+        if (a->vox_mode != VOX_SURFACE && (a->vox_method != HFVIS_VOXELIZE_PIXEL_RULE || a->max_vertices))
+            return cli_error(CLI_EXIT_USAGE, a->max_vertices ? "--max-vertices" : "--method",
+                             "applies only to --mode surface, not %s", m);
+        if (a->vox_mode == VOX_CONSERVATIVE && a->vox_axis != AXIS_DEFAULT)
+            return cli_error(CLI_EXIT_USAGE, "--axis", "does not apply to --mode conservative");
+        if (a->vox_mode == VOX_SOLID && (a->vox_axis == AXIS_DOMINANT || a->vox_axis == AXIS_ALL))
+            return cli_error(CLI_EXIT_USAGE, "--axis", "--mode solid takes x, y or z");
+        if (a->open_mesh && a->vox_mode != VOX_SOLID)
+            return cli_error(CLI_EXIT_USAGE, "--open", "applies only to --mode solid");
+        if (a->max_vertices && a->vox_method == HFVIS_VOXELIZE_PIXEL_RULE)
+            return cli_error(CLI_EXIT_USAGE, "--max-vertices", "needs --method slicing or clipping");
+    }
     if (a->cmd == CMD_LIGHT && !a->env)
         return cli_error(CLI_EXIT_USAGE, "light", "missing --env ENV.pfm");
     if (a->cmd == CMD_INDIRECT) {
@@ -564,6 +741,7 @@ static int cli_parse(int argc, char **argv, cli_args *a)
         if (a->output == OUT_INDIRECT && a->bounces < 1)
             return cli_error(CLI_EXIT_USAGE, "--output indirect", "needs --bounces >= 1");
     }
+    if (a->cmd == CMD_GI && cli_check_gi(a)) return CLI_EXIT_USAGE;
     return CLI_RUN;
 }
 
@@ -789,6 +967,88 @@ done:
     return rc;
 }
 
+/* gi: hfvis_ns_gi with a uniform sky or a projected environment, and an optional sun. */
+static int cli_run_gi(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
+                  cli_progress_state *prog)
+{
+    const char *cmd = "gi";
+    const int w = grid->width, h = grid->height;
+    const size_t n = (size_t)w * (size_t)h;
+    const int bounces = a->output == OUT_DIRECT ? 0 : a->bounces;
+    float *env_px = NULL, *direct = NULL, *bounce = NULL, *out = NULL;
+    double env_sh[4 * HFVIS_SH_COEFFS];
+    int channels = 1, rc = 0, c, b;
+    hfvis_env env;
+    hfvis_sun sun;
+    hfvis_ns_scene scene;
+    hfvis_ns_gi_options o = hfvis_ns_gi_options_default();
+    hfvis_ns_gi_outputs res;
+    hfvis_status s;
+    size_t i;
+
+    memset(&env, 0, sizeof env);
+    memset(&sun, 0, sizeof sun);
+    memset(&scene, 0, sizeof scene);
+    memset(&res, 0, sizeof res);
+    memset(env_sh, 0, sizeof env_sh);
+    if (a->env) {
+        if ((rc = cli_load_env(a->env, &env_px, &env)) != 0) goto done;
+        channels = env.channels;
+        s = hfvis_sh_project_env(&env, env_sh); /* the environment as order-4 SH ([NS09] §7) */
+        if (s != HFVIS_OK) { rc = cli_status(a->env, s, 0); goto done; }
+    } else {
+        env_sh[0] = 2.0 * sqrt(CLI_PI) * a->sky; /* a uniform sky c: Int c Y_00 = 2 sqrt(pi) c */
+    }
+    scene.channels = channels;
+    scene.env_sh = env_sh;
+    for (c = 0; c < 4; c++) scene.albedo[c] = (float)a->albedo;
+    scene.specular = (float)a->specular;
+    scene.shininess = (float)(a->has_shininess ? a->shininess : 32.0);
+    if (a->has_sun_azimuth) {
+        double psi_deg = a->math ? a->sun_azimuth : a->sun_azimuth - 90.0;
+        sun.azimuth_rad = psi_deg * (CLI_PI / 180.0);
+        sun.elevation_rad = a->sun_elevation * (CLI_PI / 180.0);
+        sun.radius_rad = a->sun_radius * (CLI_PI / 180.0);
+        for (c = 0; c < 4; c++) sun.irradiance[c] = (float)a->sun_irradiance;
+        scene.lights = &sun;
+        scene.light_count = 1;
+    }
+    o.directions = a->has_dirs ? a->dirs : 32;
+    o.sh_order = a->order;
+    o.subsample = a->subsample;
+    o.border = opts->border;
+    o.azimuth0_rad = opts->azimuth0_rad;
+    o.key_mode = HFVIS_NS_KEY_RATIO; /* a disc sun keeps its brightness (see hfvis.h) */
+    o.progress = opts->progress;
+    o.progress_user = opts->progress_user;
+    prog->total = 0; /* the library reports receiver rows over all passes */
+
+    direct = cli_alloc(n, (size_t)channels, 1);
+    out = cli_alloc(n, (size_t)channels, 1);
+    if (bounces > 0) bounce = cli_alloc(n, (size_t)channels, (size_t)bounces);
+    if (!direct || !out || (bounces > 0 && !bounce)) {
+        rc = cli_status(cmd, HFVIS_ERR_OUT_OF_MEMORY, 0);
+        goto done;
+    }
+    res.bounces = bounces;
+    res.direct = direct;
+    res.bounce = bounce;
+    s = hfvis_ns_gi(grid, &scene, &o, &res);
+    if (s != HFVIS_OK) { rc = cli_status(cmd, s, 0); goto done; }
+    for (i = 0; i < n * (size_t)channels; i++) {
+        double v = a->output == OUT_INDIRECT ? 0.0 : (double)direct[i];
+        for (b = 0; b < bounces; b++) v += (double)bounce[(size_t)b * n * (size_t)channels + i];
+        out[i] = (float)v;
+    }
+    rc = cli_save(a, out, w, h, channels, 0.0, cli_top(out, n * (size_t)channels, 1.0));
+done:
+    free(out);
+    free(bounce);
+    free(direct);
+    hfvis_free(NULL, env_px);
+    return rc;
+}
+
 /* visibility: hfvis_visibility_count; --fraction divides by the count on a flat field with the
  * same holes (where every sample is visible); --stats prints the counters after OUT is written. */
 static int cli_run_visibility(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
@@ -842,6 +1102,73 @@ static int cli_run_visibility(const cli_args *a, const hfvis_grid *grid, hfvis_s
     return rc;
 }
 
+/* voxelize: MESH.obj -> a cubic-voxel grid fitted to the mesh -> .binvox or .raw. */
+static int cli_run_voxelize(const cli_args *a)
+{
+    hfvis_mesh mesh;
+    hfvis_volume_grid grid;
+    uint8_t *occ = NULL;
+    size_t voxels, count = 0, i;
+    hfvis_status s;
+    int rc = 0;
+    errno = 0;
+    s = hfvis_mesh_load(a->in, NULL, &mesh);
+    if (s != HFVIS_OK) return cli_status(a->in, s, errno);
+    s = hfvis_volume_grid_fit(&mesh, a->res, a->padding, 1, &grid);
+    if (s == HFVIS_ERR_INVALID_ARGUMENT && mesh.triangle_count == 0) {
+        rc = cli_error(CLI_EXIT_ERROR, a->in, "the mesh has no triangles");
+        goto done;
+    }
+    if (s != HFVIS_OK) { rc = cli_status("voxelize", s, 0); goto done; }
+    voxels = (size_t)grid.dims[0] * (size_t)grid.dims[1] * (size_t)grid.dims[2];
+    occ = (uint8_t *)malloc(voxels);
+    if (!occ) { rc = cli_status("voxelize", HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
+    if (a->vox_mode == VOX_SURFACE) {
+        hfvis_voxelize_options o = hfvis_voxelize_options_default();
+        static const hfvis_voxelize_axes axes[] = {HFVIS_AXES_DOMINANT, HFVIS_AXES_DOMINANT,
+                                                   HFVIS_AXES_ALL, HFVIS_AXES_ONLY_X,
+                                                   HFVIS_AXES_ONLY_Y, HFVIS_AXES_ONLY_Z};
+        o.method = (hfvis_voxelize_method)a->vox_method;
+        o.axes = axes[a->vox_axis];
+        o.max_output_vertices = a->max_vertices;
+        if (a->max_vertices && hfvis_gs_max_slices(a->max_vertices,
+                                                   o.method == HFVIS_VOXELIZE_FRAGMENT_CLIPPING) == 0) {
+            rc = cli_error(CLI_EXIT_USAGE, "--max-vertices", "%d vertices hold no slab (slicing "
+                           "needs >= 7, clipping >= 3)", a->max_vertices);
+            goto done;
+        }
+        s = hfvis_voxelize_occupancy(&mesh, &grid, &o, occ);
+        for (i = 0; s == HFVIS_OK && i < voxels; i++) count += occ[i];
+    } else {
+        hfvis_binary_voxel_options o = hfvis_binary_voxel_options_default();
+        if (a->vox_mode == VOX_CONSERVATIVE) {
+            s = hfvis_voxelize_conservative(&mesh, &grid, &o, occ, &count);
+        } else {
+            o.axis = a->vox_axis == AXIS_X ? HFVIS_PARITY_AXIS_X
+                     : a->vox_axis == AXIS_Y ? HFVIS_PARITY_AXIS_Y : HFVIS_PARITY_AXIS_Z;
+            o.allow_open = a->open_mesh;
+            s = hfvis_voxelize_solid(&mesh, &grid, &o, occ, &count);
+            if (s == HFVIS_ERR_FORMAT) {
+                rc = cli_error(CLI_EXIT_ERROR, a->in, "the mesh is not closed (a parity ray "
+                               "crosses it an odd number of times); use --open or --mode surface");
+                goto done;
+            }
+        }
+    }
+    if (s != HFVIS_OK) { rc = cli_status("voxelize", s, 0); goto done; }
+    errno = 0;
+    s = a->out_binvox ? hfvis_binvox_save(a->out, &grid, occ) : hfvis_voxels_raw_save(a->out, &grid, occ);
+    if (s != HFVIS_OK) { rc = cli_status(a->out, s, errno); goto done; }
+    if (!a->quiet)
+        printf("voxelize: %zu triangles -> %d x %d x %d voxels of %.6g (origin %.6g %.6g %.6g), "
+               "%zu set\n", mesh.triangle_count, grid.dims[0], grid.dims[1], grid.dims[2],
+               grid.cell[0], grid.origin[0], grid.origin[1], grid.origin[2], count);
+done:
+    free(occ);
+    hfvis_mesh_free(NULL, &mesh);
+    return rc;
+}
+
 static int cli_run(const cli_args *a)
 {
     const char *cmd = cli_cmd_names[a->cmd];
@@ -854,6 +1181,7 @@ static int cli_run(const cli_args *a)
     hfvis_env env;
     hfvis_status s = HFVIS_OK;
 
+    if (a->cmd == CMD_VOXELIZE) return cli_run_voxelize(a);
     memset(&env, 0, sizeof env);
     if ((rc = cli_load_heights(a, &z, &w, &h)) != 0) return rc;
     grid.z = z; grid.width = w; grid.height = h; grid.stride = w; grid.cell_size = a->cell;
@@ -868,6 +1196,7 @@ static int cli_run(const cli_args *a)
     rc = 0;
     if (a->cmd == CMD_INDIRECT) { rc = cli_run_indirect(a, &grid, &opts, &prog); goto done; }
     if (a->cmd == CMD_VISIBILITY) { rc = cli_run_visibility(a, &grid, &opts, &prog); goto done; }
+    if (a->cmd == CMD_GI) { rc = cli_run_gi(a, &grid, &opts, &prog); goto done; }
     if (a->cmd == CMD_HORIZON) {
         size_t values = (size_t)w * (size_t)h; /* <= 2^28, so the product below cannot overflow */
         planes = a->dirs;

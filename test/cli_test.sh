@@ -107,7 +107,7 @@ expect_line2() { # NAME FILE WANT: the second header line (PFM dimensions)
 # ---- help ---------------------------------------------------------------------------------
 if "$hfvis" --help > "$dir/stdout" 2> "$dir/stderr" && grep -q '^usage: hfvis' "$dir/stdout" && [ ! -s "$dir/stderr" ]
 then ok "--help"; else bad "--help"; fi
-for c in horizon skyview sky shadow light normals indirect visibility viewshed; do
+for c in horizon skyview sky shadow light normals indirect visibility viewshed voxelize gi; do
   if "$hfvis" $c --help > "$dir/stdout" 2>&1 && grep -q "^usage: hfvis $c" "$dir/stdout"
   then ok "$c --help"; else bad "$c --help"; fi
 done
@@ -211,6 +211,24 @@ expect_ok "viewshed --max-distance" "$dir/vsm.pfm" viewshed "$f" --observer 7,0 
 expect_floats "viewshed --max-distance: NaN beyond 2 cells" "$dir/vsm.pfm" 32 0 nan nan nan nan nan 1 1 1
 expect_ok "viewshed hill pgm, eye and target heights" "$dir/vsh.pgm" viewshed "$h" --observer 3.5,2 --observer-height 1.5 --target-height 0.5 -o "$dir/vsh.pgm"
 expect_ok "viewshed with a hole" "$dir/vs7.pfm" viewshed "$dir/flat7.pgm" --nodata 7 --observer 7,5 -o "$dir/vs7.pfm"
+
+# gi (Nowrouzezahrai-Snyder): flat ground under a uniform sky returns albedo*sky, no bounce light.
+expect_ok "gi flat" "$dir/gif.pfm" gi "$f" --sky 2 --albedo 0.5 --bounces 2 -o "$dir/gif.pfm"
+expect_last_float "gi flat under sky 2, albedo 0.5 = 1" "$dir/gif.pfm" 1 1e-4
+expect_ok "gi hill, sun, specular, subsample" "$dir/gih.pgm" gi "$h" --sun-azimuth 135 --sun-elevation 30 --specular 0.2 --subsample 2 --order 2 -o "$dir/gih.pgm"
+
+# voxelize: the unit cube (8 vertices, 12 triangles) in a 4^3 grid: solid fills all 64 voxels,
+# conservative the 56 that touch a face, surface (pixel-centre rule) one layer per face.
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n' > "$dir/cube.obj"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > "$dir/tri.obj"
+expect_ok "voxelize solid" "$dir/cs.raw" voxelize "$dir/cube.obj" --res 4 --mode solid -o "$dir/cs.raw"
+grep -q '4 x 4 x 4 voxels.*, 64 set' "$dir/stdout" && ok "voxelize solid: 64 voxels" || bad "voxelize solid: $(cat "$dir/stdout")"
+[ "$(wc -c < "$dir/cs.raw" | tr -d ' ')" = 64 ] && ok "voxelize raw: 64 bytes" || bad "voxelize raw size"
+expect_ok "voxelize conservative" "$dir/cc.binvox" voxelize "$dir/cube.obj" --res 4 --mode conservative -o "$dir/cc.binvox"
+grep -q ', 56 set' "$dir/stdout" && ok "voxelize conservative: 56 voxels" || bad "voxelize conservative: $(cat "$dir/stdout")"
+head -n 1 "$dir/cc.binvox" | grep -q '^#binvox 1' && ok "voxelize binvox header" || bad "voxelize binvox header"
+expect_ok "voxelize surface, all axes, slicing" "$dir/cv.binvox" voxelize "$dir/cube.obj" --res 8 --axis all --method slicing --max-vertices 11 --padding 0.1 -o "$dir/cv.binvox"
+expect_ok "voxelize solid --axis x --open" "$dir/co.raw" voxelize "$dir/tri.obj" --res 4 --mode solid --axis x --open -o "$dir/co.raw"
 expect_floats "viewshed: the hole is NaN" "$dir/vs7.pfm" 32 0 nan 1 1 1 1 1 1 1
 expect_ok "visibility flat, 4 directions" "$dir/fv4.pfm" visibility "$f" --dirs 4 --stats -o "$dir/fv4.pfm"
 expect_floats "visibility flat, 4 directions: 12" "$dir/fv4.pfm" 32 0 12 12 12 12 12 12 12 12
@@ -303,6 +321,22 @@ expect_fail "viewshed observer outside the grid" 1 viewshed "$h" --observer 24,0
 expect_fail "viewshed --observer-height -1" 2 viewshed "$h" --observer 1,1 --observer-height -1 -o "$o"
 expect_fail "viewshed --sky" 2 viewshed "$h" --observer 1,1 --sky 1 -o "$o"
 expect_fail "shadow --observer" 2 shadow "$h" --observer 1,1 --sun-azimuth 1 --sun-elevation 1 -o "$o"
+ob=$fdir/out.binvox
+expect_fail "voxelize without --res" 2 voxelize "$dir/cube.obj" -o "$ob"
+expect_fail "voxelize to .pfm" 2 voxelize "$dir/cube.obj" --res 4 -o "$o"
+expect_fail "voxelize --mode bogus" 2 voxelize "$dir/cube.obj" --res 4 --mode bogus -o "$ob"
+expect_fail "voxelize --res 0" 2 voxelize "$dir/cube.obj" --res 0 -o "$ob"
+expect_fail "voxelize solid --axis all" 2 voxelize "$dir/cube.obj" --res 4 --mode solid --axis all -o "$ob"
+expect_fail "voxelize --max-vertices with the pixel rule" 2 voxelize "$dir/cube.obj" --res 4 --max-vertices 7 -o "$ob"
+expect_fail "voxelize slicing --max-vertices 5" 2 voxelize "$dir/cube.obj" --res 4 --method slicing --max-vertices 5 -o "$ob"
+expect_fail "voxelize --open surface" 2 voxelize "$dir/cube.obj" --res 4 --open -o "$ob"
+expect_fail "voxelize an open mesh solid" 1 voxelize "$dir/tri.obj" --res 4 --mode solid -o "$ob"
+expect_fail "voxelize garbage" 1 voxelize "$dir/garbage.pgm" --res 4 -o "$ob"
+expect_fail "voxelize missing file" 1 voxelize "$dir/none.obj" --res 4 -o "$ob"
+expect_fail "gi --shininess without --specular" 2 gi "$h" --shininess 8 -o "$o"
+expect_fail "gi --order 5" 2 gi "$h" --order 5 -o "$o"
+expect_fail "gi --sun-azimuth alone" 2 gi "$h" --sun-azimuth 90 -o "$o"
+expect_fail "gi garbage" 1 gi "$dir/garbage.pgm" -o "$o"
 expect_fail "horizon over the size limit" 1 horizon "$dir/big.pgm" --dirs 65536 -o "$o"
 grep -q 'HFVIS_ERR_LIMIT' "$dir/stderr" && ok "horizon limit names HFVIS_ERR_LIMIT" || bad "horizon limit names HFVIS_ERR_LIMIT"
 
