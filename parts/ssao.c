@@ -1459,6 +1459,27 @@ static void ss_lsao_sweep_dir(const ss_cam *c, const ss_cfg *g, const float *dep
     }
 }
 
+/* A caller's lattice is consistent: every line within max_line_samples and sample_count, the
+ * lines stored back to back (the buffers and the scratch are sized from these counts). */
+static int ss_lattice_ok(const hfvis_ssao_lattice *L, const hfvis_ssao_line *lines)
+{
+    size_t off = 0;
+    int j;
+    if (!L || !lines || !ss_dir_ok(&L->dir) || L->line_count < 0 || L->max_line_samples < 0 ||
+        !ss_finite(L->s_first) || !ss_finite(L->t_min) || !ss_finite(L->px) || !ss_finite(L->py))
+        return 0;
+    for (j = 0; j < L->line_count; j++) {
+        const hfvis_ssao_line *ln = &lines[j];
+        if (ln->count < 0 || ln->count > L->max_line_samples || ln->offset != off ||
+            !ss_finite(ln->x0) || !ss_finite(ln->y0) ||
+            (ln->count > 0 && ln->first > INT_MAX - ln->count))
+            return 0;
+        off += (size_t)ln->count;
+        if (off > L->sample_count) return 0;
+    }
+    return 1;
+}
+
 static hfvis_status ss_lsao_direction(const hfvis_camera *cam, const float *depth,
                                       const float *normals, const hfvis_lsao_options *opts,
                                       const hfvis_ssao_lattice *lat, const hfvis_ssao_line *lines,
@@ -1471,8 +1492,7 @@ static hfvis_status ss_lsao_direction(const hfvis_camera *cam, const float *dept
     void *blk;
     float *nrm = NULL;
     if (ss_cam_load(cam, &c) != HFVIS_OK || hfvis_lsao_options_resolve(opts, &o) != HFVIS_OK ||
-        !depth || !lat || !lines || !values || !ss_dir_ok(&lat->dir) || lat->line_count < 0 ||
-        lat->max_line_samples < 0)
+        !depth || !values || !ss_lattice_ok(lat, lines))
         return HFVIS_ERR_INVALID_ARGUMENT;
     ss_cfg_from_lsao(&o, &g);
     M = (size_t)lat->max_line_samples;
@@ -1654,8 +1674,8 @@ hfvis_status hfvis_lsao_gather(const hfvis_camera *cam, const float *depth, cons
     ss_cfg g;
     hfvis_lsao_options o;
     if (ss_cam_load(cam, &c) != HFVIS_OK || hfvis_lsao_options_resolve(opts, &o) != HFVIS_OK ||
-        !depth || !lat || !lines || !values || !sample_depth || !sum || !weight ||
-        !ss_dir_ok(&lat->dir) || !ss_finite(lat->dir.weight))
+        !depth || !values || !sample_depth || !sum || !weight || !ss_lattice_ok(lat, lines) ||
+        !ss_finite(lat->dir.weight))
         return HFVIS_ERR_INVALID_ARGUMENT;
     ss_cfg_from_lsao(&o, &g);
     ss_gather_dir(&c, &g, depth, normals, lat, lines, values, sample_depth, sum, weight);
@@ -1701,7 +1721,7 @@ hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth, const float
     if (ao_stride < W) return HFVIS_ERR_INVALID_ARGUMENT;
     ss_cfg_from_lsao(&o, &g);
     K = o.directions;
-    npix = (size_t)W * (size_t)H;
+    if (!ss_mul((size_t)W, (size_t)H, &npix)) return HFVIS_ERR_LIMIT;
     dirs = (hfvis_ssao_direction *)ss_alloc(o.alloc, sizeof *dirs * (size_t)K);
     if (!dirs) return HFVIS_ERR_OUT_OF_MEMORY;
     ss_lsao_dirs(&o, dirs);
@@ -1718,8 +1738,8 @@ hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth, const float
         if (!b || !(nrm = (float *)ss_alloc(o.alloc, b))) goto done;
         ss_normals_fill(&c, depth, nrm);
     }
-    if (!(lines = (hfvis_ssao_line *)ss_alloc(o.alloc, sizeof *lines * (size_t)(maxl > 0 ? maxl : 1))))
-        goto done;
+    b = ss_bytes3((size_t)(maxl > 0 ? maxl : 1), 1, sizeof *lines);
+    if (!b || !(lines = (hfvis_ssao_line *)ss_alloc(o.alloc, b))) goto done;
     b = ss_bytes3(maxs > 0 ? maxs : 1, 2, sizeof(float));
     if (!b || !(vals = (float *)ss_alloc(o.alloc, b))) goto done;
     b = ss_bytes3((size_t)(maxm > 0 ? maxm : 1), 1, 4 * sizeof(double) + sizeof(int));

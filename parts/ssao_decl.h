@@ -415,9 +415,11 @@ HFVIS_API hfvis_status hfvis_lsao_line_naive(const double *x, const double *y,
  * hfvis_lsao_line. Real tangents: the normal of the sample's texel projected into the plane,
  * t = (-n.y, n.x) (toward the occluders), sin t = t.u/|t| (fixed_sin_t where the normal is
  * (0,0,0) or perpendicular to the plane); normals NULL: reconstructed with
- * hfvis_depth_normals. Allocates 1 block of 44*max_line_samples bytes (+ 12*stride*height
+ * hfvis_depth_normals. Allocates 1 block of 36*max_line_samples bytes (+ 12*stride*height
  * for reconstructed normals). HFVIS_ERR_INVALID_ARGUMENT for invalid camera/options, NULL
- * depth/lat/lines/values, a lattice whose direction is invalid; HFVIS_ERR_OUT_OF_MEMORY. */
+ * depth/lat/lines/values, a lattice whose direction is invalid or whose lines do not match its
+ * counts (stored back to back, each within max_line_samples, all within sample_count);
+ * HFVIS_ERR_OUT_OF_MEMORY. */
 HFVIS_API hfvis_status hfvis_lsao_direction(const hfvis_camera *cam, const float *depth,
                                             const float *normals, const hfvis_lsao_options *opts,
                                             const hfvis_ssao_lattice *lat,

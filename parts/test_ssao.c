@@ -1115,6 +1115,20 @@ TEST(lsao_bad_args_and_oom)
             CHECK_EQ_STATUS(hfvis_lsao_direction(&cam, depth, NULL, &o, &L, NULL, v, NULL), HFVIS_ERR_INVALID_ARGUMENT);
             CHECK_EQ_STATUS(hfvis_lsao_direction(&cam, depth, NULL, &o, &L, lines, NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
             CHECK_EQ_STATUS(hfvis_lsao_gather(&cam, depth, NULL, &o, &L, lines, v, NULL, NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+            {
+                /* a lattice whose lines disagree with its counts is rejected before any write */
+                hfvis_ssao_lattice bad = L;
+                static double sm[W * H], wt[W * H];
+                bad.max_line_samples = L.max_line_samples - 1;
+                CHECK_EQ_STATUS(hfvis_lsao_direction(&cam, depth, NULL, &o, &bad, lines, v, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+                bad = L;
+                bad.sample_count = L.sample_count - 1;
+                CHECK_EQ_STATUS(hfvis_lsao_direction_naive(&cam, depth, NULL, &o, &bad, lines, v, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+                CHECK_EQ_STATUS(hfvis_lsao_gather(&cam, depth, NULL, &o, &bad, lines, v, v, sm, wt), HFVIS_ERR_INVALID_ARGUMENT);
+                lines[3].offset++;
+                CHECK_EQ_STATUS(hfvis_lsao_direction(&cam, depth, NULL, &o, &L, lines, v, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+                lines[3].offset--;
+            }
             CHECK(memcmp(v, vk, sizeof v) == 0);
         }
     }
