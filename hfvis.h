@@ -1035,6 +1035,277 @@ HFVIS_API hfvis_status hfvis_ns_min_blocking_angle(const double normal[3], doubl
                                                    hfvis_ns_omega_min form, double *out);
 
 /* ========================================================================================== */
+/* hfvis.c - Nowrouzezahrai-Snyder GI pipeline ([NS09] §5-9; spec GI B.2, B.4-B.9, B.12)     */
+/* ========================================================================================== */
+/* The approximate, fast counterpart of the exact P1/P2 pipeline (hfvis_direct_light,
+ * hfvis_terrain_gi): per receiver, m azimuthal slices are scanned with exponentially growing
+ * steps over a multi-resolution height pyramid ([NS09] §5.2, Eq. 14-17); each slice's visibility
+ * and indirect radiance become order-4 normalized Legendre (NLP) vectors (Eq. 10-12), which the
+ * Appendix-A wedge matrices turn into order-4 SH (Eq. 18-21); shading is an SH dot product with a
+ * diffuse or Phong zonal lobe (§7); each bounce gathers the previous bounce's exit radiance from a
+ * radiance pyramid (§5.3). Conventions are those of the math layer above (SH without the
+ * Condon-Shortley phase, Ahat multipliers, NLP in z = sin(omega)) and of the whole API
+ * (DESIGN radiance: an open flat receiver under a uniform sky c with albedo 1 returns c).
+ *
+ * Slices (spec GI B.2, B.4). A receiver at grid position (x, y) looking toward
+ * phi_j = azimuth0_rad + 2 pi j/m (phi measured like psi, from +x toward +y) takes steps
+ * tau_i = 2^(i/k) cells, i = 0..n-1 (Eq. 14 in cell units); step i reads level
+ * l_v(i) = max(0, i - k*o_v) of the height pyramid at the receiver and at the step point (Eq. 15:
+ * both heights from the same level; the level offset makes the level finer by o_v octaves, the
+ * spec GI B.4 erratum) and gives the blocking angle omega_i = atan(dz / (tau_i cell_size)).
+ * omega_max is the maximum of the uniform cubic B-spline through the omega_i at its knots and
+ * midpoints (Eq. 16, end points replicated) or the raw maximum; the casting set holds the steps
+ * whose omega_i exceeds every earlier one and the tangent-plane angle omega_min (Eq. 17; admitted
+ * when larger by more than 1e-12 rad). Steps outside the grid (HFVIS_BORDER_OPEN: the ray ends
+ * there) and steps whose height is a hole are skipped: they neither occlude nor cast.
+ *
+ * The pyramid (spec GI B.4, CPU proposal). Octave images G_0 = the heights, G_(o+1) = G_o
+ * filtered with the separable [1,3,3,1]/8 kernel and decimated by 2 (texel i of G_(o+1) is centred
+ * between texels 2i and 2i+1 of G_o); level l = k*o + j (0 <= j < k) is G_o convolved with a
+ * separable, sampled, normalised cubic B-spline kernel whose variance is (4^(j/k) - 1)/4 G_o
+ * texels^2, so the blur grows smoothly and reaches 3/4 (the decimation's) as j -> k; level 0 is the
+ * heights exactly. Levels are sampled bilinearly in octave coordinates. Filter taps outside the
+ * image follow the border (OPEN: dropped, CLAMP: edge texel, WRAP: periodic) and hole taps are
+ * dropped, the weights renormalised (a level texel with no finite tap is a hole). The same pyramid
+ * holds the exit radiance of a bounce (spec GI B.5) with levels l_u(i) = max(0, i - k*o_u).
+ * Memory: about (4/3) k W H floats per channel, not the paper's stack of n full-size textures.
+ *
+ * Outputs are radiance toward the viewer (view_dir): direct = emission + (albedo/pi) E_direct +
+ * specular * glossy_direct; bounce b = (albedo/pi) E_b + specular * glossy_b, E_b the irradiance
+ * from the SH incident radiance U_b gathered from the exit radiance of bounce b-1; total = direct +
+ * the bounces. For a diffuse surface this is, bounce by bounce, the recursion
+ * L_B = emission + albedo (D + I[L_(B-1)]) of hfvis_terrain_gi. How close it comes to the exact
+ * pipeline is measured in test_gi2.c against hfvis_sky_light and hfvis_indirect_light (P1/P2)
+ * and printed by the bench. */
+
+/* How omega_max is taken from a slice's blocking angles. */
+typedef enum hfvis_ns_omega_max {
+    HFVIS_NS_OMEGA_MAX_DEFAULT = 0,  /* = BSPLINE */
+    HFVIS_NS_OMEGA_MAX_BSPLINE = 1,  /* [NS09] Eq. 16 (smooths: lowers isolated spikes) */
+    HFVIS_NS_OMEGA_MAX_RAW = 2       /* max_i omega_i (spec GI B.4 [choice]; with it the closure
+                                        identity of B.13-9 is exact) */
+} hfvis_ns_omega_max;
+
+/* Directional lights (hfvis_sun with radius_rad == 0), spec GI B.8 [choice]. */
+typedef enum hfvis_ns_directional {
+    HFVIS_NS_DIRECTIONAL_DEFAULT = 0,  /* = HARD */
+    HFVIS_NS_DIRECTIONAL_HARD = 1,     /* E0 max(N.d, 0) [omega_L > omega_max(phi_L)], from one more
+                                          slice scan toward the light */
+    HFVIS_NS_DIRECTIONAL_SOFT = 2,     /* the indicator replaced by clamp(v(phi_L) . P^(sin omega_L),
+                                          0, 1): the NLP-smoothed step of the slice toward the light.
+                                          The order-4 NLP rings near the zenith: an open flat
+                                          receiver gets 13/16 = 0.8125 of a zenith light */
+    HFVIS_NS_DIRECTIONAL_SH = 3        /* the SH delta E0 Y(d) times the HARD indicator, shaded
+                                          through SH like the environment; rings:
+                                          E = E0 (1/4 + cos(g)/2 + (5/16) P_2(cos g)), 17/16 E0 at
+                                          g = 0 (spec GI B.13-8) */
+} hfvis_ns_directional;
+
+/* Key lights (hfvis_sun with radius_rad > 0): uniform circular caps ([NS09] §6-7, spec GI B.8). */
+typedef enum hfvis_ns_key_mode {
+    HFVIS_NS_KEY_DEFAULT = 0,      /* = SEPARATE */
+    HFVIS_NS_KEY_SEPARATE = 1,     /* own visibility V_key over the cap's azimuth extent
+                                      (key_directions samples, key_directions - 1 wedges; the full
+                                      circle with the environment's slices when the cap holds the
+                                      zenith) and elevation range [l_min, l_max] (§6); the incident
+                                      radiance gains the SH product L_key * V_key (spec B.8). Note:
+                                      order-4 SH cannot hold the narrow box V_key, and the product
+                                      loses most of a small light's energy even where nothing
+                                      occludes it (a cap of radius 0.3 rad at 40 deg elevation
+                                      delivers 29% of its irradiance to open flat ground) */
+    HFVIS_NS_KEY_ENVIRONMENT = 2,  /* folded into the environment: L_key * V (faster, softer) */
+    HFVIS_NS_KEY_RATIO = 3         /* [choice, not in [NS09]] V_key as in SEPARATE, used only as a
+                                      shadow factor: f = clamp(Int L V_key / Int L V_box, 0, 1),
+                                      V_box the unoccluded restricted visibility (dot products of
+                                      the SH vectors), and the incident radiance gains f L_key: open
+                                      ground gets the light's full SH irradiance */
+} hfvis_ns_key_mode;
+
+/* Glossy interreflection (spec GI B.5). */
+typedef enum hfvis_ns_glossy {
+    HFVIS_NS_GLOSSY_DEFAULT = 0,   /* = VECTOR */
+    HFVIS_NS_GLOSSY_VECTOR = 1,    /* two pyramids: the diffuse exit radiance, and the incident
+                                      SH I_(b-1) (16 per channel, at the receiver resolution); a
+                                      remote point q sends specular * max(F_q(s) . I_(b-1)(q), 0)
+                                      toward the receiver on top of its diffuse exit radiance,
+                                      F_q the Phong lobe about the reflection of s = normalize(p - q)
+                                      in q's full-resolution normal ([NS09] §5.3 "non-diffuse") */
+    HFVIS_NS_GLOSSY_SCALAR = 2     /* one scalar pyramid of the shade toward the viewer (diffuse +
+                                      glossy): [NS09] §5.3's "mixture" approximation */
+} hfvis_ns_glossy;
+
+/* Keeping the casting sets between passes (spec B.9 [choice] "cache cast sets for bounces"). */
+typedef enum hfvis_ns_cache {
+    HFVIS_NS_CACHE_DEFAULT = 0,    /* = ON */
+    HFVIS_NS_CACHE_ON = 1,         /* the first scan of each slice (the visibility scan of the direct
+                                      pass, or the first bounce) records its casting set as a bit
+                                      mask of steps; later bounces re-read only those steps: same
+                                      result, bit for bit, at ceil(n/64)*8 bytes per receiver and
+                                      slice (1024^2, m = 32, n <= 64: 256 MiB; 2x2: 64 MiB) */
+    HFVIS_NS_CACHE_OFF = 2         /* every bounce scans every slice again */
+} hfvis_ns_cache;
+
+/* level_offset_v / level_offset_u value for "no offset" (0 octaves; 0 itself means the default). */
+#define HFVIS_NS_NO_OFFSET (-1)
+
+/* Limits of the options (larger values are HFVIS_ERR_INVALID_ARGUMENT). */
+#define HFVIS_NS_MAX_DIRECTIONS 4096
+#define HFVIS_NS_MAX_KEY_DIRECTIONS 256
+#define HFVIS_NS_MAX_LEVELS_PER_OCTAVE 32
+#define HFVIS_NS_MAX_LEVELS 1024
+#define HFVIS_NS_MAX_LEVEL_OFFSET 64
+#define HFVIS_NS_MAX_SUBSAMPLE 64
+#define HFVIS_NS_MAX_LIGHTS 64
+
+/* Options of hfvis_ns_gi. NULL or a zeroed struct means every default. */
+typedef struct hfvis_ns_gi_options {
+    int directions;          /* m: azimuthal slices over the full circle (environment and
+                                indirect light), 1..4096; 0 = 32 ([NS09] §9) */
+    int key_directions;      /* azimuthal samples over a key light's partial extent, 2..256;
+                                0 = 3 ([NS09] §9) */
+    int levels_per_octave;   /* k = k_v = k_u (Eq. 14), 1..32; 0 = 4 */
+    int levels;              /* n = n_v = n_u: steps per slice, 1..1024; 0 = auto:
+                                1 + ceil(k log2(max(1, hypot(width-1, height-1)))), so the last
+                                step reaches the grid's diagonal (spec GI B.4's 1 + k log2 R, plus
+                                at most k/2 + 1 steps) */
+    int level_offset_v;      /* o_v, octaves, 1..64; 0 = 2 ([NS09] §5.2); HFVIS_NS_NO_OFFSET = 0 */
+    int level_offset_u;      /* o_u, likewise, for the radiance pyramid; 0 = 2 */
+    int sh_order;            /* SH order o, 1..4 (bands l < o kept in V, U, the lights and the
+                                lobes); 0 = 4. The NLP vectors stay order 4. */
+    int subsample;           /* s: V, U computed for one receiver per s x s block (at the block
+                                centre, clamped to the grid) and bilinearly upsampled; shading
+                                uses full-resolution normals ([NS09] §7), 1..64; 0 = 1 */
+    hfvis_ns_interp interp;           /* azimuthal interpolation; default LINEAR */
+    hfvis_ns_omega_min omega_min;     /* tangent-plane angle; default EXACT (atan2 form) */
+    hfvis_ns_omega_max omega_max;     /* default BSPLINE (Eq. 16) */
+    int clamp_to_tangent;    /* 1: slice visibility starts at max(omega_max, omega_min) (spec GI
+                                B.3 [choice]); 0 = off, as [NS09] (the lobe's clamped cosine
+                                removes the light from below the tangent plane, approximately) */
+    hfvis_ns_directional directional; /* default HARD */
+    hfvis_ns_key_mode key_mode;       /* default SEPARATE */
+    hfvis_ns_glossy glossy;           /* default VECTOR */
+    hfvis_ns_cache cast_cache;        /* default ON (only used with bounces) */
+    double view_dir[3];      /* unit vector from the surface toward the viewer (distant
+                                viewer; normalised here); 0,0,0 = (0, 0, 1), looking straight down.
+                                Only the glossy terms depend on it. */
+    hfvis_border border;     /* default OPEN */
+    double azimuth0_rad;     /* phi_0 of slice 0 */
+    const hfvis_allocator *alloc;    /* scratch; NULL = malloc/free */
+    hfvis_progress_fn progress;      /* optional: called after each receiver row of each pass,
+                                        total = receiver rows * (1 + bounces) */
+    void *progress_user;
+} hfvis_ns_gi_options;
+
+/* The defaults, filled in (levels stays 0 = auto: it depends on the grid). */
+HFVIS_API hfvis_ns_gi_options hfvis_ns_gi_options_default(void);
+
+/* The options hfvis_ns_gi uses for this grid: every default resolved (levels computed, enums
+ * made explicit, view_dir normalised; level offsets of "none" stay HFVIS_NS_NO_OFFSET), so a
+ * port can print the exact parameters. in may be NULL. Returns HFVIS_OK, or
+ * HFVIS_ERR_INVALID_ARGUMENT for an invalid grid, a NULL out or an invalid option. */
+HFVIS_API hfvis_status hfvis_ns_gi_options_resolve(const hfvis_grid *grid,
+                                                   const hfvis_ns_gi_options *in,
+                                                   hfvis_ns_gi_options *out);
+
+/* What is lit, and how it reflects. */
+typedef struct hfvis_ns_scene {
+    int channels;                /* C, 1..4 */
+    const double *env_sh;        /* environment radiance as SH, env_sh[c*16 + i] (e.g. from
+                                    hfvis_sh_project_env; a uniform sky c is 2 sqrt(pi) c at
+                                    i = 0), or NULL for none */
+    const hfvis_sun *lights;     /* light_count lights (azimuth = look direction toward the light,
+                                    elevation in [-pi/2, pi/2], irradiance[c] on a surface facing
+                                    it): radius_rad == 0 is a directional light, 0 < radius_rad
+                                    <= pi/2 a key light (a uniform cap of radiance
+                                    irradiance / (pi sin^2 radius)). NULL if light_count is 0. */
+    int light_count;             /* 0..64 */
+    float albedo[4];             /* diffuse albedo per channel (first C used) */
+    const float *albedo_map;     /* or per sample: albedo_map[(y*width + x)*C + c]; NULL = albedo */
+    const float *emission;       /* emitted radiance per sample, same layout, or NULL */
+    float specular;              /* Phong specular weight, >= 0 (0 = diffuse only) */
+    float shininess;             /* Phong exponent S > 0 (used when specular > 0): the lobe
+                                    ((S+1)/(2 pi)) cos^S about the reflection vector, in SH its
+                                    multipliers exp(-l^2/(2S)) (hfvis_zh_phong) */
+} hfvis_ns_scene;
+
+/* Where the results go (each pointer may be NULL). Layout [(y*width + x)*C + c], width stride;
+ * bounce plane b-1 (b = 1..bounces) at bounce + (b-1)*width*height*C; visibility[(j*rw + i)*16 + r]
+ * for receiver (i, j) of the rw x rh receiver grid, rw = ceil(width/s), rh = ceil(height/s). */
+typedef struct hfvis_ns_gi_outputs {
+    int bounces;                 /* B >= 0 indirect bounces */
+    float *direct;               /* width*height*C: emission + direct light */
+    float *bounce;               /* bounces*width*height*C: the radiance each bounce adds */
+    float *total;                /* width*height*C: direct + every bounce */
+    float *visibility;           /* 16*rw*rh: the environment visibility SH V (Eq. 21) per
+                                    receiver, for diffing a port; NaN at receivers on holes */
+} hfvis_ns_gi_outputs;
+
+/* Multi-resolution height-field global illumination ([NS09]; spec GI B.9 RENDER).
+ * Per receiver (one per s x s block): m slices (Eq. 15-17) give V = Sum_j G_j v_j with
+ * v_j = vbar(pi/2) - vbar(omega_max,j) (Eq. 11), G_j the wedge matrices rotated into place
+ * (hfvis_ns_sample_matrices; m wedges with the wrap-around one); key lights add their restricted
+ * V_key; the incident radiance is I_0 = L_env * V + Sum L_key * V_key (SH products), plus the
+ * directional lights. Per bounce b the casting sets are scanned again and the exit radiance of
+ * bounce b-1 read from the radiance pyramid at level l_u(i) (Eq. 12) gives U_b. Every texel is
+ * shaded with its own full-resolution normal (hfvis_normals_compute) from V, V_key, U_b
+ * bilinearly upsampled over the receivers (renormalised over receivers that are not holes; a texel
+ * with none around is computed as a receiver of its own): diffuse E = (Ahat_diffuse Y(N)) . I,
+ * glossy (Ahat_phong Y(R)) . I with R = reflect(view_dir, N).
+ * Exact cases (tested): an open flat field under a uniform sky c returns albedo*c for any m,
+ * interp, k, n, offsets and s (bands 0 and 1 of the hemisphere are exact, spec GI B.13-7); a
+ * V-shaped valley's bottom reproduces the order-4 trench values of B.13-9; emission 1 with a black
+ * sky and raw omega_max closes the furnace: direct(sky 1) + bounce(emission 1) = 1.
+ * Holes: a non-finite height never occludes, is never in a casting set, and gets NaN in every
+ * output. Lighting below the tangent plane and SH ringing are not clamped (spec GI B.12-8): outputs
+ * can be slightly negative.
+ * grid: valid (hfvis_grid). scene: see hfvis_ns_scene. opts may be NULL. out: non-NULL; outputs
+ * must not overlap each other or the inputs.
+ * Returns HFVIS_OK, HFVIS_ERR_INVALID_ARGUMENT for NULL grid/scene/out, an invalid grid, a bad
+ * option, channels outside 1..4, a non-finite env_sh value, a light with a non-finite field, an
+ * elevation outside [-pi/2, pi/2] or a radius outside [0, pi/2], more than 64 lights, a non-finite
+ * albedo, specular < 0 or non-finite, shininess <= 0 or non-finite with specular > 0, a
+ * non-finite albedo_map / emission value at a sample that is not a hole, bounces < 0, or sizes that
+ * overflow size_t; HFVIS_ERR_OUT_OF_MEMORY (nothing written, nothing leaked).
+ * Allocates at most 4 blocks (hfvis_ns_gi_scratch_size bytes): tables, height pyramid and
+ * normals, two receiver rows, and (with bounces) the casting-set cache and radiance pyramids.
+ * Cost: O(rw rh (m + key samples + directional lights) n) for the direct pass (about 20 ns per
+ * step on one 2020s core) and O(rw rh m K C) per bounce with the cache (K the casting-set size;
+ * x16 with VECTOR glossy), plus O(W H C 256) shading. Deterministic.
+ * Accuracy (measured, test_gi2.c and the bench, fBm terrains): with the defaults, the direct light
+ * of a uniform sky is within 1.4-2.3% RMS of P1's (hfvis_sky_light), of which about 1.8% is the
+ * order-4 SH truncation itself (the SH projection of the exact horizons is that far from P1); one
+ * bounce is within 0.016 (unit sky) RMS of P2's hfvis_indirect_light; hard sun shadows differ from
+ * hfvis_sun_visibility at 3-4% of the pixels (exponential steps miss thin ridges; P1 itself differs
+ * from a fine ray march at 4.7%). Full-frame RMS against the exact pipeline: 5-7% of the mean. */
+HFVIS_API hfvis_status hfvis_ns_gi(const hfvis_grid *grid, const hfvis_ns_scene *scene,
+                                   const hfvis_ns_gi_options *opts,
+                                   const hfvis_ns_gi_outputs *out);
+
+/* Bytes of scratch hfvis_ns_gi allocates for these arguments (the sum of its blocks, all live at
+ * once: its peak), the "memory" of [NS09] Table 1 without the caller's outputs. bounces >= 0.
+ * Same validation as hfvis_ns_gi (outputs are not needed). */
+HFVIS_API hfvis_status hfvis_ns_gi_scratch_size(const hfvis_grid *grid, const hfvis_ns_scene *scene,
+                                                const hfvis_ns_gi_options *opts, int bounces,
+                                                size_t *bytes);
+
+/* [NS09] Eq. 16: the maximum of the uniform cubic B-spline with control points omega[0..n-1]
+ * (radians), evaluated at the knots S(j) = (w_(j-1) + 4 w_j + w_(j+1))/6 and the midpoints
+ * S(j+1/2) = (w_(j-1) + 23 w_j + 23 w_(j+1) + w_(j+2))/48, end points replicated
+ * (w_(-1) = w_0, w_n = w_(n-1); spec GI B.4 [choice]). n = 0 gives -pi/2 (nothing blocks).
+ * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for a NULL out, n < 0, NULL omega with n > 0 or
+ * a non-finite omega. Cost O(n). */
+HFVIS_API hfvis_status hfvis_ns_bspline_max(int n, const double *omega_rad, double *out);
+
+/* The per-sample form of [NS09] Eq. 20-21: G[(j*16 + r)*4 + k] such that
+ * hfvis_ns_wedges_to_sh(set, w) = Sum_j G_j w_j (G_j a 16x4 matrix, r the SH index, k the NLP
+ * index): each wedge matrix block is rotated into place once, Rot_z(M_s, phi_wedge), and added to
+ * the sample it reads, so a slice costs 64 multiply-adds and no rotation. Equal to
+ * hfvis_ns_wedges_to_sh up to rounding. G must hold 64*set->samples doubles.
+ * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT as hfvis_ns_wedges_to_sh. */
+HFVIS_API hfvis_status hfvis_ns_sample_matrices(const hfvis_ns_wedges *set, double *G);
+
+
+/* ========================================================================================== */
 /* ssao.c - screen space (later issues)                                                       */
 /* ========================================================================================== */
 
@@ -1196,6 +1467,10 @@ HFVIS_API hfvis_status hfvis_volume_write(hfvis_volume *vol, int i, int j, int k
  * Returns HFVIS_ERR_INVALID_ARGUMENT otherwise. */
 HFVIS_API hfvis_status hfvis_volume_merge(hfvis_volume *dst, const hfvis_volume *src);
 
+
+/* ========================================================================================== */
+/* voxel.c - analytic test meshes and the Wavefront OBJ codec                                 */
+/* ========================================================================================== */
 
 /* ---- meshes: limits, analytic test meshes, bounds, Wavefront OBJ -------------------------- */
 
@@ -1376,6 +1651,10 @@ HFVIS_API hfvis_status hfvis_mesh_load(const char *path, const hfvis_allocator *
 HFVIS_API hfvis_status hfvis_mesh_save(const char *path, const hfvis_mesh *mesh);
 
 
+/* ========================================================================================== */
+/* voxel.c - reference rasterizer                                                             */
+/* ========================================================================================== */
+
 /* ---- reference rasterizer: triangles -> depth, normal, triangle id, barycentrics ----------- */
 
 /* Largest image side the rasterizer accepts (width, height <= 32768; past it HFVIS_ERR_LIMIT).
@@ -1498,6 +1777,230 @@ HFVIS_API hfvis_status hfvis_rasterize_reference(const hfvis_mesh *mesh, const h
                                                  const hfvis_raster_options *opts,
                                                  const hfvis_raster_outputs *out);
 
+
+/* ========================================================================================== */
+/* voxel.c - BVH and ray casting: SAH bounding volume hierarchy, watertight ray-triangle test  */
+/* ========================================================================================== */
+
+/* Rays and hits (all queries below).
+ *
+ * A ray is the segment origin + t*direction, t in [t_min, t_max] (both ends included), in the
+ * mesh's world units; direction need not be unit length (t is then in units of |direction|).
+ * Valid when origin and direction are finite, direction != 0, 0 <= t_min <= t_max (t_min
+ * finite, t_max may be +INFINITY) and cull is one of the hfvis_cull_mode values.
+ *
+ * Triangles are tested with the watertight algorithm of S. Woop, C. Benthin, I. Wald,
+ * "Watertight Ray/Triangle Intersection", JCGT 2(1), 2013 (hfvis_ray_triangle): the vertices
+ * are translated to the ray origin, permuted so the direction's largest component is z, and
+ * sheared so the ray becomes the +z axis; the three 2D edge functions U, V, W of the sheared
+ * vertices decide the hit, evaluated in float and again in double when one is exactly 0 (or
+ * not finite), so their SIGNS are exact for the sheared float vertices. A point is inside when
+ * U, V, W all have the same sign, zeros counting as either sign: edges and vertices belong to
+ * the triangle, and a ray through an edge or vertex of a closed mesh (shared vertices, or
+ * bit-identical duplicated vertices) always hits at least one of its triangles - no cracks.
+ * Zero-area triangles ((v1 - v0) x (v2 - v0) exactly 0, decided exactly) never hit; neither do
+ * triangles the ray meets edge-on (U + V + W = 0).
+ * Hit values: t = (U Az + V Bz + W Cz)/(U + V + W) (the paper's T/det, float; double on the
+ * fallback path), u = V/det, v = W/det: the hit point is (1-u-v) v0 + u v1 + v v2. front = 1
+ * when the ray meets the side the normal (v1 - v0) x (v2 - v0) points to (direction.n < 0;
+ * det > 0), 0 otherwise. A hit needs t in [t_min, t_max] and t finite.
+ *
+ * Exactness: hfvis_ray_triangle is a pure function of the ray and the three float vertices,
+ * bit-identical across IEEE-754 builds that evaluate float in float (FLT_EVAL_METHOD 0: SSE2,
+ * ARM) without FMA contraction. The closest hit is the candidate of smallest t; exactly equal t
+ * go to the LOWEST triangle index. The BVH queries return exactly what their naive oracles
+ * return (same t, triangle, u, v, front bits; for any-hit the same verdict): both apply the
+ * same test and the same order, and the BVH prunes conservatively - node boxes are padded (see
+ * hfvis_bvh_node) and the slab test widens the far distance and the current best distance by
+ * the factor (1 + 2^-16), above the 1 + 2 gamma_3 of T. Ize, "Robust BVH Ray Traversal", JCGT
+ * 2(2), 2013. What is not guaranteed: the margins cover the rounding of the slab test and of
+ * the hit distance of well-conditioned hits; for a ray grazing a triangle (angle below about
+ * 1e-4 rad) t is ill-conditioned and could in principle fall outside the padded box, and the
+ * BVH would then lose that hit only if a competing hit at almost the same distance (or t_min /
+ * t_max) prunes the box. Never observed: 0 mismatches in the tests (over 2e5 rays, incl. rays
+ * through edges, vertices and face planes), in 1.9e6 more seeded rays, and in 4.8e6
+ * adversarial rays grazing triangle corners at 1e-3 .. 1e-8 rad.
+ * Range: every vertex - origin difference and the sheared coordinates must stay in float range
+ * (|coordinates| below about 1e37); beyond that a triangle may be missed (never a crash). */
+
+/* A ray (see above). A zero-initialised struct is invalid (direction 0); t_max = INFINITY and
+ * cull = HFVIS_CULL_NONE are the usual choices. */
+typedef struct hfvis_ray {
+    float origin[3];
+    float direction[3];   /* finite, not all zero; need not be unit length */
+    float t_min;          /* >= 0, finite; hits with t >= t_min count (for the open interval
+                             (0, L] of AO rays use the smallest positive float, or an offset
+                             that skips the receiver's own triangle) */
+    float t_max;          /* >= t_min, may be INFINITY; hits with t <= t_max count */
+    hfvis_cull_mode cull; /* the rasterizer's enum: HFVIS_CULL_NONE (default, 0) both sides
+                             hit; HFVIS_CULL_BACK ignores triangles seen from behind
+                             (direction . n > 0, n = (v1 - v0) x (v2 - v0)), as the one-sided
+                             AO rays of Laine & Karras; HFVIS_CULL_FRONT ignores those seen from
+                             the front (direction . n < 0) */
+} hfvis_ray;
+
+/* A ray query's result. On a miss: t = +INFINITY, triangle = HFVIS_NO_TRIANGLE, u = v = 0,
+ * front = 0. */
+typedef struct hfvis_hit {
+    float t;            /* ray parameter of the hit point: origin + t*direction */
+    uint32_t triangle;  /* triangle index in the mesh, HFVIS_NO_TRIANGLE on a miss */
+    float u, v;         /* barycentrics of v1 and v2: point = (1-u-v) v0 + u v1 + v v2 */
+    int front;          /* 1: the ray meets the front (normal) side, 0: the back side */
+} hfvis_hit;
+
+/* Which hit a query returns. */
+typedef enum hfvis_ray_query {
+    HFVIS_RAY_CLOSEST = 0, /* smallest t in [t_min, t_max]; equal t: lowest triangle index */
+    HFVIS_RAY_ANY = 1      /* stop at the first accepted hit in [t_min, t_max] (occlusion) */
+} hfvis_ray_query;
+
+/* Optional candidate filter of hfvis_bvh_intersect / hfvis_ray_intersect_naive (alpha masks,
+ * self-intersection rules such as the Laine-Karras reference's "skip triangles whose plane
+ * passes within eps of the receiver", per-object masks). Called with a candidate hit (t in
+ * [t_min, t_max], culling passed, triangle set) that would be accepted; return nonzero to
+ * accept it, 0 to ignore that triangle for this ray. It must be a pure function of its
+ * arguments: the queries call it in different orders and not for every candidate (a candidate
+ * that cannot beat the current best is not offered), and only then do the BVH and naive results
+ * agree exactly. */
+typedef int (*hfvis_hit_filter)(void *user, const hfvis_ray *ray, const hfvis_hit *candidate);
+
+/* The watertight ray-triangle test (see "Rays and hits" above) of one triangle v0, v1, v2.
+ * On a hit writes hit (triangle = 0, the only one); on a miss writes the miss values (triangle =
+ * HFVIS_NO_TRIANGLE). Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for a NULL pointer, an
+ * invalid ray or a non-finite vertex (hit untouched). Cost: about 40 flops, plus an exact
+ * zero-area test (usually one 6-term sum) on a hit. Allocates nothing. */
+HFVIS_API hfvis_status hfvis_ray_triangle(const hfvis_ray *ray, const float v0[3],
+                                          const float v1[3], const float v2[3], hfvis_hit *hit);
+
+/* ---- BVH ------------------------------------------------------------------------------------ */
+
+#define HFVIS_BVH_MAX_LEAF_SIZE 8        /* leaves hold 1..max_leaf_size triangles */
+#define HFVIS_BVH_DEFAULT_LEAF_SIZE 4
+#define HFVIS_BVH_DEFAULT_BINS 16        /* SAH bins per axis */
+#define HFVIS_BVH_MAX_BINS 64
+#define HFVIS_BVH_SAH_DEPTH 64           /* nodes deeper than this are split at the median */
+#define HFVIS_BVH_MAX_DEPTH 96           /* guaranteed bound of hfvis_bvh.depth (SAH_DEPTH + 32) */
+#define HFVIS_BVH_MAX_TRIANGLES ((size_t)0x7FFFFFFF) /* 2^31 - 1: node indices fit uint32_t */
+
+/* One node, 32 bytes. The layout is part of the API so that GPU ports can upload it as is.
+ * lo, hi: an axis-aligned box (float) containing the float bounding boxes of all triangles
+ * below the node, padded outward: each bound moves out by pad = 2^-18 * m, m = the largest of
+ * the box's |lo[a]|, |hi[a]| and hi[a] - lo[a] (before padding, in double, then rounded to float
+ * away from the box; so every child box lies inside its parent's box).
+ * count == 0: inner node, children nodes[left_or_first] and nodes[left_or_first + 1] (siblings
+ * are adjacent); count 1..max_leaf_size: leaf holding the triangles
+ * tri_order[left_or_first .. left_or_first + count - 1]. */
+typedef struct hfvis_bvh_node {
+    float lo[3];
+    float hi[3];
+    uint32_t left_or_first;
+    uint32_t count;
+} hfvis_bvh_node;
+
+/* A BVH over a mesh's triangles. nodes[0] is the root; node_count <= 2*triangle_count - 1
+ * (0 nodes for a mesh without triangles: every query misses). tri_order is a permutation of
+ * 0..triangle_count-1 (every triangle exactly once, degenerate ones included). depth = nodes on
+ * the longest root-to-leaf path (1 for a single leaf, 0 when empty), <= HFVIS_BVH_MAX_DEPTH.
+ * The BVH holds no pointer to the mesh: pass the same, unmodified mesh to every query. */
+typedef struct hfvis_bvh {
+    hfvis_bvh_node *nodes;
+    size_t node_count;
+    uint32_t *tri_order;
+    size_t triangle_count;
+    size_t leaf_count;
+    int depth;
+    int max_leaf_size;   /* the option it was built with */
+} hfvis_bvh;
+
+/* Options of hfvis_bvh_build. NULL or a zero struct = defaults. */
+typedef struct hfvis_bvh_options {
+    const hfvis_allocator *alloc; /* for the BVH's two arrays and the scratch; NULL = malloc */
+    int max_leaf_size;            /* 1..HFVIS_BVH_MAX_LEAF_SIZE; 0 = HFVIS_BVH_DEFAULT_LEAF_SIZE */
+    int bins;                     /* SAH bins per axis, 2..HFVIS_BVH_MAX_BINS; 0 = default 16 */
+} hfvis_bvh_options;
+
+/* The defaults: alloc NULL, max_leaf_size 4, bins 16. */
+HFVIS_API hfvis_bvh_options hfvis_bvh_options_default(void);
+
+/* Build a BVH over mesh's triangles: top-down, binned surface area heuristic (MacDonald &
+ * Booth 1990; binning as I. Wald, "On fast construction of SAH-based bounding volume
+ * hierarchies", IEEE RT 2007), the spec's A.9.2 choice: for each node, triangle centroids
+ * (centres of their float bounding boxes) are put into `bins` equal bins over the centroid
+ * bounds on each axis whose centroid extent is > 0; the split between bins with the least
+ * C_trav + C_tri (A_L N_L + A_R N_R)/A (C_trav = C_tri = 1, A = box surface area) wins (ties:
+ * lower axis, then lower bin). A node becomes a leaf when it holds one triangle, or at most
+ * max_leaf_size triangles and the leaf cost N <= the best split cost; a node of more than
+ * max_leaf_size triangles is always split. Nodes deeper than HFVIS_BVH_SAH_DEPTH, and nodes
+ * whose centroids all coincide or whose box has zero area, are split at the median of the
+ * centroids along the axis of largest centroid extent (ties by triangle index), so depth <=
+ * HFVIS_BVH_MAX_DEPTH. Deterministic: same mesh and options, same arrays bit for bit.
+ * O(n log n) for n triangles (O(bins) per node and O(n) per level).
+ * On success *out owns two blocks from opts->alloc (nodes, tri_order); free them with
+ * hfvis_bvh_free(opts->alloc, out). The build allocates four blocks in all (the two above,
+ * 24 bytes per triangle of bounds and 2n-1 nodes of scratch, freed before returning).
+ * Returns HFVIS_OK; HFVIS_ERR_INVALID_ARGUMENT for NULL mesh or out, max_leaf_size or bins out
+ * of range, an invalid mesh (hfvis_mesh); HFVIS_ERR_LIMIT for more than HFVIS_BVH_MAX_TRIANGLES
+ * triangles (checked before the mesh's arrays are read); HFVIS_ERR_OUT_OF_MEMORY. On error *out
+ * is untouched and nothing is leaked. */
+HFVIS_API hfvis_status hfvis_bvh_build(const hfvis_mesh *mesh, const hfvis_bvh_options *opts,
+                                       hfvis_bvh *out);
+
+/* Release a BVH's arrays with the allocator it was built with (NULL = free) and zero the
+ * struct. bvh may be NULL. */
+HFVIS_API void hfvis_bvh_free(const hfvis_allocator *alloc, hfvis_bvh *bvh);
+
+/* Ray query through the BVH (see "Rays and hits"): the closest hit (query HFVIS_RAY_CLOSEST)
+ * or any hit (HFVIS_RAY_ANY) in [t_min, t_max] among the triangles that pass culling and the
+ * optional filter (filter may be NULL; user is passed to it). Traversal: explicit stack
+ * (HFVIS_BVH_MAX_DEPTH entries), both children's slab tests at each inner node, nearer child
+ * first, the farther one pushed with its entry distance and skipped on pop once the best hit is
+ * closer. The slab test uses 1/direction with zero components as +-infinity (the sign of the
+ * zero) and ignores the NaN of 0 * infinity, so axis-parallel rays, also rays lying in a box's
+ * face plane, are handled without NaN. The closest hit equals hfvis_ray_intersect_naive's bit
+ * for bit; the any-hit verdict equals the naive one (the triangle reported may differ: any
+ * accepted hit, not necessarily the closest). hit receives the result, miss values on a miss.
+ * Returns HFVIS_OK; HFVIS_ERR_INVALID_ARGUMENT for NULL bvh, mesh, ray or hit, an invalid ray,
+ * an unknown query, a bvh whose triangle_count differs from the mesh's or whose depth exceeds
+ * HFVIS_BVH_MAX_DEPTH, a visited triangle with an index >= vertex_count, or a corrupted bvh met
+ * during the traversal (a child index not after its parent or past node_count, a leaf range
+ * past tri_order, a stack overflow); hit is untouched then. Memory-safe for any bvh whose
+ * arrays have node_count and triangle_count entries. The mesh's coordinates are not re-checked
+ * (hfvis_bvh_build did). Allocates nothing; reentrant. Cost: O(log n) nodes for typical
+ * scenes. */
+HFVIS_API hfvis_status hfvis_bvh_intersect(const hfvis_bvh *bvh, const hfvis_mesh *mesh,
+                                           const hfvis_ray *ray, hfvis_ray_query query,
+                                           hfvis_hit_filter filter, void *user, hfvis_hit *hit);
+
+/* hfvis_bvh_intersect(bvh, mesh, ray, HFVIS_RAY_CLOSEST, NULL, NULL, hit). */
+HFVIS_API hfvis_status hfvis_bvh_closest_hit(const hfvis_bvh *bvh, const hfvis_mesh *mesh,
+                                             const hfvis_ray *ray, hfvis_hit *hit);
+
+/* hfvis_bvh_intersect(bvh, mesh, ray, HFVIS_RAY_ANY, NULL, NULL, hit): stops at the first
+ * hit found in [t_min, t_max] (shadow / AO rays). A hit has hit->triangle != HFVIS_NO_TRIANGLE. */
+HFVIS_API hfvis_status hfvis_bvh_any_hit(const hfvis_bvh *bvh, const hfvis_mesh *mesh,
+                                         const hfvis_ray *ray, hfvis_hit *hit);
+
+/* Oracle: the same query by testing every triangle in index order with hfvis_ray_triangle's
+ * test. Closest: the smallest t, ties to the lowest index. Any: the lowest-index accepted hit.
+ * Returns HFVIS_OK; HFVIS_ERR_INVALID_ARGUMENT for NULL mesh, ray or hit, NULL mesh arrays with
+ * nonzero counts, an invalid ray, an unknown query, or an index >= vertex_count (hit
+ * untouched); coordinates are not checked for finiteness. Allocates nothing. Cost: O(T). */
+HFVIS_API hfvis_status hfvis_ray_intersect_naive(const hfvis_mesh *mesh, const hfvis_ray *ray,
+                                                 hfvis_ray_query query, hfvis_hit_filter filter,
+                                                 void *user, hfvis_hit *hit);
+
+/* hfvis_ray_intersect_naive(mesh, ray, HFVIS_RAY_CLOSEST, NULL, NULL, hit). */
+HFVIS_API hfvis_status hfvis_ray_closest_naive(const hfvis_mesh *mesh, const hfvis_ray *ray,
+                                               hfvis_hit *hit);
+
+/* hfvis_ray_intersect_naive(mesh, ray, HFVIS_RAY_ANY, NULL, NULL, hit). */
+HFVIS_API hfvis_status hfvis_ray_any_naive(const hfvis_mesh *mesh, const hfvis_ray *ray,
+                                           hfvis_hit *hit);
+
+
+/* ========================================================================================== */
+/* voxel.c - surface voxelization and the Volume Buffer attributes ([G12] ch. 5-6)            */
+/* ========================================================================================== */
 
 /* ---- surface voxelization into the Volume Buffer ([G12] ch. 6 Alg. 5 and 6, ch. 5 Alg. 4;
  *      spec voxel §3.4-3.8, §3.13) ------------------------------------------------------- */
@@ -1707,6 +2210,221 @@ HFVIS_API int hfvis_voxel_attribute_channel(unsigned flags, unsigned attribute);
 HFVIS_API void hfvis_voxel_fragment_attributes(const hfvis_voxel_fragment *f, float *values,
                                                void *user);
 
+
+/* ========================================================================================== */
+/* voxel.c - binary voxelizers: conservative (SAT), solid (parity), bitmask; .binvox and raw   */
+/* ========================================================================================== */
+
+/* All three voxelizers below decide in GRID SPACE: vertex p becomes g = (p - origin) / cell,
+ * per axis in double (one division per coordinate, the same expression in every routine and its
+ * reference), so voxel (i, j, k) is the unit cube [i, i+1] x [j, j+1] x [k, k+1] with centre
+ * (i + 0.5, j + 0.5, k + 0.5). Occupancy outputs are uint8 per voxel in the grid's linear order
+ * (k*dims[1] + j)*dims[0] + i, 1 = occupied, 0 = empty; the whole array is overwritten.
+ * Common errors: HFVIS_ERR_INVALID_ARGUMENT for a NULL or invalid mesh (hfvis_mesh) or grid
+ * (hfvis_volume_grid), a NULL output or an unknown enum in the options (outputs untouched);
+ * HFVIS_ERR_LIMIT when a vertex lies more than 2^60 cells from the grid origin (the exact
+ * predicates would overflow); HFVIS_ERR_OUT_OF_MEMORY when scratch cannot be allocated (nothing
+ * leaked, outputs untouched). Degenerate triangles (zero grid-space normal) are skipped. */
+
+/* The axis along which hfvis_voxelize_solid casts its parity rays. */
+typedef enum hfvis_parity_axis {
+    HFVIS_PARITY_AXIS_DEFAULT = 0, /* = HFVIS_PARITY_AXIS_Z */
+    HFVIS_PARITY_AXIS_X = 1,
+    HFVIS_PARITY_AXIS_Y = 2,
+    HFVIS_PARITY_AXIS_Z = 3
+} hfvis_parity_axis;
+
+/* Options of the binary voxelizers (NULL or all-zero = defaults). */
+typedef struct hfvis_binary_voxel_options {
+    const hfvis_allocator *alloc; /* scratch; NULL = malloc/free */
+    hfvis_parity_axis axis;       /* solid only: ray direction (default z) */
+    int allow_open;               /* solid only: 0 (default) = a column crossed an odd number of
+                                     times (an open mesh) fails with HFVIS_ERR_FORMAT; nonzero =
+                                     such columns are left empty and the others are filled */
+} hfvis_binary_voxel_options;
+
+/* The defaults: alloc NULL, axis HFVIS_PARITY_AXIS_Z, allow_open 0. */
+HFVIS_API hfvis_binary_voxel_options hfvis_binary_voxel_options_default(void);
+
+/* Triangle / axis-aligned box overlap by the separating-axis theorem (Akenine-Moller 2001;
+ * spec voxel §3.9): the box (centre, half sizes half[a] >= 0) and the triangle (v0, v1, v2)
+ * overlap unless one of 13 axes separates them: the 3 box normals (bounding boxes), the 9
+ * cross products e_a x f_j of the box axes with the triangle edges f0 = v1-v0, f1 = v2-v1,
+ * f2 = v0-v2, and the triangle normal n = f0 x f1. Both are CLOSED sets: touching (a vertex,
+ * edge or face on the box boundary) counts as overlap, so a triangle lying in the plane shared
+ * by two voxels overlaps both. Zero axes (an edge parallel to a box axis, a degenerate
+ * triangle) never separate, so a degenerate triangle is tested as the segment or point it is.
+ * Evaluated in double with a fixed expression per axis (documented in voxel.c, 5a); exact up to
+ * the rounding of those expressions, which hfvis_voxelize_conservative reproduces bit for bit.
+ * Inputs must be finite (otherwise the result is unspecified, but no undefined behaviour).
+ * Returns 1 when they overlap, 0 when an axis separates them. */
+HFVIS_API int hfvis_triangle_box_overlap(const double center[3], const double half[3],
+                                         const double v0[3], const double v1[3],
+                                         const double v2[3]);
+
+/* Conservative surface voxelization: occ[v] = 1 for every voxel whose closed cube the triangle
+ * overlaps by hfvis_triangle_box_overlap (grid space: centre (i+.5, j+.5, k+.5), half 0.5), for
+ * every triangle; 26-separating, a superset of the pixel-centre voxelizations (spec §3.4, §3.9).
+ * Only the voxels of the triangle's bounding-box range are candidates: along each axis
+ * i = max(0, ceil(min) - 1) .. min(dims-1, floor(max)) (the voxels whose closed extent meets
+ * the triangle's); the result is EXACTLY the set hfvis_voxelize_conservative_reference gives,
+ * voxel for voxel, including ties (faces on voxel boundaries, vertices on voxel corners).
+ * Method (Schwarz & Seidel 2010, made exact): per triangle, in the frame of its dominant axis,
+ * each of the nine edge axes becomes a bound on two voxel-centre coordinates and the plane axis
+ * a bound on the layers of each column; rows of columns, then the layer interval of each
+ * column, follow from these bounds evaluated in double with a safety margin (2^-30 of the
+ * coordinate scale, far above the rounding of either side), so a voxel decided by the margin
+ * is decided as the SAT decides it, and the few voxels within a margin of a bound are decided
+ * by the SAT's own expressions. Bounding boxes of at most 16 voxels use the SAT directly on
+ * the voxels not set yet. Cost O(T + rows + columns + voxels written) plus O(grid volume / 64)
+ * to clear and emit; the baseline is O(sum of bounding-box voxels). occ: dims[0]*dims[1]*dims[2]
+ * bytes, overwritten. count (may be NULL): occupied voxels. opts: only alloc is used. Two
+ * allocations: vertex_count*24 bytes (vertices in grid space) and ceil(dims/4)^3 * 8 bytes (a
+ * bit per voxel in 4x4x4 bricks). Errors: see the section comment. */
+HFVIS_API hfvis_status hfvis_voxelize_conservative(const hfvis_mesh *mesh,
+                                                   const hfvis_volume_grid *grid,
+                                                   const hfvis_binary_voxel_options *opts,
+                                                   uint8_t *occ, size_t *count);
+
+/* The oracle and baseline of hfvis_voxelize_conservative: for every triangle, for every voxel
+ * of its bounding-box range, one call of hfvis_triangle_box_overlap (nothing precomputed).
+ * Same arguments, result and errors; no allocation. Cost O(sum over triangles of bbox voxels). */
+HFVIS_API hfvis_status hfvis_voxelize_conservative_reference(const hfvis_mesh *mesh,
+                                                             const hfvis_volume_grid *grid,
+                                                             const hfvis_binary_voxel_options *opts,
+                                                             uint8_t *occ, size_t *count);
+
+/* Solid voxelization by parity (spec §3.9: Chen & Fang 1998; Eisemann & Decoret 2008):
+ * occ[v] = 1 when the centre of voxel v lies inside the mesh, decided by the parity of the
+ * crossings of the line through the voxel centres along opts->axis (default z) below the
+ * centre. A crossing is a triangle covering the column's centre point (u, w) = (iu+.5, iw+.5)
+ * in projection: vertices are moved to that point and the three edge functions are evaluated
+ * with their EXACT sign (a double product test, falling back to Dekker's error-free products on
+ * ties), and an edge passing exactly through the point counts for the triangle on one side only
+ * (the point moved by an infinitesimal (eps, eps^2) must be inside: a top-left rule), so a
+ * shared edge or vertex is counted once where the surface passes through and 0 or 2 times where
+ * it folds. Each crossing at depth z toggles every voxel whose centre is above z (k + 0.5 > z;
+ * a centre exactly on the surface counts as below it): one toggle per crossing into occ, then a
+ * prefix XOR along the axis (O(grid volume)). Orientation does not matter; nested closed
+ * surfaces alternate inside/outside; self-intersecting ones give their crossing parity.
+ * The mesh must be closed: with exact signs every line crosses a closed surface an even number
+ * of times, so a column crossed an odd number of times proves an open mesh: HFVIS_ERR_FORMAT
+ * (occ untouched) unless opts->allow_open, which leaves such columns empty and fills the others
+ * (a hole lets the columns through it fall out; it cannot flood the rest). Triangles with a
+ * zero grid-space normal are ignored; edge-on triangles (zero projected area) never cross.
+ * opts: alloc, axis (HFVIS_ERR_INVALID_ARGUMENT for an unknown value), allow_open.
+ * count (may be NULL): occupied voxels. One allocation (dims[u]*dims[w] bytes of column
+ * parities). Cost: O(T + covered column centres) twice (a checking pass first unless
+ * allow_open) + O(grid volume). Errors: see the section comment. */
+HFVIS_API hfvis_status hfvis_voxelize_solid(const hfvis_mesh *mesh, const hfvis_volume_grid *grid,
+                                            const hfvis_binary_voxel_options *opts, uint8_t *occ,
+                                            size_t *count);
+
+/* Oracle of hfvis_voxelize_solid, per voxel centre c independently of any axis: the generalized
+ * winding number w(c) = (1/4pi) sum over triangles of their signed solid angle at c (Van
+ * Oosterom & Strackee; Jacobson et al. 2013) in double, and occ = 1 when round(|w|) is odd.
+ * On a consistently oriented closed mesh this is the parity of hfvis_voxelize_solid except for
+ * centres within rounding of the surface. Never fails on open meshes (no HFVIS_ERR_FORMAT).
+ * opts->axis is only checked. Same other arguments and errors; allocates nothing.
+ * Cost O(voxels * T) (small grids only). */
+HFVIS_API hfvis_status hfvis_voxelize_solid_reference(const hfvis_mesh *mesh,
+                                                      const hfvis_volume_grid *grid,
+                                                      const hfvis_binary_voxel_options *opts,
+                                                      uint8_t *occ, size_t *count);
+
+/* *result = 1 when the mesh's index structure is closed and consistently oriented: every
+ * directed edge a -> b (a != b) of a triangle occurs exactly once and its reverse b -> a occurs
+ * exactly once too (so every undirected edge is used by exactly two triangles in opposite
+ * directions); 0 otherwise (including triangles with a repeated index). An empty mesh is
+ * watertight. Only indices are compared: a soup whose coincident corners are separate vertices
+ * is not watertight here (hfvis_voxelize_solid works on positions and accepts it).
+ * Returns HFVIS_ERR_INVALID_ARGUMENT for a NULL result or an invalid mesh,
+ * HFVIS_ERR_OUT_OF_MEMORY if the edge array (24 bytes per triangle, one allocation from alloc,
+ * NULL = malloc) cannot be allocated; *result untouched then. Cost O(T log T). */
+HFVIS_API hfvis_status hfvis_mesh_is_watertight(const hfvis_mesh *mesh,
+                                                const hfvis_allocator *alloc, int *result);
+
+/* Words of a bitmask volume (hfvis_voxelize_bitmask): dims[0]*dims[1]*ceil(dims[2]/32);
+ * 0 for a NULL or invalid grid. */
+HFVIS_API size_t hfvis_bitmask_words(const hfvis_volume_grid *grid);
+
+/* Bitmask surface voxelization (Eisemann & Decoret 2006, run from the three axis viewpoints;
+ * spec §3.9, §6): for each axis a (u = a+1, w = a+2 mod 3), every non-degenerate triangle is
+ * rasterized into the (u, w) pixel grid with the pixel-centre rule of hfvis_voxelize_solid (the
+ * watertight top-left coverage), the depth z along a of each covered centre is interpolated
+ * (barycentrics, clamped to the triangle's depth range) and the bit of slab floor(z) (a depth
+ * on a boundary goes to the upper slab; slabs outside [0, dims[a]) are dropped) is ORed in; the
+ * three passes are ORed. This is the voxel set of the thesis' three-axis Chen-Fang variant
+ * (hfvis_voxelize_occupancy with HFVIS_AXES_ALL and the pixel rule), up to centres within
+ * rounding of an edge or depths within rounding of a slab boundary, and a subset of
+ * hfvis_voxelize_conservative (the triangle point of a fragment lies in its voxel).
+ * Layout (the slicemap layout of Eisemann & Decoret 2008): bits packed along z, 32 per word,
+ * one run of W = ceil(dims[2]/32) words per (i, j) column: voxel (i, j, k) is bit (k & 31) of
+ * bits[(j*dims[0] + i)*W + (k >> 5)]; bits for k >= dims[2] are 0. bits must hold
+ * hfvis_bitmask_words(grid) words (overwritten). count (may be NULL): set bits. opts: unused
+ * (may be NULL). Allocates nothing. Cost O(T + covered pixels of the three projections).
+ * Errors: see the section comment. */
+HFVIS_API hfvis_status hfvis_voxelize_bitmask(const hfvis_mesh *mesh, const hfvis_volume_grid *grid,
+                                              const hfvis_binary_voxel_options *opts, uint32_t *bits,
+                                              size_t *count);
+
+/* Unpacks a bitmask volume into uint8 occupancy (grid order, 0/1). Returns
+ * HFVIS_ERR_INVALID_ARGUMENT for NULL or an invalid grid. */
+HFVIS_API hfvis_status hfvis_bitmask_to_occupancy(const hfvis_volume_grid *grid,
+                                                  const uint32_t *bits, uint8_t *occ);
+
+/* .binvox (the voxel format of P. Min's binvox / viewvox; header "#binvox 1", "dim D D D",
+ * "translate tx ty tz", "scale s", "data", then run-length pairs (value, count 1..255) over the
+ * D^3 voxels with x slowest, then z, then y fastest: binvox index x*D*D + z*D + y is hfvis voxel
+ * (i, j, k) = (x, y, z)). Voxel (x, y, z) spans translate + (scale/D)*[x, x+1] x [y, y+1] x
+ * [z, z+1], so translate = origin and scale = D*cell. binvox grids are cubes with cubic voxels:
+ * a grid is written padded with empty voxels to the cube of its largest side D, with
+ * translate = origin and scale = D * max(cell[a]) (non-cubic cells are approximated by the
+ * largest). Numbers are written locale-independently with the fewest digits that read back
+ * exactly (up to 15), else 17 digits. Any nonzero occupancy byte is written as 1. */
+
+/* Exact size in bytes of the encoding of (grid, occ) (scans occ for the runs); 0 for NULL, an
+ * invalid grid, a cube of more than HFVIS_VOLUME_MAX_VOXELS voxels or a scale D*cell that
+ * overflows a double. */
+HFVIS_API size_t hfvis_binvox_encode_size(const hfvis_volume_grid *grid, const uint8_t *occ);
+
+/* Encodes into out (capacity bytes); *written = bytes written. Returns HFVIS_ERR_INVALID_ARGUMENT
+ * for NULL or an invalid grid, HFVIS_ERR_LIMIT when the padded cube exceeds
+ * HFVIS_VOLUME_MAX_VOXELS or its scale overflows, HFVIS_ERR_BUFFER_TOO_SMALL below hfvis_binvox_encode_size. */
+HFVIS_API hfvis_status hfvis_binvox_encode(const hfvis_volume_grid *grid, const uint8_t *occ,
+                                           void *out, size_t capacity, size_t *written);
+
+/* Decodes a .binvox held in memory (strict): "#binvox 1" (or 2: values 0..255) on the first
+ * line; then lines "dim", "translate", "scale" in any order, each at most once ("dim"
+ * required, three equal positive integers; "translate" three finite numbers, default 0;
+ * "scale" one positive finite number, default 1), blanks between fields, "\n" or "\r\n" line
+ * ends; then "data" and its line end; then exactly the pairs covering D^3 voxels: version 1
+ * values 0 or 1, counts 1..255, no run past the end, nothing after the last pair.
+ * On success *grid = D^3 voxels, origin = translate, cell = scale/D, and *occ = D^3 bytes in
+ * hfvis order (the file's values), allocated with alloc (NULL = malloc; free with
+ * hfvis_free(alloc, *occ)). The runs are validated before allocating (one allocation).
+ * Returns HFVIS_ERR_INVALID_ARGUMENT for NULL data, grid or occ; HFVIS_ERR_FORMAT for any
+ * malformation (also a non-cubic dim or a scale/D that is not a valid cell); HFVIS_ERR_LIMIT
+ * when D^3 exceeds HFVIS_VOLUME_MAX_VOXELS; HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on
+ * error. */
+HFVIS_API hfvis_status hfvis_binvox_decode(const void *data, size_t size,
+                                           const hfvis_allocator *alloc, hfvis_volume_grid *grid,
+                                           uint8_t **occ);
+
+/* File wrappers (not with HFVIS_NO_STDIO). Save writes atomically (a temporary file renamed
+ * onto path: complete or untouched), allocating the encoding with malloc; errors of encode,
+ * HFVIS_ERR_IO, HFVIS_ERR_OUT_OF_MEMORY. Load: errors of decode and HFVIS_ERR_IO. */
+HFVIS_API hfvis_status hfvis_binvox_save(const char *path, const hfvis_volume_grid *grid,
+                                         const uint8_t *occ);
+HFVIS_API hfvis_status hfvis_binvox_load(const char *path, const hfvis_allocator *alloc,
+                                         hfvis_volume_grid *grid, uint8_t **occ);
+
+/* Raw occupancy: exactly dims[0]*dims[1]*dims[2] bytes of voxels, as given, in grid order
+ * (x fastest, then y, then z), no header (read it with the grid's dims, e.g. a "raw volume"
+ * import of 8-bit unsigned data). Errors: HFVIS_ERR_INVALID_ARGUMENT for NULL or an invalid grid,
+ * HFVIS_ERR_IO, HFVIS_ERR_OUT_OF_MEMORY. */
+HFVIS_API hfvis_status hfvis_voxels_raw_save(const char *path, const hfvis_volume_grid *grid,
+                                             const uint8_t *voxels);
 
 /* ========================================================================================== */
 /* voxel.c - incremental image-based voxelization (thesis ch. 7, spec voxel §4)                */
@@ -1987,712 +2705,6 @@ HFVIS_API hfvis_status hfvis_voxel_distance_metrics_naive(const hfvis_mesh *mesh
                                                           const hfvis_distance_options *opts,
                                                           hfvis_distance_metrics *out);
 
-
-/* ========================================================================================== */
-/* voxel.c - BVH and ray casting: SAH bounding volume hierarchy, watertight ray-triangle test  */
-/* ========================================================================================== */
-
-/* Rays and hits (all queries below).
- *
- * A ray is the segment origin + t*direction, t in [t_min, t_max] (both ends included), in the
- * mesh's world units; direction need not be unit length (t is then in units of |direction|).
- * Valid when origin and direction are finite, direction != 0, 0 <= t_min <= t_max (t_min
- * finite, t_max may be +INFINITY) and cull is one of the hfvis_cull_mode values.
- *
- * Triangles are tested with the watertight algorithm of S. Woop, C. Benthin, I. Wald,
- * "Watertight Ray/Triangle Intersection", JCGT 2(1), 2013 (hfvis_ray_triangle): the vertices
- * are translated to the ray origin, permuted so the direction's largest component is z, and
- * sheared so the ray becomes the +z axis; the three 2D edge functions U, V, W of the sheared
- * vertices decide the hit, evaluated in float and again in double when one is exactly 0 (or
- * not finite), so their SIGNS are exact for the sheared float vertices. A point is inside when
- * U, V, W all have the same sign, zeros counting as either sign: edges and vertices belong to
- * the triangle, and a ray through an edge or vertex of a closed mesh (shared vertices, or
- * bit-identical duplicated vertices) always hits at least one of its triangles - no cracks.
- * Zero-area triangles ((v1 - v0) x (v2 - v0) exactly 0, decided exactly) never hit; neither do
- * triangles the ray meets edge-on (U + V + W = 0).
- * Hit values: t = (U Az + V Bz + W Cz)/(U + V + W) (the paper's T/det, float; double on the
- * fallback path), u = V/det, v = W/det: the hit point is (1-u-v) v0 + u v1 + v v2. front = 1
- * when the ray meets the side the normal (v1 - v0) x (v2 - v0) points to (direction.n < 0;
- * det > 0), 0 otherwise. A hit needs t in [t_min, t_max] and t finite.
- *
- * Exactness: hfvis_ray_triangle is a pure function of the ray and the three float vertices,
- * bit-identical across IEEE-754 builds that evaluate float in float (FLT_EVAL_METHOD 0: SSE2,
- * ARM) without FMA contraction. The closest hit is the candidate of smallest t; exactly equal t
- * go to the LOWEST triangle index. The BVH queries return exactly what their naive oracles
- * return (same t, triangle, u, v, front bits; for any-hit the same verdict): both apply the
- * same test and the same order, and the BVH prunes conservatively - node boxes are padded (see
- * hfvis_bvh_node) and the slab test widens the far distance and the current best distance by
- * the factor (1 + 2^-16), above the 1 + 2 gamma_3 of T. Ize, "Robust BVH Ray Traversal", JCGT
- * 2(2), 2013. What is not guaranteed: the margins cover the rounding of the slab test and of
- * the hit distance of well-conditioned hits; for a ray grazing a triangle (angle below about
- * 1e-4 rad) t is ill-conditioned and could in principle fall outside the padded box, and the
- * BVH would then lose that hit only if a competing hit at almost the same distance (or t_min /
- * t_max) prunes the box. Never observed: 0 mismatches in the tests (over 2e5 rays, incl. rays
- * through edges, vertices and face planes), in 1.9e6 more seeded rays, and in 4.8e6
- * adversarial rays grazing triangle corners at 1e-3 .. 1e-8 rad.
- * Range: every vertex - origin difference and the sheared coordinates must stay in float range
- * (|coordinates| below about 1e37); beyond that a triangle may be missed (never a crash). */
-
-/* A ray (see above). A zero-initialised struct is invalid (direction 0); t_max = INFINITY and
- * cull = HFVIS_CULL_NONE are the usual choices. */
-typedef struct hfvis_ray {
-    float origin[3];
-    float direction[3];   /* finite, not all zero; need not be unit length */
-    float t_min;          /* >= 0, finite; hits with t >= t_min count (for the open interval
-                             (0, L] of AO rays use the smallest positive float, or an offset
-                             that skips the receiver's own triangle) */
-    float t_max;          /* >= t_min, may be INFINITY; hits with t <= t_max count */
-    hfvis_cull_mode cull; /* the rasterizer's enum: HFVIS_CULL_NONE (default, 0) both sides
-                             hit; HFVIS_CULL_BACK ignores triangles seen from behind
-                             (direction . n > 0, n = (v1 - v0) x (v2 - v0)), as the one-sided
-                             AO rays of Laine & Karras; HFVIS_CULL_FRONT ignores those seen from
-                             the front (direction . n < 0) */
-} hfvis_ray;
-
-/* A ray query's result. On a miss: t = +INFINITY, triangle = HFVIS_NO_TRIANGLE, u = v = 0,
- * front = 0. */
-typedef struct hfvis_hit {
-    float t;            /* ray parameter of the hit point: origin + t*direction */
-    uint32_t triangle;  /* triangle index in the mesh, HFVIS_NO_TRIANGLE on a miss */
-    float u, v;         /* barycentrics of v1 and v2: point = (1-u-v) v0 + u v1 + v v2 */
-    int front;          /* 1: the ray meets the front (normal) side, 0: the back side */
-} hfvis_hit;
-
-/* Which hit a query returns. */
-typedef enum hfvis_ray_query {
-    HFVIS_RAY_CLOSEST = 0, /* smallest t in [t_min, t_max]; equal t: lowest triangle index */
-    HFVIS_RAY_ANY = 1      /* stop at the first accepted hit in [t_min, t_max] (occlusion) */
-} hfvis_ray_query;
-
-/* Optional candidate filter of hfvis_bvh_intersect / hfvis_ray_intersect_naive (alpha masks,
- * self-intersection rules such as the Laine-Karras reference's "skip triangles whose plane
- * passes within eps of the receiver", per-object masks). Called with a candidate hit (t in
- * [t_min, t_max], culling passed, triangle set) that would be accepted; return nonzero to
- * accept it, 0 to ignore that triangle for this ray. It must be a pure function of its
- * arguments: the queries call it in different orders and not for every candidate (a candidate
- * that cannot beat the current best is not offered), and only then do the BVH and naive results
- * agree exactly. */
-typedef int (*hfvis_hit_filter)(void *user, const hfvis_ray *ray, const hfvis_hit *candidate);
-
-/* The watertight ray-triangle test (see "Rays and hits" above) of one triangle v0, v1, v2.
- * On a hit writes hit (triangle = 0, the only one); on a miss writes the miss values (triangle =
- * HFVIS_NO_TRIANGLE). Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for a NULL pointer, an
- * invalid ray or a non-finite vertex (hit untouched). Cost: about 40 flops, plus an exact
- * zero-area test (usually one 6-term sum) on a hit. Allocates nothing. */
-HFVIS_API hfvis_status hfvis_ray_triangle(const hfvis_ray *ray, const float v0[3],
-                                          const float v1[3], const float v2[3], hfvis_hit *hit);
-
-/* ---- BVH ------------------------------------------------------------------------------------ */
-
-#define HFVIS_BVH_MAX_LEAF_SIZE 8        /* leaves hold 1..max_leaf_size triangles */
-#define HFVIS_BVH_DEFAULT_LEAF_SIZE 4
-#define HFVIS_BVH_DEFAULT_BINS 16        /* SAH bins per axis */
-#define HFVIS_BVH_MAX_BINS 64
-#define HFVIS_BVH_SAH_DEPTH 64           /* nodes deeper than this are split at the median */
-#define HFVIS_BVH_MAX_DEPTH 96           /* guaranteed bound of hfvis_bvh.depth (SAH_DEPTH + 32) */
-#define HFVIS_BVH_MAX_TRIANGLES ((size_t)0x7FFFFFFF) /* 2^31 - 1: node indices fit uint32_t */
-
-/* One node, 32 bytes. The layout is part of the API so that GPU ports can upload it as is.
- * lo, hi: an axis-aligned box (float) containing the float bounding boxes of all triangles
- * below the node, padded outward: each bound moves out by pad = 2^-18 * m, m = the largest of
- * the box's |lo[a]|, |hi[a]| and hi[a] - lo[a] (before padding, in double, then rounded to float
- * away from the box; so every child box lies inside its parent's box).
- * count == 0: inner node, children nodes[left_or_first] and nodes[left_or_first + 1] (siblings
- * are adjacent); count 1..max_leaf_size: leaf holding the triangles
- * tri_order[left_or_first .. left_or_first + count - 1]. */
-typedef struct hfvis_bvh_node {
-    float lo[3];
-    float hi[3];
-    uint32_t left_or_first;
-    uint32_t count;
-} hfvis_bvh_node;
-
-/* A BVH over a mesh's triangles. nodes[0] is the root; node_count <= 2*triangle_count - 1
- * (0 nodes for a mesh without triangles: every query misses). tri_order is a permutation of
- * 0..triangle_count-1 (every triangle exactly once, degenerate ones included). depth = nodes on
- * the longest root-to-leaf path (1 for a single leaf, 0 when empty), <= HFVIS_BVH_MAX_DEPTH.
- * The BVH holds no pointer to the mesh: pass the same, unmodified mesh to every query. */
-typedef struct hfvis_bvh {
-    hfvis_bvh_node *nodes;
-    size_t node_count;
-    uint32_t *tri_order;
-    size_t triangle_count;
-    size_t leaf_count;
-    int depth;
-    int max_leaf_size;   /* the option it was built with */
-} hfvis_bvh;
-
-/* Options of hfvis_bvh_build. NULL or a zero struct = defaults. */
-typedef struct hfvis_bvh_options {
-    const hfvis_allocator *alloc; /* for the BVH's two arrays and the scratch; NULL = malloc */
-    int max_leaf_size;            /* 1..HFVIS_BVH_MAX_LEAF_SIZE; 0 = HFVIS_BVH_DEFAULT_LEAF_SIZE */
-    int bins;                     /* SAH bins per axis, 2..HFVIS_BVH_MAX_BINS; 0 = default 16 */
-} hfvis_bvh_options;
-
-/* The defaults: alloc NULL, max_leaf_size 4, bins 16. */
-HFVIS_API hfvis_bvh_options hfvis_bvh_options_default(void);
-
-/* Build a BVH over mesh's triangles: top-down, binned surface area heuristic (MacDonald &
- * Booth 1990; binning as I. Wald, "On fast construction of SAH-based bounding volume
- * hierarchies", IEEE RT 2007), the spec's A.9.2 choice: for each node, triangle centroids
- * (centres of their float bounding boxes) are put into `bins` equal bins over the centroid
- * bounds on each axis whose centroid extent is > 0; the split between bins with the least
- * C_trav + C_tri (A_L N_L + A_R N_R)/A (C_trav = C_tri = 1, A = box surface area) wins (ties:
- * lower axis, then lower bin). A node becomes a leaf when it holds one triangle, or at most
- * max_leaf_size triangles and the leaf cost N <= the best split cost; a node of more than
- * max_leaf_size triangles is always split. Nodes deeper than HFVIS_BVH_SAH_DEPTH, and nodes
- * whose centroids all coincide or whose box has zero area, are split at the median of the
- * centroids along the axis of largest centroid extent (ties by triangle index), so depth <=
- * HFVIS_BVH_MAX_DEPTH. Deterministic: same mesh and options, same arrays bit for bit.
- * O(n log n) for n triangles (O(bins) per node and O(n) per level).
- * On success *out owns two blocks from opts->alloc (nodes, tri_order); free them with
- * hfvis_bvh_free(opts->alloc, out). The build allocates four blocks in all (the two above,
- * 24 bytes per triangle of bounds and 2n-1 nodes of scratch, freed before returning).
- * Returns HFVIS_OK; HFVIS_ERR_INVALID_ARGUMENT for NULL mesh or out, max_leaf_size or bins out
- * of range, an invalid mesh (hfvis_mesh); HFVIS_ERR_LIMIT for more than HFVIS_BVH_MAX_TRIANGLES
- * triangles (checked before the mesh's arrays are read); HFVIS_ERR_OUT_OF_MEMORY. On error *out
- * is untouched and nothing is leaked. */
-HFVIS_API hfvis_status hfvis_bvh_build(const hfvis_mesh *mesh, const hfvis_bvh_options *opts,
-                                       hfvis_bvh *out);
-
-/* Release a BVH's arrays with the allocator it was built with (NULL = free) and zero the
- * struct. bvh may be NULL. */
-HFVIS_API void hfvis_bvh_free(const hfvis_allocator *alloc, hfvis_bvh *bvh);
-
-/* Ray query through the BVH (see "Rays and hits"): the closest hit (query HFVIS_RAY_CLOSEST)
- * or any hit (HFVIS_RAY_ANY) in [t_min, t_max] among the triangles that pass culling and the
- * optional filter (filter may be NULL; user is passed to it). Traversal: explicit stack
- * (HFVIS_BVH_MAX_DEPTH entries), both children's slab tests at each inner node, nearer child
- * first, the farther one pushed with its entry distance and skipped on pop once the best hit is
- * closer. The slab test uses 1/direction with zero components as +-infinity (the sign of the
- * zero) and ignores the NaN of 0 * infinity, so axis-parallel rays, also rays lying in a box's
- * face plane, are handled without NaN. The closest hit equals hfvis_ray_intersect_naive's bit
- * for bit; the any-hit verdict equals the naive one (the triangle reported may differ: any
- * accepted hit, not necessarily the closest). hit receives the result, miss values on a miss.
- * Returns HFVIS_OK; HFVIS_ERR_INVALID_ARGUMENT for NULL bvh, mesh, ray or hit, an invalid ray,
- * an unknown query, a bvh whose triangle_count differs from the mesh's or whose depth exceeds
- * HFVIS_BVH_MAX_DEPTH, a visited triangle with an index >= vertex_count, or a corrupted bvh met
- * during the traversal (a child index not after its parent or past node_count, a leaf range
- * past tri_order, a stack overflow); hit is untouched then. Memory-safe for any bvh whose
- * arrays have node_count and triangle_count entries. The mesh's coordinates are not re-checked
- * (hfvis_bvh_build did). Allocates nothing; reentrant. Cost: O(log n) nodes for typical
- * scenes. */
-HFVIS_API hfvis_status hfvis_bvh_intersect(const hfvis_bvh *bvh, const hfvis_mesh *mesh,
-                                           const hfvis_ray *ray, hfvis_ray_query query,
-                                           hfvis_hit_filter filter, void *user, hfvis_hit *hit);
-
-/* hfvis_bvh_intersect(bvh, mesh, ray, HFVIS_RAY_CLOSEST, NULL, NULL, hit). */
-HFVIS_API hfvis_status hfvis_bvh_closest_hit(const hfvis_bvh *bvh, const hfvis_mesh *mesh,
-                                             const hfvis_ray *ray, hfvis_hit *hit);
-
-/* hfvis_bvh_intersect(bvh, mesh, ray, HFVIS_RAY_ANY, NULL, NULL, hit): stops at the first
- * hit found in [t_min, t_max] (shadow / AO rays). A hit has hit->triangle != HFVIS_NO_TRIANGLE. */
-HFVIS_API hfvis_status hfvis_bvh_any_hit(const hfvis_bvh *bvh, const hfvis_mesh *mesh,
-                                         const hfvis_ray *ray, hfvis_hit *hit);
-
-/* Oracle: the same query by testing every triangle in index order with hfvis_ray_triangle's
- * test. Closest: the smallest t, ties to the lowest index. Any: the lowest-index accepted hit.
- * Returns HFVIS_OK; HFVIS_ERR_INVALID_ARGUMENT for NULL mesh, ray or hit, NULL mesh arrays with
- * nonzero counts, an invalid ray, an unknown query, or an index >= vertex_count (hit
- * untouched); coordinates are not checked for finiteness. Allocates nothing. Cost: O(T). */
-HFVIS_API hfvis_status hfvis_ray_intersect_naive(const hfvis_mesh *mesh, const hfvis_ray *ray,
-                                                 hfvis_ray_query query, hfvis_hit_filter filter,
-                                                 void *user, hfvis_hit *hit);
-
-/* hfvis_ray_intersect_naive(mesh, ray, HFVIS_RAY_CLOSEST, NULL, NULL, hit). */
-HFVIS_API hfvis_status hfvis_ray_closest_naive(const hfvis_mesh *mesh, const hfvis_ray *ray,
-                                               hfvis_hit *hit);
-
-/* hfvis_ray_intersect_naive(mesh, ray, HFVIS_RAY_ANY, NULL, NULL, hit). */
-HFVIS_API hfvis_status hfvis_ray_any_naive(const hfvis_mesh *mesh, const hfvis_ray *ray,
-                                           hfvis_hit *hit);
-
-
-/* ========================================================================================== */
-/* hfvis.c - Nowrouzezahrai-Snyder GI pipeline ([NS09] §5-9; spec GI B.2, B.4-B.9, B.12)     */
-/* ========================================================================================== */
-/* The approximate, fast counterpart of the exact P1/P2 pipeline (hfvis_direct_light,
- * hfvis_terrain_gi): per receiver, m azimuthal slices are scanned with exponentially growing
- * steps over a multi-resolution height pyramid ([NS09] §5.2, Eq. 14-17); each slice's visibility
- * and indirect radiance become order-4 normalized Legendre (NLP) vectors (Eq. 10-12), which the
- * Appendix-A wedge matrices turn into order-4 SH (Eq. 18-21); shading is an SH dot product with a
- * diffuse or Phong zonal lobe (§7); each bounce gathers the previous bounce's exit radiance from a
- * radiance pyramid (§5.3). Conventions are those of the math layer above (SH without the
- * Condon-Shortley phase, Ahat multipliers, NLP in z = sin(omega)) and of the whole API
- * (DESIGN radiance: an open flat receiver under a uniform sky c with albedo 1 returns c).
- *
- * Slices (spec GI B.2, B.4). A receiver at grid position (x, y) looking toward
- * phi_j = azimuth0_rad + 2 pi j/m (phi measured like psi, from +x toward +y) takes steps
- * tau_i = 2^(i/k) cells, i = 0..n-1 (Eq. 14 in cell units); step i reads level
- * l_v(i) = max(0, i - k*o_v) of the height pyramid at the receiver and at the step point (Eq. 15:
- * both heights from the same level; the level offset makes the level finer by o_v octaves, the
- * spec GI B.4 erratum) and gives the blocking angle omega_i = atan(dz / (tau_i cell_size)).
- * omega_max is the maximum of the uniform cubic B-spline through the omega_i at its knots and
- * midpoints (Eq. 16, end points replicated) or the raw maximum; the casting set holds the steps
- * whose omega_i exceeds every earlier one and the tangent-plane angle omega_min (Eq. 17; admitted
- * when larger by more than 1e-12 rad). Steps outside the grid (HFVIS_BORDER_OPEN: the ray ends
- * there) and steps whose height is a hole are skipped: they neither occlude nor cast.
- *
- * The pyramid (spec GI B.4, CPU proposal). Octave images G_0 = the heights, G_(o+1) = G_o
- * filtered with the separable [1,3,3,1]/8 kernel and decimated by 2 (texel i of G_(o+1) is centred
- * between texels 2i and 2i+1 of G_o); level l = k*o + j (0 <= j < k) is G_o convolved with a
- * separable, sampled, normalised cubic B-spline kernel whose variance is (4^(j/k) - 1)/4 G_o
- * texels^2, so the blur grows smoothly and reaches 3/4 (the decimation's) as j -> k; level 0 is the
- * heights exactly. Levels are sampled bilinearly in octave coordinates. Filter taps outside the
- * image follow the border (OPEN: dropped, CLAMP: edge texel, WRAP: periodic) and hole taps are
- * dropped, the weights renormalised (a level texel with no finite tap is a hole). The same pyramid
- * holds the exit radiance of a bounce (spec GI B.5) with levels l_u(i) = max(0, i - k*o_u).
- * Memory: about (4/3) k W H floats per channel, not the paper's stack of n full-size textures.
- *
- * Outputs are radiance toward the viewer (view_dir): direct = emission + (albedo/pi) E_direct +
- * specular * glossy_direct; bounce b = (albedo/pi) E_b + specular * glossy_b, E_b the irradiance
- * from the SH incident radiance U_b gathered from the exit radiance of bounce b-1; total = direct +
- * the bounces. For a diffuse surface this is, bounce by bounce, the recursion
- * L_B = emission + albedo (D + I[L_(B-1)]) of hfvis_terrain_gi. How close it comes to the exact
- * pipeline is measured in test_gi2.c against hfvis_sky_light and hfvis_indirect_light (P1/P2)
- * and printed by the bench. */
-
-/* How omega_max is taken from a slice's blocking angles. */
-typedef enum hfvis_ns_omega_max {
-    HFVIS_NS_OMEGA_MAX_DEFAULT = 0,  /* = BSPLINE */
-    HFVIS_NS_OMEGA_MAX_BSPLINE = 1,  /* [NS09] Eq. 16 (smooths: lowers isolated spikes) */
-    HFVIS_NS_OMEGA_MAX_RAW = 2       /* max_i omega_i (spec GI B.4 [choice]; with it the closure
-                                        identity of B.13-9 is exact) */
-} hfvis_ns_omega_max;
-
-/* Directional lights (hfvis_sun with radius_rad == 0), spec GI B.8 [choice]. */
-typedef enum hfvis_ns_directional {
-    HFVIS_NS_DIRECTIONAL_DEFAULT = 0,  /* = HARD */
-    HFVIS_NS_DIRECTIONAL_HARD = 1,     /* E0 max(N.d, 0) [omega_L > omega_max(phi_L)], from one more
-                                          slice scan toward the light */
-    HFVIS_NS_DIRECTIONAL_SOFT = 2,     /* the indicator replaced by clamp(v(phi_L) . P^(sin omega_L),
-                                          0, 1): the NLP-smoothed step of the slice toward the light.
-                                          The order-4 NLP rings near the zenith: an open flat
-                                          receiver gets 13/16 = 0.8125 of a zenith light */
-    HFVIS_NS_DIRECTIONAL_SH = 3        /* the SH delta E0 Y(d) times the HARD indicator, shaded
-                                          through SH like the environment; rings:
-                                          E = E0 (1/4 + cos(g)/2 + (5/16) P_2(cos g)), 17/16 E0 at
-                                          g = 0 (spec GI B.13-8) */
-} hfvis_ns_directional;
-
-/* Key lights (hfvis_sun with radius_rad > 0): uniform circular caps ([NS09] §6-7, spec GI B.8). */
-typedef enum hfvis_ns_key_mode {
-    HFVIS_NS_KEY_DEFAULT = 0,      /* = SEPARATE */
-    HFVIS_NS_KEY_SEPARATE = 1,     /* own visibility V_key over the cap's azimuth extent
-                                      (key_directions samples, key_directions - 1 wedges; the full
-                                      circle with the environment's slices when the cap holds the
-                                      zenith) and elevation range [l_min, l_max] (§6); the incident
-                                      radiance gains the SH product L_key * V_key (spec B.8). Note:
-                                      order-4 SH cannot hold the narrow box V_key, and the product
-                                      loses most of a small light's energy even where nothing
-                                      occludes it (a cap of radius 0.3 rad at 40 deg elevation
-                                      delivers 29% of its irradiance to open flat ground) */
-    HFVIS_NS_KEY_ENVIRONMENT = 2,  /* folded into the environment: L_key * V (faster, softer) */
-    HFVIS_NS_KEY_RATIO = 3         /* [choice, not in [NS09]] V_key as in SEPARATE, used only as a
-                                      shadow factor: f = clamp(Int L V_key / Int L V_box, 0, 1),
-                                      V_box the unoccluded restricted visibility (dot products of
-                                      the SH vectors), and the incident radiance gains f L_key: open
-                                      ground gets the light's full SH irradiance */
-} hfvis_ns_key_mode;
-
-/* Glossy interreflection (spec GI B.5). */
-typedef enum hfvis_ns_glossy {
-    HFVIS_NS_GLOSSY_DEFAULT = 0,   /* = VECTOR */
-    HFVIS_NS_GLOSSY_VECTOR = 1,    /* two pyramids: the diffuse exit radiance, and the incident
-                                      SH I_(b-1) (16 per channel, at the receiver resolution); a
-                                      remote point q sends specular * max(F_q(s) . I_(b-1)(q), 0)
-                                      toward the receiver on top of its diffuse exit radiance,
-                                      F_q the Phong lobe about the reflection of s = normalize(p - q)
-                                      in q's full-resolution normal ([NS09] §5.3 "non-diffuse") */
-    HFVIS_NS_GLOSSY_SCALAR = 2     /* one scalar pyramid of the shade toward the viewer (diffuse +
-                                      glossy): [NS09] §5.3's "mixture" approximation */
-} hfvis_ns_glossy;
-
-/* Keeping the casting sets between passes (spec B.9 [choice] "cache cast sets for bounces"). */
-typedef enum hfvis_ns_cache {
-    HFVIS_NS_CACHE_DEFAULT = 0,    /* = ON */
-    HFVIS_NS_CACHE_ON = 1,         /* the first scan of each slice (the visibility scan of the direct
-                                      pass, or the first bounce) records its casting set as a bit
-                                      mask of steps; later bounces re-read only those steps: same
-                                      result, bit for bit, at ceil(n/64)*8 bytes per receiver and
-                                      slice (1024^2, m = 32, n <= 64: 256 MiB; 2x2: 64 MiB) */
-    HFVIS_NS_CACHE_OFF = 2         /* every bounce scans every slice again */
-} hfvis_ns_cache;
-
-/* level_offset_v / level_offset_u value for "no offset" (0 octaves; 0 itself means the default). */
-#define HFVIS_NS_NO_OFFSET (-1)
-
-/* Limits of the options (larger values are HFVIS_ERR_INVALID_ARGUMENT). */
-#define HFVIS_NS_MAX_DIRECTIONS 4096
-#define HFVIS_NS_MAX_KEY_DIRECTIONS 256
-#define HFVIS_NS_MAX_LEVELS_PER_OCTAVE 32
-#define HFVIS_NS_MAX_LEVELS 1024
-#define HFVIS_NS_MAX_LEVEL_OFFSET 64
-#define HFVIS_NS_MAX_SUBSAMPLE 64
-#define HFVIS_NS_MAX_LIGHTS 64
-
-/* Options of hfvis_ns_gi. NULL or a zeroed struct means every default. */
-typedef struct hfvis_ns_gi_options {
-    int directions;          /* m: azimuthal slices over the full circle (environment and
-                                indirect light), 1..4096; 0 = 32 ([NS09] §9) */
-    int key_directions;      /* azimuthal samples over a key light's partial extent, 2..256;
-                                0 = 3 ([NS09] §9) */
-    int levels_per_octave;   /* k = k_v = k_u (Eq. 14), 1..32; 0 = 4 */
-    int levels;              /* n = n_v = n_u: steps per slice, 1..1024; 0 = auto:
-                                1 + ceil(k log2(max(1, hypot(width-1, height-1)))), so the last
-                                step reaches the grid's diagonal (spec GI B.4's 1 + k log2 R, plus
-                                at most k/2 + 1 steps) */
-    int level_offset_v;      /* o_v, octaves, 1..64; 0 = 2 ([NS09] §5.2); HFVIS_NS_NO_OFFSET = 0 */
-    int level_offset_u;      /* o_u, likewise, for the radiance pyramid; 0 = 2 */
-    int sh_order;            /* SH order o, 1..4 (bands l < o kept in V, U, the lights and the
-                                lobes); 0 = 4. The NLP vectors stay order 4. */
-    int subsample;           /* s: V, U computed for one receiver per s x s block (at the block
-                                centre, clamped to the grid) and bilinearly upsampled; shading
-                                uses full-resolution normals ([NS09] §7), 1..64; 0 = 1 */
-    hfvis_ns_interp interp;           /* azimuthal interpolation; default LINEAR */
-    hfvis_ns_omega_min omega_min;     /* tangent-plane angle; default EXACT (atan2 form) */
-    hfvis_ns_omega_max omega_max;     /* default BSPLINE (Eq. 16) */
-    int clamp_to_tangent;    /* 1: slice visibility starts at max(omega_max, omega_min) (spec GI
-                                B.3 [choice]); 0 = off, as [NS09] (the lobe's clamped cosine
-                                removes the light from below the tangent plane, approximately) */
-    hfvis_ns_directional directional; /* default HARD */
-    hfvis_ns_key_mode key_mode;       /* default SEPARATE */
-    hfvis_ns_glossy glossy;           /* default VECTOR */
-    hfvis_ns_cache cast_cache;        /* default ON (only used with bounces) */
-    double view_dir[3];      /* unit vector from the surface toward the viewer (distant
-                                viewer; normalised here); 0,0,0 = (0, 0, 1), looking straight down.
-                                Only the glossy terms depend on it. */
-    hfvis_border border;     /* default OPEN */
-    double azimuth0_rad;     /* phi_0 of slice 0 */
-    const hfvis_allocator *alloc;    /* scratch; NULL = malloc/free */
-    hfvis_progress_fn progress;      /* optional: called after each receiver row of each pass,
-                                        total = receiver rows * (1 + bounces) */
-    void *progress_user;
-} hfvis_ns_gi_options;
-
-/* The defaults, filled in (levels stays 0 = auto: it depends on the grid). */
-HFVIS_API hfvis_ns_gi_options hfvis_ns_gi_options_default(void);
-
-/* The options hfvis_ns_gi uses for this grid: every default resolved (levels computed, enums
- * made explicit, view_dir normalised; level offsets of "none" stay HFVIS_NS_NO_OFFSET), so a
- * port can print the exact parameters. in may be NULL. Returns HFVIS_OK, or
- * HFVIS_ERR_INVALID_ARGUMENT for an invalid grid, a NULL out or an invalid option. */
-HFVIS_API hfvis_status hfvis_ns_gi_options_resolve(const hfvis_grid *grid,
-                                                   const hfvis_ns_gi_options *in,
-                                                   hfvis_ns_gi_options *out);
-
-/* What is lit, and how it reflects. */
-typedef struct hfvis_ns_scene {
-    int channels;                /* C, 1..4 */
-    const double *env_sh;        /* environment radiance as SH, env_sh[c*16 + i] (e.g. from
-                                    hfvis_sh_project_env; a uniform sky c is 2 sqrt(pi) c at
-                                    i = 0), or NULL for none */
-    const hfvis_sun *lights;     /* light_count lights (azimuth = look direction toward the light,
-                                    elevation in [-pi/2, pi/2], irradiance[c] on a surface facing
-                                    it): radius_rad == 0 is a directional light, 0 < radius_rad
-                                    <= pi/2 a key light (a uniform cap of radiance
-                                    irradiance / (pi sin^2 radius)). NULL if light_count is 0. */
-    int light_count;             /* 0..64 */
-    float albedo[4];             /* diffuse albedo per channel (first C used) */
-    const float *albedo_map;     /* or per sample: albedo_map[(y*width + x)*C + c]; NULL = albedo */
-    const float *emission;       /* emitted radiance per sample, same layout, or NULL */
-    float specular;              /* Phong specular weight, >= 0 (0 = diffuse only) */
-    float shininess;             /* Phong exponent S > 0 (used when specular > 0): the lobe
-                                    ((S+1)/(2 pi)) cos^S about the reflection vector, in SH its
-                                    multipliers exp(-l^2/(2S)) (hfvis_zh_phong) */
-} hfvis_ns_scene;
-
-/* Where the results go (each pointer may be NULL). Layout [(y*width + x)*C + c], width stride;
- * bounce plane b-1 (b = 1..bounces) at bounce + (b-1)*width*height*C; visibility[(j*rw + i)*16 + r]
- * for receiver (i, j) of the rw x rh receiver grid, rw = ceil(width/s), rh = ceil(height/s). */
-typedef struct hfvis_ns_gi_outputs {
-    int bounces;                 /* B >= 0 indirect bounces */
-    float *direct;               /* width*height*C: emission + direct light */
-    float *bounce;               /* bounces*width*height*C: the radiance each bounce adds */
-    float *total;                /* width*height*C: direct + every bounce */
-    float *visibility;           /* 16*rw*rh: the environment visibility SH V (Eq. 21) per
-                                    receiver, for diffing a port; NaN at receivers on holes */
-} hfvis_ns_gi_outputs;
-
-/* Multi-resolution height-field global illumination ([NS09]; spec GI B.9 RENDER).
- * Per receiver (one per s x s block): m slices (Eq. 15-17) give V = Sum_j G_j v_j with
- * v_j = vbar(pi/2) - vbar(omega_max,j) (Eq. 11), G_j the wedge matrices rotated into place
- * (hfvis_ns_sample_matrices; m wedges with the wrap-around one); key lights add their restricted
- * V_key; the incident radiance is I_0 = L_env * V + Sum L_key * V_key (SH products), plus the
- * directional lights. Per bounce b the casting sets are scanned again and the exit radiance of
- * bounce b-1 read from the radiance pyramid at level l_u(i) (Eq. 12) gives U_b. Every texel is
- * shaded with its own full-resolution normal (hfvis_normals_compute) from V, V_key, U_b
- * bilinearly upsampled over the receivers (renormalised over receivers that are not holes; a texel
- * with none around is computed as a receiver of its own): diffuse E = (Ahat_diffuse Y(N)) . I,
- * glossy (Ahat_phong Y(R)) . I with R = reflect(view_dir, N).
- * Exact cases (tested): an open flat field under a uniform sky c returns albedo*c for any m,
- * interp, k, n, offsets and s (bands 0 and 1 of the hemisphere are exact, spec GI B.13-7); a
- * V-shaped valley's bottom reproduces the order-4 trench values of B.13-9; emission 1 with a black
- * sky and raw omega_max closes the furnace: direct(sky 1) + bounce(emission 1) = 1.
- * Holes: a non-finite height never occludes, is never in a casting set, and gets NaN in every
- * output. Lighting below the tangent plane and SH ringing are not clamped (spec GI B.12-8): outputs
- * can be slightly negative.
- * grid: valid (hfvis_grid). scene: see hfvis_ns_scene. opts may be NULL. out: non-NULL; outputs
- * must not overlap each other or the inputs.
- * Returns HFVIS_OK, HFVIS_ERR_INVALID_ARGUMENT for NULL grid/scene/out, an invalid grid, a bad
- * option, channels outside 1..4, a non-finite env_sh value, a light with a non-finite field, an
- * elevation outside [-pi/2, pi/2] or a radius outside [0, pi/2], more than 64 lights, a non-finite
- * albedo, specular < 0 or non-finite, shininess <= 0 or non-finite with specular > 0, a
- * non-finite albedo_map / emission value at a sample that is not a hole, bounces < 0, or sizes that
- * overflow size_t; HFVIS_ERR_OUT_OF_MEMORY (nothing written, nothing leaked).
- * Allocates at most 4 blocks (hfvis_ns_gi_scratch_size bytes): tables, height pyramid and
- * normals, two receiver rows, and (with bounces) the casting-set cache and radiance pyramids.
- * Cost: O(rw rh (m + key samples + directional lights) n) for the direct pass (about 20 ns per
- * step on one 2020s core) and O(rw rh m K C) per bounce with the cache (K the casting-set size;
- * x16 with VECTOR glossy), plus O(W H C 256) shading. Deterministic.
- * Accuracy (measured, test_gi2.c and the bench, fBm terrains): with the defaults, the direct light
- * of a uniform sky is within 1.4-2.3% RMS of P1's (hfvis_sky_light), of which about 1.8% is the
- * order-4 SH truncation itself (the SH projection of the exact horizons is that far from P1); one
- * bounce is within 0.016 (unit sky) RMS of P2's hfvis_indirect_light; hard sun shadows differ from
- * hfvis_sun_visibility at 3-4% of the pixels (exponential steps miss thin ridges; P1 itself differs
- * from a fine ray march at 4.7%). Full-frame RMS against the exact pipeline: 5-7% of the mean. */
-HFVIS_API hfvis_status hfvis_ns_gi(const hfvis_grid *grid, const hfvis_ns_scene *scene,
-                                   const hfvis_ns_gi_options *opts,
-                                   const hfvis_ns_gi_outputs *out);
-
-/* Bytes of scratch hfvis_ns_gi allocates for these arguments (the sum of its blocks, all live at
- * once: its peak), the "memory" of [NS09] Table 1 without the caller's outputs. bounces >= 0.
- * Same validation as hfvis_ns_gi (outputs are not needed). */
-HFVIS_API hfvis_status hfvis_ns_gi_scratch_size(const hfvis_grid *grid, const hfvis_ns_scene *scene,
-                                                const hfvis_ns_gi_options *opts, int bounces,
-                                                size_t *bytes);
-
-/* [NS09] Eq. 16: the maximum of the uniform cubic B-spline with control points omega[0..n-1]
- * (radians), evaluated at the knots S(j) = (w_(j-1) + 4 w_j + w_(j+1))/6 and the midpoints
- * S(j+1/2) = (w_(j-1) + 23 w_j + 23 w_(j+1) + w_(j+2))/48, end points replicated
- * (w_(-1) = w_0, w_n = w_(n-1); spec GI B.4 [choice]). n = 0 gives -pi/2 (nothing blocks).
- * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for a NULL out, n < 0, NULL omega with n > 0 or
- * a non-finite omega. Cost O(n). */
-HFVIS_API hfvis_status hfvis_ns_bspline_max(int n, const double *omega_rad, double *out);
-
-/* The per-sample form of [NS09] Eq. 20-21: G[(j*16 + r)*4 + k] such that
- * hfvis_ns_wedges_to_sh(set, w) = Sum_j G_j w_j (G_j a 16x4 matrix, r the SH index, k the NLP
- * index): each wedge matrix block is rotated into place once, Rot_z(M_s, phi_wedge), and added to
- * the sample it reads, so a slice costs 64 multiply-adds and no rotation. Equal to
- * hfvis_ns_wedges_to_sh up to rounding. G must hold 64*set->samples doubles.
- * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT as hfvis_ns_wedges_to_sh. */
-HFVIS_API hfvis_status hfvis_ns_sample_matrices(const hfvis_ns_wedges *set, double *G);
-
-
-/* ========================================================================================== */
-/* voxel.c - binary voxelizers: conservative (SAT), solid (parity), bitmask; .binvox and raw   */
-/* ========================================================================================== */
-
-/* All three voxelizers below decide in GRID SPACE: vertex p becomes g = (p - origin) / cell,
- * per axis in double (one division per coordinate, the same expression in every routine and its
- * reference), so voxel (i, j, k) is the unit cube [i, i+1] x [j, j+1] x [k, k+1] with centre
- * (i + 0.5, j + 0.5, k + 0.5). Occupancy outputs are uint8 per voxel in the grid's linear order
- * (k*dims[1] + j)*dims[0] + i, 1 = occupied, 0 = empty; the whole array is overwritten.
- * Common errors: HFVIS_ERR_INVALID_ARGUMENT for a NULL or invalid mesh (hfvis_mesh) or grid
- * (hfvis_volume_grid), a NULL output or an unknown enum in the options (outputs untouched);
- * HFVIS_ERR_LIMIT when a vertex lies more than 2^60 cells from the grid origin (the exact
- * predicates would overflow); HFVIS_ERR_OUT_OF_MEMORY when scratch cannot be allocated (nothing
- * leaked, outputs untouched). Degenerate triangles (zero grid-space normal) are skipped. */
-
-/* The axis along which hfvis_voxelize_solid casts its parity rays. */
-typedef enum hfvis_parity_axis {
-    HFVIS_PARITY_AXIS_DEFAULT = 0, /* = HFVIS_PARITY_AXIS_Z */
-    HFVIS_PARITY_AXIS_X = 1,
-    HFVIS_PARITY_AXIS_Y = 2,
-    HFVIS_PARITY_AXIS_Z = 3
-} hfvis_parity_axis;
-
-/* Options of the binary voxelizers (NULL or all-zero = defaults). */
-typedef struct hfvis_binary_voxel_options {
-    const hfvis_allocator *alloc; /* scratch; NULL = malloc/free */
-    hfvis_parity_axis axis;       /* solid only: ray direction (default z) */
-    int allow_open;               /* solid only: 0 (default) = a column crossed an odd number of
-                                     times (an open mesh) fails with HFVIS_ERR_FORMAT; nonzero =
-                                     such columns are left empty and the others are filled */
-} hfvis_binary_voxel_options;
-
-/* The defaults: alloc NULL, axis HFVIS_PARITY_AXIS_Z, allow_open 0. */
-HFVIS_API hfvis_binary_voxel_options hfvis_binary_voxel_options_default(void);
-
-/* Triangle / axis-aligned box overlap by the separating-axis theorem (Akenine-Moller 2001;
- * spec voxel §3.9): the box (centre, half sizes half[a] >= 0) and the triangle (v0, v1, v2)
- * overlap unless one of 13 axes separates them: the 3 box normals (bounding boxes), the 9
- * cross products e_a x f_j of the box axes with the triangle edges f0 = v1-v0, f1 = v2-v1,
- * f2 = v0-v2, and the triangle normal n = f0 x f1. Both are CLOSED sets: touching (a vertex,
- * edge or face on the box boundary) counts as overlap, so a triangle lying in the plane shared
- * by two voxels overlaps both. Zero axes (an edge parallel to a box axis, a degenerate
- * triangle) never separate, so a degenerate triangle is tested as the segment or point it is.
- * Evaluated in double with a fixed expression per axis (documented in voxel.c, 5a); exact up to
- * the rounding of those expressions, which hfvis_voxelize_conservative reproduces bit for bit.
- * Inputs must be finite (otherwise the result is unspecified, but no undefined behaviour).
- * Returns 1 when they overlap, 0 when an axis separates them. */
-HFVIS_API int hfvis_triangle_box_overlap(const double center[3], const double half[3],
-                                         const double v0[3], const double v1[3],
-                                         const double v2[3]);
-
-/* Conservative surface voxelization: occ[v] = 1 for every voxel whose closed cube the triangle
- * overlaps by hfvis_triangle_box_overlap (grid space: centre (i+.5, j+.5, k+.5), half 0.5), for
- * every triangle; 26-separating, a superset of the pixel-centre voxelizations (spec §3.4, §3.9).
- * Only the voxels of the triangle's bounding-box range are candidates: along each axis
- * i = max(0, ceil(min) - 1) .. min(dims-1, floor(max)) (the voxels whose closed extent meets
- * the triangle's); the result is EXACTLY the set hfvis_voxelize_conservative_reference gives,
- * voxel for voxel, including ties (faces on voxel boundaries, vertices on voxel corners).
- * Method (Schwarz & Seidel 2010, made exact): per triangle, in the frame of its dominant axis,
- * each of the nine edge axes becomes a bound on two voxel-centre coordinates and the plane axis
- * a bound on the layers of each column; rows of columns, then the layer interval of each
- * column, follow from these bounds evaluated in double with a safety margin (2^-30 of the
- * coordinate scale, far above the rounding of either side), so a voxel decided by the margin
- * is decided as the SAT decides it, and the few voxels within a margin of a bound are decided
- * by the SAT's own expressions. Bounding boxes of at most 16 voxels use the SAT directly on
- * the voxels not set yet. Cost O(T + rows + columns + voxels written) plus O(grid volume / 64)
- * to clear and emit; the baseline is O(sum of bounding-box voxels). occ: dims[0]*dims[1]*dims[2]
- * bytes, overwritten. count (may be NULL): occupied voxels. opts: only alloc is used. Two
- * allocations: vertex_count*24 bytes (vertices in grid space) and ceil(dims/4)^3 * 8 bytes (a
- * bit per voxel in 4x4x4 bricks). Errors: see the section comment. */
-HFVIS_API hfvis_status hfvis_voxelize_conservative(const hfvis_mesh *mesh,
-                                                   const hfvis_volume_grid *grid,
-                                                   const hfvis_binary_voxel_options *opts,
-                                                   uint8_t *occ, size_t *count);
-
-/* The oracle and baseline of hfvis_voxelize_conservative: for every triangle, for every voxel
- * of its bounding-box range, one call of hfvis_triangle_box_overlap (nothing precomputed).
- * Same arguments, result and errors; no allocation. Cost O(sum over triangles of bbox voxels). */
-HFVIS_API hfvis_status hfvis_voxelize_conservative_reference(const hfvis_mesh *mesh,
-                                                             const hfvis_volume_grid *grid,
-                                                             const hfvis_binary_voxel_options *opts,
-                                                             uint8_t *occ, size_t *count);
-
-/* Solid voxelization by parity (spec §3.9: Chen & Fang 1998; Eisemann & Decoret 2008):
- * occ[v] = 1 when the centre of voxel v lies inside the mesh, decided by the parity of the
- * crossings of the line through the voxel centres along opts->axis (default z) below the
- * centre. A crossing is a triangle covering the column's centre point (u, w) = (iu+.5, iw+.5)
- * in projection: vertices are moved to that point and the three edge functions are evaluated
- * with their EXACT sign (a double product test, falling back to Dekker's error-free products on
- * ties), and an edge passing exactly through the point counts for the triangle on one side only
- * (the point moved by an infinitesimal (eps, eps^2) must be inside: a top-left rule), so a
- * shared edge or vertex is counted once where the surface passes through and 0 or 2 times where
- * it folds. Each crossing at depth z toggles every voxel whose centre is above z (k + 0.5 > z;
- * a centre exactly on the surface counts as below it): one toggle per crossing into occ, then a
- * prefix XOR along the axis (O(grid volume)). Orientation does not matter; nested closed
- * surfaces alternate inside/outside; self-intersecting ones give their crossing parity.
- * The mesh must be closed: with exact signs every line crosses a closed surface an even number
- * of times, so a column crossed an odd number of times proves an open mesh: HFVIS_ERR_FORMAT
- * (occ untouched) unless opts->allow_open, which leaves such columns empty and fills the others
- * (a hole lets the columns through it fall out; it cannot flood the rest). Triangles with a
- * zero grid-space normal are ignored; edge-on triangles (zero projected area) never cross.
- * opts: alloc, axis (HFVIS_ERR_INVALID_ARGUMENT for an unknown value), allow_open.
- * count (may be NULL): occupied voxels. One allocation (dims[u]*dims[w] bytes of column
- * parities). Cost: O(T + covered column centres) twice (a checking pass first unless
- * allow_open) + O(grid volume). Errors: see the section comment. */
-HFVIS_API hfvis_status hfvis_voxelize_solid(const hfvis_mesh *mesh, const hfvis_volume_grid *grid,
-                                            const hfvis_binary_voxel_options *opts, uint8_t *occ,
-                                            size_t *count);
-
-/* Oracle of hfvis_voxelize_solid, per voxel centre c independently of any axis: the generalized
- * winding number w(c) = (1/4pi) sum over triangles of their signed solid angle at c (Van
- * Oosterom & Strackee; Jacobson et al. 2013) in double, and occ = 1 when round(|w|) is odd.
- * On a consistently oriented closed mesh this is the parity of hfvis_voxelize_solid except for
- * centres within rounding of the surface. Never fails on open meshes (no HFVIS_ERR_FORMAT).
- * opts->axis is only checked. Same other arguments and errors; allocates nothing.
- * Cost O(voxels * T) (small grids only). */
-HFVIS_API hfvis_status hfvis_voxelize_solid_reference(const hfvis_mesh *mesh,
-                                                      const hfvis_volume_grid *grid,
-                                                      const hfvis_binary_voxel_options *opts,
-                                                      uint8_t *occ, size_t *count);
-
-/* *result = 1 when the mesh's index structure is closed and consistently oriented: every
- * directed edge a -> b (a != b) of a triangle occurs exactly once and its reverse b -> a occurs
- * exactly once too (so every undirected edge is used by exactly two triangles in opposite
- * directions); 0 otherwise (including triangles with a repeated index). An empty mesh is
- * watertight. Only indices are compared: a soup whose coincident corners are separate vertices
- * is not watertight here (hfvis_voxelize_solid works on positions and accepts it).
- * Returns HFVIS_ERR_INVALID_ARGUMENT for a NULL result or an invalid mesh,
- * HFVIS_ERR_OUT_OF_MEMORY if the edge array (24 bytes per triangle, one allocation from alloc,
- * NULL = malloc) cannot be allocated; *result untouched then. Cost O(T log T). */
-HFVIS_API hfvis_status hfvis_mesh_is_watertight(const hfvis_mesh *mesh,
-                                                const hfvis_allocator *alloc, int *result);
-
-/* Words of a bitmask volume (hfvis_voxelize_bitmask): dims[0]*dims[1]*ceil(dims[2]/32);
- * 0 for a NULL or invalid grid. */
-HFVIS_API size_t hfvis_bitmask_words(const hfvis_volume_grid *grid);
-
-/* Bitmask surface voxelization (Eisemann & Decoret 2006, run from the three axis viewpoints;
- * spec §3.9, §6): for each axis a (u = a+1, w = a+2 mod 3), every non-degenerate triangle is
- * rasterized into the (u, w) pixel grid with the pixel-centre rule of hfvis_voxelize_solid (the
- * watertight top-left coverage), the depth z along a of each covered centre is interpolated
- * (barycentrics, clamped to the triangle's depth range) and the bit of slab floor(z) (a depth
- * on a boundary goes to the upper slab; slabs outside [0, dims[a]) are dropped) is ORed in; the
- * three passes are ORed. This is the voxel set of the thesis' three-axis Chen-Fang variant
- * (hfvis_voxelize_occupancy with HFVIS_AXES_ALL and the pixel rule), up to centres within
- * rounding of an edge or depths within rounding of a slab boundary, and a subset of
- * hfvis_voxelize_conservative (the triangle point of a fragment lies in its voxel).
- * Layout (the slicemap layout of Eisemann & Decoret 2008): bits packed along z, 32 per word,
- * one run of W = ceil(dims[2]/32) words per (i, j) column: voxel (i, j, k) is bit (k & 31) of
- * bits[(j*dims[0] + i)*W + (k >> 5)]; bits for k >= dims[2] are 0. bits must hold
- * hfvis_bitmask_words(grid) words (overwritten). count (may be NULL): set bits. opts: unused
- * (may be NULL). Allocates nothing. Cost O(T + covered pixels of the three projections).
- * Errors: see the section comment. */
-HFVIS_API hfvis_status hfvis_voxelize_bitmask(const hfvis_mesh *mesh, const hfvis_volume_grid *grid,
-                                              const hfvis_binary_voxel_options *opts, uint32_t *bits,
-                                              size_t *count);
-
-/* Unpacks a bitmask volume into uint8 occupancy (grid order, 0/1). Returns
- * HFVIS_ERR_INVALID_ARGUMENT for NULL or an invalid grid. */
-HFVIS_API hfvis_status hfvis_bitmask_to_occupancy(const hfvis_volume_grid *grid,
-                                                  const uint32_t *bits, uint8_t *occ);
-
-/* .binvox (the voxel format of P. Min's binvox / viewvox; header "#binvox 1", "dim D D D",
- * "translate tx ty tz", "scale s", "data", then run-length pairs (value, count 1..255) over the
- * D^3 voxels with x slowest, then z, then y fastest: binvox index x*D*D + z*D + y is hfvis voxel
- * (i, j, k) = (x, y, z)). Voxel (x, y, z) spans translate + (scale/D)*[x, x+1] x [y, y+1] x
- * [z, z+1], so translate = origin and scale = D*cell. binvox grids are cubes with cubic voxels:
- * a grid is written padded with empty voxels to the cube of its largest side D, with
- * translate = origin and scale = D * max(cell[a]) (non-cubic cells are approximated by the
- * largest). Numbers are written locale-independently with the fewest digits that read back
- * exactly (up to 15), else 17 digits. Any nonzero occupancy byte is written as 1. */
-
-/* Exact size in bytes of the encoding of (grid, occ) (scans occ for the runs); 0 for NULL, an
- * invalid grid, a cube of more than HFVIS_VOLUME_MAX_VOXELS voxels or a scale D*cell that
- * overflows a double. */
-HFVIS_API size_t hfvis_binvox_encode_size(const hfvis_volume_grid *grid, const uint8_t *occ);
-
-/* Encodes into out (capacity bytes); *written = bytes written. Returns HFVIS_ERR_INVALID_ARGUMENT
- * for NULL or an invalid grid, HFVIS_ERR_LIMIT when the padded cube exceeds
- * HFVIS_VOLUME_MAX_VOXELS or its scale overflows, HFVIS_ERR_BUFFER_TOO_SMALL below hfvis_binvox_encode_size. */
-HFVIS_API hfvis_status hfvis_binvox_encode(const hfvis_volume_grid *grid, const uint8_t *occ,
-                                           void *out, size_t capacity, size_t *written);
-
-/* Decodes a .binvox held in memory (strict): "#binvox 1" (or 2: values 0..255) on the first
- * line; then lines "dim", "translate", "scale" in any order, each at most once ("dim"
- * required, three equal positive integers; "translate" three finite numbers, default 0;
- * "scale" one positive finite number, default 1), blanks between fields, "\n" or "\r\n" line
- * ends; then "data" and its line end; then exactly the pairs covering D^3 voxels: version 1
- * values 0 or 1, counts 1..255, no run past the end, nothing after the last pair.
- * On success *grid = D^3 voxels, origin = translate, cell = scale/D, and *occ = D^3 bytes in
- * hfvis order (the file's values), allocated with alloc (NULL = malloc; free with
- * hfvis_free(alloc, *occ)). The runs are validated before allocating (one allocation).
- * Returns HFVIS_ERR_INVALID_ARGUMENT for NULL data, grid or occ; HFVIS_ERR_FORMAT for any
- * malformation (also a non-cubic dim or a scale/D that is not a valid cell); HFVIS_ERR_LIMIT
- * when D^3 exceeds HFVIS_VOLUME_MAX_VOXELS; HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on
- * error. */
-HFVIS_API hfvis_status hfvis_binvox_decode(const void *data, size_t size,
-                                           const hfvis_allocator *alloc, hfvis_volume_grid *grid,
-                                           uint8_t **occ);
-
-/* File wrappers (not with HFVIS_NO_STDIO). Save writes atomically (a temporary file renamed
- * onto path: complete or untouched), allocating the encoding with malloc; errors of encode,
- * HFVIS_ERR_IO, HFVIS_ERR_OUT_OF_MEMORY. Load: errors of decode and HFVIS_ERR_IO. */
-HFVIS_API hfvis_status hfvis_binvox_save(const char *path, const hfvis_volume_grid *grid,
-                                         const uint8_t *occ);
-HFVIS_API hfvis_status hfvis_binvox_load(const char *path, const hfvis_allocator *alloc,
-                                         hfvis_volume_grid *grid, uint8_t **occ);
-
-/* Raw occupancy: exactly dims[0]*dims[1]*dims[2] bytes of voxels, as given, in grid order
- * (x fastest, then y, then z), no header (read it with the grid's dims, e.g. a "raw volume"
- * import of 8-bit unsigned data). Errors: HFVIS_ERR_INVALID_ARGUMENT for NULL or an invalid grid,
- * HFVIS_ERR_IO, HFVIS_ERR_OUT_OF_MEMORY. */
-HFVIS_API hfvis_status hfvis_voxels_raw_save(const char *path, const hfvis_volume_grid *grid,
-                                             const uint8_t *voxels);
 
 #ifdef __cplusplus
 }

@@ -4,6 +4,15 @@
  *   1. Common: allocation, checked sizes, mesh and grid validation, file helpers
  *   2. Views: GL-convention matrices, depth linearisation (thesis eq. 16, sign restored)
  *   3. Volume grids and the Volume Buffer (thesis ch. 6 §6.3; spec voxel §3.2-3.3)
+ *   4. Meshes: analytic test meshes (box, spheres, torus, torus knot, height field, room,
+ *      teapot) and the Wavefront OBJ codec
+ *   5. Reference rasterizer: fixed-point top-left coverage, near clipping, ray-per-pixel oracle
+ *   6. BVH and ray casting: binned SAH, watertight ray-triangle test (Woop, Benthin & Wald
+ *      2013), closest/any hit, naive oracles
+ *   7. Surface voxelization into the Volume Buffer ([G12] ch. 6 Alg. 5-6, ch. 5 Alg. 4)
+ *   8. Binary voxelizers: conservative (Akenine-Moller SAT; Schwarz & Seidel 2010), solid
+ *      (parity), bitmask (Eisemann & Decoret); .binvox and raw
+ *   9. Incremental image-based voxelization ([G12] ch. 7 Alg. 7, eq. 16-17, Table 9)
  *
  * Paper references: [G12] A. Gaitatzes, "Interactive diffuse global illumination discretization
  * methods for dynamic environments", PhD thesis, Univ. of Cyprus, 2012. "spec voxel" is the
@@ -479,22 +488,22 @@ HFVIS_API hfvis_status hfvis_volume_merge(hfvis_volume *dst, const hfvis_volume 
 }
 
 /* ========================================================================================== */
-/* 1. Meshes: analytic test meshes and the Wavefront OBJ codec                                */
+/* 4. Meshes: analytic test meshes and the Wavefront OBJ codec                                */
 /*    (infrastructure for Gaitatzes 2012, ch. 6-7 and spec voxel §3.13: the icosphere of test  */
 /*    4, the cube of tests 1-2, the 100k-triangle benchmark torus knot of issue 4)            */
 /* ========================================================================================== */
 /* Contents
- *   1a. mesh builder (exact sizes, limits, overflow checks, one cleanup path)
- *   1b. generators: box, UV sphere, icosphere, torus, torus knot, height field, room, teapot
- *   1c. bounds
- *   1d. OBJ decoder (two passes: count, then fill), own locale-independent number parser
- *   1e. OBJ encoder (own shortest round-trip float formatting), file wrappers
+ *   4a. mesh builder (exact sizes, limits, overflow checks, one cleanup path)
+ *   4b. generators: box, UV sphere, icosphere, torus, torus knot, height field, room, teapot
+ *   4c. bounds
+ *   4d. OBJ decoder (two passes: count, then fill), own locale-independent number parser
+ *   4e. OBJ encoder (own shortest round-trip float formatting), file wrappers
  * Every generated triangle is counter-clockwise seen from outside: (v1 - v0) x (v2 - v0) points
  * out of the enclosed volume (into the room for the room's walls). */
 
 #define VX_MESH_PI 3.14159265358979323846
 
-/* ---- 1a. builder ------------------------------------------------------------------------ */
+/* ---- 4a. builder ------------------------------------------------------------------------ */
 
 typedef struct vx_mesh_builder {
     float *xyz;
@@ -591,7 +600,7 @@ static size_t vx_mesh_mul(size_t a, size_t b)
 }
 static size_t vx_mesh_add(size_t a, size_t b) { return a > SIZE_MAX - b ? SIZE_MAX : a + b; }
 
-/* ---- 1b. generators --------------------------------------------------------------------- */
+/* ---- 4b. generators --------------------------------------------------------------------- */
 
 /* The 12 outward triangles of a box whose corner k is (bit0: x, bit1: y, bit2: z) hi or lo,
  * two per face in the order -x, +x, -y, +y, -z, +z. */
@@ -1158,7 +1167,7 @@ HFVIS_API hfvis_status hfvis_mesh_teapot(const hfvis_allocator *alloc, int n, hf
     return vx_mesh_builder_finish(&b, alloc, out);
 }
 
-/* ---- 1c. bounds ------------------------------------------------------------------------- */
+/* ---- 4c. bounds ------------------------------------------------------------------------- */
 
 HFVIS_API hfvis_status hfvis_mesh_bounds(const hfvis_mesh *mesh, double lo[3], double hi[3])
 {
@@ -1182,7 +1191,7 @@ HFVIS_API hfvis_status hfvis_mesh_bounds(const hfvis_mesh *mesh, double lo[3], d
     return HFVIS_OK;
 }
 
-/* ---- 1d. OBJ decoder -------------------------------------------------------------------- */
+/* ---- 4d. OBJ decoder -------------------------------------------------------------------- */
 /* Wavefront OBJ subset (DESIGN §4): `v x y z [w | r g b ...]` and `f` lines; every other
  * statement is ignored. Two passes over the bytes with the same parser: pass 1 validates and
  * counts, pass 2 fills arrays of exactly the counted sizes (forward vertex references are
@@ -1426,7 +1435,7 @@ HFVIS_API hfvis_status hfvis_obj_decode(const void *data, size_t size,
     return vx_mesh_builder_finish(&b, alloc, out);
 }
 
-/* ---- 1e. OBJ encoder, file wrappers ----------------------------------------------------- */
+/* ---- 4e. OBJ encoder, file wrappers ----------------------------------------------------- */
 
 #define VX_MESH_OBJ_FLOAT_MAX 16 /* longest number written: "-1.23456789e-38" is 15 */
 
@@ -1634,7 +1643,7 @@ HFVIS_API hfvis_status hfvis_mesh_save(const char *path, const hfvis_mesh *mesh)
 
 
 /* ========================================================================================== */
-/* Reference rasterizer (issue 4 "mesh infrastructure"; spec voxel §0 view conventions)       */
+/* 5. Reference rasterizer (spec voxel §0 view conventions)                                   */
 /* ========================================================================================== */
 /* The fixed-function GPU pipeline on the CPU, as the thesis' ch. 7 camera and light views render
  * their depth and G-buffer images ([G12] §7.4.1-7.4.2; Listings 7.1-7.2 read them):
@@ -2208,7 +2217,809 @@ HFVIS_API hfvis_status hfvis_rasterize_reference(const hfvis_mesh *mesh, const h
 }
 
 /* ========================================================================================== */
-/* 3a. Surface voxelization into the Volume Buffer                                            */
+/* 6. BVH and ray casting (the scene-space caster of spec raycast A.9.2 / A.10)               */
+/*     Watertight test: S. Woop, C. Benthin, I. Wald, "Watertight Ray/Triangle Intersection",  */
+/*     JCGT 2(1), 2013: its pseudo-code listing (ray setup, shear, edge functions U V W, the   */
+/*     double-precision recomputation of zero edge functions), quoted line by line below.     */
+/*     Slab test: T. Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013 (t_far * (1 + 2 gamma_3)).*/
+/*     SAH: MacDonald & Booth 1990, binned as I. Wald, IEEE RT 2007.                           */
+/* ========================================================================================== */
+/* Contents
+ *   6.1 rays: validation and the per-ray setup of Woop et al.
+ *   6.2 the watertight ray-triangle test and the exact zero-area test
+ *   6.3 naive oracle (every triangle in index order)
+ *   6.4 binned SAH build (explicit stack, median fallback, padded boxes)
+ *   6.5 traversal (robust slab test, nearer child first, explicit stack) */
+
+/* Far-distance and best-distance widening of the slab test: Ize's 1 + 2 gamma_3 (3.6e-7) covers
+ * the slab arithmetic; 2^-16 also covers the rounding of the triangle's own t (relative, a few
+ * ulp times the conditioning of the hit), so a hit the naive loop finds is never pruned. */
+#define VX_BVH_SLACK (1.0f + 1.0f / 65536.0f)
+/* Node boxes are padded by 2^-18 of their largest coordinate magnitude or extent: covers the
+ * off-plane rounding of a computed hit point (about gamma * box size) near box faces. */
+#define VX_BVH_PAD 0x1p-18
+/* The two inner-loop tests are forced inline (GCC/Clang), else left to the compiler. */
+#if defined(__GNUC__)
+#define VX_BVH_INLINE inline __attribute__((always_inline))
+#else
+#define VX_BVH_INLINE inline
+#endif
+/* SAH constants (spec raycast A.9.2: C_trav = C_tri = 1). */
+#define VX_BVH_C_TRAV 1.0
+#define VX_BVH_C_TRI 1.0
+
+/* ---- 6.1 rays ------------------------------------------------------------------------------ */
+
+/* A ray prepared once per query (Woop et al.: "calculate dimension where the ray direction is
+ * maximal", "swap kx and ky dimension to preserve winding direction of triangles", "calculate
+ * shear constants"). */
+typedef struct vx_bvh_ray {
+    float org[3], dir[3];
+    float inv[3];      /* 1/dir; a zero component gives +-infinity with the zero's sign */
+    int neg[3];        /* sign bit of dir: the slab's near plane is hi when set */
+    int kx, ky, kz;    /* kz = axis of the largest |dir|; kx, ky swapped if dir[kz] < 0 */
+    float sx, sy, sz;  /* shear constants: dir[kx]/dir[kz], dir[ky]/dir[kz], 1/dir[kz] */
+    float t_min, t_max;
+    int cull;
+} vx_bvh_ray;
+
+static int vx_bvh_ray_valid(const hfvis_ray *r)
+{
+    int a;
+    if (!r) return 0;
+    for (a = 0; a < 3; a++)
+        if (!isfinite(r->origin[a]) || !isfinite(r->direction[a])) return 0;
+    if (r->direction[0] == 0.0f && r->direction[1] == 0.0f && r->direction[2] == 0.0f) return 0;
+    if (!(r->t_min >= 0.0f) || !isfinite(r->t_min)) return 0; /* NaN fails the first test */
+    if (!(r->t_max >= r->t_min)) return 0;                    /* NaN fails; +inf allowed */
+    if (r->cull != HFVIS_CULL_NONE && r->cull != HFVIS_CULL_BACK
+        && r->cull != HFVIS_CULL_FRONT)
+        return 0;
+    return 1;
+}
+
+/* kz = dimension of the largest |direction| component (first on ties), kx and ky the
+ * next two cyclically, swapped when dir[kz] < 0 to keep the winding; shear constants. */
+static void vx_bvh_ray_setup(const hfvis_ray *r, vx_bvh_ray *p)
+{
+    int a, kz = 0, t;
+    float m = fabsf(r->direction[0]);
+    for (a = 0; a < 3; a++) {
+        float d = r->direction[a];
+        p->org[a] = r->origin[a];
+        p->dir[a] = d;
+        p->neg[a] = signbit(d) ? 1 : 0;
+        p->inv[a] = d == 0.0f ? copysignf(INFINITY, d) : 1.0f / d;
+        if (fabsf(d) > m) {
+            m = fabsf(d);
+            kz = a;
+        }
+    }
+    p->kz = kz;
+    p->kx = kz == 2 ? 0 : kz + 1;
+    p->ky = p->kx == 2 ? 0 : p->kx + 1;
+    if (r->direction[kz] < 0.0f) {
+        t = p->kx;
+        p->kx = p->ky;
+        p->ky = t;
+    }
+    p->sx = r->direction[p->kx] / r->direction[kz];
+    p->sy = r->direction[p->ky] / r->direction[kz];
+    p->sz = 1.0f / r->direction[kz];
+    p->t_min = r->t_min;
+    p->t_max = r->t_max;
+    p->cull = (int)r->cull;
+}
+
+static void vx_bvh_miss(hfvis_hit *h)
+{
+    h->t = INFINITY;
+    h->triangle = HFVIS_NO_TRIANGLE;
+    h->u = 0.0f;
+    h->v = 0.0f;
+    h->front = 0;
+}
+
+/* ---- 6.2 watertight ray-triangle test ----------------------------------------------------- */
+
+/* Exact test: is p[0] + ... + p[5] == 0? The p are exact products of two floats (double). A
+ * floating-point filter (the rounded sum's error is below 5 u sum|p| < 2^-50 sum|p|) decides
+ * almost always; otherwise Shewchuk's GROW-EXPANSION with Knuth's TWO-SUM and zero
+ * elimination ("Adaptive Precision Floating-Point Arithmetic and Fast Robust Geometric
+ * Predicates", 1997): the sum is zero
+ * iff no component survives. */
+static int vx_bvh_sum6_is_zero(const double p[6])
+{
+    double s = 0.0, m = 0.0, e[7];
+    int i, j, n = 0;
+    for (i = 0; i < 6; i++) {
+        s += p[i];
+        m += fabs(p[i]);
+    }
+    if (m == 0.0) return 1;
+    if (fabs(s) > m * 0x1p-50) return 0;
+    for (i = 0; i < 6; i++) {
+        double q = p[i];
+        int k = 0;
+        for (j = 0; j < n; j++) {
+            double x = q + e[j], bv = x - q, av = x - bv;
+            double err = (q - av) + (e[j] - bv);
+            q = x;
+            if (err != 0.0) e[k++] = err;
+        }
+        if (q != 0.0) e[k++] = q;
+        n = k;
+    }
+    return n == 0;
+}
+
+/* 1 when (b - a) x (c - a) is exactly the zero vector (coincident or collinear vertices). Its
+ * component (i, j) is a_i b_j - a_j b_i + b_i c_j - b_j c_i + c_i a_j - c_j a_i, each product
+ * of two floats exact in double. */
+static int vx_bvh_zero_area(const float *a, const float *b, const float *c)
+{
+    static const int ci[3] = {1, 2, 0}, cj[3] = {2, 0, 1};
+    int k;
+    for (k = 0; k < 3; k++) {
+        int i = ci[k], j = cj[k];
+        double p[6];
+        p[0] = (double)a[i] * (double)b[j];
+        p[1] = -((double)a[j] * (double)b[i]);
+        p[2] = (double)b[i] * (double)c[j];
+        p[3] = -((double)b[j] * (double)c[i]);
+        p[4] = (double)c[i] * (double)a[j];
+        p[5] = -((double)c[j] * (double)a[i]);
+        if (!vx_bvh_sum6_is_zero(p)) return 0;
+    }
+    return 1;
+}
+
+/* Woop et al.'s listing for one triangle, hits accepted with t in [t_min, t_hi] (t_hi <= t_max:
+ * callers pass their current best). Returns 1 and fills h (all but triangle) on a hit. */
+static VX_BVH_INLINE int vx_bvh_tri(const vx_bvh_ray *r, const float *p0, const float *p1,
+                                     const float *p2, float t_hi, hfvis_hit *h)
+{
+    const int kx = r->kx, ky = r->ky, kz = r->kz;
+    float ax, ay, az, bx, by, bz, cx, cy, cz, Ax, Ay, Bx, By, Cx, Cy, U, V, W, det, T, t;
+    /* "calculate vertices relative to ray origin": A = tri.A - org, ... */
+    ax = p0[kx] - r->org[kx];
+    ay = p0[ky] - r->org[ky];
+    az = p0[kz] - r->org[kz];
+    bx = p1[kx] - r->org[kx];
+    by = p1[ky] - r->org[ky];
+    bz = p1[kz] - r->org[kz];
+    cx = p2[kx] - r->org[kx];
+    cy = p2[ky] - r->org[ky];
+    cz = p2[kz] - r->org[kz];
+    /* shear: the ray becomes the +z axis ("Ax = A[kx] - Sx*A[kz]" ...) */
+    Ax = ax - r->sx * az;
+    Ay = ay - r->sy * az;
+    Bx = bx - r->sx * bz;
+    By = by - r->sy * bz;
+    Cx = cx - r->sx * cz;
+    Cy = cy - r->sy * cz;
+    /* scaled barycentric coordinates = 2D edge functions ("U = Cx*By - Cy*Bx" ...) */
+    U = Cx * By - Cy * Bx;
+    V = Ax * Cy - Ay * Cx;
+    W = Bx * Ay - By * Ax;
+    /* "fallback to test against edges using double precision": an edge function that is exactly
+     * 0 is recomputed in double, where the products of two floats are exact and the difference
+     * is correctly rounded, so its sign is exact. (The float value's sign, when nonzero, is
+     * already exact: rounding is monotonic.) */
+    if (U == 0.0f || V == 0.0f || W == 0.0f) goto exact_path;
+    /* inside iff U, V, W share a sign ("if ((U<0 || V<0 || W<0) && (U>0 || V>0 || W>0))
+     * return"); a NaN (two overflowed products) passes here and is resolved below */
+    if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return 0;
+    det = U + V + W;
+    if (!(fabsf(det) <= FLT_MAX)) goto exact_path; /* overflow or NaN: redo in double */
+    if (r->cull == HFVIS_CULL_BACK && det < 0.0f) return 0;
+    if (r->cull == HFVIS_CULL_FRONT && det > 0.0f) return 0;
+    /* scaled hit distance ("Az = Sz*A[kz]" ..., "T = U*Az + V*Bz + W*Cz") and t = T/det */
+    T = U * (r->sz * az) + V * (r->sz * bz) + W * (r->sz * cz);
+    t = T / det;
+    if (!(fabsf(t) <= FLT_MAX)) goto exact_path;
+    if (!(t >= r->t_min) || !(t <= t_hi)) return 0;
+    if (vx_bvh_zero_area(p0, p1, p2)) return 0;
+    h->t = t;
+    h->u = V / det;
+    h->v = W / det;
+    h->front = det > 0.0f;
+    return 1;
+exact_path: {
+        double Ud = (double)Cx * (double)By - (double)Cy * (double)Bx;
+        double Vd = (double)Ax * (double)Cy - (double)Ay * (double)Cx;
+        double Wd = (double)Bx * (double)Ay - (double)By * (double)Ax;
+        double dd, Td, td;
+        if ((Ud < 0.0 || Vd < 0.0 || Wd < 0.0) && (Ud > 0.0 || Vd > 0.0 || Wd > 0.0)) return 0;
+        dd = Ud + Vd + Wd;
+        if (dd == 0.0 || !(fabs(dd) <= DBL_MAX)) return 0; /* edge-on (or not finite) */
+        if (r->cull == HFVIS_CULL_BACK && dd < 0.0) return 0;
+        if (r->cull == HFVIS_CULL_FRONT && dd > 0.0) return 0;
+        Td = Ud * ((double)r->sz * (double)az) + Vd * ((double)r->sz * (double)bz)
+             + Wd * ((double)r->sz * (double)cz);
+        td = Td / dd;
+        if (!(fabs(td) <= (double)FLT_MAX)) return 0;
+        t = (float)td;
+        if (!(t >= r->t_min) || !(t <= t_hi)) return 0;
+        if (vx_bvh_zero_area(p0, p1, p2)) return 0;
+        h->t = t;
+        h->u = (float)(Vd / dd);
+        h->v = (float)(Wd / dd);
+        h->front = dd > 0.0;
+        return 1;
+    }
+}
+
+HFVIS_API hfvis_status hfvis_ray_triangle(const hfvis_ray *ray, const float v0[3],
+                                          const float v1[3], const float v2[3], hfvis_hit *hit)
+{
+    vx_bvh_ray r;
+    hfvis_hit h;
+    int a;
+    if (!vx_bvh_ray_valid(ray) || !v0 || !v1 || !v2 || !hit) return HFVIS_ERR_INVALID_ARGUMENT;
+    for (a = 0; a < 3; a++)
+        if (!isfinite(v0[a]) || !isfinite(v1[a]) || !isfinite(v2[a]))
+            return HFVIS_ERR_INVALID_ARGUMENT;
+    vx_bvh_ray_setup(ray, &r);
+    if (vx_bvh_tri(&r, v0, v1, v2, r.t_max, &h)) {
+        h.triangle = 0;
+        *hit = h;
+    } else {
+        vx_bvh_miss(hit);
+    }
+    return HFVIS_OK;
+}
+
+/* ---- 6.3 naive oracle ---------------------------------------------------------------------- */
+
+static int vx_bvh_query_valid(hfvis_ray_query q)
+{
+    return q == HFVIS_RAY_CLOSEST || q == HFVIS_RAY_ANY;
+}
+
+HFVIS_API hfvis_status hfvis_ray_intersect_naive(const hfvis_mesh *mesh, const hfvis_ray *ray,
+                                                 hfvis_ray_query query, hfvis_hit_filter filter,
+                                                 void *user, hfvis_hit *hit)
+{
+    vx_bvh_ray r;
+    hfvis_hit best, h;
+    size_t t, nv;
+    if (!mesh || !hit || !vx_bvh_ray_valid(ray) || !vx_bvh_query_valid(query))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if ((mesh->vertex_count && !mesh->xyz) || (mesh->triangle_count && !mesh->indices))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    vx_bvh_ray_setup(ray, &r);
+    vx_bvh_miss(&best);
+    best.t = r.t_max;
+    nv = mesh->vertex_count;
+    for (t = 0; t < mesh->triangle_count; t++) {
+        const uint32_t *ix = mesh->indices + 3 * t;
+        if (ix[0] >= nv || ix[1] >= nv || ix[2] >= nv) return HFVIS_ERR_INVALID_ARGUMENT;
+        /* in index order, "t < best" is the closest-hit order (ties keep the lower index) */
+        if (!vx_bvh_tri(&r, mesh->xyz + 3 * (size_t)ix[0], mesh->xyz + 3 * (size_t)ix[1],
+                        mesh->xyz + 3 * (size_t)ix[2], best.t, &h))
+            continue;
+        if (best.triangle != HFVIS_NO_TRIANGLE && !(h.t < best.t)) continue;
+        h.triangle = (uint32_t)t;
+        if (filter && !filter(user, ray, &h)) continue;
+        best = h;
+        if (query == HFVIS_RAY_ANY) break;
+    }
+    if (best.triangle == HFVIS_NO_TRIANGLE) vx_bvh_miss(&best);
+    *hit = best;
+    return HFVIS_OK;
+}
+
+HFVIS_API hfvis_status hfvis_ray_closest_naive(const hfvis_mesh *mesh, const hfvis_ray *ray,
+                                               hfvis_hit *hit)
+{
+    return hfvis_ray_intersect_naive(mesh, ray, HFVIS_RAY_CLOSEST, NULL, NULL, hit);
+}
+
+HFVIS_API hfvis_status hfvis_ray_any_naive(const hfvis_mesh *mesh, const hfvis_ray *ray,
+                                           hfvis_hit *hit)
+{
+    return hfvis_ray_intersect_naive(mesh, ray, HFVIS_RAY_ANY, NULL, NULL, hit);
+}
+
+/* ---- 6.4 binned SAH build ----------------------------------------------------------------- */
+
+HFVIS_API hfvis_bvh_options hfvis_bvh_options_default(void)
+{
+    hfvis_bvh_options o;
+    memset(&o, 0, sizeof o);
+    o.max_leaf_size = HFVIS_BVH_DEFAULT_LEAF_SIZE;
+    o.bins = HFVIS_BVH_DEFAULT_BINS;
+    return o;
+}
+
+typedef struct vx_bvh_prim {
+    float lo[3], hi[3]; /* float bounding box of the triangle (exact: min/max of its vertices) */
+} vx_bvh_prim;
+
+typedef struct vx_bvh_task {
+    uint32_t node, begin, end;
+    int depth;
+} vx_bvh_task;
+
+typedef struct vx_bvh_bin {
+    float lo[3], hi[3];
+    uint32_t count;
+} vx_bvh_bin;
+
+/* Centroid of a triangle's box on axis a, doubled (lo + hi, in double: no overflow). */
+static double vx_bvh_cen(const vx_bvh_prim *p, int a)
+{
+    return (double)p->lo[a] + (double)p->hi[a];
+}
+
+static double vx_bvh_area(const float lo[3], const float hi[3])
+{
+    double dx = (double)hi[0] - (double)lo[0], dy = (double)hi[1] - (double)lo[1],
+           dz = (double)hi[2] - (double)lo[2];
+    return 2.0 * (dx * dy + dy * dz + dz * dx);
+}
+
+static void vx_bvh_grow(float lo[3], float hi[3], const float plo[3], const float phi[3])
+{
+    int a;
+    for (a = 0; a < 3; a++) {
+        if (plo[a] < lo[a]) lo[a] = plo[a];
+        if (phi[a] > hi[a]) hi[a] = phi[a];
+    }
+}
+
+/* Bin of a (doubled) centroid c on an axis with bounds [cmin, cmax], cmax > cmin. */
+static int vx_bvh_bin_of(double c, double cmin, double scale, int bins)
+{
+    int b = (int)((c - cmin) * scale);
+    if (b < 0) b = 0;
+    if (b > bins - 1) b = bins - 1;
+    return b;
+}
+
+/* Key order of the median split: centroid on axis a, then triangle index. */
+static int vx_bvh_less(const vx_bvh_prim *prims, uint32_t x, uint32_t y, int a)
+{
+    double cx = vx_bvh_cen(prims + x, a), cy = vx_bvh_cen(prims + y, a);
+    return cx < cy || (cx == cy && x < y);
+}
+
+/* Swap *x and *y unless *x comes first. */
+static void vx_bvh_order2(const vx_bvh_prim *prims, uint32_t *x, uint32_t *y, int a)
+{
+    if (vx_bvh_less(prims, *y, *x, a)) {
+        uint32_t t = *x;
+        *x = *y;
+        *y = t;
+    }
+}
+
+/* Rearrange idx[0..n) so that idx[k] holds the k-th smallest key and smaller keys come before
+ * it (deterministic quickselect, median-of-three pivot, Lomuto partition). */
+static void vx_bvh_select(const vx_bvh_prim *prims, uint32_t *idx, size_t n, size_t k, int a)
+{
+    size_t lo = 0, hi = n - 1;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2, i, store;
+        uint32_t tmp, piv;
+        /* median of three into position hi */
+        vx_bvh_order2(prims, idx + lo, idx + mid, a);
+        vx_bvh_order2(prims, idx + lo, idx + hi, a);
+        vx_bvh_order2(prims, idx + hi, idx + mid, a); /* lo <= hi <= mid: pivot idx[hi] */
+        piv = idx[hi];
+        store = lo;
+        for (i = lo; i < hi; i++)
+            if (vx_bvh_less(prims, idx[i], piv, a)) {
+                tmp = idx[i];
+                idx[i] = idx[store];
+                idx[store] = tmp;
+                store++;
+            }
+        idx[hi] = idx[store];
+        idx[store] = piv;
+        if (store == k) return;
+        if (k < store) hi = store - 1;
+        else lo = store + 1;
+    }
+}
+
+/* Pad a finished node box outward (see hfvis_bvh_node). */
+static void vx_bvh_pad(hfvis_bvh_node *n)
+{
+    double m = 0.0, pad;
+    int a;
+    for (a = 0; a < 3; a++) {
+        double l = fabs((double)n->lo[a]), h = fabs((double)n->hi[a]);
+        double e = (double)n->hi[a] - (double)n->lo[a];
+        if (l > m) m = l;
+        if (h > m) m = h;
+        if (e > m) m = e;
+    }
+    pad = m * VX_BVH_PAD;
+    for (a = 0; a < 3; a++) {
+        double l = (double)n->lo[a] - pad, h = (double)n->hi[a] + pad;
+        /* rounded to float away from the box (the double values are within float range unless
+         * the box reaches FLT_MAX, which gives +-infinity) */
+        float lf = l < -(double)FLT_MAX ? -INFINITY : (float)l;
+        float hf = h > (double)FLT_MAX ? INFINITY : (float)h;
+        if ((double)lf > l) lf = nextafterf(lf, -INFINITY);
+        if ((double)hf < h) hf = nextafterf(hf, INFINITY);
+        n->lo[a] = lf;
+        n->hi[a] = hf;
+    }
+}
+
+HFVIS_API hfvis_status hfvis_bvh_build(const hfvis_mesh *mesh, const hfvis_bvh_options *opts,
+                                       hfvis_bvh *out)
+{
+    const hfvis_allocator *alloc = opts ? opts->alloc : NULL;
+    int max_leaf = opts && opts->max_leaf_size ? opts->max_leaf_size : HFVIS_BVH_DEFAULT_LEAF_SIZE;
+    int bins = opts && opts->bins ? opts->bins : HFVIS_BVH_DEFAULT_BINS;
+    size_t n, i, max_nodes, next, leaves = 0;
+    uint32_t *order = NULL;
+    vx_bvh_prim *prims = NULL;
+    hfvis_bvh_node *tmp = NULL, *nodes = NULL;
+    vx_bvh_task stack[HFVIS_BVH_MAX_DEPTH + 2];
+    int sp = 0, max_depth = 0;
+    hfvis_status st;
+
+    if (!out || max_leaf < 1 || max_leaf > HFVIS_BVH_MAX_LEAF_SIZE || bins < 2
+        || bins > HFVIS_BVH_MAX_BINS)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!mesh) return HFVIS_ERR_INVALID_ARGUMENT;
+    n = mesh->triangle_count;
+    if (n > HFVIS_BVH_MAX_TRIANGLES) return HFVIS_ERR_LIMIT; /* before reading the arrays */
+    st = vx_mesh_check(mesh);
+    if (st != HFVIS_OK) return st;
+    if (n == 0) {
+        memset(out, 0, sizeof *out);
+        out->max_leaf_size = max_leaf;
+        return HFVIS_OK;
+    }
+    max_nodes = 2 * n - 1;
+    order = (uint32_t *)vx_alloc_array(alloc, n, sizeof *order);
+    if (!order) goto oom;
+    prims = (vx_bvh_prim *)vx_alloc_array(alloc, n, sizeof *prims);
+    if (!prims) goto oom;
+    tmp = (hfvis_bvh_node *)vx_alloc_array(alloc, max_nodes, sizeof *tmp);
+    if (!tmp) goto oom;
+
+    for (i = 0; i < n; i++) {
+        const uint32_t *ix = mesh->indices + 3 * i;
+        const float *p0 = mesh->xyz + 3 * (size_t)ix[0], *p1 = mesh->xyz + 3 * (size_t)ix[1],
+                    *p2 = mesh->xyz + 3 * (size_t)ix[2];
+        int a;
+        for (a = 0; a < 3; a++) {
+            float lo = p0[a], hi = p0[a];
+            if (p1[a] < lo) lo = p1[a];
+            if (p1[a] > hi) hi = p1[a];
+            if (p2[a] < lo) lo = p2[a];
+            if (p2[a] > hi) hi = p2[a];
+            prims[i].lo[a] = lo;
+            prims[i].hi[a] = hi;
+        }
+        order[i] = (uint32_t)i;
+    }
+
+    next = 1;
+    stack[0].node = 0;
+    stack[0].begin = 0;
+    stack[0].end = (uint32_t)n;
+    stack[0].depth = 1;
+    sp = 1;
+    while (sp > 0) {
+        vx_bvh_task task = stack[--sp];
+        hfvis_bvh_node *node = tmp + task.node;
+        size_t count = task.end - task.begin, mid = 0;
+        double cmin[3], cmax[3], area;
+        int a, split = 0, median = 0;
+        uint32_t *idx = order + task.begin;
+        /* node box and centroid bounds: O(count) */
+        for (a = 0; a < 3; a++) {
+            node->lo[a] = prims[idx[0]].lo[a];
+            node->hi[a] = prims[idx[0]].hi[a];
+            cmin[a] = cmax[a] = vx_bvh_cen(prims + idx[0], a);
+        }
+        for (i = 1; i < count; i++) {
+            const vx_bvh_prim *p = prims + idx[i];
+            vx_bvh_grow(node->lo, node->hi, p->lo, p->hi);
+            for (a = 0; a < 3; a++) {
+                double c = vx_bvh_cen(p, a);
+                if (c < cmin[a]) cmin[a] = c;
+                if (c > cmax[a]) cmax[a] = c;
+            }
+        }
+        if (task.depth > max_depth) max_depth = task.depth;
+        area = vx_bvh_area(node->lo, node->hi);
+        if (count > 1) {
+            int degenerate = (cmax[0] == cmin[0] && cmax[1] == cmin[1] && cmax[2] == cmin[2])
+                             || !(area > 0.0) || !(area <= DBL_MAX);
+            if (task.depth >= HFVIS_BVH_SAH_DEPTH || degenerate) {
+                /* deep or degenerate nodes: leaf if small enough, else median split */
+                median = count > (size_t)max_leaf;
+            } else {
+                /* binned SAH over every axis with a centroid extent (Wald 2007) */
+                vx_bvh_bin bin[HFVIS_BVH_MAX_BINS];
+                double right_area[HFVIS_BVH_MAX_BINS];
+                uint32_t right_count[HFVIS_BVH_MAX_BINS];
+                double best = HUGE_VAL, scale_best = 0.0;
+                int best_axis = -1, best_bin = -1, b;
+                for (a = 0; a < 3; a++) {
+                    double scale;
+                    float llo[3], lhi[3];
+                    uint32_t lc = 0;
+                    if (!(cmax[a] > cmin[a])) continue;
+                    scale = (double)bins * (1.0 - 0x1p-40) / (cmax[a] - cmin[a]);
+                    for (b = 0; b < bins; b++) {
+                        bin[b].count = 0;
+                        bin[b].lo[0] = bin[b].lo[1] = bin[b].lo[2] = INFINITY;
+                        bin[b].hi[0] = bin[b].hi[1] = bin[b].hi[2] = -INFINITY;
+                    }
+                    for (i = 0; i < count; i++) {
+                        const vx_bvh_prim *p = prims + idx[i];
+                        b = vx_bvh_bin_of(vx_bvh_cen(p, a), cmin[a], scale, bins);
+                        bin[b].count++;
+                        vx_bvh_grow(bin[b].lo, bin[b].hi, p->lo, p->hi);
+                    }
+                    /* sweep from the right: boxes and counts of bins b+1..bins-1 */
+                    {
+                        float rlo[3] = {INFINITY, INFINITY, INFINITY},
+                              rhi[3] = {-INFINITY, -INFINITY, -INFINITY};
+                        uint32_t rc = 0;
+                        for (b = bins - 1; b > 0; b--) {
+                            if (bin[b].count) vx_bvh_grow(rlo, rhi, bin[b].lo, bin[b].hi);
+                            rc += bin[b].count;
+                            right_count[b - 1] = rc;
+                            right_area[b - 1] = rc ? vx_bvh_area(rlo, rhi) : 0.0;
+                        }
+                    }
+                    llo[0] = llo[1] = llo[2] = INFINITY;
+                    lhi[0] = lhi[1] = lhi[2] = -INFINITY;
+                    for (b = 0; b < bins - 1; b++) {
+                        double cost;
+                        if (bin[b].count) vx_bvh_grow(llo, lhi, bin[b].lo, bin[b].hi);
+                        lc += bin[b].count;
+                        if (lc == 0 || right_count[b] == 0) continue;
+                        cost = vx_bvh_area(llo, lhi) * (double)lc
+                               + right_area[b] * (double)right_count[b];
+                        if (cost < best) {
+                            best = cost;
+                            best_axis = a;
+                            best_bin = b;
+                            scale_best = scale;
+                        }
+                    }
+                }
+                if (best_axis < 0) {
+                    median = count > (size_t)max_leaf; /* unreachable: some extent is > 0 */
+                } else {
+                    double split_cost = VX_BVH_C_TRAV + VX_BVH_C_TRI * best / area;
+                    if (count > (size_t)max_leaf || !(VX_BVH_C_TRI * (double)count <= split_cost)) {
+                        /* partition by bin: bins <= best_bin go left */
+                        size_t lo = 0, hi = count;
+                        a = best_axis;
+                        while (lo < hi) {
+                            if (vx_bvh_bin_of(vx_bvh_cen(prims + idx[lo], a), cmin[a], scale_best,
+                                              bins) <= best_bin) {
+                                lo++;
+                            } else {
+                                uint32_t t = idx[lo];
+                                idx[lo] = idx[--hi];
+                                idx[hi] = t;
+                            }
+                        }
+                        mid = lo;
+                        split = 1;
+                        HFVIS_ASSERT(mid > 0 && mid < count);
+                    }
+                }
+            }
+            if (median) {
+                int ax = 0;
+                for (a = 1; a < 3; a++)
+                    if (cmax[a] - cmin[a] > cmax[ax] - cmin[ax]) ax = a;
+                mid = count / 2;
+                vx_bvh_select(prims, idx, count, mid, ax);
+                split = 1;
+            }
+        }
+        if (!split) {
+            node->left_or_first = task.begin;
+            node->count = (uint32_t)count;
+            leaves++;
+            continue;
+        }
+        HFVIS_ASSERT(next + 2 <= max_nodes && sp + 2 <= HFVIS_BVH_MAX_DEPTH + 2);
+        node->left_or_first = (uint32_t)next;
+        node->count = 0;
+        /* right first on the stack, so the left subtree is built (and numbered) first */
+        stack[sp].node = (uint32_t)(next + 1);
+        stack[sp].begin = task.begin + (uint32_t)mid;
+        stack[sp].end = task.end;
+        stack[sp].depth = task.depth + 1;
+        stack[sp + 1].node = (uint32_t)next;
+        stack[sp + 1].begin = task.begin;
+        stack[sp + 1].end = task.begin + (uint32_t)mid;
+        stack[sp + 1].depth = task.depth + 1;
+        sp += 2;
+        next += 2;
+    }
+    HFVIS_ASSERT(max_depth <= HFVIS_BVH_MAX_DEPTH);
+
+    nodes = (hfvis_bvh_node *)vx_alloc_array(alloc, next, sizeof *nodes);
+    if (!nodes) goto oom;
+    for (i = 0; i < next; i++) {
+        nodes[i] = tmp[i];
+        vx_bvh_pad(nodes + i);
+    }
+    vx_free(alloc, tmp);
+    vx_free(alloc, prims);
+    out->nodes = nodes;
+    out->node_count = next;
+    out->tri_order = order;
+    out->triangle_count = n;
+    out->leaf_count = leaves;
+    out->depth = max_depth;
+    out->max_leaf_size = max_leaf;
+    return HFVIS_OK;
+oom:
+    vx_free(alloc, tmp);
+    vx_free(alloc, prims);
+    vx_free(alloc, order);
+    return HFVIS_ERR_OUT_OF_MEMORY;
+}
+
+HFVIS_API void hfvis_bvh_free(const hfvis_allocator *alloc, hfvis_bvh *bvh)
+{
+    if (!bvh) return;
+    vx_free(alloc, bvh->nodes);
+    vx_free(alloc, bvh->tri_order);
+    memset(bvh, 0, sizeof *bvh);
+}
+
+/* ---- 6.5 traversal ------------------------------------------------------------------------- */
+
+/* Robust slab test (Ize 2013): entry distance max(t_min, near planes), exit distance
+ * min(far planes) * VX_BVH_SLACK; a NaN from 0 * infinity (ray in a slab's plane, zero
+ * direction component) is ignored by the comparisons, which is the right answer for a ray on
+ * the (closed) slab boundary. Hit when entry <= exit and entry <= t_hi (the widened best). */
+static VX_BVH_INLINE int vx_bvh_box(const hfvis_bvh_node *n, const vx_bvh_ray *r, float t_hi,
+                                     float *entry)
+{
+    float tn = r->t_min, tf = INFINITY, t0, t1;
+    t0 = ((r->neg[0] ? n->hi[0] : n->lo[0]) - r->org[0]) * r->inv[0];
+    t1 = ((r->neg[0] ? n->lo[0] : n->hi[0]) - r->org[0]) * r->inv[0];
+    tn = t0 > tn ? t0 : tn;
+    tf = t1 < tf ? t1 : tf;
+    t0 = ((r->neg[1] ? n->hi[1] : n->lo[1]) - r->org[1]) * r->inv[1];
+    t1 = ((r->neg[1] ? n->lo[1] : n->hi[1]) - r->org[1]) * r->inv[1];
+    tn = t0 > tn ? t0 : tn;
+    tf = t1 < tf ? t1 : tf;
+    t0 = ((r->neg[2] ? n->hi[2] : n->lo[2]) - r->org[2]) * r->inv[2];
+    t1 = ((r->neg[2] ? n->lo[2] : n->hi[2]) - r->org[2]) * r->inv[2];
+    tn = t0 > tn ? t0 : tn;
+    tf = t1 < tf ? t1 : tf;
+    tf *= VX_BVH_SLACK;
+    *entry = tn;
+    return tn <= tf && tn <= t_hi;
+}
+
+HFVIS_API hfvis_status hfvis_bvh_intersect(const hfvis_bvh *bvh, const hfvis_mesh *mesh,
+                                           const hfvis_ray *ray, hfvis_ray_query query,
+                                           hfvis_hit_filter filter, void *user, hfvis_hit *hit)
+{
+    vx_bvh_ray r;
+    hfvis_hit best, h;
+    uint32_t stack_node[HFVIS_BVH_MAX_DEPTH + 1];
+    float stack_t[HFVIS_BVH_MAX_DEPTH + 1];
+    int sp = 0;
+    const hfvis_bvh_node *nodes;
+    const uint32_t *order, *indices;
+    const float *xyz;
+    size_t nv, ntri;
+    uint32_t ni = 0;
+    float t_hi, entry;
+    const int any = query == HFVIS_RAY_ANY;
+
+    if (!bvh || !mesh || !hit || !vx_bvh_ray_valid(ray) || !vx_bvh_query_valid(query))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (bvh->triangle_count != mesh->triangle_count || bvh->depth < 0
+        || bvh->depth > HFVIS_BVH_MAX_DEPTH || (bvh->node_count && (!bvh->nodes || !bvh->tri_order))
+        || (mesh->vertex_count && !mesh->xyz) || (mesh->triangle_count && !mesh->indices))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    vx_bvh_ray_setup(ray, &r);
+    vx_bvh_miss(&best);
+    best.t = r.t_max;
+    t_hi = r.t_max * VX_BVH_SLACK;
+    nodes = bvh->nodes;
+    order = bvh->tri_order;
+    indices = mesh->indices;
+    xyz = mesh->xyz;
+    nv = mesh->vertex_count;
+    ntri = bvh->triangle_count;
+    if (bvh->node_count == 0 || !vx_bvh_box(nodes, &r, t_hi, &entry)) goto done;
+    for (;;) {
+        const hfvis_bvh_node *n = nodes + ni;
+        if (n->count) {
+            uint32_t k, first = n->left_or_first, end = first + n->count;
+            if (end < first || end > ntri) return HFVIS_ERR_INVALID_ARGUMENT; /* corrupt bvh */
+            for (k = first; k < end; k++) {
+                uint32_t tri = order[k];
+                const uint32_t *ix = indices + 3 * (size_t)tri;
+                if (tri >= ntri || ix[0] >= nv || ix[1] >= nv || ix[2] >= nv)
+                    return HFVIS_ERR_INVALID_ARGUMENT;
+                if (!vx_bvh_tri(&r, xyz + 3 * (size_t)ix[0], xyz + 3 * (size_t)ix[1],
+                                xyz + 3 * (size_t)ix[2], best.t, &h))
+                    continue;
+                /* closest-hit order: smaller t, equal t -> lower index (as the naive loop) */
+                if (best.triangle != HFVIS_NO_TRIANGLE && !(h.t < best.t || tri < best.triangle))
+                    continue;
+                h.triangle = tri;
+                if (filter && !filter(user, ray, &h)) continue;
+                best = h;
+                if (any) goto done;
+                t_hi = best.t * VX_BVH_SLACK;
+            }
+        } else {
+            uint32_t left = n->left_or_first;
+            float e0, e1;
+            int h0, h1;
+            /* children follow their parent (so every path ends) and lie inside the array */
+            if (left <= ni || (size_t)left + 1 >= bvh->node_count)
+                return HFVIS_ERR_INVALID_ARGUMENT;
+            h0 = vx_bvh_box(nodes + left, &r, t_hi, &e0);
+            h1 = vx_bvh_box(nodes + left + 1, &r, t_hi, &e1);
+            if (h0 && h1) {
+                if (sp >= HFVIS_BVH_MAX_DEPTH) return HFVIS_ERR_INVALID_ARGUMENT; /* corrupt bvh */
+                if (e1 < e0) {
+                    stack_node[sp] = left;
+                    stack_t[sp++] = e0;
+                    ni = left + 1;
+                } else {
+                    stack_node[sp] = left + 1;
+                    stack_t[sp++] = e1;
+                    ni = left;
+                }
+                continue;
+            }
+            if (h0) {
+                ni = left;
+                continue;
+            }
+            if (h1) {
+                ni = left + 1;
+                continue;
+            }
+        }
+        /* pop the next pushed node that can still hold a hit no farther than the best */
+        for (;;) {
+            if (sp == 0) goto done;
+            --sp;
+            if (stack_t[sp] <= t_hi) break;
+        }
+        ni = stack_node[sp];
+    }
+done:
+    if (best.triangle == HFVIS_NO_TRIANGLE) vx_bvh_miss(&best);
+    *hit = best;
+    return HFVIS_OK;
+}
+
+HFVIS_API hfvis_status hfvis_bvh_closest_hit(const hfvis_bvh *bvh, const hfvis_mesh *mesh,
+                                             const hfvis_ray *ray, hfvis_hit *hit)
+{
+    return hfvis_bvh_intersect(bvh, mesh, ray, HFVIS_RAY_CLOSEST, NULL, NULL, hit);
+}
+
+HFVIS_API hfvis_status hfvis_bvh_any_hit(const hfvis_bvh *bvh, const hfvis_mesh *mesh,
+                                         const hfvis_ray *ray, hfvis_hit *hit)
+{
+    return hfvis_bvh_intersect(bvh, mesh, ray, HFVIS_RAY_ANY, NULL, NULL, hit);
+}
+
+/* ========================================================================================== */
+/* 7. Surface voxelization into the Volume Buffer                                             */
 /*     [G12] ch. 6 (§6.4.1 Alg. 5 geometry-shader triangle slicing, §6.4.2 Alg. 6 pixel-shader */
 /*     fragment clipping, §6.6 output-vertex limit), ch. 5 §5.5.1 Alg. 4 (three axial passes   */
 /*     merged with MAX); spec voxel §3.4-3.8, §3.12-3.13                                       */
@@ -3132,2230 +3943,7 @@ HFVIS_API void hfvis_voxel_fragment_attributes(const hfvis_voxel_fragment *f, fl
 }
 
 /* ========================================================================================== */
-/* Incremental image-based multi-valued voxelization ([G12] ch. 7; spec voxel §4)             */
-/*   IV.1 depth images, options, channel maps                                                 */
-/*   IV.2 classification of a voxel centre: eq. 16 (sign restored), eq. 17 with the bias b,   */
-/*        Fig. 70's three zones; the conservative footprint and its min-depth pyramid         */
-/*   IV.3 cleanup (Alg. 7 "Cleanup", Listing 7.1) and single-pass IV (§7.4.3)                 */
-/*   IV.4 injection (Listing 7.2), Alg. 7 as one frame, the lighting variant (§7.5)           */
-/*   IV.5 Table 9 distance metric: exact point-triangle distance, two BVHs, seeded sampling   */
-/* ========================================================================================== */
-
-/* ---- IV.1 depth images, options, channel maps ------------------------------------------- */
-
-#define VX_IV_STACK 256 /* BVH traversal stack (median splits: depth <= 33 for 2^32 items) */
-
-/* Everything a pass needs of one image: the rows of view and proj*view that the classification
- * evaluates, as ((r[3] + r[2] z) + r[1] y) + r[0] x (the order the hoisted loops use). */
-typedef struct vx_iv_img {
-    double ez[4];             /* row 2 of view: eye-space z */
-    double cx[4], cy[4], cw[4]; /* rows 0, 1, 3 of proj*view: clip x, y, w */
-    double n, f;
-    int ortho, w, h;
-    const float *depth;
-    const float *attr;
-    int nattr;
-    const float *pyr;         /* conservative footprint: min-depth pyramid levels 1.. or NULL */
-    int levels;
-    size_t lev_off[40];
-    int lev_w[40], lev_h[40];
-} vx_iv_img;
-
-/* Resolved options. */
-typedef struct vx_iv_opt {
-    double bias;
-    int conservative;
-    int occ;                  /* occupancy channel or -1 */
-    int gw, gh;
-    const int *map;           /* explicit attribute map or NULL */
-    const hfvis_allocator *alloc;
-} vx_iv_opt;
-
-HFVIS_API hfvis_iv_options hfvis_iv_options_default(void)
-{
-    hfvis_iv_options o;
-    memset(&o, 0, sizeof o);
-    o.bias_rule = HFVIS_IV_BIAS_HALF_DIAGONAL;
-    o.bias = 0.0;
-    o.footprint = HFVIS_IV_FOOTPRINT_CENTER;
-    o.occupancy_channel = 0;
-    o.attribute_channels = NULL;
-    o.grid_width = 0;
-    o.grid_height = 0;
-    o.alloc = NULL;
-    return o;
-}
-
-HFVIS_API double hfvis_iv_bias_half_diagonal(const hfvis_volume_grid *grid)
-{
-    if (!vx_grid_valid(grid)) return (double)NAN;
-    return 0.5 * sqrt(grid->cell[0] * grid->cell[0] + grid->cell[1] * grid->cell[1]
-                      + grid->cell[2] * grid->cell[2]);
-}
-
-HFVIS_API hfvis_status hfvis_iv_bias(const hfvis_volume_grid *grid, const hfvis_iv_options *opts,
-                                     double *out)
-{
-    double b;
-    hfvis_iv_bias_rule rule = opts ? opts->bias_rule : HFVIS_IV_BIAS_HALF_DIAGONAL;
-    if (!out || !vx_grid_valid(grid)) return HFVIS_ERR_INVALID_ARGUMENT;
-    switch (rule) {
-    case HFVIS_IV_BIAS_HALF_DIAGONAL: b = hfvis_iv_bias_half_diagonal(grid); break;
-    case HFVIS_IV_BIAS_FULL_DIAGONAL: b = 2.0 * hfvis_iv_bias_half_diagonal(grid); break;
-    case HFVIS_IV_BIAS_EXPLICIT:
-        b = opts->bias;
-        if (!isfinite(b) || !(b >= 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
-        break;
-    default: return HFVIS_ERR_INVALID_ARGUMENT;
-    }
-    if (!isfinite(b)) return HFVIS_ERR_INVALID_ARGUMENT;
-    *out = b;
-    return HFVIS_OK;
-}
-
-/* 1 when vol is a usable Volume Buffer. */
-static int vx_iv_volume_ok(const hfvis_volume *vol)
-{
-    return vol && vol->data && vol->channels >= 1 && vol->channels <= HFVIS_VOLUME_MAX_CHANNELS
-           && hfvis_volume_size(&vol->grid, vol->channels) != 0;
-}
-
-static int vx_iv_same_grid(const hfvis_volume_grid *a, const hfvis_volume_grid *b)
-{
-    int i;
-    for (i = 0; i < 3; i++)
-        if (a->dims[i] != b->dims[i] || a->origin[i] != b->origin[i] || a->cell[i] != b->cell[i])
-            return 0;
-    return 1;
-}
-
-/* Options against a volume of `channels` channels (channels 0: no volume, e.g. classify); the
- * bias is resolved for grid. */
-static hfvis_status vx_iv_resolve(const hfvis_iv_options *opts, const hfvis_volume_grid *grid,
-                                  int channels, vx_iv_opt *o)
-{
-    hfvis_iv_options d = hfvis_iv_options_default();
-    hfvis_status s;
-    if (!opts) opts = &d;
-    if (opts->footprint != HFVIS_IV_FOOTPRINT_CENTER
-        && opts->footprint != HFVIS_IV_FOOTPRINT_CONSERVATIVE)
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    if (opts->grid_width < 0 || opts->grid_height < 0) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (opts->occupancy_channel < HFVIS_IV_NO_CHANNEL
-        || (channels > 0 && opts->occupancy_channel >= channels))
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    s = hfvis_iv_bias(grid, opts, &o->bias);
-    if (s != HFVIS_OK) return s;
-    o->conservative = opts->footprint == HFVIS_IV_FOOTPRINT_CONSERVATIVE;
-    o->occ = opts->occupancy_channel;
-    o->gw = opts->grid_width;
-    o->gh = opts->grid_height;
-    o->map = opts->attribute_channels;
-    o->alloc = opts->alloc;
-    return HFVIS_OK;
-}
-
-/* Channel of attribute a (< nattr) for a volume of `channels` channels, written to map[a]
- * (-1 = dropped). HFVIS_ERR_INVALID_ARGUMENT when the map is bad (see hfvis_iv_options). */
-static hfvis_status vx_iv_channel_map(const vx_iv_opt *o, int nattr, int channels, int *map)
-{
-    int a, b, c = 0;
-    for (a = 0; a < nattr; a++) {
-        if (o->map) {
-            map[a] = o->map[a];
-            if (map[a] < HFVIS_IV_NO_CHANNEL || map[a] >= channels
-                || (map[a] >= 0 && map[a] == o->occ))
-                return HFVIS_ERR_INVALID_ARGUMENT;
-            for (b = 0; b < a; b++)
-                if (map[a] >= 0 && map[b] == map[a]) return HFVIS_ERR_INVALID_ARGUMENT;
-        } else {
-            if (c == o->occ) c++;
-            if (c >= channels) return HFVIS_ERR_INVALID_ARGUMENT;
-            map[a] = c++;
-        }
-    }
-    return HFVIS_OK;
-}
-
-/* Validate one depth image and fill the per-image rows. */
-static hfvis_status vx_iv_image(const hfvis_depth_image *im, vx_iv_img *out)
-{
-    const hfvis_view *v;
-    double m[16];
-    size_t px, na;
-    int r;
-    if (!im || !im->depth) return HFVIS_ERR_INVALID_ARGUMENT;
-    v = &im->view;
-    if (v->width < 1 || v->height < 1 || !vx_all_finite(v->view, 16) || !vx_all_finite(v->proj, 16)
-        || !isfinite(v->near_plane) || !isfinite(v->far_plane)
-        || !(v->near_plane < v->far_plane) || (!v->orthographic && !(v->near_plane > 0.0)))
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    if (im->attribute_count < 0 || im->attribute_count > HFVIS_VOLUME_MAX_CHANNELS
-        || (im->attribute_count > 0 && !im->attributes))
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    if (!vx_mul_size((size_t)v->width, (size_t)v->height, &px)
-        || !vx_mul_size(px, (size_t)(im->attribute_count > 0 ? im->attribute_count : 1), &na))
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    hfvis_mat4_multiply(v->proj, v->view, m);
-    if (!vx_all_finite(m, 16)) return HFVIS_ERR_INVALID_ARGUMENT;
-    memset(out, 0, sizeof *out);
-    for (r = 0; r < 4; r++) {
-        out->ez[r] = VX_M(v->view, 2, r);
-        out->cx[r] = VX_M(m, 0, r);
-        out->cy[r] = VX_M(m, 1, r);
-        out->cw[r] = VX_M(m, 3, r);
-    }
-    out->n = v->near_plane;
-    out->f = v->far_plane;
-    out->ortho = v->orthographic ? 1 : 0;
-    out->w = v->width;
-    out->h = v->height;
-    out->depth = im->depth;
-    out->attr = im->attribute_count > 0 ? im->attributes : NULL;
-    out->nattr = im->attribute_count;
-    return HFVIS_OK;
-}
-
-/* The affine row in the fixed evaluation order ((r3 + r2 z) + r1 y) + r0 x. */
-static double vx_iv_row(const double r[4], double x, double y, double z)
-{
-    return ((r[3] + r[2] * z) + r[1] * y) + r[0] * x;
-}
-
-/* ---- IV.2 classification ---------------------------------------------------------------- */
-
-/* A depth texel usable as information: zw in [0, 1] (NaN and out-of-range values are no-data). */
-static int vx_iv_texel_ok(float zw)
-{
-    return zw >= 0.0f && zw <= 1.0f;
-}
-
-/* Eq. 17 against one valid texel zw, for a point of eye z ez: CLEARED if ez > z_e + b, else
- * KEPT for a background texel (zw = 1) or ez < z_e - b, else BAND; z_e by eq. 16 (sign restored,
- * hfvis_depth_to_eye_z) in double. The decision is that literal comparison; for perspective views
- * it is usually reached without the division of eq. 16: with D = f - zw (f - n) > 0,
- * ez - b - z_e = ((ez - b) D + n f) / D, so the sign of P = (ez - b) D + n f decides unless |P| is
- * within t = 1e-12 ((|ez| + b) D + 2 n f) - about 10^4 times the rounding of both forms - and
- * likewise Q = (ez + b) D + n f for the band; inside t the literal form is evaluated. */
-static hfvis_iv_class vx_iv_zone(const vx_iv_img *im, double b, double ez, float zw)
-{
-    double ze;
-    if (!im->ortho) {
-        double D = im->f - (double)zw * (im->f - im->n), nf = im->n * im->f;
-        double P = (ez - b) * D + nf, Q = (ez + b) * D + nf;
-        double t = 1e-12 * ((fabs(ez) + b) * D + 2.0 * nf);
-        if (P > t) return HFVIS_IV_CLEARED;
-        if (P < -t) {
-            if (zw == 1.0f || Q < -t) return HFVIS_IV_KEPT;
-            if (Q > t) return HFVIS_IV_BAND;
-        }
-    }
-    ze = hfvis_depth_to_eye_z((double)zw, im->n, im->f, im->ortho); /* eq. 16, sign restored */
-    if (ez > ze + b) return HFVIS_IV_CLEARED; /* eq. 17: in front of the recorded surface (v1) */
-    if (zw == 1.0f) return HFVIS_IV_KEPT;     /* background: nothing to update */
-    if (ez < ze - b) return HFVIS_IV_KEPT;    /* behind the surface (v3) */
-    return HFVIS_IV_BAND;                     /* surface band (v2) */
-}
-
-/* The classification of a point with eye z `ez` and clip (X, Y, W) (spec voxel §4.3): UNSEEN
- * without information, else the zone of its texel. Writes the texel read (or -1, -1). */
-static hfvis_iv_class vx_iv_decide(const vx_iv_img *im, double b, double ez, double X, double Y,
-                                   double W, int *opx, int *opy)
-{
-    double inv, nx, ny, sx, sy;
-    int px, py;
-    float zw;
-    *opx = -1;
-    *opy = -1;
-    /* behind the camera, or nearer than the near plane (NDC z < -1; no information) [C] */
-    if (!(W > 0.0) || !(ez <= -im->n)) return HFVIS_IV_UNSEEN;
-    inv = 1.0 / W;
-    nx = X * inv;
-    ny = Y * inv;
-    if (!(nx >= -1.0 && nx <= 1.0 && ny >= -1.0 && ny <= 1.0)) return HFVIS_IV_UNSEEN;
-    /* nearest texel, row 0 at the top: (floor((ndc_x+1)/2 W), floor((1-ndc_y)/2 H)), clamped */
-    sx = (nx + 1.0) * 0.5 * (double)im->w;
-    sy = (1.0 - ny) * 0.5 * (double)im->h;
-    px = (int)sx; /* sx >= 0: truncation is floor */
-    py = (int)sy;
-    if (px > im->w - 1) px = im->w - 1;
-    if (py > im->h - 1) py = im->h - 1;
-    *opx = px;
-    *opy = py;
-    zw = im->depth[(size_t)py * (size_t)im->w + (size_t)px];
-    if (!vx_iv_texel_ok(zw)) return HFVIS_IV_UNSEEN;
-    return vx_iv_zone(im, b, ez, zw);
-}
-
-/* Offsets of the 8 corners of a voxel about its centre in one row: +-(r[0] hx), ... */
-typedef struct vx_iv_corner_rows {
-    double a[4][3]; /* [row: ez, X, Y, W][axis] = r[axis] * half_cell[axis] */
-} vx_iv_corner_rows;
-
-static void vx_iv_corner_setup(const vx_iv_img *im, const hfvis_volume_grid *g,
-                               vx_iv_corner_rows *cr)
-{
-    int a;
-    for (a = 0; a < 3; a++) {
-        double h = 0.5 * g->cell[a];
-        cr->a[0][a] = im->ez[a] * h;
-        cr->a[1][a] = im->cx[a] * h;
-        cr->a[2][a] = im->cy[a] * h;
-        cr->a[3][a] = im->cw[a] * h;
-    }
-}
-
-/* Minimum over a clipped pixel rectangle of the min-depth pyramid (sentinel -1 = no-data). */
-static float vx_iv_pyr_min(const vx_iv_img *im, int x0, int x1, int y0, int y1)
-{
-    int L = 1, x, y;
-    float m = 2.0f;
-    while (L < im->levels && (((x1 >> L) - (x0 >> L)) > 1 || ((y1 >> L) - (y0 >> L)) > 1)) L++;
-    HFVIS_ASSERT(L < im->levels); /* the top level is 1 x 1 */
-    {
-        const float *lev = im->pyr + im->lev_off[L];
-        int lw = im->lev_w[L];
-        for (y = y0 >> L; y <= (y1 >> L); y++)
-            for (x = x0 >> L; x <= (x1 >> L); x++) {
-                float v = lev[(size_t)y * (size_t)lw + (size_t)x];
-                if (v < m) m = v;
-            }
-    }
-    return m;
-}
-
-/* Conservative footprint (spec voxel §4.3 [C]): 1 if the clear of a voxel whose centre test
- * cleared is vetoed: a corner before the near plane or behind the camera, or a pixel whose
- * centre lies in the bounding box of the projected corners that is no-data or does not clear
- * (p'_z > z_e + b fails). With a pyramid, a rectangle whose minimum depth clears is accepted
- * without a scan: z_e(zw) falls as zw grows (every step of eq. 16 is monotone), so the minimum
- * clearing implies every texel clears (vx_iv_zone decides exactly as the literal form, whose
- * every step is monotone in zw), and the answer is the scan's bit for bit. */
-static int vx_iv_veto(const vx_iv_img *im, const vx_iv_corner_rows *cr, double b, double ez,
-                      double X, double Y, double W)
-{
-    double nx0 = HUGE_VAL, nx1 = -HUGE_VAL, ny0 = HUGE_VAL, ny1 = -HUGE_VAL;
-    double fx0, fx1, fy0, fy1;
-    int c, x0, x1, y0, y1, x, y;
-    for (c = 0; c < 8; c++) {
-        double sx = (c & 1) ? 1.0 : -1.0, sy = (c & 2) ? 1.0 : -1.0, sz = (c & 4) ? 1.0 : -1.0;
-        double cez = ((ez + sx * cr->a[0][0]) + sy * cr->a[0][1]) + sz * cr->a[0][2];
-        double cX = ((X + sx * cr->a[1][0]) + sy * cr->a[1][1]) + sz * cr->a[1][2];
-        double cY = ((Y + sx * cr->a[2][0]) + sy * cr->a[2][1]) + sz * cr->a[2][2];
-        double cW = ((W + sx * cr->a[3][0]) + sy * cr->a[3][1]) + sz * cr->a[3][2];
-        double nx, ny;
-        if (!(cW > 0.0) || !(cez <= -im->n)) return 1;
-        nx = cX / cW;
-        ny = cY / cW;
-        if (nx < nx0) nx0 = nx;
-        if (nx > nx1) nx1 = nx;
-        if (ny < ny0) ny0 = ny;
-        if (ny > ny1) ny1 = ny;
-    }
-    /* pixel x has its centre at window x + 0.5: centres in [sx0, sx1] are ceil(sx0 - 0.5) ..
-     * floor(sx1 - 0.5); rows count from the top */
-    fx0 = ceil((nx0 + 1.0) * 0.5 * (double)im->w - 0.5);
-    fx1 = floor((nx1 + 1.0) * 0.5 * (double)im->w - 0.5);
-    fy0 = ceil((1.0 - ny1) * 0.5 * (double)im->h - 0.5);
-    fy1 = floor((1.0 - ny0) * 0.5 * (double)im->h - 0.5);
-    if (!(fx0 >= 0.0)) fx0 = 0.0;
-    if (!(fy0 >= 0.0)) fy0 = 0.0;
-    if (!(fx1 <= (double)(im->w - 1))) fx1 = (double)(im->w - 1);
-    if (!(fy1 <= (double)(im->h - 1))) fy1 = (double)(im->h - 1);
-    if (fx0 > fx1 || fy0 > fy1) return 0; /* no pixel centre inside: the centre texel decided */
-    x0 = (int)fx0;
-    x1 = (int)fx1;
-    y0 = (int)fy0;
-    y1 = (int)fy1;
-    if (im->pyr && (x1 - x0 > 1 || y1 - y0 > 1)) {
-        float m = vx_iv_pyr_min(im, x0, x1, y0, y1);
-        if (m >= 0.0f && vx_iv_zone(im, b, ez, m) == HFVIS_IV_CLEARED) return 0;
-    }
-    for (y = y0; y <= y1; y++) {
-        const float *row = im->depth + (size_t)y * (size_t)im->w;
-        for (x = x0; x <= x1; x++) {
-            float zw = row[x];
-            if (!vx_iv_texel_ok(zw)) return 1;
-            if (vx_iv_zone(im, b, ez, zw) != HFVIS_IV_CLEARED) return 1;
-        }
-    }
-    return 0;
-}
-
-/* Pyramid sizes of a w x h image (levels 1.. until 1 x 1); returns the float count, 0 on
- * overflow (never for valid images). */
-static size_t vx_iv_pyr_layout(vx_iv_img *im)
-{
-    size_t total = 0, n;
-    int L = 0, w = im->w, h = im->h;
-    im->lev_w[0] = w;
-    im->lev_h[0] = h;
-    im->lev_off[0] = 0;
-    while (w > 1 || h > 1) {
-        w = (w + 1) / 2;
-        h = (h + 1) / 2;
-        L++;
-        im->lev_w[L] = w;
-        im->lev_h[L] = h;
-        im->lev_off[L] = total;
-        if (!vx_mul_size((size_t)w, (size_t)h, &n) || total > SIZE_MAX - n) return 0;
-        total += n;
-    }
-    im->levels = L + 1;
-    return total;
-}
-
-/* Fill the pyramid (min of each 2 x 2 block; level 0 is the image, no-data -> -1). */
-static void vx_iv_pyr_build(vx_iv_img *im, float *store)
-{
-    int L, x, y;
-    im->pyr = store;
-    for (L = 1; L < im->levels; L++) {
-        int pw = im->lev_w[L - 1], ph = im->lev_h[L - 1], w = im->lev_w[L], h = im->lev_h[L];
-        const float *src = L == 1 ? im->depth : store + im->lev_off[L - 1];
-        float *dst = store + im->lev_off[L];
-        for (y = 0; y < h; y++)
-            for (x = 0; x < w; x++) {
-                float m = 2.0f;
-                int dx, dy;
-                for (dy = 0; dy < 2; dy++)
-                    for (dx = 0; dx < 2; dx++) {
-                        int sx = 2 * x + dx, sy = 2 * y + dy;
-                        float v;
-                        if (sx >= pw || sy >= ph) continue;
-                        v = src[(size_t)sy * (size_t)pw + (size_t)sx];
-                        if (L == 1 && !vx_iv_texel_ok(v)) v = -1.0f;
-                        if (v < m) m = v;
-                    }
-                dst[(size_t)y * (size_t)w + (size_t)x] = m;
-            }
-    }
-}
-
-static void vx_iv_sample_set(const vx_iv_img *im, hfvis_iv_sample *out, hfvis_iv_class cls, int px,
-                             int py, double ez)
-{
-    double ze = (double)NAN;
-    if (px >= 0) {
-        float zw = im->depth[(size_t)py * (size_t)im->w + (size_t)px];
-        if (vx_iv_texel_ok(zw)) ze = hfvis_depth_to_eye_z((double)zw, im->n, im->f, im->ortho);
-    }
-    out->cls = cls;
-    out->pixel_x = px;
-    out->pixel_y = py;
-    out->eye_z = ez;
-    out->depth_eye_z = ze;
-}
-
-HFVIS_API hfvis_status hfvis_iv_classify(const hfvis_depth_image *image, const double point[3],
-                                         double bias, hfvis_iv_sample *out)
-{
-    vx_iv_img im;
-    double ez, X, Y, W;
-    int px, py;
-    hfvis_iv_class cls;
-    if (!out || !point || !vx_all_finite(point, 3) || !isfinite(bias) || !(bias >= 0.0))
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    if (vx_iv_image(image, &im) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
-    ez = vx_iv_row(im.ez, point[0], point[1], point[2]);
-    X = vx_iv_row(im.cx, point[0], point[1], point[2]);
-    Y = vx_iv_row(im.cy, point[0], point[1], point[2]);
-    W = vx_iv_row(im.cw, point[0], point[1], point[2]);
-    cls = vx_iv_decide(&im, bias, ez, X, Y, W, &px, &py);
-    vx_iv_sample_set(&im, out, cls, px, py, ez);
-    return HFVIS_OK;
-}
-
-/* Voxel centre coordinate along axis a (the one expression every path uses). */
-static double vx_iv_centre(const hfvis_volume_grid *g, int a, int idx)
-{
-    return g->origin[a] + g->cell[a] * ((double)idx + 0.5);
-}
-
-HFVIS_API hfvis_status hfvis_iv_classify_voxel(const hfvis_depth_image *image,
-                                               const hfvis_volume_grid *grid, int i, int j, int k,
-                                               const hfvis_iv_options *opts,
-                                               hfvis_iv_sample *out)
-{
-    vx_iv_img im;
-    vx_iv_opt o;
-    double x, y, z, ez, X, Y, W;
-    int px, py;
-    hfvis_iv_class cls;
-    if (!out || !vx_grid_valid(grid) || i < 0 || j < 0 || k < 0 || i >= grid->dims[0]
-        || j >= grid->dims[1] || k >= grid->dims[2])
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    if (vx_iv_resolve(opts, grid, 0, &o) != HFVIS_OK || vx_iv_image(image, &im) != HFVIS_OK)
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    x = vx_iv_centre(grid, 0, i);
-    y = vx_iv_centre(grid, 1, j);
-    z = vx_iv_centre(grid, 2, k);
-    ez = vx_iv_row(im.ez, x, y, z);
-    X = vx_iv_row(im.cx, x, y, z);
-    Y = vx_iv_row(im.cy, x, y, z);
-    W = vx_iv_row(im.cw, x, y, z);
-    cls = vx_iv_decide(&im, o.bias, ez, X, Y, W, &px, &py);
-    if (cls == HFVIS_IV_CLEARED && o.conservative) {
-        vx_iv_corner_rows cr;
-        vx_iv_corner_setup(&im, grid, &cr);
-        if (vx_iv_veto(&im, &cr, o.bias, ez, X, Y, W)) cls = HFVIS_IV_KEPT;
-    }
-    vx_iv_sample_set(&im, out, cls, px, py, ez);
-    return HFVIS_OK;
-}
-
-/* ---- IV.3 cleanup and single pass --------------------------------------------------------- */
-
-static int vx_iv_empty(const float *v, int channels)
-{
-    int c;
-    for (c = 0; c < channels; c++)
-        if (v[c] != 0.0f) return 0;
-    return 1;
-}
-
-/* First index in [i, n) of a non-empty voxel of the row (C channels per voxel), or n: the first
- * non-zero float from voxel i on, tested in branch-free blocks of 8 floats (a cleanup pass over a
- * surface volume spends most of its time here). */
-static int vx_iv_next_nonempty(const float *row, int i, int n, int C)
-{
-    size_t f = (size_t)i * (size_t)C, end = (size_t)n * (size_t)C;
-    while (f + 8 <= end) {
-        const float *v = row + f;
-        int z = (v[0] == 0.0f) & (v[1] == 0.0f) & (v[2] == 0.0f) & (v[3] == 0.0f)
-                & (v[4] == 0.0f) & (v[5] == 0.0f) & (v[6] == 0.0f) & (v[7] == 0.0f);
-        if (!z) break;
-        f += 8;
-    }
-    while (f < end && row[f] == 0.0f) f++;
-    return (int)(f / (size_t)C);
-}
-
-/* Per-call counters. */
-typedef struct vx_iv_count {
-    size_t cls[4];
-    size_t off, on, inj, bg, outside;
-} vx_iv_count;
-
-/* One image over the whole volume: src -> dst (src == dst in place). single: turn on the band
- * (§7.4.3), else cleanup only (Alg. 7 Cleanup). map: attribute -> channel for the band. Row by
- * row: the row is copied once (ping-pong), then only voxels that can change are visited (cleanup:
- * the non-empty ones; an empty voxel stays empty). The affine rows are hoisted per slab and row in
- * the order of vx_iv_row, so every voxel sees exactly hfvis_iv_classify_voxel's numbers. */
-static void vx_iv_pass(const float *src, float *dst, const hfvis_volume_grid *g, int C,
-                       const vx_iv_img *im, const vx_iv_opt *o, int single, const int *map,
-                       vx_iv_count *cnt)
-{
-    const int nx = g->dims[0], ny = g->dims[1], nz = g->dims[2];
-    const size_t cs = (size_t)C, row = (size_t)nx * cs;
-    vx_iv_corner_rows cr;
-    int i, j, k, c;
-    size_t lin = 0;
-    vx_iv_corner_setup(im, g, &cr);
-    for (k = 0; k < nz; k++) {
-        double z = vx_iv_centre(g, 2, k);
-        double kez = im->ez[3] + im->ez[2] * z, kX = im->cx[3] + im->cx[2] * z;
-        double kY = im->cy[3] + im->cy[2] * z, kW = im->cw[3] + im->cw[2] * z;
-        for (j = 0; j < ny; j++, lin += (size_t)nx) {
-            double y = vx_iv_centre(g, 1, j);
-            double jez = kez + im->ez[1] * y, jX = kX + im->cx[1] * y;
-            double jY = kY + im->cy[1] * y, jW = kW + im->cw[1] * y;
-            const float *srow = src + lin * cs;
-            float *drow = dst + lin * cs;
-            if (drow != srow) memcpy(drow, srow, row * sizeof(float));
-            for (i = 0; i < nx; i++) {
-                float *d;
-                double x, ez, X, Y, W;
-                int px, py, empty;
-                hfvis_iv_class cls;
-                if (!single) { /* cleanup: an empty voxel stays empty */
-                    i = vx_iv_next_nonempty(drow, i, nx, C);
-                    if (i >= nx) break;
-                }
-                d = drow + (size_t)i * cs; /* holds the source values now */
-                empty = single ? vx_iv_empty(d, C) : 0;
-                x = vx_iv_centre(g, 0, i);
-                ez = jez + im->ez[0] * x;
-                X = jX + im->cx[0] * x;
-                Y = jY + im->cy[0] * x;
-                W = jW + im->cw[0] * x;
-                cls = vx_iv_decide(im, o->bias, ez, X, Y, W, &px, &py);
-                if (cls == HFVIS_IV_CLEARED && o->conservative
-                    && vx_iv_veto(im, &cr, o->bias, ez, X, Y, W))
-                    cls = HFVIS_IV_KEPT;
-                cnt->cls[cls]++;
-                if (cls == HFVIS_IV_CLEARED) {
-                    if (!empty) {
-                        for (c = 0; c < C; c++) d[c] = 0.0f;
-                        cnt->off++;
-                    }
-                } else if (cls == HFVIS_IV_BAND && single) {
-                    /* turn on / update with the centre texel's attributes (replace) */
-                    int t;
-                    if (im->nattr > 0) {
-                        const float *a = im->attr + ((size_t)py * (size_t)im->w + (size_t)px)
-                                                        * (size_t)im->nattr;
-                        for (t = 0; t < im->nattr; t++)
-                            if (map[t] >= 0) d[map[t]] = a[t];
-                    }
-                    if (o->occ >= 0) d[o->occ] = 1.0f;
-                    if (empty && !vx_iv_empty(d, C)) cnt->on++;
-                }
-            }
-        }
-    }
-}
-
-/* Validates the arguments of cleanup / single pass and resolves everything. */
-static hfvis_status vx_iv_pass_args(const hfvis_volume *prev, const hfvis_volume *curr,
-                                    const hfvis_depth_image *images, size_t count,
-                                    const hfvis_iv_options *opts, vx_iv_opt *o, int single)
-{
-    size_t t;
-    if (!vx_iv_volume_ok(prev) || !vx_iv_volume_ok(curr) || (count > 0 && !images))
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    if (prev->channels != curr->channels || !vx_iv_same_grid(&prev->grid, &curr->grid))
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    if (vx_iv_resolve(opts, &prev->grid, prev->channels, o) != HFVIS_OK)
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    for (t = 0; t < count; t++) {
-        vx_iv_img im;
-        int map[HFVIS_VOLUME_MAX_CHANNELS];
-        if (vx_iv_image(&images[t], &im) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
-        if (single && vx_iv_channel_map(o, im.nattr, prev->channels, map) != HFVIS_OK)
-            return HFVIS_ERR_INVALID_ARGUMENT;
-    }
-    return HFVIS_OK;
-}
-
-static void vx_iv_stats_out(const vx_iv_count *c, hfvis_iv_stats *stats)
-{
-    if (!stats) return;
-    memset(stats, 0, sizeof *stats);
-    stats->unseen = c->cls[HFVIS_IV_UNSEEN];
-    stats->cleared = c->cls[HFVIS_IV_CLEARED];
-    stats->band = c->cls[HFVIS_IV_BAND];
-    stats->kept = c->cls[HFVIS_IV_KEPT];
-    stats->turned_off = c->off;
-    stats->turned_on = c->on;
-    stats->points_injected = c->inj;
-    stats->points_background = c->bg;
-    stats->points_outside = c->outside;
-}
-
-/* Cleanup or single pass after validation: the pyramids (one block for all images), then the
- * images in order, the first reading prev and the others curr in place. */
-static hfvis_status vx_iv_run(const hfvis_volume *prev, hfvis_volume *curr,
-                              const hfvis_depth_image *images, size_t count, const vx_iv_opt *o,
-                              int single, vx_iv_count *cnt)
-{
-    float *pyr = NULL;
-    size_t t, total = 0, n = hfvis_volume_size(&prev->grid, prev->channels);
-    if (o->conservative && count > 0) {
-        for (t = 0; t < count; t++) {
-            vx_iv_img im;
-            size_t s;
-            (void)vx_iv_image(&images[t], &im);
-            s = vx_iv_pyr_layout(&im);
-            if (s == 0 && (im.w > 1 || im.h > 1)) return HFVIS_ERR_INVALID_ARGUMENT;
-            if (total > SIZE_MAX - s) return HFVIS_ERR_INVALID_ARGUMENT;
-            total += s;
-        }
-        if (total > 0) {
-            pyr = (float *)vx_alloc_array(o->alloc, total, sizeof(float));
-            if (!pyr) return HFVIS_ERR_OUT_OF_MEMORY;
-        }
-    }
-    if (count == 0 && curr->data != prev->data)
-        for (t = 0; t < n; t++) curr->data[t] = prev->data[t];
-    total = 0;
-    for (t = 0; t < count; t++) {
-        vx_iv_img im;
-        int map[HFVIS_VOLUME_MAX_CHANNELS] = {0};
-        (void)vx_iv_image(&images[t], &im);
-        if (single) (void)vx_iv_channel_map(o, im.nattr, prev->channels, map);
-        if (pyr) {
-            size_t s = vx_iv_pyr_layout(&im);
-            vx_iv_pyr_build(&im, pyr + total);
-            total += s;
-        }
-        vx_iv_pass(t == 0 ? prev->data : curr->data, curr->data, &prev->grid, prev->channels, &im,
-                   o, single, map, cnt);
-    }
-    vx_free(o->alloc, pyr);
-    return HFVIS_OK;
-}
-
-HFVIS_API hfvis_status hfvis_iv_cleanup(const hfvis_volume *prev, hfvis_volume *curr,
-                                        const hfvis_depth_image *images, size_t image_count,
-                                        const hfvis_iv_options *opts, hfvis_iv_stats *stats)
-{
-    vx_iv_opt o;
-    vx_iv_count cnt;
-    hfvis_status s = vx_iv_pass_args(prev, curr, images, image_count, opts, &o, 0);
-    if (s != HFVIS_OK) return s;
-    memset(&cnt, 0, sizeof cnt);
-    s = vx_iv_run(prev, curr, images, image_count, &o, 0, &cnt);
-    if (s != HFVIS_OK) return s;
-    vx_iv_stats_out(&cnt, stats);
-    return HFVIS_OK;
-}
-
-HFVIS_API hfvis_status hfvis_iv_single_pass(const hfvis_volume *prev, hfvis_volume *curr,
-                                            const hfvis_depth_image *images, size_t image_count,
-                                            const hfvis_iv_options *opts, hfvis_iv_stats *stats)
-{
-    vx_iv_opt o;
-    vx_iv_count cnt;
-    hfvis_status s = vx_iv_pass_args(prev, curr, images, image_count, opts, &o, 1);
-    if (s != HFVIS_OK) return s;
-    memset(&cnt, 0, sizeof cnt);
-    s = vx_iv_run(prev, curr, images, image_count, &o, 1, &cnt);
-    if (s != HFVIS_OK) return s;
-    vx_iv_stats_out(&cnt, stats);
-    return HFVIS_OK;
-}
-
-/* ---- IV.4 injection, one frame, lighting ---------------------------------------------------- */
-
-/* Validate the injection arguments (everything that can fail). */
-static hfvis_status vx_iv_inject_args(const hfvis_volume *vol, const hfvis_depth_image *images,
-                                      size_t count, const vx_iv_opt *o)
-{
-    size_t t;
-    int c, map[HFVIS_VOLUME_MAX_CHANNELS];
-    if (!vx_iv_volume_ok(vol) || (count > 0 && !images)) return HFVIS_ERR_INVALID_ARGUMENT;
-    for (c = 0; c < vol->channels; c++)
-        if (!vx_blend_valid(vol->blend[c])) return HFVIS_ERR_INVALID_ARGUMENT;
-    for (t = 0; t < count; t++) {
-        vx_iv_img im;
-        double m[16], inv[16];
-        if (vx_iv_image(&images[t], &im) != HFVIS_OK
-            || vx_iv_channel_map(o, im.nattr, vol->channels, map) != HFVIS_OK)
-            return HFVIS_ERR_INVALID_ARGUMENT;
-        hfvis_mat4_multiply(images[t].view.proj, images[t].view.view, m);
-        if (hfvis_mat4_invert(m, inv) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
-    }
-    return HFVIS_OK;
-}
-
-/* Listing 7.2 for validated arguments. */
-static void vx_iv_inject_run(hfvis_volume *vol, const hfvis_depth_image *images, size_t count,
-                             const vx_iv_opt *o, vx_iv_count *cnt)
-{
-    const hfvis_volume_grid *g = &vol->grid;
-    const size_t cs = (size_t)vol->channels;
-    size_t t;
-    for (t = 0; t < count; t++) {
-        vx_iv_img im;
-        double m[16], inv[16];
-        int map[HFVIS_VOLUME_MAX_CHANNELS], gx, gy, gw, gh;
-        (void)vx_iv_image(&images[t], &im);
-        (void)vx_iv_channel_map(o, im.nattr, vol->channels, map);
-        hfvis_mat4_multiply(images[t].view.proj, images[t].view.view, m);
-        (void)hfvis_mat4_invert(m, inv);
-        gw = o->gw > 0 ? o->gw : im.w;
-        gh = o->gh > 0 ? o->gh : im.h;
-        for (gy = 0; gy < gh; gy++) {
-            double v = ((double)gy + 0.5) / (double)gh;
-            int py = (int)(v * (double)im.h);
-            if (py > im.h - 1) py = im.h - 1;
-            for (gx = 0; gx < gw; gx++) {
-                double u = ((double)gx + 0.5) / (double)gw, ndc[4], hp[4], p[3];
-                int px = (int)(u * (double)im.w), idx[3], a, ok = 1;
-                size_t pix;
-                float zw, *d;
-                if (px > im.w - 1) px = im.w - 1;
-                pix = (size_t)py * (size_t)im.w + (size_t)px;
-                zw = im.depth[pix];
-                if (!(zw >= 0.0f && zw < 1.0f)) { /* background or no-data: no sample */
-                    cnt->bg++;
-                    continue;
-                }
-                /* canonical screen space -> world (PointCSS2WCS: inverse view-projection) */
-                ndc[0] = 2.0 * u - 1.0;
-                ndc[1] = 1.0 - 2.0 * v;
-                ndc[2] = 2.0 * (double)zw - 1.0;
-                ndc[3] = 1.0;
-                vx_mat4_apply(inv, ndc, hp);
-                if (!(hp[3] != 0.0)) {
-                    cnt->outside++;
-                    continue;
-                }
-                for (a = 0; a < 3; a++) {
-                    double q;
-                    p[a] = hp[a] / hp[3];
-                    q = (p[a] - g->origin[a]) / g->cell[a];
-                    if (!(q >= 0.0 && q < (double)g->dims[a])) {
-                        ok = 0;
-                        break;
-                    }
-                    idx[a] = (int)q;
-                    if (idx[a] > g->dims[a] - 1) idx[a] = g->dims[a] - 1;
-                }
-                if (!ok) {
-                    cnt->outside++;
-                    continue;
-                }
-                d = vol->data + (((size_t)idx[2] * (size_t)g->dims[1] + (size_t)idx[1])
-                                     * (size_t)g->dims[0]
-                                 + (size_t)idx[0])
-                                    * cs;
-                if (im.nattr > 0) {
-                    const float *at = im.attr + pix * (size_t)im.nattr;
-                    for (a = 0; a < im.nattr; a++)
-                        if (map[a] >= 0) d[map[a]] = vx_blend_apply(vol->blend[map[a]], d[map[a]], at[a]);
-                }
-                if (o->occ >= 0) d[o->occ] = vx_blend_apply(vol->blend[o->occ], d[o->occ], 1.0f);
-                cnt->inj++;
-            }
-        }
-    }
-}
-
-HFVIS_API hfvis_status hfvis_iv_inject(hfvis_volume *vol, const hfvis_depth_image *images,
-                                       size_t image_count, const hfvis_iv_options *opts,
-                                       hfvis_iv_stats *stats)
-{
-    vx_iv_opt o;
-    vx_iv_count cnt;
-    if (!vx_iv_volume_ok(vol) || vx_iv_resolve(opts, &vol->grid, vol->channels, &o) != HFVIS_OK
-        || vx_iv_inject_args(vol, images, image_count, &o) != HFVIS_OK)
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    memset(&cnt, 0, sizeof cnt);
-    vx_iv_inject_run(vol, images, image_count, &o, &cnt);
-    vx_iv_stats_out(&cnt, stats);
-    return HFVIS_OK;
-}
-
-HFVIS_API hfvis_status hfvis_iv_update(const hfvis_volume *prev, hfvis_volume *curr,
-                                       const hfvis_depth_image *images, size_t image_count,
-                                       const hfvis_iv_options *opts, hfvis_iv_stats *stats)
-{
-    vx_iv_opt o;
-    vx_iv_count cnt;
-    hfvis_status s = vx_iv_pass_args(prev, curr, images, image_count, opts, &o, 0);
-    if (s != HFVIS_OK) return s;
-    if (vx_iv_inject_args(curr, images, image_count, &o) != HFVIS_OK)
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    memset(&cnt, 0, sizeof cnt);
-    s = vx_iv_run(prev, curr, images, image_count, &o, 0, &cnt); /* all cleanups (Alg. 7) */
-    if (s != HFVIS_OK) return s;
-    vx_iv_inject_run(curr, images, image_count, &o, &cnt);       /* then all injections */
-    vx_iv_stats_out(&cnt, stats);
-    return HFVIS_OK;
-}
-
-HFVIS_API hfvis_status hfvis_iv_replace_nonempty(hfvis_volume *curr,
-                                                 const hfvis_volume *injection,
-                                                 const int *channels, int channel_count,
-                                                 const hfvis_iv_options *opts, size_t *replaced)
-{
-    int list[HFVIS_VOLUME_MAX_CHANNELS], n, a, b, occ, C;
-    size_t v, nv, count = 0;
-    if (!vx_iv_volume_ok(curr) || !vx_iv_volume_ok(injection)
-        || curr->channels != injection->channels || !vx_iv_same_grid(&curr->grid, &injection->grid))
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    C = curr->channels;
-    occ = opts ? opts->occupancy_channel : 0;
-    if (occ < HFVIS_IV_NO_CHANNEL || occ >= C) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (channels) {
-        if (channel_count < 1 || channel_count > C) return HFVIS_ERR_INVALID_ARGUMENT;
-        for (a = 0; a < channel_count; a++) {
-            if (channels[a] < 0 || channels[a] >= C) return HFVIS_ERR_INVALID_ARGUMENT;
-            for (b = 0; b < a; b++)
-                if (channels[b] == channels[a]) return HFVIS_ERR_INVALID_ARGUMENT;
-            list[a] = channels[a];
-        }
-        n = channel_count;
-    } else {
-        for (a = 0; a < C; a++) list[a] = a;
-        n = C;
-    }
-    nv = vx_grid_voxels(&curr->grid);
-    for (v = 0; v < nv; v++) {
-        const float *s = injection->data + v * (size_t)C;
-        float *d = curr->data + v * (size_t)C;
-        if (occ >= 0 ? s[occ] == 0.0f : vx_iv_empty(s, C)) continue;
-        for (a = 0; a < n; a++) d[list[a]] = s[list[a]];
-        count++;
-    }
-    if (replaced) *replaced = count;
-    return HFVIS_OK;
-}
-
-HFVIS_API hfvis_status hfvis_iv_occupancy(const hfvis_volume *vol, int channel, uint8_t *out,
-                                          size_t *count)
-{
-    size_t v, nv, n = 0;
-    if (!vx_iv_volume_ok(vol) || !out || channel < HFVIS_IV_NO_CHANNEL || channel >= vol->channels)
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    nv = vx_grid_voxels(&vol->grid);
-    for (v = 0; v < nv; v++) {
-        const float *s = vol->data + v * (size_t)vol->channels;
-        int on = channel >= 0 ? s[channel] != 0.0f : !vx_iv_empty(s, vol->channels);
-        out[v] = (uint8_t)(on ? 1 : 0);
-        n += (size_t)on;
-    }
-    if (count) *count = n;
-    return HFVIS_OK;
-}
-
-/* ---- IV.5 Table 9 distance metric --------------------------------------------------------- */
-
-/* Squared distance from p to triangle (a, b, c): the closest point by Voronoi regions
- * (Ericson, Real-Time Collision Detection §5.1.5), in double. A degenerate triangle (zero
- * cross product) is the union of its edges. */
-static double vx_iv_seg_d2(const double p[3], const double a[3], const double b[3])
-{
-    double ab[3], ap[3], t, l2, q, d2 = 0.0;
-    int i;
-    for (i = 0; i < 3; i++) ab[i] = b[i] - a[i], ap[i] = p[i] - a[i];
-    l2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
-    t = l2 > 0.0 ? (ab[0] * ap[0] + ab[1] * ap[1] + ab[2] * ap[2]) / l2 : 0.0;
-    if (!(t > 0.0)) t = 0.0;
-    if (t > 1.0) t = 1.0;
-    for (i = 0; i < 3; i++) {
-        q = p[i] - (a[i] + t * ab[i]);
-        d2 += q * q;
-    }
-    return d2;
-}
-
-static double vx_iv_tri_d2(const double p[3], const double a[3], const double b[3],
-                           const double c[3])
-{
-    double ab[3], ac[3], ap[3], bp[3], cp[3], q[3], n[3];
-    double d1, d2, d3, d4, d5, d6, va, vb, vc, v, w, den, r = 0.0;
-    int i;
-    for (i = 0; i < 3; i++) {
-        ab[i] = b[i] - a[i];
-        ac[i] = c[i] - a[i];
-        ap[i] = p[i] - a[i];
-        bp[i] = p[i] - b[i];
-        cp[i] = p[i] - c[i];
-    }
-    n[0] = ab[1] * ac[2] - ab[2] * ac[1];
-    n[1] = ab[2] * ac[0] - ab[0] * ac[2];
-    n[2] = ab[0] * ac[1] - ab[1] * ac[0];
-    if (n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0) {
-        double s0 = vx_iv_seg_d2(p, a, b), s1 = vx_iv_seg_d2(p, b, c), s2 = vx_iv_seg_d2(p, c, a);
-        if (s1 < s0) s0 = s1;
-        return s2 < s0 ? s2 : s0;
-    }
-    d1 = ab[0] * ap[0] + ab[1] * ap[1] + ab[2] * ap[2];
-    d2 = ac[0] * ap[0] + ac[1] * ap[1] + ac[2] * ap[2];
-    d3 = ab[0] * bp[0] + ab[1] * bp[1] + ab[2] * bp[2];
-    d4 = ac[0] * bp[0] + ac[1] * bp[1] + ac[2] * bp[2];
-    d5 = ab[0] * cp[0] + ab[1] * cp[1] + ab[2] * cp[2];
-    d6 = ac[0] * cp[0] + ac[1] * cp[1] + ac[2] * cp[2];
-    vc = d1 * d4 - d3 * d2;
-    vb = d5 * d2 - d1 * d6;
-    va = d3 * d6 - d5 * d4;
-    if (d1 <= 0.0 && d2 <= 0.0) { /* vertex region a */
-        for (i = 0; i < 3; i++) q[i] = a[i];
-    } else if (d3 >= 0.0 && d4 <= d3) { /* vertex region b */
-        for (i = 0; i < 3; i++) q[i] = b[i];
-    } else if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) { /* edge ab */
-        v = d1 / (d1 - d3);
-        for (i = 0; i < 3; i++) q[i] = a[i] + v * ab[i];
-    } else if (d6 >= 0.0 && d5 <= d6) { /* vertex region c */
-        for (i = 0; i < 3; i++) q[i] = c[i];
-    } else if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) { /* edge ac */
-        w = d2 / (d2 - d6);
-        for (i = 0; i < 3; i++) q[i] = a[i] + w * ac[i];
-    } else if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) { /* edge bc */
-        w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        for (i = 0; i < 3; i++) q[i] = b[i] + w * (c[i] - b[i]);
-    } else { /* face: barycentric (1 - v - w, v, w) */
-        den = va + vb + vc;
-        if (!(den > 0.0)) { /* rounding on a sliver: fall back to the edges */
-            double s0 = vx_iv_seg_d2(p, a, b), s1 = vx_iv_seg_d2(p, b, c), s2 = vx_iv_seg_d2(p, c, a);
-            if (s1 < s0) s0 = s1;
-            return s2 < s0 ? s2 : s0;
-        }
-        v = vb / den;
-        w = vc / den;
-        for (i = 0; i < 3; i++) q[i] = a[i] + ab[i] * v + ac[i] * w;
-    }
-    for (i = 0; i < 3; i++) r += (p[i] - q[i]) * (p[i] - q[i]);
-    return r;
-}
-
-HFVIS_API double hfvis_point_triangle_distance(const double p[3], const double a[3],
-                                               const double b[3], const double c[3])
-{
-    if (!p || !a || !b || !c) return (double)NAN;
-    return sqrt(vx_iv_tri_d2(p, a, b, c));
-}
-
-/* PCG32 (O'Neill 2014), the library's own small PRNG. */
-typedef struct vx_iv_rng {
-    uint64_t state, inc;
-} vx_iv_rng;
-
-static uint32_t vx_iv_rng_next(vx_iv_rng *r)
-{
-    uint64_t old = r->state;
-    uint32_t xs, rot;
-    r->state = old * 6364136223846793005ull + r->inc;
-    xs = (uint32_t)(((old >> 18) ^ old) >> 27);
-    rot = (uint32_t)(old >> 59);
-    return (xs >> rot) | (xs << ((32u - rot) & 31u));
-}
-
-static void vx_iv_rng_seed(vx_iv_rng *r, uint64_t seed)
-{
-    r->state = 0u;
-    r->inc = (0xda3e39cb94b95bdbull << 1u) | 1u;
-    (void)vx_iv_rng_next(r);
-    r->state += seed ^ 0x853c49e6748fea9bull;
-    (void)vx_iv_rng_next(r);
-}
-
-/* Uniform double in [0, 1) with 53 random bits. */
-static double vx_iv_rng_unit(vx_iv_rng *r)
-{
-    uint32_t a = vx_iv_rng_next(r) >> 5, b = vx_iv_rng_next(r) >> 6;
-    return ((double)a * 67108864.0 + (double)b) * (1.0 / 9007199254740992.0);
-}
-
-/* Shared set-up of the metric: the positive-area triangles, their area prefix sums, the voxel
- * centres, the bounding-box diagonal and a coordinate scale for the pruning margin. */
-typedef struct vx_iv_metric {
-    const hfvis_mesh *mesh;
-    uint32_t *tris;  /* ids of positive-area triangles */
-    double *cdf;     /* inclusive prefix sums of their areas */
-    size_t nt;
-    double *pts;     /* voxel centres, 3 per point */
-    size_t np;
-    double diag, scale2;
-    size_t samples;
-    uint64_t seed;
-    const hfvis_allocator *alloc;
-} vx_iv_metric;
-
-static void vx_iv_tri_vertices(const hfvis_mesh *m, size_t t, double v[3][3])
-{
-    int c, a;
-    for (c = 0; c < 3; c++) {
-        const float *p = m->xyz + 3 * (size_t)m->indices[3 * t + (size_t)c];
-        for (a = 0; a < 3; a++) v[c][a] = (double)p[a];
-    }
-}
-
-static void vx_iv_metric_free(vx_iv_metric *M)
-{
-    vx_free(M->alloc, M->pts);
-    vx_free(M->alloc, M->cdf);
-    vx_free(M->alloc, M->tris);
-    M->pts = NULL;
-    M->cdf = NULL;
-    M->tris = NULL;
-}
-
-/* Validates and builds the set-up (3 blocks: triangle ids, prefix sums, centres). */
-static hfvis_status vx_iv_metric_init(vx_iv_metric *M, const hfvis_mesh *mesh,
-                                      const hfvis_volume_grid *grid, const uint8_t *occ,
-                                      const hfvis_distance_options *opts)
-{
-    size_t t, nv, v, nt = 0, np = 0;
-    double lo[3], hi[3], sum = 0.0, s = 0.0, e[3];
-    int a;
-    memset(M, 0, sizeof *M);
-    if (!occ || !vx_grid_valid(grid) || vx_mesh_check(mesh) != HFVIS_OK)
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    M->mesh = mesh;
-    M->samples = opts && opts->sample_count ? opts->sample_count : 100000;
-    M->seed = opts ? opts->seed : 0u;
-    M->alloc = opts ? opts->alloc : NULL;
-    if (mesh->triangle_count > (size_t)UINT32_MAX / 2) return HFVIS_ERR_LIMIT;
-    for (a = 0; a < 3; a++) lo[a] = HUGE_VAL, hi[a] = -HUGE_VAL;
-    for (t = 0; t < mesh->triangle_count; t++) {
-        double p[3][3], u[3], w[3], n[3];
-        int c;
-        vx_iv_tri_vertices(mesh, t, p);
-        for (c = 0; c < 3; c++)
-            for (a = 0; a < 3; a++) {
-                if (p[c][a] < lo[a]) lo[a] = p[c][a];
-                if (p[c][a] > hi[a]) hi[a] = p[c][a];
-            }
-        for (a = 0; a < 3; a++) u[a] = p[1][a] - p[0][a], w[a] = p[2][a] - p[0][a];
-        n[0] = u[1] * w[2] - u[2] * w[1];
-        n[1] = u[2] * w[0] - u[0] * w[2];
-        n[2] = u[0] * w[1] - u[1] * w[0];
-        if (n[0] != 0.0 || n[1] != 0.0 || n[2] != 0.0) nt++;
-    }
-    nv = vx_grid_voxels(grid);
-    for (v = 0; v < nv; v++) np += occ[v] != 0;
-    if (nt == 0 || np == 0) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (np > (size_t)UINT32_MAX / 2 || np > SIZE_MAX / 6 || nt > SIZE_MAX / 6) return HFVIS_ERR_LIMIT;
-    for (a = 0; a < 3; a++) {
-        double m1 = fabs(lo[a]) > fabs(hi[a]) ? fabs(lo[a]) : fabs(hi[a]);
-        double g0 = fabs(grid->origin[a]), g1 = fabs(grid->origin[a] + grid->cell[a] * (double)grid->dims[a]);
-        if (g0 > m1) m1 = g0;
-        if (g1 > m1) m1 = g1;
-        s += m1 * m1;
-        e[a] = hi[a] - lo[a];
-    }
-    M->diag = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
-    M->scale2 = s;
-    M->tris = (uint32_t *)vx_alloc_array(M->alloc, nt, sizeof(uint32_t));
-    if (!M->tris) return HFVIS_ERR_OUT_OF_MEMORY;
-    M->cdf = (double *)vx_alloc_array(M->alloc, nt, sizeof(double));
-    M->pts = (double *)vx_alloc_array(M->alloc, 3 * np, sizeof(double));
-    if (!M->cdf || !M->pts) {
-        vx_iv_metric_free(M);
-        return HFVIS_ERR_OUT_OF_MEMORY;
-    }
-    M->nt = 0;
-    for (t = 0; t < mesh->triangle_count; t++) {
-        double p[3][3], u[3], w[3], n[3], area;
-        vx_iv_tri_vertices(mesh, t, p);
-        for (a = 0; a < 3; a++) u[a] = p[1][a] - p[0][a], w[a] = p[2][a] - p[0][a];
-        n[0] = u[1] * w[2] - u[2] * w[1];
-        n[1] = u[2] * w[0] - u[0] * w[2];
-        n[2] = u[0] * w[1] - u[1] * w[0];
-        if (n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0) continue;
-        area = 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        sum += area;
-        M->tris[M->nt] = (uint32_t)t;
-        M->cdf[M->nt] = sum;
-        M->nt++;
-    }
-    if (!(sum > 0.0) || !isfinite(sum)) {
-        vx_iv_metric_free(M);
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    }
-    M->np = 0;
-    {
-        int i, j, k;
-        size_t lin = 0;
-        for (k = 0; k < grid->dims[2]; k++)
-            for (j = 0; j < grid->dims[1]; j++)
-                for (i = 0; i < grid->dims[0]; i++, lin++) {
-                    if (!occ[lin]) continue;
-                    M->pts[3 * M->np + 0] = vx_iv_centre(grid, 0, i);
-                    M->pts[3 * M->np + 1] = vx_iv_centre(grid, 1, j);
-                    M->pts[3 * M->np + 2] = vx_iv_centre(grid, 2, k);
-                    M->np++;
-                }
-    }
-    return HFVIS_OK;
-}
-
-/* Sample s of the mesh (the same sequence for the fast path and the oracle). */
-static void vx_iv_metric_sample(const vx_iv_metric *M, vx_iv_rng *r, double out[3])
-{
-    double u = vx_iv_rng_unit(r) * M->cdf[M->nt - 1], r2 = vx_iv_rng_unit(r), r3 = vx_iv_rng_unit(r);
-    double v[3][3], su = sqrt(r2), w0 = 1.0 - su, w1 = su * (1.0 - r3), w2 = su * r3;
-    size_t lo = 0, hi = M->nt - 1;
-    int a;
-    while (lo < hi) { /* first prefix sum > u */
-        size_t mid = lo + (hi - lo) / 2;
-        if (M->cdf[mid] > u) hi = mid;
-        else lo = mid + 1;
-    }
-    vx_iv_tri_vertices(M->mesh, (size_t)M->tris[lo], v);
-    for (a = 0; a < 3; a++) out[a] = (w0 * v[0][a] + w1 * v[1][a]) + w2 * v[2][a];
-}
-
-static double vx_iv_pt_d2(const double p[3], const double q[3])
-{
-    double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
-    return (dx * dx + dy * dy) + dz * dz;
-}
-
-/* A bounding-volume hierarchy over items with boxes (median split of the centroids along the
- * longest axis, up to 4 items per leaf). Inner node: count 0, children first and first + 1. */
-typedef struct vx_iv_node {
-    double lo[3], hi[3];
-    uint32_t first, count;
-} vx_iv_node;
-
-typedef struct vx_iv_bvh {
-    vx_iv_node *nodes;
-    uint32_t *items;
-    void *block;
-} vx_iv_bvh;
-
-/* Reorders items[first..first+count) so that position first+mid holds the element of rank mid by
- * key (lo + hi on axis a), smaller before, larger after (Hoare quickselect, median of three). */
-static void vx_iv_select(uint32_t *it, size_t first, size_t count, size_t mid, const double *lo,
-                         const double *hi, int a)
-{
-    size_t l = first, r = first + count - 1, want = first + mid;
-    while (r > l) {
-        size_t i = l, j = r, m = l + (r - l) / 2;
-        double k0 = lo[3 * (size_t)it[l] + (size_t)a] + hi[3 * (size_t)it[l] + (size_t)a];
-        double k1 = lo[3 * (size_t)it[m] + (size_t)a] + hi[3 * (size_t)it[m] + (size_t)a];
-        double k2 = lo[3 * (size_t)it[r] + (size_t)a] + hi[3 * (size_t)it[r] + (size_t)a];
-        double piv = k0 < k1 ? (k1 < k2 ? k1 : (k0 < k2 ? k2 : k0)) : (k0 < k2 ? k0 : (k1 < k2 ? k2 : k1));
-        for (;;) {
-            uint32_t tmp;
-            while (lo[3 * (size_t)it[i] + (size_t)a] + hi[3 * (size_t)it[i] + (size_t)a] < piv) i++;
-            while (lo[3 * (size_t)it[j] + (size_t)a] + hi[3 * (size_t)it[j] + (size_t)a] > piv) j--;
-            if (i >= j) break;
-            tmp = it[i];
-            it[i] = it[j];
-            it[j] = tmp;
-            i++;
-            j--;
-        }
-        /* now [l, j] <= piv <= [j+1, r] */
-        if (want <= j) r = j;
-        else l = j + 1;
-    }
-}
-
-/* Builds over n >= 1 items with boxes lo/hi (3 doubles each). One block. */
-static hfvis_status vx_iv_bvh_build(vx_iv_bvh *b, size_t n, const double *lo, const double *hi,
-                                    const hfvis_allocator *alloc)
-{
-    size_t nn = 2 * n, bytes_nodes, bytes_items, used = 1, sp = 0, i;
-    uint32_t stack[VX_IV_STACK];
-    memset(b, 0, sizeof *b);
-    if (n > (size_t)UINT32_MAX / 2) return HFVIS_ERR_LIMIT;
-    if (!vx_mul_size(nn, sizeof(vx_iv_node), &bytes_nodes)
-        || !vx_mul_size(n, sizeof(uint32_t), &bytes_items) || bytes_nodes > SIZE_MAX - bytes_items)
-        return HFVIS_ERR_LIMIT;
-    b->block = vx_alloc(alloc, bytes_nodes + bytes_items);
-    if (!b->block) return HFVIS_ERR_OUT_OF_MEMORY;
-    b->nodes = (vx_iv_node *)b->block;
-    b->items = (uint32_t *)(void *)((unsigned char *)b->block + bytes_nodes);
-    for (i = 0; i < n; i++) b->items[i] = (uint32_t)i;
-    b->nodes[0].first = 0;
-    b->nodes[0].count = (uint32_t)n;
-    stack[sp++] = 0;
-    while (sp > 0) {
-        vx_iv_node *nd = &b->nodes[stack[--sp]];
-        size_t first = nd->first, count = nd->count, mid;
-        double clo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, chi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-        int a, axis = 0;
-        for (a = 0; a < 3; a++) nd->lo[a] = HUGE_VAL, nd->hi[a] = -HUGE_VAL;
-        for (i = first; i < first + count; i++) {
-            size_t it = (size_t)b->items[i];
-            for (a = 0; a < 3; a++) {
-                double c = lo[3 * it + (size_t)a] + hi[3 * it + (size_t)a];
-                if (lo[3 * it + (size_t)a] < nd->lo[a]) nd->lo[a] = lo[3 * it + (size_t)a];
-                if (hi[3 * it + (size_t)a] > nd->hi[a]) nd->hi[a] = hi[3 * it + (size_t)a];
-                if (c < clo[a]) clo[a] = c;
-                if (c > chi[a]) chi[a] = c;
-            }
-        }
-        if (count <= 4) continue; /* leaf */
-        for (a = 1; a < 3; a++)
-            if (chi[a] - clo[a] > chi[axis] - clo[axis]) axis = a;
-        mid = count / 2;
-        vx_iv_select(b->items, first, count, mid, lo, hi, axis);
-        HFVIS_ASSERT(used + 2 <= nn && sp + 2 <= VX_IV_STACK);
-        nd->first = (uint32_t)used;
-        nd->count = 0;
-        b->nodes[used].first = (uint32_t)first;
-        b->nodes[used].count = (uint32_t)mid;
-        b->nodes[used + 1].first = (uint32_t)(first + mid);
-        b->nodes[used + 1].count = (uint32_t)(count - mid);
-        stack[sp++] = (uint32_t)used;
-        stack[sp++] = (uint32_t)(used + 1);
-        used += 2;
-    }
-    return HFVIS_OK;
-}
-
-static double vx_iv_box_d2(const vx_iv_node *nd, const double p[3])
-{
-    double d2 = 0.0;
-    int a;
-    for (a = 0; a < 3; a++) {
-        double g = 0.0;
-        if (p[a] < nd->lo[a]) g = nd->lo[a] - p[a];
-        else if (p[a] > nd->hi[a]) g = p[a] - nd->hi[a];
-        d2 += g * g;
-    }
-    return d2;
-}
-
-/* Smallest squared distance from p to an item (tri: triangles of M, else voxel centres). A node
- * is skipped only when its box is farther than the best so far plus a margin far above the
- * rounding of the distances (1e-9 of best + coordinate scale^2), so the minimum is exactly the
- * brute-force minimum of the same per-item values. */
-static double vx_iv_bvh_nearest(const vx_iv_bvh *b, const vx_iv_metric *M, int tri,
-                                const double p[3])
-{
-    uint32_t stack[VX_IV_STACK];
-    size_t sp = 0;
-    double best = HUGE_VAL;
-    stack[sp++] = 0;
-    while (sp > 0) {
-        const vx_iv_node *nd = &b->nodes[stack[--sp]];
-        if (vx_iv_box_d2(nd, p) > best + 1e-9 * (best + M->scale2)) continue;
-        if (nd->count > 0) {
-            uint32_t i;
-            for (i = nd->first; i < nd->first + nd->count; i++) {
-                size_t it = (size_t)b->items[i];
-                double d2;
-                if (tri) {
-                    double v[3][3];
-                    vx_iv_tri_vertices(M->mesh, (size_t)M->tris[it], v);
-                    d2 = vx_iv_tri_d2(p, v[0], v[1], v[2]);
-                } else {
-                    d2 = vx_iv_pt_d2(p, M->pts + 3 * it);
-                }
-                if (d2 < best) best = d2;
-            }
-        } else {
-            double d0 = vx_iv_box_d2(&b->nodes[nd->first], p);
-            double d1 = vx_iv_box_d2(&b->nodes[nd->first + 1], p);
-            HFVIS_ASSERT(sp + 2 <= VX_IV_STACK);
-            if (d0 <= d1) { /* nearer child popped first */
-                stack[sp++] = nd->first + 1;
-                stack[sp++] = nd->first;
-            } else {
-                stack[sp++] = nd->first;
-                stack[sp++] = nd->first + 1;
-            }
-        }
-    }
-    return best;
-}
-
-static void vx_iv_metric_out(const vx_iv_metric *M, double sum_p, double max_p, double sum_s,
-                             double max_s, hfvis_distance_metrics *out)
-{
-    hfvis_distance_metrics r;
-    double mp = sum_p / (double)M->np, ms = sum_s / (double)M->samples;
-    memset(&r, 0, sizeof r);
-    r.mean_voxel_to_mesh = mp;
-    r.max_voxel_to_mesh = max_p;
-    r.mean_mesh_to_voxel = ms;
-    r.max_mesh_to_voxel = max_s;
-    r.hausdorff = max_p > max_s ? max_p : max_s;
-    r.diagonal = M->diag;
-    r.table9_percent = M->diag > 0.0 ? 100.0 * (mp > ms ? mp : ms) / M->diag : (double)NAN;
-    r.voxel_count = M->np;
-    r.sample_count = M->samples;
-    *out = r;
-}
-
-HFVIS_API hfvis_status hfvis_voxel_distance_metrics(const hfvis_mesh *mesh,
-                                                    const hfvis_volume_grid *grid,
-                                                    const uint8_t *occupancy,
-                                                    const hfvis_distance_options *opts,
-                                                    hfvis_distance_metrics *out)
-{
-    vx_iv_metric M;
-    vx_iv_bvh tb, pb;
-    vx_iv_rng rng;
-    double *box = NULL, sum_p = 0.0, max_p = 0.0, sum_s = 0.0, max_s = 0.0;
-    size_t t, s;
-    hfvis_status st;
-    if (!out) return HFVIS_ERR_INVALID_ARGUMENT;
-    st = vx_iv_metric_init(&M, mesh, grid, occupancy, opts);
-    if (st != HFVIS_OK) return st;
-    /* triangle boxes (lo: first 3 nt doubles, hi: next 3 nt) */
-    box = (double *)vx_alloc_array(M.alloc, 6 * M.nt, sizeof(double));
-    if (!box) {
-        vx_iv_metric_free(&M);
-        return HFVIS_ERR_OUT_OF_MEMORY;
-    }
-    for (t = 0; t < M.nt; t++) {
-        double v[3][3];
-        int a, c;
-        vx_iv_tri_vertices(mesh, (size_t)M.tris[t], v);
-        for (a = 0; a < 3; a++) {
-            double l = v[0][a], h = v[0][a];
-            for (c = 1; c < 3; c++) {
-                if (v[c][a] < l) l = v[c][a];
-                if (v[c][a] > h) h = v[c][a];
-            }
-            box[3 * t + (size_t)a] = l;
-            box[3 * M.nt + 3 * t + (size_t)a] = h;
-        }
-    }
-    st = vx_iv_bvh_build(&tb, M.nt, box, box + 3 * M.nt, M.alloc);
-    if (st != HFVIS_OK) {
-        vx_free(M.alloc, box);
-        vx_iv_metric_free(&M);
-        return st;
-    }
-    st = vx_iv_bvh_build(&pb, M.np, M.pts, M.pts, M.alloc);
-    if (st != HFVIS_OK) {
-        vx_free(M.alloc, tb.block);
-        vx_free(M.alloc, box);
-        vx_iv_metric_free(&M);
-        return st;
-    }
-    /* Y -> X: every voxel centre to the mesh, exactly */
-    for (s = 0; s < M.np; s++) {
-        double d = sqrt(vx_iv_bvh_nearest(&tb, &M, 1, M.pts + 3 * s));
-        sum_p += d;
-        if (d > max_p) max_p = d;
-    }
-    /* X -> Y: area-uniform samples of the mesh to the nearest voxel centre */
-    vx_iv_rng_seed(&rng, M.seed);
-    for (s = 0; s < M.samples; s++) {
-        double q[3], d;
-        vx_iv_metric_sample(&M, &rng, q);
-        d = sqrt(vx_iv_bvh_nearest(&pb, &M, 0, q));
-        sum_s += d;
-        if (d > max_s) max_s = d;
-    }
-    vx_iv_metric_out(&M, sum_p, max_p, sum_s, max_s, out);
-    vx_free(M.alloc, pb.block);
-    vx_free(M.alloc, tb.block);
-    vx_free(M.alloc, box);
-    vx_iv_metric_free(&M);
-    return HFVIS_OK;
-}
-
-HFVIS_API hfvis_status hfvis_voxel_distance_metrics_naive(const hfvis_mesh *mesh,
-                                                          const hfvis_volume_grid *grid,
-                                                          const uint8_t *occupancy,
-                                                          const hfvis_distance_options *opts,
-                                                          hfvis_distance_metrics *out)
-{
-    vx_iv_metric M;
-    vx_iv_rng rng;
-    double sum_p = 0.0, max_p = 0.0, sum_s = 0.0, max_s = 0.0;
-    size_t t, s;
-    hfvis_status st;
-    if (!out) return HFVIS_ERR_INVALID_ARGUMENT;
-    st = vx_iv_metric_init(&M, mesh, grid, occupancy, opts);
-    if (st != HFVIS_OK) return st;
-    for (s = 0; s < M.np; s++) {
-        double best = HUGE_VAL, d;
-        for (t = 0; t < M.nt; t++) {
-            double v[3][3], d2;
-            vx_iv_tri_vertices(mesh, (size_t)M.tris[t], v);
-            d2 = vx_iv_tri_d2(M.pts + 3 * s, v[0], v[1], v[2]);
-            if (d2 < best) best = d2;
-        }
-        d = sqrt(best);
-        sum_p += d;
-        if (d > max_p) max_p = d;
-    }
-    vx_iv_rng_seed(&rng, M.seed);
-    for (s = 0; s < M.samples; s++) {
-        double q[3], best = HUGE_VAL, d;
-        size_t p;
-        vx_iv_metric_sample(&M, &rng, q);
-        for (p = 0; p < M.np; p++) {
-            double d2 = vx_iv_pt_d2(q, M.pts + 3 * p);
-            if (d2 < best) best = d2;
-        }
-        d = sqrt(best);
-        sum_s += d;
-        if (d > max_s) max_s = d;
-    }
-    vx_iv_metric_out(&M, sum_p, max_p, sum_s, max_s, out);
-    vx_iv_metric_free(&M);
-    return HFVIS_OK;
-}
-
-/* ========================================================================================== */
-/* 2a. BVH and ray casting (issue 4; the scene-space caster of spec raycast A.9.2 / A.10)      */
-/*     Watertight test: S. Woop, C. Benthin, I. Wald, "Watertight Ray/Triangle Intersection",  */
-/*     JCGT 2(1), 2013: its pseudo-code listing (ray setup, shear, edge functions U V W, the   */
-/*     double-precision recomputation of zero edge functions), quoted line by line below.     */
-/*     Slab test: T. Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013 (t_far * (1 + 2 gamma_3)).*/
-/*     SAH: MacDonald & Booth 1990, binned as I. Wald, IEEE RT 2007.                           */
-/* ========================================================================================== */
-/* Contents
- *   2a.1 rays: validation and the per-ray setup of Woop et al.
- *   2a.2 the watertight ray-triangle test and the exact zero-area test
- *   2a.3 naive oracle (every triangle in index order)
- *   2a.4 binned SAH build (explicit stack, median fallback, padded boxes)
- *   2a.5 traversal (robust slab test, nearer child first, explicit stack) */
-
-/* Far-distance and best-distance widening of the slab test: Ize's 1 + 2 gamma_3 (3.6e-7) covers
- * the slab arithmetic; 2^-16 also covers the rounding of the triangle's own t (relative, a few
- * ulp times the conditioning of the hit), so a hit the naive loop finds is never pruned. */
-#define VX_BVH_SLACK (1.0f + 1.0f / 65536.0f)
-/* Node boxes are padded by 2^-18 of their largest coordinate magnitude or extent: covers the
- * off-plane rounding of a computed hit point (about gamma * box size) near box faces. */
-#define VX_BVH_PAD 0x1p-18
-/* The two inner-loop tests are forced inline (GCC/Clang), else left to the compiler. */
-#if defined(__GNUC__)
-#define VX_BVH_INLINE inline __attribute__((always_inline))
-#else
-#define VX_BVH_INLINE inline
-#endif
-/* SAH constants (spec raycast A.9.2: C_trav = C_tri = 1). */
-#define VX_BVH_C_TRAV 1.0
-#define VX_BVH_C_TRI 1.0
-
-/* ---- 2a.1 rays ------------------------------------------------------------------------------ */
-
-/* A ray prepared once per query (Woop et al.: "calculate dimension where the ray direction is
- * maximal", "swap kx and ky dimension to preserve winding direction of triangles", "calculate
- * shear constants"). */
-typedef struct vx_bvh_ray {
-    float org[3], dir[3];
-    float inv[3];      /* 1/dir; a zero component gives +-infinity with the zero's sign */
-    int neg[3];        /* sign bit of dir: the slab's near plane is hi when set */
-    int kx, ky, kz;    /* kz = axis of the largest |dir|; kx, ky swapped if dir[kz] < 0 */
-    float sx, sy, sz;  /* shear constants: dir[kx]/dir[kz], dir[ky]/dir[kz], 1/dir[kz] */
-    float t_min, t_max;
-    int cull;
-} vx_bvh_ray;
-
-static int vx_bvh_ray_valid(const hfvis_ray *r)
-{
-    int a;
-    if (!r) return 0;
-    for (a = 0; a < 3; a++)
-        if (!isfinite(r->origin[a]) || !isfinite(r->direction[a])) return 0;
-    if (r->direction[0] == 0.0f && r->direction[1] == 0.0f && r->direction[2] == 0.0f) return 0;
-    if (!(r->t_min >= 0.0f) || !isfinite(r->t_min)) return 0; /* NaN fails the first test */
-    if (!(r->t_max >= r->t_min)) return 0;                    /* NaN fails; +inf allowed */
-    if (r->cull != HFVIS_CULL_NONE && r->cull != HFVIS_CULL_BACK
-        && r->cull != HFVIS_CULL_FRONT)
-        return 0;
-    return 1;
-}
-
-/* kz = dimension of the largest |direction| component (first on ties), kx and ky the
- * next two cyclically, swapped when dir[kz] < 0 to keep the winding; shear constants. */
-static void vx_bvh_ray_setup(const hfvis_ray *r, vx_bvh_ray *p)
-{
-    int a, kz = 0, t;
-    float m = fabsf(r->direction[0]);
-    for (a = 0; a < 3; a++) {
-        float d = r->direction[a];
-        p->org[a] = r->origin[a];
-        p->dir[a] = d;
-        p->neg[a] = signbit(d) ? 1 : 0;
-        p->inv[a] = d == 0.0f ? copysignf(INFINITY, d) : 1.0f / d;
-        if (fabsf(d) > m) {
-            m = fabsf(d);
-            kz = a;
-        }
-    }
-    p->kz = kz;
-    p->kx = kz == 2 ? 0 : kz + 1;
-    p->ky = p->kx == 2 ? 0 : p->kx + 1;
-    if (r->direction[kz] < 0.0f) {
-        t = p->kx;
-        p->kx = p->ky;
-        p->ky = t;
-    }
-    p->sx = r->direction[p->kx] / r->direction[kz];
-    p->sy = r->direction[p->ky] / r->direction[kz];
-    p->sz = 1.0f / r->direction[kz];
-    p->t_min = r->t_min;
-    p->t_max = r->t_max;
-    p->cull = (int)r->cull;
-}
-
-static void vx_bvh_miss(hfvis_hit *h)
-{
-    h->t = INFINITY;
-    h->triangle = HFVIS_NO_TRIANGLE;
-    h->u = 0.0f;
-    h->v = 0.0f;
-    h->front = 0;
-}
-
-/* ---- 2a.2 watertight ray-triangle test ----------------------------------------------------- */
-
-/* Exact test: is p[0] + ... + p[5] == 0? The p are exact products of two floats (double). A
- * floating-point filter (the rounded sum's error is below 5 u sum|p| < 2^-50 sum|p|) decides
- * almost always; otherwise Shewchuk's GROW-EXPANSION with Knuth's TWO-SUM and zero
- * elimination ("Adaptive Precision Floating-Point Arithmetic and Fast Robust Geometric
- * Predicates", 1997): the sum is zero
- * iff no component survives. */
-static int vx_bvh_sum6_is_zero(const double p[6])
-{
-    double s = 0.0, m = 0.0, e[7];
-    int i, j, n = 0;
-    for (i = 0; i < 6; i++) {
-        s += p[i];
-        m += fabs(p[i]);
-    }
-    if (m == 0.0) return 1;
-    if (fabs(s) > m * 0x1p-50) return 0;
-    for (i = 0; i < 6; i++) {
-        double q = p[i];
-        int k = 0;
-        for (j = 0; j < n; j++) {
-            double x = q + e[j], bv = x - q, av = x - bv;
-            double err = (q - av) + (e[j] - bv);
-            q = x;
-            if (err != 0.0) e[k++] = err;
-        }
-        if (q != 0.0) e[k++] = q;
-        n = k;
-    }
-    return n == 0;
-}
-
-/* 1 when (b - a) x (c - a) is exactly the zero vector (coincident or collinear vertices). Its
- * component (i, j) is a_i b_j - a_j b_i + b_i c_j - b_j c_i + c_i a_j - c_j a_i, each product
- * of two floats exact in double. */
-static int vx_bvh_zero_area(const float *a, const float *b, const float *c)
-{
-    static const int ci[3] = {1, 2, 0}, cj[3] = {2, 0, 1};
-    int k;
-    for (k = 0; k < 3; k++) {
-        int i = ci[k], j = cj[k];
-        double p[6];
-        p[0] = (double)a[i] * (double)b[j];
-        p[1] = -((double)a[j] * (double)b[i]);
-        p[2] = (double)b[i] * (double)c[j];
-        p[3] = -((double)b[j] * (double)c[i]);
-        p[4] = (double)c[i] * (double)a[j];
-        p[5] = -((double)c[j] * (double)a[i]);
-        if (!vx_bvh_sum6_is_zero(p)) return 0;
-    }
-    return 1;
-}
-
-/* Woop et al.'s listing for one triangle, hits accepted with t in [t_min, t_hi] (t_hi <= t_max:
- * callers pass their current best). Returns 1 and fills h (all but triangle) on a hit. */
-static VX_BVH_INLINE int vx_bvh_tri(const vx_bvh_ray *r, const float *p0, const float *p1,
-                                     const float *p2, float t_hi, hfvis_hit *h)
-{
-    const int kx = r->kx, ky = r->ky, kz = r->kz;
-    float ax, ay, az, bx, by, bz, cx, cy, cz, Ax, Ay, Bx, By, Cx, Cy, U, V, W, det, T, t;
-    /* "calculate vertices relative to ray origin": A = tri.A - org, ... */
-    ax = p0[kx] - r->org[kx];
-    ay = p0[ky] - r->org[ky];
-    az = p0[kz] - r->org[kz];
-    bx = p1[kx] - r->org[kx];
-    by = p1[ky] - r->org[ky];
-    bz = p1[kz] - r->org[kz];
-    cx = p2[kx] - r->org[kx];
-    cy = p2[ky] - r->org[ky];
-    cz = p2[kz] - r->org[kz];
-    /* shear: the ray becomes the +z axis ("Ax = A[kx] - Sx*A[kz]" ...) */
-    Ax = ax - r->sx * az;
-    Ay = ay - r->sy * az;
-    Bx = bx - r->sx * bz;
-    By = by - r->sy * bz;
-    Cx = cx - r->sx * cz;
-    Cy = cy - r->sy * cz;
-    /* scaled barycentric coordinates = 2D edge functions ("U = Cx*By - Cy*Bx" ...) */
-    U = Cx * By - Cy * Bx;
-    V = Ax * Cy - Ay * Cx;
-    W = Bx * Ay - By * Ax;
-    /* "fallback to test against edges using double precision": an edge function that is exactly
-     * 0 is recomputed in double, where the products of two floats are exact and the difference
-     * is correctly rounded, so its sign is exact. (The float value's sign, when nonzero, is
-     * already exact: rounding is monotonic.) */
-    if (U == 0.0f || V == 0.0f || W == 0.0f) goto exact_path;
-    /* inside iff U, V, W share a sign ("if ((U<0 || V<0 || W<0) && (U>0 || V>0 || W>0))
-     * return"); a NaN (two overflowed products) passes here and is resolved below */
-    if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return 0;
-    det = U + V + W;
-    if (!(fabsf(det) <= FLT_MAX)) goto exact_path; /* overflow or NaN: redo in double */
-    if (r->cull == HFVIS_CULL_BACK && det < 0.0f) return 0;
-    if (r->cull == HFVIS_CULL_FRONT && det > 0.0f) return 0;
-    /* scaled hit distance ("Az = Sz*A[kz]" ..., "T = U*Az + V*Bz + W*Cz") and t = T/det */
-    T = U * (r->sz * az) + V * (r->sz * bz) + W * (r->sz * cz);
-    t = T / det;
-    if (!(fabsf(t) <= FLT_MAX)) goto exact_path;
-    if (!(t >= r->t_min) || !(t <= t_hi)) return 0;
-    if (vx_bvh_zero_area(p0, p1, p2)) return 0;
-    h->t = t;
-    h->u = V / det;
-    h->v = W / det;
-    h->front = det > 0.0f;
-    return 1;
-exact_path: {
-        double Ud = (double)Cx * (double)By - (double)Cy * (double)Bx;
-        double Vd = (double)Ax * (double)Cy - (double)Ay * (double)Cx;
-        double Wd = (double)Bx * (double)Ay - (double)By * (double)Ax;
-        double dd, Td, td;
-        if ((Ud < 0.0 || Vd < 0.0 || Wd < 0.0) && (Ud > 0.0 || Vd > 0.0 || Wd > 0.0)) return 0;
-        dd = Ud + Vd + Wd;
-        if (dd == 0.0 || !(fabs(dd) <= DBL_MAX)) return 0; /* edge-on (or not finite) */
-        if (r->cull == HFVIS_CULL_BACK && dd < 0.0) return 0;
-        if (r->cull == HFVIS_CULL_FRONT && dd > 0.0) return 0;
-        Td = Ud * ((double)r->sz * (double)az) + Vd * ((double)r->sz * (double)bz)
-             + Wd * ((double)r->sz * (double)cz);
-        td = Td / dd;
-        if (!(fabs(td) <= (double)FLT_MAX)) return 0;
-        t = (float)td;
-        if (!(t >= r->t_min) || !(t <= t_hi)) return 0;
-        if (vx_bvh_zero_area(p0, p1, p2)) return 0;
-        h->t = t;
-        h->u = (float)(Vd / dd);
-        h->v = (float)(Wd / dd);
-        h->front = dd > 0.0;
-        return 1;
-    }
-}
-
-HFVIS_API hfvis_status hfvis_ray_triangle(const hfvis_ray *ray, const float v0[3],
-                                          const float v1[3], const float v2[3], hfvis_hit *hit)
-{
-    vx_bvh_ray r;
-    hfvis_hit h;
-    int a;
-    if (!vx_bvh_ray_valid(ray) || !v0 || !v1 || !v2 || !hit) return HFVIS_ERR_INVALID_ARGUMENT;
-    for (a = 0; a < 3; a++)
-        if (!isfinite(v0[a]) || !isfinite(v1[a]) || !isfinite(v2[a]))
-            return HFVIS_ERR_INVALID_ARGUMENT;
-    vx_bvh_ray_setup(ray, &r);
-    if (vx_bvh_tri(&r, v0, v1, v2, r.t_max, &h)) {
-        h.triangle = 0;
-        *hit = h;
-    } else {
-        vx_bvh_miss(hit);
-    }
-    return HFVIS_OK;
-}
-
-/* ---- 2a.3 naive oracle ---------------------------------------------------------------------- */
-
-static int vx_bvh_query_valid(hfvis_ray_query q)
-{
-    return q == HFVIS_RAY_CLOSEST || q == HFVIS_RAY_ANY;
-}
-
-HFVIS_API hfvis_status hfvis_ray_intersect_naive(const hfvis_mesh *mesh, const hfvis_ray *ray,
-                                                 hfvis_ray_query query, hfvis_hit_filter filter,
-                                                 void *user, hfvis_hit *hit)
-{
-    vx_bvh_ray r;
-    hfvis_hit best, h;
-    size_t t, nv;
-    if (!mesh || !hit || !vx_bvh_ray_valid(ray) || !vx_bvh_query_valid(query))
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    if ((mesh->vertex_count && !mesh->xyz) || (mesh->triangle_count && !mesh->indices))
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    vx_bvh_ray_setup(ray, &r);
-    vx_bvh_miss(&best);
-    best.t = r.t_max;
-    nv = mesh->vertex_count;
-    for (t = 0; t < mesh->triangle_count; t++) {
-        const uint32_t *ix = mesh->indices + 3 * t;
-        if (ix[0] >= nv || ix[1] >= nv || ix[2] >= nv) return HFVIS_ERR_INVALID_ARGUMENT;
-        /* in index order, "t < best" is the closest-hit order (ties keep the lower index) */
-        if (!vx_bvh_tri(&r, mesh->xyz + 3 * (size_t)ix[0], mesh->xyz + 3 * (size_t)ix[1],
-                        mesh->xyz + 3 * (size_t)ix[2], best.t, &h))
-            continue;
-        if (best.triangle != HFVIS_NO_TRIANGLE && !(h.t < best.t)) continue;
-        h.triangle = (uint32_t)t;
-        if (filter && !filter(user, ray, &h)) continue;
-        best = h;
-        if (query == HFVIS_RAY_ANY) break;
-    }
-    if (best.triangle == HFVIS_NO_TRIANGLE) vx_bvh_miss(&best);
-    *hit = best;
-    return HFVIS_OK;
-}
-
-HFVIS_API hfvis_status hfvis_ray_closest_naive(const hfvis_mesh *mesh, const hfvis_ray *ray,
-                                               hfvis_hit *hit)
-{
-    return hfvis_ray_intersect_naive(mesh, ray, HFVIS_RAY_CLOSEST, NULL, NULL, hit);
-}
-
-HFVIS_API hfvis_status hfvis_ray_any_naive(const hfvis_mesh *mesh, const hfvis_ray *ray,
-                                           hfvis_hit *hit)
-{
-    return hfvis_ray_intersect_naive(mesh, ray, HFVIS_RAY_ANY, NULL, NULL, hit);
-}
-
-/* ---- 2a.4 binned SAH build ----------------------------------------------------------------- */
-
-HFVIS_API hfvis_bvh_options hfvis_bvh_options_default(void)
-{
-    hfvis_bvh_options o;
-    memset(&o, 0, sizeof o);
-    o.max_leaf_size = HFVIS_BVH_DEFAULT_LEAF_SIZE;
-    o.bins = HFVIS_BVH_DEFAULT_BINS;
-    return o;
-}
-
-typedef struct vx_bvh_prim {
-    float lo[3], hi[3]; /* float bounding box of the triangle (exact: min/max of its vertices) */
-} vx_bvh_prim;
-
-typedef struct vx_bvh_task {
-    uint32_t node, begin, end;
-    int depth;
-} vx_bvh_task;
-
-typedef struct vx_bvh_bin {
-    float lo[3], hi[3];
-    uint32_t count;
-} vx_bvh_bin;
-
-/* Centroid of a triangle's box on axis a, doubled (lo + hi, in double: no overflow). */
-static double vx_bvh_cen(const vx_bvh_prim *p, int a)
-{
-    return (double)p->lo[a] + (double)p->hi[a];
-}
-
-static double vx_bvh_area(const float lo[3], const float hi[3])
-{
-    double dx = (double)hi[0] - (double)lo[0], dy = (double)hi[1] - (double)lo[1],
-           dz = (double)hi[2] - (double)lo[2];
-    return 2.0 * (dx * dy + dy * dz + dz * dx);
-}
-
-static void vx_bvh_grow(float lo[3], float hi[3], const float plo[3], const float phi[3])
-{
-    int a;
-    for (a = 0; a < 3; a++) {
-        if (plo[a] < lo[a]) lo[a] = plo[a];
-        if (phi[a] > hi[a]) hi[a] = phi[a];
-    }
-}
-
-/* Bin of a (doubled) centroid c on an axis with bounds [cmin, cmax], cmax > cmin. */
-static int vx_bvh_bin_of(double c, double cmin, double scale, int bins)
-{
-    int b = (int)((c - cmin) * scale);
-    if (b < 0) b = 0;
-    if (b > bins - 1) b = bins - 1;
-    return b;
-}
-
-/* Key order of the median split: centroid on axis a, then triangle index. */
-static int vx_bvh_less(const vx_bvh_prim *prims, uint32_t x, uint32_t y, int a)
-{
-    double cx = vx_bvh_cen(prims + x, a), cy = vx_bvh_cen(prims + y, a);
-    return cx < cy || (cx == cy && x < y);
-}
-
-/* Swap *x and *y unless *x comes first. */
-static void vx_bvh_order2(const vx_bvh_prim *prims, uint32_t *x, uint32_t *y, int a)
-{
-    if (vx_bvh_less(prims, *y, *x, a)) {
-        uint32_t t = *x;
-        *x = *y;
-        *y = t;
-    }
-}
-
-/* Rearrange idx[0..n) so that idx[k] holds the k-th smallest key and smaller keys come before
- * it (deterministic quickselect, median-of-three pivot, Lomuto partition). */
-static void vx_bvh_select(const vx_bvh_prim *prims, uint32_t *idx, size_t n, size_t k, int a)
-{
-    size_t lo = 0, hi = n - 1;
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2, i, store;
-        uint32_t tmp, piv;
-        /* median of three into position hi */
-        vx_bvh_order2(prims, idx + lo, idx + mid, a);
-        vx_bvh_order2(prims, idx + lo, idx + hi, a);
-        vx_bvh_order2(prims, idx + hi, idx + mid, a); /* lo <= hi <= mid: pivot idx[hi] */
-        piv = idx[hi];
-        store = lo;
-        for (i = lo; i < hi; i++)
-            if (vx_bvh_less(prims, idx[i], piv, a)) {
-                tmp = idx[i];
-                idx[i] = idx[store];
-                idx[store] = tmp;
-                store++;
-            }
-        idx[hi] = idx[store];
-        idx[store] = piv;
-        if (store == k) return;
-        if (k < store) hi = store - 1;
-        else lo = store + 1;
-    }
-}
-
-/* Pad a finished node box outward (see hfvis_bvh_node). */
-static void vx_bvh_pad(hfvis_bvh_node *n)
-{
-    double m = 0.0, pad;
-    int a;
-    for (a = 0; a < 3; a++) {
-        double l = fabs((double)n->lo[a]), h = fabs((double)n->hi[a]);
-        double e = (double)n->hi[a] - (double)n->lo[a];
-        if (l > m) m = l;
-        if (h > m) m = h;
-        if (e > m) m = e;
-    }
-    pad = m * VX_BVH_PAD;
-    for (a = 0; a < 3; a++) {
-        double l = (double)n->lo[a] - pad, h = (double)n->hi[a] + pad;
-        /* rounded to float away from the box (the double values are within float range unless
-         * the box reaches FLT_MAX, which gives +-infinity) */
-        float lf = l < -(double)FLT_MAX ? -INFINITY : (float)l;
-        float hf = h > (double)FLT_MAX ? INFINITY : (float)h;
-        if ((double)lf > l) lf = nextafterf(lf, -INFINITY);
-        if ((double)hf < h) hf = nextafterf(hf, INFINITY);
-        n->lo[a] = lf;
-        n->hi[a] = hf;
-    }
-}
-
-HFVIS_API hfvis_status hfvis_bvh_build(const hfvis_mesh *mesh, const hfvis_bvh_options *opts,
-                                       hfvis_bvh *out)
-{
-    const hfvis_allocator *alloc = opts ? opts->alloc : NULL;
-    int max_leaf = opts && opts->max_leaf_size ? opts->max_leaf_size : HFVIS_BVH_DEFAULT_LEAF_SIZE;
-    int bins = opts && opts->bins ? opts->bins : HFVIS_BVH_DEFAULT_BINS;
-    size_t n, i, max_nodes, next, leaves = 0;
-    uint32_t *order = NULL;
-    vx_bvh_prim *prims = NULL;
-    hfvis_bvh_node *tmp = NULL, *nodes = NULL;
-    vx_bvh_task stack[HFVIS_BVH_MAX_DEPTH + 2];
-    int sp = 0, max_depth = 0;
-    hfvis_status st;
-
-    if (!out || max_leaf < 1 || max_leaf > HFVIS_BVH_MAX_LEAF_SIZE || bins < 2
-        || bins > HFVIS_BVH_MAX_BINS)
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    if (!mesh) return HFVIS_ERR_INVALID_ARGUMENT;
-    n = mesh->triangle_count;
-    if (n > HFVIS_BVH_MAX_TRIANGLES) return HFVIS_ERR_LIMIT; /* before reading the arrays */
-    st = vx_mesh_check(mesh);
-    if (st != HFVIS_OK) return st;
-    if (n == 0) {
-        memset(out, 0, sizeof *out);
-        out->max_leaf_size = max_leaf;
-        return HFVIS_OK;
-    }
-    max_nodes = 2 * n - 1;
-    order = (uint32_t *)vx_alloc_array(alloc, n, sizeof *order);
-    if (!order) goto oom;
-    prims = (vx_bvh_prim *)vx_alloc_array(alloc, n, sizeof *prims);
-    if (!prims) goto oom;
-    tmp = (hfvis_bvh_node *)vx_alloc_array(alloc, max_nodes, sizeof *tmp);
-    if (!tmp) goto oom;
-
-    for (i = 0; i < n; i++) {
-        const uint32_t *ix = mesh->indices + 3 * i;
-        const float *p0 = mesh->xyz + 3 * (size_t)ix[0], *p1 = mesh->xyz + 3 * (size_t)ix[1],
-                    *p2 = mesh->xyz + 3 * (size_t)ix[2];
-        int a;
-        for (a = 0; a < 3; a++) {
-            float lo = p0[a], hi = p0[a];
-            if (p1[a] < lo) lo = p1[a];
-            if (p1[a] > hi) hi = p1[a];
-            if (p2[a] < lo) lo = p2[a];
-            if (p2[a] > hi) hi = p2[a];
-            prims[i].lo[a] = lo;
-            prims[i].hi[a] = hi;
-        }
-        order[i] = (uint32_t)i;
-    }
-
-    next = 1;
-    stack[0].node = 0;
-    stack[0].begin = 0;
-    stack[0].end = (uint32_t)n;
-    stack[0].depth = 1;
-    sp = 1;
-    while (sp > 0) {
-        vx_bvh_task task = stack[--sp];
-        hfvis_bvh_node *node = tmp + task.node;
-        size_t count = task.end - task.begin, mid = 0;
-        double cmin[3], cmax[3], area;
-        int a, split = 0, median = 0;
-        uint32_t *idx = order + task.begin;
-        /* node box and centroid bounds: O(count) */
-        for (a = 0; a < 3; a++) {
-            node->lo[a] = prims[idx[0]].lo[a];
-            node->hi[a] = prims[idx[0]].hi[a];
-            cmin[a] = cmax[a] = vx_bvh_cen(prims + idx[0], a);
-        }
-        for (i = 1; i < count; i++) {
-            const vx_bvh_prim *p = prims + idx[i];
-            vx_bvh_grow(node->lo, node->hi, p->lo, p->hi);
-            for (a = 0; a < 3; a++) {
-                double c = vx_bvh_cen(p, a);
-                if (c < cmin[a]) cmin[a] = c;
-                if (c > cmax[a]) cmax[a] = c;
-            }
-        }
-        if (task.depth > max_depth) max_depth = task.depth;
-        area = vx_bvh_area(node->lo, node->hi);
-        if (count > 1) {
-            int degenerate = (cmax[0] == cmin[0] && cmax[1] == cmin[1] && cmax[2] == cmin[2])
-                             || !(area > 0.0) || !(area <= DBL_MAX);
-            if (task.depth >= HFVIS_BVH_SAH_DEPTH || degenerate) {
-                /* deep or degenerate nodes: leaf if small enough, else median split */
-                median = count > (size_t)max_leaf;
-            } else {
-                /* binned SAH over every axis with a centroid extent (Wald 2007) */
-                vx_bvh_bin bin[HFVIS_BVH_MAX_BINS];
-                double right_area[HFVIS_BVH_MAX_BINS];
-                uint32_t right_count[HFVIS_BVH_MAX_BINS];
-                double best = HUGE_VAL, scale_best = 0.0;
-                int best_axis = -1, best_bin = -1, b;
-                for (a = 0; a < 3; a++) {
-                    double scale;
-                    float llo[3], lhi[3];
-                    uint32_t lc = 0;
-                    if (!(cmax[a] > cmin[a])) continue;
-                    scale = (double)bins * (1.0 - 0x1p-40) / (cmax[a] - cmin[a]);
-                    for (b = 0; b < bins; b++) {
-                        bin[b].count = 0;
-                        bin[b].lo[0] = bin[b].lo[1] = bin[b].lo[2] = INFINITY;
-                        bin[b].hi[0] = bin[b].hi[1] = bin[b].hi[2] = -INFINITY;
-                    }
-                    for (i = 0; i < count; i++) {
-                        const vx_bvh_prim *p = prims + idx[i];
-                        b = vx_bvh_bin_of(vx_bvh_cen(p, a), cmin[a], scale, bins);
-                        bin[b].count++;
-                        vx_bvh_grow(bin[b].lo, bin[b].hi, p->lo, p->hi);
-                    }
-                    /* sweep from the right: boxes and counts of bins b+1..bins-1 */
-                    {
-                        float rlo[3] = {INFINITY, INFINITY, INFINITY},
-                              rhi[3] = {-INFINITY, -INFINITY, -INFINITY};
-                        uint32_t rc = 0;
-                        for (b = bins - 1; b > 0; b--) {
-                            if (bin[b].count) vx_bvh_grow(rlo, rhi, bin[b].lo, bin[b].hi);
-                            rc += bin[b].count;
-                            right_count[b - 1] = rc;
-                            right_area[b - 1] = rc ? vx_bvh_area(rlo, rhi) : 0.0;
-                        }
-                    }
-                    llo[0] = llo[1] = llo[2] = INFINITY;
-                    lhi[0] = lhi[1] = lhi[2] = -INFINITY;
-                    for (b = 0; b < bins - 1; b++) {
-                        double cost;
-                        if (bin[b].count) vx_bvh_grow(llo, lhi, bin[b].lo, bin[b].hi);
-                        lc += bin[b].count;
-                        if (lc == 0 || right_count[b] == 0) continue;
-                        cost = vx_bvh_area(llo, lhi) * (double)lc
-                               + right_area[b] * (double)right_count[b];
-                        if (cost < best) {
-                            best = cost;
-                            best_axis = a;
-                            best_bin = b;
-                            scale_best = scale;
-                        }
-                    }
-                }
-                if (best_axis < 0) {
-                    median = count > (size_t)max_leaf; /* unreachable: some extent is > 0 */
-                } else {
-                    double split_cost = VX_BVH_C_TRAV + VX_BVH_C_TRI * best / area;
-                    if (count > (size_t)max_leaf || !(VX_BVH_C_TRI * (double)count <= split_cost)) {
-                        /* partition by bin: bins <= best_bin go left */
-                        size_t lo = 0, hi = count;
-                        a = best_axis;
-                        while (lo < hi) {
-                            if (vx_bvh_bin_of(vx_bvh_cen(prims + idx[lo], a), cmin[a], scale_best,
-                                              bins) <= best_bin) {
-                                lo++;
-                            } else {
-                                uint32_t t = idx[lo];
-                                idx[lo] = idx[--hi];
-                                idx[hi] = t;
-                            }
-                        }
-                        mid = lo;
-                        split = 1;
-                        HFVIS_ASSERT(mid > 0 && mid < count);
-                    }
-                }
-            }
-            if (median) {
-                int ax = 0;
-                for (a = 1; a < 3; a++)
-                    if (cmax[a] - cmin[a] > cmax[ax] - cmin[ax]) ax = a;
-                mid = count / 2;
-                vx_bvh_select(prims, idx, count, mid, ax);
-                split = 1;
-            }
-        }
-        if (!split) {
-            node->left_or_first = task.begin;
-            node->count = (uint32_t)count;
-            leaves++;
-            continue;
-        }
-        HFVIS_ASSERT(next + 2 <= max_nodes && sp + 2 <= HFVIS_BVH_MAX_DEPTH + 2);
-        node->left_or_first = (uint32_t)next;
-        node->count = 0;
-        /* right first on the stack, so the left subtree is built (and numbered) first */
-        stack[sp].node = (uint32_t)(next + 1);
-        stack[sp].begin = task.begin + (uint32_t)mid;
-        stack[sp].end = task.end;
-        stack[sp].depth = task.depth + 1;
-        stack[sp + 1].node = (uint32_t)next;
-        stack[sp + 1].begin = task.begin;
-        stack[sp + 1].end = task.begin + (uint32_t)mid;
-        stack[sp + 1].depth = task.depth + 1;
-        sp += 2;
-        next += 2;
-    }
-    HFVIS_ASSERT(max_depth <= HFVIS_BVH_MAX_DEPTH);
-
-    nodes = (hfvis_bvh_node *)vx_alloc_array(alloc, next, sizeof *nodes);
-    if (!nodes) goto oom;
-    for (i = 0; i < next; i++) {
-        nodes[i] = tmp[i];
-        vx_bvh_pad(nodes + i);
-    }
-    vx_free(alloc, tmp);
-    vx_free(alloc, prims);
-    out->nodes = nodes;
-    out->node_count = next;
-    out->tri_order = order;
-    out->triangle_count = n;
-    out->leaf_count = leaves;
-    out->depth = max_depth;
-    out->max_leaf_size = max_leaf;
-    return HFVIS_OK;
-oom:
-    vx_free(alloc, tmp);
-    vx_free(alloc, prims);
-    vx_free(alloc, order);
-    return HFVIS_ERR_OUT_OF_MEMORY;
-}
-
-HFVIS_API void hfvis_bvh_free(const hfvis_allocator *alloc, hfvis_bvh *bvh)
-{
-    if (!bvh) return;
-    vx_free(alloc, bvh->nodes);
-    vx_free(alloc, bvh->tri_order);
-    memset(bvh, 0, sizeof *bvh);
-}
-
-/* ---- 2a.5 traversal ------------------------------------------------------------------------- */
-
-/* Robust slab test (Ize 2013): entry distance max(t_min, near planes), exit distance
- * min(far planes) * VX_BVH_SLACK; a NaN from 0 * infinity (ray in a slab's plane, zero
- * direction component) is ignored by the comparisons, which is the right answer for a ray on
- * the (closed) slab boundary. Hit when entry <= exit and entry <= t_hi (the widened best). */
-static VX_BVH_INLINE int vx_bvh_box(const hfvis_bvh_node *n, const vx_bvh_ray *r, float t_hi,
-                                     float *entry)
-{
-    float tn = r->t_min, tf = INFINITY, t0, t1;
-    t0 = ((r->neg[0] ? n->hi[0] : n->lo[0]) - r->org[0]) * r->inv[0];
-    t1 = ((r->neg[0] ? n->lo[0] : n->hi[0]) - r->org[0]) * r->inv[0];
-    tn = t0 > tn ? t0 : tn;
-    tf = t1 < tf ? t1 : tf;
-    t0 = ((r->neg[1] ? n->hi[1] : n->lo[1]) - r->org[1]) * r->inv[1];
-    t1 = ((r->neg[1] ? n->lo[1] : n->hi[1]) - r->org[1]) * r->inv[1];
-    tn = t0 > tn ? t0 : tn;
-    tf = t1 < tf ? t1 : tf;
-    t0 = ((r->neg[2] ? n->hi[2] : n->lo[2]) - r->org[2]) * r->inv[2];
-    t1 = ((r->neg[2] ? n->lo[2] : n->hi[2]) - r->org[2]) * r->inv[2];
-    tn = t0 > tn ? t0 : tn;
-    tf = t1 < tf ? t1 : tf;
-    tf *= VX_BVH_SLACK;
-    *entry = tn;
-    return tn <= tf && tn <= t_hi;
-}
-
-HFVIS_API hfvis_status hfvis_bvh_intersect(const hfvis_bvh *bvh, const hfvis_mesh *mesh,
-                                           const hfvis_ray *ray, hfvis_ray_query query,
-                                           hfvis_hit_filter filter, void *user, hfvis_hit *hit)
-{
-    vx_bvh_ray r;
-    hfvis_hit best, h;
-    uint32_t stack_node[HFVIS_BVH_MAX_DEPTH + 1];
-    float stack_t[HFVIS_BVH_MAX_DEPTH + 1];
-    int sp = 0;
-    const hfvis_bvh_node *nodes;
-    const uint32_t *order, *indices;
-    const float *xyz;
-    size_t nv, ntri;
-    uint32_t ni = 0;
-    float t_hi, entry;
-    const int any = query == HFVIS_RAY_ANY;
-
-    if (!bvh || !mesh || !hit || !vx_bvh_ray_valid(ray) || !vx_bvh_query_valid(query))
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    if (bvh->triangle_count != mesh->triangle_count || bvh->depth < 0
-        || bvh->depth > HFVIS_BVH_MAX_DEPTH || (bvh->node_count && (!bvh->nodes || !bvh->tri_order))
-        || (mesh->vertex_count && !mesh->xyz) || (mesh->triangle_count && !mesh->indices))
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    vx_bvh_ray_setup(ray, &r);
-    vx_bvh_miss(&best);
-    best.t = r.t_max;
-    t_hi = r.t_max * VX_BVH_SLACK;
-    nodes = bvh->nodes;
-    order = bvh->tri_order;
-    indices = mesh->indices;
-    xyz = mesh->xyz;
-    nv = mesh->vertex_count;
-    ntri = bvh->triangle_count;
-    if (bvh->node_count == 0 || !vx_bvh_box(nodes, &r, t_hi, &entry)) goto done;
-    for (;;) {
-        const hfvis_bvh_node *n = nodes + ni;
-        if (n->count) {
-            uint32_t k, first = n->left_or_first, end = first + n->count;
-            if (end < first || end > ntri) return HFVIS_ERR_INVALID_ARGUMENT; /* corrupt bvh */
-            for (k = first; k < end; k++) {
-                uint32_t tri = order[k];
-                const uint32_t *ix = indices + 3 * (size_t)tri;
-                if (tri >= ntri || ix[0] >= nv || ix[1] >= nv || ix[2] >= nv)
-                    return HFVIS_ERR_INVALID_ARGUMENT;
-                if (!vx_bvh_tri(&r, xyz + 3 * (size_t)ix[0], xyz + 3 * (size_t)ix[1],
-                                xyz + 3 * (size_t)ix[2], best.t, &h))
-                    continue;
-                /* closest-hit order: smaller t, equal t -> lower index (as the naive loop) */
-                if (best.triangle != HFVIS_NO_TRIANGLE && !(h.t < best.t || tri < best.triangle))
-                    continue;
-                h.triangle = tri;
-                if (filter && !filter(user, ray, &h)) continue;
-                best = h;
-                if (any) goto done;
-                t_hi = best.t * VX_BVH_SLACK;
-            }
-        } else {
-            uint32_t left = n->left_or_first;
-            float e0, e1;
-            int h0, h1;
-            /* children follow their parent (so every path ends) and lie inside the array */
-            if (left <= ni || (size_t)left + 1 >= bvh->node_count)
-                return HFVIS_ERR_INVALID_ARGUMENT;
-            h0 = vx_bvh_box(nodes + left, &r, t_hi, &e0);
-            h1 = vx_bvh_box(nodes + left + 1, &r, t_hi, &e1);
-            if (h0 && h1) {
-                if (sp >= HFVIS_BVH_MAX_DEPTH) return HFVIS_ERR_INVALID_ARGUMENT; /* corrupt bvh */
-                if (e1 < e0) {
-                    stack_node[sp] = left;
-                    stack_t[sp++] = e0;
-                    ni = left + 1;
-                } else {
-                    stack_node[sp] = left + 1;
-                    stack_t[sp++] = e1;
-                    ni = left;
-                }
-                continue;
-            }
-            if (h0) {
-                ni = left;
-                continue;
-            }
-            if (h1) {
-                ni = left + 1;
-                continue;
-            }
-        }
-        /* pop the next pushed node that can still hold a hit no farther than the best */
-        for (;;) {
-            if (sp == 0) goto done;
-            --sp;
-            if (stack_t[sp] <= t_hi) break;
-        }
-        ni = stack_node[sp];
-    }
-done:
-    if (best.triangle == HFVIS_NO_TRIANGLE) vx_bvh_miss(&best);
-    *hit = best;
-    return HFVIS_OK;
-}
-
-HFVIS_API hfvis_status hfvis_bvh_closest_hit(const hfvis_bvh *bvh, const hfvis_mesh *mesh,
-                                             const hfvis_ray *ray, hfvis_hit *hit)
-{
-    return hfvis_bvh_intersect(bvh, mesh, ray, HFVIS_RAY_CLOSEST, NULL, NULL, hit);
-}
-
-HFVIS_API hfvis_status hfvis_bvh_any_hit(const hfvis_bvh *bvh, const hfvis_mesh *mesh,
-                                         const hfvis_ray *ray, hfvis_hit *hit)
-{
-    return hfvis_bvh_intersect(bvh, mesh, ray, HFVIS_RAY_ANY, NULL, NULL, hit);
-}
-
-/* ========================================================================================== */
-/* 5. Binary voxelizers: conservative (triangle-box SAT), solid (parity), bitmask; .binvox/raw */
+/* 8. Binary voxelizers: conservative (triangle-box SAT), solid (parity), bitmask; .binvox/raw */
 /*    (spec voxel §3.9 baselines: T. Akenine-Moller, "Fast 3D triangle-box overlap testing",   */
 /*    JGT 2001 - the 13-axis separating-axis test; M. Schwarz & H.-P. Seidel, "Fast parallel   */
 /*    surface and solid voxelization on GPUs", SIGGRAPH Asia 2010 - its per-triangle setup;   */
@@ -5364,19 +3952,19 @@ HFVIS_API hfvis_status hfvis_bvh_any_hit(const hfvis_bvh *bvh, const hfvis_mesh 
 /*    bitmask ("slicemap") layout; the binvox format of P. Min / M. Kazhdan)                  */
 /* ========================================================================================== */
 /* Contents
- *   5a. grid space, ranges and the SAT predicate (hfvis_triangle_box_overlap)
- *   5b. conservative voxelization: per-voxel SAT reference and the certified-bounds fast path
- *   5c. exact 2D orientation signs and the watertight pixel-centre coverage rule
- *   5d. solid voxelization by parity (fast: toggles + prefix XOR; reference: winding number)
- *   5e. watertightness of the index structure
- *   5f. bitmask voxelization (three-axis OR, slicemap layout)
- *   5g. .binvox codec and the raw writer
+ *   8a. grid space, ranges and the SAT predicate (hfvis_triangle_box_overlap)
+ *   8b. conservative voxelization: per-voxel SAT reference and the certified-bounds fast path
+ *   8c. exact 2D orientation signs and the watertight pixel-centre coverage rule
+ *   8d. solid voxelization by parity (fast: toggles + prefix XOR; reference: winding number)
+ *   8e. watertightness of the index structure
+ *   8f. bitmask voxelization (three-axis OR, slicemap layout)
+ *   8g. .binvox codec and the raw writer
  *
  * Everything is decided in GRID SPACE: a vertex p becomes g = (p - origin) / cell (per axis, in
  * double), so voxel (i, j, k) is the unit cube [i, i+1] x [j, j+1] x [k, k+1] and its centre is
  * (i + 0.5, j + 0.5, k + 0.5). */
 
-/* ---- 5a. grid space, ranges and the SAT predicate --------------------------------------- */
+/* ---- 8a. grid space, ranges and the SAT predicate --------------------------------------- */
 
 /* Grid coordinates beyond this magnitude (in cells) make the products of the predicates below
  * lose their guarantees (overflow of the exact 2D orientation, int conversions): such meshes
@@ -5539,7 +4127,7 @@ HFVIS_API int hfvis_triangle_box_overlap(const double center[3], const double ha
 }
 #undef VX_CONS_AXIS
 
-/* ---- 5b. conservative voxelization --------------------------------------------------------- */
+/* ---- 8b. conservative voxelization --------------------------------------------------------- */
 
 HFVIS_API hfvis_binary_voxel_options hfvis_binary_voxel_options_default(void)
 {
@@ -6146,7 +4734,7 @@ HFVIS_API hfvis_status hfvis_voxelize_conservative(const hfvis_mesh *mesh,
     return HFVIS_OK;
 }
 
-/* ---- 5c. exact 2D orientation and the watertight pixel-centre coverage rule ------------- */
+/* ---- 8c. exact 2D orientation and the watertight pixel-centre coverage rule ------------- */
 
 /* The rounding error of the product p = fl(a*b): a*b - p exactly (Dekker's TwoProduct with
  * Veltkamp's split; needs round-to-nearest double arithmetic without contraction, which the
@@ -6269,7 +4857,7 @@ static void vx_cons_raster(double v[3][3], int a, const int dims[3], vx_cons_pix
                 fn(ctx, iu, iw, vx_cons_depth(e, pz));
 }
 
-/* ---- 5d. solid voxelization by parity -------------------------------------------------- */
+/* ---- 8d. solid voxelization by parity -------------------------------------------------- */
 
 /* Options resolved: the parity axis as 0, 1, 2; -1 for an unknown value. */
 static int vx_cons_parity_axis(const hfvis_binary_voxel_options *opts)
@@ -6459,7 +5047,7 @@ HFVIS_API hfvis_status hfvis_voxelize_solid_reference(const hfvis_mesh *mesh,
     return HFVIS_OK;
 }
 
-/* ---- 5e. watertightness of the index structure ----------------------------------------- */
+/* ---- 8e. watertightness of the index structure ----------------------------------------- */
 
 static int vx_cons_key_cmp(const void *x, const void *y)
 {
@@ -6503,7 +5091,7 @@ HFVIS_API hfvis_status hfvis_mesh_is_watertight(const hfvis_mesh *mesh,
     return HFVIS_OK;
 }
 
-/* ---- 5f. bitmask voxelization (three-axis OR, slicemap layout) ------------------------- */
+/* ---- 8f. bitmask voxelization (three-axis OR, slicemap layout) ------------------------- */
 
 HFVIS_API size_t hfvis_bitmask_words(const hfvis_volume_grid *grid)
 {
@@ -6583,7 +5171,7 @@ HFVIS_API hfvis_status hfvis_bitmask_to_occupancy(const hfvis_volume_grid *grid,
     return HFVIS_OK;
 }
 
-/* ---- 5g. .binvox codec and the raw writer ---------------------------------------------- */
+/* ---- 8g. .binvox codec and the raw writer ---------------------------------------------- */
 /* binvox (P. Min's voxelizer and viewvox; format by M. Kazhdan): an ASCII header
  *   "#binvox 1\n" "dim D D D\n" "translate tx ty tz\n" "scale s\n" "data\n"
  * then run-length pairs of bytes (value, count), count 1..255, over the D^3 voxels in the order
@@ -7013,3 +5601,1424 @@ HFVIS_API hfvis_status hfvis_voxels_raw_save(const char *path, const hfvis_volum
     return hfvis__write_file(path, voxels, vx_grid_voxels(grid));
 }
 #endif /* HFVIS_NO_STDIO */
+
+/* ========================================================================================== */
+/* 9. Incremental image-based multi-valued voxelization ([G12] ch. 7; spec voxel §4)          */
+/*   9.1 depth images, options, channel maps                                                 */
+/*   9.2 classification of a voxel centre: eq. 16 (sign restored), eq. 17 with the bias b,   */
+/*        Fig. 70's three zones; the conservative footprint and its min-depth pyramid         */
+/*   9.3 cleanup (Alg. 7 "Cleanup", Listing 7.1) and single-pass IV (§7.4.3)                 */
+/*   9.4 injection (Listing 7.2), Alg. 7 as one frame, the lighting variant (§7.5)           */
+/*   9.5 Table 9 distance metric: exact point-triangle distance, two BVHs, seeded sampling   */
+/* ========================================================================================== */
+
+/* ---- 9.1 depth images, options, channel maps ------------------------------------------- */
+
+#define VX_IV_STACK 256 /* BVH traversal stack (median splits: depth <= 33 for 2^32 items) */
+
+/* Everything a pass needs of one image: the rows of view and proj*view that the classification
+ * evaluates, as ((r[3] + r[2] z) + r[1] y) + r[0] x (the order the hoisted loops use). */
+typedef struct vx_iv_img {
+    double ez[4];             /* row 2 of view: eye-space z */
+    double cx[4], cy[4], cw[4]; /* rows 0, 1, 3 of proj*view: clip x, y, w */
+    double n, f;
+    int ortho, w, h;
+    const float *depth;
+    const float *attr;
+    int nattr;
+    const float *pyr;         /* conservative footprint: min-depth pyramid levels 1.. or NULL */
+    int levels;
+    size_t lev_off[40];
+    int lev_w[40], lev_h[40];
+} vx_iv_img;
+
+/* Resolved options. */
+typedef struct vx_iv_opt {
+    double bias;
+    int conservative;
+    int occ;                  /* occupancy channel or -1 */
+    int gw, gh;
+    const int *map;           /* explicit attribute map or NULL */
+    const hfvis_allocator *alloc;
+} vx_iv_opt;
+
+HFVIS_API hfvis_iv_options hfvis_iv_options_default(void)
+{
+    hfvis_iv_options o;
+    memset(&o, 0, sizeof o);
+    o.bias_rule = HFVIS_IV_BIAS_HALF_DIAGONAL;
+    o.bias = 0.0;
+    o.footprint = HFVIS_IV_FOOTPRINT_CENTER;
+    o.occupancy_channel = 0;
+    o.attribute_channels = NULL;
+    o.grid_width = 0;
+    o.grid_height = 0;
+    o.alloc = NULL;
+    return o;
+}
+
+HFVIS_API double hfvis_iv_bias_half_diagonal(const hfvis_volume_grid *grid)
+{
+    if (!vx_grid_valid(grid)) return (double)NAN;
+    return 0.5 * sqrt(grid->cell[0] * grid->cell[0] + grid->cell[1] * grid->cell[1]
+                      + grid->cell[2] * grid->cell[2]);
+}
+
+HFVIS_API hfvis_status hfvis_iv_bias(const hfvis_volume_grid *grid, const hfvis_iv_options *opts,
+                                     double *out)
+{
+    double b;
+    hfvis_iv_bias_rule rule = opts ? opts->bias_rule : HFVIS_IV_BIAS_HALF_DIAGONAL;
+    if (!out || !vx_grid_valid(grid)) return HFVIS_ERR_INVALID_ARGUMENT;
+    switch (rule) {
+    case HFVIS_IV_BIAS_HALF_DIAGONAL: b = hfvis_iv_bias_half_diagonal(grid); break;
+    case HFVIS_IV_BIAS_FULL_DIAGONAL: b = 2.0 * hfvis_iv_bias_half_diagonal(grid); break;
+    case HFVIS_IV_BIAS_EXPLICIT:
+        b = opts->bias;
+        if (!isfinite(b) || !(b >= 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
+        break;
+    default: return HFVIS_ERR_INVALID_ARGUMENT;
+    }
+    if (!isfinite(b)) return HFVIS_ERR_INVALID_ARGUMENT;
+    *out = b;
+    return HFVIS_OK;
+}
+
+/* 1 when vol is a usable Volume Buffer. */
+static int vx_iv_volume_ok(const hfvis_volume *vol)
+{
+    return vol && vol->data && vol->channels >= 1 && vol->channels <= HFVIS_VOLUME_MAX_CHANNELS
+           && hfvis_volume_size(&vol->grid, vol->channels) != 0;
+}
+
+static int vx_iv_same_grid(const hfvis_volume_grid *a, const hfvis_volume_grid *b)
+{
+    int i;
+    for (i = 0; i < 3; i++)
+        if (a->dims[i] != b->dims[i] || a->origin[i] != b->origin[i] || a->cell[i] != b->cell[i])
+            return 0;
+    return 1;
+}
+
+/* Options against a volume of `channels` channels (channels 0: no volume, e.g. classify); the
+ * bias is resolved for grid. */
+static hfvis_status vx_iv_resolve(const hfvis_iv_options *opts, const hfvis_volume_grid *grid,
+                                  int channels, vx_iv_opt *o)
+{
+    hfvis_iv_options d = hfvis_iv_options_default();
+    hfvis_status s;
+    if (!opts) opts = &d;
+    if (opts->footprint != HFVIS_IV_FOOTPRINT_CENTER
+        && opts->footprint != HFVIS_IV_FOOTPRINT_CONSERVATIVE)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (opts->grid_width < 0 || opts->grid_height < 0) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (opts->occupancy_channel < HFVIS_IV_NO_CHANNEL
+        || (channels > 0 && opts->occupancy_channel >= channels))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    s = hfvis_iv_bias(grid, opts, &o->bias);
+    if (s != HFVIS_OK) return s;
+    o->conservative = opts->footprint == HFVIS_IV_FOOTPRINT_CONSERVATIVE;
+    o->occ = opts->occupancy_channel;
+    o->gw = opts->grid_width;
+    o->gh = opts->grid_height;
+    o->map = opts->attribute_channels;
+    o->alloc = opts->alloc;
+    return HFVIS_OK;
+}
+
+/* Channel of attribute a (< nattr) for a volume of `channels` channels, written to map[a]
+ * (-1 = dropped). HFVIS_ERR_INVALID_ARGUMENT when the map is bad (see hfvis_iv_options). */
+static hfvis_status vx_iv_channel_map(const vx_iv_opt *o, int nattr, int channels, int *map)
+{
+    int a, b, c = 0;
+    for (a = 0; a < nattr; a++) {
+        if (o->map) {
+            map[a] = o->map[a];
+            if (map[a] < HFVIS_IV_NO_CHANNEL || map[a] >= channels
+                || (map[a] >= 0 && map[a] == o->occ))
+                return HFVIS_ERR_INVALID_ARGUMENT;
+            for (b = 0; b < a; b++)
+                if (map[a] >= 0 && map[b] == map[a]) return HFVIS_ERR_INVALID_ARGUMENT;
+        } else {
+            if (c == o->occ) c++;
+            if (c >= channels) return HFVIS_ERR_INVALID_ARGUMENT;
+            map[a] = c++;
+        }
+    }
+    return HFVIS_OK;
+}
+
+/* Validate one depth image and fill the per-image rows. */
+static hfvis_status vx_iv_image(const hfvis_depth_image *im, vx_iv_img *out)
+{
+    const hfvis_view *v;
+    double m[16];
+    size_t px, na;
+    int r;
+    if (!im || !im->depth) return HFVIS_ERR_INVALID_ARGUMENT;
+    v = &im->view;
+    if (v->width < 1 || v->height < 1 || !vx_all_finite(v->view, 16) || !vx_all_finite(v->proj, 16)
+        || !isfinite(v->near_plane) || !isfinite(v->far_plane)
+        || !(v->near_plane < v->far_plane) || (!v->orthographic && !(v->near_plane > 0.0)))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (im->attribute_count < 0 || im->attribute_count > HFVIS_VOLUME_MAX_CHANNELS
+        || (im->attribute_count > 0 && !im->attributes))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!vx_mul_size((size_t)v->width, (size_t)v->height, &px)
+        || !vx_mul_size(px, (size_t)(im->attribute_count > 0 ? im->attribute_count : 1), &na))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    hfvis_mat4_multiply(v->proj, v->view, m);
+    if (!vx_all_finite(m, 16)) return HFVIS_ERR_INVALID_ARGUMENT;
+    memset(out, 0, sizeof *out);
+    for (r = 0; r < 4; r++) {
+        out->ez[r] = VX_M(v->view, 2, r);
+        out->cx[r] = VX_M(m, 0, r);
+        out->cy[r] = VX_M(m, 1, r);
+        out->cw[r] = VX_M(m, 3, r);
+    }
+    out->n = v->near_plane;
+    out->f = v->far_plane;
+    out->ortho = v->orthographic ? 1 : 0;
+    out->w = v->width;
+    out->h = v->height;
+    out->depth = im->depth;
+    out->attr = im->attribute_count > 0 ? im->attributes : NULL;
+    out->nattr = im->attribute_count;
+    return HFVIS_OK;
+}
+
+/* The affine row in the fixed evaluation order ((r3 + r2 z) + r1 y) + r0 x. */
+static double vx_iv_row(const double r[4], double x, double y, double z)
+{
+    return ((r[3] + r[2] * z) + r[1] * y) + r[0] * x;
+}
+
+/* ---- 9.2 classification ---------------------------------------------------------------- */
+
+/* A depth texel usable as information: zw in [0, 1] (NaN and out-of-range values are no-data). */
+static int vx_iv_texel_ok(float zw)
+{
+    return zw >= 0.0f && zw <= 1.0f;
+}
+
+/* Eq. 17 against one valid texel zw, for a point of eye z ez: CLEARED if ez > z_e + b, else
+ * KEPT for a background texel (zw = 1) or ez < z_e - b, else BAND; z_e by eq. 16 (sign restored,
+ * hfvis_depth_to_eye_z) in double. The decision is that literal comparison; for perspective views
+ * it is usually reached without the division of eq. 16: with D = f - zw (f - n) > 0,
+ * ez - b - z_e = ((ez - b) D + n f) / D, so the sign of P = (ez - b) D + n f decides unless |P| is
+ * within t = 1e-12 ((|ez| + b) D + 2 n f) - about 10^4 times the rounding of both forms - and
+ * likewise Q = (ez + b) D + n f for the band; inside t the literal form is evaluated. */
+static hfvis_iv_class vx_iv_zone(const vx_iv_img *im, double b, double ez, float zw)
+{
+    double ze;
+    if (!im->ortho) {
+        double D = im->f - (double)zw * (im->f - im->n), nf = im->n * im->f;
+        double P = (ez - b) * D + nf, Q = (ez + b) * D + nf;
+        double t = 1e-12 * ((fabs(ez) + b) * D + 2.0 * nf);
+        if (P > t) return HFVIS_IV_CLEARED;
+        if (P < -t) {
+            if (zw == 1.0f || Q < -t) return HFVIS_IV_KEPT;
+            if (Q > t) return HFVIS_IV_BAND;
+        }
+    }
+    ze = hfvis_depth_to_eye_z((double)zw, im->n, im->f, im->ortho); /* eq. 16, sign restored */
+    if (ez > ze + b) return HFVIS_IV_CLEARED; /* eq. 17: in front of the recorded surface (v1) */
+    if (zw == 1.0f) return HFVIS_IV_KEPT;     /* background: nothing to update */
+    if (ez < ze - b) return HFVIS_IV_KEPT;    /* behind the surface (v3) */
+    return HFVIS_IV_BAND;                     /* surface band (v2) */
+}
+
+/* The classification of a point with eye z `ez` and clip (X, Y, W) (spec voxel §4.3): UNSEEN
+ * without information, else the zone of its texel. Writes the texel read (or -1, -1). */
+static hfvis_iv_class vx_iv_decide(const vx_iv_img *im, double b, double ez, double X, double Y,
+                                   double W, int *opx, int *opy)
+{
+    double inv, nx, ny, sx, sy;
+    int px, py;
+    float zw;
+    *opx = -1;
+    *opy = -1;
+    /* behind the camera, or nearer than the near plane (NDC z < -1; no information) [C] */
+    if (!(W > 0.0) || !(ez <= -im->n)) return HFVIS_IV_UNSEEN;
+    inv = 1.0 / W;
+    nx = X * inv;
+    ny = Y * inv;
+    if (!(nx >= -1.0 && nx <= 1.0 && ny >= -1.0 && ny <= 1.0)) return HFVIS_IV_UNSEEN;
+    /* nearest texel, row 0 at the top: (floor((ndc_x+1)/2 W), floor((1-ndc_y)/2 H)), clamped */
+    sx = (nx + 1.0) * 0.5 * (double)im->w;
+    sy = (1.0 - ny) * 0.5 * (double)im->h;
+    px = (int)sx; /* sx >= 0: truncation is floor */
+    py = (int)sy;
+    if (px > im->w - 1) px = im->w - 1;
+    if (py > im->h - 1) py = im->h - 1;
+    *opx = px;
+    *opy = py;
+    zw = im->depth[(size_t)py * (size_t)im->w + (size_t)px];
+    if (!vx_iv_texel_ok(zw)) return HFVIS_IV_UNSEEN;
+    return vx_iv_zone(im, b, ez, zw);
+}
+
+/* Offsets of the 8 corners of a voxel about its centre in one row: +-(r[0] hx), ... */
+typedef struct vx_iv_corner_rows {
+    double a[4][3]; /* [row: ez, X, Y, W][axis] = r[axis] * half_cell[axis] */
+} vx_iv_corner_rows;
+
+static void vx_iv_corner_setup(const vx_iv_img *im, const hfvis_volume_grid *g,
+                               vx_iv_corner_rows *cr)
+{
+    int a;
+    for (a = 0; a < 3; a++) {
+        double h = 0.5 * g->cell[a];
+        cr->a[0][a] = im->ez[a] * h;
+        cr->a[1][a] = im->cx[a] * h;
+        cr->a[2][a] = im->cy[a] * h;
+        cr->a[3][a] = im->cw[a] * h;
+    }
+}
+
+/* Minimum over a clipped pixel rectangle of the min-depth pyramid (sentinel -1 = no-data). */
+static float vx_iv_pyr_min(const vx_iv_img *im, int x0, int x1, int y0, int y1)
+{
+    int L = 1, x, y;
+    float m = 2.0f;
+    while (L < im->levels && (((x1 >> L) - (x0 >> L)) > 1 || ((y1 >> L) - (y0 >> L)) > 1)) L++;
+    HFVIS_ASSERT(L < im->levels); /* the top level is 1 x 1 */
+    {
+        const float *lev = im->pyr + im->lev_off[L];
+        int lw = im->lev_w[L];
+        for (y = y0 >> L; y <= (y1 >> L); y++)
+            for (x = x0 >> L; x <= (x1 >> L); x++) {
+                float v = lev[(size_t)y * (size_t)lw + (size_t)x];
+                if (v < m) m = v;
+            }
+    }
+    return m;
+}
+
+/* Conservative footprint (spec voxel §4.3 [C]): 1 if the clear of a voxel whose centre test
+ * cleared is vetoed: a corner before the near plane or behind the camera, or a pixel whose
+ * centre lies in the bounding box of the projected corners that is no-data or does not clear
+ * (p'_z > z_e + b fails). With a pyramid, a rectangle whose minimum depth clears is accepted
+ * without a scan: z_e(zw) falls as zw grows (every step of eq. 16 is monotone), so the minimum
+ * clearing implies every texel clears (vx_iv_zone decides exactly as the literal form, whose
+ * every step is monotone in zw), and the answer is the scan's bit for bit. */
+static int vx_iv_veto(const vx_iv_img *im, const vx_iv_corner_rows *cr, double b, double ez,
+                      double X, double Y, double W)
+{
+    double nx0 = HUGE_VAL, nx1 = -HUGE_VAL, ny0 = HUGE_VAL, ny1 = -HUGE_VAL;
+    double fx0, fx1, fy0, fy1;
+    int c, x0, x1, y0, y1, x, y;
+    for (c = 0; c < 8; c++) {
+        double sx = (c & 1) ? 1.0 : -1.0, sy = (c & 2) ? 1.0 : -1.0, sz = (c & 4) ? 1.0 : -1.0;
+        double cez = ((ez + sx * cr->a[0][0]) + sy * cr->a[0][1]) + sz * cr->a[0][2];
+        double cX = ((X + sx * cr->a[1][0]) + sy * cr->a[1][1]) + sz * cr->a[1][2];
+        double cY = ((Y + sx * cr->a[2][0]) + sy * cr->a[2][1]) + sz * cr->a[2][2];
+        double cW = ((W + sx * cr->a[3][0]) + sy * cr->a[3][1]) + sz * cr->a[3][2];
+        double nx, ny;
+        if (!(cW > 0.0) || !(cez <= -im->n)) return 1;
+        nx = cX / cW;
+        ny = cY / cW;
+        if (nx < nx0) nx0 = nx;
+        if (nx > nx1) nx1 = nx;
+        if (ny < ny0) ny0 = ny;
+        if (ny > ny1) ny1 = ny;
+    }
+    /* pixel x has its centre at window x + 0.5: centres in [sx0, sx1] are ceil(sx0 - 0.5) ..
+     * floor(sx1 - 0.5); rows count from the top */
+    fx0 = ceil((nx0 + 1.0) * 0.5 * (double)im->w - 0.5);
+    fx1 = floor((nx1 + 1.0) * 0.5 * (double)im->w - 0.5);
+    fy0 = ceil((1.0 - ny1) * 0.5 * (double)im->h - 0.5);
+    fy1 = floor((1.0 - ny0) * 0.5 * (double)im->h - 0.5);
+    if (!(fx0 >= 0.0)) fx0 = 0.0;
+    if (!(fy0 >= 0.0)) fy0 = 0.0;
+    if (!(fx1 <= (double)(im->w - 1))) fx1 = (double)(im->w - 1);
+    if (!(fy1 <= (double)(im->h - 1))) fy1 = (double)(im->h - 1);
+    if (fx0 > fx1 || fy0 > fy1) return 0; /* no pixel centre inside: the centre texel decided */
+    x0 = (int)fx0;
+    x1 = (int)fx1;
+    y0 = (int)fy0;
+    y1 = (int)fy1;
+    if (im->pyr && (x1 - x0 > 1 || y1 - y0 > 1)) {
+        float m = vx_iv_pyr_min(im, x0, x1, y0, y1);
+        if (m >= 0.0f && vx_iv_zone(im, b, ez, m) == HFVIS_IV_CLEARED) return 0;
+    }
+    for (y = y0; y <= y1; y++) {
+        const float *row = im->depth + (size_t)y * (size_t)im->w;
+        for (x = x0; x <= x1; x++) {
+            float zw = row[x];
+            if (!vx_iv_texel_ok(zw)) return 1;
+            if (vx_iv_zone(im, b, ez, zw) != HFVIS_IV_CLEARED) return 1;
+        }
+    }
+    return 0;
+}
+
+/* Pyramid sizes of a w x h image (levels 1.. until 1 x 1); returns the float count, 0 on
+ * overflow (never for valid images). */
+static size_t vx_iv_pyr_layout(vx_iv_img *im)
+{
+    size_t total = 0, n;
+    int L = 0, w = im->w, h = im->h;
+    im->lev_w[0] = w;
+    im->lev_h[0] = h;
+    im->lev_off[0] = 0;
+    while (w > 1 || h > 1) {
+        w = (w + 1) / 2;
+        h = (h + 1) / 2;
+        L++;
+        im->lev_w[L] = w;
+        im->lev_h[L] = h;
+        im->lev_off[L] = total;
+        if (!vx_mul_size((size_t)w, (size_t)h, &n) || total > SIZE_MAX - n) return 0;
+        total += n;
+    }
+    im->levels = L + 1;
+    return total;
+}
+
+/* Fill the pyramid (min of each 2 x 2 block; level 0 is the image, no-data -> -1). */
+static void vx_iv_pyr_build(vx_iv_img *im, float *store)
+{
+    int L, x, y;
+    im->pyr = store;
+    for (L = 1; L < im->levels; L++) {
+        int pw = im->lev_w[L - 1], ph = im->lev_h[L - 1], w = im->lev_w[L], h = im->lev_h[L];
+        const float *src = L == 1 ? im->depth : store + im->lev_off[L - 1];
+        float *dst = store + im->lev_off[L];
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                float m = 2.0f;
+                int dx, dy;
+                for (dy = 0; dy < 2; dy++)
+                    for (dx = 0; dx < 2; dx++) {
+                        int sx = 2 * x + dx, sy = 2 * y + dy;
+                        float v;
+                        if (sx >= pw || sy >= ph) continue;
+                        v = src[(size_t)sy * (size_t)pw + (size_t)sx];
+                        if (L == 1 && !vx_iv_texel_ok(v)) v = -1.0f;
+                        if (v < m) m = v;
+                    }
+                dst[(size_t)y * (size_t)w + (size_t)x] = m;
+            }
+    }
+}
+
+static void vx_iv_sample_set(const vx_iv_img *im, hfvis_iv_sample *out, hfvis_iv_class cls, int px,
+                             int py, double ez)
+{
+    double ze = (double)NAN;
+    if (px >= 0) {
+        float zw = im->depth[(size_t)py * (size_t)im->w + (size_t)px];
+        if (vx_iv_texel_ok(zw)) ze = hfvis_depth_to_eye_z((double)zw, im->n, im->f, im->ortho);
+    }
+    out->cls = cls;
+    out->pixel_x = px;
+    out->pixel_y = py;
+    out->eye_z = ez;
+    out->depth_eye_z = ze;
+}
+
+HFVIS_API hfvis_status hfvis_iv_classify(const hfvis_depth_image *image, const double point[3],
+                                         double bias, hfvis_iv_sample *out)
+{
+    vx_iv_img im;
+    double ez, X, Y, W;
+    int px, py;
+    hfvis_iv_class cls;
+    if (!out || !point || !vx_all_finite(point, 3) || !isfinite(bias) || !(bias >= 0.0))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (vx_iv_image(image, &im) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    ez = vx_iv_row(im.ez, point[0], point[1], point[2]);
+    X = vx_iv_row(im.cx, point[0], point[1], point[2]);
+    Y = vx_iv_row(im.cy, point[0], point[1], point[2]);
+    W = vx_iv_row(im.cw, point[0], point[1], point[2]);
+    cls = vx_iv_decide(&im, bias, ez, X, Y, W, &px, &py);
+    vx_iv_sample_set(&im, out, cls, px, py, ez);
+    return HFVIS_OK;
+}
+
+/* Voxel centre coordinate along axis a (the one expression every path uses). */
+static double vx_iv_centre(const hfvis_volume_grid *g, int a, int idx)
+{
+    return g->origin[a] + g->cell[a] * ((double)idx + 0.5);
+}
+
+HFVIS_API hfvis_status hfvis_iv_classify_voxel(const hfvis_depth_image *image,
+                                               const hfvis_volume_grid *grid, int i, int j, int k,
+                                               const hfvis_iv_options *opts,
+                                               hfvis_iv_sample *out)
+{
+    vx_iv_img im;
+    vx_iv_opt o;
+    double x, y, z, ez, X, Y, W;
+    int px, py;
+    hfvis_iv_class cls;
+    if (!out || !vx_grid_valid(grid) || i < 0 || j < 0 || k < 0 || i >= grid->dims[0]
+        || j >= grid->dims[1] || k >= grid->dims[2])
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (vx_iv_resolve(opts, grid, 0, &o) != HFVIS_OK || vx_iv_image(image, &im) != HFVIS_OK)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    x = vx_iv_centre(grid, 0, i);
+    y = vx_iv_centre(grid, 1, j);
+    z = vx_iv_centre(grid, 2, k);
+    ez = vx_iv_row(im.ez, x, y, z);
+    X = vx_iv_row(im.cx, x, y, z);
+    Y = vx_iv_row(im.cy, x, y, z);
+    W = vx_iv_row(im.cw, x, y, z);
+    cls = vx_iv_decide(&im, o.bias, ez, X, Y, W, &px, &py);
+    if (cls == HFVIS_IV_CLEARED && o.conservative) {
+        vx_iv_corner_rows cr;
+        vx_iv_corner_setup(&im, grid, &cr);
+        if (vx_iv_veto(&im, &cr, o.bias, ez, X, Y, W)) cls = HFVIS_IV_KEPT;
+    }
+    vx_iv_sample_set(&im, out, cls, px, py, ez);
+    return HFVIS_OK;
+}
+
+/* ---- 9.3 cleanup and single pass --------------------------------------------------------- */
+
+static int vx_iv_empty(const float *v, int channels)
+{
+    int c;
+    for (c = 0; c < channels; c++)
+        if (v[c] != 0.0f) return 0;
+    return 1;
+}
+
+/* First index in [i, n) of a non-empty voxel of the row (C channels per voxel), or n: the first
+ * non-zero float from voxel i on, tested in branch-free blocks of 8 floats (a cleanup pass over a
+ * surface volume spends most of its time here). */
+static int vx_iv_next_nonempty(const float *row, int i, int n, int C)
+{
+    size_t f = (size_t)i * (size_t)C, end = (size_t)n * (size_t)C;
+    while (f + 8 <= end) {
+        const float *v = row + f;
+        int z = (v[0] == 0.0f) & (v[1] == 0.0f) & (v[2] == 0.0f) & (v[3] == 0.0f)
+                & (v[4] == 0.0f) & (v[5] == 0.0f) & (v[6] == 0.0f) & (v[7] == 0.0f);
+        if (!z) break;
+        f += 8;
+    }
+    while (f < end && row[f] == 0.0f) f++;
+    return (int)(f / (size_t)C);
+}
+
+/* Per-call counters. */
+typedef struct vx_iv_count {
+    size_t cls[4];
+    size_t off, on, inj, bg, outside;
+} vx_iv_count;
+
+/* One image over the whole volume: src -> dst (src == dst in place). single: turn on the band
+ * (§7.4.3), else cleanup only (Alg. 7 Cleanup). map: attribute -> channel for the band. Row by
+ * row: the row is copied once (ping-pong), then only voxels that can change are visited (cleanup:
+ * the non-empty ones; an empty voxel stays empty). The affine rows are hoisted per slab and row in
+ * the order of vx_iv_row, so every voxel sees exactly hfvis_iv_classify_voxel's numbers. */
+static void vx_iv_pass(const float *src, float *dst, const hfvis_volume_grid *g, int C,
+                       const vx_iv_img *im, const vx_iv_opt *o, int single, const int *map,
+                       vx_iv_count *cnt)
+{
+    const int nx = g->dims[0], ny = g->dims[1], nz = g->dims[2];
+    const size_t cs = (size_t)C, row = (size_t)nx * cs;
+    vx_iv_corner_rows cr;
+    int i, j, k, c;
+    size_t lin = 0;
+    vx_iv_corner_setup(im, g, &cr);
+    for (k = 0; k < nz; k++) {
+        double z = vx_iv_centre(g, 2, k);
+        double kez = im->ez[3] + im->ez[2] * z, kX = im->cx[3] + im->cx[2] * z;
+        double kY = im->cy[3] + im->cy[2] * z, kW = im->cw[3] + im->cw[2] * z;
+        for (j = 0; j < ny; j++, lin += (size_t)nx) {
+            double y = vx_iv_centre(g, 1, j);
+            double jez = kez + im->ez[1] * y, jX = kX + im->cx[1] * y;
+            double jY = kY + im->cy[1] * y, jW = kW + im->cw[1] * y;
+            const float *srow = src + lin * cs;
+            float *drow = dst + lin * cs;
+            if (drow != srow) memcpy(drow, srow, row * sizeof(float));
+            for (i = 0; i < nx; i++) {
+                float *d;
+                double x, ez, X, Y, W;
+                int px, py, empty;
+                hfvis_iv_class cls;
+                if (!single) { /* cleanup: an empty voxel stays empty */
+                    i = vx_iv_next_nonempty(drow, i, nx, C);
+                    if (i >= nx) break;
+                }
+                d = drow + (size_t)i * cs; /* holds the source values now */
+                empty = single ? vx_iv_empty(d, C) : 0;
+                x = vx_iv_centre(g, 0, i);
+                ez = jez + im->ez[0] * x;
+                X = jX + im->cx[0] * x;
+                Y = jY + im->cy[0] * x;
+                W = jW + im->cw[0] * x;
+                cls = vx_iv_decide(im, o->bias, ez, X, Y, W, &px, &py);
+                if (cls == HFVIS_IV_CLEARED && o->conservative
+                    && vx_iv_veto(im, &cr, o->bias, ez, X, Y, W))
+                    cls = HFVIS_IV_KEPT;
+                cnt->cls[cls]++;
+                if (cls == HFVIS_IV_CLEARED) {
+                    if (!empty) {
+                        for (c = 0; c < C; c++) d[c] = 0.0f;
+                        cnt->off++;
+                    }
+                } else if (cls == HFVIS_IV_BAND && single) {
+                    /* turn on / update with the centre texel's attributes (replace) */
+                    int t;
+                    if (im->nattr > 0) {
+                        const float *a = im->attr + ((size_t)py * (size_t)im->w + (size_t)px)
+                                                        * (size_t)im->nattr;
+                        for (t = 0; t < im->nattr; t++)
+                            if (map[t] >= 0) d[map[t]] = a[t];
+                    }
+                    if (o->occ >= 0) d[o->occ] = 1.0f;
+                    if (empty && !vx_iv_empty(d, C)) cnt->on++;
+                }
+            }
+        }
+    }
+}
+
+/* Validates the arguments of cleanup / single pass and resolves everything. */
+static hfvis_status vx_iv_pass_args(const hfvis_volume *prev, const hfvis_volume *curr,
+                                    const hfvis_depth_image *images, size_t count,
+                                    const hfvis_iv_options *opts, vx_iv_opt *o, int single)
+{
+    size_t t;
+    if (!vx_iv_volume_ok(prev) || !vx_iv_volume_ok(curr) || (count > 0 && !images))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (prev->channels != curr->channels || !vx_iv_same_grid(&prev->grid, &curr->grid))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (vx_iv_resolve(opts, &prev->grid, prev->channels, o) != HFVIS_OK)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    for (t = 0; t < count; t++) {
+        vx_iv_img im;
+        int map[HFVIS_VOLUME_MAX_CHANNELS];
+        if (vx_iv_image(&images[t], &im) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+        if (single && vx_iv_channel_map(o, im.nattr, prev->channels, map) != HFVIS_OK)
+            return HFVIS_ERR_INVALID_ARGUMENT;
+    }
+    return HFVIS_OK;
+}
+
+static void vx_iv_stats_out(const vx_iv_count *c, hfvis_iv_stats *stats)
+{
+    if (!stats) return;
+    memset(stats, 0, sizeof *stats);
+    stats->unseen = c->cls[HFVIS_IV_UNSEEN];
+    stats->cleared = c->cls[HFVIS_IV_CLEARED];
+    stats->band = c->cls[HFVIS_IV_BAND];
+    stats->kept = c->cls[HFVIS_IV_KEPT];
+    stats->turned_off = c->off;
+    stats->turned_on = c->on;
+    stats->points_injected = c->inj;
+    stats->points_background = c->bg;
+    stats->points_outside = c->outside;
+}
+
+/* Cleanup or single pass after validation: the pyramids (one block for all images), then the
+ * images in order, the first reading prev and the others curr in place. */
+static hfvis_status vx_iv_run(const hfvis_volume *prev, hfvis_volume *curr,
+                              const hfvis_depth_image *images, size_t count, const vx_iv_opt *o,
+                              int single, vx_iv_count *cnt)
+{
+    float *pyr = NULL;
+    size_t t, total = 0, n = hfvis_volume_size(&prev->grid, prev->channels);
+    if (o->conservative && count > 0) {
+        for (t = 0; t < count; t++) {
+            vx_iv_img im;
+            size_t s;
+            (void)vx_iv_image(&images[t], &im);
+            s = vx_iv_pyr_layout(&im);
+            if (s == 0 && (im.w > 1 || im.h > 1)) return HFVIS_ERR_INVALID_ARGUMENT;
+            if (total > SIZE_MAX - s) return HFVIS_ERR_INVALID_ARGUMENT;
+            total += s;
+        }
+        if (total > 0) {
+            pyr = (float *)vx_alloc_array(o->alloc, total, sizeof(float));
+            if (!pyr) return HFVIS_ERR_OUT_OF_MEMORY;
+        }
+    }
+    if (count == 0 && curr->data != prev->data)
+        for (t = 0; t < n; t++) curr->data[t] = prev->data[t];
+    total = 0;
+    for (t = 0; t < count; t++) {
+        vx_iv_img im;
+        int map[HFVIS_VOLUME_MAX_CHANNELS] = {0};
+        (void)vx_iv_image(&images[t], &im);
+        if (single) (void)vx_iv_channel_map(o, im.nattr, prev->channels, map);
+        if (pyr) {
+            size_t s = vx_iv_pyr_layout(&im);
+            vx_iv_pyr_build(&im, pyr + total);
+            total += s;
+        }
+        vx_iv_pass(t == 0 ? prev->data : curr->data, curr->data, &prev->grid, prev->channels, &im,
+                   o, single, map, cnt);
+    }
+    vx_free(o->alloc, pyr);
+    return HFVIS_OK;
+}
+
+HFVIS_API hfvis_status hfvis_iv_cleanup(const hfvis_volume *prev, hfvis_volume *curr,
+                                        const hfvis_depth_image *images, size_t image_count,
+                                        const hfvis_iv_options *opts, hfvis_iv_stats *stats)
+{
+    vx_iv_opt o;
+    vx_iv_count cnt;
+    hfvis_status s = vx_iv_pass_args(prev, curr, images, image_count, opts, &o, 0);
+    if (s != HFVIS_OK) return s;
+    memset(&cnt, 0, sizeof cnt);
+    s = vx_iv_run(prev, curr, images, image_count, &o, 0, &cnt);
+    if (s != HFVIS_OK) return s;
+    vx_iv_stats_out(&cnt, stats);
+    return HFVIS_OK;
+}
+
+HFVIS_API hfvis_status hfvis_iv_single_pass(const hfvis_volume *prev, hfvis_volume *curr,
+                                            const hfvis_depth_image *images, size_t image_count,
+                                            const hfvis_iv_options *opts, hfvis_iv_stats *stats)
+{
+    vx_iv_opt o;
+    vx_iv_count cnt;
+    hfvis_status s = vx_iv_pass_args(prev, curr, images, image_count, opts, &o, 1);
+    if (s != HFVIS_OK) return s;
+    memset(&cnt, 0, sizeof cnt);
+    s = vx_iv_run(prev, curr, images, image_count, &o, 1, &cnt);
+    if (s != HFVIS_OK) return s;
+    vx_iv_stats_out(&cnt, stats);
+    return HFVIS_OK;
+}
+
+/* ---- 9.4 injection, one frame, lighting ---------------------------------------------------- */
+
+/* Validate the injection arguments (everything that can fail). */
+static hfvis_status vx_iv_inject_args(const hfvis_volume *vol, const hfvis_depth_image *images,
+                                      size_t count, const vx_iv_opt *o)
+{
+    size_t t;
+    int c, map[HFVIS_VOLUME_MAX_CHANNELS];
+    if (!vx_iv_volume_ok(vol) || (count > 0 && !images)) return HFVIS_ERR_INVALID_ARGUMENT;
+    for (c = 0; c < vol->channels; c++)
+        if (!vx_blend_valid(vol->blend[c])) return HFVIS_ERR_INVALID_ARGUMENT;
+    for (t = 0; t < count; t++) {
+        vx_iv_img im;
+        double m[16], inv[16];
+        if (vx_iv_image(&images[t], &im) != HFVIS_OK
+            || vx_iv_channel_map(o, im.nattr, vol->channels, map) != HFVIS_OK)
+            return HFVIS_ERR_INVALID_ARGUMENT;
+        hfvis_mat4_multiply(images[t].view.proj, images[t].view.view, m);
+        if (hfvis_mat4_invert(m, inv) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    }
+    return HFVIS_OK;
+}
+
+/* Listing 7.2 for validated arguments. */
+static void vx_iv_inject_run(hfvis_volume *vol, const hfvis_depth_image *images, size_t count,
+                             const vx_iv_opt *o, vx_iv_count *cnt)
+{
+    const hfvis_volume_grid *g = &vol->grid;
+    const size_t cs = (size_t)vol->channels;
+    size_t t;
+    for (t = 0; t < count; t++) {
+        vx_iv_img im;
+        double m[16], inv[16];
+        int map[HFVIS_VOLUME_MAX_CHANNELS], gx, gy, gw, gh;
+        (void)vx_iv_image(&images[t], &im);
+        (void)vx_iv_channel_map(o, im.nattr, vol->channels, map);
+        hfvis_mat4_multiply(images[t].view.proj, images[t].view.view, m);
+        (void)hfvis_mat4_invert(m, inv);
+        gw = o->gw > 0 ? o->gw : im.w;
+        gh = o->gh > 0 ? o->gh : im.h;
+        for (gy = 0; gy < gh; gy++) {
+            double v = ((double)gy + 0.5) / (double)gh;
+            int py = (int)(v * (double)im.h);
+            if (py > im.h - 1) py = im.h - 1;
+            for (gx = 0; gx < gw; gx++) {
+                double u = ((double)gx + 0.5) / (double)gw, ndc[4], hp[4], p[3];
+                int px = (int)(u * (double)im.w), idx[3], a, ok = 1;
+                size_t pix;
+                float zw, *d;
+                if (px > im.w - 1) px = im.w - 1;
+                pix = (size_t)py * (size_t)im.w + (size_t)px;
+                zw = im.depth[pix];
+                if (!(zw >= 0.0f && zw < 1.0f)) { /* background or no-data: no sample */
+                    cnt->bg++;
+                    continue;
+                }
+                /* canonical screen space -> world (PointCSS2WCS: inverse view-projection) */
+                ndc[0] = 2.0 * u - 1.0;
+                ndc[1] = 1.0 - 2.0 * v;
+                ndc[2] = 2.0 * (double)zw - 1.0;
+                ndc[3] = 1.0;
+                vx_mat4_apply(inv, ndc, hp);
+                if (!(hp[3] != 0.0)) {
+                    cnt->outside++;
+                    continue;
+                }
+                for (a = 0; a < 3; a++) {
+                    double q;
+                    p[a] = hp[a] / hp[3];
+                    q = (p[a] - g->origin[a]) / g->cell[a];
+                    if (!(q >= 0.0 && q < (double)g->dims[a])) {
+                        ok = 0;
+                        break;
+                    }
+                    idx[a] = (int)q;
+                    if (idx[a] > g->dims[a] - 1) idx[a] = g->dims[a] - 1;
+                }
+                if (!ok) {
+                    cnt->outside++;
+                    continue;
+                }
+                d = vol->data + (((size_t)idx[2] * (size_t)g->dims[1] + (size_t)idx[1])
+                                     * (size_t)g->dims[0]
+                                 + (size_t)idx[0])
+                                    * cs;
+                if (im.nattr > 0) {
+                    const float *at = im.attr + pix * (size_t)im.nattr;
+                    for (a = 0; a < im.nattr; a++)
+                        if (map[a] >= 0) d[map[a]] = vx_blend_apply(vol->blend[map[a]], d[map[a]], at[a]);
+                }
+                if (o->occ >= 0) d[o->occ] = vx_blend_apply(vol->blend[o->occ], d[o->occ], 1.0f);
+                cnt->inj++;
+            }
+        }
+    }
+}
+
+HFVIS_API hfvis_status hfvis_iv_inject(hfvis_volume *vol, const hfvis_depth_image *images,
+                                       size_t image_count, const hfvis_iv_options *opts,
+                                       hfvis_iv_stats *stats)
+{
+    vx_iv_opt o;
+    vx_iv_count cnt;
+    if (!vx_iv_volume_ok(vol) || vx_iv_resolve(opts, &vol->grid, vol->channels, &o) != HFVIS_OK
+        || vx_iv_inject_args(vol, images, image_count, &o) != HFVIS_OK)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    memset(&cnt, 0, sizeof cnt);
+    vx_iv_inject_run(vol, images, image_count, &o, &cnt);
+    vx_iv_stats_out(&cnt, stats);
+    return HFVIS_OK;
+}
+
+HFVIS_API hfvis_status hfvis_iv_update(const hfvis_volume *prev, hfvis_volume *curr,
+                                       const hfvis_depth_image *images, size_t image_count,
+                                       const hfvis_iv_options *opts, hfvis_iv_stats *stats)
+{
+    vx_iv_opt o;
+    vx_iv_count cnt;
+    hfvis_status s = vx_iv_pass_args(prev, curr, images, image_count, opts, &o, 0);
+    if (s != HFVIS_OK) return s;
+    if (vx_iv_inject_args(curr, images, image_count, &o) != HFVIS_OK)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    memset(&cnt, 0, sizeof cnt);
+    s = vx_iv_run(prev, curr, images, image_count, &o, 0, &cnt); /* all cleanups (Alg. 7) */
+    if (s != HFVIS_OK) return s;
+    vx_iv_inject_run(curr, images, image_count, &o, &cnt);       /* then all injections */
+    vx_iv_stats_out(&cnt, stats);
+    return HFVIS_OK;
+}
+
+HFVIS_API hfvis_status hfvis_iv_replace_nonempty(hfvis_volume *curr,
+                                                 const hfvis_volume *injection,
+                                                 const int *channels, int channel_count,
+                                                 const hfvis_iv_options *opts, size_t *replaced)
+{
+    int list[HFVIS_VOLUME_MAX_CHANNELS], n, a, b, occ, C;
+    size_t v, nv, count = 0;
+    if (!vx_iv_volume_ok(curr) || !vx_iv_volume_ok(injection)
+        || curr->channels != injection->channels || !vx_iv_same_grid(&curr->grid, &injection->grid))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    C = curr->channels;
+    occ = opts ? opts->occupancy_channel : 0;
+    if (occ < HFVIS_IV_NO_CHANNEL || occ >= C) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (channels) {
+        if (channel_count < 1 || channel_count > C) return HFVIS_ERR_INVALID_ARGUMENT;
+        for (a = 0; a < channel_count; a++) {
+            if (channels[a] < 0 || channels[a] >= C) return HFVIS_ERR_INVALID_ARGUMENT;
+            for (b = 0; b < a; b++)
+                if (channels[b] == channels[a]) return HFVIS_ERR_INVALID_ARGUMENT;
+            list[a] = channels[a];
+        }
+        n = channel_count;
+    } else {
+        for (a = 0; a < C; a++) list[a] = a;
+        n = C;
+    }
+    nv = vx_grid_voxels(&curr->grid);
+    for (v = 0; v < nv; v++) {
+        const float *s = injection->data + v * (size_t)C;
+        float *d = curr->data + v * (size_t)C;
+        if (occ >= 0 ? s[occ] == 0.0f : vx_iv_empty(s, C)) continue;
+        for (a = 0; a < n; a++) d[list[a]] = s[list[a]];
+        count++;
+    }
+    if (replaced) *replaced = count;
+    return HFVIS_OK;
+}
+
+HFVIS_API hfvis_status hfvis_iv_occupancy(const hfvis_volume *vol, int channel, uint8_t *out,
+                                          size_t *count)
+{
+    size_t v, nv, n = 0;
+    if (!vx_iv_volume_ok(vol) || !out || channel < HFVIS_IV_NO_CHANNEL || channel >= vol->channels)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    nv = vx_grid_voxels(&vol->grid);
+    for (v = 0; v < nv; v++) {
+        const float *s = vol->data + v * (size_t)vol->channels;
+        int on = channel >= 0 ? s[channel] != 0.0f : !vx_iv_empty(s, vol->channels);
+        out[v] = (uint8_t)(on ? 1 : 0);
+        n += (size_t)on;
+    }
+    if (count) *count = n;
+    return HFVIS_OK;
+}
+
+/* ---- 9.5 Table 9 distance metric --------------------------------------------------------- */
+
+/* Squared distance from p to triangle (a, b, c): the closest point by Voronoi regions
+ * (Ericson, Real-Time Collision Detection §5.1.5), in double. A degenerate triangle (zero
+ * cross product) is the union of its edges. */
+static double vx_iv_seg_d2(const double p[3], const double a[3], const double b[3])
+{
+    double ab[3], ap[3], t, l2, q, d2 = 0.0;
+    int i;
+    for (i = 0; i < 3; i++) ab[i] = b[i] - a[i], ap[i] = p[i] - a[i];
+    l2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
+    t = l2 > 0.0 ? (ab[0] * ap[0] + ab[1] * ap[1] + ab[2] * ap[2]) / l2 : 0.0;
+    if (!(t > 0.0)) t = 0.0;
+    if (t > 1.0) t = 1.0;
+    for (i = 0; i < 3; i++) {
+        q = p[i] - (a[i] + t * ab[i]);
+        d2 += q * q;
+    }
+    return d2;
+}
+
+static double vx_iv_tri_d2(const double p[3], const double a[3], const double b[3],
+                           const double c[3])
+{
+    double ab[3], ac[3], ap[3], bp[3], cp[3], q[3], n[3];
+    double d1, d2, d3, d4, d5, d6, va, vb, vc, v, w, den, r = 0.0;
+    int i;
+    for (i = 0; i < 3; i++) {
+        ab[i] = b[i] - a[i];
+        ac[i] = c[i] - a[i];
+        ap[i] = p[i] - a[i];
+        bp[i] = p[i] - b[i];
+        cp[i] = p[i] - c[i];
+    }
+    n[0] = ab[1] * ac[2] - ab[2] * ac[1];
+    n[1] = ab[2] * ac[0] - ab[0] * ac[2];
+    n[2] = ab[0] * ac[1] - ab[1] * ac[0];
+    if (n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0) {
+        double s0 = vx_iv_seg_d2(p, a, b), s1 = vx_iv_seg_d2(p, b, c), s2 = vx_iv_seg_d2(p, c, a);
+        if (s1 < s0) s0 = s1;
+        return s2 < s0 ? s2 : s0;
+    }
+    d1 = ab[0] * ap[0] + ab[1] * ap[1] + ab[2] * ap[2];
+    d2 = ac[0] * ap[0] + ac[1] * ap[1] + ac[2] * ap[2];
+    d3 = ab[0] * bp[0] + ab[1] * bp[1] + ab[2] * bp[2];
+    d4 = ac[0] * bp[0] + ac[1] * bp[1] + ac[2] * bp[2];
+    d5 = ab[0] * cp[0] + ab[1] * cp[1] + ab[2] * cp[2];
+    d6 = ac[0] * cp[0] + ac[1] * cp[1] + ac[2] * cp[2];
+    vc = d1 * d4 - d3 * d2;
+    vb = d5 * d2 - d1 * d6;
+    va = d3 * d6 - d5 * d4;
+    if (d1 <= 0.0 && d2 <= 0.0) { /* vertex region a */
+        for (i = 0; i < 3; i++) q[i] = a[i];
+    } else if (d3 >= 0.0 && d4 <= d3) { /* vertex region b */
+        for (i = 0; i < 3; i++) q[i] = b[i];
+    } else if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) { /* edge ab */
+        v = d1 / (d1 - d3);
+        for (i = 0; i < 3; i++) q[i] = a[i] + v * ab[i];
+    } else if (d6 >= 0.0 && d5 <= d6) { /* vertex region c */
+        for (i = 0; i < 3; i++) q[i] = c[i];
+    } else if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) { /* edge ac */
+        w = d2 / (d2 - d6);
+        for (i = 0; i < 3; i++) q[i] = a[i] + w * ac[i];
+    } else if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) { /* edge bc */
+        w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        for (i = 0; i < 3; i++) q[i] = b[i] + w * (c[i] - b[i]);
+    } else { /* face: barycentric (1 - v - w, v, w) */
+        den = va + vb + vc;
+        if (!(den > 0.0)) { /* rounding on a sliver: fall back to the edges */
+            double s0 = vx_iv_seg_d2(p, a, b), s1 = vx_iv_seg_d2(p, b, c), s2 = vx_iv_seg_d2(p, c, a);
+            if (s1 < s0) s0 = s1;
+            return s2 < s0 ? s2 : s0;
+        }
+        v = vb / den;
+        w = vc / den;
+        for (i = 0; i < 3; i++) q[i] = a[i] + ab[i] * v + ac[i] * w;
+    }
+    for (i = 0; i < 3; i++) r += (p[i] - q[i]) * (p[i] - q[i]);
+    return r;
+}
+
+HFVIS_API double hfvis_point_triangle_distance(const double p[3], const double a[3],
+                                               const double b[3], const double c[3])
+{
+    if (!p || !a || !b || !c) return (double)NAN;
+    return sqrt(vx_iv_tri_d2(p, a, b, c));
+}
+
+/* PCG32 (O'Neill 2014), the library's own small PRNG. */
+typedef struct vx_iv_rng {
+    uint64_t state, inc;
+} vx_iv_rng;
+
+static uint32_t vx_iv_rng_next(vx_iv_rng *r)
+{
+    uint64_t old = r->state;
+    uint32_t xs, rot;
+    r->state = old * 6364136223846793005ull + r->inc;
+    xs = (uint32_t)(((old >> 18) ^ old) >> 27);
+    rot = (uint32_t)(old >> 59);
+    return (xs >> rot) | (xs << ((32u - rot) & 31u));
+}
+
+static void vx_iv_rng_seed(vx_iv_rng *r, uint64_t seed)
+{
+    r->state = 0u;
+    r->inc = (0xda3e39cb94b95bdbull << 1u) | 1u;
+    (void)vx_iv_rng_next(r);
+    r->state += seed ^ 0x853c49e6748fea9bull;
+    (void)vx_iv_rng_next(r);
+}
+
+/* Uniform double in [0, 1) with 53 random bits. */
+static double vx_iv_rng_unit(vx_iv_rng *r)
+{
+    uint32_t a = vx_iv_rng_next(r) >> 5, b = vx_iv_rng_next(r) >> 6;
+    return ((double)a * 67108864.0 + (double)b) * (1.0 / 9007199254740992.0);
+}
+
+/* Shared set-up of the metric: the positive-area triangles, their area prefix sums, the voxel
+ * centres, the bounding-box diagonal and a coordinate scale for the pruning margin. */
+typedef struct vx_iv_metric {
+    const hfvis_mesh *mesh;
+    uint32_t *tris;  /* ids of positive-area triangles */
+    double *cdf;     /* inclusive prefix sums of their areas */
+    size_t nt;
+    double *pts;     /* voxel centres, 3 per point */
+    size_t np;
+    double diag, scale2;
+    size_t samples;
+    uint64_t seed;
+    const hfvis_allocator *alloc;
+} vx_iv_metric;
+
+static void vx_iv_tri_vertices(const hfvis_mesh *m, size_t t, double v[3][3])
+{
+    int c, a;
+    for (c = 0; c < 3; c++) {
+        const float *p = m->xyz + 3 * (size_t)m->indices[3 * t + (size_t)c];
+        for (a = 0; a < 3; a++) v[c][a] = (double)p[a];
+    }
+}
+
+static void vx_iv_metric_free(vx_iv_metric *M)
+{
+    vx_free(M->alloc, M->pts);
+    vx_free(M->alloc, M->cdf);
+    vx_free(M->alloc, M->tris);
+    M->pts = NULL;
+    M->cdf = NULL;
+    M->tris = NULL;
+}
+
+/* Validates and builds the set-up (3 blocks: triangle ids, prefix sums, centres). */
+static hfvis_status vx_iv_metric_init(vx_iv_metric *M, const hfvis_mesh *mesh,
+                                      const hfvis_volume_grid *grid, const uint8_t *occ,
+                                      const hfvis_distance_options *opts)
+{
+    size_t t, nv, v, nt = 0, np = 0;
+    double lo[3], hi[3], sum = 0.0, s = 0.0, e[3];
+    int a;
+    memset(M, 0, sizeof *M);
+    if (!occ || !vx_grid_valid(grid) || vx_mesh_check(mesh) != HFVIS_OK)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    M->mesh = mesh;
+    M->samples = opts && opts->sample_count ? opts->sample_count : 100000;
+    M->seed = opts ? opts->seed : 0u;
+    M->alloc = opts ? opts->alloc : NULL;
+    if (mesh->triangle_count > (size_t)UINT32_MAX / 2) return HFVIS_ERR_LIMIT;
+    for (a = 0; a < 3; a++) lo[a] = HUGE_VAL, hi[a] = -HUGE_VAL;
+    for (t = 0; t < mesh->triangle_count; t++) {
+        double p[3][3], u[3], w[3], n[3];
+        int c;
+        vx_iv_tri_vertices(mesh, t, p);
+        for (c = 0; c < 3; c++)
+            for (a = 0; a < 3; a++) {
+                if (p[c][a] < lo[a]) lo[a] = p[c][a];
+                if (p[c][a] > hi[a]) hi[a] = p[c][a];
+            }
+        for (a = 0; a < 3; a++) u[a] = p[1][a] - p[0][a], w[a] = p[2][a] - p[0][a];
+        n[0] = u[1] * w[2] - u[2] * w[1];
+        n[1] = u[2] * w[0] - u[0] * w[2];
+        n[2] = u[0] * w[1] - u[1] * w[0];
+        if (n[0] != 0.0 || n[1] != 0.0 || n[2] != 0.0) nt++;
+    }
+    nv = vx_grid_voxels(grid);
+    for (v = 0; v < nv; v++) np += occ[v] != 0;
+    if (nt == 0 || np == 0) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (np > (size_t)UINT32_MAX / 2 || np > SIZE_MAX / 6 || nt > SIZE_MAX / 6) return HFVIS_ERR_LIMIT;
+    for (a = 0; a < 3; a++) {
+        double m1 = fabs(lo[a]) > fabs(hi[a]) ? fabs(lo[a]) : fabs(hi[a]);
+        double g0 = fabs(grid->origin[a]), g1 = fabs(grid->origin[a] + grid->cell[a] * (double)grid->dims[a]);
+        if (g0 > m1) m1 = g0;
+        if (g1 > m1) m1 = g1;
+        s += m1 * m1;
+        e[a] = hi[a] - lo[a];
+    }
+    M->diag = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    M->scale2 = s;
+    M->tris = (uint32_t *)vx_alloc_array(M->alloc, nt, sizeof(uint32_t));
+    if (!M->tris) return HFVIS_ERR_OUT_OF_MEMORY;
+    M->cdf = (double *)vx_alloc_array(M->alloc, nt, sizeof(double));
+    M->pts = (double *)vx_alloc_array(M->alloc, 3 * np, sizeof(double));
+    if (!M->cdf || !M->pts) {
+        vx_iv_metric_free(M);
+        return HFVIS_ERR_OUT_OF_MEMORY;
+    }
+    M->nt = 0;
+    for (t = 0; t < mesh->triangle_count; t++) {
+        double p[3][3], u[3], w[3], n[3], area;
+        vx_iv_tri_vertices(mesh, t, p);
+        for (a = 0; a < 3; a++) u[a] = p[1][a] - p[0][a], w[a] = p[2][a] - p[0][a];
+        n[0] = u[1] * w[2] - u[2] * w[1];
+        n[1] = u[2] * w[0] - u[0] * w[2];
+        n[2] = u[0] * w[1] - u[1] * w[0];
+        if (n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0) continue;
+        area = 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        sum += area;
+        M->tris[M->nt] = (uint32_t)t;
+        M->cdf[M->nt] = sum;
+        M->nt++;
+    }
+    if (!(sum > 0.0) || !isfinite(sum)) {
+        vx_iv_metric_free(M);
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    }
+    M->np = 0;
+    {
+        int i, j, k;
+        size_t lin = 0;
+        for (k = 0; k < grid->dims[2]; k++)
+            for (j = 0; j < grid->dims[1]; j++)
+                for (i = 0; i < grid->dims[0]; i++, lin++) {
+                    if (!occ[lin]) continue;
+                    M->pts[3 * M->np + 0] = vx_iv_centre(grid, 0, i);
+                    M->pts[3 * M->np + 1] = vx_iv_centre(grid, 1, j);
+                    M->pts[3 * M->np + 2] = vx_iv_centre(grid, 2, k);
+                    M->np++;
+                }
+    }
+    return HFVIS_OK;
+}
+
+/* Sample s of the mesh (the same sequence for the fast path and the oracle). */
+static void vx_iv_metric_sample(const vx_iv_metric *M, vx_iv_rng *r, double out[3])
+{
+    double u = vx_iv_rng_unit(r) * M->cdf[M->nt - 1], r2 = vx_iv_rng_unit(r), r3 = vx_iv_rng_unit(r);
+    double v[3][3], su = sqrt(r2), w0 = 1.0 - su, w1 = su * (1.0 - r3), w2 = su * r3;
+    size_t lo = 0, hi = M->nt - 1;
+    int a;
+    while (lo < hi) { /* first prefix sum > u */
+        size_t mid = lo + (hi - lo) / 2;
+        if (M->cdf[mid] > u) hi = mid;
+        else lo = mid + 1;
+    }
+    vx_iv_tri_vertices(M->mesh, (size_t)M->tris[lo], v);
+    for (a = 0; a < 3; a++) out[a] = (w0 * v[0][a] + w1 * v[1][a]) + w2 * v[2][a];
+}
+
+static double vx_iv_pt_d2(const double p[3], const double q[3])
+{
+    double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+    return (dx * dx + dy * dy) + dz * dz;
+}
+
+/* A bounding-volume hierarchy over items with boxes (median split of the centroids along the
+ * longest axis, up to 4 items per leaf). Inner node: count 0, children first and first + 1. */
+typedef struct vx_iv_node {
+    double lo[3], hi[3];
+    uint32_t first, count;
+} vx_iv_node;
+
+typedef struct vx_iv_bvh {
+    vx_iv_node *nodes;
+    uint32_t *items;
+    void *block;
+} vx_iv_bvh;
+
+/* Reorders items[first..first+count) so that position first+mid holds the element of rank mid by
+ * key (lo + hi on axis a), smaller before, larger after (Hoare quickselect, median of three). */
+static void vx_iv_select(uint32_t *it, size_t first, size_t count, size_t mid, const double *lo,
+                         const double *hi, int a)
+{
+    size_t l = first, r = first + count - 1, want = first + mid;
+    while (r > l) {
+        size_t i = l, j = r, m = l + (r - l) / 2;
+        double k0 = lo[3 * (size_t)it[l] + (size_t)a] + hi[3 * (size_t)it[l] + (size_t)a];
+        double k1 = lo[3 * (size_t)it[m] + (size_t)a] + hi[3 * (size_t)it[m] + (size_t)a];
+        double k2 = lo[3 * (size_t)it[r] + (size_t)a] + hi[3 * (size_t)it[r] + (size_t)a];
+        double piv = k0 < k1 ? (k1 < k2 ? k1 : (k0 < k2 ? k2 : k0)) : (k0 < k2 ? k0 : (k1 < k2 ? k2 : k1));
+        for (;;) {
+            uint32_t tmp;
+            while (lo[3 * (size_t)it[i] + (size_t)a] + hi[3 * (size_t)it[i] + (size_t)a] < piv) i++;
+            while (lo[3 * (size_t)it[j] + (size_t)a] + hi[3 * (size_t)it[j] + (size_t)a] > piv) j--;
+            if (i >= j) break;
+            tmp = it[i];
+            it[i] = it[j];
+            it[j] = tmp;
+            i++;
+            j--;
+        }
+        /* now [l, j] <= piv <= [j+1, r] */
+        if (want <= j) r = j;
+        else l = j + 1;
+    }
+}
+
+/* Builds over n >= 1 items with boxes lo/hi (3 doubles each). One block. */
+static hfvis_status vx_iv_bvh_build(vx_iv_bvh *b, size_t n, const double *lo, const double *hi,
+                                    const hfvis_allocator *alloc)
+{
+    size_t nn = 2 * n, bytes_nodes, bytes_items, used = 1, sp = 0, i;
+    uint32_t stack[VX_IV_STACK];
+    memset(b, 0, sizeof *b);
+    if (n > (size_t)UINT32_MAX / 2) return HFVIS_ERR_LIMIT;
+    if (!vx_mul_size(nn, sizeof(vx_iv_node), &bytes_nodes)
+        || !vx_mul_size(n, sizeof(uint32_t), &bytes_items) || bytes_nodes > SIZE_MAX - bytes_items)
+        return HFVIS_ERR_LIMIT;
+    b->block = vx_alloc(alloc, bytes_nodes + bytes_items);
+    if (!b->block) return HFVIS_ERR_OUT_OF_MEMORY;
+    b->nodes = (vx_iv_node *)b->block;
+    b->items = (uint32_t *)(void *)((unsigned char *)b->block + bytes_nodes);
+    for (i = 0; i < n; i++) b->items[i] = (uint32_t)i;
+    b->nodes[0].first = 0;
+    b->nodes[0].count = (uint32_t)n;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        vx_iv_node *nd = &b->nodes[stack[--sp]];
+        size_t first = nd->first, count = nd->count, mid;
+        double clo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, chi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+        int a, axis = 0;
+        for (a = 0; a < 3; a++) nd->lo[a] = HUGE_VAL, nd->hi[a] = -HUGE_VAL;
+        for (i = first; i < first + count; i++) {
+            size_t it = (size_t)b->items[i];
+            for (a = 0; a < 3; a++) {
+                double c = lo[3 * it + (size_t)a] + hi[3 * it + (size_t)a];
+                if (lo[3 * it + (size_t)a] < nd->lo[a]) nd->lo[a] = lo[3 * it + (size_t)a];
+                if (hi[3 * it + (size_t)a] > nd->hi[a]) nd->hi[a] = hi[3 * it + (size_t)a];
+                if (c < clo[a]) clo[a] = c;
+                if (c > chi[a]) chi[a] = c;
+            }
+        }
+        if (count <= 4) continue; /* leaf */
+        for (a = 1; a < 3; a++)
+            if (chi[a] - clo[a] > chi[axis] - clo[axis]) axis = a;
+        mid = count / 2;
+        vx_iv_select(b->items, first, count, mid, lo, hi, axis);
+        HFVIS_ASSERT(used + 2 <= nn && sp + 2 <= VX_IV_STACK);
+        nd->first = (uint32_t)used;
+        nd->count = 0;
+        b->nodes[used].first = (uint32_t)first;
+        b->nodes[used].count = (uint32_t)mid;
+        b->nodes[used + 1].first = (uint32_t)(first + mid);
+        b->nodes[used + 1].count = (uint32_t)(count - mid);
+        stack[sp++] = (uint32_t)used;
+        stack[sp++] = (uint32_t)(used + 1);
+        used += 2;
+    }
+    return HFVIS_OK;
+}
+
+static double vx_iv_box_d2(const vx_iv_node *nd, const double p[3])
+{
+    double d2 = 0.0;
+    int a;
+    for (a = 0; a < 3; a++) {
+        double g = 0.0;
+        if (p[a] < nd->lo[a]) g = nd->lo[a] - p[a];
+        else if (p[a] > nd->hi[a]) g = p[a] - nd->hi[a];
+        d2 += g * g;
+    }
+    return d2;
+}
+
+/* Smallest squared distance from p to an item (tri: triangles of M, else voxel centres). A node
+ * is skipped only when its box is farther than the best so far plus a margin far above the
+ * rounding of the distances (1e-9 of best + coordinate scale^2), so the minimum is exactly the
+ * brute-force minimum of the same per-item values. */
+static double vx_iv_bvh_nearest(const vx_iv_bvh *b, const vx_iv_metric *M, int tri,
+                                const double p[3])
+{
+    uint32_t stack[VX_IV_STACK];
+    size_t sp = 0;
+    double best = HUGE_VAL;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        const vx_iv_node *nd = &b->nodes[stack[--sp]];
+        if (vx_iv_box_d2(nd, p) > best + 1e-9 * (best + M->scale2)) continue;
+        if (nd->count > 0) {
+            uint32_t i;
+            for (i = nd->first; i < nd->first + nd->count; i++) {
+                size_t it = (size_t)b->items[i];
+                double d2;
+                if (tri) {
+                    double v[3][3];
+                    vx_iv_tri_vertices(M->mesh, (size_t)M->tris[it], v);
+                    d2 = vx_iv_tri_d2(p, v[0], v[1], v[2]);
+                } else {
+                    d2 = vx_iv_pt_d2(p, M->pts + 3 * it);
+                }
+                if (d2 < best) best = d2;
+            }
+        } else {
+            double d0 = vx_iv_box_d2(&b->nodes[nd->first], p);
+            double d1 = vx_iv_box_d2(&b->nodes[nd->first + 1], p);
+            HFVIS_ASSERT(sp + 2 <= VX_IV_STACK);
+            if (d0 <= d1) { /* nearer child popped first */
+                stack[sp++] = nd->first + 1;
+                stack[sp++] = nd->first;
+            } else {
+                stack[sp++] = nd->first;
+                stack[sp++] = nd->first + 1;
+            }
+        }
+    }
+    return best;
+}
+
+static void vx_iv_metric_out(const vx_iv_metric *M, double sum_p, double max_p, double sum_s,
+                             double max_s, hfvis_distance_metrics *out)
+{
+    hfvis_distance_metrics r;
+    double mp = sum_p / (double)M->np, ms = sum_s / (double)M->samples;
+    memset(&r, 0, sizeof r);
+    r.mean_voxel_to_mesh = mp;
+    r.max_voxel_to_mesh = max_p;
+    r.mean_mesh_to_voxel = ms;
+    r.max_mesh_to_voxel = max_s;
+    r.hausdorff = max_p > max_s ? max_p : max_s;
+    r.diagonal = M->diag;
+    r.table9_percent = M->diag > 0.0 ? 100.0 * (mp > ms ? mp : ms) / M->diag : (double)NAN;
+    r.voxel_count = M->np;
+    r.sample_count = M->samples;
+    *out = r;
+}
+
+HFVIS_API hfvis_status hfvis_voxel_distance_metrics(const hfvis_mesh *mesh,
+                                                    const hfvis_volume_grid *grid,
+                                                    const uint8_t *occupancy,
+                                                    const hfvis_distance_options *opts,
+                                                    hfvis_distance_metrics *out)
+{
+    vx_iv_metric M;
+    vx_iv_bvh tb, pb;
+    vx_iv_rng rng;
+    double *box = NULL, sum_p = 0.0, max_p = 0.0, sum_s = 0.0, max_s = 0.0;
+    size_t t, s;
+    hfvis_status st;
+    if (!out) return HFVIS_ERR_INVALID_ARGUMENT;
+    st = vx_iv_metric_init(&M, mesh, grid, occupancy, opts);
+    if (st != HFVIS_OK) return st;
+    /* triangle boxes (lo: first 3 nt doubles, hi: next 3 nt) */
+    box = (double *)vx_alloc_array(M.alloc, 6 * M.nt, sizeof(double));
+    if (!box) {
+        vx_iv_metric_free(&M);
+        return HFVIS_ERR_OUT_OF_MEMORY;
+    }
+    for (t = 0; t < M.nt; t++) {
+        double v[3][3];
+        int a, c;
+        vx_iv_tri_vertices(mesh, (size_t)M.tris[t], v);
+        for (a = 0; a < 3; a++) {
+            double l = v[0][a], h = v[0][a];
+            for (c = 1; c < 3; c++) {
+                if (v[c][a] < l) l = v[c][a];
+                if (v[c][a] > h) h = v[c][a];
+            }
+            box[3 * t + (size_t)a] = l;
+            box[3 * M.nt + 3 * t + (size_t)a] = h;
+        }
+    }
+    st = vx_iv_bvh_build(&tb, M.nt, box, box + 3 * M.nt, M.alloc);
+    if (st != HFVIS_OK) {
+        vx_free(M.alloc, box);
+        vx_iv_metric_free(&M);
+        return st;
+    }
+    st = vx_iv_bvh_build(&pb, M.np, M.pts, M.pts, M.alloc);
+    if (st != HFVIS_OK) {
+        vx_free(M.alloc, tb.block);
+        vx_free(M.alloc, box);
+        vx_iv_metric_free(&M);
+        return st;
+    }
+    /* Y -> X: every voxel centre to the mesh, exactly */
+    for (s = 0; s < M.np; s++) {
+        double d = sqrt(vx_iv_bvh_nearest(&tb, &M, 1, M.pts + 3 * s));
+        sum_p += d;
+        if (d > max_p) max_p = d;
+    }
+    /* X -> Y: area-uniform samples of the mesh to the nearest voxel centre */
+    vx_iv_rng_seed(&rng, M.seed);
+    for (s = 0; s < M.samples; s++) {
+        double q[3], d;
+        vx_iv_metric_sample(&M, &rng, q);
+        d = sqrt(vx_iv_bvh_nearest(&pb, &M, 0, q));
+        sum_s += d;
+        if (d > max_s) max_s = d;
+    }
+    vx_iv_metric_out(&M, sum_p, max_p, sum_s, max_s, out);
+    vx_free(M.alloc, pb.block);
+    vx_free(M.alloc, tb.block);
+    vx_free(M.alloc, box);
+    vx_iv_metric_free(&M);
+    return HFVIS_OK;
+}
+
+HFVIS_API hfvis_status hfvis_voxel_distance_metrics_naive(const hfvis_mesh *mesh,
+                                                          const hfvis_volume_grid *grid,
+                                                          const uint8_t *occupancy,
+                                                          const hfvis_distance_options *opts,
+                                                          hfvis_distance_metrics *out)
+{
+    vx_iv_metric M;
+    vx_iv_rng rng;
+    double sum_p = 0.0, max_p = 0.0, sum_s = 0.0, max_s = 0.0;
+    size_t t, s;
+    hfvis_status st;
+    if (!out) return HFVIS_ERR_INVALID_ARGUMENT;
+    st = vx_iv_metric_init(&M, mesh, grid, occupancy, opts);
+    if (st != HFVIS_OK) return st;
+    for (s = 0; s < M.np; s++) {
+        double best = HUGE_VAL, d;
+        for (t = 0; t < M.nt; t++) {
+            double v[3][3], d2;
+            vx_iv_tri_vertices(mesh, (size_t)M.tris[t], v);
+            d2 = vx_iv_tri_d2(M.pts + 3 * s, v[0], v[1], v[2]);
+            if (d2 < best) best = d2;
+        }
+        d = sqrt(best);
+        sum_p += d;
+        if (d > max_p) max_p = d;
+    }
+    vx_iv_rng_seed(&rng, M.seed);
+    for (s = 0; s < M.samples; s++) {
+        double q[3], best = HUGE_VAL, d;
+        size_t p;
+        vx_iv_metric_sample(&M, &rng, q);
+        for (p = 0; p < M.np; p++) {
+            double d2 = vx_iv_pt_d2(q, M.pts + 3 * p);
+            if (d2 < best) best = d2;
+        }
+        d = sqrt(best);
+        sum_s += d;
+        if (d > max_s) max_s = d;
+    }
+    vx_iv_metric_out(&M, sum_p, max_p, sum_s, max_s, out);
+    vx_iv_metric_free(&M);
+    return HFVIS_OK;
+}
