@@ -17,6 +17,9 @@
  *  12. Viewshed of one observer (Franklin & Ray 1994, R2) and its exact line-of-sight oracle
  *  13. Nowrouzezahrai-Snyder GI, math layer: real SH of order 4, zonal lobes, environment
  *      projection, normalized Legendre polynomials, Appendix-A wedge matrices ([NS09]; spec GI B)
+ *  14. Nowrouzezahrai-Snyder GI pipeline: slice scanning over the height pyramid, casting sets,
+ *      wedges to SH visibility, environment, directional and key lights, diffuse and glossy
+ *      bounces through the radiance pyramid, sub-sampling ([NS09] §5-9; spec GI B.2-B.9, B.12)
  *
  * Paper references: [P1] Timonen & Westerholm, "Scalable Height Field Self-Shadowing",
  * CGF 29(2), 2010 (thesis appendix A.1). "spec" is the project's restatement
@@ -4814,7 +4817,6 @@ hfvis_status hfvis_ns_min_blocking_angle(const double normal[3], double phi_rad,
     }
     return HFVIS_OK;
 }
-
 
 /* ========================================================================================== */
 /* 14. Nowrouzezahrai-Snyder GI: slices, pyramid, lights, bounces                             */
