@@ -993,7 +993,7 @@ TEST(lsao_gather_rejection)
             free(lines);
         }
         for (i = 0; i < (W - 4) * (H - 4); i++) {
-            double zc = depth[(i / (W - 4) + 2) * W + i % (W - 4) + 2], g = sum[i] / wt[i];
+            double zc = (double)depth[(i / (W - 4) + 2) * W + i % (W - 4) + 2], g = sum[i] / wt[i];
             if (m < 2 && !(fabs(g - zc) <= 0.03 * zc + 1e-6)) bad++;
             if (m < 2 && !(fabs(wt[i] - 1.0) < 1e-9)) bad++; /* every direction found a sample */
             if (m == 2 && fabs(g - zc) > 0.03 * zc) leak++;
