@@ -84,6 +84,7 @@ HFVIS_API hfvis_volgi_options hfvis_volgi_options_default(void)
     o.resolution = HFVIS_VOLGI_DEFAULT_RESOLUTION;
     o.transfer = HFVIS_VOLGI_TRANSFER_CONE;
     o.reflection = HFVIS_VOLGI_REFLECT_MIRROR;
+    o.paths = HFVIS_VOLGI_PATHS_ALL;
     o.reflectance_source = HFVIS_VOLGI_REFLECTANCE_THESIS;
     o.reflectance = (float)HFVIS_VOLGI_DEFAULT_REFLECTANCE;
     o.gather_scale = HFVIS_VOLGI_DEFAULT_GATHER_SCALE;
@@ -98,6 +99,7 @@ typedef struct vx_gi_cfg {
     hfvis_volgi_transfer transfer;
     hfvis_volgi_reflection reflection;
     hfvis_volgi_reflectance rsrc;
+    hfvis_volgi_paths paths;
     double rho;           /* the constant reflectance (THESIS or CONSTANT) */
     double gather_scale;
     double shadow_bias;   /* 0: relative to the scene */
@@ -118,8 +120,11 @@ static hfvis_status vx_gi_resolve(const hfvis_volgi_options *o, vx_gi_cfg *c)
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (o->reflection != HFVIS_VOLGI_REFLECT_MIRROR && o->reflection != HFVIS_VOLGI_REFLECT_DIFFUSE)
         return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o->paths != HFVIS_VOLGI_PATHS_ALL && o->paths != HFVIS_VOLGI_PATHS_VOID)
+        return HFVIS_ERR_INVALID_ARGUMENT;
     c->transfer = o->transfer;
     c->reflection = o->reflection;
+    c->paths = o->paths;
     c->rsrc = o->reflectance_source;
     switch (o->reflectance_source) {
     case HFVIS_VOLGI_REFLECTANCE_THESIS: c->rho = HFVIS_VOLGI_DEFAULT_REFLECTANCE; break;
@@ -284,36 +289,57 @@ static double vx_gi_cone_flux(const vx_gi_consts *K, const float *q, int d)
     return F > 0.0 ? F : 0.0;
 }
 
-/* 1 when the neighbour of voxel (i, j, k) in direction d exists. */
+/* 1 when the neighbour of voxel ijk in (travel) direction d exists. */
 static int vx_gi_has(const int dims[3], const int ijk[3], int d)
 {
     int ax = d / 2;
     return (d & 1) ? ijk[ax] > 0 : ijk[ax] + 1 < dims[ax];
 }
 
-/* Normalised transfer: Phi / sum_o F_o for band q of a voxel (clamped cone fluxes summed in the
- * order o = 0..5), or 0 when either is <= 0. */
-static double vx_gi_norm_scale(const vx_gi_consts *K, const float *q)
+/* Linear index of the (existing) neighbour of voxel v in direction d. */
+static size_t vx_gi_nb(const vx_gi_step *c, size_t v, int d)
 {
-    double sum = 0.0, phi = K->flux * (double)q[0];
+    return (d & 1) ? v - c->stride[d / 2] : v + c->stride[d / 2];
+}
+
+/* Path weight of a transfer from voxel jl to its face neighbour il: 1 (HFVIS_VOLGI_PATHS_ALL),
+ * or 1 - alpha_j alpha_i (HFVIS_VOLGI_PATHS_VOID: no light between two occupied voxels). */
+static double vx_gi_path(const vx_gi_step *c, size_t jl, size_t il)
+{
+    if (c->cfg.paths == HFVIS_VOLGI_PATHS_ALL) return 1.0;
+    return 1.0 - (double)c->g->occupancy[jl] * (double)c->g->occupancy[il];
+}
+
+/* Normalised transfer: Phi / sum_o F_o w_o for band b of voxel v at ijk (clamped cone fluxes
+ * times path weights, summed in the order o = 0..5; leaving the grid has weight 1), or 0 when
+ * either is <= 0. */
+static double vx_gi_norm_scale(const vx_gi_step *c, size_t v, const int ijk[3], int b)
+{
+    const float *q = c->pin + v * VX_GI_F + 4 * b;
+    double sum = 0.0, phi = c->K.flux * (double)q[0];
     int d;
-    for (d = 0; d < 6; d++) sum += vx_gi_cone_flux(K, q, d);
+    for (d = 0; d < 6; d++) {
+        double F = vx_gi_cone_flux(&c->K, q, d);
+        if (vx_gi_has(c->dims, ijk, d)) F *= vx_gi_path(c, v, vx_gi_nb(c, v, d));
+        sum += F;
+    }
     return phi > 0.0 && sum > 0.0 ? phi / sum : 0.0;
 }
 
 /* The table of vx_gi_norm_scale for every voxel and band (the fast step's normalisation). */
-static void vx_gi_scale_pass(const vx_gi_consts *K, const float *pin, size_t n, double *scale)
+static void vx_gi_scale_pass(const vx_gi_step *c, double *scale)
 {
-    size_t v;
-    int b;
-    for (v = 0; v < n; v++)
-        for (b = 0; b < 3; b++)
-            scale[3 * v + (size_t)b] = vx_gi_norm_scale(K, pin + v * VX_GI_F + 4 * b);
+    int ijk[3], b;
+    size_t v = 0;
+    for (ijk[2] = 0; ijk[2] < c->dims[2]; ijk[2]++)
+        for (ijk[1] = 0; ijk[1] < c->dims[1]; ijk[1]++)
+            for (ijk[0] = 0; ijk[0] < c->dims[0]; ijk[0]++, v++)
+                for (b = 0; b < 3; b++) scale[3 * v + (size_t)b] = vx_gi_norm_scale(c, v, ijk, b);
 }
 
-/* The source side of the energy accounting (start, escaped, uncovered, created), shared by the
- * fast step and the reference: per voxel and band the fluxes it sends (F_o, times the
- * normalisation) and those that leave the grid. */
+/* The source side of the energy accounting (start, escaped, blocked, uncovered, created), shared
+ * by the fast step and the reference: per voxel and band what it sends, what leaves the grid and
+ * what the path weights hold back. */
 static void vx_gi_energy_sources(const vx_gi_step *c)
 {
     hfvis_volgi_energy *e = c->en;
@@ -325,20 +351,24 @@ static void vx_gi_energy_sources(const vx_gi_step *c)
             for (ijk[0] = 0; ijk[0] < c->dims[0]; ijk[0]++, v++)
                 for (b = 0; b < 3; b++) {
                     const float *q = c->pin + v * VX_GI_F + 4 * b;
-                    double phi = c->K.flux * (double)q[0], sent = 0.0, esc = 0.0, sc = 1.0;
-                    if (norm) sc = vx_gi_norm_scale(&c->K, q);
+                    double phi = c->K.flux * (double)q[0], sent = 0.0, esc = 0.0, blk = 0.0;
+                    double sc = norm ? vx_gi_norm_scale(c, v, ijk, b) : 1.0;
                     for (d = 0; d < 6; d++) {
-                        double F = vx_gi_cone_flux(&c->K, q, d);
-                        if (norm) F *= sc;
-                        sent += F;
-                        if (!vx_gi_has(c->dims, ijk, d)) esc += F;
+                        double F = vx_gi_cone_flux(&c->K, q, d) * sc, w = 1.0;
+                        if (vx_gi_has(c->dims, ijk, d)) w = vx_gi_path(c, v, vx_gi_nb(c, v, d));
+                        else esc += F;
+                        sent += F * w;
+                        blk += F * (1.0 - w);
                     }
-                    /* normalised: the fluxes sum to Phi exactly in real arithmetic */
-                    if (norm && phi > 0.0) sent = phi;
+                    if (norm && phi > 0.0) { /* exact in real arithmetic: all or nothing */
+                        if (sc > 0.0) sent = phi, blk = 0.0;
+                        else sent = 0.0, blk = phi, esc = 0.0;
+                    }
                     e->start[b] += phi;
                     e->escaped[b] += esc;
-                    if (phi > sent) e->uncovered[b] += phi - sent;
-                    else e->created[b] += sent - phi;
+                    e->blocked[b] += blk;
+                    if (phi > sent + blk) e->uncovered[b] += phi - sent - blk;
+                    else e->created[b] += sent + blk - phi;
                 }
 }
 
@@ -398,17 +428,21 @@ static void vx_gi_finish(const vx_gi_step *c, size_t lin, const double s[VX_GI_F
         for (b = 0; b < 3; b++) c->en->end[b] += c->K.flux * (double)po[4 * b];
 }
 
-/* The fast kernel's contribution of neighbour q (voxel jlin) travelling in direction d:
- * S_in += (F/pi) CC(d), touching only the two non-zero coefficients of CC(d). */
-static void vx_gi_take(const vx_gi_step *c, double s[VX_GI_F], const float *q, size_t jlin, int d)
+/* The fast kernel's contribution of neighbour q (voxel jl) to voxel il, travelling in direction
+ * d: S_in += (F/pi) CC(d), touching only the two non-zero coefficients of CC(d). */
+static void vx_gi_take(const vx_gi_step *c, double s[VX_GI_F], const float *q, size_t jl, size_t il,
+                       int d)
 {
     const int m = vx_gi_band1[d / 2];
     const double a = c->K.a, sb = c->K.sb[d], sc = c->K.sc[d], c0 = c->K.c0;
+    const double w = vx_gi_path(c, jl, il);
     int b;
+    if (!(w > 0.0)) return; /* a blocked path adds exactly 0 */
     for (b = 0; b < 3; b++) {
         double F = a * (double)q[4 * b] + sb * (double)q[4 * b + m], f;
         if (!(F > 0.0)) continue; /* negative SH ringing is clamped [C] */
-        if (c->scale) F *= c->scale[3 * jlin + (size_t)b];
+        F *= w;
+        if (c->scale) F *= c->scale[3 * jl + (size_t)b];
         f = F / VX_PI;
         s[4 * b] += f * c0;
         s[4 * b + m] += f * sc;
@@ -429,20 +463,28 @@ static void vx_gi_step_fast(const vx_gi_step *c)
                 const float *p = c->pin + lin * VX_GI_F;
                 double s[VX_GI_F] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 };
                 /* o = +x comes from i - 1, o = -x from i + 1, ... (j = i - o) */
-                if (i > 0) vx_gi_take(c, s, p - VX_GI_F, lin - 1, 0);
-                if (i + 1 < nx) vx_gi_take(c, s, p + VX_GI_F, lin + 1, 1);
-                if (j > 0) vx_gi_take(c, s, p - sy * VX_GI_F, lin - sy, 2);
-                if (j + 1 < ny) vx_gi_take(c, s, p + sy * VX_GI_F, lin + sy, 3);
-                if (k > 0) vx_gi_take(c, s, p - sz * VX_GI_F, lin - sz, 4);
-                if (k + 1 < nz) vx_gi_take(c, s, p + sz * VX_GI_F, lin + sz, 5);
+                if (i > 0) vx_gi_take(c, s, p - VX_GI_F, lin - 1, lin, 0);
+                if (i + 1 < nx) vx_gi_take(c, s, p + VX_GI_F, lin + 1, lin, 1);
+                if (j > 0) vx_gi_take(c, s, p - sy * VX_GI_F, lin - sy, lin, 2);
+                if (j + 1 < ny) vx_gi_take(c, s, p + sy * VX_GI_F, lin + sy, lin, 3);
+                if (k > 0) vx_gi_take(c, s, p - sz * VX_GI_F, lin - sz, lin, 4);
+                if (k + 1 < nz) vx_gi_take(c, s, p + sz * VX_GI_F, lin + sz, lin, 5);
                 vx_gi_finish(c, lin, s);
             }
         }
 }
 
-/* Reference step: spec §2.5's pseudo-code literally, full 4-coefficient products. */
+/* Linear index of voxel v of grid dims. */
+static size_t vx_gi_lin(const int dims[3], const int v[3])
+{
+    return ((size_t)v[2] * (size_t)dims[1] + (size_t)v[1]) * (size_t)dims[0] + (size_t)v[0];
+}
+
+/* Reference step: spec §2.5's pseudo-code literally, full 4-coefficient products, every path
+ * weight and normalisation recomputed per (i, o). */
 static void vx_gi_step_reference(const vx_gi_step *c)
 {
+    const int void_only = c->cfg.paths == HFVIS_VOLGI_PATHS_VOID;
     int ijk[3], d, b, k, e;
     size_t lin = 0;
     for (ijk[2] = 0; ijk[2] < c->dims[2]; ijk[2]++)
@@ -454,23 +496,32 @@ static void vx_gi_step_reference(const vx_gi_step *c)
                     int jj[3];
                     size_t jlin;
                     const float *P;
+                    double w;
                     jj[0] = ijk[0], jj[1] = ijk[1], jj[2] = ijk[2];
                     jj[d / 2] += (d & 1) ? 1 : -1;    /* j = i - o */
                     if (jj[d / 2] < 0 || jj[d / 2] >= c->dims[d / 2]) continue;
-                    jlin = ((size_t)jj[2] * (size_t)c->dims[1] + (size_t)jj[1]) * (size_t)c->dims[0]
-                           + (size_t)jj[0];
+                    jlin = vx_gi_lin(c->dims, jj);
                     P = c->pin + jlin * VX_GI_F;
+                    w = void_only ? 1.0 - (double)c->g->occupancy[jlin] * (double)c->g->occupancy[lin] : 1.0;
                     for (b = 0; b < 3; b++) {
                         double F = 0.0, f;
                         for (k = 0; k < 4; k++) F += (double)P[4 * b + k] * c->K.cone[d][k];
                         F = F > 0.0 ? F : 0.0;
+                        F *= w;
                         if (c->cfg.transfer == HFVIS_VOLGI_TRANSFER_CONE_NORMALIZED) {
-                            /* all six clamped cone fluxes of j, recomputed */
+                            /* all six weighted cone fluxes of j, recomputed */
                             double sum = 0.0, phi = c->K.flux * (double)P[4 * b];
                             for (e = 0; e < 6; e++) {
                                 double G = 0.0;
+                                int nn[3];
                                 for (k = 0; k < 4; k++) G += (double)P[4 * b + k] * c->K.cone[e][k];
-                                sum += G > 0.0 ? G : 0.0;
+                                G = G > 0.0 ? G : 0.0;
+                                nn[0] = jj[0], nn[1] = jj[1], nn[2] = jj[2];
+                                nn[e / 2] += (e & 1) ? -1 : 1; /* j + o_e */
+                                if (void_only && nn[e / 2] >= 0 && nn[e / 2] < c->dims[e / 2])
+                                    G *= 1.0 - (double)c->g->occupancy[jlin]
+                                                   * (double)c->g->occupancy[vx_gi_lin(c->dims, nn)];
+                                sum += G;
                             }
                             F *= phi > 0.0 && sum > 0.0 ? phi / sum : 0.0;
                         }
@@ -535,7 +586,7 @@ static hfvis_status vx_gi_step_entry(const hfvis_volgi_geometry *g, const hfvis_
     memset(&en, 0, sizeof en);
     vx_gi_step_init(&c, g, &cfg, pin, pout, acc, NULL, energy ? &en : NULL);
     if (scale) {
-        vx_gi_scale_pass(&c.K, pin, n, scale);
+        vx_gi_scale_pass(&c, scale);
         c.scale = scale;
     }
     if (energy) vx_gi_energy_sources(&c);
@@ -579,7 +630,7 @@ static void vx_gi_propagate_run(const hfvis_volgi_geometry *g, const vx_gi_cfg *
         if (energy) memset(&energy[t], 0, sizeof energy[t]);
         vx_gi_step_init(&c, g, cfg, cur, nxt, accum, NULL, energy ? &energy[t] : NULL);
         if (scale) {
-            vx_gi_scale_pass(&c.K, cur, n, scale);
+            vx_gi_scale_pass(&c, scale);
             c.scale = scale;
         }
         if (energy) vx_gi_energy_sources(&c);

@@ -116,6 +116,22 @@ typedef enum hfvis_volgi_reflectance {
                                              must then be given), per band: coloured bounces */
 } hfvis_volgi_reflectance;
 
+/* Which face-neighbour transfers carry light. */
+typedef enum hfvis_volgi_paths {
+    /* Default, spec §2.5's reference kernel: every voxel gathers from all six neighbours, also
+     * an occupied voxel from an occupied one (spec §2.9: occupied sources emit into all six
+     * directions). Side effect: the side lobes of a lit wall's VPLs land in the neighbouring
+     * voxels of the same wall and are recorded there, so a lit surface receives a share of its
+     * own light as "indirect" (about 4 x 0.146 of a VPL's flux per step). */
+    HFVIS_VOLGI_PATHS_ALL = 0,
+    /* "Energy is propagated only in void space, from one voxel boundary to the next" ([G12]
+     * §5.5) read literally [C]: a transfer from voxel j to face neighbour i carries the weight
+     * 1 - alpha_j alpha_i, so nothing passes between two occupied voxels (no light creeping
+     * along or through surfaces). The held-back flux is reported as `blocked` (CONE) or given to
+     * the open directions (CONE_NORMALIZED; all blocked: reported as blocked). */
+    HFVIS_VOLGI_PATHS_VOID = 1
+} hfvis_volgi_paths;
+
 /* Options of every hfvis_volgi_* routine that has tunables. NULL or a zero struct = defaults. */
 typedef struct hfvis_volgi_options {
     const hfvis_allocator *alloc;   /* scratch and internal BVH; NULL = malloc/free */
@@ -126,6 +142,7 @@ typedef struct hfvis_volgi_options {
     hfvis_volgi_transfer transfer;  /* default HFVIS_VOLGI_TRANSFER_CONE */
     hfvis_volgi_reflection reflection; /* default HFVIS_VOLGI_REFLECT_MIRROR */
     hfvis_volgi_reflectance reflectance_source; /* default HFVIS_VOLGI_REFLECTANCE_THESIS */
+    hfvis_volgi_paths paths;        /* default HFVIS_VOLGI_PATHS_ALL */
     float reflectance;              /* with HFVIS_VOLGI_REFLECTANCE_CONSTANT: rho in [0, 1] */
     double gather_scale;            /* kappa of hfvis_volgi_gather, finite, > 0; 0 = 12/7 */
     double shadow_bias;             /* world distance a shadow ray skips at its start, finite,
@@ -154,7 +171,7 @@ typedef struct hfvis_volgi_geometry {
 
 /* Energy accounting of one propagation step, per colour band, in flux units (2 sqrt(pi) c_0
  * summed over voxels, double). Exactly (up to float rounding of the stored volume):
- *   start = end + absorbed + escaped + uncovered - created.
+ *   start = end + absorbed + escaped + blocked + uncovered - created.
  * created is 0 for every volume produced by hfvis_volgi_inject and the propagation (each voxel's
  * band-1 magnitude stays <= (2/sqrt 3) c_0, the bound of a cosine lobe, under which the six
  * clamped cone fluxes never exceed the voxel's flux); only arbitrary inputs (e.g. c_0 < 0) can
@@ -164,8 +181,10 @@ typedef struct hfvis_volgi_energy {
     double end[3];        /* flux in prop_out */
     double absorbed[3];   /* alpha (1 - rho) Phi(S_in) at occupied voxels */
     double escaped[3];    /* fluxes sent across the grid's border (lost) */
-    double uncovered[3];  /* sum over voxels of max(0, Phi_j - sum_o F_o(j)): not transported */
-    double created[3];    /* sum over voxels of max(0, sum_o F_o(j) - Phi_j) */
+    double blocked[3];    /* held back by the path weights (HFVIS_VOLGI_PATHS_VOID) */
+    double uncovered[3];  /* sum over voxels of max(0, Phi_j - sent_j - blocked_j): outside the
+                             six cones, not transported */
+    double created[3];    /* sum over voxels of max(0, sent_j + blocked_j - Phi_j) */
     double deposited[3];  /* alpha Phi(S_in) added to the accumulation volume: the flux that
                              reached surfaces in this step */
 } hfvis_volgi_energy;
