@@ -1,4 +1,5 @@
-/* ex_gi.c - multi-resolution height-field GI ([NS09] Nowrouzezahrai & Snyder): direct light, one bounce and three bounces side by side. */
+/* 09_ns_gi.c - multi-resolution height-field GI ([NS09] Nowrouzezahrai & Snyder): direct light,
+ * one bounce and three bounces side by side. Usage: 09_ns_gi [OUTDIR]   (default "out") */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -34,7 +35,7 @@ int main(int argc, char **argv)
     size_t i, counted = 0;
     int x, y, rc = 1;
 
-    if (!z || !direct || !bounce || !one || !three || !panels) { ex_error("ex_gi", "out of memory"); goto fail; }
+    if (!z || !direct || !bounce || !one || !three || !panels) { ex_error("09_ns_gi", "out of memory"); goto fail; }
     EX_CHECK(hfvis_field_generate(&terrain, W, H, W, z), "hfvis_field_generate");
     grid.z = z; grid.width = W; grid.height = H; grid.stride = W; grid.cell_size = 1.0;
 
@@ -57,8 +58,8 @@ int main(int argc, char **argv)
         if ((double)three[i] > top) top = (double)three[i];
         if (three[i] > 0.0f) { share += (double)(three[i] - direct[i]) / (double)three[i]; counted++; }
     }
-    if (counted == 0 || !(top > 0.0)) { ex_error("ex_gi", "no light: unexpected result"); goto fail; }
-    printf("ex_gi: %d bounces, albedo %.1f: on average %.1f%% of the light comes from other terrain "
+    if (counted == 0 || !(top > 0.0)) { ex_error("09_ns_gi", "no light: unexpected result"); goto fail; }
+    printf("09_ns_gi: %d bounces, albedo %.1f: on average %.1f%% of the light comes from other terrain "
            "(largest radiance %.4f)\n", BOUNCES, (double)ALBEDO, 100.0 * share / (double)counted, top);
     /* Side by side, on one scale: direct | one bounce | three bounces. */
     for (y = 0; y < H; y++)
