@@ -151,7 +151,7 @@ HFVIS_API hfvis_status hfvis_visfield_position(int positions_n, size_t k, double
  * octahedron |x| + |y| + |z| = 1 of its hemisphere (h = q.z < 0), and the 3 x 3 lattice
  * points around (round(n x), round(n y)) with |a| + |b| <= n are compared. Equals
  * hfvis_visfield_nearest_position_naive bit for bit (the same dot products); the tests check
- * this on 10^6 random and adversarial directions. Returns HFVIS_ERR_INVALID_ARGUMENT for n out
+ * this on 4 x 10^5 random and adversarial directions. Returns HFVIS_ERR_INVALID_ARGUMENT for n out
  * of range, NULL, a non-finite or zero q (k untouched). */
 HFVIS_API hfvis_status hfvis_visfield_nearest_position(int positions_n, const double q[3],
                                                        size_t *k);
