@@ -1,12 +1,2459 @@
-/* ssao.c - screen space. Part of hfvis (see hfvis.h).
+/* ssao.c - screen space. Part of hfvis (see hfvis.h for the conventions and the API).
  *
- * Contents (built by the screen-space and Laine-Karras issues)
- *   1. Camera, depth linearisation, view-space reconstruction
- *   2. The line lattice in screen space (P3)
- *   3. P3 line-sweep AO; HBAO; the screen-space ray-traced reference
- *   4. P4 far-field AO and the mipmap baseline
- *   5. Laine-Karras bitmask ray-cast AO
- * This file holds no code yet; it compiles to an empty object so that vendoring the four files
- * works from the first release. */
+ * Contents
+ *   1. Common: allocation, checked sizes, the hash PRNG
+ *   2. Camera, hardware depth linearisation, view-space reconstruction, normals from depth
+ *      (spec screenspace-p3-p4 §2.1)
+ *   3. Falloff functions ([P3] Eq. 2-3; spec §1.1)
+ *   4. The azimuthal line plane, uniform and box-pattern directions, the line lattice
+ *      ([P3] §5.1-5.2, [P4] §6; spec §2.2-2.3, §3.5)
+ *   5. P3 line-sweep AO: the obscurity hull along one line ([P3] §4, Alg. 1) and its brute-force
+ *      oracle (spec §4.2), the sweep of one direction, the per-pixel gather ([P3] §5.1), the
+ *      driver (spec §3)
+ *   6. HBAO in three variants (Bavoil, Sainz, Dimitrov 2008, as the thesis describes it; spec §4.1)
+ *   7. The screen-space ray-traced reference ([P4] §8; spec §5.11)
+ *   8. Analytic depth buffers (spec §6 T1-T7)
+ * Later issues add: P4 far-field AO and the mipmap baseline; Laine-Karras bitmask ray-cast AO.
+ *
+ * Paper references: [P3] V. Timonen, "Line-Sweep Ambient Obscurance", EGSR 2013; [P4]
+ * V. Timonen, "Screen-Space Far-Field Ambient Obscurance", HPG 2013 (both in Timonen's 2014
+ * thesis). "spec" is the project's restatement spec/screenspace-p3-p4.md, which fixes the
+ * papers' errata and marks each open choice.
+ */
 #include "hfvis.h"
-typedef int hfvis__ssao_empty_translation_unit; /* ISO C forbids an empty translation unit */
+
+#include <float.h>
+#include <limits.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#endif
+
+#ifndef HFVIS_ASSERT
+#ifdef HFVIS_ENABLE_ASSERTS
+#include <assert.h>
+#define HFVIS_ASSERT(x) assert(x)
+#else
+#define HFVIS_ASSERT(x) ((void)0)
+#endif
+#endif
+
+#define SS_PI 3.14159265358979323846
+#define SS_INF ((double)INFINITY)
+#define SS_NAN ((double)NAN)
+
+/* ========================================================================================== */
+/* 1. Common                                                                                  */
+/* ========================================================================================== */
+
+static void *ss_alloc(const hfvis_allocator *a, size_t bytes)
+{
+    if (bytes == 0) return NULL;
+    if (a && a->alloc) return a->alloc(a->user, bytes);
+    return malloc(bytes);
+}
+
+static void ss_free(const hfvis_allocator *a, void *p)
+{
+    if (!p) return;
+    if (a && a->free) a->free(a->user, p);
+    else if (!(a && a->alloc)) free(p);
+}
+
+/* a*b into *out; 1 if it does not overflow. */
+static int ss_mul(size_t a, size_t b, size_t *out)
+{
+    if (a != 0 && b > SIZE_MAX / a) return 0;
+    *out = a * b;
+    return 1;
+}
+
+/* a*b*c bytes, 0 on overflow (callers never ask for 0 bytes). */
+static size_t ss_bytes3(size_t a, size_t b, size_t c)
+{
+    size_t t, u;
+    if (!ss_mul(a, b, &t) || !ss_mul(t, c, &u)) return 0;
+    return u;
+}
+
+static int ss_finite(double v) { return v == v && v - v == 0.0; }
+
+/* SplitMix64 finaliser: the library's stateless hash PRNG (no global state). */
+static uint64_t ss_mix(uint64_t z)
+{
+    z += 0x9E3779B97F4A7C15ull;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+/* Uniform double in [0, 1) from (a, b, c, seed). */
+static double ss_hash01(uint32_t a, uint32_t b, uint32_t c, uint32_t seed)
+{
+    uint64_t h = ss_mix(((uint64_t)seed << 32) ^ (uint64_t)a);
+    h = ss_mix(h ^ ((uint64_t)b << 32) ^ (uint64_t)c);
+    return (double)(h >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* ========================================================================================== */
+/* 2. Camera, depth, view-space reconstruction, normals (spec §2.1)                           */
+/* ========================================================================================== */
+
+/* The validated camera in the form the inner loops use. */
+typedef struct ss_cam {
+    int persp;
+    int W, H, gx, gy;
+    ptrdiff_t stride;
+    double fx, fy, cx, cy, ifx, ify, sx, sy;
+    double far_d;              /* +inf when the camera has no far limit */
+} ss_cam;
+
+hfvis_status hfvis_camera_check(const hfvis_camera *cam)
+{
+    if (!cam) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (cam->width < 1 || cam->height < 1) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (cam->stride < 0 || (cam->stride != 0 && cam->stride < cam->width))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (cam->guard_x < 0 || cam->guard_y < 0) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (cam->guard_x >= (cam->width + 1) / 2 || cam->guard_y >= (cam->height + 1) / 2)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (cam->projection == HFVIS_CAMERA_PERSPECTIVE) {
+        if (!(ss_finite(cam->fx) && cam->fx > 0.0 && ss_finite(cam->fy) && cam->fy > 0.0))
+            return HFVIS_ERR_INVALID_ARGUMENT;
+    } else if (cam->projection == HFVIS_CAMERA_ORTHOGRAPHIC) {
+        if (!(ss_finite(cam->scale_x) && cam->scale_x > 0.0 && ss_finite(cam->scale_y) &&
+              cam->scale_y > 0.0))
+            return HFVIS_ERR_INVALID_ARGUMENT;
+    } else {
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    }
+    if (!ss_finite(cam->cx) || !ss_finite(cam->cy)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!(cam->far_depth >= 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (cam->width > HFVIS_SSAO_MAX_SIZE || cam->height > HFVIS_SSAO_MAX_SIZE)
+        return HFVIS_ERR_LIMIT;
+    {
+        size_t st = (size_t)(cam->stride ? cam->stride : cam->width), n;
+        if (!ss_mul(st, (size_t)cam->height, &n) || !ss_mul(n, 3 * sizeof(float), &n) ||
+            n > (size_t)PTRDIFF_MAX)
+            return HFVIS_ERR_LIMIT;
+    }
+    return HFVIS_OK;
+}
+
+static hfvis_status ss_cam_load(const hfvis_camera *cam, ss_cam *c)
+{
+    hfvis_status s = hfvis_camera_check(cam);
+    if (s != HFVIS_OK) return s;
+    memset(c, 0, sizeof *c);
+    c->persp = cam->projection == HFVIS_CAMERA_PERSPECTIVE;
+    c->W = cam->width;
+    c->H = cam->height;
+    c->gx = cam->guard_x;
+    c->gy = cam->guard_y;
+    c->stride = cam->stride ? cam->stride : cam->width;
+    c->cx = cam->cx;
+    c->cy = cam->cy;
+    if (c->persp) {
+        c->fx = cam->fx;
+        c->fy = cam->fy;
+        c->ifx = 1.0 / cam->fx;
+        c->ify = 1.0 / cam->fy;
+    } else {
+        c->sx = cam->scale_x;
+        c->sy = cam->scale_y;
+    }
+    c->far_d = cam->far_depth > 0.0 ? cam->far_depth : SS_INF;
+    return HFVIS_OK;
+}
+
+/* Background: not finite, <= 0 or >= far. */
+static int ss_bg(const ss_cam *c, double z) { return !(z > 0.0 && z < c->far_d); }
+
+static void ss_unproject(const ss_cam *c, double u, double v, double z, double out[3])
+{
+    if (c->persp) {
+        out[0] = (u - c->cx) * z * c->ifx;
+        out[1] = -(v - c->cy) * z * c->ify;
+    } else {
+        out[0] = (u - c->cx) * c->sx;
+        out[1] = -(v - c->cy) * c->sy;
+    }
+    out[2] = -z;
+}
+
+hfvis_status hfvis_camera_perspective(hfvis_camera *cam, int width, int height, int guard_x,
+                                      int guard_y, double fov_y_rad)
+{
+    hfvis_camera c;
+    hfvis_status s;
+    double f;
+    if (!cam || !(fov_y_rad > 0.0 && fov_y_rad < SS_PI)) return HFVIS_ERR_INVALID_ARGUMENT;
+    memset(&c, 0, sizeof c);
+    c.width = width;
+    c.height = height;
+    c.guard_x = guard_x;
+    c.guard_y = guard_y;
+    c.projection = HFVIS_CAMERA_PERSPECTIVE;
+    c.fx = c.fy = 1.0; /* placeholder for the check */
+    c.cx = 0.5 * (double)width;
+    c.cy = 0.5 * (double)height;
+    s = hfvis_camera_check(&c);
+    if (s != HFVIS_OK) return s;
+    f = 0.5 * (double)(height - 2 * guard_y) / tan(0.5 * fov_y_rad);
+    if (!(ss_finite(f) && f > 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
+    c.fx = c.fy = f;
+    *cam = c;
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_camera_orthographic(hfvis_camera *cam, int width, int height, int guard_x,
+                                       int guard_y, double pixel_size)
+{
+    hfvis_camera c;
+    hfvis_status s;
+    if (!cam || !(ss_finite(pixel_size) && pixel_size > 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
+    memset(&c, 0, sizeof c);
+    c.width = width;
+    c.height = height;
+    c.guard_x = guard_x;
+    c.guard_y = guard_y;
+    c.projection = HFVIS_CAMERA_ORTHOGRAPHIC;
+    c.scale_x = c.scale_y = pixel_size;
+    c.cx = 0.5 * (double)width;
+    c.cy = 0.5 * (double)height;
+    s = hfvis_camera_check(&c);
+    if (s != HFVIS_OK) return s;
+    *cam = c;
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_camera_from_view(hfvis_camera *cam, const struct hfvis_view *view,
+                                    int guard_x, int guard_y)
+{
+    hfvis_camera c;
+    hfvis_status s;
+    const double *P;
+    double W, H;
+    int i;
+    if (!cam || !view) return HFVIS_ERR_INVALID_ARGUMENT;
+    P = view->proj;
+    for (i = 0; i < 16; i++)
+        if (!ss_finite(P[i])) return HFVIS_ERR_INVALID_ARGUMENT;
+    W = (double)view->width;
+    H = (double)view->height;
+    memset(&c, 0, sizeof c);
+    c.width = view->width;
+    c.height = view->height;
+    c.guard_x = guard_x;
+    c.guard_y = guard_y;
+    /* GL matrices are column-major: element (row r, col c) = m[c*4 + r]. Off-diagonal terms
+     * that mix x and y (shear) are not representable by a camera: reject them. */
+    if (P[4] != 0.0 || P[1] != 0.0 || P[6] != 0.0 || P[2] != 0.0 || P[0] == 0.0 ||
+        P[5] == 0.0)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!view->orthographic) {
+        /* x_ndc = P00 x/d - P02 (d = -z): u = W/2 (x_ndc + 1) = cx + fx x/d */
+        if (P[3] != 0.0 || P[7] != 0.0 || P[11] != -1.0 || P[15] != 0.0 || P[12] != 0.0 ||
+            P[13] != 0.0)
+            return HFVIS_ERR_INVALID_ARGUMENT;
+        c.projection = HFVIS_CAMERA_PERSPECTIVE;
+        c.fx = 0.5 * W * P[0];
+        c.fy = 0.5 * H * P[5];
+        c.cx = 0.5 * W * (1.0 - P[8]);
+        c.cy = 0.5 * H * (1.0 + P[9]); /* P12 = m[9]: y_ndc = P11 y/d - P12 */
+    } else {
+        if (P[3] != 0.0 || P[7] != 0.0 || P[11] != 0.0 || P[15] != 1.0 || P[8] != 0.0 ||
+            P[9] != 0.0)
+            return HFVIS_ERR_INVALID_ARGUMENT;
+        c.projection = HFVIS_CAMERA_ORTHOGRAPHIC;
+        c.scale_x = 2.0 / (W * P[0]);
+        c.scale_y = 2.0 / (H * P[5]);
+        /* x_ndc = P00 x + P03 -> u = W/2 (P00 x + P03 + 1) -> x = (u - W/2 (1 + P03)) sx */
+        c.cx = 0.5 * W * (1.0 + P[12]);
+        c.cy = 0.5 * H * (1.0 - P[13]);
+    }
+    c.far_depth = view->far_plane > 0.0 ? view->far_plane : 0.0;
+    if (c.projection == HFVIS_CAMERA_PERSPECTIVE && (c.fx <= 0.0 || c.fy <= 0.0))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (c.projection == HFVIS_CAMERA_ORTHOGRAPHIC && (c.scale_x <= 0.0 || c.scale_y <= 0.0))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    s = hfvis_camera_check(&c);
+    if (s != HFVIS_OK) return s;
+    *cam = c;
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_camera_unproject(const hfvis_camera *cam, double u, double v, double depth,
+                                    double out[3])
+{
+    ss_cam c;
+    hfvis_status s = ss_cam_load(cam, &c);
+    if (s != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!out || !ss_finite(u) || !ss_finite(v) || !ss_finite(depth))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_unproject(&c, u, v, depth, out);
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_camera_project(const hfvis_camera *cam, const double p[3], double *u,
+                                  double *v, double *depth)
+{
+    ss_cam c;
+    double d;
+    hfvis_status s = ss_cam_load(cam, &c);
+    if (s != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!p || !u || !v || !depth || !ss_finite(p[0]) || !ss_finite(p[1]) || !ss_finite(p[2]))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    d = -p[2];
+    if (c.persp) {
+        if (!(d > 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
+        *u = c.cx + c.fx * p[0] / d;
+        *v = c.cy - c.fy * p[1] / d;
+    } else {
+        *u = c.cx + p[0] / c.sx;
+        *v = c.cy - p[1] / c.sy;
+    }
+    *depth = d;
+    return HFVIS_OK;
+}
+
+/* Validate the planes of an encoding; 1 if usable. */
+static int ss_depth_params(hfvis_depth_encoding e, int ortho, double n, double f)
+{
+    if (ortho != 0 && ortho != 1) return 0;
+    if (e < HFVIS_DEPTH_GL || e > HFVIS_DEPTH_REVERSED_INFINITE) return 0;
+    if (e == HFVIS_DEPTH_INFINITE_FAR || e == HFVIS_DEPTH_REVERSED_INFINITE)
+        return !ortho && ss_finite(n) && n > 0.0;
+    if (!ss_finite(n) || !ss_finite(f) || !(n < f)) return 0;
+    return ortho ? n >= 0.0 : n > 0.0;
+}
+
+double hfvis_depth_linear(double d, hfvis_depth_encoding e, int ortho, double n, double f)
+{
+    double z;
+    if (!ss_depth_params(e, ortho, n, f)) return SS_NAN;
+    if (!ss_finite(d)) return SS_INF;
+    if (e == HFVIS_DEPTH_GL_NDC) {
+        if (!(d >= -1.0 && d <= 1.0)) return SS_INF;
+        d = 0.5 * (d + 1.0);
+        e = HFVIS_DEPTH_GL;
+    }
+    if (!(d >= 0.0 && d <= 1.0)) return SS_INF;
+    switch (e) {
+    case HFVIS_DEPTH_GL:
+    case HFVIS_DEPTH_D3D:
+        z = ortho ? n + d * (f - n) : n * f / (f - d * (f - n));
+        break;
+    case HFVIS_DEPTH_REVERSED_Z:
+        z = ortho ? f - d * (f - n) : n * f / (n + d * (f - n));
+        break;
+    case HFVIS_DEPTH_INFINITE_FAR:
+        z = d < 1.0 ? n / (1.0 - d) : SS_INF;
+        break;
+    default: /* HFVIS_DEPTH_REVERSED_INFINITE */
+        z = d > 0.0 ? n / d : SS_INF;
+        break;
+    }
+    return ss_finite(z) ? z : SS_INF;
+}
+
+double hfvis_depth_hardware(double z, hfvis_depth_encoding e, int ortho, double n, double f)
+{
+    double d;
+    if (!ss_depth_params(e, ortho, n, f) || z != z) return SS_NAN;
+    if (!ortho && !(z > 0.0)) return SS_NAN;
+    switch (e) {
+    case HFVIS_DEPTH_GL:
+    case HFVIS_DEPTH_GL_NDC:
+    case HFVIS_DEPTH_D3D:
+        d = ortho ? (z - n) / (f - n) : f * (z - n) / (z * (f - n));
+        if (e == HFVIS_DEPTH_GL_NDC) d = 2.0 * d - 1.0;
+        break;
+    case HFVIS_DEPTH_REVERSED_Z:
+        d = ortho ? (f - z) / (f - n) : n * (f - z) / (z * (f - n));
+        break;
+    case HFVIS_DEPTH_INFINITE_FAR:
+        d = 1.0 - n / z;
+        break;
+    default:
+        d = n / z;
+        break;
+    }
+    return d;
+}
+
+hfvis_status hfvis_depth_linearize(const float *in, int width, int height, ptrdiff_t in_stride,
+                                   hfvis_depth_encoding e, int ortho, double n, double f,
+                                   float *out, ptrdiff_t out_stride)
+{
+    int x, y;
+    if (!in || !out || width < 1 || height < 1 || in_stride < width || out_stride < width)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!ss_depth_params(e, ortho, n, f)) return HFVIS_ERR_INVALID_ARGUMENT;
+    for (y = 0; y < height; y++) {
+        const float *src = in + (ptrdiff_t)y * in_stride;
+        float *dst = out + (ptrdiff_t)y * out_stride;
+        for (x = 0; x < width; x++) dst[x] = (float)hfvis_depth_linear((double)src[x], e, ortho, n, f);
+    }
+    return HFVIS_OK;
+}
+
+static double ss_dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void ss_cross3(const double a[3], const double b[3], double out[3])
+{
+    double r0 = a[1] * b[2] - a[2] * b[1];
+    double r1 = a[2] * b[0] - a[0] * b[2];
+    double r2 = a[0] * b[1] - a[1] * b[0];
+    out[0] = r0;
+    out[1] = r1;
+    out[2] = r2;
+}
+
+static int ss_normalize3(double v[3])
+{
+    double l = sqrt(ss_dot3(v, v));
+    if (!(l > 0.0) || !ss_finite(l)) return 0;
+    v[0] /= l;
+    v[1] /= l;
+    v[2] /= l;
+    return 1;
+}
+
+/* Depth of texel (x, y) (no bounds check). */
+static double ss_tex(const ss_cam *c, const float *depth, int x, int y)
+{
+    return (double)depth[(ptrdiff_t)y * c->stride + x];
+}
+
+/* Normal of texel (x, y) from depth, into n[3]; 0 for background. */
+static int ss_normal_at(const ss_cam *c, const float *depth, int x, int y, double n[3])
+{
+    double zc = ss_tex(c, depth, x, y), P[3], Q[3], a[3], b[3];
+    int have_a = 0, have_b = 0, k;
+    if (ss_bg(c, zc)) {
+        n[0] = n[1] = n[2] = 0.0;
+        return 0;
+    }
+    ss_unproject(c, (double)x + 0.5, (double)y + 0.5, zc, P);
+    for (k = 0; k < 2; k++) {
+        /* k = 0: x axis (a = d/du), k = 1: y axis (b = d/dv) */
+        int lo_ok = 0, hi_ok = 0, lx = x - (k == 0), ly = y - (k == 1), hx = x + (k == 0),
+            hy = y + (k == 1);
+        double zl = 0.0, zh = 0.0, *out = k == 0 ? a : b;
+        if (lx >= 0 && ly >= 0) {
+            zl = ss_tex(c, depth, lx, ly);
+            lo_ok = !ss_bg(c, zl);
+        }
+        if (hx < c->W && hy < c->H) {
+            zh = ss_tex(c, depth, hx, hy);
+            hi_ok = !ss_bg(c, zh);
+        }
+        if (hi_ok && (!lo_ok || fabs(zh - zc) <= fabs(zc - zl))) {
+            ss_unproject(c, (double)hx + 0.5, (double)hy + 0.5, zh, Q);
+            out[0] = Q[0] - P[0];
+            out[1] = Q[1] - P[1];
+            out[2] = Q[2] - P[2];
+        } else if (lo_ok) {
+            ss_unproject(c, (double)lx + 0.5, (double)ly + 0.5, zl, Q);
+            out[0] = P[0] - Q[0];
+            out[1] = P[1] - Q[1];
+            out[2] = P[2] - Q[2];
+        } else {
+            continue;
+        }
+        if (k == 0) have_a = 1;
+        else have_b = 1;
+    }
+    if (have_a && have_b) {
+        ss_cross3(a, b, n);
+        if (ss_normalize3(n)) {
+            double facing = c->persp ? -ss_dot3(n, P) : n[2];
+            if (facing < 0.0) {
+                n[0] = -n[0];
+                n[1] = -n[1];
+                n[2] = -n[2];
+            }
+            return 1;
+        }
+    }
+    if (c->persp) {
+        n[0] = -P[0];
+        n[1] = -P[1];
+        n[2] = -P[2];
+        ss_normalize3(n);
+    } else {
+        n[0] = n[1] = 0.0;
+        n[2] = 1.0;
+    }
+    return 1;
+}
+
+static void ss_normals_fill(const ss_cam *c, const float *depth, float *normals)
+{
+    int x, y;
+    for (y = 0; y < c->H; y++)
+        for (x = 0; x < c->W; x++) {
+            double n[3];
+            float *o = normals + 3 * ((ptrdiff_t)y * c->stride + x);
+            ss_normal_at(c, depth, x, y, n);
+            o[0] = (float)n[0];
+            o[1] = (float)n[1];
+            o[2] = (float)n[2];
+        }
+}
+
+hfvis_status hfvis_depth_normals(const hfvis_camera *cam, const float *depth, float *normals)
+{
+    ss_cam c;
+    if (ss_cam_load(cam, &c) != HFVIS_OK || !depth || !normals) return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_normals_fill(&c, depth, normals);
+    return HFVIS_OK;
+}
+
+/* ========================================================================================== */
+/* 3. Falloff ([P3] Eq. 2-3; spec §1.1)                                                       */
+/* ========================================================================================== */
+
+/* The falloff in the form the inner loops use. */
+typedef struct ss_fall {
+    int kind;
+    double a;        /* r, lambda, R, or the custom support (0 = none) */
+    double r1c, c;   /* HBAO: r(1 + C), C */
+    double support;  /* rho = 0 for d >= support; +inf if unbounded */
+    hfvis_falloff_fn fn;
+    void *user;
+} ss_fall;
+
+hfvis_status hfvis_falloff_check(const hfvis_falloff *f)
+{
+    if (!f) return HFVIS_ERR_INVALID_ARGUMENT;
+    switch (f->kind) {
+    case HFVIS_FALLOFF_DEFAULT:
+    case HFVIS_FALLOFF_NONE:
+        return HFVIS_OK;
+    case HFVIS_FALLOFF_INV_QUADRATIC:
+    case HFVIS_FALLOFF_EXPONENTIAL:
+    case HFVIS_FALLOFF_STEP:
+        return ss_finite(f->param) && f->param > 0.0 ? HFVIS_OK : HFVIS_ERR_INVALID_ARGUMENT;
+    case HFVIS_FALLOFF_HBAO:
+        if (!(ss_finite(f->param) && f->param > 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
+        return ss_finite(f->hbao_c) && f->hbao_c >= 0.0 ? HFVIS_OK : HFVIS_ERR_INVALID_ARGUMENT;
+    case HFVIS_FALLOFF_CUSTOM:
+        if (!f->fn) return HFVIS_ERR_INVALID_ARGUMENT;
+        return ss_finite(f->param) && f->param >= 0.0 ? HFVIS_OK : HFVIS_ERR_INVALID_ARGUMENT;
+    }
+    return HFVIS_ERR_INVALID_ARGUMENT;
+}
+
+/* f may be NULL (= NONE); returns the check's status. */
+static hfvis_status ss_fall_load(const hfvis_falloff *f, ss_fall *o)
+{
+    hfvis_falloff none;
+    hfvis_status s;
+    if (!f) {
+        memset(&none, 0, sizeof none);
+        f = &none;
+    }
+    s = hfvis_falloff_check(f);
+    if (s != HFVIS_OK) return s;
+    memset(o, 0, sizeof *o);
+    o->kind = f->kind == HFVIS_FALLOFF_DEFAULT ? HFVIS_FALLOFF_NONE : (int)f->kind;
+    o->a = f->param;
+    o->support = SS_INF;
+    switch (o->kind) {
+    case HFVIS_FALLOFF_HBAO:
+        o->c = f->hbao_c > 0.0 ? f->hbao_c : 0.3;
+        o->r1c = f->param * (1.0 + o->c);
+        o->support = sqrt(f->param / o->c);
+        break;
+    case HFVIS_FALLOFF_STEP:
+        o->support = f->param;
+        break;
+    case HFVIS_FALLOFF_CUSTOM:
+        o->fn = f->fn;
+        o->user = f->user;
+        if (f->param > 0.0) o->support = f->param;
+        break;
+    default:
+        break;
+    }
+    return HFVIS_OK;
+}
+
+static double ss_rho_general(const ss_fall *f, double d);
+
+/* rho(d): the rational falloffs inline, the rest out of line. */
+static double ss_rho(const ss_fall *f, double d)
+{
+    if (f->kind == HFVIS_FALLOFF_INV_QUADRATIC) return f->a / (f->a + d * d);
+    if (f->kind == HFVIS_FALLOFF_HBAO) {
+        double v = f->r1c / (f->a + d * d) - f->c;
+        return v > 0.0 ? v : 0.0;
+    }
+    if (f->kind == HFVIS_FALLOFF_NONE) return 1.0;
+    return ss_rho_general(f, d);
+}
+
+static double ss_rho_general(const ss_fall *f, double d)
+{
+    double v;
+    switch (f->kind) {
+    case HFVIS_FALLOFF_INV_QUADRATIC:
+        return f->a / (f->a + d * d);
+    case HFVIS_FALLOFF_HBAO:
+        v = f->r1c / (f->a + d * d) - f->c;
+        return v > 0.0 ? v : 0.0;
+    case HFVIS_FALLOFF_EXPONENTIAL:
+        return exp(-d / f->a);
+    case HFVIS_FALLOFF_STEP:
+        return d < f->a ? 1.0 : 0.0;
+    case HFVIS_FALLOFF_CUSTOM:
+        if (!(d < f->support)) return 0.0;
+        v = f->fn(f->user, d);
+        return v > 0.0 ? (v < 1.0 ? v : 1.0) : 0.0;
+    default:
+        return 1.0;
+    }
+}
+
+double hfvis_falloff_eval(const hfvis_falloff *f, double distance)
+{
+    ss_fall o;
+    if (ss_fall_load(f, &o) != HFVIS_OK || distance != distance) return SS_NAN;
+    return ss_rho(&o, distance);
+}
+
+double hfvis_falloff_support(const hfvis_falloff *f)
+{
+    ss_fall o;
+    if (ss_fall_load(f, &o) != HFVIS_OK) return SS_NAN;
+    return o.support;
+}
+
+/* ========================================================================================== */
+/* 4. Line plane, directions, lattice ([P3] §5.1-5.2, [P4] §6; spec §2.2-2.3, §3.5)           */
+/* ========================================================================================== */
+
+/* e1 of screen direction (du, dv) (spec §2.2; unit, z = 0). */
+static void ss_plane_e1(const ss_cam *c, double du, double dv, double e1[3])
+{
+    if (c->persp) {
+        e1[0] = du * c->ifx;
+        e1[1] = -dv * c->ify;
+    } else {
+        e1[0] = du * c->sx;
+        e1[1] = -dv * c->sy;
+    }
+    e1[2] = 0.0;
+    ss_normalize3(e1);
+}
+
+/* yhat of the plane through the eye, e1 and view point ref (perspective); (0, 0, 1) ortho. */
+static void ss_plane_yhat(const ss_cam *c, const double e1[3], const double ref[3], double y[3])
+{
+    double N[3];
+    if (!c->persp) {
+        y[0] = y[1] = 0.0;
+        y[2] = 1.0;
+        return;
+    }
+    ss_cross3(e1, ref, N);
+    ss_normalize3(N);
+    ss_cross3(N, e1, y);
+    ss_normalize3(y);
+    if (y[2] < 0.0) {
+        y[0] = -y[0];
+        y[1] = -y[1];
+        y[2] = -y[2];
+    }
+}
+
+hfvis_status hfvis_camera_line_plane(const hfvis_camera *cam, const double ref[3], double du,
+                                     double dv, double e1[3], double yhat[3])
+{
+    ss_cam c;
+    double a[3], b[3];
+    if (ss_cam_load(cam, &c) != HFVIS_OK || !ref || !e1 || !yhat) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!ss_finite(ref[0]) || !ss_finite(ref[1]) || !ss_finite(ref[2]) || !ss_finite(du) ||
+        !ss_finite(dv) || (du == 0.0 && dv == 0.0))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (c.persp && !(ref[2] < 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_plane_e1(&c, du, dv, a);
+    if (!(a[0] * a[0] + a[1] * a[1] > 0.5)) return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_plane_yhat(&c, a, ref, b);
+    memcpy(e1, a, sizeof a);
+    memcpy(yhat, b, sizeof b);
+    return HFVIS_OK;
+}
+
+#define SS_MIN_STEP (1.0 / 64.0)
+
+static int ss_step_ok(double s) { return ss_finite(s) && s >= SS_MIN_STEP && s <= (double)HFVIS_SSAO_MAX_SIZE; }
+
+/* Snap components within 1e-15 of 0 or +-1. */
+static double ss_snap_unit(double v)
+{
+    if (fabs(v) < 1e-15) return 0.0;
+    if (fabs(v - 1.0) < 1e-15) return 1.0;
+    if (fabs(v + 1.0) < 1e-15) return -1.0;
+    return v;
+}
+
+hfvis_status hfvis_ssao_directions_uniform(int K, double azimuth0_rad, double step,
+                                           double spacing, hfvis_ssao_direction *out)
+{
+    int k;
+    if (!out || K < 1 || K > HFVIS_SSAO_MAX_DIRECTIONS || !ss_finite(azimuth0_rad) ||
+        !ss_step_ok(step) || !ss_step_ok(spacing))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    for (k = 0; k < K; k++) {
+        double psi = azimuth0_rad + 2.0 * SS_PI * (double)k / (double)K;
+        hfvis_ssao_direction *d = &out[k];
+        d->dx = ss_snap_unit(cos(psi));
+        d->dy = ss_snap_unit(sin(psi));
+        d->step = step;
+        d->step_x = step * d->dx;
+        d->step_y = step * d->dy;
+        d->spacing = spacing;
+        d->weight = 1.0 / (double)K;
+    }
+    return HFVIS_OK;
+}
+
+/* Azimuth in [0, 2 pi) of integer vector (i, j) (screen, +y down). */
+static double ss_azimuth(double i, double j)
+{
+    double a = atan2(j, i);
+    return a < 0.0 ? a + 2.0 * SS_PI : a;
+}
+
+hfvis_status hfvis_ssao_directions_box(int n, int scale, double spacing,
+                                       hfvis_ssao_direction *out)
+{
+    int K, k, i, j, cnt = 0, axis;
+    double mean = 0.0;
+    if (!out || n < 1 || scale < 1 || n > HFVIS_SSAO_MAX_DIRECTIONS / 8 || n > 4096 / scale ||
+        !ss_step_ok(spacing))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    K = 8 * n;
+    /* the ring in azimuth order: walk the square's boundary counter-clockwise on screen from
+     * (n, 0) toward +y, which is increasing azimuth */
+    k = 0;
+    for (j = 0; j < n; j++) out[k++].step_x = (double)n, out[k - 1].step_y = (double)j;
+    for (i = n; i > -n; i--) out[k++].step_x = (double)i, out[k - 1].step_y = (double)n;
+    for (j = n; j > -n; j--) out[k++].step_x = (double)-n, out[k - 1].step_y = (double)j;
+    for (i = -n; i < n; i++) out[k++].step_x = (double)i, out[k - 1].step_y = (double)-n;
+    for (j = -n; j < 0; j++) out[k++].step_x = (double)n, out[k - 1].step_y = (double)j;
+    HFVIS_ASSERT(k == K);
+    for (k = 0; k < K; k++)
+        if (out[k].step_x != 0.0 && out[k].step_y != 0.0) {
+            mean += sqrt(out[k].step_x * out[k].step_x + out[k].step_y * out[k].step_y);
+            cnt++;
+        }
+    mean = cnt ? mean / (double)cnt : (double)n;
+    axis = (int)floor((double)scale * mean + 0.5);
+    if (axis < 1) axis = 1;
+    for (k = 0; k < K; k++) {
+        hfvis_ssao_direction *d = &out[k];
+        double sx = d->step_x, sy = d->step_y, len;
+        if (sx == 0.0 || sy == 0.0) {
+            sx = sx == 0.0 ? 0.0 : (sx > 0.0 ? (double)axis : -(double)axis);
+            sy = sy == 0.0 ? 0.0 : (sy > 0.0 ? (double)axis : -(double)axis);
+        } else {
+            sx *= (double)scale;
+            sy *= (double)scale;
+        }
+        len = sqrt(sx * sx + sy * sy);
+        d->step_x = sx;
+        d->step_y = sy;
+        d->step = len;
+        d->dx = sx / len;
+        d->dy = sy / len;
+        d->spacing = spacing;
+    }
+    for (k = 0; k < K; k++) {
+        double a0 = ss_azimuth(out[(k + K - 1) % K].step_x, out[(k + K - 1) % K].step_y);
+        double a2 = ss_azimuth(out[(k + 1) % K].step_x, out[(k + 1) % K].step_y);
+        double gap = a2 - a0;
+        if (gap < 0.0) gap += 2.0 * SS_PI;
+        out[k].weight = gap / (4.0 * SS_PI);
+    }
+    return HFVIS_OK;
+}
+
+static int ss_dir_ok(const hfvis_ssao_direction *d)
+{
+    double l;
+    if (!d || !ss_finite(d->dx) || !ss_finite(d->dy) || !ss_step_ok(d->step) ||
+        !ss_step_ok(d->spacing) || !ss_finite(d->step_x) || !ss_finite(d->step_y))
+        return 0;
+    l = d->dx * d->dx + d->dy * d->dy;
+    if (fabs(l - 1.0) > 1e-9) return 0;
+    if (fabs(d->step_x - d->step * d->dx) > 1e-9 * d->step ||
+        fabs(d->step_y - d->step * d->dy) > 1e-9 * d->step)
+        return 0;
+    return 1;
+}
+
+/* Step range [first, first + count) of line j, and its step-0 position. */
+static void ss_line_range(const ss_cam *c, const hfvis_ssao_lattice *L, int j, hfvis_ssao_line *ln)
+{
+    const double eps = 1e-7;
+    double s = L->s_first + (double)j * L->dir.spacing;
+    double ox = s * L->px, oy = s * L->py, tlo = -SS_INF, thi = SS_INF;
+    double D[2], O[2], lo[2], hi[2];
+    double fa, fb;
+    int a;
+    D[0] = L->dir.dx;
+    D[1] = L->dir.dy;
+    O[0] = ox;
+    O[1] = oy;
+    lo[0] = lo[1] = 0.5 - eps;
+    hi[0] = (double)c->W - 0.5 + eps;
+    hi[1] = (double)c->H - 0.5 + eps;
+    ln->x0 = ox + L->t_min * L->dir.dx;
+    ln->y0 = oy + L->t_min * L->dir.dy;
+    ln->first = 0;
+    ln->count = 0;
+    ln->offset = 0;
+    for (a = 0; a < 2; a++) {
+        if (D[a] == 0.0) {
+            if (O[a] < lo[a] || O[a] > hi[a]) return;
+        } else {
+            double t1 = (lo[a] - O[a]) / D[a], t2 = (hi[a] - O[a]) / D[a];
+            if (t1 > t2) {
+                double t = t1;
+                t1 = t2;
+                t2 = t;
+            }
+            if (t1 > tlo) tlo = t1;
+            if (t2 < thi) thi = t2;
+        }
+    }
+    if (!(tlo <= thi)) return;
+    fa = ceil((tlo - L->t_min) / L->dir.step - 1e-9);
+    fb = floor((thi - L->t_min) / L->dir.step + 1e-9);
+    if (fb < fa) return;
+    ln->first = (int)fa;
+    ln->count = (int)(fb - fa) + 1;
+}
+
+static hfvis_status ss_lattice_init(const ss_cam *c, const hfvis_ssao_direction *dir,
+                                    hfvis_ssao_lattice *lat)
+{
+    hfvis_ssao_lattice L;
+    double cu[4], cv[4], smin = SS_INF, smax = -SS_INF, tmin = SS_INF, span, nl;
+    size_t total = 0;
+    int k, j, maxc = 0;
+    memset(&L, 0, sizeof L);
+    L.dir = *dir;
+    L.px = -dir->dy;
+    L.py = dir->dx;
+    cu[0] = cu[2] = 0.5;
+    cu[1] = cu[3] = (double)c->W - 0.5;
+    cv[0] = cv[1] = 0.5;
+    cv[2] = cv[3] = (double)c->H - 0.5;
+    for (k = 0; k < 4; k++) {
+        double s = cu[k] * L.px + cv[k] * L.py, t = cu[k] * dir->dx + cv[k] * dir->dy;
+        if (s < smin) smin = s;
+        if (s > smax) smax = s;
+        if (t < tmin) tmin = t;
+    }
+    span = smax - smin;
+    nl = floor(span / dir->spacing + 1e-9) + 1.0;
+    if (nl > (double)INT_MAX) return HFVIS_ERR_LIMIT;
+    L.line_count = (int)nl;
+    L.s_first = smin + 0.5 * (span - (nl - 1.0) * dir->spacing);
+    L.t_min = tmin;
+    /* bound the sample count before walking the lines: (lines) x (longest possible line) */
+    if (nl * (floor(((double)c->W + (double)c->H) / dir->step) + 2.0) > 2147483647.0 * 64.0)
+        return HFVIS_ERR_LIMIT;
+    for (j = 0; j < L.line_count; j++) {
+        hfvis_ssao_line ln;
+        ss_line_range(c, &L, j, &ln);
+        total += (size_t)ln.count;
+        if (ln.count > maxc) maxc = ln.count;
+        if (total > (size_t)INT_MAX) return HFVIS_ERR_LIMIT;
+    }
+    L.max_line_samples = maxc;
+    L.sample_count = total;
+    *lat = L;
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_ssao_lattice_init(const hfvis_camera *cam, const hfvis_ssao_direction *dir,
+                                     hfvis_ssao_lattice *lat)
+{
+    ss_cam c;
+    hfvis_status s = ss_cam_load(cam, &c);
+    if (s != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!lat || !ss_dir_ok(dir)) return HFVIS_ERR_INVALID_ARGUMENT;
+    return ss_lattice_init(&c, dir, lat);
+}
+
+static void ss_lattice_fill(const ss_cam *c, const hfvis_ssao_lattice *lat, hfvis_ssao_line *lines)
+{
+    size_t off = 0;
+    int j;
+    for (j = 0; j < lat->line_count; j++) {
+        ss_line_range(c, lat, j, &lines[j]);
+        lines[j].offset = off;
+        off += (size_t)lines[j].count;
+    }
+}
+
+hfvis_status hfvis_ssao_lattice_lines(const hfvis_camera *cam, const hfvis_ssao_lattice *lat,
+                                      hfvis_ssao_line *lines)
+{
+    ss_cam c;
+    if (ss_cam_load(cam, &c) != HFVIS_OK || !lat || !lines || !ss_dir_ok(&lat->dir))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_lattice_fill(&c, lat, lines);
+    return HFVIS_OK;
+}
+
+/* Nearest sample (spec §2.3); 1 if found. */
+static int ss_nearest(const hfvis_ssao_lattice *L, const hfvis_ssao_line *lines, double u,
+                      double v, int *jo, int *io)
+{
+    double jf = (u * L->px + v * L->py - L->s_first) / L->dir.spacing;
+    double tf = (u * L->dir.dx + v * L->dir.dy - L->t_min) / L->dir.step;
+    int j, d, i;
+    if (L->line_count < 1) return 0;
+    jf = floor(jf + 0.5);
+    if (jf < 0.0) jf = 0.0;
+    if (jf > (double)(L->line_count - 1)) jf = (double)(L->line_count - 1);
+    j = (int)jf;
+    for (d = 0; d < L->line_count; d++) {
+        int cand[2], m;
+        cand[0] = j - d;
+        cand[1] = j + d;
+        for (m = 0; m < (d ? 2 : 1); m++) {
+            const hfvis_ssao_line *ln;
+            double ti;
+            if (cand[m] < 0 || cand[m] >= L->line_count) continue;
+            ln = &lines[cand[m]];
+            if (ln->count < 1) continue;
+            ti = floor(tf + 0.5);
+            if (ti < (double)ln->first) ti = (double)ln->first;
+            if (ti > (double)(ln->first + ln->count - 1)) ti = (double)(ln->first + ln->count - 1);
+            i = (int)ti;
+            *jo = cand[m];
+            *io = i;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+int hfvis_ssao_lattice_nearest(const hfvis_ssao_lattice *lat, const hfvis_ssao_line *lines,
+                               double u, double v, int *line, int *step)
+{
+    if (!lat || !lines || !line || !step || !ss_finite(u) || !ss_finite(v)) return 0;
+    if (!(lat->dir.spacing > 0.0) || !(lat->dir.step > 0.0)) return 0;
+    return ss_nearest(lat, lines, u, v, line, step);
+}
+
+/* ========================================================================================== */
+/* 5. P3 line-sweep ambient obscurance ([P3] §4-5, Alg. 1; spec §3)                           */
+/* ========================================================================================== */
+
+#define SS_LSAO_DEFAULT_K 16
+#define SS_DEFAULT_SIN_T (-0.85)   /* [P3] §4.1: "fix all tangents to sin(t) = -0.85" */
+#define SS_DEFAULT_REJECT_DEPTH 0.03 /* spec §3.6 [R], from P4's box filter */
+#define SS_DEFAULT_REJECT_NORMAL 0.5
+#define SS_COINCIDENT 1e-12        /* |h| <= 1e-12 |p|: the same point (spec §3.9 item 3) */
+
+/* Resolved LSAO/HBAO parameters in the form the loops use. */
+typedef struct ss_cfg {
+    ss_fall fall;
+    int tangent, sampling, exact, ties, gather;
+    double fixed;
+    double rej_z;      /* < 0: off */
+    double rej_n;      /* -inf: off */
+} ss_cfg;
+
+hfvis_lsao_options hfvis_lsao_options_default(void)
+{
+    hfvis_lsao_options o;
+    memset(&o, 0, sizeof o);
+    o.directions = SS_LSAO_DEFAULT_K;
+    o.pattern = HFVIS_SSAO_PATTERN_BOX;
+    o.box_scale = 1;
+    o.step = 1.0;
+    o.spacing = 0.0; /* depends on K: hfvis_lsao_options_resolve fills it in */
+    o.falloff.kind = HFVIS_FALLOFF_NONE;
+    o.tangent = HFVIS_SSAO_TANGENT_FIXED;
+    o.fixed_sin_t = SS_DEFAULT_SIN_T;
+    o.sampling = HFVIS_SSAO_SAMPLING_NEAREST;
+    o.plane = HFVIS_SSAO_PLANE_PAPER;
+    o.pop = HFVIS_LSAO_POP_TIES;
+    o.gather = HFVIS_SSAO_GATHER_NEAREST;
+    o.reject_depth = SS_DEFAULT_REJECT_DEPTH;
+    o.reject_normal = SS_DEFAULT_REJECT_NORMAL;
+    return o;
+}
+
+/* Mean |step| of the non-axis box vectors of n (the paper's D_S of a box pattern). */
+static double ss_box_mean(int n, int m)
+{
+    double s = 0.0;
+    int i, cnt = 0;
+    /* ring vectors (n, j) for j = 1..n-1 and (n, n), times 8 symmetric copies: the mean over one
+     * octant-symmetric set equals the mean over the ring without axes */
+    for (i = 1; i <= n; i++) {
+        double l = sqrt((double)n * (double)n + (double)i * (double)i);
+        int mult = i == n ? 4 : 8;
+        s += l * (double)mult;
+        cnt += mult;
+    }
+    return (double)m * s / (double)cnt;
+}
+
+hfvis_status hfvis_lsao_options_resolve(const hfvis_lsao_options *in, hfvis_lsao_options *out)
+{
+    hfvis_lsao_options o;
+    int K, k;
+    if (!out) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (in) o = *in;
+    else memset(&o, 0, sizeof o);
+    K = o.directions ? o.directions : SS_LSAO_DEFAULT_K;
+    if (K < 1 || K > HFVIS_SSAO_MAX_DIRECTIONS) return HFVIS_ERR_INVALID_ARGUMENT;
+    o.directions = K;
+    if (o.pattern == HFVIS_SSAO_PATTERN_DEFAULT) o.pattern = HFVIS_SSAO_PATTERN_BOX;
+    if (o.box_scale < 0 || !ss_finite(o.step) || !ss_finite(o.spacing) ||
+        !ss_finite(o.azimuth0_rad))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.box_scale == 0) o.box_scale = 1;
+    if (o.step == 0.0) o.step = 1.0;
+    if (!ss_step_ok(o.step)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.spacing != 0.0 && !ss_step_ok(o.spacing)) return HFVIS_ERR_INVALID_ARGUMENT;
+    switch (o.pattern) {
+    case HFVIS_SSAO_PATTERN_BOX:
+        if (K % 8 != 0 || o.box_scale > 4096 / (K / 8)) return HFVIS_ERR_INVALID_ARGUMENT;
+        if (o.spacing == 0.0) o.spacing = (double)K / (4.0 * ss_box_mean(K / 8, o.box_scale));
+        break;
+    case HFVIS_SSAO_PATTERN_UNIFORM:
+        if (o.spacing == 0.0) o.spacing = (double)K / (4.0 * o.step);
+        break;
+    case HFVIS_SSAO_PATTERN_CUSTOM: {
+        double ws = 0.0;
+        if (!o.custom_directions) return HFVIS_ERR_INVALID_ARGUMENT;
+        for (k = 0; k < K; k++) {
+            const hfvis_ssao_direction *d = &o.custom_directions[k];
+            if (!ss_dir_ok(d) || !ss_finite(d->weight) || d->weight < 0.0)
+                return HFVIS_ERR_INVALID_ARGUMENT;
+            ws += d->weight;
+        }
+        if (!(ws > 0.0) || !ss_finite(ws)) return HFVIS_ERR_INVALID_ARGUMENT;
+        break;
+    }
+    default:
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    }
+    if (o.spacing != 0.0 && o.spacing < SS_MIN_STEP) o.spacing = SS_MIN_STEP;
+    if (o.falloff.kind == HFVIS_FALLOFF_DEFAULT) o.falloff.kind = HFVIS_FALLOFF_NONE;
+    if (hfvis_falloff_check(&o.falloff) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.falloff.kind == HFVIS_FALLOFF_HBAO && o.falloff.hbao_c == 0.0) o.falloff.hbao_c = 0.3;
+    if (o.tangent == HFVIS_SSAO_TANGENT_DEFAULT) o.tangent = HFVIS_SSAO_TANGENT_FIXED;
+    if (o.tangent < HFVIS_SSAO_TANGENT_FIXED || o.tangent > HFVIS_SSAO_TANGENT_FIXED_HULL_REAL_EVAL)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.fixed_sin_t == 0.0) o.fixed_sin_t = SS_DEFAULT_SIN_T;
+    if (!(o.fixed_sin_t >= -1.0 && o.fixed_sin_t <= 1.0)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.sampling == HFVIS_SSAO_SAMPLING_DEFAULT) o.sampling = HFVIS_SSAO_SAMPLING_NEAREST;
+    if (o.sampling != HFVIS_SSAO_SAMPLING_NEAREST && o.sampling != HFVIS_SSAO_SAMPLING_BILINEAR)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.plane == HFVIS_SSAO_PLANE_DEFAULT) o.plane = HFVIS_SSAO_PLANE_PAPER;
+    if (o.plane != HFVIS_SSAO_PLANE_PAPER && o.plane != HFVIS_SSAO_PLANE_EXACT)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.pop == HFVIS_LSAO_POP_DEFAULT) o.pop = HFVIS_LSAO_POP_TIES;
+    if (o.pop != HFVIS_LSAO_POP_TIES && o.pop != HFVIS_LSAO_POP_STRICT)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.gather == HFVIS_SSAO_GATHER_DEFAULT) o.gather = HFVIS_SSAO_GATHER_NEAREST;
+    if (o.gather != HFVIS_SSAO_GATHER_NEAREST && o.gather != HFVIS_SSAO_GATHER_BILINEAR)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.reject_depth != o.reject_depth || o.reject_normal != o.reject_normal ||
+        o.reject_normal > 1.0)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.reject_depth == 0.0) o.reject_depth = SS_DEFAULT_REJECT_DEPTH;
+    if (o.reject_normal == 0.0) o.reject_normal = SS_DEFAULT_REJECT_NORMAL;
+    *out = o;
+    return HFVIS_OK;
+}
+
+/* Directions of resolved options into out[K], weights normalised. */
+static void ss_lsao_dirs(const hfvis_lsao_options *o, hfvis_ssao_direction *out)
+{
+    int K = o->directions, k;
+    double ws = 0.0;
+    switch (o->pattern) {
+    case HFVIS_SSAO_PATTERN_BOX:
+        hfvis_ssao_directions_box(K / 8, o->box_scale, o->spacing, out);
+        break;
+    case HFVIS_SSAO_PATTERN_UNIFORM:
+        hfvis_ssao_directions_uniform(K, o->azimuth0_rad, o->step, o->spacing, out);
+        break;
+    default:
+        memcpy(out, o->custom_directions, sizeof *out * (size_t)K);
+        break;
+    }
+    for (k = 0; k < K; k++) ws += out[k].weight;
+    for (k = 0; k < K; k++) out[k].weight /= ws;
+}
+
+hfvis_status hfvis_lsao_directions(const hfvis_lsao_options *opts, hfvis_ssao_direction *out)
+{
+    hfvis_lsao_options o;
+    if (!out || hfvis_lsao_options_resolve(opts, &o) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_lsao_dirs(&o, out);
+    return HFVIS_OK;
+}
+
+static void ss_cfg_from_lsao(const hfvis_lsao_options *o, ss_cfg *g)
+{
+    memset(g, 0, sizeof *g);
+    ss_fall_load(&o->falloff, &g->fall);
+    g->tangent = (int)o->tangent;
+    g->sampling = (int)o->sampling;
+    g->exact = o->plane == HFVIS_SSAO_PLANE_EXACT;
+    g->ties = o->pop == HFVIS_LSAO_POP_TIES;
+    g->gather = (int)o->gather;
+    g->fixed = o->fixed_sin_t;
+    g->rej_z = o->reject_depth;
+    g->rej_n = o->reject_normal;
+}
+
+/* Occ of point (hx, hy) = occluder - receiver seen along zenith (ux, uy) with tangent st
+ * ([P3] Alg. 1 l.25-29); *sin_out = Sin(h) (-inf for a coincident point, which casts st). */
+static double ss_occ(const ss_fall *f, double hx, double hy, double ux, double uy, double st,
+                     double tiny, double *sin_out)
+{
+    double len = sqrt(hx * hx + hy * hy), s;
+    if (!(len > tiny)) {
+        *sin_out = -SS_INF;
+        return st;
+    }
+    s = (hx * ux + hy * uy) / len;
+    *sin_out = s;
+    return s > st ? st + (s - st) * ss_rho(f, len) : st;
+}
+
+/* The obscurity hull along one line ([P3] Alg. 1, spec §3.3). */
+static void ss_hull_line(const double *x, const double *y, const double *stc, const double *ste,
+                         int n, int persp, double fixed, const ss_fall *f, int ties, int *stack,
+                         double *out)
+{
+    int top = 0, i;
+    for (i = 0; i < n; i++) {
+        double px = x[i], py = y[i], r, ux, uy, sc, se, tiny, o1 = 0.0, s1 = 0.0, o2, s2;
+        if (!ss_finite(px) || !ss_finite(py)) {
+            out[i] = SS_NAN;
+            continue;
+        }
+        r = sqrt(px * px + py * py);
+        if (persp) {
+            if (!(r > 0.0)) {
+                out[i] = SS_NAN;
+                continue;
+            }
+            ux = -px / r; /* l.7: unit vector towards the camera */
+            uy = -py / r;
+        } else {
+            ux = 0.0;
+            uy = 1.0;
+        }
+        tiny = SS_COINCIDENT * (fabs(px) + fabs(py));
+        sc = stc ? stc[i] : fixed;
+        se = ste ? ste[i] : fixed;
+        if (top >= 1) {
+            int a = stack[top - 1];
+            o1 = ss_occ(f, x[a] - px, y[a] - py, ux, uy, sc, tiny, &s1);
+        }
+        while (top >= 2) { /* l.12-18 */
+            int b = stack[top - 2];
+            o2 = ss_occ(f, x[b] - px, y[b] - py, ux, uy, sc, tiny, &s2);
+            if ((ties ? o1 <= o2 : o1 < o2) && s1 < s2) {
+                top--;
+                o1 = o2;
+                s1 = s2;
+            } else {
+                break;
+            }
+        }
+        if (top == 0) {
+            out[i] = se; /* no occluder yet: rho = 0 (spec §3.9 item 1) */
+        } else if (se == sc) {
+            out[i] = o1; /* l.20 */
+        } else {
+            int a = stack[top - 1];
+            double s;
+            out[i] = ss_occ(f, x[a] - px, y[a] - py, ux, uy, se, tiny, &s);
+        }
+        if (top == 0 || s1 != -SS_INF) stack[top++] = i; /* l.21 (coincident points skipped) */
+    }
+}
+
+/* Brute-force oracle (spec §4.2). */
+static void ss_hull_line_naive(const double *x, const double *y, const double *stc,
+                               const double *ste, int n, int persp, double fixed,
+                               const ss_fall *f, double *out)
+{
+    int i, j;
+    for (i = 0; i < n; i++) {
+        double px = x[i], py = y[i], r, ux, uy, sc, se, tiny, maxs = -SS_INF, bo = 0.0, bs = 0.0;
+        int best = -1;
+        if (!ss_finite(px) || !ss_finite(py)) {
+            out[i] = SS_NAN;
+            continue;
+        }
+        r = sqrt(px * px + py * py);
+        if (persp) {
+            if (!(r > 0.0)) {
+                out[i] = SS_NAN;
+                continue;
+            }
+            ux = -px / r;
+            uy = -py / r;
+        } else {
+            ux = 0.0;
+            uy = 1.0;
+        }
+        tiny = SS_COINCIDENT * (fabs(px) + fabs(py));
+        sc = stc ? stc[i] : fixed;
+        se = ste ? ste[i] : fixed;
+        for (j = i - 1; j >= 0; j--) {
+            double s, o;
+            if (!ss_finite(x[j]) || !ss_finite(y[j])) continue;
+            if (persp && !(x[j] * x[j] + y[j] * y[j] > 0.0)) continue;
+            o = ss_occ(f, x[j] - px, y[j] - py, ux, uy, sc, tiny, &s);
+            if (!(s > maxs)) continue; /* hidden behind a nearer point */
+            maxs = s;
+            if (best < 0 || o > bo || (o == bo && s > bs)) {
+                best = j;
+                bo = o;
+                bs = s;
+            }
+        }
+        if (best < 0) {
+            out[i] = se;
+        } else if (se == sc) {
+            out[i] = bo;
+        } else {
+            double s;
+            out[i] = ss_occ(f, x[best] - px, y[best] - py, ux, uy, se, tiny, &s);
+        }
+    }
+}
+
+static hfvis_status ss_line_args(const double *x, const double *y, int n, int ortho,
+                                 const hfvis_lsao_options *opts, hfvis_lsao_options *o)
+{
+    if (n < 0 || (n > 0 && (!x || !y)) || (ortho != 0 && ortho != 1))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    return hfvis_lsao_options_resolve(opts, o) == HFVIS_OK ? HFVIS_OK : HFVIS_ERR_INVALID_ARGUMENT;
+}
+
+hfvis_status hfvis_lsao_line(const double *x, const double *y, const double *sin_t_cull,
+                             const double *sin_t_eval, int n, int orthographic,
+                             const hfvis_lsao_options *opts, int *stack, double *out)
+{
+    hfvis_lsao_options o;
+    ss_cfg g;
+    if (ss_line_args(x, y, n, orthographic, opts, &o) != HFVIS_OK || (n > 0 && (!stack || !out)))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_cfg_from_lsao(&o, &g);
+    ss_hull_line(x, y, sin_t_cull, sin_t_eval, n, !orthographic, g.fixed, &g.fall, g.ties, stack,
+                 out);
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_lsao_line_naive(const double *x, const double *y, const double *sin_t_cull,
+                                   const double *sin_t_eval, int n, int orthographic,
+                                   const hfvis_lsao_options *opts, double *out)
+{
+    hfvis_lsao_options o;
+    ss_cfg g;
+    if (ss_line_args(x, y, n, orthographic, opts, &o) != HFVIS_OK || (n > 0 && !out))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_cfg_from_lsao(&o, &g);
+    ss_hull_line_naive(x, y, sin_t_cull, sin_t_eval, n, !orthographic, g.fixed, &g.fall, out);
+    return HFVIS_OK;
+}
+
+/* Depth at screen position (u, v): NEAREST reads texel (tx, ty) (already snapped by the
+ * caller) and returns its centre in (*qu, *qv); BILINEAR interpolates at (u, v) (NaN if a tap
+ * with non-zero weight is background). Background -> NaN. */
+static double ss_sample(const ss_cam *c, const float *depth, int bilinear, double u, double v,
+                        int tx, int ty, double *qu, double *qv)
+{
+    double z;
+    if (!bilinear) {
+        z = ss_tex(c, depth, tx, ty);
+        *qu = (double)tx + 0.5;
+        *qv = (double)ty + 0.5;
+        return ss_bg(c, z) ? SS_NAN : z;
+    } else {
+        double a = u - 0.5, b = v - 0.5, fa, fb, z00, z10, z01, z11;
+        int x0, y0, x1, y1;
+        if (a < 0.0) a = 0.0;
+        if (b < 0.0) b = 0.0;
+        if (a > (double)(c->W - 1)) a = (double)(c->W - 1);
+        if (b > (double)(c->H - 1)) b = (double)(c->H - 1);
+        x0 = (int)a;
+        y0 = (int)b;
+        if (x0 > c->W - 2) x0 = c->W > 1 ? c->W - 2 : 0;
+        if (y0 > c->H - 2) y0 = c->H > 1 ? c->H - 2 : 0;
+        fa = a - (double)x0;
+        fb = b - (double)y0;
+        x1 = c->W > 1 ? x0 + 1 : x0;
+        y1 = c->H > 1 ? y0 + 1 : y0;
+        z00 = ss_tex(c, depth, x0, y0);
+        z10 = ss_tex(c, depth, x1, y0);
+        z01 = ss_tex(c, depth, x0, y1);
+        z11 = ss_tex(c, depth, x1, y1);
+        *qu = u;
+        *qv = v;
+        if ((fa < 1.0 && fb < 1.0 && ss_bg(c, z00)) || (fa > 0.0 && fb < 1.0 && ss_bg(c, z10)) ||
+            (fa < 1.0 && fb > 0.0 && ss_bg(c, z01)) || (fa > 0.0 && fb > 0.0 && ss_bg(c, z11)))
+            return SS_NAN;
+        if (fa == 0.0) z10 = z00, z11 = z01; /* zero weights never touch a background tap */
+        if (fb == 0.0) z01 = z00, z11 = z10;
+        if (fa == 1.0) z00 = z10, z01 = z11;
+        if (fb == 1.0) z00 = z01, z10 = z11;
+        z = (1.0 - fb) * ((1.0 - fa) * z00 + fa * z10) + fb * ((1.0 - fa) * z01 + fa * z11);
+        return z;
+    }
+}
+
+static int ss_clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
+
+static int ss_texel(double p, int n)
+{
+    double f = floor(p);
+    if (!(f >= 0.0)) return 0;
+    if (f > (double)(n - 1)) return n - 1;
+    return (int)f;
+}
+
+/* sin t of the real tangent of a sample ([P3] §4.1, spec §3.4): normal of texel (tx, ty)
+ * projected into the plane, t = side*(-n2.y, n2.x) (side +1: toward the occluders behind, as
+ * LSAO; -1: ahead, as HBAO), sin t = t.u/|t|; the fixed value without a usable normal. */
+static double ss_real_sin_t(const ss_cam *c, const float *normals, int tx, int ty,
+                            const double e1[3], const double yh[3], int exact, double ux,
+                            double uy, double side, double fixed)
+{
+    const float *np = normals + 3 * ((ptrdiff_t)ty * c->stride + tx);
+    double n[3], n2x, n2y, tx2, ty2, l;
+    n[0] = (double)np[0];
+    n[1] = (double)np[1];
+    n[2] = (double)np[2];
+    n2x = ss_dot3(n, e1);
+    n2y = exact ? ss_dot3(n, yh) : n[2];
+    tx2 = -side * n2y;
+    ty2 = side * n2x;
+    l = sqrt(tx2 * tx2 + ty2 * ty2);
+    if (!(l > 1e-12) || !ss_finite(l)) return fixed;
+    return (tx2 * ux + ty2 * uy) / l;
+}
+
+/* The 2D samples of one lattice line: x, y (NaN at holes), real-tangent sines (if wanted),
+ * sample depths. */
+static void ss_line_points(const ss_cam *c, const ss_cfg *g, const float *depth,
+                           const float *normals, const hfvis_ssao_lattice *L,
+                           const hfvis_ssao_line *ln, double *x, double *y, double *st_real,
+                           float *zs)
+{
+    const hfvis_ssao_direction *d = &L->dir;
+    double e1[3], yh[3], ref[3], fx0 = 0.0, fy0 = 0.0;
+    int bil = g->sampling == HFVIS_SSAO_SAMPLING_BILINEAR, k, tx0 = 0, ty0 = 0;
+    int integral = d->step_x == floor(d->step_x) && d->step_y == floor(d->step_y) &&
+                   fabs(d->step_x) < 1e9 && fabs(d->step_y) < 1e9;
+    ss_plane_e1(c, d->dx, d->dy, e1);
+    if (ln->count > 0) {
+        int mid = ln->first + ln->count / 2;
+        ss_unproject(c, ln->x0 + (double)mid * d->step_x, ln->y0 + (double)mid * d->step_y, 1.0,
+                     ref);
+        ss_plane_yhat(c, e1, ref, yh);
+        tx0 = ss_texel(ln->x0 + (double)ln->first * d->step_x, c->W);
+        ty0 = ss_texel(ln->y0 + (double)ln->first * d->step_y, c->H);
+        fx0 = ln->x0 + (double)ln->first * d->step_x - (double)tx0;
+        fy0 = ln->y0 + (double)ln->first * d->step_y - (double)ty0;
+    }
+    for (k = 0; k < ln->count; k++) {
+        int i = ln->first + k, tx, ty;
+        double u = ln->x0 + (double)i * d->step_x, v = ln->y0 + (double)i * d->step_y, qu, qv, z,
+               Q[3];
+        if (integral) { /* box patterns: integer offsets from the first texel ([P3] §5.2) */
+            tx = ss_clampi(tx0 + k * (int)d->step_x, 0, c->W - 1);
+            ty = ss_clampi(ty0 + k * (int)d->step_y, 0, c->H - 1);
+            if (bil) { /* integer part exact, the same fraction at every step */
+                u = (double)(tx0 + k * (int)d->step_x) + fx0;
+                v = (double)(ty0 + k * (int)d->step_y) + fy0;
+            }
+        } else {
+            tx = ss_texel(u, c->W);
+            ty = ss_texel(v, c->H);
+        }
+        if (bil) {
+            z = ss_sample(c, depth, 1, u, v, tx, ty, &qu, &qv);
+        } else { /* ss_sample's NEAREST branch, inline */
+            z = ss_tex(c, depth, tx, ty);
+            if (ss_bg(c, z)) z = SS_NAN;
+            qu = (double)tx + 0.5;
+            qv = (double)ty + 0.5;
+        }
+        if (zs) zs[k] = (float)z;
+        if (z != z) {
+            x[k] = y[k] = SS_NAN;
+            if (st_real) st_real[k] = g->fixed;
+            continue;
+        }
+        ss_unproject(c, qu, qv, z, Q);
+        x[k] = ss_dot3(Q, e1);
+        y[k] = g->exact ? ss_dot3(Q, yh) : Q[2];
+        if (st_real) {
+            double ux = 0.0, uy = 1.0;
+            if (c->persp) {
+                double r = sqrt(x[k] * x[k] + y[k] * y[k]);
+                ux = -x[k] / r;
+                uy = -y[k] / r;
+            }
+            st_real[k] = ss_real_sin_t(c, normals, tx, ty, e1, yh, g->exact, ux, uy, 1.0, g->fixed);
+        }
+    }
+}
+
+/* Sweep (or brute-force) every line of a direction into values / sample depths.
+ * scratch: 4*M doubles (x, y, sin t, out), stack: M ints. */
+static void ss_lsao_sweep_dir(const ss_cam *c, const ss_cfg *g, const float *depth,
+                              const float *normals, const hfvis_ssao_lattice *L,
+                              const hfvis_ssao_line *lines, double *scratch, int *stack,
+                              int naive, float *values, float *sdepth)
+{
+    int M = L->max_line_samples, j, k;
+    double *x = scratch, *y = scratch + M, *st = scratch + 2 * (size_t)M,
+           *out = scratch + 3 * (size_t)M;
+    int real = g->tangent != HFVIS_SSAO_TANGENT_FIXED;
+    for (j = 0; j < L->line_count; j++) {
+        const hfvis_ssao_line *ln = &lines[j];
+        const double *stc, *ste;
+        if (ln->count < 1) continue;
+        ss_line_points(c, g, depth, normals, L, ln, x, y, real ? st : NULL,
+                       sdepth ? sdepth + ln->offset : NULL);
+        stc = g->tangent == HFVIS_SSAO_TANGENT_REAL ? st : NULL;
+        ste = real ? st : NULL;
+        if (naive)
+            ss_hull_line_naive(x, y, stc, ste, ln->count, c->persp, g->fixed, &g->fall, out);
+        else
+            ss_hull_line(x, y, stc, ste, ln->count, c->persp, g->fixed, &g->fall, g->ties, stack,
+                         out);
+        for (k = 0; k < ln->count; k++) values[ln->offset + (size_t)k] = (float)out[k];
+    }
+}
+
+/* A caller's lattice is consistent: every line within max_line_samples and sample_count, the
+ * lines stored back to back (the buffers and the scratch are sized from these counts). */
+static int ss_lattice_ok(const hfvis_ssao_lattice *L, const hfvis_ssao_line *lines)
+{
+    size_t off = 0;
+    int j;
+    if (!L || !lines || !ss_dir_ok(&L->dir) || L->line_count < 0 || L->max_line_samples < 0 ||
+        !ss_finite(L->s_first) || !ss_finite(L->t_min) || !ss_finite(L->px) || !ss_finite(L->py))
+        return 0;
+    for (j = 0; j < L->line_count; j++) {
+        const hfvis_ssao_line *ln = &lines[j];
+        if (ln->count < 0 || ln->count > L->max_line_samples || ln->offset != off ||
+            !ss_finite(ln->x0) || !ss_finite(ln->y0) ||
+            (ln->count > 0 && ln->first > INT_MAX - ln->count))
+            return 0;
+        off += (size_t)ln->count;
+        if (off > L->sample_count) return 0;
+    }
+    return 1;
+}
+
+static hfvis_status ss_lsao_direction(const hfvis_camera *cam, const float *depth,
+                                      const float *normals, const hfvis_lsao_options *opts,
+                                      const hfvis_ssao_lattice *lat, const hfvis_ssao_line *lines,
+                                      float *values, float *sample_depth, int naive)
+{
+    ss_cam c;
+    ss_cfg g;
+    hfvis_lsao_options o;
+    size_t M, bytes, nb = 0;
+    void *blk;
+    float *nrm = NULL;
+    if (ss_cam_load(cam, &c) != HFVIS_OK || hfvis_lsao_options_resolve(opts, &o) != HFVIS_OK ||
+        !depth || !values || !ss_lattice_ok(lat, lines))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_cfg_from_lsao(&o, &g);
+    M = (size_t)lat->max_line_samples;
+    if (M == 0) return HFVIS_OK;
+    bytes = ss_bytes3(M, 1, 4 * sizeof(double) + sizeof(int));
+    if (!bytes) return HFVIS_ERR_OUT_OF_MEMORY;
+    if (g.tangent != HFVIS_SSAO_TANGENT_FIXED && !normals) {
+        nb = ss_bytes3((size_t)c.stride, (size_t)c.H, 3 * sizeof(float));
+        nrm = (float *)ss_alloc(o.alloc, nb);
+        if (!nrm) return HFVIS_ERR_OUT_OF_MEMORY;
+        ss_normals_fill(&c, depth, nrm);
+        normals = nrm;
+    }
+    blk = ss_alloc(o.alloc, bytes);
+    if (!blk) {
+        ss_free(o.alloc, nrm);
+        return HFVIS_ERR_OUT_OF_MEMORY;
+    }
+    ss_lsao_sweep_dir(&c, &g, depth, normals, lat, lines, (double *)blk,
+                      (int *)((double *)blk + 4 * M), naive, values, sample_depth);
+    ss_free(o.alloc, blk);
+    ss_free(o.alloc, nrm);
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_lsao_direction(const hfvis_camera *cam, const float *depth,
+                                  const float *normals, const hfvis_lsao_options *opts,
+                                  const hfvis_ssao_lattice *lat, const hfvis_ssao_line *lines,
+                                  float *values, float *sample_depth)
+{
+    return ss_lsao_direction(cam, depth, normals, opts, lat, lines, values, sample_depth, 0);
+}
+
+hfvis_status hfvis_lsao_direction_naive(const hfvis_camera *cam, const float *depth,
+                                        const float *normals, const hfvis_lsao_options *opts,
+                                        const hfvis_ssao_lattice *lat,
+                                        const hfvis_ssao_line *lines, float *values,
+                                        float *sample_depth)
+{
+    return ss_lsao_direction(cam, depth, normals, opts, lat, lines, values, sample_depth, 1);
+}
+
+/* Is lattice sample (j, i) acceptable for receiver depth zc / normal nc? Writes its value. */
+static int ss_accept(const ss_cam *c, const ss_cfg *g, const float *normals,
+                     const hfvis_ssao_lattice *L, const hfvis_ssao_line *ln, int i,
+                     const float *values, const float *sdepth, double zc, const float *nc,
+                     double *val)
+{
+    size_t idx;
+    double v, zs;
+    if (i < ln->first || i >= ln->first + ln->count) return 0;
+    idx = ln->offset + (size_t)(i - ln->first);
+    v = (double)values[idx];
+    zs = (double)sdepth[idx];
+    if (v != v || zs != zs) return 0;
+    if (g->rej_z >= 0.0 && fabs(zs - zc) > g->rej_z * zc) return 0;
+    if (normals && g->rej_n > -1.0) {
+        int tx = ss_texel(ln->x0 + (double)i * L->dir.step_x, c->W);
+        int ty = ss_texel(ln->y0 + (double)i * L->dir.step_y, c->H);
+        const float *ns = normals + 3 * ((ptrdiff_t)ty * c->stride + tx);
+        double dot = (double)ns[0] * (double)nc[0] + (double)ns[1] * (double)nc[1] +
+                     (double)ns[2] * (double)nc[2];
+        if (!(dot >= g->rej_n)) return 0;
+    }
+    *val = v;
+    return 1;
+}
+
+/* The nearest accepted sample within radius R2 (squared) of (u, v) (spec §3.6 fallback). */
+static int ss_fallback(const ss_cam *c, const ss_cfg *g, const float *normals,
+                       const hfvis_ssao_lattice *L, const hfvis_ssao_line *lines,
+                       const float *values, const float *sdepth, double u, double v, double zc,
+                       const float *nc, double R, double *val)
+{
+    const hfvis_ssao_direction *d = &L->dir;
+    double jf = (u * L->px + v * L->py - L->s_first) / d->spacing;
+    double tf = (u * d->dx + v * d->dy - L->t_min) / d->step;
+    int a = (int)ceil(R / d->spacing), b = (int)ceil(R / d->step), j0 = (int)floor(jf + 0.5),
+        i0 = (int)floor(tf + 0.5), j, i, found = 0;
+    double best = R * R, bv = 0.0;
+    for (j = j0 - a; j <= j0 + a; j++) {
+        const hfvis_ssao_line *ln;
+        if (j < 0 || j >= L->line_count) continue;
+        ln = &lines[j];
+        for (i = i0 - b; i <= i0 + b; i++) {
+            double su = ln->x0 + (double)i * d->step_x - u, sv = ln->y0 + (double)i * d->step_y - v;
+            double dd = su * su + sv * sv, vv;
+            if (dd > best || (found && dd == best)) continue;
+            if (!ss_accept(c, g, normals, L, ln, i, values, sdepth, zc, nc, &vv)) continue;
+            best = dd;
+            bv = vv;
+            found = 1;
+        }
+    }
+    *val = bv;
+    return found;
+}
+
+/* Gather one direction into sum / weight (inner pixels, row-major W). */
+static void ss_gather_dir(const ss_cam *c, const ss_cfg *g, const float *depth,
+                          const float *normals, const hfvis_ssao_lattice *L,
+                          const hfvis_ssao_line *lines, const float *values, const float *sdepth,
+                          double *sum, double *wsum)
+{
+    const hfvis_ssao_direction *d = &L->dir;
+    int W = c->W - 2 * c->gx, x, y, nlines = L->line_count;
+    double w = d->weight, ids = 1.0 / d->step, idl = 1.0 / d->spacing;
+    double R2 = 2.0 * sqrt(0.25 * d->step * d->step + 0.25 * d->spacing * d->spacing);
+    if (nlines < 1) return;
+    for (y = c->gy; y < c->H - c->gy; y++) {
+        double v = (double)y + 0.5;
+        for (x = c->gx; x < c->W - c->gx; x++) {
+            double u = (double)x + 0.5, zc = ss_tex(c, depth, x, y), val = 0.0;
+            const float *nc = normals ? normals + 3 * ((ptrdiff_t)y * c->stride + x) : NULL;
+            double jf, tf;
+            int ok = 0;
+            size_t o;
+            if (ss_bg(c, zc)) continue;
+            jf = (u * L->px + v * L->py - L->s_first) * idl;
+            tf = (u * d->dx + v * d->dy - L->t_min) * ids;
+            if (g->gather == HFVIS_SSAO_GATHER_NEAREST) {
+                int j, i;
+                /* fast path of ss_nearest: the rounded line and step lie inside the lattice */
+                if (jf > -0.5 && jf < (double)nlines - 0.5 && tf > -0.5 && tf < 2147483647.0) {
+                    const hfvis_ssao_line *ln;
+                    j = (int)(jf + 0.5);
+                    i = (int)(tf + 0.5);
+                    ln = &lines[j];
+                    if (i >= ln->first && i < ln->first + ln->count) {
+                        size_t idx = ln->offset + (size_t)(i - ln->first);
+                        double zs = (double)sdepth[idx];
+                        val = (double)values[idx];
+                        ok = val == val && zs == zs &&
+                             (g->rej_z < 0.0 || fabs(zs - zc) <= g->rej_z * zc);
+                        if (ok && nc)
+                            ok = ss_accept(c, g, normals, L, ln, i, values, sdepth, zc, nc, &val);
+                        goto have;
+                    }
+                }
+                if (ss_nearest(L, lines, u, v, &j, &i))
+                    ok = ss_accept(c, g, normals, L, &lines[j], i, values, sdepth, zc, nc, &val);
+            } else {
+                double fj = floor(jf), fi = floor(tf), aj = jf - fj, ai = tf - fi, ws = 0.0,
+                       vs = 0.0;
+                int dj, di;
+                for (dj = 0; dj < 2; dj++)
+                    for (di = 0; di < 2; di++) {
+                        double wt = (dj ? aj : 1.0 - aj) * (di ? ai : 1.0 - ai), vv;
+                        double jj = fj + (double)dj, ii = fi + (double)di;
+                        if (!(wt > 0.0) || jj < 0.0 || jj >= (double)nlines) continue;
+                        if (!ss_accept(c, g, normals, L, &lines[(int)jj], (int)ii, values,
+                                       sdepth, zc, nc, &vv))
+                            continue;
+                        ws += wt;
+                        vs += wt * vv;
+                    }
+                if (ws > 0.0) {
+                    val = vs / ws;
+                    ok = 1;
+                }
+            }
+        have:
+            if (!ok)
+                ok = ss_fallback(c, g, normals, L, lines, values, sdepth, u, v, zc, nc, R2, &val);
+            if (!ok) continue;
+            o = (size_t)(y - c->gy) * (size_t)W + (size_t)(x - c->gx);
+            sum[o] += w * val;
+            wsum[o] += w;
+        }
+    }
+}
+
+hfvis_status hfvis_lsao_gather(const hfvis_camera *cam, const float *depth, const float *normals,
+                               const hfvis_lsao_options *opts, const hfvis_ssao_lattice *lat,
+                               const hfvis_ssao_line *lines, const float *values,
+                               const float *sample_depth, double *sum, double *weight)
+{
+    ss_cam c;
+    ss_cfg g;
+    hfvis_lsao_options o;
+    if (ss_cam_load(cam, &c) != HFVIS_OK || hfvis_lsao_options_resolve(opts, &o) != HFVIS_OK ||
+        !depth || !values || !sample_depth || !sum || !weight || !ss_lattice_ok(lat, lines) ||
+        !ss_finite(lat->dir.weight))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_cfg_from_lsao(&o, &g);
+    ss_gather_dir(&c, &g, depth, normals, lat, lines, values, sample_depth, sum, weight);
+    return HFVIS_OK;
+}
+
+/* Final AO of accumulators into ao (inner pixels). */
+static void ss_finish(const ss_cam *c, const float *depth, const double *sum, const double *wsum,
+                      float *ao, ptrdiff_t ao_stride)
+{
+    int W = c->W - 2 * c->gx, H = c->H - 2 * c->gy, x, y;
+    for (y = 0; y < H; y++)
+        for (x = 0; x < W; x++) {
+            size_t o = (size_t)y * (size_t)W + (size_t)x;
+            double a = 0.0;
+            if (!ss_bg(c, ss_tex(c, depth, x + c->gx, y + c->gy)) && wsum[o] > 0.0) {
+                a = sum[o] / wsum[o];
+                a = a > 0.0 ? (a < 1.0 ? a : 1.0) : 0.0;
+            }
+            ao[(ptrdiff_t)y * ao_stride + x] = (float)a;
+        }
+}
+
+hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth, const float *normals,
+                        const hfvis_lsao_options *opts, float *ao, ptrdiff_t ao_stride)
+{
+    ss_cam c;
+    ss_cfg g;
+    hfvis_lsao_options o;
+    hfvis_ssao_direction *dirs = NULL;
+    hfvis_ssao_lattice lat;
+    hfvis_ssao_line *lines = NULL;
+    float *nrm = NULL, *vals = NULL;
+    double *scratch = NULL, *acc = NULL;
+    size_t maxs = 0, npix, b;
+    int K, k, maxl = 0, maxm = 0, W, H;
+    hfvis_status s = HFVIS_OK;
+    if (ss_cam_load(cam, &c) != HFVIS_OK || hfvis_lsao_options_resolve(opts, &o) != HFVIS_OK ||
+        !depth || !ao)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    W = c.W - 2 * c.gx;
+    H = c.H - 2 * c.gy;
+    if (ao_stride < W) return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_cfg_from_lsao(&o, &g);
+    K = o.directions;
+    if (!ss_mul((size_t)W, (size_t)H, &npix)) return HFVIS_ERR_LIMIT;
+    dirs = (hfvis_ssao_direction *)ss_alloc(o.alloc, sizeof *dirs * (size_t)K);
+    if (!dirs) return HFVIS_ERR_OUT_OF_MEMORY;
+    ss_lsao_dirs(&o, dirs);
+    for (k = 0; k < K; k++) {
+        s = ss_lattice_init(&c, &dirs[k], &lat);
+        if (s != HFVIS_OK) goto done;
+        if (lat.line_count > maxl) maxl = lat.line_count;
+        if (lat.max_line_samples > maxm) maxm = lat.max_line_samples;
+        if (lat.sample_count > maxs) maxs = lat.sample_count;
+    }
+    s = HFVIS_ERR_OUT_OF_MEMORY;
+    if (g.tangent != HFVIS_SSAO_TANGENT_FIXED && !normals) {
+        b = ss_bytes3((size_t)c.stride, (size_t)c.H, 3 * sizeof(float));
+        if (!b || !(nrm = (float *)ss_alloc(o.alloc, b))) goto done;
+        ss_normals_fill(&c, depth, nrm);
+    }
+    b = ss_bytes3((size_t)(maxl > 0 ? maxl : 1), 1, sizeof *lines);
+    if (!b || !(lines = (hfvis_ssao_line *)ss_alloc(o.alloc, b))) goto done;
+    b = ss_bytes3(maxs > 0 ? maxs : 1, 2, sizeof(float));
+    if (!b || !(vals = (float *)ss_alloc(o.alloc, b))) goto done;
+    b = ss_bytes3((size_t)(maxm > 0 ? maxm : 1), 1, 4 * sizeof(double) + sizeof(int));
+    if (!b || !(scratch = (double *)ss_alloc(o.alloc, b))) goto done;
+    b = ss_bytes3(npix, 2, sizeof(double));
+    if (!b || !(acc = (double *)ss_alloc(o.alloc, b))) goto done;
+    for (b = 0; b < 2 * npix; b++) acc[b] = 0.0;
+    for (k = 0; k < K; k++) {
+        ss_lattice_init(&c, &dirs[k], &lat);
+        ss_lattice_fill(&c, &lat, lines);
+        ss_lsao_sweep_dir(&c, &g, depth, nrm ? nrm : normals, &lat, lines, scratch,
+                          (int *)(scratch + 4 * (size_t)(maxm > 0 ? maxm : 1)), 0, vals,
+                          vals + (maxs > 0 ? maxs : 1));
+        ss_gather_dir(&c, &g, depth, normals, &lat, lines, vals, vals + (maxs > 0 ? maxs : 1),
+                      acc, acc + npix);
+    }
+    ss_finish(&c, depth, acc, acc + npix, ao, ao_stride);
+    s = HFVIS_OK;
+done:
+    ss_free(o.alloc, acc);
+    ss_free(o.alloc, scratch);
+    ss_free(o.alloc, vals);
+    ss_free(o.alloc, lines);
+    ss_free(o.alloc, nrm);
+    ss_free(o.alloc, dirs);
+    return s;
+}
+
+/* ========================================================================================== */
+/* 6. HBAO (Bavoil, Sainz, Dimitrov 2008; thesis l.466, [P4] l.1988; spec §4.1)               */
+/* ========================================================================================== */
+
+#define SS_HBAO_DEFAULT_K 8
+
+hfvis_hbao_options hfvis_hbao_options_default(void)
+{
+    hfvis_hbao_options o;
+    memset(&o, 0, sizeof o);
+    o.directions = SS_HBAO_DEFAULT_K;
+    o.variant = HFVIS_HBAO_INCREMENTAL;
+    o.step_px = 1.0;
+    o.falloff.kind = HFVIS_FALLOFF_NONE;
+    o.tangent = HFVIS_SSAO_TANGENT_REAL;
+    o.fixed_sin_t = SS_DEFAULT_SIN_T;
+    o.sampling = HFVIS_SSAO_SAMPLING_NEAREST;
+    o.plane = HFVIS_SSAO_PLANE_EXACT;
+    o.jitter = HFVIS_HBAO_JITTER_NONE;
+    return o;
+}
+
+hfvis_status hfvis_hbao_options_resolve(const hfvis_hbao_options *in, hfvis_hbao_options *out)
+{
+    hfvis_hbao_options o;
+    int K, k;
+    if (!out) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (in) o = *in;
+    else memset(&o, 0, sizeof o);
+    K = o.directions ? o.directions : SS_HBAO_DEFAULT_K;
+    if (K < 1 || K > HFVIS_SSAO_MAX_DIRECTIONS || !ss_finite(o.azimuth0_rad))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    o.directions = K;
+    if (o.custom_directions) {
+        double ws = 0.0;
+        for (k = 0; k < K; k++) {
+            const hfvis_ssao_direction *d = &o.custom_directions[k];
+            if (!ss_dir_ok(d) || !ss_finite(d->weight) || d->weight < 0.0)
+                return HFVIS_ERR_INVALID_ARGUMENT;
+            ws += d->weight;
+        }
+        if (!(ws > 0.0) || !ss_finite(ws)) return HFVIS_ERR_INVALID_ARGUMENT;
+    }
+    if (o.variant == HFVIS_HBAO_DEFAULT) o.variant = HFVIS_HBAO_INCREMENTAL;
+    if (o.variant < HFVIS_HBAO_INCREMENTAL || o.variant > HFVIS_HBAO_LARGEST_OCCLUDER)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.steps < 0 || !ss_finite(o.step_px) || !ss_finite(o.radius) || o.radius < 0.0 ||
+        !ss_finite(o.max_radius_px) || o.max_radius_px < 0.0)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.step_px == 0.0) o.step_px = 1.0;
+    if (!ss_step_ok(o.step_px)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.falloff.kind == HFVIS_FALLOFF_DEFAULT) o.falloff.kind = HFVIS_FALLOFF_NONE;
+    if (hfvis_falloff_check(&o.falloff) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.falloff.kind == HFVIS_FALLOFF_HBAO && o.falloff.hbao_c == 0.0) o.falloff.hbao_c = 0.3;
+    if (o.tangent == HFVIS_SSAO_TANGENT_DEFAULT) o.tangent = HFVIS_SSAO_TANGENT_REAL;
+    if (o.tangent != HFVIS_SSAO_TANGENT_REAL && o.tangent != HFVIS_SSAO_TANGENT_FIXED)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.fixed_sin_t == 0.0) o.fixed_sin_t = SS_DEFAULT_SIN_T;
+    if (!(o.fixed_sin_t >= -1.0 && o.fixed_sin_t <= 1.0)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.sampling == HFVIS_SSAO_SAMPLING_DEFAULT) o.sampling = HFVIS_SSAO_SAMPLING_NEAREST;
+    if (o.sampling != HFVIS_SSAO_SAMPLING_NEAREST && o.sampling != HFVIS_SSAO_SAMPLING_BILINEAR)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.plane == HFVIS_SSAO_PLANE_DEFAULT) o.plane = HFVIS_SSAO_PLANE_EXACT;
+    if (o.plane != HFVIS_SSAO_PLANE_PAPER && o.plane != HFVIS_SSAO_PLANE_EXACT)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.jitter == HFVIS_HBAO_JITTER_DEFAULT) o.jitter = HFVIS_HBAO_JITTER_NONE;
+    if (o.jitter < HFVIS_HBAO_JITTER_NONE || o.jitter > HFVIS_HBAO_JITTER_ROTATION_STEP)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.custom_directions && o.jitter != HFVIS_HBAO_JITTER_NONE)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    *out = o;
+    return HFVIS_OK;
+}
+
+/* One HBAO pixel (spec §4.1 HbaoPixel). dirs: the custom directions or NULL; the result is
+ * divided by the weight sum, which normalises custom weights. */
+static double ss_hbao_pixel(const ss_cam *c, const hfvis_hbao_options *o, const ss_fall *f,
+                            const hfvis_ssao_direction *dirs, const float *depth,
+                            const float *normals, int x, int y, double support)
+{
+    int K = o->directions, k, bil = o->sampling == HFVIS_SSAO_SAMPLING_BILINEAR;
+    int exact = o->plane == HFVIS_SSAO_PLANE_EXACT, custom = o->custom_directions != NULL;
+    double u0 = (double)x + 0.5, v0 = (double)y + 0.5, zc = ss_tex(c, depth, x, y), P[3];
+    double rot = 0.0, xi = 1.0, sum = 0.0, wsum = 0.0, maxr;
+    ss_unproject(c, u0, v0, zc, P);
+    maxr = o->max_radius_px > 0.0 ? o->max_radius_px
+                                   : sqrt((double)c->W * (double)c->W + (double)c->H * (double)c->H);
+    if (o->jitter != HFVIS_HBAO_JITTER_NONE)
+        rot = 2.0 * SS_PI / (double)K * ss_hash01((uint32_t)x, (uint32_t)y, 0u, o->seed);
+    if (o->jitter == HFVIS_HBAO_JITTER_ROTATION_STEP)
+        xi = 1.0 - ss_hash01((uint32_t)x, (uint32_t)y, 1u, o->seed); /* (0, 1] */
+    for (k = 0; k < K; k++) {
+        double dx, dy, sx, sy, e1[3], yh[3], px, py, r, ux, uy, st, rpx, L, w, maxs, acc = 0.0,
+               best, hdist = 0.0, tiny;
+        int N, s, found = 0;
+        if (custom) {
+            dx = dirs[k].dx;
+            dy = dirs[k].dy;
+            w = dirs[k].weight;
+        } else {
+            double psi = o->azimuth0_rad + 2.0 * SS_PI * (double)k / (double)K + rot;
+            dx = ss_snap_unit(cos(psi));
+            dy = ss_snap_unit(sin(psi));
+            w = 1.0 / (double)K;
+        }
+        ss_plane_e1(c, dx, dy, e1);
+        ss_plane_yhat(c, e1, P, yh);
+        px = ss_dot3(P, e1);
+        py = exact ? ss_dot3(P, yh) : P[2];
+        r = sqrt(px * px + py * py);
+        if (c->persp) {
+            ux = -px / r;
+            uy = -py / r;
+        } else {
+            ux = 0.0;
+            uy = 1.0;
+        }
+        tiny = SS_COINCIDENT * (fabs(px) + fabs(py));
+        st = o->tangent == HFVIS_SSAO_TANGENT_REAL
+                 ? ss_real_sin_t(c, normals, x, y, e1, yh, exact, ux, uy, -1.0, o->fixed_sin_t)
+                 : o->fixed_sin_t;
+        /* screen radius of the view-space radius along e1 at the receiver's depth */
+        if (support < SS_INF) {
+            double a = c->persp ? zc * sqrt(dx * c->ifx * dx * c->ifx + dy * c->ify * dy * c->ify)
+                                : sqrt(dx * c->sx * dx * c->sx + dy * c->sy * dy * c->sy);
+            rpx = support / a;
+            if (!(rpx < maxr)) rpx = maxr;
+        } else {
+            rpx = maxr;
+        }
+        if (custom) {
+            sx = dirs[k].step_x;
+            sy = dirs[k].step_y;
+            N = o->steps > 0 ? o->steps : (int)ceil(rpx / dirs[k].step);
+        } else {
+            N = o->steps > 0 ? o->steps : (int)ceil(rpx / o->step_px);
+            if (N < 1) N = 1;
+            L = rpx / (double)N;
+            sx = L * dx;
+            sy = L * dy;
+        }
+        maxs = st;
+        best = st;
+        for (s = 1; s <= N; s++) {
+            double t = custom ? (double)s : (double)s - 1.0 + xi, u = u0 + t * sx, v = v0 + t * sy;
+            double qu, qv, z, Q[3], hx, hy, len, sh;
+            if (!(u >= 0.0 && v >= 0.0 && u < (double)c->W && v < (double)c->H)) break;
+            z = ss_sample(c, depth, bil, u, v, ss_texel(u, c->W), ss_texel(v, c->H), &qu, &qv);
+            if (z != z) continue;
+            ss_unproject(c, qu, qv, z, Q);
+            hx = ss_dot3(Q, e1) - px;
+            hy = (exact ? ss_dot3(Q, yh) : Q[2]) - py;
+            len = sqrt(hx * hx + hy * hy);
+            if (!(len > tiny)) continue;
+            sh = (hx * ux + hy * uy) / len;
+            if (!(sh > maxs)) continue;
+            switch (o->variant) {
+            case HFVIS_HBAO_INCREMENTAL:
+                acc += ss_rho(f, len) * (sh - maxs);
+                break;
+            case HFVIS_HBAO_SINGLE_HORIZON:
+                hdist = len;
+                found = 1;
+                break;
+            default: {
+                double oc = st + (sh - st) * ss_rho(f, len);
+                if (oc > best) best = oc;
+                break;
+            }
+            }
+            maxs = sh;
+        }
+        if (o->variant == HFVIS_HBAO_SINGLE_HORIZON) acc = found ? ss_rho(f, hdist) * (maxs - st) : 0.0;
+        else if (o->variant == HFVIS_HBAO_LARGEST_OCCLUDER) acc = best;
+        sum += w * acc;
+        wsum += w;
+    }
+    return wsum > 0.0 ? sum / wsum : 0.0;
+}
+
+hfvis_status hfvis_hbao(const hfvis_camera *cam, const float *depth, const float *normals,
+                        const hfvis_hbao_options *opts, float *ao, ptrdiff_t ao_stride)
+{
+    ss_cam c;
+    ss_fall f;
+    hfvis_hbao_options o;
+    float *nrm = NULL;
+    double support;
+    int x, y, W;
+    if (ss_cam_load(cam, &c) != HFVIS_OK || hfvis_hbao_options_resolve(opts, &o) != HFVIS_OK ||
+        !depth || !ao)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    W = c.W - 2 * c.gx;
+    if (ao_stride < W) return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_fall_load(&o.falloff, &f);
+    support = o.radius > 0.0 ? o.radius : f.support;
+    if (o.tangent == HFVIS_SSAO_TANGENT_REAL && !normals) {
+        size_t b = ss_bytes3((size_t)c.stride, (size_t)c.H, 3 * sizeof(float));
+        if (!b || !(nrm = (float *)ss_alloc(o.alloc, b))) return HFVIS_ERR_OUT_OF_MEMORY;
+        ss_normals_fill(&c, depth, nrm);
+        normals = nrm;
+    }
+    for (y = c.gy; y < c.H - c.gy; y++)
+        for (x = c.gx; x < c.W - c.gx; x++) {
+            double a = 0.0;
+            if (!ss_bg(&c, ss_tex(&c, depth, x, y))) {
+                a = ss_hbao_pixel(&c, &o, &f, o.custom_directions, depth, normals, x, y, support);
+                a = a > 0.0 ? (a < 1.0 ? a : 1.0) : 0.0;
+            }
+            ao[(ptrdiff_t)(y - c.gy) * ao_stride + (x - c.gx)] = (float)a;
+        }
+    ss_free(o.alloc, nrm);
+    return HFVIS_OK;
+}
+
+/* ========================================================================================== */
+/* 7. The screen-space ray-traced reference ([P4] §8; spec §5.11)                             */
+/* ========================================================================================== */
+
+#define SS_RT_DEFAULT_RAYS 256
+#define SS_RT_DEFAULT_REFINE 20
+#define SS_RT_DEFAULT_BIAS 1e-5
+
+hfvis_ssao_rt_options hfvis_ssao_rt_options_default(void)
+{
+    hfvis_ssao_rt_options o;
+    memset(&o, 0, sizeof o);
+    o.rays = SS_RT_DEFAULT_RAYS;
+    o.falloff.kind = HFVIS_FALLOFF_NONE;
+    o.sampling = HFVIS_SSAO_SAMPLING_DEFAULT; /* resolved from the thickness */
+    o.refine_iterations = SS_RT_DEFAULT_REFINE;
+    o.bias = SS_RT_DEFAULT_BIAS;
+    return o;
+}
+
+hfvis_status hfvis_ssao_rt_options_resolve(const hfvis_ssao_rt_options *in,
+                                           hfvis_ssao_rt_options *out)
+{
+    hfvis_ssao_rt_options o;
+    if (!out) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (in) o = *in;
+    else memset(&o, 0, sizeof o);
+    if (o.rays < 0 || o.refine_iterations < 0 || o.refine_iterations > 64 ||
+        !ss_finite(o.thickness) || o.thickness < 0.0 ||
+        !ss_finite(o.bias) || o.bias < 0.0 || !ss_finite(o.max_distance) || o.max_distance < 0.0)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.rays == 0) o.rays = SS_RT_DEFAULT_RAYS;
+    if (o.refine_iterations == 0) o.refine_iterations = SS_RT_DEFAULT_REFINE;
+    if (o.bias == 0.0) o.bias = SS_RT_DEFAULT_BIAS;
+    if (o.sampling == HFVIS_SSAO_SAMPLING_DEFAULT)
+        o.sampling = o.thickness > 0.0 ? HFVIS_SSAO_SAMPLING_NEAREST : HFVIS_SSAO_SAMPLING_BILINEAR;
+    if (o.sampling != HFVIS_SSAO_SAMPLING_NEAREST && o.sampling != HFVIS_SSAO_SAMPLING_BILINEAR)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.falloff.kind == HFVIS_FALLOFF_DEFAULT) o.falloff.kind = HFVIS_FALLOFF_NONE;
+    if (hfvis_falloff_check(&o.falloff) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.falloff.kind == HFVIS_FALLOFF_HBAO && o.falloff.hbao_c == 0.0) o.falloff.hbao_c = 0.3;
+    *out = o;
+    return HFVIS_OK;
+}
+
+/* Radical inverse in base 2 of r (van der Corput). */
+static double ss_radical2(uint32_t r)
+{
+    r = (r << 16) | (r >> 16);
+    r = ((r & 0x00ff00ffu) << 8) | ((r & 0xff00ff00u) >> 8);
+    r = ((r & 0x0f0f0f0fu) << 4) | ((r & 0xf0f0f0f0u) >> 4);
+    r = ((r & 0x33333333u) << 2) | ((r & 0xccccccccu) >> 2);
+    r = ((r & 0x55555555u) << 1) | ((r & 0xaaaaaaaau) >> 1);
+    return (double)r * (1.0 / 4294967296.0);
+}
+
+typedef struct ss_rt {
+    const ss_cam *c;
+    const float *depth;
+    const hfvis_ssao_rt_options *o;
+    double zmin, zmax, maxdist;
+    int bil;
+} ss_rt;
+
+/* The ray parameter s >= 0 at which the screen coordinate `axis` (0: u, 1: v) of O + s w
+ * equals k; +inf when the ray never gets there. */
+static double ss_rt_cross(const ss_cam *c, const double O[3], const double w[3], int axis,
+                          double k)
+{
+    double num, den, s;
+    if (c->persp) { /* u = cx + fx X/d, v = cy - fy Y/d, d = d0 - s w.z */
+        double d0 = -O[2];
+        if (axis == 0) {
+            num = (k - c->cx) * d0 - c->fx * O[0];
+            den = c->fx * w[0] + (k - c->cx) * w[2];
+        } else {
+            num = (k - c->cy) * d0 + c->fy * O[1];
+            den = -c->fy * w[1] + (k - c->cy) * w[2];
+        }
+    } else {
+        if (axis == 0) {
+            num = (k - c->cx) * c->sx - O[0];
+            den = w[0];
+        } else {
+            num = -(k - c->cy) * c->sy - O[1];
+            den = w[1];
+        }
+    }
+    if (den == 0.0) return SS_INF;
+    s = num / den;
+    /* the screen coordinate is monotone along the ray: a crossing behind the origin means the
+     * coordinate tends to an asymptote (the vanishing point) short of k */
+    return s >= 0.0 ? s : SS_INF;
+}
+
+/* Screen position of O + s w. */
+static void ss_rt_screen(const ss_cam *c, const double O[3], const double w[3], double s,
+                         double *u, double *v)
+{
+    double X = O[0] + s * w[0], Y = O[1] + s * w[1], d = -(O[2] + s * w[2]);
+    if (c->persp) {
+        *u = c->cx + c->fx * X / d;
+        *v = c->cy - c->fy * Y / d;
+    } else {
+        *u = c->cx + X / c->sx;
+        *v = c->cy - Y / c->sy;
+    }
+}
+
+/* Bilinear depth of cell (ix, iy) (centres ix+0.5 .. ix+1.5) at (u, v); NaN on background. */
+static double ss_rt_bilinear(const ss_rt *t, int ix, int iy, double u, double v)
+{
+    const ss_cam *c = t->c;
+    double a = u - ((double)ix + 0.5), b = v - ((double)iy + 0.5);
+    double z00 = ss_tex(c, t->depth, ix, iy), z10 = ss_tex(c, t->depth, ix + 1, iy);
+    double z01 = ss_tex(c, t->depth, ix, iy + 1), z11 = ss_tex(c, t->depth, ix + 1, iy + 1);
+    if (ss_bg(c, z00) || ss_bg(c, z10) || ss_bg(c, z01) || ss_bg(c, z11)) return SS_NAN;
+    a = a < 0.0 ? 0.0 : (a > 1.0 ? 1.0 : a);
+    b = b < 0.0 ? 0.0 : (b > 1.0 ? 1.0 : b);
+    return (1.0 - b) * ((1.0 - a) * z00 + a * z10) + b * ((1.0 - a) * z01 + a * z11);
+}
+
+/* Is ray depth d inside the field of depth zb? */
+static int ss_rt_in(const ss_rt *t, double d, double zb)
+{
+    if (zb != zb || !(d > zb)) return 0;
+    return t->o->thickness > 0.0 ? d < zb + t->o->thickness : 1;
+}
+
+/* Distance to the first hit of the ray O + s w (spec §5.11), or -1 for a miss. The ray is
+ * traversed cell by cell in screen space (a DDA whose cell boundaries are solved exactly in s):
+ * texels under NEAREST, where the depth along the ray is linear and the field constant, so the
+ * first inside point is exact; the cells between texel centres under BILINEAR, where each cell
+ * is tested at its entry, middle and exit and a hit refined by bisection. */
+static double ss_rt_ray(const ss_rt *t, const double O[3], const double w[3])
+{
+    const ss_cam *c = t->c;
+    double off = t->bil ? 0.5 : 0.0, u, v, s = 0.0, d0 = -O[2], s_eye = SS_INF;
+    double thick = t->o->thickness;
+    int ix, iy, su, sv, nx = t->bil ? c->W - 1 : c->W, ny = t->bil ? c->H - 1 : c->H;
+    if (c->persp) {
+        double du = w[0] * d0 + O[0] * w[2], dv = -(w[1] * d0 + O[1] * w[2]);
+        su = du > 0.0 ? 1 : (du < 0.0 ? -1 : 0);
+        sv = dv > 0.0 ? 1 : (dv < 0.0 ? -1 : 0);
+        if (w[2] > 0.0) s_eye = d0 / w[2] * (1.0 - 1e-12); /* behind the eye past this */
+    } else {
+        su = w[0] > 0.0 ? 1 : (w[0] < 0.0 ? -1 : 0);
+        sv = w[1] < 0.0 ? 1 : (w[1] > 0.0 ? -1 : 0);
+    }
+    ss_rt_screen(c, O, w, 0.0, &u, &v);
+    if (!(u - off >= 0.0 && v - off >= 0.0)) return -1.0;
+    ix = (int)floor(u - off);
+    iy = (int)floor(v - off);
+    if (ix >= nx || iy >= ny) return -1.0;
+    for (;;) {
+        double s_u = su > 0 ? ss_rt_cross(c, O, w, 0, (double)(ix + 1) + off)
+                            : (su < 0 ? ss_rt_cross(c, O, w, 0, (double)ix + off) : SS_INF);
+        double s_v = sv > 0 ? ss_rt_cross(c, O, w, 1, (double)(iy + 1) + off)
+                            : (sv < 0 ? ss_rt_cross(c, O, w, 1, (double)iy + off) : SS_INF);
+        double s_next = s_u < s_v ? s_u : s_v, s_end = s_next, da, db;
+        int last = 0;
+        if (!(s_end >= s)) s_end = s;
+        if (s_end >= t->maxdist) { s_end = t->maxdist; last = 1; }
+        if (s_end >= s_eye) { s_end = s_eye; last = 1; }
+        if (s_end == SS_INF) { /* the ray stays in this cell: the field is constant along it */
+            double zb, qu, qv;
+            if (w[2] >= 0.0) return -1.0;
+            zb = t->bil ? ss_rt_bilinear(t, ix, iy, u, v)
+                        : ss_sample(c, t->depth, 0, u, v, ix, iy, &qu, &qv);
+            da = d0 - s * w[2];
+            if (zb != zb) return -1.0;
+            if (ss_rt_in(t, da, zb)) return s;
+            if (thick > 0.0 && da >= zb + thick) return -1.0;
+            da = (d0 - zb) / w[2]; /* where the descending ray reaches the depth */
+            return da > s ? da : s;
+        }
+        da = d0 - s * w[2];
+        db = d0 - s_end * w[2];
+        if (!t->bil) {
+            double zb = ss_tex(c, t->depth, ix, iy);
+            if (!ss_bg(c, zb)) {
+                if (ss_rt_in(t, da, zb)) return s;
+                if (db > da && da <= zb && db > zb) { /* entering from above */
+                    double sh = (d0 - zb) / w[2];
+                    return sh > s ? sh : s;
+                }
+                if (thick > 0.0 && db < da && da >= zb + thick && db < zb + thick) {
+                    double sh = (d0 - zb - thick) / w[2];
+                    return sh > s ? sh : s;
+                }
+            }
+        } else {
+            double ss3[3], lo = s, hi = -1.0;
+            int m, it;
+            ss3[0] = s;
+            ss3[1] = 0.5 * (s + s_end);
+            ss3[2] = s_end;
+            for (m = 0; m < 3; m++) {
+                double uu, vv, zb;
+                ss_rt_screen(c, O, w, ss3[m], &uu, &vv);
+                zb = ss_rt_bilinear(t, ix, iy, uu, vv);
+                if (ss_rt_in(t, d0 - ss3[m] * w[2], zb)) {
+                    hi = ss3[m];
+                    break;
+                }
+                lo = ss3[m];
+            }
+            if (hi >= 0.0) {
+                if (hi == s) return s;
+                for (it = 0; it < t->o->refine_iterations; it++) {
+                    double mid = 0.5 * (lo + hi), uu, vv;
+                    ss_rt_screen(c, O, w, mid, &uu, &vv);
+                    if (ss_rt_in(t, d0 - mid * w[2], ss_rt_bilinear(t, ix, iy, uu, vv))) hi = mid;
+                    else lo = mid;
+                }
+                return 0.5 * (lo + hi);
+            }
+        }
+        if (last) return -1.0;
+        /* rising above every depth, or sinking below every depth plus the thickness */
+        if (w[2] > 0.0 && db < t->zmin) return -1.0;
+        if (w[2] < 0.0 && thick > 0.0 && db > t->zmax + thick) return -1.0;
+        if (s_u <= s_v) ix += su;
+        if (s_v <= s_u) iy += sv;
+        if (ix < 0 || iy < 0 || ix >= nx || iy >= ny) return -1.0;
+        s = s_end;
+        if (t->bil) ss_rt_screen(c, O, w, s, &u, &v);
+    }
+}
+
+hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth, const float *normals,
+                                 const hfvis_ssao_rt_options *opts, float *ao, ptrdiff_t ao_stride)
+{
+    ss_cam c;
+    ss_fall f;
+    ss_rt t;
+    hfvis_ssao_rt_options o;
+    float *nrm = NULL;
+    int x, y, W, r;
+    if (ss_cam_load(cam, &c) != HFVIS_OK || hfvis_ssao_rt_options_resolve(opts, &o) != HFVIS_OK ||
+        !depth || !ao)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    W = c.W - 2 * c.gx;
+    if (ao_stride < W) return HFVIS_ERR_INVALID_ARGUMENT;
+    ss_fall_load(&o.falloff, &f);
+    if (!normals) {
+        size_t b = ss_bytes3((size_t)c.stride, (size_t)c.H, 3 * sizeof(float));
+        if (!b || !(nrm = (float *)ss_alloc(o.alloc, b))) return HFVIS_ERR_OUT_OF_MEMORY;
+        ss_normals_fill(&c, depth, nrm);
+        normals = nrm;
+    }
+    t.c = &c;
+    t.depth = depth;
+    t.o = &o;
+    t.bil = o.sampling == HFVIS_SSAO_SAMPLING_BILINEAR;
+    t.maxdist = o.max_distance > 0.0 ? o.max_distance : f.support;
+    t.zmin = SS_INF;
+    t.zmax = 0.0;
+    for (y = 0; y < c.H; y++)
+        for (x = 0; x < c.W; x++) {
+            double z = ss_tex(&c, depth, x, y);
+            if (ss_bg(&c, z)) continue;
+            if (z < t.zmin) t.zmin = z;
+            if (z > t.zmax) t.zmax = z;
+        }
+    for (y = c.gy; y < c.H - c.gy; y++)
+        for (x = c.gx; x < c.W - c.gx; x++) {
+            double zc = ss_tex(&c, depth, x, y), acc = 0.0, a = 0.0;
+            if (!ss_bg(&c, zc)) {
+                const float *np = normals + 3 * ((ptrdiff_t)y * c.stride + x);
+                double P[3], n[3], O[3], T[3], B[3], sg, aa, bb, xi1, xi2;
+                ss_unproject(&c, (double)x + 0.5, (double)y + 0.5, zc, P);
+                n[0] = (double)np[0];
+                n[1] = (double)np[1];
+                n[2] = (double)np[2];
+                if (!ss_normalize3(n)) {
+                    if (c.persp) {
+                        n[0] = -P[0];
+                        n[1] = -P[1];
+                        n[2] = -P[2];
+                        ss_normalize3(n);
+                    } else {
+                        n[0] = n[1] = 0.0;
+                        n[2] = 1.0;
+                    }
+                }
+                /* orthonormal basis (Duff et al. 2017) */
+                sg = n[2] >= 0.0 ? 1.0 : -1.0;
+                aa = -1.0 / (sg + n[2]);
+                bb = n[0] * n[1] * aa;
+                T[0] = 1.0 + sg * n[0] * n[0] * aa;
+                T[1] = sg * bb;
+                T[2] = -sg * n[0];
+                B[0] = bb;
+                B[1] = sg + n[1] * n[1] * aa;
+                B[2] = -n[1];
+                O[0] = P[0] + o.bias * zc * n[0];
+                O[1] = P[1] + o.bias * zc * n[1];
+                O[2] = P[2] + o.bias * zc * n[2];
+                xi1 = ss_hash01((uint32_t)x, (uint32_t)y, 1u, o.seed);
+                xi2 = ss_hash01((uint32_t)x, (uint32_t)y, 2u, o.seed);
+                for (r = 0; r < o.rays; r++) {
+                    double u1 = (double)r / (double)o.rays + xi1, u2 = ss_radical2((uint32_t)r) + xi2;
+                    double rr, ph, lx, ly, lz, w[3], hit;
+                    if (u1 >= 1.0) u1 -= 1.0;
+                    if (u2 >= 1.0) u2 -= 1.0;
+                    rr = sqrt(u1);
+                    ph = 2.0 * SS_PI * u2;
+                    lx = rr * cos(ph);
+                    ly = rr * sin(ph);
+                    lz = sqrt(1.0 - u1 > 0.0 ? 1.0 - u1 : 0.0);
+                    w[0] = lx * T[0] + ly * B[0] + lz * n[0];
+                    w[1] = lx * T[1] + ly * B[1] + lz * n[1];
+                    w[2] = lx * T[2] + ly * B[2] + lz * n[2];
+                    hit = ss_rt_ray(&t, O, w);
+                    if (hit >= 0.0) acc += ss_rho(&f, hit);
+                }
+                a = acc / (double)o.rays;
+            }
+            ao[(ptrdiff_t)(y - c.gy) * ao_stride + (x - c.gx)] = (float)a;
+        }
+    ss_free(o.alloc, nrm);
+    return HFVIS_OK;
+}
+
+/* ========================================================================================== */
+/* 8. Analytic depth buffers (spec §6 T1-T7)                                                  */
+/* ========================================================================================== */
+
+static int ss_scene_ok(const hfvis_ssao_scene *s)
+{
+    if (!s || !ss_finite(s->base_depth) || !(s->base_depth > 0.0)) return 0;
+    switch (s->kind) {
+    case HFVIS_SSAO_SCENE_PLANE:
+        return ss_finite(s->slope_x) && ss_finite(s->slope_y);
+    case HFVIS_SSAO_SCENE_STEP:
+        return ss_finite(s->x0) && ss_finite(s->height) && s->base_depth - s->height > 0.0;
+    case HFVIS_SSAO_SCENE_VGROOVE:
+        return ss_finite(s->x0) && s->angle > 0.0 && s->angle < 0.5 * SS_PI;
+    case HFVIS_SSAO_SCENE_PIT:
+        return ss_finite(s->x0) && ss_finite(s->y0) && ss_finite(s->radius) && s->radius > 0.0;
+    }
+    return 0;
+}
+
+/* Keep candidate t if valid and smaller. */
+static void ss_take(double t, int ok, double *best, int *which, int id)
+{
+    if (ok && t > 0.0 && ss_finite(t) && t < *best) {
+        *best = t;
+        *which = id;
+    }
+}
+
+/* First surface along the pixel ray: depth (+inf for a miss) and normal. Orthographic rays are
+ * vertical through (rx, ry); perspective rays are t (rx, ry, -1). */
+static double ss_scene_hit(const hfvis_ssao_scene *s, int persp, double rx, double ry, double n[3])
+{
+    double Z0 = s->base_depth, best = SS_INF, x;
+    int which = -1;
+    n[0] = n[1] = 0.0;
+    n[2] = 1.0;
+    switch (s->kind) {
+    case HFVIS_SSAO_SCENE_PLANE: {
+        double a = s->slope_x, b = s->slope_y, l = sqrt(a * a + b * b + 1.0);
+        if (persp) {
+            double den = 1.0 + a * rx + b * ry;
+            ss_take(Z0 / den, den > 0.0, &best, &which, 0);
+        } else {
+            ss_take(Z0 - (a * rx + b * ry), 1, &best, &which, 0);
+        }
+        n[0] = -a / l;
+        n[1] = -b / l;
+        n[2] = 1.0 / l;
+        break;
+    }
+    case HFVIS_SSAO_SCENE_STEP: {
+        double h = s->height, lo = Z0 - h < Z0 ? Z0 - h : Z0, hi = Z0 - h < Z0 ? Z0 : Z0 - h;
+        if (persp) {
+            ss_take(Z0, Z0 * rx < s->x0, &best, &which, 0);
+            ss_take(Z0 - h, (Z0 - h) * rx >= s->x0, &best, &which, 1);
+            if (rx != 0.0) {
+                double t = s->x0 / rx;
+                ss_take(t, t >= lo && t <= hi, &best, &which, 2);
+            }
+        } else {
+            ss_take(rx < s->x0 ? Z0 : Z0 - h, 1, &best, &which, rx < s->x0 ? 0 : 1);
+        }
+        if (which == 2) {
+            n[0] = h > 0.0 ? -1.0 : 1.0;
+            n[2] = 0.0;
+        }
+        break;
+    }
+    case HFVIS_SSAO_SCENE_VGROOVE: {
+        double tb = tan(s->angle), l = sqrt(1.0 + tb * tb);
+        if (persp) {
+            double d1 = 1.0 + rx * tb, d2 = 1.0 - rx * tb, t1 = (Z0 + s->x0 * tb) / d1,
+                   t2 = (Z0 - s->x0 * tb) / d2;
+            ss_take(t1, d1 > 0.0 && t1 * rx >= s->x0, &best, &which, 0);
+            ss_take(t2, d2 > 0.0 && t2 * rx < s->x0, &best, &which, 1);
+            x = best * rx;
+        } else {
+            x = rx;
+            ss_take(Z0 - fabs(rx - s->x0) * tb, 1, &best, &which, rx >= s->x0 ? 0 : 1);
+        }
+        if (which >= 0 && x != s->x0) {
+            n[0] = (x > s->x0 ? -tb : tb) / l;
+            n[2] = 1.0 / l;
+        }
+        break;
+    }
+    default: { /* PIT */
+        double R = s->radius, dx, dy, C[3], X[3];
+        if (persp) {
+            dx = Z0 * rx - s->x0;
+            dy = Z0 * ry - s->y0;
+            if (dx * dx + dy * dy >= R * R) {
+                ss_take(Z0, 1, &best, &which, 0);
+            } else {
+                double rr = rx * rx + ry * ry + 1.0, rc = rx * s->x0 + ry * s->y0 + Z0;
+                double cc = s->x0 * s->x0 + s->y0 * s->y0 + Z0 * Z0 - R * R, disc = rc * rc - rr * cc;
+                if (disc < 0.0) disc = 0.0;
+                ss_take((rc + sqrt(disc)) / rr, 1, &best, &which, 1);
+            }
+            X[0] = best * rx;
+            X[1] = best * ry;
+        } else {
+            dx = rx - s->x0;
+            dy = ry - s->y0;
+            X[0] = rx;
+            X[1] = ry;
+            if (dx * dx + dy * dy >= R * R) ss_take(Z0, 1, &best, &which, 0);
+            else ss_take(Z0 + sqrt(R * R - dx * dx - dy * dy), 1, &best, &which, 1);
+        }
+        if (which == 1) {
+            C[0] = s->x0;
+            C[1] = s->y0;
+            C[2] = -Z0;
+            X[2] = -best;
+            n[0] = (C[0] - X[0]) / R;
+            n[1] = (C[1] - X[1]) / R;
+            n[2] = (C[2] - X[2]) / R;
+            ss_normalize3(n);
+        }
+        break;
+    }
+    }
+    if (which < 0) n[0] = n[1] = n[2] = 0.0;
+    return best;
+}
+
+hfvis_status hfvis_ssao_scene_render(const hfvis_camera *cam, const hfvis_ssao_scene *scene,
+                                     float *depth, float *normals)
+{
+    ss_cam c;
+    int x, y;
+    if (ss_cam_load(cam, &c) != HFVIS_OK || !ss_scene_ok(scene) || !depth)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    for (y = 0; y < c.H; y++)
+        for (x = 0; x < c.W; x++) {
+            double P[3], n[3], z;
+            ptrdiff_t o = (ptrdiff_t)y * c.stride + x;
+            ss_unproject(&c, (double)x + 0.5, (double)y + 0.5, 1.0, P);
+            z = ss_scene_hit(scene, c.persp, P[0], P[1], n);
+            depth[o] = (float)z;
+            if (normals) {
+                normals[3 * o] = (float)n[0];
+                normals[3 * o + 1] = (float)n[1];
+                normals[3 * o + 2] = (float)n[2];
+            }
+        }
+    return HFVIS_OK;
+}

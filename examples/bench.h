@@ -9,4 +9,5 @@ void bench_iv(int quick);
 void bench_bvh(int quick);
 void bench_gi2(int quick);
 void bench_cons(int quick);
+void bench_ssao(int quick);
 #endif
