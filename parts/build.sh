@@ -42,8 +42,8 @@ mv "$out/hfvis.c.tmp" "$out/hfvis.c"
 case " $name $* " in *" ssao "*) [ -f parts/ssao.c ] && cp parts/ssao.c "$out/ssao_dev.c" || cp ssao.c "$out/ssao_dev.c"
   [ -f parts/ssao_decl.h ] && decls="$decls parts/ssao_decl.h";;
 *) cp ssao.c "$out/ssao_dev.c";; esac
-# ssao.c appended parts: lk (Laine-Karras)
-for p in lk; do
+# ssao.c appended parts: ssaob (P4 far-field AO), lk (Laine-Karras)
+for p in ssaob lk; do
   [ -f "parts/$p.c" ] || continue
   case "$want" in *" $p "*)
     printf '\n/* ---- parts/%s.c ---- */\n' "$p" >> "$out/ssao_dev.c"
