@@ -899,6 +899,289 @@ TEST(vf_multi_object)
     hfvis_bvh_free(NULL, &bvh);
     hfvis_mesh_free(NULL, &knot);
 }
+/* Hard and soft shadows of a sphere over a floor under a spherical light ([G12] §4.5.2): inside
+ * the umbra of a point light the reference is 0, outside the shadow 1 (closed-form cone), and the
+ * field agrees with ray casting on most points. */
+TEST(vf_shadows)
+{
+    const double c0[3] = {0.0, 0.0, 0.0}, light[3] = {0.0, 0.0, 6.0}, h = 2.0, r = 0.5;
+    enum { G = 41, P = G * G };
+    static float pts[3 * P], hard[P], hard_ref[P], soft[P], soft_ref[P];
+    hfvis_mesh ico;
+    hfvis_bvh bvh;
+    hfvis_visfield vf;
+    hfvis_visfield_object ob;
+    hfvis_visfield_shadow_options o;
+    /* umbra of a point light at height L over a sphere at height h: a disc of radius
+     * L tan(asin(r/(L - h))) on the floor */
+    double L = light[2], rad = L * tan(asin(r / (L - h))), diff = 0.0, agree = 0.0;
+    int p, inside_ok = 1, outside_ok = 1, ordered = 1;
+    CHECK_EQ_STATUS(hfvis_mesh_icosphere(NULL, c0, r, 4, &ico), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_bvh_build(&ico, NULL, &bvh), HFVIS_OK);
+    CHECK(field_init(&vf, c0, 0.8, 16, 32, HFVIS_DIRMAP_CONCENTRIC, HFVIS_VISFIELD_U8));
+    CHECK_EQ_STATUS(hfvis_visfield_build(&ico, NULL, &vf), HFVIS_OK);
+    ob = make_object(&vf, &ico, &bvh);
+    ob.object_to_world[14] = h;
+    for (p = 0; p < P; p++) {
+        pts[3 * p] = (float)(-2.0 + 4.0 * (p % G) / (G - 1));
+        pts[3 * p + 1] = (float)(-2.0 + 4.0 * (p / G) / (G - 1));
+        pts[3 * p + 2] = 0.0f;
+    }
+    memset(&o, 0, sizeof o);
+    o.samples = 1;
+    CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pts, P, light, 0.0, &o, hard), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_visfield_soft_shadow_reference(&ob, 1, pts, P, light, 0.0, &o, hard_ref), HFVIS_OK);
+    o.samples = 0; /* 20 */
+    CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pts, P, light, 1.0, &o, soft), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_visfield_soft_shadow_reference(&ob, 1, pts, P, light, 1.0, &o, soft_ref), HFVIS_OK);
+    for (p = 0; p < P; p++) {
+        double x = pts[3 * p], y = pts[3 * p + 1], rr = sqrt(x * x + y * y);
+        if (rr < 0.9 * rad && (hard_ref[p] != 0.0f || hard[p] != 0.0f)) inside_ok = 0;
+        if (rr > 1.1 * rad && (hard_ref[p] != 1.0f || hard[p] != 1.0f)) outside_ok = 0;
+        agree += hard[p] == hard_ref[p];
+        diff += fabs((double)soft[p] - (double)soft_ref[p]);
+        if (rr < 0.5 * rad && soft_ref[p] > 0.5f) ordered = 0;   /* the soft shadow's core */
+        if (rr > 2.5 * rad && soft_ref[p] != 1.0f) ordered = 0;  /* fully lit far away */
+    }
+    printf("  point light: umbra radius %.3f; VF agrees with ray casting on %.1f %% of %d floor points;\n"
+           "  light of radius 1, 20 rays: mean |VF - ray cast| %.4f\n", rad, 100.0 * agree / P, P, diff / P);
+    CHECK(inside_ok);
+    CHECK(outside_ok);
+    CHECK(ordered);
+    CHECK(agree / P > 0.97);
+    CHECK(diff / P < 0.02);
+    field_done(&vf);
+    hfvis_bvh_free(NULL, &bvh);
+    hfvis_mesh_free(NULL, &ico);
+}
+
+/* Tracing and reflections with the normal-carrying variant ([G12] §4.5.2): hit points, distances
+ * and normals against ray casting; the mirror and glossy reflection ray sets. */
+TEST(vf_trace_reflect)
+{
+    const double c0[3] = {0.0, 0.0, 0.0};
+    hfvis_mesh knot;
+    hfvis_bvh bvh;
+    hfvis_visfield vf;
+    hfvis_visfield_object ob;
+    double c[3], R, T[3] = {0.0, 0.0, 1.5}, axis[3] = {0.0, 0.6, 0.8};
+    double sum_d = 0.0, sum_a = 0.0;
+    int q, both = 0, mism = 0, N = 4000, bad_refl = 0, lobe_ok = 1;
+    CHECK_EQ_STATUS(hfvis_mesh_torus_knot(NULL, c0, 0.5, 2, 3, 160, 12, &knot), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_bvh_build(&knot, NULL, &bvh), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_visfield_bounding_sphere(&knot, c, &R), HFVIS_OK);
+    CHECK(field_init(&vf, c, R, 16, 64, HFVIS_DIRMAP_CONCENTRIC, HFVIS_VISFIELD_NORMAL));
+    CHECK_EQ_STATUS(hfvis_visfield_build(&knot, NULL, &vf), HFVIS_OK);
+    ob = make_object(&vf, &knot, &bvh);
+    rigid(ob.object_to_world, axis, 0.4, 1.0, T);
+    rng_state = 21;
+    for (q = 0; q < N; q++) { /* rays from the floor toward random points near the object */
+        double o[3], d[3], tg[3], len;
+        hfvis_visfield_trace_hit a, b;
+        int k;
+        o[0] = 4.0 * rng_unit() - 2.0;
+        o[1] = 4.0 * rng_unit() - 2.0;
+        o[2] = 0.0;
+        for (k = 0; k < 3; k++) tg[k] = T[k] + (2.0 * rng_unit() - 1.0) * R * 0.8;
+        for (k = 0; k < 3; k++) d[k] = tg[k] - o[k];
+        len = sqrt(dot3(d, d));
+        for (k = 0; k < 3; k++) d[k] /= len;
+        CHECK_EQ_STATUS(hfvis_visfield_trace(&ob, 1, o, d, 0.0, &a), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_visfield_trace_reference(&ob, 1, o, d, 0.0, &b), HFVIS_OK);
+        if ((a.object == HFVIS_VISFIELD_NONE) != (b.object == HFVIS_VISFIELD_NONE)) {
+            mism++;
+        } else if (a.object == 0) {
+            double e = fabs(a.point[0] - (o[0] + a.distance * d[0]));
+            both++;
+            sum_d += fabs(a.distance - b.distance) / R;
+            sum_a += acos(fmin(1.0, dot3(a.normal, b.normal))) * 180.0 / PI;
+            if (e > 1e-12 || fabs(sqrt(dot3(a.normal, a.normal)) - 1.0) > 1e-9) mism += 1000000;
+        }
+        /* the mirror reflection off the floor of the ray going down: the same ray upward */
+        if (q % 8 == 0) {
+            double inc[3] = {d[0], d[1], -d[2]}, up[3] = {0.0, 0.0, 1.0}, o2[3];
+            hfvis_visfield_trace_hit r1[4], r2[4];
+            hfvis_visfield_reflect_options ro;
+            int i;
+            memset(&ro, 0, sizeof ro);
+            CHECK_EQ_STATUS(hfvis_visfield_reflect(&ob, 1, o, up, inc, &ro, r1), HFVIS_OK);
+            if (r1[0].object != a.object || fabs(r1[0].distance - a.distance) > 1e-9 || r1[3].distance != r1[0].distance)
+                bad_refl++;
+            CHECK_EQ_STATUS(hfvis_visfield_reflect_reference(&ob, 1, o, up, inc, &ro, r2), HFVIS_OK);
+            if (r2[0].object != b.object || fabs(r2[0].distance - b.distance) > 1e-6) bad_refl++;
+            /* glossy: 16 rays within the Phong lobe, all above the floor or misses */
+            ro.rays = 16;
+            ro.shininess = 50.0;
+            {
+                hfvis_visfield_trace_hit g[16];
+                CHECK_EQ_STATUS(hfvis_visfield_reflect(&ob, 1, o, up, inc, &ro, g), HFVIS_OK);
+                for (i = 0; i < 16; i++)
+                    if (g[i].object == 0) {
+                        for (k = 0; k < 3; k++) o2[k] = g[i].point[k] - o[k];
+                        len = sqrt(dot3(o2, o2));
+                        /* Phong 50: the lobe ray i has cos >= ((0.5)/16)^(1/51) ~ 0.934 */
+                        if (dot3(o2, d) / len < 0.93 || o2[2] <= 0.0) lobe_ok = 0;
+                    }
+            }
+        }
+    }
+    printf("  knot (NORMAL format, K = 1090, D = 64), %d rays: hit/miss disagreement %.2f %%, "
+           "mean |dd|/R %.4f, mean normal error %.1f deg\n", N, 100.0 * mism / N, sum_d / both,
+           sum_a / both);
+    CHECK(mism < N / 10);
+    CHECK(sum_d / both < 0.07);  /* regression bound (measured 0.056) */
+    CHECK(sum_a / both < 25.0);  /* regression bound (measured 17.7 deg) */
+    CHECK(bad_refl == 0);
+    CHECK(lobe_ok);
+    field_done(&vf);
+    hfvis_bvh_free(NULL, &bvh);
+    hfvis_mesh_free(NULL, &knot);
+}
+/* The thesis' Fig. 35 setting: a tessellated corner (floor and two walls, 3 x 33 x 33 receiver
+ * vertices, 256 concentric rays each) around an occluder; RMS of the obscurance against ray casting
+ * with the same rays, on the 8-bit scale (x 255), per (K, D). Plus outside-ray statistics against
+ * the mesh (hit/miss disagreement, mean |d - d_exact|/R) for rays from 3R toward the mesh's box. */
+#define CORNER_N 33
+static void corner_points(double L, float *pts, float *nrm)
+{
+    int f, i, j;
+    size_t p = 0;
+    for (f = 0; f < 3; f++)
+        for (j = 0; j < CORNER_N; j++)
+            for (i = 0; i < CORNER_N; i++, p++) {
+                double u = L * i / (CORNER_N - 1), v = L * j / (CORNER_N - 1);
+                double x[3], n[3] = {0.0, 0.0, 0.0};
+                int a;
+                if (f == 0) { x[0] = u; x[1] = v; x[2] = 0.0; n[2] = 1.0; }      /* floor */
+                else if (f == 1) { x[0] = 0.0; x[1] = u; x[2] = v; n[0] = 1.0; } /* wall x = 0 */
+                else { x[0] = u; x[1] = 0.0; x[2] = v; n[1] = 1.0; }             /* wall y = 0 */
+                for (a = 0; a < 3; a++) {
+                    pts[3 * p + a] = (float)x[a];
+                    nrm[3 * p + a] = (float)n[a];
+                }
+            }
+}
+
+typedef struct mesh_table_cell {
+    double mismatch, mean_err, ao_rms, build_s;
+} mesh_table_cell;
+
+/* One table: rows ns[], columns Ds[]; returns the cells (rows x cols). */
+static void mesh_table(const char *name, const hfvis_mesh *mesh, const double T[3], double L,
+                       const int *ns, int rows, const int *Ds, int cols, int rays,
+                       mesh_table_cell *cells)
+{
+    enum { P = 3 * CORNER_N * CORNER_N };
+    static float pts[3 * P], nrm[3 * P], ref[P], fast[P];
+    hfvis_bvh bvh;
+    hfvis_visfield vf0;
+    hfvis_visfield_object ob;
+    hfvis_visfield_build_options bo;
+    hfvis_visfield_hit *exact;
+    double c[3], R, lo[3], hi[3];
+    double (*org)[3], (*dir)[3];
+    int a, b, q, k;
+    exact = (hfvis_visfield_hit *)malloc(sizeof *exact * (size_t)rays);
+    org = (double (*)[3])malloc(sizeof *org * (size_t)rays);
+    dir = (double (*)[3])malloc(sizeof *dir * (size_t)rays);
+    CHECK(exact && org && dir);
+    if (!exact || !org || !dir) goto out;
+    CHECK_EQ_STATUS(hfvis_bvh_build(mesh, NULL, &bvh), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_visfield_bounding_sphere(mesh, c, &R), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_mesh_bounds(mesh, lo, hi), HFVIS_OK);
+    memset(&vf0, 0, sizeof vf0);
+    for (k = 0; k < 3; k++) vf0.center[k] = c[k];
+    vf0.radius = R;
+    vf0.positions_n = 1;
+    vf0.dir_res = 1;
+    ob = make_object(&vf0, mesh, &bvh);
+    for (k = 0; k < 3; k++) ob.object_to_world[12 + k] = T[k];
+    corner_points(L, pts, nrm);
+    CHECK_EQ_STATUS(hfvis_visfield_ambient_occlusion_reference(&ob, 1, pts, nrm, P, NULL, ref), HFVIS_OK);
+    rng_state = 4242;
+    for (q = 0; q < rays; q++) {
+        double e[3], len;
+        rng_dir(e);
+        for (k = 0; k < 3; k++) {
+            org[q][k] = c[k] + 3.0 * R * e[k];
+            dir[q][k] = lo[k] + (hi[k] - lo[k]) * rng_unit() - org[q][k];
+        }
+        len = sqrt(dot3(dir[q], dir[q]));
+        for (k = 0; k < 3; k++) dir[q][k] /= len;
+        CHECK_EQ_STATUS(hfvis_visfield_query_reference(&vf0, mesh, &bvh, org[q], dir[q], 0.0, &exact[q]),
+                        HFVIS_OK);
+    }
+    printf("  %s (%zu triangles) in a corner, %d receivers x 256 rays; %d outside rays:\n"
+           "  hit/miss disagreement %% / mean |d - d_exact|/R / AO RMS x 255\n  %6s", name,
+           mesh->triangle_count, P, rays, "K \\ D");
+    for (b = 0; b < cols; b++) printf("   %16d x %-4d", Ds[b], Ds[b]);
+    printf("\n");
+    for (a = 0; a < rows; a++) {
+        printf("  %6zu", hfvis_visfield_position_count(ns[a]));
+        for (b = 0; b < cols; b++) {
+            mesh_table_cell *cell = cells + a * cols + b;
+            hfvis_visfield vf;
+            int mism = 0, both = 0;
+            size_t p;
+            double sum = 0.0, rms = 0.0;
+            CHECK(field_init(&vf, c, R, ns[a], Ds[b], HFVIS_DIRMAP_CONCENTRIC, HFVIS_VISFIELD_U8));
+            memset(&bo, 0, sizeof bo);
+            bo.bvh = &bvh;
+            CHECK_EQ_STATUS(hfvis_visfield_build(mesh, &bo, &vf), HFVIS_OK);
+            for (q = 0; q < rays; q++) {
+                hfvis_visfield_hit h;
+                hfvis_visfield_query(&vf, org[q], dir[q], 0.0, &h);
+                if ((h.result == HFVIS_VISFIELD_HIT) != (exact[q].result == HFVIS_VISFIELD_HIT)) mism++;
+                else if (h.result == HFVIS_VISFIELD_HIT) {
+                    sum += fabs(h.distance - exact[q].distance) / R;
+                    both++;
+                }
+            }
+            ob.field = &vf;
+            CHECK_EQ_STATUS(hfvis_visfield_ambient_occlusion(&ob, 1, pts, nrm, P, NULL, fast), HFVIS_OK);
+            for (p = 0; p < P; p++) {
+                double d = 255.0 * ((double)fast[p] - (double)ref[p]);
+                rms += d * d;
+            }
+            cell->mismatch = (double)mism / rays;
+            cell->mean_err = both ? sum / both : 0.0;
+            cell->ao_rms = sqrt(rms / P);
+            printf("   %5.2f%% / %.4f / %5.2f", 100.0 * cell->mismatch, cell->mean_err, cell->ao_rms);
+            field_done(&vf);
+        }
+        printf("\n");
+    }
+    hfvis_bvh_free(NULL, &bvh);
+out:
+    free(exact);
+    free(org);
+    free(dir);
+}
+
+TEST(vf_table_meshes)
+{
+    static const int ns[3] = {4, 8, 16}, Ds[2] = {16, 32};
+    const double c0[3] = {0.0, 0.0, 0.0}, Tt[3] = {1.9, 1.6, 0.0}, Tr[3] = {1.6, 1.6, 0.35};
+    mesh_table_cell cells[6];
+    hfvis_mesh teapot, torus;
+    int b;
+    CHECK_EQ_STATUS(hfvis_mesh_teapot(NULL, 2, &teapot), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_mesh_torus(NULL, c0, 1.0, 0.35, 48, 24, &torus), HFVIS_OK);
+    mesh_table("teapot", &teapot, Tt, 3.6, ns, 3, Ds, 2, 10000, cells);
+    for (b = 0; b < 2; b++) { /* positional samples dominate the error (Fig. 35) */
+        CHECK(cells[4 + b].ao_rms < cells[b].ao_rms);
+        CHECK(cells[4 + b].mismatch < cells[b].mismatch);
+    }
+    CHECK(cells[5].ao_rms < 8.0); /* regression bound at K = 1090, D = 32 */
+    mesh_table("torus", &torus, Tr, 3.2, ns, 3, Ds, 2, 10000, cells);
+    for (b = 0; b < 2; b++) {
+        CHECK(cells[4 + b].ao_rms < cells[b].ao_rms);
+        CHECK(cells[4 + b].mismatch < cells[b].mismatch);
+    }
+    CHECK(cells[5].ao_rms < 8.0);
+    hfvis_mesh_free(NULL, &teapot);
+    hfvis_mesh_free(NULL, &torus);
+}
 int main(int argc, char **argv)
 {
     const char *only = argc > 1 && argv[1][0] != '-' ? argv[1] : NULL;
@@ -917,5 +1200,8 @@ int main(int argc, char **argv)
     RUN_IF(vf_ao_convex_no_self_occlusion);
     RUN_IF(vf_ao_wall);
     RUN_IF(vf_multi_object);
+    RUN_IF(vf_shadows);
+    RUN_IF(vf_trace_reflect);
+    RUN_IF(vf_table_meshes);
     return TEST_DONE();
 }
