@@ -1182,6 +1182,169 @@ TEST(vf_table_meshes)
     hfvis_mesh_free(NULL, &teapot);
     hfvis_mesh_free(NULL, &torus);
 }
+/* ========================================================================================== */
+/* file codec                                                                                 */
+/* ========================================================================================== */
+
+static void put32(unsigned char *p, uint32_t v)
+{
+    p[0] = (unsigned char)v;
+    p[1] = (unsigned char)(v >> 8);
+    p[2] = (unsigned char)(v >> 16);
+    p[3] = (unsigned char)(v >> 24);
+}
+static void put64(unsigned char *p, uint64_t v)
+{
+    put32(p, (uint32_t)v);
+    put32(p + 4, (uint32_t)(v >> 32));
+}
+static void putf64(unsigned char *p, double d)
+{
+    uint64_t v;
+    memcpy(&v, &d, 8);
+    put64(p, v);
+}
+
+/* Decode must fail with `want` and leave out untouched. */
+static int decode_fails(const unsigned char *data, size_t size, hfvis_status want)
+{
+    hfvis_visfield out;
+    hfvis_status s;
+    memset(&out, 0x5A, sizeof out);
+    s = hfvis_visfield_decode(data, size, NULL, &out);
+    if (s == HFVIS_OK) hfvis_visfield_free(NULL, &out);
+    {
+        unsigned char pat[sizeof out];
+        memset(pat, 0x5A, sizeof pat);
+        if (s != HFVIS_OK && memcmp(&out, pat, sizeof out) != 0) return 0;
+    }
+    return s == want;
+}
+
+TEST(vf_codec)
+{
+    const double c0[3] = {0.0, 0.0, 0.0};
+    hfvis_mesh torus;
+    int f, m, bad = 0;
+    size_t cut;
+    CHECK_EQ_STATUS(hfvis_mesh_torus(NULL, c0, 1.0, 0.4, 10, 6, &torus), HFVIS_OK);
+    for (f = 0; f <= 4; f++)
+        for (m = 0; m <= 3; m++) {
+            hfvis_visfield vf, back;
+            double c[3], R;
+            unsigned char *buf, *bad_buf;
+            size_t need, written = 0, K, t, texels;
+            CHECK_EQ_STATUS(hfvis_visfield_bounding_sphere(&torus, c, &R), HFVIS_OK);
+            CHECK(field_init(&vf, c, R, 1 + (f + m) % 3, 3 + m, (hfvis_dirmap)m, (hfvis_visfield_format)f));
+            CHECK_EQ_STATUS(hfvis_visfield_build(&torus, NULL, &vf), HFVIS_OK);
+            need = hfvis_visfield_encode_size(&vf);
+            CHECK(need == HFVIS_VISFIELD_FILE_HEADER + vf.maps_size);
+            buf = (unsigned char *)malloc(need + 1);
+            bad_buf = (unsigned char *)malloc(need + 1);
+            CHECK(buf && bad_buf);
+            if (!buf || !bad_buf) { free(buf); free(bad_buf); field_done(&vf); continue; }
+            memset(buf, 0x77, need + 1);
+            CHECK_EQ_STATUS(hfvis_visfield_encode(&vf, buf, need - 1, &written), HFVIS_ERR_BUFFER_TOO_SMALL);
+            CHECK(buf[0] == 0x77 && written == 0);
+            CHECK_EQ_STATUS(hfvis_visfield_encode(&vf, buf, need, &written), HFVIS_OK);
+            CHECK(written == need && buf[need] == 0x77);
+            CHECK(memcmp(buf, "HFVFIELD", 8) == 0);
+            CHECK(buf[12] == (f ? f : 1) && buf[16] == (m ? m : 3)); /* explicit enums */
+            CHECK_EQ_STATUS(hfvis_visfield_decode(buf, need, NULL, &back), HFVIS_OK);
+            if (back.maps_size != vf.maps_size || memcmp(back.maps, vf.maps, vf.maps_size) != 0
+                || back.radius != vf.radius || back.avg_distance != vf.avg_distance
+                || memcmp(back.center, vf.center, sizeof vf.center) != 0
+                || back.positions_n != vf.positions_n || back.dir_res != vf.dir_res)
+                bad++;
+            hfvis_visfield_free(NULL, &back);
+            CHECK(back.maps == NULL);
+            /* every truncation and one trailing byte: FORMAT */
+            for (cut = 0; cut < need; cut++)
+                if (!decode_fails(buf, cut, HFVIS_ERR_FORMAT)) bad++;
+            if (!decode_fails(buf, need + 1, HFVIS_ERR_FORMAT)) bad++;
+            /* header fields */
+#define MUTATE(stmt, want) do { memcpy(bad_buf, buf, need); stmt; \
+        if (!decode_fails(bad_buf, need, want)) { bad++; printf("  mutation failed: %s\n", #stmt); } } while (0)
+            MUTATE(bad_buf[0] = 'X', HFVIS_ERR_FORMAT);
+            MUTATE(put32(bad_buf + 8, 2), HFVIS_ERR_FORMAT);
+            MUTATE(put32(bad_buf + 12, 0), HFVIS_ERR_FORMAT);
+            MUTATE(put32(bad_buf + 12, 5), HFVIS_ERR_FORMAT);
+            MUTATE(put32(bad_buf + 16, 0), HFVIS_ERR_FORMAT);
+            MUTATE(put32(bad_buf + 16, 4), HFVIS_ERR_FORMAT);
+            MUTATE(put32(bad_buf + 20, 0), HFVIS_ERR_FORMAT);
+            MUTATE(put32(bad_buf + 24, 0), HFVIS_ERR_FORMAT);
+            MUTATE(put32(bad_buf + 28, 1), HFVIS_ERR_FORMAT);
+            MUTATE(put32(bad_buf + 20, HFVIS_VISFIELD_MAX_N + 1), HFVIS_ERR_LIMIT);
+            MUTATE(put32(bad_buf + 24, HFVIS_VISFIELD_MAX_DIR_RES + 1), HFVIS_ERR_LIMIT);
+            MUTATE(put32(bad_buf + 20, 0xFFFFFFFFu), HFVIS_ERR_LIMIT);
+            MUTATE((put32(bad_buf + 20, 1024), put32(bad_buf + 24, 4096)), HFVIS_ERR_LIMIT); /* 70 TB */
+            MUTATE(put32(bad_buf + 24, (uint32_t)vf.dir_res + 2u), HFVIS_ERR_FORMAT); /* sizes disagree */
+            MUTATE(putf64(bad_buf + 32, NAN), HFVIS_ERR_FORMAT);
+            MUTATE(putf64(bad_buf + 48, INFINITY), HFVIS_ERR_FORMAT);
+            MUTATE(putf64(bad_buf + 56, 0.0), HFVIS_ERR_FORMAT);
+            MUTATE(putf64(bad_buf + 56, -1.0), HFVIS_ERR_FORMAT);
+            MUTATE(putf64(bad_buf + 64, 1.5), HFVIS_ERR_FORMAT);
+            MUTATE(putf64(bad_buf + 64, -0.1), HFVIS_ERR_FORMAT);
+            MUTATE(put64(bad_buf + 72, (uint64_t)vf.maps_size + 1), HFVIS_ERR_FORMAT);
+            MUTATE(put64(bad_buf + 72, ~(uint64_t)0), HFVIS_ERR_FORMAT);
+            /* payload contents a build cannot produce */
+            K = hfvis_visfield_position_count(vf.positions_n);
+            texels = K * (size_t)vf.dir_res * (size_t)vf.dir_res;
+            if ((f == 2)) {
+                MUTATE(memcpy(bad_buf + 80, "\0\0\xc0\x7f", 4), HFVIS_ERR_FORMAT); /* NaN */
+                MUTATE(memcpy(bad_buf + 80, "\0\0\0\xbf", 4), HFVIS_ERR_FORMAT);   /* -0.5 */
+                MUTATE(memcpy(bad_buf + 80, "\0\0\0\x40", 4), HFVIS_ERR_FORMAT);   /* 2 */
+            }
+            if (f == 4) { /* a miss with a normal */
+                for (t = 0; t < texels && buf[80 + 4 * t + 3] != 255; t++) {}
+                if (t < texels) MUTATE(bad_buf[80 + 4 * t] = 1, HFVIS_ERR_FORMAT);
+            }
+            if (f == 3 && (texels & 7u)) MUTATE(bad_buf[need - 1] |= 0x80, HFVIS_ERR_FORMAT);
+            if (m == 2) { /* an unused rejection texel (corner (0, 0) of map 0) holding a hit */
+                if (f == 2) MUTATE(memcpy(bad_buf + 80, "\0\0\0\x3f", 4), HFVIS_ERR_FORMAT);
+                else if (f == 3) MUTATE(bad_buf[80] |= 1, HFVIS_ERR_FORMAT);
+                else if (f == 4) MUTATE((bad_buf[80] = 0, bad_buf[83] = 3), HFVIS_ERR_FORMAT);
+                else MUTATE(bad_buf[80] = 3, HFVIS_ERR_FORMAT);
+            }
+#undef MUTATE
+            /* file round trip */
+            {
+                const char *path = "/tmp/hfvis_test_vf.hfvf";
+                CHECK_EQ_STATUS(hfvis_visfield_save(path, &vf), HFVIS_OK);
+                CHECK_EQ_STATUS(hfvis_visfield_load(path, NULL, &back), HFVIS_OK);
+                if (memcmp(back.maps, vf.maps, vf.maps_size) != 0) bad++;
+                hfvis_visfield_free(NULL, &back);
+                remove(path);
+                CHECK_EQ_STATUS(hfvis_visfield_load(path, NULL, &back), HFVIS_ERR_IO);
+                CHECK_EQ_STATUS(hfvis_visfield_save("/tmp", &vf), HFVIS_ERR_IO);
+            }
+            free(buf);
+            free(bad_buf);
+            field_done(&vf);
+        }
+    CHECK(bad == 0);
+    CHECK_EQ_STATUS(hfvis_visfield_decode(NULL, 0, NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    {
+        hfvis_visfield out;
+        CHECK_EQ_STATUS(hfvis_visfield_decode(NULL, 5, NULL, &out), HFVIS_ERR_INVALID_ARGUMENT);
+        CHECK_EQ_STATUS(hfvis_visfield_decode(NULL, 0, NULL, &out), HFVIS_ERR_FORMAT);
+        /* a header that claims a huge field: LIMIT from the header alone */
+        {
+            unsigned char h[80];
+            memset(h, 0, sizeof h);
+            memcpy(h, "HFVFIELD", 8);
+            put32(h + 8, 1);
+            put32(h + 12, 2);
+            put32(h + 16, 3);
+            put32(h + 20, 1000);
+            put32(h + 24, 1000);
+            putf64(h + 56, 1.0);
+            CHECK(decode_fails(h, sizeof h, HFVIS_ERR_LIMIT));
+        }
+    }
+    hfvis_visfield_free(NULL, NULL);
+    hfvis_mesh_free(NULL, &torus);
+}
 int main(int argc, char **argv)
 {
     const char *only = argc > 1 && argv[1][0] != '-' ? argv[1] : NULL;
@@ -1203,5 +1366,6 @@ int main(int argc, char **argv)
     RUN_IF(vf_shadows);
     RUN_IF(vf_trace_reflect);
     RUN_IF(vf_table_meshes);
+    RUN_IF(vf_codec);
     return TEST_DONE();
 }
