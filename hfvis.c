@@ -5238,6 +5238,22 @@ static inline void hf_ns_axis_clamped(double u, int n, int *i0, double *f)
     if (*f > 1.0) *f = 1.0;
 }
 
+/* The four bilinear taps of grid position (x, y) on level L: columns x0, x1, rows y0, y1 and the
+ * weights fx, fy (wrapped, or clamped to the level). */
+static inline void hf_ns_taps(const hf_ns_level *L, int wrap, double x, double y, int *x0, int *x1,
+                              int *y0, int *y1, double *fx, double *fy)
+{
+    if (wrap) {
+        hf_ns_axis(x * L->a + L->b, L->w, 1, x0, x1, fx);
+        hf_ns_axis(y * L->a + L->b, L->h, 1, y0, y1, fy);
+    } else {
+        hf_ns_axis_clamped(x * L->a + L->b, L->w, x0, fx);
+        hf_ns_axis_clamped(y * L->a + L->b, L->h, y0, fy);
+        *x1 = L->w > 1 ? *x0 + 1 : *x0;
+        *y1 = L->h > 1 ? *y0 + 1 : *y0;
+    }
+}
+
 /* One channel (heights): bilinear at grid position (x, y); a tap with zero weight is never read
  * (as hf_bilerp), so a hole beside an exact sample position does not leak in. NaN = hole. */
 static inline double hf_ns_sample1(const hf_ns_level *L, int wrap, int holes, double x, double y)
@@ -5245,15 +5261,7 @@ static inline double hf_ns_sample1(const hf_ns_level *L, int wrap, int holes, do
     int x0, x1, y0, y1;
     double fx, fy, r0 = 0.0, r1;
     const float *p0, *p1;
-    if (wrap) {
-        hf_ns_axis(x * L->a + L->b, L->w, 1, &x0, &x1, &fx);
-        hf_ns_axis(y * L->a + L->b, L->h, 1, &y0, &y1, &fy);
-    } else {
-        hf_ns_axis_clamped(x * L->a + L->b, L->w, &x0, &fx);
-        hf_ns_axis_clamped(y * L->a + L->b, L->h, &y0, &fy);
-        x1 = L->w > 1 ? x0 + 1 : x0;
-        y1 = L->h > 1 ? y0 + 1 : y0;
-    }
+    hf_ns_taps(L, wrap, x, y, &x0, &x1, &y0, &y1, &fx, &fy);
     p0 = L->img + (size_t)y0 * (size_t)L->w;
     p1 = L->img + (size_t)y1 * (size_t)L->w;
     if (!holes) /* every tap finite: the plain form gives the same value */
@@ -5277,15 +5285,7 @@ static int hf_ns_sampleC(const hf_ns_level *L, int C, int wrap, int holes, doubl
     int x0, x1, y0, y1, c, q;
     double fx, fy, wt[4];
     const float *tp[4];
-    if (wrap) {
-        hf_ns_axis(x * L->a + L->b, L->w, 1, &x0, &x1, &fx);
-        hf_ns_axis(y * L->a + L->b, L->h, 1, &y0, &y1, &fy);
-    } else {
-        hf_ns_axis_clamped(x * L->a + L->b, L->w, &x0, &fx);
-        hf_ns_axis_clamped(y * L->a + L->b, L->h, &y0, &fy);
-        x1 = L->w > 1 ? x0 + 1 : x0;
-        y1 = L->h > 1 ? y0 + 1 : y0;
-    }
+    hf_ns_taps(L, wrap, x, y, &x0, &x1, &y0, &y1, &fx, &fy);
     wt[0] = (1.0 - fx) * (1.0 - fy);
     wt[1] = fx * (1.0 - fy);
     wt[2] = (1.0 - fx) * fy;

@@ -6257,34 +6257,34 @@ static hfvis_status vx_iv_run(const hfvis_volume *prev, hfvis_volume *curr,
     return HFVIS_OK;
 }
 
+/* hfvis_iv_cleanup (single = 0) and hfvis_iv_single_pass (single = 1). */
+static hfvis_status vx_iv_entry(const hfvis_volume *prev, hfvis_volume *curr,
+                                const hfvis_depth_image *images, size_t image_count,
+                                const hfvis_iv_options *opts, hfvis_iv_stats *stats, int single)
+{
+    vx_iv_opt o;
+    vx_iv_count cnt;
+    hfvis_status s = vx_iv_pass_args(prev, curr, images, image_count, opts, &o, single);
+    if (s != HFVIS_OK) return s;
+    memset(&cnt, 0, sizeof cnt);
+    s = vx_iv_run(prev, curr, images, image_count, &o, single, &cnt);
+    if (s != HFVIS_OK) return s;
+    vx_iv_stats_out(&cnt, stats);
+    return HFVIS_OK;
+}
+
 HFVIS_API hfvis_status hfvis_iv_cleanup(const hfvis_volume *prev, hfvis_volume *curr,
                                         const hfvis_depth_image *images, size_t image_count,
                                         const hfvis_iv_options *opts, hfvis_iv_stats *stats)
 {
-    vx_iv_opt o;
-    vx_iv_count cnt;
-    hfvis_status s = vx_iv_pass_args(prev, curr, images, image_count, opts, &o, 0);
-    if (s != HFVIS_OK) return s;
-    memset(&cnt, 0, sizeof cnt);
-    s = vx_iv_run(prev, curr, images, image_count, &o, 0, &cnt);
-    if (s != HFVIS_OK) return s;
-    vx_iv_stats_out(&cnt, stats);
-    return HFVIS_OK;
+    return vx_iv_entry(prev, curr, images, image_count, opts, stats, 0);
 }
 
 HFVIS_API hfvis_status hfvis_iv_single_pass(const hfvis_volume *prev, hfvis_volume *curr,
                                             const hfvis_depth_image *images, size_t image_count,
                                             const hfvis_iv_options *opts, hfvis_iv_stats *stats)
 {
-    vx_iv_opt o;
-    vx_iv_count cnt;
-    hfvis_status s = vx_iv_pass_args(prev, curr, images, image_count, opts, &o, 1);
-    if (s != HFVIS_OK) return s;
-    memset(&cnt, 0, sizeof cnt);
-    s = vx_iv_run(prev, curr, images, image_count, &o, 1, &cnt);
-    if (s != HFVIS_OK) return s;
-    vx_iv_stats_out(&cnt, stats);
-    return HFVIS_OK;
+    return vx_iv_entry(prev, curr, images, image_count, opts, stats, 1);
 }
 
 /* ---- 9.4 injection, one frame, lighting ---------------------------------------------------- */
