@@ -1345,6 +1345,376 @@ TEST(vf_codec)
     hfvis_visfield_free(NULL, NULL);
     hfvis_mesh_free(NULL, &torus);
 }
+/* ========================================================================================== */
+/* bad arguments and failing allocations                                                      */
+/* ========================================================================================== */
+
+TEST(vf_bad_arguments)
+{
+    const double c0[3] = {0.0, 0.0, 0.0}, z3[3] = {0.0, 0.0, 0.0}, up[3] = {0.0, 0.0, 1.0};
+    const double nan3[3] = {NAN, 0.0, 1.0}, inf3[3] = {0.0, INFINITY, 1.0}, down[3] = {0.0, 0.0, -1.0};
+    const float pt[3] = {0.0f, 0.0f, -2.0f}, nz[3] = {0.0f, 0.0f, 1.0f}, nzero[3] = {0.0f, 0.0f, 0.0f};
+    const float pnan[3] = {0.0f, NAN, 0.0f};
+    hfvis_mesh ico, badmesh;
+    hfvis_visfield vf, v2;
+    hfvis_visfield_object ob, ob2;
+    hfvis_visfield_hit hit, hit0;
+    hfvis_visfield_trace_hit th[4], th0[4];
+    hfvis_visfield_ao_options ao;
+    hfvis_visfield_shadow_options so;
+    hfvis_visfield_reflect_options ro;
+    double d3[3] = {7.0, 7.0, 7.0}, r = 7.0, c[3];
+    size_t k = 77;
+    int i = 77, j = 77, used = 77, h = 77;
+    float out = 7.0f;
+    unsigned char buf[256];
+
+    CHECK_EQ_STATUS(hfvis_mesh_icosphere(NULL, c0, 0.5, 1, &ico), HFVIS_OK);
+    CHECK(field_init(&vf, c0, 1.0, 2, 4, HFVIS_DIRMAP_DEFAULT, HFVIS_VISFIELD_DEFAULT));
+    CHECK_EQ_STATUS(hfvis_visfield_build(&ico, NULL, &vf), HFVIS_OK);
+
+    /* samples and maps */
+    CHECK_EQ_STATUS(hfvis_visfield_position(0, 0, d3), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_position(2, 26, d3), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_position(2, 0, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK(d3[0] == 7.0);
+    CHECK_EQ_STATUS(hfvis_visfield_nearest_position(2, z3, &k), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_nearest_position(2, nan3, &k), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_nearest_position(2, inf3, &k), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_nearest_position(0, up, &k), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_nearest_position(2, NULL, &k), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_nearest_position(2, up, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_nearest_position_naive(2, z3, &k), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_nearest_position_naive(HFVIS_VISFIELD_MAX_N + 1, up, &k), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK(k == 77);
+    CHECK_EQ_STATUS(hfvis_dirmap_to_local((hfvis_dirmap)4, 8, 0, 0, d3, &used), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_dirmap_to_local((hfvis_dirmap)-1, 8, 0, 0, d3, &used), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_dirmap_to_local(HFVIS_DIRMAP_POLAR, 0, 0, 0, d3, &used), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_dirmap_to_local(HFVIS_DIRMAP_POLAR, 8, 8, 0, d3, &used), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_dirmap_to_local(HFVIS_DIRMAP_POLAR, 8, 0, -1, d3, &used), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_dirmap_to_local(HFVIS_DIRMAP_POLAR, 8, 0, 0, NULL, &used), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_dirmap_to_local(HFVIS_DIRMAP_POLAR, 8, 0, 0, d3, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_dirmap_from_local(HFVIS_DIRMAP_POLAR, 8, down, &i, &j, &used), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_dirmap_from_local(HFVIS_DIRMAP_POLAR, 8, z3, &i, &j, &used), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_dirmap_from_local(HFVIS_DIRMAP_POLAR, 8, nan3, &i, &j, &used), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_dirmap_from_local(HFVIS_DIRMAP_POLAR, 8, up, NULL, &j, &used), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_dirmap_from_local(HFVIS_DIRMAP_POLAR, 8, up, &i, NULL, &used), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_dirmap_from_local((hfvis_dirmap)7, 8, up, &i, &j, &used), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_dirmap_from_local(HFVIS_DIRMAP_POLAR, HFVIS_VISFIELD_MAX_DIR_RES + 1, up, &i, &j, &used),
+                    HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK(d3[0] == 7.0 && i == 77 && j == 77 && used == 77);
+
+    /* build */
+    CHECK_EQ_STATUS(hfvis_visfield_bounding_sphere(NULL, c, &r), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_bounding_sphere(&ico, NULL, &r), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_bounding_sphere(&ico, c, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    badmesh = ico;
+    badmesh.vertex_count = 0;
+    CHECK_EQ_STATUS(hfvis_visfield_bounding_sphere(&badmesh, c, &r), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK(r == 7.0);
+    v2 = vf;
+    v2.maps = malloc(vf.maps_size);
+    CHECK(v2.maps != NULL);
+    memset(v2.maps, 0x33, v2.maps_size);
+#define BUILD_BAD(stmt, want) do { hfvis_visfield bw_ = v2; unsigned char chk_ = 0x33; size_t q_; int ok_ = 1; stmt; \
+        CHECK_EQ_STATUS(hfvis_visfield_build(&ico, NULL, &bw_), want); \
+        CHECK_EQ_STATUS(hfvis_visfield_build_reference(&ico, NULL, &bw_), want); \
+        for (q_ = 0; q_ < v2.maps_size; q_++) ok_ &= ((unsigned char *)v2.maps)[q_] == chk_; \
+        CHECK(ok_ && bw_.avg_distance == v2.avg_distance); } while (0)
+    BUILD_BAD(bw_.radius = 0.0, HFVIS_ERR_INVALID_ARGUMENT);
+    BUILD_BAD(bw_.radius = NAN, HFVIS_ERR_INVALID_ARGUMENT);
+    BUILD_BAD(bw_.radius = 0.4, HFVIS_ERR_INVALID_ARGUMENT);      /* the mesh is not inside */
+    BUILD_BAD(bw_.center[0] = 0.6, HFVIS_ERR_INVALID_ARGUMENT);
+    BUILD_BAD(bw_.center[1] = INFINITY, HFVIS_ERR_INVALID_ARGUMENT);
+    BUILD_BAD(bw_.positions_n = 0, HFVIS_ERR_INVALID_ARGUMENT);
+    BUILD_BAD(bw_.positions_n = HFVIS_VISFIELD_MAX_N + 1, HFVIS_ERR_INVALID_ARGUMENT);
+    BUILD_BAD(bw_.dir_res = -1, HFVIS_ERR_INVALID_ARGUMENT);
+    BUILD_BAD(bw_.mapping = (hfvis_dirmap)9, HFVIS_ERR_INVALID_ARGUMENT);
+    BUILD_BAD(bw_.format = (hfvis_visfield_format)5, HFVIS_ERR_INVALID_ARGUMENT);
+    BUILD_BAD(bw_.maps_size = v2.maps_size - 1, HFVIS_ERR_BUFFER_TOO_SMALL);
+    BUILD_BAD(bw_.dir_res = 5, HFVIS_ERR_BUFFER_TOO_SMALL);
+    BUILD_BAD(bw_.format = HFVIS_VISFIELD_F32, HFVIS_ERR_BUFFER_TOO_SMALL);
+#undef BUILD_BAD
+    {
+        hfvis_visfield w = v2;
+        hfvis_visfield_build_options bo;
+        hfvis_bvh other;
+        hfvis_mesh tor;
+        w.maps = NULL;
+        CHECK_EQ_STATUS(hfvis_visfield_build(&ico, NULL, &w), HFVIS_ERR_INVALID_ARGUMENT);
+        CHECK_EQ_STATUS(hfvis_visfield_build(NULL, NULL, &v2), HFVIS_ERR_INVALID_ARGUMENT);
+        CHECK_EQ_STATUS(hfvis_visfield_build(&ico, NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+        CHECK_EQ_STATUS(hfvis_visfield_build_reference(NULL, NULL, &v2), HFVIS_ERR_INVALID_ARGUMENT);
+        badmesh = ico;
+        badmesh.indices = NULL;
+        CHECK_EQ_STATUS(hfvis_visfield_build(&badmesh, NULL, &v2), HFVIS_ERR_INVALID_ARGUMENT);
+        CHECK_EQ_STATUS(hfvis_mesh_torus(NULL, c0, 0.3, 0.1, 5, 3, &tor), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_bvh_build(&tor, NULL, &other), HFVIS_OK);
+        memset(&bo, 0, sizeof bo);
+        bo.bvh = &other; /* a BVH of another mesh */
+        CHECK_EQ_STATUS(hfvis_visfield_build(&ico, &bo, &v2), HFVIS_ERR_INVALID_ARGUMENT);
+        hfvis_bvh_free(NULL, &other);
+        hfvis_mesh_free(NULL, &tor);
+    }
+    free(v2.maps);
+    CHECK_EQ_STATUS(hfvis_visfield_texel(&vf, 26, 0, 0, &h, &r, d3), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_texel(&vf, 0, 4, 0, &h, &r, d3), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_texel(&vf, 0, 0, -1, &h, &r, d3), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_texel(&vf, 0, 0, 0, NULL, &r, d3), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_texel(&vf, 0, 0, 0, &h, NULL, d3), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_texel(NULL, 0, 0, 0, &h, &r, d3), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK(h == 77 && r == 7.0 && d3[0] == 7.0);
+
+    /* queries */
+    memset(&hit0, 0x44, sizeof hit0);
+    hit = hit0;
+    CHECK_EQ_STATUS(hfvis_visfield_query(NULL, c0, up, 0.0, &hit), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_query(&vf, NULL, up, 0.0, &hit), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_query(&vf, nan3, up, 0.0, &hit), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_query(&vf, c0, z3, 0.0, &hit), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_query(&vf, c0, inf3, 0.0, &hit), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_query(&vf, c0, up, -1.0, &hit), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_query(&vf, c0, up, NAN, &hit), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_query(&vf, c0, up, 0.0, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    v2 = vf;
+    v2.avg_distance = 2.0;
+    CHECK_EQ_STATUS(hfvis_visfield_query(&v2, c0, up, 0.0, &hit), HFVIS_ERR_INVALID_ARGUMENT);
+    v2 = vf;
+    v2.maps_size--;
+    CHECK_EQ_STATUS(hfvis_visfield_query(&v2, c0, up, 0.0, &hit), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_query_reference(&vf, NULL, NULL, c0, up, 0.0, &hit), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_query_reference(&vf, &ico, NULL, c0, z3, 0.0, &hit), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK(memcmp(&hit, &hit0, sizeof hit) == 0);
+    /* the reference needs only the sphere: maps may be NULL */
+    v2 = vf;
+    v2.maps = NULL;
+    CHECK_EQ_STATUS(hfvis_visfield_query_reference(&v2, &ico, NULL, c0, up, 0.0, &hit), HFVIS_OK);
+
+    /* scenes */
+    ob = make_object(&vf, &ico, NULL);
+    ao = hfvis_visfield_ao_options_default();
+#define AO_BAD(stmt) do { hfvis_visfield_ao_options o_ = ao; hfvis_visfield_object b_ = ob; float r_ = 7.0f; stmt; \
+        CHECK_EQ_STATUS(hfvis_visfield_ambient_occlusion(&b_, 1, pt, nz, 1, &o_, &r_), HFVIS_ERR_INVALID_ARGUMENT); \
+        CHECK_EQ_STATUS(hfvis_visfield_ambient_occlusion_reference(&b_, 1, pt, nz, 1, &o_, &r_), HFVIS_ERR_INVALID_ARGUMENT); \
+        CHECK(r_ == 7.0f); } while (0)
+    AO_BAD(o_.rays_sqrt = -1);
+    AO_BAD(o_.rays_sqrt = HFVIS_VISFIELD_MAX_RAYS_SQRT + 1);
+    AO_BAD(o_.max_distance = -1.0);
+    AO_BAD(o_.max_distance = NAN);
+    AO_BAD(o_.falloff = (hfvis_visfield_falloff)3);
+    AO_BAD(o_.combine = (hfvis_visfield_combine)3);
+    AO_BAD(o_.falloff = HFVIS_VISFIELD_FALLOFF_LINEAR); /* without a finite max_distance */
+    AO_BAD(o_.bias = -0.1);
+    AO_BAD(o_.bias = INFINITY);
+    AO_BAD(o_.offset = -0.1);
+    AO_BAD(o_.offset = NAN);
+    AO_BAD(b_.object_to_world[0] = 2.0);              /* non-uniform scale */
+    AO_BAD(b_.object_to_world[4] = 0.5);              /* shear */
+    AO_BAD(b_.object_to_world[3] = 0.1);              /* projective row */
+    AO_BAD(b_.object_to_world[15] = 2.0);
+    AO_BAD(b_.object_to_world[13] = NAN);
+    AO_BAD(memset(b_.object_to_world, 0, sizeof b_.object_to_world); b_.object_to_world[15] = 1.0);
+    AO_BAD(b_.field = NULL);
+#undef AO_BAD
+    ob2 = ob;
+    ob2.field = &v2; /* maps NULL: the fast path needs them, the reference only the sphere */
+    CHECK_EQ_STATUS(hfvis_visfield_ambient_occlusion(&ob2, 1, pt, nz, 1, NULL, &out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK(out == 7.0f);
+    CHECK_EQ_STATUS(hfvis_visfield_ambient_occlusion_reference(&ob2, 1, pt, nz, 1, NULL, &out), HFVIS_OK);
+    out = 7.0f;
+    /* the reference needs meshes; the fast path does not */
+    ob2 = ob;
+    ob2.mesh = NULL;
+    CHECK_EQ_STATUS(hfvis_visfield_ambient_occlusion(&ob2, 1, pt, nz, 1, NULL, &out), HFVIS_OK);
+    out = 7.0f;
+    CHECK_EQ_STATUS(hfvis_visfield_ambient_occlusion_reference(&ob2, 1, pt, nz, 1, NULL, &out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_ambient_occlusion(NULL, 1, pt, nz, 1, NULL, &out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_ambient_occlusion(&ob, 1, NULL, nz, 1, NULL, &out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_ambient_occlusion(&ob, 1, pt, NULL, 1, NULL, &out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_ambient_occlusion(&ob, 1, pt, nz, 1, NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_ambient_occlusion(&ob, 1, pnan, nz, 1, NULL, &out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_ambient_occlusion(&ob, 1, pt, nzero, 1, NULL, &out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK(out == 7.0f);
+    CHECK_EQ_STATUS(hfvis_visfield_ambient_occlusion(NULL, 0, NULL, NULL, 0, NULL, NULL), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_visfield_ambient_occlusion(NULL, 0, pt, nz, 1, NULL, &out), HFVIS_OK);
+    CHECK(out == 0.0f); /* no objects: nothing blocks */
+    /* a mirror-image transform (det < 0) is rigid too */
+    ob2 = ob;
+    ob2.object_to_world[0] = -1.0;
+    CHECK_EQ_STATUS(hfvis_visfield_ambient_occlusion(&ob2, 1, pt, nz, 1, NULL, &out), HFVIS_OK);
+
+    memset(&so, 0, sizeof so);
+    out = 7.0f;
+    CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pt, 1, NULL, 0.0, &so, &out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pt, 1, nan3, 0.0, &so, &out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pt, 1, up, -1.0, &so, &out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pt, 1, up, INFINITY, &so, &out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pnan, 1, up, 0.0, &so, &out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, NULL, 1, up, 0.0, &so, &out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pt, 1, up, 0.0, &so, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    so.samples = HFVIS_VISFIELD_MAX_SAMPLES + 1;
+    CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pt, 1, up, 0.0, &so, &out), HFVIS_ERR_INVALID_ARGUMENT);
+    so.samples = -2;
+    CHECK_EQ_STATUS(hfvis_visfield_soft_shadow_reference(&ob, 1, pt, 1, up, 0.0, &so, &out), HFVIS_ERR_INVALID_ARGUMENT);
+    so.samples = 0;
+    so.bias = -1.0;
+    CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pt, 1, up, 0.0, &so, &out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK(out == 7.0f);
+
+    memset(th0, 0x22, sizeof th0);
+    memcpy(th, th0, sizeof th);
+    CHECK_EQ_STATUS(hfvis_visfield_trace(&ob, 1, NULL, up, 0.0, th), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_trace(&ob, 1, c0, z3, 0.0, th), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_trace(&ob, 1, c0, up, -0.5, th), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_trace(&ob, 1, c0, up, 0.0, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_trace(NULL, 1, c0, up, 0.0, th), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_trace_reference(&ob2, 1, c0, up, 0.0, th), HFVIS_OK);
+    memcpy(th, th0, sizeof th);
+    ob2.mesh = NULL;
+    CHECK_EQ_STATUS(hfvis_visfield_trace_reference(&ob2, 1, c0, up, 0.0, th), HFVIS_ERR_INVALID_ARGUMENT);
+    memset(&ro, 0, sizeof ro);
+#define RF_BAD(stmt) do { hfvis_visfield_reflect_options o_ = ro; stmt; \
+        CHECK_EQ_STATUS(hfvis_visfield_reflect(&ob, 1, c0, up, down, &o_, th), HFVIS_ERR_INVALID_ARGUMENT); \
+        CHECK_EQ_STATUS(hfvis_visfield_reflect_reference(&ob, 1, c0, up, down, &o_, th), HFVIS_ERR_INVALID_ARGUMENT); \
+        } while (0)
+    RF_BAD(o_.rays = -1);
+    RF_BAD(o_.rays = HFVIS_VISFIELD_MAX_SAMPLES + 1);
+    RF_BAD(o_.shininess = -1.0);
+    RF_BAD(o_.shininess = NAN);
+    RF_BAD(o_.bias = NAN);
+    RF_BAD(o_.offset = -1.0);
+#undef RF_BAD
+    CHECK_EQ_STATUS(hfvis_visfield_reflect(&ob, 1, c0, z3, down, NULL, th), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_reflect(&ob, 1, c0, up, z3, NULL, th), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_reflect(&ob, 1, nan3, up, down, NULL, th), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_reflect(&ob, 1, c0, up, down, NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK(memcmp(th, th0, sizeof th) == 0);
+
+    /* codec */
+    CHECK(hfvis_visfield_encode_size(NULL) == 0);
+    CHECK(hfvis_visfield_encode_size(&v2) == 0); /* maps NULL */
+    CHECK_EQ_STATUS(hfvis_visfield_encode(&vf, NULL, 256, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_encode(NULL, buf, sizeof buf, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_save(NULL, &vf), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_save("/tmp/x.hfvf", NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_load(NULL, NULL, &v2), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_load("/tmp/x.hfvf", NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    field_done(&vf);
+    hfvis_mesh_free(NULL, &ico);
+}
+
+/* Every allocation of every allocating routine fails in turn: OUT_OF_MEMORY, outputs untouched,
+ * nothing leaked. */
+TEST(vf_out_of_memory)
+{
+    const double c0[3] = {0.0, 0.0, 0.0}, light[3] = {0.0, 0.0, 3.0};
+    enum { P = 5 };
+    float pts[3 * P], nrm[3 * P], out[P], want[P];
+    hfvis_mesh ico;
+    hfvis_visfield vf, ref, back;
+    hfvis_visfield_object ob;
+    hfvis_allocator al;
+    counting cnt;
+    unsigned char *file;
+    size_t need;
+    int routine, k, p;
+    CHECK_EQ_STATUS(hfvis_mesh_icosphere(NULL, c0, 0.5, 2, &ico), HFVIS_OK);
+    CHECK(field_init(&vf, c0, 1.0, 3, 6, HFVIS_DIRMAP_CONCENTRIC, HFVIS_VISFIELD_U8));
+    CHECK(field_init(&ref, c0, 1.0, 3, 6, HFVIS_DIRMAP_CONCENTRIC, HFVIS_VISFIELD_U8));
+    CHECK_EQ_STATUS(hfvis_visfield_build_reference(&ico, NULL, &ref), HFVIS_OK);
+    need = hfvis_visfield_encode_size(&ref);
+    file = (unsigned char *)malloc(need);
+    CHECK(file != NULL);
+    if (!file) return;
+    CHECK_EQ_STATUS(hfvis_visfield_encode(&ref, file, need, NULL), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_visfield_save("/tmp/hfvis_test_vf_oom.hfvf", &ref), HFVIS_OK);
+    for (p = 0; p < P; p++) {
+        pts[3 * p] = (float)(0.3 * p - 0.6);
+        pts[3 * p + 1] = 0.2f;
+        pts[3 * p + 2] = -1.2f;
+        nrm[3 * p] = nrm[3 * p + 1] = 0.0f;
+        nrm[3 * p + 2] = 1.0f;
+    }
+    ob = make_object(&ref, &ico, NULL);
+    al.alloc = c_alloc;
+    al.free = c_free;
+    al.user = &cnt;
+    for (routine = 0; routine < 7; routine++) {
+        int succeeded = 0, sites = 0;
+        for (k = 1; k < 64 && !succeeded; k++) {
+            hfvis_status s = HFVIS_OK;
+            memset(&cnt, 0, sizeof cnt);
+            cnt.fail_at = k;
+            for (p = 0; p < P; p++) out[p] = 7.0f;
+            memset(vf.maps, 0x66, vf.maps_size);
+            vf.avg_distance = 0.0;
+            memset(&back, 0x5A, sizeof back);
+            switch (routine) {
+            case 0: {
+                hfvis_visfield_build_options bo;
+                memset(&bo, 0, sizeof bo);
+                bo.alloc = &al;
+                s = hfvis_visfield_build(&ico, &bo, &vf);
+                if (s == HFVIS_OK) CHECK(memcmp(vf.maps, ref.maps, ref.maps_size) == 0);
+                else CHECK(((unsigned char *)vf.maps)[0] == 0x66 && vf.avg_distance == 0.0);
+                break;
+            }
+            case 1:
+            case 2: {
+                hfvis_visfield_ao_options o = hfvis_visfield_ao_options_default();
+                o.alloc = &al;
+                s = routine == 1 ? hfvis_visfield_ambient_occlusion(&ob, 1, pts, nrm, P, &o, out)
+                                 : hfvis_visfield_ambient_occlusion_reference(&ob, 1, pts, nrm, P, &o, out);
+                if (s == HFVIS_OK) {
+                    if (routine == 1) hfvis_visfield_ambient_occlusion(&ob, 1, pts, nrm, P, NULL, want);
+                    else hfvis_visfield_ambient_occlusion_reference(&ob, 1, pts, nrm, P, NULL, want);
+                    CHECK(memcmp(out, want, sizeof out) == 0);
+                }
+                break;
+            }
+            case 3:
+            case 4: {
+                hfvis_visfield_shadow_options o;
+                memset(&o, 0, sizeof o);
+                o.alloc = &al;
+                s = routine == 3 ? hfvis_visfield_soft_shadow(&ob, 1, pts, P, light, 0.5, &o, out)
+                                 : hfvis_visfield_soft_shadow_reference(&ob, 1, pts, P, light, 0.5, &o, out);
+                break;
+            }
+            case 5:
+                s = hfvis_visfield_decode(file, need, &al, &back);
+                if (s == HFVIS_OK) {
+                    CHECK(memcmp(back.maps, ref.maps, ref.maps_size) == 0);
+                    hfvis_visfield_free(&al, &back);
+                }
+                break;
+            default:
+                s = hfvis_visfield_load("/tmp/hfvis_test_vf_oom.hfvf", &al, &back);
+                if (s == HFVIS_OK) hfvis_visfield_free(&al, &back);
+                break;
+            }
+            if (s == HFVIS_OK) {
+                succeeded = 1;
+            } else {
+                unsigned char pat[sizeof back];
+                memset(pat, 0x5A, sizeof pat);
+                sites++;
+                CHECK_EQ_STATUS(s, HFVIS_ERR_OUT_OF_MEMORY);
+                if (routine >= 1 && routine <= 4) CHECK(out[0] == 7.0f && out[P - 1] == 7.0f);
+                if (routine >= 5) CHECK(memcmp(&back, pat, sizeof back) == 0);
+            }
+            CHECK(cnt.live == 0 && cnt.allocs - (cnt.fail_at <= cnt.allocs) == cnt.frees);
+        }
+        CHECK(succeeded);
+        printf("  routine %d: %d allocation sites failed cleanly\n", routine, sites);
+        CHECK(sites >= (routine == 0 ? 4 : routine == 2 || routine == 4 ? 3 : routine >= 5 ? 1 : 2));
+    }
+    remove("/tmp/hfvis_test_vf_oom.hfvf");
+    free(file);
+    field_done(&vf);
+    field_done(&ref);
+    hfvis_mesh_free(NULL, &ico);
+}
 int main(int argc, char **argv)
 {
     const char *only = argc > 1 && argv[1][0] != '-' ? argv[1] : NULL;
@@ -1367,5 +1737,7 @@ int main(int argc, char **argv)
     RUN_IF(vf_trace_reflect);
     RUN_IF(vf_table_meshes);
     RUN_IF(vf_codec);
+    RUN_IF(vf_bad_arguments);
+    RUN_IF(vf_out_of_memory);
     return TEST_DONE();
 }
