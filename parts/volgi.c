@@ -17,6 +17,14 @@
 
 #define VX_GI_F 12 /* HFVIS_VOLGI_FLOATS */
 
+/* The per-voxel tail of the fast kernel is forced inline: called out of line, its vector loads
+ * of the just-stored accumulators miss store-to-load forwarding (a 2x slowdown measured). */
+#if defined(__GNUC__)
+#define VX_GI_INLINE static inline __attribute__((always_inline))
+#else
+#define VX_GI_INLINE static
+#endif
+
 /* ---- GI.1 2-band SH (DESIGN: real, orthonormal, no Condon-Shortley phase, index l(l+1)+m:
  *      0 = Y00, 1 = y, 2 = z, 3 = x) ------------------------------------------------------ */
 
@@ -150,6 +158,8 @@ typedef struct vx_gi_consts {
     double a;             /* cone[d][0], sqrt(pi)(1 - cos 45) */
     double sb[6], sc[6];  /* cone[d][band1 of d's axis], cc[d][same]: +-b, +-sqrt(pi/3) */
     double c0;            /* cc[d][0], sqrt(pi)/2 */
+    double ccpi[6][4];    /* cc[d][k]/pi: S_in += F ccpi[o] is eq. 11's re-expansion (F/pi) CC(o) */
+    double k0, k1[6];     /* ccpi[d][0], ccpi[d][band1 of d's axis] */
     double lobe;          /* c1/c0 of a cosine lobe: 2/sqrt 3 */
     double flux;          /* 2 sqrt(pi): flux of a band = flux * c_0 */
 } vx_gi_consts;
@@ -166,8 +176,14 @@ static void vx_gi_consts_init(vx_gi_consts *k)
         k->sb[d] = k->cone[d][vx_gi_band1[ax]];
         k->sc[d] = k->cc[d][vx_gi_band1[ax]];
     }
+    for (d = 0; d < 6; d++) {
+        int q;
+        for (q = 0; q < 4; q++) k->ccpi[d][q] = k->cc[d][q] / VX_PI;
+        k->k1[d] = k->ccpi[d][vx_gi_band1[d / 2]];
+    }
     k->a = k->cone[0][0];
     k->c0 = k->cc[0][0];
+    k->k0 = k->ccpi[0][0];
     k->lobe = k->cc[0][3] / k->cc[0][0];
     k->flux = 2.0 * sqrt(VX_PI);
 }
@@ -326,15 +342,25 @@ static double vx_gi_norm_scale(const vx_gi_step *c, size_t v, const int ijk[3], 
     return phi > 0.0 && sum > 0.0 ? phi / sum : 0.0;
 }
 
-/* The table of vx_gi_norm_scale for every voxel and band (the fast step's normalisation). */
+/* The table of vx_gi_norm_scale for every voxel and band (the fast step's normalisation); the
+ * same products and sums, with the six path weights computed once per voxel. */
 static void vx_gi_scale_pass(const vx_gi_step *c, double *scale)
 {
-    int ijk[3], b;
+    int ijk[3], b, d;
     size_t v = 0;
     for (ijk[2] = 0; ijk[2] < c->dims[2]; ijk[2]++)
         for (ijk[1] = 0; ijk[1] < c->dims[1]; ijk[1]++)
-            for (ijk[0] = 0; ijk[0] < c->dims[0]; ijk[0]++, v++)
-                for (b = 0; b < 3; b++) scale[3 * v + (size_t)b] = vx_gi_norm_scale(c, v, ijk, b);
+            for (ijk[0] = 0; ijk[0] < c->dims[0]; ijk[0]++, v++) {
+                double w[6];
+                for (d = 0; d < 6; d++)
+                    w[d] = vx_gi_has(c->dims, ijk, d) ? vx_gi_path(c, v, vx_gi_nb(c, v, d)) : 1.0;
+                for (b = 0; b < 3; b++) {
+                    const float *q = c->pin + v * VX_GI_F + 4 * b;
+                    double sum = 0.0, phi = c->K.flux * (double)q[0];
+                    for (d = 0; d < 6; d++) sum += vx_gi_cone_flux(&c->K, q, d) * w[d];
+                    scale[3 * v + (size_t)b] = phi > 0.0 && sum > 0.0 ? phi / sum : 0.0;
+                }
+            }
 }
 
 /* The source side of the energy accounting (start, escaped, blocked, uncovered, created), shared
@@ -373,7 +399,7 @@ static void vx_gi_energy_sources(const vx_gi_step *c)
 }
 
 /* R(S_in) of one band (the thesis' T_r, or the diffuse alternative), into r. */
-static void vx_gi_reflect(const vx_gi_step *c, const float *nv, const double *s, double r[4])
+VX_GI_INLINE void vx_gi_reflect(const vx_gi_step *c, const float *nv, const double *s, double r[4])
 {
     int k, ax = vx_gi_dominant((double)nv[0], (double)nv[1], (double)nv[2]);
     if (c->cfg.reflection == HFVIS_VOLGI_REFLECT_MIRROR) {
@@ -400,7 +426,7 @@ static void vx_gi_reflect(const vx_gi_step *c, const float *nv, const double *s,
 
 /* The receiving side of voxel lin, shared by the fast step and the reference: record and
  * reflect at occupied voxels (T_r), transmit through empty ones; energy end/absorbed/deposited. */
-static void vx_gi_finish(const vx_gi_step *c, size_t lin, const double s[VX_GI_F])
+VX_GI_INLINE void vx_gi_finish(const vx_gi_step *c, size_t lin, const double s[VX_GI_F])
 {
     float *po = c->pout + lin * VX_GI_F;
     double alpha = (double)c->g->occupancy[lin];
@@ -428,51 +454,66 @@ static void vx_gi_finish(const vx_gi_step *c, size_t lin, const double s[VX_GI_F
         for (b = 0; b < 3; b++) c->en->end[b] += c->K.flux * (double)po[4 * b];
 }
 
-/* The fast kernel's contribution of neighbour q (voxel jl) to voxel il, travelling in direction
- * d: S_in += (F/pi) CC(d), touching only the two non-zero coefficients of CC(d). */
-static void vx_gi_take(const vx_gi_step *c, double s[VX_GI_F], const float *q, size_t jl, size_t il,
-                       int d)
-{
-    const int m = vx_gi_band1[d / 2];
-    const double a = c->K.a, sb = c->K.sb[d], sc = c->K.sc[d], c0 = c->K.c0;
-    const double w = vx_gi_path(c, jl, il);
-    int b;
-    if (!(w > 0.0)) return; /* a blocked path adds exactly 0 */
-    for (b = 0; b < 3; b++) {
-        double F = a * (double)q[4 * b] + sb * (double)q[4 * b + m], f;
-        if (!(F > 0.0)) continue; /* negative SH ringing is clamped [C] */
-        F *= w;
-        if (c->scale) F *= c->scale[3 * jl + (size_t)b];
-        f = F / VX_PI;
-        s[4 * b] += f * c0;
-        s[4 * b + m] += f * sc;
-    }
-}
+/* One neighbour of the fast kernel: direction D (travel), its band-1 coefficient M (a constant,
+ * so that the accumulators stay in registers), source voxel JL. Per band: F = max(0, a c_0 +
+ * (+-b) c_M) (the sparse form of P_j . Cone(o)), times the path weight and the normalisation;
+ * S_in += F ccpi[o] on the two non-zero coefficients of (F/pi) CC(o). The branch-free clamp adds
+ * exact zeros for F = 0, so the sums equal the reference's bit for bit. */
+#define VX_GI_TAKE(D, M, JL)                                                                   \
+    do {                                                                                       \
+        const size_t jl_ = (JL);                                                               \
+        const float *q_ = pin + jl_ * VX_GI_F;                                                 \
+        const double sb_ = K->sb[D], k1_ = K->k1[D];                                           \
+        double w_ = 1.0, F0_, F1_, F2_;                                                        \
+        if (void_only) w_ = 1.0 - (double)occ[jl_] * ai;                                        \
+        if (w_ > 0.0) {                                                                        \
+            F0_ = a * (double)q_[0] + sb_ * (double)q_[M];                                     \
+            F1_ = a * (double)q_[4] + sb_ * (double)q_[4 + M];                                 \
+            F2_ = a * (double)q_[8] + sb_ * (double)q_[8 + M];                                 \
+            F0_ = (F0_ > 0.0 ? F0_ : 0.0) * w_;                                                \
+            F1_ = (F1_ > 0.0 ? F1_ : 0.0) * w_;                                                \
+            F2_ = (F2_ > 0.0 ? F2_ : 0.0) * w_;                                                \
+            if (scale) {                                                                       \
+                F0_ *= scale[3 * jl_], F1_ *= scale[3 * jl_ + 1], F2_ *= scale[3 * jl_ + 2];   \
+            }                                                                                  \
+            s0 += F0_ * k0, s4 += F1_ * k0, s8 += F2_ * k0;                                    \
+            s[M] += F0_ * k1_, s[4 + M] += F1_ * k1_, s[8 + M] += F2_ * k1_;                   \
+        }                                                                                      \
+    } while (0)
 
-/* Fast step: gathering at every voxel from its six face neighbours ([G12] Fig. 51). */
+/* Fast step: gathering at every voxel from its six face neighbours ([G12] Fig. 51), in the
+ * order +x, -x, +y, -y, +z, -z of the reference. */
 static void vx_gi_step_fast(const vx_gi_step *c)
 {
     const int nx = c->dims[0], ny = c->dims[1], nz = c->dims[2];
+    const int void_only = c->cfg.paths == HFVIS_VOLGI_PATHS_VOID;
     const size_t sy = c->stride[1], sz = c->stride[2];
+    const vx_gi_consts *K = &c->K;
+    const double a = K->a, k0 = K->k0;
+    const float *occ = c->g->occupancy, *pin = c->pin;
+    const double *scale = c->scale;
     int i, j, k;
     for (k = 0; k < nz; k++)
         for (j = 0; j < ny; j++) {
-            size_t row = (size_t)k * sz + (size_t)j * sy;
+            const size_t row = (size_t)k * sz + (size_t)j * sy;
             for (i = 0; i < nx; i++) {
-                size_t lin = row + (size_t)i;
-                const float *p = c->pin + lin * VX_GI_F;
+                const size_t lin = row + (size_t)i;
+                const double ai = void_only ? (double)occ[lin] : 0.0;
                 double s[VX_GI_F] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 };
+                double s0 = 0.0, s4 = 0.0, s8 = 0.0;
                 /* o = +x comes from i - 1, o = -x from i + 1, ... (j = i - o) */
-                if (i > 0) vx_gi_take(c, s, p - VX_GI_F, lin - 1, lin, 0);
-                if (i + 1 < nx) vx_gi_take(c, s, p + VX_GI_F, lin + 1, lin, 1);
-                if (j > 0) vx_gi_take(c, s, p - sy * VX_GI_F, lin - sy, lin, 2);
-                if (j + 1 < ny) vx_gi_take(c, s, p + sy * VX_GI_F, lin + sy, lin, 3);
-                if (k > 0) vx_gi_take(c, s, p - sz * VX_GI_F, lin - sz, lin, 4);
-                if (k + 1 < nz) vx_gi_take(c, s, p + sz * VX_GI_F, lin + sz, lin, 5);
+                if (i > 0) VX_GI_TAKE(0, 3, lin - 1);
+                if (i + 1 < nx) VX_GI_TAKE(1, 3, lin + 1);
+                if (j > 0) VX_GI_TAKE(2, 1, lin - sy);
+                if (j + 1 < ny) VX_GI_TAKE(3, 1, lin + sy);
+                if (k > 0) VX_GI_TAKE(4, 2, lin - sz);
+                if (k + 1 < nz) VX_GI_TAKE(5, 2, lin + sz);
+                s[0] = s0, s[4] = s4, s[8] = s8;
                 vx_gi_finish(c, lin, s);
             }
         }
 }
+#undef VX_GI_TAKE
 
 /* Linear index of voxel v of grid dims. */
 static size_t vx_gi_lin(const int dims[3], const int v[3])
@@ -504,7 +545,7 @@ static void vx_gi_step_reference(const vx_gi_step *c)
                     P = c->pin + jlin * VX_GI_F;
                     w = void_only ? 1.0 - (double)c->g->occupancy[jlin] * (double)c->g->occupancy[lin] : 1.0;
                     for (b = 0; b < 3; b++) {
-                        double F = 0.0, f;
+                        double F = 0.0;
                         for (k = 0; k < 4; k++) F += (double)P[4 * b + k] * c->K.cone[d][k];
                         F = F > 0.0 ? F : 0.0;
                         F *= w;
@@ -525,8 +566,7 @@ static void vx_gi_step_reference(const vx_gi_step *c)
                             }
                             F *= phi > 0.0 && sum > 0.0 ? phi / sum : 0.0;
                         }
-                        f = F / VX_PI;
-                        for (k = 0; k < 4; k++) s[4 * b + k] += f * c->K.cc[d][k];
+                        for (k = 0; k < 4; k++) s[4 * b + k] += F * c->K.ccpi[d][k]; /* (F/pi) CC(o) */
                     }
                 }
                 vx_gi_finish(c, lin, s);
