@@ -221,6 +221,7 @@ HFVIS_API hfvis_lk_ray_options hfvis_lk_ray_options_default(void)
 /* Sites of the disc in a uniform B x B grid over [-1, 1]^2 (nearest-site queries for Lloyd). */
 typedef struct lk_sites {
     int n, B;
+    int wrap;            /* periodic square (torus) instead of the plane */
     double cs;           /* cell size 2/B */
     const double *xy;    /* 2n */
     int *start;          /* B*B + 1 */
@@ -233,6 +234,26 @@ static int lk_sites_cell(const lk_sites *g, double v)
     if (!(c >= 0.0)) return 0;
     if (c >= (double)g->B) return g->B - 1;
     return (int)c;
+}
+
+/* Difference a - b, on the torus [-1, 1)^2 the shortest one. */
+static double lk_sites_diff(const lk_sites *g, double a, double b)
+{
+    double d = a - b;
+    if (g->wrap) {
+        if (d >= 1.0) d -= 2.0;
+        else if (d < -1.0) d += 2.0;
+    }
+    return d;
+}
+
+/* v wrapped into [-1, 1). */
+static double lk_wrap(double v)
+{
+    if (v >= 1.0) v -= 2.0;
+    if (v < -1.0) v += 2.0;
+    if (v >= 1.0 || v < -1.0) v = 0.0;
+    return v;
 }
 
 static void lk_sites_build(lk_sites *g)
@@ -259,15 +280,18 @@ static int lk_sites_nearest(const lk_sites *g, double qx, double qy)
     for (ring = 0; ring < g->B; ring++) {
         int j;
         for (j = cy - ring; j <= cy + ring; j++) {
-            int i, step = (j == cy - ring || j == cy + ring) ? 1 : 2 * ring;
-            if (j < 0 || j >= g->B) continue;
+            int i, step = (j == cy - ring || j == cy + ring) ? 1 : 2 * ring, jj = j;
+            if (g->wrap) jj = ((j % g->B) + g->B) % g->B;
+            else if (j < 0 || j >= g->B) continue;
             for (i = cx - ring; i <= cx + ring; i += step) {
-                int k, c;
-                if (i < 0 || i >= g->B) continue;
-                c = j * g->B + i;
+                int k, c, ii = i;
+                if (g->wrap) ii = ((i % g->B) + g->B) % g->B;
+                else if (i < 0 || i >= g->B) continue;
+                c = jj * g->B + ii;
                 for (k = g->start[c]; k < g->start[c + 1]; k++) {
                     int s = g->items[k];
-                    double dx = g->xy[2 * s] - qx, dy = g->xy[2 * s + 1] - qy, d2 = dx * dx + dy * dy;
+                    double dx = lk_sites_diff(g, g->xy[2 * s], qx), dy = lk_sites_diff(g, g->xy[2 * s + 1], qy);
+                    double d2 = dx * dx + dy * dy;
                     if (d2 < best || (d2 == best && s < best_i)) {
                         best = d2;
                         best_i = s;
@@ -277,7 +301,7 @@ static int lk_sites_nearest(const lk_sites *g, double qx, double qy)
         }
         if (best_i >= 0) {
             double lim = (double)ring * g->cs;
-            if (best < lim * lim) break;
+            if (best < lim * lim || (g->wrap && 2 * ring > g->B + 2)) break;
         }
     }
     return best_i;
@@ -292,18 +316,22 @@ static void lk_lloyd_pass(lk_sites *g, double *xy, const double *dens, size_t nd
     int i;
     lk_sites_build(g);
     for (i = 0; i < g->n; i++) sum[3 * i] = sum[3 * i + 1] = sum[3 * i + 2] = 0.0;
-    for (k = 0; k < nd; k++) {
+    for (k = 0; k < nd; k++) { /* offsets from the site (shortest on the torus) */
         int s = lk_sites_nearest(g, dens[2 * k], dens[2 * k + 1]);
         assign[k] = s;
-        sum[3 * s] += dens[2 * k];
-        sum[3 * s + 1] += dens[2 * k + 1];
+        sum[3 * s] += lk_sites_diff(g, dens[2 * k], xy[2 * s]);
+        sum[3 * s + 1] += lk_sites_diff(g, dens[2 * k + 1], xy[2 * s + 1]);
         sum[3 * s + 2] += 1.0;
     }
     if (!move) return;
     for (i = 0; i < g->n; i++)
         if (sum[3 * i + 2] > 0.0) {
-            xy[2 * i] = sum[3 * i] / sum[3 * i + 2];
-            xy[2 * i + 1] = sum[3 * i + 1] / sum[3 * i + 2];
+            xy[2 * i] += sum[3 * i] / sum[3 * i + 2];
+            xy[2 * i + 1] += sum[3 * i + 1] / sum[3 * i + 2];
+            if (g->wrap) {
+                xy[2 * i] = lk_wrap(xy[2 * i]);
+                xy[2 * i + 1] = lk_wrap(xy[2 * i + 1]);
+            }
         }
 }
 
@@ -314,9 +342,31 @@ static void lk_disc_uniform(lk_pcg *g, double *x, double *y)
     *y = r * sin(t);
 }
 
-/* The Lloyd / Voronoi-jitter disc of spec A.2 DISC_SAMPLES, into xy (2n). */
+/* Shirley-Chiu concentric map of the square [-1, 1]^2 onto the unit disc (area-preserving:
+ * P. Shirley, K. Chiu, "A Low Distortion Map Between Disk and Square", JGT 2(3), 1997). */
+static void lk_concentric(double a, double b, double *x, double *y)
+{
+    double r, phi;
+    if (a == 0.0 && b == 0.0) {
+        *x = *y = 0.0;
+        return;
+    }
+    if (fabs(a) > fabs(b)) {
+        r = a;
+        phi = (LK_PI / 4.0) * (b / a);
+    } else {
+        r = b;
+        phi = LK_PI / 2.0 - (LK_PI / 4.0) * (a / b);
+    }
+    *x = r * cos(phi);
+    *y = r * sin(phi);
+}
+
+/* The Lloyd / Voronoi-jitter disc of spec A.2 DISC_SAMPLES, into xy (2n). torus != 0: the same
+ * relaxation on the periodic square [-1, 1)^2 (no boundary, so no rim bias), then the concentric
+ * map onto the disc. */
 static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *g,
-                                  const hfvis_allocator *alloc, double *xy)
+                                  const hfvis_allocator *alloc, int torus, double *xy)
 {
     const int G = o->density_resolution;
     int B = 1, i, it;
@@ -326,11 +376,11 @@ static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *
     int *assign;
     lk_sites sites;
     while (B * B * 2 < n) B++; /* about two sites per cell */
-    for (i = 0; i < G; i++) { /* density points: centres of G x G cells inside the disc */
+    for (i = 0; i < G; i++) { /* density points: centres of G x G cells (inside the disc) */
         double y = -1.0 + (2.0 * i + 1.0) / G;
         for (it = 0; it < G; it++) {
             double x = -1.0 + (2.0 * it + 1.0) / G;
-            if (x * x + y * y < LK_DISC_R2) nd++;
+            if (torus || x * x + y * y < LK_DISC_R2) nd++;
         }
     }
     if (!lk_part(&bytes, nd, 2 * sizeof(double)) || !lk_part(&bytes, nd, sizeof(int)) ||
@@ -352,6 +402,7 @@ static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *
     sites.items = (int *)lk_take(&cur, (size_t)n, sizeof(int));
     sites.n = n;
     sites.B = B;
+    sites.wrap = torus;
     sites.cs = 2.0 / B;
     sites.xy = xy;
     k = 0;
@@ -359,16 +410,25 @@ static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *
         double y = -1.0 + (2.0 * i + 1.0) / G;
         for (it = 0; it < G; it++) {
             double x = -1.0 + (2.0 * it + 1.0) / G;
-            if (x * x + y * y < LK_DISC_R2) {
+            if (torus || x * x + y * y < LK_DISC_R2) {
                 dens[2 * k] = x;
                 dens[2 * k + 1] = y;
                 k++;
             }
         }
     }
-    for (i = 0; i < n; i++) lk_disc_uniform(g, xy + 2 * i, xy + 2 * i + 1);
+    for (i = 0; i < n; i++) { /* 1. random points */
+        if (torus) {
+            xy[2 * i] = lk_wrap(2.0 * lk_pcg_unit(g) - 1.0);
+            xy[2 * i + 1] = lk_wrap(2.0 * lk_pcg_unit(g) - 1.0);
+        } else {
+            lk_disc_uniform(g, xy + 2 * i, xy + 2 * i + 1);
+        }
+    }
+    /* 2. Lloyd relaxation */
     for (it = 0; it < o->lloyd_iterations; it++) lk_lloyd_pass(&sites, xy, dens, nd, assign, sum, 1);
-    /* Voronoi jitter: each site -> a uniform point of its own cell (cells of the relaxed set) */
+    /* 3. Voronoi jitter: each site -> a uniform point of its own cell (cells of the relaxed set,
+     * sampled by rejection in the box of its density points, offsets from the site) */
     lk_lloyd_pass(&sites, xy, dens, nd, assign, sum, 0);
     for (i = 0; i < n; i++) {
         box[4 * i] = box[4 * i + 1] = DBL_MAX;
@@ -376,10 +436,12 @@ static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *
     }
     for (k = 0; k < nd; k++) {
         double *b = box + 4 * assign[k];
-        if (dens[2 * k] < b[0]) b[0] = dens[2 * k];
-        if (dens[2 * k + 1] < b[1]) b[1] = dens[2 * k + 1];
-        if (dens[2 * k] > b[2]) b[2] = dens[2 * k];
-        if (dens[2 * k + 1] > b[3]) b[3] = dens[2 * k + 1];
+        double dx = lk_sites_diff(&sites, dens[2 * k], xy[2 * assign[k]]);
+        double dy = lk_sites_diff(&sites, dens[2 * k + 1], xy[2 * assign[k] + 1]);
+        if (dx < b[0]) b[0] = dx;
+        if (dy < b[1]) b[1] = dy;
+        if (dx > b[2]) b[2] = dx;
+        if (dy > b[3]) b[3] = dy;
     }
     for (i = 0; i < n; i++) {
         const double *b = box + 4 * i, h = 1.0 / G;
@@ -388,9 +450,15 @@ static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *
         jit[2 * i + 1] = xy[2 * i + 1];
         if (b[0] > b[2]) continue; /* no density point: keep the site */
         for (a = 0; a < LK_JITTER_ATTEMPTS; a++) {
-            double qx = b[0] - h + (b[2] - b[0] + 2.0 * h) * lk_pcg_unit(g);
-            double qy = b[1] - h + (b[3] - b[1] + 2.0 * h) * lk_pcg_unit(g);
-            if (qx * qx + qy * qy < LK_DISC_R2 && lk_sites_nearest(&sites, qx, qy) == i) {
+            double qx = xy[2 * i] + b[0] - h + (b[2] - b[0] + 2.0 * h) * lk_pcg_unit(g);
+            double qy = xy[2 * i + 1] + b[1] - h + (b[3] - b[1] + 2.0 * h) * lk_pcg_unit(g);
+            if (torus) {
+                qx = lk_wrap(qx);
+                qy = lk_wrap(qy);
+            } else if (!(qx * qx + qy * qy < LK_DISC_R2)) {
+                continue;
+            }
+            if (lk_sites_nearest(&sites, qx, qy) == i) {
                 jit[2 * i] = qx;
                 jit[2 * i + 1] = qy;
                 break;
@@ -398,7 +466,17 @@ static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *
         }
     }
     memcpy(xy, jit, sizeof(double) * 2 * (size_t)n);
+    /* 4. a few more Lloyd steps */
     for (it = 0; it < o->final_iterations; it++) lk_lloyd_pass(&sites, xy, dens, nd, assign, sum, 1);
+    if (torus) {
+        const double sc = sqrt(LK_DISC_R2);
+        for (i = 0; i < n; i++) {
+            double x, y;
+            lk_concentric(xy[2 * i], xy[2 * i + 1], &x, &y);
+            xy[2 * i] = sc * x;
+            xy[2 * i + 1] = sc * y;
+        }
+    }
     lk_free(alloc, block);
     return HFVIS_OK;
 }
@@ -526,7 +604,7 @@ HFVIS_API hfvis_status hfvis_lk_rays_build(int count, double radius,
         o.falloff_fn = opts->falloff_fn;
         o.falloff_user = opts->falloff_user;
     }
-    if ((o.pattern != HFVIS_LK_PATTERN_LLOYD && o.pattern != HFVIS_LK_PATTERN_RANDOM) ||
+    if (o.pattern < HFVIS_LK_PATTERN_LLOYD || o.pattern > HFVIS_LK_PATTERN_LLOYD_TORUS ||
         o.lloyd_iterations < 1 || o.lloyd_iterations > 10000 || o.final_iterations < 1 ||
         o.final_iterations > 10000 || o.density_resolution < 16 || o.density_resolution > 2048 ||
         o.falloff < HFVIS_LK_FALLOFF_CONSTANT || o.falloff > HFVIS_LK_FALLOFF_CUSTOM)
@@ -546,8 +624,8 @@ HFVIS_API hfvis_status hfvis_lk_rays_build(int count, double radius,
     xy = r.point;
     keys = (uint64_t *)(void *)r.length;
     lk_pcg_seed(&g, o.seed, 0x4C4B31u);
-    if (o.pattern == HFVIS_LK_PATTERN_LLOYD) {
-        s = lk_disc_lloyd(count, &o, &g, o.alloc, xy);
+    if (o.pattern == HFVIS_LK_PATTERN_LLOYD || o.pattern == HFVIS_LK_PATTERN_LLOYD_TORUS) {
+        s = lk_disc_lloyd(count, &o, &g, o.alloc, o.pattern == HFVIS_LK_PATTERN_LLOYD_TORUS, xy);
         if (s != HFVIS_OK) {
             lk_free(o.alloc, r.direction);
             return s;

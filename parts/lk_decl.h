@@ -74,7 +74,16 @@ typedef enum hfvis_lk_pattern {
                                      point replaced by a uniform random point of its Voronoi
                                      cell, final_iterations more steps (cells estimated on a
                                      density_resolution^2 grid of the disc, spec A.2) */
-    HFVIS_LK_PATTERN_RANDOM = 2   /* independent uniform points of the disc (for tests) */
+    HFVIS_LK_PATTERN_RANDOM = 2,  /* independent uniform points of the disc (for tests) */
+    HFVIS_LK_PATTERN_LLOYD_TORUS = 3 /* the same relaxation and jitter on the periodic square,
+                                        mapped onto the disc by the area-preserving concentric
+                                        map of Shirley & Chiu 1997. On the disc the Lloyd
+                                        centroids of the rim cells lie inward, so LLOYD leaves
+                                        the outermost ring of points about half a cell inside
+                                        the rim and under-samples grazing directions (N = 1024:
+                                        no point beyond rho = 0.995, and the AO of a plane at
+                                        h = 0.3 r comes out about 0.01 low); the torus has no
+                                        rim (moments within about 0.005 at N = 1024) */
 } hfvis_lk_pattern;
 
 /* The falloff rho(x) of the normalised occluder distance x = D/r, non-increasing, rho = 0 from
@@ -421,8 +430,9 @@ HFVIS_API hfvis_status hfvis_lk_gbuffer_receivers(const hfvis_mesh *mesh, const 
  * Returns HFVIS_OK; HFVIS_ERR_INVALID_ARGUMENT for NULL mesh/view/rays, both outputs NULL, an
  * invalid mesh, view or ray set, bad options or a window beyond the radius; the rasterizer's
  * HFVIS_ERR_LIMIT; HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on error.
- * Memory: 5 blocks: the rasterizer's outputs and scratch, 12 doubles per pixel with a receiver,
- * 40 bytes per triangle, the masks (when masks is NULL). Cost O(T + covered pixels * N). */
+ * Memory: 3 blocks: the G-buffer (12 bytes per pixel), the rasterizer's scratch, and one block
+ * of 4 bytes per pixel plus 104 bytes per receiver (plus its masks when masks is NULL).
+ * Cost O(T + covered pixels * N). */
 HFVIS_API hfvis_status hfvis_lk_raster(const hfvis_mesh *mesh, const hfvis_view *view,
                                        const hfvis_lk_rays *rays, const hfvis_lk_options *opts,
                                        uint32_t *masks, float *obscurance, hfvis_lk_stats *stats);
@@ -438,8 +448,8 @@ HFVIS_API hfvis_status hfvis_lk_raster(const hfvis_mesh *mesh, const hfvis_view 
  * recv->count*words, obscurance: recv->count; either may be NULL (not both).
  * Returns HFVIS_OK; HFVIS_ERR_INVALID_ARGUMENT for NULL, an invalid mesh, ray set or receiver
  * (non-finite, zero normal), a BVH that does not match the mesh or is malformed, bad options;
- * HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on error. Memory: 3 blocks (40 bytes per
- * triangle, the BVH check, the traversal stack). */
+ * HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on error. Memory: 1 block (32 bytes per
+ * triangle, 1 byte per node, the traversal stack). */
 HFVIS_API hfvis_status hfvis_lk_bvh(const hfvis_mesh *mesh, const hfvis_bvh *bvh,
                                     const hfvis_lk_rays *rays, const hfvis_lk_receivers *recv,
                                     const hfvis_lk_options *opts, uint32_t *masks,
@@ -450,7 +460,8 @@ HFVIS_API hfvis_status hfvis_lk_bvh(const hfvis_mesh *mesh, const hfvis_bvh *bvh
  * widened by 2^-40) with an any-hit query; the ray-triangle test is opts->raycast_test (EXACT:
  * the blocking predicate, so the masks equal Methods 1 and 2 bit for bit; WATERTIGHT: the
  * library's float hfvis_bvh_intersect). Arguments, outputs and errors as hfvis_lk_bvh (its
- * options mask_mode, node_mask and cull do not apply). Memory: 3 blocks. Cost O(rays log T). */
+ * options mask_mode, node_mask and cull do not apply). Memory: 1 block, as hfvis_lk_bvh. Cost
+ * O(rays log T). */
 HFVIS_API hfvis_status hfvis_lk_raycast(const hfvis_mesh *mesh, const hfvis_bvh *bvh,
                                         const hfvis_lk_rays *rays,
                                         const hfvis_lk_receivers *recv,

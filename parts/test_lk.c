@@ -15,10 +15,11 @@
 
 /* Tolerances (each with its reason) */
 #define TOL_UNIT 1e-14        /* |u| = 1, orthonormal frames: a few double roundings */
-#define TOL_MOMENT_LLOYD 0.01 /* mean u_z, u_z^2 of a Lloyd set of N >= 128: relaxed sets are
-                                 within ~1/N of the moments; 0.01 leaves room for N = 128 */
-#define TOL_CLOSED_1024 0.02  /* continuous-limit closed forms vs W_N at N = 1024 (Lloyd set:
-                                 the discrepancy of 1024 relaxed points is below 1e-2) */
+#define TOL_MOMENT_LLOYD 0.02 /* mean u_z, u_z^2 of a Lloyd disc set, N >= 128: the rim cells'
+                                 centroids lie inward (measured 0.004..0.016 over seeds) */
+#define TOL_MOMENT_TORUS 0.01 /* the torus-relaxed set has no rim (measured <= 0.008) */
+#define TOL_CLOSED_1024 0.02  /* continuous-limit closed forms vs W_N at N = 1024: the finite
+                                 set's discrepancy (Lloyd disc: rim effect, up to ~0.016) */
 #define TOL_LINEAR_FALLOFF 0.03 /* linear falloff: stratified lengths paired at random with
                                    the directions add O(1/sqrt(N)) ~ 0.03 of noise */
 #define TOL_ON_PLANE 1e-12    /* G-buffer receivers lie on their triangle's plane (double) */
@@ -343,6 +344,23 @@ TEST(rays_lloyd_set)
         hfvis_lk_rays_free(NULL, &b);
         hfvis_lk_rays_free(NULL, &c);
         CHECK(a.direction == NULL && a.count == 0);
+    }
+    { /* LLOYD_TORUS: no rim bias */
+        hfvis_lk_ray_options o = hfvis_lk_ray_options_default();
+        hfvis_lk_rays r;
+        double mz = 0.0, mz2 = 0.0;
+        int i;
+        o.pattern = HFVIS_LK_PATTERN_LLOYD_TORUS;
+        CHECK_EQ_STATUS(hfvis_lk_rays_build(512, 1.0, &o, &r), HFVIS_OK);
+        for (i = 0; i < 512; i++) {
+            mz += r.direction[3 * i + 2];
+            mz2 += r.direction[3 * i + 2] * r.direction[3 * i + 2];
+        }
+        printf("  torus N=512: mean u_z %.5f, mean u_z^2 %.5f\n", mz / 512.0, mz2 / 512.0);
+        CHECK_NEAR(mz / 512.0, 2.0 / 3.0, TOL_MOMENT_TORUS, 0.0);
+        CHECK_NEAR(mz2 / 512.0, 0.5, TOL_MOMENT_TORUS, 0.0);
+        CHECK(r.min_elevation > 0.0);
+        hfvis_lk_rays_free(NULL, &r);
     }
     { /* RANDOM pattern: plain i.i.d. points, looser moments */
         hfvis_lk_ray_options o = hfvis_lk_ray_options_default();
@@ -1140,12 +1158,12 @@ TEST(three_methods_identical_on_meshes)
         const double c0[3] = {0.0, 0.0, 0.0}, e2[3] = {0.3, -3.0, 2.0}, t2[3] = {0.0, 0.0, 0.0};
         const double up[3] = {0.0, 0.0, 1.0};
         hfvis_view ov;
-        hfvis_lk_rays r32 = make_rays(32, 0.6, HFVIS_LK_FALLOFF_LINEAR, 33);
+        hfvis_lk_rays r32 = make_rays(32, 0.9, HFVIS_LK_FALLOFF_CONSTANT, 33);
         CHECK_EQ_STATUS(hfvis_mesh_torus_knot(NULL, c0, 1.0, 2, 3, 240, 10, &k), HFVIS_OK);
         hfvis_view_orthographic(&ov, e2, t2, up, 1.8, 56, 40, 0.1, 10.0);
         o = hfvis_lk_options_default();
         bad = three_way(&k, &ov, &r32, &o, &n, &blocked, NULL, NULL);
-        printf("  torus knot (%zu triangles, orthographic), N=32 linear falloff r=0.6: %zu receivers, "
+        printf("  torus knot (%zu triangles, orthographic), N=32 r=0.9: %zu receivers, "
                "%.3f blocked, %ld differ\n", k.triangle_count, n, (double)blocked / ((double)n * 32), bad);
         CHECK(bad == 0 && blocked > 100);
         hfvis_mesh_free(NULL, &k);
