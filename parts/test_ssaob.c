@@ -321,7 +321,7 @@ TEST(ffao_closed_forms)
             sc.kind = HFVIS_SSAO_SCENE_PIT;
             sc.radius = 2.0;
         }
-        CHECK(scene_make(&s, 0, 112, 80, 20, 16, pix, &sc));
+        CHECK(scene_make(&s, 0, 128, 96, 24, 18, pix, &sc));
         CHECK_EQ_STATUS(hfvis_ffao(&s.cam, s.depth, s.nrm, &o, s.a, s.IW), HFVIS_OK);
         CHECK_EQ_STATUS(hfvis_ssao_raytrace(&s.cam, s.depth, s.nrm, &ro, s.b, s.IW), HFVIS_OK);
         py = s.IH / 2;
