@@ -13,10 +13,10 @@
 #include <string.h>
 #include "hfvis.h"
 
-#define W0 384
-#define H0 288
-#define GX 32
-#define GY 24
+#define W0 256
+#define H0 192
+#define GX 24
+#define GY 18
 #define IW (W0 - 2 * GX)
 #define IH (H0 - 2 * GY)
 
@@ -88,7 +88,7 @@ int main(int argc, char **argv)
     {
         hfvis_ssao_rt_options o = hfvis_ssao_rt_options_default();
         o.falloff = fo;
-        o.rays = 128;
+        o.rays = 48;
         if (hfvis_ssao_raytrace(&cam, depth, nrm, &o, ao[3], IW) != HFVIS_OK) goto fail;
     }
     for (k = 0; k < 4; k++)
