@@ -97,43 +97,62 @@ HFVIS_API hfvis_status hfvis_visfield_position(int positions_n, size_t k, double
     return HFVIS_OK;
 }
 
-/* The dot product every nearest-sample search ranks by: q . u (the same expression for the fast
- * search and the oracle, so that they agree bit for bit). */
-static double vx_vf_dot(const double q[3], const double u[3])
+/* The key every nearest-sample search ranks lattice point (a, b, cs) by, cs = +-(n - |a| - |b|)
+ * (the sign of its hemisphere): with d = q . (a, b, cs) and L = a^2 + b^2 + cs^2 (exact), the key
+ * d |d| / L = |q|^2 cos|cos| is monotone in the cosine of the angle between q and the sample, so
+ * its maximum is the nearest sample, and it needs no square root. One expression for the fast
+ * search and the oracle, so that they agree bit for bit. */
+static double vx_vf_key(const double q[3], int a, int b, int cs)
 {
-    return q[0] * u[0] + q[1] * u[1] + q[2] * u[2];
+    double L = (double)((long long)a * a + (long long)b * b + (long long)cs * cs);
+    double d = q[0] * (double)a + q[1] * (double)b + q[2] * (double)cs;
+    return d * fabs(d) / L;
 }
 
 /* Nearest sample to q (finite, not zero): radial projection onto the octahedron face of q's
- * hemisphere, the 3 x 3 lattice points around it, ranked by q . u; equal dot products go to the
- * lower index, where an equator point counts with its upper copy's index (same point, same dot
- * product, lower index): the oracle's rule exactly. */
+ * hemisphere, the (up to) 9 lattice points of the 3 x 3 window around it, ranked by vx_vf_key;
+ * equal keys go to the lower index, where an equator point counts with its upper copy's index
+ * (same point, same key, lower index): the oracle's rule exactly. Returns the index and the
+ * winner's lattice point (*h, *a, *b), the equator in the upper hemisphere. */
+static size_t vx_vf_nearest_abh(int n, const double q[3], int *ph, int *pa, int *pb)
+{
+    int h = q[2] < 0.0, ra, rb, a, b, m = 0, i, best = 0;
+    int ca[9], cb[9], cc[9];
+    double key[9], qz = fabs(q[2]), s = fabs(q[0]) + fabs(q[1]) + qz;
+    size_t best_k = 0;
+    ra = (int)floor(q[0] / s * (double)n + 0.5);
+    rb = (int)floor(q[1] / s * (double)n + 0.5);
+    for (b = rb - 1; b <= rb + 1; b++)
+        for (a = ra - 1; a <= ra + 1; a++) {
+            int c = n - abs(a) - abs(b);
+            if (b < -n || b > n || c < 0) continue;
+            ca[m] = a;
+            cb[m] = b;
+            cc[m] = h ? -c : c;
+            m++;
+        }
+    HFVIS_ASSERT(m > 0);
+    for (i = 0; i < m; i++) key[i] = vx_vf_key(q, ca[i], cb[i], cc[i]); /* independent: pipelined */
+    for (i = 1; i < m; i++) {
+        if (key[i] < key[best]) continue;
+        if (key[i] == key[best]) { /* a tie: the lower index wins */
+            size_t ki = vx_vf_encode_index(n, cc[i] == 0 ? 0 : h, ca[i], cb[i]);
+            best_k = vx_vf_encode_index(n, cc[best] == 0 ? 0 : h, ca[best], cb[best]);
+            if (ki >= best_k) continue;
+        }
+        best = i;
+    }
+    *ph = cc[best] == 0 ? 0 : h;
+    *pa = ca[best];
+    *pb = cb[best];
+    best_k = vx_vf_encode_index(n, *ph, *pa, *pb);
+    return best_k;
+}
+
 static size_t vx_vf_nearest(int n, const double q[3])
 {
-    int h = q[2] < 0.0, ra, rb, a, b, found = 0;
-    double qz = fabs(q[2]), s = fabs(q[0]) + fabs(q[1]) + qz, best = -HUGE_VAL, u[3];
-    double ox = q[0] / s * (double)n, oy = q[1] / s * (double)n;
-    size_t best_k = 0;
-    ra = (int)floor(ox + 0.5);
-    rb = (int)floor(oy + 0.5);
-    for (b = rb - 1; b <= rb + 1; b++) {
-        if (b < -n || b > n) continue;
-        for (a = ra - 1; a <= ra + 1; a++) {
-            double dd;
-            size_t kk;
-            if (abs(a) + abs(b) > n) continue;
-            vx_vf_oct_dir(n, a, b, h, u);
-            dd = vx_vf_dot(q, u);
-            kk = vx_vf_encode_index(n, abs(a) + abs(b) == n ? 0 : h, a, b);
-            if (!found || dd > best || (dd == best && kk < best_k)) {
-                best = dd;
-                best_k = kk;
-                found = 1;
-            }
-        }
-    }
-    HFVIS_ASSERT(found);
-    return best_k;
+    int h, a, b;
+    return vx_vf_nearest_abh(n, q, &h, &a, &b);
 }
 
 static int vx_vf_vec_ok(const double v[3])
@@ -154,15 +173,15 @@ HFVIS_API hfvis_status hfvis_visfield_nearest_position_naive(int positions_n, co
                                                              size_t *k)
 {
     size_t K, i, best_i = 0;
-    double best = -HUGE_VAL, u[3];
+    double best = -HUGE_VAL;
     if (!vx_vf_n_valid(positions_n) || !vx_vf_vec_ok(q) || !k) return HFVIS_ERR_INVALID_ARGUMENT;
     K = 2u * vx_vf_hemi(positions_n);
     for (i = 0; i < K; i++) {
         double dd;
-        int h, a, b;
+        int h, a, b, c;
         vx_vf_decode_index(positions_n, i, &h, &a, &b);
-        vx_vf_oct_dir(positions_n, a, b, h, u);
-        dd = vx_vf_dot(q, u);
+        c = positions_n - abs(a) - abs(b);
+        dd = vx_vf_key(q, a, b, h ? -c : c);
         if (i == 0 || dd > best) {
             best = dd;
             best_i = i;
@@ -757,9 +776,8 @@ static int vx_vf_lookup(const hfvis_visfield *vf, const double rel[3], const dou
     const int n = vf->positions_n, D = vf->dir_res;
     const hfvis_visfield_format f = vx_vf_format(vf->format);
     double u[3], w[3], t[3], b[3], l[3];
-    size_t k = vx_vf_nearest(n, rel);
     int h, aa, bb, i, j;
-    vx_vf_decode_index(n, k, &h, &aa, &bb);
+    size_t k = vx_vf_nearest_abh(n, rel, &h, &aa, &bb);
     vx_vf_oct_dir(n, aa, bb, h, u);
     w[0] = -u[0];
     w[1] = -u[1];
