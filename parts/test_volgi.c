@@ -1376,9 +1376,11 @@ TEST(volgi_bad_arguments)
                     HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_volgi_propagate(&geo, NULL, 0, p, a, &e), HFVIS_OK);
     /* options */
-    for (i = 0; i < 9; i++) {
+    for (i = 0; i < 11; i++) {
         o = hfvis_volgi_options_default();
         switch (i) {
+        case 9: o.paths = (hfvis_volgi_paths)2; break;
+        case 10: o.resolution = HFVIS_VOLGI_MAX_RESOLUTION + 1; break;
         case 0: o.transfer = (hfvis_volgi_transfer)7; break;
         case 1: o.reflection = (hfvis_volgi_reflection)-1; break;
         case 2: o.reflectance_source = (hfvis_volgi_reflectance)3; break;
@@ -1391,10 +1393,31 @@ TEST(volgi_bad_arguments)
         }
         CHECK_EQ_STATUS(hfvis_volgi_propagate_step(&geo, &o, p, q, a, &e), HFVIS_ERR_INVALID_ARGUMENT);
         CHECK_EQ_STATUS(hfvis_volgi_propagate(&geo, &o, 1, p, a, &e), HFVIS_ERR_INVALID_ARGUMENT);
-        if (i < 8) CHECK_EQ_STATUS(hfvis_volgi_gather(&geo, a, &o, pt, up, E), HFVIS_ERR_INVALID_ARGUMENT);
+        if (i != 8) CHECK_EQ_STATUS(hfvis_volgi_gather(&geo, a, &o, pt, up, E), HFVIS_ERR_INVALID_ARGUMENT);
     }
     CHECK(memcmp(q, q0, 12 * t.n * sizeof(float)) == 0);
     CHECK(memcmp(&e, &e0, sizeof e) == 0);
+    /* resolve: the defaults filled in, the same rejections */
+    {
+        hfvis_volgi_options r, z;
+        memset(&z, 0, sizeof z);
+        CHECK_EQ_STATUS(hfvis_volgi_options_resolve(&z, &r), HFVIS_OK);
+        CHECK(r.iterations == 64 && r.resolution == 32 && r.reflectance == 0.5f
+              && r.gather_scale == 12.0 / 7.0 && r.paths == HFVIS_VOLGI_PATHS_ALL && r.shadow_bias == 0.0);
+        CHECK_EQ_STATUS(hfvis_volgi_options_resolve(NULL, &r), HFVIS_OK);
+        CHECK(r.iterations == 64);
+        z.reflectance_source = HFVIS_VOLGI_REFLECTANCE_CONSTANT, z.reflectance = 0.25f;
+        CHECK_EQ_STATUS(hfvis_volgi_options_resolve(&z, &r), HFVIS_OK);
+        CHECK(r.reflectance == 0.25f);
+        z.paths = (hfvis_volgi_paths)2;
+        r.iterations = -7;
+        CHECK_EQ_STATUS(hfvis_volgi_options_resolve(&z, &r), HFVIS_ERR_INVALID_ARGUMENT);
+        CHECK(r.iterations == -7);
+        CHECK_EQ_STATUS(hfvis_volgi_options_resolve(NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+        z = hfvis_volgi_options_default();
+        z.resolution = 1;
+        CHECK_EQ_STATUS(hfvis_volgi_options_resolve(&z, &r), HFVIS_ERR_INVALID_ARGUMENT);
+    }
     /* gather */
     CHECK_EQ_STATUS(hfvis_volgi_gather(&geo, a, NULL, pt, zero, E), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_volgi_gather(&geo, a, NULL, nanv, up, E), HFVIS_ERR_INVALID_ARGUMENT);

@@ -150,6 +150,30 @@ static hfvis_status vx_gi_resolve(const hfvis_volgi_options *o, vx_gi_cfg *c)
     return HFVIS_OK;
 }
 
+HFVIS_API hfvis_status hfvis_volgi_options_resolve(const hfvis_volgi_options *opts,
+                                                   hfvis_volgi_options *out)
+{
+    vx_gi_cfg c;
+    hfvis_volgi_options r;
+    hfvis_status s;
+    if (!out) return HFVIS_ERR_INVALID_ARGUMENT;
+    s = vx_gi_resolve(opts, &c);
+    if (s != HFVIS_OK) return s;
+    memset(&r, 0, sizeof r);
+    r.alloc = c.alloc;
+    r.iterations = c.iterations;
+    r.resolution = c.resolution;
+    r.transfer = c.transfer;
+    r.reflection = c.reflection;
+    r.reflectance_source = c.rsrc;
+    r.paths = c.paths;
+    r.reflectance = c.rsrc == HFVIS_VOLGI_REFLECTANCE_ALBEDO ? (opts ? opts->reflectance : 0.0f) : (float)c.rho;
+    r.gather_scale = c.gather_scale;
+    r.shadow_bias = c.shadow_bias;
+    *out = r;
+    return HFVIS_OK;
+}
+
 /* The transport constants, for the six travel directions o in the order +x, -x, +y, -y, +z, -z:
  * Cone45(o) and CC(o) as 4-vectors (from the public helpers, so that the fast kernel and the
  * reference use the same bits), and the sparse form the fast kernel uses. */

@@ -150,8 +150,18 @@ typedef struct hfvis_volgi_options {
 } hfvis_volgi_options;
 
 /* The defaults above, filled in (alloc NULL, iterations 64, resolution 32, CONE, MIRROR,
- * THESIS, reflectance 0.5, gather_scale 12/7, shadow_bias 0 = relative to the scene). */
+ * THESIS, ALL, reflectance 0.5, gather_scale 12/7, shadow_bias 0 = relative to the scene). */
 HFVIS_API hfvis_volgi_options hfvis_volgi_options_default(void);
+
+/* The parameters a call with opts uses (so that a port can print them): every 0 replaced by its
+ * default, reflectance = the rho in use (0.5 for THESIS; unchanged for ALBEDO); shadow_bias stays
+ * 0 when it is relative to the scene. opts may be NULL. Returns HFVIS_OK, or
+ * HFVIS_ERR_INVALID_ARGUMENT for a NULL out or an invalid field (out untouched): an unknown enum,
+ * iterations outside 0..HFVIS_VOLGI_MAX_ITERATIONS, resolution outside 0, 2..2048, a reflectance
+ * outside [0, 1] with CONSTANT, a negative or non-finite gather_scale or shadow_bias. Every
+ * hfvis_volgi_* routine that takes options rejects the same fields. */
+HFVIS_API hfvis_status hfvis_volgi_options_resolve(const hfvis_volgi_options *opts,
+                                                   hfvis_volgi_options *out);
 
 /* ---- the geometry volume and the transport ------------------------------------------------ */
 
@@ -213,11 +223,14 @@ HFVIS_API hfvis_status hfvis_volgi_inject(const hfvis_volgi_geometry *geometry,
  * first step: the thesis' A starts at zero, so direct light is not in A). energy may be NULL;
  * otherwise it receives the step's accounting (one extra pass over prop_in).
  * prop_in and accum must not overlap prop_out; prop_in may not overlap accum.
+ * With HFVIS_VOLGI_PATHS_VOID every transfer j -> i is weighted by 1 - alpha_j alpha_i.
  * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL arrays, an invalid geometry, invalid
- * options (unknown enum, reflectance outside [0, 1], HFVIS_VOLGI_REFLECTANCE_ALBEDO without
- * albedo), or a prop_in or accum value that is not finite or above HFVIS_VOLGI_MAX_VALUE in
- * magnitude; outputs untouched then. Allocates nothing with the default transfer; the normalised
- * transfer allocates one block of 24 bytes per voxel (HFVIS_ERR_OUT_OF_MEMORY).
+ * options (hfvis_volgi_options_resolve; also HFVIS_VOLGI_REFLECTANCE_ALBEDO without albedo), or a
+ * prop_in or accum value that is not finite or above HFVIS_VOLGI_MAX_VALUE in magnitude;
+ * HFVIS_ERR_LIMIT when an SH volume of the grid would exceed SIZE_MAX bytes (32-bit builds);
+ * outputs untouched then. Allocates nothing with the default transfer; the normalised transfer
+ * allocates one block of 24 bytes per voxel (HFVIS_ERR_OUT_OF_MEMORY). The inputs are checked
+ * on every call (O(voxels), about a quarter of a step): use hfvis_volgi_propagate for loops.
  * Cost: O(voxels); about 6 x 3 x 4 floating-point operations and 7 voxel reads per voxel.
  * Exact: equals hfvis_volgi_propagate_step_reference bit for bit. */
 HFVIS_API hfvis_status hfvis_volgi_propagate_step(const hfvis_volgi_geometry *geometry,
@@ -260,7 +273,14 @@ HFVIS_API hfvis_status hfvis_volgi_propagate(const hfvis_volgi_geometry *geometr
  * s_n^2 is the grid face perpendicular to n's dominant axis: accum holds flux, E is irradiance.
  * kappa = opts->gather_scale (default 12/7 = 1/(7/12), the SH self-product of the clamped cosine
  * over pi: a flux F arriving head on as the lobe (F/pi) CC(-n) gives exactly F/s^2). The
- * absolute scale is the library's choice: the thesis gives none. No occupied voxel among the 8:
+ * absolute scale is the library's choice: the thesis gives none. Accuracy (measured in the
+ * tests): two parallel plates 9 voxels apart, emitter radiance L, absorbing receiver; the exact
+ * irradiance at the receiver's centre is 0.858 pi L, this method gives 0.9 % of it with the
+ * CONE transfer (each step forwards only (3 - sqrt 2)/4 of a lobe along its axis and spreads the
+ * rest sideways, where the 45-degree cones lose a share), 10.5 % with CONE_NORMALIZED and 26 %
+ * with CONE_NORMALIZED and HFVIS_VOLGI_PATHS_VOID: the transport is a diffusion over a few voxels,
+ * good for relative, short-range effects (colour bleeding, contact light), not for absolute
+ * radiometry. No occupied voxel among the 8:
  * E = 0. Outgoing indirect radiance is albedo E / pi (DESIGN §2).
  * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL, an invalid geometry (not re-checked
  * per value: O(1) call; the arrays are only read at the 8 voxels), a non-finite point, a zero or
@@ -310,7 +330,8 @@ typedef struct hfvis_volgi_scene {
  * lights) when the shadow ray from point toward the light (BVH any-hit, both faces block, for
  * t in [bias, d - bias], bias = opts->shadow_bias or 1e-5 times the diagonal of the BVH's root
  * box) meets no triangle other than skip_triangle (the receiver's own triangle, or
- * HFVIS_NO_TRIANGLE). A receiver on the light's position (d <= bias) gets nothing from it.
+ * HFVIS_NO_TRIANGLE); directional lights: t in [bias, infinity) along -direction. A receiver
+ * within 2 bias of a point or spot light gets nothing from it.
  * scene->bvh must be the mesh's BVH; the mesh is not re-checked (O(lights x log T) per call).
  * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL, a NULL bvh or one whose
  * triangle_count differs from the mesh's, an invalid light, non-finite point or normal, a zero
@@ -377,19 +398,24 @@ typedef struct hfvis_volgi_render_info {
 /* The whole pipeline for one view: G-buffer (hfvis_rasterize: triangle id, barycentrics, world
  * normal; no culling) -> voxelization with direct light (hfvis_volgi_voxelize over grid, or, when
  * grid is NULL, over hfvis_volgi_grid_fit(mesh, opts->resolution)) -> VPL injection ->
- * opts->iterations propagation steps -> per covered pixel, at the exact surface point (from the
- * barycentrics) with the face normal: direct = emission + albedo E_direct/pi (shadow rays,
- * hfvis_volgi_direct_irradiance), indirect = albedo E_indirect/pi (hfvis_volgi_gather with the
- * face normal as the front side is lit; back faces see the light behind them: gather with
- * the face normal regardless of the viewer), total = direct + indirect.
- * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT (NULL scene, view or outputs, every output
- * NULL is fine), the errors of hfvis_rasterize, hfvis_volgi_voxelize and hfvis_volgi_propagate,
- * HFVIS_ERR_OUT_OF_MEMORY; outputs and info untouched on error.
- * Memory (opts->alloc): the BVH if scene->bvh is NULL (four blocks, two kept until return), 88
- * bytes per voxel in three blocks (geometry, SH volumes, the voxelizer's scratch, freed before the
- * propagation), the propagation's scratch (48 or 72 bytes per voxel), 28 bytes per pixel of
- * G-buffer and the rasterizer's scratch. Cost: the voxelization, iterations x voxels, and
- * width x height x (lights shadow rays + 8 voxel reads). Deterministic. */
+ * opts->iterations propagation steps (hfvis_volgi_propagate with opts) -> per covered pixel, at
+ * the exact surface point (from the barycentrics) with the face normal of its triangle (the lit
+ * side is the front side, hfvis_volgi_scene; a back face seen by the camera is shaded as what it
+ * is, the unlit side):
+ *   direct = emission + albedo E_direct/pi   (shadow rays, hfvis_volgi_direct_irradiance),
+ *   indirect = albedo E_indirect/pi          (hfvis_volgi_gather),
+ *   total = direct + indirect                (the two floats added in double, rounded once).
+ * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT (NULL scene, view or outputs; every output NULL
+ * is fine), the errors of hfvis_rasterize (invalid view: HFVIS_ERR_INVALID_ARGUMENT; width or
+ * height > HFVIS_RASTER_MAX_SIZE: HFVIS_ERR_LIMIT), hfvis_volgi_grid_fit, hfvis_volgi_voxelize and
+ * hfvis_volgi_propagate, HFVIS_ERR_OUT_OF_MEMORY; outputs and info untouched on error.
+ * Memory (opts->alloc), in this order: a G-buffer block of 24 bytes per pixel and the
+ * rasterizer's scratch; the BVH when scene->bvh is NULL (hfvis_bvh_build: four blocks, two kept
+ * until return); the geometry block (40 bytes per voxel); the voxelizer's scratch (40 bytes per
+ * voxel, freed before the next); the P and A volumes (96 bytes per voxel); the propagation's
+ * scratch (48 bytes per voxel, + 24 normalised): 6 blocks with a scene BVH, 10 without.
+ * Cost: the voxelization, iterations x voxels, and per pixel (lights shadow rays + 8 voxel reads).
+ * Deterministic (bit-exact on one build). */
 HFVIS_API hfvis_status hfvis_volgi_render(const hfvis_volgi_scene *scene,
                                           const hfvis_volume_grid *grid, const hfvis_view *view,
                                           const hfvis_volgi_options *opts,
