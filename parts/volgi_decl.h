@@ -34,6 +34,17 @@
  *   "90-degree cone"), Cone(d) = (sqrt(pi)(1 - cos 45), (sqrt(3 pi)/2) sin^2 45 d_y, ...).
  * - All transport arithmetic is double, rounded to float once per stored value. Determinism:
  *   same inputs, same binary, same bits.
+ * - Choices the thesis leaves open [C] (spec §2.9), each an option where it matters: the VPL scale
+ *   (the flux of one voxel face, above); the meaning of eq. 11 (hfvis_volgi_transfer: per
+ *   neighbour the cone flux, re-expanded as a cosine lobe along the travel direction, negative SH
+ *   ringing clamped); transfers between two occupied voxels (hfvis_volgi_paths); the mirror axis
+ *   (dominant axis of the average normal, ties to the lowest axis; no normal: all three) or a
+ *   diffuse re-emission (hfvis_volgi_reflection); partial occupancy as transparency (1 - alpha
+ *   passes unchanged); light sent out of the grid is lost; A starts at zero (direct light is not
+ *   in A; the first bounce's albedo is in the injected radiance); rho after the first bounce
+ *   (hfvis_volgi_reflectance); normals and albedo averaged, radiance MAX-merged
+ *   (hfvis_volgi_voxelize); the gather's renormalised trilinear weights over occupied voxels and
+ *   its flux-to-irradiance scale (hfvis_volgi_gather); direct light by BVH shadow rays, one-sided.
  * - Thin (one-voxel) walls leak light through the side lobes of the kernel and a cone covers
  *   only 11.04 of the 12.57 sr of the sphere (12 % of an isotropic voxel's flux is not
  *   transported per step; 1.8 % of a cosine lobe's): the reference kernel is the thesis', not an
