@@ -213,7 +213,7 @@ HFVIS_API hfvis_lk_ray_options hfvis_lk_ray_options_default(void)
     o.pattern = HFVIS_LK_PATTERN_LLOYD;
     o.lloyd_iterations = 64;
     o.final_iterations = 4;
-    o.density_resolution = 256;
+    o.density_resolution = 0; /* adaptive */
     o.falloff = HFVIS_LK_FALLOFF_CONSTANT;
     return o;
 }
@@ -225,7 +225,8 @@ typedef struct lk_sites {
     double cs;           /* cell size 2/B */
     const double *xy;    /* 2n */
     int *start;          /* B*B + 1 */
-    int *items;          /* n */
+    int *items;          /* n: site indices in cell order */
+    double *cxy;         /* 2n: their coordinates, in the same order */
 } lk_sites;
 
 static int lk_sites_cell(const lk_sites *g, double v)
@@ -265,6 +266,8 @@ static void lk_sites_build(lk_sites *g)
     for (i = 0; i < cells; i++) g->start[i + 1] += g->start[i];
     for (i = 0; i < g->n; i++) { /* fill in index order; start[] is shifted back afterwards */
         int c = lk_sites_cell(g, g->xy[2 * i + 1]) * g->B + lk_sites_cell(g, g->xy[2 * i]);
+        g->cxy[2 * g->start[c]] = g->xy[2 * i];
+        g->cxy[2 * g->start[c] + 1] = g->xy[2 * i + 1];
         g->items[g->start[c]++] = i;
     }
     for (i = cells; i > 0; i--) g->start[i] = g->start[i - 1];
@@ -289,12 +292,11 @@ static int lk_sites_nearest(const lk_sites *g, double qx, double qy)
                 else if (i < 0 || i >= g->B) continue;
                 c = jj * g->B + ii;
                 for (k = g->start[c]; k < g->start[c + 1]; k++) {
-                    int s = g->items[k];
-                    double dx = lk_sites_diff(g, g->xy[2 * s], qx), dy = lk_sites_diff(g, g->xy[2 * s + 1], qy);
+                    double dx = lk_sites_diff(g, g->cxy[2 * k], qx), dy = lk_sites_diff(g, g->cxy[2 * k + 1], qy);
                     double d2 = dx * dx + dy * dy;
-                    if (d2 < best || (d2 == best && s < best_i)) {
+                    if (d2 < best || (d2 == best && g->items[k] < best_i)) {
                         best = d2;
-                        best_i = s;
+                        best_i = g->items[k];
                     }
                 }
             }
@@ -368,14 +370,17 @@ static void lk_concentric(double a, double b, double *x, double *y)
 static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *g,
                                   const hfvis_allocator *alloc, int torus, double *xy)
 {
-    const int G = o->density_resolution;
-    int B = 1, i, it;
+    int G = o->density_resolution, B = 1, i, it;
     size_t nd = 0, bytes = 0, k;
     unsigned char *block, *cur;
     double *dens, *sum, *box, *jit;
     int *assign;
     lk_sites sites;
     while (B * B * 2 < n) B++; /* about two sites per cell */
+    if (G == 0) { /* adaptive: about 48 density points per site, at least 64 x 64 */
+        G = (int)ceil(sqrt(48.0 * n * (torus ? 1.0 : 4.0 / LK_PI)));
+        if (G < 64) G = 64;
+    }
     for (i = 0; i < G; i++) { /* density points: centres of G x G cells (inside the disc) */
         double y = -1.0 + (2.0 * i + 1.0) / G;
         for (it = 0; it < G; it++) {
@@ -388,7 +393,7 @@ static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *
         !lk_part(&bytes, (size_t)n, 4 * sizeof(double)) ||
         !lk_part(&bytes, (size_t)n, 2 * sizeof(double)) ||
         !lk_part(&bytes, (size_t)B * (size_t)B + 1, sizeof(int)) ||
-        !lk_part(&bytes, (size_t)n, sizeof(int)))
+        !lk_part(&bytes, (size_t)n, sizeof(int)) || !lk_part(&bytes, (size_t)n, 2 * sizeof(double)))
         return HFVIS_ERR_OUT_OF_MEMORY;
     block = (unsigned char *)lk_alloc(alloc, bytes);
     if (!block) return HFVIS_ERR_OUT_OF_MEMORY;
@@ -400,6 +405,7 @@ static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *
     jit = (double *)lk_take(&cur, (size_t)n, 2 * sizeof(double));
     sites.start = (int *)lk_take(&cur, (size_t)B * (size_t)B + 1, sizeof(int));
     sites.items = (int *)lk_take(&cur, (size_t)n, sizeof(int));
+    sites.cxy = (double *)lk_take(&cur, (size_t)n, 2 * sizeof(double));
     sites.n = n;
     sites.B = B;
     sites.wrap = torus;
@@ -606,7 +612,7 @@ HFVIS_API hfvis_status hfvis_lk_rays_build(int count, double radius,
     }
     if (o.pattern < HFVIS_LK_PATTERN_LLOYD || o.pattern > HFVIS_LK_PATTERN_LLOYD_TORUS ||
         o.lloyd_iterations < 1 || o.lloyd_iterations > 10000 || o.final_iterations < 1 ||
-        o.final_iterations > 10000 || o.density_resolution < 16 || o.density_resolution > 2048 ||
+        o.final_iterations > 10000 || (o.density_resolution != 0 && o.density_resolution < 16) || o.density_resolution > 2048 ||
         o.falloff < HFVIS_LK_FALLOFF_CONSTANT || o.falloff > HFVIS_LK_FALLOFF_CUSTOM)
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (o.falloff == HFVIS_LK_FALLOFF_CUSTOM) { /* finite, in [0, 1], non-increasing */
@@ -2111,6 +2117,14 @@ static void lk_node_mask(const lk_ctx *c, const hfvis_bvh_node *nd, const double
             if ((cone[4] * cb + cone[3] * sb > 0.0 && cphi < lim - LK_MARGIN) ||
                 dist - Rn > cone[6] + LK_MARGIN) {
                 out[k] = 0;
+                continue;
+            }
+            /* all ones when the word's cone lies inside the sphere's (angle(axis, c) + theta <=
+             * beta: cos phi >= cos(beta - theta), beta > theta) and its shortest ray reaches
+             * dist (every ray inside the cone enters the sphere before distance dist) */
+            if (sb * cone[3] - cb * cone[4] > 0.0 && cphi >= cb * cone[3] + sb * cone[4] + LK_MARGIN &&
+                cone[5] >= dist + LK_MARGIN) {
+                out[k] = lk_word_bits(R->count, k);
                 continue;
             }
             for (i = i0; i < i1; i++) {

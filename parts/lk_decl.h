@@ -109,13 +109,14 @@ typedef struct hfvis_lk_ray_options {
     int lloyd_iterations;           /* LLOYD: steps before the Voronoi jitter, 1..10000;
                                        0 = 64 */
     int final_iterations;           /* LLOYD: steps after it, 1..10000; 0 = 4 */
-    int density_resolution;         /* LLOYD: the density grid's side, 16..4096; 0 = 256 */
+    int density_resolution;         /* LLOYD: the density grid's side, 16..2048; 0 = adaptive:
+                                       ceil(sqrt(48 N 4/pi)) (48 points per site), >= 64 */
     hfvis_lk_falloff falloff;       /* default CONSTANT */
     hfvis_lk_falloff_fn falloff_fn; /* CUSTOM only */
     void *falloff_user;             /* CUSTOM only */
 } hfvis_lk_ray_options;
 
-/* The defaults: alloc NULL, LLOYD, seed 0, 64 + 4 Lloyd steps on a 256^2 grid, CONSTANT. */
+/* The defaults: alloc NULL, LLOYD, seed 0, 64 + 4 Lloyd steps, adaptive grid, CONSTANT. */
 HFVIS_API hfvis_lk_ray_options hfvis_lk_ray_options_default(void);
 
 /* A ray set in the canonical receiver frame (z = normal), shared by every receiver ([LK] §3).
