@@ -10,4 +10,5 @@ void bench_bvh(int quick);
 void bench_gi2(int quick);
 void bench_cons(int quick);
 void bench_ssao(int quick);
+void bench_ssaob(int quick);
 #endif

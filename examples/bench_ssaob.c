@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include "bench.h"
 #include "hfvis.h"
 
 static double bench_ssaob_now(void)
@@ -72,15 +73,9 @@ done:
     free(d); free(n); free(a); free(m); free(r);
 }
 
-static void bench_ssaob(int quick)
+void bench_ssaob(int quick)
 {
     printf("P4 far-field AO (inverse-quadratic falloff r = 1, perspective pit scene):\n");
     if (quick) bench_ssaob_size(320, 180, 32);
     else bench_ssaob_size(1280, 720, 16);
-}
-
-int main(int argc, char **argv)
-{
-    bench_ssaob(argc > 1 && strcmp(argv[1], "--quick") == 0);
-    return 0;
 }

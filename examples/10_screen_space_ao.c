@@ -1,4 +1,4 @@
-/* ex_ssaob.c - screen-space obscurance of a rasterized scene by the four methods of issue 5:
+/* 10_screen_space_ao.c - screen-space obscurance of a rasterized scene by the four methods of issue 5:
  * a torus knot ("dragon-like" tangle) standing on a ground slab, rendered with hfvis_rasterize
  * (linear depth, guard band 10 % per side), then P3 LSAO, HBAO, P4 FFAO and the screen-space
  * ray-traced reference. Writes into argv[1] (default "out"):

@@ -572,7 +572,7 @@ TEST(alloc_failures)
 }
 
 /* goldens: one small PFM per method on the perspective pit (rho_q) */
-#define GOLDEN_DIR "parts/golden_ssao/"
+#define GOLDEN_DIR "test/golden/"
 static void golden_check(const char *name, const float *img, int w, int h)
 {
     char path[256];
