@@ -1312,7 +1312,7 @@ TEST(volgi_bad_arguments)
     double out4[4] = { 9, 9, 9, 9 }, nanv[3];
     size_t v;
     int i;
-    nanv[0] = 0.0, nanv[1] = NAN, nanv[2] = 1.0;
+    nanv[0] = 0.0, nanv[1] = (double)NAN, nanv[2] = 1.0;
     tg_init(&t, 3, 3, 3, 1, 1, 1);
     p = sh_alloc(t.n), q = sh_alloc(t.n), a = sh_alloc(t.n), q0 = sh_alloc(t.n);
     for (v = 0; v < 27 * 3; v++) rad[v] = 1.0f;
@@ -1327,7 +1327,7 @@ TEST(volgi_bad_arguments)
     CHECK_EQ_STATUS(hfvis_volgi_sh_clamped_cosine(nanv, out4), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_volgi_sh_cone(up, 0.0, out4), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_volgi_sh_cone(up, 3.2, out4), HFVIS_ERR_INVALID_ARGUMENT);
-    CHECK_EQ_STATUS(hfvis_volgi_sh_cone(up, NAN, out4), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_volgi_sh_cone(up, (double)NAN, out4), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK(out4[0] == 9.0 && out4[3] == 9.0);
     /* geometry */
     bad = geo, bad.occupancy = NULL;
@@ -1387,7 +1387,7 @@ TEST(volgi_bad_arguments)
         case 3: o.reflectance_source = HFVIS_VOLGI_REFLECTANCE_CONSTANT, o.reflectance = 1.5f; break;
         case 4: o.reflectance_source = HFVIS_VOLGI_REFLECTANCE_CONSTANT, o.reflectance = NAN; break;
         case 5: o.gather_scale = -1.0; break;
-        case 6: o.shadow_bias = INFINITY; break;
+        case 6: o.shadow_bias = (double)INFINITY; break;
         case 7: o.iterations = -3; break;
         default: o.reflectance_source = HFVIS_VOLGI_REFLECTANCE_ALBEDO; break; /* albedo NULL */
         }
@@ -1456,7 +1456,7 @@ TEST(volgi_bad_scene_arguments)
         switch (i) {
         case 0: L.type = (hfvis_volgi_light_type)9; break;
         case 1: L.intensity[1] = -1.0f; break;
-        case 2: L.position[0] = NAN; break;
+        case 2: L.position[0] = (double)NAN; break;
         case 3: L.type = HFVIS_VOLGI_LIGHT_DIRECTIONAL; break; /* zero direction */
         case 4: L.type = HFVIS_VOLGI_LIGHT_SPOT, L.direction[2] = -1, L.spot_outer_rad = 0.0; break;
         case 5: L.type = HFVIS_VOLGI_LIGHT_SPOT, L.direction[2] = -1, L.spot_inner_rad = 0.5,
@@ -1519,7 +1519,7 @@ TEST(volgi_bad_scene_arguments)
         v2.width = 0;
         CHECK_EQ_STATUS(hfvis_volgi_render(&sc, NULL, &v2, NULL, &out, NULL), HFVIS_ERR_INVALID_ARGUMENT);
         v2 = view;
-        v2.proj[0] = NAN;
+        v2.proj[0] = (double)NAN;
         CHECK_EQ_STATUS(hfvis_volgi_render(&sc, NULL, &v2, NULL, &out, NULL), HFVIS_ERR_INVALID_ARGUMENT);
     }
     {
