@@ -183,12 +183,14 @@ TEST(vf_nearest_matches_naive)
                 q[2] = (c & 8) ? -0.0 : 0.0;
                 if (c & 16) q[(c >> 5) % 2] = 0.0;
                 if (q[0] == 0.0 && q[1] == 0.0) q[0] = 1.0;
-            } else { /* near the octahedron's edges and vertices, scaled */
+            } else { /* near the octahedron's edges and vertices, scaled (also to 1e+-250) */
+                static const double scale[4] = {1e3, 1e250, 1e-250, 1.0};
+                double sc = scale[(c >> 2) & 3];
                 rng_dir(q);
                 q[(int)(rng_next() % 3)] *= 1e-9;
-                q[0] *= 1e3;
-                q[1] *= 1e3;
-                q[2] *= 1e3;
+                q[0] *= sc;
+                q[1] *= sc;
+                q[2] *= sc;
             }
             CHECK_EQ_STATUS(hfvis_visfield_nearest_position(n, q, &a), HFVIS_OK);
             CHECK_EQ_STATUS(hfvis_visfield_nearest_position_naive(n, q, &b), HFVIS_OK);

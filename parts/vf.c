@@ -109,19 +109,43 @@ static double vx_vf_key(const double q[3], int a, int b, int cs)
     return d * fabs(d) / L;
 }
 
+/* q itself, or q divided by its largest |component| when that lies outside [1e-100, 1e100], so
+ * that the keys neither overflow nor underflow. Applied by the fast search and the oracle alike. */
+static void vx_vf_safe_q(const double q[3], double out[3])
+{
+    double m = fabs(q[0]);
+    if (fabs(q[1]) > m) m = fabs(q[1]);
+    if (fabs(q[2]) > m) m = fabs(q[2]);
+    if (m >= 1e-100 && m <= 1e100) {
+        out[0] = q[0];
+        out[1] = q[1];
+        out[2] = q[2];
+    } else {
+        out[0] = q[0] / m;
+        out[1] = q[1] / m;
+        out[2] = q[2] / m;
+    }
+}
+
 /* Nearest sample to q (finite, not zero): radial projection onto the octahedron face of q's
  * hemisphere, the (up to) 9 lattice points of the 3 x 3 window around it, ranked by vx_vf_key;
  * equal keys go to the lower index, where an equator point counts with its upper copy's index
  * (same point, same key, lower index): the oracle's rule exactly. Returns the index and the
  * winner's lattice point (*h, *a, *b), the equator in the upper hemisphere. */
-static size_t vx_vf_nearest_abh(int n, const double q[3], int *ph, int *pa, int *pb)
+static size_t vx_vf_nearest_abh(int n, const double q0[3], int *ph, int *pa, int *pb)
 {
-    int h = q[2] < 0.0, ra, rb, a, b, m = 0, i, best = 0;
+    double q[3];
+    int h = q0[2] < 0.0, ra, rb, a, b, m = 0, i, best = 0;
     int ca[9], cb[9], cc[9];
-    double key[9], qz = fabs(q[2]), s = fabs(q[0]) + fabs(q[1]) + qz;
+    double key[9], qz, s, fx, fy;
     size_t best_k = 0;
-    ra = (int)floor(q[0] / s * (double)n + 0.5);
-    rb = (int)floor(q[1] / s * (double)n + 0.5);
+    vx_vf_safe_q(q0, q);
+    qz = fabs(q[2]);
+    s = fabs(q[0]) + fabs(q[1]) + qz;
+    fx = floor(q[0] / s * (double)n + 0.5);
+    fy = floor(q[1] / s * (double)n + 0.5);
+    ra = fx >= -(double)n && fx <= (double)n ? (int)fx : 0;
+    rb = fy >= -(double)n && fy <= (double)n ? (int)fy : 0;
     for (b = rb - 1; b <= rb + 1; b++)
         for (a = ra - 1; a <= ra + 1; a++) {
             int c = n - abs(a) - abs(b);
@@ -169,13 +193,14 @@ HFVIS_API hfvis_status hfvis_visfield_nearest_position(int positions_n, const do
     return HFVIS_OK;
 }
 
-HFVIS_API hfvis_status hfvis_visfield_nearest_position_naive(int positions_n, const double q[3],
+HFVIS_API hfvis_status hfvis_visfield_nearest_position_naive(int positions_n, const double q0[3],
                                                              size_t *k)
 {
     size_t K, i, best_i = 0;
-    double best = -HUGE_VAL;
-    if (!vx_vf_n_valid(positions_n) || !vx_vf_vec_ok(q) || !k) return HFVIS_ERR_INVALID_ARGUMENT;
+    double best = -HUGE_VAL, q[3];
+    if (!vx_vf_n_valid(positions_n) || !vx_vf_vec_ok(q0) || !k) return HFVIS_ERR_INVALID_ARGUMENT;
     K = 2u * vx_vf_hemi(positions_n);
+    vx_vf_safe_q(q0, q);
     for (i = 0; i < K; i++) {
         double dd;
         int h, a, b, c;
@@ -746,6 +771,8 @@ static int vx_vf_sphere(const hfvis_visfield *vf, const double o[3], const doubl
     beta = oc[0] * d[0] + oc[1] * d[1] + oc[2] * d[2];
     gamma = oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2] - R * R;
     delta = beta * beta - gamma;
+    /* fields or rays so far out that the squares overflow: no answer rather than a NaN index */
+    if (!isfinite(beta) || !isfinite(gamma) || !isfinite(delta)) return 0;
     if (gamma >= 0.0) {
         if (!(delta > 0.0)) return 0;
         sq = sqrt(delta);
@@ -757,7 +784,7 @@ static int vx_vf_sphere(const hfvis_visfield *vf, const double o[3], const doubl
         for (a = 0; a < 3; a++) rel[a] = oc[a] + t0 * d[a];
         if (rel[0] == 0.0 && rel[1] == 0.0 && rel[2] == 0.0) /* underflow: a central ray */
             for (a = 0; a < 3; a++) rel[a] = -d[a];
-        return 1;
+        return isfinite(t0) && isfinite(rel[0]) && isfinite(rel[1]) && isfinite(rel[2]) ? 1 : 0;
     }
     sq = sqrt(delta);
     t1 = -beta + sq;
@@ -765,7 +792,7 @@ static int vx_vf_sphere(const hfvis_visfield *vf, const double o[3], const doubl
     for (a = 0; a < 3; a++) rel[a] = oc[a] + t1 * d[a];
     if (rel[0] == 0.0 && rel[1] == 0.0 && rel[2] == 0.0)
         for (a = 0; a < 3; a++) rel[a] = d[a];
-    return 2;
+    return isfinite(t1) && isfinite(rel[0]) && isfinite(rel[1]) && isfinite(rel[2]) ? 2 : 0;
 }
 
 /* The map lookup of both cases: direction e (unit) toward the object at the sample nearest rel.
