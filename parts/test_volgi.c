@@ -1081,11 +1081,6 @@ TEST(volgi_room_colour_bleeding)
             CHECK(R[1] > R[0]);
             CHECK(L[0] / L[1] > 1.4 * (R[0] / R[1]));
         }
-        if (getenv("VOLGI_DEBUG"))
-            for (i = 0; i < 4; i++)
-                for (b = 0; b < 3; b++)
-                    printf("%d %d %d: %.6g %.6g %.6g %.6g %.6g %.6g\n", mode, i, b, hist[0][i][b], hist[1][i][b],
-                           hist[2][i][b], hist[3][i][b], hist[4][i][b], hist[5][i][b]);
         /* converges: from 128 steps on each doubling adds less than the one before, the last one
          * changes the light by less than TOL_CONVERGED(_NORM), and almost no light is left */
         {
