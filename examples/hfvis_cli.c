@@ -30,10 +30,10 @@
 #define CLI_RUN (-1)                              /* parse_args: go on and run the command */
 
 enum { CMD_HORIZON, CMD_SKYVIEW, CMD_SKY, CMD_SHADOW, CMD_LIGHT, CMD_NORMALS, CMD_INDIRECT,
-       CMD_VISIBILITY, CMD_VIEWSHED, CMD_VOXELIZE, CMD_GI, CMD_COUNT };
+       CMD_VISIBILITY, CMD_VIEWSHED, CMD_VOXELIZE, CMD_GI, CMD_SSAO, CMD_COUNT };
 static const char *const cli_cmd_names[CMD_COUNT] = {
     "horizon", "skyview", "sky", "shadow", "light", "normals", "indirect", "visibility",
-    "viewshed", "voxelize", "gi"
+    "viewshed", "voxelize", "gi", "ssao"
 };
 
 /* voxelize --mode, --axis, --method */
@@ -60,7 +60,13 @@ typedef struct cli_args {
     double padding;
     int order, subsample, has_dirs, has_specular, has_shininess;
     double specular, shininess;
+    int ssao_method, ssao_depth, ssao_has_ortho, ssao_has_near, ssao_has_far, ssao_guard;
+    double ssao_fov, ssao_ortho, ssao_radius, ssao_near, ssao_far;
 } cli_args;
+
+/* ssao --method, --depth */
+enum { SSAO_LSAO, SSAO_HBAO, SSAO_FFAO, SSAO_RAYTRACE };
+enum { SSAO_DEPTH_LINEAR, SSAO_DEPTH_GL, SSAO_DEPTH_D3D, SSAO_DEPTH_REVERSED };
 
 #define CLI_GI_HELP                                                                                  \
     "usage: hfvis gi IN -o OUT [--dirs K] [--order O] [--subsample S] [--bounces B] [--albedo A]\n"  \
@@ -122,7 +128,8 @@ static const char cli_usage[] =
     "  gi          multi-resolution GI (Nowrouzezahrai & Snyder): sky, sun, bounces, gloss\n"
     "  visibility  visibility index: the grid samples each point sees along K directions\n"
     "  viewshed    which samples an observer at one point sees (line of sight)\n"
-    "  voxelize    voxels of an OBJ mesh: surface, conservative or solid (.binvox or .raw)\n";
+    "  voxelize    voxels of an OBJ mesh: surface, conservative or solid (.binvox or .raw)\n"
+    "  ssao        screen-space obscurance of a depth buffer: LSAO, HBAO, FFAO, ray traced\n";
 
 static const char cli_shared_help[] =
     "\n"
@@ -289,7 +296,26 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "then y, then z; the dimensions are printed). Prints the grid and the voxel count unless\n"
     "--quiet. Only -o and --quiet of the shared options apply.\n",
 
-    CLI_GI_HELP
+    CLI_GI_HELP,
+
+    "usage: hfvis ssao DEPTH.pfm -o OUT [--method lsao|hbao|ffao|raytrace] [--fov-y DEG]\n"
+    "         [--ortho SCALE] [--radius R] [--dirs K] [--guard PIXELS]\n"
+    "         [--depth linear|gl|d3d|reversed --near N --far F]\n"
+    "Screen-space ambient obscurance of a depth buffer (one-channel PFM or PGM, row 0 at the\n"
+    "top). OUT is obscurance in [0, 1] (0 = open) of the inner pixels: the buffer minus the\n"
+    "guard band on every side.\n"
+    "  --method M        lsao: line-sweep AO ([P3]); hbao: horizon-based ray march; ffao:\n"
+    "                    far-field AO ([P4], default); raytrace: the screen-space ray-traced\n"
+    "                    reference (256 rays per pixel, slow)\n"
+    "  --fov-y DEG       vertical field of view of the inner image, 0..180 (default 60)\n"
+    "  --ortho SCALE     orthographic camera instead, SCALE view units per pixel\n"
+    "  --radius R        falloff rho = R^2/(R^2 + d^2) (view units); default none (rho = 1)\n"
+    "  --dirs K          directions (default: lsao 16, hbao 8, ffao 8 x 2 segments; raytrace\n"
+    "                    ignores it)\n"
+    "  --guard PIXELS    guard band per side (default 10 %% of the width and height)\n"
+    "  --depth ENC       linear view depth (default), gl or d3d window depth, reversed Z; the\n"
+    "                    hardware encodings need --near and --far\n"
+    "Only -o, --dirs and --quiet of the shared options apply. Default PGM range 0:1.\n"
 };
 
 /* ------------------------------------------------------------------------------------------ */
@@ -408,6 +434,39 @@ static int cli_ends_with(const char *s, const char *ext)
     return 1;
 }
 
+/* The flags only `ssao` has, and its --method; -1 if f is none of them. */
+static int cli_set_ssao(cli_args *a, const char *f, const char *v)
+{
+    if (!strcmp(f, "--method") || !strcmp(f, "--depth")) {
+        static const char *const methods[] = {"lsao", "hbao", "ffao", "raytrace"};
+        static const char *const encodings[] = {"linear", "gl", "d3d", "reversed"};
+        int is_method = !strcmp(f, "--method"), i;
+        for (i = 0; i < 4; i++)
+            if (!strcmp(v, is_method ? methods[i] : encodings[i])) {
+                *(is_method ? &a->ssao_method : &a->ssao_depth) = i;
+                return 0;
+            }
+        return cli_error(CLI_EXIT_USAGE, f, is_method ? "expected lsao, hbao, ffao or raytrace, "
+                         "got '%s'" : "expected linear, gl, d3d or reversed, got '%s'", v);
+    }
+    if (!strcmp(f, "--fov-y")) return cli_real(f, v, 0.0, 1, 179.999, "degrees in (0, 180)", &a->ssao_fov);
+    if (!strcmp(f, "--ortho")) {
+        a->ssao_has_ortho = 1;
+        return cli_real(f, v, 0.0, 1, CLI_FLT_MAX, "a scale > 0", &a->ssao_ortho);
+    }
+    if (!strcmp(f, "--radius")) return cli_real(f, v, 0.0, 1, CLI_FLT_MAX, "a radius > 0", &a->ssao_radius);
+    if (!strcmp(f, "--guard")) return cli_int(f, v, 0, 65536, "an integer 0..65536", &a->ssao_guard);
+    if (!strcmp(f, "--near")) {
+        a->ssao_has_near = 1;
+        return cli_real(f, v, -CLI_FLT_MAX, 0, CLI_FLT_MAX, "a finite distance", &a->ssao_near);
+    }
+    if (!strcmp(f, "--far")) {
+        a->ssao_has_far = 1;
+        return cli_real(f, v, -CLI_FLT_MAX, 0, CLI_FLT_MAX, "a finite distance", &a->ssao_far);
+    }
+    return -1;
+}
+
 /* The flags only `gi` has; -1 if f is none of them. */
 static int cli_set_gi(cli_args *a, const char *f, const char *v)
 {
@@ -462,7 +521,7 @@ static const cli_flag cli_flags[] = {
     { "--sun-azimuth", 1, CLI_SUN },              { "--sun-elevation", 1, CLI_SUN },
     { "--sun-radius", 1, CLI_SUN },               { "--math", 0, CLI_SUN },
     { "--env", 1, CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
-    { "--method", 1, CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VOXELIZE) },
+    { "--method", 1, CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_SSAO) },
     { "--sun-irradiance", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) }, { "--albedo-map", 1, CLI_ONLY(CMD_INDIRECT) },
     { "--emission", 1, CLI_ONLY(CMD_INDIRECT) },  { "--bounces", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
     { "--output", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
@@ -474,7 +533,11 @@ static const cli_flag cli_flags[] = {
     { "--axis", 1, CLI_ONLY(CMD_VOXELIZE) },  
     { "--max-vertices", 1, CLI_ONLY(CMD_VOXELIZE) }, { "--padding", 1, CLI_ONLY(CMD_VOXELIZE) },
     { "--open", 0, CLI_ONLY(CMD_VOXELIZE) },
-    CLI_GI_FLAGS
+    CLI_GI_FLAGS,
+    { "--fov-y", 1, CLI_ONLY(CMD_SSAO) },         { "--ortho", 1, CLI_ONLY(CMD_SSAO) },
+    { "--radius", 1, CLI_ONLY(CMD_SSAO) },        { "--guard", 1, CLI_ONLY(CMD_SSAO) },
+    { "--depth", 1, CLI_ONLY(CMD_SSAO) },         { "--near", 1, CLI_ONLY(CMD_SSAO) },
+    { "--far", 1, CLI_ONLY(CMD_SSAO) }
 };
 
 /* Apply one recognised flag; returns 0 or CLI_EXIT_USAGE (message printed). */
@@ -619,6 +682,7 @@ static int cli_set(cli_args *a, const char *f, const char *v)
     {
         int r = cli_set_gi(a, f, v);
         if (r >= 0) return r;
+        if (a->cmd == CMD_SSAO && (r = cli_set_ssao(a, f, v)) >= 0) return r;
     }
     if (a->cmd == CMD_VOXELIZE) { /* --method of voxelize */
         if (!strcmp(v, "pixel")) a->vox_method = HFVIS_VOXELIZE_PIXEL_RULE;
@@ -643,6 +707,8 @@ static int cli_parse(int argc, char **argv, cli_args *a)
     a->border = HFVIS_BORDER_OPEN; a->method = HFVIS_ENV_PREFIX;
     a->bounces = 1; a->sun_irradiance = CLI_PI; a->output = OUT_TOTAL;
     a->order = 4; a->subsample = 1;
+    a->ssao_method = SSAO_FFAO; a->ssao_depth = SSAO_DEPTH_LINEAR; a->ssao_fov = 60.0;
+    a->ssao_guard = -1;
     if (argc < 2) return cli_error(CLI_EXIT_USAGE, "usage", "missing COMMAND (try 'hfvis --help')");
     if (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help") || !strcmp(argv[1], "help")) {
         if (argc > 2 && strcmp(argv[1], "help") == 0) {
@@ -1102,6 +1168,86 @@ static int cli_run_visibility(const cli_args *a, const hfvis_grid *grid, hfvis_s
     return rc;
 }
 
+/* ssao: a depth buffer (linear, or hardware depth linearised first) -> obscurance of the inner
+ * pixels by the chosen method. */
+static int cli_run_ssao(const cli_args *a)
+{
+    float *depth = NULL, *ao = NULL;
+    hfvis_image_info info;
+    hfvis_camera cam;
+    hfvis_falloff fo;
+    hfvis_status s;
+    int rc = 0, gx, gy, W, H;
+    errno = 0;
+    s = hfvis_image_load(a->in, NULL, &depth, &info);
+    if (s != HFVIS_OK) return cli_status(a->in, s, errno);
+    if (info.channels != 1) {
+        rc = cli_error(CLI_EXIT_ERROR, a->in, "expected a one-channel depth buffer");
+        goto done;
+    }
+    gx = a->ssao_guard >= 0 ? a->ssao_guard : info.width / 10;
+    gy = a->ssao_guard >= 0 ? a->ssao_guard : info.height / 10;
+    if (2 * gx >= info.width || 2 * gy >= info.height) {
+        rc = cli_error(CLI_EXIT_USAGE, "--guard", "leaves no inner pixel in a %dx%d buffer",
+                       info.width, info.height);
+        goto done;
+    }
+    if (a->ssao_depth != SSAO_DEPTH_LINEAR) {
+        static const hfvis_depth_encoding enc[] = {HFVIS_DEPTH_GL, HFVIS_DEPTH_GL, HFVIS_DEPTH_D3D,
+                                                   HFVIS_DEPTH_REVERSED_Z};
+        if (!a->ssao_has_near || !a->ssao_has_far) {
+            rc = cli_error(CLI_EXIT_USAGE, "--depth", "hardware depth needs --near and --far");
+            goto done;
+        }
+        s = hfvis_depth_linearize(depth, info.width, info.height, info.width, enc[a->ssao_depth],
+                                  a->ssao_has_ortho, a->ssao_near, a->ssao_far, depth, info.width);
+        if (s != HFVIS_OK) { rc = cli_status("--near/--far", s, 0); goto done; }
+    }
+    if (a->ssao_has_ortho)
+        s = hfvis_camera_orthographic(&cam, info.width, info.height, gx, gy, a->ssao_ortho);
+    else
+        s = hfvis_camera_perspective(&cam, info.width, info.height, gx, gy,
+                                     a->ssao_fov * CLI_PI / 180.0);
+    if (s != HFVIS_OK) { rc = cli_status("camera", s, 0); goto done; }
+    if (a->ssao_depth != SSAO_DEPTH_LINEAR)
+        cam.far_depth = a->ssao_far; /* the far plane is background */
+    memset(&fo, 0, sizeof fo);
+    if (a->ssao_radius > 0.0) {
+        fo.kind = HFVIS_FALLOFF_INV_QUADRATIC;
+        fo.param = a->ssao_radius * a->ssao_radius;
+    }
+    W = info.width - 2 * gx;
+    H = info.height - 2 * gy;
+    ao = (float *)malloc(sizeof(float) * (size_t)W * (size_t)H);
+    if (!ao) { rc = cli_status("ssao", HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
+    if (a->ssao_method == SSAO_LSAO) {
+        hfvis_lsao_options o = hfvis_lsao_options_default();
+        o.falloff = fo;
+        o.directions = a->has_dirs ? a->dirs : 0;
+        s = hfvis_lsao(&cam, depth, NULL, &o, ao, W);
+    } else if (a->ssao_method == SSAO_HBAO) {
+        hfvis_hbao_options o = hfvis_hbao_options_default();
+        o.falloff = fo;
+        o.directions = a->has_dirs ? a->dirs : 0;
+        s = hfvis_hbao(&cam, depth, NULL, &o, ao, W);
+    } else if (a->ssao_method == SSAO_FFAO) {
+        hfvis_ffao_options o = hfvis_ffao_options_default();
+        o.falloff = fo;
+        o.directions = a->has_dirs ? a->dirs : 0;
+        s = hfvis_ffao(&cam, depth, NULL, &o, ao, W);
+    } else {
+        hfvis_ssao_rt_options o = hfvis_ssao_rt_options_default();
+        o.falloff = fo;
+        s = hfvis_ssao_raytrace(&cam, depth, NULL, &o, ao, W);
+    }
+    if (s != HFVIS_OK) { rc = cli_status("ssao", s, 0); goto done; }
+    rc = cli_save(a, ao, W, H, 1, 0.0, 1.0);
+done:
+    free(ao);
+    hfvis_free(NULL, depth);
+    return rc;
+}
+
 /* voxelize: MESH.obj -> a cubic-voxel grid fitted to the mesh -> .binvox or .raw. */
 static int cli_run_voxelize(const cli_args *a)
 {
@@ -1182,6 +1328,7 @@ static int cli_run(const cli_args *a)
     hfvis_status s = HFVIS_OK;
 
     if (a->cmd == CMD_VOXELIZE) return cli_run_voxelize(a);
+    if (a->cmd == CMD_SSAO) return cli_run_ssao(a);
     memset(&env, 0, sizeof env);
     if ((rc = cli_load_heights(a, &z, &w, &h)) != 0) return rc;
     grid.z = z; grid.width = w; grid.height = h; grid.stride = w; grid.cell_size = a->cell;

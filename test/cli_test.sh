@@ -107,7 +107,7 @@ expect_line2() { # NAME FILE WANT: the second header line (PFM dimensions)
 # ---- help ---------------------------------------------------------------------------------
 if "$hfvis" --help > "$dir/stdout" 2> "$dir/stderr" && grep -q '^usage: hfvis' "$dir/stdout" && [ ! -s "$dir/stderr" ]
 then ok "--help"; else bad "--help"; fi
-for c in horizon skyview sky shadow light normals indirect visibility viewshed voxelize gi; do
+for c in horizon skyview sky shadow light normals indirect visibility viewshed voxelize gi ssao; do
   if "$hfvis" $c --help > "$dir/stdout" 2>&1 && grep -q "^usage: hfvis $c" "$dir/stdout"
   then ok "$c --help"; else bad "$c --help"; fi
 done
@@ -216,6 +216,16 @@ expect_ok "viewshed with a hole" "$dir/vs7.pfm" viewshed "$dir/flat7.pgm" --noda
 expect_ok "gi flat" "$dir/gif.pfm" gi "$f" --sky 2 --albedo 0.5 --bounces 2 -o "$dir/gif.pfm"
 expect_last_float "gi flat under sky 2, albedo 0.5 = 1" "$dir/gif.pfm" 1 1e-4
 expect_ok "gi hill, sun, specular, subsample" "$dir/gih.pgm" gi "$h" --sun-azimuth 135 --sun-elevation 30 --specular 0.2 --subsample 2 --order 2 -o "$dir/gih.pgm"
+
+# ssao: a fronto-parallel plane (linear depth 5 everywhere, 20 x 16) is open: AO 0 by every method;
+# the output covers the inner 16 x 12 pixels (guard 2).
+{ printf 'Pf\n20 16\n-1\n'; i=0; while [ $i -lt 320 ]; do printf '\000\000\240\100'; i=$((i + 1)); done; } > "$dir/plane.pfm"
+for m in lsao hbao ffao raytrace; do
+  expect_ok "ssao $m" "$dir/ao_$m.pfm" ssao "$dir/plane.pfm" --method $m --fov-y 60 --guard 2 -o "$dir/ao_$m.pfm"
+  [ "$(head -c 9 "$dir/ao_$m.pfm" | tr '\n' ' ')" = "Pf 16 12 " ] && ok "ssao $m: inner 16 x 12" || bad "ssao $m size"
+  expect_last_float "ssao $m: open plane" "$dir/ao_$m.pfm" 0 1e-4
+done
+expect_ok "ssao ortho, falloff, pgm" "$dir/ao.pgm" ssao "$dir/plane.pfm" --ortho 0.1 --radius 2 -o "$dir/ao.pgm"
 
 # voxelize: the unit cube (8 vertices, 12 triangles) in a 4^3 grid: solid fills all 64 voxels,
 # conservative the 56 that touch a face, surface (pixel-centre rule) one layer per face.
@@ -333,6 +343,11 @@ expect_fail "voxelize --open surface" 2 voxelize "$dir/cube.obj" --res 4 --open 
 expect_fail "voxelize an open mesh solid" 1 voxelize "$dir/tri.obj" --res 4 --mode solid -o "$ob"
 expect_fail "voxelize garbage" 1 voxelize "$dir/garbage.pgm" --res 4 -o "$ob"
 expect_fail "voxelize missing file" 1 voxelize "$dir/none.obj" --res 4 -o "$ob"
+expect_fail "ssao --method nope" 2 ssao "$dir/plane.pfm" --method nope -o "$o"
+expect_fail "ssao --depth gl without planes" 2 ssao "$dir/plane.pfm" --depth gl -o "$o"
+expect_fail "ssao guard too big" 2 ssao "$dir/plane.pfm" --guard 10 -o "$o"
+expect_fail "ssao --fov-y 0" 2 ssao "$dir/plane.pfm" --fov-y 0 -o "$o"
+expect_fail "ssao garbage" 1 ssao "$dir/garbage.pgm" -o "$o"
 expect_fail "gi --shininess without --specular" 2 gi "$h" --shininess 8 -o "$o"
 expect_fail "gi --order 5" 2 gi "$h" --order 5 -o "$o"
 expect_fail "gi --sun-azimuth alone" 2 gi "$h" --sun-azimuth 90 -o "$o"
