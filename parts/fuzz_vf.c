@@ -53,7 +53,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0) d[2] = 1.0;
         if (!isfinite(o[0] + o[1] + o[2] + d[0] + d[1] + d[2])) break; /* huge centre or radius */
         if (hfvis_visfield_query(&vf, o, d, 0.02 * R, &h) != HFVIS_OK) abort();
-        if (h.result != HFVIS_VISFIELD_MISS && !(h.position < hfvis_visfield_position_count(vf.positions_n)))
+        if (h.result != HFVIS_VISFIELD_MISS
+            && !(h.position < hfvis_visfield_position_count(vf.positions_n)))
             abort();
     }
     hfvis_visfield_free(NULL, &vf);

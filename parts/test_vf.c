@@ -1717,6 +1717,38 @@ TEST(vf_out_of_memory)
     field_done(&ref);
     hfvis_mesh_free(NULL, &ico);
 }
+/* Regression (fuzzer find): a field whose radius squares to infinity made the sphere test produce
+ * NaN entry points and a wild map index. Such spheres now give misses, never a read. */
+TEST(vf_regression_huge_radius_query)
+{
+    const double c0[3] = {0.0, 0.0, 0.0}, up[3] = {0.0, 0.0, 1.0};
+    static const double radii[3] = {1.8e184, 1e300, 1e-300};
+    const float pt[3] = {0.0f, 0.0f, 0.0f}, nz[3] = {0.0f, 0.0f, 1.0f};
+    hfvis_mesh ico;
+    hfvis_visfield vf;
+    hfvis_visfield_object ob;
+    int r, q;
+    float out = 7.0f;
+    CHECK_EQ_STATUS(hfvis_mesh_icosphere(NULL, c0, 0.5, 0, &ico), HFVIS_OK);
+    CHECK(field_init(&vf, c0, 1.0, 2, 4, HFVIS_DIRMAP_POLAR, HFVIS_VISFIELD_U8));
+    CHECK_EQ_STATUS(hfvis_visfield_build(&ico, NULL, &vf), HFVIS_OK);
+    for (r = 0; r < 3; r++) {
+        vf.radius = radii[r];
+        for (q = 0; q < 4; q++) {
+            double o[3] = {0.3 * q, -1e200 * (q & 1), q == 3 ? 1e-310 : 2.0}, d[3] = {0.1, 0.2, -1.0};
+            hfvis_visfield_hit h;
+            CHECK_EQ_STATUS(hfvis_visfield_query(&vf, o, d, 0.0, &h), HFVIS_OK);
+            CHECK(h.result == HFVIS_VISFIELD_MISS || h.position < hfvis_visfield_position_count(2));
+            CHECK_EQ_STATUS(hfvis_visfield_query(&vf, c0, up, 0.0, &h), HFVIS_OK);
+        }
+        ob = make_object(&vf, &ico, NULL);
+        CHECK_EQ_STATUS(hfvis_visfield_ambient_occlusion(&ob, 1, pt, nz, 1, NULL, &out), HFVIS_OK);
+        CHECK(out >= 0.0f && out <= 1.0f);
+    }
+    field_done(&vf);
+    hfvis_mesh_free(NULL, &ico);
+}
+
 int main(int argc, char **argv)
 {
     const char *only = argc > 1 && argv[1][0] != '-' ? argv[1] : NULL;
@@ -1741,5 +1773,6 @@ int main(int argc, char **argv)
     RUN_IF(vf_codec);
     RUN_IF(vf_bad_arguments);
     RUN_IF(vf_out_of_memory);
+    RUN_IF(vf_regression_huge_radius_query);
     return TEST_DONE();
 }

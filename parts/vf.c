@@ -642,7 +642,8 @@ static hfvis_status vx_vf_build_check(const hfvis_mesh *mesh, const hfvis_visfie
 {
     size_t need, v;
     double lim;
-    if (!mesh || !vf || vx_mesh_check(mesh) != HFVIS_OK || !vf->maps) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!mesh || !vf || vx_mesh_check(mesh) != HFVIS_OK || !vf->maps)
+        return HFVIS_ERR_INVALID_ARGUMENT;
     if (!isfinite(vf->center[0]) || !isfinite(vf->center[1]) || !isfinite(vf->center[2])
         || !isfinite(vf->radius) || !(vf->radius > 0.0) || !vx_vf_n_valid(vf->positions_n)
         || !vx_vf_d_valid(vf->dir_res) || !vx_vf_mapping_valid(vf->mapping)
@@ -976,7 +977,8 @@ static int vx_vf_transform(const double m[16], vx_vf_inst *in)
     if (!(s2 > 0.0) || !isfinite(s2)) return 0;
     for (a = 0; a < 3; a++)
         for (b = a; b < 3; b++) {
-            double dd = m[4 * a] * m[4 * b] + m[4 * a + 1] * m[4 * b + 1] + m[4 * a + 2] * m[4 * b + 2];
+            double dd = m[4 * a] * m[4 * b] + m[4 * a + 1] * m[4 * b + 1]
+                        + m[4 * a + 2] * m[4 * b + 2];
             if (!(fabs(dd - (a == b ? s2 : 0.0)) <= VX_VF_RIGID_TOL * s2)) return 0;
         }
     in->s = sqrt(s2);
@@ -1121,8 +1123,10 @@ static hfvis_status vx_vf_ao_run(const hfvis_visfield_object *objects, size_t co
     maxd = o.max_distance;
     if (o.rays_sqrt < 1 || o.rays_sqrt > HFVIS_VISFIELD_MAX_RAYS_SQRT || !(maxd > 0.0)
         || bias_frac < 0.0 || !isfinite(o.offset) || o.offset < 0.0
-        || (o.falloff != HFVIS_VISFIELD_FALLOFF_BINARY && o.falloff != HFVIS_VISFIELD_FALLOFF_LINEAR)
-        || (o.combine != HFVIS_VISFIELD_COMBINE_ANY && o.combine != HFVIS_VISFIELD_COMBINE_SUBTRACTIVE)
+        || (o.falloff != HFVIS_VISFIELD_FALLOFF_BINARY
+            && o.falloff != HFVIS_VISFIELD_FALLOFF_LINEAR)
+        || (o.combine != HFVIS_VISFIELD_COMBINE_ANY
+            && o.combine != HFVIS_VISFIELD_COMBINE_SUBTRACTIVE)
         || (o.falloff == HFVIS_VISFIELD_FALLOFF_LINEAR && !isfinite(maxd)))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (pc && (!points || !normals || !out)) return HFVIS_ERR_INVALID_ARGUMENT;
@@ -1139,7 +1143,8 @@ static hfvis_status vx_vf_ao_run(const hfvis_visfield_object *objects, size_t co
     for (j = 0; j < o.rays_sqrt; j++)
         for (i = 0; i < o.rays_sqrt; i++) {
             double x, y, r2, *l = rays + 3 * ((size_t)j * S + (size_t)i);
-            hfvis_concentric_square_to_disk(vx_vf_sq(i, o.rays_sqrt), vx_vf_sq(j, o.rays_sqrt), &x, &y);
+            hfvis_concentric_square_to_disk(vx_vf_sq(i, o.rays_sqrt), vx_vf_sq(j, o.rays_sqrt),
+                                            &x, &y);
             r2 = x * x + y * y;
             l[0] = x;
             l[1] = y;
@@ -1613,7 +1618,8 @@ HFVIS_API hfvis_status hfvis_visfield_decode(const void *data, size_t size,
     unsigned char *maps;
     size_t i;
     if (!out || (!data && size > 0)) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (size < HFVIS_VISFIELD_FILE_HEADER || memcmp(p, vx_vf_magic, 8) != 0) return HFVIS_ERR_FORMAT;
+    if (size < HFVIS_VISFIELD_FILE_HEADER || memcmp(p, vx_vf_magic, 8) != 0)
+        return HFVIS_ERR_FORMAT;
     version = vx_vf_get32(p + 8);
     fmt = vx_vf_get32(p + 12);
     map = vx_vf_get32(p + 16);

@@ -145,23 +145,28 @@ HFVIS_API size_t hfvis_visfield_position_count(int positions_n);
  * Returns HFVIS_ERR_INVALID_ARGUMENT for n out of range, k >= K or NULL dir (dir untouched). */
 HFVIS_API hfvis_status hfvis_visfield_position(int positions_n, size_t k, double dir[3]);
 
-/* Nearest positional sample to direction q (any length > 0): the k maximising q . u_k, ties to
- * the lowest index (an equator point therefore gives its upper copy), in constant time (spec
- * §1.3; a CPU replacement of Slater's colour-index buffer): q is projected radially onto the
- * octahedron |x| + |y| + |z| = 1 of its hemisphere (h = q.z < 0), and the 3 x 3 lattice
- * points around (round(n x), round(n y)) with |a| + |b| <= n are compared. Equals
- * hfvis_visfield_nearest_position_naive bit for bit (the same dot products); the tests check
- * this on 4 x 10^5 random and adversarial directions. Returns HFVIS_ERR_INVALID_ARGUMENT for n out
+/* Nearest positional sample to direction q (any length > 0), in constant time (spec §1.3; a CPU
+ * replacement of Slater's colour-index buffer). Samples are ranked by the key d |d| / L, d = the
+ * dot product of q with the lattice point (a, b, +-c), L = a^2 + b^2 + c^2 (exact): a monotone
+ * function of the cosine, so the largest key is the nearest sample (no square root). Equal keys
+ * go to the lowest index (an equator point therefore gives its upper copy). q is first divided by
+ * its largest |component| when that lies outside [1e-100, 1e100] (no overflow). The search
+ * projects q radially onto the octahedron |x| + |y| + |z| = 1 of its hemisphere (h = q.z < 0)
+ * and compares the 3 x 3 lattice points around (round(n x), round(n y)) with |a| + |b| <= n.
+ * Equals hfvis_visfield_nearest_position_naive bit for bit (the same keys, the same tie rule):
+ * the tests check 4 x 10^5 random and adversarial directions (Voronoi edges between samples,
+ * the equator, coordinate planes, scales 1e+-250). Returns HFVIS_ERR_INVALID_ARGUMENT for n out
  * of range, NULL, a non-finite or zero q (k untouched). */
 HFVIS_API hfvis_status hfvis_visfield_nearest_position(int positions_n, const double q[3],
                                                        size_t *k);
 
-/* Oracle: the same by comparing all K samples in index order (strictly greater wins). O(K). */
+/* Oracle: the same key over all K samples in index order (strictly greater wins). O(K). */
 HFVIS_API hfvis_status hfvis_visfield_nearest_position_naive(int positions_n, const double q[3],
                                                              size_t *k);
 
 /* The fixed tangent frame of a unit vector w (Duff et al., "Building an orthonormal basis,
- * revisited", JCGT 6(1), 2017): s = copysign(1, w.z), a = -1/(s + w.z), e = w.x w.y a,
+ * revisited", JCGT 6(1), 2017): s = -1 if w.z < 0 else 1 (also for -0), a = -1/(s + w.z),
+ * e = w.x w.y a,
  * t = (1 + s w.x^2 a, s e, -s w.x), b = (e, s + w.y^2 a, -w.y); (t, b, w) is orthonormal and
  * right-handed (t x b = w) to rounding. Used for the maps (w = -u_k) and the AO ray sets
  * (w = the receiver normal). w must be unit length (not checked). */
@@ -228,7 +233,9 @@ typedef struct hfvis_visfield_build_options {
  * HFVIS_ERR_BUFFER_TOO_SMALL if maps_size < hfvis_visfield_size; the BVH build's errors
  * (HFVIS_ERR_LIMIT, HFVIS_ERR_OUT_OF_MEMORY). On error vf is untouched.
  * Memory: the BVH build's four blocks (two freed before it returns, two at the end); none with
- * opts->bvh. Cost O(K D^2 log T) rays (thesis: 4226 x 32^2 = 4.3 M rays). Deterministic. */
+ * opts->bvh. Cost O(K D^2 log T) rays (thesis: 4226 x 32^2 = 4.3 M rays). Deterministic. A
+ * corrupt caller BVH is detected by the ray queries (HFVIS_ERR_INVALID_ARGUMENT) only once the
+ * traversal meets it, possibly after maps were written. */
 HFVIS_API hfvis_status hfvis_visfield_build(const hfvis_mesh *mesh,
                                             const hfvis_visfield_build_options *opts,
                                             hfvis_visfield *vf);
@@ -273,8 +280,11 @@ HFVIS_API hfvis_status hfvis_visfield_query(const hfvis_visfield *vf, const doub
 /* Oracle: the same query with the map lookup replaced by exact ray casting against the mesh
  * (bvh, or hfvis_ray_closest_naive when bvh is NULL): outside, the ray from the entry point
  * along d (HIT at t0 + t); inside, the reversed ray from the exit point along -d (OCCLUDED at
- * t1 - t when t < t1 - bias). Rays are hfvis_ray in float, t_min 0, t_max 2R (1 + 2^-20);
- * normal = the hit triangle's unit normal. Only vf's sphere is used (maps may be NULL).
+ * t1 - t when t < t1 - bias). Rays are hfvis_ray in float (t_min 0, t_max INFINITY, no culling),
+ * t converted to the unit direction as in the build; normal = the hit triangle's unit normal.
+ * (With the mesh inside the sphere the outside answer is the exact first hit from the origin;
+ * the inside one is exact for the decision, and its distance is that of the last crossing
+ * before the exit, as the field's.) Only vf's sphere is used (maps may be NULL).
  * Returns the errors of hfvis_visfield_query (vf's parameters without maps), plus NULL mesh,
  * and the errors of the ray query (a bvh not of this mesh). */
 HFVIS_API hfvis_status hfvis_visfield_query_reference(const hfvis_visfield *vf,
@@ -396,7 +406,8 @@ HFVIS_API hfvis_status hfvis_visfield_soft_shadow_reference(
 typedef struct hfvis_visfield_trace_hit {
     size_t object;                  /* index into objects; HFVIS_VISFIELD_NONE on a miss */
     hfvis_visfield_result result;   /* HIT or OCCLUDED (origin inside that object's sphere) */
-    double distance;                /* world distance along the unit direction; INFINITY on a miss */
+    double distance;                /* world distance along the unit direction; INFINITY on a
+                                       miss */
     double point[3];                /* world hit point origin + distance * direction */
     double normal[3];               /* world unit normal from a NORMAL field (or the reference),
                                        else 0 */
