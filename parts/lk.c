@@ -942,8 +942,10 @@ static int lk_blocks(const lk_tri *t, const double *s)
 
 /* Exact triangle mask: the predicate for every ray; a word is skipped when its cone lies
  * outside an edge plane or cannot reach the plane, by more than LK_MARGIN (so the skipped
- * rays are exactly those the per-ray loop rejects). */
-static void lk_mask_exact(const hfvis_lk_rays *R, const lk_tri *t, uint32_t *out)
+ * rays are exactly those the per-ray loop rejects). skip (may be NULL): the caller's
+ * accumulated mask; words it has full are left 0 (the OR is the same). */
+static void lk_mask_exact(const hfvis_lk_rays *R, const lk_tri *t, const uint32_t *skip,
+                          uint32_t *out)
 {
     double eh[9], lim;
     int w, k, i;
@@ -967,14 +969,26 @@ static void lk_mask_exact(const hfvis_lk_rays *R, const lk_tri *t, uint32_t *out
         const double *cone = R->word_cone + 7 * w;
         int i0 = 32 * w, i1 = i0 + 32 < R->count ? i0 + 32 : R->count;
         uint32_t bits = 0;
-        double mx = lk_cone_max(cone, t->m);
+        double mx;
+        if (skip && (~skip[w] & lk_word_bits(R->count, w)) == 0) { /* all already blocked */
+            out[w] = 0;
+            continue;
+        }
+        mx = lk_cone_max(cone, t->m);
         if (lk_cone_max(cone, eh) < -LK_MARGIN || lk_cone_max(cone, eh + 3) < -LK_MARGIN ||
             lk_cone_max(cone, eh + 6) < -LK_MARGIN || (mx >= 0.0 ? cone[6] * mx : cone[5] * mx) < lim) {
             out[w] = 0;
             continue;
         }
-        for (i = i0; i < i1; i++)
-            if (lk_blocks(t, R->point + 3 * i)) bits |= 1u << (i - i0);
+        for (i = i0; i < i1; i++) { /* lk_blocks, branch-free (the same expressions) */
+            const double *sp = R->point + 3 * i;
+            double a = t->e[0] * sp[0] + t->e[1] * sp[1] + t->e[2] * sp[2];
+            double b = t->e[3] * sp[0] + t->e[4] * sp[1] + t->e[5] * sp[2];
+            double c = t->e[6] * sp[0] + t->e[7] * sp[1] + t->e[8] * sp[2];
+            double ms = t->m[0] * sp[0] + t->m[1] * sp[1] + t->m[2] * sp[2];
+            uint32_t hit = (uint32_t)((a >= 0.0) & (b >= 0.0) & (c >= 0.0) & (ms >= t->dr) & !(ms > t->drmin));
+            bits |= hit << (i - i0);
+        }
         out[w] = bits;
     }
 }
@@ -1195,7 +1209,7 @@ HFVIS_API hfvis_status hfvis_lk_triangle_mask(const hfvis_lk_rays *rays, const h
     lk_tri_setup(&t, frame, position, v0, v1, v2, two_sided != 0, r_min, r_max,
                  epsilon);
     if (lut) lk_mask_lut(lut, &t, mask);
-    else lk_mask_exact(rays, &t, mask);
+    else lk_mask_exact(rays, &t, NULL, mask);
     if (verdict) *verdict = t.verdict;
     return HFVIS_OK;
 }
@@ -1523,11 +1537,11 @@ static void lk_window(const lk_ctx *c, size_t t, double *r_min, double *r_max)
     }
 }
 
-/* The triangle mask after the setup (exact or LUT); counts it. */
-static void lk_ctx_mask(const lk_ctx *c, const lk_tri *t, uint32_t *out)
+/* The triangle mask after the setup (exact or LUT); skip as lk_mask_exact. */
+static void lk_ctx_mask(const lk_ctx *c, const lk_tri *t, const uint32_t *skip, uint32_t *out)
 {
     if (c->lut) lk_mask_lut(c->lut, t, out);
-    else lk_mask_exact(c->R, t, out);
+    else lk_mask_exact(c->R, t, skip, out);
 }
 
 /* Receivers' validity: finite positions, finite non-zero normals. */
@@ -1900,9 +1914,9 @@ HFVIS_API hfvis_status hfvis_lk_raster(const hfvis_mesh *mesh, const hfvis_view 
                     st.culled_horizon++;
                     continue;
                 }
-                lk_ctx_mask(&ctx, &tri, tmask);
-                st.masks++;
                 dst = acc + (masks ? (size_t)y * (size_t)view->width + (size_t)x : (size_t)ri) * (size_t)words;
+                lk_ctx_mask(&ctx, &tri, dst, tmask);
+                st.masks++;
                 for (k = 0; k < words; k++) dst[k] |= tmask[k];
             }
     }
@@ -2065,11 +2079,13 @@ static double lk_box_zmax(const hfvis_bvh_node *nd, const double F[9], const dou
 
 /* Node occlusion mask (spec A.9.3) of the box's bounding sphere (centre, half-diagonal).
  * EXACT: bit i = the segment [0, s_i] (units of r) meets the sphere of radius R (1 + 1e-9) +
- * 1e-9 r; words are skipped by their cones. SPHERE_LUT: [LK] Fig. 4 - equal lengths: the cone
- * P(c, tau/dist) if tau <= r, else the separating plane P(c, (r^2 + dist^2 - R^2)/(2 r dist));
- * variable lengths: the cone in the direction table. NONE: all ones. */
+ * 1e-9 r; words are skipped by their cones, and rays already blocked (set in C) are not
+ * computed (left 0: only M & ~C is ever used, and C only grows). SPHERE_LUT: [LK] Fig. 4 -
+ * equal lengths: the cone P(c, tau/dist) if tau <= r, else the separating plane
+ * P(c, (r^2 + dist^2 - R^2)/(2 r dist)); variable lengths: the cone in the direction table.
+ * NONE: all ones. */
 static void lk_node_mask(const lk_ctx *c, const hfvis_bvh_node *nd, const double F[9],
-                         const double p[3], uint32_t *out)
+                         const double p[3], const uint32_t *C, uint32_t *out)
 {
     const hfvis_lk_rays *R = c->R;
     double w[3], cl[3], Rn, d2, dist, ch[3], half = 0.0;
@@ -2111,6 +2127,10 @@ static void lk_node_mask(const lk_ctx *c, const hfvis_bvh_node *nd, const double
             int i0 = 32 * k, i1 = i0 + 32 < R->count ? i0 + 32 : R->count;
             double cphi = lk_dot(ch, cone), lim = cone[3] * cb - cone[4] * sb;
             uint32_t bits = 0;
+            if ((~C[k] & lk_word_bits(R->count, k)) == 0) { /* every ray already blocked */
+                out[k] = 0;
+                continue;
+            }
             /* zero when the word's cone and the sphere's cone (half-angle beta) do not meet:
              * angle(axis, c) > theta + beta (tested when theta + beta < pi: sin > 0), or
              * the sphere lies beyond the word's longest ray */
@@ -2128,14 +2148,20 @@ static void lk_node_mask(const lk_ctx *c, const hfvis_bvh_node *nd, const double
                 continue;
             }
             for (i = i0; i < i1; i++) {
+                /* the segment [0, s] meets the sphere (c, Rn), c outside: with p = c.s, the
+                 * closest point is s when p >= s.s, else t s with t = p/s.s (p <= 0: the origin,
+                 * outside): |c - s|^2 <= Rn^2, or d2 - p^2/s.s <= Rn^2 (multiplied out) */
                 const double *s = R->point + 3 * i;
-                double ss = lk_dot(s, s), tt, q[3];
-                if (!(ss > 0.0)) continue;
-                tt = lk_dot(cl, s) / ss;
-                if (tt < 0.0) tt = 0.0;
-                if (tt > 1.0) tt = 1.0;
-                for (a = 0; a < 3; a++) q[a] = cl[a] - tt * s[a];
-                if (lk_dot(q, q) <= Rn * Rn) bits |= 1u << (i - i0);
+                double ss = lk_dot(s, s), pp, q[3];
+                if ((C[k] >> (i - i0)) & 1u) continue; /* already blocked: bit irrelevant */
+                pp = lk_dot(cl, s);
+                if (!(pp > 0.0)) continue;
+                if (pp >= ss) {
+                    for (a = 0; a < 3; a++) q[a] = cl[a] - s[a];
+                    if (lk_dot(q, q) <= Rn * Rn) bits |= 1u << (i - i0);
+                } else if ((d2 - Rn * Rn) * ss <= pp * pp) {
+                    bits |= 1u << (i - i0);
+                }
             }
             out[k] = bits;
         }
@@ -2177,7 +2203,7 @@ static void lk_bvh_receiver(const lk_ctx *c, const hfvis_bvh *bvh, const lk_trav
     if (bvh->node_count == 0) return;
     if (!lk_node_keep(c, bvh->nodes, F, p, st)) return;
     stk[0] = 0;
-    lk_node_mask(c, bvh->nodes, F, p, stk + 1);
+    lk_node_mask(c, bvh->nodes, F, p, C, stk + 1);
     sp = 1;
     while (sp > 0) {
         const uint32_t *top = stk + (size_t)(sp - 1) * ent;
@@ -2233,7 +2259,7 @@ static void lk_bvh_receiver(const lk_ctx *c, const hfvis_bvh *bvh, const lk_trav
                     st->culled_sphere++;
                     continue;
                 }
-                lk_ctx_mask(c, &tri, tv->tmask);
+                lk_ctx_mask(c, &tri, C, tv->tmask);
                 st->masks++;
                 full = 1;
                 for (k = 0; k < words; k++) {
@@ -2253,7 +2279,7 @@ static void lk_bvh_receiver(const lk_ctx *c, const hfvis_bvh *bvh, const lk_trav
                 keep[q] = lk_node_keep(c, cn, F, p, st);
                 e[q] = 0;
                 if (!keep[q]) continue;
-                lk_node_mask(c, cn, F, p, mk[q]);
+                lk_node_mask(c, cn, F, p, C, mk[q]);
                 e[q] = lk_estimate(mk[q], C, words);
                 if (e[q] == 0) {
                     st->nodes_culled_mask++;
