@@ -251,22 +251,23 @@ static void bench_vf_errors(const hfvis_mesh *mesh, const hfvis_bvh *bvh, const 
 static void bench_vf_table(const char *name, const hfvis_mesh *mesh, const double T[3], double L,
                            const double *center, double radius)
 {
-    static const int ns[4] = {4, 8, 16, 32}, Ds[3] = {32, 64, 128};
+    static const int ns[4] = {4, 8, 16, 32}, Ds[4] = {32, 64, 128, 256};
     hfvis_bvh bvh;
     int a, b;
     if (hfvis_bvh_build(mesh, NULL, &bvh) != HFVIS_OK) return;
     printf("\n%s (%zu triangles) in a corner, 3 x 33 x 33 receivers x 256 rays; 20000 outside rays\n"
            "cell: build s / hit-miss disagreement %% / mean |d - d_exact|/R / AO RMS x 255\n%6s",
            name, mesh->triangle_count, "K \\ D");
-    for (b = 0; b < 3; b++) printf("  %21d x %-5d", Ds[b], Ds[b]);
+    for (b = 0; b < 4; b++) printf("  %21d x %-5d", Ds[b], Ds[b]);
     printf("\n");
     for (a = 0; a < 4; a++) {
         printf("%6zu", hfvis_visfield_position_count(ns[a]));
-        for (b = 0; b < 3; b++) {
+        for (b = 0; b < 4; b++) {
             hfvis_visfield vf;
             hfvis_visfield_build_options bo;
             double t0, dt, e[3];
-            if (ns[a] == 32 && Ds[b] == 128) { printf("  %29s", "(skipped: 69 M rays)"); continue; }
+            double rays = (double)hfvis_visfield_position_count(ns[a]) * Ds[b] * Ds[b];
+            if (rays > 3e7) { printf("  %29s", "(skipped: > 30 M rays)"); continue; }
             if (!bench_vf_field(mesh, ns[a], Ds[b], HFVIS_VISFIELD_U8, &vf)) continue;
             if (center) {
                 memcpy(vf.center, center, sizeof vf.center);
@@ -279,6 +280,40 @@ static void bench_vf_table(const char *name, const hfvis_mesh *mesh, const doubl
             dt = bench_vf_now() - t0;
             bench_vf_errors(mesh, &bvh, &vf, T, L, e);
             printf("  %6.2f / %5.2f%% / %.4f / %5.2f", dt, 100.0 * e[0], e[1], e[2]);
+            fflush(stdout);
+            free(vf.maps);
+        }
+        printf("\n");
+    }
+    hfvis_bvh_free(NULL, &bvh);
+}
+
+/* The thesis' Fig. 33/34/36 comparisons: direction mapping and storage format at one (K, D),
+ * AO RMS x 255 on the corner and outside-ray errors. */
+static void bench_vf_variants(const hfvis_mesh *mesh, const double T[3], double L, int n, int D)
+{
+    static const char *const mname[4] = {"", "polar", "rejection", "concentric"};
+    static const char *const fname[5] = {"", "u8", "f32", "bit", "normal"};
+    hfvis_bvh bvh;
+    int m, f;
+    if (hfvis_bvh_build(mesh, NULL, &bvh) != HFVIS_OK) return;
+    printf("\nteapot, K = %zu, D = %d: mapping x format, cell: hit-miss %% / mean |dd|/R / AO RMS x 255\n%11s",
+           hfvis_visfield_position_count(n), D, "");
+    for (f = 1; f <= 4; f++) printf("  %24s", fname[f]);
+    printf("\n");
+    for (m = 1; m <= 3; m++) {
+        printf("%11s", mname[m]);
+        for (f = 1; f <= 4; f++) {
+            hfvis_visfield vf;
+            hfvis_visfield_build_options bo;
+            double e[3];
+            if (!bench_vf_field(mesh, n, D, (hfvis_visfield_format)f, &vf)) continue;
+            vf.mapping = (hfvis_dirmap)m;
+            memset(&bo, 0, sizeof bo);
+            bo.bvh = &bvh;
+            hfvis_visfield_build(mesh, &bo, &vf);
+            bench_vf_errors(mesh, &bvh, &vf, T, L, e);
+            printf("  %5.2f%% / %.4f / %6.2f", 100.0 * e[0], e[1], e[2]);
             fflush(stdout);
             free(vf.maps);
         }
@@ -319,6 +354,7 @@ static void bench_vf(int quick)
     /* the error tables at the thesis' grid (Fig. 35 form) */
     if (hfvis_mesh_teapot(NULL, 4, &teapot) == HFVIS_OK) {
         const double T[3] = {1.9, 1.6, 0.0};
+        bench_vf_variants(&teapot, T, 3.6, 16, 32);
         bench_vf_table("teapot", &teapot, T, 3.6, NULL, 0.0);
         hfvis_mesh_free(NULL, &teapot);
     }
