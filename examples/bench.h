@@ -11,4 +11,5 @@ void bench_gi2(int quick);
 void bench_cons(int quick);
 void bench_ssao(int quick);
 void bench_ssaob(int quick);
+void bench_volgi(int quick);
 #endif

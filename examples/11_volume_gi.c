@@ -1,4 +1,5 @@
-/* ex_volgi.c - volume-based VPL indirect light ([G12] ch. 5): a Cornell-like room with a red and a green wall, direct, indirect and total light. */
+/* 11_volume_gi.c - volume-based VPL indirect light ([G12] ch. 5): a Cornell-like room with a red
+ * and a green wall; direct, indirect and total light. Usage: 11_volume_gi [OUTDIR] (default "out") */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -62,7 +63,7 @@ int main(int argc, char **argv)
     int t, rc = 1;
 
     memset(&room, 0, sizeof room);
-    if (!direct || !indirect || !total || !indirect_void || !pan) { ex_error("ex_volgi", "out of memory"); goto fail; }
+    if (!direct || !indirect || !total || !indirect_void || !pan) { ex_error("11_volume_gi", "out of memory"); goto fail; }
     EX_CHECK(hfvis_mesh_room(NULL, &room), "hfvis_mesh_room");
     /* walls 0-1: x = 0 (red), 2-3: x = 1 (green); back, floor, ceiling and both boxes white */
     for (t = 0; t < 30; t++) {
@@ -94,11 +95,11 @@ int main(int argc, char **argv)
     EX_CHECK(hfvis_volgi_render(&scene, NULL, &view, &opts, &out, NULL), "hfvis_volgi_render (void paths)");
 
     left = red_green(indirect, 0, W / 6), right = red_green(indirect, W - W / 6, W);
-    printf("ex_volgi: %dx%dx%d grid, %zu occupied voxels, %d iterations; surfaces received %.2f x the VPL "
+    printf("11_volume_gi: %dx%dx%d grid, %zu occupied voxels, %d iterations; surfaces received %.2f x the VPL "
            "flux; indirect floor light red/green %.2f beside the red wall, %.2f beside the green wall\n",
            info.grid.dims[0], info.grid.dims[1], info.grid.dims[2], info.occupied, ITERATIONS,
            info.deposited[0] / info.injected[0], left, right);
-    if (!(left > 1.0 && right < 1.0)) { ex_error("ex_volgi", "no colour bleeding: unexpected result"); goto fail; }
+    if (!(left > 1.0 && right < 1.0)) { ex_error("11_volume_gi", "no colour bleeding: unexpected result"); goto fail; }
 
     /* One range for direct and total (so they compare), one for each indirect image (99th
      * percentiles). Each PGM holds the R, G and B channels side by side. */

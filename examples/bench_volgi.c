@@ -6,6 +6,7 @@
  * the final gather (eqs. 12-15) beside the direct light with one BVH shadow ray, and the whole
  * pipeline (hfvis_volgi_render). */
 #define _POSIX_C_SOURCE 199309L
+#include "bench.h"
 #include "hfvis.h"
 
 #include <math.h>
@@ -187,7 +188,7 @@ static void bench_volgi_row(const char *grid, const char *what, double s, double
     do { int r_; var = 1e30; for (r_ = 0; r_ < (reps); r_++) { double t_ = (expr); \
          if (t_ >= 0.0 && t_ < var) var = t_; } } while (0)
 
-static void bench_volgi(int quick)
+void bench_volgi(int quick)
 {
     enum { W = 1280, H = 720 };
     static const int res_list[3] = { 32, 64, 128 };
@@ -311,10 +312,4 @@ static void bench_volgi(int quick)
            "propagation 61 ms; \"higher grid sizes are prohibitive\"\n");
     free(nrm), free(bary), free(tri), free(pts), free(img);
     bench_volgi_scene_free(&s);
-}
-
-int main(int argc, char **argv)
-{
-    bench_volgi(argc > 1 && strcmp(argv[1], "quick") == 0);
-    return 0;
 }
