@@ -30,10 +30,10 @@
 #define CLI_RUN (-1)                              /* parse_args: go on and run the command */
 
 enum { CMD_HORIZON, CMD_SKYVIEW, CMD_SKY, CMD_SHADOW, CMD_LIGHT, CMD_NORMALS, CMD_INDIRECT,
-       CMD_VISIBILITY, CMD_VIEWSHED, CMD_VOXELIZE, CMD_GI, CMD_SSAO, CMD_COUNT };
+       CMD_VISIBILITY, CMD_VIEWSHED, CMD_VOXELIZE, CMD_GI, CMD_SSAO, CMD_VOLGI, CMD_COUNT };
 static const char *const cli_cmd_names[CMD_COUNT] = {
     "horizon", "skyview", "sky", "shadow", "light", "normals", "indirect", "visibility",
-    "viewshed", "voxelize", "gi", "ssao"
+    "viewshed", "voxelize", "gi", "ssao", "volgi"
 };
 
 /* voxelize --mode, --axis, --method */
@@ -43,6 +43,58 @@ enum { AXIS_DEFAULT, AXIS_DOMINANT, AXIS_ALL, AXIS_X, AXIS_Y, AXIS_Z };
 
 /* indirect --output */
 enum { OUT_TOTAL, OUT_DIRECT, OUT_INDIRECT };
+
+#define CLI_VOLGI_MAX_LIGHTS 8
+
+#define CLI_VOLGI_HELP                                                                              \
+    "usage: hfvis volgi MESH.obj|--room -o OUT.pfm|OUT.pgm [--res N] [--iterations I]\n"           \
+    "         [--light SPEC]... [--eye X,Y,Z] [--target X,Y,Z] [--up X,Y,Z] [--fov DEG]\n"          \
+    "         [--size WxH] [--albedo A] [--output total|direct|indirect] [--transfer cone|normalized]\n" \
+    "         [--paths all|void] [--reflection mirror|diffuse] [--reflectance R|albedo]\n"          \
+    "Direct and indirect light of a triangle mesh with the volume-based VPL method of Gaitatzes\n" \
+    "2012, ch. 5: the mesh is voxelized along x, y and z with its direct light (shadow rays), every\n" \
+    "lit voxel becomes a virtual point light (a cosine lobe in 2-band spherical harmonics), the\n"  \
+    "light is propagated I steps from voxel to voxel (reflected where it meets occupied voxels)\n"  \
+    "and each pixel gathers it from the occupied voxels around its surface point. OUT holds RGB\n"  \
+    "radiance toward the camera (Lambertian; a .pgm stacks R, G, B as planes top to bottom).\n"     \
+    "  --room            the test room instead of MESH: the unit cube open at y = 0 with a red wall\n" \
+    "                    at x = 0, a green wall at x = 1, two white boxes (albedo 0.75)\n"         \
+    "  --res N           voxels along the longest side, 2..2048 (default 32, the thesis'); the\n"   \
+    "                    outermost planes of the mesh lie on voxel centres\n"                     \
+    "  --iterations I    propagation steps, 1..1048576 (default 64: 2 bounces on 32^3)\n"          \
+    "  --light SPEC      up to 8 lights (default: one point light, see below), SPEC one of\n"       \
+    "                      point:X,Y,Z[:I]            radiant intensity I (W/sr)\n"                 \
+    "                      spot:X,Y,Z:DX,DY,DZ:OUTER[,INNER][:I]  cone half-angles in degrees\n"    \
+    "                                                  (INNER default 0.8 OUTER)\n"                \
+    "                      dir:DX,DY,DZ[:E]           travelling along D, irradiance E\n"           \
+    "                    I and E: one value (grey) or R,G,B; default 1 for the room; for a mesh\n" \
+    "                    the default light sits above and in front of it, at about 2 sizes\n"      \
+    "  --eye, --target   camera position and aim (default: in front of the open side of the room;\n" \
+    "                    for a mesh: 2.2 sizes in front (-y) and a little above its centre)\n"     \
+    "  --up X,Y,Z        camera up direction (default 0,0,1)\n"                                   \
+    "  --fov DEG         vertical field of view, 1..179 (default 40)\n"                           \
+    "  --size WxH        image size (default 512x512)\n"                                          \
+    "  --albedo A        grey albedo of MESH, 0..1 (default 0.75; not with --room)\n"             \
+    "  --output WHAT     total: direct + indirect (default); direct: the direct light with\n"   \
+    "                    shadows (shadow rays); indirect: the propagated light only\n"           \
+    "  --transfer T      cone: the thesis kernel, clamped 45-degree cone fluxes (default);\n"     \
+    "                    normalized: the same proportions, nothing lost between the cones\n"       \
+    "  --paths P         all: every face neighbour exchanges light (default, the spec kernel);\n"  \
+    "                    void: no light between two occupied voxels (\"only in void space\")\n"   \
+    "  --reflection R    mirror: on the dominant axis of the voxel normal (default, the thesis);\n" \
+    "                    diffuse: re-emitted as a cosine lobe about the normal\n"                  \
+    "  --reflectance R   reflectance of occupied voxels during the propagation, 0..1 (default\n"   \
+    "                    0.5, the thesis), or 'albedo' for the voxels' own colour\n"               \
+    "Prints the grid, the voxel counts and the light budget unless --quiet. Default PGM range\n"   \
+    "0:the largest output value. Only -o, --range and --quiet of the shared options apply.\n"
+
+#define CLI_VOLGI_FLAGS                                                                      \
+    { "--room", 0, CLI_ONLY(CMD_VOLGI) }, { "--iterations", 1, CLI_ONLY(CMD_VOLGI) },        \
+    { "--light", 1, CLI_ONLY(CMD_VOLGI) }, { "--eye", 1, CLI_ONLY(CMD_VOLGI) },              \
+    { "--target", 1, CLI_ONLY(CMD_VOLGI) }, { "--up", 1, CLI_ONLY(CMD_VOLGI) },              \
+    { "--fov", 1, CLI_ONLY(CMD_VOLGI) }, { "--size", 1, CLI_ONLY(CMD_VOLGI) },               \
+    { "--transfer", 1, CLI_ONLY(CMD_VOLGI) }, { "--paths", 1, CLI_ONLY(CMD_VOLGI) },         \
+    { "--reflection", 1, CLI_ONLY(CMD_VOLGI) }, { "--reflectance", 1, CLI_ONLY(CMD_VOLGI) }
 
 typedef struct cli_args {
     int cmd;
@@ -62,6 +114,10 @@ typedef struct cli_args {
     double specular, shininess;
     int ssao_method, ssao_depth, ssao_has_ortho, ssao_has_near, ssao_has_far, ssao_guard;
     double ssao_fov, ssao_ortho, ssao_radius, ssao_near, ssao_far;
+    int room, iterations, vg_nlights, vg_has_eye, vg_has_target, vg_width, vg_height, vg_transfer,
+        vg_paths, vg_reflection, vg_rho_albedo, vg_has_rho;
+    double vg_eye[3], vg_target[3], vg_up[3], vg_fov, vg_rho;
+    hfvis_volgi_light vg_lights[CLI_VOLGI_MAX_LIGHTS];
 } cli_args;
 
 /* ssao --method, --depth */
@@ -129,6 +185,7 @@ static const char cli_usage[] =
     "  visibility  visibility index: the grid samples each point sees along K directions\n"
     "  viewshed    which samples an observer at one point sees (line of sight)\n"
     "  voxelize    voxels of an OBJ mesh: surface, conservative or solid (.binvox or .raw)\n"
+    "  volgi       direct + indirect light of an OBJ mesh or the test room ([G12] ch. 5)\n"
     "  ssao        screen-space obscurance of a depth buffer: LSAO, HBAO, FFAO, ray traced\n";
 
 static const char cli_shared_help[] =
@@ -315,7 +372,9 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "  --guard PIXELS    guard band per side (default 10 %% of the width and height)\n"
     "  --depth ENC       linear view depth (default), gl or d3d window depth, reversed Z; the\n"
     "                    hardware encodings need --near and --far\n"
-    "Only -o, --dirs and --quiet of the shared options apply. Default PGM range 0:1.\n"
+    "Only -o, --dirs and --quiet of the shared options apply. Default PGM range 0:1.\n",
+
+    CLI_VOLGI_HELP
 };
 
 /* ------------------------------------------------------------------------------------------ */
@@ -507,6 +566,170 @@ static int cli_check_gi(const cli_args *a)
     return 0;
 }
 
+
+static void cli_volgi_defaults(cli_args *a)
+{
+    a->vg_up[0] = 0.0, a->vg_up[1] = 0.0, a->vg_up[2] = 1.0;
+    a->vg_fov = 40.0;
+    a->vg_width = 512, a->vg_height = 512;
+    a->iterations = HFVIS_VOLGI_DEFAULT_ITERATIONS;
+}
+
+/* Parse "r1,r2,...": between min and max finite reals (s[0..len)); returns the count or -1. */
+static int cli_volgi_reals(const char *s, size_t len, double *out, int min, int max)
+{
+    char buf[256];
+    const char *p;
+    int n = 0;
+    if (len >= sizeof buf) return -1;
+    memcpy(buf, s, len);
+    buf[len] = '\0';
+    p = buf;
+    for (;;) {
+        char *comma = strchr(p, ',');
+        if (n == max) return -1;
+        if (comma) *comma = '\0';
+        if (!cli_parse_real(p, &out[n])) return -1;
+        n++;
+        if (!comma) break;
+        p = comma + 1;
+    }
+    return n >= min ? n : -1;
+}
+
+/* --light SPEC (see CLI_VOLGI_HELP); returns 0 or CLI_EXIT_USAGE. */
+static int cli_volgi_light(cli_args *a, const char *v)
+{
+    static const char *const kinds[3] = { "point:", "spot:", "dir:" };
+    const char *bad = "expected point:X,Y,Z[:I], spot:X,Y,Z:DX,DY,DZ:OUTER[,INNER][:I] or "
+                      "dir:DX,DY,DZ[:E], got '%s'";
+    hfvis_volgi_light L;
+    const char *p, *parts[4];
+    size_t lens[4];
+    double vals[3];
+    int kind, np = 0, need, c, n;
+    memset(&L, 0, sizeof L);
+    if (a->vg_nlights == CLI_VOLGI_MAX_LIGHTS)
+        return cli_error(CLI_EXIT_USAGE, "--light", "at most %d lights", CLI_VOLGI_MAX_LIGHTS);
+    for (kind = 0; kind < 3 && strncmp(v, kinds[kind], strlen(kinds[kind])); kind++) {}
+    if (kind == 3) return cli_error(CLI_EXIT_USAGE, "--light", bad, v);
+    p = v + strlen(kinds[kind]);
+    while (np < 4) { /* split at ':' */
+        const char *colon = strchr(p, ':');
+        parts[np] = p;
+        lens[np] = colon ? (size_t)(colon - p) : strlen(p);
+        np++;
+        if (!colon) break;
+        p = colon + 1;
+        if (np == 4) return cli_error(CLI_EXIT_USAGE, "--light", bad, v);
+    }
+    need = kind == 1 ? 3 : 1; /* parts before the optional intensity */
+    if (np != need && np != need + 1) return cli_error(CLI_EXIT_USAGE, "--light", bad, v);
+    L.type = kind == 0 ? HFVIS_VOLGI_LIGHT_POINT : kind == 1 ? HFVIS_VOLGI_LIGHT_SPOT
+                                                           : HFVIS_VOLGI_LIGHT_DIRECTIONAL;
+    if (cli_volgi_reals(parts[0], lens[0], kind == 2 ? L.direction : L.position, 3, 3) != 3)
+        return cli_error(CLI_EXIT_USAGE, "--light", bad, v);
+    if (kind == 1) {
+        double ang[2];
+        if (cli_volgi_reals(parts[1], lens[1], L.direction, 3, 3) != 3)
+            return cli_error(CLI_EXIT_USAGE, "--light", bad, v);
+        n = cli_volgi_reals(parts[2], lens[2], ang, 1, 2);
+        if (n < 0 || !(ang[0] > 0.0 && ang[0] <= 180.0) || (n == 2 && !(ang[1] >= 0.0 && ang[1] <= ang[0])))
+            return cli_error(CLI_EXIT_USAGE, "--light", "spot angles: OUTER in (0, 180], 0 <= INNER <= "
+                             "OUTER degrees, got '%s'", v);
+        L.spot_outer_rad = ang[0] * (CLI_PI / 180.0);
+        L.spot_inner_rad = (n == 2 ? ang[1] : 0.8 * ang[0]) * (CLI_PI / 180.0);
+    }
+    if ((kind == 1 || kind == 2) && L.direction[0] == 0.0 && L.direction[1] == 0.0 && L.direction[2] == 0.0)
+        return cli_error(CLI_EXIT_USAGE, "--light", "the direction must not be 0,0,0, got '%s'", v);
+    vals[0] = vals[1] = vals[2] = 1.0;
+    if (np == need + 1) {
+        n = cli_volgi_reals(parts[need], lens[need], vals, 1, 3);
+        if (n == 2 || n < 0) return cli_error(CLI_EXIT_USAGE, "--light", "intensity: one value or R,G,B, got '%s'", v);
+        if (n == 1) vals[1] = vals[2] = vals[0];
+    }
+    for (c = 0; c < 3; c++) {
+        if (!(vals[c] >= 0.0 && vals[c] <= CLI_FLT_MAX))
+            return cli_error(CLI_EXIT_USAGE, "--light", "intensity must be >= 0, got '%s'", v);
+        L.intensity[c] = (float)vals[c];
+    }
+    for (c = 0; c < 3; c++)
+        if (fabs(L.position[c]) > 1e30)
+            return cli_error(CLI_EXIT_USAGE, "--light", "position beyond 1e30, got '%s'", v);
+    a->vg_lights[a->vg_nlights++] = L;
+    return 0;
+}
+
+/* The flags only `volgi` has; -1 if f is none of them. */
+static int cli_set_volgi(cli_args *a, const char *f, const char *v)
+{
+    if (!strcmp(f, "--room")) { a->room = 1; return 0; }
+    if (!strcmp(f, "--iterations"))
+        return cli_int(f, v, 1, HFVIS_VOLGI_MAX_ITERATIONS, "an integer 1..1048576", &a->iterations);
+    if (!strcmp(f, "--light")) return cli_volgi_light(a, v);
+    if (!strcmp(f, "--eye") || !strcmp(f, "--target") || !strcmp(f, "--up")) {
+        double *dst = f[2] == 'e' ? a->vg_eye : f[2] == 't' ? a->vg_target : a->vg_up;
+        if (cli_volgi_reals(v, strlen(v), dst, 3, 3) != 3 || fabs(dst[0]) > 1e30 || fabs(dst[1]) > 1e30
+            || fabs(dst[2]) > 1e30)
+            return cli_error(CLI_EXIT_USAGE, f, "expected X,Y,Z (finite, below 1e30), got '%s'", v);
+        if (f[2] == 'e') a->vg_has_eye = 1;
+        if (f[2] == 't') a->vg_has_target = 1;
+        return 0;
+    }
+    if (!strcmp(f, "--fov")) return cli_real(f, v, 1.0, 0, 179.0, "degrees in 1..179", &a->vg_fov);
+    if (!strcmp(f, "--size")) {
+        char *end;
+        long w, h;
+        errno = 0;
+        w = strtol(v, &end, 10);
+        if (end == v || (*end != 'x' && *end != 'X') || w < 1 || w > HFVIS_RASTER_MAX_SIZE)
+            return cli_error(CLI_EXIT_USAGE, f, "expected WxH, sides 1..%d, got '%s'", HFVIS_RASTER_MAX_SIZE, v);
+        h = strtol(end + 1, &end, 10);
+        if (*end != '\0' || errno == ERANGE || h < 1 || h > HFVIS_RASTER_MAX_SIZE || (long long)w * h > 1LL << 26)
+            return cli_error(CLI_EXIT_USAGE, f, "expected WxH, sides 1..%d, at most 2^26 pixels, got '%s'",
+                             HFVIS_RASTER_MAX_SIZE, v);
+        a->vg_width = (int)w, a->vg_height = (int)h;
+        return 0;
+    }
+    if (!strcmp(f, "--transfer")) {
+        if (!strcmp(v, "cone")) a->vg_transfer = HFVIS_VOLGI_TRANSFER_CONE;
+        else if (!strcmp(v, "normalized")) a->vg_transfer = HFVIS_VOLGI_TRANSFER_CONE_NORMALIZED;
+        else return cli_error(CLI_EXIT_USAGE, f, "expected cone or normalized, got '%s'", v);
+        return 0;
+    }
+    if (!strcmp(f, "--paths")) {
+        if (!strcmp(v, "all")) a->vg_paths = HFVIS_VOLGI_PATHS_ALL;
+        else if (!strcmp(v, "void")) a->vg_paths = HFVIS_VOLGI_PATHS_VOID;
+        else return cli_error(CLI_EXIT_USAGE, f, "expected all or void, got '%s'", v);
+        return 0;
+    }
+    if (!strcmp(f, "--reflection")) {
+        if (!strcmp(v, "mirror")) a->vg_reflection = HFVIS_VOLGI_REFLECT_MIRROR;
+        else if (!strcmp(v, "diffuse")) a->vg_reflection = HFVIS_VOLGI_REFLECT_DIFFUSE;
+        else return cli_error(CLI_EXIT_USAGE, f, "expected mirror or diffuse, got '%s'", v);
+        return 0;
+    }
+    if (!strcmp(f, "--reflectance")) {
+        a->vg_has_rho = 1;
+        if (!strcmp(v, "albedo")) { a->vg_rho_albedo = 1; return 0; }
+        a->vg_rho_albedo = 0;
+        return cli_real(f, v, 0.0, 0, 1.0, "a reflectance in 0..1 or 'albedo'", &a->vg_rho);
+    }
+    return -1;
+}
+
+/* Combinations `volgi` rejects; returns 0 or CLI_EXIT_USAGE (message printed). */
+static int cli_check_volgi(const cli_args *a)
+{
+    if (a->room && a->in) return cli_error(CLI_EXIT_USAGE, a->in, "--room renders the test room: no MESH");
+    if (a->room && a->has_albedo)
+        return cli_error(CLI_EXIT_USAGE, "--albedo", "applies to a MESH (the room has its own colours)");
+    if (a->has_albedo && a->albedo > 1.0)
+        return cli_error(CLI_EXIT_USAGE, "--albedo", "expected an albedo in 0..1, got %g", a->albedo);
+    if (a->res == 1) return cli_error(CLI_EXIT_USAGE, "--res", "volgi needs at least 2 voxels");
+    return 0;
+}
+
 #define CLI_ALL ((1u << CMD_COUNT) - 1u)
 #define CLI_ONLY(c) (1u << (c))
 #define CLI_SUN (CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI)) /* the sun flags */
@@ -517,23 +740,25 @@ static const cli_flag cli_flags[] = {
     { "--azimuth0", 1, CLI_ALL },   { "--compass", 0, CLI_ALL },     { "--degrees", 0, CLI_ALL },
     { "--border", 1, CLI_ALL },     { "--border-cells", 1, CLI_ALL }, { "--quiet", 0, CLI_ALL },
     { "--sky", 1, CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
-    { "--albedo", 1, CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
+    { "--albedo", 1, CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI)
+                  | CLI_ONLY(CMD_VOLGI) },
     { "--sun-azimuth", 1, CLI_SUN },              { "--sun-elevation", 1, CLI_SUN },
     { "--sun-radius", 1, CLI_SUN },               { "--math", 0, CLI_SUN },
     { "--env", 1, CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
     { "--method", 1, CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_SSAO) },
     { "--sun-irradiance", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) }, { "--albedo-map", 1, CLI_ONLY(CMD_INDIRECT) },
     { "--emission", 1, CLI_ONLY(CMD_INDIRECT) },  { "--bounces", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
-    { "--output", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
+    { "--output", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VOLGI) },
     { "--fraction", 0, CLI_ONLY(CMD_VISIBILITY) }, { "--stats", 0, CLI_ONLY(CMD_VISIBILITY) },
     { "--observer", 1, CLI_ONLY(CMD_VIEWSHED) },  { "--observer-height", 1, CLI_ONLY(CMD_VIEWSHED) },
     { "--target-height", 1, CLI_ONLY(CMD_VIEWSHED) }, { "--max-distance", 1, CLI_ONLY(CMD_VIEWSHED) },
     { "--exact", 0, CLI_ONLY(CMD_VIEWSHED) },
-    { "--res", 1, CLI_ONLY(CMD_VOXELIZE) },       { "--mode", 1, CLI_ONLY(CMD_VOXELIZE) },
+    { "--res", 1, CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_VOLGI) },       { "--mode", 1, CLI_ONLY(CMD_VOXELIZE) },
     { "--axis", 1, CLI_ONLY(CMD_VOXELIZE) },  
     { "--max-vertices", 1, CLI_ONLY(CMD_VOXELIZE) }, { "--padding", 1, CLI_ONLY(CMD_VOXELIZE) },
     { "--open", 0, CLI_ONLY(CMD_VOXELIZE) },
     CLI_GI_FLAGS,
+    CLI_VOLGI_FLAGS,
     { "--fov-y", 1, CLI_ONLY(CMD_SSAO) },         { "--ortho", 1, CLI_ONLY(CMD_SSAO) },
     { "--radius", 1, CLI_ONLY(CMD_SSAO) },        { "--guard", 1, CLI_ONLY(CMD_SSAO) },
     { "--depth", 1, CLI_ONLY(CMD_SSAO) },         { "--near", 1, CLI_ONLY(CMD_SSAO) },
@@ -680,6 +905,10 @@ static int cli_set(cli_args *a, const char *f, const char *v)
         return cli_error(CLI_EXIT_USAGE, f, "expected dominant, all, x, y or z, got '%s'", v);
     }
     {
+        int r = cli_set_volgi(a, f, v);
+        if (r >= 0) return r;
+    }
+    {
         int r = cli_set_gi(a, f, v);
         if (r >= 0) return r;
         if (a->cmd == CMD_SSAO && (r = cli_set_ssao(a, f, v)) >= 0) return r;
@@ -709,6 +938,7 @@ static int cli_parse(int argc, char **argv, cli_args *a)
     a->order = 4; a->subsample = 1;
     a->ssao_method = SSAO_FFAO; a->ssao_depth = SSAO_DEPTH_LINEAR; a->ssao_fov = 60.0;
     a->ssao_guard = -1;
+    cli_volgi_defaults(a);
     if (argc < 2) return cli_error(CLI_EXIT_USAGE, "usage", "missing COMMAND (try 'hfvis --help')");
     if (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help") || !strcmp(argv[1], "help")) {
         if (argc > 2 && strcmp(argv[1], "help") == 0) {
@@ -761,7 +991,8 @@ static int cli_parse(int argc, char **argv, cli_args *a)
         }
         if (cli_set(a, name, value)) return CLI_EXIT_USAGE;
     }
-    if (!a->in) return cli_error(CLI_EXIT_USAGE, cli_cmd_names[a->cmd], "missing input file IN");
+    if (!a->in && !(a->cmd == CMD_VOLGI && a->room))
+        return cli_error(CLI_EXIT_USAGE, cli_cmd_names[a->cmd], "missing input file IN");
     if (!a->out) return cli_error(CLI_EXIT_USAGE, cli_cmd_names[a->cmd], "missing -o OUT");
     if (a->has_range && !a->out_pgm)
         return cli_error(CLI_EXIT_USAGE, "--range", "applies only to .pgm output");
@@ -808,6 +1039,7 @@ static int cli_parse(int argc, char **argv, cli_args *a)
             return cli_error(CLI_EXIT_USAGE, "--output indirect", "needs --bounces >= 1");
     }
     if (a->cmd == CMD_GI && cli_check_gi(a)) return CLI_EXIT_USAGE;
+    if (a->cmd == CMD_VOLGI && cli_check_volgi(a)) return CLI_EXIT_USAGE;
     return CLI_RUN;
 }
 
@@ -1315,6 +1547,112 @@ done:
     return rc;
 }
 
+
+/* volgi: MESH.obj or the room -> hfvis_volgi_render -> the chosen RGB plane as PFM or PGM. */
+static int cli_run_volgi(const cli_args *a)
+{
+    const char *cmd = "volgi";
+    const int w = a->vg_width, h = a->vg_height;
+    const size_t n = (size_t)w * (size_t)h;
+    hfvis_mesh mesh;
+    hfvis_volgi_scene sc;
+    hfvis_volgi_light def;
+    hfvis_volgi_options o = hfvis_volgi_options_default();
+    hfvis_volgi_outputs out;
+    hfvis_volgi_render_info info;
+    hfvis_view view;
+    double lo[3], hi[3], c[3], e = 0.0, eye[3], target[3], d;
+    float *albedo = NULL, *img = NULL;
+    hfvis_status s;
+    size_t t;
+    int k, rc = 0;
+
+    memset(&mesh, 0, sizeof mesh);
+    errno = 0;
+    s = a->room ? hfvis_mesh_room(NULL, &mesh) : hfvis_mesh_load(a->in, NULL, &mesh);
+    if (s != HFVIS_OK) return cli_status(a->room ? cmd : a->in, s, errno);
+    if (mesh.triangle_count == 0 || hfvis_mesh_bounds(&mesh, lo, hi) != HFVIS_OK) {
+        rc = cli_error(CLI_EXIT_ERROR, a->in, "the mesh has no triangles");
+        goto done;
+    }
+    for (k = 0; k < 3; k++) {
+        c[k] = 0.5 * (lo[k] + hi[k]);
+        if (hi[k] - lo[k] > e) e = hi[k] - lo[k];
+    }
+    if (!(e > 0.0)) { rc = cli_error(CLI_EXIT_ERROR, a->in, "the mesh has no extent"); goto done; }
+    albedo = cli_alloc(mesh.triangle_count, 3, 1);
+    img = cli_alloc(n, 3, 1);
+    if (!albedo || !img) { rc = cli_status(cmd, HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
+    for (t = 0; t < mesh.triangle_count; t++) { /* room: walls 0-1 red (x = 0), 2-3 green (x = 1) */
+        float grey = a->has_albedo ? (float)a->albedo : 0.75f;
+        albedo[3 * t] = a->room && t >= 2 && t < 4 ? 0.15f : grey;
+        albedo[3 * t + 1] = a->room && t < 2 ? 0.15f : grey;
+        albedo[3 * t + 2] = a->room && t < 4 ? 0.15f : grey;
+    }
+    /* camera and default light */
+    memset(&def, 0, sizeof def);
+    def.type = HFVIS_VOLGI_LIGHT_POINT;
+    if (a->room) {
+        eye[0] = 0.5, eye[1] = -1.1, eye[2] = 0.5, target[0] = 0.5, target[1] = 0.5, target[2] = 0.45;
+        def.position[0] = 0.5, def.position[1] = 0.45, def.position[2] = 0.9;
+        def.intensity[0] = def.intensity[1] = def.intensity[2] = 1.0f;
+    } else {
+        eye[0] = c[0], eye[1] = c[1] - 2.2 * e, eye[2] = c[2] + 0.6 * e;
+        target[0] = c[0], target[1] = c[1], target[2] = c[2];
+        def.position[0] = c[0] + 0.6 * e, def.position[1] = c[1] - 1.2 * e, def.position[2] = c[2] + 1.5 * e;
+        def.intensity[0] = def.intensity[1] = def.intensity[2] = (float)(4.0 * e * e);
+    }
+    for (k = 0; k < 3; k++) {
+        if (a->vg_has_eye) eye[k] = a->vg_eye[k];
+        if (a->vg_has_target) target[k] = a->vg_target[k];
+    }
+    d = sqrt((eye[0] - target[0]) * (eye[0] - target[0]) + (eye[1] - target[1]) * (eye[1] - target[1])
+             + (eye[2] - target[2]) * (eye[2] - target[2]));
+    s = hfvis_view_perspective(&view, eye, target, a->vg_up, a->vg_fov * (CLI_PI / 180.0), w, h,
+                               1e-3 * (d + e), 100.0 * (d + e));
+    if (s != HFVIS_OK) {
+        rc = cli_error(CLI_EXIT_USAGE, "--eye", "camera: eye and target must differ and the view "
+                       "direction must not be parallel to --up");
+        goto done;
+    }
+    memset(&sc, 0, sizeof sc);
+    sc.mesh = &mesh;
+    sc.albedo = albedo;
+    sc.lights = a->vg_nlights ? a->vg_lights : &def;
+    sc.light_count = a->vg_nlights ? a->vg_nlights : 1;
+    o.resolution = a->res ? a->res : HFVIS_VOLGI_DEFAULT_RESOLUTION;
+    o.iterations = a->iterations;
+    o.transfer = (hfvis_volgi_transfer)a->vg_transfer;
+    o.paths = (hfvis_volgi_paths)a->vg_paths;
+    o.reflection = (hfvis_volgi_reflection)a->vg_reflection;
+    if (a->vg_has_rho) {
+        o.reflectance_source = a->vg_rho_albedo ? HFVIS_VOLGI_REFLECTANCE_ALBEDO : HFVIS_VOLGI_REFLECTANCE_CONSTANT;
+        o.reflectance = (float)a->vg_rho;
+    }
+    memset(&out, 0, sizeof out);
+    if (a->output == OUT_DIRECT) out.direct = img;
+    else if (a->output == OUT_INDIRECT) out.indirect = img;
+    else out.total = img;
+    s = hfvis_volgi_render(&sc, NULL, &view, &o, &out, &info);
+    if (s == HFVIS_ERR_LIMIT) {
+        rc = cli_error(CLI_EXIT_ERROR, "--res", "%s: the grid would exceed 2^31 voxels", hfvis_status_string(s));
+        goto done;
+    }
+    if (s != HFVIS_OK) { rc = cli_status(cmd, s, 0); goto done; }
+    rc = cli_save(a, img, w, h, 3, 0.0, cli_top(img, 3 * n, 1.0));
+    if (rc == 0 && !a->quiet)
+        printf("volgi: %zu triangles, %d x %d x %d voxels of %.6g, %zu occupied (%zu fragments), %d "
+               "iterations; VPL flux %.6g, recorded at surfaces %.6g, still travelling %.6g (red band); "
+               "%zu of %zu pixels covered\n", mesh.triangle_count, info.grid.dims[0], info.grid.dims[1],
+               info.grid.dims[2], info.grid.cell[0], info.occupied, info.fragments, a->iterations,
+               info.injected[0], info.deposited[0], info.remaining[0], info.covered_pixels, n);
+done:
+    free(img);
+    free(albedo);
+    hfvis_mesh_free(NULL, &mesh);
+    return rc;
+}
+
 static int cli_run(const cli_args *a)
 {
     const char *cmd = cli_cmd_names[a->cmd];
@@ -1329,6 +1667,7 @@ static int cli_run(const cli_args *a)
 
     if (a->cmd == CMD_VOXELIZE) return cli_run_voxelize(a);
     if (a->cmd == CMD_SSAO) return cli_run_ssao(a);
+    if (a->cmd == CMD_VOLGI) return cli_run_volgi(a);
     memset(&env, 0, sizeof env);
     if ((rc = cli_load_heights(a, &z, &w, &h)) != 0) return rc;
     grid.z = z; grid.width = w; grid.height = h; grid.stride = w; grid.cell_size = a->cell;

@@ -107,7 +107,7 @@ expect_line2() { # NAME FILE WANT: the second header line (PFM dimensions)
 # ---- help ---------------------------------------------------------------------------------
 if "$hfvis" --help > "$dir/stdout" 2> "$dir/stderr" && grep -q '^usage: hfvis' "$dir/stdout" && [ ! -s "$dir/stderr" ]
 then ok "--help"; else bad "--help"; fi
-for c in horizon skyview sky shadow light normals indirect visibility viewshed voxelize gi ssao; do
+for c in horizon skyview sky shadow light normals indirect visibility viewshed voxelize gi ssao volgi; do
   if "$hfvis" $c --help > "$dir/stdout" 2>&1 && grep -q "^usage: hfvis $c" "$dir/stdout"
   then ok "$c --help"; else bad "$c --help"; fi
 done
@@ -239,6 +239,12 @@ grep -q ', 56 set' "$dir/stdout" && ok "voxelize conservative: 56 voxels" || bad
 head -n 1 "$dir/cc.binvox" | grep -q '^#binvox 1' && ok "voxelize binvox header" || bad "voxelize binvox header"
 expect_ok "voxelize surface, all axes, slicing" "$dir/cv.binvox" voxelize "$dir/cube.obj" --res 8 --axis all --method slicing --max-vertices 11 --padding 0.1 -o "$dir/cv.binvox"
 expect_ok "voxelize solid --axis x --open" "$dir/co.raw" voxelize "$dir/tri.obj" --res 4 --mode solid --axis x --open -o "$dir/co.raw"
+# volgi: the room and a mesh with two lights render; every output choice and option parses.
+expect_ok "volgi room" "$dir/vg.pfm" volgi --room --res 16 --iterations 16 --size 32x24 -o "$dir/vg.pfm"
+grep -q '16 x 16 x 16 voxels' "$dir/stdout" && ok "volgi room grid" || bad "volgi room: $(cat "$dir/stdout")"
+expect_ok "volgi room indirect, void paths, pgm" "$dir/vgi.pgm" volgi --room --res 16 --iterations 24 --paths void --transfer normalized --reflectance albedo --reflection diffuse --output indirect --size 32x24 -o "$dir/vgi.pgm"
+expect_ok "volgi mesh, two lights, camera" "$dir/vgc.pfm" volgi "$dir/cube.obj" --res 8 --iterations 8 --albedo 0.5 --light point:2,-3,4:10 --light spot:0.5,0.5,3:0,0,-1:40,20:1,0.5,0.25 --eye 3,-4,2 --target 0.5,0.5,0.5 --fov 30 --size 16x16 --output direct -o "$dir/vgc.pfm"
+
 expect_floats "viewshed: the hole is NaN" "$dir/vs7.pfm" 32 0 nan 1 1 1 1 1 1 1
 expect_ok "visibility flat, 4 directions" "$dir/fv4.pfm" visibility "$f" --dirs 4 --stats -o "$dir/fv4.pfm"
 expect_floats "visibility flat, 4 directions: 12" "$dir/fv4.pfm" 32 0 12 12 12 12 12 12 12 12
@@ -338,6 +344,17 @@ expect_fail "voxelize --mode bogus" 2 voxelize "$dir/cube.obj" --res 4 --mode bo
 expect_fail "voxelize --res 0" 2 voxelize "$dir/cube.obj" --res 0 -o "$ob"
 expect_fail "voxelize solid --axis all" 2 voxelize "$dir/cube.obj" --res 4 --mode solid --axis all -o "$ob"
 expect_fail "voxelize --max-vertices with the pixel rule" 2 voxelize "$dir/cube.obj" --res 4 --max-vertices 7 -o "$ob"
+expect_fail "volgi without MESH or --room" 2 volgi -o "$o"
+expect_fail "volgi --room with MESH" 2 volgi "$dir/cube.obj" --room -o "$o"
+expect_fail "volgi --light bogus" 2 volgi --room --light lamp:1,2,3 -o "$o"
+expect_fail "volgi --light spot without angle" 2 volgi --room --light spot:0,0,1:0,0,-1 -o "$o"
+expect_fail "volgi --light dir 0,0,0" 2 volgi --room --light dir:0,0,0 -o "$o"
+expect_fail "volgi --res 1" 2 volgi --room --res 1 -o "$o"
+expect_fail "volgi --albedo with --room" 2 volgi --room --albedo 0.5 -o "$o"
+expect_fail "volgi --size 0x4" 2 volgi --room --size 0x4 -o "$o"
+expect_fail "volgi --reflectance 2" 2 volgi --room --reflectance 2 -o "$o"
+expect_fail "volgi eye = target" 2 volgi --room --eye 0.5,0.5,0.5 --target 0.5,0.5,0.5 -o "$o"
+expect_fail "volgi missing mesh file" 1 volgi "$dir/nope.obj" -o "$o"
 expect_fail "voxelize slicing --max-vertices 5" 2 voxelize "$dir/cube.obj" --res 4 --method slicing --max-vertices 5 -o "$ob"
 expect_fail "voxelize --open surface" 2 voxelize "$dir/cube.obj" --res 4 --open -o "$ob"
 expect_fail "voxelize an open mesh solid" 1 voxelize "$dir/tri.obj" --res 4 --mode solid -o "$ob"
