@@ -41,7 +41,12 @@
  * - Every query is an approximation: the stored ray starts at the snapped sample p_k and runs
  *   along the snapped texel direction, so hit distances carry a positional error of about
  *   R * (covering angle, ~79 deg / n) and the 8-bit step R/127; the tests report hit/miss
- *   disagreement and mean distance error against ray casting (the oracle) per (K, D). */
+ *   disagreement and mean distance error against ray casting (the oracle) per (K, D). Measured
+ *   (teapot in the thesis' corner, 256 AO rays per receiver, 8-bit scale): AO RMS about 9, 4.4,
+ *   3.0, 2.6 for K = 82, 290, 1090, 4226 at D = 32 (the thesis' Fig. 35 trend: K matters, D
+ *   hardly). Receivers on the object itself (intra-object AO) need the bias above the snapping
+ *   offset: a convex sphere occludes itself by 10 % at K = 1090 with the default bias (0 with
+ *   0.1 R) and by 0.4 % at K = 4226. */
 
 #define HFVIS_VISFIELD_MAX_N 1024          /* positions_n: 1..1024 (K <= 4,198,402 maps) */
 #define HFVIS_VISFIELD_MAX_DIR_RES 4096    /* dir_res D: 1..4096 */
@@ -169,12 +174,12 @@ HFVIS_API hfvis_status hfvis_visfield_nearest_position_naive(int positions_n, co
  * e = w.x w.y a,
  * t = (1 + s w.x^2 a, s e, -s w.x), b = (e, s + w.y^2 a, -w.y); (t, b, w) is orthonormal and
  * right-handed (t x b = w) to rounding. Used for the maps (w = -u_k) and the AO ray sets
- * (w = the receiver normal). w must be unit length (not checked). */
+ * (w = the receiver normal). w must be unit length and the pointers valid (not checked). */
 HFVIS_API void hfvis_visfield_frame(const double w[3], double t[3], double b[3]);
 
 /* Shirley & Chiu's concentric map, "A low distortion map between disk and square", JGT 2(3),
  * 1997 (spec §1.4 formulas): square [-1, 1]^2 -> unit disk, area preserving; the disk radius is
- * max(|a|, |b|). And its inverse (the origin maps to (0, 0)). */
+ * max(|a|, |b|). And its inverse (the origin maps to (0, 0)). Outputs must not be NULL. */
 HFVIS_API void hfvis_concentric_square_to_disk(double a, double b, double *x, double *y);
 HFVIS_API void hfvis_concentric_disk_to_square(double x, double y, double *a, double *b);
 
