@@ -3,24 +3,27 @@
  * field and write an ambient-obscurance image of a ground plane under the object.
  *
  * MERGE RECIPE (examples/hfvis_cli.c; tested by applying it to a copy, see the commands at the end):
- *  1. enum: add CMD_VISFIELD before CMD_COUNT; cli_cmd_names: add "visfield" at the end.
+ *  1. enum: add CMD_VISFIELD just before CMD_COUNT; cli_cmd_names: add "visfield" at the end.
  *  2. cli_usage, after the "voxelize" line:
  *       "  visfield    4D visibility field of an OBJ mesh (.hfvf), or AO images from one\n"
  *  3. cli_cmd_help: append CLI_VF_HELP (below) as the last entry.
- *  4. cli_args: add   int vf_positions, vf_format, vf_mapping, vf_ao, vf_size, vf_rays;
+ *  4. cli_args: add   int vf_positions, vf_format, vf_mapping, vf_ao, vf_rays, vf_has_size;
  *                     int vf_has_extent, vf_has_ground, vf_has_bias;
  *                     double vf_extent, vf_ground, vf_bias;
  *                     const char *vf_reference;
- *     (has_dirs already exists: the gi part added it; --dirs sets it.)
- *  5. flags: "--max-distance" gains | CLI_ONLY(CMD_VISFIELD); add CLI_VF_FLAGS after CLI_GI_FLAGS
- *     (a comma between them).
+ *     (has_dirs exists (gi part; --dirs sets it); --size WxH is volgi's: vg_width, vg_height.)
+ *  5. flags: "--max-distance" gains | CLI_ONLY(CMD_VISFIELD), and so does "--size" (in
+ *     CLI_VOLGI_FLAGS); add CLI_VF_FLAGS as the last entries of cli_flags.
  *  6. cli_set: first statement:  if (!strcmp(f, "-o") && a->cmd == CMD_VISFIELD) return cli_set_vf(a, f, v);
- *     and beside the cli_set_gi call:  { int r = cli_set_vf(a, f, v); if (r >= 0) return r; }
+ *     and just BEFORE the cli_set_volgi call:  { int r = cli_set_vf(a, f, v); if (r >= 0) return r; }
+ *     (cli_set_vf notes --size and lets volgi's code parse the WxH)
  *  7. cli_parse: before "return CLI_RUN;" add
  *       if (a->cmd == CMD_VISFIELD && cli_check_vf(a)) return CLI_EXIT_USAGE;
  *  8. cli_run: after the voxelize line:  if (a->cmd == CMD_VISFIELD) return cli_run_visfield(a);
  *  9. Paste PART A (the two macros) after CLI_GI_FLAGS, PART B (cli_set_vf, cli_check_vf) after
  *     cli_check_gi, PART C (cli_run_visfield and its helpers) after cli_run_voxelize.
+ *  (Applied to examples/hfvis_cli.c of commit 62e9155 and built with -Werror; every command below
+ *  and the usage errors were run.)
  *  Then e.g.:
  *    hfvis visfield teapot.obj --positions 4226 --dirs 32 -o teapot.hfvf
  *    hfvis visfield --ao teapot.hfvf --ground 0 -o teapot_ao.pgm
@@ -32,7 +35,7 @@
 #define CLI_VF_HELP                                                                                  \
     "usage: hfvis visfield MESH.obj -o FIELD.hfvf [--positions K] [--dirs D] [--format F]\n"        \
     "                      [--mapping M]\n"                                                          \
-    "       hfvis visfield --ao FIELD.hfvf -o OUT [--ground Z] [--extent E] [--size N] [--rays S]\n" \
+    "       hfvis visfield --ao FIELD.hfvf -o OUT [--ground Z] [--extent E] [--size WxH] [--rays S]\n" \
     "                      [--max-distance L] [--bias B] [--reference MESH.obj]\n"                  \
     "Pre-computed 4D visibility fields ([G12] ch. 4): for K sample points on the mesh's bounding\n" \
     "sphere and D x D directions over the inward hemisphere at each, the distance to the mesh\n"    \
@@ -46,12 +49,12 @@
     "                    average distance), normal (RGBA8: normal + 8-bit distance)\n"              \
     "  --mapping M       concentric (default, Shirley-Chiu + Malley), polar or rejection\n"         \
     "--ao reads FIELD and writes the ambient obscurance (0 open .. 1 blocked, cosine-weighted,\n"   \
-    "[G12] Alg. 2) of the ground plane z = Z under the object, seen from above: an N x N image\n"  \
-    "of the square of half-size E around the sphere's centre, row 0 = +y.\n"                        \
+    "[G12] Alg. 2) of the ground plane z = Z under the object, seen from above: a W x H image of\n" \
+    "the rectangle of half-width E (half-height E H/W) around the sphere's centre, row 0 = +y.\n"   \
     "  --ground Z        height of the ground plane in the field's object space (default: the\n"   \
     "                    bottom of the bounding sphere, centre z - radius)\n"                       \
-    "  --extent E        half-size of the square, > 0 (default 1.5 x the sphere's radius)\n"        \
-    "  --size N          image width and height in pixels, 1..8192 (default 256)\n"                 \
+    "  --extent E        half-width of the rectangle, > 0 (default 1.5 x the sphere's radius)\n"    \
+    "  --size WxH        image size in pixels (default 256x256)\n"                                  \
     "  --rays S          S x S concentric rays per pixel, 1..256 (default 16: 256 rays)\n"          \
     "  --max-distance L  rays blocked farther than L do not count (default: unlimited)\n"          \
     "  --bias B          inside-query bias as a fraction of the radius, >= 0 (default 0.02)\n"     \
@@ -63,7 +66,7 @@
     { "--positions", 1, CLI_ONLY(CMD_VISFIELD) }, { "--format", 1, CLI_ONLY(CMD_VISFIELD) },      \
     { "--mapping", 1, CLI_ONLY(CMD_VISFIELD) }, { "--ao", 0, CLI_ONLY(CMD_VISFIELD) },            \
     { "--ground", 1, CLI_ONLY(CMD_VISFIELD) }, { "--extent", 1, CLI_ONLY(CMD_VISFIELD) },         \
-    { "--size", 1, CLI_ONLY(CMD_VISFIELD) }, { "--rays", 1, CLI_ONLY(CMD_VISFIELD) },             \
+    { "--rays", 1, CLI_ONLY(CMD_VISFIELD) },                                                      \
     { "--bias", 1, CLI_ONLY(CMD_VISFIELD) }, { "--reference", 1, CLI_ONLY(CMD_VISFIELD) }
 
 /* ---- PART B: after cli_check_gi ------------------------------------------------------------- */
@@ -109,6 +112,7 @@ static int cli_set_vf(cli_args *a, const char *f, const char *v)
         return 0;
     }
     if (!strcmp(f, "--ao")) { a->vf_ao = 1; return 0; }
+    if (!strcmp(f, "--size")) { a->vf_has_size = 1; return -1; } /* WxH parsed by volgi's code */
     if (!strcmp(f, "--ground")) {
         a->vf_has_ground = 1;
         return cli_real(f, v, -CLI_FLT_MAX, 0, CLI_FLT_MAX, "a finite height", &a->vf_ground);
@@ -117,7 +121,6 @@ static int cli_set_vf(cli_args *a, const char *f, const char *v)
         a->vf_has_extent = 1;
         return cli_real(f, v, 0.0, 1, CLI_FLT_MAX, "a half-size > 0", &a->vf_extent);
     }
-    if (!strcmp(f, "--size")) return cli_int(f, v, 1, 8192, "an integer 1..8192", &a->vf_size);
     if (!strcmp(f, "--rays"))
         return cli_int(f, v, 1, HFVIS_VISFIELD_MAX_RAYS_SQRT, "an integer 1..256", &a->vf_rays);
     if (!strcmp(f, "--bias")) {
@@ -140,10 +143,10 @@ static int cli_check_vf(const cli_args *a)
         return 0;
     }
     if (a->has_range) return cli_error(CLI_EXIT_USAGE, "--range", "applies only to --ao images");
-    if (a->vf_has_ground || a->vf_has_extent || a->vf_size || a->vf_rays || a->vf_has_bias
+    if (a->vf_has_ground || a->vf_has_extent || a->vf_has_size || a->vf_rays || a->vf_has_bias
         || a->vf_reference || a->max_distance > 0.0)
         return cli_error(CLI_EXIT_USAGE, a->vf_has_ground ? "--ground" : a->vf_has_extent ? "--extent"
-                         : a->vf_size ? "--size" : a->vf_rays ? "--rays" : a->vf_has_bias ? "--bias"
+                         : a->vf_has_size ? "--size" : a->vf_rays ? "--rays" : a->vf_has_bias ? "--bias"
                          : a->vf_reference ? "--reference" : "--max-distance", "applies only to --ao");
     if (a->has_dirs && (a->dirs < 1 || a->dirs > HFVIS_VISFIELD_MAX_DIR_RES))
         return cli_error(CLI_EXIT_USAGE, "--dirs", "a field takes 1..4096 directions per side, got %d",
@@ -222,9 +225,9 @@ static int cli_vf_ao(const cli_args *a)
     hfvis_bvh bvh;
     hfvis_status s;
     float *pts = NULL, *nrm = NULL, *ao = NULL;
-    const int N = a->vf_size ? a->vf_size : 256;
-    size_t n = (size_t)N * (size_t)N, p;
-    double E, Z;
+    const int W = a->vf_has_size ? a->vg_width : 256, H = a->vf_has_size ? a->vg_height : 256;
+    size_t n = (size_t)W * (size_t)H, p;
+    double E, EY, Z;
     int rc = 0, x, y, i, have_bvh = 0;
     memset(&vf, 0, sizeof vf);
     memset(&bvh, 0, sizeof bvh);
@@ -232,16 +235,17 @@ static int cli_vf_ao(const cli_args *a)
     s = hfvis_visfield_load(a->in, NULL, &vf);
     if (s != HFVIS_OK) return cli_status(a->in, s, errno);
     E = a->vf_has_extent ? a->vf_extent : 1.5 * vf.radius;
+    EY = E * (double)H / (double)W;
     Z = a->vf_has_ground ? a->vf_ground : vf.center[2] - vf.radius;
     pts = cli_alloc(n, 3, 1);
     nrm = cli_alloc(n, 3, 1);
     ao = cli_alloc(n, 1, 1);
     if (!pts || !nrm || !ao) { rc = cli_status("visfield", HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
-    for (y = 0; y < N; y++)
-        for (x = 0; x < N; x++) { /* seen from above: x right, row 0 at +y */
-            p = (size_t)y * (size_t)N + (size_t)x;
-            pts[3 * p] = (float)(vf.center[0] - E + 2.0 * E * (x + 0.5) / N);
-            pts[3 * p + 1] = (float)(vf.center[1] + E - 2.0 * E * (y + 0.5) / N);
+    for (y = 0; y < H; y++)
+        for (x = 0; x < W; x++) { /* seen from above: x right, row 0 at +y */
+            p = (size_t)y * (size_t)W + (size_t)x;
+            pts[3 * p] = (float)(vf.center[0] - E + 2.0 * E * (x + 0.5) / W);
+            pts[3 * p + 1] = (float)(vf.center[1] + EY - 2.0 * EY * (y + 0.5) / H);
             pts[3 * p + 2] = (float)Z;
             nrm[3 * p] = nrm[3 * p + 1] = 0.0f;
             nrm[3 * p + 2] = 1.0f;
@@ -267,13 +271,13 @@ static int cli_vf_ao(const cli_args *a)
         s = hfvis_visfield_ambient_occlusion(&ob, 1, pts, nrm, n, &o, ao);
     }
     if (s != HFVIS_OK) { rc = cli_status("visfield", s, 0); goto done; }
-    rc = cli_save(a, ao, N, N, 1, 0.0, 1.0);
+    rc = cli_save(a, ao, W, H, 1, 0.0, 1.0);
     if (rc == 0 && !a->quiet) {
         double mean = 0.0;
         for (p = 0; p < n; p++) mean += (double)ao[p];
         printf("visfield: %s obscurance of the plane z = %.6g over [%.6g, %.6g] x [%.6g, %.6g], "
                "%d x %d rays per pixel: mean %.4f\n", a->vf_reference ? "ray-cast" : "field", Z,
-               vf.center[0] - E, vf.center[0] + E, vf.center[1] - E, vf.center[1] + E, o.rays_sqrt,
+               vf.center[0] - E, vf.center[0] + E, vf.center[1] - EY, vf.center[1] + EY, o.rays_sqrt,
                o.rays_sqrt, mean / (double)n);
     }
 done:
