@@ -213,14 +213,14 @@ static const double bench_lk_paper_ratio[2][6] = {
 static void bench_lk(int quick)
 {
     const char *names[3] = {"room+objects", "torus knot 100k", "hairball"};
-    const double radii[3][2] = {{0.05, 0.15}, {0.25, 0.75}, {0.05, 0.15}};
+    const double radii[3][2] = {{0.05, 0.15}, {0.2, 0.5}, {0.04, 0.12}};
     const double eyes[3][3] = {{0.5, -1.15, 0.5}, {0.0, -5.0, 2.5}, {0.0, -3.2, 0.9}};
     const double tgts[3][3] = {{0.5, 0.5, 0.38}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
     const double fovs[3] = {55.0, 38.0, 40.0};
-    const int W = quick ? 96 : 256, H = quick ? 72 : 192;
+    const int W = quick ? 80 : 192, H = quick ? 60 : 144;
     const int ncount = quick ? 1 : 2;
     const int Ns[2] = {128, 1024};
-    double rays_budget = quick ? 1.5e5 : 1.5e6; /* rays per ray-caster / Method 2 run */
+    double rays_budget = quick ? 1e5 : 1e6; /* rays per ray-caster / Method 2 run */
     int sc, ri, ni;
     printf("Laine-Karras bitmask AO: Mrays/s (single thread), %dx%d G-buffer receivers; Method 2 and "
            "the ray casters on every k-th receiver (about %.1fM rays per run)\n", W, H, rays_budget * 1e-6);
@@ -361,7 +361,7 @@ static void bench_lk(int quick)
                 double t0 = bench_lk_now(), best = 1e30;
                 int rep;
                 o.cull = sets[k];
-                for (rep = 0; rep < (quick ? 1 : 3); rep++) {
+                for (rep = 0; rep < (quick ? 1 : 2); rep++) {
                     t0 = bench_lk_now();
                     if (!ob || hfvis_lk_raster(&m, &v, &rays, &o, NULL, ob, &st) != HFVIS_OK) break;
                     if (bench_lk_now() - t0 < best) best = bench_lk_now() - t0;

@@ -1863,7 +1863,8 @@ HFVIS_API hfvis_status hfvis_lk_raster(const hfvis_mesh *mesh, const hfvis_view 
                     if (!lk_prism_clip(&P, o, D, &ti, &to) || to < 1.0) continue;
                     fdepth = cam.ortho ? dp + (to - 1.0) : dp * to;
                 } else {
-                    if (!lk_ball_clip(c, Rs, o, D, &ti, &to)) continue;
+                    fdepth = dc + Rs; /* the billboard sits just behind the sphere */
+                    if (dp > fdepth || !lk_ball_clip(c, Rs, o, D, &ti, &to)) continue;
                     if (!two) { /* front half: -nw.(x - v0) <= low */
                         double a0 = -(nw[0] * (o[0] - (double)f0[0]) + nw[1] * (o[1] - (double)f0[1]) +
                                       nw[2] * (o[2] - (double)f0[2])) - low;
@@ -1877,8 +1878,6 @@ HFVIS_API hfvis_status hfvis_lk_raster(const hfvis_mesh *mesh, const hfvis_view 
                         }
                         if (ti > to) continue;
                     }
-                    fdepth = dc + Rs; /* the billboard sits just behind the sphere */
-                    if (dp > fdepth) continue;
                 }
                 st.fragments++;
                 /* culling tests in the order of [LK] §4.2 */
