@@ -12,4 +12,5 @@ void bench_cons(int quick);
 void bench_ssao(int quick);
 void bench_ssaob(int quick);
 void bench_volgi(int quick);
+void bench_vf(int quick);
 #endif

@@ -11,6 +11,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench.h"
 #include "hfvis.h"
 
 static double bench_vf_now(void)
@@ -324,7 +325,7 @@ static void bench_vf_variants(const hfvis_mesh *mesh, const double T[3], double 
     hfvis_bvh_free(NULL, &bvh);
 }
 
-static void bench_vf(int quick)
+void bench_vf(int quick)
 {
     const double c0[3] = {0.0, 0.0, 0.0};
     hfvis_mesh knot, teapot;
@@ -368,10 +369,4 @@ static void bench_vf(int quick)
             hfvis_mesh_free(NULL, &ico);
         }
     }
-}
-
-int main(int argc, char **argv)
-{
-    bench_vf(argc > 1 && strcmp(argv[1], "quick") == 0);
-    return 0;
 }

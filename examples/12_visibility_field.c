@@ -1,4 +1,5 @@
-/* ex_vf.c - a 4D visibility field of a teapot ([G12] ch. 4): ambient occlusion on the ground plane under it from the field and from direct ray casting, and their difference. */
+/* 12_visibility_field.c - a 4D visibility field of a teapot ([G12] ch. 4): ambient occlusion on
+ * the ground plane under it from the field and from direct ray casting, and their difference. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,7 +27,7 @@ int main(int argc, char **argv)
     size_t i;
     int x, y, k, rc = 1;
 
-    if (!pts || !nrm || !ao || !ref || !diff) { ex_error("ex_vf", "out of memory"); goto fail; }
+    if (!pts || !nrm || !ao || !ref || !diff) { ex_error("12_visibility_field", "out of memory"); goto fail; }
     /* The teapot-like test mesh stands on z = 0 (bounds about [-1.5, 1.7] x [-1, 1] x [0, 1.4]). */
     EX_CHECK(hfvis_mesh_teapot(NULL, 4, &teapot), "hfvis_mesh_teapot");
     EX_CHECK(hfvis_bvh_build(&teapot, NULL, &bvh), "hfvis_bvh_build");
@@ -37,7 +38,7 @@ int main(int argc, char **argv)
              "hfvis_visfield_bounding_sphere");
     field.maps_size = hfvis_visfield_size(POS_N, DIRS, HFVIS_VISFIELD_U8);
     field.maps = malloc(field.maps_size);
-    if (!field.maps) { ex_error("ex_vf", "out of memory"); goto fail; }
+    if (!field.maps) { ex_error("12_visibility_field", "out of memory"); goto fail; }
     EX_CHECK(hfvis_visfield_build(&teapot, NULL, &field), "hfvis_visfield_build");
 
     /* One instance of the object, turned about z by a rigid transform (the field is reused as
@@ -73,14 +74,14 @@ int main(int argc, char **argv)
         if (fabs(d) > worst) worst = fabs(d);
         diff[i] = (float)fabs(d);
     }
-    printf("ex_vf: %zu maps of %d x %d (%zu bytes) for %zu triangles; AO of %d x %d ground points, "
+    printf("12_visibility_field: %zu maps of %d x %d (%zu bytes) for %zu triangles; AO of %d x %d ground points, "
            "256 rays each: RMS vs ray casting %.2f on the 8-bit scale, worst %.3f\n",
            hfvis_visfield_position_count(POS_N), DIRS, DIRS, field.maps_size, teapot.triangle_count,
            W, W, 255.0 * sqrt(rms / (double)n), worst);
     /* Obscurance: 0 (black) = open sky, 1 = fully blocked; the difference is shown x 4. */
-    if (ex_save_pgm(dir, "ex_vf_ao_field.pgm", ao, W, W, W, 0.0f, 1.0f)) goto fail;
-    if (ex_save_pgm(dir, "ex_vf_ao_raycast.pgm", ref, W, W, W, 0.0f, 1.0f)) goto fail;
-    if (ex_save_pgm(dir, "ex_vf_ao_difference.pgm", diff, W, W, W, 0.0f, 0.25f)) goto fail;
+    if (ex_save_pgm(dir, "12_visibility_field_ao_field.pgm", ao, W, W, W, 0.0f, 1.0f)) goto fail;
+    if (ex_save_pgm(dir, "12_visibility_field_ao_raycast.pgm", ref, W, W, W, 0.0f, 1.0f)) goto fail;
+    if (ex_save_pgm(dir, "12_visibility_field_ao_difference.pgm", diff, W, W, W, 0.0f, 0.25f)) goto fail;
     rc = 0;
 fail:
     free(field.maps);
