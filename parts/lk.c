@@ -394,7 +394,7 @@ static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *
         !lk_part(&bytes, (size_t)n, 2 * sizeof(double)) ||
         !lk_part(&bytes, (size_t)B * (size_t)B + 1, sizeof(int)) ||
         !lk_part(&bytes, (size_t)n, sizeof(int)) || !lk_part(&bytes, (size_t)n, 2 * sizeof(double)))
-        return HFVIS_ERR_OUT_OF_MEMORY;
+        return HFVIS_ERR_LIMIT; /* only on 32-bit size_t */
     block = (unsigned char *)lk_alloc(alloc, bytes);
     if (!block) return HFVIS_ERR_OUT_OF_MEMORY;
     cur = block;
@@ -1652,7 +1652,7 @@ static hfvis_status lk_gbuffer_run(const hfvis_mesh *mesh, const hfvis_view *vie
         return HFVIS_ERR_LIMIT;
     n = (size_t)view->width * (size_t)view->height;
     if (!lk_part(&bytes, n, sizeof(uint32_t)) || !lk_part(&bytes, n, 2 * sizeof(float)))
-        return HFVIS_ERR_OUT_OF_MEMORY;
+        return HFVIS_ERR_LIMIT; /* only on 32-bit size_t */
     block = (unsigned char *)lk_alloc(alloc, bytes);
     if (!block) return HFVIS_ERR_OUT_OF_MEMORY;
     cur = block;
@@ -1757,7 +1757,7 @@ HFVIS_API hfvis_status hfvis_lk_raster(const hfvis_mesh *mesh, const hfvis_view 
         !lk_part(&bytes, (size_t)words, sizeof(uint32_t)) ||
         (!masks && !lk_part(&bytes, nrec, (size_t)words * sizeof(uint32_t)))) {
         lk_free(ctx.o.alloc, ids);
-        return HFVIS_ERR_OUT_OF_MEMORY;
+        return HFVIS_ERR_LIMIT; /* only on 32-bit size_t */
     }
     block = (unsigned char *)lk_alloc(ctx.o.alloc, bytes);
     if (!block) {
@@ -2015,7 +2015,7 @@ static hfvis_status lk_trav_init(lk_trav *tv, const lk_ctx *c, const hfvis_bvh *
     if (!lk_part(&bytes, T, 4 * sizeof(double)) || !lk_part(&bytes, bvh->node_count, 1) ||
         !lk_part(&bytes, LK_STACK, (1 + (size_t)c->words) * sizeof(uint32_t)) ||
         !lk_part(&bytes, 2 * (size_t)c->words, sizeof(uint32_t)))
-        return HFVIS_ERR_OUT_OF_MEMORY;
+        return HFVIS_ERR_LIMIT; /* only on 32-bit size_t */
     tv->block = (unsigned char *)lk_alloc(c->o.alloc, bytes);
     if (!tv->block) return HFVIS_ERR_OUT_OF_MEMORY;
     cur = tv->block;
@@ -2046,7 +2046,7 @@ static hfvis_status lk_explicit_init(lk_ctx *c, const hfvis_mesh *mesh, const hf
     if (s != HFVIS_OK) return s;
     if (!lk_receivers_valid(recv)) return HFVIS_ERR_INVALID_ARGUMENT;
     if (!lk_mul(recv->count, (size_t)rays->words, &words) || words > SIZE_MAX / sizeof(uint32_t))
-        return HFVIS_ERR_INVALID_ARGUMENT;
+        return HFVIS_ERR_LIMIT;
     return HFVIS_OK;
 }
 

@@ -51,6 +51,24 @@
  * exact ones for rays within about one table node of a plane (the paper's faint systematic
  * errors), and the three-way identity holds only in exact mode.
  *
+ * What is and is not guaranteed
+ *   - Exact mode (the defaults: MASK_EXACT, NODE_EXACT, RAYCAST_EXACT): Methods 1 and 2 and the
+ *     ray caster return the same masks for the same receivers, frames and rays, by construction:
+ *     all three OR values of the one predicate routine, and every shortcut (word cones, culling
+ *     tests, node masks, influence volumes, slab tests, rays already blocked) skips only work
+ *     whose predicate value is 0 (or already set) with a margin of at least 1e-9 relative, far
+ *     above its rounding (about 1e-15). Tested bit for bit on seeded random soups (one-, two-
+ *     and per-triangle sides, LOD windows, three falloffs) and on the test meshes, and with every
+ *     culling test switched off.
+ *   - The predicate is the geometric answer up to double rounding: 0 disagreements with an
+ *     independent Moller-Trumbore test in double on 384,000 random ray-triangle pairs, and 0 with
+ *     the library's float watertight any-hit test on 241,664 AO rays of the room scene; expect
+ *     differences only for rays within about 1e-15 (double) or 1e-7 (float) relative of an edge,
+ *     a vertex or the segment's end.
+ *   - Not guaranteed: the margins assume coordinates within about 1e6 r of the origin and
+ *     triangles not thinner than about 1e-9 r; beyond that a shortcut could in principle skip a
+ *     ray the predicate would set (never observed). LUT mode and the paper's far-depth test give
+ *     approximations (see there).
  * Determinism: same inputs, same binary, same bits. Rays, frames and jitter come from explicit
  * seeds and the library's own PCG32 / SplitMix64; receiver k's jitter key is k (or the pixel
  * index y*width + x for G-buffer receivers). */
@@ -72,8 +90,9 @@ typedef enum hfvis_lk_pattern {
     HFVIS_LK_PATTERN_DEFAULT = 0, /* = LLOYD */
     HFVIS_LK_PATTERN_LLOYD = 1,   /* [LK] §6: random points, lloyd_iterations Lloyd steps, each
                                      point replaced by a uniform random point of its Voronoi
-                                     cell, final_iterations more steps (cells estimated on a
-                                     density_resolution^2 grid of the disc, spec A.2) */
+                                     cell (rejection sampling, 64 attempts, else it stays),
+                                     final_iterations more steps (cells estimated from the
+                                     centres of a density_resolution^2 grid, spec A.2) */
     HFVIS_LK_PATTERN_RANDOM = 2,  /* independent uniform points of the disc (for tests) */
     HFVIS_LK_PATTERN_LLOYD_TORUS = 3 /* the same relaxation and jitter on the periodic square,
                                         mapped onto the disc by the area-preserving concentric
@@ -106,11 +125,12 @@ typedef struct hfvis_lk_ray_options {
     const hfvis_allocator *alloc;   /* the ray set's block and the scratch; NULL = malloc */
     hfvis_lk_pattern pattern;       /* default LLOYD */
     uint64_t seed;                  /* 0 is a valid seed and the default */
-    int lloyd_iterations;           /* LLOYD: steps before the Voronoi jitter, 1..10000;
+    int lloyd_iterations;           /* LLOYD*: steps before the Voronoi jitter, 1..10000;
                                        0 = 64 */
-    int final_iterations;           /* LLOYD: steps after it, 1..10000; 0 = 4 */
-    int density_resolution;         /* LLOYD: the density grid's side, 16..2048; 0 = adaptive:
-                                       ceil(sqrt(48 N 4/pi)) (48 points per site), >= 64 */
+    int final_iterations;           /* LLOYD*: steps after it, 1..10000; 0 = 4 */
+    int density_resolution;         /* LLOYD*: the density grid's side, 16..2048; 0 = adaptive,
+                                       about 48 grid points per site and at least 64:
+                                       ceil(sqrt(48 N 4/pi)) (disc), ceil(sqrt(48 N)) (torus) */
     hfvis_lk_falloff falloff;       /* default CONSTANT */
     hfvis_lk_falloff_fn falloff_fn; /* CUSTOM only */
     void *falloff_user;             /* CUSTOM only */
@@ -141,7 +161,8 @@ typedef struct hfvis_lk_rays {
  * to the hemisphere u = (x, y, sqrt(1 - x^2 - y^2)), every point strictly inside the disc of
  * radius sqrt(1 - 2^-20) (so u_z >= 2^-10), ordered by the Morton code of the disc point, and
  * the lengths of the falloff. Deterministic (seed). Cost: LLOYD O((iterations + jitter) *
- * density_resolution^2) (about 60 ms at the defaults), RANDOM O(N log N).
+ * density_resolution^2), at the defaults 0.03 s for N = 128 and 0.22 s for N = 1024 (torus:
+ * 0.05 s, 0.34 s); RANDOM O(N log N).
  * Allocations: the set's one block (8*(7N + 7 words) bytes) and, LLOYD, one scratch block.
  * Returns HFVIS_OK; HFVIS_ERR_INVALID_ARGUMENT for a NULL out, count outside
  * 1..HFVIS_LK_MAX_RAYS, a non-positive or non-finite radius, an unknown pattern or falloff, an
@@ -429,8 +450,12 @@ HFVIS_API hfvis_status hfvis_lk_gbuffer_receivers(const hfvis_mesh *mesh, const 
  * masks: width*height*words uint32 (pixel y*width + x), obscurance: width*height floats (NaN
  * at pixels without a receiver); either may be NULL (not both); stats may be NULL.
  * Returns HFVIS_OK; HFVIS_ERR_INVALID_ARGUMENT for NULL mesh/view/rays, both outputs NULL, an
- * invalid mesh, view or ray set, bad options or a window beyond the radius; the rasterizer's
- * HFVIS_ERR_LIMIT; HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on error.
+ * invalid mesh, view or ray set, bad options or a window beyond the radius; HFVIS_ERR_LIMIT
+ * for width or height > HFVIS_RASTER_MAX_SIZE (and the rasterizer's limits, or a size that
+ * overflows size_t on 32-bit builds); HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on error.
+ * Receivers: only pixels whose triangle the G-buffer shows (background pixels have none,
+ * spec A.13-11); the receiver normal faces the viewer, so the hemisphere is on the visible
+ * side (back faces seen through an open mesh receive on their visible side too).
  * Memory: 3 blocks: the G-buffer (12 bytes per pixel), the rasterizer's scratch, and one block
  * of 4 bytes per pixel plus 104 bytes per receiver (plus its masks when masks is NULL).
  * Cost O(T + covered pixels * N). */
@@ -449,7 +474,7 @@ HFVIS_API hfvis_status hfvis_lk_raster(const hfvis_mesh *mesh, const hfvis_view 
  * recv->count*words, obscurance: recv->count; either may be NULL (not both).
  * Returns HFVIS_OK; HFVIS_ERR_INVALID_ARGUMENT for NULL, an invalid mesh, ray set or receiver
  * (non-finite, zero normal), a BVH that does not match the mesh or is malformed, bad options;
- * HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on error. Memory: 1 block (32 bytes per
+ * HFVIS_ERR_LIMIT when count*words or the scratch overflows size_t; HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on error. Memory: 1 block (32 bytes per
  * triangle, 1 byte per node, the traversal stack). */
 HFVIS_API hfvis_status hfvis_lk_bvh(const hfvis_mesh *mesh, const hfvis_bvh *bvh,
                                     const hfvis_lk_rays *rays, const hfvis_lk_receivers *recv,
