@@ -401,7 +401,8 @@ typedef struct hfvis_lk_stats {
     uint64_t rays;                 /* receivers * N */
     uint64_t rays_blocked;         /* set bits in all masks */
     uint64_t fragments;            /* M1: pairs passing the inverted depth test; M2: triangles
-                                      met in leaves; ray caster: predicate evaluations */
+                                      met in leaves; ray caster: predicate evaluations (EXACT
+                                      test only; 0 with WATERTIGHT) */
     uint64_t culled_far_depth;     /* M1 test 1 (safe or paper form) */
     uint64_t culled_sphere;        /* influence-sphere test */
     uint64_t culled_facing;
@@ -410,7 +411,7 @@ typedef struct hfvis_lk_stats {
     uint64_t skipped;              /* degenerate or |h| < epsilon (not a culling test) */
     uint64_t masks;                /* triangle masks computed */
     uint64_t prisms, spheres;      /* M1: volumes of each kind rasterized */
-    uint64_t nodes_visited;        /* M2 and ray caster: inner nodes and leaves entered */
+    uint64_t nodes_visited;        /* M2 and ray caster (EXACT): inner nodes and leaves entered */
     uint64_t nodes_culled_distance, nodes_culled_horizon, nodes_culled_mask; /* M2 */
 } hfvis_lk_stats;
 

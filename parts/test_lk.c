@@ -176,6 +176,8 @@ static void cnt_free(void *user, void *p)
     free(p);
 }
 
+static int count_at_least(const hfvis_lk_rays *r, int dim, double sign, double c);
+
 static hfvis_lk_rays make_rays(int n, double r, hfvis_lk_falloff f, uint64_t seed)
 {
     hfvis_lk_rays rays;
@@ -344,6 +346,24 @@ TEST(rays_lloyd_set)
         hfvis_lk_rays_free(NULL, &b);
         hfvis_lk_rays_free(NULL, &c);
         CHECK(a.direction == NULL && a.count == 0);
+    }
+    { /* odd counts: 1 ray, a partial last word; every method runs */
+        static const int odd[3] = {1, 33, 95};
+        int q2, agree;
+        for (q2 = 0; q2 < 3; q2++) {
+            hfvis_lk_ray_options o = hfvis_lk_ray_options_default();
+            hfvis_lk_rays r;
+            tmesh tm = {0};
+            hfvis_mesh m;
+            o.pattern = q2 == 1 ? HFVIS_LK_PATTERN_LLOYD_TORUS : HFVIS_LK_PATTERN_LLOYD;
+            CHECK_EQ_STATUS(hfvis_lk_rays_build(odd[q2], 1.0, &o, &r), HFVIS_OK);
+            CHECK(r.words == (odd[q2] + 31) / 32 && r.min_elevation > 0.0);
+            tm_rect(&tm, 2, 0.5, (const double[2]){-3, -3}, (const double[2]){3, 3}, -1.0);
+            m = tm_view(&tm);
+            CHECK(origin_count(&m, &r, NULL, &agree) == count_at_least(&r, 2, 1.0, 0.5) && agree);
+            tm_free(&tm);
+            hfvis_lk_rays_free(NULL, &r);
+        }
     }
     { /* LLOYD_TORUS: no rim bias */
         hfvis_lk_ray_options o = hfvis_lk_ray_options_default();
