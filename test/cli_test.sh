@@ -107,7 +107,7 @@ expect_line2() { # NAME FILE WANT: the second header line (PFM dimensions)
 # ---- help ---------------------------------------------------------------------------------
 if "$hfvis" --help > "$dir/stdout" 2> "$dir/stderr" && grep -q '^usage: hfvis' "$dir/stdout" && [ ! -s "$dir/stderr" ]
 then ok "--help"; else bad "--help"; fi
-for c in horizon skyview sky shadow light normals indirect visibility viewshed voxelize gi ssao volgi; do
+for c in horizon skyview sky shadow light normals indirect visibility viewshed voxelize gi ssao volgi visfield; do
   if "$hfvis" $c --help > "$dir/stdout" 2>&1 && grep -q "^usage: hfvis $c" "$dir/stdout"
   then ok "$c --help"; else bad "$c --help"; fi
 done
@@ -239,6 +239,10 @@ grep -q ', 56 set' "$dir/stdout" && ok "voxelize conservative: 56 voxels" || bad
 head -n 1 "$dir/cc.binvox" | grep -q '^#binvox 1' && ok "voxelize binvox header" || bad "voxelize binvox header"
 expect_ok "voxelize surface, all axes, slicing" "$dir/cv.binvox" voxelize "$dir/cube.obj" --res 8 --axis all --method slicing --max-vertices 11 --padding 0.1 -o "$dir/cv.binvox"
 expect_ok "voxelize solid --axis x --open" "$dir/co.raw" voxelize "$dir/tri.obj" --res 4 --mode solid --axis x --open -o "$dir/co.raw"
+# visfield: build a field of the cube, then AO images of the ground from the field and by ray casting.
+expect_ok "visfield build" "$dir/cube.hfvf" visfield "$dir/cube.obj" --positions 82 --dirs 16 -o "$dir/cube.hfvf"
+expect_ok "visfield --ao" "$dir/vfao.pgm" visfield --ao "$dir/cube.hfvf" --ground 0 --size 24x24 --rays 4 -o "$dir/vfao.pgm"
+expect_ok "visfield --ao --reference" "$dir/vfar.pfm" visfield --ao "$dir/cube.hfvf" --ground 0 --size 24x24 --rays 4 --reference "$dir/cube.obj" -o "$dir/vfar.pfm"
 # volgi: the room and a mesh with two lights render; every output choice and option parses.
 expect_ok "volgi room" "$dir/vg.pfm" volgi --room --res 16 --iterations 16 --size 32x24 -o "$dir/vg.pfm"
 grep -q '16 x 16 x 16 voxels' "$dir/stdout" && ok "volgi room grid" || bad "volgi room: $(cat "$dir/stdout")"
@@ -344,6 +348,11 @@ expect_fail "voxelize --mode bogus" 2 voxelize "$dir/cube.obj" --res 4 --mode bo
 expect_fail "voxelize --res 0" 2 voxelize "$dir/cube.obj" --res 0 -o "$ob"
 expect_fail "voxelize solid --axis all" 2 voxelize "$dir/cube.obj" --res 4 --mode solid --axis all -o "$ob"
 expect_fail "voxelize --max-vertices with the pixel rule" 2 voxelize "$dir/cube.obj" --res 4 --max-vertices 7 -o "$ob"
+expect_fail "visfield --positions 83" 2 visfield "$dir/cube.obj" --positions 83 -o "$fdir/x.hfvf"
+expect_fail "visfield build with --ground" 2 visfield "$dir/cube.obj" --ground 0 -o "$fdir/x.hfvf"
+expect_fail "visfield --ao of a mesh" 1 visfield --ao "$dir/cube.obj" -o "$o"
+expect_fail "visfield --ao with --positions" 2 visfield --ao "$dir/cube.obj" --positions 82 -o "$o"
+expect_fail "visfield missing mesh" 1 visfield "$dir/none.obj" -o "$fdir/x.hfvf"
 expect_fail "volgi without MESH or --room" 2 volgi -o "$o"
 expect_fail "volgi --room with MESH" 2 volgi "$dir/cube.obj" --room -o "$o"
 expect_fail "volgi --light bogus" 2 volgi --room --light lamp:1,2,3 -o "$o"
