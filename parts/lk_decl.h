@@ -62,7 +62,8 @@
  *     culling test switched off.
  *   - The predicate is the geometric answer up to double rounding: 0 disagreements with an
  *     independent Moller-Trumbore test in double on 384,000 random ray-triangle pairs, and 0 with
- *     the library's float watertight any-hit test on 241,664 AO rays of the room scene; expect
+ *     the library's float watertight any-hit test on 292,864 AO rays (the room scene one- and
+ *     two-sided, a random soup with per-triangle sides); expect
  *     differences only for rays within about 1e-15 (double) or 1e-7 (float) relative of an edge,
  *     a vertex or the segment's end.
  *   - Not guaranteed: the margins assume coordinates within about 1e6 r of the origin and

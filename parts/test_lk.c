@@ -1511,6 +1511,47 @@ TEST(watertight_caster_and_lut_modes)
                "(%ld blocked)\n", sides == 1 ? "one" : "two", diff, total, blocked);
         CHECK((double)diff / (double)total < RATE_WATERTIGHT && blocked > 10000);
     }
+    { /* a random soup with per-triangle sides (many back-face hits): explicit receivers */
+        enum { R = 400 };
+        tmesh sm = {0};
+        hfvis_mesh smm;
+        hfvis_bvh sb;
+        double sp[3 * R], sn[3 * R];
+        uint8_t *two;
+        hfvis_lk_receivers src;
+        size_t t;
+        soup_scene(&sm, 500, 4242);
+        smm = tm_view(&sm);
+        two = (uint8_t *)malloc(smm.triangle_count);
+        for (t = 0; t < smm.triangle_count; t++) two[t] = (uint8_t)(t % 2);
+        for (i = 0; i < 3 * R; i++) {
+            sp[i] = i % 3 == 2 ? 1.2 * urand() : 1.4 * srand1();
+            sn[i] = srand1();
+        }
+        src.count = R;
+        src.position = sp;
+        src.normal = sn;
+        src.key = NULL;
+        o = hfvis_lk_options_default();
+        o.sides = HFVIS_LK_SIDES_PER_TRIANGLE;
+        o.two_sided = two;
+        CHECK_EQ_STATUS(hfvis_bvh_build(&smm, NULL, &sb), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_lk_raycast(&smm, &sb, &rays, &src, &o, ex, NULL, NULL), HFVIS_OK);
+        o.raycast_test = HFVIS_LK_RAYCAST_WATERTIGHT;
+        CHECK_EQ_STATUS(hfvis_lk_raycast(&smm, &sb, &rays, &src, &o, wt, NULL, NULL), HFVIS_OK);
+        for (i = 0, diff = 0, blocked = 0; i < (size_t)R * words; i++) {
+            uint32_t x = ex[i] ^ wt[i];
+            diff += count_bits(&x, 1);
+            blocked += count_bits(ex + i, 1);
+        }
+        printf("  soup, per-triangle sides: float watertight caster vs the double predicate: %ld of %d "
+               "rays differ (%ld blocked)\n", diff, R * 128, blocked);
+        CHECK((double)diff / (R * 128.0) < RATE_WATERTIGHT && blocked > 2000);
+        hfvis_bvh_free(NULL, &sb);
+        free(two);
+        tm_free(&sm);
+        o = hfvis_lk_options_default();
+    }
     /* LUT masks in Methods 1 and 2 (T = 64): close to exact, not identical */
     o = hfvis_lk_options_default();
     CHECK_EQ_STATUS(hfvis_lk_lut_build(&rays, 64, NULL, &L), HFVIS_OK);
