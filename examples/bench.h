@@ -13,4 +13,5 @@ void bench_ssao(int quick);
 void bench_ssaob(int quick);
 void bench_volgi(int quick);
 void bench_vf(int quick);
+void bench_lk(int quick);
 #endif

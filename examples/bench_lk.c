@@ -5,6 +5,7 @@
  * paper's Table 1 ratios; the culling statistics in the shape of its Table 2; the plane
  * table's size and build time. */
 #define _POSIX_C_SOURCE 199309L
+#include "bench.h"
 #include "hfvis.h"
 
 #include <math.h>
@@ -210,7 +211,7 @@ static const double bench_lk_paper_ratio[2][6] = {
     {6.97, 2.49, 11.06, 5.33, 15.29, 5.37},   /* N = 128: Sibenik .75 2.25, City 75 225, Hairball .1 .3 */
     {7.73, 2.25, 15.32, 6.06, 30.70, 6.78}};  /* N = 1024 */
 
-static void bench_lk(int quick)
+void bench_lk(int quick)
 {
     const char *names[3] = {"room+objects", "torus knot 100k", "hairball"};
     const double radii[3][2] = {{0.05, 0.15}, {0.2, 0.5}, {0.04, 0.12}};
@@ -414,10 +415,4 @@ static void bench_lk(int quick)
                "HFVIS_LK_LUT_MAX_BYTES); with variable lengths two tables -> HFVIS_ERR_LIMIT\n",
                (double)hfvis_lk_lut_bytes(128, 1024, 0) / 1048576.0);
     }
-}
-
-int main(void)
-{
-    bench_lk(0);
-    return 0;
 }

@@ -1,4 +1,5 @@
-/* ex_lk.c - Laine-Karras ray-cast ambient obscurance of a teapot in a room by rasterization, BVH traversal and ray casting (identical images), and the table-mask error. */
+/* 13_mesh_ao.c - Laine-Karras ray-cast ambient obscurance of a teapot in a room by rasterization,
+ * BVH traversal and ray casting (identical images), and the table-mask error. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -78,7 +79,7 @@ int main(int argc, char **argv)
     memset(&rays, 0, sizeof rays);
     memset(&lut, 0, sizeof lut);
     for (m = 0; m < 4; m++) ao[m] = malloc(sizeof(float) * W * H);
-    if (!diff || !ao[0] || !ao[1] || !ao[2] || !ao[3]) { ex_error("ex_lk", "out of memory"); goto fail; }
+    if (!diff || !ao[0] || !ao[1] || !ao[2] || !ao[3]) { ex_error("13_mesh_ao", "out of memory"); goto fail; }
     EX_CHECK(room_with_teapot(&mesh, &xyz, &idx), "room_with_teapot");
     EX_CHECK(hfvis_view_perspective(&view, eye, target, up, 55.0 * 3.14159265358979323846 / 180.0, W, H,
                                     0.05, 10.0), "hfvis_view_perspective");
@@ -90,7 +91,7 @@ int main(int argc, char **argv)
         clock_t t0 = clock();
         EX_CHECK(hfvis_lk_image(methods[m], &mesh, NULL, &view, &rays, &opts, NULL, ao[m], &st),
                  "hfvis_lk_image");
-        printf("ex_lk: %-7s %llu receivers x %d rays, mean obscurance %.4f, %llu %s, %.2f s\n",
+        printf("13_mesh_ao: %-7s %llu receivers x %d rays, mean obscurance %.4f, %llu %s, %.2f s\n",
                names[m], (unsigned long long)st.receivers, N, (double)st.rays_blocked / (double)st.rays,
                (unsigned long long)(m == 2 ? st.fragments : st.masks),
                m == 2 ? "ray-triangle tests" : "triangle masks", (double)(clock() - t0) / CLOCKS_PER_SEC);
@@ -102,8 +103,8 @@ int main(int argc, char **argv)
     if (ex_save_pgm(dir, "lk_diff_raster_bvh.pgm", diff, W, H, W, 0.0f, 0.05f)) goto fail;
     worst2 = diff_image(ao[2], ao[1], diff);
     if (ex_save_pgm(dir, "lk_diff_raycast_bvh.pgm", diff, W, H, W, 0.0f, 0.05f)) goto fail;
-    printf("ex_lk: max |raster - bvh| = %g, max |raycast - bvh| = %g\n", worst, worst2);
-    if (worst != 0.0 || worst2 != 0.0) { ex_error("ex_lk", "the methods disagree"); goto fail; }
+    printf("13_mesh_ao: max |raster - bvh| = %g, max |raycast - bvh| = %g\n", worst, worst2);
+    if (worst != 0.0 || worst2 != 0.0) { ex_error("13_mesh_ao", "the methods disagree"); goto fail; }
 
     /* Table masks ([LK] §3.1, T = 64): faster for large N, quantised near planes */
     EX_CHECK(hfvis_lk_lut_build(&rays, 64, NULL, &lut), "hfvis_lk_lut_build");
@@ -112,7 +113,7 @@ int main(int argc, char **argv)
     EX_CHECK(hfvis_lk_image(HFVIS_LK_METHOD_BVH, &mesh, NULL, &view, &rays, &opts, NULL, ao[3], NULL),
              "hfvis_lk_image (LUT)");
     worst = diff_image(ao[3], ao[1], diff);
-    printf("ex_lk: table (%.0f MiB) vs exact masks: max difference %g (%.0f of %d rays)\n",
+    printf("13_mesh_ao: table (%.0f MiB) vs exact masks: max difference %g (%.0f of %d rays)\n",
            (double)lut.bytes / 1048576.0, worst, worst * N, N);
     if (ex_save_pgm(dir, "lk_diff_lut_exact.pgm", diff, W, H, W, 0.0f, 0.05f)) goto fail;
     rc = 0;
