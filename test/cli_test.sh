@@ -107,7 +107,7 @@ expect_line2() { # NAME FILE WANT: the second header line (PFM dimensions)
 # ---- help ---------------------------------------------------------------------------------
 if "$hfvis" --help > "$dir/stdout" 2> "$dir/stderr" && grep -q '^usage: hfvis' "$dir/stdout" && [ ! -s "$dir/stderr" ]
 then ok "--help"; else bad "--help"; fi
-for c in horizon skyview sky shadow light normals indirect visibility viewshed voxelize gi ssao volgi visfield; do
+for c in horizon skyview sky shadow light normals indirect visibility viewshed voxelize gi ssao volgi visfield meshao; do
   if "$hfvis" $c --help > "$dir/stdout" 2>&1 && grep -q "^usage: hfvis $c" "$dir/stdout"
   then ok "$c --help"; else bad "$c --help"; fi
 done
@@ -239,6 +239,14 @@ grep -q ', 56 set' "$dir/stdout" && ok "voxelize conservative: 56 voxels" || bad
 head -n 1 "$dir/cc.binvox" | grep -q '^#binvox 1' && ok "voxelize binvox header" || bad "voxelize binvox header"
 expect_ok "voxelize surface, all axes, slicing" "$dir/cv.binvox" voxelize "$dir/cube.obj" --res 8 --axis all --method slicing --max-vertices 11 --padding 0.1 -o "$dir/cv.binvox"
 expect_ok "voxelize solid --axis x --open" "$dir/co.raw" voxelize "$dir/tri.obj" --res 4 --mode solid --axis x --open -o "$dir/co.raw"
+# meshao: the cube seen from outside: every method writes the same image
+expect_ok "meshao bvh" "$dir/ao_b.pfm" meshao "$dir/cube.obj" --rays 64 --radius 0.5 --size 24x18 -o "$dir/ao_b.pfm"
+expect_ok "meshao raster" "$dir/ao_r.pfm" meshao "$dir/cube.obj" --method raster --rays 64 --radius 0.5 --size 24x18 -o "$dir/ao_r.pfm"
+expect_ok "meshao raycast" "$dir/ao_c.pfm" meshao "$dir/cube.obj" --method raycast --rays 64 --radius 0.5 --size 24x18 -o "$dir/ao_c.pfm"
+cmp -s "$dir/ao_b.pfm" "$dir/ao_r.pfm" && cmp -s "$dir/ao_b.pfm" "$dir/ao_c.pfm" && ok "meshao: three methods, same bytes" || bad "meshao: methods differ"
+expect_ok "meshao inside the cube, two-sided, linear, lut, stats" "$dir/ao_i.pgm" meshao "$dir/cube.obj" --two-sided --falloff linear --lut 16 --rays 96 --radius 2 --eye 0.5,0.5,0.5 --target 0.5,1,0.5 --fov 90 --size 16x16 --seed 3 --no-jitter --stats -o "$dir/ao_i.pgm"
+grep -q '^receivers: 256$' "$dir/stdout" && ok "meshao inside: 256 receivers" || bad "meshao stats: $(cat "$dir/stdout")"
+
 # visfield: build a field of the cube, then AO images of the ground from the field and by ray casting.
 expect_ok "visfield build" "$dir/cube.hfvf" visfield "$dir/cube.obj" --positions 82 --dirs 16 -o "$dir/cube.hfvf"
 expect_ok "visfield --ao" "$dir/vfao.pgm" visfield --ao "$dir/cube.hfvf" --ground 0 --size 24x24 --rays 4 -o "$dir/vfao.pgm"
@@ -348,6 +356,12 @@ expect_fail "voxelize --mode bogus" 2 voxelize "$dir/cube.obj" --res 4 --mode bo
 expect_fail "voxelize --res 0" 2 voxelize "$dir/cube.obj" --res 0 -o "$ob"
 expect_fail "voxelize solid --axis all" 2 voxelize "$dir/cube.obj" --res 4 --mode solid --axis all -o "$ob"
 expect_fail "voxelize --max-vertices with the pixel rule" 2 voxelize "$dir/cube.obj" --res 4 --max-vertices 7 -o "$ob"
+expect_fail "meshao --method" 2 meshao "$dir/cube.obj" --method lsao -o "$o"
+expect_fail "meshao --rays 0" 2 meshao "$dir/cube.obj" --rays 0 -o "$o"
+expect_fail "meshao --size" 2 meshao "$dir/cube.obj" --size 10 -o "$o"
+expect_fail "meshao --eye" 2 meshao "$dir/cube.obj" --eye 1,2 -o "$o"
+expect_fail "meshao --lut too big" 1 meshao "$dir/cube.obj" --rays 1024 --falloff linear --lut 128 -o "$o"
+expect_fail "meshao empty mesh" 1 meshao "$dir/garbage.pgm" -o "$o"
 expect_fail "visfield --positions 83" 2 visfield "$dir/cube.obj" --positions 83 -o "$fdir/x.hfvf"
 expect_fail "visfield build with --ground" 2 visfield "$dir/cube.obj" --ground 0 -o "$fdir/x.hfvf"
 expect_fail "visfield --ao of a mesh" 1 visfield --ao "$dir/cube.obj" -o "$o"
