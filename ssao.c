@@ -3665,33 +3665,13 @@ hfvis_status hfvis_ssao_error(const float *ao, ptrdiff_t ao_stride, const float 
 
 /* ---- 12.1 common ---------------------------------------------------------------------------- */
 
-static void *lk_alloc(const hfvis_allocator *a, size_t bytes)
-{
-    if (bytes == 0) return NULL;
-    if (a && a->alloc) return a->alloc(a->user, bytes);
-    return malloc(bytes);
-}
-
-static void lk_free(const hfvis_allocator *a, void *p)
-{
-    if (!p) return;
-    if (a && a->free) a->free(a->user, p);
-    else if (!a || !a->alloc) free(p);
-}
-
-/* *out = a*b; 0 on overflow. */
-static int lk_mul(size_t a, size_t b, size_t *out)
-{
-    if (a != 0 && b > SIZE_MAX / a) return 0;
-    *out = a * b;
-    return 1;
-}
+/* Allocation and checked sizes: ss_alloc, ss_free, ss_mul (section 1). */
 
 /* *acc += a*b rounded up to a multiple of 16 (one sub-array of a block); 0 on overflow. */
 static int lk_part(size_t *acc, size_t count, size_t elem)
 {
     size_t bytes;
-    if (!lk_mul(count, elem, &bytes) || bytes > SIZE_MAX - 15) return 0;
+    if (!ss_mul(count, elem, &bytes) || bytes > SIZE_MAX - 15) return 0;
     bytes = (bytes + 15) & ~(size_t)15;
     if (*acc > SIZE_MAX - bytes) return 0;
     *acc += bytes;
@@ -4020,7 +4000,7 @@ static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *
         !lk_part(&bytes, (size_t)B * (size_t)B + 1, sizeof(int)) ||
         !lk_part(&bytes, (size_t)n, sizeof(int)) || !lk_part(&bytes, (size_t)n, 2 * sizeof(double)))
         return HFVIS_ERR_LIMIT; /* only on 32-bit size_t */
-    block = (unsigned char *)lk_alloc(alloc, bytes);
+    block = (unsigned char *)ss_alloc(alloc, bytes);
     if (!block) return HFVIS_ERR_OUT_OF_MEMORY;
     cur = block;
     dens = (double *)lk_take(&cur, nd, 2 * sizeof(double));
@@ -4108,7 +4088,7 @@ static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *
             xy[2 * i + 1] = sc * y;
         }
     }
-    lk_free(alloc, block);
+    ss_free(alloc, block);
     return HFVIS_OK;
 }
 
@@ -4178,7 +4158,7 @@ static hfvis_status lk_rays_alloc(int count, double radius, const hfvis_allocato
 {
     int words = (count + 31) / 32;
     size_t doubles = 7 * (size_t)count + 7 * (size_t)words;
-    double *block = (double *)lk_alloc(alloc, doubles * sizeof(double));
+    double *block = (double *)ss_alloc(alloc, doubles * sizeof(double));
     if (!block) return HFVIS_ERR_OUT_OF_MEMORY;
     memset(r, 0, sizeof *r);
     r->count = count;
@@ -4258,7 +4238,7 @@ HFVIS_API hfvis_status hfvis_lk_rays_build(int count, double radius,
     if (o.pattern == HFVIS_LK_PATTERN_LLOYD || o.pattern == HFVIS_LK_PATTERN_LLOYD_TORUS) {
         s = lk_disc_lloyd(count, &o, &g, o.alloc, o.pattern == HFVIS_LK_PATTERN_LLOYD_TORUS, xy);
         if (s != HFVIS_OK) {
-            lk_free(o.alloc, r.direction);
+            ss_free(o.alloc, r.direction);
             return s;
         }
     } else {
@@ -4335,7 +4315,7 @@ HFVIS_API hfvis_status hfvis_lk_rays_custom(int count, double radius, const doub
 HFVIS_API void hfvis_lk_rays_free(const hfvis_allocator *alloc, hfvis_lk_rays *rays)
 {
     if (!rays) return;
-    lk_free(alloc, rays->direction);
+    ss_free(alloc, rays->direction);
     memset(rays, 0, sizeof *rays);
 }
 
@@ -4627,8 +4607,8 @@ HFVIS_API size_t hfvis_lk_lut_bytes(int resolution, int count, int two_tables)
     if (resolution < HFVIS_LK_LUT_MIN_RESOLUTION || resolution > HFVIS_LK_LUT_MAX_RESOLUTION ||
         words == 0)
         return 0;
-    if (!lk_mul((size_t)resolution, (size_t)resolution, &n) || !lk_mul(n, (size_t)resolution, &n) ||
-        !lk_mul(n, (size_t)words * sizeof(uint32_t), &b) || !lk_mul(b, two_tables ? 2 : 1, &b))
+    if (!ss_mul((size_t)resolution, (size_t)resolution, &n) || !ss_mul(n, (size_t)resolution, &n) ||
+        !ss_mul(n, (size_t)words * sizeof(uint32_t), &b) || !ss_mul(b, two_tables ? 2 : 1, &b))
         return 0;
     return b;
 }
@@ -4694,12 +4674,12 @@ HFVIS_API hfvis_status hfvis_lk_lut_build(const hfvis_lk_rays *rays, int resolut
     L.count = rays->count;
     L.words = rays->words;
     L.bytes = all;
-    L.masks = (uint32_t *)lk_alloc(alloc, one);
+    L.masks = (uint32_t *)ss_alloc(alloc, one);
     if (!L.masks) return HFVIS_ERR_OUT_OF_MEMORY;
     if (!rays->equal_lengths) {
-        L.directions = (uint32_t *)lk_alloc(alloc, one);
+        L.directions = (uint32_t *)ss_alloc(alloc, one);
         if (!L.directions) {
-            lk_free(alloc, L.masks);
+            ss_free(alloc, L.masks);
             return HFVIS_ERR_OUT_OF_MEMORY;
         }
     }
@@ -4712,8 +4692,8 @@ HFVIS_API hfvis_status hfvis_lk_lut_build(const hfvis_lk_rays *rays, int resolut
 HFVIS_API void hfvis_lk_lut_free(const hfvis_allocator *alloc, hfvis_lk_lut *lut)
 {
     if (!lut) return;
-    lk_free(alloc, lut->directions);
-    lk_free(alloc, lut->masks);
+    ss_free(alloc, lut->directions);
+    ss_free(alloc, lut->masks);
     memset(lut, 0, sizeof *lut);
 }
 
@@ -5278,7 +5258,7 @@ static hfvis_status lk_gbuffer_run(const hfvis_mesh *mesh, const hfvis_view *vie
     n = (size_t)view->width * (size_t)view->height;
     if (!lk_part(&bytes, n, sizeof(uint32_t)) || !lk_part(&bytes, n, 2 * sizeof(float)))
         return HFVIS_ERR_LIMIT; /* only on 32-bit size_t */
-    block = (unsigned char *)lk_alloc(alloc, bytes);
+    block = (unsigned char *)ss_alloc(alloc, bytes);
     if (!block) return HFVIS_ERR_OUT_OF_MEMORY;
     cur = block;
     memset(&ro, 0, sizeof ro);
@@ -5289,7 +5269,7 @@ static hfvis_status lk_gbuffer_run(const hfvis_mesh *mesh, const hfvis_view *vie
     out.barycentric = (float *)lk_take(&cur, n, 2 * sizeof(float));
     s = hfvis_rasterize(mesh, view, &ro, &out);
     if (s != HFVIS_OK) {
-        lk_free(alloc, block);
+        ss_free(alloc, block);
         return s;
     }
     *ids = out.triangle_id;
@@ -5342,7 +5322,7 @@ HFVIS_API hfvis_status hfvis_lk_gbuffer_receivers(const hfvis_mesh *mesh, const 
         k++;
     }
     *count = k;
-    lk_free(o.alloc, ids);
+    ss_free(o.alloc, ids);
     return HFVIS_OK;
 }
 
@@ -5373,7 +5353,7 @@ HFVIS_API hfvis_status hfvis_lk_raster(const hfvis_mesh *mesh, const hfvis_view 
     if (view->width > HFVIS_RASTER_MAX_SIZE || view->height > HFVIS_RASTER_MAX_SIZE)
         return HFVIS_ERR_LIMIT;
     npix = (size_t)view->width * (size_t)view->height;
-    if (!lk_mul(npix, (size_t)words, &maskwords) || maskwords > SIZE_MAX / sizeof(uint32_t))
+    if (!ss_mul(npix, (size_t)words, &maskwords) || maskwords > SIZE_MAX / sizeof(uint32_t))
         return HFVIS_ERR_LIMIT;
     s = lk_gbuffer_run(mesh, view, ctx.o.gbuffer_cull, ctx.o.alloc, &ids, &bary);
     if (s != HFVIS_OK) return s;
@@ -5381,12 +5361,12 @@ HFVIS_API hfvis_status hfvis_lk_raster(const hfvis_mesh *mesh, const hfvis_view 
     if (!lk_part(&bytes, npix, sizeof(int32_t)) || !lk_part(&bytes, nrec, LK_REC * sizeof(double)) ||
         !lk_part(&bytes, (size_t)words, sizeof(uint32_t)) ||
         (!masks && !lk_part(&bytes, nrec, (size_t)words * sizeof(uint32_t)))) {
-        lk_free(ctx.o.alloc, ids);
+        ss_free(ctx.o.alloc, ids);
         return HFVIS_ERR_LIMIT; /* only on 32-bit size_t */
     }
-    block = (unsigned char *)lk_alloc(ctx.o.alloc, bytes);
+    block = (unsigned char *)ss_alloc(ctx.o.alloc, bytes);
     if (!block) {
-        lk_free(ctx.o.alloc, ids);
+        ss_free(ctx.o.alloc, ids);
         return HFVIS_ERR_OUT_OF_MEMORY;
     }
     cur = block;
@@ -5408,7 +5388,7 @@ HFVIS_API hfvis_status hfvis_lk_raster(const hfvis_mesh *mesh, const hfvis_view 
         r[12] = lk_depth(&cam, r);
         recidx[i] = (int32_t)nrec++;
     }
-    lk_free(ctx.o.alloc, ids);
+    ss_free(ctx.o.alloc, ids);
     /* occlusion buffers cleared (step 2); masks[pixel] or acc[receiver] */
     memset(acc, 0, sizeof(uint32_t) * (masks ? maskwords : nrec * (size_t)words));
     memset(&st, 0, sizeof st);
@@ -5561,7 +5541,7 @@ HFVIS_API hfvis_status hfvis_lk_raster(const hfvis_mesh *mesh, const hfvis_view 
     st.receivers = nrec;
     st.rays = (uint64_t)nrec * (uint64_t)rays->count;
     if (stats) *stats = st;
-    lk_free(ctx.o.alloc, block);
+    ss_free(ctx.o.alloc, block);
     return HFVIS_OK;
 }
 
@@ -5641,7 +5621,7 @@ static hfvis_status lk_trav_init(lk_trav *tv, const lk_ctx *c, const hfvis_bvh *
         !lk_part(&bytes, LK_STACK, (1 + (size_t)c->words) * sizeof(uint32_t)) ||
         !lk_part(&bytes, 2 * (size_t)c->words, sizeof(uint32_t)))
         return HFVIS_ERR_LIMIT; /* only on 32-bit size_t */
-    tv->block = (unsigned char *)lk_alloc(c->o.alloc, bytes);
+    tv->block = (unsigned char *)ss_alloc(c->o.alloc, bytes);
     if (!tv->block) return HFVIS_ERR_OUT_OF_MEMORY;
     cur = tv->block;
     tv->td = (double *)lk_take(&cur, T, 4 * sizeof(double));
@@ -5651,7 +5631,7 @@ static hfvis_status lk_trav_init(lk_trav *tv, const lk_ctx *c, const hfvis_bvh *
     tv->tmask = tv->C + c->words;
     s = lk_bvh_check(bvh, c->mesh, depth);
     if (s != HFVIS_OK) {
-        lk_free(c->o.alloc, tv->block);
+        ss_free(c->o.alloc, tv->block);
         return s;
     }
     lk_tri_table(c->mesh, tv->td);
@@ -5670,7 +5650,7 @@ static hfvis_status lk_explicit_init(lk_ctx *c, const hfvis_mesh *mesh, const hf
     s = lk_ctx_init(c, mesh, rays, opts);
     if (s != HFVIS_OK) return s;
     if (!lk_receivers_valid(recv)) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (!lk_mul(recv->count, (size_t)rays->words, &words) || words > SIZE_MAX / sizeof(uint32_t))
+    if (!ss_mul(recv->count, (size_t)rays->words, &words) || words > SIZE_MAX / sizeof(uint32_t))
         return HFVIS_ERR_LIMIT;
     return HFVIS_OK;
 }
@@ -5977,7 +5957,7 @@ HFVIS_API hfvis_status hfvis_lk_bvh(const hfvis_mesh *mesh, const hfvis_bvh *bvh
     st.receivers = recv->count;
     st.rays = (uint64_t)recv->count * (uint64_t)rays->count;
     if (stats) *stats = st;
-    lk_free(c.o.alloc, tv.block);
+    ss_free(c.o.alloc, tv.block);
     return HFVIS_OK;
 }
 
@@ -6149,7 +6129,7 @@ HFVIS_API hfvis_status hfvis_lk_raycast(const hfvis_mesh *mesh, const hfvis_bvh 
     st.receivers = recv->count;
     st.rays = (uint64_t)recv->count * (uint64_t)rays->count;
     if (s == HFVIS_OK && stats) *stats = st;
-    lk_free(c.o.alloc, tv.block);
+    ss_free(c.o.alloc, tv.block);
     return s;
 }
 
@@ -6190,7 +6170,7 @@ HFVIS_API hfvis_status hfvis_lk_image(hfvis_lk_method method, const hfvis_mesh *
         (masks && !lk_part(&bytes, npix, words * sizeof(uint32_t))) ||
         (obscurance && !lk_part(&bytes, npix, sizeof(float))))
         return HFVIS_ERR_LIMIT;
-    block = (unsigned char *)lk_alloc(o.alloc, bytes);
+    block = (unsigned char *)ss_alloc(o.alloc, bytes);
     if (!block) return HFVIS_ERR_OUT_OF_MEMORY;
     cur = block;
     pos = (double *)lk_take(&cur, npix, 3 * sizeof(double));
@@ -6200,7 +6180,7 @@ HFVIS_API hfvis_status hfvis_lk_image(hfvis_lk_method method, const hfvis_mesh *
     if (obscurance) ro = (float *)lk_take(&cur, npix, sizeof(float));
     s = hfvis_lk_gbuffer_receivers(mesh, view, &o, pos, nrm, key, &count);
     if (s != HFVIS_OK) {
-        lk_free(o.alloc, block);
+        ss_free(o.alloc, block);
         return s;
     }
     if (!bvh) {
@@ -6208,7 +6188,7 @@ HFVIS_API hfvis_status hfvis_lk_image(hfvis_lk_method method, const hfvis_mesh *
         bo.alloc = o.alloc;
         s = hfvis_bvh_build(mesh, &bo, &own);
         if (s != HFVIS_OK) {
-            lk_free(o.alloc, block);
+            ss_free(o.alloc, block);
             return s;
         }
     }
@@ -6228,6 +6208,6 @@ HFVIS_API hfvis_status hfvis_lk_image(hfvis_lk_method method, const hfvis_mesh *
             if (obscurance) obscurance[key[i]] = ro[i];
         }
     }
-    lk_free(o.alloc, block);
+    ss_free(o.alloc, block);
     return s;
 }

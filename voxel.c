@@ -352,17 +352,13 @@ HFVIS_API double hfvis_eye_z_to_depth(double z_eye, double near_plane, double fa
 /* 3. Volume grids and the Volume Buffer ([G12] §6.3; spec voxel §3.2-3.3)                     */
 /* ========================================================================================== */
 
-HFVIS_API hfvis_status hfvis_volume_grid_fit(const hfvis_mesh *mesh, int resolution,
-                                             double padding, int cubic, hfvis_volume_grid *out)
+/* Bounds of the vertices the triangles of a valid mesh use (a soup may carry unused vertices);
+ * returns the longest extent. */
+static double vx_used_bounds(const hfvis_mesh *mesh, double lo[3], double hi[3])
 {
-    double lo[3], hi[3], ext[3], ext_max = 0.0, cell_max;
-    hfvis_volume_grid g;
-    size_t i, total = 1;
+    double ext_max = 0.0;
+    size_t i;
     int a;
-    if (!out || vx_mesh_check(mesh) != HFVIS_OK || mesh->triangle_count == 0 || resolution < 1
-        || !(padding >= 0.0) || !isfinite(padding))
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    /* Bounds of the vertices the triangles use (a soup may carry unused vertices). */
     for (a = 0; a < 3; a++) lo[a] = HUGE_VAL, hi[a] = -HUGE_VAL;
     for (i = 0; i < 3 * mesh->triangle_count; i++) {
         const float *p = mesh->xyz + 3 * (size_t)mesh->indices[i];
@@ -373,6 +369,20 @@ HFVIS_API hfvis_status hfvis_volume_grid_fit(const hfvis_mesh *mesh, int resolut
     }
     for (a = 0; a < 3; a++)
         if (hi[a] - lo[a] > ext_max) ext_max = hi[a] - lo[a];
+    return ext_max;
+}
+
+HFVIS_API hfvis_status hfvis_volume_grid_fit(const hfvis_mesh *mesh, int resolution,
+                                             double padding, int cubic, hfvis_volume_grid *out)
+{
+    double lo[3], hi[3], ext[3], ext_max = 0.0, cell_max;
+    hfvis_volume_grid g;
+    size_t total = 1;
+    int a;
+    if (!out || vx_mesh_check(mesh) != HFVIS_OK || mesh->triangle_count == 0 || resolution < 1
+        || !(padding >= 0.0) || !isfinite(padding))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    ext_max = vx_used_bounds(mesh, lo, hi);
     if (!(ext_max > 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
     for (a = 0; a < 3; a++) {
         lo[a] -= padding * ext_max;
@@ -9708,21 +9718,12 @@ HFVIS_API hfvis_status hfvis_volgi_grid_fit(const hfvis_mesh *mesh, int resoluti
 {
     double lo[3], hi[3], ext_max = 0.0, s;
     hfvis_volume_grid g;
-    size_t i, total = 1;
+    size_t total = 1;
     int a;
     if (!out || vx_mesh_check(mesh) != HFVIS_OK || mesh->triangle_count == 0 || resolution < 2
         || resolution > HFVIS_VOLGI_MAX_RESOLUTION)
         return HFVIS_ERR_INVALID_ARGUMENT;
-    for (a = 0; a < 3; a++) lo[a] = HUGE_VAL, hi[a] = -HUGE_VAL;
-    for (i = 0; i < 3 * mesh->triangle_count; i++) {
-        const float *p = mesh->xyz + 3 * (size_t)mesh->indices[i];
-        for (a = 0; a < 3; a++) {
-            if ((double)p[a] < lo[a]) lo[a] = (double)p[a];
-            if ((double)p[a] > hi[a]) hi[a] = (double)p[a];
-        }
-    }
-    for (a = 0; a < 3; a++)
-        if (hi[a] - lo[a] > ext_max) ext_max = hi[a] - lo[a];
+    ext_max = vx_used_bounds(mesh, lo, hi);
     if (!(ext_max > 0.0) || !isfinite(ext_max)) return HFVIS_ERR_INVALID_ARGUMENT;
     s = ext_max / (double)(resolution - 1);
     memset(&g, 0, sizeof g);

@@ -666,8 +666,8 @@ static void cli_lk_defaults(cli_args *a)
     a->lk_up[0] = 0.0; a->lk_up[1] = 0.0; a->lk_up[2] = 1.0;
 }
 
-/* "X,Y,Z": three finite numbers. */
-static int cli_lk_reals(const char *f, const char *v, double out[3])
+/* "X,Y,Z" (--eye, --target, --up): three finite numbers; 0 or CLI_EXIT_USAGE (reported). */
+static int cli_xyz(const char *f, const char *v, double out[3])
 {
     char buf[256];
     const char *p = v;
@@ -682,6 +682,26 @@ static int cli_lk_reals(const char *f, const char *v, double out[3])
         p = e + 1;
     }
     if (k < 3) return cli_error(CLI_EXIT_USAGE, f, "expected X,Y,Z (three finite numbers), got '%s'", v);
+    return 0;
+}
+
+/* "WxH" (--size): sides 1..HFVIS_RASTER_MAX_SIZE, at most 2^26 pixels; 0 or CLI_EXIT_USAGE. */
+static int cli_size(const char *f, const char *v, int *width, int *height)
+{
+    char *end;
+    long w, h;
+    errno = 0;
+    w = strtol(v, &end, 10);
+    if (end == v || !isdigit((unsigned char)v[0]) || (*end != 'x' && *end != 'X') || w < 1
+        || w > HFVIS_RASTER_MAX_SIZE)
+        return cli_error(CLI_EXIT_USAGE, f, "expected WxH, sides 1..%d, got '%s'",
+                         HFVIS_RASTER_MAX_SIZE, v);
+    h = strtol(end + 1, &end, 10);
+    if (*end != '\0' || errno == ERANGE || h < 1 || h > HFVIS_RASTER_MAX_SIZE
+        || (long long)w * h > 1LL << 26)
+        return cli_error(CLI_EXIT_USAGE, f, "expected WxH, sides 1..%d, at most 2^26 pixels, got "
+                         "'%s'", HFVIS_RASTER_MAX_SIZE, v);
+    *width = (int)w, *height = (int)h;
     return 0;
 }
 
@@ -715,25 +735,11 @@ static int cli_set_lk(cli_args *a, const char *f, const char *v)
         else return cli_error(CLI_EXIT_USAGE, f, "expected constant, linear or quadratic, got '%s'", v);
         return 0;
     }
-    if (!strcmp(f, "--eye")) { a->lk_has_eye = 1; return cli_lk_reals(f, v, a->lk_eye); }
-    if (!strcmp(f, "--target")) { a->lk_has_target = 1; return cli_lk_reals(f, v, a->lk_target); }
-    if (!strcmp(f, "--up")) { a->lk_has_up = 1; return cli_lk_reals(f, v, a->lk_up); }
+    if (!strcmp(f, "--eye")) { a->lk_has_eye = 1; return cli_xyz(f, v, a->lk_eye); }
+    if (!strcmp(f, "--target")) { a->lk_has_target = 1; return cli_xyz(f, v, a->lk_target); }
+    if (!strcmp(f, "--up")) { a->lk_has_up = 1; return cli_xyz(f, v, a->lk_up); }
     if (!strcmp(f, "--fov")) return cli_real(f, v, 1.0, 0, 179.0, "degrees in 1..179", &a->lk_fov);
-    if (!strcmp(f, "--size")) {
-        char *x = NULL;
-        long w, h;
-        errno = 0;
-        w = strtol(v, &x, 10);
-        if (x == v || !x || (*x != 'x' && *x != 'X') || errno == ERANGE)
-            return cli_error(CLI_EXIT_USAGE, f, "expected WxH (e.g. 640x480), got '%s'", v);
-        h = strtol(x + 1, &x, 10);
-        if (*x != '\0' || errno == ERANGE || w < 1 || h < 1 || w > 8192 || h > 8192 ||
-            !isdigit((unsigned char)v[0]))
-            return cli_error(CLI_EXIT_USAGE, f, "expected WxH with W, H in 1..8192, got '%s'", v);
-        a->lk_width = (int)w;
-        a->lk_height = (int)h;
-        return 0;
-    }
+    if (!strcmp(f, "--size")) return cli_size(f, v, &a->lk_width, &a->lk_height);
     if (!strcmp(f, "--two-sided")) { a->lk_two_sided = 1; return 0; }
     if (!strcmp(f, "--lut"))
         return cli_int(f, v, HFVIS_LK_LUT_MIN_RESOLUTION, HFVIS_LK_LUT_MAX_RESOLUTION,
@@ -943,29 +949,12 @@ static int cli_set_volgi(cli_args *a, const char *f, const char *v)
         return cli_int(f, v, 1, HFVIS_VOLGI_MAX_ITERATIONS, "an integer 1..1048576", &a->iterations);
     if (!strcmp(f, "--light")) return cli_volgi_light(a, v);
     if (!strcmp(f, "--eye") || !strcmp(f, "--target") || !strcmp(f, "--up")) {
-        double *dst = f[2] == 'e' ? a->vg_eye : f[2] == 't' ? a->vg_target : a->vg_up;
-        if (cli_volgi_reals(v, strlen(v), dst, 3, 3) != 3 || fabs(dst[0]) > 1e30 || fabs(dst[1]) > 1e30
-            || fabs(dst[2]) > 1e30)
-            return cli_error(CLI_EXIT_USAGE, f, "expected X,Y,Z (finite, below 1e30), got '%s'", v);
         if (f[2] == 'e') a->vg_has_eye = 1;
         if (f[2] == 't') a->vg_has_target = 1;
-        return 0;
+        return cli_xyz(f, v, f[2] == 'e' ? a->vg_eye : f[2] == 't' ? a->vg_target : a->vg_up);
     }
     if (!strcmp(f, "--fov")) return cli_real(f, v, 1.0, 0, 179.0, "degrees in 1..179", &a->vg_fov);
-    if (!strcmp(f, "--size")) {
-        char *end;
-        long w, h;
-        errno = 0;
-        w = strtol(v, &end, 10);
-        if (end == v || (*end != 'x' && *end != 'X') || w < 1 || w > HFVIS_RASTER_MAX_SIZE)
-            return cli_error(CLI_EXIT_USAGE, f, "expected WxH, sides 1..%d, got '%s'", HFVIS_RASTER_MAX_SIZE, v);
-        h = strtol(end + 1, &end, 10);
-        if (*end != '\0' || errno == ERANGE || h < 1 || h > HFVIS_RASTER_MAX_SIZE || (long long)w * h > 1LL << 26)
-            return cli_error(CLI_EXIT_USAGE, f, "expected WxH, sides 1..%d, at most 2^26 pixels, got '%s'",
-                             HFVIS_RASTER_MAX_SIZE, v);
-        a->vg_width = (int)w, a->vg_height = (int)h;
-        return 0;
-    }
+    if (!strcmp(f, "--size")) return cli_size(f, v, &a->vg_width, &a->vg_height);
     if (!strcmp(f, "--transfer")) {
         if (!strcmp(v, "cone")) a->vg_transfer = HFVIS_VOLGI_TRANSFER_CONE;
         else if (!strcmp(v, "normalized")) a->vg_transfer = HFVIS_VOLGI_TRANSFER_CONE_NORMALIZED;
