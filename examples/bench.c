@@ -12,36 +12,6 @@
 #include <string.h>
 #include <time.h>
 
-static double now_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
-}
-
-/* An allocator that records the peak number of bytes live (library scratch only). */
-typedef struct { size_t live, peak; } tracker;
-typedef struct { size_t size; double align; } block_head;
-static void *track_alloc(void *user, size_t size)
-{
-    tracker *t = (tracker *)user;
-    block_head *b = (block_head *)malloc(sizeof(block_head) + size);
-    if (!b) return NULL;
-    b->size = size;
-    t->live += size;
-    if (t->live > t->peak) t->peak = t->live;
-    return b + 1;
-}
-static void track_free(void *user, void *p)
-{
-    tracker *t = (tracker *)user;
-    block_head *b;
-    if (!p) return;
-    b = (block_head *)p - 1;
-    t->live -= b->size;
-    free(b);
-}
-
 static void die(const char *what, hfvis_status s)
 {
     fprintf(stderr, "bench: %s: %s\n", what, hfvis_status_string(s));
@@ -112,25 +82,25 @@ static void bench_others(int n)
     hfvis_lattice_init(&L, n, n, 0.5235987755982988);
     nodes = hfvis_lattice_size(&L);
     lat = (float *)xmalloc(sizeof(float) * nodes);
-    t0 = now_s();
+    t0 = bench_now();
     if ((s = hfvis_horizon_lattice(&g, 0.5235987755982988, NULL, lat)) != HFVIS_OK) die("lattice", s);
-    t_fast = (now_s() - t0) * 1e9 / (double)cells;
-    t0 = now_s();
+    t_fast = (bench_now() - t0) * 1e9 / (double)cells;
+    t0 = bench_now();
     if ((s = hfvis_horizon_lattice_naive(&g, 0.5235987755982988, NULL, lat)) != HFVIS_OK) die("lattice naive", s);
-    t_slow = (now_s() - t0) * 1e9 / (double)cells;
+    t_slow = (bench_now() - t0) * 1e9 / (double)cells;
     printf("%-44s %9.2f ns %9.0f ns %8.0fx\n", "hull lattice vs per-line brute force, /node", t_fast, t_slow, t_slow / t_fast);
     pts = sample_points(n, P);
     ref = (float *)xmalloc(sizeof(float) * (size_t)P * (size_t)K);
-    t0 = now_s();
+    t0 = bench_now();
     if ((s = hfvis_horizon_reference(&g, K, NULL, NULL, pts, (size_t)P, ref)) != HFVIS_OK) die("reference", s);
-    t_slow = (now_s() - t0) * 1e9 / ((double)P * (double)K);
-    t0 = now_s();
+    t_slow = (bench_now() - t0) * 1e9 / ((double)P * (double)K);
+    t0 = bench_now();
     if ((s = hfvis_sky_view_factor(&g, K, NULL, out, n)) != HFVIS_OK) die("svf", s);
-    t_fast = (now_s() - t0) * 1e9 / ((double)cells * (double)K);
+    t_fast = (bench_now() - t0) * 1e9 / ((double)cells * (double)K);
     printf("%-44s %9.2f ns %9.0f ns %8.0fx\n", "sky-view factor K=16 vs ray march, /rd", t_fast, t_slow, t_slow / t_fast);
-    t0 = now_s();
+    t0 = bench_now();
     if ((s = hfvis_sun_visibility(&g, 0.7, 0.3, 0.0046, NULL, out, n)) != HFVIS_OK) die("sun", s);
-    t_fast = (now_s() - t0) * 1e9 / (double)cells;
+    t_fast = (bench_now() - t0) * 1e9 / (double)cells;
     printf("%-44s %9.2f ns %9.0f ns %8.0fx\n", "sun visibility (1 sweep) vs ray march, /rcv", t_fast, t_slow, t_slow / t_fast);
     /* Environment light against the hemisphere oracle (256 azimuths x 512 zenith steps). */
     for (i = 0; i < 64 * 128 * 3; i++) env_rad[i] = 0.2f + 0.8f * (float)((i / 3) % 128) / 128.0f;
@@ -150,20 +120,20 @@ static void bench_others(int n)
             pn[3 * p + 2] = nrm[3 * idx + 2];
         }
         memset(&ho, 0, sizeof ho);
-        t0 = now_s();
+        t0 = bench_now();
         if ((s = hfvis_light_reference(&g, &env, 1.0f, NULL, NULL, &ho, pts, pn, (size_t)P, ref)) != HFVIS_OK)
             die("light reference", s);
-        t_slow = (now_s() - t0) * 1e9 / (double)P;
+        t_slow = (bench_now() - t0) * 1e9 / (double)P;
         free(pn);
     }
-    t0 = now_s();
+    t0 = bench_now();
     if ((s = hfvis_env_light(&g, K, &env, 1.0f, NULL, NULL, out, n)) != HFVIS_OK) die("env", s);
-    t_fast = (now_s() - t0) * 1e9 / (double)cells;
+    t_fast = (bench_now() - t0) * 1e9 / (double)cells;
     printf("%-44s %9.0f ns %9.0f ns %8.0fx\n", "env light prefix K=16 vs hemisphere, /rcv", t_fast, t_slow, t_slow / t_fast);
     lp.method = HFVIS_ENV_LP_TABLE;
-    t0 = now_s();
+    t0 = bench_now();
     if ((s = hfvis_env_light(&g, K, &env, 1.0f, NULL, &lp, out, n)) != HFVIS_OK) die("env lp", s);
-    t_fast = (now_s() - t0) * 1e9 / (double)cells;
+    t_fast = (bench_now() - t0) * 1e9 / (double)cells;
     printf("%-44s %9.0f ns %9.0f ns %8.0fx\n", "env light L_p K=16 vs hemisphere, /rcv", t_fast, t_slow, t_slow / t_fast);
     free(z);
     free(out);
@@ -212,12 +182,12 @@ static void bench_p2(int quick)
             g.height = n;
             g.stride = n;
             g.cell_size = 1.0;
-            t0 = now_s();
+            t0 = bench_now();
             if ((s = hfvis_visibility_count(&g, K, NULL, NULL, out, n, &st)) != HFVIS_OK) die("visibility", s);
-            tt = (now_s() - t0) * 1e3 / (double)K;
-            t0 = now_s();
+            tt = (bench_now() - t0) * 1e3 / (double)K;
+            t0 = bench_now();
             if ((s = hfvis_visibility_count_naive(&g, K, NULL, out, n, &sn)) != HFVIS_OK) die("visibility naive", s);
-            tn = (now_s() - t0) * 1e3 / (double)K;
+            tn = (bench_now() - t0) * 1e3 / (double)K;
             r = st.receivers;
             printf("%-7s %5d^2 | %9.2f %9.2f %9.2f | %9.1f %8.2f%% | %9.1f %9.1f %7.1fx\n",
                    fi == 0 ? "fBm" : "bricks", n, st.visible / r, st.horizons / r, st.iterations / r,
@@ -293,12 +263,12 @@ static void bench_indirect(int n)
     g.stride = n;
     g.cell_size = 1.0;
     rd = (double)cells * (double)K;
-    t0 = now_s();
+    t0 = bench_now();
     if ((s = hfvis_indirect_light(&g, K, ex, 1, 1.0f, 1.0f, NULL, NULL, out, n)) != HFVIS_OK) die("indirect", s);
-    tt = (now_s() - t0) * 1e9 / rd;
-    t0 = now_s();
+    tt = (bench_now() - t0) * 1e9 / rd;
+    t0 = bench_now();
     if ((s = hfvis_indirect_light_naive(&g, K, ex, 1, 1.0f, 1.0f, NULL, out, n)) != HFVIS_OK) die("indirect naive", s);
-    tn = (now_s() - t0) * 1e9 / rd;
+    tn = (bench_now() - t0) * 1e9 / rd;
     printf("indirect gather %d^2 K=16: tree %.1f ns/rd, naive %.1f ns/rd, %.1fx\n", n, tt, tn, tn / tt);
     free(z);
     free(ex);
@@ -328,32 +298,32 @@ static void bench_gi_viewshed(int n)
     sun.azimuth_rad = 0.7; sun.elevation_rad = 0.5;
     sun.irradiance[0] = 3.14159265f;
     rd = (double)cells * (double)K;
-    t0 = now_s();
+    t0 = bench_now();
     if ((s = hfvis_direct_light(&g, K, &sun, 1.0f, NULL, 1, NULL, d)) != HFVIS_OK) die("direct", s);
-    t_direct = now_s() - t0;
-    t0 = now_s();
+    t_direct = bench_now() - t0;
+    t0 = bench_now();
     if ((s = hfvis_terrain_gi(&g, K, d, NULL, NULL, rho, 1, B, NULL, NULL, g2)) != HFVIS_OK) die("gi", s);
-    t_gi = now_s() - t0;
+    t_gi = bench_now() - t0;
     /* naive pipeline: L_0 = rho*D, L_(b+1) = rho*(D + I_naive[L_b]) */
-    t0 = now_s();
+    t0 = bench_now();
     for (i = 0; i < cells; i++) l[i] = rho * d[i];
     for (b = 0; b < B; b++) {
         if ((s = hfvis_indirect_light_naive(&g, K, l, 1, 1.0f, 1.0f, NULL, tmp, n)) != HFVIS_OK)
             die("indirect naive", s);
         for (i = 0; i < cells; i++) l[i] = isnan(tmp[i]) ? tmp[i] : rho * (d[i] + tmp[i]);
     }
-    t_naive = now_s() - t0;
+    t_naive = bench_now() - t0;
     printf("\nterrain GI %d^2 K=%d, %d bounces: direct light %.1f ns/rd; GI %.1f ns/rd per bounce, "
            "naive pipeline %.1f, %.1fx\n", n, K, B, t_direct * 1e9 / rd, t_gi * 1e9 / rd / B,
            t_naive * 1e9 / rd / B, t_naive / t_gi);
     memset(&vo, 0, sizeof vo);
     vo.observer_height = 1.7; /* an eye above the surface; the fBm's amplitude is n/8 */
-    t0 = now_s();
+    t0 = bench_now();
     if ((s = hfvis_viewshed(&g, n * 0.5, n * 0.5, &vo, d, n)) != HFVIS_OK) die("viewshed", s);
-    t_r2 = now_s() - t0;
-    t0 = now_s();
+    t_r2 = bench_now() - t0;
+    t0 = bench_now();
     if ((s = hfvis_viewshed_reference(&g, n * 0.5, n * 0.5, &vo, 0.0, l, n)) != HFVIS_OK) die("viewshed ref", s);
-    t_exact = now_s() - t0;
+    t_exact = bench_now() - t0;
     for (i = 0; i < cells; i++) differ += d[i] != l[i] && !(isnan(d[i]) && isnan(l[i]));
     printf("viewshed %d^2 (eye 1.7 above the centre): R2 %.1f ns/cell (%.3f s), exact LOS %.0f ns/cell, %.0fx; "
            "%.2f%% cells differ\n", n, t_r2 * 1e9 / (double)cells, t_r2, t_exact * 1e9 / (double)cells,
@@ -418,8 +388,8 @@ static void bench_horizon(int quick)
             int K = Ks[ki], P = quick ? 64 : 256;
             float *map = (float *)xmalloc(sizeof(float) * cells * (size_t)K);
             float *pts = sample_points(n, P), *ref = (float *)xmalloc(sizeof(float) * (size_t)P * (size_t)K);
-            tracker tm = {0, 0}, ts = {0, 0};
-            hfvis_allocator am = {track_alloc, track_free, NULL}, as = {track_alloc, track_free, NULL};
+            bench_tracker tm = {0, 0}, ts = {0, 0};
+            hfvis_allocator am = {bench_track_alloc, bench_track_free, NULL}, as = {bench_track_alloc, bench_track_free, NULL};
             hfvis_sweep_options om = hfvis_sweep_options_default(), os = om;
             double t0, t_map, t_sky, t_ref, rd = (double)cells * (double)K;
             hfvis_status s;
@@ -427,16 +397,16 @@ static void bench_horizon(int quick)
             as.user = &ts;
             om.alloc = &am;
             os.alloc = &as;
-            t0 = now_s();
+            t0 = bench_now();
             if ((s = hfvis_horizon_map(&g, K, &om, map)) != HFVIS_OK) die("horizon map", s);
-            t_map = now_s() - t0;
-            t0 = now_s();
+            t_map = bench_now() - t0;
+            t0 = bench_now();
             if ((s = hfvis_sky_light(&g, K, 1.0f, 1.0f, &os, light, n)) != HFVIS_OK) die("sky", s);
-            t_sky = now_s() - t0;
-            t0 = now_s();
+            t_sky = bench_now() - t0;
+            t0 = bench_now();
             if ((s = hfvis_horizon_reference(&g, K, NULL, NULL, pts, (size_t)P, ref)) != HFVIS_OK)
                 die("reference", s);
-            t_ref = (now_s() - t0) * 1e9 / ((double)P * (double)K);
+            t_ref = (bench_now() - t0) * 1e9 / ((double)P * (double)K);
             printf("%4d^2 %4d | %-10s %9.2f %8.1fM | %-10s %9.2f %8.1fM | %10.1f %7.0fx %7.0fx\n", n, K,
                    "", t_map * 1e9 / rd, (double)tm.peak / 1048576.0, "", t_sky * 1e9 / rd,
                    (double)ts.peak / 1048576.0, t_ref, t_ref / (t_map * 1e9 / rd),

@@ -2,6 +2,42 @@
  * library module; examples/bench.c's main calls each (quick = the short `bench quick` run). */
 #ifndef HFVIS_BENCH_H
 #define HFVIS_BENCH_H
+
+#include <stddef.h>
+#include <stdlib.h>
+#include <time.h>
+
+/* Seconds on the monotonic clock (the including file defines _POSIX_C_SOURCE first). */
+static inline double bench_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
+}
+
+/* An allocator (hfvis_allocator with user = a bench_tracker) that records the peak number of
+ * bytes live: the library's scratch memory. */
+typedef struct bench_tracker { size_t live, peak; } bench_tracker;
+typedef struct bench_block { size_t size; double align; } bench_block;
+static inline void *bench_track_alloc(void *user, size_t size)
+{
+    bench_tracker *t = (bench_tracker *)user;
+    bench_block *b = (bench_block *)malloc(sizeof(bench_block) + size);
+    if (!b) return NULL;
+    b->size = size;
+    t->live += size;
+    if (t->live > t->peak) t->peak = t->live;
+    return b + 1;
+}
+static inline void bench_track_free(void *user, void *p)
+{
+    bench_tracker *t = (bench_tracker *)user;
+    bench_block *b;
+    if (!p) return;
+    b = (bench_block *)p - 1;
+    t->live -= b->size;
+    free(b);
+}
 void bench_mesh(int quick);
 void bench_raster(int quick);
 void bench_vox(int quick);

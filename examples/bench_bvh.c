@@ -10,13 +10,6 @@
 #include <string.h>
 #include <time.h>
 
-static double bench_bvh_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
-}
-
 static uint64_t bench_bvh_rng = 0x853C49E6748FEA9Bull;
 static double bench_bvh_unit(void)
 {
@@ -123,7 +116,7 @@ static double bench_bvh_run(const hfvis_bvh *b, const hfvis_mesh *m, const hfvis
     double best = 1e30;
     int r;
     for (r = 0; r < reps; r++) {
-        double t0 = bench_bvh_now(), t;
+        double t0 = bench_now(), t;
         size_t i, c = 0;
         for (i = 0; i < n; i++) {
             hfvis_hit h;
@@ -131,7 +124,7 @@ static double bench_bvh_run(const hfvis_bvh *b, const hfvis_mesh *m, const hfvis
             c += h.triangle != HFVIS_NO_TRIANGLE;
         }
         *hits = c;
-        t = bench_bvh_now() - t0;
+        t = bench_now() - t0;
         if (t < best) best = t;
     }
     return best;
@@ -140,7 +133,7 @@ static double bench_bvh_run(const hfvis_bvh *b, const hfvis_mesh *m, const hfvis
 static double bench_bvh_run_naive(const hfvis_mesh *m, const hfvis_ray *rays, size_t n, size_t stride,
                                   hfvis_ray_query q, size_t *count)
 {
-    double t0 = bench_bvh_now();
+    double t0 = bench_now();
     size_t i, c = 0;
     for (i = 0; i < n; i += stride) {
         hfvis_hit h;
@@ -148,7 +141,7 @@ static double bench_bvh_run_naive(const hfvis_mesh *m, const hfvis_ray *rays, si
         c++;
     }
     *count = c;
-    return bench_bvh_now() - t0;
+    return bench_now() - t0;
 }
 
 static void bench_bvh_line(const char *what, size_t n, double sec, size_t hits, double naive_ns)
@@ -188,9 +181,9 @@ void bench_bvh(int quick)
         o.max_leaf_size = leaf;
         best = 1e30;
         for (rep = 0; rep < (quick ? 1 : 3); rep++) {
-            t0 = bench_bvh_now();
+            t0 = bench_now();
             if (hfvis_bvh_build(&m, &o, &b) != HFVIS_OK) return;
-            sec = bench_bvh_now() - t0;
+            sec = bench_now() - t0;
             if (sec < best) best = sec;
             if (rep + 1 < (quick ? 1 : 3)) hfvis_bvh_free(NULL, &b);
         }

@@ -13,13 +13,6 @@
 #include <string.h>
 #include <time.h>
 
-static double bench_cons_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 typedef hfvis_status (*bench_cons_fn)(const hfvis_mesh *, const hfvis_volume_grid *,
                                       const hfvis_binary_voxel_options *, uint8_t *, size_t *);
 
@@ -37,9 +30,9 @@ static double bench_cons_time(bench_cons_fn fn, const hfvis_mesh *m, const hfvis
     double best = 1e30;
     int r;
     for (r = 0; r < reps; r++) {
-        double t = bench_cons_now();
+        double t = bench_now();
         if (fn(m, g, NULL, out, count) != HFVIS_OK) return -1.0;
-        t = bench_cons_now() - t;
+        t = bench_now() - t;
         if (t < best) best = t;
     }
     return best;

@@ -20,13 +20,6 @@
 #define BENCH_GI2_ALBEDO 0.5f
 #define BENCH_GI2_B 3           /* bounces */
 
-static double bench_gi2_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
-}
-
 static void *bench_gi2_xmalloc(size_t n)
 {
     void *p = malloc(n);
@@ -44,29 +37,6 @@ static void bench_gi2_die(const char *what, hfvis_status s)
     exit(1);
 }
 
-/* Peak-tracking allocator (library scratch only). */
-typedef struct { size_t live, peak; } bench_gi2_tracker;
-typedef struct { size_t size; double align; } bench_gi2_head;
-static void *bench_gi2_alloc(void *user, size_t size)
-{
-    bench_gi2_tracker *t = (bench_gi2_tracker *)user;
-    bench_gi2_head *b = (bench_gi2_head *)malloc(sizeof(bench_gi2_head) + size);
-    if (!b) return NULL;
-    b->size = size;
-    t->live += size;
-    if (t->live > t->peak) t->peak = t->live;
-    return b + 1;
-}
-static void bench_gi2_free(void *user, void *p)
-{
-    bench_gi2_tracker *t = (bench_gi2_tracker *)user;
-    bench_gi2_head *b;
-    if (!p) return;
-    b = (bench_gi2_head *)p - 1;
-    t->live -= b->size;
-    free(b);
-}
-
 /* The time at the end of each pass of hfvis_ns_gi, from its progress callback (one call per
  * receiver row of each pass): pass p ends when done reaches (p+1) * rows. */
 typedef struct {
@@ -77,7 +47,7 @@ static void bench_gi2_progress(void *user, int done, int total)
 {
     bench_gi2_clock *c = (bench_gi2_clock *)user;
     (void)total;
-    if (done % c->rows == 0 && done / c->rows <= BENCH_GI2_B + 1) c->end[done / c->rows - 1] = bench_gi2_now() - c->t0;
+    if (done % c->rows == 0 && done / c->rows <= BENCH_GI2_B + 1) c->end[done / c->rows - 1] = bench_now() - c->t0;
 }
 
 /* The bench terrain of examples/bench.c: fBm, amplitude n/8, base wavelength n/4, seed 3. */
@@ -113,24 +83,24 @@ static void bench_gi2_exact(const hfvis_grid *g, float *L, double *t, size_t *pe
     hfvis_sun sun = bench_gi2_sun();
     hfvis_sweep_options so = hfvis_sweep_options_default();
     hfvis_allocator al;
-    bench_gi2_tracker tr = {0, 0};
+    bench_tracker tr = {0, 0};
     hfvis_status s;
-    double t0 = bench_gi2_now();
+    double t0 = bench_now();
     size_t i;
     int b;
-    al.alloc = bench_gi2_alloc;
-    al.free = bench_gi2_free;
+    al.alloc = bench_track_alloc;
+    al.free = bench_track_free;
     al.user = &tr;
     so.alloc = &al;
     if ((s = hfvis_direct_light(g, BENCH_GI2_K, &sun, 1.0f, NULL, 1, &so, D)) != HFVIS_OK) bench_gi2_die("direct", s);
     for (i = 0; i < cells; i++) L[i] = BENCH_GI2_ALBEDO * D[i];
-    t[0] = bench_gi2_now() - t0;
+    t[0] = bench_now() - t0;
     for (b = 1; b <= BENCH_GI2_B; b++) {
         float *prev = L + (size_t)(b - 1) * cells, *cur = L + (size_t)b * cells;
         if ((s = hfvis_indirect_light(g, BENCH_GI2_K, prev, 1, 0.0f, 1.0f, &so, NULL, I, g->width)) != HFVIS_OK)
             bench_gi2_die("indirect", s);
         for (i = 0; i < cells; i++) cur[i] = BENCH_GI2_ALBEDO * (D[i] + I[i]);
-        t[b] = bench_gi2_now() - t0;
+        t[b] = bench_now() - t0;
     }
     *peak = tr.peak;
     free(D);
@@ -150,7 +120,7 @@ static void bench_gi2_ns(const hfvis_grid *g, int s, int bounces, float *tot, do
     hfvis_ns_gi_options o;
     hfvis_ns_gi_outputs out;
     hfvis_allocator al;
-    bench_gi2_tracker tr = {0, 0};
+    bench_tracker tr = {0, 0};
     bench_gi2_clock ck;
     hfvis_status st;
     size_t i;
@@ -165,8 +135,8 @@ static void bench_gi2_ns(const hfvis_grid *g, int s, int bounces, float *tot, do
     sc.albedo[0] = BENCH_GI2_ALBEDO;
     memset(&o, 0, sizeof o);
     o.subsample = s;
-    al.alloc = bench_gi2_alloc;
-    al.free = bench_gi2_free;
+    al.alloc = bench_track_alloc;
+    al.free = bench_track_free;
     al.user = &tr;
     o.alloc = &al;
     o.progress = bench_gi2_progress;
@@ -178,7 +148,7 @@ static void bench_gi2_ns(const hfvis_grid *g, int s, int bounces, float *tot, do
     memset(&ck, 0, sizeof ck);
     ck.rows = (g->height + s - 1) / s;
     if ((st = hfvis_ns_gi_scratch_size(g, &sc, &o, bounces, query)) != HFVIS_OK) bench_gi2_die("ns scratch", st);
-    ck.t0 = bench_gi2_now();
+    ck.t0 = bench_now();
     if ((st = hfvis_ns_gi(g, &sc, &o, &out)) != HFVIS_OK) bench_gi2_die("ns gi", st);
     for (b = 0; b <= bounces; b++) t[b] = ck.end[b];
     /* planes 1..B become the running totals */

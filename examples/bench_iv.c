@@ -16,13 +16,6 @@
 #include <string.h>
 #include <time.h>
 
-static double bench_iv_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
 /* The timed steps. Each returns seconds of one run. */
 static double bench_iv_raster(const hfvis_mesh *m, const hfvis_view *v, float *depth, float *normal)
 {
@@ -31,9 +24,9 @@ static double bench_iv_raster(const hfvis_mesh *m, const hfvis_view *v, float *d
     memset(&out, 0, sizeof out);
     out.window_depth = depth;
     out.normal = normal;
-    t0 = bench_iv_now();
+    t0 = bench_now();
     if (hfvis_rasterize(m, v, NULL, &out) != HFVIS_OK) return -1.0;
-    return bench_iv_now() - t0;
+    return bench_now() - t0;
 }
 
 static double bench_iv_cleanup(const hfvis_volume *prev, hfvis_volume *curr,
@@ -42,9 +35,9 @@ static double bench_iv_cleanup(const hfvis_volume *prev, hfvis_volume *curr,
     hfvis_iv_options o = hfvis_iv_options_default();
     double t0;
     o.footprint = conservative ? HFVIS_IV_FOOTPRINT_CONSERVATIVE : HFVIS_IV_FOOTPRINT_CENTER;
-    t0 = bench_iv_now();
+    t0 = bench_now();
     if (hfvis_iv_cleanup(prev, curr, im, 1, &o, st) != HFVIS_OK) return -1.0;
-    return bench_iv_now() - t0;
+    return bench_now() - t0;
 }
 
 static double bench_iv_inject(hfvis_volume *vol, const hfvis_depth_image *im, int grid,
@@ -54,30 +47,30 @@ static double bench_iv_inject(hfvis_volume *vol, const hfvis_depth_image *im, in
     double t0;
     o.grid_width = grid;
     o.grid_height = grid;
-    t0 = bench_iv_now();
+    t0 = bench_now();
     if (hfvis_iv_inject(vol, im, 1, &o, st) != HFVIS_OK) return -1.0;
-    return bench_iv_now() - t0;
+    return bench_now() - t0;
 }
 
 static double bench_iv_single(const hfvis_volume *prev, hfvis_volume *curr,
                               const hfvis_depth_image *im, hfvis_iv_stats *st)
 {
-    double t0 = bench_iv_now();
+    double t0 = bench_now();
     if (hfvis_iv_single_pass(prev, curr, im, 1, NULL, st) != HFVIS_OK) return -1.0;
-    return bench_iv_now() - t0;
+    return bench_now() - t0;
 }
 
 /* Full geometric re-voxelization: clear the volume, voxelize every triangle. */
 static double bench_iv_geometric(const hfvis_mesh *m, hfvis_volume *vol, double *clear_s)
 {
     hfvis_voxelize_options o = hfvis_voxelize_options_default();
-    double t0 = bench_iv_now(), t1;
+    double t0 = bench_now(), t1;
     if (vol->channels == 4) o.fragment = hfvis_voxel_fragment_normal_occupancy;
     hfvis_volume_clear(vol, 0.0f);
-    t1 = bench_iv_now();
+    t1 = bench_now();
     if (hfvis_voxelize_surface(m, vol, &o, NULL) != HFVIS_OK) return -1.0;
     *clear_s = t1 - t0;
-    return bench_iv_now() - t0;
+    return bench_now() - t0;
 }
 
 static size_t bench_iv_nonempty(const hfvis_volume *v)

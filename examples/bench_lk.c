@@ -15,13 +15,6 @@
 #include <string.h>
 #include <time.h>
 
-static double bench_lk_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
-}
-
 static uint64_t bench_lk_rng = 0x853C49E6748FEA9Bull;
 static double bench_lk_unit(void)
 {
@@ -195,11 +188,11 @@ static int bench_lk_method(int method, const hfvis_mesh *m, const hfvis_bvh *bvh
     rc.position = pos;
     rc.normal = nrm;
     rc.key = key;
-    t0 = bench_lk_now();
+    t0 = bench_now();
     if (method == 0) s = hfvis_lk_raster(m, v, rays, opts, NULL, ob, &out->st);
     else if (method == 1) s = hfvis_lk_bvh(m, bvh, rays, &rc, opts, NULL, ob, &out->st);
     else s = hfvis_lk_raycast(m, bvh, rays, &rc, opts, NULL, ob, &out->st);
-    out->sec = bench_lk_now() - t0;
+    out->sec = bench_now() - t0;
     out->rays = (double)out->st.rays;
     out->blocked = (double)out->st.rays_blocked;
     free(ob); free(pos); free(nrm); free(key);
@@ -359,13 +352,13 @@ void bench_lk(int quick)
                 hfvis_lk_options o = hfvis_lk_options_default();
                 hfvis_lk_stats st;
                 float *ob = (float *)malloc(sizeof(float) * (size_t)W * (size_t)H);
-                double t0 = bench_lk_now(), best = 1e30;
+                double t0 = bench_now(), best = 1e30;
                 int rep;
                 o.cull = sets[k];
                 for (rep = 0; rep < (quick ? 1 : 2); rep++) {
-                    t0 = bench_lk_now();
+                    t0 = bench_now();
                     if (!ob || hfvis_lk_raster(&m, &v, &rays, &o, NULL, ob, &st) != HFVIS_OK) break;
-                    if (bench_lk_now() - t0 < best) best = bench_lk_now() - t0;
+                    if (bench_now() - t0 < best) best = bench_now() - t0;
                 }
                 frag[ri][k] = (double)st.masks;
                 sec[ri][k] = best;
@@ -403,10 +396,10 @@ void bench_lk(int quick)
             hfvis_lk_lut L;
             double t0;
             if (hfvis_lk_rays_build(cfg[c][0], 1.0, NULL, &rays) != HFVIS_OK) continue;
-            t0 = bench_lk_now();
+            t0 = bench_now();
             if (hfvis_lk_lut_build(&rays, cfg[c][1], NULL, &L) == HFVIS_OK) {
                 printf("  N = %4d, T = %3d: %6.1f MiB, built in %.3f s\n", cfg[c][0], cfg[c][1],
-                       (double)L.bytes / 1048576.0, bench_lk_now() - t0);
+                       (double)L.bytes / 1048576.0, bench_now() - t0);
                 hfvis_lk_lut_free(NULL, &L);
             }
             hfvis_lk_rays_free(NULL, &rays);

@@ -9,17 +9,10 @@
 #include <string.h>
 #include <time.h>
 
-static double bench_mesh_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static double bench_mesh_knot(int reps, hfvis_mesh *keep)
 {
     const double c[3] = {0.0, 0.0, 0.0};
-    double t0 = bench_mesh_now();
+    double t0 = bench_now();
     int r;
     for (r = 0; r < reps; r++) {
         hfvis_mesh m;
@@ -27,7 +20,7 @@ static double bench_mesh_knot(int reps, hfvis_mesh *keep)
         if (r == reps - 1) *keep = m;
         else hfvis_mesh_free(NULL, &m);
     }
-    return (bench_mesh_now() - t0) / reps;
+    return (bench_now() - t0) / reps;
 }
 
 static double bench_mesh_encode(const hfvis_mesh *m, int reps, unsigned char **buf, size_t *n)
@@ -36,22 +29,22 @@ static double bench_mesh_encode(const hfvis_mesh *m, int reps, unsigned char **b
     double t0;
     int r;
     *buf = (unsigned char *)malloc(need);
-    t0 = bench_mesh_now();
+    t0 = bench_now();
     for (r = 0; r < reps; r++)
         if (hfvis_obj_encode(m, *buf, need, n) != HFVIS_OK) exit(1);
-    return (bench_mesh_now() - t0) / reps;
+    return (bench_now() - t0) / reps;
 }
 
 static double bench_mesh_decode(const unsigned char *buf, size_t n, int reps)
 {
-    double t0 = bench_mesh_now();
+    double t0 = bench_now();
     int r;
     for (r = 0; r < reps; r++) {
         hfvis_mesh m;
         if (hfvis_obj_decode(buf, n, NULL, &m) != HFVIS_OK) exit(1);
         hfvis_mesh_free(NULL, &m);
     }
-    return (bench_mesh_now() - t0) / reps;
+    return (bench_now() - t0) / reps;
 }
 
 /* Baseline: the same text's v lines through strtof and f lines through strtol (what a
@@ -63,7 +56,7 @@ static double bench_mesh_decode_libc(const unsigned char *buf, size_t n, int rep
     int r;
     memcpy(text, buf, n);
     text[n] = '\0';
-    t0 = bench_mesh_now();
+    t0 = bench_now();
     for (r = 0; r < reps; r++) {
         char *p = text;
         while (*p) {
@@ -84,13 +77,13 @@ static double bench_mesh_decode_libc(const unsigned char *buf, size_t n, int rep
     }
     *sink += acc;
     free(text);
-    return (bench_mesh_now() - t0) / reps;
+    return (bench_now() - t0) / reps;
 }
 
 static double bench_mesh_printf(const hfvis_mesh *m, int reps)
 {
     char line[128];
-    double t0 = bench_mesh_now();
+    double t0 = bench_now();
     size_t i, total = 0;
     int r;
     for (r = 0; r < reps; r++) {
@@ -102,7 +95,7 @@ static double bench_mesh_printf(const hfvis_mesh *m, int reps)
                                       m->indices[3 * i + 1] + 1u, m->indices[3 * i + 2] + 1u);
     }
     if (total == 0) exit(1);
-    return (bench_mesh_now() - t0) / reps;
+    return (bench_now() - t0) / reps;
 }
 
 void bench_mesh(int quick)

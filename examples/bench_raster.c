@@ -9,13 +9,6 @@
 #include <string.h>
 #include <time.h>
 
-static double bench_raster_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* The benchmark view: the knot (|x|, |y| <= 1.75, |z| <= 0.75) seen obliquely from above,
  * close enough to cover about 3/4 of a 1280x720 frame (its tube reaches past the borders). */
 static int bench_raster_view(hfvis_view *v, int w, int h)
@@ -65,9 +58,9 @@ static double bench_raster_frames(const hfvis_mesh *m, const hfvis_view *v,
     double best = -1.0;
     int f;
     for (f = 0; f < frames; f++) {
-        double t0 = bench_raster_now(), t;
+        double t0 = bench_now(), t;
         if (hfvis_rasterize(m, v, opt, o) != HFVIS_OK) return -1.0;
-        t = bench_raster_now() - t0;
+        t = bench_now() - t0;
         if (best < 0.0 || t < best) best = t;
     }
     return best;
@@ -76,9 +69,9 @@ static double bench_raster_frames(const hfvis_mesh *m, const hfvis_view *v,
 static double bench_raster_reference(const hfvis_mesh *m, const hfvis_view *v,
                                      const hfvis_raster_outputs *o)
 {
-    double t0 = bench_raster_now();
+    double t0 = bench_now();
     if (hfvis_rasterize_reference(m, v, NULL, o) != HFVIS_OK) return -1.0;
-    return bench_raster_now() - t0;
+    return bench_now() - t0;
 }
 
 void bench_raster(int quick)

@@ -18,13 +18,6 @@
 #include <string.h>
 #include <time.h>
 
-static double bench_ssao_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* Render the knot-on-ground scene into W0 x H0 linear depth; camera with guard (gx, gy). */
 static int bench_ssao_scene(int W0, int H0, int gx, int gy, float *depth, hfvis_camera *cam)
 {
@@ -72,9 +65,9 @@ static double bench_ssao_lsao(const hfvis_camera *cam, const float *depth,
     double best = 1e30;
     int r;
     for (r = 0; r < reps; r++) {
-        double t0 = bench_ssao_now(), t;
+        double t0 = bench_now(), t;
         if (hfvis_lsao(cam, depth, NULL, o, ao, cam->width - 2 * cam->guard_x) != HFVIS_OK) return -1.0;
-        t = bench_ssao_now() - t0;
+        t = bench_now() - t0;
         if (t < best) best = t;
     }
     return best;
@@ -92,9 +85,9 @@ static double bench_ssao_hbao(const hfvis_camera *cam, const float *depth,
     skip = (IH - rows) / 2;
     band.guard_y = cam->guard_y + skip;
     rows = cam->height - 2 * band.guard_y;
-    t0 = bench_ssao_now();
+    t0 = bench_now();
     if (hfvis_hbao(&band, depth, NULL, o, ao + (size_t)skip * (size_t)IW, IW) != HFVIS_OK) return -1.0;
-    t = bench_ssao_now() - t0;
+    t = bench_now() - t0;
     return t * (double)IH / (double)rows; /* per whole image */
 }
 
@@ -118,12 +111,12 @@ static void bench_ssao_breakdown(const hfvis_camera *cam, const float *depth,
         lines = (hfvis_ssao_line *)malloc(sizeof *lines * (size_t)L.line_count);
         vals = (float *)malloc(sizeof(float) * 2 * L.sample_count);
         hfvis_ssao_lattice_lines(cam, &L, lines);
-        t0 = bench_ssao_now();
+        t0 = bench_now();
         hfvis_lsao_direction(cam, depth, NULL, o, &L, lines, vals, vals + L.sample_count);
-        *t_sweep += bench_ssao_now() - t0;
-        t0 = bench_ssao_now();
+        *t_sweep += bench_now() - t0;
+        t0 = bench_now();
         hfvis_lsao_gather(cam, depth, NULL, o, &L, lines, vals, vals + L.sample_count, acc, acc + n);
-        *t_gather += bench_ssao_now() - t0;
+        *t_gather += bench_now() - t0;
         free(vals);
         free(lines);
     }

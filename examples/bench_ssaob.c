@@ -10,13 +10,6 @@
 #include "bench.h"
 #include "hfvis.h"
 
-static double bench_ssaob_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
 static void bench_ssaob_size(int W, int H, int rays)
 {
     int gx = W / 10, gy = H / 10, W0 = W + 2 * gx, H0 = H + 2 * gy;
@@ -41,20 +34,20 @@ static void bench_ssaob_size(int W, int H, int rays)
     o.falloff.param = 1.0;
     ro.falloff = o.falloff;
     ro.rays = rays;
-    t0 = bench_ssaob_now();
+    t0 = bench_now();
     hfvis_ssao_raytrace(&cam, d, n, &ro, r, W);
     printf("  %dx%d (+%d,+%d): ray-traced reference %d rays: %.1f ms\n", W, H, 2 * gx, 2 * gy, rays,
-           1e3 * (bench_ssaob_now() - t0));
+           1e3 * (bench_now() - t0));
     for (K = 8; K <= 16; K += 8) {
         o.directions = K;
         o.sparse = 0;
-        t0 = bench_ssaob_now();
+        t0 = bench_now();
         hfvis_ffao(&cam, d, n, &o, a, W);
-        tf = bench_ssaob_now() - t0;
+        tf = bench_now() - t0;
         o.mip_directions = 16;
-        t0 = bench_ssaob_now();
+        t0 = bench_now();
         hfvis_ssao_mipmap(&cam, d, n, &o, m, W);
-        tm = bench_ssaob_now() - t0;
+        tm = bench_now() - t0;
         hfvis_ssao_error(a, W, r, W, W, H, 0.05, 0, &ef, NULL, 0);
         hfvis_ssao_error(m, W, r, W, W, H, 0.05, 0, &em, NULL, 0);
         printf("    FFAO %2dx2: %8.1f ns/px  e_A %.3f %%  e_<5%% %.1f %% | mipmap K=16: %8.1f ns/px  e_A %.3f %%  e_<5%% %.1f %%  (error ratio %.1fx)\n",
@@ -64,9 +57,9 @@ static void bench_ssaob_size(int W, int H, int rays)
     o.directions = 18;
     o.sparse = 1;
     o.blur = 1;
-    t0 = bench_ssaob_now();
+    t0 = bench_now();
     hfvis_ffao(&cam, d, n, &o, a, W);
-    ts = bench_ssaob_now() - t0;
+    ts = bench_now() - t0;
     hfvis_ssao_error(a, W, r, W, W, H, 0.05, 0, &ef, NULL, 0);
     printf("    FFAO 18x2 sparse 3x3 + blur: %8.1f ns/px  e_A %.3f %%\n", 1e9 * ts / ((double)W * H), 100 * ef.mean);
 done:

@@ -14,13 +14,6 @@
 #include "bench.h"
 #include "hfvis.h"
 
-static double bench_vf_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static uint64_t bench_vf_rng = 12345;
 static double bench_vf_unit(void)
 {
@@ -53,9 +46,9 @@ static double bench_vf_build(const hfvis_mesh *mesh, int n, int D, int reference
     double t0, dt;
     hfvis_status s;
     if (!bench_vf_field(mesh, n, D, HFVIS_VISFIELD_U8, &vf)) return NAN;
-    t0 = bench_vf_now();
+    t0 = bench_now();
     s = reference ? hfvis_visfield_build_reference(mesh, NULL, &vf) : hfvis_visfield_build(mesh, NULL, &vf);
-    dt = bench_vf_now() - t0;
+    dt = bench_now() - t0;
     free(vf.maps);
     if (s != HFVIS_OK) return NAN;
     if (total_s) *total_s = dt;
@@ -112,7 +105,7 @@ static void bench_vf_query(const hfvis_mesh *mesh, const hfvis_bvh *bvh, const h
     for (rep = 0; rep < BENCH_VF_REPS; rep++)
         for (m = 0; m < 3; m++) {
             hits_vf = hits_bvh = 0.0;
-            t0 = bench_vf_now();
+            t0 = bench_now();
             for (q = 0; q < nr; q++) {
                 if (m == 0) {
                     hfvis_visfield_hit h;
@@ -135,7 +128,7 @@ static void bench_vf_query(const hfvis_mesh *mesh, const hfvis_bvh *bvh, const h
                     sink += (double)h.u;
                 }
             }
-            dt = (bench_vf_now() - t0) / (double)nr;
+            dt = (bench_now() - t0) / (double)nr;
             if (dt < out[m]) out[m] = dt;
             if (m == 0) out[3] = hits_vf / (double)nr;
             if (m == 1) out[4] = hits_bvh / (double)nr;
@@ -170,16 +163,16 @@ static void bench_vf_ao(const hfvis_mesh *mesh, const hfvis_bvh *bvh, const hfvi
     for (i = 0; i < 16; i++) ob.object_to_world[i] = (i % 5 == 0) ? 1.0 : 0.0;
     out[0] = out[1] = HUGE_VAL;
     for (rep = 0; rep < BENCH_VF_REPS; rep++) {
-        t0 = bench_vf_now();
+        t0 = bench_now();
         if (hfvis_visfield_ambient_occlusion(&ob, 1, pts, nrm, (size_t)receivers, NULL, ao) != HFVIS_OK)
             goto done;
-        dt = (bench_vf_now() - t0) / ((double)receivers * 256.0);
+        dt = (bench_now() - t0) / ((double)receivers * 256.0);
         if (dt < out[0]) out[0] = dt;
-        t0 = bench_vf_now();
+        t0 = bench_now();
         if (hfvis_visfield_ambient_occlusion_reference(&ob, 1, pts, nrm, (size_t)receivers, NULL, ao)
             != HFVIS_OK)
             goto done;
-        dt = (bench_vf_now() - t0) / ((double)receivers * 256.0);
+        dt = (bench_now() - t0) / ((double)receivers * 256.0);
         if (dt < out[1]) out[1] = dt;
     }
 done:
@@ -278,9 +271,9 @@ static void bench_vf_table(const char *name, const hfvis_mesh *mesh, const doubl
             }
             memset(&bo, 0, sizeof bo);
             bo.bvh = &bvh;
-            t0 = bench_vf_now();
+            t0 = bench_now();
             hfvis_visfield_build(mesh, &bo, &vf);
-            dt = bench_vf_now() - t0;
+            dt = bench_now() - t0;
             bench_vf_errors(mesh, &bvh, &vf, T, L, e);
             printf("  %6.2f / %5.2f%% / %.4f / %5.2f", dt, 100.0 * e[0], e[1], e[2]);
             fflush(stdout);

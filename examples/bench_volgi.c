@@ -15,13 +15,6 @@
 #include <string.h>
 #include <time.h>
 
-static double bench_volgi_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
 /* The scene: the room with a red (x = 0) and a green (x = 1) wall, a point light. */
 typedef struct bench_volgi_scene {
     hfvis_mesh mesh;
@@ -101,18 +94,18 @@ static hfvis_volgi_geometry bench_volgi_geo(const bench_volgi_vol *v)
 /* Timed work: each returns the seconds of one run (negative on failure). */
 static double bench_volgi_voxelize(const hfvis_volgi_scene *sc, bench_volgi_vol *v, size_t *frags)
 {
-    double t0 = bench_volgi_now();
+    double t0 = bench_now();
     if (hfvis_volgi_voxelize(sc, &v->grid, NULL, v->occ, v->nrm, v->alb, v->rad, frags) != HFVIS_OK)
         return -1.0;
-    return bench_volgi_now() - t0;
+    return bench_now() - t0;
 }
 
 static double bench_volgi_inject(bench_volgi_vol *v)
 {
     hfvis_volgi_geometry g = bench_volgi_geo(v);
-    double t0 = bench_volgi_now();
+    double t0 = bench_now();
     if (hfvis_volgi_inject(&g, v->rad, v->p0) != HFVIS_OK) return -1.0;
-    return bench_volgi_now() - t0;
+    return bench_now() - t0;
 }
 
 /* `iterations` steps of the loop (one scratch allocation, inputs checked once) */
@@ -122,9 +115,9 @@ static double bench_volgi_propagate(bench_volgi_vol *v, const hfvis_volgi_option
     double t0;
     memcpy(v->p, v->p0, HFVIS_VOLGI_FLOATS * v->n * sizeof(float));
     memset(v->a, 0, HFVIS_VOLGI_FLOATS * v->n * sizeof(float));
-    t0 = bench_volgi_now();
+    t0 = bench_now();
     if (hfvis_volgi_propagate(&g, o, iterations, v->p, v->a, NULL) != HFVIS_OK) return -1.0;
-    return bench_volgi_now() - t0;
+    return bench_now() - t0;
 }
 
 /* one step, fast or reference, optionally with the energy accounting (includes the O(voxels)
@@ -134,12 +127,12 @@ static double bench_volgi_step(bench_volgi_vol *v, const hfvis_volgi_options *o,
 {
     hfvis_volgi_geometry g = bench_volgi_geo(v);
     hfvis_volgi_energy e;
-    double t0 = bench_volgi_now();
+    double t0 = bench_now();
     hfvis_status s = reference
         ? hfvis_volgi_propagate_step_reference(&g, o, v->p0, v->q, v->a, energy ? &e : NULL)
         : hfvis_volgi_propagate_step(&g, o, v->p0, v->q, v->a, energy ? &e : NULL);
     if (s != HFVIS_OK) return -1.0;
-    return bench_volgi_now() - t0;
+    return bench_now() - t0;
 }
 
 /* per pixel: gather (eqs. 12-15) at the G-buffer's surface points, or the direct light */
@@ -147,7 +140,7 @@ static double bench_volgi_pixels(const bench_volgi_scene *s, const bench_volgi_v
                                  const double *pts, size_t count, int direct, double *sum)
 {
     hfvis_volgi_geometry g = bench_volgi_geo(v);
-    double t0 = bench_volgi_now(), acc = 0.0;
+    double t0 = bench_now(), acc = 0.0;
     size_t i;
     for (i = 0; i < count; i++) {
         float E[3];
@@ -159,7 +152,7 @@ static double bench_volgi_pixels(const bench_volgi_scene *s, const bench_volgi_v
         acc += (double)E[0];
     }
     *sum = acc;
-    return bench_volgi_now() - t0;
+    return bench_now() - t0;
 }
 
 static double bench_volgi_render(const hfvis_volgi_scene *sc, const hfvis_view *view, int res,
@@ -171,9 +164,9 @@ static double bench_volgi_render(const hfvis_volgi_scene *sc, const hfvis_view *
     o.resolution = res;
     o.iterations = iterations;
     out.direct = NULL, out.indirect = NULL, out.total = img;
-    t0 = bench_volgi_now();
+    t0 = bench_now();
     if (hfvis_volgi_render(sc, NULL, view, &o, &out, NULL) != HFVIS_OK) return -1.0;
-    return bench_volgi_now() - t0;
+    return bench_now() - t0;
 }
 
 static void bench_volgi_row(const char *grid, const char *what, double s, double units,

@@ -12,13 +12,6 @@
 #include <string.h>
 #include <time.h>
 
-static double bench_vox_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
 /* Best of `reps` voxelizations into vol (cleared before each, outside the timing), seconds;
  * *frags = fragments written. */
 static double bench_vox_time(const hfvis_mesh *m, hfvis_volume *vol, const hfvis_voxelize_options *o,
@@ -29,10 +22,10 @@ static double bench_vox_time(const hfvis_mesh *m, hfvis_volume *vol, const hfvis
     for (r = 0; r < reps; r++) {
         double t0, t;
         hfvis_volume_clear(vol, 0.0f);
-        t0 = bench_vox_now();
+        t0 = bench_now();
         if (reference) hfvis_voxelize_surface_reference(m, vol, o, frags);
         else hfvis_voxelize_surface(m, vol, o, frags);
-        t = bench_vox_now() - t0;
+        t = bench_now() - t0;
         if (t < best) best = t;
     }
     return best;
