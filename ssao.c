@@ -1026,6 +1026,31 @@ static double ss_box_mean(int n, int m)
     return (double)m * s / (double)cnt;
 }
 
+/* The falloff of an options struct: DEFAULT -> NONE, checked, HBAO's c defaulted to 0.3. */
+static hfvis_status ss_resolve_falloff(hfvis_falloff *f)
+{
+    if (f->kind == HFVIS_FALLOFF_DEFAULT) f->kind = HFVIS_FALLOFF_NONE;
+    if (hfvis_falloff_check(f) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (f->kind == HFVIS_FALLOFF_HBAO && f->hbao_c == 0.0) f->hbao_c = 0.3;
+    return HFVIS_OK;
+}
+
+/* The fixed tangent, the depth sampling and the receiver plane that LSAO and HBAO share; the
+ * two methods differ only in the default plane. */
+static hfvis_status ss_resolve_sampling(double *fixed_sin_t, hfvis_ssao_sampling *sampling,
+                                        hfvis_ssao_plane *plane, hfvis_ssao_plane plane_default)
+{
+    if (*fixed_sin_t == 0.0) *fixed_sin_t = SS_DEFAULT_SIN_T;
+    if (!(*fixed_sin_t >= -1.0 && *fixed_sin_t <= 1.0)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (*sampling == HFVIS_SSAO_SAMPLING_DEFAULT) *sampling = HFVIS_SSAO_SAMPLING_NEAREST;
+    if (*sampling != HFVIS_SSAO_SAMPLING_NEAREST && *sampling != HFVIS_SSAO_SAMPLING_BILINEAR)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (*plane == HFVIS_SSAO_PLANE_DEFAULT) *plane = plane_default;
+    if (*plane != HFVIS_SSAO_PLANE_PAPER && *plane != HFVIS_SSAO_PLANE_EXACT)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    return HFVIS_OK;
+}
+
 hfvis_status hfvis_lsao_options_resolve(const hfvis_lsao_options *in, hfvis_lsao_options *out)
 {
     hfvis_lsao_options o;
@@ -1068,19 +1093,12 @@ hfvis_status hfvis_lsao_options_resolve(const hfvis_lsao_options *in, hfvis_lsao
         return HFVIS_ERR_INVALID_ARGUMENT;
     }
     if (o.spacing != 0.0 && o.spacing < SS_MIN_STEP) o.spacing = SS_MIN_STEP;
-    if (o.falloff.kind == HFVIS_FALLOFF_DEFAULT) o.falloff.kind = HFVIS_FALLOFF_NONE;
-    if (hfvis_falloff_check(&o.falloff) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (o.falloff.kind == HFVIS_FALLOFF_HBAO && o.falloff.hbao_c == 0.0) o.falloff.hbao_c = 0.3;
+    if (ss_resolve_falloff(&o.falloff) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     if (o.tangent == HFVIS_SSAO_TANGENT_DEFAULT) o.tangent = HFVIS_SSAO_TANGENT_FIXED;
     if (o.tangent < HFVIS_SSAO_TANGENT_FIXED || o.tangent > HFVIS_SSAO_TANGENT_FIXED_HULL_REAL_EVAL)
         return HFVIS_ERR_INVALID_ARGUMENT;
-    if (o.fixed_sin_t == 0.0) o.fixed_sin_t = SS_DEFAULT_SIN_T;
-    if (!(o.fixed_sin_t >= -1.0 && o.fixed_sin_t <= 1.0)) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (o.sampling == HFVIS_SSAO_SAMPLING_DEFAULT) o.sampling = HFVIS_SSAO_SAMPLING_NEAREST;
-    if (o.sampling != HFVIS_SSAO_SAMPLING_NEAREST && o.sampling != HFVIS_SSAO_SAMPLING_BILINEAR)
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    if (o.plane == HFVIS_SSAO_PLANE_DEFAULT) o.plane = HFVIS_SSAO_PLANE_PAPER;
-    if (o.plane != HFVIS_SSAO_PLANE_PAPER && o.plane != HFVIS_SSAO_PLANE_EXACT)
+    if (ss_resolve_sampling(&o.fixed_sin_t, &o.sampling, &o.plane, HFVIS_SSAO_PLANE_PAPER)
+        != HFVIS_OK)
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (o.pop == HFVIS_LSAO_POP_DEFAULT) o.pop = HFVIS_LSAO_POP_TIES;
     if (o.pop != HFVIS_LSAO_POP_TIES && o.pop != HFVIS_LSAO_POP_STRICT)
@@ -1827,19 +1845,12 @@ hfvis_status hfvis_hbao_options_resolve(const hfvis_hbao_options *in, hfvis_hbao
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (o.step_px == 0.0) o.step_px = 1.0;
     if (!ss_step_ok(o.step_px)) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (o.falloff.kind == HFVIS_FALLOFF_DEFAULT) o.falloff.kind = HFVIS_FALLOFF_NONE;
-    if (hfvis_falloff_check(&o.falloff) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (o.falloff.kind == HFVIS_FALLOFF_HBAO && o.falloff.hbao_c == 0.0) o.falloff.hbao_c = 0.3;
+    if (ss_resolve_falloff(&o.falloff) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     if (o.tangent == HFVIS_SSAO_TANGENT_DEFAULT) o.tangent = HFVIS_SSAO_TANGENT_REAL;
     if (o.tangent != HFVIS_SSAO_TANGENT_REAL && o.tangent != HFVIS_SSAO_TANGENT_FIXED)
         return HFVIS_ERR_INVALID_ARGUMENT;
-    if (o.fixed_sin_t == 0.0) o.fixed_sin_t = SS_DEFAULT_SIN_T;
-    if (!(o.fixed_sin_t >= -1.0 && o.fixed_sin_t <= 1.0)) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (o.sampling == HFVIS_SSAO_SAMPLING_DEFAULT) o.sampling = HFVIS_SSAO_SAMPLING_NEAREST;
-    if (o.sampling != HFVIS_SSAO_SAMPLING_NEAREST && o.sampling != HFVIS_SSAO_SAMPLING_BILINEAR)
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    if (o.plane == HFVIS_SSAO_PLANE_DEFAULT) o.plane = HFVIS_SSAO_PLANE_EXACT;
-    if (o.plane != HFVIS_SSAO_PLANE_PAPER && o.plane != HFVIS_SSAO_PLANE_EXACT)
+    if (ss_resolve_sampling(&o.fixed_sin_t, &o.sampling, &o.plane, HFVIS_SSAO_PLANE_EXACT)
+        != HFVIS_OK)
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (o.jitter == HFVIS_HBAO_JITTER_DEFAULT) o.jitter = HFVIS_HBAO_JITTER_NONE;
     if (o.jitter < HFVIS_HBAO_JITTER_NONE || o.jitter > HFVIS_HBAO_JITTER_ROTATION_STEP)
@@ -2029,9 +2040,7 @@ hfvis_status hfvis_ssao_rt_options_resolve(const hfvis_ssao_rt_options *in,
         o.sampling = o.thickness > 0.0 ? HFVIS_SSAO_SAMPLING_NEAREST : HFVIS_SSAO_SAMPLING_BILINEAR;
     if (o.sampling != HFVIS_SSAO_SAMPLING_NEAREST && o.sampling != HFVIS_SSAO_SAMPLING_BILINEAR)
         return HFVIS_ERR_INVALID_ARGUMENT;
-    if (o.falloff.kind == HFVIS_FALLOFF_DEFAULT) o.falloff.kind = HFVIS_FALLOFF_NONE;
-    if (hfvis_falloff_check(&o.falloff) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (o.falloff.kind == HFVIS_FALLOFF_HBAO && o.falloff.hbao_c == 0.0) o.falloff.hbao_c = 0.3;
+    if (ss_resolve_falloff(&o.falloff) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     *out = o;
     return HFVIS_OK;
 }
