@@ -705,16 +705,10 @@ static int cli_size(const char *f, const char *v, int *width, int *height)
     return 0;
 }
 
-/* -o and the flags of `meshao` (called only for it); -1 if f is none of them. */
+/* The flags of `meshao` (called only for it, before the shared ones, because it gives --method,
+ * --rays, --radius and the camera flags their own meaning); -1 if f is none of them. */
 static int cli_set_lk(cli_args *a, const char *f, const char *v)
 {
-    if (!strcmp(f, "-o")) {
-        if (cli_ends_with(v, ".pfm")) a->out_pgm = 0;
-        else if (cli_ends_with(v, ".pgm")) a->out_pgm = 1;
-        else return cli_error(CLI_EXIT_USAGE, v, "unknown output type (use a .pfm or .pgm name)");
-        a->out = v;
-        return 0;
-    }
     if (!strcmp(f, "--method")) {
         if (!strcmp(v, "raster")) a->lk_method = HFVIS_LK_METHOD_RASTER;
         else if (!strcmp(v, "bvh")) a->lk_method = HFVIS_LK_METHOD_BVH;
