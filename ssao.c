@@ -2531,19 +2531,20 @@ static void ssb_range(double c, double d, double *lo0, double *hi0)
 static double ssb_F(double t, double d) { return 0.5 * t * sin(d) - 0.25 * cos(2.0 * t - d); }
 
 /* Integral of rho(b / sin(c - t)) cos(t - d) sin t over [A, B] (already clipped), by
- * Gauss-Legendre with n nodes (x, w on [-1, 1]). */
+ * Gauss-Legendre with n nodes (x, w on [-1, 1]). One sine and one cosine per node: sin(c - t) and
+ * cos(t - d) come from sin t, cos t by the angle-addition formulas (spec §5.2 L). */
 static double ssb_quad(const ss_fall *f, double A, double B, double b, double c, double d, int n,
                        const double *x, const double *w)
 {
     double m = 0.5 * (A + B), h = 0.5 * (B - A), s = 0.0;
-    int i;
+    double sc = sin(c), cc = cos(c), sd = sin(d), cd = cos(d);
+    int i, flat = f->kind == HFVIS_FALLOFF_NONE || b == 0.0;
     if (!(B > A)) return 0.0;
     for (i = 0; i < n; i++) {
-        double t = m + h * x[i], sn = sin(c - t), dist, r;
-        dist = sn > 0.0 ? b / sn : SS_INF;
-        r = f->kind == HFVIS_FALLOFF_NONE ? 1.0 : (dist < SS_INF ? ss_rho(f, dist) : 0.0);
-        if (f->kind != HFVIS_FALLOFF_NONE && b == 0.0) r = 1.0;
-        s += w[i] * r * cos(t - d) * sin(t);
+        double t = m + h * x[i], st = sin(t), ct = cos(t), sn = sc * ct - cc * st, r;
+        if (flat) r = 1.0;
+        else r = sn > 0.0 ? ss_rho(f, b / sn) : 0.0;
+        s += w[i] * r * (ct * cd + st * sd) * st;
     }
     return s * h;
 }
@@ -2764,12 +2765,47 @@ static double ssb_theta(const ssb_rx *r, double wx, double wy)
     return atan2(wx * r->xx + wy * r->xy, wx * r->ux + wy * r->uy);
 }
 
-/* The slab of point h (spec §5.2 SliceObscurance): adds nothing unless h is visible
- * (a < theta_min, strict); returns the slab's integral and lowers *thmin to a. */
-static double ssb_slab(const ssb_est *e, const ssb_rx *r, double hx, double hy, double *thmin)
+/* The running horizon theta_min of a slice (spec §5.2 [R]: zenith angles, visible iff
+ * a < theta_min) with the L1 pseudo-angle of the same direction (monotone in the angle on
+ * (-pi, pi]; NaN when unknown). The pseudo-angle only rejects points clearly below the horizon
+ * before the atan2; everything within SSB_PSEUDO_MARGIN of it takes the exact test, so the
+ * result is that of the plain atan2 comparison. */
+typedef struct ssb_hz {
+    double th, ps;
+} ssb_hz;
+
+#define SSB_PSEUDO_MARGIN 1e-9 /* >> the few-ulp rounding of both pseudo-angles */
+
+/* Pseudo-angle of atan2(s, c): 1 - c/(|s|+|c|) for s > 0, c/(|s|+|c|) - 1 for s < 0 (so 0 at 0,
+ * +-1 at +-pi/2, +-2 at +-pi); NaN on the axis s = 0, where atan2's sign of zero decides. */
+static double ssb_pseudo(double s, double c)
 {
-    double a = ssb_theta(r, hx - r->px, hy - r->py), b, c, tl, lo, hi, s;
-    if (!(a < *thmin)) return 0.0;
+    double q;
+    if (s > 0.0) q = c / (s + fabs(c));
+    else if (s < 0.0) q = c / (fabs(c) - s);
+    else return SS_NAN;
+    return s > 0.0 ? 1.0 - q : q - 1.0;
+}
+
+static ssb_hz ssb_hz_init(double th)
+{
+    ssb_hz h;
+    h.th = th;
+    if (th == SS_PI) h.ps = 2.0; /* the start of every slice: nothing seen yet */
+    else if (th > -SS_PI && th < SS_PI) h.ps = ssb_pseudo(sin(th), cos(th));
+    else h.ps = th > SS_PI ? SS_INF : SS_NAN;
+    return h;
+}
+
+/* The slab of point h (spec §5.2 SliceObscurance): adds nothing unless h is visible
+ * (a < theta_min, strict); returns the slab's integral and lowers the horizon to a. */
+static double ssb_slab(const ssb_est *e, const ssb_rx *r, double hx, double hy, ssb_hz *hz)
+{
+    double wx = hx - r->px, wy = hy - r->py, sa = wx * r->xx + wy * r->xy, ca = wx * r->ux + wy * r->uy;
+    double ps = ssb_pseudo(sa, ca), a, b, c, tl, lo, hi, s;
+    if (ps > hz->ps + SSB_PSEUDO_MARGIN) return 0.0; /* clearly below the horizon */
+    a = atan2(sa, ca);
+    if (!(a < hz->th)) return 0.0;
     if (r->ortho) {
         b = fabs(hx - r->px);
         c = SS_PI;
@@ -2779,7 +2815,7 @@ static double ssb_slab(const ssb_est *e, const ssb_rx *r, double hx, double hy, 
         c = ssb_theta(r, hx, hy);
         if (c < 0.0) c = -c; /* a point behind the eye's axis of the slice (degenerate) */
     }
-    tl = *thmin;
+    tl = hz->th;
     if (e->thickness > 0.0) { /* [P4] §11: the slab ends thickness below h along its view ray */
         double bx, by, tb;
         if (r->ortho) {
@@ -2793,7 +2829,8 @@ static double ssb_slab(const ssb_est *e, const ssb_rx *r, double hx, double hy, 
         tb = ssb_theta(r, bx - r->px, by - r->py);
         if (tb < tl) tl = tb;
     }
-    *thmin = a;
+    hz->th = a;
+    hz->ps = ps;
     if (e->mode == 2) {
         double dd = r->d;
         s = ssb_lookup(e->table, a, b, c, dd) - (tl < c ? ssb_lookup(e->table, tl, b, c, dd) : 0.0);
@@ -2862,7 +2899,8 @@ hfvis_status hfvis_ffao_slice(const double p[2], const double n[2], const double
     hfvis_ffao_options o;
     ssb_est e;
     ssb_rx r;
-    double th, acc = 0.0;
+    double acc = 0.0;
+    ssb_hz th;
     int i;
     if (hfvis_ffao_options_resolve(opts, &o) != HFVIS_OK || !p || !n || count < 0 ||
         (count > 0 && (!hx || !hy)) || (orthographic != 0 && orthographic != 1) ||
@@ -2874,14 +2912,14 @@ hfvis_status hfvis_ffao_slice(const double p[2], const double n[2], const double
     if (ssb_est_init(&e, &o.falloff, o.estimator, o.table, o.quad_nodes, o.thickness) != HFVIS_OK)
         return HFVIS_ERR_INVALID_ARGUMENT;
     ssb_rx_init(&r, orthographic, p[0], p[1], n[0], n[1]);
-    th = theta_start;
+    th = ssb_hz_init(theta_start);
     for (i = 0; i < count; i++) {
         if (!ss_finite(hx[i]) || !ss_finite(hy[i])) continue;
         if (!orthographic && !(hx[i] * hx[i] + hy[i] * hy[i] > 0.0)) continue;
         acc += ssb_slab(&e, &r, hx[i], hy[i], &th);
     }
     *obscurance = acc;
-    if (theta_min) *theta_min = th;
+    if (theta_min) *theta_min = th.th;
     return HFVIS_OK;
 }
 
@@ -3054,7 +3092,7 @@ static void ssb_scan(const ssb_ctx *x, ssb_dir *dd, double *mem)
 /* Near field (spec §5.8 [R]): direct samples at 1, 2, ... px along +D from the receiver up to
  * (excluding) along-line distance `until`, through the slab estimator. */
 static double ssb_near(const ssb_ctx *x, const ssb_dir *dd, const ssb_rx *r, double cu, double cv,
-                       double zs, double until, double *thmin)
+                       double zs, double until, ssb_hz *thmin)
 {
     const ss_cam *c = &x->c;
     double acc = 0.0, sdist;
@@ -3077,9 +3115,10 @@ static void ssb_pixel_dir(const ssb_ctx *x, const ssb_dir *dd, double cu, double
                           double *near_sum, double *far_sum, double *wsum)
 {
     const ss_cam *c = &x->c;
-    double P[3], yh[3], v[3], zs, t_pix, jx, far0, thn = SS_PI, In = 0.0, wsec = 0.0, Ifar = 0.0;
-    double dphi = 2.0 * SS_PI / ((double)x->o.directions * (double)x->o.segments);
+    double P[3], yh[3], v[3], zs, t_pix, jx, far0, In = 0.0, wsec = 0.0, Ifar = 0.0;
+    double dphi = 2.0 * SS_PI / ((double)x->o.directions * (double)x->o.segments), wseg[64];
     ssb_rx r;
+    ssb_hz thn = ssb_hz_init(SS_PI);
     int S = x->o.segments, g, J0, b0 = x->o.b0;
     ss_unproject(c, cu, cv, z, P);
     ss_plane_yhat(c, dd->e1, P, yh);
@@ -3099,29 +3138,33 @@ static void ssb_pixel_dir(const ssb_ctx *x, const ssb_dir *dd, double cu, double
     J0 = (int)ceil((t_pix + (double)b0) / (double)b0 - 1e-9);
     far0 = (double)J0 * (double)b0;
     if (x->o.near_field == HFVIS_FFAO_NEAR_DIRECT) In = ssb_near(x, dd, &r, cu, cv, zs, far0 - t_pix, &thn);
-    for (g = 0; g < S; g++) wsec += ssb_wedge(dd->eb[g], dd->eb[g + 1], v);
+    for (g = 0; g < S; g++) {
+        wseg[g] = ssb_wedge(dd->eb[g], dd->eb[g + 1], v);
+        wsec += wseg[g];
+    }
     *wsum = wsec;
     *near_sum = want_near ? wsec * In : 0.0;
     *far_sum = 0.0;
     if (!want_far) return;
     for (g = 0; g < S; g++) {
-        double wg = ssb_wedge(dd->eb[g], dd->eb[g + 1], v), th = thn, Ig = 0.0;
+        double wg = wseg[g], Ig = 0.0;
+        ssb_hz th = thn;
         double alo = -SS_PI / (double)x->o.directions + dphi * (double)g + jit * 0.5 * dphi;
         double ahi = alo + dphi, tlo = tan(alo), thi = tan(ahi), amid = tan(0.5 * (alo + ahi));
-        long long cur = (long long)J0 * b0;
-        while (cur <= dd->smax) {
+        long long q = J0; /* the far field starts at step q * b0, a multiple of b0 */
+        while (q * b0 <= dd->smax) {
             int n = dd->nlev - 1, J, lA, lB;
             long long bn;
             double rr, olo, ohi, cnt, m0, m1, hx, hy;
             const double *row;
             size_t nl1 = (size_t)dd->lat.line_count + 1;
-            for (; n > 0; n--) {
-                bn = (long long)b0 << n;
-                if (cur % bn == 0 && (double)bn <= x->o.level_gamma * ((double)cur - t_pix)) break;
-            }
+            for (; n > 0; n--) /* the coarsest level whose block starts here and is near enough */
+                if ((q & ((1LL << n) - 1)) == 0 &&
+                    (double)((long long)b0 << n) <= x->o.level_gamma * ((double)(q * b0) - t_pix))
+                    break;
             bn = (long long)b0 << n;
-            J = (int)(cur / bn);
-            cur += bn;
+            J = (int)(q >> n);
+            q += 1LL << n;
             if (J >= dd->nj[n]) break;
             rr = ((double)J + 0.5) * (double)bn - t_pix;
             if (x->o.averaging == HFVIS_FFAO_AVERAGE_ON) {
@@ -3528,7 +3571,8 @@ hfvis_status hfvis_ssao_mipmap(const hfvis_camera *cam, const float *depth, cons
             else v[0] = v[1] = 0.0, v[2] = 1.0;
             for (k = 0; k < K; k++) {
                 double phi = x.o.azimuth0_rad + 2.0 * SS_PI * (double)k / (double)K;
-                double D[2], e1[3], ea[3], eb[3], yh[3], zs, th = SS_PI, I = 0.0, dist, step, tmax;
+                double D[2], e1[3], ea[3], eb[3], yh[3], zs, I = 0.0, dist, step, tmax;
+                ssb_hz th = ssb_hz_init(SS_PI);
                 double cu = (double)tx + 0.5, cv = (double)ty + 0.5, t1;
                 ssb_rx r;
                 int last = 0;

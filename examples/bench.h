@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include "hfvis.h"
+
 /* Seconds on the monotonic clock (the including file defines _POSIX_C_SOURCE first). */
 static inline double bench_now(void)
 {
@@ -47,6 +49,9 @@ void bench_gi2(int quick);
 void bench_cons(int quick);
 void bench_ssao(int quick);
 void bench_ssaob(int quick);
+/* bench_ssao.c: the knot-on-ground scene (100k triangles) rendered into W0 x H0 linear depth, the
+ * camera with guard band (gx, gy); 0 on failure. */
+int bench_ssao_scene(int W0, int H0, int gx, int gy, float *depth, hfvis_camera *cam);
 void bench_volgi(int quick);
 void bench_vf(int quick);
 void bench_lk(int quick);

@@ -19,7 +19,7 @@
 #include <time.h>
 
 /* Render the knot-on-ground scene into W0 x H0 linear depth; camera with guard (gx, gy). */
-static int bench_ssao_scene(int W0, int H0, int gx, int gy, float *depth, hfvis_camera *cam)
+int bench_ssao_scene(int W0, int H0, int gx, int gy, float *depth, hfvis_camera *cam)
 {
     hfvis_mesh knot, ground, m;
     hfvis_view view;
