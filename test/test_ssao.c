@@ -1823,10 +1823,65 @@ TEST(lsao_vs_hbao_scenes)
     }
 }
 
+/* [P4] §8 on the rendered scenes (knot on ground, room, oblique terrain): FFAO 8x2 against the
+ * screen-space ray-traced reference "within a few percent", and closer to it than the mipmap
+ * baseline at the same sample count (P4: an order of magnitude; measured 1.5-2.7x in e_A here and
+ * 2.3-3.3x in the bench). The reference is noisy, so it is run twice with independent seeds: e_A is taken
+ * against the mean of the two, and the RMS error is corrected for the reference's variance. */
+#define FFAO_SCENE_EA_TOL 0.05 /* "within a few percent": measured 0.010 (terrain), 0.015 (knot),
+                                 0.039 (room: corners at 96x72 pixels) */
+#define FFAO_SCENE_RAYS 192
+TEST(ffao_vs_raytrace_scenes)
+{
+    enum { W0 = 112, H0 = 84, GX = 8, GY = 6, IW = W0 - 2 * GX, IH = H0 - 2 * GY };
+    static float depth[W0 * H0], nrm[3 * W0 * H0], r1[IW * IH], r2[IW * IH], rm[IW * IH], a[IW * IH];
+    int sc, i;
+    for (sc = 0; sc < 3; sc++) {
+        hfvis_camera cam;
+        hfvis_ffao_options fo = hfvis_ffao_options_default();
+        hfvis_ssao_rt_options ro = hfvis_ssao_rt_options_default();
+        hfvis_ssao_error_stats ef, em;
+        double noise = 0.0, rms[2] = {0.0, 0.0};
+        int m;
+        CHECK(render_scene(sc, W0, H0, GX, GY, depth, nrm, &cam));
+        fo.falloff.kind = HFVIS_FALLOFF_INV_QUADRATIC;
+        fo.falloff.param = sc == 2 ? 10.0 : (sc == 1 ? 0.3 : 1.0); /* about a tenth of the scene */
+        ro.falloff = fo.falloff;
+        ro.rays = FFAO_SCENE_RAYS;
+        ro.seed = 1;
+        CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, nrm, &ro, r1, IW), HFVIS_OK);
+        ro.seed = 2;
+        CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, nrm, &ro, r2, IW), HFVIS_OK);
+        for (i = 0; i < IW * IH; i++) {
+            double d = (double)r1[i] - (double)r2[i];
+            rm[i] = 0.5f * (r1[i] + r2[i]);
+            noise += d * d;
+        }
+        for (m = 0; m < 2; m++) {
+            if (m == 0) CHECK_EQ_STATUS(hfvis_ffao(&cam, depth, nrm, &fo, a, IW), HFVIS_OK);
+            else CHECK_EQ_STATUS(hfvis_ssao_mipmap(&cam, depth, nrm, &fo, a, IW), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_ssao_error(a, IW, rm, IW, IW, IH, 0.05, 0, m ? &em : &ef, NULL, 0), HFVIS_OK);
+            for (i = 0; i < IW * IH; i++) {
+                double d = (double)a[i] - (double)r1[i];
+                rms[m] += d * d;
+            }
+            rms[m] = (rms[m] - 0.5 * noise) / (IW * IH);
+            rms[m] = rms[m] > 0.0 ? sqrt(rms[m]) : 0.0;
+        }
+        printf("  scene %d: FFAO 8x2 e_A %.4f e_<5%% %.3f RMS %.4f | mipmap K=16 e_A %.4f e_<5%% %.3f RMS %.4f "
+               "| reference noise %.4f\n", sc, ef.mean, ef.within, rms[0], em.mean, em.within, rms[1],
+               sqrt(noise / (IW * IH)) / 2.0);
+        CHECK(ef.mean <= FFAO_SCENE_EA_TOL);
+        CHECK(ef.mean < em.mean);
+        CHECK(rms[0] < rms[1]);
+    }
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
     RUN(camera_check);
+    RUN(ffao_vs_raytrace_scenes);
     RUN(camera_project_roundtrip);
     RUN(camera_from_view);
     RUN(depth_linearize);
