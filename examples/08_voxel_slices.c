@@ -32,7 +32,7 @@ static hfvis_status save_slices(const char *dir, const char *name, const unsigne
                     x == 0 && s > 0 ? 0.25f : (float)occ[lin];
             }
     }
-    st = ex_save_pgm(dir, name, img, w, h, w, 0.0f, 1.0f);
+    st = ex_save_pgm_png(dir, name, img, w, h, w, 0.0f, 1.0f);
     free(img);
     return st;
 }
