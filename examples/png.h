@@ -263,8 +263,9 @@ static inline hfvis_status ex_png_save(const char *path, const float *pixels, in
     hfvis_status s = ex_png_layout(width, height, channels, depth, &row, NULL, &total);
     int y;
     if (s != HFVIS_OK) return s;
+    /* the last row starts (height - 1) stride channels floats in: that must be addressable */
     if (!path || !pixels || stride < width || !isfinite(lo) || !isfinite(hi) || !(lo < hi) ||
-        (size_t)stride > (SIZE_MAX / (size_t)channels) / (size_t)height)
+        (size_t)stride > ((size_t)PTRDIFF_MAX / (size_t)channels) / (size_t)height)
         return HFVIS_ERR_INVALID_ARGUMENT;
     samples = (unsigned char *)malloc(row * (size_t)height);
     file = (unsigned char *)malloc(total);
