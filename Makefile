@@ -118,3 +118,12 @@ install: $(LIB)
 
 clean:
 	rm -rf build out
+
+# make gallery: the release examples, then docs/gallery/*.png (README's Gallery) picked from the
+# PNGs they write (examples/gallery.sh). The PNG writer is examples/png.h, included by common.h.
+.PHONY: gallery
+gallery:
+	@$(MAKE) --no-print-directory config=release all
+	@sh examples/gallery.sh build docs/gallery
+$(EXAMPLES) $(CLI) $(BENCH): examples/png.h
+$(BUILD)/test/test_png: examples/png.h examples/common.h

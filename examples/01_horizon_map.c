@@ -36,7 +36,7 @@ int main(int argc, char **argv)
      * border (nothing outside the grid), psi_0 = 0. */
     EX_CHECK(hfvis_horizon_map(&grid, K, NULL, map), "hfvis_horizon_map");
     for (k = 0; k < K; k += 2)  /* east, south, west, north; 0 and 45 degrees map to black, white */
-        if (ex_save_pgm(dir, names[k / 2], map + (size_t)k * W * H, W, H, W, 0.0f, (float)(PI / 4.0)))
+        if (ex_save_pgm_png(dir, names[k / 2], map + (size_t)k * W * H, W, H, W, 0.0f, (float)(PI / 4.0)))
             goto fail;
 
     /* Hillshade: Lambert max(n.l, 0), and black where the horizon toward the sun is higher than
@@ -49,7 +49,11 @@ int main(int argc, char **argv)
         shadowed += !lit;
     }
     printf("01_horizon_map: %.1f%% of the terrain is in cast shadow\n", 100.0 * (double)shadowed / (W * H));
-    if (ex_save_pgm(dir, "01_hillshade.pgm", shade, W, H, W, 0.0f, 1.0f)) goto fail;
+    if (ex_save_pgm_png(dir, "01_hillshade.pgm", shade, W, H, W, 0.0f, 1.0f)) goto fail;
+    {   /* picture: the horizon toward the sun (0 to 45 deg) beside the hillshade read from it */
+        const ex_panel sheet[2] = { { map + (size_t)sun_k * W * H, 0.0f, (float)(PI / 4.0) }, { shade, 0.0f, 1.0f } };
+        if (ex_save_png_sheet(dir, "01_horizon_sheet.png", sheet, 2, 2, W, H, 1)) goto fail;
+    }
     rc = 0;
 fail:
     free(z); free(map); free(n); free(shade);

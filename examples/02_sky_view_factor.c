@@ -47,8 +47,12 @@ int main(int argc, char **argv)
            mean(sky, (size_t)W * H), mean(svf, (size_t)W * H));
 
     /* Both lie in [0, 1], and mostly above 0.5 on this terrain: stretch [0.5, 1] to grey. */
-    if (ex_save_pgm(dir, "02_sky_light.pgm", sky, W, H, W, 0.5f, 1.0f)) goto fail;
-    if (ex_save_pgm(dir, "02_sky_view_factor.pgm", svf, W, H, W, 0.5f, 1.0f)) goto fail;
+    if (ex_save_pgm_png(dir, "02_sky_light.pgm", sky, W, H, W, 0.5f, 1.0f)) goto fail;
+    if (ex_save_pgm_png(dir, "02_sky_view_factor.pgm", svf, W, H, W, 0.5f, 1.0f)) goto fail;
+    {   /* picture: both side by side */
+        const ex_panel sheet[2] = { { sky, 0.5f, 1.0f }, { svf, 0.5f, 1.0f } };
+        if (ex_save_png_sheet(dir, "02_sky_sheet.png", sheet, 2, 2, W, H, 1)) goto fail;
+    }
     rc = 0;
 fail:
     free(z); free(sky); free(svf);

@@ -72,7 +72,9 @@ int main(int argc, char **argv)
         if (isfinite(y) && fabs(y - y_lp) > diff) diff = fabs(y - y_lp);
     }
     printf("03_environment_light: largest luminance %.4f, prefix vs L_p table differ by <= %.4f\n", top, diff);
-    if (ex_save_pgm(dir, "03_environment_light.pgm", lum, W, H, W, 0.0f, (float)top)) goto fail;
+    if (ex_save_pgm_png(dir, "03_environment_light.pgm", lum, W, H, W, 0.0f, (float)top)) goto fail;
+    /* picture: the RGB radiance on the same scale */
+    if (ex_save_png_rgb(dir, "03_environment_light_rgb.png", rgb, W, H, W, 0.0f, (float)top)) goto fail;
     rc = 0;
 fail:
     free(z); free(rgb); free(rgb_lp); free(lum); free(radiance);

@@ -16,7 +16,8 @@ int main(int argc, char **argv)
                                   .octaves = 6, .seed = 2010 };
     const double sun_radius = 0.27 * PI / 180.0; /* the real sun: soft shadow edges */
     float *z = malloc(sizeof(float) * W * H), *n = malloc(sizeof(float) * 3 * W * H);
-    float *vis = malloc(sizeof(float) * W * H), *shade = malloc(sizeof(float) * W * H);
+    ex_panel sheet[STEPS];
+    float *vis = malloc(sizeof(float) * W * H), *shade = malloc(sizeof(float) * STEPS * W * H);
     hfvis_grid grid;
     size_t i;
     int step, rc = 1;
@@ -35,20 +36,24 @@ int main(int argc, char **argv)
         double l[3] = { cos(elev) * cos(psi), cos(elev) * sin(psi), sin(elev) };
         double lit = 0.0;
         char name[64];
+        float *img = shade + (size_t)step * W * H;
 
         /* Visible fraction of the sun disc from one exact sweep toward the sun; the receiver's
          * own tangent plane is not included, so multiply by max(n.l, 0) for the light. */
         EX_CHECK(hfvis_sun_visibility(&grid, psi, elev, sun_radius, NULL, vis, W), "hfvis_sun_visibility");
         for (i = 0; i < (size_t)W * H; i++) {
             double ndotl = (double)n[3 * i] * l[0] + (double)n[3 * i + 1] * l[1] + (double)n[3 * i + 2] * l[2];
-            shade[i] = (float)((double)vis[i] * (ndotl > 0.0 ? ndotl : 0.0));
+            img[i] = (float)((double)vis[i] * (ndotl > 0.0 ? ndotl : 0.0));
             lit += (double)vis[i];
         }
         printf("04_sun_shadows: bearing %5.1f deg, elevation %4.1f deg: %5.1f%% of the sun visible\n",
                bearing * 180.0 / PI, elev * 180.0 / PI, 100.0 * lit / (W * H));
         snprintf(name, sizeof name, "04_sun_%d.pgm", step);
-        if (ex_save_pgm(dir, name, shade, W, H, W, 0.0f, 1.0f)) goto fail;
+        if (ex_save_pgm_png(dir, name, img, W, H, W, 0.0f, 1.0f)) goto fail;
+        sheet[step].pixels = img, sheet[step].lo = 0.0f, sheet[step].hi = 1.0f;
     }
+    /* picture: the day in two rows, morning top left */
+    if (ex_save_png_sheet(dir, "04_sun_sheet.png", sheet, STEPS, 3, W, H, 1)) goto fail;
     rc = 0;
 fail:
     free(z); free(n); free(vis); free(shade);

@@ -59,9 +59,13 @@ int main(int argc, char **argv)
            "other terrain (largest indirect %.4f, largest total %.4f)\n",
            BOUNCES, (double)ALBEDO, 100.0 * fraction / (double)counted, dtop, top);
     /* One range for both light images, so that they compare; the difference has its own. */
-    if (ex_save_pgm(dir, "05_direct.pgm", l0, W, H, W, 0.0f, (float)top)) goto fail;
-    if (ex_save_pgm(dir, "05_bounces.pgm", lb, W, H, W, 0.0f, (float)top)) goto fail;
-    if (ex_save_pgm(dir, "05_indirect.pgm", diff, W, H, W, 0.0f, (float)dtop)) goto fail;
+    if (ex_save_pgm_png(dir, "05_direct.pgm", l0, W, H, W, 0.0f, (float)top)) goto fail;
+    if (ex_save_pgm_png(dir, "05_bounces.pgm", lb, W, H, W, 0.0f, (float)top)) goto fail;
+    if (ex_save_pgm_png(dir, "05_indirect.pgm", diff, W, H, W, 0.0f, (float)dtop)) goto fail;
+    {   /* picture: direct | after two bounces | the bounced light alone (own scale) */
+        const ex_panel sheet[3] = { { l0, 0.0f, (float)top }, { lb, 0.0f, (float)top }, { diff, 0.0f, (float)dtop } };
+        if (ex_save_png_sheet(dir, "05_sheet.png", sheet, 3, 3, W, H, 1)) goto fail;
+    }
     rc = 0;
 fail:
     free(z); free(direct); free(l0); free(lb); free(diff);

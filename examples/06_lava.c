@@ -77,13 +77,15 @@ int main(int argc, char **argv)
         if (isfinite(lum[i]) && (double)lum[i] > top) top = (double)lum[i];
     }
     /* Range: half the brightest glow, so that its spread up the walls shows. */
-    if (ex_save_pgm(dir, "06_lava_glow.pgm", lum, W, H, W, 0.0f, (float)(0.5 * top))) goto fail;
+    if (ex_save_pgm_png(dir, "06_lava_glow.pgm", lum, W, H, W, 0.0f, (float)(0.5 * top))) goto fail;
     for (i = 0; i < (size_t)W * H; i++) {
         const float *p = lit + i * C;
         lum[i] = (float)(0.2126 * (double)p[0] + 0.7152 * (double)p[1] + 0.0722 * (double)p[2]);
     }
     /* Range: the same, so that the lava saturates and the lit walls show. */
-    if (ex_save_pgm(dir, "06_lava_scene.pgm", lum, W, H, W, 0.0f, (float)(0.5 * top))) goto fail;
+    if (ex_save_pgm_png(dir, "06_lava_scene.pgm", lum, W, H, W, 0.0f, (float)(0.5 * top))) goto fail;
+    /* picture: the scene in colour on the same scale */
+    if (ex_save_png_rgb(dir, "06_lava_scene_rgb.png", lit, W, H, W, 0.0f, (float)(0.5 * top))) goto fail;
     rc = 0;
 fail:
     free(z); free(fbm); free(emit); free(direct); free(glow); free(lit); free(lum);

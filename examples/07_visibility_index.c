@@ -46,7 +46,7 @@ int main(int argc, char **argv)
            st.visible / st.receivers, ns.iterations / ns.receivers, 100.0 * st.visible / ns.iterations,
            st.horizons / st.receivers, st.iterations / st.receivers,
            100.0 * st.iterations / ns.iterations);
-    if (ex_save_pgm(dir, "07_visibility_index.pgm", count, W, H, W, 0.0f, (float)top)) goto fail;
+    if (ex_save_pgm_png(dir, "07_visibility_index.pgm", count, W, H, W, 0.0f, (float)top)) goto fail;
     rc = 0;
 fail:
     free(z); free(count); free(naive);

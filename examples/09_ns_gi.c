@@ -68,10 +68,10 @@ int main(int argc, char **argv)
             const float *src = panel == 0 ? direct : panel == 1 ? one : three;
             panels[(size_t)y * PW + (size_t)x] = px < W ? src[(size_t)y * W + (size_t)px] : (float)top;
         }
-    if (ex_save_pgm(dir, "gi_direct.pgm", direct, W, H, W, 0.0f, (float)top)) goto fail;
-    if (ex_save_pgm(dir, "gi_1bounce.pgm", one, W, H, W, 0.0f, (float)top)) goto fail;
-    if (ex_save_pgm(dir, "gi_3bounces.pgm", three, W, H, W, 0.0f, (float)top)) goto fail;
-    if (ex_save_pgm(dir, "gi_side_by_side.pgm", panels, PW, H, PW, 0.0f, (float)top)) goto fail;
+    if (ex_save_pgm_png(dir, "gi_direct.pgm", direct, W, H, W, 0.0f, (float)top)) goto fail;
+    if (ex_save_pgm_png(dir, "gi_1bounce.pgm", one, W, H, W, 0.0f, (float)top)) goto fail;
+    if (ex_save_pgm_png(dir, "gi_3bounces.pgm", three, W, H, W, 0.0f, (float)top)) goto fail;
+    if (ex_save_pgm_png(dir, "gi_side_by_side.pgm", panels, PW, H, PW, 0.0f, (float)top)) goto fail;
     rc = 0;
 fail:
     free(z); free(direct); free(bounce); free(one); free(three); free(panels);

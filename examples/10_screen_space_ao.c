@@ -5,13 +5,14 @@
  *   ssao_ao.pgm      the four AO images side by side (LSAO | HBAO | FFAO | ray traced),
  *                    white = open (ambient light 1 - AO)
  *   ssao_error.pgm   |method - ray traced| for LSAO | HBAO | FFAO, white = 0, black >= 20 %
+ *   the same as PNG, and ssao_sheet.png with both, the errors under their methods
  * and prints e_A and e_<5% of each against the reference. LSAO and HBAO estimate solid-angle
  * obscurance (spec §1.2), so their error against the cosine-weighted reference is expected to be
  * larger: the comparison that P4 makes is FFAO's. Runs in a few seconds. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "hfvis.h"
+#include "common.h"
 
 #define W0 256
 #define H0 192
@@ -47,7 +48,7 @@ int main(int argc, char **argv)
     idx = (uint32_t *)malloc(sizeof(uint32_t) * 3 * (knot.triangle_count + slab.triangle_count));
     depth = (float *)malloc(sizeof(float) * W0 * H0);
     nrm = (float *)malloc(sizeof(float) * 3 * W0 * H0);
-    sheet = (float *)malloc(sizeof(float) * 4 * IW * IH);
+    sheet = (float *)malloc(sizeof(float) * 8 * IW * IH); /* AO sheet above, error sheet below */
     err = (float *)malloc(sizeof(float) * IW * IH);
     for (k = 0; k < 4; k++) ao[k] = (float *)malloc(sizeof(float) * IW * IH);
     if (!xyz || !idx || !depth || !nrm || !sheet || !err || !ao[0] || !ao[1] || !ao[2] || !ao[3]) goto fail;
@@ -96,16 +97,21 @@ int main(int argc, char **argv)
             for (x = 0; x < IW; x++) sheet[(size_t)y * 4 * IW + (size_t)k * IW + (size_t)x] = 1.0f - ao[k][y * IW + x];
     snprintf(path, sizeof path, "%s/ssao_ao.pgm", dir);
     if (hfvis_pgm_save(path, sheet, 4 * IW, IH, 4 * IW, 0.0f, 1.0f, 255) != HFVIS_OK) { fprintf(stderr, "ex_ssaob: cannot write %s\n", path); goto fail; }
+    if (ex_save_png(dir, "ssao_ao.png", sheet, 4 * IW, IH, 4 * IW, 0.0f, 1.0f)) goto fail;
+    for (i = (size_t)4 * IW * IH; i < (size_t)8 * IW * IH; i++) sheet[i] = 1.0f; /* under the reference: white */
     for (k = 0; k < 3; k++) {
         hfvis_ssao_error_stats e;
         if (hfvis_ssao_error(ao[k], IW, ao[3], IW, IW, IH, 0.05, 0, &e, err, IW) != HFVIS_OK) goto fail;
         printf("%-5s vs %s: e_A %.2f %%, e_<5%% %.1f %% of pixels, bias %+.2f %%\n", names[k], names[3],
                100.0 * e.mean, 100.0 * e.within, 100.0 * e.bias);
         for (y = 0; y < IH; y++)
-            for (x = 0; x < IW; x++) sheet[(size_t)y * 3 * IW + (size_t)k * IW + (size_t)x] = err[y * IW + x];
+            for (x = 0; x < IW; x++) sheet[(size_t)(IH + y) * 4 * IW + (size_t)k * IW + (size_t)x] = err[y * IW + x];
     }
     snprintf(path, sizeof path, "%s/ssao_error.pgm", dir);
-    if (hfvis_pgm_save(path, sheet, 3 * IW, IH, 3 * IW, 0.0f, 1.0f, 255) != HFVIS_OK) goto fail;
+    if (hfvis_pgm_save(path, sheet + 4 * IW * IH, 3 * IW, IH, 4 * IW, 0.0f, 1.0f, 255) != HFVIS_OK) goto fail;
+    if (ex_save_png(dir, "ssao_error.png", sheet + 4 * IW * IH, 3 * IW, IH, 4 * IW, 0.0f, 1.0f)) goto fail;
+    /* picture: the AO images above, the error of LSAO, HBAO and FFAO below */
+    if (ex_save_png(dir, "ssao_sheet.png", sheet, 4 * IW, 2 * IH, 4 * IW, 0.0f, 1.0f)) goto fail;
     printf("wrote %s/ssao_ao.pgm and %s/ssao_error.pgm\n", dir, dir);
     rc = 0;
 fail:

@@ -105,15 +105,20 @@ int main(int argc, char **argv)
      * percentiles). Each PGM holds the R, G and B channels side by side. */
     top = top_of(total, n, pan);
     panels(direct, pan);
-    if (ex_save_pgm(dir, "volgi_direct.pgm", pan, 3 * W, H, 3 * W, 0.0f, top)) goto fail;
+    if (ex_save_pgm_png(dir, "volgi_direct.pgm", pan, 3 * W, H, 3 * W, 0.0f, top)) goto fail;
     panels(total, pan);
-    if (ex_save_pgm(dir, "volgi_total.pgm", pan, 3 * W, H, 3 * W, 0.0f, top)) goto fail;
+    if (ex_save_pgm_png(dir, "volgi_total.pgm", pan, 3 * W, H, 3 * W, 0.0f, top)) goto fail;
     itop = top_of(indirect, n, pan);
     panels(indirect, pan);
-    if (ex_save_pgm(dir, "volgi_indirect.pgm", pan, 3 * W, H, 3 * W, 0.0f, itop)) goto fail;
+    if (ex_save_pgm_png(dir, "volgi_indirect.pgm", pan, 3 * W, H, 3 * W, 0.0f, itop)) goto fail;
     itop = top_of(indirect_void, n, pan);
     panels(indirect_void, pan);
-    if (ex_save_pgm(dir, "volgi_indirect_void.pgm", pan, 3 * W, H, 3 * W, 0.0f, itop)) goto fail;
+    if (ex_save_pgm_png(dir, "volgi_indirect_void.pgm", pan, 3 * W, H, 3 * W, 0.0f, itop)) goto fail;
+    {   /* picture in colour: direct | indirect (own scale) | total */
+        const ex_panel sheet[3] = { { direct, 0.0f, top }, { indirect, 0.0f, top_of(indirect, n, pan) },
+                                    { total, 0.0f, top } };
+        if (ex_save_png_sheet(dir, "volgi_sheet.png", sheet, 3, 3, W, H, 3)) goto fail;
+    }
     rc = 0;
 fail:
     free(direct), free(indirect), free(total), free(indirect_void), free(pan);

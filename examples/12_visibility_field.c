@@ -79,9 +79,13 @@ int main(int argc, char **argv)
            hfvis_visfield_position_count(POS_N), DIRS, DIRS, field.maps_size, teapot.triangle_count,
            W, W, 255.0 * sqrt(rms / (double)n), worst);
     /* Obscurance: 0 (black) = open sky, 1 = fully blocked; the difference is shown x 4. */
-    if (ex_save_pgm(dir, "12_visibility_field_ao_field.pgm", ao, W, W, W, 0.0f, 1.0f)) goto fail;
-    if (ex_save_pgm(dir, "12_visibility_field_ao_raycast.pgm", ref, W, W, W, 0.0f, 1.0f)) goto fail;
-    if (ex_save_pgm(dir, "12_visibility_field_ao_difference.pgm", diff, W, W, W, 0.0f, 0.25f)) goto fail;
+    if (ex_save_pgm_png(dir, "12_visibility_field_ao_field.pgm", ao, W, W, W, 0.0f, 1.0f)) goto fail;
+    if (ex_save_pgm_png(dir, "12_visibility_field_ao_raycast.pgm", ref, W, W, W, 0.0f, 1.0f)) goto fail;
+    if (ex_save_pgm_png(dir, "12_visibility_field_ao_difference.pgm", diff, W, W, W, 0.0f, 0.25f)) goto fail;
+    {   /* picture: field | ray casting | difference x 4 */
+        const ex_panel sheet[3] = { { ao, 0.0f, 1.0f }, { ref, 0.0f, 1.0f }, { diff, 0.0f, 0.25f } };
+        if (ex_save_png_sheet(dir, "12_visibility_field_sheet.png", sheet, 3, 3, W, W, 1)) goto fail;
+    }
     rc = 0;
 fail:
     free(field.maps);

@@ -96,13 +96,13 @@ int main(int argc, char **argv)
                (unsigned long long)(m == 2 ? st.fragments : st.masks),
                m == 2 ? "ray-triangle tests" : "triangle masks", (double)(clock() - t0) / CLOCKS_PER_SEC);
         snprintf(name, sizeof name, "lk_ao_%s.pgm", names[m]);
-        if (ex_save_pgm(dir, name, ao[m], W, H, W, 0.0f, 1.0f)) goto fail;
+        if (ex_save_pgm_png(dir, name, ao[m], W, H, W, 0.0f, 1.0f)) goto fail;
     }
     /* Exact masks: the methods agree bit for bit, so the difference images are black */
     worst = diff_image(ao[0], ao[1], diff);
-    if (ex_save_pgm(dir, "lk_diff_raster_bvh.pgm", diff, W, H, W, 0.0f, 0.05f)) goto fail;
+    if (ex_save_pgm_png(dir, "lk_diff_raster_bvh.pgm", diff, W, H, W, 0.0f, 0.05f)) goto fail;
     worst2 = diff_image(ao[2], ao[1], diff);
-    if (ex_save_pgm(dir, "lk_diff_raycast_bvh.pgm", diff, W, H, W, 0.0f, 0.05f)) goto fail;
+    if (ex_save_pgm_png(dir, "lk_diff_raycast_bvh.pgm", diff, W, H, W, 0.0f, 0.05f)) goto fail;
     printf("13_mesh_ao: max |raster - bvh| = %g, max |raycast - bvh| = %g\n", worst, worst2);
     if (worst != 0.0 || worst2 != 0.0) { ex_error("13_mesh_ao", "the methods disagree"); goto fail; }
 
@@ -115,7 +115,12 @@ int main(int argc, char **argv)
     worst = diff_image(ao[3], ao[1], diff);
     printf("13_mesh_ao: table (%.0f MiB) vs exact masks: max difference %g (%.0f of %d rays)\n",
            (double)lut.bytes / 1048576.0, worst, worst * N, N);
-    if (ex_save_pgm(dir, "lk_diff_lut_exact.pgm", diff, W, H, W, 0.0f, 0.05f)) goto fail;
+    if (ex_save_pgm_png(dir, "lk_diff_lut_exact.pgm", diff, W, H, W, 0.0f, 0.05f)) goto fail;
+    {   /* picture: ray casting | BVH masks | table masks | |table - exact| x 20 */
+        const ex_panel sheet[4] = { { ao[2], 0.0f, 1.0f }, { ao[1], 0.0f, 1.0f }, { ao[3], 0.0f, 1.0f },
+                                    { diff, 0.0f, 0.05f } };
+        if (ex_save_png_sheet(dir, "lk_sheet.png", sheet, 4, 4, W, H, 1)) goto fail;
+    }
     rc = 0;
 fail:
     hfvis_lk_lut_free(NULL, &lut);

@@ -20,6 +20,15 @@ for e in "$build"/examples/*; do
   if "$e" "$scratch" > "$scratch/log" 2>&1; then passed=$((passed + 1)); echo "ok   example $(basename "$e")"
   else failed=$((failed + 1)); cat "$scratch/log"; echo "FAIL example $(basename "$e")"; fi
 done
+# The examples' PNGs through a real decoder, and a copy with its zlib header byte (offset 41)
+# overwritten that must be rejected; SKIP (exit 77) without python3 and ImageMagick.
+sh test/png_check.sh "$scratch" > "$scratch/log" 2>&1; rc=$?
+if [ "$rc" -eq 77 ]; then cat "$scratch/log"
+elif [ "$rc" -eq 0 ] && mkdir -p "$scratch/bad" && cp "$(ls "$scratch"/*.png | head -n 1)" "$scratch/bad/x.png" &&
+     printf X | dd of="$scratch/bad/x.png" bs=1 seek=41 conv=notrunc 2>/dev/null &&
+     ! sh test/png_check.sh "$scratch/bad" > /dev/null 2>&1; then
+  passed=$((passed + 1)); echo "ok   png check: $(tail -n 1 "$scratch/log" | sed "s/^png_check: //"), a corrupted copy rejected"
+else failed=$((failed + 1)); cat "$scratch/log"; echo "FAIL png check"; fi
 if [ -f test/cli_test.sh ] && [ -x "$build/hfvis" ]; then
   if sh test/cli_test.sh "$build/hfvis" "$scratch" > "$scratch/log" 2>&1; then passed=$((passed + 1)); echo "ok   cli"
   else failed=$((failed + 1)); cat "$scratch/log"; echo "FAIL cli"; fi
