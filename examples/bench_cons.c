@@ -2,7 +2,9 @@
  * (hfvis_voxelize_conservative_reference), solid (parity) and bitmask, on the issue's
  * 100k-triangle torus knot at 128^3, 256^3, 512^3 and on a large-triangle mesh (icosphere, 2
  * subdivisions, 320 triangles) at 256^3. Grids: hfvis_volume_grid_fit(mesh, N, 0.01, cubic = 0).
- * Times are the best of a few runs (CLOCK_MONOTONIC); the baseline runs once at 512^3. */
+ * At 256^3 also the knot in an 8x grid volume and the floors of issue 4's 20x target
+ * (bench_cons_floors). Times are the best of a few runs (CLOCK_MONOTONIC); the baseline runs
+ * once at 512^3. */
 #define _POSIX_C_SOURCE 199309L
 #include "bench.h"
 #include "hfvis.h"
@@ -188,8 +190,8 @@ static void bench_cons_row(const char *what, int res, double secs, size_t tris, 
     printf("\n");
 }
 
-/* One mesh at one resolution: conservative fast and baseline (and, with floors, the floors of
- * bench_cons_floors), solid, bitmask. */
+/* One mesh at one resolution: conservative fast and baseline (and, with floors, the same mesh
+ * in an 8x grid volume and the floors of bench_cons_floors), solid, bitmask. */
 static void bench_cons_case(const char *name, const hfvis_mesh *m, int res, int quick, int floors)
 {
     hfvis_volume_grid g;
@@ -217,7 +219,27 @@ static void bench_cons_case(const char *name, const hfvis_mesh *m, int res, int 
            nf, (nf == nr && memcmp(a, b, nv) == 0) ? "==" : "!=");
     bench_cons_row("conservative (fast)", res, tf, m->triangle_count, nf, tr);
     bench_cons_row("conservative baseline (SAT)", res, tr, m->triangle_count, nr, 0.0);
-    if (floors) bench_cons_floors(m, &g, tr);
+    if (floors) {
+        /* the same voxels in a grid 2x larger per axis (8x the volume), mesh in its middle:
+         * cost should follow the voxels written, not the grid */
+        hfvis_volume_grid g8 = g;
+        size_t nv8, n8 = 0;
+        uint8_t *c8;
+        int ax;
+        for (ax = 0; ax < 3; ax++) {
+            g8.origin[ax] -= (double)(g.dims[ax] / 2) * g.cell[ax]; /* whole cells */
+            g8.dims[ax] *= 2;
+        }
+        nv8 = (size_t)g8.dims[0] * (size_t)g8.dims[1] * (size_t)g8.dims[2];
+        c8 = (uint8_t *)malloc(nv8);
+        if (c8) {
+            double t8 = bench_cons_time(hfvis_voxelize_conservative, m, &g8, c8, &n8, reps);
+            printf("  same knot in an 8x grid volume (%d x %d x %d): %.2f ms, time x%.2f, %zu voxels\n",
+                   g8.dims[0], g8.dims[1], g8.dims[2], 1e3 * t8, t8 / tf, n8);
+            free(c8);
+        }
+        bench_cons_floors(m, &g, tr);
+    }
     ts = bench_cons_time(hfvis_voxelize_solid, m, &g, a, &ns, reps);
     if (ts > 0.0) bench_cons_row("solid (parity)", res, ts, m->triangle_count, ns, 0.0);
     tb = bench_cons_time(bench_cons_bitmask, m, &g, a, &nb, reps);
