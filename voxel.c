@@ -4294,11 +4294,12 @@ static int vx_cons_layer_ok(const vx_cons_tri *T, double t[3][3], int k)
         && !vx_cons_sep_proj(T, W, D, U, t);
 }
 
-/* ceil(x) clamped to [lo, hi + 1] (hi + 1 = "empty"), floor(x) clamped to [lo - 1, hi]; x may be
- * any double but NaN (lo >= 0). Branch-free: clamp in double, truncate, correct. */
-static VX_CONS_INLINE int vx_cons_ceil_in(double x, int lo, int hi)
+/* ceil(x) clamped to [lo, hi + 1] (hi + 1 = "empty"), floor(x) clamped to [lo - 1, hi] for a
+ * range lo..hi given as l = lo - 1, h = hi + 1 (doubles, set up once per range); x may be any
+ * double but NaN (lo >= 0).
+ * Branch-free: clamp in double, truncate, correct. */
+static VX_CONS_INLINE int vx_cons_ceil_in(double x, int lo, double l, double h)
 {
-    double l = (double)lo - 1.0, h = (double)hi + 1.0;
     int i;
     x = x > l ? x : l;
     x = x < h ? x : h;
@@ -4307,9 +4308,8 @@ static VX_CONS_INLINE int vx_cons_ceil_in(double x, int lo, int hi)
     return i < lo ? lo : i;
 }
 
-static VX_CONS_INLINE int vx_cons_floor_in(double x, int lo, int hi)
+static VX_CONS_INLINE int vx_cons_floor_in(double x, int hi, double l, double h)
 {
-    double l = (double)lo - 1.0, h = (double)hi + 1.0;
     int i;
     x = x > l ? x : l;
     x = x < h ? x : h;
@@ -4386,20 +4386,20 @@ typedef struct vx_cons_bound {
     int flat;             /* A == 0 */
 } vx_cons_bound;
 
-/* The bound of axis (A, B) whose two vertices have coordinates (xj, yj), (xo, yo). */
-static VX_CONS_INLINE void vx_cons_bound_init(vx_cons_bound *b, double A, double B, double xj,
-                                              double yj, double xo, double yo, double eps)
+/* The bound of axis (A, B) whose two vertices have coordinates (xj, yj), (xo, yo); inv = 1/A
+ * (any value when A == 0), shared by the axes with the same A up to sign. */
+static VX_CONS_INLINE void vx_cons_bound_init(vx_cons_bound *b, double A, double B, double inv,
+                                              double xj, double yj, double xo, double yo,
+                                              double eps)
 {
+    /* min/max as separate selections (branch-free minsd/maxsd): the signs are data */
     double qa = A * xj + B * yj, qb = A * xo + B * yo, r = 0.5 * (fabs(A) + fabs(B));
-    double lo = (qa < qb ? qa : qb) - r, hi = (qa < qb ? qb : qa) + r, dl = 2.0 * eps * r;
+    double qmin = qa < qb ? qa : qb, qmax = qa > qb ? qa : qb;
+    double lo = qmin - r, hi = qmax + r, dl = 2.0 * eps * r;
     b->flat = A == 0.0;
     if (!b->flat) {
-        double inv = 1.0 / A, dk = dl * fabs(inv), c1 = lo * inv, c2 = hi * inv;
-        if (inv < 0.0) {
-            double tmp = c1;
-            c1 = c2;
-            c2 = tmp;
-        }
+        double dk = dl * fabs(inv), p1 = lo * inv, p2 = hi * inv;
+        double c1 = p1 < p2 ? p1 : p2, c2 = p1 > p2 ? p1 : p2; /* swapped when inv < 0 */
         b->m = B * inv;
         b->c[0] = c1 - dk;
         b->c[1] = c2 + dk;
@@ -4452,7 +4452,9 @@ static const uint64_t vx_cons_layer_masks[3][4][4] = {
  * calling it on most voxels (Schwarz & Seidel 2010's per-triangle decomposition, made exact):
  *  - the work is done in the frame (x, y, z) = (U, W, D), a cyclic permutation, in which the
  *    SAT's axes keep their form: the edge axes of projection a are e_a x f_j with in-plane axes
- *    (a+1, a+2). Each edge axis is a two-sided bound on two centre coordinates (vx_cons_bound):
+ *    (a+1, a+2); or in (W, U, D) when the bounding box is shorter along U (fewer rows, each
+ *    with its own setup): that odd permutation negates every axis, which leaves each two-sided
+ *    bound as it is. Each edge axis is a two-sided bound on two centre coordinates (vx_cons_bound):
  *    the three axes of projection z bound the columns x of each row y; the three of projection x
  *    bound the layers z of each row y; the three of projection y bound the layers z of each
  *    column index x; the plane axis bounds the layers of each column (x, y) to
@@ -4479,10 +4481,17 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
                                vx_cons_bricks *B)
 {
     const int D = T->D, U = T->U, W = T->W;
-    const int x0 = lo[U], x1 = hi[U], y0 = lo[W], y1 = hi[W], z0 = lo[D], z1 = hi[D];
-    const unsigned sh = D == 0 ? 0u : (D == 1 ? 2u : 4u);
-    const size_t sD = B->bs[D], sU = B->bs[U], sW = B->bs[W];
-    double P[3][3], f[3][3], nx, ny, nz, ax, ay, K0, hwid, eps, scale, t[3][3];
+    const int z0 = lo[D], z1 = hi[D];
+    const int X = hi[U] - lo[U] < hi[W] - lo[W] ? W : U, Y = X == U ? W : U;
+    const int x0 = lo[X], x1 = hi[X], y0 = lo[Y], y1 = hi[Y];
+    const unsigned sh = 2u * (unsigned)D, shX = 2u * (unsigned)X, shY = 2u * (unsigned)Y;
+    const size_t sD = B->bs[D], sX = B->bs[X], sY = B->bs[Y];
+    const uint64_t(*lmask)[4] = vx_cons_layer_masks[D];
+    double P[3][3], f[3][3], invy[3], invx[3], nx, ny, nz, inz, ax, ay, K0, hwid, eps, scale;
+    double plo, phi;
+    const double xl = (double)x0 - 1.0, xh = (double)x1 + 1.0, zl = (double)z0 - 1.0,
+                 zh = (double)z1 + 1.0;
+    double t[3][3];
     vx_cons_bound bz[3], bx[3], by[3];
     size_t slow = 0;
     int ix, iy, k, j, have_sat = 0, have_xy = 0;
@@ -4512,8 +4521,8 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
         return 0;
     }
     for (k = 0; k < 3; k++) {
-        P[k][0] = T->v[k][U];
-        P[k][1] = T->v[k][W];
+        P[k][0] = T->v[k][X];
+        P[k][1] = T->v[k][Y];
         P[k][2] = T->v[k][D];
     }
     for (j = 0; j < 3; j++) {
@@ -4521,68 +4530,66 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
         f[j][0] = P[e][0] - P[j][0];
         f[j][1] = P[e][1] - P[j][1];
         f[j][2] = P[e][2] - P[j][2];
+        invy[j] = f[j][1] != 0.0 ? 1.0 / f[j][1] : 0.0; /* projections z and x */
     }
-    nx = T->n[U];
-    ny = T->n[W];
+    nx = T->n[X];
+    ny = T->n[Y];
     nz = T->n[D];
     /* the plane slab per column: kc(x, y) = K0 - ax x - ay y (layer of the centre), |ax|, |ay|
      * <= 1, half width rn/|n_z| <= 1.5 */
-    ax = nx / nz;
-    ay = ny / nz;
-    K0 = P[0][2] - 0.5 + (nx * (P[0][0] - 0.5) + ny * (P[0][1] - 0.5)) / nz;
-    hwid = 0.5 * (fabs(nx) + fabs(ny) + fabs(nz)) / fabs(nz);
+    inz = 1.0 / nz;
+    ax = nx * inz;
+    ay = ny * inz;
+    K0 = P[0][2] - 0.5 + (nx * (P[0][0] - 0.5) + ny * (P[0][1] - 0.5)) * inz;
+    hwid = 0.5 * (fabs(nx) + fabs(ny) + fabs(nz)) * fabs(inz);
     scale = 4.0 + (double)(x1 + y1 + z1);
     for (k = 0; k < 3; k++) scale += fabs(P[k][0]) + fabs(P[k][1]) + fabs(P[k][2]);
     eps = scale * 9.313225746154785e-10; /* 2^-30 */
+    plo = hwid + eps + 0.5; /* the plane's candidate layers: ceil(kc - plo) .. floor(kc + phi) */
+    phi = hwid + eps - 0.5;
     /* the nine edge axes: projection z (x = cx, y = cy), x (x = cz, y = cy), y (x = cz,
      * y = cx); vertex pairs (j, o) = (0, 2), (1, 0), (2, 1). Projections x and y are only set
      * up when some candidate voxel is not set yet. */
     for (j = 0; j < 3; j++) {
         const int o = j == 0 ? 2 : j - 1;
-        vx_cons_bound_init(&bz[j], -f[j][1], f[j][0], P[j][0], P[j][1], P[o][0], P[o][1], eps);
+        vx_cons_bound_init(&bz[j], -f[j][1], f[j][0], -invy[j], P[j][0], P[j][1], P[o][0],
+                           P[o][1], eps);
     }
     for (iy = y0; iy <= y1; iy++) {
-        double cy = (double)iy + 0.5, krow = K0 - ay * (double)iy + 0.5, rc[4], rk[4];
-        int ca0, ca1, cc0, cc1, p[3], have_rk = 0;
-        size_t rowbase;
-        unsigned rowbit;
+        const double cy = (double)iy + 0.5, krow = K0 - ay * (double)iy + 0.5;
+        const size_t rowbase = (size_t)(iy >> 2) * sY;
+        const unsigned rowbit = (unsigned)(iy & 3) << shY;
+        double rc[4], rk[4];
+        int ca0, ca1, cc0, cc1, have_rk = 0;
         /* the row's columns (projection z), on centres */
         rc[0] = rc[2] = -HUGE_VAL;
         rc[1] = rc[3] = HUGE_VAL;
         for (j = 0; j < 3; j++) vx_cons_bound_apply(&bz[j], cy, rc);
-        ca0 = vx_cons_ceil_in(rc[0] - 0.5, x0, x1);
-        ca1 = vx_cons_floor_in(rc[1] - 0.5, x0, x1);
+        ca0 = vx_cons_ceil_in(rc[0] - 0.5, x0, xl, xh);
+        ca1 = vx_cons_floor_in(rc[1] - 0.5, x1, xl, xh);
         if (ca0 > ca1) continue;
         /* the certain range is the candidate one unless a bound is within its margin of a
          * centre: ceil(rc[2] - .5) == ca0 iff ca0 >= rc[2] - .5 (rc[2] >= rc[0]) */
-        cc0 = (double)ca0 >= rc[2] - 0.5 ? ca0 : vx_cons_ceil_in(rc[2] - 0.5, x0, x1);
-        cc1 = (double)ca1 <= rc[3] - 0.5 ? ca1 : vx_cons_floor_in(rc[3] - 0.5, x0, x1);
-        p[U] = 0;
-        p[W] = iy;
-        p[D] = 0;
-        rowbase = vx_cons_brick_of(B, p, &rowbit);
+        cc0 = (double)ca0 >= rc[2] - 0.5 ? ca0 : vx_cons_ceil_in(rc[2] - 0.5, x0, xl, xh);
+        cc1 = (double)ca1 <= rc[3] - 0.5 ? ca1 : vx_cons_floor_in(rc[3] - 0.5, x1, xl, xh);
         for (ix = ca0; ix <= ca1; ix++) {
-            double kc = krow - ax * (double)ix, r[4];
-            int ka, kb, kA, kB;
-            size_t base = rowbase + (size_t)(ix >> 2) * sU;
-            unsigned bit0 = rowbit | (unsigned)(ix & 3) << (U == 0 ? 0 : (U == 1 ? 2 : 4));
+            const double kc = krow - ax * (double)ix;
+            const size_t base = rowbase + (size_t)(ix >> 2) * sX;
+            const unsigned bit0 = rowbit | (unsigned)(ix & 3) << shX;
+            double r[4];
+            int ka = vx_cons_ceil_in(kc - plo, z0, zl, zh), kb, kA, kB;
 #define VX_CONS_WORD(kk) B->w[base + (size_t)((kk) >> 2) * sD]
 #define VX_CONS_MASK(kk) ((uint64_t)1 << (bit0 | ((unsigned)((kk) & 3) << sh)))
             /* the plane's candidate layers; done if they are all set already */
-            r[0] = kc - hwid - eps;
-            r[1] = kc + hwid + eps;
-            ka = vx_cons_ceil_in(r[0] - 0.5, z0, z1);
-            kb = vx_cons_floor_in(r[1] - 0.5, z0, z1);
+            kb = vx_cons_floor_in(kc + phi, z1, zl, zh);
             if (ka > kb) continue;
             if (kb - ka <= 4) {
                 /* at most two bricks: masks of the layers in each (vx_cons_layer_masks) */
                 int kc3 = ka | 3, last = kb < kc3 ? kb : kc3;
-                uint64_t m1 = vx_cons_layer_masks[sh >> 1][ka & 3][last & 3] << bit0, m2 = 0, w2 = 0;
-                if (kb > kc3) {
-                    m2 = vx_cons_layer_masks[sh >> 1][0][kb & 3] << bit0;
-                    w2 = VX_CONS_WORD(kb);
-                }
-                if ((VX_CONS_WORD(ka) & m1) == m1 && (w2 & m2) == m2) continue;
+                uint64_t m1 = lmask[ka & 3][last & 3] << bit0;
+                uint64_t m2 = (lmask[0][kb & 3] & ((uint64_t)0 - (uint64_t)(kb > kc3))) << bit0;
+                /* m2 = 0 when kb is in ka's brick; masks without branches (the data decide) */
+                if ((VX_CONS_WORD(ka) & m1) == m1 && (VX_CONS_WORD(kb) & m2) == m2) continue;
             } else {
                 for (k = ka; k <= kb && (VX_CONS_WORD(k) & VX_CONS_MASK(k)); k++) {}
                 if (k > kb) continue;
@@ -4591,10 +4598,11 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
             if (!have_xy) {
                 for (j = 0; j < 3; j++) {
                     const int o = j == 0 ? 2 : j - 1;
-                    vx_cons_bound_init(&bx[j], f[j][1], -f[j][2], P[j][2], P[j][1], P[o][2],
-                                       P[o][1], eps);
-                    vx_cons_bound_init(&by[j], -f[j][0], f[j][2], P[j][2], P[j][0], P[o][2],
-                                       P[o][0], eps);
+                    invx[j] = f[j][0] != 0.0 ? 1.0 / f[j][0] : 0.0;
+                    vx_cons_bound_init(&bx[j], f[j][1], -f[j][2], invy[j], P[j][2], P[j][1],
+                                       P[o][2], P[o][1], eps);
+                    vx_cons_bound_init(&by[j], -f[j][0], f[j][2], -invx[j], P[j][2], P[j][0],
+                                       P[o][2], P[o][0], eps);
                 }
                 have_xy = 1;
             }
@@ -4604,6 +4612,8 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
                 for (j = 0; j < 3; j++) vx_cons_bound_apply(&bx[j], cy, rk);
                 have_rk = 1;
             }
+            r[0] = kc - hwid - eps;
+            r[1] = kc + hwid + eps;
             r[2] = kc - hwid + eps;
             r[3] = kc + hwid - eps;
             for (j = 0; j < 3; j++) vx_cons_bound_apply(&by[j], (double)ix + 0.5, r);
@@ -4611,11 +4621,11 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
             r[1] = r[1] < rk[1] ? r[1] : rk[1];
             r[2] = r[2] > rk[2] ? r[2] : rk[2];
             r[3] = r[3] < rk[3] ? r[3] : rk[3];
-            ka = vx_cons_ceil_in(r[0] - 0.5, z0, z1);
-            kb = vx_cons_floor_in(r[1] - 0.5, z0, z1);
+            ka = vx_cons_ceil_in(r[0] - 0.5, z0, zl, zh);
+            kb = vx_cons_floor_in(r[1] - 0.5, z1, zl, zh);
             if (ka > kb) continue;
-            kA = (double)ka >= r[2] - 0.5 ? ka : vx_cons_ceil_in(r[2] - 0.5, z0, z1);
-            kB = (double)kb <= r[3] - 0.5 ? kb : vx_cons_floor_in(r[3] - 0.5, z0, z1);
+            kA = (double)ka >= r[2] - 0.5 ? ka : vx_cons_ceil_in(r[2] - 0.5, z0, zl, zh);
+            kB = (double)kb <= r[3] - 0.5 ? kb : vx_cons_floor_in(r[3] - 0.5, z1, zl, zh);
             if (ka == kA && kb == kB && ix >= cc0 && ix <= cc1) {
                 for (k = ka; k <= kb; k++) VX_CONS_WORD(k) |= VX_CONS_MASK(k); /* certain */
                 continue;
@@ -4627,13 +4637,13 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
                 have_sat = 1;
             }
             {
-                double cu = (double)ix + 0.5;
-                t[0][U] = T->v[0][U] - cu;
-                t[1][U] = T->v[1][U] - cu;
-                t[2][U] = T->v[2][U] - cu;
-                t[0][W] = T->v[0][W] - cy;
-                t[1][W] = T->v[1][W] - cy;
-                t[2][W] = T->v[2][W] - cy;
+                double cx = (double)ix + 0.5;
+                t[0][X] = T->v[0][X] - cx;
+                t[1][X] = T->v[1][X] - cx;
+                t[2][X] = T->v[2][X] - cx;
+                t[0][Y] = T->v[0][Y] - cy;
+                t[1][Y] = T->v[1][Y] - cy;
+                t[2][Y] = T->v[2][Y] - cy;
             }
             if ((ix < cc0 || ix > cc1) && vx_cons_sep_proj(T, D, U, W, t)) continue;
             for (k = ka; k <= kb; k++)
@@ -4642,7 +4652,6 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
 #undef VX_CONS_MASK
         }
     }
-    (void)sW;
     return slow;
 }
 
@@ -4662,16 +4671,17 @@ static uint64_t *vx_cons_bricks_init(vx_cons_bricks *B, const hfvis_volume_grid 
     return B->w;
 }
 
-/* Index of the lowest set bit of m != 0. */
+/* Index of the lowest set bit of m != 0, branch-free: the isolated bit times a de Bruijn
+ * sequence B(2, 6) has a distinct top 6 bits per bit position (Leiserson, Prokop & Randall,
+ * "Using de Bruijn sequences to index a 1 in a computer word", 1998). */
 static unsigned vx_cons_ctz64(uint64_t m)
 {
-    unsigned b = 0;
-    if (!(m & 0xffffffffu)) { m >>= 32; b += 32; }
-    if (!(m & 0xffffu)) { m >>= 16; b += 16; }
-    if (!(m & 0xffu)) { m >>= 8; b += 8; }
-    if (!(m & 0xfu)) { m >>= 4; b += 4; }
-    if (!(m & 0x3u)) { m >>= 2; b += 2; }
-    return b + (unsigned)!(m & 1u);
+    static const unsigned char pos[64] = {
+        0,  1,  48, 2,  57, 49, 28, 3,  61, 58, 50, 42, 38, 29, 17, 4,
+        62, 55, 59, 36, 53, 51, 43, 22, 45, 39, 33, 30, 24, 18, 12, 5,
+        63, 47, 56, 27, 60, 41, 37, 16, 54, 35, 52, 21, 44, 32, 23, 11,
+        46, 26, 40, 15, 34, 20, 31, 10, 25, 14, 19, 9,  13, 8,  7,  6};
+    return pos[((m & (0u - m)) * 0x03f79d71b4cb0a89ull) >> 58];
 }
 
 /* Clears occ and sets the voxels of the bricks' set bits; returns their number. */
@@ -4705,16 +4715,23 @@ HFVIS_API hfvis_status hfvis_voxelize_conservative(const hfvis_mesh *mesh,
     size_t t, v, n;
     double *gv;
     vx_cons_bricks B;
-    hfvis_status s = vx_cons_args(mesh, grid, occ);
-    if (s != HFVIS_OK) return s;
-    /* scratch: every vertex in grid space (transformed once), and the brick bits */
+    if (!occ || !vx_grid_valid(grid) || vx_mesh_check(mesh) != HFVIS_OK)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    /* scratch: every vertex in grid space (transformed once, and checked against
+     * VX_CONS_MAX_COORD as vx_cons_args does), and the brick bits */
     gv = (double *)vx_alloc_array(alloc, mesh->vertex_count, 3 * sizeof(double));
     if (!gv && mesh->vertex_count) return HFVIS_ERR_OUT_OF_MEMORY;
+    for (v = 0; v < 3 * mesh->vertex_count; v++) {
+        gv[v] = vx_cons_gc(grid, (int)(v % 3), mesh->xyz[v]);
+        if (!(fabs(gv[v]) <= VX_CONS_MAX_COORD)) {
+            vx_free(alloc, gv);
+            return HFVIS_ERR_LIMIT;
+        }
+    }
     if (!vx_cons_bricks_init(&B, grid, alloc)) {
         vx_free(alloc, gv);
         return HFVIS_ERR_OUT_OF_MEMORY;
     }
-    for (v = 0; v < mesh->vertex_count; v++) vx_cons_gvert(mesh, grid, (uint32_t)v, gv + 3 * v);
     for (t = 0; t < mesh->triangle_count; t++) {
         vx_cons_tri T;
         int lo[3], hi[3], a, k;

@@ -384,6 +384,108 @@ TEST(conservative_fast_equals_reference)
     CHECK(bad == 0);
 }
 
+/* Slivers (the 100k knot's triangles are about 0.5 x 6 voxels): long thin triangles in every
+ * orientation, near-collinear ones, slivers snapped to the half-voxel lattice or lying in a
+ * lattice plane, and long strips of slivers sharing vertices (so most candidate voxels are set
+ * already when a triangle is reached), with both bounding-box orientations of the fast path's
+ * row/column frame; fast == reference on each soup. */
+static void tc_sliver_soup(tc_soup *s, size_t ntri, double n, double maxlen)
+{
+    size_t t;
+    int k, a;
+    tc_soup_alloc(s, ntri);
+    for (t = 0; t < ntri; t++) {
+        float *v = s->xyz + 9 * t;
+        double c[3], d[3], e[3], len = maxlen * (0.05 + tc_unit()), nd = 0.0;
+        double width = len * pow(10.0, -5.0 * tc_unit()); /* aspect 1 to 1e5 */
+        int mode = tc_int(5);
+        for (a = 0; a < 3; a++) {
+            c[a] = -1.0 + (n + 2.0) * tc_unit();
+            d[a] = tc_unit() - 0.5;
+            e[a] = tc_unit() - 0.5;
+            nd += d[a] * d[a];
+        }
+        nd = sqrt(nd) + 1e-300;
+        for (a = 0; a < 3; a++) {
+            v[a] = (float)c[a];
+            v[3 + a] = (float)(c[a] + len * d[a] / nd);
+            v[6 + a] = (float)(c[a] + (0.1 + 0.8 * tc_unit()) * len * d[a] / nd + width * e[a]);
+        }
+        if (mode == 1) /* on the half-voxel lattice */
+            for (k = 0; k < 9; k++) v[k] = floorf(v[k] * 2.0f) * 0.5f;
+        if (mode == 2) { /* in a lattice plane */
+            int f = tc_int(3);
+            v[f] = v[3 + f] = v[6 + f] = floorf(v[f]);
+        }
+        if (mode == 3) /* collinear in exact arithmetic before rounding to float */
+            for (a = 0; a < 3; a++) v[6 + a] = (float)(c[a] + 0.375 * len * d[a] / nd);
+    }
+}
+
+/* A strip of 2 * segs slivers along a helix-like curve, sharing vertices: ring i has vertices
+ * 2i (inner) and 2i + 1 (outer), width w cells. */
+static void tc_strip(float *xyz, uint32_t *idx, int segs, double n, double w, double phase)
+{
+    int i;
+    for (i = 0; i <= segs; i++) {
+        double u = phase + 6.0 * (double)i / (double)segs, r = 0.35 * n;
+        double x = 0.5 * n + r * cos(u), y = 0.5 * n + r * sin(u), z = 0.5 * n + 0.3 * n * sin(0.7 * u);
+        xyz[6 * i + 0] = (float)x;
+        xyz[6 * i + 1] = (float)y;
+        xyz[6 * i + 2] = (float)z;
+        xyz[6 * i + 3] = (float)(x + w * cos(u));
+        xyz[6 * i + 4] = (float)(y + w * sin(u));
+        xyz[6 * i + 5] = (float)(z + w * 0.3);
+        if (i < segs) {
+            uint32_t a = (uint32_t)(2 * i), *q = idx + 6 * i;
+            q[0] = a;
+            q[1] = a + 1;
+            q[2] = a + 2;
+            q[3] = a + 1;
+            q[4] = a + 3;
+            q[5] = a + 2;
+        }
+    }
+}
+
+TEST(conservative_fast_equals_reference_slivers)
+{
+    int bad = 0, trial;
+    tc_seed(2010);
+    for (trial = 0; trial < 40; trial++) {
+        int n = 10 + tc_int(40);
+        hfvis_volume_grid g = tc_grid(n, 8 + tc_int(40), 8 + tc_int(40));
+        tc_soup s;
+        if (trial % 2) {
+            int a;
+            for (a = 0; a < 3; a++) {
+                g.origin[a] = -0.5 + tc_unit();
+                g.cell[a] = 0.6 + 0.8 * tc_unit();
+            }
+        }
+        tc_sliver_soup(&s, 200, (double)n, trial % 4 == 3 ? 4.0 * (double)n : 1.0 + 12.0 * tc_unit());
+        tc_cons_check(&s.m, &g, &bad);
+        tc_soup_free(&s);
+    }
+    {
+        enum { SEGS = 600 };
+        static float xyz[6 * (SEGS + 1)];
+        static uint32_t idx[6 * SEGS];
+        hfvis_volume_grid g = tc_grid(40, 40, 40);
+        hfvis_mesh m;
+        int w;
+        m.xyz = xyz;
+        m.vertex_count = 2 * (SEGS + 1);
+        m.indices = idx;
+        m.triangle_count = 2 * SEGS;
+        for (w = 0; w < 4; w++) {
+            tc_strip(xyz, idx, SEGS, 40.0, 0.25 + 0.75 * (double)w, 0.3 * (double)w);
+            tc_cons_check(&m, &g, &bad);
+        }
+    }
+    CHECK(bad == 0);
+}
+
 /* Translating a mesh by whole voxels translates the conservative voxel set (spec §3.13.8). */
 TEST(conservative_translation)
 {
@@ -1122,6 +1224,7 @@ int main(int argc, char **argv)
     RUN(sat_cases);
     RUN(conservative_spec_counts);
     RUN(conservative_fast_equals_reference);
+    RUN(conservative_fast_equals_reference_slivers);
     RUN(conservative_translation);
     RUN(solid_box_exact);
     RUN(solid_spheres);
