@@ -2319,9 +2319,11 @@ static int cli_run_partial(const cli_args *a, const hfvis_grid *grid, hfvis_swee
         else s = hfvis_horizon_map(grid, a->dirs, opts, map);
         for (i = 0; s == HFVIS_OK && i < n * (size_t)planes; i++) sums[i] = (double)map[i];
     } else if (a->cmd == CMD_LIGHT) {
+        hfvis_env_options eopts = hfvis_env_options_default();
+        eopts.method = (hfvis_env_method)a->method;
         raw = (double *)malloc(n * (size_t)channels * sizeof(double));
         if (!raw) s = HFVIS_ERR_OUT_OF_MEMORY;
-        else s = hfvis_direction_sums(grid, a->dirs, HFVIS_SUM_ENV_LIGHT, env, NULL, opts, raw);
+        else s = hfvis_direction_sums(grid, a->dirs, HFVIS_SUM_ENV_LIGHT, env, &eopts, opts, raw);
         for (i = 0; s == HFVIS_OK && i < n; i++) /* interleaved channels -> planes */
             for (c = 0; c < channels; c++) sums[(size_t)c * n + i] = raw[i * (size_t)channels + (size_t)c];
     } else {
@@ -2483,6 +2485,13 @@ static int cli_sum(int argc, char **argv)
     K = parts[0].directions, W = parts[0].width, H = parts[0].height, planes = parts[0].planes;
     for (i = 1; i < nparts; i++) {
         const hfvis_partial *p = &parts[i];
+        if (p->width != W || p->height != H || p->directions != K ||
+            (cmd != CMD_HORIZON && p->planes != planes)) {
+            rc = cli_error(CLI_EXIT_ERROR, names[i], "not the same run as %s: %d x %d x %d values of "
+                           "K = %d there, %d x %d x %d of K = %d here", names[0], W, H, planes, K,
+                           p->width, p->height, p->planes, p->directions);
+            goto done;
+        }
         cli_tag_first_difference(p->tag, parts[0].tag, key, sizeof key);
         if (key[0]) {
             char *eq = strchr(key, '=');
@@ -2490,13 +2499,6 @@ static int cli_sum(int argc, char **argv)
             if (!cli_tag_value(parts[0].tag, key, other, sizeof other)) strcpy(other, "(none)");
             rc = cli_error(CLI_EXIT_ERROR, names[i], "not the same run as %s: %s=%s there, %s here",
                            names[0], key, other, eq ? eq + 1 : "");
-            goto done;
-        }
-        if (p->width != W || p->height != H || p->directions != K ||
-            (cmd != CMD_HORIZON && p->planes != planes)) {
-            rc = cli_error(CLI_EXIT_ERROR, names[i], "not the same run as %s: %d x %d x %d values of "
-                           "K = %d there, %d x %d x %d of K = %d here", names[0], W, H, planes, K,
-                           p->width, p->height, p->planes, p->directions);
             goto done;
         }
     }
