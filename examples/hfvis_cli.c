@@ -2414,13 +2414,47 @@ static int cli_tag_real(const char *tag, const char *key, double *v)
     return cli_tag_value(tag, key, buf, sizeof buf) && cli_parse_real(buf, v);
 }
 
-/* `hfvis sum PART... -o OUT`: check that the parts are one run's and tile [0, K), add them in
- * direction order, finish exactly as the single run does, write OUT (atomically: the codecs
+/* One part's header and a copy of its tag (pass 1 of `sum` keeps these, not the sums). */
+typedef struct cli_part {
+    int width, height, planes, directions, begin, end;
+    char *tag;
+} cli_part;
+
+/* Load path; on success copy its header and tag into m (when m->tag is NULL) or check that they
+ * still equal m's (pass 2). The caller frees *p with hfvis_partial_free. */
+static int cli_sum_load(const char *path, hfvis_partial *p, cli_part *m)
+{
+    hfvis_status s;
+    errno = 0;
+    s = hfvis_partial_load(path, NULL, p);
+    if (s != HFVIS_OK) return cli_status(path, s, errno);
+    if (!m->tag) {
+        size_t len = strlen(p->tag);
+        m->tag = (char *)malloc(len + 1);
+        if (!m->tag) {
+            hfvis_partial_free(NULL, p);
+            return cli_status(path, HFVIS_ERR_OUT_OF_MEMORY, 0);
+        }
+        memcpy(m->tag, p->tag, len + 1);
+        m->width = p->width, m->height = p->height, m->planes = p->planes;
+        m->directions = p->directions, m->begin = p->begin, m->end = p->end;
+    } else if (strcmp(m->tag, p->tag) || m->width != p->width || m->height != p->height ||
+               m->planes != p->planes || m->directions != p->directions || m->begin != p->begin ||
+               m->end != p->end) {
+        hfvis_partial_free(NULL, p);
+        return cli_error(CLI_EXIT_ERROR, path, "changed while being summed");
+    }
+    return 0;
+}
+
+/* `hfvis sum PART... -o OUT`: check that the parts are one run's and tile [0, K) (pass 1 reads
+ * each part and keeps only its header), then add them in direction order, one part in memory at
+ * a time (pass 2), finish exactly as the single run does and write OUT (atomically: the codecs
  * write a temporary file and rename it). */
 static int cli_sum(int argc, char **argv)
 {
     enum { MAX_PARTS = 4096 };
-    static hfvis_partial parts[MAX_PARTS];
+    static cli_part meta[MAX_PARTS];
     static const char *names[MAX_PARTS];
     static int order[MAX_PARTS];
     cli_args a;
@@ -2463,18 +2497,15 @@ static int cli_sum(int argc, char **argv)
     if (!a.out) return cli_error(CLI_EXIT_USAGE, cmdname, "missing -o OUT");
     if (a.has_range && !a.out_pgm) return cli_error(CLI_EXIT_USAGE, "--range", "applies only to .pgm output");
 
+    /* pass 1: headers and tags */
+    for (i = 0; i < nparts; i++) meta[i].tag = NULL;
     for (i = 0; i < nparts; i++) {
-        hfvis_status s;
-        errno = 0;
-        s = hfvis_partial_load(names[i], NULL, &parts[i]);
-        if (s != HFVIS_OK) {
-            rc = cli_status(names[i], s, errno);
-            nparts = i;
-            goto done;
-        }
+        hfvis_partial p;
+        if ((rc = cli_sum_load(names[i], &p, &meta[i])) != 0) goto done;
+        hfvis_partial_free(NULL, &p);
     }
     /* the first part decides the run; every other part must be the same run */
-    if (!cli_tag_value(parts[0].tag, "cmd", name, sizeof name)) name[0] = '\0';
+    if (!cli_tag_value(meta[0].tag, "cmd", name, sizeof name)) name[0] = '\0';
     for (cmd = 0; cmd < CMD_COUNT && strcmp(name, cli_cmd_names[cmd]); cmd++) {}
     if (cmd != CMD_HORIZON && cmd != CMD_SKYVIEW && cmd != CMD_SKY && cmd != CMD_LIGHT &&
         cmd != CMD_VISIBILITY) {
@@ -2482,9 +2513,9 @@ static int cli_sum(int argc, char **argv)
                        "light or visibility");
         goto done;
     }
-    K = parts[0].directions, W = parts[0].width, H = parts[0].height, planes = parts[0].planes;
+    K = meta[0].directions, W = meta[0].width, H = meta[0].height, planes = meta[0].planes;
     for (i = 1; i < nparts; i++) {
-        const hfvis_partial *p = &parts[i];
+        const cli_part *p = &meta[i];
         if (p->width != W || p->height != H || p->directions != K ||
             (cmd != CMD_HORIZON && p->planes != planes)) {
             rc = cli_error(CLI_EXIT_ERROR, names[i], "not the same run as %s: %d x %d x %d values of "
@@ -2492,32 +2523,32 @@ static int cli_sum(int argc, char **argv)
                            p->width, p->height, p->planes, p->directions);
             goto done;
         }
-        cli_tag_first_difference(p->tag, parts[0].tag, key, sizeof key);
+        cli_tag_first_difference(p->tag, meta[0].tag, key, sizeof key);
         if (key[0]) {
             char *eq = strchr(key, '=');
             if (eq) *eq = '\0';
-            if (!cli_tag_value(parts[0].tag, key, other, sizeof other)) strcpy(other, "(none)");
+            if (!cli_tag_value(meta[0].tag, key, other, sizeof other)) strcpy(other, "(none)");
             rc = cli_error(CLI_EXIT_ERROR, names[i], "not the same run as %s: %s=%s there, %s here",
                            names[0], key, other, eq ? eq + 1 : "");
             goto done;
         }
     }
     for (i = 0; i < nparts; i++) /* horizon parts hold one plane per direction */
-        if (cmd == CMD_HORIZON && parts[i].planes != parts[i].end - parts[i].begin) {
-            rc = cli_error(CLI_EXIT_ERROR, names[i], "%d planes for directions %d:%d", parts[i].planes,
-                           parts[i].begin, parts[i].end);
+        if (cmd == CMD_HORIZON && meta[i].planes != meta[i].end - meta[i].begin) {
+            rc = cli_error(CLI_EXIT_ERROR, names[i], "%d planes for directions %d:%d", meta[i].planes,
+                           meta[i].begin, meta[i].end);
             goto done;
         }
     /* the ranges, sorted by their first direction (insertion sort), must tile [0, K) */
     for (i = 0; i < nparts; i++) {
-        for (j = i; j > 0 && parts[order[j - 1]].begin > parts[i].begin; j--) order[j] = order[j - 1];
+        for (j = i; j > 0 && meta[order[j - 1]].begin > meta[i].begin; j--) order[j] = order[j - 1];
         order[j] = i;
     }
     for (i = 0; i < nparts; i++) {
-        int b = parts[order[i]].begin, prev_end = i ? parts[order[i - 1]].end : 0;
+        int b = meta[order[i]].begin, prev_end = i ? meta[order[i - 1]].end : 0;
         if (b < prev_end) {
             rc = cli_error(CLI_EXIT_ERROR, names[order[i]], "directions %d:%d overlap %d:%d of %s",
-                           b, parts[order[i]].end, parts[order[i - 1]].begin, prev_end,
+                           b, meta[order[i]].end, meta[order[i - 1]].begin, prev_end,
                            names[order[i - 1]]);
             goto done;
         }
@@ -2527,19 +2558,21 @@ static int cli_sum(int argc, char **argv)
             goto done;
         }
     }
-    if (parts[order[nparts - 1]].end != K) {
+    if (meta[order[nparts - 1]].end != K) {
         rc = cli_error(CLI_EXIT_ERROR, cmdname, "directions %d:%d of K = %d are missing (no part holds "
-                       "them)", parts[order[nparts - 1]].end, K, K);
+                       "them)", meta[order[nparts - 1]].end, K, K);
         goto done;
     }
 
-    /* add in direction order and finish as the single run (cli_run) does */
+    /* pass 2: add in direction order and finish as the single run (cli_run) does */
     n = (size_t)W * (size_t)H;
     if (cmd == CMD_LIGHT) channels = planes;
     if (cmd == CMD_HORIZON) out_planes = K;
-    if ((size_t)out_planes * (size_t)channels > HFVIS_IMAGE_MAX_VALUES / n) {
-        rc = cli_error(CLI_EXIT_ERROR, cmdname, "%s: %d planes of %d x %d exceed the limit of 2^28 values",
-                       hfvis_status_string(HFVIS_ERR_LIMIT), out_planes, W, H);
+    if ((size_t)out_planes * (size_t)channels > HFVIS_IMAGE_MAX_VALUES / n ||
+        (long long)out_planes * H > HFVIS_IMAGE_MAX_DIM) {
+        rc = cli_error(CLI_EXIT_ERROR, cmdname, "%s: %d planes of %d x %d exceed the limit of 2^28 "
+                       "values and %d rows", hfvis_status_string(HFVIS_ERR_LIMIT), out_planes, W, H,
+                       HFVIS_IMAGE_MAX_DIM);
         goto done;
     }
     out = cli_alloc(n, (size_t)out_planes, (size_t)channels);
@@ -2547,58 +2580,64 @@ static int cli_sum(int argc, char **argv)
     if (!out || (cmd != CMD_HORIZON && !acc)) { rc = cli_status(cmdname, HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
     if (cmd == CMD_HORIZON) {
         char v[8];
-        deg = cli_tag_value(parts[0].tag, "degrees", v, sizeof v) && !strcmp(v, "1");
-        for (i = 0; i < nparts; i++)
-            for (k = 0; k < n * (size_t)parts[i].planes; k++) {
-                double alpha = parts[i].sums[k];
-                out[(size_t)parts[i].begin * n + k] = deg ? (float)(alpha * (180.0 / CLI_PI)) : (float)alpha;
-            }
+        deg = cli_tag_value(meta[0].tag, "degrees", v, sizeof v) && !strcmp(v, "1");
         lo = deg ? -90.0 : -CLI_PI / 2.0;
         hi = deg ? 90.0 : CLI_PI / 2.0;
-    } else {
-        memcpy(acc, parts[order[0]].sums, n * (size_t)planes * sizeof(double));
-        for (i = 1; i < nparts; i++)
-            for (k = 0; k < n * (size_t)planes; k++) acc[k] += parts[order[i]].sums[k];
-        if (cmd == CMD_SKYVIEW) {
-            for (k = 0; k < n; k++) out[k] = (float)(1.0 + (-1.0 / (double)K) * acc[k]);
-        } else if (cmd == CMD_SKY) {
-            double sky = 0.0, albedo = 0.0, scale;
-            if (!cli_tag_real(parts[0].tag, "sky", &sky) || !cli_tag_real(parts[0].tag, "albedo", &albedo)) {
-                rc = cli_error(CLI_EXIT_ERROR, names[0], "the part does not name its sky and albedo");
-                goto done;
-            }
-            scale = (double)(float)sky * (double)(float)albedo; /* the floats the single run passes */
-            for (k = 0; k < n; k++) out[k] = (float)(0.0 + scale * acc[k]);
-            if (sky * albedo <= CLI_FLT_MAX && (float)(sky * albedo) > 0.0f) hi = sky * albedo;
-        } else if (cmd == CMD_LIGHT) {
-            double albedo = 0.0;
-            int c;
-            if (!cli_tag_real(parts[0].tag, "albedo", &albedo)) {
-                rc = cli_error(CLI_EXIT_ERROR, names[0], "the part does not name its albedo");
-                goto done;
-            }
-            for (k = 0; k < n; k++)
-                for (c = 0; c < channels; c++)
-                    out[k * (size_t)channels + (size_t)c] =
-                        (float)(0.0 + (double)(float)albedo * acc[(size_t)c * n + k]);
-            hi = cli_top(out, n * (size_t)channels, 1.0);
-        } else { /* CMD_VISIBILITY; with --fraction plane 1 holds the flat field's counts */
-            for (k = 0; k < n; k++) {
-                float count = (float)(0.0 + 1.0 * acc[k]);
-                if (planes == 2 && !isnan(count)) {
-                    float tested = (float)(0.0 + 1.0 * acc[n + k]);
-                    count = tested > 0.0f ? (float)((double)count / (double)tested) : 0.0f;
-                }
-                out[k] = count;
-            }
-            hi = planes == 2 ? 1.0 : cli_top(out, n, 1.0);
+    }
+    for (i = 0; i < nparts; i++) {
+        hfvis_partial p;
+        const size_t count = n * (size_t)meta[order[i]].planes;
+        if ((rc = cli_sum_load(names[order[i]], &p, &meta[order[i]])) != 0) goto done;
+        if (cmd == CMD_HORIZON) {
+            float *dst = out + (size_t)p.begin * n;
+            for (k = 0; k < count; k++)
+                dst[k] = deg ? (float)(p.sums[k] * (180.0 / CLI_PI)) : (float)p.sums[k];
+        } else if (i == 0) {
+            memcpy(acc, p.sums, count * sizeof(double));
+        } else {
+            for (k = 0; k < count; k++) acc[k] += p.sums[k];
         }
+        hfvis_partial_free(NULL, &p);
+    }
+    if (cmd == CMD_SKYVIEW) {
+        for (k = 0; k < n; k++) out[k] = (float)(1.0 + (-1.0 / (double)K) * acc[k]);
+    } else if (cmd == CMD_SKY) {
+        double sky = 0.0, albedo = 0.0, scale;
+        if (!cli_tag_real(meta[0].tag, "sky", &sky) || !cli_tag_real(meta[0].tag, "albedo", &albedo)) {
+            rc = cli_error(CLI_EXIT_ERROR, names[0], "the part does not name its sky and albedo");
+            goto done;
+        }
+        scale = (double)(float)sky * (double)(float)albedo; /* the floats the single run passes */
+        for (k = 0; k < n; k++) out[k] = (float)(0.0 + scale * acc[k]);
+        if (sky * albedo <= CLI_FLT_MAX && (float)(sky * albedo) > 0.0f) hi = sky * albedo;
+    } else if (cmd == CMD_LIGHT) {
+        double albedo = 0.0;
+        int c;
+        if (!cli_tag_real(meta[0].tag, "albedo", &albedo)) {
+            rc = cli_error(CLI_EXIT_ERROR, names[0], "the part does not name its albedo");
+            goto done;
+        }
+        for (k = 0; k < n; k++)
+            for (c = 0; c < channels; c++)
+                out[k * (size_t)channels + (size_t)c] =
+                    (float)(0.0 + (double)(float)albedo * acc[(size_t)c * n + k]);
+        hi = cli_top(out, n * (size_t)channels, 1.0);
+    } else if (cmd == CMD_VISIBILITY) { /* with --fraction plane 1 holds the flat field's counts */
+        for (k = 0; k < n; k++) {
+            float count = (float)(0.0 + 1.0 * acc[k]);
+            if (planes == 2 && !isnan(count)) {
+                float tested = (float)(0.0 + 1.0 * acc[n + k]);
+                count = tested > 0.0f ? (float)((double)count / (double)tested) : 0.0f;
+            }
+            out[k] = count;
+        }
+        hi = planes == 2 ? 1.0 : cli_top(out, n, 1.0);
     }
     rc = cli_save(&a, out, W, H * out_planes, channels, lo, hi);
 done:
     free(acc);
     free(out);
-    for (i = 0; i < nparts; i++) hfvis_partial_free(NULL, &parts[i]);
+    for (i = 0; i < nparts; i++) free(meta[i].tag);
     return rc;
 }
 
