@@ -1156,7 +1156,9 @@ static size_t hf_align_add(size_t *total, size_t count, size_t elem, int *ok)
 static int hf_opts_valid(const hfvis_sweep_options *o)
 {
     return !o || (hf_border_valid(o->border) && o->border_cells >= 0 && isfinite(o->azimuth0_rad) &&
-                  o->direction_begin >= 0 && o->direction_end >= 0);
+                  o->direction_begin >= 0 && o->direction_end >= 0 &&
+                  o->direction_order >= HFVIS_DIRECTION_ORDER_DEFAULT &&
+                  o->direction_order <= HFVIS_DIRECTION_ORDER_SWEEP);
 }
 
 /* Resolved options (NULL or zero fields = defaults). */
@@ -1791,6 +1793,13 @@ hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, int k,
 
 static hfvis_status hf_direction_range(const hfvis_sweep_options *o, int K, int *begin, int *end);
 
+/* Position of direction k in the order of o->direction_order (hfvis.h). */
+static int hf_direction_position(const hfvis_sweep_options *o, int K, int k)
+{
+    if (o->direction_order != HFVIS_DIRECTION_ORDER_SWEEP || K % 4 != 0) return k;
+    return (k % (K / 4)) * 4 + k / (K / 4);
+}
+
 /* The planes [begin, end) of the map: each direction exactly as hfvis_horizon_direction does it
  * (its group's lattice sampled once, one orientation at a time), so plane k is bit-identical to
  * plane k of the full map. */
@@ -1806,8 +1815,8 @@ static hfvis_status hf_horizon_map_range(const hfvis_grid *grid, int K, const hf
         double ux, uy;
         int m0, sampled = 0;
         for (m = 0; m < per; m++) {
-            int k = gidx + m * groups;
-            if (k < begin || k >= end) continue;
+            int k = gidx + m * groups, pos = hf_direction_position(o, K, k);
+            if (pos < begin || pos >= end) continue;
             if (!sampled) {
                 hf_direction_base(K, gidx, o->azimuth0_rad, &ux, &uy, &m0);
                 hf_sweep_group(&sw, ux, uy);
@@ -1815,7 +1824,7 @@ static hfvis_status hf_horizon_map_range(const hfvis_grid *grid, int K, const hf
             }
             hf_lattice_fill(&sw, HF_NAN);
             hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL);
-            hf_gather_planes(&sw, 1, m, out + (size_t)(k - begin) * plane, 0, grid->width);
+            hf_gather_planes(&sw, 1, m, out + (size_t)(pos - begin) * plane, 0, grid->width);
             hf_progress(o, ++done, end - begin);
         }
     }
@@ -1839,7 +1848,8 @@ hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_
     if (hf_direction_range(&o, K, &begin, &end) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     per = K % 4 == 0 ? 4 : 1;
     groups = K / per;
-    if (end - begin < K) return hf_horizon_map_range(grid, K, &o, begin, end, out);
+    if (end - begin < K || hf_direction_position(&o, K, 1) != 1) /* a part, or planes in sweep order */
+        return hf_horizon_map_range(grid, K, &o, begin, end, out);
     if ((s = hf_sweep_alloc(&sw, grid, &o, 0, per, 0)) != HFVIS_OK) return s;
     for (gidx = 0; gidx < groups; gidx++) {
         double ux, uy;
@@ -2046,8 +2056,8 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
         int m0, any = 0;
         size_t i, n;
         for (m = 0; m < per; m++) {
-            int k = gidx + m * groups;
-            any |= k >= begin && k < end;
+            int pos = hf_direction_position(o, K, gidx + m * groups);
+            any |= pos >= begin && pos < end;
         }
         if (!any) continue;
         hf_direction_base(K, gidx, o->azimuth0_rad, &ux, &uy, &m0);
@@ -2059,8 +2069,8 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
         }
         if (ctx->group) ctx->group(sw, ctx);
         for (m = 0; m < per; m++) {
-            int k = gidx + m * groups;
-            if (k < begin || k >= end) continue;
+            int k = gidx + m * groups, pos = hf_direction_position(o, K, k);
+            if (pos < begin || pos >= end) continue;
             ctx->K = K;
             ctx->k = k;
             hf_look_dir(sw, m, &ctx->lx, &ctx->ly);

@@ -322,6 +322,18 @@ HFVIS_API int hfvis_lattice_line(const hfvis_lattice *lattice, int j, int *i_fir
 /* hfvis.c - P1 horizons ([P1] §5 Alg. 1, App. A.1; spec heightfield §4)                      */
 /* ========================================================================================== */
 
+/* How hfvis_sweep_options.direction_begin/end count the K directions. */
+typedef enum hfvis_direction_order {
+    HFVIS_DIRECTION_ORDER_DEFAULT = 0, /* = INDEX */
+    HFVIS_DIRECTION_ORDER_INDEX = 1,   /* position p is direction k = p */
+    HFVIS_DIRECTION_ORDER_SWEEP = 2    /* the order the sweep visits them: when K % 4 == 0,
+                                          position p is k = p/4 + (p%4)*K/4, so the four quarter
+                                          turns that share one sampled lattice (spec §3.6) are
+                                          consecutive; else k = p. A range of whole quarter-turn
+                                          groups (begin, end multiples of 4) samples only its own
+                                          lattices: P such parts cost about 1/P of the run each */
+} hfvis_direction_order;
+
 /* Options shared by every sweep (horizons, sky light, sky-view factor, shadows, environment). */
 typedef struct hfvis_sweep_options {
     hfvis_border border;            /* default HFVIS_BORDER_OPEN */
@@ -329,8 +341,9 @@ typedef struct hfvis_sweep_options {
                                        0 = max(width, height) */
     double azimuth0_rad;            /* psi_0 of direction 0 */
     const hfvis_allocator *alloc;   /* scratch; NULL = malloc/free */
-    int direction_begin;            /* process only directions [begin, end) of the K, 0 <= begin */
-    int direction_end;              /* < end <= K (else HFVIS_ERR_INVALID_ARGUMENT); 0, 0 = all K.
+    int direction_begin;            /* process only the directions at positions [begin, end) of */
+    int direction_end;              /* the K (direction_order), 0 <= begin < end <= K (else
+                                       HFVIS_ERR_INVALID_ARGUMENT); 0, 0 = all K.
                                        Honoured by the per-direction sums (sky light, sky-view
                                        factor, environment light, visibility index, intervisibility,
                                        one indirect gather, hfvis_direction_sums: each returns its
@@ -339,6 +352,7 @@ typedef struct hfvis_sweep_options {
                                        (hfvis_horizon_direction, hfvis_sun_visibility, lattices) */
     hfvis_progress_fn progress;     /* optional, called once per direction */
     void *progress_user;
+    hfvis_direction_order direction_order; /* how direction_begin/end count; default INDEX */
 } hfvis_sweep_options;
 
 HFVIS_API hfvis_sweep_options hfvis_sweep_options_default(void);
@@ -384,8 +398,9 @@ HFVIS_API hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, in
  * large: K = 64 at 1024^2 is 256 MiB; prefer the fused lighting calls). When K % 4 == 0 the
  * four directions psi, psi+pi/2, psi+pi, psi+3pi/2 share one sampled lattice (spec §3.6).
  * With opts->direction_begin/end = [b, e) only those planes are made: out then holds
- * (e-b)*width*height floats, plane k at out[(k-b)*width*height ...], bit-identical to plane k
- * of the full map (split a map across processes and stack the parts).
+ * (e-b)*width*height floats, in position order (opts->direction_order): the direction at
+ * position p is out[(p-b)*width*height ...], bit-identical to its plane of the full map (split a
+ * map across processes and stack the parts).
  * Returns HFVIS_ERR_INVALID_ARGUMENT for K < 1 or a bad range. Cost O(K*width*height). */
 HFVIS_API hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K,
                                          const hfvis_sweep_options *opts, float *out);
@@ -1334,7 +1349,9 @@ HFVIS_API hfvis_status hfvis_ns_sample_matrices(const hfvis_ns_wedges *set, doub
  * runs lose nothing to float rounding: adding the doubles of the parts in range order gives S
  * up to double rounding (at most (P-1) * 2^-53 * |S| for P parts, far below a float ulp), and
  * the finish in float then equals the single run's output except where S lies that close to a
- * float rounding boundary (at most 1 ulp apart then). */
+ * float rounding boundary (at most 1 ulp apart then). With HFVIS_DIRECTION_ORDER_SWEEP and parts
+ * of exactly one quarter-turn group each (K % 4 == 0, ranges [4g, 4g+4)), added in position
+ * order, the additions are the single run's own, one gathered group at a time: bit-exact. */
 
 typedef enum hfvis_sum_kind {
     HFVIS_SUM_SKY_VIEW = 1,   /* T_k = sin(max(alpha_k, 0)); hfvis_sky_view_factor = (float)(1 - S/K) */

@@ -303,9 +303,13 @@ static const char cli_shared_help[] =
     "                    from north (psi_k = 2 pi k/K - pi/2); --azimuth0 is then the bearing of\n"
     "                    direction 0 in radians (psi_0 = azimuth0 - pi/2)\n"
     "  --degrees         angle outputs in degrees instead of radians\n"
-    "  --dir-range A:B   horizon, skyview, sky, light, visibility: only directions A..B-1 of the K\n"
-    "                    (0 <= A < B <= K); OUT (*.hfvs) is then a partial result, and\n"
-    "                    'hfvis sum' adds the parts of a split into the single run's OUT\n"
+    "  --dir-range A:B   horizon, skyview, sky, light, visibility: only the directions at\n"
+    "                    positions A..B-1 of the K (0 <= A < B <= K) in sweep order (with K a\n"
+    "                    multiple of 4, each 4 consecutive positions are the quarter turns\n"
+    "                    k, k+K/4, k+K/2, k+3K/4 that share one lattice: give A and B as\n"
+    "                    multiples of 4 and each part costs its share of the run); OUT (*.hfvs)\n"
+    "                    is then a partial result, and 'hfvis sum' adds the parts of a split\n"
+    "                    into the single run's OUT\n"
     "  --border MODE     open (nothing outside the grid, default), clamp (edge heights extend\n"
     "                    outward) or wrap (periodic field)\n"
     "  --border-cells N  clamp/wrap: lines start N cells outside the grid, 1..1048576\n"
@@ -2297,6 +2301,7 @@ static int cli_run_partial(const cli_args *a, const hfvis_grid *grid, hfvis_swee
 
     opts->direction_begin = a->dir_begin;
     opts->direction_end = a->dir_end;
+    opts->direction_order = HFVIS_DIRECTION_ORDER_SWEEP; /* parts of whole quarter-turn groups */
     if (a->cmd == CMD_HORIZON) {
         planes = count;
         if ((size_t)a->dirs > CLI_HORIZON_MAX_VALUES / n || (long long)a->dirs * grid->height > HFVIS_IMAGE_MAX_DIM)
@@ -2588,10 +2593,13 @@ static int cli_sum(int argc, char **argv)
         hfvis_partial p;
         const size_t count = n * (size_t)meta[order[i]].planes;
         if ((rc = cli_sum_load(names[order[i]], &p, &meta[order[i]])) != 0) goto done;
-        if (cmd == CMD_HORIZON) {
-            float *dst = out + (size_t)p.begin * n;
-            for (k = 0; k < count; k++)
-                dst[k] = deg ? (float)(p.sums[k] * (180.0 / CLI_PI)) : (float)p.sums[k];
+        if (cmd == CMD_HORIZON) { /* plane j is the direction at sweep position begin + j */
+            for (j = 0; j < p.planes; j++) {
+                int pos = p.begin + j, kk = K % 4 ? pos : pos / 4 + (pos % 4) * (K / 4);
+                const double *src = p.sums + (size_t)j * n;
+                float *dst = out + (size_t)kk * n;
+                for (k = 0; k < n; k++) dst[k] = deg ? (float)(src[k] * (180.0 / CLI_PI)) : (float)src[k];
+            }
         } else if (i == 0) {
             memcpy(acc, p.sums, count * sizeof(double));
         } else {

@@ -283,6 +283,63 @@ TEST(bad_ranges)
     }
 }
 
+/* HFVIS_DIRECTION_ORDER_SWEEP: position p is k = p/4 + (p%4)*K/4. Horizon parts come out in
+ * position order, bit-identical to their planes; sum parts of exactly one quarter-turn group,
+ * added in position order, repeat the single run's own order of additions (one gathered group
+ * at a time into the accumulator), so they are bit-exact too. */
+TEST(sweep_order_parts)
+{
+    static const hfvis_sum_kind kinds[] = { HFVIS_SUM_SKY_VIEW, HFVIS_SUM_SKY_LIGHT, HFVIS_SUM_VISIBILITY };
+    hfvis_grid g = make_grid(21);
+    const int K = 16, G = K / 4;
+    const size_t plane = (size_t)W * H, n = plane;
+    hfvis_sweep_options o = hfvis_sweep_options_default();
+    int p, j, ok = 1;
+    size_t kk, i;
+    o.azimuth0_rad = 0.7;
+    CHECK_EQ_STATUS(hfvis_horizon_map(&g, K, &o, full), HFVIS_OK);
+    o.direction_order = HFVIS_DIRECTION_ORDER_SWEEP;
+    for (p = 0; p < K; p += 4) { /* one group per part, then one odd-sized part */
+        o.direction_begin = p;
+        o.direction_end = p + 4;
+        CHECK_EQ_STATUS(hfvis_horizon_map(&g, K, &o, part), HFVIS_OK);
+        for (j = 0; j < 4; j++) {
+            int pos = p + j, k = pos / 4 + (pos % 4) * G;
+            ok &= same_bits(part + (size_t)j * plane, full + (size_t)k * plane, plane);
+        }
+    }
+    o.direction_begin = 3;
+    o.direction_end = 10;
+    CHECK_EQ_STATUS(hfvis_horizon_map(&g, K, &o, part), HFVIS_OK);
+    for (j = 0; j < 7; j++) {
+        int pos = 3 + j, k = pos / 4 + (pos % 4) * G;
+        ok &= same_bits(part + (size_t)j * plane, full + (size_t)k * plane, plane);
+    }
+    o.direction_begin = o.direction_end = 0; /* all K in sweep order */
+    CHECK_EQ_STATUS(hfvis_horizon_map(&g, K, &o, part), HFVIS_OK);
+    ok &= same_bits(part + 1 * plane, full + (size_t)G * plane, plane);
+    CHECK(ok);
+    for (kk = 0; kk < sizeof kinds / sizeof kinds[0]; kk++) {
+        o.direction_begin = o.direction_end = 0;
+        o.direction_order = HFVIS_DIRECTION_ORDER_INDEX;
+        CHECK_EQ_STATUS(hfvis_direction_sums(&g, K, kinds[kk], NULL, NULL, &o, dfull), HFVIS_OK);
+        o.direction_order = HFVIS_DIRECTION_ORDER_SWEEP;
+        for (p = 0; p < K; p += 4) {
+            o.direction_begin = p;
+            o.direction_end = p + 4;
+            CHECK_EQ_STATUS(hfvis_direction_sums(&g, K, kinds[kk], NULL, NULL, &o, dpart), HFVIS_OK);
+            for (i = 0; i < n; i++) dacc[i] = p == 0 ? dpart[i] : dacc[i] + dpart[i];
+        }
+        CHECK(memcmp(dacc, dfull, n * sizeof(double)) == 0);
+    }
+    o.direction_order = (hfvis_direction_order)3;
+    CHECK_EQ_STATUS(hfvis_direction_sums(&g, K, HFVIS_SUM_SKY_VIEW, NULL, NULL, &o, dpart),
+                    HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_horizon_map(&g, K, &o, part), HFVIS_ERR_INVALID_ARGUMENT);
+    o.direction_order = (hfvis_direction_order)-1;
+    CHECK_EQ_STATUS(hfvis_sky_view_factor(&g, K, &o, part, W), HFVIS_ERR_INVALID_ARGUMENT);
+}
+
 /* A counting allocator that fails allocation number fail_at (0-based; -1 = never). */
 typedef struct count_alloc { int calls, fail_at, live; } count_alloc;
 static void *ca_alloc(void *user, size_t size)
@@ -504,6 +561,7 @@ int main(int argc, char **argv)
     RUN(direction_sums_split_within_double_rounding);
     RUN(float_routines_split);
     RUN(bad_ranges);
+    RUN(sweep_order_parts);
     RUN(allocation_failures);
     RUN(partial_round_trip);
     RUN(partial_encode_rejects_invalid);
