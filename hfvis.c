@@ -6561,7 +6561,9 @@ static int hf_partial_valid(const hfvis_partial *p, size_t *values, size_t *tag_
         p->begin >= p->end || p->end > p->directions)
         return 0;
     n = (size_t)p->width * (size_t)p->height;
-    if (!hf_mul_size(n, (size_t)p->planes, &n) || n > HFVIS_IMAGE_MAX_VALUES) return 0;
+    if (!hf_mul_size(n, (size_t)p->planes, &n) || (unsigned long long)n > HFVIS_PARTIAL_MAX_VALUES ||
+        n > SIZE_MAX / 8u)
+        return 0;
     for (t = 0; t <= HFVIS_PARTIAL_MAX_TAG && p->tag[t] != '\0'; t++)
         if ((unsigned char)p->tag[t] < 32u || (unsigned char)p->tag[t] > 126u) return 0;
     if (t == 0 || t > HFVIS_PARTIAL_MAX_TAG) return 0;
@@ -6681,9 +6683,11 @@ hfvis_status hfvis_partial_decode(const void *data, size_t size, const hfvis_all
     if (r.width > HFVIS_IMAGE_MAX_DIM || r.height > HFVIS_IMAGE_MAX_DIM || r.planes > HFVIS_PARTIAL_MAX_PLANES)
         return HFVIS_ERR_LIMIT;
     values = (size_t)r.width * (size_t)r.height;
-    if (!hf_mul_size(values, (size_t)r.planes, &values) || values > HFVIS_IMAGE_MAX_VALUES)
+    if (!hf_mul_size(values, (size_t)r.planes, &values) ||
+        (unsigned long long)values > HFVIS_PARTIAL_MAX_VALUES || values > SIZE_MAX / 8u)
         return HFVIS_ERR_LIMIT;
-    bytes = values * 8u; /* <= 2^31 */
+    bytes = values * 8u;
+    if (bytes > SIZE_MAX - tag_len - 1u) return HFVIS_ERR_LIMIT;
     if (size - pos != bytes) return HFVIS_ERR_FORMAT;
     block = bytes + tag_len + 1u;
     mem = (unsigned char *)hf_alloc(alloc, block);

@@ -1382,11 +1382,12 @@ HFVIS_API hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis
  * tool stores its command and every parameter that changes the result there. */
 #define HFVIS_PARTIAL_MAX_TAG 4096
 #define HFVIS_PARTIAL_MAX_PLANES 65536
+#define HFVIS_PARTIAL_MAX_VALUES ((unsigned long long)1 << 32) /* planes*width*height (32 GiB) */
 
 typedef struct hfvis_partial {
     int width, height;        /* of the grid, 1..HFVIS_IMAGE_MAX_DIM */
     int planes;               /* values per sample, 1..HFVIS_PARTIAL_MAX_PLANES; planes*width*height
-                                 <= HFVIS_IMAGE_MAX_VALUES */
+                                 <= HFVIS_PARTIAL_MAX_VALUES (and its bytes must fit a size_t) */
     int directions;           /* K of the whole run, >= 1 */
     int begin, end;           /* the directions [begin, end) this part holds, 0 <= begin < end <= K */
     const char *tag;          /* NUL-terminated, 1..HFVIS_PARTIAL_MAX_TAG printable ASCII chars */
@@ -1405,7 +1406,8 @@ HFVIS_API hfvis_status hfvis_partial_encode(const hfvis_partial *p, void *out,
  * holds the sums and the tag: release it with hfvis_partial_free. p is untouched on error.
  * Returns HFVIS_OK, HFVIS_ERR_INVALID_ARGUMENT (NULL data or p), HFVIS_ERR_FORMAT (bad magic or
  * version, malformed numbers, a range or tag out of bounds, wrong data length), HFVIS_ERR_LIMIT
- * (planes*width*height over HFVIS_IMAGE_MAX_VALUES or a side over HFVIS_IMAGE_MAX_DIM) or
+ * (planes*width*height over HFVIS_PARTIAL_MAX_VALUES or SIZE_MAX/8, or a side over
+ * HFVIS_IMAGE_MAX_DIM) or
  * HFVIS_ERR_OUT_OF_MEMORY. Cost O(size). */
 HFVIS_API hfvis_status hfvis_partial_decode(const void *data, size_t size,
                                             const hfvis_allocator *alloc, hfvis_partial *p);

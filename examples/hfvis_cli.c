@@ -2311,8 +2311,8 @@ static int cli_run_partial(const cli_args *a, const hfvis_grid *grid, hfvis_swee
                              HFVIS_IMAGE_MAX_DIM);
     } else if (a->cmd == CMD_LIGHT) planes = channels = env->channels;
     else if (a->cmd == CMD_VISIBILITY && a->fraction) planes = 2;
-    if ((size_t)planes > HFVIS_IMAGE_MAX_VALUES / n)
-        return cli_error(CLI_EXIT_ERROR, cmd, "%s: %d planes of %d x %d exceed the limit of 2^28 "
+    if ((unsigned long long)planes * n > HFVIS_PARTIAL_MAX_VALUES || (size_t)planes > SIZE_MAX / 8u / n)
+        return cli_error(CLI_EXIT_ERROR, cmd, "%s: %d planes of %d x %d exceed the limit of 2^32 "
                          "values; use a smaller --dir-range", hfvis_status_string(HFVIS_ERR_LIMIT),
                          planes, grid->width, grid->height);
     sums = (double *)malloc(n * (size_t)planes * sizeof(double));
@@ -2573,8 +2573,7 @@ static int cli_sum(int argc, char **argv)
     n = (size_t)W * (size_t)H;
     if (cmd == CMD_LIGHT) channels = planes;
     if (cmd == CMD_HORIZON) out_planes = K;
-    if ((size_t)out_planes * (size_t)channels > HFVIS_IMAGE_MAX_VALUES / n ||
-        (long long)out_planes * H > HFVIS_IMAGE_MAX_DIM) {
+    if ((size_t)out_planes > CLI_HORIZON_MAX_VALUES / n || (long long)out_planes * H > HFVIS_IMAGE_MAX_DIM) {
         rc = cli_error(CLI_EXIT_ERROR, cmdname, "%s: %d planes of %d x %d exceed the limit of 2^28 "
                        "values and %d rows", hfvis_status_string(HFVIS_ERR_LIMIT), out_planes, W, H,
                        HFVIS_IMAGE_MAX_DIM);

@@ -456,7 +456,7 @@ TEST(partial_encode_rejects_invalid)
     b = p; b.tag = "two\nlines"; CHECK(hfvis_partial_encode_size(&b) == 0);
     b = p; b.tag = NULL; CHECK(hfvis_partial_encode_size(&b) == 0);
     b = p; b.sums = NULL; CHECK(hfvis_partial_encode_size(&b) == 0);
-    b = p; b.width = 1 << 15; b.height = 1 << 14; CHECK(hfvis_partial_encode_size(&b) == 0);
+    b = p; b.width = 1 << 20; b.height = 1 << 13; CHECK(hfvis_partial_encode_size(&b) == 0);
     CHECK(hfvis_partial_encode_size(NULL) == 0);
     b = p; b.end = 3;
     CHECK_EQ_STATUS(hfvis_partial_encode(&b, enc, sizeof enc, &w), HFVIS_ERR_INVALID_ARGUMENT);
@@ -515,7 +515,8 @@ TEST(partial_malformed_headers)
     CHECK_EQ_STATUS(decode_with_header("3 2 1 8 0 8", "", 48), HFVIS_ERR_FORMAT);    /* empty tag */
     CHECK_EQ_STATUS(decode_with_header("3 2 1 8 0 8", "t\tab", 48), HFVIS_ERR_FORMAT);
     CHECK_EQ_STATUS(decode_with_header("1048577 1 1 8 0 8", "t", 0), HFVIS_ERR_LIMIT);
-    CHECK_EQ_STATUS(decode_with_header("16384 16385 1 8 0 8", "t", 0), HFVIS_ERR_LIMIT);
+    CHECK_EQ_STATUS(decode_with_header("65536 65537 1 8 0 8", "t", 0), HFVIS_ERR_LIMIT);
+    CHECK_EQ_STATUS(decode_with_header("16384 16385 1 8 0 8", "t", 0), HFVIS_ERR_FORMAT); /* short */
     CHECK_EQ_STATUS(decode_with_header("1 1 65537 8 0 8", "t", 0), HFVIS_ERR_LIMIT);
     memset(longtag, 'x', sizeof longtag);
     longtag[HFVIS_PARTIAL_MAX_TAG] = '\0';

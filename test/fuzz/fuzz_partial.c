@@ -26,7 +26,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         || p.begin >= p.end || p.end > p.directions || !p.tag || !p.sums)
         abort();
     values = (size_t)p.width * (size_t)p.height * (size_t)p.planes;
-    if (values > HFVIS_IMAGE_MAX_VALUES || strlen(p.tag) < 1 || strlen(p.tag) > HFVIS_PARTIAL_MAX_TAG)
+    if ((unsigned long long)values > HFVIS_PARTIAL_MAX_VALUES || strlen(p.tag) < 1 || strlen(p.tag) > HFVIS_PARTIAL_MAX_TAG)
         abort();
     need = hfvis_partial_encode_size(&p);
     if (need != size) abort(); /* the format has one spelling per content */
