@@ -1800,9 +1800,10 @@ static int hf_direction_position(const hfvis_sweep_options *o, int K, int k)
     return (k % (K / 4)) * 4 + k / (K / 4);
 }
 
-/* The planes [begin, end) of the map: each direction exactly as hfvis_horizon_direction does it
- * (its group's lattice sampled once, one orientation at a time), so plane k is bit-identical to
- * plane k of the full map. */
+/* The planes of the positions [begin, end) (direction_order) of the map: each direction exactly
+ * as hfvis_horizon_direction does it (its group's lattice sampled once, one orientation at a
+ * time), so the plane of position p, out + (p - begin)*plane, is bit-identical to its plane k of
+ * the full map. */
 static hfvis_status hf_horizon_map_range(const hfvis_grid *grid, int K, const hfvis_sweep_options *o,
                                          int begin, int end, float *out)
 {
