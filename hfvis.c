@@ -6489,7 +6489,7 @@ hfvis_status hfvis_ns_gi(const hfvis_grid *grid, const hfvis_ns_scene *scene,
 /* 15. Split runs: raw direction sums and the partial-sum file                                */
 /* ========================================================================================== */
 /* Every fused output is a finish of a per-receiver sum over directions (hfvis.h, "split runs"):
- * Zaksek et al. 2011 Eq. 1 (SVF), [P1] Eq. 5-6 (sky, environment), [P2] §8 (visibility index).
+ * Zaksek et al. 2011 (SVF), [P1] Eq. 5-6 (sky, environment), spec heightfield §8 (visibility index).
  * hfvis_direction_sums runs the same fused consumer as the finished routine over the options'
  * direction range and returns the grid accumulator itself, in double. */
 

@@ -685,9 +685,9 @@ HFVIS_API hfvis_status hfvis_intervisibility(const hfvis_grid *grid, int K,
 /* Visibility index ("total viewshed"): the number of samples each grid point sees along the K
  * directions, sum over k of the visible samples of its line (gathered from the lattice like the
  * light paths). Pre-roll samples outside the grid are not counted. NaN at holes.
- * opts->direction_begin/end select a partial count ([P2] §8: a sum over the K lines); the counts
- * are gathered bilinearly from the lattices, so they are not integers off the axis directions,
- * and the parts of a split add up to the full count up to float rounding. */
+ * opts->direction_begin/end select a partial count (spec heightfield §8: a sum over the K
+ * lines); the counts are gathered bilinearly from the lattices, so they are not integers off the
+ * axis directions, and the parts of a split add up to the full count up to float rounding. */
 HFVIS_API hfvis_status hfvis_visibility_count(const hfvis_grid *grid, int K,
                                               const hfvis_sweep_options *opts,
                                               const hfvis_tree_options *tree_opts, float *out,
@@ -1341,13 +1341,14 @@ HFVIS_API hfvis_status hfvis_ns_sample_matrices(const hfvis_ns_wedges *set, doub
 /* ========================================================================================== */
 /* Every fused output above is a finish f(S) of a per-receiver sum over the K directions,
  * S = sum_k T_k: the sky-view factor 1 - S/K with T_k = sin(max(alpha_k, 0)) (Zaksek et al.
- * 2011, Eq. 1), the uniform sky albedo*sky*S with T_k = [P1] Eq. 5's sector integral S_k, the
+ * 2011), the uniform sky albedo*sky*S with T_k = [P1] Eq. 5's sector integral S_k, the
  * environment albedo*S with T_k = [P1] Eq. 6's sector term, the visibility index S with T_k the
- * samples seen along line k ([P2] §8), each gathered from its lattice to the grid points. A run over a direction range [b, e) (sweep options)
- * returns the partial sum of its range; the partial sums of ranges that tile [0, K) add up to S.
- * hfvis_direction_sums returns S (or a partial S) in double, before the finish, so that split
- * runs lose nothing to float rounding: adding the doubles of the parts in range order gives S
- * up to double rounding (at most (P-1) * 2^-53 * |S| for P parts, far below a float ulp), and
+ * samples seen along line k (spec heightfield §8), each gathered from its lattice to the grid
+ * points. A run over a direction range [b, e) (sweep options) returns the partial sum of its
+ * range; the partial sums of ranges that tile [0, K) add up to S. hfvis_direction_sums returns S
+ * (or a partial S) in double, before the finish, so that split runs lose nothing to float
+ * rounding: the terms are non-negative, so adding the parts in range order gives the single
+ * run's S up to K * 2^-52 * S (two orders of at most K additions, far below a float ulp), and
  * the finish in float then equals the single run's output except where S lies that close to a
  * float rounding boundary (at most 1 ulp apart then). With HFVIS_DIRECTION_ORDER_SWEEP and parts
  * of exactly one quarter-turn group each (K % 4 == 0, ranges [4g, 4g+4)), added in position
@@ -1357,7 +1358,7 @@ typedef enum hfvis_sum_kind {
     HFVIS_SUM_SKY_VIEW = 1,   /* T_k = sin(max(alpha_k, 0)); hfvis_sky_view_factor = (float)(1 - S/K) */
     HFVIS_SUM_SKY_LIGHT = 2,  /* T_k = [P1] Eq. 5 S_k; hfvis_sky_light = (float)(sky*albedo * S) */
     HFVIS_SUM_ENV_LIGHT = 3,  /* [P1] Eq. 6 per channel; hfvis_env_light = (float)(albedo * S) */
-    HFVIS_SUM_VISIBILITY = 4  /* samples seen ([P2] §8); hfvis_visibility_count = (float)S */
+    HFVIS_SUM_VISIBILITY = 4  /* samples seen (spec heightfield §8); hfvis_visibility_count = (float)S */
 } hfvis_sum_kind;
 
 /* Raw per-receiver sums S of the directions opts->direction_begin/end (all K when 0, 0) for

@@ -2304,7 +2304,8 @@ static int cli_run_partial(const cli_args *a, const hfvis_grid *grid, hfvis_swee
     opts->direction_order = HFVIS_DIRECTION_ORDER_SWEEP; /* parts of whole quarter-turn groups */
     if (a->cmd == CMD_HORIZON) {
         planes = count;
-        if ((size_t)a->dirs > CLI_HORIZON_MAX_VALUES / n || (long long)a->dirs * grid->height > HFVIS_IMAGE_MAX_DIM)
+        if ((size_t)a->dirs > CLI_HORIZON_MAX_VALUES / n ||
+            (long long)a->dirs * grid->height > HFVIS_IMAGE_MAX_DIM)
             return cli_error(CLI_EXIT_ERROR, cmd, "%s: the summed map, %d planes of %d x %d, would exceed "
                              "the limit of 2^28 values and %d rows; use fewer --dirs, or skyview/sky/light",
                              hfvis_status_string(HFVIS_ERR_LIMIT), a->dirs, grid->width, grid->height,
@@ -2581,7 +2582,10 @@ static int cli_sum(int argc, char **argv)
     }
     out = cli_alloc(n, (size_t)out_planes, (size_t)channels);
     if (cmd != CMD_HORIZON) acc = (double *)malloc(n * (size_t)planes * sizeof(double));
-    if (!out || (cmd != CMD_HORIZON && !acc)) { rc = cli_status(cmdname, HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
+    if (!out || (cmd != CMD_HORIZON && !acc)) {
+        rc = cli_status(cmdname, HFVIS_ERR_OUT_OF_MEMORY, 0);
+        goto done;
+    }
     if (cmd == CMD_HORIZON) {
         char v[8];
         deg = cli_tag_value(meta[0].tag, "degrees", v, sizeof v) && !strcmp(v, "1");
