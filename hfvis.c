@@ -20,6 +20,7 @@
  *  14. Nowrouzezahrai-Snyder GI pipeline: slice scanning over the height pyramid, casting sets,
  *      wedges to SH visibility, environment, directional and key lights, diffuse and glossy
  *      bounces through the radiance pyramid, sub-sampling ([NS09] §5-9; spec GI B.2-B.9, B.12)
+ *  15. Split runs: raw per-receiver direction sums in double and the partial-sum file
  *
  * Paper references: [P1] Timonen & Westerholm, "Scalable Height Field Self-Shadowing",
  * CGF 29(2), 2010 (thesis appendix A.1). "spec" is the project's restatement
@@ -1155,7 +1156,9 @@ static size_t hf_align_add(size_t *total, size_t count, size_t elem, int *ok)
 static int hf_opts_valid(const hfvis_sweep_options *o)
 {
     return !o || (hf_border_valid(o->border) && o->border_cells >= 0 && isfinite(o->azimuth0_rad) &&
-                  o->direction_begin >= 0 && o->direction_end >= 0);
+                  o->direction_begin >= 0 && o->direction_end >= 0 &&
+                  o->direction_order >= HFVIS_DIRECTION_ORDER_DEFAULT &&
+                  o->direction_order <= HFVIS_DIRECTION_ORDER_SWEEP);
 }
 
 /* Resolved options (NULL or zero fields = defaults). */
@@ -1788,6 +1791,48 @@ hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, int k,
     return HFVIS_OK;
 }
 
+static hfvis_status hf_direction_range(const hfvis_sweep_options *o, int K, int *begin, int *end);
+
+/* Position of direction k in the order of o->direction_order (hfvis.h). */
+static int hf_direction_position(const hfvis_sweep_options *o, int K, int k)
+{
+    if (o->direction_order != HFVIS_DIRECTION_ORDER_SWEEP || K % 4 != 0) return k;
+    return (k % (K / 4)) * 4 + k / (K / 4);
+}
+
+/* The planes of the positions [begin, end) (direction_order) of the map: each direction exactly
+ * as hfvis_horizon_direction does it (its group's lattice sampled once, one orientation at a
+ * time), so the plane of position p, out + (p - begin)*plane, is bit-identical to its plane k of
+ * the full map. */
+static hfvis_status hf_horizon_map_range(const hfvis_grid *grid, int K, const hfvis_sweep_options *o,
+                                         int begin, int end, float *out)
+{
+    hf_sweep sw;
+    hfvis_status s;
+    size_t plane = hf_grid_count(grid);
+    int per = K % 4 == 0 ? 4 : 1, groups = K / per, gidx, m, done = 0;
+    if ((s = hf_sweep_alloc(&sw, grid, o, 0, 1, 0)) != HFVIS_OK) return s;
+    for (gidx = 0; gidx < groups; gidx++) {
+        double ux, uy;
+        int m0, sampled = 0;
+        for (m = 0; m < per; m++) {
+            int k = gidx + m * groups, pos = hf_direction_position(o, K, k);
+            if (pos < begin || pos >= end) continue;
+            if (!sampled) {
+                hf_direction_base(K, gidx, o->azimuth0_rad, &ux, &uy, &m0);
+                hf_sweep_group(&sw, ux, uy);
+                sampled = 1;
+            }
+            hf_lattice_fill(&sw, HF_NAN);
+            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL);
+            hf_gather_planes(&sw, 1, m, out + (size_t)(pos - begin) * plane, 0, grid->width);
+            hf_progress(o, ++done, end - begin);
+        }
+    }
+    hf_sweep_free(&sw);
+    return HFVIS_OK;
+}
+
 hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
                                float *out)
 {
@@ -1796,12 +1841,16 @@ hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_
     hfvis_status s;
     size_t plane = 0, total;
     int groups, per, gidx, m, done = 0;
+    int begin, end;
     if (hf_check_common(grid, opts) != HFVIS_OK || !out || K < 1) return HFVIS_ERR_INVALID_ARGUMENT;
     plane = hf_grid_count(grid);
     if (!hf_mul_size(plane, (size_t)K, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
+    if (hf_direction_range(&o, K, &begin, &end) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     per = K % 4 == 0 ? 4 : 1;
     groups = K / per;
+    if (end - begin < K || hf_direction_position(&o, K, 1) != 1) /* a part, or planes in sweep order */
+        return hf_horizon_map_range(grid, K, &o, begin, end, out);
     if ((s = hf_sweep_alloc(&sw, grid, &o, 0, per, 0)) != HFVIS_OK) return s;
     for (gidx = 0; gidx < groups; gidx++) {
         double ux, uy;
@@ -2008,8 +2057,8 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
         int m0, any = 0;
         size_t i, n;
         for (m = 0; m < per; m++) {
-            int k = gidx + m * groups;
-            any |= k >= begin && k < end;
+            int pos = hf_direction_position(o, K, gidx + m * groups);
+            any |= pos >= begin && pos < end;
         }
         if (!any) continue;
         hf_direction_base(K, gidx, o->azimuth0_rad, &ux, &uy, &m0);
@@ -2021,8 +2070,8 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
         }
         if (ctx->group) ctx->group(sw, ctx);
         for (m = 0; m < per; m++) {
-            int k = gidx + m * groups;
-            if (k < begin || k >= end) continue;
+            int k = gidx + m * groups, pos = hf_direction_position(o, K, k);
+            if (pos < begin || pos >= end) continue;
             ctx->K = K;
             ctx->k = k;
             hf_look_dir(sw, m, &ctx->lx, &ctx->ly);
@@ -6435,3 +6484,263 @@ hfvis_status hfvis_ns_gi(const hfvis_grid *grid, const hfvis_ns_scene *scene,
     for (q = 3; q >= 0; q--) hf_free(alloc, blk[q]);
     return HFVIS_OK;
 }
+
+/* ========================================================================================== */
+/* 15. Split runs: raw direction sums and the partial-sum file                                */
+/* ========================================================================================== */
+/* Every fused output is a finish of a per-receiver sum over directions (hfvis.h, "split runs"):
+ * Zaksek et al. 2011 (SVF), [P1] Eq. 5-6 (sky, environment), spec heightfield §8 (visibility index).
+ * hfvis_direction_sums runs the same fused consumer as the finished routine over the options'
+ * direction range and returns the grid accumulator itself, in double. */
+
+hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind kind,
+                                  const hfvis_env *env, const hfvis_env_options *eopts,
+                                  const hfvis_sweep_options *opts, double *sums)
+{
+    hfvis_sweep_options o;
+    hf_sweep sw;
+    hf_sky_ctx sky;
+    hf_env_ctx ec;
+    hf_env_eval eval;
+    hf_p2_ctx p2;
+    float *table = NULL;
+    hfvis_status s;
+    int channels = 1, begin, end, x, y, c;
+    if (hf_check_common(grid, opts) != HFVIS_OK || !sums || K < 1 || kind < HFVIS_SUM_SKY_VIEW ||
+        kind > HFVIS_SUM_VISIBILITY || (kind == HFVIS_SUM_ENV_LIGHT && !hf_env_valid(env)))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    o = hf_opts_resolve(grid, opts);
+    if (hf_direction_range(&o, K, &begin, &end) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    memset(&sky, 0, sizeof sky);
+    switch (kind) {
+    case HFVIS_SUM_SKY_VIEW:
+        s = hf_fused_run(&sw, grid, K, &o, 1, 0, hf_svf_line, &sky.f);
+        break;
+    case HFVIS_SUM_SKY_LIGHT:
+        sky.inv_k = 1.0 / (double)K;
+        sky.lobe = sin(HF_PI / (double)K) / HF_PI;
+        s = hf_fused_run(&sw, grid, K, &o, 1, 1, hf_sky_line, &sky.f);
+        break;
+    case HFVIS_SUM_ENV_LIGHT:
+        channels = env->channels;
+        s = hf_env_tables_create(env, K, o.azimuth0_rad, eopts, o.alloc, &table, &eval);
+        if (s != HFVIS_OK) return s;
+        memset(&ec, 0, sizeof ec);
+        ec.e = &eval;
+        s = hf_fused_run(&sw, grid, K, &o, channels, 1, hf_env_line, &ec.f);
+        break;
+    default: /* HFVIS_SUM_VISIBILITY */
+        memset(&p2, 0, sizeof p2);
+        p2.fn = hf_p2_count;
+        s = hf_p2_run(&sw, grid, K, &o, 1, 0, &p2);
+        break;
+    }
+    if (s == HFVIS_OK) {
+        for (y = 0; y < grid->height; y++)
+            for (x = 0; x < grid->width; x++) {
+                size_t i = ((size_t)y * (size_t)grid->width + (size_t)x) * (size_t)channels;
+                int hole = hf_is_hole(grid, x, y);
+                for (c = 0; c < channels; c++) sums[i + (size_t)c] = hole ? HF_NAN : sw.gacc[i + (size_t)c];
+            }
+        hf_sweep_free(&sw);
+    }
+    hf_free(o.alloc, table);
+    return s;
+}
+
+#define HF_PARTIAL_MAGIC "HFVISSUM 1\n"
+#define HF_PARTIAL_MAGIC_LEN 11u
+#define HF_PARTIAL_NUMBERS 6
+
+/* The six header numbers of p, or 0 if p is invalid; *values receives planes*width*height. */
+static int hf_partial_valid(const hfvis_partial *p, size_t *values, size_t *tag_len)
+{
+    size_t n, t;
+    if (!p || !p->tag || !p->sums || p->width < 1 || p->height < 1 ||
+        p->width > HFVIS_IMAGE_MAX_DIM || p->height > HFVIS_IMAGE_MAX_DIM || p->planes < 1 ||
+        p->planes > HFVIS_PARTIAL_MAX_PLANES || p->directions < 1 || p->begin < 0 ||
+        p->begin >= p->end || p->end > p->directions)
+        return 0;
+    n = (size_t)p->width * (size_t)p->height;
+    if (!hf_mul_size(n, (size_t)p->planes, &n) || (unsigned long long)n > HFVIS_PARTIAL_MAX_VALUES ||
+        n > SIZE_MAX / 8u)
+        return 0;
+    for (t = 0; t <= HFVIS_PARTIAL_MAX_TAG && p->tag[t] != '\0'; t++)
+        if ((unsigned char)p->tag[t] < 32u || (unsigned char)p->tag[t] > 126u) return 0;
+    if (t == 0 || t > HFVIS_PARTIAL_MAX_TAG) return 0;
+    *values = n;
+    *tag_len = t;
+    return 1;
+}
+
+/* Decimal digits of v (>= 0) into buf, returns the count. */
+static size_t hf_partial_digits(unsigned char *buf, int v)
+{
+    unsigned char d[12];
+    size_t nd = 0, i;
+    unsigned u = (unsigned)v;
+    do {
+        d[nd++] = (unsigned char)('0' + u % 10u);
+        u /= 10u;
+    } while (u != 0);
+    for (i = 0; i < nd; i++) buf[i] = d[nd - 1 - i];
+    return nd;
+}
+
+/* The header line of numbers, at most 6*11 bytes. */
+static size_t hf_partial_numbers(const hfvis_partial *p, unsigned char *buf)
+{
+    const int v[HF_PARTIAL_NUMBERS] = { p->width, p->height, p->planes, p->directions, p->begin, p->end };
+    size_t len = 0;
+    int i;
+    for (i = 0; i < HF_PARTIAL_NUMBERS; i++) {
+        len += hf_partial_digits(buf + len, v[i]);
+        buf[len++] = (unsigned char)(i + 1 < HF_PARTIAL_NUMBERS ? ' ' : '\n');
+    }
+    return len;
+}
+
+size_t hfvis_partial_encode_size(const hfvis_partial *p)
+{
+    unsigned char line[6 * 12];
+    size_t values, tag_len, head, bytes;
+    if (!hf_partial_valid(p, &values, &tag_len)) return 0;
+    head = HF_PARTIAL_MAGIC_LEN + hf_partial_numbers(p, line) + tag_len + 1u;
+    if (!hf_mul_size(values, 8u, &bytes) || bytes > SIZE_MAX - head) return 0;
+    return head + bytes;
+}
+
+hfvis_status hfvis_partial_encode(const hfvis_partial *p, void *out, size_t out_capacity,
+                                  size_t *written)
+{
+    unsigned char *dst = (unsigned char *)out;
+    size_t need = hfvis_partial_encode_size(p), values, tag_len, i;
+    int b;
+    if (!out || !written || need == 0 || !hf_partial_valid(p, &values, &tag_len))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (out_capacity < need) return HFVIS_ERR_BUFFER_TOO_SMALL;
+    memcpy(dst, HF_PARTIAL_MAGIC, HF_PARTIAL_MAGIC_LEN);
+    dst += HF_PARTIAL_MAGIC_LEN;
+    dst += hf_partial_numbers(p, dst);
+    memcpy(dst, p->tag, tag_len);
+    dst += tag_len;
+    *dst++ = '\n';
+    for (i = 0; i < values; i++) {
+        uint64_t u;
+        memcpy(&u, &p->sums[i], 8);
+        for (b = 0; b < 8; b++) *dst++ = (unsigned char)((u >> (8 * b)) & 0xffu);
+    }
+    *written = need;
+    return HFVIS_OK;
+}
+
+/* One decimal number 0..INT_MAX at data[*pos], no sign, no leading zero, then the byte end. */
+static int hf_partial_number(const unsigned char *data, size_t size, size_t *pos, unsigned char end,
+                             int *out)
+{
+    size_t i = *pos;
+    long long v = 0;
+    if (i >= size || data[i] < '0' || data[i] > '9') return 0;
+    if (data[i] == '0' && i + 1 < size && data[i + 1] >= '0' && data[i + 1] <= '9') return 0;
+    while (i < size && data[i] >= '0' && data[i] <= '9') {
+        v = v * 10 + (data[i] - '0');
+        if (v > INT_MAX) return 0;
+        i++;
+    }
+    if (i >= size || data[i] != end) return 0;
+    *pos = i + 1;
+    *out = (int)v;
+    return 1;
+}
+
+hfvis_status hfvis_partial_decode(const void *data, size_t size, const hfvis_allocator *alloc,
+                                  hfvis_partial *p)
+{
+    const unsigned char *d = (const unsigned char *)data;
+    hfvis_partial r;
+    int v[HF_PARTIAL_NUMBERS], i;
+    size_t pos = HF_PARTIAL_MAGIC_LEN, tag0, tag_len, values, bytes, block, k;
+    unsigned char *mem;
+    if (!data || !p) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (size < HF_PARTIAL_MAGIC_LEN || memcmp(d, HF_PARTIAL_MAGIC, HF_PARTIAL_MAGIC_LEN) != 0)
+        return HFVIS_ERR_FORMAT;
+    for (i = 0; i < HF_PARTIAL_NUMBERS; i++)
+        if (!hf_partial_number(d, size, &pos, (unsigned char)(i + 1 < HF_PARTIAL_NUMBERS ? ' ' : '\n'), &v[i]))
+            return HFVIS_ERR_FORMAT;
+    tag0 = pos;
+    while (pos < size && pos - tag0 <= HFVIS_PARTIAL_MAX_TAG && d[pos] != '\n') {
+        if (d[pos] < 32u || d[pos] > 126u) return HFVIS_ERR_FORMAT;
+        pos++;
+    }
+    tag_len = pos - tag0;
+    if (pos >= size || d[pos] != '\n' || tag_len == 0 || tag_len > HFVIS_PARTIAL_MAX_TAG)
+        return HFVIS_ERR_FORMAT;
+    pos++;
+    memset(&r, 0, sizeof r);
+    r.width = v[0], r.height = v[1], r.planes = v[2], r.directions = v[3], r.begin = v[4], r.end = v[5];
+    if (r.width < 1 || r.height < 1 || r.planes < 1 || r.directions < 1 || r.begin >= r.end ||
+        r.end > r.directions)
+        return HFVIS_ERR_FORMAT;
+    if (r.width > HFVIS_IMAGE_MAX_DIM || r.height > HFVIS_IMAGE_MAX_DIM || r.planes > HFVIS_PARTIAL_MAX_PLANES)
+        return HFVIS_ERR_LIMIT;
+    values = (size_t)r.width * (size_t)r.height;
+    if (!hf_mul_size(values, (size_t)r.planes, &values) ||
+        (unsigned long long)values > HFVIS_PARTIAL_MAX_VALUES || values > SIZE_MAX / 8u)
+        return HFVIS_ERR_LIMIT;
+    bytes = values * 8u;
+    if (bytes > SIZE_MAX - tag_len - 1u) return HFVIS_ERR_LIMIT;
+    if (size - pos != bytes) return HFVIS_ERR_FORMAT;
+    block = bytes + tag_len + 1u;
+    mem = (unsigned char *)hf_alloc(alloc, block);
+    if (!mem) return HFVIS_ERR_OUT_OF_MEMORY;
+    r.sums = (double *)(void *)mem;
+    for (k = 0; k < values; k++) {
+        const unsigned char *b = d + pos + 8u * k;
+        uint64_t u = 0;
+        int q;
+        for (q = 7; q >= 0; q--) u = (u << 8) | b[q];
+        memcpy(&r.sums[k], &u, 8);
+    }
+    memcpy(mem + bytes, d + tag0, tag_len);
+    mem[bytes + tag_len] = '\0';
+    r.tag = (const char *)(mem + bytes);
+    *p = r;
+    return HFVIS_OK;
+}
+
+void hfvis_partial_free(const hfvis_allocator *alloc, hfvis_partial *p)
+{
+    if (!p) return;
+    hf_free(alloc, p->sums);
+    p->sums = NULL;
+    p->tag = NULL;
+}
+
+#ifndef HFVIS_NO_STDIO
+hfvis_status hfvis_partial_save(const char *path, const hfvis_partial *p)
+{
+    size_t need = hfvis_partial_encode_size(p), written = 0;
+    unsigned char *buf;
+    hfvis_status s;
+    if (!path || need == 0) return HFVIS_ERR_INVALID_ARGUMENT;
+    buf = (unsigned char *)hf_alloc(NULL, need);
+    if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
+    s = hfvis_partial_encode(p, buf, need, &written);
+    if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
+    hf_free(NULL, buf);
+    return s;
+}
+
+hfvis_status hfvis_partial_load(const char *path, const hfvis_allocator *alloc, hfvis_partial *p)
+{
+    unsigned char *data;
+    size_t size;
+    hfvis_status s;
+    if (!path || !p) return HFVIS_ERR_INVALID_ARGUMENT;
+    s = hfvis__read_file(path, alloc, &data, &size);
+    if (s != HFVIS_OK) return s;
+    s = hfvis_partial_decode(data, size, alloc, p);
+    hf_free(alloc, data);
+    return s;
+}
+#endif /* HFVIS_NO_STDIO */

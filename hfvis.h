@@ -322,6 +322,18 @@ HFVIS_API int hfvis_lattice_line(const hfvis_lattice *lattice, int j, int *i_fir
 /* hfvis.c - P1 horizons ([P1] §5 Alg. 1, App. A.1; spec heightfield §4)                      */
 /* ========================================================================================== */
 
+/* How hfvis_sweep_options.direction_begin/end count the K directions. */
+typedef enum hfvis_direction_order {
+    HFVIS_DIRECTION_ORDER_DEFAULT = 0, /* = INDEX */
+    HFVIS_DIRECTION_ORDER_INDEX = 1,   /* position p is direction k = p */
+    HFVIS_DIRECTION_ORDER_SWEEP = 2    /* the order the sweep visits them: when K % 4 == 0,
+                                          position p is k = p/4 + (p%4)*K/4, so the four quarter
+                                          turns that share one sampled lattice (spec §3.6) are
+                                          consecutive; else k = p. A range of whole quarter-turn
+                                          groups (begin, end multiples of 4) samples only its own
+                                          lattices: P such parts cost about 1/P of the run each */
+} hfvis_direction_order;
+
 /* Options shared by every sweep (horizons, sky light, sky-view factor, shadows, environment). */
 typedef struct hfvis_sweep_options {
     hfvis_border border;            /* default HFVIS_BORDER_OPEN */
@@ -329,10 +341,18 @@ typedef struct hfvis_sweep_options {
                                        0 = max(width, height) */
     double azimuth0_rad;            /* psi_0 of direction 0 */
     const hfvis_allocator *alloc;   /* scratch; NULL = malloc/free */
-    int direction_begin;            /* fused light/SVF only: process directions [begin, end) of */
-    int direction_end;              /* the K and return that partial sum; 0, 0 = all K */
+    int direction_begin;            /* process only the directions at positions [begin, end) of */
+    int direction_end;              /* the K (direction_order), 0 <= begin < end <= K (else
+                                       HFVIS_ERR_INVALID_ARGUMENT); 0, 0 = all K.
+                                       Honoured by the per-direction sums (sky light, sky-view
+                                       factor, environment light, visibility index, intervisibility,
+                                       one indirect gather, hfvis_direction_sums: each returns its
+                                       range's share of the sum) and by hfvis_horizon_map (the
+                                       range's planes only); ignored by single-direction calls
+                                       (hfvis_horizon_direction, hfvis_sun_visibility, lattices) */
     hfvis_progress_fn progress;     /* optional, called once per direction */
     void *progress_user;
+    hfvis_direction_order direction_order; /* how direction_begin/end count; default INDEX */
 } hfvis_sweep_options;
 
 HFVIS_API hfvis_sweep_options hfvis_sweep_options_default(void);
@@ -377,7 +397,11 @@ HFVIS_API hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, in
  * toward psi_k. out must hold K*width*height floats (check the product for overflow; it is
  * large: K = 64 at 1024^2 is 256 MiB; prefer the fused lighting calls). When K % 4 == 0 the
  * four directions psi, psi+pi/2, psi+pi, psi+3pi/2 share one sampled lattice (spec §3.6).
- * Returns HFVIS_ERR_INVALID_ARGUMENT for K < 1. Cost O(K*width*height). */
+ * With opts->direction_begin/end = [b, e) only those planes are made: out then holds
+ * (e-b)*width*height floats, in position order (opts->direction_order): the direction at
+ * position p is out[(p-b)*width*height ...], bit-identical to its plane of the full map (split a
+ * map across processes and stack the parts).
+ * Returns HFVIS_ERR_INVALID_ARGUMENT for K < 1 or a bad range. Cost O(K*width*height). */
 HFVIS_API hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K,
                                          const hfvis_sweep_options *opts, float *out);
 
@@ -437,7 +461,10 @@ HFVIS_API hfvis_status hfvis_sky_light_from_map(const hfvis_grid *grid, int K,
                                                 ptrdiff_t out_stride);
 
 /* Sky-view factor SVF = 1 - (1/K) sum_k sin(max(alpha_k, 0)), fused into the sweep (the term is
- * accumulated on the lattice and gathered), memory O(width*height). NaN at holes. */
+ * accumulated on the lattice and gathered), memory O(width*height). NaN at holes.
+ * A direction range [b, e) returns its share (e-b)/K - (1/K) sum_{b<=k<e} ..., so the shares of
+ * ranges that tile [0, K) add up to SVF (up to float rounding; hfvis_direction_sums keeps the
+ * sums in double). */
 HFVIS_API hfvis_status hfvis_sky_view_factor(const hfvis_grid *grid, int K,
                                              const hfvis_sweep_options *opts, float *out,
                                              ptrdiff_t out_stride);
@@ -505,7 +532,8 @@ HFVIS_API hfvis_status hfvis_env_table_build(const hfvis_env *env, int K, double
  * albedo/pi * sum_k [Nz A_k + a_k B_k + b_k C_k](theta_k) (prefix) or
  * albedo * sum_k |N_p| L_p^k(theta_n, theta_h) ([P1] Eq. 6), in lattice space, gathered.
  * out_stride in pixels. Allocates 2 blocks: the tables (hfvis_env_table_size floats) and the
- * lattice scratch of hfvis_sky_light (plus channels-1 doubles per node). */
+ * lattice scratch of hfvis_sky_light (plus channels-1 doubles per node).
+ * opts->direction_begin/end select a partial sum of the K directions. */
 HFVIS_API hfvis_status hfvis_env_light(const hfvis_grid *grid, int K, const hfvis_env *env,
                                        float albedo, const hfvis_sweep_options *opts,
                                        const hfvis_env_options *eopts, float *out,
@@ -656,7 +684,10 @@ HFVIS_API hfvis_status hfvis_intervisibility(const hfvis_grid *grid, int K,
 
 /* Visibility index ("total viewshed"): the number of samples each grid point sees along the K
  * directions, sum over k of the visible samples of its line (gathered from the lattice like the
- * light paths). Pre-roll samples outside the grid are not counted. NaN at holes. */
+ * light paths). Pre-roll samples outside the grid are not counted. NaN at holes.
+ * opts->direction_begin/end select a partial count (spec heightfield §8: a sum over the K
+ * lines); the counts are gathered bilinearly from the lattices, so they are not integers off the
+ * axis directions, and the parts of a split add up to the full count up to float rounding. */
 HFVIS_API hfvis_status hfvis_visibility_count(const hfvis_grid *grid, int K,
                                               const hfvis_sweep_options *opts,
                                               const hfvis_tree_options *tree_opts, float *out,
@@ -1304,6 +1335,92 @@ HFVIS_API hfvis_status hfvis_ns_bspline_max(int n, const double *omega_rad, doub
  * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT as hfvis_ns_wedges_to_sh. */
 HFVIS_API hfvis_status hfvis_ns_sample_matrices(const hfvis_ns_wedges *set, double *G);
 
+
+/* ========================================================================================== */
+/* hfvis.c - split runs: raw direction sums and the partial-sum file                          */
+/* ========================================================================================== */
+/* Every fused output above is a finish f(S) of a per-receiver sum over the K directions,
+ * S = sum_k T_k: the sky-view factor 1 - S/K with T_k = sin(max(alpha_k, 0)) (Zaksek et al.
+ * 2011), the uniform sky albedo*sky*S with T_k = [P1] Eq. 5's sector integral S_k, the
+ * environment albedo*S with T_k = [P1] Eq. 6's sector term, the visibility index S with T_k the
+ * samples seen along line k (spec heightfield §8), each gathered from its lattice to the grid
+ * points. A run over a direction range [b, e) (sweep options) returns the partial sum of its
+ * range; the partial sums of ranges that tile [0, K) add up to S. hfvis_direction_sums returns S
+ * (or a partial S) in double, before the finish, so that split runs lose nothing to float
+ * rounding: the terms are non-negative, so adding the parts in range order gives the single
+ * run's S up to K * 2^-52 * S (two orders of at most K additions, far below a float ulp), and
+ * the finish in float then equals the single run's output except where S lies that close to a
+ * float rounding boundary (at most 1 ulp apart then). With HFVIS_DIRECTION_ORDER_SWEEP and parts
+ * of exactly one quarter-turn group each (K % 4 == 0, ranges [4g, 4g+4)), added in position
+ * order, the additions are the single run's own, one gathered group at a time: bit-exact. */
+
+typedef enum hfvis_sum_kind {
+    HFVIS_SUM_SKY_VIEW = 1,   /* T_k = sin(max(alpha_k, 0)); hfvis_sky_view_factor = (float)(1 - S/K) */
+    HFVIS_SUM_SKY_LIGHT = 2,  /* T_k = [P1] Eq. 5 S_k; hfvis_sky_light = (float)(sky*albedo * S) */
+    HFVIS_SUM_ENV_LIGHT = 3,  /* [P1] Eq. 6 per channel; hfvis_env_light = (float)(albedo * S) */
+    HFVIS_SUM_VISIBILITY = 4  /* samples seen (spec heightfield §8); hfvis_visibility_count = (float)S */
+} hfvis_sum_kind;
+
+/* Raw per-receiver sums S of the directions opts->direction_begin/end (all K when 0, 0) for
+ * kind, before the finish (see the enum; the finishes are computed in double as written, e.g.
+ * SVF = (float)(1.0 + (-1.0/K) * S), sky light (float)(((double)sky*(double)albedo) * S)).
+ * sums[(y*width + x)*channels + c]: channels = env->channels for HFVIS_SUM_ENV_LIGHT, else 1;
+ * NaN at holes. env and eopts are used by HFVIS_SUM_ENV_LIGHT only (env required there, else
+ * may be NULL). Scratch: that of the matching routine (hfvis_sky_light etc.).
+ * Returns HFVIS_OK, HFVIS_ERR_INVALID_ARGUMENT (NULL grid or sums, K < 1, bad range, unknown
+ * kind, missing env), HFVIS_ERR_LIMIT or HFVIS_ERR_OUT_OF_MEMORY. Cost O((e-b)*width*height). */
+HFVIS_API hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind kind,
+                                            const hfvis_env *env, const hfvis_env_options *eopts,
+                                            const hfvis_sweep_options *opts, double *sums);
+
+/* The partial-sum file ("HFVISSUM"): the sums (or horizon planes) of one direction range of one
+ * run, with what is needed to check that parts belong together. Layout, byte for byte:
+ *   "HFVISSUM 1\n"
+ *   "<width> <height> <planes> <directions> <begin> <end>\n"   decimal, single spaces
+ *   "<tag>\n"                                                  1..HFVIS_PARTIAL_MAX_TAG bytes
+ *   planes*height*width little-endian IEEE-754 doubles, sums[(p*height + y)*width + x]
+ * and nothing after. The tag is printable ASCII (32..126) chosen by the producer; the hfvis
+ * tool stores its command and every parameter that changes the result there. */
+#define HFVIS_PARTIAL_MAX_TAG 4096
+#define HFVIS_PARTIAL_MAX_PLANES 65536
+#define HFVIS_PARTIAL_MAX_VALUES ((unsigned long long)1 << 32) /* planes*width*height (32 GiB) */
+
+typedef struct hfvis_partial {
+    int width, height;        /* of the grid, 1..HFVIS_IMAGE_MAX_DIM */
+    int planes;               /* values per sample, 1..HFVIS_PARTIAL_MAX_PLANES; planes*width*height
+                                 <= HFVIS_PARTIAL_MAX_VALUES (and its bytes must fit a size_t) */
+    int directions;           /* K of the whole run, >= 1 */
+    int begin, end;           /* the directions [begin, end) this part holds, 0 <= begin < end <= K */
+    const char *tag;          /* NUL-terminated, 1..HFVIS_PARTIAL_MAX_TAG printable ASCII chars */
+    double *sums;             /* planes*height*width values */
+} hfvis_partial;
+
+/* Bytes of the encoded file, or 0 if p is invalid (NULL fields, out-of-range numbers or tag). */
+HFVIS_API size_t hfvis_partial_encode_size(const hfvis_partial *p);
+
+/* Encode p into out (out_capacity bytes; *written receives the count). Returns HFVIS_OK,
+ * HFVIS_ERR_INVALID_ARGUMENT or HFVIS_ERR_BUFFER_TOO_SMALL. */
+HFVIS_API hfvis_status hfvis_partial_encode(const hfvis_partial *p, void *out,
+                                            size_t out_capacity, size_t *written);
+
+/* Decode a partial-sum file from memory. Allocates one block with alloc (NULL = malloc) that
+ * holds the sums and the tag: release it with hfvis_partial_free. p is untouched on error.
+ * Returns HFVIS_OK, HFVIS_ERR_INVALID_ARGUMENT (NULL data or p), HFVIS_ERR_FORMAT (bad magic or
+ * version, malformed numbers, a range or tag out of bounds, wrong data length), HFVIS_ERR_LIMIT
+ * (planes*width*height over HFVIS_PARTIAL_MAX_VALUES or SIZE_MAX/8, or a side over
+ * HFVIS_IMAGE_MAX_DIM) or
+ * HFVIS_ERR_OUT_OF_MEMORY. Cost O(size). */
+HFVIS_API hfvis_status hfvis_partial_decode(const void *data, size_t size,
+                                            const hfvis_allocator *alloc, hfvis_partial *p);
+
+/* Release what hfvis_partial_decode/load allocated (same alloc); p may be NULL or zeroed. */
+HFVIS_API void hfvis_partial_free(const hfvis_allocator *alloc, hfvis_partial *p);
+
+/* File wrappers (absent with HFVIS_NO_STDIO): save writes through a temporary file and a rename,
+ * as hfvis_pfm_save; load reads and decodes. Errors as encode/decode plus HFVIS_ERR_IO. */
+HFVIS_API hfvis_status hfvis_partial_save(const char *path, const hfvis_partial *p);
+HFVIS_API hfvis_status hfvis_partial_load(const char *path, const hfvis_allocator *alloc,
+                                          hfvis_partial *p);
 
 /* ========================================================================================== */
 /* ssao.c - screen space: camera and depth, line lattice, P3 line-sweep AO, HBAO, references  */

@@ -400,6 +400,106 @@ printf 'old\n' > "$dir/keep.pfm"
 "$hfvis" skyview "$dir/garbage.pgm" -o "$dir/keep.pfm" 2> /dev/null
 [ "$(cat "$dir/keep.pfm")" = old ] && ok "failed run keeps the old OUT" || bad "failed run keeps the old OUT"
 
+# ---- split runs: --dir-range A:B writes a partial result, `hfvis sum` adds the parts ----------
+# Each supported command split 4 ways (parts summed in shuffled order) must give the single run's
+# file. The parts carry double sums, so the output is bit-exact unless a value lies within about
+# K*2^-53 of a float rounding boundary; then it may differ by one ulp, which same_or_ulp accepts
+# for PFM (adjacent floats of one sign differ by 1 as unsigned integers).
+same_or_ulp() {
+  name=$1; a=$2; b=$3
+  if cmp -s "$a" "$b"; then ok "$name: bit-exact"; return; fi
+  if [ "$little_endian" = 1 ] && [ "$(wc -c < "$a")" = "$(wc -c < "$b")" ] && \
+     [ "$(head -n 3 "$a")" = "$(head -n 3 "$b")" ]; then
+    hb=$(head -n 3 "$a" | wc -c | tr -d ' ')
+    tail -c +$((hb + 1)) "$a" | od -An -v -tu4 | tr -s ' ' '\n' | grep . > "$dir/ulp_a"
+    tail -c +$((hb + 1)) "$b" | od -An -v -tu4 | tr -s ' ' '\n' | grep . > "$dir/ulp_b"
+    if paste "$dir/ulp_a" "$dir/ulp_b" | awk '{ d = $1 - $2; if (d > 1 || d < -1) bad = 1 } END { exit bad }'; then
+      ok "$name: within one ulp"; return; fi
+  fi
+  bad "$name: $b differs from $a"
+}
+# split4 NAME CMD EXT RANGES... -- ARGS...: the single run, one part per range, sum (parts in
+# reverse order), compare.
+split4() {
+  name=$1; cmd=$2; ext=$3; shift 3; ranges=""
+  while [ "$1" != "--" ]; do ranges="$ranges $1"; shift; done; shift
+  rm -f "$dir"/part_*.hfvs
+  "$hfvis" "$cmd" "$h" "$@" -o "$dir/single.$ext" 2> "$dir/stderr" || { bad "$name: single run: $(cat "$dir/stderr")"; return; }
+  parts=""
+  for r in $ranges; do
+    p=$dir/part_${r%%:*}.hfvs
+    "$hfvis" "$cmd" "$h" "$@" --dir-range "$r" -o "$p" 2> "$dir/stderr" || { bad "$name: part $r: $(cat "$dir/stderr")"; return; }
+    parts="$p $parts"
+  done
+  # shellcheck disable=SC2086
+  "$hfvis" sum $parts -o "$dir/summed.$ext" 2> "$dir/stderr" || { bad "$name: sum: $(cat "$dir/stderr")"; return; }
+  if [ "$ext" = pfm ]; then same_or_ulp "$name" "$dir/single.$ext" "$dir/summed.$ext"
+  elif cmp -s "$dir/single.$ext" "$dir/summed.$ext"; then ok "$name: bit-exact"
+  else bad "$name: $dir/summed.$ext differs from the single run"; fi
+}
+split4 "split horizon 4 ways" horizon pfm 0:3 3:8 8:13 13:16 -- --dirs 16 --degrees
+split4 "split horizon K=6 (no quarter turns)" horizon pfm 0:1 1:3 3:4 4:6 -- --dirs 6 --border wrap
+split4 "split skyview 4 ways" skyview pfm 0:3 3:8 8:13 13:16 -- --dirs 16 --border clamp
+split4 "split skyview 4 ways, PGM" skyview pgm 0:4 4:8 8:12 12:16 -- --dirs 16 --compass
+split4 "split sky 4 ways" sky pfm 0:5 5:6 6:11 11:12 -- --dirs 12 --sky 2 --albedo 0.5 --azimuth0 0.25
+split4 "split light 4 ways (RGB)" light pfm 0:3 3:8 8:13 13:16 -- --dirs 16 --env "$dir/env3.pfm" --albedo 0.8
+split4 "split light --method lp" light pfm 0:1 1:2 2:3 3:8 -- --dirs 8 --env "$dir/env1.pfm" --method lp
+split4 "split visibility 4 ways" visibility pfm 0:2 2:4 4:6 6:8 -- --dirs 8
+split4 "split visibility --fraction" visibility pfm 0:3 3:4 4:7 7:8 -- --dirs 8 --fraction --zscale 3
+"$hfvis" skyview "$h" --dirs 16 --dir-range 0:16 -o "$dir/whole.hfvs" 2> /dev/null
+"$hfvis" sum "$dir/whole.hfvs" -o "$dir/whole.pfm" 2> /dev/null
+"$hfvis" skyview "$h" --dirs 16 -o "$dir/single.pfm" 2> /dev/null
+same_or_ulp "one part 0:K" "$dir/single.pfm" "$dir/whole.pfm"
+head -n 1 "$dir/whole.hfvs" | grep -q '^HFVISSUM 1$' && ok "partial file magic" || bad "partial file magic"
+
+# Refusals: one line, non-zero exit, nothing written.
+for r in 0:4 4:8 8:12 12:16; do "$hfvis" skyview "$h" --dirs 16 --dir-range "$r" -o "$dir/sv_${r%%:*}.hfvs"; done
+"$hfvis" skyview "$h" --dirs 16 --dir-range 2:6 -o "$dir/sv_2.hfvs"
+"$hfvis" skyview "$h" --dirs 16 --dir-range 12:16 --cell 2 -o "$dir/sv_cell2.hfvs"
+"$hfvis" skyview "$h" --dirs 16 --dir-range 12:16 --zscale 2 -o "$dir/sv_z2.hfvs"
+"$hfvis" sky "$h" --dirs 16 --dir-range 12:16 -o "$dir/sky_12.hfvs"
+"$hfvis" skyview "$h" --dirs 32 --dir-range 16:32 -o "$dir/sv32_16.hfvs"
+"$hfvis" skyview "$dir/flat.pgm" --dirs 16 --dir-range 12:16 -o "$dir/flat_12.hfvs"
+s0=$dir/sv_0.hfvs; s4=$dir/sv_4.hfvs; s8=$dir/sv_8.hfvs; s12=$dir/sv_12.hfvs
+expect_fail "sum: overlapping ranges" 1 sum "$s0" "$s4" "$dir/sv_2.hfvs" "$s8" "$s12" -o "$o"
+grep -q 'overlap' "$dir/stderr" && ok "sum: overlap is named" || bad "sum: overlap is named"
+expect_fail "sum: the same part twice" 1 sum "$s0" "$s4" "$s4" "$s8" "$s12" -o "$o"
+expect_fail "sum: a gap" 1 sum "$s0" "$s8" "$s12" -o "$o"
+grep -q 'directions 4:8 of K = 16 are missing' "$dir/stderr" && ok "sum: gap is named" || bad "sum: gap is named"
+expect_fail "sum: the last range missing" 1 sum "$s0" "$s4" "$s8" -o "$o"
+grep -q 'directions 12:16 of K = 16 are missing' "$dir/stderr" && ok "sum: missing end is named" || bad "sum: missing end is named"
+expect_fail "sum: different --cell" 1 sum "$s0" "$s4" "$s8" "$dir/sv_cell2.hfvs" -o "$o"
+grep -q 'cell=' "$dir/stderr" && ok "sum: the differing parameter is named" || bad "sum: the differing parameter is named"
+expect_fail "sum: different input (zscale)" 1 sum "$s0" "$s4" "$s8" "$dir/sv_z2.hfvs" -o "$o"
+expect_fail "sum: different command" 1 sum "$s0" "$s4" "$s8" "$dir/sky_12.hfvs" -o "$o"
+expect_fail "sum: different K" 1 sum "$s0" "$s4" "$s8" "$dir/sv32_16.hfvs" -o "$o"
+expect_fail "sum: different grid" 1 sum "$s0" "$s4" "$s8" "$dir/flat_12.hfvs" -o "$o"
+expect_fail "sum: garbage file" 1 sum "$s0" "$dir/garbage.pgm" -o "$o"
+head -c 60 "$s0" > "$dir/trunc.hfvs"
+expect_fail "sum: truncated part" 1 sum "$dir/trunc.hfvs" "$s4" "$s8" "$s12" -o "$o"
+expect_fail "sum: missing part file" 1 sum "$dir/none.hfvs" -o "$o"
+expect_fail "sum: no parts" 2 sum -o "$o"
+expect_fail "sum: no -o" 2 sum "$s0"
+expect_fail "sum: -o .hfvs" 2 sum "$s0" -o "$fdir/x.hfvs"
+expect_fail "sum: --range with .pfm" 2 sum "$s0" --range 0:1 -o "$o"
+expect_fail "sum: unknown option" 2 sum "$s0" --dirs 4 -o "$o"
+expect_fail "--dir-range beyond K" 2 skyview "$h" --dirs 16 --dir-range 0:17 -o "$fdir/x.hfvs"
+expect_fail "--dir-range empty" 2 skyview "$h" --dirs 16 --dir-range 3:3 -o "$fdir/x.hfvs"
+expect_fail "--dir-range A>B" 2 skyview "$h" --dirs 16 --dir-range 5:2 -o "$fdir/x.hfvs"
+expect_fail "--dir-range x:y" 2 skyview "$h" --dir-range x:y -o "$fdir/x.hfvs"
+expect_fail "--dir-range -1:2" 2 skyview "$h" --dir-range -1:2 -o "$fdir/x.hfvs"
+expect_fail "--dir-range to .pfm" 2 skyview "$h" --dir-range 0:4 -o "$o"
+expect_fail ".hfvs without --dir-range" 2 skyview "$h" -o "$fdir/x.hfvs"
+expect_fail "--dir-range with --range" 2 skyview "$h" --dir-range 0:4 --range 0:1 -o "$fdir/x.hfvs"
+expect_fail "--dir-range on shadow" 2 shadow "$h" --sun-azimuth 1 --sun-elevation 1 --dir-range 0:4 -o "$fdir/x.hfvs"
+expect_fail "--dir-range on gi" 2 gi "$h" --dir-range 0:4 -o "$fdir/x.hfvs"
+expect_fail "--dir-range with --stats" 2 visibility "$h" --stats --dir-range 0:4 -o "$fdir/x.hfvs"
+expect_fail "horizon part of an oversized map" 1 horizon "$dir/big.pgm" --dirs 65536 --dir-range 0:1 -o "$fdir/x.hfvs"
+printf 'old\n' > "$dir/keep.pfm"
+"$hfvis" sum "$s0" "$s8" -o "$dir/keep.pfm" 2> /dev/null
+[ "$(cat "$dir/keep.pfm")" = old ] && ok "refused sum keeps the old OUT" || bad "refused sum keeps the old OUT"
+"$hfvis" help sum | grep -q 'PART.hfvs' && ok "help sum" || bad "help sum"
+
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
