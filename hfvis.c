@@ -2307,13 +2307,22 @@ typedef struct hf_env_resolved {
 /* Checks the environment's shape (not its radiance pointer: hfvis_env_table_size can be asked
  * before the map is loaded), K and the options; resolves defaults and the table size.
  * lp_normal_res must be odd and >= 3 (M = 1 leaves no theta_n interval to interpolate). */
+/* The radiance array (n_theta*n_phi*channels floats) must be addressable: a size that
+ * overflows size_t describes no array (env fields already checked >= 1). */
+static int hf_env_size_ok(const hfvis_env *env)
+{
+    size_t n, bytes;
+    return hf_mul_size((size_t)env->n_theta, (size_t)env->n_phi, &n) &&
+           hf_mul_size(n, (size_t)env->channels, &n) && hf_mul_size(n, sizeof(float), &bytes);
+}
+
 static hfvis_status hf_env_resolve(const hfvis_env *env, int K, const hfvis_env_options *eopts,
                                    hf_env_resolved *r)
 {
     hfvis_env_options o;
     size_t n, bytes;
     if (env == NULL || K < 1 || env->n_theta < 1 || env->n_phi < 1 || env->channels < 1 ||
-        env->channels > 4)
+        env->channels > 4 || !hf_env_size_ok(env))
         return HFVIS_ERR_INVALID_ARGUMENT;
     o = hfvis_env_options_default();
     if (eopts != NULL) {
@@ -2733,7 +2742,7 @@ static hfvis_status hf_env_tables_create(const hfvis_env *env, int K, double azi
 static int hf_env_valid(const hfvis_env *env)
 {
     return env != NULL && env->radiance != NULL && env->n_theta >= 1 && env->n_phi >= 1 &&
-           env->channels >= 1 && env->channels <= 4;
+           env->channels >= 1 && env->channels <= 4 && hf_env_size_ok(env);
 }
 
 hfvis_status hfvis_env_light_from_map(const hfvis_grid *grid, int K,
@@ -4521,7 +4530,7 @@ hfvis_status hfvis_sh_project_env(const hfvis_env *env, double *out)
     if (env == NULL || out == NULL || env->radiance == NULL || env->n_theta < 1 ||
         env->n_phi < 1 || env->channels < 1 || env->channels > 4 ||
         !hf_mul_size((size_t)env->n_theta, (size_t)env->n_phi, &n) ||
-        !hf_mul_size(n, (size_t)env->channels, &n))
+        !hf_mul_size(n, (size_t)env->channels, &n) || !hf_env_size_ok(env))
         return HFVIS_ERR_INVALID_ARGUMENT;
     T = env->n_theta;
     P = env->n_phi;
