@@ -478,6 +478,8 @@ HFVIS_API hfvis_status hfvis_volume_write(hfvis_volume *vol, int i, int j, int k
         || vol->channels > HFVIS_VOLUME_MAX_CHANNELS || i < 0 || j < 0 || k < 0
         || i >= vol->grid.dims[0] || j >= vol->grid.dims[1] || k >= vol->grid.dims[2])
         return HFVIS_ERR_INVALID_ARGUMENT;
+    for (c = 0; c < vol->channels; c++)
+        if (!vx_blend_valid(vol->blend[c])) return HFVIS_ERR_INVALID_ARGUMENT;
     d = vol->data + (((size_t)k * (size_t)vol->grid.dims[1] + (size_t)j) * (size_t)vol->grid.dims[0]
                      + (size_t)i) * (size_t)vol->channels;
     for (c = 0; c < vol->channels; c++) d[c] = vx_blend_apply(vol->blend[c], d[c], values[c]);
@@ -494,6 +496,8 @@ HFVIS_API hfvis_status hfvis_volume_merge(hfvis_volume *dst, const hfvis_volume 
     if (n == 0) return HFVIS_ERR_INVALID_ARGUMENT;
     for (a = 0; a < 3; a++)
         if (dst->grid.dims[a] != src->grid.dims[a]) return HFVIS_ERR_INVALID_ARGUMENT;
+    for (c = 0; c < dst->channels; c++)
+        if (!vx_blend_valid(dst->blend[c])) return HFVIS_ERR_INVALID_ARGUMENT;
     for (i = 0; i < n; i += (size_t)dst->channels)
         for (c = 0; c < dst->channels; c++)
             dst->data[i + (size_t)c] =
@@ -959,6 +963,7 @@ HFVIS_API hfvis_status hfvis_mesh_from_grid(const hfvis_allocator *alloc, const 
     uint32_t *remap = NULL;
     size_t W, H, x, y, nv = 0, nt = 0, npts;
     if (!out || !g || !g->z || g->width < 1 || g->height < 1 || g->stride < g->width
+        || (size_t)g->height > (size_t)PTRDIFF_MAX / sizeof(float) / (size_t)g->stride
         || !isfinite(g->cell_size) || !(g->cell_size > 0.0))
         return HFVIS_ERR_INVALID_ARGUMENT;
     W = (size_t)g->width;
