@@ -2652,9 +2652,10 @@ static void args_ffao_virtual_point(void)
 {
     double h[2] = {7.0, 7.0};
     begin("ffao_virtual_point");
+    hfvis_ffao_virtual_point(1.0, 0.5, -1.0, 2.0, h); /* h = ((m0 - m1)/slope, m0 zscale) */
+    CHECK(h[0] == -0.5 && h[1] == 2.0);
     hfvis_ffao_virtual_point(1.0, 0.5, -1.0, 1.0, NULL);
-    hfvis_ffao_virtual_point(NAN, 0.5, -1.0, 1.0, h);
-    BADV('N', 1);
+    BADV('N', h[0] == -0.5 && h[1] == 2.0);
 }
 
 static void args_ffao_sector_weight(void)
