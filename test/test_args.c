@@ -285,8 +285,8 @@
     X(visfield_ambient_occlusion_reference, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(visfield_soft_shadow, S, A, "NGOFES", "INVALID_ARGUMENT") \
     X(visfield_soft_shadow_reference, S, A, "NGOFES", "INVALID_ARGUMENT") \
-    X(visfield_trace, S, -, "NZGFES", "INVALID_ARGUMENT") \
-    X(visfield_trace_reference, S, -, "NZGFES", "INVALID_ARGUMENT") \
+    X(visfield_trace, S, -, "NZGOFES", "INVALID_ARGUMENT") \
+    X(visfield_trace_reference, S, -, "NZGOFES", "INVALID_ARGUMENT") \
     X(visfield_reflect, S, -, "NZGOFES", "INVALID_ARGUMENT") \
     X(visfield_reflect_reference, S, -, "NZGOFES", "INVALID_ARGUMENT") \
     X(visfield_encode_size, V, -, "NZE", "0") \
@@ -593,6 +593,7 @@ static void teardown(void)
     bo = hfvis_sweep_options_default(); bo.border_cells = -1; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.azimuth0_rad = NAN; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.direction_begin = -1; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.direction_end = -2; BAD('S', INV, expr); \
     } while (0)
 
 /* ========================================================================================== */
@@ -1215,6 +1216,7 @@ static void args_light_reference(void)
     BAD('N', INV, hfvis_light_reference(&g_ok, NULL, 1.0f, NULL, NULL, &h, NULL, nrm, 1, out));
     BAD('N', INV, hfvis_light_reference(&g_ok, NULL, 1.0f, NULL, NULL, &h, pts, NULL, 1, out));
     BAD('N', INV, hfvis_light_reference(&g_ok, NULL, 1.0f, NULL, NULL, &h, pts, nrm, 1, NULL));
+    BAD('O', INV, hfvis_light_reference(&g_ok, NULL, 1.0f, NULL, NULL, &h, pts, nrm, SIZE_MAX / 2, out));
     BAD('F', INV, hfvis_light_reference(&g_ok, NULL, NAN, NULL, NULL, &h, pts, nrm, 1, out));
     h.azimuth_samples = -1;
     BAD('S', INV, hfvis_light_reference(&g_ok, NULL, 1.0f, NULL, NULL, &h, pts, nrm, 1, out));
@@ -1884,6 +1886,16 @@ static void args_ns_gi_options_default(void)
     bn = hfvis_ns_gi_options_default(); bn.border = (hfvis_border)7; BAD('E', INV, expr); \
     bn = hfvis_ns_gi_options_default(); bn.view_dir[0] = NAN; BAD('F', INV, expr); \
     bn = hfvis_ns_gi_options_default(); bn.azimuth0_rad = INFINITY; BAD('F', INV, expr); \
+    bn = hfvis_ns_gi_options_default(); bn.key_directions = 1; BAD('S', INV, expr); \
+    bn = hfvis_ns_gi_options_default(); bn.levels_per_octave = 33; BAD('O', INV, expr); \
+    bn = hfvis_ns_gi_options_default(); bn.level_offset_v = -2; BAD('G', INV, expr); \
+    bn = hfvis_ns_gi_options_default(); bn.subsample = 65; BAD('O', INV, expr); \
+    bn = hfvis_ns_gi_options_default(); bn.omega_min = (hfvis_ns_omega_min)9; BAD('E', INV, expr); \
+    bn = hfvis_ns_gi_options_default(); bn.omega_max = (hfvis_ns_omega_max)9; BAD('E', INV, expr); \
+    bn = hfvis_ns_gi_options_default(); bn.directional = (hfvis_ns_directional)9; BAD('E', INV, expr); \
+    bn = hfvis_ns_gi_options_default(); bn.key_mode = (hfvis_ns_key_mode)9; BAD('E', INV, expr); \
+    bn = hfvis_ns_gi_options_default(); bn.cast_cache = (hfvis_ns_cache)9; BAD('E', INV, expr); \
+    bn = hfvis_ns_gi_options_default(); bn.clamp_to_tangent = 2; BAD('S', INV, expr); \
     } while (0)
 
 static void args_ns_gi_options_resolve(void)
@@ -2320,6 +2332,13 @@ static void args_lsao_options_default(void)
     bl = hfvis_lsao_options_default(); bl.reject_depth = NAN; BAD('F', INV, expr); \
     bl = hfvis_lsao_options_default(); bl.pattern = HFVIS_SSAO_PATTERN_CUSTOM; BAD('N', INV, expr); \
     bl = hfvis_lsao_options_default(); bl.falloff.kind = (hfvis_falloff_kind)99; BAD('S', INV, expr); \
+    bl = hfvis_lsao_options_default(); bl.box_scale = -1; BAD('G', INV, expr); \
+    bl = hfvis_lsao_options_default(); bl.sampling = (hfvis_ssao_sampling)9; BAD('E', INV, expr); \
+    bl = hfvis_lsao_options_default(); bl.plane = (hfvis_ssao_plane)9; BAD('E', INV, expr); \
+    bl = hfvis_lsao_options_default(); bl.pop = (hfvis_lsao_pop)9; BAD('E', INV, expr); \
+    bl = hfvis_lsao_options_default(); bl.reject_normal = 1.5; BAD('S', INV, expr); \
+    bl = hfvis_lsao_options_default(); bl.azimuth0_rad = INFINITY; bl.pattern = HFVIS_SSAO_PATTERN_UNIFORM; BAD('F', INV, expr); \
+    bl = hfvis_lsao_options_default(); bl.spacing = 1e9; BAD('O', INV, expr); \
     } while (0)
 
 static void args_lsao_options_resolve(void)
@@ -2473,6 +2492,11 @@ static void args_hbao_options_default(void)
     bh = hfvis_hbao_options_default(); bh.jitter = (hfvis_hbao_jitter)-1; BAD('E', INV, expr); \
     bh = hfvis_hbao_options_default(); bh.tangent = HFVIS_SSAO_TANGENT_FIXED_HULL_REAL_EVAL; BAD('S', INV, expr); \
     bh = hfvis_hbao_options_default(); bh.fixed_sin_t = -1.5; BAD('S', INV, expr); \
+    bh = hfvis_hbao_options_default(); bh.max_radius_px = -1.0; BAD('G', INV, expr); \
+    bh = hfvis_hbao_options_default(); bh.sampling = (hfvis_ssao_sampling)9; BAD('E', INV, expr); \
+    bh = hfvis_hbao_options_default(); bh.plane = (hfvis_ssao_plane)9; BAD('E', INV, expr); \
+    bh = hfvis_hbao_options_default(); bh.falloff.kind = HFVIS_FALLOFF_STEP; BAD('S', INV, expr); \
+    bh = hfvis_hbao_options_default(); bh.azimuth0_rad = NAN; BAD('F', INV, expr); \
     } while (0)
 
 static void args_hbao_options_resolve(void)
@@ -2573,6 +2597,16 @@ static void args_ffao_options_default(void)
     bq = hfvis_ffao_options_default(); bq.estimator = (hfvis_ffao_estimator)99; BAD('E', INV, expr); \
     bq = hfvis_ffao_options_default(); bq.near_field = (hfvis_ffao_near)-1; BAD('E', INV, expr); \
     bq = hfvis_ffao_options_default(); bq.mip_growth = 0.5; BAD('S', INV, expr); \
+    bq = hfvis_ffao_options_default(); bq.levels = -1; BAD('G', INV, expr); \
+    bq = hfvis_ffao_options_default(); bq.quad_nodes = 65; BAD('O', INV, expr); \
+    bq = hfvis_ffao_options_default(); bq.blur_radius = -1; BAD('G', INV, expr); \
+    bq = hfvis_ffao_options_default(); bq.sparse = 1; bq.directions = 8; BAD('S', INV, expr); \
+    bq = hfvis_ffao_options_default(); bq.averaging = (hfvis_ffao_averaging)9; BAD('E', INV, expr); \
+    bq = hfvis_ffao_options_default(); bq.sampling = (hfvis_ssao_sampling)9; BAD('E', INV, expr); \
+    bq = hfvis_ffao_options_default(); bq.level_gamma = NAN; BAD('F', INV, expr); \
+    bq = hfvis_ffao_options_default(); bq.blur_threshold = INFINITY; BAD('F', INV, expr); \
+    bq = hfvis_ffao_options_default(); bq.estimator = HFVIS_FFAO_L_CLOSED_FORM; bq.falloff.kind = HFVIS_FALLOFF_STEP; \
+    bq.falloff.param = 1.0; BAD('S', INV, expr); \
     } while (0)
 
 static void args_ffao_options_resolve(void)
@@ -2775,6 +2809,7 @@ static const uint32_t tri_idx[3] = {0, 1, 2};
     bm = m_box; bm.indices = bad_idx; bm.triangle_count = 1; BAD('R', INV, expr); \
     bm.xyz = nan_xyz; bm.vertex_count = 3; bm.indices = tri_idx; bm.triangle_count = 1; BAD('F', INV, expr); \
     bm = m_box; bm.triangle_count = SIZE_MAX / 2; BAD('O', huge_status, expr); \
+    bm = m_box; bm.vertex_count = SIZE_MAX / 2; BAD('O', INV, expr); \
     } while (0)
 
 /* Invalid volume grids, substituted as &bv. */
@@ -3925,6 +3960,7 @@ static hfvis_volume iv_prev(void)
     BAD('N', INV, fn(NULL, &cur, &iv_img, 1, NULL, st)); \
     BAD('N', INV, fn(&prev, NULL, &iv_img, 1, NULL, st)); \
     BAD('N', INV, fn(&prev, &cur, NULL, 1, NULL, st)); \
+    BAD('O', INV, fn(&prev, &cur, &iv_img, SIZE_MAX / 2, NULL, st)); \
     bp = cur; bp.data = NULL; BAD('N', INV, fn(&prev, &bp, &iv_img, 1, NULL, st)); \
     bp = cur; bp.channels = 1; BAD('R', INV, fn(&prev, &bp, &iv_img, 1, NULL, st)); \
     bp = cur; bp.grid.dims[0] = 3; BAD('R', INV, fn(&prev, &bp, &iv_img, 1, NULL, st)); \
@@ -4359,6 +4395,8 @@ static const float vp_nan[3] = {0.5f, NAN, 1.5f};
     BAD('N', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, 1, NULL, NULL)); \
     BAD('Z', INV, fn(&vf_obj, 1, vp_pts, vp_zero, 1, NULL, out)); \
     BAD('F', INV, fn(&vf_obj, 1, vp_nan, vp_nrm, 1, NULL, out)); \
+    BAD('O', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, SIZE_MAX / 2, NULL, out)); \
+    BAD('O', INV, fn(&vf_obj, SIZE_MAX / 2, vp_pts, vp_nrm, 1, NULL, out)); \
     VFOBJ_CASES(fn(&bo1, 1, vp_pts, vp_nrm, 1, NULL, out)); \
     bq = hfvis_visfield_ao_options_default(); bq.rays_sqrt = HFVIS_VISFIELD_MAX_RAYS_SQRT + 1; BAD('O', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, 1, &bq, out)); \
     bq = hfvis_visfield_ao_options_default(); bq.rays_sqrt = -1; BAD('G', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, 1, &bq, out)); \
@@ -4367,6 +4405,8 @@ static const float vp_nan[3] = {0.5f, NAN, 1.5f};
     bq = hfvis_visfield_ao_options_default(); bq.combine = (hfvis_visfield_combine)-1; BAD('E', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, 1, &bq, out)); \
     bq = hfvis_visfield_ao_options_default(); bq.falloff = HFVIS_VISFIELD_FALLOFF_LINEAR; BAD('S', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, 1, &bq, out)); \
     bq = hfvis_visfield_ao_options_default(); bq.offset = -1.0; BAD('S', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, 1, &bq, out)); \
+    bq = hfvis_visfield_ao_options_default(); bq.bias = -0.1; BAD('S', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, 1, &bq, out)); \
+    bq = hfvis_visfield_ao_options_default(); bq.max_distance = -1.0; BAD('S', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, 1, &bq, out)); \
     } while (0)
 
 static void args_visfield_ambient_occlusion(void)
@@ -4404,6 +4444,7 @@ static const double light_c[3] = {0.5, 0.5, 4.0};
     BAD('N', INV, fn(&vf_obj, 1, vp_pts, 1, NULL, 0.5, NULL, out)); \
     BAD('N', INV, fn(&vf_obj, 1, vp_pts, 1, light_c, 0.5, NULL, NULL)); \
     BAD('F', INV, fn(&vf_obj, 1, vp_nan, 1, light_c, 0.5, NULL, out)); \
+    BAD('O', INV, fn(&vf_obj, 1, vp_pts, SIZE_MAX / 2, light_c, 0.5, NULL, out)); \
     BAD('F', INV, fn(&vf_obj, 1, vp_pts, 1, v3_nan, 0.5, NULL, out)); \
     BAD('F', INV, fn(&vf_obj, 1, vp_pts, 1, light_c, INFINITY, NULL, out)); \
     BAD('G', INV, fn(&vf_obj, 1, vp_pts, 1, light_c, -0.5, NULL, out)); \
@@ -4443,6 +4484,7 @@ static void args_visfield_soft_shadow_reference(void)
     BAD('N', INV, fn(&vf_obj, 1, q_o, NULL, 0.0, h)); \
     BAD('N', INV, fn(&vf_obj, 1, q_o, q_d, 0.0, NULL)); \
     BAD('Z', INV, fn(&vf_obj, 1, q_o, v3_zero, 0.0, h)); \
+    BAD('O', INV, fn(&vf_obj, SIZE_MAX / 2, q_o, q_d, 0.0, h)); \
     BAD('F', INV, fn(&vf_obj, 1, v3_inf, q_d, 0.0, h)); \
     BAD('F', INV, fn(&vf_obj, 1, q_o, q_d, NAN, h)); \
     BAD('G', INV, fn(&vf_obj, 1, q_o, q_d, -0.1, h)); \
@@ -4650,6 +4692,10 @@ static void args_volgi_options_default(void)
     memset(&bo, 0, sizeof bo); bo.reflectance_source = HFVIS_VOLGI_REFLECTANCE_CONSTANT; bo.reflectance = 2.0f; BAD('S', INV, expr); \
     memset(&bo, 0, sizeof bo); bo.gather_scale = NAN; BAD('F', INV, expr); \
     memset(&bo, 0, sizeof bo); bo.shadow_bias = -1.0; BAD('S', INV, expr); \
+    memset(&bo, 0, sizeof bo); bo.reflectance_source = (hfvis_volgi_reflectance)9; BAD('E', INV, expr); \
+    memset(&bo, 0, sizeof bo); bo.resolution = HFVIS_VOLGI_MAX_RESOLUTION + 1; BAD('O', INV, expr); \
+    memset(&bo, 0, sizeof bo); bo.reflectance_source = HFVIS_VOLGI_REFLECTANCE_CONSTANT; bo.reflectance = NAN; BAD('F', INV, expr); \
+    memset(&bo, 0, sizeof bo); bo.shadow_bias = INFINITY; BAD('F', INV, expr); \
     } while (0)
 
 static void args_volgi_options_resolve(void)
@@ -5136,6 +5182,13 @@ static void args_lk_options_default(void)
     bk = hfvis_lk_options_default(); bk.mask_mode = HFVIS_LK_MASK_LUT; BAD('N', INV, expr); \
     bk = hfvis_lk_options_default(); bk.sides = HFVIS_LK_SIDES_PER_TRIANGLE; BAD('N', INV, expr); \
     bk = hfvis_lk_options_default(); bk.jitter = HFVIS_LK_JITTER_CUSTOM; bk.tilt_max_rad = 2.0; BAD('R', INV, expr); \
+    bk = hfvis_lk_options_default(); bk.jitter = (hfvis_lk_jitter)9; BAD('E', INV, expr); \
+    bk = hfvis_lk_options_default(); bk.node_mask = (hfvis_lk_node_mask)9; BAD('E', INV, expr); \
+    bk = hfvis_lk_options_default(); bk.volume = (hfvis_lk_volume)9; BAD('E', INV, expr); \
+    bk = hfvis_lk_options_default(); bk.raycast_test = (hfvis_lk_raycast_test)9; BAD('E', INV, expr); \
+    bk = hfvis_lk_options_default(); bk.gbuffer_cull = (hfvis_cull_mode)9; BAD('E', INV, expr); \
+    bk = hfvis_lk_options_default(); bk.node_mask = HFVIS_LK_NODE_SPHERE_LUT; BAD('N', INV, expr); \
+    bk = hfvis_lk_options_default(); bk.epsilon = INFINITY; BAD('F', INV, expr); \
     } while (0)
 
 static void args_lk_options_resolve(void)
