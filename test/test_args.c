@@ -1931,7 +1931,13 @@ static hfvis_ns_scene ns_scene_ok(void)
     bs = ns_scene_ok(); bs.albedo[0] = NAN; BAD('F', INV, expr); \
     bs = ns_scene_ok(); bs.specular = -1.0f; BAD('S', INV, expr); \
     bs = ns_scene_ok(); bs.specular = 1.0f; bs.shininess = 0.0f; BAD('S', INV, expr); \
+    bs = ns_scene_ok(); bs.albedo_map = ns_bad_map; BAD('F', INV, expr); \
+    bs = ns_scene_ok(); bs.emission = ns_bad_map; BAD('F', INV, expr); \
+    bs = ns_scene_ok(); bs.env_sh = ns_bad_sh; BAD('F', INV, expr); \
     } while (0)
+/* A per-sample map with one NaN at sample 5 (not a hole), and an SH vector with an Inf. */
+static const float ns_bad_map[GW * GH] = {0.5f, 0.5f, 0.5f, 0.5f, 0.5f, NAN, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f};
+static const double ns_bad_sh[16] = {1.0, INFINITY};
 
 static void args_ns_gi(void)
 {
@@ -2276,12 +2282,16 @@ static void args_ssao_lattice_init(void)
     CAMERA_CASES(hfvis_ssao_lattice_init(&bc, &d, L));
 }
 
+static hfvis_ssao_direction bad_weight_dir; /* a valid direction with weight -1 (setup) */
+
 static hfvis_ssao_lattice lat_ok;
 static hfvis_ssao_line lines_ok[64];
 
 static void make_lattice(void)
 {
     hfvis_ssao_direction d = dir_ok();
+    bad_weight_dir = d;
+    bad_weight_dir.weight = -1.0;
     if (hfvis_ssao_lattice_init(&cam_ok, &d, &lat_ok) != HFVIS_OK || lat_ok.line_count > 64 ||
         hfvis_ssao_lattice_lines(&cam_ok, &lat_ok, lines_ok) != HFVIS_OK)
         exit(2);
@@ -2339,6 +2349,8 @@ static void args_lsao_options_default(void)
     bl = hfvis_lsao_options_default(); bl.reject_normal = 1.5; BAD('S', INV, expr); \
     bl = hfvis_lsao_options_default(); bl.azimuth0_rad = INFINITY; bl.pattern = HFVIS_SSAO_PATTERN_UNIFORM; BAD('F', INV, expr); \
     bl = hfvis_lsao_options_default(); bl.spacing = 1e9; BAD('O', INV, expr); \
+    bl = hfvis_lsao_options_default(); bl.pattern = HFVIS_SSAO_PATTERN_CUSTOM; bl.directions = 1; \
+    bl.custom_directions = &bad_weight_dir; BAD('S', INV, expr); \
     } while (0)
 
 static void args_lsao_options_resolve(void)
