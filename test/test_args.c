@@ -369,14 +369,18 @@ static void *out_bytes(size_t n)
 #define AT(type) ((type *)out_bytes(sizeof(type)))
 #define ATN(type, n) ((type *)out_bytes((size_t)(n) * sizeof(type)))
 
-static void arena_fill(void) { memset(arena, SENTINEL, arena_used + ARENA_SLACK); }
-static int arena_untouched(void)
+/* What the arena must still hold after a failing call: the sentinel, or (BADP) the state an
+ * in/out argument was given before the call. */
+static unsigned char *arena_expect;
+
+static void arena_fill_upto(size_t n)
 {
-    size_t i, n = arena_used + ARENA_SLACK;
-    for (i = 0; i < n; i++)
-        if (arena[i] != SENTINEL) return 0;
-    return 1;
+    memset(arena, SENTINEL, n);
+    memset(arena_expect, SENTINEL, n);
 }
+static void arena_fill(void) { arena_fill_upto(arena_used + ARENA_SLACK); }
+static void arena_snapshot(void) { memcpy(arena_expect, arena, arena_used + ARENA_SLACK); }
+static int arena_untouched(void) { return memcmp(arena, arena_expect, arena_used + ARENA_SLACK) == 0; }
 
 /* The function under test, the classes it exercised, counters. */
 static const char *cur_name;
@@ -433,6 +437,10 @@ static void base_status(int got, int line)
 #define OK(call) do { arena_fill(); base_status((int)(call), __LINE__); } while (0)
 /* An invalid call: the documented status, outputs untouched. */
 #define BAD(cls, want, call) do { arena_fill(); case_status((cls), (int)(want), (int)(call), __LINE__); } while (0)
+/* An invalid call on in/out arguments: poke sets them up in the arena, then the call must fail
+ * with want and leave them (and every output) exactly as poke left them. */
+#define BADP(cls, want, poke, call) do { arena_fill(); poke; arena_snapshot(); \
+    case_status((cls), (int)(want), (int)(call), __LINE__); } while (0)
 /* An invalid call of a value-returning function: cond (which makes the call) must hold. */
 #define BADV(cls, cond) do { arena_fill(); case_value((cls), (cond) ? 1 : 0, #cond, __LINE__); } while (0)
 
@@ -1288,19 +1296,26 @@ static void args_hull_tree_reset(void)
 
 static void args_hull_tree_push(void)
 {
-    hfvis_hull_tree *t;
+    size_t need = hfvis_hull_tree_size(3);
+    hfvis_hull_tree *t = NULL;
+    void *mem;
     int *hc;
     begin("hull_tree_push");
     hc = AT(int);
-    CHECK(hfvis_hull_tree_init(tree_mem, sizeof tree_mem, 2, NULL, &t) == HFVIS_OK);
-    OK(hfvis_hull_tree_push(t, 0.0, 1.0, hc));
-    BAD('N', INV, hfvis_hull_tree_push(NULL, 2.0, 1.0, hc));
-    BAD('F', INV, hfvis_hull_tree_push(t, NAN, 1.0, hc));
-    BAD('F', INV, hfvis_hull_tree_push(t, 2.0, INFINITY, hc));
-    BAD('R', INV, hfvis_hull_tree_push(t, 0.0, 1.0, hc));
-    OK(hfvis_hull_tree_push(t, 1.0, 0.0, NULL));
-    BAD('O', LIM, hfvis_hull_tree_push(t, 2.0, 0.0, hc));
-    BADV('R', hfvis_hull_tree_count(t) == 2);
+    mem = out_bytes(need); /* the tree is an in/out argument: a failing push must not change it */
+    arena_fill();
+    CHECK(hfvis_hull_tree_init(mem, need, 3, NULL, &t) == HFVIS_OK);
+    base_status(hfvis_hull_tree_push(t, 0.0, 1.0, hc), __LINE__);
+#define TREE_TWO (hfvis_hull_tree_init(mem, need, 3, NULL, &t), hfvis_hull_tree_push(t, 0.0, 1.0, NULL), \
+                  hfvis_hull_tree_push(t, 1.0, 0.5, NULL))
+    BADP('N', INV, TREE_TWO, hfvis_hull_tree_push(NULL, 2.0, 1.0, hc));
+    BADP('F', INV, TREE_TWO, hfvis_hull_tree_push(t, NAN, 1.0, hc));
+    BADP('F', INV, TREE_TWO, hfvis_hull_tree_push(t, 2.0, INFINITY, hc));
+    BADP('R', INV, TREE_TWO, hfvis_hull_tree_push(t, 1.0, 1.0, hc));
+    BADP('R', INV, TREE_TWO, hfvis_hull_tree_push(t, 0.5, 1.0, hc));
+    BADP('O', LIM, (TREE_TWO, hfvis_hull_tree_push(t, 2.0, 0.0, NULL)), hfvis_hull_tree_push(t, 3.0, 0.0, hc));
+#undef TREE_TWO
+    CHECK(hfvis_hull_tree_count(t) == 3); /* the full tree the LIMIT case was given is intact */
 }
 
 static void args_hull_tree_horizons(void)
@@ -3979,7 +3994,13 @@ static hfvis_volume iv_prev(void)
     bp = cur; bp.channels = 0; BAD('Z', INV, fn(&prev, &bp, &iv_img, 1, NULL, st)); \
     IMAGE_CASES(fn(&prev, &cur, &bi, 1, NULL, st)); \
     IVOPT_CASES(fn(&prev, &cur, &iv_img, 1, &bo, st)); \
+    two_images[0] = iv_img; two_images[1] = iv_img; two_images[1].depth = NULL; \
+    BAD('N', INV, fn(&prev, &cur, two_images, 2, NULL, st)); \
+    two_images[1] = iv_img; two_images[1].view.far_plane = NAN; \
+    BAD('F', INV, fn(&prev, &cur, two_images, 2, NULL, st)); \
     } while (0)
+/* An image pair whose second image is invalid: nothing may be written for the first. */
+static hfvis_depth_image two_images[2];
 
 static void args_iv_cleanup(void)
 {
@@ -4010,6 +4031,10 @@ static void args_iv_inject(void)
     o = hfvis_iv_options_default(); o.occupancy_channel = 2;
     BAD('R', INV, hfvis_iv_inject(&cur, &iv_img, 1, &o, st));
     IMAGE_CASES(hfvis_iv_inject(&cur, &bi, 1, NULL, st));
+    two_images[0] = iv_img; two_images[1] = iv_img; two_images[1].view.width = 0;
+    BAD('Z', INV, hfvis_iv_inject(&cur, two_images, 2, NULL, st));
+    two_images[1] = iv_img; two_images[1].attribute_count = 1; /* attributes NULL */
+    BAD('N', INV, hfvis_iv_inject(&cur, two_images, 2, NULL, st));
     IVOPT_CASES(hfvis_iv_inject(&cur, &iv_img, 1, &bo, st));
 }
 
@@ -4400,7 +4425,13 @@ static void args_visfield_ao_options_default(void)
 static const float vp_pts[3] = {0.5f, 0.5f, 1.5f}, vp_nrm[3] = {0.0f, 0.0f, -1.0f}, vp_zero[3] = {0, 0, 0};
 static const float vp_nan[3] = {0.5f, NAN, 1.5f};
 
-#define VFAO_CASES(fn) do { hfvis_visfield_ao_options bq; \
+/* Second point / normal / object invalid: the first one's output must not be written. */
+static const float vp_pts2[6] = {0.5f, 0.5f, 1.5f, 0.5f, 0.5f, 1.6f};
+static const float vp_pts2_nan[6] = {0.5f, 0.5f, 1.5f, 0.5f, NAN, 1.6f};
+static const float vp_nrm2[6] = {0, 0, -1, 0, 0, -1}, vp_nrm2_zero[6] = {0, 0, -1, 0, 0, 0};
+static hfvis_visfield_object objs2[2];
+
+#define VFAO_CASES(fn) do { hfvis_visfield_ao_options bq; float *out2 = AF(2); \
     BAD('N', INV, fn(NULL, 1, vp_pts, vp_nrm, 1, NULL, out)); \
     BAD('N', INV, fn(&vf_obj, 1, NULL, vp_nrm, 1, NULL, out)); \
     BAD('N', INV, fn(&vf_obj, 1, vp_pts, NULL, 1, NULL, out)); \
@@ -4419,6 +4450,10 @@ static const float vp_nan[3] = {0.5f, NAN, 1.5f};
     bq = hfvis_visfield_ao_options_default(); bq.offset = -1.0; BAD('S', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, 1, &bq, out)); \
     bq = hfvis_visfield_ao_options_default(); bq.bias = -0.1; BAD('S', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, 1, &bq, out)); \
     bq = hfvis_visfield_ao_options_default(); bq.max_distance = -1.0; BAD('S', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, 1, &bq, out)); \
+    BAD('F', INV, fn(&vf_obj, 1, vp_pts2_nan, vp_nrm2, 2, NULL, out2)); \
+    BAD('Z', INV, fn(&vf_obj, 1, vp_pts2, vp_nrm2_zero, 2, NULL, out2)); \
+    objs2[0] = vf_obj; objs2[1] = vf_obj; objs2[1].object_to_world[5] = 3.0; \
+    BAD('S', INV, fn(objs2, 2, vp_pts2, vp_nrm2, 2, NULL, out2)); \
     } while (0)
 
 static void args_visfield_ambient_occlusion(void)
@@ -4450,7 +4485,7 @@ static void args_visfield_ambient_occlusion_reference(void)
 
 static const double light_c[3] = {0.5, 0.5, 4.0};
 
-#define VFSHADOW_CASES(fn) do { hfvis_visfield_shadow_options bq; \
+#define VFSHADOW_CASES(fn) do { hfvis_visfield_shadow_options bq; float *out2 = AF(2); \
     BAD('N', INV, fn(NULL, 1, vp_pts, 1, light_c, 0.5, NULL, out)); \
     BAD('N', INV, fn(&vf_obj, 1, NULL, 1, light_c, 0.5, NULL, out)); \
     BAD('N', INV, fn(&vf_obj, 1, vp_pts, 1, NULL, 0.5, NULL, out)); \
@@ -4464,6 +4499,9 @@ static const double light_c[3] = {0.5, 0.5, 4.0};
     memset(&bq, 0, sizeof bq); bq.samples = HFVIS_VISFIELD_MAX_SAMPLES + 1; BAD('O', INV, fn(&vf_obj, 1, vp_pts, 1, light_c, 0.5, &bq, out)); \
     memset(&bq, 0, sizeof bq); bq.samples = -1; BAD('G', INV, fn(&vf_obj, 1, vp_pts, 1, light_c, 0.5, &bq, out)); \
     memset(&bq, 0, sizeof bq); bq.bias = NAN; BAD('S', INV, fn(&vf_obj, 1, vp_pts, 1, light_c, 0.5, &bq, out)); \
+    BAD('F', INV, fn(&vf_obj, 1, vp_pts2_nan, 2, light_c, 0.5, NULL, out2)); \
+    objs2[0] = vf_obj; objs2[1] = vf_obj; objs2[1].field = NULL; \
+    BAD('N', INV, fn(objs2, 2, vp_pts2, 2, light_c, 0.5, NULL, out2)); \
     } while (0)
 
 static void args_visfield_soft_shadow(void)
@@ -4501,6 +4539,8 @@ static void args_visfield_soft_shadow_reference(void)
     BAD('F', INV, fn(&vf_obj, 1, q_o, q_d, NAN, h)); \
     BAD('G', INV, fn(&vf_obj, 1, q_o, q_d, -0.1, h)); \
     VFOBJ_CASES(fn(&bo1, 1, q_o, q_d, 0.0, h)); \
+    objs2[0] = vf_obj; objs2[1] = vf_obj; objs2[1].object_to_world[12] = INFINITY; \
+    BAD('F', INV, fn(objs2, 2, q_o, q_d, 0.0, h)); \
     } while (0)
 
 static void args_visfield_trace(void)
@@ -4807,6 +4847,8 @@ static void args_volgi_propagate(void)
     BAD('N', INV, hfvis_volgi_propagate(&geo_ok, NULL, 2, prop, NULL, en));
     BAD('G', INV, hfvis_volgi_propagate(&geo_ok, NULL, -1, prop, acc, en));
     BAD('O', INV, hfvis_volgi_propagate(&geo_ok, NULL, HFVIS_VOLGI_MAX_ITERATIONS + 1, prop, acc, en));
+    BADP('F', INV, prop[100] = NAN, hfvis_volgi_propagate(&geo_ok, NULL, 2, prop, acc, en));
+    BADP('S', INV, acc[7] = 1e30f, hfvis_volgi_propagate(&geo_ok, NULL, 2, prop, acc, en));
     GEO_CASES(hfvis_volgi_propagate(&bg3, NULL, 2, prop, acc, en));
     VOLGI_OPT_CASES(hfvis_volgi_propagate(&geo_ok, &bo, 2, prop, acc, en));
 }
@@ -5256,6 +5298,7 @@ static void args_lk_raster(void)
 
 static const double rc_pos[6] = {0.5, 0.5, 1.0, 0.5, 0.5, -1.0}, rc_nrm[6] = {0, 0, 1, 0, 0, -1};
 static const double rc_nan[6] = {0.5, 0.5, NAN, 0.5, 0.5, -1.0}, rc_zero[6] = {0, 0, 0, 0, 0, -1};
+static const double rc_nan2[6] = {0.5, 0.5, 1.0, 0.5, NAN, -1.0}, rc_zero2[6] = {0, 0, 1, 0, 0, 0};
 
 static hfvis_lk_receivers recv_ok(void)
 {
@@ -5275,6 +5318,8 @@ static hfvis_lk_receivers recv_ok(void)
     brc = rc; brc.position = rc_nan; BAD('F', INV, fn(&m_box, &m_bvh, &lk_rays, &brc, NULL, masks, ob, st)); \
     brc = rc; brc.normal = rc_zero; BAD('Z', INV, fn(&m_box, &m_bvh, &lk_rays, &brc, NULL, masks, ob, st)); \
     brc = rc; brc.count = SIZE_MAX / 2; BAD('O', INV, fn(&m_box, &m_bvh, &lk_rays, &brc, NULL, masks, ob, st)); \
+    brc = rc; brc.position = rc_nan2; BAD('F', INV, fn(&m_box, &m_bvh, &lk_rays, &brc, NULL, masks, ob, st)); \
+    brc = rc; brc.normal = rc_zero2; BAD('Z', INV, fn(&m_box, &m_bvh, &lk_rays, &brc, NULL, masks, ob, st)); \
     BAD('R', INV, fn(&m_box, &bad_bvh, &lk_rays, &rc, NULL, masks, ob, st)); \
     RAYSET_CASES(fn(&m_box, &m_bvh, &bry, &rc, NULL, masks, ob, st)); \
     LKOPT_CASES(fn(&m_box, &m_bvh, &lk_rays, &rc, &bk, masks, ob, st)); \
@@ -5966,7 +6011,7 @@ static long sweep_one(const sweep_entry *e)
     }
     for (k = 1; k <= SWEEP_MAX_K; k++) {
         arena_used = 0;
-        memset(arena, SENTINEL, arena_high + ARENA_SLACK);
+        arena_fill_upto(arena_high + ARENA_SLACK);
         a = make_counter(&c, k);
         s = e->fn(&a);
         if (c.calls < k) { /* allocation k never happened: the call ran to completion */
@@ -6222,7 +6267,8 @@ int main(int argc, char **argv)
     int rc;
     TEST_INIT(argc, argv);
     arena = (unsigned char *)malloc(ARENA_BYTES);
-    if (!arena || !mkdtemp(t)) return 2;
+    arena_expect = (unsigned char *)malloc(ARENA_BYTES);
+    if (!arena || !arena_expect || !mkdtemp(t)) return 2;
     snprintf(tmpdir, sizeof tmpdir, "%s", t);
     setup();
     RUN(inventory_is_the_header);
@@ -6231,6 +6277,7 @@ int main(int argc, char **argv)
     RUN(malloc_only_writers);
     teardown();
     remove_tree(tmpdir);
+    free(arena_expect);
     free(arena);
     rc = TEST_DONE();
     return rc;
