@@ -6202,7 +6202,9 @@ static hfvis_status vx_iv_pass_args(const hfvis_volume *prev, const hfvis_volume
                                     const hfvis_iv_options *opts, vx_iv_opt *o, int single)
 {
     size_t t;
-    if (!vx_iv_volume_ok(prev) || !vx_iv_volume_ok(curr) || (count > 0 && !images))
+    /* an image array of count entries must be addressable */
+    if (!vx_iv_volume_ok(prev) || !vx_iv_volume_ok(curr) || (count > 0 && !images)
+        || count > SIZE_MAX / sizeof(hfvis_depth_image))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (prev->channels != curr->channels || !vx_iv_same_grid(&prev->grid, &curr->grid))
         return HFVIS_ERR_INVALID_ARGUMENT;
@@ -6314,7 +6316,9 @@ static hfvis_status vx_iv_inject_args(const hfvis_volume *vol, const hfvis_depth
 {
     size_t t;
     int c, map[HFVIS_VOLUME_MAX_CHANNELS];
-    if (!vx_iv_volume_ok(vol) || (count > 0 && !images)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!vx_iv_volume_ok(vol) || (count > 0 && !images)
+        || count > SIZE_MAX / sizeof(hfvis_depth_image))
+        return HFVIS_ERR_INVALID_ARGUMENT;
     for (c = 0; c < vol->channels; c++)
         if (!vx_blend_valid(vol->blend[c])) return HFVIS_ERR_INVALID_ARGUMENT;
     for (t = 0; t < count; t++) {
@@ -8042,7 +8046,9 @@ static hfvis_status vx_vf_objects_check(const hfvis_visfield_object *objects, si
 {
     size_t i;
     vx_vf_inst tmp;
-    if (count && !objects) return HFVIS_ERR_INVALID_ARGUMENT;
+    /* the object array (and the per-object scratch sized from count) must be addressable */
+    if ((count && !objects) || count > SIZE_MAX / sizeof(hfvis_visfield_object))
+        return HFVIS_ERR_INVALID_ARGUMENT;
     for (i = 0; i < count; i++) {
         const hfvis_visfield_object *o = objects + i;
         if (!vx_vf_transform(o->object_to_world, &tmp)) return HFVIS_ERR_INVALID_ARGUMENT;
