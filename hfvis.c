@@ -119,6 +119,13 @@ static int hf_grid_valid(const hfvis_grid *g)
 /* width*height as size_t (valid grids only). */
 static size_t hf_grid_count(const hfvis_grid *g) { return (size_t)g->width * (size_t)g->height; }
 
+/* 1 if an output plane of `height` rows `stride` pixels apart, up to 4 floats per pixel, is
+ * addressable: every index (y*stride + x)*channels stays below PTRDIFF_MAX bytes. */
+static int hf_out_fits(ptrdiff_t stride, int height)
+{
+    return stride >= 1 && (size_t)height <= (size_t)PTRDIFF_MAX / (4 * sizeof(float)) / (size_t)stride;
+}
+
 static int hf_border_valid(hfvis_border b) { return b >= HFVIS_BORDER_DEFAULT && b <= HFVIS_BORDER_WRAP; }
 
 /* splitmix64: the library's only PRNG / hash (fixed, seeded, no global state). */
@@ -1777,7 +1784,7 @@ hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, int k,
     double ux, uy;
     int m;
     if (hf_check_common(grid, opts) != HFVIS_OK || !out || K < 1 || k < 0 || k >= K ||
-        out_stride < grid->width)
+        out_stride < grid->width || !hf_out_fits(out_stride, grid->height))
         return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
     if ((s = hf_sweep_alloc(&sw, grid, &o, 0, 1, 0)) != HFVIS_OK) return s;
@@ -2121,7 +2128,8 @@ static void hf_sky_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdif
 static int hf_light_args_valid(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
                                const void *out, ptrdiff_t out_stride)
 {
-    return hf_check_common(grid, opts) == HFVIS_OK && out && K >= 1 && out_stride >= grid->width;
+    return hf_check_common(grid, opts) == HFVIS_OK && out && K >= 1 && out_stride >= grid->width &&
+           hf_out_fits(out_stride, grid->height);
 }
 
 hfvis_status hfvis_sky_light(const hfvis_grid *grid, int K, float sky, float albedo,
@@ -2148,7 +2156,7 @@ static int hf_map_args_valid(const hfvis_grid *grid, int K, const float *map, co
 {
     size_t total;
     return hf_grid_valid(grid) && K >= 1 && map && out && out_stride >= grid->width &&
-           hf_mul_size(hf_grid_count(grid), (size_t)K, &total);
+           hf_out_fits(out_stride, grid->height) && hf_mul_size(hf_grid_count(grid), (size_t)K, &total);
 }
 
 /* tan of a stored elevation; -pi/2 (or below) means no occluder. */
@@ -2271,7 +2279,7 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
     double ux, uy;
     int x, y;
     if (hf_check_common(grid, opts) != HFVIS_OK || !out || out_stride < grid->width ||
-        !isfinite(sun_azimuth_rad) || !isfinite(sun_elevation_rad) || !isfinite(sun_radius_rad) ||
+        !hf_out_fits(out_stride, grid->height) || !isfinite(sun_azimuth_rad) || !isfinite(sun_elevation_rad) || !isfinite(sun_radius_rad) ||
         sun_radius_rad < 0.0 || sun_elevation_rad < -HF_HALF_PI || sun_elevation_rad > HF_HALF_PI)
         return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
@@ -2356,13 +2364,22 @@ typedef struct hf_env_resolved {
 /* Checks the environment's shape (not its radiance pointer: hfvis_env_table_size can be asked
  * before the map is loaded), K and the options; resolves defaults and the table size.
  * lp_normal_res must be odd and >= 3 (M = 1 leaves no theta_n interval to interpolate). */
+/* The radiance array (n_theta*n_phi*channels floats) must be addressable: a size that
+ * overflows size_t describes no array (env fields already checked >= 1). */
+static int hf_env_size_ok(const hfvis_env *env)
+{
+    size_t n, bytes;
+    return hf_mul_size((size_t)env->n_theta, (size_t)env->n_phi, &n) &&
+           hf_mul_size(n, (size_t)env->channels, &n) && hf_mul_size(n, sizeof(float), &bytes);
+}
+
 static hfvis_status hf_env_resolve(const hfvis_env *env, int K, const hfvis_env_options *eopts,
                                    hf_env_resolved *r)
 {
     hfvis_env_options o;
     size_t n, bytes;
     if (env == NULL || K < 1 || env->n_theta < 1 || env->n_phi < 1 || env->channels < 1 ||
-        env->channels > 4)
+        env->channels > 4 || !hf_env_size_ok(env))
         return HFVIS_ERR_INVALID_ARGUMENT;
     o = hfvis_env_options_default();
     if (eopts != NULL) {
@@ -2782,7 +2799,7 @@ static hfvis_status hf_env_tables_create(const hfvis_env *env, int K, double azi
 static int hf_env_valid(const hfvis_env *env)
 {
     return env != NULL && env->radiance != NULL && env->n_theta >= 1 && env->n_phi >= 1 &&
-           env->channels >= 1 && env->channels <= 4;
+           env->channels >= 1 && env->channels <= 4 && hf_env_size_ok(env);
 }
 
 hfvis_status hfvis_env_light_from_map(const hfvis_grid *grid, int K,
@@ -2800,7 +2817,7 @@ hfvis_status hfvis_env_light_from_map(const hfvis_grid *grid, int K,
     int x, y, k, c, C;
     if (!hf_grid_valid(grid) || K < 1 || !isfinite(map_azimuth0_rad) || map == NULL ||
         !hf_env_valid(env) || !isfinite(albedo) || out == NULL ||
-        out_stride < (ptrdiff_t)grid->width)
+        out_stride < (ptrdiff_t)grid->width || !hf_out_fits(out_stride, grid->height))
         return HFVIS_ERR_INVALID_ARGUMENT;
     st = hf_env_resolve(env, K, eopts, &r);
     if (st != HFVIS_OK) return st;
@@ -4570,7 +4587,7 @@ hfvis_status hfvis_sh_project_env(const hfvis_env *env, double *out)
     if (env == NULL || out == NULL || env->radiance == NULL || env->n_theta < 1 ||
         env->n_phi < 1 || env->channels < 1 || env->channels > 4 ||
         !hf_mul_size((size_t)env->n_theta, (size_t)env->n_phi, &n) ||
-        !hf_mul_size(n, (size_t)env->channels, &n))
+        !hf_mul_size(n, (size_t)env->channels, &n) || !hf_env_size_ok(env))
         return HFVIS_ERR_INVALID_ARGUMENT;
     T = env->n_theta;
     P = env->n_phi;

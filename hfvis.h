@@ -52,7 +52,9 @@
  * Numbers. Public arrays are float; hull tests, slopes and integrals are double, rounded to
  *   float once at the output.
  * Errors. Every fallible function returns hfvis_status (HFVIS_OK == 0) and writes results
- *   through out-pointers. On any error the outputs are left untouched. The library never
+ *   through out-pointers. On any error the outputs are left untouched. A buffer described by
+ *   a size and a stride (rows*stride elements) that cannot be addressed, i.e. whose byte size
+ *   overflows PTRDIFF_MAX, is HFVIS_ERR_INVALID_ARGUMENT like any other bad size. The library never
  *   prints, never exits, never aborts on input, and has no global mutable state: every
  *   function is reentrant and may run concurrently on different outputs.
  * Memory. The caller owns every output and sizes it with the documented formula or a *_size()
@@ -312,10 +314,11 @@ typedef struct hfvis_lattice {
 HFVIS_API hfvis_status hfvis_lattice_init(hfvis_lattice *lattice, int width, int height,
                                           double azimuth_rad);
 
-/* Number of nodes of the lattice buffer, rows*cols. */
+/* Number of nodes of the lattice buffer, rows*cols; 0 for NULL or an empty lattice. */
 HFVIS_API size_t hfvis_lattice_size(const hfvis_lattice *lattice);
 
-/* The in-domain node range [*i_first, *i_last] of line j; returns the count (0 if empty). */
+/* The in-domain node range [*i_first, *i_last] of line j; returns the count (0 if empty, if j is
+ * outside j_min..j_max or lattice is NULL: outputs not written then). */
 HFVIS_API int hfvis_lattice_line(const hfvis_lattice *lattice, int j, int *i_first, int *i_last);
 
 /* ========================================================================================== */
@@ -439,7 +442,8 @@ HFVIS_API hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user
 
 /* [P1] Eq. 5 per sector: S_k(theta) = (Nz/K) sin^2 theta + (sin(pi/K)/pi) a (theta - sin 2theta / 2),
  * where a = Nx cos psi_k + Ny sin psi_k and theta the (tangent-clamped) horizon zenith angle.
- * Pure helper; the uniform-sky radiance is c * sum_k S_k. */
+ * Pure helper; the uniform-sky radiance is c * sum_k S_k. NaN for K < 1; non-finite inputs give
+ * non-finite results. */
 HFVIS_API double hfvis_sector_weight(int K, double nz, double a, double theta);
 
 /* Uniform sky, fused into the sweep ([P1] §6.1 Eq. 4-5 with the clamp correction of spec §5.2):
@@ -494,7 +498,8 @@ HFVIS_API hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_a
 typedef struct hfvis_env {
     const float *radiance;
     int n_theta, n_phi;      /* >= 1 */
-    int channels;            /* 1..4 */
+    int channels;            /* 1..4; n_theta*n_phi*channels floats must be addressable (a
+                                count that overflows is HFVIS_ERR_INVALID_ARGUMENT) */
 } hfvis_env;
 
 typedef enum hfvis_env_method {
@@ -605,7 +610,8 @@ HFVIS_API size_t hfvis_hull_tree_size(int max_samples);
 HFVIS_API hfvis_status hfvis_hull_tree_init(void *mem, size_t mem_size, int max_samples,
                                            const hfvis_tree_options *opts, hfvis_hull_tree **tree);
 
-/* Empty the tree for a new line (keeps capacity and options; the iteration count restarts). */
+/* Empty the tree for a new line (keeps capacity and options; the iteration count restarts).
+ * tree may be NULL (no-op). */
 HFVIS_API void hfvis_hull_tree_reset(hfvis_hull_tree *tree);
 
 /* Push the next sample (distance strictly greater than the previous one, finite height) and
@@ -624,7 +630,7 @@ HFVIS_API hfvis_status hfvis_hull_tree_push(hfvis_hull_tree *tree, double distan
 HFVIS_API int hfvis_hull_tree_horizons(const hfvis_hull_tree *tree, int minimal, int *out, int cap);
 
 /* Number of samples pushed, and RecConvexity tests made since the last reset (the paper's
- * iteration count t; t <= 2m + n). */
+ * iteration count t; t <= 2m + n). Both 0 for NULL. */
 HFVIS_API int hfvis_hull_tree_count(const hfvis_hull_tree *tree);
 HFVIS_API long long hfvis_hull_tree_iterations(const hfvis_hull_tree *tree);
 
@@ -1484,7 +1490,9 @@ typedef struct hfvis_camera {
  * stride or 0 < stride < width, guard bands < 0 or leaving no inner pixel, an unknown
  * projection, non-finite or non-positive focal lengths / scales (only those of the chosen
  * projection are read), a non-finite principal point, far_depth < 0 or NaN; HFVIS_ERR_LIMIT
- * when width or height exceeds HFVIS_SSAO_MAX_SIZE or 3*stride*height overflows. */
+ * when width or height exceeds HFVIS_SSAO_MAX_SIZE or 3*stride*height overflows. Every other
+ * routine that takes a camera returns HFVIS_ERR_INVALID_ARGUMENT for any camera this rejects
+ * (HFVIS_ERR_LIMIT included), except the constructors below, which return this status. */
 HFVIS_API hfvis_status hfvis_camera_check(const hfvis_camera *cam);
 
 /* A symmetric perspective camera: the VISIBLE (inner) image of (width - 2 guard_x) x (height -
@@ -2169,6 +2177,8 @@ HFVIS_API double hfvis_ffao_slab_rho1(double a, double theta_hi, double c, doubl
 HFVIS_API hfvis_status hfvis_ffao_table_build(const hfvis_falloff *falloff, int na, int nb, int nc,
                                               int nd, double b_ref, const hfvis_allocator *alloc,
                                               hfvis_ffao_table *out);
+/* Release a table's values with the allocator it was built with and zero it; table may be
+ * NULL (no-op). */
 HFVIS_API void hfvis_ffao_table_free(hfvis_ffao_table *table);
 /* L(a, b, c, d) from the table (inputs clamped to its ranges); NaN for an invalid table. */
 HFVIS_API double hfvis_ffao_table_lookup(const hfvis_ffao_table *table, double a, double b,
@@ -2313,7 +2323,8 @@ typedef struct hfvis_view {
 
 /* Matrices (column-major double[16], OpenGL conventions; see hfvis_view). */
 
-/* out = a * b (apply b first). out may alias a or b. */
+/* out = a * b (apply b first). out may alias a or b. Cannot fail; the pointers must be valid
+ * (not checked) and non-finite entries propagate. */
 HFVIS_API void hfvis_mat4_multiply(const double a[16], const double b[16], double out[16]);
 /* out = inverse of m (Gauss-Jordan, partial pivoting). HFVIS_ERR_INVALID_ARGUMENT if m is singular
  * (a pivot below 1e-300) or not finite; out untouched then. out may alias m. */
@@ -2347,7 +2358,8 @@ HFVIS_API hfvis_status hfvis_view_orthographic(hfvis_view *view, const double ey
                                                double near_plane, double far_plane);
 /* Eye-space z of a window depth zw in [0, 1] (thesis eq. 16 with its sign restored, spec voxel
  * §4.2): perspective z_e = -n f / (f - zw (f - n)), orthographic z_e = -(n + zw (f - n));
- * zw = 0 gives -n, zw = 1 gives -f. The linear view depth is -z_e. */
+ * zw = 0 gives -n, zw = 1 gives -f. The linear view depth is -z_e. Pure: no argument is
+ * checked (this one and the inverse below); NaN in gives NaN out. */
 HFVIS_API double hfvis_depth_to_eye_z(double zw, double near_plane, double far_plane,
                                       int orthographic);
 /* Inverse of hfvis_depth_to_eye_z: the window depth of eye-space z (z < 0 in front). */
@@ -2411,17 +2423,20 @@ HFVIS_API size_t hfvis_volume_size(const hfvis_volume_grid *grid, int channels);
 HFVIS_API hfvis_status hfvis_volume_init(hfvis_volume *vol, const hfvis_volume_grid *grid,
                                          int channels, float *storage, hfvis_blend blend);
 
-/* Set every value of every channel to `value`. vol must have been set up by hfvis_volume_init. */
+/* Set every value of every channel to `value`. vol must have been set up by hfvis_volume_init;
+ * a NULL vol or vol->data is a no-op. */
 HFVIS_API void hfvis_volume_clear(hfvis_volume *vol, float value);
 
 /* Blend values[0..channels) into voxel (i, j, k): data = op_c(data, values[c]) per channel.
- * Returns HFVIS_ERR_INVALID_ARGUMENT for NULL or a voxel outside the grid (nothing written). */
+ * Returns HFVIS_ERR_INVALID_ARGUMENT for NULL, an invalid grid or channel count, an unknown
+ * blend in vol->blend[0..channels) or a voxel outside the grid (nothing written). */
 HFVIS_API hfvis_status hfvis_volume_write(hfvis_volume *vol, int i, int j, int k,
                                           const float *values);
 
 /* Merge src into dst voxel by voxel with dst's per-channel blend (the thesis' MAX merge of the
  * three axis passes, ch. 5 Alg. 4). The grids' dims and the channel counts must be equal.
- * Returns HFVIS_ERR_INVALID_ARGUMENT otherwise. */
+ * Returns HFVIS_ERR_INVALID_ARGUMENT otherwise, for NULL, or for an unknown blend of dst
+ * (nothing written). */
 HFVIS_API hfvis_status hfvis_volume_merge(hfvis_volume *dst, const hfvis_volume *src);
 
 
@@ -3599,7 +3614,8 @@ HFVIS_API hfvis_status hfvis_iv_single_pass(const hfvis_volume *prev, hfvis_volu
  * (NULL = every channel). Non-empty: the occupancy channel of opts is non-zero, or with
  * HFVIS_IV_NO_CHANNEL any channel is non-zero. replaced (may be NULL) gets the number of voxels.
  * Errors: HFVIS_ERR_INVALID_ARGUMENT for NULL, unequal grids or channel counts, a channel out of
- * range or listed twice, channel_count outside 1..channels with a list. No allocation. */
+ * range or listed twice, channel_count outside 1..channels with a list, an occupancy channel
+ * out of range. Of opts only occupancy_channel is read (may be NULL). No allocation. */
 HFVIS_API hfvis_status hfvis_iv_replace_nonempty(hfvis_volume *curr,
                                                  const hfvis_volume *injection,
                                                  const int *channels, int channel_count,
@@ -5100,7 +5116,8 @@ HFVIS_API hfvis_status hfvis_lk_raster(const hfvis_mesh *mesh, const hfvis_view 
  * bvh: built over mesh (hfvis_bvh_build); it is validated first (O(nodes)). masks:
  * recv->count*words, obscurance: recv->count; either may be NULL (not both).
  * Returns HFVIS_OK; HFVIS_ERR_INVALID_ARGUMENT for NULL, an invalid mesh, ray set or receiver
- * (non-finite, zero normal), a BVH that does not match the mesh or is malformed, bad options;
+ * (non-finite, zero normal, a count whose 3*count doubles overflow), a BVH that does not match
+ * the mesh or is malformed, bad options;
  * HFVIS_ERR_LIMIT when count*words or the scratch overflows size_t; HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on error. Memory: 1 block (32 bytes per
  * triangle, 1 byte per node, the traversal stack). */
 HFVIS_API hfvis_status hfvis_lk_bvh(const hfvis_mesh *mesh, const hfvis_bvh *bvh,

@@ -80,6 +80,13 @@ static int ss_mul(size_t a, size_t b, size_t *out)
     return 1;
 }
 
+/* 1 if a caller plane of `height` rows `stride` floats apart (stride >= 1) is addressable:
+ * height*stride floats fit in PTRDIFF_MAX bytes, so y*stride + x never overflows. */
+static int ss_plane_fits(ptrdiff_t stride, int height)
+{
+    return stride >= 1 && (size_t)height <= (size_t)PTRDIFF_MAX / sizeof(float) / (size_t)stride;
+}
+
 /* a*b*c bytes, 0 on overflow (callers never ask for 0 bytes). */
 static size_t ss_bytes3(size_t a, size_t b, size_t c)
 {
@@ -399,7 +406,8 @@ hfvis_status hfvis_depth_linearize(const float *in, int width, int height, ptrdi
                                    float *out, ptrdiff_t out_stride)
 {
     int x, y;
-    if (!in || !out || width < 1 || height < 1 || in_stride < width || out_stride < width)
+    if (!in || !out || width < 1 || height < 1 || in_stride < width || out_stride < width ||
+        !ss_plane_fits(in_stride, height) || !ss_plane_fits(out_stride, height))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (!ss_depth_params(e, ortho, n, f)) return HFVIS_ERR_INVALID_ARGUMENT;
     for (y = 0; y < height; y++) {
@@ -1744,7 +1752,7 @@ hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth, const float
         return HFVIS_ERR_INVALID_ARGUMENT;
     W = c.W - 2 * c.gx;
     H = c.H - 2 * c.gy;
-    if (ao_stride < W) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (ao_stride < W || !ss_plane_fits(ao_stride, H)) return HFVIS_ERR_INVALID_ARGUMENT;
     ss_cfg_from_lsao(&o, &g);
     K = o.directions;
     if (!ss_mul((size_t)W, (size_t)H, &npix)) return HFVIS_ERR_LIMIT;
@@ -1980,7 +1988,7 @@ hfvis_status hfvis_hbao(const hfvis_camera *cam, const float *depth, const float
         !depth || !ao)
         return HFVIS_ERR_INVALID_ARGUMENT;
     W = c.W - 2 * c.gx;
-    if (ao_stride < W) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (ao_stride < W || !ss_plane_fits(ao_stride, c.H - 2 * c.gy)) return HFVIS_ERR_INVALID_ARGUMENT;
     ss_fall_load(&o.falloff, &f);
     support = o.radius > 0.0 ? o.radius : f.support;
     if (o.tangent == HFVIS_SSAO_TANGENT_REAL && !normals) {
@@ -2243,7 +2251,7 @@ hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth, co
         !depth || !ao)
         return HFVIS_ERR_INVALID_ARGUMENT;
     W = c.W - 2 * c.gx;
-    if (ao_stride < W) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (ao_stride < W || !ss_plane_fits(ao_stride, c.H - 2 * c.gy)) return HFVIS_ERR_INVALID_ARGUMENT;
     ss_fall_load(&o.falloff, &f);
     if (!normals) {
         size_t b = ss_bytes3((size_t)c.stride, (size_t)c.H, 3 * sizeof(float));
@@ -3274,6 +3282,7 @@ hfvis_status hfvis_ssao_bilateral_blur(const float *in, ptrdiff_t in_stride, int
                                        ptrdiff_t out_stride)
 {
     if (!in || !out || width < 1 || height < 1 || in_stride < width || out_stride < width ||
+        !ss_plane_fits(in_stride, height) || !ss_plane_fits(out_stride, height) ||
         radius < 0 || radius > 64 || !(ss_finite(threshold) && threshold >= 0.0) || in == out)
         return HFVIS_ERR_INVALID_ARGUMENT;
     ssb_blur(in, in_stride, width, height, radius, threshold, out, out_stride);
@@ -3290,7 +3299,8 @@ static hfvis_status ssb_setup(ssb_ctx *x, const hfvis_camera *cam, const float *
     memset(x, 0, sizeof *x);
     memset(own, 0, sizeof *own);
     if (ss_cam_load(cam, &x->c) != HFVIS_OK || hfvis_ffao_options_resolve(opts, &x->o) != HFVIS_OK ||
-        !depth || !ao || ao_stride < x->c.W - 2 * x->c.gx)
+        !depth || !ao || ao_stride < x->c.W - 2 * x->c.gx ||
+        !ss_plane_fits(ao_stride, x->c.H - 2 * x->c.gy))
         return HFVIS_ERR_INVALID_ARGUMENT;
     x->depth = depth;
     x->bil = x->o.sampling == HFVIS_SSAO_SAMPLING_BILINEAR;
@@ -3650,6 +3660,8 @@ hfvis_status hfvis_ssao_error(const float *ao, ptrdiff_t ao_stride, const float 
     int x, y;
     if (!ao || !ref || !stats || width < 1 || height < 1 || ao_stride < width ||
         ref_stride < width || (error_image && error_stride < width) ||
+        !ss_plane_fits(ao_stride, height) || !ss_plane_fits(ref_stride, height) ||
+        (error_image && !ss_plane_fits(error_stride, height)) ||
         !(ss_finite(tolerance) && tolerance >= 0.0) || (relative != 0 && relative != 1))
         return HFVIS_ERR_INVALID_ARGUMENT;
     for (y = 0; y < height; y++)

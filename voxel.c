@@ -478,6 +478,8 @@ HFVIS_API hfvis_status hfvis_volume_write(hfvis_volume *vol, int i, int j, int k
         || vol->channels > HFVIS_VOLUME_MAX_CHANNELS || i < 0 || j < 0 || k < 0
         || i >= vol->grid.dims[0] || j >= vol->grid.dims[1] || k >= vol->grid.dims[2])
         return HFVIS_ERR_INVALID_ARGUMENT;
+    for (c = 0; c < vol->channels; c++)
+        if (!vx_blend_valid(vol->blend[c])) return HFVIS_ERR_INVALID_ARGUMENT;
     d = vol->data + (((size_t)k * (size_t)vol->grid.dims[1] + (size_t)j) * (size_t)vol->grid.dims[0]
                      + (size_t)i) * (size_t)vol->channels;
     for (c = 0; c < vol->channels; c++) d[c] = vx_blend_apply(vol->blend[c], d[c], values[c]);
@@ -494,6 +496,8 @@ HFVIS_API hfvis_status hfvis_volume_merge(hfvis_volume *dst, const hfvis_volume 
     if (n == 0) return HFVIS_ERR_INVALID_ARGUMENT;
     for (a = 0; a < 3; a++)
         if (dst->grid.dims[a] != src->grid.dims[a]) return HFVIS_ERR_INVALID_ARGUMENT;
+    for (c = 0; c < dst->channels; c++)
+        if (!vx_blend_valid(dst->blend[c])) return HFVIS_ERR_INVALID_ARGUMENT;
     for (i = 0; i < n; i += (size_t)dst->channels)
         for (c = 0; c < dst->channels; c++)
             dst->data[i + (size_t)c] =
@@ -959,6 +963,7 @@ HFVIS_API hfvis_status hfvis_mesh_from_grid(const hfvis_allocator *alloc, const 
     uint32_t *remap = NULL;
     size_t W, H, x, y, nv = 0, nt = 0, npts;
     if (!out || !g || !g->z || g->width < 1 || g->height < 1 || g->stride < g->width
+        || (size_t)g->height > (size_t)PTRDIFF_MAX / sizeof(float) / (size_t)g->stride
         || !isfinite(g->cell_size) || !(g->cell_size > 0.0))
         return HFVIS_ERR_INVALID_ARGUMENT;
     W = (size_t)g->width;
@@ -6214,7 +6219,9 @@ static hfvis_status vx_iv_pass_args(const hfvis_volume *prev, const hfvis_volume
                                     const hfvis_iv_options *opts, vx_iv_opt *o, int single)
 {
     size_t t;
-    if (!vx_iv_volume_ok(prev) || !vx_iv_volume_ok(curr) || (count > 0 && !images))
+    /* an image array of count entries must be addressable */
+    if (!vx_iv_volume_ok(prev) || !vx_iv_volume_ok(curr) || (count > 0 && !images)
+        || count > SIZE_MAX / sizeof(hfvis_depth_image))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (prev->channels != curr->channels || !vx_iv_same_grid(&prev->grid, &curr->grid))
         return HFVIS_ERR_INVALID_ARGUMENT;
@@ -6326,7 +6333,9 @@ static hfvis_status vx_iv_inject_args(const hfvis_volume *vol, const hfvis_depth
 {
     size_t t;
     int c, map[HFVIS_VOLUME_MAX_CHANNELS];
-    if (!vx_iv_volume_ok(vol) || (count > 0 && !images)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!vx_iv_volume_ok(vol) || (count > 0 && !images)
+        || count > SIZE_MAX / sizeof(hfvis_depth_image))
+        return HFVIS_ERR_INVALID_ARGUMENT;
     for (c = 0; c < vol->channels; c++)
         if (!vx_blend_valid(vol->blend[c])) return HFVIS_ERR_INVALID_ARGUMENT;
     for (t = 0; t < count; t++) {
@@ -8054,7 +8063,9 @@ static hfvis_status vx_vf_objects_check(const hfvis_visfield_object *objects, si
 {
     size_t i;
     vx_vf_inst tmp;
-    if (count && !objects) return HFVIS_ERR_INVALID_ARGUMENT;
+    /* the object array (and the per-object scratch sized from count) must be addressable */
+    if ((count && !objects) || count > SIZE_MAX / sizeof(hfvis_visfield_object))
+        return HFVIS_ERR_INVALID_ARGUMENT;
     for (i = 0; i < count; i++) {
         const hfvis_visfield_object *o = objects + i;
         if (!vx_vf_transform(o->object_to_world, &tmp)) return HFVIS_ERR_INVALID_ARGUMENT;
