@@ -133,6 +133,13 @@
     X(ns_gi_scratch_size, S, -, "NZGOFESR", "INVALID_ARGUMENT") \
     X(ns_bspline_max, S, -, "NGF", "INVALID_ARGUMENT") \
     X(ns_sample_matrices, S, -, "NZE", "INVALID_ARGUMENT") \
+    X(direction_sums, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
+    X(partial_encode_size, V, -, "NZGOSR", "0") \
+    X(partial_encode, S, -, "NZGOSR", "INVALID_ARGUMENT BUFFER_TOO_SMALL") \
+    X(partial_decode, S, A, "NZGOFER", "INVALID_ARGUMENT FORMAT LIMIT") \
+    X(partial_free, V, -, "N", "no-op for NULL") \
+    X(partial_save, S, M, "NZGOSR", "INVALID_ARGUMENT IO") \
+    X(partial_load, S, A, "NZOR", "INVALID_ARGUMENT FORMAT LIMIT IO") \
     X(camera_check, S, -, "NZGOFER", "INVALID_ARGUMENT LIMIT") \
     X(camera_perspective, S, -, "NZGOFR", "INVALID_ARGUMENT LIMIT") \
     X(camera_orthographic, S, -, "NZGOF", "INVALID_ARGUMENT LIMIT") \
@@ -602,6 +609,7 @@ static void teardown(void)
     bo = hfvis_sweep_options_default(); bo.azimuth0_rad = NAN; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.direction_begin = -1; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.direction_end = -2; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.direction_order = (hfvis_direction_order)3; BAD('E', INV, expr); \
     } while (0)
 
 /* ========================================================================================== */
@@ -2017,6 +2025,245 @@ static void args_ns_sample_matrices(void)
     BAD('N', INV, hfvis_ns_sample_matrices(&w, NULL));
     b = w; b.interp = (hfvis_ns_interp)99; BAD('E', INV, hfvis_ns_sample_matrices(&b, G));
     b = w; b.samples = 0; BAD('Z', INV, hfvis_ns_sample_matrices(&b, G));
+}
+
+/* ---- split runs: raw direction sums and the partial-sum file ------------------------------ */
+
+static void args_direction_sums(void)
+{
+    hfvis_sweep_options o;
+    double *sums;
+    begin("direction_sums");
+    sums = AD(GW * GH);
+    OK(hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_SKY_VIEW, NULL, NULL, NULL, sums));
+    OK(hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_SKY_LIGHT, NULL, NULL, NULL, sums));
+    OK(hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_ENV_LIGHT, &g_env, NULL, NULL, sums));
+    OK(hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_VISIBILITY, NULL, NULL, NULL, sums));
+    o = hfvis_sweep_options_default();
+    o.direction_begin = 1; o.direction_end = 3; o.direction_order = HFVIS_DIRECTION_ORDER_SWEEP;
+    OK(hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_SKY_VIEW, NULL, NULL, &o, sums));
+    BAD('N', INV, hfvis_direction_sums(NULL, 4, HFVIS_SUM_SKY_VIEW, NULL, NULL, NULL, sums));
+    BAD('N', INV, hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_SKY_VIEW, NULL, NULL, NULL, NULL));
+    BAD('N', INV, hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_ENV_LIGHT, NULL, NULL, NULL, sums));
+    BAD('Z', INV, hfvis_direction_sums(&g_ok, 0, HFVIS_SUM_SKY_VIEW, NULL, NULL, NULL, sums));
+    BAD('G', INV, hfvis_direction_sums(&g_ok, -4, HFVIS_SUM_VISIBILITY, NULL, NULL, NULL, sums));
+    BAD('E', INV, hfvis_direction_sums(&g_ok, 4, (hfvis_sum_kind)0, NULL, NULL, NULL, sums));
+    BAD('E', INV, hfvis_direction_sums(&g_ok, 4, (hfvis_sum_kind)5, NULL, NULL, NULL, sums));
+    BAD('E', INV, hfvis_direction_sums(&g_ok, 4, (hfvis_sum_kind)-1, NULL, NULL, NULL, sums));
+    o = hfvis_sweep_options_default(); o.direction_end = 5;
+    BAD('S', INV, hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_SKY_VIEW, NULL, NULL, &o, sums));
+    o = hfvis_sweep_options_default(); o.direction_begin = 2; o.direction_end = 2;
+    BAD('S', INV, hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_SKY_LIGHT, NULL, NULL, &o, sums));
+    o = hfvis_sweep_options_default(); o.direction_begin = 3; o.direction_end = 1;
+    BAD('S', INV, hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_VISIBILITY, NULL, NULL, &o, sums));
+    o = hfvis_sweep_options_default(); o.direction_order = (hfvis_direction_order)3;
+    BAD('E', INV, hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_SKY_VIEW, NULL, NULL, &o, sums));
+    o = hfvis_sweep_options_default(); o.direction_order = (hfvis_direction_order)-1;
+    BAD('E', INV, hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_ENV_LIGHT, &g_env, NULL, &o, sums));
+    GRID_CASES(hfvis_direction_sums(&bg, 4, HFVIS_SUM_SKY_VIEW, NULL, NULL, NULL, sums));
+    GRID_CASES(hfvis_direction_sums(&bg, 4, HFVIS_SUM_VISIBILITY, NULL, NULL, NULL, sums));
+    SWEEP_OPT_CASES(hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_SKY_LIGHT, NULL, NULL, &bo, sums));
+    SWEEP_OPT_CASES(hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_ENV_LIGHT, &g_env, NULL, &bo, sums));
+    ENV_CASES(hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_ENV_LIGHT, &be, NULL, NULL, sums));
+    EOPT_CASES(hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_ENV_LIGHT, &g_env, &bx, NULL, sums));
+}
+
+/* A valid partial: the 4 x 3 grid, one plane, directions [1, 3) of 4. */
+static double p_sums[GW * GH] = {0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5, 5.0, 5.5};
+static const hfvis_partial p_ok = {GW, GH, 1, 4, 1, 3, "svf K=4", p_sums};
+static unsigned char p_file[512];
+static size_t p_file_len;
+
+/* A tag one byte over HFVIS_PARTIAL_MAX_TAG. */
+static const char *long_tag(void)
+{
+    static char t[HFVIS_PARTIAL_MAX_TAG + 2];
+    memset(t, 'a', HFVIS_PARTIAL_MAX_TAG + 1);
+    t[HFVIS_PARTIAL_MAX_TAG + 1] = '\0';
+    return t;
+}
+
+/* Invalid partials, substituted as &bp; CASE(cls, expr) is P_INV (status) or P_ZERO (size). */
+#define P_INV(cls, expr) BAD(cls, INV, expr)
+#define P_ZERO(cls, expr) BADV(cls, (expr) == 0)
+#define PARTIAL_CASES(CASE, expr) do { hfvis_partial bp; \
+    bp = p_ok; bp.sums = NULL; CASE('N', expr); \
+    bp = p_ok; bp.tag = NULL; CASE('N', expr); \
+    bp = p_ok; bp.width = 0; CASE('Z', expr); \
+    bp = p_ok; bp.planes = 0; CASE('Z', expr); \
+    bp = p_ok; bp.directions = 0; CASE('Z', expr); \
+    bp = p_ok; bp.tag = ""; CASE('Z', expr); \
+    bp = p_ok; bp.height = -1; CASE('G', expr); \
+    bp = p_ok; bp.begin = -1; CASE('G', expr); \
+    bp = p_ok; bp.width = HFVIS_IMAGE_MAX_DIM + 1; CASE('O', expr); \
+    bp = p_ok; bp.planes = HFVIS_PARTIAL_MAX_PLANES + 1; CASE('O', expr); \
+    bp = p_ok; bp.width = 65536; bp.height = 65536; bp.planes = 2; CASE('O', expr); \
+    bp = p_ok; bp.tag = long_tag(); CASE('O', expr); \
+    bp = p_ok; bp.tag = "svf\nK=4"; CASE('R', expr); \
+    bp = p_ok; bp.tag = "svf\x7f"; CASE('R', expr); \
+    bp = p_ok; bp.end = bp.begin; CASE('S', expr); \
+    bp = p_ok; bp.end = 5; CASE('S', expr); \
+    bp = p_ok; bp.begin = 3; bp.end = 1; CASE('S', expr); \
+    } while (0)
+
+static void args_partial_encode_size(void)
+{
+    begin("partial_encode_size");
+    CHECK(hfvis_partial_encode_size(&p_ok) == 11 + 12 + 8 + 8 * GW * GH);
+    BADV('N', hfvis_partial_encode_size(NULL) == 0);
+    PARTIAL_CASES(P_ZERO, hfvis_partial_encode_size(&bp));
+}
+
+static void args_partial_encode(void)
+{
+    size_t need = hfvis_partial_encode_size(&p_ok), *wr;
+    unsigned char *out;
+    begin("partial_encode");
+    out = ATN(unsigned char, need); wr = AT(size_t);
+    OK(hfvis_partial_encode(&p_ok, out, need, wr));
+    BAD('N', INV, hfvis_partial_encode(NULL, out, need, wr));
+    BAD('N', INV, hfvis_partial_encode(&p_ok, NULL, need, wr));
+    BAD('N', INV, hfvis_partial_encode(&p_ok, out, need, NULL));
+    BAD('Z', SMALL, hfvis_partial_encode(&p_ok, out, 0, wr));
+    BAD('R', SMALL, hfvis_partial_encode(&p_ok, out, need - 1, wr));
+    PARTIAL_CASES(P_INV, hfvis_partial_encode(&bp, out, need, wr));
+}
+
+/* A file of header text head followed by values zero doubles, into buf (cap bytes). */
+static size_t partial_file(unsigned char *buf, size_t cap, const char *head, size_t values)
+{
+    size_t n = strlen(head);
+    if (n + 8 * values > cap) exit(2);
+    memcpy(buf, head, n);
+    memset(buf + n, 0, 8 * values);
+    return n + 8 * values;
+}
+
+static unsigned char p_bad[HFVIS_PARTIAL_MAX_TAG + 256];
+
+static void args_partial_decode(void)
+{
+    /* a header with the numbers line nums; a 4 x 3 one-plane file has 12 values */
+#define P_HEAD(nums) "HFVISSUM 1\n" nums "\nsvf K=4\n"
+    hfvis_partial *p;
+    size_t n;
+    char head[HFVIS_PARTIAL_MAX_TAG + 64];
+    begin("partial_decode");
+    CHECK(hfvis_partial_encode(&p_ok, p_file, sizeof p_file, &p_file_len) == HFVIS_OK);
+    p = AT(hfvis_partial);
+    arena_fill();
+    base_status(hfvis_partial_decode(p_file, p_file_len, NULL, p), __LINE__);
+    hfvis_partial_free(NULL, p);
+    n = partial_file(p_bad, sizeof p_bad, P_HEAD("4 3 1 4 0 4"), 12);
+    OK(hfvis_partial_decode(p_bad, n, NULL, p));
+    hfvis_partial_free(NULL, p);
+    BAD('N', INV, hfvis_partial_decode(NULL, p_file_len, NULL, p));
+    BAD('N', INV, hfvis_partial_decode(p_file, p_file_len, NULL, NULL));
+    BAD('Z', FMT, hfvis_partial_decode(p_file, 0, NULL, p));
+    BAD('R', FMT, hfvis_partial_decode(p_file, p_file_len - 1, NULL, p));
+    BAD('R', FMT, hfvis_partial_decode(p_file, 20, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, P_HEAD("4 3 1 4 0 4"), 13);
+    BAD('R', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, P_HEAD("0 3 1 4 0 4"), 0);
+    BAD('Z', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, P_HEAD("4 3 0 4 0 4"), 0);
+    BAD('Z', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, P_HEAD("4 3 1 0 0 4"), 12);
+    BAD('Z', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 1\n4 3 1 4 0 4\n\n", 12);
+    BAD('Z', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, P_HEAD("4 -3 1 4 0 4"), 12);
+    BAD('G', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, P_HEAD("4 3 1 4 -1 4"), 12);
+    BAD('G', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, P_HEAD("1048577 1 1 4 0 4"), 0);
+    BAD('O', LIM, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, P_HEAD("4 3 65537 4 0 4"), 0);
+    BAD('O', LIM, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, P_HEAD("65536 65536 2 4 0 4"), 0);
+    BAD('O', LIM, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, P_HEAD("2147483648 3 1 4 0 4"), 0);
+    BAD('O', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    snprintf(head, sizeof head, "HFVISSUM 1\n4 3 1 4 0 4\n%s\n", long_tag());
+    n = partial_file(p_bad, sizeof p_bad, head, 12);
+    BAD('O', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, P_HEAD("inf 3 1 4 0 4"), 12);
+    BAD('F', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, P_HEAD("nan 3 1 4 0 4"), 12);
+    BAD('F', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 2\n4 3 1 4 0 4\nsvf K=4\n", 12);
+    BAD('E', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, "HFVISSUN 1\n4 3 1 4 0 4\nsvf K=4\n", 12);
+    BAD('E', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, P_HEAD("4 3 1 4 2 2"), 12);
+    BAD('R', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, P_HEAD("4 3 1 4 0 5"), 12);
+    BAD('R', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, P_HEAD("04 3 1 4 0 4"), 12);
+    BAD('R', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, P_HEAD("4  3 1 4 0 4"), 12);
+    BAD('R', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, P_HEAD("4 3 1 4 0 4 5"), 12);
+    BAD('R', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 1\n4 3 1 4 0 4\nsvf\tK=4\n", 12);
+    BAD('R', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 1\n4 3 1 4 0 4\nsvf K=4", 0);
+    BAD('R', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
+#undef P_HEAD
+}
+
+static void args_partial_free(void)
+{
+    hfvis_partial p;
+    begin("partial_free");
+    memset(&p, 0, sizeof p);
+    hfvis_partial_free(NULL, NULL);
+    hfvis_partial_free(NULL, &p);
+    BADV('N', p.sums == NULL && p.tag == NULL);
+}
+
+static void args_partial_save(void)
+{
+    begin("partial_save");
+    OK(hfvis_partial_save(tmp_path("s.hfvs"), &p_ok));
+    BAD('N', INV, hfvis_partial_save(NULL, &p_ok));
+    BAD('N', INV, hfvis_partial_save(tmp_path("t.hfvs"), NULL));
+    BAD('R', IOE, hfvis_partial_save(bad_dir_path("t.hfvs"), &p_ok));
+    PARTIAL_CASES(P_INV, hfvis_partial_save(tmp_path("t.hfvs"), &bp));
+    BADV('R', access(tmp_path("t.hfvs"), F_OK) != 0);
+}
+
+/* Writes n bytes to the temporary file leaf. */
+static void write_tmp(const char *leaf, const void *data, size_t n)
+{
+    FILE *f = fopen(tmp_path(leaf), "wb");
+    CHECK(f != NULL);
+    if (!f) return;
+    CHECK(fwrite(data, 1, n, f) == n);
+    fclose(f);
+}
+
+static void args_partial_load(void)
+{
+    hfvis_partial *p;
+    size_t n;
+    begin("partial_load");
+    write_tmp("empty.hfvs", "", 0);
+    write_tmp("short.hfvs", p_file, p_file_len - 1);
+    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 1\n1048576 1048576 1 4 0 4\nsvf K=4\n", 0);
+    write_tmp("huge.hfvs", p_bad, n);
+    p = AT(hfvis_partial);
+    arena_fill();
+    base_status(hfvis_partial_load(tmp_path("s.hfvs"), NULL, p), __LINE__);
+    CHECK(p->width == GW && p->begin == 1 && p->end == 3 && strcmp(p->tag, p_ok.tag) == 0 &&
+          memcmp(p->sums, p_sums, sizeof p_sums) == 0);
+    hfvis_partial_free(NULL, p);
+    BAD('N', INV, hfvis_partial_load(NULL, NULL, p));
+    BAD('N', INV, hfvis_partial_load(tmp_path("s.hfvs"), NULL, NULL));
+    BAD('R', IOE, hfvis_partial_load(tmp_path("missing.hfvs"), NULL, p));
+    BAD('Z', FMT, hfvis_partial_load(tmp_path("empty.hfvs"), NULL, p));
+    BAD('R', FMT, hfvis_partial_load(tmp_path("short.hfvs"), NULL, p));
+    BAD('O', LIM, hfvis_partial_load(tmp_path("huge.hfvs"), NULL, p));
 }
 
 /* ========================================================================================== */
@@ -5456,6 +5703,25 @@ SW(ns_gi)
     out.bounces = 1; out.total = AF(GW * GH); out.bounce = AF(GW * GH);
     return hfvis_ns_gi(&g_ok, &sc, &o, &out);
 }
+SW(direction_sums)
+{
+    hfvis_sweep_options o = sweep_opts(al);
+    return hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_SKY_VIEW, NULL, NULL, &o, AD(GW * GH));
+}
+SW(partial_decode)
+{
+    hfvis_partial *p = AT(hfvis_partial);
+    hfvis_status s = hfvis_partial_decode(p_file, p_file_len, al, p);
+    if (s == HFVIS_OK) hfvis_partial_free(al, p);
+    return s;
+}
+SW(partial_load)
+{
+    hfvis_partial *p = AT(hfvis_partial);
+    hfvis_status s = hfvis_partial_load(tmp_path("s.hfvs"), al, p);
+    if (s == HFVIS_OK) hfvis_partial_free(al, p);
+    return s;
+}
 SW(lsao_direction)
 {
     hfvis_lsao_options o = hfvis_lsao_options_default();
@@ -5883,6 +6149,19 @@ SW(volgi_propagate_normalized)
     o.alloc = al; o.transfer = HFVIS_VOLGI_TRANSFER_CONE_NORMALIZED;
     return hfvis_volgi_propagate(&geo_ok, &o, 2, prop, acc, ATN(hfvis_volgi_energy, 2));
 }
+SW(direction_sums_env_range)
+{
+    hfvis_sweep_options o = sweep_opts(al);
+    hfvis_env_options e = hfvis_env_options_default();
+    e.method = HFVIS_ENV_LP_TABLE;
+    o.direction_begin = 1; o.direction_end = 3; o.direction_order = HFVIS_DIRECTION_ORDER_SWEEP;
+    return hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_ENV_LIGHT, &g_env, &e, &o, AD(GW * GH));
+}
+SW(direction_sums_visibility)
+{
+    hfvis_sweep_options o = sweep_opts(al);
+    return hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_VISIBILITY, NULL, NULL, &o, AD(GW * GH));
+}
 SW(lk_image_raster)
 {
     hfvis_lk_options o = hfvis_lk_options_default();
@@ -5957,6 +6236,7 @@ static const sweep_entry sweeps[] = {
     SWEEP(sun_visibility), SWEEP(env_light), SWEEP(env_light_from_map), SWEEP(intervisibility),
     SWEEP(visibility_count), SWEEP(visibility_count_naive), SWEEP(indirect_light),
     SWEEP(indirect_light_naive), SWEEP(terrain_gi), SWEEP(direct_light), SWEEP(ns_gi),
+    SWEEP(direction_sums), SWEEP(partial_decode), SWEEP(partial_load),
     SWEEP(lsao_direction), SWEEP(lsao_direction_naive), SWEEP(lsao), SWEEP(hbao), SWEEP(ssao_raytrace),
     SWEEP(ffao_table_build), SWEEP(ffao), SWEEP(ssao_mipmap),
     SWEEP(mesh_box), SWEEP(mesh_uv_sphere), SWEEP(mesh_icosphere), SWEEP(mesh_torus),
@@ -5975,6 +6255,8 @@ static const sweep_entry sweeps[] = {
     SWEEP_VARIANT(lk_raster, lk_raster_lut), SWEEP_VARIANT(iv_cleanup, iv_cleanup_two_images),
     SWEEP_VARIANT(ns_gi, ns_gi_bounces_key_glossy), SWEEP_VARIANT(lsao, lsao_bilinear_real),
     SWEEP_VARIANT(volgi_render, volgi_render_grid_bvh),
+    SWEEP_VARIANT(direction_sums, direction_sums_env_range),
+    SWEEP_VARIANT(direction_sums, direction_sums_visibility),
     NOALLOC(horizon_reference), NOALLOC(horizon_reference_fn), NOALLOC(light_reference),
     NOALLOC(viewshed), NOALLOC(viewshed_reference), NOALLOC(lsao_gather), NOALLOC(rasterize_reference),
     NOALLOC(voxelize_surface), NOALLOC(voxelize_conservative_reference), NOALLOC(voxelize_solid_reference),
@@ -6046,6 +6328,7 @@ static hfvis_status io_mesh_save(const char *path) { return hfvis_mesh_save(path
 static hfvis_status io_binvox_save(const char *path) { return hfvis_binvox_save(path, &vg_ok, occ_box); }
 static hfvis_status io_voxels_raw_save(const char *path) { return hfvis_voxels_raw_save(path, &vg_ok, occ_box); }
 static hfvis_status io_visfield_save(const char *path) { return hfvis_visfield_save(path, &vf_ok); }
+static hfvis_status io_partial_save(const char *path) { return hfvis_partial_save(path, &p_ok); }
 
 typedef struct io_entry {
     const char *name;
@@ -6054,7 +6337,7 @@ typedef struct io_entry {
 #define IOSAVE(name) {#name, io_##name}
 static const io_entry io_savers[] = {
     IOSAVE(pfm_save), IOSAVE(pgm_save), IOSAVE(mesh_save), IOSAVE(binvox_save),
-    IOSAVE(voxels_raw_save), IOSAVE(visfield_save),
+    IOSAVE(voxels_raw_save), IOSAVE(visfield_save), IOSAVE(partial_save),
 };
 #define IO_COUNT ((int)(sizeof io_savers / sizeof io_savers[0]))
 
