@@ -128,3 +128,9 @@ uninstall:
 
 clean:
 	rm -rf build out
+
+# The portability matrix (test/portability.sh): make test with gcc and clang at -O0 and -O2 and with
+# tcc, -DHFVIS_NO_STDIO per compiler, hfvis.h as C++98/11/17; absent compilers are skipped.
+.PHONY: uninstall portability
+portability:
+	@sh test/portability.sh
