@@ -349,7 +349,7 @@ TEST(ns_constant_slice)
 static double ns_trench(double a, int m, hfvis_ns_interp interp, hfvis_ns_omega_max omax)
 {
     enum { N = 5 };
-    float z[N * N], d[N * N];
+    float z[N * N] = {0.0f}, d[N * N];
     double env[16];
     hfvis_grid g = ns_grid(z, N, N);
     hfvis_ns_scene sc;
