@@ -1,5 +1,6 @@
 # hfvis - plain Makefile. Variables: CC, CXX, CFLAGS, config=release|debug|test|sanitize|coverage,
-# werror=1, PREFIX (install), FUZZ_SECONDS (fuzz).
+# werror=1, opt=0|1|2|3|s (replaces the config's -O level; outputs go to <build dir>-O<opt>),
+# PREFIX and DESTDIR (install, uninstall), FUZZ_SECONDS (fuzz).
 CC ?= cc
 CXX ?= c++
 config ?= release
@@ -33,6 +34,10 @@ else
 endif
 ifeq ($(werror),1)
   OPT += -Werror
+endif
+ifneq ($(opt),)
+  OPT := $(filter-out -O%,$(OPT)) -O$(opt)
+  BUILD := $(BUILD)-O$(opt)
 endif
 
 ALL_CFLAGS := $(BASEFLAGS) $(OPT) $(CFLAGS)
@@ -78,7 +83,7 @@ test check:
 sanitize:
 	@$(MAKE) --no-print-directory config=sanitize werror=1 run-tests
 run-tests: $(TESTS) $(EXAMPLES) $(CLI) $(BENCH)
-	@sh test/run.sh $(BUILD) "$(CXX)"
+	@CC="$(CC)" CFLAGS="$(OPT) $(CFLAGS)" sh test/run.sh $(BUILD) "$(CXX)"
 
 symbols: $(LIB)
 	@bad=$$(nm -g --defined-only $(LIB) | awk 'NF==3 && $$2 ~ /[TDBRC]/ {print $$3}' | grep -v '^hfvis_' || true); \
@@ -110,11 +115,16 @@ fuzz:
 	  build/fuzz/$$f -max_total_time=$(FUZZ_SECONDS) -max_len=4096 build/fuzz/corpus_$$f test/fuzz/seeds/$${f#fuzz_} || exit 1; \
 	done
 
+# The version in hfvis.pc is read from hfvis.h's HFVIS_VERSION_MAJOR/MINOR/PATCH. DESTDIR stages
+# the files (packaging); the .pc file names PREFIX, where they end up.
+HFVIS_VERSION_STRING := $(shell awk 'NF >= 3 && $$1 ~ /define$$/ && $$2 ~ /^HFVIS_VERSION_(MAJOR|MINOR|PATCH)$$/ { v = v s $$3; s = "." } END { print v }' hfvis.h)
 install: $(LIB)
-	mkdir -p $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/lib/pkgconfig
-	cp hfvis.h $(DESTDIR)$(PREFIX)/include/
-	cp $(LIB) $(DESTDIR)$(PREFIX)/lib/
-	printf 'prefix=%s\nincludedir=$${prefix}/include\nlibdir=$${prefix}/lib\n\nName: hfvis\nDescription: height-field and screen-space visibility reference\nVersion: 0.1.0\nCflags: -I$${includedir}\nLibs: -L$${libdir} -lhfvis -lm\n' '$(PREFIX)' > $(DESTDIR)$(PREFIX)/lib/pkgconfig/hfvis.pc
+	mkdir -p '$(DESTDIR)$(PREFIX)/include' '$(DESTDIR)$(PREFIX)/lib/pkgconfig'
+	cp hfvis.h '$(DESTDIR)$(PREFIX)/include/'
+	cp $(LIB) '$(DESTDIR)$(PREFIX)/lib/'
+	printf 'prefix=%s\nincludedir=$${prefix}/include\nlibdir=$${prefix}/lib\n\nName: hfvis\nDescription: height-field and screen-space visibility reference\nVersion: %s\nCflags: -I$${includedir}\nLibs: -L$${libdir} -lhfvis -lm\n' '$(PREFIX)' '$(HFVIS_VERSION_STRING)' > '$(DESTDIR)$(PREFIX)/lib/pkgconfig/hfvis.pc'
+uninstall:
+	rm -f '$(DESTDIR)$(PREFIX)/include/hfvis.h' '$(DESTDIR)$(PREFIX)/lib/libhfvis.a' '$(DESTDIR)$(PREFIX)/lib/pkgconfig/hfvis.pc'
 
 clean:
 	rm -rf build out
@@ -127,3 +137,9 @@ gallery:
 	@sh examples/gallery.sh build docs/gallery
 $(EXAMPLES) $(CLI) $(BENCH): examples/png.h
 $(BUILD)/test/test_png: examples/png.h examples/common.h
+
+# The portability matrix (test/portability.sh): make test with gcc and clang at -O0 and -O2 and with
+# tcc, -DHFVIS_NO_STDIO per compiler, hfvis.h as C++98/11/17; absent compilers are skipped.
+.PHONY: uninstall portability
+portability:
+	@sh test/portability.sh

@@ -3096,7 +3096,7 @@ void hfvis_hull_tree_reset(hfvis_hull_tree *tree)
 
 int hfvis_hull_tree_count(const hfvis_hull_tree *tree) { return tree ? tree->n : 0; }
 
-long long hfvis_hull_tree_iterations(const hfvis_hull_tree *tree) { return tree ? tree->iterations : 0; }
+int64_t hfvis_hull_tree_iterations(const hfvis_hull_tree *tree) { return tree ? tree->iterations : 0; }
 
 /* convex(c -> p -> r): p strictly above the chord c-r (spec §7.3; strict, so collinear points
  * are not kept: the tree then matches the naive rule with >=, spec §7.6). */

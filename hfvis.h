@@ -632,7 +632,7 @@ HFVIS_API int hfvis_hull_tree_horizons(const hfvis_hull_tree *tree, int minimal,
 /* Number of samples pushed, and RecConvexity tests made since the last reset (the paper's
  * iteration count t; t <= 2m + n). Both 0 for NULL. */
 HFVIS_API int hfvis_hull_tree_count(const hfvis_hull_tree *tree);
-HFVIS_API long long hfvis_hull_tree_iterations(const hfvis_hull_tree *tree);
+HFVIS_API int64_t hfvis_hull_tree_iterations(const hfvis_hull_tree *tree);
 
 /* Visible samples of receiver index `receiver` on a line (distance increasing), enumerated
  * from its horizon list (farthest first) as spec §8: out receives the sample indices farthest

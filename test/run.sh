@@ -35,6 +35,14 @@ if [ -f test/cli_test.sh ] && [ -x "$build/hfvis" ]; then
 fi
 if $cxx -std=c++11 -Wall -Wextra -Werror -pedantic -fsyntax-only -I. test/cxx_header.cpp; then
   passed=$((passed + 1)); echo "ok   cxx header"; else failed=$((failed + 1)); echo "FAIL cxx header"; fi
+# install (make install/uninstall, pkg-config, a user program; exit 77 = skipped without pkg-config)
+# and vendor (the four library files alone, plain $CC -std=c99): one pass/fail each.
+sh test/install_test.sh "$build" "$scratch" > "$scratch/log" 2>&1; rc=$?
+if [ "$rc" -eq 0 ]; then passed=$((passed + 1)); tail -n 1 "$scratch/log"
+elif [ "$rc" -eq 77 ]; then cat "$scratch/log"
+else failed=$((failed + 1)); cat "$scratch/log"; echo "FAIL install"; fi
+if sh test/vendor_test.sh "$scratch" > "$scratch/log" 2>&1; then passed=$((passed + 1)); tail -n 1 "$scratch/log"
+else failed=$((failed + 1)); cat "$scratch/log"; echo "FAIL vendor"; fi
 bad=$(nm -g --defined-only "$build/libhfvis.a" | awk 'NF==3 && $2 ~ /[TDBRC]/ {print $3}' | grep -v '^hfvis_')
 if [ -z "$bad" ]; then passed=$((passed + 1)); echo "ok   symbols"; else failed=$((failed + 1)); echo "FAIL symbols: $bad"; fi
 rm -rf "$scratch"

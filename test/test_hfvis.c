@@ -272,7 +272,7 @@ TEST(horizon_lattice_vs_naive)
             g.z = z; g.width = w; g.height = h; g.stride = w; g.cell_size = cells[ci];
             for (a = 0; a < 30; a++) {
                 /* the five special azimuths, then random ones (some negative or > 2pi) */
-                static const double special[5] = { 0.0, 0.5 * PI, PI, 1.5 * PI, 0.25 * PI };
+                const double special[5] = { 0.0, 0.5 * PI, PI, 1.5 * PI, 0.25 * PI };
                 double az = a < 5 ? special[a] : (rng_unit() * 4.0 - 1.0) * PI;
                 hfvis_lattice L;
                 size_t n;
@@ -349,7 +349,7 @@ static long lattice_walk(const hfvis_lattice *L, int *lines, int *ok)
 
 TEST(lattice_geometry)
 {
-    static const double axes[4] = { 0.0, 0.5 * PI, PI, 1.5 * PI };
+    const double axes[4] = { 0.0, 0.5 * PI, PI, 1.5 * PI };
     hfvis_lattice L;
     int a, lines, ok;
     long total;
