@@ -130,13 +130,13 @@ clean:
 	rm -rf build out
 
 # make gallery: the release examples, then docs/gallery/*.png (README's Gallery) picked from the
-# PNGs they write (examples/gallery.sh). The PNG writer is examples/png.h, included by common.h.
+# PNGs they write (examples/gallery.sh). The PNG writer is examples/png_write.h, included by common.h.
 .PHONY: gallery
 gallery:
 	@$(MAKE) --no-print-directory config=release all
 	@sh examples/gallery.sh build docs/gallery
-$(EXAMPLES) $(CLI) $(BENCH): examples/png.h
-$(BUILD)/test/test_png: examples/png.h examples/common.h
+$(EXAMPLES) $(CLI) $(BENCH): examples/png_write.h
+$(BUILD)/test/test_png: examples/png_write.h examples/common.h
 
 # The portability matrix (test/portability.sh): make test with gcc and clang at -O0 and -O2 and with
 # tcc, -DHFVIS_NO_STDIO per compiler, hfvis.h as C++98/11/17; absent compilers are skipped.

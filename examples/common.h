@@ -1,12 +1,13 @@
 /* common.h - helpers shared by the examples and the hfvis tool: one-line error reports, PGM
- * output and its PNG picture twins (png.h). Header-only, every function static inline (unused ones cost nothing and do not warn). */
+ * output and its PNG picture twins (png_write.h). Header-only, every function static inline
+ * (unused ones cost nothing and do not warn). */
 #ifndef HFVIS_EXAMPLES_COMMON_H
 #define HFVIS_EXAMPLES_COMMON_H
 
 #include <limits.h>
 #include <stdio.h>
 #include "hfvis.h"
-#include "png.h"
+#include "png_write.h"
 
 /* Print the one error line every hfvis program uses, "hfvis: <what>: <why>", on stderr. */
 static inline void ex_error(const char *what, const char *why)

@@ -1,5 +1,5 @@
-/* test_png.c - the examples' PNG writer (examples/png.h and its common.h wrappers): the CRC-32 and
- * Adler-32 check values, the chunk and zlib layout byte by byte, stored-block splitting at 65535,
+/* test_png.c - the examples' PNG writer (examples/png_write.h and its common.h wrappers): the
+ * CRC-32 and Adler-32 check values, the chunk and zlib layout byte by byte, stored-block splitting at 65535,
  * a bit-exact round trip through a stored-block decoder written here, the float mapping, and the
  * failure paths (bad sizes, overflow, short buffers, unwritable paths leave nothing behind). */
 #define _POSIX_C_SOURCE 200809L /* mkdtemp, opendir, mkdir, rmdir */
@@ -15,7 +15,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-/* ---- references written from the specifications, independent of png.h ---- */
+/* ---- references written from the specifications, independent of png_write.h ---- */
 
 /* CRC-32, one bit at a time (PNG Annex D). */
 static uint32_t crc_bitwise(const unsigned char *p, size_t n)
