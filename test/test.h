@@ -5,7 +5,10 @@
 #define HFVIS_TEST_H
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+
+#include "../hfvis.h"
 
 static int test_checks, test_check_failures, test_failed_tests, test_run_tests;
 static int test_current_failed;
@@ -34,4 +37,43 @@ static int test_update_golden;
 #define TEST_DONE() (printf("DONE: %d checks, %d failed\nRESULT tests=%d failed=%d checks=%d\n", \
     test_checks, test_check_failures, test_run_tests, test_failed_tests, test_checks), \
     test_failed_tests ? 1 : 0)
+
+/* A counting allocator for the failing-allocator sweeps: the fail_at-th allocation (1-based;
+ * 0 = never) returns NULL; live = blocks allocated and not yet freed; bytes = total handed out. */
+typedef struct test_counting {
+    long allocs, frees, live, fail_at;
+    size_t bytes;
+} test_counting;
+static inline void *test_count_alloc(void *user, size_t n)
+{
+    test_counting *c = (test_counting *)user;
+    void *p;
+    c->allocs++;
+    if (c->fail_at != 0 && c->allocs == c->fail_at) return NULL;
+    p = malloc(n);
+    if (p) {
+        c->live++;
+        c->bytes += n;
+    }
+    return p;
+}
+static inline void test_count_free(void *user, void *p)
+{
+    test_counting *c = (test_counting *)user;
+    if (!p) return;
+    c->frees++;
+    c->live--;
+    free(p);
+}
+/* Zeroes *c, sets its fail_at and returns the allocator that counts into it. */
+static inline hfvis_allocator test_counting_allocator(test_counting *c, long fail_at)
+{
+    hfvis_allocator a;
+    memset(c, 0, sizeof *c);
+    c->fail_at = fail_at;
+    a.alloc = test_count_alloc;
+    a.free = test_count_free;
+    a.user = c;
+    return a;
+}
 #endif

@@ -25,43 +25,6 @@
 /* Shared helpers                                                                             */
 /* ========================================================================================== */
 
-/* A counting allocator that fails the fail_at-th allocation (1-based; 0 = never). */
-typedef struct count_alloc {
-    long calls;       /* allocations attempted */
-    long live;        /* blocks allocated and not yet freed */
-    long fail_at;
-} count_alloc;
-
-static void *count_alloc_fn(void *user, size_t size)
-{
-    count_alloc *c = (count_alloc *)user;
-    void *p;
-    c->calls++;
-    if (c->fail_at != 0 && c->calls == c->fail_at) return NULL;
-    p = malloc(size);
-    if (p) c->live++;
-    return p;
-}
-
-static void count_free_fn(void *user, void *ptr)
-{
-    count_alloc *c = (count_alloc *)user;
-    if (!ptr) return;
-    c->live--;
-    free(ptr);
-}
-
-static hfvis_allocator count_allocator(count_alloc *state, long fail_at)
-{
-    hfvis_allocator a;
-    memset(state, 0, sizeof *state);
-    state->fail_at = fail_at;
-    a.alloc = count_alloc_fn;
-    a.free = count_free_fn;
-    a.user = state;
-    return a;
-}
-
 /* Byte pattern written into outputs before a call that must fail, to see they stay untouched. */
 #define SENTINEL_BYTE 0xA5
 
@@ -810,8 +773,8 @@ TEST(files_load_failing_allocator)
     for (pass = 0; pass < 2; pass++) {
         long k, successes = 0, failures = 0;
         for (k = 1; k < 100; k++) {
-            count_alloc state;
-            hfvis_allocator a = count_allocator(&state, k);
+            test_counting state;
+            hfvis_allocator a = test_counting_allocator(&state, k);
             float *const px_sentinel = &sentinel_target;
             float *px = px_sentinel;
             hfvis_image_info info;
@@ -825,7 +788,7 @@ TEST(files_load_failing_allocator)
                 CHECK(px != px_sentinel && same_floats(px, img, (size_t)(W * H)));
                 hfvis_free(&a, px);
                 CHECK(state.live == 0);
-                CHECK(state.calls == (pass == 0 ? 2 : 3));
+                CHECK(state.allocs == (pass == 0 ? 2 : 3));
                 break;
             }
             failures++;
@@ -926,17 +889,17 @@ TEST(sweeps_failing_allocator)
     int r;
     CHECK_EQ_STATUS(hfvis_horizon_map(&g, SWEEP_K, NULL, sweep_map), HFVIS_OK);
     for (r = 0; r < SWEEP_ROUTINES; r++) {
-        count_alloc state;
-        hfvis_allocator a = count_allocator(&state, 0);
+        test_counting state;
+        hfvis_allocator a = test_counting_allocator(&state, 0);
         long total, k;
         /* Count the allocations of a successful call; each must be released. */
         CHECK_EQ_STATUS(sweep_call(r, &a, out), HFVIS_OK);
-        total = state.calls;
+        total = state.allocs;
         CHECK(total >= 1);
         CHECK(state.live == 0);
         /* Fail allocation k for every k: HFVIS_ERR_OUT_OF_MEMORY, nothing leaked, output untouched. */
         for (k = 1; k <= total; k++) {
-            hfvis_allocator f = count_allocator(&state, k);
+            hfvis_allocator f = test_counting_allocator(&state, k);
             memset(out, SENTINEL_BYTE, sizeof out);
             CHECK_EQ_STATUS(sweep_call(r, &f, out), HFVIS_ERR_OUT_OF_MEMORY);
             CHECK(state.live == 0);
@@ -950,8 +913,8 @@ TEST(oracles_allocate_nothing)
     /* The ray-march and hemisphere oracles are documented as allocation-free: an allocator that
      * fails every call must not change their result. */
     hfvis_grid g = sweep_grid();
-    count_alloc state;
-    hfvis_allocator a = count_allocator(&state, 1);
+    test_counting state;
+    hfvis_allocator a = test_counting_allocator(&state, 1);
     hfvis_sweep_options o = hfvis_sweep_options_default();
     float pts[4] = {3.0f, 4.0f, 10.5f, 8.25f}, nrm[6] = {0, 0, 1, 0, 0, 1}, out[2 * SWEEP_K], ref[2 * SWEEP_K];
     o.alloc = &a;
@@ -959,7 +922,7 @@ TEST(oracles_allocate_nothing)
     CHECK_EQ_STATUS(hfvis_horizon_reference(&g, SWEEP_K, NULL, NULL, pts, 2, ref), HFVIS_OK);
     CHECK(memcmp(out, ref, sizeof out) == 0);
     CHECK_EQ_STATUS(hfvis_light_reference(&g, NULL, 1.0f, &o, NULL, NULL, pts, nrm, 2, out), HFVIS_OK);
-    CHECK(state.calls == 0);
+    CHECK(state.allocs == 0);
 }
 
 int main(int argc, char **argv)

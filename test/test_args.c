@@ -451,41 +451,6 @@ static void base_status(int got, int line)
 /* An invalid call of a value-returning function: cond (which makes the call) must hold. */
 #define BADV(cls, cond) do { arena_fill(); case_value((cls), (cond) ? 1 : 0, #cond, __LINE__); } while (0)
 
-/* A counting allocator that fails allocation number fail_at (1-based; 0 = never). */
-typedef struct count_alloc {
-    long calls, live, fail_at;
-} count_alloc;
-
-static void *count_alloc_fn(void *user, size_t size)
-{
-    count_alloc *c = (count_alloc *)user;
-    void *p;
-    c->calls++;
-    if (c->fail_at != 0 && c->calls == c->fail_at) return NULL;
-    p = malloc(size);
-    if (p) c->live++;
-    return p;
-}
-
-static void count_free_fn(void *user, void *ptr)
-{
-    count_alloc *c = (count_alloc *)user;
-    if (!ptr) return;
-    c->live--;
-    free(ptr);
-}
-
-static hfvis_allocator make_counter(count_alloc *state, long fail_at)
-{
-    hfvis_allocator a;
-    memset(state, 0, sizeof *state);
-    state->fail_at = fail_at;
-    a.alloc = count_alloc_fn;
-    a.free = count_free_fn;
-    a.user = state;
-    return a;
-}
-
 /* A temporary directory for the file functions. */
 static char tmpdir[64];
 static char path_buf[160];
@@ -629,12 +594,12 @@ static void args_status_string(void)
 
 static void args_free(void)
 {
-    count_alloc c;
-    hfvis_allocator a = make_counter(&c, 0);
+    test_counting c;
+    hfvis_allocator a = test_counting_allocator(&c, 0);
     begin("free");
     hfvis_free(NULL, NULL);
     hfvis_free(&a, NULL);
-    BADV('N', c.calls == 0 && c.live == 0);
+    BADV('N', c.allocs == 0 && c.live == 0);
 }
 
 static void args_image_info_read(void)
@@ -6276,14 +6241,14 @@ static int sweep_failures_total; /* failing calls made by the sweep */
  * number of allocations of the successful call. */
 static long sweep_one(const sweep_entry *e)
 {
-    count_alloc c;
+    test_counting c;
     hfvis_allocator a;
     hfvis_status s;
     long k, calls;
     begin(e->name);
-    a = make_counter(&c, 0);
+    a = test_counting_allocator(&c, 0);
     s = e->fn(&a);
-    calls = c.calls;
+    calls = c.allocs;
     CHECK_EQ_STATUS(s, HFVIS_OK);
     CHECK(c.live == 0);
     if (e->allocates ? calls == 0 : calls != 0) {
@@ -6294,9 +6259,9 @@ static long sweep_one(const sweep_entry *e)
     for (k = 1; k <= SWEEP_MAX_K; k++) {
         arena_used = 0;
         arena_fill_upto(arena_high + ARENA_SLACK);
-        a = make_counter(&c, k);
+        a = test_counting_allocator(&c, k);
         s = e->fn(&a);
-        if (c.calls < k) { /* allocation k never happened: the call ran to completion */
+        if (c.allocs < k) { /* allocation k never happened: the call ran to completion */
             CHECK_EQ_STATUS(s, HFVIS_OK);
             CHECK(c.live == 0);
             break;

@@ -52,37 +52,6 @@ static void rng_dir(double d[3]) /* uniform on the unit sphere */
     d[2] = z;
 }
 
-typedef struct counting {
-    int allocs, frees, live, fail_at;
-} counting;
-static void *c_alloc(void *user, size_t n)
-{
-    counting *c = (counting *)user;
-    void *p;
-    c->allocs++;
-    if (c->fail_at != 0 && c->allocs == c->fail_at) return NULL;
-    p = malloc(n);
-    if (p) c->live++;
-    return p;
-}
-static void c_free(void *user, void *p)
-{
-    counting *c = (counting *)user;
-    if (!p) return;
-    c->frees++;
-    c->live--;
-    free(p);
-}
-static hfvis_allocator counting_allocator(counting *c)
-{
-    hfvis_allocator a;
-    memset(c, 0, sizeof *c);
-    a.alloc = c_alloc;
-    a.free = c_free;
-    a.user = c;
-    return a;
-}
-
 static hfvis_ray make_ray(double ox, double oy, double oz, double dx, double dy, double dz)
 {
     hfvis_ray r;
@@ -1216,8 +1185,8 @@ TEST(alloc_failure)
     hfvis_mesh m;
     hfvis_bvh b, sentinel;
     hfvis_bvh_options o = hfvis_bvh_options_default();
-    counting c;
-    hfvis_allocator a = counting_allocator(&c);
+    test_counting c;
+    hfvis_allocator a = test_counting_allocator(&c, 0);
     int k, total;
     CHECK(gen_ok(hfvis_mesh_icosphere(NULL, c0, 1.0, 2, &m)));
     o.alloc = &a;
@@ -1229,7 +1198,7 @@ TEST(alloc_failure)
     CHECK(c.live == 0 && c.allocs == c.frees);
     memset(&sentinel, 0x5A, sizeof sentinel);
     for (k = 1; k <= total; k++) {
-        a = counting_allocator(&c);
+        a = test_counting_allocator(&c, 0);
         c.fail_at = k;
         b = sentinel;
         CHECK_EQ_STATUS(hfvis_bvh_build(&m, &o, &b), HFVIS_ERR_OUT_OF_MEMORY);
@@ -1237,7 +1206,7 @@ TEST(alloc_failure)
         CHECK(c.live == 0 && c.allocs - 1 == c.frees);
     }
     /* queries allocate nothing */
-    a = counting_allocator(&c);
+    a = test_counting_allocator(&c, 0);
     CHECK_EQ_STATUS(hfvis_bvh_build(&m, &o, &b), HFVIS_OK);
     c.allocs = 0;
     {

@@ -1137,25 +1137,6 @@ TEST(bad_arguments)
     hfvis_mesh_free(NULL, &m);
 }
 
-/* Counting allocator: fail_at = the 1-based allocation that fails (0 = never). */
-typedef struct tc_counting {
-    int allocs, frees, fail_at;
-} tc_counting;
-static void *tc_alloc(void *user, size_t n)
-{
-    tc_counting *c = (tc_counting *)user;
-    c->allocs++;
-    if (c->fail_at != 0 && c->allocs == c->fail_at) return NULL;
-    return malloc(n);
-}
-static void tc_free(void *user, void *p)
-{
-    tc_counting *c = (tc_counting *)user;
-    if (!p) return;
-    c->frees++;
-    free(p);
-}
-
 TEST(allocation_failures)
 {
     double lo[3] = {1.2, 1.3, 1.4}, hi[3] = {5.7, 4.6, 6.1};
@@ -1172,13 +1153,13 @@ TEST(allocation_failures)
     CHECK_EQ_STATUS(hfvis_binvox_save(path, &g, occ), HFVIS_OK);
     for (fn = 0; fn < 5; fn++) {
         int total = 0;
-        tc_counting c;
+        test_counting c;
         hfvis_allocator a;
         hfvis_binary_voxel_options opt = hfvis_binary_voxel_options_default();
         hfvis_status s;
         int r = -7;
-        a.alloc = tc_alloc;
-        a.free = tc_free;
+        a.alloc = test_count_alloc;
+        a.free = test_count_free;
         a.user = &c;
         opt.alloc = &a;
         /* count the allocations of a successful run, then fail each in turn */
@@ -1200,7 +1181,7 @@ TEST(allocation_failures)
             if (k == 0) {
                 CHECK_EQ_STATUS(s, HFVIS_OK);
                 total = c.allocs;
-                if (o) tc_free(&c, o);
+                if (o) test_count_free(&c, o);
                 CHECK(c.allocs == c.frees);
                 CHECK(total >= 1);
                 continue;

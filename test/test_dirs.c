@@ -340,21 +340,6 @@ TEST(sweep_order_parts)
     CHECK_EQ_STATUS(hfvis_sky_view_factor(&g, K, &o, part, W), HFVIS_ERR_INVALID_ARGUMENT);
 }
 
-/* A counting allocator that fails allocation number fail_at (0-based; -1 = never). */
-typedef struct count_alloc { int calls, fail_at, live; } count_alloc;
-static void *ca_alloc(void *user, size_t size)
-{
-    count_alloc *c = (count_alloc *)user;
-    if (c->calls++ == c->fail_at) return NULL;
-    c->live++;
-    return malloc(size);
-}
-static void ca_free(void *user, void *ptr)
-{
-    ((count_alloc *)user)->live--;
-    free(ptr);
-}
-
 TEST(allocation_failures)
 {
     hfvis_grid g = make_grid(4);
@@ -367,29 +352,29 @@ TEST(allocation_failures)
     env.n_phi = 4;
     env.channels = 1;
     for (kind = HFVIS_SUM_SKY_VIEW; kind <= HFVIS_SUM_VISIBILITY + 1; kind++) {
-        count_alloc c;
+        test_counting c;
         hfvis_allocator a;
         hfvis_sweep_options o = hfvis_sweep_options_default();
         int total;
-        a.alloc = ca_alloc;
-        a.free = ca_free;
+        a.alloc = test_count_alloc;
+        a.free = test_count_free;
         a.user = &c;
         o.alloc = &a;
         o.direction_begin = 1;
         o.direction_end = 6;
         memset(&c, 0, sizeof c);
-        c.fail_at = -1;
+        c.fail_at = 0;
         if (kind > HFVIS_SUM_VISIBILITY) /* the horizon map's range path */
             CHECK_EQ_STATUS(hfvis_horizon_map(&g, 8, &o, part), HFVIS_OK);
         else
             CHECK_EQ_STATUS(hfvis_direction_sums(&g, 8, (hfvis_sum_kind)kind, &env, NULL, &o, dpart), HFVIS_OK);
         CHECK(c.live == 0);
-        total = c.calls;
+        total = c.allocs;
         CHECK(total >= 1);
         for (k = 0; k < total; k++) {
             hfvis_status s;
             memset(&c, 0, sizeof c);
-            c.fail_at = k;
+            c.fail_at = k + 1;
             if (kind > HFVIS_SUM_VISIBILITY) s = hfvis_horizon_map(&g, 8, &o, part);
             else s = hfvis_direction_sums(&g, 8, (hfvis_sum_kind)kind, &env, NULL, &o, dpart);
             CHECK_EQ_STATUS(s, HFVIS_ERR_OUT_OF_MEMORY);
@@ -535,19 +520,19 @@ TEST(partial_decode_allocation_failure)
 {
     double sums[12];
     hfvis_partial p = sample_partial(sums), q;
-    count_alloc c;
+    test_counting c;
     hfvis_allocator a;
     size_t n = 0;
     CHECK_EQ_STATUS(hfvis_partial_encode(&p, enc, sizeof enc, &n), HFVIS_OK);
-    a.alloc = ca_alloc;
-    a.free = ca_free;
+    a.alloc = test_count_alloc;
+    a.free = test_count_free;
     a.user = &c;
     memset(&c, 0, sizeof c);
-    c.fail_at = 0;
+    c.fail_at = 1;
     memset(&q, 0, sizeof q);
     CHECK_EQ_STATUS(hfvis_partial_decode(enc, n, &a, &q), HFVIS_ERR_OUT_OF_MEMORY);
     CHECK(q.sums == NULL && c.live == 0);
-    c.fail_at = -1;
+    c.fail_at = 0;
     CHECK_EQ_STATUS(hfvis_partial_decode(enc, n, &a, &q), HFVIS_OK);
     CHECK(c.live == 1);
     hfvis_partial_free(&a, &q);

@@ -1294,34 +1294,6 @@ TEST(ns_bad_args)
 
 /* ------------------------------------------------------------ allocation failures */
 
-typedef struct ns_counting {
-    int allocs, frees, live, fail_at;
-    size_t bytes;
-} ns_counting;
-
-static void *ns_alloc(void *user, size_t n)
-{
-    ns_counting *c = (ns_counting *)user;
-    void *p;
-    c->allocs++;
-    if (c->fail_at != 0 && c->allocs == c->fail_at) return NULL;
-    p = malloc(n);
-    if (p) {
-        c->live++;
-        c->bytes += n;
-    }
-    return p;
-}
-
-static void ns_free(void *user, void *p)
-{
-    ns_counting *c = (ns_counting *)user;
-    if (!p) return;
-    c->frees++;
-    c->live--;
-    free(p);
-}
-
 /* Every allocation site fails once: HFVIS_ERR_OUT_OF_MEMORY, outputs untouched, nothing leaked;
  * the scratch query equals the bytes allocated; the allocator does not change the result. */
 TEST(ns_alloc_failures)
@@ -1336,7 +1308,7 @@ TEST(ns_alloc_failures)
     hfvis_ns_gi_outputs out = ns_out(B, d, b, t, v);
     hfvis_allocator al;
     hfvis_sun L[3];
-    ns_counting cnt;
+    test_counting cnt;
     size_t bytes = 0;
     int k, i, total_allocs;
     ns_fbm(z, W, H, 4.0, 8.0, 9u);
@@ -1363,15 +1335,15 @@ TEST(ns_alloc_failures)
     CHECK_EQ_STATUS(hfvis_ns_gi(&g, &sc, &o, &out), HFVIS_OK);
     memcpy(ref, t, sizeof ref);
     memset(&cnt, 0, sizeof cnt);
-    al.alloc = ns_alloc;
-    al.free = ns_free;
+    al.alloc = test_count_alloc;
+    al.free = test_count_free;
     al.user = &cnt;
     o.alloc = &al;
     CHECK_EQ_STATUS(hfvis_ns_gi(&g, &sc, &o, &out), HFVIS_OK);
     CHECK(memcmp(ref, t, sizeof ref) == 0);
     CHECK(cnt.live == 0 && cnt.allocs == cnt.frees);
     CHECK_EQ_STATUS(hfvis_ns_gi_scratch_size(&g, &sc, &o, B, &bytes), HFVIS_OK);
-    printf("  allocations: %d blocks, %lu bytes (scratch query %lu)\n", cnt.allocs,
+    printf("  allocations: %ld blocks, %lu bytes (scratch query %lu)\n", cnt.allocs,
            (unsigned long)cnt.bytes, (unsigned long)bytes);
     CHECK(bytes == cnt.bytes);
     total_allocs = cnt.allocs;

@@ -2189,23 +2189,6 @@ static double env_t_theta(double alpha, double a, double nz)
     return tc < th ? tc : th;
 }
 
-typedef struct env_t_counting {
-    int allocs, frees, fail_at; /* fail_at: 1-based allocation that fails, 0 = never */
-} env_t_counting;
-static void *env_t_alloc(void *user, size_t n)
-{
-    env_t_counting *c = (env_t_counting *)user;
-    c->allocs++;
-    if (c->fail_at != 0 && c->allocs == c->fail_at) return NULL;
-    return malloc(n);
-}
-static void env_t_free(void *user, void *p)
-{
-    env_t_counting *c = (env_t_counting *)user;
-    if (p != NULL) c->frees++;
-    free(p);
-}
-
 /* Random heights: a smooth base plus noise, slopes up to about 1. */
 static void env_t_random_grid(env_t_rng *r, float *z, int w, int h, double amp)
 {
@@ -2768,10 +2751,10 @@ TEST(env_from_map_allocations)
     float rad[1] = {1.0f}, z[9] = {0}, map[2 * 9] = {0}, out[9];
     hfvis_env env = {rad, 1, 1, 1};
     hfvis_grid g = {z, 3, 3, 3, 1.0};
-    env_t_counting cnt = {0, 0, 0};
+    test_counting cnt;
     hfvis_allocator al;
     int f, i, untouched;
-    al.alloc = env_t_alloc; al.free = env_t_free; al.user = &cnt;
+    al = test_counting_allocator(&cnt, 0);
     CHECK_EQ_STATUS(hfvis_env_light_from_map(&g, 2, 0.0, map, &env, 1.0f, NULL, &al, out, 3), HFVIS_OK);
     CHECK(cnt.allocs == 2 && cnt.frees == 2);
     for (f = 1; f <= 2; f++) {
@@ -3918,29 +3901,6 @@ TEST(p2t_indirect_valley)
 /* 5. Terrain GI with bounces (spec §9 multi-bounce)                                        */
 /* ---------------------------------------------------------------------------------------- */
 
-/* Counting allocator: fail_at = the 1-based allocation that fails (0 = never). */
-typedef struct p2t_counting {
-    int allocs, frees, live, fail_at;
-} p2t_counting;
-static void *p2t_alloc(void *user, size_t n)
-{
-    p2t_counting *c = (p2t_counting *)user;
-    void *p;
-    c->allocs++;
-    if (c->fail_at != 0 && c->allocs == c->fail_at) return NULL;
-    p = malloc(n);
-    if (p) c->live++;
-    return p;
-}
-static void p2t_free(void *user, void *p)
-{
-    p2t_counting *c = (p2t_counting *)user;
-    if (!p) return;
-    c->frees++;
-    c->live--;
-    free(p);
-}
-
 TEST(p2t_terrain_gi)
 {
     enum { W = 27, H = 23, C = 3 };
@@ -4026,7 +3986,7 @@ TEST(p2t_terrain_gi_oom)
     hfvis_grid g;
     hfvis_allocator al;
     hfvis_sweep_options o = hfvis_sweep_options_default();
-    p2t_counting cnt;
+    test_counting cnt;
     int n, k, i, untouched = 1;
     g.z = z;
     g.width = W;
@@ -4036,8 +3996,8 @@ TEST(p2t_terrain_gi_oom)
     p2t_field(0, W, H, 3, 0, z);
     for (i = 0; i < W * H * 2; i++) direct[i] = 1.0f;
     memset(&cnt, 0, sizeof cnt);
-    al.alloc = p2t_alloc;
-    al.free = p2t_free;
+    al.alloc = test_count_alloc;
+    al.free = test_count_free;
     al.user = &cnt;
     o.alloc = &al;
     CHECK_EQ_STATUS(hfvis_terrain_gi(&g, 4, direct, NULL, NULL, 0.5f, 2, 2, &o, NULL, out), HFVIS_OK);

@@ -232,29 +232,6 @@ static size_t iv_count_nonempty(const hfvis_volume *v)
     return n;
 }
 
-/* Counting allocator: fail_at = the 1-based allocation that fails (0 = never). */
-typedef struct iv_counting {
-    int allocs, frees, live, fail_at;
-} iv_counting;
-static void *iv_alloc(void *user, size_t n)
-{
-    iv_counting *c = (iv_counting *)user;
-    void *p;
-    c->allocs++;
-    if (c->fail_at != 0 && c->allocs == c->fail_at) return NULL;
-    p = malloc(n);
-    if (p) c->live++;
-    return p;
-}
-static void iv_free(void *user, void *p)
-{
-    iv_counting *c = (iv_counting *)user;
-    if (!p) return;
-    c->frees++;
-    c->live--;
-    free(p);
-}
-
 /* ---- eq. 16 and the bias ------------------------------------------------------------------ */
 
 TEST(iv_eq16_round_trip)
@@ -1847,7 +1824,7 @@ TEST(iv_alloc_failures)
     hfvis_iv_options o = hfvis_iv_options_default();
     hfvis_iv_stats st, st0;
     hfvis_allocator al;
-    iv_counting c;
+    test_counting c;
     iv_scene sc;
     int k, n, fn;
     const double t[3] = {0, 0, 0}, dir[3] = {0.3, 0.4, 1.0};
@@ -1859,7 +1836,7 @@ TEST(iv_alloc_failures)
     iv_render(&v, &sc, depth);
     iv_image(&im[0], &v, depth, NULL, 0);
     im[1] = im[0];
-    al.alloc = iv_alloc, al.free = iv_free, al.user = &c;
+    al.alloc = test_count_alloc, al.free = test_count_free, al.user = &c;
     o.alloc = &al;
     o.footprint = HFVIS_IV_FOOTPRINT_CONSERVATIVE;
     CHECK_EQ_STATUS(hfvis_volume_init(&P, &g, 1, data, HFVIS_BLEND_MAX), HFVIS_OK);

@@ -153,29 +153,6 @@ static void tm_free(tmesh *m)
     memset(m, 0, sizeof *m);
 }
 
-/* Counting allocator: fail_at = the 1-based allocation that fails (0 = never). */
-typedef struct lk_counting {
-    int allocs, frees, live, fail_at;
-} lk_counting;
-static void *cnt_alloc(void *user, size_t n)
-{
-    lk_counting *c = (lk_counting *)user;
-    void *p;
-    c->allocs++;
-    if (c->fail_at != 0 && c->allocs == c->fail_at) return NULL;
-    p = malloc(n);
-    if (p) c->live++;
-    return p;
-}
-static void cnt_free(void *user, void *p)
-{
-    lk_counting *c = (lk_counting *)user;
-    if (!p) return;
-    c->frees++;
-    c->live--;
-    free(p);
-}
-
 static int count_at_least(const hfvis_lk_rays *r, int dim, double sign, double c);
 
 static hfvis_lk_rays make_rays(int n, double r, hfvis_lk_falloff f, uint64_t seed)
@@ -526,8 +503,8 @@ TEST(rays_alloc_failures)
     int k, pat;
     for (pat = 0; pat < 2; pat++)
         for (k = 1; k <= 3; k++) {
-            lk_counting c = {0, 0, 0, 0};
-            hfvis_allocator al = {cnt_alloc, cnt_free, NULL};
+            test_counting c = {0, 0, 0, 0, 0};
+            hfvis_allocator al = {test_count_alloc, test_count_free, NULL};
             hfvis_lk_ray_options o = hfvis_lk_ray_options_default();
             hfvis_lk_rays r;
             hfvis_status s;
@@ -548,8 +525,8 @@ TEST(rays_alloc_failures)
             CHECK(c.live == 0 && c.allocs - (k <= (pat ? 1 : 2) ? 1 : 0) == c.frees);
         }
     {
-        lk_counting c = {0, 0, 0, 1};
-        hfvis_allocator al = {cnt_alloc, cnt_free, NULL};
+        test_counting c = {0, 0, 0, 1, 0};
+        hfvis_allocator al = {test_count_alloc, test_count_free, NULL};
         double d[3] = {0.0, 0.0, 1.0};
         hfvis_lk_rays r;
         al.user = &c;
@@ -818,8 +795,8 @@ TEST(plane_mask_and_lut)
     CHECK(hfvis_lk_lut_fetch(&L16, 0, (const double[3]){0.0, 0.0, 0.0}, 0.5) == NULL);
     /* OOM sweep of the build: 1 or 2 blocks */
     for (T = 1; T <= 3; T++) {
-        lk_counting c = {0, 0, 0, 0};
-        hfvis_allocator al = {cnt_alloc, cnt_free, NULL};
+        test_counting c = {0, 0, 0, 0, 0};
+        hfvis_allocator al = {test_count_alloc, test_count_free, NULL};
         hfvis_lk_lut L;
         hfvis_status s;
         al.user = &c;
@@ -1873,8 +1850,8 @@ TEST(methods_alloc_failures)
     for (which = 0; which < 7; which++) {
         int k, done = 0, fails = 0;
         for (k = 1; k <= 20 && !done; k++) {
-            lk_counting c = {0, 0, 0, 0};
-            hfvis_allocator al = {cnt_alloc, cnt_free, NULL};
+            test_counting c = {0, 0, 0, 0, 0};
+            hfvis_allocator al = {test_count_alloc, test_count_free, NULL};
             hfvis_lk_options o = hfvis_lk_options_default();
             hfvis_lk_receivers rc;
             uint32_t masks[120 * 2];

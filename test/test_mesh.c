@@ -21,37 +21,6 @@
 
 /* ---- helpers ----------------------------------------------------------------------------- */
 
-typedef struct counting {
-    int allocs, frees, live, fail_at;
-} counting;
-static void *c_alloc(void *user, size_t n)
-{
-    counting *c = (counting *)user;
-    void *p;
-    c->allocs++;
-    if (c->fail_at != 0 && c->allocs == c->fail_at) return NULL;
-    p = malloc(n);
-    if (p) c->live++;
-    return p;
-}
-static void c_free(void *user, void *p)
-{
-    counting *c = (counting *)user;
-    if (!p) return;
-    c->frees++;
-    c->live--;
-    free(p);
-}
-static hfvis_allocator counting_allocator(counting *c)
-{
-    hfvis_allocator a;
-    memset(c, 0, sizeof *c);
-    a.alloc = c_alloc;
-    a.free = c_free;
-    a.user = c;
-    return a;
-}
-
 static void vtx(const hfvis_mesh *m, size_t v, double p[3])
 {
     p[0] = (double)m->xyz[3 * v];
@@ -411,8 +380,8 @@ TEST(generators_alloc_failure)
 {
     int which;
     for (which = 0; which < 8; which++) {
-        counting cnt;
-        hfvis_allocator a = counting_allocator(&cnt);
+        test_counting cnt;
+        hfvis_allocator a = test_counting_allocator(&cnt, 0);
         hfvis_mesh ref, m;
         int n, k;
         CHECK_EQ_STATUS(gen_call(which, &a, &ref), HFVIS_OK);
@@ -421,7 +390,7 @@ TEST(generators_alloc_failure)
         hfvis_mesh_free(&a, &ref);
         CHECK(cnt.live == 0);
         for (k = 1; k <= n; k++) {
-            a = counting_allocator(&cnt);
+            a = test_counting_allocator(&cnt, 0);
             cnt.fail_at = k;
             memset(&m, 0xAB, sizeof m);
             CHECK_EQ_STATUS(gen_call(which, &a, &m), HFVIS_ERR_OUT_OF_MEMORY);
@@ -1132,19 +1101,19 @@ TEST(obj_errors)
 TEST(obj_alloc_failure)
 {
     static const char text[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3 4\nf 1 3 2\n";
-    counting cnt;
+    test_counting cnt;
     hfvis_allocator a;
     hfvis_mesh m, ref;
     int k;
     CHECK_EQ_STATUS(hfvis_obj_decode(text, sizeof text - 1, NULL, &ref), HFVIS_OK);
     for (k = 1; k <= 2; k++) {
-        a = counting_allocator(&cnt);
+        a = test_counting_allocator(&cnt, 0);
         cnt.fail_at = k;
         memset(&m, 0x44, sizeof m);
         CHECK_EQ_STATUS(hfvis_obj_decode(text, sizeof text - 1, &a, &m), HFVIS_ERR_OUT_OF_MEMORY);
         CHECK(cnt.live == 0 && m.vertex_count == (size_t)0x4444444444444444ull);
     }
-    a = counting_allocator(&cnt);
+    a = test_counting_allocator(&cnt, 0);
     CHECK_EQ_STATUS(hfvis_obj_decode(text, sizeof text - 1, &a, &m), HFVIS_OK);
     CHECK(cnt.allocs == 2 && same_mesh(&m, &ref));
     hfvis_mesh_free(&a, &m);
@@ -1158,7 +1127,7 @@ TEST(obj_alloc_failure)
         if (!f) return;
         fwrite(text, 1, sizeof text - 1, f);
         fclose(f);
-        a = counting_allocator(&cnt);
+        a = test_counting_allocator(&cnt, 0);
         CHECK_EQ_STATUS(hfvis_mesh_load(path, &a, &m), HFVIS_OK);
         CHECK(same_mesh(&m, &ref));
         n = cnt.allocs;
@@ -1166,7 +1135,7 @@ TEST(obj_alloc_failure)
         hfvis_mesh_free(&a, &m);
         CHECK(cnt.live == 0);
         for (k = 1; k <= n; k++) {
-            a = counting_allocator(&cnt);
+            a = test_counting_allocator(&cnt, 0);
             cnt.fail_at = k;
             memset(&m, 0x44, sizeof m);
             CHECK_EQ_STATUS(hfvis_mesh_load(path, &a, &m), HFVIS_ERR_OUT_OF_MEMORY);

@@ -944,32 +944,13 @@ TEST(bad_arguments)
     hfvis_mesh_free(NULL, &m);
 }
 
-/* Counting allocator that fails the k-th allocation. */
-typedef struct counting {
-    int allocs, frees, fail_at;
-} counting;
-static void *c_alloc(void *user, size_t n)
-{
-    counting *c = (counting *)user;
-    c->allocs++;
-    if (c->fail_at != 0 && c->allocs == c->fail_at) return NULL;
-    return malloc(n);
-}
-static void c_free(void *user, void *p)
-{
-    counting *c = (counting *)user;
-    if (!p) return;
-    c->frees++;
-    free(p);
-}
-
 TEST(alloc_failures)
 {
     const double c0[3] = {0.0, 0.0, 0.0}, eye[3] = {0.5, -3.0, 1.0}, up[3] = {0.0, 0.0, 1.0};
     hfvis_mesh m;
     hfvis_view v;
     hfvis_allocator al;
-    counting cnt;
+    test_counting cnt;
     hfvis_raster_options o = hfvis_raster_options_default();
     planes p;
     hfvis_raster_outputs out;
@@ -979,7 +960,7 @@ TEST(alloc_failures)
     CHECK_EQ_STATUS(hfvis_view_perspective(&v, eye, c0, up, 1.0, 24, 16, 0.1, 10.0), HFVIS_OK);
     planes_alloc(&p, 24, 16);
     out = planes_out(&p);
-    al.alloc = c_alloc, al.free = c_free, al.user = &cnt;
+    al.alloc = test_count_alloc, al.free = test_count_free, al.user = &cnt;
     o.alloc = &al;
     memset(&cnt, 0, sizeof cnt);
     CHECK_EQ_STATUS(hfvis_rasterize(&m, &v, &o, &out), HFVIS_OK);

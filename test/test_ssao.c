@@ -36,29 +36,6 @@ static double rng_unit(void)
     return (double)((rng_state * 2685821657736338717ull) >> 11) * (1.0 / 9007199254740992.0);
 }
 
-/* ---- counting allocator: fail_at = the 1-based allocation that fails (0 = never) ---- */
-typedef struct counting {
-    int allocs, frees, live, fail_at;
-} counting;
-static void *cnt_alloc(void *user, size_t n)
-{
-    counting *c = (counting *)user;
-    void *p;
-    c->allocs++;
-    if (c->fail_at != 0 && c->allocs == c->fail_at) return NULL;
-    p = malloc(n);
-    if (p) c->live++;
-    return p;
-}
-static void cnt_free(void *user, void *p)
-{
-    counting *c = (counting *)user;
-    if (!p) return;
-    c->frees++;
-    c->live--;
-    free(p);
-}
-
 /* ========================================================================================== */
 /* 1. Camera and depth                                                                        */
 /* ========================================================================================== */
@@ -1011,7 +988,7 @@ TEST(lsao_bad_args_and_oom)
     hfvis_camera cam, bc;
     hfvis_lsao_options o = hfvis_lsao_options_default(), b, r;
     hfvis_allocator al;
-    counting cnt;
+    test_counting cnt;
     int k, tangent;
     CHECK_EQ_STATUS(hfvis_camera_perspective(&cam, W, H, 2, 2, 1.0), HFVIS_OK);
     random_depth(depth, W, H, W, 6.0, 5, 3);
@@ -1063,8 +1040,8 @@ TEST(lsao_bad_args_and_oom)
     CHECK(memcmp(ao, keep, sizeof ao) == 0);
     /* allocation failure at every site: hfvis_lsao (fixed tangent: 5 blocks; real tangent
      * without normals: 6), hfvis_lsao_direction (1 or 2) */
-    al.alloc = cnt_alloc;
-    al.free = cnt_free;
+    al.alloc = test_count_alloc;
+    al.free = test_count_free;
     al.user = &cnt;
     o.alloc = &al;
     o.directions = 8;
@@ -1505,7 +1482,7 @@ TEST(hbao_rt_bad_args_and_oom)
     hfvis_hbao_options h = hfvis_hbao_options_default(), hb, hr;
     hfvis_ssao_rt_options r = hfvis_ssao_rt_options_default(), rb, rr;
     hfvis_allocator al;
-    counting cnt;
+    test_counting cnt;
     hfvis_ssao_direction d[8];
     int i;
     CHECK_EQ_STATUS(hfvis_camera_perspective(&cam, W, H, 1, 1, 1.0), HFVIS_OK);
@@ -1561,8 +1538,8 @@ TEST(hbao_rt_bad_args_and_oom)
     CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, nrm, &r, NULL, W), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, nrm, &r, ao, W - 3), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK(memcmp(ao, keep, sizeof ao) == 0);
-    al.alloc = cnt_alloc;
-    al.free = cnt_free;
+    al.alloc = test_count_alloc;
+    al.free = test_count_free;
     al.user = &cnt;
     h.alloc = &al;
     r.alloc = &al;

@@ -38,29 +38,6 @@
 
 #define RAYS 256
 
-/* ---- counting allocator: fail_at = the 1-based allocation that fails (0 = never) ---- */
-typedef struct counting {
-    int allocs, frees, live, fail_at;
-} counting;
-static void *cnt_alloc(void *user, size_t n)
-{
-    counting *c = (counting *)user;
-    void *p;
-    c->allocs++;
-    if (c->fail_at != 0 && c->allocs == c->fail_at) return NULL;
-    p = malloc(n);
-    if (p) c->live++;
-    return p;
-}
-static void cnt_free(void *user, void *p)
-{
-    counting *c = (counting *)user;
-    if (!p) return;
-    c->frees++;
-    c->live--;
-    free(p);
-}
-
 /* ---- small deterministic PRNG (xorshift64*) ---- */
 static uint64_t rng_state = 88172645463325252ull;
 static double rng_unit(void)
@@ -521,13 +498,13 @@ TEST(alloc_failures)
     sc.x0 = 0.3;
     CHECK(scene_make(&s, 1, 24, 20, 3, 2, 1.0, &sc));
     for (v = 0; v < 3; v++) {
-        counting cn;
+        test_counting cn;
         hfvis_allocator al;
         hfvis_ffao_options o = hfvis_ffao_options_default();
         int k, n, i;
         memset(&cn, 0, sizeof cn);
-        al.alloc = cnt_alloc;
-        al.free = cnt_free;
+        al.alloc = test_count_alloc;
+        al.free = test_count_free;
         al.user = &cn;
         o.alloc = &al;
         o.falloff.kind = HFVIS_FALLOFF_INV_QUADRATIC;
@@ -553,7 +530,7 @@ TEST(alloc_failures)
         printf("     variant %d: %d allocation sites\n", v, n);
     }
     {
-        counting cn;
+        test_counting cn;
         hfvis_allocator al;
         hfvis_ffao_table t;
         hfvis_falloff q;
@@ -561,8 +538,8 @@ TEST(alloc_failures)
         memset(&q, 0, sizeof q);
         q.kind = HFVIS_FALLOFF_EXPONENTIAL;
         q.param = 1.0;
-        al.alloc = cnt_alloc;
-        al.free = cnt_free;
+        al.alloc = test_count_alloc;
+        al.free = test_count_free;
         al.user = &cn;
         cn.fail_at = 1;
         CHECK_EQ_STATUS(hfvis_ffao_table_build(&q, 8, 8, 4, 5, 0.0, &al, &t), HFVIS_ERR_OUT_OF_MEMORY);

@@ -55,29 +55,6 @@ static void rng_dir(double d[3])
 }
 static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-/* Counting allocator: fail_at = the 1-based allocation that fails (0 = never). */
-typedef struct counting {
-    int allocs, frees, live, fail_at;
-} counting;
-static void *c_alloc(void *user, size_t n)
-{
-    counting *c = (counting *)user;
-    void *p;
-    c->allocs++;
-    if (c->fail_at != 0 && c->allocs == c->fail_at) return NULL;
-    p = malloc(n);
-    if (p) c->live++;
-    return p;
-}
-static void c_free(void *user, void *p)
-{
-    counting *c = (counting *)user;
-    if (!p) return;
-    c->frees++;
-    c->live--;
-    free(p);
-}
-
 /* A field with malloc'ed maps (parameters set, not built). */
 static int field_init(hfvis_visfield *vf, const double c[3], double R, int n, int D,
                       hfvis_dirmap m, hfvis_visfield_format f)
@@ -1616,7 +1593,7 @@ TEST(vf_out_of_memory)
     hfvis_visfield vf, ref, back;
     hfvis_visfield_object ob;
     hfvis_allocator al;
-    counting cnt;
+    test_counting cnt;
     unsigned char *file;
     size_t need;
     int routine, k, p;
@@ -1638,8 +1615,8 @@ TEST(vf_out_of_memory)
         nrm[3 * p + 2] = 1.0f;
     }
     ob = make_object(&ref, &ico, NULL);
-    al.alloc = c_alloc;
-    al.free = c_free;
+    al.alloc = test_count_alloc;
+    al.free = test_count_free;
     al.user = &cnt;
     for (routine = 0; routine < 7; routine++) {
         int succeeded = 0, sites = 0;

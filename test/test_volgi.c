@@ -98,29 +98,6 @@ static double flux_of(const float *p, int b) { return 2.0 * sqrt(PI) * (double)p
 
 static float *sh_alloc(size_t n) { return (float *)calloc(n * HFVIS_VOLGI_FLOATS, sizeof(float)); }
 
-/* Counting allocator: fail_at = the 1-based allocation that fails (0 = never). */
-typedef struct counting {
-    int allocs, frees, live, fail_at;
-} counting;
-static void *c_alloc(void *user, size_t n)
-{
-    counting *c = (counting *)user;
-    void *p;
-    c->allocs++;
-    if (c->fail_at != 0 && c->allocs == c->fail_at) return NULL;
-    p = malloc(n);
-    if (p) c->live++;
-    return p;
-}
-static void c_free(void *user, void *p)
-{
-    counting *c = (counting *)user;
-    if (!p) return;
-    c->frees++;
-    c->live--;
-    free(p);
-}
-
 /* The coloured room: hfvis_mesh_room with a red wall at x = 0 (triangles 0, 1), a green wall at
  * x = 1 (2, 3), everything else white 0.75; a point light under the ceiling. */
 typedef struct room {
@@ -1537,14 +1514,14 @@ TEST(volgi_alloc_failures)
     hfvis_volgi_geometry geo;
     hfvis_volgi_options o = hfvis_volgi_options_default();
     hfvis_allocator al;
-    counting c;
+    test_counting c;
     float *p0, *rad, *p, *a, *p_keep;
     int k, n, fn;
     room_init(&r);
     room_volume(&r, 10, &t, &p0, &rad);
     geo = tg_geo(&t, 1);
     p = sh_alloc(t.n), a = sh_alloc(t.n), p_keep = sh_alloc(t.n);
-    al.alloc = c_alloc, al.free = c_free, al.user = &c;
+    al.alloc = test_count_alloc, al.free = test_count_free, al.user = &c;
     o.alloc = &al;
     /* the loop (one block) and the normalised step (one block), both transfers */
     for (fn = 0; fn < 3; fn++) {

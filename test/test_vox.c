@@ -1341,20 +1341,6 @@ TEST(pathological_estimates)
 
 /* ---- bad arguments, allocator ------------------------------------------------------------- */
 
-typedef struct vox_counting {
-    int allocs, frees;
-} vox_counting;
-static void *vox_alloc(void *user, size_t n)
-{
-    ((vox_counting *)user)->allocs++;
-    return malloc(n);
-}
-static void vox_free(void *user, void *p)
-{
-    if (p) ((vox_counting *)user)->frees++;
-    free(p);
-}
-
 TEST(bad_arguments)
 {
     const double a[3] = { 1.2, 1.3, 2.5 }, b[3] = { 6.7, 1.1, 2.6 }, c[3] = { 1.4, 6.8, 2.5 };
@@ -1454,7 +1440,7 @@ TEST(bad_arguments)
 TEST(no_allocation)
 {
     const double c0[3] = { 0.0, 0.0, 0.0 };
-    vox_counting cnt = { 0, 0 };
+    test_counting cnt;
     hfvis_allocator al;
     hfvis_mesh m;
     hfvis_volume_grid g;
@@ -1462,7 +1448,7 @@ TEST(no_allocation)
     float *st;
     uint8_t *occ;
     int mi, ai;
-    al.alloc = vox_alloc, al.free = vox_free, al.user = &cnt;
+    al = test_counting_allocator(&cnt, 0);
     CHECK_EQ_STATUS(hfvis_mesh_torus(NULL, c0, 1.0, 0.4, 24, 12, &m), HFVIS_OK);
     CHECK_EQ_STATUS(hfvis_volume_grid_fit(&m, 24, 0.05, 0, &g), HFVIS_OK);
     st = vox_storage(&g, 4);
