@@ -118,3 +118,11 @@ install: $(LIB)
 
 clean:
 	rm -rf build out
+
+# make valgrind: the test build's test programs, examples and CLI script under valgrind memcheck
+# (errors and definite/indirect leaks fail); the last line is "valgrind: N programs, ...".
+.PHONY: valgrind run-valgrind
+valgrind:
+	@$(MAKE) --no-print-directory config=test werror=1 run-valgrind
+run-valgrind: $(TESTS) $(EXAMPLES) $(CLI)
+	@sh test/valgrind.sh $(BUILD)
