@@ -4,9 +4,10 @@
 # Memory errors and definite or indirect leaks fail a program (libdeflate's run_tests.sh runs
 # its tests the same way). Prints one line per program, then
 # "valgrind: N programs, E errors, L bytes leaked, M failed, S s".
-# usage: sh test/valgrind.sh BUILD      (`make valgrind` builds BUILD = build/test first)
-build=$1
-[ -n "$build" ] && [ -d "$build/test" ] || { echo "usage: sh test/valgrind.sh BUILD"; exit 2; }
+# usage: sh test/valgrind.sh BUILD [NAME...]   (`make valgrind` builds BUILD = build/test first)
+#   NAMEs (test_x, an example such as 06_lava, or cli) run only those programs; default all.
+build=$1; [ $# -gt 0 ] && shift; only=" $* "
+[ -n "$build" ] && [ -d "$build/test" ] || { echo "usage: sh test/valgrind.sh BUILD [NAME...]"; exit 2; }
 command -v valgrind > /dev/null 2>&1 || { echo "valgrind: not installed"; exit 2; }
 vg="valgrind --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=definite,indirect"
 scratch=$(mktemp -d 2>/dev/null || echo "$build/vgscratch"); mkdir -p "$scratch/out" || exit 1
@@ -27,19 +28,22 @@ tally() {
   rm -f "$scratch"/vg.*.log
 }
 
+# wanted NAME: true if no NAMEs were given or NAME is one of them.
+wanted() { [ "$only" = "  " ] || case $only in *" $1 "*) true ;; *) false ;; esac; }
+
 for t in "$build"/test/test_*; do
-  [ -x "$t" ] || continue
+  [ -x "$t" ] && wanted "$(basename "$t")" || continue
   s=$(date +%s)
   $vg --log-file="$scratch/vg.%p.log" "$t" > "$scratch/log" 2>&1; rc=$?
   tally "$(basename "$t")" "$rc" $(($(date +%s) - s))
 done
 for e in "$build"/examples/*; do
-  [ -x "$e" ] || continue
+  [ -x "$e" ] && wanted "$(basename "$e")" || continue
   s=$(date +%s)
   $vg --log-file="$scratch/vg.%p.log" "$e" "$scratch/out" > "$scratch/log" 2>&1; rc=$?
   tally "example $(basename "$e")" "$rc" $(($(date +%s) - s))
 done
-if [ -x "$build/hfvis" ]; then
+if [ -x "$build/hfvis" ] && wanted cli; then
   # The wrapper keeps valgrind's report out of the CLI's stderr, which cli_test.sh inspects.
   printf '#!/bin/sh\nexec %s --log-file="%s/vg.%%p.log" "%s/hfvis" "$@"\n' "$vg" "$scratch" "$abs" > "$scratch/hfvis"
   chmod +x "$scratch/hfvis"
