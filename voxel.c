@@ -7795,9 +7795,9 @@ HFVIS_API hfvis_status hfvis_visfield_build_reference(const hfvis_mesh *mesh,
 static void vx_vf_hit_miss(hfvis_visfield_hit *h)
 {
     h->result = HFVIS_VISFIELD_MISS;
-    h->distance = INFINITY;
+    h->distance = HUGE_VAL;
     h->normal[0] = h->normal[1] = h->normal[2] = 0.0;
-    h->sphere_t = INFINITY;
+    h->sphere_t = HUGE_VAL;
     h->position = HFVIS_VISFIELD_NONE;
     h->texel_i = h->texel_j = -1;
 }
@@ -8095,7 +8095,7 @@ HFVIS_API hfvis_visfield_ao_options hfvis_visfield_ao_options_default(void)
     hfvis_visfield_ao_options o;
     memset(&o, 0, sizeof o);
     o.rays_sqrt = VX_VF_DEFAULT_RAYS_SQRT;
-    o.max_distance = INFINITY;
+    o.max_distance = HUGE_VAL;
     o.falloff = HFVIS_VISFIELD_FALLOFF_BINARY;
     o.combine = HFVIS_VISFIELD_COMBINE_ANY;
     o.bias = HFVIS_VISFIELD_DEFAULT_BIAS;
@@ -8156,7 +8156,7 @@ static hfvis_status vx_vf_ao_run(const hfvis_visfield_object *objects, size_t co
     if (opts) {
         o = *opts;
         if (o.rays_sqrt == 0) o.rays_sqrt = VX_VF_DEFAULT_RAYS_SQRT;
-        if (o.max_distance == 0.0) o.max_distance = INFINITY;
+        if (o.max_distance == 0.0) o.max_distance = HUGE_VAL;
         if (o.falloff == HFVIS_VISFIELD_FALLOFF_DEFAULT) o.falloff = HFVIS_VISFIELD_FALLOFF_BINARY;
         if (o.combine == HFVIS_VISFIELD_COMBINE_DEFAULT) o.combine = HFVIS_VISFIELD_COMBINE_ANY;
     }
@@ -8376,7 +8376,7 @@ static hfvis_status vx_vf_trace_core(const hfvis_visfield_object *objects, size_
     int a;
     out->object = HFVIS_VISFIELD_NONE;
     out->result = HFVIS_VISFIELD_MISS;
-    out->distance = INFINITY;
+    out->distance = HUGE_VAL;
     for (a = 0; a < 3; a++) out->point[a] = out->normal[a] = 0.0;
     for (m = 0; m < count; m++) {
         vx_vf_inst in;
@@ -8485,7 +8485,7 @@ static hfvis_status vx_vf_reflect_run(const hfvis_visfield_object *objects, size
             if (!(d[0] * n[0] + d[1] * n[1] + d[2] * n[2] > 0.0)) { /* below the surface */
                 h.object = HFVIS_VISFIELD_NONE;
                 h.result = HFVIS_VISFIELD_MISS;
-                h.distance = INFINITY;
+                h.distance = HUGE_VAL;
                 for (a = 0; a < 3; a++) h.point[a] = h.normal[a] = 0.0;
             } else {
                 s = vx_vf_trace_core(objects, count, x, d, bf, reference, &h);

@@ -45,12 +45,12 @@ static double bench_vf_build(const hfvis_mesh *mesh, int n, int D, int reference
     hfvis_visfield vf;
     double t0, dt;
     hfvis_status s;
-    if (!bench_vf_field(mesh, n, D, HFVIS_VISFIELD_U8, &vf)) return NAN;
+    if (!bench_vf_field(mesh, n, D, HFVIS_VISFIELD_U8, &vf)) return (double)NAN;
     t0 = bench_now();
     s = reference ? hfvis_visfield_build_reference(mesh, NULL, &vf) : hfvis_visfield_build(mesh, NULL, &vf);
     dt = bench_now() - t0;
     free(vf.maps);
-    if (s != HFVIS_OK) return NAN;
+    if (s != HFVIS_OK) return (double)NAN;
     if (total_s) *total_s = dt;
     return dt / ((double)hfvis_visfield_position_count(n) * (double)D * (double)D);
 }
@@ -94,7 +94,7 @@ static void bench_vf_query(const hfvis_mesh *mesh, const hfvis_bvh *bvh, const h
     double *org = (double *)malloc(sizeof(double) * 3 * nr), *dir = (double *)malloc(sizeof(double) * 3 * nr);
     double t0, dt, hits_vf = 0.0, hits_bvh = 0.0, sink = 0.0;
     int a, rep, m;
-    out[0] = out[1] = out[2] = out[3] = out[4] = NAN;
+    out[0] = out[1] = out[2] = out[3] = out[4] = (double)NAN;
     if (!org || !dir) {
         free(org);
         free(dir);
@@ -148,7 +148,7 @@ static void bench_vf_ao(const hfvis_mesh *mesh, const hfvis_bvh *bvh, const hfvi
     hfvis_visfield_object ob;
     double t0, dt;
     int p, i, rep;
-    out[0] = out[1] = NAN;
+    out[0] = out[1] = (double)NAN;
     if (!pts || !nrm || !ao) goto done;
     for (p = 0; p < receivers; p++) {
         pts[3 * p] = (float)(vf->center[0] + (bench_vf_unit() * 2.0 - 1.0) * 1.5 * vf->radius);

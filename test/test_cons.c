@@ -1000,7 +1000,7 @@ TEST(bad_arguments)
         gb.cell[2] = -1.0;
         CHECK_EQ_STATUS(fns[f](&m, &gb, NULL, out, &n), HFVIS_ERR_INVALID_ARGUMENT);
         gb = g;
-        gb.origin[0] = NAN;
+        gb.origin[0] = (double)NAN;
         CHECK_EQ_STATUS(fns[f](&m, &gb, NULL, out, &n), HFVIS_ERR_INVALID_ARGUMENT);
         bad = m;
         bad.indices = NULL;

@@ -198,7 +198,7 @@ TEST(ns_bspline_max)
         CHECK(out == brute);
         CHECK(out <= w[0] || n > 0);
     }
-    w[1] = NAN;
+    w[1] = (double)NAN;
     CHECK_EQ_STATUS(hfvis_ns_bspline_max(3, w, &out), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_ns_bspline_max(-1, w, &out), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_ns_bspline_max(2, NULL, &out), HFVIS_ERR_INVALID_ARGUMENT);
@@ -1194,7 +1194,7 @@ TEST(ns_bad_args)
     gb = g; gb.width = 0; NS_BAD(&gb, &sc, &o, &out);
     gb = g; gb.stride = W - 1; NS_BAD(&gb, &sc, &o, &out);
     gb = g; gb.cell_size = 0.0; NS_BAD(&gb, &sc, &o, &out);
-    gb = g; gb.cell_size = NAN; NS_BAD(&gb, &sc, &o, &out);
+    gb = g; gb.cell_size = (double)NAN; NS_BAD(&gb, &sc, &o, &out);
     /* scene */
     for (cs = 0; cs < 20; cs++) {
         double envb[16];
@@ -1207,7 +1207,7 @@ TEST(ns_bad_args)
         switch (cs) {
         case 0: sb.channels = 0; break;
         case 1: sb.channels = 5; break;
-        case 2: envb[3] = NAN; sb.env_sh = envb; break;
+        case 2: envb[3] = (double)NAN; sb.env_sh = envb; break;
         case 3: sb.light_count = 1; sb.lights = NULL; break;
         case 4: sb.light_count = -1; break;
         case 5: sb.light_count = HFVIS_NS_MAX_LIGHTS + 1; sb.lights = &L; break;
@@ -1215,7 +1215,7 @@ TEST(ns_bad_args)
         case 7: L.radius_rad = -0.1; sb.lights = &L; sb.light_count = 1; break;
         case 8: L.radius_rad = 1.6; sb.lights = &L; sb.light_count = 1; break;
         case 9: L.irradiance[0] = INFINITY; sb.lights = &L; sb.light_count = 1; break;
-        case 10: L.azimuth_rad = NAN; sb.lights = &L; sb.light_count = 1; break;
+        case 10: L.azimuth_rad = (double)NAN; sb.lights = &L; sb.light_count = 1; break;
         case 11: sb.albedo[0] = NAN; break;
         case 12: sb.specular = -0.1f; break;
         case 13: sb.specular = 0.5f; sb.shininess = 0.0f; break;
@@ -1260,10 +1260,10 @@ TEST(ns_bad_args)
         case 18: ob.directional = (hfvis_ns_directional)4; break;
         case 19: ob.key_mode = (hfvis_ns_key_mode)4; break;
         case 20: ob.glossy = (hfvis_ns_glossy)3; break;
-        case 21: ob.view_dir[1] = NAN; break;
+        case 21: ob.view_dir[1] = (double)NAN; break;
         case 22: ob.view_dir[0] = 1e300; ob.view_dir[1] = 1e300; break;
         case 23: ob.border = (hfvis_border)4; break;
-        case 24: ob.azimuth0_rad = INFINITY; break;
+        case 24: ob.azimuth0_rad = HUGE_VAL; break;
         case 25: ob.cast_cache = (hfvis_ns_cache)3; break;
         default: ob.omega_min = (hfvis_ns_omega_min)-1; break;
         }

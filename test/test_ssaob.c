@@ -467,7 +467,7 @@ TEST(bad_args)
         b[2].b0 = -3;
         b[3].receiver_slope = 1.0;
         b[4].averaging = (hfvis_ffao_averaging)7;
-        b[5].thickness = NAN;
+        b[5].thickness = (double)NAN;
         b[6].estimator = (hfvis_ffao_estimator)9;
         b[7].near_field = (hfvis_ffao_near)5;
         b[8].sparse = 1; /* K = 8 is not a multiple of 9 */
@@ -478,7 +478,7 @@ TEST(bad_args)
         b[10].falloff.param = 1.0;
         b[11].quad_nodes = 65;
         b[12].mip_growth = 0.5;
-        b[13].level_gamma = INFINITY;
+        b[13].level_gamma = HUGE_VAL;
         for (i = 0; i < 14; i++) {
             CHECK_EQ_STATUS(hfvis_ffao_options_resolve(&b[i], &r), HFVIS_ERR_INVALID_ARGUMENT);
             CHECK_EQ_STATUS(hfvis_ffao(&s.cam, s.depth, NULL, &b[i], s.a, s.IW), HFVIS_ERR_INVALID_ARGUMENT);
@@ -494,7 +494,7 @@ TEST(bad_args)
     CHECK_EQ_STATUS(hfvis_ffao_table_build(NULL, 0, 0, 0, 0, 0.0, NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK(isnan(hfvis_ffao_table_lookup(NULL, 0, 0, 0, 0)));
     CHECK(isnan(hfvis_ffao_slab_integral(NULL, 0.0, PI, 1.0, PI, 0.0, 0)));
-    CHECK(isnan(hfvis_ffao_slab_rho1(NAN, PI, PI, 0.0)));
+    CHECK(isnan(hfvis_ffao_slab_rho1((double)NAN, PI, PI, 0.0)));
     {
         double p[2] = {0, 0}, n[2] = {0, 1}, I;
         o.estimator = HFVIS_FFAO_L_TABLE;

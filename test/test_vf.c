@@ -867,7 +867,7 @@ TEST(vf_multi_object)
     if (xyz) {
         double d = 0.0;
         for (v = 0; v < knot.vertex_count; v++) {
-            double pin[4] = {knot.xyz[3 * v], knot.xyz[3 * v + 1], knot.xyz[3 * v + 2], 1.0};
+            double pin[4] = {(double)knot.xyz[3 * v], (double)knot.xyz[3 * v + 1], (double)knot.xyz[3 * v + 2], 1.0};
             for (a = 0; a < 3; a++)
                 xyz[3 * v + a] = (float)(obs[0].object_to_world[a] * pin[0] + obs[0].object_to_world[4 + a] * pin[1]
                                          + obs[0].object_to_world[8 + a] * pin[2] + obs[0].object_to_world[12 + a]);
@@ -937,7 +937,7 @@ TEST(vf_shadows)
     CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pts, P, light, 1.0, &o, soft), HFVIS_OK);
     CHECK_EQ_STATUS(hfvis_visfield_soft_shadow_reference(&ob, 1, pts, P, light, 1.0, &o, soft_ref), HFVIS_OK);
     for (p = 0; p < P; p++) {
-        double x = pts[3 * p], y = pts[3 * p + 1], rr = sqrt(x * x + y * y);
+        double x = (double)pts[3 * p], y = (double)pts[3 * p + 1], rr = sqrt(x * x + y * y);
         if (rr < 0.9 * rad && (hard_ref[p] != 0.0f || hard[p] != 0.0f)) inside_ok = 0;
         if (rr > 1.1 * rad && (hard_ref[p] != 1.0f || hard[p] != 1.0f)) outside_ok = 0;
         agree += hard[p] == hard_ref[p];
@@ -1281,8 +1281,8 @@ TEST(vf_codec)
             MUTATE(put32(bad_buf + 20, 0xFFFFFFFFu), HFVIS_ERR_LIMIT);
             MUTATE((put32(bad_buf + 20, 1024), put32(bad_buf + 24, 4096)), HFVIS_ERR_LIMIT); /* 70 TB */
             MUTATE(put32(bad_buf + 24, (uint32_t)vf.dir_res + 2u), HFVIS_ERR_FORMAT); /* sizes disagree */
-            MUTATE(putf64(bad_buf + 32, NAN), HFVIS_ERR_FORMAT);
-            MUTATE(putf64(bad_buf + 48, INFINITY), HFVIS_ERR_FORMAT);
+            MUTATE(putf64(bad_buf + 32, (double)NAN), HFVIS_ERR_FORMAT);
+            MUTATE(putf64(bad_buf + 48, HUGE_VAL), HFVIS_ERR_FORMAT);
             MUTATE(putf64(bad_buf + 56, 0.0), HFVIS_ERR_FORMAT);
             MUTATE(putf64(bad_buf + 56, -1.0), HFVIS_ERR_FORMAT);
             MUTATE(putf64(bad_buf + 64, 1.5), HFVIS_ERR_FORMAT);
@@ -1292,7 +1292,7 @@ TEST(vf_codec)
             /* payload contents a build cannot produce */
             K = hfvis_visfield_position_count(vf.positions_n);
             texels = K * (size_t)vf.dir_res * (size_t)vf.dir_res;
-            if ((f == 2)) {
+            if (f == 2) {
                 MUTATE(memcpy(bad_buf + 80, "\0\0\xc0\x7f", 4), HFVIS_ERR_FORMAT); /* NaN */
                 MUTATE(memcpy(bad_buf + 80, "\0\0\0\xbf", 4), HFVIS_ERR_FORMAT);   /* -0.5 */
                 MUTATE(memcpy(bad_buf + 80, "\0\0\0\x40", 4), HFVIS_ERR_FORMAT);   /* 2 */
@@ -1354,7 +1354,7 @@ TEST(vf_codec)
 TEST(vf_bad_arguments)
 {
     const double c0[3] = {0.0, 0.0, 0.0}, z3[3] = {0.0, 0.0, 0.0}, up[3] = {0.0, 0.0, 1.0};
-    const double nan3[3] = {NAN, 0.0, 1.0}, inf3[3] = {0.0, INFINITY, 1.0}, down[3] = {0.0, 0.0, -1.0};
+    const double nan3[3] = {(double)NAN, 0.0, 1.0}, inf3[3] = {0.0, HUGE_VAL, 1.0}, down[3] = {0.0, 0.0, -1.0};
     const float pt[3] = {0.0f, 0.0f, -2.0f}, nz[3] = {0.0f, 0.0f, 1.0f}, nzero[3] = {0.0f, 0.0f, 0.0f};
     const float pnan[3] = {0.0f, NAN, 0.0f};
     hfvis_mesh ico, badmesh;
@@ -1424,10 +1424,10 @@ TEST(vf_bad_arguments)
         for (q_ = 0; q_ < v2.maps_size; q_++) ok_ &= ((unsigned char *)v2.maps)[q_] == chk_; \
         CHECK(ok_ && bw_.avg_distance == v2.avg_distance); } while (0)
     BUILD_BAD(bw_.radius = 0.0, HFVIS_ERR_INVALID_ARGUMENT);
-    BUILD_BAD(bw_.radius = NAN, HFVIS_ERR_INVALID_ARGUMENT);
+    BUILD_BAD(bw_.radius = (double)NAN, HFVIS_ERR_INVALID_ARGUMENT);
     BUILD_BAD(bw_.radius = 0.4, HFVIS_ERR_INVALID_ARGUMENT);      /* the mesh is not inside */
     BUILD_BAD(bw_.center[0] = 0.6, HFVIS_ERR_INVALID_ARGUMENT);
-    BUILD_BAD(bw_.center[1] = INFINITY, HFVIS_ERR_INVALID_ARGUMENT);
+    BUILD_BAD(bw_.center[1] = HUGE_VAL, HFVIS_ERR_INVALID_ARGUMENT);
     BUILD_BAD(bw_.positions_n = 0, HFVIS_ERR_INVALID_ARGUMENT);
     BUILD_BAD(bw_.positions_n = HFVIS_VISFIELD_MAX_N + 1, HFVIS_ERR_INVALID_ARGUMENT);
     BUILD_BAD(bw_.dir_res = -1, HFVIS_ERR_INVALID_ARGUMENT);
@@ -1476,7 +1476,7 @@ TEST(vf_bad_arguments)
     CHECK_EQ_STATUS(hfvis_visfield_query(&vf, c0, z3, 0.0, &hit), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_visfield_query(&vf, c0, inf3, 0.0, &hit), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_visfield_query(&vf, c0, up, -1.0, &hit), HFVIS_ERR_INVALID_ARGUMENT);
-    CHECK_EQ_STATUS(hfvis_visfield_query(&vf, c0, up, NAN, &hit), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_query(&vf, c0, up, (double)NAN, &hit), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_visfield_query(&vf, c0, up, 0.0, NULL), HFVIS_ERR_INVALID_ARGUMENT);
     v2 = vf;
     v2.avg_distance = 2.0;
@@ -1502,19 +1502,19 @@ TEST(vf_bad_arguments)
     AO_BAD(o_.rays_sqrt = -1);
     AO_BAD(o_.rays_sqrt = HFVIS_VISFIELD_MAX_RAYS_SQRT + 1);
     AO_BAD(o_.max_distance = -1.0);
-    AO_BAD(o_.max_distance = NAN);
+    AO_BAD(o_.max_distance = (double)NAN);
     AO_BAD(o_.falloff = (hfvis_visfield_falloff)3);
     AO_BAD(o_.combine = (hfvis_visfield_combine)3);
     AO_BAD(o_.falloff = HFVIS_VISFIELD_FALLOFF_LINEAR); /* without a finite max_distance */
     AO_BAD(o_.bias = -0.1);
-    AO_BAD(o_.bias = INFINITY);
+    AO_BAD(o_.bias = HUGE_VAL);
     AO_BAD(o_.offset = -0.1);
-    AO_BAD(o_.offset = NAN);
+    AO_BAD(o_.offset = (double)NAN);
     AO_BAD(b_.object_to_world[0] = 2.0);              /* non-uniform scale */
     AO_BAD(b_.object_to_world[4] = 0.5);              /* shear */
     AO_BAD(b_.object_to_world[3] = 0.1);              /* projective row */
     AO_BAD(b_.object_to_world[15] = 2.0);
-    AO_BAD(b_.object_to_world[13] = NAN);
+    AO_BAD(b_.object_to_world[13] = (double)NAN);
     AO_BAD(memset(b_.object_to_world, 0, sizeof b_.object_to_world); b_.object_to_world[15] = 1.0);
     AO_BAD(b_.field = NULL);
 #undef AO_BAD
@@ -1550,7 +1550,7 @@ TEST(vf_bad_arguments)
     CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pt, 1, NULL, 0.0, &so, &out), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pt, 1, nan3, 0.0, &so, &out), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pt, 1, up, -1.0, &so, &out), HFVIS_ERR_INVALID_ARGUMENT);
-    CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pt, 1, up, INFINITY, &so, &out), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pt, 1, up, HUGE_VAL, &so, &out), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pnan, 1, up, 0.0, &so, &out), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, NULL, 1, up, 0.0, &so, &out), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pt, 1, up, 0.0, &so, NULL), HFVIS_ERR_INVALID_ARGUMENT);
@@ -1582,8 +1582,8 @@ TEST(vf_bad_arguments)
     RF_BAD(o_.rays = -1);
     RF_BAD(o_.rays = HFVIS_VISFIELD_MAX_SAMPLES + 1);
     RF_BAD(o_.shininess = -1.0);
-    RF_BAD(o_.shininess = NAN);
-    RF_BAD(o_.bias = NAN);
+    RF_BAD(o_.shininess = (double)NAN);
+    RF_BAD(o_.bias = (double)NAN);
     RF_BAD(o_.offset = -1.0);
 #undef RF_BAD
     CHECK_EQ_STATUS(hfvis_visfield_reflect(&ob, 1, c0, z3, down, NULL, th), HFVIS_ERR_INVALID_ARGUMENT);

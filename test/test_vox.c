@@ -1394,7 +1394,7 @@ TEST(bad_arguments)
         CHECK_EQ_STATUS(fn(&m, &bv, NULL, &frags), HFVIS_ERR_INVALID_ARGUMENT);
         bv = v, bv.grid.cell[0] = -1.0;
         CHECK_EQ_STATUS(fn(&m, &bv, NULL, &frags), HFVIS_ERR_INVALID_ARGUMENT);
-        bv = v, bv.grid.origin[1] = NAN;
+        bv = v, bv.grid.origin[1] = (double)NAN;
         CHECK_EQ_STATUS(fn(&m, &bv, NULL, &frags), HFVIS_ERR_INVALID_ARGUMENT);
         bm = m, bm.xyz = NULL;
         CHECK_EQ_STATUS(fn(&bm, &v, NULL, &frags), HFVIS_ERR_INVALID_ARGUMENT);

@@ -52,7 +52,7 @@ TEST(mat4_multiply_invert)
         CHECK_EQ_STATUS(hfvis_mat4_invert(sing, out), HFVIS_ERR_INVALID_ARGUMENT);
         CHECK(out[3] == keep);
         sing[5] = sing[10] = sing[15] = 1.0;
-        sing[7] = NAN;
+        sing[7] = (double)NAN;
         CHECK_EQ_STATUS(hfvis_mat4_invert(sing, out), HFVIS_ERR_INVALID_ARGUMENT);
         CHECK_EQ_STATUS(hfvis_mat4_invert(NULL, out), HFVIS_ERR_INVALID_ARGUMENT);
     }
@@ -97,7 +97,7 @@ TEST(look_at_and_projections)
     CHECK_EQ_STATUS(hfvis_mat4_perspective(0.0, 1, 1, 2, proj), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_mat4_perspective(1.0, 1, 0, 2, proj), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_mat4_perspective(1.0, 1, 2, 2, proj), HFVIS_ERR_INVALID_ARGUMENT);
-    CHECK_EQ_STATUS(hfvis_mat4_perspective(1.0, NAN, 1, 2, proj), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_mat4_perspective(1.0, (double)NAN, 1, 2, proj), HFVIS_ERR_INVALID_ARGUMENT);
     /* ortho maps its box onto [-1, 1]^3 */
     CHECK_EQ_STATUS(hfvis_mat4_ortho(-2, 6, -1, 3, 1, 9, proj), HFVIS_OK);
     p[0] = 6, p[1] = -1, p[2] = -9, p[3] = 1;
@@ -190,7 +190,7 @@ TEST(grid_fit)
     g = keep;
     CHECK_EQ_STATUS(hfvis_volume_grid_fit(&m, 0, 0.0, 0, &g), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_volume_grid_fit(&m, 8, -0.1, 0, &g), HFVIS_ERR_INVALID_ARGUMENT);
-    CHECK_EQ_STATUS(hfvis_volume_grid_fit(&m, 8, NAN, 0, &g), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_volume_grid_fit(&m, 8, (double)NAN, 0, &g), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_volume_grid_fit(NULL, 8, 0, 0, &g), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_volume_grid_fit(&m, 4096, 0, 1, &g), HFVIS_ERR_LIMIT);
     m.triangle_count = 0;
