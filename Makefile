@@ -135,3 +135,9 @@ determinism:
 	@$(MAKE) --no-print-directory config=release werror=1 CC=gcc BUILD=build/gcc all build/gcc/test/imgdiff
 	@$(MAKE) --no-print-directory config=release werror=1 CC=clang BUILD=build/clang all build/clang/test/imgdiff
 	@sh test/determinism.sh build/gcc build/clang
+
+# make fuzz-coverage: line coverage of each decoder by the corpus `make fuzz` left in build/fuzz
+# plus the seeds (clang source-based coverage; test/fuzz/coverage.sh).
+.PHONY: fuzz-coverage
+fuzz-coverage:
+	@sh test/fuzz/coverage.sh
