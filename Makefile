@@ -143,3 +143,26 @@ $(BUILD)/test/test_png: examples/png_write.h examples/common.h
 .PHONY: uninstall portability
 portability:
 	@sh test/portability.sh
+
+# make valgrind: the test build's test programs, examples and CLI script under valgrind memcheck
+# (errors and definite/indirect leaks fail); the last line is "valgrind: N programs, ...".
+# VALGRIND_ONLY="test_x 06_lava cli" runs only those programs.
+.PHONY: valgrind run-valgrind
+valgrind:
+	@$(MAKE) --no-print-directory config=test werror=1 run-valgrind
+run-valgrind: $(TESTS) $(EXAMPLES) $(CLI)
+	@sh test/valgrind.sh $(BUILD) $(VALGRIND_ONLY)
+
+# make determinism: release builds with gcc (build/gcc) and clang (build/clang); every CLI command
+# and example twice per build (bit-identical) and gcc against clang (test/determinism.sh).
+.PHONY: determinism
+determinism:
+	@$(MAKE) --no-print-directory config=release werror=1 CC=gcc BUILD=build/gcc all build/gcc/test/imgdiff
+	@$(MAKE) --no-print-directory config=release werror=1 CC=clang BUILD=build/clang all build/clang/test/imgdiff
+	@sh test/determinism.sh build/gcc build/clang
+
+# make fuzz-coverage: line coverage of each decoder by the corpus `make fuzz` left in build/fuzz
+# plus the seeds (clang source-based coverage; test/fuzz/coverage.sh).
+.PHONY: fuzz-coverage
+fuzz-coverage:
+	@sh test/fuzz/coverage.sh

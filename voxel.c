@@ -1428,7 +1428,8 @@ static hfvis_status vx_mesh_obj_run(vx_mesh_obj_pass *ps, const unsigned char *p
 HFVIS_API hfvis_status hfvis_obj_decode(const void *data, size_t size,
                                         const hfvis_allocator *alloc, hfvis_mesh *out)
 {
-    const unsigned char *p = (const unsigned char *)data;
+    /* An empty input may be NULL; point at a literal so p + size is defined (C99 6.5.6p8). */
+    const unsigned char *p = (const unsigned char *)(data ? data : "");
     vx_mesh_obj_pass ps;
     vx_mesh_builder b;
     hfvis_status s;

@@ -2,7 +2,7 @@
  * only cubes within HFVIS_VOLUME_MAX_VOXELS with a valid grid, and what it accepts must survive
  * encode -> decode (version-1 occupancy: any nonzero byte reads back as 1; same dims; origin and
  * cell within the number formatter's few ulps).
- * Seeds: parts/fuzz_seeds_cons (test/fuzz/seeds/binvox after the merge). */
+ * Seeds: test/fuzz/seeds/binvox. Built and run by `make fuzz`. */
 #include "hfvis.h"
 #include <math.h>
 #include <stdint.h>

@@ -1,6 +1,6 @@
-/* fuzz_mesh.c - libFuzzer target for hfvis_obj_decode: it must never crash, leak or read out of
+/* fuzz_obj.c - libFuzzer target for hfvis_obj_decode: it must never crash, leak or read out of
  * bounds, and whatever decodes must be a valid mesh that re-encodes and decodes to the same bits.
- * Build: see parts/BRIEF.md (clang -fsanitize=fuzzer,address,undefined). */
+ * Seeds: test/fuzz/seeds/obj. Built and run by `make fuzz` (clang -fsanitize=fuzzer,address,undefined). */
 #include "hfvis.h"
 
 #include <math.h>

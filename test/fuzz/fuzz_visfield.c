@@ -2,7 +2,7 @@
  * crash, must fail only with FORMAT, LIMIT or OUT_OF_MEMORY (leaving the output untouched), and
  * what it accepts must be a valid field that re-encodes to the very same bytes (the format has
  * one encoding per field) and answers queries.
- * Seeds: parts/fuzz_seeds_vf (test/fuzz/seeds/visfield after the merge). */
+ * Seeds: test/fuzz/seeds/visfield. Built and run by `make fuzz`. */
 #include "hfvis.h"
 #include <math.h>
 #include <stdint.h>
