@@ -146,7 +146,7 @@
     X(camera_from_view, S, -, "NZGOFSR", "INVALID_ARGUMENT LIMIT") \
     X(camera_unproject, S, -, "NZGOFER", "INVALID_ARGUMENT") \
     X(camera_project, S, -, "NZGOFER", "INVALID_ARGUMENT") \
-    X(depth_linear, V, -, "ZFER", "NaN; +INFINITY for a non-finite depth") \
+    X(depth_linear, V, -, "ZFER", "NaN; +(double)INFINITY for a non-finite depth") \
     X(depth_hardware, V, -, "GFER", "NaN") \
     X(depth_linearize, S, -, "NZGOFER", "INVALID_ARGUMENT") \
     X(depth_normals, S, -, "NZGOFER", "INVALID_ARGUMENT") \
@@ -561,8 +561,8 @@ static void teardown(void)
     bg = g_ok; bg.height = -1; BAD('G', INV, expr); \
     bg = g_ok; bg.stride = GW - 1; BAD('R', INV, expr); \
     bg = g_ok; bg.cell_size = 0.0; BAD('Z', INV, expr); \
-    bg = g_ok; bg.cell_size = NAN; BAD('F', INV, expr); \
-    bg = g_ok; bg.cell_size = INFINITY; BAD('F', INV, expr); \
+    bg = g_ok; bg.cell_size = (double)NAN; BAD('F', INV, expr); \
+    bg = g_ok; bg.cell_size = (double)INFINITY; BAD('F', INV, expr); \
     bg = g_ok; bg.stride = PTRDIFF_MAX; BAD('O', INV, expr); \
     } while (0)
 
@@ -571,7 +571,7 @@ static void teardown(void)
     bo = hfvis_sweep_options_default(); bo.border = (hfvis_border)99; BAD('E', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.border = (hfvis_border)-1; BAD('E', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.border_cells = -1; BAD('S', INV, expr); \
-    bo = hfvis_sweep_options_default(); bo.azimuth0_rad = NAN; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.azimuth0_rad = (double)NAN; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.direction_begin = -1; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.direction_end = -2; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.direction_order = (hfvis_direction_order)3; BAD('E', INV, expr); \
@@ -687,8 +687,8 @@ static void args_pgm_encode(void)
     BAD('Z', INV, hfvis_pgm_encode(px, 0, 1, 2, 0.0f, 2.0f, 255, out, need, wr));
     BAD('G', INV, hfvis_pgm_encode(px, 2, -1, 2, 0.0f, 2.0f, 255, out, need, wr));
     BAD('R', INV, hfvis_pgm_encode(px, 2, 1, 1, 0.0f, 2.0f, 255, out, need, wr));
-    BAD('F', INV, hfvis_pgm_encode(px, 2, 1, 2, NAN, 2.0f, 255, out, need, wr));
-    BAD('F', INV, hfvis_pgm_encode(px, 2, 1, 2, 0.0f, INFINITY, 255, out, need, wr));
+    BAD('F', INV, hfvis_pgm_encode(px, 2, 1, 2, (double)NAN, 2.0f, 255, out, need, wr));
+    BAD('F', INV, hfvis_pgm_encode(px, 2, 1, 2, 0.0f, (double)INFINITY, 255, out, need, wr));
     BAD('R', INV, hfvis_pgm_encode(px, 2, 1, 2, 2.0f, 2.0f, 255, out, need, wr));
     BAD('Z', INV, hfvis_pgm_encode(px, 2, 1, 2, 0.0f, 2.0f, 0, out, need, wr));
     BAD('O', INV, hfvis_pgm_encode(px, 2, 1, 2, 0.0f, 2.0f, 65536, out, need, wr));
@@ -736,7 +736,7 @@ static void args_pgm_save(void)
     BAD('N', INV, hfvis_pgm_save(tmp_path("t.pgm"), NULL, 2, 1, 2, 0.0f, 2.0f, 255));
     BAD('Z', INV, hfvis_pgm_save(tmp_path("t.pgm"), px, 0, 1, 2, 0.0f, 2.0f, 255));
     BAD('G', INV, hfvis_pgm_save(tmp_path("t.pgm"), px, 2, -1, 2, 0.0f, 2.0f, 255));
-    BAD('F', INV, hfvis_pgm_save(tmp_path("t.pgm"), px, 2, 1, 2, NAN, 2.0f, 255));
+    BAD('F', INV, hfvis_pgm_save(tmp_path("t.pgm"), px, 2, 1, 2, (double)NAN, 2.0f, 255));
     BAD('R', INV, hfvis_pgm_save(tmp_path("t.pgm"), px, 2, 1, 2, 0.0f, 2.0f, 70000));
     BAD('R', IOE, hfvis_pgm_save(bad_dir_path("t.pgm"), px, 2, 1, 2, 0.0f, 2.0f, 255));
     BADV('R', access(tmp_path("t.pgm"), F_OK) != 0);
@@ -758,9 +758,9 @@ static void args_field_height(void)
     BADV('N', isnan(hfvis_field_height(NULL, 1.0, 2.0)));
     b = f; b.kind = (hfvis_field_kind)999;
     BADV('E', isnan(hfvis_field_height(&b, 1.0, 2.0)));
-    b = f; b.wavelength = NAN;
+    b = f; b.wavelength = (double)NAN;
     BADV('S', isnan(hfvis_field_height(&b, 1.0, 2.0)));
-    BADV('F', isnan(hfvis_field_height(&f, NAN, 2.0)));
+    BADV('F', isnan(hfvis_field_height(&f, (double)NAN, 2.0)));
 }
 
 static void args_field_generate(void)
@@ -778,8 +778,8 @@ static void args_field_generate(void)
     BAD('O', INV, hfvis_field_generate(&f, GW, 3, PTRDIFF_MAX, out));
     b = f; b.kind = (hfvis_field_kind)999; BAD('E', INV, hfvis_field_generate(&b, GW, GH, GW, out));
     b = f; b.kind = (hfvis_field_kind)0; BAD('E', INV, hfvis_field_generate(&b, GW, GH, GW, out));
-    b = f; b.wavelength = NAN; BAD('F', INV, hfvis_field_generate(&b, GW, GH, GW, out));
-    b = f; b.amplitude = INFINITY; BAD('F', INV, hfvis_field_generate(&b, GW, GH, GW, out));
+    b = f; b.wavelength = (double)NAN; BAD('F', INV, hfvis_field_generate(&b, GW, GH, GW, out));
+    b = f; b.amplitude = (double)INFINITY; BAD('F', INV, hfvis_field_generate(&b, GW, GH, GW, out));
     b = f; b.wavelength = 0.0; BAD('S', INV, hfvis_field_generate(&b, GW, GH, GW, out));
 }
 
@@ -789,7 +789,7 @@ static void args_grid_sample(void)
     begin("grid_sample");
     CHECK(isfinite(hfvis_grid_sample(&g_ok, 1.5, 1.5)));
     BADV('N', isnan(hfvis_grid_sample(NULL, 1.0, 1.0)));
-    BADV('F', isnan(hfvis_grid_sample(&g_ok, NAN, 1.0)));
+    BADV('F', isnan(hfvis_grid_sample(&g_ok, (double)NAN, 1.0)));
     b.width = 0;
     BADV('Z', isnan(hfvis_grid_sample(&b, 1.0, 1.0)));
 }
@@ -814,8 +814,8 @@ static void args_lattice_init(void)
     BAD('N', INV, hfvis_lattice_init(NULL, GW, GH, 0.3));
     BAD('Z', INV, hfvis_lattice_init(L, 0, GH, 0.3));
     BAD('G', INV, hfvis_lattice_init(L, GW, -1, 0.3));
-    BAD('F', INV, hfvis_lattice_init(L, GW, GH, NAN));
-    BAD('F', INV, hfvis_lattice_init(L, GW, GH, INFINITY));
+    BAD('F', INV, hfvis_lattice_init(L, GW, GH, (double)NAN));
+    BAD('F', INV, hfvis_lattice_init(L, GW, GH, (double)INFINITY));
     BAD('O', LIM, hfvis_lattice_init(L, INT_MAX, INT_MAX, 0.3));
 }
 
@@ -850,7 +850,7 @@ static void args_sweep_options_default(void)
 static void args_line_horizons(void)
 {
     static const double d[4] = {0, 1, 2, 3}, h[4] = {1, 0, 2, 0}, dbad[4] = {0, 1, 1, 3};
-    static const double dnan[4] = {0, NAN, 2, 3};
+    static const double dnan[4] = {0, (double)NAN, 2, 3};
     double *t;
     int *c, *st;
     begin("line_horizons");
@@ -869,7 +869,7 @@ static void args_line_horizons(void)
 static void args_line_horizons_naive(void)
 {
     static const double d[4] = {0, 1, 2, 3}, h[4] = {1, 0, 2, 0}, dbad[4] = {0, 1, 1, 3};
-    static const double dnan[4] = {0, NAN, 2, 3};
+    static const double dnan[4] = {0, (double)NAN, 2, 3};
     double *t;
     int *c;
     begin("line_horizons_naive");
@@ -893,8 +893,8 @@ static void args_horizon_lattice(void)
     OK(hfvis_horizon_lattice(&g_ok, 0.3, NULL, out));
     BAD('N', INV, hfvis_horizon_lattice(NULL, 0.3, NULL, out));
     BAD('N', INV, hfvis_horizon_lattice(&g_ok, 0.3, NULL, NULL));
-    BAD('F', INV, hfvis_horizon_lattice(&g_ok, NAN, NULL, out));
-    BAD('F', INV, hfvis_horizon_lattice(&g_ok, -INFINITY, NULL, out));
+    BAD('F', INV, hfvis_horizon_lattice(&g_ok, (double)NAN, NULL, out));
+    BAD('F', INV, hfvis_horizon_lattice(&g_ok, -(double)INFINITY, NULL, out));
     GRID_CASES(hfvis_horizon_lattice(&bg, 0.3, NULL, out));
     SWEEP_OPT_CASES(hfvis_horizon_lattice(&g_ok, 0.3, &bo, out));
 }
@@ -909,7 +909,7 @@ static void args_horizon_lattice_naive(void)
     OK(hfvis_horizon_lattice_naive(&g_ok, 0.3, NULL, out));
     BAD('N', INV, hfvis_horizon_lattice_naive(NULL, 0.3, NULL, out));
     BAD('N', INV, hfvis_horizon_lattice_naive(&g_ok, 0.3, NULL, NULL));
-    BAD('F', INV, hfvis_horizon_lattice_naive(&g_ok, NAN, NULL, out));
+    BAD('F', INV, hfvis_horizon_lattice_naive(&g_ok, (double)NAN, NULL, out));
     GRID_CASES(hfvis_horizon_lattice_naive(&bg, 0.3, NULL, out));
     SWEEP_OPT_CASES(hfvis_horizon_lattice_naive(&g_ok, 0.3, &bo, out));
 }
@@ -961,7 +961,7 @@ static void args_horizon_reference(void)
     BAD('Z', INV, hfvis_horizon_reference(&g_ok, 0, NULL, NULL, pts, 2, out));
     BAD('G', INV, hfvis_horizon_reference(&g_ok, -1, NULL, NULL, pts, 2, out));
     m.step_cells = -1.0; BAD('S', INV, hfvis_horizon_reference(&g_ok, 4, NULL, &m, pts, 2, out));
-    m.step_cells = NAN; BAD('F', INV, hfvis_horizon_reference(&g_ok, 4, NULL, &m, pts, 2, out));
+    m.step_cells = (double)NAN; BAD('F', INV, hfvis_horizon_reference(&g_ok, 4, NULL, &m, pts, 2, out));
     m.step_cells = 0.0; m.max_distance_cells = -1.0;
     BAD('S', INV, hfvis_horizon_reference(&g_ok, 4, NULL, &m, pts, 2, out));
     BAD('O', INV, hfvis_horizon_reference(&g_ok, INT_MAX, NULL, NULL, pts, SIZE_MAX / 2, out));
@@ -988,7 +988,7 @@ static void args_horizon_reference_fn(void)
     BAD('Z', INV, hfvis_horizon_reference_fn(plane_fn, NULL, 0, GH, 1.0, 4, NULL, NULL, pts, 2, out));
     BAD('G', INV, hfvis_horizon_reference_fn(plane_fn, NULL, GW, -1, 1.0, 4, NULL, NULL, pts, 2, out));
     BAD('Z', INV, hfvis_horizon_reference_fn(plane_fn, NULL, GW, GH, 0.0, 4, NULL, NULL, pts, 2, out));
-    BAD('F', INV, hfvis_horizon_reference_fn(plane_fn, NULL, GW, GH, NAN, 4, NULL, NULL, pts, 2, out));
+    BAD('F', INV, hfvis_horizon_reference_fn(plane_fn, NULL, GW, GH, (double)NAN, 4, NULL, NULL, pts, 2, out));
     BAD('Z', INV, hfvis_horizon_reference_fn(plane_fn, NULL, GW, GH, 1.0, 0, NULL, NULL, pts, 2, out));
     SWEEP_OPT_CASES(hfvis_horizon_reference_fn(plane_fn, NULL, GW, GH, 1.0, 4, &bo, NULL, pts, 2, out));
 }
@@ -999,7 +999,7 @@ static void args_sector_weight(void)
     CHECK(isfinite(hfvis_sector_weight(4, 1.0, 0.0, 1.0)));
     BADV('Z', isnan(hfvis_sector_weight(0, 1.0, 0.0, 1.0)));
     BADV('G', isnan(hfvis_sector_weight(-1, 1.0, 0.0, 1.0)));
-    BADV('F', isnan(hfvis_sector_weight(4, NAN, 0.0, 1.0)));
+    BADV('F', isnan(hfvis_sector_weight(4, (double)NAN, 0.0, 1.0)));
 }
 
 static void args_sky_light(void)
@@ -1012,8 +1012,8 @@ static void args_sky_light(void)
     BAD('N', INV, hfvis_sky_light(&g_ok, 4, 1.0f, 1.0f, NULL, NULL, GW));
     BAD('Z', INV, hfvis_sky_light(&g_ok, 0, 1.0f, 1.0f, NULL, out, GW));
     BAD('G', INV, hfvis_sky_light(&g_ok, -2, 1.0f, 1.0f, NULL, out, GW));
-    BAD('F', INV, hfvis_sky_light(&g_ok, 4, NAN, 1.0f, NULL, out, GW));
-    BAD('F', INV, hfvis_sky_light(&g_ok, 4, 1.0f, INFINITY, NULL, out, GW));
+    BAD('F', INV, hfvis_sky_light(&g_ok, 4, (double)NAN, 1.0f, NULL, out, GW));
+    BAD('F', INV, hfvis_sky_light(&g_ok, 4, 1.0f, (double)INFINITY, NULL, out, GW));
     BAD('R', INV, hfvis_sky_light(&g_ok, 4, 1.0f, 1.0f, NULL, out, GW - 1));
     BAD('O', INV, hfvis_sky_light(&g_ok, 4, 1.0f, 1.0f, NULL, out, PTRDIFF_MAX));
     GRID_CASES(hfvis_sky_light(&bg, 4, 1.0f, 1.0f, NULL, out, GW));
@@ -1031,9 +1031,9 @@ static void args_sky_light_from_map(void)
     BAD('N', INV, hfvis_sky_light_from_map(&g_ok, 4, 0.0, g_map, 1.0f, 1.0f, NULL, NULL, GW));
     BAD('Z', INV, hfvis_sky_light_from_map(&g_ok, 0, 0.0, g_map, 1.0f, 1.0f, NULL, out, GW));
     BAD('G', INV, hfvis_sky_light_from_map(&g_ok, -4, 0.0, g_map, 1.0f, 1.0f, NULL, out, GW));
-    BAD('F', INV, hfvis_sky_light_from_map(&g_ok, 4, NAN, g_map, 1.0f, 1.0f, NULL, out, GW));
-    BAD('F', INV, hfvis_sky_light_from_map(&g_ok, 4, 0.0, g_map, INFINITY, 1.0f, NULL, out, GW));
-    BAD('F', INV, hfvis_sky_light_from_map(&g_ok, 4, 0.0, g_map, 1.0f, NAN, NULL, out, GW));
+    BAD('F', INV, hfvis_sky_light_from_map(&g_ok, 4, (double)NAN, g_map, 1.0f, 1.0f, NULL, out, GW));
+    BAD('F', INV, hfvis_sky_light_from_map(&g_ok, 4, 0.0, g_map, (double)INFINITY, 1.0f, NULL, out, GW));
+    BAD('F', INV, hfvis_sky_light_from_map(&g_ok, 4, 0.0, g_map, 1.0f, (double)NAN, NULL, out, GW));
     BAD('R', INV, hfvis_sky_light_from_map(&g_ok, 4, 0.0, g_map, 1.0f, 1.0f, NULL, out, GW - 1));
     BAD('O', INV, hfvis_sky_light_from_map(&g_ok, 4, 0.0, g_map, 1.0f, 1.0f, NULL, out, PTRDIFF_MAX));
     GRID_CASES(hfvis_sky_light_from_map(&bg, 4, 0.0, g_map, 1.0f, 1.0f, NULL, out, GW));
@@ -1079,9 +1079,9 @@ static void args_sun_visibility(void)
     OK(hfvis_sun_visibility(&g_ok, 0.3, 0.4, 0.01, NULL, out, GW));
     BAD('N', INV, hfvis_sun_visibility(NULL, 0.3, 0.4, 0.01, NULL, out, GW));
     BAD('N', INV, hfvis_sun_visibility(&g_ok, 0.3, 0.4, 0.01, NULL, NULL, GW));
-    BAD('F', INV, hfvis_sun_visibility(&g_ok, NAN, 0.4, 0.01, NULL, out, GW));
-    BAD('F', INV, hfvis_sun_visibility(&g_ok, 0.3, INFINITY, 0.01, NULL, out, GW));
-    BAD('F', INV, hfvis_sun_visibility(&g_ok, 0.3, 0.4, NAN, NULL, out, GW));
+    BAD('F', INV, hfvis_sun_visibility(&g_ok, (double)NAN, 0.4, 0.01, NULL, out, GW));
+    BAD('F', INV, hfvis_sun_visibility(&g_ok, 0.3, (double)INFINITY, 0.01, NULL, out, GW));
+    BAD('F', INV, hfvis_sun_visibility(&g_ok, 0.3, 0.4, (double)NAN, NULL, out, GW));
     BAD('G', INV, hfvis_sun_visibility(&g_ok, 0.3, 0.4, -0.01, NULL, out, GW));
     BAD('R', INV, hfvis_sun_visibility(&g_ok, 0.3, 0.4, 0.01, NULL, out, GW - 1));
     BAD('O', INV, hfvis_sun_visibility(&g_ok, 0.3, 0.4, 0.01, NULL, out, PTRDIFF_MAX));
@@ -1137,7 +1137,7 @@ static void args_env_table_build(void)
     BAD('N', INV, hfvis_env_table_build(&g_env, 4, 0.0, NULL, NULL));
     BAD('Z', INV, hfvis_env_table_build(&g_env, 0, 0.0, NULL, t));
     BAD('G', INV, hfvis_env_table_build(&g_env, -1, 0.0, NULL, t));
-    BAD('F', INV, hfvis_env_table_build(&g_env, 4, NAN, NULL, t));
+    BAD('F', INV, hfvis_env_table_build(&g_env, 4, (double)NAN, NULL, t));
     ENV_CASES(hfvis_env_table_build(&be, 4, 0.0, NULL, t));
     EOPT_CASES(hfvis_env_table_build(&g_env, 4, 0.0, &bx, t));
 }
@@ -1153,7 +1153,7 @@ static void args_env_light(void)
     BAD('N', INV, hfvis_env_light(&g_ok, 4, &g_env, 1.0f, NULL, NULL, NULL, GW));
     BAD('Z', INV, hfvis_env_light(&g_ok, 0, &g_env, 1.0f, NULL, NULL, out, GW));
     BAD('G', INV, hfvis_env_light(&g_ok, -4, &g_env, 1.0f, NULL, NULL, out, GW));
-    BAD('F', INV, hfvis_env_light(&g_ok, 4, &g_env, NAN, NULL, NULL, out, GW));
+    BAD('F', INV, hfvis_env_light(&g_ok, 4, &g_env, (double)NAN, NULL, NULL, out, GW));
     BAD('R', INV, hfvis_env_light(&g_ok, 4, &g_env, 1.0f, NULL, NULL, out, GW - 1));
     BAD('O', INV, hfvis_env_light(&g_ok, 4, &g_env, 1.0f, NULL, NULL, out, PTRDIFF_MAX));
     GRID_CASES(hfvis_env_light(&bg, 4, &g_env, 1.0f, NULL, NULL, out, GW));
@@ -1174,8 +1174,8 @@ static void args_env_light_from_map(void)
     BAD('N', INV, hfvis_env_light_from_map(&g_ok, 4, 0.0, g_map, &g_env, 1.0f, NULL, NULL, NULL, GW));
     BAD('Z', INV, hfvis_env_light_from_map(&g_ok, 0, 0.0, g_map, &g_env, 1.0f, NULL, NULL, out, GW));
     BAD('G', INV, hfvis_env_light_from_map(&g_ok, -4, 0.0, g_map, &g_env, 1.0f, NULL, NULL, out, GW));
-    BAD('F', INV, hfvis_env_light_from_map(&g_ok, 4, NAN, g_map, &g_env, 1.0f, NULL, NULL, out, GW));
-    BAD('F', INV, hfvis_env_light_from_map(&g_ok, 4, 0.0, g_map, &g_env, INFINITY, NULL, NULL, out, GW));
+    BAD('F', INV, hfvis_env_light_from_map(&g_ok, 4, (double)NAN, g_map, &g_env, 1.0f, NULL, NULL, out, GW));
+    BAD('F', INV, hfvis_env_light_from_map(&g_ok, 4, 0.0, g_map, &g_env, (double)INFINITY, NULL, NULL, out, GW));
     BAD('R', INV, hfvis_env_light_from_map(&g_ok, 4, 0.0, g_map, &g_env, 1.0f, NULL, NULL, out, GW - 1));
     BAD('O', INV, hfvis_env_light_from_map(&g_ok, 4, 0.0, g_map, &g_env, 1.0f, NULL, NULL, out, PTRDIFF_MAX));
     GRID_CASES(hfvis_env_light_from_map(&bg, 4, 0.0, g_map, &g_env, 1.0f, NULL, NULL, out, GW));
@@ -1198,7 +1198,7 @@ static void args_light_reference(void)
     BAD('N', INV, hfvis_light_reference(&g_ok, NULL, 1.0f, NULL, NULL, &h, pts, NULL, 1, out));
     BAD('N', INV, hfvis_light_reference(&g_ok, NULL, 1.0f, NULL, NULL, &h, pts, nrm, 1, NULL));
     BAD('O', INV, hfvis_light_reference(&g_ok, NULL, 1.0f, NULL, NULL, &h, pts, nrm, SIZE_MAX / 2, out));
-    BAD('F', INV, hfvis_light_reference(&g_ok, NULL, NAN, NULL, NULL, &h, pts, nrm, 1, out));
+    BAD('F', INV, hfvis_light_reference(&g_ok, NULL, (double)NAN, NULL, NULL, &h, pts, nrm, 1, out));
     h.azimuth_samples = -1;
     BAD('S', INV, hfvis_light_reference(&g_ok, NULL, 1.0f, NULL, NULL, &h, pts, nrm, 1, out));
     h.azimuth_samples = 8;
@@ -1282,8 +1282,8 @@ static void args_hull_tree_push(void)
 #define TREE_TWO (hfvis_hull_tree_init(mem, need, 3, NULL, &t), hfvis_hull_tree_push(t, 0.0, 1.0, NULL), \
                   hfvis_hull_tree_push(t, 1.0, 0.5, NULL))
     BADP('N', INV, TREE_TWO, hfvis_hull_tree_push(NULL, 2.0, 1.0, hc));
-    BADP('F', INV, TREE_TWO, hfvis_hull_tree_push(t, NAN, 1.0, hc));
-    BADP('F', INV, TREE_TWO, hfvis_hull_tree_push(t, 2.0, INFINITY, hc));
+    BADP('F', INV, TREE_TWO, hfvis_hull_tree_push(t, (double)NAN, 1.0, hc));
+    BADP('F', INV, TREE_TWO, hfvis_hull_tree_push(t, 2.0, (double)INFINITY, hc));
     BADP('R', INV, TREE_TWO, hfvis_hull_tree_push(t, 1.0, 1.0, hc));
     BADP('R', INV, TREE_TWO, hfvis_hull_tree_push(t, 0.5, 1.0, hc));
     BADP('O', LIM, (TREE_TWO, hfvis_hull_tree_push(t, 2.0, 0.0, NULL)), hfvis_hull_tree_push(t, 3.0, 0.0, hc));
@@ -1439,8 +1439,8 @@ static void args_indirect_light(void)
     BAD('Z', INV, hfvis_indirect_light(&g_ok, 4, ex_rad, 0, 1.0f, 0.5f, NULL, NULL, out, GW));
     BAD('G', INV, hfvis_indirect_light(&g_ok, -4, ex_rad, 1, 1.0f, 0.5f, NULL, NULL, out, GW));
     BAD('R', INV, hfvis_indirect_light(&g_ok, 4, ex_rad, 5, 1.0f, 0.5f, NULL, NULL, out, GW));
-    BAD('F', INV, hfvis_indirect_light(&g_ok, 4, ex_rad, 1, NAN, 0.5f, NULL, NULL, out, GW));
-    BAD('F', INV, hfvis_indirect_light(&g_ok, 4, ex_rad, 1, 1.0f, INFINITY, NULL, NULL, out, GW));
+    BAD('F', INV, hfvis_indirect_light(&g_ok, 4, ex_rad, 1, (double)NAN, 0.5f, NULL, NULL, out, GW));
+    BAD('F', INV, hfvis_indirect_light(&g_ok, 4, ex_rad, 1, 1.0f, (double)INFINITY, NULL, NULL, out, GW));
     BAD('R', INV, hfvis_indirect_light(&g_ok, 4, ex_rad, 1, 1.0f, 0.5f, NULL, NULL, out, GW - 1));
     BAD('O', INV, hfvis_indirect_light(&g_ok, 4, ex_rad, 1, 1.0f, 0.5f, NULL, NULL, out, PTRDIFF_MAX));
     GRID_CASES(hfvis_indirect_light(&bg, 4, ex_rad, 1, 1.0f, 0.5f, NULL, NULL, out, GW));
@@ -1460,8 +1460,8 @@ static void args_indirect_light_naive(void)
     BAD('Z', INV, hfvis_indirect_light_naive(&g_ok, 0, ex_rad, 1, 1.0f, 0.5f, NULL, out, GW));
     BAD('G', INV, hfvis_indirect_light_naive(&g_ok, 4, ex_rad, -1, 1.0f, 0.5f, NULL, out, GW));
     BAD('R', INV, hfvis_indirect_light_naive(&g_ok, 4, ex_rad, 5, 1.0f, 0.5f, NULL, out, GW));
-    BAD('F', INV, hfvis_indirect_light_naive(&g_ok, 4, ex_rad, 1, INFINITY, 0.5f, NULL, out, GW));
-    BAD('F', INV, hfvis_indirect_light_naive(&g_ok, 4, ex_rad, 1, 1.0f, NAN, NULL, out, GW));
+    BAD('F', INV, hfvis_indirect_light_naive(&g_ok, 4, ex_rad, 1, (double)INFINITY, 0.5f, NULL, out, GW));
+    BAD('F', INV, hfvis_indirect_light_naive(&g_ok, 4, ex_rad, 1, 1.0f, (double)NAN, NULL, out, GW));
     BAD('R', INV, hfvis_indirect_light_naive(&g_ok, 4, ex_rad, 1, 1.0f, 0.5f, NULL, out, GW - 1));
     BAD('O', INV, hfvis_indirect_light_naive(&g_ok, 4, ex_rad, 1, 1.0f, 0.5f, NULL, out, PTRDIFF_MAX));
     GRID_CASES(hfvis_indirect_light_naive(&bg, 4, ex_rad, 1, 1.0f, 0.5f, NULL, out, GW));
@@ -1481,7 +1481,7 @@ static void args_terrain_gi(void)
     BAD('Z', INV, hfvis_terrain_gi(&g_ok, 4, ex_rad, NULL, NULL, 0.5f, 0, 1, NULL, NULL, out));
     BAD('G', INV, hfvis_terrain_gi(&g_ok, 4, ex_rad, NULL, NULL, 0.5f, 1, -1, NULL, NULL, out));
     BAD('R', INV, hfvis_terrain_gi(&g_ok, 4, ex_rad, NULL, NULL, 0.5f, 5, 1, NULL, NULL, out));
-    BAD('F', INV, hfvis_terrain_gi(&g_ok, 4, ex_rad, NULL, NULL, NAN, 1, 1, NULL, NULL, out));
+    BAD('F', INV, hfvis_terrain_gi(&g_ok, 4, ex_rad, NULL, NULL, (double)NAN, 1, 1, NULL, NULL, out));
     GRID_CASES(hfvis_terrain_gi(&bg, 4, ex_rad, NULL, NULL, 0.5f, 1, 1, NULL, NULL, out));
     SWEEP_OPT_CASES(hfvis_terrain_gi(&g_ok, 4, ex_rad, NULL, NULL, 0.5f, 1, 1, &bo, NULL, out));
     TREE_OPT_CASES(hfvis_terrain_gi(&g_ok, 4, ex_rad, NULL, NULL, 0.5f, 1, 1, NULL, &bt, out));
@@ -1504,10 +1504,10 @@ static void args_direct_light(void)
     BAD('G', INV, hfvis_direct_light(&g_ok, -4, &sun, 1.0f, NULL, 1, NULL, out));
     BAD('R', INV, hfvis_direct_light(&g_ok, 4, &sun, 1.0f, NULL, 5, NULL, out));
     BAD('R', INV, hfvis_direct_light(&g_ok, 4, &sun, 1.0f, &g_env, 2, NULL, out));
-    BAD('F', INV, hfvis_direct_light(&g_ok, 4, &sun, NAN, NULL, 1, NULL, out));
-    b = sun; b.azimuth_rad = NAN; BAD('S', INV, hfvis_direct_light(&g_ok, 4, &b, 1.0f, NULL, 1, NULL, out));
+    BAD('F', INV, hfvis_direct_light(&g_ok, 4, &sun, (double)NAN, NULL, 1, NULL, out));
+    b = sun; b.azimuth_rad = (double)NAN; BAD('S', INV, hfvis_direct_light(&g_ok, 4, &b, 1.0f, NULL, 1, NULL, out));
     b = sun; b.radius_rad = -1.0; BAD('S', INV, hfvis_direct_light(&g_ok, 4, &b, 1.0f, NULL, 1, NULL, out));
-    b = sun; b.irradiance[0] = INFINITY; BAD('S', INV, hfvis_direct_light(&g_ok, 4, &b, 1.0f, NULL, 1, NULL, out));
+    b = sun; b.irradiance[0] = (double)INFINITY; BAD('S', INV, hfvis_direct_light(&g_ok, 4, &b, 1.0f, NULL, 1, NULL, out));
     GRID_CASES(hfvis_direct_light(&bg, 4, &sun, 1.0f, NULL, 1, NULL, out));
     SWEEP_OPT_CASES(hfvis_direct_light(&g_ok, 4, &sun, 1.0f, NULL, 1, &bo, out));
     ENV_CASES(hfvis_direct_light(&g_ok, 4, &sun, 1.0f, &be, 1, NULL, out));
@@ -1515,9 +1515,9 @@ static void args_direct_light(void)
 
 #define VIEWSHED_OPT_CASES(expr) do { hfvis_viewshed_options bv; \
     memset(&bv, 0, sizeof bv); bv.observer_height = -1.0; BAD('S', INV, expr); \
-    memset(&bv, 0, sizeof bv); bv.target_height = NAN; BAD('S', INV, expr); \
-    memset(&bv, 0, sizeof bv); bv.max_distance = -INFINITY; BAD('S', INV, expr); \
-    memset(&bv, 0, sizeof bv); bv.max_distance = INFINITY; BAD('S', INV, expr); \
+    memset(&bv, 0, sizeof bv); bv.target_height = (double)NAN; BAD('S', INV, expr); \
+    memset(&bv, 0, sizeof bv); bv.max_distance = -(double)INFINITY; BAD('S', INV, expr); \
+    memset(&bv, 0, sizeof bv); bv.max_distance = (double)INFINITY; BAD('S', INV, expr); \
     } while (0)
 
 static void args_viewshed(void)
@@ -1528,8 +1528,8 @@ static void args_viewshed(void)
     OK(hfvis_viewshed(&g_ok, 1.0, 1.0, NULL, out, GW));
     BAD('N', INV, hfvis_viewshed(NULL, 1.0, 1.0, NULL, out, GW));
     BAD('N', INV, hfvis_viewshed(&g_ok, 1.0, 1.0, NULL, NULL, GW));
-    BAD('F', INV, hfvis_viewshed(&g_ok, NAN, 1.0, NULL, out, GW));
-    BAD('F', INV, hfvis_viewshed(&g_ok, 1.0, INFINITY, NULL, out, GW));
+    BAD('F', INV, hfvis_viewshed(&g_ok, (double)NAN, 1.0, NULL, out, GW));
+    BAD('F', INV, hfvis_viewshed(&g_ok, 1.0, (double)INFINITY, NULL, out, GW));
     BAD('G', INV, hfvis_viewshed(&g_ok, -0.5, 1.0, NULL, out, GW));
     BAD('R', INV, hfvis_viewshed(&g_ok, 1.0, GH, NULL, out, GW));
     BAD('R', INV, hfvis_viewshed(&g_ok, 1.0, 1.0, NULL, out, GW - 1));
@@ -1546,9 +1546,9 @@ static void args_viewshed_reference(void)
     OK(hfvis_viewshed_reference(&g_ok, 1.0, 1.0, NULL, 0.5, out, GW));
     BAD('N', INV, hfvis_viewshed_reference(NULL, 1.0, 1.0, NULL, 0.5, out, GW));
     BAD('N', INV, hfvis_viewshed_reference(&g_ok, 1.0, 1.0, NULL, 0.5, NULL, GW));
-    BAD('F', INV, hfvis_viewshed_reference(&g_ok, NAN, 1.0, NULL, 0.5, out, GW));
-    BAD('F', INV, hfvis_viewshed_reference(&g_ok, 1.0, 1.0, NULL, NAN, out, GW));
-    BAD('F', INV, hfvis_viewshed_reference(&g_ok, 1.0, 1.0, NULL, INFINITY, out, GW));
+    BAD('F', INV, hfvis_viewshed_reference(&g_ok, (double)NAN, 1.0, NULL, 0.5, out, GW));
+    BAD('F', INV, hfvis_viewshed_reference(&g_ok, 1.0, 1.0, NULL, (double)NAN, out, GW));
+    BAD('F', INV, hfvis_viewshed_reference(&g_ok, 1.0, 1.0, NULL, (double)INFINITY, out, GW));
     BAD('G', INV, hfvis_viewshed_reference(&g_ok, 1.0, 1.0, NULL, -0.5, out, GW));
     BAD('R', INV, hfvis_viewshed_reference(&g_ok, GW, 1.0, NULL, 0.5, out, GW));
     BAD('R', INV, hfvis_viewshed_reference(&g_ok, 1.0, 1.0, NULL, 0.5, out, GW - 1));
@@ -1559,10 +1559,10 @@ static void args_viewshed_reference(void)
 
 /* ---- Nowrouzezahrai-Snyder math layer and pipeline --------------------------------------- */
 
-static const double v3_ok[3] = {0.3, -0.2, 0.9}, v3_zero[3] = {0, 0, 0}, v3_nan[3] = {0, NAN, 1};
-static const double v3_inf[3] = {INFINITY, 0, 1};
+static const double v3_ok[3] = {0.3, -0.2, 0.9}, v3_zero[3] = {0, 0, 0}, v3_nan[3] = {0, (double)NAN, 1};
+static const double v3_inf[3] = {(double)INFINITY, 0, 1};
 static double sh16_ok[16] = {1, 0.5, 0.25, -0.5, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1, 1.1, 1.2};
-static const double ahat_ok[4] = {3.14, 2.09, 0.78, 0}, ahat_nan[4] = {3.14, NAN, 0.78, 0};
+static const double ahat_ok[4] = {3.14, 2.09, 0.78, 0}, ahat_nan[4] = {3.14, (double)NAN, 0.78, 0};
 static double gamma_tab[4096];
 
 static void args_sh_eval(void)
@@ -1586,8 +1586,8 @@ static void args_sh_rotate_z(void)
     OK(hfvis_sh_rotate_z(sh16_ok, 0.3, o));
     BAD('N', INV, hfvis_sh_rotate_z(NULL, 0.3, o));
     BAD('N', INV, hfvis_sh_rotate_z(sh16_ok, 0.3, NULL));
-    BAD('F', INV, hfvis_sh_rotate_z(sh16_ok, NAN, o));
-    BAD('F', INV, hfvis_sh_rotate_z(sh16_ok, INFINITY, o));
+    BAD('F', INV, hfvis_sh_rotate_z(sh16_ok, (double)NAN, o));
+    BAD('F', INV, hfvis_sh_rotate_z(sh16_ok, (double)INFINITY, o));
 }
 
 static void args_sh_dot(void)
@@ -1679,8 +1679,8 @@ static void args_zh_phong(void)
     BAD('N', INV, hfvis_zh_phong(8.0, NULL));
     BAD('Z', INV, hfvis_zh_phong(0.0, a));
     BAD('G', INV, hfvis_zh_phong(-1.0, a));
-    BAD('F', INV, hfvis_zh_phong(NAN, a));
-    BAD('F', INV, hfvis_zh_phong(INFINITY, a));
+    BAD('F', INV, hfvis_zh_phong((double)NAN, a));
+    BAD('F', INV, hfvis_zh_phong((double)INFINITY, a));
 }
 
 static void args_zh_cap(void)
@@ -1692,7 +1692,7 @@ static void args_zh_cap(void)
     BAD('N', INV, hfvis_zh_cap(0.5, NULL));
     BAD('G', INV, hfvis_zh_cap(-0.1, a));
     BAD('R', INV, hfvis_zh_cap(4.0, a));
-    BAD('F', INV, hfvis_zh_cap(NAN, a));
+    BAD('F', INV, hfvis_zh_cap((double)NAN, a));
 }
 
 static void args_sh_project_env(void)
@@ -1713,7 +1713,7 @@ static void args_nlp_eval(void)
     p = AD(4);
     OK(hfvis_nlp_eval(0.5, p));
     BAD('N', INV, hfvis_nlp_eval(0.5, NULL));
-    BAD('F', INV, hfvis_nlp_eval(NAN, p));
+    BAD('F', INV, hfvis_nlp_eval((double)NAN, p));
     BAD('R', INV, hfvis_nlp_eval(1.5, p));
     BAD('G', INV, hfvis_nlp_eval(-1.5, p));
 }
@@ -1725,8 +1725,8 @@ static void args_nlp_occlusion(void)
     p = AD(4);
     OK(hfvis_nlp_occlusion(0.5, p));
     BAD('N', INV, hfvis_nlp_occlusion(0.5, NULL));
-    BAD('F', INV, hfvis_nlp_occlusion(NAN, p));
-    BAD('F', INV, hfvis_nlp_occlusion(-INFINITY, p));
+    BAD('F', INV, hfvis_nlp_occlusion((double)NAN, p));
+    BAD('F', INV, hfvis_nlp_occlusion(-(double)INFINITY, p));
 }
 
 static void args_nlp_visibility(void)
@@ -1736,13 +1736,13 @@ static void args_nlp_visibility(void)
     p = AD(4);
     OK(hfvis_nlp_visibility(0.1, 0.5, p));
     BAD('N', INV, hfvis_nlp_visibility(0.1, 0.5, NULL));
-    BAD('F', INV, hfvis_nlp_visibility(NAN, 0.5, p));
-    BAD('F', INV, hfvis_nlp_visibility(0.1, INFINITY, p));
+    BAD('F', INV, hfvis_nlp_visibility((double)NAN, 0.5, p));
+    BAD('F', INV, hfvis_nlp_visibility(0.1, (double)INFINITY, p));
 }
 
 static void args_nlp_radiance(void)
 {
-    static const double om[2] = {0.1, 0.3}, u[2] = {1, 2}, ombad[2] = {0.3, 0.1}, omnan[2] = {0.1, NAN};
+    static const double om[2] = {0.1, 0.3}, u[2] = {1, 2}, ombad[2] = {0.3, 0.1}, omnan[2] = {0.1, (double)NAN};
     double *p;
     begin("nlp_radiance");
     p = AD(4);
@@ -1755,7 +1755,7 @@ static void args_nlp_radiance(void)
     BAD('R', INV, hfvis_nlp_radiance(2, ombad, u, 0.0, p));
     BAD('R', INV, hfvis_nlp_radiance(2, om, u, 0.2, p));
     BAD('F', INV, hfvis_nlp_radiance(2, omnan, u, 0.0, p));
-    BAD('F', INV, hfvis_nlp_radiance(2, om, u, NAN, p));
+    BAD('F', INV, hfvis_nlp_radiance(2, om, u, (double)NAN, p));
 }
 
 static void args_nlp_reconstruct(void)
@@ -1767,7 +1767,7 @@ static void args_nlp_reconstruct(void)
     OK(hfvis_nlp_reconstruct(c, 0.3, o));
     BAD('N', INV, hfvis_nlp_reconstruct(NULL, 0.3, o));
     BAD('N', INV, hfvis_nlp_reconstruct(c, 0.3, NULL));
-    BAD('F', INV, hfvis_nlp_reconstruct(c, NAN, o));
+    BAD('F', INV, hfvis_nlp_reconstruct(c, (double)NAN, o));
 }
 
 static void args_ns_wedge_columns(void)
@@ -1789,7 +1789,7 @@ static void args_ns_wedge_matrix(void)
     BAD('Z', INV, hfvis_ns_wedge_matrix(HFVIS_NS_INTERP_LINEAR, 0.0, M));
     BAD('G', INV, hfvis_ns_wedge_matrix(HFVIS_NS_INTERP_LINEAR, -0.5, M));
     BAD('R', INV, hfvis_ns_wedge_matrix(HFVIS_NS_INTERP_LINEAR, 7.0, M));
-    BAD('F', INV, hfvis_ns_wedge_matrix(HFVIS_NS_INTERP_LINEAR, NAN, M));
+    BAD('F', INV, hfvis_ns_wedge_matrix(HFVIS_NS_INTERP_LINEAR, (double)NAN, M));
 }
 
 static void args_ns_wedges_full(void)
@@ -1802,7 +1802,7 @@ static void args_ns_wedges_full(void)
     BAD('E', INV, hfvis_ns_wedges_full(w, (hfvis_ns_interp)99, 4, 0.0));
     BAD('Z', INV, hfvis_ns_wedges_full(w, HFVIS_NS_INTERP_LINEAR, 0, 0.0));
     BAD('G', INV, hfvis_ns_wedges_full(w, HFVIS_NS_INTERP_LINEAR, -4, 0.0));
-    BAD('F', INV, hfvis_ns_wedges_full(w, HFVIS_NS_INTERP_LINEAR, 4, NAN));
+    BAD('F', INV, hfvis_ns_wedges_full(w, HFVIS_NS_INTERP_LINEAR, 4, (double)NAN));
 }
 
 static void args_ns_wedges_partial(void)
@@ -1817,7 +1817,7 @@ static void args_ns_wedges_partial(void)
     BAD('G', INV, hfvis_ns_wedges_partial(w, HFVIS_NS_INTERP_LINEAR, -3, -0.3, 0.2));
     BAD('R', INV, hfvis_ns_wedges_partial(w, HFVIS_NS_INTERP_LINEAR, 3, 0.2, -0.3));
     BAD('R', INV, hfvis_ns_wedges_partial(w, HFVIS_NS_INTERP_LINEAR, 3, 0.0, 7.0));
-    BAD('F', INV, hfvis_ns_wedges_partial(w, HFVIS_NS_INTERP_LINEAR, 3, NAN, 0.2));
+    BAD('F', INV, hfvis_ns_wedges_partial(w, HFVIS_NS_INTERP_LINEAR, 3, (double)NAN, 0.2));
 }
 
 static hfvis_ns_wedges wedges_ok(void)
@@ -1853,7 +1853,7 @@ static void args_ns_min_blocking_angle(void)
     BAD('N', INV, hfvis_ns_min_blocking_angle(v3_ok, 0.3, HFVIS_NS_OMEGA_MIN_EXACT, NULL));
     BAD('Z', INV, hfvis_ns_min_blocking_angle(v3_zero, 0.3, HFVIS_NS_OMEGA_MIN_EXACT, o));
     BAD('F', INV, hfvis_ns_min_blocking_angle(v3_nan, 0.3, HFVIS_NS_OMEGA_MIN_EXACT, o));
-    BAD('F', INV, hfvis_ns_min_blocking_angle(v3_ok, INFINITY, HFVIS_NS_OMEGA_MIN_EXACT, o));
+    BAD('F', INV, hfvis_ns_min_blocking_angle(v3_ok, (double)INFINITY, HFVIS_NS_OMEGA_MIN_EXACT, o));
     BAD('E', INV, hfvis_ns_min_blocking_angle(v3_ok, 0.3, (hfvis_ns_omega_min)99, o));
 }
 
@@ -1872,8 +1872,8 @@ static void args_ns_gi_options_default(void)
     bn = hfvis_ns_gi_options_default(); bn.interp = (hfvis_ns_interp)99; BAD('E', INV, expr); \
     bn = hfvis_ns_gi_options_default(); bn.glossy = (hfvis_ns_glossy)-1; BAD('E', INV, expr); \
     bn = hfvis_ns_gi_options_default(); bn.border = (hfvis_border)7; BAD('E', INV, expr); \
-    bn = hfvis_ns_gi_options_default(); bn.view_dir[0] = NAN; BAD('F', INV, expr); \
-    bn = hfvis_ns_gi_options_default(); bn.azimuth0_rad = INFINITY; BAD('F', INV, expr); \
+    bn = hfvis_ns_gi_options_default(); bn.view_dir[0] = (double)NAN; BAD('F', INV, expr); \
+    bn = hfvis_ns_gi_options_default(); bn.azimuth0_rad = (double)INFINITY; BAD('F', INV, expr); \
     bn = hfvis_ns_gi_options_default(); bn.key_directions = 1; BAD('S', INV, expr); \
     bn = hfvis_ns_gi_options_default(); bn.levels_per_octave = 33; BAD('O', INV, expr); \
     bn = hfvis_ns_gi_options_default(); bn.level_offset_v = -2; BAD('G', INV, expr); \
@@ -1914,9 +1914,9 @@ static hfvis_ns_scene ns_scene_ok(void)
     bs = ns_scene_ok(); bs.light_count = -1; BAD('G', INV, expr); \
     bs = ns_scene_ok(); bs.light_count = 65; bs.lights = &bsun; BAD('O', INV, expr); \
     bs = ns_scene_ok(); bs.light_count = 1; bs.lights = NULL; BAD('N', INV, expr); \
-    bs = ns_scene_ok(); memset(&bsun, 0, sizeof bsun); bsun.elevation_rad = NAN; bs.light_count = 1; \
+    bs = ns_scene_ok(); memset(&bsun, 0, sizeof bsun); bsun.elevation_rad = (double)NAN; bs.light_count = 1; \
     bs.lights = &bsun; BAD('F', INV, expr); \
-    bs = ns_scene_ok(); bs.albedo[0] = NAN; BAD('F', INV, expr); \
+    bs = ns_scene_ok(); bs.albedo[0] = (double)NAN; BAD('F', INV, expr); \
     bs = ns_scene_ok(); bs.specular = -1.0f; BAD('S', INV, expr); \
     bs = ns_scene_ok(); bs.specular = 1.0f; bs.shininess = 0.0f; BAD('S', INV, expr); \
     bs = ns_scene_ok(); bs.albedo_map = ns_bad_map; BAD('F', INV, expr); \
@@ -1924,8 +1924,8 @@ static hfvis_ns_scene ns_scene_ok(void)
     bs = ns_scene_ok(); bs.env_sh = ns_bad_sh; BAD('F', INV, expr); \
     } while (0)
 /* A per-sample map with one NaN at sample 5 (not a hole), and an SH vector with an Inf. */
-static const float ns_bad_map[GW * GH] = {0.5f, 0.5f, 0.5f, 0.5f, 0.5f, NAN, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f};
-static const double ns_bad_sh[16] = {1.0, INFINITY};
+static const float ns_bad_map[GW * GH] = {0.5f, 0.5f, 0.5f, 0.5f, 0.5f, (double)NAN, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f};
+static const double ns_bad_sh[16] = {1.0, (double)INFINITY};
 
 static void args_ns_gi(void)
 {
@@ -1967,7 +1967,7 @@ static void args_ns_gi_scratch_size(void)
 
 static void args_ns_bspline_max(void)
 {
-    static const double om[3] = {0.1, 0.5, 0.2}, omnan[3] = {0.1, NAN, 0.2};
+    static const double om[3] = {0.1, 0.5, 0.2}, omnan[3] = {0.1, (double)NAN, 0.2};
     double *o;
     begin("ns_bspline_max");
     o = AD(1);
@@ -2247,9 +2247,9 @@ static void args_partial_load(void)
     bc = cam_ok; bc.stride = 3; BAD('R', INV, expr); \
     bc = cam_ok; bc.guard_x = 4; BAD('R', INV, expr); \
     bc = cam_ok; bc.projection = (hfvis_camera_projection)9; BAD('E', INV, expr); \
-    bc = cam_ok; bc.fx = NAN; BAD('F', INV, expr); \
+    bc = cam_ok; bc.fx = (double)NAN; BAD('F', INV, expr); \
     bc = cam_ok; bc.fy = 0.0; BAD('Z', INV, expr); \
-    bc = cam_ok; bc.cx = INFINITY; BAD('F', INV, expr); \
+    bc = cam_ok; bc.cx = (double)INFINITY; BAD('F', INV, expr); \
     bc = cam_ok; bc.far_depth = -1.0; BAD('G', INV, expr); \
     bc = cam_ok; bc.width = HFVIS_SSAO_MAX_SIZE + 1; BAD('O', limit_status, expr); \
     } while (0)
@@ -2274,7 +2274,7 @@ static void args_camera_perspective(void)
     BAD('R', INV, hfvis_camera_perspective(c, 8, 8, 4, 1, 1.0));
     BAD('Z', INV, hfvis_camera_perspective(c, 8, 8, 1, 1, 0.0));
     BAD('R', INV, hfvis_camera_perspective(c, 8, 8, 1, 1, 3.2));
-    BAD('F', INV, hfvis_camera_perspective(c, 8, 8, 1, 1, NAN));
+    BAD('F', INV, hfvis_camera_perspective(c, 8, 8, 1, 1, (double)NAN));
     BAD('O', LIM, hfvis_camera_perspective(c, HFVIS_SSAO_MAX_SIZE + 1, 8, 1, 1, 1.0));
 }
 
@@ -2289,7 +2289,7 @@ static void args_camera_orthographic(void)
     BAD('G', INV, hfvis_camera_orthographic(c, 8, 8, 1, -1, 0.1));
     BAD('Z', INV, hfvis_camera_orthographic(c, 8, 8, 1, 1, 0.0));
     BAD('G', INV, hfvis_camera_orthographic(c, 8, 8, 1, 1, -0.1));
-    BAD('F', INV, hfvis_camera_orthographic(c, 8, 8, 1, 1, INFINITY));
+    BAD('F', INV, hfvis_camera_orthographic(c, 8, 8, 1, 1, (double)INFINITY));
     BAD('O', LIM, hfvis_camera_orthographic(c, 8, HFVIS_SSAO_MAX_SIZE + 1, 1, 1, 0.1));
 }
 
@@ -2305,7 +2305,7 @@ static void args_camera_from_view(void)
     BAD('G', INV, hfvis_camera_from_view(c, &view_ok, -1, 1));
     BAD('R', INV, hfvis_camera_from_view(c, &view_ok, 1, 4));
     b = view_ok; b.width = 0; BAD('Z', INV, hfvis_camera_from_view(c, &b, 1, 1));
-    b = view_ok; b.proj[0] = NAN; BAD('F', INV, hfvis_camera_from_view(c, &b, 1, 1));
+    b = view_ok; b.proj[0] = (double)NAN; BAD('F', INV, hfvis_camera_from_view(c, &b, 1, 1));
     b = view_ok; b.proj[3] = 1.0; BAD('S', INV, hfvis_camera_from_view(c, &b, 1, 1));
     b = view_ok; b.width = HFVIS_SSAO_MAX_SIZE + 1; BAD('O', LIM, hfvis_camera_from_view(c, &b, 1, 1));
 }
@@ -2318,14 +2318,14 @@ static void args_camera_unproject(void)
     OK(hfvis_camera_unproject(&cam_ok, 4.0, 4.0, 2.0, o));
     BAD('N', INV, hfvis_camera_unproject(NULL, 4.0, 4.0, 2.0, o));
     BAD('N', INV, hfvis_camera_unproject(&cam_ok, 4.0, 4.0, 2.0, NULL));
-    BAD('F', INV, hfvis_camera_unproject(&cam_ok, NAN, 4.0, 2.0, o));
-    BAD('F', INV, hfvis_camera_unproject(&cam_ok, 4.0, 4.0, INFINITY, o));
+    BAD('F', INV, hfvis_camera_unproject(&cam_ok, (double)NAN, 4.0, 2.0, o));
+    BAD('F', INV, hfvis_camera_unproject(&cam_ok, 4.0, 4.0, (double)INFINITY, o));
     CAMERA_CASES(hfvis_camera_unproject(&bc, 4.0, 4.0, 2.0, o));
 }
 
 static void args_camera_project(void)
 {
-    static const double p[3] = {0.1, 0.2, -2.0}, pb[3] = {0.1, 0.2, 1.0}, pn[3] = {NAN, 0.2, -2.0};
+    static const double p[3] = {0.1, 0.2, -2.0}, pb[3] = {0.1, 0.2, 1.0}, pn[3] = {(double)NAN, 0.2, -2.0};
     double *u, *v, *d;
     begin("camera_project");
     u = AD(1); v = AD(1); d = AD(1);
@@ -2346,8 +2346,8 @@ static void args_depth_linear(void)
     BADV('E', isnan(hfvis_depth_linear(0.5, (hfvis_depth_encoding)99, 0, 0.1, 10.0)));
     BADV('R', isnan(hfvis_depth_linear(0.5, HFVIS_DEPTH_GL, 2, 0.1, 10.0)));
     BADV('Z', isnan(hfvis_depth_linear(0.5, HFVIS_DEPTH_GL, 0, 0.0, 10.0)));
-    BADV('F', isnan(hfvis_depth_linear(0.5, HFVIS_DEPTH_GL, 0, 0.1, NAN)));
-    BADV('F', hfvis_depth_linear(NAN, HFVIS_DEPTH_GL, 0, 0.1, 10.0) == (double)INFINITY);
+    BADV('F', isnan(hfvis_depth_linear(0.5, HFVIS_DEPTH_GL, 0, 0.1, (double)NAN)));
+    BADV('F', hfvis_depth_linear((double)NAN, HFVIS_DEPTH_GL, 0, 0.1, 10.0) == (double)INFINITY);
     BADV('R', isnan(hfvis_depth_linear(0.5, HFVIS_DEPTH_INFINITE_FAR, 1, 0.1, 10.0)));
 }
 
@@ -2358,7 +2358,7 @@ static void args_depth_hardware(void)
     BADV('E', isnan(hfvis_depth_hardware(2.0, (hfvis_depth_encoding)0, 0, 0.1, 10.0)));
     BADV('R', isnan(hfvis_depth_hardware(2.0, HFVIS_DEPTH_GL, -1, 0.1, 10.0)));
     BADV('G', isnan(hfvis_depth_hardware(-2.0, HFVIS_DEPTH_GL, 0, 0.1, 10.0)));
-    BADV('F', isnan(hfvis_depth_hardware(2.0, HFVIS_DEPTH_GL, 0, INFINITY, 10.0)));
+    BADV('F', isnan(hfvis_depth_hardware(2.0, HFVIS_DEPTH_GL, 0, (double)INFINITY, 10.0)));
 }
 
 static void args_depth_linearize(void)
@@ -2376,7 +2376,7 @@ static void args_depth_linearize(void)
     BAD('R', INV, hfvis_depth_linearize(in, 2, 2, 2, HFVIS_DEPTH_GL, 0, 0.1, 10.0, out, 1));
     BAD('E', INV, hfvis_depth_linearize(in, 2, 2, 2, (hfvis_depth_encoding)99, 0, 0.1, 10.0, out, 2));
     BAD('R', INV, hfvis_depth_linearize(in, 2, 2, 2, HFVIS_DEPTH_GL, 3, 0.1, 10.0, out, 2));
-    BAD('F', INV, hfvis_depth_linearize(in, 2, 2, 2, HFVIS_DEPTH_GL, 0, NAN, 10.0, out, 2));
+    BAD('F', INV, hfvis_depth_linearize(in, 2, 2, 2, HFVIS_DEPTH_GL, 0, (double)NAN, 10.0, out, 2));
     BAD('R', INV, hfvis_depth_linearize(in, 2, 2, 2, HFVIS_DEPTH_GL, 0, 10.0, 0.1, out, 2));
     BAD('O', INV, hfvis_depth_linearize(in, 2, 3, PTRDIFF_MAX, HFVIS_DEPTH_GL, 0, 0.1, 10.0, out, 2));
 }
@@ -2395,7 +2395,7 @@ static void args_depth_normals(void)
 
 static void args_camera_line_plane(void)
 {
-    static const double ref[3] = {0.1, 0.1, -2.0}, rb[3] = {0.1, 0.1, 2.0}, rn[3] = {0.1, NAN, -2.0};
+    static const double ref[3] = {0.1, 0.1, -2.0}, rb[3] = {0.1, 0.1, 2.0}, rn[3] = {0.1, (double)NAN, -2.0};
     double *e1, *y;
     begin("camera_line_plane");
     e1 = AD(3); y = AD(3);
@@ -2405,7 +2405,7 @@ static void args_camera_line_plane(void)
     BAD('N', INV, hfvis_camera_line_plane(&cam_ok, ref, 1.0, 0.0, NULL, y));
     BAD('N', INV, hfvis_camera_line_plane(&cam_ok, ref, 1.0, 0.0, e1, NULL));
     BAD('Z', INV, hfvis_camera_line_plane(&cam_ok, ref, 0.0, 0.0, e1, y));
-    BAD('F', INV, hfvis_camera_line_plane(&cam_ok, ref, NAN, 0.0, e1, y));
+    BAD('F', INV, hfvis_camera_line_plane(&cam_ok, ref, (double)NAN, 0.0, e1, y));
     BAD('F', INV, hfvis_camera_line_plane(&cam_ok, rn, 1.0, 0.0, e1, y));
     BAD('R', INV, hfvis_camera_line_plane(&cam_ok, rb, 1.0, 0.0, e1, y));
     CAMERA_CASES(hfvis_camera_line_plane(&bc, ref, 1.0, 0.0, e1, y));
@@ -2415,7 +2415,7 @@ static void args_camera_line_plane(void)
 #define FALLOFF_CASES(expr) do { hfvis_falloff bf; \
     memset(&bf, 0, sizeof bf); bf.kind = (hfvis_falloff_kind)99; BAD('E', INV, expr); \
     memset(&bf, 0, sizeof bf); bf.kind = HFVIS_FALLOFF_STEP; bf.param = 0.0; BAD('Z', INV, expr); \
-    memset(&bf, 0, sizeof bf); bf.kind = HFVIS_FALLOFF_EXPONENTIAL; bf.param = NAN; BAD('F', INV, expr); \
+    memset(&bf, 0, sizeof bf); bf.kind = HFVIS_FALLOFF_EXPONENTIAL; bf.param = (double)NAN; BAD('F', INV, expr); \
     memset(&bf, 0, sizeof bf); bf.kind = HFVIS_FALLOFF_HBAO; bf.param = 1.0; bf.hbao_c = -1.0; BAD('G', INV, expr); \
     memset(&bf, 0, sizeof bf); bf.kind = HFVIS_FALLOFF_CUSTOM; BAD('N', INV, expr); \
     } while (0)
@@ -2438,7 +2438,7 @@ static void args_falloff_eval(void)
     f.kind = (hfvis_falloff_kind)99;
     CHECK(hfvis_falloff_eval(NULL, 1.0) == 1.0);
     BADV('E', isnan(hfvis_falloff_eval(&f, 1.0)));
-    f.kind = HFVIS_FALLOFF_STEP; f.param = NAN;
+    f.kind = HFVIS_FALLOFF_STEP; f.param = (double)NAN;
     BADV('F', isnan(hfvis_falloff_eval(&f, 1.0)));
 }
 
@@ -2464,8 +2464,8 @@ static void args_ssao_directions_uniform(void)
     BAD('Z', INV, hfvis_ssao_directions_uniform(0, 0.0, 1.0, 1.0, d));
     BAD('G', INV, hfvis_ssao_directions_uniform(-4, 0.0, 1.0, 1.0, d));
     BAD('O', INV, hfvis_ssao_directions_uniform(HFVIS_SSAO_MAX_DIRECTIONS + 1, 0.0, 1.0, 1.0, d));
-    BAD('F', INV, hfvis_ssao_directions_uniform(4, NAN, 1.0, 1.0, d));
-    BAD('F', INV, hfvis_ssao_directions_uniform(4, 0.0, INFINITY, 1.0, d));
+    BAD('F', INV, hfvis_ssao_directions_uniform(4, (double)NAN, 1.0, 1.0, d));
+    BAD('F', INV, hfvis_ssao_directions_uniform(4, 0.0, (double)INFINITY, 1.0, d));
     BAD('R', INV, hfvis_ssao_directions_uniform(4, 0.0, 1.0, 1e-3, d));
 }
 
@@ -2480,7 +2480,7 @@ static void args_ssao_directions_box(void)
     BAD('G', INV, hfvis_ssao_directions_box(1, -1, 1.0, d));
     BAD('O', INV, hfvis_ssao_directions_box(1, 5000, 1.0, d));
     BAD('O', INV, hfvis_ssao_directions_box(HFVIS_SSAO_MAX_DIRECTIONS / 8 + 1, 1, 1.0, d));
-    BAD('F', INV, hfvis_ssao_directions_box(1, 1, NAN, d));
+    BAD('F', INV, hfvis_ssao_directions_box(1, 1, (double)NAN, d));
     BAD('R', INV, hfvis_ssao_directions_box(1, 1, 1e6, d));
 }
 
@@ -2501,7 +2501,7 @@ static void args_ssao_lattice_init(void)
     BAD('N', INV, hfvis_ssao_lattice_init(NULL, &d, L));
     BAD('N', INV, hfvis_ssao_lattice_init(&cam_ok, NULL, L));
     BAD('N', INV, hfvis_ssao_lattice_init(&cam_ok, &d, NULL));
-    b = d; b.dx = NAN; BAD('F', INV, hfvis_ssao_lattice_init(&cam_ok, &b, L));
+    b = d; b.dx = (double)NAN; BAD('F', INV, hfvis_ssao_lattice_init(&cam_ok, &b, L));
     b = d; b.dx = 2.0; BAD('S', INV, hfvis_ssao_lattice_init(&cam_ok, &b, L));
     b = d; b.step = 0.0; BAD('Z', INV, hfvis_ssao_lattice_init(&cam_ok, &b, L));
     b = d; b.spacing = -1.0; BAD('G', INV, hfvis_ssao_lattice_init(&cam_ok, &b, L));
@@ -2546,7 +2546,7 @@ static void args_ssao_lattice_nearest(void)
     BADV('N', hfvis_ssao_lattice_nearest(NULL, lines_ok, 4.0, 4.0, l, s) == 0);
     BADV('N', hfvis_ssao_lattice_nearest(&lat_ok, NULL, 4.0, 4.0, l, s) == 0);
     BADV('N', hfvis_ssao_lattice_nearest(&lat_ok, lines_ok, 4.0, 4.0, NULL, s) == 0);
-    BADV('F', hfvis_ssao_lattice_nearest(&lat_ok, lines_ok, NAN, 4.0, l, s) == 0);
+    BADV('F', hfvis_ssao_lattice_nearest(&lat_ok, lines_ok, (double)NAN, 4.0, l, s) == 0);
 }
 
 static void args_lsao_options_default(void)
@@ -2564,9 +2564,9 @@ static void args_lsao_options_default(void)
     bl = hfvis_lsao_options_default(); bl.pattern = (hfvis_ssao_pattern)99; BAD('E', INV, expr); \
     bl = hfvis_lsao_options_default(); bl.tangent = (hfvis_ssao_tangent)99; BAD('E', INV, expr); \
     bl = hfvis_lsao_options_default(); bl.gather = (hfvis_ssao_gather)-1; BAD('E', INV, expr); \
-    bl = hfvis_lsao_options_default(); bl.pattern = HFVIS_SSAO_PATTERN_UNIFORM; bl.step = NAN; BAD('F', INV, expr); \
+    bl = hfvis_lsao_options_default(); bl.pattern = HFVIS_SSAO_PATTERN_UNIFORM; bl.step = (double)NAN; BAD('F', INV, expr); \
     bl = hfvis_lsao_options_default(); bl.fixed_sin_t = 2.0; BAD('S', INV, expr); \
-    bl = hfvis_lsao_options_default(); bl.reject_depth = NAN; BAD('F', INV, expr); \
+    bl = hfvis_lsao_options_default(); bl.reject_depth = (double)NAN; BAD('F', INV, expr); \
     bl = hfvis_lsao_options_default(); bl.pattern = HFVIS_SSAO_PATTERN_CUSTOM; BAD('N', INV, expr); \
     bl = hfvis_lsao_options_default(); bl.falloff.kind = (hfvis_falloff_kind)99; BAD('S', INV, expr); \
     bl = hfvis_lsao_options_default(); bl.box_scale = -1; BAD('G', INV, expr); \
@@ -2574,7 +2574,7 @@ static void args_lsao_options_default(void)
     bl = hfvis_lsao_options_default(); bl.plane = (hfvis_ssao_plane)9; BAD('E', INV, expr); \
     bl = hfvis_lsao_options_default(); bl.pop = (hfvis_lsao_pop)9; BAD('E', INV, expr); \
     bl = hfvis_lsao_options_default(); bl.reject_normal = 1.5; BAD('S', INV, expr); \
-    bl = hfvis_lsao_options_default(); bl.azimuth0_rad = INFINITY; bl.pattern = HFVIS_SSAO_PATTERN_UNIFORM; BAD('F', INV, expr); \
+    bl = hfvis_lsao_options_default(); bl.azimuth0_rad = (double)INFINITY; bl.pattern = HFVIS_SSAO_PATTERN_UNIFORM; BAD('F', INV, expr); \
     bl = hfvis_lsao_options_default(); bl.spacing = 1e9; BAD('O', INV, expr); \
     bl = hfvis_lsao_options_default(); bl.pattern = HFVIS_SSAO_PATTERN_CUSTOM; bl.directions = 1; \
     bl.custom_directions = &bad_weight_dir; BAD('S', INV, expr); \
@@ -2633,7 +2633,7 @@ static void args_lsao_line_naive(void)
 
 /* Invalid lattices, substituted as &bk (lines_ok stays). */
 #define LATTICE_CASES(expr) do { hfvis_ssao_lattice bk; \
-    bk = lat_ok; bk.dir.dx = NAN; BAD('F', INV, expr); \
+    bk = lat_ok; bk.dir.dx = (double)NAN; BAD('F', INV, expr); \
     bk = lat_ok; bk.line_count = -1; BAD('G', INV, expr); \
     bk = lat_ok; bk.sample_count = 1; BAD('R', INV, expr); \
     bk = lat_ok; bk.max_line_samples = 0; BAD('Z', INV, expr); \
@@ -2725,8 +2725,8 @@ static void args_hbao_options_default(void)
     bh = hfvis_hbao_options_default(); bh.directions = -1; BAD('G', INV, expr); \
     bh = hfvis_hbao_options_default(); bh.directions = HFVIS_SSAO_MAX_DIRECTIONS + 1; BAD('O', INV, expr); \
     bh = hfvis_hbao_options_default(); bh.steps = -1; BAD('G', INV, expr); \
-    bh = hfvis_hbao_options_default(); bh.radius = NAN; BAD('F', INV, expr); \
-    bh = hfvis_hbao_options_default(); bh.step_px = INFINITY; BAD('F', INV, expr); \
+    bh = hfvis_hbao_options_default(); bh.radius = (double)NAN; BAD('F', INV, expr); \
+    bh = hfvis_hbao_options_default(); bh.step_px = (double)INFINITY; BAD('F', INV, expr); \
     bh = hfvis_hbao_options_default(); bh.variant = (hfvis_hbao_variant)99; BAD('E', INV, expr); \
     bh = hfvis_hbao_options_default(); bh.jitter = (hfvis_hbao_jitter)-1; BAD('E', INV, expr); \
     bh = hfvis_hbao_options_default(); bh.tangent = HFVIS_SSAO_TANGENT_FIXED_HULL_REAL_EVAL; BAD('S', INV, expr); \
@@ -2735,7 +2735,7 @@ static void args_hbao_options_default(void)
     bh = hfvis_hbao_options_default(); bh.sampling = (hfvis_ssao_sampling)9; BAD('E', INV, expr); \
     bh = hfvis_hbao_options_default(); bh.plane = (hfvis_ssao_plane)9; BAD('E', INV, expr); \
     bh = hfvis_hbao_options_default(); bh.falloff.kind = HFVIS_FALLOFF_STEP; BAD('S', INV, expr); \
-    bh = hfvis_hbao_options_default(); bh.azimuth0_rad = NAN; BAD('F', INV, expr); \
+    bh = hfvis_hbao_options_default(); bh.azimuth0_rad = (double)NAN; BAD('F', INV, expr); \
     } while (0)
 
 static void args_hbao_options_resolve(void)
@@ -2768,9 +2768,9 @@ static void args_ssao_rt_options_default(void)
 #define RT_OPT_CASES(expr) do { hfvis_ssao_rt_options br; \
     br = hfvis_ssao_rt_options_default(); br.rays = -1; BAD('G', INV, expr); \
     br = hfvis_ssao_rt_options_default(); br.refine_iterations = 65; BAD('O', INV, expr); \
-    br = hfvis_ssao_rt_options_default(); br.thickness = NAN; BAD('F', INV, expr); \
+    br = hfvis_ssao_rt_options_default(); br.thickness = (double)NAN; BAD('F', INV, expr); \
     br = hfvis_ssao_rt_options_default(); br.bias = -1.0; BAD('G', INV, expr); \
-    br = hfvis_ssao_rt_options_default(); br.max_distance = INFINITY; BAD('F', INV, expr); \
+    br = hfvis_ssao_rt_options_default(); br.max_distance = (double)INFINITY; BAD('F', INV, expr); \
     br = hfvis_ssao_rt_options_default(); br.sampling = (hfvis_ssao_sampling)99; BAD('E', INV, expr); \
     br = hfvis_ssao_rt_options_default(); br.falloff.kind = (hfvis_falloff_kind)99; BAD('S', INV, expr); \
     } while (0)
@@ -2813,7 +2813,7 @@ static void args_ssao_scene_render(void)
     b = sc; b.kind = (hfvis_ssao_scene_kind)99; BAD('E', INV, hfvis_ssao_scene_render(&cam_ok, &b, d, n));
     b = sc; b.base_depth = 0.0; BAD('Z', INV, hfvis_ssao_scene_render(&cam_ok, &b, d, n));
     b = sc; b.radius = -1.0; BAD('G', INV, hfvis_ssao_scene_render(&cam_ok, &b, d, n));
-    b = sc; b.x0 = NAN; BAD('F', INV, hfvis_ssao_scene_render(&cam_ok, &b, d, n));
+    b = sc; b.x0 = (double)NAN; BAD('F', INV, hfvis_ssao_scene_render(&cam_ok, &b, d, n));
     b = sc; b.kind = HFVIS_SSAO_SCENE_VGROOVE; b.angle = 2.0; BAD('S', INV, hfvis_ssao_scene_render(&cam_ok, &b, d, n));
     CAMERA_CASES(hfvis_ssao_scene_render(&bc, &sc, d, n));
 }
@@ -2830,9 +2830,9 @@ static void args_ffao_options_default(void)
     bq = hfvis_ffao_options_default(); bq.directions = -1; BAD('G', INV, expr); \
     bq = hfvis_ffao_options_default(); bq.segments = 65; BAD('O', INV, expr); \
     bq = hfvis_ffao_options_default(); bq.b0 = 5000; BAD('O', INV, expr); \
-    bq = hfvis_ffao_options_default(); bq.azimuth0_rad = NAN; BAD('F', INV, expr); \
+    bq = hfvis_ffao_options_default(); bq.azimuth0_rad = (double)NAN; BAD('F', INV, expr); \
     bq = hfvis_ffao_options_default(); bq.receiver_slope = 1.0; BAD('S', INV, expr); \
-    bq = hfvis_ffao_options_default(); bq.thickness = INFINITY; BAD('F', INV, expr); \
+    bq = hfvis_ffao_options_default(); bq.thickness = (double)INFINITY; BAD('F', INV, expr); \
     bq = hfvis_ffao_options_default(); bq.estimator = (hfvis_ffao_estimator)99; BAD('E', INV, expr); \
     bq = hfvis_ffao_options_default(); bq.near_field = (hfvis_ffao_near)-1; BAD('E', INV, expr); \
     bq = hfvis_ffao_options_default(); bq.mip_growth = 0.5; BAD('S', INV, expr); \
@@ -2842,8 +2842,8 @@ static void args_ffao_options_default(void)
     bq = hfvis_ffao_options_default(); bq.sparse = 1; bq.directions = 8; BAD('S', INV, expr); \
     bq = hfvis_ffao_options_default(); bq.averaging = (hfvis_ffao_averaging)9; BAD('E', INV, expr); \
     bq = hfvis_ffao_options_default(); bq.sampling = (hfvis_ssao_sampling)9; BAD('E', INV, expr); \
-    bq = hfvis_ffao_options_default(); bq.level_gamma = NAN; BAD('F', INV, expr); \
-    bq = hfvis_ffao_options_default(); bq.blur_threshold = INFINITY; BAD('F', INV, expr); \
+    bq = hfvis_ffao_options_default(); bq.level_gamma = (double)NAN; BAD('F', INV, expr); \
+    bq = hfvis_ffao_options_default(); bq.blur_threshold = (double)INFINITY; BAD('F', INV, expr); \
     bq = hfvis_ffao_options_default(); bq.estimator = HFVIS_FFAO_L_CLOSED_FORM; bq.falloff.kind = HFVIS_FALLOFF_STEP; \
     bq.falloff.param = 1.0; BAD('S', INV, expr); \
     } while (0)
@@ -2866,7 +2866,7 @@ static void args_ffao_slab_integral(void)
     CHECK(isfinite(hfvis_ffao_slab_integral(&f, 0.2, 1.0, 1.0, 2.0, 0.0, 8)));
     BADV('Z', isnan(hfvis_ffao_slab_integral(&f, 0.2, 1.0, 1.0, 2.0, 0.0, 0)));
     BADV('O', isnan(hfvis_ffao_slab_integral(&f, 0.2, 1.0, 1.0, 2.0, 0.0, 65)));
-    BADV('F', isnan(hfvis_ffao_slab_integral(&f, NAN, 1.0, 1.0, 2.0, 0.0, 8)));
+    BADV('F', isnan(hfvis_ffao_slab_integral(&f, (double)NAN, 1.0, 1.0, 2.0, 0.0, 8)));
     f.kind = (hfvis_falloff_kind)99;
     BADV('E', isnan(hfvis_ffao_slab_integral(&f, 0.2, 1.0, 1.0, 2.0, 0.0, 8)));
 }
@@ -2875,9 +2875,9 @@ static void args_ffao_slab_rho1(void)
 {
     begin("ffao_slab_rho1");
     CHECK(isfinite(hfvis_ffao_slab_rho1(0.2, 1.0, 2.0, 0.0)));
-    BADV('F', isnan(hfvis_ffao_slab_rho1(NAN, 1.0, 2.0, 0.0)));
-    BADV('F', isnan(hfvis_ffao_slab_rho1(0.2, NAN, 2.0, 0.0)));
-    BADV('F', isnan(hfvis_ffao_slab_rho1(0.2, 1.0, INFINITY, 0.0)));
+    BADV('F', isnan(hfvis_ffao_slab_rho1((double)NAN, 1.0, 2.0, 0.0)));
+    BADV('F', isnan(hfvis_ffao_slab_rho1(0.2, (double)NAN, 2.0, 0.0)));
+    BADV('F', isnan(hfvis_ffao_slab_rho1(0.2, 1.0, (double)INFINITY, 0.0)));
 }
 
 static void args_ffao_table_build(void)
@@ -2894,7 +2894,7 @@ static void args_ffao_table_build(void)
     BAD('R', INV, hfvis_ffao_table_build(&f, 1, 2, 2, 2, 1.0, NULL, t));
     BAD('G', INV, hfvis_ffao_table_build(&f, 2, -2, 2, 2, 1.0, NULL, t));
     BAD('O', INV, hfvis_ffao_table_build(&f, 2, 2, 4097, 2, 1.0, NULL, t));
-    BAD('F', INV, hfvis_ffao_table_build(&f, 2, 2, 2, 2, NAN, NULL, t));
+    BAD('F', INV, hfvis_ffao_table_build(&f, 2, 2, 2, 2, (double)NAN, NULL, t));
     BAD('G', INV, hfvis_ffao_table_build(&f, 2, 2, 2, 2, -1.0, NULL, t));
     FALLOFF_CASES(hfvis_ffao_table_build(&bf, 2, 2, 2, 2, 1.0, NULL, t));
 }
@@ -2918,7 +2918,7 @@ static void args_ffao_table_lookup(void)
     CHECK(hfvis_ffao_table_build(&f, 2, 2, 2, 2, 1.0, NULL, &t) == HFVIS_OK);
     CHECK(isfinite(hfvis_ffao_table_lookup(&t, 0.5, 1.0, 2.0, 0.0)));
     BADV('N', isnan(hfvis_ffao_table_lookup(NULL, 0.5, 1.0, 2.0, 0.0)));
-    BADV('F', isnan(hfvis_ffao_table_lookup(&t, NAN, 1.0, 2.0, 0.0)));
+    BADV('F', isnan(hfvis_ffao_table_lookup(&t, (double)NAN, 1.0, 2.0, 0.0)));
     t.na = 0;
     BADV('S', isnan(hfvis_ffao_table_lookup(&t, 0.5, 1.0, 2.0, 0.0)));
     t.na = 2;
@@ -2944,12 +2944,12 @@ static void args_ffao_sector_weight(void)
     BADV('N', isnan(hfvis_ffao_sector_weight(&cam_ok, NULL, 0.0, 1.0)));
     BADV('R', isnan(hfvis_ffao_sector_weight(&cam_ok, pb, 0.0, 1.0)));
     BADV('R', isnan(hfvis_ffao_sector_weight(&cam_ok, p, 1.0, 0.5)));
-    BADV('F', isnan(hfvis_ffao_sector_weight(&cam_ok, p, NAN, 1.0)));
+    BADV('F', isnan(hfvis_ffao_sector_weight(&cam_ok, p, (double)NAN, 1.0)));
 }
 
 static void args_ffao_slice(void)
 {
-    static const double p[2] = {0.0, -3.0}, n[2] = {0.0, 1.0}, pn[2] = {NAN, -3.0}, pe[2] = {0.0, 0.0};
+    static const double p[2] = {0.0, -3.0}, n[2] = {0.0, 1.0}, pn[2] = {(double)NAN, -3.0}, pe[2] = {0.0, 0.0};
     static const double hx[2] = {1.0, 2.0}, hy[2] = {-2.5, -2.0};
     double *ob, *tm;
     begin("ffao_slice");
@@ -3007,7 +3007,7 @@ static void args_ssao_bilateral_blur(void)
     BAD('R', INV, hfvis_ssao_bilateral_blur(in, 4, 4, 4, 2, 0.07, out, 3));
     BAD('O', INV, hfvis_ssao_bilateral_blur(in, 4, 4, 4, 65, 0.07, out, 4));
     BAD('G', INV, hfvis_ssao_bilateral_blur(in, 4, 4, 4, -1, 0.07, out, 4));
-    BAD('F', INV, hfvis_ssao_bilateral_blur(in, 4, 4, 4, 2, NAN, out, 4));
+    BAD('F', INV, hfvis_ssao_bilateral_blur(in, 4, 4, 4, 2, (double)NAN, out, 4));
     BAD('O', INV, hfvis_ssao_bilateral_blur(in, PTRDIFF_MAX, 4, 4, 2, 0.07, out, 4));
 }
 
@@ -3028,7 +3028,7 @@ static void args_ssao_error(void)
     BAD('R', INV, hfvis_ssao_error(a, 1, r, 2, 2, 2, 0.05, 0, st, img, 2));
     BAD('R', INV, hfvis_ssao_error(a, 2, r, 2, 2, 2, 0.05, 0, st, img, 1));
     BAD('G', INV, hfvis_ssao_error(a, 2, r, 2, 2, 2, -0.05, 0, st, img, 2));
-    BAD('F', INV, hfvis_ssao_error(a, 2, r, 2, 2, 2, INFINITY, 0, st, img, 2));
+    BAD('F', INV, hfvis_ssao_error(a, 2, r, 2, 2, 2, (double)INFINITY, 0, st, img, 2));
     BAD('R', INV, hfvis_ssao_error(a, 2, r, 2, 2, 2, 0.05, 2, st, img, 2));
     BAD('O', INV, hfvis_ssao_error(a, 2, r, PTRDIFF_MAX, 2, 2, 0.05, 0, st, img, 2));
 }
@@ -3038,7 +3038,7 @@ static void args_ssao_error(void)
 /* ========================================================================================== */
 
 static const uint32_t bad_idx[3] = {0, 1, 99};
-static const float nan_xyz[9] = {0, 0, 0, 1, 0, 0, 0, NAN, 0};
+static const float nan_xyz[9] = {0, 0, 0, 1, 0, 0, 0, (double)NAN, 0};
 static const uint32_t tri_idx[3] = {0, 1, 2};
 
 /* Invalid meshes, substituted as &bm; huge_status is what a triangle count past the limits gives. */
@@ -3056,8 +3056,8 @@ static const uint32_t tri_idx[3] = {0, 1, 2};
     bv = vg_ok; bv.dims[0] = 0; BAD('Z', INV, expr); \
     bv = vg_ok; bv.dims[1] = -2; BAD('G', INV, expr); \
     bv = vg_ok; bv.cell[2] = 0.0; BAD('Z', INV, expr); \
-    bv = vg_ok; bv.cell[0] = NAN; BAD('F', INV, expr); \
-    bv = vg_ok; bv.origin[1] = INFINITY; BAD('F', INV, expr); \
+    bv = vg_ok; bv.cell[0] = (double)NAN; BAD('F', INV, expr); \
+    bv = vg_ok; bv.origin[1] = (double)INFINITY; BAD('F', INV, expr); \
     bv = vg_ok; bv.dims[0] = bv.dims[1] = bv.dims[2] = 2048; BAD('O', huge_status, expr); \
     } while (0)
 
@@ -3093,7 +3093,7 @@ static void args_mat4_invert(void)
     BAD('N', INV, hfvis_mat4_invert(NULL, o));
     BAD('N', INV, hfvis_mat4_invert(m, NULL));
     BAD('Z', INV, hfvis_mat4_invert(z, o));
-    memcpy(n, m, sizeof n); n[3] = NAN;
+    memcpy(n, m, sizeof n); n[3] = (double)NAN;
     BAD('F', INV, hfvis_mat4_invert(n, o));
 }
 
@@ -3126,8 +3126,8 @@ static void args_mat4_perspective(void)
     BAD('G', INV, hfvis_mat4_perspective(1.0, -1.5, 0.1, 10.0, o));
     BAD('Z', INV, hfvis_mat4_perspective(1.0, 1.5, 0.0, 10.0, o));
     BAD('R', INV, hfvis_mat4_perspective(1.0, 1.5, 10.0, 0.1, o));
-    BAD('F', INV, hfvis_mat4_perspective(1.0, 1.5, 0.1, INFINITY, o));
-    BAD('F', INV, hfvis_mat4_perspective(NAN, 1.5, 0.1, 10.0, o));
+    BAD('F', INV, hfvis_mat4_perspective(1.0, 1.5, 0.1, (double)INFINITY, o));
+    BAD('F', INV, hfvis_mat4_perspective((double)NAN, 1.5, 0.1, 10.0, o));
 }
 
 static void args_mat4_ortho(void)
@@ -3140,8 +3140,8 @@ static void args_mat4_ortho(void)
     BAD('R', INV, hfvis_mat4_ortho(1, -1, -1, 1, 0.1, 10.0, o));
     BAD('R', INV, hfvis_mat4_ortho(-1, 1, 1, 1, 0.1, 10.0, o));
     BAD('R', INV, hfvis_mat4_ortho(-1, 1, -1, 1, 10.0, 0.1, o));
-    BAD('F', INV, hfvis_mat4_ortho(NAN, 1, -1, 1, 0.1, 10.0, o));
-    BAD('F', INV, hfvis_mat4_ortho(-1, 1, -1, INFINITY, 0.1, 10.0, o));
+    BAD('F', INV, hfvis_mat4_ortho((double)NAN, 1, -1, 1, 0.1, 10.0, o));
+    BAD('F', INV, hfvis_mat4_ortho(-1, 1, -1, (double)INFINITY, 0.1, 10.0, o));
 }
 
 static void args_view_perspective(void)
@@ -3154,7 +3154,7 @@ static void args_view_perspective(void)
     BAD('N', INV, hfvis_view_perspective(v, NULL, tgt_ok, up_ok, 1.0, 8, 8, 0.1, 10.0));
     BAD('Z', INV, hfvis_view_perspective(v, eye_ok, tgt_ok, up_ok, 1.0, 0, 8, 0.1, 10.0));
     BAD('G', INV, hfvis_view_perspective(v, eye_ok, tgt_ok, up_ok, 1.0, 8, -8, 0.1, 10.0));
-    BAD('F', INV, hfvis_view_perspective(v, eye_ok, tgt_ok, up_ok, NAN, 8, 8, 0.1, 10.0));
+    BAD('F', INV, hfvis_view_perspective(v, eye_ok, tgt_ok, up_ok, (double)NAN, 8, 8, 0.1, 10.0));
     BAD('R', INV, hfvis_view_perspective(v, eye_ok, tgt_ok, up_ok, 1.0, 8, 8, 10.0, 0.1));
     BAD('R', INV, hfvis_view_perspective(v, eye_ok, eye_ok, up_ok, 1.0, 8, 8, 0.1, 10.0));
 }
@@ -3170,7 +3170,7 @@ static void args_view_orthographic(void)
     BAD('Z', INV, hfvis_view_orthographic(v, eye_ok, tgt_ok, up_ok, 0.0, 8, 8, 0.1, 10.0));
     BAD('G', INV, hfvis_view_orthographic(v, eye_ok, tgt_ok, up_ok, -2.0, 8, 8, 0.1, 10.0));
     BAD('Z', INV, hfvis_view_orthographic(v, eye_ok, tgt_ok, up_ok, 2.0, 8, 0, 0.1, 10.0));
-    BAD('F', INV, hfvis_view_orthographic(v, eye_ok, tgt_ok, up_ok, INFINITY, 8, 8, 0.1, 10.0));
+    BAD('F', INV, hfvis_view_orthographic(v, eye_ok, tgt_ok, up_ok, (double)INFINITY, 8, 8, 0.1, 10.0));
     BAD('R', INV, hfvis_view_orthographic(v, eye_ok, tgt_ok, up_ok, 2.0, 8, 8, 10.0, 0.1));
 }
 
@@ -3179,14 +3179,14 @@ static void args_depth_to_eye_z(void)
     begin("depth_to_eye_z");
     CHECK(hfvis_depth_to_eye_z(0.0, 0.5, 10.0, 0) == -0.5);
     CHECK(hfvis_depth_to_eye_z(1.0, 0.5, 10.0, 1) == -10.0);
-    CHECK(isnan(hfvis_depth_to_eye_z(NAN, 0.5, 10.0, 0)));
+    CHECK(isnan(hfvis_depth_to_eye_z((double)NAN, 0.5, 10.0, 0)));
 }
 
 static void args_eye_z_to_depth(void)
 {
     begin("eye_z_to_depth");
     CHECK(hfvis_eye_z_to_depth(-0.5, 0.5, 10.0, 0) == 0.0);
-    CHECK(isnan(hfvis_eye_z_to_depth(NAN, 0.5, 10.0, 1)));
+    CHECK(isnan(hfvis_eye_z_to_depth((double)NAN, 0.5, 10.0, 1)));
 }
 
 static void args_volume_grid_fit(void)
@@ -3199,7 +3199,7 @@ static void args_volume_grid_fit(void)
     BAD('N', INV, hfvis_volume_grid_fit(&m_box, 4, 0.1, 0, NULL));
     BAD('Z', INV, hfvis_volume_grid_fit(&m_box, 0, 0.1, 0, g));
     BAD('G', INV, hfvis_volume_grid_fit(&m_box, 4, -0.1, 0, g));
-    BAD('F', INV, hfvis_volume_grid_fit(&m_box, 4, NAN, 0, g));
+    BAD('F', INV, hfvis_volume_grid_fit(&m_box, 4, (double)NAN, 0, g));
     BAD('O', LIM, hfvis_volume_grid_fit(&m_box, 4096, 0.1, 1, g));
     MESH_CASES(hfvis_volume_grid_fit(&bm, 4, 0.1, 0, g), INV);
 }
@@ -3272,7 +3272,7 @@ static void args_volume_write(void)
     b = v; b.data = NULL; BAD('N', INV, hfvis_volume_write(&b, 1, 2, 3, val));
     b = v; b.channels = 0; BAD('Z', INV, hfvis_volume_write(&b, 1, 2, 3, val));
     b = v; b.blend[0] = (hfvis_blend)99; BAD('E', INV, hfvis_volume_write(&b, 1, 2, 3, val));
-    b = v; b.grid.cell[0] = NAN; BAD('F', INV, hfvis_volume_write(&b, 1, 2, 3, val));
+    b = v; b.grid.cell[0] = (double)NAN; BAD('F', INV, hfvis_volume_write(&b, 1, 2, 3, val));
 }
 
 static float merge_src[128];
@@ -3301,7 +3301,7 @@ static const double c_ok[3] = {0, 0, 0};
 
 static void args_mesh_box(void)
 {
-    static const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, hn[3] = {1, NAN, 1};
+    static const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, hn[3] = {1, (double)NAN, 1};
     hfvis_mesh *m;
     begin("mesh_box");
     m = AT(hfvis_mesh);
@@ -3324,7 +3324,7 @@ static void args_mesh_uv_sphere(void)
     BAD('N', INV, hfvis_mesh_uv_sphere(NULL, c_ok, 1.0, 4, 3, NULL));
     BAD('Z', INV, hfvis_mesh_uv_sphere(NULL, c_ok, 0.0, 4, 3, m));
     BAD('G', INV, hfvis_mesh_uv_sphere(NULL, c_ok, -1.0, 4, 3, m));
-    BAD('F', INV, hfvis_mesh_uv_sphere(NULL, c_ok, NAN, 4, 3, m));
+    BAD('F', INV, hfvis_mesh_uv_sphere(NULL, c_ok, (double)NAN, 4, 3, m));
     BAD('F', INV, hfvis_mesh_uv_sphere(NULL, v3_inf, 1.0, 4, 3, m));
     BAD('R', INV, hfvis_mesh_uv_sphere(NULL, c_ok, 1.0, 2, 3, m));
     BAD('R', INV, hfvis_mesh_uv_sphere(NULL, c_ok, 1.0, 4, 1, m));
@@ -3342,7 +3342,7 @@ static void args_mesh_icosphere(void)
     BAD('N', INV, hfvis_mesh_icosphere(NULL, c_ok, 1.0, 0, NULL));
     BAD('Z', INV, hfvis_mesh_icosphere(NULL, c_ok, 0.0, 0, m));
     BAD('G', INV, hfvis_mesh_icosphere(NULL, c_ok, 1.0, -1, m));
-    BAD('F', INV, hfvis_mesh_icosphere(NULL, c_ok, INFINITY, 0, m));
+    BAD('F', INV, hfvis_mesh_icosphere(NULL, c_ok, (double)INFINITY, 0, m));
     BAD('O', INV, hfvis_mesh_icosphere(NULL, c_ok, 1.0, HFVIS_MESH_ICOSPHERE_MAX_SUBDIVISIONS + 1, m));
 }
 
@@ -3358,7 +3358,7 @@ static void args_mesh_torus(void)
     BAD('R', INV, hfvis_mesh_torus(NULL, c_ok, 0.5, 2.0, 3, 3, m));
     BAD('G', INV, hfvis_mesh_torus(NULL, c_ok, 2.0, 0.5, -3, 3, m));
     BAD('R', INV, hfvis_mesh_torus(NULL, c_ok, 2.0, 0.5, 3, 2, m));
-    BAD('F', INV, hfvis_mesh_torus(NULL, c_ok, NAN, 0.5, 3, 3, m));
+    BAD('F', INV, hfvis_mesh_torus(NULL, c_ok, (double)NAN, 0.5, 3, 3, m));
     BAD('O', LIM, hfvis_mesh_torus(NULL, c_ok, 2.0, 0.5, INT_MAX, INT_MAX, m));
 }
 
@@ -3374,7 +3374,7 @@ static void args_mesh_torus_knot(void)
     BAD('Z', INV, hfvis_mesh_torus_knot(NULL, c_ok, 1.0, 0, 3, 8, 3, m));
     BAD('R', INV, hfvis_mesh_torus_knot(NULL, c_ok, 1.0, 2, 4, 8, 3, m));
     BAD('G', INV, hfvis_mesh_torus_knot(NULL, c_ok, 1.0, 2, 3, -8, 3, m));
-    BAD('F', INV, hfvis_mesh_torus_knot(NULL, c_ok, NAN, 2, 3, 8, 3, m));
+    BAD('F', INV, hfvis_mesh_torus_knot(NULL, c_ok, (double)NAN, 2, 3, 8, 3, m));
     BAD('O', LIM, hfvis_mesh_torus_knot(NULL, c_ok, 1.0, 2, 3, INT_MAX, INT_MAX, m));
 }
 
@@ -3509,7 +3509,7 @@ static void args_raster_options_default(void)
 #define VIEW_CASES(expr) do { hfvis_view bw; \
     bw = view_ok; bw.width = 0; BAD('Z', INV, expr); \
     bw = view_ok; bw.height = -1; BAD('G', INV, expr); \
-    bw = view_ok; bw.proj[5] = NAN; BAD('F', INV, expr); \
+    bw = view_ok; bw.proj[5] = (double)NAN; BAD('F', INV, expr); \
     bw = view_ok; bw.near_plane = 20.0; BAD('R', INV, expr); \
     bw = view_ok; bw.width = HFVIS_RASTER_MAX_SIZE + 1; BAD('O', LIM, expr); \
     } while (0)
@@ -3560,21 +3560,21 @@ static hfvis_ray ray_ok(void)
     hfvis_ray r;
     memset(&r, 0, sizeof r);
     r.origin[0] = 0.5f; r.origin[1] = 0.5f; r.origin[2] = -1.0f;
-    r.direction[2] = 1.0f; r.t_max = INFINITY;
+    r.direction[2] = 1.0f; r.t_max = (double)INFINITY;
     return r;
 }
 
 /* Invalid rays, substituted as &br. */
 #define RAY_CASES(expr) do { hfvis_ray br; \
     br = ray_ok(); br.direction[2] = 0.0f; BAD('Z', INV, expr); \
-    br = ray_ok(); br.origin[0] = NAN; BAD('F', INV, expr); \
-    br = ray_ok(); br.direction[1] = INFINITY; BAD('F', INV, expr); \
+    br = ray_ok(); br.origin[0] = (double)NAN; BAD('F', INV, expr); \
+    br = ray_ok(); br.direction[1] = (double)INFINITY; BAD('F', INV, expr); \
     br = ray_ok(); br.t_min = -1.0f; BAD('G', INV, expr); \
     br = ray_ok(); br.t_min = 2.0f; br.t_max = 1.0f; BAD('R', INV, expr); \
     br = ray_ok(); br.cull = (hfvis_cull_mode)7; BAD('E', INV, expr); \
     } while (0)
 
-static const float tv0[3] = {0, 0, 0}, tv1[3] = {1, 0, 0}, tv2[3] = {0, 1, 0}, tvn[3] = {0, NAN, 0};
+static const float tv0[3] = {0, 0, 0}, tv1[3] = {1, 0, 0}, tv2[3] = {0, 1, 0}, tvn[3] = {0, (double)NAN, 0};
 
 static void args_ray_triangle(void)
 {
@@ -3766,7 +3766,7 @@ static void args_voxelize_surface(void)
     b = v; b.channels = 0; BAD('Z', INV, hfvis_voxelize_surface(&m_box, &b, NULL, fr));
     b = v; b.channels = 33; BAD('O', INV, hfvis_voxelize_surface(&m_box, &b, NULL, fr));
     b = v; b.blend[0] = (hfvis_blend)9; BAD('E', INV, hfvis_voxelize_surface(&m_box, &b, NULL, fr));
-    b = v; b.grid.cell[1] = NAN; BAD('F', INV, hfvis_voxelize_surface(&m_box, &b, NULL, fr));
+    b = v; b.grid.cell[1] = (double)NAN; BAD('F', INV, hfvis_voxelize_surface(&m_box, &b, NULL, fr));
     MESH_CASES(hfvis_voxelize_surface(&bm, &v, NULL, fr), INV);
     VOXOPT_CASES(hfvis_voxelize_surface(&m_box, &v, &bo, fr));
 }
@@ -3783,7 +3783,7 @@ static void args_voxelize_surface_reference(void)
     BAD('N', INV, hfvis_voxelize_surface_reference(&m_box, NULL, NULL, fr));
     b = v; b.channels = 0; BAD('Z', INV, hfvis_voxelize_surface_reference(&m_box, &b, NULL, fr));
     b = v; b.blend[0] = (hfvis_blend)9; BAD('E', INV, hfvis_voxelize_surface_reference(&m_box, &b, NULL, fr));
-    b = v; b.grid.origin[0] = INFINITY; BAD('F', INV, hfvis_voxelize_surface_reference(&m_box, &b, NULL, fr));
+    b = v; b.grid.origin[0] = (double)INFINITY; BAD('F', INV, hfvis_voxelize_surface_reference(&m_box, &b, NULL, fr));
     MESH_CASES(hfvis_voxelize_surface_reference(&bm, &v, NULL, fr), INV);
     VOXOPT_CASES(hfvis_voxelize_surface_reference(&m_box, &v, &bo, fr));
 }
@@ -3952,7 +3952,7 @@ static void args_bitmask_words(void)
     BADV('N', hfvis_bitmask_words(NULL) == 0);
     b.dims[2] = 0;
     BADV('Z', hfvis_bitmask_words(&b) == 0);
-    b = vg_ok; b.cell[0] = NAN;
+    b = vg_ok; b.cell[0] = (double)NAN;
     BADV('F', hfvis_bitmask_words(&b) == 0);
 }
 
@@ -4014,7 +4014,7 @@ static void args_binvox_encode(void)
     BAD('O', LIM, hfvis_binvox_encode(&b, occ_box, out, need, wr));
     b = vg_ok; b.cell[0] = 1e308;
     BAD('O', LIM, hfvis_binvox_encode(&b, occ_box, out, need, wr));
-    b = vg_ok; b.cell[1] = NAN;
+    b = vg_ok; b.cell[1] = (double)NAN;
     BAD('F', INV, hfvis_binvox_encode(&b, occ_box, out, need, wr));
     b = vg_ok; b.dims[2] = -1;
     BAD('G', INV, hfvis_binvox_encode(&b, occ_box, out, need, wr));
@@ -4103,14 +4103,14 @@ static void make_depth_image(void)
 #define IMAGE_CASES(expr) do { hfvis_depth_image bi; \
     bi = iv_img; bi.depth = NULL; BAD('N', INV, expr); \
     bi = iv_img; bi.view.width = 0; BAD('Z', INV, expr); \
-    bi = iv_img; bi.view.view[3] = NAN; BAD('F', INV, expr); \
+    bi = iv_img; bi.view.view[3] = (double)NAN; BAD('F', INV, expr); \
     bi = iv_img; bi.view.near_plane = -1.0; BAD('G', INV, expr); \
     bi = iv_img; bi.attribute_count = HFVIS_VOLUME_MAX_CHANNELS + 1; BAD('O', INV, expr); \
     } while (0)
 #define IVOPT_CASES(expr) do { hfvis_iv_options bo; \
     bo = hfvis_iv_options_default(); bo.bias_rule = (hfvis_iv_bias_rule)9; BAD('E', INV, expr); \
     bo = hfvis_iv_options_default(); bo.footprint = (hfvis_iv_footprint)-1; BAD('E', INV, expr); \
-    bo = hfvis_iv_options_default(); bo.bias_rule = HFVIS_IV_BIAS_EXPLICIT; bo.bias = NAN; BAD('F', INV, expr); \
+    bo = hfvis_iv_options_default(); bo.bias_rule = HFVIS_IV_BIAS_EXPLICIT; bo.bias = (double)NAN; BAD('F', INV, expr); \
     bo = hfvis_iv_options_default(); bo.bias_rule = HFVIS_IV_BIAS_EXPLICIT; bo.bias = -1.0; BAD('S', INV, expr); \
     } while (0)
 
@@ -4127,7 +4127,7 @@ static void args_iv_bias_half_diagonal(void)
     begin("iv_bias_half_diagonal");
     CHECK(hfvis_iv_bias_half_diagonal(&vg_ok) > 0.0);
     BADV('N', isnan(hfvis_iv_bias_half_diagonal(NULL)));
-    b.cell[0] = NAN;
+    b.cell[0] = (double)NAN;
     BADV('F', isnan(hfvis_iv_bias_half_diagonal(&b)));
     b = vg_ok; b.dims[0] = 0;
     BADV('Z', isnan(hfvis_iv_bias_half_diagonal(&b)));
@@ -4145,7 +4145,7 @@ static void args_iv_bias(void)
     {   /* only the bias rule and bias are read */
         hfvis_iv_options bo = hfvis_iv_options_default();
         bo.bias_rule = (hfvis_iv_bias_rule)9; BAD('E', INV, hfvis_iv_bias(&vg_ok, &bo, o));
-        bo.bias_rule = HFVIS_IV_BIAS_EXPLICIT; bo.bias = NAN; BAD('F', INV, hfvis_iv_bias(&vg_ok, &bo, o));
+        bo.bias_rule = HFVIS_IV_BIAS_EXPLICIT; bo.bias = (double)NAN; BAD('F', INV, hfvis_iv_bias(&vg_ok, &bo, o));
         bo.bias = -1.0; BAD('S', INV, hfvis_iv_bias(&vg_ok, &bo, o));
     }
 }
@@ -4161,7 +4161,7 @@ static void args_iv_classify(void)
     BAD('N', INV, hfvis_iv_classify(&iv_img, NULL, 0.1, s));
     BAD('N', INV, hfvis_iv_classify(&iv_img, p, 0.1, NULL));
     BAD('F', INV, hfvis_iv_classify(&iv_img, v3_nan, 0.1, s));
-    BAD('F', INV, hfvis_iv_classify(&iv_img, p, NAN, s));
+    BAD('F', INV, hfvis_iv_classify(&iv_img, p, (double)NAN, s));
     BAD('G', INV, hfvis_iv_classify(&iv_img, p, -0.1, s));
     IMAGE_CASES(hfvis_iv_classify(&bi, p, 0.1, s));
 }
@@ -4208,7 +4208,7 @@ static hfvis_volume iv_prev(void)
     IVOPT_CASES(fn(&prev, &cur, &iv_img, 1, &bo, st)); \
     two_images[0] = iv_img; two_images[1] = iv_img; two_images[1].depth = NULL; \
     BAD('N', INV, fn(&prev, &cur, two_images, 2, NULL, st)); \
-    two_images[1] = iv_img; two_images[1].view.far_plane = NAN; \
+    two_images[1] = iv_img; two_images[1].view.far_plane = (double)NAN; \
     BAD('F', INV, fn(&prev, &cur, two_images, 2, NULL, st)); \
     } while (0)
 /* An image pair whose second image is invalid: nothing may be written for the first. */
@@ -4364,7 +4364,7 @@ static void args_voxel_distance_metrics_naive(void)
     bf = vf_ok; bf.maps = NULL; BAD('N', INV, expr); \
     bf = vf_ok; bf.radius = 0.0; BAD('Z', INV, expr); \
     bf = vf_ok; bf.radius = -1.0; BAD('G', INV, expr); \
-    bf = vf_ok; bf.center[1] = NAN; BAD('F', INV, expr); \
+    bf = vf_ok; bf.center[1] = (double)NAN; BAD('F', INV, expr); \
     bf = vf_ok; bf.format = (hfvis_visfield_format)9; BAD('E', INV, expr); \
     bf = vf_ok; bf.mapping = (hfvis_dirmap)-1; BAD('E', INV, expr); \
     bf = vf_ok; bf.positions_n = HFVIS_VISFIELD_MAX_N + 1; BAD('O', INV, expr); \
@@ -4523,7 +4523,7 @@ static hfvis_visfield arena_field(void)
     bf = *(vfp); bf.maps = NULL; BAD('N', INV, fn(&m_box, NULL, &bf)); \
     bf = *(vfp); bf.radius = 0.0; BAD('Z', INV, fn(&m_box, NULL, &bf)); \
     bf = *(vfp); bf.radius = 0.1; BAD('R', INV, fn(&m_box, NULL, &bf)); \
-    bf = *(vfp); bf.center[0] = INFINITY; BAD('F', INV, fn(&m_box, NULL, &bf)); \
+    bf = *(vfp); bf.center[0] = (double)INFINITY; BAD('F', INV, fn(&m_box, NULL, &bf)); \
     bf = *(vfp); bf.format = (hfvis_visfield_format)9; BAD('E', INV, fn(&m_box, NULL, &bf)); \
     bf = *(vfp); bf.dir_res = HFVIS_VISFIELD_MAX_DIR_RES + 1; BAD('O', INV, fn(&m_box, NULL, &bf)); \
     bf = *(vfp); bf.maps_size -= 1; BAD('R', SMALL, fn(&m_box, NULL, &bf)); \
@@ -4592,7 +4592,7 @@ static void args_visfield_query(void)
     BAD('N', INV, hfvis_visfield_query(&vf_ok, q_o, q_d, 0.01, NULL));
     BAD('Z', INV, hfvis_visfield_query(&vf_ok, q_o, v3_zero, 0.01, h));
     BAD('F', INV, hfvis_visfield_query(&vf_ok, v3_nan, q_d, 0.01, h));
-    BAD('F', INV, hfvis_visfield_query(&vf_ok, q_o, q_d, INFINITY, h));
+    BAD('F', INV, hfvis_visfield_query(&vf_ok, q_o, q_d, (double)INFINITY, h));
     BAD('G', INV, hfvis_visfield_query(&vf_ok, q_o, q_d, -0.01, h));
     VF_CASES(hfvis_visfield_query(&bf, q_o, q_d, 0.01, h));
 }
@@ -4611,7 +4611,7 @@ static void args_visfield_query_reference(void)
     BAD('N', INV, hfvis_visfield_query_reference(&vf_ok, &m_box, &m_bvh, NULL, q_d, 0.01, h));
     BAD('N', INV, hfvis_visfield_query_reference(&vf_ok, &m_box, &m_bvh, q_o, q_d, 0.01, NULL));
     BAD('Z', INV, hfvis_visfield_query_reference(&vf_ok, &m_box, &m_bvh, q_o, v3_zero, 0.01, h));
-    BAD('F', INV, hfvis_visfield_query_reference(&vf_ok, &m_box, &m_bvh, q_o, q_d, NAN, h));
+    BAD('F', INV, hfvis_visfield_query_reference(&vf_ok, &m_box, &m_bvh, q_o, q_d, (double)NAN, h));
     BAD('G', INV, hfvis_visfield_query_reference(&vf_ok, &m_box, &m_bvh, q_o, q_d, -1.0, h));
     BAD('R', INV, hfvis_visfield_query_reference(&vf_ok, &m_box, &bad_bvh, q_o, q_d, 0.01, h));
     nm.radius = -1.0;
@@ -4628,18 +4628,18 @@ static void args_visfield_ao_options_default(void)
 /* Invalid scene objects, substituted as &bo1 (one object). */
 #define VFOBJ_CASES(expr) do { hfvis_visfield_object bo1; hfvis_visfield bfl; \
     bo1 = vf_obj; bo1.field = NULL; BAD('N', INV, expr); \
-    bo1 = vf_obj; bo1.object_to_world[0] = NAN; BAD('F', INV, expr); \
+    bo1 = vf_obj; bo1.object_to_world[0] = (double)NAN; BAD('F', INV, expr); \
     bo1 = vf_obj; bo1.object_to_world[0] = 2.0; BAD('S', INV, expr); \
     bo1 = vf_obj; bo1.object_to_world[3] = 1.0; BAD('S', INV, expr); \
     bo1 = vf_obj; bfl = vf_ok; bfl.format = (hfvis_visfield_format)9; bo1.field = &bfl; BAD('E', INV, expr); \
     } while (0)
 
 static const float vp_pts[3] = {0.5f, 0.5f, 1.5f}, vp_nrm[3] = {0.0f, 0.0f, -1.0f}, vp_zero[3] = {0, 0, 0};
-static const float vp_nan[3] = {0.5f, NAN, 1.5f};
+static const float vp_nan[3] = {0.5f, (double)NAN, 1.5f};
 
 /* Second point / normal / object invalid: the first one's output must not be written. */
 static const float vp_pts2[6] = {0.5f, 0.5f, 1.5f, 0.5f, 0.5f, 1.6f};
-static const float vp_pts2_nan[6] = {0.5f, 0.5f, 1.5f, 0.5f, NAN, 1.6f};
+static const float vp_pts2_nan[6] = {0.5f, 0.5f, 1.5f, 0.5f, (double)NAN, 1.6f};
 static const float vp_nrm2[6] = {0, 0, -1, 0, 0, -1}, vp_nrm2_zero[6] = {0, 0, -1, 0, 0, 0};
 static hfvis_visfield_object objs2[2];
 
@@ -4655,7 +4655,7 @@ static hfvis_visfield_object objs2[2];
     VFOBJ_CASES(fn(&bo1, 1, vp_pts, vp_nrm, 1, NULL, out)); \
     bq = hfvis_visfield_ao_options_default(); bq.rays_sqrt = HFVIS_VISFIELD_MAX_RAYS_SQRT + 1; BAD('O', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, 1, &bq, out)); \
     bq = hfvis_visfield_ao_options_default(); bq.rays_sqrt = -1; BAD('G', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, 1, &bq, out)); \
-    bq = hfvis_visfield_ao_options_default(); bq.max_distance = NAN; BAD('F', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, 1, &bq, out)); \
+    bq = hfvis_visfield_ao_options_default(); bq.max_distance = (double)NAN; BAD('F', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, 1, &bq, out)); \
     bq = hfvis_visfield_ao_options_default(); bq.falloff = (hfvis_visfield_falloff)9; BAD('E', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, 1, &bq, out)); \
     bq = hfvis_visfield_ao_options_default(); bq.combine = (hfvis_visfield_combine)-1; BAD('E', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, 1, &bq, out)); \
     bq = hfvis_visfield_ao_options_default(); bq.falloff = HFVIS_VISFIELD_FALLOFF_LINEAR; BAD('S', INV, fn(&vf_obj, 1, vp_pts, vp_nrm, 1, &bq, out)); \
@@ -4705,12 +4705,12 @@ static const double light_c[3] = {0.5, 0.5, 4.0};
     BAD('F', INV, fn(&vf_obj, 1, vp_nan, 1, light_c, 0.5, NULL, out)); \
     BAD('O', INV, fn(&vf_obj, 1, vp_pts, SIZE_MAX / 2, light_c, 0.5, NULL, out)); \
     BAD('F', INV, fn(&vf_obj, 1, vp_pts, 1, v3_nan, 0.5, NULL, out)); \
-    BAD('F', INV, fn(&vf_obj, 1, vp_pts, 1, light_c, INFINITY, NULL, out)); \
+    BAD('F', INV, fn(&vf_obj, 1, vp_pts, 1, light_c, (double)INFINITY, NULL, out)); \
     BAD('G', INV, fn(&vf_obj, 1, vp_pts, 1, light_c, -0.5, NULL, out)); \
     VFOBJ_CASES(fn(&bo1, 1, vp_pts, 1, light_c, 0.5, NULL, out)); \
     memset(&bq, 0, sizeof bq); bq.samples = HFVIS_VISFIELD_MAX_SAMPLES + 1; BAD('O', INV, fn(&vf_obj, 1, vp_pts, 1, light_c, 0.5, &bq, out)); \
     memset(&bq, 0, sizeof bq); bq.samples = -1; BAD('G', INV, fn(&vf_obj, 1, vp_pts, 1, light_c, 0.5, &bq, out)); \
-    memset(&bq, 0, sizeof bq); bq.bias = NAN; BAD('S', INV, fn(&vf_obj, 1, vp_pts, 1, light_c, 0.5, &bq, out)); \
+    memset(&bq, 0, sizeof bq); bq.bias = (double)NAN; BAD('S', INV, fn(&vf_obj, 1, vp_pts, 1, light_c, 0.5, &bq, out)); \
     BAD('F', INV, fn(&vf_obj, 1, vp_pts2_nan, 2, light_c, 0.5, NULL, out2)); \
     objs2[0] = vf_obj; objs2[1] = vf_obj; objs2[1].field = NULL; \
     BAD('N', INV, fn(objs2, 2, vp_pts2, 2, light_c, 0.5, NULL, out2)); \
@@ -4748,10 +4748,10 @@ static void args_visfield_soft_shadow_reference(void)
     BAD('Z', INV, fn(&vf_obj, 1, q_o, v3_zero, 0.0, h)); \
     BAD('O', INV, fn(&vf_obj, SIZE_MAX / 2, q_o, q_d, 0.0, h)); \
     BAD('F', INV, fn(&vf_obj, 1, v3_inf, q_d, 0.0, h)); \
-    BAD('F', INV, fn(&vf_obj, 1, q_o, q_d, NAN, h)); \
+    BAD('F', INV, fn(&vf_obj, 1, q_o, q_d, (double)NAN, h)); \
     BAD('G', INV, fn(&vf_obj, 1, q_o, q_d, -0.1, h)); \
     VFOBJ_CASES(fn(&bo1, 1, q_o, q_d, 0.0, h)); \
-    objs2[0] = vf_obj; objs2[1] = vf_obj; objs2[1].object_to_world[12] = INFINITY; \
+    objs2[0] = vf_obj; objs2[1] = vf_obj; objs2[1].object_to_world[12] = (double)INFINITY; \
     BAD('F', INV, fn(objs2, 2, q_o, q_d, 0.0, h)); \
     } while (0)
 
@@ -4786,7 +4786,7 @@ static void args_visfield_trace_reference(void)
     memset(&bq, 0, sizeof bq); bq.rays = HFVIS_VISFIELD_MAX_SAMPLES + 1; BAD('O', INV, fn(&vf_obj, 1, rp, rn, ri, &bq, h)); \
     memset(&bq, 0, sizeof bq); bq.rays = -1; BAD('G', INV, fn(&vf_obj, 1, rp, rn, ri, &bq, h)); \
     memset(&bq, 0, sizeof bq); bq.shininess = -1.0; BAD('S', INV, fn(&vf_obj, 1, rp, rn, ri, &bq, h)); \
-    memset(&bq, 0, sizeof bq); bq.offset = NAN; BAD('S', INV, fn(&vf_obj, 1, rp, rn, ri, &bq, h)); \
+    memset(&bq, 0, sizeof bq); bq.offset = (double)NAN; BAD('S', INV, fn(&vf_obj, 1, rp, rn, ri, &bq, h)); \
     } while (0)
 
 static const double rp[3] = {0.5, 0.5, 3.0}, rn[3] = {0, 0, 1}, ri[3] = {0.3, 0, -1};
@@ -4935,7 +4935,7 @@ static void args_volgi_sh_cone(void)
     BAD('Z', INV, hfvis_volgi_sh_cone(v3_ok, 0.0, o));
     BAD('G', INV, hfvis_volgi_sh_cone(v3_ok, -0.7, o));
     BAD('R', INV, hfvis_volgi_sh_cone(v3_ok, 3.5, o));
-    BAD('F', INV, hfvis_volgi_sh_cone(v3_ok, NAN, o));
+    BAD('F', INV, hfvis_volgi_sh_cone(v3_ok, (double)NAN, o));
 }
 
 static void args_volgi_options_default(void)
@@ -4954,12 +4954,12 @@ static void args_volgi_options_default(void)
     memset(&bo, 0, sizeof bo); bo.iterations = HFVIS_VOLGI_MAX_ITERATIONS + 1; BAD('O', INV, expr); \
     memset(&bo, 0, sizeof bo); bo.resolution = 1; BAD('S', INV, expr); \
     memset(&bo, 0, sizeof bo); bo.reflectance_source = HFVIS_VOLGI_REFLECTANCE_CONSTANT; bo.reflectance = 2.0f; BAD('S', INV, expr); \
-    memset(&bo, 0, sizeof bo); bo.gather_scale = NAN; BAD('F', INV, expr); \
+    memset(&bo, 0, sizeof bo); bo.gather_scale = (double)NAN; BAD('F', INV, expr); \
     memset(&bo, 0, sizeof bo); bo.shadow_bias = -1.0; BAD('S', INV, expr); \
     memset(&bo, 0, sizeof bo); bo.reflectance_source = (hfvis_volgi_reflectance)9; BAD('E', INV, expr); \
     memset(&bo, 0, sizeof bo); bo.resolution = HFVIS_VOLGI_MAX_RESOLUTION + 1; BAD('O', INV, expr); \
-    memset(&bo, 0, sizeof bo); bo.reflectance_source = HFVIS_VOLGI_REFLECTANCE_CONSTANT; bo.reflectance = NAN; BAD('F', INV, expr); \
-    memset(&bo, 0, sizeof bo); bo.shadow_bias = INFINITY; BAD('F', INV, expr); \
+    memset(&bo, 0, sizeof bo); bo.reflectance_source = HFVIS_VOLGI_REFLECTANCE_CONSTANT; bo.reflectance = (double)NAN; BAD('F', INV, expr); \
+    memset(&bo, 0, sizeof bo); bo.shadow_bias = (double)INFINITY; BAD('F', INV, expr); \
     } while (0)
 
 static void args_volgi_options_resolve(void)
@@ -4977,7 +4977,7 @@ static float bad_occ[27], nan_nrm[81];
 /* Invalid geometries, substituted as &bg3. */
 #define GEO_CASES(expr) do { hfvis_volgi_geometry bg3; int i_; \
     for (i_ = 0; i_ < 27; i_++) bad_occ[i_] = 2.0f; \
-    for (i_ = 0; i_ < 81; i_++) nan_nrm[i_] = NAN; \
+    for (i_ = 0; i_ < 81; i_++) nan_nrm[i_] = (double)NAN; \
     bg3 = geo_ok; bg3.occupancy = NULL; BAD('N', INV, expr); \
     bg3 = geo_ok; bg3.normal = NULL; BAD('N', INV, expr); \
     bg3 = geo_ok; bg3.grid.dims[0] = 0; BAD('Z', INV, expr); \
@@ -4999,7 +4999,7 @@ static void args_volgi_inject(void)
     BAD('N', INV, hfvis_volgi_inject(&geo_ok, vg_rad, NULL));
     memcpy(rad_bad, vg_rad, sizeof rad_bad);
     rad_bad[0] = -1.0f; BAD('S', INV, hfvis_volgi_inject(&geo_ok, rad_bad, prop));
-    rad_bad[0] = INFINITY; BAD('S', INV, hfvis_volgi_inject(&geo_ok, rad_bad, prop));
+    rad_bad[0] = (double)INFINITY; BAD('S', INV, hfvis_volgi_inject(&geo_ok, rad_bad, prop));
     GEO_CASES(hfvis_volgi_inject(&bg3, vg_rad, prop));
 }
 
@@ -5010,7 +5010,7 @@ static float prop_bad[27 * 12];
     BAD('N', INV, fn(&geo_ok, NULL, NULL, pout, acc, en)); \
     BAD('N', INV, fn(&geo_ok, NULL, sh_prop, NULL, acc, en)); \
     BAD('N', INV, fn(&geo_ok, NULL, sh_prop, pout, NULL, en)); \
-    memcpy(prop_bad, sh_prop, sizeof prop_bad); prop_bad[5] = NAN; \
+    memcpy(prop_bad, sh_prop, sizeof prop_bad); prop_bad[5] = (double)NAN; \
     BAD('S', INV, fn(&geo_ok, NULL, prop_bad, pout, acc, en)); \
     prop_bad[5] = 1e30f; BAD('S', INV, fn(&geo_ok, NULL, prop_bad, pout, acc, en)); \
     GEO_CASES(fn(&bg3, NULL, sh_prop, pout, acc, en)); \
@@ -5059,7 +5059,7 @@ static void args_volgi_propagate(void)
     BAD('N', INV, hfvis_volgi_propagate(&geo_ok, NULL, 2, prop, NULL, en));
     BAD('G', INV, hfvis_volgi_propagate(&geo_ok, NULL, -1, prop, acc, en));
     BAD('O', INV, hfvis_volgi_propagate(&geo_ok, NULL, HFVIS_VOLGI_MAX_ITERATIONS + 1, prop, acc, en));
-    BADP('F', INV, prop[100] = NAN, hfvis_volgi_propagate(&geo_ok, NULL, 2, prop, acc, en));
+    BADP('F', INV, prop[100] = (double)NAN, hfvis_volgi_propagate(&geo_ok, NULL, 2, prop, acc, en));
     BADP('S', INV, acc[7] = 1e30f, hfvis_volgi_propagate(&geo_ok, NULL, 2, prop, acc, en));
     GEO_CASES(hfvis_volgi_propagate(&bg3, NULL, 2, prop, acc, en));
     VOLGI_OPT_CASES(hfvis_volgi_propagate(&geo_ok, &bo, 2, prop, acc, en));
@@ -5083,7 +5083,7 @@ static void args_volgi_gather(void)
     {   /* the geometry's arrays are not re-checked (O(1) call): only the grid and pointers */
         hfvis_volgi_geometry bg3 = geo_ok;
         bg3.grid.dims[0] = 0; BAD('Z', INV, hfvis_volgi_gather(&bg3, sh_accum, NULL, gp, gn, irr));
-        bg3 = geo_ok; bg3.grid.cell[0] = NAN; BAD('F', INV, hfvis_volgi_gather(&bg3, sh_accum, NULL, gp, gn, irr));
+        bg3 = geo_ok; bg3.grid.cell[0] = (double)NAN; BAD('F', INV, hfvis_volgi_gather(&bg3, sh_accum, NULL, gp, gn, irr));
         bg3 = geo_ok; bg3.occupancy = NULL; BAD('N', INV, hfvis_volgi_gather(&bg3, sh_accum, NULL, gp, gn, irr));
     }
     VOLGI_OPT_CASES(hfvis_volgi_gather(&geo_ok, sh_accum, &bo, gp, gn, irr));
@@ -5120,14 +5120,14 @@ static float bmat[36];
     bs = scene_ok(); bs.light_count = -1; BAD('G', INV, expr); \
     bs = scene_ok(); bs.light_count = HFVIS_VOLGI_MAX_LIGHTS + 1; BAD('O', INV, expr); \
     bs = scene_ok(); blight = light_ok(); blight.type = (hfvis_volgi_light_type)9; bs.lights = &blight; BAD('E', INV, expr); \
-    bs = scene_ok(); blight = light_ok(); blight.position[0] = NAN; bs.lights = &blight; BAD('F', INV, expr); \
+    bs = scene_ok(); blight = light_ok(); blight.position[0] = (double)NAN; bs.lights = &blight; BAD('F', INV, expr); \
     bs = scene_ok(); blight = light_ok(); blight.intensity[1] = -1.0f; bs.lights = &blight; BAD('S', INV, expr); \
     (void)i_; \
     } while (0)
 /* Invalid materials (voxelize and render read them; direct irradiance does not). */
 #define MATERIAL_CASES(expr) do { hfvis_volgi_scene bs; int i_; \
     bs = scene_ok(); for (i_ = 0; i_ < 36; i_++) bmat[i_] = 2.0f; bs.albedo = bmat; BAD('S', INV, expr); \
-    bs = scene_ok(); for (i_ = 0; i_ < 36; i_++) bmat[i_] = NAN; bs.emission = bmat; BAD('F', INV, expr); \
+    bs = scene_ok(); for (i_ = 0; i_ < 36; i_++) bmat[i_] = (double)NAN; bs.emission = bmat; BAD('F', INV, expr); \
     } while (0)
 
 static void args_volgi_direct_irradiance(void)
@@ -5236,7 +5236,7 @@ static void args_lk_rays_build(void)
     BAD('O', INV, hfvis_lk_rays_build(HFVIS_LK_MAX_RAYS + 1, 1.0, &o, r));
     BAD('Z', INV, hfvis_lk_rays_build(8, 0.0, &o, r));
     BAD('G', INV, hfvis_lk_rays_build(8, -1.0, &o, r));
-    BAD('F', INV, hfvis_lk_rays_build(8, INFINITY, &o, r));
+    BAD('F', INV, hfvis_lk_rays_build(8, (double)INFINITY, &o, r));
     b = o; b.pattern = (hfvis_lk_pattern)9; BAD('E', INV, hfvis_lk_rays_build(8, 1.0, &b, r));
     b = o; b.falloff = (hfvis_lk_falloff)-1; BAD('E', INV, hfvis_lk_rays_build(8, 1.0, &b, r));
     b = o; b.lloyd_iterations = -1; BAD('S', INV, hfvis_lk_rays_build(8, 1.0, &b, r));
@@ -5250,7 +5250,7 @@ static const double lk_dirs[6] = {0, 0, 1, 0.5, 0, 1}, lk_len[2] = {1.0, 0.5};
 
 static void args_lk_rays_custom(void)
 {
-    static const double dzero[6] = {0, 0, 0, 0, 0, 1}, ddown[6] = {0, 0, -1, 0, 0, 1}, dnan[6] = {0, NAN, 1, 0, 0, 1};
+    static const double dzero[6] = {0, 0, 0, 0, 0, 1}, ddown[6] = {0, 0, -1, 0, 0, 1}, dnan[6] = {0, (double)NAN, 1, 0, 0, 1};
     static const double lbad[2] = {1.0, 1.5};
     hfvis_lk_rays *r;
     begin("lk_rays_custom");
@@ -5263,7 +5263,7 @@ static void args_lk_rays_custom(void)
     BAD('Z', INV, hfvis_lk_rays_custom(0, 1.0, lk_dirs, lk_len, NULL, r));
     BAD('O', INV, hfvis_lk_rays_custom(HFVIS_LK_MAX_RAYS + 1, 1.0, lk_dirs, lk_len, NULL, r));
     BAD('G', INV, hfvis_lk_rays_custom(2, -1.0, lk_dirs, lk_len, NULL, r));
-    BAD('F', INV, hfvis_lk_rays_custom(2, NAN, lk_dirs, lk_len, NULL, r));
+    BAD('F', INV, hfvis_lk_rays_custom(2, (double)NAN, lk_dirs, lk_len, NULL, r));
     BAD('Z', INV, hfvis_lk_rays_custom(2, 1.0, dzero, lk_len, NULL, r));
     BAD('R', INV, hfvis_lk_rays_custom(2, 1.0, ddown, lk_len, NULL, r));
     BAD('F', INV, hfvis_lk_rays_custom(2, 1.0, dnan, lk_len, NULL, r));
@@ -5304,7 +5304,7 @@ static void args_lk_obscurance(void)
     bry = lk_rays; bry.direction = NULL; BAD('N', INV, expr); \
     bry = lk_rays; bry.count = 0; BAD('Z', INV, expr); \
     bry = lk_rays; bry.words = 7; BAD('S', INV, expr); \
-    bry = lk_rays; bry.radius = NAN; BAD('F', INV, expr); \
+    bry = lk_rays; bry.radius = (double)NAN; BAD('F', INV, expr); \
     } while (0)
 
 static void args_lk_frame(void)
@@ -5322,7 +5322,7 @@ static void args_lk_frame(void)
     BAD('E', INV, hfvis_lk_frame(&lk_rays, v3_ok, 1, 2, (hfvis_lk_jitter)9, 0.0, 0.0, f));
     BAD('R', INV, hfvis_lk_frame(&lk_rays, v3_ok, 1, 2, HFVIS_LK_JITTER_CUSTOM, 4.0, 0.0, f));
     BAD('G', INV, hfvis_lk_frame(&lk_rays, v3_ok, 1, 2, HFVIS_LK_JITTER_CUSTOM, 1.0, -0.1, f));
-    BAD('F', INV, hfvis_lk_frame(&lk_rays, v3_ok, 1, 2, HFVIS_LK_JITTER_CUSTOM, NAN, 0.0, f));
+    BAD('F', INV, hfvis_lk_frame(&lk_rays, v3_ok, 1, 2, HFVIS_LK_JITTER_CUSTOM, (double)NAN, 0.0, f));
     RAYSET_CASES(hfvis_lk_frame(&bry, v3_ok, 1, 2, HFVIS_LK_JITTER_DEFAULT, 0.0, 0.0, f));
 }
 
@@ -5374,7 +5374,7 @@ static void args_lk_lut_index(void)
     BAD('O', INV, hfvis_lk_lut_index(HFVIS_LK_LUT_MAX_RESOLUTION + 1, v3_ok, 0.5, ijk));
     BAD('Z', INV, hfvis_lk_lut_index(4, v3_zero, 0.5, ijk));
     BAD('F', INV, hfvis_lk_lut_index(4, v3_nan, 0.5, ijk));
-    BAD('F', INV, hfvis_lk_lut_index(4, v3_ok, NAN, ijk));
+    BAD('F', INV, hfvis_lk_lut_index(4, v3_ok, (double)NAN, ijk));
 }
 
 static void args_lk_lut_fetch(void)
@@ -5384,7 +5384,7 @@ static void args_lk_lut_fetch(void)
     BADV('N', hfvis_lk_lut_fetch(NULL, 0, v3_ok, 0.5) == NULL);
     BADV('N', hfvis_lk_lut_fetch(&lut_ok, 0, NULL, 0.5) == NULL);
     BADV('Z', hfvis_lk_lut_fetch(&lut_ok, 0, v3_zero, 0.5) == NULL);
-    BADV('F', hfvis_lk_lut_fetch(&lut_ok, 0, v3_ok, INFINITY) == NULL);
+    BADV('F', hfvis_lk_lut_fetch(&lut_ok, 0, v3_ok, (double)INFINITY) == NULL);
 }
 
 static void args_lk_plane_mask(void)
@@ -5397,7 +5397,7 @@ static void args_lk_plane_mask(void)
     BAD('N', INV, hfvis_lk_plane_mask(&lk_rays, NULL, 0.5, m));
     BAD('N', INV, hfvis_lk_plane_mask(&lk_rays, v3_ok, 0.5, NULL));
     BAD('F', INV, hfvis_lk_plane_mask(&lk_rays, v3_nan, 0.5, m));
-    BAD('F', INV, hfvis_lk_plane_mask(&lk_rays, v3_ok, NAN, m));
+    BAD('F', INV, hfvis_lk_plane_mask(&lk_rays, v3_ok, (double)NAN, m));
     RAYSET_CASES(hfvis_lk_plane_mask(&bry, v3_ok, 0.5, m));
 }
 
@@ -5407,7 +5407,7 @@ static const float lv0[3] = {-1, -1, 0.2f}, lv1[3] = {1, -1, 0.2f}, lv2[3] = {0,
 
 static void args_lk_triangle_mask(void)
 {
-    static const double fnan[9] = {1, 0, 0, 0, NAN, 0, 0, 0, 1};
+    static const double fnan[9] = {1, 0, 0, 0, (double)NAN, 0, 0, 0, 1};
     hfvis_lk_lut other = lut_ok;
     uint32_t *m;
     hfvis_lk_verdict *v;
@@ -5444,7 +5444,7 @@ static void args_lk_options_default(void)
     bk = hfvis_lk_options_default(); bk.sides = (hfvis_lk_sides)-1; BAD('E', INV, expr); \
     bk = hfvis_lk_options_default(); bk.cull = 0x40u; BAD('S', INV, expr); \
     bk = hfvis_lk_options_default(); bk.epsilon = -1.0; BAD('G', INV, expr); \
-    bk = hfvis_lk_options_default(); bk.alpha = NAN; BAD('F', INV, expr); \
+    bk = hfvis_lk_options_default(); bk.alpha = (double)NAN; BAD('F', INV, expr); \
     bk = hfvis_lk_options_default(); bk.mask_mode = HFVIS_LK_MASK_LUT; BAD('N', INV, expr); \
     bk = hfvis_lk_options_default(); bk.sides = HFVIS_LK_SIDES_PER_TRIANGLE; BAD('N', INV, expr); \
     bk = hfvis_lk_options_default(); bk.jitter = HFVIS_LK_JITTER_CUSTOM; bk.tilt_max_rad = 2.0; BAD('R', INV, expr); \
@@ -5454,7 +5454,7 @@ static void args_lk_options_default(void)
     bk = hfvis_lk_options_default(); bk.raycast_test = (hfvis_lk_raycast_test)9; BAD('E', INV, expr); \
     bk = hfvis_lk_options_default(); bk.gbuffer_cull = (hfvis_cull_mode)9; BAD('E', INV, expr); \
     bk = hfvis_lk_options_default(); bk.node_mask = HFVIS_LK_NODE_SPHERE_LUT; BAD('N', INV, expr); \
-    bk = hfvis_lk_options_default(); bk.epsilon = INFINITY; BAD('F', INV, expr); \
+    bk = hfvis_lk_options_default(); bk.epsilon = (double)INFINITY; BAD('F', INV, expr); \
     } while (0)
 
 static void args_lk_options_resolve(void)
@@ -5465,7 +5465,7 @@ static void args_lk_options_resolve(void)
     OK(hfvis_lk_options_resolve(NULL, 0.5, o));
     BAD('N', INV, hfvis_lk_options_resolve(NULL, 0.5, NULL));
     BAD('Z', INV, hfvis_lk_options_resolve(NULL, 0.0, o));
-    BAD('F', INV, hfvis_lk_options_resolve(NULL, INFINITY, o));
+    BAD('F', INV, hfvis_lk_options_resolve(NULL, (double)INFINITY, o));
     LKOPT_CASES(hfvis_lk_options_resolve(&bk, 0.5, o));
 }
 
@@ -5509,8 +5509,8 @@ static void args_lk_raster(void)
 }
 
 static const double rc_pos[6] = {0.5, 0.5, 1.0, 0.5, 0.5, -1.0}, rc_nrm[6] = {0, 0, 1, 0, 0, -1};
-static const double rc_nan[6] = {0.5, 0.5, NAN, 0.5, 0.5, -1.0}, rc_zero[6] = {0, 0, 0, 0, 0, -1};
-static const double rc_nan2[6] = {0.5, 0.5, 1.0, 0.5, NAN, -1.0}, rc_zero2[6] = {0, 0, 1, 0, 0, 0};
+static const double rc_nan[6] = {0.5, 0.5, (double)NAN, 0.5, 0.5, -1.0}, rc_zero[6] = {0, 0, 0, 0, 0, -1};
+static const double rc_nan2[6] = {0.5, 0.5, 1.0, 0.5, (double)NAN, -1.0}, rc_zero2[6] = {0, 0, 1, 0, 0, 0};
 
 static hfvis_lk_receivers recv_ok(void)
 {
