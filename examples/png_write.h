@@ -1,9 +1,10 @@
 /* png_write.h - the smallest PNG writer the examples need (PNG spec, ISO/IEC 15948:2003; zlib
- * RFC 1950; deflate RFC 1951): 8- or 16-bit greyscale and 8-bit RGB, no interlace, every row filter type 0,
- * one IDAT chunk holding a zlib stream of STORED (uncompressed) deflate blocks. The files are as
- * large as the pixels (plus 11 bytes per 65535), which is the price of no compressor.
- * Header-only, every function static inline; it prints nothing (common.h reports failures) and
- * keeps no state. The library itself stays PFM/PGM: this file belongs to the examples. */
+ * RFC 1950; deflate RFC 1951): 8- or 16-bit greyscale and 8-bit RGB, no interlace, every row
+ * filter type 0, one IDAT chunk holding a zlib stream of STORED (uncompressed) deflate blocks.
+ * The files are as large as the pixels (plus 11 bytes per 65535), which is the price of no
+ * compressor. Header-only, every function static inline; it prints nothing (common.h reports
+ * failures) and keeps no state. The library itself stays PFM/PGM: this file belongs to the
+ * examples. */
 #ifndef HFVIS_EXAMPLES_PNG_H
 #define HFVIS_EXAMPLES_PNG_H
 

@@ -1,7 +1,8 @@
 /* test_png.c - the examples' PNG writer (examples/png_write.h and its common.h wrappers): the
- * CRC-32 and Adler-32 check values, the chunk and zlib layout byte by byte, stored-block splitting at 65535,
- * a bit-exact round trip through a stored-block decoder written here, the float mapping, and the
- * failure paths (bad sizes, overflow, short buffers, unwritable paths leave nothing behind). */
+ * CRC-32 and Adler-32 check values, the chunk and zlib layout byte by byte, stored-block
+ * splitting at 65535, a bit-exact round trip through a stored-block decoder written here, the
+ * float mapping, and the failure paths (bad sizes, overflow, short buffers, unwritable paths
+ * leave nothing behind). */
 #define _POSIX_C_SOURCE 200809L /* mkdtemp, opendir, mkdir, rmdir */
 #include "examples/common.h"
 #include "test.h"
