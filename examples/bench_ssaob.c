@@ -77,21 +77,22 @@ void bench_ssaob(int quick)
            s.W0 - Wt, s.H0 - Ht);
     for (K = 8; K <= 18; K += K == 8 ? 8 : 2) {
         hfvis_ffao_options o = hfvis_ffao_options_default();
-        double t0;
+        double t0, t;
         o.falloff.kind = HFVIS_FALLOFF_INV_QUADRATIC;
         o.falloff.param = 1.0;
         o.directions = K;
         o.sparse = o.blur = K == 18;
         t0 = bench_now();
         if (hfvis_ffao(&s.cam, s.depth, NULL, &o, s.a, Wt) != HFVIS_OK) printf("  FFAO failed\n");
+        t = bench_now() - t0;
         printf("    FFAO %2dx2%-20s %9.1f ns/px  %8.1f ms\n", K, K == 18 ? " sparse 3x3 + blur" : "",
-               1e9 * (bench_now() - t0) / ((double)Wt * Ht), 1e3 * (bench_now() - t0));
+               1e9 * t / ((double)Wt * Ht), 1e3 * t);
         if (K == 16) {
             o.sparse = o.blur = 0;
             t0 = bench_now();
             if (hfvis_ssao_mipmap(&s.cam, s.depth, NULL, &o, s.a, Wt) != HFVIS_OK) printf("  mipmap failed\n");
-            printf("    mipmap K=16%-19s %9.1f ns/px  %8.1f ms\n", "", 1e9 * (bench_now() - t0) / ((double)Wt * Ht),
-                   1e3 * (bench_now() - t0));
+            t = bench_now() - t0;
+            printf("    mipmap K=16%-19s %9.1f ns/px  %8.1f ms\n", "", 1e9 * t / ((double)Wt * Ht), 1e3 * t);
         }
     }
     ffb_free(&s);
