@@ -4300,28 +4300,23 @@ static int vx_cons_layer_ok(const vx_cons_tri *T, double t[3][3], int k)
         && !vx_cons_sep_proj(T, W, D, U, t);
 }
 
-/* ceil(x) clamped to [lo, hi + 1] (hi + 1 = "empty"), floor(x) clamped to [lo - 1, hi] for a
- * range lo..hi given as l = lo - 1, h = hi + 1 (doubles, set up once per range); x may be any
- * double but NaN (lo >= 0).
- * Branch-free: clamp in double, truncate, correct. */
-static VX_CONS_INLINE int vx_cons_ceil_in(double x, int lo, double l, double h)
-{
-    int i;
-    x = x > l ? x : l;
-    x = x < h ? x : h;
-    i = (int)x; /* x >= -1: truncation, then up when x had a fraction */
-    i += (double)i < x;
-    return i < lo ? lo : i;
-}
+/* The fast path's per-vertex data, computed once per vertex (about six triangles share one):
+ * the grid-space coordinates, their magnitude |g0| + |g1| + |g2| (for the margin) and, per axis,
+ * the voxel range of the vertex' closed extent, ceil(g) - 1 and floor(g), clamped to [-1, n]
+ * (so a triangle's bounding-box range is the min and max of its vertices', clipped). */
+typedef struct vx_cons_vert {
+    double g[3];
+    double mag;
+    int lo[3], hi[3];
+} vx_cons_vert;
 
-static VX_CONS_INLINE int vx_cons_floor_in(double x, int hi, double l, double h)
+/* x clamped to [0, top] (a NaN becomes top), then truncated: floor(x) for x >= 0. Local indices
+ * are int64_t so lo + 1 cannot overflow for a range of INT_MAX voxels. */
+static VX_CONS_INLINE int64_t vx_cons_floor_local(double x, double top)
 {
-    int i;
-    x = x > l ? x : l;
-    x = x < h ? x : h;
-    i = (int)x;
-    i -= (double)i > x; /* truncation of x in (-1, 0) gives 0 */
-    return i > hi ? hi : i;
+    x = x < top ? x : top;
+    x = x > 0.0 ? x : 0.0;
+    return (int64_t)x;
 }
 
 /* The fast path's scratch occupancy: bits in 4x4x4 bricks, one uint64 per brick (brick
@@ -4349,33 +4344,6 @@ static int vx_cons_inside_voxel(const vx_cons_tri *T, const int p[3])
     for (k = 0; k < 3; k++)
         for (a = 0; a < 3; a++)
             if (!(T->v[k][a] >= (double)p[a] && T->v[k][a] <= (double)p[a] + 1.0)) return 0;
-    return 1;
-}
-
-/* vx_cons_bbox, exactly, without libm calls: on each axis lo = max(0, ceil(min) - 1),
- * hi = min(n - 1, floor(max)); the coordinates are clamped first (which keeps the result) so
- * the int conversions are exact. */
-static VX_CONS_INLINE int vx_cons_bbox_fast(const vx_cons_tri *T, const hfvis_volume_grid *grid,
-                                            int lo[3], int hi[3])
-{
-    int a;
-    for (a = 0; a < 3; a++) {
-        double mn = vx_cons_min3(T->v[0][a], T->v[1][a], T->v[2][a]);
-        double mx = vx_cons_max3(T->v[0][a], T->v[1][a], T->v[2][a]);
-        double top = (double)grid->dims[a] + 1.0;
-        int i;
-        mn = mn > -1.0 ? mn : -1.0;
-        mn = mn < top ? mn : top;
-        mx = mx > -1.0 ? mx : -1.0;
-        mx = mx < top ? mx : top;
-        i = (int)mn; /* truncation; ceil */
-        i += (double)i < mn;
-        lo[a] = i - 1 > 0 ? i - 1 : 0;
-        i = (int)mx; /* floor (mx >= -1) */
-        i -= (double)i > mx;
-        hi[a] = i < grid->dims[a] - 1 ? i : grid->dims[a] - 1;
-        if (lo[a] > hi[a]) return 0;
-    }
     return 1;
 }
 
@@ -4483,31 +4451,31 @@ static const uint64_t vx_cons_layer_masks[3][4][4] = {
  *    |t| <= h, and then no axis of the SAT can separate (|fl(L.t)| <= fl(h |L|) term by term,
  *    since rounding is monotone and the radii are summed in the same order): the voxel is set.
  * Returns the number of columns decided with the SAT's expressions (a statistic). */
-static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
+static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3], double scale,
                                vx_cons_bricks *B)
 {
     const int D = T->D, U = T->U, W = T->W;
-    const int z0 = lo[D], z1 = hi[D];
     const int X = hi[U] - lo[U] < hi[W] - lo[W] ? W : U, Y = X == U ? W : U;
-    const int x0 = lo[X], x1 = hi[X], y0 = lo[Y], y1 = hi[Y];
     const unsigned sh = 2u * (unsigned)D, shX = 2u * (unsigned)X, shY = 2u * (unsigned)Y;
     const size_t sD = B->bs[D], sX = B->bs[X], sY = B->bs[Y];
     const uint64_t(*lmask)[4] = vx_cons_layer_masks[D];
-    double P[3][3], f[3][3], invy[3], invx[3], nx, ny, nz, inz, ax, ay, K0, hwid, eps, scale;
-    double plo, phi;
-    const double xl = (double)x0 - 1.0, xh = (double)x1 + 1.0, zl = (double)z0 - 1.0,
-                 zh = (double)z1 + 1.0;
+    /* the local frame: index i - o with o = lo - 1 per axis, so the range is 1..n */
+    const int ox = lo[X] - 1, oy = lo[Y] - 1, oz = lo[D] - 1;
+    const int64_t ny = (int64_t)hi[Y] - oy;
+    const double topx = (double)((int64_t)hi[X] - ox) + 0.5, topz = (double)((int64_t)hi[D] - oz) + 0.5;
+    double P[3][3], f[3][3], invy[3], invx[3], nx, ny_, nz, inz, ax, ay, K0, hwid, eps, plo, phi;
     double t[3][3];
     vx_cons_bound bz[3], bx[3], by[3];
     size_t slow = 0;
-    int ix, iy, k, j, have_sat = 0, have_xy = 0;
-    if (x0 == x1 && y0 == y1 && z0 == z1 && vx_cons_inside_voxel(T, lo)) {
+    int64_t ix, iy, k;
+    int j, have_sat = 0, have_xy = 0;
+    if (lo[0] == hi[0] && lo[1] == hi[1] && lo[2] == hi[2] && vx_cons_inside_voxel(T, lo)) {
         unsigned bit;
         size_t wi = vx_cons_brick_of(B, lo, &bit); /* sequenced before bit is read */
         B->w[wi] |= (uint64_t)1 << bit;
         return 0;
     }
-    if ((x1 - x0 + 1) * (y1 - y0 + 1) * (z1 - z0 + 1) <= VX_CONS_SMALL_BOX) {
+    if ((hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1) <= VX_CONS_SMALL_BOX) {
         /* a small box: the SAT itself on the voxels not yet set (the result is a union) */
         int q[3];
         for (q[2] = lo[2]; q[2] <= hi[2]; q[2]++)
@@ -4527,9 +4495,9 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
         return 0;
     }
     for (k = 0; k < 3; k++) {
-        P[k][0] = T->v[k][X];
-        P[k][1] = T->v[k][Y];
-        P[k][2] = T->v[k][D];
+        P[k][0] = T->v[k][X] - (double)ox;
+        P[k][1] = T->v[k][Y] - (double)oy;
+        P[k][2] = T->v[k][D] - (double)oz;
     }
     for (j = 0; j < 3; j++) {
         const int e = j == 2 ? 0 : j + 1;
@@ -4539,17 +4507,15 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
         invy[j] = f[j][1] != 0.0 ? 1.0 / f[j][1] : 0.0; /* projections z and x */
     }
     nx = T->n[X];
-    ny = T->n[Y];
+    ny_ = T->n[Y];
     nz = T->n[D];
-    /* the plane slab per column: kc(x, y) = K0 - ax x - ay y (layer of the centre), |ax|, |ay|
-     * <= 1, half width rn/|n_z| <= 1.5 */
+    /* the plane slab per column: kc(x, y) = K0 - ax x - ay y + 0.5 (the plane's height at the
+     * column's centre), |ax|, |ay| <= 1, half width rn/|n_z| <= 1.5 */
     inz = 1.0 / nz;
     ax = nx * inz;
-    ay = ny * inz;
-    K0 = P[0][2] - 0.5 + (nx * (P[0][0] - 0.5) + ny * (P[0][1] - 0.5)) * inz;
-    hwid = 0.5 * (fabs(nx) + fabs(ny) + fabs(nz)) * fabs(inz);
-    scale = 4.0 + (double)(x1 + y1 + z1);
-    for (k = 0; k < 3; k++) scale += fabs(P[k][0]) + fabs(P[k][1]) + fabs(P[k][2]);
+    ay = ny_ * inz;
+    K0 = P[0][2] - 0.5 + (nx * (P[0][0] - 0.5) + ny_ * (P[0][1] - 0.5)) * inz;
+    hwid = 0.5 * (fabs(nx) + fabs(ny_) + fabs(nz)) * fabs(inz);
     eps = scale * 9.313225746154785e-10; /* 2^-30 */
     plo = hwid + eps + 0.5; /* the plane's candidate layers: ceil(kc - plo) .. floor(kc + phi) */
     phi = hwid + eps - 0.5;
@@ -4561,44 +4527,50 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
         vx_cons_bound_init(&bz[j], -f[j][1], f[j][0], -invy[j], P[j][0], P[j][1], P[o][0],
                            P[o][1], eps);
     }
-    for (iy = y0; iy <= y1; iy++) {
+    for (iy = 1; iy <= ny; iy++) {
         const double cy = (double)iy + 0.5, krow = K0 - ay * (double)iy + 0.5;
-        const size_t rowbase = (size_t)(iy >> 2) * sY;
-        const unsigned rowbit = (unsigned)(iy & 3) << shY;
+        const int gy = (int)(iy + oy);
+        const size_t rowbase = (size_t)(gy >> 2) * sY;
+        const unsigned rowbit = (unsigned)(gy & 3) << shY;
         double rc[4], rk[4];
-        int ca0, ca1, cc0, cc1, have_rk = 0;
-        /* the row's columns (projection z), on centres */
+        int64_t ca0, ca1, cc0, cc1;
+        int have_rk = 0;
+        /* the row's columns (projection z), on centres: candidates ca0..ca1, certain cc0..cc1
+         * (ceil as floor + 1: it differs only on an integer, a centre exactly a margin away) */
         rc[0] = rc[2] = -HUGE_VAL;
         rc[1] = rc[3] = HUGE_VAL;
         for (j = 0; j < 3; j++) vx_cons_bound_apply(&bz[j], cy, rc);
-        ca0 = vx_cons_ceil_in(rc[0] - 0.5, x0, xl, xh);
-        ca1 = vx_cons_floor_in(rc[1] - 0.5, x1, xl, xh);
+        ca0 = vx_cons_floor_local(rc[0] - 0.5, topx) + 1;
+        ca1 = vx_cons_floor_local(rc[1] - 0.5, topx);
         if (ca0 > ca1) continue;
-        /* the certain range is the candidate one unless a bound is within its margin of a
-         * centre: ceil(rc[2] - .5) == ca0 iff ca0 >= rc[2] - .5 (rc[2] >= rc[0]) */
-        cc0 = (double)ca0 >= rc[2] - 0.5 ? ca0 : vx_cons_ceil_in(rc[2] - 0.5, x0, xl, xh);
-        cc1 = (double)ca1 <= rc[3] - 0.5 ? ca1 : vx_cons_floor_in(rc[3] - 0.5, x1, xl, xh);
+        cc0 = vx_cons_floor_local(rc[2] - 0.5, topx) + 1;
+        cc1 = vx_cons_floor_local(rc[3] - 0.5, topx);
         for (ix = ca0; ix <= ca1; ix++) {
             const double kc = krow - ax * (double)ix;
-            const size_t base = rowbase + (size_t)(ix >> 2) * sX;
-            const unsigned bit0 = rowbit | (unsigned)(ix & 3) << shX;
+            const int gx = (int)(ix + ox);
+            const size_t base = rowbase + (size_t)(gx >> 2) * sX;
+            const unsigned bit0 = rowbit | (unsigned)(gx & 3) << shX;
             double r[4];
-            int ka = vx_cons_ceil_in(kc - plo, z0, zl, zh), kb, kA, kB;
+            int64_t ka = vx_cons_floor_local(kc - plo, topz) + 1, kb, kA, kB;
+            int ga, gb;
 #define VX_CONS_WORD(kk) B->w[base + (size_t)((kk) >> 2) * sD]
 #define VX_CONS_MASK(kk) ((uint64_t)1 << (bit0 | ((unsigned)((kk) & 3) << sh)))
             /* the plane's candidate layers; done if they are all set already */
-            kb = vx_cons_floor_in(kc + phi, z1, zl, zh);
+            kb = vx_cons_floor_local(kc + phi, topz);
             if (ka > kb) continue;
-            if (kb - ka <= 4) {
+            ga = (int)(ka + oz);
+            gb = (int)(kb + oz);
+            if (gb - ga <= 4) {
                 /* at most two bricks: masks of the layers in each (vx_cons_layer_masks) */
-                int kc3 = ka | 3, last = kb < kc3 ? kb : kc3;
-                uint64_t m1 = lmask[ka & 3][last & 3] << bit0;
-                uint64_t m2 = (lmask[0][kb & 3] & ((uint64_t)0 - (uint64_t)(kb > kc3))) << bit0;
-                /* m2 = 0 when kb is in ka's brick; masks without branches (the data decide) */
-                if ((VX_CONS_WORD(ka) & m1) == m1 && (VX_CONS_WORD(kb) & m2) == m2) continue;
+                int g3 = ga | 3, last = gb < g3 ? gb : g3;
+                uint64_t m1 = lmask[ga & 3][last & 3] << bit0;
+                uint64_t m2 = (lmask[0][gb & 3] & ((uint64_t)0 - (uint64_t)(gb > g3))) << bit0;
+                /* m2 = 0 when gb is in ga's brick; masks without branches (the data decide) */
+                if ((VX_CONS_WORD(ga) & m1) == m1 && (VX_CONS_WORD(gb) & m2) == m2) continue;
             } else {
-                for (k = ka; k <= kb && (VX_CONS_WORD(k) & VX_CONS_MASK(k)); k++) {}
-                if (k > kb) continue;
+                int g;
+                for (g = ga; g <= gb && (VX_CONS_WORD(g) & VX_CONS_MASK(g)); g++) {}
+                if (g > gb) continue;
             }
             /* layer bounds on the centre: plane, projection x (row), projection y (column) */
             if (!have_xy) {
@@ -4627,13 +4599,13 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
             r[1] = r[1] < rk[1] ? r[1] : rk[1];
             r[2] = r[2] > rk[2] ? r[2] : rk[2];
             r[3] = r[3] < rk[3] ? r[3] : rk[3];
-            ka = vx_cons_ceil_in(r[0] - 0.5, z0, zl, zh);
-            kb = vx_cons_floor_in(r[1] - 0.5, z1, zl, zh);
+            ka = vx_cons_floor_local(r[0] - 0.5, topz) + 1;
+            kb = vx_cons_floor_local(r[1] - 0.5, topz);
             if (ka > kb) continue;
-            kA = (double)ka >= r[2] - 0.5 ? ka : vx_cons_ceil_in(r[2] - 0.5, z0, zl, zh);
-            kB = (double)kb <= r[3] - 0.5 ? kb : vx_cons_floor_in(r[3] - 0.5, z1, zl, zh);
+            kA = vx_cons_floor_local(r[2] - 0.5, topz) + 1;
+            kB = vx_cons_floor_local(r[3] - 0.5, topz);
             if (ka == kA && kb == kB && ix >= cc0 && ix <= cc1) {
-                for (k = ka; k <= kb; k++) VX_CONS_WORD(k) |= VX_CONS_MASK(k); /* certain */
+                for (k = ka + oz; k <= kb + oz; k++) VX_CONS_WORD(k) |= VX_CONS_MASK(k); /* certain */
                 continue;
             }
             /* within a margin of an end: the SAT's own expressions decide */
@@ -4643,17 +4615,19 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
                 have_sat = 1;
             }
             {
-                double cx = (double)ix + 0.5;
-                t[0][X] = T->v[0][X] - cx;
-                t[1][X] = T->v[1][X] - cx;
-                t[2][X] = T->v[2][X] - cx;
-                t[0][Y] = T->v[0][Y] - cy;
-                t[1][Y] = T->v[1][Y] - cy;
-                t[2][Y] = T->v[2][Y] - cy;
+                const double gcx = (double)gx + 0.5, gcy = (double)gy + 0.5;
+                t[0][X] = T->v[0][X] - gcx;
+                t[1][X] = T->v[1][X] - gcx;
+                t[2][X] = T->v[2][X] - gcx;
+                t[0][Y] = T->v[0][Y] - gcy;
+                t[1][Y] = T->v[1][Y] - gcy;
+                t[2][Y] = T->v[2][Y] - gcy;
             }
             if ((ix < cc0 || ix > cc1) && vx_cons_sep_proj(T, D, U, W, t)) continue;
-            for (k = ka; k <= kb; k++)
-                if ((k >= kA && k <= kB) || vx_cons_layer_ok(T, t, k)) VX_CONS_WORD(k) |= VX_CONS_MASK(k);
+            for (k = ka; k <= kb; k++) {
+                const int g = (int)(k + oz);
+                if ((k >= kA && k <= kB) || vx_cons_layer_ok(T, t, g)) VX_CONS_WORD(g) |= VX_CONS_MASK(g);
+            }
 #undef VX_CONS_WORD
 #undef VX_CONS_MASK
         }
@@ -4719,54 +4693,78 @@ HFVIS_API hfvis_status hfvis_voxelize_conservative(const hfvis_mesh *mesh,
 {
     const hfvis_allocator *alloc = opts ? opts->alloc : NULL;
     size_t t, v, n;
-    double *gv;
+    vx_cons_vert *vert;
     vx_cons_bricks B;
     if (!occ || !vx_grid_valid(grid) || vx_mesh_check(mesh) != HFVIS_OK)
         return HFVIS_ERR_INVALID_ARGUMENT;
-    /* scratch: every vertex in grid space (transformed once, and checked against
+    /* scratch: every vertex in grid space with its ranges (transformed once, and checked against
      * VX_CONS_MAX_COORD as vx_cons_args does), and the brick bits */
-    gv = (double *)vx_alloc_array(alloc, mesh->vertex_count, 3 * sizeof(double));
-    if (!gv && mesh->vertex_count) return HFVIS_ERR_OUT_OF_MEMORY;
-    for (v = 0; v < 3 * mesh->vertex_count; v++) {
-        gv[v] = vx_cons_gc(grid, (int)(v % 3), mesh->xyz[v]);
-        if (!(fabs(gv[v]) <= VX_CONS_MAX_COORD)) {
-            vx_free(alloc, gv);
-            return HFVIS_ERR_LIMIT;
+    vert = (vx_cons_vert *)vx_alloc_array(alloc, mesh->vertex_count, sizeof(vx_cons_vert));
+    if (!vert && mesh->vertex_count) return HFVIS_ERR_OUT_OF_MEMORY;
+    for (v = 0; v < mesh->vertex_count; v++) {
+        vx_cons_vert *p = vert + v;
+        int a;
+        p->mag = 0.0;
+        for (a = 0; a < 3; a++) {
+            double g = vx_cons_gc(grid, a, mesh->xyz[3 * v + (size_t)a]), l, h;
+            const double top = (double)grid->dims[a];
+            if (!(fabs(g) <= VX_CONS_MAX_COORD)) {
+                vx_free(alloc, vert);
+                return HFVIS_ERR_LIMIT;
+            }
+            p->g[a] = g;
+            p->mag += fabs(g);
+            l = ceil(g) - 1.0; /* vx_cons_range before clipping, kept within [-1, n] */
+            h = floor(g);
+            p->lo[a] = (int)(l < -1.0 ? -1.0 : l > top ? top : l);
+            p->hi[a] = (int)(h < -1.0 ? -1.0 : h > top ? top : h);
         }
     }
     if (!vx_cons_bricks_init(&B, grid, alloc)) {
-        vx_free(alloc, gv);
+        vx_free(alloc, vert);
         return HFVIS_ERR_OUT_OF_MEMORY;
     }
     for (t = 0; t < mesh->triangle_count; t++) {
+        const vx_cons_vert *p[3];
         vx_cons_tri T;
-        int lo[3], hi[3], a, k;
+        double f0[3], f1[3];
+        int lo[3], hi[3], a, k, empty = 0;
+        for (k = 0; k < 3; k++) p[k] = vert + mesh->indices[3 * t + (size_t)k];
+        for (a = 0; a < 3; a++) { /* vx_cons_bbox: the min and max of the vertices' ranges */
+            int l = p[0]->lo[a], h = p[0]->hi[a];
+            l = p[1]->lo[a] < l ? p[1]->lo[a] : l;
+            l = p[2]->lo[a] < l ? p[2]->lo[a] : l;
+            h = p[1]->hi[a] > h ? p[1]->hi[a] : h;
+            h = p[2]->hi[a] > h ? p[2]->hi[a] : h;
+            lo[a] = l > 0 ? l : 0;
+            hi[a] = h < grid->dims[a] - 1 ? h : grid->dims[a] - 1;
+            empty |= lo[a] > hi[a];
+        }
+        if (empty) continue;
         for (k = 0; k < 3; k++) {
-            const double *g = gv + 3 * (size_t)mesh->indices[3 * t + (size_t)k];
-            T.v[k][0] = g[0];
-            T.v[k][1] = g[1];
-            T.v[k][2] = g[2];
+            T.v[k][0] = p[k]->g[0];
+            T.v[k][1] = p[k]->g[1];
+            T.v[k][2] = p[k]->g[2];
         }
-        if (!vx_cons_bbox_fast(&T, grid, lo, hi)) continue;
-        {
-            double f0[3], f1[3];
-            for (a = 0; a < 3; a++) {
-                f0[a] = T.v[1][a] - T.v[0][a];
-                f1[a] = T.v[2][a] - T.v[1][a];
-            }
-            vx_cons_normal(f0, f1, T.n); /* the SAT's normal: degenerate iff it is zero */
+        for (a = 0; a < 3; a++) {
+            f0[a] = T.v[1][a] - T.v[0][a];
+            f1[a] = T.v[2][a] - T.v[1][a];
         }
+        vx_cons_normal(f0, f1, T.n); /* the SAT's normal: degenerate iff it is zero */
         if (T.n[0] == 0.0 && T.n[1] == 0.0 && T.n[2] == 0.0) continue;
         T.D = 0;
         if (fabs(T.n[1]) > fabs(T.n[T.D])) T.D = 1;
         if (fabs(T.n[2]) > fabs(T.n[T.D])) T.D = 2;
         T.U = T.D == 2 ? 0 : T.D + 1;
         T.W = T.D == 0 ? 2 : T.D - 1;
-        vx_cons_fast_tri(&T, lo, hi, &B);
+        /* the margin's coordinate scale (vx_cons_fast_tri) */
+        vx_cons_fast_tri(&T, lo, hi,
+                         4.0 + (double)hi[0] + (double)hi[1] + (double)hi[2] + p[0]->mag + p[1]->mag + p[2]->mag,
+                         &B);
     }
     n = vx_cons_bricks_emit(&B, grid, occ);
     vx_free(alloc, B.w);
-    vx_free(alloc, gv);
+    vx_free(alloc, vert);
     if (count) *count = n;
     return HFVIS_OK;
 }
