@@ -3248,10 +3248,12 @@ HFVIS_API int hfvis_triangle_box_overlap(const double center[3], const double ha
  * coordinate scale, far above the rounding of either side), so a voxel decided by the margin
  * is decided as the SAT decides it, and the few voxels within a margin of a bound are decided
  * by the SAT's own expressions. Bounding boxes of at most 16 voxels use the SAT directly on
- * the voxels not set yet. Cost O(T + rows + columns + voxels written) plus O(grid volume / 64)
- * to clear and emit; the baseline is O(sum of bounding-box voxels). occ: dims[0]*dims[1]*dims[2]
+ * the voxels not set yet. Cost O(V + T + rows + columns + voxels written) plus O(grid volume /
+ * 64) for the bit scratch and a memset of the byte output (O(grid volume) bytes, at memory
+ * bandwidth); the baseline is O(sum of bounding-box voxels). occ: dims[0]*dims[1]*dims[2]
  * bytes, overwritten. count (may be NULL): occupied voxels. opts: only alloc is used. Two
- * allocations: vertex_count*24 bytes (vertices in grid space) and ceil(dims/4)^3 * 8 bytes (a
+ * allocations: vertex_count*56 bytes (each vertex in grid space with its magnitude and voxel
+ * ranges, computed once for the about six triangles sharing it) and ceil(dims/4)^3 * 8 bytes (a
  * bit per voxel in 4x4x4 bricks). Errors: see the section comment. */
 HFVIS_API hfvis_status hfvis_voxelize_conservative(const hfvis_mesh *mesh,
                                                    const hfvis_volume_grid *grid,
