@@ -51,6 +51,15 @@
 #endif
 #endif
 
+/* The allocation behind a NULL allocator (hfvis.h, "Memory"): define both to replace it. */
+#if defined(HFVIS_MALLOC) != defined(HFVIS_FREE)
+#error "define both HFVIS_MALLOC and HFVIS_FREE, or neither"
+#endif
+#ifndef HFVIS_MALLOC
+#define HFVIS_MALLOC(size) malloc(size)
+#define HFVIS_FREE(ptr) free(ptr)
+#endif
+
 #define HF_NAN ((double)NAN)
 #define HF_INF ((double)INFINITY)
 #define HF_PI 3.14159265358979323846
@@ -78,7 +87,7 @@ static void *hf_alloc(const hfvis_allocator *a, size_t bytes)
 {
     if (bytes == 0) return NULL;
     if (a && a->alloc) return a->alloc(a->user, bytes);
-    return malloc(bytes);
+    return HFVIS_MALLOC(bytes);
 }
 
 static void hf_free(const hfvis_allocator *a, void *p)
@@ -88,7 +97,7 @@ static void hf_free(const hfvis_allocator *a, void *p)
         if (a->free) a->free(a->user, p);
         return;
     }
-    free(p);
+    HFVIS_FREE(p);
 }
 
 void hfvis_free(const hfvis_allocator *alloc, void *ptr) { hf_free(alloc, ptr); }

@@ -60,6 +60,9 @@
  * Memory. The caller owns every output and sizes it with the documented formula or a *_size()
  *   query. Scratch comes from the optional allocator in the options (NULL = malloc/free); each
  *   function documents how many blocks it allocates. The library keeps no pointer after a call.
+ *   The *_save writers, which take no allocator, and every NULL allocator use HFVIS_MALLOC(size)
+ *   and HFVIS_FREE(ptr), malloc and free unless both are defined when the library's .c files
+ *   are compiled (as stb's STBI_MALLOC; test/test_oom.c fails them on purpose).
  * Options. NULL and a zero-initialised options struct both mean the documented defaults; zero is
  *   never a valid non-default value. hfvis_*_options_default() returns the defaults filled in.
  *

@@ -50,6 +50,15 @@
 #endif
 #endif
 
+/* The allocation behind a NULL allocator (hfvis.h, "Memory"): define both to replace it. */
+#if defined(HFVIS_MALLOC) != defined(HFVIS_FREE)
+#error "define both HFVIS_MALLOC and HFVIS_FREE, or neither"
+#endif
+#ifndef HFVIS_MALLOC
+#define HFVIS_MALLOC(size) malloc(size)
+#define HFVIS_FREE(ptr) free(ptr)
+#endif
+
 #define SS_PI 3.14159265358979323846
 #define SS_INF ((double)INFINITY)
 #define SS_NAN ((double)NAN)
@@ -62,14 +71,14 @@ static void *ss_alloc(const hfvis_allocator *a, size_t bytes)
 {
     if (bytes == 0) return NULL;
     if (a && a->alloc) return a->alloc(a->user, bytes);
-    return malloc(bytes);
+    return HFVIS_MALLOC(bytes);
 }
 
 static void ss_free(const hfvis_allocator *a, void *p)
 {
     if (!p) return;
     if (a && a->free) a->free(a->user, p);
-    else if (!(a && a->alloc)) free(p);
+    else if (!(a && a->alloc)) HFVIS_FREE(p);
 }
 
 /* a*b into *out; 1 if it does not overflow. */

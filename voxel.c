@@ -47,6 +47,15 @@
 #endif
 #endif
 
+/* The allocation behind a NULL allocator (hfvis.h, "Memory"): define both to replace it. */
+#if defined(HFVIS_MALLOC) != defined(HFVIS_FREE)
+#error "define both HFVIS_MALLOC and HFVIS_FREE, or neither"
+#endif
+#ifndef HFVIS_MALLOC
+#define HFVIS_MALLOC(size) malloc(size)
+#define HFVIS_FREE(ptr) free(ptr)
+#endif
+
 #define VX_PI 3.14159265358979323846
 
 /* Marks internal helpers that a given build may leave unused (-Wunused-function). */
@@ -72,14 +81,14 @@ static void *vx_alloc(const hfvis_allocator *a, size_t bytes)
 {
     if (bytes == 0) return NULL;
     if (a && a->alloc) return a->alloc(a->user, bytes);
-    return malloc(bytes);
+    return HFVIS_MALLOC(bytes);
 }
 
 static void vx_free(const hfvis_allocator *a, void *p)
 {
     if (!p) return;
     if (a && a->free) a->free(a->user, p);
-    else if (!a || !a->alloc) free(p);
+    else if (!a || !a->alloc) HFVIS_FREE(p);
 }
 
 /* *out = a*b; returns 0 (and leaves *out alone) on overflow. */
@@ -8748,11 +8757,11 @@ HFVIS_API hfvis_status hfvis_visfield_save(const char *path, const hfvis_visfiel
     unsigned char *buf;
     hfvis_status s;
     if (!path || need == 0) return HFVIS_ERR_INVALID_ARGUMENT;
-    buf = (unsigned char *)malloc(need);
+    buf = (unsigned char *)vx_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_visfield_encode(vf, buf, need, &written);
     if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
-    free(buf);
+    vx_free(NULL, buf);
     return s;
 }
 
