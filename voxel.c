@@ -4319,12 +4319,12 @@ typedef struct vx_cons_vert {
     int lo[3], hi[3];
 } vx_cons_vert;
 
-/* x clamped to [0, top] (a NaN becomes top), then truncated: floor(x) for x >= 0. Local indices
+/* x clamped to [0, top] (a NaN becomes 0), then truncated: floor(x) for x >= 0. Local indices
  * are int64_t so lo + 1 cannot overflow for a range of INT_MAX voxels. */
 static VX_CONS_INLINE int64_t vx_cons_floor_local(double x, double top)
 {
-    x = x < top ? x : top;
     x = x > 0.0 ? x : 0.0;
+    x = x < top ? x : top;
     return (int64_t)x;
 }
 
