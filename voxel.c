@@ -4451,7 +4451,12 @@ static const uint64_t vx_cons_layer_masks[3][4][4] = {
  *    fails it for certain. Voxels within a margin of an end (exact ties such as faces on voxel
  *    boundaries, or 1e-9-close calls) are decided with the SAT's own expressions in the
  *    original frame (vx_cons_sep_proj, vx_cons_layer_ok; set up lazily), which makes the
- *    result identical to the reference;
+ *    result identical to the reference. scale (from the caller) is 4 + the bounding box's high
+ *    indices + the vertices' coordinate magnitudes. The bounds are evaluated in a local frame
+ *    (index minus lo - 1 per axis, so ranges are 1..n and every range end is one clamp and one
+ *    truncation, vx_cons_floor_local); a ceiling is taken as floor + 1, which differs only when
+ *    the bound is an integer, i.e. for a centre exactly a margin away: outside a candidate
+ *    range (certainly out) or outside a certain one (decided by the SAT's expressions);
  *  - a voxel already set needs no decision (the result is a union): a column whose plane
  *    candidates are all set is skipped before the other projections' bounds are even set up
  *    (they are set up once per triangle, when first needed); a bounding box of at most
@@ -4470,9 +4475,9 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
     const uint64_t(*lmask)[4] = vx_cons_layer_masks[D];
     /* the local frame: index i - o with o = lo - 1 per axis, so the range is 1..n */
     const int ox = lo[X] - 1, oy = lo[Y] - 1, oz = lo[D] - 1;
-    const int64_t ny = (int64_t)hi[Y] - oy;
+    const int64_t rows = (int64_t)hi[Y] - oy;
     const double topx = (double)((int64_t)hi[X] - ox) + 0.5, topz = (double)((int64_t)hi[D] - oz) + 0.5;
-    double P[3][3], f[3][3], invy[3], invx[3], nx, ny_, nz, inz, ax, ay, K0, hwid, eps, plo, phi;
+    double P[3][3], f[3][3], invy[3], invx[3], nx, ny, nz, inz, ax, ay, K0, hwid, eps, plo, phi;
     double t[3][3];
     vx_cons_bound bz[3], bx[3], by[3];
     size_t slow = 0;
@@ -4516,15 +4521,15 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
         invy[j] = f[j][1] != 0.0 ? 1.0 / f[j][1] : 0.0; /* projections z and x */
     }
     nx = T->n[X];
-    ny_ = T->n[Y];
+    ny = T->n[Y];
     nz = T->n[D];
     /* the plane slab per column: kc(x, y) = K0 - ax x - ay y + 0.5 (the plane's height at the
      * column's centre), |ax|, |ay| <= 1, half width rn/|n_z| <= 1.5 */
     inz = 1.0 / nz;
     ax = nx * inz;
-    ay = ny_ * inz;
-    K0 = P[0][2] - 0.5 + (nx * (P[0][0] - 0.5) + ny_ * (P[0][1] - 0.5)) * inz;
-    hwid = 0.5 * (fabs(nx) + fabs(ny_) + fabs(nz)) * fabs(inz);
+    ay = ny * inz;
+    K0 = P[0][2] - 0.5 + (nx * (P[0][0] - 0.5) + ny * (P[0][1] - 0.5)) * inz;
+    hwid = 0.5 * (fabs(nx) + fabs(ny) + fabs(nz)) * fabs(inz);
     eps = scale * 9.313225746154785e-10; /* 2^-30 */
     plo = hwid + eps + 0.5; /* the plane's candidate layers: ceil(kc - plo) .. floor(kc + phi) */
     phi = hwid + eps - 0.5;
@@ -4536,7 +4541,7 @@ static size_t vx_cons_fast_tri(vx_cons_tri *T, const int lo[3], const int hi[3],
         vx_cons_bound_init(&bz[j], -f[j][1], f[j][0], -invy[j], P[j][0], P[j][1], P[o][0],
                            P[o][1], eps);
     }
-    for (iy = 1; iy <= ny; iy++) {
+    for (iy = 1; iy <= rows; iy++) {
         const double cy = (double)iy + 0.5, krow = K0 - ay * (double)iy + 0.5;
         const int gy = (int)(iy + oy);
         const size_t rowbase = (size_t)(gy >> 2) * sY;
