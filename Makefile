@@ -25,7 +25,7 @@ else ifeq ($(config),test)
   OPT := -O2 -g -DHFVIS_ENABLE_ASSERTS
 else ifeq ($(config),sanitize)
   BUILD := build/sanitize
-  OPT := -O1 -g -DHFVIS_ENABLE_ASSERTS -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+  OPT := -O1 -g -DHFVIS_ENABLE_ASSERTS -fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all -fno-omit-frame-pointer
 else ifeq ($(config),coverage)
   BUILD := build/coverage
   OPT := -O0 -g --coverage

@@ -955,13 +955,18 @@ static hfvis_status hf_lattice_from_u(hfvis_lattice *L, int W, int H, double ux,
         vmin = fmin(vmin, b);
         vmax = fmax(vmax, b);
     }
-    L->i_min = (int)ceil(umin - HF_LATTICE_EPS);
-    L->i_max = (int)floor(umax + HF_LATTICE_EPS);
-    L->j_min = (int)ceil(vmin - HF_LATTICE_EPS);
-    L->j_max = (int)floor(vmax + HF_LATTICE_EPS);
-    rows = (double)L->j_max - (double)L->j_min + 1.0;
-    cols = (double)L->i_max - (double)L->i_min + 1.0;
+    umin = ceil(umin - HF_LATTICE_EPS);
+    umax = floor(umax + HF_LATTICE_EPS);
+    vmin = ceil(vmin - HF_LATTICE_EPS);
+    vmax = floor(vmax + HF_LATTICE_EPS);
+    rows = vmax - vmin + 1.0;
+    cols = umax - umin + 1.0;
+    /* over 2^31 nodes (0 lies in both ranges, so within the limit the indices fit an int) */
     if (rows * cols > 2147483647.0) return HFVIS_ERR_LIMIT;
+    L->i_min = (int)umin;
+    L->i_max = (int)umax;
+    L->j_min = (int)vmin;
+    L->j_max = (int)vmax;
     return HFVIS_OK;
 }
 
