@@ -72,7 +72,7 @@ $(CLI): examples/hfvis_cli.c examples/common.h $(LIB)
 $(BENCH): examples/bench.c $(wildcard examples/bench_*.c) examples/bench.h examples/common.h $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -I. examples/bench.c $(wildcard examples/bench_*.c) $(LIB) $(LDLIBS) -o $@
-$(BUILD)/test/%: test/%.c test/test.h $(LIB)
+$(BUILD)/test/%: test/%.c test/test.h test/test_dir.h $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -I. $< $(LIB) $(LDLIBS) -o $@
 

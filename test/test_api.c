@@ -7,7 +7,7 @@
 #include "hfvis.h"
 #include "test.h"
 
-#include <dirent.h>
+#include "test_dir.h"
 #include <float.h>
 #include <limits.h>
 #include <math.h>
@@ -593,19 +593,6 @@ static const char *tmp_path(char *buf, size_t cap, const char *name)
     return (n > 0 && (size_t)n < cap) ? buf : "";
 }
 
-/* Entries of a directory except . and .. (-1 if it cannot be opened). */
-static int count_entries(const char *dir)
-{
-    DIR *d = opendir(dir);
-    struct dirent *e;
-    int n = 0;
-    if (!d) return -1;
-    while ((e = readdir(d)) != NULL)
-        if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0) n++;
-    closedir(d);
-    return n;
-}
-
 static int write_bytes(const char *path, const void *data, size_t n)
 {
     FILE *f = fopen(path, "wb");
@@ -668,7 +655,7 @@ TEST(files_save_and_load)
     CHECK(px && px[0] == 0.0f && px[1] == (float)round(255.0 / 11.0));
     hfvis_free(NULL, px);
     /* nothing but the two files is left behind */
-    CHECK(count_entries(test_dir) == 2);
+    CHECK(test_dir_entries(test_dir) == 2);
     CHECK(remove(path) == 0 && remove(path2) == 0);
 }
 
@@ -703,7 +690,7 @@ TEST(files_errors)
     CHECK_EQ_STATUS(hfvis_pfm_save(path, img, 2, 2, 1, 1), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_pgm_save(path, img, 2, 2, 2, 1.0f, 0.0f, 255), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_pgm_save(path, img, 2, 2, 2, 0.0f, 1.0f, 0), HFVIS_ERR_INVALID_ARGUMENT);
-    CHECK(count_entries(test_dir) == 0);
+    CHECK(test_dir_entries(test_dir) == 0);
     /* save into a directory that does not exist */
     CHECK_EQ_STATUS(hfvis_pfm_save(tmp_path(path, sizeof path, "no/such/dir/s.pfm"), img, 2, 2, 1, 2),
                     HFVIS_ERR_IO);
@@ -713,7 +700,7 @@ TEST(files_errors)
     CHECK(mkdir(tmp_path(dir, sizeof dir, "adir"), 0700) == 0);
     CHECK_EQ_STATUS(hfvis_pfm_save(dir, img, 2, 2, 1, 2), HFVIS_ERR_IO);
     CHECK_EQ_STATUS(hfvis_pgm_save(dir, img, 2, 2, 2, 0.0f, 4.0f, 255), HFVIS_ERR_IO);
-    CHECK(count_entries(test_dir) == 1 && count_entries(dir) == 0);
+    CHECK(test_dir_entries(test_dir) == 1 && test_dir_entries(dir) == 0);
     /* save into a read-only directory (root ignores permissions, so only as another user) */
     if (geteuid() != 0) {
         int n = snprintf(sub, sizeof sub, "%s/s.pfm", dir);
@@ -721,10 +708,10 @@ TEST(files_errors)
         CHECK(chmod(dir, 0500) == 0);
         CHECK_EQ_STATUS(hfvis_pfm_save(sub, img, 2, 2, 1, 2), HFVIS_ERR_IO);
         CHECK(chmod(dir, 0700) == 0);
-        CHECK(count_entries(dir) == 0);
+        CHECK(test_dir_entries(dir) == 0);
     }
     CHECK(rmdir(dir) == 0);
-    CHECK(count_entries(test_dir) == 0);
+    CHECK(test_dir_entries(test_dir) == 0);
 }
 
 /* A pipe cannot seek, so the loader grows its buffer as data arrives: serve the file through a
@@ -803,7 +790,7 @@ TEST(files_load_failing_allocator)
 
 TEST(files_teardown)
 {
-    CHECK(count_entries(test_dir) == 0);
+    CHECK(test_dir_entries(test_dir) == 0);
     CHECK(rmdir(test_dir) == 0);
 }
 

@@ -29,7 +29,7 @@
 #include "hfvis.h"
 #include "test.h"
 
-#include <dirent.h>
+#include "test_dir.h"
 #include <float.h>
 #include <limits.h>
 #include <math.h>
@@ -6306,17 +6306,6 @@ static const io_entry io_savers[] = {
 };
 #define IO_COUNT ((int)(sizeof io_savers / sizeof io_savers[0]))
 
-static int dir_entries(const char *dir)
-{
-    DIR *d = opendir(dir);
-    struct dirent *e;
-    int n = 0;
-    if (!d) return -1;
-    while ((e = readdir(d)) != NULL) n++;
-    closedir(d);
-    return n;
-}
-
 /* Success writes the file; a path in a missing directory and a path that is a directory fail
  * with HFVIS_ERR_IO and leave no temporary file behind; an existing file is replaced whole. */
 static void io_one(const io_entry *e)
@@ -6331,11 +6320,11 @@ static void io_one(const io_entry *e)
     CHECK_EQ_STATUS(e->fn(target), HFVIS_OK);
     CHECK((f = fopen(target, "rb")) != NULL);
     if (f) fclose(f);
-    before = dir_entries(sub);
+    before = test_dir_entries(sub);
     snprintf(target, sizeof target, "%s/missing/out", sub);
     CHECK_EQ_STATUS(e->fn(target), HFVIS_ERR_IO);
     CHECK_EQ_STATUS(e->fn(sub), HFVIS_ERR_IO);
-    CHECK(dir_entries(sub) == before);
+    CHECK(test_dir_entries(sub) == before);
     CHECK_EQ_STATUS(e->fn(tmp_path(e->name)), HFVIS_OK);
     CHECK_EQ_STATUS(e->fn(tmp_path(e->name)), HFVIS_OK); /* replaces */
 }

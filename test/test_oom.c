@@ -36,7 +36,7 @@ static void oom_free(void *p)
 
 #include "test.h"
 
-#include <dirent.h>
+#include "test_dir.h"
 #include <unistd.h>
 
 static char oom_dir[64];
@@ -45,19 +45,6 @@ static const char *oom_path(char *buf, size_t cap, const char *name)
 {
     int n = snprintf(buf, cap, "%s/%s", oom_dir, name);
     return (n > 0 && (size_t)n < cap) ? buf : "";
-}
-
-/* Entries of the scratch folder except . and .. (-1 if it cannot be opened). */
-static int oom_entries(void)
-{
-    DIR *d = opendir(oom_dir);
-    struct dirent *e;
-    int n = 0;
-    if (!d) return -1;
-    while ((e = readdir(d)) != NULL)
-        if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0) n++;
-    closedir(d);
-    return n;
 }
 
 /* The whole file into a malloc'd block (*size bytes); NULL if it cannot be read. */
@@ -110,11 +97,11 @@ static long oom_sweep_save(const char *name, oom_save_fn save)
             if (s == HFVIS_OK) {
                 made = oom_calls;
                 CHECK(n > made); /* every allocation before succeeded */
-                CHECK(oom_entries() == 1);
+                CHECK(test_dir_entries(oom_dir) == 1);
                 break;
             }
             CHECK_EQ_STATUS(s, HFVIS_ERR_OUT_OF_MEMORY);
-            CHECK(oom_entries() == pre); /* no temporary file left */
+            CHECK(test_dir_entries(oom_dir) == pre); /* no temporary file left */
             back = oom_read(path, &size);
             if (pre) CHECK(back && size == sizeof old && memcmp(back, old, sizeof old) == 0);
             else CHECK(back == NULL);
@@ -250,7 +237,7 @@ TEST(teardown)
 {
     hfvis_mesh_free(NULL, &oom_mesh);
     CHECK(oom_live == 0);
-    CHECK(oom_entries() == 0);
+    CHECK(test_dir_entries(oom_dir) == 0);
     CHECK(rmdir(oom_dir) == 0);
 }
 

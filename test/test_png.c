@@ -7,7 +7,7 @@
 #include "examples/common.h"
 #include "test.h"
 
-#include <dirent.h>
+#include "test_dir.h"
 #include <limits.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -167,19 +167,6 @@ static const char *in_dir(char *buf, size_t cap, const char *name)
 {
     int n = snprintf(buf, cap, "%s/%s", test_dir, name);
     return (n > 0 && (size_t)n < cap) ? buf : "";
-}
-
-/* Entries of a directory except . and .. (-1 if it cannot be opened). */
-static int count_entries(const char *dir)
-{
-    DIR *d = opendir(dir);
-    struct dirent *e;
-    int n = 0;
-    if (!d) return -1;
-    while ((e = readdir(d)) != NULL)
-        if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0) n++;
-    closedir(d);
-    return n;
 }
 
 /* Read a whole file (at most cap bytes); returns its size, 0 if it cannot be read. */
@@ -414,7 +401,7 @@ TEST(save_maps_floats)
     CHECK(remove(in_dir(path, sizeof path, "g8.png")) == 0);
     CHECK(remove(in_dir(path, sizeof path, "g16.png")) == 0);
     CHECK(remove(in_dir(path, sizeof path, "rgb.png")) == 0);
-    CHECK(count_entries(test_dir) == 0);
+    CHECK(test_dir_entries(test_dir) == 0);
 }
 
 TEST(save_failures_leave_nothing)
@@ -434,22 +421,22 @@ TEST(save_failures_leave_nothing)
     CHECK_EQ_STATUS(ex_png_save(path, px, 1, 3, PTRDIFF_MAX, 1, 8, 0.0f, 1.0f), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(ex_png_save(path, px, 46341, 46341, 46341, 1, 8, 0.0f, 1.0f), HFVIS_ERR_LIMIT);
     CHECK_EQ_STATUS(ex_png_write_file(NULL, (const unsigned char *)"x", 1), HFVIS_ERR_INVALID_ARGUMENT);
-    CHECK(count_entries(test_dir) == 0);
+    CHECK(test_dir_entries(test_dir) == 0);
     /* into a directory that does not exist */
     CHECK_EQ_STATUS(ex_png_save(in_dir(path, sizeof path, "no/such/x.png"), px, 2, 2, 2, 1, 8, 0.0f, 1.0f),
                     HFVIS_ERR_IO);
-    CHECK(count_entries(test_dir) == 0);
+    CHECK(test_dir_entries(test_dir) == 0);
     /* onto an existing directory: the temporary file is written, the rename fails and the
      * temporary file is removed again */
     CHECK(mkdir(in_dir(dir, sizeof dir, "adir"), 0700) == 0);
     CHECK_EQ_STATUS(ex_png_save(dir, px, 2, 2, 2, 1, 8, 0.0f, 1.0f), HFVIS_ERR_IO);
-    CHECK(count_entries(test_dir) == 1 && count_entries(dir) == 0);
+    CHECK(test_dir_entries(test_dir) == 1 && test_dir_entries(dir) == 0);
     /* the example wrappers report the failure and write nothing either */
     CHECK_EQ_STATUS(ex_save_png(test_dir, "adir", px, 2, 2, 2, 0.0f, 1.0f), HFVIS_ERR_IO);
     CHECK_EQ_STATUS(ex_save_pgm_png(test_dir, "x.pfm", px, 2, 2, 2, 0.0f, 1.0f), HFVIS_ERR_INVALID_ARGUMENT);
-    CHECK(count_entries(test_dir) == 1 && count_entries(dir) == 0);
+    CHECK(test_dir_entries(test_dir) == 1 && test_dir_entries(dir) == 0);
     CHECK(rmdir(dir) == 0);
-    CHECK(count_entries(test_dir) == 0);
+    CHECK(test_dir_entries(test_dir) == 0);
 }
 
 TEST(example_wrappers)
@@ -492,7 +479,7 @@ TEST(example_wrappers)
     CHECK_EQ_STATUS(ex_save_png_sheet(test_dir, "s.png", bad, 1, 1, 2, 2, 1), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(ex_save_png_sheet(test_dir, "s.png", panels, 3, 2, 2, 2, 2), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(ex_save_png_sheet(test_dir, "s.png", panels, 0, 2, 2, 2, 1), HFVIS_ERR_INVALID_ARGUMENT);
-    CHECK(count_entries(test_dir) == 0);
+    CHECK(test_dir_entries(test_dir) == 0);
 }
 
 int main(int argc, char **argv)
