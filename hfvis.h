@@ -2618,7 +2618,7 @@ HFVIS_API hfvis_status hfvis_obj_encode(const hfvis_mesh *mesh, void *out, size_
 
 /* File wrappers (absent with HFVIS_NO_STDIO). load reads the whole file with alloc and decodes
  * it (hfvis_obj_decode; three allocations, the file buffer freed before returning). save encodes
- * into a malloc'ed buffer and writes a temporary file beside path, then renames it, so path is
+ * into an HFVIS_MALLOC buffer and writes a temporary file beside path, then renames it, so path is
  * either complete or untouched. Returns the decoder's / encoder's errors, HFVIS_ERR_IO if the
  * file cannot be read or written (e.g. path is a directory), HFVIS_ERR_OUT_OF_MEMORY. */
 HFVIS_API hfvis_status hfvis_mesh_load(const char *path, const hfvis_allocator *alloc,
@@ -3389,7 +3389,7 @@ HFVIS_API hfvis_status hfvis_binvox_decode(const void *data, size_t size,
                                            uint8_t **occ);
 
 /* File wrappers (not with HFVIS_NO_STDIO). Save writes atomically (a temporary file renamed
- * onto path: complete or untouched), allocating the encoding with malloc; errors of encode,
+ * onto path: complete or untouched), allocating the encoding with HFVIS_MALLOC; errors of encode,
  * HFVIS_ERR_IO, HFVIS_ERR_OUT_OF_MEMORY. Load: errors of decode and HFVIS_ERR_IO. */
 HFVIS_API hfvis_status hfvis_binvox_save(const char *path, const hfvis_volume_grid *grid,
                                          const uint8_t *occ);
@@ -4203,8 +4203,8 @@ HFVIS_API hfvis_status hfvis_visfield_decode(const void *data, size_t size,
  * the struct. vf may be NULL. (Never call it on a field whose maps the caller owns.) */
 HFVIS_API void hfvis_visfield_free(const hfvis_allocator *alloc, hfvis_visfield *vf);
 
-/* File wrappers (absent with HFVIS_NO_STDIO): save encodes into a malloc'ed buffer and writes it
- * atomically (temporary file renamed onto path); load reads the whole file with alloc and
+/* File wrappers (absent with HFVIS_NO_STDIO): save encodes into an HFVIS_MALLOC buffer and
+ * writes it atomically (temporary file renamed onto path); load reads the whole file with alloc and
  * decodes it (two allocations, the file buffer freed before returning). Errors of the codec,
  * HFVIS_ERR_IO, HFVIS_ERR_OUT_OF_MEMORY. */
 HFVIS_API hfvis_status hfvis_visfield_save(const char *path, const hfvis_visfield *vf);

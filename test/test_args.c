@@ -6277,7 +6277,7 @@ static long sweep_one(const sweep_entry *e)
     return calls;
 }
 
-/* ---- malloc-only functions (the *_save writers): their failure paths in a temporary dir ---- */
+/* ---- allocator-less functions (the *_save writers): their I/O failure paths in a temp dir -- */
 
 static hfvis_status io_pfm_save(const char *path)
 {
@@ -6479,7 +6479,7 @@ TEST(malloc_only_writers)
         rows += inventory[i].alloc[0] == 'M';
     }
     for (i = 0; i < IO_COUNT; i++) io_one(&io_savers[i]);
-    printf("malloc-only writers: %d of %d checked (missing directory, directory as path, replace)\n", IO_COUNT, rows);
+    printf("allocator-less writers: %d of %d checked (missing directory, directory as path, replace)\n", IO_COUNT, rows);
 }
 
 /* Removes the temporary directory (one level of subdirectories). */
