@@ -1111,6 +1111,9 @@ hfvis_status hfvis_lsao_options_resolve(const hfvis_lsao_options *in, hfvis_lsao
     }
     if (o.spacing != 0.0 && o.spacing < SS_MIN_STEP) o.spacing = SS_MIN_STEP;
     if (ss_resolve_falloff(&o.falloff) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    /* A step falloff breaks the obscurity hull: a point popped under a farther, higher one is
+     * the answer again once the farther one leaves the radius (see the header). */
+    if (o.falloff.kind == HFVIS_FALLOFF_STEP) return HFVIS_ERR_INVALID_ARGUMENT;
     if (o.tangent == HFVIS_SSAO_TANGENT_DEFAULT) o.tangent = HFVIS_SSAO_TANGENT_FIXED;
     if (o.tangent < HFVIS_SSAO_TANGENT_FIXED || o.tangent > HFVIS_SSAO_TANGENT_FIXED_HULL_REAL_EVAL)
         return HFVIS_ERR_INVALID_ARGUMENT;
@@ -1452,6 +1455,10 @@ static void ss_line_points(const ss_cam *c, const ss_cfg *g, const float *depth,
             if (ss_bg(c, z)) z = SS_NAN;
             qu = (double)tx + 0.5;
             qv = (double)ty + 0.5;
+            if (g->exact && !integral) { /* keep the point in the line's plane (see header) */
+                qu = u;
+                qv = v;
+            }
         }
         if (zs) zs[k] = (float)z;
         if (z != z) {
