@@ -1487,6 +1487,9 @@ typedef struct hfvis_camera {
                                    buffer (both projections; symmetric: width/2, height/2) */
     double scale_x, scale_y;    /* orthographic: view units per pixel, > 0 */
     double far_depth;           /* depth >= far_depth is background; 0 = no far limit */
+    int rows_bottom_up;         /* 0: memory row 0 is the top of the image; 1: the bottom, as
+                                   glReadPixels returns it (depth and normals are read in place;
+                                   AO outputs stay top-down) */
 } hfvis_camera;
 
 /* HFVIS_OK if the camera is valid; HFVIS_ERR_INVALID_ARGUMENT for NULL, sizes < 1, a negative
@@ -1569,6 +1572,44 @@ HFVIS_API hfvis_status hfvis_depth_linearize(const float *in, int width, int hei
                                              ptrdiff_t in_stride, hfvis_depth_encoding encoding,
                                              int orthographic, double near_plane,
                                              double far_plane, float *out, ptrdiff_t out_stride);
+
+/* The clip-space depth range a projection matrix was built for. */
+typedef enum hfvis_clip_depth {
+    HFVIS_CLIP_DEPTH_GL = 1,           /* z_ndc in [-1, 1], window depth (z_ndc + 1)/2: OpenGL */
+    HFVIS_CLIP_DEPTH_ZERO_TO_ONE = 2   /* z_ndc in [0, 1]: Direct3D, Vulkan, Metal, and OpenGL
+                                          with glClipControl(..., GL_ZERO_TO_ONE) */
+} hfvis_clip_depth;
+
+/* What a projection matrix says about its depth buffer, ready for hfvis_depth_linearize. */
+typedef struct hfvis_projection_depth {
+    hfvis_depth_encoding encoding;     /* D3D (= GL window depth: standard), REVERSED_Z,
+                                          INFINITE_FAR or REVERSED_INFINITE */
+    int orthographic;
+    double near_plane, far_plane;      /* far_plane +INFINITY for the infinite-far encodings */
+} hfvis_projection_depth;
+
+/* The camera of a projection matrix as a port already has it. m holds the 16 elements in the
+ * order glUniformMatrix4fv(..., GL_FALSE, m) takes them, which is also the memory order of a
+ * row-major Direct3D / DirectXMath matrix: m[4*col + row] = A[row][col] with clip = A (x, y,
+ * z, 1). Right-handed (GL, w = -z) and left-handed (D3D, w = +z) matrices, standard, reversed
+ * and infinite-far depth are recognised from the matrix itself: perspective
+ *   fx = W A00/(2|A32|), fy = H A11/(2|A32|), cx = W/2 (1 + s A02/|A32|),
+ *   cy = H/2 (1 - s A12/|A32|), s = sign(A32);
+ * orthographic (A32 = 0) sx = 2 A33/(W A00), sy = 2 A33/(H A11), cx = W/2 (1 + A03/A33),
+ * cy = H/2 (1 - A13/A33). The window depth is then alpha + beta/z (orthographic alpha + beta z)
+ * and the encoding and planes follow from it: an infinite far plane needs the exact form
+ * (alpha exactly 1 or 0: A22 = -1, A23 = -2n for GL), an epsilon-adjusted one is refused. The
+ * camera's far_depth is the far plane as a float buffer stores it (a cleared pixel is
+ * background); 0 for an infinite far plane. width, height: the full buffer (guard band
+ * included), row 0 at the top (set rows_bottom_up afterwards for glReadPixels order).
+ * depth may be NULL. HFVIS_ERR_INVALID_ARGUMENT for NULL cam/m, an unknown clip, a non-finite
+ * element, a matrix with x-y shear, a w row that is neither (0, 0, +-a, 0) nor (0, 0, 0, a),
+ * non-positive scales, planes not 0 < near < far (orthographic 0 <= near), or the errors of
+ * hfvis_camera_check. */
+HFVIS_API hfvis_status hfvis_camera_from_matrix(hfvis_camera *cam, const double m[16],
+                                                hfvis_clip_depth clip, int width, int height,
+                                                int guard_x, int guard_y,
+                                                hfvis_projection_depth *depth);
 
 /* Normals from depth (spec §2.1 [R]): for each texel, the view-space points of the left/right
  * and upper/lower neighbours; on each axis the side whose depth differs less from the centre

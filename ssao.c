@@ -132,6 +132,8 @@ typedef struct ss_cam {
     int persp;
     int W, H, gx, gy;
     ptrdiff_t stride;
+    ptrdiff_t row0, row_step;  /* element of texel (x, y): row0 + y*row_step + x (bottom-up
+                                  rows: row0 = (H - 1) stride, row_step = -stride) */
     double fx, fy, cx, cy, ifx, ify, sx, sy;
     double far_d;              /* +inf when the camera has no far limit */
 } ss_cam;
@@ -143,6 +145,7 @@ hfvis_status hfvis_camera_check(const hfvis_camera *cam)
     if (cam->stride < 0 || (cam->stride != 0 && cam->stride < cam->width))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (cam->guard_x < 0 || cam->guard_y < 0) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (cam->rows_bottom_up != 0 && cam->rows_bottom_up != 1) return HFVIS_ERR_INVALID_ARGUMENT;
     if (cam->guard_x >= (cam->width + 1) / 2 || cam->guard_y >= (cam->height + 1) / 2)
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (cam->projection == HFVIS_CAMERA_PERSPECTIVE) {
@@ -179,6 +182,8 @@ static hfvis_status ss_cam_load(const hfvis_camera *cam, ss_cam *c)
     c->gx = cam->guard_x;
     c->gy = cam->guard_y;
     c->stride = cam->stride ? cam->stride : cam->width;
+    c->row0 = cam->rows_bottom_up ? (ptrdiff_t)(c->H - 1) * c->stride : 0;
+    c->row_step = cam->rows_bottom_up ? -c->stride : c->stride;
     c->cx = cam->cx;
     c->cy = cam->cy;
     if (c->persp) {
@@ -308,6 +313,125 @@ hfvis_status hfvis_camera_from_view(hfvis_camera *cam, const struct hfvis_view *
     s = hfvis_camera_check(&c);
     if (s != HFVIS_OK) return s;
     *cam = c;
+    return HFVIS_OK;
+}
+
+/* The depth encoding of window depth d = alpha + beta/z (perspective) or alpha + beta z
+ * (orthographic) as a linear function of linear depth z: which hfvis_depth_encoding it is and
+ * its planes. 0 when it is none of them. */
+static int ss_depth_form(int ortho, double alpha, double beta, hfvis_projection_depth *pd)
+{
+    double n, f;
+    if (!ss_finite(alpha) || !ss_finite(beta) || beta == 0.0) return 0;
+    if (ortho) {
+        if (beta > 0.0) { /* d(n) = 0, d(f) = 1 */
+            n = -alpha / beta;
+            f = (1.0 - alpha) / beta;
+            pd->encoding = HFVIS_DEPTH_D3D;
+        } else { /* reversed: d(n) = 1, d(f) = 0 */
+            n = (1.0 - alpha) / beta;
+            f = -alpha / beta;
+            pd->encoding = HFVIS_DEPTH_REVERSED_Z;
+        }
+        if (!(n >= 0.0 && f > n && ss_finite(f))) return 0;
+    } else if (alpha == 1.0 && beta < 0.0) { /* d = 1 - n/z */
+        n = -beta;
+        f = SS_INF;
+        pd->encoding = HFVIS_DEPTH_INFINITE_FAR;
+    } else if (alpha == 0.0 && beta > 0.0) { /* d = n/z */
+        n = beta;
+        f = SS_INF;
+        pd->encoding = HFVIS_DEPTH_REVERSED_INFINITE;
+    } else {
+        if (beta < 0.0) { /* d = f/(f - n) - f n/((f - n) z) */
+            n = -beta / alpha;
+            f = beta / (1.0 - alpha);
+            pd->encoding = HFVIS_DEPTH_D3D;
+        } else { /* d = n f/((f - n) z) - n/(f - n) */
+            n = beta / (1.0 - alpha);
+            f = -beta / alpha;
+            pd->encoding = HFVIS_DEPTH_REVERSED_Z;
+        }
+        if (!(n > 0.0 && f > n && ss_finite(f))) return 0;
+    }
+    if (!(n > 0.0 || (ortho && n == 0.0)) || !ss_finite(n)) return 0;
+    pd->orthographic = ortho;
+    pd->near_plane = n;
+    pd->far_plane = f;
+    return 1;
+}
+
+hfvis_status hfvis_camera_from_matrix(hfvis_camera *cam, const double m[16],
+                                      hfvis_clip_depth clip, int width, int height,
+                                      int guard_x, int guard_y, hfvis_projection_depth *depth)
+{
+    hfvis_camera c;
+    hfvis_projection_depth pd;
+    hfvis_status st;
+    double A[4][4], W = (double)width, H = (double)height, alpha, beta, w;
+    int r, k, ortho;
+    if (!cam || !m || (clip != HFVIS_CLIP_DEPTH_GL && clip != HFVIS_CLIP_DEPTH_ZERO_TO_ONE))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    for (k = 0; k < 16; k++)
+        if (!ss_finite(m[k])) return HFVIS_ERR_INVALID_ARGUMENT;
+    for (r = 0; r < 4; r++)
+        for (k = 0; k < 4; k++) A[r][k] = m[4 * k + r];
+    /* clip = A v; no shear between x and y, and x, y independent of the view z offset */
+    if (A[0][1] != 0.0 || A[1][0] != 0.0 || A[3][0] != 0.0 || A[3][1] != 0.0 ||
+        !(A[0][0] > 0.0) || !(A[1][1] > 0.0) || A[2][0] != 0.0 || A[2][1] != 0.0)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    memset(&c, 0, sizeof c);
+    memset(&pd, 0, sizeof pd);
+    c.width = width;
+    c.height = height;
+    c.guard_x = guard_x;
+    c.guard_y = guard_y;
+    ortho = A[3][2] == 0.0;
+    if (!ortho) {
+        /* w = A32 Z: linear depth z = w/|A32| and the view z = sign(A32) z (RH looks down -Z) */
+        double sg = A[3][2] > 0.0 ? 1.0 : -1.0;
+        w = fabs(A[3][2]);
+        if (A[3][3] != 0.0 || A[0][3] != 0.0 || A[1][3] != 0.0) return HFVIS_ERR_INVALID_ARGUMENT;
+        c.projection = HFVIS_CAMERA_PERSPECTIVE;
+        c.fx = 0.5 * W * A[0][0] / w; /* x_ndc = (A00 X)/(w z) + sg A02/w */
+        c.fy = 0.5 * H * A[1][1] / w;
+        c.cx = 0.5 * W * (1.0 + sg * A[0][2] / w);
+        c.cy = 0.5 * H * (1.0 - sg * A[1][2] / w); /* row 0 at the top: v grows as y_ndc falls */
+        alpha = sg * A[2][2] / w;                   /* z_ndc = alpha + beta / z */
+        beta = A[2][3] / w;
+    } else {
+        if (A[3][3] == 0.0 || A[0][2] != 0.0 || A[1][2] != 0.0) return HFVIS_ERR_INVALID_ARGUMENT;
+        w = A[3][3];
+        c.projection = HFVIS_CAMERA_ORTHOGRAPHIC;
+        c.scale_x = 2.0 * w / (W * A[0][0]);
+        c.scale_y = 2.0 * w / (H * A[1][1]);
+        c.cx = 0.5 * W * (1.0 + A[0][3] / w);
+        c.cy = 0.5 * H * (1.0 - A[1][3] / w);
+        /* z_ndc = (A22 Z + A23)/w with Z = -+z: the sense follows from the planes (below) */
+        alpha = A[2][3] / w;
+        beta = -fabs(A[2][2] / w);
+    }
+    if (clip == HFVIS_CLIP_DEPTH_GL) { /* window depth (z_ndc + 1)/2 */
+        alpha = 0.5 * (alpha + 1.0);
+        beta *= 0.5;
+    }
+    if (ortho) {
+        /* standard depth grows with z (beta > 0, d(0) <= 0); reversed falls (d(0) >= 1) */
+        if (alpha <= 0.0) beta = -beta;
+        else if (!(alpha >= 1.0)) return HFVIS_ERR_INVALID_ARGUMENT;
+    }
+    if (!ss_depth_form(ortho, alpha, beta, &pd)) return HFVIS_ERR_INVALID_ARGUMENT;
+    /* The far plane as a float depth buffer holds it, so a cleared pixel is background. */
+    if (ss_finite(pd.far_plane)) {
+        double ff = (double)(float)pd.far_plane;
+        c.far_depth = ff < pd.far_plane ? ff : pd.far_plane;
+    }
+    st = hfvis_camera_check(&c);
+    if (st != HFVIS_OK) return st;
+    if (c.projection == HFVIS_CAMERA_PERSPECTIVE && !(ss_finite(c.fx) && ss_finite(c.fy)))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    *cam = c;
+    if (depth) *depth = pd;
     return HFVIS_OK;
 }
 
@@ -452,10 +576,16 @@ static int ss_normalize3(double v[3])
     return 1;
 }
 
+/* Element index of texel (x, y) (row 0 the top of the image) in the caller's layout. */
+static ptrdiff_t ss_index(const ss_cam *c, int x, int y)
+{
+    return c->row0 + (ptrdiff_t)y * c->row_step + x;
+}
+
 /* Depth of texel (x, y) (no bounds check). */
 static double ss_tex(const ss_cam *c, const float *depth, int x, int y)
 {
-    return (double)depth[(ptrdiff_t)y * c->stride + x];
+    return (double)depth[ss_index(c, x, y)];
 }
 
 /* Normal of texel (x, y) from depth, into n[3]; 0 for background. */
@@ -527,7 +657,7 @@ static void ss_normals_fill(const ss_cam *c, const float *depth, float *normals)
     for (y = 0; y < c->H; y++)
         for (x = 0; x < c->W; x++) {
             double n[3];
-            float *o = normals + 3 * ((ptrdiff_t)y * c->stride + x);
+            float *o = normals + 3 * ss_index(c, x, y);
             ss_normal_at(c, depth, x, y, n);
             o[0] = (float)n[0];
             o[1] = (float)n[1];
@@ -1396,7 +1526,7 @@ static double ss_real_sin_t(const ss_cam *c, const float *normals, int tx, int t
                             const double e1[3], const double yh[3], int exact, double ux,
                             double uy, double side, double fixed)
 {
-    const float *np = normals + 3 * ((ptrdiff_t)ty * c->stride + tx);
+    const float *np = normals + 3 * ss_index(c, tx, ty);
     double n[3], n2x, n2y, tx2, ty2, l;
     n[0] = (double)np[0];
     n[1] = (double)np[1];
@@ -1602,7 +1732,7 @@ static int ss_accept(const ss_cam *c, const ss_cfg *g, const float *normals,
     if (normals && g->rej_n > -1.0) {
         int tx = ss_texel(ln->x0 + (double)i * L->dir.step_x, c->W);
         int ty = ss_texel(ln->y0 + (double)i * L->dir.step_y, c->H);
-        const float *ns = normals + 3 * ((ptrdiff_t)ty * c->stride + tx);
+        const float *ns = normals + 3 * ss_index(c, tx, ty);
         double dot = (double)ns[0] * (double)nc[0] + (double)ns[1] * (double)nc[1] +
                      (double)ns[2] * (double)nc[2];
         if (!(dot >= g->rej_n)) return 0;
@@ -1656,7 +1786,7 @@ static void ss_gather_dir(const ss_cam *c, const ss_cfg *g, const float *depth,
         double v = (double)y + 0.5;
         for (x = c->gx; x < c->W - c->gx; x++) {
             double u = (double)x + 0.5, zc = ss_tex(c, depth, x, y), val = 0.0;
-            const float *nc = normals ? normals + 3 * ((ptrdiff_t)y * c->stride + x) : NULL;
+            const float *nc = normals ? normals + 3 * ss_index(c, x, y) : NULL;
             double jf, tf;
             int ok = 0;
             size_t o;
@@ -2293,7 +2423,7 @@ hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth, co
         for (x = c.gx; x < c.W - c.gx; x++) {
             double zc = ss_tex(&c, depth, x, y), acc = 0.0, a = 0.0;
             if (!ss_bg(&c, zc)) {
-                const float *np = normals + 3 * ((ptrdiff_t)y * c.stride + x);
+                const float *np = normals + 3 * ss_index(&c, x, y);
                 double P[3], n[3], O[3], T[3], B[3], sg, aa, bb, xi1, xi2;
                 ss_unproject(&c, (double)x + 0.5, (double)y + 0.5, zc, P);
                 n[0] = (double)np[0];
@@ -2486,7 +2616,7 @@ hfvis_status hfvis_ssao_scene_render(const hfvis_camera *cam, const hfvis_ssao_s
     for (y = 0; y < c.H; y++)
         for (x = 0; x < c.W; x++) {
             double P[3], n[3], z;
-            ptrdiff_t o = (ptrdiff_t)y * c.stride + x;
+            ptrdiff_t o = ss_index(&c, x, y);
             ss_unproject(&c, (double)x + 0.5, (double)y + 0.5, 1.0, P);
             z = ss_scene_hit(scene, c.persp, P[0], P[1], n);
             depth[o] = (float)z;
@@ -3222,7 +3352,7 @@ static void ssb_pixel_dir(const ssb_ctx *x, const ssb_dir *dd, double cu, double
  * it is (0,0,0)). */
 static void ssb_normal(const ss_cam *c, const float *normals, int x, int y, double z, double n[3])
 {
-    const float *np = normals + 3 * ((ptrdiff_t)y * c->stride + x);
+    const float *np = normals + 3 * ss_index(c, x, y);
     n[0] = (double)np[0];
     n[1] = (double)np[1];
     n[2] = (double)np[2];

@@ -149,6 +149,7 @@
     X(depth_linear, V, -, "ZFER", "NaN; +(double)INFINITY for a non-finite depth") \
     X(depth_hardware, V, -, "GFER", "NaN") \
     X(depth_linearize, S, -, "NZGOFER", "INVALID_ARGUMENT") \
+    X(camera_from_matrix, S, -, "NZGOFER", "INVALID_ARGUMENT LIMIT") \
     X(depth_normals, S, -, "NZGOFER", "INVALID_ARGUMENT") \
     X(camera_line_plane, S, -, "NZGOFER", "INVALID_ARGUMENT") \
     X(falloff_check, S, -, "NZGFE", "INVALID_ARGUMENT") \
@@ -2251,6 +2252,7 @@ static void args_partial_load(void)
     bc = cam_ok; bc.fy = 0.0; BAD('Z', INV, expr); \
     bc = cam_ok; bc.cx = (double)INFINITY; BAD('F', INV, expr); \
     bc = cam_ok; bc.far_depth = -1.0; BAD('G', INV, expr); \
+    bc = cam_ok; bc.rows_bottom_up = 2; BAD('R', INV, expr); \
     bc = cam_ok; bc.width = HFVIS_SSAO_MAX_SIZE + 1; BAD('O', limit_status, expr); \
     } while (0)
 
@@ -2308,6 +2310,33 @@ static void args_camera_from_view(void)
     b = view_ok; b.proj[0] = (double)NAN; BAD('F', INV, hfvis_camera_from_view(c, &b, 1, 1));
     b = view_ok; b.proj[3] = 1.0; BAD('S', INV, hfvis_camera_from_view(c, &b, 1, 1));
     b = view_ok; b.width = HFVIS_SSAO_MAX_SIZE + 1; BAD('O', LIM, hfvis_camera_from_view(c, &b, 1, 1));
+}
+
+static void args_camera_from_matrix(void)
+{
+    /* a GL perspective matrix (n = 0.5, f = 50), column-major */
+    static const double gl[16] = {1.5, 0, 0, 0, 0, 2.0, 0, 0, 0, 0, -50.5 / 49.5, -1, 0, 0, -50.0 / 49.5, 0};
+    double b[16];
+    hfvis_camera *c;
+    hfvis_projection_depth *d;
+    begin("camera_from_matrix");
+    c = AT(hfvis_camera);
+    d = AT(hfvis_projection_depth);
+    OK(hfvis_camera_from_matrix(c, gl, HFVIS_CLIP_DEPTH_GL, 8, 8, 1, 1, d));
+    BAD('N', INV, hfvis_camera_from_matrix(NULL, gl, HFVIS_CLIP_DEPTH_GL, 8, 8, 1, 1, d));
+    BAD('N', INV, hfvis_camera_from_matrix(c, NULL, HFVIS_CLIP_DEPTH_GL, 8, 8, 1, 1, d));
+    BAD('Z', INV, hfvis_camera_from_matrix(c, gl, HFVIS_CLIP_DEPTH_GL, 0, 8, 1, 1, d));
+    BAD('G', INV, hfvis_camera_from_matrix(c, gl, HFVIS_CLIP_DEPTH_GL, 8, 8, -1, 1, d));
+    BAD('O', LIM, hfvis_camera_from_matrix(c, gl, HFVIS_CLIP_DEPTH_GL, HFVIS_SSAO_MAX_SIZE + 1, 8, 1, 1, d));
+    BAD('E', INV, hfvis_camera_from_matrix(c, gl, (hfvis_clip_depth)0, 8, 8, 1, 1, d));
+    BAD('E', INV, hfvis_camera_from_matrix(c, gl, (hfvis_clip_depth)3, 8, 8, 1, 1, d));
+    memcpy(b, gl, sizeof b); b[10] = (double)NAN;
+    BAD('F', INV, hfvis_camera_from_matrix(c, b, HFVIS_CLIP_DEPTH_GL, 8, 8, 1, 1, d));
+    memcpy(b, gl, sizeof b); b[4] = 0.1; /* x-y shear */
+    BAD('R', INV, hfvis_camera_from_matrix(c, b, HFVIS_CLIP_DEPTH_GL, 8, 8, 1, 1, d));
+    memcpy(b, gl, sizeof b); b[10] = -1.0 + 1e-7; /* an epsilon-adjusted infinite far plane */
+    BAD('R', INV, hfvis_camera_from_matrix(c, b, HFVIS_CLIP_DEPTH_GL, 8, 8, 1, 1, d));
+    BAD('R', INV, hfvis_camera_from_matrix(c, gl, HFVIS_CLIP_DEPTH_GL, 8, 8, 4, 1, d));
 }
 
 static void args_camera_unproject(void)

@@ -1971,9 +1971,118 @@ TEST(lsao_falloff_tangent_plane_vs_oracle)
             }
 }
 
+/* Projection matrices as ports have them: GL (right-handed, clip z in [-1, 1]) and D3D
+ * (left-handed, [0, 1]), standard, reversed, infinite far, perspective and orthographic. Each
+ * matrix projects view points to (u, v, window depth); the camera and the recognised encoding
+ * must give the point back. */
+#define FROM_MATRIX_TOL 1e-9 /* double round trips through a few divisions */
+TEST(camera_from_matrix_round_trip)
+{
+    enum { W = 64, H = 48 };
+    const double n = 0.5, f = 80.0, sx = 1.4, sy = 1.9, ox = 0.1, oy = -0.05;
+    int kase;
+    for (kase = 0; kase < 10; kase++) {
+        /* A[row][col]; lh: the view looks down +Z (D3D), else -Z (GL) */
+        double A[4][4], m[16], as = 0.0, bs = 0.0;
+        int lh = kase >= 4 && kase != 8, zo = kase >= 3, ortho = kase >= 7, r, k, enc;
+        hfvis_clip_depth clip = zo ? HFVIS_CLIP_DEPTH_ZERO_TO_ONE : HFVIS_CLIP_DEPTH_GL;
+        hfvis_camera cam;
+        hfvis_projection_depth pd;
+        double zsgn = lh ? 1.0 : -1.0; /* view Z of a point at linear depth z: zsgn z */
+        memset(A, 0, sizeof A);
+        A[0][0] = sx;
+        A[1][1] = sy;
+        if (!ortho) {
+            A[0][2] = zsgn * ox; /* off-centre: x_ndc = sx X/z + ox */
+            A[1][2] = zsgn * oy;
+            A[3][2] = zsgn;
+        } else {
+            A[0][3] = ox;
+            A[1][3] = oy;
+            A[3][3] = 1.0;
+        }
+        /* window depth d = alpha + beta/z (ortho alpha + beta z), then mapped to z_ndc */
+        switch (kase) {
+        case 0: case 3: case 4: as = f / (f - n); bs = -f * n / (f - n); enc = HFVIS_DEPTH_D3D; break;
+        case 1: as = 1.0; bs = -n; enc = HFVIS_DEPTH_INFINITE_FAR; break;
+        case 2: case 5: as = -n / (f - n); bs = n * f / (f - n); enc = HFVIS_DEPTH_REVERSED_Z; break;
+        case 6: as = 0.0; bs = n; enc = HFVIS_DEPTH_REVERSED_INFINITE; break;
+        case 7: case 8: as = -n / (f - n); bs = 1.0 / (f - n); enc = HFVIS_DEPTH_D3D; break;
+        default: as = f / (f - n); bs = -1.0 / (f - n); enc = HFVIS_DEPTH_REVERSED_Z; break;
+        }
+        if (!zo) { as = 2.0 * as - 1.0; bs *= 2.0; } /* z_ndc = 2 d - 1 */
+        if (!ortho) { A[2][2] = zsgn * as; A[2][3] = bs; }
+        else { A[2][2] = zsgn * bs; A[2][3] = as; }
+        for (r = 0; r < 4; r++)
+            for (k = 0; k < 4; k++) m[4 * k + r] = A[r][k];
+        CHECK_EQ_STATUS(hfvis_camera_from_matrix(&cam, m, clip, W, H, 4, 3, &pd), HFVIS_OK);
+        CHECK(pd.encoding == (hfvis_depth_encoding)enc && pd.orthographic == ortho);
+        CHECK_NEAR(pd.near_plane, n, FROM_MATRIX_TOL, FROM_MATRIX_TOL);
+        if (kase == 1 || kase == 6) CHECK(isinf(pd.far_plane) && cam.far_depth == 0.0);
+        else {
+            CHECK_NEAR(pd.far_plane, f, FROM_MATRIX_TOL, FROM_MATRIX_TOL);
+            CHECK(cam.far_depth <= pd.far_plane && (double)(float)pd.far_plane >= cam.far_depth);
+        }
+        for (k = 0; k < 5; k++) {
+            double X = -1.3 + 0.7 * k, Y = 0.9 - 0.4 * k, z = 1.0 + 9.0 * k, v4[4], clipv[4], u, v, d, zl, P[3];
+            v4[0] = X; v4[1] = Y; v4[2] = zsgn * z; v4[3] = 1.0;
+            for (r = 0; r < 4; r++) clipv[r] = A[r][0] * v4[0] + A[r][1] * v4[1] + A[r][2] * v4[2] + A[r][3] * v4[3];
+            u = 0.5 * W * (1.0 + clipv[0] / clipv[3]);
+            v = 0.5 * H * (1.0 - clipv[1] / clipv[3]);
+            d = clipv[2] / clipv[3];
+            if (!zo) d = 0.5 * (d + 1.0);
+            zl = hfvis_depth_linear(d, pd.encoding, pd.orthographic, pd.near_plane, pd.far_plane);
+            CHECK_NEAR(zl, z, FROM_MATRIX_TOL, FROM_MATRIX_TOL);
+            CHECK_EQ_STATUS(hfvis_camera_unproject(&cam, u, v, zl, P), HFVIS_OK);
+            CHECK_NEAR(P[0], X, FROM_MATRIX_TOL, FROM_MATRIX_TOL);
+            CHECK_NEAR(P[1], Y, FROM_MATRIX_TOL, FROM_MATRIX_TOL);
+            CHECK_NEAR(P[2], -z, FROM_MATRIX_TOL, FROM_MATRIX_TOL);
+        }
+    }
+}
+
+/* Bottom-up rows (glReadPixels order) read in place equal the top-down run bit for bit. */
+TEST(rows_bottom_up)
+{
+    enum { W = 48, H = 36, G = 4, IW = W - 2 * G, IH = H - 2 * G };
+    static float depth[W * H], flipped[W * H], nf[3 * W * H], nt[3 * W * H], a[IW * IH], b[IW * IH];
+    hfvis_camera cam, up;
+    hfvis_ssao_scene sc;
+    hfvis_lsao_options lo = hfvis_lsao_options_default();
+    hfvis_hbao_options ho = hfvis_hbao_options_default();
+    int x, y;
+    memset(&sc, 0, sizeof sc);
+    sc.kind = HFVIS_SSAO_SCENE_PIT;
+    sc.base_depth = 10.0;
+    sc.radius = 2.0;
+    sc.x0 = 0.7;
+    sc.y0 = -0.4; /* off-centre, so a flipped image would differ */
+    CHECK_EQ_STATUS(hfvis_camera_perspective(&cam, W, H, G, G, 1.0), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_ssao_scene_render(&cam, &sc, depth, NULL), HFVIS_OK);
+    for (y = 0; y < H; y++) memcpy(flipped + (size_t)(H - 1 - y) * W, depth + (size_t)y * W, W * sizeof(float));
+    up = cam;
+    up.rows_bottom_up = 1;
+    CHECK_EQ_STATUS(hfvis_lsao(&cam, depth, NULL, &lo, a, IW), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_lsao(&up, flipped, NULL, &lo, b, IW), HFVIS_OK);
+    CHECK(memcmp(a, b, sizeof a) == 0);
+    ho.max_radius_px = 8.0;
+    CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, NULL, &ho, a, IW), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_hbao(&up, flipped, NULL, &ho, b, IW), HFVIS_OK);
+    CHECK(memcmp(a, b, sizeof a) == 0);
+    CHECK_EQ_STATUS(hfvis_depth_normals(&cam, depth, nt), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_depth_normals(&up, flipped, nf), HFVIS_OK);
+    for (y = 0; y < H; y++)
+        for (x = 0; x < 3 * W; x++)
+            if (nt[(size_t)y * 3 * W + x] != nf[(size_t)(H - 1 - y) * 3 * W + x]) { CHECK(0); return; }
+    CHECK_EQ_STATUS(hfvis_ssao_scene_render(&up, &sc, flipped, NULL), HFVIS_OK);
+    for (y = 0; y < H; y++) CHECK(memcmp(flipped + (size_t)(H - 1 - y) * W, depth + (size_t)y * W, W * sizeof(float)) == 0);
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
+    RUN(camera_from_matrix_round_trip);
+    RUN(rows_bottom_up);
     RUN(lsao_flat_plane_bound);
     RUN(lsao_falloff_tangent_plane_vs_oracle);
     RUN(camera_check);
