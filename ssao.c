@@ -1952,7 +1952,7 @@ done:
 /* 6. HBAO (Bavoil, Sainz, Dimitrov 2008; thesis l.466, [P4] l.1988; spec §4.1)               */
 /* ========================================================================================== */
 
-#define SS_HBAO_DEFAULT_K 8
+#define SS_HBAO_DEFAULT_K 16 /* as LSAO: no paper asks HBAO for fewer */
 
 hfvis_hbao_options hfvis_hbao_options_default(void)
 {
@@ -2015,6 +2015,14 @@ hfvis_status hfvis_hbao_options_resolve(const hfvis_hbao_options *in, hfvis_hbao
     return HFVIS_OK;
 }
 
+/* The default cap on HBAO's screen radius: a sixteenth of the inner image's height, at least 8
+ * pixels (a 720p frame marches 45 pixels per direction, not to the buffer's edge). */
+static double ss_hbao_default_radius_px(const ss_cam *c)
+{
+    double r = (double)(c->H - 2 * c->gy) / 16.0;
+    return r > 8.0 ? r : 8.0;
+}
+
 /* One HBAO pixel (spec §4.1 HbaoPixel). dirs: the custom directions or NULL; the result is
  * divided by the weight sum, which normalises custom weights. */
 static double ss_hbao_pixel(const ss_cam *c, const hfvis_hbao_options *o, const ss_fall *f,
@@ -2024,10 +2032,12 @@ static double ss_hbao_pixel(const ss_cam *c, const hfvis_hbao_options *o, const 
     int K = o->directions, k, bil = o->sampling == HFVIS_SSAO_SAMPLING_BILINEAR;
     int exact = o->plane == HFVIS_SSAO_PLANE_EXACT, custom = o->custom_directions != NULL;
     double u0 = (double)x + 0.5, v0 = (double)y + 0.5, zc = ss_tex(c, depth, x, y), P[3];
-    double rot = 0.0, xi = 1.0, sum = 0.0, wsum = 0.0, maxr;
+    double rot = 0.0, xi = 1.0, sum = 0.0, wsum = 0.0, maxr, diag;
     ss_unproject(c, u0, v0, zc, P);
-    maxr = o->max_radius_px > 0.0 ? o->max_radius_px
-                                   : sqrt((double)c->W * (double)c->W + (double)c->H * (double)c->H);
+    maxr = o->max_radius_px > 0.0 ? o->max_radius_px : ss_hbao_default_radius_px(c);
+    diag = sqrt((double)c->W * (double)c->W + (double)c->H * (double)c->H);
+    if (!(maxr < diag)) maxr = diag; /* no sample beyond the diagonal is inside the buffer (and
+                                        ceil(R_px / step) then fits an int) */
     if (o->jitter != HFVIS_HBAO_JITTER_NONE)
         rot = 2.0 * SS_PI / (double)K * ss_hash01((uint32_t)x, (uint32_t)y, 0u, o->seed);
     if (o->jitter == HFVIS_HBAO_JITTER_ROTATION_STEP)

@@ -1344,6 +1344,15 @@ TEST(raytrace_plane_zero)
     CHECK(bad == 0);
 }
 
+/* HBAO options that march to the buffer's edge (the closed forms and the LSAO comparison
+ * assume the unbounded march; the default caps the screen radius). */
+static hfvis_hbao_options hbao_whole_buffer(int width, int height)
+{
+    hfvis_hbao_options o = hfvis_hbao_options_default();
+    o.max_radius_px = sqrt((double)width * (double)width + (double)height * (double)height);
+    return o;
+}
+
 /* HBAO against the SA closed forms (spec §6): T5 cliff with K = 4 axis directions exactly
  * H/sqrt(H^2 + l^2)/4 (l = L + px/2: the first plateau texel centre); T6 groove K = 4:
  * sin(beta)/2 exactly; T7 pit: sin 45 deg and, with rho_q, the integral of rho(2 Rb s). */
@@ -1353,7 +1362,7 @@ TEST(hbao_sa_closed_forms)
     static float depth[W0 * H0], nrm[3 * W0 * H0], ao[IW * IH];
     hfvis_camera c;
     hfvis_ssao_scene sc;
-    hfvis_hbao_options o = hfvis_hbao_options_default();
+    hfvis_hbao_options o = hbao_whole_buffer(W0, H0);
     double px = 0.1, Hs = 1.5;
     int x, bad = 0;
     CHECK_EQ_STATUS(hfvis_camera_orthographic(&c, W0, H0, G, GY, px), HFVIS_OK);
@@ -1491,7 +1500,7 @@ TEST(hbao_rt_bad_args_and_oom)
     for (i = 0; i < W * H; i++) ao[i] = keep[i] = -3.0f;
     CHECK_EQ_STATUS(hfvis_hbao_options_resolve(NULL, &hr), HFVIS_OK);
     CHECK_EQ_STATUS(hfvis_hbao_options_resolve(&h, &hb), HFVIS_OK);
-    CHECK(memcmp(&hr, &hb, sizeof hr) == 0 && hr.directions == 8 && hr.tangent == HFVIS_SSAO_TANGENT_REAL);
+    CHECK(memcmp(&hr, &hb, sizeof hr) == 0 && hr.directions == 16 && hr.tangent == HFVIS_SSAO_TANGENT_REAL);
     CHECK_EQ_STATUS(hfvis_ssao_rt_options_resolve(NULL, &rr), HFVIS_OK);
     CHECK_EQ_STATUS(hfvis_ssao_rt_options_resolve(&r, &rb), HFVIS_OK);
     CHECK(memcmp(&rr, &rb, sizeof rr) == 0 && rr.rays == 256 && rr.sampling == HFVIS_SSAO_SAMPLING_BILINEAR);
@@ -1731,7 +1740,7 @@ TEST(lsao_vs_hbao_scenes)
     for (sc = 0; sc < 3; sc++) {
         hfvis_camera cam;
         hfvis_lsao_options lo = hfvis_lsao_options_default();
-        hfvis_hbao_options ho = hfvis_hbao_options_default();
+        hfvis_hbao_options ho = hbao_whole_buffer(W0, H0);
         hfvis_ssao_direction dirs[16];
         double r = sc == 2 ? 40.0 : (sc == 1 ? 0.01 : 0.3), mean = 0.0, mean_dense = 0.0, maxd = 0.0;
         int i, n = 0;
@@ -2065,6 +2074,13 @@ TEST(rows_bottom_up)
     CHECK_EQ_STATUS(hfvis_lsao(&cam, depth, NULL, &lo, a, IW), HFVIS_OK);
     CHECK_EQ_STATUS(hfvis_lsao(&up, flipped, NULL, &lo, b, IW), HFVIS_OK);
     CHECK(memcmp(a, b, sizeof a) == 0);
+    /* a radius past the diagonal marches exactly as the diagonal (it once overflowed the step
+     * count: ceil(1e12 / step) does not fit an int) */
+    ho.max_radius_px = 1e12;
+    CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, NULL, &ho, a, IW), HFVIS_OK);
+    ho.max_radius_px = sqrt((double)W * W + (double)H * H);
+    CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, NULL, &ho, b, IW), HFVIS_OK);
+    CHECK(memcmp(a, b, sizeof a) == 0);
     ho.max_radius_px = 8.0;
     CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, NULL, &ho, a, IW), HFVIS_OK);
     CHECK_EQ_STATUS(hfvis_hbao(&up, flipped, NULL, &ho, b, IW), HFVIS_OK);
@@ -2078,9 +2094,38 @@ TEST(rows_bottom_up)
     for (y = 0; y < H; y++) CHECK(memcmp(flipped + (size_t)(H - 1 - y) * W, depth + (size_t)y * W, W * sizeof(float)) == 0);
 }
 
+/* HBAO's default screen radius is a sixteenth of the inner height (at least 8 pixels): a cliff
+ * 20 pixels from the receivers is out of reach by default and in reach with the diagonal. It
+ * used to march to the buffer's edge, 72 s of one core for a 720p frame. */
+TEST(hbao_default_radius)
+{
+    enum { W0 = 160, H0 = 128, G = 16, IW = W0 - 2 * G, IH = H0 - 2 * G };
+    static float depth[W0 * H0], ao[IW * IH];
+    hfvis_camera c;
+    hfvis_ssao_scene sc;
+    hfvis_hbao_options o = hfvis_hbao_options_default(), r;
+    const double px = 0.1;
+    int x0 = 40; /* receivers at inner column 40 - 20 = 20 see the cliff 20 px away */
+    CHECK_EQ_STATUS(hfvis_camera_orthographic(&c, W0, H0, G, G, px), HFVIS_OK);
+    memset(&sc, 0, sizeof sc);
+    sc.kind = HFVIS_SSAO_SCENE_STEP;
+    sc.base_depth = 20.0;
+    sc.height = 5.0;
+    sc.x0 = ((double)(G + x0) - 0.5 * W0) * px;
+    CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, depth, NULL), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_hbao_options_resolve(&o, &r), HFVIS_OK);
+    CHECK(r.directions == 16);
+    CHECK_EQ_STATUS(hfvis_hbao(&c, depth, NULL, &o, ao, IW), HFVIS_OK);
+    CHECK(ao[(IH / 2) * IW + x0 - 20] == 0.0f); /* IH/16 = 6 -> the 8-pixel floor */
+    o.max_radius_px = sqrt((double)W0 * W0 + (double)H0 * H0);
+    CHECK_EQ_STATUS(hfvis_hbao(&c, depth, NULL, &o, ao, IW), HFVIS_OK);
+    CHECK(ao[(IH / 2) * IW + x0 - 20] > 0.05f);
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
+    RUN(hbao_default_radius);
     RUN(camera_from_matrix_round_trip);
     RUN(rows_bottom_up);
     RUN(lsao_flat_plane_bound);
