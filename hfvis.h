@@ -1,14 +1,92 @@
 /* hfvis.h - height-field and screen-space visibility: the authoritative CPU reference.
  * Version 0.1.0. MIT licence (see LICENSE).
  *
- * hfvis computes horizon maps, sky light, sun shadows and environment light on height fields
- * with the line-sweep convex-hull algorithm of Timonen & Westerholm 2010 ([P1], "Scalable
- * Height Field Self-Shadowing"), and ships a brute-force oracle beside every fast routine so a
- * GPU port can be checked against hfvis, and hfvis against first principles.
+ * hfvis is a pure C99, single-threaded, dependency-free library: copy this header and the
+ * .c files you need (hfvis.c for height fields, ssao.c for screen space, voxel.c for meshes and
+ * volumes; ssao.c and voxel.c need hfvis.c) into a project and compile them with
+ * `cc -std=c99 -c`. It computes, on the CPU and as the papers define them:
+ *   - horizon maps, sky light, sky-view factor, sun shadows and environment light on height
+ *     fields by line sweeps with convex hulls [P1]; intervisibility, visibility index and
+ *     indirect light with hull trees [P2]; viewsheds [R2]; multi-resolution height-field
+ *     global illumination [NS09];
+ *   - screen-space obscurance: line-sweep AO [P3], far-field AO [P4], HBAO [BSD08] and a
+ *     screen-space ray-traced reference; bitmask ray-cast AO on meshes [LK];
+ *   - meshes, BVH ray casting, surface / conservative / solid voxelization, incremental
+ *     image-based voxelization, 4D visibility fields and volume-based VPL indirect light [G12].
+ * Beside every fast routine stands its oracle, a slow public function from first principles, so
+ * a GPU port can be checked against hfvis, and hfvis against the definition.
  *
- * History
- *   0.1.0  PGM/PFM codecs, analytic fields, sweep lattice, P1 hull horizons, uniform sky,
- *          sky-view factor, sun visibility, environment light (prefix and L_p table), oracles.
+ * Oracles and production routines. A production routine is the fast algorithm of a paper. Its
+ * oracle is documented beside it ("Oracle of ...") and computes the same quantity by brute
+ * force: *_naive over exactly the samples the fast routine uses (held to it bit for bit, or
+ * within the tolerance its documentation names), *_reference from first principles with its
+ * own sampling (a ray march, a hemisphere integral, a per-voxel test); a few oracles predate
+ * the suffixes (hfvis_ssao_raytrace, hfvis_lk_raycast) and say so in their comments.
+ * Production routines never call oracles; oracles cost what their comments state (often
+ * quadratic) and are meant for tests and validation, not for production sizes.
+ *
+ * Contents (main entry points per task; every section below documents its building blocks)
+ *   Files        hfvis_image_load, hfvis_pfm_save, hfvis_pgm_save; the in-memory codecs
+ *                hfvis_image_decode, hfvis_pfm_encode, hfvis_pgm_encode
+ *   Terrain      hfvis_horizon_map, hfvis_horizon_direction (oracles hfvis_horizon_reference,
+ *                hfvis_horizon_lattice_naive); hfvis_sky_view_factor, hfvis_sky_light,
+ *                hfvis_sun_visibility, hfvis_env_light (oracle hfvis_light_reference);
+ *                hfvis_intervisibility, hfvis_visibility_count, hfvis_indirect_light,
+ *                hfvis_terrain_gi (oracles *_naive); hfvis_viewshed (hfvis_viewshed_reference);
+ *                split runs: hfvis_direction_sums and the partial-sum file hfvis_partial_*
+ *   Terrain GI   hfvis_ns_gi ([NS09]); the SH, ZH and NLP helpers hfvis_sh_*, hfvis_zh_*,
+ *                hfvis_nlp_*
+ *   Screen space hfvis_camera_perspective, hfvis_camera_from_matrix, hfvis_depth_linearize;
+ *                hfvis_lsao (oracle route hfvis_lsao_direction_naive), hfvis_hbao, hfvis_ffao,
+ *                hfvis_ssao_raytrace (the reference), hfvis_ssao_mipmap, hfvis_ssao_error
+ *   Meshes       hfvis_mesh_load, hfvis_rasterize, hfvis_bvh_build, hfvis_bvh_closest_hit,
+ *                hfvis_lk_image ([LK]; oracle hfvis_lk_raycast)
+ *   Voxels       hfvis_voxelize_surface, hfvis_voxelize_conservative, hfvis_voxelize_solid,
+ *                hfvis_voxelize_bitmask, hfvis_iv_update (each with its *_reference),
+ *                hfvis_binvox_save
+ *   Visibility fields  hfvis_visfield_build, hfvis_visfield_query,
+ *                hfvis_visfield_ambient_occlusion (each with its *_reference)
+ *   Volume GI    hfvis_volgi_render and its stages hfvis_volgi_inject, _propagate, _gather
+ *
+ * References
+ *   [P1]   V. Timonen, J. Westerholm, "Scalable Height Field Self-Shadowing", Computer Graphics
+ *          Forum 29(2) (Eurographics 2010).
+ *   [P2]   V. Timonen, "Low-Complexity Intervisibility in Height Fields", Computer Graphics
+ *          Forum 31(8), 2012.
+ *   [P3]   V. Timonen, "Line-Sweep Ambient Obscurance", Computer Graphics Forum 32(4)
+ *          (EGSR 2013).
+ *   [P4]   V. Timonen, "Screen-Space Far-Field Ambient Obscurance", HPG 2013.
+ *          [P1]-[P4] are collected, with appendices A.1 and A.2 that correct [P1] and [P2], in
+ *          V. Timonen, "Scalable Algorithms for Height Field Illumination", TUCS Dissertations
+ *          173, Abo Akademi University, 2014.
+ *   [LK]   S. Laine, T. Karras, "Two Methods for Fast Ray-Cast Ambient Occlusion", Computer
+ *          Graphics Forum 29(4) (EGSR 2010).
+ *   [NS09] D. Nowrouzezahrai, J. Snyder, "Fast Global Illumination on Dynamic Height Fields",
+ *          Computer Graphics Forum 28(4) (EGSR 2009).
+ *   [G12]  A. Gaitatzes, "Interactive Diffuse Global Illumination Discretization Methods for
+ *          Dynamic Environments", PhD thesis, University of Cyprus, 2012.
+ *   [R2]   W. R. Franklin, C. K. Ray, "Higher isn't necessarily better: visibility algorithms
+ *          and experiments", 6th Int. Symposium on Spatial Data Handling, 1994 (algorithm R2).
+ *   [BSD08] L. Bavoil, M. Sainz, R. Dimitrov, "Image-Space Horizon-Based Ambient Occlusion",
+ *          SIGGRAPH 2008 Talks.
+ *   [Z11]  K. Zaksek, K. Ostir, Z. Kokalj, "Sky-View Factor as a Relief Visualization
+ *          Technique", Remote Sensing 3(2), 2011 (the sky-view factor of terrain tools).
+ *
+ * History (one line per milestone)
+ *   P1 engine     PGM/PFM codecs, analytic fields, sweep lattice, P1 hull horizons, uniform sky,
+ *                 sky-view factor, sun visibility, environment light (prefix and L_p table).
+ *   P2            hull trees, intervisibility, visibility index, indirect light and bounces.
+ *   Screen space  camera and depth, P3 line-sweep AO, P4 far-field AO, HBAO, the ray-traced
+ *                 reference, the mipmap baseline, error metrics.
+ *   Meshes        meshes and OBJ, rasterizer, BVH, surface / conservative / solid voxelization,
+ *                 binvox, incremental voxelization.
+ *   [LK]          bitmask ray-cast AO: ray sets, masks, look-up tables, raster and BVH methods.
+ *   [G12]         4D visibility fields and volume-based VPL indirect light.
+ *   [NS09]        multi-resolution height-field GI.
+ *   Release       the hfvis CLI, split runs and the partial-sum file, install and pkg-config,
+ *                 viewsheds, the gallery.
+ *   Ports         cameras from projection matrices, bottom-up rows, LSAO's step-falloff
+ *                 refusal, HBAO defaults aligned with LSAO's.
  *
  * ------------------------------------------------------------------------------------------
  * QUICK START
