@@ -76,4 +76,67 @@ static inline hfvis_allocator test_counting_allocator(test_counting *c, long fai
     a.user = c;
     return a;
 }
+
+/* The golden check every test program uses: img (w x h floats) against test/golden/NAME.pfm
+ * (the programs run from the repository root). A value differs when it is NaN where the golden
+ * is not (or the reverse) or farther than tol from it. With --update-golden the file is
+ * rewritten instead. On a failure the check writes NAME.failed.pfm, expected | actual |
+ * |actual - expected| side by side in one 3w x h PFM, into $HFVIS_TEST_OUT (default: the
+ * current directory), and says where. */
+static inline void test_golden(const char *name, const float *img, int w, int h, double tol)
+{
+    char path[512], out[1024];
+    const char *dir = getenv("HFVIS_TEST_OUT");
+    float *gold = NULL, *panel;
+    hfvis_image_info info;
+    hfvis_status st;
+    int i, bad = 0;
+    double worst = 0.0;
+    snprintf(path, sizeof path, "test/golden/%s.pfm", name);
+    if (test_update_golden) {
+        CHECK_EQ_STATUS(hfvis_pfm_save(path, img, w, h, 1, w), HFVIS_OK);
+        printf("     wrote %s\n", path);
+        return;
+    }
+    st = hfvis_image_load(path, NULL, &gold, &info);
+    CHECK_EQ_STATUS(st, HFVIS_OK);
+    if (st != HFVIS_OK) {
+        fprintf(stderr, "  golden: cannot load %s (run from the repository root; "
+                "make update-golden writes it)\n", path);
+        return;
+    }
+    if (info.width != w || info.height != h || info.channels != 1) {
+        fprintf(stderr, "  golden %s: %d x %d x %d, want %d x %d x 1\n", path, info.width,
+                info.height, info.channels, w, h);
+        CHECK(0);
+        hfvis_free(NULL, gold);
+        return;
+    }
+    for (i = 0; i < w * h; i++) {
+        double d = fabs((double)img[i] - (double)gold[i]);
+        if (isnan(img[i]) != isnan(gold[i]) || d > tol) bad++;
+        if (d > worst) worst = d;
+    }
+    CHECK(bad == 0);
+    if (bad && (panel = (float *)malloc(sizeof(float) * 3 * (size_t)w * (size_t)h)) != NULL) {
+        int x, y;
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w; x++) {
+                float e = gold[y * w + x], a = img[y * w + x];
+                panel[(size_t)y * 3 * w + x] = e;
+                panel[(size_t)y * 3 * w + w + x] = a;
+                panel[(size_t)y * 3 * w + 2 * w + x] = (float)fabs((double)a - (double)e);
+            }
+        snprintf(out, sizeof out, "%s%s%s.failed.pfm", dir ? dir : "", dir ? "/" : "", name);
+        if (hfvis_pfm_save(out, panel, 3 * w, h, 1, 3 * w) == HFVIS_OK)
+            fprintf(stderr, "  golden %s: %d values differ (worst %.3g); wrote %s (expected | "
+                    "actual | difference); if intended, run make update-golden\n", path, bad,
+                    worst, out);
+        else
+            fprintf(stderr, "  golden %s: %d values differ (worst %.3g); if intended, run make "
+                    "update-golden\n", path, bad, worst);
+        free(panel);
+    }
+    hfvis_free(NULL, gold);
+}
 #endif

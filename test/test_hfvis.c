@@ -966,8 +966,6 @@ TEST(l1_pit)
  * relative, which can flip a float rounding; 1e-6 rad is far above that and far below any
  * algorithmic change. */
 #define GOLDEN_TOL 1e-6
-#define GOLDEN_PATH "test/golden/horizon_fbm32_k8.pfm"
-#define GOLDEN_ACTUAL "build/horizon_fbm32_k8_actual.pfm"
 
 TEST(golden_horizon_map)
 {
@@ -980,37 +978,7 @@ TEST(golden_horizon_map)
     if (!z || !map) { free(z); free(map); return; }
     g.z = z; g.width = W; g.height = H; g.stride = W; g.cell_size = 1.0;
     CHECK_EQ_STATUS(hfvis_horizon_map(&g, K, NULL, map), HFVIS_OK);
-    if (test_update_golden) {
-        CHECK_EQ_STATUS(hfvis_pfm_save(GOLDEN_PATH, map, W, K * H, 1, W), HFVIS_OK);
-        printf("     wrote %s\n", GOLDEN_PATH);
-    } else {
-        float *gold = NULL;
-        hfvis_image_info info;
-        hfvis_status st = hfvis_image_load(GOLDEN_PATH, NULL, &gold, &info);
-        CHECK_EQ_STATUS(st, HFVIS_OK);
-        if (st == HFVIS_OK) {
-            int i, bad = 0;
-            double worst = 0.0;
-            CHECK(info.width == W && info.height == K * H && info.channels == 1);
-            if (info.width == W && info.height == K * H && info.channels == 1)
-                for (i = 0; i < K * W * H; i++) {
-                    double d = fabs((double)map[i] - (double)gold[i]);
-                    if (isnan(map[i]) != isnan(gold[i]) || d > GOLDEN_TOL) bad++;
-                    if (d > worst) worst = d;
-                }
-            else bad = 1;
-            if (bad) {
-                hfvis_pfm_save(GOLDEN_ACTUAL, map, W, K * H, 1, W);
-                fprintf(stderr, "  golden: %d values differ (worst %.3g rad); wrote %s; if the change is "
-                        "intended, run make update-golden\n", bad, worst, GOLDEN_ACTUAL);
-            }
-            CHECK(bad == 0);
-        } else {
-            fprintf(stderr, "  golden: cannot load %s (run from the repository root); "
-                    "run make update-golden\n", GOLDEN_PATH);
-        }
-        hfvis_free(NULL, gold);
-    }
+    test_golden("horizon_fbm32_k8", map, W, K * H, GOLDEN_TOL);
     free(z);
     free(map);
 }

@@ -549,37 +549,6 @@ TEST(alloc_failures)
 }
 
 /* goldens: one small PFM per method on the perspective pit (rho_q) */
-#define GOLDEN_DIR "test/golden/"
-static void golden_check(const char *name, const float *img, int w, int h)
-{
-    char path[256];
-    snprintf(path, sizeof path, GOLDEN_DIR "%s.pfm", name);
-    if (test_update_golden) {
-        CHECK_EQ_STATUS(hfvis_pfm_save(path, img, w, h, 1, w), HFVIS_OK);
-        printf("     wrote %s\n", path);
-    } else {
-        float *gold = NULL;
-        hfvis_image_info info;
-        hfvis_status st = hfvis_image_load(path, NULL, &gold, &info);
-        CHECK_EQ_STATUS(st, HFVIS_OK);
-        if (st == HFVIS_OK) {
-            int i, bad = 0;
-            double worst = 0.0;
-            if (info.width == w && info.height == h && info.channels == 1)
-                for (i = 0; i < w * h; i++) {
-                    double d = fabs((double)img[i] - (double)gold[i]);
-                    if (!(d <= TOL_GOLDEN)) bad++;
-                    if (d > worst) worst = d;
-                }
-            else bad = 1;
-            if (bad) fprintf(stderr, "  golden %s: %d values differ (worst %.3g); rerun with --update-golden if intended\n", path, bad, worst);
-            CHECK(bad == 0);
-        } else {
-            fprintf(stderr, "  golden: cannot load %s (run from the repository root with --update-golden)\n", path);
-        }
-        hfvis_free(NULL, gold);
-    }
-}
 
 TEST(goldens)
 {
@@ -600,26 +569,26 @@ TEST(goldens)
         hfvis_lsao_options lo = hfvis_lsao_options_default();
         lo.falloff = q;
         CHECK_EQ_STATUS(hfvis_lsao(&s.cam, s.depth, s.nrm, &lo, s.a, s.IW), HFVIS_OK);
-        golden_check("pit_lsao", s.a, s.IW, s.IH);
+        test_golden("pit_lsao", s.a, s.IW, s.IH, TOL_GOLDEN);
     }
     {
         hfvis_hbao_options ho = hfvis_hbao_options_default();
         ho.falloff = q;
         CHECK_EQ_STATUS(hfvis_hbao(&s.cam, s.depth, s.nrm, &ho, s.a, s.IW), HFVIS_OK);
-        golden_check("pit_hbao", s.a, s.IW, s.IH);
+        test_golden("pit_hbao", s.a, s.IW, s.IH, TOL_GOLDEN);
     }
     {
         hfvis_ffao_options fo = hfvis_ffao_options_default();
         fo.falloff = q;
         CHECK_EQ_STATUS(hfvis_ffao(&s.cam, s.depth, s.nrm, &fo, s.a, s.IW), HFVIS_OK);
-        golden_check("pit_ffao", s.a, s.IW, s.IH);
+        test_golden("pit_ffao", s.a, s.IW, s.IH, TOL_GOLDEN);
     }
     {
         hfvis_ssao_rt_options ro = hfvis_ssao_rt_options_default();
         ro.falloff = q;
         ro.rays = 64;
         CHECK_EQ_STATUS(hfvis_ssao_raytrace(&s.cam, s.depth, s.nrm, &ro, s.a, s.IW), HFVIS_OK);
-        golden_check("pit_raytrace", s.a, s.IW, s.IH);
+        test_golden("pit_raytrace", s.a, s.IW, s.IH, TOL_GOLDEN);
     }
     scene_free(&s);
 }
