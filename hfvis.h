@@ -165,7 +165,11 @@
 
 /* Configuration macros (all #ifndef-guarded):
  *   HFVIS_API           decoration for every public function (default empty).
- *   HFVIS_EXPERIMENTAL  reserved for functions whose signature may still change (default empty).
+ *   HFVIS_EXPERIMENTAL  decoration of the building blocks a port diffs against whose signatures
+ *                       may still change before 1.0 (default empty): the SH, ZH and normalized
+ *                       Legendre helpers and the wedge matrices of [NS09], the [LK] frame, plane
+ *                       masks and look-up-table indexing, the [P2] hull tree, the 2-band SH of
+ *                       the volume GI. Define it (e.g. as a deprecation attribute) to find uses.
  *   HFVIS_NO_STDIO      define when compiling the .c files to remove the file wrappers
  *                       (hfvis_*_load / hfvis_*_save); the in-memory codecs remain.
  *   HFVIS_ENABLE_ASSERTS / HFVIS_ASSERT(x)  internal invariant checks in the .c files only. */
@@ -683,36 +687,36 @@ typedef struct hfvis_tree_options {
 
 /* Bytes of caller memory for a tree of up to max_samples samples (0 if max_samples < 1 or the
  * size overflows). The memory must be aligned for double (malloc'd memory is). */
-HFVIS_API size_t hfvis_hull_tree_size(int max_samples);
+HFVIS_API HFVIS_EXPERIMENTAL size_t hfvis_hull_tree_size(int max_samples);
 
 /* Set up a tree in mem (mem_size >= hfvis_hull_tree_size(max_samples)); opts may be NULL.
  * *tree points into mem; nothing is allocated; no cleanup is needed.
  * Returns HFVIS_ERR_INVALID_ARGUMENT (NULL, bad options) or HFVIS_ERR_BUFFER_TOO_SMALL. */
-HFVIS_API hfvis_status hfvis_hull_tree_init(void *mem, size_t mem_size, int max_samples,
-                                           const hfvis_tree_options *opts, hfvis_hull_tree **tree);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_hull_tree_init(void *mem, size_t mem_size, int max_samples,
+                                                              const hfvis_tree_options *opts, hfvis_hull_tree **tree);
 
 /* Empty the tree for a new line (keeps capacity and options; the iteration count restarts).
  * tree may be NULL (no-op). */
-HFVIS_API void hfvis_hull_tree_reset(hfvis_hull_tree *tree);
+HFVIS_API HFVIS_EXPERIMENTAL void hfvis_hull_tree_reset(hfvis_hull_tree *tree);
 
 /* Push the next sample (distance strictly greater than the previous one, finite height) and
  * update the tree ([P2] Alg. 1). *horizon_count (may be NULL) receives the number of root
  * children. Returns HFVIS_ERR_INVALID_ARGUMENT for a non-finite value or a non-increasing
  * distance, HFVIS_ERR_LIMIT when max_samples samples are already in the tree.
  * Cost: amortised O(m) for m horizons; t <= 2m + n tests over a line ([P2] §6). */
-HFVIS_API hfvis_status hfvis_hull_tree_push(hfvis_hull_tree *tree, double distance, double height,
-                                           int *horizon_count);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_hull_tree_push(hfvis_hull_tree *tree, double distance, double height,
+                                                              int *horizon_count);
 
 /* The horizons of the newest sample, farthest first, as sample indices (push order) into out
  * (capacity cap). minimal = 0 gives the root children as the tree holds them, which are a
  * superset of the local horizons (spec §7.6); minimal = 1 keeps only true local horizons
  * (sample 0, or a sample whose predecessor is hidden). Returns the count (which may exceed cap:
  * then only cap are written), or -1 on NULL. */
-HFVIS_API int hfvis_hull_tree_horizons(const hfvis_hull_tree *tree, int minimal, int *out, int cap);
+HFVIS_API HFVIS_EXPERIMENTAL int hfvis_hull_tree_horizons(const hfvis_hull_tree *tree, int minimal, int *out, int cap);
 
 /* Number of samples pushed, and RecConvexity tests made since the last reset (the paper's
  * iteration count t; t <= 2m + n). Both 0 for NULL. */
-HFVIS_API int hfvis_hull_tree_count(const hfvis_hull_tree *tree);
+HFVIS_API HFVIS_EXPERIMENTAL int hfvis_hull_tree_count(const hfvis_hull_tree *tree);
 HFVIS_API int64_t hfvis_hull_tree_iterations(const hfvis_hull_tree *tree);
 
 /* Visible samples of receiver index `receiver` on a line (distance increasing), enumerated
@@ -945,7 +949,7 @@ HFVIS_API hfvis_status hfvis_viewshed_reference(const hfvis_grid *grid, double o
  * dir need not be unit length (it is normalised); Y receives Y_i(dir), i = l(l+1)+m.
  * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL, a non-finite or zero dir.
  * Cost: about 40 flops. */
-HFVIS_API hfvis_status hfvis_sh_eval(const double dir[3], double Y[16]);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_sh_eval(const double dir[3], double Y[16]);
 
 /* Rotate an SH vector about +z by angle_rad (active, counter-clockwise seen from +z, i.e. from
  * +x toward +y): the result f' satisfies f'(R_z(a) d) = f(d), i.e. f'(theta, phi) =
@@ -954,11 +958,11 @@ HFVIS_API hfvis_status hfvis_sh_eval(const double dir[3], double Y[16]);
  * m = 0 coefficients are unchanged. [NS09] Eq. 21 uses it to place each wedge.
  * out may equal in. Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL or a non-finite
  * angle. Cost: 6 trigonometric calls and 24 multiply-adds. */
-HFVIS_API hfvis_status hfvis_sh_rotate_z(const double in[16], double angle_rad, double out[16]);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_sh_rotate_z(const double in[16], double angle_rad, double out[16]);
 
 /* *out = Sum_i a_i b_i, the integral over the sphere of the product of the two functions
  * ([NS09] §7 "double product integral"). Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL. */
-HFVIS_API hfvis_status hfvis_sh_dot(const double a[16], const double b[16], double *out);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_sh_dot(const double a[16], const double b[16], double *out);
 
 /* Fill the SH triple-product tensor gamma[(i*16 + j)*16 + k] = Int Y_i Y_j Y_k dw (spec GI B.7),
  * HFVIS_SH_COEFFS^3 = 4096 doubles. Computed exactly (up to rounding) with an 8-point
@@ -966,54 +970,54 @@ HFVIS_API hfvis_status hfvis_sh_dot(const double a[16], const double b[16], doub
  * are set to exactly 0 (the true non-zeros are >= 0.058), which leaves 353 non-zeros.
  * Build it once and pass it to hfvis_sh_product. Returns HFVIS_OK, or
  * HFVIS_ERR_INVALID_ARGUMENT if gamma is NULL. Cost: about 0.5 M multiply-adds, no allocation. */
-HFVIS_API hfvis_status hfvis_sh_product_tensor(double *gamma);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_sh_product_tensor(double *gamma);
 
 /* SH product truncated to order 4: out_k = Sum_ij gamma_ijk a_i b_j, the projection of the
  * pointwise product of the two functions ([NS09] §7: incident radiance = L * V). gamma comes
  * from hfvis_sh_product_tensor. out may equal a or b. Returns HFVIS_OK, or
  * HFVIS_ERR_INVALID_ARGUMENT for NULL. Cost: at most 4096 multiply-adds (zeros skipped). */
-HFVIS_API hfvis_status hfvis_sh_product(const double *gamma, const double a[16],
-                                        const double b[16], double out[16]);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_sh_product(const double *gamma, const double a[16],
+                                                           const double b[16], double out[16]);
 
 /* Convolve an SH vector with a zonal lobe given by its multipliers Ahat (Funk-Hecke):
  * out_lm = Ahat_l in_lm. With the diffuse Ahat, evaluating out at N gives the irradiance
  * E(N) = Int L(w) max(N.w, 0) dw. out may equal in. Returns HFVIS_OK, or
  * HFVIS_ERR_INVALID_ARGUMENT for NULL or a non-finite Ahat. */
-HFVIS_API hfvis_status hfvis_sh_convolve_zh(const double in[16], const double Ahat[4],
-                                            double out[16]);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_sh_convolve_zh(const double in[16], const double Ahat[4],
+                                                               double out[16]);
 
 /* Rotate a zonal lobe to an axis: out_lm = Ahat_l Y_lm(axis) = sqrt(4 pi/(2l+1)) z_l Y_lm(axis)
  * ([NS09] §7 F(w_o), spec GI B.7). axis need not be unit length. Then Sum out_i I_i is the lobe
  * applied to the incident radiance I. Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL, a
  * non-finite Ahat or a non-finite or zero axis. */
-HFVIS_API hfvis_status hfvis_sh_from_zh(const double Ahat[4], const double axis[3],
-                                        double out[16]);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_sh_from_zh(const double Ahat[4], const double axis[3],
+                                                           double out[16]);
 
 /* Shade: *out = Sum_lm Ahat_l Y_lm(axis) I_lm ([NS09] §7: F(w_o) . I). With the diffuse Ahat and
  * axis = N this is the irradiance E(N); the library's exit radiance is (albedo/pi) E (spec GI
  * B.7 [choice]: [NS09] omits albedo/pi). With the Phong Ahat and axis = reflect(view, N) it is
  * the reflected radiance of a lobe with unit specular albedo. Errors as hfvis_sh_from_zh. */
-HFVIS_API hfvis_status hfvis_sh_shade_zh(const double Ahat[4], const double axis[3],
-                                         const double I[16], double *out);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_sh_shade_zh(const double Ahat[4], const double axis[3],
+                                                            const double I[16], double *out);
 
 /* The clamped-cosine (diffuse) lobe: Ahat = (pi, 2pi/3, pi/4, 0), from the raw ZH
  * (sqrt(pi)/2, sqrt(pi/3), sqrt(5 pi)/8, 0) = (0.886227, 1.02333, 0.495416, 0) of [NS09] §7.
  * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT if Ahat is NULL. */
-HFVIS_API hfvis_status hfvis_zh_diffuse(double Ahat[4]);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_zh_diffuse(double Ahat[4]);
 
 /* The Phong lobe of exponent S ([NS09] §7 citing Ramamoorthi-Hanrahan 2002):
  * Ahat_l = exp(-l^2/(2S)). These are the multipliers of the normalised lobe
  * ((S+1)/(2 pi)) cos^S about the reflection vector (spec GI B.7 erratum; Ahat_0 = 1, so a uniform
  * unit environment reflects 1), in the Gaussian approximation of [RH02], accurate for large S.
  * S > 0 and finite. Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL or a bad S. */
-HFVIS_API hfvis_status hfvis_zh_phong(double S, double Ahat[4]);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_zh_phong(double S, double Ahat[4]);
 
 /* The indicator of a circular cap of angular radius half_angle_rad in [0, pi] about +z
  * (spec GI B.8 key lights): Ahat_l = 2 pi Int_c^1 P_l(z) dz, c = cos(half_angle); Ahat_0 is the
  * cap's solid angle 2 pi (1 - c). A uniform cap of radiance L0 about axis a is L0 times
  * hfvis_sh_from_zh(Ahat, a). Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL or a
  * half-angle outside [0, pi] or non-finite. */
-HFVIS_API hfvis_status hfvis_zh_cap(double half_angle_rad, double Ahat[4]);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_zh_cap(double half_angle_rad, double Ahat[4]);
 
 /* Project a lat-long environment (hfvis_env: row t = theta in [pi t/T, pi (t+1)/T) from the
  * zenith, column p = phi in [2 pi p/P, 2 pi (p+1)/P)) onto the SH basis:
@@ -1028,12 +1032,12 @@ HFVIS_API hfvis_status hfvis_zh_cap(double half_angle_rad, double Ahat[4]);
  * n_phi < 1, channels outside 1..4, or a texel count that overflows size_t.
  * Cost: O(n_theta*n_phi*channels*7) multiply-adds, 6 trigonometric calls per column and 4 per
  * row and block of 64 columns. No allocation. */
-HFVIS_API hfvis_status hfvis_sh_project_env(const hfvis_env *env, double *out);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_sh_project_env(const hfvis_env *env, double *out);
 
 /* Evaluate the 4 NLPs at z in [-1, 1]: P = (1/sqrt2, sqrt(3/2) z, (sqrt10/4)(3z^2 - 1),
  * (sqrt14/4)(5z^3 - 3z)) ([NS09] §4 with the spec GI B.3 erratum). Returns HFVIS_OK, or
  * HFVIS_ERR_INVALID_ARGUMENT for NULL or z non-finite or outside [-1, 1]. */
-HFVIS_API hfvis_status hfvis_nlp_eval(double z, double P[4]);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_nlp_eval(double z, double P[4]);
 
 /* Occlusion vector vbar(sigma) = Int_{-1}^{sin sigma} P^(z) dz ([NS09] Eq. 10, limits as in spec
  * GI B.3): the NLP projection of the step that is 1 for elevations omega <= sigma. Closed form
@@ -1041,7 +1045,7 @@ HFVIS_API hfvis_status hfvis_nlp_eval(double z, double P[4]);
  * sqrt(7/2)(5s^4-6s^2+1)/8). sigma_rad is clamped to [-pi/2, pi/2] (vbar(-pi/2) = 0,
  * vbar(pi/2) = (sqrt2, 0, 0, 0)). Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL or a
  * non-finite sigma. */
-HFVIS_API hfvis_status hfvis_nlp_occlusion(double sigma_rad, double out[4]);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_nlp_occlusion(double sigma_rad, double out[4]);
 
 /* Visibility vector of the elevation interval (omega_lo, omega_hi], both clamped to
  * [-pi/2, pi/2]: vbar(hi) - vbar(lo) if hi > lo, else 0.
@@ -1050,8 +1054,8 @@ HFVIS_API hfvis_status hfvis_nlp_occlusion(double sigma_rad, double out[4]);
  *   hi = l_max. Clamping below the tangent plane is the caller's choice: lo = max(omega_max,
  *   omega_min) (spec GI B.3 [choice]).
  * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL or a non-finite angle. */
-HFVIS_API hfvis_status hfvis_nlp_visibility(double omega_lo_rad, double omega_hi_rad,
-                                            double out[4]);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_nlp_visibility(double omega_lo_rad, double omega_hi_rad,
+                                                               double out[4]);
 
 /* NLP vector of the indirect radiance along one slice ([NS09] Eq. 8 and 12 with the spec GI B.3
  * errata: the integral covers z in [-1, 1], u(t_(i+1)) = 0 once i+1 >= |T|):
@@ -1063,13 +1067,13 @@ HFVIS_API hfvis_status hfvis_nlp_visibility(double omega_lo_rad, double omega_hi
  * channel of exit radiance per element (call once per channel). Angles are clamped to
  * [-pi/2, pi/2] as in hfvis_nlp_occlusion. Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL,
  * K < 0, a non-finite value or a decreasing angle sequence. Cost: O(K). */
-HFVIS_API hfvis_status hfvis_nlp_radiance(int K, const double *omega_rad, const double *u,
-                                          double omega_min_rad, double out[4]);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_nlp_radiance(int K, const double *omega_rad, const double *u,
+                                                             double omega_min_rad, double out[4]);
 
 /* Reconstruct an elevation function from its NLP vector: *out = c . P^(sin omega)
  * ([NS09] Eq. 13). The order-4 truncation rings (spec GI B.3: values < 0 or > 1 occur).
  * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL or a non-finite omega. */
-HFVIS_API hfvis_status hfvis_nlp_reconstruct(const double c[4], double omega_rad, double *out);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_nlp_reconstruct(const double c[4], double omega_rad, double *out);
 
 /* Azimuthal interpolation of the NLP vectors across a wedge ([NS09] §6, App. A). */
 typedef enum hfvis_ns_interp {
@@ -1083,7 +1087,7 @@ typedef enum hfvis_ns_interp {
 #define HFVIS_NS_WEDGE_MATRIX_MAX 256
 
 /* Columns of the wedge matrix: 8 (linear, default) or 16 (B-spline); 0 for an unknown value. */
-HFVIS_API int hfvis_ns_wedge_columns(hfvis_ns_interp interp);
+HFVIS_API HFVIS_EXPERIMENTAL int hfvis_ns_wedge_columns(hfvis_ns_interp interp);
 
 /* The Appendix-A wedge matrix for a wedge of width dphi_rad in (0, 2 pi], row-major,
  * M[r*cols + s*4 + k], r = SH index, s = sample of the wedge (0..1 linear: w_j, w_(j+1);
@@ -1099,7 +1103,7 @@ HFVIS_API int hfvis_ns_wedge_columns(hfvis_ns_interp interp);
  * M must hold 16*hfvis_ns_wedge_columns(interp) doubles. Returns HFVIS_OK, or
  * HFVIS_ERR_INVALID_ARGUMENT for NULL, an unknown interp, or dphi non-finite or outside (0, 2 pi].
  * Cost: about 2000 flops and 12 trigonometric calls. */
-HFVIS_API hfvis_status hfvis_ns_wedge_matrix(hfvis_ns_interp interp, double dphi_rad, double *M);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_wedge_matrix(hfvis_ns_interp interp, double dphi_rad, double *M);
 
 /* A set of m azimuthal samples phi_j = phi0_rad + j*dphi_rad and its wedge matrix. Fill it with
  * hfvis_ns_wedges_full or hfvis_ns_wedges_partial; it holds no pointers and may be copied. */
@@ -1116,24 +1120,24 @@ typedef struct hfvis_ns_wedges {
  * m wedges including the wrap-around wedge (spec GI B.6 erratum: [NS09] Eq. 21's sum to m-1 is
  * the partial case). B-spline indices wrap modulo m. Returns HFVIS_OK, or
  * HFVIS_ERR_INVALID_ARGUMENT for NULL, m < 1, an unknown interp or a non-finite phi0. */
-HFVIS_API hfvis_status hfvis_ns_wedges_full(hfvis_ns_wedges *set, hfvis_ns_interp interp, int m,
-                                            double phi0_rad);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_wedges_full(hfvis_ns_wedges *set, hfvis_ns_interp interp, int m,
+                                                               double phi0_rad);
 
 /* Partial extent [phi_a, phi_b] (key lights, [NS09] §6): m >= 2 samples, dphi =
  * (phi_b - phi_a)/(m-1), m-1 wedges; B-spline indices are clamped to the end samples (spec GI
  * B.6 [choice]). phi_b > phi_a and phi_b - phi_a <= 2 pi (an extent crossing 0 is given as, e.g.,
  * [-0.3, 0.2]). Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL, m < 2, an unknown interp
  * or a bad extent. */
-HFVIS_API hfvis_status hfvis_ns_wedges_partial(hfvis_ns_wedges *set, hfvis_ns_interp interp,
-                                               int m, double phi_a_rad, double phi_b_rad);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_wedges_partial(hfvis_ns_wedges *set, hfvis_ns_interp interp,
+                                                                  int m, double phi_a_rad, double phi_b_rad);
 
 /* From slices to SH ([NS09] Eq. 20-21, spec GI B.6 SLICES_TO_SH): w[j*4 + k] is the NLP vector
  * of sample j (j = 0..m-1, from hfvis_nlp_visibility or hfvis_nlp_radiance at azimuth phi_j);
  * out = Sum_wedges Rot_z(M x_j, phi_j). One channel per call. Returns HFVIS_OK, or
  * HFVIS_ERR_INVALID_ARGUMENT for NULL or a set whose interp or sample count is invalid.
  * Cost: per wedge 128 (linear) or 256 (B-spline) multiply-adds plus one hfvis_sh_rotate_z. */
-HFVIS_API hfvis_status hfvis_ns_wedges_to_sh(const hfvis_ns_wedges *set, const double *w,
-                                             double out[16]);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_wedges_to_sh(const hfvis_ns_wedges *set, const double *w,
+                                                                double out[16]);
 
 /* Which formula gives the tangent plane's minimum blocking angle. */
 typedef enum hfvis_ns_omega_min {
@@ -1149,8 +1153,8 @@ typedef enum hfvis_ns_omega_min {
  * paper's form a tilted plane admits its own surface into the casting set (spec GI B.13-10).
  * normal need not be unit length. Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL, a
  * zero or non-finite normal, a non-finite phi or an unknown form. */
-HFVIS_API hfvis_status hfvis_ns_min_blocking_angle(const double normal[3], double phi_rad,
-                                                   hfvis_ns_omega_min form, double *out);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_min_blocking_angle(const double normal[3], double phi_rad,
+                                                                      hfvis_ns_omega_min form, double *out);
 
 /* ========================================================================================== */
 /* hfvis.c - Nowrouzezahrai-Snyder GI pipeline ([NS09] §5-9; spec GI B.2, B.4-B.9, B.12)     */
@@ -1412,7 +1416,7 @@ HFVIS_API hfvis_status hfvis_ns_gi_scratch_size(const hfvis_grid *grid, const hf
  * (w_(-1) = w_0, w_n = w_(n-1); spec GI B.4 [choice]). n = 0 gives -pi/2 (nothing blocks).
  * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for a NULL out, n < 0, NULL omega with n > 0 or
  * a non-finite omega. Cost O(n). */
-HFVIS_API hfvis_status hfvis_ns_bspline_max(int n, const double *omega_rad, double *out);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_bspline_max(int n, const double *omega_rad, double *out);
 
 /* The per-sample form of [NS09] Eq. 20-21: G[(j*16 + r)*4 + k] such that
  * hfvis_ns_wedges_to_sh(set, w) = Sum_j G_j w_j (G_j a 16x4 matrix, r the SH index, k the NLP
@@ -1420,7 +1424,7 @@ HFVIS_API hfvis_status hfvis_ns_bspline_max(int n, const double *omega_rad, doub
  * the sample it reads, so a slice costs 64 multiply-adds and no rotation. Equal to
  * hfvis_ns_wedges_to_sh up to rounding. G must hold 64*set->samples doubles.
  * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT as hfvis_ns_wedges_to_sh. */
-HFVIS_API hfvis_status hfvis_ns_sample_matrices(const hfvis_ns_wedges *set, double *G);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_sample_matrices(const hfvis_ns_wedges *set, double *G);
 
 
 /* ========================================================================================== */
@@ -1967,8 +1971,9 @@ HFVIS_API hfvis_status hfvis_lsao_line_naive(const double *x, const double *y,
  * background sample, or under BILINEAR a tap on background) and, if sample_depth is not NULL,
  * the depth read at the sample (NaN at holes). Per sample: the depth at the snapped texel
  * centre (NEAREST; box-pattern steps are integer texel offsets from the line's first texel;
- * with the EXACT plane and non-integer steps that depth is deprojected at the sample's own
- * position, so every point lies in the line's plane instead of jittering across it) or
+ * with the EXACT plane and non-integer steps that depth is deprojected at the point of the
+ * line nearest the texel centre, so every point lies in the line's plane instead of jittering
+ * across it) or
  * bilinear at the sample (BILINEAR), deprojected, projected into the line's plane (PAPER: e1 of
  * the direction, y = Q.z; EXACT: e1, yhat through the line's middle sample ray), then
  * hfvis_lsao_line. Real tangents: the normal of the sample's texel projected into the plane,
@@ -2127,9 +2132,10 @@ HFVIS_API hfvis_status hfvis_hbao_options_resolve(const hfvis_hbao_options *in,
  * direction set should be symmetric to compare with LSAO), the samples
  *   uniform: c + (s - 1 + xi) (R_px/N) D, s = 1..N (xi = 1 without step jitter)
  *   custom:  c + s (step_x, step_y)
- * until one leaves the buffer, read as in LSAO (NEAREST: the snapped texel centre), deprojected
- * and put in the plane of P and D (EXACT: (Q.e1, Q.yhat) with yhat through P; PAPER: (Q.e1,
- * Q.z)); h = q - p, zenith u = -p/|p| (orthographic +y), Sin(h) = h.u/|h|; background samples
+ * until one leaves the buffer, read as in LSAO (NEAREST: the snapped texel's depth, at the
+ * texel centre, or with the EXACT plane at the point of the march's line nearest it, so a
+ * plane facing the camera stays at 0 from every direction), deprojected and put in the plane
+ * of P and D (EXACT: (Q.e1, Q.yhat) with yhat through P; PAPER: (Q.e1, Q.z)); h = q - p, zenith u = -p/|p| (orthographic +y), Sin(h) = h.u/|h|; background samples
  * and samples coincident with P are skipped. The tangent: REAL = the receiver's normal in the
  * plane, t = (n2.y, -n2.x) (ahead), sin t = t.u/|t|; FIXED = fixed_sin_t. Per direction the
  * variant's value (INCREMENTAL sum, SINGLE_HORIZON, LARGEST_OCCLUDER, see the enum; the
@@ -4437,20 +4443,20 @@ HFVIS_API hfvis_status hfvis_visfield_load(const char *path, const hfvis_allocat
 
 /* The 4 basis functions at the unit direction dir/|dir|. Returns HFVIS_OK, or
  * HFVIS_ERR_INVALID_ARGUMENT for NULL, a non-finite or zero dir (out untouched). */
-HFVIS_API hfvis_status hfvis_volgi_sh_basis(const double dir[3], double out[4]);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_volgi_sh_basis(const double dir[3], double out[4]);
 
 /* SH projection of the clamped cosine max(0, n.w) about n/|n|: CC(n) above; its integral is pi
  * and CC(n).CC(n) = 7 pi/12 (the projection keeps 0.875 of the lobe's 2 pi/3 self-product).
  * Errors as hfvis_volgi_sh_basis. */
-HFVIS_API hfvis_status hfvis_volgi_sh_clamped_cosine(const double normal[3], double out[4]);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_volgi_sh_clamped_cosine(const double normal[3], double out[4]);
 
 /* SH projection of the indicator of the cone of half-angle half_angle_rad in (0, pi] about
  * axis/|axis|: (sqrt(pi)(1 - cos a), (sqrt(3 pi)/2) sin^2 a axis_y, ... z, ... x), so that
  * f.Cone = the integral of the SH function f over the cone. 45 degrees: (0.5191397,
  * 0.7674950 d_y, 0.7674950 d_z, 0.7674950 d_x). Errors as hfvis_volgi_sh_basis, plus a
  * half-angle outside (0, pi] or not finite. */
-HFVIS_API hfvis_status hfvis_volgi_sh_cone(const double axis[3], double half_angle_rad,
-                                           double out[4]);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_volgi_sh_cone(const double axis[3], double half_angle_rad,
+                                                              double out[4]);
 
 /* ---- options ------------------------------------------------------------------------------ */
 
@@ -5013,10 +5019,10 @@ typedef enum hfvis_lk_jitter {
  * plane (each keeps an elevation >= 0.1 min_elevation). World direction of ray i: F^T u_i.
  * JITTER_NONE: (t1, t2, n). Returns HFVIS_ERR_INVALID_ARGUMENT for NULL, an invalid ray set, a
  * zero or non-finite normal, an unknown jitter or custom bounds out of range. */
-HFVIS_API hfvis_status hfvis_lk_frame(const hfvis_lk_rays *rays, const double normal[3],
-                                      uint64_t seed, uint64_t key, hfvis_lk_jitter jitter,
-                                      double rotation_max_rad, double tilt_max_rad,
-                                      double frame[9]);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_lk_frame(const hfvis_lk_rays *rays, const double normal[3],
+                                                         uint64_t seed, uint64_t key, hfvis_lk_jitter jitter,
+                                                         double rotation_max_rad, double tilt_max_rad,
+                                                         double frame[9]);
 
 /* ---- occlusion masks and the plane look-up table (spec A.4) ------------------------------- */
 
@@ -5055,8 +5061,8 @@ HFVIS_API void hfvis_lk_lut_free(const hfvis_allocator *alloc, hfvis_lk_lut *lut
  * q = m (1 - 7 delta/8)/max_j |m_j|; k_j = clamp(floor((q_j + 1)(T - 1)/2 + 1/2), 0, T - 1).
  * Returns HFVIS_ERR_INVALID_ARGUMENT for NULL, a resolution out of range, m zero or not finite,
  * a non-finite d_over_r. */
-HFVIS_API hfvis_status hfvis_lk_lut_index(int resolution, const double m[3], double d_over_r,
-                                          int ijk[3]);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_lk_lut_index(int resolution, const double m[3], double d_over_r,
+                                                             int ijk[3]);
 
 /* The mask of plane (m, d/r) in the table (directions != 0: the direction table, which is the
  * main table when all lengths are 1); NULL for the invalid arguments of hfvis_lk_lut_index. */
@@ -5065,8 +5071,8 @@ HFVIS_API const uint32_t *hfvis_lk_lut_fetch(const hfvis_lk_lut *lut, int direct
 
 /* Exact plane mask: bit i = (m.s_i >= d_over_r), for every ray (mask holds words words).
  * Returns HFVIS_ERR_INVALID_ARGUMENT for NULL, an invalid ray set or non-finite m / d_over_r. */
-HFVIS_API hfvis_status hfvis_lk_plane_mask(const hfvis_lk_rays *rays, const double m[3],
-                                           double d_over_r, uint32_t *mask);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_lk_plane_mask(const hfvis_lk_rays *rays, const double m[3],
+                                                              double d_over_r, uint32_t *mask);
 
 /* What the blocking predicate made of one triangle for one receiver. */
 typedef enum hfvis_lk_verdict {
@@ -5085,12 +5091,12 @@ typedef enum hfvis_lk_verdict {
  * unless the verdict is MASKED); verdict may be NULL. Returns HFVIS_ERR_INVALID_ARGUMENT for NULL
  * pointers, an invalid ray set, non-finite inputs, a bad window or epsilon, a lut built for
  * another ray count. No allocation; O(N) (LUT: O(words)). */
-HFVIS_API hfvis_status hfvis_lk_triangle_mask(const hfvis_lk_rays *rays, const hfvis_lk_lut *lut,
-                                              const double position[3], const double frame[9],
-                                              const float v0[3], const float v1[3],
-                                              const float v2[3], int two_sided, double r_min,
-                                              double r_max, double epsilon, uint32_t *mask,
-                                              hfvis_lk_verdict *verdict);
+HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_lk_triangle_mask(const hfvis_lk_rays *rays, const hfvis_lk_lut *lut,
+                                                                 const double position[3], const double frame[9],
+                                                                 const float v0[3], const float v1[3],
+                                                                 const float v2[3], int two_sided, double r_min,
+                                                                 double r_max, double epsilon, uint32_t *mask,
+                                                                 hfvis_lk_verdict *verdict);
 
 /* ---- the three methods ------------------------------------------------------------------ */
 

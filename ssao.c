@@ -1540,6 +1540,18 @@ static double ss_real_sin_t(const ss_cam *c, const float *normals, int tx, int t
     return (tx2 * ux + ty2 * uy) / l;
 }
 
+/* Moves a snapped texel centre (*u, *v) to the nearest point of the screen line through
+ * (u0, v0) with unit direction (dx, dy). The EXACT plane is the plane of the eye and that line:
+ * a texel centre off the line would leave it, and in perspective its projection onto
+ * (e1, yhat) then jitters up and down with the snapping (a flat plane facing the camera got
+ * obscurance 0.05-0.19 from directions between the axes). The texel's depth is kept. */
+static void ss_onto_line(double u0, double v0, double dx, double dy, double *u, double *v)
+{
+    double t = (*u - u0) * dx + (*v - v0) * dy;
+    *u = u0 + t * dx;
+    *v = v0 + t * dy;
+}
+
 /* The 2D samples of one lattice line: x, y (NaN at holes), real-tangent sines (if wanted),
  * sample depths. */
 static void ss_line_points(const ss_cam *c, const ss_cfg *g, const float *depth,
@@ -1585,10 +1597,7 @@ static void ss_line_points(const ss_cam *c, const ss_cfg *g, const float *depth,
             if (ss_bg(c, z)) z = SS_NAN;
             qu = (double)tx + 0.5;
             qv = (double)ty + 0.5;
-            if (g->exact && !integral) { /* keep the point in the line's plane (see header) */
-                qu = u;
-                qv = v;
-            }
+            if (g->exact && !integral) ss_onto_line(ln->x0, ln->y0, d->dx, d->dy, &qu, &qv);
         }
         if (zs) zs[k] = (float)z;
         if (z != z) {
@@ -2100,6 +2109,7 @@ static double ss_hbao_pixel(const ss_cam *c, const hfvis_hbao_options *o, const 
             if (!(u >= 0.0 && v >= 0.0 && u < (double)c->W && v < (double)c->H)) break;
             z = ss_sample(c, depth, bil, u, v, ss_texel(u, c->W), ss_texel(v, c->H), &qu, &qv);
             if (z != z) continue;
+            if (exact && !bil) ss_onto_line(u0, v0, dx, dy, &qu, &qv);
             ss_unproject(c, qu, qv, z, Q);
             hx = ss_dot3(Q, e1) - px;
             hy = (exact ? ss_dot3(Q, yh) : Q[2]) - py;

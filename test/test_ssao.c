@@ -2122,9 +2122,31 @@ TEST(hbao_default_radius)
     CHECK(ao[(IH / 2) * IW + x0 - 20] > 0.05f);
 }
 
+/* HBAO on a plane facing the camera is 0 from every direction: the real tangent is the plane.
+ * K = 16 gave 0.05 while the EXACT plane deprojected snapped texels off the march's line. */
+#define HBAO_FLAT_TOL 1e-6 /* float depth of a plane; the sums cancel to ~1e-15 */
+TEST(hbao_flat_plane)
+{
+    enum { W = 64, H = 48, G = 4, IW = W - 2 * G, IH = H - 2 * G };
+    static float depth[W * H], ao[IW * IH];
+    hfvis_camera cam;
+    int i, k;
+    for (i = 0; i < W * H; i++) depth[i] = 5.0f;
+    CHECK_EQ_STATUS(hfvis_camera_perspective(&cam, W, H, G, G, 60.0 * PI / 180.0), HFVIS_OK);
+    for (k = 8; k <= 24; k += 8) {
+        hfvis_hbao_options o = hfvis_hbao_options_default();
+        double mx = 0.0;
+        o.directions = k;
+        CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, NULL, &o, ao, IW), HFVIS_OK);
+        for (i = 0; i < IW * IH; i++) if ((double)ao[i] > mx) mx = (double)ao[i];
+        CHECK(mx <= HBAO_FLAT_TOL);
+    }
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
+    RUN(hbao_flat_plane);
     RUN(hbao_default_radius);
     RUN(camera_from_matrix_round_trip);
     RUN(rows_bottom_up);
