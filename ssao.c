@@ -74,11 +74,16 @@ static void *ss_alloc(const hfvis_allocator *a, size_t bytes)
     return HFVIS_MALLOC(bytes);
 }
 
+/* Memory from an allocator without alloc came from HFVIS_MALLOC: it goes back to HFVIS_FREE,
+ * whatever free says (hfvis.c's hf_free does the same). */
 static void ss_free(const hfvis_allocator *a, void *p)
 {
     if (!p) return;
-    if (a && a->free) a->free(a->user, p);
-    else if (!(a && a->alloc)) HFVIS_FREE(p);
+    if (a && a->alloc) {
+        if (a->free) a->free(a->user, p);
+        return;
+    }
+    HFVIS_FREE(p);
 }
 
 /* a*b into *out; 1 if it does not overflow. */

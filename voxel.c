@@ -84,11 +84,15 @@ static void *vx_alloc(const hfvis_allocator *a, size_t bytes)
     return HFVIS_MALLOC(bytes);
 }
 
+/* As ss_free and hf_free: without alloc, the memory came from HFVIS_MALLOC. */
 static void vx_free(const hfvis_allocator *a, void *p)
 {
     if (!p) return;
-    if (a && a->free) a->free(a->user, p);
-    else if (!a || !a->alloc) HFVIS_FREE(p);
+    if (a && a->alloc) {
+        if (a->free) a->free(a->user, p);
+        return;
+    }
+    HFVIS_FREE(p);
 }
 
 /* *out = a*b; returns 0 (and leaves *out alone) on overflow. */

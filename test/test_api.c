@@ -912,9 +912,49 @@ TEST(oracles_allocate_nothing)
     CHECK(state.allocs == 0);
 }
 
+/* An allocator with free but no alloc: every block came from HFVIS_MALLOC, so the library
+ * frees it with HFVIS_FREE and never hands it to free (ssao.c and voxel.c once did: a mesh
+ * from hfvis_mesh_box went to the caller's free). */
+static long api_foreign_frees;
+static void api_count_free(void *user, void *p)
+{
+    (void)user;
+    (void)p;
+    api_foreign_frees++;
+}
+TEST(allocator_free_without_alloc)
+{
+    static const double lo[3] = {0, 0, 0}, hi[3] = {1, 2, 3};
+    hfvis_allocator a;
+    hfvis_mesh m;
+    hfvis_ffao_table t;
+    hfvis_falloff q;
+    hfvis_sweep_options so = hfvis_sweep_options_default();
+    float z[16 * 16], out[16 * 16];
+    hfvis_grid g;
+    int i;
+    a.alloc = NULL;
+    a.free = api_count_free;
+    a.user = NULL;
+    api_foreign_frees = 0;
+    CHECK_EQ_STATUS(hfvis_mesh_box(&a, lo, hi, &m), HFVIS_OK);
+    hfvis_mesh_free(&a, &m);
+    memset(&q, 0, sizeof q);
+    q.kind = HFVIS_FALLOFF_INV_QUADRATIC;
+    q.param = 1.0;
+    CHECK_EQ_STATUS(hfvis_ffao_table_build(&q, 4, 4, 2, 3, 0.0, &a, &t), HFVIS_OK);
+    hfvis_ffao_table_free(&t);
+    for (i = 0; i < 16 * 16; i++) z[i] = (float)(i % 7);
+    g.z = z; g.width = 16; g.height = 16; g.stride = 16; g.cell_size = 1.0;
+    so.alloc = &a;
+    CHECK_EQ_STATUS(hfvis_sky_view_factor(&g, 8, &so, out, 16), HFVIS_OK);
+    CHECK(api_foreign_frees == 0);
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
+    RUN(allocator_free_without_alloc);
     /* Status strings */
     RUN(status_strings);
     /* Codecs in memory */
