@@ -136,8 +136,13 @@
  *   prints, never exits, never aborts on input, and has no global mutable state: every
  *   function is reentrant and may run concurrently on different outputs.
  * Memory. The caller owns every output and sizes it with the documented formula or a *_size()
- *   query. Scratch comes from the optional allocator in the options (NULL = malloc/free); each
- *   function documents how many blocks it allocates. The library keeps no pointer after a call.
+ *   query. Scratch comes from the optional allocator in the options (NULL = malloc/free);
+ *   test/test_args.c's allocator sweep lists every function that allocates and fails each of
+ *   its allocations in turn. The library keeps no pointer after a call, except the objects it
+ *   hands back for later release: a hfvis_ffao_table keeps its allocator (which must outlive
+ *   the table) so that hfvis_ffao_table_free can return its values. An allocator whose alloc
+ *   is NULL means HFVIS_MALLOC for every block, which then go back to HFVIS_FREE whatever its
+ *   free says.
  *   The *_save writers, which take no allocator, and every NULL allocator use HFVIS_MALLOC(size)
  *   and HFVIS_FREE(ptr), malloc and free unless both are defined when the library's .c files
  *   are compiled (as stb's STBI_MALLOC; test/test_oom.c fails them on purpose).
@@ -2451,7 +2456,9 @@ HFVIS_API hfvis_status hfvis_ssao_error(const float *ao, ptrdiff_t ao_stride, co
  * (n = (v1 - v0) x (v2 - v0)). A triangle soup is allowed (shared vertices not required, no
  * watertightness assumed) except by hfvis_voxelize_solid, which says so. Valid when every index
  * is < vertex_count and every coordinate is finite; functions that take a mesh check this
- * (O(V + T)) and return HFVIS_ERR_INVALID_ARGUMENT otherwise. Degenerate (zero-area) triangles
+ * (O(V + T)) and return HFVIS_ERR_INVALID_ARGUMENT otherwise, except the per-ray queries that
+ * take the mesh with its BVH (hfvis_bvh_intersect and its kin, the volume-GI light queries):
+ * hfvis_bvh_build checked it, and they say so. Degenerate (zero-area) triangles
  * are allowed and never hit, rasterized or voxelized. */
 typedef struct hfvis_mesh {
     const float *xyz;
