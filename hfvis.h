@@ -56,9 +56,9 @@
  *   [P3]   V. Timonen, "Line-Sweep Ambient Obscurance", Computer Graphics Forum 32(4)
  *          (EGSR 2013).
  *   [P4]   V. Timonen, "Screen-Space Far-Field Ambient Obscurance", HPG 2013.
- *          [P1]-[P4] are collected, with appendices A.1 and A.2 that correct [P1] and [P2], in
- *          V. Timonen, "Scalable Algorithms for Height Field Illumination", TUCS Dissertations
- *          173, Abo Akademi University, 2014.
+ *   [T14]  V. Timonen, "Scalable Algorithms for Height Field Illumination", TUCS Dissertations
+ *          173, Abo Akademi University, 2014: collects [P1]-[P4], with appendices A.1 and A.2
+ *          that correct [P1] and [P2].
  *   [LK]   S. Laine, T. Karras, "Two Methods for Fast Ray-Cast Ambient Occlusion", Computer
  *          Graphics Forum 29(4) (EGSR 2010).
  *   [NS09] D. Nowrouzezahrai, J. Snyder, "Fast Global Illumination on Dynamic Height Fields",
