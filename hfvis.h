@@ -3213,9 +3213,10 @@ typedef enum hfvis_parity_axis {
 typedef struct hfvis_binary_voxel_options {
     const hfvis_allocator *alloc; /* scratch; NULL = malloc/free */
     hfvis_parity_axis axis;       /* solid only: ray direction (default z) */
-    int allow_open;               /* solid only: 0 (default) = a column crossed an odd number of
-                                     times (an open mesh) fails with HFVIS_ERR_FORMAT; nonzero =
-                                     such columns are left empty and the others are filled */
+    int allow_open;               /* solid only: 0 (default) = a column of any of the three
+                                     axes crossed an odd number of times (an open mesh) fails
+                                     with HFVIS_ERR_FORMAT; nonzero = such columns of `axis` are
+                                     left empty and the others are filled */
 } hfvis_binary_voxel_options;
 
 /* The defaults: alloc NULL, axis HFVIS_PARITY_AXIS_Z, allow_open 0. */
@@ -3285,14 +3286,22 @@ HFVIS_API hfvis_status hfvis_voxelize_conservative_reference(const hfvis_mesh *m
  * prefix XOR along the axis (O(grid volume)). Orientation does not matter; nested closed
  * surfaces alternate inside/outside; self-intersecting ones give their crossing parity.
  * The mesh must be closed: with exact signs every line crosses a closed surface an even number
- * of times, so a column crossed an odd number of times proves an open mesh: HFVIS_ERR_FORMAT
- * (occ untouched) unless opts->allow_open, which leaves such columns empty and fills the others
- * (a hole lets the columns through it fall out; it cannot flood the rest). Triangles with a
- * zero grid-space normal are ignored; edge-on triangles (zero projected area) never cross.
- * opts: alloc, axis (HFVIS_ERR_INVALID_ARGUMENT for an unknown value), allow_open.
- * count (may be NULL): occupied voxels. One allocation (dims[u]*dims[w] bytes of column
- * parities). Cost: O(T + covered column centres) twice (a checking pass first unless
- * allow_open) + O(grid volume). Errors: see the section comment. */
+ * of times, so a column crossed an odd number of times proves an open mesh. Unless
+ * opts->allow_open, the columns of ALL THREE axes are checked first, whatever opts->axis, so the
+ * status does not depend on the axis: one odd column on any axis gives HFVIS_ERR_FORMAT (occ
+ * untouched). (A hole in a face parallel to the parity axis is crossed by no column of that
+ * axis; checking one axis only would fill such a mesh as if it were closed, e.g. the open Utah
+ * teapot along z.) An open mesh passes only if no column centre of any axis sees its boundary
+ * an odd number of times (holes smaller than a voxel between the column lines); then the fill is
+ * the crossing parity along opts->axis. allow_open skips the check, leaves the columns of
+ * opts->axis that are crossed an odd number of times empty and fills the others (a hole lets
+ * the columns through it fall out; it cannot flood the rest); the result then depends on the
+ * axis. Triangles with a zero grid-space normal are ignored; edge-on triangles (zero projected
+ * area) never cross. opts: alloc, axis (HFVIS_ERR_INVALID_ARGUMENT for an unknown value),
+ * allow_open. count (may be NULL): occupied voxels. One allocation (the largest of
+ * dims[0]*dims[1], dims[1]*dims[2], dims[0]*dims[2] bytes of column parities). Cost:
+ * O(T + covered column centres) four times (three checking passes unless allow_open) +
+ * O(grid volume). Errors: see the section comment. */
 HFVIS_API hfvis_status hfvis_voxelize_solid(const hfvis_mesh *mesh, const hfvis_volume_grid *grid,
                                             const hfvis_binary_voxel_options *opts, uint8_t *occ,
                                             size_t *count);

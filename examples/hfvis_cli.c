@@ -442,7 +442,8 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "                    triangle in the sweep along its dominant axis ([G12] ch. 6, 6-separating\n"
     "                    with --axis all); conservative: every voxel a triangle touches (exact\n"
     "                    triangle-box overlap); solid: the voxels whose centre is inside the\n"
-    "                    mesh, by ray parity (the mesh must be closed unless --open)\n"
+    "                    mesh, by ray parity (the mesh must be closed unless --open: the\n"     \
+    "                    parity of every column along x, y and z is checked, whatever --axis)\n"
     "  --axis A          surface: dominant (default), all (three sweeps merged, [G12] Alg. 4) or\n"
     "                    x, y, z (one sweep); solid: the parity ray direction x, y or z (default z)\n"
     "  --method M        surface: pixel (the pixel-centre rule, default), slicing (geometry-shader\n"
