@@ -4751,8 +4751,9 @@ HFVIS_API hfvis_status hfvis_volgi_render(const hfvis_volgi_scene *scene,
  * the obscurance of curved meshes low (mean obscurance of hfvis meshao's bunny view against an
  * independent cosine-sampled estimate, docs/mesh-ao.md: LLOYD -40 % at N = 128 and -16 % at
  * N = 1024; LLOYD_TORUS, mean of 4 seeds, +1.2 % and +2.2 %, within the estimate's error of
- * 1.4-1.9 %). The torus pattern is unbiased over seeds (its point process is invariant under
- * translations of the periodic square, so each point is uniform on the disc); one seed still has
+ * 1.4-1.9 %). The torus pattern is unbiased over seeds up to its density grid's step (random
+ * starting points on the periodic square, relaxed by rules that commute with translations by
+ * that step, so each point is uniform on the disc at that scale); one seed still has
  * a realization error where the blocked directions form a thin band at the horizon (a few
  * percent at N = 1024; another seed gives another realization). */
 typedef enum hfvis_lk_pattern {
