@@ -892,9 +892,14 @@ typedef struct hfvis_viewshed_options {
  * the grid point, and sees the terrain only at one crossing per cell. The decisions agree with
  * hfvis_viewshed_reference except at grid points whose sight line nearly grazes the terrain, i.e.
  * along the boundaries of the visible regions (R2 mostly errs towards visible: a ridge between
- * two crossings is missed). Measured against the oracle: 0.4-1.9% of the grid points of a rough
- * 128^2 fBm (97-100% of them next to a visibility boundary), 0.4% (eye 1.5) and 1.5% (eye 100)
- * on a 1024^2 fBm; none on a wall seen along the rays' major axis.
+ * two crossings is missed), so the fraction grows with how much the observer sees. Measured
+ * against the oracle at step 0.5 (`hfvis viewshed --exact`), 8 observers per terrain (the
+ * summit, a valley floor, a point on the slope between them, 5 random cells), eye 0 and 1.7
+ * above the surface: a 512^2 SRTM tile around Longs Peak, Colorado (90 m cells): 0.005-1.21%
+ * of the grid points, mean 0.21%; a 512^2 fBm: 0.03-1.21%, mean 0.35-0.44%; three 256^2 fBm
+ * (relatively more boundary): 0.13-3.13%, mean 0.81-1.33% (eye 1.7). The summit is the worst
+ * case on every terrain (it sees the most: 11-41% of the grid). On rough 128^2 fBm 0.4-1.9% (97-100% of the disagreements next to a
+ * visibility boundary); none on a wall seen along the rays' major axis.
  * out must hold (height-1)*out_stride + width floats, out_stride >= width, and must not overlap
  * grid->z. opts may be NULL (defaults). out is used as scratch during the call.
  * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT if grid is NULL or invalid, out is NULL,
@@ -3383,9 +3388,10 @@ typedef enum hfvis_parity_axis {
 typedef struct hfvis_binary_voxel_options {
     const hfvis_allocator *alloc; /* scratch; NULL = malloc/free */
     hfvis_parity_axis axis;       /* solid only: ray direction (default z) */
-    int allow_open;               /* solid only: 0 (default) = a column crossed an odd number of
-                                     times (an open mesh) fails with HFVIS_ERR_FORMAT; nonzero =
-                                     such columns are left empty and the others are filled */
+    int allow_open;               /* solid only: 0 (default) = a column of any of the three
+                                     axes crossed an odd number of times (an open mesh) fails
+                                     with HFVIS_ERR_FORMAT; nonzero = such columns of `axis` are
+                                     left empty and the others are filled */
 } hfvis_binary_voxel_options;
 
 /* The defaults: alloc NULL, axis HFVIS_PARITY_AXIS_Z, allow_open 0. */
@@ -3455,14 +3461,22 @@ HFVIS_API hfvis_status hfvis_voxelize_conservative_reference(const hfvis_mesh *m
  * prefix XOR along the axis (O(grid volume)). Orientation does not matter; nested closed
  * surfaces alternate inside/outside; self-intersecting ones give their crossing parity.
  * The mesh must be closed: with exact signs every line crosses a closed surface an even number
- * of times, so a column crossed an odd number of times proves an open mesh: HFVIS_ERR_FORMAT
- * (occ untouched) unless opts->allow_open, which leaves such columns empty and fills the others
- * (a hole lets the columns through it fall out; it cannot flood the rest). Triangles with a
- * zero grid-space normal are ignored; edge-on triangles (zero projected area) never cross.
- * opts: alloc, axis (HFVIS_ERR_INVALID_ARGUMENT for an unknown value), allow_open.
- * count (may be NULL): occupied voxels. One allocation (dims[u]*dims[w] bytes of column
- * parities). Cost: O(T + covered column centres) twice (a checking pass first unless
- * allow_open) + O(grid volume). Errors: see the section comment. */
+ * of times, so a column crossed an odd number of times proves an open mesh. Unless
+ * opts->allow_open, the columns of ALL THREE axes are checked first, whatever opts->axis, so the
+ * status does not depend on the axis: one odd column on any axis gives HFVIS_ERR_FORMAT (occ
+ * untouched). (A hole in a face parallel to the parity axis is crossed by no column of that
+ * axis; checking one axis only would fill such a mesh as if it were closed, e.g. the open Utah
+ * teapot along z.) An open mesh passes only if no column centre of any axis sees its boundary
+ * an odd number of times (holes smaller than a voxel between the column lines); then the fill is
+ * the crossing parity along opts->axis. allow_open skips the check, leaves the columns of
+ * opts->axis that are crossed an odd number of times empty and fills the others (a hole lets
+ * the columns through it fall out; it cannot flood the rest); the result then depends on the
+ * axis. Triangles with a zero grid-space normal are ignored; edge-on triangles (zero projected
+ * area) never cross. opts: alloc, axis (HFVIS_ERR_INVALID_ARGUMENT for an unknown value),
+ * allow_open. count (may be NULL): occupied voxels. One allocation (the largest of
+ * dims[0]*dims[1], dims[1]*dims[2], dims[0]*dims[2] bytes of column parities). Cost:
+ * O(T + covered column centres) four times (three checking passes unless allow_open) +
+ * O(grid volume). Errors: see the section comment. */
 HFVIS_API hfvis_status hfvis_voxelize_solid(const hfvis_mesh *mesh, const hfvis_volume_grid *grid,
                                             const hfvis_binary_voxel_options *opts, uint8_t *occ,
                                             size_t *count);
@@ -4902,24 +4916,34 @@ HFVIS_API hfvis_status hfvis_volgi_render(const hfvis_volgi_scene *scene,
 
 /* ---- ray sets (spec A.2) ------------------------------------------------------------------ */
 
-/* How the N disc points are placed before they are lifted to the hemisphere. */
+/* How the N disc points are placed before they are lifted to the hemisphere. The default is
+ * the torus pattern: the disc pattern of [LK] §6 under-samples grazing directions, which biases
+ * the obscurance of curved meshes low (mean obscurance of hfvis meshao's bunny view against an
+ * independent cosine-sampled estimate, docs/mesh-ao.md: LLOYD -40 % at N = 128 and -16 % at
+ * N = 1024; LLOYD_TORUS, mean of 4 seeds, +1.2 % and +2.2 %, within the estimate's error of
+ * 1.4-1.9 %). The torus pattern is unbiased over seeds up to its density grid's step (random
+ * starting points on the periodic square, relaxed by rules that commute with translations by
+ * that step, so each point is uniform on the disc at that scale); one seed still has
+ * a realization error where the blocked directions form a thin band at the horizon (a few
+ * percent at N = 1024; another seed gives another realization). */
 typedef enum hfvis_lk_pattern {
-    HFVIS_LK_PATTERN_DEFAULT = 0, /* = LLOYD */
+    HFVIS_LK_PATTERN_DEFAULT = 0, /* = LLOYD_TORUS (LLOYD in 0.1.0) */
     HFVIS_LK_PATTERN_LLOYD = 1,   /* [LK] §6: random points, lloyd_iterations Lloyd steps, each
                                      point replaced by a uniform random point of its Voronoi
                                      cell (rejection sampling, 64 attempts, else it stays),
                                      final_iterations more steps (cells estimated from the
-                                     centres of a density_resolution^2 grid, spec A.2) */
-    HFVIS_LK_PATTERN_RANDOM = 2,  /* independent uniform points of the disc (for tests) */
+                                     centres of a density_resolution^2 grid, spec A.2). On the
+                                     disc the Lloyd centroids of the rim cells lie inward, so
+                                     the outermost ring of points stays about half a cell inside
+                                     the rim and grazing directions are under-sampled (N = 1024:
+                                     no point beyond rho = 0.995): biased low wherever grazing
+                                     rays are blocked (see above); kept for the paper's setup */
+    HFVIS_LK_PATTERN_RANDOM = 2,  /* independent uniform points of the disc: unbiased, noisier */
     HFVIS_LK_PATTERN_LLOYD_TORUS = 3 /* the same relaxation and jitter on the periodic square,
                                         mapped onto the disc by the area-preserving concentric
-                                        map of Shirley & Chiu 1997. On the disc the Lloyd
-                                        centroids of the rim cells lie inward, so LLOYD leaves
-                                        the outermost ring of points about half a cell inside
-                                        the rim and under-samples grazing directions (N = 1024:
-                                        no point beyond rho = 0.995, and the AO of a plane at
-                                        h = 0.3 r comes out about 0.01 low); the torus has no
-                                        rim (moments within about 0.005 at N = 1024) */
+                                        map of Shirley & Chiu 1997: the torus has no rim, so the
+                                        points stay uniform up to the disc's edge (moments
+                                        within about 0.005 at N = 1024) */
 } hfvis_lk_pattern;
 
 /* The falloff rho(x) of the normalised occluder distance x = D/r, non-increasing, rho = 0 from
@@ -4940,7 +4964,7 @@ typedef double (*hfvis_lk_falloff_fn)(void *user, double x);
 /* Options of hfvis_lk_rays_build. NULL or a zero struct = defaults. */
 typedef struct hfvis_lk_ray_options {
     const hfvis_allocator *alloc;   /* the ray set's block and the scratch; NULL = malloc */
-    hfvis_lk_pattern pattern;       /* default LLOYD */
+    hfvis_lk_pattern pattern;       /* default LLOYD_TORUS */
     uint64_t seed;                  /* 0 is a valid seed and the default */
     int lloyd_iterations;           /* LLOYD*: steps before the Voronoi jitter, 1..10000;
                                        0 = 64 */
@@ -4953,7 +4977,7 @@ typedef struct hfvis_lk_ray_options {
     void *falloff_user;             /* CUSTOM only */
 } hfvis_lk_ray_options;
 
-/* The defaults: alloc NULL, LLOYD, seed 0, 64 + 4 Lloyd steps, adaptive grid, CONSTANT. */
+/* The defaults: alloc NULL, LLOYD_TORUS, seed 0, 64 + 4 Lloyd steps, adaptive grid, CONSTANT. */
 HFVIS_API hfvis_lk_ray_options hfvis_lk_ray_options_default(void);
 
 /* A ray set in the canonical receiver frame (z = normal), shared by every receiver ([LK] §3).
@@ -4977,9 +5001,9 @@ typedef struct hfvis_lk_rays {
 /* Build a ray set of `count` rays of radius `radius` (> 0, finite): disc points (pattern), lifted
  * to the hemisphere u = (x, y, sqrt(1 - x^2 - y^2)), every point strictly inside the disc of
  * radius sqrt(1 - 2^-20) (so u_z >= 2^-10), ordered by the Morton code of the disc point, and
- * the lengths of the falloff. Deterministic (seed). Cost: LLOYD O((iterations + jitter) *
- * density_resolution^2), at the defaults 0.03 s for N = 128 and 0.22 s for N = 1024 (torus:
- * 0.05 s, 0.34 s); RANDOM O(N log N).
+ * the lengths of the falloff. Deterministic (seed). Cost: LLOYD* O((iterations + jitter) *
+ * density_resolution^2), at the defaults (LLOYD_TORUS) 0.05 s for N = 128 and 0.34 s for
+ * N = 1024 (LLOYD: 0.03 s, 0.22 s); RANDOM O(N log N).
  * Allocations: the set's one block (8*(7N + 7 words) bytes) and, LLOYD, one scratch block.
  * Returns HFVIS_OK; HFVIS_ERR_INVALID_ARGUMENT for a NULL out, count outside
  * 1..HFVIS_LK_MAX_RAYS, a non-positive or non-finite radius, an unknown pattern or falloff, an

@@ -4051,7 +4051,7 @@ HFVIS_API hfvis_lk_ray_options hfvis_lk_ray_options_default(void)
 {
     hfvis_lk_ray_options o;
     memset(&o, 0, sizeof o);
-    o.pattern = HFVIS_LK_PATTERN_LLOYD;
+    o.pattern = HFVIS_LK_PATTERN_LLOYD_TORUS; /* unbiased at grazing angles (hfvis.h) */
     o.lloyd_iterations = 64;
     o.final_iterations = 4;
     o.density_resolution = 0; /* adaptive */

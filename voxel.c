@@ -4988,25 +4988,40 @@ HFVIS_API hfvis_status hfvis_voxelize_solid(const hfvis_mesh *mesh, const hfvis_
     stride[0] = 1;
     stride[1] = (size_t)grid->dims[0];
     stride[2] = stride[1] * (size_t)grid->dims[1];
-    ncol = (size_t)grid->dims[u] * (size_t)grid->dims[w];
+    /* the column-parity block is sized for the largest projection (the checking pass uses all
+     * three) */
+    ncol = (size_t)grid->dims[0] * (size_t)grid->dims[1];
+    if ((size_t)grid->dims[1] * (size_t)grid->dims[2] > ncol)
+        ncol = (size_t)grid->dims[1] * (size_t)grid->dims[2];
+    if ((size_t)grid->dims[0] * (size_t)grid->dims[2] > ncol)
+        ncol = (size_t)grid->dims[0] * (size_t)grid->dims[2];
     memset(&c, 0, sizeof c);
     c.colpar = (uint8_t *)vx_alloc(alloc, ncol);
     if (!c.colpar) return HFVIS_ERR_OUT_OF_MEMORY;
+    if (!allow_open) {
+        /* pass 1: along EACH of the three axes every column must be crossed an even number of
+         * times (a closed surface), so the status does not depend on opts->axis: a hole whose
+         * plane is parallel to the parity axis is found by another axis */
+        int b;
+        for (b = 0; b < 3; b++) {
+            int bu = b == 2 ? 0 : b + 1, bw = b == 0 ? 2 : b - 1;
+            size_t nb = (size_t)grid->dims[bu] * (size_t)grid->dims[bw];
+            memset(c.colpar, 0, nb);
+            c.nu = grid->dims[bu];
+            vx_cons_raster_mesh(mesh, grid, b, vx_cons_solid_pixel, &c);
+            for (i = 0; i < nb; i++)
+                if (c.colpar[i]) {
+                    vx_free(alloc, c.colpar);
+                    return HFVIS_ERR_FORMAT;
+                }
+        }
+    }
     memset(c.colpar, 0, ncol);
     c.nu = grid->dims[u];
     c.na = grid->dims[a];
     c.stride_u = stride[u];
     c.stride_w = stride[w];
     c.stride_a = stride[a];
-    if (!allow_open) {
-        /* pass 1: every column must be crossed an even number of times (a closed surface) */
-        vx_cons_raster_mesh(mesh, grid, a, vx_cons_solid_pixel, &c);
-        for (i = 0; i < ncol; i++)
-            if (c.colpar[i]) {
-                vx_free(alloc, c.colpar);
-                return HFVIS_ERR_FORMAT;
-            }
-    }
     /* pass 2 (Chen & Fang; Eisemann & Decoret 2008): each crossing toggles the first voxel whose
      * centre lies above it; a prefix XOR along the axis then gives the parity of the crossings
      * below every voxel centre. */

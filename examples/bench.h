@@ -55,5 +55,6 @@ int bench_ssao_scene(int W0, int H0, int gx, int gy, float *depth, hfvis_camera 
 void bench_volgi(int quick);
 void bench_vf(int quick);
 void bench_lk(int quick);
+void bench_lk_obj(int quick); /* bench_lkobj.c: the meshes of HFVIS_BENCH_MESHES */
 void bench_dirs(int quick);
 #endif

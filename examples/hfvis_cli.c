@@ -138,7 +138,7 @@ enum { OUT_TOTAL, OUT_DIRECT, OUT_INDIRECT };
 
 #define CLI_LK_HELP                                                                                  \
     "usage: hfvis meshao MESH.obj -o OUT [--method raster|bvh|raycast] [--rays N] [--radius R]\n"  \
-    "         [--falloff constant|linear|quadratic] [--eye X,Y,Z] [--target X,Y,Z] [--up X,Y,Z]\n"  \
+    "         [--pattern torus|lloyd|random] [--falloff constant|linear|quadratic] [--eye X,Y,Z] [--target X,Y,Z] [--up X,Y,Z]\n"  \
     "         [--fov DEG] [--size WxH] [--two-sided] [--lut T] [--seed S] [--no-jitter] [--stats]\n" \
     "Ray-cast ambient obscurance of a triangle mesh seen by a pinhole camera, with the bit masks of\n" \
     "Laine & Karras 2010: each visible point (pixel) casts N cosine-distributed shadow rays of\n"   \
@@ -149,6 +149,11 @@ enum { OUT_TOTAL, OUT_DIRECT, OUT_INDIRECT };
     "                    raster: each triangle's region of influence projected over the pixels\n"   \
     "                    (Method 1); raycast: every ray through the BVH (the reference)\n"          \
     "  --rays N          rays per point, 1..4096 (default 128)\n"                                  \
+    "  --pattern P       how the N directions are placed (one set, turned per point): torus\n"     \
+    "                    (default: Lloyd-relaxed points of the periodic square mapped onto the\n"  \
+    "                    disc, uniform up to the horizon), lloyd (Lloyd-relaxed on the disc as in\n" \
+    "                    the paper: too few grazing rays, obscurance biased low, e.g. -16 % for\n"   \
+    "                    the bunny at N = 1024) or random (independent points: unbiased, noisier)\n" \
     "  --radius R        longest ray, > 0 (default 0.1 x the mesh's bounding-box diagonal)\n"      \
     "  --falloff F       constant (default: every ray has length R), linear (rho = 1 - d/R) or\n"   \
     "                    quadratic (rho = (1 - d/R)^2): ray lengths distributed by the falloff\n"   \
@@ -182,7 +187,7 @@ enum { OUT_TOTAL, OUT_DIRECT, OUT_INDIRECT };
 #define CLI_LK_FLAGS                                                                          \
     { "--falloff", 1, CLI_ONLY(CMD_MESHAO) }, { "--two-sided", 0, CLI_ONLY(CMD_MESHAO) },     \
     { "--lut", 1, CLI_ONLY(CMD_MESHAO) }, { "--seed", 1, CLI_ONLY(CMD_MESHAO) },              \
-    { "--no-jitter", 0, CLI_ONLY(CMD_MESHAO) }
+    { "--no-jitter", 0, CLI_ONLY(CMD_MESHAO) }, { "--pattern", 1, CLI_ONLY(CMD_MESHAO) }
 
 typedef struct cli_args {
     int cmd;
@@ -211,7 +216,7 @@ typedef struct cli_args {
     int vf_has_extent, vf_has_ground, vf_has_bias;
     double vf_extent, vf_ground, vf_bias;
     const char *vf_reference;
-    int lk_method, lk_rays, lk_falloff, lk_width, lk_height, lk_two_sided, lk_lut, lk_no_jitter,
+    int lk_method, lk_rays, lk_pattern, lk_falloff, lk_width, lk_height, lk_two_sided, lk_lut, lk_no_jitter,
         lk_has_eye, lk_has_target, lk_has_up, lk_has_radius;
     double lk_radius, lk_fov, lk_seed, lk_eye[3], lk_target[3], lk_up[3];
 } cli_args;
@@ -420,8 +425,10 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "0 where terrain hides it, NaN at holes and beyond --max-distance (0 in PGM). The terrain\n"
     "is the bilinear surface through the samples; a sight line that grazes it counts as\n"
     "visible. Method: R2 of Franklin & Ray 1994 (rays to every border sample, running maximum\n"
-    "slope), O(W*H); it differs from the exact line of sight only at samples whose sight line\n"
-    "nearly grazes the terrain (about 0.4%% of a rough 1024 x 1024 terrain).\n"
+    "slope), O(W*H); it differs from the exact line of sight (--exact) only at samples whose\n"
+    "sight line nearly grazes the terrain: measured from 8 observers (summit, valley, slope, 5\n"
+    "random) on a 512 x 512 SRTM tile and a 512 x 512 fBm, on 0.005-1.2 % of the samples (mean\n"
+    "0.2-0.4 %); the most from a summit, which sees the most.\n"
     "  --observer X,Y        the observer's column and row, reals in [0, W-1] x [0, H-1] (required)\n"
     "  --observer-height H   eye height above the surface, height units, >= 0 (default 0)\n"
     "  --target-height T     target height above each sample, >= 0 (default 0)\n"
@@ -442,7 +449,8 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "                    triangle in the sweep along its dominant axis ([G12] ch. 6, 6-separating\n"
     "                    with --axis all); conservative: every voxel a triangle touches (exact\n"
     "                    triangle-box overlap); solid: the voxels whose centre is inside the\n"
-    "                    mesh, by ray parity (the mesh must be closed unless --open)\n"
+    "                    mesh, by ray parity (the mesh must be closed unless --open: the\n"     \
+    "                    parity of every column along x, y and z is checked, whatever --axis)\n"
     "  --axis A          surface: dominant (default), all (three sweeps merged, [G12] Alg. 4) or\n"
     "                    x, y, z (one sweep); solid: the parity ray direction x, y or z (default z)\n"
     "  --method M        surface: pixel (the pixel-centre rule, default), slicing (geometry-shader\n"
@@ -744,6 +752,13 @@ static int cli_set_lk(cli_args *a, const char *f, const char *v)
     }
     if (!strcmp(f, "--rays"))
         return cli_int(f, v, 1, HFVIS_LK_MAX_RAYS, "an integer 1..4096", &a->lk_rays);
+    if (!strcmp(f, "--pattern")) {
+        if (!strcmp(v, "torus")) a->lk_pattern = HFVIS_LK_PATTERN_LLOYD_TORUS;
+        else if (!strcmp(v, "lloyd")) a->lk_pattern = HFVIS_LK_PATTERN_LLOYD;
+        else if (!strcmp(v, "random")) a->lk_pattern = HFVIS_LK_PATTERN_RANDOM;
+        else return cli_error(CLI_EXIT_USAGE, f, "expected torus, lloyd or random, got '%s'", v);
+        return 0;
+    }
     if (!strcmp(f, "--radius")) {
         a->lk_has_radius = 1;
         return cli_real(f, v, 0.0, 1, CLI_FLT_MAX, "a radius > 0", &a->lk_radius);
@@ -1940,6 +1955,7 @@ static int cli_run_meshao(const cli_args *a)
     }
     /* rays, options, optional table */
     ro.falloff = (hfvis_lk_falloff)a->lk_falloff;
+    ro.pattern = (hfvis_lk_pattern)a->lk_pattern; /* 0 = the library's default */
     ro.seed = (uint64_t)a->lk_seed;
     s = hfvis_lk_rays_build(a->lk_rays, radius, &ro, &rays);
     if (s != HFVIS_OK) { rc = cli_status(cmd, s, 0); goto done; }

@@ -244,6 +244,13 @@ expect_ok "meshao bvh" "$dir/ao_b.pfm" meshao "$dir/cube.obj" --rays 64 --radius
 expect_ok "meshao raster" "$dir/ao_r.pfm" meshao "$dir/cube.obj" --method raster --rays 64 --radius 0.5 --size 24x18 -o "$dir/ao_r.pfm"
 expect_ok "meshao raycast" "$dir/ao_c.pfm" meshao "$dir/cube.obj" --method raycast --rays 64 --radius 0.5 --size 24x18 -o "$dir/ao_c.pfm"
 cmp -s "$dir/ao_b.pfm" "$dir/ao_r.pfm" && cmp -s "$dir/ao_b.pfm" "$dir/ao_c.pfm" && ok "meshao: three methods, same bytes" || bad "meshao: methods differ"
+# --pattern: torus is the default (same bytes), lloyd and random are other ray sets
+expect_ok "meshao --pattern torus" "$dir/ao_t.pfm" meshao "$dir/cube.obj" --pattern torus --two-sided --rays 64 --radius 0.3 --eye 0.5,0.5,0.5 --target 0.5,1,0.5 --fov 90 --size 16x16 -o "$dir/ao_t.pfm"
+expect_ok "meshao --pattern lloyd" "$dir/ao_l.pfm" meshao "$dir/cube.obj" --pattern lloyd --two-sided --rays 64 --radius 0.3 --eye 0.5,0.5,0.5 --target 0.5,1,0.5 --fov 90 --size 16x16 -o "$dir/ao_l.pfm"
+expect_ok "meshao --pattern random" "$dir/ao_x.pfm" meshao "$dir/cube.obj" --pattern random --two-sided --rays 64 --radius 0.3 --eye 0.5,0.5,0.5 --target 0.5,1,0.5 --fov 90 --size 16x16 -o "$dir/ao_x.pfm"
+expect_ok "meshao inside, default pattern" "$dir/ao_d.pfm" meshao "$dir/cube.obj" --two-sided --rays 64 --radius 0.3 --eye 0.5,0.5,0.5 --target 0.5,1,0.5 --fov 90 --size 16x16 -o "$dir/ao_d.pfm"
+cmp -s "$dir/ao_d.pfm" "$dir/ao_t.pfm" && ok "meshao: torus is the default pattern" || bad "meshao: --pattern torus differs from the default"
+! cmp -s "$dir/ao_t.pfm" "$dir/ao_l.pfm" && ! cmp -s "$dir/ao_t.pfm" "$dir/ao_x.pfm" && ok "meshao: lloyd and random differ from torus" || bad "meshao: --pattern has no effect"
 expect_ok "meshao inside the cube, two-sided, linear, lut, stats" "$dir/ao_i.pgm" meshao "$dir/cube.obj" --two-sided --falloff linear --lut 16 --rays 96 --radius 2 --eye 0.5,0.5,0.5 --target 0.5,1,0.5 --fov 90 --size 16x16 --seed 3 --no-jitter --stats -o "$dir/ao_i.pgm"
 grep -q '^receivers: 256$' "$dir/stdout" && ok "meshao inside: 256 receivers" || bad "meshao stats: $(cat "$dir/stdout")"
 
@@ -358,6 +365,7 @@ expect_fail "voxelize solid --axis all" 2 voxelize "$dir/cube.obj" --res 4 --mod
 expect_fail "voxelize --max-vertices with the pixel rule" 2 voxelize "$dir/cube.obj" --res 4 --max-vertices 7 -o "$ob"
 expect_fail "meshao --method" 2 meshao "$dir/cube.obj" --method lsao -o "$o"
 expect_fail "meshao --rays 0" 2 meshao "$dir/cube.obj" --rays 0 -o "$o"
+expect_fail "meshao --pattern" 2 meshao "$dir/cube.obj" --pattern box -o "$o"
 expect_fail "meshao --size" 2 meshao "$dir/cube.obj" --size 10 -o "$o"
 expect_fail "meshao --eye" 2 meshao "$dir/cube.obj" --eye 1,2 -o "$o"
 expect_fail "meshao --lut too big" 1 meshao "$dir/cube.obj" --rays 1024 --falloff linear --lut 128 -o "$o"
