@@ -56,4 +56,5 @@ void bench_volgi(int quick);
 void bench_vf(int quick);
 void bench_lk(int quick);
 void bench_dirs(int quick);
+void bench_exact(int quick);
 #endif

@@ -503,7 +503,7 @@ static void accuracy(const char *name, const hfvis_grid *g, int stride_pts, int 
         for (k = 0; k < 16; k++)
             for (y = 0; y < g->height; y += stride_pts)
                 for (x = (y / stride_pts) % stride_pts; x < g->width; x += stride_pts) {
-                    double arg, ref = fields_ray_max(g, x, y, az[k], 0.0, &arg), got, e;
+                    double arg = 0.0, ref = fields_ray_max(g, x, y, az[k], 0.0, &arg), got, e;
                     got = (m ? out_b : out_a)[(size_t)k * plane + (size_t)y * (size_t)g->width + (size_t)x];
                     if (!isfinite(ref) || ref <= -1.5 || arg < 1.0) continue;
                     e = fabs(got - ref) * 180.0 / PI;
