@@ -6968,7 +6968,19 @@ static void hf_exact_dirs_fill(hf_exact_dirs *d, int K, double azimuth0, int N)
 typedef struct hf_cross {
     int ox, oy, kind;
     double f, u;
+    /* the piece from this crossing to the next (or to g + (a, b)): inside cell (cx, cy) (offsets
+       from g), from (fx0, fy0) to (fx1, fy1) in cell coordinates, du sub-steps long */
+    int cx, cy;
+    double fx0, fy0, fx1, fy1, du;
 } hf_cross;
+
+/* Subdivision of concave pieces (beyond the crossing set): along a ray the bilinear surface is a
+ * quadratic inside each cell; where it bulges above its chord (a saddle: box corners, the corners
+ * of stair-stepped cliffs) the tangent from a receiver can touch between two crossings. Such a
+ * piece gets m - 1 interior samples, m the power of two (<= HF_EXACT_MAX_SPLIT) that brings the
+ * bulge r/4 below HF_EXACT_BULGE cells of height; powers of two keep every distance exact. */
+#define HF_EXACT_BULGE (1.0 / 1024.0)
+#define HF_EXACT_MAX_SPLIT 16
 
 typedef struct hf_exact {
     const hfvis_grid *g;
@@ -6986,6 +6998,25 @@ typedef struct hf_exact {
     const hfvis_allocator *alloc;
 } hf_exact;
 
+/* The piece after each crossing e (to crossing e + 1, the last one to the next grid point at
+ * u = L): its cell, found from its midpoint, and its ends in that cell's coordinates. */
+static void hf_exact_pieces(hf_cross *cross, int n, int a, int b, double L)
+{
+    int e;
+    for (e = 0; e < n; e++) {
+        double u0 = cross[e].u, u1 = e + 1 < n ? cross[e + 1].u : L, um = 0.5 * (u0 + u1);
+        double mx = um * (double)a / L, my = um * (double)b / L;
+        hf_cross *c = cross + e;
+        c->cx = (int)floor(mx);
+        c->cy = (int)floor(my);
+        c->fx0 = u0 * (double)a / L - (double)c->cx;
+        c->fy0 = u0 * (double)b / L - (double)c->cy;
+        c->fx1 = u1 * (double)a / L - (double)c->cx;
+        c->fy1 = u1 * (double)b / L - (double)c->cy;
+        c->du = u1 - u0;
+    }
+}
+
 /* Crossings of direction (a, b) into cross[]; returns P = |a| + |b| - 1 (1 for the axes),
  * *L the sub-steps per step and *scale the factor from height per sub-step to tangent. */
 static int hf_exact_geometry(hf_cross *cross, const hfvis_grid *g, int a, int b, double *L,
@@ -6994,8 +7025,7 @@ static int hf_exact_geometry(hf_cross *cross, const hfvis_grid *g, int a, int b,
     int A = a < 0 ? -a : a, B = b < 0 ? -b : b, ja = 0, jb = 1, n = 0;
     double len = sqrt((double)a * (double)a + (double)b * (double)b);
     if (A == 0 || B == 0) {
-        cross[0].ox = cross[0].oy = cross[0].kind = 0;
-        cross[0].f = cross[0].u = 0.0;
+        memset(cross, 0, sizeof *cross); /* along a grid line the surface is linear: no pieces */
         *L = 1.0;
         *scale = 1.0 / (len * g->cell_size);
         return 1;
@@ -7022,6 +7052,7 @@ static int hf_exact_geometry(hf_cross *cross, const hfvis_grid *g, int a, int b,
     }
     *L = (double)A * (double)B;
     *scale = *L / (len * g->cell_size);
+    hf_exact_pieces(cross, n, a, b, *L);
     return n;
 }
 
@@ -7048,6 +7079,35 @@ static double hf_cross_height(const hfvis_grid *g, hfvis_border border, int X, i
                             (double)Y + (c->kind == 1 ? c->f : 0.0));
 }
 
+/* Interior samples of piece c after base grid point (X, Y) (see HF_EXACT_BULGE): writes up to
+ * HF_EXACT_MAX_SPLIT - 1 heights h[j] at sub-step offsets du[j] from the piece's start, in
+ * increasing order, and returns the count; 0 for a piece that is not concave enough, outside
+ * the grid or touching a hole. */
+static int hf_piece_samples(const hfvis_grid *g, int X, int Y, const hf_cross *c, double *h,
+                            double *du)
+{
+    const float *p;
+    double z00, z10, z01, z11, dfx = c->fx1 - c->fx0, dfy = c->fy1 - c->fy0, bulge, lim;
+    int m = 1, j, cx = X + c->cx, cy = Y + c->cy;
+    if (c->du == 0.0 || cx < 0 || cy < 0 || cx + 1 >= g->width || cy + 1 >= g->height) return 0;
+    p = g->z + (ptrdiff_t)cy * g->stride + cx;
+    z00 = (double)p[0];
+    z10 = (double)p[1];
+    z01 = (double)p[g->stride];
+    z11 = (double)p[g->stride + 1];
+    bulge = -0.25 * (z00 - z10 - z01 + z11) * dfx * dfy; /* r/4 of h(t) = ... + r t^2, negated */
+    if (!(bulge > 0.0) || !isfinite(bulge)) return 0;
+    lim = HF_EXACT_BULGE * g->cell_size;
+    while (m < HF_EXACT_MAX_SPLIT && bulge > lim * (double)m * (double)m) m *= 2;
+    for (j = 1; j < m; j++) {
+        double t = (double)j / (double)m, fx = c->fx0 + t * dfx, fy = c->fy0 + t * dfy;
+        double r0 = z00 + (z10 - z00) * fx, r1 = z01 + (z11 - z01) * fx;
+        h[j - 1] = r0 + (r1 - r0) * fy;
+        du[j - 1] = c->du * t;
+    }
+    return m - 1;
+}
+
 /* Whole periods k >= 0 of the ray from grid point (x, y) along (a, b) that can hold a crossing
  * inside the grid grown by R cells. */
 static int hf_exact_periods(const hfvis_grid *g, int R, int x, int y, int a, int b)
@@ -7068,7 +7128,7 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
 {
     const hfvis_grid *g = E->g;
     const hf_cross *cr = E->cross;
-    double *sd = E->sd, *sh = E->sh;
+    double *sd = E->sd, *sh = E->sh, ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
     const ptrdiff_t stride = g->stride;
     int top = 0, k, e, q;
 #define HF_HULL_PUSH(dd, hh)                                                                     \
@@ -7079,10 +7139,17 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
     } while (0)
     for (k = hf_exact_periods(g, E->R, hx, hy, a, b); k >= 0; k--) {
         int bx = hx + k * a, by = hy + k * b;
-        for (e = P - 1; e >= (k == 0 ? 1 : 0); e--) {
-            int X = bx + cr[e].ox, Y = by + cr[e].oy;
+        for (e = P - 1; e >= 0; e--) {
+            int X = bx + cr[e].ox, Y = by + cr[e].oy, j = hf_piece_samples(g, bx, by, cr + e, ph, pu);
             double h, d;
-            if (!hf_cross_inside(g, E->R, X, Y, cr + e)) continue;
+            while (j-- > 0) { /* the piece after crossing e, far end first */
+                if (isnan(ph[j])) continue;
+                d = -((double)k * L + (cr[e].u + pu[j]));
+                HF_HULL_PUSH(d, ph[j]);
+                sd[top] = d;
+                sh[top++] = ph[j];
+            }
+            if ((k == 0 && e == 0) || !hf_cross_inside(g, E->R, X, Y, cr + e)) continue;
             h = hf_cross_height(g, E->border, X, Y, cr + e);
             if (isnan(h)) continue;
             d = -((double)k * L + cr[e].u);
@@ -7104,8 +7171,17 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
             sh[top++] = h;
         }
         if (nx < 0 || ny < 0 || nx >= g->width || ny >= g->height) break;
-        for (e = P - 1; e >= 1; e--) { /* between two grid points: inside the grid */
+        for (e = P - 1; e >= 0; e--) { /* between two grid points: inside the grid */
             const float *p = g->z + (ptrdiff_t)(ny + cr[e].oy) * stride + (nx + cr[e].ox);
+            int j = hf_piece_samples(g, nx, ny, cr + e, ph, pu);
+            while (j-- > 0) {
+                if (isnan(ph[j])) continue;
+                d = (double)(q + 1) * L - (cr[e].u + pu[j]);
+                HF_HULL_PUSH(d, ph[j]);
+                sd[top] = d;
+                sh[top++] = ph[j];
+            }
+            if (e == 0) break; /* crossing 0 is the next receiver */
             h = (double)p[0];
             h += ((double)p[cr[e].kind == 1 ? stride : 1] - h) * cr[e].f; /* as hf_cross_height */
             if (!isfinite(h)) continue;
@@ -7154,10 +7230,16 @@ static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, co
     int k, e, kmax = hf_exact_periods(g, R, x, y, a, b);
     if (!isfinite(hr)) return HF_NAN;
     for (k = 0; k <= kmax; k++)
-        for (e = k == 0 ? 1 : 0; e < P; e++) {
-            int X = x + k * a + cr[e].ox, Y = y + k * b + cr[e].oy;
-            double h, s;
-            if (!hf_cross_inside(g, R, X, Y, cr + e)) continue;
+        for (e = 0; e < P; e++) {
+            int X = x + k * a + cr[e].ox, Y = y + k * b + cr[e].oy, j;
+            double h, s, ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
+            int np = hf_piece_samples(g, x + k * a, y + k * b, cr + e, ph, pu);
+            for (j = 0; j < np; j++) {
+                if (isnan(ph[j])) continue;
+                s = (ph[j] - hr) / ((double)k * L + (cr[e].u + pu[j])) * scale;
+                if (s > best) best = s;
+            }
+            if ((k == 0 && e == 0) || !hf_cross_inside(g, R, X, Y, cr + e)) continue;
             h = hf_cross_height(g, border, X, Y, cr + e);
             if (isnan(h)) continue;
             s = (h - hr) / ((double)k * L + cr[e].u) * scale;
@@ -7191,7 +7273,10 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
         if (p > maxp) maxp = p;
     }
     gridn = hf_grid_count(g);
-    if (!hf_mul_size((size_t)side + 2u * (size_t)E->R + 3u, (size_t)maxp, &cap)) return HFVIS_ERR_LIMIT;
+    /* a line crosses each grid line once (W + H + 4R of them within reach) and has at most
+       W + H pieces inside the grid, each split at most HF_EXACT_MAX_SPLIT - 1 times */
+    cap = (size_t)g->width + (size_t)g->height + 4u * (size_t)E->R + 8u +
+          ((size_t)g->width + (size_t)g->height + 2u) * (HF_EXACT_MAX_SPLIT - 1);
     off_ray = hf_align_add(&total, (size_t)K, sizeof(hf_ray), &ok);
     off_d = hf_align_add(&total, (size_t)K * 5u, sizeof(double), &ok);
     off_c = hf_align_add(&total, (size_t)maxp, sizeof(hf_cross), &ok);
@@ -7216,18 +7301,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     E->nrm = want_normals ? (float *)(void *)(blk + off_n) : NULL;
     E->acc = channels ? (double *)(void *)(blk + off_a) : NULL;
     hf_exact_dirs_fill(&E->d, K, o->azimuth0_rad, E->N);
-    if (want_normals) {
-        int x, y;
-        for (y = 0; y < g->height; y++)
-            for (x = 0; x < g->width; x++) {
-                double n[3];
-                float *p = E->nrm + ((size_t)y * (size_t)g->width + (size_t)x) * 3;
-                hf_normal_at(g, x, y, n);
-                p[0] = (float)n[0];
-                p[1] = (float)n[1];
-                p[2] = (float)n[2];
-            }
-    }
+    if (want_normals) (void)hfvis_normals_compute(g, E->nrm); /* the grid normals, as floats */
     if (channels) memset(E->acc, 0, gridn * (size_t)channels * sizeof(double));
     return HFVIS_OK;
 }

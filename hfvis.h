@@ -464,11 +464,17 @@ HFVIS_API hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user
  *     all grid points of a line share it. Between two of them the line crosses |a| - 1 columns
  *     and |b| - 1 rows; at a crossing the bilinear surface is the linear interpolation along that
  *     grid line, an exact point of the surface.
+ *   - Between two crossings the ray stays in one cell, where the bilinear surface along it is a
+ *     quadratic. Where that piece bulges above its chord (a saddle: box corners, the corners of
+ *     stair-stepped cliffs) the tangent from a receiver can touch between the crossings, so such
+ *     a piece also gets m - 1 evenly spaced interior samples, m the power of two up to 16 that
+ *     brings the bulge below 1/1024 cell of height (power-of-two spacing keeps every distance
+ *     exact in double). Pieces outside the grid or touching a hole are not split.
  *   - Each line is swept from its far end with the hull stack of [P1] §5 (Alg. 1) over all its
- *     crossings; each grid point reads the hull's tangent at its turn. The result is, bit for bit,
- *     the maximum elevation over every grid-line crossing of the receiver's own ray
- *     (hfvis_horizon_exact_naive is that maximum computed receiver by receiver). Along an axis
- *     or a diagonal the crossings are the grid points only.
+ *     samples; each grid point reads the hull's tangent at its turn. The result is, bit for bit,
+ *     the maximum elevation over every sample of the receiver's own ray (hfvis_horizon_exact_naive
+ *     is that maximum computed receiver by receiver). Along an axis the crossings are the grid
+ *     points only (the surface is linear along a grid line).
  *   - Rule: direction k is the representable direction nearest to psi_k = azimuth0 + 2 pi k/K
  *     (ties: the smaller |a| + |b|). hfvis_sweep_azimuths returns the K azimuths actually used
  *     and their quadrature weights. The default N = max(5, ceil(K/4)) (64 for K = 1). Largest
@@ -498,12 +504,10 @@ HFVIS_API hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user
  *     routines (uniform azimuths) ignore the field.
  *   - Outputs are written at grid points directly (no gather). Scratch: one block of about
  *     8*width*height bytes (plus 12 for normals and 8*channels for the lighting sums) and the
- *     hull stack, 16*(max(W, H) + 2*border_cells + 3)*(2N - 1) bytes at most.
- *   - What the crossing set misses: the bilinear surface between two crossings is quadratic
- *     along the ray, and on a saddle (a box corner, a stair-stepped cliff corner) its tangent
- *     point can lie between them. Against the exact maximum over the bilinear surface
- *     (occluders >= 1 cell away) the exact mode measures urban 512^2 mean 0.09 / p99 0.57 deg,
- *     fBm 0.009 / 0.25 deg (lattice 1.1 / 19 and 0.36 / 4.3); docs/exact-rays.md has all figures. */
+ *     hull stack, 16*(16*(W + H + 2) + 4*border_cells) bytes.
+ *   - Accuracy: against the exact maximum over the bilinear surface (occluders >= 1 cell away)
+ *     the exact mode is within 0.001 deg mean and 0.02 deg p99 on urban boxes, terraces with
+ *     one-cell cliffs and fBm (the lattice: 1-5 deg mean, 11-35 deg p99); docs/exact-rays.md. */
 
 /* The K azimuths actually used by a run with these options (radians; azimuths[k] is plane k of
  * hfvis_horizon_map, index order) and their quadrature weights (each direction's share of the
@@ -516,8 +520,8 @@ HFVIS_API hfvis_status hfvis_sweep_azimuths(int K, const hfvis_sweep_options *op
                                             double *azimuths, double *weights);
 
 /* Oracle for the exact mode: for every grid point and direction, the maximum elevation over every
- * grid-line crossing of its own ray (the same heights and quotients as the sweep), receiver by
- * receiver. Always exact rays, whatever opts->rays says; otherwise the layout, range, border and
+ * sample of its own ray (grid-line crossings and the interior samples of bulging pieces; the same
+ * heights and quotients as the sweep), receiver by receiver. Always exact rays, whatever opts->rays says; otherwise the layout, range, border and
  * hole rules of hfvis_horizon_map. Equal to hfvis_horizon_map in exact mode bit for bit.
  * Allocates 1 block (2N crossings). Cost O(K*width*height*(max(W, H) + border_cells)). */
 HFVIS_API hfvis_status hfvis_horizon_exact_naive(const hfvis_grid *grid, int K,

@@ -13,14 +13,15 @@
 #define EXACT_HULL_TOL 1e-12
 /* Closed-form horizons (planes, walls, boxes) recomputed in double by another route. */
 #define CLOSED_FORM_TOL 1e-9
-/* Regression bounds against the exact bilinear maximum, per field (mean, p99 in degrees): the
- * crossing set misses interior maxima of the bilinear pieces (saddles at box corners and at the
- * stair-stepped corners of curved cliffs); measured urban 0.19/3.2, terraces 0.28/7.7, fBm
- * 0.044/1.1, bounds set 25% above. The lattice on the same pairs: 2.2/35, 4.6/34, 1.3/11. */
-static const double acc_bound[3][2] = {{0.25, 4.0}, {0.35, 9.6}, {0.055, 1.45}};
-/* Lattice and exact sky-view factor and sky light on smooth fBm: they differ by the lattice's
- * gather error (measured 0.175 SVF, 0.094 sky on this 8-octave field). */
-#define MODES_AGREE_TOL 0.25
+/* Accuracy against the exact bilinear maximum, occluders >= 1 cell away (issue 16's targets:
+ * mean 0.15 deg, p99 1.5 deg; measured with the concave pieces split: urban 0.000/0.010,
+ * terraces 0.001/0.018, fBm 0.000/0.006; the lattice on the same pairs 2.2/35, 4.6/34, 1.3/11). */
+#define ACC_MEAN_DEG 0.15
+#define ACC_P99_DEG 1.5
+/* Lattice and exact sky-view factor and sky light on a smooth sinusoid, two cells from the
+ * border: they differ by the lattice's gather error and the directions' deviation (0.7 deg at
+ * K = 16); measured 0.020 (SVF) and 0.008 (sky). */
+#define MODES_AGREE_TOL 0.03
 
 static float zbuf[160 * 160], out_a[16 * 160 * 160], out_b[16 * 160 * 160];
 
@@ -337,7 +338,7 @@ TEST(flat_field_quadrature_exact)
     }
 }
 
-/* Exact and lattice agree on smooth terrain (the fused light paths and the quadrature), and the
+/* Exact and lattice agree on a smooth field (the fused light paths and the quadrature), and the
  * sky-view factor equals 1 - sum w_k sin(max(alpha_k, 0)) from the exact horizon map. */
 TEST(light_consistent_with_map)
 {
@@ -349,8 +350,13 @@ TEST(light_consistent_with_map)
     hfvis_env env;
     int j, k, bad = 0, bad_env = 0;
     double worst = 0.0;
+    hfvis_field sf;
     lat.azimuth0_rad = 0.1;
-    fbm(zbuf, 40, 36, 10.0, 12.0, 9);
+    memset(&sf, 0, sizeof sf);
+    sf.kind = HFVIS_FIELD_SINUSOID;
+    sf.amplitude = 3.0;
+    sf.wavelength = 20.0;
+    hfvis_field_generate(&sf, 40, 36, 40, zbuf);
     CHECK_EQ_STATUS(hfvis_horizon_map(&g, 16, &o, out_a), HFVIS_OK);
     CHECK_EQ_STATUS(hfvis_sweep_azimuths(16, &o, NULL, w), HFVIS_OK);
     CHECK_EQ_STATUS(hfvis_sky_view_factor(&g, 16, &o, out_b, 40), HFVIS_OK);
@@ -362,7 +368,8 @@ TEST(light_consistent_with_map)
             s += 16.0 * w[k] * (a > 0.0 ? sin(a) : 0.0);
         }
         if (fabs((1.0 - s / 16.0) - (double)out_b[j]) > 1e-6) bad++;
-        if (fabs(out_b[j] - svf_l[j]) > worst) worst = fabs(out_b[j] - svf_l[j]);
+        if (j % 40 >= 2 && j % 40 < 38 && j / 40 >= 2 && j / 40 < 34 && fabs(out_b[j] - svf_l[j]) > worst)
+            worst = fabs(out_b[j] - svf_l[j]); /* away from the border, where the modes differ */
     }
     CHECK(bad == 0);
     CHECK(worst < MODES_AGREE_TOL);
@@ -370,7 +377,9 @@ TEST(light_consistent_with_map)
     CHECK_EQ_STATUS(hfvis_sky_light(&g, 16, 1.0f, 1.0f, &o, sky_e, 40), HFVIS_OK);
     CHECK_EQ_STATUS(hfvis_sky_light(&g, 16, 1.0f, 1.0f, &lat, sky_l, 40), HFVIS_OK);
     worst = 0.0;
-    for (j = 0; j < 40 * 36; j++) if (fabs(sky_e[j] - sky_l[j]) > worst) worst = fabs(sky_e[j] - sky_l[j]);
+    for (j = 0; j < 40 * 36; j++)
+        if (j % 40 >= 2 && j % 40 < 38 && j / 40 >= 2 && j / 40 < 34 && fabs(sky_e[j] - sky_l[j]) > worst)
+            worst = fabs(sky_e[j] - sky_l[j]);
     CHECK(worst < MODES_AGREE_TOL);
     printf("     sky light exact - lattice: largest %.3f\n", worst);
     /* a uniform environment of radiance 1 equals the uniform sky (prefix tables, exact sectors) */
@@ -488,7 +497,7 @@ static int cmp_double(const void *a, const void *b)
 /* Accuracy against the exact bilinear maximum (occluders >= 1 cell away: pairs whose maximum lies
  * nearer are left out), off-axis directions included, on the three fields of the issue at test
  * size, and the lattice mode measured beside it (printed). */
-static void accuracy(const char *name, const hfvis_grid *g, int stride_pts, int field)
+static void accuracy(const char *name, const hfvis_grid *g, int stride_pts)
 {
     hfvis_sweep_options o = exact_opts(0.0, HFVIS_BORDER_OPEN, 0), lat = hfvis_sweep_options_default();
     static double errs[2][200000];
@@ -519,8 +528,8 @@ static void accuracy(const char *name, const hfvis_grid *g, int stride_pts, int 
         p99 = e[r];
         printf("     %-9s %s: mean %.3f deg, p99 %.3f deg (%zu pairs)\n", name, m ? "lattice" : "exact  ", mean, p99, n);
         if (m == 0) {
-            CHECK(mean <= acc_bound[field][0]);
-            CHECK(p99 <= acc_bound[field][1]);
+            CHECK(mean <= ACC_MEAN_DEG);
+            CHECK(p99 <= ACC_P99_DEG);
         }
     }
 }
@@ -530,13 +539,13 @@ TEST(accuracy_against_exact_bilinear_max)
     hfvis_grid g;
     fields_urban(zbuf, 128, 128, 40, 1);
     g = grid_of(zbuf, 128, 128, 1.0);
-    accuracy("urban", &g, 3, 0);
+    accuracy("urban", &g, 3);
     fields_terraces(zbuf, 96, 72, 1.0, 5.0, 80.0, 2);
     g = grid_of(zbuf, 96, 72, 1.0);
-    accuracy("terraces", &g, 2, 1);
+    accuracy("terraces", &g, 2);
     fbm(zbuf, 96, 72, 20.0, 24.0, 3);
     g = grid_of(zbuf, 96, 72, 1.0);
-    accuracy("fbm", &g, 2, 2);
+    accuracy("fbm", &g, 2);
 }
 
 int main(int argc, char **argv)
