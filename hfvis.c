@@ -6979,7 +6979,7 @@ typedef struct hf_cross {
  * of stair-stepped cliffs) the tangent from a receiver can touch between two crossings. Such a
  * piece gets m - 1 interior samples, m the power of two (<= HF_EXACT_MAX_SPLIT) that brings the
  * bulge r/4 below HF_EXACT_BULGE cells of height; powers of two keep every distance exact. */
-#define HF_EXACT_BULGE (1.0 / 1024.0)
+#define HF_EXACT_BULGE (1.0 / 128.0)
 #define HF_EXACT_MAX_SPLIT 16
 
 typedef struct hf_exact {

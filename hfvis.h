@@ -468,7 +468,7 @@ HFVIS_API hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user
  *     quadratic. Where that piece bulges above its chord (a saddle: box corners, the corners of
  *     stair-stepped cliffs) the tangent from a receiver can touch between the crossings, so such
  *     a piece also gets m - 1 evenly spaced interior samples, m the power of two up to 16 that
- *     brings the bulge below 1/1024 cell of height (power-of-two spacing keeps every distance
+ *     brings the bulge below 1/128 cell of height (power-of-two spacing keeps every distance
  *     exact in double). Pieces outside the grid or touching a hole are not split.
  *   - Each line is swept from its far end with the hull stack of [P1] §5 (Alg. 1) over all its
  *     samples; each grid point reads the hull's tangent at its turn. The result is, bit for bit,

@@ -534,12 +534,48 @@ static void accuracy(const char *name, const hfvis_grid *g, int stride_pts)
     }
 }
 
+/* Sky-view factor next to walls (a 4-neighbour more than 2 m higher or lower) against the one
+ * from the exact bilinear maxima along the same directions with the same weights. */
+#define SVF_WALL_TOL 0.02 /* issue 16: SVF max error next to walls */
+static void svf_next_to_walls(const hfvis_grid *g)
+{
+    static float svf[2][128 * 128];
+    hfvis_sweep_options o = exact_opts(0.0, HFVIS_BORDER_OPEN, 0), lat = hfvis_sweep_options_default();
+    double az[2][16], w[2][16], worst[2] = {0.0, 0.0};
+    int m, k, x, y, n = 0, W = g->width;
+    for (m = 0; m < 2; m++) {
+        CHECK_EQ_STATUS(hfvis_sweep_azimuths(16, m ? &lat : &o, az[m], w[m]), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_sky_view_factor(g, 16, m ? &lat : &o, svf[m], W), HFVIS_OK);
+    }
+    for (y = 2; y < g->height - 2; y++)
+        for (x = 2; x < W - 2; x++) {
+            const float *z = g->z + y * W + x;
+            if (!(fabsf(z[1] - z[0]) > 2.0f || fabsf(z[-1] - z[0]) > 2.0f || fabsf(z[W] - z[0]) > 2.0f ||
+                  fabsf(z[-W] - z[0]) > 2.0f))
+                continue;
+            n++;
+            for (m = 0; m < 2; m++) {
+                double S = 0.0, e;
+                for (k = 0; k < 16; k++) {
+                    double a = fields_ray_max(g, x, y, az[m][k], 0.0, NULL);
+                    if (a > 0.0) S += w[m][k] * sin(a);
+                }
+                e = fabs((1.0 - S) - (double)svf[m][y * W + x]);
+                if (e > worst[m]) worst[m] = e;
+            }
+        }
+    printf("     SVF next to walls (%d receivers): largest error exact %.4f, lattice %.3f\n", n, worst[0], worst[1]);
+    CHECK(n > 1000);
+    CHECK(worst[0] <= SVF_WALL_TOL);
+}
+
 TEST(accuracy_against_exact_bilinear_max)
 {
     hfvis_grid g;
     fields_urban(zbuf, 128, 128, 40, 1);
     g = grid_of(zbuf, 128, 128, 1.0);
     accuracy("urban", &g, 3);
+    svf_next_to_walls(&g);
     fields_terraces(zbuf, 96, 72, 1.0, 5.0, 80.0, 2);
     g = grid_of(zbuf, 96, 72, 1.0);
     accuracy("terraces", &g, 2);
