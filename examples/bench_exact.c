@@ -1,7 +1,8 @@
 /* bench_exact.c - exact rays beside the lattice and the per-receiver ray march (hfvis.h, "Exact
  * rays"): horizon maps at K = 16 on an urban DSM (boxes on flat ground, 1 m grid) and on fBm, the
  * time of each and its error against the exact maximum over the bilinear surface
- * (fields_ray_max; pairs whose maximum lies nearer than one cell left out) on 1500 receivers. */
+ * (fields_ray_max; pairs whose maximum lies nearer than one cell left out) on 1500 receivers;
+ * and the fused sky-view factor in both modes. */
 #define _POSIX_C_SOURCE 199309L
 #include <math.h>
 #include <stdio.h>
@@ -48,7 +49,7 @@ static void exact_field(const char *name, float *z, int n, float *map)
     hfvis_sweep_options lat = hfvis_sweep_options_default(), ex = lat;
     static int px[EXACT_BENCH_PTS], py[EXACT_BENCH_PTS];
     static float pts[2 * EXACT_BENCH_PTS], march[EXACT_BENCH_PTS * EXACT_BENCH_K];
-    double az_l[EXACT_BENCH_K], az_e[EXACT_BENCH_K], t0, tl, te, tm, ml, pl, me, pe, mm, pm;
+    double az_l[EXACT_BENCH_K], az_e[EXACT_BENCH_K], t0, tl, te, tm, ml, pl, me, pe, mm, pm, sl, se;
     double rd = (double)n * (double)n * EXACT_BENCH_K;
     uint64_t seed = 77;
     int i;
@@ -74,7 +75,15 @@ static void exact_field(const char *name, float *z, int n, float *map)
     hfvis_horizon_reference(&g, EXACT_BENCH_K, &ex, NULL, pts, EXACT_BENCH_PTS, march);
     tm = (bench_now() - t0) / (EXACT_BENCH_PTS * (double)EXACT_BENCH_K);
     exact_err(&g, march, 1, px, py, az_e, &mm, &pm);
-    printf("exact rays, %s %d^2 K=%d: lattice %.1f ms (%.1f ns/rd, err mean %.3f p99 %.2f deg) | exact "
+    t0 = bench_now();
+    hfvis_sky_view_factor(&g, EXACT_BENCH_K, &lat, map, n);
+    sl = bench_now() - t0;
+    t0 = bench_now();
+    hfvis_sky_view_factor(&g, EXACT_BENCH_K, &ex, map, n);
+    se = bench_now() - t0;
+    printf("exact rays, %s %d^2 K=%d: sky-view factor lattice %.1f ns/rd, exact %.1f ns/rd (%.2fx)\n", name, n,
+           EXACT_BENCH_K, 1e9 * sl / rd, 1e9 * se / rd, se / sl);
+    printf("exact rays, %s %d^2 K=%d: horizon map lattice %.1f ms (%.1f ns/rd, err mean %.3f p99 %.2f deg) | exact "
            "%.1f ms (%.1f ns/rd, %.2fx lattice, err mean %.3f p99 %.2f deg) | unit-step march %.0f ns/rd "
            "(%.0fx lattice, err mean %.3f p99 %.2f deg)\n",
            name, n, EXACT_BENCH_K, 1e3 * tl, 1e9 * tl / rd, ml, pl, 1e3 * te, 1e9 * te / rd, te / tl, me, pe,
