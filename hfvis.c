@@ -6971,7 +6971,7 @@ typedef struct hf_cross {
     /* the piece from this crossing to the next (or to g + (a, b)): inside cell (cx, cy) (offsets
        from g), from (fx0, fy0) to (fx1, fy1) in cell coordinates, du sub-steps long */
     int cx, cy;
-    double fx0, fy0, fx1, fy1, du;
+    double fx0, fy0, fx1, fy1, du, q; /* q = -(fx1 - fx0)(fy1 - fy0)/4: bulge = q * twist */
 } hf_cross;
 
 /* Subdivision of concave pieces (beyond the crossing set): along a ray the bilinear surface is a
@@ -6991,6 +6991,7 @@ typedef struct hf_exact {
     hf_cross *cross;        /* the current direction's crossings, up to 2N - 1 */
     double *sd, *sh;        /* hull stack: distances (sub-steps), heights (world units) */
     double *tan;            /* width*height tangents of the current direction, NaN at holes */
+    double *twist;          /* width*height cell twists (hf_cell_twist), cell (x, y) at y*width + x */
     float *nrm;             /* width*height*3 grid normals (lighting), else NULL */
     double *acc;            /* width*height*channels sums, else NULL */
     int channels;
@@ -7014,6 +7015,7 @@ static void hf_exact_pieces(hf_cross *cross, int n, int a, int b, double L)
         c->fx1 = u1 * (double)a / L - (double)c->cx;
         c->fy1 = u1 * (double)b / L - (double)c->cy;
         c->du = u1 - u0;
+        c->q = -0.25 * (c->fx1 - c->fx0) * (c->fy1 - c->fy0);
     }
 }
 
@@ -7083,21 +7085,27 @@ static double hf_cross_height(const hfvis_grid *g, hfvis_border border, int X, i
  * HF_EXACT_MAX_SPLIT - 1 heights h[j] at sub-step offsets du[j] from the piece's start, in
  * increasing order, and returns the count; 0 for a piece that is not concave enough, outside
  * the grid or touching a hole. */
-static int hf_piece_samples(const hfvis_grid *g, int X, int Y, const hf_cross *c, double *h,
-                            double *du)
+static double hf_cell_twist(const float *p, ptrdiff_t stride)
+{
+    return (double)p[0] - (double)p[1] - (double)p[stride] + (double)p[stride + 1];
+}
+
+static int hf_piece_samples(const hfvis_grid *g, const double *twist, int X, int Y, const hf_cross *c,
+                            double *h, double *du)
 {
     const float *p;
     double z00, z10, z01, z11, dfx = c->fx1 - c->fx0, dfy = c->fy1 - c->fy0, bulge, lim;
     int m = 1, j, cx = X + c->cx, cy = Y + c->cy;
     if (c->du == 0.0 || cx < 0 || cy < 0 || cx + 1 >= g->width || cy + 1 >= g->height) return 0;
     p = g->z + (ptrdiff_t)cy * g->stride + cx;
+    /* the twist z00 - z10 - z01 + z11 of the cell (precomputed by the sweep: one load) */
+    bulge = c->q * (twist ? twist[(size_t)cy * (size_t)g->width + (size_t)cx] : hf_cell_twist(p, g->stride));
+    lim = HF_EXACT_BULGE * g->cell_size;
+    if (!(bulge > lim) || !isfinite(bulge)) return 0;
     z00 = (double)p[0];
     z10 = (double)p[1];
     z01 = (double)p[g->stride];
     z11 = (double)p[g->stride + 1];
-    bulge = -0.25 * (z00 - z10 - z01 + z11) * dfx * dfy; /* r/4 of h(t) = ... + r t^2, negated */
-    if (!(bulge > 0.0) || !isfinite(bulge)) return 0;
-    lim = HF_EXACT_BULGE * g->cell_size;
     while (m < HF_EXACT_MAX_SPLIT && bulge > lim * (double)m * (double)m) m *= 2;
     for (j = 1; j < m; j++) {
         double t = (double)j / (double)m, fx = c->fx0 + t * dfx, fy = c->fy0 + t * dfy;
@@ -7140,7 +7148,7 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
     for (k = hf_exact_periods(g, E->R, hx, hy, a, b); k >= 0; k--) {
         int bx = hx + k * a, by = hy + k * b;
         for (e = P - 1; e >= 0; e--) {
-            int X = bx + cr[e].ox, Y = by + cr[e].oy, j = hf_piece_samples(g, bx, by, cr + e, ph, pu);
+            int X = bx + cr[e].ox, Y = by + cr[e].oy, j = hf_piece_samples(g, E->twist, bx, by, cr + e, ph, pu);
             double h, d;
             while (j-- > 0) { /* the piece after crossing e, far end first */
                 if (isnan(ph[j])) continue;
@@ -7173,7 +7181,7 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
         if (nx < 0 || ny < 0 || nx >= g->width || ny >= g->height) break;
         for (e = P - 1; e >= 0; e--) { /* between two grid points: inside the grid */
             const float *p = g->z + (ptrdiff_t)(ny + cr[e].oy) * stride + (nx + cr[e].ox);
-            int j = hf_piece_samples(g, nx, ny, cr + e, ph, pu);
+            int j = hf_piece_samples(g, E->twist, nx, ny, cr + e, ph, pu);
             while (j-- > 0) {
                 if (isnan(ph[j])) continue;
                 d = (double)(q + 1) * L - (cr[e].u + pu[j]);
@@ -7233,7 +7241,7 @@ static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, co
         for (e = 0; e < P; e++) {
             int X = x + k * a + cr[e].ox, Y = y + k * b + cr[e].oy, j;
             double h, s, ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
-            int np = hf_piece_samples(g, x + k * a, y + k * b, cr + e, ph, pu);
+            int np = hf_piece_samples(g, NULL, x + k * a, y + k * b, cr + e, ph, pu);
             for (j = 0; j < np; j++) {
                 if (isnan(ph[j])) continue;
                 s = (ph[j] - hr) / ((double)k * L + (cr[e].u + pu[j])) * scale;
@@ -7255,7 +7263,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
                                   const hfvis_sweep_options *o, int want_tan, int want_normals,
                                   int channels)
 {
-    size_t total = 0, off_ray, off_d, off_c, off_s, off_t = 0, off_n = 0, off_a = 0, gridn, cap;
+    size_t total = 0, off_ray, off_d, off_c, off_s, off_t = 0, off_w, off_n = 0, off_a = 0, gridn, cap;
     int ok = 1, k, maxp = 1, side = g->width > g->height ? g->width : g->height;
     unsigned char *blk;
     memset(E, 0, sizeof *E);
@@ -7282,6 +7290,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     off_c = hf_align_add(&total, (size_t)maxp, sizeof(hf_cross), &ok);
     off_s = hf_align_add(&total, cap, 2u * sizeof(double), &ok);
     if (want_tan) off_t = hf_align_add(&total, gridn, sizeof(double), &ok);
+    off_w = hf_align_add(&total, gridn, sizeof(double), &ok);
     if (want_normals) off_n = hf_align_add(&total, gridn, 3u * sizeof(float), &ok);
     if (channels) off_a = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
     if (!ok) return HFVIS_ERR_LIMIT;
@@ -7298,6 +7307,14 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     E->sd = (double *)(void *)(blk + off_s);
     E->sh = E->sd + cap;
     E->tan = want_tan ? (double *)(void *)(blk + off_t) : NULL;
+    E->twist = (double *)(void *)(blk + off_w);
+    {
+        int x, y;
+        for (y = 0; y + 1 < g->height; y++)
+            for (x = 0; x + 1 < g->width; x++)
+                E->twist[(size_t)y * (size_t)g->width + (size_t)x] =
+                    hf_cell_twist(g->z + (ptrdiff_t)y * g->stride + x, g->stride);
+    }
     E->nrm = want_normals ? (float *)(void *)(blk + off_n) : NULL;
     E->acc = channels ? (double *)(void *)(blk + off_a) : NULL;
     hf_exact_dirs_fill(&E->d, K, o->azimuth0_rad, E->N);
