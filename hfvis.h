@@ -483,8 +483,10 @@ HFVIS_API hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user
  *   - Cost: a direction costs |a| + |b| - 1 crossings per receiver (1 on the axes and diagonals)
  *     where the lattice costs about one node, so a larger N buys smaller deviations with longer
  *     sweeps: K = 16 with the default N = 5 takes directions (1,0), (5,2), (1,1), (2,5): 3.5
- *     crossings per receiver-direction on average; measured (make bench, section exact) the
- *     exact horizon map then takes 0.35-0.8x the lattice map's time (no gather), far under 4x.
+ *     crossings per receiver-direction on average, plus the interior samples below. Measured
+ *     (make bench, section exact): the horizon map 0.5-0.7x the lattice map's time on urban
+ *     DSMs (no gather), 1.5-2.1x on fBm rough at the cell scale; the fused sky-view factor
+ *     1.0-1.3x and 2.1-3.3x.
  *   - Quadrature: every direction integral uses the actual azimuths phi_k. Direction k owns the
  *     sector between the midpoints to its neighbours (edges rounded to multiples of 2^-40 turn,
  *     so the shares w_k are exact and add up to exactly 1): the sky-view factor is
