@@ -435,8 +435,9 @@ typedef struct hfvis_march_options {
 /* Oracle: per-receiver bilinear ray march on the grid. For every receiver point (x_i, y_i)
  * (grid units; points[2*i], points[2*i+1]) and each of the K directions, samples the surface at
  * p + s*step*(cos psi_k, sin psi_k), s = 1, 2, ... and keeps the largest elevation.
- * out[i*K + k] = elevation angle. Border as in opts. Use it for all grid points, or for a
- * subset of receivers (the bench does). Cost O(count*K*N). No allocation. */
+ * out[i*K + k] = elevation angle. Border as in opts; with opts->rays = HFVIS_RAYS_EXACT the rays
+ * follow the exact mode's actual directions (hfvis_sweep_azimuths). Use it for all grid points,
+ * or for a subset of receivers (the bench does). Cost O(count*K*N). No allocation. */
 HFVIS_API hfvis_status hfvis_horizon_reference(const hfvis_grid *grid, int K,
                                                const hfvis_sweep_options *opts,
                                                const hfvis_march_options *march,
