@@ -21,6 +21,9 @@
  *      wedges to SH visibility, environment, directional and key lights, diffuse and glossy
  *      bounces through the radiance pyramid, sub-sampling ([NS09] §5-9; spec GI B.2-B.9, B.12)
  *  15. Split runs: raw per-receiver direction sums in double and the partial-sum file
+ *  16. Exact rays (beyond [P1]): rational directions, every grid-line crossing and the split
+ *      bulging pieces swept with the [P1] §5 hull, the per-receiver oracle, actual azimuths and
+ *      their quadrature, the exact-mode light paths
  *
  * Paper references: [P1] Timonen & Westerholm, "Scalable Height Field Self-Shadowing",
  * CGF 29(2), 2010 (thesis appendix A.1). "spec" is the project's restatement
