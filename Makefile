@@ -63,16 +63,16 @@ $(BUILD)/obj/%.o: %.c hfvis.h
 $(LIB): $(LIBOBJ)
 	@rm -f $@
 	ar rcs $@ $^
-$(BUILD)/examples/%: examples/%.c examples/common.h $(LIB)
+$(BUILD)/examples/%: examples/%.c examples/common.h examples/fields.h $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -I. $< $(LIB) $(LDLIBS) -o $@
 $(CLI): examples/hfvis_cli.c examples/common.h $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -I. $< $(LIB) $(LDLIBS) -o $@
-$(BENCH): examples/bench.c $(wildcard examples/bench_*.c) examples/bench.h examples/common.h $(LIB)
+$(BENCH): examples/bench.c $(wildcard examples/bench_*.c) examples/bench.h examples/common.h examples/fields.h $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -I. examples/bench.c $(wildcard examples/bench_*.c) $(LIB) $(LDLIBS) -o $@
-$(BUILD)/test/%: test/%.c test/test.h test/test_dir.h $(LIB)
+$(BUILD)/test/%: test/%.c test/test.h test/test_dir.h examples/fields.h $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -I. $< $(LIB) $(LDLIBS) -o $@
 

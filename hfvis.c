@@ -21,6 +21,9 @@
  *      wedges to SH visibility, environment, directional and key lights, diffuse and glossy
  *      bounces through the radiance pyramid, sub-sampling ([NS09] §5-9; spec GI B.2-B.9, B.12)
  *  15. Split runs: raw per-receiver direction sums in double and the partial-sum file
+ *  16. Exact rays (beyond [P1]): rational directions, every grid-line crossing and the split
+ *      bulging pieces swept with the [P1] §5 hull, the per-receiver oracle, actual azimuths and
+ *      their quadrature, the exact-mode light paths
  *
  * Paper references: [P1] Timonen & Westerholm, "Scalable Height Field Self-Shadowing",
  * CGF 29(2), 2010 (thesis appendix A.1). "spec" is the project's restatement
@@ -64,6 +67,32 @@
 #define HF_INF ((double)INFINITY)
 #define HF_PI 3.14159265358979323846
 #define HF_HALF_PI 1.57079632679489661923
+
+/* Exact rays (section 16), called from the public routines of sections 8, 9, 10 and 15. */
+/* One exact-ray direction: look vector (a, b), gcd 1, and its azimuth, unwrapped to within pi of
+ * the requested one. */
+typedef struct hf_ray {
+    int a, b;
+    double azimuth;
+} hf_ray;
+static int hf_exact_bound(const hfvis_sweep_options *o, int K);
+static hf_ray hf_ray_nearest(double psi, int N);
+static hfvis_status hf_exact_horizon_map(const hfvis_grid *g, int K, const hfvis_sweep_options *o,
+                                         int begin, int end, float *out);
+static hfvis_status hf_exact_horizon_direction(const hfvis_grid *g, int K, int k,
+                                               const hfvis_sweep_options *o, float *out,
+                                               ptrdiff_t out_stride);
+static hfvis_status hf_exact_light(const hfvis_grid *g, int K, hfvis_sum_kind kind,
+                                   const hfvis_env *env, const hfvis_env_options *eopts,
+                                   const hfvis_sweep_options *o, double scale, float *out,
+                                   ptrdiff_t out_stride);
+static hfvis_status hf_exact_sun(const hfvis_grid *g, double azimuth, double elevation,
+                                 double radius, const hfvis_sweep_options *o, float *out,
+                                 ptrdiff_t out_stride);
+static hfvis_status hf_exact_direction_sums(const hfvis_grid *g, int K, hfvis_sum_kind kind,
+                                            const hfvis_env *env, const hfvis_env_options *eopts,
+                                            const hfvis_sweep_options *o, int begin, int end,
+                                            double *sums);
 
 /* ========================================================================================== */
 /* 1. Common                                                                                  */
@@ -1179,7 +1208,9 @@ static int hf_opts_valid(const hfvis_sweep_options *o)
     return !o || (hf_border_valid(o->border) && o->border_cells >= 0 && isfinite(o->azimuth0_rad) &&
                   o->direction_begin >= 0 && o->direction_end >= 0 &&
                   o->direction_order >= HFVIS_DIRECTION_ORDER_DEFAULT &&
-                  o->direction_order <= HFVIS_DIRECTION_ORDER_SWEEP);
+                  o->direction_order <= HFVIS_DIRECTION_ORDER_SWEEP &&
+                  (o->rays == HFVIS_RAYS_LATTICE || o->rays == HFVIS_RAYS_EXACT) &&
+                  o->ray_denominator >= 0 && o->ray_denominator <= HFVIS_RAY_DENOMINATOR_MAX);
 }
 
 /* Resolved options (NULL or zero fields = defaults). */
@@ -1801,6 +1832,7 @@ hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, int k,
         out_stride < grid->width || !hf_out_fits(out_stride, grid->height))
         return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
+    if (o.rays == HFVIS_RAYS_EXACT) return hf_exact_horizon_direction(grid, K, k, &o, out, out_stride);
     if ((s = hf_sweep_alloc(&sw, grid, &o, 0, 1, 0)) != HFVIS_OK) return s;
     hf_direction_base(K, k, o.azimuth0_rad, &ux, &uy, &m);
     hf_sweep_group(&sw, ux, uy);
@@ -1868,6 +1900,7 @@ hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_
     if (!hf_mul_size(plane, (size_t)K, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
     if (hf_direction_range(&o, K, &begin, &end) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.rays == HFVIS_RAYS_EXACT) return hf_exact_horizon_map(grid, K, &o, begin, end, out);
     per = K % 4 == 0 ? 4 : 1;
     groups = K / per;
     if (end - begin < K || hf_direction_position(&o, K, 1) != 1) /* a part, or planes in sweep order */
@@ -1939,7 +1972,7 @@ static double hf_march_tan(const hf_surface *S, double px, double py, double h0,
     return best;
 }
 
-static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0,
+static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0, int exact_bound,
                                      const hfvis_march_options *march, const float *points,
                                      size_t count, float *out)
 {
@@ -1956,7 +1989,14 @@ static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0
                 out[i * (size_t)K + (size_t)k] = HF_NAN;
                 continue;
             }
-            hf_sweep_vector(azimuth0 + 2.0 * HF_PI * (double)k / (double)K, &ux, &uy);
+            if (exact_bound > 0) { /* exact mode: along the actual direction (a, b) */
+                hf_ray r = hf_ray_nearest(azimuth0 + 2.0 * HF_PI * (double)k / (double)K, exact_bound);
+                double len = sqrt((double)r.a * (double)r.a + (double)r.b * (double)r.b);
+                ux = -(double)r.a / len;
+                uy = -(double)r.b / len;
+            } else {
+                hf_sweep_vector(azimuth0 + 2.0 * HF_PI * (double)k / (double)K, &ux, &uy);
+            }
             t = hf_march_tan(S, px, py, h0, -ux, -uy, step, maxd);
             out[i * (size_t)K + (size_t)k] = (float)hf_tan_to_elevation(t);
         }
@@ -1987,7 +2027,8 @@ hfvis_status hfvis_horizon_reference(const hfvis_grid *grid, int K,
     S.cell_size = grid->cell_size;
     S.border = o.border;
     S.reach = o.border == HFVIS_BORDER_OPEN ? 0.0 : (double)o.border_cells;
-    return hf_reference_run(&S, K, o.azimuth0_rad, march, points, count, out);
+    return hf_reference_run(&S, K, o.azimuth0_rad, o.rays == HFVIS_RAYS_EXACT ? hf_exact_bound(&o, K) : 0,
+                            march, points, count, out);
 }
 
 hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user, int width, int height,
@@ -2007,7 +2048,9 @@ hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user, int widt
     S.height = height;
     S.cell_size = cell_size;
     S.border = HFVIS_BORDER_OPEN;
-    return hf_reference_run(&S, K, opts ? opts->azimuth0_rad : 0.0, march, points, count, out);
+    return hf_reference_run(&S, K, opts ? opts->azimuth0_rad : 0.0,
+                            opts && opts->rays == HFVIS_RAYS_EXACT ? hf_exact_bound(opts, K) : 0, march,
+                            points, count, out);
 }
 
 /* ========================================================================================== */
@@ -2156,6 +2199,9 @@ hfvis_status hfvis_sky_light(const hfvis_grid *grid, int K, float sky, float alb
     if (!hf_light_args_valid(grid, K, opts, out, out_stride) || !isfinite(sky) || !isfinite(albedo))
         return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
+    if (o.rays == HFVIS_RAYS_EXACT)
+        return hf_exact_light(grid, K, HFVIS_SUM_SKY_LIGHT, NULL, NULL, &o,
+                              (double)sky * (double)albedo, out, out_stride);
     memset(&ctx, 0, sizeof ctx);
     ctx.inv_k = 1.0 / (double)K;
     ctx.lobe = sin(HF_PI / (double)K) / HF_PI;
@@ -2241,6 +2287,9 @@ hfvis_status hfvis_sky_view_factor(const hfvis_grid *grid, int K, const hfvis_sw
     int begin, end;
     if (!hf_light_args_valid(grid, K, opts, out, out_stride)) return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
+    if (o.rays == HFVIS_RAYS_EXACT)
+        return hf_exact_light(grid, K, HFVIS_SUM_SKY_VIEW, NULL, NULL, &o, -1.0 / (double)K, out,
+                              out_stride);
     memset(&ctx, 0, sizeof ctx);
     if ((s = hf_direction_range(&o, K, &begin, &end)) != HFVIS_OK) return s;
     if ((s = hf_fused_run(&sw, grid, K, &o, 1, 0, hf_svf_line, &ctx)) != HFVIS_OK) return s;
@@ -2297,6 +2346,9 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
         sun_radius_rad < 0.0 || sun_elevation_rad < -HF_HALF_PI || sun_elevation_rad > HF_HALF_PI)
         return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
+    if (o.rays == HFVIS_RAYS_EXACT)
+        return hf_exact_sun(grid, sun_azimuth_rad, sun_elevation_rad, sun_radius_rad, &o, out,
+                            out_stride);
     if ((s = hf_sweep_alloc(&sw, grid, &o, 0, 1, 0)) != HFVIS_OK) return s;
     hf_sweep_vector(sun_azimuth_rad, &ux, &uy);
     hf_sweep_group(&sw, ux, uy);
@@ -3018,6 +3070,9 @@ hfvis_status hfvis_env_light(const hfvis_grid *grid, int K, const hfvis_env *env
         !isfinite(albedo))
         return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
+    if (o.rays == HFVIS_RAYS_EXACT)
+        return hf_exact_light(grid, K, HFVIS_SUM_ENV_LIGHT, env, eopts, &o, (double)albedo, out,
+                              out_stride);
     s = hf_env_tables_create(env, K, o.azimuth0_rad, eopts, o.alloc, &table, &eval);
     if (s != HFVIS_OK) return s;
     memset(&ctx, 0, sizeof ctx);
@@ -3601,6 +3656,7 @@ static hfvis_status hf_p2_run(hf_sweep *sw, const hfvis_grid *grid, int K, hfvis
                               int out_channels, int want_normals, hf_p2_ctx *c)
 {
     int ok = 1;
+    if (o->rays == HFVIS_RAYS_EXACT) return HFVIS_ERR_INVALID_ARGUMENT; /* lattices only (hfvis.h) */
     if (c->tree_opts && (c->tree_opts->order < HFVIS_TREE_DEFAULT ||
                          c->tree_opts->order > HFVIS_TREE_BREADTH_FIRST || c->tree_opts->safe_zone < 0 ||
                          c->tree_opts->safe_zone > 1 || c->tree_opts->safe_zone_steps < 0))
@@ -6542,6 +6598,8 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
         return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
     if (hf_direction_range(&o, K, &begin, &end) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (o.rays == HFVIS_RAYS_EXACT && kind != HFVIS_SUM_VISIBILITY)
+        return hf_exact_direction_sums(grid, K, kind, env, eopts, &o, begin, end, sums);
     memset(&sky, 0, sizeof sky);
     switch (kind) {
     case HFVIS_SUM_SKY_VIEW:
@@ -6775,3 +6833,790 @@ hfvis_status hfvis_partial_load(const char *path, const hfvis_allocator *alloc, 
     return s;
 }
 #endif /* HFVIS_NO_STDIO */
+
+/* ========================================================================================== */
+/* 16. Exact rays (beyond [P1])                                                               */
+/* ========================================================================================== */
+/* The lattice of [P1] §4 gives each receiver the horizon of the lattice lines beside it, blended
+ * by the gather; where the horizon itself jumps (walls, roofs, cliffs) the blend is wrong by tens
+ * of degrees. Exact rays give every grid point its own ray instead. A look direction with integer
+ * components (a, b), gcd 1, is shared by the receivers it joins: the line through grid point g
+ * also passes through g + (a, b). Between two such grid points the line crosses |a| - 1 columns
+ * and |b| - 1 rows; at each crossing the bilinear surface is a linear interpolation along one grid
+ * line, an exact point of the surface. Every line is swept from its far end with the hull stack
+ * of [P1] §5 (Alg. 1) over all its crossings, and each grid point on it reads the tangent of the
+ * hull at its turn: the maximum over every crossing of its own ray, no interpolation between
+ * lines. Distances are integers in units of 1/(|a||b|) of the step |(a, b)|, so the hull and the
+ * per-receiver oracle (hfvis_horizon_exact_naive) compute the same quotients from the same heights.
+ * Directions are the nearest representable ones (hfvis.h, "Exact rays"); the light integrals weight
+ * each by its share of the circle. */
+
+#define HF_EXACT_MIN_DENOMINATOR 5  /* the default bound never goes below this (K = 16: 0.7 deg) */
+#define HF_EXACT_SUN_DENOMINATOR 64 /* default for one direction (the sun): deviation <= 0.45 deg */
+#define HF_EXACT_QUANTUM 1099511627776.0 /* 2^40: sector edges are multiples of 2^-40 turn, so the
+                                            weights are exact and add up to exactly 1 */
+
+static int hf_gcd(int a, int b)
+{
+    while (b != 0) {
+        int t = a % b;
+        a = b;
+        b = t;
+    }
+    return a;
+}
+
+static int hf_floor_div(int num, int den) /* den > 0 */
+{
+    int q = num / den;
+    return (num % den != 0 && num < 0) ? q - 1 : q;
+}
+
+/* The resolved denominator bound of a run of K directions (hfvis.h). */
+static int hf_exact_bound(const hfvis_sweep_options *o, int K)
+{
+    if (o->ray_denominator > 0) return o->ray_denominator;
+    if (K == 1) return HF_EXACT_SUN_DENOMINATOR;
+    return (K + 3) / 4 > HF_EXACT_MIN_DENOMINATOR ? (K + 3) / 4 : HF_EXACT_MIN_DENOMINATOR;
+}
+
+/* Nearest direction (a, b), gcd 1, max(|a|, |b|) <= N, to azimuth psi; ties go to the smaller
+ * |a| + |b| (the cheaper sweep). Searched in the first octant: for each a, the two b beside
+ * a tan(theta). */
+static hf_ray hf_ray_nearest(double psi, int N)
+{
+    hf_ray r;
+    double t = psi - 2.0 * HF_PI * floor(psi / (2.0 * HF_PI)), rr, th, tn, best;
+    int q, mirror, a, c, ba = 1, bb = 0, x, y, turn;
+    q = (int)floor(t / HF_HALF_PI);
+    if (q > 3) q = 3;
+    if (q < 0) q = 0;
+    rr = t - (double)q * HF_HALF_PI;
+    if (rr < 0.0) rr = 0.0;
+    mirror = rr > 0.25 * HF_PI;
+    th = mirror ? HF_HALF_PI - rr : rr;
+    tn = tan(th);
+    best = th; /* (1, 0) */
+    for (a = 1; a <= N; a++) {
+        double bf = floor((double)a * tn);
+        for (c = 0; c < 2; c++) {
+            int b = (int)bf + c;
+            double dev;
+            if (b < 0 || b > a || hf_gcd(a, b) != 1) continue;
+            dev = fabs(atan2((double)b, (double)a) - th);
+            if (dev < best || (dev == best && a + b < ba + bb)) {
+                best = dev;
+                ba = a;
+                bb = b;
+            }
+        }
+    }
+    x = mirror ? bb : ba;
+    y = mirror ? ba : bb;
+    for (turn = 0; turn < q; turn++) { /* (x, y) turned by +pi/2 */
+        int nx = -y;
+        y = x;
+        x = nx;
+    }
+    r.a = x;
+    r.b = y;
+    r.azimuth = psi + remainder(atan2((double)y, (double)x) - psi, 2.0 * HF_PI);
+    return r;
+}
+
+/* The K directions of a run and their quadrature (hfvis.h, "Exact rays"): sector k runs between
+ * the midpoints to its neighbours, its edges rounded to multiples of 2^-40 turn relative to
+ * azimuth0; w[k] is its share of the circle, (lc[k], ls[k]) = (1/2pi) Int (cos phi, sin phi) dphi
+ * over it ([P1] Eq. 5's lobe term for an uncentred sector), lo/hi its edges (radians). */
+typedef struct hf_exact_dirs {
+    int K;
+    hf_ray *ray;
+    double *w, *lc, *ls, *lo, *hi;
+} hf_exact_dirs;
+
+static void hf_exact_dirs_fill(hf_exact_dirs *d, int K, double azimuth0, int N)
+{
+    int k;
+    double prev, *Q = d->lo; /* edges in quanta relative to azimuth0, first */
+    for (k = 0; k < K; k++)
+        d->ray[k] = hf_ray_nearest(azimuth0 + 2.0 * HF_PI * (double)k / (double)K, N);
+    d->K = K;
+    prev = d->ray[K - 1].azimuth - 2.0 * HF_PI - azimuth0;
+    for (k = 0; k < K; k++) {
+        double cur = d->ray[k].azimuth - azimuth0;
+        Q[k] = floor(0.5 * (prev + cur) / (2.0 * HF_PI) * HF_EXACT_QUANTUM + 0.5);
+        if (k > 0 && Q[k] < Q[k - 1]) Q[k] = Q[k - 1]; /* rounding never makes a sector negative */
+        prev = cur;
+    }
+    for (k = 0; k < K; k++) {
+        double qhi = k + 1 < K ? Q[k + 1] : Q[0] + HF_EXACT_QUANTUM;
+        d->hi[k] = qhi;
+        d->w[k] = qhi > Q[k] ? (qhi - Q[k]) / HF_EXACT_QUANTUM : 0.0;
+    }
+    for (k = 0; k < K; k++) {
+        double lo = azimuth0 + Q[k] * (2.0 * HF_PI / HF_EXACT_QUANTUM);
+        double hi = azimuth0 + d->hi[k] * (2.0 * HF_PI / HF_EXACT_QUANTUM);
+        double mid = 0.5 * (lo + hi), sh = sin(HF_PI * d->w[k]) / HF_PI;
+        d->lo[k] = lo;
+        d->hi[k] = hi;
+        d->lc[k] = cos(mid) * sh; /* (sin hi - sin lo)/2pi in difference form */
+        d->ls[k] = sin(mid) * sh; /* (cos lo - cos hi)/2pi */
+    }
+}
+
+/* One crossing of a period: offset e of the P crossings between grid point g (e = 0) and
+ * g + (a, b), in sweep order of increasing u. kind 0: the grid point; 1: a column crossing, the
+ * surface between taps (X, Y) and (X, Y+1) at fraction f; 2: a row crossing, between (X, Y) and
+ * (X+1, Y). u: its distance from g in sub-steps of 1/L of the step (an integer). */
+typedef struct hf_cross {
+    int ox, oy, kind;
+    double f, u;
+    /* the piece from this crossing to the next (or to g + (a, b)): inside cell (cx, cy) (offsets
+       from g), from (fx0, fy0) to (fx1, fy1) in cell coordinates, du sub-steps long */
+    int cx, cy;
+    double fx0, fy0, fx1, fy1, du, q; /* q = -(fx1 - fx0)(fy1 - fy0)/4: bulge = q * twist */
+} hf_cross;
+
+/* Subdivision of concave pieces (beyond the crossing set): along a ray the bilinear surface is a
+ * quadratic inside each cell; where it bulges above its chord (a saddle: box corners, the corners
+ * of stair-stepped cliffs) the tangent from a receiver can touch between two crossings. Such a
+ * piece gets m - 1 interior samples, m the power of two (<= HF_EXACT_MAX_SPLIT) that brings the
+ * bulge r/4 below HF_EXACT_BULGE cells of height; powers of two keep every distance exact. */
+#define HF_EXACT_BULGE (1.0 / 128.0)
+#define HF_EXACT_MAX_SPLIT 16
+
+typedef struct hf_exact {
+    const hfvis_grid *g;
+    hfvis_border border;
+    int R;                  /* reach beyond the grid in cells (CLAMP/WRAP: border_cells) */
+    int N;                  /* denominator bound */
+    hf_exact_dirs d;
+    hf_cross *cross;        /* the current direction's crossings, up to 2N - 1 */
+    double *sd, *sh;        /* hull stack: distances (sub-steps), heights (world units) */
+    double *tan;            /* width*height tangents of the current direction, NaN at holes */
+    double *twist;          /* width*height cell twists (hf_cell_twist), cell (x, y) at y*width + x */
+    float *nrm;             /* width*height*3 grid normals (lighting), else NULL */
+    double *acc;            /* width*height*channels sums, else NULL */
+    int channels;
+    void *block;
+    const hfvis_allocator *alloc;
+} hf_exact;
+
+/* The piece after each crossing e (to crossing e + 1, the last one to the next grid point at
+ * u = L): its cell, found from its midpoint, and its ends in that cell's coordinates. */
+static void hf_exact_pieces(hf_cross *cross, int n, int a, int b, double L)
+{
+    int e;
+    for (e = 0; e < n; e++) {
+        double u0 = cross[e].u, u1 = e + 1 < n ? cross[e + 1].u : L, um = 0.5 * (u0 + u1);
+        double mx = um * (double)a / L, my = um * (double)b / L;
+        hf_cross *c = cross + e;
+        c->cx = (int)floor(mx);
+        c->cy = (int)floor(my);
+        c->fx0 = u0 * (double)a / L - (double)c->cx;
+        c->fy0 = u0 * (double)b / L - (double)c->cy;
+        c->fx1 = u1 * (double)a / L - (double)c->cx;
+        c->fy1 = u1 * (double)b / L - (double)c->cy;
+        c->du = u1 - u0;
+        c->q = -0.25 * (c->fx1 - c->fx0) * (c->fy1 - c->fy0);
+    }
+}
+
+/* Crossings of direction (a, b) into cross[]; returns P = |a| + |b| - 1 (1 for the axes),
+ * *L the sub-steps per step and *scale the factor from height per sub-step to tangent. */
+static int hf_exact_geometry(hf_cross *cross, const hfvis_grid *g, int a, int b, double *L,
+                             double *scale)
+{
+    int A = a < 0 ? -a : a, B = b < 0 ? -b : b, ja = 0, jb = 1, n = 0;
+    double len = sqrt((double)a * (double)a + (double)b * (double)b);
+    if (A == 0 || B == 0) {
+        memset(cross, 0, sizeof *cross); /* along a grid line the surface is linear: no pieces */
+        *L = 1.0;
+        *scale = 1.0 / (len * g->cell_size);
+        return 1;
+    }
+    while (ja < A || jb < B) {
+        hf_cross *c = cross + n++;
+        if (jb >= B || (ja < A && ja * B < jb * A)) {
+            int num = ja * b;
+            c->kind = ja == 0 ? 0 : 1;
+            c->ox = a < 0 ? -ja : ja;
+            c->oy = hf_floor_div(num, A);
+            c->f = (double)(num - c->oy * A) / (double)A;
+            c->u = (double)(ja * B);
+            ja++;
+        } else {
+            int num = jb * a;
+            c->kind = 2;
+            c->oy = b < 0 ? -jb : jb;
+            c->ox = hf_floor_div(num, B);
+            c->f = (double)(num - c->ox * B) / (double)B;
+            c->u = (double)(jb * A);
+            jb++;
+        }
+    }
+    *L = (double)A * (double)B;
+    *scale = *L / (len * g->cell_size);
+    hf_exact_pieces(cross, n, a, b, *L);
+    return n;
+}
+
+/* Is crossing c at base tap (X, Y) inside the grid grown by R cells? */
+static int hf_cross_inside(const hfvis_grid *g, int R, int X, int Y, const hf_cross *c)
+{
+    return X >= -R && Y >= -R && X + (c->kind == 2) <= g->width - 1 + R &&
+           Y + (c->kind == 1) <= g->height - 1 + R;
+}
+
+/* The surface height (world units) at crossing c with base tap (X, Y): the linear interpolation
+ * along its grid line inside the grid, the border rule outside; NaN at holes. */
+static double hf_cross_height(const hfvis_grid *g, hfvis_border border, int X, int Y,
+                              const hf_cross *c)
+{
+    double h;
+    if (X >= 0 && Y >= 0 && X + (c->kind == 2) < g->width && Y + (c->kind == 1) < g->height) {
+        const float *p = g->z + (ptrdiff_t)Y * g->stride + X;
+        h = (double)p[0];
+        if (c->kind != 0) h += ((double)p[c->kind == 1 ? g->stride : 1] - h) * c->f; /* exact on flats */
+        return isfinite(h) ? h : HF_NAN;
+    }
+    return hf_sample_border(g, border, (double)X + (c->kind == 2 ? c->f : 0.0),
+                            (double)Y + (c->kind == 1 ? c->f : 0.0));
+}
+
+/* Interior samples of piece c after base grid point (X, Y) (see HF_EXACT_BULGE): writes up to
+ * HF_EXACT_MAX_SPLIT - 1 heights h[j] at sub-step offsets du[j] from the piece's start, in
+ * increasing order, and returns the count; 0 for a piece that is not concave enough, outside
+ * the grid or touching a hole. */
+static double hf_cell_twist(const float *p, ptrdiff_t stride)
+{
+    return (double)p[0] - (double)p[1] - (double)p[stride] + (double)p[stride + 1];
+}
+
+static int hf_piece_samples(const hfvis_grid *g, const double *twist, int X, int Y, const hf_cross *c,
+                            double *h, double *du)
+{
+    const float *p;
+    double z00, z10, z01, z11, dfx = c->fx1 - c->fx0, dfy = c->fy1 - c->fy0, bulge, lim;
+    int m = 1, j, cx = X + c->cx, cy = Y + c->cy;
+    if (c->du == 0.0 || cx < 0 || cy < 0 || cx + 1 >= g->width || cy + 1 >= g->height) return 0;
+    p = g->z + (ptrdiff_t)cy * g->stride + cx;
+    /* the twist z00 - z10 - z01 + z11 of the cell (precomputed by the sweep: one load) */
+    bulge = c->q * (twist ? twist[(size_t)cy * (size_t)g->width + (size_t)cx] : hf_cell_twist(p, g->stride));
+    lim = HF_EXACT_BULGE * g->cell_size;
+    if (!(bulge > lim) || !isfinite(bulge)) return 0;
+    z00 = (double)p[0];
+    z10 = (double)p[1];
+    z01 = (double)p[g->stride];
+    z11 = (double)p[g->stride + 1];
+    while (m < HF_EXACT_MAX_SPLIT && bulge > lim * (double)m * (double)m) m *= 2;
+    for (j = 1; j < m; j++) {
+        double t = (double)j / (double)m, fx = c->fx0 + t * dfx, fy = c->fy0 + t * dfy;
+        double r0 = z00 + (z10 - z00) * fx, r1 = z01 + (z11 - z01) * fx;
+        h[j - 1] = r0 + (r1 - r0) * fy;
+        du[j - 1] = c->du * t;
+    }
+    return m - 1;
+}
+
+/* Whole periods k >= 0 of the ray from grid point (x, y) along (a, b) that can hold a crossing
+ * inside the grid grown by R cells. */
+static int hf_exact_periods(const hfvis_grid *g, int R, int x, int y, int a, int b)
+{
+    int k = INT_MAX;
+    if (a > 0) k = (g->width - 1 + R - x) / a;
+    else if (a < 0) k = (x + R) / -a;
+    if (b > 0 && (g->height - 1 + R - y) / b < k) k = (g->height - 1 + R - y) / b;
+    else if (b < 0 && (y + R) / -b < k) k = (y + R) / -b;
+    return k;
+}
+
+/* One line of direction (a, b) from its head (hx, hy), the grid point whose successor
+ * (hx + a, hy + b) lies outside the grid: the crossings beyond the head (the CLAMP/WRAP pre-roll,
+ * or the part of a step still inside the grid), then each grid point (a receiver) and the
+ * crossings behind it, through the [P1] §5 hull stack. */
+static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, double L, double scale)
+{
+    const hfvis_grid *g = E->g;
+    const hf_cross *cr = E->cross;
+    double *sd = E->sd, *sh = E->sh, ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
+    const ptrdiff_t stride = g->stride;
+    int top = 0, k, e, q;
+#define HF_HULL_PUSH(dd, hh)                                                                     \
+    do {                                                                                         \
+        while (top >= 2 &&                                                                       \
+               (sh[top - 2] - (hh)) * ((dd) - sd[top - 1]) >= (sh[top - 1] - (hh)) * ((dd) - sd[top - 2])) \
+            top--;                                                                               \
+    } while (0)
+    for (k = hf_exact_periods(g, E->R, hx, hy, a, b); k >= 0; k--) {
+        int bx = hx + k * a, by = hy + k * b;
+        for (e = P - 1; e >= 0; e--) {
+            int X = bx + cr[e].ox, Y = by + cr[e].oy, j = hf_piece_samples(g, E->twist, bx, by, cr + e, ph, pu);
+            double h, d;
+            while (j-- > 0) { /* the piece after crossing e, far end first */
+                if (isnan(ph[j])) continue;
+                d = -((double)k * L + (cr[e].u + pu[j]));
+                HF_HULL_PUSH(d, ph[j]);
+                sd[top] = d;
+                sh[top++] = ph[j];
+            }
+            if ((k == 0 && e == 0) || !hf_cross_inside(g, E->R, X, Y, cr + e)) continue;
+            h = hf_cross_height(g, E->border, X, Y, cr + e);
+            if (isnan(h)) continue;
+            d = -((double)k * L + cr[e].u);
+            HF_HULL_PUSH(d, h);
+            sd[top] = d;
+            sh[top++] = h;
+        }
+    }
+    for (q = 0;; q++) {
+        int gx = hx - q * a, gy = hy - q * b, nx = gx - a, ny = gy - b;
+        double h = (double)g->z[(ptrdiff_t)gy * stride + gx], d = (double)q * L;
+        double *t = E->tan + (size_t)gy * (size_t)g->width + (size_t)gx;
+        if (!isfinite(h)) {
+            *t = HF_NAN;
+        } else {
+            HF_HULL_PUSH(d, h);
+            *t = top ? (sh[top - 1] - h) / (d - sd[top - 1]) * scale : -HF_INF;
+            sd[top] = d;
+            sh[top++] = h;
+        }
+        if (nx < 0 || ny < 0 || nx >= g->width || ny >= g->height) break;
+        for (e = P - 1; e >= 0; e--) { /* between two grid points: inside the grid */
+            const float *p = g->z + (ptrdiff_t)(ny + cr[e].oy) * stride + (nx + cr[e].ox);
+            int j = hf_piece_samples(g, E->twist, nx, ny, cr + e, ph, pu);
+            while (j-- > 0) {
+                if (isnan(ph[j])) continue;
+                d = (double)(q + 1) * L - (cr[e].u + pu[j]);
+                HF_HULL_PUSH(d, ph[j]);
+                sd[top] = d;
+                sh[top++] = ph[j];
+            }
+            if (e == 0) break; /* crossing 0 is the next receiver */
+            h = (double)p[0];
+            h += ((double)p[cr[e].kind == 1 ? stride : 1] - h) * cr[e].f; /* as hf_cross_height */
+            if (!isfinite(h)) continue;
+            d = (double)(q + 1) * L - cr[e].u;
+            HF_HULL_PUSH(d, h);
+            sd[top] = d;
+            sh[top++] = h;
+        }
+    }
+#undef HF_HULL_PUSH
+}
+
+/* Tangents of every grid point toward ray r into E->tan (-INFINITY: no terrain, NaN: hole).
+ * Heads are enumerated row by row, so consecutive lines are neighbours. */
+static void hf_exact_sweep(hf_exact *E, hf_ray r)
+{
+    const hfvis_grid *g = E->g;
+    double L, scale;
+    int P = hf_exact_geometry(E->cross, g, r.a, r.b, &L, &scale), x, y;
+    for (y = 0; y < g->height; y++) {
+        int xlo, xhi;
+        if (y + r.b < 0 || y + r.b >= g->height) {
+            xlo = 0;
+            xhi = g->width - 1;
+        } else if (r.a > 0) {
+            xlo = g->width - r.a;
+            xhi = g->width - 1;
+        } else if (r.a < 0) {
+            xlo = 0;
+            xhi = -r.a - 1;
+        } else {
+            continue;
+        }
+        if (xlo < 0) xlo = 0;
+        if (xhi > g->width - 1) xhi = g->width - 1;
+        for (x = xlo; x <= xhi; x++) hf_exact_line(E, x, y, r.a, r.b, P, L, scale);
+    }
+}
+
+/* Oracle twin of hf_exact_sweep for one receiver: every crossing of its own ray, the same
+ * heights and quotients, the largest kept. */
+static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, const hf_cross *cr,
+                             int P, double L, double scale, int a, int b, int x, int y)
+{
+    double hr = (double)g->z[(ptrdiff_t)y * g->stride + x], best = -HF_INF;
+    int k, e, kmax = hf_exact_periods(g, R, x, y, a, b);
+    if (!isfinite(hr)) return HF_NAN;
+    for (k = 0; k <= kmax; k++)
+        for (e = 0; e < P; e++) {
+            int X = x + k * a + cr[e].ox, Y = y + k * b + cr[e].oy, j;
+            double h, s, ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
+            int np = hf_piece_samples(g, NULL, x + k * a, y + k * b, cr + e, ph, pu);
+            for (j = 0; j < np; j++) {
+                if (isnan(ph[j])) continue;
+                s = (ph[j] - hr) / ((double)k * L + (cr[e].u + pu[j])) * scale;
+                if (s > best) best = s;
+            }
+            if ((k == 0 && e == 0) || !hf_cross_inside(g, R, X, Y, cr + e)) continue;
+            h = hf_cross_height(g, border, X, Y, cr + e);
+            if (isnan(h)) continue;
+            s = (h - hr) / ((double)k * L + cr[e].u) * scale;
+            if (s > best) best = s;
+        }
+    return best;
+}
+
+/* Scratch of one exact-mode call, one block: the K directions and their quadrature, the
+ * crossings, the hull stack (one line's crossings at most), the tangent plane, and optionally
+ * grid normals and a channels-deep accumulator. */
+static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
+                                  const hfvis_sweep_options *o, int want_tan, int want_normals,
+                                  int channels)
+{
+    size_t total = 0, off_ray, off_d, off_c, off_s, off_t = 0, off_w, off_n = 0, off_a = 0, gridn, cap;
+    int ok = 1, k, maxp = 1, side = g->width > g->height ? g->width : g->height;
+    unsigned char *blk;
+    memset(E, 0, sizeof *E);
+    E->g = g;
+    E->border = o->border;
+    E->R = o->border == HFVIS_BORDER_OPEN ? 0 : o->border_cells;
+    E->N = hf_exact_bound(o, K);
+    E->channels = channels;
+    E->alloc = o->alloc;
+    if (E->N > HFVIS_RAY_DENOMINATOR_MAX) return HFVIS_ERR_INVALID_ARGUMENT;
+    if ((double)side + 2.0 * (double)E->R + 3.0 > (double)INT_MAX / 2.0) return HFVIS_ERR_LIMIT;
+    for (k = 0; k < K; k++) {
+        hf_ray r = hf_ray_nearest(o->azimuth0_rad + 2.0 * HF_PI * (double)k / (double)K, E->N);
+        int p = (r.a < 0 ? -r.a : r.a) + (r.b < 0 ? -r.b : r.b) - 1;
+        if (p > maxp) maxp = p;
+    }
+    gridn = hf_grid_count(g);
+    /* a line crosses each grid line once (W + H + 4R of them within reach) and has at most
+       W + H pieces inside the grid, each split at most HF_EXACT_MAX_SPLIT - 1 times */
+    cap = (size_t)g->width + (size_t)g->height + 4u * (size_t)E->R + 8u +
+          ((size_t)g->width + (size_t)g->height + 2u) * (HF_EXACT_MAX_SPLIT - 1);
+    off_ray = hf_align_add(&total, (size_t)K, sizeof(hf_ray), &ok);
+    off_d = hf_align_add(&total, (size_t)K * 5u, sizeof(double), &ok);
+    off_c = hf_align_add(&total, (size_t)maxp, sizeof(hf_cross), &ok);
+    off_s = hf_align_add(&total, cap, 2u * sizeof(double), &ok);
+    if (want_tan) off_t = hf_align_add(&total, gridn, sizeof(double), &ok);
+    off_w = hf_align_add(&total, gridn, sizeof(double), &ok);
+    if (want_normals) off_n = hf_align_add(&total, gridn, 3u * sizeof(float), &ok);
+    if (channels) off_a = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
+    if (!ok) return HFVIS_ERR_LIMIT;
+    blk = (unsigned char *)hf_alloc(o->alloc, total);
+    if (!blk) return HFVIS_ERR_OUT_OF_MEMORY;
+    E->block = blk;
+    E->d.ray = (hf_ray *)(void *)(blk + off_ray);
+    E->d.w = (double *)(void *)(blk + off_d);
+    E->d.lc = E->d.w + K;
+    E->d.ls = E->d.lc + K;
+    E->d.lo = E->d.ls + K;
+    E->d.hi = E->d.lo + K;
+    E->cross = (hf_cross *)(void *)(blk + off_c);
+    E->sd = (double *)(void *)(blk + off_s);
+    E->sh = E->sd + cap;
+    E->tan = want_tan ? (double *)(void *)(blk + off_t) : NULL;
+    E->twist = (double *)(void *)(blk + off_w);
+    {
+        int x, y;
+        for (y = 0; y + 1 < g->height; y++)
+            for (x = 0; x + 1 < g->width; x++)
+                E->twist[(size_t)y * (size_t)g->width + (size_t)x] =
+                    hf_cell_twist(g->z + (ptrdiff_t)y * g->stride + x, g->stride);
+    }
+    E->nrm = want_normals ? (float *)(void *)(blk + off_n) : NULL;
+    E->acc = channels ? (double *)(void *)(blk + off_a) : NULL;
+    hf_exact_dirs_fill(&E->d, K, o->azimuth0_rad, E->N);
+    if (want_normals) (void)hfvis_normals_compute(g, E->nrm); /* the grid normals, as floats */
+    if (channels) memset(E->acc, 0, gridn * (size_t)channels * sizeof(double));
+    return HFVIS_OK;
+}
+
+static void hf_exact_free(hf_exact *E) { hf_free(E->alloc, E->block); }
+
+/* The horizon planes of positions [begin, end) (direction_order), as hfvis_horizon_map. */
+static hfvis_status hf_exact_horizon_map(const hfvis_grid *g, int K, const hfvis_sweep_options *o,
+                                         int begin, int end, float *out)
+{
+    hf_exact E;
+    hfvis_status s;
+    size_t plane = hf_grid_count(g), i;
+    int k, done = 0;
+    if ((s = hf_exact_init(&E, g, K, o, 1, 0, 0)) != HFVIS_OK) return s;
+    for (k = 0; k < K; k++) {
+        int pos = hf_direction_position(o, K, k);
+        float *p;
+        if (pos < begin || pos >= end) continue;
+        hf_exact_sweep(&E, E.d.ray[k]);
+        p = out + (size_t)(pos - begin) * plane;
+        for (i = 0; i < plane; i++) p[i] = (float)hf_tan_to_elevation(E.tan[i]);
+        hf_progress(o, ++done, end - begin);
+    }
+    hf_exact_free(&E);
+    return HFVIS_OK;
+}
+
+static hfvis_status hf_exact_horizon_direction(const hfvis_grid *g, int K, int k,
+                                               const hfvis_sweep_options *o, float *out,
+                                               ptrdiff_t out_stride)
+{
+    hf_exact E;
+    hfvis_status s;
+    int x, y;
+    if ((s = hf_exact_init(&E, g, K, o, 1, 0, 0)) != HFVIS_OK) return s;
+    hf_exact_sweep(&E, E.d.ray[k]);
+    for (y = 0; y < g->height; y++)
+        for (x = 0; x < g->width; x++)
+            out[(ptrdiff_t)y * out_stride + x] =
+                (float)hf_tan_to_elevation(E.tan[(size_t)y * (size_t)g->width + (size_t)x]);
+    hf_exact_free(&E);
+    hf_progress(o, 1, 1);
+    return HFVIS_OK;
+}
+
+/* [P1] Eq. 5 for the uncentred sector of direction k (hf_exact_dirs): nz w sin^2 theta +
+ * (nx lc + ny ls)(theta - sin 2theta/2), with the tangent-plane clamp of hf_sky_term taken
+ * along the direction itself. */
+static double hf_exact_sky_term(const hf_exact_dirs *d, int k, const float *n, double t)
+{
+    double nx = (double)n[0], ny = (double)n[1], nz = (double)n[2];
+    double cp = cos(d->ray[k].azimuth), sp = sin(d->ray[k].azimuth);
+    double tc = -(nx * cp + ny * sp) / nz, q, theta;
+    if (t > tc) tc = t;
+    q = 1.0 / (1.0 + tc * tc);
+    theta = HF_HALF_PI - atan(tc);
+    return nz * d->w[k] * q + (nx * d->lc[k] + ny * d->ls[k]) * (theta - tc * q);
+}
+
+/* Environment tables over the exact sectors (the layouts of hfvis_env_table_build, sector k
+ * = [lo_k, hi_k] around the actual azimuth). One block from alloc. */
+static hfvis_status hf_exact_env_tables(const hf_exact_dirs *d, const hfvis_env *env,
+                                        const hfvis_env_options *eopts,
+                                        const hfvis_allocator *alloc, float **table, hf_env_eval *e)
+{
+    hf_env_resolved r;
+    hfvis_status st = hf_env_resolve(env, d->K, eopts, &r);
+    float *t;
+    int k;
+    if (st != HFVIS_OK) return st;
+    t = (float *)hf_alloc(alloc, r.table_floats * sizeof(float));
+    if (t == NULL) return HFVIS_ERR_OUT_OF_MEMORY;
+    for (k = 0; k < d->K; k++) {
+        hf_env_sector s;
+        double st0 = fmod(d->lo[k], 2.0 * HF_PI);
+        if (st0 < 0.0) st0 += 2.0 * HF_PI;
+        if (st0 >= 2.0 * HF_PI) st0 = 0.0;
+        s.start = st0;
+        s.width = d->hi[k] - d->lo[k];
+        s.centre = st0 + (d->ray[k].azimuth - d->lo[k]);
+        if (r.method == HFVIS_ENV_LP_TABLE) {
+            size_t per = (size_t)r.lp_normal_res * (size_t)r.lp_horizon_res * (size_t)env->channels;
+            hf_env_build_lp_direction(env, &s, r.lp_normal_res, r.lp_horizon_res, t + (size_t)k * per);
+        } else {
+            size_t per = ((size_t)env->n_theta + 1u) * HF_ENV_PREFIX_RECORD * (size_t)env->channels;
+            hf_env_build_prefix_direction(env, &s, t + (size_t)k * per);
+        }
+    }
+    st = hf_env_eval_init(e, env, d->K, eopts, t);
+    if (st != HFVIS_OK) {
+        hf_free(alloc, t);
+        return st;
+    }
+    *table = t;
+    return HFVIS_OK;
+}
+
+/* The per-receiver direction sums S of hfvis_direction_sums for kind (SKY_VIEW, SKY_LIGHT or
+ * ENV_LIGHT) over positions [begin, end), in exact mode: T_k = K w_k sin(max(alpha_k, 0)) for the
+ * sky-view factor (so the finish 1 - S/K is unchanged), hf_exact_sky_term for the sky, the
+ * environment tables of the exact sectors. On HFVIS_OK E->acc holds S (the caller frees E). */
+static hfvis_status hf_exact_sums(hf_exact *E, const hfvis_grid *g, int K, hfvis_sum_kind kind,
+                                  const hfvis_env *env, const hfvis_env_options *eopts,
+                                  const hfvis_sweep_options *o, int begin, int end)
+{
+    hfvis_status s;
+    hf_env_eval eval;
+    float *table = NULL;
+    int channels = kind == HFVIS_SUM_ENV_LIGHT ? env->channels : 1, k, done = 0;
+    size_t i, n = hf_grid_count(g);
+    if ((s = hf_exact_init(E, g, K, o, 1, kind != HFVIS_SUM_SKY_VIEW, channels)) != HFVIS_OK) return s;
+    if (kind == HFVIS_SUM_ENV_LIGHT &&
+        (s = hf_exact_env_tables(&E->d, env, eopts, o->alloc, &table, &eval)) != HFVIS_OK) {
+        hf_exact_free(E);
+        return s;
+    }
+    for (k = 0; k < K; k++) {
+        int pos = hf_direction_position(o, K, k);
+        double wk = (double)K * E->d.w[k];
+        double cp = cos(E->d.ray[k].azimuth), sp = sin(E->d.ray[k].azimuth);
+        if (pos < begin || pos >= end) continue;
+        hf_exact_sweep(E, E->d.ray[k]);
+        for (i = 0; i < n; i++) {
+            double t = E->tan[i];
+            const float *nr = E->nrm ? E->nrm + i * 3 : NULL;
+            if (isnan(t)) continue;
+            if (kind == HFVIS_SUM_SKY_VIEW) E->acc[i] += wk * hf_svf_term(t);
+            else if (kind == HFVIS_SUM_SKY_LIGHT) E->acc[i] += hf_exact_sky_term(&E->d, k, nr, t);
+            else
+                hf_env_accumulate(&eval, k, cp, sp, (double)nr[0], (double)nr[1], (double)nr[2], t,
+                                  E->acc + i * (size_t)channels);
+        }
+        hf_progress(o, ++done, end - begin);
+    }
+    hf_free(o->alloc, table);
+    return HFVIS_OK;
+}
+
+/* Finish of the exact sums into out (holes NaN): offset + scale * S per channel. */
+static void hf_exact_output(const hf_exact *E, double scale, double offset, float *out,
+                            ptrdiff_t out_stride)
+{
+    const hfvis_grid *g = E->g;
+    int x, y, c, ch = E->channels;
+    for (y = 0; y < g->height; y++)
+        for (x = 0; x < g->width; x++) {
+            const double *a = E->acc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)ch;
+            float *p = out + ((ptrdiff_t)y * out_stride + x) * ch;
+            int hole = hf_is_hole(g, x, y);
+            for (c = 0; c < ch; c++) p[c] = (float)(hole ? HF_NAN : offset + scale * a[c]);
+        }
+}
+
+/* hfvis_sky_light, hfvis_sky_view_factor, hfvis_env_light in exact mode (arguments checked). */
+static hfvis_status hf_exact_light(const hfvis_grid *g, int K, hfvis_sum_kind kind,
+                                   const hfvis_env *env, const hfvis_env_options *eopts,
+                                   const hfvis_sweep_options *o, double scale, float *out,
+                                   ptrdiff_t out_stride)
+{
+    hf_exact E;
+    hfvis_status s;
+    int begin, end, k;
+    double offset = 0.0;
+    if ((s = hf_direction_range(o, K, &begin, &end)) != HFVIS_OK) return s;
+    if ((s = hf_exact_sums(&E, g, K, kind, env, eopts, o, begin, end)) != HFVIS_OK) return s;
+    if (kind == HFVIS_SUM_SKY_VIEW) /* the range's share of 1 - S/K: its weights, exact */
+        for (k = 0; k < K; k++) {
+            int pos = hf_direction_position(o, K, k);
+            if (pos >= begin && pos < end) offset += E.d.w[k];
+        }
+    hf_exact_output(&E, scale, offset, out, out_stride);
+    hf_exact_free(&E);
+    return HFVIS_OK;
+}
+
+/* hfvis_sun_visibility in exact mode: one direction, the sun's nearest representable one. */
+static hfvis_status hf_exact_sun(const hfvis_grid *g, double azimuth, double elevation,
+                                 double radius, const hfvis_sweep_options *o, float *out,
+                                 ptrdiff_t out_stride)
+{
+    hfvis_sweep_options o1 = *o;
+    hf_exact E;
+    hfvis_status s;
+    int x, y;
+    o1.azimuth0_rad = azimuth;
+    if ((s = hf_exact_init(&E, g, 1, &o1, 1, 0, 0)) != HFVIS_OK) return s;
+    hf_exact_sweep(&E, E.d.ray[0]);
+    for (y = 0; y < g->height; y++)
+        for (x = 0; x < g->width; x++) {
+            double t = E.tan[(size_t)y * (size_t)g->width + (size_t)x];
+            out[(ptrdiff_t)y * out_stride + x] =
+                (float)hf_sun_fraction(elevation, radius, hf_tan_to_elevation(t));
+        }
+    hf_exact_free(&E);
+    hf_progress(o, 1, 1);
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_sweep_azimuths(int K, const hfvis_sweep_options *opts, double *azimuths,
+                                  double *weights)
+{
+    hfvis_sweep_options o = hfvis_sweep_options_default();
+    hf_exact_dirs d;
+    int k, N;
+    if (K < 1 || (!azimuths && !weights) || !hf_opts_valid(opts)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (opts) o = *opts;
+    if (o.rays != HFVIS_RAYS_EXACT) {
+        for (k = 0; k < K; k++) {
+            if (azimuths) azimuths[k] = o.azimuth0_rad + 2.0 * HF_PI * (double)k / (double)K;
+            if (weights) weights[k] = 1.0 / (double)K;
+        }
+        return HFVIS_OK;
+    }
+    N = hf_exact_bound(&o, K);
+    if (N > HFVIS_RAY_DENOMINATOR_MAX) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!weights) { /* no scratch needed */
+        for (k = 0; k < K; k++) azimuths[k] = hf_ray_nearest(o.azimuth0_rad + 2.0 * HF_PI * (double)k / (double)K, N).azimuth;
+        return HFVIS_OK;
+    }
+    memset(&d, 0, sizeof d);
+    d.ray = (hf_ray *)hf_alloc_array(o.alloc, (size_t)K, sizeof(hf_ray) + 5u * sizeof(double));
+    if (!d.ray) return HFVIS_ERR_OUT_OF_MEMORY;
+    d.w = (double *)(void *)(d.ray + K);
+    d.lc = d.w + K;
+    d.ls = d.lc + K;
+    d.lo = d.ls + K;
+    d.hi = d.lo + K;
+    hf_exact_dirs_fill(&d, K, o.azimuth0_rad, N);
+    for (k = 0; k < K; k++) {
+        if (azimuths) azimuths[k] = d.ray[k].azimuth;
+        weights[k] = d.w[k];
+    }
+    hf_free(o.alloc, d.ray);
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_horizon_exact_naive(const hfvis_grid *grid, int K,
+                                       const hfvis_sweep_options *opts, float *out)
+{
+    hfvis_sweep_options o;
+    hf_cross *cr;
+    size_t plane, total;
+    int N, k, begin, end, x, y, maxp = 1, R, done = 0;
+    if (hf_check_common(grid, opts) != HFVIS_OK || !out || K < 1) return HFVIS_ERR_INVALID_ARGUMENT;
+    plane = hf_grid_count(grid);
+    if (!hf_mul_size(plane, (size_t)K, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
+    o = hf_opts_resolve(grid, opts);
+    if (hf_direction_range(&o, K, &begin, &end) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    N = hf_exact_bound(&o, K);
+    R = o.border == HFVIS_BORDER_OPEN ? 0 : o.border_cells;
+    if (N > HFVIS_RAY_DENOMINATOR_MAX) return HFVIS_ERR_INVALID_ARGUMENT;
+    if ((double)(grid->width > grid->height ? grid->width : grid->height) + 2.0 * (double)R + 3.0 >
+        (double)INT_MAX / 2.0)
+        return HFVIS_ERR_LIMIT;
+    for (k = 0; k < K; k++) {
+        hf_ray r = hf_ray_nearest(o.azimuth0_rad + 2.0 * HF_PI * (double)k / (double)K, N);
+        int p = (r.a < 0 ? -r.a : r.a) + (r.b < 0 ? -r.b : r.b) - 1;
+        if (p > maxp) maxp = p;
+    }
+    cr = (hf_cross *)hf_alloc_array(o.alloc, (size_t)maxp, sizeof(hf_cross));
+    if (!cr) return HFVIS_ERR_OUT_OF_MEMORY;
+    for (k = 0; k < K; k++) {
+        int pos = hf_direction_position(&o, K, k), P;
+        hf_ray r = hf_ray_nearest(o.azimuth0_rad + 2.0 * HF_PI * (double)k / (double)K, N);
+        double L, scale;
+        float *p;
+        if (pos < begin || pos >= end) continue;
+        P = hf_exact_geometry(cr, grid, r.a, r.b, &L, &scale);
+        p = out + (size_t)(pos - begin) * plane;
+        for (y = 0; y < grid->height; y++)
+            for (x = 0; x < grid->width; x++)
+                p[(size_t)y * (size_t)grid->width + (size_t)x] = (float)hf_tan_to_elevation(
+                    hf_exact_march(grid, o.border, R, cr, P, L, scale, r.a, r.b, x, y));
+        hf_progress(&o, ++done, end - begin);
+    }
+    hf_free(o.alloc, cr);
+    return HFVIS_OK;
+}
+
+static hfvis_status hf_exact_direction_sums(const hfvis_grid *g, int K, hfvis_sum_kind kind,
+                                            const hfvis_env *env, const hfvis_env_options *eopts,
+                                            const hfvis_sweep_options *o, int begin, int end,
+                                            double *sums)
+{
+    hf_exact E;
+    hfvis_status s;
+    int x, y, c;
+    if ((s = hf_exact_sums(&E, g, K, kind, env, eopts, o, begin, end)) != HFVIS_OK) return s;
+    for (y = 0; y < g->height; y++)
+        for (x = 0; x < g->width; x++) {
+            size_t i = ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)E.channels;
+            int hole = hf_is_hole(g, x, y);
+            for (c = 0; c < E.channels; c++) sums[i + (size_t)c] = hole ? HF_NAN : E.acc[i + (size_t)c];
+        }
+    hf_exact_free(&E);
+    return HFVIS_OK;
+}

@@ -57,4 +57,5 @@ void bench_vf(int quick);
 void bench_lk(int quick);
 void bench_lk_obj(int quick); /* bench_lkobj.c: the meshes of HFVIS_BENCH_MESHES */
 void bench_dirs(int quick);
+void bench_exact(int quick);
 #endif

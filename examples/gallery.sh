@@ -31,6 +31,7 @@ ssao.png                  ssao_sheet.png
 volume_gi.png             volgi_sheet.png
 visibility_field.png      12_visibility_field_sheet.png
 mesh_ao.png               lk_sheet.png
+exact_rays.png            14_exact_sheet.png
 LIST
 rc=0; sh test/png_check.sh "$dest" || rc=$?
 if [ "$rc" -ne 0 ] && [ "$rc" -ne 77 ]; then exit 1; fi

@@ -290,7 +290,8 @@ static const char cli_usage[] =
     "  visfield    4D visibility field of an OBJ mesh (.hfvf), or AO images from one\n"
     "  meshao      ray-cast ambient obscurance of an OBJ mesh (Laine & Karras bit masks)\n"
     "  ssao        screen-space obscurance of a depth buffer: LSAO, HBAO, FFAO, ray traced\n"
-    "  sum         add up the partial results of --dir-range runs into the single run's OUT\n";
+    "  sum         add up the partial results of --dir-range runs into the single run's OUT\n"
+    "  azimuths    print the K azimuths a run uses, in degrees, in output-plane order\n";
 
 static const char cli_shared_help[] =
     "\n"
@@ -319,6 +320,11 @@ static const char cli_shared_help[] =
     "                    outward) or wrap (periodic field)\n"
     "  --border-cells N  clamp/wrap: lines start N cells outside the grid, 1..1048576\n"
     "                    (default max(width, height))\n"
+    "  --exact           horizon, skyview, sky, light, shadow: exact rays (beyond [P1]): every\n"
+    "                    sample gets its own ray along the nearest rational direction, no\n"
+    "                    interpolation between lattice lines (right at walls, roofs, cliffs;\n"
+    "                    'hfvis azimuths --exact' prints the directions used). visibility,\n"
+    "                    indirect and gi keep the lattice\n"
     "  --quiet           no progress bar (shown on stderr only when it is a terminal)\n"
     "  -h, --help        this help; 'hfvis COMMAND --help' describes one command\n"
     "\n"
@@ -1054,7 +1060,8 @@ static const cli_flag cli_flags[] = {
     { "--fraction", 0, CLI_ONLY(CMD_VISIBILITY) }, { "--stats", 0, CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_MESHAO) },
     { "--observer", 1, CLI_ONLY(CMD_VIEWSHED) },  { "--observer-height", 1, CLI_ONLY(CMD_VIEWSHED) },
     { "--target-height", 1, CLI_ONLY(CMD_VIEWSHED) }, { "--max-distance", 1, CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_VISFIELD) },
-    { "--exact", 0, CLI_ONLY(CMD_VIEWSHED) },
+    { "--exact", 0, CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY)
+                    | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_SHADOW) },
     { "--res", 1, CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_VOLGI) },       { "--mode", 1, CLI_ONLY(CMD_VOXELIZE) },
     { "--axis", 1, CLI_ONLY(CMD_VOXELIZE) },  
     { "--max-vertices", 1, CLI_ONLY(CMD_VOXELIZE) }, { "--padding", 1, CLI_ONLY(CMD_VOXELIZE) },
@@ -2280,9 +2287,10 @@ static void cli_partial_tag(const cli_args *a, const hfvis_grid *grid, const hfv
                             const hfvis_env *env, char *tag)
 {
     int n = snprintf(tag, CLI_TAG_MAX, "cmd=%s dirs=%d in=%016llx cell=%a border=%d border-cells=%d "
-                     "azimuth0=%a", cli_cmd_names[a->cmd], a->dirs,
+                     "azimuth0=%a rays=%s", cli_cmd_names[a->cmd], a->dirs,
                      cli_fingerprint(grid->z, (size_t)grid->width * (size_t)grid->height),
-                     grid->cell_size, (int)o->border, o->border_cells, o->azimuth0_rad);
+                     grid->cell_size, (int)o->border, o->border_cells, o->azimuth0_rad,
+                     o->rays == HFVIS_RAYS_EXACT ? "exact" : "lattice");
     char *t = tag + n;
     size_t left = CLI_TAG_MAX - (size_t)n;
     switch (a->cmd) {
@@ -2692,6 +2700,7 @@ static int cli_run(const cli_args *a)
     opts.border = (hfvis_border)a->border;
     opts.border_cells = a->border_cells;
     opts.azimuth0_rad = a->compass ? a->azimuth0 - CLI_PI / 2.0 : a->azimuth0;
+    if (a->exact && a->cmd != CMD_VIEWSHED) opts.rays = HFVIS_RAYS_EXACT;
     prog.label = cmd; prog.base = 0; prog.total = 0;
     if (!a->quiet && cli_stderr_is_terminal()) {
         opts.progress = cli_progress;
@@ -2789,11 +2798,64 @@ done:
     return rc;
 }
 
+static const char cli_azimuths_help[] =
+    "usage: hfvis azimuths --dirs K [--exact] [--compass] [--azimuth0 RAD]\n"
+    "Prints the K azimuths a run with these options uses, in degrees, one per line, in\n"
+    "output-plane order (plane k of 'hfvis horizon'). Without --exact: psi_k = azimuth0 +\n"
+    "360k/K; with --exact: the nearest rational directions (a, b), max(|a|, |b|) <= max(5,\n"
+    "ceil(K/4)) (64 for K = 1). Degrees from east toward south, or compass bearings\n"
+    "(clockwise from north) with --compass, where --azimuth0 is the bearing of direction 0.\n";
+
+/* hfvis azimuths: the directions of a run (hfvis_sweep_azimuths), one per line. */
+static int cli_azimuths(int argc, char **argv)
+{
+    hfvis_sweep_options o = hfvis_sweep_options_default();
+    double az0 = 0.0, *az;
+    int i, K = 16, compass = 0, has_dirs = 0, k, rc;
+    for (i = 2; i < argc; i++) {
+        const char *f = argv[i], *v = NULL, *eq = strchr(f, '=');
+        char name[32];
+        size_t n = eq ? (size_t)(eq - f) : strlen(f);
+        if (!strcmp(f, "-h") || !strcmp(f, "--help")) {
+            printf("%s", cli_azimuths_help);
+            return 0;
+        }
+        if (n >= sizeof name) n = sizeof name - 1;
+        memcpy(name, f, n);
+        name[n] = '\0';
+        if (!strcmp(name, "--exact") && !eq) { o.rays = HFVIS_RAYS_EXACT; continue; }
+        if (!strcmp(name, "--compass") && !eq) { compass = 1; continue; }
+        if (strcmp(name, "--dirs") && strcmp(name, "--azimuth0"))
+            return cli_error(CLI_EXIT_USAGE, f, "unknown option (see 'hfvis azimuths --help')");
+        if (eq) v = eq + 1;
+        else if (i + 1 < argc) v = argv[++i];
+        else return cli_error(CLI_EXIT_USAGE, name, "needs a value");
+        if (!strcmp(name, "--dirs")) {
+            if ((rc = cli_int(name, v, 1, CLI_MAX_DIRS, "an integer 1..65536", &K)) != 0) return rc;
+            has_dirs = 1;
+        } else if (!cli_parse_real(v, &az0)) {
+            return cli_error(CLI_EXIT_USAGE, name, "expected a finite number of radians, got '%s'", v);
+        }
+    }
+    if (!has_dirs) return cli_error(CLI_EXIT_USAGE, "azimuths", "needs --dirs K");
+    o.azimuth0_rad = compass ? az0 - CLI_PI / 2.0 : az0;
+    az = (double *)malloc((size_t)K * sizeof(double));
+    if (!az) return cli_status("azimuths", HFVIS_ERR_OUT_OF_MEMORY, 0);
+    if (hfvis_sweep_azimuths(K, &o, az, NULL) != HFVIS_OK) {
+        free(az);
+        return cli_error(CLI_EXIT_USAGE, "--azimuth0", "not a usable azimuth");
+    }
+    for (k = 0; k < K; k++) printf("%.17g\n", (az[k] + (compass ? CLI_PI / 2.0 : 0.0)) * (180.0 / CLI_PI));
+    free(az);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     cli_args a;
     int rc;
     if (argc >= 2 && !strcmp(argv[1], "sum")) return cli_sum(argc, argv);
+    if (argc >= 2 && !strcmp(argv[1], "azimuths")) return cli_azimuths(argc, argv);
     rc = cli_parse(argc, argv, &a);
     if (rc != CLI_RUN) return rc;
     return cli_run(&a);

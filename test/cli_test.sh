@@ -454,6 +454,31 @@ split4 "split light 4 ways (RGB)" light pfm 0:3 3:8 8:13 13:16 -- --dirs 16 --en
 split4 "split light --method lp" light pfm 0:1 1:2 2:3 3:8 -- --dirs 8 --env "$dir/env1.pfm" --method lp
 split4 "split visibility 4 ways" visibility pfm 0:2 2:4 4:6 6:8 -- --dirs 8
 split4 "split visibility --fraction" visibility pfm 0:3 3:4 4:7 7:8 -- --dirs 8 --fraction --zscale 3
+# exact rays (--exact): split runs and sums as for the lattice; mixing modes is refused
+split4 "split horizon --exact" horizon pfm 0:3 3:8 8:13 13:16 -- --dirs 16 --exact
+split4 "split skyview --exact" skyview pfm 0:4 4:8 8:12 12:16 -- --dirs 16 --exact --border clamp
+split4 "split sky --exact" sky pfm 0:5 5:6 6:11 11:12 -- --dirs 12 --exact --sky 2 --albedo 0.5 --azimuth0 0.25
+split4 "split light --exact" light pfm 0:3 3:8 8:13 13:16 -- --dirs 16 --exact --env "$dir/env3.pfm"
+"$hfvis" skyview "$h" --dirs 8 --exact --dir-range 0:4 -o "$dir/mx_e.hfvs" 2> /dev/null
+"$hfvis" skyview "$h" --dirs 8 --dir-range 4:8 -o "$dir/mx_l.hfvs" 2> /dev/null
+expect_fail "sum refuses exact and lattice parts" 1 sum "$dir/mx_e.hfvs" "$dir/mx_l.hfvs" -o "$fdir/x.pfm"
+"$hfvis" skyview "$dir/flat.pgm" --exact --dirs 7 -o "$dir/svf_flat.pfm" && [ "$(last_bytes "$dir/svf_flat.pfm" 4)" = "00 00 80 3f" ] \
+  && ok "skyview --exact on flat: 1" || bad "skyview --exact on flat: 1"
+"$hfvis" sky "$dir/flat.pgm" --exact --dirs 5 --sky 2 --albedo 0.5 -o "$dir/sky_flat.pfm" && \
+  [ "$(last_bytes "$dir/sky_flat.pfm" 4)" = "00 00 80 3f" ] && ok "sky --exact on flat: albedo*c" || bad "sky --exact on flat: albedo*c"
+"$hfvis" shadow "$h" --sun-azimuth 130 --sun-elevation 25 --exact -o "$dir/sh_e.pfm" && ok "shadow --exact" || bad "shadow --exact"
+expect_fail "visibility --exact" 2 visibility "$h" --exact -o "$fdir/x.pfm"
+expect_fail "indirect --exact" 2 indirect "$h" --exact -o "$fdir/x.pfm"
+expect_fail "gi --exact" 2 gi "$h" --exact -o "$fdir/x.pfm"
+# hfvis azimuths: K lines in output-plane order, both modes
+[ "$("$hfvis" azimuths --dirs 4 | tr '\n' ' ')" = "0 90 180 270 " ] && ok "azimuths lattice" || bad "azimuths lattice"
+[ "$("$hfvis" azimuths --dirs 4 --compass --azimuth0 0 | tr '\n' ' ')" = "0 90 180 270 " ] && ok "azimuths --compass" || bad "azimuths --compass"
+[ "$("$hfvis" azimuths --dirs 16 --exact | sed -n 2p)" = "21.801409486351812" ] && ok "azimuths --exact: atan(2/5)" || bad "azimuths --exact: atan(2/5)"
+[ "$("$hfvis" azimuths --dirs 64 --exact | wc -l | tr -d ' ')" = 64 ] && ok "azimuths --exact: 64 lines" || bad "azimuths --exact: 64 lines"
+expect_fail "azimuths without --dirs" 2 azimuths --exact
+expect_fail "azimuths --dirs 0" 2 azimuths --dirs 0
+expect_fail "azimuths unknown option" 2 azimuths --dirs 4 -o "$fdir/x.txt"
+expect_fail "azimuths --azimuth0 nan" 2 azimuths --dirs 4 --azimuth0 nan
 "$hfvis" skyview "$h" --dirs 16 --dir-range 0:16 -o "$dir/whole.hfvs" 2> /dev/null
 "$hfvis" sum "$dir/whole.hfvs" -o "$dir/whole.pfm" 2> /dev/null
 "$hfvis" skyview "$h" --dirs 16 -o "$dir/single.pfm" 2> /dev/null

@@ -73,6 +73,8 @@
     X(horizon_map, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(horizon_reference, S, -, "NZGOFESR", "INVALID_ARGUMENT") \
     X(horizon_reference_fn, S, -, "NZGFES", "INVALID_ARGUMENT") \
+    X(sweep_azimuths, S, A, "NZGES", "INVALID_ARGUMENT") \
+    X(horizon_exact_naive, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(sector_weight, V, -, "ZGF", "NaN") \
     X(sky_light, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(sky_light_from_map, S, A, "NZGOFR", "INVALID_ARGUMENT") \
@@ -576,6 +578,9 @@ static void teardown(void)
     bo = hfvis_sweep_options_default(); bo.direction_begin = -1; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.direction_end = -2; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.direction_order = (hfvis_direction_order)3; BAD('E', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.rays = (hfvis_ray_mode)2; BAD('E', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.ray_denominator = -1; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.ray_denominator = HFVIS_RAY_DENOMINATOR_MAX + 1; BAD('S', INV, expr); \
     } while (0)
 
 /* ========================================================================================== */
@@ -992,6 +997,35 @@ static void args_horizon_reference_fn(void)
     BAD('F', INV, hfvis_horizon_reference_fn(plane_fn, NULL, GW, GH, (double)NAN, 4, NULL, NULL, pts, 2, out));
     BAD('Z', INV, hfvis_horizon_reference_fn(plane_fn, NULL, GW, GH, 1.0, 0, NULL, NULL, pts, 2, out));
     SWEEP_OPT_CASES(hfvis_horizon_reference_fn(plane_fn, NULL, GW, GH, 1.0, 4, &bo, NULL, pts, 2, out));
+}
+
+static void args_sweep_azimuths(void)
+{
+    double *az, *w;
+    hfvis_sweep_options eo = hfvis_sweep_options_default();
+    begin("sweep_azimuths");
+    az = AD(8);
+    w = AD(8);
+    eo.rays = HFVIS_RAYS_EXACT;
+    OK(hfvis_sweep_azimuths(8, &eo, az, w));
+    BAD('N', INV, hfvis_sweep_azimuths(8, &eo, NULL, NULL));
+    BAD('Z', INV, hfvis_sweep_azimuths(0, &eo, az, w));
+    BAD('G', INV, hfvis_sweep_azimuths(-3, &eo, az, w));
+    SWEEP_OPT_CASES(hfvis_sweep_azimuths(8, &bo, az, w));
+}
+
+static void args_horizon_exact_naive(void)
+{
+    float *out;
+    begin("horizon_exact_naive");
+    out = AF(4 * GW * GH);
+    OK(hfvis_horizon_exact_naive(&g_ok, 4, NULL, out));
+    BAD('N', INV, hfvis_horizon_exact_naive(NULL, 4, NULL, out));
+    BAD('N', INV, hfvis_horizon_exact_naive(&g_ok, 4, NULL, NULL));
+    BAD('Z', INV, hfvis_horizon_exact_naive(&g_ok, 0, NULL, out));
+    BAD('G', INV, hfvis_horizon_exact_naive(&g_ok, -1, NULL, out));
+    GRID_CASES(hfvis_horizon_exact_naive(&bg, 4, NULL, out));
+    SWEEP_OPT_CASES(hfvis_horizon_exact_naive(&g_ok, 4, &bo, out));
 }
 
 static void args_sector_weight(void)
@@ -5651,6 +5685,21 @@ SW(horizon_lattice_naive)
 }
 SW(horizon_direction) { hfvis_sweep_options o = sweep_opts(al); return hfvis_horizon_direction(&g_ok, 4, 1, &o, AF(GW * GH), GW); }
 SW(horizon_map) { hfvis_sweep_options o = sweep_opts(al); return hfvis_horizon_map(&g_ok, 4, &o, AF(4 * GW * GH)); }
+/* exact rays: the same calls through the exact-mode paths */
+static hfvis_sweep_options exact_opts(const hfvis_allocator *al)
+{
+    hfvis_sweep_options o = sweep_opts(al);
+    o.rays = HFVIS_RAYS_EXACT;
+    return o;
+}
+SW(sweep_azimuths) { hfvis_sweep_options o = exact_opts(al); return hfvis_sweep_azimuths(8, &o, AD(8), AD(8)); }
+SW(horizon_exact_naive) { hfvis_sweep_options o = exact_opts(al); return hfvis_horizon_exact_naive(&g_ok, 8, &o, AF(8 * GW * GH)); }
+SW(horizon_map_exact) { hfvis_sweep_options o = exact_opts(al); return hfvis_horizon_map(&g_ok, 8, &o, AF(8 * GW * GH)); }
+SW(horizon_direction_exact) { hfvis_sweep_options o = exact_opts(al); return hfvis_horizon_direction(&g_ok, 8, 3, &o, AF(GW * GH), GW); }
+SW(sky_light_exact) { hfvis_sweep_options o = exact_opts(al); return hfvis_sky_light(&g_ok, 8, 1.0f, 1.0f, &o, AF(GW * GH), GW); }
+SW(sky_view_factor_exact) { hfvis_sweep_options o = exact_opts(al); return hfvis_sky_view_factor(&g_ok, 8, &o, AF(GW * GH), GW); }
+SW(sun_visibility_exact) { hfvis_sweep_options o = exact_opts(al); return hfvis_sun_visibility(&g_ok, 0.3, 0.4, 0.01, &o, AF(GW * GH), GW); }
+SW(env_light_exact) { hfvis_sweep_options o = exact_opts(al); return hfvis_env_light(&g_ok, 8, &g_env, 1.0f, &o, NULL, AF(GW * GH), GW); }
 SW(sky_light) { hfvis_sweep_options o = sweep_opts(al); return hfvis_sky_light(&g_ok, 4, 1.0f, 1.0f, &o, AF(GW * GH), GW); }
 SW(sky_light_from_map) { return hfvis_sky_light_from_map(&g_ok, 4, 0.0, g_map, 1.0f, 1.0f, al, AF(GW * GH), GW); }
 SW(sky_view_factor) { hfvis_sweep_options o = sweep_opts(al); return hfvis_sky_view_factor(&g_ok, 4, &o, AF(GW * GH), GW); }
@@ -6227,6 +6276,10 @@ typedef struct sweep_entry {
 static const sweep_entry sweeps[] = {
     SWEEP(image_load), SWEEP(horizon_lattice), SWEEP(horizon_lattice_naive), SWEEP(horizon_direction),
     SWEEP(horizon_map), SWEEP(sky_light), SWEEP(sky_light_from_map), SWEEP(sky_view_factor),
+    SWEEP(sweep_azimuths), SWEEP(horizon_exact_naive), SWEEP_VARIANT(horizon_map, horizon_map_exact),
+    SWEEP_VARIANT(horizon_direction, horizon_direction_exact), SWEEP_VARIANT(sky_light, sky_light_exact),
+    SWEEP_VARIANT(sky_view_factor, sky_view_factor_exact), SWEEP_VARIANT(sun_visibility, sun_visibility_exact),
+    SWEEP_VARIANT(env_light, env_light_exact),
     SWEEP(sun_visibility), SWEEP(env_light), SWEEP(env_light_from_map), SWEEP(intervisibility),
     SWEEP(visibility_count), SWEEP(visibility_count_naive), SWEEP(indirect_light),
     SWEEP(indirect_light_naive), SWEEP(terrain_gi), SWEEP(direct_light), SWEEP(ns_gi),

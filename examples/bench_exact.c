@@ -1,0 +1,115 @@
+/* bench_exact.c - exact rays beside the lattice and the per-receiver ray march (hfvis.h, "Exact
+ * rays"): horizon maps at K = 16 on an urban DSM (boxes on flat ground, 1 m grid) and on fBm, the
+ * time of each and its error against the exact maximum over the bilinear surface
+ * (fields_ray_max; pairs whose maximum lies nearer than one cell left out) on 1500 receivers;
+ * and the fused sky-view factor in both modes. */
+#define _POSIX_C_SOURCE 199309L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "bench.h"
+#include "fields.h"
+
+#define EXACT_BENCH_K 16
+#define EXACT_BENCH_PTS 1500
+
+static int exact_cmp(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* mean and p99 (degrees) of |value - exact| over the sampled receivers of K planes (or of the
+ * march's count*K values when pts_layout). */
+static void exact_err(const hfvis_grid *g, const float *v, int march, const int *px, const int *py,
+                      const double *az, double *mean, double *p99)
+{
+    static double e[EXACT_BENCH_PTS * EXACT_BENCH_K];
+    size_t n = 0, plane = (size_t)g->width * (size_t)g->height;
+    int i, k;
+    double s = 0.0;
+    for (i = 0; i < EXACT_BENCH_PTS; i++)
+        for (k = 0; k < EXACT_BENCH_K; k++) {
+            double arg = 0.0, ref = fields_ray_max(g, px[i], py[i], az[k], 0.0, &arg), got;
+            got = march ? v[(size_t)i * EXACT_BENCH_K + (size_t)k]
+                        : v[(size_t)k * plane + (size_t)py[i] * (size_t)g->width + (size_t)px[i]];
+            if (!isfinite(ref) || ref <= -1.5 || arg < 1.0) continue;
+            e[n] = fabs((double)got - ref) * (180.0 / 3.14159265358979323846);
+            s += e[n++];
+        }
+    qsort(e, n, sizeof(double), exact_cmp);
+    *mean = n ? s / (double)n : 0.0;
+    *p99 = n ? e[(size_t)(0.99 * (double)(n - 1))] : 0.0;
+}
+
+static void exact_field(const char *name, float *z, int n, float *map)
+{
+    hfvis_grid g;
+    hfvis_sweep_options lat = hfvis_sweep_options_default(), ex = lat;
+    static int px[EXACT_BENCH_PTS], py[EXACT_BENCH_PTS];
+    static float pts[2 * EXACT_BENCH_PTS], march[EXACT_BENCH_PTS * EXACT_BENCH_K];
+    double az_l[EXACT_BENCH_K], az_e[EXACT_BENCH_K], t0, tl, te, tm, ml, pl, me, pe, mm, pm, sl, se;
+    double rd = (double)n * (double)n * EXACT_BENCH_K;
+    uint64_t seed = 77;
+    int i;
+    g.z = z; g.width = n; g.height = n; g.stride = n; g.cell_size = 1.0;
+    ex.rays = HFVIS_RAYS_EXACT;
+    hfvis_sweep_azimuths(EXACT_BENCH_K, &lat, az_l, NULL);
+    hfvis_sweep_azimuths(EXACT_BENCH_K, &ex, az_e, NULL);
+    for (i = 0; i < EXACT_BENCH_PTS; i++) {
+        px[i] = (int)(fields_uniform(&seed) * (double)n);
+        py[i] = (int)(fields_uniform(&seed) * (double)n);
+        pts[2 * i] = (float)px[i];
+        pts[2 * i + 1] = (float)py[i];
+    }
+    t0 = bench_now();
+    hfvis_horizon_map(&g, EXACT_BENCH_K, &lat, map);
+    tl = bench_now() - t0;
+    exact_err(&g, map, 0, px, py, az_l, &ml, &pl);
+    t0 = bench_now();
+    hfvis_horizon_map(&g, EXACT_BENCH_K, &ex, map);
+    te = bench_now() - t0;
+    exact_err(&g, map, 0, px, py, az_e, &me, &pe);
+    t0 = bench_now();
+    hfvis_horizon_reference(&g, EXACT_BENCH_K, &ex, NULL, pts, EXACT_BENCH_PTS, march);
+    tm = (bench_now() - t0) / (EXACT_BENCH_PTS * (double)EXACT_BENCH_K);
+    exact_err(&g, march, 1, px, py, az_e, &mm, &pm);
+    t0 = bench_now();
+    hfvis_sky_view_factor(&g, EXACT_BENCH_K, &lat, map, n);
+    sl = bench_now() - t0;
+    t0 = bench_now();
+    hfvis_sky_view_factor(&g, EXACT_BENCH_K, &ex, map, n);
+    se = bench_now() - t0;
+    printf("exact rays, %s %d^2 K=%d: sky-view factor lattice %.1f ns/rd, exact %.1f ns/rd (%.2fx)\n", name, n,
+           EXACT_BENCH_K, 1e9 * sl / rd, 1e9 * se / rd, se / sl);
+    printf("exact rays, %s %d^2 K=%d: horizon map lattice %.1f ms (%.1f ns/rd, err mean %.3f p99 %.2f deg) | exact "
+           "%.1f ms (%.1f ns/rd, %.2fx lattice, err mean %.3f p99 %.2f deg) | unit-step march %.0f ns/rd "
+           "(%.0fx lattice, err mean %.3f p99 %.2f deg)\n",
+           name, n, EXACT_BENCH_K, 1e3 * tl, 1e9 * tl / rd, ml, pl, 1e3 * te, 1e9 * te / rd, te / tl, me, pe,
+           1e9 * tm, tm / (tl / rd), mm, pm);
+}
+
+void bench_exact(int quick)
+{
+    int sizes[2] = {512, 1024}, s;
+    for (s = 0; s < 2; s++) {
+        int n = quick ? sizes[s] / 4 : sizes[s];
+        size_t cells = (size_t)n * (size_t)n;
+        float *z = (float *)malloc(sizeof(float) * cells);
+        float *map = (float *)malloc(sizeof(float) * cells * EXACT_BENCH_K);
+        hfvis_field f;
+        if (!z || !map) { printf("exact: out of memory\n"); free(z); free(map); return; }
+        fields_urban(z, n, n, (int)(260.0 * (double)cells / (512.0 * 512.0)), 5);
+        exact_field("urban", z, n, map);
+        memset(&f, 0, sizeof f);
+        f.kind = HFVIS_FIELD_FBM;
+        f.amplitude = (double)n / 8.0;
+        f.wavelength = (double)n / 4.0;
+        f.seed = 3;
+        hfvis_field_generate(&f, n, n, n, z);
+        exact_field("fBm", z, n, map);
+        free(z);
+        free(map);
+    }
+}
