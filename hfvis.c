@@ -1695,24 +1695,96 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
         }
 }
 
-/* Gather the lattice accumulator into the grid accumulator. */
+/* Gather the lattice accumulator into the grid accumulator. The common case, all four taps
+ * inside the lattice with some finite weight, is hf_gather_setup + hf_gather_apply written out
+ * without the tap table: a tap with zero weight or a non-finite value adds +0.0 instead of being
+ * skipped, which leaves every sum bit-identical (a sum started at +0.0 is never -0.0, and
+ * x + 0.0 == x otherwise). Everything else takes the general routine. */
 static void hf_gather_accumulate(hf_sweep *sw)
 {
     const hfvis_grid *g = sw->g;
+    const hfvis_lattice *L = &sw->L;
+    const double *lat = sw->lat;
+    const ptrdiff_t cols = sw->cols;
     int x, y, c, ch = sw->channels;
     double v[4];
     hf_gather G;
     int tx, ty;
     for (ty = 0; ty < g->height; ty += HF_TILE)
         for (tx = 0; tx < g->width; tx += HF_TILE)
-    for (y = ty; y < g->height && y < ty + HF_TILE; y++)
+    for (y = ty; y < g->height && y < ty + HF_TILE; y++) {
+        const float *zr = g->z + (ptrdiff_t)y * g->stride;
+        double *accr = sw->gacc + (size_t)y * (size_t)g->width * (size_t)ch;
+        const double ya = (double)y * L->uy, yb = (double)y * L->vy;
         for (x = tx; x < g->width && x < tx + HF_TILE; x++) {
-            double *acc = sw->gacc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)ch;
-            if (hf_is_hole(g, x, y)) continue;
-            hf_gather_setup(sw, x, y, &G);
-            hf_gather_apply(sw, sw->lat, ch, &G, v);
-            for (c = 0; c < ch; c++) acc[c] += v[c];
+            double *acc = accr + (size_t)x * (size_t)ch;
+            double a, b, fa, fb, wa, wb, w[4], sum, wsum;
+            const double *p;
+            int ia, jb, q;
+            if (!isfinite(zr[x])) continue;
+            a = (double)x * L->ux + ya;
+            b = (double)x * L->vx + yb;
+            fa = floor(a);
+            fb = floor(b);
+            ia = (int)fa - L->i_min;
+            jb = (int)fb - L->j_min;
+            if (ia < 0 || jb < 0 || ia + 1 >= sw->cols || jb + 1 >= sw->rows) {
+                hf_gather_setup(sw, x, y, &G);
+                hf_gather_apply(sw, lat, ch, &G, v);
+                for (c = 0; c < ch; c++) acc[c] += v[c];
+                continue;
+            }
+            wa = a - fa;
+            wb = b - fb;
+            w[0] = (1.0 - wa) * (1.0 - wb);
+            w[1] = wa * (1.0 - wb);
+            w[2] = (1.0 - wa) * wb;
+            w[3] = wa * wb;
+            p = lat + ((ptrdiff_t)jb * cols + ia) * ch;
+            if (ch == 1) {
+                double t0 = p[0], t1 = p[1], t2 = p[cols], t3 = p[cols + 1];
+                double w0 = w[0] != 0.0 && isfinite(t0) ? w[0] : 0.0;
+                double w1 = w[1] != 0.0 && isfinite(t1) ? w[1] : 0.0;
+                double w2 = w[2] != 0.0 && isfinite(t2) ? w[2] : 0.0;
+                double w3 = w[3] != 0.0 && isfinite(t3) ? w[3] : 0.0;
+                wsum = 0.0 + w0 + w1 + w2 + w3;
+                if (!(wsum > 0.0)) {
+                    hf_gather_setup(sw, x, y, &G);
+                    hf_gather_apply(sw, lat, ch, &G, v);
+                    acc[0] += v[0];
+                    continue;
+                }
+                sum = 0.0 + (w0 != 0.0 ? w0 * t0 : 0.0) + (w1 != 0.0 ? w1 * t1 : 0.0) +
+                      (w2 != 0.0 ? w2 * t2 : 0.0) + (w3 != 0.0 ? w3 * t3 : 0.0);
+                acc[0] += wsum != 1.0 ? sum / wsum : sum;
+                continue;
+            }
+            {
+                const double *tp[4];
+                double wq[4];
+                tp[0] = p;
+                tp[1] = p + ch;
+                tp[2] = p + cols * ch;
+                tp[3] = p + (cols + 1) * ch;
+                wsum = 0.0;
+                for (q = 0; q < 4; q++) {
+                    wq[q] = w[q] != 0.0 && isfinite(tp[q][0]) ? w[q] : 0.0;
+                    wsum += wq[q];
+                }
+                if (!(wsum > 0.0)) {
+                    hf_gather_setup(sw, x, y, &G);
+                    hf_gather_apply(sw, lat, ch, &G, v);
+                    for (c = 0; c < ch; c++) acc[c] += v[c];
+                    continue;
+                }
+                for (c = 0; c < ch; c++) {
+                    sum = 0.0;
+                    for (q = 0; q < 4; q++) sum += wq[q] != 0.0 ? wq[q] * tp[q][c] : 0.0;
+                    acc[c] += wsum != 1.0 ? sum / wsum : sum;
+                }
+            }
         }
+    }
 }
 
 static void hf_lattice_fill(hf_sweep *sw, double value)
