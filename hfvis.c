@@ -825,11 +825,30 @@ hfvis_status hfvis_field_generate(const hfvis_field *field, int width, int heigh
 /* Bilinear height at (x, y) inside [0, W-1] x [0, H-1] (spec §3.2: x0 = min(floor x, W-2),
  * 1-D for W or H = 1). A tap with zero weight is never read into the sum, so a hole beside an
  * exact sample position does not leak into it. */
+/* The bilinear value from the taps at p (cell origin) with fractions fx, fy in [0, 1]; taps of
+ * zero weight are not read, so a hole next to an exact sample position does not leak. */
+static inline double hf_bilerp_taps(const float *p, ptrdiff_t stride, double fx, double fy)
+{
+    double r0, r1;
+    if (fx == 0.0) {
+        r0 = (double)p[0];
+        r1 = fy != 0.0 ? (double)p[stride] : 0.0;
+    } else if (fx == 1.0) {
+        r0 = (double)p[1];
+        r1 = fy != 0.0 ? (double)p[stride + 1] : 0.0;
+    } else {
+        r0 = (double)p[0] * (1.0 - fx) + (double)p[1] * fx;
+        r1 = fy != 0.0 ? (double)p[stride] * (1.0 - fx) + (double)p[stride + 1] * fx : 0.0;
+    }
+    if (fy == 0.0) r1 = r0;
+    else if (fy != 1.0) r1 = r0 * (1.0 - fy) + r1 * fy;
+    return isfinite(r1) ? r1 : HF_NAN; /* a +-Inf tap is a hole too */
+}
+
 static double hf_bilerp(const float *z, ptrdiff_t stride, int W, int H, double x, double y)
 {
     int x0, y0;
-    double fx, fy, r0, r1;
-    const float *p;
+    double fx, fy;
     if (W > 1) {
         double f = floor(x);
         x0 = f >= (double)(W - 2) ? W - 2 : (int)f;
@@ -846,20 +865,7 @@ static double hf_bilerp(const float *z, ptrdiff_t stride, int W, int H, double x
         y0 = 0;
         fy = 0.0;
     }
-    p = z + (ptrdiff_t)y0 * stride + x0;
-    if (fx == 0.0) {
-        r0 = (double)p[0];
-        r1 = fy != 0.0 ? (double)p[stride] : 0.0;
-    } else if (fx == 1.0) {
-        r0 = (double)p[1];
-        r1 = fy != 0.0 ? (double)p[stride + 1] : 0.0;
-    } else {
-        r0 = (double)p[0] * (1.0 - fx) + (double)p[1] * fx;
-        r1 = fy != 0.0 ? (double)p[stride] * (1.0 - fx) + (double)p[stride + 1] * fx : 0.0;
-    }
-    if (fy == 0.0) r1 = r0;
-    else if (fy != 1.0) r1 = r0 * (1.0 - fy) + r1 * fy;
-    return isfinite(r1) ? r1 : HF_NAN; /* a +-Inf tap is a hole too */
+    return hf_bilerp_taps(z + (ptrdiff_t)y0 * stride + x0, stride, fx, fy);
 }
 
 static double hf_clampd(double v, double lo, double hi) { return v < lo ? lo : v > hi ? hi : v; }
@@ -1140,6 +1146,8 @@ hfvis_status hfvis_line_horizons_naive(const double *distance, const double *hei
  *   m = 0: rows, increasing i      m = 1: columns, increasing j
  *   m = 2: rows, decreasing i      m = 3: columns, decreasing j
  * (turning u by +pi/2 gives u' = v, v' = -u, so node (i', j') of psi + pi/2 is node (-j', i')). */
+#define HF_STRIP 8 /* columns swept side by side, so a row step touches whole cache lines */
+
 typedef struct hf_sweep {
     const hfvis_grid *g;
     hfvis_border border;
@@ -1153,8 +1161,9 @@ typedef struct hf_sweep {
     double *h;                  /* rows*cols heights in cell units, NaN outside or at holes */
     float *nrm;                 /* rows*cols*3 node normals (want_normals) */
     double *lat;                /* rows*cols*channels output / accumulator */
-    double *lh, *lt;            /* one line: stack heights (or the oracle's copy), tangents */
+    double *lh, *lt;            /* HF_STRIP lines: stack heights (or the oracle's copy), tangents */
     double *sd;                 /* hull stack distances (heights in lh) */
+    size_t linelen;             /* preroll + the longest line: the stride of lh and sd */
     float *grid_nrm;            /* width*height*3 grid normals (want_normals) */
     double *gacc;               /* width*height*channels grid accumulator (fused light) */
     unsigned char *extra;       /* extra_size bytes for the caller (the P2 tree and line data) */
@@ -1228,6 +1237,7 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     nodes = (size_t)D * (size_t)D;
     gridn = hf_grid_count(g);
     linelen = (size_t)D + (size_t)sw->preroll;
+    sw->linelen = linelen + 2;
     off_rf = hf_align_add(&total, (size_t)D, sizeof(int), &ok);
     off_rl = hf_align_add(&total, (size_t)D, sizeof(int), &ok);
     off_cf = hf_align_add(&total, (size_t)D, sizeof(int), &ok);
@@ -1235,9 +1245,10 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     off_h = hf_align_add(&total, nodes, sizeof(double), &ok);
     if (want_normals) off_n = hf_align_add(&total, nodes, 3 * sizeof(float), &ok);
     off_lat = hf_align_add(&total, nodes, (size_t)channels * sizeof(double), &ok);
-    off_lh = hf_align_add(&total, linelen, sizeof(double), &ok);
-    off_lt = hf_align_add(&total, linelen, sizeof(double), &ok);
-    off_stk = hf_align_add(&total, linelen, sizeof(double), &ok);
+    /* HF_STRIP lines at a time, each stack with two pad entries in front (hf_hull_pop) */
+    off_lh = hf_align_add(&total, linelen + 2, HF_STRIP * sizeof(double), &ok);
+    off_lt = hf_align_add(&total, linelen, HF_STRIP * sizeof(double), &ok);
+    off_stk = hf_align_add(&total, linelen + 2, HF_STRIP * sizeof(double), &ok);
     if (want_normals) off_gn = hf_align_add(&total, gridn, 3 * sizeof(float), &ok);
     if (want_gacc) off_ga = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
     if (extra_size) off_x = hf_align_add(&total, extra_size, 1, &ok);
@@ -1255,6 +1266,8 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     sw->lh = (double *)(void *)(b + off_lh);
     sw->lt = (double *)(void *)(b + off_lt);
     sw->sd = (double *)(void *)(b + off_stk);
+    memset(sw->lh, 0, (linelen + 2) * HF_STRIP * sizeof(double)); /* the pads are read */
+    memset(sw->sd, 0, (linelen + 2) * HF_STRIP * sizeof(double));
     sw->grid_nrm = want_normals ? (float *)(void *)(b + off_gn) : NULL;
     sw->gacc = want_gacc ? (double *)(void *)(b + off_ga) : NULL;
     sw->extra = extra_size ? b + off_x : NULL;
@@ -1380,7 +1393,7 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
             w[1] = fx * (1.0 - fy);
             w[2] = (1.0 - fx) * fy;
             w[3] = fx * fy;
-            hr[i] = hf_bilerp(g->z, g->stride, g->width, g->height, x, y) * inv_cs;
+            hr[i] = hf_bilerp_taps(g->z + (ptrdiff_t)y0 * g->stride + x0, g->stride, fx, fy) * inv_cs;
             if (sw->want_normals) {
                 double n0 = 0.0, n1 = 0.0, n2 = 0.0, inv;
                 float *no = sw->nrm + ((size_t)j * (size_t)sw->cols + (size_t)i) * 3;
@@ -1452,20 +1465,107 @@ static void hf_brute_unit(const double *h, int n, double *t)
     }
 }
 
-/* Per-line consumer: receives the tangents t[0..n-1] of the in-domain nodes of one line of
- * orientation m, starting at buffer index node0 with index step `step`. */
+/* Per-line consumer: receives the tangents t[0..n-1] of n in-domain nodes of orientation m,
+ * starting at buffer index node0 with index step `step`: a whole line in sweep order, or (odd m,
+ * see hf_sweep_orientation) the part of one lattice row inside a strip of columns. */
 typedef void (*hf_line_fn)(hf_sweep *sw, void *ctx, int m, ptrdiff_t node0, ptrdiff_t step,
                            int n, const double *t);
 
-/* Run orientation m of the current group: copy each line (with its pre-roll) out of the
- * sampled lattice, find the horizons, hand them to fn. brute = 1 uses the oracle. */
+/* One step of the hull stack (sh, sd, top) for the sample (d, h) (spec §4.2, the arithmetic of
+ * hfvis_line_horizons with distance = node index): pop while the second entry is seen at least as
+ * high, then return the tangent to the top (-inf on an empty stack) and push. The first two pop
+ * decisions are taken without branches (sh, sd have two readable pad entries in front; the
+ * (top >= 2) factor discards what they give), so only a third pop costs a branch. */
+static inline double hf_hull_step(double *sh, double *sd, int *top_io, double h, double d)
+{
+    int top = *top_io;
+    double t;
+    while (top >= 2 && (sh[top - 2] - h) * (d - sd[top - 1]) >= (sh[top - 1] - h) * (d - sd[top - 2]))
+        top--;
+    t = top ? (sh[top - 1] - h) / (d - sd[top - 1]) : -HF_INF;
+    sd[top] = d;
+    sh[top++] = h;
+    *top_io = top;
+    return t;
+}
+
+/* Pre-roll (spec §3.4): R lattice nodes before the first in-domain node (i0, j0) of a line with
+ * lattice step (di, dj), sampled with the border rule, at distances -R..-1; they occlude but
+ * receive nothing. Returns the stack height. */
+static int hf_preroll(const hf_sweep *sw, int i0, int j0, int di, int dj, double *sh, double *sd)
+{
+    const hfvis_lattice *L = &sw->L;
+    const int R = sw->preroll;
+    const double inv_cs = 1.0 / sw->g->cell_size;
+    int r, top = 0;
+    for (r = 0; r < R; r++) {
+        double x, y, h;
+        hf_node_pos(L, i0 - (R - r) * di + L->i_min, j0 - (R - r) * dj + L->j_min, &x, &y);
+        h = hf_sample_border(sw->g, sw->border, x, y) * inv_cs;
+        if (isnan(h)) continue;
+        (void)hf_hull_step(sh, sd, &top, h, (double)(r - R));
+    }
+    return top;
+}
+
+/* Run orientation m of the current group: find the horizons of every line (with its pre-roll)
+ * of the sampled lattice, hand them to fn. brute = 1 uses the oracle, line by line. Rows (even m)
+ * go line by line. Columns (odd m) go HF_STRIP side by side, one lattice row at a time, so each
+ * row step reads whole cache lines instead of one node per line; fn then receives the strip row
+ * by row (step 1), which keeps its own reads and writes in row order too. Every node's tangent
+ * is computed exactly as line by line. */
 static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, void *ctx)
 {
     int nlines = (m & 1) ? sw->cols : sw->rows, line;
     const hfvis_lattice *L = &sw->L;
     const int R = sw->preroll;
     const double inv_cs = 1.0 / sw->g->cell_size;
-    double *sd = sw->sd, *sh = sw->lh, *t = sw->lt;
+    const size_t ll = sw->linelen;
+    double *sd = sw->sd + 2, *sh = sw->lh + 2, *t = sw->lt;
+    if ((m & 1) && !brute) {
+        const ptrdiff_t cols = sw->cols;
+        int c0;
+        for (c0 = 0; c0 < nlines; c0 += HF_STRIP) {
+            int top[HF_STRIP], first[HF_STRIP], last[HF_STRIP], nb = nlines - c0, b, r, rlo = INT_MAX, rhi = -1;
+            if (nb > HF_STRIP) nb = HF_STRIP;
+            for (b = 0; b < nb; b++) {
+                first[b] = sw->col_first[c0 + b];
+                last[b] = sw->col_last[c0 + b];
+                top[b] = 0;
+                if (first[b] > last[b]) continue;
+                if (first[b] < rlo) rlo = first[b];
+                if (last[b] > rhi) rhi = last[b];
+                if (R > 0)
+                    top[b] = m == 1 ? hf_preroll(sw, c0 + b, first[b], 0, 1, sh + b * ll, sd + b * ll)
+                                    : hf_preroll(sw, c0 + b, last[b], 0, -1, sh + b * ll, sd + b * ll);
+            }
+            if (rhi < 0) continue;
+            for (r = 0; r <= rhi - rlo; r++) {
+                int row = m == 1 ? rlo + r : rhi - r;
+                const double *hr = sw->h + (ptrdiff_t)row * cols + c0;
+                double *tr = t + (size_t)(row - rlo) * HF_STRIP;
+                for (b = 0; b < nb; b++) {
+                    double h;
+                    if (row < first[b] || row > last[b]) continue;
+                    h = hr[b];
+                    if (isnan(h)) {
+                        tr[b] = HF_NAN;
+                        continue;
+                    }
+                    tr[b] = hf_hull_step(sh + b * ll, sd + b * ll, &top[b], h,
+                                         (double)(m == 1 ? row - first[b] : last[b] - row));
+                }
+            }
+            for (r = rlo; r <= rhi; r++) {
+                int lo = sw->row_first[r] > c0 ? sw->row_first[r] : c0;
+                int hi = sw->row_last[r] < c0 + nb - 1 ? sw->row_last[r] : c0 + nb - 1;
+                if (lo <= hi)
+                    fn(sw, ctx, m, (ptrdiff_t)r * cols + lo, 1, hi - lo + 1,
+                       t + (size_t)(r - rlo) * HF_STRIP + (lo - c0));
+            }
+        }
+        return;
+    }
     for (line = 0; line < nlines; line++) {
         ptrdiff_t node0, step, p;
         int i0, j0, di, dj, n, s, r, top = 0;
@@ -1483,31 +1583,14 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
             fn(sw, ctx, m, node0, step, n, t + R);
             continue;
         }
-        /* Pre-roll (spec §3.4): R lattice nodes before the first in-domain node, sampled with
-         * the border rule, at distances -R..-1; they occlude but receive nothing. */
-        for (r = 0; r < R; r++) {
-            double x, y, h, d = (double)(r - R);
-            hf_node_pos(L, i0 - (R - r) * di + L->i_min, j0 - (R - r) * dj + L->j_min, &x, &y);
-            h = hf_sample_border(sw->g, sw->border, x, y) * inv_cs;
-            if (isnan(h)) continue;
-            while (top >= 2 && (sh[top - 2] - h) * (d - sd[top - 1]) >= (sh[top - 1] - h) * (d - sd[top - 2]))
-                top--;
-            sd[top] = d;
-            sh[top++] = h;
-        }
-        /* The hull stack of spec §4.2 (same arithmetic as hfvis_line_horizons with
-         * distance = node index): pop while the second entry is seen at least as high. */
+        if (R > 0) top = hf_preroll(sw, i0, j0, di, dj, sh, sd);
         for (s = 0, p = node0; s < n; s++, p += step) {
-            double h = sw->h[p], d = (double)s;
+            double h = sw->h[p];
             if (isnan(h)) {
                 t[s] = HF_NAN;
                 continue;
             }
-            while (top >= 2 && (sh[top - 2] - h) * (d - sd[top - 1]) >= (sh[top - 1] - h) * (d - sd[top - 2]))
-                top--;
-            t[s] = top ? (sh[top - 1] - h) / (d - sd[top - 1]) : -HF_INF;
-            sd[top] = d;
-            sh[top++] = h;
+            t[s] = hf_hull_step(sh, sd, &top, h, (double)s);
         }
         fn(sw, ctx, m, node0, step, n, t);
     }
