@@ -1379,25 +1379,24 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
             /* Bilinear taps (spec §3.2), shared by the height and, for lighting, the normal
              * ([P1] §7: normals bilinearly filtered, then renormalised). Zero-weight taps are
              * never read, so holes do not leak into exact sample positions. */
+            /* the cell of hf_bilerp: x >= 0 after the clamp, so (int)x is floor(x) */
             if (g->width > 1) {
-                double f = floor(x);
-                x0 = f >= (double)(g->width - 2) ? g->width - 2 : (int)f;
+                x0 = (int)x < g->width - 2 ? (int)x : g->width - 2;
                 fx = x - (double)x0;
             }
             if (g->height > 1) {
-                double f = floor(y);
-                y0 = f >= (double)(g->height - 2) ? g->height - 2 : (int)f;
+                y0 = (int)y < g->height - 2 ? (int)y : g->height - 2;
                 fy = y - (double)y0;
             }
-            w[0] = (1.0 - fx) * (1.0 - fy);
-            w[1] = fx * (1.0 - fy);
-            w[2] = (1.0 - fx) * fy;
-            w[3] = fx * fy;
             hr[i] = hf_bilerp_taps(g->z + (ptrdiff_t)y0 * g->stride + x0, g->stride, fx, fy) * inv_cs;
             if (sw->want_normals) {
                 double n0 = 0.0, n1 = 0.0, n2 = 0.0, inv;
                 float *no = sw->nrm + ((size_t)j * (size_t)sw->cols + (size_t)i) * 3;
                 const float *np = sw->grid_nrm + ((size_t)y0 * (size_t)g->width + (size_t)x0) * 3;
+                w[0] = (1.0 - fx) * (1.0 - fy);
+                w[1] = fx * (1.0 - fy);
+                w[2] = (1.0 - fx) * fy;
+                w[3] = fx * fy;
                 for (q = 0; q < 4; q++) {
                     const float *t3;
                     if (w[q] == 0.0) continue;
@@ -1807,10 +1806,15 @@ static void hf_gather_accumulate(hf_sweep *sw)
             if (!isfinite(zr[x])) continue;
             a = (double)x * L->ux + ya;
             b = (double)x * L->vx + yb;
-            fa = floor(a);
-            fb = floor(b);
-            ia = (int)fa - L->i_min;
-            jb = (int)fb - L->j_min;
+            /* floor of a lattice coordinate (within the int range, hf_lattice_from_u) */
+            ia = (int)a;
+            ia -= (double)ia > a;
+            jb = (int)b;
+            jb -= (double)jb > b;
+            fa = (double)ia;
+            fb = (double)jb;
+            ia -= L->i_min;
+            jb -= L->j_min;
             if (ia < 0 || jb < 0 || ia + 1 >= sw->cols || jb + 1 >= sw->rows) {
                 hf_gather_setup(sw, x, y, &G);
                 hf_gather_apply(sw, lat, ch, &G, v);
@@ -1825,11 +1829,17 @@ static void hf_gather_accumulate(hf_sweep *sw)
             w[3] = wa * wb;
             p = lat + ((ptrdiff_t)jb * cols + ia) * ch;
             if (ch == 1) {
-                double t0 = p[0], t1 = p[1], t2 = p[cols], t3 = p[cols + 1];
-                double w0 = w[0] != 0.0 && isfinite(t0) ? w[0] : 0.0;
-                double w1 = w[1] != 0.0 && isfinite(t1) ? w[1] : 0.0;
-                double w2 = w[2] != 0.0 && isfinite(t2) ? w[2] : 0.0;
-                double w3 = w[3] != 0.0 && isfinite(t3) ? w[3] : 0.0;
+                double t0 = p[0], t1 = p[1], t2 = p[cols], t3 = p[cols + 1], w0, w1, w2, w3;
+                if (isfinite(t0 + t1 + t2 + t3)) { /* all finite: w*t of w == 0 is a +-0 too */
+                    wsum = 0.0 + w[0] + w[1] + w[2] + w[3];
+                    sum = 0.0 + w[0] * t0 + w[1] * t1 + w[2] * t2 + w[3] * t3;
+                    acc[0] += wsum != 1.0 ? sum / wsum : sum;
+                    continue;
+                }
+                w0 = w[0] != 0.0 && isfinite(t0) ? w[0] : 0.0;
+                w1 = w[1] != 0.0 && isfinite(t1) ? w[1] : 0.0;
+                w2 = w[2] != 0.0 && isfinite(t2) ? w[2] : 0.0;
+                w3 = w[3] != 0.0 && isfinite(t3) ? w[3] : 0.0;
                 wsum = 0.0 + w0 + w1 + w2 + w3;
                 if (!(wsum > 0.0)) {
                     hf_gather_setup(sw, x, y, &G);
@@ -2230,8 +2240,7 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
     groups = K / per;
     for (gidx = 0; gidx < groups; gidx++) {
         double ux, uy;
-        int m0, any = 0;
-        size_t i, n;
+        int m0, any = 0, j;
         for (m = 0; m < per; m++) {
             int pos = hf_direction_position(o, K, gidx + m * groups);
             any |= pos >= begin && pos < end;
@@ -2239,10 +2248,15 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
         if (!any) continue;
         hf_direction_base(K, gidx, o->azimuth0_rad, &ux, &uy, &m0);
         hf_sweep_group(sw, ux, uy);
-        n = (size_t)sw->rows * (size_t)sw->cols;
-        for (i = 0; i < n; i++) {
-            int c;
-            for (c = 0; c < channels; c++) sw->lat[i * (size_t)channels + (size_t)c] = isnan(sw->h[i]) ? HF_NAN : 0.0;
+        /* the accumulator: 0 at every in-domain node with a height, else NaN */
+        hf_lattice_fill(sw, HF_NAN);
+        for (j = 0; j < sw->rows; j++) {
+            const double *hr = sw->h + (size_t)j * (size_t)sw->cols;
+            double *lr = sw->lat + (size_t)j * (size_t)sw->cols * (size_t)channels;
+            int i, c;
+            for (i = sw->row_first[j]; i <= sw->row_last[j]; i++)
+                if (!isnan(hr[i]))
+                    for (c = 0; c < channels; c++) lr[(size_t)i * (size_t)channels + (size_t)c] = 0.0;
         }
         if (ctx->group) ctx->group(sw, ctx);
         for (m = 0; m < per; m++) {
