@@ -1146,8 +1146,6 @@ hfvis_status hfvis_line_horizons_naive(const double *distance, const double *hei
  *   m = 0: rows, increasing i      m = 1: columns, increasing j
  *   m = 2: rows, decreasing i      m = 3: columns, decreasing j
  * (turning u by +pi/2 gives u' = v, v' = -u, so node (i', j') of psi + pi/2 is node (-j', i')). */
-#define HF_STRIP 8 /* columns swept side by side, so a row step touches whole cache lines */
-
 typedef struct hf_sweep {
     const hfvis_grid *g;
     hfvis_border border;
@@ -1161,9 +1159,8 @@ typedef struct hf_sweep {
     double *h;                  /* rows*cols heights in cell units, NaN outside or at holes */
     float *nrm;                 /* rows*cols*3 node normals (want_normals) */
     double *lat;                /* rows*cols*channels output / accumulator */
-    double *lh, *lt;            /* HF_STRIP lines: stack heights (or the oracle's copy), tangents */
+    double *lh, *lt;            /* one line: stack heights (or the oracle's copy), tangents */
     double *sd;                 /* hull stack distances (heights in lh) */
-    size_t linelen;             /* preroll + the longest line: the stride of lh and sd */
     float *grid_nrm;            /* width*height*3 grid normals (want_normals) */
     double *gacc;               /* width*height*channels grid accumulator (fused light) */
     unsigned char *extra;       /* extra_size bytes for the caller (the P2 tree and line data) */
@@ -1237,7 +1234,6 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     nodes = (size_t)D * (size_t)D;
     gridn = hf_grid_count(g);
     linelen = (size_t)D + (size_t)sw->preroll;
-    sw->linelen = linelen + 2;
     off_rf = hf_align_add(&total, (size_t)D, sizeof(int), &ok);
     off_rl = hf_align_add(&total, (size_t)D, sizeof(int), &ok);
     off_cf = hf_align_add(&total, (size_t)D, sizeof(int), &ok);
@@ -1245,10 +1241,9 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     off_h = hf_align_add(&total, nodes, sizeof(double), &ok);
     if (want_normals) off_n = hf_align_add(&total, nodes, 3 * sizeof(float), &ok);
     off_lat = hf_align_add(&total, nodes, (size_t)channels * sizeof(double), &ok);
-    /* HF_STRIP lines at a time, each stack with two pad entries in front (hf_hull_pop) */
-    off_lh = hf_align_add(&total, linelen + 2, HF_STRIP * sizeof(double), &ok);
-    off_lt = hf_align_add(&total, linelen, HF_STRIP * sizeof(double), &ok);
-    off_stk = hf_align_add(&total, linelen + 2, HF_STRIP * sizeof(double), &ok);
+    off_lh = hf_align_add(&total, linelen, sizeof(double), &ok);
+    off_lt = hf_align_add(&total, linelen, sizeof(double), &ok);
+    off_stk = hf_align_add(&total, linelen, sizeof(double), &ok);
     if (want_normals) off_gn = hf_align_add(&total, gridn, 3 * sizeof(float), &ok);
     if (want_gacc) off_ga = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
     if (extra_size) off_x = hf_align_add(&total, extra_size, 1, &ok);
@@ -1266,8 +1261,6 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     sw->lh = (double *)(void *)(b + off_lh);
     sw->lt = (double *)(void *)(b + off_lt);
     sw->sd = (double *)(void *)(b + off_stk);
-    memset(sw->lh, 0, (linelen + 2) * HF_STRIP * sizeof(double)); /* the pads are read */
-    memset(sw->sd, 0, (linelen + 2) * HF_STRIP * sizeof(double));
     sw->grid_nrm = want_normals ? (float *)(void *)(b + off_gn) : NULL;
     sw->gacc = want_gacc ? (double *)(void *)(b + off_ga) : NULL;
     sw->extra = extra_size ? b + off_x : NULL;
@@ -1397,7 +1390,22 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
                 w[1] = fx * (1.0 - fy);
                 w[2] = (1.0 - fx) * fy;
                 w[3] = fx * fy;
-                for (q = 0; q < 4; q++) {
+                if (g->width > 1 && g->height > 1) {
+                    /* all four taps in the grid: summed without the zero-weight test, which is
+                     * bit-identical while they are finite (w*n of w == 0 is a +-0) */
+                    const float *r = np + (ptrdiff_t)g->width * 3;
+                    n0 = 0.0 + w[0] * (double)np[0] + w[1] * (double)np[3] + w[2] * (double)r[0] + w[3] * (double)r[3];
+                    n1 = 0.0 + w[0] * (double)np[1] + w[1] * (double)np[4] + w[2] * (double)r[1] + w[3] * (double)r[4];
+                    n2 = 0.0 + w[0] * (double)np[2] + w[1] * (double)np[5] + w[2] * (double)r[2] + w[3] * (double)r[5];
+                    q = 4;
+                    if (!isfinite(n0 + n1 + n2)) { /* a hole's NaN normal: tap by tap */
+                        n0 = n1 = n2 = 0.0;
+                        q = 0;
+                    }
+                } else {
+                    q = 0;
+                }
+                for (; q < 4; q++) {
                     const float *t3;
                     if (w[q] == 0.0) continue;
                     t3 = np + ((q >> 1) * (ptrdiff_t)g->width + (q & 1)) * 3;
@@ -1464,17 +1472,15 @@ static void hf_brute_unit(const double *h, int n, double *t)
     }
 }
 
-/* Per-line consumer: receives the tangents t[0..n-1] of n in-domain nodes of orientation m,
- * starting at buffer index node0 with index step `step`: a whole line in sweep order, or (odd m,
- * see hf_sweep_orientation) the part of one lattice row inside a strip of columns. */
+/* Per-line consumer: receives the tangents t[0..n-1] of the in-domain nodes of one line of
+ * orientation m, starting at buffer index node0 with index step `step`. */
 typedef void (*hf_line_fn)(hf_sweep *sw, void *ctx, int m, ptrdiff_t node0, ptrdiff_t step,
                            int n, const double *t);
 
 /* One step of the hull stack (sh, sd, top) for the sample (d, h) (spec §4.2, the arithmetic of
  * hfvis_line_horizons with distance = node index): pop while the second entry is seen at least as
- * high, then return the tangent to the top (-inf on an empty stack) and push. The first two pop
- * decisions are taken without branches (sh, sd have two readable pad entries in front; the
- * (top >= 2) factor discards what they give), so only a third pop costs a branch. */
+ * high, then return the tangent to the top (-inf on an empty stack) and push. (Pop decisions
+ * taken without branches measured slower: they chain every step on the previous one's loads.) */
 static inline double hf_hull_step(double *sh, double *sd, int *top_io, double h, double d)
 {
     int top = *top_io;
@@ -1507,64 +1513,17 @@ static int hf_preroll(const hf_sweep *sw, int i0, int j0, int di, int dj, double
     return top;
 }
 
-/* Run orientation m of the current group: find the horizons of every line (with its pre-roll)
- * of the sampled lattice, hand them to fn. brute = 1 uses the oracle, line by line. Rows (even m)
- * go line by line. Columns (odd m) go HF_STRIP side by side, one lattice row at a time, so each
- * row step reads whole cache lines instead of one node per line; fn then receives the strip row
- * by row (step 1), which keeps its own reads and writes in row order too. Every node's tangent
- * is computed exactly as line by line. */
+/* Run orientation m of the current group: copy each line (with its pre-roll) out of the
+ * sampled lattice, find the horizons, hand them to fn. brute = 1 uses the oracle. (Sweeping
+ * columns several side by side, so each row step reads whole cache lines, measured no faster:
+ * docs/performance.md.) */
 static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, void *ctx)
 {
     int nlines = (m & 1) ? sw->cols : sw->rows, line;
     const hfvis_lattice *L = &sw->L;
     const int R = sw->preroll;
     const double inv_cs = 1.0 / sw->g->cell_size;
-    const size_t ll = sw->linelen;
-    double *sd = sw->sd + 2, *sh = sw->lh + 2, *t = sw->lt;
-    if ((m & 1) && !brute) {
-        const ptrdiff_t cols = sw->cols;
-        int c0;
-        for (c0 = 0; c0 < nlines; c0 += HF_STRIP) {
-            int top[HF_STRIP], first[HF_STRIP], last[HF_STRIP], nb = nlines - c0, b, r, rlo = INT_MAX, rhi = -1;
-            if (nb > HF_STRIP) nb = HF_STRIP;
-            for (b = 0; b < nb; b++) {
-                first[b] = sw->col_first[c0 + b];
-                last[b] = sw->col_last[c0 + b];
-                top[b] = 0;
-                if (first[b] > last[b]) continue;
-                if (first[b] < rlo) rlo = first[b];
-                if (last[b] > rhi) rhi = last[b];
-                if (R > 0)
-                    top[b] = m == 1 ? hf_preroll(sw, c0 + b, first[b], 0, 1, sh + b * ll, sd + b * ll)
-                                    : hf_preroll(sw, c0 + b, last[b], 0, -1, sh + b * ll, sd + b * ll);
-            }
-            if (rhi < 0) continue;
-            for (r = 0; r <= rhi - rlo; r++) {
-                int row = m == 1 ? rlo + r : rhi - r;
-                const double *hr = sw->h + (ptrdiff_t)row * cols + c0;
-                double *tr = t + (size_t)(row - rlo) * HF_STRIP;
-                for (b = 0; b < nb; b++) {
-                    double h;
-                    if (row < first[b] || row > last[b]) continue;
-                    h = hr[b];
-                    if (isnan(h)) {
-                        tr[b] = HF_NAN;
-                        continue;
-                    }
-                    tr[b] = hf_hull_step(sh + b * ll, sd + b * ll, &top[b], h,
-                                         (double)(m == 1 ? row - first[b] : last[b] - row));
-                }
-            }
-            for (r = rlo; r <= rhi; r++) {
-                int lo = sw->row_first[r] > c0 ? sw->row_first[r] : c0;
-                int hi = sw->row_last[r] < c0 + nb - 1 ? sw->row_last[r] : c0 + nb - 1;
-                if (lo <= hi)
-                    fn(sw, ctx, m, (ptrdiff_t)r * cols + lo, 1, hi - lo + 1,
-                       t + (size_t)(r - rlo) * HF_STRIP + (lo - c0));
-            }
-        }
-        return;
-    }
+    double *sd = sw->sd, *sh = sw->lh, *t = sw->lt;
     for (line = 0; line < nlines; line++) {
         ptrdiff_t node0, step, p;
         int i0, j0, di, dj, n, s, r, top = 0;
