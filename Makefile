@@ -92,9 +92,10 @@ symbols: $(LIB)
 cxx:
 	$(CXX) -std=c++11 -Wall -Wextra -Werror -pedantic -fsyntax-only -I. test/cxx_header.cpp
 
+# make bench follows config= and opt= (default: the release build, build/bench).
 bench:
-	@$(MAKE) --no-print-directory config=release $(BENCH)
-	@build/bench $(BENCH_ARGS)
+	@$(MAKE) --no-print-directory $(BENCH)
+	@$(BENCH) $(BENCH_ARGS)
 
 demo: 
 	@$(MAKE) --no-print-directory config=release all

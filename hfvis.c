@@ -854,11 +854,30 @@ hfvis_status hfvis_field_generate(const hfvis_field *field, int width, int heigh
 /* Bilinear height at (x, y) inside [0, W-1] x [0, H-1] (spec §3.2: x0 = min(floor x, W-2),
  * 1-D for W or H = 1). A tap with zero weight is never read into the sum, so a hole beside an
  * exact sample position does not leak into it. */
+/* The bilinear value from the taps at p (cell origin) with fractions fx, fy in [0, 1]; taps of
+ * zero weight are not read, so a hole next to an exact sample position does not leak. */
+static inline double hf_bilerp_taps(const float *p, ptrdiff_t stride, double fx, double fy)
+{
+    double r0, r1;
+    if (fx == 0.0) {
+        r0 = (double)p[0];
+        r1 = fy != 0.0 ? (double)p[stride] : 0.0;
+    } else if (fx == 1.0) {
+        r0 = (double)p[1];
+        r1 = fy != 0.0 ? (double)p[stride + 1] : 0.0;
+    } else {
+        r0 = (double)p[0] * (1.0 - fx) + (double)p[1] * fx;
+        r1 = fy != 0.0 ? (double)p[stride] * (1.0 - fx) + (double)p[stride + 1] * fx : 0.0;
+    }
+    if (fy == 0.0) r1 = r0;
+    else if (fy != 1.0) r1 = r0 * (1.0 - fy) + r1 * fy;
+    return isfinite(r1) ? r1 : HF_NAN; /* a +-Inf tap is a hole too */
+}
+
 static double hf_bilerp(const float *z, ptrdiff_t stride, int W, int H, double x, double y)
 {
     int x0, y0;
-    double fx, fy, r0, r1;
-    const float *p;
+    double fx, fy;
     if (W > 1) {
         double f = floor(x);
         x0 = f >= (double)(W - 2) ? W - 2 : (int)f;
@@ -875,20 +894,7 @@ static double hf_bilerp(const float *z, ptrdiff_t stride, int W, int H, double x
         y0 = 0;
         fy = 0.0;
     }
-    p = z + (ptrdiff_t)y0 * stride + x0;
-    if (fx == 0.0) {
-        r0 = (double)p[0];
-        r1 = fy != 0.0 ? (double)p[stride] : 0.0;
-    } else if (fx == 1.0) {
-        r0 = (double)p[1];
-        r1 = fy != 0.0 ? (double)p[stride + 1] : 0.0;
-    } else {
-        r0 = (double)p[0] * (1.0 - fx) + (double)p[1] * fx;
-        r1 = fy != 0.0 ? (double)p[stride] * (1.0 - fx) + (double)p[stride + 1] * fx : 0.0;
-    }
-    if (fy == 0.0) r1 = r0;
-    else if (fy != 1.0) r1 = r0 * (1.0 - fy) + r1 * fy;
-    return isfinite(r1) ? r1 : HF_NAN; /* a +-Inf tap is a hole too */
+    return hf_bilerp_taps(z + (ptrdiff_t)y0 * stride + x0, stride, fx, fy);
 }
 
 static double hf_clampd(double v, double lo, double hi) { return v < lo ? lo : v > hi ? hi : v; }
@@ -1397,26 +1403,40 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
             /* Bilinear taps (spec §3.2), shared by the height and, for lighting, the normal
              * ([P1] §7: normals bilinearly filtered, then renormalised). Zero-weight taps are
              * never read, so holes do not leak into exact sample positions. */
+            /* the cell of hf_bilerp: x >= 0 after the clamp, so (int)x is floor(x) */
             if (g->width > 1) {
-                double f = floor(x);
-                x0 = f >= (double)(g->width - 2) ? g->width - 2 : (int)f;
+                x0 = (int)x < g->width - 2 ? (int)x : g->width - 2;
                 fx = x - (double)x0;
             }
             if (g->height > 1) {
-                double f = floor(y);
-                y0 = f >= (double)(g->height - 2) ? g->height - 2 : (int)f;
+                y0 = (int)y < g->height - 2 ? (int)y : g->height - 2;
                 fy = y - (double)y0;
             }
-            w[0] = (1.0 - fx) * (1.0 - fy);
-            w[1] = fx * (1.0 - fy);
-            w[2] = (1.0 - fx) * fy;
-            w[3] = fx * fy;
-            hr[i] = hf_bilerp(g->z, g->stride, g->width, g->height, x, y) * inv_cs;
+            hr[i] = hf_bilerp_taps(g->z + (ptrdiff_t)y0 * g->stride + x0, g->stride, fx, fy) * inv_cs;
             if (sw->want_normals) {
                 double n0 = 0.0, n1 = 0.0, n2 = 0.0, inv;
                 float *no = sw->nrm + ((size_t)j * (size_t)sw->cols + (size_t)i) * 3;
                 const float *np = sw->grid_nrm + ((size_t)y0 * (size_t)g->width + (size_t)x0) * 3;
-                for (q = 0; q < 4; q++) {
+                w[0] = (1.0 - fx) * (1.0 - fy);
+                w[1] = fx * (1.0 - fy);
+                w[2] = (1.0 - fx) * fy;
+                w[3] = fx * fy;
+                if (g->width > 1 && g->height > 1) {
+                    /* all four taps in the grid: summed without the zero-weight test, which is
+                     * bit-identical while they are finite (w*n of w == 0 is a +-0) */
+                    const float *r = np + (ptrdiff_t)g->width * 3;
+                    n0 = 0.0 + w[0] * (double)np[0] + w[1] * (double)np[3] + w[2] * (double)r[0] + w[3] * (double)r[3];
+                    n1 = 0.0 + w[0] * (double)np[1] + w[1] * (double)np[4] + w[2] * (double)r[1] + w[3] * (double)r[4];
+                    n2 = 0.0 + w[0] * (double)np[2] + w[1] * (double)np[5] + w[2] * (double)r[2] + w[3] * (double)r[5];
+                    q = 4;
+                    if (!isfinite(n0 + n1 + n2)) { /* a hole's NaN normal: tap by tap */
+                        n0 = n1 = n2 = 0.0;
+                        q = 0;
+                    }
+                } else {
+                    q = 0;
+                }
+                for (; q < 4; q++) {
                     const float *t3;
                     if (w[q] == 0.0) continue;
                     t3 = np + ((q >> 1) * (ptrdiff_t)g->width + (q & 1)) * 3;
@@ -1488,8 +1508,46 @@ static void hf_brute_unit(const double *h, int n, double *t)
 typedef void (*hf_line_fn)(hf_sweep *sw, void *ctx, int m, ptrdiff_t node0, ptrdiff_t step,
                            int n, const double *t);
 
+/* One step of the hull stack (sh, sd, top) for the sample (d, h) (spec §4.2, the arithmetic of
+ * hfvis_line_horizons with distance = node index): pop while the second entry is seen at least as
+ * high, then return the tangent to the top (-inf on an empty stack) and push. (Pop decisions
+ * taken without branches measured slower: they chain every step on the previous one's loads.) */
+static inline double hf_hull_step(double *sh, double *sd, int *top_io, double h, double d)
+{
+    int top = *top_io;
+    double t;
+    while (top >= 2 && (sh[top - 2] - h) * (d - sd[top - 1]) >= (sh[top - 1] - h) * (d - sd[top - 2]))
+        top--;
+    t = top ? (sh[top - 1] - h) / (d - sd[top - 1]) : -HF_INF;
+    sd[top] = d;
+    sh[top++] = h;
+    *top_io = top;
+    return t;
+}
+
+/* Pre-roll (spec §3.4): R lattice nodes before the first in-domain node (i0, j0) of a line with
+ * lattice step (di, dj), sampled with the border rule, at distances -R..-1; they occlude but
+ * receive nothing. Returns the stack height. */
+static int hf_preroll(const hf_sweep *sw, int i0, int j0, int di, int dj, double *sh, double *sd)
+{
+    const hfvis_lattice *L = &sw->L;
+    const int R = sw->preroll;
+    const double inv_cs = 1.0 / sw->g->cell_size;
+    int r, top = 0;
+    for (r = 0; r < R; r++) {
+        double x, y, h;
+        hf_node_pos(L, i0 - (R - r) * di + L->i_min, j0 - (R - r) * dj + L->j_min, &x, &y);
+        h = hf_sample_border(sw->g, sw->border, x, y) * inv_cs;
+        if (isnan(h)) continue;
+        (void)hf_hull_step(sh, sd, &top, h, (double)(r - R));
+    }
+    return top;
+}
+
 /* Run orientation m of the current group: copy each line (with its pre-roll) out of the
- * sampled lattice, find the horizons, hand them to fn. brute = 1 uses the oracle. */
+ * sampled lattice, find the horizons, hand them to fn. brute = 1 uses the oracle. (Sweeping
+ * columns several side by side, so each row step reads whole cache lines, measured no faster:
+ * docs/performance.md.) */
 static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, void *ctx)
 {
     int nlines = (m & 1) ? sw->cols : sw->rows, line;
@@ -1514,31 +1572,14 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
             fn(sw, ctx, m, node0, step, n, t + R);
             continue;
         }
-        /* Pre-roll (spec §3.4): R lattice nodes before the first in-domain node, sampled with
-         * the border rule, at distances -R..-1; they occlude but receive nothing. */
-        for (r = 0; r < R; r++) {
-            double x, y, h, d = (double)(r - R);
-            hf_node_pos(L, i0 - (R - r) * di + L->i_min, j0 - (R - r) * dj + L->j_min, &x, &y);
-            h = hf_sample_border(sw->g, sw->border, x, y) * inv_cs;
-            if (isnan(h)) continue;
-            while (top >= 2 && (sh[top - 2] - h) * (d - sd[top - 1]) >= (sh[top - 1] - h) * (d - sd[top - 2]))
-                top--;
-            sd[top] = d;
-            sh[top++] = h;
-        }
-        /* The hull stack of spec §4.2 (same arithmetic as hfvis_line_horizons with
-         * distance = node index): pop while the second entry is seen at least as high. */
+        if (R > 0) top = hf_preroll(sw, i0, j0, di, dj, sh, sd);
         for (s = 0, p = node0; s < n; s++, p += step) {
-            double h = sw->h[p], d = (double)s;
+            double h = sw->h[p];
             if (isnan(h)) {
                 t[s] = HF_NAN;
                 continue;
             }
-            while (top >= 2 && (sh[top - 2] - h) * (d - sd[top - 1]) >= (sh[top - 1] - h) * (d - sd[top - 2]))
-                top--;
-            t[s] = top ? (sh[top - 1] - h) / (d - sd[top - 1]) : -HF_INF;
-            sd[top] = d;
-            sh[top++] = h;
+            t[s] = hf_hull_step(sh, sd, &top, h, (double)s);
         }
         fn(sw, ctx, m, node0, step, n, t);
     }
@@ -1726,24 +1767,107 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
         }
 }
 
-/* Gather the lattice accumulator into the grid accumulator. */
+/* Gather the lattice accumulator into the grid accumulator. The common case, all four taps
+ * inside the lattice with some finite weight, is hf_gather_setup + hf_gather_apply written out
+ * without the tap table: a tap with zero weight or a non-finite value adds +0.0 instead of being
+ * skipped, which leaves every sum bit-identical (a sum started at +0.0 is never -0.0, and
+ * x + 0.0 == x otherwise). Everything else takes the general routine. */
 static void hf_gather_accumulate(hf_sweep *sw)
 {
     const hfvis_grid *g = sw->g;
+    const hfvis_lattice *L = &sw->L;
+    const double *lat = sw->lat;
+    const ptrdiff_t cols = sw->cols;
     int x, y, c, ch = sw->channels;
     double v[4];
     hf_gather G;
     int tx, ty;
     for (ty = 0; ty < g->height; ty += HF_TILE)
         for (tx = 0; tx < g->width; tx += HF_TILE)
-    for (y = ty; y < g->height && y < ty + HF_TILE; y++)
+    for (y = ty; y < g->height && y < ty + HF_TILE; y++) {
+        const float *zr = g->z + (ptrdiff_t)y * g->stride;
+        double *accr = sw->gacc + (size_t)y * (size_t)g->width * (size_t)ch;
+        const double ya = (double)y * L->uy, yb = (double)y * L->vy;
         for (x = tx; x < g->width && x < tx + HF_TILE; x++) {
-            double *acc = sw->gacc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)ch;
-            if (hf_is_hole(g, x, y)) continue;
-            hf_gather_setup(sw, x, y, &G);
-            hf_gather_apply(sw, sw->lat, ch, &G, v);
-            for (c = 0; c < ch; c++) acc[c] += v[c];
+            double *acc = accr + (size_t)x * (size_t)ch;
+            double a, b, fa, fb, wa, wb, w[4], sum, wsum;
+            const double *p;
+            int ia, jb, q;
+            if (!isfinite(zr[x])) continue;
+            a = (double)x * L->ux + ya;
+            b = (double)x * L->vx + yb;
+            /* floor of a lattice coordinate (within the int range, hf_lattice_from_u) */
+            ia = (int)a;
+            ia -= (double)ia > a;
+            jb = (int)b;
+            jb -= (double)jb > b;
+            fa = (double)ia;
+            fb = (double)jb;
+            ia -= L->i_min;
+            jb -= L->j_min;
+            if (ia < 0 || jb < 0 || ia + 1 >= sw->cols || jb + 1 >= sw->rows) {
+                hf_gather_setup(sw, x, y, &G);
+                hf_gather_apply(sw, lat, ch, &G, v);
+                for (c = 0; c < ch; c++) acc[c] += v[c];
+                continue;
+            }
+            wa = a - fa;
+            wb = b - fb;
+            w[0] = (1.0 - wa) * (1.0 - wb);
+            w[1] = wa * (1.0 - wb);
+            w[2] = (1.0 - wa) * wb;
+            w[3] = wa * wb;
+            p = lat + ((ptrdiff_t)jb * cols + ia) * ch;
+            if (ch == 1) {
+                double t0 = p[0], t1 = p[1], t2 = p[cols], t3 = p[cols + 1], w0, w1, w2, w3;
+                if (isfinite(t0 + t1 + t2 + t3)) { /* all finite: w*t of w == 0 is a +-0 too */
+                    wsum = 0.0 + w[0] + w[1] + w[2] + w[3];
+                    sum = 0.0 + w[0] * t0 + w[1] * t1 + w[2] * t2 + w[3] * t3;
+                    acc[0] += wsum != 1.0 ? sum / wsum : sum;
+                    continue;
+                }
+                w0 = w[0] != 0.0 && isfinite(t0) ? w[0] : 0.0;
+                w1 = w[1] != 0.0 && isfinite(t1) ? w[1] : 0.0;
+                w2 = w[2] != 0.0 && isfinite(t2) ? w[2] : 0.0;
+                w3 = w[3] != 0.0 && isfinite(t3) ? w[3] : 0.0;
+                wsum = 0.0 + w0 + w1 + w2 + w3;
+                if (!(wsum > 0.0)) {
+                    hf_gather_setup(sw, x, y, &G);
+                    hf_gather_apply(sw, lat, ch, &G, v);
+                    acc[0] += v[0];
+                    continue;
+                }
+                sum = 0.0 + (w0 != 0.0 ? w0 * t0 : 0.0) + (w1 != 0.0 ? w1 * t1 : 0.0) +
+                      (w2 != 0.0 ? w2 * t2 : 0.0) + (w3 != 0.0 ? w3 * t3 : 0.0);
+                acc[0] += wsum != 1.0 ? sum / wsum : sum;
+                continue;
+            }
+            {
+                const double *tp[4];
+                double wq[4];
+                tp[0] = p;
+                tp[1] = p + ch;
+                tp[2] = p + cols * ch;
+                tp[3] = p + (cols + 1) * ch;
+                wsum = 0.0;
+                for (q = 0; q < 4; q++) {
+                    wq[q] = w[q] != 0.0 && isfinite(tp[q][0]) ? w[q] : 0.0;
+                    wsum += wq[q];
+                }
+                if (!(wsum > 0.0)) {
+                    hf_gather_setup(sw, x, y, &G);
+                    hf_gather_apply(sw, lat, ch, &G, v);
+                    for (c = 0; c < ch; c++) acc[c] += v[c];
+                    continue;
+                }
+                for (c = 0; c < ch; c++) {
+                    sum = 0.0;
+                    for (q = 0; q < 4; q++) sum += wq[q] != 0.0 ? wq[q] * tp[q][c] : 0.0;
+                    acc[c] += wsum != 1.0 ? sum / wsum : sum;
+                }
+            }
         }
+    }
 }
 
 static void hf_lattice_fill(hf_sweep *sw, double value)
@@ -2118,8 +2242,7 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
     groups = K / per;
     for (gidx = 0; gidx < groups; gidx++) {
         double ux, uy;
-        int m0, any = 0;
-        size_t i, n;
+        int m0, any = 0, j;
         for (m = 0; m < per; m++) {
             int pos = hf_direction_position(o, K, gidx + m * groups);
             any |= pos >= begin && pos < end;
@@ -2127,10 +2250,15 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
         if (!any) continue;
         hf_direction_base(K, gidx, o->azimuth0_rad, &ux, &uy, &m0);
         hf_sweep_group(sw, ux, uy);
-        n = (size_t)sw->rows * (size_t)sw->cols;
-        for (i = 0; i < n; i++) {
-            int c;
-            for (c = 0; c < channels; c++) sw->lat[i * (size_t)channels + (size_t)c] = isnan(sw->h[i]) ? HF_NAN : 0.0;
+        /* the accumulator: 0 at every in-domain node with a height, else NaN */
+        hf_lattice_fill(sw, HF_NAN);
+        for (j = 0; j < sw->rows; j++) {
+            const double *hr = sw->h + (size_t)j * (size_t)sw->cols;
+            double *lr = sw->lat + (size_t)j * (size_t)sw->cols * (size_t)channels;
+            int i, c;
+            for (i = sw->row_first[j]; i <= sw->row_last[j]; i++)
+                if (!isnan(hr[i]))
+                    for (c = 0; c < channels; c++) lr[(size_t)i * (size_t)channels + (size_t)c] = 0.0;
         }
         if (ctx->group) ctx->group(sw, ctx);
         for (m = 0; m < per; m++) {

@@ -363,15 +363,17 @@ int main(int argc, char **argv)
     return 0;
 }
 
-/* P1: horizon map and fused sky beside the ray-march oracle. */
+/* P1, lattice mode: horizon map, fused sky light and sky-view factor beside the ray-march
+ * oracle, in ns per receiver-direction (single-threaded; docs/performance.md has the profile). */
 static void bench_horizon(int quick)
 {
     int sizes[2] = {512, 1024}, Ks[3] = {16, 64, 256}, si, ki, nsizes = quick ? 1 : 2;
     int nk = quick ? 1 : 3;
     printf("hfvis bench (ns per receiver-direction; oracle = per-receiver ray march, unit steps,\n"
            "on a fixed random subset of receivers; scratch = peak library allocation)\n\n");
-    printf("%-6s %4s | %-10s %9s %9s | %-10s %9s %9s | %10s %8s %8s\n", "size", "K", "map",
-           "ns/rd", "scratch", "sky", "ns/rd", "scratch", "oracle", "map x", "sky x");
+    printf("lattice mode: map = hfvis_horizon_map, sky = hfvis_sky_light, svf = hfvis_sky_view_factor\n");
+    printf("%-6s %4s | %9s %8s | %9s %8s | %9s %8s | %9s %7s %7s %7s\n", "size", "K", "map ns/rd",
+           "scratch", "sky ns/rd", "scratch", "svf ns/rd", "scratch", "oracle", "map x", "sky x", "svf x");
     for (si = 0; si < nsizes; si++) {
         int n = sizes[si];
         size_t cells = (size_t)n * (size_t)n;
@@ -388,29 +390,33 @@ static void bench_horizon(int quick)
             int K = Ks[ki], P = quick ? 64 : 256;
             float *map = (float *)xmalloc(sizeof(float) * cells * (size_t)K);
             float *pts = sample_points(n, P), *ref = (float *)xmalloc(sizeof(float) * (size_t)P * (size_t)K);
-            bench_tracker tm = {0, 0}, ts = {0, 0};
-            hfvis_allocator am = {bench_track_alloc, bench_track_free, NULL}, as = {bench_track_alloc, bench_track_free, NULL};
-            hfvis_sweep_options om = hfvis_sweep_options_default(), os = om;
-            double t0, t_map, t_sky, t_ref, rd = (double)cells * (double)K;
+            bench_tracker tm = {0, 0}, ts = {0, 0}, tv = {0, 0};
+            hfvis_allocator am = {bench_track_alloc, bench_track_free, NULL}, as = am, av = am;
+            hfvis_sweep_options om = hfvis_sweep_options_default(), os = om, ov = om;
+            double t0, t_map, t_sky, t_svf, t_ref, rd = (double)cells * (double)K;
             hfvis_status s;
             am.user = &tm;
             as.user = &ts;
+            av.user = &tv;
             om.alloc = &am;
             os.alloc = &as;
+            ov.alloc = &av;
             t0 = bench_now();
             if ((s = hfvis_horizon_map(&g, K, &om, map)) != HFVIS_OK) die("horizon map", s);
-            t_map = bench_now() - t0;
+            t_map = (bench_now() - t0) * 1e9 / rd;
             t0 = bench_now();
             if ((s = hfvis_sky_light(&g, K, 1.0f, 1.0f, &os, light, n)) != HFVIS_OK) die("sky", s);
-            t_sky = bench_now() - t0;
+            t_sky = (bench_now() - t0) * 1e9 / rd;
+            t0 = bench_now();
+            if ((s = hfvis_sky_view_factor(&g, K, &ov, light, n)) != HFVIS_OK) die("svf", s);
+            t_svf = (bench_now() - t0) * 1e9 / rd;
             t0 = bench_now();
             if ((s = hfvis_horizon_reference(&g, K, NULL, NULL, pts, (size_t)P, ref)) != HFVIS_OK)
                 die("reference", s);
             t_ref = (bench_now() - t0) * 1e9 / ((double)P * (double)K);
-            printf("%4d^2 %4d | %-10s %9.2f %8.1fM | %-10s %9.2f %8.1fM | %10.1f %7.0fx %7.0fx\n", n, K,
-                   "", t_map * 1e9 / rd, (double)tm.peak / 1048576.0, "", t_sky * 1e9 / rd,
-                   (double)ts.peak / 1048576.0, t_ref, t_ref / (t_map * 1e9 / rd),
-                   t_ref / (t_sky * 1e9 / rd));
+            printf("%4d^2 %4d | %9.2f %7.1fM | %9.2f %7.1fM | %9.2f %7.1fM | %9.1f %6.0fx %6.0fx %6.0fx\n",
+                   n, K, t_map, (double)tm.peak / 1048576.0, t_sky, (double)ts.peak / 1048576.0, t_svf,
+                   (double)tv.peak / 1048576.0, t_ref, t_ref / t_map, t_ref / t_sky, t_ref / t_svf);
             fflush(stdout);
             free(map);
             free(pts);
