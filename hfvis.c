@@ -527,6 +527,154 @@ HFVIS_API hfvis_status hfvis_pgm_encode(const float *pixels, int width, int heig
     return HFVIS_OK;
 }
 
+/* NoData-safe PGM with its range (hfvis.h): a 16-bit P5 whose code 0 is NoData and whose codes
+ * 1..65535 map [lo, hi], with the comment "# hfvis range LO HI nodata 0" after the magic. LO and HI
+ * are written with 9 significant digits, which any float survives (2^-24 relative spacing against
+ * a quantum of 1e-8), without stdio (the codecs work under HFVIS_NO_STDIO). */
+#define HF_PGM_RANGE_TEXT_MAX 64 /* "# hfvis range " + 2 x 15 + " nodata 0\n" */
+
+/* "d.dddddddde+xx" of a finite float into buf; returns the length (at most 15). */
+static size_t hf_img_float_text(float f, unsigned char *buf)
+{
+    double v = (double)f, m;
+    unsigned long digits;
+    size_t len = 0;
+    int e, k;
+    if (v < 0.0) buf[len++] = '-', v = -v;
+    if (v == 0.0) {
+        e = 0, digits = 0;
+    } else {
+        e = (int)floor(log10(v));
+        m = v / pow(10.0, (double)e); /* [1, 10) up to the rounding of log10 and pow */
+        digits = (unsigned long)floor(m * 1e8 + 0.5);
+        if (digits >= 1000000000ul) digits = (digits + 5) / 10, e++;
+        if (digits < 100000000ul) digits = (unsigned long)floor(v / pow(10.0, (double)(e - 1)) * 1e8 + 0.5), e--;
+    }
+    for (k = 8; k >= 0; k--) { /* nine digits, a point after the first */
+        unsigned long p = 1;
+        int q;
+        for (q = 0; q < k; q++) p *= 10;
+        buf[len++] = (unsigned char)('0' + (digits / p) % 10);
+        if (k == 8) buf[len++] = '.';
+    }
+    buf[len++] = 'e';
+    buf[len++] = (unsigned char)(e < 0 ? '-' : '+');
+    if (e < 0) e = -e;
+    buf[len++] = (unsigned char)('0' + e / 10);
+    buf[len++] = (unsigned char)('0' + e % 10);
+    return len;
+}
+
+/* The comment line for [lo, hi]; returns its length. */
+static size_t hf_pgm_range_text(float lo, float hi, unsigned char *buf)
+{
+    size_t len = 14;
+    memcpy(buf, "# hfvis range ", 14);
+    len += hf_img_float_text(lo, buf + len);
+    buf[len++] = ' ';
+    len += hf_img_float_text(hi, buf + len);
+    memcpy(buf + len, " nodata 0\n", 10);
+    return len + 10;
+}
+
+HFVIS_API size_t hfvis_pgm_range_encode_size(int width, int height, float lo, float hi)
+{
+    unsigned char text[HF_PGM_RANGE_TEXT_MAX];
+    size_t base = hfvis_pgm_encode_size(width, height, 65535);
+    size_t extra = isfinite(lo) && isfinite(hi) && lo < hi ? hf_pgm_range_text(lo, hi, text) : 0;
+    if (base == 0 || extra == 0 || base > SIZE_MAX - extra) return 0;
+    return base + extra;
+}
+
+HFVIS_API hfvis_status hfvis_pgm_range_encode(const float *pixels, int width, int height,
+                                              ptrdiff_t stride, float lo, float hi, void *out,
+                                              size_t out_capacity, size_t *written)
+{
+    unsigned char text[HF_PGM_RANGE_TEXT_MAX], *dst = (unsigned char *)out;
+    size_t need = hfvis_pgm_range_encode_size(width, height, lo, hi), tlen;
+    double dlo = (double)lo, range = (double)hi - (double)lo;
+    int x, y;
+    if (!pixels || !out || !written || need == 0 || !hf_img_stride_ok(width, height, 1, stride))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (out_capacity < need) return HFVIS_ERR_BUFFER_TOO_SMALL;
+    tlen = hf_pgm_range_text(lo, hi, text);
+    memcpy(dst, "P5\n", 3);
+    memcpy(dst + 3, text, tlen);
+    dst += 3 + tlen;
+    {
+        unsigned char head[HF_IMG_HEADER_MAX];
+        size_t hl = hf_img_header_text(head, width, height, 1, 65535);
+        memcpy(dst, head + 3, hl - 3); /* without its "P5\n" */
+        dst += hl - 3;
+    }
+    for (y = 0; y < height; y++) {
+        const float *src = pixels + (ptrdiff_t)y * stride;
+        for (x = 0; x < width; x++) {
+            double t = ((double)src[x] - dlo) / range * (double)HFVIS_PGM_RANGE_CODES;
+            unsigned q;
+            if (!isfinite(src[x])) q = HFVIS_PGM_NODATA_CODE;
+            else if (!(t > 0.0)) q = 1;
+            else if (t >= (double)HFVIS_PGM_RANGE_CODES) q = 65535;
+            else q = 1u + (unsigned)floor(t + 0.5);
+            *dst++ = (unsigned char)(q >> 8);
+            *dst++ = (unsigned char)(q & 0xffu);
+        }
+    }
+    *written = need;
+    return HFVIS_OK;
+}
+
+HFVIS_API hfvis_status hfvis_pgm_range_read(const void *data, size_t size, float *lo, float *hi)
+{
+    const unsigned char *p = (const unsigned char *)data;
+    hf_img_header h;
+    size_t i = 2;
+    hfvis_status s;
+    if (!data || !lo || !hi) return HFVIS_ERR_INVALID_ARGUMENT;
+    s = hf_img_parse(p, size, &h);
+    if (s != HFVIS_OK) return s;
+    if (h.info.format != HFVIS_FORMAT_PGM) return HFVIS_ERR_FORMAT;
+    while (i < h.data_offset) { /* each comment of the header */
+        size_t end = i, j;
+        double a, b;
+        if (p[i] != '#') { i++; continue; }
+        while (end < h.data_offset && p[end] != '\n' && p[end] != '\r') end++;
+        j = i + 13;
+        if (end - i > 14 && !memcmp(p + i, "# hfvis range", 13) && hf_img_scale(p, end, &j, &a) &&
+            hf_img_scale(p, end, &j, &b) && end - j >= 9 && !memcmp(p + j, " nodata 0", 9) &&
+            isfinite(a) && isfinite(b) && fabs(a) <= (double)FLT_MAX && fabs(b) <= (double)FLT_MAX &&
+            (float)a < (float)b) {
+            *lo = (float)a;
+            *hi = (float)b;
+            return HFVIS_OK;
+        }
+        i = end;
+    }
+    return HFVIS_ERR_FORMAT;
+}
+
+HFVIS_API hfvis_status hfvis_pgm_range_decode(const void *data, size_t size, float *out,
+                                              size_t out_count, hfvis_image_info *info)
+{
+    hfvis_image_info inf;
+    float lo, hi;
+    size_t i, n;
+    hfvis_status s = hfvis_pgm_range_read(data, size, &lo, &hi);
+    if (s != HFVIS_OK) return s;
+    if (!out) return HFVIS_ERR_INVALID_ARGUMENT;
+    s = hfvis_image_decode(data, size, out, out_count, &inf);
+    if (s != HFVIS_OK) return s;
+    n = (size_t)inf.width * (size_t)inf.height;
+    for (i = 0; i < n; i++) {
+        double code = (double)out[i];
+        out[i] = code == (double)HFVIS_PGM_NODATA_CODE ? (float)HF_NAN
+                 : (float)((double)lo + (code - 1.0) * ((double)hi - (double)lo) /
+                                           (double)HFVIS_PGM_RANGE_CODES);
+    }
+    if (info) *info = inf;
+    return HFVIS_OK;
+}
+
 #ifndef HFVIS_NO_STDIO
 /* A regular file's size from fseek/ftell is only a first guess for the buffer: special files
  * (pipes, /proc, directories on some file systems) report 0, fail, or report absurd sizes, so
@@ -704,6 +852,21 @@ HFVIS_API hfvis_status hfvis_pgm_save(const char *path, const float *pixels, int
     buf = (unsigned char *)hf_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_pgm_encode(pixels, width, height, stride, lo, hi, maxval, buf, need, &written);
+    if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
+    hf_free(NULL, buf);
+    return s;
+}
+HFVIS_API hfvis_status hfvis_pgm_range_save(const char *path, const float *pixels, int width,
+                                            int height, ptrdiff_t stride, float lo, float hi)
+{
+    size_t need = hfvis_pgm_range_encode_size(width, height, lo, hi), written = 0;
+    unsigned char *buf;
+    hfvis_status s;
+    if (!path || !pixels || need == 0 || !hf_img_stride_ok(width, height, 1, stride))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    buf = (unsigned char *)hf_alloc(NULL, need);
+    if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
+    s = hfvis_pgm_range_encode(pixels, width, height, stride, lo, hi, buf, need, &written);
     if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
     hf_free(NULL, buf);
     return s;

@@ -231,6 +231,31 @@ HFVIS_API hfvis_status hfvis_pgm_save(const char *path, const float *pixels, int
                                       int height, ptrdiff_t stride, float lo, float hi,
                                       int maxval);
 
+/* NoData-safe PGM with its value range (the hfvis tool writes its PGM outputs so): a 16-bit binary
+ * PGM whose code HFVIS_PGM_NODATA_CODE (0) marks NoData (every non-finite value) and whose codes
+ * 1..65535 map [lo, hi] linearly, code = 1 + round((v - lo)/(hi - lo) * 65534) clamped to
+ * [1, 65535]. The header carries the comment "# hfvis range LO HI nodata 0" right after "P5"
+ * (LO, HI with 9 significant digits: the floats given, exactly), so any pgm(5) reader reads the
+ * file and hfvis_pgm_range_decode maps the codes back, v = lo + (code - 1)(hi - lo)/65534 (within
+ * (hi - lo)/131068 of the value written), NaN for code 0. Requires finite lo < hi.
+ * encode_size: the bytes of such a file (0 for invalid sizes or range). */
+#define HFVIS_PGM_NODATA_CODE 0
+#define HFVIS_PGM_RANGE_CODES 65534 /* codes 1..65535 span [lo, hi] */
+HFVIS_API size_t hfvis_pgm_range_encode_size(int width, int height, float lo, float hi);
+HFVIS_API hfvis_status hfvis_pgm_range_encode(const float *pixels, int width, int height,
+                                              ptrdiff_t stride, float lo, float hi, void *out,
+                                              size_t out_capacity, size_t *written);
+HFVIS_API hfvis_status hfvis_pgm_range_save(const char *path, const float *pixels, int width,
+                                            int height, ptrdiff_t stride, float lo, float hi);
+/* The range of a PGM in memory from its "# hfvis range" comment. Returns the decoder's errors, or
+ * HFVIS_ERR_FORMAT for a PFM or a PGM without the comment (a plain PGM, or one the hfvis tool wrote
+ * before 0.2: codes 0..65535 spanned the range and NoData was 0). */
+HFVIS_API hfvis_status hfvis_pgm_range_read(const void *data, size_t size, float *lo, float *hi);
+/* Decode such a PGM to values (as above; NaN for NoData): out holds width*height floats
+ * (out_count); info may be NULL. Errors as hfvis_pgm_range_read and hfvis_image_decode. */
+HFVIS_API hfvis_status hfvis_pgm_range_decode(const void *data, size_t size, float *out,
+                                              size_t out_count, hfvis_image_info *info);
+
 /* ========================================================================================== */
 /* hfvis.c - analytic test fields (spec heightfield §12)                                      */
 /* ========================================================================================== */

@@ -1719,7 +1719,8 @@ static float *cli_alloc(size_t a, size_t b, size_t c)
     return (float *)malloc(a * b * c * sizeof(float));
 }
 
-/* Write OUT: PFM with its channels, or a 16-bit PGM with the channel planes stacked. */
+/* Write OUT: PFM with its channels, or a 16-bit PGM with the channel planes stacked (NoData code 0,
+ * the range in its header: hfvis_pgm_range_save). */
 static int cli_save(const cli_args *a, const float *px, int w, int h, int channels, double lo,
                     double hi)
 {
@@ -1730,7 +1731,7 @@ static int cli_save(const cli_args *a, const float *px, int w, int h, int channe
     } else {
         if (a->has_range) { lo = a->range_lo; hi = a->range_hi; }
         if (channels == 1) {
-            s = hfvis_pgm_save(a->out, px, w, h, w, (float)lo, (float)hi, 65535);
+            s = hfvis_pgm_range_save(a->out, px, w, h, w, (float)lo, (float)hi);
         } else {
             size_t n = (size_t)w * (size_t)h, i;
             int c;
@@ -1739,7 +1740,7 @@ static int cli_save(const cli_args *a, const float *px, int w, int h, int channe
             for (c = 0; c < channels; c++)
                 for (i = 0; i < n; i++) planes[(size_t)c * n + i] = px[i * (size_t)channels + (size_t)c];
             if ((long long)h * channels > INT_MAX) s = HFVIS_ERR_LIMIT;
-            else s = hfvis_pgm_save(a->out, planes, w, h * channels, w, (float)lo, (float)hi, 65535);
+            else s = hfvis_pgm_range_save(a->out, planes, w, h * channels, w, (float)lo, (float)hi);
             free(planes);
         }
     }

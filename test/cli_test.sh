@@ -158,7 +158,7 @@ expect_bytes "skyview flat = 1" "$dir/f.pgm" 2 "ff ff"
 expect_ok "shadow flat, sun up" "$dir/fs.pgm" shadow "$f" --sun-azimuth 270 --sun-elevation 30 -o "$dir/fs.pgm"
 expect_bytes "shadow flat, sun up = 1" "$dir/fs.pgm" 2 "ff ff"
 expect_ok "shadow flat, sun down" "$dir/fd.pgm" shadow "$f" --sun-azimuth 270 --sun-elevation -10 -o "$dir/fd.pgm"
-expect_bytes "shadow flat, sun in the west below the horizon = 0" "$dir/fd.pgm" 2 "00 00"
+expect_bytes "shadow flat, sun in the west below the horizon = 0 (code 1)" "$dir/fd.pgm" 2 "00 01"
 expect_ok "normals flat" "$dir/fn.pfm" normals "$f" --zscale 3 -o "$dir/fn.pfm"
 expect_bytes "normals flat: z = 1" "$dir/fn.pfm" 4 "00 00 80 3f"
 # horizon, --dirs 4 --degrees --convention grid: plane 0 looks east, so (6, 0) sees flat ground
@@ -608,6 +608,17 @@ expect_stdout "viewshed --target hidden" "target 12200,0 (column 122, row 0): hi
 expect_stdout "viewshed --target outside" "target 99999,0 (column -1, row -1): outside the grid"
 expect_ok "viewshed --curvature --refraction 0" "$dir/vc00.pfm" viewshed "$dir/line.pgm" --cell 100 --observer 0,0 --observer-height 10 --curvature --refraction 0 --exact -o "$dir/vc00.pfm"
 expect_floats "viewshed --curvature (k = 0): horizon after column 113" "$dir/vc00.pfm" 752 0 1 1 0 0
+
+# PGM outputs: code 0 is NoData, 1..65535 the range, recorded in the header comment.
+expect_ok "skyview PGM with a hole" "$dir/nd.pgm" skyview "$dir/flat7.pgm" --nodata 7 -o "$dir/nd.pgm"
+[ "$(head -c 3 "$dir/nd.pgm" | od -An -c | tr -d ' ')" = 'P5\n' ] &&
+  sed -n 2p "$dir/nd.pgm" | grep -qx '# hfvis range 0.00000000e+00 1.00000000e+00 nodata 0' &&
+  ok "PGM range comment" || bad "PGM range comment: $(head -c 80 "$dir/nd.pgm" | tr '\n' '|')"
+size=$(wc -c < "$dir/nd.pgm" | tr -d ' ')
+first=$(od -An -tx1 -j $((size - 96)) -N 4 "$dir/nd.pgm" | tr -s ' ' | sed 's/^ //; s/ $//')
+[ "$first" = "00 00 ff ff" ] && ok "PGM: NoData is code 0, SVF 1 is 65535" || bad "PGM NoData codes: '$first'"
+expect_ok "horizon PGM --degrees south: -90 deg is code 1, not NoData" "$dir/hd.pgm" horizon "$f" --azimuth 180 --degrees -o "$dir/hd.pgm"
+expect_bytes "horizon PGM: the open border (-90) is code 1" "$dir/hd.pgm" 2 "00 01"
 
 # Never destroy an input: the same file through a hard link or a symbolic link is refused.
 cp "$h" "$dir/in.pgm"; cp "$h" "$dir/in_copy.pgm"
