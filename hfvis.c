@@ -2,13 +2,14 @@
  *
  * Contents
  *   1. Common: status strings, allocation, checked sizes, PRNG
- *   2. Codecs: PGM (P2/P5) and PFM (Pf/PF) in memory, file wrappers
+ *   2. Codecs: PGM (P2/P5) and PFM (Pf/PF) in memory, file wrappers; the NoData-safe PGM with
+ *      its range comment
  *   3. Analytic test fields (spec heightfield §12)
  *   4. Bilinear sampling and normals ([P1] §4, §7 "quad sum"; spec §3.2, §5.1)
  *   5. The sweep lattice ([P1] §4, Fig. 2; spec §3.2)
  *   6. The P1 hull stack along one line ([P1] §5 Alg. 1, App. A.1; spec §4)
  *   7. The sweep driver: sampled lattice, four-way symmetry, borders, gather (spec §3.3-3.6)
- *   8. Horizon outputs and the ray-march oracles (spec §6)
+ *   8. Horizon outputs and the ray-march oracles (spec §6); topographic openness (Yokoyama 2002)
  *   9. Light: uniform sky ([P1] Eq. 4-5), sky-view factor, sun visibility
  *  10. Environment light: prefix integrals and the L_p table ([P1] Eq. 6-7; spec §5.4),
  *      the hemisphere-integration oracle
@@ -2079,9 +2080,10 @@ static double hf_surface_height(const hf_surface *S, double x, double y)
 }
 
 /* Per-receiver march (spec §6 item 1; P2's "naive method"): samples at p + s*step*l,
- * s = 1, 2, ..., while inside the grid (plus the border reach), keeping the largest slope. */
+ * s = 1, 2, ..., while inside the grid (plus the border reach), keeping the largest slope; sign
+ * -1 takes the slopes of the inverted surface -z (negative openness). */
 static double hf_march_tan(const hf_surface *S, double px, double py, double h0, double lx,
-                           double ly, double step, double max_dist)
+                           double ly, double step, double max_dist, double sign)
 {
     double best = -HF_INF, xmin = -S->reach - HF_LATTICE_EPS, ymin = xmin;
     double xmax = (double)(S->width - 1) + S->reach + HF_LATTICE_EPS;
@@ -2096,7 +2098,7 @@ static double hf_march_tan(const hf_surface *S, double px, double py, double h0,
         y = y < 0.0 && y > -HF_LATTICE_EPS ? 0.0 : y;
         h = hf_surface_height(S, x, y);
         if (!isfinite(h)) continue;
-        t = (h - h0) * inv / d;
+        t = (sign > 0.0 ? h - h0 : h0 - h) * inv / d;
         if (t > best) best = t;
     }
     return best;
@@ -2120,7 +2122,7 @@ static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0
                 continue;
             }
             hf_sweep_vector(azimuth0 + 2.0 * HF_PI * (double)k / (double)K, &ux, &uy);
-            t = hf_march_tan(S, px, py, h0, -ux, -uy, step, maxd);
+            t = hf_march_tan(S, px, py, h0, -ux, -uy, step, maxd, 1.0);
             out[i * (size_t)K + (size_t)k] = (float)hf_tan_to_elevation(t);
         }
     }
@@ -2171,6 +2173,93 @@ hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user, int widt
     S.cell_size = cell_size;
     S.border = HFVIS_BORDER_OPEN;
     return hf_reference_run(&S, K, opts ? opts->azimuth0_rad : 0.0, march, points, count, out);
+}
+
+/* Topographic openness (Yokoyama, Shirasawa & Pike 2002): the mean zenith angle pi/2 - beta_k
+ * of the K skylines. Radius-limited: every receiver marches each direction out to the radius
+ * (hf_march_tan, the oracle's march; sign -1 marches the inverted surface for negative
+ * openness). Unlimited: the exact sweep, one direction at a time (hfvis_horizon_direction), of
+ * the surface or of its negated copy. */
+hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_options *oo,
+                            const hfvis_sweep_options *opts, float *out, ptrdiff_t out_stride)
+{
+    const int W = grid ? grid->width : 0, H = grid ? grid->height : 0;
+    double radius = oo ? oo->radius : 0.0, step = oo && oo->step_cells > 0.0 ? oo->step_cells : 1.0;
+    int negative = oo ? oo->negative : 0, x, y, k;
+    hfvis_sweep_options o;
+    if (hf_check_common(grid, opts) != HFVIS_OK || K < 1 || !out || out_stride < W ||
+        !hf_out_fits(out_stride, H) || !isfinite(radius) || radius < 0.0 || !isfinite(step) ||
+        (oo && !(oo->step_cells >= 0.0)) || (negative != 0 && negative != 1))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    o = hf_opts_resolve(grid, opts);
+    if (radius > 0.0) { /* the march: no allocation */
+        hf_surface S;
+        const double maxd = radius / grid->cell_size;
+        memset(&S, 0, sizeof S);
+        S.g = grid;
+        S.width = W;
+        S.height = H;
+        S.cell_size = grid->cell_size;
+        S.border = o.border;
+        S.reach = o.border == HFVIS_BORDER_OPEN ? 0.0 : (double)o.border_cells;
+        for (y = 0; y < H; y++) {
+            for (x = 0; x < W; x++) {
+                double h0 = (double)grid->z[(ptrdiff_t)y * grid->stride + x], sum = 0.0;
+                if (!isfinite(h0)) {
+                    out[(ptrdiff_t)y * out_stride + x] = (float)HF_NAN;
+                    continue;
+                }
+                for (k = 0; k < K; k++) {
+                    double ux, uy, t;
+                    hf_sweep_vector(o.azimuth0_rad + 2.0 * HF_PI * (double)k / (double)K, &ux, &uy);
+                    t = hf_march_tan(&S, (double)x, (double)y, h0, -ux, -uy, step, maxd,
+                                     negative ? -1.0 : 1.0);
+                    /* the angle as a float, as the horizon outputs (and the sweep path) hold it */
+                    sum += HF_HALF_PI - (double)(float)hf_tan_to_elevation(t);
+                }
+                out[(ptrdiff_t)y * out_stride + x] = (float)(sum / (double)K);
+            }
+            hf_progress(&o, y + 1, H);
+        }
+    } else { /* the sweep: a plane, its sums and (negative) the inverted surface */
+        const size_t n = hf_grid_count(grid);
+        float *plane = (float *)hf_alloc_array(o.alloc, n, sizeof(float));
+        double *sum = (double *)hf_alloc_array(o.alloc, n, sizeof(double));
+        float *inv = negative ? (float *)hf_alloc_array(o.alloc, n, sizeof(float)) : NULL;
+        hfvis_sweep_options quiet = o;
+        hfvis_grid g = *grid;
+        hfvis_status s = HFVIS_OK;
+        size_t i;
+        if (!plane || !sum || (negative && !inv)) {
+            hf_free(o.alloc, inv);
+            hf_free(o.alloc, sum);
+            hf_free(o.alloc, plane);
+            return HFVIS_ERR_OUT_OF_MEMORY;
+        }
+        if (negative) {
+            for (y = 0; y < H; y++)
+                for (x = 0; x < W; x++)
+                    inv[(size_t)y * (size_t)W + (size_t)x] = -grid->z[(ptrdiff_t)y * grid->stride + x];
+            g.z = inv;
+            g.stride = W;
+        }
+        quiet.progress = NULL; /* reported here, once per direction */
+        for (i = 0; i < n; i++) sum[i] = 0.0;
+        for (k = 0; k < K && s == HFVIS_OK; k++) {
+            s = hfvis_horizon_direction(&g, K, k, &quiet, plane, W);
+            for (i = 0; s == HFVIS_OK && i < n; i++) sum[i] += HF_HALF_PI - (double)plane[i];
+            if (s == HFVIS_OK) hf_progress(&o, k + 1, K);
+        }
+        if (s == HFVIS_OK)
+            for (y = 0; y < H; y++)
+                for (x = 0; x < W; x++)
+                    out[(ptrdiff_t)y * out_stride + x] = (float)(sum[(size_t)y * (size_t)W + (size_t)x] / (double)K);
+        hf_free(o.alloc, inv);
+        hf_free(o.alloc, sum);
+        hf_free(o.alloc, plane);
+        return s;
+    }
+    return HFVIS_OK;
 }
 
 /* ========================================================================================== */

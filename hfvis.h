@@ -464,6 +464,38 @@ HFVIS_API hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user
                                                   const float *points, size_t count,
                                                   float *out);
 
+/* Topographic openness (Yokoyama, Shirasawa & Pike 2002, "Visualizing topography by openness",
+ * PE&RS 68(3)). Positive openness: the mean over the K directions psi_k of the zenith angle
+ * pi/2 - beta_k, beta_k the largest elevation angle of the terrain seen from the sample toward
+ * psi_k within the horizontal distance radius. Negative openness: the mean nadir angle
+ * pi/2 + delta_k, delta_k the smallest elevation angle within radius, computed as the positive
+ * openness of -z (bit for bit). Radians in [0, pi]: pi/2 on a plane, more on summits (positive)
+ * and in pits (negative). A direction that meets no terrain (the open border) counts
+ * beta = -pi/2 (use HFVIS_BORDER_CLAMP to extend the edges). NaN at holes. */
+typedef struct hfvis_openness_options {
+    double radius;      /* search distance in world units, >= 0; 0 = unlimited */
+    int negative;       /* 0: positive openness; 1: negative */
+    double step_cells;  /* radius > 0: march step in cells, >= 0; 0 = 1 */
+} hfvis_openness_options;
+
+/* Openness at every grid point, out[y*out_stride + x]. opts: border, border_cells, azimuth0_rad,
+ * alloc and progress; the direction range is not honoured (all K).
+ * radius > 0: the per-receiver march of hfvis_horizon_reference out to the radius, at step_cells
+ *   (so the same bilinear samples as the oracle with max_distance_cells = radius/cell_size),
+ *   O(K*W*H*radius/(cell_size*step_cells)); no allocation; progress once per row.
+ * radius = 0: the exact sweep, hfvis_horizon_direction per direction, O(K*W*H); allocates
+ *   W*H floats and W*H doubles (and W*H floats for negative) plus each sweep's scratch;
+ *   progress once per direction. Both ways each angle is rounded to float (as the horizon
+ *   outputs hold it) and the K of a sample are summed in double, so with axis directions
+ *   (K = 4, azimuth0 0) the sweep equals the march with a radius beyond the grid bit for bit;
+ *   otherwise they differ by the gather tolerance of hfvis_horizon_direction.
+ * Returns HFVIS_ERR_INVALID_ARGUMENT (bad grid, options, K < 1, out NULL, out_stride < width,
+ * negative or non-finite radius or step, negative not 0/1), HFVIS_ERR_OUT_OF_MEMORY or
+ * HFVIS_ERR_LIMIT (the sweep's). */
+HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_options *oo,
+                                      const hfvis_sweep_options *opts, float *out,
+                                      ptrdiff_t out_stride);
+
 /* ========================================================================================== */
 /* hfvis.c - P1 light ([P1] §6 Eq. 3-7; spec heightfield §5)                                  */
 /* ========================================================================================== */

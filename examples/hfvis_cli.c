@@ -194,7 +194,7 @@ enum { OUT_TOTAL, OUT_DIRECT, OUT_INDIRECT };
     "open border) counts beta = -pi/2: use --border clamp to extend the edges. NaN at holes.\n"    \
     "  --radius R        search distance in height units (--cell applies), >= 0 (default 0 =\n"   \
     "                    unlimited: the exact sweep, O(K W H)); R > 0: a bilinear ray march in\n"  \
-    "                    1-cell steps, O(K W H R/cell) (RVT's and SAGA's radius)\n"                \
+    "                    1-cell steps, O(K W H R/cell) (RVT's and SAGA's radius); hfvis_openness\n" \
     "  --negative        negative openness\n"                                                      \
     "  --dirs K          directions (default 8, the paper's)\n"                                     \
     "  --degrees         output in degrees (default radians)\n"                                     \
@@ -384,9 +384,9 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "  --degrees         alpha in degrees\n"
     "  --azimuth A       one direction only, toward azimuth A (the convention's, degrees unless\n"
     "                    --radians): the same as --dirs 1 --azimuth0 A\n"
-    "  --split           one file per direction instead of the stack, named OUT's stem + \"_\" +\n"
-    "                    the direction's azimuth in the convention in degrees, as r.horizon names\n"
-    "                    its maps: hor.pfm -> hor_000.pfm, hor_022_500.pfm (22.5), ...\n"
+    "  --split           one file per direction instead of the stack (as r.horizon writes one\n"
+    "                    map per direction), named OUT's stem + \"_\" + the direction's azimuth in\n"
+    "                    the convention in degrees: hor.pfm -> hor_000.pfm, hor_022_500.pfm (22.5)\n"
     "Planes follow the convention: compass clockwise from azimuth0 (north by default), grass\n"
     "counter-clockwise from azimuth0 (east by default), grid clockwise from east.\n"
     "Default PGM range -1.5707963:1.5707963 (-90:90 with --degrees).\n",
@@ -3180,75 +3180,22 @@ done:
     return rc;
 }
 
-/* openness (Yokoyama et al. 2002): the mean over K directions of the zenith angle
- * pi/2 - beta_k, beta_k the largest elevation angle of the terrain within --radius R (positive
- * openness); negative openness is the same of the inverted surface -z (pi/2 + the smallest
- * elevation angle). R > 0: the per-receiver ray march (hfvis_horizon_reference, 1-cell steps on
- * the bilinear surface, O(W H K R/cell)); R = 0 (unlimited): the exact sweep (hfvis_horizon_direction,
- * O(K W H)). Where a direction meets no terrain at all (the open border) beta = -pi/2. */
+/* openness: hfvis_openness (Yokoyama et al. 2002), in radians or, with --degrees, degrees. */
 static int cli_run_openness(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
                             cli_progress_state *prog, float *out)
 {
-    enum { ROWS = 16 }; /* receiver rows per ray-march batch */
-    const int w = grid->width, h = grid->height, K = a->dirs;
-    const size_t n = (size_t)w * (size_t)h;
-    const double to_out = a->degrees ? 180.0 / CLI_PI : 1.0;
-    hfvis_grid g = *grid;
-    float *zneg = NULL, *buf = NULL, *pts = NULL;
-    double *acc = (double *)calloc(n, sizeof(double));
-    hfvis_status s = HFVIS_OK;
-    size_t i;
-    int k, y, rc = 0;
-    if (!acc) return cli_status("openness", HFVIS_ERR_OUT_OF_MEMORY, 0);
-    if (a->negative) { /* negative openness = positive openness of -z */
-        int x;
-        zneg = cli_alloc(n, 1, 1);
-        if (!zneg) { rc = cli_status("openness", HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
-        for (y = 0; y < h; y++)
-            for (x = 0; x < w; x++) zneg[(size_t)y * (size_t)w + (size_t)x] = -grid->z[(size_t)y * (size_t)grid->stride + (size_t)x];
-        g.z = zneg;
-        g.stride = w;
-    }
-    if (a->radius > 0.0) {
-        hfvis_march_options m;
-        memset(&m, 0, sizeof m);
-        m.step_cells = 1.0;
-        m.max_distance_cells = a->radius / grid->cell_size;
-        buf = cli_alloc((size_t)w * ROWS, (size_t)K, 1);
-        pts = cli_alloc((size_t)w * ROWS, 2, 1);
-        if (!buf || !pts) { rc = cli_status("openness", HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
-        prog->total = h;
-        for (y = 0; s == HFVIS_OK && y < h; y += ROWS) {
-            const int rows = h - y < ROWS ? h - y : ROWS;
-            const size_t count = (size_t)w * (size_t)rows;
-            size_t p;
-            for (p = 0; p < count; p++) {
-                pts[2 * p] = (float)(p % (size_t)w);
-                pts[2 * p + 1] = (float)(y + (int)(p / (size_t)w));
-            }
-            s = hfvis_horizon_reference(&g, K, opts, &m, pts, count, buf);
-            for (p = 0; s == HFVIS_OK && p < count; p++)
-                for (k = 0; k < K; k++)
-                    acc[(size_t)y * (size_t)w + p] += CLI_PI / 2.0 - (double)buf[p * (size_t)K + (size_t)k];
-            if (opts->progress) opts->progress(opts->progress_user, y + rows, h);
-        }
-    } else {
-        buf = cli_alloc(n, 1, 1);
-        if (!buf) { rc = cli_status("openness", HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
-        prog->total = K;
-        for (k = 0; s == HFVIS_OK && k < K; k++) {
-            s = hfvis_horizon_direction(&g, K, k, opts, buf, w);
-            for (i = 0; s == HFVIS_OK && i < n; i++) acc[i] += CLI_PI / 2.0 - (double)buf[i];
-        }
-    }
-    if (s != HFVIS_OK) { rc = cli_status("openness", s, 0); goto done; }
-    for (i = 0; i < n; i++) out[i] = (float)(acc[i] / K * to_out);
-done:
-    free(pts);
-    free(buf);
-    free(zneg);
-    free(acc);
-    return rc;
+    hfvis_openness_options oo;
+    hfvis_status s;
+    size_t i, n = (size_t)grid->width * (size_t)grid->height;
+    memset(&oo, 0, sizeof oo);
+    oo.radius = a->radius;
+    oo.negative = a->negative;
+    prog->total = a->radius > 0.0 ? grid->height : a->dirs; /* rows of the march, or directions */
+    s = hfvis_openness(grid, a->dirs, &oo, opts, out, grid->width);
+    if (s != HFVIS_OK) return cli_status("openness", s, 0);
+    if (a->degrees)
+        for (i = 0; i < n; i++) out[i] = (float)((double)out[i] * (180.0 / CLI_PI));
+    return 0;
 }
 
 /* skyview --svf saga|visible, SAGA's "Sky View Factor" tool (ta_lighting, after Hantzschel et al.
