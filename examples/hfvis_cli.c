@@ -1430,9 +1430,6 @@ static int cli_set(cli_args *a, const char *f, const char *v)
     }
     if (!strcmp(f, "--dirs")) a->has_dirs = 1;
     if (!strcmp(f, "--dirs")) return cli_int(f, v, 1, CLI_MAX_DIRS, "an integer 1..65536", &a->dirs);
-    if (!strcmp(f, "--azimuth0"))
-        return cli_real(f, v, -DBL_MAX, 0, DBL_MAX, "a finite angle in radians", &a->azimuth0);
-    if (!strcmp(f, "--compass")) { a->compass = 1; return 0; }
     if (!strcmp(f, "--degrees")) { a->degrees = 1; return 0; }
     if (!strcmp(f, "--quiet")) { a->quiet = 1; return 0; }
     if (!strcmp(f, "--border")) {
@@ -1484,19 +1481,6 @@ static int cli_set(cli_args *a, const char *f, const char *v)
         return cli_real(f, v, 0.0, 0, 90.0, "degrees in 0..90", &a->sun_radius);
     }
     if (!strcmp(f, "--env")) { a->env = v; return 0; }
-    if (!strcmp(f, "--observer")) {
-        char buf[256];
-        const char *comma = strchr(v, ',');
-        size_t n = comma ? (size_t)(comma - v) : 0;
-        if (!comma || n >= sizeof buf)
-            return cli_error(CLI_EXIT_USAGE, f, "expected X,Y (column,row), got '%s'", v);
-        memcpy(buf, v, n);
-        buf[n] = '\0';
-        if (!cli_parse_real(buf, &a->observer_x) || !cli_parse_real(comma + 1, &a->observer_y))
-            return cli_error(CLI_EXIT_USAGE, f, "expected X,Y (column,row), got '%s'", v);
-        a->has_observer = 1;
-        return 0;
-    }
     if (!strcmp(f, "--observer-height"))
         return cli_real(f, v, 0.0, 0, DBL_MAX, "a height >= 0", &a->observer_height);
     if (!strcmp(f, "--target-height"))
