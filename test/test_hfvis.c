@@ -1661,6 +1661,25 @@ TEST(openness_closed_forms_and_oracle)
     /* K = 4 unlimited on the valley floor: 90 - 90/4 degrees */
     CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, &o, out, W), HFVIS_OK);
     CHECK_NEAR(out[20 * W + 20], half_pi - half_pi / 4.0, OPEN_TOL, 0.0);
+    /* a cone pit z = 0.5 r around (20, 20): along the axes every sample rises at tan = 0.5 from the
+     * apex, so positive openness pi/2 - atan(0.5) and negative pi/2 + atan(0.5) (no terrain
+     * lies below the apex), both ways */
+    f.kind = HFVIS_FIELD_CONE;
+    f.x0 = 20.0;
+    f.y0 = 20.0;
+    f.slope = 0.5;
+    CHECK_EQ_STATUS(hfvis_field_generate(&f, W, H, W, z), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, &o, out, W), HFVIS_OK);
+    CHECK_NEAR(out[20 * W + 20], half_pi - atan(0.5), OPEN_TOL, 0.0);
+    oo.radius = 6.0;
+    CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, &o, out, W), HFVIS_OK);
+    CHECK_NEAR(out[20 * W + 20], half_pi - atan(0.5), OPEN_TOL, 0.0);
+    oo.negative = 1;
+    CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, &o, out, W), HFVIS_OK);
+    CHECK_NEAR(out[20 * W + 20], half_pi + atan(0.5), OPEN_TOL, 0.0);
+    oo.negative = 0;
+    oo.radius = 0.0;
+    f.y0 = 0.0;
     /* the radius: a 10-high wall 10 cells east of (20, 20) counts within 15 cells, not within 5
      * (clamped borders keep the other directions level) */
     f.kind = HFVIS_FIELD_STEP;
