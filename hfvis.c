@@ -2,13 +2,14 @@
  *
  * Contents
  *   1. Common: status strings, allocation, checked sizes, PRNG
- *   2. Codecs: PGM (P2/P5) and PFM (Pf/PF) in memory, file wrappers
+ *   2. Codecs: PGM (P2/P5) and PFM (Pf/PF) in memory, file wrappers; the NoData-safe PGM with
+ *      its range comment
  *   3. Analytic test fields (spec heightfield §12)
  *   4. Bilinear sampling and normals ([P1] §4, §7 "quad sum"; spec §3.2, §5.1)
  *   5. The sweep lattice ([P1] §4, Fig. 2; spec §3.2)
  *   6. The P1 hull stack along one line ([P1] §5 Alg. 1, App. A.1; spec §4)
  *   7. The sweep driver: sampled lattice, four-way symmetry, borders, gather (spec §3.3-3.6)
- *   8. Horizon outputs and the ray-march oracles (spec §6)
+ *   8. Horizon outputs and the ray-march oracles (spec §6); topographic openness (Yokoyama 2002)
  *   9. Light: uniform sky ([P1] Eq. 4-5), sky-view factor, sun visibility
  *  10. Environment light: prefix integrals and the L_p table ([P1] Eq. 6-7; spec §5.4),
  *      the hemisphere-integration oracle
@@ -556,6 +557,154 @@ HFVIS_API hfvis_status hfvis_pgm_encode(const float *pixels, int width, int heig
     return HFVIS_OK;
 }
 
+/* NoData-safe PGM with its range (hfvis.h): a 16-bit P5 whose code 0 is NoData and whose codes
+ * 1..65535 map [lo, hi], with the comment "# hfvis range LO HI nodata 0" after the magic. LO and HI
+ * are written with 9 significant digits, which any float survives (2^-24 relative spacing against
+ * a quantum of 1e-8), without stdio (the codecs work under HFVIS_NO_STDIO). */
+#define HF_PGM_RANGE_TEXT_MAX 64 /* "# hfvis range " + 2 x 15 + " nodata 0\n" */
+
+/* "d.dddddddde+xx" of a finite float into buf; returns the length (at most 15). */
+static size_t hf_img_float_text(float f, unsigned char *buf)
+{
+    double v = (double)f, m;
+    unsigned long digits;
+    size_t len = 0;
+    int e, k;
+    if (v < 0.0) buf[len++] = '-', v = -v;
+    if (v == 0.0) {
+        e = 0, digits = 0;
+    } else {
+        e = (int)floor(log10(v));
+        m = v / pow(10.0, (double)e); /* [1, 10) up to the rounding of log10 and pow */
+        digits = (unsigned long)floor(m * 1e8 + 0.5);
+        if (digits >= 1000000000ul) digits = (digits + 5) / 10, e++;
+        if (digits < 100000000ul) digits = (unsigned long)floor(v / pow(10.0, (double)(e - 1)) * 1e8 + 0.5), e--;
+    }
+    for (k = 8; k >= 0; k--) { /* nine digits, a point after the first */
+        unsigned long p = 1;
+        int q;
+        for (q = 0; q < k; q++) p *= 10;
+        buf[len++] = (unsigned char)('0' + (digits / p) % 10);
+        if (k == 8) buf[len++] = '.';
+    }
+    buf[len++] = 'e';
+    buf[len++] = (unsigned char)(e < 0 ? '-' : '+');
+    if (e < 0) e = -e;
+    buf[len++] = (unsigned char)('0' + e / 10);
+    buf[len++] = (unsigned char)('0' + e % 10);
+    return len;
+}
+
+/* The comment line for [lo, hi]; returns its length. */
+static size_t hf_pgm_range_text(float lo, float hi, unsigned char *buf)
+{
+    size_t len = 14;
+    memcpy(buf, "# hfvis range ", 14);
+    len += hf_img_float_text(lo, buf + len);
+    buf[len++] = ' ';
+    len += hf_img_float_text(hi, buf + len);
+    memcpy(buf + len, " nodata 0\n", 10);
+    return len + 10;
+}
+
+HFVIS_API size_t hfvis_pgm_range_encode_size(int width, int height, float lo, float hi)
+{
+    unsigned char text[HF_PGM_RANGE_TEXT_MAX];
+    size_t base = hfvis_pgm_encode_size(width, height, 65535);
+    size_t extra = isfinite(lo) && isfinite(hi) && lo < hi ? hf_pgm_range_text(lo, hi, text) : 0;
+    if (base == 0 || extra == 0 || base > SIZE_MAX - extra) return 0;
+    return base + extra;
+}
+
+HFVIS_API hfvis_status hfvis_pgm_range_encode(const float *pixels, int width, int height,
+                                              ptrdiff_t stride, float lo, float hi, void *out,
+                                              size_t out_capacity, size_t *written)
+{
+    unsigned char text[HF_PGM_RANGE_TEXT_MAX], *dst = (unsigned char *)out;
+    size_t need = hfvis_pgm_range_encode_size(width, height, lo, hi), tlen;
+    double dlo = (double)lo, range = (double)hi - (double)lo;
+    int x, y;
+    if (!pixels || !out || !written || need == 0 || !hf_img_stride_ok(width, height, 1, stride))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (out_capacity < need) return HFVIS_ERR_BUFFER_TOO_SMALL;
+    tlen = hf_pgm_range_text(lo, hi, text);
+    memcpy(dst, "P5\n", 3);
+    memcpy(dst + 3, text, tlen);
+    dst += 3 + tlen;
+    {
+        unsigned char head[HF_IMG_HEADER_MAX];
+        size_t hl = hf_img_header_text(head, width, height, 1, 65535);
+        memcpy(dst, head + 3, hl - 3); /* without its "P5\n" */
+        dst += hl - 3;
+    }
+    for (y = 0; y < height; y++) {
+        const float *src = pixels + (ptrdiff_t)y * stride;
+        for (x = 0; x < width; x++) {
+            double t = ((double)src[x] - dlo) / range * (double)HFVIS_PGM_RANGE_CODES;
+            unsigned q;
+            if (!isfinite(src[x])) q = HFVIS_PGM_NODATA_CODE;
+            else if (!(t > 0.0)) q = 1;
+            else if (t >= (double)HFVIS_PGM_RANGE_CODES) q = 65535;
+            else q = 1u + (unsigned)floor(t + 0.5);
+            *dst++ = (unsigned char)(q >> 8);
+            *dst++ = (unsigned char)(q & 0xffu);
+        }
+    }
+    *written = need;
+    return HFVIS_OK;
+}
+
+HFVIS_API hfvis_status hfvis_pgm_range_read(const void *data, size_t size, float *lo, float *hi)
+{
+    const unsigned char *p = (const unsigned char *)data;
+    hf_img_header h;
+    size_t i = 2;
+    hfvis_status s;
+    if (!data || !lo || !hi) return HFVIS_ERR_INVALID_ARGUMENT;
+    s = hf_img_parse(p, size, &h);
+    if (s != HFVIS_OK) return s;
+    if (h.info.format != HFVIS_FORMAT_PGM) return HFVIS_ERR_FORMAT;
+    while (i < h.data_offset) { /* each comment of the header */
+        size_t end = i, j;
+        double a, b;
+        if (p[i] != '#') { i++; continue; }
+        while (end < h.data_offset && p[end] != '\n' && p[end] != '\r') end++;
+        j = i + 13;
+        if (end - i > 14 && !memcmp(p + i, "# hfvis range", 13) && hf_img_scale(p, end, &j, &a) &&
+            hf_img_scale(p, end, &j, &b) && end - j >= 9 && !memcmp(p + j, " nodata 0", 9) &&
+            isfinite(a) && isfinite(b) && fabs(a) <= (double)FLT_MAX && fabs(b) <= (double)FLT_MAX &&
+            (float)a < (float)b) {
+            *lo = (float)a;
+            *hi = (float)b;
+            return HFVIS_OK;
+        }
+        i = end;
+    }
+    return HFVIS_ERR_FORMAT;
+}
+
+HFVIS_API hfvis_status hfvis_pgm_range_decode(const void *data, size_t size, float *out,
+                                              size_t out_count, hfvis_image_info *info)
+{
+    hfvis_image_info inf;
+    float lo, hi;
+    size_t i, n;
+    hfvis_status s = hfvis_pgm_range_read(data, size, &lo, &hi);
+    if (s != HFVIS_OK) return s;
+    if (!out) return HFVIS_ERR_INVALID_ARGUMENT;
+    s = hfvis_image_decode(data, size, out, out_count, &inf);
+    if (s != HFVIS_OK) return s;
+    n = (size_t)inf.width * (size_t)inf.height;
+    for (i = 0; i < n; i++) {
+        double code = (double)out[i];
+        out[i] = code == (double)HFVIS_PGM_NODATA_CODE ? (float)HF_NAN
+                 : (float)((double)lo + (code - 1.0) * ((double)hi - (double)lo) /
+                                           (double)HFVIS_PGM_RANGE_CODES);
+    }
+    if (info) *info = inf;
+    return HFVIS_OK;
+}
+
 #ifndef HFVIS_NO_STDIO
 /* A regular file's size from fseek/ftell is only a first guess for the buffer: special files
  * (pipes, /proc, directories on some file systems) report 0, fail, or report absurd sizes, so
@@ -733,6 +882,21 @@ HFVIS_API hfvis_status hfvis_pgm_save(const char *path, const float *pixels, int
     buf = (unsigned char *)hf_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_pgm_encode(pixels, width, height, stride, lo, hi, maxval, buf, need, &written);
+    if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
+    hf_free(NULL, buf);
+    return s;
+}
+HFVIS_API hfvis_status hfvis_pgm_range_save(const char *path, const float *pixels, int width,
+                                            int height, ptrdiff_t stride, float lo, float hi)
+{
+    size_t need = hfvis_pgm_range_encode_size(width, height, lo, hi), written = 0;
+    unsigned char *buf;
+    hfvis_status s;
+    if (!path || !pixels || need == 0 || !hf_img_stride_ok(width, height, 1, stride))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    buf = (unsigned char *)hf_alloc(NULL, need);
+    if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
+    s = hfvis_pgm_range_encode(pixels, width, height, stride, lo, hi, buf, need, &written);
     if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
     hf_free(NULL, buf);
     return s;
@@ -2073,9 +2237,10 @@ static double hf_surface_height(const hf_surface *S, double x, double y)
 }
 
 /* Per-receiver march (spec §6 item 1; P2's "naive method"): samples at p + s*step*l,
- * s = 1, 2, ..., while inside the grid (plus the border reach), keeping the largest slope. */
+ * s = 1, 2, ..., while inside the grid (plus the border reach), keeping the largest slope; sign
+ * -1 takes the slopes of the inverted surface -z (negative openness). */
 static double hf_march_tan(const hf_surface *S, double px, double py, double h0, double lx,
-                           double ly, double step, double max_dist)
+                           double ly, double step, double max_dist, double sign)
 {
     double best = -HF_INF, xmin = -S->reach - HF_LATTICE_EPS, ymin = xmin;
     double xmax = (double)(S->width - 1) + S->reach + HF_LATTICE_EPS;
@@ -2090,7 +2255,7 @@ static double hf_march_tan(const hf_surface *S, double px, double py, double h0,
         y = y < 0.0 && y > -HF_LATTICE_EPS ? 0.0 : y;
         h = hf_surface_height(S, x, y);
         if (!isfinite(h)) continue;
-        t = (h - h0) * inv / d;
+        t = (sign > 0.0 ? h - h0 : h0 - h) * inv / d;
         if (t > best) best = t;
     }
     return best;
@@ -2121,7 +2286,7 @@ static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0
             } else {
                 hf_sweep_vector(azimuth0 + 2.0 * HF_PI * (double)k / (double)K, &ux, &uy);
             }
-            t = hf_march_tan(S, px, py, h0, -ux, -uy, step, maxd);
+            t = hf_march_tan(S, px, py, h0, -ux, -uy, step, maxd, 1.0);
             out[i * (size_t)K + (size_t)k] = (float)hf_tan_to_elevation(t);
         }
     }
@@ -2175,6 +2340,93 @@ hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user, int widt
     return hf_reference_run(&S, K, opts ? opts->azimuth0_rad : 0.0,
                             opts && opts->rays == HFVIS_RAYS_EXACT ? hf_exact_bound(opts, K) : 0, march,
                             points, count, out);
+}
+
+/* Topographic openness (Yokoyama, Shirasawa & Pike 2002): the mean zenith angle pi/2 - beta_k
+ * of the K skylines. Radius-limited: every receiver marches each direction out to the radius
+ * (hf_march_tan, the oracle's march; sign -1 marches the inverted surface for negative
+ * openness). Unlimited: the exact sweep, one direction at a time (hfvis_horizon_direction), of
+ * the surface or of its negated copy. */
+hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_options *oo,
+                            const hfvis_sweep_options *opts, float *out, ptrdiff_t out_stride)
+{
+    const int W = grid ? grid->width : 0, H = grid ? grid->height : 0;
+    double radius = oo ? oo->radius : 0.0, step = oo && oo->step_cells > 0.0 ? oo->step_cells : 1.0;
+    int negative = oo ? oo->negative : 0, x, y, k;
+    hfvis_sweep_options o;
+    if (hf_check_common(grid, opts) != HFVIS_OK || K < 1 || !out || out_stride < W ||
+        !hf_out_fits(out_stride, H) || !isfinite(radius) || radius < 0.0 || !isfinite(step) ||
+        (oo && !(oo->step_cells >= 0.0)) || (negative != 0 && negative != 1))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    o = hf_opts_resolve(grid, opts);
+    if (radius > 0.0) { /* the march: no allocation */
+        hf_surface S;
+        const double maxd = radius / grid->cell_size;
+        memset(&S, 0, sizeof S);
+        S.g = grid;
+        S.width = W;
+        S.height = H;
+        S.cell_size = grid->cell_size;
+        S.border = o.border;
+        S.reach = o.border == HFVIS_BORDER_OPEN ? 0.0 : (double)o.border_cells;
+        for (y = 0; y < H; y++) {
+            for (x = 0; x < W; x++) {
+                double h0 = (double)grid->z[(ptrdiff_t)y * grid->stride + x], sum = 0.0;
+                if (!isfinite(h0)) {
+                    out[(ptrdiff_t)y * out_stride + x] = (float)HF_NAN;
+                    continue;
+                }
+                for (k = 0; k < K; k++) {
+                    double ux, uy, t;
+                    hf_sweep_vector(o.azimuth0_rad + 2.0 * HF_PI * (double)k / (double)K, &ux, &uy);
+                    t = hf_march_tan(&S, (double)x, (double)y, h0, -ux, -uy, step, maxd,
+                                     negative ? -1.0 : 1.0);
+                    /* the angle as a float, as the horizon outputs (and the sweep path) hold it */
+                    sum += HF_HALF_PI - (double)(float)hf_tan_to_elevation(t);
+                }
+                out[(ptrdiff_t)y * out_stride + x] = (float)(sum / (double)K);
+            }
+            hf_progress(&o, y + 1, H);
+        }
+    } else { /* the sweep: a plane, its sums and (negative) the inverted surface */
+        const size_t n = hf_grid_count(grid);
+        float *plane = (float *)hf_alloc_array(o.alloc, n, sizeof(float));
+        double *sum = (double *)hf_alloc_array(o.alloc, n, sizeof(double));
+        float *inv = negative ? (float *)hf_alloc_array(o.alloc, n, sizeof(float)) : NULL;
+        hfvis_sweep_options quiet = o;
+        hfvis_grid g = *grid;
+        hfvis_status s = HFVIS_OK;
+        size_t i;
+        if (!plane || !sum || (negative && !inv)) {
+            hf_free(o.alloc, inv);
+            hf_free(o.alloc, sum);
+            hf_free(o.alloc, plane);
+            return HFVIS_ERR_OUT_OF_MEMORY;
+        }
+        if (negative) {
+            for (y = 0; y < H; y++)
+                for (x = 0; x < W; x++)
+                    inv[(size_t)y * (size_t)W + (size_t)x] = -grid->z[(ptrdiff_t)y * grid->stride + x];
+            g.z = inv;
+            g.stride = W;
+        }
+        quiet.progress = NULL; /* reported here, once per direction */
+        for (i = 0; i < n; i++) sum[i] = 0.0;
+        for (k = 0; k < K && s == HFVIS_OK; k++) {
+            s = hfvis_horizon_direction(&g, K, k, &quiet, plane, W);
+            for (i = 0; s == HFVIS_OK && i < n; i++) sum[i] += HF_HALF_PI - (double)plane[i];
+            if (s == HFVIS_OK) hf_progress(&o, k + 1, K);
+        }
+        if (s == HFVIS_OK)
+            for (y = 0; y < H; y++)
+                for (x = 0; x < W; x++)
+                    out[(ptrdiff_t)y * out_stride + x] = (float)(sum[(size_t)y * (size_t)W + (size_t)x] / (double)K);
+        hf_free(o.alloc, inv);
+        hf_free(o.alloc, sum);
+        hf_free(o.alloc, plane);
+        return s;
+    }
+    return HFVIS_OK;
 }
 
 /* ========================================================================================== */

@@ -318,6 +318,31 @@ HFVIS_API hfvis_status hfvis_pgm_save(const char *path, const float *pixels, int
                                       int height, ptrdiff_t stride, float lo, float hi,
                                       int maxval);
 
+/* NoData-safe PGM with its value range (the hfvis tool writes its PGM outputs so): a 16-bit binary
+ * PGM whose code HFVIS_PGM_NODATA_CODE (0) marks NoData (every non-finite value) and whose codes
+ * 1..65535 map [lo, hi] linearly, code = 1 + round((v - lo)/(hi - lo) * 65534) clamped to
+ * [1, 65535]. The header carries the comment "# hfvis range LO HI nodata 0" right after "P5"
+ * (LO, HI with 9 significant digits: the floats given, exactly), so any pgm(5) reader reads the
+ * file and hfvis_pgm_range_decode maps the codes back, v = lo + (code - 1)(hi - lo)/65534 (within
+ * (hi - lo)/131068 of the value written), NaN for code 0. Requires finite lo < hi.
+ * encode_size: the bytes of such a file (0 for invalid sizes or range). */
+#define HFVIS_PGM_NODATA_CODE 0
+#define HFVIS_PGM_RANGE_CODES 65534 /* codes 1..65535 span [lo, hi] */
+HFVIS_API size_t hfvis_pgm_range_encode_size(int width, int height, float lo, float hi);
+HFVIS_API hfvis_status hfvis_pgm_range_encode(const float *pixels, int width, int height,
+                                              ptrdiff_t stride, float lo, float hi, void *out,
+                                              size_t out_capacity, size_t *written);
+HFVIS_API hfvis_status hfvis_pgm_range_save(const char *path, const float *pixels, int width,
+                                            int height, ptrdiff_t stride, float lo, float hi);
+/* The range of a PGM in memory from its "# hfvis range" comment. Returns the decoder's errors, or
+ * HFVIS_ERR_FORMAT for a PFM or a PGM without the comment (a plain PGM, or one the hfvis tool wrote
+ * before 0.2: codes 0..65535 spanned the range and NoData was 0). */
+HFVIS_API hfvis_status hfvis_pgm_range_read(const void *data, size_t size, float *lo, float *hi);
+/* Decode such a PGM to values (as above; NaN for NoData): out holds width*height floats
+ * (out_count); info may be NULL. Errors as hfvis_pgm_range_read and hfvis_image_decode. */
+HFVIS_API hfvis_status hfvis_pgm_range_decode(const void *data, size_t size, float *out,
+                                              size_t out_count, hfvis_image_info *info);
+
 /* ========================================================================================== */
 /* hfvis.c - analytic test fields (spec heightfield §12)                                      */
 /* ========================================================================================== */
@@ -539,6 +564,38 @@ HFVIS_API hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user
                                                   const hfvis_march_options *march,
                                                   const float *points, size_t count,
                                                   float *out);
+
+/* Topographic openness (Yokoyama, Shirasawa & Pike 2002, "Visualizing topography by openness",
+ * PE&RS 68(3)). Positive openness: the mean over the K directions psi_k of the zenith angle
+ * pi/2 - beta_k, beta_k the largest elevation angle of the terrain seen from the sample toward
+ * psi_k within the horizontal distance radius. Negative openness: the mean nadir angle
+ * pi/2 + delta_k, delta_k the smallest elevation angle within radius, computed as the positive
+ * openness of -z (bit for bit). Radians in [0, pi]: pi/2 on a plane, more on summits (positive)
+ * and in pits (negative). A direction that meets no terrain (the open border) counts
+ * beta = -pi/2 (use HFVIS_BORDER_CLAMP to extend the edges). NaN at holes. */
+typedef struct hfvis_openness_options {
+    double radius;      /* search distance in world units, >= 0; 0 = unlimited */
+    int negative;       /* 0: positive openness; 1: negative */
+    double step_cells;  /* radius > 0: march step in cells, >= 0; 0 = 1 */
+} hfvis_openness_options;
+
+/* Openness at every grid point, out[y*out_stride + x]. opts: border, border_cells, azimuth0_rad,
+ * alloc and progress; the direction range is not honoured (all K).
+ * radius > 0: the per-receiver march of hfvis_horizon_reference out to the radius, at step_cells
+ *   (so the same bilinear samples as the oracle with max_distance_cells = radius/cell_size),
+ *   O(K*W*H*radius/(cell_size*step_cells)); no allocation; progress once per row.
+ * radius = 0: the exact sweep, hfvis_horizon_direction per direction, O(K*W*H); allocates
+ *   W*H floats and W*H doubles (and W*H floats for negative) plus each sweep's scratch;
+ *   progress once per direction. Both ways each angle is rounded to float (as the horizon
+ *   outputs hold it) and the K of a sample are summed in double, so with axis directions
+ *   (K = 4, azimuth0 0) the sweep equals the march with a radius beyond the grid bit for bit;
+ *   otherwise they differ by the gather tolerance of hfvis_horizon_direction.
+ * Returns HFVIS_ERR_INVALID_ARGUMENT (bad grid, options, K < 1, out NULL, out_stride < width,
+ * negative or non-finite radius or step, negative not 0/1), HFVIS_ERR_OUT_OF_MEMORY or
+ * HFVIS_ERR_LIMIT (the sweep's). */
+HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_options *oo,
+                                      const hfvis_sweep_options *opts, float *out,
+                                      ptrdiff_t out_stride);
 
 /* ========================================================================================== */
 /* hfvis.c - exact rays (beyond [P1])                                                         */

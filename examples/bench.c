@@ -98,6 +98,19 @@ static void bench_others(int n)
     if ((s = hfvis_sky_view_factor(&g, K, NULL, out, n)) != HFVIS_OK) die("svf", s);
     t_fast = (bench_now() - t0) * 1e9 / ((double)cells * (double)K);
     printf("%-44s %9.2f ns %9.0f ns %8.0fx\n", "sky-view factor K=16 vs ray march, /rd", t_fast, t_slow, t_slow / t_fast);
+    {   /* openness K = 8: the unlimited sweep beside the march limited to 32 cells (RVT-like) */
+        hfvis_openness_options oo;
+        memset(&oo, 0, sizeof oo);
+        t0 = bench_now();
+        if ((s = hfvis_openness(&g, 8, &oo, NULL, out, n)) != HFVIS_OK) die("openness", s);
+        t_fast = (bench_now() - t0) * 1e9 / ((double)cells * 8.0);
+        oo.radius = 32.0;
+        t0 = bench_now();
+        if ((s = hfvis_openness(&g, 8, &oo, NULL, out, n)) != HFVIS_OK) die("openness radius", s);
+        t_slow = (bench_now() - t0) * 1e9 / ((double)cells * 8.0);
+        printf("%-44s %9.2f ns %9.0f ns %8.1fx\n", "openness K=8 unlimited vs R=32 march, /rd", t_fast, t_slow,
+               t_slow / t_fast);
+    }
     t0 = bench_now();
     if ((s = hfvis_sun_visibility(&g, 0.7, 0.3, 0.0046, NULL, out, n)) != HFVIS_OK) die("sun", s);
     t_fast = (bench_now() - t0) * 1e9 / (double)cells;

@@ -15,9 +15,11 @@
 #include <stdlib.h>
 #include <string.h>
 #if defined(__unix__) || (defined(__APPLE__) && defined(__MACH__))
+#include <sys/stat.h> /* stat(): an output that is an input */
 #include <unistd.h>
 #define CLI_HAVE_ISATTY 1
 #endif
+#include <time.h>
 #include "common.h"
 
 #define CLI_PI 3.14159265358979323846
@@ -25,16 +27,18 @@
 #define CLI_MAX_DIRS 65536                        /* --dirs upper bound */
 #define CLI_HORIZON_MAX_VALUES HFVIS_IMAGE_MAX_VALUES /* K*W*H limit of `horizon` (2^28 floats, 1 GiB) */
 #define CLI_MAX_BOUNCES 1000                      /* --bounces upper bound (one sweep each) */
+#define CLI_MAX_TARGETS 64                        /* viewshed --target points per run */
 #define CLI_EXIT_ERROR 1
 #define CLI_EXIT_USAGE 2
 #define CLI_RUN (-1)                              /* parse_args: go on and run the command */
 
 enum { CMD_HORIZON, CMD_SKYVIEW, CMD_SKY, CMD_SHADOW, CMD_LIGHT, CMD_NORMALS, CMD_INDIRECT,
        CMD_VISIBILITY, CMD_VIEWSHED, CMD_VOXELIZE, CMD_GI, CMD_SSAO, CMD_VOLGI, CMD_VISFIELD, CMD_MESHAO,
-       CMD_SUM, CMD_COUNT };
+       CMD_HILLSHADE, CMD_OPENNESS, CMD_SUM, CMD_COUNT };
 static const char *const cli_cmd_names[CMD_COUNT] = {
     "horizon", "skyview", "sky", "shadow", "light", "normals", "indirect", "visibility",
-    "viewshed", "voxelize", "gi", "ssao", "volgi", "visfield", "meshao", "sum"
+    "viewshed", "voxelize", "gi", "ssao", "volgi", "visfield", "meshao", "hillshade", "openness",
+    "sum"
 };
 
 /* voxelize --mode, --axis, --method */
@@ -92,7 +96,7 @@ enum { OUT_TOTAL, OUT_DIRECT, OUT_INDIRECT };
 #define CLI_VOLGI_FLAGS                                                                      \
     { "--room", 0, CLI_ONLY(CMD_VOLGI) }, { "--iterations", 1, CLI_ONLY(CMD_VOLGI) },        \
     { "--light", 1, CLI_ONLY(CMD_VOLGI) }, { "--eye", 1, CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO) },              \
-    { "--target", 1, CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO) }, { "--up", 1, CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO) },              \
+    { "--target", 1, CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO) | CLI_ONLY(CMD_VIEWSHED) }, { "--up", 1, CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO) },              \
     { "--fov", 1, CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO) }, { "--size", 1, CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_MESHAO) },               \
     { "--transfer", 1, CLI_ONLY(CMD_VOLGI) }, { "--paths", 1, CLI_ONLY(CMD_VOLGI) },         \
     { "--reflection", 1, CLI_ONLY(CMD_VOLGI) }, { "--reflectance", 1, CLI_ONLY(CMD_VOLGI) }
@@ -171,6 +175,36 @@ enum { OUT_TOTAL, OUT_DIRECT, OUT_INDIRECT };
     "  --stats           print the counts of the run (receivers, rays, culling) to stdout\n"       \
     "OUT is .pgm (16-bit, range 0:1; pixels without geometry 0) or .pfm (NaN there).\n"
 
+#define CLI_HILLSHADE_HELP                                                                           \
+    "usage: hfvis hillshade IN -o OUT [--sun-azimuth A] [--sun-elevation E] [--sun-radius R]\n"    \
+    "         [--blend N] [--no-shadows] [options]\n"                                              \
+    "Shaded relief with cast shadows: H = (1/N) sum_j max(n . l_j, 0) V_j, n the grid normal, l_j\n" \
+    "the direction of sun j and V_j its visibility from the exact sweep toward it (0 in shadow,\n" \
+    "1 lit; with --sun-radius the visible fraction of the sun disc: soft shadows). In [0, 1];\n"   \
+    "without shadows it is the classic hillshade cos(zenith) cos(slope) + sin(zenith) sin(slope)\n" \
+    "cos(azimuth - aspect) (gdaldem hillshade / 255). NaN at holes. Default PGM range 0:1.\n"     \
+    "  --sun-azimuth A   azimuth of the sun in the --convention (default 315: north-west)\n"       \
+    "  --sun-elevation E elevation of the sun, -90..90 (default 45)\n"                            \
+    "  --sun-radius R    angular radius of the sun disc, 0..90 (default 0; the real sun 0.27)\n"  \
+    "  --blend N         multi-directional: N suns at A + 360 j/N, averaged (default 1)\n"         \
+    "  --no-shadows      V_j = 1: the local hillshade only\n"
+
+#define CLI_OPENNESS_HELP                                                                            \
+    "usage: hfvis openness IN -o OUT [--radius R] [--negative] [--dirs K] [--degrees] [options]\n" \
+    "Topographic openness (Yokoyama, Shirasawa & Pike 2002): the mean over K directions of the\n"  \
+    "zenith angle pi/2 - beta_k, beta_k the largest elevation angle of the terrain within the\n"   \
+    "horizontal distance R (positive openness); --negative: the mean nadir angle pi/2 + delta_k,\n" \
+    "delta_k the smallest elevation angle within R (the positive openness of -z). pi/2 on a plane,\n" \
+    "larger on summits (positive) and in pits (negative). A direction that meets no terrain (the\n" \
+    "open border) counts beta = -pi/2: use --border clamp to extend the edges. NaN at holes.\n"    \
+    "  --radius R        search distance in height units (--cell applies), >= 0 (default 0 =\n"   \
+    "                    unlimited: the exact sweep, O(K W H)); R > 0: a bilinear ray march in\n"  \
+    "                    1-cell steps, O(K W H R/cell) (RVT's and SAGA's radius); hfvis_openness\n" \
+    "  --negative        negative openness\n"                                                      \
+    "  --dirs K          directions (default 8, the paper's)\n"                                     \
+    "  --degrees         output in degrees (default radians)\n"                                     \
+    "Default PGM range 0:pi (0:180 with --degrees).\n"
+
 #define CLI_SUM_HELP                                                                                 \
     "usage: hfvis sum PART.hfvs... -o OUT [--range LO:HI] [--quiet]\n"                              \
     "Add up the partial results of one run split with --dir-range (horizon, skyview, sky, light,\n" \
@@ -182,7 +216,8 @@ enum { OUT_TOTAL, OUT_DIRECT, OUT_INDIRECT };
     "by one ulp. Refused, with nothing written: parts of different commands, inputs, grids or\n"   \
     "parameters, overlapping ranges, and directions that no part holds.\n"                        \
     "  -o OUT            *.pfm or *.pgm, as for the command that made the parts\n"                 \
-    "  --range LO:HI     .pgm only: the values mapped to 0 and 65535\n"
+    "  --range LO:HI     .pgm only: the values mapped to codes 1 and 65535\n"                 \
+    "  --overwrite       allow OUT to be one of the parts\n"
 
 #define CLI_LK_FLAGS                                                                          \
     { "--falloff", 1, CLI_ONLY(CMD_MESHAO) }, { "--two-sided", 0, CLI_ONLY(CMD_MESHAO) },     \
@@ -204,6 +239,12 @@ typedef struct cli_args {
     int has_observer, exact;
     int res, vox_mode, vox_axis, vox_method, max_vertices, open_mesh, out_binvox;
     double padding;
+    /* GIS conventions, map coordinates, hillshade, openness, safety, progress (CLI_GIS_HELP) */
+    int convention, has_convention, radians, has_azimuth0, has_azimuth, split, overwrite;
+    int progress_lines, observer_grid, curvature, svf, blend, negative, no_shadows, ntargets;
+    int has_geotransform, has_radius, has_refraction, has_earth_radius;
+    double azimuth, refraction, earth_radius, radius, targets[2 * CLI_MAX_TARGETS];
+    double geotransform[6]; /* GDAL order; set by a georeferenced input (else cli_georef's default) */
     int order, subsample, has_dirs, has_specular, has_shininess;
     double specular, shininess;
     int ssao_method, ssao_depth, ssao_has_ortho, ssao_has_near, ssao_has_far, ssao_guard;
@@ -243,8 +284,7 @@ enum { SSAO_DEPTH_LINEAR, SSAO_DEPTH_GL, SSAO_DEPTH_D3D, SSAO_DEPTH_REVERSED };
     "  --albedo A            diffuse albedo, >= 0 (default 1)\n"                                      \
     "  --specular S          Phong specular weight, >= 0 (default 0), seen from straight above\n"     \
     "  --shininess N         Phong exponent, > 0 (default 32; with --specular)\n"                     \
-    "  --sun-azimuth DEG     compass bearing of the sun, degrees clockwise from north\n"              \
-    "  --math                --sun-azimuth is psi instead: degrees from east toward south\n"          \
+    "  --sun-azimuth DEG     the sun's azimuth: the --convention's, compass by default\n"              \
     "  --sun-elevation DEG   sun elevation above the horizontal, -90..90 (with --sun-azimuth)\n"      \
     "  --sun-radius DEG      0 (default): a directional sun, hard shadows; 0..90: a key light\n"      \
     "                        (a disc with soft SH shadows from its own restricted visibility)\n"      \
@@ -285,6 +325,8 @@ static const char cli_usage[] =
     "  gi          multi-resolution GI (Nowrouzezahrai & Snyder): sky, sun, bounces, gloss\n"
     "  visibility  visibility index: the grid samples each point sees along K directions\n"
     "  viewshed    which samples an observer at one point sees (line of sight)\n"
+    "  hillshade   shaded relief with cast shadows from the exact sweep, one or more suns\n"
+    "  openness    positive or negative topographic openness (Yokoyama et al. 2002)\n"
     "  voxelize    voxels of an OBJ mesh: surface, conservative or solid (.binvox or .raw)\n"
     "  volgi       direct + indirect light of an OBJ mesh or the test room ([G12] ch. 5)\n"
     "  visfield    4D visibility field of an OBJ mesh (.hfvf), or AO images from one\n"
@@ -297,17 +339,23 @@ static const char cli_shared_help[] =
     "\n"
     "shared options (every command accepts them and ignores those it does not use):\n"
     "  -o OUT            output file, required: *.pfm writes PFM floats, *.pgm a 16-bit PGM;\n"
-    "                    a PGM of a 3-channel result stacks the channels as planes, top to bottom\n"
+    "                    a PGM of a 3-channel result stacks the channels as planes, top to bottom;\n"
+    "                    PGM code 0 is NoData and LO..HI map to 1..65535, recorded in the header\n"
+    "                    comment \"# hfvis range LO HI nodata 0\"\n"
     "  --range LO:HI     .pgm only: the values mapped to 0 and 65535 (default per command)\n"
     "  --cell S          distance between samples, in height units (default 1)\n"
     "  --zscale Z        multiply input values by Z, non-zero (default 1)\n"
-    "  --nodata V        input values equal to V are holes: no occlusion, output NaN (0 in PGM)\n"
+    "  --nodata V        input values equal to V are holes: no occlusion, output NaN (PGM code 0)\n"
     "  --dirs K          number of azimuth directions, 1..65536 (default 16)\n"
-    "  --azimuth0 RAD    azimuth of direction 0 in radians, from east toward south (default 0);\n"
-    "                    direction k is psi_k = azimuth0 + 2 pi k/K\n"
-    "  --compass         direction k looks toward the compass bearing 360k/K degrees, clockwise\n"
-    "                    from north (psi_k = 2 pi k/K - pi/2); --azimuth0 is then the bearing of\n"
-    "                    direction 0 in radians (psi_0 = azimuth0 - pi/2)\n"
+    "  --convention C    how azimuths are read and directions ordered (height-field commands):\n"
+    "                    compass (default): bearings clockwise from north, direction k at\n"
+    "                    azimuth0 + 360k/K; grass: counter-clockwise from east (r.horizon,\n"
+    "                    r.sun), direction k at azimuth0 + 360k/K counter-clockwise; grid: the\n"
+    "                    library's psi, from east toward south (x toward y; the old --math)\n"
+    "  --azimuth0 A      azimuth of direction 0 in the convention (default: compass 0 = north;\n"
+    "                    grass and grid 0 = east). Degrees (before 0.2: radians); see --radians\n"
+    "  --radians         angle flags (--azimuth0, --azimuth, --sun-*) in radians, not degrees\n"
+    "  --compass         the same as --convention compass (the default)\n"
     "  --degrees         angle outputs in degrees instead of radians\n"
     "  --dir-range A:B   horizon, skyview, sky, light, visibility: only the directions at\n"
     "                    positions A..B-1 of the K (0 <= A < B <= K) in sweep order (with K a\n"
@@ -326,6 +374,11 @@ static const char cli_shared_help[] =
     "                    'hfvis azimuths --exact' prints the directions used). visibility,\n"
     "                    indirect and gi keep the lattice\n"
     "  --quiet           no progress bar (shown on stderr only when it is a terminal)\n"
+    "  --progress        plain progress lines on stderr instead (percent, elapsed, ETA), for logs\n"
+    "                    and job schedulers, and a summary line at the end (time, cells,\n"
+    "                    directions); runs over 10 s end with the summary anyway (not --quiet)\n"
+    "  --overwrite       allow OUT to be one of the inputs (refused otherwise: same file,\n"
+    "                    through hard and symbolic links too)\n"
     "  -h, --help        this help; 'hfvis COMMAND --help' describes one command\n"
     "\n"
     "Options take their value as the next argument or as --option=value.\n"
@@ -340,11 +393,25 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "W x (K*H) image. K*W*H may not exceed 2^28 values (1 GiB) and K*H not 1048576 rows; for\n"
     "larger inputs use skyview, sky or light, which keep no horizon map.\n"
     "  --degrees         alpha in degrees\n"
+    "  --azimuth A       one direction only, toward azimuth A (the convention's, degrees unless\n"
+    "                    --radians): the same as --dirs 1 --azimuth0 A\n"
+    "  --split           one file per direction instead of the stack (as r.horizon writes one\n"
+    "                    map per direction), named OUT's stem + \"_\" + the direction's azimuth in\n"
+    "                    the convention in degrees: hor.pfm -> hor_000.pfm, hor_022_500.pfm (22.5)\n"
+    "Planes follow the convention: compass clockwise from azimuth0 (north by default), grass\n"
+    "counter-clockwise from azimuth0 (east by default), grid clockwise from east.\n"
     "Default PGM range -1.5707963:1.5707963 (-90:90 with --degrees).\n",
 
-    "usage: hfvis skyview IN -o OUT [options]\n"
+    "usage: hfvis skyview IN -o OUT [--svf zaksek|saga|visible] [options]\n"
     "The sky-view factor SVF = 1 - (1/K) sum_k sin(max(alpha_k, 0)) (Zaksek et al. 2011, as RVT\n"
-    "and GRASS r.skyview): 1 on open flat ground, lower in valleys. Default PGM range 0:1.\n",
+    "and GRASS r.skyview): 1 on open flat ground, lower in valleys. Default PGM range 0:1.\n"
+    "  --svf D           zaksek (default, above; the fused sweep); saga: SAGA's \"Sky View\n"
+    "                    Factor\", the cosine-weighted sky of the tilted receiver,\n"
+    "                    (1/K) sum_k [n_z cos^2 phi_k + (n_x cos psi_k + n_y sin psi_k)\n"
+    "                    (pi/2 - phi_k - sin phi_k cos phi_k)], phi_k = max(alpha_k, 0), n the grid\n"
+    "                    normal: 1 - (1/K) sum sin^2 phi_k on level ground; visible: SAGA's\n"
+    "                    \"Visible Sky\" (1/K) sum (1 - phi_k/(pi/2)) as a fraction (SAGA: percent).\n"
+    "                    saga and visible sweep one direction at a time (no --dir-range)\n",
 
     "usage: hfvis sky IN -o OUT [--sky C] [--albedo A] [options]\n"
     "Light reflected under a uniform sky of radiance C, [P1] Eq. 5: cosine-weighted and aware\n"
@@ -356,8 +423,7 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "usage: hfvis shadow IN --sun-azimuth DEG --sun-elevation DEG [--sun-radius DEG] -o OUT\n"
     "Sun visibility in [0, 1] from one exact sweep toward the sun: 1 lit, 0 in shadow. The\n"
     "receiver's own tangent plane is not applied; multiply by max(n.l, 0) for shading.\n"
-    "  --sun-azimuth DEG     compass bearing of the sun, degrees clockwise from north (required)\n"
-    "  --math                --sun-azimuth is psi instead: degrees from east toward south\n"
+    "  --sun-azimuth DEG     the sun's azimuth: the --convention's, compass by default (required)\n"
     "  --sun-elevation DEG   sun elevation above the horizontal, -90..90 (required)\n"
     "  --sun-radius DEG      angular radius of the sun disc, 0..90 (default 0: hard shadow);\n"
     "                        > 0 gives the visible fraction of the disc (the real sun: 0.27)\n"
@@ -391,8 +457,7 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "  --albedo A            constant albedo, >= 0 (default 1)\n"
     "  --albedo-map MAP      per-sample albedo, a map of IN's size (instead of --albedo)\n"
     "  --bounces B           interreflection bounces, 0..1000 (default 1); one sweep each\n"
-    "  --sun-azimuth DEG     compass bearing of the sun, degrees clockwise from north\n"
-    "  --math                --sun-azimuth is psi instead: degrees from east toward south\n"
+    "  --sun-azimuth DEG     the sun's azimuth: the --convention's, compass by default\n"
     "  --sun-elevation DEG   sun elevation above the horizontal, -90..90 (with --sun-azimuth)\n"
     "  --sun-radius DEG      angular radius of the sun disc, 0..90 (default 0: hard shadows)\n"
     "  --sun-irradiance E    irradiance on a surface facing the sun, >= 0 (default pi: a flat\n"
@@ -435,7 +500,17 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "sight line nearly grazes the terrain: measured from 8 observers (summit, valley, slope, 5\n"
     "random) on a 512 x 512 SRTM tile and a 512 x 512 fBm, on 0.005-1.2 % of the samples (mean\n"
     "0.2-0.4 %); the most from a summit, which sees the most.\n"
-    "  --observer X,Y        the observer's column and row, reals in [0, W-1] x [0, H-1] (required)\n"
+    "  --observer X,Y        the observer in map coordinates (required, or --observer-grid):\n"
+    "                        sample (column c, row r) is at X = c*cell, Y = r*cell (cell centres;\n"
+    "                        a georeferenced input uses its geotransform); it must stand on data\n"
+    "  --observer-grid C,R   the observer's column and row instead, reals in [0, W-1] x [0, H-1]\n"
+    "  --target X,Y          a point of interest (map coordinates, up to 64): prints\n"
+    "                        \"target X,Y (column c, row r): visible|hidden|...\" for its nearest sample\n"
+    "  --curvature           Earth curvature and refraction as GRASS r.viewshed -c -r: each target\n"
+    "                        is lowered by (1 - k) d^2/(2 R), d its horizontal distance (heights and\n"
+    "                        --cell in metres)\n"
+    "  --refraction K        refraction coefficient k, -1..1 (default 0.13; 0: curvature only)\n"
+    "  --earth-radius R      R in metres (default 6371000, the mean radius)\n"
     "  --observer-height H   eye height above the surface, height units, >= 0 (default 0)\n"
     "  --target-height T     target height above each sample, >= 0 (default 0)\n"
     "  --max-distance D      horizontal range in height units (--cell applies), >= 0;\n"
@@ -501,6 +576,10 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
 
     CLI_LK_HELP,
 
+    CLI_HILLSHADE_HELP,
+
+    CLI_OPENNESS_HELP,
+
     CLI_SUM_HELP
 };
 
@@ -540,15 +619,26 @@ typedef struct cli_progress_state {
     long long total;  /* units of the whole run */
 } cli_progress_state;
 
+/* One library report (done of total) as the run's units now of all; the base moves on when a
+ * call completes. */
+static void cli_progress_advance(cli_progress_state *p, int done, int total, long long *now,
+                                 long long *all)
+{
+    *all = p->total > 0 ? p->total : total;
+    *now = p->total > 0 ? p->base + done : done;
+    if (*now > *all) *now = *all;
+    if (done >= total) p->base += total;
+}
+
 /* hfvis_progress_fn: "\r<command> [#####.....] done/total" on stderr. */
 static void cli_progress(void *user, int done, int total)
 {
     enum { BAR = 32 };
     cli_progress_state *p = (cli_progress_state *)user;
-    long long all = p->total > 0 ? p->total : total, now = p->total > 0 ? p->base + done : done;
+    long long all, now;
     char bar[BAR + 1];
     int i, fill;
-    if (now > all) now = all;
+    cli_progress_advance(p, done, total, &now, &all);
     fill = all > 0 ? (int)(now * BAR / all) : BAR;
     for (i = 0; i < BAR; i++) bar[i] = i < fill ? '#' : '.';
     bar[BAR] = '\0';
@@ -556,7 +646,6 @@ static void cli_progress(void *user, int done, int total)
     cli_bar_open = now < all;
     if (!cli_bar_open) fputc('\n', stderr);
     fflush(stderr);
-    if (done >= total) p->base += total;
 }
 
 static int cli_stderr_is_terminal(void)
@@ -1035,9 +1124,225 @@ static int cli_check_volgi(const cli_args *a)
     return 0;
 }
 
+/* ------------------------------------------------------------------------------------------ */
+/* GIS conventions: angle units, azimuth conventions, map coordinates (docs/gis-conventions.md) */
+/* ------------------------------------------------------------------------------------------ */
+
+/* --convention: how an azimuth flag's value is read and in which sense directions k advance.
+ * The library's psi runs from east toward south (+x toward +y, rows down): clockwise on a
+ * north-up map. */
+enum { CONV_COMPASS, CONV_GRASS, CONV_GRID };
+static const char *const cli_conv_names[3] = { "compass", "grass", "grid" };
+
+#define CLI_SUMMARY_SECONDS 10.0 /* runs at least this long end with a summary line on stderr */
+
+#define CLI_GIS_FLAGS                                                                             \
+    { "--convention", 1, CLI_HF }, { "--radians", 0, CLI_HF }, { "--overwrite", 0, CLI_ALL },     \
+    { "--progress", 0, CLI_ALL }, { "--azimuth", 1, CLI_ONLY(CMD_HORIZON) },                      \
+    { "--split", 0, CLI_ONLY(CMD_HORIZON) }, { "--observer-grid", 1, CLI_ONLY(CMD_VIEWSHED) },    \
+    { "--curvature", 0, CLI_ONLY(CMD_VIEWSHED) }, { "--refraction", 1, CLI_ONLY(CMD_VIEWSHED) },  \
+    { "--earth-radius", 1, CLI_ONLY(CMD_VIEWSHED) }, { "--svf", 1, CLI_ONLY(CMD_SKYVIEW) },       \
+    { "--blend", 1, CLI_ONLY(CMD_HILLSHADE) }, { "--no-shadows", 0, CLI_ONLY(CMD_HILLSHADE) },    \
+    { "--negative", 0, CLI_ONLY(CMD_OPENNESS) }
+
+#define CLI_EARTH_RADIUS 6371000.0 /* mean Earth radius in metres (IUGG), --earth-radius default */
+#define CLI_REFRACTION 0.13        /* the usual refraction coefficient (ArcGIS's default) */
+
+/* An angle flag's value in degrees (it was given in radians with --radians). */
+static double cli_deg(const cli_args *a, double v)
+{
+    return a->radians ? v * (180.0 / CLI_PI) : v;
+}
+
+/* An azimuth in degrees, read in convention conv, as the library's psi in radians. */
+static double cli_psi(int conv, double deg)
+{
+    if (conv == CONV_COMPASS) return (deg - 90.0) * (CLI_PI / 180.0);
+    if (conv == CONV_GRASS) return -deg * (CLI_PI / 180.0);
+    return deg * (CLI_PI / 180.0);
+}
+
+/* psi in radians as an azimuth of convention conv, in degrees in [0, 360). */
+static double cli_from_psi(int conv, double psi)
+{
+    double deg = psi * (180.0 / CLI_PI), v;
+    v = conv == CONV_COMPASS ? deg + 90.0 : conv == CONV_GRASS ? -deg : deg;
+    v = fmod(v, 360.0);
+    if (v < 0.0) v += 360.0;
+    if (v >= 360.0 - 1e-9 || v == 0.0) v = 0.0; /* -0.0 and rounding just under a turn */
+    return v;
+}
+
+/* The library direction that is direction k of the user's convention: GRASS's directions run
+ * counter-clockwise, the library's clockwise from the same psi_0. */
+static int cli_lib_direction(const cli_args *a, int k)
+{
+    return a->convention == CONV_GRASS ? (a->dirs - k) % a->dirs : k;
+}
+
+/* "X,Y" -> two finite reals; 0 or CLI_EXIT_USAGE (reported with what). */
+static int cli_pair(const char *f, const char *v, const char *what, double *x, double *y)
+{
+    char buf[256];
+    const char *comma = strchr(v, ',');
+    size_t n = comma ? (size_t)(comma - v) : 0;
+    if (!comma || n >= sizeof buf) return cli_error(CLI_EXIT_USAGE, f, "expected %s, got '%s'", what, v);
+    memcpy(buf, v, n);
+    buf[n] = '\0';
+    if (!cli_parse_real(buf, x) || !cli_parse_real(comma + 1, y) || fabs(*x) > 1e300 || fabs(*y) > 1e300)
+        return cli_error(CLI_EXIT_USAGE, f, "expected %s, got '%s'", what, v);
+    return 0;
+}
+
+/* The GIS flags (conventions, map coordinates, hillshade, openness, safety, progress); -1 if f
+ * is none of them. */
+static int cli_set_gis(cli_args *a, const char *f, const char *v)
+{
+    if (!strcmp(f, "--convention")) {
+        int c;
+        for (c = 0; c < 3; c++)
+            if (!strcmp(v, cli_conv_names[c])) {
+                a->convention = c;
+                a->has_convention = 1;
+                return 0;
+            }
+        if (!strcmp(v, "math"))
+            return cli_error(CLI_EXIT_USAGE, f, "'math' is ambiguous: use grass (counter-clockwise "
+                             "from east) or grid (from east toward south, the old --math)");
+        return cli_error(CLI_EXIT_USAGE, f, "expected compass, grass or grid, got '%s'", v);
+    }
+    if (!strcmp(f, "--compass")) { /* the default since 0.2; kept so old command lines run */
+        if (a->has_convention && a->convention != CONV_COMPASS)
+            return cli_error(CLI_EXIT_USAGE, f, "contradicts --convention %s",
+                             cli_conv_names[a->convention]);
+        a->convention = CONV_COMPASS;
+        a->has_convention = 1;
+        return 0;
+    }
+    if (!strcmp(f, "--math"))
+        return cli_error(CLI_EXIT_USAGE, f, "removed: it read --sun-azimuth from east toward south, "
+                         "now '--convention grid'; GRASS's counter-clockwise from east is "
+                         "'--convention grass'");
+    if (!strcmp(f, "--radians")) { a->radians = 1; return 0; }
+    if (!strcmp(f, "--azimuth0")) {
+        a->has_azimuth0 = 1;
+        return cli_real(f, v, -1e6, 0, 1e6, "a finite angle (degrees, or radians with --radians)",
+                        &a->azimuth0);
+    }
+    if (!strcmp(f, "--azimuth")) {
+        a->has_azimuth = 1;
+        return cli_real(f, v, -1e6, 0, 1e6, "a finite angle (degrees, or radians with --radians)",
+                        &a->azimuth);
+    }
+    if (!strcmp(f, "--split")) { a->split = 1; return 0; }
+    if (!strcmp(f, "--overwrite")) { a->overwrite = 1; return 0; }
+    if (!strcmp(f, "--progress")) { a->progress_lines = 1; return 0; }
+    if (a->cmd == CMD_VIEWSHED) {
+        if (!strcmp(f, "--observer") || !strcmp(f, "--observer-grid")) {
+            a->observer_grid = f[10] == '-';
+            a->has_observer = 1;
+            return cli_pair(f, v, a->observer_grid ? "COL,ROW (grid position)" : "X,Y (map "
+                            "coordinates)", &a->observer_x, &a->observer_y);
+        }
+        if (!strcmp(f, "--target")) {
+            if (a->ntargets == CLI_MAX_TARGETS)
+                return cli_error(CLI_EXIT_USAGE, f, "at most %d targets", CLI_MAX_TARGETS);
+            a->ntargets++;
+            return cli_pair(f, v, "X,Y (map coordinates)", &a->targets[2 * a->ntargets - 2],
+                            &a->targets[2 * a->ntargets - 1]);
+        }
+        if (!strcmp(f, "--curvature")) { a->curvature = 1; return 0; }
+        if (!strcmp(f, "--refraction")) {
+            a->has_refraction = 1;
+            return cli_real(f, v, -1.0, 0, 1.0, "a coefficient in -1..1", &a->refraction);
+        }
+        if (!strcmp(f, "--earth-radius")) {
+            a->has_earth_radius = 1;
+            return cli_real(f, v, 0.0, 1, 1e12, "a radius > 0 (metres)", &a->earth_radius);
+        }
+    }
+    if (!strcmp(f, "--svf")) {
+        static const char *const names[3] = { "zaksek", "saga", "visible" };
+        int k;
+        for (k = 0; k < 3; k++)
+            if (!strcmp(v, names[k])) { a->svf = k; return 0; }
+        return cli_error(CLI_EXIT_USAGE, f, "expected zaksek, saga or visible, got '%s'", v);
+    }
+    if (!strcmp(f, "--blend")) return cli_int(f, v, 1, 360, "a count of sun directions 1..360", &a->blend);
+    if (!strcmp(f, "--no-shadows")) { a->no_shadows = 1; return 0; }
+    if (!strcmp(f, "--negative")) { a->negative = 1; return 0; }
+    if (a->cmd == CMD_OPENNESS && !strcmp(f, "--radius")) {
+        a->has_radius = 1;
+        return cli_real(f, v, 0.0, 0, DBL_MAX, "a distance >= 0 (0 = unlimited)", &a->radius);
+    }
+    return -1;
+}
+
+/* After parsing: read the angle flags in their unit and convention and store them as the
+ * library's psi (a->azimuth0 in radians, --sun-azimuth in psi degrees with a->math set), check
+ * the GIS combinations. Returns 0 or CLI_EXIT_USAGE (reported). */
+static int cli_gis_finish(cli_args *a)
+{
+    double deg;
+    if (a->cmd == CMD_HILLSHADE) { /* the cartographic default light: north-west, 45 degrees up */
+        if (!a->has_sun_azimuth) a->sun_azimuth = a->radians ? 315.0 * CLI_PI / 180.0 : 315.0;
+        if (!a->has_sun_elevation) a->sun_elevation = a->radians ? CLI_PI / 4.0 : 45.0;
+        a->has_sun_azimuth = a->has_sun_elevation = 1;
+        if (!a->blend) a->blend = 1;
+    }
+    if (a->has_sun_elevation) {
+        a->sun_elevation = cli_deg(a, a->sun_elevation);
+        if (a->sun_elevation < -90.0 || a->sun_elevation > 90.0)
+            return cli_error(CLI_EXIT_USAGE, "--sun-elevation", "expected -90..90 degrees, got %g",
+                             a->sun_elevation);
+    }
+    if (a->has_sun_radius) {
+        a->sun_radius = cli_deg(a, a->sun_radius);
+        if (a->sun_radius > 90.0)
+            return cli_error(CLI_EXIT_USAGE, "--sun-radius", "expected 0..90 degrees, got %g",
+                             a->sun_radius);
+    }
+    if (a->has_sun_azimuth) { /* as psi in degrees: the existing sun code reads that with math */
+        a->sun_azimuth = cli_psi(a->convention, cli_deg(a, a->sun_azimuth)) * (180.0 / CLI_PI);
+        a->math = 1;
+    }
+    if (a->has_azimuth) {
+        if (a->has_dirs && a->dirs != 1)
+            return cli_error(CLI_EXIT_USAGE, "--azimuth", "gives one direction: not with --dirs %d",
+                             a->dirs);
+        if (a->has_azimuth0)
+            return cli_error(CLI_EXIT_USAGE, "--azimuth", "cannot be combined with --azimuth0");
+        a->dirs = 1;
+        a->azimuth0 = a->azimuth;
+        a->has_azimuth0 = 1;
+    }
+    if (a->svf != 0 && a->has_dir_range)
+        return cli_error(CLI_EXIT_USAGE, "--dir-range", "applies to --svf zaksek only");
+    if (a->split && (a->out_partial || a->has_dir_range))
+        return cli_error(CLI_EXIT_USAGE, "--split", "cannot be combined with --dir-range");
+    if (a->convention == CONV_GRASS && a->cmd == CMD_HORIZON && a->has_dir_range)
+        return cli_error(CLI_EXIT_USAGE, "--dir-range", "horizon parts keep the library's clockwise "
+                         "order: use --convention compass or grid for a split horizon run");
+    if ((a->has_refraction || a->has_earth_radius) && !a->curvature)
+        return cli_error(CLI_EXIT_USAGE, a->has_refraction ? "--refraction" : "--earth-radius",
+                         "applies with --curvature");
+    if (!a->has_refraction) a->refraction = CLI_REFRACTION;
+    if (!a->has_earth_radius) a->earth_radius = CLI_EARTH_RADIUS;
+    if (a->cmd == CMD_OPENNESS && !a->has_dirs) a->dirs = 8; /* Yokoyama et al.'s eight */
+    /* direction 0: north (compass) or east (grass, grid: r.horizon's start=0 and the old default) */
+    deg = a->has_azimuth0 ? cli_deg(a, a->azimuth0) : 0.0;
+    a->azimuth0 = cli_psi(a->convention, deg);
+    a->compass = 0; /* a->azimuth0 is psi_0 now */
+    return 0;
+}
+
 #define CLI_ALL ((1u << CMD_COUNT) - 1u)
 #define CLI_ONLY(c) (1u << (c))
-#define CLI_SUN (CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI)) /* the sun flags */
+#define CLI_SUN (CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) \
+                 | CLI_ONLY(CMD_HILLSHADE)) /* the sun flags */
+/* the height-field commands: the GIS conventions apply to them */
+#define CLI_HF (CLI_ALL & ~(CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_VOLGI) \
+                            | CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_MESHAO) | CLI_ONLY(CMD_SUM)))
 typedef struct cli_flag { const char *name; int has_value; unsigned commands; } cli_flag;
 static const cli_flag cli_flags[] = {
     { "-o", 1, CLI_ALL },           { "--range", 1, CLI_ALL },       { "--cell", 1, CLI_ALL },
@@ -1071,14 +1376,19 @@ static const cli_flag cli_flags[] = {
     CLI_VF_FLAGS,
     CLI_LK_FLAGS,
     { "--fov-y", 1, CLI_ONLY(CMD_SSAO) },         { "--ortho", 1, CLI_ONLY(CMD_SSAO) },
-    { "--radius", 1, CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_MESHAO) },        { "--guard", 1, CLI_ONLY(CMD_SSAO) },
+    { "--radius", 1, CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_MESHAO) | CLI_ONLY(CMD_OPENNESS) },        { "--guard", 1, CLI_ONLY(CMD_SSAO) },
     { "--depth", 1, CLI_ONLY(CMD_SSAO) },         { "--near", 1, CLI_ONLY(CMD_SSAO) },
-    { "--far", 1, CLI_ONLY(CMD_SSAO) }
+    { "--far", 1, CLI_ONLY(CMD_SSAO) },
+    CLI_GIS_FLAGS
 };
 
 /* Apply one recognised flag; returns 0 or CLI_EXIT_USAGE (message printed). */
 static int cli_set(cli_args *a, const char *f, const char *v)
 {
+    {
+        int r = cli_set_gis(a, f, v);
+        if (r >= 0) return r;
+    }
     if (a->cmd == CMD_MESHAO) {
         int r = cli_set_lk(a, f, v);
         if (r >= 0) return r;
@@ -1143,12 +1453,8 @@ static int cli_set(cli_args *a, const char *f, const char *v)
     }
     if (!strcmp(f, "--dirs")) a->has_dirs = 1;
     if (!strcmp(f, "--dirs")) return cli_int(f, v, 1, CLI_MAX_DIRS, "an integer 1..65536", &a->dirs);
-    if (!strcmp(f, "--azimuth0"))
-        return cli_real(f, v, -DBL_MAX, 0, DBL_MAX, "a finite angle in radians", &a->azimuth0);
-    if (!strcmp(f, "--compass")) { a->compass = 1; return 0; }
     if (!strcmp(f, "--degrees")) { a->degrees = 1; return 0; }
     if (!strcmp(f, "--quiet")) { a->quiet = 1; return 0; }
-    if (!strcmp(f, "--math")) { a->math = 1; return 0; }
     if (!strcmp(f, "--border")) {
         if (!strcmp(v, "open")) a->border = HFVIS_BORDER_OPEN;
         else if (!strcmp(v, "clamp")) a->border = HFVIS_BORDER_CLAMP;
@@ -1198,19 +1504,6 @@ static int cli_set(cli_args *a, const char *f, const char *v)
         return cli_real(f, v, 0.0, 0, 90.0, "degrees in 0..90", &a->sun_radius);
     }
     if (!strcmp(f, "--env")) { a->env = v; return 0; }
-    if (!strcmp(f, "--observer")) {
-        char buf[256];
-        const char *comma = strchr(v, ',');
-        size_t n = comma ? (size_t)(comma - v) : 0;
-        if (!comma || n >= sizeof buf)
-            return cli_error(CLI_EXIT_USAGE, f, "expected X,Y (column,row), got '%s'", v);
-        memcpy(buf, v, n);
-        buf[n] = '\0';
-        if (!cli_parse_real(buf, &a->observer_x) || !cli_parse_real(comma + 1, &a->observer_y))
-            return cli_error(CLI_EXIT_USAGE, f, "expected X,Y (column,row), got '%s'", v);
-        a->has_observer = 1;
-        return 0;
-    }
     if (!strcmp(f, "--observer-height"))
         return cli_real(f, v, 0.0, 0, DBL_MAX, "a height >= 0", &a->observer_height);
     if (!strcmp(f, "--target-height"))
@@ -1433,7 +1726,8 @@ static float *cli_alloc(size_t a, size_t b, size_t c)
     return (float *)malloc(a * b * c * sizeof(float));
 }
 
-/* Write OUT: PFM with its channels, or a 16-bit PGM with the channel planes stacked. */
+/* Write OUT: PFM with its channels, or a 16-bit PGM with the channel planes stacked (NoData code 0,
+ * the range in its header: hfvis_pgm_range_save). */
 static int cli_save(const cli_args *a, const float *px, int w, int h, int channels, double lo,
                     double hi)
 {
@@ -1444,7 +1738,7 @@ static int cli_save(const cli_args *a, const float *px, int w, int h, int channe
     } else {
         if (a->has_range) { lo = a->range_lo; hi = a->range_hi; }
         if (channels == 1) {
-            s = hfvis_pgm_save(a->out, px, w, h, w, (float)lo, (float)hi, 65535);
+            s = hfvis_pgm_range_save(a->out, px, w, h, w, (float)lo, (float)hi);
         } else {
             size_t n = (size_t)w * (size_t)h, i;
             int c;
@@ -1453,7 +1747,7 @@ static int cli_save(const cli_args *a, const float *px, int w, int h, int channe
             for (c = 0; c < channels; c++)
                 for (i = 0; i < n; i++) planes[(size_t)c * n + i] = px[i * (size_t)channels + (size_t)c];
             if ((long long)h * channels > INT_MAX) s = HFVIS_ERR_LIMIT;
-            else s = hfvis_pgm_save(a->out, planes, w, h * channels, w, (float)lo, (float)hi, 65535);
+            else s = hfvis_pgm_range_save(a->out, planes, w, h * channels, w, (float)lo, (float)hi);
             free(planes);
         }
     }
@@ -2482,6 +2776,7 @@ static int cli_sum_load(const char *path, hfvis_partial *p, cli_part *m)
  * each part and keeps only its header), then add them in direction order, one part in memory at
  * a time (pass 2), finish exactly as the single run does and write OUT (atomically: the codecs
  * write a temporary file and rename it). */
+static int cli_refuse_input(int overwrite, const char *out, const char *const *inputs, int n);
 static int cli_sum(int argc, char **argv)
 {
     enum { MAX_PARTS = 4096 };
@@ -2519,6 +2814,7 @@ static int cli_sum(int argc, char **argv)
             continue;
         }
         if (!strcmp(arg, "--quiet")) continue;
+        if (!strcmp(arg, "--overwrite")) { a.overwrite = 1; continue; }
         if (arg[0] == '-' && arg[1] != '\0')
             return cli_error(CLI_EXIT_USAGE, arg, "unknown option (see 'hfvis sum --help')");
         if (nparts == MAX_PARTS) return cli_error(CLI_EXIT_USAGE, arg, "more than %d parts", MAX_PARTS);
@@ -2527,6 +2823,7 @@ static int cli_sum(int argc, char **argv)
     if (nparts == 0) return cli_error(CLI_EXIT_USAGE, cmdname, "missing PART.hfvs files");
     if (!a.out) return cli_error(CLI_EXIT_USAGE, cmdname, "missing -o OUT");
     if (a.has_range && !a.out_pgm) return cli_error(CLI_EXIT_USAGE, "--range", "applies only to .pgm output");
+    if ((rc = cli_refuse_input(a.overwrite, a.out, names, nparts)) != 0) return rc;
 
     /* pass 1: headers and tags */
     for (i = 0; i < nparts; i++) meta[i].tag = NULL;
@@ -2677,6 +2974,350 @@ done:
     return rc;
 }
 
+/* ------------------------------------------------------------------------------------------ */
+/* GIS commands and safety: same-file refusal, progress lines, map coordinates, viewshed,       */
+/* hillshade, openness, SAGA's sky-view factor, horizon planes per file                         */
+/* ------------------------------------------------------------------------------------------ */
+
+static double cli_t0;             /* start of the run, cli_now() */
+static double cli_run_cells;      /* grid samples of the run, for the summary line */
+static int cli_run_directions;    /* directions of the run (0: none), for the summary line */
+static double cli_line_last;      /* when the last --progress line was printed */
+static int cli_line_pct = -1;     /* and its percentage */
+
+/* Seconds on a monotonic clock (wall clock where there is none). */
+static double cli_now(void)
+{
+#if defined(CLOCK_MONOTONIC) && defined(CLI_HAVE_ISATTY)
+    struct timespec ts;
+    if (clock_gettime(CLOCK_MONOTONIC, &ts) == 0) return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+#endif
+    return (double)time(NULL);
+}
+
+/* hfvis_progress_fn of --progress: plain lines "hfvis CMD: P% (done/total), T s elapsed, ETA E s"
+ * on stderr, one per 5% (or per 30 s), for logs and job schedulers. */
+static void cli_progress_line(void *user, int done, int total)
+{
+    cli_progress_state *p = (cli_progress_state *)user;
+    long long all, now;
+    double t = cli_now() - cli_t0;
+    int pct;
+    cli_progress_advance(p, done, total, &now, &all);
+    pct = all > 0 ? (int)(now * 100 / all) : 100;
+    if (pct >= cli_line_pct + 5 || now == all || t - cli_line_last >= 30.0) {
+        if (now >= all)
+            fprintf(stderr, "hfvis %s: 100%% (%lld/%lld), %.1f s\n", p->label, now, all, t);
+        else if (now > 0)
+            fprintf(stderr, "hfvis %s: %d%% (%lld/%lld), %.0f s elapsed, ETA %.0f s\n", p->label, pct,
+                    now, all, t, t * (double)(all - now) / (double)now);
+        else
+            fprintf(stderr, "hfvis %s: 0%% (0/%lld), %.0f s elapsed\n", p->label, all, t);
+        fflush(stderr);
+        cli_line_pct = pct;
+        cli_line_last = t;
+    }
+}
+
+/* Whether paths x and y name one file (same device and inode: hard links and symbolic links
+ * too); 0 when either does not exist. */
+static int cli_same_file(const char *x, const char *y)
+{
+#ifdef CLI_HAVE_ISATTY
+    struct stat sx, sy;
+    if (stat(x, &sx) != 0 || stat(y, &sy) != 0) return 0;
+    return sx.st_dev == sy.st_dev && sx.st_ino == sy.st_ino;
+#else
+    return strcmp(x, y) == 0;
+#endif
+}
+
+/* Refuse to write out over one of the n inputs (NULL entries skipped) unless --overwrite:
+ * 0, or CLI_EXIT_ERROR after one error line. */
+static int cli_refuse_input(int overwrite, const char *out, const char *const *inputs, int n)
+{
+    int i;
+    for (i = 0; i < n && !overwrite; i++)
+        if (inputs[i] && cli_same_file(out, inputs[i]))
+            return cli_error(CLI_EXIT_ERROR, out, "is the input %s: refusing to replace an input "
+                             "(give --overwrite to do so)", inputs[i]);
+    return 0;
+}
+
+/* Every input of a command against out. */
+static int cli_refuse_inputs(const cli_args *a, const char *out)
+{
+    const char *inputs[5];
+    inputs[0] = a->in, inputs[1] = a->env, inputs[2] = a->albedo_map, inputs[3] = a->emission;
+    inputs[4] = a->vf_reference;
+    return cli_refuse_input(a->overwrite, out, inputs, 5);
+}
+
+/* The georeference as a GDAL geotransform: map X = gt[0] + P*gt[1] + L*gt[2],
+ * Y = gt[3] + P*gt[4] + L*gt[5] for pixel-corner coordinates (P, L); the sample of column c, row
+ * r is the centre of its pixel, (P, L) = (c + 0.5, r + 0.5). Without a georeferenced input
+ * (PFM, PGM) the sample of column c, row r lies at X = c*cell, Y = r*cell (the library's world
+ * frame: Y grows southward). */
+static void cli_georef(const cli_args *a, double cell, double gt[6])
+{
+    int i;
+    if (a->has_geotransform) {
+        for (i = 0; i < 6; i++) gt[i] = a->geotransform[i];
+        return;
+    }
+    gt[0] = -0.5 * cell, gt[1] = cell, gt[2] = 0.0;
+    gt[3] = -0.5 * cell, gt[4] = 0.0, gt[5] = cell;
+}
+
+/* Map point (X, Y) -> grid position (x, y) (column, row of sample centres); 0 if the transform
+ * cannot be inverted. */
+static int cli_map_to_grid(const cli_args *a, double cell, double X, double Y, double *x, double *y)
+{
+    double gt[6], det, dx, dy;
+    cli_georef(a, cell, gt);
+    det = gt[1] * gt[5] - gt[2] * gt[4];
+    if (!(fabs(det) > 0.0) || !isfinite(det)) return 0;
+    dx = X - gt[0], dy = Y - gt[3];
+    *x = (gt[5] * dx - gt[2] * dy) / det - 0.5;
+    *y = (-gt[4] * dx + gt[1] * dy) / det - 0.5;
+    return isfinite(*x) && isfinite(*y);
+}
+
+/* viewshed: the observer (map coordinates, or --observer-grid) on a sample that is not NoData,
+ * optional Earth curvature and refraction as in GRASS r.viewshed (each target's height lowered by
+ * (1 - k) d^2 / (2 R), d its horizontal distance from the observer), R2 or the exact oracle, and
+ * the verdict at each --target on stdout. */
+static int cli_run_viewshed(const cli_args *a, const hfvis_grid *grid, float *out)
+{
+    const int w = grid->width, h = grid->height;
+    const size_t n = (size_t)w * (size_t)h;
+    hfvis_viewshed_options vo;
+    hfvis_grid g = *grid;
+    float *zc = NULL;
+    double ox = a->observer_x, oy = a->observer_y;
+    hfvis_status s;
+    int rc = 0, t;
+    memset(&vo, 0, sizeof vo);
+    vo.observer_height = a->observer_height;
+    vo.target_height = a->target_height;
+    vo.max_distance = a->max_distance;
+    if (!a->observer_grid && !cli_map_to_grid(a, grid->cell_size, a->observer_x, a->observer_y, &ox, &oy))
+        return cli_error(CLI_EXIT_ERROR, "--observer", "the georeference cannot be inverted");
+    if (!(ox >= 0.0 && ox <= w - 1 && oy >= 0.0 && oy <= h - 1))
+        return cli_error(CLI_EXIT_ERROR, a->observer_grid ? "--observer-grid" : "--observer",
+                         "%g,%g (column %g, row %g) is outside the grid [0, %d] x [0, %d]",
+                         a->observer_x, a->observer_y, ox, oy, w - 1, h - 1);
+    if (isnan(hfvis_grid_sample(grid, ox, oy)))
+        return cli_error(CLI_EXIT_ERROR, a->observer_grid ? "--observer-grid" : "--observer",
+                         "%g,%g (column %g, row %g) is on NoData: the observer needs ground",
+                         a->observer_x, a->observer_y, ox, oy);
+    if (a->curvature) { /* GRASS r.viewshed -c -r: z - (1 - k) d^2/(2R), d in metres */
+        const double c = (1.0 - a->refraction) / (2.0 * a->earth_radius);
+        size_t i;
+        zc = cli_alloc(n, 1, 1);
+        if (!zc) return cli_status("viewshed", HFVIS_ERR_OUT_OF_MEMORY, 0);
+        for (i = 0; i < n; i++) {
+            double dx = ((double)(i % (size_t)w) - ox) * grid->cell_size;
+            double dy = ((double)(i / (size_t)w) - oy) * grid->cell_size;
+            zc[i] = (float)((double)grid->z[i] - c * (dx * dx + dy * dy));
+        }
+        g.z = zc;
+        g.stride = w;
+    }
+    if (a->exact) s = hfvis_viewshed_reference(&g, ox, oy, &vo, 0.0, out, w);
+    else s = hfvis_viewshed(&g, ox, oy, &vo, out, w);
+    free(zc);
+    if (s != HFVIS_OK) return cli_status("viewshed", s, 0);
+    for (t = 0; t < a->ntargets; t++) { /* the verdict of the sample nearest to each target */
+        double X = a->targets[2 * t], Y = a->targets[2 * t + 1], x, y;
+        const char *verdict = "outside the grid";
+        long c = -1, r = -1;
+        if (cli_map_to_grid(a, grid->cell_size, X, Y, &x, &y) && x > -0.5 && x < w - 0.5 &&
+            y > -0.5 && y < h - 0.5) {
+            float v;
+            c = (long)floor(x + 0.5), r = (long)floor(y + 0.5);
+            v = out[(size_t)r * (size_t)w + (size_t)c];
+            verdict = v == 1.0f ? "visible" : v == 0.0f ? "hidden" :
+                      isnan(grid->z[(size_t)r * (size_t)grid->stride + (size_t)c]) ? "no data"
+                      : "beyond --max-distance";
+        }
+        printf("target %.10g,%.10g (column %ld, row %ld): %s\n", X, Y, c, r, verdict);
+    }
+    if (a->ntargets > 0 && fflush(stdout) != 0) rc = cli_error(CLI_EXIT_ERROR, "stdout", "%s", strerror(errno));
+    return rc;
+}
+
+/* hillshade: H = (1/N) sum_j max(n . l_j, 0) V_j over N suns spread evenly in azimuth from
+ * --sun-azimuth (N = --blend), n the grid normal, l_j the direction of sun j's centre and V_j its
+ * visibility from the exact sweep (hfvis_sun_visibility: 0/1, or the visible fraction of a disc
+ * of --sun-radius), V_j = 1 with --no-shadows. In [0, 1]; NaN at holes. */
+static int cli_run_hillshade(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
+                             cli_progress_state *prog, float *out)
+{
+    const int w = grid->width, N = a->blend;
+    const size_t n = (size_t)w * (size_t)grid->height;
+    const double el = a->sun_elevation * (CLI_PI / 180.0), psi0 = a->sun_azimuth * (CLI_PI / 180.0);
+    float *nrm = cli_alloc(n, 3, 1), *vis = cli_alloc(n, 1, 1);
+    double *acc = (double *)calloc(n, sizeof(double));
+    hfvis_status s = HFVIS_OK;
+    size_t i;
+    int j, rc = 0;
+    if (!nrm || !vis || !acc) { rc = cli_status("hillshade", HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
+    s = hfvis_normals_compute(grid, nrm);
+    prog->total = N;
+    for (j = 0; s == HFVIS_OK && j < N; j++) {
+        const double psi = psi0 + 2.0 * CLI_PI * j / N;
+        const double l[3] = { cos(el) * cos(psi), cos(el) * sin(psi), sin(el) };
+        if (a->no_shadows) {
+            for (i = 0; i < n; i++) vis[i] = 1.0f;
+            if (opts->progress) opts->progress(opts->progress_user, 1, 1);
+        } else {
+            s = hfvis_sun_visibility(grid, psi, el, a->sun_radius * (CLI_PI / 180.0), opts, vis, w);
+        }
+        for (i = 0; s == HFVIS_OK && i < n; i++) {
+            double d = (double)nrm[3 * i] * l[0] + (double)nrm[3 * i + 1] * l[1] + (double)nrm[3 * i + 2] * l[2];
+            acc[i] += (d > 0.0 ? d : 0.0) * (double)vis[i];
+        }
+    }
+    if (s != HFVIS_OK) { rc = cli_status("hillshade", s, 0); goto done; }
+    for (i = 0; i < n; i++) out[i] = isfinite(grid->z[(i / (size_t)w) * (size_t)grid->stride + i % (size_t)w])
+                                     ? (float)(acc[i] / N) : (float)NAN;
+done:
+    free(acc);
+    free(vis);
+    free(nrm);
+    return rc;
+}
+
+/* openness: hfvis_openness (Yokoyama et al. 2002), in radians or, with --degrees, degrees. */
+static int cli_run_openness(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
+                            cli_progress_state *prog, float *out)
+{
+    hfvis_openness_options oo;
+    hfvis_status s;
+    size_t i, n = (size_t)grid->width * (size_t)grid->height;
+    memset(&oo, 0, sizeof oo);
+    oo.radius = a->radius;
+    oo.negative = a->negative;
+    prog->total = a->radius > 0.0 ? grid->height : a->dirs; /* rows of the march, or directions */
+    s = hfvis_openness(grid, a->dirs, &oo, opts, out, grid->width);
+    if (s != HFVIS_OK) return cli_status("openness", s, 0);
+    if (a->degrees)
+        for (i = 0; i < n; i++) out[i] = (float)((double)out[i] * (180.0 / CLI_PI));
+    return 0;
+}
+
+/* skyview --svf saga|visible, SAGA's "Sky View Factor" tool (ta_lighting, after Hantzschel et al.
+ * 2005), from the K horizon angles phi_k = max(alpha_k, 0) (SAGA never lets a horizon fall below
+ * the horizontal) and the grid normal (n_x, n_y, n_z):
+ *   saga:    (1/K) sum_k [n_z cos^2 phi_k + (n_x cos psi_k + n_y sin psi_k)(pi/2 - phi_k - sin phi_k cos phi_k)]
+ *            (n_z = cos slope, n_x cos psi + n_y sin psi = sin slope cos(psi - aspect)): the
+ *            cosine-weighted sky, 1 - (1/K) sum sin^2 phi_k on level ground;
+ *   visible: (1/K) sum_k (1 - phi_k/(pi/2)), SAGA's "Visible Sky" as a fraction (SAGA: percent). */
+static int cli_run_skyview_saga(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
+                                cli_progress_state *prog, float *out)
+{
+    const int w = grid->width, K = a->dirs;
+    const size_t n = (size_t)w * (size_t)grid->height;
+    float *nrm = a->svf == 1 ? cli_alloc(n, 3, 1) : NULL, *plane = cli_alloc(n, 1, 1);
+    double *acc = (double *)calloc(n, sizeof(double));
+    hfvis_status s = HFVIS_OK;
+    size_t i;
+    int k, rc = 0;
+    if ((a->svf == 1 && !nrm) || !plane || !acc) { rc = cli_status("skyview", HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
+    if (nrm) s = hfvis_normals_compute(grid, nrm);
+    prog->total = K;
+    for (k = 0; s == HFVIS_OK && k < K; k++) {
+        const double psi = opts->azimuth0_rad + 2.0 * CLI_PI * k / K, c = cos(psi), sn = sin(psi);
+        s = hfvis_horizon_direction(grid, K, k, opts, plane, w);
+        for (i = 0; s == HFVIS_OK && i < n; i++) {
+            double phi = (double)plane[i] > 0.0 ? (double)plane[i] : 0.0;
+            if (isnan(plane[i])) { acc[i] = NAN; continue; }
+            if (nrm)
+                acc[i] += (double)nrm[3 * i + 2] * cos(phi) * cos(phi) +
+                          ((double)nrm[3 * i] * c + (double)nrm[3 * i + 1] * sn) *
+                              (CLI_PI / 2.0 - phi - sin(phi) * cos(phi));
+            else
+                acc[i] += 1.0 - phi / (CLI_PI / 2.0);
+        }
+    }
+    if (s != HFVIS_OK) { rc = cli_status("skyview", s, 0); goto done; }
+    for (i = 0; i < n; i++) out[i] = (float)(acc[i] / K);
+done:
+    free(acc);
+    free(plane);
+    free(nrm);
+    return rc;
+}
+
+/* The commands of this section: compute into out (W x H) and save it. */
+static int cli_run_gis(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
+                       cli_progress_state *prog)
+{
+    const int w = grid->width, h = grid->height;
+    float *out = cli_alloc((size_t)w, (size_t)h, 1);
+    double lo = 0.0, hi = 1.0;
+    int rc;
+    if (!out) return cli_status(cli_cmd_names[a->cmd], HFVIS_ERR_OUT_OF_MEMORY, 0);
+    if (a->cmd == CMD_VIEWSHED) {
+        rc = cli_run_viewshed(a, grid, out);
+    } else if (a->cmd == CMD_HILLSHADE) {
+        cli_run_directions = a->blend;
+        rc = cli_run_hillshade(a, grid, opts, prog, out);
+    } else if (a->cmd == CMD_OPENNESS) {
+        hi = a->degrees ? 180.0 : CLI_PI; /* 0 .. 180 degrees */
+        rc = cli_run_openness(a, grid, opts, prog, out);
+    } else {
+        rc = cli_run_skyview_saga(a, grid, opts, prog, out);
+    }
+    if (rc == 0) rc = cli_save(a, out, w, h, 1, lo, hi);
+    free(out);
+    return rc;
+}
+
+/* horizon, after the sweep: the planes in the user's convention's order (GRASS's run
+ * counter-clockwise) and, with --split, one file per direction named OUT's stem + "_" + the
+ * direction's azimuth in degrees in the convention (as r.horizon names its maps: "_045", or
+ * "_022_500" for 22.5), else the stacked map. */
+static int cli_horizon_finish(const cli_args *a, float *map, int w, int h, double lo, double hi)
+{
+    const size_t n = (size_t)w * (size_t)h;
+    const int K = a->dirs;
+    int k, rc = 0;
+    if (a->convention == CONV_GRASS && K > 2) { /* plane k <- library plane (K - k) % K, in place */
+        float *tmp = cli_alloc(n, 1, 1);
+        if (!tmp) return cli_status("horizon", HFVIS_ERR_OUT_OF_MEMORY, 0);
+        for (k = 1; k < K - k; k++) {
+            memcpy(tmp, map + (size_t)k * n, n * sizeof(float));
+            memcpy(map + (size_t)k * n, map + (size_t)(K - k) * n, n * sizeof(float));
+            memcpy(map + (size_t)(K - k) * n, tmp, n * sizeof(float));
+        }
+        free(tmp);
+    }
+    if (!a->split) return cli_save(a, map, w, h * K, 1, lo, hi);
+    for (k = 0; k < K && rc == 0; k++) {
+        cli_args one = *a;
+        char name[4096];
+        const char *dot = strrchr(a->out, '.');
+        const double psi = a->azimuth0 + 2.0 * CLI_PI * cli_lib_direction(a, k) / K;
+        double deg = cli_from_psi(a->convention, psi);
+        long whole = (long)floor(deg), milli = (long)floor((deg - (double)whole) * 1000.0 + 0.5);
+        size_t stem = dot ? (size_t)(dot - a->out) : strlen(a->out);
+        int len;
+        if (milli == 1000) whole++, milli = 0;
+        if (milli == 0)
+            len = snprintf(name, sizeof name, "%.*s_%03ld%s", (int)stem, a->out, whole, a->out + stem);
+        else
+            len = snprintf(name, sizeof name, "%.*s_%03ld_%03ld%s", (int)stem, a->out, whole, milli,
+                           a->out + stem);
+        if (len < 0 || (size_t)len >= sizeof name) return cli_error(CLI_EXIT_ERROR, a->out, "name too long");
+        if ((rc = cli_refuse_inputs(a, name)) != 0) return rc;
+        one.out = name;
+        rc = cli_save(&one, map + (size_t)k * n, w, h, 1, lo, hi);
+    }
+    return rc;
+}
+
 static int cli_run(const cli_args *a)
 {
     const char *cmd = cli_cmd_names[a->cmd];
@@ -2702,7 +3343,13 @@ static int cli_run(const cli_args *a)
     opts.azimuth0_rad = a->compass ? a->azimuth0 - CLI_PI / 2.0 : a->azimuth0;
     if (a->exact && a->cmd != CMD_VIEWSHED) opts.rays = HFVIS_RAYS_EXACT;
     prog.label = cmd; prog.base = 0; prog.total = 0;
-    if (!a->quiet && cli_stderr_is_terminal()) {
+    cli_run_cells = (double)w * (double)h;
+    cli_run_directions = a->cmd == CMD_NORMALS || a->cmd == CMD_VIEWSHED ? 0
+                         : a->cmd == CMD_SHADOW ? 1 : a->dirs;
+    if (a->progress_lines && !a->quiet) {
+        opts.progress = cli_progress_line;
+        opts.progress_user = &prog;
+    } else if (!a->quiet && cli_stderr_is_terminal()) {
         opts.progress = cli_progress;
         opts.progress_user = &prog;
     }
@@ -2715,6 +3362,11 @@ static int cli_run(const cli_args *a)
     if (a->cmd == CMD_INDIRECT) { rc = cli_run_indirect(a, &grid, &opts, &prog); goto done; }
     if (a->cmd == CMD_VISIBILITY) { rc = cli_run_visibility(a, &grid, &opts, &prog); goto done; }
     if (a->cmd == CMD_GI) { rc = cli_run_gi(a, &grid, &opts, &prog); goto done; }
+    if (a->cmd == CMD_VIEWSHED || a->cmd == CMD_HILLSHADE || a->cmd == CMD_OPENNESS ||
+        (a->cmd == CMD_SKYVIEW && a->svf != 0)) {
+        rc = cli_run_gis(a, &grid, &opts, &prog);
+        goto done;
+    }
     if (a->cmd == CMD_HORIZON) {
         size_t values = (size_t)w * (size_t)h; /* <= 2^28, so the product below cannot overflow */
         planes = a->dirs;
@@ -2759,24 +3411,6 @@ static int cli_run(const cli_args *a)
                                  a->sun_radius * (CLI_PI / 180.0), &opts, out, w);
         break;
     }
-    case CMD_VIEWSHED: {
-        hfvis_viewshed_options vopts;
-        memset(&vopts, 0, sizeof vopts);
-        vopts.observer_height = a->observer_height;
-        vopts.target_height = a->target_height;
-        vopts.max_distance = a->max_distance;
-        if (a->observer_x < 0.0 || a->observer_x > w - 1 || a->observer_y < 0.0 ||
-            a->observer_y > h - 1) {
-            rc = cli_error(CLI_EXIT_ERROR, "--observer", "%g,%g is outside the grid [0, %d] x [0, %d]",
-                           a->observer_x, a->observer_y, w - 1, h - 1);
-            goto done;
-        }
-        if (a->exact)
-            s = hfvis_viewshed_reference(&grid, a->observer_x, a->observer_y, &vopts, 0.0, out, w);
-        else
-            s = hfvis_viewshed(&grid, a->observer_x, a->observer_y, &vopts, out, w);
-        break;
-    }
     case CMD_LIGHT: {
         hfvis_env_options eopts = hfvis_env_options_default();
         eopts.method = (hfvis_env_method)a->method;
@@ -2789,6 +3423,7 @@ static int cli_run(const cli_args *a)
         break;
     }
     if (s != HFVIS_OK) { rc = cli_status(cmd, s, 0); goto done; }
+    if (a->cmd == CMD_HORIZON) { rc = cli_horizon_finish(a, out, w, h, lo, hi); goto done; }
     rc = cli_save(a, out, w, h * planes, channels, lo, hi);
 done:
     if (cli_bar_open) { fputc('\n', stderr); cli_bar_open = 0; } /* a bar that fell short */
@@ -2799,19 +3434,22 @@ done:
 }
 
 static const char cli_azimuths_help[] =
-    "usage: hfvis azimuths --dirs K [--exact] [--compass] [--azimuth0 RAD]\n"
-    "Prints the K azimuths a run with these options uses, in degrees, one per line, in\n"
-    "output-plane order (plane k of 'hfvis horizon'). Without --exact: psi_k = azimuth0 +\n"
-    "360k/K; with --exact: the nearest rational directions (a, b), max(|a|, |b|) <= max(5,\n"
-    "ceil(K/4)) (64 for K = 1). Degrees from east toward south, or compass bearings\n"
-    "(clockwise from north) with --compass, where --azimuth0 is the bearing of direction 0.\n";
+    "usage: hfvis azimuths --dirs K [--exact] [--convention compass|grass|grid] [--azimuth0 A]\n"
+    "         [--radians]\n"
+    "Prints the K azimuths a run with these options uses, one per line, in output-plane order\n"
+    "(plane k of 'hfvis horizon'), in degrees of the convention: compass bearings (clockwise\n"
+    "from north, the default; --compass says the same), GRASS's counter-clockwise from east, or\n"
+    "grid (from east toward south, the library's psi). --azimuth0 is direction 0 in that\n"
+    "convention, degrees unless --radians. Without --exact: direction k is azimuth0 + 360k/K\n"
+    "(GRASS: counter-clockwise); with --exact: the nearest rational directions (a, b),\n"
+    "max(|a|, |b|) <= max(5, ceil(K/4)) (64 for K = 1).\n";
 
 /* hfvis azimuths: the directions of a run (hfvis_sweep_azimuths), one per line. */
 static int cli_azimuths(int argc, char **argv)
 {
     hfvis_sweep_options o = hfvis_sweep_options_default();
     double az0 = 0.0, *az;
-    int i, K = 16, compass = 0, has_dirs = 0, k, rc;
+    int i, K = 16, conv = CONV_COMPASS, radians = 0, has_dirs = 0, k, c, rc;
     for (i = 2; i < argc; i++) {
         const char *f = argv[i], *v = NULL, *eq = strchr(f, '=');
         char name[32];
@@ -2824,8 +3462,9 @@ static int cli_azimuths(int argc, char **argv)
         memcpy(name, f, n);
         name[n] = '\0';
         if (!strcmp(name, "--exact") && !eq) { o.rays = HFVIS_RAYS_EXACT; continue; }
-        if (!strcmp(name, "--compass") && !eq) { compass = 1; continue; }
-        if (strcmp(name, "--dirs") && strcmp(name, "--azimuth0"))
+        if (!strcmp(name, "--compass") && !eq) { conv = CONV_COMPASS; continue; }
+        if (!strcmp(name, "--radians") && !eq) { radians = 1; continue; }
+        if (strcmp(name, "--dirs") && strcmp(name, "--azimuth0") && strcmp(name, "--convention"))
             return cli_error(CLI_EXIT_USAGE, f, "unknown option (see 'hfvis azimuths --help')");
         if (eq) v = eq + 1;
         else if (i + 1 < argc) v = argv[++i];
@@ -2833,19 +3472,24 @@ static int cli_azimuths(int argc, char **argv)
         if (!strcmp(name, "--dirs")) {
             if ((rc = cli_int(name, v, 1, CLI_MAX_DIRS, "an integer 1..65536", &K)) != 0) return rc;
             has_dirs = 1;
+        } else if (!strcmp(name, "--convention")) {
+            for (c = 0; c < 3 && strcmp(v, cli_conv_names[c]); c++) {}
+            if (c == 3) return cli_error(CLI_EXIT_USAGE, name, "expected compass, grass or grid, got '%s'", v);
+            conv = c;
         } else if (!cli_parse_real(v, &az0)) {
-            return cli_error(CLI_EXIT_USAGE, name, "expected a finite number of radians, got '%s'", v);
+            return cli_error(CLI_EXIT_USAGE, name, "expected a finite angle, got '%s'", v);
         }
     }
     if (!has_dirs) return cli_error(CLI_EXIT_USAGE, "azimuths", "needs --dirs K");
-    o.azimuth0_rad = compass ? az0 - CLI_PI / 2.0 : az0;
+    o.azimuth0_rad = cli_psi(conv, radians ? az0 * (180.0 / CLI_PI) : az0);
     az = (double *)malloc((size_t)K * sizeof(double));
     if (!az) return cli_status("azimuths", HFVIS_ERR_OUT_OF_MEMORY, 0);
     if (hfvis_sweep_azimuths(K, &o, az, NULL) != HFVIS_OK) {
         free(az);
         return cli_error(CLI_EXIT_USAGE, "--azimuth0", "not a usable azimuth");
     }
-    for (k = 0; k < K; k++) printf("%.17g\n", (az[k] + (compass ? CLI_PI / 2.0 : 0.0)) * (180.0 / CLI_PI));
+    for (k = 0; k < K; k++) /* GRASS's direction k is the library's (K - k) mod K */
+        printf("%.17g\n", cli_from_psi(conv, az[conv == CONV_GRASS ? (K - k) % K : k]));
     free(az);
     return 0;
 }
@@ -2856,7 +3500,18 @@ int main(int argc, char **argv)
     int rc;
     if (argc >= 2 && !strcmp(argv[1], "sum")) return cli_sum(argc, argv);
     if (argc >= 2 && !strcmp(argv[1], "azimuths")) return cli_azimuths(argc, argv);
+    cli_t0 = cli_now();
     rc = cli_parse(argc, argv, &a);
     if (rc != CLI_RUN) return rc;
-    return cli_run(&a);
+    if ((rc = cli_gis_finish(&a)) != 0) return rc;
+    if ((rc = cli_refuse_inputs(&a, a.out)) != 0) return rc;
+    rc = cli_run(&a);
+    if (rc == 0 && !a.quiet && a.out && (a.progress_lines || cli_now() - cli_t0 >= CLI_SUMMARY_SECONDS)) {
+        fprintf(stderr, "hfvis %s: done in %.1f s", cli_cmd_names[a.cmd], cli_now() - cli_t0);
+        if (cli_run_cells > 0.0) fprintf(stderr, ": %.0f cells", cli_run_cells);
+        if (cli_run_directions > 0) fprintf(stderr, ", %d direction%s", cli_run_directions,
+                                            cli_run_directions == 1 ? "" : "s");
+        fprintf(stderr, " -> %s\n", a.out);
+    }
+    return rc;
 }

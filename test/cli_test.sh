@@ -107,7 +107,7 @@ expect_line2() { # NAME FILE WANT: the second header line (PFM dimensions)
 # ---- help ---------------------------------------------------------------------------------
 if "$hfvis" --help > "$dir/stdout" 2> "$dir/stderr" && grep -q '^usage: hfvis' "$dir/stdout" && [ ! -s "$dir/stderr" ]
 then ok "--help"; else bad "--help"; fi
-for c in horizon skyview sky shadow light normals indirect visibility viewshed voxelize gi ssao volgi visfield meshao; do
+for c in horizon skyview sky shadow light normals indirect visibility viewshed voxelize gi ssao volgi visfield meshao hillshade openness; do
   if "$hfvis" $c --help > "$dir/stdout" 2>&1 && grep -q "^usage: hfvis $c" "$dir/stdout"
   then ok "$c --help"; else bad "$c --help"; fi
 done
@@ -125,7 +125,7 @@ expect_ok "skyview pgm --border clamp --border-cells 5" "$dir/svf.pgm" skyview "
 expect_ok "sky" "$dir/sky.pfm" sky "$h" --sky 2 --albedo 0.5 --dirs 12 -o "$dir/sky.pfm"
 expect_ok "sky pgm --range" "$dir/sky.pgm" sky "$h" --range 0:1.5 -o "$dir/sky.pgm"
 expect_ok "shadow" "$dir/sh.pfm" shadow "$h" --sun-azimuth 135 --sun-elevation 20 -o "$dir/sh.pfm"
-expect_ok "shadow --math --sun-radius" "$dir/sh2.pgm" shadow "$h" --math --sun-azimuth -45 --sun-elevation 10 --sun-radius 2 -o "$dir/sh2.pgm"
+expect_ok "shadow --convention grid --sun-radius" "$dir/sh2.pgm" shadow "$h" --convention grid --sun-azimuth -45 --sun-elevation 10 --sun-radius 2 -o "$dir/sh2.pgm"
 expect_ok "light grey env" "$dir/l1.pfm" light "$h" --env "$dir/env1.pfm" -o "$dir/l1.pfm"
 expect_ok "light rgb env lp" "$dir/l3.pfm" light "$h" --env "$dir/env3.pfm" --method lp --albedo 0.7 -o "$dir/l3.pfm"
 head -n 1 "$dir/l3.pfm" | grep -q '^PF' && ok "light rgb env writes PF" || bad "light rgb env writes PF"
@@ -138,7 +138,7 @@ expect_ok "a PFM input (the tool's own output)" "$dir/svf2.pfm" skyview "$dir/sv
 expect_ok "indirect, defaults" "$dir/i.pfm" indirect "$h" -o "$dir/i.pfm"
 head -n 1 "$dir/i.pfm" | grep -q '^Pf' && ok "indirect grey writes Pf" || bad "indirect grey writes Pf"
 expect_ok "indirect, sun and 3 bounces" "$dir/is.pfm" indirect "$h" --sun-azimuth 135 --sun-elevation 20 --sun-radius 0.27 --sun-irradiance 5 --sky 0.2 --albedo 0.6 --bounces 3 --dirs 8 -o "$dir/is.pfm"
-expect_ok "indirect --math --output indirect pgm" "$dir/is.pgm" indirect "$h" --math --sun-azimuth 45 --sun-elevation 30 --output indirect --border wrap --dirs 3 -o "$dir/is.pgm"
+expect_ok "indirect --convention grid --output indirect pgm" "$dir/is.pgm" indirect "$h" --convention grid --sun-azimuth 45 --sun-elevation 30 --output indirect --border wrap --dirs 3 -o "$dir/is.pgm"
 expect_ok "indirect rgb env" "$dir/ie.pfm" indirect "$h" --env "$dir/env3.pfm" --albedo 0.5 -o "$dir/ie.pfm"
 head -n 1 "$dir/ie.pfm" | grep -q '^PF' && ok "indirect rgb env writes PF" || bad "indirect rgb env writes PF"
 expect_ok "indirect --albedo-map pgm --emission" "$dir/im.pfm" indirect "$h" --albedo-map "$h" --emission "$dir/svf.pfm" --output direct -o "$dir/im.pfm"
@@ -158,17 +158,17 @@ expect_bytes "skyview flat = 1" "$dir/f.pgm" 2 "ff ff"
 expect_ok "shadow flat, sun up" "$dir/fs.pgm" shadow "$f" --sun-azimuth 270 --sun-elevation 30 -o "$dir/fs.pgm"
 expect_bytes "shadow flat, sun up = 1" "$dir/fs.pgm" 2 "ff ff"
 expect_ok "shadow flat, sun down" "$dir/fd.pgm" shadow "$f" --sun-azimuth 270 --sun-elevation -10 -o "$dir/fd.pgm"
-expect_bytes "shadow flat, sun in the west below the horizon = 0" "$dir/fd.pgm" 2 "00 00"
+expect_bytes "shadow flat, sun in the west below the horizon = 0 (code 1)" "$dir/fd.pgm" 2 "00 01"
 expect_ok "normals flat" "$dir/fn.pfm" normals "$f" --zscale 3 -o "$dir/fn.pfm"
 expect_bytes "normals flat: z = 1" "$dir/fn.pfm" 4 "00 00 80 3f"
-# horizon, --dirs 4 --degrees: plane 0 looks east, so (6, 0) sees flat ground (0 deg) and (7, 0)
-# nothing (-90 deg); with --compass plane 0 looks north, off the grid for both; with --border
-# clamp the flat ground extends and both see 0 deg.
-expect_ok "horizon flat" "$dir/fh.pfm" horizon "$f" --dirs 4 --degrees -o "$dir/fh.pfm"
+# horizon, --dirs 4 --degrees --convention grid: plane 0 looks east, so (6, 0) sees flat ground
+# (0 deg) and (7, 0) nothing (-90 deg); by default (compass) plane 0 looks north, off the grid for
+# both; with --border clamp the flat ground extends and both see 0 deg.
+expect_ok "horizon flat" "$dir/fh.pfm" horizon "$f" --dirs 4 --degrees --convention grid -o "$dir/fh.pfm"
 expect_bytes "horizon flat east: 0, -90 deg" "$dir/fh.pfm" 8 "00 00 00 00 00 00 b4 c2" "00 00 00 80 00 00 b4 c2"
 expect_ok "horizon flat --compass" "$dir/fc.pfm" horizon "$f" --dirs 4 --degrees --compass -o "$dir/fc.pfm"
 expect_bytes "horizon flat --compass north: -90, -90 deg" "$dir/fc.pfm" 8 "00 00 b4 c2 00 00 b4 c2"
-expect_ok "horizon flat --border clamp" "$dir/fb.pfm" horizon "$f" --dirs 4 --border clamp -o "$dir/fb.pfm"
+expect_ok "horizon flat --border clamp" "$dir/fb.pfm" horizon "$f" --dirs 4 --border clamp --convention grid -o "$dir/fb.pfm"
 expect_bytes "horizon flat clamp east: 0, 0" "$dir/fb.pfm" 8 "00 00 00 00 00 00 00 00" \
   "00 00 00 80 00 00 00 00" "00 00 00 00 00 00 00 80" "00 00 00 80 00 00 00 80"
 expect_ok "light flat, uniform env" "$dir/fl.pfm" light "$f" --env "$dir/env1.pfm" -o "$dir/fl.pfm"
@@ -197,10 +197,11 @@ expect_ok "indirect flat, RGB emission, grey albedo map" "$dir/fe3.pfm" indirect
 expect_floats "indirect flat: RGB 1 + 0.2 * sky 1 = 1.2" "$dir/fe3.pfm" 12 1e-4 1.2 1.2 1.2
 expect_ok "indirect, NaN in a map at a hole of IN" "$dir/fh.pfm" indirect "$dir/flat7.pgm" --nodata 7 --emission "$dir/nanrow.pfm" -o "$dir/fh.pfm"
 expect_floats "indirect: the hole is NaN, its neighbour is lit" "$dir/fh.pfm" 32 1e-4 nan 2 2 2 2 2 2 2
-# visibility: on a flat field every earlier sample of a line is seen. --dirs 1 looks east:
-# column x of the 8-wide row sees 7 - x samples; --dirs 4: (7-x) + x + (5-y) + y = 12 everywhere;
-# --compass --dirs 1 looks north: row y sees y samples (the first stored PFM row is y = 5).
-expect_ok "visibility flat east" "$dir/fv1.pfm" visibility "$f" --dirs 1 -o "$dir/fv1.pfm"
+# visibility: on a flat field every earlier sample of a line is seen. --dirs 1 --convention grid
+# looks east: column x of the 8-wide row sees 7 - x samples; --dirs 4: (7-x) + x + (5-y) + y = 12
+# everywhere; --dirs 1 (compass, the default) looks north: row y sees y samples (the first stored
+# PFM row is y = 5).
+expect_ok "visibility flat east" "$dir/fv1.pfm" visibility "$f" --dirs 1 --convention grid -o "$dir/fv1.pfm"
 expect_floats "visibility flat east: 7 - x" "$dir/fv1.pfm" 32 0 7 6 5 4 3 2 1 0
 # viewshed: an eye on a flat field sees all of it (grazing counts); --max-distance cuts it off.
 expect_ok "viewshed flat" "$dir/vsf.pfm" viewshed "$f" --observer 0,0 -o "$dir/vsf.pfm"
@@ -273,9 +274,9 @@ expect_stdout "visibility --stats: visible" "visible per receiver-direction: 3"
 expect_ok "visibility flat north" "$dir/fvn.pfm" visibility "$f" --dirs 1 --compass -o "$dir/fvn.pfm"
 expect_floats "visibility flat north: y" "$dir/fvn.pfm" 192 0 5 5 5 5 5 5 5 5
 expect_floats "visibility flat north: y (last row)" "$dir/fvn.pfm" 32 0 0 0 0 0 0 0 0 0
-expect_ok "visibility flat --fraction" "$dir/fvf.pfm" visibility "$f" --dirs 1 --fraction -o "$dir/fvf.pfm"
+expect_ok "visibility flat --fraction" "$dir/fvf.pfm" visibility "$f" --dirs 1 --fraction --convention grid -o "$dir/fvf.pfm"
 expect_floats "visibility flat --fraction: 1, 0 where nothing lies behind" "$dir/fvf.pfm" 32 0 1 1 1 1 1 1 1 0
-expect_ok "visibility with a hole" "$dir/fv7.pfm" visibility "$dir/flat7.pgm" --nodata 7 --dirs 1 -o "$dir/fv7.pfm"
+expect_ok "visibility with a hole" "$dir/fv7.pfm" visibility "$dir/flat7.pgm" --nodata 7 --dirs 1 --convention grid -o "$dir/fv7.pfm"
 expect_floats "visibility: the hole is NaN and never seen" "$dir/fv7.pfm" 32 0 nan 6 5 4 3 2 1 0
 
 # ---- failures: one line, non-zero exit, nothing written -----------------------------------
@@ -473,7 +474,9 @@ expect_fail "gi --exact" 2 gi "$h" --exact -o "$fdir/x.pfm"
 # hfvis azimuths: K lines in output-plane order, both modes
 [ "$("$hfvis" azimuths --dirs 4 | tr '\n' ' ')" = "0 90 180 270 " ] && ok "azimuths lattice" || bad "azimuths lattice"
 [ "$("$hfvis" azimuths --dirs 4 --compass --azimuth0 0 | tr '\n' ' ')" = "0 90 180 270 " ] && ok "azimuths --compass" || bad "azimuths --compass"
-[ "$("$hfvis" azimuths --dirs 16 --exact | sed -n 2p)" = "21.801409486351812" ] && ok "azimuths --exact: atan(2/5)" || bad "azimuths --exact: atan(2/5)"
+awk -v v="$("$hfvis" azimuths --dirs 16 --exact | sed -n 2p)" 'BEGIN { exit !(v - 21.801409486351812 < 1e-12 && 21.801409486351812 - v < 1e-12) }' && ok "azimuths --exact: atan(2/5)" || bad "azimuths --exact: atan(2/5)"
+[ "$("$hfvis" azimuths --dirs 4 --convention grass --azimuth0 0 | tr '\n' ' ')" = "0 90 180 270 " ] && ok "azimuths --convention grass" || bad "azimuths --convention grass"
+[ "$("$hfvis" azimuths --dirs 4 --convention grid --azimuth0 0.5 --radians | sed -n 1p)" = "28.647889756541161" ] && ok "azimuths --radians" || bad "azimuths --radians"
 [ "$("$hfvis" azimuths --dirs 64 --exact | wc -l | tr -d ' ')" = 64 ] && ok "azimuths --exact: 64 lines" || bad "azimuths --exact: 64 lines"
 expect_fail "azimuths without --dirs" 2 azimuths --exact
 expect_fail "azimuths --dirs 0" 2 azimuths --dirs 0
@@ -532,6 +535,154 @@ printf 'old\n' > "$dir/keep.pfm"
 "$hfvis" sum "$s0" "$s8" -o "$dir/keep.pfm" 2> /dev/null
 [ "$(cat "$dir/keep.pfm")" = old ] && ok "refused sum keeps the old OUT" || bad "refused sum keeps the old OUT"
 "$hfvis" help sum | grep -q 'PART.hfvs' && ok "help sum" || bad "help sum"
+
+# ---- GIS conventions and commands ---------------------------------------------------------
+# Angle flags in degrees, or radians with --radians; --convention compass (default), grass, grid.
+expect_ok "horizon --azimuth 90 (compass: east)" "$dir/ae.pfm" horizon "$h" --azimuth 90 -o "$dir/ae.pfm"
+expect_ok "horizon --azimuth 1.5707963267948966 --radians" "$dir/aer.pfm" horizon "$h" --azimuth 1.5707963267948966 --radians -o "$dir/aer.pfm"
+cmp -s "$dir/ae.pfm" "$dir/aer.pfm" && ok "degrees = radians, bit for bit" || bad "degrees and radians differ"
+expect_ok "horizon --convention grid --azimuth 0 (east)" "$dir/ag.pfm" horizon "$h" --convention grid --azimuth 0 -o "$dir/ag.pfm"
+cmp -s "$dir/ae.pfm" "$dir/ag.pfm" && ok "compass 90 = grid 0" || bad "compass 90 differs from grid 0"
+expect_ok "horizon --convention grass --azimuth 0 (east)" "$dir/as.pfm" horizon "$h" --convention grass --azimuth 0 -o "$dir/as.pfm"
+cmp -s "$dir/ae.pfm" "$dir/as.pfm" && ok "compass 90 = grass 0" || bad "compass 90 differs from grass 0"
+expect_ok "horizon --convention grass --azimuth 90 (north)" "$dir/an.pfm" horizon "$h" --convention grass --azimuth 90 -o "$dir/an.pfm"
+expect_ok "horizon --azimuth 0 (compass: north)" "$dir/an2.pfm" horizon "$h" --azimuth 0 -o "$dir/an2.pfm"
+cmp -s "$dir/an.pfm" "$dir/an2.pfm" && ok "grass 90 = compass 0" || bad "grass 90 differs from compass 0"
+expect_ok "horizon --convention grid --azimuth -90 (north)" "$dir/an3.pfm" horizon "$h" --convention grid --azimuth -90 -o "$dir/an3.pfm"
+cmp -s "$dir/an.pfm" "$dir/an3.pfm" && ok "grid -90 = compass 0" || bad "grid -90 differs from compass 0"
+expect_ok "shadow --radians" "$dir/shr.pfm" shadow "$h" --sun-azimuth 3.9269908169872414 --sun-elevation 0.17453292519943295 --radians -o "$dir/shr.pfm"
+expect_ok "shadow degrees" "$dir/shd.pfm" shadow "$h" --sun-azimuth 225 --sun-elevation 10 -o "$dir/shd.pfm"
+same_or_ulp "shadow: degrees = radians" "$dir/shd.pfm" "$dir/shr.pfm"
+# --split: one file per direction named by its azimuth; compass planes run clockwise from north,
+# grass planes counter-clockwise from east, so compass _090 (east) is grass _000 and compass _000
+# (north) is grass _090.
+expect_ok "horizon --split (compass)" "$dir/hs_000.pfm" horizon "$h" --dirs 4 --split -o "$dir/hs.pfm"
+for b in 090 180 270; do [ -s "$dir/hs_$b.pfm" ] && ok "--split wrote hs_$b.pfm" || bad "--split: no hs_$b.pfm"; done
+[ ! -e "$dir/hs.pfm" ] && ok "--split writes no stack" || bad "--split wrote the stack"
+expect_ok "horizon --split --convention grass" "$dir/hg_000.pfm" horizon "$h" --dirs 4 --split --convention grass -o "$dir/hg.pfm"
+cmp -s "$dir/hs_090.pfm" "$dir/hg_000.pfm" && ok "east: compass _090 = grass _000" || bad "compass _090 differs from grass _000"
+cmp -s "$dir/hs_000.pfm" "$dir/hg_090.pfm" && ok "north: compass _000 = grass _090" || bad "compass _000 differs from grass _090"
+cmp -s "$dir/hs_000.pfm" "$dir/an2.pfm" && ok "--split plane = --azimuth run" || bad "--split plane differs from the --azimuth run"
+expect_ok "horizon --split 16 directions, PGM" "$dir/hp_022_500.pgm" horizon "$h" --dirs 16 --split -o "$dir/hp.pgm"
+[ -s "$dir/hp_337_500.pgm" ] && ok "--split names 337.5 as _337_500" || bad "--split: no hp_337_500.pgm"
+expect_ok "horizon grass --azimuth 180 (west)" "$dir/hg1.pfm" horizon "$h" --convention grass --azimuth 180 -o "$dir/hg1.pfm"
+cmp -s "$dir/hg_180.pfm" "$dir/hg1.pfm" && ok "grass _180 = --azimuth 180 (west)" || bad "grass _180 differs"
+expect_fail "--math is gone, loudly" 2 shadow "$h" --math --sun-azimuth 1 --sun-elevation 1 -o "$o"
+expect_fail "--convention math" 2 skyview "$h" --convention math -o "$o"
+expect_fail "--convention foo" 2 skyview "$h" --convention foo -o "$o"
+expect_fail "--azimuth with --dirs 4" 2 horizon "$h" --azimuth 10 --dirs 4 -o "$o"
+expect_fail "--azimuth with --azimuth0" 2 horizon "$h" --azimuth 10 --azimuth0 3 -o "$o"
+expect_fail "--split with --dir-range" 2 horizon "$h" --split --dir-range 0:4 -o "$fdir/x.hfvs"
+expect_fail "--sun-elevation 2 rad" 2 shadow "$h" --sun-azimuth 1 --sun-elevation 2 --radians -o "$o"
+expect_fail "--compass with --convention grass" 2 skyview "$h" --convention grass --compass -o "$o"
+
+# V valley z = |x - 20| on 41 x 41 (cell 1): closed forms for hillshade, SAGA's SVF and openness
+# (checked on the last row and at the centre, 841 floats before the end).
+awk 'BEGIN { print "P2 41 41 255"; for (y = 0; y < 41; y++) { s = ""; for (x = 0; x < 41; x++) s = s " " (x < 20 ? 20 - x : x - 20); print s } }' > "$dir/vv.pgm"
+# hillshade: sun in the east, tan(elevation) = 1/2. The west slope (normal (1,0,1)/sqrt2) gets
+# n.l = (cos e + sin e)/sqrt2 = 0.948683 where lit; a point a cells west of the floor sees the
+# east rim 20 cells east of the floor at tan = (20 - a)/(20 + a): in shadow for a <= 6 and on the
+# floor; the east slope faces away (0).
+expect_ok "hillshade V valley" "$dir/hv.pfm" hillshade "$dir/vv.pgm" --sun-azimuth 90 --sun-elevation 26.565051177077990 -o "$dir/hv.pfm"
+expect_floats "hillshade V valley: lit x <= 13, cast shadow 14..20" "$dir/hv.pfm" 164 1e-5 \
+  0.948683 0.948683 0.948683 0.948683 0.948683 0.948683 0.948683 0.948683 0.948683 0.948683 \
+  0.948683 0.948683 0.948683 0.948683 0 0 0 0 0 0 0 0 0
+expect_ok "hillshade V valley --no-shadows --blend 2" "$dir/hv2.pfm" hillshade "$dir/vv.pgm" --sun-azimuth 90 --sun-elevation 26.565051177077990 --no-shadows --blend 2 -o "$dir/hv2.pfm"
+expect_floats "hillshade --blend 2 (east + west) without shadows: half of each slope's n.l" "$dir/hv2.pfm" 88 1e-5 \
+  0.474342 0.447214 0.474342 0.474342 0.474342
+expect_ok "hillshade flat, 4 suns, soft" "$dir/hf.pfm" hillshade "$f" --blend 4 --sun-radius 0.27 -o "$dir/hf.pfm"
+expect_floats "hillshade flat = sin 45 deg" "$dir/hf.pfm" 8 1e-6 0.707107 0.707107
+# SAGA's SVF with K = 4 (axis directions: the sweep is exact there). On the valley floor (the
+# centre) the horizons are 0 (N, S) and 45 deg (E, W): saga 1 - (1/4)(1/2 + 1/2) = 0.75, visible
+# (1/4)(1 + 1/2 + 1 + 1/2) = 0.75, Zaksek 1 - (1/4)(2 sin 45) = 0.646447. On the west slope 10 cells
+# from the floor (normal (1,0,1)/sqrt2, 851 floats before the end): N, S 0, W 45 deg, E atan(1/3)
+# (the far rim): saga (1/4)[2 n_z + n_z cos^2 phi_E + n_x (pi/2 - phi_E - sin cos) + n_z/2
+# - n_x (pi/4 - 1/2)] = 0.718358 (the slope term of SAGA's formula), visible 0.823792,
+# Zaksek 0.744166.
+expect_ok "skyview --svf saga" "$dir/sv_saga.pfm" skyview "$dir/vv.pgm" --dirs 4 --svf saga -o "$dir/sv_saga.pfm"
+expect_floats "skyview --svf saga, valley floor" "$dir/sv_saga.pfm" 3364 1e-6 0.75
+expect_floats "skyview --svf saga, west slope" "$dir/sv_saga.pfm" 3404 1e-6 0.718358
+expect_ok "skyview --svf visible" "$dir/sv_vis.pfm" skyview "$dir/vv.pgm" --dirs 4 --svf visible -o "$dir/sv_vis.pfm"
+expect_floats "skyview --svf visible, valley floor" "$dir/sv_vis.pfm" 3364 1e-6 0.75
+expect_floats "skyview --svf visible, west slope" "$dir/sv_vis.pfm" 3404 1e-6 0.823792
+expect_ok "skyview (Zaksek)" "$dir/sv_z.pfm" skyview "$dir/vv.pgm" --dirs 4 -o "$dir/sv_z.pfm"
+expect_floats "skyview Zaksek, valley floor" "$dir/sv_z.pfm" 3364 1e-6 0.646447
+expect_floats "skyview Zaksek, west slope" "$dir/sv_z.pfm" 3404 1e-6 0.744166
+expect_ok "skyview --svf saga flat" "$dir/sv_sf.pfm" skyview "$f" --svf saga -o "$dir/sv_sf.pfm"
+expect_floats "skyview --svf saga flat = 1" "$dir/sv_sf.pfm" 8 1e-6 1 1
+expect_fail "--svf saga with --dir-range" 2 skyview "$h" --svf saga --dir-range 0:4 -o "$fdir/x.hfvs"
+# openness on the valley floor: K = 8 within 5 cells (the ray march; diagonals rise at
+# atan(1/sqrt2) = 35.2644 deg): positive 90 - (2*45 + 4*35.2644)/8 = 61.1178 deg, negative
+# 90 + 28.8822 = 118.8822 deg; unlimited (the sweep), K = 4: 90 - 90/4 = 67.5 deg.
+expect_ok "openness --radius 5" "$dir/op5.pfm" openness "$dir/vv.pgm" --radius 5 --degrees -o "$dir/op5.pfm"
+expect_floats "openness positive, radius 5, valley floor" "$dir/op5.pfm" 3364 1e-3 61.1178
+expect_ok "openness unlimited" "$dir/op0.pfm" openness "$dir/vv.pgm" --dirs 4 --degrees -o "$dir/op0.pfm"
+expect_floats "openness positive, unlimited, valley floor" "$dir/op0.pfm" 3364 1e-4 67.5
+expect_ok "openness --negative --radius 5" "$dir/on5.pfm" openness "$dir/vv.pgm" --negative --radius 5 --degrees -o "$dir/on5.pfm"
+expect_floats "openness negative, valley floor" "$dir/on5.pfm" 3364 1e-3 118.8822
+expect_ok "openness flat, clamp" "$dir/opf.pfm" openness "$f" --radius 3 --border clamp -o "$dir/opf.pfm"
+expect_floats "openness of a plane = pi/2" "$dir/opf.pfm" 8 1e-6 1.570796 1.570796
+
+# viewshed: map coordinates (X = column * cell), the observer on NoData, --target, curvature.
+expect_ok "viewshed --observer in map units" "$dir/vmap.pfm" viewshed "$h" --cell 2 --observer 7,4 -o "$dir/vmap.pfm"
+expect_ok "viewshed --observer-grid" "$dir/vgrid.pfm" viewshed "$h" --cell 2 --observer-grid 3.5,2 -o "$dir/vgrid.pfm"
+cmp -s "$dir/vmap.pfm" "$dir/vgrid.pfm" && ok "viewshed: map 7,4 at cell 2 = grid 3.5,2" || bad "viewshed map and grid observers differ"
+expect_fail "viewshed observer on NoData" 1 viewshed "$dir/flat7.pgm" --nodata 7 --observer 0,0 -o "$o"
+grep -q 'NoData' "$dir/stderr" && ok "viewshed: NoData observer named" || bad "viewshed: NoData observer not named"
+expect_fail "viewshed observer outside" 1 viewshed "$f" --observer 8,0 -o "$o"
+expect_fail "--refraction without --curvature" 2 viewshed "$f" --observer 0,0 --refraction 0.2 -o "$o"
+# A flat 300 x 1 field, 100 m cells, eye 10 m up: the horizon is at sqrt(2 R h/(1 - k)) =
+# 12102 m (k = 0.13) or 11288 m (k = 0): on the samples, the last visible one is column 121 (113).
+awk 'BEGIN { print "P2 300 1 255"; for (x = 0; x < 300; x++) print 0 }' > "$dir/line.pgm"
+expect_ok "viewshed flat, no curvature" "$dir/vc0.pfm" viewshed "$dir/line.pgm" --cell 100 --observer 0,0 --observer-height 10 -o "$dir/vc0.pfm"
+expect_floats "viewshed flat without curvature sees everything" "$dir/vc0.pfm" 8 0 1 1
+expect_ok "viewshed --curvature" "$dir/vc.pfm" viewshed "$dir/line.pgm" --cell 100 --observer 0,0 --observer-height 10 --curvature --target 12100,0 --target 12200,0 --target 99999,0 -o "$dir/vc.pfm"
+expect_floats "viewshed --curvature (k = 0.13): horizon after column 121" "$dir/vc.pfm" 720 0 1 1 0 0
+expect_stdout "viewshed --target visible" "target 12100,0 (column 121, row 0): visible"
+expect_stdout "viewshed --target hidden" "target 12200,0 (column 122, row 0): hidden"
+expect_stdout "viewshed --target outside" "target 99999,0 (column -1, row -1): outside the grid"
+expect_ok "viewshed --curvature --refraction 0" "$dir/vc00.pfm" viewshed "$dir/line.pgm" --cell 100 --observer 0,0 --observer-height 10 --curvature --refraction 0 --exact -o "$dir/vc00.pfm"
+expect_floats "viewshed --curvature (k = 0): horizon after column 113" "$dir/vc00.pfm" 752 0 1 1 0 0
+
+# PGM outputs: code 0 is NoData, 1..65535 the range, recorded in the header comment.
+expect_ok "skyview PGM with a hole" "$dir/nd.pgm" skyview "$dir/flat7.pgm" --nodata 7 -o "$dir/nd.pgm"
+[ "$(head -c 3 "$dir/nd.pgm" | od -An -c | tr -d ' ')" = 'P5\n' ] &&
+  sed -n 2p "$dir/nd.pgm" | grep -qx '# hfvis range 0.00000000e+00 1.00000000e+00 nodata 0' &&
+  ok "PGM range comment" || bad "PGM range comment: $(head -c 80 "$dir/nd.pgm" | tr '\n' '|')"
+size=$(wc -c < "$dir/nd.pgm" | tr -d ' ')
+first=$(od -An -tx1 -j $((size - 96)) -N 4 "$dir/nd.pgm" | tr -s ' ' | sed 's/^ //; s/ $//')
+[ "$first" = "00 00 ff ff" ] && ok "PGM: NoData is code 0, SVF 1 is 65535" || bad "PGM NoData codes: '$first'"
+expect_ok "horizon PGM --degrees south: -90 deg is code 1, not NoData" "$dir/hd.pgm" horizon "$f" --azimuth 180 --degrees -o "$dir/hd.pgm"
+expect_bytes "horizon PGM: the open border (-90) is code 1" "$dir/hd.pgm" 2 "00 01"
+
+# Never destroy an input: the same file through a hard link or a symbolic link is refused.
+cp "$h" "$dir/in.pgm"; cp "$h" "$dir/in_copy.pgm"
+ln "$dir/in.pgm" "$dir/in_hard.pgm" 2> /dev/null
+ln -s "$dir/in.pgm" "$dir/in_sym.pgm" 2> /dev/null
+expect_fail "same file as the input" 1 skyview "$dir/in.pgm" -o "$dir/in.pgm"
+grep -q 'refusing to replace an input' "$dir/stderr" && ok "same-file refusal names the reason" || bad "same-file refusal message"
+if [ -f "$dir/in_hard.pgm" ]; then expect_fail "output is a hard link to the input" 1 skyview "$dir/in.pgm" -o "$dir/in_hard.pgm"
+else ok "hard link: skipped (no ln)"; fi
+if [ -L "$dir/in_sym.pgm" ]; then expect_fail "output is a symbolic link to the input" 1 skyview "$dir/in.pgm" -o "$dir/in_sym.pgm"
+else ok "symbolic link: skipped (no ln -s)"; fi
+expect_fail "output is the albedo map" 1 indirect "$f" --albedo-map "$dir/alb51.pgm" -o "$dir/alb51.pgm"
+cmp -s "$dir/in.pgm" "$dir/in_copy.pgm" && ok "refused runs leave the input intact" || bad "the input changed"
+ln -s "$s0" "$dir/part_as_out.pfm" 2> /dev/null
+if [ -L "$dir/part_as_out.pfm" ]; then expect_fail "sum: output is a part" 1 sum "$s0" "$s4" "$s8" "$s12" -o "$dir/part_as_out.pfm"
+else ok "sum same file: skipped (no ln -s)"; fi
+cp "$dir/vv.pgm" "$dir/ow.pgm"
+if "$hfvis" hillshade "$dir/ow.pgm" --overwrite -o "$dir/ow.pgm" 2> "$dir/stderr" && ! cmp -s "$dir/ow.pgm" "$dir/vv.pgm"
+then ok "--overwrite replaces the input"; else bad "--overwrite: $(cat "$dir/stderr")"; fi
+
+# --progress: plain lines with percent and ETA, and the summary line.
+if "$hfvis" skyview "$h" --dirs 16 --progress -o "$dir/pr.pfm" > "$dir/stdout" 2> "$dir/stderr" &&
+   grep -q '^hfvis skyview: 100% (16/16)' "$dir/stderr" &&
+   grep -q '^hfvis skyview: done in [0-9.]* s: 480 cells, 16 directions -> ' "$dir/stderr" &&
+   ! grep -q "$(printf '\r')" "$dir/stderr"
+then ok "--progress lines and summary"; else bad "--progress: $(cat "$dir/stderr")"; fi
+if "$hfvis" skyview "$h" --dirs 16 --progress --quiet -o "$dir/pr.pfm" 2> "$dir/stderr" && [ ! -s "$dir/stderr" ]
+then ok "--quiet silences --progress"; else bad "--quiet with --progress: $(cat "$dir/stderr")"; fi
+
 
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"

@@ -58,6 +58,11 @@ run_all() {
     "indirect.pfm"    "indirect $i/hill.pgm --zscale 0.002 --sun-azimuth 200 --sun-elevation 25 --bounces 2 --dirs 8" \
     "visibility.pfm"  "visibility $i/hill.pgm --zscale 0.002 --dirs 8 --fraction" \
     "viewshed.pfm"    "viewshed $i/hill.pgm --zscale 0.002 --observer 20,30 --observer-height 2" \
+    "viewshed_c.pfm"  "viewshed $i/hill.pgm --zscale 0.002 --cell 50 --observer 1000,1500 --observer-height 2 --curvature" \
+    "hillshade.pfm"   "hillshade $i/hill.pgm --zscale 0.002 --blend 3 --sun-radius 0.5" \
+    "openness.pfm"    "openness $i/hill.pgm --zscale 0.002 --radius 12 --negative" \
+    "openness_0.pfm"  "openness $i/hill.pgm --zscale 0.002 --dirs 12" \
+    "svf_saga.pfm"    "skyview $i/hill.pgm --zscale 0.002 --svf saga" \
     "gi.pfm"          "gi $i/hill.pgm --zscale 0.002 --sun-azimuth 135 --sun-elevation 30 --specular 0.2 --bounces 2" \
     "ssao_lsao.pfm"   "ssao $i/depth.pgm --method lsao --fov-y 60 --radius 20" \
     "ssao_hbao.pfm"   "ssao $i/depth.pgm --method hbao --fov-y 60 --radius 20" \

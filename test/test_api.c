@@ -328,6 +328,91 @@ TEST(pgm_encode_mapping)
     }
 }
 
+TEST(pgm_range_nodata_round_trip)
+{
+    /* NoData-safe PGM: code 0 = NoData, codes 1..65535 span [lo, hi], the range in the header
+     * comment. Values come back within half a code step; NaN and +-Inf come back NaN. */
+    const float img[8] = {-1.0f, 1.0f, 0.0f, 2.0f, -5.0f, NAN, INFINITY, -INFINITY};
+    const float codes[8] = {1, 65535, 32768, 65535, 1, 0, 0, 0};
+    const double step = 2.0 / HFVIS_PGM_RANGE_CODES; /* one code, (hi - lo)/65534 */
+    unsigned char enc[CODEC_MAX_BYTES];
+    float back[8], lo = 0.0f, hi = 0.0f;
+    hfvis_image_info info;
+    size_t written = 0, i;
+    const char *comment = "P5\n# hfvis range -1.00000000e+00 1.00000000e+00 nodata 0\n4 2\n65535\n";
+    CHECK(hfvis_pgm_range_encode_size(4, 2, -1.0f, 1.0f) == strlen(comment) + 16);
+    CHECK_EQ_STATUS(hfvis_pgm_range_encode(img, 4, 2, 4, -1.0f, 1.0f, enc, sizeof enc, &written),
+                    HFVIS_OK);
+    CHECK(written == strlen(comment) + 16 && memcmp(enc, comment, strlen(comment)) == 0);
+    check_decode(enc, written, HFVIS_FORMAT_PGM, 4, 2, 1, 65535, 0, codes); /* plain readers */
+    CHECK_EQ_STATUS(hfvis_pgm_range_read(enc, written, &lo, &hi), HFVIS_OK);
+    CHECK(lo == -1.0f && hi == 1.0f);
+    CHECK_EQ_STATUS(hfvis_pgm_range_decode(enc, written, back, 8, &info), HFVIS_OK);
+    CHECK(info.width == 4 && info.height == 2);
+    CHECK_NEAR(back[0], -1.0, 0.0, 0.0);
+    CHECK_NEAR(back[1], 1.0, 1e-6, 0.0);
+    CHECK_NEAR(back[2], 0.0, 0.5 * step, 0.0);
+    CHECK_NEAR(back[3], 1.0, 1e-6, 0.0); /* clamped */
+    for (i = 5; i < 8; i++) CHECK(isnan(back[i]));
+    /* seeded random values and ranges: every float range survives the 9-digit text, every value
+     * comes back within half a step */
+    {
+        uint32_t state = 12345u;
+        int r;
+        for (r = 0; r < 200; r++) {
+            float v[8], a, b;
+            double e;
+            state = state * 1664525u + 1013904223u;
+            memcpy(&a, &state, 4);
+            state = state * 1664525u + 1013904223u;
+            memcpy(&b, &state, 4);
+            if (!isfinite(a) || !isfinite(b) || a == b || fabsf(a) > 1e30f || fabsf(b) > 1e30f) continue;
+            if (a > b) { float t = a; a = b; b = t; }
+            for (i = 0; i < 8; i++) {
+                state = state * 1664525u + 1013904223u;
+                v[i] = (float)((double)a + ((double)b - (double)a) * (double)(state >> 8) / 16777216.0);
+            }
+            CHECK_EQ_STATUS(hfvis_pgm_range_encode(v, 8, 1, 8, a, b, enc, sizeof enc, &written), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_pgm_range_read(enc, written, &lo, &hi), HFVIS_OK);
+            CHECK(lo == a && hi == b);
+            CHECK_EQ_STATUS(hfvis_pgm_range_decode(enc, written, back, 8, NULL), HFVIS_OK);
+            e = ((double)b - (double)a) / HFVIS_PGM_RANGE_CODES;
+            for (i = 0; i < 8; i++) CHECK_NEAR(back[i], v[i], 0.5 * e + 1e-6 * fabs((double)v[i]), 0.0);
+        }
+    }
+    /* old files (no comment), PFM, a damaged comment: HFVIS_ERR_FORMAT; bad arguments */
+    CHECK_EQ_STATUS(hfvis_pgm_encode(img, 4, 2, 4, -1.0f, 1.0f, 65535, enc, sizeof enc, &written), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_pgm_range_read(enc, written, &lo, &hi), HFVIS_ERR_FORMAT);
+    CHECK_EQ_STATUS(hfvis_pgm_range_decode(enc, written, back, 8, NULL), HFVIS_ERR_FORMAT);
+    CHECK_EQ_STATUS(hfvis_pfm_encode(img, 4, 2, 1, 4, enc, sizeof enc, &written), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_pgm_range_read(enc, written, &lo, &hi), HFVIS_ERR_FORMAT);
+    {
+        char bad[128];
+        size_t n = (size_t)snprintf(bad, sizeof bad, "P2\n# hfvis range 1 x nodata 0\n1 1 9\n3\n");
+        CHECK_EQ_STATUS(hfvis_pgm_range_read(bad, n, &lo, &hi), HFVIS_ERR_FORMAT);
+        n = (size_t)snprintf(bad, sizeof bad, "P2\n# hfvis range 2 1 nodata 0\n1 1 9\n3\n");
+        CHECK_EQ_STATUS(hfvis_pgm_range_read(bad, n, &lo, &hi), HFVIS_ERR_FORMAT); /* lo > hi */
+        n = (size_t)snprintf(bad, sizeof bad, "P2\n# hfvis range 1 2\n1 1 9\n3\n");
+        CHECK_EQ_STATUS(hfvis_pgm_range_read(bad, n, &lo, &hi), HFVIS_ERR_FORMAT); /* no nodata */
+        n = (size_t)snprintf(bad, sizeof bad, "P2 1 1 9\n# hfvis range 0 9 nodata 0\n3\n");
+        CHECK_EQ_STATUS(hfvis_pgm_range_read(bad, n, &lo, &hi), HFVIS_ERR_FORMAT); /* in the data */
+        n = (size_t)snprintf(bad, sizeof bad, "P2 # hfvis range 0 9 nodata 0\n1 1 9\n3\n");
+        CHECK_EQ_STATUS(hfvis_pgm_range_read(bad, n, &lo, &hi), HFVIS_OK);
+        CHECK(lo == 0.0f && hi == 9.0f);
+        CHECK_EQ_STATUS(hfvis_pgm_range_decode(bad, n, back, 1, NULL), HFVIS_OK);
+        CHECK_NEAR(back[0], 2.0 * 9.0 / HFVIS_PGM_RANGE_CODES, 1e-7, 0.0);
+        CHECK_EQ_STATUS(hfvis_pgm_range_decode(bad, n, back, 0, NULL), HFVIS_ERR_BUFFER_TOO_SMALL);
+    }
+    CHECK(hfvis_pgm_range_encode_size(4, 2, 1.0f, 1.0f) == 0);
+    CHECK(hfvis_pgm_range_encode_size(4, 2, 0.0f, INFINITY) == 0);
+    CHECK(hfvis_pgm_range_encode_size(0, 2, 0.0f, 1.0f) == 0);
+    CHECK_EQ_STATUS(hfvis_pgm_range_encode(img, 4, 2, 3, 0.0f, 1.0f, enc, sizeof enc, &written),
+                    HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_pgm_range_encode(img, 4, 2, 4, 0.0f, 1.0f, enc, 10, &written),
+                    HFVIS_ERR_BUFFER_TOO_SMALL);
+    CHECK_EQ_STATUS(hfvis_pgm_range_read(NULL, 4, &lo, &hi), HFVIS_ERR_INVALID_ARGUMENT);
+}
+
 TEST(codec_round_trip_integers)
 {
     /* Integers 0..maxval survive P5 encode (lo = 0, hi = maxval) -> decode exactly. */
@@ -654,6 +739,16 @@ TEST(files_save_and_load)
     CHECK(info.maxval == 255 && info.width == 2 && info.height == 1);
     CHECK(px && px[0] == 0.0f && px[1] == (float)round(255.0 / 11.0));
     hfvis_free(NULL, px);
+    /* the NoData-safe PGM with its range: the file is its encoding, and decodes back */
+    img[0] = NAN;
+    CHECK_EQ_STATUS(hfvis_pgm_range_save(path2, img, 3, 4, 3, 0.0f, 1.0f), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_pgm_range_encode(img, 3, 4, 3, 0.0f, 1.0f, enc, sizeof enc, &written), HFVIS_OK);
+    CHECK(read_bytes(path2, file, sizeof file) == written && memcmp(file, enc, written) == 0);
+    CHECK_EQ_STATUS(hfvis_image_load(path2, NULL, &px, &info), HFVIS_OK);
+    CHECK(info.maxval == 65535 && px && px[0] == (float)HFVIS_PGM_NODATA_CODE && px[11] == 65535.0f);
+    hfvis_free(NULL, px);
+    CHECK_EQ_STATUS(hfvis_pgm_range_save(path2, img, 3, 4, 3, 1.0f, 0.0f), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_pgm_range_save(NULL, img, 3, 4, 3, 0.0f, 1.0f), HFVIS_ERR_INVALID_ARGUMENT);
     /* nothing but the two files is left behind */
     CHECK(test_dir_entries(test_dir) == 2);
     CHECK(remove(path) == 0 && remove(path2) == 0);
@@ -963,6 +1058,7 @@ int main(int argc, char **argv)
     RUN(pfm_header_spellings);
     RUN(pgm_decode_ascii_and_binary);
     RUN(pgm_encode_mapping);
+    RUN(pgm_range_nodata_round_trip);
     RUN(codec_round_trip_integers);
     RUN(codec_truncated_at_every_length);
     RUN(codec_bad_magic);

@@ -57,6 +57,11 @@
     X(image_load, S, A, "NR", "INVALID_ARGUMENT IO") \
     X(pfm_save, S, M, "NZGR", "INVALID_ARGUMENT IO") \
     X(pgm_save, S, M, "NZGFR", "INVALID_ARGUMENT IO") \
+    X(pgm_range_encode_size, V, -, "ZGFR", "0") \
+    X(pgm_range_encode, S, -, "NZGFR", "INVALID_ARGUMENT BUFFER_TOO_SMALL") \
+    X(pgm_range_save, S, M, "NZGFR", "INVALID_ARGUMENT IO") \
+    X(pgm_range_read, S, -, "NZOR", "INVALID_ARGUMENT FORMAT LIMIT") \
+    X(pgm_range_decode, S, -, "NZOR", "INVALID_ARGUMENT FORMAT LIMIT BUFFER_TOO_SMALL") \
     X(field_height, V, -, "NFES", "NaN") \
     X(field_generate, S, -, "NZGOFESR", "INVALID_ARGUMENT") \
     X(grid_sample, V, -, "NZF", "NaN") \
@@ -73,6 +78,7 @@
     X(horizon_map, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(horizon_reference, S, -, "NZGOFESR", "INVALID_ARGUMENT") \
     X(horizon_reference_fn, S, -, "NZGFES", "INVALID_ARGUMENT") \
+    X(openness, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(sweep_azimuths, S, A, "NZGES", "INVALID_ARGUMENT") \
     X(horizon_exact_naive, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(sector_weight, V, -, "ZGF", "NaN") \
@@ -748,6 +754,88 @@ static void args_pgm_save(void)
     BADV('R', access(tmp_path("t.pgm"), F_OK) != 0);
 }
 
+static const char pgm_range_ok[] = "P2\n# hfvis range 0 2 nodata 0\n2 1 65535\n0 65535\n";
+
+static void args_pgm_range_encode_size(void)
+{
+    begin("pgm_range_encode_size");
+    CHECK(hfvis_pgm_range_encode_size(2, 1, 0.0f, 2.0f) > 0);
+    BADV('Z', hfvis_pgm_range_encode_size(0, 1, 0.0f, 2.0f) == 0);
+    BADV('G', hfvis_pgm_range_encode_size(2, -1, 0.0f, 2.0f) == 0);
+    BADV('F', hfvis_pgm_range_encode_size(2, 1, (float)NAN, 2.0f) == 0);
+    BADV('F', hfvis_pgm_range_encode_size(2, 1, 0.0f, (float)INFINITY) == 0);
+    BADV('R', hfvis_pgm_range_encode_size(2, 1, 2.0f, 2.0f) == 0);
+}
+
+static void args_pgm_range_encode(void)
+{
+    static const float px[2] = {1.0f, 2.0f};
+    size_t need = hfvis_pgm_range_encode_size(2, 1, 0.0f, 2.0f), *wr;
+    unsigned char *out;
+    begin("pgm_range_encode");
+    out = ATN(unsigned char, need);
+    wr = AT(size_t);
+    OK(hfvis_pgm_range_encode(px, 2, 1, 2, 0.0f, 2.0f, out, need, wr));
+    BAD('N', INV, hfvis_pgm_range_encode(NULL, 2, 1, 2, 0.0f, 2.0f, out, need, wr));
+    BAD('N', INV, hfvis_pgm_range_encode(px, 2, 1, 2, 0.0f, 2.0f, NULL, need, wr));
+    BAD('N', INV, hfvis_pgm_range_encode(px, 2, 1, 2, 0.0f, 2.0f, out, need, NULL));
+    BAD('Z', INV, hfvis_pgm_range_encode(px, 0, 1, 2, 0.0f, 2.0f, out, need, wr));
+    BAD('G', INV, hfvis_pgm_range_encode(px, 2, -1, 2, 0.0f, 2.0f, out, need, wr));
+    BAD('R', INV, hfvis_pgm_range_encode(px, 2, 1, 1, 0.0f, 2.0f, out, need, wr));
+    BAD('F', INV, hfvis_pgm_range_encode(px, 2, 1, 2, (float)NAN, 2.0f, out, need, wr));
+    BAD('R', INV, hfvis_pgm_range_encode(px, 2, 1, 2, 2.0f, 2.0f, out, need, wr));
+    BAD('R', SMALL, hfvis_pgm_range_encode(px, 2, 1, 2, 0.0f, 2.0f, out, need - 1, wr));
+    BAD('Z', SMALL, hfvis_pgm_range_encode(px, 2, 1, 2, 0.0f, 2.0f, out, 0, wr));
+}
+
+static void args_pgm_range_save(void)
+{
+    static const float px[2] = {1.0f, 2.0f};
+    begin("pgm_range_save");
+    OK(hfvis_pgm_range_save(tmp_path("r.pgm"), px, 2, 1, 2, 0.0f, 2.0f));
+    BAD('N', INV, hfvis_pgm_range_save(NULL, px, 2, 1, 2, 0.0f, 2.0f));
+    BAD('N', INV, hfvis_pgm_range_save(tmp_path("u.pgm"), NULL, 2, 1, 2, 0.0f, 2.0f));
+    BAD('Z', INV, hfvis_pgm_range_save(tmp_path("u.pgm"), px, 0, 1, 2, 0.0f, 2.0f));
+    BAD('G', INV, hfvis_pgm_range_save(tmp_path("u.pgm"), px, 2, -1, 2, 0.0f, 2.0f));
+    BAD('F', INV, hfvis_pgm_range_save(tmp_path("u.pgm"), px, 2, 1, 2, (float)NAN, 2.0f));
+    BAD('R', INV, hfvis_pgm_range_save(tmp_path("u.pgm"), px, 2, 1, 1, 0.0f, 2.0f));
+    BAD('R', IOE, hfvis_pgm_range_save(bad_dir_path("u.pgm"), px, 2, 1, 2, 0.0f, 2.0f));
+    BADV('R', access(tmp_path("u.pgm"), F_OK) != 0);
+}
+
+static void args_pgm_range_read(void)
+{
+    float *lo, *hi;
+    begin("pgm_range_read");
+    lo = AT(float);
+    hi = AT(float);
+    OK(hfvis_pgm_range_read(pgm_range_ok, sizeof pgm_range_ok - 1, lo, hi));
+    BAD('N', INV, hfvis_pgm_range_read(NULL, 10, lo, hi));
+    BAD('N', INV, hfvis_pgm_range_read(pgm_range_ok, sizeof pgm_range_ok - 1, NULL, hi));
+    BAD('N', INV, hfvis_pgm_range_read(pgm_range_ok, sizeof pgm_range_ok - 1, lo, NULL));
+    BAD('Z', FMT, hfvis_pgm_range_read(pgm_range_ok, 0, lo, hi));
+    BAD('R', FMT, hfvis_pgm_range_read(pgm_ok, sizeof pgm_ok - 1, lo, hi)); /* no range comment */
+    BAD('O', LIM, hfvis_pgm_range_read(pgm_huge, sizeof pgm_huge - 1, lo, hi));
+}
+
+static void args_pgm_range_decode(void)
+{
+    hfvis_image_info *info;
+    float *out;
+    begin("pgm_range_decode");
+    info = AT(hfvis_image_info);
+    out = AF(2);
+    OK(hfvis_pgm_range_decode(pgm_range_ok, sizeof pgm_range_ok - 1, out, 2, info));
+    OK(hfvis_pgm_range_decode(pgm_range_ok, sizeof pgm_range_ok - 1, out, 2, NULL));
+    BAD('N', INV, hfvis_pgm_range_decode(NULL, 10, out, 2, info));
+    BAD('N', INV, hfvis_pgm_range_decode(pgm_range_ok, sizeof pgm_range_ok - 1, NULL, 2, info));
+    BAD('Z', FMT, hfvis_pgm_range_decode(pgm_range_ok, 0, out, 2, info));
+    BAD('Z', SMALL, hfvis_pgm_range_decode(pgm_range_ok, sizeof pgm_range_ok - 1, out, 0, info));
+    BAD('R', SMALL, hfvis_pgm_range_decode(pgm_range_ok, sizeof pgm_range_ok - 1, out, 1, info));
+    BAD('R', FMT, hfvis_pgm_range_decode(pgm_ok, sizeof pgm_ok - 1, out, 2, info));
+    BAD('O', LIM, hfvis_pgm_range_decode(pgm_huge, sizeof pgm_huge - 1, out, 2, info));
+}
+
 static hfvis_field field_ok(void)
 {
     hfvis_field f;
@@ -997,6 +1085,33 @@ static void args_horizon_reference_fn(void)
     BAD('F', INV, hfvis_horizon_reference_fn(plane_fn, NULL, GW, GH, (double)NAN, 4, NULL, NULL, pts, 2, out));
     BAD('Z', INV, hfvis_horizon_reference_fn(plane_fn, NULL, GW, GH, 1.0, 0, NULL, NULL, pts, 2, out));
     SWEEP_OPT_CASES(hfvis_horizon_reference_fn(plane_fn, NULL, GW, GH, 1.0, 4, &bo, NULL, pts, 2, out));
+}
+
+static void args_openness(void)
+{
+    hfvis_openness_options oo;
+    float *out;
+    begin("openness");
+    out = AF(GW * GH);
+    memset(&oo, 0, sizeof oo);
+    OK(hfvis_openness(&g_ok, 4, NULL, NULL, out, GW));
+    oo.radius = 2.0;
+    oo.negative = 1;
+    OK(hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
+    BAD('N', INV, hfvis_openness(NULL, 4, NULL, NULL, out, GW));
+    BAD('N', INV, hfvis_openness(&g_ok, 4, NULL, NULL, NULL, GW));
+    BAD('Z', INV, hfvis_openness(&g_ok, 0, NULL, NULL, out, GW));
+    BAD('G', INV, hfvis_openness(&g_ok, -4, NULL, NULL, out, GW));
+    BAD('R', INV, hfvis_openness(&g_ok, 4, NULL, NULL, out, GW - 1));
+    BAD('O', INV, hfvis_openness(&g_ok, 4, NULL, NULL, out, PTRDIFF_MAX));
+    oo.radius = -1.0; BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
+    oo.radius = (double)NAN; BAD('F', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
+    oo.radius = (double)INFINITY; BAD('F', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
+    oo.radius = 1.0; oo.step_cells = -1.0; BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
+    oo.step_cells = (double)NAN; BAD('F', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
+    oo.step_cells = 0.0; oo.negative = 2; BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
+    GRID_CASES(hfvis_openness(&bg, 4, NULL, NULL, out, GW));
+    SWEEP_OPT_CASES(hfvis_openness(&g_ok, 4, NULL, &bo, out, GW));
 }
 
 static void args_sweep_azimuths(void)
@@ -5684,6 +5799,7 @@ SW(horizon_lattice_naive)
     return hfvis_horizon_lattice_naive(&g_ok, 0.3, &o, AF(hfvis_lattice_size(&L)));
 }
 SW(horizon_direction) { hfvis_sweep_options o = sweep_opts(al); return hfvis_horizon_direction(&g_ok, 4, 1, &o, AF(GW * GH), GW); }
+SW(openness) { hfvis_sweep_options o = sweep_opts(al); return hfvis_openness(&g_ok, 4, NULL, &o, AF(GW * GH), GW); }
 SW(horizon_map) { hfvis_sweep_options o = sweep_opts(al); return hfvis_horizon_map(&g_ok, 4, &o, AF(4 * GW * GH)); }
 /* exact rays: the same calls through the exact-mode paths */
 static hfvis_sweep_options exact_opts(const hfvis_allocator *al)
@@ -6275,6 +6391,7 @@ typedef struct sweep_entry {
 
 static const sweep_entry sweeps[] = {
     SWEEP(image_load), SWEEP(horizon_lattice), SWEEP(horizon_lattice_naive), SWEEP(horizon_direction),
+    SWEEP(openness),
     SWEEP(horizon_map), SWEEP(sky_light), SWEEP(sky_light_from_map), SWEEP(sky_view_factor),
     SWEEP(sweep_azimuths), SWEEP(horizon_exact_naive), SWEEP_VARIANT(horizon_map, horizon_map_exact),
     SWEEP_VARIANT(horizon_direction, horizon_direction_exact), SWEEP_VARIANT(sky_light, sky_light_exact),
@@ -6371,6 +6488,11 @@ static hfvis_status io_pgm_save(const char *path)
     static const float px[2] = {1.0f, 2.0f};
     return hfvis_pgm_save(path, px, 2, 1, 2, 0.0f, 2.0f, 255);
 }
+static hfvis_status io_pgm_range_save(const char *path)
+{
+    static const float px[2] = {1.0f, (float)NAN};
+    return hfvis_pgm_range_save(path, px, 2, 1, 2, 0.0f, 2.0f);
+}
 static hfvis_status io_mesh_save(const char *path) { return hfvis_mesh_save(path, &m_box); }
 static hfvis_status io_binvox_save(const char *path) { return hfvis_binvox_save(path, &vg_ok, occ_box); }
 static hfvis_status io_voxels_raw_save(const char *path) { return hfvis_voxels_raw_save(path, &vg_ok, occ_box); }
@@ -6383,7 +6505,7 @@ typedef struct io_entry {
 } io_entry;
 #define IOSAVE(name) {#name, io_##name}
 static const io_entry io_savers[] = {
-    IOSAVE(pfm_save), IOSAVE(pgm_save), IOSAVE(mesh_save), IOSAVE(binvox_save),
+    IOSAVE(pfm_save), IOSAVE(pgm_save), IOSAVE(pgm_range_save), IOSAVE(mesh_save), IOSAVE(binvox_save),
     IOSAVE(voxels_raw_save), IOSAVE(visfield_save), IOSAVE(partial_save),
 };
 #define IO_COUNT ((int)(sizeof io_savers / sizeof io_savers[0]))

@@ -1566,6 +1566,153 @@ TEST(p2_gather_vs_oracle_fbm)
     CHECK(bad == 0);
 }
 
+/* ---------------------------------------------------------------- openness (Yokoyama 2002) */
+
+#define OPEN_TOL 1e-6 /* closed forms: float output of double sums of exact slopes */
+
+/* Openness on fields with closed forms, the radius, negative = positive of -z bit for bit, and
+ * the sweep (radius 0) against the march (a radius beyond the grid). */
+TEST(openness_closed_forms_and_oracle)
+{
+    enum { W = 41, H = 41, N = W * H };
+    static float z[N], zn[N], out[N], out2[N];
+    const double half_pi = 1.5707963267948966;
+    hfvis_grid g, gn;
+    hfvis_field f;
+    hfvis_openness_options oo;
+    hfvis_sweep_options o = hfvis_sweep_options_default();
+    double want, diag_sum;
+    size_t i, bad;
+    memset(&oo, 0, sizeof oo);
+    memset(&f, 0, sizeof f);
+    p2_grid_init(&g, z, W, H);
+    /* a plane: pi/2 everywhere with clamped borders, both ways */
+    f.kind = HFVIS_FIELD_PLANE;
+    f.height = 3.0;
+    CHECK_EQ_STATUS(hfvis_field_generate(&f, W, H, W, z), HFVIS_OK);
+    o.border = HFVIS_BORDER_CLAMP;
+    oo.radius = 3.0;
+    CHECK_EQ_STATUS(hfvis_openness(&g, 8, &oo, &o, out, W), HFVIS_OK);
+    for (i = 0, bad = 0; i < N; i++) bad += fabs((double)out[i] - half_pi) > OPEN_TOL;
+    CHECK(bad == 0);
+    oo.radius = 0.0;
+    CHECK_EQ_STATUS(hfvis_openness(&g, 8, &oo, &o, out, W), HFVIS_OK);
+    for (i = 0, bad = 0; i < N; i++) bad += fabs((double)out[i] - half_pi) > OPEN_TOL;
+    CHECK(bad == 0);
+    o.border = HFVIS_BORDER_OPEN;
+    /* V valley z = |x - 20|, floor (20, 20), K = 8 within 5 cells: E, W rise at 45 deg, the
+     * diagonals at atan(1/sqrt2), N and S stay level */
+    f.kind = HFVIS_FIELD_V_VALLEY;
+    f.x0 = 20.0;
+    f.slope = 1.0;
+    f.height = 0.0;
+    CHECK_EQ_STATUS(hfvis_field_generate(&f, W, H, W, z), HFVIS_OK);
+    diag_sum = 2.0 * atan(1.0) + 4.0 * atan(sqrt(0.5));
+    oo.radius = 5.0;
+    CHECK_EQ_STATUS(hfvis_openness(&g, 8, &oo, &o, out, W), HFVIS_OK);
+    CHECK_NEAR(out[20 * W + 20], half_pi - diag_sum / 8.0, OPEN_TOL, 0.0);
+    oo.negative = 1;
+    CHECK_EQ_STATUS(hfvis_openness(&g, 8, &oo, &o, out2, W), HFVIS_OK);
+    CHECK_NEAR(out2[20 * W + 20], half_pi + diag_sum / 8.0, OPEN_TOL, 0.0);
+    /* negative openness of z is the positive openness of -z, bit for bit: march and sweep */
+    for (i = 0; i < N; i++) zn[i] = -z[i];
+    p2_grid_init(&gn, zn, W, H);
+    oo.negative = 0;
+    CHECK_EQ_STATUS(hfvis_openness(&gn, 8, &oo, &o, out, W), HFVIS_OK);
+    CHECK(memcmp(out, out2, sizeof out) == 0);
+    oo.radius = 0.0;
+    oo.negative = 1;
+    CHECK_EQ_STATUS(hfvis_openness(&g, 8, &oo, &o, out2, W), HFVIS_OK);
+    oo.negative = 0;
+    CHECK_EQ_STATUS(hfvis_openness(&gn, 8, &oo, &o, out, W), HFVIS_OK);
+    CHECK(memcmp(out, out2, sizeof out) == 0);
+    /* K = 4 unlimited on the valley floor: 90 - 90/4 degrees */
+    CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, &o, out, W), HFVIS_OK);
+    CHECK_NEAR(out[20 * W + 20], half_pi - half_pi / 4.0, OPEN_TOL, 0.0);
+    /* a cone pit z = 0.5 r around (20, 20): along the axes every sample rises at tan = 0.5 from the
+     * apex, so positive openness pi/2 - atan(0.5) and negative pi/2 + atan(0.5) (no terrain
+     * lies below the apex), both ways */
+    f.kind = HFVIS_FIELD_CONE;
+    f.x0 = 20.0;
+    f.y0 = 20.0;
+    f.slope = 0.5;
+    CHECK_EQ_STATUS(hfvis_field_generate(&f, W, H, W, z), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, &o, out, W), HFVIS_OK);
+    CHECK_NEAR(out[20 * W + 20], half_pi - atan(0.5), OPEN_TOL, 0.0);
+    oo.radius = 6.0;
+    CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, &o, out, W), HFVIS_OK);
+    CHECK_NEAR(out[20 * W + 20], half_pi - atan(0.5), OPEN_TOL, 0.0);
+    oo.negative = 1;
+    CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, &o, out, W), HFVIS_OK);
+    CHECK_NEAR(out[20 * W + 20], half_pi + atan(0.5), OPEN_TOL, 0.0);
+    oo.negative = 0;
+    oo.radius = 0.0;
+    f.y0 = 0.0;
+    /* the radius: a 10-high wall 10 cells east of (20, 20) counts within 15 cells, not within 5
+     * (clamped borders keep the other directions level) */
+    f.kind = HFVIS_FIELD_STEP;
+    f.x0 = 30.0;
+    f.amplitude = 10.0;
+    CHECK_EQ_STATUS(hfvis_field_generate(&f, W, H, W, z), HFVIS_OK);
+    o.border = HFVIS_BORDER_CLAMP;
+    oo.radius = 5.0;
+    CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, &o, out, W), HFVIS_OK);
+    CHECK_NEAR(out[20 * W + 20], half_pi, OPEN_TOL, 0.0);
+    oo.radius = 15.0;
+    CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, &o, out, W), HFVIS_OK);
+    want = half_pi - atan(1.0) / 4.0;
+    CHECK_NEAR(out[20 * W + 20], want, OPEN_TOL, 0.0);
+    g.cell_size = 2.0; /* the radius is in world units: 15 is 7.5 cells now */
+    CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, &o, out, W), HFVIS_OK);
+    CHECK_NEAR(out[20 * W + 20], half_pi, OPEN_TOL, 0.0);
+    g.cell_size = 1.0;
+    o.border = HFVIS_BORDER_OPEN;
+    /* the oracle: on a seeded fBm with holes, the sweep equals the march with a radius beyond the
+     * grid bit for bit along the axes (K = 4), and within the gather tolerance otherwise */
+    p2_fbm(z, W, H, 11, 6.0);
+    z[7 * W + 9] = NAN;
+    oo.radius = 1e6;
+    CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, &o, out, W), HFVIS_OK);
+    oo.radius = 0.0;
+    CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, &o, out2, W), HFVIS_OK);
+    for (i = 0, bad = 0; i < N; i++)
+        bad += !(out[i] == out2[i] || (isnan(out[i]) && isnan(out2[i])));
+    CHECK(bad == 0);
+    CHECK(isnan(out[7 * W + 9]));
+    {
+        static double d[N];
+        size_t n = 0;
+        oo.radius = 1e6;
+        o.azimuth0_rad = 0.3;
+        CHECK_EQ_STATUS(hfvis_openness(&g, 16, &oo, &o, out, W), HFVIS_OK);
+        oo.radius = 0.0;
+        CHECK_EQ_STATUS(hfvis_openness(&g, 16, &oo, &o, out2, W), HFVIS_OK);
+        for (i = 0; i < N; i++)
+            if (!isnan(out[i])) d[n++] = fabs((double)out[i] - (double)out2[i]);
+        qsort(d, n, sizeof d[0], p2_cmp_double);
+        /* a mean of K angles, each within the gather tolerances of p2_gather_vs_oracle_fbm */
+        CHECK(n == N - 1 && d[n / 2] <= P2_TOL_GATHER_MEDIAN && d[n - 1] <= P2_TOL_GATHER_MAX);
+        o.azimuth0_rad = 0.0;
+    }
+    /* bad arguments, outputs untouched */
+    out[0] = 42.0f;
+    CHECK_EQ_STATUS(hfvis_openness(NULL, 4, NULL, NULL, out, W), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_openness(&g, 0, NULL, NULL, out, W), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_openness(&g, 4, NULL, NULL, NULL, W), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_openness(&g, 4, NULL, NULL, out, W - 1), HFVIS_ERR_INVALID_ARGUMENT);
+    oo.radius = -1.0;
+    CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, NULL, out, W), HFVIS_ERR_INVALID_ARGUMENT);
+    oo.radius = NAN;
+    CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, NULL, out, W), HFVIS_ERR_INVALID_ARGUMENT);
+    oo.radius = 1.0;
+    oo.step_cells = -1.0;
+    CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, NULL, out, W), HFVIS_ERR_INVALID_ARGUMENT);
+    oo.step_cells = 0.0;
+    oo.negative = 2;
+    CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, NULL, out, W), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK(out[0] == 42.0f);
+}
+
 /* hfvis_horizon_direction(K, k) is documented bit-identical to plane k of hfvis_horizon_map,
  * also when K % 4 == 0 (the quarter-turn lattice sharing of spec §3.6). */
 TEST(p2_direction_equals_map_plane)
@@ -2115,6 +2262,7 @@ static void run_part2_tests(void)
     RUN(p2_wall_fn_visibility);
     RUN(p2_hemisphere_sweep);
     RUN(p2_gather_vs_oracle_fbm);
+    RUN(openness_closed_forms_and_oracle);
     RUN(p2_direction_equals_map_plane);
     RUN(p2_partial_direction_sums);
     RUN(p2_sky_light_fused_map_oracle);

@@ -125,6 +125,7 @@ static unsigned char oom_vf_maps[4096];
 
 static hfvis_status oom_pfm(const char *p) { return hfvis_pfm_save(p, oom_img, 6, 5, 3, 6); }
 static hfvis_status oom_pgm(const char *p) { return hfvis_pgm_save(p, oom_img, 6, 5, 6, 0.0f, 1.0f, 255); }
+static hfvis_status oom_pgm_range(const char *p) { return hfvis_pgm_range_save(p, oom_img, 6, 5, 6, 0.0f, 1.0f); }
 static hfvis_status oom_obj(const char *p) { return hfvis_mesh_save(p, &oom_mesh); }
 static hfvis_status oom_binvox(const char *p) { return hfvis_binvox_save(p, &oom_grid, oom_occ); }
 static hfvis_status oom_raw(const char *p) { return hfvis_voxels_raw_save(p, &oom_grid, oom_occ); }
@@ -172,6 +173,7 @@ TEST(writers)
     /* each writer: its encode buffer, then the temporary name */
     CHECK(oom_sweep_save("a.pfm", oom_pfm) == 2);
     CHECK(oom_sweep_save("a.pgm", oom_pgm) == 2);
+    CHECK(oom_sweep_save("r.pgm", oom_pgm_range) == 2);
     CHECK(oom_sweep_save("a.obj", oom_obj) == 2);
     CHECK(oom_sweep_save("a.binvox", oom_binvox) == 2);
     CHECK(oom_sweep_save("a.raw", oom_raw) == 1); /* writes the caller's bytes */
