@@ -19,6 +19,7 @@
 #define CLI_HAVE_ISATTY 1
 #endif
 #include "common.h"
+#include "raster_io.h"
 
 #define CLI_PI 3.14159265358979323846
 #define CLI_FLT_MAX ((double)FLT_MAX)                 /* largest value a float flag may take */
@@ -188,7 +189,7 @@ typedef struct cli_args {
     int cmd;
     int has_dir_range, dir_begin, dir_end, out_partial; /* --dir-range A:B, -o *.hfvs */
     const char *in, *out, *env, *albedo_map, *emission;
-    int out_pgm;
+    int out_pgm, out_raster, band, has_cell; /* -o *.tif/.asc/.bil/.flt; --band N (1-based) */
     double cell, zscale, azimuth0, nodata, range_lo, range_hi;
     double sky, albedo, sun_azimuth, sun_elevation, sun_radius, sun_irradiance;
     int dirs, border, border_cells, method, bounces, output;
@@ -266,8 +267,9 @@ static const char cli_usage[] =
     "       hfvis COMMAND --help\n"
     "\n"
     "Visibility and light on height fields with the line-sweep horizon algorithm of\n"
-    "Timonen & Westerholm 2010. IN is a height field: PGM (P2/P5, 8 or 16 bit, raw values)\n"
-    "or grey PFM (Pf). Row 0 is the north edge, x (columns) runs east, y (rows) south.\n"
+    "Timonen & Westerholm 2010. IN is a height field: PGM (P2/P5, 8 or 16 bit, raw values),\n"
+    "grey PFM (Pf), GeoTIFF (.tif), ESRI ASCII grid (.asc) or EHdr raw grid (.bil/.flt).\n"
+    "Row 0 is the north edge, x (columns) runs east, y (rows) south.\n"
     "\n"
     "commands:\n"
     "  horizon     horizon elevation angle toward K directions (K planes in one image)\n"
@@ -291,9 +293,14 @@ static const char cli_shared_help[] =
     "\n"
     "shared options (every command accepts them and ignores those it does not use):\n"
     "  -o OUT            output file, required: *.pfm writes PFM floats, *.pgm a 16-bit PGM;\n"
-    "                    a PGM of a 3-channel result stacks the channels as planes, top to bottom\n"
+    "                    a PGM of a 3-channel result stacks the channels as planes, top to bottom;\n"
+    "                    *.tif a Float32 GeoTIFF (tiled, DEFLATE), *.asc an ESRI ASCII grid,\n"
+    "                    *.bil/*.flt raw floats + .hdr: these carry IN's georeference and NoData\n"
+    "                    (planes and channels become bands)\n"
+    "  --band N          IN is a multi-band raster: use band N (1-based, default 1)\n"
     "  --range LO:HI     .pgm only: the values mapped to 0 and 65535 (default per command)\n"
-    "  --cell S          distance between samples, in height units (default 1)\n"
+    "  --cell S          distance between samples, in height units (default: the cell size of a\n"
+    "                    georeferenced IN (.tif, .asc, .bil/.flt), else 1 with a note)\n"
     "  --zscale Z        multiply input values by Z, non-zero (default 1)\n"
     "  --nodata V        input values equal to V are holes: no occlusion, output NaN (0 in PGM)\n"
     "  --dirs K          number of azimuth directions, 1..65536 (default 16)\n"
@@ -314,7 +321,7 @@ static const char cli_shared_help[] =
     "                    outward) or wrap (periodic field)\n"
     "  --border-cells N  clamp/wrap: lines start N cells outside the grid, 1..1048576\n"
     "                    (default max(width, height))\n"
-    "  --quiet           no progress bar (shown on stderr only when it is a terminal)\n"
+    "  --quiet           no progress bar (shown on stderr only when it is a terminal) and no notes\n"
     "  -h, --help        this help; 'hfvis COMMAND --help' describes one command\n"
     "\n"
     "Options take their value as the next argument or as --option=value.\n"
@@ -1022,6 +1029,7 @@ static const cli_flag cli_flags[] = {
     { "--zscale", 1, CLI_ALL },     { "--nodata", 1, CLI_ALL },      { "--dirs", 1, CLI_ALL },
     { "--azimuth0", 1, CLI_ALL },   { "--compass", 0, CLI_ALL },     { "--degrees", 0, CLI_ALL },
     { "--border", 1, CLI_ALL },     { "--border-cells", 1, CLI_ALL }, { "--quiet", 0, CLI_ALL },
+    { "--band", 1, CLI_ALL },
     { "--dir-range", 1, CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY)
                         | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VISIBILITY) },
     { "--sky", 1, CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
@@ -1073,7 +1081,9 @@ static int cli_set(cli_args *a, const char *f, const char *v)
         if (cli_ends_with(v, ".pfm")) a->out_pgm = 0;
         else if (cli_ends_with(v, ".pgm")) a->out_pgm = 1;
         else if (cli_ends_with(v, ".hfvs")) a->out_partial = 1;
-        else return cli_error(CLI_EXIT_USAGE, v, "unknown output type (use a .pfm or .pgm name)");
+        else if (ex_rio_format_of(v)) a->out_raster = 1;
+        else return cli_error(CLI_EXIT_USAGE, v, "unknown output type (use a .pfm, .pgm, .tif, .asc, .bil "
+                              "or .flt name)");
         a->out = v;
         return 0;
     }
@@ -1107,7 +1117,11 @@ static int cli_set(cli_args *a, const char *f, const char *v)
         a->has_range = 1;
         return 0;
     }
-    if (!strcmp(f, "--cell")) return cli_real(f, v, 0.0, 1, DBL_MAX, "a number > 0", &a->cell);
+    if (!strcmp(f, "--cell")) {
+        a->has_cell = 1;
+        return cli_real(f, v, 0.0, 1, DBL_MAX, "a number > 0", &a->cell);
+    }
+    if (!strcmp(f, "--band")) return cli_int(f, v, 1, EX_RIO_MAX_BANDS, "a band number 1..65535", &a->band);
     if (!strcmp(f, "--zscale")) {
         if (cli_real(f, v, -CLI_FLT_MAX, 0, CLI_FLT_MAX, "a non-zero number", &a->zscale)) return CLI_EXIT_USAGE;
         if ((float)a->zscale == 0.0f)
@@ -1377,27 +1391,115 @@ static int cli_parse(int argc, char **argv, cli_args *a)
 /* running a command                                                                          */
 /* ------------------------------------------------------------------------------------------ */
 
-/* Load IN as a one-channel height field; --nodata values become NaN, the rest are scaled. */
-static int cli_load_heights(const cli_args *a, float **z, int *w, int *h)
+/* The georeference of a raster IN, carried to a raster OUT (cli_save); the rows of IN, to
+ * recognise stacked output planes. The CLI's one piece of global state besides the bar. */
+static ex_georef cli_geo;
+static int cli_in_height;
+static float *cli_alloc(size_t a, size_t b, size_t c);
+
+/* Load a GeoTIFF, ASC or EHdr IN (band --band): NoData -> NaN, the georeference kept in cli_geo,
+ * *cell from it (geographic CRS refused unless --cell), --cell overriding with a note. */
+static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double *cell)
+{
+    ex_rio_reader r;
+    float *px;
+    double rc_cell;
+    char why[256];
+    if (ex_rio_open(&r, a->in) != 0) return cli_error(CLI_EXIT_ERROR, a->in, "%s", r.err);
+    if ((a->band ? a->band : 1) > r.bands) {
+        cli_error(CLI_EXIT_ERROR, a->in, "--band %d: the raster has %d band%s", a->band, r.bands,
+                  r.bands == 1 ? "" : "s");
+        ex_rio_close(&r);
+        return CLI_EXIT_ERROR;
+    }
+    if (r.width > HFVIS_IMAGE_MAX_DIM || r.height > HFVIS_IMAGE_MAX_DIM ||
+        (size_t)r.width * (size_t)r.height > HFVIS_IMAGE_MAX_VALUES) {
+        cli_error(CLI_EXIT_ERROR, a->in, "%s: %d x %d cells exceed the limit of 2^28 values",
+                  hfvis_status_string(HFVIS_ERR_LIMIT), r.width, r.height);
+        ex_rio_close(&r);
+        return CLI_EXIT_ERROR;
+    }
+    if (r.geo.has_transform) {
+        if (r.geo.crs == EX_RIO_CRS_GEOGRAPHIC && !a->has_cell) {
+            char crs[32] = "";
+            if (r.geo.epsg) snprintf(crs, sizeof crs, ", EPSG:%d", r.geo.epsg);
+            cli_error(CLI_EXIT_ERROR, a->in, "geographic coordinates (cells in degrees%s): reproject to "
+                      "metres first, e.g. gdalwarp -t_srs EPSG:32633 (your UTM zone) -r bilinear IN out.tif, "
+                      "or give --cell in metres", crs);
+            ex_rio_close(&r);
+            return CLI_EXIT_ERROR;
+        }
+        if (ex_georef_cell(&r.geo, &rc_cell, why) != 0) {
+            cli_error(CLI_EXIT_ERROR, a->in, "%s", why);
+            ex_rio_close(&r);
+            return CLI_EXIT_ERROR;
+        }
+        if (!a->has_cell) *cell = rc_cell;
+        else if (!a->quiet && a->cell != rc_cell)
+            fprintf(stderr, "hfvis: note: --cell %g overrides the cell size %.10g of %s\n", a->cell, rc_cell,
+                    a->in);
+    } else if (!a->has_cell && !a->quiet) {
+        fprintf(stderr, "hfvis: note: %s has no georeference: cell size 1 (give --cell)\n", a->in);
+    }
+    px = cli_alloc((size_t)r.width, (size_t)r.height, 1);
+    if (!px) {
+        ex_rio_close(&r);
+        return cli_status(a->in, HFVIS_ERR_OUT_OF_MEMORY, 0);
+    }
+    r.nodata_to_nan = 1;
+    if (ex_rio_read(&r, a->band ? a->band - 1 : 0, 0, 0, r.width, r.height, px, r.width) != 0) {
+        cli_error(CLI_EXIT_ERROR, a->in, "%s", r.err);
+        free(px);
+        ex_rio_close(&r);
+        return CLI_EXIT_ERROR;
+    }
+    *z = px; *w = r.width; *h = r.height;
+    ex_georef_free(&cli_geo);
+    cli_geo = r.geo; /* moved: the reader no longer owns it */
+    memset(&r.geo, 0, sizeof r.geo);
+    ex_rio_close(&r);
+    return 0;
+}
+
+/* Load IN as a one-channel height field; --nodata values become NaN, the rest are scaled.
+ * *cell: --cell, else the raster's cell size, else 1 (with a note unless --quiet). */
+static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double *cell)
 {
     hfvis_image_info info;
     float *px = NULL, zscale = (float)a->zscale, nodata = (float)a->nodata;
     size_t i, n;
     hfvis_status s;
-    errno = 0;
-    s = hfvis_image_load(a->in, NULL, &px, &info);
-    if (s != HFVIS_OK) return cli_status(a->in, s, errno);
-    if (info.channels != 1) {
-        hfvis_free(NULL, px);
-        return cli_error(CLI_EXIT_ERROR, a->in, "a height field has one channel, this image has %d",
-                         info.channels);
+    *cell = a->cell;
+    if (ex_rio_format_of(a->in)) {
+        int rc = cli_load_raster(a, &px, w, h, cell);
+        if (rc != 0) return rc;
+    } else {
+        if (a->band > 1)
+            return cli_error(CLI_EXIT_ERROR, a->in, "--band %d: a PFM/PGM height field has one band", a->band);
+        errno = 0;
+        s = hfvis_image_load(a->in, NULL, &px, &info);
+        if (s != HFVIS_OK) return cli_status(a->in, s, errno);
+        if (info.channels != 1) {
+            hfvis_free(NULL, px);
+            return cli_error(CLI_EXIT_ERROR, a->in, "a height field has one channel, this image has %d",
+                             info.channels);
+        }
+        if (!a->has_cell && !a->quiet)
+            fprintf(stderr, "hfvis: note: %s has no cell size: using 1 (give --cell)\n", a->in);
+        *w = info.width; *h = info.height;
     }
-    n = (size_t)info.width * (size_t)info.height; /* <= HFVIS_IMAGE_MAX_VALUES (decoder limit) */
+    n = (size_t)*w * (size_t)*h; /* <= HFVIS_IMAGE_MAX_VALUES (decoder limit) */
     for (i = 0; i < n; i++) {
         if (a->has_nodata && px[i] == nodata) px[i] = (float)NAN;
         else px[i] *= zscale;
     }
-    *z = px; *w = info.width; *h = info.height;
+    if (a->has_nodata && !cli_geo.has_nodata) { /* --nodata is the outputs' NoData too */
+        cli_geo.has_nodata = 1;
+        cli_geo.nodata = (double)nodata;
+        snprintf(cli_geo.nodata_text, sizeof cli_geo.nodata_text, "%.9g", (double)nodata);
+    }
+    cli_in_height = *h;
+    *z = px;
     return 0;
 }
 
@@ -1416,6 +1518,36 @@ static int cli_save(const cli_args *a, const float *px, int w, int h, int channe
 {
     hfvis_status s;
     errno = 0;
+    if (a->out_raster) {
+        /* planes stacked top to bottom (horizon) or channels interleaved become bands */
+        int planes = cli_in_height > 0 && h % cli_in_height == 0 ? h / cli_in_height : 1;
+        ex_rio_image img;
+        ex_rio_write_options o;
+        ex_georef g = cli_geo; /* shallow: only the NoData fields change, on the copy */
+        char why[256];
+        size_t i, n = (size_t)w * (size_t)h * (size_t)channels;
+        img.data = px;
+        img.width = w;
+        img.height = h / planes;
+        img.bands = planes * channels;
+        img.pixel_step = (size_t)channels;
+        img.row_step = (size_t)w * (size_t)channels;
+        img.band_step = channels > 1 ? 1 : (size_t)w * (size_t)img.height;
+        if (!g.has_nodata) /* NaN cells: declare NoData NaN */
+            for (i = 0; i < n; i++)
+                if (isnan(px[i])) {
+                    g.has_nodata = 1;
+                    g.nodata = (double)NAN;
+                    strcpy(g.nodata_text, "nan");
+                    break;
+                }
+        memset(&o, 0, sizeof o);
+        o.tiled = 1;
+        o.deflate = 1;
+        o.predictor = 3;
+        if (ex_rio_write(a->out, &img, &g, &o, why) != 0) return cli_error(CLI_EXIT_ERROR, a->out, "%s", why);
+        return 0;
+    }
     if (!a->out_pgm) {
         s = hfvis_pfm_save(a->out, px, w, h, channels, w);
     } else {
@@ -2670,8 +2802,8 @@ static int cli_run(const cli_args *a)
     if (a->cmd == CMD_VISFIELD) return cli_run_visfield(a);
     if (a->cmd == CMD_MESHAO) return cli_run_meshao(a);
     memset(&env, 0, sizeof env);
-    if ((rc = cli_load_heights(a, &z, &w, &h)) != 0) return rc;
-    grid.z = z; grid.width = w; grid.height = h; grid.stride = w; grid.cell_size = a->cell;
+    if ((rc = cli_load_heights(a, &z, &w, &h, &grid.cell_size)) != 0) return rc;
+    grid.z = z; grid.width = w; grid.height = h; grid.stride = w;
     opts.border = (hfvis_border)a->border;
     opts.border_cells = a->border_cells;
     opts.azimuth0_rad = a->compass ? a->azimuth0 - CLI_PI / 2.0 : a->azimuth0;
@@ -2779,5 +2911,7 @@ int main(int argc, char **argv)
     if (argc >= 2 && !strcmp(argv[1], "sum")) return cli_sum(argc, argv);
     rc = cli_parse(argc, argv, &a);
     if (rc != CLI_RUN) return rc;
-    return cli_run(&a);
+    rc = cli_run(&a);
+    ex_georef_free(&cli_geo);
+    return rc;
 }

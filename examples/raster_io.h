@@ -130,8 +130,8 @@ typedef struct {
     /* raw (EHdr) layout: byte of (band, row, col) = skip + row * row_bytes + band * band_bytes
      * + col * col_bytes */
     uint64_t skip, row_bytes, band_bytes, col_bytes;
-    /* ASC: the whole grid */
-    float *grid;
+    /* ASC: the whole grid, as parsed (NoData is matched at read time) */
+    double *grid;
     /* decoding buffers and the chunk decoded last */
     unsigned char *cbuf, *dbuf;
     size_t cbuf_cap, dbuf_cap;
@@ -859,7 +859,10 @@ static inline int ex_rio_chunk(ex_rio_reader *r, uint64_t k, uint64_t rows, uint
         unsigned char *tmp = r->dbuf + (size_t)full; /* the spare row after the chunk */
         for (y = 0; y < rows; y++)
             ex_rio_unpredict3(r->dbuf + y * (size_t)rowb, tmp, (size_t)(rowb / bytes), (int)bytes, (size_t)spc);
-        r->cached_be = 1;
+        /* libtiff writes the byte planes most significant first for a little-endian file but,
+         * having swapped the samples to the file's order first, least significant first for
+         * a big-endian one (GDAL ENDIANNESS=BIG); it reads them back the same way. */
+        r->cached_be = !r->big_endian;
     }
     r->cached = k + 1;
     return 0;
@@ -884,8 +887,8 @@ static inline float ex_rio_cell(const ex_rio_reader *r, double v)
     if (r->nodata_to_nan && r->geo.has_nodata &&
         (v == r->geo.nodata || (isnan(v) && isnan(r->geo.nodata))))
         return (float)NAN;
-    if (v > FLT_MAX) return (float)INFINITY;
-    if (v < -FLT_MAX) return -(float)INFINITY;
+    if (v > (double)FLT_MAX) return (float)INFINITY;
+    if (v < -(double)FLT_MAX) return -(float)INFINITY;
     return (float)v;
 }
 
@@ -975,14 +978,14 @@ static inline int ex_rio_parse_asc(ex_rio_reader *r, const char *text, size_t n)
     r->geo.gt[1] = dx;
     r->geo.gt[3] = y - (ycenter ? 0.5 * dy : 0.0) + dy * (double)r->height;
     r->geo.gt[5] = -dy;
-    r->grid = (float *)malloc(count * sizeof(float));
+    r->grid = (double *)malloc(count * sizeof(double));
     if (!r->grid) return ex_rio_fail(r->err, "out of memory");
     for (i = 0; i < count; i++) {
         if (ex_rio_token(text, n, &pos, val, sizeof val) == 0)
             return ex_rio_fail(r->err, "ASC grid ends after %llu of %llu values", (unsigned long long)i,
                                (unsigned long long)count);
         if (ex_rio_number(val, &v) != 0) return ex_rio_fail(r->err, "ASC value '%s' is not a number", val);
-        r->grid[i] = ex_rio_cell(r, v);
+        r->grid[i] = v;
     }
     if (ex_rio_token(text, n, &pos, val, sizeof val) != 0)
         return ex_rio_fail(r->err, "ASC grid has more than %llu values", (unsigned long long)count);
@@ -1294,7 +1297,7 @@ static inline int ex_rio_read(ex_rio_reader *r, int band, int x0, int y0, int w,
             for (yy = cy0; yy < cy1; yy++)
                 for (xx = cx0; xx < cx1; xx++)
                     out[(ptrdiff_t)(yy - y0) * stride + (ptrdiff_t)(xx - x0)] =
-                        r->grid[(size_t)yy * (size_t)r->width + (size_t)xx];
+                        ex_rio_cell(r, r->grid[(size_t)yy * (size_t)r->width + (size_t)xx]);
             return 0;
         }
         if (r->format == EX_RIO_EHDR) {
@@ -1385,10 +1388,12 @@ static inline void ex_rio_predict(unsigned char *row, unsigned char *tmp, size_t
             ex_rio_put_uint(row + i * (size_t)bytes, (c - a) & mask, bytes, be);
         }
     } else if (pred == 3) {
-        /* bytes MSB first into planes, then byte differences (libtiff fpDiff) */
+        /* byte planes, then byte differences (libtiff fpDiff): most significant byte first in
+         * a little-endian file, least significant first in a big-endian one (see ex_rio_chunk) */
+        (void)be;
         for (i = 0; i < nsamp; i++)
             for (b = 0; b < bytes; b++)
-                tmp[(size_t)b * nsamp + i] = row[i * (size_t)bytes + (size_t)(be ? b : bytes - 1 - b)];
+                tmp[(size_t)b * nsamp + i] = row[i * (size_t)bytes + (size_t)(bytes - 1 - b)];
         memcpy(row, tmp, n);
         for (i = n; i-- > 1;) row[i] = (unsigned char)(row[i] - row[i - 1]);
     }
