@@ -931,7 +931,8 @@ static inline int ex_rio_number(const char *s, double *v)
 static inline int ex_rio_parse_asc(ex_rio_reader *r, const char *text, size_t n)
 {
     char key[64], val[128];
-    double ncols = -1, nrows = -1, x = NAN, y = NAN, cell = NAN, dx = NAN, dy = NAN, v;
+    const double unset = (double)NAN;
+    double ncols = -1, nrows = -1, x = unset, y = unset, cell = unset, dx = unset, dy = unset, v;
     int xcenter = 0, ycenter = 0;
     size_t pos = 0, count, i;
     r->format = EX_RIO_ASC;
@@ -999,7 +1000,8 @@ static inline int ex_rio_parse_hdr(ex_rio_reader *r, const char *text, size_t n,
 {
     char key[64], val[128];
     double v, nrows = -1, ncols = -1, nbands = 1, nbits = flt ? 32 : 8, skip = 0, brb = -1, trb = -1, gap = 0;
-    double ulx = NAN, uly = NAN, xdim = NAN, ydim = NAN, xll = NAN, yll = NAN, cell = NAN;
+    const double unset = (double)NAN;
+    double ulx = unset, uly = unset, xdim = unset, ydim = unset, xll = unset, yll = unset, cell = unset;
     int layout = 0, kind = flt ? EX_RIO_FLOAT : EX_RIO_UINT, xcenter = 0, ycenter = 0; /* 0 BIL 1 BIP 2 BSQ */
     size_t pos = 0;
     uint64_t bytes, w, h, b, need;
