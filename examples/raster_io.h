@@ -1697,11 +1697,30 @@ static inline void ex_rio_fmt(char *buf, size_t cap, double v, int is_float)
     else snprintf(buf, cap, is_float ? "%.9g" : "%.17g", v);
 }
 
+/* The .prj of geo (when it has one) beside path, atomically. */
+static inline int ex_rio_write_prj(const char *path, const ex_georef *geo, char *err)
+{
+    char *prj, *tmpname = NULL;
+    FILE *f;
+    int ok;
+    if (!geo || !geo->prj) return 0;
+    prj = ex_rio_sidecar(path, ".prj");
+    if (!prj) return ex_rio_fail(err, "out of memory");
+    f = ex_atomic_open(prj, geo, &tmpname);
+    ok = f && fputs(geo->prj, f) >= 0;
+    if (!f || !ex_atomic_close(f, tmpname, prj, ok)) {
+        free(prj);
+        return ex_rio_fail(err, "cannot write the .prj");
+    }
+    free(prj);
+    return 0;
+}
+
 /* Write band 0 of img as an ESRI ASCII grid (+ the .prj of geo when it has one). NaN cells are
  * written as the NoData value (geo's, else -9999). */
 static inline int ex_rio_write_asc(const char *path, const ex_rio_image *img, const ex_georef *geo, char *err)
 {
-    char *tmpname = NULL, num[64], *prj;
+    char *tmpname = NULL, num[64];
     FILE *f;
     int x, y, ok = 1;
     double cell = 1.0, nd = geo && geo->has_nodata ? geo->nodata : -9999.0;
@@ -1736,16 +1755,7 @@ static inline int ex_rio_write_asc(const char *path, const ex_rio_image *img, co
     }
     (void)nd;
     if (!ex_atomic_close(f, tmpname, path, ok)) return ex_rio_fail(err, "cannot write the file");
-    if (geo && geo->prj && (prj = ex_rio_sidecar(path, ".prj")) != NULL) {
-        f = ex_atomic_open(prj, img, &tmpname);
-        ok = f && fputs(geo->prj, f) >= 0;
-        if (!f || !ex_atomic_close(f, tmpname, prj, ok)) {
-            free(prj);
-            return ex_rio_fail(err, "cannot write the .prj");
-        }
-        free(prj);
-    }
-    return 0;
+    return ex_rio_write_prj(path, geo, err);
 }
 
 /* Write img as EHdr (.bil/.flt data + .hdr [+ .prj]): 32-bit floats, BIL, little endian. */
@@ -1791,16 +1801,7 @@ static inline int ex_rio_write_ehdr(const char *path, const ex_rio_image *img, c
         return ex_rio_fail(err, "cannot write the .hdr");
     }
     free(side);
-    if (geo && geo->prj && (side = ex_rio_sidecar(path, ".prj")) != NULL) {
-        f = ex_atomic_open(side, img, &tmpname);
-        ok = f && fputs(geo->prj, f) >= 0;
-        if (!f || !ex_atomic_close(f, tmpname, side, ok)) {
-            free(side);
-            return ex_rio_fail(err, "cannot write the .prj");
-        }
-        free(side);
-    }
-    return 0;
+    return ex_rio_write_prj(path, geo, err);
 }
 
 /* Write img by the extension of path (.tif/.tiff with opt, .asc, .bil/.flt). */
