@@ -294,7 +294,8 @@ static const char cli_shared_help[] =
     "shared options (every command accepts them and ignores those it does not use):\n"
     "  -o OUT            output file, required: *.pfm writes PFM floats, *.pgm a 16-bit PGM;\n"
     "                    a PGM of a 3-channel result stacks the channels as planes, top to bottom;\n"
-    "                    *.tif a Float32 GeoTIFF (tiled, DEFLATE), *.asc an ESRI ASCII grid,\n"
+    "                    *.tif a GeoTIFF (tiled, DEFLATE; Float32, or the smallest integer type\n"
+    "                    for viewshed and visibility counts), *.asc an ESRI ASCII grid,\n"
     "                    *.bil/*.flt raw floats + .hdr: these carry IN's georeference and NoData\n"
     "                    (planes and channels become bands)\n"
     "  --band N          IN is a multi-band raster: use band N (1-based, default 1)\n"
@@ -1512,6 +1513,46 @@ static float *cli_alloc(size_t a, size_t b, size_t c)
     return (float *)malloc(a * b * c * sizeof(float));
 }
 
+/* Integral outputs (viewshed 0/1, visibility counts) go into the smallest integer GeoTIFF type
+ * holding their values and NoData: the input's NoData when it is an integer, else (holes
+ * present) one past the largest value. Returns 0 (and leaves o, g alone) to keep Float32. */
+static int cli_integral_type(const cli_args *a, const float *px, size_t n, ex_georef *g,
+                             ex_rio_write_options *o)
+{
+    static const int types[4][2] = { { EX_RIO_UINT, 8 }, { EX_RIO_UINT, 16 }, { EX_RIO_INT, 16 },
+                                     { EX_RIO_INT, 32 } };
+    double lo = 0.0, hi = 0.0, nd = 0.0;
+    int holes = 0, want_nd, k;
+    size_t i;
+    if (!(a->cmd == CMD_VIEWSHED || (a->cmd == CMD_VISIBILITY && !a->fraction))) return 0;
+    for (i = 0; i < n; i++) {
+        double v = (double)px[i];
+        if (isnan(v)) { holes = 1; continue; }
+        if (v != floor(v) || fabs(v) > 2147483647.0) return 0;
+        if (v < lo) lo = v;
+        if (v > hi) hi = v;
+    }
+    want_nd = holes || g->has_nodata;
+    if (g->has_nodata && isfinite(g->nodata) && g->nodata == floor(g->nodata)) nd = g->nodata;
+    else if (g->has_nodata && !holes) want_nd = 0; /* a NaN or fractional NoData nobody needs */
+    else if (want_nd) nd = hi + 1.0;
+    for (k = 0; k < 4; k++) {
+        double tlo = types[k][0] == EX_RIO_UINT ? 0.0 : -ldexp(1.0, types[k][1] - 1);
+        double thi = types[k][0] == EX_RIO_UINT ? ldexp(1.0, types[k][1]) - 1.0 : ldexp(1.0, types[k][1] - 1) - 1.0;
+        if (lo >= tlo && hi <= thi && (!want_nd || (nd >= tlo && nd <= thi))) break;
+    }
+    if (k == 4) return 0;
+    o->kind = types[k][0];
+    o->bits = types[k][1];
+    o->predictor = 2;
+    g->has_nodata = want_nd;
+    if (want_nd) {
+        g->nodata = nd;
+        snprintf(g->nodata_text, sizeof g->nodata_text, "%.0f", nd);
+    }
+    return 1;
+}
+
 /* Write OUT: PFM with its channels, or a 16-bit PGM with the channel planes stacked. */
 static int cli_save(const cli_args *a, const float *px, int w, int h, int channels, double lo,
                     double hi)
@@ -1526,6 +1567,7 @@ static int cli_save(const cli_args *a, const float *px, int w, int h, int channe
         ex_georef g = cli_geo; /* shallow: only the NoData fields change, on the copy */
         char why[256];
         size_t i, n = (size_t)w * (size_t)h * (size_t)channels;
+        int moved = 0;
         img.data = px;
         img.width = w;
         img.height = h / planes;
@@ -1533,7 +1575,19 @@ static int cli_save(const cli_args *a, const float *px, int w, int h, int channe
         img.pixel_step = (size_t)channels;
         img.row_step = (size_t)w * (size_t)channels;
         img.band_step = channels > 1 ? 1 : (size_t)w * (size_t)img.height;
-        if (!g.has_nodata) /* NaN cells: declare NoData NaN */
+        memset(&o, 0, sizeof o);
+        o.tiled = 1;
+        o.deflate = 1;
+        o.predictor = 3;
+        if (g.has_nodata) /* the input's NoData, unless the output has it as a real value */
+            for (i = 0; i < n; i++)
+                if (!isnan(px[i]) && (double)px[i] == g.nodata) {
+                    moved = 1;
+                    g.has_nodata = 0;
+                    break;
+                }
+        if ((ex_rio_format_of(a->out) != EX_RIO_TIFF || !cli_integral_type(a, px, n, &g, &o)) && !g.has_nodata)
+            /* NaN cells: declare NoData NaN */
             for (i = 0; i < n; i++)
                 if (isnan(px[i])) {
                     g.has_nodata = 1;
@@ -1541,11 +1595,10 @@ static int cli_save(const cli_args *a, const float *px, int w, int h, int channe
                     strcpy(g.nodata_text, "nan");
                     break;
                 }
-        memset(&o, 0, sizeof o);
-        o.tiled = 1;
-        o.deflate = 1;
-        o.predictor = 3;
         if (ex_rio_write(a->out, &img, &g, &o, why) != 0) return cli_error(CLI_EXIT_ERROR, a->out, "%s", why);
+        if (moved && !a->quiet)
+            fprintf(stderr, "hfvis: note: %s: the input's NoData %s is a value of this output: holes are "
+                    "written as %s\n", a->out, cli_geo.nodata_text, g.has_nodata ? g.nodata_text : "NaN");
         return 0;
     }
     if (!a->out_pgm) {

@@ -112,6 +112,15 @@ if command -v gdal_translate > /dev/null 2>&1 && command -v gdalinfo > /dev/null
   gt -of EHdr "$dir/asc.flt" "$dir/flt_gdal.flt" && same "GDAL reads hfvis's EHdr .flt" "$dir/asc.flt" "$dir/flt_gdal.flt"
   gt -of EHdr "$dir/h.tif" "$dir/h_gdal.bil" && same "GDAL reads the 4-band horizon GeoTIFF = hfvis's BIL" "$dir/h.bil" "$dir/h_gdal.bil"
   gdalinfo "$dir/h.tif" | grep -c '^Band ' | grep -qx 4 && ok "gdalinfo: 4 bands" || bad "horizon GeoTIFF bands"
+  # integral outputs: the smallest integer type; NoData moved off the values when it collides
+  if run "viewshed -> tif" viewshed "$dir/dem.asc" --observer 20,16 -o "$dir/vs.tif"; then
+    grep -q "input's NoData 0 is a value of this output" "$dir/err" && ok "NoData colliding with a viewshed value: a note" \
+      || bad "no collision note: $(cat "$dir/err")"
+    gdalinfo -stats "$dir/vs.tif" > "$dir/vs.info" 2>&1
+    grep -q 'Type=Byte' "$dir/vs.info" && grep -q 'NoData Value=2$' "$dir/vs.info" && grep -q 'STATISTICS_MAXIMUM=1$' "$dir/vs.info" \
+      && grep -q 'STATISTICS_MINIMUM=0$' "$dir/vs.info" && ok "viewshed GeoTIFF: Byte, values 0..1, NoData 2" \
+      || bad "viewshed GeoTIFF: $(grep -E 'Type|NoData|STATISTICS_M' "$dir/vs.info")"
+  fi
 else
   echo "SKIP gdal: gdal_translate/gdalinfo not installed"
 fi
