@@ -395,6 +395,21 @@ static inline int ex_rio_entry_doubles(ex_rio_reader *r, const ex_rio_entry *e, 
     return 0;
 }
 
+/* A tag of exactly want numbers (ModelPixelScale, ModelTransformation) into dst; *has = 1. A
+ * tag of another length is ignored, as GDAL does. */
+static inline int ex_rio_entry_fixed(ex_rio_reader *r, const ex_rio_entry *e, double *dst, size_t want, int *has)
+{
+    size_t i;
+    uint64_t u;
+    if (e->count != want) return 0;
+    for (i = 0; i < want; i++)
+        if (ex_rio_entry_value(r, e, i, dst + i, &u) != 0)
+            return ex_rio_fail(r->err, "TIFF tag %u: values past the end of the file or of a non-numeric type",
+                               e->tag);
+    *has = 1;
+    return 0;
+}
+
 /* StripOffsets/TileOffsets or the byte counts: exactly want values, as uint64. */
 static inline int ex_rio_entry_chunks(ex_rio_reader *r, const ex_rio_entry *e, uint64_t want,
                                       uint64_t **out)
@@ -543,27 +558,13 @@ static inline int ex_rio_tiff_parse(ex_rio_reader *r)
         case 322: if (ex_rio_entry_u(r, &e, &tw)) return -1; have_tw = 1; break;
         case 323: if (ex_rio_entry_u(r, &e, &th)) return -1; have_th = 1; break;
         case 339: if (ex_rio_entry_u(r, &e, &fmt)) return -1; break;
-        case 33550: {
-            double *d = NULL;
-            size_t n = 0;
-            if (ex_rio_entry_doubles(r, &e, 3, &d, &n)) { free(d); return -1; }
-            if (n == 3) { memcpy(r->geo.scale, d, sizeof r->geo.scale); r->geo.has_scale = 1; }
-            free(d);
-            break;
-        }
+        case 33550: if (ex_rio_entry_fixed(r, &e, r->geo.scale, 3, &r->geo.has_scale)) return -1; break;
         case 33922:
             free(r->geo.tiepoints);
             r->geo.tiepoints = NULL;
             if (ex_rio_entry_doubles(r, &e, EX_RIO_MAX_GEO, &r->geo.tiepoints, &r->geo.n_tiepoints)) return -1;
             break;
-        case 34264: {
-            double *d = NULL;
-            size_t n = 0;
-            if (ex_rio_entry_doubles(r, &e, 16, &d, &n)) { free(d); return -1; }
-            if (n == 16) { memcpy(r->geo.matrix, d, sizeof r->geo.matrix); r->geo.has_matrix = 1; }
-            free(d);
-            break;
-        }
+        case 34264: if (ex_rio_entry_fixed(r, &e, r->geo.matrix, 16, &r->geo.has_matrix)) return -1; break;
         case 34735: {
             double *d = NULL;
             size_t n = 0, k;
