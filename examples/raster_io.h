@@ -461,6 +461,9 @@ static inline const char *ex_rio_compression_name(uint64_t c)
     }
 }
 
+static inline int ex_rio_chunk_check(ex_rio_reader *r, uint64_t k, uint64_t *rowb_out, uint64_t *need_out,
+                                     uint64_t *full_out);
+
 /* Walk the IFD chain from first (refusing loops and offsets past the end) and parse IFD 0. */
 static inline int ex_rio_tiff_parse(ex_rio_reader *r)
 {
@@ -663,6 +666,10 @@ static inline int ex_rio_tiff_parse(ex_rio_reader *r)
     if (!have_off || !have_cnt) return ex_rio_fail(r->err, "TIFF without strip/tile offsets or byte counts");
     if (ex_rio_entry_chunks(r, &off_e, r->nchunks, &r->offsets)) return -1;
     if (ex_rio_entry_chunks(r, &cnt_e, r->nchunks, &r->counts)) return -1;
+    for (v = 0; v < r->nchunks; v++) {
+        uint64_t rowb, need, full;
+        if (ex_rio_chunk_check(r, v, &rowb, &need, &full) != 0) return -1;
+    }
     if (r->geo.n_geokeys && ex_georef_keys(&r->geo, r->err) != 0) return -1;
     ex_georef_transform(&r->geo);
     return 0;
@@ -795,20 +802,24 @@ static inline int ex_rio_grow(unsigned char **buf, size_t *cap, size_t need)
     return 0;
 }
 
-/* Decode chunk index k (rows x cols cells, spc samples per cell) into r->dbuf. */
-static inline int ex_rio_chunk(ex_rio_reader *r, uint64_t k, uint64_t rows, uint64_t spc)
+/* The layout of chunk k: bytes per row, decoded bytes of its rows in the image (need) and of a
+ * whole strip (full: the last strip may be shorter; full = need when a whole one could not come
+ * from its bytes); and the checks that its bytes lie in the file and can hold need bytes (the
+ * codec's largest ratio). Run for every chunk when the file is opened, so a size the file cannot
+ * back is refused before anyone allocates for it. */
+static inline int ex_rio_chunk_check(ex_rio_reader *r, uint64_t k, uint64_t *rowb_out, uint64_t *need_out,
+                                     uint64_t *full_out)
 {
-    uint64_t bytes = (uint64_t)r->bits / 8u, rowb, need, full, cnt = r->counts[k], off = r->offsets[k];
-    size_t got = 0, y;
-    int ok;
-    if (r->cached == k + 1) return 0;
-    r->cached = 0;
+    uint64_t bytes = (uint64_t)r->bits / 8u, rowb, need, full, rows = r->chunk_h;
+    uint64_t cnt = r->counts[k], off = r->offsets[k], d = (k % (r->across * r->down)) / r->across;
+    uint64_t spc = r->planar == 2 ? 1u : (uint64_t)r->bands;
+    if (!r->tiled && d * r->chunk_h + rows > (uint64_t)r->height) rows = (uint64_t)r->height - d * r->chunk_h;
     rowb = (uint64_t)r->chunk_w * spc * bytes; /* chunk_w, spc < 2^31, 2^16: no overflow */
     if (rowb > EX_RIO_MAX_CHUNK || rows > EX_RIO_MAX_CHUNK / rowb)
         return ex_rio_fail(r->err, "TIFF strip/tile %llu decodes to more than %llu bytes", (unsigned long long)k,
                            (unsigned long long)EX_RIO_MAX_CHUNK);
-    need = rowb * rows;                        /* the rows of the image in this chunk */
-    full = rowb * (uint64_t)r->chunk_h;        /* a whole strip: the last one may be shorter */
+    need = rowb * rows;
+    full = rowb * (uint64_t)r->chunk_h;
     if (full > EX_RIO_MAX_CHUNK) full = need;
     if (off > r->size || cnt > r->size - off)
         return ex_rio_fail(r->err, "TIFF strip/tile %llu (offset %llu, %llu bytes) runs past the end of the file",
@@ -817,7 +828,6 @@ static inline int ex_rio_chunk(ex_rio_reader *r, uint64_t k, uint64_t rows, uint
         if (cnt < need)
             return ex_rio_fail(r->err, "TIFF strip/tile %llu holds %llu bytes, %llu needed", (unsigned long long)k,
                                (unsigned long long)cnt, (unsigned long long)need);
-        cnt = need;
     } else {
         uint64_t ratio = r->compression == 5 ? EX_RIO_RATIO_LZW :
                          r->compression == 32773 ? EX_RIO_RATIO_PACKBITS : EX_RIO_RATIO_DEFLATE;
@@ -826,6 +836,22 @@ static inline int ex_rio_chunk(ex_rio_reader *r, uint64_t k, uint64_t rows, uint
                                (unsigned long long)k, (unsigned long long)cnt, (unsigned long long)need);
         if (full / ratio > cnt) full = need;
     }
+    *rowb_out = rowb;
+    *need_out = need;
+    *full_out = full;
+    return 0;
+}
+
+/* Decode chunk index k (rows x cols cells, spc samples per cell) into r->dbuf. */
+static inline int ex_rio_chunk(ex_rio_reader *r, uint64_t k, uint64_t rows, uint64_t spc)
+{
+    uint64_t bytes = (uint64_t)r->bits / 8u, rowb, need, full, cnt = r->counts[k], off = r->offsets[k];
+    size_t got = 0, y;
+    int ok;
+    if (r->cached == k + 1) return 0;
+    r->cached = 0;
+    if (ex_rio_chunk_check(r, k, &rowb, &need, &full) != 0) return -1;
+    if (r->compression == 1) cnt = need;
     if (ex_rio_grow(&r->dbuf, &r->dbuf_cap, (size_t)full + (size_t)rowb) != 0)
         return ex_rio_fail(r->err, "out of memory");
     if (r->compression == 1) {

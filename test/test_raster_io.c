@@ -613,6 +613,8 @@ TEST(tiff_malformed)
     e[0][1] = 4; e[0][3] = 16384; e[1][1] = 4; e[1][3] = 16384; e[3][3] = 8; e[6][1] = 4; e[6][3] = 16384;
     mini_tiff(buf, e, 9, 0);
     CHECK(open_err(buf, 216, "cannot hold") || open_err(buf, 216, "more than"));
+    CHECK(ex_rio_open_tiff_mem(&r, buf, 216) != 0); /* refused when opened, before any allocation */
+    ex_rio_close(&r);
     /* random byte corruption of a real file never crashes and never passes unnoticed sizes */
     {
         ex_rio_write_options o;
