@@ -136,8 +136,9 @@ clean:
 gallery:
 	@$(MAKE) --no-print-directory config=release all
 	@sh examples/gallery.sh build docs/gallery
-$(EXAMPLES) $(CLI) $(BENCH): examples/png_write.h
-$(BUILD)/test/test_png: examples/png_write.h examples/common.h
+$(EXAMPLES) $(CLI) $(BENCH): examples/png_write.h examples/zio.h examples/raster_io.h
+$(BUILD)/test/test_png: examples/png_write.h examples/zio.h examples/common.h
+$(BUILD)/test/test_raster_io: examples/raster_io.h examples/zio.h
 
 # The portability matrix (test/portability.sh): make test with gcc and clang at -O0 and -O2 and with
 # tcc, -DHFVIS_NO_STDIO per compiler, hfvis.h as C++98/11/17; absent compilers are skipped.

@@ -21,6 +21,7 @@
 #endif
 #include <time.h>
 #include "common.h"
+#include "raster_io.h"
 
 #define CLI_PI 3.14159265358979323846
 #define CLI_FLT_MAX ((double)FLT_MAX)                 /* largest value a float flag may take */
@@ -228,7 +229,7 @@ typedef struct cli_args {
     int cmd;
     int has_dir_range, dir_begin, dir_end, out_partial; /* --dir-range A:B, -o *.hfvs */
     const char *in, *out, *env, *albedo_map, *emission;
-    int out_pgm;
+    int out_pgm, out_raster, band, has_cell; /* -o *.tif/.asc/.bil/.flt; --band N (1-based) */
     double cell, zscale, azimuth0, nodata, range_lo, range_hi;
     double sky, albedo, sun_azimuth, sun_elevation, sun_radius, sun_irradiance;
     int dirs, border, border_cells, method, bounces, output;
@@ -311,8 +312,9 @@ static const char cli_usage[] =
     "       hfvis COMMAND --help\n"
     "\n"
     "Visibility and light on height fields with the line-sweep horizon algorithm of\n"
-    "Timonen & Westerholm 2010. IN is a height field: PGM (P2/P5, 8 or 16 bit, raw values)\n"
-    "or grey PFM (Pf). Row 0 is the north edge, x (columns) runs east, y (rows) south.\n"
+    "Timonen & Westerholm 2010. IN is a height field: PGM (P2/P5, 8 or 16 bit, raw values),\n"
+    "grey PFM (Pf), GeoTIFF (.tif), ESRI ASCII grid (.asc) or EHdr raw grid (.bil/.flt).\n"
+    "Row 0 is the north edge, x (columns) runs east, y (rows) south.\n"
     "\n"
     "commands:\n"
     "  horizon     horizon elevation angle toward K directions (K planes in one image)\n"
@@ -342,8 +344,14 @@ static const char cli_shared_help[] =
     "                    a PGM of a 3-channel result stacks the channels as planes, top to bottom;\n"
     "                    PGM code 0 is NoData and LO..HI map to 1..65535, recorded in the header\n"
     "                    comment \"# hfvis range LO HI nodata 0\"\n"
+    "                    *.tif a GeoTIFF (tiled, DEFLATE; Float32, or the smallest integer type\n"
+    "                    for viewshed and visibility counts), *.asc an ESRI ASCII grid,\n"
+    "                    *.bil/*.flt raw floats + .hdr: these carry IN's georeference and NoData\n"
+    "                    (planes and channels become bands)\n"
+    "  --band N          IN is a multi-band raster: use band N (1-based, default 1)\n"
     "  --range LO:HI     .pgm only: the values mapped to 0 and 65535 (default per command)\n"
-    "  --cell S          distance between samples, in height units (default 1)\n"
+    "  --cell S          distance between samples, in height units (default: the cell size of a\n"
+    "                    georeferenced IN (.tif, .asc, .bil/.flt), else 1 with a note)\n"
     "  --zscale Z        multiply input values by Z, non-zero (default 1)\n"
     "  --nodata V        input values equal to V are holes: no occlusion, output NaN (PGM code 0)\n"
     "  --dirs K          number of azimuth directions, 1..65536 (default 16)\n"
@@ -356,7 +364,8 @@ static const char cli_shared_help[] =
     "                    grass and grid 0 = east). Degrees (before 0.2: radians); see --radians\n"
     "  --radians         angle flags (--azimuth0, --azimuth, --sun-*) in radians, not degrees\n"
     "  --compass         the same as --convention compass (the default)\n"
-    "  --degrees         angle outputs in degrees instead of radians\n"
+    "  --degrees         angle outputs in degrees instead of radians\n";
+static const char cli_shared_help2[] =
     "  --dir-range A:B   horizon, skyview, sky, light, visibility: only the directions at\n"
     "                    positions A..B-1 of the K (0 <= A < B <= K) in sweep order (with K a\n"
     "                    multiple of 4, each 4 consecutive positions are the quarter turns\n"
@@ -373,7 +382,7 @@ static const char cli_shared_help[] =
     "                    interpolation between lattice lines (right at walls, roofs, cliffs;\n"
     "                    'hfvis azimuths --exact' prints the directions used). visibility,\n"
     "                    indirect and gi keep the lattice\n"
-    "  --quiet           no progress bar (shown on stderr only when it is a terminal)\n"
+    "  --quiet           no progress bar (shown on stderr only when it is a terminal) and no notes\n"
     "  --progress        plain progress lines on stderr instead (percent, elapsed, ETA), for logs\n"
     "                    and job schedulers, and a summary line at the end (time, cells,\n"
     "                    directions); runs over 10 s end with the summary anyway (not --quiet)\n"
@@ -1349,6 +1358,7 @@ static const cli_flag cli_flags[] = {
     { "--zscale", 1, CLI_ALL },     { "--nodata", 1, CLI_ALL },      { "--dirs", 1, CLI_ALL },
     { "--azimuth0", 1, CLI_ALL },   { "--compass", 0, CLI_ALL },     { "--degrees", 0, CLI_ALL },
     { "--border", 1, CLI_ALL },     { "--border-cells", 1, CLI_ALL }, { "--quiet", 0, CLI_ALL },
+    { "--band", 1, CLI_ALL },
     { "--dir-range", 1, CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY)
                         | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VISIBILITY) },
     { "--sky", 1, CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
@@ -1406,7 +1416,9 @@ static int cli_set(cli_args *a, const char *f, const char *v)
         if (cli_ends_with(v, ".pfm")) a->out_pgm = 0;
         else if (cli_ends_with(v, ".pgm")) a->out_pgm = 1;
         else if (cli_ends_with(v, ".hfvs")) a->out_partial = 1;
-        else return cli_error(CLI_EXIT_USAGE, v, "unknown output type (use a .pfm or .pgm name)");
+        else if (ex_rio_format_of(v)) a->out_raster = 1;
+        else return cli_error(CLI_EXIT_USAGE, v, "unknown output type (use a .pfm, .pgm, .tif, .asc, .bil "
+                              "or .flt name)");
         a->out = v;
         return 0;
     }
@@ -1440,7 +1452,11 @@ static int cli_set(cli_args *a, const char *f, const char *v)
         a->has_range = 1;
         return 0;
     }
-    if (!strcmp(f, "--cell")) return cli_real(f, v, 0.0, 1, DBL_MAX, "a number > 0", &a->cell);
+    if (!strcmp(f, "--cell")) {
+        a->has_cell = 1;
+        return cli_real(f, v, 0.0, 1, DBL_MAX, "a number > 0", &a->cell);
+    }
+    if (!strcmp(f, "--band")) return cli_int(f, v, 1, EX_RIO_MAX_BANDS, "a band number 1..65535", &a->band);
     if (!strcmp(f, "--zscale")) {
         if (cli_real(f, v, -CLI_FLT_MAX, 0, CLI_FLT_MAX, "a non-zero number", &a->zscale)) return CLI_EXIT_USAGE;
         if ((float)a->zscale == 0.0f)
@@ -1575,12 +1591,12 @@ static int cli_parse(int argc, char **argv, cli_args *a)
         if (argc > 2 && strcmp(argv[1], "help") == 0) {
             for (c = 0; c < CMD_COUNT; c++)
                 if (!strcmp(argv[2], cli_cmd_names[c])) {
-                    printf("%s%s", cli_cmd_help[c], cli_shared_help);
+                    printf("%s%s%s", cli_cmd_help[c], cli_shared_help, cli_shared_help2);
                     return 0;
                 }
             return cli_error(CLI_EXIT_USAGE, argv[2], "unknown command (try 'hfvis --help')");
         }
-        printf("%s%s", cli_usage, cli_shared_help);
+        printf("%s%s%s", cli_usage, cli_shared_help, cli_shared_help2);
         return 0;
     }
     for (c = 0; c < CMD_COUNT && strcmp(argv[1], cli_cmd_names[c]); c++) {}
@@ -1597,7 +1613,7 @@ static int cli_parse(int argc, char **argv, cli_args *a)
         }
         if (!strcmp(arg, "--")) { positional_only = 1; continue; }
         if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) {
-            printf("%s%s", cli_cmd_help[a->cmd], cli_shared_help);
+            printf("%s%s%s", cli_cmd_help[a->cmd], cli_shared_help, cli_shared_help2);
             return 0;
         }
         eq = strchr(arg, '=');
@@ -1693,27 +1709,115 @@ static int cli_parse(int argc, char **argv, cli_args *a)
 /* running a command                                                                          */
 /* ------------------------------------------------------------------------------------------ */
 
-/* Load IN as a one-channel height field; --nodata values become NaN, the rest are scaled. */
-static int cli_load_heights(const cli_args *a, float **z, int *w, int *h)
+/* The georeference of a raster IN, carried to a raster OUT (cli_save); the rows of IN, to
+ * recognise stacked output planes. The CLI's one piece of global state besides the bar. */
+static ex_georef cli_geo;
+static int cli_in_height;
+static float *cli_alloc(size_t a, size_t b, size_t c);
+
+/* Load a GeoTIFF, ASC or EHdr IN (band --band): NoData -> NaN, the georeference kept in cli_geo,
+ * *cell from it (geographic CRS refused unless --cell), --cell overriding with a note. */
+static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double *cell)
+{
+    ex_rio_reader r;
+    float *px;
+    double rc_cell = 0.0;
+    char why[256];
+    if (ex_rio_open(&r, a->in) != 0) return cli_error(CLI_EXIT_ERROR, a->in, "%s", r.err);
+    if ((a->band ? a->band : 1) > r.bands) {
+        cli_error(CLI_EXIT_ERROR, a->in, "--band %d: the raster has %d band%s", a->band, r.bands,
+                  r.bands == 1 ? "" : "s");
+        ex_rio_close(&r);
+        return CLI_EXIT_ERROR;
+    }
+    if (r.width > HFVIS_IMAGE_MAX_DIM || r.height > HFVIS_IMAGE_MAX_DIM ||
+        (size_t)r.width * (size_t)r.height > HFVIS_IMAGE_MAX_VALUES) {
+        cli_error(CLI_EXIT_ERROR, a->in, "%s: %d x %d cells exceed the limit of 2^28 values",
+                  hfvis_status_string(HFVIS_ERR_LIMIT), r.width, r.height);
+        ex_rio_close(&r);
+        return CLI_EXIT_ERROR;
+    }
+    if (r.geo.has_transform) {
+        if (r.geo.crs == EX_RIO_CRS_GEOGRAPHIC && !a->has_cell) {
+            char crs[32] = "";
+            if (r.geo.epsg) snprintf(crs, sizeof crs, ", EPSG:%d", r.geo.epsg);
+            cli_error(CLI_EXIT_ERROR, a->in, "geographic coordinates (cells in degrees%s): reproject to "
+                      "metres first, e.g. gdalwarp -t_srs EPSG:32633 (your UTM zone) -r bilinear IN out.tif, "
+                      "or give --cell in metres", crs);
+            ex_rio_close(&r);
+            return CLI_EXIT_ERROR;
+        }
+        if (ex_georef_cell(&r.geo, &rc_cell, why) != 0) {
+            cli_error(CLI_EXIT_ERROR, a->in, "%s", why);
+            ex_rio_close(&r);
+            return CLI_EXIT_ERROR;
+        }
+        if (!a->has_cell) *cell = rc_cell;
+        else if (!a->quiet && a->cell != rc_cell)
+            fprintf(stderr, "hfvis: note: --cell %g overrides the cell size %.10g of %s\n", a->cell, rc_cell,
+                    a->in);
+    } else if (!a->has_cell && !a->quiet) {
+        fprintf(stderr, "hfvis: note: %s has no georeference: cell size 1 (give --cell)\n", a->in);
+    }
+    px = cli_alloc((size_t)r.width, (size_t)r.height, 1);
+    if (!px) {
+        ex_rio_close(&r);
+        return cli_status(a->in, HFVIS_ERR_OUT_OF_MEMORY, 0);
+    }
+    r.nodata_to_nan = 1;
+    if (ex_rio_read(&r, a->band ? a->band - 1 : 0, 0, 0, r.width, r.height, px, r.width) != 0) {
+        cli_error(CLI_EXIT_ERROR, a->in, "%s", r.err);
+        free(px);
+        ex_rio_close(&r);
+        return CLI_EXIT_ERROR;
+    }
+    *z = px; *w = r.width; *h = r.height;
+    ex_georef_free(&cli_geo);
+    cli_geo = r.geo; /* moved: the reader no longer owns it */
+    memset(&r.geo, 0, sizeof r.geo);
+    ex_rio_close(&r);
+    return 0;
+}
+
+/* Load IN as a one-channel height field; --nodata values become NaN, the rest are scaled.
+ * *cell: --cell, else the raster's cell size, else 1 (with a note unless --quiet). */
+static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double *cell)
 {
     hfvis_image_info info;
     float *px = NULL, zscale = (float)a->zscale, nodata = (float)a->nodata;
     size_t i, n;
     hfvis_status s;
-    errno = 0;
-    s = hfvis_image_load(a->in, NULL, &px, &info);
-    if (s != HFVIS_OK) return cli_status(a->in, s, errno);
-    if (info.channels != 1) {
-        hfvis_free(NULL, px);
-        return cli_error(CLI_EXIT_ERROR, a->in, "a height field has one channel, this image has %d",
-                         info.channels);
+    *cell = a->cell;
+    if (ex_rio_format_of(a->in)) {
+        int rc = cli_load_raster(a, &px, w, h, cell);
+        if (rc != 0) return rc;
+    } else {
+        if (a->band > 1)
+            return cli_error(CLI_EXIT_ERROR, a->in, "--band %d: a PFM/PGM height field has one band", a->band);
+        errno = 0;
+        s = hfvis_image_load(a->in, NULL, &px, &info);
+        if (s != HFVIS_OK) return cli_status(a->in, s, errno);
+        if (info.channels != 1) {
+            hfvis_free(NULL, px);
+            return cli_error(CLI_EXIT_ERROR, a->in, "a height field has one channel, this image has %d",
+                             info.channels);
+        }
+        if (!a->has_cell && !a->quiet)
+            fprintf(stderr, "hfvis: note: %s has no cell size: using 1 (give --cell)\n", a->in);
+        *w = info.width; *h = info.height;
     }
-    n = (size_t)info.width * (size_t)info.height; /* <= HFVIS_IMAGE_MAX_VALUES (decoder limit) */
+    n = (size_t)*w * (size_t)*h; /* <= HFVIS_IMAGE_MAX_VALUES (decoder limit) */
     for (i = 0; i < n; i++) {
         if (a->has_nodata && px[i] == nodata) px[i] = (float)NAN;
         else px[i] *= zscale;
     }
-    *z = px; *w = info.width; *h = info.height;
+    if (a->has_nodata && !cli_geo.has_nodata) { /* --nodata is the outputs' NoData too */
+        cli_geo.has_nodata = 1;
+        cli_geo.nodata = (double)nodata;
+        snprintf(cli_geo.nodata_text, sizeof cli_geo.nodata_text, "%.9g", (double)nodata);
+    }
+    cli_in_height = *h;
+    *z = px;
     return 0;
 }
 
@@ -1726,6 +1830,46 @@ static float *cli_alloc(size_t a, size_t b, size_t c)
     return (float *)malloc(a * b * c * sizeof(float));
 }
 
+/* Integral outputs (viewshed 0/1, visibility counts) go into the smallest integer GeoTIFF type
+ * holding their values and NoData: the input's NoData when it is an integer, else (holes
+ * present) one past the largest value. Returns 0 (and leaves o, g alone) to keep Float32. */
+static int cli_integral_type(const cli_args *a, const float *px, size_t n, ex_georef *g,
+                             ex_rio_write_options *o)
+{
+    static const int types[4][2] = { { EX_RIO_UINT, 8 }, { EX_RIO_UINT, 16 }, { EX_RIO_INT, 16 },
+                                     { EX_RIO_INT, 32 } };
+    double lo = 0.0, hi = 0.0, nd = 0.0;
+    int holes = 0, want_nd, k;
+    size_t i;
+    if (!(a->cmd == CMD_VIEWSHED || (a->cmd == CMD_VISIBILITY && !a->fraction))) return 0;
+    for (i = 0; i < n; i++) {
+        double v = (double)px[i];
+        if (isnan(v)) { holes = 1; continue; }
+        if (v != floor(v) || fabs(v) > 2147483647.0) return 0;
+        if (v < lo) lo = v;
+        if (v > hi) hi = v;
+    }
+    want_nd = holes || g->has_nodata;
+    if (g->has_nodata && isfinite(g->nodata) && g->nodata == floor(g->nodata)) nd = g->nodata;
+    else if (g->has_nodata && !holes) want_nd = 0; /* a NaN or fractional NoData nobody needs */
+    else if (want_nd) nd = hi + 1.0;
+    for (k = 0; k < 4; k++) {
+        double tlo = types[k][0] == EX_RIO_UINT ? 0.0 : -ldexp(1.0, types[k][1] - 1);
+        double thi = types[k][0] == EX_RIO_UINT ? ldexp(1.0, types[k][1]) - 1.0 : ldexp(1.0, types[k][1] - 1) - 1.0;
+        if (lo >= tlo && hi <= thi && (!want_nd || (nd >= tlo && nd <= thi))) break;
+    }
+    if (k == 4) return 0;
+    o->kind = types[k][0];
+    o->bits = types[k][1];
+    o->predictor = 2;
+    g->has_nodata = want_nd;
+    if (want_nd) {
+        g->nodata = nd;
+        snprintf(g->nodata_text, sizeof g->nodata_text, "%.0f", nd);
+    }
+    return 1;
+}
+
 /* Write OUT: PFM with its channels, or a 16-bit PGM with the channel planes stacked (NoData code 0,
  * the range in its header: hfvis_pgm_range_save). */
 static int cli_save(const cli_args *a, const float *px, int w, int h, int channels, double lo,
@@ -1733,6 +1877,48 @@ static int cli_save(const cli_args *a, const float *px, int w, int h, int channe
 {
     hfvis_status s;
     errno = 0;
+    if (a->out_raster) {
+        /* planes stacked top to bottom (horizon) or channels interleaved become bands */
+        int planes = cli_in_height > 0 && h % cli_in_height == 0 ? h / cli_in_height : 1;
+        ex_rio_image img;
+        ex_rio_write_options o;
+        ex_georef g = cli_geo; /* shallow: only the NoData fields change, on the copy */
+        char why[256];
+        size_t i, n = (size_t)w * (size_t)h * (size_t)channels;
+        int moved = 0;
+        img.data = px;
+        img.width = w;
+        img.height = h / planes;
+        img.bands = planes * channels;
+        img.pixel_step = (size_t)channels;
+        img.row_step = (size_t)w * (size_t)channels;
+        img.band_step = channels > 1 ? 1 : (size_t)w * (size_t)img.height;
+        memset(&o, 0, sizeof o);
+        o.tiled = 1;
+        o.deflate = 1;
+        o.predictor = 3;
+        if (g.has_nodata) /* the input's NoData, unless the output has it as a real value */
+            for (i = 0; i < n; i++)
+                if (!isnan(px[i]) && (double)px[i] == g.nodata) {
+                    moved = 1;
+                    g.has_nodata = 0;
+                    break;
+                }
+        if ((ex_rio_format_of(a->out) != EX_RIO_TIFF || !cli_integral_type(a, px, n, &g, &o)) && !g.has_nodata)
+            /* NaN cells: declare NoData NaN */
+            for (i = 0; i < n; i++)
+                if (isnan(px[i])) {
+                    g.has_nodata = 1;
+                    g.nodata = (double)NAN;
+                    strcpy(g.nodata_text, "nan");
+                    break;
+                }
+        if (ex_rio_write(a->out, &img, &g, &o, why) != 0) return cli_error(CLI_EXIT_ERROR, a->out, "%s", why);
+        if (moved && !a->quiet)
+            fprintf(stderr, "hfvis: note: %s: the input's NoData %s is a value of this output: holes are "
+                    "written as %s\n", a->out, cli_geo.nodata_text, g.has_nodata ? g.nodata_text : "NaN");
+        return 0;
+    }
     if (!a->out_pgm) {
         s = hfvis_pfm_save(a->out, px, w, h, channels, w);
     } else {
@@ -3065,6 +3251,10 @@ static void cli_georef(const cli_args *a, double cell, double gt[6])
         for (i = 0; i < 6; i++) gt[i] = a->geotransform[i];
         return;
     }
+    if (cli_geo.has_transform) { /* a georeferenced input (GeoTIFF, ASC, EHdr) */
+        for (i = 0; i < 6; i++) gt[i] = cli_geo.gt[i];
+        return;
+    }
     gt[0] = -0.5 * cell, gt[1] = cell, gt[2] = 0.0;
     gt[3] = -0.5 * cell, gt[4] = 0.0, gt[5] = cell;
 }
@@ -3336,8 +3526,8 @@ static int cli_run(const cli_args *a)
     if (a->cmd == CMD_VISFIELD) return cli_run_visfield(a);
     if (a->cmd == CMD_MESHAO) return cli_run_meshao(a);
     memset(&env, 0, sizeof env);
-    if ((rc = cli_load_heights(a, &z, &w, &h)) != 0) return rc;
-    grid.z = z; grid.width = w; grid.height = h; grid.stride = w; grid.cell_size = a->cell;
+    if ((rc = cli_load_heights(a, &z, &w, &h, &grid.cell_size)) != 0) return rc;
+    grid.z = z; grid.width = w; grid.height = h; grid.stride = w;
     opts.border = (hfvis_border)a->border;
     opts.border_cells = a->border_cells;
     opts.azimuth0_rad = a->compass ? a->azimuth0 - CLI_PI / 2.0 : a->azimuth0;
@@ -3506,6 +3696,7 @@ int main(int argc, char **argv)
     if ((rc = cli_gis_finish(&a)) != 0) return rc;
     if ((rc = cli_refuse_inputs(&a, a.out)) != 0) return rc;
     rc = cli_run(&a);
+    ex_georef_free(&cli_geo);
     if (rc == 0 && !a.quiet && a.out && (a.progress_lines || cli_now() - cli_t0 >= CLI_SUMMARY_SECONDS)) {
         fprintf(stderr, "hfvis %s: done in %.1f s", cli_cmd_names[a.cmd], cli_now() - cli_t0);
         if (cli_run_cells > 0.0) fprintf(stderr, ": %.0f cells", cli_run_cells);

@@ -2,7 +2,7 @@
  * RFC 1950; deflate RFC 1951): 8- or 16-bit greyscale and 8-bit RGB, no interlace, every row
  * filter type 0, one IDAT chunk holding a zlib stream of STORED (uncompressed) deflate blocks.
  * The files are as large as the pixels (plus 11 bytes per 65535), which is the price of no
- * compressor. Header-only, every function static inline; it prints nothing (common.h reports
+ * compressor. Checksums and the atomic file write come from zio.h. Header-only, every function static inline; it prints nothing (common.h reports
  * failures) and keeps no state. The library itself stays PFM/PGM: this file belongs to the
  * examples. */
 #ifndef HFVIS_EXAMPLES_PNG_H
@@ -15,52 +15,13 @@
 #include <stdlib.h>
 #include <string.h>
 #include "hfvis.h"
+#include "zio.h"
 
 /* A PNG chunk length is at most 2^31 - 1 (PNG §5.3), and the whole zlib stream goes in one IDAT
  * chunk: images whose stream would be longer are refused with HFVIS_ERR_LIMIT (about 2 GB). */
 #define EX_PNG_MAX_CHUNK 0x7fffffffu
 /* A stored deflate block holds at most 65535 bytes (RFC 1951 §3.2.4: LEN is 16 bits). */
 #define EX_PNG_MAX_STORED 65535u
-
-/* CRC-32 of PNG Annex D (reflected polynomial 0xEDB88320, initial and final XOR 0xFFFFFFFF) over
- * n bytes, continuing crc (start from 0): ex_png_crc32(0, "123456789", 9) = 0xCBF43926. Four bits
- * per step from a 16-entry table (entry i = CRC register after shifting the nibble i out). */
-static inline uint32_t ex_png_crc32(uint32_t crc, const unsigned char *p, size_t n)
-{
-    static const uint32_t t[16] = {
-        0x00000000u, 0x1db71064u, 0x3b6e20c8u, 0x26d930acu, 0x76dc4190u, 0x6b6b51f4u,
-        0x4db26158u, 0x5005713cu, 0xedb88320u, 0xf00f9344u, 0xd6d6a3e8u, 0xcb61b38cu,
-        0x9b64c2b0u, 0x86d3d2d4u, 0xa00ae278u, 0xbdbdf21cu
-    };
-    size_t i;
-    crc = ~crc;
-    for (i = 0; i < n; i++) {
-        crc ^= p[i];
-        crc = (crc >> 4) ^ t[crc & 15u];
-        crc = (crc >> 4) ^ t[crc & 15u];
-    }
-    return ~crc;
-}
-
-/* Adler-32 of RFC 1950 §8.2 over n bytes, continuing adler (start from 1):
- * ex_png_adler32(1, "Wikipedia", 9) = 0x11E60398. Reduces mod 65521 every 5552 bytes, the
- * longest run whose sums cannot overflow 32 bits (zlib's NMAX). */
-static inline uint32_t ex_png_adler32(uint32_t adler, const unsigned char *p, size_t n)
-{
-    uint32_t a = adler & 0xffffu, b = adler >> 16;
-    while (n > 0) {
-        size_t k = n < 5552u ? n : 5552u, i;
-        for (i = 0; i < k; i++) {
-            a += p[i];
-            b += a;
-        }
-        a %= 65521u;
-        b %= 65521u;
-        p += k;
-        n -= k;
-    }
-    return (b << 16) | a;
-}
 
 /* Bytes per row of samples (no filter byte), the zlib stream length and the file size of a
  * width x height PNG with channels 1 (grey) or 3 (RGB) and depth 8 or 16 (16 only for grey).
@@ -105,7 +66,7 @@ static inline unsigned char *ex_png__chunk(unsigned char *p, const char type[4],
 {
     ex_png__be32(p, (uint32_t)n);
     memcpy(p + 4, type, 4);
-    return ex_png__be32(p + 8 + n, ex_png_crc32(0, p + 4, 4 + n));
+    return ex_png__be32(p + 8 + n, ex_crc32(0, p + 4, 4 + n));
 }
 
 /* The deflate writer: copies the filtered scanlines into stored blocks of at most 65535 bytes,
@@ -132,7 +93,7 @@ static inline void ex_png__stored(ex_png__deflate *z, const unsigned char *src, 
         }
         k = n < z->block_left ? n : z->block_left;
         memcpy(z->p, src, k);
-        z->adler = ex_png_adler32(z->adler, src, k);
+        z->adler = ex_adler32(z->adler, src, k);
         z->p += k;
         src += k;
         n -= k;
@@ -188,56 +149,17 @@ static inline hfvis_status ex_png_encode(const unsigned char *samples, int width
     return HFVIS_OK;
 }
 
-/* Write n bytes to "<path>.tmp<8 hex digits>" beside path and rename it onto path, as the
- * library's savers do: a reader never sees a partial file. The suffix hashes the path and the
- * address of the bytes; a name already taken is skipped. On failure the temporary file is
- * removed, path is untouched and the result is HFVIS_ERR_IO (or _OUT_OF_MEMORY). */
+/* Write n bytes to path atomically (zio.h's ex_atomic_open/close: a temporary file beside path,
+ * renamed onto it), as the library's savers do: a reader never sees a partial file. On failure
+ * path is untouched and the result is HFVIS_ERR_IO. */
 static inline hfvis_status ex_png_write_file(const char *path, const unsigned char *bytes, size_t n)
 {
-    static const char hex[] = "0123456789abcdef";
-    size_t len, k;
-    const void *addr = bytes;
-    unsigned char raw[sizeof addr];
-    uint32_t tag;
     char *tmp;
-    FILE *f = NULL;
-    int attempt, ok;
+    FILE *f;
     if (!path || !bytes) return HFVIS_ERR_INVALID_ARGUMENT;
-    len = strlen(path);
-    if (len > SIZE_MAX - 16) return HFVIS_ERR_IO;
-    tmp = (char *)malloc(len + 16);
-    if (!tmp) return HFVIS_ERR_OUT_OF_MEMORY;
-    memcpy(raw, &addr, sizeof raw);
-    tag = ex_png_crc32(ex_png_crc32(0, (const unsigned char *)path, len), raw, sizeof raw);
-    memcpy(tmp, path, len);
-    memcpy(tmp + len, ".tmp", 4);
-    tmp[len + 12] = '\0';
-    for (attempt = 0; attempt < 16; attempt++, tag += 0x9e3779b9u) {
-        FILE *existing;
-        for (k = 0; k < 8; k++) tmp[len + 4 + k] = hex[(tag >> (28 - 4 * k)) & 15u];
-        existing = fopen(tmp, "rb");
-        if (!existing) break;
-        fclose(existing);
-    }
-    if (attempt < 16) f = fopen(tmp, "wb");
-    if (!f) {
-        free(tmp);
-        return HFVIS_ERR_IO;
-    }
-    ok = fwrite(bytes, 1, n, f) == n;
-    ok = (fflush(f) == 0) && ok;
-    ok = (fclose(f) == 0) && ok;
-    if (ok && rename(tmp, path) != 0) {
-#if defined(_WIN32)
-        /* Windows' rename does not replace an existing file: replace non-atomically. */
-        ok = remove(path) == 0 && rename(tmp, path) == 0;
-#else
-        ok = 0;
-#endif
-    }
-    if (!ok) remove(tmp);
-    free(tmp);
-    return ok ? HFVIS_OK : HFVIS_ERR_IO;
+    f = ex_atomic_open(path, bytes, &tmp);
+    if (!f) return HFVIS_ERR_IO;
+    return ex_atomic_close(f, tmp, path, fwrite(bytes, 1, n, f) == n) ? HFVIS_OK : HFVIS_ERR_IO;
 }
 
 /* One sample of [lo, hi] on 0..top, as hfvis_pgm_encode maps it: values outside clamp, NaN and

@@ -42,11 +42,15 @@ little_endian=0
 [ "$(printf '\001\000' | od -An -tu2 | tr -d ' ')" = 1 ] && little_endian=1
 
 # ---- helpers ------------------------------------------------------------------------------
+# drop_notes: remove the "hfvis: note: ..." lines (e.g. "no cell size: using 1") from the last
+# run's stderr; test/raster_cli_test.sh checks the notes themselves.
+drop_notes() { grep -v '^hfvis: note: ' "$dir/stderr" > "$dir/stderr.n"; mv "$dir/stderr.n" "$dir/stderr"; }
 # expect_ok NAME OUT ARGS...: exit 0, nothing on stderr, OUT written.
 expect_ok() {
   name=$1; out=$2; shift 2
   rm -f "$out"
   "$hfvis" "$@" > "$dir/stdout" 2> "$dir/stderr"; rc=$?
+  drop_notes
   if [ "$rc" -ne 0 ]; then bad "$name: exit $rc: $(head -n 3 "$dir/stderr")"
   elif [ -s "$dir/stderr" ]; then bad "$name: unexpected stderr: $(head -n 3 "$dir/stderr")"
   elif [ ! -s "$out" ]; then bad "$name: $out not written"
@@ -57,6 +61,7 @@ expect_ok() {
 expect_fail() {
   name=$1; want=$2; shift 2
   "$hfvis" "$@" > "$dir/stdout" 2> "$dir/stderr"; rc=$?
+  drop_notes
   lines=$(wc -l < "$dir/stderr" | tr -d ' ')
   left=$(ls -A "$fdir")
   if [ "$rc" -ne "$want" ]; then bad "$name: exit $rc, want $want: $(head -n 3 "$dir/stderr")"

@@ -33,6 +33,12 @@ if [ -f test/cli_test.sh ] && [ -x "$build/hfvis" ]; then
   if sh test/cli_test.sh "$build/hfvis" "$scratch" > "$scratch/log" 2>&1; then passed=$((passed + 1)); echo "ok   cli"
   else failed=$((failed + 1)); cat "$scratch/log"; echo "FAIL cli"; fi
 fi
+# GIS rasters through the tool (GDAL interop when installed, else a printed SKIP)
+if [ -x "$build/hfvis" ]; then
+  if sh test/raster_cli_test.sh "$build/hfvis" "$scratch" > "$scratch/log" 2>&1; then passed=$((passed + 1))
+    grep '^SKIP' "$scratch/log"; echo "ok   raster cli: $(tail -n 1 "$scratch/log")"
+  else failed=$((failed + 1)); cat "$scratch/log"; echo "FAIL raster cli"; fi
+fi
 if $cxx -std=c++11 -Wall -Wextra -Werror -pedantic -fsyntax-only -I. test/cxx_header.cpp; then
   passed=$((passed + 1)); echo "ok   cxx header"; else failed=$((failed + 1)); echo "FAIL cxx header"; fi
 # install (make install/uninstall, pkg-config, a user program; exit 77 = skipped without pkg-config)

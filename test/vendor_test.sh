@@ -2,7 +2,7 @@
 # vendor_test.sh - the README's vendoring promise, checked: copy ONLY hfvis.h, hfvis.c, ssao.c and
 # voxel.c into an empty folder, compile them with plain `cc -std=c99 -c` (no Makefile, no -D, no
 # generated file), then build every example (examples/0*.c, 1*.c) and the hfvis tool against
-# them from a second folder holding the example sources with examples/common.h, examples/png_write.h and examples/fields.h copied beside
+# them from a second folder holding the example sources with examples/common.h, png_write.h, zio.h, raster_io.h and fields.h copied beside
 # them, and run one example into a scratch folder.
 # usage: sh test/vendor_test.sh [SCRATCHDIR]   (from the repository root; compiler $CC, default
 # cc; extra flags in $VENDOR_CFLAGS, e.g. -O2). Exit 0 = passed, anything else = failed.
@@ -14,7 +14,7 @@ rm -rf "$dir"; mkdir -p "$dir/vendor" "$dir/app" "$dir/out" || exit 1
 fail() { echo "FAIL vendor: $1"; rm -rf "$dir"; exit 1; }
 
 cp hfvis.h hfvis.c ssao.c voxel.c "$dir/vendor/" || fail "copy"
-cp examples/common.h examples/png_write.h examples/fields.h examples/0*.c examples/1*.c examples/hfvis_cli.c "$dir/app/" || fail "copy"
+cp examples/common.h examples/png_write.h examples/zio.h examples/raster_io.h examples/fields.h examples/0*.c examples/1*.c examples/hfvis_cli.c "$dir/app/" || fail "copy"
 # shellcheck disable=SC2086 # $flags is a list of flags
 (cd "$dir/vendor" && $cc $flags -c hfvis.c && $cc $flags -c ssao.c && $cc $flags -c voxel.c) \
   > "$dir/log" 2>&1 || { cat "$dir/log"; fail "$cc $flags -c hfvis.c ssao.c voxel.c"; }

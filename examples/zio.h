@@ -1,0 +1,563 @@
+/* zio.h - the byte-level helpers the examples' file codecs share: CRC-32 (PNG Annex D), Adler-32
+ * and zlib streams (RFC 1950) holding deflate data (RFC 1951) both ways, and the atomic file
+ * replacement every writer uses. Header-only, every function static inline, pure C99, no state,
+ * prints nothing. Used by png_write.h (checksums, atomic write) and raster_io.h (inflate for
+ * DEFLATE TIFFs, deflate for the TIFF writer).
+ *
+ * Contents
+ *   1. checksums        ex_crc32, ex_adler32
+ *   2. inflate          ex_inflate: a zlib or raw deflate stream into a buffer of known size
+ *   3. deflate          ex_deflate_bound, ex_deflate_zlib: LZ77 (hash chains) + fixed Huffman,
+ *                       a stored block instead when that is shorter
+ *   4. atomic files     ex_atomic_open, ex_atomic_close
+ */
+#ifndef HFVIS_EXAMPLES_ZIO_H
+#define HFVIS_EXAMPLES_ZIO_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------------------------------------------ */
+/* 1. checksums                                                                               */
+/* ------------------------------------------------------------------------------------------ */
+
+/* CRC-32 of PNG Annex D (reflected polynomial 0xEDB88320, initial and final XOR 0xFFFFFFFF) over
+ * n bytes, continuing crc (start from 0): ex_crc32(0, "123456789", 9) = 0xCBF43926. Four bits
+ * per step from a 16-entry table (entry i = CRC register after shifting the nibble i out). */
+static inline uint32_t ex_crc32(uint32_t crc, const unsigned char *p, size_t n)
+{
+    static const uint32_t t[16] = {
+        0x00000000u, 0x1db71064u, 0x3b6e20c8u, 0x26d930acu, 0x76dc4190u, 0x6b6b51f4u,
+        0x4db26158u, 0x5005713cu, 0xedb88320u, 0xf00f9344u, 0xd6d6a3e8u, 0xcb61b38cu,
+        0x9b64c2b0u, 0x86d3d2d4u, 0xa00ae278u, 0xbdbdf21cu
+    };
+    size_t i;
+    crc = ~crc;
+    for (i = 0; i < n; i++) {
+        crc ^= p[i];
+        crc = (crc >> 4) ^ t[crc & 15u];
+        crc = (crc >> 4) ^ t[crc & 15u];
+    }
+    return ~crc;
+}
+
+/* Adler-32 of RFC 1950 §8.2 over n bytes, continuing adler (start from 1):
+ * ex_adler32(1, "Wikipedia", 9) = 0x11E60398. Reduces mod 65521 every 5552 bytes, the
+ * longest run whose sums cannot overflow 32 bits (zlib's NMAX). */
+static inline uint32_t ex_adler32(uint32_t adler, const unsigned char *p, size_t n)
+{
+    uint32_t a = adler & 0xffffu, b = adler >> 16;
+    while (n > 0) {
+        size_t k = n < 5552u ? n : 5552u, i;
+        for (i = 0; i < k; i++) {
+            a += p[i];
+            b += a;
+        }
+        a %= 65521u;
+        b %= 65521u;
+        p += k;
+        n -= k;
+    }
+    return (b << 16) | a;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* 2. inflate                                                                                 */
+/* ------------------------------------------------------------------------------------------ */
+
+/* Results of ex_inflate. */
+enum {
+    EX_Z_OK = 0,
+    EX_Z_TRUNCATED = 1, /* the input ended inside the stream */
+    EX_Z_BAD = 2,       /* an invalid header, block type, code set, code or distance */
+    EX_Z_OVERFLOW = 3,  /* the stream holds more bytes than the output's capacity */
+    EX_Z_CHECK = 4      /* the Adler-32 check value differs */
+};
+
+/* Longest Huffman code of deflate (RFC 1951 §3.2.7). */
+#define EX_Z_MAXBITS 15
+
+typedef struct {
+    const unsigned char *in;
+    size_t in_len, in_pos;
+    uint32_t bits;
+    int nbits;
+    unsigned char *out;
+    size_t out_len, out_pos;
+    int truncated;
+} ex_z_state;
+
+/* A canonical Huffman code as counts per length and symbols in code order (Mark Adler's puff). */
+typedef struct {
+    short count[EX_Z_MAXBITS + 1];
+    short symbol[288];
+} ex_z_huff;
+
+static inline int ex_z_bits(ex_z_state *s, int need)
+{
+    uint32_t v = s->bits;
+    while (s->nbits < need) {
+        if (s->in_pos == s->in_len) {
+            s->truncated = 1;
+            return 0;
+        }
+        v |= (uint32_t)s->in[s->in_pos++] << s->nbits;
+        s->nbits += 8;
+    }
+    s->bits = v >> need;
+    s->nbits -= need;
+    return (int)(v & ((1u << need) - 1u));
+}
+
+/* Decode one symbol, reading the code bit by bit (codes are stored most significant bit first). */
+static inline int ex_z_decode(ex_z_state *s, const ex_z_huff *h)
+{
+    int code = 0, first = 0, index = 0, len;
+    for (len = 1; len <= EX_Z_MAXBITS; len++) {
+        int count;
+        code |= ex_z_bits(s, 1);
+        if (s->truncated) return -1;
+        count = h->count[len];
+        if (code - count < first) return h->symbol[index + (code - first)];
+        index += count;
+        first += count;
+        first <<= 1;
+        code <<= 1;
+    }
+    return -2; /* ran out of codes */
+}
+
+/* Build h from n code lengths; 0 when complete or (as RFC 1951 allows for one distance code)
+ * incomplete, -1 when over-subscribed. */
+static inline int ex_z_build(ex_z_huff *h, const short *length, int n)
+{
+    short offs[EX_Z_MAXBITS + 1];
+    int symbol, len, left;
+    for (len = 0; len <= EX_Z_MAXBITS; len++) h->count[len] = 0;
+    for (symbol = 0; symbol < n; symbol++) h->count[length[symbol]]++;
+    if (h->count[0] == n) return 0;
+    left = 1;
+    for (len = 1; len <= EX_Z_MAXBITS; len++) {
+        left <<= 1;
+        left -= h->count[len];
+        if (left < 0) return -1;
+    }
+    offs[1] = 0;
+    for (len = 1; len < EX_Z_MAXBITS; len++) offs[len + 1] = (short)(offs[len] + h->count[len]);
+    for (symbol = 0; symbol < n; symbol++)
+        if (length[symbol] != 0) h->symbol[offs[length[symbol]]++] = (short)symbol;
+    return left;
+}
+
+static const short ex_z_len_base[29] = { 3, 4, 5, 6, 7, 8, 9, 10, 11, 13, 15, 17, 19, 23, 27, 31,
+                                         35, 43, 51, 59, 67, 83, 99, 115, 131, 163, 195, 227, 258 };
+static const short ex_z_len_extra[29] = { 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2,
+                                          3, 3, 3, 3, 4, 4, 4, 4, 5, 5, 5, 5, 0 };
+static const short ex_z_dist_base[30] = { 1, 2, 3, 4, 5, 7, 9, 13, 17, 25, 33, 49, 65, 97, 129, 193,
+                                          257, 385, 513, 769, 1025, 1537, 2049, 3073, 4097, 6145,
+                                          8193, 12289, 16385, 24577 };
+static const short ex_z_dist_extra[30] = { 0, 0, 0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6,
+                                           7, 7, 8, 8, 9, 9, 10, 10, 11, 11, 12, 12, 13, 13 };
+
+/* Literals and matches of one compressed block until its end-of-block code. */
+static inline int ex_z_codes(ex_z_state *s, const ex_z_huff *lit, const ex_z_huff *dist)
+{
+    for (;;) {
+        int sym = ex_z_decode(s, lit);
+        if (s->truncated) return EX_Z_TRUNCATED;
+        if (sym < 0) return EX_Z_BAD;
+        if (sym < 256) {
+            if (s->out_pos == s->out_len) return EX_Z_OVERFLOW;
+            s->out[s->out_pos++] = (unsigned char)sym;
+        } else if (sym == 256) {
+            return EX_Z_OK;
+        } else {
+            size_t len, d;
+            int e;
+            sym -= 257;
+            if (sym >= 29) return EX_Z_BAD;
+            len = (size_t)ex_z_len_base[sym] + (size_t)ex_z_bits(s, ex_z_len_extra[sym]);
+            e = ex_z_decode(s, dist);
+            if (s->truncated) return EX_Z_TRUNCATED;
+            if (e < 0 || e >= 30) return EX_Z_BAD;
+            d = (size_t)ex_z_dist_base[e] + (size_t)ex_z_bits(s, ex_z_dist_extra[e]);
+            if (s->truncated) return EX_Z_TRUNCATED;
+            if (d > s->out_pos) return EX_Z_BAD; /* before the start of the output */
+            if (len > s->out_len - s->out_pos) return EX_Z_OVERFLOW;
+            while (len--) {
+                s->out[s->out_pos] = s->out[s->out_pos - d];
+                s->out_pos++;
+            }
+        }
+    }
+}
+
+static inline int ex_z_fixed(ex_z_state *s)
+{
+    ex_z_huff lit, dist;
+    short len[288];
+    int i;
+    for (i = 0; i < 144; i++) len[i] = 8;
+    for (; i < 256; i++) len[i] = 9;
+    for (; i < 280; i++) len[i] = 7;
+    for (; i < 288; i++) len[i] = 8;
+    ex_z_build(&lit, len, 288);
+    for (i = 0; i < 30; i++) len[i] = 5;
+    ex_z_build(&dist, len, 30);
+    return ex_z_codes(s, &lit, &dist);
+}
+
+static inline int ex_z_dynamic(ex_z_state *s)
+{
+    static const short order[19] = { 16, 17, 18, 0, 8, 7, 9, 6, 10, 5, 11, 4, 12, 3, 13, 2, 14, 1, 15 };
+    short len[320];
+    ex_z_huff lencode, lit, dist;
+    int nlen, ndist, ncode, i, err;
+    nlen = ex_z_bits(s, 5) + 257;
+    ndist = ex_z_bits(s, 5) + 1;
+    ncode = ex_z_bits(s, 4) + 4;
+    if (s->truncated) return EX_Z_TRUNCATED;
+    if (nlen > 286 || ndist > 30) return EX_Z_BAD;
+    for (i = 0; i < 19; i++) len[order[i]] = (short)(i < ncode ? ex_z_bits(s, 3) : 0);
+    if (s->truncated) return EX_Z_TRUNCATED;
+    if (ex_z_build(&lencode, len, 19) != 0) return EX_Z_BAD; /* must be complete */
+    i = 0;
+    while (i < nlen + ndist) {
+        int sym = ex_z_decode(s, &lencode), rep;
+        short val = 0;
+        if (s->truncated) return EX_Z_TRUNCATED;
+        if (sym < 0) return EX_Z_BAD;
+        if (sym < 16) {
+            len[i++] = (short)sym;
+            continue;
+        }
+        if (sym == 16) {
+            if (i == 0) return EX_Z_BAD;
+            val = len[i - 1];
+            rep = 3 + ex_z_bits(s, 2);
+        } else if (sym == 17) {
+            rep = 3 + ex_z_bits(s, 3);
+        } else {
+            rep = 11 + ex_z_bits(s, 7);
+        }
+        if (s->truncated) return EX_Z_TRUNCATED;
+        if (i + rep > nlen + ndist) return EX_Z_BAD;
+        while (rep--) len[i++] = val;
+    }
+    if (len[256] == 0) return EX_Z_BAD; /* no end-of-block code */
+    err = ex_z_build(&lit, len, nlen);
+    if (err < 0 || (err > 0 && nlen - lit.count[0] != 1)) return EX_Z_BAD;
+    err = ex_z_build(&dist, len + nlen, ndist);
+    if (err < 0 || (err > 0 && ndist - dist.count[0] != 1)) return EX_Z_BAD;
+    return ex_z_codes(s, &lit, &dist);
+}
+
+/* Inflate the zlib stream (zlib = 1; RFC 1950 header and Adler-32 checked) or raw deflate data
+ * (zlib = 0) in[0..in_len) into out (capacity out_len); *produced = the bytes it held. Memory:
+ * none beyond the caller's buffers (the tables live on the stack); time linear in the input plus
+ * the output. Returns an EX_Z_* code. */
+static inline int ex_inflate(const unsigned char *in, size_t in_len, unsigned char *out,
+                             size_t out_len, int zlib, size_t *produced)
+{
+    ex_z_state s;
+    int last = 0, rc = EX_Z_OK;
+    *produced = 0;
+    memset(&s, 0, sizeof s);
+    s.in = in; s.in_len = in_len; s.out = out; s.out_len = out_len;
+    if (zlib) {
+        if (in_len < 2) return EX_Z_TRUNCATED;
+        /* CM 8 (deflate), CINFO <= 7 (window <= 32 KiB), FCHECK, no preset dictionary */
+        if ((in[0] & 15) != 8 || (in[0] >> 4) > 7 || ((unsigned)in[0] * 256u + in[1]) % 31u != 0 ||
+            (in[1] & 0x20))
+            return EX_Z_BAD;
+        s.in_pos = 2;
+    }
+    while (!last) {
+        int type;
+        last = ex_z_bits(&s, 1);
+        type = ex_z_bits(&s, 2);
+        if (s.truncated) return EX_Z_TRUNCATED;
+        if (type == 0) {
+            size_t len;
+            s.bits = 0; s.nbits = 0; /* to a byte boundary */
+            if (s.in_len - s.in_pos < 4) return EX_Z_TRUNCATED;
+            len = (size_t)s.in[s.in_pos] | (size_t)s.in[s.in_pos + 1] << 8;
+            if ((s.in[s.in_pos + 2] ^ s.in[s.in_pos]) != 0xff || (s.in[s.in_pos + 3] ^ s.in[s.in_pos + 1]) != 0xff)
+                return EX_Z_BAD;
+            s.in_pos += 4;
+            if (s.in_len - s.in_pos < len) return EX_Z_TRUNCATED;
+            if (s.out_len - s.out_pos < len) return EX_Z_OVERFLOW;
+            memcpy(s.out + s.out_pos, s.in + s.in_pos, len);
+            s.in_pos += len;
+            s.out_pos += len;
+        } else if (type == 1) {
+            rc = ex_z_fixed(&s);
+        } else if (type == 2) {
+            rc = ex_z_dynamic(&s);
+        } else {
+            return EX_Z_BAD;
+        }
+        if (rc != EX_Z_OK) return rc;
+    }
+    *produced = s.out_pos;
+    if (zlib) {
+        const unsigned char *c;
+        uint32_t want;
+        if (s.in_len - s.in_pos < 4) return EX_Z_TRUNCATED;
+        c = s.in + s.in_pos;
+        want = (uint32_t)c[0] << 24 | (uint32_t)c[1] << 16 | (uint32_t)c[2] << 8 | c[3];
+        if (want != ex_adler32(1, out, s.out_pos)) return EX_Z_CHECK;
+    }
+    return EX_Z_OK;
+}
+
+/* A one-line reason for an EX_Z_* code. */
+static inline const char *ex_inflate_string(int rc)
+{
+    switch (rc) {
+    case EX_Z_OK: return "ok";
+    case EX_Z_TRUNCATED: return "truncated deflate stream";
+    case EX_Z_BAD: return "invalid deflate stream";
+    case EX_Z_OVERFLOW: return "deflate stream longer than the data it should hold";
+    default: return "deflate stream fails its Adler-32 check";
+    }
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* 3. deflate                                                                                 */
+/* ------------------------------------------------------------------------------------------ */
+
+/* Hash-chain LZ77: matches of 3..258 bytes within 32 KiB, the first EX_Z_CHAIN candidates of a
+ * 3-byte hash examined (zlib's level-6 chain length is 128; 32 keeps the writer fast). */
+#define EX_Z_CHAIN 32
+#define EX_Z_HASH_BITS 15
+#define EX_Z_WINDOW 32768
+
+/* Upper bound of ex_deflate_zlib's output for n input bytes: the stored form (5 bytes per 65535)
+ * plus the 2-byte header and 4-byte check; 0 when that overflows size_t. */
+static inline size_t ex_deflate_bound(size_t n)
+{
+    size_t blocks = n / 65535u + 1u;
+    if (n > SIZE_MAX - 6u - 5u * blocks || blocks > (SIZE_MAX - 6u) / 5u) return 0;
+    return n + 5u * blocks + 6u;
+}
+
+typedef struct {
+    unsigned char *out;
+    size_t cap, pos;
+    uint32_t bits;
+    int nbits;
+    int full; /* the output passed cap: the fixed-Huffman form is longer than the stored one */
+} ex_z_writer;
+
+static inline void ex_z_put(ex_z_writer *w, uint32_t v, int n)
+{
+    w->bits |= v << w->nbits;
+    w->nbits += n;
+    while (w->nbits >= 8) {
+        if (w->pos < w->cap) w->out[w->pos++] = (unsigned char)w->bits;
+        else w->full = 1;
+        w->bits >>= 8;
+        w->nbits -= 8;
+    }
+}
+
+/* Put a Huffman code of n bits, most significant bit first (RFC 1951 §3.1.1). */
+static inline void ex_z_put_code(ex_z_writer *w, uint32_t code, int n)
+{
+    uint32_t r = 0;
+    int i;
+    for (i = 0; i < n; i++) r |= ((code >> i) & 1u) << (n - 1 - i);
+    ex_z_put(w, r, n);
+}
+
+/* The fixed literal/length code of RFC 1951 §3.2.6. */
+static inline void ex_z_put_lit(ex_z_writer *w, int sym)
+{
+    if (sym < 144) ex_z_put_code(w, 0x30u + (uint32_t)sym, 8);
+    else if (sym < 256) ex_z_put_code(w, 0x190u + (uint32_t)(sym - 144), 9);
+    else if (sym < 280) ex_z_put_code(w, (uint32_t)(sym - 256), 7);
+    else ex_z_put_code(w, 0xc0u + (uint32_t)(sym - 280), 8);
+}
+
+static inline void ex_z_put_match(ex_z_writer *w, int len, int dist)
+{
+    int i = 28, j = 29;
+    while (ex_z_len_base[i] > len) i--;
+    ex_z_put_lit(w, 257 + i);
+    ex_z_put(w, (uint32_t)(len - ex_z_len_base[i]), ex_z_len_extra[i]);
+    while (ex_z_dist_base[j] > dist) j--;
+    ex_z_put_code(w, (uint32_t)j, 5);
+    ex_z_put(w, (uint32_t)(dist - ex_z_dist_base[j]), ex_z_dist_extra[j]);
+}
+
+/* Compress in[0..n) as a zlib stream into out (capacity at least ex_deflate_bound(n)): one
+ * fixed-Huffman block of greedy LZ77 matches, or stored blocks when those come out shorter.
+ * *written = the stream length. Returns 0, or -1 (capacity short, or no memory for the hash
+ * chains: 2^15 + 32768 ints). */
+static inline int ex_deflate_zlib(const unsigned char *in, size_t n, unsigned char *out, size_t cap,
+                                  size_t *written)
+{
+    size_t bound = ex_deflate_bound(n), i, stored;
+    int32_t *head, *prev;
+    ex_z_writer w;
+    uint32_t adler = ex_adler32(1, in, n);
+    if (bound == 0 || cap < bound) return -1;
+    head = (int32_t *)malloc(sizeof(int32_t) << EX_Z_HASH_BITS);
+    prev = (int32_t *)malloc(sizeof(int32_t) * EX_Z_WINDOW);
+    if (!head || !prev) {
+        free(head);
+        free(prev);
+        return -1;
+    }
+    for (i = 0; i < ((size_t)1 << EX_Z_HASH_BITS); i++) head[i] = -1;
+    stored = bound - 6u; /* the stored form's length without header and check */
+    memset(&w, 0, sizeof w);
+    w.out = out + 2;
+    w.cap = stored; /* the fixed form is used only when strictly shorter */
+    ex_z_put(&w, 1u | (1u << 1), 3); /* BFINAL, BTYPE 01 */
+    i = 0;
+    /* Positions are kept relative to a base so the int32 chains work for any n: every 2^30
+     * bytes the tables are cleared (a match never reaches across that seam). */
+    while (i < n && !w.full) {
+        size_t base = i - (i & (((size_t)1 << 30) - 1u)), best_len = 0, best_dist = 0;
+        if (i + 2 < n) {
+            uint32_t hsh = ((uint32_t)in[i] << 16 | (uint32_t)in[i + 1] << 8 | in[i + 2]) * 2654435761u
+                           >> (32 - EX_Z_HASH_BITS);
+            int32_t cand = head[hsh];
+            int chain = EX_Z_CHAIN;
+            size_t rel = i - base;
+            if ((i & (((size_t)1 << 30) - 1u)) == 0 && i > 0) {
+                size_t k;
+                for (k = 0; k < ((size_t)1 << EX_Z_HASH_BITS); k++) head[k] = -1;
+                cand = -1;
+            }
+            while (cand >= 0 && chain-- > 0 && rel - (size_t)cand <= EX_Z_WINDOW) {
+                size_t c = base + (size_t)cand, len = 0, maxlen = n - i < 258 ? n - i : 258;
+                while (len < maxlen && in[c + len] == in[i + len]) len++;
+                if (len > best_len) {
+                    best_len = len;
+                    best_dist = i - c;
+                    if (len == maxlen) break;
+                }
+                cand = prev[(size_t)cand & (EX_Z_WINDOW - 1)];
+            }
+            prev[rel & (EX_Z_WINDOW - 1)] = head[hsh];
+            head[hsh] = (int32_t)rel;
+        }
+        if (best_len >= 3) {
+            size_t k;
+            ex_z_put_match(&w, (int)best_len, (int)best_dist);
+            /* insert the skipped positions into the chains */
+            for (k = 1; k < best_len; k++) {
+                size_t p = i + k, rel = p - base;
+                uint32_t hsh;
+                if (p + 2 >= n || (p & (((size_t)1 << 30) - 1u)) == 0) break;
+                hsh = ((uint32_t)in[p] << 16 | (uint32_t)in[p + 1] << 8 | in[p + 2]) * 2654435761u
+                      >> (32 - EX_Z_HASH_BITS);
+                prev[rel & (EX_Z_WINDOW - 1)] = head[hsh];
+                head[hsh] = (int32_t)rel;
+            }
+            i += best_len;
+        } else {
+            ex_z_put_lit(&w, in[i]);
+            i++;
+        }
+    }
+    ex_z_put_lit(&w, 256);
+    ex_z_put(&w, 0, 7); /* flush the last byte */
+    free(head);
+    free(prev);
+    out[0] = 0x78;
+    out[1] = 0x01; /* CMF/FLG: deflate, 32 KiB window, 0x7801 % 31 == 0 */
+    if (w.full || w.pos >= stored) {
+        /* stored blocks of at most 65535 bytes (BFINAL on the last, LEN, NLEN) */
+        size_t pos = 2, done = 0;
+        do {
+            size_t len = n - done < 65535u ? n - done : 65535u;
+            out[pos] = (unsigned char)(done + len == n);
+            out[pos + 1] = (unsigned char)(len & 0xffu);
+            out[pos + 2] = (unsigned char)(len >> 8);
+            out[pos + 3] = (unsigned char)(~len & 0xffu);
+            out[pos + 4] = (unsigned char)((~len >> 8) & 0xffu);
+            if (len) memcpy(out + pos + 5, in + done, len);
+            pos += 5 + len;
+            done += len;
+        } while (done < n);
+        w.pos = pos - 2;
+    }
+    out[2 + w.pos] = (unsigned char)(adler >> 24);
+    out[3 + w.pos] = (unsigned char)(adler >> 16);
+    out[4 + w.pos] = (unsigned char)(adler >> 8);
+    out[5 + w.pos] = (unsigned char)adler;
+    *written = w.pos + 6;
+    return 0;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* 4. atomic files                                                                            */
+/* ------------------------------------------------------------------------------------------ */
+
+/* Open "<path>.tmp<8 hex digits>" beside path for writing (the name is stored in *tmp_out, to be
+ * passed to ex_atomic_close). The suffix hashes the path and the address of key; a name already
+ * taken is skipped. NULL (and *tmp_out NULL) on failure. */
+static inline FILE *ex_atomic_open(const char *path, const void *key, char **tmp_out)
+{
+    static const char hex[] = "0123456789abcdef";
+    size_t len, k;
+    unsigned char raw[sizeof key];
+    uint32_t tag;
+    char *tmp;
+    FILE *f = NULL;
+    int attempt;
+    *tmp_out = NULL;
+    if (!path) return NULL;
+    len = strlen(path);
+    if (len > SIZE_MAX - 16) return NULL;
+    tmp = (char *)malloc(len + 16);
+    if (!tmp) return NULL;
+    memcpy(raw, &key, sizeof raw);
+    tag = ex_crc32(ex_crc32(0, (const unsigned char *)path, len), raw, sizeof raw);
+    memcpy(tmp, path, len);
+    memcpy(tmp + len, ".tmp", 4);
+    tmp[len + 12] = '\0';
+    for (attempt = 0; attempt < 16; attempt++, tag += 0x9e3779b9u) {
+        FILE *existing;
+        for (k = 0; k < 8; k++) tmp[len + 4 + k] = hex[(tag >> (28 - 4 * k)) & 15u];
+        existing = fopen(tmp, "rb");
+        if (!existing) break;
+        fclose(existing);
+    }
+    if (attempt < 16) f = fopen(tmp, "wb");
+    if (!f) {
+        free(tmp);
+        return NULL;
+    }
+    *tmp_out = tmp;
+    return f;
+}
+
+/* Finish a file from ex_atomic_open: with ok, flush, close and rename it onto path (a reader
+ * never sees a partial file); otherwise (or when any of that fails) close and remove it, leaving
+ * path untouched. Frees tmp. Returns 1 when path now holds the new file. */
+static inline int ex_atomic_close(FILE *f, char *tmp, const char *path, int ok)
+{
+    ok = (fflush(f) == 0) && ok;
+    ok = (fclose(f) == 0) && ok;
+    if (ok && rename(tmp, path) != 0) {
+#if defined(_WIN32)
+        /* Windows' rename does not replace an existing file: replace non-atomically. */
+        ok = remove(path) == 0 && rename(tmp, path) == 0;
+#else
+        ok = 0;
+#endif
+    }
+    if (!ok) remove(tmp);
+    free(tmp);
+    return ok;
+}
+
+#endif /* HFVIS_EXAMPLES_ZIO_H */

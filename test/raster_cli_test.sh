@@ -1,0 +1,130 @@
+#!/bin/sh
+# raster_cli_test.sh - the hfvis tool with GIS rasters (examples/raster_io.h): ASC and EHdr in and
+# out against the PGM route bit for bit, the cell size and NoData taken from the raster, --cell
+# overriding with a note, the no-georeference note, geographic CRS refused, --band; then, when
+# GDAL is installed, GeoTIFFs written by gdal_translate (DEFLATE/LZW/PackBits, tiled, predictors,
+# BigTIFF, big-endian) read bit for bit and hfvis's GeoTIFF/EHdr/ASC outputs read by GDAL with the
+# input's CRS, geotransform, NoData and values (gdalinfo, gdal_translate, gdalcompare.py);
+# "SKIP gdal" without it.
+# usage: sh test/raster_cli_test.sh BUILD/hfvis SCRATCHDIR
+hfvis=$1
+[ -n "$hfvis" ] && [ -x "$hfvis" ] || { echo "usage: sh test/raster_cli_test.sh BUILD/hfvis SCRATCHDIR"; exit 2; }
+dir=${2:-${TMPDIR:-/tmp}}/raster_cli_test.$$
+rm -rf "$dir"; mkdir -p "$dir" || exit 1
+passed=0; failed=0
+ok()  { passed=$((passed + 1)); echo "ok   raster $1"; }
+bad() { failed=$((failed + 1)); echo "FAIL raster $1"; }
+# run NAME ARGS...: exit 0; stderr kept in $dir/err
+run() { name=$1; shift; if "$hfvis" "$@" > /dev/null 2> "$dir/err"; then return 0; fi
+        bad "$name: exit $?: $(head -n 2 "$dir/err")"; return 1; }
+# fails NAME ARGS...: exit 1 with exactly one stderr line
+fails() { name=$1; shift; "$hfvis" "$@" > /dev/null 2> "$dir/err"; rc=$?
+          if [ "$rc" -eq 1 ] && [ "$(wc -l < "$dir/err" | tr -d ' ')" = 1 ]; then ok "$name: $(cat "$dir/err")"
+          else bad "$name: exit $rc, stderr: $(head -n 3 "$dir/err")"; fi; }
+# same NAME A B: files identical
+same() { if cmp -s "$2" "$3"; then ok "$1"; else bad "$1: $2 and $3 differ"; fi; }
+
+# ---- inputs: one 41 x 33 integer terrain with a NoData hole, as PGM (values only) and ASC ------
+awk 'BEGIN { w = 41; h = 33; print "P2"; print w, h; print 65535
+  for (y = 0; y < h; y++) { s = ""; for (x = 0; x < w; x++) {
+    v = int(3000 + 900 * sin(x / 5) * cos(y / 6) + 13 * x); if (x == 7 && y == 9) v = 0; s = s " " v }
+    print s } }' > "$dir/dem.pgm"
+{ printf 'ncols 41\nnrows 33\nxllcorner 500000\nyllcorner 4100000\ncellsize 30\nNODATA_value 0\n'
+  tail -n +4 "$dir/dem.pgm"; } > "$dir/dem.asc"
+printf 'PROJCS["WGS 84 / UTM zone 33N",GEOGCS["WGS 84",DATUM["WGS_1984",SPHEROID["WGS 84",6378137,298.257223563]],PRIMEM["Greenwich",0],UNIT["degree",0.0174532925199433]],PROJECTION["Transverse_Mercator"],PARAMETER["latitude_of_origin",0],PARAMETER["central_meridian",15],PARAMETER["scale_factor",0.9996],PARAMETER["false_easting",500000],PARAMETER["false_northing",0],UNIT["metre",1],AUTHORITY["EPSG","32633"]]\n' > "$dir/dem.prj"
+
+# ---- the PGM route and the raster routes agree bit for bit ------------------------------------
+run "skyview pgm route" skyview "$dir/dem.pgm" --cell 30 --nodata 0 --dirs 8 -o "$dir/ref.flt" && ok "skyview pgm route -> .flt"
+run "skyview asc" skyview "$dir/dem.asc" --dirs 8 -o "$dir/asc.flt" && same "skyview dem.asc = pgm route (cell 30, NoData from the grid)" "$dir/ref.flt" "$dir/asc.flt"
+[ -s "$dir/err" ] && bad "georeferenced input printed: $(cat "$dir/err")"
+grep -q '^NODATA 0$' "$dir/asc.hdr" && grep -q '^XDIM 30$' "$dir/asc.hdr" && grep -q '^ULXMAP 500015$' "$dir/asc.hdr" \
+  && ok ".hdr carries NoData, cell and corner" || bad ".hdr: $(cat "$dir/asc.hdr")"
+[ -s "$dir/asc.prj" ] && same ".prj carried to the output" "$dir/dem.prj" "$dir/asc.prj"
+run "skyview flt" skyview "$dir/asc.flt" --dirs 8 -o "$dir/flt.flt" && ok "an .flt output reads back as input"
+run "skyview asc -> asc" skyview "$dir/dem.asc" --dirs 8 -o "$dir/svf.asc" && run "asc -> flt" skyview "$dir/dem.asc" --dirs 8 -o "$dir/svf2.flt" \
+  && grep -q '^NODATA_value 0$' "$dir/svf.asc" && grep -q '^cellsize 30$' "$dir/svf.asc" && ok "asc output header"
+run "skyview asc -> tif" skyview "$dir/dem.asc" --dirs 8 -o "$dir/svf.tif" && ok "skyview dem.asc -o svf.tif"
+run "skyview tif (hfvis-written) -> flt" skyview "$dir/svf.tif" --dirs 8 -o "$dir/svf_of_svf.flt" && ok "hfvis reads its own GeoTIFF"
+run "horizon asc -> tif bands" horizon "$dir/dem.asc" --dirs 4 -o "$dir/h.tif" && run "horizon -> bil" horizon "$dir/dem.asc" --dirs 4 -o "$dir/h.bil" \
+  && grep -q '^NBANDS 4$' "$dir/h.hdr" && ok "horizon: 4 planes -> 4 bands"
+run "band 3 of the horizon GeoTIFF" skyview "$dir/h.tif" --band 3 --dirs 4 --cell 30 -o "$dir/b3.flt" && ok "--band 3"
+fails "--band beyond the bands" skyview "$dir/h.tif" --band 5 -o "$dir/x.flt"
+fails "--band on a PGM" skyview "$dir/dem.pgm" --band 2 -o "$dir/x.flt"
+
+# ---- notes on stderr ------------------------------------------------------------------------
+run "pgm without --cell" skyview "$dir/dem.pgm" --dirs 4 -o "$dir/n.flt" && grep -q '^hfvis: note: .*cell size: using 1' "$dir/err" \
+  && [ "$(wc -l < "$dir/err" | tr -d ' ')" = 1 ] && ok "no cell size: one note line" || bad "no-cell note: $(cat "$dir/err")"
+run "pgm --quiet" skyview "$dir/dem.pgm" --dirs 4 --quiet -o "$dir/n.flt" && [ ! -s "$dir/err" ] && ok "--quiet drops the note" || bad "--quiet: $(cat "$dir/err")"
+run "asc --cell" skyview "$dir/dem.asc" --dirs 4 --cell 10 -o "$dir/n.flt" && grep -q '^hfvis: note: --cell 10 overrides the cell size 30' "$dir/err" \
+  && ok "--cell overrides with a note" || bad "--cell override note: $(cat "$dir/err")"
+
+# ---- refused ------------------------------------------------------------------------------
+cp "$dir/dem.asc" "$dir/geo.asc"
+printf 'GEOGCS["WGS 84",DATUM["WGS_1984",SPHEROID["WGS 84",6378137,298.257223563]],PRIMEM["Greenwich",0],UNIT["degree",0.0174532925199433]]\n' > "$dir/geo.prj"
+fails "geographic CRS refused" skyview "$dir/geo.asc" -o "$dir/x.flt"
+grep -q 'gdalwarp -t_srs' "$dir/err" && ok "the refusal says how to reproject" || bad "no gdalwarp hint: $(cat "$dir/err")"
+run "geographic with --cell" skyview "$dir/geo.asc" --cell 30 --dirs 4 -o "$dir/g.flt" && ok "geographic accepted with --cell in metres"
+printf 'ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2 3\n' > "$dir/bad.asc"
+fails "asc with too many values" skyview "$dir/bad.asc" -o "$dir/x.flt"
+printf 'II*\000\010\000\000\000\377\377' > "$dir/bad.tif"
+fails "truncated TIFF" skyview "$dir/bad.tif" -o "$dir/x.flt"
+fails "an ASC output of several bands" horizon "$dir/dem.asc" --dirs 2 -o "$dir/x.asc"
+ls "$dir"/x.* > /dev/null 2>&1 && bad "a failed run left an output" || ok "failed runs leave no output"
+
+# ---- GDAL interop -------------------------------------------------------------------------
+if command -v gdal_translate > /dev/null 2>&1 && command -v gdalinfo > /dev/null 2>&1; then
+  gt() { gdal_translate -q "$@" 2> "$dir/gerr" || bad "gdal_translate $*: $(cat "$dir/gerr")"; }
+  gt -a_srs EPSG:32633 -ot Float32 "$dir/dem.asc" "$dir/base.tif"
+  n=0
+  for opts in "-co COMPRESS=DEFLATE -co TILED=YES -co BLOCKXSIZE=16 -co BLOCKYSIZE=16" \
+              "-co COMPRESS=DEFLATE -co PREDICTOR=3 -co TILED=YES" "-co COMPRESS=LZW -co PREDICTOR=3" \
+              "-co COMPRESS=LZW" "-co COMPRESS=PACKBITS" "-co BIGTIFF=YES -co COMPRESS=DEFLATE -co TILED=YES" \
+              "-co ENDIANNESS=BIG -co COMPRESS=DEFLATE -co PREDICTOR=3" "-ot Int16 -co COMPRESS=DEFLATE -co PREDICTOR=2" \
+              "-ot UInt16 -co COMPRESS=LZW -co PREDICTOR=2 -co TILED=YES" "-ot Int32 -co ENDIANNESS=BIG -co COMPRESS=LZW -co PREDICTOR=2" \
+              "-ot Float64 -co COMPRESS=DEFLATE -co PREDICTOR=3" "-ot Float64 -co BIGTIFF=YES -co ENDIANNESS=BIG"; do
+    n=$((n + 1))
+    # shellcheck disable=SC2086 # $opts is a list of options
+    gt $opts "$dir/base.tif" "$dir/g$n.tif"
+    if "$hfvis" skyview "$dir/g$n.tif" --dirs 8 -o "$dir/g$n.flt" > /dev/null 2> "$dir/err"; then
+      same "GDAL GeoTIFF ($opts) = pgm route" "$dir/ref.flt" "$dir/g$n.flt"
+    else bad "GDAL GeoTIFF ($opts): $(cat "$dir/err")"; fi
+  done
+  # the issue's case: skyview dem.tif -o svf.tif on a GDAL DEFLATE tiled GeoTIFF with NoData
+  gt -co COMPRESS=DEFLATE -co TILED=YES -co BLOCKXSIZE=16 -co BLOCKYSIZE=16 "$dir/base.tif" "$dir/dem.tif"
+  if run "skyview dem.tif -o svf.tif" skyview "$dir/dem.tif" --dirs 8 -o "$dir/svf.tif"; then
+    gdalinfo "$dir/dem.tif" > "$dir/in.info" 2>&1; gdalinfo "$dir/svf.tif" > "$dir/out.info" 2>&1
+    for key in 'Origin =' 'Pixel Size =' 'NoData Value=' 'ID\["EPSG",32633\]\]$' 'Size is'; do
+      a=$(grep "$key" "$dir/in.info"); b=$(grep "$key" "$dir/out.info")
+      if [ -n "$a" ] && [ "$a" = "$b" ]; then ok "gdalinfo svf.tif: same '$a'"; else bad "gdalinfo '$key': in '$a', out '$b'"; fi
+    done
+    grep -qi 'warning\|error' "$dir/out.info" && bad "gdalinfo complains: $(grep -i 'warning\|error' "$dir/out.info")"
+    gt -of EHdr "$dir/svf.tif" "$dir/svf_gdal.flt"
+    same "svf.tif through GDAL = pgm route bit for bit" "$dir/ref.flt" "$dir/svf_gdal.flt"
+    if command -v gdalcompare.py > /dev/null 2>&1; then
+      gdalcompare.py "$dir/asc.flt" "$dir/svf.tif" > "$dir/cmp" 2>&1
+      grep -q 'Pixels Differing: [1-9]' "$dir/cmp" && bad "gdalcompare: $(grep Differ "$dir/cmp")" || ok "gdalcompare.py: pixels equal"
+    else echo "SKIP gdalcompare.py not found"; fi
+  fi
+  # hfvis's outputs in every format and option read by GDAL
+  gt -of EHdr "$dir/svf.asc" "$dir/asc_gdal.flt" && cmp -s "$dir/asc_gdal.flt" "$dir/svf2.flt" \
+    && ok "GDAL reads hfvis's ASC (%.9g round trips)" || bad "GDAL ASC read differs"
+  gdalinfo "$dir/svf.asc" | grep -q 'EPSG",32633' && ok "GDAL sees the .prj carried with the ASC" || bad "ASC .prj not seen by GDAL"
+  gt -of EHdr "$dir/asc.flt" "$dir/flt_gdal.flt" && same "GDAL reads hfvis's EHdr .flt" "$dir/asc.flt" "$dir/flt_gdal.flt"
+  gt -of EHdr "$dir/h.tif" "$dir/h_gdal.bil" && same "GDAL reads the 4-band horizon GeoTIFF = hfvis's BIL" "$dir/h.bil" "$dir/h_gdal.bil"
+  gdalinfo "$dir/h.tif" | grep -c '^Band ' | grep -qx 4 && ok "gdalinfo: 4 bands" || bad "horizon GeoTIFF bands"
+  # integral outputs: the smallest integer type; NoData moved off the values when it collides
+  if run "viewshed -> tif" viewshed "$dir/dem.asc" --observer 20,16 -o "$dir/vs.tif"; then
+    grep -q "input's NoData 0 is a value of this output" "$dir/err" && ok "NoData colliding with a viewshed value: a note" \
+      || bad "no collision note: $(cat "$dir/err")"
+    gdalinfo -stats "$dir/vs.tif" > "$dir/vs.info" 2>&1
+    grep -q 'Type=Byte' "$dir/vs.info" && grep -q 'NoData Value=2$' "$dir/vs.info" && grep -q 'STATISTICS_MAXIMUM=1$' "$dir/vs.info" \
+      && grep -q 'STATISTICS_MINIMUM=0$' "$dir/vs.info" && ok "viewshed GeoTIFF: Byte, values 0..1, NoData 2" \
+      || bad "viewshed GeoTIFF: $(grep -E 'Type|NoData|STATISTICS_M' "$dir/vs.info")"
+  fi
+else
+  echo "SKIP gdal: gdal_translate/gdalinfo not installed"
+fi
+
+rm -rf "$dir"
+echo "raster: $passed passed, $failed failed"
+[ "$failed" -eq 0 ]

@@ -1,0 +1,785 @@
+/* test_raster_io.c - examples/zio.h (inflate, deflate) and examples/raster_io.h (GeoTIFF, ASC,
+ * EHdr): round trips for every byte order, layout, compression, predictor, sample type and
+ * BigTIFF; LZW and PackBits files built here with reference encoders; window reads against the
+ * whole read, and a window that never touches a corrupted tile; hand-built malformed files
+ * (truncated IFDs, offsets past the end, huge tile counts, IFD loops, bad LZW/deflate streams,
+ * strips claiming impossible sizes) refused with a message. Writes into a temporary folder. */
+#define _POSIX_C_SOURCE 200809L /* mkdtemp, rmdir */
+#include "test.h"
+#include "test_dir.h"
+#include "../examples/raster_io.h"
+#include <stdint.h>
+#include <unistd.h>
+
+static char tdir[256];
+
+static char *tpath(const char *name)
+{
+    static char p[4][512];
+    static int k;
+    k = (k + 1) & 3;
+    snprintf(p[k], sizeof p[k], "%s/%s", tdir, name);
+    return p[k];
+}
+
+static unsigned char *slurp(const char *path, size_t *n)
+{
+    FILE *f = fopen(path, "rb");
+    unsigned char *b;
+    long len;
+    *n = 0;
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    len = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    b = (unsigned char *)malloc((size_t)len + 1);
+    if (b && fread(b, 1, (size_t)len, f) == (size_t)len) *n = (size_t)len;
+    fclose(f);
+    return b;
+}
+
+static void spit(const char *path, const void *p, size_t n)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f) return;
+    if (fwrite(p, 1, n, f) != n) fprintf(stderr, "short write %s\n", path);
+    fclose(f);
+}
+
+static uint32_t lcg(uint32_t *s)
+{
+    *s = *s * 1103515245u + 12345u;
+    return (*s >> 16) & 0x7fffu;
+}
+
+/* A test field: integers (fit every sample type) or fractions, with one NaN hole when asked. */
+static void field(float *z, int w, int h, int bands, int integral, uint32_t seed)
+{
+    int i, n = w * h * bands;
+    for (i = 0; i < n; i++) {
+        uint32_t r = lcg(&seed);
+        z[i] = integral ? (float)(r % 120) : (float)((double)r / 32768.0 * 1000.0 - 200.0);
+    }
+}
+
+/* ---- zio.h ------------------------------------------------------------------------------ */
+
+/* A dynamic-Huffman zlib stream (zlib.compress, level 9) of 600 bytes from lcg seed 12345. */
+static const unsigned char dyn_stream[] = {
+    0x78,0xda,0x1d,0x92,0xd9,0x11,0xc3,0x50,0x08,0x03,0x6b,0x15,0x20,0x50,0xff,0x15,0x78,0x9f,0x27,0x1f,
+    0x4e,0x02,0xe8,0xb4,0xbd,0x9d,0xdd,0xee,0xf5,0x5c,0x46,0xe5,0x55,0x2a,0x5a,0x9b,0xc9,0x9c,0xa6,0x3b,
+    0xb9,0xa8,0xea,0x4a,0xa3,0x5d,0x57,0x55,0xee,0xfa,0xe2,0xda,0x1d,0xab,0xcb,0x9e,0x3e,0xae,0x01,0xf1,
+    0xb2,0x17,0x31,0xb4,0xd3,0xb7,0x56,0xb5,0xeb,0xc0,0x99,0x33,0x2c,0x3b,0x13,0xd8,0x5a,0x7d,0x9c,0xde,
+    0xcd,0x4d,0x4b,0x0b,0x72,0x9a,0xb9,0x95,0xe1,0x0e,0x50,0x16,0x57,0x7e,0x48,0xbd,0x90,0xd7,0xcd,0x82,
+    0x9f,0x83,0xed,0x50,0x08,0xe5,0xd5,0x3e,0x6c,0x73,0x57,0xf2,0x02,0x2b,0xac,0x8c,0xf9,0x73,0x16,0xc5,
+    0x2d,0xfb,0x57,0xf5,0x7e,0xcd,0xb4,0x03,0x70,0x06,0x57,0xec,0x0a,0x47,0x18,0xfb,0x5d,0xb8,0xb5,0xf7,
+    0xd8,0x76,0x33,0x05,0xfd,0x2f,0xc1,0xa5,0x93,0x5c,0xa9,0xd3,0xd5,0x35,0x12,0xbb,0xf9,0xa2,0xec,0x9b,
+    0xa2,0xaf,0x14,0x46,0x64,0xa6,0xa7,0x84,0xab,0xc3,0x18,0xec,0xef,0x2c,0x1d,0xf0,0x88,0x69,0x1f,0x0c,
+    0x20,0xe8,0x82,0xe3,0xf7,0x88,0x10,0x10,0x7e,0xef,0x37,0x51,0x7e,0x2b,0xbe,0x15,0x24,0x88,0xaa,0x4c,
+    0xc8,0x9e,0x70,0xc0,0xe8,0x29,0xa0,0x52,0x58,0x48,0x55,0x8f,0x88,0x9b,0xb8,0xf8,0xbc,0x6a,0xde,0x36,
+    0xac,0x74,0x46,0xe6,0x70,0xec,0xd4,0xce,0x5f,0x91,0xad,0x57,0x20,0x51,0xd7,0x8b,0xfc,0xde,0x53,0x0b,
+    0x30,0xc9,0x4a,0x93,0x3c,0x32,0x00,0x28,0xdd,0xbf,0x8c,0x6d,0x5a,0x9a,0x7a,0x16,0x59,0xa9,0xd7,0x07,
+    0x29,0x51,0xd2,0x1f,0x50,0x9e,0x12,0x63,0xf7,0x35,0xb7,0xb4,0xf1,0xfa,0xe5,0x98,0x59,0xfd,0x2f,0x09,
+    0xe5,0xa0,0x74,0x86,0xbb,0xcb,0xed,0x7e,0x8b,0xb8,0xeb,0x78
+};
+
+TEST(inflate_dynamic_and_errors)
+{
+    unsigned char want[600], got[700], bad[sizeof dyn_stream];
+    uint32_t x = 12345;
+    size_t i, n = 0;
+    for (i = 0; i < 600; i++) {
+        x = (x * 1103515245u + 12345u) & 0x7fffffffu;
+        want[i] = (unsigned char)"abcdefgh"[(x >> 16) % 8];
+    }
+    CHECK(ex_inflate(dyn_stream, sizeof dyn_stream, got, sizeof got, 1, &n) == EX_Z_OK);
+    CHECK(n == 600 && memcmp(got, want, 600) == 0);
+    CHECK(ex_inflate(dyn_stream, sizeof dyn_stream, got, 599, 1, &n) == EX_Z_OVERFLOW);
+    for (i = 0; i < sizeof dyn_stream; i++) /* every truncation is refused */
+        if (ex_inflate(dyn_stream, i, got, sizeof got, 1, &n) == EX_Z_OK) break;
+    CHECK(i == sizeof dyn_stream);
+    memcpy(bad, dyn_stream, sizeof bad);
+    bad[sizeof bad - 1] ^= 1;
+    CHECK(ex_inflate(bad, sizeof bad, got, sizeof got, 1, &n) == EX_Z_CHECK);
+    bad[0] = 0x79; /* not deflate (CM 9) */
+    CHECK(ex_inflate(bad, sizeof bad, got, sizeof got, 1, &n) == EX_Z_BAD);
+    /* block type 3 is invalid; a distance before the start of the output */
+    {
+        static const unsigned char type3[] = { 0x78, 0x01, 0x07 };
+        static const unsigned char far[] = { 0x78, 0x01, 0x63, 0x00, 0x02, 0x00 }; /* 'a'? no: lit 0 + dist 3 */
+        CHECK(ex_inflate(type3, sizeof type3, got, sizeof got, 1, &n) == EX_Z_BAD);
+        CHECK(ex_inflate(far, sizeof far, got, sizeof got, 1, &n) != EX_Z_OK);
+    }
+    /* every single-bit flip of the stream: refused or decoded within the buffer, never more
+     * (Adler-32 lets a few through: a flip that moves equal sums of bytes is invisible to it) */
+    for (i = 0; i < 8 * sizeof dyn_stream; i++) {
+        int rc;
+        memcpy(bad, dyn_stream, sizeof bad);
+        bad[i / 8] ^= (unsigned char)(1u << (i % 8));
+        rc = ex_inflate(bad, sizeof bad, got, 600, 1, &n);
+        CHECK(rc != EX_Z_OK || n <= 600);
+    }
+}
+
+TEST(deflate_round_trip)
+{
+    size_t sizes[] = { 0, 1, 2, 3, 257, 4096, 70000, 300000 };
+    size_t k;
+    for (k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
+        size_t n = sizes[k], cap = ex_deflate_bound(n), zn = 0, got = 0, i;
+        unsigned char *a = (unsigned char *)malloc(n + 1), *z = (unsigned char *)malloc(cap),
+                      *b = (unsigned char *)malloc(n + 1);
+        int kind;
+        for (kind = 0; kind < 3; kind++) {
+            uint32_t s = (uint32_t)(k * 7 + (size_t)kind);
+            for (i = 0; i < n; i++)
+                a[i] = kind == 0 ? (unsigned char)lcg(&s) : kind == 1 ? (unsigned char)(i / 100) :
+                       (unsigned char)"terrain "[lcg(&s) % 8];
+            CHECK(ex_deflate_zlib(a, n, z, cap, &zn) == 0);
+            CHECK(zn <= cap);
+            CHECK(ex_inflate(z, zn, b, n, 1, &got) == EX_Z_OK && got == n && memcmp(a, b, n) == 0);
+            /* runs compress far below the stored size (LZ77 + Huffman, not stored blocks) */
+            if (kind == 1 && n >= 4096) CHECK(zn < n / 10);
+            if (kind == 2 && n >= 4096) CHECK(zn < n * 3 / 4);
+        }
+        CHECK(ex_deflate_zlib(a, n, z, cap - 1, &zn) == -1);
+        free(a);
+        free(z);
+        free(b);
+    }
+}
+
+/* ---- reference LZW and PackBits encoders (libtiff's conventions) ---------------------------- */
+
+typedef struct {
+    unsigned char *p;
+    size_t pos;
+    uint32_t acc;
+    int n;
+} bitw;
+
+static void put_code(bitw *w, int code, int width)
+{
+    w->acc = (w->acc << width) | (uint32_t)code;
+    w->n += width;
+    while (w->n >= 8) {
+        w->p[w->pos++] = (unsigned char)(w->acc >> (w->n - 8));
+        w->n -= 8;
+    }
+}
+
+/* TIFF LZW: Clear first, codes MSB first, width grows when the next code reaches 2^width (the
+ * decoder's early change), Clear again before 4094 codes. Output capacity: 2n + 16. */
+static size_t lzw_encode(const unsigned char *in, size_t n, unsigned char *out)
+{
+    uint16_t *child = (uint16_t *)calloc(4096 * 256, sizeof(uint16_t));
+    bitw w = { NULL, 0, 0, 0 };
+    int width = 9, next = 258, ent;
+    size_t i;
+    w.p = out;
+    put_code(&w, 256, 9);
+    if (n == 0) {
+        put_code(&w, 257, 9);
+    } else {
+        ent = in[0];
+        for (i = 1; i < n; i++) {
+            int c = in[i];
+            if (child[ent * 256 + c]) {
+                ent = child[ent * 256 + c];
+                continue;
+            }
+            while (next >= (1 << width) && width < 12) width++;
+            put_code(&w, ent, width);
+            child[ent * 256 + c] = (uint16_t)next++;
+            ent = c;
+            if (next >= 4093) { /* table full: Clear (the decoder restarts as at the beginning) */
+                while (next >= (1 << width) && width < 12) width++;
+                put_code(&w, 256, width);
+                memset(child, 0, 4096 * 256 * sizeof(uint16_t));
+                next = 258;
+                width = 9;
+            }
+        }
+        while (next >= (1 << width) && width < 12) width++;
+        put_code(&w, ent, width);
+        while (next + 1 >= (1 << width) && width < 12) width++;
+        put_code(&w, 257, width);
+    }
+    if (w.n > 0) w.p[w.pos++] = (unsigned char)(w.acc << (8 - w.n));
+    free(child);
+    return w.pos;
+}
+
+/* PackBits: runs of 3+ equal bytes as repeats, the rest as literal runs of up to 128. */
+static size_t packbits_encode(const unsigned char *in, size_t n, unsigned char *out)
+{
+    size_t i = 0, o = 0;
+    while (i < n) {
+        size_t run = 1;
+        while (i + run < n && run < 128 && in[i + run] == in[i]) run++;
+        if (run >= 3) {
+            out[o++] = (unsigned char)(257 - run);
+            out[o++] = in[i];
+            i += run;
+        } else {
+            size_t lit = 0, start = i;
+            while (i < n && lit < 128 && !(i + 2 < n && in[i] == in[i + 1] && in[i] == in[i + 2])) { i++; lit++; }
+            out[o++] = (unsigned char)(lit - 1);
+            memcpy(out + o, in + start, lit);
+            o += lit;
+        }
+    }
+    out[o++] = 0x80; /* a no-op header at the end, as some writers leave */
+    return o;
+}
+
+/* Recompress every strip/tile of an uncompressed TIFF (from our writer) with LZW (5) or PackBits
+ * (32773), optionally with predictor 2 applied first; a new file. Strips are 1 band, 16-bit. */
+static int recompress(const char *src, const char *dst, int comp, int pred2)
+{
+    ex_rio_reader r;
+    size_t n, k;
+    unsigned char *file = slurp(src, &n), *out, *p;
+    int rc = -1;
+    if (!file || ex_rio_open_tiff_mem(&r, file, n) != 0) { free(file); return -1; }
+    out = (unsigned char *)malloc(3 * n + 4096);
+    memcpy(out, file, n);
+    p = out + n;
+    for (k = 0; k < r.nchunks; k++) {
+        unsigned char *chunk = file + r.offsets[k], *tmp = (unsigned char *)malloc((size_t)r.counts[k] + 1);
+        size_t len = (size_t)r.counts[k], m, y, rowb = (size_t)r.chunk_w * (size_t)(r.bits / 8);
+        memcpy(tmp, chunk, len);
+        if (pred2)
+            for (y = 0; y < len / rowb; y++) ex_rio_predict(tmp + y * rowb, NULL, rowb / (size_t)(r.bits / 8), r.bits / 8, 2, r.big_endian);
+        m = comp == 5 ? lzw_encode(tmp, len, p) : packbits_encode(tmp, len, p);
+        free(tmp);
+        r.offsets[k] = (uint64_t)(p - out);
+        r.counts[k] = m;
+        p += m;
+    }
+    /* rewrite the arrays and the Compression/Predictor values by walking the IFD again */
+    {
+        uint64_t ifd = ex_rio_uint(out + 4, 4, r.big_endian), ne = ex_rio_uint(out + ifd, 2, r.big_endian), i;
+        for (i = 0; i < ne; i++) {
+            unsigned char *e = out + ifd + 2 + 12 * i;
+            unsigned tag = (unsigned)ex_rio_uint(e, 2, r.big_endian);
+            uint64_t cnt = ex_rio_uint(e + 4, 4, r.big_endian), at;
+            at = cnt == 1 ? (uint64_t)(e + 8 - out) : ex_rio_uint(e + 8, 4, r.big_endian);
+            if (tag == 259) ex_rio_put_uint(e + 8, (uint64_t)comp, 2, r.big_endian);
+            if (tag == 284 && pred2) { /* PlanarConfiguration 1 is the default: its slot becomes Predictor 2 */
+                ex_rio_put_uint(e, 317, 2, r.big_endian);
+                ex_rio_put_uint(e + 8, 2, 2, r.big_endian);
+            }
+            if (tag == 273 || tag == 324 || tag == 279 || tag == 325)
+                for (k = 0; k < cnt; k++)
+                    ex_rio_put_uint(out + at + 4 * k, (tag == 273 || tag == 324) ? r.offsets[k] : r.counts[k], 4,
+                                    r.big_endian);
+        }
+    }
+    spit(dst, out, (size_t)(p - out));
+    rc = 0;
+    ex_rio_close(&r);
+    free(out);
+    free(file);
+    return rc;
+}
+
+/* ---- TIFF round trips ------------------------------------------------------------------- */
+
+static int read_all(const char *path, int band, float *out, int *w, int *h, ex_rio_reader *keep)
+{
+    ex_rio_reader r;
+    int rc;
+    if (ex_rio_open(&r, path) != 0) {
+        fprintf(stderr, "open %s: %s\n", path, r.err);
+        return -1;
+    }
+    *w = r.width;
+    *h = r.height;
+    rc = ex_rio_read(&r, band, 0, 0, r.width, r.height, out, r.width);
+    if (rc != 0) fprintf(stderr, "read %s: %s\n", path, r.err);
+    if (keep) *keep = r;
+    else ex_rio_close(&r);
+    return rc;
+}
+
+static int same_bits(const float *a, const float *b, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; i++)
+        if (memcmp(a + i, b + i, 4) != 0 && !(isnan(a[i]) && isnan(b[i]))) return 0;
+    return 1;
+}
+
+TEST(tiff_round_trips)
+{
+    enum { W = 45, H = 37, B = 3 };
+    static const int kinds[][2] = { { EX_RIO_FLOAT, 32 }, { EX_RIO_FLOAT, 64 }, { EX_RIO_UINT, 8 },
+                                    { EX_RIO_INT, 8 }, { EX_RIO_UINT, 16 }, { EX_RIO_INT, 16 },
+                                    { EX_RIO_UINT, 32 }, { EX_RIO_INT, 32 } };
+    float *src = (float *)malloc(sizeof(float) * W * H * B), *got = (float *)malloc(sizeof(float) * W * H);
+    ex_georef g;
+    size_t kk;
+    int combos = 0;
+    memset(&g, 0, sizeof g);
+    g.has_transform = 1;
+    g.gt[0] = 300000.0; g.gt[1] = 2.0; g.gt[3] = 5000000.0; g.gt[5] = -2.0;
+    ex_georef_set_nodata(&g, "-9999", 5);
+    for (kk = 0; kk < sizeof kinds / sizeof kinds[0]; kk++) {
+        int layout, comp, pred, be, big, bands;
+        for (layout = 0; layout < 2; layout++)
+            for (comp = 0; comp < 2; comp++)
+                for (pred = 1; pred <= 3; pred++)
+                    for (be = 0; be < 2; be++)
+                        for (big = 0; big < 2; big++)
+                            for (bands = 1; bands <= B; bands += B - 1) {
+                                ex_rio_write_options o;
+                                ex_rio_image img;
+                                char err[256];
+                                const char *p = tpath("rt.tif");
+                                int b, w, h, isint = kinds[kk][0] != EX_RIO_FLOAT;
+                                if ((pred == 3) == isint && pred != 1) continue;
+                                if (pred != 1 && !comp) continue;
+                                field(src, W, H, bands, isint, (uint32_t)(kk * 100 + (size_t)combos));
+                                if (kinds[kk][0] == EX_RIO_INT) src[5] = -100.0f;
+                                src[7] = (float)NAN; /* -> NoData -9999 (clamped for unsigned/8-bit) */
+                                memset(&o, 0, sizeof o);
+                                o.kind = kinds[kk][0]; o.bits = kinds[kk][1];
+                                o.tiled = layout; o.tile_size = 16; o.rows_per_strip = layout ? 0 : 5;
+                                o.deflate = comp; o.predictor = pred; o.big_endian = be; o.bigtiff = big;
+                                img.data = src; img.width = W; img.height = H; img.bands = bands;
+                                img.band_step = (size_t)W * H; img.row_step = W; img.pixel_step = 1;
+                                CHECK(ex_rio_write(p, &img, &g, &o, err) == 0);
+                                combos++;
+                                for (b = 0; b < bands; b++) {
+                                    ex_rio_reader r;
+                                    int ok = read_all(p, b, got, &w, &h, &r) == 0;
+                                    CHECK(ok && w == W && h == H);
+                                    if (!ok) { ex_rio_close(&r); continue; }
+                                    CHECK(r.bigtiff == big && r.big_endian == be && r.tiled == layout);
+                                    CHECK(r.compression == (comp ? 8 : 1) && r.kind == kinds[kk][0] && r.bits == kinds[kk][1]);
+                                    CHECK(r.geo.has_nodata && r.geo.nodata == -9999.0 && r.geo.gt[0] == 300000.0 &&
+                                          r.geo.gt[5] == -2.0 && r.geo.gt[3] == 5000000.0);
+                                    {
+                                        size_t i, n = (size_t)W * H, bad = 0;
+                                        for (i = 0; i < n; i++) {
+                                            float want = src[(size_t)b * n + i];
+                                            if (i == 7 && b == 0) {
+                                                /* NoData as stored: -9999 in the type, clamped */
+                                                double lo = kinds[kk][0] == EX_RIO_UINT ? 0.0 :
+                                                            kinds[kk][1] == 8 ? -128.0 : -9999.0;
+                                                want = (float)lo;
+                                            }
+                                            if (memcmp(&want, got + i, 4) != 0) bad++;
+                                        }
+                                        if (bad) fprintf(stderr, "kind %d/%d layout %d comp %d pred %d be %d big %d "
+                                                         "bands %d band %d: %lu values differ\n", kinds[kk][0],
+                                                         kinds[kk][1], layout, comp, pred, be, big, bands, b,
+                                                         (unsigned long)bad);
+                                        CHECK(bad == 0);
+                                    }
+                                    ex_rio_close(&r);
+                                }
+                            }
+    }
+    CHECK(combos > 100);
+    free(src);
+    free(got);
+}
+
+TEST(tiff_lzw_packbits)
+{
+    enum { W = 300, H = 70 };
+    float *src = (float *)malloc(sizeof(float) * W * H), *got = (float *)malloc(sizeof(float) * W * H);
+    int comp, pred, be, layout, w, h;
+    for (comp = 0; comp < 2; comp++)
+        for (pred = 0; pred < 2; pred++)
+            for (be = 0; be < 2; be++)
+                for (layout = 0; layout < 2; layout++) {
+                    ex_rio_write_options o;
+                    ex_rio_image img;
+                    char err[256];
+                    int x, y;
+                    if (!comp && pred) continue; /* libtiff applies predictors only with LZW and deflate */
+                    for (y = 0; y < H; y++) /* smooth rows (long LZW strings), a flat band (PackBits runs) */
+                        for (x = 0; x < W; x++)
+                            src[y * W + x] = y < 20 ? 7.0f : (float)((x / 3 + y * 5) % 400);
+                    memset(&o, 0, sizeof o);
+                    o.kind = EX_RIO_UINT; o.bits = 16; o.big_endian = be; o.tiled = layout; o.tile_size = 32;
+                    o.rows_per_strip = 16;
+                    img.data = src; img.width = W; img.height = H; img.bands = 1;
+                    img.band_step = 0; img.row_step = W; img.pixel_step = 1;
+                    CHECK(ex_rio_write(tpath("u.tif"), &img, NULL, &o, err) == 0);
+                    CHECK(recompress(tpath("u.tif"), tpath("c.tif"), comp ? 5 : 32773, pred) == 0);
+                    CHECK(read_all(tpath("c.tif"), 0, got, &w, &h, NULL) == 0);
+                    CHECK(w == W && h == H && same_bits(src, got, (size_t)W * H));
+                }
+    /* LZW with more than 4093 codes (Clear in mid-stream) on noise */
+    {
+        size_t n = 20000, m, got_n, i;
+        unsigned char *a = (unsigned char *)malloc(n), *z = (unsigned char *)malloc(2 * n + 16),
+                      *b = (unsigned char *)malloc(n);
+        uint32_t s = 99;
+        for (i = 0; i < n; i++) a[i] = (unsigned char)(lcg(&s) % 5);
+        m = lzw_encode(a, n, z);
+        CHECK(ex_rio_lzw(z, m, b, n, &got_n) == 0 && got_n == n && memcmp(a, b, n) == 0);
+        z[3] ^= 0xff; /* a code beyond the table */
+        CHECK(ex_rio_lzw(z, m, b, n, &got_n) != 0 || got_n < n || memcmp(a, b, n) != 0);
+        free(a);
+        free(z);
+        free(b);
+    }
+    free(src);
+    free(got);
+}
+
+/* ---- windows ------------------------------------------------------------------------------ */
+
+TEST(window_reads)
+{
+    enum { W = 70, H = 53 };
+    float *src = (float *)malloc(sizeof(float) * W * H), *all = (float *)malloc(sizeof(float) * W * H);
+    float win[40 * 40];
+    int layout;
+    for (layout = 0; layout < 3; layout++) {
+        ex_rio_write_options o;
+        ex_rio_image img;
+        ex_rio_reader r;
+        char err[256];
+        uint32_t s = 5;
+        int t, w, h;
+        field(src, W, H, 1, 0, 77);
+        memset(&o, 0, sizeof o);
+        o.tiled = layout == 1; o.tile_size = 16; o.rows_per_strip = 3; o.deflate = 1; o.predictor = 3;
+        img.data = src; img.width = W; img.height = H; img.bands = 1; img.band_step = 0; img.row_step = W;
+        img.pixel_step = 1;
+        CHECK(ex_rio_write(tpath(layout == 2 ? "w.flt" : "w.tif"), &img, NULL, &o, err) == 0);
+        CHECK(read_all(tpath(layout == 2 ? "w.flt" : "w.tif"), 0, all, &w, &h, &r) == 0);
+        CHECK(same_bits(src, all, (size_t)W * H));
+        for (t = 0; t < 200; t++) { /* windows with halos past every edge */
+            int x0 = (int)(lcg(&s) % (W + 20)) - 10, y0 = (int)(lcg(&s) % (H + 20)) - 10;
+            int ww = 1 + (int)(lcg(&s) % 40), wh = 1 + (int)(lcg(&s) % 40), x, y, bad = 0;
+            CHECK(ex_rio_read(&r, 0, x0, y0, ww, wh, win, 40) == 0);
+            for (y = 0; y < wh; y++)
+                for (x = 0; x < ww; x++) {
+                    int gx = x0 + x, gy = y0 + y;
+                    float v = win[y * 40 + x];
+                    if (gx < 0 || gy < 0 || gx >= W || gy >= H) bad += !isnan(v);
+                    else bad += memcmp(&v, all + gy * W + gx, 4) != 0;
+                }
+            CHECK(bad == 0);
+        }
+        CHECK(ex_rio_read(&r, 1, 0, 0, 1, 1, win, 1) != 0); /* no band 2 */
+        ex_rio_close(&r);
+    }
+    /* a window reads only the tiles it touches: corrupt tile 0, read a window elsewhere */
+    {
+        ex_rio_write_options o;
+        ex_rio_image img;
+        ex_rio_reader r;
+        char err[256];
+        size_t n;
+        unsigned char *file;
+        memset(&o, 0, sizeof o);
+        o.tiled = 1; o.tile_size = 16; o.deflate = 1;
+        img.data = src; img.width = W; img.height = H; img.bands = 1; img.band_step = 0; img.row_step = W;
+        img.pixel_step = 1;
+        CHECK(ex_rio_write(tpath("t.tif"), &img, NULL, &o, err) == 0);
+        file = slurp(tpath("t.tif"), &n);
+        CHECK(file && ex_rio_open_tiff_mem(&r, file, n) == 0);
+        if (file && r.offsets) {
+            memset(file + r.offsets[0], 0xff, (size_t)r.counts[0]);
+            CHECK(ex_rio_read(&r, 0, 20, 20, 30, 30, win, 40) == 0);
+            CHECK(memcmp(win, src + 20 * W + 20, 4) == 0);
+            CHECK(ex_rio_read(&r, 0, 0, 0, W, H, all, W) != 0);
+            CHECK(strstr(r.err, "strip/tile 0") != NULL);
+        }
+        ex_rio_close(&r);
+        free(file);
+    }
+    free(src);
+    free(all);
+}
+
+/* ---- malformed TIFFs ------------------------------------------------------------------------ */
+
+/* A classic little-endian TIFF: one IFD at 8 with the given entries (tag, type, count, value). */
+static size_t mini_tiff(unsigned char *buf, uint32_t (*e)[4], int n, uint32_t next)
+{
+    int i;
+    memcpy(buf, "II*\0\x08\0\0\0", 8);
+    ex_rio_put_uint(buf + 8, (uint64_t)n, 2, 0);
+    for (i = 0; i < n; i++) {
+        unsigned char *p = buf + 10 + 12 * i;
+        ex_rio_put_uint(p, e[i][0], 2, 0);
+        ex_rio_put_uint(p + 2, e[i][1], 2, 0);
+        ex_rio_put_uint(p + 4, e[i][2], 4, 0);
+        ex_rio_put_uint(p + 8, e[i][3], 4, 0);
+    }
+    ex_rio_put_uint(buf + 10 + 12 * n, next, 4, 0);
+    return (size_t)(14 + 12 * n);
+}
+
+static int open_err(const unsigned char *b, size_t n, const char *needle)
+{
+    ex_rio_reader r;
+    int rc = ex_rio_open_tiff_mem(&r, b, n), found = strstr(r.err, needle) != NULL;
+    if (rc == 0) {
+        float v[4];
+        rc = ex_rio_read(&r, 0, 0, 0, 2, 2, v, 2);
+        found = strstr(r.err, needle) != NULL;
+    }
+    if (!found) fprintf(stderr, "want '%s', got '%s' (rc %d)\n", needle, r.err, rc);
+    ex_rio_close(&r);
+    return rc != 0 && found;
+}
+
+TEST(tiff_malformed)
+{
+    unsigned char buf[4096];
+    size_t n, i;
+    /* a valid 2 x 2 Float32 strip image: data at 200 */
+    uint32_t ok[][4] = { { 256, 3, 1, 2 }, { 257, 3, 1, 2 }, { 258, 3, 1, 32 }, { 259, 3, 1, 1 },
+                         { 273, 4, 1, 200 }, { 277, 3, 1, 1 }, { 278, 3, 1, 2 }, { 279, 4, 1, 16 },
+                         { 339, 3, 1, 3 } };
+    uint32_t e[12][4];
+    ex_rio_reader r;
+    memset(buf, 0, sizeof buf);
+    n = mini_tiff(buf, ok, 9, 0);
+    CHECK(ex_rio_open_tiff_mem(&r, buf, 216) == 0);
+    ex_rio_close(&r);
+    /* every truncation of the header and IFD is refused with a message */
+    for (i = 0; i < n; i++) {
+        CHECK(ex_rio_open_tiff_mem(&r, buf, i) != 0 && r.err[0] != '\0');
+        ex_rio_close(&r);
+    }
+    CHECK(open_err(buf, 210, "past the end"));            /* strip past the end */
+    memcpy(e, ok, sizeof ok);
+    e[4][3] = 100000;                                      /* offset past the end */
+    mini_tiff(buf, e, 9, 0);
+    CHECK(open_err(buf, 216, "past the end"));
+    mini_tiff(buf, ok, 9, 8);                              /* next IFD = itself: a loop */
+    CHECK(open_err(buf, 216, "loop"));
+    mini_tiff(buf, ok, 9, 4000);                           /* next IFD past the end */
+    CHECK(open_err(buf, 216, "past the end"));
+    memcpy(e, ok, sizeof ok);
+    e[0][1] = 4; e[0][3] = 0x7fffffff; e[1][1] = 4; e[1][3] = 0x7fffffff; /* huge image, 2^62 strips */
+    e[6][3] = 1;
+    mini_tiff(buf, e, 9, 0);
+    CHECK(open_err(buf, 216, "more than"));
+    memcpy(e, ok, sizeof ok);                              /* huge tile count: tiles 16 x 16 of 2^31 */
+    e[0][1] = 4; e[0][3] = 0x7fffffff;
+    e[4][0] = 322; e[4][1] = 3; e[4][3] = 16; e[6][0] = 323; e[6][3] = 16;
+    e[5][0] = 277; e[7][0] = 324; e[7][3] = 200;
+    {
+        uint32_t t[10][4];
+        memcpy(t, ok, sizeof ok);
+        t[0][1] = 4; t[0][3] = 0x7fffffff;
+        t[4][0] = 277; t[4][2] = 1; t[4][3] = 1;
+        t[5][0] = 322; t[5][3] = 16;
+        t[6][0] = 323; t[6][3] = 16;
+        t[7][0] = 324; t[7][1] = 4; t[7][3] = 200;
+        t[8][0] = 325; t[8][1] = 4; t[8][3] = 16;
+        t[9][0] = 339; t[9][1] = 3; t[9][2] = 1; t[9][3] = 3;
+        mini_tiff(buf, t, 10, 0);
+        CHECK(open_err(buf, 216, "more than 16777216"));
+    }
+    memcpy(e, ok, sizeof ok);
+    e[3][3] = 7;                                           /* JPEG */
+    mini_tiff(buf, e, 9, 0);
+    CHECK(open_err(buf, 216, "JPEG"));
+    memcpy(e, ok, sizeof ok);
+    e[2][3] = 12;                                          /* 12-bit */
+    mini_tiff(buf, e, 9, 0);
+    CHECK(open_err(buf, 216, "12-bit"));
+    memcpy(e, ok, sizeof ok);
+    e[8][0] = 320;                                         /* a ColorMap: palette */
+    mini_tiff(buf, e, 9, 0);
+    CHECK(open_err(buf, 216, "palette"));
+    memcpy(e, ok, sizeof ok);
+    e[3][3] = 8; e[7][3] = 6;                              /* deflate: a bad stream */
+    mini_tiff(buf, e, 9, 0);
+    memcpy(buf + 200, "\x78\x01\x07\x00\x00\x00", 6);
+    CHECK(open_err(buf, 216, "invalid deflate stream"));
+    memcpy(buf + 200, "\x78\x01\x00\x02\x00", 5);             /* truncated */
+    CHECK(open_err(buf, 216, "truncated deflate"));
+    e[3][3] = 5; e[7][3] = 4;                              /* LZW: code 300 right after Clear */
+    mini_tiff(buf, e, 9, 0);
+    memcpy(buf + 200, "\x80\x4b\x00\x00", 4);
+    CHECK(open_err(buf, 216, "invalid LZW code"));
+    memcpy(buf + 200, "\x80\x00\x80\x00", 4);                 /* LZW that ends too early */
+    CHECK(open_err(buf, 216, "needed"));
+    memcpy(e, ok, sizeof ok);                              /* a strip claiming 1 GiB from 16 bytes */
+    e[0][1] = 4; e[0][3] = 16384; e[1][1] = 4; e[1][3] = 16384; e[3][3] = 8; e[6][1] = 4; e[6][3] = 16384;
+    mini_tiff(buf, e, 9, 0);
+    CHECK(open_err(buf, 216, "cannot hold") || open_err(buf, 216, "more than"));
+    CHECK(ex_rio_open_tiff_mem(&r, buf, 216) != 0); /* refused when opened, before any allocation */
+    ex_rio_close(&r);
+    /* random byte corruption of a real file never crashes and never passes unnoticed sizes */
+    {
+        ex_rio_write_options o;
+        ex_rio_image img;
+        char err[256];
+        float src[30 * 20], out[30 * 20];
+        size_t fn, t;
+        unsigned char *file, *mut;
+        uint32_t s = 1;
+        field(src, 30, 20, 1, 0, 3);
+        memset(&o, 0, sizeof o);
+        o.tiled = 1; o.tile_size = 16; o.deflate = 1; o.predictor = 3;
+        img.data = src; img.width = 30; img.height = 20; img.bands = 1; img.band_step = 0; img.row_step = 30;
+        img.pixel_step = 1;
+        CHECK(ex_rio_write(tpath("m.tif"), &img, NULL, &o, err) == 0);
+        file = slurp(tpath("m.tif"), &fn);
+        mut = (unsigned char *)malloc(fn);
+        for (t = 0; t < 3000 && file; t++) {
+            int k;
+            memcpy(mut, file, fn);
+            for (k = 0; k < 1 + (int)(t % 4); k++) mut[lcg(&s) % fn] = (unsigned char)lcg(&s);
+            if (ex_rio_open_tiff_mem(&r, mut, (size_t)(t % 7 == 0 ? lcg(&s) % fn : fn)) == 0 &&
+                r.width <= 64 && r.height <= 64)
+                ex_rio_read(&r, 0, 0, 0, r.width < 30 ? r.width : 30, r.height < 20 ? r.height : 20, out, 30);
+            ex_rio_close(&r);
+        }
+        CHECK(1);
+        free(file);
+        free(mut);
+    }
+}
+
+/* ---- ASC and EHdr ------------------------------------------------------------------------- */
+
+TEST(asc_ehdr)
+{
+    enum { W = 23, H = 17 };
+    float src[W * H * 2], got[W * H];
+    ex_georef g;
+    ex_rio_image img;
+    ex_rio_reader r;
+    char err[256];
+    int w, h, b;
+    memset(&g, 0, sizeof g);
+    g.has_transform = 1;
+    g.gt[0] = 1000.5; g.gt[1] = 25.0; g.gt[3] = 9000.25; g.gt[5] = -25.0;
+    ex_georef_set_nodata(&g, "-32768", 6);
+    g.prj = (char *)malloc(64);
+    strcpy(g.prj, "PROJCS[\"x\"]");
+    field(src, W, H, 2, 0, 11);
+    src[3] = (float)NAN;
+    img.data = src; img.width = W; img.height = H; img.bands = 1; img.band_step = (size_t)W * H;
+    img.row_step = W; img.pixel_step = 1;
+    CHECK(ex_rio_write(tpath("a.asc"), &img, &g, NULL, err) == 0);
+    CHECK(read_all(tpath("a.asc"), 0, got, &w, &h, &r) == 0);
+    CHECK(w == W && h == H && r.geo.gt[0] == 1000.5 && r.geo.gt[3] == 9000.25 && r.geo.gt[1] == 25.0);
+    CHECK(r.geo.prj && strcmp(r.geo.prj, "PROJCS[\"x\"]") == 0 && r.geo.crs == EX_RIO_CRS_PROJECTED);
+    CHECK(got[3] == -32768.0f);
+    got[3] = (float)NAN;
+    CHECK(same_bits(src, got, (size_t)W * H));
+    r.nodata_to_nan = 1;
+    CHECK(ex_rio_read(&r, 0, 3, 0, 1, 1, got, 1) == 0 && isnan(got[0]));
+    ex_rio_close(&r);
+    img.bands = 2;
+    CHECK(ex_rio_write(tpath("a2.asc"), &img, &g, NULL, err) != 0 && strstr(err, "one band"));
+    for (b = 0; b < 2; b++) {
+        const char *name = b ? "e.bil" : "e.flt";
+        CHECK(ex_rio_write(tpath(name), &img, &g, NULL, err) == 0);
+        CHECK(read_all(tpath(name), 1, got, &w, &h, &r) == 0);
+        CHECK(r.bands == 2 && r.geo.gt[0] == 1000.5 && r.geo.gt[3] == 9000.25 && r.geo.nodata == -32768.0);
+        CHECK(same_bits(src + W * H, got, (size_t)W * H));
+        ex_rio_close(&r);
+    }
+    /* ESRI .flt header, big-endian, BSQ/BIP layouts and malformed headers */
+    {
+        static const char esri[] = "ncols 2\nnrows 2\nxllcorner 10\nyllcorner 20\ncellsize 5\nNODATA_value -1\n"
+                                   "byteorder MSBFIRST\n";
+        static const unsigned char data[16] = { 0x3f, 0x80, 0, 0, 0x40, 0, 0, 0, 0x40, 0x40, 0, 0, 0xbf, 0x80, 0, 0 };
+        static const char bip[] = "NROWS 1\nNCOLS 2\nNBANDS 2\nNBITS 16\nPIXELTYPE SIGNEDINT\nLAYOUT BIP\n";
+        static const unsigned char d2[8] = { 1, 0, 0xfe, 0xff, 3, 0, 4, 0 };
+        float v[4];
+        CHECK(ex_rio_open_ehdr_mem(&r, esri, strlen(esri), data, 16, 1) == 0);
+        r.nodata_to_nan = 1;
+        CHECK(ex_rio_read(&r, 0, 0, 0, 2, 2, v, 2) == 0 && v[0] == 1.0f && v[2] == 3.0f && isnan(v[3]));
+        CHECK(r.geo.gt[0] == 10.0 && r.geo.gt[3] == 30.0);
+        ex_rio_close(&r);
+        CHECK(ex_rio_open_ehdr_mem(&r, esri, strlen(esri), data, 15, 1) != 0 && strstr(r.err, "holds 15 bytes"));
+        ex_rio_close(&r);
+        CHECK(ex_rio_open_ehdr_mem(&r, bip, strlen(bip), d2, 8, 0) == 0);
+        CHECK(ex_rio_read(&r, 1, 0, 0, 2, 1, v, 2) == 0 && v[0] == -2.0f && v[1] == 4.0f);
+        ex_rio_close(&r);
+        CHECK(ex_rio_open_ehdr_mem(&r, "NROWS 99999999999\nNCOLS 2\n", 26, d2, 8, 0) != 0);
+        ex_rio_close(&r);
+        CHECK(ex_rio_open_ehdr_mem(&r, "NROWS 2\nNCOLS 2\nNBITS 12\n", 25, d2, 8, 0) != 0 && strstr(r.err, "12-bit"));
+        ex_rio_close(&r);
+    }
+    /* ASC: centre corners, truncated and overlong grids, a size claim beyond the text */
+    {
+        static const char c[] = "NCOLS 2\nNROWS 1\nXLLCENTER 5\nYLLCENTER 5\nCELLSIZE 2\n1 2\n";
+        CHECK(ex_rio_open_asc_mem(&r, c, strlen(c)) == 0 && r.geo.gt[0] == 4.0 && r.geo.gt[3] == 6.0);
+        ex_rio_close(&r);
+        CHECK(ex_rio_open_asc_mem(&r, "ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2 3", 52) != 0);
+        ex_rio_close(&r);
+        CHECK(ex_rio_open_asc_mem(&r, "ncols 99999\nnrows 99999\nxllcorner 0\nyllcorner 0\ncellsize 1\n1", 59) != 0 &&
+              strstr(r.err, "truncated"));
+        ex_rio_close(&r);
+        CHECK(ex_rio_open_asc_mem(&r, "ncols 1\nnrows 1\nbogus 0\n1", 25) != 0 && strstr(r.err, "bogus"));
+        ex_rio_close(&r);
+    }
+    ex_georef_free(&g);
+}
+
+TEST(georef_cells)
+{
+    ex_georef g;
+    double cell = 0.0;
+    char err[256];
+    memset(&g, 0, sizeof g);
+    CHECK(ex_georef_cell(&g, &cell, err) != 0);
+    g.has_transform = 1;
+    g.gt[1] = 10.0; g.gt[5] = -10.0;
+    CHECK(ex_georef_cell(&g, &cell, err) == 0 && cell == 10.0);
+    g.gt[5] = -12.0;
+    CHECK(ex_georef_cell(&g, &cell, err) != 0 && strstr(err, "not square"));
+    g.gt[5] = -10.0; g.gt[2] = 0.5;
+    CHECK(ex_georef_cell(&g, &cell, err) != 0 && strstr(err, "rotated"));
+    /* GeoKeys: geographic model type and EPSG 4326; PixelIsPoint moves the transform half a cell */
+    {
+        uint16_t keys[] = { 1, 1, 0, 3, 1024, 0, 1, 2, 1025, 0, 1, 2, 2048, 0, 1, 4326 };
+        double tie[6] = { 0, 0, 0, 100.0, 50.0, 0 };
+        memset(&g, 0, sizeof g);
+        g.geokeys = keys; g.n_geokeys = 16; g.tiepoints = tie; g.n_tiepoints = 6;
+        g.has_scale = 1; g.scale[0] = 0.5; g.scale[1] = 0.5;
+        CHECK(ex_georef_keys(&g, err) == 0 && g.crs == EX_RIO_CRS_GEOGRAPHIC && g.epsg == 4326 && g.pixel_is_point);
+        ex_georef_transform(&g);
+        CHECK(g.has_transform && g.gt[0] == 99.75 && g.gt[3] == 50.25 && g.gt[1] == 0.5 && g.gt[5] == -0.5);
+        keys[3] = 9; /* more keys than the directory holds */
+        CHECK(ex_georef_keys(&g, err) != 0);
+    }
+}
+
+int main(int argc, char **argv)
+{
+    const char *base = getenv("TMPDIR");
+    TEST_INIT(argc, argv);
+    snprintf(tdir, sizeof tdir, "%s/hfvis_test_raster_io_XXXXXX", base ? base : "/tmp");
+    if (!mkdtemp(tdir)) {
+        perror("mkdtemp");
+        return 1;
+    }
+    RUN(inflate_dynamic_and_errors);
+    RUN(deflate_round_trip);
+    RUN(tiff_round_trips);
+    RUN(tiff_lzw_packbits);
+    RUN(window_reads);
+    RUN(tiff_malformed);
+    RUN(asc_ehdr);
+    RUN(georef_cells);
+    {
+        const char *names[] = { "rt.tif", "u.tif", "c.tif", "w.tif", "w.flt", "w.hdr", "t.tif", "m.tif", "a.asc",
+                                "a.prj", "e.flt", "e.bil", "e.hdr", "e.prj" };
+        size_t i;
+        for (i = 0; i < sizeof names / sizeof names[0]; i++) remove(tpath(names[i]));
+        CHECK(test_dir_entries(tdir) == 0); /* no temporary file left by a writer */
+        rmdir(tdir);
+    }
+    return TEST_DONE();
+}
