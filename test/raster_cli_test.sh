@@ -41,6 +41,11 @@ grep -q '^NODATA 0$' "$dir/asc.hdr" && grep -q '^XDIM 30$' "$dir/asc.hdr" && gre
   && ok ".hdr carries NoData, cell and corner" || bad ".hdr: $(cat "$dir/asc.hdr")"
 [ -s "$dir/asc.prj" ] && same ".prj carried to the output" "$dir/dem.prj" "$dir/asc.prj"
 run "skyview flt" skyview "$dir/asc.flt" --dirs 8 -o "$dir/flt.flt" && ok "an .flt output reads back as input"
+# viewshed --observer in map coordinates of a georeferenced input: the centre of column 20, row 16
+# of dem.asc is X = 500000 + 20.5*30, Y = 4100000 + (33 - 16.5)*30 (the rows run southward)
+run "viewshed map" viewshed "$dir/dem.asc" --observer 500615,4100495 -o "$dir/vs_map.flt" \
+  && run "viewshed grid" viewshed "$dir/dem.asc" --observer-grid 20,16 -o "$dir/vs_grid.flt" \
+  && same "viewshed --observer in the raster's map coordinates = --observer-grid" "$dir/vs_map.flt" "$dir/vs_grid.flt"
 run "skyview asc -> asc" skyview "$dir/dem.asc" --dirs 8 -o "$dir/svf.asc" && run "asc -> flt" skyview "$dir/dem.asc" --dirs 8 -o "$dir/svf2.flt" \
   && grep -q '^NODATA_value 0$' "$dir/svf.asc" && grep -q '^cellsize 30$' "$dir/svf.asc" && ok "asc output header"
 run "skyview asc -> tif" skyview "$dir/dem.asc" --dirs 8 -o "$dir/svf.tif" && ok "skyview dem.asc -o svf.tif"
@@ -113,7 +118,7 @@ if command -v gdal_translate > /dev/null 2>&1 && command -v gdalinfo > /dev/null
   gt -of EHdr "$dir/h.tif" "$dir/h_gdal.bil" && same "GDAL reads the 4-band horizon GeoTIFF = hfvis's BIL" "$dir/h.bil" "$dir/h_gdal.bil"
   gdalinfo "$dir/h.tif" | grep -c '^Band ' | grep -qx 4 && ok "gdalinfo: 4 bands" || bad "horizon GeoTIFF bands"
   # integral outputs: the smallest integer type; NoData moved off the values when it collides
-  if run "viewshed -> tif" viewshed "$dir/dem.asc" --observer 20,16 -o "$dir/vs.tif"; then
+  if run "viewshed -> tif" viewshed "$dir/dem.asc" --observer-grid 20,16 -o "$dir/vs.tif"; then
     grep -q "input's NoData 0 is a value of this output" "$dir/err" && ok "NoData colliding with a viewshed value: a note" \
       || bad "no collision note: $(cat "$dir/err")"
     gdalinfo -stats "$dir/vs.tif" > "$dir/vs.info" 2>&1
