@@ -928,6 +928,13 @@ hfvis_status hfvis_normals_compute(const hfvis_grid *grid, float *out)
 /* ========================================================================================== */
 
 #define HF_LATTICE_EPS 1e-9 /* spec §3.2: nodes within 1e-9 cell of the border are inside */
+/* Half-width of the domain across an axis of one sample: a grid 1 sample wide (or tall) is
+ * swept as a strip one cell wide, heights constant across it. A line of zero width would hold a
+ * lattice node only where a node happens to land on it, and the gather would find none. */
+#define HF_STRIP_HALF 0.5
+
+/* The domain along one axis of n samples: [-pad, n - 1 + pad]. */
+static double hf_domain_pad(int n) { return n == 1 ? HF_STRIP_HALF : HF_LATTICE_EPS; }
 
 /* Fill the lattice for a given sweep vector u (unit; v = (-u.y, u.x)). Directions are stored
  * as look azimuth psi with u = -(cos psi, sin psi) (spec §1: a sweep along u yields the horizon
@@ -935,7 +942,7 @@ hfvis_status hfvis_normals_compute(const hfvis_grid *grid, float *out)
 static hfvis_status hf_lattice_from_u(hfvis_lattice *L, int W, int H, double ux, double uy)
 {
     double cx[4], cy[4], umin = DBL_MAX, umax = -DBL_MAX, vmin = DBL_MAX, vmax = -DBL_MAX;
-    double rows, cols;
+    double rows, cols, px, py;
     int c;
     L->ux = ux;
     L->uy = uy;
@@ -944,10 +951,12 @@ static hfvis_status hf_lattice_from_u(hfvis_lattice *L, int W, int H, double ux,
     L->width = W;
     L->height = H;
     L->azimuth_rad = atan2(-uy, -ux);
-    cx[0] = 0.0; cy[0] = 0.0;
-    cx[1] = (double)(W - 1); cy[1] = 0.0;
-    cx[2] = 0.0; cy[2] = (double)(H - 1);
-    cx[3] = (double)(W - 1); cy[3] = (double)(H - 1);
+    px = W == 1 ? HF_STRIP_HALF : 0.0; /* a thin axis: the strip's corners */
+    py = H == 1 ? HF_STRIP_HALF : 0.0;
+    cx[0] = -px; cy[0] = -py;
+    cx[1] = (double)(W - 1) + px; cy[1] = -py;
+    cx[2] = -px; cy[2] = (double)(H - 1) + py;
+    cx[3] = (double)(W - 1) + px; cy[3] = (double)(H - 1) + py;
     for (c = 0; c < 4; c++) {
         double a = cx[c] * L->ux + cy[c] * L->uy, b = cx[c] * L->vx + cy[c] * L->vy;
         umin = fmin(umin, a);
@@ -1012,29 +1021,31 @@ static void hf_node_pos(const hfvis_lattice *L, int i, int j, double *x, double 
 static int hf_node_inside(const hfvis_lattice *L, int i, int j)
 {
     double x, y;
+    double px = hf_domain_pad(L->width), py = hf_domain_pad(L->height);
     hf_node_pos(L, i, j, &x, &y);
-    return x >= -HF_LATTICE_EPS && x <= (double)(L->width - 1) + HF_LATTICE_EPS &&
-           y >= -HF_LATTICE_EPS && y <= (double)(L->height - 1) + HF_LATTICE_EPS;
+    return x >= -px && x <= (double)(L->width - 1) + px && y >= -py && y <= (double)(L->height - 1) + py;
 }
 
 int hfvis_lattice_line(const hfvis_lattice *L, int j, int *i_first, int *i_last)
 {
     double lo = -DBL_MAX, hi = DBL_MAX;
-    double u[2], v[2], len[2];
+    double u[2], v[2], len[2], pad[2];
     int a, first, last;
     if (!L || j < L->j_min || j > L->j_max) return 0;
     u[0] = L->ux; u[1] = L->uy;
     v[0] = L->vx; v[1] = L->vy;
     len[0] = (double)(L->width - 1);
     len[1] = (double)(L->height - 1);
+    pad[0] = hf_domain_pad(L->width);
+    pad[1] = hf_domain_pad(L->height);
     /* Slab test per axis (spec §3.2) gives the range to within rounding ... */
     for (a = 0; a < 2; a++) {
-        double off = (double)j * v[a];
+        double off = (double)j * v[a], lo_a = pad[a] > HF_LATTICE_EPS ? -pad[a] : 0.0;
         if (u[a] != 0.0) {
-            double t0 = (0.0 - off) / u[a], t1 = (len[a] - off) / u[a];
+            double t0 = (lo_a - off) / u[a], t1 = (len[a] - lo_a - off) / u[a];
             lo = fmax(lo, fmin(t0, t1));
             hi = fmin(hi, fmax(t0, t1));
-        } else if (off < -HF_LATTICE_EPS || off > len[a] + HF_LATTICE_EPS) {
+        } else if (off < -pad[a] || off > len[a] + pad[a]) {
             return 0;
         }
     }

@@ -311,7 +311,11 @@ typedef struct hfvis_lattice {
     int width, height;          /* of the grid */
 } hfvis_lattice;
 
-/* Set up the lattice of look direction azimuth_rad over a width x height grid.
+/* Set up the lattice of look direction azimuth_rad over a width x height grid. The domain is
+ * [0, width-1] x [0, height-1] (nodes within 1e-9 cell of its border inside), except that an axis
+ * of one sample spans [-0.5, 0.5]: a grid one sample wide or tall is a strip one cell wide with
+ * heights constant across it, so that every line crossing it holds a node and every grid point
+ * has nodes to gather from (a line of zero width would hold a node only by chance).
  * Returns HFVIS_ERR_INVALID_ARGUMENT for NULL, sizes < 1 or a non-finite azimuth, and
  * HFVIS_ERR_LIMIT if the lattice would exceed 2^31 nodes. */
 HFVIS_API hfvis_status hfvis_lattice_init(hfvis_lattice *lattice, int width, int height,
