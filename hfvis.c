@@ -102,6 +102,26 @@ static void hf_free(const hfvis_allocator *a, void *p)
 
 void hfvis_free(const hfvis_allocator *alloc, void *ptr) { hf_free(alloc, ptr); }
 
+/* Four bits per step from a 16-entry table (entry i = the CRC register after shifting the
+ * nibble i out), reflected polynomial 0xEDB88320. */
+uint32_t hfvis_crc32(uint32_t crc, const void *data, size_t n)
+{
+    static const uint32_t t[16] = {
+        0x00000000u, 0x1db71064u, 0x3b6e20c8u, 0x26d930acu, 0x76dc4190u, 0x6b6b51f4u,
+        0x4db26158u, 0x5005713cu, 0xedb88320u, 0xf00f9344u, 0xd6d6a3e8u, 0xcb61b38cu,
+        0x9b64c2b0u, 0x86d3d2d4u, 0xa00ae278u, 0xbdbdf21cu
+    };
+    const unsigned char *p = (const unsigned char *)data;
+    size_t i;
+    crc = ~crc;
+    for (i = 0; i < n; i++) {
+        crc ^= p[i];
+        crc = (crc >> 4) ^ t[crc & 15u];
+        crc = (crc >> 4) ^ t[crc & 15u];
+    }
+    return ~crc;
+}
+
 /* a*b without overflow (stb's mul2sizes_valid). */
 static int hf_mul_size(size_t a, size_t b, size_t *out)
 {
@@ -6590,8 +6610,9 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
     return s;
 }
 
-#define HF_PARTIAL_MAGIC "HFVISSUM 1\n"
+#define HF_PARTIAL_MAGIC "HFVISSUM 2\n"
 #define HF_PARTIAL_MAGIC_LEN 11u
+#define HF_PARTIAL_CRC_LEN 4u /* the trailing hfvis_crc32 of everything before it */
 #define HF_PARTIAL_NUMBERS 6
 
 /* The six header numbers of p, or 0 if p is invalid; *values receives planes*width*height. */
@@ -6647,7 +6668,7 @@ size_t hfvis_partial_encode_size(const hfvis_partial *p)
     unsigned char line[6 * 12];
     size_t values, tag_len, head, bytes;
     if (!hf_partial_valid(p, &values, &tag_len)) return 0;
-    head = HF_PARTIAL_MAGIC_LEN + hf_partial_numbers(p, line) + tag_len + 1u;
+    head = HF_PARTIAL_MAGIC_LEN + hf_partial_numbers(p, line) + tag_len + 1u + HF_PARTIAL_CRC_LEN;
     if (!hf_mul_size(values, 8u, &bytes) || bytes > SIZE_MAX - head) return 0;
     return head + bytes;
 }
@@ -6657,6 +6678,7 @@ hfvis_status hfvis_partial_encode(const hfvis_partial *p, void *out, size_t out_
 {
     unsigned char *dst = (unsigned char *)out;
     size_t need = hfvis_partial_encode_size(p), values, tag_len, i;
+    uint32_t crc;
     int b;
     if (!out || !written || need == 0 || !hf_partial_valid(p, &values, &tag_len))
         return HFVIS_ERR_INVALID_ARGUMENT;
@@ -6672,6 +6694,8 @@ hfvis_status hfvis_partial_encode(const hfvis_partial *p, void *out, size_t out_
         memcpy(&u, &p->sums[i], 8);
         for (b = 0; b < 8; b++) *dst++ = (unsigned char)((u >> (8 * b)) & 0xffu);
     }
+    crc = hfvis_crc32(0, out, need - HF_PARTIAL_CRC_LEN);
+    for (b = 0; b < 4; b++) *dst++ = (unsigned char)((crc >> (8 * b)) & 0xffu);
     *written = need;
     return HFVIS_OK;
 }
@@ -6702,6 +6726,7 @@ hfvis_status hfvis_partial_decode(const void *data, size_t size, const hfvis_all
     hfvis_partial r;
     int v[HF_PARTIAL_NUMBERS], i;
     size_t pos = HF_PARTIAL_MAGIC_LEN, tag0, tag_len, values, bytes, block, k;
+    uint32_t crc;
     unsigned char *mem;
     if (!data || !p) return HFVIS_ERR_INVALID_ARGUMENT;
     if (size < HF_PARTIAL_MAGIC_LEN || memcmp(d, HF_PARTIAL_MAGIC, HF_PARTIAL_MAGIC_LEN) != 0)
@@ -6730,8 +6755,11 @@ hfvis_status hfvis_partial_decode(const void *data, size_t size, const hfvis_all
         (unsigned long long)values > HFVIS_PARTIAL_MAX_VALUES || values > SIZE_MAX / 8u)
         return HFVIS_ERR_LIMIT;
     bytes = values * 8u;
-    if (bytes > SIZE_MAX - tag_len - 1u) return HFVIS_ERR_LIMIT;
-    if (size - pos != bytes) return HFVIS_ERR_FORMAT;
+    if (bytes > SIZE_MAX - tag_len - 1u - HF_PARTIAL_CRC_LEN) return HFVIS_ERR_LIMIT;
+    if (size - pos != bytes + HF_PARTIAL_CRC_LEN) return HFVIS_ERR_FORMAT;
+    for (k = 0, crc = 0; k < HF_PARTIAL_CRC_LEN; k++)
+        crc |= (uint32_t)d[size - HF_PARTIAL_CRC_LEN + k] << (8u * k);
+    if (hfvis_crc32(0, d, size - HF_PARTIAL_CRC_LEN) != crc) return HFVIS_ERR_FORMAT;
     block = bytes + tag_len + 1u;
     mem = (unsigned char *)hf_alloc(alloc, block);
     if (!mem) return HFVIS_ERR_OUT_OF_MEMORY;

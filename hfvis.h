@@ -138,6 +138,11 @@ typedef struct hfvis_allocator {
  * same allocator (NULL = free). ptr may be NULL. */
 HFVIS_API void hfvis_free(const hfvis_allocator *alloc, void *ptr);
 
+/* CRC-32 (ISO-HDLC: the polynomial of PNG, zlib and gzip) of n bytes continuing crc (start from
+ * 0): hfvis_crc32(0, "123456789", 9) = 0xCBF43926. data may be NULL when n is 0. Pure helper;
+ * the partial-sum files carry one, the PNG writer of the examples uses it for its chunks. */
+HFVIS_API uint32_t hfvis_crc32(uint32_t crc, const void *data, size_t n);
+
 /* A height field. See CONVENTIONS. */
 typedef struct hfvis_grid {
     const float *z;        /* heights, z[y*stride + x]; non-finite = hole */
@@ -1388,11 +1393,13 @@ HFVIS_API hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis
 
 /* The partial-sum file ("HFVISSUM"): the sums (or horizon planes) of one direction range of one
  * run, with what is needed to check that parts belong together. Layout, byte for byte:
- *   "HFVISSUM 1\n"
+ *   "HFVISSUM 2\n"
  *   "<width> <height> <planes> <directions> <begin> <end>\n"   decimal, single spaces
  *   "<tag>\n"                                                  1..HFVIS_PARTIAL_MAX_TAG bytes
  *   planes*height*width little-endian IEEE-754 doubles, sums[(p*height + y)*width + x]
- * and nothing after. The tag is printable ASCII (32..126) chosen by the producer; the hfvis
+ *   4 bytes: hfvis_crc32 of every byte before them, little-endian
+ * and nothing after. A file whose checksum does not match is HFVIS_ERR_FORMAT, as is a version-1
+ * file ("HFVISSUM 1\n", no checksum: written by hfvis 0.1.0 before the checksum; rerun it). The tag is printable ASCII (32..126) chosen by the producer; the hfvis
  * tool stores its command and every parameter that changes the result there. */
 #define HFVIS_PARTIAL_MAX_TAG 4096
 #define HFVIS_PARTIAL_MAX_PLANES 65536

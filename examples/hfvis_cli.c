@@ -2433,6 +2433,19 @@ static int cli_sum_load(const char *path, hfvis_partial *p, cli_part *m)
     hfvis_status s;
     errno = 0;
     s = hfvis_partial_load(path, NULL, p);
+    if (s == HFVIS_ERR_FORMAT) { /* say which: an old part, or a damaged or foreign file */
+        char head[12] = { 0 };
+        FILE *f = fopen(path, "rb");
+        size_t got = f ? fread(head, 1, 11, f) : 0;
+        if (f) fclose(f);
+        if (got == 11 && !memcmp(head, "HFVISSUM 1\n", 11))
+            return cli_error(CLI_EXIT_ERROR, path, "a version-1 part (no checksum; written by an "
+                             "older hfvis): rerun its --dir-range with this hfvis");
+        if (got == 11 && !memcmp(head, "HFVISSUM 2\n", 11))
+            return cli_error(CLI_EXIT_ERROR, path, "%s: damaged part (its header, size or CRC-32 "
+                             "checksum does not match): rerun its --dir-range",
+                             hfvis_status_string(s));
+    }
     if (s != HFVIS_OK) return cli_status(path, s, errno);
     if (!m->tag) {
         size_t len = strlen(p->tag);
@@ -2449,6 +2462,31 @@ static int cli_sum_load(const char *path, hfvis_partial *p, cli_part *m)
                m->end != p->end) {
         hfvis_partial_free(NULL, p);
         return cli_error(CLI_EXIT_ERROR, path, "changed while being summed");
+    }
+    return 0;
+}
+
+/* The domain of a part's values (NaN marks a hole in every kind): horizon elevations lie in
+ * [-pi/2, pi/2] (as floats); a sky-view sum of n directions in [0, n] (each term
+ * sin(max(alpha, 0))); sky light terms ([P1] Eq. 5) in [0, 1] each; environment sums are finite
+ * and >= 0 (radiance >= 0); visibility counts in [0, n*(W + H + 3)] (a lattice line holds at
+ * most diagonal + 3 nodes). A value outside is refused rather than summed. */
+static int cli_sum_check(const char *path, int cmd, const hfvis_partial *p)
+{
+    const size_t count = (size_t)p->width * (size_t)p->height * (size_t)p->planes;
+    const double n = (double)(p->end - p->begin);
+    double lo = 0.0, hi = n;
+    size_t k;
+    if (cmd == CMD_HORIZON) hi = (double)(float)(CLI_PI / 2.0), lo = -hi;
+    else if (cmd == CMD_LIGHT) hi = HUGE_VAL;
+    else if (cmd == CMD_VISIBILITY) hi = n * ((double)p->width + (double)p->height + 3.0);
+    for (k = 0; k < count; k++) {
+        double v = p->sums[k];
+        if (isnan(v)) continue;
+        if (!(v >= lo && v <= hi && isfinite(v)))
+            return cli_error(CLI_EXIT_ERROR, path, "value %.17g at index %lu lies outside the domain "
+                             "[%g, %g] of a %s part: the file is damaged", v, (unsigned long)k, lo, hi,
+                             cli_cmd_names[cmd]);
     }
     return 0;
 }
@@ -2596,6 +2634,10 @@ static int cli_sum(int argc, char **argv)
         hfvis_partial p;
         const size_t count = n * (size_t)meta[order[i]].planes;
         if ((rc = cli_sum_load(names[order[i]], &p, &meta[order[i]])) != 0) goto done;
+        if ((rc = cli_sum_check(names[order[i]], cmd, &p)) != 0) {
+            hfvis_partial_free(NULL, &p);
+            goto done;
+        }
         if (cmd == CMD_HORIZON) { /* plane j is the direction at sweep position begin + j */
             for (j = 0; j < p.planes; j++) {
                 int pos = p.begin + j, kk = K % 4 ? pos : pos / 4 + (pos % 4) * (K / 4);

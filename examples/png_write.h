@@ -22,25 +22,7 @@
 /* A stored deflate block holds at most 65535 bytes (RFC 1951 §3.2.4: LEN is 16 bits). */
 #define EX_PNG_MAX_STORED 65535u
 
-/* CRC-32 of PNG Annex D (reflected polynomial 0xEDB88320, initial and final XOR 0xFFFFFFFF) over
- * n bytes, continuing crc (start from 0): ex_png_crc32(0, "123456789", 9) = 0xCBF43926. Four bits
- * per step from a 16-entry table (entry i = CRC register after shifting the nibble i out). */
-static inline uint32_t ex_png_crc32(uint32_t crc, const unsigned char *p, size_t n)
-{
-    static const uint32_t t[16] = {
-        0x00000000u, 0x1db71064u, 0x3b6e20c8u, 0x26d930acu, 0x76dc4190u, 0x6b6b51f4u,
-        0x4db26158u, 0x5005713cu, 0xedb88320u, 0xf00f9344u, 0xd6d6a3e8u, 0xcb61b38cu,
-        0x9b64c2b0u, 0x86d3d2d4u, 0xa00ae278u, 0xbdbdf21cu
-    };
-    size_t i;
-    crc = ~crc;
-    for (i = 0; i < n; i++) {
-        crc ^= p[i];
-        crc = (crc >> 4) ^ t[crc & 15u];
-        crc = (crc >> 4) ^ t[crc & 15u];
-    }
-    return ~crc;
-}
+/* The chunk CRC of PNG Annex D is the library's hfvis_crc32 (ISO-HDLC, reflected 0xEDB88320). */
 
 /* Adler-32 of RFC 1950 §8.2 over n bytes, continuing adler (start from 1):
  * ex_png_adler32(1, "Wikipedia", 9) = 0x11E60398. Reduces mod 65521 every 5552 bytes, the
@@ -105,7 +87,7 @@ static inline unsigned char *ex_png__chunk(unsigned char *p, const char type[4],
 {
     ex_png__be32(p, (uint32_t)n);
     memcpy(p + 4, type, 4);
-    return ex_png__be32(p + 8 + n, ex_png_crc32(0, p + 4, 4 + n));
+    return ex_png__be32(p + 8 + n, hfvis_crc32(0, p + 4, 4 + n));
 }
 
 /* The deflate writer: copies the filtered scanlines into stored blocks of at most 65535 bytes,
@@ -208,7 +190,7 @@ static inline hfvis_status ex_png_write_file(const char *path, const unsigned ch
     tmp = (char *)malloc(len + 16);
     if (!tmp) return HFVIS_ERR_OUT_OF_MEMORY;
     memcpy(raw, &addr, sizeof raw);
-    tag = ex_png_crc32(ex_png_crc32(0, (const unsigned char *)path, len), raw, sizeof raw);
+    tag = hfvis_crc32(hfvis_crc32(0, (const unsigned char *)path, len), raw, sizeof raw);
     memcpy(tmp, path, len);
     memcpy(tmp + len, ".tmp", 4);
     tmp[len + 12] = '\0';

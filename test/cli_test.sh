@@ -450,7 +450,7 @@ split4 "split visibility --fraction" visibility pfm 0:3 3:4 4:7 7:8 -- --dirs 8 
 "$hfvis" sum "$dir/whole.hfvs" -o "$dir/whole.pfm" 2> /dev/null
 "$hfvis" skyview "$h" --dirs 16 -o "$dir/single.pfm" 2> /dev/null
 same_or_ulp "one part 0:K" "$dir/single.pfm" "$dir/whole.pfm"
-head -n 1 "$dir/whole.hfvs" | grep -q '^HFVISSUM 1$' && ok "partial file magic" || bad "partial file magic"
+head -n 1 "$dir/whole.hfvs" | grep -q '^HFVISSUM 2$' && ok "partial file magic" || bad "partial file magic"
 
 # Refusals: one line, non-zero exit, nothing written.
 for r in 0:4 4:8 8:12 12:16; do "$hfvis" skyview "$h" --dirs 16 --dir-range "$r" -o "$dir/sv_${r%%:*}.hfvs"; done
@@ -495,6 +495,41 @@ expect_fail "--dir-range on shadow" 2 shadow "$h" --sun-azimuth 1 --sun-elevatio
 expect_fail "--dir-range on gi" 2 gi "$h" --dir-range 0:4 -o "$fdir/x.hfvs"
 expect_fail "--dir-range with --stats" 2 visibility "$h" --stats --dir-range 0:4 -o "$fdir/x.hfvs"
 expect_fail "horizon part of an oversized map" 1 horizon "$dir/big.pgm" --dirs 65536 --dir-range 0:1 -o "$fdir/x.hfvs"
+# Damaged parts (issue: a NaN or 1e308 planted in a body was summed, exit 0): one byte changed is
+# caught by the CRC-32, a version-1 part (no checksum) is named as such, and a value outside its
+# domain under a correct checksum (written here with crc32_le, POSIX sh arithmetic) is refused.
+crc32_le() { # FILE: the CRC-32 (ISO-HDLC) of FILE as four printf octal escapes, little-endian
+  od -An -v -tu1 "$1" | awk '{ for (i = 1; i <= NF; i++) print $i }' > "$dir/crc_bytes"
+  c=4294967295
+  while read -r b; do
+    c=$(( c ^ b )); k=0
+    while [ $k -lt 8 ]; do
+      if [ $(( c & 1 )) -eq 1 ]; then c=$(( (c >> 1) ^ 3988292384 )); else c=$(( c >> 1 )); fi
+      k=$((k + 1))
+    done
+  done < "$dir/crc_bytes"
+  c=$(( c ^ 4294967295 ))
+  printf '\\%03o\\%03o\\%03o\\%03o' $((c & 255)) $(((c >> 8) & 255)) $(((c >> 16) & 255)) $(((c >> 24) & 255))
+}
+"$hfvis" skyview "$dir/flat.pgm" --dirs 4 --dir-range 0:4 -o "$dir/f04.hfvs"
+fsize=$(wc -c < "$dir/f04.hfvs" | tr -d ' ')
+cp "$dir/f04.hfvs" "$dir/flip.hfvs"
+printf '\377' | dd of="$dir/flip.hfvs" bs=1 seek=$((fsize - 12)) conv=notrunc 2>/dev/null
+expect_fail "sum: a body byte changed" 1 sum "$dir/flip.hfvs" -o "$o"
+grep -q 'CRC-32' "$dir/stderr" && ok "sum: damaged part named" || bad "sum: damaged part named: $(cat "$dir/stderr")"
+{ printf 'HFVISSUM 1\n'; tail -c +12 "$dir/f04.hfvs" | head -c $((fsize - 15)); } > "$dir/v1.hfvs"
+expect_fail "sum: a version-1 part" 1 sum "$dir/v1.hfvs" -o "$o"
+grep -q 'version-1 part' "$dir/stderr" && ok "sum: version-1 part named" || bad "sum: version-1 part named: $(cat "$dir/stderr")"
+# 1e308 (0x7fe1ccf385ebc8a0) over the last sum, then a correct trailer
+head -c $((fsize - 12)) "$dir/f04.hfvs" > "$dir/big.body"
+printf '\240\310\353\205\363\314\341\177' >> "$dir/big.body"
+{ cat "$dir/big.body"; printf "$(crc32_le "$dir/big.body")"; } > "$dir/big.hfvs"
+expect_fail "sum: 1e308 under a correct checksum" 1 sum "$dir/big.hfvs" -o "$o"
+grep -q 'outside the domain' "$dir/stderr" && ok "sum: out-of-domain value named" || bad "sum: out-of-domain value named: $(cat "$dir/stderr")"
+{ cat "$dir/f04.hfvs"; } > "$dir/same.hfvs"
+head -c $((fsize - 4)) "$dir/f04.hfvs" > "$dir/same.body"
+[ "$(printf "$(crc32_le "$dir/same.body")" | od -An -tx1)" = "$(tail -c 4 "$dir/f04.hfvs" | od -An -tx1)" ] &&
+  ok "crc32_le agrees with the library" || bad "crc32_le agrees with the library"
 printf 'old\n' > "$dir/keep.pfm"
 "$hfvis" sum "$s0" "$s8" -o "$dir/keep.pfm" 2> /dev/null
 [ "$(cat "$dir/keep.pfm")" = old ] && ok "refused sum keeps the old OUT" || bad "refused sum keeps the old OUT"

@@ -48,6 +48,7 @@
 #define HFVIS_INVENTORY(X) \
     X(status_string, V, -, "E", "an HFVIS_ERR_UNKNOWN string, never NULL") \
     X(free, V, -, "N", "no-op for NULL") \
+    X(crc32, V, -, "N", "the crc unchanged for NULL with n = 0") \
     X(image_info_read, S, -, "NZO", "INVALID_ARGUMENT FORMAT LIMIT") \
     X(image_decode, S, -, "NZOR", "INVALID_ARGUMENT FORMAT LIMIT BUFFER_TOO_SMALL") \
     X(pfm_encode_size, V, -, "ZGOR", "0") \
@@ -600,6 +601,12 @@ static void args_free(void)
     hfvis_free(NULL, NULL);
     hfvis_free(&a, NULL);
     BADV('N', c.allocs == 0 && c.live == 0);
+}
+
+static void args_crc32(void)
+{
+    begin("crc32");
+    BADV('N', hfvis_crc32(0, NULL, 0) == 0u && hfvis_crc32(0x12345678u, NULL, 0) == 0x12345678u);
 }
 
 static void args_image_info_read(void)
@@ -2074,7 +2081,7 @@ static const char *long_tag(void)
 static void args_partial_encode_size(void)
 {
     begin("partial_encode_size");
-    CHECK(hfvis_partial_encode_size(&p_ok) == 11 + 12 + 8 + 8 * GW * GH);
+    CHECK(hfvis_partial_encode_size(&p_ok) == 11 + 12 + 8 + 8 * GW * GH + 4);
     BADV('N', hfvis_partial_encode_size(NULL) == 0);
     PARTIAL_CASES(P_ZERO, hfvis_partial_encode_size(&bp));
 }
@@ -2094,14 +2101,18 @@ static void args_partial_encode(void)
     PARTIAL_CASES(P_INV, hfvis_partial_encode(&bp, out, need, wr));
 }
 
-/* A file of header text head followed by values zero doubles, into buf (cap bytes). */
+/* A file of header text head followed by values zero doubles and the CRC-32 trailer of the
+ * HFVISSUM format, into buf (cap bytes). */
 static size_t partial_file(unsigned char *buf, size_t cap, const char *head, size_t values)
 {
-    size_t n = strlen(head);
-    if (n + 8 * values > cap) exit(2);
+    size_t n = strlen(head), k;
+    uint32_t crc;
+    if (n + 8 * values + 4 > cap) exit(2);
     memcpy(buf, head, n);
     memset(buf + n, 0, 8 * values);
-    return n + 8 * values;
+    crc = hfvis_crc32(0, buf, n + 8 * values);
+    for (k = 0; k < 4; k++) buf[n + 8 * values + k] = (unsigned char)(crc >> (8 * k));
+    return n + 8 * values + 4;
 }
 
 static unsigned char p_bad[HFVIS_PARTIAL_MAX_TAG + 256];
@@ -2109,7 +2120,7 @@ static unsigned char p_bad[HFVIS_PARTIAL_MAX_TAG + 256];
 static void args_partial_decode(void)
 {
     /* a header with the numbers line nums; a 4 x 3 one-plane file has 12 values */
-#define P_HEAD(nums) "HFVISSUM 1\n" nums "\nsvf K=4\n"
+#define P_HEAD(nums) "HFVISSUM 2\n" nums "\nsvf K=4\n"
     hfvis_partial *p;
     size_t n;
     char head[HFVIS_PARTIAL_MAX_TAG + 64];
@@ -2135,7 +2146,7 @@ static void args_partial_decode(void)
     BAD('Z', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
     n = partial_file(p_bad, sizeof p_bad, P_HEAD("4 3 1 0 0 4"), 12);
     BAD('Z', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
-    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 1\n4 3 1 4 0 4\n\n", 12);
+    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 2\n4 3 1 4 0 4\n\n", 12);
     BAD('Z', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
     n = partial_file(p_bad, sizeof p_bad, P_HEAD("4 -3 1 4 0 4"), 12);
     BAD('G', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
@@ -2149,14 +2160,14 @@ static void args_partial_decode(void)
     BAD('O', LIM, hfvis_partial_decode(p_bad, n, NULL, p));
     n = partial_file(p_bad, sizeof p_bad, P_HEAD("2147483648 3 1 4 0 4"), 0);
     BAD('O', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
-    snprintf(head, sizeof head, "HFVISSUM 1\n4 3 1 4 0 4\n%s\n", long_tag());
+    snprintf(head, sizeof head, "HFVISSUM 2\n4 3 1 4 0 4\n%s\n", long_tag());
     n = partial_file(p_bad, sizeof p_bad, head, 12);
     BAD('O', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
     n = partial_file(p_bad, sizeof p_bad, P_HEAD("inf 3 1 4 0 4"), 12);
     BAD('F', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
     n = partial_file(p_bad, sizeof p_bad, P_HEAD("nan 3 1 4 0 4"), 12);
     BAD('F', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
-    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 2\n4 3 1 4 0 4\nsvf K=4\n", 12);
+    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 1\n4 3 1 4 0 4\nsvf K=4\n", 12);
     BAD('E', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
     n = partial_file(p_bad, sizeof p_bad, "HFVISSUN 1\n4 3 1 4 0 4\nsvf K=4\n", 12);
     BAD('E', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
@@ -2170,9 +2181,9 @@ static void args_partial_decode(void)
     BAD('R', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
     n = partial_file(p_bad, sizeof p_bad, P_HEAD("4 3 1 4 0 4 5"), 12);
     BAD('R', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
-    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 1\n4 3 1 4 0 4\nsvf\tK=4\n", 12);
+    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 2\n4 3 1 4 0 4\nsvf\tK=4\n", 12);
     BAD('R', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
-    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 1\n4 3 1 4 0 4\nsvf K=4", 0);
+    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 2\n4 3 1 4 0 4\nsvf K=4", 0);
     BAD('R', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
 #undef P_HEAD
 }
@@ -2215,7 +2226,7 @@ static void args_partial_load(void)
     begin("partial_load");
     write_tmp("empty.hfvs", "", 0);
     write_tmp("short.hfvs", p_file, p_file_len - 1);
-    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 1\n1048576 1048576 1 4 0 4\nsvf K=4\n", 0);
+    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 2\n1048576 1048576 1 4 0 4\nsvf K=4\n", 0);
     write_tmp("huge.hfvs", p_bad, n);
     p = AT(hfvis_partial);
     arena_fill();
