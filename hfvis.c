@@ -326,12 +326,13 @@ static void hf_img_pfm_rows(const unsigned char *p, const hf_img_header *h, floa
     }
 }
 
-/* Parses and validates a whole PGM/PFM held in p[0..n); see the section comment. */
-static hfvis_status hf_img_parse(const unsigned char *p, size_t n, hf_img_header *out)
+/* Parses the header of a PGM/PFM held in p[0..n) (n may end anywhere after it): info, values
+ * and data_offset; the samples are not looked at. */
+static hfvis_status hf_img_header_parse(const unsigned char *p, size_t n, hf_img_header *out)
 {
     hf_img_header h;
     unsigned long w, ht, maxval = 0;
-    size_t i = 2, bytes;
+    size_t i = 2;
     memset(&h, 0, sizeof h);
     if (n < 2 || p[0] != 'P') return HFVIS_ERR_FORMAT;
     if (p[1] == '2' || p[1] == '5') {
@@ -369,12 +370,31 @@ static hfvis_status hf_img_parse(const unsigned char *p, size_t n, hf_img_header
         || h.values > HFVIS_IMAGE_MAX_VALUES)
         return HFVIS_ERR_LIMIT;
     h.data_offset = i;
+    *out = h;
+    return HFVIS_OK;
+}
+
+/* Bytes of the binary samples (P5, PFM) of a parsed header. */
+static int hf_img_data_bytes(const hf_img_header *h, size_t *bytes)
+{
+    size_t bytes_per_value = h->info.format == HFVIS_FORMAT_PFM ? 4 : h->info.maxval < 256 ? 1 : 2;
+    return hf_mul_size(h->values, bytes_per_value, bytes);
+}
+
+/* Parses and validates a whole PGM/PFM held in p[0..n); see the section comment. */
+static hfvis_status hf_img_parse(const unsigned char *p, size_t n, hf_img_header *out)
+{
+    hf_img_header h;
+    size_t i, bytes;
+    unsigned long maxval;
+    hfvis_status s = hf_img_header_parse(p, n, &h);
+    if (s != HFVIS_OK) return s;
+    i = h.data_offset;
+    maxval = (unsigned long)h.info.maxval;
     if (h.ascii) {
         if (!hf_img_p2_samples(p, n, i, h.values, maxval, NULL)) return HFVIS_ERR_FORMAT;
     } else {
-        size_t bytes_per_value = h.info.format == HFVIS_FORMAT_PFM ? 4 : maxval < 256 ? 1 : 2;
-        if (!hf_mul_size(h.values, bytes_per_value, &bytes) || n - i < bytes)
-            return HFVIS_ERR_FORMAT;
+        if (!hf_img_data_bytes(&h, &bytes) || n - i < bytes) return HFVIS_ERR_FORMAT;
         if (h.info.format == HFVIS_FORMAT_PGM && maxval != 255 && maxval != 65535
             && !hf_img_p5_samples(p + i, h.values, (unsigned)maxval, NULL))
             return HFVIS_ERR_FORMAT;
@@ -548,72 +568,122 @@ HFVIS_API hfvis_status hfvis_pgm_encode(const float *pixels, int width, int heig
 }
 
 #ifndef HFVIS_NO_STDIO
-/* A regular file's size from fseek/ftell is only a first guess for the buffer: special files
- * (pipes, /proc, directories on some file systems) report 0, fail, or report absurd sizes, so
- * guesses above this are ignored and the buffer grows by doubling instead. */
-#define HF_IMG_MAX_SIZE_GUESS ((size_t)1 << 31)
-#define HF_IMG_FIRST_CHUNK ((size_t)1 << 16)
-
-/* Internal, shared with voxel.c (not API; declared again there). */
-hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, unsigned char **data,
-                             size_t *size);
+/* Internal, shared with voxel.c (not API; declared again there). A sizer looks at the first
+ * bytes of a file (at most HFVIS__READ_HEAD, fewer if the file is shorter) and sets *total to
+ * the exact size its header announces or HFVIS__READ_ALL (a text format: read to the end), or
+ * returns the decoder's error for the header (refused before anything more is read). */
+#define HFVIS__READ_HEAD ((size_t)1 << 16)
+#define HFVIS__READ_ALL ((size_t)-1)
+typedef hfvis_status (*hfvis__sizer)(const unsigned char *head, size_t n, size_t *total);
+hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, hfvis__sizer sizer,
+                             unsigned char **data, size_t *size);
 hfvis_status hfvis__write_file(const char *path, const unsigned char *bytes, size_t n);
 
-/* Reads the whole file into a block from alloc (hfvis__read_file). */
-hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, unsigned char **data,
-                             size_t *size)
+/* Reads a file into a block from alloc: the head first; when the sizer announces a size, exactly
+ * that many bytes and one more (so that trailing data reaches the decoder, which refuses it or
+ * ignores it as its format says), and a file shorter than announced is HFVIS_ERR_FORMAT without
+ * reading further; else (no sizer, HFVIS__READ_ALL) the whole file. */
+hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, hfvis__sizer sizer,
+                             unsigned char **data, size_t *size)
 {
     FILE *f = fopen(path, "rb");
     unsigned char *buf;
-    size_t cap = HF_IMG_FIRST_CHUNK, len = 0;
-    long end;
+    size_t cap = HFVIS__READ_HEAD, len, total;
+    hfvis_status s;
     if (!f) return HFVIS_ERR_IO;
-    if (fseek(f, 0, SEEK_END) == 0) {
-        end = ftell(f);
-        if (end >= 0 && (unsigned long)end < HF_IMG_MAX_SIZE_GUESS)
-            cap = (size_t)end + 1; /* + 1: the read that meets end of file needs room */
-        if (fseek(f, 0, SEEK_SET) != 0) {
-            fclose(f);
-            return HFVIS_ERR_IO;
-        }
-    } else {
-        clearerr(f); /* unseekable (a pipe): nothing was consumed */
-    }
     buf = (unsigned char *)hf_alloc(alloc, cap);
     if (!buf) {
         fclose(f);
         return HFVIS_ERR_OUT_OF_MEMORY;
     }
-    for (;;) {
-        size_t want = cap - len, got = fread(buf + len, 1, want, f);
-        len += got;
-        if (got < want) break;
-        if (len == cap) {
-            unsigned char *bigger;
-            if (cap > SIZE_MAX / 2) {
-                bigger = NULL;
-            } else {
-                bigger = (unsigned char *)hf_alloc(alloc, cap * 2);
-            }
-            if (!bigger) {
-                hf_free(alloc, buf);
-                fclose(f);
-                return HFVIS_ERR_OUT_OF_MEMORY;
-            }
-            memcpy(bigger, buf, len);
-            hf_free(alloc, buf);
-            buf = bigger;
-            cap *= 2;
-        }
-    }
+    len = fread(buf, 1, cap, f);
     if (ferror(f)) {
         hf_free(alloc, buf);
         fclose(f);
         return HFVIS_ERR_IO;
     }
+    total = HFVIS__READ_ALL;
+    s = sizer ? sizer(buf, len, &total) : HFVIS_OK;
+    if (s == HFVIS_OK && total != HFVIS__READ_ALL && len < cap && len < total)
+        s = HFVIS_ERR_FORMAT; /* shorter than its header says */
+    if (s != HFVIS_OK) {
+        hf_free(alloc, buf);
+        fclose(f);
+        return s;
+    }
+    if (total != HFVIS__READ_ALL) {
+        if (total >= SIZE_MAX - 1u) {
+            hf_free(alloc, buf);
+            fclose(f);
+            return HFVIS_ERR_LIMIT;
+        }
+        if (len > total) len = total + 1u; /* one byte past the announced end is enough */
+        else if (len == cap) {
+            unsigned char *all;
+            long end; /* a regular file shorter than announced is refused before allocating */
+            if (fseek(f, 0, SEEK_END) == 0 && (end = ftell(f)) >= 0 &&
+                ((unsigned long)end < total && (unsigned long)end >= len)) {
+                hf_free(alloc, buf);
+                fclose(f);
+                return HFVIS_ERR_FORMAT;
+            }
+            if (fseek(f, (long)len, SEEK_SET) != 0) clearerr(f); /* a pipe: still at len */
+            all = (unsigned char *)hf_alloc(alloc, total + 1u);
+            if (!all) {
+                hf_free(alloc, buf);
+                fclose(f);
+                return HFVIS_ERR_OUT_OF_MEMORY;
+            }
+            memcpy(all, buf, len);
+            hf_free(alloc, buf);
+            buf = all;
+            len += fread(buf + len, 1, total + 1u - len, f);
+            if (ferror(f) || len < total) {
+                s = ferror(f) ? HFVIS_ERR_IO : HFVIS_ERR_FORMAT;
+                hf_free(alloc, buf);
+                fclose(f);
+                return s;
+            }
+        }
+        fclose(f);
+        *data = buf;
+        *size = len;
+        return HFVIS_OK;
+    }
+    while (len == cap) { /* read to the end, doubling */
+        unsigned char *bigger = cap > SIZE_MAX / 2 ? NULL : (unsigned char *)hf_alloc(alloc, cap * 2);
+        if (!bigger) {
+            hf_free(alloc, buf);
+            fclose(f);
+            return HFVIS_ERR_OUT_OF_MEMORY;
+        }
+        memcpy(bigger, buf, len);
+        hf_free(alloc, buf);
+        buf = bigger;
+        cap *= 2;
+        len += fread(buf + len, 1, cap - len, f);
+        if (ferror(f)) {
+            hf_free(alloc, buf);
+            fclose(f);
+            return HFVIS_ERR_IO;
+        }
+    }
     fclose(f);
     *data = buf;
     *size = len;
+    return HFVIS_OK;
+}
+
+/* The sizer of PGM/PFM: the header, then exactly the binary samples; P2 reads to the end. */
+static hfvis_status hf_img_sizer(const unsigned char *head, size_t n, size_t *total)
+{
+    hf_img_header h;
+    size_t bytes;
+    hfvis_status s = hf_img_header_parse(head, n, &h);
+    if (s != HFVIS_OK) return s;
+    if (h.ascii) return HFVIS_OK; /* *total stays HFVIS__READ_ALL */
+    if (!hf_img_data_bytes(&h, &bytes) || bytes > SIZE_MAX - h.data_offset) return HFVIS_ERR_LIMIT;
+    *total = h.data_offset + bytes;
     return HFVIS_OK;
 }
 
@@ -626,7 +696,7 @@ HFVIS_API hfvis_status hfvis_image_load(const char *path, const hfvis_allocator 
     hf_img_header h;
     hfvis_status s;
     if (!path || !pixels || !info) return HFVIS_ERR_INVALID_ARGUMENT;
-    s = hfvis__read_file(path, alloc, &data, &size);
+    s = hfvis__read_file(path, alloc, hf_img_sizer, &data, &size);
     if (s != HFVIS_OK) return s;
     s = hf_img_parse(data, size, &h);
     if (s == HFVIS_OK) {
@@ -728,8 +798,6 @@ HFVIS_API hfvis_status hfvis_pgm_save(const char *path, const float *pixels, int
     hf_free(NULL, buf);
     return s;
 }
-#undef HF_IMG_MAX_SIZE_GUESS
-#undef HF_IMG_FIRST_CHUNK
 #endif /* HFVIS_NO_STDIO */
 
 /* ========================================================================================== */
@@ -6719,16 +6787,13 @@ static int hf_partial_number(const unsigned char *data, size_t size, size_t *pos
     return 1;
 }
 
-hfvis_status hfvis_partial_decode(const void *data, size_t size, const hfvis_allocator *alloc,
-                                  hfvis_partial *p)
+/* The header of a partial-sum file in d[0..size) (size may end anywhere after it): the numbers
+ * into r, the tag's offset and length, the body's offset and its value count. */
+static hfvis_status hf_partial_header(const unsigned char *d, size_t size, hfvis_partial *r,
+                                      size_t *tag_at, size_t *tag_bytes, size_t *body, size_t *count)
 {
-    const unsigned char *d = (const unsigned char *)data;
-    hfvis_partial r;
     int v[HF_PARTIAL_NUMBERS], i;
-    size_t pos = HF_PARTIAL_MAGIC_LEN, tag0, tag_len, values, bytes, block, k;
-    uint32_t crc;
-    unsigned char *mem;
-    if (!data || !p) return HFVIS_ERR_INVALID_ARGUMENT;
+    size_t pos = HF_PARTIAL_MAGIC_LEN, tag0, tag_len, values;
     if (size < HF_PARTIAL_MAGIC_LEN || memcmp(d, HF_PARTIAL_MAGIC, HF_PARTIAL_MAGIC_LEN) != 0)
         return HFVIS_ERR_FORMAT;
     for (i = 0; i < HF_PARTIAL_NUMBERS; i++)
@@ -6743,17 +6808,50 @@ hfvis_status hfvis_partial_decode(const void *data, size_t size, const hfvis_all
     if (pos >= size || d[pos] != '\n' || tag_len == 0 || tag_len > HFVIS_PARTIAL_MAX_TAG)
         return HFVIS_ERR_FORMAT;
     pos++;
-    memset(&r, 0, sizeof r);
-    r.width = v[0], r.height = v[1], r.planes = v[2], r.directions = v[3], r.begin = v[4], r.end = v[5];
-    if (r.width < 1 || r.height < 1 || r.planes < 1 || r.directions < 1 || r.begin >= r.end ||
-        r.end > r.directions)
+    memset(r, 0, sizeof *r);
+    r->width = v[0], r->height = v[1], r->planes = v[2], r->directions = v[3], r->begin = v[4], r->end = v[5];
+    if (r->width < 1 || r->height < 1 || r->planes < 1 || r->directions < 1 || r->begin >= r->end ||
+        r->end > r->directions)
         return HFVIS_ERR_FORMAT;
-    if (r.width > HFVIS_IMAGE_MAX_DIM || r.height > HFVIS_IMAGE_MAX_DIM || r.planes > HFVIS_PARTIAL_MAX_PLANES)
+    if (r->width > HFVIS_IMAGE_MAX_DIM || r->height > HFVIS_IMAGE_MAX_DIM || r->planes > HFVIS_PARTIAL_MAX_PLANES)
         return HFVIS_ERR_LIMIT;
-    values = (size_t)r.width * (size_t)r.height;
-    if (!hf_mul_size(values, (size_t)r.planes, &values) ||
+    values = (size_t)r->width * (size_t)r->height;
+    if (!hf_mul_size(values, (size_t)r->planes, &values) ||
         (unsigned long long)values > HFVIS_PARTIAL_MAX_VALUES || values > SIZE_MAX / 8u)
         return HFVIS_ERR_LIMIT;
+    *tag_at = tag0;
+    *tag_bytes = tag_len;
+    *body = pos;
+    *count = values;
+    return HFVIS_OK;
+}
+
+#ifndef HFVIS_NO_STDIO
+/* The partial-sum file's sizer (hfvis__read_file): header, body, checksum. */
+static hfvis_status hf_partial_sizer(const unsigned char *head, size_t n, size_t *total)
+{
+    hfvis_partial r;
+    size_t tag0, tag_len, pos, values;
+    hfvis_status s = hf_partial_header(head, n, &r, &tag0, &tag_len, &pos, &values);
+    if (s != HFVIS_OK) return s;
+    if (values > (SIZE_MAX - pos - HF_PARTIAL_CRC_LEN) / 8u) return HFVIS_ERR_LIMIT;
+    *total = pos + values * 8u + HF_PARTIAL_CRC_LEN;
+    return HFVIS_OK;
+}
+#endif
+
+hfvis_status hfvis_partial_decode(const void *data, size_t size, const hfvis_allocator *alloc,
+                                  hfvis_partial *p)
+{
+    const unsigned char *d = (const unsigned char *)data;
+    hfvis_partial r;
+    size_t pos, tag0, tag_len, values, bytes, block, k;
+    uint32_t crc;
+    unsigned char *mem;
+    hfvis_status s;
+    if (!data || !p) return HFVIS_ERR_INVALID_ARGUMENT;
+    s = hf_partial_header(d, size, &r, &tag0, &tag_len, &pos, &values);
+    if (s != HFVIS_OK) return s;
     bytes = values * 8u;
     if (bytes > SIZE_MAX - tag_len - 1u - HF_PARTIAL_CRC_LEN) return HFVIS_ERR_LIMIT;
     if (size - pos != bytes + HF_PARTIAL_CRC_LEN) return HFVIS_ERR_FORMAT;
@@ -6807,7 +6905,7 @@ hfvis_status hfvis_partial_load(const char *path, const hfvis_allocator *alloc, 
     size_t size;
     hfvis_status s;
     if (!path || !p) return HFVIS_ERR_INVALID_ARGUMENT;
-    s = hfvis__read_file(path, alloc, &data, &size);
+    s = hfvis__read_file(path, alloc, hf_partial_sizer, &data, &size);
     if (s != HFVIS_OK) return s;
     s = hfvis_partial_decode(data, size, alloc, p);
     hf_free(alloc, data);

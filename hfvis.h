@@ -224,7 +224,13 @@ HFVIS_API hfvis_status hfvis_pgm_encode(const float *pixels, int width, int heig
                                         void *out, size_t out_capacity, size_t *written);
 
 /* File wrappers (absent with HFVIS_NO_STDIO). load reads PGM or PFM, allocates *pixels with
- * alloc (NULL = malloc; release with hfvis_free) and fills info. save writes to a temporary
+ * alloc (NULL = malloc; release with hfvis_free) and fills info. Every *_load of the library
+ * reads the header first (the first 64 KiB at most; a header longer than that is refused) and
+ * refuses a bad one before reading further; then exactly the bytes the header announces and one
+ * more (P5/PFM samples: trailing data is ignored, as by the decoders; partial-sum and field
+ * files: trailing data is refused); a file shorter than announced is HFVIS_ERR_FORMAT, a regular
+ * file without allocating for it. P2 (ASCII) and binvox bodies have no announced size and are
+ * read whole after the header check; OBJ (hfvis_mesh_load) has no header and is read whole. save writes to a temporary
  * file beside path and renames it, so path is either complete or untouched.
  * Returns the decoder's errors, HFVIS_ERR_IO if the file cannot be read or written, or
  * HFVIS_ERR_OUT_OF_MEMORY. */

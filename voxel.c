@@ -72,8 +72,9 @@
 #ifndef HFVIS_NO_STDIO
 /* Internal, defined in hfvis.c (section 2): whole-file read into a block from alloc, and an
  * atomic write (temporary file renamed onto path: the target is complete or untouched). */
-hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, unsigned char **data,
-                             size_t *size);
+hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc,
+                             hfvis_status (*sizer)(const unsigned char *head, size_t n, size_t *total),
+                             unsigned char **data, size_t *size);
 hfvis_status hfvis__write_file(const char *path, const unsigned char *bytes, size_t n);
 #endif
 
@@ -1646,7 +1647,7 @@ HFVIS_API hfvis_status hfvis_mesh_load(const char *path, const hfvis_allocator *
     size_t size = 0;
     hfvis_status s;
     if (!path || !out) return HFVIS_ERR_INVALID_ARGUMENT;
-    s = hfvis__read_file(path, alloc, &data, &size);
+    s = hfvis__read_file(path, alloc, NULL, &data, &size); /* text without a size: read whole */
     if (s != HFVIS_OK) return s;
     s = hfvis_obj_decode(data, size, alloc, out);
     vx_free(alloc, data);
@@ -5629,6 +5630,15 @@ HFVIS_API hfvis_status hfvis_binvox_save(const char *path, const hfvis_volume_gr
     return s;
 }
 
+/* The binvox sizer (hfvis__read_file): the magic first; the run-length body has no announced
+ * size, so the rest is read whole. */
+static hfvis_status vx_binvox_sizer(const unsigned char *head, size_t n, size_t *total)
+{
+    size_t i = 0;
+    (void)total;
+    return vx_cons_keyword(head, n, &i, "#binvox") ? HFVIS_OK : HFVIS_ERR_FORMAT;
+}
+
 HFVIS_API hfvis_status hfvis_binvox_load(const char *path, const hfvis_allocator *alloc,
                                          hfvis_volume_grid *grid, uint8_t **occ)
 {
@@ -5636,7 +5646,7 @@ HFVIS_API hfvis_status hfvis_binvox_load(const char *path, const hfvis_allocator
     size_t size = 0;
     hfvis_status s;
     if (!path || !grid || !occ) return HFVIS_ERR_INVALID_ARGUMENT;
-    s = hfvis__read_file(path, alloc, &data, &size);
+    s = hfvis__read_file(path, alloc, vx_binvox_sizer, &data, &size);
     if (s != HFVIS_OK) return s;
     s = hfvis_binvox_decode(data, size, alloc, grid, occ);
     vx_free(alloc, data);
@@ -8770,6 +8780,18 @@ HFVIS_API hfvis_status hfvis_visfield_save(const char *path, const hfvis_visfiel
     return s;
 }
 
+/* The field file's sizer (hfvis__read_file): the 80-byte header's magic and payload size. */
+static hfvis_status vx_vf_sizer(const unsigned char *head, size_t n, size_t *total)
+{
+    uint64_t payload;
+    if (n < HFVIS_VISFIELD_FILE_HEADER || memcmp(head, vx_vf_magic, 8) != 0) return HFVIS_ERR_FORMAT;
+    payload = vx_vf_get64(head + 72);
+    if (payload > HFVIS_VISFIELD_MAX_BYTES || payload > (uint64_t)SIZE_MAX - HFVIS_VISFIELD_FILE_HEADER)
+        return HFVIS_ERR_LIMIT;
+    *total = HFVIS_VISFIELD_FILE_HEADER + (size_t)payload;
+    return HFVIS_OK;
+}
+
 HFVIS_API hfvis_status hfvis_visfield_load(const char *path, const hfvis_allocator *alloc,
                                            hfvis_visfield *out)
 {
@@ -8777,7 +8799,7 @@ HFVIS_API hfvis_status hfvis_visfield_load(const char *path, const hfvis_allocat
     size_t size = 0;
     hfvis_status s;
     if (!path || !out) return HFVIS_ERR_INVALID_ARGUMENT;
-    s = hfvis__read_file(path, alloc, &data, &size);
+    s = hfvis__read_file(path, alloc, vx_vf_sizer, &data, &size);
     if (s != HFVIS_OK) return s;
     s = hfvis_visfield_decode(data, size, alloc, out);
     vx_free(alloc, data);
