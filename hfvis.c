@@ -577,7 +577,6 @@ HFVIS_API hfvis_status hfvis_pgm_encode(const float *pixels, int width, int heig
 typedef hfvis_status (*hfvis__sizer)(const unsigned char *head, size_t n, size_t *total);
 hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, hfvis__sizer sizer,
                              unsigned char **data, size_t *size);
-hfvis_status hfvis__write_file(const char *path, const unsigned char *bytes, size_t n);
 
 /* Reads a file into a block from alloc: the head first; when the sizer announces a size, exactly
  * that many bytes and one more (so that trailing data reaches the decoder, which refuses it or
@@ -713,43 +712,57 @@ HFVIS_API hfvis_status hfvis_image_load(const char *path, const hfvis_allocator 
     return s;
 }
 
-/* Writes bytes to "<path>.tmp<8 hex digits>" beside path, then renames it onto path. The
- * suffix hashes the addresses of the buffer and of a local, which differ between concurrent
- * calls in one process (and usually between processes); a name already taken is skipped.
- * On any failure the temporary file is removed and path is untouched. */
-hfvis_status hfvis__write_file(const char *path, const unsigned char *bytes, size_t n)
+/* The temporary name: "<path>.tmp<8 hex digits>" beside path; when the last component would
+ * then exceed HF_NAME_MAX bytes, that component is cut to leave room for the suffix (same
+ * directory, same file system, so the rename stays atomic). The suffix hashes the addresses of
+ * the buffer and of a local, which differ between concurrent calls in one process (and usually
+ * between processes); a name already taken is skipped. */
+#define HF_NAME_MAX 255    /* bytes of a file name on common file systems (POSIX NAME_MAX) */
+#define HF_TMP_SUFFIX 12u  /* ".tmp" and 8 hex digits */
+hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
+                              const hfvis_write_options *opts)
 {
     static const char hex[] = "0123456789abcdef";
-    size_t len = strlen(path), k;
+    size_t len, base = 0, keep, k;
     const void *addrs[2];
     unsigned char raw[sizeof addrs];
     uint32_t tag = 2166136261u; /* FNV-1a */
     char *tmp;
     FILE *f = NULL;
     int attempt, ok;
-    if (len > SIZE_MAX - 16) return HFVIS_ERR_IO;
-    tmp = (char *)hf_alloc(NULL, len + 16);
+    if (!path || (!bytes && n > 0) || path[0] == '\0') return HFVIS_ERR_INVALID_ARGUMENT;
+    len = strlen(path);
+    if (len > SIZE_MAX - HF_TMP_SUFFIX - 1u) return HFVIS_ERR_IO;
+    for (k = 0; k < len; k++)
+        if (path[k] == '/' || path[k] == '\\') base = k + 1;
+    keep = len; /* bytes of path kept before the suffix */
+    if (len - base + HF_TMP_SUFFIX > HF_NAME_MAX) keep = base + (HF_NAME_MAX - HF_TMP_SUFFIX);
+    tmp = (char *)hf_alloc(NULL, keep + HF_TMP_SUFFIX + 1u);
     if (!tmp) return HFVIS_ERR_OUT_OF_MEMORY;
     addrs[0] = bytes;
     addrs[1] = &len;
     memcpy(raw, addrs, sizeof raw);
     for (k = 0; k < sizeof raw; k++) tag = (uint32_t)((tag ^ raw[k]) * 16777619u);
-    memcpy(tmp, path, len);
-    memcpy(tmp + len, ".tmp", 4);
-    tmp[len + 12] = '\0';
+    memcpy(tmp, path, keep);
+    memcpy(tmp + keep, ".tmp", 4);
+    tmp[keep + HF_TMP_SUFFIX] = '\0';
     for (attempt = 0; attempt < 16; attempt++, tag += 0x9e3779b9u) {
         FILE *existing;
-        for (k = 0; k < 8; k++) tmp[len + 4 + k] = hex[(tag >> (28 - 4 * k)) & 15u];
+        for (k = 0; k < 8; k++) tmp[keep + 4 + k] = hex[(tag >> (28 - 4 * k)) & 15u];
         existing = fopen(tmp, "rb");
         if (!existing) break;
         fclose(existing);
     }
-    if (attempt < 16) f = fopen(tmp, "wb");
+    if (attempt < 16) {
+        if (opts && opts->on_temp) opts->on_temp(opts->user, tmp); /* before it exists */
+        f = fopen(tmp, "wb");
+    }
     if (!f) {
+        if (attempt < 16 && opts && opts->on_temp) opts->on_temp(opts->user, NULL);
         hf_free(NULL, tmp);
         return HFVIS_ERR_IO;
     }
-    ok = fwrite(bytes, 1, n, f) == n;
+    ok = n == 0 || fwrite(bytes, 1, n, f) == n;
     ok = (fflush(f) == 0) && ok;
     ok = (fclose(f) == 0) && ok;
     if (ok && rename(tmp, path) != 0) {
@@ -761,9 +774,12 @@ hfvis_status hfvis__write_file(const char *path, const unsigned char *bytes, siz
 #endif
     }
     if (!ok) remove(tmp);
+    if (opts && opts->on_temp) opts->on_temp(opts->user, NULL); /* renamed or removed */
     hf_free(NULL, tmp);
     return ok ? HFVIS_OK : HFVIS_ERR_IO;
 }
+#undef HF_NAME_MAX
+#undef HF_TMP_SUFFIX
 
 HFVIS_API hfvis_status hfvis_pfm_save(const char *path, const float *pixels, int width,
                                       int height, int channels, ptrdiff_t stride)
@@ -776,7 +792,7 @@ HFVIS_API hfvis_status hfvis_pfm_save(const char *path, const float *pixels, int
     buf = (unsigned char *)hf_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_pfm_encode(pixels, width, height, channels, stride, buf, need, &written);
-    if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
+    if (s == HFVIS_OK) s = hfvis_write_file(path, buf, written, NULL);
     hf_free(NULL, buf);
     return s;
 }
@@ -794,7 +810,7 @@ HFVIS_API hfvis_status hfvis_pgm_save(const char *path, const float *pixels, int
     buf = (unsigned char *)hf_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_pgm_encode(pixels, width, height, stride, lo, hi, maxval, buf, need, &written);
-    if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
+    if (s == HFVIS_OK) s = hfvis_write_file(path, buf, written, NULL);
     hf_free(NULL, buf);
     return s;
 }
@@ -6894,7 +6910,7 @@ hfvis_status hfvis_partial_save(const char *path, const hfvis_partial *p)
     buf = (unsigned char *)hf_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_partial_encode(p, buf, need, &written);
-    if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
+    if (s == HFVIS_OK) s = hfvis_write_file(path, buf, written, NULL);
     hf_free(NULL, buf);
     return s;
 }

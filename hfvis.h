@@ -234,6 +234,25 @@ HFVIS_API hfvis_status hfvis_pgm_encode(const float *pixels, int width, int heig
  * file beside path and renames it, so path is either complete or untouched.
  * Returns the decoder's errors, HFVIS_ERR_IO if the file cannot be read or written, or
  * HFVIS_ERR_OUT_OF_MEMORY. */
+/* How hfvis_write_file reports its temporary file (opts may be NULL). */
+typedef struct hfvis_write_options {
+    /* Called with the temporary name just before the file is created, and with NULL once it is
+     * renamed onto path or removed: a program that may be interrupted keeps a copy of the name
+     * (the hfvis tool unlinks it from its SIGINT/SIGTERM/SIGHUP handler). May be NULL. */
+    void (*on_temp)(void *user, const char *temp_path);
+    void *user;
+} hfvis_write_options;
+
+/* Write n bytes to path atomically, as every saver of the library does: the bytes go to a
+ * temporary file beside path ("<path>.tmp<8 hex digits>"; when that name's last component would
+ * exceed 255 bytes, the component is cut so the name fits), which is then renamed onto path.
+ * path is either complete or untouched; on failure the temporary file is removed. bytes may be
+ * NULL when n is 0. A symbolic link at path is replaced by the file, not written through.
+ * Returns HFVIS_OK, HFVIS_ERR_INVALID_ARGUMENT (NULL or empty path, NULL bytes with n > 0),
+ * HFVIS_ERR_IO or HFVIS_ERR_OUT_OF_MEMORY (the name). */
+HFVIS_API hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
+                                        const hfvis_write_options *opts);
+
 HFVIS_API hfvis_status hfvis_image_load(const char *path, const hfvis_allocator *alloc,
                                         float **pixels, hfvis_image_info *info);
 HFVIS_API hfvis_status hfvis_pfm_save(const char *path, const float *pixels, int width,

@@ -75,7 +75,6 @@
 hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc,
                              hfvis_status (*sizer)(const unsigned char *head, size_t n, size_t *total),
                              unsigned char **data, size_t *size);
-hfvis_status hfvis__write_file(const char *path, const unsigned char *bytes, size_t n);
 #endif
 
 static void *vx_alloc(const hfvis_allocator *a, size_t bytes)
@@ -1665,7 +1664,7 @@ HFVIS_API hfvis_status hfvis_mesh_save(const char *path, const hfvis_mesh *mesh)
     buf = (unsigned char *)vx_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     written = vx_mesh_obj_emit(mesh, buf);
-    s = hfvis__write_file(path, buf, written);
+    s = hfvis_write_file(path, buf, written, NULL);
     vx_free(NULL, buf);
     return s;
 }
@@ -5625,7 +5624,7 @@ HFVIS_API hfvis_status hfvis_binvox_save(const char *path, const hfvis_volume_gr
     buf = (unsigned char *)vx_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_binvox_encode(grid, occ, buf, need, &written);
-    if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
+    if (s == HFVIS_OK) s = hfvis_write_file(path, buf, written, NULL);
     vx_free(NULL, buf);
     return s;
 }
@@ -5657,7 +5656,7 @@ HFVIS_API hfvis_status hfvis_voxels_raw_save(const char *path, const hfvis_volum
                                              const uint8_t *voxels)
 {
     if (!path || !voxels || !vx_grid_valid(grid)) return HFVIS_ERR_INVALID_ARGUMENT;
-    return hfvis__write_file(path, voxels, vx_grid_voxels(grid));
+    return hfvis_write_file(path, voxels, vx_grid_voxels(grid), NULL);
 }
 #endif /* HFVIS_NO_STDIO */
 
@@ -8775,7 +8774,7 @@ HFVIS_API hfvis_status hfvis_visfield_save(const char *path, const hfvis_visfiel
     buf = (unsigned char *)vx_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_visfield_encode(vf, buf, need, &written);
-    if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
+    if (s == HFVIS_OK) s = hfvis_write_file(path, buf, written, NULL);
     vx_free(NULL, buf);
     return s;
 }

@@ -1,8 +1,9 @@
 /* hfvis_cli.c - the `hfvis` command-line tool (DESIGN.md §4): horizon maps, sky-view factor,
  * uniform-sky light, sun shadows, environment light, normals, interreflected light, the
  * visibility index and viewsheds of PGM/PFM height fields; voxelization of OBJ meshes.
- * Every file is read and written through the library's codecs (hfvis_image_load, hfvis_*_save),
- * so the tool exercises exactly what a vendoring user gets. Errors: one line
+ * Every file is read and written through the library's codecs (hfvis_image_load, the encoders
+ * and hfvis_write_file), so the tool exercises exactly what a vendoring user gets; an interrupt
+ * (SIGINT, SIGTERM, SIGHUP) removes the temporary file of a write in progress. Errors: one line
  * "hfvis: <what>: <why>" on stderr, exit 1 (2 for usage errors); exit 0 means OUT is complete. */
 #define _POSIX_C_SOURCE 200809L /* isatty() under -std=c99 */
 #include <ctype.h>
@@ -14,9 +15,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
 #if defined(__unix__) || (defined(__APPLE__) && defined(__MACH__))
 #include <unistd.h>
 #define CLI_HAVE_ISATTY 1
+#define CLI_HAVE_SIGACTION 1
 #endif
 #include "common.h"
 
@@ -1410,6 +1413,121 @@ static float *cli_alloc(size_t a, size_t b, size_t c)
     return (float *)malloc(a * b * c * sizeof(float));
 }
 
+/* ------------------------------------------------------------------------------------------ */
+/* writing: every file goes through hfvis_write_file, whose temporary name is kept here so that  */
+/* SIGINT, SIGTERM and SIGHUP remove it (the handler unlinks it and re-raises the signal)        */
+/* ------------------------------------------------------------------------------------------ */
+
+#define CLI_TMP_CAP 4096 /* longest temporary name the handler can remove (PATH_MAX on Linux) */
+static char cli_tmp_name[CLI_TMP_CAP];
+static volatile sig_atomic_t cli_tmp_armed; /* cli_tmp_name names a file that may exist */
+
+/* hfvis_write_options.on_temp: armed only after the name is complete, disarmed before it changes. */
+static void cli_on_temp(void *user, const char *tmp)
+{
+    size_t n = tmp ? strlen(tmp) : 0;
+    (void)user;
+    cli_tmp_armed = 0;
+    if (!tmp || n >= CLI_TMP_CAP) return;
+    memcpy(cli_tmp_name, tmp, n + 1);
+    cli_tmp_armed = 1;
+}
+
+#ifdef CLI_HAVE_SIGACTION
+/* Async-signal-safe: unlink the temporary file, restore the default action and re-raise, so the
+ * exit status says which signal ended the run (130 for SIGINT, 143 for SIGTERM in a shell). */
+static void cli_on_signal(int sig)
+{
+    if (cli_tmp_armed) unlink(cli_tmp_name);
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+/* Install the handler for SIGINT, SIGTERM and SIGHUP, leaving an ignored signal ignored. */
+static void cli_signals(void)
+{
+    static const int sigs[3] = { SIGINT, SIGTERM, SIGHUP };
+    int i;
+    for (i = 0; i < 3; i++) {
+        struct sigaction sa, old;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = cli_on_signal;
+        sigemptyset(&sa.sa_mask);
+        if (sigaction(sigs[i], NULL, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+        sigaction(sigs[i], &sa, NULL);
+    }
+}
+#else
+static void cli_signals(void) {}
+#endif
+
+/* Write n bytes to path (hfvis_write_file with the temporary name recorded), freeing bytes. */
+static hfvis_status cli_write(const char *path, unsigned char *bytes, size_t n, hfvis_status s)
+{
+    hfvis_write_options wo;
+    wo.on_temp = cli_on_temp;
+    wo.user = NULL;
+    if (s == HFVIS_OK) s = hfvis_write_file(path, bytes, n, &wo);
+    free(bytes);
+    return s;
+}
+
+/* The library's savers, through cli_write: encode into memory, then write. */
+static hfvis_status cli_pfm_save(const char *path, const float *px, int w, int h, int channels, ptrdiff_t stride)
+{
+    size_t need = hfvis_pfm_encode_size(w, h, channels), written = 0;
+    unsigned char *buf = need ? (unsigned char *)malloc(need) : NULL;
+    hfvis_status s;
+    if (!buf) return need ? HFVIS_ERR_OUT_OF_MEMORY : HFVIS_ERR_INVALID_ARGUMENT;
+    s = hfvis_pfm_encode(px, w, h, channels, stride, buf, need, &written);
+    return cli_write(path, buf, written, s);
+}
+static hfvis_status cli_pgm_save(const char *path, const float *px, int w, int h, ptrdiff_t stride,
+                                 float lo, float hi, int maxval)
+{
+    size_t need = hfvis_pgm_encode_size(w, h, maxval), written = 0;
+    unsigned char *buf = need ? (unsigned char *)malloc(need) : NULL;
+    hfvis_status s;
+    if (!buf) return need ? HFVIS_ERR_OUT_OF_MEMORY : HFVIS_ERR_INVALID_ARGUMENT;
+    s = hfvis_pgm_encode(px, w, h, stride, lo, hi, maxval, buf, need, &written);
+    return cli_write(path, buf, written, s);
+}
+static hfvis_status cli_binvox_save(const char *path, const hfvis_volume_grid *grid, const uint8_t *occ)
+{
+    size_t need = hfvis_binvox_encode_size(grid, occ), written = 0;
+    unsigned char *buf = need ? (unsigned char *)malloc(need) : NULL;
+    hfvis_status s;
+    if (!buf) return need ? HFVIS_ERR_OUT_OF_MEMORY : HFVIS_ERR_INVALID_ARGUMENT;
+    s = hfvis_binvox_encode(grid, occ, buf, need, &written);
+    return cli_write(path, buf, written, s);
+}
+static hfvis_status cli_voxels_raw_save(const char *path, const hfvis_volume_grid *grid, const uint8_t *occ)
+{
+    hfvis_write_options wo;
+    size_t n = (size_t)grid->dims[0] * (size_t)grid->dims[1] * (size_t)grid->dims[2];
+    wo.on_temp = cli_on_temp;
+    wo.user = NULL;
+    return hfvis_write_file(path, occ, n, &wo);
+}
+static hfvis_status cli_visfield_save(const char *path, const hfvis_visfield *vf)
+{
+    size_t need = hfvis_visfield_encode_size(vf), written = 0;
+    unsigned char *buf = need ? (unsigned char *)malloc(need) : NULL;
+    hfvis_status s;
+    if (!buf) return need ? HFVIS_ERR_OUT_OF_MEMORY : HFVIS_ERR_INVALID_ARGUMENT;
+    s = hfvis_visfield_encode(vf, buf, need, &written);
+    return cli_write(path, buf, written, s);
+}
+static hfvis_status cli_partial_save(const char *path, const hfvis_partial *p)
+{
+    size_t need = hfvis_partial_encode_size(p), written = 0;
+    unsigned char *buf = need ? (unsigned char *)malloc(need) : NULL;
+    hfvis_status s;
+    if (!buf) return need ? HFVIS_ERR_OUT_OF_MEMORY : HFVIS_ERR_INVALID_ARGUMENT;
+    s = hfvis_partial_encode(p, buf, need, &written);
+    return cli_write(path, buf, written, s);
+}
+
 /* Write OUT: PFM with its channels, or a 16-bit PGM with the channel planes stacked. */
 static int cli_save(const cli_args *a, const float *px, int w, int h, int channels, double lo,
                     double hi)
@@ -1417,11 +1535,11 @@ static int cli_save(const cli_args *a, const float *px, int w, int h, int channe
     hfvis_status s;
     errno = 0;
     if (!a->out_pgm) {
-        s = hfvis_pfm_save(a->out, px, w, h, channels, w);
+        s = cli_pfm_save(a->out, px, w, h, channels, w);
     } else {
         if (a->has_range) { lo = a->range_lo; hi = a->range_hi; }
         if (channels == 1) {
-            s = hfvis_pgm_save(a->out, px, w, h, w, (float)lo, (float)hi, 65535);
+            s = cli_pgm_save(a->out, px, w, h, w, (float)lo, (float)hi, 65535);
         } else {
             size_t n = (size_t)w * (size_t)h, i;
             int c;
@@ -1430,7 +1548,7 @@ static int cli_save(const cli_args *a, const float *px, int w, int h, int channe
             for (c = 0; c < channels; c++)
                 for (i = 0; i < n; i++) planes[(size_t)c * n + i] = px[i * (size_t)channels + (size_t)c];
             if ((long long)h * channels > INT_MAX) s = HFVIS_ERR_LIMIT;
-            else s = hfvis_pgm_save(a->out, planes, w, h * channels, w, (float)lo, (float)hi, 65535);
+            else s = cli_pgm_save(a->out, planes, w, h * channels, w, (float)lo, (float)hi, 65535);
             free(planes);
         }
     }
@@ -1865,7 +1983,7 @@ static int cli_run_voxelize(const cli_args *a)
     }
     if (s != HFVIS_OK) { rc = cli_status("voxelize", s, 0); goto done; }
     errno = 0;
-    s = a->out_binvox ? hfvis_binvox_save(a->out, &grid, occ) : hfvis_voxels_raw_save(a->out, &grid, occ);
+    s = a->out_binvox ? cli_binvox_save(a->out, &grid, occ) : cli_voxels_raw_save(a->out, &grid, occ);
     if (s != HFVIS_OK) { rc = cli_status(a->out, s, errno); goto done; }
     if (!a->quiet)
         printf("voxelize: %zu triangles -> %d x %d x %d voxels of %.6g (origin %.6g %.6g %.6g), "
@@ -2036,7 +2154,7 @@ static int cli_vf_build(const cli_args *a)
     s = hfvis_visfield_build(&mesh, &bo, &vf);
     if (s != HFVIS_OK) { rc = cli_status("visfield", s, 0); goto done; }
     errno = 0;
-    s = hfvis_visfield_save(a->out, &vf);
+    s = cli_visfield_save(a->out, &vf);
     if (s != HFVIS_OK) { rc = cli_status(a->out, s, errno); goto done; }
     if (!a->quiet)
         printf("visfield: %zu triangles -> %zu maps of %d x %d (%s), sphere centre %.6g %.6g %.6g "
@@ -2358,7 +2476,7 @@ static int cli_run_partial(const cli_args *a, const hfvis_grid *grid, hfvis_swee
     part.tag = tag;
     part.sums = sums;
     errno = 0;
-    s = hfvis_partial_save(a->out, &part);
+    s = cli_partial_save(a->out, &part);
     if (s != HFVIS_OK) rc = cli_status(a->out, s, errno);
 done:
     free(flat_z);
@@ -2818,6 +2936,7 @@ int main(int argc, char **argv)
 {
     cli_args a;
     int rc;
+    cli_signals();
     if (argc >= 2 && !strcmp(argv[1], "sum")) return cli_sum(argc, argv);
     rc = cli_parse(argc, argv, &a);
     if (rc != CLI_RUN) return rc;

@@ -170,56 +170,11 @@ static inline hfvis_status ex_png_encode(const unsigned char *samples, int width
     return HFVIS_OK;
 }
 
-/* Write n bytes to "<path>.tmp<8 hex digits>" beside path and rename it onto path, as the
- * library's savers do: a reader never sees a partial file. The suffix hashes the path and the
- * address of the bytes; a name already taken is skipped. On failure the temporary file is
- * removed, path is untouched and the result is HFVIS_ERR_IO (or _OUT_OF_MEMORY). */
+/* Write n bytes to path atomically: the library's hfvis_write_file (a temporary file beside
+ * path renamed onto it; on failure path is untouched and nothing is left). */
 static inline hfvis_status ex_png_write_file(const char *path, const unsigned char *bytes, size_t n)
 {
-    static const char hex[] = "0123456789abcdef";
-    size_t len, k;
-    const void *addr = bytes;
-    unsigned char raw[sizeof addr];
-    uint32_t tag;
-    char *tmp;
-    FILE *f = NULL;
-    int attempt, ok;
-    if (!path || !bytes) return HFVIS_ERR_INVALID_ARGUMENT;
-    len = strlen(path);
-    if (len > SIZE_MAX - 16) return HFVIS_ERR_IO;
-    tmp = (char *)malloc(len + 16);
-    if (!tmp) return HFVIS_ERR_OUT_OF_MEMORY;
-    memcpy(raw, &addr, sizeof raw);
-    tag = hfvis_crc32(hfvis_crc32(0, (const unsigned char *)path, len), raw, sizeof raw);
-    memcpy(tmp, path, len);
-    memcpy(tmp + len, ".tmp", 4);
-    tmp[len + 12] = '\0';
-    for (attempt = 0; attempt < 16; attempt++, tag += 0x9e3779b9u) {
-        FILE *existing;
-        for (k = 0; k < 8; k++) tmp[len + 4 + k] = hex[(tag >> (28 - 4 * k)) & 15u];
-        existing = fopen(tmp, "rb");
-        if (!existing) break;
-        fclose(existing);
-    }
-    if (attempt < 16) f = fopen(tmp, "wb");
-    if (!f) {
-        free(tmp);
-        return HFVIS_ERR_IO;
-    }
-    ok = fwrite(bytes, 1, n, f) == n;
-    ok = (fflush(f) == 0) && ok;
-    ok = (fclose(f) == 0) && ok;
-    if (ok && rename(tmp, path) != 0) {
-#if defined(_WIN32)
-        /* Windows' rename does not replace an existing file: replace non-atomically. */
-        ok = remove(path) == 0 && rename(tmp, path) == 0;
-#else
-        ok = 0;
-#endif
-    }
-    if (!ok) remove(tmp);
-    free(tmp);
-    return ok ? HFVIS_OK : HFVIS_ERR_IO;
+    return hfvis_write_file(path, bytes, n, NULL);
 }
 
 /* One sample of [lo, hi] on 0..top, as hfvis_pgm_encode maps it: values outside clamp, NaN and

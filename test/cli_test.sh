@@ -535,6 +535,41 @@ printf 'old\n' > "$dir/keep.pfm"
 [ "$(cat "$dir/keep.pfm")" = old ] && ok "refused sum keeps the old OUT" || bad "refused sum keeps the old OUT"
 "$hfvis" help sum | grep -q 'PART.hfvs' && ok "help sum" || bad "help sum"
 
+# An interrupt during a real write (issue: SIGINT/SIGTERM while a 4096^2 horizon was written
+# left its 354 MB temporary file): the 48 MB write of `normals` on 2048 x 2048 zeros is started
+# in the foreground (a background job would have SIGINT ignored), a poller signals it as soon as
+# its temporary file exists, and nothing of OUT may remain. Exit 128 + the signal number.
+sigdir=$dir/sig; mkdir -p "$sigdir"
+{ printf 'Pf\n2048 2048\n-1\n'; head -c 16777216 /dev/zero; } > "$dir/zero2048.pfm"
+for sig in INT TERM HUP; do
+  rm -f "$dir/sig.pid" "$dir/sig.caught"
+  ( i=0; while [ ! -s "$dir/sig.pid" ] && [ $i -lt 200000 ]; do i=$((i + 1)); done
+    i=0
+    while [ $i -lt 1000000 ]; do
+      for t in "$sigdir"/n.pfm.tmp*; do
+        if [ -e "$t" ]; then kill -"$sig" "$(cat "$dir/sig.pid")"; : > "$dir/sig.caught"; exit 0; fi
+      done
+      i=$((i + 1))
+    done ) &
+  poller=$!
+  sh -c 'echo $$ > "$1"; exec "$2" normals "$3" -o "$4"' sh "$dir/sig.pid" "$hfvis" "$dir/zero2048.pfm" "$sigdir/n.pfm" 2> /dev/null
+  rc=$?
+  wait "$poller"
+  left=$(ls "$sigdir" | wc -l | tr -d ' ')
+  if [ ! -f "$dir/sig.caught" ]; then bad "SIG$sig during a write: the temporary file was never seen"
+  elif [ "$rc" -eq 0 ] && [ "$sig" = INT ]; then ok "SIGINT during a write: SKIP (SIGINT ignored by the parent)"
+  elif [ "$rc" -le 128 ]; then bad "SIG$sig during a write: exit $rc"
+  elif [ "$left" -ne 0 ]; then bad "SIG$sig during a write: left $(ls "$sigdir")"
+  else ok "SIG$sig during a write: exit $rc, directory clean"; fi
+  rm -f "$sigdir"/*
+done
+rm -f "$dir/zero2048.pfm"
+
+# Legal long names (issue: the 12-byte temporary suffix made a 244-byte name fail, ENAMETOOLONG)
+long=$(awk 'BEGIN { for (i = 0; i < 247; i++) printf "%c", 97 + i % 26 }').pfm
+expect_ok "a 251-byte output name" "$dir/$long" skyview "$dir/flat.pgm" --dirs 4 -o "$dir/$long"
+rm -f "$dir/$long"
+
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

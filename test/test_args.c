@@ -55,6 +55,7 @@
     X(pgm_encode_size, V, -, "ZGR", "0") \
     X(pfm_encode, S, -, "NZGOR", "INVALID_ARGUMENT BUFFER_TOO_SMALL") \
     X(pgm_encode, S, -, "NZGOFR", "INVALID_ARGUMENT BUFFER_TOO_SMALL") \
+    X(write_file, S, M, "NZR", "INVALID_ARGUMENT IO") \
     X(image_load, S, A, "NR", "INVALID_ARGUMENT IO") \
     X(pfm_save, S, M, "NZGR", "INVALID_ARGUMENT IO") \
     X(pgm_save, S, M, "NZGFR", "INVALID_ARGUMENT IO") \
@@ -454,7 +455,7 @@ static void base_status(int got, int line)
 
 /* A temporary directory for the file functions. */
 static char tmpdir[64];
-static char path_buf[160];
+static char path_buf[400]; /* room for a 255-byte leaf */
 static const char *tmp_path(const char *leaf)
 {
     snprintf(path_buf, sizeof path_buf, "%s/%s", tmpdir, leaf);
@@ -718,6 +719,48 @@ static void args_image_load(void)
     BAD('N', INV, hfvis_image_load(tmp_path("a.pgm"), NULL, NULL, info));
     BAD('N', INV, hfvis_image_load(tmp_path("a.pgm"), NULL, px, NULL));
     BAD('R', IOE, hfvis_image_load(tmp_path("missing.pgm"), NULL, px, info));
+}
+
+/* Records the temporary names hfvis_write_file announces (on_temp). */
+static char wf_seen[4096];
+static int wf_calls, wf_nulls;
+static void wf_on_temp(void *user, const char *tmp)
+{
+    (void)user;
+    wf_calls++;
+    if (!tmp) wf_nulls++;
+    else if (strlen(tmp) < sizeof wf_seen) strcpy(wf_seen, tmp);
+}
+
+static void args_write_file(void)
+{
+    hfvis_write_options wo;
+    char name[300], *leaf;
+    const char *full;
+    size_t k;
+    begin("write_file");
+    wo.on_temp = wf_on_temp;
+    wo.user = NULL;
+    wf_calls = wf_nulls = 0;
+    OK(hfvis_write_file(tmp_path("w.bin"), "abc", 3, &wo));
+    /* the name was announced before the file existed and withdrawn after the rename */
+    CHECK(wf_calls == 2 && wf_nulls == 1 && strncmp(wf_seen, tmp_path("w.bin"), strlen(tmp_path("w.bin"))) == 0);
+    CHECK(access(wf_seen, F_OK) != 0);
+    OK(hfvis_write_file(tmp_path("empty.bin"), NULL, 0, NULL));
+    /* a 250-byte leaf (legal: NAME_MAX 255) once failed, ENAMETOOLONG on "<leaf>.tmpXXXXXXXX" */
+    for (k = 0; k < 250; k++) name[k] = (char)('a' + (int)(k % 26));
+    name[250] = '\0';
+    full = tmp_path(name);
+    OK(hfvis_write_file(full, "abc", 3, &wo));
+    BADV('R', access(full, F_OK) == 0);
+    leaf = strrchr(wf_seen, '/');
+    CHECK(leaf && strlen(leaf + 1) == 255); /* the cut leaf and its 12-byte suffix */
+    CHECK(remove(full) == 0);
+    BAD('N', INV, hfvis_write_file(NULL, "abc", 3, NULL));
+    BAD('N', INV, hfvis_write_file(tmp_path("t.bin"), NULL, 3, NULL));
+    BAD('Z', INV, hfvis_write_file("", "abc", 3, NULL));
+    BAD('R', IOE, hfvis_write_file(bad_dir_path("t.bin"), "abc", 3, NULL));
+    BADV('R', access(tmp_path("t.bin"), F_OK) != 0);
 }
 
 static void args_pfm_save(void)
@@ -6305,6 +6348,7 @@ static hfvis_status io_binvox_save(const char *path) { return hfvis_binvox_save(
 static hfvis_status io_voxels_raw_save(const char *path) { return hfvis_voxels_raw_save(path, &vg_ok, occ_box); }
 static hfvis_status io_visfield_save(const char *path) { return hfvis_visfield_save(path, &vf_ok); }
 static hfvis_status io_partial_save(const char *path) { return hfvis_partial_save(path, &p_ok); }
+static hfvis_status io_write_file(const char *path) { return hfvis_write_file(path, "abc", 3, NULL); }
 
 typedef struct io_entry {
     const char *name;
@@ -6313,7 +6357,7 @@ typedef struct io_entry {
 #define IOSAVE(name) {#name, io_##name}
 static const io_entry io_savers[] = {
     IOSAVE(pfm_save), IOSAVE(pgm_save), IOSAVE(mesh_save), IOSAVE(binvox_save),
-    IOSAVE(voxels_raw_save), IOSAVE(visfield_save), IOSAVE(partial_save),
+    IOSAVE(voxels_raw_save), IOSAVE(visfield_save), IOSAVE(partial_save), IOSAVE(write_file),
 };
 #define IO_COUNT ((int)(sizeof io_savers / sizeof io_savers[0]))
 
