@@ -159,14 +159,16 @@ enum { OUT_TOTAL, OUT_DIRECT, OUT_INDIRECT };
     "  --target X,Y,Z    point looked at (default: the bounding-box centre)\n"                     \
     "  --up X,Y,Z        up direction (default 0,0,1; 0,1,0 when looking along z)\n"              \
     "  --fov DEG         vertical field of view, 1..179 (default 45)\n"                            \
-    "  --size WxH        image size in pixels, 1..8192 each (default 512x384)\n"                  \
+    "  --size WxH        image size in pixels, 1..32768 each, at most 2^26 pixels\n"              \
+    "                    (default 512x384)\n"                                                     \
     "  --two-sided       every triangle occludes from both sides (default: only from the side its\n" \
     "                    normal, counter-clockwise winding, points to)\n"                         \
     "  --lut T           plane look-up table masks of T^3 nodes, 2..1024 (faster for many rays;\n"  \
     "                    approximate: rays within about one node of a plane may flip)\n"          \
     "  --seed S          seed of the ray pattern and the per-pixel jitter, 0..2^53 (default 0)\n"  \
     "  --no-jitter       no per-pixel rotation of the pattern (banding on flat areas)\n"          \
-    "  --stats           print the counts of the run (receivers, rays, culling) to stdout\n"       \
+    "  --stats           print the counts of the run (receivers, rays, culling) to stdout, before\n"   \
+    "                    OUT is written (if the print fails, OUT is left untouched)\n"       \
     "OUT is .pgm (16-bit, range 0:1; pixels without geometry 0) or .pfm (NaN there).\n"
 
 #define CLI_SUM_HELP                                                                                 \
@@ -320,7 +322,11 @@ static const char cli_shared_help[] =
     "  --quiet           no progress bar (shown on stderr only when it is a terminal)\n"
     "  -h, --help        this help; 'hfvis COMMAND --help' describes one command\n"
     "\n"
-    "Options take their value as the next argument or as --option=value.\n"
+    "Options take their value as the next argument or as --option=value; an option given twice\n"
+    "takes its last value (as most Unix tools; volgi's --light adds one light each time).\n"
+    "OUT is written to a temporary file beside it and renamed onto it: a symbolic link named\n"
+    "OUT is replaced by the file (write to the link's target to keep the link); an interrupt\n"
+    "(SIGINT, SIGTERM, SIGHUP) removes the temporary file.\n"
     "Exit status: 0 = OUT is complete, 1 = error, 2 = usage error; an error is one line\n"
     "\"hfvis: <what>: <why>\" on stderr, and OUT is then left untouched.\n";
 
@@ -411,7 +417,7 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "               with IN's holes, where every sample is seen; in [0, 1], 0 where the point's\n"
     "               lines hold no sample. Runs a second sweep in which every sample is visible,\n"
     "               O(K*W*H*N): 15 s at 1024 x 1024, K = 16 on one core\n"
-    "  --stats      after writing OUT, print the sweep's counters to stdout as averages per\n"
+    "  --stats      before writing OUT, print the sweep's counters to stdout as averages per\n"
     "               receiver-direction (lattice node and direction), as [P2] Tables 1-2:\n"
     "               visible samples, horizons m_a and tree iterations t_a; with --fraction also\n"
     "               the samples tested (the naive scan's iterations) and the ratios\n"
@@ -424,7 +430,7 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "is the bilinear surface through the samples; a sight line that grazes it counts as\n"
     "visible. Method: R2 of Franklin & Ray 1994 (rays to every border sample, running maximum\n"
     "slope), O(W*H); it differs from the exact line of sight only at samples whose sight line\n"
-    "nearly grazes the terrain (about 0.4%% of a rough 1024 x 1024 terrain).\n"
+    "nearly grazes the terrain (about 0.4% of a rough 1024 x 1024 terrain).\n"
     "  --observer X,Y        the observer's column and row, reals in [0, W-1] x [0, H-1] (required)\n"
     "  --observer-height H   eye height above the surface, height units, >= 0 (default 0)\n"
     "  --target-height T     target height above each sample, >= 0 (default 0)\n"
@@ -478,7 +484,7 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "  --radius R        falloff rho = R^2/(R^2 + d^2) (view units); default none (rho = 1)\n"
     "  --dirs K          directions (default: lsao 16, hbao 8, ffao 8 x 2 segments; raytrace\n"
     "                    ignores it)\n"
-    "  --guard PIXELS    guard band per side (default 10 %% of the width and height)\n"
+    "  --guard PIXELS    guard band per side (default 10 % of the width and height)\n"
     "  --depth ENC       linear view depth (default), gl or d3d window depth, reversed Z; the\n"
     "                    hardware encodings need --near and --far\n"
     "Only -o, --dirs and --quiet of the shared options apply. Default PGM range 0:1.\n",
@@ -858,6 +864,8 @@ static int cli_check_vf(const cli_args *a)
         return 0;
     }
     if (a->has_range) return cli_error(CLI_EXIT_USAGE, "--range", "applies only to --ao images");
+    if (!cli_ends_with(a->out, ".hfvf"))
+        return cli_error(CLI_EXIT_USAGE, a->out, "unknown output type for a field (use a .hfvf name)");
     if (a->vf_has_ground || a->vf_has_extent || a->vf_has_size || a->vf_rays || a->vf_has_bias
         || a->vf_reference || a->max_distance > 0.0)
         return cli_error(CLI_EXIT_USAGE, a->vf_has_ground ? "--ground" : a->vf_has_extent ? "--extent"
@@ -1562,10 +1570,19 @@ static int cli_load_env(const char *path, float **px, hfvis_env *env)
     hfvis_image_info info;
     hfvis_status s;
     errno = 0;
+    size_t i, n;
     s = hfvis_image_load(path, NULL, px, &info);
     if (s != HFVIS_OK) return cli_status(path, s, errno);
     env->radiance = *px; env->n_theta = info.height; env->n_phi = info.width;
     env->channels = info.channels;
+    n = (size_t)info.width * (size_t)info.height * (size_t)info.channels;
+    for (i = 0; i < n; i++) /* radiance: finite and >= 0 (a NaN or negative sky is no light) */
+        if (!((*px)[i] >= 0.0f && (*px)[i] <= FLT_MAX)) {
+            size_t pix = i / (size_t)info.channels;
+            return cli_error(CLI_EXIT_ERROR, path, "radiance %g at (%lu, %lu): must be finite and >= 0",
+                             (double)(*px)[i], (unsigned long)(pix % (size_t)info.width),
+                             (unsigned long)(pix / (size_t)info.width));
+        }
     return 0;
 }
 
@@ -1796,7 +1813,8 @@ done:
 }
 
 /* visibility: hfvis_visibility_count; --fraction divides by the count on a flat field with the
- * same holes (where every sample is visible); --stats prints the counters after OUT is written. */
+ * same holes (where every sample is visible); --stats prints the counters before OUT is written
+ * (a print that fails leaves OUT untouched). */
 static int cli_run_visibility(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
                               cli_progress_state *prog)
 {
@@ -1826,9 +1844,8 @@ static int cli_run_visibility(const cli_args *a, const hfvis_grid *grid, hfvis_s
         for (i = 0; s == HFVIS_OK && i < n; i++)
             if (!isnan(out[i])) out[i] = tested[i] > 0.0f ? (float)((double)out[i] / (double)tested[i]) : 0.0f;
     }
-    if (s != HFVIS_OK) rc = cli_status(cmd, s, 0);
-    else rc = cli_save(a, out, w, h, 1, 0.0, a->fraction ? 1.0 : cli_top(out, n, 1.0));
-    if (rc == 0 && a->stats) {
+    rc = s != HFVIS_OK ? cli_status(cmd, s, 0) : 0;
+    if (rc == 0 && a->stats) { /* before OUT: a failed print must not follow a replaced OUT */
         double r = st.receivers > 0.0 ? st.receivers : 1.0; /* 0 receivers: print zeros */
         printf("receiver-directions: %.0f\n", st.receivers);
         printf("visible per receiver-direction: %.6g\n", st.visible / r);
@@ -1840,8 +1857,10 @@ static int cli_run_visibility(const cli_args *a, const hfvis_grid *grid, hfvis_s
             printf("visible/tested: %.6g\n", st.visible / t);
             printf("t_a/tested: %.6g\n", st.iterations / t);
         }
-        if (fflush(stdout) != 0) rc = cli_error(CLI_EXIT_ERROR, "stdout", "%s", strerror(errno));
+        if (fflush(stdout) != 0 || ferror(stdout))
+            rc = cli_error(CLI_EXIT_ERROR, "stdout", "%s (OUT not written)", strerror(errno));
     }
+    if (rc == 0) rc = cli_save(a, out, w, h, 1, 0.0, a->fraction ? 1.0 : cli_top(out, n, 1.0));
     free(tested);
     free(flat_z);
     free(out);
@@ -1858,6 +1877,12 @@ static int cli_run_ssao(const cli_args *a)
     hfvis_falloff fo;
     hfvis_status s;
     int rc = 0, gx, gy, W, H;
+    /* the methods' direction counts (hfvis.h): the flag is named, not the library's status */
+    if (a->has_dirs && a->ssao_method != SSAO_RAYTRACE &&
+        (a->dirs > HFVIS_SSAO_MAX_DIRECTIONS || (a->ssao_method == SSAO_FFAO && a->dirs < 3)))
+        return cli_error(CLI_EXIT_USAGE, "--dirs", "ssao --method %s takes %d..%d directions, got %d",
+                         a->ssao_method == SSAO_LSAO ? "lsao" : a->ssao_method == SSAO_HBAO ? "hbao" : "ffao",
+                         a->ssao_method == SSAO_FFAO ? 3 : 1, HFVIS_SSAO_MAX_DIRECTIONS, a->dirs);
     errno = 0;
     s = hfvis_image_load(a->in, NULL, &depth, &info);
     if (s != HFVIS_OK) return cli_status(a->in, s, errno);
@@ -2080,8 +2105,7 @@ static int cli_run_meshao(const cli_args *a)
     if (!out) { rc = cli_status(cmd, HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
     s = hfvis_lk_image((hfvis_lk_method)a->lk_method, &mesh, NULL, &view, &rays, &o, NULL, out, &st);
     if (s != HFVIS_OK) { rc = cli_status(cmd, s, 0); goto done; }
-    rc = cli_save(a, out, a->lk_width, a->lk_height, 1, 0.0, 1.0);
-    if (rc == 0 && a->stats) {
+    if (a->stats) { /* before OUT: a failed print must not follow a replaced OUT */
         printf("receivers: %llu\nrays: %llu\nblocked: %llu (mean obscurance %.6f)\n",
                (unsigned long long)st.receivers, (unsigned long long)st.rays,
                (unsigned long long)st.rays_blocked,
@@ -2099,8 +2123,12 @@ static int cli_run_meshao(const cli_args *a)
             printf("nodes visited: %llu (culled: distance %llu, horizon %llu, mask %llu)\n",
                    (unsigned long long)st.nodes_visited, (unsigned long long)st.nodes_culled_distance,
                    (unsigned long long)st.nodes_culled_horizon, (unsigned long long)st.nodes_culled_mask);
-        if (fflush(stdout) != 0) rc = cli_error(CLI_EXIT_ERROR, "stdout", "%s", strerror(errno));
+        if (fflush(stdout) != 0 || ferror(stdout)) {
+            rc = cli_error(CLI_EXIT_ERROR, "stdout", "%s (OUT not written)", strerror(errno));
+            goto done;
+        }
     }
+    rc = cli_save(a, out, a->lk_width, a->lk_height, 1, 0.0, 1.0);
 done:
     free(out);
     hfvis_lk_lut_free(NULL, &lut);

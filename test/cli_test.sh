@@ -535,6 +535,40 @@ printf 'old\n' > "$dir/keep.pfm"
 [ "$(cat "$dir/keep.pfm")" = old ] && ok "refused sum keeps the old OUT" || bad "refused sum keeps the old OUT"
 "$hfvis" help sum | grep -q 'PART.hfvs' && ok "help sum" || bad "help sum"
 
+# A failed summary never follows a replaced OUT (issue: `visibility --stats > /dev/full` exited 1
+# after renaming the new file over OUT): the counters are printed first, OUT is then untouched.
+if [ -w /dev/full ]; then
+  printf 'old\n' > "$dir/old.pfm"
+  "$hfvis" visibility "$h" --dirs 4 --stats -o "$dir/old.pfm" > /dev/full 2> "$dir/stderr"; rc=$?
+  [ "$rc" -eq 1 ] && [ "$(cat "$dir/old.pfm")" = old ] && [ "$(wc -l < "$dir/stderr" | tr -d ' ')" = 1 ] &&
+    ok "visibility --stats > /dev/full: exit 1, OUT untouched" || bad "visibility --stats > /dev/full: exit $rc, OUT $(head -c 2 "$dir/old.pfm")"
+else
+  ok "visibility --stats > /dev/full: SKIP (no /dev/full)"
+fi
+# visfield build enforces its extension (issue: HFVF data went into x.pfm or field.txt, exit 0)
+expect_fail "visfield build -o x.pfm" 2 visfield "$dir/cube.obj" --positions 82 --dirs 4 -o "$fdir/x.pfm"
+expect_fail "visfield build -o field.txt" 2 visfield "$dir/cube.obj" --positions 82 --dirs 4 -o "$fdir/field.txt"
+# the flag at fault is named (issue: "ssao: HFVIS_ERR_INVALID_ARGUMENT")
+expect_fail "ssao --dirs 5000" 2 ssao "$dir/plane.pfm" --method lsao --dirs 5000 -o "$o"
+grep -q -- '--dirs' "$dir/stderr" && ok "ssao --dirs named" || bad "ssao --dirs named: $(cat "$dir/stderr")"
+expect_fail "ssao ffao --dirs 2" 2 ssao "$dir/plane.pfm" --method ffao --dirs 2 -o "$o"
+# light --env with NaN or negative radiance is refused, as gi does
+{ printf 'Pf\n4 2\n-1\n'; printf "$nan"; i=1; while [ $i -lt 8 ]; do printf "$one"; i=$((i + 1)); done; } > "$dir/envnan.pfm"
+{ printf 'Pf\n4 2\n-1\n'; printf "$mone"; i=1; while [ $i -lt 8 ]; do printf "$one"; i=$((i + 1)); done; } > "$dir/envneg.pfm"
+expect_fail "light --env with NaN" 1 light "$h" --env "$dir/envnan.pfm" -o "$o"
+expect_fail "light --env negative" 1 light "$h" --env "$dir/envneg.pfm" -o "$o"
+grep -q 'radiance' "$dir/stderr" && ok "light --env: radiance named" || bad "light --env: radiance named"
+# help texts: no literal %%, meshao's --size range as enforced, duplicates and links documented
+if "$hfvis" --help 2>&1 | grep -q '%%' || "$hfvis" ssao --help | grep -q '%%' || "$hfvis" viewshed --help | grep -q '%%'
+then bad "help: a literal %%"; else ok "help: no literal %%"; fi
+for c in horizon skyview sky shadow light normals indirect visibility viewshed voxelize gi ssao volgi visfield meshao; do
+  "$hfvis" "$c" --help | grep -q '%%' && bad "help $c: a literal %%"
+done
+"$hfvis" meshao --help | grep -q '1..32768 each' && ok "help meshao: --size range" || bad "help meshao: --size range"
+expect_ok "meshao --size 16384x1 (as documented)" "$dir/m.pfm" meshao "$dir/cube.obj" --size 16384x1 --rays 1 -o "$dir/m.pfm"
+"$hfvis" skyview --help | grep -q 'given twice' && ok "help: duplicated options documented" || bad "help: duplicated options documented"
+"$hfvis" skyview --help | grep -q 'symbolic link' && ok "help: symbolic links documented" || bad "help: symbolic links documented"
+
 # An interrupt during a real write (issue: SIGINT/SIGTERM while a 4096^2 horizon was written
 # left its 354 MB temporary file): the 48 MB write of `normals` on 2048 x 2048 zeros is started
 # in the foreground (a background job would have SIGINT ignored), a poller signals it as soon as
