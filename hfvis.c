@@ -990,6 +990,7 @@ static double hf_slope_1d(double hm, double h0, double hp, int has_m, int has_p)
     return 0.0;
 }
 
+#define HF_SLOPE_SQUARE_MAX 1e150 /* a slope whose square stays far from DBL_MAX (1.8e308) */
 static void hf_normal_at(const hfvis_grid *g, int x, int y, double n[3])
 {
     const float *p = g->z + (ptrdiff_t)y * g->stride + x;
@@ -1002,12 +1003,22 @@ static void hf_normal_at(const hfvis_grid *g, int x, int y, double n[3])
                      x > 0, x + 1 < g->width);
     gy = hf_slope_1d(y > 0 ? (double)p[-g->stride] : 0.0, h0,
                      y + 1 < g->height ? (double)p[g->stride] : 0.0, y > 0, y + 1 < g->height);
-    gx /= g->cell_size;
-    gy /= g->cell_size;
-    len = sqrt(gx * gx + gy * gy + 1.0);
-    n[0] = gx / len;
-    n[1] = gy / len;
-    n[2] = 1.0 / len;
+    if (fabs(gx) / g->cell_size < HF_SLOPE_SQUARE_MAX && fabs(gy) / g->cell_size < HF_SLOPE_SQUARE_MAX) {
+        gx /= g->cell_size;
+        gy /= g->cell_size;
+        len = sqrt(gx * gx + gy * gy + 1.0);
+        n[0] = gx / len;
+        n[1] = gy / len;
+        n[2] = 1.0 / len;
+    } else { /* (gx, gy, cell) scaled by its largest part first: no overflow for tiny cells */
+        double m = fmax(fmax(fabs(gx), fabs(gy)), g->cell_size), c = g->cell_size / m;
+        gx /= m;
+        gy /= m;
+        len = sqrt(gx * gx + gy * gy + c * c);
+        n[0] = gx / len;
+        n[1] = gy / len;
+        n[2] = c / len;
+    }
 }
 
 hfvis_status hfvis_normals_compute(const hfvis_grid *grid, float *out)
@@ -2143,8 +2154,16 @@ double hfvis_sector_weight(int K, double nz, double a, double theta)
  * fields), then sin^2 theta = 1/(1+t'^2), sin 2theta = 2t'/(1+t'^2), theta = pi/2 - atan t'. */
 static double hf_sky_term(double t, double nz, double a, double inv_k, double lobe)
 {
-    double tc = -a / nz, q, theta;
+    double tc, q, theta;
+    /* nz = 0: a vertical receiver, or a float normal whose z underflowed (tiny cells): the
+     * limits of tc = -a/nz; facing away (a <= 0), the direction lies below the tangent plane */
+    if (nz > 0.0) tc = -a / nz;
+    else if (a > 0.0) tc = -HF_INF;
+    else return 0.0;
     if (t > tc) tc = t;
+    if (isinf(tc)) { /* tc = -inf: q = 0, tc q -> 0, theta = pi */
+        return tc > 0.0 ? 0.0 : lobe * a * HF_PI;
+    }
     q = 1.0 / (1.0 + tc * tc);
     theta = HF_HALF_PI - atan(tc);
     return nz * inv_k * q + lobe * a * (theta - tc * q);
@@ -2334,7 +2353,18 @@ hfvis_status hfvis_sky_light_from_map(const hfvis_grid *grid, int K, double map_
 }
 
 /* Sky-view factor term per direction: sin(max(alpha, 0)) = t/sqrt(1+t^2) for t > 0. */
-static double hf_svf_term(double t) { return t > 0.0 ? t / sqrt(1.0 + t * t) : 0.0; }
+/* sin(atan(t)) without overflow: t/sqrt(1 + t^2), or for |t| past the square's range (heights
+ * over tiny cells) sign(t)/sqrt(1 + (1/t)^2). */
+static double hf_tan_sine(double t)
+{
+    if (fabs(t) > HF_SLOPE_SQUARE_MAX) {
+        double r = 1.0 / t;
+        return (t > 0.0 ? 1.0 : -1.0) / sqrt(1.0 + r * r);
+    }
+    return t / sqrt(1.0 + t * t);
+}
+
+static double hf_svf_term(double t) { return t > 0.0 ? hf_tan_sine(t) : 0.0; }
 
 static void hf_svf_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdiff_t step, int n,
                         const double *t)
@@ -5082,7 +5112,6 @@ static void hf_ns_lobe(const double *Ahat, const double *a, double *F)
     for (i = 0; i < NS_SH_N; i++) F[i] *= Ahat[hf_ns_band(i)];
 }
 
-static double hf_ns_sine(double t) { return t / sqrt(1.0 + t * t); }
 
 /* acc (16) += G (16x4, row-major) * w (4). */
 static void hf_ns_acc(double *acc, const double *G, const double *w)
@@ -5969,7 +5998,7 @@ static double hf_ns_smax(hf_ns_ctx *c, int nv)
         double t = c->tv[0];
         for (i = 1; i < nv; i++)
             if (c->tv[i] > t) t = c->tv[i];
-        return hf_ns_sine(t);
+        return hf_tan_sine(t);
     }
     return sin(hf_ns_omax_bspline(c->tv, nv, c->wc, c->wa));
 }
@@ -6214,7 +6243,7 @@ static void hf_ns_bounce_rec(hf_ns_ctx *c, double X, double Y, const double *N, 
                     }
                 }
             }
-            hf_ns_vbar(hf_ns_sine(e->t), c->vb + (size_t)q * 4u);
+            hf_ns_vbar(hf_tan_sine(e->t), c->vb + (size_t)q * 4u);
         }
         hf_ns_vbar(smin, vm);
         /* Eq. 12 (spec B.3 errata): Sum_k (u_k - u_(k+1)) vbar(omega_k) - u_0 vbar(omega_min) */

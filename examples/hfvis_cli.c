@@ -28,6 +28,7 @@
 #define CLI_MAX_DIRS 65536                        /* --dirs upper bound */
 #define CLI_HORIZON_MAX_VALUES HFVIS_IMAGE_MAX_VALUES /* K*W*H limit of `horizon` (2^28 floats, 1 GiB) */
 #define CLI_MAX_BOUNCES 1000                      /* --bounces upper bound (one sweep each) */
+#define CLI_MAX_RELIEF 1e150 /* |height| / cell: the slopes' squares stay far below DBL_MAX */
 #define CLI_EXIT_ERROR 1
 #define CLI_EXIT_USAGE 2
 #define CLI_RUN (-1)                              /* parse_args: go on and run the command */
@@ -1320,6 +1321,9 @@ static int cli_parse(int argc, char **argv, cli_args *a)
     if (!a->in && !(a->cmd == CMD_VOLGI && a->room))
         return cli_error(CLI_EXIT_USAGE, cli_cmd_names[a->cmd], "missing input file IN");
     if (!a->out) return cli_error(CLI_EXIT_USAGE, cli_cmd_names[a->cmd], "missing -o OUT");
+    if (a->sky * a->albedo > CLI_FLT_MAX) /* the sky light's scale: outputs would be inf */
+        return cli_error(CLI_EXIT_USAGE, "--sky/--albedo", "%g x %g exceeds the float range (3.4e38)",
+                         a->sky, a->albedo);
     if (a->has_range && !a->out_pgm)
         return cli_error(CLI_EXIT_USAGE, "--range", a->out_partial ? "applies to 'hfvis sum', not to "
                          "a partial result" : "applies only to .pgm output");
@@ -1393,6 +1397,7 @@ static int cli_load_heights(const cli_args *a, float **z, int *w, int *h)
 {
     hfvis_image_info info;
     float *px = NULL, zscale = (float)a->zscale, nodata = (float)a->nodata;
+    double top = 0.0; /* largest |height| */
     size_t i, n;
     hfvis_status s;
     errno = 0;
@@ -1405,8 +1410,26 @@ static int cli_load_heights(const cli_args *a, float **z, int *w, int *h)
     }
     n = (size_t)info.width * (size_t)info.height; /* <= HFVIS_IMAGE_MAX_VALUES (decoder limit) */
     for (i = 0; i < n; i++) {
-        if (a->has_nodata && px[i] == nodata) px[i] = (float)NAN;
-        else px[i] *= zscale;
+        float v = px[i];
+        if (a->has_nodata && v == nodata) {
+            px[i] = (float)NAN;
+            continue;
+        }
+        px[i] = v * zscale;
+        if (isfinite(v) && !isfinite(px[i])) { /* not a hole: refused, never silently one */
+            hfvis_free(NULL, px);
+            return cli_error(CLI_EXIT_ERROR, "--zscale", "%g times the value %g at (%lu, %lu) "
+                             "exceeds the float range (3.4e38)", a->zscale, (double)v,
+                             (unsigned long)(i % (size_t)info.width), (unsigned long)(i / (size_t)info.width));
+        }
+        if (fabs((double)px[i]) > top) top = fabs((double)px[i]);
+    }
+    /* heights in cells (z / cell, in double) and their squares must stay finite */
+    if (top / a->cell > CLI_MAX_RELIEF || a->cell < DBL_MIN) {
+        hfvis_free(NULL, px);
+        return cli_error(CLI_EXIT_ERROR, "--cell", "%g is too small for heights up to %g: their ratio "
+                         "must stay below %g (and the cell at least %g)", a->cell, top, CLI_MAX_RELIEF,
+                         DBL_MIN);
     }
     *z = px; *w = info.width; *h = info.height;
     return 0;

@@ -569,6 +569,17 @@ expect_ok "meshao --size 16384x1 (as documented)" "$dir/m.pfm" meshao "$dir/cube
 "$hfvis" skyview --help | grep -q 'given twice' && ok "help: duplicated options documented" || bad "help: duplicated options documented"
 "$hfvis" skyview --help | grep -q 'symbolic link' && ok "help: symbolic links documented" || bad "help: symbolic links documented"
 
+# Tiny cells and huge scales are computed scale-free or refused with the flag named (issue:
+# --cell 1e-50 gave NaN with exit 0, --zscale 3e38 turned samples into holes silently)
+expect_ok "skyview --cell 1e-50" "$dir/c.pfm" skyview "$h" --cell 1e-50 -o "$dir/c.pfm"
+expect_ok "sky --cell 1e-50" "$dir/c.pfm" sky "$h" --cell 1e-50 -o "$dir/c.pfm"
+expect_ok "normals --cell 1e-100" "$dir/c.pfm" normals "$h" --cell 1e-100 -o "$dir/c.pfm"
+expect_fail "--cell 1e-160 (ratio past 1e150)" 1 skyview "$h" --cell 1e-160 -o "$o"
+grep -q -- '--cell' "$dir/stderr" && ok "--cell named" || bad "--cell named"
+expect_fail "--zscale 3e38" 1 skyview "$h" --zscale 3e38 -o "$o"
+grep -q -- '--zscale' "$dir/stderr" && ok "--zscale named" || bad "--zscale named"
+expect_fail "--sky 3e38 --albedo 3e38" 2 sky "$h" --sky 3e38 --albedo 3e38 -o "$o"
+
 # An interrupt during a real write (issue: SIGINT/SIGTERM while a 4096^2 horizon was written
 # left its 354 MB temporary file): the 48 MB write of `normals` on 2048 x 2048 zeros is started
 # in the foreground (a background job would have SIGINT ignored), a poller signals it as soon as

@@ -1151,6 +1151,44 @@ TEST(thin_grids)
     CHECK(bad_flat == 0);
 }
 
+/* Tiny and huge cells (issue: --cell 1e-50 gave NaN sky light, 7e-46 values down to -2e-44,
+ * normals at 1e-300 were (0, 0, 0)): heights over the cell stay in double, a normal is scaled
+ * by its largest part when the slopes' squares would overflow, sin(atan(t)) is taken without
+ * squaring a huge t. Every output finite and in range; as cells shrink the slopes go vertical,
+ * so the sky-view factors at 1e-50 and 1e-300 agree. */
+#define CELL_NORMAL_TOL 1e-6 /* |n| of a float-stored unit normal */
+#define CELL_LIMIT_TOL 1e-6  /* svf at 1e-300 vs 1e-50: both are the vertical-slope limit */
+#define CELL_QUAD_TOL 0.05   /* K = 16 sum of [P1] Eq. 5 on near-vertical receivers over its
+                                hemisphere integral: measured 2.6% here */
+TEST(tiny_and_huge_cells)
+{
+    static const double cells[] = { 1e-30, 1e-50, 1e-149, 1e-200, 1e-300, 1e30, 1e300 };
+    float z[64], svf[64], svf50[64], sky[64], nrm[192];
+    size_t c;
+    int i, bad = 0, bad_limit = 0, bad_normal = 0;
+    for (i = 0; i < 64; i++) z[i] = (float)((i * 37) % 11);
+    for (c = 0; c < sizeof cells / sizeof cells[0]; c++) {
+        hfvis_grid g;
+        g.z = z; g.width = 8; g.height = 8; g.stride = 8; g.cell_size = cells[c];
+        CHECK_EQ_STATUS(hfvis_sky_view_factor(&g, 16, NULL, svf, 8), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_sky_light(&g, 16, 1.0f, 1.0f, NULL, sky, 8), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_normals_compute(&g, nrm), HFVIS_OK);
+        for (i = 0; i < 64; i++) {
+            double len = sqrt((double)nrm[3 * i] * (double)nrm[3 * i] + (double)nrm[3 * i + 1] * (double)nrm[3 * i + 1] +
+                              (double)nrm[3 * i + 2] * (double)nrm[3 * i + 2]);
+            if (!(svf[i] >= 0.0f && svf[i] <= 1.0f)) bad++;
+            if (!(sky[i] >= 0.0f && (double)sky[i] <= 1.0 + CELL_QUAD_TOL)) bad++;
+            if (!(fabs(len - 1.0) <= CELL_NORMAL_TOL) || !(nrm[3 * i + 2] >= 0.0f)) bad_normal++;
+        }
+        if (cells[c] == 1e-50) memcpy(svf50, svf, sizeof svf);
+        if (cells[c] == 1e-300)
+            for (i = 0; i < 64; i++) bad_limit += !(fabs((double)svf[i] - (double)svf50[i]) <= CELL_LIMIT_TOL);
+    }
+    CHECK(bad == 0);
+    CHECK(bad_normal == 0);
+    CHECK(bad_limit == 0);
+}
+
 TEST(bad_arguments)
 {
     float z[64], map[8 * 64], pts[2] = { 3.0f, 3.0f };
@@ -5130,6 +5168,7 @@ int main(int argc, char **argv)
     RUN(l1_pit);
     RUN(golden_horizon_map);
     RUN(thin_grids);
+    RUN(tiny_and_huge_cells);
     RUN(bad_arguments);
     run_part2_tests();
     run_env_tests();
