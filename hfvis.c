@@ -1274,6 +1274,7 @@ typedef struct hf_sweep {
     int channels;               /* of the lattice accumulator */
     hfvis_lattice L;            /* base lattice of the current group */
     int rows, cols;
+    size_t nodes_cap;           /* rows*cols of any direction fits (hf_lattice_nodes_bound) */
     int *row_first, *row_last;  /* per row: in-domain column range (buffer indices) */
     int *col_first, *col_last;  /* per column: in-domain row range */
     double *h;                  /* rows*cols heights in cell units, NaN outside or at holes */
@@ -1334,6 +1335,18 @@ static int hf_lattice_bound(const hfvis_grid *g)
     return (int)d + 3;
 }
 
+/* Nodes of the largest lattice buffer over all directions: rows x cols of a direction at angle
+ * theta is at most (a|s| + b|c| + 1)(a|c| + b|s| + 1) with a, b the (padded) grid extents, at
+ * most (a + b)^2/2 + 1.5(a + b) + 2: half the D x D square for a thin grid (a line at 45 degrees
+ * needs an (N/sqrt 2)^2 buffer, not N^2), and D x D otherwise. */
+static size_t hf_lattice_nodes_bound(const hfvis_grid *g, int D)
+{
+    double a = (double)(g->width - 1) + (g->width == 1 ? 2.0 * HF_STRIP_HALF : 0.0);
+    double b = (double)(g->height - 1) + (g->height == 1 ? 2.0 * HF_STRIP_HALF : 0.0);
+    double thin = (a + b) * (a + b) / 2.0 + 1.5 * (a + b) + 2.0, square = (double)D * (double)D;
+    return (size_t)(thin < square ? thin : square);
+}
+
 static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
                                          const hfvis_sweep_options *o, int want_normals,
                                          int channels, int want_gacc, size_t extra_size)
@@ -1351,7 +1364,8 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     sw->alloc = o->alloc;
     if ((double)D * (double)D > 2147483647.0 || (double)D + (double)sw->preroll > 2147483647.0)
         return HFVIS_ERR_LIMIT;
-    nodes = (size_t)D * (size_t)D;
+    nodes = hf_lattice_nodes_bound(g, D);
+    sw->nodes_cap = nodes;
     gridn = hf_grid_count(g);
     linelen = (size_t)D + (size_t)sw->preroll;
     off_rf = hf_align_add(&total, (size_t)D, sizeof(int), &ok);
@@ -1458,6 +1472,7 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
     sw->cols = L->i_max - L->i_min + 1;
     HFVIS_ASSERT(sw->rows <= hf_lattice_bound(g) && sw->cols <= hf_lattice_bound(g));
     nodes = (size_t)sw->rows * (size_t)sw->cols;
+    HFVIS_ASSERT(nodes <= sw->nodes_cap);
     for (n = 0; n < nodes; n++) sw->h[n] = HF_NAN;
     for (c = 0; c < sw->cols; c++) {
         sw->col_first[c] = INT_MAX;
@@ -3595,7 +3610,7 @@ static size_t hf_p2_extra_size(const hfvis_grid *g, const hfvis_sweep_options *o
     hf_align_add(&total, len, 4 * sizeof(double), ok);
     hf_align_add(&total, len, (size_t)channels * sizeof(double), ok);
     hf_align_add(&total, len, 2 * sizeof(int), ok);
-    if (channels) hf_align_add(&total, D * D, (size_t)channels * sizeof(double), ok);
+    if (channels) hf_align_add(&total, hf_lattice_nodes_bound(g, (int)D), (size_t)channels * sizeof(double), ok);
     *len_out = (int)len;
     return total;
 }
@@ -3610,7 +3625,8 @@ static void hf_p2_carve(hf_sweep *sw, hf_p2_ctx *c)
     o_line = hf_align_add(&total, len, 4 * sizeof(double), &ok);
     o_exit = hf_align_add(&total, len, (size_t)c->channels * sizeof(double), &ok);
     o_int = hf_align_add(&total, len, 2 * sizeof(int), &ok);
-    if (c->channels) o_lat = hf_align_add(&total, D * D, (size_t)c->channels * sizeof(double), &ok);
+    if (c->channels)
+        o_lat = hf_align_add(&total, hf_lattice_nodes_bound(sw->g, (int)D), (size_t)c->channels * sizeof(double), &ok);
     HFVIS_ASSERT(ok && total <= sw->extra_size);
     hfvis_hull_tree_init(sw->extra + o_tree, tree, c->len, c->tree_opts, &c->tree);
     c->ld = (double *)(void *)(sw->extra + o_line);

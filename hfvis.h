@@ -414,7 +414,8 @@ HFVIS_API hfvis_status hfvis_line_horizons_naive(const double *distance, const d
 /* Raw lattice output of one direction, for GPU-port diffing: the horizon elevation angle at
  * every lattice node of hfvis_lattice_init(width, height, azimuth_rad); NaN at nodes outside the
  * grid and at holes. out must hold hfvis_lattice_size() floats.
- * Allocates 1 block of about 8*(W^2+H^2) bytes (the sampled lattice). Cost O(width*height). */
+ * Allocates 1 block of about 8*min(W^2+H^2, (W+H)^2/2) bytes (the sampled lattice: the largest
+ * buffer over all directions, half the diagonal's square for a thin grid). Cost O(width*height). */
 HFVIS_API hfvis_status hfvis_horizon_lattice(const hfvis_grid *grid, double azimuth_rad,
                                              const hfvis_sweep_options *opts, float *out);
 

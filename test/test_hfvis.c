@@ -1189,6 +1189,31 @@ TEST(tiny_and_huge_cells)
     CHECK(bad_limit == 0);
 }
 
+/* A thin grid's lattice buffer is sized by the largest rows x cols over the directions, about
+ * (W + H)^2/2 nodes, not the D x D square of the diagonal (issue: a 1 x 16384 PGM made skyview
+ * allocate 2.1 GB). Bytes asked of the allocator by a 1 x 1024 sky-view run (heights and one
+ * accumulator channel, 16 bytes a node): at most 0.55 x 16 D^2. */
+#define THIN_LATTICE_SHARE 0.55 /* (a + b)^2/2 + 1.5(a + b) + 2 over D^2 for a = 1, b = 1023 */
+TEST(thin_grid_lattice_size)
+{
+    enum { N = 1024 };
+    static float z[N], out[N];
+    test_counting c;
+    hfvis_sweep_options o = hfvis_sweep_options_default();
+    hfvis_grid g;
+    double D = floor(sqrt((double)(N - 1) * (double)(N - 1))) + 3.0;
+    g.z = z; g.width = 1; g.height = N; g.stride = 1; g.cell_size = 1.0;
+    o.alloc = NULL;
+    {
+        hfvis_allocator a = test_counting_allocator(&c, 0);
+        o.alloc = &a;
+        CHECK_EQ_STATUS(hfvis_sky_view_factor(&g, 16, &o, out, 1), HFVIS_OK);
+    }
+    CHECK(c.live == 0);
+    CHECK((double)c.bytes <= THIN_LATTICE_SHARE * 16.0 * D * D);
+    CHECK(out[N / 2] == 1.0f);
+}
+
 TEST(bad_arguments)
 {
     float z[64], map[8 * 64], pts[2] = { 3.0f, 3.0f };
@@ -5169,6 +5194,7 @@ int main(int argc, char **argv)
     RUN(golden_horizon_map);
     RUN(thin_grids);
     RUN(tiny_and_huge_cells);
+    RUN(thin_grid_lattice_size);
     RUN(bad_arguments);
     run_part2_tests();
     run_env_tests();
