@@ -220,6 +220,7 @@ typedef struct cli_args {
     int lk_method, lk_rays, lk_falloff, lk_width, lk_height, lk_two_sided, lk_lut, lk_no_jitter,
         lk_has_eye, lk_has_target, lk_has_up, lk_has_radius;
     double lk_radius, lk_fov, lk_seed, lk_eye[3], lk_target[3], lk_up[3];
+    double max_memory; /* --max-memory bytes, 0 = no limit (default: cli_default_max_memory) */
 } cli_args;
 
 /* ssao --method, --depth */
@@ -321,6 +322,11 @@ static const char cli_shared_help[] =
     "  --border-cells N  clamp/wrap: lines start N cells outside the grid, 1..1048576\n"
     "                    (default max(width, height))\n"
     "  --quiet           no progress bar (shown on stderr only when it is a terminal)\n"
+    "  --max-memory B    refuse a run whose estimated memory exceeds B bytes (suffix K, M, G or\n"
+    "                    T: powers of 1024; 0 = no limit); default half of the physical memory\n"
+    "                    where the system reports it (sysconf), else no limit. The estimate and\n"
+    "                    the work (lattice nodes swept, rays, voxel updates) are printed on\n"
+    "                    stderr with the progress bar\n"
     "  -h, --help        this help; 'hfvis COMMAND --help' describes one command\n"
     "\n"
     "Options take their value as the next argument or as --option=value; an option given twice\n"
@@ -430,7 +436,8 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "0 where terrain hides it, NaN at holes and beyond --max-distance (0 in PGM). The terrain\n"
     "is the bilinear surface through the samples; a sight line that grazes it counts as\n"
     "visible. Method: R2 of Franklin & Ray 1994 (rays to every border sample, running maximum\n"
-    "slope), O(W*H); it differs from the exact line of sight only at samples whose sight line\n"
+    "slope), O((W + H) * max(W, H)): 2(W + H) rays of up to max(W, H) steps (a 1 x 1048576 grid\n"
+    "takes hours); it differs from the exact line of sight only at samples whose sight line\n"
     "nearly grazes the terrain (about 0.4% of a rough 1024 x 1024 terrain).\n"
     "  --observer X,Y        the observer's column and row, reals in [0, W-1] x [0, H-1] (required)\n"
     "  --observer-height H   eye height above the surface, height units, >= 0 (default 0)\n"
@@ -552,6 +559,16 @@ static void cli_progress(void *user, int done, int total)
     if (!cli_bar_open) fputc('\n', stderr);
     fflush(stderr);
     if (done >= total) p->base += total;
+}
+
+/* --max-memory's default: half of the physical memory where sysconf reports it, else 0 (none). */
+static double cli_default_max_memory(void)
+{
+#if defined(CLI_HAVE_SIGACTION) && defined(_SC_PHYS_PAGES) && defined(_SC_PAGESIZE)
+    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    if (pages > 0 && page > 0) return 0.5 * (double)pages * (double)page;
+#endif
+    return 0.0;
 }
 
 static int cli_stderr_is_terminal(void)
@@ -1034,6 +1051,7 @@ static const cli_flag cli_flags[] = {
     { "--zscale", 1, CLI_ALL },     { "--nodata", 1, CLI_ALL },      { "--dirs", 1, CLI_ALL },
     { "--azimuth0", 1, CLI_ALL },   { "--compass", 0, CLI_ALL },     { "--degrees", 0, CLI_ALL },
     { "--border", 1, CLI_ALL },     { "--border-cells", 1, CLI_ALL }, { "--quiet", 0, CLI_ALL },
+    { "--max-memory", 1, CLI_ALL },
     { "--dir-range", 1, CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY)
                         | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VISIBILITY) },
     { "--sky", 1, CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
@@ -1117,6 +1135,21 @@ static int cli_set(cli_args *a, const char *f, const char *v)
             !((float)a->range_lo < (float)a->range_hi))
             return cli_error(CLI_EXIT_USAGE, f, "expected LO:HI with finite LO < HI, got '%s'", v);
         a->has_range = 1;
+        return 0;
+    }
+    if (!strcmp(f, "--max-memory")) { /* BYTES with an optional K, M, G or T (powers of 1024) */
+        char *end;
+        double m;
+        errno = 0;
+        m = strtod(v, &end);
+        if (end != v && *end) {
+            const char *u = "KMGT", *q = strchr(u, toupper((unsigned char)*end));
+            if (q && end[1] == '\0') m *= pow(1024.0, (double)(q - u + 1)), end++;
+        }
+        if (end == v || *end != '\0' || !(m >= 0.0) || !isfinite(m) || !isdigit((unsigned char)v[0]))
+            return cli_error(CLI_EXIT_USAGE, f, "expected bytes >= 0 with an optional K, M, G or T "
+                             "(0 = no limit), got '%s'", v);
+        a->max_memory = m;
         return 0;
     }
     if (!strcmp(f, "--cell")) return cli_real(f, v, 0.0, 1, DBL_MAX, "a number > 0", &a->cell);
@@ -1259,6 +1292,7 @@ static int cli_parse(int argc, char **argv, cli_args *a)
     int i, c, positional_only = 0;
     memset(a, 0, sizeof *a);
     a->cell = 1.0; a->zscale = 1.0; a->dirs = 16; a->sky = 1.0; a->albedo = 1.0;
+    a->max_memory = cli_default_max_memory();
     a->border = HFVIS_BORDER_OPEN; a->method = HFVIS_ENV_PREFIX;
     a->bounces = 1; a->sun_irradiance = CLI_PI; a->output = OUT_TOTAL;
     a->order = 4; a->subsample = 1;
@@ -1393,6 +1427,79 @@ static int cli_parse(int argc, char **argv, cli_args *a)
 /* ------------------------------------------------------------------------------------------ */
 
 /* Load IN as a one-channel height field; --nodata values become NaN, the rest are scaled. */
+/* What a run is expected to cost before it allocates: bytes at its peak and units of work. */
+typedef struct cli_cost {
+    double bytes, work;
+    const char *unit;
+} cli_cost;
+
+/* The estimate of a command on a w x h input (height fields, ssao) or from its flags (meshes,
+ * volumes). Height fields: input, output, the sweep's lattice (about min(W^2 + H^2,
+ * (W + H)^2/2) nodes of 8-byte heights, 12-byte normals and 8 bytes a channel), the grid
+ * accumulator; the work is K sweeps over the lattice. A model of the allocations, not a bound
+ * on them (the file buffers of the codecs come on top for a moment). */
+static cli_cost cli_estimate(const cli_args *a, int w, int h, int channels)
+{
+    cli_cost c;
+    double n = (double)w * (double)h, W = (double)w, H = (double)h, K = (double)a->dirs, lat, ch = channels;
+    double diag2 = W * W + H * H, thin = (W + H) * (W + H) / 2.0;
+    lat = diag2 < thin ? diag2 : thin;
+    c.bytes = 0.0, c.work = 0.0, c.unit = "lattice nodes swept";
+    switch (a->cmd) {
+    case CMD_VOXELIZE:
+        c.bytes = pow((double)a->res, 3.0), c.work = c.bytes, c.unit = "voxels";
+        return c;
+    case CMD_VOLGI:
+        c.bytes = pow((double)a->res, 3.0) * 4.0 * 16.0 + (double)a->vg_width * (double)a->vg_height * 12.0;
+        c.work = pow((double)a->res, 3.0) * (double)a->iterations, c.unit = "voxel updates";
+        return c;
+    case CMD_VISFIELD:
+        if (a->vf_ao) {
+            c.bytes = (double)a->vg_width * (double)a->vg_height * 4.0;
+            c.work = c.bytes / 4.0 * (double)(a->vf_rays ? a->vf_rays : 64), c.unit = "rays";
+        } else {
+            double P = (double)(a->vf_positions ? a->vf_positions : 82), D = (double)(a->has_dirs ? a->dirs : 16);
+            c.bytes = P * 2.0 * D * D * 4.0, c.work = P * 2.0 * D * D, c.unit = "direction texels";
+        }
+        return c;
+    case CMD_MESHAO:
+        c.bytes = (double)a->lk_width * (double)a->lk_height * 16.0;
+        c.work = (double)a->lk_width * (double)a->lk_height * (double)(a->lk_rays ? a->lk_rays : 64);
+        c.unit = "rays";
+        return c;
+    case CMD_SSAO:
+        c.bytes = n * 8.0, c.work = n * (a->has_dirs ? K : 16.0) * (W > H ? W : H) / 4.0, c.unit = "depth samples";
+        return c;
+    case CMD_VIEWSHED:
+        c.bytes = n * 8.0, c.work = (W + H) * (W > H ? W : H), c.unit = "line-of-sight steps";
+        return c;
+    case CMD_HORIZON: ch = 4.0; break;
+    case CMD_GI: c.bytes = n * 4.0 * 64.0; break; /* the NS09 pyramids and SH planes */
+    default: break;
+    }
+    c.bytes += n * 4.0 + n * 4.0 * (a->cmd == CMD_HORIZON ? K : (double)channels); /* in, out */
+    c.bytes += lat * (8.0 + 12.0 + 8.0 * ch) + n * (12.0 + 8.0 * ch);             /* sweep */
+    if (a->cmd == CMD_VISIBILITY || a->cmd == CMD_INDIRECT) c.bytes += lat * 8.0 * ch;
+    c.work = K * (n + lat / 4.0);
+    if (a->cmd == CMD_INDIRECT) c.work *= (double)(a->bounces + 1);
+    if (a->cmd == CMD_VISIBILITY && a->fraction) c.work *= 2.0;
+    return c;
+}
+
+/* Print the estimate with the progress bar, and refuse a run past --max-memory (0 = none). */
+static int cli_check_cost(const cli_args *a, int w, int h, int channels)
+{
+    const char *cmd = cli_cmd_names[a->cmd];
+    cli_cost c = cli_estimate(a, w, h, channels);
+    if (!a->quiet && cli_stderr_is_terminal())
+        fprintf(stderr, "%s: estimate %.3g MiB, %.3g %s\n", cmd, c.bytes / 1048576.0, c.work, c.unit);
+    if (a->max_memory > 0.0 && c.bytes > a->max_memory)
+        return cli_error(CLI_EXIT_ERROR, cmd, "needs about %.3g MiB (%.3g %s), over --max-memory %.3g "
+                         "MiB; raise --max-memory or make the run smaller (input, --dir-range, flags)",
+                         c.bytes / 1048576.0, c.work, c.unit, a->max_memory / 1048576.0);
+    return 0;
+}
+
 static int cli_load_heights(const cli_args *a, float **z, int *w, int *h)
 {
     hfvis_image_info info;
@@ -1909,6 +2016,7 @@ static int cli_run_ssao(const cli_args *a)
     errno = 0;
     s = hfvis_image_load(a->in, NULL, &depth, &info);
     if (s != HFVIS_OK) return cli_status(a->in, s, errno);
+    if ((rc = cli_check_cost(a, info.width, info.height, 1)) != 0) goto done;
     if (info.channels != 1) {
         rc = cli_error(CLI_EXIT_ERROR, a->in, "expected a one-channel depth buffer");
         goto done;
@@ -2875,6 +2983,8 @@ static int cli_run(const cli_args *a)
     hfvis_env env;
     hfvis_status s = HFVIS_OK;
 
+    if (a->cmd == CMD_VOXELIZE || a->cmd == CMD_VOLGI || a->cmd == CMD_VISFIELD || a->cmd == CMD_MESHAO)
+        if ((rc = cli_check_cost(a, 0, 0, 1)) != 0) return rc;
     if (a->cmd == CMD_VOXELIZE) return cli_run_voxelize(a);
     if (a->cmd == CMD_SSAO) return cli_run_ssao(a);
     if (a->cmd == CMD_VOLGI) return cli_run_volgi(a);
@@ -2891,7 +3001,7 @@ static int cli_run(const cli_args *a)
         opts.progress = cli_progress;
         opts.progress_user = &prog;
     }
-    rc = 0;
+    if ((rc = cli_check_cost(a, w, h, a->cmd == CMD_NORMALS ? 3 : 1)) != 0) goto done;
     if (a->has_dir_range) {
         if (a->cmd == CMD_LIGHT && (rc = cli_load_env(a->env, &env_px, &env)) != 0) goto done;
         rc = cli_run_partial(a, &grid, &opts, &prog, &env);

@@ -580,6 +580,19 @@ expect_fail "--zscale 3e38" 1 skyview "$h" --zscale 3e38 -o "$o"
 grep -q -- '--zscale' "$dir/stderr" && ok "--zscale named" || bad "--zscale named"
 expect_fail "--sky 3e38 --albedo 3e38" 2 sky "$h" --sky 3e38 --albedo 3e38 -o "$o"
 
+# Costs up front (issue: a 16 KB 1 x 16384 PGM made skyview allocate 2.1 GB; volgi --res 256
+# --iterations 1048576 ran with no estimate): --max-memory refuses before allocating and names
+# the estimate; the help states the viewshed's true cost
+awk 'BEGIN { print "P2 1 16384 255"; for (i = 0; i < 16384; i++) print 0 }' > "$dir/thin.pgm"
+expect_fail "skyview 1 x 16384 over --max-memory 100M" 1 skyview "$dir/thin.pgm" --max-memory 100M -o "$o"
+grep -q 'needs about' "$dir/stderr" && ok "--max-memory: the estimate is named" || bad "--max-memory: the estimate is named"
+expect_fail "volgi 256^3 x 2^20 over --max-memory 512M" 1 volgi --room --res 256 --iterations 1048576 --max-memory 512M -o "$o"
+expect_fail "--max-memory 1X" 2 skyview "$h" --max-memory 1X -o "$o"
+expect_ok "--max-memory 0 (no limit)" "$dir/mm.pfm" skyview "$h" --max-memory 0 -o "$dir/mm.pfm"
+expect_ok "--max-memory 64M" "$dir/mm.pfm" skyview "$h" --max-memory 64M -o "$dir/mm.pfm"
+"$hfvis" viewshed --help | grep -q 'O((W + H) \* max(W, H))' && ok "help viewshed: its cost" || bad "help viewshed: its cost"
+"$hfvis" skyview --help | grep -q 'max-memory' && ok "help: --max-memory" || bad "help: --max-memory"
+
 # An interrupt during a real write (issue: SIGINT/SIGTERM while a 4096^2 horizon was written
 # left its 354 MB temporary file): the 48 MB write of `normals` on 2048 x 2048 zeros is started
 # in the foreground (a background job would have SIGINT ignored), a poller signals it as soon as
