@@ -2169,7 +2169,7 @@ double hfvis_sector_weight(int K, double nz, double a, double theta)
  * fields), then sin^2 theta = 1/(1+t'^2), sin 2theta = 2t'/(1+t'^2), theta = pi/2 - atan t'. */
 static double hf_sky_term(double t, double nz, double a, double inv_k, double lobe)
 {
-    double tc, q, theta;
+    double tc, q, theta, r;
     /* nz = 0: a vertical receiver, or a float normal whose z underflowed (tiny cells): the
      * limits of tc = -a/nz; facing away (a <= 0), the direction lies below the tangent plane */
     if (nz > 0.0) tc = -a / nz;
@@ -2181,7 +2181,10 @@ static double hf_sky_term(double t, double nz, double a, double inv_k, double lo
     }
     q = 1.0 / (1.0 + tc * tc);
     theta = HF_HALF_PI - atan(tc);
-    return nz * inv_k * q + lobe * a * (theta - tc * q);
+    /* The term integrates a cosine over the visible arc, so it is >= 0; for a steep horizon
+     * (large tc) theta - tc q cancels to about 2/(3 tc^3) and rounding can dip below 0. */
+    r = nz * inv_k * q + lobe * a * (theta - tc * q);
+    return r > 0.0 ? r : 0.0;
 }
 
 /* The common head of every fused consumer's context. */

@@ -149,7 +149,9 @@ typedef struct hfvis_grid {
     int width;             /* samples per row, >= 1 */
     int height;            /* rows, >= 1 */
     ptrdiff_t stride;      /* elements between rows, >= width */
-    double cell_size;      /* world distance between adjacent samples, > 0, same unit as z */
+    double cell_size;      /* world distance between adjacent samples, > 0, same unit as z;
+                              outputs keep their documented ranges while max|z| / cell_size
+                              <= 1e150 (heights in cells, in double; test/fuzz/fuzz_heightfield) */
 } hfvis_grid;
 
 /* What lies outside the grid. 0 is the default (OPEN). */

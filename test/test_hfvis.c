@@ -1187,6 +1187,19 @@ TEST(tiny_and_huge_cells)
     CHECK(bad == 0);
     CHECK(bad_normal == 0);
     CHECK(bad_limit == 0);
+    {   /* steep horizons (tan ~ 1e32) with holes and wrap, K = 5 (found by fuzz_heightfield):
+         * the sky term's theta - tc q cancelled below 0, sky light -2e-32 */
+        static float zw[100], sw[100];
+        hfvis_grid g;
+        hfvis_sweep_options o = hfvis_sweep_options_default();
+        int neg = 0;
+        for (i = 0; i < 100; i++) zw[i] = i % 9 == 0 ? (float)INFINITY : (float)i;
+        g.z = zw; g.width = 10; g.height = 10; g.stride = 10; g.cell_size = 2.37e-31;
+        o.border = HFVIS_BORDER_WRAP;
+        CHECK_EQ_STATUS(hfvis_sky_light(&g, 5, 1.0f, 1.0f, &o, sw, 10), HFVIS_OK);
+        for (i = 0; i < 100; i++) neg += i % 9 != 0 && !(sw[i] >= 0.0f);
+        CHECK(neg == 0);
+    }
 }
 
 /* A thin grid's lattice buffer is sized by the largest rows x cols over the directions, about
