@@ -1610,34 +1610,70 @@ static hfvis_status cli_write(const char *path, unsigned char *bytes, size_t n, 
     return s;
 }
 
-/* The library's savers, through cli_write: encode into memory, then write. */
-static hfvis_status cli_pfm_save(const char *path, const float *px, int w, int h, int channels, ptrdiff_t stride)
+/* The library's savers, through cli_write: encode into memory (need bytes), then write. */
+typedef hfvis_status (*cli_encoder)(const void *what, void *out, size_t cap, size_t *written);
+static hfvis_status cli_write_encoded(const char *path, size_t need, cli_encoder encode, const void *what)
 {
-    size_t need = hfvis_pfm_encode_size(w, h, channels), written = 0;
     unsigned char *buf = need ? (unsigned char *)malloc(need) : NULL;
+    size_t written = 0;
     hfvis_status s;
     if (!buf) return need ? HFVIS_ERR_OUT_OF_MEMORY : HFVIS_ERR_INVALID_ARGUMENT;
-    s = hfvis_pfm_encode(px, w, h, channels, stride, buf, need, &written);
+    s = encode(what, buf, need, &written);
     return cli_write(path, buf, written, s);
+}
+typedef struct cli_image { /* the arguments of hfvis_pfm_encode / hfvis_pgm_encode */
+    const float *px;
+    int w, h, channels, maxval;
+    ptrdiff_t stride;
+    float lo, hi;
+} cli_image;
+typedef struct cli_voxels {
+    const hfvis_volume_grid *grid;
+    const uint8_t *occ;
+} cli_voxels;
+static hfvis_status cli_enc_pfm(const void *what, void *out, size_t cap, size_t *written)
+{
+    const cli_image *m = (const cli_image *)what;
+    return hfvis_pfm_encode(m->px, m->w, m->h, m->channels, m->stride, out, cap, written);
+}
+static hfvis_status cli_enc_pgm(const void *what, void *out, size_t cap, size_t *written)
+{
+    const cli_image *m = (const cli_image *)what;
+    return hfvis_pgm_encode(m->px, m->w, m->h, m->stride, m->lo, m->hi, m->maxval, out, cap, written);
+}
+static hfvis_status cli_enc_binvox(const void *what, void *out, size_t cap, size_t *written)
+{
+    const cli_voxels *v = (const cli_voxels *)what;
+    return hfvis_binvox_encode(v->grid, v->occ, out, cap, written);
+}
+static hfvis_status cli_enc_visfield(const void *what, void *out, size_t cap, size_t *written)
+{
+    return hfvis_visfield_encode((const hfvis_visfield *)what, out, cap, written);
+}
+static hfvis_status cli_enc_partial(const void *what, void *out, size_t cap, size_t *written)
+{
+    return hfvis_partial_encode((const hfvis_partial *)what, out, cap, written);
+}
+static hfvis_status cli_pfm_save(const char *path, const float *px, int w, int h, int channels, ptrdiff_t stride)
+{
+    cli_image m;
+    memset(&m, 0, sizeof m);
+    m.px = px, m.w = w, m.h = h, m.channels = channels, m.stride = stride;
+    return cli_write_encoded(path, hfvis_pfm_encode_size(w, h, channels), cli_enc_pfm, &m);
 }
 static hfvis_status cli_pgm_save(const char *path, const float *px, int w, int h, ptrdiff_t stride,
                                  float lo, float hi, int maxval)
 {
-    size_t need = hfvis_pgm_encode_size(w, h, maxval), written = 0;
-    unsigned char *buf = need ? (unsigned char *)malloc(need) : NULL;
-    hfvis_status s;
-    if (!buf) return need ? HFVIS_ERR_OUT_OF_MEMORY : HFVIS_ERR_INVALID_ARGUMENT;
-    s = hfvis_pgm_encode(px, w, h, stride, lo, hi, maxval, buf, need, &written);
-    return cli_write(path, buf, written, s);
+    cli_image m;
+    memset(&m, 0, sizeof m);
+    m.px = px, m.w = w, m.h = h, m.stride = stride, m.lo = lo, m.hi = hi, m.maxval = maxval;
+    return cli_write_encoded(path, hfvis_pgm_encode_size(w, h, maxval), cli_enc_pgm, &m);
 }
 static hfvis_status cli_binvox_save(const char *path, const hfvis_volume_grid *grid, const uint8_t *occ)
 {
-    size_t need = hfvis_binvox_encode_size(grid, occ), written = 0;
-    unsigned char *buf = need ? (unsigned char *)malloc(need) : NULL;
-    hfvis_status s;
-    if (!buf) return need ? HFVIS_ERR_OUT_OF_MEMORY : HFVIS_ERR_INVALID_ARGUMENT;
-    s = hfvis_binvox_encode(grid, occ, buf, need, &written);
-    return cli_write(path, buf, written, s);
+    cli_voxels v;
+    v.grid = grid, v.occ = occ;
+    return cli_write_encoded(path, hfvis_binvox_encode_size(grid, occ), cli_enc_binvox, &v);
 }
 static hfvis_status cli_voxels_raw_save(const char *path, const hfvis_volume_grid *grid, const uint8_t *occ)
 {
@@ -1649,21 +1685,11 @@ static hfvis_status cli_voxels_raw_save(const char *path, const hfvis_volume_gri
 }
 static hfvis_status cli_visfield_save(const char *path, const hfvis_visfield *vf)
 {
-    size_t need = hfvis_visfield_encode_size(vf), written = 0;
-    unsigned char *buf = need ? (unsigned char *)malloc(need) : NULL;
-    hfvis_status s;
-    if (!buf) return need ? HFVIS_ERR_OUT_OF_MEMORY : HFVIS_ERR_INVALID_ARGUMENT;
-    s = hfvis_visfield_encode(vf, buf, need, &written);
-    return cli_write(path, buf, written, s);
+    return cli_write_encoded(path, hfvis_visfield_encode_size(vf), cli_enc_visfield, vf);
 }
 static hfvis_status cli_partial_save(const char *path, const hfvis_partial *p)
 {
-    size_t need = hfvis_partial_encode_size(p), written = 0;
-    unsigned char *buf = need ? (unsigned char *)malloc(need) : NULL;
-    hfvis_status s;
-    if (!buf) return need ? HFVIS_ERR_OUT_OF_MEMORY : HFVIS_ERR_INVALID_ARGUMENT;
-    s = hfvis_partial_encode(p, buf, need, &written);
-    return cli_write(path, buf, written, s);
+    return cli_write_encoded(path, hfvis_partial_encode_size(p), cli_enc_partial, p);
 }
 
 /* Write OUT: PFM with its channels, or a 16-bit PGM with the channel planes stacked. */

@@ -19,7 +19,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 #define FZ_MAX_SIDE 48
 #define FZ_MAX_K 32
 #define FZ_HALF_PI 1.5707963267948966
-#define FZ_QUAD_TOL 0.05   /* K-term sum of [P1] Eq. 5 over its hemisphere integral (tests: 2.6%) */
+#define FZ_SKY_MAX 3.2     /* sky light of sky = albedo = 1: K terms of [P1] Eq. 5 on a near-vertical
+                              receiver overshoot the hemisphere's 1 (measured 2.24 at K = 3,
+                              1.06 at K = 16); each term is at most pi/K of it */
 #define FZ_RELIEF 1e150    /* |z| / cell guaranteed by hfvis.h */
 
 static float z[FZ_MAX_SIDE * FZ_MAX_SIDE], out[FZ_MAX_SIDE * FZ_MAX_SIDE * 4];
@@ -81,7 +83,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (bad(i, (double)out[i], 0.0, 1.0)) abort();
     if (hfvis_sky_light(&g, K, 1.0f, 1.0f, &o, out, W) != HFVIS_OK) abort();
     for (i = 0; i < n; i++)
-        if (bad(i, (double)out[i], 0.0, 1.0 + FZ_QUAD_TOL)) abort();
+        if (bad(i, (double)out[i], 0.0, FZ_SKY_MAX)) abort();
     if (hfvis_visibility_count(&g, K, &o, NULL, out, W, NULL) != HFVIS_OK) abort();
     for (i = 0; i < n; i++)
         if (bad(i, (double)out[i], 0.0, (double)K * (double)(W + H + 3))) abort();
