@@ -30,14 +30,14 @@ static double sums[FZ_MAX_SIDE * FZ_MAX_SIDE];
 
 static int W_, H_;
 static int hole(int i) { return !isfinite(z[i]); }
-/* A sample with a hole among its 8 neighbours may receive NaN: every lattice node of an oblique
+/* A sample with a hole within two cells may receive NaN: every lattice node of an oblique
  * direction around it can touch the hole (a bilinear sample touching a hole is a hole), and the
  * gather finds no finite node within two cells (known limitation, docs/reliability.md). */
 static int near_hole(int i)
 {
     int x = i % W_, y = i / W_, dx, dy;
-    for (dy = -1; dy <= 1; dy++)
-        for (dx = -1; dx <= 1; dx++)
+    for (dy = -2; dy <= 2; dy++)
+        for (dx = -2; dx <= 2; dx++)
             if (x + dx >= 0 && x + dx < W_ && y + dy >= 0 && y + dy < H_ && hole((y + dy) * W_ + x + dx))
                 return 1;
     return 0;
