@@ -132,6 +132,26 @@ static void hf_free(const hfvis_allocator *a, void *p)
 
 void hfvis_free(const hfvis_allocator *alloc, void *ptr) { hf_free(alloc, ptr); }
 
+/* Four bits per step from a 16-entry table (entry i = the CRC register after shifting the
+ * nibble i out), reflected polynomial 0xEDB88320. */
+uint32_t hfvis_crc32(uint32_t crc, const void *data, size_t n)
+{
+    static const uint32_t t[16] = {
+        0x00000000u, 0x1db71064u, 0x3b6e20c8u, 0x26d930acu, 0x76dc4190u, 0x6b6b51f4u,
+        0x4db26158u, 0x5005713cu, 0xedb88320u, 0xf00f9344u, 0xd6d6a3e8u, 0xcb61b38cu,
+        0x9b64c2b0u, 0x86d3d2d4u, 0xa00ae278u, 0xbdbdf21cu
+    };
+    const unsigned char *p = (const unsigned char *)data;
+    size_t i;
+    crc = ~crc;
+    for (i = 0; i < n; i++) {
+        crc ^= p[i];
+        crc = (crc >> 4) ^ t[crc & 15u];
+        crc = (crc >> 4) ^ t[crc & 15u];
+    }
+    return ~crc;
+}
+
 /* a*b without overflow (stb's mul2sizes_valid). */
 static int hf_mul_size(size_t a, size_t b, size_t *out)
 {
@@ -336,12 +356,13 @@ static void hf_img_pfm_rows(const unsigned char *p, const hf_img_header *h, floa
     }
 }
 
-/* Parses and validates a whole PGM/PFM held in p[0..n); see the section comment. */
-static hfvis_status hf_img_parse(const unsigned char *p, size_t n, hf_img_header *out)
+/* Parses the header of a PGM/PFM held in p[0..n) (n may end anywhere after it): info, values
+ * and data_offset; the samples are not looked at. */
+static hfvis_status hf_img_header_parse(const unsigned char *p, size_t n, hf_img_header *out)
 {
     hf_img_header h;
     unsigned long w, ht, maxval = 0;
-    size_t i = 2, bytes;
+    size_t i = 2;
     memset(&h, 0, sizeof h);
     if (n < 2 || p[0] != 'P') return HFVIS_ERR_FORMAT;
     if (p[1] == '2' || p[1] == '5') {
@@ -379,12 +400,31 @@ static hfvis_status hf_img_parse(const unsigned char *p, size_t n, hf_img_header
         || h.values > HFVIS_IMAGE_MAX_VALUES)
         return HFVIS_ERR_LIMIT;
     h.data_offset = i;
+    *out = h;
+    return HFVIS_OK;
+}
+
+/* Bytes of the binary samples (P5, PFM) of a parsed header. */
+static int hf_img_data_bytes(const hf_img_header *h, size_t *bytes)
+{
+    size_t bytes_per_value = h->info.format == HFVIS_FORMAT_PFM ? 4 : h->info.maxval < 256 ? 1 : 2;
+    return hf_mul_size(h->values, bytes_per_value, bytes);
+}
+
+/* Parses and validates a whole PGM/PFM held in p[0..n); see the section comment. */
+static hfvis_status hf_img_parse(const unsigned char *p, size_t n, hf_img_header *out)
+{
+    hf_img_header h;
+    size_t i, bytes;
+    unsigned long maxval;
+    hfvis_status s = hf_img_header_parse(p, n, &h);
+    if (s != HFVIS_OK) return s;
+    i = h.data_offset;
+    maxval = (unsigned long)h.info.maxval;
     if (h.ascii) {
         if (!hf_img_p2_samples(p, n, i, h.values, maxval, NULL)) return HFVIS_ERR_FORMAT;
     } else {
-        size_t bytes_per_value = h.info.format == HFVIS_FORMAT_PFM ? 4 : maxval < 256 ? 1 : 2;
-        if (!hf_mul_size(h.values, bytes_per_value, &bytes) || n - i < bytes)
-            return HFVIS_ERR_FORMAT;
+        if (!hf_img_data_bytes(&h, &bytes) || n - i < bytes) return HFVIS_ERR_FORMAT;
         if (h.info.format == HFVIS_FORMAT_PGM && maxval != 255 && maxval != 65535
             && !hf_img_p5_samples(p + i, h.values, (unsigned)maxval, NULL))
             return HFVIS_ERR_FORMAT;
@@ -706,72 +746,121 @@ HFVIS_API hfvis_status hfvis_pgm_range_decode(const void *data, size_t size, flo
 }
 
 #ifndef HFVIS_NO_STDIO
-/* A regular file's size from fseek/ftell is only a first guess for the buffer: special files
- * (pipes, /proc, directories on some file systems) report 0, fail, or report absurd sizes, so
- * guesses above this are ignored and the buffer grows by doubling instead. */
-#define HF_IMG_MAX_SIZE_GUESS ((size_t)1 << 31)
-#define HF_IMG_FIRST_CHUNK ((size_t)1 << 16)
+/* Internal, shared with voxel.c (not API; declared again there). A sizer looks at the first
+ * bytes of a file (at most HFVIS__READ_HEAD, fewer if the file is shorter) and sets *total to
+ * the exact size its header announces or HFVIS__READ_ALL (a text format: read to the end), or
+ * returns the decoder's error for the header (refused before anything more is read). */
+#define HFVIS__READ_HEAD ((size_t)1 << 16)
+#define HFVIS__READ_ALL ((size_t)-1)
+typedef hfvis_status (*hfvis__sizer)(const unsigned char *head, size_t n, size_t *total);
+hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, hfvis__sizer sizer,
+                             unsigned char **data, size_t *size);
 
-/* Internal, shared with voxel.c (not API; declared again there). */
-hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, unsigned char **data,
-                             size_t *size);
-hfvis_status hfvis__write_file(const char *path, const unsigned char *bytes, size_t n);
-
-/* Reads the whole file into a block from alloc (hfvis__read_file). */
-hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, unsigned char **data,
-                             size_t *size)
+/* Reads a file into a block from alloc: the head first; when the sizer announces a size, exactly
+ * that many bytes and one more (so that trailing data reaches the decoder, which refuses it or
+ * ignores it as its format says), and a file shorter than announced is HFVIS_ERR_FORMAT without
+ * reading further; else (no sizer, HFVIS__READ_ALL) the whole file. */
+hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, hfvis__sizer sizer,
+                             unsigned char **data, size_t *size)
 {
     FILE *f = fopen(path, "rb");
     unsigned char *buf;
-    size_t cap = HF_IMG_FIRST_CHUNK, len = 0;
-    long end;
+    size_t cap = HFVIS__READ_HEAD, len, total;
+    hfvis_status s;
     if (!f) return HFVIS_ERR_IO;
-    if (fseek(f, 0, SEEK_END) == 0) {
-        end = ftell(f);
-        if (end >= 0 && (unsigned long)end < HF_IMG_MAX_SIZE_GUESS)
-            cap = (size_t)end + 1; /* + 1: the read that meets end of file needs room */
-        if (fseek(f, 0, SEEK_SET) != 0) {
-            fclose(f);
-            return HFVIS_ERR_IO;
-        }
-    } else {
-        clearerr(f); /* unseekable (a pipe): nothing was consumed */
-    }
     buf = (unsigned char *)hf_alloc(alloc, cap);
     if (!buf) {
         fclose(f);
         return HFVIS_ERR_OUT_OF_MEMORY;
     }
-    for (;;) {
-        size_t want = cap - len, got = fread(buf + len, 1, want, f);
-        len += got;
-        if (got < want) break;
-        if (len == cap) {
-            unsigned char *bigger;
-            if (cap > SIZE_MAX / 2) {
-                bigger = NULL;
-            } else {
-                bigger = (unsigned char *)hf_alloc(alloc, cap * 2);
-            }
-            if (!bigger) {
-                hf_free(alloc, buf);
-                fclose(f);
-                return HFVIS_ERR_OUT_OF_MEMORY;
-            }
-            memcpy(bigger, buf, len);
-            hf_free(alloc, buf);
-            buf = bigger;
-            cap *= 2;
-        }
-    }
+    len = fread(buf, 1, cap, f);
     if (ferror(f)) {
         hf_free(alloc, buf);
         fclose(f);
         return HFVIS_ERR_IO;
     }
+    total = HFVIS__READ_ALL;
+    s = sizer ? sizer(buf, len, &total) : HFVIS_OK;
+    if (s == HFVIS_OK && total != HFVIS__READ_ALL && len < cap && len < total)
+        s = HFVIS_ERR_FORMAT; /* shorter than its header says */
+    if (s != HFVIS_OK) {
+        hf_free(alloc, buf);
+        fclose(f);
+        return s;
+    }
+    if (total != HFVIS__READ_ALL) {
+        if (total >= SIZE_MAX - 1u) {
+            hf_free(alloc, buf);
+            fclose(f);
+            return HFVIS_ERR_LIMIT;
+        }
+        if (len > total) len = total + 1u; /* one byte past the announced end is enough */
+        else if (len == cap) {
+            unsigned char *all;
+            long end; /* a regular file shorter than announced is refused before allocating */
+            if (fseek(f, 0, SEEK_END) == 0 && (end = ftell(f)) >= 0 &&
+                ((unsigned long)end < total && (unsigned long)end >= len)) {
+                hf_free(alloc, buf);
+                fclose(f);
+                return HFVIS_ERR_FORMAT;
+            }
+            if (fseek(f, (long)len, SEEK_SET) != 0) clearerr(f); /* a pipe: still at len */
+            all = (unsigned char *)hf_alloc(alloc, total + 1u);
+            if (!all) {
+                hf_free(alloc, buf);
+                fclose(f);
+                return HFVIS_ERR_OUT_OF_MEMORY;
+            }
+            memcpy(all, buf, len);
+            hf_free(alloc, buf);
+            buf = all;
+            len += fread(buf + len, 1, total + 1u - len, f);
+            if (ferror(f) || len < total) {
+                s = ferror(f) ? HFVIS_ERR_IO : HFVIS_ERR_FORMAT;
+                hf_free(alloc, buf);
+                fclose(f);
+                return s;
+            }
+        }
+        fclose(f);
+        *data = buf;
+        *size = len;
+        return HFVIS_OK;
+    }
+    while (len == cap) { /* read to the end, doubling */
+        unsigned char *bigger = cap > SIZE_MAX / 2 ? NULL : (unsigned char *)hf_alloc(alloc, cap * 2);
+        if (!bigger) {
+            hf_free(alloc, buf);
+            fclose(f);
+            return HFVIS_ERR_OUT_OF_MEMORY;
+        }
+        memcpy(bigger, buf, len);
+        hf_free(alloc, buf);
+        buf = bigger;
+        cap *= 2;
+        len += fread(buf + len, 1, cap - len, f);
+        if (ferror(f)) {
+            hf_free(alloc, buf);
+            fclose(f);
+            return HFVIS_ERR_IO;
+        }
+    }
     fclose(f);
     *data = buf;
     *size = len;
+    return HFVIS_OK;
+}
+
+/* The sizer of PGM/PFM: the header, then exactly the binary samples; P2 reads to the end. */
+static hfvis_status hf_img_sizer(const unsigned char *head, size_t n, size_t *total)
+{
+    hf_img_header h;
+    size_t bytes;
+    hfvis_status s = hf_img_header_parse(head, n, &h);
+    if (s != HFVIS_OK) return s;
+    if (h.ascii) return HFVIS_OK; /* *total stays HFVIS__READ_ALL */
+    if (!hf_img_data_bytes(&h, &bytes) || bytes > SIZE_MAX - h.data_offset) return HFVIS_ERR_LIMIT;
+    *total = h.data_offset + bytes;
     return HFVIS_OK;
 }
 
@@ -784,7 +873,7 @@ HFVIS_API hfvis_status hfvis_image_load(const char *path, const hfvis_allocator 
     hf_img_header h;
     hfvis_status s;
     if (!path || !pixels || !info) return HFVIS_ERR_INVALID_ARGUMENT;
-    s = hfvis__read_file(path, alloc, &data, &size);
+    s = hfvis__read_file(path, alloc, hf_img_sizer, &data, &size);
     if (s != HFVIS_OK) return s;
     s = hf_img_parse(data, size, &h);
     if (s == HFVIS_OK) {
@@ -801,43 +890,57 @@ HFVIS_API hfvis_status hfvis_image_load(const char *path, const hfvis_allocator 
     return s;
 }
 
-/* Writes bytes to "<path>.tmp<8 hex digits>" beside path, then renames it onto path. The
- * suffix hashes the addresses of the buffer and of a local, which differ between concurrent
- * calls in one process (and usually between processes); a name already taken is skipped.
- * On any failure the temporary file is removed and path is untouched. */
-hfvis_status hfvis__write_file(const char *path, const unsigned char *bytes, size_t n)
+/* The temporary name: "<path>.tmp<8 hex digits>" beside path; when the last component would
+ * then exceed HF_NAME_MAX bytes, that component is cut to leave room for the suffix (same
+ * directory, same file system, so the rename stays atomic). The suffix hashes the addresses of
+ * the buffer and of a local, which differ between concurrent calls in one process (and usually
+ * between processes); a name already taken is skipped. */
+#define HF_NAME_MAX 255    /* bytes of a file name on common file systems (POSIX NAME_MAX) */
+#define HF_TMP_SUFFIX 12u  /* ".tmp" and 8 hex digits */
+hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
+                              const hfvis_write_options *opts)
 {
     static const char hex[] = "0123456789abcdef";
-    size_t len = strlen(path), k;
+    size_t len, base = 0, keep, k;
     const void *addrs[2];
     unsigned char raw[sizeof addrs];
     uint32_t tag = 2166136261u; /* FNV-1a */
     char *tmp;
     FILE *f = NULL;
     int attempt, ok;
-    if (len > SIZE_MAX - 16) return HFVIS_ERR_IO;
-    tmp = (char *)hf_alloc(NULL, len + 16);
+    if (!path || (!bytes && n > 0) || path[0] == '\0') return HFVIS_ERR_INVALID_ARGUMENT;
+    len = strlen(path);
+    if (len > SIZE_MAX - HF_TMP_SUFFIX - 1u) return HFVIS_ERR_IO;
+    for (k = 0; k < len; k++)
+        if (path[k] == '/' || path[k] == '\\') base = k + 1;
+    keep = len; /* bytes of path kept before the suffix */
+    if (len - base + HF_TMP_SUFFIX > HF_NAME_MAX) keep = base + (HF_NAME_MAX - HF_TMP_SUFFIX);
+    tmp = (char *)hf_alloc(NULL, keep + HF_TMP_SUFFIX + 1u);
     if (!tmp) return HFVIS_ERR_OUT_OF_MEMORY;
     addrs[0] = bytes;
     addrs[1] = &len;
     memcpy(raw, addrs, sizeof raw);
     for (k = 0; k < sizeof raw; k++) tag = (uint32_t)((tag ^ raw[k]) * 16777619u);
-    memcpy(tmp, path, len);
-    memcpy(tmp + len, ".tmp", 4);
-    tmp[len + 12] = '\0';
+    memcpy(tmp, path, keep);
+    memcpy(tmp + keep, ".tmp", 4);
+    tmp[keep + HF_TMP_SUFFIX] = '\0';
     for (attempt = 0; attempt < 16; attempt++, tag += 0x9e3779b9u) {
         FILE *existing;
-        for (k = 0; k < 8; k++) tmp[len + 4 + k] = hex[(tag >> (28 - 4 * k)) & 15u];
+        for (k = 0; k < 8; k++) tmp[keep + 4 + k] = hex[(tag >> (28 - 4 * k)) & 15u];
         existing = fopen(tmp, "rb");
         if (!existing) break;
         fclose(existing);
     }
-    if (attempt < 16) f = fopen(tmp, "wb");
+    if (attempt < 16) {
+        if (opts && opts->on_temp) opts->on_temp(opts->user, tmp); /* before it exists */
+        f = fopen(tmp, "wb");
+    }
     if (!f) {
+        if (attempt < 16 && opts && opts->on_temp) opts->on_temp(opts->user, NULL);
         hf_free(NULL, tmp);
         return HFVIS_ERR_IO;
     }
-    ok = fwrite(bytes, 1, n, f) == n;
+    ok = n == 0 || fwrite(bytes, 1, n, f) == n;
     ok = (fflush(f) == 0) && ok;
     ok = (fclose(f) == 0) && ok;
     if (ok && rename(tmp, path) != 0) {
@@ -849,9 +952,12 @@ hfvis_status hfvis__write_file(const char *path, const unsigned char *bytes, siz
 #endif
     }
     if (!ok) remove(tmp);
+    if (opts && opts->on_temp) opts->on_temp(opts->user, NULL); /* renamed or removed */
     hf_free(NULL, tmp);
     return ok ? HFVIS_OK : HFVIS_ERR_IO;
 }
+#undef HF_NAME_MAX
+#undef HF_TMP_SUFFIX
 
 HFVIS_API hfvis_status hfvis_pfm_save(const char *path, const float *pixels, int width,
                                       int height, int channels, ptrdiff_t stride)
@@ -864,7 +970,7 @@ HFVIS_API hfvis_status hfvis_pfm_save(const char *path, const float *pixels, int
     buf = (unsigned char *)hf_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_pfm_encode(pixels, width, height, channels, stride, buf, need, &written);
-    if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
+    if (s == HFVIS_OK) s = hfvis_write_file(path, buf, written, NULL);
     hf_free(NULL, buf);
     return s;
 }
@@ -882,7 +988,7 @@ HFVIS_API hfvis_status hfvis_pgm_save(const char *path, const float *pixels, int
     buf = (unsigned char *)hf_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_pgm_encode(pixels, width, height, stride, lo, hi, maxval, buf, need, &written);
-    if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
+    if (s == HFVIS_OK) s = hfvis_write_file(path, buf, written, NULL);
     hf_free(NULL, buf);
     return s;
 }
@@ -897,12 +1003,10 @@ HFVIS_API hfvis_status hfvis_pgm_range_save(const char *path, const float *pixel
     buf = (unsigned char *)hf_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_pgm_range_encode(pixels, width, height, stride, lo, hi, buf, need, &written);
-    if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
+    if (s == HFVIS_OK) s = hfvis_write_file(path, buf, written, NULL);
     hf_free(NULL, buf);
     return s;
 }
-#undef HF_IMG_MAX_SIZE_GUESS
-#undef HF_IMG_FIRST_CHUNK
 #endif /* HFVIS_NO_STDIO */
 
 /* ========================================================================================== */
@@ -1085,6 +1189,7 @@ static double hf_slope_1d(double hm, double h0, double hp, int has_m, int has_p)
     return 0.0;
 }
 
+#define HF_SLOPE_SQUARE_MAX 1e150 /* a slope whose square stays far from DBL_MAX (1.8e308) */
 static void hf_normal_at(const hfvis_grid *g, int x, int y, double n[3])
 {
     const float *p = g->z + (ptrdiff_t)y * g->stride + x;
@@ -1097,12 +1202,22 @@ static void hf_normal_at(const hfvis_grid *g, int x, int y, double n[3])
                      x > 0, x + 1 < g->width);
     gy = hf_slope_1d(y > 0 ? (double)p[-g->stride] : 0.0, h0,
                      y + 1 < g->height ? (double)p[g->stride] : 0.0, y > 0, y + 1 < g->height);
-    gx /= g->cell_size;
-    gy /= g->cell_size;
-    len = sqrt(gx * gx + gy * gy + 1.0);
-    n[0] = gx / len;
-    n[1] = gy / len;
-    n[2] = 1.0 / len;
+    if (fabs(gx) / g->cell_size < HF_SLOPE_SQUARE_MAX && fabs(gy) / g->cell_size < HF_SLOPE_SQUARE_MAX) {
+        gx /= g->cell_size;
+        gy /= g->cell_size;
+        len = sqrt(gx * gx + gy * gy + 1.0);
+        n[0] = gx / len;
+        n[1] = gy / len;
+        n[2] = 1.0 / len;
+    } else { /* (gx, gy, cell) scaled by its largest part first: no overflow for tiny cells */
+        double m = fmax(fmax(fabs(gx), fabs(gy)), g->cell_size), c = g->cell_size / m;
+        gx /= m;
+        gy /= m;
+        len = sqrt(gx * gx + gy * gy + c * c);
+        n[0] = gx / len;
+        n[1] = gy / len;
+        n[2] = c / len;
+    }
 }
 
 hfvis_status hfvis_normals_compute(const hfvis_grid *grid, float *out)
@@ -1127,6 +1242,13 @@ hfvis_status hfvis_normals_compute(const hfvis_grid *grid, float *out)
 /* ========================================================================================== */
 
 #define HF_LATTICE_EPS 1e-9 /* spec §3.2: nodes within 1e-9 cell of the border are inside */
+/* Half-width of the domain across an axis of one sample: a grid 1 sample wide (or tall) is
+ * swept as a strip one cell wide, heights constant across it. A line of zero width would hold a
+ * lattice node only where a node happens to land on it, and the gather would find none. */
+#define HF_STRIP_HALF 0.5
+
+/* The domain along one axis of n samples: [-pad, n - 1 + pad]. */
+static double hf_domain_pad(int n) { return n == 1 ? HF_STRIP_HALF : HF_LATTICE_EPS; }
 
 /* Fill the lattice for a given sweep vector u (unit; v = (-u.y, u.x)). Directions are stored
  * as look azimuth psi with u = -(cos psi, sin psi) (spec §1: a sweep along u yields the horizon
@@ -1134,7 +1256,7 @@ hfvis_status hfvis_normals_compute(const hfvis_grid *grid, float *out)
 static hfvis_status hf_lattice_from_u(hfvis_lattice *L, int W, int H, double ux, double uy)
 {
     double cx[4], cy[4], umin = DBL_MAX, umax = -DBL_MAX, vmin = DBL_MAX, vmax = -DBL_MAX;
-    double rows, cols;
+    double rows, cols, px, py;
     int c;
     L->ux = ux;
     L->uy = uy;
@@ -1143,10 +1265,12 @@ static hfvis_status hf_lattice_from_u(hfvis_lattice *L, int W, int H, double ux,
     L->width = W;
     L->height = H;
     L->azimuth_rad = atan2(-uy, -ux);
-    cx[0] = 0.0; cy[0] = 0.0;
-    cx[1] = (double)(W - 1); cy[1] = 0.0;
-    cx[2] = 0.0; cy[2] = (double)(H - 1);
-    cx[3] = (double)(W - 1); cy[3] = (double)(H - 1);
+    px = W == 1 ? HF_STRIP_HALF : 0.0; /* a thin axis: the strip's corners */
+    py = H == 1 ? HF_STRIP_HALF : 0.0;
+    cx[0] = -px; cy[0] = -py;
+    cx[1] = (double)(W - 1) + px; cy[1] = -py;
+    cx[2] = -px; cy[2] = (double)(H - 1) + py;
+    cx[3] = (double)(W - 1) + px; cy[3] = (double)(H - 1) + py;
     for (c = 0; c < 4; c++) {
         double a = cx[c] * L->ux + cy[c] * L->uy, b = cx[c] * L->vx + cy[c] * L->vy;
         umin = fmin(umin, a);
@@ -1211,29 +1335,31 @@ static void hf_node_pos(const hfvis_lattice *L, int i, int j, double *x, double 
 static int hf_node_inside(const hfvis_lattice *L, int i, int j)
 {
     double x, y;
+    double px = hf_domain_pad(L->width), py = hf_domain_pad(L->height);
     hf_node_pos(L, i, j, &x, &y);
-    return x >= -HF_LATTICE_EPS && x <= (double)(L->width - 1) + HF_LATTICE_EPS &&
-           y >= -HF_LATTICE_EPS && y <= (double)(L->height - 1) + HF_LATTICE_EPS;
+    return x >= -px && x <= (double)(L->width - 1) + px && y >= -py && y <= (double)(L->height - 1) + py;
 }
 
 int hfvis_lattice_line(const hfvis_lattice *L, int j, int *i_first, int *i_last)
 {
     double lo = -DBL_MAX, hi = DBL_MAX;
-    double u[2], v[2], len[2];
+    double u[2], v[2], len[2], pad[2];
     int a, first, last;
     if (!L || j < L->j_min || j > L->j_max) return 0;
     u[0] = L->ux; u[1] = L->uy;
     v[0] = L->vx; v[1] = L->vy;
     len[0] = (double)(L->width - 1);
     len[1] = (double)(L->height - 1);
+    pad[0] = hf_domain_pad(L->width);
+    pad[1] = hf_domain_pad(L->height);
     /* Slab test per axis (spec §3.2) gives the range to within rounding ... */
     for (a = 0; a < 2; a++) {
-        double off = (double)j * v[a];
+        double off = (double)j * v[a], lo_a = pad[a] > HF_LATTICE_EPS ? -pad[a] : 0.0;
         if (u[a] != 0.0) {
-            double t0 = (0.0 - off) / u[a], t1 = (len[a] - off) / u[a];
+            double t0 = (lo_a - off) / u[a], t1 = (len[a] - lo_a - off) / u[a];
             lo = fmax(lo, fmin(t0, t1));
             hi = fmin(hi, fmax(t0, t1));
-        } else if (off < -HF_LATTICE_EPS || off > len[a] + HF_LATTICE_EPS) {
+        } else if (off < -pad[a] || off > len[a] + pad[a]) {
             return 0;
         }
     }
@@ -1347,6 +1473,7 @@ typedef struct hf_sweep {
     int channels;               /* of the lattice accumulator */
     hfvis_lattice L;            /* base lattice of the current group */
     int rows, cols;
+    size_t nodes_cap;           /* rows*cols of any direction fits (hf_lattice_nodes_bound) */
     int *row_first, *row_last;  /* per row: in-domain column range (buffer indices) */
     int *col_first, *col_last;  /* per column: in-domain row range */
     double *h;                  /* rows*cols heights in cell units, NaN outside or at holes */
@@ -1409,6 +1536,18 @@ static int hf_lattice_bound(const hfvis_grid *g)
     return (int)d + 3;
 }
 
+/* Nodes of the largest lattice buffer over all directions: rows x cols of a direction at angle
+ * theta is at most (a|s| + b|c| + 1)(a|c| + b|s| + 1) with a, b the (padded) grid extents, at
+ * most (a + b)^2/2 + 1.5(a + b) + 2: half the D x D square for a thin grid (a line at 45 degrees
+ * needs an (N/sqrt 2)^2 buffer, not N^2), and D x D otherwise. */
+static size_t hf_lattice_nodes_bound(const hfvis_grid *g, int D)
+{
+    double a = (double)(g->width - 1) + (g->width == 1 ? 2.0 * HF_STRIP_HALF : 0.0);
+    double b = (double)(g->height - 1) + (g->height == 1 ? 2.0 * HF_STRIP_HALF : 0.0);
+    double thin = (a + b) * (a + b) / 2.0 + 1.5 * (a + b) + 2.0, square = (double)D * (double)D;
+    return (size_t)(thin < square ? thin : square);
+}
+
 static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
                                          const hfvis_sweep_options *o, int want_normals,
                                          int channels, int want_gacc, size_t extra_size)
@@ -1426,7 +1565,8 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     sw->alloc = o->alloc;
     if ((double)D * (double)D > 2147483647.0 || (double)D + (double)sw->preroll > 2147483647.0)
         return HFVIS_ERR_LIMIT;
-    nodes = (size_t)D * (size_t)D;
+    nodes = hf_lattice_nodes_bound(g, D);
+    sw->nodes_cap = nodes;
     gridn = hf_grid_count(g);
     linelen = (size_t)D + (size_t)sw->preroll;
     off_rf = hf_align_add(&total, (size_t)D, sizeof(int), &ok);
@@ -1533,6 +1673,7 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
     sw->cols = L->i_max - L->i_min + 1;
     HFVIS_ASSERT(sw->rows <= hf_lattice_bound(g) && sw->cols <= hf_lattice_bound(g));
     nodes = (size_t)sw->rows * (size_t)sw->cols;
+    HFVIS_ASSERT(nodes <= sw->nodes_cap);
     for (n = 0; n < nodes; n++) sw->h[n] = HF_NAN;
     for (c = 0; c < sw->cols; c++) {
         sw->col_first[c] = INT_MAX;
@@ -2447,11 +2588,22 @@ double hfvis_sector_weight(int K, double nz, double a, double theta)
  * fields), then sin^2 theta = 1/(1+t'^2), sin 2theta = 2t'/(1+t'^2), theta = pi/2 - atan t'. */
 static double hf_sky_term(double t, double nz, double a, double inv_k, double lobe)
 {
-    double tc = -a / nz, q, theta;
+    double tc, q, theta, r;
+    /* nz = 0: a vertical receiver, or a float normal whose z underflowed (tiny cells): the
+     * limits of tc = -a/nz; facing away (a <= 0), the direction lies below the tangent plane */
+    if (nz > 0.0) tc = -a / nz;
+    else if (a > 0.0) tc = -HF_INF;
+    else return 0.0;
     if (t > tc) tc = t;
+    if (isinf(tc)) { /* tc = -inf: q = 0, tc q -> 0, theta = pi */
+        return tc > 0.0 ? 0.0 : lobe * a * HF_PI;
+    }
     q = 1.0 / (1.0 + tc * tc);
     theta = HF_HALF_PI - atan(tc);
-    return nz * inv_k * q + lobe * a * (theta - tc * q);
+    /* The term integrates a cosine over the visible arc, so it is >= 0; for a steep horizon
+     * (large tc) theta - tc q cancels to about 2/(3 tc^3) and rounding can dip below 0. */
+    r = nz * inv_k * q + lobe * a * (theta - tc * q);
+    return r > 0.0 ? r : 0.0;
 }
 
 /* The common head of every fused consumer's context. */
@@ -2645,7 +2797,18 @@ hfvis_status hfvis_sky_light_from_map(const hfvis_grid *grid, int K, double map_
 }
 
 /* Sky-view factor term per direction: sin(max(alpha, 0)) = t/sqrt(1+t^2) for t > 0. */
-static double hf_svf_term(double t) { return t > 0.0 ? t / sqrt(1.0 + t * t) : 0.0; }
+/* sin(atan(t)) without overflow: t/sqrt(1 + t^2), or for |t| past the square's range (heights
+ * over tiny cells) sign(t)/sqrt(1 + (1/t)^2). */
+static double hf_tan_sine(double t)
+{
+    if (fabs(t) > HF_SLOPE_SQUARE_MAX) {
+        double r = 1.0 / t;
+        return (t > 0.0 ? 1.0 : -1.0) / sqrt(1.0 + r * r);
+    }
+    return t / sqrt(1.0 + t * t);
+}
+
+static double hf_svf_term(double t) { return t > 0.0 ? hf_tan_sine(t) : 0.0; }
 
 static void hf_svf_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdiff_t step, int n,
                         const double *t)
@@ -3885,7 +4048,7 @@ static size_t hf_p2_extra_size(const hfvis_grid *g, const hfvis_sweep_options *o
     hf_align_add(&total, len, 4 * sizeof(double), ok);
     hf_align_add(&total, len, (size_t)channels * sizeof(double), ok);
     hf_align_add(&total, len, 2 * sizeof(int), ok);
-    if (channels) hf_align_add(&total, D * D, (size_t)channels * sizeof(double), ok);
+    if (channels) hf_align_add(&total, hf_lattice_nodes_bound(g, (int)D), (size_t)channels * sizeof(double), ok);
     *len_out = (int)len;
     return total;
 }
@@ -3900,7 +4063,8 @@ static void hf_p2_carve(hf_sweep *sw, hf_p2_ctx *c)
     o_line = hf_align_add(&total, len, 4 * sizeof(double), &ok);
     o_exit = hf_align_add(&total, len, (size_t)c->channels * sizeof(double), &ok);
     o_int = hf_align_add(&total, len, 2 * sizeof(int), &ok);
-    if (c->channels) o_lat = hf_align_add(&total, D * D, (size_t)c->channels * sizeof(double), &ok);
+    if (c->channels)
+        o_lat = hf_align_add(&total, hf_lattice_nodes_bound(sw->g, (int)D), (size_t)c->channels * sizeof(double), &ok);
     HFVIS_ASSERT(ok && total <= sw->extra_size);
     hfvis_hull_tree_init(sw->extra + o_tree, tree, c->len, c->tree_opts, &c->tree);
     c->ld = (double *)(void *)(sw->extra + o_line);
@@ -5403,7 +5567,6 @@ static void hf_ns_lobe(const double *Ahat, const double *a, double *F)
     for (i = 0; i < NS_SH_N; i++) F[i] *= Ahat[hf_ns_band(i)];
 }
 
-static double hf_ns_sine(double t) { return t / sqrt(1.0 + t * t); }
 
 /* acc (16) += G (16x4, row-major) * w (4). */
 static void hf_ns_acc(double *acc, const double *G, const double *w)
@@ -6290,7 +6453,7 @@ static double hf_ns_smax(hf_ns_ctx *c, int nv)
         double t = c->tv[0];
         for (i = 1; i < nv; i++)
             if (c->tv[i] > t) t = c->tv[i];
-        return hf_ns_sine(t);
+        return hf_tan_sine(t);
     }
     return sin(hf_ns_omax_bspline(c->tv, nv, c->wc, c->wa));
 }
@@ -6535,7 +6698,7 @@ static void hf_ns_bounce_rec(hf_ns_ctx *c, double X, double Y, const double *N, 
                     }
                 }
             }
-            hf_ns_vbar(hf_ns_sine(e->t), c->vb + (size_t)q * 4u);
+            hf_ns_vbar(hf_tan_sine(e->t), c->vb + (size_t)q * 4u);
         }
         hf_ns_vbar(smin, vm);
         /* Eq. 12 (spec B.3 errata): Sum_k (u_k - u_(k+1)) vbar(omega_k) - u_0 vbar(omega_min) */
@@ -7017,8 +7180,9 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
     return s;
 }
 
-#define HF_PARTIAL_MAGIC "HFVISSUM 1\n"
+#define HF_PARTIAL_MAGIC "HFVISSUM 2\n"
 #define HF_PARTIAL_MAGIC_LEN 11u
+#define HF_PARTIAL_CRC_LEN 4u /* the trailing hfvis_crc32 of everything before it */
 #define HF_PARTIAL_NUMBERS 6
 
 /* The six header numbers of p, or 0 if p is invalid; *values receives planes*width*height. */
@@ -7074,7 +7238,7 @@ size_t hfvis_partial_encode_size(const hfvis_partial *p)
     unsigned char line[6 * 12];
     size_t values, tag_len, head, bytes;
     if (!hf_partial_valid(p, &values, &tag_len)) return 0;
-    head = HF_PARTIAL_MAGIC_LEN + hf_partial_numbers(p, line) + tag_len + 1u;
+    head = HF_PARTIAL_MAGIC_LEN + hf_partial_numbers(p, line) + tag_len + 1u + HF_PARTIAL_CRC_LEN;
     if (!hf_mul_size(values, 8u, &bytes) || bytes > SIZE_MAX - head) return 0;
     return head + bytes;
 }
@@ -7084,6 +7248,7 @@ hfvis_status hfvis_partial_encode(const hfvis_partial *p, void *out, size_t out_
 {
     unsigned char *dst = (unsigned char *)out;
     size_t need = hfvis_partial_encode_size(p), values, tag_len, i;
+    uint32_t crc;
     int b;
     if (!out || !written || need == 0 || !hf_partial_valid(p, &values, &tag_len))
         return HFVIS_ERR_INVALID_ARGUMENT;
@@ -7099,6 +7264,8 @@ hfvis_status hfvis_partial_encode(const hfvis_partial *p, void *out, size_t out_
         memcpy(&u, &p->sums[i], 8);
         for (b = 0; b < 8; b++) *dst++ = (unsigned char)((u >> (8 * b)) & 0xffu);
     }
+    crc = hfvis_crc32(0, out, need - HF_PARTIAL_CRC_LEN);
+    for (b = 0; b < 4; b++) *dst++ = (unsigned char)((crc >> (8 * b)) & 0xffu);
     *written = need;
     return HFVIS_OK;
 }
@@ -7122,15 +7289,13 @@ static int hf_partial_number(const unsigned char *data, size_t size, size_t *pos
     return 1;
 }
 
-hfvis_status hfvis_partial_decode(const void *data, size_t size, const hfvis_allocator *alloc,
-                                  hfvis_partial *p)
+/* The header of a partial-sum file in d[0..size) (size may end anywhere after it): the numbers
+ * into r, the tag's offset and length, the body's offset and its value count. */
+static hfvis_status hf_partial_header(const unsigned char *d, size_t size, hfvis_partial *r,
+                                      size_t *tag_at, size_t *tag_bytes, size_t *body, size_t *count)
 {
-    const unsigned char *d = (const unsigned char *)data;
-    hfvis_partial r;
     int v[HF_PARTIAL_NUMBERS], i;
-    size_t pos = HF_PARTIAL_MAGIC_LEN, tag0, tag_len, values, bytes, block, k;
-    unsigned char *mem;
-    if (!data || !p) return HFVIS_ERR_INVALID_ARGUMENT;
+    size_t pos = HF_PARTIAL_MAGIC_LEN, tag0, tag_len, values;
     if (size < HF_PARTIAL_MAGIC_LEN || memcmp(d, HF_PARTIAL_MAGIC, HF_PARTIAL_MAGIC_LEN) != 0)
         return HFVIS_ERR_FORMAT;
     for (i = 0; i < HF_PARTIAL_NUMBERS; i++)
@@ -7145,20 +7310,56 @@ hfvis_status hfvis_partial_decode(const void *data, size_t size, const hfvis_all
     if (pos >= size || d[pos] != '\n' || tag_len == 0 || tag_len > HFVIS_PARTIAL_MAX_TAG)
         return HFVIS_ERR_FORMAT;
     pos++;
-    memset(&r, 0, sizeof r);
-    r.width = v[0], r.height = v[1], r.planes = v[2], r.directions = v[3], r.begin = v[4], r.end = v[5];
-    if (r.width < 1 || r.height < 1 || r.planes < 1 || r.directions < 1 || r.begin >= r.end ||
-        r.end > r.directions)
+    memset(r, 0, sizeof *r);
+    r->width = v[0], r->height = v[1], r->planes = v[2], r->directions = v[3], r->begin = v[4], r->end = v[5];
+    if (r->width < 1 || r->height < 1 || r->planes < 1 || r->directions < 1 || r->begin >= r->end ||
+        r->end > r->directions)
         return HFVIS_ERR_FORMAT;
-    if (r.width > HFVIS_IMAGE_MAX_DIM || r.height > HFVIS_IMAGE_MAX_DIM || r.planes > HFVIS_PARTIAL_MAX_PLANES)
+    if (r->width > HFVIS_IMAGE_MAX_DIM || r->height > HFVIS_IMAGE_MAX_DIM || r->planes > HFVIS_PARTIAL_MAX_PLANES)
         return HFVIS_ERR_LIMIT;
-    values = (size_t)r.width * (size_t)r.height;
-    if (!hf_mul_size(values, (size_t)r.planes, &values) ||
+    values = (size_t)r->width * (size_t)r->height;
+    if (!hf_mul_size(values, (size_t)r->planes, &values) ||
         (unsigned long long)values > HFVIS_PARTIAL_MAX_VALUES || values > SIZE_MAX / 8u)
         return HFVIS_ERR_LIMIT;
+    *tag_at = tag0;
+    *tag_bytes = tag_len;
+    *body = pos;
+    *count = values;
+    return HFVIS_OK;
+}
+
+#ifndef HFVIS_NO_STDIO
+/* The partial-sum file's sizer (hfvis__read_file): header, body, checksum. */
+static hfvis_status hf_partial_sizer(const unsigned char *head, size_t n, size_t *total)
+{
+    hfvis_partial r;
+    size_t tag0, tag_len, pos, values;
+    hfvis_status s = hf_partial_header(head, n, &r, &tag0, &tag_len, &pos, &values);
+    if (s != HFVIS_OK) return s;
+    if (values > (SIZE_MAX - pos - HF_PARTIAL_CRC_LEN) / 8u) return HFVIS_ERR_LIMIT;
+    *total = pos + values * 8u + HF_PARTIAL_CRC_LEN;
+    return HFVIS_OK;
+}
+#endif
+
+hfvis_status hfvis_partial_decode(const void *data, size_t size, const hfvis_allocator *alloc,
+                                  hfvis_partial *p)
+{
+    const unsigned char *d = (const unsigned char *)data;
+    hfvis_partial r;
+    size_t pos, tag0, tag_len, values, bytes, block, k;
+    uint32_t crc;
+    unsigned char *mem;
+    hfvis_status s;
+    if (!data || !p) return HFVIS_ERR_INVALID_ARGUMENT;
+    s = hf_partial_header(d, size, &r, &tag0, &tag_len, &pos, &values);
+    if (s != HFVIS_OK) return s;
     bytes = values * 8u;
-    if (bytes > SIZE_MAX - tag_len - 1u) return HFVIS_ERR_LIMIT;
-    if (size - pos != bytes) return HFVIS_ERR_FORMAT;
+    if (bytes > SIZE_MAX - tag_len - 1u - HF_PARTIAL_CRC_LEN) return HFVIS_ERR_LIMIT;
+    if (size - pos != bytes + HF_PARTIAL_CRC_LEN) return HFVIS_ERR_FORMAT;
+    for (k = 0, crc = 0; k < HF_PARTIAL_CRC_LEN; k++)
+        crc |= (uint32_t)d[size - HF_PARTIAL_CRC_LEN + k] << (8u * k);
+    if (hfvis_crc32(0, d, size - HF_PARTIAL_CRC_LEN) != crc) return HFVIS_ERR_FORMAT;
     block = bytes + tag_len + 1u;
     mem = (unsigned char *)hf_alloc(alloc, block);
     if (!mem) return HFVIS_ERR_OUT_OF_MEMORY;
@@ -7195,7 +7396,7 @@ hfvis_status hfvis_partial_save(const char *path, const hfvis_partial *p)
     buf = (unsigned char *)hf_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_partial_encode(p, buf, need, &written);
-    if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
+    if (s == HFVIS_OK) s = hfvis_write_file(path, buf, written, NULL);
     hf_free(NULL, buf);
     return s;
 }
@@ -7206,7 +7407,7 @@ hfvis_status hfvis_partial_load(const char *path, const hfvis_allocator *alloc, 
     size_t size;
     hfvis_status s;
     if (!path || !p) return HFVIS_ERR_INVALID_ARGUMENT;
-    s = hfvis__read_file(path, alloc, &data, &size);
+    s = hfvis__read_file(path, alloc, hf_partial_sizer, &data, &size);
     if (s != HFVIS_OK) return s;
     s = hfvis_partial_decode(data, size, alloc, p);
     hf_free(alloc, data);

@@ -225,13 +225,20 @@ typedef struct hfvis_allocator {
  * same allocator (NULL = free). ptr may be NULL. */
 HFVIS_API void hfvis_free(const hfvis_allocator *alloc, void *ptr);
 
+/* CRC-32 (ISO-HDLC: the polynomial of PNG, zlib and gzip) of n bytes continuing crc (start from
+ * 0): hfvis_crc32(0, "123456789", 9) = 0xCBF43926. data may be NULL when n is 0. Pure helper;
+ * the partial-sum files carry one, the PNG writer of the examples uses it for its chunks. */
+HFVIS_API uint32_t hfvis_crc32(uint32_t crc, const void *data, size_t n);
+
 /* A height field. See CONVENTIONS. */
 typedef struct hfvis_grid {
     const float *z;        /* heights, z[y*stride + x]; non-finite = hole */
     int width;             /* samples per row, >= 1 */
     int height;            /* rows, >= 1 */
     ptrdiff_t stride;      /* elements between rows, >= width */
-    double cell_size;      /* world distance between adjacent samples, > 0, same unit as z */
+    double cell_size;      /* world distance between adjacent samples, > 0, same unit as z;
+                              outputs keep their documented ranges while max|z| / cell_size
+                              <= 1e150 (heights in cells, in double; test/fuzz/fuzz_heightfield) */
 } hfvis_grid;
 
 /* What lies outside the grid. 0 is the default (OPEN). */
@@ -306,10 +313,35 @@ HFVIS_API hfvis_status hfvis_pgm_encode(const float *pixels, int width, int heig
                                         void *out, size_t out_capacity, size_t *written);
 
 /* File wrappers (absent with HFVIS_NO_STDIO). load reads PGM or PFM, allocates *pixels with
- * alloc (NULL = malloc; release with hfvis_free) and fills info. save writes to a temporary
+ * alloc (NULL = malloc; release with hfvis_free) and fills info. Every *_load of the library
+ * reads the header first (the first 64 KiB at most; a header longer than that is refused) and
+ * refuses a bad one before reading further; then exactly the bytes the header announces and one
+ * more (P5/PFM samples: trailing data is ignored, as by the decoders; partial-sum and field
+ * files: trailing data is refused); a file shorter than announced is HFVIS_ERR_FORMAT, a regular
+ * file without allocating for it. P2 (ASCII) and binvox bodies have no announced size and are
+ * read whole after the header check; OBJ (hfvis_mesh_load) has no header and is read whole. save writes to a temporary
  * file beside path and renames it, so path is either complete or untouched.
  * Returns the decoder's errors, HFVIS_ERR_IO if the file cannot be read or written, or
  * HFVIS_ERR_OUT_OF_MEMORY. */
+/* How hfvis_write_file reports its temporary file (opts may be NULL). */
+typedef struct hfvis_write_options {
+    /* Called with the temporary name just before the file is created, and with NULL once it is
+     * renamed onto path or removed: a program that may be interrupted keeps a copy of the name
+     * (the hfvis tool unlinks it from its SIGINT/SIGTERM/SIGHUP handler). May be NULL. */
+    void (*on_temp)(void *user, const char *temp_path);
+    void *user;
+} hfvis_write_options;
+
+/* Write n bytes to path atomically, as every saver of the library does: the bytes go to a
+ * temporary file beside path ("<path>.tmp<8 hex digits>"; when that name's last component would
+ * exceed 255 bytes, the component is cut so the name fits), which is then renamed onto path.
+ * path is either complete or untouched; on failure the temporary file is removed. bytes may be
+ * NULL when n is 0. A symbolic link at path is replaced by the file, not written through.
+ * Returns HFVIS_OK, HFVIS_ERR_INVALID_ARGUMENT (NULL or empty path, NULL bytes with n > 0),
+ * HFVIS_ERR_IO or HFVIS_ERR_OUT_OF_MEMORY (the name). */
+HFVIS_API hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
+                                        const hfvis_write_options *opts);
+
 HFVIS_API hfvis_status hfvis_image_load(const char *path, const hfvis_allocator *alloc,
                                         float **pixels, hfvis_image_info *info);
 HFVIS_API hfvis_status hfvis_pfm_save(const char *path, const float *pixels, int width,
@@ -423,7 +455,11 @@ typedef struct hfvis_lattice {
     int width, height;          /* of the grid */
 } hfvis_lattice;
 
-/* Set up the lattice of look direction azimuth_rad over a width x height grid.
+/* Set up the lattice of look direction azimuth_rad over a width x height grid. The domain is
+ * [0, width-1] x [0, height-1] (nodes within 1e-9 cell of its border inside), except that an axis
+ * of one sample spans [-0.5, 0.5]: a grid one sample wide or tall is a strip one cell wide with
+ * heights constant across it, so that every line crossing it holds a node and every grid point
+ * has nodes to gather from (a line of zero width would hold a node only by chance).
  * Returns HFVIS_ERR_INVALID_ARGUMENT for NULL, sizes < 1 or a non-finite azimuth, and
  * HFVIS_ERR_LIMIT if the lattice would exceed 2^31 nodes. */
 HFVIS_API hfvis_status hfvis_lattice_init(hfvis_lattice *lattice, int width, int height,
@@ -505,7 +541,8 @@ HFVIS_API hfvis_status hfvis_line_horizons_naive(const double *distance, const d
 /* Raw lattice output of one direction, for GPU-port diffing: the horizon elevation angle at
  * every lattice node of hfvis_lattice_init(width, height, azimuth_rad); NaN at nodes outside the
  * grid and at holes. out must hold hfvis_lattice_size() floats.
- * Allocates 1 block of about 8*(W^2+H^2) bytes (the sampled lattice). Cost O(width*height). */
+ * Allocates 1 block of about 8*min(W^2+H^2, (W+H)^2/2) bytes (the sampled lattice: the largest
+ * buffer over all directions, half the diagonal's square for a thin grid). Cost O(width*height). */
 HFVIS_API hfvis_status hfvis_horizon_lattice(const hfvis_grid *grid, double azimuth_rad,
                                              const hfvis_sweep_options *opts, float *out);
 
@@ -1624,11 +1661,13 @@ HFVIS_API hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis
 
 /* The partial-sum file ("HFVISSUM"): the sums (or horizon planes) of one direction range of one
  * run, with what is needed to check that parts belong together. Layout, byte for byte:
- *   "HFVISSUM 1\n"
+ *   "HFVISSUM 2\n"
  *   "<width> <height> <planes> <directions> <begin> <end>\n"   decimal, single spaces
  *   "<tag>\n"                                                  1..HFVIS_PARTIAL_MAX_TAG bytes
  *   planes*height*width little-endian IEEE-754 doubles, sums[(p*height + y)*width + x]
- * and nothing after. The tag is printable ASCII (32..126) chosen by the producer; the hfvis
+ *   4 bytes: hfvis_crc32 of every byte before them, little-endian
+ * and nothing after. A file whose checksum does not match is HFVIS_ERR_FORMAT, as is a version-1
+ * file ("HFVISSUM 1\n", no checksum: written by hfvis 0.1.0 before the checksum; rerun it). The tag is printable ASCII (32..126) chosen by the producer; the hfvis
  * tool stores its command and every parameter that changes the result there. */
 #define HFVIS_PARTIAL_MAX_TAG 4096
 #define HFVIS_PARTIAL_MAX_PLANES 65536

@@ -72,9 +72,9 @@
 #ifndef HFVIS_NO_STDIO
 /* Internal, defined in hfvis.c (section 2): whole-file read into a block from alloc, and an
  * atomic write (temporary file renamed onto path: the target is complete or untouched). */
-hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, unsigned char **data,
-                             size_t *size);
-hfvis_status hfvis__write_file(const char *path, const unsigned char *bytes, size_t n);
+hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc,
+                             hfvis_status (*sizer)(const unsigned char *head, size_t n, size_t *total),
+                             unsigned char **data, size_t *size);
 #endif
 
 static void *vx_alloc(const hfvis_allocator *a, size_t bytes)
@@ -1650,7 +1650,7 @@ HFVIS_API hfvis_status hfvis_mesh_load(const char *path, const hfvis_allocator *
     size_t size = 0;
     hfvis_status s;
     if (!path || !out) return HFVIS_ERR_INVALID_ARGUMENT;
-    s = hfvis__read_file(path, alloc, &data, &size);
+    s = hfvis__read_file(path, alloc, NULL, &data, &size); /* text without a size: read whole */
     if (s != HFVIS_OK) return s;
     s = hfvis_obj_decode(data, size, alloc, out);
     vx_free(alloc, data);
@@ -1668,7 +1668,7 @@ HFVIS_API hfvis_status hfvis_mesh_save(const char *path, const hfvis_mesh *mesh)
     buf = (unsigned char *)vx_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     written = vx_mesh_obj_emit(mesh, buf);
-    s = hfvis__write_file(path, buf, written);
+    s = hfvis_write_file(path, buf, written, NULL);
     vx_free(NULL, buf);
     return s;
 }
@@ -5643,9 +5643,18 @@ HFVIS_API hfvis_status hfvis_binvox_save(const char *path, const hfvis_volume_gr
     buf = (unsigned char *)vx_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_binvox_encode(grid, occ, buf, need, &written);
-    if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
+    if (s == HFVIS_OK) s = hfvis_write_file(path, buf, written, NULL);
     vx_free(NULL, buf);
     return s;
+}
+
+/* The binvox sizer (hfvis__read_file): the magic first; the run-length body has no announced
+ * size, so the rest is read whole. */
+static hfvis_status vx_binvox_sizer(const unsigned char *head, size_t n, size_t *total)
+{
+    size_t i = 0;
+    (void)total;
+    return vx_cons_keyword(head, n, &i, "#binvox") ? HFVIS_OK : HFVIS_ERR_FORMAT;
 }
 
 HFVIS_API hfvis_status hfvis_binvox_load(const char *path, const hfvis_allocator *alloc,
@@ -5655,7 +5664,7 @@ HFVIS_API hfvis_status hfvis_binvox_load(const char *path, const hfvis_allocator
     size_t size = 0;
     hfvis_status s;
     if (!path || !grid || !occ) return HFVIS_ERR_INVALID_ARGUMENT;
-    s = hfvis__read_file(path, alloc, &data, &size);
+    s = hfvis__read_file(path, alloc, vx_binvox_sizer, &data, &size);
     if (s != HFVIS_OK) return s;
     s = hfvis_binvox_decode(data, size, alloc, grid, occ);
     vx_free(alloc, data);
@@ -5666,7 +5675,7 @@ HFVIS_API hfvis_status hfvis_voxels_raw_save(const char *path, const hfvis_volum
                                              const uint8_t *voxels)
 {
     if (!path || !voxels || !vx_grid_valid(grid)) return HFVIS_ERR_INVALID_ARGUMENT;
-    return hfvis__write_file(path, voxels, vx_grid_voxels(grid));
+    return hfvis_write_file(path, voxels, vx_grid_voxels(grid), NULL);
 }
 #endif /* HFVIS_NO_STDIO */
 
@@ -8784,9 +8793,21 @@ HFVIS_API hfvis_status hfvis_visfield_save(const char *path, const hfvis_visfiel
     buf = (unsigned char *)vx_alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_visfield_encode(vf, buf, need, &written);
-    if (s == HFVIS_OK) s = hfvis__write_file(path, buf, written);
+    if (s == HFVIS_OK) s = hfvis_write_file(path, buf, written, NULL);
     vx_free(NULL, buf);
     return s;
+}
+
+/* The field file's sizer (hfvis__read_file): the 80-byte header's magic and payload size. */
+static hfvis_status vx_vf_sizer(const unsigned char *head, size_t n, size_t *total)
+{
+    uint64_t payload;
+    if (n < HFVIS_VISFIELD_FILE_HEADER || memcmp(head, vx_vf_magic, 8) != 0) return HFVIS_ERR_FORMAT;
+    payload = vx_vf_get64(head + 72);
+    if (payload > HFVIS_VISFIELD_MAX_BYTES || payload > (uint64_t)SIZE_MAX - HFVIS_VISFIELD_FILE_HEADER)
+        return HFVIS_ERR_LIMIT;
+    *total = HFVIS_VISFIELD_FILE_HEADER + (size_t)payload;
+    return HFVIS_OK;
 }
 
 HFVIS_API hfvis_status hfvis_visfield_load(const char *path, const hfvis_allocator *alloc,
@@ -8796,7 +8817,7 @@ HFVIS_API hfvis_status hfvis_visfield_load(const char *path, const hfvis_allocat
     size_t size = 0;
     hfvis_status s;
     if (!path || !out) return HFVIS_ERR_INVALID_ARGUMENT;
-    s = hfvis__read_file(path, alloc, &data, &size);
+    s = hfvis__read_file(path, alloc, vx_vf_sizer, &data, &size);
     if (s != HFVIS_OK) return s;
     s = hfvis_visfield_decode(data, size, alloc, out);
     vx_free(alloc, data);

@@ -1,8 +1,9 @@
 /* hfvis_cli.c - the `hfvis` command-line tool (DESIGN.md §4): horizon maps, sky-view factor,
  * uniform-sky light, sun shadows, environment light, normals, interreflected light, the
  * visibility index and viewsheds of PGM/PFM height fields; voxelization of OBJ meshes.
- * Every file is read and written through the library's codecs (hfvis_image_load, hfvis_*_save),
- * so the tool exercises exactly what a vendoring user gets. Errors: one line
+ * Every file is read and written through the library's codecs (hfvis_image_load, the encoders
+ * and hfvis_write_file), so the tool exercises exactly what a vendoring user gets; an interrupt
+ * (SIGINT, SIGTERM, SIGHUP) removes the temporary file of a write in progress. Errors: one line
  * "hfvis: <what>: <why>" on stderr, exit 1 (2 for usage errors); exit 0 means OUT is complete. */
 #define _POSIX_C_SOURCE 200809L /* isatty() under -std=c99 */
 #include <ctype.h>
@@ -14,10 +15,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
 #if defined(__unix__) || (defined(__APPLE__) && defined(__MACH__))
 #include <sys/stat.h> /* stat(): an output that is an input */
 #include <unistd.h>
 #define CLI_HAVE_ISATTY 1
+#define CLI_HAVE_SIGACTION 1
 #endif
 #include <time.h>
 #include "common.h"
@@ -29,6 +32,7 @@
 #define CLI_HORIZON_MAX_VALUES HFVIS_IMAGE_MAX_VALUES /* K*W*H limit of `horizon` (2^28 floats, 1 GiB) */
 #define CLI_MAX_BOUNCES 1000                      /* --bounces upper bound (one sweep each) */
 #define CLI_MAX_TARGETS 64                        /* viewshed --target points per run */
+#define CLI_MAX_RELIEF 1e150 /* |height| / cell: the slopes' squares stay far below DBL_MAX */
 #define CLI_EXIT_ERROR 1
 #define CLI_EXIT_USAGE 2
 #define CLI_RUN (-1)                              /* parse_args: go on and run the command */
@@ -166,14 +170,16 @@ enum { OUT_TOTAL, OUT_DIRECT, OUT_INDIRECT };
     "  --target X,Y,Z    point looked at (default: the bounding-box centre)\n"                     \
     "  --up X,Y,Z        up direction (default 0,0,1; 0,1,0 when looking along z)\n"              \
     "  --fov DEG         vertical field of view, 1..179 (default 45)\n"                            \
-    "  --size WxH        image size in pixels, 1..8192 each (default 512x384)\n"                  \
+    "  --size WxH        image size in pixels, 1..32768 each, at most 2^26 pixels\n"              \
+    "                    (default 512x384)\n"                                                     \
     "  --two-sided       every triangle occludes from both sides (default: only from the side its\n" \
     "                    normal, counter-clockwise winding, points to)\n"                         \
     "  --lut T           plane look-up table masks of T^3 nodes, 2..1024 (faster for many rays;\n"  \
     "                    approximate: rays within about one node of a plane may flip)\n"          \
     "  --seed S          seed of the ray pattern and the per-pixel jitter, 0..2^53 (default 0)\n"  \
     "  --no-jitter       no per-pixel rotation of the pattern (banding on flat areas)\n"          \
-    "  --stats           print the counts of the run (receivers, rays, culling) to stdout\n"       \
+    "  --stats           print the counts of the run (receivers, rays, culling) to stdout, before\n"   \
+    "                    OUT is written (if the print fails, OUT is left untouched)\n"       \
     "OUT is .pgm (16-bit, range 0:1; pixels without geometry 0) or .pfm (NaN there).\n"
 
 #define CLI_HILLSHADE_HELP                                                                           \
@@ -261,6 +267,7 @@ typedef struct cli_args {
     int lk_method, lk_rays, lk_pattern, lk_falloff, lk_width, lk_height, lk_two_sided, lk_lut, lk_no_jitter,
         lk_has_eye, lk_has_target, lk_has_up, lk_has_radius;
     double lk_radius, lk_fov, lk_seed, lk_eye[3], lk_target[3], lk_up[3];
+    double max_memory; /* --max-memory bytes, 0 = no limit (default: cli_default_max_memory) */
 } cli_args;
 
 /* ssao --method, --depth */
@@ -388,9 +395,18 @@ static const char cli_shared_help2[] =
     "                    directions); runs over 10 s end with the summary anyway (not --quiet)\n"
     "  --overwrite       allow OUT to be one of the inputs (refused otherwise: same file,\n"
     "                    through hard and symbolic links too)\n"
+    "  --max-memory B    refuse a run whose estimated memory exceeds B bytes (suffix K, M, G or\n"
+    "                    T: powers of 1024; 0 = no limit); default half of the physical memory\n"
+    "                    where the system reports it (sysconf), else no limit. The estimate and\n"
+    "                    the work (lattice nodes swept, rays, voxel updates) are printed on\n"
+    "                    stderr with the progress bar\n"
     "  -h, --help        this help; 'hfvis COMMAND --help' describes one command\n"
     "\n"
-    "Options take their value as the next argument or as --option=value.\n"
+    "Options take their value as the next argument or as --option=value; an option given twice\n"
+    "takes its last value (as most Unix tools; volgi's --light adds one light each time).\n"
+    "OUT is written to a temporary file beside it and renamed onto it: a symbolic link named\n"
+    "OUT is replaced by the file (write to the link's target to keep the link); an interrupt\n"
+    "(SIGINT, SIGTERM, SIGHUP) removes the temporary file.\n"
     "Exit status: 0 = OUT is complete, 1 = error, 2 = usage error; an error is one line\n"
     "\"hfvis: <what>: <why>\" on stderr, and OUT is then left untouched.\n";
 
@@ -493,7 +509,7 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "               with IN's holes, where every sample is seen; in [0, 1], 0 where the point's\n"
     "               lines hold no sample. Runs a second sweep in which every sample is visible,\n"
     "               O(K*W*H*N): 15 s at 1024 x 1024, K = 16 on one core\n"
-    "  --stats      after writing OUT, print the sweep's counters to stdout as averages per\n"
+    "  --stats      before writing OUT, print the sweep's counters to stdout as averages per\n"
     "               receiver-direction (lattice node and direction), as [P2] Tables 1-2:\n"
     "               visible samples, horizons m_a and tree iterations t_a; with --fraction also\n"
     "               the samples tested (the naive scan's iterations) and the ratios\n"
@@ -505,7 +521,8 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "0 where terrain hides it, NaN at holes and beyond --max-distance (0 in PGM). The terrain\n"
     "is the bilinear surface through the samples; a sight line that grazes it counts as\n"
     "visible. Method: R2 of Franklin & Ray 1994 (rays to every border sample, running maximum\n"
-    "slope), O(W*H); it differs from the exact line of sight (--exact) only at samples whose\n"
+    "slope), O((W + H) * max(W, H)): 2(W + H) rays of up to max(W, H) steps (a 1 x 1048576 grid\n"
+    "takes hours); it differs from the exact line of sight (--exact) only at samples whose\n"
     "sight line nearly grazes the terrain: measured from 8 observers (summit, valley, slope, 5\n"
     "random) on a 512 x 512 SRTM tile and a 512 x 512 fBm, on 0.005-1.2 % of the samples (mean\n"
     "0.2-0.4 %); the most from a summit, which sees the most.\n"
@@ -574,7 +591,7 @@ static const char *const cli_cmd_help[CMD_COUNT] = {
     "  --radius R        falloff rho = R^2/(R^2 + d^2) (view units); default none (rho = 1)\n"
     "  --dirs K          directions (default: lsao 16, hbao 16, ffao 8 x 2 segments; raytrace\n"
     "                    ignores it)\n"
-    "  --guard PIXELS    guard band per side (default 10 %% of the width and height)\n"
+    "  --guard PIXELS    guard band per side (default 10 % of the width and height)\n"
     "  --depth ENC       linear view depth (default), gl or d3d window depth, reversed Z; the\n"
     "                    hardware encodings need --near and --far\n"
     "Only -o, --dirs and --quiet of the shared options apply. Default PGM range 0:1.\n",
@@ -655,6 +672,16 @@ static void cli_progress(void *user, int done, int total)
     cli_bar_open = now < all;
     if (!cli_bar_open) fputc('\n', stderr);
     fflush(stderr);
+}
+
+/* --max-memory's default: half of the physical memory where sysconf reports it, else 0 (none). */
+static double cli_default_max_memory(void)
+{
+#if defined(CLI_HAVE_SIGACTION) && defined(_SC_PHYS_PAGES) && defined(_SC_PAGESIZE)
+    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    if (pages > 0 && page > 0) return 0.5 * (double)pages * (double)page;
+#endif
+    return 0.0;
 }
 
 static int cli_stderr_is_terminal(void)
@@ -975,6 +1002,8 @@ static int cli_check_vf(const cli_args *a)
         return 0;
     }
     if (a->has_range) return cli_error(CLI_EXIT_USAGE, "--range", "applies only to --ao images");
+    if (!cli_ends_with(a->out, ".hfvf"))
+        return cli_error(CLI_EXIT_USAGE, a->out, "unknown output type for a field (use a .hfvf name)");
     if (a->vf_has_ground || a->vf_has_extent || a->vf_has_size || a->vf_rays || a->vf_has_bias
         || a->vf_reference || a->max_distance > 0.0)
         return cli_error(CLI_EXIT_USAGE, a->vf_has_ground ? "--ground" : a->vf_has_extent ? "--extent"
@@ -1359,6 +1388,7 @@ static const cli_flag cli_flags[] = {
     { "--azimuth0", 1, CLI_ALL },   { "--compass", 0, CLI_ALL },     { "--degrees", 0, CLI_ALL },
     { "--border", 1, CLI_ALL },     { "--border-cells", 1, CLI_ALL }, { "--quiet", 0, CLI_ALL },
     { "--band", 1, CLI_ALL },
+    { "--max-memory", 1, CLI_ALL },
     { "--dir-range", 1, CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY)
                         | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VISIBILITY) },
     { "--sky", 1, CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
@@ -1450,6 +1480,21 @@ static int cli_set(cli_args *a, const char *f, const char *v)
             !((float)a->range_lo < (float)a->range_hi))
             return cli_error(CLI_EXIT_USAGE, f, "expected LO:HI with finite LO < HI, got '%s'", v);
         a->has_range = 1;
+        return 0;
+    }
+    if (!strcmp(f, "--max-memory")) { /* BYTES with an optional K, M, G or T (powers of 1024) */
+        char *end;
+        double m;
+        errno = 0;
+        m = strtod(v, &end);
+        if (end != v && *end) {
+            const char *u = "KMGT", *q = strchr(u, toupper((unsigned char)*end));
+            if (q && end[1] == '\0') m *= pow(1024.0, (double)(q - u + 1)), end++;
+        }
+        if (end == v || *end != '\0' || !(m >= 0.0) || !isfinite(m) || !isdigit((unsigned char)v[0]))
+            return cli_error(CLI_EXIT_USAGE, f, "expected bytes >= 0 with an optional K, M, G or T "
+                             "(0 = no limit), got '%s'", v);
+        a->max_memory = m;
         return 0;
     }
     if (!strcmp(f, "--cell")) {
@@ -1579,6 +1624,7 @@ static int cli_parse(int argc, char **argv, cli_args *a)
     int i, c, positional_only = 0;
     memset(a, 0, sizeof *a);
     a->cell = 1.0; a->zscale = 1.0; a->dirs = 16; a->sky = 1.0; a->albedo = 1.0;
+    a->max_memory = cli_default_max_memory();
     a->border = HFVIS_BORDER_OPEN; a->method = HFVIS_ENV_PREFIX;
     a->bounces = 1; a->sun_irradiance = CLI_PI; a->output = OUT_TOTAL;
     a->order = 4; a->subsample = 1;
@@ -1641,6 +1687,9 @@ static int cli_parse(int argc, char **argv, cli_args *a)
     if (!a->in && !(a->cmd == CMD_VOLGI && a->room))
         return cli_error(CLI_EXIT_USAGE, cli_cmd_names[a->cmd], "missing input file IN");
     if (!a->out) return cli_error(CLI_EXIT_USAGE, cli_cmd_names[a->cmd], "missing -o OUT");
+    if (a->sky * a->albedo > CLI_FLT_MAX) /* the sky light's scale: outputs would be inf */
+        return cli_error(CLI_EXIT_USAGE, "--sky/--albedo", "%g x %g exceeds the float range (3.4e38)",
+                         a->sky, a->albedo);
     if (a->has_range && !a->out_pgm)
         return cli_error(CLI_EXIT_USAGE, "--range", a->out_partial ? "applies to 'hfvis sum', not to "
                          "a partial result" : "applies only to .pgm output");
@@ -1779,12 +1828,87 @@ static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double 
     return 0;
 }
 
+/* What a run is expected to cost before it allocates: bytes at its peak and units of work. */
+typedef struct cli_cost {
+    double bytes, work;
+    const char *unit;
+} cli_cost;
+
+/* The estimate of a command on a w x h input (height fields, ssao) or from its flags (meshes,
+ * volumes). Height fields: input, output, the sweep's lattice (about min(W^2 + H^2,
+ * (W + H)^2/2) nodes of 8-byte heights, 12-byte normals and 8 bytes a channel), the grid
+ * accumulator; the work is K sweeps over the lattice. A model of the allocations, not a bound
+ * on them (the file buffers of the codecs come on top for a moment). */
+static cli_cost cli_estimate(const cli_args *a, int w, int h, int channels)
+{
+    cli_cost c;
+    double n = (double)w * (double)h, W = (double)w, H = (double)h, K = (double)a->dirs, lat, ch = channels;
+    double diag2 = W * W + H * H, thin = (W + H) * (W + H) / 2.0;
+    lat = diag2 < thin ? diag2 : thin;
+    c.bytes = 0.0, c.work = 0.0, c.unit = "lattice nodes swept";
+    switch (a->cmd) {
+    case CMD_VOXELIZE:
+        c.bytes = pow((double)a->res, 3.0), c.work = c.bytes, c.unit = "voxels";
+        return c;
+    case CMD_VOLGI:
+        c.bytes = pow((double)a->res, 3.0) * 4.0 * 16.0 + (double)a->vg_width * (double)a->vg_height * 12.0;
+        c.work = pow((double)a->res, 3.0) * (double)a->iterations, c.unit = "voxel updates";
+        return c;
+    case CMD_VISFIELD:
+        if (a->vf_ao) {
+            c.bytes = (double)a->vg_width * (double)a->vg_height * 4.0;
+            c.work = c.bytes / 4.0 * (double)(a->vf_rays ? a->vf_rays : 64), c.unit = "rays";
+        } else {
+            double P = (double)(a->vf_positions ? a->vf_positions : 82), D = (double)(a->has_dirs ? a->dirs : 16);
+            c.bytes = P * 2.0 * D * D * 4.0, c.work = P * 2.0 * D * D, c.unit = "direction texels";
+        }
+        return c;
+    case CMD_MESHAO:
+        c.bytes = (double)a->lk_width * (double)a->lk_height * 16.0;
+        c.work = (double)a->lk_width * (double)a->lk_height * (double)(a->lk_rays ? a->lk_rays : 64);
+        c.unit = "rays";
+        return c;
+    case CMD_SSAO:
+        c.bytes = n * 8.0, c.work = n * (a->has_dirs ? K : 16.0) * (W > H ? W : H) / 4.0, c.unit = "depth samples";
+        return c;
+    case CMD_VIEWSHED:
+        c.bytes = n * 8.0, c.work = (W + H) * (W > H ? W : H), c.unit = "line-of-sight steps";
+        return c;
+    case CMD_HORIZON: ch = 4.0; break;
+    case CMD_GI: c.bytes = n * 4.0 * 64.0; break; /* the NS09 pyramids and SH planes */
+    default: break;
+    }
+    c.bytes += n * 4.0 + n * 4.0 * (a->cmd == CMD_HORIZON ? K : (double)channels); /* in, out */
+    c.bytes += lat * (8.0 + 12.0 + 8.0 * ch) + n * (12.0 + 8.0 * ch);             /* sweep */
+    if (a->cmd == CMD_VISIBILITY || a->cmd == CMD_INDIRECT) c.bytes += lat * 8.0 * ch;
+    c.work = K * (n + lat / 4.0);
+    if (a->cmd == CMD_INDIRECT) c.work *= (double)(a->bounces + 1);
+    if (a->cmd == CMD_VISIBILITY && a->fraction) c.work *= 2.0;
+    return c;
+}
+
+/* Print the estimate with the progress bar or the --progress lines, and refuse a run past
+ * --max-memory (0 = none). */
+static int cli_check_cost(const cli_args *a, int w, int h, int channels)
+{
+    const char *cmd = cli_cmd_names[a->cmd];
+    cli_cost c = cli_estimate(a, w, h, channels);
+    if (!a->quiet && (a->progress_lines || cli_stderr_is_terminal()))
+        fprintf(stderr, "%s: estimate %.3g MiB, %.3g %s\n", cmd, c.bytes / 1048576.0, c.work, c.unit);
+    if (a->max_memory > 0.0 && c.bytes > a->max_memory)
+        return cli_error(CLI_EXIT_ERROR, cmd, "needs about %.3g MiB (%.3g %s), over --max-memory %.3g "
+                         "MiB; raise --max-memory or make the run smaller (input, --dir-range, flags)",
+                         c.bytes / 1048576.0, c.work, c.unit, a->max_memory / 1048576.0);
+    return 0;
+}
+
 /* Load IN as a one-channel height field; --nodata values become NaN, the rest are scaled.
  * *cell: --cell, else the raster's cell size, else 1 (with a note unless --quiet). */
 static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double *cell)
 {
     hfvis_image_info info;
     float *px = NULL, zscale = (float)a->zscale, nodata = (float)a->nodata;
+    double top = 0.0; /* largest |height| */
     size_t i, n;
     hfvis_status s;
     *cell = a->cell;
@@ -1808,8 +1932,26 @@ static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double
     }
     n = (size_t)*w * (size_t)*h; /* <= HFVIS_IMAGE_MAX_VALUES (decoder limit) */
     for (i = 0; i < n; i++) {
-        if (a->has_nodata && px[i] == nodata) px[i] = (float)NAN;
-        else px[i] *= zscale;
+        float v = px[i];
+        if (a->has_nodata && v == nodata) {
+            px[i] = (float)NAN;
+            continue;
+        }
+        px[i] = v * zscale;
+        if (isfinite(v) && !isfinite(px[i])) { /* not a hole: refused, never silently one */
+            hfvis_free(NULL, px);
+            return cli_error(CLI_EXIT_ERROR, "--zscale", "%g times the value %g at (%lu, %lu) "
+                             "exceeds the float range (3.4e38)", a->zscale, (double)v,
+                             (unsigned long)(i % (size_t)*w), (unsigned long)(i / (size_t)*w));
+        }
+        if (fabs((double)px[i]) > top) top = fabs((double)px[i]);
+    }
+    /* heights in cells (z / cell, in double) and their squares must stay finite */
+    if (top / *cell > CLI_MAX_RELIEF || *cell < DBL_MIN) {
+        hfvis_free(NULL, px);
+        return cli_error(CLI_EXIT_ERROR, "--cell", "%g is too small for heights up to %g: their ratio "
+                         "must stay below %g (and the cell at least %g)", *cell, top, CLI_MAX_RELIEF,
+                         DBL_MIN);
     }
     if (a->has_nodata && !cli_geo.has_nodata) { /* --nodata is the outputs' NoData too */
         cli_geo.has_nodata = 1;
@@ -1870,6 +2012,148 @@ static int cli_integral_type(const cli_args *a, const float *px, size_t n, ex_ge
     return 1;
 }
 
+/* ------------------------------------------------------------------------------------------ */
+/* writing: every file goes through hfvis_write_file, whose temporary name is kept here so that  */
+/* SIGINT, SIGTERM and SIGHUP remove it (the handler unlinks it and re-raises the signal)        */
+/* ------------------------------------------------------------------------------------------ */
+
+#define CLI_TMP_CAP 4096 /* longest temporary name the handler can remove (PATH_MAX on Linux) */
+static char cli_tmp_name[CLI_TMP_CAP];
+static volatile sig_atomic_t cli_tmp_armed; /* cli_tmp_name names a file that may exist */
+
+/* hfvis_write_options.on_temp: armed only after the name is complete, disarmed before it changes. */
+static void cli_on_temp(void *user, const char *tmp)
+{
+    size_t n = tmp ? strlen(tmp) : 0;
+    (void)user;
+    cli_tmp_armed = 0;
+    if (!tmp || n >= CLI_TMP_CAP) return;
+    memcpy(cli_tmp_name, tmp, n + 1);
+    cli_tmp_armed = 1;
+}
+
+#ifdef CLI_HAVE_SIGACTION
+/* Async-signal-safe: unlink the temporary file, restore the default action and re-raise, so the
+ * exit status says which signal ended the run (130 for SIGINT, 143 for SIGTERM in a shell). */
+static void cli_on_signal(int sig)
+{
+    if (cli_tmp_armed) unlink(cli_tmp_name);
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+/* Install the handler for SIGINT, SIGTERM and SIGHUP, leaving an ignored signal ignored. */
+static void cli_signals(void)
+{
+    static const int sigs[3] = { SIGINT, SIGTERM, SIGHUP };
+    int i;
+    for (i = 0; i < 3; i++) {
+        struct sigaction sa, old;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = cli_on_signal;
+        sigemptyset(&sa.sa_mask);
+        if (sigaction(sigs[i], NULL, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+        sigaction(sigs[i], &sa, NULL);
+    }
+}
+#else
+static void cli_signals(void) {}
+#endif
+
+/* Write n bytes to path (hfvis_write_file with the temporary name recorded), freeing bytes. */
+static hfvis_status cli_write(const char *path, unsigned char *bytes, size_t n, hfvis_status s)
+{
+    hfvis_write_options wo;
+    wo.on_temp = cli_on_temp;
+    wo.user = NULL;
+    if (s == HFVIS_OK) s = hfvis_write_file(path, bytes, n, &wo);
+    free(bytes);
+    return s;
+}
+
+/* The library's savers, through cli_write: encode into memory (need bytes), then write. */
+typedef hfvis_status (*cli_encoder)(const void *what, void *out, size_t cap, size_t *written);
+static hfvis_status cli_write_encoded(const char *path, size_t need, cli_encoder encode, const void *what)
+{
+    unsigned char *buf = need ? (unsigned char *)malloc(need) : NULL;
+    size_t written = 0;
+    hfvis_status s;
+    if (!buf) return need ? HFVIS_ERR_OUT_OF_MEMORY : HFVIS_ERR_INVALID_ARGUMENT;
+    s = encode(what, buf, need, &written);
+    return cli_write(path, buf, written, s);
+}
+typedef struct cli_image { /* the arguments of hfvis_pfm_encode / hfvis_pgm_range_encode */
+    const float *px;
+    int w, h, channels;
+    ptrdiff_t stride;
+    float lo, hi;
+} cli_image;
+typedef struct cli_voxels {
+    const hfvis_volume_grid *grid;
+    const uint8_t *occ;
+} cli_voxels;
+static hfvis_status cli_enc_pfm(const void *what, void *out, size_t cap, size_t *written)
+{
+    const cli_image *m = (const cli_image *)what;
+    return hfvis_pfm_encode(m->px, m->w, m->h, m->channels, m->stride, out, cap, written);
+}
+static hfvis_status cli_enc_binvox(const void *what, void *out, size_t cap, size_t *written)
+{
+    const cli_voxels *v = (const cli_voxels *)what;
+    return hfvis_binvox_encode(v->grid, v->occ, out, cap, written);
+}
+static hfvis_status cli_enc_visfield(const void *what, void *out, size_t cap, size_t *written)
+{
+    return hfvis_visfield_encode((const hfvis_visfield *)what, out, cap, written);
+}
+static hfvis_status cli_enc_partial(const void *what, void *out, size_t cap, size_t *written)
+{
+    return hfvis_partial_encode((const hfvis_partial *)what, out, cap, written);
+}
+static hfvis_status cli_pfm_save(const char *path, const float *px, int w, int h, int channels, ptrdiff_t stride)
+{
+    cli_image m;
+    memset(&m, 0, sizeof m);
+    m.px = px, m.w = w, m.h = h, m.channels = channels, m.stride = stride;
+    return cli_write_encoded(path, hfvis_pfm_encode_size(w, h, channels), cli_enc_pfm, &m);
+}
+static hfvis_status cli_enc_pgm_range(const void *what, void *out, size_t cap, size_t *written)
+{
+    const cli_image *m = (const cli_image *)what;
+    return hfvis_pgm_range_encode(m->px, m->w, m->h, m->stride, m->lo, m->hi, out, cap, written);
+}
+/* A NoData-safe 16-bit PGM with its range in the header (hfvis_pgm_range_encode). */
+static hfvis_status cli_pgm_save(const char *path, const float *px, int w, int h, ptrdiff_t stride,
+                                 float lo, float hi)
+{
+    cli_image m;
+    memset(&m, 0, sizeof m);
+    m.px = px, m.w = w, m.h = h, m.stride = stride, m.lo = lo, m.hi = hi;
+    return cli_write_encoded(path, hfvis_pgm_range_encode_size(w, h, lo, hi), cli_enc_pgm_range, &m);
+}
+static hfvis_status cli_binvox_save(const char *path, const hfvis_volume_grid *grid, const uint8_t *occ)
+{
+    cli_voxels v;
+    v.grid = grid, v.occ = occ;
+    return cli_write_encoded(path, hfvis_binvox_encode_size(grid, occ), cli_enc_binvox, &v);
+}
+static hfvis_status cli_voxels_raw_save(const char *path, const hfvis_volume_grid *grid, const uint8_t *occ)
+{
+    hfvis_write_options wo;
+    size_t n = (size_t)grid->dims[0] * (size_t)grid->dims[1] * (size_t)grid->dims[2];
+    wo.on_temp = cli_on_temp;
+    wo.user = NULL;
+    return hfvis_write_file(path, occ, n, &wo);
+}
+static hfvis_status cli_visfield_save(const char *path, const hfvis_visfield *vf)
+{
+    return cli_write_encoded(path, hfvis_visfield_encode_size(vf), cli_enc_visfield, vf);
+}
+static hfvis_status cli_partial_save(const char *path, const hfvis_partial *p)
+{
+    return cli_write_encoded(path, hfvis_partial_encode_size(p), cli_enc_partial, p);
+}
+
 /* Write OUT: PFM with its channels, or a 16-bit PGM with the channel planes stacked (NoData code 0,
  * the range in its header: hfvis_pgm_range_save). */
 static int cli_save(const cli_args *a, const float *px, int w, int h, int channels, double lo,
@@ -1920,11 +2204,11 @@ static int cli_save(const cli_args *a, const float *px, int w, int h, int channe
         return 0;
     }
     if (!a->out_pgm) {
-        s = hfvis_pfm_save(a->out, px, w, h, channels, w);
+        s = cli_pfm_save(a->out, px, w, h, channels, w);
     } else {
         if (a->has_range) { lo = a->range_lo; hi = a->range_hi; }
         if (channels == 1) {
-            s = hfvis_pgm_range_save(a->out, px, w, h, w, (float)lo, (float)hi);
+            s = cli_pgm_save(a->out, px, w, h, w, (float)lo, (float)hi);
         } else {
             size_t n = (size_t)w * (size_t)h, i;
             int c;
@@ -1933,7 +2217,7 @@ static int cli_save(const cli_args *a, const float *px, int w, int h, int channe
             for (c = 0; c < channels; c++)
                 for (i = 0; i < n; i++) planes[(size_t)c * n + i] = px[i * (size_t)channels + (size_t)c];
             if ((long long)h * channels > INT_MAX) s = HFVIS_ERR_LIMIT;
-            else s = hfvis_pgm_range_save(a->out, planes, w, h * channels, w, (float)lo, (float)hi);
+            else s = cli_pgm_save(a->out, planes, w, h * channels, w, (float)lo, (float)hi);
             free(planes);
         }
     }
@@ -1947,10 +2231,19 @@ static int cli_load_env(const char *path, float **px, hfvis_env *env)
     hfvis_image_info info;
     hfvis_status s;
     errno = 0;
+    size_t i, n;
     s = hfvis_image_load(path, NULL, px, &info);
     if (s != HFVIS_OK) return cli_status(path, s, errno);
     env->radiance = *px; env->n_theta = info.height; env->n_phi = info.width;
     env->channels = info.channels;
+    n = (size_t)info.width * (size_t)info.height * (size_t)info.channels;
+    for (i = 0; i < n; i++) /* radiance: finite and >= 0 (a NaN or negative sky is no light) */
+        if (!((*px)[i] >= 0.0f && (*px)[i] <= FLT_MAX)) {
+            size_t pix = i / (size_t)info.channels;
+            return cli_error(CLI_EXIT_ERROR, path, "radiance %g at (%lu, %lu): must be finite and >= 0",
+                             (double)(*px)[i], (unsigned long)(pix % (size_t)info.width),
+                             (unsigned long)(pix / (size_t)info.width));
+        }
     return 0;
 }
 
@@ -2181,7 +2474,8 @@ done:
 }
 
 /* visibility: hfvis_visibility_count; --fraction divides by the count on a flat field with the
- * same holes (where every sample is visible); --stats prints the counters after OUT is written. */
+ * same holes (where every sample is visible); --stats prints the counters before OUT is written
+ * (a print that fails leaves OUT untouched). */
 static int cli_run_visibility(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
                               cli_progress_state *prog)
 {
@@ -2211,9 +2505,8 @@ static int cli_run_visibility(const cli_args *a, const hfvis_grid *grid, hfvis_s
         for (i = 0; s == HFVIS_OK && i < n; i++)
             if (!isnan(out[i])) out[i] = tested[i] > 0.0f ? (float)((double)out[i] / (double)tested[i]) : 0.0f;
     }
-    if (s != HFVIS_OK) rc = cli_status(cmd, s, 0);
-    else rc = cli_save(a, out, w, h, 1, 0.0, a->fraction ? 1.0 : cli_top(out, n, 1.0));
-    if (rc == 0 && a->stats) {
+    rc = s != HFVIS_OK ? cli_status(cmd, s, 0) : 0;
+    if (rc == 0 && a->stats) { /* before OUT: a failed print must not follow a replaced OUT */
         double r = st.receivers > 0.0 ? st.receivers : 1.0; /* 0 receivers: print zeros */
         printf("receiver-directions: %.0f\n", st.receivers);
         printf("visible per receiver-direction: %.6g\n", st.visible / r);
@@ -2225,8 +2518,10 @@ static int cli_run_visibility(const cli_args *a, const hfvis_grid *grid, hfvis_s
             printf("visible/tested: %.6g\n", st.visible / t);
             printf("t_a/tested: %.6g\n", st.iterations / t);
         }
-        if (fflush(stdout) != 0) rc = cli_error(CLI_EXIT_ERROR, "stdout", "%s", strerror(errno));
+        if (fflush(stdout) != 0 || ferror(stdout))
+            rc = cli_error(CLI_EXIT_ERROR, "stdout", "%s (OUT not written)", strerror(errno));
     }
+    if (rc == 0) rc = cli_save(a, out, w, h, 1, 0.0, a->fraction ? 1.0 : cli_top(out, n, 1.0));
     free(tested);
     free(flat_z);
     free(out);
@@ -2243,9 +2538,16 @@ static int cli_run_ssao(const cli_args *a)
     hfvis_falloff fo;
     hfvis_status s;
     int rc = 0, gx, gy, W, H;
+    /* the methods' direction counts (hfvis.h): the flag is named, not the library's status */
+    if (a->has_dirs && a->ssao_method != SSAO_RAYTRACE &&
+        (a->dirs > HFVIS_SSAO_MAX_DIRECTIONS || (a->ssao_method == SSAO_FFAO && a->dirs < 3)))
+        return cli_error(CLI_EXIT_USAGE, "--dirs", "ssao --method %s takes %d..%d directions, got %d",
+                         a->ssao_method == SSAO_LSAO ? "lsao" : a->ssao_method == SSAO_HBAO ? "hbao" : "ffao",
+                         a->ssao_method == SSAO_FFAO ? 3 : 1, HFVIS_SSAO_MAX_DIRECTIONS, a->dirs);
     errno = 0;
     s = hfvis_image_load(a->in, NULL, &depth, &info);
     if (s != HFVIS_OK) return cli_status(a->in, s, errno);
+    if ((rc = cli_check_cost(a, info.width, info.height, 1)) != 0) goto done;
     if (info.channels != 1) {
         rc = cli_error(CLI_EXIT_ERROR, a->in, "expected a one-channel depth buffer");
         goto done;
@@ -2368,7 +2670,7 @@ static int cli_run_voxelize(const cli_args *a)
     }
     if (s != HFVIS_OK) { rc = cli_status("voxelize", s, 0); goto done; }
     errno = 0;
-    s = a->out_binvox ? hfvis_binvox_save(a->out, &grid, occ) : hfvis_voxels_raw_save(a->out, &grid, occ);
+    s = a->out_binvox ? cli_binvox_save(a->out, &grid, occ) : cli_voxels_raw_save(a->out, &grid, occ);
     if (s != HFVIS_OK) { rc = cli_status(a->out, s, errno); goto done; }
     if (!a->quiet)
         printf("voxelize: %zu triangles -> %d x %d x %d voxels of %.6g (origin %.6g %.6g %.6g), "
@@ -2466,8 +2768,7 @@ static int cli_run_meshao(const cli_args *a)
     if (!out) { rc = cli_status(cmd, HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
     s = hfvis_lk_image((hfvis_lk_method)a->lk_method, &mesh, NULL, &view, &rays, &o, NULL, out, &st);
     if (s != HFVIS_OK) { rc = cli_status(cmd, s, 0); goto done; }
-    rc = cli_save(a, out, a->lk_width, a->lk_height, 1, 0.0, 1.0);
-    if (rc == 0 && a->stats) {
+    if (a->stats) { /* before OUT: a failed print must not follow a replaced OUT */
         printf("receivers: %llu\nrays: %llu\nblocked: %llu (mean obscurance %.6f)\n",
                (unsigned long long)st.receivers, (unsigned long long)st.rays,
                (unsigned long long)st.rays_blocked,
@@ -2485,8 +2786,12 @@ static int cli_run_meshao(const cli_args *a)
             printf("nodes visited: %llu (culled: distance %llu, horizon %llu, mask %llu)\n",
                    (unsigned long long)st.nodes_visited, (unsigned long long)st.nodes_culled_distance,
                    (unsigned long long)st.nodes_culled_horizon, (unsigned long long)st.nodes_culled_mask);
-        if (fflush(stdout) != 0) rc = cli_error(CLI_EXIT_ERROR, "stdout", "%s", strerror(errno));
+        if (fflush(stdout) != 0 || ferror(stdout)) {
+            rc = cli_error(CLI_EXIT_ERROR, "stdout", "%s (OUT not written)", strerror(errno));
+            goto done;
+        }
     }
+    rc = cli_save(a, out, a->lk_width, a->lk_height, 1, 0.0, 1.0);
 done:
     free(out);
     hfvis_lk_lut_free(NULL, &lut);
@@ -2540,7 +2845,7 @@ static int cli_vf_build(const cli_args *a)
     s = hfvis_visfield_build(&mesh, &bo, &vf);
     if (s != HFVIS_OK) { rc = cli_status("visfield", s, 0); goto done; }
     errno = 0;
-    s = hfvis_visfield_save(a->out, &vf);
+    s = cli_visfield_save(a->out, &vf);
     if (s != HFVIS_OK) { rc = cli_status(a->out, s, errno); goto done; }
     if (!a->quiet)
         printf("visfield: %zu triangles -> %zu maps of %d x %d (%s), sphere centre %.6g %.6g %.6g "
@@ -2863,7 +3168,7 @@ static int cli_run_partial(const cli_args *a, const hfvis_grid *grid, hfvis_swee
     part.tag = tag;
     part.sums = sums;
     errno = 0;
-    s = hfvis_partial_save(a->out, &part);
+    s = cli_partial_save(a->out, &part);
     if (s != HFVIS_OK) rc = cli_status(a->out, s, errno);
 done:
     free(flat_z);
@@ -2938,6 +3243,19 @@ static int cli_sum_load(const char *path, hfvis_partial *p, cli_part *m)
     hfvis_status s;
     errno = 0;
     s = hfvis_partial_load(path, NULL, p);
+    if (s == HFVIS_ERR_FORMAT) { /* say which: an old part, or a damaged or foreign file */
+        char head[12] = { 0 };
+        FILE *f = fopen(path, "rb");
+        size_t got = f ? fread(head, 1, 11, f) : 0;
+        if (f) fclose(f);
+        if (got == 11 && !memcmp(head, "HFVISSUM 1\n", 11))
+            return cli_error(CLI_EXIT_ERROR, path, "a version-1 part (no checksum; written by an "
+                             "older hfvis): rerun its --dir-range with this hfvis");
+        if (got == 11 && !memcmp(head, "HFVISSUM 2\n", 11))
+            return cli_error(CLI_EXIT_ERROR, path, "%s: damaged part (its header, size or CRC-32 "
+                             "checksum does not match): rerun its --dir-range",
+                             hfvis_status_string(s));
+    }
     if (s != HFVIS_OK) return cli_status(path, s, errno);
     if (!m->tag) {
         size_t len = strlen(p->tag);
@@ -2954,6 +3272,31 @@ static int cli_sum_load(const char *path, hfvis_partial *p, cli_part *m)
                m->end != p->end) {
         hfvis_partial_free(NULL, p);
         return cli_error(CLI_EXIT_ERROR, path, "changed while being summed");
+    }
+    return 0;
+}
+
+/* The domain of a part's values (NaN marks a hole in every kind): horizon elevations lie in
+ * [-pi/2, pi/2] (as floats); a sky-view sum of n directions in [0, n] (each term
+ * sin(max(alpha, 0))); sky light terms ([P1] Eq. 5) in [0, 1] each; environment sums are finite
+ * and >= 0 (radiance >= 0); visibility counts in [0, n*(W + H + 3)] (a lattice line holds at
+ * most diagonal + 3 nodes). A value outside is refused rather than summed. */
+static int cli_sum_check(const char *path, int cmd, const hfvis_partial *p)
+{
+    const size_t count = (size_t)p->width * (size_t)p->height * (size_t)p->planes;
+    const double n = (double)(p->end - p->begin);
+    double lo = 0.0, hi = n;
+    size_t k;
+    if (cmd == CMD_HORIZON) hi = (double)(float)(CLI_PI / 2.0), lo = -hi;
+    else if (cmd == CMD_LIGHT) hi = HUGE_VAL;
+    else if (cmd == CMD_VISIBILITY) hi = n * ((double)p->width + (double)p->height + 3.0);
+    for (k = 0; k < count; k++) {
+        double v = p->sums[k];
+        if (isnan(v)) continue;
+        if (!(v >= lo && v <= hi && isfinite(v)))
+            return cli_error(CLI_EXIT_ERROR, path, "value %.17g at index %lu lies outside the domain "
+                             "[%g, %g] of a %s part: the file is damaged", v, (unsigned long)k, lo, hi,
+                             cli_cmd_names[cmd]);
     }
     return 0;
 }
@@ -3104,6 +3447,10 @@ static int cli_sum(int argc, char **argv)
         hfvis_partial p;
         const size_t count = n * (size_t)meta[order[i]].planes;
         if ((rc = cli_sum_load(names[order[i]], &p, &meta[order[i]])) != 0) goto done;
+        if ((rc = cli_sum_check(names[order[i]], cmd, &p)) != 0) {
+            hfvis_partial_free(NULL, &p);
+            goto done;
+        }
         if (cmd == CMD_HORIZON) { /* plane j is the direction at sweep position begin + j */
             for (j = 0; j < p.planes; j++) {
                 int pos = p.begin + j, kk = K % 4 ? pos : pos / 4 + (pos % 4) * (K / 4);
@@ -3520,6 +3867,8 @@ static int cli_run(const cli_args *a)
     hfvis_env env;
     hfvis_status s = HFVIS_OK;
 
+    if (a->cmd == CMD_VOXELIZE || a->cmd == CMD_VOLGI || a->cmd == CMD_VISFIELD || a->cmd == CMD_MESHAO)
+        if ((rc = cli_check_cost(a, 0, 0, 1)) != 0) return rc;
     if (a->cmd == CMD_VOXELIZE) return cli_run_voxelize(a);
     if (a->cmd == CMD_SSAO) return cli_run_ssao(a);
     if (a->cmd == CMD_VOLGI) return cli_run_volgi(a);
@@ -3543,7 +3892,7 @@ static int cli_run(const cli_args *a)
         opts.progress = cli_progress;
         opts.progress_user = &prog;
     }
-    rc = 0;
+    if ((rc = cli_check_cost(a, w, h, a->cmd == CMD_NORMALS ? 3 : 1)) != 0) goto done;
     if (a->has_dir_range) {
         if (a->cmd == CMD_LIGHT && (rc = cli_load_env(a->env, &env_px, &env)) != 0) goto done;
         rc = cli_run_partial(a, &grid, &opts, &prog, &env);
@@ -3688,6 +4037,8 @@ int main(int argc, char **argv)
 {
     cli_args a;
     int rc;
+    cli_signals();
+    ex_atomic_on_temp = cli_on_temp; /* the raster writers' temporary files too */
     if (argc >= 2 && !strcmp(argv[1], "sum")) return cli_sum(argc, argv);
     if (argc >= 2 && !strcmp(argv[1], "azimuths")) return cli_azimuths(argc, argv);
     cli_t0 = cli_now();

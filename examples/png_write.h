@@ -23,6 +23,9 @@
 /* A stored deflate block holds at most 65535 bytes (RFC 1951 §3.2.4: LEN is 16 bits). */
 #define EX_PNG_MAX_STORED 65535u
 
+/* The chunk CRC of PNG Annex D is the library's hfvis_crc32 (ISO-HDLC, reflected 0xEDB88320);
+ * Adler-32 is zio.h's ex_adler32. */
+
 /* Bytes per row of samples (no filter byte), the zlib stream length and the file size of a
  * width x height PNG with channels 1 (grey) or 3 (RGB) and depth 8 or 16 (16 only for grey).
  * HFVIS_ERR_INVALID_ARGUMENT for other values, non-positive or size_t-overflowing sizes;
@@ -66,7 +69,7 @@ static inline unsigned char *ex_png__chunk(unsigned char *p, const char type[4],
 {
     ex_png__be32(p, (uint32_t)n);
     memcpy(p + 4, type, 4);
-    return ex_png__be32(p + 8 + n, ex_crc32(0, p + 4, 4 + n));
+    return ex_png__be32(p + 8 + n, hfvis_crc32(0, p + 4, 4 + n));
 }
 
 /* The deflate writer: copies the filtered scanlines into stored blocks of at most 65535 bytes,
@@ -149,17 +152,11 @@ static inline hfvis_status ex_png_encode(const unsigned char *samples, int width
     return HFVIS_OK;
 }
 
-/* Write n bytes to path atomically (zio.h's ex_atomic_open/close: a temporary file beside path,
- * renamed onto it), as the library's savers do: a reader never sees a partial file. On failure
- * path is untouched and the result is HFVIS_ERR_IO. */
+/* Write n bytes to path atomically: the library's hfvis_write_file (a temporary file beside
+ * path renamed onto it; on failure path is untouched and nothing is left). */
 static inline hfvis_status ex_png_write_file(const char *path, const unsigned char *bytes, size_t n)
 {
-    char *tmp;
-    FILE *f;
-    if (!path || !bytes) return HFVIS_ERR_INVALID_ARGUMENT;
-    f = ex_atomic_open(path, bytes, &tmp);
-    if (!f) return HFVIS_ERR_IO;
-    return ex_atomic_close(f, tmp, path, fwrite(bytes, 1, n, f) == n) ? HFVIS_OK : HFVIS_ERR_IO;
+    return hfvis_write_file(path, bytes, n, NULL);
 }
 
 /* One sample of [lo, hi] on 0..top, as hfvis_pgm_encode maps it: values outside clamp, NaN and

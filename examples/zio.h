@@ -1,11 +1,12 @@
-/* zio.h - the byte-level helpers the examples' file codecs share: CRC-32 (PNG Annex D), Adler-32
- * and zlib streams (RFC 1950) holding deflate data (RFC 1951) both ways, and the atomic file
- * replacement every writer uses. Header-only, every function static inline, pure C99, no state,
- * prints nothing. Used by png_write.h (checksums, atomic write) and raster_io.h (inflate for
- * DEFLATE TIFFs, deflate for the TIFF writer).
+/* zio.h - the byte-level helpers the examples' file codecs share: Adler-32, zlib streams
+ * (RFC 1950) holding deflate data (RFC 1951) both ways, and the streaming atomic file
+ * replacement of the raster writers (whole buffers go through the library's hfvis_write_file;
+ * CRC-32 is the library's hfvis_crc32). Header-only, every function static inline, pure C99,
+ * prints nothing. Used by png_write.h (Adler-32) and raster_io.h (inflate for DEFLATE TIFFs,
+ * deflate for the TIFF writer, atomic files).
  *
  * Contents
- *   1. checksums        ex_crc32, ex_adler32
+ *   1. checksums        ex_adler32
  *   2. inflate          ex_inflate: a zlib or raw deflate stream into a buffer of known size
  *   3. deflate          ex_deflate_bound, ex_deflate_zlib: LZ77 (hash chains) + fixed Huffman,
  *                       a stored block instead when that is shorter
@@ -20,29 +21,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "hfvis.h"
+
 /* ------------------------------------------------------------------------------------------ */
 /* 1. checksums                                                                               */
 /* ------------------------------------------------------------------------------------------ */
-
-/* CRC-32 of PNG Annex D (reflected polynomial 0xEDB88320, initial and final XOR 0xFFFFFFFF) over
- * n bytes, continuing crc (start from 0): ex_crc32(0, "123456789", 9) = 0xCBF43926. Four bits
- * per step from a 16-entry table (entry i = CRC register after shifting the nibble i out). */
-static inline uint32_t ex_crc32(uint32_t crc, const unsigned char *p, size_t n)
-{
-    static const uint32_t t[16] = {
-        0x00000000u, 0x1db71064u, 0x3b6e20c8u, 0x26d930acu, 0x76dc4190u, 0x6b6b51f4u,
-        0x4db26158u, 0x5005713cu, 0xedb88320u, 0xf00f9344u, 0xd6d6a3e8u, 0xcb61b38cu,
-        0x9b64c2b0u, 0x86d3d2d4u, 0xa00ae278u, 0xbdbdf21cu
-    };
-    size_t i;
-    crc = ~crc;
-    for (i = 0; i < n; i++) {
-        crc ^= p[i];
-        crc = (crc >> 4) ^ t[crc & 15u];
-        crc = (crc >> 4) ^ t[crc & 15u];
-    }
-    return ~crc;
-}
 
 /* Adler-32 of RFC 1950 §8.2 over n bytes, continuing adler (start from 1):
  * ex_adler32(1, "Wikipedia", 9) = 0x11E60398. Reduces mod 65521 every 5552 bytes, the
@@ -504,6 +487,11 @@ static inline int ex_deflate_zlib(const unsigned char *in, size_t n, unsigned ch
 /* Open "<path>.tmp<8 hex digits>" beside path for writing (the name is stored in *tmp_out, to be
  * passed to ex_atomic_close). The suffix hashes the path and the address of key; a name already
  * taken is skipped. NULL (and *tmp_out NULL) on failure. */
+/* Told each temporary name once it exists and NULL before it is renamed or removed, so that a
+ * program's signal handler can remove it on an interrupt (the hfvis CLI sets it, as it sets
+ * hfvis_write_options.on_temp); NULL: nobody is told. */
+static void (*ex_atomic_on_temp)(void *user, const char *tmp);
+
 static inline FILE *ex_atomic_open(const char *path, const void *key, char **tmp_out)
 {
     static const char hex[] = "0123456789abcdef";
@@ -520,7 +508,7 @@ static inline FILE *ex_atomic_open(const char *path, const void *key, char **tmp
     tmp = (char *)malloc(len + 16);
     if (!tmp) return NULL;
     memcpy(raw, &key, sizeof raw);
-    tag = ex_crc32(ex_crc32(0, (const unsigned char *)path, len), raw, sizeof raw);
+    tag = hfvis_crc32(hfvis_crc32(0, path, len), raw, sizeof raw);
     memcpy(tmp, path, len);
     memcpy(tmp + len, ".tmp", 4);
     tmp[len + 12] = '\0';
@@ -537,6 +525,7 @@ static inline FILE *ex_atomic_open(const char *path, const void *key, char **tmp
         return NULL;
     }
     *tmp_out = tmp;
+    if (ex_atomic_on_temp) ex_atomic_on_temp(NULL, tmp);
     return f;
 }
 
@@ -547,6 +536,7 @@ static inline int ex_atomic_close(FILE *f, char *tmp, const char *path, int ok)
 {
     ok = (fflush(f) == 0) && ok;
     ok = (fclose(f) == 0) && ok;
+    if (ex_atomic_on_temp) ex_atomic_on_temp(NULL, NULL);
     if (ok && rename(tmp, path) != 0) {
 #if defined(_WIN32)
         /* Windows' rename does not replace an existing file: replace non-atomically. */

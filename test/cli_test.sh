@@ -491,7 +491,7 @@ expect_fail "azimuths --azimuth0 nan" 2 azimuths --dirs 4 --azimuth0 nan
 "$hfvis" sum "$dir/whole.hfvs" -o "$dir/whole.pfm" 2> /dev/null
 "$hfvis" skyview "$h" --dirs 16 -o "$dir/single.pfm" 2> /dev/null
 same_or_ulp "one part 0:K" "$dir/single.pfm" "$dir/whole.pfm"
-head -n 1 "$dir/whole.hfvs" | grep -q '^HFVISSUM 1$' && ok "partial file magic" || bad "partial file magic"
+head -n 1 "$dir/whole.hfvs" | grep -q '^HFVISSUM 2$' && ok "partial file magic" || bad "partial file magic"
 
 # Refusals: one line, non-zero exit, nothing written.
 for r in 0:4 4:8 8:12 12:16; do "$hfvis" skyview "$h" --dirs 16 --dir-range "$r" -o "$dir/sv_${r%%:*}.hfvs"; done
@@ -536,6 +536,41 @@ expect_fail "--dir-range on shadow" 2 shadow "$h" --sun-azimuth 1 --sun-elevatio
 expect_fail "--dir-range on gi" 2 gi "$h" --dir-range 0:4 -o "$fdir/x.hfvs"
 expect_fail "--dir-range with --stats" 2 visibility "$h" --stats --dir-range 0:4 -o "$fdir/x.hfvs"
 expect_fail "horizon part of an oversized map" 1 horizon "$dir/big.pgm" --dirs 65536 --dir-range 0:1 -o "$fdir/x.hfvs"
+# Damaged parts (issue: a NaN or 1e308 planted in a body was summed, exit 0): one byte changed is
+# caught by the CRC-32, a version-1 part (no checksum) is named as such, and a value outside its
+# domain under a correct checksum (written here with crc32_le, POSIX sh arithmetic) is refused.
+crc32_le() { # FILE: the CRC-32 (ISO-HDLC) of FILE as four printf octal escapes, little-endian
+  od -An -v -tu1 "$1" | awk '{ for (i = 1; i <= NF; i++) print $i }' > "$dir/crc_bytes"
+  c=4294967295
+  while read -r b; do
+    c=$(( c ^ b )); k=0
+    while [ $k -lt 8 ]; do
+      if [ $(( c & 1 )) -eq 1 ]; then c=$(( (c >> 1) ^ 3988292384 )); else c=$(( c >> 1 )); fi
+      k=$((k + 1))
+    done
+  done < "$dir/crc_bytes"
+  c=$(( c ^ 4294967295 ))
+  printf '\\%03o\\%03o\\%03o\\%03o' $((c & 255)) $(((c >> 8) & 255)) $(((c >> 16) & 255)) $(((c >> 24) & 255))
+}
+"$hfvis" skyview "$dir/flat.pgm" --dirs 4 --dir-range 0:4 -o "$dir/f04.hfvs"
+fsize=$(wc -c < "$dir/f04.hfvs" | tr -d ' ')
+cp "$dir/f04.hfvs" "$dir/flip.hfvs"
+printf '\377' | dd of="$dir/flip.hfvs" bs=1 seek=$((fsize - 12)) conv=notrunc 2>/dev/null
+expect_fail "sum: a body byte changed" 1 sum "$dir/flip.hfvs" -o "$o"
+grep -q 'CRC-32' "$dir/stderr" && ok "sum: damaged part named" || bad "sum: damaged part named: $(cat "$dir/stderr")"
+{ printf 'HFVISSUM 1\n'; tail -c +12 "$dir/f04.hfvs" | head -c $((fsize - 15)); } > "$dir/v1.hfvs"
+expect_fail "sum: a version-1 part" 1 sum "$dir/v1.hfvs" -o "$o"
+grep -q 'version-1 part' "$dir/stderr" && ok "sum: version-1 part named" || bad "sum: version-1 part named: $(cat "$dir/stderr")"
+# 1e308 (0x7fe1ccf385ebc8a0) over the last sum, then a correct trailer
+head -c $((fsize - 12)) "$dir/f04.hfvs" > "$dir/big.body"
+printf '\240\310\353\205\363\314\341\177' >> "$dir/big.body"
+{ cat "$dir/big.body"; printf "$(crc32_le "$dir/big.body")"; } > "$dir/big.hfvs"
+expect_fail "sum: 1e308 under a correct checksum" 1 sum "$dir/big.hfvs" -o "$o"
+grep -q 'outside the domain' "$dir/stderr" && ok "sum: out-of-domain value named" || bad "sum: out-of-domain value named: $(cat "$dir/stderr")"
+{ cat "$dir/f04.hfvs"; } > "$dir/same.hfvs"
+head -c $((fsize - 4)) "$dir/f04.hfvs" > "$dir/same.body"
+[ "$(printf "$(crc32_le "$dir/same.body")" | od -An -tx1)" = "$(tail -c 4 "$dir/f04.hfvs" | od -An -tx1)" ] &&
+  ok "crc32_le agrees with the library" || bad "crc32_le agrees with the library"
 printf 'old\n' > "$dir/keep.pfm"
 "$hfvis" sum "$s0" "$s8" -o "$dir/keep.pfm" 2> /dev/null
 [ "$(cat "$dir/keep.pfm")" = old ] && ok "refused sum keeps the old OUT" || bad "refused sum keeps the old OUT"
@@ -688,6 +723,98 @@ then ok "--progress lines and summary"; else bad "--progress: $(cat "$dir/stderr
 if "$hfvis" skyview "$h" --dirs 16 --progress --quiet -o "$dir/pr.pfm" 2> "$dir/stderr" && [ ! -s "$dir/stderr" ]
 then ok "--quiet silences --progress"; else bad "--quiet with --progress: $(cat "$dir/stderr")"; fi
 
+# A failed summary never follows a replaced OUT (issue: `visibility --stats > /dev/full` exited 1
+# after renaming the new file over OUT): the counters are printed first, OUT is then untouched.
+if [ -w /dev/full ]; then
+  printf 'old\n' > "$dir/old.pfm"
+  "$hfvis" visibility "$h" --dirs 4 --stats -o "$dir/old.pfm" > /dev/full 2> "$dir/stderr"; rc=$?
+  [ "$rc" -eq 1 ] && [ "$(cat "$dir/old.pfm")" = old ] && [ "$(wc -l < "$dir/stderr" | tr -d ' ')" = 1 ] &&
+    ok "visibility --stats > /dev/full: exit 1, OUT untouched" || bad "visibility --stats > /dev/full: exit $rc, OUT $(head -c 2 "$dir/old.pfm")"
+else
+  ok "visibility --stats > /dev/full: SKIP (no /dev/full)"
+fi
+# visfield build enforces its extension (issue: HFVF data went into x.pfm or field.txt, exit 0)
+expect_fail "visfield build -o x.pfm" 2 visfield "$dir/cube.obj" --positions 82 --dirs 4 -o "$fdir/x.pfm"
+expect_fail "visfield build -o field.txt" 2 visfield "$dir/cube.obj" --positions 82 --dirs 4 -o "$fdir/field.txt"
+# the flag at fault is named (issue: "ssao: HFVIS_ERR_INVALID_ARGUMENT")
+expect_fail "ssao --dirs 5000" 2 ssao "$dir/plane.pfm" --method lsao --dirs 5000 -o "$o"
+grep -q -- '--dirs' "$dir/stderr" && ok "ssao --dirs named" || bad "ssao --dirs named: $(cat "$dir/stderr")"
+expect_fail "ssao ffao --dirs 2" 2 ssao "$dir/plane.pfm" --method ffao --dirs 2 -o "$o"
+# light --env with NaN or negative radiance is refused, as gi does
+{ printf 'Pf\n4 2\n-1\n'; printf "$nan"; i=1; while [ $i -lt 8 ]; do printf "$one"; i=$((i + 1)); done; } > "$dir/envnan.pfm"
+{ printf 'Pf\n4 2\n-1\n'; printf "$mone"; i=1; while [ $i -lt 8 ]; do printf "$one"; i=$((i + 1)); done; } > "$dir/envneg.pfm"
+expect_fail "light --env with NaN" 1 light "$h" --env "$dir/envnan.pfm" -o "$o"
+expect_fail "light --env negative" 1 light "$h" --env "$dir/envneg.pfm" -o "$o"
+grep -q 'radiance' "$dir/stderr" && ok "light --env: radiance named" || bad "light --env: radiance named"
+# help texts: no literal %%, meshao's --size range as enforced, duplicates and links documented
+if "$hfvis" --help 2>&1 | grep -q '%%' || "$hfvis" ssao --help | grep -q '%%' || "$hfvis" viewshed --help | grep -q '%%'
+then bad "help: a literal %%"; else ok "help: no literal %%"; fi
+for c in horizon skyview sky shadow light normals indirect visibility viewshed voxelize gi ssao volgi visfield meshao; do
+  "$hfvis" "$c" --help | grep -q '%%' && bad "help $c: a literal %%"
+done
+"$hfvis" meshao --help | grep -q '1..32768 each' && ok "help meshao: --size range" || bad "help meshao: --size range"
+expect_ok "meshao --size 16384x1 (as documented)" "$dir/m.pfm" meshao "$dir/cube.obj" --size 16384x1 --rays 1 -o "$dir/m.pfm"
+"$hfvis" skyview --help | grep -q 'given twice' && ok "help: duplicated options documented" || bad "help: duplicated options documented"
+"$hfvis" skyview --help | grep -q 'symbolic link' && ok "help: symbolic links documented" || bad "help: symbolic links documented"
+
+# Tiny cells and huge scales are computed scale-free or refused with the flag named (issue:
+# --cell 1e-50 gave NaN with exit 0, --zscale 3e38 turned samples into holes silently)
+expect_ok "skyview --cell 1e-50" "$dir/c.pfm" skyview "$h" --cell 1e-50 -o "$dir/c.pfm"
+expect_ok "sky --cell 1e-50" "$dir/c.pfm" sky "$h" --cell 1e-50 -o "$dir/c.pfm"
+expect_ok "normals --cell 1e-100" "$dir/c.pfm" normals "$h" --cell 1e-100 -o "$dir/c.pfm"
+expect_fail "--cell 1e-160 (ratio past 1e150)" 1 skyview "$h" --cell 1e-160 -o "$o"
+grep -q -- '--cell' "$dir/stderr" && ok "--cell named" || bad "--cell named"
+expect_fail "--zscale 3e38" 1 skyview "$h" --zscale 3e38 -o "$o"
+grep -q -- '--zscale' "$dir/stderr" && ok "--zscale named" || bad "--zscale named"
+expect_fail "--sky 3e38 --albedo 3e38" 2 sky "$h" --sky 3e38 --albedo 3e38 -o "$o"
+
+# Costs up front (issue: a 16 KB 1 x 16384 PGM made skyview allocate 2.1 GB; volgi --res 256
+# --iterations 1048576 ran with no estimate): --max-memory refuses before allocating and names
+# the estimate; the help states the viewshed's true cost
+awk 'BEGIN { print "P2 1 16384 255"; for (i = 0; i < 16384; i++) print 0 }' > "$dir/thin.pgm"
+expect_fail "skyview 1 x 16384 over --max-memory 100M" 1 skyview "$dir/thin.pgm" --max-memory 100M -o "$o"
+grep -q 'needs about' "$dir/stderr" && ok "--max-memory: the estimate is named" || bad "--max-memory: the estimate is named"
+expect_fail "volgi 256^3 x 2^20 over --max-memory 512M" 1 volgi --room --res 256 --iterations 1048576 --max-memory 512M -o "$o"
+expect_fail "--max-memory 1X" 2 skyview "$h" --max-memory 1X -o "$o"
+expect_ok "--max-memory 0 (no limit)" "$dir/mm.pfm" skyview "$h" --max-memory 0 -o "$dir/mm.pfm"
+expect_ok "--max-memory 64M" "$dir/mm.pfm" skyview "$h" --max-memory 64M -o "$dir/mm.pfm"
+"$hfvis" viewshed --help | grep -q 'O((W + H) \* max(W, H))' && ok "help viewshed: its cost" || bad "help viewshed: its cost"
+"$hfvis" skyview --help | grep -q 'max-memory' && ok "help: --max-memory" || bad "help: --max-memory"
+
+# An interrupt during a real write (issue: SIGINT/SIGTERM while a 4096^2 horizon was written
+# left its 354 MB temporary file): the 48 MB write of `normals` on 2048 x 2048 zeros is started
+# in the foreground (a background job would have SIGINT ignored), a poller signals it as soon as
+# its temporary file exists, and nothing of OUT may remain. Exit 128 + the signal number.
+sigdir=$dir/sig; mkdir -p "$sigdir"
+{ printf 'Pf\n2048 2048\n-1\n'; head -c 16777216 /dev/zero; } > "$dir/zero2048.pfm"
+for sig in INT TERM HUP; do
+  rm -f "$dir/sig.pid" "$dir/sig.caught"
+  ( i=0; while [ ! -s "$dir/sig.pid" ] && [ $i -lt 200000 ]; do i=$((i + 1)); done
+    i=0
+    while [ $i -lt 1000000 ]; do
+      for t in "$sigdir"/n.pfm.tmp*; do
+        if [ -e "$t" ]; then kill -"$sig" "$(cat "$dir/sig.pid")"; : > "$dir/sig.caught"; exit 0; fi
+      done
+      i=$((i + 1))
+    done ) &
+  poller=$!
+  sh -c 'echo $$ > "$1"; exec "$2" normals "$3" -o "$4"' sh "$dir/sig.pid" "$hfvis" "$dir/zero2048.pfm" "$sigdir/n.pfm" 2> /dev/null
+  rc=$?
+  wait "$poller"
+  left=$(ls "$sigdir" | wc -l | tr -d ' ')
+  if [ ! -f "$dir/sig.caught" ]; then bad "SIG$sig during a write: the temporary file was never seen"
+  elif [ "$rc" -eq 0 ] && [ "$sig" = INT ]; then ok "SIGINT during a write: SKIP (SIGINT ignored by the parent)"
+  elif [ "$rc" -le 128 ]; then bad "SIG$sig during a write: exit $rc"
+  elif [ "$left" -ne 0 ]; then bad "SIG$sig during a write: left $(ls "$sigdir")"
+  else ok "SIG$sig during a write: exit $rc, directory clean"; fi
+  rm -f "$sigdir"/*
+done
+rm -f "$dir/zero2048.pfm"
+
+# Legal long names (issue: the 12-byte temporary suffix made a 244-byte name fail, ENAMETOOLONG)
+long=$(awk 'BEGIN { for (i = 0; i < 247; i++) printf "%c", 97 + i % 26 }').pfm
+expect_ok "a 251-byte output name" "$dir/$long" skyview "$dir/flat.pgm" --dirs 4 -o "$dir/$long"
+rm -f "$dir/$long"
 
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"

@@ -48,12 +48,14 @@
 #define HFVIS_INVENTORY(X) \
     X(status_string, V, -, "E", "an HFVIS_ERR_UNKNOWN string, never NULL") \
     X(free, V, -, "N", "no-op for NULL") \
+    X(crc32, V, -, "N", "the crc unchanged for NULL with n = 0") \
     X(image_info_read, S, -, "NZO", "INVALID_ARGUMENT FORMAT LIMIT") \
     X(image_decode, S, -, "NZOR", "INVALID_ARGUMENT FORMAT LIMIT BUFFER_TOO_SMALL") \
     X(pfm_encode_size, V, -, "ZGOR", "0") \
     X(pgm_encode_size, V, -, "ZGR", "0") \
     X(pfm_encode, S, -, "NZGOR", "INVALID_ARGUMENT BUFFER_TOO_SMALL") \
     X(pgm_encode, S, -, "NZGOFR", "INVALID_ARGUMENT BUFFER_TOO_SMALL") \
+    X(write_file, S, M, "NZR", "INVALID_ARGUMENT IO") \
     X(image_load, S, A, "NR", "INVALID_ARGUMENT IO") \
     X(pfm_save, S, M, "NZGR", "INVALID_ARGUMENT IO") \
     X(pgm_save, S, M, "NZGFR", "INVALID_ARGUMENT IO") \
@@ -462,7 +464,7 @@ static void base_status(int got, int line)
 
 /* A temporary directory for the file functions. */
 static char tmpdir[64];
-static char path_buf[160];
+static char path_buf[400]; /* room for a 255-byte leaf */
 static const char *tmp_path(const char *leaf)
 {
     snprintf(path_buf, sizeof path_buf, "%s/%s", tmpdir, leaf);
@@ -614,6 +616,12 @@ static void args_free(void)
     BADV('N', c.allocs == 0 && c.live == 0);
 }
 
+static void args_crc32(void)
+{
+    begin("crc32");
+    BADV('N', hfvis_crc32(0, NULL, 0) == 0u && hfvis_crc32(0x12345678u, NULL, 0) == 0x12345678u);
+}
+
 static void args_image_info_read(void)
 {
     hfvis_image_info *info;
@@ -723,6 +731,48 @@ static void args_image_load(void)
     BAD('N', INV, hfvis_image_load(tmp_path("a.pgm"), NULL, NULL, info));
     BAD('N', INV, hfvis_image_load(tmp_path("a.pgm"), NULL, px, NULL));
     BAD('R', IOE, hfvis_image_load(tmp_path("missing.pgm"), NULL, px, info));
+}
+
+/* Records the temporary names hfvis_write_file announces (on_temp). */
+static char wf_seen[4096];
+static int wf_calls, wf_nulls;
+static void wf_on_temp(void *user, const char *tmp)
+{
+    (void)user;
+    wf_calls++;
+    if (!tmp) wf_nulls++;
+    else if (strlen(tmp) < sizeof wf_seen) strcpy(wf_seen, tmp);
+}
+
+static void args_write_file(void)
+{
+    hfvis_write_options wo;
+    char name[300], *leaf;
+    const char *full;
+    size_t k;
+    begin("write_file");
+    wo.on_temp = wf_on_temp;
+    wo.user = NULL;
+    wf_calls = wf_nulls = 0;
+    OK(hfvis_write_file(tmp_path("w.bin"), "abc", 3, &wo));
+    /* the name was announced before the file existed and withdrawn after the rename */
+    CHECK(wf_calls == 2 && wf_nulls == 1 && strncmp(wf_seen, tmp_path("w.bin"), strlen(tmp_path("w.bin"))) == 0);
+    CHECK(access(wf_seen, F_OK) != 0);
+    OK(hfvis_write_file(tmp_path("empty.bin"), NULL, 0, NULL));
+    /* a 250-byte leaf (legal: NAME_MAX 255) once failed, ENAMETOOLONG on "<leaf>.tmpXXXXXXXX" */
+    for (k = 0; k < 250; k++) name[k] = (char)('a' + (int)(k % 26));
+    name[250] = '\0';
+    full = tmp_path(name);
+    OK(hfvis_write_file(full, "abc", 3, &wo));
+    BADV('R', access(full, F_OK) == 0);
+    leaf = strrchr(wf_seen, '/');
+    CHECK(leaf && strlen(leaf + 1) == 255); /* the cut leaf and its 12-byte suffix */
+    CHECK(remove(full) == 0);
+    BAD('N', INV, hfvis_write_file(NULL, "abc", 3, NULL));
+    BAD('N', INV, hfvis_write_file(tmp_path("t.bin"), NULL, 3, NULL));
+    BAD('Z', INV, hfvis_write_file("", "abc", 3, NULL));
+    BAD('R', IOE, hfvis_write_file(bad_dir_path("t.bin"), "abc", 3, NULL));
+    BADV('R', access(tmp_path("t.bin"), F_OK) != 0);
 }
 
 static void args_pfm_save(void)
@@ -2224,7 +2274,7 @@ static const char *long_tag(void)
 static void args_partial_encode_size(void)
 {
     begin("partial_encode_size");
-    CHECK(hfvis_partial_encode_size(&p_ok) == 11 + 12 + 8 + 8 * GW * GH);
+    CHECK(hfvis_partial_encode_size(&p_ok) == 11 + 12 + 8 + 8 * GW * GH + 4);
     BADV('N', hfvis_partial_encode_size(NULL) == 0);
     PARTIAL_CASES(P_ZERO, hfvis_partial_encode_size(&bp));
 }
@@ -2244,14 +2294,18 @@ static void args_partial_encode(void)
     PARTIAL_CASES(P_INV, hfvis_partial_encode(&bp, out, need, wr));
 }
 
-/* A file of header text head followed by values zero doubles, into buf (cap bytes). */
+/* A file of header text head followed by values zero doubles and the CRC-32 trailer of the
+ * HFVISSUM format, into buf (cap bytes). */
 static size_t partial_file(unsigned char *buf, size_t cap, const char *head, size_t values)
 {
-    size_t n = strlen(head);
-    if (n + 8 * values > cap) exit(2);
+    size_t n = strlen(head), k;
+    uint32_t crc;
+    if (n + 8 * values + 4 > cap) exit(2);
     memcpy(buf, head, n);
     memset(buf + n, 0, 8 * values);
-    return n + 8 * values;
+    crc = hfvis_crc32(0, buf, n + 8 * values);
+    for (k = 0; k < 4; k++) buf[n + 8 * values + k] = (unsigned char)(crc >> (8 * k));
+    return n + 8 * values + 4;
 }
 
 static unsigned char p_bad[HFVIS_PARTIAL_MAX_TAG + 256];
@@ -2259,7 +2313,7 @@ static unsigned char p_bad[HFVIS_PARTIAL_MAX_TAG + 256];
 static void args_partial_decode(void)
 {
     /* a header with the numbers line nums; a 4 x 3 one-plane file has 12 values */
-#define P_HEAD(nums) "HFVISSUM 1\n" nums "\nsvf K=4\n"
+#define P_HEAD(nums) "HFVISSUM 2\n" nums "\nsvf K=4\n"
     hfvis_partial *p;
     size_t n;
     char head[HFVIS_PARTIAL_MAX_TAG + 64];
@@ -2285,7 +2339,7 @@ static void args_partial_decode(void)
     BAD('Z', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
     n = partial_file(p_bad, sizeof p_bad, P_HEAD("4 3 1 0 0 4"), 12);
     BAD('Z', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
-    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 1\n4 3 1 4 0 4\n\n", 12);
+    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 2\n4 3 1 4 0 4\n\n", 12);
     BAD('Z', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
     n = partial_file(p_bad, sizeof p_bad, P_HEAD("4 -3 1 4 0 4"), 12);
     BAD('G', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
@@ -2299,14 +2353,14 @@ static void args_partial_decode(void)
     BAD('O', LIM, hfvis_partial_decode(p_bad, n, NULL, p));
     n = partial_file(p_bad, sizeof p_bad, P_HEAD("2147483648 3 1 4 0 4"), 0);
     BAD('O', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
-    snprintf(head, sizeof head, "HFVISSUM 1\n4 3 1 4 0 4\n%s\n", long_tag());
+    snprintf(head, sizeof head, "HFVISSUM 2\n4 3 1 4 0 4\n%s\n", long_tag());
     n = partial_file(p_bad, sizeof p_bad, head, 12);
     BAD('O', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
     n = partial_file(p_bad, sizeof p_bad, P_HEAD("inf 3 1 4 0 4"), 12);
     BAD('F', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
     n = partial_file(p_bad, sizeof p_bad, P_HEAD("nan 3 1 4 0 4"), 12);
     BAD('F', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
-    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 2\n4 3 1 4 0 4\nsvf K=4\n", 12);
+    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 1\n4 3 1 4 0 4\nsvf K=4\n", 12);
     BAD('E', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
     n = partial_file(p_bad, sizeof p_bad, "HFVISSUN 1\n4 3 1 4 0 4\nsvf K=4\n", 12);
     BAD('E', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
@@ -2320,9 +2374,9 @@ static void args_partial_decode(void)
     BAD('R', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
     n = partial_file(p_bad, sizeof p_bad, P_HEAD("4 3 1 4 0 4 5"), 12);
     BAD('R', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
-    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 1\n4 3 1 4 0 4\nsvf\tK=4\n", 12);
+    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 2\n4 3 1 4 0 4\nsvf\tK=4\n", 12);
     BAD('R', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
-    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 1\n4 3 1 4 0 4\nsvf K=4", 0);
+    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 2\n4 3 1 4 0 4\nsvf K=4", 0);
     BAD('R', FMT, hfvis_partial_decode(p_bad, n, NULL, p));
 #undef P_HEAD
 }
@@ -2365,7 +2419,7 @@ static void args_partial_load(void)
     begin("partial_load");
     write_tmp("empty.hfvs", "", 0);
     write_tmp("short.hfvs", p_file, p_file_len - 1);
-    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 1\n1048576 1048576 1 4 0 4\nsvf K=4\n", 0);
+    n = partial_file(p_bad, sizeof p_bad, "HFVISSUM 2\n1048576 1048576 1 4 0 4\nsvf K=4\n", 0);
     write_tmp("huge.hfvs", p_bad, n);
     p = AT(hfvis_partial);
     arena_fill();
@@ -6498,6 +6552,7 @@ static hfvis_status io_binvox_save(const char *path) { return hfvis_binvox_save(
 static hfvis_status io_voxels_raw_save(const char *path) { return hfvis_voxels_raw_save(path, &vg_ok, occ_box); }
 static hfvis_status io_visfield_save(const char *path) { return hfvis_visfield_save(path, &vf_ok); }
 static hfvis_status io_partial_save(const char *path) { return hfvis_partial_save(path, &p_ok); }
+static hfvis_status io_write_file(const char *path) { return hfvis_write_file(path, "abc", 3, NULL); }
 
 typedef struct io_entry {
     const char *name;
@@ -6506,7 +6561,7 @@ typedef struct io_entry {
 #define IOSAVE(name) {#name, io_##name}
 static const io_entry io_savers[] = {
     IOSAVE(pfm_save), IOSAVE(pgm_save), IOSAVE(pgm_range_save), IOSAVE(mesh_save), IOSAVE(binvox_save),
-    IOSAVE(voxels_raw_save), IOSAVE(visfield_save), IOSAVE(partial_save),
+    IOSAVE(voxels_raw_save), IOSAVE(visfield_save), IOSAVE(partial_save), IOSAVE(write_file),
 };
 #define IO_COUNT ((int)(sizeof io_savers / sizeof io_savers[0]))
 

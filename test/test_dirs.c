@@ -411,8 +411,8 @@ TEST(partial_round_trip)
     double sums[12];
     hfvis_partial p = sample_partial(sums), q;
     size_t n = hfvis_partial_encode_size(&p), written = 0;
-    static const char head[] = "HFVISSUM 1\n3 2 2 16 4 9\n";
-    CHECK(n == sizeof head - 1 + strlen(p.tag) + 1 + 12 * 8);
+    static const char head[] = "HFVISSUM 2\n3 2 2 16 4 9\n";
+    CHECK(n == sizeof head - 1 + strlen(p.tag) + 1 + 12 * 8 + 4); /* + the CRC-32 */
     CHECK_EQ_STATUS(hfvis_partial_encode(&p, enc, n - 1, &written), HFVIS_ERR_BUFFER_TOO_SMALL);
     CHECK_EQ_STATUS(hfvis_partial_encode(&p, enc, sizeof enc, &written), HFVIS_OK);
     CHECK(written == n);
@@ -472,10 +472,13 @@ static hfvis_status decode_with_header(const char *numbers, const char *tag, siz
 {
     hfvis_partial q;
     hfvis_status s;
-    size_t len = (size_t)sprintf((char *)enc2, "HFVISSUM 1\n%s\n%s\n", numbers, tag);
+    size_t len = (size_t)sprintf((char *)enc2, "HFVISSUM 2\n%s\n%s\n", numbers, tag), k;
+    uint32_t crc;
     memset(enc2 + len, 0, data_bytes);
+    crc = hfvis_crc32(0, enc2, len + data_bytes);
+    for (k = 0; k < 4; k++) enc2[len + data_bytes + k] = (unsigned char)(crc >> (8 * k));
     memset(&q, 0, sizeof q);
-    s = hfvis_partial_decode(enc2, len + data_bytes, NULL, &q);
+    s = hfvis_partial_decode(enc2, len + data_bytes + 4, NULL, &q);
     if (s == HFVIS_OK) hfvis_partial_free(NULL, &q);
     return s;
 }
@@ -511,9 +514,40 @@ TEST(partial_malformed_headers)
     CHECK_EQ_STATUS(decode_with_header("1 1 1 1 0 1", longtag, 8), HFVIS_ERR_FORMAT);
     {   /* a bad magic or version */
         hfvis_partial q;
-        memcpy(enc2, "HFVISSUM 2\n1 1 1 1 0 1\nt\n", 25);
-        CHECK_EQ_STATUS(hfvis_partial_decode(enc2, 33, NULL, &q), HFVIS_ERR_FORMAT);
+        memcpy(enc2, "HFVISSUM 3\n1 1 1 1 0 1\nt\n", 25);
+        CHECK_EQ_STATUS(hfvis_partial_decode(enc2, 37, NULL, &q), HFVIS_ERR_FORMAT);
     }
+}
+
+/* The CRC-32 trailer: a part written by version 1 (no trailer) is refused, and so is every
+ * single-byte change of a valid file (a NaN or 1e308 planted in the body was summed before). */
+TEST(partial_checksum)
+{
+    double sums[12];
+    hfvis_partial p = sample_partial(sums), q;
+    size_t n = 0, k, flips_refused = 0;
+    CHECK_EQ_STATUS(hfvis_partial_encode(&p, enc, sizeof enc, &n), HFVIS_OK);
+    for (k = 0; k < n; k++) { /* bit 6 of each byte in turn */
+        enc[k] ^= 0x40u;
+        memset(&q, 0, sizeof q);
+        flips_refused += hfvis_partial_decode(enc, n, NULL, &q) == HFVIS_ERR_FORMAT && q.sums == NULL;
+        enc[k] ^= 0x40u;
+    }
+    CHECK(flips_refused == n);
+    {   /* 1e308 over sums[0] with the old trailer */
+        double big = 1e308;
+        size_t body = n - 4 - 12 * 8, b;
+        uint64_t u;
+        memcpy(&u, &big, 8);
+        for (b = 0; b < 8; b++) enc[body + b] = (unsigned char)(u >> (8 * b));
+        CHECK_EQ_STATUS(hfvis_partial_decode(enc, n, NULL, &q), HFVIS_ERR_FORMAT);
+    }
+    /* the version-1 layout: the same header and body under "HFVISSUM 1", no trailer */
+    CHECK_EQ_STATUS(hfvis_partial_encode(&p, enc, sizeof enc, &n), HFVIS_OK);
+    enc[9] = '1';
+    CHECK_EQ_STATUS(hfvis_partial_decode(enc, n - 4, NULL, &q), HFVIS_ERR_FORMAT);
+    CHECK(hfvis_crc32(0, "123456789", 9) == 0xcbf43926u);
+    CHECK(hfvis_crc32(0, NULL, 0) == 0u);
 }
 
 TEST(partial_decode_allocation_failure)
@@ -553,6 +587,7 @@ int main(int argc, char **argv)
     RUN(partial_encode_rejects_invalid);
     RUN(partial_truncations);
     RUN(partial_malformed_headers);
+    RUN(partial_checksum);
     RUN(partial_decode_allocation_failure);
     return TEST_DONE();
 }

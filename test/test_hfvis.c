@@ -316,12 +316,15 @@ TEST(horizon_lattice_vs_naive)
 
 /* Domain slack of spec §3.2 (eps = 1e-9): nodes on the boundary belong to the domain. */
 #define LATTICE_EPS 1e-9
+/* An axis of one sample is a strip one cell wide (hfvis.h, hfvis_lattice_init). */
+#define LATTICE_STRIP_HALF 0.5
 
 static int node_inside(const hfvis_lattice *L, int i, int j)
 {
     double x = (double)i * L->ux + (double)j * L->vx, y = (double)i * L->uy + (double)j * L->vy;
-    return x >= -LATTICE_EPS && x <= (double)(L->width - 1) + LATTICE_EPS &&
-           y >= -LATTICE_EPS && y <= (double)(L->height - 1) + LATTICE_EPS;
+    double px = L->width == 1 ? LATTICE_STRIP_HALF : LATTICE_EPS;
+    double py = L->height == 1 ? LATTICE_STRIP_HALF : LATTICE_EPS;
+    return x >= -px && x <= (double)(L->width - 1) + px && y >= -py && y <= (double)(L->height - 1) + py;
 }
 
 /* Walks every line: in-range nodes inside, the nodes just before/after outside, lines beyond
@@ -390,7 +393,9 @@ TEST(lattice_geometry)
             ok = 0;
         /* nodes of a unit lattice in the (W-1) x (H-1) rectangle: its area, +- about half
          * the perimeter (spec §3.2 "(W-1)(H-1) + boundary") */
-        if (labs(total - (long)(w - 1) * (long)(h - 1)) > (long)(w + h)) ok = 0;
+        if (w > 1 && h > 1 && labs(total - (long)(w - 1) * (long)(h - 1)) > (long)(w + h)) ok = 0;
+        /* a strip (w or h = 1, one cell wide): its area w * h, +- its perimeter */
+        if ((w == 1 || h == 1) && labs(total - (long)w * (long)h) > 2L * (long)(w + h)) ok = 0;
     }
     CHECK(ok);
 }
@@ -1033,6 +1038,162 @@ static const hfvis_grid *bad_grid(int i, hfvis_grid *store, const float *z)
 }
 
 static double bad_fn(void *user, double x, double y) { (void)user; return x + y; }
+
+/* Thin grids (issue: 1 x 50 zeros gave NaN sky-view factors at 47 of 50 samples). Every sweep
+ * output on 1 x N, N x 1, 1 x 1, 2 x N and N x 2, for K in {1, 4, 8, 12, 16, 32} and the three
+ * borders: finite at every sample and inside its documented range; on a flat field of zeros the
+ * values of a plane (sky-view factor 1, sky light sky*albedo, nothing occluded). */
+#define THIN_TOL 1e-6 /* float outputs of double sums of at most 32 terms */
+#define THIN_QUAD_TOL 0.01 /* K-term sum of a tilted receiver's [P1] Eq. 5 over its hemisphere
+                              integral: measured up to 0.43% on the 2 x 50 bumps at K = 16 */
+TEST(thin_grids)
+{
+    static const int shapes[][2] = { { 1, 50 }, { 50, 1 }, { 1, 1 }, { 2, 50 }, { 50, 2 }, { 1, 7 } };
+    static const int Ks[] = { 1, 4, 8, 12, 16, 32 };
+    static const float env_rad[2] = { 0.5f, 0.5f };
+    float z[100], out[400], map[32 * 100], exitr[100];
+    double sums[100];
+    size_t si;
+    int ki, b, flat, bad = 0, bad_flat = 0, bad_status = 0;
+    for (si = 0; si < sizeof shapes / sizeof shapes[0]; si++)
+        for (ki = 0; ki < 6; ki++)
+            for (b = HFVIS_BORDER_OPEN; b <= HFVIS_BORDER_WRAP; b++)
+                for (flat = 0; flat < 2; flat++) {
+                    int W = shapes[si][0], H = shapes[si][1], K = Ks[ki], n = W * H, i;
+                    hfvis_grid g;
+                    hfvis_sweep_options o = hfvis_sweep_options_default();
+                    hfvis_env env;
+                    hfvis_sun sun;
+                    for (i = 0; i < n; i++) {
+                        z[i] = flat ? 0.0f : (float)((i * 7) % 5) * 0.75f;
+                        exitr[i] = 0.25f;
+                    }
+                    g.z = z; g.width = W; g.height = H; g.stride = W; g.cell_size = 1.0;
+                    o.border = (hfvis_border)b;
+                    env.radiance = env_rad; env.n_theta = 1; env.n_phi = 2; env.channels = 1;
+                    memset(&sun, 0, sizeof sun);
+                    sun.azimuth_rad = 0.3; sun.elevation_rad = 0.6; sun.radius_rad = 0.01;
+                    sun.irradiance[0] = 1.0f;
+                    /* horizon map: elevations in [-pi/2, pi/2] */
+                    if (hfvis_horizon_map(&g, K, &o, map) != HFVIS_OK) bad_status++;
+                    for (i = 0; i < K * n; i++) if (!(fabs(map[i]) <= 0.5 * PI + THIN_TOL)) bad++;
+                    if (hfvis_sky_view_factor(&g, K, &o, out, W) != HFVIS_OK) bad_status++;
+                    for (i = 0; i < n; i++) {
+                        if (!(out[i] >= 0.0f && out[i] <= 1.0f)) bad++;
+                        if (flat && !(fabs((double)out[i] - 1.0) <= THIN_TOL)) bad_flat++;
+                    }
+                    if (hfvis_sky_light(&g, K, 1.0f, 1.0f, &o, out, W) != HFVIS_OK) bad_status++;
+                    for (i = 0; i < n; i++) {
+                        if (!(out[i] >= 0.0f && (double)out[i] <= 1.0 + THIN_QUAD_TOL)) bad++;
+                        if (flat && !(fabs((double)out[i] - 1.0) <= THIN_TOL)) bad_flat++;
+                    }
+                    if (hfvis_env_light(&g, K, &env, 1.0f, &o, NULL, out, W) != HFVIS_OK) bad_status++;
+                    for (i = 0; i < n; i++) {
+                        if (!(out[i] >= 0.0f && (double)out[i] <= 0.5 * (1.0 + THIN_QUAD_TOL))) bad++;
+                        if (flat && !(fabs((double)out[i] - 0.5) <= THIN_TOL)) bad_flat++;
+                    }
+                    if (hfvis_visibility_count(&g, K, &o, NULL, out, W, NULL) != HFVIS_OK) bad_status++;
+                    for (i = 0; i < n; i++) if (!(out[i] >= 0.0f && out[i] <= (float)K * (float)n)) bad++;
+                    if (hfvis_direct_light(&g, K, &sun, 1.0f, NULL, 1, &o, out) != HFVIS_OK) bad_status++;
+                    for (i = 0; i < n; i++) if (!(out[i] >= 0.0f && out[i] <= 2.0f)) bad++;
+                    if (hfvis_sun_visibility(&g, 0.3, 0.6, 0.01, &o, out, W) != HFVIS_OK) bad_status++;
+                    for (i = 0; i < n; i++) if (!(out[i] >= 0.0f && out[i] <= 1.0f)) bad++;
+                    if (hfvis_indirect_light(&g, K, exitr, 1, 1.0f, 1.0f, &o, NULL, out, W) != HFVIS_OK)
+                        bad_status++;
+                    for (i = 0; i < n; i++) {
+                        if (!(out[i] >= 0.0f && (double)out[i] <= (1.0 + 0.25) * (1.0 + THIN_QUAD_TOL))) bad++;
+                        if (flat && !(fabs((double)out[i] - 1.0) <= THIN_TOL)) bad_flat++;
+                    }
+                    /* a direction range (the split runs' sums): each term in [0, 1] */
+                    o.direction_begin = K / 2;
+                    o.direction_end = K;
+                    if (hfvis_direction_sums(&g, K, HFVIS_SUM_SKY_VIEW, NULL, NULL, &o, sums) != HFVIS_OK)
+                        bad_status++;
+                    for (i = 0; i < n; i++) {
+                        if (!(sums[i] >= 0.0 && sums[i] <= (double)(K - K / 2))) bad++;
+                        if (flat && sums[i] != 0.0) bad_flat++;
+                    }
+                }
+    CHECK(bad_status == 0);
+    CHECK(bad == 0);
+    CHECK(bad_flat == 0);
+}
+
+/* Tiny and huge cells (issue: --cell 1e-50 gave NaN sky light, 7e-46 values down to -2e-44,
+ * normals at 1e-300 were (0, 0, 0)): heights over the cell stay in double, a normal is scaled
+ * by its largest part when the slopes' squares would overflow, sin(atan(t)) is taken without
+ * squaring a huge t. Every output finite and in range; as cells shrink the slopes go vertical,
+ * so the sky-view factors at 1e-50 and 1e-300 agree. */
+#define CELL_NORMAL_TOL 1e-6 /* |n| of a float-stored unit normal */
+#define CELL_LIMIT_TOL 1e-6  /* svf at 1e-300 vs 1e-50: both are the vertical-slope limit */
+#define CELL_QUAD_TOL 0.05   /* K = 16 sum of [P1] Eq. 5 on near-vertical receivers over its
+                                hemisphere integral: measured 2.6% here */
+TEST(tiny_and_huge_cells)
+{
+    static const double cells[] = { 1e-30, 1e-50, 1e-149, 1e-200, 1e-300, 1e30, 1e300 };
+    float z[64], svf[64], svf50[64], sky[64], nrm[192];
+    size_t c;
+    int i, bad = 0, bad_limit = 0, bad_normal = 0;
+    for (i = 0; i < 64; i++) z[i] = (float)((i * 37) % 11);
+    for (c = 0; c < sizeof cells / sizeof cells[0]; c++) {
+        hfvis_grid g;
+        g.z = z; g.width = 8; g.height = 8; g.stride = 8; g.cell_size = cells[c];
+        CHECK_EQ_STATUS(hfvis_sky_view_factor(&g, 16, NULL, svf, 8), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_sky_light(&g, 16, 1.0f, 1.0f, NULL, sky, 8), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_normals_compute(&g, nrm), HFVIS_OK);
+        for (i = 0; i < 64; i++) {
+            double len = sqrt((double)nrm[3 * i] * (double)nrm[3 * i] + (double)nrm[3 * i + 1] * (double)nrm[3 * i + 1] +
+                              (double)nrm[3 * i + 2] * (double)nrm[3 * i + 2]);
+            if (!(svf[i] >= 0.0f && svf[i] <= 1.0f)) bad++;
+            if (!(sky[i] >= 0.0f && (double)sky[i] <= 1.0 + CELL_QUAD_TOL)) bad++;
+            if (!(fabs(len - 1.0) <= CELL_NORMAL_TOL) || !(nrm[3 * i + 2] >= 0.0f)) bad_normal++;
+        }
+        if (cells[c] == 1e-50) memcpy(svf50, svf, sizeof svf);
+        if (cells[c] == 1e-300)
+            for (i = 0; i < 64; i++) bad_limit += !(fabs((double)svf[i] - (double)svf50[i]) <= CELL_LIMIT_TOL);
+    }
+    CHECK(bad == 0);
+    CHECK(bad_normal == 0);
+    CHECK(bad_limit == 0);
+    {   /* steep horizons (tan ~ 1e32) with holes and wrap, K = 5 (found by fuzz_heightfield):
+         * the sky term's theta - tc q cancelled below 0, sky light -2e-32 */
+        static float zw[100], sw[100];
+        hfvis_grid g;
+        hfvis_sweep_options o = hfvis_sweep_options_default();
+        int neg = 0;
+        for (i = 0; i < 100; i++) zw[i] = i % 9 == 0 ? (float)INFINITY : (float)i;
+        g.z = zw; g.width = 10; g.height = 10; g.stride = 10; g.cell_size = 2.37e-31;
+        o.border = HFVIS_BORDER_WRAP;
+        CHECK_EQ_STATUS(hfvis_sky_light(&g, 5, 1.0f, 1.0f, &o, sw, 10), HFVIS_OK);
+        for (i = 0; i < 100; i++) neg += i % 9 != 0 && !(sw[i] >= 0.0f);
+        CHECK(neg == 0);
+    }
+}
+
+/* A thin grid's lattice buffer is sized by the largest rows x cols over the directions, about
+ * (W + H)^2/2 nodes, not the D x D square of the diagonal (issue: a 1 x 16384 PGM made skyview
+ * allocate 2.1 GB). Bytes asked of the allocator by a 1 x 1024 sky-view run (heights and one
+ * accumulator channel, 16 bytes a node): at most 0.55 x 16 D^2. */
+#define THIN_LATTICE_SHARE 0.55 /* (a + b)^2/2 + 1.5(a + b) + 2 over D^2 for a = 1, b = 1023 */
+TEST(thin_grid_lattice_size)
+{
+    enum { N = 1024 };
+    static float z[N], out[N];
+    test_counting c;
+    hfvis_sweep_options o = hfvis_sweep_options_default();
+    hfvis_grid g;
+    double D = floor(sqrt((double)(N - 1) * (double)(N - 1))) + 3.0;
+    g.z = z; g.width = 1; g.height = N; g.stride = 1; g.cell_size = 1.0;
+    o.alloc = NULL;
+    {
+        hfvis_allocator a = test_counting_allocator(&c, 0);
+        o.alloc = &a;
+        CHECK_EQ_STATUS(hfvis_sky_view_factor(&g, 16, &o, out, 1), HFVIS_OK);
+    }
+    CHECK(c.live == 0);
+    CHECK((double)c.bytes <= THIN_LATTICE_SHARE * 16.0 * D * D);
+    CHECK(out[N / 2] == 1.0f);
+}
 
 TEST(bad_arguments)
 {
@@ -5215,6 +5376,9 @@ int main(int argc, char **argv)
     RUN(v_valley_finite_flank);
     RUN(l1_pit);
     RUN(golden_horizon_map);
+    RUN(thin_grids);
+    RUN(tiny_and_huge_cells);
+    RUN(thin_grid_lattice_size);
     RUN(bad_arguments);
     run_part2_tests();
     run_env_tests();
