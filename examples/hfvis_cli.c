@@ -3287,6 +3287,21 @@ static int cli_sum_check(const char *path, int cmd, const hfvis_partial *p)
     const double n = (double)(p->end - p->begin);
     double lo = 0.0, hi = n;
     size_t k;
+    char rays[16];
+    if ((cmd == CMD_SKYVIEW || cmd == CMD_SKY) && cli_tag_value(p->tag, "rays", rays, sizeof rays) &&
+        !strcmp(rays, "exact")) { /* exact rays weight direction k by K w_k, its share of the circle */
+        hfvis_sweep_options o = hfvis_sweep_options_default();
+        double *w = (double *)malloc(sizeof(double) * (size_t)p->directions), wmax = 0.0;
+        o.rays = HFVIS_RAYS_EXACT;
+        if (!w || !cli_tag_real(p->tag, "azimuth0", &o.azimuth0_rad) ||
+            hfvis_sweep_azimuths(p->directions, &o, NULL, w) != HFVIS_OK) {
+            free(w);
+            return cli_error(CLI_EXIT_ERROR, path, "cannot recompute the exact-ray weights of this part");
+        }
+        for (k = 0; k < (size_t)p->directions; k++) if (w[k] > wmax) wmax = w[k];
+        free(w);
+        hi = n * (double)p->directions * wmax;
+    }
     if (cmd == CMD_HORIZON) hi = (double)(float)(CLI_PI / 2.0), lo = -hi;
     else if (cmd == CMD_LIGHT) hi = HUGE_VAL;
     else if (cmd == CMD_VISIBILITY) hi = n * ((double)p->width + (double)p->height + 3.0);

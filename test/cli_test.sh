@@ -727,7 +727,7 @@ then ok "--quiet silences --progress"; else bad "--quiet with --progress: $(cat 
 # after renaming the new file over OUT): the counters are printed first, OUT is then untouched.
 if [ -w /dev/full ]; then
   printf 'old\n' > "$dir/old.pfm"
-  "$hfvis" visibility "$h" --dirs 4 --stats -o "$dir/old.pfm" > /dev/full 2> "$dir/stderr"; rc=$?
+  "$hfvis" visibility "$h" --dirs 4 --cell 1 --stats -o "$dir/old.pfm" > /dev/full 2> "$dir/stderr"; rc=$?
   [ "$rc" -eq 1 ] && [ "$(cat "$dir/old.pfm")" = old ] && [ "$(wc -l < "$dir/stderr" | tr -d ' ')" = 1 ] &&
     ok "visibility --stats > /dev/full: exit 1, OUT untouched" || bad "visibility --stats > /dev/full: exit $rc, OUT $(head -c 2 "$dir/old.pfm")"
 else
