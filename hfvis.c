@@ -4,31 +4,30 @@
  *   1. Common: status strings, allocation, checked sizes, PRNG
  *   2. Codecs: PGM (P2/P5) and PFM (Pf/PF) in memory, file wrappers; the NoData-safe PGM with
  *      its range comment
- *   3. Analytic test fields (spec heightfield §12)
- *   4. Bilinear sampling and normals ([P1] §4, §7 "quad sum"; spec §3.2, §5.1)
- *   5. The sweep lattice ([P1] §4, Fig. 2; spec §3.2)
- *   6. The P1 hull stack along one line ([P1] §5 Alg. 1, App. A.1; spec §4)
- *   7. The sweep driver: sampled lattice, four-way symmetry, borders, gather (spec §3.3-3.6)
- *   8. Horizon outputs and the ray-march oracles (spec §6); topographic openness (Yokoyama 2002)
+ *   3. Analytic test fields
+ *   4. Bilinear sampling and normals ([P1] §4, §7 "quad sum"; docs/errata.md E5; [P1] §7; docs/errata.md E10)
+ *   5. The sweep lattice ([P1] §4, Fig. 2; docs/errata.md E5)
+ *   6. The P1 hull stack along one line ([P1] §5 Alg. 1, App. A.1; [P1] §5, Alg. 1, App. A.1)
+ *   7. The sweep driver: sampled lattice, four-way symmetry, borders, gather ([P1] §4, §7; docs/errata.md E5, E7, E8)
+ *   8. Horizon outputs and the ray-march oracles ([P1] §2, [P2] §1); topographic openness (Yokoyama 2002)
  *   9. Light: uniform sky ([P1] Eq. 4-5), sky-view factor, sun visibility
- *  10. Environment light: prefix integrals and the L_p table ([P1] Eq. 6-7; spec §5.4),
+ *  10. Environment light: prefix integrals and the L_p table ([P1] Eq. 6-7; docs/errata.md E9),
  *      the hemisphere-integration oracle
- *  11. P2: the convex-hull tree ([P2] Alg. 1-3, App. A.2; spec §7), visible sets (spec §8),
- *      intervisibility sweeps, visibility index, indirect light and bounces (spec §9)
+ *  11. P2: the convex-hull tree ([P2] Alg. 1-3, App. A.2; [P2] §4-7, Alg. 1-3), visible sets ([P2] §10.1),
+ *      intervisibility sweeps, visibility index, indirect light and bounces (docs/errata.md E17)
  *  12. Viewshed of one observer (Franklin & Ray 1994, R2) and its exact line-of-sight oracle
  *  13. Nowrouzezahrai-Snyder GI, math layer: real SH of order 4, zonal lobes, environment
- *      projection, normalized Legendre polynomials, Appendix-A wedge matrices ([NS09]; spec GI B)
+ *      projection, normalized Legendre polynomials, Appendix-A wedge matrices ([NS09])
  *  14. Nowrouzezahrai-Snyder GI pipeline: slice scanning over the height pyramid, casting sets,
  *      wedges to SH visibility, environment, directional and key lights, diffuse and glossy
- *      bounces through the radiance pyramid, sub-sampling ([NS09] §5-9; spec GI B.2-B.9, B.12)
+ *      bounces through the radiance pyramid, sub-sampling ([NS09] §5-9; [NS09] §3-9; [NS09] §8)
  *  15. Split runs: raw per-receiver direction sums in double and the partial-sum file
  *  16. Exact rays (beyond [P1]): rational directions, every grid-line crossing and the split
  *      bulging pieces swept with the [P1] §5 hull, the per-receiver oracle, actual azimuths and
  *      their quadrature, the exact-mode light paths
  *
  * Paper references: [P1] Timonen & Westerholm, "Scalable Height Field Self-Shadowing",
- * CGF 29(2), 2010 (thesis appendix A.1). "spec" is the project's restatement
- * spec/heightfield-p1-p2.md, which fixes the paper's errata.
+ * CGF 29(2), 2010 (thesis appendix A.1). Errata and choices: docs/errata.md E1-E18.
  */
 #include "hfvis.h"
 
@@ -1010,7 +1009,7 @@ HFVIS_API hfvis_status hfvis_pgm_range_save(const char *path, const float *pixel
 #endif /* HFVIS_NO_STDIO */
 
 /* ========================================================================================== */
-/* 3. Analytic test fields (spec heightfield §12)                                             */
+/* 3. Analytic test fields                                                                    */
 /* ========================================================================================== */
 
 /* Value noise in [-1, 1] at (x, y) for one octave: hashed lattice values with the quintic fade,
@@ -1119,7 +1118,7 @@ hfvis_status hfvis_field_generate(const hfvis_field *field, int width, int heigh
 /* 4. Bilinear sampling and normals                                                           */
 /* ========================================================================================== */
 
-/* Bilinear height at (x, y) inside [0, W-1] x [0, H-1] (spec §3.2: x0 = min(floor x, W-2),
+/* Bilinear height at (x, y) inside [0, W-1] x [0, H-1] (docs/errata.md E5: x0 = min(floor x, W-2),
  * 1-D for W or H = 1). A tap with zero weight is never read into the sum, so a hole beside an
  * exact sample position does not leak into it. */
 /* The bilinear value from the taps at p (cell origin) with fractions fx, fy in [0, 1]; taps of
@@ -1178,7 +1177,7 @@ double hfvis_grid_sample(const hfvis_grid *grid, double x, double y)
 /* One gradient component along an axis: central difference in the interior, one-sided at the
  * border or beside a hole, 0 if both neighbours are missing. [P1] §7 sums the unnormalised
  * normals of the four quads around the sample; that sum equals this central difference
- * (spec §5.1), and at the border it is exactly the one-sided difference. */
+ * ([P1] §7; docs/errata.md E10), and at the border it is exactly the one-sided difference. */
 static double hf_slope_1d(double hm, double h0, double hp, int has_m, int has_p)
 {
     has_m = has_m && isfinite(hm);
@@ -1241,7 +1240,7 @@ hfvis_status hfvis_normals_compute(const hfvis_grid *grid, float *out)
 /* 5. The sweep lattice                                                                       */
 /* ========================================================================================== */
 
-#define HF_LATTICE_EPS 1e-9 /* spec §3.2: nodes within 1e-9 cell of the border are inside */
+#define HF_LATTICE_EPS 1e-9 /* docs/errata.md E5: nodes within 1e-9 cell of the border are inside */
 /* Half-width of the domain across an axis of one sample: a grid 1 sample wide (or tall) is
  * swept as a strip one cell wide, heights constant across it. A line of zero width would hold a
  * lattice node only where a node happens to land on it, and the gather would find none. */
@@ -1251,7 +1250,7 @@ hfvis_status hfvis_normals_compute(const hfvis_grid *grid, float *out)
 static double hf_domain_pad(int n) { return n == 1 ? HF_STRIP_HALF : HF_LATTICE_EPS; }
 
 /* Fill the lattice for a given sweep vector u (unit; v = (-u.y, u.x)). Directions are stored
- * as look azimuth psi with u = -(cos psi, sin psi) (spec §1: a sweep along u yields the horizon
+ * as look azimuth psi with u = -(cos psi, sin psi) (docs/errata.md E4: a sweep along u yields the horizon
  * toward -u). */
 static hfvis_status hf_lattice_from_u(hfvis_lattice *L, int W, int H, double ux, double uy)
 {
@@ -1293,7 +1292,7 @@ static hfvis_status hf_lattice_from_u(hfvis_lattice *L, int W, int H, double ux,
     return HFVIS_OK;
 }
 
-/* Unit sweep vector of look azimuth psi, snapped on the axes (spec §3.2). */
+/* Unit sweep vector of look azimuth psi, snapped on the axes (docs/errata.md E5). */
 static void hf_sweep_vector(double psi, double *ux, double *uy)
 {
     double x = -cos(psi), y = -sin(psi);
@@ -1325,7 +1324,7 @@ size_t hfvis_lattice_size(const hfvis_lattice *L)
 }
 
 /* Position of node (i, j). Written as i*u + j*v with the two products summed, so a lattice
- * turned by a quarter turn (u' = v, v' = -u) yields bit-identical positions (spec §3.6). */
+ * turned by a quarter turn (u' = v, v' = -u) yields bit-identical positions ([P1] §7). */
 static void hf_node_pos(const hfvis_lattice *L, int i, int j, double *x, double *y)
 {
     *x = (double)i * L->ux + (double)j * L->vx;
@@ -1352,7 +1351,7 @@ int hfvis_lattice_line(const hfvis_lattice *L, int j, int *i_first, int *i_last)
     len[1] = (double)(L->height - 1);
     pad[0] = hf_domain_pad(L->width);
     pad[1] = hf_domain_pad(L->height);
-    /* Slab test per axis (spec §3.2) gives the range to within rounding ... */
+    /* Slab test per axis (docs/errata.md E5) gives the range to within rounding ... */
     for (a = 0; a < 2; a++) {
         double off = (double)j * v[a], lo_a = pad[a] > HF_LATTICE_EPS ? -pad[a] : 0.0;
         if (u[a] != 0.0) {
@@ -1369,7 +1368,7 @@ int hfvis_lattice_line(const hfvis_lattice *L, int j, int *i_first, int *i_last)
     first = (int)ceil(lo - HF_LATTICE_EPS);
     last = (int)floor(hi + HF_LATTICE_EPS);
     /* ... and the per-node position test decides exactly, so every lattice and its quarter
-     * turns agree on which nodes exist (spec §11 item 10). The in-domain set of a line is an
+     * turns agree on which nodes exist (docs/errata.md E5). The in-domain set of a line is an
      * interval (a line meets a rectangle in a segment). */
     if (first < L->i_min) first = L->i_min;
     if (last > L->i_max) last = L->i_max;
@@ -1387,7 +1386,7 @@ int hfvis_lattice_line(const hfvis_lattice *L, int j, int *i_first, int *i_last)
 /* 6. The P1 hull stack along one line                                                        */
 /* ========================================================================================== */
 
-/* [P1] Alg. 1 / App. A.1 (spec §4.2). The caster of the highest horizon of p_i is the vertex
+/* [P1] Alg. 1 / App. A.1 (docs/errata.md E1, E2). The caster of the highest horizon of p_i is the vertex
  * before p_i on the upper hull of p_0..p_i ([P1] Eq. 2). Pop while the second entry b is seen at
  * least as high as the top a: (h_b - h)(d - d_a) >= (h_a - h)(d - d_b), P1's
  * h(v2) d(v1) >= h(v1) d(v2) ("ties pop", so on a plane the caster is the previous sample).
@@ -1461,14 +1460,14 @@ hfvis_status hfvis_line_horizons_naive(const double *distance, const double *hei
 
 /* Scratch for all the sweeps of one call, carved out of a single allocation (one block per
  * call, freed before return). The base lattice of a direction group is sampled once; its four
- * quarter turns psi + m pi/2 visit the same nodes (spec §3.6) and are traversed as
+ * quarter turns psi + m pi/2 visit the same nodes ([P1] §7) and are traversed as
  *   m = 0: rows, increasing i      m = 1: columns, increasing j
  *   m = 2: rows, decreasing i      m = 3: columns, decreasing j
  * (turning u by +pi/2 gives u' = v, v' = -u, so node (i', j') of psi + pi/2 is node (-j', i')). */
 typedef struct hf_sweep {
     const hfvis_grid *g;
     hfvis_border border;
-    int preroll;                /* cells of CLAMP/WRAP pre-roll before each line (spec §3.4) */
+    int preroll;                /* cells of CLAMP/WRAP pre-roll before each line (docs/errata.md E8) */
     int want_normals;
     int channels;               /* of the lattice accumulator */
     hfvis_lattice L;            /* base lattice of the current group */
@@ -1625,7 +1624,7 @@ static hfvis_status hf_sweep_alloc(hf_sweep *sw, const hfvis_grid *g, const hfvi
 static void hf_sweep_free(hf_sweep *sw) { hf_free(sw->alloc, sw->block); }
 
 /* Height (world units) at any position under the border rule: CLAMP clamps to the grid,
- * WRAP treats the field as periodic with period width x height (spec §3.4). */
+ * WRAP treats the field as periodic with period width x height (docs/errata.md E8). */
 static double hf_sample_border(const hfvis_grid *g, hfvis_border border, double x, double y)
 {
     if (border == HFVIS_BORDER_WRAP) {
@@ -1705,7 +1704,7 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
             hf_node_pos(L, i + L->i_min, j + L->j_min, &x, &y);
             x = hf_clampd(x, 0.0, (double)(g->width - 1));
             y = hf_clampd(y, 0.0, (double)(g->height - 1));
-            /* Bilinear taps (spec §3.2), shared by the height and, for lighting, the normal
+            /* Bilinear taps (docs/errata.md E5), shared by the height and, for lighting, the normal
              * ([P1] §7: normals bilinearly filtered, then renormalised). Zero-weight taps are
              * never read, so holes do not leak into exact sample positions. */
             /* the cell of hf_bilerp: x >= 0 after the clamp, so (int)x is floor(x) */
@@ -1787,7 +1786,7 @@ static int hf_line_span(const hf_sweep *sw, int m, int line, ptrdiff_t *node0, p
     return last - first + 1;
 }
 
-/* The brute-force maximum on unit-spaced samples (spec §6 item 2): the oracle twin of the
+/* The brute-force maximum on unit-spaced samples (docs/errata.md E5): the oracle twin of the
  * hull in hf_sweep_orientation. */
 static void hf_brute_unit(const double *h, int n, double *t)
 {
@@ -1813,7 +1812,7 @@ static void hf_brute_unit(const double *h, int n, double *t)
 typedef void (*hf_line_fn)(hf_sweep *sw, void *ctx, int m, ptrdiff_t node0, ptrdiff_t step,
                            int n, const double *t);
 
-/* One step of the hull stack (sh, sd, top) for the sample (d, h) (spec §4.2, the arithmetic of
+/* One step of the hull stack (sh, sd, top) for the sample (d, h) ([P1] Alg. 1; docs/errata.md E1, E2, the arithmetic of
  * hfvis_line_horizons with distance = node index): pop while the second entry is seen at least as
  * high, then return the tangent to the top (-inf on an empty stack) and push. (Pop decisions
  * taken without branches measured slower: they chain every step on the previous one's loads.) */
@@ -1830,7 +1829,7 @@ static inline double hf_hull_step(double *sh, double *sd, int *top_io, double h,
     return t;
 }
 
-/* Pre-roll (spec §3.4): R lattice nodes before the first in-domain node (i0, j0) of a line with
+/* Pre-roll (docs/errata.md E8): R lattice nodes before the first in-domain node (i0, j0) of a line with
  * lattice step (di, dj), sampled with the border rule, at distances -R..-1; they occlude but
  * receive nothing. Returns the stack height. */
 static int hf_preroll(const hf_sweep *sw, int i0, int j0, int di, int dj, double *sh, double *sd)
@@ -1866,7 +1865,7 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
         n = hf_line_span(sw, m, line, &node0, &step, &i0, &j0, &di, &dj);
         if (n == 0) continue;
         if (brute) {
-            /* Oracle: copy the line (pre-roll first) and scan it (spec §6 item 2). */
+            /* Oracle: copy the line (pre-roll first) and scan it (docs/errata.md E5). */
             for (r = 0; r < R; r++) {
                 double x, y;
                 hf_node_pos(L, i0 - (R - r) * di + L->i_min, j0 - (R - r) * dj + L->j_min, &x, &y);
@@ -1904,7 +1903,7 @@ static void hf_look_dir(const hf_sweep *sw, int m, double *lx, double *ly)
 }
 
 /* Direction k of K -> the sweep vector of its group's base lattice and its quarter turn m
- * (spec §3.6: with K % 4 == 0, psi_{k + m K/4} is psi_k turned by m quarter turns). */
+ * ([P1] §7: with K % 4 == 0, psi_{k + m K/4} is psi_k turned by m quarter turns). */
 static void hf_direction_base(int K, int k, double azimuth0, double *ux, double *uy, int *m)
 {
     int base = k;
@@ -1916,7 +1915,7 @@ static void hf_direction_base(int K, int k, double azimuth0, double *ux, double 
     hf_sweep_vector(azimuth0 + 2.0 * HF_PI * (double)base / (double)K, ux, uy);
 }
 
-/* Gather (spec §3.3): the value at grid point (x, y) from a lattice buffer, bilinear over the
+/* Gather (docs/errata.md E7): the value at grid point (x, y) from a lattice buffer, bilinear over the
  * four surrounding nodes using only finite ones, renormalised; if none is finite, the nearest
  * finite node within two cells; else NaN. Exact for axis directions (integer coordinates).
  * The weights are set up once per grid point and applied to every channel; all channels of a
@@ -1993,7 +1992,7 @@ static int hf_is_hole(const hfvis_grid *g, int x, int y)
 /* Gather of elevation angles. Channel by channel, nodes without a caster (alpha = -pi/2: the
  * first node of each line, which sees nothing) take part only when no neighbouring node has a
  * caster: a receiver between a line start and its successor lies inside the grid and does see
- * terrain ahead, and averaging -pi/2 into its angle is the border artefact spec §3.3 warns of.
+ * terrain ahead, and averaging -pi/2 into its angle is the border artefact docs/errata.md E7 warns of.
  * Otherwise as hf_gather_apply. */
 static void hf_gather_elevations(const hf_sweep *sw, int ch, const hf_gather *G, double *out)
 {
@@ -2040,7 +2039,7 @@ static void hf_gather_elevations(const hf_sweep *sw, int ch, const hf_gather *G,
 /* Gather the ch-channel lattice elevations into ch float planes (holes NaN): channel c holds
  * quarter turn m_first + c and goes to out + c*plane_step, row stride out_stride. With the open
  * border a receiver whose first unit step toward the look direction leaves the grid sees no
- * terrain: -pi/2, exactly as the per-receiver march decides it (spec §6 item 1). */
+ * terrain: -pi/2, exactly as the per-receiver march decides it ([P2] §1). */
 static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out,
                              size_t plane_step, ptrdiff_t out_stride)
 {
@@ -2377,7 +2376,7 @@ static double hf_surface_height(const hf_surface *S, double x, double y)
     return hf_sample_border(S->g, S->border, x, y);
 }
 
-/* Per-receiver march (spec §6 item 1; P2's "naive method"): samples at p + s*step*l,
+/* Per-receiver march ([P2] §1; P2's "naive method"): samples at p + s*step*l,
  * s = 1, 2, ..., while inside the grid (plus the border reach), keeping the largest slope; sign
  * -1 takes the slopes of the inverted surface -z (negative openness). */
 static double hf_march_tan(const hf_surface *S, double px, double py, double h0, double lx,
@@ -2574,7 +2573,7 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
 /* 9. Light: uniform sky, sky-view factor, sun visibility                                     */
 /* ========================================================================================== */
 
-/* [P1] Eq. 5 re-derived (spec §5.3): the phi-integral of the cosine term over the sector
+/* [P1] Eq. 5 re-derived: the phi-integral of the cosine term over the sector
  * [psi_k - pi/K, psi_k + pi/K] is exact (2 sin(pi/K)); the b_k term integrates to zero. */
 double hfvis_sector_weight(int K, double nz, double a, double theta)
 {
@@ -2583,7 +2582,7 @@ double hfvis_sector_weight(int K, double nz, double a, double theta)
            sin(HF_PI / (double)K) / HF_PI * a * (theta - 0.5 * sin(2.0 * theta));
 }
 
-/* S_k from the horizon tangent t, in slope space (spec §5.2): the tangent-plane clamp
+/* S_k from the horizon tangent t, in slope space (docs/errata.md E3): the tangent-plane clamp
  * theta_k = min(theta_h, pi/2 + atan2(a, Nz)) is t' = max(t, -a/Nz) (Nz > 0 for height
  * fields), then sin^2 theta = 1/(1+t'^2), sin 2theta = 2t'/(1+t'^2), theta = pi/2 - atan t'. */
 static double hf_sky_term(double t, double nz, double a, double inv_k, double lobe)
@@ -2910,7 +2909,7 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
 
 /* ==========================================================================================
  * 10. Environment light tables and evaluation, the hemisphere-integration oracle
- * [P1] §6 Eq. 3-7; spec heightfield §5.2-5.4, §11 items 2, 3, 15, 16, 17, §12.12.
+ * [P1] §6 Eq. 3-7; docs/errata.md E3, E9.
 
  *
  * Contents
@@ -2924,7 +2923,7 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
  * Table layouts (floats; C = env->channels, T = env->n_theta, K directions):
  *   HFVIS_ENV_PREFIX: 6*K*(T+1)*C floats. Record (k, b), b = 0..T, is 6*C floats at
  *     table[((k*(T+1) + b)*6 + q)*C + c], q = 0..5:
- *       q = 0,1,2: A_k, B_k, C_k of spec §5.4 at the band edge theta_b = b*pi/T (prefix over
+ *       q = 0,1,2: A_k, B_k, C_k of [P1] Eq. 6-7; docs/errata.md E9 at the band edge theta_b = b*pi/T (prefix over
  *                  bands 0..b-1; record 0 is zero, record T is the whole sphere);
  *       q = 3,4,5: the sector phi-integrals of band b, Int_sector L dphi,
  *                  Int_sector L cos(phi-psi_k) dphi, Int_sector L sin(phi-psi_k) dphi
@@ -2938,7 +2937,7 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
  *   HFVIS_ENV_LP_TABLE: K*M*Th*C floats, M = lp_normal_res (odd), Th = lp_horizon_res,
  *     table[((k*M + i)*Th + j)*C + c] = L_p^k(theta_n_i, theta_h_j),
  *     theta_n_i = pi*(i/(M-1) - 1/2) in [-pi/2, pi/2] (i = (M-1)/2 is exactly 0),
- *     theta_h_j = pi*j/(Th-1) in [0, pi] (spec §11 item 16). Already includes 1/pi.
+ *     theta_h_j = pi*j/(Th-1) in [0, pi] (docs/errata.md E9). Already includes 1/pi.
  * ========================================================================================== */
 
 /* ---------------------------------------------------------------- 1. constants, resolution */
@@ -3027,7 +3026,7 @@ size_t hfvis_env_table_size(const hfvis_env *env, int K, const hfvis_env_options
     return r.table_floats;
 }
 
-/* ------------------------------------ 2. sector phi-integrals, band theta-weights (spec §5.4) */
+/* ------------------------------------ 2. sector phi-integrals, band theta-weights ([P1] Eq. 6-7; docs/errata.md E9) */
 
 /* The sector [psi_k - pi/K, psi_k + pi/K] as an unwrapped interval [start, start + width]
  * with start reduced to [0, 2pi); the centre start + pi/K is psi_k modulo 2pi. */
@@ -3048,12 +3047,12 @@ static hf_env_sector hf_env_sector_of(int K, double azimuth0_rad, int k)
     return s;
 }
 
-/* Sector phi-integrals of texel row t (spec §5.4 "inner phi-integrals ... closed-form"):
+/* Sector phi-integrals of texel row t ([P1] Eq. 6-7; docs/errata.md E9 "inner phi-integrals ... closed-form"):
  * a0[c] = Int L dphi, a1[c] = Int L cos(phi - psi) dphi, a2[c] = Int L sin(phi - psi) dphi
  * over the sector, the texels being constant. Columns are visited as unwrapped intervals
  * [2pi p'/P, 2pi (p'+1)/P) with p' from just below the sector start up to 2P, column p' mod P,
  * so a sector that wraps past 2pi, or is narrower or wider than a column, is covered exactly.
- * a2 may be NULL (the L_p table drops the C term, spec §5.4). */
+ * a2 may be NULL (the L_p table drops the C term, [P1] Eq. 6-7; docs/errata.md E9). */
 static void hf_env_band_sector(const hfvis_env *env, int t, const hf_env_sector *s, double *a0,
                                double *a1, double *a2)
 {
@@ -3090,7 +3089,7 @@ static void hf_env_band_sector(const hfvis_env *env, int t, const hf_env_sector 
     }
 }
 
-/* Theta-weights between theta0 and theta (spec §5.2/§5.4 antiderivatives):
+/* Theta-weights between theta0 and theta (docs/errata.md E3 antiderivatives):
  * *wa = Int sin cos = (sin^2 theta - sin^2 theta0)/2 = sin(d) sin(s)/2,
  * *wb = Int sin^2   = (d - (sin 2theta - sin 2theta0)/2)/2 = (d - cos(s) sin(d))/2,
  * d = theta - theta0, s = theta + theta0 (difference forms: no cancellation inside a band). */
@@ -3110,7 +3109,7 @@ static double hf_env_band_edge(int b, int T)
 /* ---------------------------------------------------------- 3. hfvis_env_table_build */
 
 /* Running prefix A_k, B_k (and C_k) over the bands, for the L_p build: evaluated at
- * non-decreasing cutoffs theta in [0, pi] (spec §5.4 prefix form, band-partial exact). */
+ * non-decreasing cutoffs theta in [0, pi] ([P1] Eq. 6-7; docs/errata.md E9 prefix form, band-partial exact). */
 typedef struct hf_env_prefix_walk {
     const hfvis_env *env;
     hf_env_sector sector;
@@ -3153,7 +3152,7 @@ static void hf_env_walk_eval(hf_env_prefix_walk *w, double theta, double *A, dou
     }
 }
 
-/* L_p axes (spec §11 item 16); the build and the evaluator use these expressions. */
+/* L_p axes (docs/errata.md E9); the build and the evaluator use these expressions. */
 static double hf_env_lp_normal_angle(int i, int M)
 {
     return HF_PI * ((double)i / (double)(M - 1) - 0.5);
@@ -3169,7 +3168,7 @@ static double hf_env_lp_cutoff(int i, int M)
     return c < 0.0 ? 0.0 : (c > HF_PI ? HF_PI : c);
 }
 
-/* L_p table of one direction ([P1] Eq. 7 in its Eq. 5-consistent form, spec §5.4):
+/* L_p table of one direction ([P1] Eq. 7 in its Eq. 5-consistent form, [P1] Eq. 6-7; docs/errata.md E9):
  * L_p(theta_n, theta_h) = (1/pi)[cos theta_n A_k(c) + sin theta_n B_k(c)],
  * c = min(theta_h, theta_n + pi/2). Entries with theta_h_j < theta_n_i + pi/2 need A, B at
  * theta_h_j (shared by all i): one walk over j. The others need A, B at theta_n_i + pi/2
@@ -3306,16 +3305,16 @@ static hfvis_status hf_env_eval_init(hf_env_eval *e, const hfvis_env *env, int K
  * (cos_psi, sin_psi): look direction psi_k; (nx, ny, nz): unit normal, z up; tan_h: tangent
  * of the horizon elevation, -INFINITY = no occluder, +INFINITY = zenith blocked. A NaN tan_h
  * or normal adds NaN.
- * PREFIX ([P1] Eq. 4 with spec §5.2's clamp, §5.4 prefix form):
+ * PREFIX ([P1] Eq. 4 with the clamp of docs/errata.md E3, §5.4 prefix form):
  *   theta = min(theta_h, pi/2 + atan2(a, nz)) clamped to [0, pi], theta_h = pi/2 - atan(tan_h),
  *   acc += (1/pi)[nz A_k(theta) + a B_k(theta) + b C_k(theta)],
  *   a = nx cos psi + ny sin psi, b = -nx sin psi + ny cos psi.
  * LP_TABLE ([P1] Eq. 6): acc += |N_p| L_p^k(theta_n, theta_h), |N_p| = sqrt(a^2 + nz^2),
  *   theta_n = atan2(a, nz) clamped to [-pi/2, pi/2] (height-field normals have nz > 0),
  *   bilinear in (theta_n, theta_h). Because L_p is constant in theta_h beyond theta_n + pi/2
- *   (Eq. 7's upper limit; spec §11 item 16), a lookup with theta_h >= theta_n + pi/2 is made
+ *   (Eq. 7's upper limit; docs/errata.md E9), a lookup with theta_h >= theta_n + pi/2 is made
  *   at theta_h = pi, an exact table column: an open horizon then carries only the theta_n
- *   interpolation error, and N = up with theta_h >= pi/2 is exact (spec §12.12). */
+ *   interpolation error, and N = up with theta_h >= pi/2 is exact (docs/errata.md E9). */
 static void hf_env_accumulate(const hf_env_eval *e, int k, double cos_psi, double sin_psi,
                               double nx, double ny, double nz, double tan_h, double *acc)
 {
@@ -3481,7 +3480,7 @@ hfvis_status hfvis_env_light_from_map(const hfvis_grid *grid, int K,
 /* L_o = albedo/pi Int L_i V max(n.w, 0) dw ([P1] Eq. 3, the header's Lambertian convention)
  * by the midpoint rule: azimuths phi_m = 2pi (m + 1/2)/A, zenith angles
  * theta_j = pi (j + 1/2)/Z over the whole sphere [0, pi] (horizons may lie below the
- * horizontal, spec §11 item 15), dw = sin theta dtheta dphi. V = 1 iff the elevation
+ * horizontal, docs/errata.md E9), dw = sin theta dtheta dphi. V = 1 iff the elevation
  * pi/2 - theta_j exceeds the exact horizon alpha(phi_m) of hfvis_horizon_reference.
  * Each azimuth is one call with K = 1 and azimuth0 = phi_m, so no scratch and no limit on A
  * (the header promises "no allocation"); opts->azimuth0_rad is therefore not used, and
@@ -3633,7 +3632,7 @@ hfvis_status hfvis_env_light(const hfvis_grid *grid, int K, const hfvis_env *env
 /* 11. P2: the convex-hull tree, intervisibility, indirect light                              */
 /* ========================================================================================== */
 /* [P2] Timonen, "Low-Complexity Intervisibility in Height Fields", CGF 31(8), 2012 (thesis
- * appendix A.2); spec §7-9. Terms: samples p_0..p_n pushed in order of increasing distance,
+ * appendix A.2); [P2] §4-7, §10.1. Terms: samples p_0..p_n pushed in order of increasing distance,
  * R = p_n the receiver; "convex" = a cap (p_i above the chord of its neighbours, [P2] Eq. 1);
  * a segment starts where a convex section follows a concave one. The tree is the union of the
  * upper hulls S_j from every segment start j to R ([P2] Eq. 2); the root is R and its children,
@@ -3645,7 +3644,7 @@ struct hfvis_hull_tree {
     int safe_zone, zone_steps;
     long long iterations;
     double *d, *h;              /* the samples */
-    int *fc, *ns, *ps;          /* first child, next and previous sibling (spec §7.7) */
+    int *fc, *ns, *ps;          /* first child, next and previous sibling (docs/errata.md E16) */
     signed char *seg, *cls;     /* segment-start flag; convexity class +1 cap, -1 cup */
     int *pc, *pp;               /* pending (child, parent) tests: stack or ring queue */
     /* SafeZoneUpdate state ([P2] Alg. 3): a chord below every root child's line gc -> c */
@@ -3710,8 +3709,8 @@ int hfvis_hull_tree_count(const hfvis_hull_tree *tree) { return tree ? tree->n :
 
 int64_t hfvis_hull_tree_iterations(const hfvis_hull_tree *tree) { return tree ? tree->iterations : 0; }
 
-/* convex(c -> p -> r): p strictly above the chord c-r (spec §7.3; strict, so collinear points
- * are not kept: the tree then matches the naive rule with >=, spec §7.6). */
+/* convex(c -> p -> r): p strictly above the chord c-r ([P2] Alg. 1; strict, so collinear points
+ * are not kept: the tree then matches the naive rule with >=, docs/errata.md E14). */
 static int hf_tree_convex(const hfvis_hull_tree *t, int c, int p, int r)
 {
     return (t->h[p] - t->h[c]) * (t->d[r] - t->d[c]) > (t->h[r] - t->h[c]) * (t->d[p] - t->d[c]);
@@ -3725,7 +3724,7 @@ static void hf_tree_unlink(hfvis_hull_tree *t, int x, int r)
     if (t->ns[x] >= 0) t->ps[t->ns[x]] = t->ps[x];
 }
 
-/* SafeZoneUpdate ([P2] Alg. 3; spec §7.10): over the window [b1, b2] starting at the current
+/* SafeZoneUpdate ([P2] Alg. 3; docs/errata.md E15): over the window [b1, b2] starting at the current
  * distance, the lowest of the lines gc -> c (c a root child, gc its first child) at both ends;
  * the chord between them lies below all those lines on the window (a minimum of lines is
  * concave). */
@@ -3751,9 +3750,9 @@ static void hf_tree_zone_refresh(hfvis_hull_tree *t, int r)
 }
 
 /* The shortcut applies when the new sample r only replaces the old root o: the last child of o
- * fails its test (so every child fails, spec §7.3), and r lies strictly below every line
+ * fails its test (so every child fails, [P2] Alg. 1), and r lies strictly below every line
  * gc -> c (so every first grandchild passes). Never when o is a segment start: its leaf would be
- * lost (spec §7.10). */
+ * lost ([P2] Alg. 3; docs/errata.md E15). */
 static int hf_tree_zone_applies(hfvis_hull_tree *t, int o, int r)
 {
     int last = t->fc[o], chord_ok;
@@ -3807,13 +3806,13 @@ hfvis_status hfvis_hull_tree_push(hfvis_hull_tree *t, double distance, double he
     r = k;
     if (k >= 2) {
         /* [P2] Eq. 1 for p_i, i = k-1, now that p_{i+1} is known (non-uniform spacing form of
-         * spec §7.1); collinear inherits the previous class. */
+         * [P2] Eq. 1); collinear inherits the previous class. */
         double lhs, rhs;
         i = k - 1;
         lhs = (t->h[i] - t->h[i - 1]) * (t->d[i + 1] - t->d[i - 1]);
         rhs = (t->h[i + 1] - t->h[i - 1]) * (t->d[i] - t->d[i - 1]);
         t->cls[i] = lhs > rhs ? 1 : lhs < rhs ? -1 : t->cls[i - 1];
-        /* spec §7.4 (b): mark the segment start before RecConvexity, so the leaf stays in the
+        /* docs/errata.md E13: mark the segment start before RecConvexity, so the leaf stays in the
          * root list when orphaned and is among this step's horizons */
         if (t->cls[i] == 1 && t->cls[i - 1] == -1) t->seg[i] = 1;
     }
@@ -3840,7 +3839,7 @@ hfvis_status hfvis_hull_tree_push(hfvis_hull_tree *t, double distance, double he
             }
             t->iterations++;
             if (hf_tree_convex(t, c, p, r)) continue;
-            /* detach c, p's first child (the sibling is saved first: A.2 erratum, spec §7.5) */
+            /* detach c, p's first child (the sibling is saved first: A.2 erratum, docs/errata.md E12) */
             next = t->ns[c];
             t->fc[p] = next;
             if (next >= 0) t->ps[next] = -1;
@@ -3878,7 +3877,7 @@ int hfvis_hull_tree_horizons(const hfvis_hull_tree *tree, int minimal, int *out,
     if (tree->n < 2) return 0;
     r = tree->n - 1;
     for (c = tree->fc[r]; c >= 0; c = tree->ns[c]) {
-        /* spec §7.6: a root child whose predecessor is visible too is a segment start seen from
+        /* docs/errata.md E14: a root child whose predecessor is visible too is a segment start seen from
          * above, not a tangent point; the filter keeps c = 0 or a hidden predecessor */
         if (minimal && c > 0 &&
             !(hf_slope_from(tree->d, tree->h, r, c - 1) < hf_slope_from(tree->d, tree->h, r, c)))
@@ -3889,7 +3888,7 @@ int hfvis_hull_tree_horizons(const hfvis_hull_tree *tree, int minimal, int *out,
     return m;
 }
 
-/* Enumerate the visible samples from a horizon list (spec §8), farthest first, skipping holes.
+/* Enumerate the visible samples from a horizon list ([P2] §10.1), farthest first, skipping holes.
  * The q < next guard keeps runs of spurious horizons from overlapping. */
 static int hf_visible_from_horizons(const double *d, const double *h, int s, const int *H, int m,
                                     int *out, int cap)
@@ -3926,7 +3925,7 @@ int hfvis_line_visible_from_horizons(const double *distance, const double *heigh
     return hf_visible_from_horizons(distance, height, receiver, horizons, m, out, cap);
 }
 
-/* The naive visible set (spec §8): walking outward from the receiver, a sample is visible when
+/* The naive visible set ([P2] §10.1): walking outward from the receiver, a sample is visible when
  * its slope is >= the running maximum. Written near to far into tmp order reversed on output. */
 static int hf_visible_naive(const double *d, const double *h, int s, int *out, int cap)
 {
@@ -4233,7 +4232,7 @@ static void hf_p2_event(hf_sweep *sw, hf_p2_ctx *c, ptrdiff_t node, int s, const
     int i, m = 0;
     const int cols = sw->cols;
     c->st.visible += (double)nv;
-    for (i = 0; i < nh; i++) /* the minimal filter of spec §7.6 */
+    for (i = 0; i < nh; i++) /* the minimal filter of docs/errata.md E14 */
         if (hz[i] == 0 || hf_slope_from(c->ld, c->lh, s, hz[i] - 1) < hf_slope_from(c->ld, c->lh, s, hz[i]))
             c->hz[m++] = hz[i];
     e.k = c->f.k;
@@ -4248,11 +4247,11 @@ static void hf_p2_event(hf_sweep *sw, hf_p2_ctx *c, ptrdiff_t node, int s, const
     c->user_fn(c->user, &e);
 }
 
-/* Consumer: indirect light by the band rule of spec §9. With W(t) the tangent-clamped [P1]
+/* Consumer: indirect light by the band rule of docs/errata.md E17. With W(t) the tangent-clamped [P1]
  * Eq. 5 sector integral up to the zenith angle of slope t (hf_sky_term), the visible samples
  * s_1..s_M (far to near, slopes non-increasing) own the bands [W(t_j), W(t_{j+1})], the last up
  * to the tangent plane W(-inf); the sky owns [0, W(t_1)]. The sum telescopes: uniform radiance c
- * everywhere gives c W(-inf) = c S_k(c_k), the furnace identity (spec §12.10). */
+ * everywhere gives c W(-inf) = c S_k(c_k), the furnace identity (docs/errata.md E17). */
 static void hf_p2_indirect(hf_sweep *sw, hf_p2_ctx *c, ptrdiff_t node, int s, const int *vis,
                            int nv, const int *hz, int nh)
 {
@@ -4764,8 +4763,8 @@ hfvis_status hfvis_viewshed_reference(const hfvis_grid *grid, double observer_x,
  * Height Fields", CGF 28(4), 2009: real SH of order 4 (§7), normalized Legendre polynomials and
  * the closed-form 1-D projections of visibility and indirect radiance (§4, Eq. 9-13), the
  * Appendix-A wedge matrices and the Z-rotation that turn per-azimuth NLP vectors into SH
- * (§6, Eq. 18-24), the BRDF / light ZH lobes (§7, spec B.7-B.8) and the tangent-plane minimum
- * blocking angle (§3). "spec" is spec/raycast-ao-and-hf-gi.md part B, which fixes the errata.
+ * (§6, Eq. 18-24), the BRDF / light ZH lobes (§7, [NS09] §6-7) and the tangent-plane minimum
+ * blocking angle (§3). Errata: docs/errata.md E47-E53.
  *
  * Contents
  *   1. Real SH basis: Cartesian evaluation and the separable form K * P_l^mu(z) * Phi_m(phi)
@@ -4774,17 +4773,17 @@ hfvis_status hfvis_viewshed_reference(const hfvis_grid *grid, double observer_x,
  *   4. Projection of a lat-long environment (exact per-texel integrals)
  *   5. Normalized Legendre polynomials and the 1-D projections (Eq. 10-13)
  *   6. Appendix-A wedge matrices and the accumulation of Eq. 21
- *   7. The tangent-plane minimum blocking angle (§3, spec B.2 erratum)
+ *   7. The tangent-plane minimum blocking angle (§3, docs/errata.md E47)
  *
- * SH convention (DESIGN §2): real, orthonormal, no Condon-Shortley phase, index l(l+1)+m,
+ * SH convention (hfvis.h, Conventions): real, orthonormal, no Condon-Shortley phase, index l(l+1)+m,
  *   Y_lm = K_l^|m| * Pt_l^|m|(cos theta) * Phi_m(phi),  K_l^mu = sqrt((2l+1)/(4 pi) (l-mu)!/(l+mu)!),
  *   Pt_l^mu(z) = (1-z^2)^(mu/2) d^mu P_l/dz^mu (no (-1)^mu),
  *   Phi_m = sqrt2 cos(m phi) (m > 0), 1 (m = 0), sqrt2 sin(|m| phi) (m < 0),
- * with theta from +z and phi measured like psi (from +x toward +y). Compared with the spec's
+ * with theta from +z and phi measured like psi (from +x toward +y). Compared with the quoted
  * tables (written with the Condon-Shortley phase) every value with odd |m| changes sign
- * (spec B.7 "library-wide alignment"); shaded values do not.
+ * ([NS09] §7 "library-wide alignment"); shaded values do not.
  *
- * Errata of [NS09] applied here (spec B.2-B.7): the P^_2, P^_3 constants (sqrt10/4, sqrt14/4);
+ * Errata of [NS09] applied here ([NS09] §3-7): the P^_2, P^_3 constants (sqrt10/4, sqrt14/4);
  * the limits of Eq. 10 (z from -1 to sin sigma) and of Eq. 12 (z over [-1, 1]); Eq. 12's
  * "u(t_(i+1)) = 0 when i+1 >= |T|"; the canonical wedge alpha = phi/dphi of Eq. 18; m wedges on a
  * full circle (Eq. 21); M_bspl is 16x16, not 16x32; the Phong vector is a set of multipliers
@@ -4798,7 +4797,7 @@ hfvis_status hfvis_viewshed_reference(const hfvis_grid *grid, double observer_x,
 /* ------------------------------------------------------------------------ 1. the SH basis */
 
 /* Cartesian constants of the basis (K_l^|m| times sqrt2 for m != 0 and the polynomial's
- * leading factor), spec B.7 table without the Condon-Shortley signs. */
+ * leading factor), [NS09] §7 table without the Condon-Shortley signs. */
 #define NS_C00 0.28209479177387814   /* 1/(2 sqrt(pi)) */
 #define NS_C1 0.4886025119029199     /* sqrt(3/(4 pi)) */
 #define NS_C2A 1.0925484305920792    /* sqrt(15/pi)/2: xy, yz, xz */
@@ -4981,7 +4980,7 @@ hfvis_status hfvis_sh_rotate_z(const double in[16], double angle_rad, double out
     int l, m, i;
     if (in == NULL || out == NULL || !isfinite(angle_rad)) return HFVIS_ERR_INVALID_ARGUMENT;
     for (i = 0; i < NS_SH_N; i++) t[i] = in[i];
-    /* spec B.6: active rotation f'(phi) = f(phi - a); the (m, -m) pair turns by m a */
+    /* [NS09] §6, App. A; docs/errata.md E51: active rotation f'(phi) = f(phi - a); the (m, -m) pair turns by m a */
     for (m = 1; m <= 3; m++) {
         double c = cos((double)m * angle_rad), s = sin((double)m * angle_rad);
         for (l = m; l <= 3; l++) {
@@ -5021,7 +5020,7 @@ static const double ns_gl8_w[8] = {
 
 hfvis_status hfvis_sh_product_tensor(double *gamma)
 {
-    /* spec B.7: Gamma_ijk = Int Y_i Y_j Y_k. The integrand is a trigonometric polynomial of
+    /* [NS09] §7: Gamma_ijk = Int Y_i Y_j Y_k. The integrand is a trigonometric polynomial of
      * degree <= 9 in phi (uniform 16-point rule exact) and, once phi is integrated, a
      * polynomial of degree <= 9 in z (8-point Gauss-Legendre exact to degree 15). */
     int a, b, i, j, k;
@@ -5089,7 +5088,7 @@ hfvis_status hfvis_sh_convolve_zh(const double in[16], const double Ahat[4], dou
     int l, i;
     if (in == NULL || Ahat == NULL || out == NULL || !ns_ahat_valid(Ahat))
         return HFVIS_ERR_INVALID_ARGUMENT;
-    /* Funk-Hecke: a circularly symmetric kernel scales band l by Ahat_l (spec B.7) */
+    /* Funk-Hecke: a circularly symmetric kernel scales band l by Ahat_l ([NS09] §7) */
     for (l = 0; l < 4; l++)
         for (i = l * l; i < (l + 1) * (l + 1); i++) out[i] = Ahat[l] * in[i];
     return HFVIS_OK;
@@ -5101,7 +5100,7 @@ hfvis_status hfvis_sh_from_zh(const double Ahat[4], const double axis[3], double
     int l, i;
     if (Ahat == NULL || axis == NULL || out == NULL || !ns_ahat_valid(Ahat) || !ns_unit(axis, u))
         return HFVIS_ERR_INVALID_ARGUMENT;
-    /* spec B.7: F_lm = Ahat_l Y_lm(a) = sqrt(4 pi/(2l+1)) z_l Y_lm(a) ([NS09] §7, [SLS05]) */
+    /* [NS09] §7: F_lm = Ahat_l Y_lm(a) = sqrt(4 pi/(2l+1)) z_l Y_lm(a) ([NS09] §7, [SLS05]) */
     ns_sh_eval_unit(u[0], u[1], u[2], Y);
     for (l = 0; l < 4; l++)
         for (i = l * l; i < (l + 1) * (l + 1); i++) out[i] = Ahat[l] * Y[i];
@@ -5124,7 +5123,7 @@ hfvis_status hfvis_zh_diffuse(double Ahat[4])
 {
     if (Ahat == NULL) return HFVIS_ERR_INVALID_ARGUMENT;
     /* 2 pi Int_0^1 z P_l(z) dz: the clamped cosine's raw ZH (sqrt(pi)/2, sqrt(pi/3),
-     * sqrt(5 pi)/8, 0) of [NS09] §7 times sqrt(4 pi/(2l+1)) (spec B.7) */
+     * sqrt(5 pi)/8, 0) of [NS09] §7 times sqrt(4 pi/(2l+1)) */
     Ahat[0] = HF_PI;
     Ahat[1] = 2.0 * HF_PI / 3.0;
     Ahat[2] = HF_PI / 4.0;
@@ -5136,7 +5135,7 @@ hfvis_status hfvis_zh_phong(double S, double Ahat[4])
 {
     int l;
     if (Ahat == NULL || !isfinite(S) || !(S > 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
-    /* [NS09] §7 citing [RH02]: e^(-l^2/(2S)); spec B.7 erratum: these are multipliers Ahat */
+    /* [NS09] §7 citing [RH02]: e^(-l^2/(2S)); docs/errata.md E52: these are multipliers Ahat */
     for (l = 0; l < 4; l++) Ahat[l] = exp(-(double)(l * l) / (2.0 * S));
     return HFVIS_OK;
 }
@@ -5147,7 +5146,7 @@ hfvis_status hfvis_zh_cap(double half_angle_rad, double Ahat[4])
     int l;
     if (Ahat == NULL || !isfinite(half_angle_rad) || half_angle_rad < 0.0 || half_angle_rad > HF_PI)
         return HFVIS_ERR_INVALID_ARGUMENT;
-    /* spec B.8: Ahat_l = 2 pi Int_c^1 P_l = 2 pi (P_(l-1)(c) - P_(l+1)(c))/(2l+1), P_-1 := 1 */
+    /* [NS09] §6: Ahat_l = 2 pi Int_c^1 P_l = 2 pi (P_(l-1)(c) - P_(l+1)(c))/(2l+1), P_-1 := 1 */
     c = cos(half_angle_rad);
     P[0] = 1.0;
     P[1] = c;
@@ -5239,13 +5238,13 @@ hfvis_status hfvis_sh_project_env(const hfvis_env *env, double *out)
 
 /* ------------------------------------------------------- 5. normalized Legendre polynomials */
 
-/* sqrt((2l+1)/2), the NLP normalisation (spec B.3). */
+/* sqrt((2l+1)/2), the NLP normalisation ([NS09] §4, Eq. 9-13; docs/errata.md E48, E49). */
 #define NS_NLP0 0.70710678118654752440   /* sqrt(1/2) */
 #define NS_NLP1 1.22474487139158904910   /* sqrt(3/2) */
 #define NS_NLP2 1.58113883008418966600   /* sqrt(5/2) */
 #define NS_NLP3 1.87082869338697069279   /* sqrt(7/2) */
 
-/* Ascending coefficients of P^_k (degree k), spec B.3 erratum (sqrt10/4, sqrt14/4). */
+/* Ascending coefficients of P^_k (degree k), docs/errata.md E48, E49 (sqrt10/4, sqrt14/4). */
 static void ns_nlp_poly(int k, double q[4])
 {
     static const double norm[4] = {NS_NLP0, NS_NLP1, NS_NLP2, NS_NLP3};
@@ -5264,7 +5263,7 @@ hfvis_status hfvis_nlp_eval(double z, double P[4])
     return HFVIS_OK;
 }
 
-/* vbar(sigma) = Int_{-1}^{sin sigma} P^(z) dz ([NS09] Eq. 10 with the limits of spec B.3),
+/* vbar(sigma) = Int_{-1}^{sin sigma} P^(z) dz ([NS09] Eq. 10 with the limits of [NS09] §4, Eq. 9-13; docs/errata.md E48, E49),
  * from Int_{-1}^s P_l = (P_(l+1)(s) - P_(l-1)(s))/(2l+1); sigma is clamped to [-pi/2, pi/2]. */
 static void ns_vbar(double sigma, double *v)
 {
@@ -5318,7 +5317,7 @@ hfvis_status hfvis_nlp_radiance(int K, const double *omega_rad, const double *u,
             omega_rad[i] < (i == 0 ? omega_min_rad : omega_rad[i - 1]))
             return HFVIS_ERR_INVALID_ARGUMENT;
     for (k = 0; k < 4; k++) c[k] = 0.0;
-    /* [NS09] Eq. 12 with the errata of spec B.3: the integral covers z in [-1, 1] and
+    /* [NS09] Eq. 12 with the errata of [NS09] §4, Eq. 9-13; docs/errata.md E48, E49: the integral covers z in [-1, 1] and
      * u(t_(i+1)) = 0 once i + 1 >= |T| */
     for (i = 0; i < K; i++) {
         double du = u[i] - (i + 1 < K ? u[i + 1] : 0.0);
@@ -5345,7 +5344,7 @@ hfvis_status hfvis_nlp_reconstruct(const double c[4], double omega_rad, double *
 
 /* -------------------------------------------------------- 6. Appendix-A wedge matrices (B.6) */
 
-/* Ascending coefficients in alpha of the interpolation kernels beta_s (spec B.6). */
+/* Ascending coefficients in alpha of the interpolation kernels beta_s ([NS09] §6, App. A; docs/errata.md E51). */
 static const double ns_beta_lin[2][4] = {{1.0, -1.0, 0.0, 0.0}, {0.0, 1.0, 0.0, 0.0}};
 static const double ns_beta_bspl[4][4] = {
     {1.0 / 6.0, -3.0 / 6.0, 3.0 / 6.0, -1.0 / 6.0},   /* (1-a)^3/6 */
@@ -5362,7 +5361,7 @@ int hfvis_ns_wedge_columns(hfvis_ns_interp interp)
 
 hfvis_status hfvis_ns_wedge_matrix(hfvis_ns_interp interp, double dphi_rad, double *M)
 {
-    /* spec B.6 separable closed form: M[(l,m); (s,k)] = K_l^|m| A_(l,|m|,k) B_(m,s)(D) with
+    /* [NS09] §6, App. A; docs/errata.md E51 separable closed form: M[(l,m); (s,k)] = K_l^|m| A_(l,|m|,k) B_(m,s)(D) with
      * A = Int_{-1}^{1} Pt_l^|m| P^_k dz (exact, section 2) and
      * B = Int_0^D beta_s(phi/D) Phi_m(phi) dphi = D Sum_p beta_(s,p) Int_0^1 a^p Phi_m(D a) da. */
     const double (*beta)[4];
@@ -5424,7 +5423,7 @@ hfvis_status hfvis_ns_wedges_full(hfvis_ns_wedges *set, hfvis_ns_interp interp, 
                                   double phi0_rad)
 {
     if (set == NULL || m < 1 || !isfinite(phi0_rad)) return HFVIS_ERR_INVALID_ARGUMENT;
-    /* spec B.6 erratum on Eq. 21: a full circle has m wedges, the last one wrapping to sample 0 */
+    /* docs/errata.md E51 on Eq. 21: a full circle has m wedges, the last one wrapping to sample 0 */
     return ns_wedges_init(set, interp, m, 1, phi0_rad, NS_TWO_PI / (double)m);
 }
 
@@ -5452,7 +5451,7 @@ hfvis_status hfvis_ns_wedges_to_sh(const hfvis_ns_wedges *set, const double *w, 
     for (i = 0; i < NS_SH_N; i++) acc[i] = 0.0;
     for (j = 0; j < nw; j++) {
         /* [NS09] Eq. 20 (linear: w_j, w_(j+1)) or the B-spline form (w_(j-1) .. w_(j+2)), indices
-         * wrapped on a full circle and clamped to the end samples otherwise (spec B.6) */
+         * wrapped on a full circle and clamped to the end samples otherwise ([NS09] §6, App. A; docs/errata.md E51) */
         double x[16], Wj[NS_SH_N], R[NS_SH_N];
         for (s = 0; s < ns; s++) {
             int idx = j + s - (ns == 4 ? 1 : 0);
@@ -5492,7 +5491,7 @@ hfvis_status hfvis_ns_min_blocking_angle(const double normal[3], double phi_rad,
         if (d < -1.0) d = -1.0;
         *out = -asin(d);
     } else {
-        /* spec B.2 erratum: the tangent plane's horizon in azimuth phi */
+        /* docs/errata.md E47: the tangent plane's horizon in azimuth phi */
         *out = atan2(-d, n[2]);
     }
     return HFVIS_OK;
@@ -5507,32 +5506,32 @@ hfvis_status hfvis_ns_min_blocking_angle(const double normal[3], double phi_rad,
  * as a B-spline maximum and the casting set (Eq. 16-17), the visibility and indirect-radiance
  * NLP vectors (Eq. 11-12), the per-sample form of the wedge accumulation (Eq. 20-21), key and
  * directional lights (§6-7), shading with diffuse and Phong lobes (§7), the radiance pyramids of
- * the bounces (§5.3) and sub-sampling with full-resolution normals (§7, Fig. 6-7). "spec" is
- * spec/raycast-ao-and-hf-gi.md part B; its errata and [choice]s are applied and cited.
+ * the bounces (§5.3) and sub-sampling with full-resolution normals (§7, Fig. 6-7). Errata and choices:
+ * docs/errata.md E47-E53.
  *
  * Contents
  *   1. Limits, small helpers, the B-spline maximum (Eq. 16) and per-sample wedge matrices
- *   2. The multi-resolution pyramid (spec B.4 CPU proposal, B.5)
+ *   2. The multi-resolution pyramid ([NS09] §5.2, Eq. 14-17 CPU proposal, B.5)
  *   3. Options, scene validation and the memory plan
  *   4. The slice scan: blocking angles, omega_max, casting set (Eq. 14-17)
- *   5. Receiver records: visibility, key and directional lights (Eq. 11, §6, spec B.8)
- *   6. Receiver records: indirect radiance of a bounce (Eq. 12, §5.3, spec B.5)
- *   7. Shading (§7) and the sliding two-row upsampling of sub-sampled receivers (spec B.9)
- *   8. The driver (spec B.9 RENDER)
+ *   5. Receiver records: visibility, key and directional lights (Eq. 11, §6, [NS09] §6)
+ *   6. Receiver records: indirect radiance of a bounce (Eq. 12, §5.3, [NS09] §5.3)
+ *   7. Shading (§7) and the sliding two-row upsampling of sub-sampled receivers ([NS09] §9, Fig. 6)
+ *   8. The driver ([NS09] §9, Fig. 6 RENDER)
  *
  * Everything is computed in double; the pyramids, the glossy incident-radiance buffer and the
  * outputs are float. Comparisons of blocking angles are made on tangents (atan is monotone), and
  * the NLP projections only need sin(omega) = t / sqrt(1 + t^2), so atan is evaluated only where
  * the B-spline maximum needs angles. */
 
-#define HF_NS_CAST_TOL 1e-12          /* spec B.4: omega_i > run + 1e-12 enters the casting set */
+#define HF_NS_CAST_TOL 1e-12          /* [NS09] §5.2, Eq. 14-17: omega_i > run + 1e-12 enters the casting set */
 #define HF_NS_SNAP 1e-15              /* |cos|, |sin| below this are axis directions: exactly 0 */
 #define HF_NS_MAXCH 64                /* channels of a pyramid: 16 SH x 4 colour channels */
 #define HF_NS_KTAPS 7                 /* blur kernel taps (offsets -3..3) */
 
 /* ------------------------------------------------------ 1. helpers, Eq. 16, sample matrices */
 
-/* vbar(sigma) of Eq. 10 from s = sin(sigma) (spec B.3 closed form; same as ns_vbar). */
+/* vbar(sigma) of Eq. 10 from s = sin(sigma) ([NS09] §4, Eq. 9-13; docs/errata.md E48, E49 closed form; same as ns_vbar). */
 static void hf_ns_vbar(double s, double *v)
 {
     double s2 = s * s;
@@ -5830,7 +5829,7 @@ static double hf_ns_b3_variance(double s, double *w)
     return m2 / sum;
 }
 
-/* The blur kernel of level j of an octave (spec B.4: "a normalized, sampled cubic B-spline kernel
+/* The blur kernel of level j of an octave ([NS09] §5.2, Eq. 14-17: "a normalized, sampled cubic B-spline kernel
  * of scale 2^(j/k)"): its scale is chosen (bisection) so that its variance is (4^(j/k) - 1)/4 G_o
  * texels^2: the variance of a level then grows like 4^(l/k) across the whole pyramid, G_(o+1)
  * adding the 3/4 of the [1,3,3,1]/8 decimation. j = 0 is the identity. */
@@ -6128,7 +6127,7 @@ hfvis_status hfvis_ns_gi_options_resolve(const hfvis_grid *grid, const hfvis_ns_
     if (o.cast_cache == HFVIS_NS_CACHE_DEFAULT) o.cast_cache = d.cast_cache;
     if (o.border == HFVIS_BORDER_DEFAULT) o.border = d.border;
     if (o.levels == 0) {
-        /* the last step tau_(n-1) = 2^((n-1)/k) reaches the grid's diagonal (spec B.4: the natural
+        /* the last step tau_(n-1) = 2^((n-1)/k) reaches the grid's diagonal ([NS09] §5.2, Eq. 14-17: the natural
          * choice 1 + k log2 R, for any aspect) */
         double D = hypot((double)(grid->width - 1), (double)(grid->height - 1)), e;
         if (D < 1.0) D = 1.0;
@@ -6428,7 +6427,7 @@ static int hf_ns_scan(const hf_ns_ctx *c, const hf_ns_recv *r, double cph, doubl
         t = (hq - hp) * c->inv_dist[i];
         if (tv) tv[nv] = t;
         nv++;
-        /* Eq. 17 (spec B.4): omega_i above the running maximum, which starts at omega_min */
+        /* Eq. 17 ([NS09] §5.2, Eq. 14-17): omega_i above the running maximum, which starts at omega_min */
         if (cast && t > run + HF_NS_CAST_TOL * (1.0 + run * run)) {
             cast[K].i = i;
             cast[K].t = t;
@@ -6459,7 +6458,7 @@ static double hf_ns_smax(hf_ns_ctx *c, int nv)
 }
 
 /* omega_min of the receiver normal N toward (cph, sph) as tangent and sine ([NS09] §3 with the
- * spec B.2 erratum; N_z > 0 for every normal the library makes). */
+ * docs/errata.md E47; N_z > 0 for every normal the library makes). */
 static void hf_ns_omega_min(const hf_ns_ctx *c, const double *N, double cph, double sph,
                             double *t_min, double *s_min)
 {
@@ -6512,7 +6511,7 @@ static void hf_ns_direct_rec(hf_ns_ctx *c, double X, double Y, const double *N, 
             int K;
             if (bits || c->o.clamp_to_tangent) hf_ns_omega_min(c, N, c->ecos[j], c->esin[j], &tmin, &smin);
             for (q = 0; bits && q < c->cwords; q++) bits[q] = 0;
-            /* the casting set for the bounces comes with the visibility scan (spec B.9 [choice]) */
+            /* the casting set for the bounces comes with the visibility scan ([NS09] §9) */
             nv = hf_ns_scan(c, &r, c->ecos[j], c->esin[j], tmin, c->tv, bits ? c->cast : NULL, &K, bits);
             sm = hf_ns_smax(c, nv);
             c->smax[j] = sm;
@@ -6548,7 +6547,7 @@ static void hf_ns_direct_rec(hf_ns_ctx *c, double X, double Y, const double *N, 
         nv = hf_ns_scan(c, &r, D->cph, D->sph, 0.0, c->tv, NULL, NULL, NULL);
         sm = hf_ns_smax(c, nv);
         if (c->o.directional == HFVIS_NS_DIRECTIONAL_SOFT) {
-            /* spec B.8 soft: clamp(v(phi_L) . P^(sin omega_L), 0, 1) */
+            /* [NS09] §6 soft: clamp(v(phi_L) . P^(sin omega_L), 0, 1) */
             double v[4], P[4], val;
             hf_ns_vis(sm, 1.0, v);
             (void)hfvis_nlp_eval(D->sin_e, P);
@@ -6561,7 +6560,7 @@ static void hf_ns_direct_rec(hf_ns_ctx *c, double X, double Y, const double *N, 
 }
 
 /* The SH incident radiance of a direct record, channel ch: L_env * V + Sum L_key * V_key, plus
- * the directional lights as SH deltas when sh_dirs (spec B.7-B.8). */
+ * the directional lights as SH deltas when sh_dirs ([NS09] §6-7). */
 static void hf_ns_incident(const hf_ns_ctx *c, const double *rec, int ch, int sh_dirs, double *I)
 {
     int q, i;
@@ -6669,12 +6668,12 @@ static void hf_ns_bounce_rec(hf_ns_ctx *c, double X, double Y, const double *N, 
             for (i = 0; bits && i < c->cwords; i++) bits[i] = 0;
             (void)hf_ns_scan(c, &r, cph, sph, tmin, NULL, c->cast, &K, bits);
         }
-        if (K == 0) continue; /* spec B.3: an empty casting set gives u = 0 */
+        if (K == 0) continue; /* [NS09] §4, Eq. 9-13; docs/errata.md E48, E49: an empty casting set gives u = 0 */
         for (q = 0; q < K; q++) {
             const hf_ns_cast *e = &c->cast[q];
             const int lu = c->lu_i[e->i];
             double *u = c->ub + (size_t)q * (size_t)C;
-            /* [NS09] §5.3: u(tau) from the radiance pyramid at level l_u(i) (spec B.5) */
+            /* [NS09] §5.3: u(tau) from the radiance pyramid at level l_u(i) */
             if (!hf_ns_sampleC(&c->dp[lu], C, c->wrap, c->holes, e->x, e->y, u))
                 for (ch = 0; ch < C; ch++) u[ch] = 0.0;
             if (c->gvec) {
@@ -6701,7 +6700,7 @@ static void hf_ns_bounce_rec(hf_ns_ctx *c, double X, double Y, const double *N, 
             hf_ns_vbar(hf_tan_sine(e->t), c->vb + (size_t)q * 4u);
         }
         hf_ns_vbar(smin, vm);
-        /* Eq. 12 (spec B.3 errata): Sum_k (u_k - u_(k+1)) vbar(omega_k) - u_0 vbar(omega_min) */
+        /* Eq. 12 (docs/errata.md E48, E49): Sum_k (u_k - u_(k+1)) vbar(omega_k) - u_0 vbar(omega_min) */
         for (ch = 0; ch < C; ch++) {
             double w[4] = {0.0, 0.0, 0.0, 0.0};
             const double u0 = c->ub[ch];
@@ -6937,7 +6936,7 @@ static void hf_ns_tables(hf_ns_ctx *c)
     memset(&ws, 0, sizeof ws);
     (void)hfvis_sh_product_tensor(c->gamma);
     for (i = 0; i < c->n; i++) {
-        /* Eq. 14 in cell units (spec B.4): tau_i = 2^(i/k); l_v(i) = max(0, i - k o_v) */
+        /* Eq. 14 in cell units ([NS09] §5.2, Eq. 14-17): tau_i = 2^(i/k); l_v(i) = max(0, i - k o_v) */
         c->tau[i] = pow(2.0, (double)i / (double)c->k);
         c->inv_dist[i] = 1.0 / (c->tau[i] * c->cell);
         c->lv_i[i] = i - c->k * c->ov < 0 ? 0 : i - c->k * c->ov;
@@ -6948,7 +6947,7 @@ static void hf_ns_tables(hf_ns_ctx *c)
         c->ecos[j] = fabs(cos(phi)) < HF_NS_SNAP ? 0.0 : cos(phi);
         c->esin[j] = fabs(sin(phi)) < HF_NS_SNAP ? 0.0 : sin(phi);
     }
-    /* full circle: m wedges with the wrap-around one (spec B.6 erratum on Eq. 21) */
+    /* full circle: m wedges with the wrap-around one (docs/errata.md E51 on Eq. 21) */
     (void)hfvis_ns_wedges_full(&ws, c->o.interp, c->m, c->o.azimuth0_rad);
     (void)hfvis_ns_sample_matrices(&ws, c->G_env);
     for (j = 0; j < c->m; j++)
@@ -6980,7 +6979,7 @@ static void hf_ns_tables(hf_ns_ctx *c)
             ns_sh_eval_unit(a[0], a[1], a[2], D->Yd);
             for (i = nb; i < NS_SH_N; i++) D->Yd[i] = 0.0;
         } else {
-            /* spec B.8: a uniform cap of angular radius alpha about a, L0 = E0 / (pi sin^2 alpha)
+            /* [NS09] §6: a uniform cap of angular radius alpha about a, L0 = E0 / (pi sin^2 alpha)
              * (its irradiance on a facing surface is L0 pi sin^2 alpha), L_lm = L0 Ahat_l Y_lm(a) */
             double Ah[4], F[NS_SH_N], sa = sin(L->radius_rad);
             double *dst;
@@ -7119,7 +7118,7 @@ hfvis_status hfvis_ns_gi(const hfvis_grid *grid, const hfvis_ns_scene *scene,
 /* 15. Split runs: raw direction sums and the partial-sum file                                */
 /* ========================================================================================== */
 /* Every fused output is a finish of a per-receiver sum over directions (hfvis.h, "split runs"):
- * Zaksek et al. 2011 (SVF), [P1] Eq. 5-6 (sky, environment), spec heightfield §8 (visibility index).
+ * Zaksek et al. 2011 (SVF), [P1] Eq. 5-6 (sky, environment), [P2] §10.1 (visibility index).
  * hfvis_direction_sums runs the same fused consumer as the finished routine over the options'
  * direction range and returns the grid accumulator itself, in double. */
 

@@ -155,7 +155,7 @@
  *   - Exact: the hull sweep equals the per-line brute force on the same lattice samples
  *     (hfvis_horizon_lattice_naive) bit for bit; axis directions reproduce the grid exactly.
  *   - Within tolerance: gathered (non-axis) directions against the per-receiver ray march
- *     (bilinear resampling of the lattice, spec heightfield §3.3); libm differences across C
+ *     (bilinear resampling of the lattice, docs/errata.md E7); libm differences across C
  *     libraries (sin, cos, atan) at the 1e-15 relative level.
  *   - Not guaranteed: agreement with GPU implementations that use fp16 heights or 8-bit angles
  *     ([P1] §7); expect differences of about 1e-3 rad there.
@@ -376,7 +376,7 @@ HFVIS_API hfvis_status hfvis_pgm_range_decode(const void *data, size_t size, flo
                                               size_t out_count, hfvis_image_info *info);
 
 /* ========================================================================================== */
-/* hfvis.c - analytic test fields (spec heightfield §12)                                      */
+/* hfvis.c - analytic test fields                                                             */
 /* ========================================================================================== */
 
 typedef enum hfvis_field_kind {
@@ -388,7 +388,7 @@ typedef enum hfvis_field_kind {
     HFVIS_FIELD_CONE = 6,         /* z = height + slope*r,  r = |(x,y)-(x0,y0)|  (cone pit)     */
     HFVIS_FIELD_HEMISPHERE = 7,   /* z = height + amplitude*sqrt(1 - (r/radius)^2) for r < radius,
                                      else height; amplitude = radius*cell_size is a true
-                                     hemisphere (spec §12.8)                                   */
+                                     hemisphere                                                */
     HFVIS_FIELD_STEP = 8,         /* z = height for x < x0, height + amplitude for x >= x0 (a
                                      wall facing -x; sampled on the grid the rise is the bilinear
                                      ramp over [x0-1, x0])                                      */
@@ -430,7 +430,7 @@ HFVIS_API hfvis_status hfvis_field_generate(const hfvis_field *field, int width,
                                            ptrdiff_t stride, float *out);
 
 /* ========================================================================================== */
-/* hfvis.c - sampling, normals and the sweep lattice ([P1] §4, §7; spec heightfield §3, §5.1) */
+/* hfvis.c - sampling, normals and the sweep lattice ([P1] §4, §7; [P1] §4, Fig. 2; docs/errata.md E5, E7, E8; [P1] §7; docs/errata.md E10) */
 /* ========================================================================================== */
 
 /* Bilinear height at grid position (x, y), clamped to the grid, in world units; NaN if a tap
@@ -444,7 +444,7 @@ HFVIS_API double hfvis_grid_sample(const hfvis_grid *grid, double x, double y);
  * Returns HFVIS_OK or HFVIS_ERR_INVALID_ARGUMENT. Cost O(width*height). */
 HFVIS_API hfvis_status hfvis_normals_compute(const hfvis_grid *grid, float *out);
 
-/* The parallel-line lattice of one look direction (spec heightfield §3.2). Sweep direction
+/* The parallel-line lattice of one look direction (docs/errata.md E5). Sweep direction
  * u = -(cos psi, sin psi), line offset v = (-u.y, u.x); node (i, j) lies at grid position
  * i*u + j*v; line j is traversed in increasing i. Lattice buffers are row-major with
  * rows j - j_min and columns i - i_min: rows = j_max-j_min+1, cols = i_max-i_min+1. */
@@ -473,7 +473,7 @@ HFVIS_API size_t hfvis_lattice_size(const hfvis_lattice *lattice);
 HFVIS_API int hfvis_lattice_line(const hfvis_lattice *lattice, int j, int *i_first, int *i_last);
 
 /* ========================================================================================== */
-/* hfvis.c - P1 horizons ([P1] §5 Alg. 1, App. A.1; spec heightfield §4)                      */
+/* hfvis.c - P1 horizons ([P1] §5 Alg. 1, App. A.1; [P1] §5, Alg. 1, App. A.1)                */
 /* ========================================================================================== */
 
 /* How hfvis_sweep_options.direction_begin/end count the K directions. */
@@ -482,7 +482,7 @@ typedef enum hfvis_direction_order {
     HFVIS_DIRECTION_ORDER_INDEX = 1,   /* position p is direction k = p */
     HFVIS_DIRECTION_ORDER_SWEEP = 2    /* the order the sweep visits them: when K % 4 == 0,
                                           position p is k = p/4 + (p%4)*K/4, so the four quarter
-                                          turns that share one sampled lattice (spec §3.6) are
+                                          turns that share one sampled lattice ([P1] §7) are
                                           consecutive; else k = p. A range of whole quarter-turn
                                           groups (begin, end multiples of 4) samples only its own
                                           lattices: P such parts cost about 1/P of the run each */
@@ -547,14 +547,14 @@ HFVIS_API hfvis_status hfvis_horizon_lattice(const hfvis_grid *grid, double azim
                                              const hfvis_sweep_options *opts, float *out);
 
 /* Oracle for hfvis_horizon_lattice: every node scans all earlier samples of its line
- * (spec heightfield §6 item 2). Bit-identical to the sweep. Cost O(width*height*N). */
+ * (docs/errata.md E5). Bit-identical to the sweep. Cost O(width*height*N). */
 HFVIS_API hfvis_status hfvis_horizon_lattice_naive(const hfvis_grid *grid, double azimuth_rad,
                                                    const hfvis_sweep_options *opts, float *out);
 
 /* Horizon elevation toward direction k of K (psi_k = azimuth0 + 2 pi k/K) at every grid point:
- * the lattice gathered back with renormalised bilinear weights (spec heightfield §3.3; exact for
+ * the lattice gathered back with renormalised bilinear weights (docs/errata.md E7; exact for
  * axis directions). When K % 4 == 0, direction k is computed on the lattice of direction
- * k mod K/4 turned by whole quarter turns (spec §3.6), exactly as hfvis_horizon_map does, so
+ * k mod K/4 turned by whole quarter turns ([P1] §7), exactly as hfvis_horizon_map does, so
  * plane k of the map equals this output bit for bit; use it to split directions across threads
  * or machines. out[y*out_stride + x], out_stride >= width. Cost O(width*height). */
 HFVIS_API hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, int k,
@@ -564,7 +564,7 @@ HFVIS_API hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, in
 /* The full horizon map: K planes, plane k = out[k*width*height + y*width + x], the elevation
  * toward psi_k. out must hold K*width*height floats (check the product for overflow; it is
  * large: K = 64 at 1024^2 is 256 MiB; prefer the fused lighting calls). When K % 4 == 0 the
- * four directions psi, psi+pi/2, psi+pi, psi+3pi/2 share one sampled lattice (spec §3.6).
+ * four directions psi, psi+pi/2, psi+pi, psi+3pi/2 share one sampled lattice ([P1] §7).
  * With opts->direction_begin/end = [b, e) only those planes are made: out then holds
  * (e-b)*width*height floats, in position order (opts->direction_order): the direction at
  * position p is out[(p-b)*width*height ...], bit-identical to its plane of the full map (split a
@@ -576,7 +576,7 @@ HFVIS_API hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K,
 /* Options of the per-receiver ray-march oracle. */
 typedef struct hfvis_march_options {
     double step_cells;      /* march step along the ray in cells; 0 = 1 (the papers' naive
-                               method takes unit steps, spec heightfield §6 item 1) */
+                               method takes unit steps, [P2] §1) */
     double max_distance_cells; /* stop after this distance; 0 = until the ray leaves the grid
                                (or border_cells beyond it for CLAMP/WRAP) */
 } hfvis_march_options;
@@ -592,7 +592,7 @@ HFVIS_API hfvis_status hfvis_horizon_reference(const hfvis_grid *grid, int K,
                                                const hfvis_march_options *march,
                                                const float *points, size_t count, float *out);
 
-/* Same oracle on an analytic surface (spec heightfield §12.5-12.8): heights come from
+/* Same oracle on an analytic surface: heights come from
  * fn(user, x, y) in world units, the domain is [0, width-1] x [0, height-1] in grid units and
  * one cell is cell_size world units. Only HFVIS_BORDER_OPEN is meaningful here. */
 HFVIS_API hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user, int width,
@@ -712,7 +712,7 @@ HFVIS_API hfvis_status hfvis_horizon_exact_naive(const hfvis_grid *grid, int K,
                                                  const hfvis_sweep_options *opts, float *out);
 
 /* ========================================================================================== */
-/* hfvis.c - P1 light ([P1] §6 Eq. 3-7; spec heightfield §5)                                  */
+/* hfvis.c - P1 light ([P1] §6 Eq. 3-7; [P1] §6-7)                                            */
 /* ========================================================================================== */
 
 /* [P1] Eq. 5 per sector: S_k(theta) = (Nz/K) sin^2 theta + (sin(pi/K)/pi) a (theta - sin 2theta / 2),
@@ -721,7 +721,7 @@ HFVIS_API hfvis_status hfvis_horizon_exact_naive(const hfvis_grid *grid, int K,
  * non-finite results. */
 HFVIS_API double hfvis_sector_weight(int K, double nz, double a, double theta);
 
-/* Uniform sky, fused into the sweep ([P1] §6.1 Eq. 4-5 with the clamp correction of spec §5.2):
+/* Uniform sky, fused into the sweep ([P1] §6.1 Eq. 4-5 with the clamp correction of docs/errata.md E3):
  * out = albedo * sky * sum_k S_k(theta_k) at every grid point, computed in lattice space with
  * bilinearly sampled normals and gathered (the paper's pipeline, [P1] §7). No horizon map is
  * stored: one block of about 48*(W^2+H^2) bytes, O(width*height). NaN at holes.
@@ -754,7 +754,7 @@ HFVIS_API hfvis_status hfvis_sky_view_factor_from_map(const hfvis_grid *grid, in
                                                       ptrdiff_t out_stride);
 
 /* Sun visibility in [0, 1] from one exact sweep toward the sun's azimuth (look direction
- * sun_azimuth_rad, DESIGN convention) and its elevation. sun_radius_rad = 0 gives a hard shadow
+ * sun_azimuth_rad, hfvis.h convention) and its elevation. sun_radius_rad = 0 gives a hard shadow
  * (1 if the sun centre is above the horizon, else 0); > 0 gives the visible fraction of a sun
  * disc of that angular radius above the horizon line, 1 - (acos(d) - d sqrt(1-d^2))/pi with
  * d = clamp((elevation - alpha)/radius, -1, 1). Self-shadowing by the receiver's own tangent
@@ -779,7 +779,7 @@ typedef struct hfvis_env {
 
 typedef enum hfvis_env_method {
     HFVIS_ENV_DEFAULT = 0,
-    HFVIS_ENV_PREFIX = 1,    /* exact prefix integrals A_k, B_k, C_k (spec heightfield §5.4) */
+    HFVIS_ENV_PREFIX = 1,    /* exact prefix integrals A_k, B_k, C_k ([P1] Eq. 6-7; docs/errata.md E9) */
     HFVIS_ENV_LP_TABLE = 2   /* the paper's L_p table, [P1] Eq. 6-7, bilinear in (theta_n, theta_h) */
 } hfvis_env_method;
 
@@ -789,7 +789,7 @@ typedef struct hfvis_env_options {
                                  16 is "safe"; odd so that theta_n = 0 is a sample) */
     int lp_horizon_res;       /* L_p table theta_h samples, >= 2; 0 = 257 ([P1]'s theta_N = 256
                                  intervals; odd so that theta_h = pi/2 is a sample and a flat
-                                 receiver is exact, spec §12.12) */
+                                 receiver is exact, docs/errata.md E9) */
 } hfvis_env_options;
 
 HFVIS_API hfvis_env_options hfvis_env_options_default(void);
@@ -850,14 +850,14 @@ HFVIS_API hfvis_status hfvis_light_reference(const hfvis_grid *grid, const hfvis
                                              size_t count, float *out);
 
 /* ========================================================================================== */
-/* hfvis.c - P2 intervisibility ([P2] §4-8, Alg. 1-3, App. A.2; spec heightfield §7-8)        */
+/* hfvis.c - P2 intervisibility ([P2] §4-8, Alg. 1-3, App. A.2)                               */
 /* ========================================================================================== */
 
 /* The convex-hull tree along one line ([P2] §5): samples are pushed in order of increasing
  * distance; after each push the tree's root children are the local visibility horizons of the
  * newest sample (the receiver), from which its visible samples follow. RecConvexity ([P2]
- * Alg. 1) runs iteratively on arrays indexed by sample (spec §7.7) with the errata of spec
- * §7.4-7.5 fixed (the segment-start leaf is marked before the step's horizons are read; the
+ * Alg. 1) runs iteratively on arrays indexed by sample (docs/errata.md E16) with the errata of
+ * docs/errata.md E12-E13 fixed (the segment-start leaf is marked before the step's horizons are read; the
  * convexity test is Eq. 1's, strict). Lives in caller memory: no allocation. */
 typedef struct hfvis_hull_tree hfvis_hull_tree;
 
@@ -872,7 +872,7 @@ typedef struct hfvis_tree_options {
     hfvis_tree_order order;   /* default HFVIS_TREE_DEPTH_FIRST */
     int safe_zone;            /* 1 = SafeZoneUpdate shortcut ([P2] Alg. 3): when the new sample
                                  only replaces the root, skip the tests; same output; 0 = off */
-    int safe_zone_steps;      /* window length b2 - b1 in samples; 0 = 4 (spec §7.10) */
+    int safe_zone_steps;      /* window length b2 - b1 in samples; 0 = 4 ([P2] Alg. 3; docs/errata.md E15) */
 } hfvis_tree_options;
 
 /* Bytes of caller memory for a tree of up to max_samples samples (0 if max_samples < 1 or the
@@ -899,7 +899,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_hull_tree_push(hfvis_hull_tree *
 
 /* The horizons of the newest sample, farthest first, as sample indices (push order) into out
  * (capacity cap). minimal = 0 gives the root children as the tree holds them, which are a
- * superset of the local horizons (spec §7.6); minimal = 1 keeps only true local horizons
+ * superset of the local horizons (docs/errata.md E14); minimal = 1 keeps only true local horizons
  * (sample 0, or a sample whose predecessor is hidden). Returns the count (which may exceed cap:
  * then only cap are written), or -1 on NULL. */
 HFVIS_API HFVIS_EXPERIMENTAL int hfvis_hull_tree_horizons(const hfvis_hull_tree *tree, int minimal, int *out, int cap);
@@ -910,7 +910,7 @@ HFVIS_API HFVIS_EXPERIMENTAL int hfvis_hull_tree_count(const hfvis_hull_tree *tr
 HFVIS_API int64_t hfvis_hull_tree_iterations(const hfvis_hull_tree *tree);
 
 /* Visible samples of receiver index `receiver` on a line (distance increasing), enumerated
- * from its horizon list (farthest first) as spec §8: out receives the sample indices farthest
+ * from its horizon list (farthest first) as [P2] §10.1: out receives the sample indices farthest
  * first (elevation seen from the receiver non-increasing). A sample is visible when its
  * elevation is >= that of every sample between it and the receiver (grazing counts). Holes
  * (non-finite heights) are never visible and never occlude. Returns the count (written up to
@@ -920,7 +920,7 @@ HFVIS_API int hfvis_line_visible_from_horizons(const double *distance, const dou
                                                int *out, int cap);
 
 /* Oracles: the naive visible set (walk from the receiver outward keeping the running maximum,
- * spec §8), farthest first, and the naive local horizons (visible samples whose predecessor is
+ * [P2] §10.1), farthest first, and the naive local horizons (visible samples whose predecessor is
  * not visible), farthest first. Same return convention. Cost O(receiver). */
 HFVIS_API int hfvis_line_visible_naive(const double *distance, const double *height, int receiver,
                                        int *out, int cap);
@@ -966,7 +966,7 @@ HFVIS_API hfvis_status hfvis_intervisibility(const hfvis_grid *grid, int K,
 /* Visibility index ("total viewshed"): the number of samples each grid point sees along the K
  * directions, sum over k of the visible samples of its line (gathered from the lattice like the
  * light paths). Pre-roll samples outside the grid are not counted. NaN at holes.
- * opts->direction_begin/end select a partial count (spec heightfield §8: a sum over the K
+ * opts->direction_begin/end select a partial count ([P2] §10.1: a sum over the K
  * lines); the counts are gathered bilinearly from the lattices, so they are not integers off the
  * axis directions, and the parts of a split add up to the full count up to float rounding. */
 HFVIS_API hfvis_status hfvis_visibility_count(const hfvis_grid *grid, int K,
@@ -974,21 +974,21 @@ HFVIS_API hfvis_status hfvis_visibility_count(const hfvis_grid *grid, int K,
                                               const hfvis_tree_options *tree_opts, float *out,
                                               ptrdiff_t out_stride, hfvis_visibility_stats *stats);
 
-/* Oracle: the same counts from the naive visible sets (spec §6 item 1 on the same lattice).
+/* Oracle: the same counts from the naive visible sets ([P2] §1 on the same lattice).
  * Equal to hfvis_visibility_count exactly. Cost O(K*W*H*N). */
 HFVIS_API hfvis_status hfvis_visibility_count_naive(const hfvis_grid *grid, int K,
                                                     const hfvis_sweep_options *opts, float *out,
                                                     ptrdiff_t out_stride,
                                                     hfvis_visibility_stats *stats);
 
-/* Indirect light from visible terrain ([P2] §10.1 with the band rule of spec §9): for each
+/* Indirect light from visible terrain ([P2] §10.1 with the band rule of docs/errata.md E17): for each
  * receiver and direction, the visible samples s_1..s_M (far to near) each own the band of
  * zenith angles between themselves and the next nearer visible sample; the receiver reflects
  * out = albedo * [ sky * S^(theta(s_1)) + sum_j L_exit(s_j) (S^(theta(s_{j+1})) - S^(theta(s_j))) ]
  * summed over k, with S^ the tangent-clamped sector integral of [P1] Eq. 5, 1/pi included,
  * and theta(s_{M+1}) the tangent plane (so the sky part is
  * exactly the uniform-sky light of hfvis_sky_light, and uniform exit radiance c with sky c gives
- * c * sum_k S_k: the furnace identity, spec §12.10). exit_radiance[(y*width + x)*channels + c]
+ * c * sum_k S_k: the furnace identity, docs/errata.md E17). exit_radiance[(y*width + x)*channels + c]
  * is the surface's exit radiance (bilinear between samples, border rule outside), channels 1..4;
  * sky is the uniform sky radiance above the horizon (0 for terrain light only).
  * out[(y*out_stride + x)*channels + c]; NaN at holes. One block of scratch. */
@@ -1006,7 +1006,7 @@ HFVIS_API hfvis_status hfvis_indirect_light_naive(const hfvis_grid *grid, int K,
                                                   const hfvis_sweep_options *opts, float *out,
                                                   ptrdiff_t out_stride);
 
-/* Direct + indirect light with bounces ([P2] §10.1; spec §9):
+/* Direct + indirect light with bounces ([P2] §10.1; docs/errata.md E17):
  *   L_0 = emission + albedo * direct,  L_{b+1} = emission + albedo * (direct + I[L_b]),
  * where I[L] is hfvis_indirect_light of exit radiance L with sky 0 and albedo 1, and direct is
  * the caller's direct light as reflected radiance for albedo 1 (e.g. hfvis_sky_light plus sun
@@ -1022,7 +1022,7 @@ HFVIS_API hfvis_status hfvis_terrain_gi(const hfvis_grid *grid, int K, const flo
                                         const hfvis_tree_options *tree_opts, float *out);
 
 /* A sun: a disc of angular radius radius_rad at (azimuth_rad, elevation_rad) (look direction,
- * DESIGN convention) giving irradiance[c] on a surface facing it. */
+ * hfvis.h convention) giving irradiance[c] on a surface facing it. */
 typedef struct hfvis_sun {
     double azimuth_rad, elevation_rad, radius_rad;
     float irradiance[4];
@@ -1113,10 +1113,10 @@ HFVIS_API hfvis_status hfvis_viewshed_reference(const hfvis_grid *grid, double o
                                                 ptrdiff_t out_stride);
 
 /* ========================================================================================== */
-/* hfvis.c - Nowrouzezahrai-Snyder GI, math layer ([NS09] §4, §6, §7, App. A; spec GI B.2-B.8) */
+/* hfvis.c - Nowrouzezahrai-Snyder GI, math layer ([NS09] §4, §6, §7, App. A; [NS09] §3-7) */
 /* ========================================================================================== */
 /* [NS09] D. Nowrouzezahrai, J. Snyder, "Fast Global Illumination on Dynamic Height Fields",
- * CGF 28(4), 2009. "spec GI" is spec/raycast-ao-and-hf-gi.md part B, which fixes its errata.
+ * CGF 28(4), 2009. Errata: docs/errata.md E47-E53.
  *
  * Spherical harmonics (SH). Order 4: 16 real, orthonormal coefficients, index l(l+1)+m
  *   (l = 0..3, m = -l..l), NO Condon-Shortley phase: Y_1,-1 = +0.4886 y, Y_1,0 = +0.4886 z,
@@ -1124,12 +1124,12 @@ HFVIS_API hfvis_status hfvis_viewshed_reference(const hfvis_grid *grid, double o
  *   y = increasing row, z up); the azimuth phi is measured like psi (from +x toward +y) and theta
  *   from +z. Separable form: Y_lm = K_l^|m| Pt_l^|m|(cos theta) Phi_m(phi) with
  *   Pt_l^mu = (1-z^2)^(mu/2) d^mu P_l/dz^mu, Phi_m = sqrt2 cos(m phi) (m > 0), 1 (m = 0),
- *   sqrt2 sin(|m| phi) (m < 0). Tables in spec GI (A, M_lin, M_bspl, Cartesian constants) use the
+ *   sqrt2 sin(|m| phi) (m < 0). Tables printed with the phase (A, M_lin, M_bspl, Cartesian constants) use the
  *   Condon-Shortley phase: their entries with odd |m| have the opposite sign here.
  * Zonal lobes are stored as convolution multipliers Ahat_l = sqrt(4 pi/(2l+1)) z_l (z_l the raw
- *   ZH coefficients Int g Y_l0), for every lobe (spec GI B.7 erratum on the Phong vector).
+ *   ZH coefficients Int g Y_l0), for every lobe (docs/errata.md E52 on the Phong vector).
  * Normalized Legendre polynomials (NLP): P^_l(z) = sqrt((2l+1)/2) P_l(z), orthonormal on
- *   [-1, 1], l = 0..3, with the corrected constants of spec GI B.3 (sqrt10/4 and sqrt14/4, not the
+ *   [-1, 1], l = 0..3, with the corrected constants of [NS09] §4, Eq. 9-13; docs/errata.md E48, E49 (sqrt10/4 and sqrt14/4, not the
  *   5 sqrt2/4 and 7 sqrt2/4 printed in [NS09] §4). Along a slice the variable is
  *   z = cos theta = sin omega, omega the elevation (blocking angle) above the horizontal plane.
  * Precision. Everything here is double: these are the building blocks of the GI pipeline and of
@@ -1148,7 +1148,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_sh_eval(const double dir[3], dou
 
 /* Rotate an SH vector about +z by angle_rad (active, counter-clockwise seen from +z, i.e. from
  * +x toward +y): the result f' satisfies f'(R_z(a) d) = f(d), i.e. f'(theta, phi) =
- * f(theta, phi - a). Each pair (l, +m), (l, -m) turns by m*a (spec GI B.6):
+ * f(theta, phi - a). Each pair (l, +m), (l, -m) turns by m*a ([NS09] §6, App. A; docs/errata.md E51):
  *   c'_(+m) = c_(+m) cos(ma) - c_(-m) sin(ma),  c'_(-m) = c_(+m) sin(ma) + c_(-m) cos(ma);
  * m = 0 coefficients are unchanged. [NS09] Eq. 21 uses it to place each wedge.
  * out may equal in. Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL or a non-finite
@@ -1159,7 +1159,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_sh_rotate_z(const double in[16],
  * ([NS09] §7 "double product integral"). Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL. */
 HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_sh_dot(const double a[16], const double b[16], double *out);
 
-/* Fill the SH triple-product tensor gamma[(i*16 + j)*16 + k] = Int Y_i Y_j Y_k dw (spec GI B.7),
+/* Fill the SH triple-product tensor gamma[(i*16 + j)*16 + k] = Int Y_i Y_j Y_k dw ([NS09] §7),
  * HFVIS_SH_COEFFS^3 = 4096 doubles. Computed exactly (up to rounding) with an 8-point
  * Gauss-Legendre rule in z and a 16-point uniform rule in phi; entries below 1e-12 in magnitude
  * are set to exactly 0 (the true non-zeros are >= 0.058), which leaves 353 non-zeros.
@@ -1182,15 +1182,15 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_sh_convolve_zh(const double in[1
                                                                double out[16]);
 
 /* Rotate a zonal lobe to an axis: out_lm = Ahat_l Y_lm(axis) = sqrt(4 pi/(2l+1)) z_l Y_lm(axis)
- * ([NS09] §7 F(w_o), spec GI B.7). axis need not be unit length. Then Sum out_i I_i is the lobe
+ * ([NS09] §7 F(w_o)). axis need not be unit length. Then Sum out_i I_i is the lobe
  * applied to the incident radiance I. Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL, a
  * non-finite Ahat or a non-finite or zero axis. */
 HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_sh_from_zh(const double Ahat[4], const double axis[3],
                                                            double out[16]);
 
 /* Shade: *out = Sum_lm Ahat_l Y_lm(axis) I_lm ([NS09] §7: F(w_o) . I). With the diffuse Ahat and
- * axis = N this is the irradiance E(N); the library's exit radiance is (albedo/pi) E (spec GI
- * B.7 [choice]: [NS09] omits albedo/pi). With the Phong Ahat and axis = reflect(view, N) it is
+ * axis = N this is the irradiance E(N); the library's exit radiance is (albedo/pi) E (docs/errata.md
+ * E52: [NS09] omits albedo/pi). With the Phong Ahat and axis = reflect(view, N) it is
  * the reflected radiance of a lobe with unit specular albedo. Errors as hfvis_sh_from_zh. */
 HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_sh_shade_zh(const double Ahat[4], const double axis[3],
                                                             const double I[16], double *out);
@@ -1202,13 +1202,13 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_zh_diffuse(double Ahat[4]);
 
 /* The Phong lobe of exponent S ([NS09] §7 citing Ramamoorthi-Hanrahan 2002):
  * Ahat_l = exp(-l^2/(2S)). These are the multipliers of the normalised lobe
- * ((S+1)/(2 pi)) cos^S about the reflection vector (spec GI B.7 erratum; Ahat_0 = 1, so a uniform
+ * ((S+1)/(2 pi)) cos^S about the reflection vector (docs/errata.md E52; Ahat_0 = 1, so a uniform
  * unit environment reflects 1), in the Gaussian approximation of [RH02], accurate for large S.
  * S > 0 and finite. Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL or a bad S. */
 HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_zh_phong(double S, double Ahat[4]);
 
 /* The indicator of a circular cap of angular radius half_angle_rad in [0, pi] about +z
- * (spec GI B.8 key lights): Ahat_l = 2 pi Int_c^1 P_l(z) dz, c = cos(half_angle); Ahat_0 is the
+ * ([NS09] §6 key lights): Ahat_l = 2 pi Int_c^1 P_l(z) dz, c = cos(half_angle); Ahat_0 is the
  * cap's solid angle 2 pi (1 - c). A uniform cap of radiance L0 about axis a is L0 times
  * hfvis_sh_from_zh(Ahat, a). Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL or a
  * half-angle outside [0, pi] or non-finite. */
@@ -1221,7 +1221,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_zh_cap(double half_angle_rad, do
  * integral is exact: Int Phi_m dphi in closed form, and Int Pt_l^mu(cos t) sin t dt as a
  * polynomial antiderivative in z = cos t (even mu) or through Int cos^k t sin^2 t dt (odd mu) -
  * no quadrature, so a constant map L gives out_0 = 2 sqrt(pi) L and 0 elsewhere up to rounding
- * (spec GI B.8 suggests sin(theta) dtheta dphi texel weights instead; those are only
+ * ([NS09] §6 suggests sin(theta) dtheta dphi texel weights instead; those are only
  * approximate). Non-finite radiance propagates into the output.
  * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL (env, env->radiance, out), n_theta or
  * n_phi < 1, channels outside 1..4, or a texel count that overflows size_t.
@@ -1230,12 +1230,12 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_zh_cap(double half_angle_rad, do
 HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_sh_project_env(const hfvis_env *env, double *out);
 
 /* Evaluate the 4 NLPs at z in [-1, 1]: P = (1/sqrt2, sqrt(3/2) z, (sqrt10/4)(3z^2 - 1),
- * (sqrt14/4)(5z^3 - 3z)) ([NS09] §4 with the spec GI B.3 erratum). Returns HFVIS_OK, or
+ * (sqrt14/4)(5z^3 - 3z)) ([NS09] §4 with the docs/errata.md E48, E49). Returns HFVIS_OK, or
  * HFVIS_ERR_INVALID_ARGUMENT for NULL or z non-finite or outside [-1, 1]. */
 HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_nlp_eval(double z, double P[4]);
 
-/* Occlusion vector vbar(sigma) = Int_{-1}^{sin sigma} P^(z) dz ([NS09] Eq. 10, limits as in spec
- * GI B.3): the NLP projection of the step that is 1 for elevations omega <= sigma. Closed form
+/* Occlusion vector vbar(sigma) = Int_{-1}^{sin sigma} P^(z) dz ([NS09] Eq. 10, limits as in
+ * docs/errata.md E49): the NLP projection of the step that is 1 for elevations omega <= sigma. Closed form
  * with s = sin sigma: ((s+1)/sqrt2, sqrt(3/2)(s^2-1)/2, sqrt(5/2)(s^3-s)/2,
  * sqrt(7/2)(5s^4-6s^2+1)/8). sigma_rad is clamped to [-pi/2, pi/2] (vbar(-pi/2) = 0,
  * vbar(pi/2) = (sqrt2, 0, 0, 0)). Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL or a
@@ -1247,12 +1247,12 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_nlp_occlusion(double sigma_rad, 
  *   [NS09] Eq. 11 (environment): lo = omega_max, hi = pi/2.
  *   [NS09] §6 (key light with elevation range [l_min, l_max]): lo = max(omega_max, l_min),
  *   hi = l_max. Clamping below the tangent plane is the caller's choice: lo = max(omega_max,
- *   omega_min) (spec GI B.3 [choice]).
+ *   omega_min) (docs/errata.md E53).
  * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL or a non-finite angle. */
 HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_nlp_visibility(double omega_lo_rad, double omega_hi_rad,
                                                                double out[4]);
 
-/* NLP vector of the indirect radiance along one slice ([NS09] Eq. 8 and 12 with the spec GI B.3
+/* NLP vector of the indirect radiance along one slice ([NS09] Eq. 8 and 12 with the [NS09] §4, Eq. 9-13; docs/errata.md E48, E49
  * errata: the integral covers z in [-1, 1], u(t_(i+1)) = 0 once i+1 >= |T|):
  *   u(omega) = u[k] for omega_rad[k-1] <= omega < omega_rad[k] (omega_rad[-1] := omega_min_rad),
  *   0 below omega_min and above omega_rad[K-1];
@@ -1266,7 +1266,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_nlp_radiance(int K, const double
                                                              double omega_min_rad, double out[4]);
 
 /* Reconstruct an elevation function from its NLP vector: *out = c . P^(sin omega)
- * ([NS09] Eq. 13). The order-4 truncation rings (spec GI B.3: values < 0 or > 1 occur).
+ * ([NS09] Eq. 13). The order-4 truncation rings ([NS09] §4, Eq. 9-13; docs/errata.md E48, E49: values < 0 or > 1 occur).
  * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL or a non-finite omega. */
 HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_nlp_reconstruct(const double c[4], double omega_rad, double *out);
 
@@ -1275,7 +1275,7 @@ typedef enum hfvis_ns_interp {
     HFVIS_NS_INTERP_DEFAULT = 0,  /* = LINEAR */
     HFVIS_NS_INTERP_LINEAR = 1,   /* (1-a) w_j + a w_(j+1): M_lin is 16x8 ([NS09] Eq. 20, 24) */
     HFVIS_NS_INTERP_BSPLINE = 2   /* uniform cubic B-spline on w_(j-1)..w_(j+2): M_bspl is 16x16
-                                     (spec GI B.6 erratum: not the 16x32 of [NS09] §1) */
+                                     (docs/errata.md E51: not the 16x32 of [NS09] §1) */
 } hfvis_ns_interp;
 
 /* Largest wedge matrix, in doubles (16x16). */
@@ -1287,14 +1287,14 @@ HFVIS_API HFVIS_EXPERIMENTAL int hfvis_ns_wedge_columns(hfvis_ns_interp interp);
 /* The Appendix-A wedge matrix for a wedge of width dphi_rad in (0, 2 pi], row-major,
  * M[r*cols + s*4 + k], r = SH index, s = sample of the wedge (0..1 linear: w_j, w_(j+1);
  * 0..3 B-spline: w_(j-1), w_j, w_(j+1), w_(j+2)), k = NLP index. The wedge is canonical,
- * phi in [0, dphi], alpha = phi/dphi (spec GI B.6 erratum on Eq. 18), so
+ * phi in [0, dphi], alpha = phi/dphi (docs/errata.md E51 on Eq. 18), so
  *   M[(l,m); (s,k)] = Int_0^dphi Int_0^pi beta_s(alpha) P^_k(cos t) Y_lm(t, phi) sin t dt dphi.
- * Derivation (spec GI B.6 separable form, computed at run time, no table):
+ * Derivation ([NS09] §6, App. A; docs/errata.md E51 separable form, computed at run time, no table):
  * M = K_l^|m| A_(l,|m|,k) B_(m,s)(dphi) with A = Int_{-1}^{1} Pt_l^|m| P^_k dz from exact
  * polynomial / Int cos^k sin^2 antiderivatives, and B = Int_0^dphi beta_s(phi/dphi) Phi_m(phi)
  * dphi from the moments Int_0^1 a^p cos(c a) da, Int_0^1 a^p sin(c a) da (power series for
  * c <= 2, integration by parts above). Each m = 0 row (l, 0) of M_lin is dphi/(2 sqrt(2 pi)) at
- * the columns (s, k = l) and 0 elsewhere (spec GI B.13-13).
+ * the columns (s, k = l) and 0 elsewhere.
  * M must hold 16*hfvis_ns_wedge_columns(interp) doubles. Returns HFVIS_OK, or
  * HFVIS_ERR_INVALID_ARGUMENT for NULL, an unknown interp, or dphi non-finite or outside (0, 2 pi].
  * Cost: about 2000 flops and 12 trigonometric calls. */
@@ -1312,21 +1312,21 @@ typedef struct hfvis_ns_wedges {
 } hfvis_ns_wedges;
 
 /* Full circle (environment visibility, indirect radiance): m >= 1 samples, dphi = 2 pi/m,
- * m wedges including the wrap-around wedge (spec GI B.6 erratum: [NS09] Eq. 21's sum to m-1 is
+ * m wedges including the wrap-around wedge (docs/errata.md E51: [NS09] Eq. 21's sum to m-1 is
  * the partial case). B-spline indices wrap modulo m. Returns HFVIS_OK, or
  * HFVIS_ERR_INVALID_ARGUMENT for NULL, m < 1, an unknown interp or a non-finite phi0. */
 HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_wedges_full(hfvis_ns_wedges *set, hfvis_ns_interp interp, int m,
                                                                double phi0_rad);
 
 /* Partial extent [phi_a, phi_b] (key lights, [NS09] §6): m >= 2 samples, dphi =
- * (phi_b - phi_a)/(m-1), m-1 wedges; B-spline indices are clamped to the end samples (spec GI
- * B.6 [choice]). phi_b > phi_a and phi_b - phi_a <= 2 pi (an extent crossing 0 is given as, e.g.,
+ * (phi_b - phi_a)/(m-1), m-1 wedges; B-spline indices are clamped to the end samples ([NS09] App. A;
+ * the library's choice). phi_b > phi_a and phi_b - phi_a <= 2 pi (an extent crossing 0 is given as, e.g.,
  * [-0.3, 0.2]). Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL, m < 2, an unknown interp
  * or a bad extent. */
 HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_wedges_partial(hfvis_ns_wedges *set, hfvis_ns_interp interp,
                                                                   int m, double phi_a_rad, double phi_b_rad);
 
-/* From slices to SH ([NS09] Eq. 20-21, spec GI B.6 SLICES_TO_SH): w[j*4 + k] is the NLP vector
+/* From slices to SH ([NS09] Eq. 20-21, [NS09] §6, App. A; docs/errata.md E51 SLICES_TO_SH): w[j*4 + k] is the NLP vector
  * of sample j (j = 0..m-1, from hfvis_nlp_visibility or hfvis_nlp_radiance at azimuth phi_j);
  * out = Sum_wedges Rot_z(M x_j, phi_j). One channel per call. Returns HFVIS_OK, or
  * HFVIS_ERR_INVALID_ARGUMENT for NULL or a set whose interp or sample count is invalid.
@@ -1337,7 +1337,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_wedges_to_sh(const hfvis_ns_w
 /* Which formula gives the tangent plane's minimum blocking angle. */
 typedef enum hfvis_ns_omega_min {
     HFVIS_NS_OMEGA_MIN_DEFAULT = 0,  /* = EXACT */
-    HFVIS_NS_OMEGA_MIN_EXACT = 1,    /* atan2(-(N_x cos phi + N_y sin phi), N_z) (spec GI B.2) */
+    HFVIS_NS_OMEGA_MIN_EXACT = 1,    /* atan2(-(N_x cos phi + N_y sin phi), N_z) ([NS09] §3) */
     HFVIS_NS_OMEGA_MIN_PAPER = 2     /* -asin(N_x cos phi + N_y sin phi) ([NS09] §3), exact only
                                         when N lies in the slice's vertical plane */
 } hfvis_ns_omega_min;
@@ -1345,14 +1345,14 @@ typedef enum hfvis_ns_omega_min {
 /* The elevation of the receiver's tangent plane in azimuth phi_rad, in [-pi/2, pi/2] for an
  * upward normal: the minimum blocking angle omega_min of [NS09] §3 (it seeds the casting set).
  * Example: N = (1,1,1)/sqrt3, phi = 0 gives -45 deg (exact) and -35.26 deg (paper); with the
- * paper's form a tilted plane admits its own surface into the casting set (spec GI B.13-10).
+ * paper's form a tilted plane admits its own surface into the casting set.
  * normal need not be unit length. Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL, a
  * zero or non-finite normal, a non-finite phi or an unknown form. */
 HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_min_blocking_angle(const double normal[3], double phi_rad,
                                                                       hfvis_ns_omega_min form, double *out);
 
 /* ========================================================================================== */
-/* hfvis.c - Nowrouzezahrai-Snyder GI pipeline ([NS09] §5-9; spec GI B.2, B.4-B.9, B.12)     */
+/* hfvis.c - Nowrouzezahrai-Snyder GI pipeline ([NS09] §5-9; [NS09] §3; [NS09] §8)           */
 /* ========================================================================================== */
 /* The approximate, fast counterpart of the exact P1/P2 pipeline (hfvis_direct_light,
  * hfvis_terrain_gi): per receiver, m azimuthal slices are scanned with exponentially growing
@@ -1362,21 +1362,21 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_min_blocking_angle(const doub
  * diffuse or Phong zonal lobe (§7); each bounce gathers the previous bounce's exit radiance from a
  * radiance pyramid (§5.3). Conventions are those of the math layer above (SH without the
  * Condon-Shortley phase, Ahat multipliers, NLP in z = sin(omega)) and of the whole API
- * (DESIGN radiance: an open flat receiver under a uniform sky c with albedo 1 returns c).
+ * (hfvis.h, Conventions: an open flat receiver under a uniform sky c with albedo 1 returns c).
  *
- * Slices (spec GI B.2, B.4). A receiver at grid position (x, y) looking toward
+ * Slices ([NS09] §3; [NS09] §5.2, Eq. 14-17). A receiver at grid position (x, y) looking toward
  * phi_j = azimuth0_rad + 2 pi j/m (phi measured like psi, from +x toward +y) takes steps
  * tau_i = 2^(i/k) cells, i = 0..n-1 (Eq. 14 in cell units); step i reads level
  * l_v(i) = max(0, i - k*o_v) of the height pyramid at the receiver and at the step point (Eq. 15:
  * both heights from the same level; the level offset makes the level finer by o_v octaves, the
- * spec GI B.4 erratum) and gives the blocking angle omega_i = atan(dz / (tau_i cell_size)).
+ * docs/errata.md E50) and gives the blocking angle omega_i = atan(dz / (tau_i cell_size)).
  * omega_max is the maximum of the uniform cubic B-spline through the omega_i at its knots and
  * midpoints (Eq. 16, end points replicated) or the raw maximum; the casting set holds the steps
  * whose omega_i exceeds every earlier one and the tangent-plane angle omega_min (Eq. 17; admitted
  * when larger by more than 1e-12 rad). Steps outside the grid (HFVIS_BORDER_OPEN: the ray ends
  * there) and steps whose height is a hole are skipped: they neither occlude nor cast.
  *
- * The pyramid (spec GI B.4, CPU proposal). Octave images G_0 = the heights, G_(o+1) = G_o
+ * The pyramid ([NS09] §5.2, Eq. 14-17, CPU proposal). Octave images G_0 = the heights, G_(o+1) = G_o
  * filtered with the separable [1,3,3,1]/8 kernel and decimated by 2 (texel i of G_(o+1) is centred
  * between texels 2i and 2i+1 of G_o); level l = k*o + j (0 <= j < k) is G_o convolved with a
  * separable, sampled, normalised cubic B-spline kernel whose variance is (4^(j/k) - 1)/4 G_o
@@ -1384,7 +1384,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_min_blocking_angle(const doub
  * heights exactly. Levels are sampled bilinearly in octave coordinates. Filter taps outside the
  * image follow the border (OPEN: dropped, CLAMP: edge texel, WRAP: periodic) and hole taps are
  * dropped, the weights renormalised (a level texel with no finite tap is a hole). The same pyramid
- * holds the exit radiance of a bounce (spec GI B.5) with levels l_u(i) = max(0, i - k*o_u).
+ * holds the exit radiance of a bounce ([NS09] §5.3) with levels l_u(i) = max(0, i - k*o_u).
  * Memory: about (4/3) k W H floats per channel, not the paper's stack of n full-size textures.
  *
  * Outputs are radiance toward the viewer (view_dir): direct = emission + (albedo/pi) E_direct +
@@ -1399,11 +1399,11 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_min_blocking_angle(const doub
 typedef enum hfvis_ns_omega_max {
     HFVIS_NS_OMEGA_MAX_DEFAULT = 0,  /* = BSPLINE */
     HFVIS_NS_OMEGA_MAX_BSPLINE = 1,  /* [NS09] Eq. 16 (smooths: lowers isolated spikes) */
-    HFVIS_NS_OMEGA_MAX_RAW = 2       /* max_i omega_i (spec GI B.4 [choice]; with it the closure
+    HFVIS_NS_OMEGA_MAX_RAW = 2       /* max_i omega_i (docs/errata.md E53; with it the closure
                                         identity of B.13-9 is exact) */
 } hfvis_ns_omega_max;
 
-/* Directional lights (hfvis_sun with radius_rad == 0), spec GI B.8 [choice]. */
+/* Directional lights (hfvis_sun with radius_rad == 0), [NS09] §6. */
 typedef enum hfvis_ns_directional {
     HFVIS_NS_DIRECTIONAL_DEFAULT = 0,  /* = HARD */
     HFVIS_NS_DIRECTIONAL_HARD = 1,     /* E0 max(N.d, 0) [omega_L > omega_max(phi_L)], from one more
@@ -1415,17 +1415,17 @@ typedef enum hfvis_ns_directional {
     HFVIS_NS_DIRECTIONAL_SH = 3        /* the SH delta E0 Y(d) times the HARD indicator, shaded
                                           through SH like the environment; rings:
                                           E = E0 (1/4 + cos(g)/2 + (5/16) P_2(cos g)), 17/16 E0 at
-                                          g = 0 (spec GI B.13-8) */
+                                          g = 0 */
 } hfvis_ns_directional;
 
-/* Key lights (hfvis_sun with radius_rad > 0): uniform circular caps ([NS09] §6-7, spec GI B.8). */
+/* Key lights (hfvis_sun with radius_rad > 0): uniform circular caps ([NS09] §6-7). */
 typedef enum hfvis_ns_key_mode {
     HFVIS_NS_KEY_DEFAULT = 0,      /* = SEPARATE */
     HFVIS_NS_KEY_SEPARATE = 1,     /* own visibility V_key over the cap's azimuth extent
                                       (key_directions samples, key_directions - 1 wedges; the full
                                       circle with the environment's slices when the cap holds the
                                       zenith) and elevation range [l_min, l_max] (§6); the incident
-                                      radiance gains the SH product L_key * V_key (spec B.8). Note:
+                                      radiance gains the SH product L_key * V_key ([NS09] §6). Note:
                                       order-4 SH cannot hold the narrow box V_key, and the product
                                       loses most of a small light's energy even where nothing
                                       occludes it (a cap of radius 0.3 rad at 40 deg elevation
@@ -1438,7 +1438,7 @@ typedef enum hfvis_ns_key_mode {
                                       ground gets the light's full SH irradiance */
 } hfvis_ns_key_mode;
 
-/* Glossy interreflection (spec GI B.5). */
+/* Glossy interreflection ([NS09] §5.3). */
 typedef enum hfvis_ns_glossy {
     HFVIS_NS_GLOSSY_DEFAULT = 0,   /* = VECTOR */
     HFVIS_NS_GLOSSY_VECTOR = 1,    /* two pyramids: the diffuse exit radiance, and the incident
@@ -1451,7 +1451,7 @@ typedef enum hfvis_ns_glossy {
                                       glossy): [NS09] §5.3's "mixture" approximation */
 } hfvis_ns_glossy;
 
-/* Keeping the casting sets between passes (spec B.9 [choice] "cache cast sets for bounces"). */
+/* Keeping the casting sets between passes ([NS09] §9 "cache cast sets for bounces"). */
 typedef enum hfvis_ns_cache {
     HFVIS_NS_CACHE_DEFAULT = 0,    /* = ON */
     HFVIS_NS_CACHE_ON = 1,         /* the first scan of each slice (the visibility scan of the direct
@@ -1483,7 +1483,7 @@ typedef struct hfvis_ns_gi_options {
     int levels_per_octave;   /* k = k_v = k_u (Eq. 14), 1..32; 0 = 4 */
     int levels;              /* n = n_v = n_u: steps per slice, 1..1024; 0 = auto:
                                 1 + ceil(k log2(max(1, hypot(width-1, height-1)))), so the last
-                                step reaches the grid's diagonal (spec GI B.4's 1 + k log2 R, plus
+                                step reaches the grid's diagonal (1 + k log2 R levels, [NS09] §5.2, plus
                                 at most k/2 + 1 steps) */
     int level_offset_v;      /* o_v, octaves, 1..64; 0 = 2 ([NS09] §5.2); HFVIS_NS_NO_OFFSET = 0 */
     int level_offset_u;      /* o_u, likewise, for the radiance pyramid; 0 = 2 */
@@ -1495,8 +1495,8 @@ typedef struct hfvis_ns_gi_options {
     hfvis_ns_interp interp;           /* azimuthal interpolation; default LINEAR */
     hfvis_ns_omega_min omega_min;     /* tangent-plane angle; default EXACT (atan2 form) */
     hfvis_ns_omega_max omega_max;     /* default BSPLINE (Eq. 16) */
-    int clamp_to_tangent;    /* 1: slice visibility starts at max(omega_max, omega_min) (spec GI
-                                B.3 [choice]); 0 = off, as [NS09] (the lobe's clamped cosine
+    int clamp_to_tangent;    /* 1: slice visibility starts at max(omega_max, omega_min) (docs/errata.md
+                                E53); 0 = off, as [NS09] (the lobe's clamped cosine
                                 removes the light from below the tangent plane, approximately) */
     hfvis_ns_directional directional; /* default HARD */
     hfvis_ns_key_mode key_mode;       /* default SEPARATE */
@@ -1557,7 +1557,7 @@ typedef struct hfvis_ns_gi_outputs {
                                     receiver, for diffing a port; NaN at receivers on holes */
 } hfvis_ns_gi_outputs;
 
-/* Multi-resolution height-field global illumination ([NS09]; spec GI B.9 RENDER).
+/* Multi-resolution height-field global illumination ([NS09]; [NS09] §9, Fig. 6 RENDER).
  * Per receiver (one per s x s block): m slices (Eq. 15-17) give V = Sum_j G_j v_j with
  * v_j = vbar(pi/2) - vbar(omega_max,j) (Eq. 11), G_j the wedge matrices rotated into place
  * (hfvis_ns_sample_matrices; m wedges with the wrap-around one); key lights add their restricted
@@ -1569,11 +1569,11 @@ typedef struct hfvis_ns_gi_outputs {
  * with none around is computed as a receiver of its own): diffuse E = (Ahat_diffuse Y(N)) . I,
  * glossy (Ahat_phong Y(R)) . I with R = reflect(view_dir, N).
  * Exact cases (tested): an open flat field under a uniform sky c returns albedo*c for any m,
- * interp, k, n, offsets and s (bands 0 and 1 of the hemisphere are exact, spec GI B.13-7); a
+ * interp, k, n, offsets and s (bands 0 and 1 of the hemisphere are exact); a
  * V-shaped valley's bottom reproduces the order-4 trench values of B.13-9; emission 1 with a black
  * sky and raw omega_max closes the furnace: direct(sky 1) + bounce(emission 1) = 1.
  * Holes: a non-finite height never occludes, is never in a casting set, and gets NaN in every
- * output. Lighting below the tangent plane and SH ringing are not clamped (spec GI B.12-8): outputs
+ * output. Lighting below the tangent plane and SH ringing are not clamped ([NS09] §4): outputs
  * can be slightly negative.
  * grid: valid (hfvis_grid). scene: see hfvis_ns_scene. opts may be NULL. out: non-NULL; outputs
  * must not overlap each other or the inputs.
@@ -1608,7 +1608,7 @@ HFVIS_API hfvis_status hfvis_ns_gi_scratch_size(const hfvis_grid *grid, const hf
 /* [NS09] Eq. 16: the maximum of the uniform cubic B-spline with control points omega[0..n-1]
  * (radians), evaluated at the knots S(j) = (w_(j-1) + 4 w_j + w_(j+1))/6 and the midpoints
  * S(j+1/2) = (w_(j-1) + 23 w_j + 23 w_(j+1) + w_(j+2))/48, end points replicated
- * (w_(-1) = w_0, w_n = w_(n-1); spec GI B.4 [choice]). n = 0 gives -pi/2 (nothing blocks).
+ * (w_(-1) = w_0, w_n = w_(n-1); docs/errata.md E53). n = 0 gives -pi/2 (nothing blocks).
  * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for a NULL out, n < 0, NULL omega with n > 0 or
  * a non-finite omega. Cost O(n). */
 HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_bspline_max(int n, const double *omega_rad, double *out);
@@ -1629,7 +1629,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_sample_matrices(const hfvis_n
  * S = sum_k T_k: the sky-view factor 1 - S/K with T_k = sin(max(alpha_k, 0)) (Zaksek et al.
  * 2011), the uniform sky albedo*sky*S with T_k = [P1] Eq. 5's sector integral S_k, the
  * environment albedo*S with T_k = [P1] Eq. 6's sector term, the visibility index S with T_k the
- * samples seen along line k (spec heightfield §8), each gathered from its lattice to the grid
+ * samples seen along line k ([P2] §10.1), each gathered from its lattice to the grid
  * points. A run over a direction range [b, e) (sweep options) returns the partial sum of its
  * range; the partial sums of ranges that tile [0, K) add up to S. hfvis_direction_sums returns S
  * (or a partial S) in double, before the finish, so that split runs lose nothing to float
@@ -1644,7 +1644,7 @@ typedef enum hfvis_sum_kind {
     HFVIS_SUM_SKY_VIEW = 1,   /* T_k = sin(max(alpha_k, 0)); hfvis_sky_view_factor = (float)(1 - S/K) */
     HFVIS_SUM_SKY_LIGHT = 2,  /* T_k = [P1] Eq. 5 S_k; hfvis_sky_light = (float)(sky*albedo * S) */
     HFVIS_SUM_ENV_LIGHT = 3,  /* [P1] Eq. 6 per channel; hfvis_env_light = (float)(albedo * S) */
-    HFVIS_SUM_VISIBILITY = 4  /* samples seen (spec heightfield §8); hfvis_visibility_count = (float)S */
+    HFVIS_SUM_VISIBILITY = 4  /* samples seen ([P2] §10.1); hfvis_visibility_count = (float)S */
 } hfvis_sum_kind;
 
 /* Raw per-receiver sums S of the directions opts->direction_begin/end (all K when 0, 0) for
@@ -1715,7 +1715,7 @@ HFVIS_API hfvis_status hfvis_partial_load(const char *path, const hfvis_allocato
 /* ========================================================================================== */
 
 /* ------------------------------------------------------------------------------------------
- * Screen space conventions (spec screenspace-p3-p4 §2.1; [P3] = Timonen, "Line-Sweep Ambient
+ * Screen space conventions ([P4] §3; docs/errata.md C7; [P3] = Timonen, "Line-Sweep Ambient
  * Obscurance", EGSR 2013; [P4] = Timonen, "Screen-Space Far-Field Ambient Obscurance", HPG 2013)
  *
  * Buffers. A depth buffer is width x height floats (the FULL buffer W0 x H0, guard band
@@ -1735,9 +1735,9 @@ HFVIS_API hfvis_status hfvis_partial_load(const char *path, const hfvis_allocato
  *   (x, y) = buffer texel (x + guard_x, y + guard_y). P3's "1280(+256) x 720(+144), 20 % guard
  *   band" is guard_x = 128, guard_y = 72.
  * Directions. A screen direction D = (dx, dy) is in pixels, +x right, +y DOWN; its azimuth is
- *   atan2(dy, dx) (DESIGN §2: from +x toward +y).
+ *   atan2(dy, dx) (hfvis.h, Conventions: from +x toward +y).
  * Obscurance. Every AO output is obscurance in [0, 1], 0 = nothing blocks. Two integrands exist
- *   (spec §1.2): HBAO and LSAO weight by solid angle per azimuthal slice ("SA", the zenith is
+ *   (docs/errata.md C4): HBAO and LSAO weight by solid angle per azimuthal slice ("SA", the zenith is
  *   the direction to the eye, not the normal), the ray-traced reference is cosine-weighted
  *   around the normal (P4 Eq. 1, "COS"). They give different numbers for the same scene.
  * ------------------------------------------------------------------------------------------ */
@@ -1752,7 +1752,7 @@ struct hfvis_view; /* declared with the views below (voxel.c) */
 
 typedef enum hfvis_camera_projection {
     HFVIS_CAMERA_PERSPECTIVE = 1,
-    HFVIS_CAMERA_ORTHOGRAPHIC = 2   /* test mode (spec §6): camera at infinity, zenith +Z */
+    HFVIS_CAMERA_ORTHOGRAPHIC = 2   /* test mode: camera at infinity, zenith +Z */
 } hfvis_camera_projection;
 
 /* A screen-space camera. Not an options struct: projection 0 is invalid. */
@@ -1783,7 +1783,7 @@ HFVIS_API hfvis_status hfvis_camera_check(const hfvis_camera *cam);
 /* A symmetric perspective camera: the VISIBLE (inner) image of (width - 2 guard_x) x (height -
  * 2 guard_y) pixels spans the vertical field of view fov_y_rad in (0, pi), square pixels
  * (fx = fy = inner_height / (2 tan(fov_y/2))), principal point at the buffer centre, no far
- * limit, stride 0. The guard band keeps the focal length of the visible image (spec §1.3).
+ * limit, stride 0. The guard band keeps the focal length of the visible image ([T14] §2.4, [P4] §3; docs/errata.md E26).
  * Returns the errors of hfvis_camera_check, or HFVIS_ERR_INVALID_ARGUMENT for a bad fov. */
 HFVIS_API hfvis_status hfvis_camera_perspective(hfvis_camera *cam, int width, int height,
                                                 int guard_x, int guard_y, double fov_y_rad);
@@ -1890,7 +1890,7 @@ HFVIS_API hfvis_status hfvis_camera_from_matrix(hfvis_camera *cam, const double 
                                                 int guard_x, int guard_y,
                                                 hfvis_projection_depth *depth);
 
-/* Normals from depth (spec §2.1 [R]): for each texel, the view-space points of the left/right
+/* Normals from depth (docs/errata.md E28): for each texel, the view-space points of the left/right
  * and upper/lower neighbours; on each axis the side whose depth differs less from the centre
  * (ties: right, lower; only one side if the other is background or outside the buffer) gives a
  * one-sided difference, and the normal is the normalised cross product of the two, turned to
@@ -1902,7 +1902,7 @@ HFVIS_API hfvis_status hfvis_camera_from_matrix(hfvis_camera *cam, const double 
 HFVIS_API hfvis_status hfvis_depth_normals(const hfvis_camera *cam, const float *depth,
                                            float *normals);
 
-/* The azimuthal plane of a screen line (spec §2.2): the plane through the eye and the screen
+/* The azimuthal plane of a screen line (docs/errata.md E20, E21): the plane through the eye and the screen
  * line through reference view point ref with screen direction (du, dv). e1 is the unit 3D
  * direction of the line at constant depth, normalize(du/fx, -dv/fy, 0) (orthographic:
  * normalize(du sx, -dv sy, 0)); yhat is the unit vector in the plane perpendicular to e1 on the
@@ -1932,7 +1932,7 @@ typedef enum hfvis_falloff_kind {
 typedef double (*hfvis_falloff_fn)(void *user, double distance);
 
 /* A falloff rho(d) of the view-space distance d to the occluder: monotonically decreasing by
- * intent, rho(0) = 1 (spec §1.1). A zero struct is NONE. */
+ * intent, rho(0) = 1 (docs/errata.md C4). A zero struct is NONE. */
 typedef struct hfvis_falloff {
     hfvis_falloff_kind kind;
     double param;                 /* r, lambda, R or the custom support (see the kinds) */
@@ -1952,7 +1952,7 @@ HFVIS_API double hfvis_falloff_eval(const hfvis_falloff *f, double distance);
  * +INFINITY for unbounded falloffs; NaN for an invalid falloff. */
 HFVIS_API double hfvis_falloff_support(const hfvis_falloff *f);
 
-/* ---- directions and the line lattice ([P3] §5.1-5.2, [P4] §6; spec §2.3, §3.5) ------------ */
+/* ---- directions and the line lattice ([P3] §5.1-5.2, [P4] §6; [P3] §5.1, [P4] §6; docs/errata.md E24) ------------ */
 
 /* One azimuthal direction of a line sweep. */
 typedef struct hfvis_ssao_direction {
@@ -1984,7 +1984,7 @@ HFVIS_API hfvis_status hfvis_ssao_directions_uniform(int K, double azimuth0_rad,
 HFVIS_API hfvis_status hfvis_ssao_directions_box(int n, int scale, double spacing,
                                                  hfvis_ssao_direction *out);
 
-/* The line lattice of one direction over the full buffer (spec §2.3 BuildLattice): lines
+/* The line lattice of one direction over the full buffer ([P3] §5.1, [P4] §6): lines
  * parallel to D, spacing D_L apart along P = (-dy, dx) and centred in the texel-centre rectangle
  * [0.5, W0 - 0.5] x [0.5, H0 - 0.5] (the leftover split evenly at both sides); all lines share
  * the along-line origin t_min, so step i of every line lies at along-line coordinate
@@ -2022,7 +2022,7 @@ HFVIS_API hfvis_status hfvis_ssao_lattice_lines(const hfvis_camera *cam,
                                                 const hfvis_ssao_lattice *lat,
                                                 hfvis_ssao_line *lines);
 
-/* The lattice sample nearest to screen position (u, v) in lattice coordinates (spec §2.3):
+/* The lattice sample nearest to screen position (u, v) in lattice coordinates ([P3] §5.1, [P4] §6):
  * line j = round((c.P - s_first)/D_L) clamped to the lines, step i = round((c.D - t_min)/D_S)
  * clamped to that line's steps; an empty line is replaced by the nearest non-empty one.
  * Returns 1 and writes *line, *step, or 0 when the lattice has no sample or an argument is
@@ -2041,7 +2041,7 @@ typedef enum hfvis_ssao_pattern {
 } hfvis_ssao_pattern;
 
 /* The tangent plane of Eq. 1, used to decide what the hull culls and to evaluate the result
- * ([P3] §4.1, Fig. 7; spec §3.4). */
+ * ([P3] §4.1, Fig. 7). */
 typedef enum hfvis_ssao_tangent {
     HFVIS_SSAO_TANGENT_DEFAULT = 0,            /* LSAO: FIXED; HBAO: REAL */
     HFVIS_SSAO_TANGENT_FIXED = 1,              /* sin t = fixed_sin_t everywhere (P3's choice) */
@@ -2049,7 +2049,7 @@ typedef enum hfvis_ssao_tangent {
     HFVIS_SSAO_TANGENT_FIXED_HULL_REAL_EVAL = 3 /* fixed for the hull, real for the value (2) */
 } hfvis_ssao_tangent;
 
-/* How depth is read along a line ([P3] §5.2, spec §2.4). */
+/* How depth is read along a line ([P3] §5.2). */
 typedef enum hfvis_ssao_sampling {
     HFVIS_SSAO_SAMPLING_DEFAULT = 0,   /* LSAO, HBAO: NEAREST; ray tracer: see its options */
     HFVIS_SSAO_SAMPLING_NEAREST = 1,   /* snap to the texel centre, deproject there (as HBAO) */
@@ -2058,7 +2058,7 @@ typedef enum hfvis_ssao_sampling {
                                           non-zero weight on background makes a hole */
 } hfvis_ssao_sampling;
 
-/* The 2D coordinates of a line's azimuthal plane (spec §2.2). */
+/* The 2D coordinates of a line's azimuthal plane (docs/errata.md E20, E21). */
 typedef enum hfvis_ssao_plane {
     HFVIS_SSAO_PLANE_DEFAULT = 0,  /* LSAO: PAPER; HBAO: EXACT */
     HFVIS_SSAO_PLANE_PAPER = 1,    /* (Q.e1, Q.z) as [P3] Alg. 1 l.4 (with e1 normalised and
@@ -2067,15 +2067,15 @@ typedef enum hfvis_ssao_plane {
     HFVIS_SSAO_PLANE_EXACT = 2     /* (Q.e1, Q.yhat): an isometry of the line's plane */
 } hfvis_ssao_plane;
 
-/* The hull's pop test ([P3] Alg. 1 l.12; spec §3.3 tie rule). */
+/* The hull's pop test ([P3] Alg. 1 l.12; docs/errata.md E19). */
 typedef enum hfvis_lsao_pop {
     HFVIS_LSAO_POP_DEFAULT = 0,  /* = TIES */
     HFVIS_LSAO_POP_TIES = 1,     /* pop when occ(top) <= occ(second) and the second is higher */
     HFVIS_LSAO_POP_STRICT = 2    /* the paper's literal occ(top) < occ(second): sticks on deep
-                                    points behind depth steps (spec §3.3: 5x the error) */
+                                    points behind depth steps (docs/errata.md E19: 5x the error) */
 } hfvis_lsao_pop;
 
-/* How a pixel reads a direction's lattice values ([P3] §5.1, spec §3.6). */
+/* How a pixel reads a direction's lattice values ([P3] §5.1, [P3] §5.1, Fig. 8; docs/errata.md E23). */
 typedef enum hfvis_ssao_gather {
     HFVIS_SSAO_GATHER_DEFAULT = 0,   /* = NEAREST */
     HFVIS_SSAO_GATHER_NEAREST = 1,   /* the nearest lattice sample (the paper) */
@@ -2129,7 +2129,7 @@ HFVIS_API hfvis_status hfvis_lsao_options_resolve(const hfvis_lsao_options *in,
 HFVIS_API hfvis_status hfvis_lsao_directions(const hfvis_lsao_options *opts,
                                              hfvis_ssao_direction *out);
 
-/* The obscurity hull along one line in 2D line space ([P3] §4.2, Alg. 1; spec §3.3):
+/* The obscurity hull along one line in 2D line space ([P3] §4.2, Alg. 1):
  * points (x[i], y[i]) in sweep order (y grows toward the camera; the eye at the origin in
  * perspective; orthographic 1: the zenith is +y everywhere). For each receiver i the zenith is
  * u = -p/|p| (orthographic (0, 1)) and, with Sin(h) = h.u/|h| and
@@ -2148,7 +2148,7 @@ HFVIS_API hfvis_status hfvis_lsao_line(const double *x, const double *y, const d
                                        const double *sin_t_eval, int n, int orthographic,
                                        const hfvis_lsao_options *opts, int *stack, double *out);
 
-/* Oracle of hfvis_lsao_line (spec §4.2; the [P3] Fig. 7 reference): for each receiver, walk
+/* Oracle of hfvis_lsao_line ([P3] Fig. 7; the [P3] Fig. 7 reference): for each receiver, walk
  * back over the earlier points; point j is visible iff Sin(p_j - p_i) exceeds every Sin seen
  * nearer to i; among the visible points take the largest Occ(., st_cull) (ties: the higher,
  * i.e. farther visible point) and return its Occ(., st_eval) (st_eval if none). Same contract,
@@ -2196,7 +2196,7 @@ HFVIS_API hfvis_status hfvis_lsao_direction_naive(const hfvis_camera *cam, const
                                                   const hfvis_ssao_line *lines, float *values,
                                                   float *sample_depth);
 
-/* Gather one direction's lattice values into per-pixel accumulators ([P3] §5.1, spec §3.6):
+/* Gather one direction's lattice values into per-pixel accumulators ([P3] §5.1, [P3] §5.1, Fig. 8; docs/errata.md E23):
  * for every non-background inner pixel c (buffer texel (x + guard_x, y + guard_y), centre
  * + 0.5), the nearest lattice sample (GATHER_NEAREST) or the 2 x 2 neighbours (BILINEAR) are
  * accepted when their value is not NaN, |sample_depth - z_c| <= reject_depth * z_c and (normals
@@ -2217,7 +2217,7 @@ HFVIS_API hfvis_status hfvis_lsao_gather(const hfvis_camera *cam, const float *d
  *   ao = clamp( sum_k w_k v_k / sum_k w_k , 0, 1 )
  * over the directions accepted at the pixel (background receivers 0). ao[y*ao_stride + x] for
  * the inner (width - 2 guard_x) x (height - 2 guard_y) pixels, obscurance (SA convention,
- * spec §1.2), the falloff over view-space distance. Work is O(K W0 H0 / (D_S D_L)) for the
+ * docs/errata.md C4), the falloff over view-space distance. Work is O(K W0 H0 / (D_S D_L)) for the
  * sweeps and O(K W H) for the gathers, independent of the falloff radius; memory O(W0 H0)
  * whatever K is (one direction at a time). Allocates 5 blocks (directions, lines, the lattice
  * buffers 8 bytes/sample, the line scratch, the 16-byte/pixel accumulators) plus 1 for
@@ -2248,7 +2248,7 @@ HFVIS_API hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth,
                                   const float *normals, const hfvis_lsao_options *opts,
                                   float *ao, ptrdiff_t ao_stride);
 
-/* ---- HBAO (Bavoil, Sainz, Dimitrov 2008, as the thesis describes it; spec §4.1) ----------- */
+/* ---- HBAO (Bavoil, Sainz, Dimitrov 2008, as the thesis describes it; [T14] §4.1, [P4] §8; docs/errata.md E25) ----------- */
 /* LSAO and HBAO defaults side by side (each differs only where its paper says so):
  *                 LSAO                                 HBAO
  *   directions    16 (box pattern, [P3] §5.2)           16 uniform
@@ -2324,7 +2324,7 @@ HFVIS_API hfvis_hbao_options hfvis_hbao_options_default(void);
 HFVIS_API hfvis_status hfvis_hbao_options_resolve(const hfvis_hbao_options *in,
                                                   hfvis_hbao_options *out);
 
-/* Horizon-based ambient obscurance by ray marching (spec §4.1 HbaoPixel): for every inner
+/* Horizon-based ambient obscurance by ray marching ([T14] §4.1, [P4] §8; docs/errata.md E25): for every inner
  * non-background pixel c with view point P and each direction D_k (looking TOWARD +D, so the
  * direction set should be symmetric to compare with LSAO), the samples
  *   uniform: c + (s - 1 + xi) (R_px/N) D, s = 1..N (xi = 1 without step jitter)
@@ -2338,7 +2338,7 @@ HFVIS_API hfvis_status hfvis_hbao_options_resolve(const hfvis_hbao_options *in,
  * variant's value (INCREMENTAL sum, SINGLE_HORIZON, LARGEST_OCCLUDER, see the enum; the
  * running horizon starts at sin t), then
  *   ao = clamp( sum_k w_k value_k / sum_k w_k , 0, 1 ),   w_k = 1/K or the custom weights.
- * INCREMENTAL with falloff NONE and the real tangent is the SA obscurance of spec §1.2.
+ * INCREMENTAL with falloff NONE and the real tangent is the SA obscurance of docs/errata.md C4.
  * ao[y*ao_stride + x], inner pixels; background receivers 0. normals NULL: reconstructed with
  * hfvis_depth_normals when the tangent is REAL (1 block of 12*stride*height bytes; nothing is
  * allocated otherwise). Cost O(K N W H). Deterministic for a seed.
@@ -2348,7 +2348,7 @@ HFVIS_API hfvis_status hfvis_hbao(const hfvis_camera *cam, const float *depth,
                                   const float *normals, const hfvis_hbao_options *opts,
                                   float *ao, ptrdiff_t ao_stride);
 
-/* ---- the screen-space ray-traced reference ([P4] §8; spec §5.11) --------------------------- */
+/* ---- the screen-space ray-traced reference ([P4] §8; docs/errata.md E36) --------------------------- */
 
 /* Options of hfvis_ssao_raytrace. NULL or a zero struct = the defaults in brackets. */
 typedef struct hfvis_ssao_rt_options {
@@ -2393,7 +2393,7 @@ HFVIS_API hfvis_status hfvis_ssao_rt_options_resolve(const hfvis_ssao_rt_options
  * the buffer, passes behind the eye, rises above every depth, sinks below every depth plus the
  * thickness (finite thickness) or exceeds max_distance is a miss (unknown geometry counts as
  * empty). ao = (1/R) sum rho: a quasi-Monte-Carlo estimate of [P4] Eq. 1,
- * (1/pi) Int rho(d) max(0, n.w) dw - the COS convention (spec §1.2) - converging as R grows.
+ * (1/pi) Int rho(d) max(0, n.w) dw - the COS convention (docs/errata.md C4) - converging as R grows.
  * ao[y*ao_stride + x], inner pixels; background receivers 0. normals NULL: reconstructed with
  * hfvis_depth_normals (1 block of 12*stride*height bytes; nothing is allocated otherwise).
  * Deterministic for a seed. Cost O(W H R (W0 + H0)) at worst (cells per ray).
@@ -2404,10 +2404,10 @@ HFVIS_API hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float 
                                            const hfvis_ssao_rt_options *opts, float *ao,
                                            ptrdiff_t ao_stride);
 
-/* ---- analytic depth buffers (spec §6 T1-T7) ---------------------------------------------- */
+/* ---- analytic depth buffers ---------------------------------------------- */
 
 /* Height fields H(x, y) over the view-space plane z = -base_depth (x, y in view units, H toward
- * the camera), for the closed-form tests of spec §6. The orthographic camera sees them as true
+ * the camera), for the closed-form tests. The orthographic camera sees them as true
  * height fields (zenith +Z); a perspective camera looking down -Z sees them in perspective
  * (vertical faces included). */
 typedef enum hfvis_ssao_scene_kind {
@@ -2443,9 +2443,9 @@ HFVIS_API hfvis_status hfvis_ssao_scene_render(const hfvis_camera *cam,
 
 
 
-/* ---- P4 far-field ambient obscurance (FFAO; [P4], spec §5) --------------------------------- */
+/* ---- P4 far-field ambient obscurance (FFAO; [P4]) --------------------------------- */
 
-/* How the slab integral L(a, b, c, d) of [P4] Eq. 3 is evaluated (spec §5.2). */
+/* How the slab integral L(a, b, c, d) of [P4] Eq. 3 is evaluated ([P4] §4, Eq. 2-3). */
 typedef enum hfvis_ffao_estimator {
     HFVIS_FFAO_L_DEFAULT = 0,      /* CLOSED_FORM for falloff NONE, else TABLE (the options'
                                       table, or one built per call with the default sizes) */
@@ -2454,14 +2454,14 @@ typedef enum hfvis_ffao_estimator {
     HFVIS_FFAO_L_CLOSED_FORM = 3   /* F(t) = t sin(d)/2 - cos(2t - d)/4: falloff NONE only */
 } hfvis_ffao_estimator;
 
-/* Sector averaging of the virtual points (spec §5.6). */
+/* Sector averaging of the virtual points ([P4] §7; docs/errata.md E35). */
 typedef enum hfvis_ffao_averaging {
     HFVIS_FFAO_AVERAGE_DEFAULT = 0, /* ON for thickness 0 (continuous depth), else OFF */
     HFVIS_FFAO_AVERAGE_ON = 1,      /* mean of (m0, m1) over the lines inside the segment */
     HFVIS_FFAO_AVERAGE_OFF = 2      /* the single line through the segment's middle */
 } hfvis_ffao_averaging;
 
-/* The near field (spec §5.8): what covers the first 1-2 intervals ahead of a receiver. */
+/* The near field ([P4] §9; docs/errata.md E37): what covers the first 1-2 intervals ahead of a receiver. */
 typedef enum hfvis_ffao_near {
     HFVIS_FFAO_NEAR_DEFAULT = 0,   /* = DIRECT */
     HFVIS_FFAO_NEAR_NONE = 1,      /* far field only ([P4] Fig. 1 "far field >= 15 px") */
@@ -2470,7 +2470,7 @@ typedef enum hfvis_ffao_near {
                                       point of the same estimator; its horizon is handed on */
 } hfvis_ffao_near;
 
-/* A tabulated L(a, b, c, d) (spec §5.2 [R]): na x nb x nc x nd floats over a in [0, pi],
+/* A tabulated L(a, b, c, d) ([P4] Eq. 3; docs/errata.md E31, E33): na x nb x nc x nd floats over a in [0, pi],
  * u = b/(b + b_ref) in [0, 1], c in [pi/2, pi], d in [-pi/2, pi/2], each on a uniform grid
  * including the ends; L(a) = Int_{max(a, d - pi/2, 0)}^{min(c, d + pi/2, pi)} rho(b/sin(c - t))
  * cos(t - d) sin t dt, accumulated from a = pi down with 8-node Gauss-Legendre per a-cell.
@@ -2491,7 +2491,7 @@ typedef struct hfvis_ffao_options {
     double azimuth0_rad;           /* direction k at azimuth0 + 2 pi k/K [0] */
     int b0;                        /* B0, base interval length in steps (px), 1..4096 [10] */
     int levels;                    /* hierarchy levels B_n = B0 2^n; 0 = all that fit, 1 = none */
-    double level_gamma;            /* schedule (spec §5.5): B_n <= gamma (distance) [1] */
+    double level_gamma;            /* schedule ([P4] §6; docs/errata.md E34): B_n <= gamma (distance) [1] */
     double receiver_slope;         /* s of the second receiver angle, < 0 [-1] */
     hfvis_ffao_averaging averaging;/* [DEFAULT] */
     int jitter;                    /* 1: rotate every segment of a pixel by one hash in
@@ -2521,7 +2521,7 @@ HFVIS_API hfvis_ffao_options hfvis_ffao_options_default(void);
 HFVIS_API hfvis_status hfvis_ffao_options_resolve(const hfvis_ffao_options *in,
                                                   hfvis_ffao_options *out);
 
-/* The slab integral of [P4] Eq. 3 (spec §5.2 [D]) over [a, theta_hi] clipped to
+/* The slab integral of [P4] Eq. 3 ([P4] §4, Eq. 2-3; docs/errata.md E32) over [a, theta_hi] clipped to
  * [max(d - pi/2, 0), min(c, d + pi/2, pi)]: Int rho(b / sin(c - t)) cos(t - d) sin t dt, angles
  * in radians from the receiver's zenith (t = 0 zenith, toward the scan direction), b the
  * distance from the receiver to the slab's line (view units), c the slab's direction, d the
@@ -2547,20 +2547,20 @@ HFVIS_API void hfvis_ffao_table_free(hfvis_ffao_table *table);
 HFVIS_API double hfvis_ffao_table_lookup(const hfvis_ffao_table *table, double a, double b,
                                          double c, double d);
 
-/* The virtual point of an interval (spec §5.4): h = ((m0 - m1)/slope, m0 zscale) from
- * m0 = max y and m1 = max(y - slope x) (the corrected [P4] Alg. 1, spec §5.3). h NULL: no-op. */
+/* The virtual point of an interval ([P4] §6): h = ((m0 - m1)/slope, m0 zscale) from
+ * m0 = max y and m1 = max(y - slope x) (the corrected [P4] Alg. 1, docs/errata.md E29, E30). h NULL: no-op. */
 HFVIS_API void hfvis_ffao_virtual_point(double m0, double m1, double slope, double zscale,
                                         double h[2]);
 
 /* The angular width around the zenith of the screen sector [phi_lo, phi_hi] (radians, screen
- * azimuths, 0 < phi_hi - phi_lo < pi) at view point p (spec §5.2 [D]): the angle between the
+ * azimuths, 0 < phi_hi - phi_lo < pi) at view point p ([P4] §4, Eq. 2-3; docs/errata.md E32): the angle between the
  * sector's boundary line directions e1 projected onto the plane perpendicular to the view ray
  * (orthographic: the view axis). Sectors of a full circle sum to 2 pi; 2 pi/K on the axis.
  * NaN for an invalid camera or argument (perspective p not in front of the eye). Pure. */
 HFVIS_API double hfvis_ffao_sector_weight(const hfvis_camera *cam, const double p[3],
                                           double phi_lo, double phi_hi);
 
-/* One slice of the slab estimator (spec §5.2 SliceObscurance): receiver p and projected normal
+/* One slice of the slab estimator ([P4] Alg. 2; docs/errata.md E31): receiver p and projected normal
  * n in the slice's 2D frame (eye at the origin, y toward the camera; orthographic 1: zenith +y),
  * points (hx[i], hy[i]) ordered outward; point i is visible iff its zenith angle a_i is below
  * every earlier one (strictly; starting from theta_start, pi = nothing yet), and then adds
@@ -2575,8 +2575,8 @@ HFVIS_API hfvis_status hfvis_ffao_slice(const double p[2], const double n[2], co
                                         double theta_start, const hfvis_ffao_options *opts,
                                         double *obscurance, double *theta_min);
 
-/* Screen-space far-field ambient obscurance ([P4]; spec §5.7 FfaoPixel), the COS convention
- * (spec §1.2: converges to the ray-traced reference, P4 Eq. 1). Per scan direction k (uniform
+/* Screen-space far-field ambient obscurance ([P4]; [P4] Alg. 2), the COS convention
+ * (docs/errata.md C4: converges to the ray-traced reference, P4 Eq. 1). Per scan direction k (uniform
  * azimuths, dense lattice D_S = D_L = 1 px): the scan kernel stores per line and interval of B0
  * steps m0 = max Q.z and m1 = max(Q.z - s Q.e1) over the samples (background skipped), levels
  * B_n = B0 2^n take the max of two children, prefix sums over the lines (double) give sector
@@ -2600,7 +2600,7 @@ HFVIS_API hfvis_status hfvis_ffao(const hfvis_camera *cam, const float *depth,
                                   const float *normals, const hfvis_ffao_options *opts,
                                   float *ao, ptrdiff_t ao_stride);
 
-/* The mipmap baseline ([P4] §5, spec §5.10): a pyramid of averaged depth (thickness 0) or of
+/* The mipmap baseline ([P4] §5): a pyramid of averaged depth (thickness 0) or of
  * the nearest depth ("max mips", thickness > 0; background ignored); per pixel, mip_directions
  * directions with samples at 1 px, then steps growing by mip_growth, plus one at the buffer
  * edge, each read trilinearly at level log2(max(1, 2 s tan(pi/K))) and fed as a slab point to
@@ -2620,7 +2620,7 @@ HFVIS_API hfvis_status hfvis_ssao_bilateral_blur(const float *in, ptrdiff_t in_s
                                                  int height, int radius, double threshold,
                                                  float *out, ptrdiff_t out_stride);
 
-/* Error statistics of an AO image against a reference ([P4] §8, spec §5.12). */
+/* Error statistics of an AO image against a reference ([P4] §8, docs/errata.md E36). */
 typedef struct hfvis_ssao_error_stats {
     double mean;     /* e_A: mean |ao - ref| (relative: / |ref| where |ref| > 1e-6) */
     double bias;     /* mean (ao - ref), absolute */
@@ -2643,7 +2643,7 @@ HFVIS_API hfvis_status hfvis_ssao_error(const float *ao, ptrdiff_t ao_stride, co
 /* voxel.c - meshes: type, OBJ codec, analytic meshes                                          */
 /* ========================================================================================== */
 
-/* A triangle mesh (DESIGN §2): vertex v is (xyz[3v], xyz[3v+1], xyz[3v+2]); triangle t has the
+/* A triangle mesh (hfvis.h, Conventions): vertex v is (xyz[3v], xyz[3v+1], xyz[3v+2]); triangle t has the
  * vertices indices[3t..3t+2], counter-clockwise seen from the side its normal points to
  * (n = (v1 - v0) x (v2 - v0)). A triangle soup is allowed (shared vertices not required, no
  * watertightness assumed) except by hfvis_voxelize_solid, which says so. Valid when every index
@@ -2670,7 +2670,7 @@ HFVIS_API void hfvis_mesh_free(const hfvis_allocator *alloc, hfvis_mesh *mesh);
 /* voxel.c - views: GL-convention matrices, shared by the rasterizer and incremental voxelizer */
 /* ========================================================================================== */
 
-/* A view of the world (spec voxel §0): 4x4 matrices in double, column-major as OpenGL
+/* A view of the world (docs/errata.md C7): 4x4 matrices in double, column-major as OpenGL
  * (element (row r, column c) is m[c*4 + r]), world -> eye (view, rigid) and eye -> clip (proj).
  * Eye space looks down -z; NDC z in [-1, 1]; window depth zw = (z_ndc + 1)/2 in [0, 1].
  * Images are width x height pixels, row 0 at the TOP (as image files): pixel (x, y) has its
@@ -2721,8 +2721,8 @@ HFVIS_API hfvis_status hfvis_view_orthographic(hfvis_view *view, const double ey
                                                const double target[3], const double up[3],
                                                double half_height, int width, int height,
                                                double near_plane, double far_plane);
-/* Eye-space z of a window depth zw in [0, 1] (thesis eq. 16 with its sign restored, spec voxel
- * §4.2): perspective z_e = -n f / (f - zw (f - n)), orthographic z_e = -(n + zw (f - n));
+/* Eye-space z of a window depth zw in [0, 1] (thesis eq. 16 with its sign restored, docs/errata.md
+ * E54): perspective z_e = -n f / (f - zw (f - n)), orthographic z_e = -(n + zw (f - n));
  * zw = 0 gives -n, zw = 1 gives -f. The linear view depth is -z_e. Pure: no argument is
  * checked (this one and the inverse below); NaN in gives NaN out. */
 HFVIS_API double hfvis_depth_to_eye_z(double zw, double near_plane, double far_plane,
@@ -2735,7 +2735,7 @@ HFVIS_API double hfvis_eye_z_to_depth(double z_eye, double near_plane, double fa
 /* voxel.c - volumes and the Volume Buffer                                                     */
 /* ========================================================================================== */
 
-/* A voxel grid (spec voxel §0): voxel (i, j, k) covers [origin + cell*(i, j, k),
+/* A voxel grid (docs/errata.md C7): voxel (i, j, k) covers [origin + cell*(i, j, k),
  * origin + cell*(i+1, j+1, k+1)) (half-open), linear index (k*dims[1] + j)*dims[0] + i
  * (x fastest). Valid when every dims[a] >= 1, every cell[a] > 0 and finite, origin finite, and
  * dims[0]*dims[1]*dims[2] <= HFVIS_VOLUME_MAX_VOXELS. */
@@ -2757,7 +2757,7 @@ typedef enum hfvis_blend {
     HFVIS_BLEND_ADD = 3
 } hfvis_blend;
 
-/* The Volume Buffer (thesis ch. 6, spec voxel §3.3): `channels` floats per voxel, interleaved,
+/* The Volume Buffer (thesis ch. 6, [G12] ch. 6): `channels` floats per voxel, interleaved,
  * data[lin*channels + c], caller-owned (hfvis_volume_size floats), each channel with its blend. */
 typedef struct hfvis_volume {
     hfvis_volume_grid grid;
@@ -2766,7 +2766,7 @@ typedef struct hfvis_volume {
     hfvis_blend blend[HFVIS_VOLUME_MAX_CHANNELS];
 } hfvis_volume;
 
-/* Fit a grid around a mesh (spec voxel §3.2): the longest axis of the mesh's bounding box,
+/* Fit a grid around a mesh ([G12] ch. 6; docs/errata.md E61): the longest axis of the mesh's bounding box,
  * enlarged by `padding` (a fraction of the longest extent, >= 0, on every side), gets
  * `resolution` voxels. cubic = 0: N_a = max(1, round(resolution*ext_a/ext_max)) and
  * cell_a = ext_a/N_a (near-cubic voxels covering the box exactly; the thesis' Table 3 sizes);
@@ -2848,7 +2848,7 @@ HFVIS_API hfvis_status hfvis_mesh_uv_sphere(const hfvis_allocator *alloc, const 
 /* Icosphere of centre c, radius r > 0: the icosahedron subdivided `subdivisions` times
  * (0..HFVIS_MESH_ICOSPHERE_MAX_SUBDIVISIONS), 10*4^s + 2 vertices, 20*4^s triangles, closed.
  * Construction (exactly A. Kahler's widely copied "Creating an icosphere mesh in code", 2009,
- * which the spec voxel §3.13 sphere counts were made with): base vertices, in this order,
+ * which the sphere counts were made with): base vertices, in this order,
  * (-1,t,0) (1,t,0) (-1,-t,0) (1,-t,0) (0,-1,t) (0,1,t) (0,-1,-t) (0,1,-t) (t,0,-1) (t,0,1)
  * (-t,0,-1) (-t,0,1), t = (1+sqrt 5)/2, normalised to the unit sphere; faces (0,11,5) (0,5,1)
  * (0,1,7) (0,7,10) (0,10,11) (1,5,9) (5,11,4) (11,10,2) (10,7,6) (7,1,8) (3,9,4) (3,4,2) (3,2,6)
@@ -2888,8 +2888,8 @@ HFVIS_API hfvis_status hfvis_mesh_torus_knot(const hfvis_allocator *alloc, const
                                              double scale, int p, int q, int segments, int sides,
                                              hfvis_mesh *out);
 
-/* A height field as a mesh: sample (x, y) becomes vertex (x*cell_size, y*cell_size, z) (DESIGN
- * §2), and each cell with corners a = (x,y), b = (x+1,y), c = (x,y+1), d = (x+1,y+1) is split
+/* A height field as a mesh: sample (x, y) becomes vertex (x*cell_size, y*cell_size, z) (hfvis.h,
+ * Conventions), and each cell with corners a = (x,y), b = (x+1,y), c = (x,y+1), d = (x+1,y+1) is split
  * along the diagonal a-d into (a, b, d) and (a, d, c), whose normals point to +z (up) for a
  * flat field. hfvis.c's surface is bilinear (hfvis_grid_sample), which no triangulation
  * reproduces: the two agree along every grid line (cell edges are linear in both) and on cells
@@ -3060,7 +3060,7 @@ typedef struct hfvis_raster_outputs {
 /* Rasterize a triangle mesh seen through a view: the visible triangle at every pixel centre and
  * its depth, normal and barycentrics, as OpenGL/D3D hardware does it (the scenes of the
  * incremental voxelizer and the screen-space issues are rendered with it).
- * Pipeline (spec voxel §0 conventions): vertices go to clip space c = proj*view*v in double;
+ * Pipeline (docs/errata.md C7 conventions): vertices go to clip space c = proj*view*v in double;
  * triangles entirely outside one frustum plane are skipped; the rest are clipped in homogeneous
  * clip space against the near plane z = -w (Sutherland-Hodgman; crossing triangles are cut,
  * never dropped) and, only where they leave the guard band, against the guard-band planes
@@ -3261,7 +3261,7 @@ HFVIS_API hfvis_bvh_options hfvis_bvh_options_default(void);
 
 /* Build a BVH over mesh's triangles: top-down, binned surface area heuristic (MacDonald &
  * Booth 1990; binning as I. Wald, "On fast construction of SAH-based bounding volume
- * hierarchies", IEEE RT 2007), the spec's A.9.2 choice: for each node, triangle centroids
+ * hierarchies", IEEE RT 2007), a binned form of the greedy SAH build of [LK] §6: for each node, triangle centroids
  * (centres of their float bounding boxes) are put into `bins` equal bins over the centroid
  * bounds on each axis whose centroid extent is > 0; the split between bins with the least
  * C_trav + C_tri (A_L N_L + A_R N_R)/A (C_trav = C_tri = 1, A = box surface area) wins (ties:
@@ -3340,7 +3340,7 @@ HFVIS_API hfvis_status hfvis_ray_any_naive(const hfvis_mesh *mesh, const hfvis_r
 /* ========================================================================================== */
 
 /* ---- surface voxelization into the Volume Buffer ([G12] ch. 6 Alg. 5 and 6, ch. 5 Alg. 4;
- *      spec voxel §3.4-3.8, §3.13) ------------------------------------------------------- */
+ *      [G12] ch. 6, Alg. 5-6) ------------------------------------------------------- */
 
 /* One voxel fragment: a sample point of a triangle written into one voxel. The sample point is
  * the centre of the pass's pixel (voxel[u] + 0.5, voxel[w] + 0.5) in grid space, u = (axis+1)
@@ -3351,7 +3351,7 @@ typedef struct hfvis_voxel_fragment {
     uint32_t triangle;     /* index of the triangle in the mesh */
     float barycentric[3];  /* of the sample point w.r.t. the triangle's vertices 0, 1, 2; they
                               sum to 1 and lie in [0, 1] up to rounding (orthographic sweep: no
-                              perspective correction, spec voxel §3.8) */
+                              perspective correction, [G12] ch. 6) */
     float position[3];     /* world position of the sample point, sum_i barycentric_i v_i */
     float normal[3];       /* unit world-space geometric normal, (v1 - v0) x (v2 - v0) normalised */
 } hfvis_voxel_fragment;
@@ -3363,21 +3363,21 @@ typedef struct hfvis_voxel_fragment {
  * The callback must not modify the volume being written. */
 typedef void (*hfvis_voxel_fragment_fn)(const hfvis_voxel_fragment *f, float *values, void *user);
 
-/* How a triangle is cut into the slabs of its sweep (spec voxel §3.4-3.6). Without an output
+/* How a triangle is cut into the slabs of its sweep ([G12] ch. 6, Alg. 5-6). Without an output
  * vertex limit all three give the voxel set of the pixel-centre rule; they differ in cost and,
  * with a limit, in the holes they leave. */
 typedef enum hfvis_voxelize_method {
-    /* Default. The common CPU rule (spec §3.4): each pass pixel (pu, pw) whose centre lies in the
+    /* Default. The common CPU rule ([G12] ch. 6): each pass pixel (pu, pw) whose centre lies in the
      * projected triangle gets the voxel of slab floor(z), z = the triangle plane's depth at the
      * centre. One fragment per covered pixel. No vertex limit (max_output_vertices must be 0). */
     HFVIS_VOXELIZE_PIXEL_RULE = 0,
-    /* Geometry-shader triangle slicing ([G12] Alg. 5, spec §3.5): the triangle is clipped
+    /* Geometry-shader triangle slicing ([G12] Alg. 5, [G12] ch. 6, Alg. 5; docs/errata.md E58): the triangle is clipped
      * (Sutherland-Hodgman against both planes of a slab) into one convex piece per slab it
      * spans, lowest slab first, and each piece is rasterised (pixel centres, top-left rule on the
      * piece's own edges) into its slab. Equals the pixel rule except where a pixel centre lies
      * within rounding (about 1e-12 voxels) of a slab plane or a triangle edge. */
     HFVIS_VOXELIZE_GS_SLICING = 1,
-    /* Pixel-shader fragment clipping ([G12] Alg. 6, spec §3.6): the whole triangle is rasterised
+    /* Pixel-shader fragment clipping ([G12] Alg. 6, [G12] ch. 6, Alg. 6; docs/errata.md E57): the whole triangle is rasterised
      * once per slab it spans, lowest first, and a fragment is kept only in the slab that holds its
      * depth, [k, k+1) (the half-open form of the thesis' open interval). Without a limit this is
      * the pixel rule exactly; the cost grows with the slabs spanned (n passes over the
@@ -3396,7 +3396,7 @@ typedef enum hfvis_voxelize_axes {
      * (hfvis_volume_merge of the three HFVIS_AXES_ONLY_* results). */
     HFVIS_AXES_ALL = 1,
     /* One pass only (one of Alg. 4's per-axis volumes; also the thesis' "one axis per frame"
-     * amortisation, spec §2.3). */
+     * amortisation, [G12] ch. 5, Alg. 4). */
     HFVIS_AXES_ONLY_X = 2,
     HFVIS_AXES_ONLY_Y = 3,
     HFVIS_AXES_ONLY_Z = 4
@@ -3408,7 +3408,7 @@ typedef struct hfvis_voxelize_options {
     hfvis_voxelize_method method;   /* default HFVIS_VOXELIZE_PIXEL_RULE */
     hfvis_voxelize_axes axes;       /* default HFVIS_AXES_DOMINANT */
     int max_output_vertices;        /* the geometry shader's declared vertex limit V ([G12] §6.6,
-                                       spec §3.7); 0 = unlimited (default). With V > 0 a triangle
+                                       [G12] ch. 6; docs/errata.md E58); 0 = unlimited (default). With V > 0 a triangle
                                        keeps only its hfvis_gs_max_slices(V, method ==
                                        FRAGMENT_CLIPPING) lowest slabs, counted from the slab of
                                        its lowest vertex (slabs outside the grid count too):
@@ -3422,7 +3422,7 @@ typedef struct hfvis_voxelize_options {
 
 HFVIS_API hfvis_voxelize_options hfvis_voxelize_options_default(void);
 
-/* Slabs a triangle keeps under a geometry-shader output limit of V vertices (spec §3.7):
+/* Slabs a triangle keeps under a geometry-shader output limit of V vertices ([G12] ch. 6; docs/errata.md E58):
  * GS slicing emits 3 + 4n vertices for n slabs, so floor((V - 3)/4) (V = 7, 11, 15, 19 ->
  * 1, 2, 3, 4); fragment clipping (pixel_clipping != 0) emits 3n, so floor(V/3) (V = 3, 6, 9 ->
  * 1, 2, 3). 0 when V is too small for one slab (and for V <= 0). */
@@ -3432,7 +3432,7 @@ HFVIS_API int hfvis_gs_max_slices(int max_output_vertices, int pixel_clipping);
  * HFVIS_AXES_ALL). Grid space is g = (p - origin)/cell per axis, so a voxel is a unit cube; a
  * pass along axis a (u = a+1, w = a+2 mod 3) projects onto the (u, w) plane, whose pixel
  * (pu, pw) has its centre at (pu + 0.5, pw + 0.5), and cuts along a into slabs [k, k+1).
- * Rules, exactly (spec §3.4, §3.12):
+ * Rules, exactly ([G12] ch. 6):
  *   - The grid-space normal n = (g1 - g0) x (g2 - g0) in double; n == 0: the triangle is
  *     degenerate and skipped; in a pass with n_a == 0 it is edge-on and skipped. A triangle with
  *     a grid coordinate beyond 1e150 voxels is skipped; a pass whose depth slope |n_u/n_a| or
@@ -3499,7 +3499,7 @@ HFVIS_API hfvis_status hfvis_voxelize_occupancy(const hfvis_mesh *mesh,
                                                 const hfvis_voxelize_options *opts, uint8_t *occ);
 
 /* Ready-made attribute callbacks (hfvis_voxel_fragment_fn), the thesis' Volume Buffer channels
- * ([G12] §6.5, spec §3.8). */
+ * ([G12] §6.5, [G12] ch. 6). */
 
 /* values[0] = 1 (occupancy). user unused. */
 HFVIS_API void hfvis_voxel_fragment_occupancy(const hfvis_voxel_fragment *f, float *values,
@@ -3521,7 +3521,7 @@ typedef void (*hfvis_voxel_irradiance_fn)(const float position[3], const float n
 #define HFVIS_VOXEL_ATTR_NORMAL 2u    /* 3 channels: unit world normal (x, y, z) */
 #define HFVIS_VOXEL_ATTR_ALBEDO 4u    /* 3 channels: RGB albedo */
 #define HFVIS_VOXEL_ATTR_RADIANCE 8u  /* 3 channels: RGB outgoing radiance, Lambertian
-                                         (DESIGN §2): albedo * E / pi + emission */
+                                         (hfvis.h, Conventions): albedo * E / pi + emission */
 
 /* user of hfvis_voxel_fragment_attributes. Zero-initialised = occupancy only. */
 typedef struct hfvis_voxel_attributes {
@@ -3585,7 +3585,7 @@ typedef struct hfvis_binary_voxel_options {
 HFVIS_API hfvis_binary_voxel_options hfvis_binary_voxel_options_default(void);
 
 /* Triangle / axis-aligned box overlap by the separating-axis theorem (Akenine-Moller 2001;
- * spec voxel §3.9): the box (centre, half sizes half[a] >= 0) and the triangle (v0, v1, v2)
+ * [G12] ch. 6): the box (centre, half sizes half[a] >= 0) and the triangle (v0, v1, v2)
  * overlap unless one of 13 axes separates them: the 3 box normals (bounding boxes), the 9
  * cross products e_a x f_j of the box axes with the triangle edges f0 = v1-v0, f1 = v2-v1,
  * f2 = v0-v2, and the triangle normal n = f0 x f1. Both are CLOSED sets: touching (a vertex,
@@ -3602,7 +3602,7 @@ HFVIS_API int hfvis_triangle_box_overlap(const double center[3], const double ha
 
 /* Conservative surface voxelization: occ[v] = 1 for every voxel whose closed cube the triangle
  * overlaps by hfvis_triangle_box_overlap (grid space: centre (i+.5, j+.5, k+.5), half 0.5), for
- * every triangle; 26-separating, a superset of the pixel-centre voxelizations (spec §3.4, §3.9).
+ * every triangle; 26-separating, a superset of the pixel-centre voxelizations ([G12] ch. 6).
  * Only the voxels of the triangle's bounding-box range are candidates: along each axis
  * i = max(0, ceil(min) - 1) .. min(dims-1, floor(max)) (the voxels whose closed extent meets
  * the triangle's); the result is EXACTLY the set hfvis_voxelize_conservative_reference gives,
@@ -3634,7 +3634,7 @@ HFVIS_API hfvis_status hfvis_voxelize_conservative_reference(const hfvis_mesh *m
                                                              const hfvis_binary_voxel_options *opts,
                                                              uint8_t *occ, size_t *count);
 
-/* Solid voxelization by parity (spec §3.9: Chen & Fang 1998; Eisemann & Decoret 2008):
+/* Solid voxelization by parity ([G12] ch. 6: Chen & Fang 1998; Eisemann & Decoret 2008):
  * occ[v] = 1 when the centre of voxel v lies inside the mesh, decided by the parity of the
  * crossings of the line through the voxel centres along opts->axis (default z) below the
  * centre. A crossing is a triangle covering the column's centre point (u, w) = (iu+.5, iw+.5)
@@ -3697,7 +3697,7 @@ HFVIS_API hfvis_status hfvis_mesh_is_watertight(const hfvis_mesh *mesh,
 HFVIS_API size_t hfvis_bitmask_words(const hfvis_volume_grid *grid);
 
 /* Bitmask surface voxelization (Eisemann & Decoret 2006, run from the three axis viewpoints;
- * spec §3.9, §6): for each axis a (u = a+1, w = a+2 mod 3), every non-degenerate triangle is
+ * [G12] ch. 6): for each axis a (u = a+1, w = a+2 mod 3), every non-degenerate triangle is
  * rasterized into the (u, w) pixel grid with the pixel-centre rule of hfvis_voxelize_solid (the
  * watertight top-left coverage), the depth z along a of each covered centre is interpolated
  * (barycentrics, clamped to the triangle's depth range) and the bit of slab floor(z) (a depth
@@ -3775,7 +3775,7 @@ HFVIS_API hfvis_status hfvis_voxels_raw_save(const char *path, const hfvis_volum
                                              const uint8_t *voxels);
 
 /* ========================================================================================== */
-/* voxel.c - incremental image-based voxelization (thesis ch. 7, spec voxel §4)                */
+/* voxel.c - incremental image-based voxelization (thesis ch. 7, [G12] ch. 7)                  */
 /* ========================================================================================== */
 
 /* Incremental voxelization (IV, Gaitatzes 2012 ch. 7) keeps last frame's Volume Buffer and
@@ -3814,7 +3814,7 @@ typedef struct hfvis_depth_image {
     int attribute_count;
 } hfvis_depth_image;
 
-/* Where a voxel centre lies against one depth image (thesis Fig. 70, spec voxel §4.3). */
+/* Where a voxel centre lies against one depth image (thesis Fig. 70, [G12] ch. 7, Alg. 7, eq. 17; docs/errata.md E55). */
 typedef enum hfvis_iv_class {
     HFVIS_IV_UNSEEN = 0,  /* no information: behind the camera, nearer than the near plane,
                              outside the image (|ndc x| or |ndc y| > 1) or a no-data pixel; kept */
@@ -3910,7 +3910,7 @@ HFVIS_API double hfvis_iv_bias_half_diagonal(const hfvis_volume_grid *grid);
 HFVIS_API hfvis_status hfvis_iv_bias(const hfvis_volume_grid *grid, const hfvis_iv_options *opts,
                                      double *out);
 
-/* Classify a world point against one depth image with bias b (spec voxel §4.3): project with
+/* Classify a world point against one depth image with bias b ([G12] ch. 7, Alg. 7, eq. 17; docs/errata.md E55): project with
  * proj*view; UNSEEN if clip w <= 0, p'_z > -near_plane, |ndc x| > 1 or |ndc y| > 1 (ndc =
  * clip.xy * (1/clip.w)); texel (floor((ndc_x+1)/2*W), floor((1-ndc_y)/2*H)) clamped to W-1, H-1;
  * UNSEEN for a no-data texel; then CLEARED / BAND / KEPT by eq. 17 in eye space, in double,
@@ -3973,7 +3973,7 @@ HFVIS_API hfvis_status hfvis_iv_update(const hfvis_volume *prev, hfvis_volume *c
                                        const hfvis_depth_image *images, size_t image_count,
                                        const hfvis_iv_options *opts, hfvis_iv_stats *stats);
 
-/* Single-pass ("optimised") IV (§7.4.3, spec voxel §4.5): no injection; for every voxel and every
+/* Single-pass ("optimised") IV (§7.4.3, [G12] ch. 7): no injection; for every voxel and every
  * image in order: CLEARED empties it, BAND turns it on / updates it: occupancy channel = 1 and
  * the mapped channels = the attributes of the centre texel, written as they are (REPLACE, like
  * the thesis' shader output; the blends are not used), KEPT and UNSEEN keep it. A voxel cleared
@@ -3984,7 +3984,7 @@ HFVIS_API hfvis_status hfvis_iv_single_pass(const hfvis_volume *prev, hfvis_volu
                                             const hfvis_depth_image *images, size_t image_count,
                                             const hfvis_iv_options *opts, hfvis_iv_stats *stats);
 
-/* IV for lighting (§7.5, spec voxel §4.6): after cleanup of the attribute volume, every NON-EMPTY
+/* IV for lighting (§7.5, [G12] ch. 7): after cleanup of the attribute volume, every NON-EMPTY
  * voxel of the separate injection volume (cleared every frame, VPLs injected with ADD, camera
  * samples with REPLACE) replaces the corresponding values of curr: channels[0..channel_count)
  * (NULL = every channel). Non-empty: the occupancy channel of opts is non-zero, or with
@@ -4017,8 +4017,8 @@ typedef struct hfvis_distance_options {
     const hfvis_allocator *alloc;   /* scratch; NULL = malloc/free */
 } hfvis_distance_options;
 
-/* Distances between a mesh X and a voxel set Y (its voxel centres), thesis Table 9 (spec voxel
- * §4.8): Y -> X exactly (every centre's distance to the nearest triangle, point-triangle in
+/* Distances between a mesh X and a voxel set Y (its voxel centres), thesis Table 9 ([G12] ch. 7;
+ * docs/errata.md E62): Y -> X exactly (every centre's distance to the nearest triangle, point-triangle in
  * double); X -> Y over seeded area-uniform samples of X (a lower bound of the true sup).
  * Table 9 reports the "average Hausdorff distance" normalised by the mesh bounding-box diagonal,
  * in percent; the thesis leaves "average" open, hfvis reports both directed means and maxima:
@@ -4058,7 +4058,7 @@ HFVIS_API hfvis_status hfvis_voxel_distance_metrics_naive(const hfvis_mesh *mesh
 
 
 /* ========================================================================================== */
-/* voxel.c - 4D visibility fields ([G12] ch. 4, Alg. 1-3; spec voxel §1)                      */
+/* voxel.c - 4D visibility fields ([G12] ch. 4, Alg. 1-3)                                     */
 /* ========================================================================================== */
 
 /* A visibility field (Gaitatzes et al., WSCG 2008/2010; [G12] ch. 4) replaces the ray-object
@@ -4072,7 +4072,7 @@ HFVIS_API hfvis_status hfvis_voxel_distance_metrics_naive(const hfvis_mesh *mesh
  * uniform scale) share one field.
  *
  * Conventions of this section.
- * - Positional samples (spec §1.3, the octahedral construction that reproduces the thesis'
+ * - Positional samples ([G12] ch. 4; docs/errata.md E56, the octahedral construction that reproduces the thesis'
  *   counts; [G12] cites Slater's triangle subdivision): with frequency n, the upper hemisphere
  *   holds the points (a, b, n - |a| - |b|)/|.| for integer |a| + |b| <= n (H = 2n^2 + 2n + 1
  *   of them), the lower one their mirror images (a, b, -(n - |a| - |b|))/|.|, so
@@ -4084,7 +4084,7 @@ HFVIS_API hfvis_status hfvis_voxel_distance_metrics_naive(const hfvis_mesh *mesh
  * - Frame: the hemisphere of sample k is expressed in the tangent frame (t, b, w) of
  *   hfvis_visfield_frame(w), w = -u_k; a local direction l = (lx, ly, lz), lz >= 0, is the
  *   object direction lx t + ly b + lz w.
- * - Maps (spec §1.4): texel (i, j), 0 <= i, j < D, has square coordinates A = 2(i + 0.5)/D - 1
+ * - Maps ([G12] ch. 4, Fig. 30-34): texel (i, j), 0 <= i, j < D, has square coordinates A = 2(i + 0.5)/D - 1
  *   (column i), B = 2(j + 0.5)/D - 1 (row j); see hfvis_dirmap. Storage is maps[k][j][i].
  * - Distances are stored normalised by the sphere's diameter 2R, so they lie in [0, 1]: a chord
  *   is at most 2R long. A MISS means the ray from p_k leaves the sphere without meeting the
@@ -4119,7 +4119,7 @@ HFVIS_API hfvis_status hfvis_voxel_distance_metrics_naive(const hfvis_mesh *mesh
 #define HFVIS_VISFIELD_MAX_BYTES ((uint64_t)1 << 32)
 #define HFVIS_VISFIELD_FILE_HEADER 80      /* bytes before the payload in a field file */
 
-/* How the hemisphere of directions maps onto the D x D texels ([G12] §4.4.4, spec §1.4). */
+/* How the hemisphere of directions maps onto the D x D texels ([G12] §4.4.4, [G12] ch. 4, Fig. 30-34). */
 typedef enum hfvis_dirmap {
     HFVIS_DIRMAP_DEFAULT = 0,    /* = HFVIS_DIRMAP_CONCENTRIC */
     /* Polar ("uniform") mapping: column i is the polar angle theta = (i + 0.5)/D * pi/2 from the
@@ -4136,7 +4136,7 @@ typedef enum hfvis_dirmap {
     HFVIS_DIRMAP_CONCENTRIC = 3
 } hfvis_dirmap;
 
-/* What a texel stores ([G12] §4.6.1, spec §1.2, §1.5-1.6). */
+/* What a texel stores ([G12] §4.6.1, [G12] ch. 4, Fig. 42; [G12] ch. 4, Alg. 1). */
 typedef enum hfvis_visfield_format {
     HFVIS_VISFIELD_DEFAULT = 0,  /* = HFVIS_VISFIELD_U8 */
     /* 1 byte per texel: a hit at distance th stores q = min(254, floor(254 th/(2R) + 0.5)),
@@ -4208,7 +4208,7 @@ HFVIS_API size_t hfvis_visfield_position_count(int positions_n);
  * Returns HFVIS_ERR_INVALID_ARGUMENT for n out of range, k >= K or NULL dir (dir untouched). */
 HFVIS_API hfvis_status hfvis_visfield_position(int positions_n, size_t k, double dir[3]);
 
-/* Nearest positional sample to direction q (any length > 0), in constant time (spec §1.3; a CPU
+/* Nearest positional sample to direction q (any length > 0), in constant time ([G12] ch. 4; docs/errata.md E56; a CPU
  * replacement of Slater's colour-index buffer). Samples are ranked by the key d |d| / L, d = the
  * dot product of q with the lattice point (a, b, +-c), L = a^2 + b^2 + c^2 (exact): a monotone
  * function of the cosine, so the largest key is the nearest sample (no square root). Equal keys
@@ -4236,7 +4236,7 @@ HFVIS_API hfvis_status hfvis_visfield_nearest_position_naive(int positions_n, co
 HFVIS_API void hfvis_visfield_frame(const double w[3], double t[3], double b[3]);
 
 /* Shirley & Chiu's concentric map, "A low distortion map between disk and square", JGT 2(3),
- * 1997 (spec §1.4 formulas): square [-1, 1]^2 -> unit disk, area preserving; the disk radius is
+ * 1997 ([G12] ch. 4, Fig. 30-34 formulas): square [-1, 1]^2 -> unit disk, area preserving; the disk radius is
  * max(|a|, |b|). And its inverse (the origin maps to (0, 0)). Outputs must not be NULL. */
 HFVIS_API void hfvis_concentric_square_to_disk(double a, double b, double *x, double *y);
 HFVIS_API void hfvis_concentric_disk_to_square(double x, double y, double *a, double *b);
@@ -4266,7 +4266,7 @@ HFVIS_API hfvis_status hfvis_dirmap_from_local(hfvis_dirmap mapping, int dir_res
  * of range, an unknown format, or a size that overflows size_t. */
 HFVIS_API size_t hfvis_visfield_size(int positions_n, int dir_res, hfvis_visfield_format format);
 
-/* A bounding sphere for a field (spec §1.1 proposal): centre = the centre of the mesh's
+/* A bounding sphere for a field ([G12] ch. 4 proposal): centre = the centre of the mesh's
  * axis-aligned bounds, radius = (1 + 1e-4) * the largest vertex distance from it (and at least
  * 1e-30, for a mesh of one point). Returns HFVIS_ERR_INVALID_ARGUMENT for NULL, an invalid mesh
  * or one without vertices (outputs untouched). */
@@ -4282,7 +4282,7 @@ typedef struct hfvis_visfield_build_options {
     void *progress_user;
 } hfvis_visfield_build_options;
 
-/* Build a visibility field ([G12] Alg. 1, spec §1.5): for every sample k, p_k = c + R u_k,
+/* Build a visibility field ([G12] Alg. 1, [G12] ch. 4, Alg. 1): for every sample k, p_k = c + R u_k,
  * w = -u_k, and every texel (i, j) of the mapping (unused rejection texels get the miss code),
  * the ray hfvis_ray{origin = (float)p_k, direction = (float)(lx t + ly b + lz w), t_min = 0,
  * t_max = INFINITY, cull none} is cast with hfvis_bvh_closest_hit; a hit at t stores
@@ -4318,7 +4318,7 @@ HFVIS_API hfvis_status hfvis_visfield_build_reference(const hfvis_mesh *mesh,
 HFVIS_API hfvis_status hfvis_visfield_texel(const hfvis_visfield *vf, size_t k, int i, int j,
                                             int *hit, double *distance, double normal[3]);
 
-/* ---- queries (Algorithms 2 and 3, spec §1.7) ------------------------------------------------ */
+/* ---- queries (Algorithms 2 and 3, [G12] ch. 4, Alg. 2-3) ------------------------------------------------ */
 
 /* One ray against one field, in object space: origin o, direction d (any length > 0; t counts
  * along d/|d|). With oc = o - c, beta = oc.d, gamma = oc.oc - R^2, Delta = beta^2 - gamma:
@@ -4329,7 +4329,7 @@ HFVIS_API hfvis_status hfvis_visfield_texel(const hfvis_visfield *vf, size_t k, 
  *  - gamma < 0 (inside, Fig. 31): the exit p1 at t1; k = nearest sample to p1; the REVERSED ray
  *    -d in k's frame; unoccluded (MISS) if lz <= 0, unused or a miss; else d2 = v 2R and the
  *    result is OCCLUDED at distance t1 - d2 when d2 < t1 - bias, MISS otherwise. The bias
- *    (object units, >= 0) is the thesis' missing tolerance (spec §1.7(b)): a receiver on the
+ *    (object units, >= 0) is the thesis' missing tolerance ([G12] ch. 4, Fig. 31): a receiver on the
  *    object's own surface sees its own surface at d2 ~ t1; use >= the 8-bit step 2R/254 plus the
  *    snapping error (HFVIS_VISFIELD_DEFAULT_BIAS * R is a reasonable start).
  * Exactly one map texel is read. out receives the result (see hfvis_visfield_hit).
@@ -4373,7 +4373,7 @@ typedef struct hfvis_visfield_object {
 typedef enum hfvis_visfield_combine {
     HFVIS_VISFIELD_COMBINE_DEFAULT = 0,     /* = ANY */
     HFVIS_VISFIELD_COMBINE_ANY = 1,         /* a ray is blocked when any object blocks it (the
-                                               physically consistent rule; spec §1.7(c) [C]) */
+                                               physically consistent rule; docs/errata.md E64) */
     HFVIS_VISFIELD_COMBINE_SUBTRACTIVE = 2  /* the thesis' GPU passes with reverse-subtract
                                                blending: obscurance = min(1, sum over objects),
                                                a ray blocked twice counts twice */
@@ -4401,7 +4401,7 @@ typedef struct hfvis_visfield_ao_options {
 
 HFVIS_API hfvis_visfield_ao_options hfvis_visfield_ao_options_default(void);
 
-/* Ambient obscurance of receiver points from visibility fields ([G12] Alg. 2/3, spec §1.7(c)):
+/* Ambient obscurance of receiver points from visibility fields ([G12] Alg. 2/3, [G12] ch. 4, Alg. 2-3; docs/errata.md E64):
  * per point x with unit normal n (renormalised here), the S x S rays l = concentric((2i+1)/S - 1,
  * (2j+1)/S - 1) lifted by Malley (cosine distributed, as the thesis' pre-generated ray set) in
  * the frame hfvis_visfield_frame(n), direction lx t + ly b + lz n, from x + offset n; each object
@@ -4409,7 +4409,7 @@ HFVIS_API hfvis_visfield_ao_options hfvis_visfield_ao_options_default(void);
  * OCCLUDED at world distance s*distance <= max_distance blocks the ray with weight 1 (binary)
  * or 1 - distance/max_distance (linear); ANY takes the largest weight over the objects (the
  * nearest blocker), SUBTRACTIVE their sum. out[p] = min(1, (1/S^2) sum over rays) is the
- * obscurance (DESIGN: 0 = open, 1 = fully blocked; the thesis prints 1 - this). Because the rays
+ * obscurance (hfvis.h conventions: 0 = open, 1 = fully blocked; the thesis prints 1 - this). Because the rays
  * are cosine distributed this estimates (1/pi) Int (1 - V) cos.
  * points, normals: 3 floats per point; out: point_count floats (must not overlap them).
  * Returns HFVIS_ERR_INVALID_ARGUMENT for NULL objects with object_count > 0, an invalid field
@@ -4441,7 +4441,7 @@ typedef struct hfvis_visfield_shadow_options {
 } hfvis_visfield_shadow_options;
 
 /* Visibility of a spherical light (centre, radius >= 0; 0 = a point light, hard shadows) from
- * points ([G12] §4.5.2, spec §1.7(d)): per point x, `samples` points y_i on the disc of the light
+ * points ([G12] §4.5.2, [G12] ch. 4): per point x, `samples` points y_i on the disc of the light
  * facing x (centre + radius (dx e1 + dy e2), (dx, dy) = the concentric map of the Hammersley
  * point ((i + 0.5)/N, radical inverse of i in base 2), (e1, e2) = the frame of the unit vector
  * from x to the centre); the shadow ray x -> y_i of length L is blocked when some object
@@ -4583,7 +4583,7 @@ HFVIS_API hfvis_status hfvis_visfield_load(const char *path, const hfvis_allocat
                                            hfvis_visfield *out);
 
 /* ========================================================================================== */
-/* voxel.c - volume-based VPL indirect illumination ([G12] ch. 5, spec voxel §2)               */
+/* voxel.c - volume-based VPL indirect illumination ([G12] ch. 5)                              */
 /* ========================================================================================== */
 
 /* Gaitatzes' volume-based indirect light ([G12] ch. 5; 3IA/CGVCVIP 2010 with Mavridis and
@@ -4595,29 +4595,29 @@ HFVIS_API hfvis_status hfvis_visfield_load(const char *path, const hfvis_allocat
  *   2. every lit voxel becomes a virtual point light (VPL), a cosine lobe about its normal in
  *      2-band spherical harmonics (hfvis_volgi_inject);
  *   3. the light is propagated iteratively from voxel to face neighbour (eq. 11, the reference
- *      kernel of spec §2.5; hfvis_volgi_propagate): through empty voxels unchanged, and at
+ *      kernel of [G12] ch. 5, eq. 11; docs/errata.md E59; hfvis_volgi_propagate): through empty voxels unchanged, and at
  *      occupied voxels it is recorded in an accumulation volume A and reflected (T_r);
  *   4. each pixel gathers A from the occupied voxels around it and integrates it against its
  *      clamped cosine (eqs. 12-15; hfvis_volgi_gather).
  * hfvis_volgi_render runs the whole pipeline for a view.
  *
  * Conventions of this section.
- * - SH: real, orthonormal, 2 bands = 4 coefficients per colour band, DESIGN's convention:
+ * - SH: real, orthonormal, 2 bands = 4 coefficients per colour band, the hfvis.h convention:
  *   Y_0 = 1/(2 sqrt pi), Y_1 = 0.4886 y, Y_2 = 0.4886 z, Y_3 = 0.4886 x (0.4886 = sqrt(3/(4 pi))),
  *   the first 4 values of hfvis_sh_eval. An SH volume holds HFVIS_VOLGI_FLOATS = 12 floats per
  *   voxel, band-major: v[lin*12 + 4*band + k], bands R, G, B, lin = the grid's linear index.
  * - The propagation volume P and the accumulation volume A hold radiant INTENSITY (flux per
  *   steradian, W/sr in a world where radiance is W/(m^2 sr)) as a function of the direction the
  *   light TRAVELS. The flux (energy) of a band is its integral over the sphere, 2 sqrt(pi) c_0.
- * - A VPL of a voxel with outgoing radiance L (Lambertian, DESIGN §2) and unit normal n has the
+ * - A VPL of a voxel with outgoing radiance L (Lambertian, hfvis.h, Conventions) and unit normal n has the
  *   flux Phi = pi L s^2 of one voxel face (s^2 = the face of the grid perpendicular to n's
- *   dominant axis) and the intensity (Phi/pi) max(0, n.w) (spec §2.4 [C]).
- * - Constants (spec §2.2): the clamped cosine about n, CC(n) = (sqrt(pi)/2, sqrt(pi/3) n_y,
+ *   dominant axis) and the intensity (Phi/pi) max(0, n.w) ([G12] ch. 5; docs/errata.md E60).
+ * - Constants ([G12] ch. 5): the clamped cosine about n, CC(n) = (sqrt(pi)/2, sqrt(pi/3) n_y,
  *   sqrt(pi/3) n_z, sqrt(pi/3) n_x), and the cone of half-angle 45 degrees about d (the thesis'
  *   "90-degree cone"), Cone(d) = (sqrt(pi)(1 - cos 45), (sqrt(3 pi)/2) sin^2 45 d_y, ...).
  * - All transport arithmetic is double, rounded to float once per stored value. Determinism:
  *   same inputs, same binary, same bits.
- * - Choices the thesis leaves open [C] (spec §2.9), each an option where it matters: the VPL scale
+ * - Choices the thesis leaves open [C] (docs/errata.md E59), each an option where it matters: the VPL scale
  *   (the flux of one voxel face, above); the meaning of eq. 11 (hfvis_volgi_transfer: per
  *   neighbour the cone flux, re-expanded as a cosine lobe along the travel direction, negative SH
  *   ringing clamped); transfers between two occupied voxels (hfvis_volgi_paths); the mirror axis
@@ -4647,7 +4647,7 @@ HFVIS_API hfvis_status hfvis_visfield_load(const char *path, const hfvis_allocat
  * (2^31 voxels x 2^20 iterations x 1e20 < FLT_MAX). */
 #define HFVIS_VOLGI_MAX_VALUE 1e20f
 
-/* ---- 2-band SH helpers (spec §2.2) ---------------------------------------------------------- */
+/* ---- 2-band SH helpers ([G12] ch. 5) ---------------------------------------------------------- */
 
 /* The 4 basis functions at the unit direction dir/|dir|. Returns HFVIS_OK, or
  * HFVIS_ERR_INVALID_ARGUMENT for NULL, a non-finite or zero dir (out untouched). */
@@ -4668,9 +4668,9 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_volgi_sh_cone(const double axis[
 
 /* ---- options ------------------------------------------------------------------------------ */
 
-/* How the flux that leaves a voxel toward a face neighbour is computed (eq. 11, spec §2.5). */
+/* How the flux that leaves a voxel toward a face neighbour is computed (eq. 11, [G12] ch. 5, eq. 11; docs/errata.md E59). */
 typedef enum hfvis_volgi_transfer {
-    /* Default: the reference kernel of spec §2.5 [C]. The flux through the face toward
+    /* Default: the reference kernel of docs/errata.md E59. The flux through the face toward
      * neighbour i = j + o is F = max(0, P_j . Cone(o)) per band (the SH integral of P_j over the
      * 45-degree cone about o, negative values from SH ringing clamped), and it arrives at i as a
      * cosine lobe (F/pi) CC(o) travelling along o. The part of P_j's flux outside the six cones
@@ -4693,7 +4693,7 @@ typedef enum hfvis_volgi_reflection {
      * the reflected flux is exactly rho times the arriving flux. A voxel whose normal is 0
      * negates all three band-1 coefficients (sends the light back) [C]. */
     HFVIS_VOLGI_REFLECT_MIRROR = 0,
-    /* Alternative (b) of spec §2.5, "the new propagation direction is determined by the stored
+    /* Alternative (b) of [G12] ch. 5, eq. 11; docs/errata.md E59, "the new propagation direction is determined by the stored
      * average voxel normal": the arriving flux Phi = 2 sqrt(pi) c_0 is re-emitted as a cosine lobe
      * rho (Phi/pi) CC(+-n) about the normal, on the side the light came from (-n when the band-1
      * part of S_in points along +n, i.e. the light arrives from behind). Normal 0: an isotropic
@@ -4712,8 +4712,8 @@ typedef enum hfvis_volgi_reflectance {
 
 /* Which face-neighbour transfers carry light. */
 typedef enum hfvis_volgi_paths {
-    /* Default, spec §2.5's reference kernel: every voxel gathers from all six neighbours, also
-     * an occupied voxel from an occupied one (spec §2.9: occupied sources emit into all six
+    /* Default, the reference kernel of docs/errata.md E59: every voxel gathers from all six neighbours, also
+     * an occupied voxel from an occupied one (docs/errata.md E59: occupied sources emit into all six
      * directions). Side effect: the side lobes of a lit wall's VPLs land in the neighbouring
      * voxels of the same wall and are recorded there, so a lit surface receives a share of its
      * own light as "indirect" (about 4 x 0.146 of a VPL's flux per step). */
@@ -4793,7 +4793,7 @@ typedef struct hfvis_volgi_energy {
                              reached surfaces in this step */
 } hfvis_volgi_energy;
 
-/* VPL injection ([G12] §5.5.1, spec §2.4): prop[v] = L_v s^2 CC(n_v) per band for every voxel with
+/* VPL injection ([G12] §5.5.1, [G12] ch. 5): prop[v] = L_v s^2 CC(n_v) per band for every voxel with
  * occupancy > 0, a non-zero normal and radiance L_v = radiance[3v..3v+2] (outgoing radiance of the
  * lit or emissive surface, >= 0), i.e. a cosine lobe carrying the flux pi L_v s^2 (s^2: the face
  * perpendicular to the normal's dominant axis); an occupied voxel without a normal gets the
@@ -4805,7 +4805,7 @@ typedef struct hfvis_volgi_energy {
 HFVIS_API hfvis_status hfvis_volgi_inject(const hfvis_volgi_geometry *geometry,
                                           const float *radiance, float *prop);
 
-/* One propagation step (eq. 11 with the reference kernel of spec §2.5), by gathering at each
+/* One propagation step (eq. 11 with the reference kernel of [G12] ch. 5, eq. 11; docs/errata.md E59), by gathering at each
  * voxel i from its six face neighbours j = i - o, o in the order +x, -x, +y, -y, +z, -z:
  *   S_in = sum_o (F_o(j)/pi) CC(o)     (F: see hfvis_volgi_transfer; neighbours outside the grid
  *                                       send nothing, light sent out of the grid is lost)
@@ -4813,7 +4813,7 @@ HFVIS_API hfvis_status hfvis_volgi_inject(const hfvis_volgi_geometry *geometry,
  *   occupied:                 accum[i] += alpha S_in
  *                             prop_out[i] = (1 - alpha) S_in + alpha rho R(S_in)
  * with R the reflection of opts->reflection and rho of opts->reflectance_source. Occupied source
- * voxels emit into all six directions too (spec §2.9). accum is added to (clear it before the
+ * voxels emit into all six directions too (docs/errata.md E59). accum is added to (clear it before the
  * first step: the thesis' A starts at zero, so direct light is not in A). energy may be NULL;
  * otherwise it receives the step's accounting (one extra pass over prop_in).
  * prop_in and accum must not overlap prop_out; prop_in may not overlap accum.
@@ -4832,7 +4832,7 @@ HFVIS_API hfvis_status hfvis_volgi_propagate_step(const hfvis_volgi_geometry *ge
                                                   const float *prop_in, float *prop_out,
                                                   float *accum, hfvis_volgi_energy *energy);
 
-/* Oracle of hfvis_volgi_propagate_step: spec §2.5's pseudo-code literally, per voxel and
+/* Oracle of hfvis_volgi_propagate_step: the kernel of docs/errata.md E59 literally, per voxel and
  * direction with the full 4-coefficient products P_j . Cone(o) and (F/pi) CC(o) (the vectors of
  * hfvis_volgi_sh_cone and hfvis_volgi_sh_clamped_cosine along the six axes), and for the
  * normalised transfer all six cone fluxes of j recomputed for every (i, o). Same arguments,
@@ -4857,7 +4857,7 @@ HFVIS_API hfvis_status hfvis_volgi_propagate(const hfvis_volgi_geometry *geometr
                                              float *prop, float *accum,
                                              hfvis_volgi_energy *energy);
 
-/* Final gather ([G12] §5.5.3, eqs. 12-15, spec §2.6) at a surface point with unit normal n
+/* Final gather ([G12] §5.5.3, eqs. 12-15, [G12] ch. 5, eq. 12-15; docs/errata.md E60) at a surface point with unit normal n
  * (normalised here): with g = (p - origin)/cell - 1/2, b = floor(g), f = g - b, the trilinear
  * weights of the 8 voxels b + {0,1}^3 are applied to accum over those inside the grid with
  * occupancy > 0 only ("from the eight closest grid points only the ones corresponding to occupied
@@ -4875,7 +4875,7 @@ HFVIS_API hfvis_status hfvis_volgi_propagate(const hfvis_volgi_geometry *geometr
  * with CONE_NORMALIZED and HFVIS_VOLGI_PATHS_VOID: the transport is a diffusion over a few voxels,
  * good for relative, short-range effects (colour bleeding, contact light), not for absolute
  * radiometry. No occupied voxel among the 8:
- * E = 0. Outgoing indirect radiance is albedo E / pi (DESIGN §2).
+ * E = 0. Outgoing indirect radiance is albedo E / pi (hfvis.h, Conventions).
  * Returns HFVIS_OK, or HFVIS_ERR_INVALID_ARGUMENT for NULL, an invalid geometry (not re-checked
  * per value: O(1) call; the arrays are only read at the 8 voxels), a non-finite point, a zero or
  * non-finite normal, invalid options. Allocates nothing. */
@@ -4946,13 +4946,13 @@ HFVIS_API hfvis_status hfvis_volgi_direct_irradiance(const hfvis_volgi_scene *sc
 HFVIS_API hfvis_status hfvis_volgi_grid_fit(const hfvis_mesh *mesh, int resolution,
                                             hfvis_volume_grid *out);
 
-/* Voxelization with direct lighting ([G12] ch. 5 Alg. 4, spec §2.3): hfvis_voxelize_surface with
+/* Voxelization with direct lighting ([G12] ch. 5 Alg. 4, [G12] ch. 5, Alg. 4): hfvis_voxelize_surface with
  * HFVIS_AXES_ALL (the x, y and z slicing passes, pixel-centre rule) over scene->mesh, where each
  * fragment at position p on triangle t with normal n_t writes
  *   radiance = albedo_t E_direct(p, n_t)/pi + emission_t   (hfvis_volgi_direct_irradiance)
  * merged per channel with MAX over every fragment of the voxel (the thesis' MAX blend, also the
  * MAX merge of the three per-axis volumes), and the normal and albedo AVERAGED over the voxel's
- * fragments ([C], spec §2.9; the GPU's MAX merge of normals is biased). Outputs, each over the
+ * fragments ([C], docs/errata.md E59; the GPU's MAX merge of normals is biased). Outputs, each over the
  * grid's voxels in linear order, caller-owned, written entirely: occupancy (1 floats per voxel:
  * 1 where a fragment landed, else 0), normal (3: unit average, 0 where the fragments' normals
  * cancel or the voxel is empty), albedo (3; may be NULL), radiance (3). fragments (may be NULL)
@@ -4971,7 +4971,7 @@ HFVIS_API hfvis_status hfvis_volgi_voxelize(const hfvis_volgi_scene *scene,
 
 /* Per-pixel RGB outputs of hfvis_volgi_render, each 3 floats per pixel (pixel (x, y) at
  * 3*(y*width + x), row 0 at the top, hfvis_view), or NULL when not wanted; they must not overlap.
- * Outgoing radiance toward the camera (Lambertian, DESIGN §2); empty pixels get 0. */
+ * Outgoing radiance toward the camera (Lambertian, hfvis.h, Conventions); empty pixels get 0. */
 typedef struct hfvis_volgi_outputs {
     float *direct;    /* emission + albedo E_direct / pi (with shadow rays per pixel) */
     float *indirect;  /* albedo E_indirect / pi (hfvis_volgi_gather) */
@@ -5020,33 +5020,32 @@ HFVIS_API hfvis_status hfvis_volgi_render(const hfvis_volgi_scene *scene,
 /* ssao.c - Laine-Karras bitmask ray-cast AO (declared here: it uses the meshes, views, BVH)    */
 /* ========================================================================================== */
 
-/* S. Laine, T. Karras, "Two Methods for Fast Ray-Cast Ambient Occlusion", EGSR 2010 ([LK]);
- * spec raycast-ao-and-hf-gi.md part A. All N shadow rays of one receiver are resolved together as
+/* S. Laine, T. Karras, "Two Methods for Fast Ray-Cast Ambient Occlusion", EGSR 2010 ([LK]); errata:
+ * docs/errata.md E39-E46. All N shadow rays of one receiver are resolved together as
  * an N-bit occlusion mask: ray i -> word i/32, bit i%32 (mask words = ceil(N/32), unused bits 0).
  * Three ways of filling the masks, which give IDENTICAL masks for identical ray sets (exact
  * mode, below):
  *   Method 1, hfvis_lk_raster   - per triangle, the receivers of a camera's G-buffer that its
- *                                 region of influence covers ([LK] §4, spec A.6-A.8);
+ *                                 region of influence covers ([LK] §4);
  *   Method 2, hfvis_lk_bvh      - per receiver (any points), a BVH traversal with conservative
- *                                 node masks ([LK] §5, spec A.9);
+ *                                 node masks ([LK] §5);
  *   reference, hfvis_lk_raycast - every ray of every receiver cast through the same BVH with an
- *                                 any-hit query (spec A.10).
+ *                                 any-hit query ([LK] §6).
  *
- * Obscurance (DESIGN §2): W = popcount(mask)/N in [0, 1], 0 = nothing blocks ([LK] Eq. 3). The
+ * Obscurance (hfvis.h, Conventions): W = popcount(mask)/N in [0, 1], 0 = nothing blocks ([LK] Eq. 3). The
  * directions are cosine-distributed (Malley's lifting of disc points), so W estimates
  * (1/pi) Int rho(D(p, w)) (n.w) dw ([LK] Eq. 1) with the falloff rho folded into the ray
- * lengths (l_i = r rho^-1(xi_i), spec A.2): a ray is "blocked" when a triangle crosses the
+ * lengths (l_i = r rho^-1(xi_i), [LK] §3; docs/errata.md E44): a ray is "blocked" when a triangle crosses the
  * segment p -> p + l_i w_i. With the default constant falloff every ray has length r.
  *
- * The blocking predicate (spec A.4.1), evaluated in double and IDENTICALLY by all three methods
+ * The blocking predicate ([LK] §3.1, Fig. 1), evaluated in double and IDENTICALLY by all three methods
  * (they share one routine; this is what makes the masks equal bit for bit). For a receiver at p
  * with the orthonormal frame F (rows x', y', z'; z' = the jittered normal) and a triangle
  * v0, v1, v2 (floats): a = F (v0 - p), b = F (v1 - p), c = F (v2 - p) (each row dotted with the
  * double difference, x + y + z in that order); n = (b - a) x (c - a), nh = n/|n|; h = nh.a.
  *   - the triangle is skipped (never blocks) when its WORLD cross product (v1 - v0) x (v2 - v0),
  *     evaluated in double, is exactly 0 (zero area), when n is 0, or when |h| < epsilon (the
- *     receiver lies in the triangle's plane: its own triangle and coplanar neighbours, spec
- *     A.13-7);
+ *     receiver lies in the triangle's plane: its own triangle and coplanar neighbours, [LK] §4.2);
  *   - one-sided triangles block only receivers on their front side: h < 0, i.e.
  *     nh.(p - v0) > 0 (the side the normal (v1 - v0) x (v2 - v0) points to);
  *   - d = |h|; with the triangle's distance window [r_min, r_max] (LOD, default [0, r]) the
@@ -5057,13 +5056,13 @@ HFVIS_API hfvis_status hfvis_volgi_render(const hfvis_volgi_scene *scene,
  *       and not (r_min > 0 and d < r_min and m.s_i > d/r_min),
  *     i.e. the segment of length l_i r_max/r reaches the plane inside the triangle (edges and
  *     the far end included: the hit distance t = l_i d/(r m.s_i) satisfies
- *     r_min l_i/r <= t <= r_max l_i/r, spec A.4.3).
- * Every culling test (spec A.5) only skips work: it is applied only where it implies that the
+ *     r_min l_i/r <= t <= r_max l_i/r, [LK] §4.3; docs/errata.md E42).
+ * Every culling test ([LK] §4.2, §5) only skips work: it is applied only where it implies that the
  * predicate is false for every ray, with margins far above the rounding of the predicate, so
  * switching tests on or off never changes a mask (tested exactly). The paper's literal "far
- * depth" test is the one exception (HFVIS_LK_CULL_PAPER_FAR_DEPTH, off by default; spec A.13-1).
+ * depth" test is the one exception (HFVIS_LK_CULL_PAPER_FAR_DEPTH, off by default; docs/errata.md E39).
  *
- * LUT mode (spec A.4.2) replaces the per-ray dot products by 4 (5 with a window) look-ups in a
+ * LUT mode ([LK] §3.1; docs/errata.md E40) replaces the per-ray dot products by 4 (5 with a window) look-ups in a
  * T^3 table of plane masks: faster for large N, but quantised - masks then differ from the
  * exact ones for rays within about one table node of a plane (the paper's faint systematic
  * errors), and the three-way identity holds only in exact mode.
@@ -5101,7 +5100,7 @@ HFVIS_API hfvis_status hfvis_volgi_render(const hfvis_volgi_scene *scene,
 #define HFVIS_LK_DEFAULT_ALPHA 0.2              /* prism if R_T/r_max > alpha ([LK] §4.1) */
 #define HFVIS_LK_DEFAULT_TILT 0.05              /* default normal-tilt jitter bound, radians */
 
-/* ---- ray sets (spec A.2) ------------------------------------------------------------------ */
+/* ---- ray sets ([LK] §3; docs/errata.md E44) ------------------------------------------------------------------ */
 
 /* How the N disc points are placed before they are lifted to the hemisphere. The default is
  * the torus pattern: the disc pattern of [LK] §6 under-samples grazing directions, which biases
@@ -5119,7 +5118,7 @@ typedef enum hfvis_lk_pattern {
                                      point replaced by a uniform random point of its Voronoi
                                      cell (rejection sampling, 64 attempts, else it stays),
                                      final_iterations more steps (cells estimated from the
-                                     centres of a density_resolution^2 grid, spec A.2). On the
+                                     centres of a density_resolution^2 grid, [LK] §3; docs/errata.md E44). On the
                                      disc the Lloyd centroids of the rim cells lie inward, so
                                      the outermost ring of points stays about half a cell inside
                                      the rim and grazing directions are under-sampled (N = 1024:
@@ -5136,7 +5135,7 @@ typedef enum hfvis_lk_pattern {
 /* The falloff rho(x) of the normalised occluder distance x = D/r, non-increasing, rho = 0 from
  * x = 1 on. The ray lengths realise it: l_i/r = sup{x in [0, 1] : rho(x) >= xi_i} with the
  * stratified xi_i = (pi(i) + 1/2)/N, pi a seeded random permutation (uncorrelated with the
- * directions), so P(l >= D) = rho(D) ([LK] Eq. 3, spec A.1). */
+ * directions), so P(l >= D) = rho(D) ([LK] Eq. 3, [LK] §3, Eq. 1-3). */
 typedef enum hfvis_lk_falloff {
     HFVIS_LK_FALLOFF_DEFAULT = 0,   /* = CONSTANT */
     HFVIS_LK_FALLOFF_CONSTANT = 1,  /* rho = 1 on [0, 1): every l_i = r (the paper's tests) */
@@ -5217,7 +5216,7 @@ HFVIS_API int hfvis_lk_mask_words(int count);
 /* Obscurance of one mask: popcount(mask)/count in [0, 1] (NaN for NULL or a bad count). */
 HFVIS_API double hfvis_lk_obscurance(const uint32_t *mask, int count);
 
-/* ---- receiver frame and jitter (spec A.3) ------------------------------------------------- */
+/* ---- receiver frame and jitter ([LK] §3; docs/errata.md E45) ------------------------------------------------- */
 
 /* Jitter of the receiver frame ([LK] §3: against banding on flat areas). */
 typedef enum hfvis_lk_jitter {
@@ -5228,7 +5227,7 @@ typedef enum hfvis_lk_jitter {
 } hfvis_lk_jitter;
 
 /* The receiver frame F (rows x', y', z', row-major double[9], orthonormal up to rounding) of a
- * normal n (need not be unit) and a jitter key, spec A.3: (xi1, xi2, xi3) = SplitMix64 of
+ * normal n (need not be unit) and a jitter key, [LK] §3; docs/errata.md E45: (xi1, xi2, xi3) = SplitMix64 of
  * seed and key; t1, t2 = the branchless orthonormal basis of T. Duff et al. 2017 ("Building an
  * Orthonormal Basis, Revisited"); delta = min(tilt_max, 0.9 min_elevation);
  * n' = cos(delta xi1) n + sin(delta xi1)(cos(2 pi xi2) t1 + sin(2 pi xi2) t2), normalised;
@@ -5242,9 +5241,9 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_lk_frame(const hfvis_lk_rays *ra
                                                          double rotation_max_rad, double tilt_max_rad,
                                                          double frame[9]);
 
-/* ---- occlusion masks and the plane look-up table (spec A.4) ------------------------------- */
+/* ---- occlusion masks and the plane look-up table ([LK] §3.1, Fig. 1) ------------------------------- */
 
-/* The 3-D plane look-up table ([LK] §3.1) with the node convention of spec A.4.2: node
+/* The 3-D plane look-up table ([LK] §3.1) with the node convention of docs/errata.md E40: node
  * k = (kx, ky, kz) in 0..T-1 stands for q = -1 + 2k/(T - 1); s = max|q_j|; nodes with s < 1/8
  * are 0 (unused core); otherwise the plane m = q/|q|, delta = (1 - s) 8/7 (= d/r) and bit i is
  * (m.s_i > delta). Masks at masks[((kz*T + ky)*T + kx)*words]. `directions` is the same table
@@ -5275,7 +5274,7 @@ HFVIS_API hfvis_status hfvis_lk_lut_build(const hfvis_lk_rays *rays, int resolut
 /* Release the tables (allocator they were built with) and zero *lut. NULL allowed. */
 HFVIS_API void hfvis_lk_lut_free(const hfvis_allocator *alloc, hfvis_lk_lut *lut);
 
-/* Node of a plane (m, d/r) (spec A.4.2 LUT_FETCH): delta = d_over_r clamped to [0, 1];
+/* Node of a plane (m, d/r) ([LK] §3.1; docs/errata.md E40 LUT_FETCH): delta = d_over_r clamped to [0, 1];
  * q = m (1 - 7 delta/8)/max_j |m_j|; k_j = clamp(floor((q_j + 1)(T - 1)/2 + 1/2), 0, T - 1).
  * Returns HFVIS_ERR_INVALID_ARGUMENT for NULL, a resolution out of range, m zero or not finite,
  * a non-finite d_over_r. */
@@ -5302,7 +5301,7 @@ typedef enum hfvis_lk_verdict {
 } hfvis_lk_verdict;
 
 /* The exact occlusion mask of one triangle for one receiver (the blocking predicate above;
- * lut != NULL: the LUT form (spec A.4.2/A.4.3): edges lut(e_k/|e_k|, 0), plane lut(m, d/r_max),
+ * lut != NULL: the LUT form ([LK] §3.1, §4.3): edges lut(e_k/|e_k|, 0), plane lut(m, d/r_max),
  * window ~lut(m, d/r_min)). position = p (world, double), frame = F (hfvis_lk_frame); the
  * distance window [r_min, r_max] with 0 <= r_min <= r_max <= radius; epsilon > 0 (world units,
  * e.g. HFVIS_LK_DEFAULT_EPSILON * radius). mask (words words) is written in every case (all 0
@@ -5318,7 +5317,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_lk_triangle_mask(const hfvis_lk_
 
 /* ---- the three methods ------------------------------------------------------------------ */
 
-/* Culling tests (spec A.5), bit flags of hfvis_lk_options.cull. They only skip work (see the
+/* Culling tests ([LK] §4.2, §5), bit flags of hfvis_lk_options.cull. They only skip work (see the
  * predicate above), except PAPER_FAR_DEPTH. */
 #define HFVIS_LK_CULL_FAR_DEPTH 0x01u       /* Method 1 test 1, safe form: skip when every vertex's
                                                linear view depth exceeds the receiver's by more
@@ -5331,7 +5330,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_lk_triangle_mask(const hfvis_lk_
 #define HFVIS_LK_CULL_PAPER_FAR_DEPTH 0x20u /* Method 1 test 1 as [LK] §4.2 states it: skip when
                                                the rasterized far-side depth of the influence
                                                volume exceeds the receiver's depth + r_max. NOT
-                                               conservative (spec A.13-1): behind a grazing
+                                               conservative (docs/errata.md E39): behind a grazing
                                                prism or a billboard it drops real occluders */
 #define HFVIS_LK_CULL_SET 0x100u            /* marks an explicit set: cull = HFVIS_LK_CULL_SET |
                                                flags; HFVIS_LK_CULL_SET alone = no test */
@@ -5345,7 +5344,7 @@ typedef enum hfvis_lk_mask_mode {
     HFVIS_LK_MASK_LUT = 2      /* table look-ups (opts->lut required); approximate */
 } hfvis_lk_mask_mode;
 
-/* Method 2's node occlusion masks (spec A.9.3), from the node box's bounding sphere (box centre,
+/* Method 2's node occlusion masks ([LK] §5, Fig. 4; docs/errata.md E41), from the node box's bounding sphere (box centre,
  * half-diagonal). */
 typedef enum hfvis_lk_node_mask {
     HFVIS_LK_NODE_DEFAULT = 0,    /* = EXACT */
@@ -5365,7 +5364,7 @@ typedef enum hfvis_lk_sides {
     HFVIS_LK_SIDES_PER_TRIANGLE = 3 /* two_sided[t] != 0 marks triangle t two-sided */
 } hfvis_lk_sides;
 
-/* Method 1's bounding volume of a triangle's region of influence ([LK] §4.1, spec A.6). */
+/* Method 1's bounding volume of a triangle's region of influence ([LK] §4.1, [LK] §4.1, Fig. 2-3). */
 typedef enum hfvis_lk_volume {
     HFVIS_LK_VOLUME_DEFAULT = 0, /* = AUTO */
     HFVIS_LK_VOLUME_AUTO = 1,    /* prism if R_T/r_max > alpha, else the sphere billboard */
@@ -5465,7 +5464,7 @@ HFVIS_API hfvis_status hfvis_lk_gbuffer_receivers(const hfvis_mesh *mesh, const 
                                                   const hfvis_lk_options *opts, double *position,
                                                   double *normal, uint64_t *key, size_t *count);
 
-/* Method 1 (rasterization, [LK] §4, spec A.6-A.8) on the CPU. The receivers are those of
+/* Method 1 (rasterization, [LK] §4) on the CPU. The receivers are those of
  * hfvis_lk_gbuffer_receivers (frames by hfvis_lk_frame with opts' jitter and key = pixel
  * index). Per triangle, in index order: the minimal bounding sphere (c_T, R_T); the volume
  * bounding its region of influence with radius r_max: the hexagonal prism in half-space form
@@ -5483,7 +5482,7 @@ HFVIS_API hfvis_status hfvis_lk_gbuffer_receivers(const hfvis_mesh *mesh, const 
  * for width or height > HFVIS_RASTER_MAX_SIZE (and the rasterizer's limits, or a size that
  * overflows size_t on 32-bit builds); HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on error.
  * Receivers: only pixels whose triangle the G-buffer shows (background pixels have none,
- * spec A.13-11); the receiver normal faces the viewer, so the hemisphere is on the visible
+ * [LK] §4); the receiver normal faces the viewer, so the hemisphere is on the visible
  * side (back faces seen through an open mesh receive on their visible side too).
  * Memory: 3 blocks: the G-buffer (12 bytes per pixel), the rasterizer's scratch, and one block
  * of 4 bytes per pixel plus 104 bytes per receiver (plus its masks when masks is NULL).
@@ -5492,7 +5491,7 @@ HFVIS_API hfvis_status hfvis_lk_raster(const hfvis_mesh *mesh, const hfvis_view 
                                        const hfvis_lk_rays *rays, const hfvis_lk_options *opts,
                                        uint32_t *masks, float *obscurance, hfvis_lk_stats *stats);
 
-/* Method 2 (BVH traversal, [LK] §5, spec A.9) for explicit receivers. Per receiver: cumulative
+/* Method 2 (BVH traversal, [LK] §5) for explicit receivers. Per receiver: cumulative
  * mask C = 0; a node (the root too) is culled when its padded box lies farther than r from p,
  * entirely below the horizon (every corner's local z <= 0), or its node mask adds no ray
  * (popcount(M & ~C) = 0); surviving children are visited larger estimate first; leaf triangles
@@ -5511,7 +5510,7 @@ HFVIS_API hfvis_status hfvis_lk_bvh(const hfvis_mesh *mesh, const hfvis_bvh *bvh
                                     const hfvis_lk_options *opts, uint32_t *masks,
                                     float *obscurance, hfvis_lk_stats *stats);
 
-/* The reference ray caster (spec A.10): every ray i of every receiver, the segment
+/* The reference ray caster ([LK] §6): every ray i of every receiver, the segment
  * p + t r F^T s_i, t in [0, 1], cast through the BVH (slab tests in double on the padded boxes,
  * widened by 2^-40) with an any-hit query; the ray-triangle test is opts->raycast_test (EXACT:
  * the blocking predicate, so the masks equal Methods 1 and 2 bit for bit; WATERTIGHT: the

@@ -3,30 +3,30 @@
  * Contents
  *   1. Common: allocation, checked sizes, the hash PRNG
  *   2. Camera, hardware depth linearisation, view-space reconstruction, normals from depth
- *      (spec screenspace-p3-p4 §2.1)
- *   3. Falloff functions ([P3] Eq. 2-3; spec §1.1)
+ *      ([P4] §3; docs/errata.md C7)
+ *   3. Falloff functions ([P3] Eq. 2-3; docs/errata.md C4)
  *   4. The azimuthal line plane, uniform and box-pattern directions, the line lattice
- *      ([P3] §5.1-5.2, [P4] §6; spec §2.2-2.3, §3.5)
+ *      ([P3] §5.1-5.2, [P4] §6; [P3] §5.1, [P4] §6; docs/errata.md E20, E21; docs/errata.md E24)
  *   5. P3 line-sweep AO: the obscurity hull along one line ([P3] §4, Alg. 1) and its brute-force
- *      oracle (spec §4.2), the sweep of one direction, the per-pixel gather ([P3] §5.1), the
- *      driver (spec §3)
- *   6. HBAO in three variants (Bavoil, Sainz, Dimitrov 2008, as the thesis describes it; spec §4.1)
- *   7. The screen-space ray-traced reference ([P4] §8; spec §5.11)
- *   8. Analytic depth buffers (spec §6 T1-T7)
+ *      oracle ([P3] Fig. 7), the sweep of one direction, the per-pixel gather ([P3] §5.1), the
+ *      driver ([P3] §4-5)
+ *   6. HBAO in three variants (Bavoil, Sainz, Dimitrov 2008, as the thesis describes it; [T14] §4.1, [P4] §8; docs/errata.md E25)
+ *   7. The screen-space ray-traced reference ([P4] §8; docs/errata.md E36)
+ *   8. Analytic depth buffers
  *   9. P4 far-field obscurance: scan kernel (Alg. 1, sign corrected), virtual points, level
  *      hierarchy, prefix sums and sector averaging, obscurity kernel (Alg. 2), slab estimator
  *      (quadrature, L(a,b,c,d) table, closed form for rho = 1), near field, sparse 3x3, blur
- *      ([P4] §3-7; spec §5.1-5.9)
- *  10. The mipmap baseline ([P4] §5; spec §5.10)
- *  11. Error metrics ([P4] §8; spec §5.12)
+ *      ([P4] §3-7; [P4] §3-11)
+ *  10. The mipmap baseline ([P4] §5)
+ *  11. Error metrics ([P4] §8; docs/errata.md E36)
  *  12. Laine-Karras bitmask ray-cast AO: ray sets, receiver frames, exact and table triangle
  *      masks, culling, Method 1 (rasterization), Method 2 (BVH traversal with exact node masks),
- *      the reference ray caster ([LK] EGSR 2010; spec raycast-ao-and-hf-gi part A)
+ *      the reference ray caster ([LK] EGSR 2010)
  *
  * Paper references: [P3] V. Timonen, "Line-Sweep Ambient Obscurance", EGSR 2013; [P4]
  * V. Timonen, "Screen-Space Far-Field Ambient Obscurance", HPG 2013 (both in Timonen's 2014
- * thesis). "spec" is the project's restatement spec/screenspace-p3-p4.md, which fixes the
- * papers' errata and marks each open choice.
+ * thesis). Errata and choices: docs/errata.md
+ * E19-E38.
  */
 #include "hfvis.h"
 
@@ -129,7 +129,7 @@ static double ss_hash01(uint32_t a, uint32_t b, uint32_t c, uint32_t seed)
 }
 
 /* ========================================================================================== */
-/* 2. Camera, depth, view-space reconstruction, normals (spec §2.1)                           */
+/* 2. Camera, depth, view-space reconstruction, normals ([P4] §3; docs/errata.md C7)          */
 /* ========================================================================================== */
 
 /* The validated camera in the form the inner loops use. */
@@ -679,7 +679,7 @@ hfvis_status hfvis_depth_normals(const hfvis_camera *cam, const float *depth, fl
 }
 
 /* ========================================================================================== */
-/* 3. Falloff ([P3] Eq. 2-3; spec §1.1)                                                       */
+/* 3. Falloff ([P3] Eq. 2-3; docs/errata.md C4)                                               */
 /* ========================================================================================== */
 
 /* The falloff in the form the inner loops use. */
@@ -799,10 +799,10 @@ double hfvis_falloff_support(const hfvis_falloff *f)
 }
 
 /* ========================================================================================== */
-/* 4. Line plane, directions, lattice ([P3] §5.1-5.2, [P4] §6; spec §2.2-2.3, §3.5)           */
+/* 4. Line plane, directions, lattice ([P3] §5.1-5.2, [P4] §6; [P3] §5.1, [P4] §6; docs/errata.md E20, E21; docs/errata.md E24) */
 /* ========================================================================================== */
 
-/* e1 of screen direction (du, dv) (spec §2.2; unit, z = 0). */
+/* e1 of screen direction (du, dv) (docs/errata.md E20, E21; unit, z = 0). */
 static void ss_plane_e1(const ss_cam *c, double du, double dv, double e1[3])
 {
     if (c->persp) {
@@ -1080,7 +1080,7 @@ hfvis_status hfvis_ssao_lattice_lines(const hfvis_camera *cam, const hfvis_ssao_
     return HFVIS_OK;
 }
 
-/* Nearest sample (spec §2.3); 1 if found. */
+/* Nearest sample ([P3] §5.1, [P4] §6); 1 if found. */
 static int ss_nearest(const hfvis_ssao_lattice *L, const hfvis_ssao_line *lines, double u,
                       double v, int *jo, int *io)
 {
@@ -1123,14 +1123,14 @@ int hfvis_ssao_lattice_nearest(const hfvis_ssao_lattice *lat, const hfvis_ssao_l
 }
 
 /* ========================================================================================== */
-/* 5. P3 line-sweep ambient obscurance ([P3] §4-5, Alg. 1; spec §3)                           */
+/* 5. P3 line-sweep ambient obscurance ([P3] §4-5, Alg. 1)                                    */
 /* ========================================================================================== */
 
 #define SS_LSAO_DEFAULT_K 16
 #define SS_DEFAULT_SIN_T (-0.85)   /* [P3] §4.1: "fix all tangents to sin(t) = -0.85" */
-#define SS_DEFAULT_REJECT_DEPTH 0.03 /* spec §3.6 [R], from P4's box filter */
+#define SS_DEFAULT_REJECT_DEPTH 0.03 /* docs/errata.md E23, from P4's box filter */
 #define SS_DEFAULT_REJECT_NORMAL 0.5
-#define SS_COINCIDENT 1e-12        /* |h| <= 1e-12 |p|: the same point (spec §3.9 item 3) */
+#define SS_COINCIDENT 1e-12        /* |h| <= 1e-12 |p|: the same point (docs/errata.md E27) */
 
 /* Resolved LSAO/HBAO parameters in the form the loops use. */
 typedef struct ss_cfg {
@@ -1327,7 +1327,7 @@ static double ss_occ(const ss_fall *f, double hx, double hy, double ux, double u
     return s > st ? st + (s - st) * ss_rho(f, len) : st;
 }
 
-/* The obscurity hull along one line ([P3] Alg. 1, spec §3.3). */
+/* The obscurity hull along one line ([P3] Alg. 1, [P3] §4.2, Alg. 1). */
 static void ss_hull_line(const double *x, const double *y, const double *stc, const double *ste,
                          int n, int persp, double fixed, const ss_fall *f, int ties, int *stack,
                          double *out)
@@ -1370,7 +1370,7 @@ static void ss_hull_line(const double *x, const double *y, const double *stc, co
             }
         }
         if (top == 0) {
-            out[i] = se; /* no occluder yet: rho = 0 (spec §3.9 item 1) */
+            out[i] = se; /* no occluder yet: rho = 0 (docs/errata.md E27) */
         } else if (se == sc) {
             out[i] = o1; /* l.20 */
         } else {
@@ -1382,7 +1382,7 @@ static void ss_hull_line(const double *x, const double *y, const double *stc, co
     }
 }
 
-/* Brute-force oracle (spec §4.2). */
+/* Brute-force oracle ([P3] Fig. 7). */
 static void ss_hull_line_naive(const double *x, const double *y, const double *stc,
                                const double *ste, int n, int persp, double fixed,
                                const ss_fall *f, double *out)
@@ -1524,7 +1524,7 @@ static int ss_texel(double p, int n)
     return (int)f;
 }
 
-/* sin t of the real tangent of a sample ([P3] §4.1, spec §3.4): normal of texel (tx, ty)
+/* sin t of the real tangent of a sample ([P3] §4.1, [P3] §4.1, Fig. 7): normal of texel (tx, ty)
  * projected into the plane, t = side*(-n2.y, n2.x) (side +1: toward the occluders behind, as
  * LSAO; -1: ahead, as HBAO), sin t = t.u/|t|; the fixed value without a usable normal. */
 static double ss_real_sin_t(const ss_cam *c, const float *normals, int tx, int ty,
@@ -1755,7 +1755,7 @@ static int ss_accept(const ss_cam *c, const ss_cfg *g, const float *normals,
     return 1;
 }
 
-/* The nearest accepted sample within radius R2 (squared) of (u, v) (spec §3.6 fallback). */
+/* The nearest accepted sample within radius R2 (squared) of (u, v) (docs/errata.md E23). */
 static int ss_fallback(const ss_cam *c, const ss_cfg *g, const float *normals,
                        const hfvis_ssao_lattice *L, const hfvis_ssao_line *lines,
                        const float *values, const float *sdepth, double u, double v, double zc,
@@ -1963,7 +1963,7 @@ done:
 }
 
 /* ========================================================================================== */
-/* 6. HBAO (Bavoil, Sainz, Dimitrov 2008; thesis l.466, [P4] l.1988; spec §4.1)               */
+/* 6. HBAO (Bavoil, Sainz, Dimitrov 2008; [T14] §4.1, [P4] §8, Fig. 8; docs/errata.md E25)      */
 /* ========================================================================================== */
 
 #define SS_HBAO_DEFAULT_K 16 /* as LSAO: no paper asks HBAO for fewer */
@@ -2037,7 +2037,7 @@ static double ss_hbao_default_radius_px(const ss_cam *c)
     return r > 8.0 ? r : 8.0;
 }
 
-/* One HBAO pixel (spec §4.1 HbaoPixel). dirs: the custom directions or NULL; the result is
+/* One HBAO pixel ([T14] §4.1, [P4] §8; docs/errata.md E25). dirs: the custom directions or NULL; the result is
  * divided by the weight sum, which normalises custom weights. */
 static double ss_hbao_pixel(const ss_cam *c, const hfvis_hbao_options *o, const ss_fall *f,
                             const hfvis_ssao_direction *dirs, const float *depth,
@@ -2182,7 +2182,7 @@ hfvis_status hfvis_hbao(const hfvis_camera *cam, const float *depth, const float
 }
 
 /* ========================================================================================== */
-/* 7. The screen-space ray-traced reference ([P4] §8; spec §5.11)                             */
+/* 7. The screen-space ray-traced reference ([P4] §8; docs/errata.md E36)                     */
 /* ========================================================================================== */
 
 #define SS_RT_DEFAULT_RAYS 256
@@ -2308,7 +2308,7 @@ static int ss_rt_in(const ss_rt *t, double d, double zb)
     return t->o->thickness > 0.0 ? d < zb + t->o->thickness : 1;
 }
 
-/* Distance to the first hit of the ray O + s w (spec §5.11), or -1 for a miss. The ray is
+/* Distance to the first hit of the ray O + s w ([P4] §8; docs/errata.md E36), or -1 for a miss. The ray is
  * traversed cell by cell in screen space (a DDA whose cell boundaries are solved exactly in s):
  * texels under NEAREST, where the depth along the ray is linear and the field constant, so the
  * first inside point is exact; the cells between texel centres under BILINEAR, where each cell
@@ -2505,7 +2505,7 @@ hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth, co
 }
 
 /* ========================================================================================== */
-/* 8. Analytic depth buffers (spec §6 T1-T7)                                                  */
+/* 8. Analytic depth buffers                                                  */
 /* ========================================================================================== */
 
 static int ss_scene_ok(const hfvis_ssao_scene *s)
@@ -2657,20 +2657,20 @@ hfvis_status hfvis_ssao_scene_render(const hfvis_camera *cam, const hfvis_ssao_s
 
 /* ========================================================================================== */
 /* 9. P4 far-field ambient obscurance ([P4] Timonen, "Screen-Space Far-Field Ambient          */
-/*    Obscurance", HPG 2013; spec screenspace-p3-p4 §5): the slab estimator L(a, b, c, d)     */
+/*    Obscurance", HPG 2013; [P4]): the slab estimator L(a, b, c, d)                          */
 /*    ([P4] Eq. 2-3) by quadrature, table and the closed form for rho = 1, the scan kernel    */
-/*    ([P4] Alg. 1 with the sign correction of spec §5.3), virtual points (§5.4), the          */
+/*    ([P4] Alg. 1 with the sign correction of docs/errata.md E29, E30), virtual points (§5.4), the */
 /*    resolution hierarchy (§5.5), prefix sums and sector averaging (§5.6), the obscurity     */
-/*    kernel ([P4] Alg. 2, spec §5.7), the near field (§5.8), jitter, sparse 3x3 evaluation    */
-/*    and the bilateral blur (§5.9); 10. the mipmap baseline ([P4] §5, spec §5.10);            */
-/*    11. error metrics ([P4] §8, spec §5.12).                                                 */
+/*    kernel ([P4] Alg. 2), the near field (§5.8), jitter, sparse 3x3 evaluation               */
+/*    and the bilateral blur (§5.9); 10. the mipmap baseline ([P4] §5);                        */
+/*    11. error metrics ([P4] §8, docs/errata.md E36).                                         */
 /* ========================================================================================== */
 
 #define SSB_MAX_LEVELS 24
 #define SSB_MAX_NODES 64
 #define SSB_TABLE_MAX 4096
 
-/* ---- 9.1 the slab integral L (spec §5.2) ------------------------------------------------- */
+/* ---- 9.1 the slab integral L ([P4] §4, Eq. 2-3) ------------------------------------------------- */
 
 /* Gauss-Legendre nodes and weights on [-1, 1] (Newton on P_n; n <= SSB_MAX_NODES). */
 static void ssb_gauss(int n, double *x, double *w)
@@ -2706,12 +2706,12 @@ static void ssb_range(double c, double d, double *lo0, double *hi0)
     *hi0 = hi;
 }
 
-/* Antiderivative of sin(t) cos(t - d) (spec §5.2: F = t sin d / 2 - cos(2t - d) / 4). */
+/* Antiderivative of sin(t) cos(t - d) ([P4] §4, Eq. 2-3: F = t sin d / 2 - cos(2t - d) / 4). */
 static double ssb_F(double t, double d) { return 0.5 * t * sin(d) - 0.25 * cos(2.0 * t - d); }
 
 /* Integral of rho(b / sin(c - t)) cos(t - d) sin t over [A, B] (already clipped), by
  * Gauss-Legendre with n nodes (x, w on [-1, 1]). One sine and one cosine per node: sin(c - t) and
- * cos(t - d) come from sin t, cos t by the angle-addition formulas (spec §5.2 L). */
+ * cos(t - d) come from sin t, cos t by the angle-addition formulas ([P4] Eq. 3; docs/errata.md E33). */
 static double ssb_quad(const ss_fall *f, double A, double B, double b, double c, double d, int n,
                        const double *x, const double *w)
 {
@@ -2754,7 +2754,7 @@ double hfvis_ffao_slab_integral(const hfvis_falloff *falloff, double a, double t
     return ssb_quad(&f, lo, hi, b, c, d, nodes, x, w);
 }
 
-/* ---- 9.2 the tabulated L (spec §5.2 Table L [R]) ------------------------------------------ */
+/* ---- 9.2 the tabulated L (docs/errata.md E33) ------------------------------------------ */
 
 
 hfvis_status hfvis_ffao_table_build(const hfvis_falloff *falloff, int na, int nb, int nc, int nd,
@@ -2874,12 +2874,12 @@ double hfvis_ffao_table_lookup(const hfvis_ffao_table *t, double a, double b, do
     return ssb_lookup(t, a, b, c, d);
 }
 
-/* ---- 9.3 virtual points, sector weights, the slice estimator (spec §5.2, §5.4) ------------- */
+/* ---- 9.3 virtual points, sector weights, the slice estimator ([P4] §4, Eq. 2-3; [P4] §6) ------------- */
 
 void hfvis_ffao_virtual_point(double m0, double m1, double slope, double zscale, double h[2])
 {
     if (!h) return;
-    h[0] = (m0 - m1) / slope; /* spec §5.3: m1 = max(y - s x), so x_h = (m0 - m1)/s */
+    h[0] = (m0 - m1) / slope; /* [P4] Alg. 1; docs/errata.md E29, E30: m1 = max(y - s x), so x_h = (m0 - m1)/s */
     h[1] = m0 * zscale;
 }
 
@@ -2889,7 +2889,7 @@ static void ssb_e1_phi(const ss_cam *c, double phi, double e[3])
     ss_plane_e1(c, cos(phi), sin(phi), e);
 }
 
-/* Angle around the zenith between boundary vectors ea, eb (spec §5.2 [D]): both projected onto
+/* Angle around the zenith between boundary vectors ea, eb ([P4] §4, Eq. 2-3; docs/errata.md E32): both projected onto
  * the plane perpendicular to v (unit view ray; orthographic +Z). */
 static double ssb_wedge(const double ea[3], const double eb[3], const double v[3])
 {
@@ -2922,7 +2922,7 @@ double hfvis_ffao_sector_weight(const hfvis_camera *cam, const double p[3], doub
     return ssb_wedge(ea, eb, v);
 }
 
-/* The receiver in its slice (spec §5.7): 2D position, zenith, the x axis toward +D, the
+/* The receiver in its slice ([P4] Alg. 2): 2D position, zenith, the x axis toward +D, the
  * projected normal's angle d and length. */
 typedef struct ssb_rx {
     double px, py, ux, uy, xx, xy, d, nlen;
@@ -2944,7 +2944,7 @@ static double ssb_theta(const ssb_rx *r, double wx, double wy)
     return atan2(wx * r->xx + wy * r->xy, wx * r->ux + wy * r->uy);
 }
 
-/* The running horizon theta_min of a slice (spec §5.2 [R]: zenith angles, visible iff
+/* The running horizon theta_min of a slice ([P4] Eq. 3; docs/errata.md E31, E33: zenith angles, visible iff
  * a < theta_min) with the L1 pseudo-angle of the same direction (monotone in the angle on
  * (-pi, pi]; NaN when unknown). The pseudo-angle only rejects points clearly below the horizon
  * before the atan2; everything within SSB_PSEUDO_MARGIN of it takes the exact test, so the
@@ -2976,7 +2976,7 @@ static ssb_hz ssb_hz_init(double th)
     return h;
 }
 
-/* The slab of point h (spec §5.2 SliceObscurance): adds nothing unless h is visible
+/* The slab of point h ([P4] Alg. 2; docs/errata.md E31): adds nothing unless h is visible
  * (a < theta_min, strict); returns the slab's integral and lowers the horizon to a. */
 static double ssb_slab(const ssb_est *e, const ssb_rx *r, double hx, double hy, ssb_hz *hz)
 {
@@ -3201,7 +3201,7 @@ static size_t ssb_dir_size(const ssb_ctx *x, ssb_dir *dd)
     return tot;
 }
 
-/* Scan kernel ([P4] Alg. 1, spec §5.3) + hierarchy (§5.5) + prefix sums (§5.6). */
+/* Scan kernel ([P4] Alg. 1, docs/errata.md E29, E30) + hierarchy (§5.5) + prefix sums (§5.6). */
 static void ssb_scan(const ssb_ctx *x, ssb_dir *dd, double *mem)
 {
     const ss_cam *c = &x->c;
@@ -3268,7 +3268,7 @@ static void ssb_scan(const ssb_ctx *x, ssb_dir *dd, double *mem)
         }
 }
 
-/* Near field (spec §5.8 [R]): direct samples at 1, 2, ... px along +D from the receiver up to
+/* Near field ([P4] §9; docs/errata.md E37): direct samples at 1, 2, ... px along +D from the receiver up to
  * (excluding) along-line distance `until`, through the slab estimator. */
 static double ssb_near(const ssb_ctx *x, const ssb_dir *dd, const ssb_rx *r, double cu, double cv,
                        double zs, double until, ssb_hz *thmin)
@@ -3286,7 +3286,7 @@ static double ssb_near(const ssb_ctx *x, const ssb_dir *dd, const ssb_rx *r, dou
     return acc;
 }
 
-/* One receiver, one scan direction (spec §5.7 FfaoPixel for sector k): returns in *near_sum
+/* One receiver, one scan direction ([P4] Alg. 2 for sector k): returns in *near_sum
  * and *far_sum the w-weighted integrals (w in radians around the zenith) of the near and far
  * fields, in *wsum the sector's weight. jit in [-1, 1]: the sector rotation of §5.9. */
 static void ssb_pixel_dir(const ssb_ctx *x, const ssb_dir *dd, double cu, double cv, double z,
@@ -3363,7 +3363,7 @@ static void ssb_pixel_dir(const ssb_ctx *x, const ssb_dir *dd, double cu, double
             if (!(cnt > 0.0)) continue;
             m0 = (row[3 * (lB + 1)] - row[3 * lA]) / cnt;
             m1 = (row[3 * (lB + 1) + 1] - row[3 * lA + 1]) / cnt;
-            hx = (m0 - m1) / x->o.receiver_slope; /* virtual point (spec §5.4) */
+            hx = (m0 - m1) / x->o.receiver_slope; /* virtual point ([P4] §6) */
             hy = m0 * zs;
             if (!r.ortho && !(hx * hx + hy * hy > 0.0)) continue;
             Ig += ssb_slab(&x->e, &r, hx, hy, &th);
@@ -3395,7 +3395,7 @@ static void ssb_normal(const ss_cam *c, const float *normals, int x, int y, doub
     }
 }
 
-/* Sparse mode box average (spec §5.9): mean depth and normal over the accepted 3x3 neighbours
+/* Sparse mode box average ([P4] §10, §11.1; docs/errata.md E38): mean depth and normal over the accepted 3x3 neighbours
  * (n_c . n_i > 0.5 and |z_i - z_c| < 3 % z_c); bit (dy+1)*3 + (dx+1) of *mask marks them. */
 static void ssb_box(const ss_cam *c, const float *depth, const float *normals, int x, int y,
                     double *zo, double no[3], unsigned *mask)
@@ -3583,7 +3583,7 @@ hfvis_status hfvis_ffao(const hfvis_camera *cam, const float *depth, const float
                 ao[(ptrdiff_t)py * ao_stride + px] = (float)(a > 0.0 ? (a < 1.0 ? a : 1.0) : 0.0);
             }
     } else {
-        /* gather (spec §5.9): near field + far field averaged over the accepted 3x3 pixels,
+        /* gather ([P4] §10, §11.1; docs/errata.md E38): near field + far field averaged over the accepted 3x3 pixels,
          * renormalised by the summed sector weights; then the optional 5x5 bilateral blur */
         float *tmp = (float *)(acc + npix); /* the far sums are consumed row by row below */
         double *res = acc;                  /* reuse: result per pixel overwrites the near sum */
@@ -3636,7 +3636,7 @@ done:
 }
 
 /* ========================================================================================== */
-/* 10. The mipmap baseline ([P4] §5, spec §5.10)                                               */
+/* 10. The mipmap baseline ([P4] §5)                                                           */
 /* ========================================================================================== */
 
 /* Pyramid level sizes: level l is ceil(W / 2^l) x ceil(H / 2^l); offsets into one block. */
@@ -3779,7 +3779,7 @@ hfvis_status hfvis_ssao_mipmap(const hfvis_camera *cam, const float *depth, cons
                 while (!last) {
                     double u, vv, lam, lf, zq, z2, Q[3];
                     int l0;
-                    if (dist >= tmax) { /* one extra sample at the buffer edge (spec §5.10) */
+                    if (dist >= tmax) { /* one extra sample at the buffer edge ([P4] §5) */
                         dist = tmax;
                         last = 1;
                         if (!(tmax > 0.0)) break;
@@ -3818,7 +3818,7 @@ done:
 }
 
 /* ========================================================================================== */
-/* 11. Error metrics ([P4] §8, spec §5.12)                                                     */
+/* 11. Error metrics ([P4] §8, docs/errata.md E36)                                             */
 /* ========================================================================================== */
 
 hfvis_status hfvis_ssao_error(const float *ao, ptrdiff_t ao_stride, const float *ref,
@@ -3871,20 +3871,20 @@ hfvis_status hfvis_ssao_error(const float *ao, ptrdiff_t ao_stride, const float 
 /* ========================================================================================== */
 /* 12. Laine-Karras bitmask ray-cast ambient occlusion                                         */
 /*    S. Laine, T. Karras, "Two Methods for Fast Ray-Cast Ambient Occlusion", EGSR 2010 ([LK]); */
-/*    spec raycast-ao-and-hf-gi.md part A (A.1-A.14), whose errata and choices are followed.  */
+/*    errata and choices: docs/errata.md E39-E46.                              */
 /* ========================================================================================== */
 /* Contents
  *   12.1 common: allocation, checked sizes, PCG32 / SplitMix64, popcount
  *   12.2 ray sets: Lloyd-relaxed disc with Voronoi jitter, Malley lifting, falloff lengths ([LK]
- *       §3, §6; spec A.2), Morton order and per-word cones
- *   12.3 the receiver frame with rotation and tilt jitter ([LK] §3; spec A.3)
- *   12.4 the blocking predicate and the exact triangle mask (spec A.4.1, window A.4.3), the plane
- *       look-up table with node indexing ([LK] §3.1; spec A.4.2)
+ *       §3, §6; [LK] §3; docs/errata.md E44), Morton order and per-word cones
+ *   12.3 the receiver frame with rotation and tilt jitter ([LK] §3; docs/errata.md E45)
+ *   12.4 the blocking predicate and the exact triangle mask ([LK] §3.1, Fig. 1; window [LK] §4.3), the plane
+ *       look-up table with node indexing ([LK] §3.1; docs/errata.md E40)
  *   12.5 per-triangle data: minimal bounding sphere (A.5), hexagonal prism (A.6, [LK] Fig. 2)
  *   12.6 options
- *   12.7 G-buffer receivers and Method 1, rasterization ([LK] §4; spec A.6-A.8)
- *   12.8 Method 2, BVH traversal with exact node masks ([LK] §5; spec A.9)
- *   12.9 the reference ray caster (spec A.10)
+ *   12.7 G-buffer receivers and Method 1, rasterization ([LK] §4)
+ *   12.8 Method 2, BVH traversal with exact node masks ([LK] §5)
+ *   12.9 the reference ray caster ([LK] §6)
  *   12.10 the image driver
  * Why the three methods agree bit for bit: they evaluate one predicate (lk_tri_setup +
  * lk_blocks) on the same doubles, and every test that skips work (word cones, culling tests,
@@ -4016,7 +4016,7 @@ static const float *lk_vertex(const hfvis_mesh *m, size_t t, int k)
     return m->xyz + 3 * (size_t)m->indices[3 * t + (size_t)k];
 }
 
-/* ---- 12.2 ray sets (spec A.2) ---------------------------------------------------------------- */
+/* ---- 12.2 ray sets ([LK] §3; docs/errata.md E44) ---------------------------------------------------------------- */
 
 HFVIS_API int hfvis_lk_mask_words(int count)
 {
@@ -4205,7 +4205,7 @@ static void lk_concentric(double a, double b, double *x, double *y)
     *y = r * sin(phi);
 }
 
-/* The Lloyd / Voronoi-jitter disc of spec A.2 DISC_SAMPLES, into xy (2n). torus != 0: the same
+/* The Lloyd / Voronoi-jitter disc of [LK] §3; docs/errata.md E44 DISC_SAMPLES, into xy (2n). torus != 0: the same
  * relaxation on the periodic square [-1, 1)^2 (no boundary, so no rim bias), then the concentric
  * map onto the disc. */
 static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *g,
@@ -4576,7 +4576,7 @@ static double lk_cone_min(const double *cone, const double n[3])
     return c * cone[3] - s * cone[4];
 }
 
-/* ---- 12.3 receiver frame (spec A.3) -------------------------------------------------------- */
+/* ---- 12.3 receiver frame ([LK] §3; docs/errata.md E45) -------------------------------------------------------- */
 
 /* Branchless orthonormal basis of the unit vector n: T. Duff, J. Burgess, P. Christensen et al.,
  * "Building an Orthonormal Basis, Revisited", JCGT 6(1), 2017, Listing 3. */
@@ -4672,7 +4672,7 @@ HFVIS_API hfvis_status hfvis_lk_frame(const hfvis_lk_rays *rays, const double no
 
 /* ---- 12.4 the blocking predicate, triangle masks, the plane look-up table -------------------- */
 
-/* One triangle prepared for one receiver (spec A.4.1 in the receiver's frame). The predicate of
+/* One triangle prepared for one receiver ([LK] §3.1, Fig. 1 in the receiver's frame). The predicate of
  * ray s is lk_blocks(t, s); dr = +infinity makes it false for every ray (skipped, facing away,
  * too far), so lk_blocks is the complete predicate whatever the verdict. */
 typedef struct lk_tri {
@@ -4706,7 +4706,7 @@ static int lk_world_degenerate(const float *v0, const float *v1, const float *v2
     return n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0;
 }
 
-/* The setup of spec A.4.1 (see hfvis.h): a, b, c local; n = (b - a) x (c - a); h = nh.a; the
+/* The setup of [LK] §3.1, Fig. 1 (see hfvis.h): a, b, c local; n = (b - a) x (c - a); h = nh.a; the
  * epsilon, one-sided and far rules; m and the oriented edge planes. */
 static void lk_tri_setup(lk_tri *t, const double F[9], const double p[3], const float *v0,
                          const float *v1, const float *v2, int two_sided, double r_min,
@@ -4834,7 +4834,7 @@ static void lk_mask_exact(const hfvis_lk_rays *R, const lk_tri *t, const uint32_
     }
 }
 
-/* ---- the 3-D plane table (spec A.4.2, node convention) ---- */
+/* ---- the 3-D plane table ([LK] §3.1; docs/errata.md E40, node convention) ---- */
 
 HFVIS_API size_t hfvis_lk_lut_bytes(int resolution, int count, int two_tables)
 {
@@ -4986,7 +4986,7 @@ HFVIS_API const uint32_t *hfvis_lk_lut_fetch(const hfvis_lk_lut *lut, int direct
     return lk_lut_get(lut, directions, m, d_over_r);
 }
 
-/* LUT triangle mask (spec A.4.2-A.4.3): lut(e1,0) & lut(e2,0) & lut(e3,0) & lut(m, d/r_max)
+/* LUT triangle mask ([LK] §3.1, §4.3): lut(e1,0) & lut(e2,0) & lut(e3,0) & lut(m, d/r_max)
  * [& ~lut(m, d/r_min)]. A zero edge vector (a vertex direction through the origin twice)
  * constrains nothing. */
 static void lk_mask_lut(const hfvis_lk_lut *L, const lk_tri *t, uint32_t *out)
@@ -5057,7 +5057,7 @@ HFVIS_API hfvis_status hfvis_lk_triangle_mask(const hfvis_lk_rays *rays, const h
 
 /* ---- 12.5 per-triangle bounds: minimal bounding sphere (A.5), hexagonal prism (A.6) -------- */
 
-/* The minimal bounding sphere of a triangle (spec A.5 [choice]): the midpoint of the longest
+/* The minimal bounding sphere of a triangle ([LK] §4.2; docs/errata.md E46): the midpoint of the longest
  * edge when the triangle is right or obtuse, else the circumcentre; R = the largest distance
  * to a vertex, times (1 + 1e-12) (so every vertex is inside despite rounding). */
 static void lk_tri_sphere(const float *v0, const float *v1, const float *v2, double c[3],
@@ -5116,7 +5116,7 @@ static double lk_margin(double r_max, double R, const float *v0, const float *v1
     return LK_MARGIN * (r_max + R) + 1e-12 * mag;
 }
 
-/* The hexagonal prism of spec A.6 in half-space form, pl[j] = (n, c) meaning n.x <= c:
+/* The hexagonal prism of [LK] §4.1, Fig. 2-3 in half-space form, pl[j] = (n, c) meaning n.x <= c:
  * o_k.(x - v_k) <= r (the offset edge lines A, B, C of [LK] Fig. 2), u_k.(x - v_k) <= r (the
  * corner cuts P, Q, R, u_k = the bisector of o_{k-1} and o_k), n.(x - v0) <= r and
  * -n.(x - v0) <= low; and its vertices (nv <= 12): the base polygon - the enlarged triangle
@@ -5781,7 +5781,7 @@ HFVIS_API hfvis_status hfvis_lk_raster(const hfvis_mesh *mesh, const hfvis_view 
     return HFVIS_OK;
 }
 
-/* ---- 12.8 Method 2: BVH traversal ([LK] §5, spec A.9) ------------------------------------- */
+/* ---- 12.8 Method 2: BVH traversal ([LK] §5) ------------------------------------- */
 
 /* Per-triangle data of Methods 2 and the ray caster: minimal bounding sphere (c, R), R < 0 for
  * a zero-area triangle. 4 doubles per triangle. */
@@ -5917,7 +5917,7 @@ static double lk_box_zmax(const hfvis_bvh_node *nd, const double F[9], const dou
     return z;
 }
 
-/* Node occlusion mask (spec A.9.3) of the box's bounding sphere (centre, half-diagonal).
+/* Node occlusion mask ([LK] §5, Fig. 4; docs/errata.md E41) of the box's bounding sphere (centre, half-diagonal).
  * EXACT: bit i = the segment [0, s_i] (units of r) meets the sphere of radius R (1 + 1e-9) +
  * 1e-9 r; words are skipped by their cones, and rays already blocked (set in C) are not
  * computed (left 0: only M & ~C is ever used, and C only grows). SPHERE_LUT: [LK] Fig. 4 -
@@ -6197,7 +6197,7 @@ HFVIS_API hfvis_status hfvis_lk_bvh(const hfvis_mesh *mesh, const hfvis_bvh *bvh
     return HFVIS_OK;
 }
 
-/* ---- 12.9 the reference ray caster (spec A.10) ------------------------------------------- */
+/* ---- 12.9 the reference ray caster ([LK] §6) ------------------------------------------- */
 
 /* Slab test of the segment p + tD, t in [0, 1], against a padded node box, in double, widened
  * by LK_SLAB_PAD (relative) so it never rejects a box that the predicate's hit point lies in. */

@@ -3,7 +3,7 @@
  * Contents
  *   1. Common: allocation, checked sizes, mesh and grid validation, file helpers
  *   2. Views: GL-convention matrices, depth linearisation (thesis eq. 16, sign restored)
- *   3. Volume grids and the Volume Buffer (thesis ch. 6 §6.3; spec voxel §3.2-3.3)
+ *   3. Volume grids and the Volume Buffer (thesis ch. 6 §6.3; [G12] ch. 6)
  *   4. Meshes: analytic test meshes (box, spheres, torus, torus knot, height field, room,
  *      teapot) and the Wavefront OBJ codec
  *   5. Reference rasterizer: fixed-point top-left coverage, near clipping, ray-per-pixel oracle
@@ -19,8 +19,8 @@
  *      gather, direct light, the whole pipeline for a view ([G12] ch. 5)
  *
  * Paper references: [G12] A. Gaitatzes, "Interactive diffuse global illumination discretization
- * methods for dynamic environments", PhD thesis, Univ. of Cyprus, 2012. "spec voxel" is the
- * project's restatement spec/voxel-visfield-volgi.md, which fixes the thesis' errata.
+ * methods for dynamic environments", PhD thesis, Univ. of Cyprus, 2012. Errata and choices:
+ * docs/errata.md E54-E66.
  */
 #include "hfvis.h"
 
@@ -160,7 +160,7 @@ HFVIS_API void hfvis_mesh_free(const hfvis_allocator *alloc, hfvis_mesh *mesh)
 }
 
 /* ========================================================================================== */
-/* 2. Views (spec voxel §0)                                                                   */
+/* 2. Views (docs/errata.md C7)                                                               */
 /* ========================================================================================== */
 
 #define VX_M(m, r, c) ((m)[(c) * 4 + (r)]) /* column-major element (row r, column c) */
@@ -346,7 +346,7 @@ HFVIS_API hfvis_status hfvis_view_orthographic(hfvis_view *view, const double ey
 }
 
 /* [G12] eq. 16 prints z_e = n f / (f - zw (f - n)), a positive distance for a camera looking
- * down -z; spec voxel §4.2 restores the sign of the GL eye coordinate. */
+ * down -z; docs/errata.md E54 restores the sign of the GL eye coordinate. */
 HFVIS_API double hfvis_depth_to_eye_z(double zw, double near_plane, double far_plane,
                                       int orthographic)
 {
@@ -362,7 +362,7 @@ HFVIS_API double hfvis_eye_z_to_depth(double z_eye, double near_plane, double fa
 }
 
 /* ========================================================================================== */
-/* 3. Volume grids and the Volume Buffer ([G12] §6.3; spec voxel §3.2-3.3)                     */
+/* 3. Volume grids and the Volume Buffer ([G12] §6.3; [G12] ch. 6)                             */
 /* ========================================================================================== */
 
 /* Bounds of the vertices the triangles of a valid mesh use (a soup may carry unused vertices);
@@ -520,7 +520,7 @@ HFVIS_API hfvis_status hfvis_volume_merge(hfvis_volume *dst, const hfvis_volume 
 
 /* ========================================================================================== */
 /* 4. Meshes: analytic test meshes and the Wavefront OBJ codec                                */
-/*    (infrastructure for Gaitatzes 2012, ch. 6-7 and spec voxel §3.13: the icosphere of test  */
+/*    (infrastructure for Gaitatzes 2012, ch. 6-7 and the icosphere of test                    */
 /*    4, the cube of tests 1-2, the 100k-triangle benchmark torus knot of issue 4)            */
 /* ========================================================================================== */
 /* Contents
@@ -1224,7 +1224,7 @@ HFVIS_API hfvis_status hfvis_mesh_bounds(const hfvis_mesh *mesh, double lo[3], d
 }
 
 /* ---- 4d. OBJ decoder -------------------------------------------------------------------- */
-/* Wavefront OBJ subset (DESIGN §4): `v x y z [w | r g b ...]` and `f` lines; every other
+/* Wavefront OBJ subset (README.md, CLI): `v x y z [w | r g b ...]` and `f` lines; every other
  * statement is ignored. Two passes over the bytes with the same parser: pass 1 validates and
  * counts, pass 2 fills arrays of exactly the counted sizes (forward vertex references are
  * range-checked there). */
@@ -1676,7 +1676,7 @@ HFVIS_API hfvis_status hfvis_mesh_save(const char *path, const hfvis_mesh *mesh)
 
 
 /* ========================================================================================== */
-/* 5. Reference rasterizer (spec voxel §0 view conventions)                                   */
+/* 5. Reference rasterizer (docs/errata.md C7 view conventions)                               */
 /* ========================================================================================== */
 /* The fixed-function GPU pipeline on the CPU, as the thesis' ch. 7 camera and light views render
  * their depth and G-buffer images ([G12] §7.4.1-7.4.2; Listings 7.1-7.2 read them):
@@ -2250,7 +2250,7 @@ HFVIS_API hfvis_status hfvis_rasterize_reference(const hfvis_mesh *mesh, const h
 }
 
 /* ========================================================================================== */
-/* 6. BVH and ray casting (the scene-space caster of spec raycast A.9.2 / A.10)               */
+/* 6. BVH and ray casting (the scene-space caster of [LK] §5-6)               */
 /*     Watertight test: S. Woop, C. Benthin, I. Wald, "Watertight Ray/Triangle Intersection",  */
 /*     JCGT 2(1), 2013: its pseudo-code listing (ray setup, shear, edge functions U V W, the   */
 /*     double-precision recomputation of zero edge functions), quoted line by line below.     */
@@ -2277,7 +2277,7 @@ HFVIS_API hfvis_status hfvis_rasterize_reference(const hfvis_mesh *mesh, const h
 #else
 #define VX_BVH_INLINE inline
 #endif
-/* SAH constants (spec raycast A.9.2: C_trav = C_tri = 1). */
+/* SAH constants ([LK] §6; docs/errata.md E46: C_trav = C_tri = 1). */
 #define VX_BVH_C_TRAV 1.0
 #define VX_BVH_C_TRI 1.0
 
@@ -3055,7 +3055,7 @@ HFVIS_API hfvis_status hfvis_bvh_any_hit(const hfvis_bvh *bvh, const hfvis_mesh 
 /* 7. Surface voxelization into the Volume Buffer                                             */
 /*     [G12] ch. 6 (§6.4.1 Alg. 5 geometry-shader triangle slicing, §6.4.2 Alg. 6 pixel-shader */
 /*     fragment clipping, §6.6 output-vertex limit), ch. 5 §5.5.1 Alg. 4 (three axial passes   */
-/*     merged with MAX); spec voxel §3.4-3.8, §3.12-3.13                                       */
+/*     merged with MAX); [G12] ch. 6, Alg. 5-6; [G12] ch. 6                                    */
 /* ========================================================================================== */
 /*
  * Everything happens in grid space g = (p - origin)/cell, where a voxel is a unit cube. A pass
@@ -3231,7 +3231,7 @@ static int vx_vox_tri_setup(vx_vox_tri *T, const hfvis_mesh *m, const hfvis_volu
     return 1;
 }
 
-/* Dominant axis of the grid-space normal (spec §3.4, §3.12: ties -> lowest index). */
+/* Dominant axis of the grid-space normal ([G12] ch. 6: ties -> lowest index). */
 static int vx_vox_dominant(const double n[3])
 {
     int a = 0;
@@ -3693,7 +3693,7 @@ static void vx_vox_row(vx_vox_sink *s, const vx_vox_pass *p, int pw, int s0, int
     if (L <= R) vx_vox_row_slabs(s, &r, pw, L, R, s0, s1);
 }
 
-/* Pixel rule (spec §3.4): every covered pixel of the pass into the slab of its depth. */
+/* Pixel rule ([G12] ch. 6): every covered pixel of the pass into the slab of its depth. */
 static void vx_vox_fast_pixel_rule(vx_vox_sink *s, const vx_vox_pass *p)
 {
     int pw;
@@ -3911,7 +3911,7 @@ HFVIS_API hfvis_status hfvis_voxelize_occupancy(const hfvis_mesh *mesh,
     return HFVIS_OK;
 }
 
-/* ---- ready-made attribute callbacks ([G12] §6.5; spec §3.8) ------------------------------- */
+/* ---- ready-made attribute callbacks ([G12] §6.5; [G12] ch. 6) ------------------------------- */
 
 HFVIS_API void hfvis_voxel_fragment_occupancy(const hfvis_voxel_fragment *f, float *values,
                                               void *user)
@@ -3977,7 +3977,7 @@ HFVIS_API void hfvis_voxel_fragment_attributes(const hfvis_voxel_fragment *f, fl
 
 /* ========================================================================================== */
 /* 8. Binary voxelizers: conservative (triangle-box SAT), solid (parity), bitmask; .binvox/raw */
-/*    (spec voxel §3.9 baselines: T. Akenine-Moller, "Fast 3D triangle-box overlap testing",   */
+/*    ([G12] ch. 6 baselines: T. Akenine-Moller, "Fast 3D triangle-box overlap testing",       */
 /*    JGT 2001 - the 13-axis separating-axis test; M. Schwarz & H.-P. Seidel, "Fast parallel   */
 /*    surface and solid voxelization on GPUs", SIGGRAPH Asia 2010 - its per-triangle setup;   */
 /*    solid voxelization by parity / XOR, Chen & Fang 1998, Eisemann & Decoret 2008;          */
@@ -4813,7 +4813,7 @@ static int vx_cons_det_sign(double a, double b, double c, double d)
     return ep > eq ? 1 : (ep < eq ? -1 : 0);
 }
 
-/* Coverage of the point (cu, cw) by a triangle projected to (pu[k], pw[k]) (spec §3.4, §3.9:
+/* Coverage of the point (cu, cw) by a triangle projected to (pu[k], pw[k]) ([G12] ch. 6:
  * the pixel-centre rule with a watertight tie rule). The vertices are moved to the point first,
  * q_k = fl(p_k - c) (shared vertices give the same q in every triangle), and the three edge
  * functions E_k = q_{k+1} x q_{k+2} are evaluated with their EXACT sign (vx_cons_det_sign), so
@@ -5680,7 +5680,7 @@ HFVIS_API hfvis_status hfvis_voxels_raw_save(const char *path, const hfvis_volum
 #endif /* HFVIS_NO_STDIO */
 
 /* ========================================================================================== */
-/* 9. Incremental image-based multi-valued voxelization ([G12] ch. 7; spec voxel §4)          */
+/* 9. Incremental image-based multi-valued voxelization ([G12] ch. 7)                         */
 /*   9.1 depth images, options, channel maps                                                 */
 /*   9.2 classification of a voxel centre: eq. 16 (sign restored), eq. 17 with the bias b,   */
 /*        Fig. 70's three zones; the conservative footprint and its min-depth pyramid         */
@@ -5905,7 +5905,7 @@ static hfvis_iv_class vx_iv_zone(const vx_iv_img *im, double b, double ez, float
     return HFVIS_IV_BAND;                     /* surface band (v2) */
 }
 
-/* The classification of a point with eye z `ez` and clip (X, Y, W) (spec voxel §4.3): UNSEEN
+/* The classification of a point with eye z `ez` and clip (X, Y, W) ([G12] ch. 7, Alg. 7, eq. 17; docs/errata.md E55): UNSEEN
  * without information, else the zone of its texel. Writes the texel read (or -1, -1). */
 static hfvis_iv_class vx_iv_decide(const vx_iv_img *im, double b, double ez, double X, double Y,
                                    double W, int *opx, int *opy)
@@ -5972,7 +5972,7 @@ static float vx_iv_pyr_min(const vx_iv_img *im, int x0, int x1, int y0, int y1)
     return m;
 }
 
-/* Conservative footprint (spec voxel §4.3 [C]): 1 if the clear of a voxel whose centre test
+/* Conservative footprint (docs/errata.md E63): 1 if the clear of a voxel whose centre test
  * cleared is vetoed: a corner before the near plane or behind the camera, or a pixel whose
  * centre lies in the bounding box of the projected corners that is no-data or does not clear
  * (p'_z > z_e + b fails). With a pyramid, a rectangle whose minimum depth clears is accepted
@@ -7107,12 +7107,12 @@ HFVIS_API hfvis_status hfvis_voxel_distance_metrics_naive(const hfvis_mesh *mesh
 
 /* ========================================================================================== */
 /* 10. 4D visibility fields ([G12] ch. 4: Alg. 1 build, Alg. 2/3 queries, Figs. 29/31;        */
-/*     spec voxel §1; A. Gaitatzes et al., "Presampled visibility for ambient occlusion",    */
+/*     [G12] ch. 4; A. Gaitatzes et al., "Presampled visibility for ambient occlusion",      */
 /*     WSCG 2008, and "Fast approximate visibility on the GPU using pre-computed 4D          */
 /*     visibility fields", WSCG 2010)                                                        */
 /* ========================================================================================== */
 /* Contents
- *   vf-a. positional samples on the bounding sphere (octahedral subdivision, spec §1.3) and
+ *   vf-a. positional samples on the bounding sphere (octahedral subdivision, [G12] ch. 4; docs/errata.md E56) and
  *         the constant-time nearest-sample lookup
  *   vf-b. tangent frame (Duff et al. 2017) and the three hemisphere direction maps (§1.4)
  *   vf-c. sizes, validation, texel encoding (§1.2, §1.5-1.6)
@@ -7552,7 +7552,7 @@ static int vx_vf_valid(const hfvis_visfield *vf)
     return need != 0 && vf->maps_size >= need;
 }
 
-/* 8-bit distance code of a normalised hit distance v in [0, 1] (spec §1.5 [C]). */
+/* 8-bit distance code of a normalised hit distance v in [0, 1] ([G12] ch. 4, Alg. 1; docs/errata.md E64). */
 static unsigned char vx_vf_code8(double v)
 {
     double q = floor((double)HFVIS_VISFIELD_U8_SCALE * v + 0.5);
@@ -7923,7 +7923,7 @@ static int vx_vf_lookup(const hfvis_visfield *vf, const double rel[3], const dou
     l[0] = e[0] * t[0] + e[1] * t[1] + e[2] * t[2];
     l[1] = e[0] * b[0] + e[1] * b[1] + e[2] * b[2];
     l[2] = e[0] * w[0] + e[1] * w[1] + e[2] * w[2];
-    if (!(l[2] > 0.0)) return 0; /* grazing: outside the sample's hemisphere (spec §1.7 [C]) */
+    if (!(l[2] > 0.0)) return 0; /* grazing: outside the sample's hemisphere (docs/errata.md E64) */
     if (!vx_vf_from_local(vx_vf_mapping(vf->mapping), D, l, &i, &j)) {
         out->texel_i = i;
         out->texel_j = j;
@@ -8827,14 +8827,14 @@ HFVIS_API hfvis_status hfvis_visfield_load(const char *path, const hfvis_allocat
 
 /* ========================================================================================== */
 /* 11. Volume-based VPL indirect illumination ([G12] ch. 5, "Interactive Volume-based         */
-/* Indirect Illumination of Dynamic Scenes": Alg. 4, eqs. 7, 11-15; spec voxel §2)            */
-/*   GI.1 2-band SH: basis, clamped cosine, cone (spec §2.2)                                  */
+/* Indirect Illumination of Dynamic Scenes": Alg. 4, eqs. 7, 11-15; [G12] ch. 5)              */
+/*   GI.1 2-band SH: basis, clamped cosine, cone ([G12] ch. 5)                                */
 /*   GI.2 options, transport constants, validation                                           */
-/*   GI.3 VPL injection ([G12] §5.5.1, spec §2.4)                                             */
-/*   GI.4 one propagation step (eq. 11 with the reference kernel of spec §2.5): the fast      */
+/*   GI.3 VPL injection ([G12] §5.5.1, [G12] ch. 5)                                           */
+/*   GI.4 one propagation step (eq. 11 with the reference kernel of [G12] ch. 5, eq. 11; docs/errata.md E59): the fast */
 /*        gathering kernel, the literal reference, the energy accounting                     */
 /*   GI.5 the propagation loop (multiple bounces, §5.5.2 / §5.6)                               */
-/*   GI.6 final gather (eqs. 12-15, spec §2.6)                                                */
+/*   GI.6 final gather (eqs. 12-15, [G12] ch. 5, eq. 12-15; docs/errata.md E60)               */
 /*   GI.7 lights and direct irradiance with BVH shadow rays                                   */
 /*   GI.8 voxelization with direct light (Alg. 4) and the room grid                           */
 /*   GI.9 the whole pipeline for a view                                                       */
@@ -8851,7 +8851,7 @@ HFVIS_API hfvis_status hfvis_visfield_load(const char *path, const hfvis_allocat
 #define VX_GI_INLINE static
 #endif
 
-/* ---- GI.1 2-band SH (DESIGN: real, orthonormal, no Condon-Shortley phase, index l(l+1)+m:
+/* ---- GI.1 2-band SH (hfvis.h conventions: real, orthonormal, no Condon-Shortley phase, index l(l+1)+m:
  *      0 = Y00, 1 = y, 2 = z, 3 = x) ------------------------------------------------------ */
 
 /* u = d/|d| (scaled first, so no intermediate overflows); 0 for NULL, non-finite or zero d. */
@@ -9124,7 +9124,7 @@ HFVIS_API hfvis_status hfvis_volgi_inject(const hfvis_volgi_geometry *geometry,
             area = pow(geometry->grid.cell[0] * geometry->grid.cell[1] * geometry->grid.cell[2],
                        2.0 / 3.0);
         }
-        /* P0 = (Phi/pi) CC(n), Phi = pi L s^2 (spec §2.4 [C]) */
+        /* P0 = (Phi/pi) CC(n), Phi = pi L s^2 ([G12] ch. 5; docs/errata.md E60) */
         for (b = 0; b < 3; b++) {
             double q = (double)radiance[3 * v + (size_t)b] * area;
             for (k = 0; k < 4; k++) p[4 * b + k] = (float)(q * cc[k]);
@@ -9371,7 +9371,7 @@ static size_t vx_gi_lin(const int dims[3], const int v[3])
     return ((size_t)v[2] * (size_t)dims[1] + (size_t)v[1]) * (size_t)dims[0] + (size_t)v[0];
 }
 
-/* Reference step: spec §2.5's pseudo-code literally, full 4-coefficient products, every path
+/* Reference step: the kernel of docs/errata.md E59 literally, full 4-coefficient products, every path
  * weight and normalisation recomputed per (i, o). */
 static void vx_gi_step_reference(const vx_gi_step *c)
 {
@@ -9570,7 +9570,7 @@ HFVIS_API hfvis_status hfvis_volgi_propagate(const hfvis_volgi_geometry *geometr
 
 /* ---- GI.6 final gather ------------------------------------------------------------------ */
 
-/* Eqs. 12-15 on validated inputs (spec §2.6); n need not be unit (a zero n gives 0). */
+/* Eqs. 12-15 on validated inputs ([G12] ch. 5, eq. 12-15; docs/errata.md E60); n need not be unit (a zero n gives 0). */
 static void vx_gi_gather_point(const hfvis_volgi_geometry *g, const float *accum, double kappa,
                                const double p[3], const double n[3], double E[3])
 {

@@ -57,7 +57,7 @@ int main(int argc, char **argv)
         }
     env.radiance = radiance; env.n_theta = N_THETA; env.n_phi = N_PHI; env.channels = 3;
 
-    /* Default method: exact prefix integrals of the map per direction (spec heightfield §5.4). */
+    /* Default method: exact prefix integrals of the map per direction ([P1] Eq. 6-7; docs/errata.md E9). */
     EX_CHECK(hfvis_env_light(&grid, K, &env, 0.8f, NULL, NULL, rgb, W), "hfvis_env_light");
     /* The paper's own method: the L_p table of [P1] Eq. 6-7, bilinear in (theta_n, theta_h). */
     eopts.method = HFVIS_ENV_LP_TABLE;

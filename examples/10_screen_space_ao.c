@@ -7,7 +7,7 @@
  *   ssao_error.pgm   |method - ray traced| for LSAO | HBAO | FFAO, white = 0, black >= 20 %
  *   the same as PNG, and ssao_sheet.png with both, the errors under their methods
  * and prints e_A and e_<5% of each against the reference. LSAO and HBAO estimate solid-angle
- * obscurance (spec §1.2), so their error against the cosine-weighted reference is expected to be
+ * obscurance (docs/errata.md C4), so their error against the cosine-weighted reference is expected to be
  * larger: the comparison that P4 makes is FFAO's. Runs in a few seconds. */
 #include <stdio.h>
 #include <stdlib.h>

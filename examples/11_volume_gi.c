@@ -82,7 +82,7 @@ int main(int argc, char **argv)
     scene.light_count = 1;
     EX_CHECK(hfvis_view_perspective(&view, eye, target, up, 40.0 * PI / 180.0, W, H, 0.1, 10.0), "view");
 
-    /* The thesis' method: Alg. 4 voxelization with direct light, VPLs, 64 steps of the spec §2.5
+    /* The thesis' method: Alg. 4 voxelization with direct light, VPLs, 64 steps of the [G12] ch. 5, eq. 11; docs/errata.md E59
      * kernel, per-pixel gather. */
     opts.resolution = RES;
     opts.iterations = ITERATIONS;

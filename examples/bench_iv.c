@@ -1,4 +1,4 @@
-/* bench_iv.c - incremental image-based voxelization ([G12] ch. 7; spec voxel §4), the thesis'
+/* bench_iv.c - incremental image-based voxelization ([G12] ch. 7), the thesis'
  * Table 8 comparison on the CPU: per 1280x720 view of the issue's 100k-triangle torus knot at
  * 256^3 and 512^3, the cleanup (Alg. 7 / Listing 7.1, both footprints), the injection (Listing 7.2:
  * one point per pixel, and the thesis' worst case, a point grid proportional to the volume side),

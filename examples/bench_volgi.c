@@ -1,7 +1,7 @@
 /* bench_volgi.c - volume-based VPL indirect illumination ([G12] ch. 5, Table 2 on the CPU): the
  * coloured room (hfvis_mesh_room, one point light) at 32^3, 64^3 and 128^3: voxelization with
  * direct light (Alg. 4: three sweeps, a shadow ray per fragment), VPL injection, the propagation
- * step per voxel-iteration (the issue's number: spec §2.5 kernel, the void-only / normalised
+ * step per voxel-iteration (the issue's number: docs/errata.md E59 kernel, the void-only / normalised
  * variant, the literal reference and the energy accounting beside it), and per 1280x720 pixel
  * the final gather (eqs. 12-15) beside the direct light with one BVH shadow ray, and the whole
  * pipeline (hfvis_volgi_render). */
@@ -226,11 +226,11 @@ void bench_volgi(int quick)
                 1e9 * t_vox / (double)(frags ? frags : 1));
         bench_volgi_row(gname, "voxelize + direct light (Alg. 4, 3 sweeps)", t_vox, vox, "voxel", note);
         BENCH_VOLGI_MIN(t_inj, reps, bench_volgi_inject(&v));
-        bench_volgi_row(gname, "inject VPLs (spec §2.4)", t_inj, vox, "voxel", NULL);
+        bench_volgi_row(gname, "inject VPLs ([G12] ch. 5)", t_inj, vox, "voxel", NULL);
         vi = vox * (double)iters;
         BENCH_VOLGI_MIN(t_prop, reps, bench_volgi_propagate(&v, &o, iters));
         sprintf(note, "%d iterations; %.1f ms per 64", iters, 1e3 * t_prop * 64.0 / iters);
-        bench_volgi_row(gname, "propagate, spec §2.5 kernel (ALL/CONE)", t_prop, vi, "voxel-iteration", note);
+        bench_volgi_row(gname, "propagate, docs/errata.md E59 kernel (ALL/CONE)", t_prop, vi, "voxel-iteration", note);
         o.paths = HFVIS_VOLGI_PATHS_VOID;
         BENCH_VOLGI_MIN(t_void, reps, bench_volgi_propagate(&v, &o, iters));
         bench_volgi_row(gname, "propagate, void-only paths (VOID/CONE)", t_void, vi, "voxel-iteration", NULL);

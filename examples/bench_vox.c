@@ -1,4 +1,4 @@
-/* bench_vox.c - surface voxelizers ([G12] ch. 6 Alg. 5/6, ch. 5 Alg. 4; spec voxel §3.4-3.7) on
+/* bench_vox.c - surface voxelizers ([G12] ch. 6 Alg. 5/6, ch. 5 Alg. 4; [G12] ch. 6, Alg. 5-6) on
  * the issue's 100k-triangle torus knot at 128^3, 256^3, 512^3 (longest axis), each method beside
  * its per-voxel oracle in the same run; the same voxels written into an 8x larger grid (cost
  * follows the voxels written, not the grid volume); and a coarse icosphere whose large triangles
@@ -90,7 +90,7 @@ void bench_vox(int quick)
         printf("bench_vox: mesh generation failed\n");
         return;
     }
-    printf("\nSurface voxelization (spec voxel §3.4-3.7), torus knot (2,3) 2500x20 = %zu triangles, "
+    printf("\nSurface voxelization ([G12] ch. 6, Alg. 5-6), torus knot (2,3) 2500x20 = %zu triangles, "
            "1 float channel (MAX); oracle = per-voxel test of each triangle's bounding box\n", m.triangle_count);
     bench_vox_header();
     for (ri = 0; ri < nres; ri++) {

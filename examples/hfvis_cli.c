@@ -1,4 +1,4 @@
-/* hfvis_cli.c - the `hfvis` command-line tool (DESIGN.md §4): horizon maps, sky-view factor,
+/* hfvis_cli.c - the `hfvis` command-line tool (README.md, CLI): horizon maps, sky-view factor,
  * uniform-sky light, sun shadows, environment light, normals, interreflected light, the
  * visibility index and viewsheds of PGM/PFM height fields; voxelization of OBJ meshes.
  * Every file is read and written through the library's codecs (hfvis_image_load, the encoders
@@ -89,7 +89,7 @@ enum { OUT_TOTAL, OUT_DIRECT, OUT_INDIRECT };
     "                    shadows (shadow rays); indirect: the propagated light only\n"           \
     "  --transfer T      cone: the thesis kernel, clamped 45-degree cone fluxes (default);\n"     \
     "                    normalized: the same proportions, nothing lost between the cones\n"       \
-    "  --paths P         all: every face neighbour exchanges light (default, the spec kernel);\n"  \
+    "  --paths P         all: every face neighbour exchanges light (default, the reference kernel, docs/errata.md E59);\n"  \
     "                    void: no light between two occupied voxels (\"only in void space\")\n"   \
     "  --reflection R    mirror: on the dominant axis of the voxel normal (default, the thesis);\n" \
     "                    diffuse: re-emitted as a cosine lobe about the normal\n"                  \

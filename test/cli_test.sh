@@ -1,5 +1,5 @@
 #!/bin/sh
-# cli_test.sh - end-to-end checks of the hfvis command-line tool (DESIGN.md §4): every subcommand
+# cli_test.sh - end-to-end checks of the hfvis command-line tool (README.md, CLI): every subcommand
 # writes its file, closed-form answers on a flat field, and bad input gives a non-zero exit, exactly
 # one stderr line "hfvis: ..." and no file left behind.
 # usage: sh test/cli_test.sh BUILD/hfvis SCRATCHDIR      (prints one line per check)

@@ -1,5 +1,5 @@
 #!/bin/sh
-# determinism.sh - DESIGN.md §2 "Numbers": same input, same binary gives bit-identical output;
+# determinism.sh - hfvis.h, Conventions "Numbers": same input, same binary gives bit-identical output;
 # across compilers, outputs agree within a stated tolerance.
 # usage: sh test/determinism.sh BUILD_A [BUILD_B]
 #   Each BUILD holds a release build (hfvis, examples/, test/imgdiff), e.g. gcc and clang builds

@@ -180,7 +180,7 @@ TEST(sat_cases)
     CHECK(hfvis_triangle_box_overlap(c, h, a, b, b) == 1);
 }
 
-/* ---- conservative: analytic counts (spec §3.13) ------------------------------------------- */
+/* ---- conservative: analytic counts ------------------------------------------- */
 
 TEST(conservative_spec_counts)
 {
@@ -232,7 +232,7 @@ TEST(conservative_spec_counts)
         CHECK(m.triangle_count == 20480);
         n = tc_cons_check(&m, &g64, &bad);
         CHECK(n == 7542);
-        printf("  icosphere r=20 in 64^3: conservative %zu voxels (spec 7542)\n", n);
+        printf("  icosphere r=20 in 64^3: conservative %zu voxels (prototype count 7542)\n", n);
         hfvis_mesh_free(NULL, &m);
     }
     CHECK(bad == 0);
@@ -486,7 +486,7 @@ TEST(conservative_fast_equals_reference_slivers)
     CHECK(bad == 0);
 }
 
-/* Translating a mesh by whole voxels translates the conservative voxel set (spec §3.13.8). */
+/* Translating a mesh by whole voxels translates the conservative voxel set. */
 TEST(conservative_translation)
 {
     tc_soup s;
@@ -889,7 +889,7 @@ TEST(bitmask)
     int bad = 0, trial;
     size_t n;
     {
-        /* spec §3.13.1: ALL_AXES on the cube [2.25, 10.25]^3: 6*64 - 3*8 + 1 = 361 */
+        /* ALL_AXES on the cube [2.25, 10.25]^3: 6*64 - 3*8 + 1 = 361 */
         double lo[3] = {2.25, 2.25, 2.25}, hi[3] = {10.25, 10.25, 10.25};
         CHECK_EQ_STATUS(hfvis_mesh_box(NULL, lo, hi, &m), HFVIS_OK);
         n = tc_bitmask_check(&m, &g, &bad);
@@ -923,7 +923,7 @@ TEST(bitmask)
         CHECK_EQ_STATUS(hfvis_mesh_icosphere(NULL, c, 20.0, 5, &m), HFVIS_OK);
         n = tc_bitmask_check(&m, &g64, &bad);
         CHECK(n == 4183);
-        printf("  icosphere r=20 in 64^3: bitmask %zu voxels (spec ALL_AXES 4183)\n", n);
+        printf("  icosphere r=20 in 64^3: bitmask %zu voxels (prototype ALL_AXES 4183)\n", n);
         hfvis_mesh_free(NULL, &m);
     }
     tc_seed(23);

@@ -9,7 +9,7 @@
 
 /* test_gi.c - tests of the Nowrouzezahrai-Snyder math layer (hfvis.c section 13): real SH,
  * zonal lobes, environment projection, normalized Legendre polynomials, Appendix-A wedge
- * matrices, the tangent-plane angle. Analytic cases are spec GI B.13 (spec/raycast-ao-and-hf-gi.md);
+ * matrices, the tangent-plane angle. Analytic cases are closed forms derived for these tests;
  * expected values are written here, nothing is read from outside the repository.
  * Defines run_gi_tests(); needs hfvis.h, test.h, math.h, stdio.h, stdlib.h, string.h included. */
 
@@ -25,7 +25,7 @@
 #define GI_TOL_TABLE6 6e-7
 /* Spec B.7 Cartesian constants printed with 6 decimals, times |coordinate products| <= 1. */
 #define GI_TOL_CART6 2e-6
-/* Fig. 4 ringing values of spec B.3, printed with 4 decimals. */
+/* Fig. 4 ringing values of [NS09] §4, Eq. 9-13; docs/errata.md E48, E49, printed with 4 decimals. */
 #define GI_TOL_TABLE4 6e-5
 
 #define GI_PI 3.14159265358979323846
@@ -134,8 +134,8 @@ static void gi_uniform_sky(double L, double *c)
 
 TEST(gi_sh_basis_constants)
 {
-    /* DESIGN §2 convention (no Condon-Shortley phase) and spec B.7's Cartesian table with the odd
-     * |m| signs flipped, at the spec's check direction (1,2,3)/sqrt14. */
+    /* hfvis.h convention (no Condon-Shortley phase) and the Cartesian table of [NS09] §7 with the odd
+     * |m| signs flipped, at the quoted check direction (1,2,3)/sqrt14. */
     static const double ex[3] = {1.0, 0.0, 0.0}, ey[3] = {0.0, 1.0, 0.0}, ez[3] = {0.0, 0.0, 1.0};
     double d[3] = {1.0, 2.0, 3.0}, Y[16], x, y, z, want[16];
     int i;
@@ -209,7 +209,7 @@ TEST(gi_sh_orthonormal)
 TEST(gi_sh_rotate_z)
 {
     /* Rotating coefficients by a equals evaluating the original at the direction rotated by -a
-     * (spec B.6: f'(phi) = f(phi - a)); Rot(2 pi) = identity; angles add; in place. */
+     * ([NS09] §6, App. A; docs/errata.md E51: f'(phi) = f(phi - a)); Rot(2 pi) = identity; angles add; in place. */
     unsigned long long s = 7;
     double c[16], r[16], r2[16], r3[16];
     int i, n;
@@ -237,7 +237,7 @@ TEST(gi_sh_rotate_z)
 
 TEST(gi_sh_product)
 {
-    /* spec B.7: 353 non-zeros, Gamma_0jk = delta_jk/(2 sqrt(pi)), exactly symmetric; the product equals
+    /* [NS09] §7: 353 non-zeros, Gamma_0jk = delta_jk/(2 sqrt(pi)), exactly symmetric; the product equals
      * the projection of the pointwise product by an independent exact quadrature. */
     double *G = (double *)malloc(4096 * sizeof(double));
     double a[16], b[16], p[16], q[16], gx[8], gw[8];
@@ -288,7 +288,7 @@ TEST(gi_sh_product)
 
 TEST(gi_zh_clamped_cosine)
 {
-    /* spec B.13-6: raw ZH of max(cos, 0) = (sqrt(pi)/2, sqrt(pi/3), sqrt(5 pi)/8, 0) by exact
+    /* raw ZH of max(cos, 0) = (sqrt(pi)/2, sqrt(pi/3), sqrt(5 pi)/8, 0) by exact
      * quadrature (polynomial on [0, 1]), Ahat = (pi, 2pi/3, pi/4, 0); [NS09] §7 prints
      * (0.886227, 1.02333, 0.495416, 0). */
     static const double paper[4] = {0.886227, 1.02333, 0.495416, 0.0};
@@ -332,7 +332,7 @@ TEST(gi_zh_convolution_irradiance)
 
 TEST(gi_directional_ringing)
 {
-    /* spec B.13-8: L_lm = E0 Y_lm(d), diffuse: E = E0 [1/4 + cos(g)/2 + 5/16 P_2(cos g)]:
+    /* L_lm = E0 Y_lm(d), diffuse: E = E0 [1/4 + cos(g)/2 + 5/16 P_2(cos g)]:
      * 17/16 at g = 0 (exact answer 1), 0.878325, 0.4609375, 0.09375, -0.0390625 at 30..120 deg. */
     static const double gam[5] = {0.0, 30.0, 60.0, 90.0, 120.0};
     static const double want[5] = {1.0625, 0.878325, 0.4609375, 0.09375, -0.0390625};
@@ -361,8 +361,8 @@ TEST(gi_directional_ringing)
 
 TEST(gi_zh_phong_and_cap)
 {
-    /* Phong (spec B.7): Ahat_l = exp(-l^2/(2S)), Ahat_0 = 1 (a unit sky reflects 1). Cap
-     * (spec B.8): Ahat_l = sqrt(4pi/(2l+1)) z_l with z_l of the spec, Ahat_0 = 2 pi (1 - cos a),
+    /* Phong ([NS09] §7): Ahat_l = exp(-l^2/(2S)), Ahat_0 = 1 (a unit sky reflects 1). Cap
+     * ([NS09] §6): Ahat_l = sqrt(4pi/(2l+1)) z_l with z_l of the cap, Ahat_0 = 2 pi (1 - cos a),
      * and against exact quadrature of the indicator on [cos a, 1]. */
     static const double Sv[3] = {1.0, 8.0, 100.0};
     double A[4], L[16], n[3] = {0.2, 0.1, -0.9}, v, gx[8], gw[8];
@@ -525,8 +525,8 @@ TEST(gi_env_recovers_basis_function)
 
 TEST(gi_nlp_orthonormal)
 {
-    /* spec B.13-1: 4-node Gauss-Legendre is exact for degree <= 7. The paper's printed
-     * constants 5 sqrt2/4 and 7 sqrt2/4 (spec B.3 erratum) are not normalised. */
+    /* 4-node Gauss-Legendre is exact for degree <= 7. The paper's printed
+     * constants 5 sqrt2/4 and 7 sqrt2/4 (docs/errata.md E48, E49) are not normalised. */
     double gx[4], gw[4], P[4], G[4][4], bad2 = 0.0, bad3 = 0.0;
     int a, i, j;
     gi_gauss_legendre(4, gx, gw);
@@ -576,7 +576,7 @@ static void gi_nlp_int_omega(double lo, double hi, double *out)
 
 TEST(gi_nlp_occlusion_closed_form)
 {
-    /* spec B.13-2: vbar(-pi/2) = 0, vbar(pi/2) = (sqrt2, 0, 0, 0),
+    /* vbar(-pi/2) = 0, vbar(pi/2) = (sqrt2, 0, 0, 0),
      * vbar(0) = (0.70710678, -0.61237244, 0, 0.23385359); the paper's cos-form (Eq. 10 as
      * printed) agrees; both against quadrature in omega. */
     double v[4], q[4];
@@ -608,8 +608,8 @@ TEST(gi_nlp_occlusion_closed_form)
 TEST(gi_nlp_visibility_and_ringing)
 {
     /* Eq. 11: v = vbar(pi/2) - vbar(omega_max); the hemisphere omega_max = 0 gives
-     * (1/sqrt2, sqrt6/4, 0, -sqrt14/16) (spec B.13-3); an empty interval gives 0; the order-4
-     * reconstruction of vbar(pi/4) rings (spec B.3 Fig. 4 values; the spec's "pi/4" sample was
+     * (1/sqrt2, sqrt6/4, 0, -sqrt14/16); an empty interval gives 0; the order-4
+     * reconstruction of vbar(pi/4) rings ([NS09] §4, Eq. 9-13; docs/errata.md E48, E49 Fig. 4 values; the quoted "pi/4" sample was
      * evaluated at omega = 0.785: 0.536485 there, 0.535908 at pi/4). */
     static const double om[7] = {-1.5, -0.5, 0.0, 0.5, 0.785, 1.0, 1.5};
     static const double want[7] = {1.1122, 0.9564, 1.0745, 0.8879, 0.5365, 0.2150, -0.2823};
@@ -636,7 +636,7 @@ TEST(gi_nlp_visibility_and_ringing)
 
 TEST(gi_nlp_radiance_vs_quadrature)
 {
-    /* spec B.13-12: Eq. 12 equals Int u(w) P^(sin w) cos w dw of the step function of Eq. 8,
+    /* Eq. 12 equals Int u(w) P^(sin w) cos w dw of the step function of Eq. 8,
      * for seeded random casting sets (also with omega_min below the horizontal). */
     unsigned long long s = 5;
     int n, k, i;
@@ -662,7 +662,7 @@ TEST(gi_nlp_radiance_vs_quadrature)
 
 TEST(gi_wedge_matrix_spec_tables)
 {
-    /* spec B.6 regression table M_lin(2 pi/32) and the first M_bspl rows; the spec prints the
+    /* [NS09] §6, App. A; docs/errata.md E51 regression table M_lin(2 pi/32) and the first M_bspl rows; the values are printed with the
      * Condon-Shortley phase, so rows with odd |m| (1,+-1), (2,+-1), (3,+-1), (3,+-3) flip. */
     static const double lin[16][8] = {
         {0.03916607, 0, 0, 0, 0.03916607, 0, 0, 0},
@@ -695,7 +695,7 @@ TEST(gi_wedge_matrix_spec_tables)
     for (r = 0; r < 16; r++)
         for (c = 0; c < 8; c++)
             CHECK_NEAR(M[r * 8 + c], (odd_m[r] ? -1.0 : 1.0) * lin[r][c], GI_TOL_TABLE8, 0.0);
-    CHECK_NEAR(M[0], D / (2.0 * sqrt(GI_TWO_PI)), GI_TOL_EXACT, 0.0);   /* spec B.13-13 */
+    CHECK_NEAR(M[0], D / (2.0 * sqrt(GI_TWO_PI)), GI_TOL_EXACT, 0.0);   /* */
     CHECK_EQ_STATUS(hfvis_ns_wedge_matrix(HFVIS_NS_INTERP_BSPLINE, D, M), HFVIS_OK);
     for (s = 0; s < 4; s++) {
         CHECK_NEAR(M[0 * 16 + s * 4], b00[s], GI_TOL_TABLE8, 0.0);
@@ -706,8 +706,8 @@ TEST(gi_wedge_matrix_spec_tables)
 
 TEST(gi_wedge_matrix_linear_closed_form)
 {
-    /* spec B.6: B_(m,s) of linear interpolation in closed form, and every m = 0 entry
-     * D/(2 sqrt(2 pi)) at (s, k = l); A_(l,mu,k) of spec B.6 (sign-flipped for odd mu) recovered
+    /* [NS09] §6, App. A; docs/errata.md E51: B_(m,s) of linear interpolation in closed form, and every m = 0 entry
+     * D/(2 sqrt(2 pi)) at (s, k = l); A_(l,mu,k) of [NS09] §6, App. A; docs/errata.md E51 (sign-flipped for odd mu) recovered
      * as M / (K B). Wedge widths cover the series (c <= 2) and the by-parts (c > 2) branches. */
     static const double widths[5] = {0.01, GI_TWO_PI / 32.0, 0.7, 2.1, GI_TWO_PI};
     double M[128];
@@ -736,7 +736,7 @@ TEST(gi_wedge_matrix_linear_closed_form)
                         if (m == 0) {
                             CHECK_NEAR(got, k == l ? D / (2.0 * sqrt(GI_TWO_PI)) : 0.0, GI_TOL_EXACT, 0.0);
                         } else if (w == 1) {
-                            /* A table of spec B.6 at this width (12 digits; CS signs flipped) */
+                            /* A table of [NS09] §6, App. A; docs/errata.md E51 at this width (12 digits; CS signs flipped) */
                             double Aw = 0.0, A = got / (Kn * B[s]);
                             if (l == 1 && mu == 1 && k == 0) Aw = 1.110720734540;
                             if (l == 1 && mu == 1 && k == 2) Aw = -0.310455883306;
@@ -874,7 +874,7 @@ static void gi_wedges_numeric(const hfvis_ns_wedges *set, const double *w, doubl
 
 TEST(gi_wedges_sum_equals_projection)
 {
-    /* Eq. 20-21 summed over all wedges (wrap-around wedge included, spec B.6 erratum) equal the
+    /* Eq. 20-21 summed over all wedges (wrap-around wedge included, docs/errata.md E51) equal the
      * SH projection of the interpolated function, for random slice vectors: full circle and a
      * partial extent crossing phi = 0, linear and B-spline, several m. */
     static const int ms[4] = {1, 3, 5, 8};
@@ -897,7 +897,7 @@ TEST(gi_wedges_sum_equals_projection)
             }
 }
 
-/* Int_0^pi K Pt_l^mu(cos t) P^_k(cos t) sin t dt (the spec's K * A) by 32-node Gauss-Legendre in t. */
+/* Int_0^pi K Pt_l^mu(cos t) P^_k(cos t) sin t dt (the quoted K * A) by 32-node Gauss-Legendre in t. */
 static double gi_KA(int l, int mu, int k)
 {
     double gx[32], gw[32], P[4], r = 0.0;
@@ -981,7 +981,7 @@ TEST(gi_wedges_band_limited_reproduction)
 
 TEST(gi_wedges_hemisphere_and_constant)
 {
-    /* spec B.13-3: omega_max = 0 everywhere gives V_l0 = sqrt(2 pi) v_l =
+    /* omega_max = 0 everywhere gives V_l0 = sqrt(2 pi) v_l =
      * (1.77245385, 1.53499006, 0, -0.58618401), V_lm = 0 for m != 0, any m >= 1;
      * B.13-4: the constant slice (sqrt2, 0, 0, 0) gives V_00 = 2 sqrt(pi). Both interpolations. */
     static const int ms[4] = {1, 3, 8, 32};
@@ -1019,7 +1019,7 @@ TEST(gi_wedges_hemisphere_and_constant)
 
 TEST(gi_wedges_keylight_box)
 {
-    /* spec B.13-11: no occlusion (omega_max = -pi/2), elevation [l_min, l_max], azimuths
+    /* no occlusion (omega_max = -pi/2), elevation [l_min, l_max], azimuths
      * [phi_a, phi_b]: V_00 = Omega/(2 sqrt(pi)), Omega = (phi_b - phi_a)(sin l_max - sin l_min). */
     double v[4], w[3 * 4], out[16], pa = -0.4, pb = 0.9, lmin = 0.2, lmax = 0.8;
     int bs, j, i;
@@ -1060,7 +1060,7 @@ static double gi_flat_omega(double phi, double unused) { (void)phi; (void)unused
 
 TEST(gi_flat_uniform_sky)
 {
-    /* spec B.13-7: E = pi L exactly for any m and interpolation (bands 0-1 of the hemisphere are
+    /* E = pi L exactly for any m and interpolation (bands 0-1 of the hemisphere are
      * exact and the clamped cosine's band 3 is 0). */
     static const double up[3] = {0.0, 0.0, 1.0};
     static const int ms[4] = {1, 2, 7, 32};
@@ -1074,11 +1074,11 @@ TEST(gi_flat_uniform_sky)
 
 TEST(gi_trench_sky_fraction)
 {
-    /* spec B.13-9: trench with a = 2h/w, exact omega_max = atan(a |cos phi|), N = z. Pipeline
+    /* trench with a = 2h/w, exact omega_max = atan(a |cos phi|), N = z. Pipeline
      * values for m = 8/32/128 (linear = B-spline here), and the order-4 limit
      * [pi/2 - atan a + pi/(2 sqrt(1+a^2)) + 5a/(8(1+a^2))]/pi, reached at m = 4096 within 1e-7
      * (the error is O(1/m^2): 5e-5 at m = 128). The formula gives 0.7030252 for a = 1 and
-     * 0.4507679 for a = 2; the spec prints 0.703033 and 0.450767 (arithmetic slips in its last
+     * 0.4507679 for a = 2; the quoted values 0.703033 and 0.450767 (arithmetic slips in its last
      * digits; its formula and its m = 8/32/128 values are right). The exact sky fraction
      * 1/sqrt(1+a^2) differs by the order-4 truncation. */
     static const double up[3] = {0.0, 0.0, 1.0};
@@ -1101,7 +1101,7 @@ TEST(gi_trench_sky_fraction)
 
 TEST(gi_closure)
 {
-    /* spec B.13-9 closure: per slice a casting set ending at the raw omega_max with constant exit
+    /* closure: per slice a casting set ending at the raw omega_max with constant exit
      * radiance u0 gives v + u/u0 = vbar(pi/2) - vbar(0), so E_direct + E_indirect = pi L exactly
      * (L = u0 = 1); with a black sky E_ind/u0 = pi - E_sky. Seeded random casting sets. */
     static const double up[3] = {0.0, 0.0, 1.0};
@@ -1142,7 +1142,7 @@ TEST(gi_closure)
 
 TEST(gi_tilted_plane)
 {
-    /* spec B.13-10: f = s x, N = (-s, 0, 1)/sqrt(1+s^2), omega_max = atan(s cos phi) exactly.
+    /* f = s x, N = (-s, 0, 1)/sqrt(1+s^2), omega_max = atan(s cos phi) exactly.
      * Regression values of E/pi; the exact omega_min equals omega_max (empty casting set), while
      * the paper's arcsin form lies below it for cos phi > 0 except at phi = 0, where N lies in
      * the slice's vertical plane (there the surface would be admitted). */
@@ -1175,7 +1175,7 @@ TEST(gi_tilted_plane)
 
 TEST(gi_min_blocking_angle)
 {
-    /* spec B.2 erratum: N = (1,1,1)/sqrt3 at phi = 0: exact -45 deg, paper -35.26 deg; a normal in
+    /* docs/errata.md E47: N = (1,1,1)/sqrt3 at phi = 0: exact -45 deg, paper -35.26 deg; a normal in
      * the slice's vertical plane gives the same angle with both forms; DEFAULT = EXACT. */
     static const double n1[3] = {1.0, 1.0, 1.0}, n2[3] = {0.3, 0.0, 0.8};
     double a, b, c;

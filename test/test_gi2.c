@@ -1,5 +1,5 @@
 /* test_gi2.c - the Nowrouzezahrai-Snyder GI pipeline (hfvis.c section 14): hfvis_ns_gi end to end.
- * Analytic cases are spec GI B.13 (spec/raycast-ao-and-hf-gi.md part B); the exact pipeline it is
+ * Analytic cases are the exact pipeline it is
  * checked against is P1 (hfvis_sky_light) and P2 (hfvis_indirect_light). Expected values are
  * written here or assembled from the math layer (section 13), never read from outside. */
 #include "hfvis.h"
@@ -240,7 +240,7 @@ TEST(ns_sample_matrices)
 
 /* ------------------------------------------------------------- B.13-7, B.13-3, B.13-4 */
 
-/* Flat terrain under a uniform sky (spec B.13-7): every receiver whose slices all see terrain
+/* Flat terrain under a uniform sky: every receiver whose slices all see terrain
  * has the hemisphere visibility, bands 0 and 1 of which are exact, so E = pi c and the library's
  * radiance is albedo * c exactly, for any m, interpolation, pyramid or sub-sampling; the casting
  * sets are empty, so every bounce is 0 exactly. V itself is (sqrt(pi), sqrt(3 pi)/2, 0,
@@ -384,17 +384,17 @@ TEST(ns_trench)
             }
     /* the order-4 limit (m -> infinity), closed form of B.13-9:
      * E_4/pi = [pi/2 - atan a + pi/(2 sqrt(1+a^2)) + 5a/(8(1+a^2))]/pi.
-     * a = 1: (pi/4 + pi/(2 sqrt2) + 5/16)/pi = 0.70302523; spec B.13-9 prints 0.703033, a typo:
+     * a = 1: (pi/4 + pi/(2 sqrt2) + 5/16)/pi = 0.70302523; a quoted limit of 0.703033, a typo:
      * the pipeline at m = 4096 (1/m^2 convergence from 0.703049 at m = 128) lands on 0.7030252. */
     lim1 = (NS_PI / 2.0 - atan(1.0) + NS_PI / (2.0 * sqrt(2.0)) + 5.0 / 16.0) / NS_PI;
     lim2 = (NS_PI / 2.0 - atan(2.0) + NS_PI / (2.0 * sqrt(5.0)) + 10.0 / 40.0) / NS_PI;
     e4096 = ns_trench(1.0, 4096, HFVIS_NS_INTERP_LINEAR, HFVIS_NS_OMEGA_MAX_RAW);
-    printf("  trench a=1: m=4096 %.7f, closed-form limit %.7f, spec's printed limit 0.703033, exact "
+    printf("  trench a=1: m=4096 %.7f, closed-form limit %.7f, quoted printed limit 0.703033, exact "
            "sky fraction %.7f\n", e4096, lim1, 1.0 / sqrt(2.0));
     CHECK_NEAR(lim1, 0.7030252, 1e-7, 0.0);
     CHECK_NEAR(e4096, lim1, NS_TOL_TRENCH_LIMIT, 0.0);
     CHECK(fabs(e4096 - 0.703033) > 5e-6);
-    /* the spec's 0.450767 for a = 2 is truncated, not rounded: the limit is 0.4507679 */
+    /* the quoted 0.450767 for a = 2 is truncated, not rounded: the limit is 0.4507679 */
     CHECK_NEAR(lim2, 0.4507679, 1e-7, 0.0);
     CHECK_NEAR(ns_trench(2.0, 4096, HFVIS_NS_INTERP_BSPLINE, HFVIS_NS_OMEGA_MAX_BSPLINE), lim2,
                NS_TOL_TRENCH_LIMIT, 0.0);
@@ -566,7 +566,7 @@ TEST(ns_directional)
     CHECK_NEAR(ns_dir_light(flat, N, N, 7, 7, 0.3, 90.0 * deg, HFVIS_NS_DIRECTIONAL_SH), 17.0 / 16.0, NS_TOL_TABLE6, 0.0);
     CHECK_NEAR(ns_dir_light(flat, N, N, 7, 7, 0.3, 60.0 * deg, HFVIS_NS_DIRECTIONAL_SH), 0.878325, NS_TOL_TABLE6, 0.0);
     CHECK_NEAR(ns_dir_light(flat, N, N, 7, 7, 1.3, 30.0 * deg, HFVIS_NS_DIRECTIONAL_SH), 0.4609375, NS_TOL_TABLE6, 0.0);
-    /* SOFT (spec B.8): clamp(v . P^(sin omega_L), 0, 1) with v the hemisphere slice
+    /* SOFT ([NS09] §6): clamp(v . P^(sin omega_L), 0, 1) with v the hemisphere slice
      * (1/sqrt2, sqrt6/4, 0, -sqrt14/16): 1/2 + 3/4 - 7/16 = 13/16 at the zenith; 1.066 -> 1 at 30 deg */
     CHECK_NEAR(ns_dir_light(flat, N, N, 7, 7, 0.3, 90.0 * deg, HFVIS_NS_DIRECTIONAL_SOFT), 13.0 / 16.0, 0.0, NS_TOL_FLOAT);
     CHECK_NEAR(ns_dir_light(flat, N, N, 7, 7, 0.3, 30.0 * deg, HFVIS_NS_DIRECTIONAL_SOFT), 0.5, 0.0, NS_TOL_FLOAT);
@@ -777,7 +777,7 @@ TEST(ns_glossy)
 
 /* -------------------------------------------------------- holes, sub-sampling, borders */
 
-/* Holes never occlude and receive NaN (DESIGN): on a flat field with holes every other texel
+/* Holes never occlude and receive NaN (hfvis.h): on a flat field with holes every other texel
  * keeps the flat value exactly and casts nothing, for any sub-sampling (texels whose receivers
  * are all holes are computed as receivers of their own). */
 TEST(ns_holes)
@@ -935,7 +935,7 @@ static double ns_bilerp(const float *a, int w, int h, double x, double y)
            ((double)a[(y0 + 1) * w + x0] * (1.0 - fx) + (double)a[(y0 + 1) * w + x0 + 1] * fx) * fy;
 }
 
-/* The order-4 SH-projected ray-march reference of spec B.13-15: per receiver and each of MREF
+/* The order-4 SH-projected ray-march reference of per receiver and each of MREF
  * azimuths, a march with step STEP cells on the bilinear surface finds omega_max and the exact
  * running-maximum casting set from omega_min, whose exit radiance (bilinear) gives Eq. 12; the
  * math layer turns them into NLP vectors (hfvis_nlp_visibility / hfvis_nlp_radiance), SH
@@ -1359,7 +1359,7 @@ TEST(ns_alloc_failures)
         CHECK(ns_untouched(d, W * H * C) && ns_untouched(t, W * H * C) && ns_untouched(b, B * W * H * C) &&
               ns_untouched(v, 16 * W * H));
     }
-    /* same inputs, same bits (DESIGN determinism); the casting-set cache changes no bit, whether
+    /* same inputs, same bits (hfvis.h, determinism); the casting-set cache changes no bit, whether
      * the direct pass fills it (environment) or the first bounce does (emission only) */
     o.alloc = NULL;
     CHECK_EQ_STATUS(hfvis_ns_gi(&g, &sc, &o, &out), HFVIS_OK);

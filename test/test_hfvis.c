@@ -1,5 +1,5 @@
-/* test_hfvis.c - height-field horizon / sky-light tests against the spec
- * (heightfield-p1-p2 §3.2 lattice, §4, §5.1-5.3, §11, §12.1-12.4 closed forms). */
+/* test_hfvis.c - height-field horizon / sky-light tests ([P1] §4-6: lattice,
+ * hull stack, normals and light; closed forms for planes, valleys and pits). */
 #include "../hfvis.h"
 #include "test.h"
 
@@ -23,7 +23,7 @@ static int rng_int(int n) { return (int)(rng_next() % (uint64_t)n); }
 
 
 /* ---------------------------------------------------------------------------------------- */
-/* 1. Hull stack vs brute force (spec §4.2, §11 item 5, §12.9, §12.11)                       */
+/* 1. Hull stack vs brute force ([P1] Alg. 1; docs/errata.md E1, E2; docs/errata.md E2; [P2] §6) */
 /* ---------------------------------------------------------------------------------------- */
 
 #define LINE_MAX_N 320
@@ -176,7 +176,7 @@ TEST(line_horizons_holes)
 
 TEST(line_horizons_worst_shapes)
 {
-    /* spec §12.9 */
+    /* [P2] §6 */
     double d[LINE_MAX_N], h[LINE_MAX_N], t[LINE_MAX_N];
     int c[LINE_MAX_N], stack[LINE_MAX_N], n = 300, i, ok;
     /* dome h = -(x - 150)^2: strictly concave, every receiver's caster is its neighbour,
@@ -233,7 +233,7 @@ TEST(line_horizons_bad_args)
 
 static const double PI = 3.14159265358979323846;
 
-/* A seeded fBm field (spec §12.11-style random terrain) into a new buffer. */
+/* A seeded fBm field (fBm-style random terrain) into a new buffer. */
 static float *make_fbm(int w, int h, uint64_t seed, double amplitude, double wavelength)
 {
     hfvis_field f;
@@ -248,7 +248,7 @@ static float *make_fbm(int w, int h, uint64_t seed, double amplitude, double wav
 }
 
 /* ---------------------------------------------------------------------------------------- */
-/* 2. Sweep lattice == per-node brute force, bit for bit (spec §6 item 2)                     */
+/* 2. Sweep lattice == per-node brute force, bit for bit (docs/errata.md E5)                  */
 /* ---------------------------------------------------------------------------------------- */
 
 TEST(horizon_lattice_vs_naive)
@@ -311,10 +311,10 @@ TEST(horizon_lattice_vs_naive)
 
 
 /* ---------------------------------------------------------------------------------------- */
-/* 3. Lattice geometry (spec §3.2)                                                           */
+/* 3. Lattice geometry (docs/errata.md E5)                                                   */
 /* ---------------------------------------------------------------------------------------- */
 
-/* Domain slack of spec §3.2 (eps = 1e-9): nodes on the boundary belong to the domain. */
+/* Domain slack of docs/errata.md E5 (eps = 1e-9): nodes on the boundary belong to the domain. */
 #define LATTICE_EPS 1e-9
 /* An axis of one sample is a strip one cell wide (hfvis.h, hfvis_lattice_init). */
 #define LATTICE_STRIP_HALF 0.5
@@ -372,7 +372,7 @@ TEST(lattice_geometry)
         CHECK(L.ux * L.vx + L.uy * L.vy == 0.0);
     }
     /* 45 degrees: 89 lines, 4050 in-domain nodes. Buffer: rows = j_max-j_min+1 = 89 (one per
-     * line), cols = i_max-i_min+1 = 90; the spec's "90 x 89" lists (cols x rows). */
+     * line), cols = i_max-i_min+1 = 90; the quoted "90 x 89" lists (cols x rows). */
     CHECK_EQ_STATUS(hfvis_lattice_init(&L, 64, 64, 0.25 * PI), HFVIS_OK);
     ok = 1;
     total = lattice_walk(&L, &lines, &ok);
@@ -392,7 +392,7 @@ TEST(lattice_geometry)
         if ((size_t)(L.j_max - L.j_min + 1) * (size_t)(L.i_max - L.i_min + 1) != hfvis_lattice_size(&L))
             ok = 0;
         /* nodes of a unit lattice in the (W-1) x (H-1) rectangle: its area, +- about half
-         * the perimeter (spec §3.2 "(W-1)(H-1) + boundary") */
+         * the perimeter (docs/errata.md E5 "(W-1)(H-1) + boundary") */
         if (w > 1 && h > 1 && labs(total - (long)(w - 1) * (long)(h - 1)) > (long)(w + h)) ok = 0;
         /* a strip (w or h = 1, one cell wide): its area w * h, +- its perimeter */
         if ((w == 1 || h == 1) && labs(total - (long)w * (long)h) > 2L * (long)(w + h)) ok = 0;
@@ -402,7 +402,7 @@ TEST(lattice_geometry)
 
 
 /* ---------------------------------------------------------------------------------------- */
-/* 4. Bilinear sampling (spec §3.2 "Bilinear sampling", §11 item 11)                         */
+/* 4. Bilinear sampling (docs/errata.md E5 "Bilinear sampling", §11 item 11)                 */
 /* ---------------------------------------------------------------------------------------- */
 
 /* A 4-tap blend of a plane rounds a few ulps of heights <= 100: 1e-12 absolute. */
@@ -479,7 +479,7 @@ TEST(grid_sample)
 
 
 /* ---------------------------------------------------------------------------------------- */
-/* 5. Normals (spec §5.1)                                                                    */
+/* 5. Normals ([P1] §7; docs/errata.md E10)                                                  */
 /* ---------------------------------------------------------------------------------------- */
 
 /* Normals are stored as float: half an ulp of a unit vector component is 6e-8; 1e-6 leaves
@@ -547,7 +547,7 @@ TEST(normals)
 
 
 /* ---------------------------------------------------------------------------------------- */
-/* 6. Flat plane (spec §12.1)                                                                */
+/* 6. Flat plane                                                                             */
 /* ---------------------------------------------------------------------------------------- */
 
 /* Light outputs are float: Sum_k S_k rounded once; 1e-6 is ~8 float ulps at 1. */
@@ -555,7 +555,7 @@ TEST(normals)
 
 /* A grid point is "interior" for gathered directions if every lattice node its gather can
  * touch (within sqrt 2 cells) is a non-first node (first nodes lie within 1 cell of the
- * border): distance >= 3 cells from every edge (spec §3.3). */
+ * border): distance >= 3 cells from every edge (docs/errata.md E7). */
 #define INTERIOR_MARGIN 3
 
 static int interior(int x, int y, int w, int h)
@@ -611,12 +611,12 @@ TEST(flat_plane)
 }
 
 /* ---------------------------------------------------------------------------------------- */
-/* 7. Tilted plane (spec §12.2)                                                              */
+/* 7. Tilted plane                                                                           */
 /* ---------------------------------------------------------------------------------------- */
 
-/* The spec's table values are rounded to 6 decimals: |table - exact| <= 5e-7. */
+/* The quoted table values are rounded to 6 decimals: |table - exact| <= 5e-7. */
 #define TABLE_ROUND_TOL 5e-7
-/* The raw lattice stores alpha as float: the spec's 1e-9 on t is invisible through a float
+/* The raw lattice stores alpha as float: the quoted 1e-9 on t is invisible through a float
  * output, whose rounding (half an ulp, 2^-24 |alpha|) is the limit; allow one ulp. */
 #define LATTICE_ALPHA_REL_TOL (double)FLT_EPSILON
 #define LATTICE_ALPHA_ABS_TOL 1e-12
@@ -626,7 +626,7 @@ TEST(flat_plane)
 
 static double sector_sum_plane(int K, double g, double q, double az0, int flip)
 {
-    /* [P1] Eq. 5 with the clamp of spec §5.2 on the plane h = g x + q y: N = (-g,-q,1)/|.|,
+    /* [P1] Eq. 5 with the clamp of docs/errata.md E3 on the plane h = g x + q y: N = (-g,-q,1)/|.|,
      * t_k = g cos psi_k + q sin psi_k (or its negative when the opposite direction's horizon
      * is fed in), clamped up to the tangent plane t >= -a_k/N_z. */
     double len = sqrt(1.0 + g * g + q * q), nx = -g / len, ny = -q / len, nz = 1.0 / len, sum = 0.0;
@@ -730,7 +730,7 @@ TEST(tilted_plane_light)
 TEST(tilted_plane_lattice)
 {
     /* raw lattice: every non-first node of every line has tan(alpha) = g cos psi + q sin psi
-     * exactly (the samples along a line are collinear; spec §12.2), NaN outside the domain */
+     * exactly (the samples along a line are collinear), NaN outside the domain */
     enum { W = 40, H = 33 };
     static const double gq[4][2] = { { 0.5, 0.0 }, { 2.0, 0.0 }, { 0.5, 0.25 }, { -0.75, -1.25 } };
     int p, a, bad = 0, nodes = 0;
@@ -785,13 +785,13 @@ TEST(tilted_plane_lattice)
 
 
 /* ---------------------------------------------------------------------------------------- */
-/* 8. V-valley (spec §12.3) and 9. L1 pyramid pit (spec §12.4), per-receiver oracle          */
+/* 8. V-valley and 9. L1 pyramid pit, per-receiver oracle                                    */
 /* ---------------------------------------------------------------------------------------- */
 
 /* A float elevation <= pi/2 is within 2^-24 * pi/2 = 9.4e-8 of its double; the double march
  * arithmetic adds ~1e-15. Two float ulps. */
 #define REF_ALPHA_TOL 2.4e-7
-/* V from float elevations: d(cos^2 a)/da <= 1, so the error is <= REF_ALPHA_TOL; the spec's
+/* V from float elevations: d(cos^2 a)/da <= 1, so the error is <= REF_ALPHA_TOL; the quoted
  * values carry 6-7 significant digits (<= 5e-7 rounding). */
 #define V_TOL 1e-6
 /* Finite-domain pipeline (map + gather) vs the §12.3 finite-domain closed form built from
@@ -800,7 +800,7 @@ TEST(tilted_plane_lattice)
  * cross-valley gathered directions, weighted <= 1/K in Eq. 5 (observed 1.3e-5). */
 #define FLANK_PIPELINE_TOL 1e-4
 
-/* V = (1/K) sum_k cos^2(max(alpha_k, 0)) = (1/K) sum 1/(1+t_k^2) (spec §12 notation) */
+/* V = (1/K) sum_k cos^2(max(alpha_k, 0)) = (1/K) sum 1/(1+t_k^2) */
 static double v_from_alpha(const float *alpha, int K)
 {
     double v = 0.0;
@@ -814,7 +814,7 @@ static double v_from_alpha(const float *alpha, int K)
 
 static double eq5_sum(int K, double nx, double ny, double nz, const double *t)
 {
-    /* [P1] Eq. 5 with the tangent clamp (spec §5.2-5.3), psi_k = 2 pi k / K */
+    /* [P1] Eq. 5 with the tangent clamp ([P1] Eq. 4-5; docs/errata.md E3), psi_k = 2 pi k / K */
     double sum = 0.0;
     int k;
     for (k = 0; k < K; k++) {
@@ -1389,7 +1389,7 @@ TEST(bad_arguments)
     CHECK_EQ_STATUS(hfvis_horizon_map(&good, 8, NULL, sent_buf), HFVIS_OK);
 }
 
-/* wip/test_hfvis_part2.c - analytic and cross-path tests of the sweeps (spec heightfield §3.3,
+/* wip/test_hfvis_part2.c - analytic and cross-path tests of the sweeps (docs/errata.md E7,
  * §3.4, §5.2-5.4, §6, §11, §12.5-12.8, §12.12). Pasted into test/test_hfvis.c, which includes
  * <math.h>, <stdio.h>, <stdlib.h>, <string.h>, hfvis.h and test.h. Public API only.
  * run_part2_tests() runs them all. */
@@ -1398,7 +1398,7 @@ TEST(bad_arguments)
 
 /* ---------------------------------------------------------------- helpers */
 
-/* Cosine-weighted visibility of an upward receiver from K horizon elevations (spec §12):
+/* Cosine-weighted visibility of an upward receiver from K horizon elevations:
  * V = (1/K) sum_k cos^2(max(alpha_k, 0)). */
 static double p2_vis_from_alpha(const float *alpha, int K)
 {
@@ -1449,7 +1449,7 @@ TEST(p2_linf_pit_apex)
         f.x0 = f.y0 = 50.0;
         f.slope = slope[i];
         CHECK_EQ_STATUS(p2_fn_horizons(&f, N, K, 0.05, 50.0, 50.0, alpha), HFVIS_OK);
-        /* V = (4/pi) (1/sqrt(1+s^2)) atan(1/sqrt(1+s^2)) (spec §12.5) */
+        /* V = (4/pi) (1/sqrt(1+s^2)) atan(1/sqrt(1+s^2)) */
         q = 1.0 / sqrt(1.0 + slope[i] * slope[i]);
         closed = 4.0 / P2_PI * q * atan(q);
         CHECK_NEAR(closed, want[i], 1e-6, 0.0);
@@ -1480,7 +1480,7 @@ TEST(p2_cone_pit_apex)
         f.x0 = f.y0 = 40.0;
         f.slope = slope[i];
         CHECK_EQ_STATUS(p2_fn_horizons(&f, N, K, 0.05, 40.0, 40.0, alpha), HFVIS_OK);
-        /* V = 1/(1+s^2) (spec §12.6) */
+        /* V = 1/(1+s^2) */
         CHECK_NEAR(p2_vis_from_alpha(alpha, K), 1.0 / (1.0 + slope[i] * slope[i]),
                    P2_TOL_FN_DISCRETE, 0.0);
     }
@@ -1490,7 +1490,7 @@ TEST(p2_cone_pit_apex)
 
 /* §12.7 on the grid: with the rise sampled as the bilinear ramp over [x_s-1, x_s], the caster
  * on the +x axis is the grid sample at x_s, so t = A/delta exactly and every other axis
- * direction sees flat ground (t = 0). Axis directions reproduce the grid exactly (spec §3.3). */
+ * direction sees flat ground (t = 0). Axis directions reproduce the grid exactly (docs/errata.md E7). */
 TEST(p2_step_axis_exact)
 {
     enum { W = 48, H = 24, XS = 30 };
@@ -1509,7 +1509,7 @@ TEST(p2_step_axis_exact)
     CHECK_EQ_STATUS(hfvis_horizon_direction(&g, 4, 0, NULL, dir, W), HFVIS_OK);
     for (y = 1; y < H - 1; y++) {
         for (x = 1; x < XS; x++) {
-            /* +x: t = A cos 0 / delta, delta = x_s - x (spec §12.7) */
+            /* +x: t = A cos 0 / delta, delta = x_s - x */
             float want0 = (float)atan(A / (double)(XS - x));
             if (map[y * W + x] != want0 || dir[y * W + x] != want0) bad++;
             for (k = 1; k < 4; k++)
@@ -1519,7 +1519,7 @@ TEST(p2_step_axis_exact)
     CHECK(bad == 0);
 }
 
-/* The analytic wall seen from delta = 2 (spec §12.7): V = 1/2 (1 + delta/sqrt(delta^2 + A^2)).
+/* The analytic wall seen from delta = 2: V = 1/2 (1 + delta/sqrt(delta^2 + A^2)).
  * The march finds the wall up to one step past its face (t = A/tau, tau <= delta/cos psi +
  * step), an error linear in the step: measured +1.75e-4 at 0.005, +6.2e-5 at 0.002 (used),
  * +3.4e-5 at 0.001. The K = 256 sum of the exact t equals the limit to 1e-15, and the domain
@@ -1544,7 +1544,7 @@ TEST(p2_wall_fn_visibility)
 
 /* ---------------------------------------------------------------- §12.8 hemisphere */
 
-/* Exact horizon elevation toward a hemisphere of radius R at distance rho (spec §12.8), phi the
+/* Exact horizon elevation toward a hemisphere of radius R at distance rho, phi the
  * angle between the look direction and the direction to the centre:
  * sin alpha = sqrt(R^2 - rho^2 sin^2 phi)/(rho cos phi) for |sin phi| < R/rho, cos phi > 0. */
 static double p2_hemisphere_alpha(double R, double rho, double phi)
@@ -1561,13 +1561,13 @@ static double p2_hemisphere_alpha(double R, double rho, double phi)
  *   45    0.925890  0.925840  0.925797          0.003518            0.0065
  *   41.2  0.899242  0.899438  0.899290          0.005957            0.0214
  *   33    0.757330  0.757849  0.757971          0.063708            0.0878
- * The sweep and march V of rho = 45 and 33 reproduce the spec's 0.92584 / 0.75785 and
- * 0.92580 / 0.75797, and the spec's per-direction figures (0.0035, 0.064 rad) are those of the
+ * The sweep and march V of rho = 45 and 33 reproduce the quoted 0.92584 / 0.75785 and
+ * 0.92580 / 0.75797, and the quoted per-direction figures (0.0035, 0.064 rad) are those of the
  * unit-step march; the sweep's gathered per-direction error is about 1.4x larger (gather at the
- * hemisphere's silhouette kink, spec §3.3). The spec's "exact 0.89909" for rho = 41.2 does not
+ * hemisphere's silhouette kink, docs/errata.md E7). The quoted "exact 0.89909" for rho = 41.2 does not
  * match its own closed form (0.899242, verified by 2e5-point quadrature), so the closed form is
  * used. */
-#define P2_TOL_HEMI_SPEC_VALUE 5e-6  /* the spec prints 5 decimals; same configuration */
+#define P2_TOL_HEMI_SPEC_VALUE 5e-6  /* the reference values have 5 decimals; same configuration */
 TEST(p2_hemisphere_sweep)
 {
     enum { N = 129, K = 64, YR = 64 };
@@ -1576,10 +1576,10 @@ TEST(p2_hemisphere_sweep)
     static const double want_exact[3] = { 0.92589, -1.0, 0.75733 };
     static const double spec_sweep[3] = { 0.92584, -1.0, 0.75785 };
     static const double spec_march[3] = { 0.92580, -1.0, 0.75797 };
-    /* |V_sweep - exact|: the spec's sweep errors (5e-5, 5.2e-4) rounded up; 41.2: measured
+    /* |V_sweep - exact|: the quoted sweep errors (5e-5, 5.2e-4) rounded up; 41.2: measured
      * 1.96e-4 */
     static const double tol_v[3] = { 6e-5, 3e-4, 6e-4 };
-    /* per direction, unit-step march: the spec's figures (41.2: measured 0.0060, bounded by
+    /* per direction, unit-step march: the quoted figures (41.2: measured 0.0060, bounded by
      * the 0.064 of rho = 33) */
     static const double tol_march[3] = { 0.00355, 0.064, 0.064 };
     /* per direction, gathered sweep: measured 0.0065 / 0.0214 / 0.0878 with ~20 % headroom */
@@ -1612,7 +1612,7 @@ TEST(p2_hemisphere_sweep)
             if (fabs((double)alpha[k] - e) > dsweep) dsweep = fabs((double)alpha[k] - e);
             if (fabs((double)ref[k] - e) > dmarch) dmarch = fabs((double)ref[k] - e);
         }
-        /* V = 1 - (beta - sin beta cos beta)/pi, sin beta = R/rho (spec §12.8) */
+        /* V = 1 - (beta - sin beta cos beta)/pi, sin beta = R/rho */
         sb = R / rho;
         beta = asin(sb);
         exact = 1.0 - (beta - sb * cos(beta)) / P2_PI;
@@ -1678,7 +1678,7 @@ static size_t p2_points(float *pts, int w, int h, int margin)
 }
 
 /* Gathered (non-axis) directions differ from the per-receiver march by the bilinear gather of
- * lattice horizons, largest at kinks and shadow edges (spec §3.3); 8-octave fBm (amplitude 8,
+ * lattice horizons, largest at kinks and shadow edges (docs/errata.md E7); 8-octave fBm (amplitude 8,
  * base wavelength 16) is kinked everywhere. Measured at seed 7, K = 16, psi_0 = 0.3, receivers
  * >= 3 cells from the border: median 0.0208, 99th percentile 0.249, max 0.511 rad (seeds 1, 2,
  * 3, 99: medians 0.017-0.021, max up to 0.549). Tolerances: the measurement with ~30 % headroom. */
@@ -1875,7 +1875,7 @@ TEST(openness_closed_forms_and_oracle)
 }
 
 /* hfvis_horizon_direction(K, k) is documented bit-identical to plane k of hfvis_horizon_map,
- * also when K % 4 == 0 (the quarter-turn lattice sharing of spec §3.6). */
+ * also when K % 4 == 0 (the quarter-turn lattice sharing of [P1] §7). */
 TEST(p2_direction_equals_map_plane)
 {
     enum { W = 37, H = 29, OS = W + 3 };
@@ -1985,10 +1985,10 @@ static void p2_diff_stats(const float *a, const float *b, int w, int h, int marg
 
 /* Uniform sky, K = 64, psi_0 = 0.3, on 4-octave fBm of amplitude 4 (slopes up to about 1).
  * Fused (lattice-space light with bilinearly sampled normals, gathered, [P1] §7) vs from-map
- * (gathered angles, grid normals, spec §3.3): measured mean 0.0033, max 0.026 (of ~1).
+ * (gathered angles, grid normals, docs/errata.md E7): measured mean 0.0033, max 0.026 (of ~1).
  * Both vs the hemisphere oracle (unit-step march, 256 azimuths, grid normals) on every third
  * interior point: fused mean 0.42 %, max 2.05 %; from-map mean 0.16 %, max 1.6 % relative.
- * The sources are the sector-constant horizon and clamp of Eq. 5 (spec §11 item 17), the
+ * The sources are the sector-constant horizon and clamp of Eq. 5 ([P1] Eq. 4), the
  * gather at kinks (§3.3) and, for the fused path, lattice-sampled normals. Tolerances: the
  * measurement with ~40 % headroom. (8-octave fBm of amplitude 8 is far rougher: fused vs
  * oracle mean 2.1 %, max 19 % in narrow pits, so it is not used here.) */
@@ -2046,7 +2046,7 @@ TEST(p2_sky_light_fused_map_oracle)
 /* An exact double result stored as float (values <= 1: half an ulp is 6e-8). */
 #define P2_TOL_FLOAT_OUT 1e-7
 /* SVF fused (sin(max(alpha, 0)) accumulated on the lattice, gathered) vs from-map (gathered
- * angles): the gather does not commute with sin(max(., 0)) at kinks (spec §3.3). Measured on
+ * angles): the gather does not commute with sin(max(., 0)) at kinks (docs/errata.md E7). Measured on
  * 4-octave fBm of amplitude 4, K = 32: mean 6.6e-4, max 0.0129; tolerances with ~50 % headroom. */
 #define P2_TOL_SVF_FUSED_MAP_MEAN 1e-3
 #define P2_TOL_SVF_FUSED_MAP_MAX 0.02
@@ -2079,7 +2079,7 @@ TEST(p2_sky_view_factor_cases)
         if (fused[i] != 1.0f || frommap[i] != 1.0f) bad++;
     CHECK(bad == 0);
     /* V-valley bottom, s = 1, axis directions (K = 4, psi_0 = 0): t = s |cos psi| exactly
-     * (spec §12.3), alpha = pi/4 toward +-x and 0 toward +-y, so
+     *, alpha = pi/4 toward +-x and 0 toward +-y, so
      * SVF = 1 - (1/4)(2 sin(pi/4) + 0 + 0) = 1 - sqrt(2)/4 = 0.646447 */
     memset(&f, 0, sizeof f);
     f.kind = HFVIS_FIELD_V_VALLEY;
@@ -2335,7 +2335,7 @@ static void p2_env_fill(float *rad, int nt, int np, const double *base, double v
  * on 4-octave fBm of amplitude 4 ([P1] Fig. 7 reports max 0.42 % at resolution 16). Where
  * N is straight up (flat field) theta_n = 0 is a table sample (odd M) and theta_h = pi/2 is a
  * sample only for odd T: measured 0 with T = 257 but 3.4e-6 with the default T = 256, where
- * pi/2 falls between theta_h samples 127 and 128 (spec §12.12 says "exactly"; left failing).
+ * pi/2 falls between theta_h samples 127 and 128 (docs/errata.md E9 says "exactly"; left failing).
  * Axis directions on a flat field: fused = from-map (measured 0; 1e-6 = 2 float ulps at ~4). */
 #define P2_TOL_ENV_PREFIX 1e-6
 #define P2_TOL_ENV_LP_M15 0.007
@@ -2360,7 +2360,7 @@ TEST(p2_env_consistency)
     env.n_phi = NP;
     env.channels = 3;
     o.azimuth0_rad = 0.3;
-    /* constant environment c through the prefix tables = Eq. 5 with sky = c (spec §12.12) */
+    /* constant environment c through the prefix tables = Eq. 5 with sky = c (docs/errata.md E9) */
     for (c = 0; c < 3; c++) {
         CHECK_EQ_STATUS(hfvis_sky_light(&g, K, (float)base[c], 1.0f, &o, sky, W), HFVIS_OK);
         eo.method = HFVIS_ENV_PREFIX;
@@ -2434,7 +2434,7 @@ static void run_part2_tests(void)
     RUN(p2_env_consistency);
 }
 
-/* ---- Environment light ([P1] Eq. 6-7, spec §5.4, §12.12) and the hemisphere oracle ---- */
+/* ---- Environment light ([P1] Eq. 6-7, docs/errata.md E9) and the hemisphere oracle ---- */
 
 
 /* ---------------------------------------------------------------- helpers */
@@ -2457,7 +2457,7 @@ static double env_t_range(env_t_rng *r, double lo, double hi)
     return lo + (hi - lo) * env_t_uniform(r);
 }
 
-/* Clamped upper limit of sector k (spec §5.2): min(pi/2 - alpha, pi/2 + atan2(a, nz)). */
+/* Clamped upper limit of sector k (docs/errata.md E3): min(pi/2 - alpha, pi/2 + atan2(a, nz)). */
 static double env_t_theta(double alpha, double a, double nz)
 {
     double th = ENV_T_PI / 2 - alpha, tc = ENV_T_PI / 2 + atan2(a, nz);
@@ -2517,7 +2517,7 @@ TEST(env_table_size)
     float rad[1] = {1.0f};
     hfvis_env env = {rad, 256, 64, 3};
     hfvis_env_options lp = {HFVIS_ENV_LP_TABLE, 0, 0}, o;
-    /* prefix: 6*K*(T+1)*C; L_p: K*M*Th*C (spec §5.4 space figures) */
+    /* prefix: 6*K*(T+1)*C; L_p: K*M*Th*C ([P1] Eq. 6-7; docs/errata.md E9 space figures) */
     CHECK(hfvis_env_table_size(&env, 64, NULL) == (size_t)6 * 64 * 257 * 3);
     CHECK(hfvis_env_table_size(&env, 64, &lp) == (size_t)64 * 15 * 257 * 3);
     lp.lp_normal_res = 7;
@@ -2605,7 +2605,7 @@ TEST(env_table_build_bad_arguments)
 /* ---------------------------------------------------------------- table contents */
 
 /* Constant environment c: A_k(theta) = c (pi/K) sin^2 theta, B_k = c sin(pi/K)(theta - sin 2theta/2),
- * C_k = 0 (spec §5.4), band phi-integrals c 2pi/K, 2c sin(pi/K), 0; documented layout. */
+ * C_k = 0 ([P1] Eq. 6-7; docs/errata.md E9), band phi-integrals c 2pi/K, 2c sin(pi/K), 0; documented layout. */
 TEST(env_prefix_table_layout)
 {
     enum { T = 7, P = 5, C = 2, K = 3 };
@@ -2662,7 +2662,7 @@ TEST(env_lp_table_layout)
             }
 }
 
-/* ---------------------------------------------------------------- spec §12.12 */
+/* ---------------------------------------------------------------- docs/errata.md E9 */
 
 /* A constant environment through the prefix tables equals Eq. 5 (hfvis_sector_weight) for
  * random normals (3x3..5x5 random grids) and random horizons, several K, azimuth0, channels. */
@@ -2715,7 +2715,7 @@ TEST(env_prefix_uniform_equals_eq5)
     }
 }
 
-/* The same through the L_p table with odd M (spec §12.12): N = up with horizons at or below
+/* The same through the L_p table with odd M (docs/errata.md E9): N = up with horizons at or below
  * the horizontal is exact; N = up with raised horizons carries only the theta_h interpolation
  * error; random normals carry the theta_n interpolation error. */
 TEST(env_lp_uniform_equals_eq5)
@@ -2815,7 +2815,7 @@ static double env_t_texel_integral(double th0, double th1, double ph0, double ph
 }
 
 /* One bright texel straddling phi = 0 across two columns (wrap), a sector boundary inside each
- * texel, K odd, and a texel below the horizontal (seen by tilted receivers on peaks, spec §11
+ * texel, K odd, and a texel below the horizontal (seen by tilted receivers on peaks, docs/errata.md
  * item 15); horizons cut through the texels (partial bands). Prefix path against the
  * numerical integral written above. */
 TEST(env_sun_texel_prefix_vs_numeric)
@@ -2887,7 +2887,7 @@ static void env_t_rel_diff(const float *x, const float *ref, int n, double *mean
  * M = 15. (P1 Fig. 7 reports mean 0.03% / max 0.42% at resolution 16, against a 256-sample
  * reference: its percentages cannot be per-pixel relative errors of this scheme.) In theta_h
  * the error grows with the sharpness of the sky in theta (the third channel is one bright band).
- * Part 2, a sky varying in azimuth: the table also drops the b_k C_k term (spec §5.4), an
+ * Part 2, a sky varying in azimuth: the table also drops the b_k C_k term ([P1] Eq. 6-7; docs/errata.md E9), an
  * O(K^-2) difference even at M = 255. */
 TEST(env_lp_vs_prefix)
 {
@@ -3302,7 +3302,7 @@ static void run_env_tests(void)
 
 
 
-/* test_p2.c - P2 intervisibility tests (spec heightfield §7-9, §11, §12.1, §12.3, §12.9-12.11):
+/* test_p2.c - P2 intervisibility tests ([P2] §4-7, §10.1; docs/errata.md; [P2] §6):
  * the convex-hull tree against the naive visible sets, the field sweeps against their oracles,
  * indirect light (band rule, furnace identity), terrain GI and direct light. */
 
@@ -3320,7 +3320,7 @@ static double p2t_unit(void) { return (double)(p2t_next() >> 11) * (1.0 / 900719
 static int p2t_int(int n) { return (int)(p2t_next() % (uint64_t)n); }
 
 /* ---------------------------------------------------------------------------------------- */
-/* 1. The hull tree against the naive visible sets (spec §7.6, §7.8, §8, §12.9, §12.11)      */
+/* 1. The hull tree against the naive visible sets (docs/errata.md E14; [P2] §6; [P2] §10.1) */
 /* ---------------------------------------------------------------------------------------- */
 
 #define P2T_NMAX 300
@@ -3353,7 +3353,7 @@ static void p2t_make_line(int kind, int n, int nonuniform, double *d, double *h)
         case P2T_PLATEAU: h[i] = i > 0 && p2t_int(4) != 0 ? h[i - 1] : (double)p2t_int(7); break;
         case P2T_MONOTONE: h[i] = (i ? h[i - 1] : 0.0) + (a > 0.5 ? 1.0 : -1.0) * 3.0 * p2t_unit(); break;
         case P2T_SINE: h[i] = 5.0 * sin(0.13 * a * (double)i + ph) + 0.3 * (p2t_unit() - 0.5); break;
-        /* spec §12.9: bowl with every other sample lowered: O(n^2) iterations. Lowered by
+        /* [P2] §6: bowl with every other sample lowered: O(n^2) iterations. Lowered by
          * 2|e| + 8 so every lowered sample is a cup at any position (a fixed 0.5 on e^2 is too
          * shallow: t stays ~n; measured t = 14756 at n = 300 here) */
         case P2T_WORST: h[i] = e * e - ((i & 1) ? 2.0 * fabs(e) + 8.0 : 0.0); break;
@@ -3425,7 +3425,7 @@ TEST(p2t_tree_vs_naive)
                     }
                     sum_min += nmin;
                     receivers++;
-                    /* spec §12.9 shapes */
+                    /* [P2] §6 shapes */
                     if (k >= 1 && kind == P2T_DOME && (nvn != 1 || vis_n[0] != k - 1 || m != 1)) bad_shape++;
                     if (k >= 1 && kind == P2T_BOWL && (nvn != k || nl != 1 || loc_n[0] != 0 || m != 1))
                         bad_shape++;
@@ -3437,7 +3437,7 @@ TEST(p2t_tree_vs_naive)
             }
             t = hfvis_hull_tree_iterations(tree[c]);
             CHECK(hfvis_hull_tree_count(tree[c]) == n);
-            /* [P2] §6 (spec §7.8): t <= 2m + n, n the steps of the line */
+            /* [P2] §6: t <= 2m + n, n the steps of the line */
             if (t > 2 * msum + n) {
                 if (bad_bound++ < 3)
                     fprintf(stderr, "  line %d kind %d n=%d config %d: t=%lld > 2m+n = %lld\n", line, kind,
@@ -3458,8 +3458,8 @@ TEST(p2t_tree_vs_naive)
     CHECK(bad_cfg == 0);
     CHECK(bad_bound == 0);
     CHECK(bad_shape == 0);
-    /* the worst case is quadratic: at n = 300 the spec's n = 201 rate (39.8 tests per step,
-     * spec §7.6) gives ~12000; a linear algorithm would stay near 2-3 n */
+    /* the worst case is quadratic: at n = 300 the quoted n = 201 rate (39.8 tests per step,
+     * docs/errata.md E14) gives ~12000; a linear algorithm would stay near 2-3 n */
     CHECK(worst_n == P2T_NMAX && worst_t > (long long)P2T_NMAX * P2T_NMAX / 10);
     printf("  tree: %lld receivers, t/step %.2f, m/step %.2f, minimal/step %.2f, worst t=%lld (n=%lld)\n",
            receivers, sum_t / (double)receivers, sum_m / (double)receivers, sum_min / (double)receivers,
@@ -3579,7 +3579,7 @@ TEST(p2t_tree_api_errors)
     free(mem);
 }
 
-/* Holes in the line arrays (spec §11, hfvis.h: never visible, never occlude): the naive and
+/* Holes in the line arrays (docs/errata.md, hfvis.h: never visible, never occlude): the naive and
  * from-horizons results on a line with holes equal those of the line with the holes removed,
  * indices mapped back; the horizons come from a tree fed the compacted line. */
 TEST(p2t_line_holes)
@@ -3668,7 +3668,7 @@ TEST(p2t_line_holes)
 #define P2T_DIRECT_REL (4.0 / 16777216.0)
 #define P2T_PART_REL (3.0 / 16777216.0)
 
-/* A test field: 0 fBm, 1 bricks ([P2] Fig. 7), 2 flat, 3 tilted plane (spec §12.2, normals
+/* A test field: 0 fBm, 1 bricks ([P2] Fig. 7), 2 flat, 3 tilted plane (normals
  * constant); holes: about 1 in 30 samples NaN. */
 static void p2t_field(int kind, int W, int H, uint64_t seed, int holes, float *z)
 {
@@ -3806,7 +3806,7 @@ TEST(p2t_visibility_count)
            naive_it, tree_it / naive_it);
 }
 
-/* Flat field: every sample before the receiver on its line is visible (ties count, spec §7.6). */
+/* Flat field: every sample before the receiver on its line is visible (ties count, docs/errata.md E14). */
 TEST(p2t_visibility_flat)
 {
     static float z[P2T_W * P2T_H], out[P2T_W * P2T_H];
@@ -3921,7 +3921,7 @@ TEST(p2t_intervisibility)
 }
 
 /* ---------------------------------------------------------------------------------------- */
-/* 4. Indirect light (spec §9 band rule, §12.3, §12.10)                                     */
+/* 4. Indirect light (docs/errata.md E17 band rule, §12.3, §12.10)                          */
 /* ---------------------------------------------------------------------------------------- */
 
 TEST(p2t_indirect_vs_naive)
@@ -3977,7 +3977,7 @@ TEST(p2t_indirect_vs_naive)
 }
 
 /* sum_k S_k(c_k) at grid point (x, y) from the grid normals ([P1] Eq. 5 with the clamp
- * c_k = pi/2 + atan2(a_k, N_z), spec §5.2), directions psi_k = 2 pi k / K, k in [k0, k1).
+ * c_k = pi/2 + atan2(a_k, N_z), docs/errata.md E3), directions psi_k = 2 pi k / K, k in [k0, k1).
  * The normal is renormalised and rounded to float as the lattice does with its bilinear
  * normals (at a grid point the bilinear weight is 1). */
 static double p2t_furnace(const float *nrm, int W, int x, int y, int K, int k0, int k1)
@@ -3994,7 +3994,7 @@ static double p2t_furnace(const float *nrm, int W, int x, int y, int K, int k0, 
     return sum;
 }
 
-/* Furnace (spec §12.10): exit radiance == sky == c gives c * sum_k S_k(c_k) whatever the
+/* Furnace (docs/errata.md E17): exit radiance == sky == c gives c * sum_k S_k(c_k) whatever the
  * geometry; flat field: exactly c. On the axis directions the lattice nodes are grid points and
  * the lattice normals the grid normals, so the identity holds to float rounding per point
  * (each axis direction alone via direction_begin/end). The diagonal lattices of K = 8 have
@@ -4116,7 +4116,7 @@ TEST(p2t_indirect_sky_only)
  * identity indirect = L_s (F - V_K) with F the lattice furnace sum (exit = sky = 1) to float
  * rounding. F is 1 only where the lattice normal is up: the diagonal lattices' nodes lie off
  * the bottom and their bilinear normals tilt, so L_s (1 - V_K) holds there only up to the
- * gather (printed, spec §12.3 notes the same kink interpolation for V). */
+ * gather (printed notes the same kink interpolation for V). */
 TEST(p2t_indirect_valley)
 {
     enum { W = 33, H = 29 };
@@ -4175,7 +4175,7 @@ TEST(p2t_indirect_valley)
 }
 
 /* ---------------------------------------------------------------------------------------- */
-/* 5. Terrain GI with bounces (spec §9 multi-bounce)                                        */
+/* 5. Terrain GI with bounces (docs/errata.md E17 multi-bounce)                             */
 /* ---------------------------------------------------------------------------------------- */
 
 TEST(p2t_terrain_gi)
@@ -4199,7 +4199,7 @@ TEST(p2t_terrain_gi)
         emis[i] = (i % 7 == 0) ? (float)(3.0 * p2t_unit()) : 0.0f;
         amap[i] = rho;
     }
-    /* flat field: the surface occupies no solid angle (spec §12.1), no indirect for any bounce;
+    /* flat field: the surface occupies no solid angle, no indirect for any bounce;
      * bounces = 0 on any field: emission + albedo * direct, as the library rounds it */
     p2t_field(2, W, H, 1, 0, z);
     for (bounces = 0; bounces <= 3; bounces++) {

@@ -1,5 +1,5 @@
-/* test_iv.c - incremental image-based voxelization ([G12] ch. 7, spec voxel §4): the exact
- * analytic numbers of spec §4.11, the per-voxel oracle against cleanup / single pass, the
+/* test_iv.c - incremental image-based voxelization ([G12] ch. 7): the exact
+ * analytic numbers of the per-voxel oracle against cleanup / single pass, the
  * conservative footprint's guarantee, convergence of a moved object, injection, the lighting
  * variant (§7.5), the Table 9 metric against its brute-force oracle, bad arguments and
  * allocation failures. Scenes come from an analytic ray caster written here (planes, spheres,
@@ -14,7 +14,7 @@
 
 /* zw -> z_e -> zw in double: a few ulps of numbers of size f/(f-n) */
 #define IV_ROUNDTRIP_TOL 1e-12
-/* the spec's printed zw = 0.666667 and b = 0.027063 (six decimals) */
+/* the quoted printed zw = 0.666667 and b = 0.027063 (six decimals) */
 #define IV_SPEC_PRINT_TOL 5e-7
 /* exact point-triangle distances of simple configurations, in double */
 #define IV_DIST_TOL 1e-15
@@ -82,7 +82,7 @@ static void iv_image(hfvis_depth_image *im, const hfvis_view *v, const float *de
     im->attribute_count = nattr;
 }
 
-/* The spec §4.11 camera: at (0.5, 0.5, 3) looking down -z, fovy 60 deg, 256^2, n 1, f 10. */
+/* The camera: at (0.5, 0.5, 3) looking down -z, fovy 60 deg, 256^2, n 1, f 10. */
 static void iv_spec_view(hfvis_view *v)
 {
     const double eye[3] = {0.5, 0.5, 3.0}, target[3] = {0.5, 0.5, 0.0}, up[3] = {0.0, 1.0, 0.0};
@@ -253,7 +253,7 @@ TEST(iv_eq16_round_trip)
                     CHECK_NEAR(ze, 2.0 * n * f / ((f - n) * (2.0 * zw - 1.0) - (f + n)), 1e-12 * f, 0.0);
             }
         }
-    /* spec §4.11: eye depth 2.5 with n = 1, f = 10 -> zw = f(d-n)/(d(f-n)) = 0.666667 */
+    /* eye depth 2.5 with n = 1, f = 10 -> zw = f(d-n)/(d(f-n)) = 0.666667 */
     CHECK_NEAR(hfvis_eye_z_to_depth(-2.5, 1.0, 10.0, 0), 0.666667, IV_SPEC_PRINT_TOL, 0.0);
     CHECK_NEAR(hfvis_depth_to_eye_z(2.0 / 3.0, 1.0, 10.0, 0), -2.5, 1e-14, 0.0);
 }
@@ -264,7 +264,7 @@ TEST(iv_bias_rules)
     hfvis_iv_options o = hfvis_iv_options_default();
     double b = -1.0;
     iv_grid(&g, 32, 32, 32, 0, 0, 0, 1.0 / 32, 1.0 / 32, 1.0 / 32);
-    /* spec §4.11: b = (sqrt 3 / 2) s = 0.027063 for s = 1/32 */
+    /* b = (sqrt 3 / 2) s = 0.027063 for s = 1/32 */
     CHECK_NEAR(hfvis_iv_bias_half_diagonal(&g), 0.027063, IV_SPEC_PRINT_TOL, 0.0);
     CHECK(hfvis_iv_bias_half_diagonal(&g) == 0.5 * sqrt(3.0 / 1024.0));
     CHECK_EQ_STATUS(hfvis_iv_bias(&g, NULL, &b), HFVIS_OK);
@@ -294,12 +294,12 @@ TEST(iv_bias_rules)
     CHECK(hfvis_iv_bias_half_diagonal(&g) == 6.5);
 }
 
-/* ---- spec §4.11 items 1-3: the plane z = 0.5 seen from (0.5, 0.5, 3) ----------------------- */
+/* ----  the plane z = 0.5 seen from (0.5, 0.5, 3) ----------------------- */
 
 static float iv_plane_depth[256 * 256];
 static float iv_plane_attr[256 * 256 * 2];
 
-/* spec §4.11 item 1: cleanup of a full 32^3 volume: cleared 15,360 (k = 17..31), band 2,048
+/* cleanup of a full 32^3 volume: cleared 15,360 (k = 17..31), band 2,048
  * (k = 15, 16), kept 15,360 (k = 0..14). The margins are wide (the nearest centre is 0.0114
  * from a zone boundary), so the float depth of 2/3 does not matter. */
 TEST(iv_spec_cleanup_counts)
@@ -380,7 +380,7 @@ TEST(iv_spec_cleanup_counts)
     }
 }
 
-/* spec §4.11 item 2: single-pass IV from an empty volume turns on exactly the 2,048 band
+/* single-pass IV from an empty volume turns on exactly the 2,048 band
  * voxels (k = 15, 16), with the attributes of the centre texel. */
 TEST(iv_spec_single_pass)
 {
@@ -424,11 +424,11 @@ TEST(iv_spec_single_pass)
     CHECK(bad == 0);
 }
 
-/* spec §4.11 item 3: two-stage injection with a 256^2 grid from an empty volume: exactly 1,024
+/* two-stage injection with a 256^2 grid from an empty volume: exactly 1,024
  * voxels, all in one layer. The plane z = 0.5 lies exactly on the boundary of layers 15 and 16,
  * so the layer depends on rounding: the float depth of 2/3 rounds UP (0.66666669), eq. 16 puts
  * the points at z = 0.5 - 1.1e-7 and every point lands in layer 15 (IEEE binary32, any
- * compiler). The robust construction of the spec's "layer 16" is the plane a quarter voxel
+ * compiler). The robust construction of the quoted "layer 16" is the plane a quarter voxel
  * higher, z = 0.5 + 1/128: exactly 1,024 voxels, all in layer 16. */
 TEST(iv_spec_injection)
 {
@@ -739,7 +739,7 @@ TEST(iv_conservative_guarantee)
            lost_cons);
 }
 
-/* ---- spec §4.11 item 4: a moved object ------------------------------------------------------ */
+/* ---- a moved object ------------------------------------------------------ */
 
 TEST(iv_moved_object_analytic)
 {
@@ -813,7 +813,7 @@ TEST(iv_moved_object_analytic)
     }
 }
 
-/* ---- spec §4.11 item 5: convergence of a moved sphere (analytic scene) ---------------------- */
+/* ---- convergence of a moved sphere (analytic scene) ---------------------- */
 
 /* Voxels of `vol` not within b (+ eps) of the sphere surface (centre c, radius r). */
 static size_t iv_stale_sphere(const hfvis_volume *vol, const double c[4], double b, size_t *hidden)
@@ -997,7 +997,7 @@ TEST(iv_single_pass_order_and_update)
     for (i = 0; i < (size_t)N * N * N; i++)
         if (a[2 * i] != 0.0f && a[2 * i + 1] != 1.0f && a[2 * i + 1] != 2.0f) bad++;
     CHECK(bad == 0);
-    /* a voxel cleared by image 1 can be turned on by image 2 (order dependence, spec §4.10) */
+    /* a voxel cleared by image 1 can be turned on by image 2 (order dependence, [G12] ch. 7) */
     {
         int found = 0, x, y, z;
         for (z = 0; z < N && !found; z++)
@@ -1028,7 +1028,7 @@ TEST(iv_single_pass_order_and_update)
     CHECK(memcmp(c, a, sizeof c) == 0 && st.cleared == 0);
 }
 
-/* The lighting variant (§7.5, spec §4.6): the injection volume is cleared every frame, lights
+/* The lighting variant (§7.5, [G12] ch. 7): the injection volume is cleared every frame, lights
  * are injected with ADD, the camera with REPLACE; after cleanup every non-empty injection voxel
  * replaces the attribute volume's values. */
 TEST(iv_lighting_replace_nonempty)
@@ -1446,7 +1446,7 @@ static size_t iv_stale_mesh(const hfvis_volume *vol, const hfvis_mesh *m, double
     return n;
 }
 
-/* spec §4.11 item 4 on a rasterized scene: the room with an extra box that moves; after views
+/* on a rasterized scene: the room with an extra box that moves; after views
  * covering its old place no stale voxel is left there. */
 TEST(iv_scene_moved_object_room)
 {
@@ -1575,7 +1575,7 @@ TEST(iv_scene_convergence_table9)
             off_centre += (int)st.turned_off;
         }
     CHECK(off_centre > 5 * off);
-    /* spec §4.11 item 5: the IV set stays within the all-axes geometric voxelization dilated by
+    /* the IV set stays within the all-axes geometric voxelization dilated by
      * ceil(b/s) = 1 voxel */
     {
         hfvis_voxelize_options vo = hfvis_voxelize_options_default();

@@ -1,6 +1,6 @@
 /* test_lk.c - Laine-Karras bitmask ray-cast AO (ssao.c section 5): ray sets, frames, masks, the
  * plane table, the three methods (rasterization, BVH traversal, ray caster) and their exact
- * agreement, the analytic cases of spec A.14, culling, LOD windows, bad arguments, failing
+ * agreement, the analytic cases of culling, LOD windows, bad arguments, failing
  * allocators. */
 #include "hfvis.h"
 #include "test.h"
@@ -275,7 +275,7 @@ static hfvis_view persp(const double eye[3], const double tgt[3], double fov_deg
 }
 
 /* ---------------------------------------------------------------------------------------- */
-/* ray sets (spec A.2, A.14-7)                                                               */
+/* ray sets ([LK] §3; docs/errata.md E44)                                                    */
 /* ---------------------------------------------------------------------------------------- */
 
 TEST(rays_lloyd_set)
@@ -316,7 +316,7 @@ TEST(rays_lloyd_set)
             CHECK_NEAR(mz2, 0.5, TOL_MOMENT_LLOYD, 0.0);
             CHECK_NEAR(mx2, 0.25, TOL_MOMENT_LLOYD, 0.0);
             CHECK_NEAR(my2, 0.25, TOL_MOMENT_LLOYD, 0.0);
-        } else { /* spec A.14-7: about 2/sqrt(N) */
+        } else { /* about 2/sqrt(N) */
             CHECK_NEAR(mz, 2.0 / 3.0, 2.0 / sqrt((double)n), 0.0);
             CHECK_NEAR(mz2, 0.5, 2.0 / sqrt((double)n), 0.0);
         }
@@ -544,7 +544,7 @@ TEST(rays_alloc_failures)
 }
 
 /* ---------------------------------------------------------------------------------------- */
-/* receiver frame (spec A.3)                                                                 */
+/* receiver frame ([LK] §3; docs/errata.md E45)                                              */
 /* ---------------------------------------------------------------------------------------- */
 
 TEST(frame_orthonormal_and_jitter)
@@ -617,7 +617,7 @@ TEST(frame_orthonormal_and_jitter)
 }
 
 /* ---------------------------------------------------------------------------------------- */
-/* masks: plane mask, triangle mask vs independent ray tests, LUT (spec A.4, A.14-9/12)     */
+/* masks: plane mask, triangle mask vs independent ray tests, LUT ([LK] §3.1, Fig. 1)     */
 /* ---------------------------------------------------------------------------------------- */
 
 /* Independent oracle in double (Moller-Trumbore on the world segment p -> p + l w, both ends
@@ -715,7 +715,7 @@ TEST(plane_mask_and_lut)
     for (i = 0, bad = 0; i < 128; i++)
         bad += (int)((mask[i >> 5] >> (i & 31)) & 1u) != (rays.point[3 * i + 2] >= 0.5);
     CHECK(bad == 0);
-    /* node indexing (spec A.4.2): T = 3, m = +x: d = 0 -> the outer shell, d = r -> centre */
+    /* node indexing ([LK] §3.1; docs/errata.md E40): T = 3, m = +x: d = 0 -> the outer shell, d = r -> centre */
     CHECK_EQ_STATUS(hfvis_lk_lut_index(3, (const double[3]){1.0, 0.0, 0.0}, 0.0, ijk), HFVIS_OK);
     CHECK(ijk[0] == 2 && ijk[1] == 1 && ijk[2] == 1);
     CHECK_EQ_STATUS(hfvis_lk_lut_index(3, (const double[3]){1.0, 0.0, 0.0}, 1.0, ijk), HFVIS_OK);
@@ -893,7 +893,7 @@ TEST(triangle_mask_bad_args)
 }
 
 /* ---------------------------------------------------------------------------------------- */
-/* analytic cases (spec A.14-1..6), every method                                             */
+/* analytic cases (..6), every method                                                        */
 /* ---------------------------------------------------------------------------------------- */
 
 /* Rays of s_dim >= c (dim 0..2, sign +-1). */
@@ -1256,7 +1256,7 @@ TEST(analytic_closed_box)
 }
 
 /* ---------------------------------------------------------------------------------------- */
-/* the three methods agree bit for bit (spec A.14-8)                                         */
+/* the three methods agree bit for bit                                                       */
 /* ---------------------------------------------------------------------------------------- */
 
 static void tm_add_xf(tmesh *tm, const hfvis_mesh *src, double s, double ox, double oy, double oz)
@@ -1448,7 +1448,7 @@ TEST(three_methods_identical_on_soups)
 }
 
 /* ---------------------------------------------------------------------------------------- */
-/* culling never removes an occluder; the paper's far-depth test does (spec A.5, A.13-1)     */
+/* culling never removes an occluder; the paper's far-depth test does ([LK] §4.2, §5; docs/errata.md E39) */
 /* ---------------------------------------------------------------------------------------- */
 
 TEST(culling_never_changes_masks)
@@ -1576,7 +1576,7 @@ TEST(paper_far_depth_test_drops_occluders)
 }
 
 /* ---------------------------------------------------------------------------------------- */
-/* LOD windows (spec A.4.3, A.14-11)                                                         */
+/* LOD windows ([LK] §4.3; docs/errata.md E42)                                               */
 /* ---------------------------------------------------------------------------------------- */
 
 TEST(lod_window_identities)

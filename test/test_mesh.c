@@ -12,7 +12,7 @@
 
 /* Tolerances */
 #define T_FLOAT_REL 1e-6     /* area/volume of float-rounded vertices vs double closed form */
-#define T_SPHERE_S5 3e-4     /* icosphere s=5 area vs the spec's 5025.0 (rounded to 0.1) */
+#define T_SPHERE_S5 3e-4     /* icosphere s=5 area vs the quoted 5025.0 (rounded to 0.1) */
 #define T_CONVERGE 2e-3      /* fine tessellations vs the smooth surface's area/volume */
 #define T_COORD 1e-6         /* float rounding of O(1) coordinates (2^-23 = 1.2e-7 relative) */
 #define T_ANGLE 1e-6         /* angle from two float-rounded O(1) points, 0.15 apart */
@@ -241,7 +241,7 @@ TEST(icosphere)
             CHECK_NEAR(V, 5.0 * (3.0 + sqrt(5.0)) / 12.0 * a * a * a, 0.0, T_FLOAT_REL);
         }
         if (s == 5) {
-            printf("  icosphere s=5 r=20: area %.4f (spec 5025.0), volume %.3f\n", mesh_area(&m), V);
+            printf("  icosphere s=5 r=20: area %.4f (prototype 5025.0), volume %.3f\n", mesh_area(&m), V);
             CHECK_NEAR(mesh_area(&m), 5025.0, 0.0, T_SPHERE_S5);
         }
         hfvis_mesh_free(NULL, &m);
@@ -403,8 +403,8 @@ TEST(generators_alloc_failure)
 
 /* ---- more generator checks ------------------------------------------------------------ */
 
-/* Kahler's base icosahedron and the first subdivision's face order (the construction the spec
- * voxel §3.13 counts were made with). */
+/* Kahler's base icosahedron and the first subdivision's face order (the construction the prototype
+ * voxel counts were made with). */
 TEST(icosphere_construction)
 {
     const double c[3] = {0.0, 0.0, 0.0}, t = (1.0 + sqrt(5.0)) / 2.0;
@@ -440,8 +440,8 @@ TEST(icosphere_construction)
     hfvis_mesh_free(NULL, &m);
 }
 
-/* The pixel-centre dominant-axis rule of spec voxel §3.4 (as the spec's prototype; no ties occur
- * on this mesh), counting voxels of a 64^3 unit grid: reproduces the spec §3.13 test 4 numbers
+/* The pixel-centre dominant-axis rule of [G12] ch. 6 (as the quoted prototype; no ties occur
+ * on this mesh), counting voxels of a 64^3 unit grid: reproduces the  numbers
  * with this icosphere (dominant 4147, all three axes 4183). */
 static long proto_voxel_count(const hfvis_mesh *m, int all_axes)
 {

@@ -1,6 +1,6 @@
 /* test_ssao.c - tests of ssao.c: camera and depth helpers, falloffs, directions and the line
- * lattice, P3 line-sweep AO against its brute-force oracle and the closed forms of spec
- * screenspace-p3-p4 §6, HBAO, the screen-space ray-traced reference, bad arguments and
+ * lattice, P3 line-sweep AO against its brute-force oracle and analytic closed forms,
+ * HBAO, the screen-space ray-traced reference, bad arguments and
  * allocation failure at every site. */
 #include "hfvis.h"
 #include "test.h"
@@ -458,7 +458,7 @@ TEST(directions)
 
 /* Every lattice sample lies in the texel-centre rectangle, lines are D_L apart, steps share
  * the origin, the sample count matches the lines, and the nearest sample of every pixel lies
- * within sqrt((D_S/2)^2 + (D_L/2)^2) (spec §2.3). */
+ * within sqrt((D_S/2)^2 + (D_L/2)^2) ([P3] §5.1, [P4] §6). */
 TEST(lattice)
 {
     hfvis_camera c;
@@ -544,7 +544,7 @@ TEST(lattice)
 /* 3. P3 line-sweep AO                                                                        */
 /* ========================================================================================== */
 
-/* a random profile rarely produces hull degeneracies: spec §6 T2 asks for >= ~88 % of the
+/* a random profile rarely produces hull degeneracies: asks for >= ~88 % of the
  * receivers to agree and a mean |error| <~ 1e-3 with the tie rule */
 #define T2_MIN_AGREE 0.88
 #define T2_MAX_MEAN_ERR 1e-3
@@ -644,7 +644,7 @@ TEST(lsao_line_exact_cases)
     CHECK_EQ_STATUS(hfvis_lsao_line(x, y, NULL, NULL, 3, 0, &o, stack, out), HFVIS_ERR_INVALID_ARGUMENT);
 }
 
-/* T2 random profiles (spec §3.3 setup: perspective profiles, smooth depth plus 4 depth steps):
+/* T2 random profiles ([P3] §4.2, Alg. 1 setup: perspective profiles, smooth depth plus 4 depth steps):
  * with falloff NONE the hull equals the oracle exactly; with rho_q the tie rule agrees on
  * >= 88 % of receivers with mean |error| <= 1e-3, and the paper's strict '<' is clearly worse
  * (the regression test for the tie rule). */
@@ -903,7 +903,7 @@ TEST(lsao_t1_real_tangent_plane)
 
 /* T5, LSAO closed form (ortho, fixed tangent, K = 4 axis directions, nearest, the cliff between
  * texel columns): toward the cliff v = max(-0.85 + 0.85 rho(d), -0.85 + (H/D' + 0.85) rho(D')),
- * the other three directions -0.85 + 0.85 rho(d) each (spec §6 T5). */
+ * the other three directions -0.85 + 0.85 rho(d) each. */
 TEST(lsao_t5_step_closed_form)
 {
     enum { W = 48, H = 20, X0 = 30 };
@@ -1112,10 +1112,10 @@ TEST(lsao_bad_args_and_oom)
 }
 
 /* ========================================================================================== */
-/* 4. Analytic scenes, closed forms (spec §6), HBAO and the ray-traced reference              */
+/* 4. Analytic scenes, closed forms, HBAO and the ray-traced reference                        */
 /* ========================================================================================== */
 
-/* S(x) = acos(x) - x sqrt(1 - x^2) for 0 <= x < 1, 0 for x >= 1 (spec §6 symbols) */
+/* S(x) = acos(x) - x sqrt(1 - x^2) for 0 <= x < 1, 0 for x >= 1 */
 static double S_fn(double x) { return x >= 1.0 ? 0.0 : acos(x) - x * sqrt(1.0 - x * x); }
 /* T5 COS, receiver on the floor at L from a cliff of height H (T4 wall: H -> infinity) */
 static double cos_step_none(double L, double H) { return 0.5 * (1.0 - L / sqrt(L * L + H * H)); }
@@ -1135,7 +1135,7 @@ static double cos_pit_R(double Rb, double R) { double v = (R / (2.0 * Rb)) * (R 
 
 TEST(closed_forms_consistent)
 {
-    /* the spec's numerical checks: H -> infinity of the step is the wall; step/pit limits */
+    /* the quoted numerical checks: H -> infinity of the step is the wall; step/pit limits */
     CHECK_NEAR(cos_step_none(1.0, 1e9), 0.5, 1e-9, 0.0);
     CHECK_NEAR(cos_step_q(1.3, 1e7, 2.0), 0.5 + 0.8450 - 0.919239 * sqrt(1.0 + 0.845), 1e-5, 0.0);
     CHECK_NEAR(cos_step_R(1.0, 1e9, 2.0), S_fn(0.5) / PI, 1e-9, 0.0);
@@ -1229,7 +1229,7 @@ static double col_mean(const float *ao, int w, int h, int x)
 }
 
 /* T5 / T4: the ray tracer against the COS closed forms of a cliff, ortho and perspective, for
- * rho = 1, rho_q and rho_R (spec §6 T9: within 3 sigma). */
+ * rho = 1, rho_q and rho_R (within 3 sigma). */
 TEST(raytrace_step_cos)
 {
     enum { W0 = 200, H0 = 400, GX = 98, GY = 198, IW = 4, IH = 4, RAYS = 1024 };
@@ -1353,7 +1353,7 @@ static hfvis_hbao_options hbao_whole_buffer(int width, int height)
     return o;
 }
 
-/* HBAO against the SA closed forms (spec §6): T5 cliff with K = 4 axis directions exactly
+/* HBAO against the SA closed forms: T5 cliff with K = 4 axis directions exactly
  * H/sqrt(H^2 + l^2)/4 (l = L + px/2: the first plateau texel centre); T6 groove K = 4:
  * sin(beta)/2 exactly; T7 pit: sin 45 deg and, with rho_q, the integral of rho(2 Rb s). */
 TEST(hbao_sa_closed_forms)
@@ -1584,7 +1584,7 @@ TEST(hbao_rt_bad_args_and_oom)
 }
 
 /* HBAO details: jitter is deterministic per seed; the three variants are ordered as the
- * spec's definitions imply on a pit with rho = 1 (INCREMENTAL = SINGLE_HORIZON: the sum of
+ * quoted definitions imply on a pit with rho = 1 (INCREMENTAL = SINGLE_HORIZON: the sum of
  * the rises is the top minus sin t); a radius limits the march. */
 TEST(hbao_variants_jitter)
 {
@@ -1726,12 +1726,12 @@ static int render_scene(int which, int W0, int H0, int gx, int gy, float *depth,
 /* T9: LSAO against the brute-force HBAO LARGEST_OCCLUDER mode with equal parameters (the same
  * box directions and integer steps, nearest texels, fixed tangent, paper plane, falloff) on
  * rendered scenes: they differ only by hull degeneracies and by the gather reading the nearest
- * lattice sample instead of the pixel itself (spec: "virtually identical", mean |d| < 1e-3 for
+ * lattice sample instead of the pixel itself ([P3] §6: "virtually identical", mean |d| < 1e-3 for
  * the degeneracies alone). */
 #define LSAO_HBAO_MEAN_TOL 0.02 /* measured below; the gather offset of up to
                                    sqrt((D_S/2)^2 + (D_L/2)^2) px dominates */
 #define LSAO_HBAO_EXACT_TOL 1e-6 /* per-direction float rounding in LSAO, averages of K = 4 */
-#define LSAO_HBAO_DEGENERATE_TOL 1e-3 /* spec §6 T9: hull degeneracies only */
+#define LSAO_HBAO_DEGENERATE_TOL 1e-3 /* hull degeneracies only */
 TEST(lsao_vs_hbao_scenes)
 {
     enum { W0 = 112, H0 = 84, GX = 8, GY = 6, IW = W0 - 2 * GX, IH = H0 - 2 * GY };

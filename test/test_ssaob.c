@@ -1,4 +1,4 @@
-/* test_ssaob.c - tests of the P4 far-field AO part of ssao.c (spec screenspace-p3-p4 §5, §6):
+/* test_ssaob.c - tests of the P4 far-field AO part of ssao.c ([P4]):
  * the slab integral (quadrature, closed form, table), virtual points, sector weights, the slice
  * estimator against the closed forms of T5, FFAO on the analytic scenes of §6 against the closed
  * forms and the ray-traced reference, the mipmap baseline, error metrics, the blur, goldens, bad
@@ -22,7 +22,7 @@
 /* AO output is float: a plane gives exactly 0 up to the rounding of a = d + pi/2 */
 #define TOL_PLANE 1e-5
 /* FFAO vs a closed form on the analytic scenes at K = 16 x 2 with virtual points and
- * averaging: spec §6 T9 expects 2-5 %; FFAO under-estimates where the geometry is in the near
+ * averaging: expects 2-5 %; FFAO under-estimates where the geometry is in the near
  * field (1-px direct samples along the sector's centre line, the bilinear smear of a cliff) or
  * where a virtual point lands up to B0 px past an edge (§5.4): measured 0.051 (step, receiver
  * 9.5 px from the cliff), 0.057 (pit bottom, R = 20 px), 0.001 (groove) */
@@ -30,7 +30,7 @@
 /* FFAO vs the ray-traced reference, mean absolute error over the image (e_A) on the scenes
  * below: P4 claims "within a few percent"; measured 0.2-1.4 % */
 #define TOL_FFAO_EA 0.02
-/* the ray tracer against a closed form (spec §6 T9: 3 sigma of 256 rays ~ 0.5-1 %) */
+/* the ray tracer against a closed form (3 sigma of 256 rays ~ 0.5-1 %) */
 #define TOL_RT 0.02
 /* goldens: the same code on another compiler/libm may round differently in atan2/sin; AO is
  * a sum of ~100 slab integrals of float inputs */

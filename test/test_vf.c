@@ -1,4 +1,4 @@
-/* test_vf.c - 4D visibility fields ([G12] ch. 4, spec voxel §1): positional samples, direction
+/* test_vf.c - 4D visibility fields ([G12] ch. 4): positional samples, direction
  * maps, the build against its naive oracle, the exact sphere-in-sphere maps, queries and AO /
  * shadows / reflections against ray casting, the file codec, bad arguments and failing
  * allocations. Prints the thesis-style error tables (hit/miss disagreement, mean distance error,
@@ -274,7 +274,7 @@ TEST(vf_dirmaps)
 
 TEST(vf_sizes)
 {
-    /* spec §1.2: the thesis' memory figures are K*D^2 bytes (Fig. 42, 46/47) */
+    /* [G12] ch. 4, Fig. 42: the thesis' memory figures are K*D^2 bytes (Fig. 42, 46/47) */
     CHECK(hfvis_visfield_size(32, 64, HFVIS_VISFIELD_U8) == 17309696u);   /* "16.508 MB" */
     CHECK(hfvis_visfield_size(64, 64, HFVIS_VISFIELD_U8) == 68165632u);   /* "65.00 MB" */
     CHECK(hfvis_visfield_size(16, 32, HFVIS_VISFIELD_U8) == 1116160u);    /* "1.064 MB" */
@@ -299,7 +299,7 @@ TEST(vf_sizes)
 /* build                                                                                      */
 /* ========================================================================================== */
 
-/* Analytic 8-bit code of the concentric-sphere object (spec §1.13.3): texel square coordinates
+/* Analytic 8-bit code of the concentric-sphere object: texel square coordinates
  * (A, B), rho = max(|A|, |B|) = sin(angle to the inward normal); hit iff R rho <= r; distance
  * d = R sqrt(1 - rho^2) - sqrt(r^2 - R^2 rho^2). Returns 255 for a miss. */
 static int sphere_code(double A, double B, double R, double r)
@@ -348,7 +348,7 @@ TEST(vf_sphere_in_sphere_exact)
                 if ((want == 255) != (got == 255)) bad_hit++;
                 else if (want != 255 && abs(want - got) > TOL_Q_SPHERE) bad_q++;
                 else if (want != got) off_by_one++;
-                /* 1-bit consistency (spec §1.13.8): bit set <=> 8-bit code != miss */
+                /* 1-bit consistency: bit set <=> 8-bit code != miss */
                 hb = (((const unsigned char *)bit.maps)[tx >> 3] >> (tx & 7u)) & 1u;
                 if (hb != (got != 255)) bad_bit++;
                 /* the float and the NORMAL variant's distance byte carry the same distance */
@@ -372,7 +372,7 @@ TEST(vf_sphere_in_sphere_exact)
                 }
             }
         if (hits != 256) per_map_bad++; /* D = 32, r/R = 1/2: the 16 x 16 central texels */
-        if (m[16 * D + 16] != 64) per_map_bad++; /* texel (16, 16) stores 64 (spec §1.13.3) */
+        if (m[16 * D + 16] != 64) per_map_bad++; /* texel (16, 16) stores 64 */
     }
     printf("  sphere-in-sphere K = %zu, D = %d: %zu hit/miss errors, %zu codes off by one of %zu, "
            "max normal error %.2f deg\n", K, D, bad_hit, off_by_one, K * (size_t)D * D, max_ang);
@@ -534,7 +534,7 @@ TEST(vf_query_on_stored_rays)
     hfvis_mesh_free(NULL, &mesh);
 }
 
-/* Error statistics of outside rays against an off-centre sphere (spec §1.13.5). */
+/* Error statistics of outside rays against an off-centre sphere. */
 typedef struct ray_stats {
     double mismatch;   /* fraction of rays whose hit/miss differs from the oracle */
     double mean_err;   /* mean |d_vf - d_exact| / R over rays both call hits */
@@ -607,13 +607,13 @@ TEST(vf_table_sphere)
         }
         printf("\n");
     }
-    /* the error must shrink with K at every D (positional snapping dominates, spec §1.11) */
+    /* the error must shrink with K at every D (positional snapping dominates, [G12] ch. 4) */
     for (b = 0; b < 3; b++)
         for (a = 1; a < 3; a++) {
             CHECK(st[a][b].mismatch < st[a - 1][b].mismatch);
             CHECK(st[a][b].mean_err < st[a - 1][b].mean_err);
         }
-    /* regression bounds at K = 1090, D = 32 (spec prototype, another ray set: 4.6 %, 0.023) */
+    /* regression bounds at K = 1090, D = 32 (a prototype with another ray set: 4.6 %, 0.023) */
     CHECK(st[2][1].mismatch < 0.08); /* this ray set aims at 1.3 r: silhouette-heavy */
     CHECK(st[2][1].mean_err < 0.025);
     hfvis_bvh_free(NULL, &bvh);
@@ -636,7 +636,7 @@ static hfvis_visfield_object make_object(const hfvis_visfield *vf, const hfvis_m
     return o;
 }
 
-/* AO under a sphere (spec §1.13.4): receiver at the origin, normal +z, occluder sphere of radius
+/* AO under a sphere: receiver at the origin, normal +z, occluder sphere of radius
  * r whose centre is at distance h in the direction at angle th from the normal, fully above the
  * horizon: exact obscurance cos(th) (r/h)^2 (the sphere's form factor). */
 TEST(vf_ao_form_factor)
@@ -674,7 +674,7 @@ TEST(vf_ao_form_factor)
     hfvis_mesh_free(NULL, &ico);
 }
 
-/* A convex object does not occlude itself (spec §1.13.6): receivers on the sphere, rays in their
+/* A convex object does not occlude itself: receivers on the sphere, rays in their
  * outward hemisphere, inside queries. The reversed stored ray starts at the snapped sample, up to
  * R x covering angle (~79 deg / n) beside the true exit point, so rays near the tangent plane
  * meet the sphere early unless the bias exceeds that offset: the thesis' "intra-object AO needs
@@ -730,7 +730,7 @@ TEST(vf_ao_convex_no_self_occlusion)
     hfvis_mesh_free(NULL, &ico);
 }
 
-/* A large wall beside a floor receiver (spec §1.13.7): exactly half of the cosine-weighted
+/* A large wall beside a floor receiver: exactly half of the cosine-weighted
  * hemisphere is blocked. The ray-cast estimator is exactly 1/2 (the 16 x 16 set is symmetric
  * about every axis); the field is approximate (R x covering angle vs the receiver distance). */
 TEST(vf_ao_wall)

@@ -1,4 +1,4 @@
-/* test_volgi.c - volume-based VPL indirect illumination ([G12] ch. 5, spec voxel §2): the SH
+/* test_volgi.c - volume-based VPL indirect illumination ([G12] ch. 5): the SH
  * constants, the closed-form first-step fluxes, the mirror and closed-box cases, fast step ==
  * literal reference bit for bit, energy accounting per iteration, gather, direct light, Alg. 4,
  * the coloured room (colour bleeding, convergence), the pipeline, bad arguments, allocation
@@ -17,7 +17,7 @@
 
 /* Tolerances */
 #define TOL_EXACT 1e-12       /* double closed forms of the SH helpers (a few roundings) */
-#define TOL_SPEC7 6e-8        /* spec constants printed with 7 decimals */
+#define TOL_SPEC7 6e-8        /* constants quoted with 7 decimals */
 #define TOL_QUAD_CC 2e-4      /* 1000 x 2000 midpoint quadrature of a clamped cosine (kink) */
 #define TOL_QUAD_CONE 3e-3    /* the same quadrature of a cone indicator (discontinuous) */
 #define TOL_FLOAT 2e-6        /* values stored in float, a few roundings (relative) */
@@ -179,7 +179,7 @@ TEST(volgi_sh_constants)
     CHECK_EQ_STATUS(hfvis_volgi_sh_cone(z, PI, cz), HFVIS_OK);
     CHECK_NEAR(cz[0], 2.0 * sqrt(PI), TOL_EXACT, 0);
     CHECK_NEAR(cz[2], 0.0, TOL_EXACT, 0);
-    /* the basis is the first four values of hfvis_sh_eval (DESIGN's convention) */
+    /* the basis is the first four values of hfvis_sh_eval (the hfvis.h convention) */
     rng_state = 11;
     for (t = 0; t < 20; t++) {
         double dir[3];
@@ -286,7 +286,7 @@ TEST(volgi_inject)
     free(rad);
 }
 
-/* ---- GI.4 closed-form first step (spec §2.5, §2.10.2) --------------------------------- */
+/* ---- GI.4 closed-form first step ([G12] ch. 5, eq. 11; docs/errata.md E59) --------------------------------- */
 
 static void first_step(hfvis_volgi_transfer tr)
 {
@@ -361,7 +361,7 @@ TEST(volgi_border_escape)
     free(p), free(q), free(a);
 }
 
-/* ---- spec §2.10.3 mirror test ---------------------------------------------------------- */
+/* ---- mirror test ---------------------------------------------------------- */
 
 static void mirror_case(double nz, hfvis_volgi_reflection refl, hfvis_volgi_reflectance src, float rho)
 {
@@ -623,7 +623,7 @@ TEST(volgi_energy_accounting)
     room_free(&r);
 }
 
-/* ---- spec §2.10.4: a closed box with rho = 0 keeps everything inside --------------------- */
+/* ---- a closed box with rho = 0 keeps everything inside --------------------- */
 
 TEST(volgi_closed_box_absorbs)
 {
@@ -671,7 +671,7 @@ TEST(volgi_closed_box_absorbs)
     free(p), free(q), free(a);
 }
 
-/* ---- spec §2.10.5 linearity -------------------------------------------------------------- */
+/* ---- linearity -------------------------------------------------------------- */
 
 TEST(volgi_linearity)
 {
@@ -705,7 +705,7 @@ TEST(volgi_linearity)
     free(p1), free(p2), free(p12), free(a1), free(a2), free(a12), free(pd), free(ad);
 }
 
-/* ---- spec §2.10.6 gather ---------------------------------------------------------------- */
+/* ---- gather ---------------------------------------------------------------- */
 
 TEST(volgi_gather)
 {

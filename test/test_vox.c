@@ -1,5 +1,5 @@
 /* test_vox.c - surface voxelizers and the Volume Buffer attribute path ([G12] ch. 5 Alg. 4,
- * ch. 6 Alg. 5/6; spec voxel §3.4-3.8, §3.13). Exact analytic counts of spec §3.13, the fast
+ * ch. 6 Alg. 5/6; [G12] ch. 6, Alg. 5-6). Exact analytic counts of the fast
  * routines against their per-voxel oracle bit for bit, the output-vertex holes, 6-separation of
  * the three-axis variant, blends, callbacks, bad arguments. */
 #include "hfvis.h"
@@ -8,7 +8,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 
-/* Icosphere area of spec §3.13.4 is quoted to 0.1: 5025.0 */
+/* Icosphere area, quoted to 0.1: 5025.0 */
 #define VOX_ICO_AREA_TOL 0.05
 /* Spec §3.13.4: "within +-2 % of 0.8312 * area" for large smooth closed surfaces */
 #define VOX_AREA_PREDICTION_REL 0.02
@@ -153,7 +153,7 @@ static size_t vox_lin(const hfvis_volume_grid *g, int i, int j, int k)
 
 TEST(gs_max_slices)
 {
-    /* spec §3.7: GS floor((V-3)/4): 7, 11, 15, 19 -> 1..4; PS floor(V/3): 6, 9, 12, 15 -> 2..5 */
+    /* [G12] ch. 6; docs/errata.md E58: GS floor((V-3)/4): 7, 11, 15, 19 -> 1..4; PS floor(V/3): 6, 9, 12, 15 -> 2..5 */
     CHECK(hfvis_gs_max_slices(7, 0) == 1 && hfvis_gs_max_slices(11, 0) == 2);
     CHECK(hfvis_gs_max_slices(15, 0) == 3 && hfvis_gs_max_slices(19, 0) == 4);
     CHECK(hfvis_gs_max_slices(10, 0) == 1 && hfvis_gs_max_slices(6, 0) == 0);
@@ -175,7 +175,7 @@ TEST(options_default)
 }
 
 
-/* ---- spec §3.13 analytic counts ----------------------------------------------------------- */
+/* ---- analytic counts ----------------------------------------------------------- */
 
 static const hfvis_voxelize_method vox_methods[3] = { HFVIS_VOXELIZE_PIXEL_RULE, HFVIS_VOXELIZE_GS_SLICING,
                                                       HFVIS_VOXELIZE_FRAGMENT_CLIPPING };
@@ -760,7 +760,7 @@ TEST(watertight_shared_edges)
     }
 }
 
-/* Fragment contents (spec §3.8): barycentrics, world position at the pixel centre on the
+/* Fragment contents ([G12] ch. 6): barycentrics, world position at the pixel centre on the
  * triangle, unit normal, axis, triangle id, voxel; non-cubic cells and an offset origin. */
 typedef struct vox_cb_check {
     const hfvis_mesh *m;
@@ -939,7 +939,7 @@ TEST(attribute_callbacks)
 }
 
 
-/* ---- output-vertex limit: the thesis' holes (spec §3.7, §3.13.6; [G12] Fig. 66) ------------ */
+/* ---- output-vertex limit: the thesis' holes ([G12] ch. 6; docs/errata.md E58; [G12] Fig. 66) ------------ */
 
 /* Pixels of the pass along axis a whose column holds no voxel although its centre lies in the
  * projected triangle (the PR voxelization tells which centres are covered: one voxel each). */

@@ -130,7 +130,7 @@ TEST(views)
     CHECK_NEAR(v.proj[5], 0.5, VC_TOL_ROUND, 0);
 }
 
-/* Eq. 16 with its sign restored (spec voxel §4.2) against the projection matrix itself. */
+/* Eq. 16 with its sign restored (docs/errata.md E54) against the projection matrix itself. */
 TEST(depth_linearisation)
 {
     double proj[16], n = 0.3, f = 70.0;
