@@ -857,7 +857,9 @@ static hfvis_status hf_img_sizer(const unsigned char *head, size_t n, size_t *to
     size_t bytes;
     hfvis_status s = hf_img_header_parse(head, n, &h);
     if (s != HFVIS_OK) return s;
-    if (h.ascii) return HFVIS_OK; /* *total stays HFVIS__READ_ALL */
+    if (h.ascii) /* *total stays HFVIS__READ_ALL; text holds no NUL byte (/dev/zero, junk) */
+        return h.data_offset < n && memchr(head + h.data_offset, 0, n - h.data_offset)
+                   ? HFVIS_ERR_FORMAT : HFVIS_OK;
     if (!hf_img_data_bytes(&h, &bytes) || bytes > SIZE_MAX - h.data_offset) return HFVIS_ERR_LIMIT;
     *total = h.data_offset + bytes;
     return HFVIS_OK;

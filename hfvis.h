@@ -2979,7 +2979,9 @@ HFVIS_API hfvis_status hfvis_obj_encode(const hfvis_mesh *mesh, void *out, size_
                                         size_t *written);
 
 /* File wrappers (absent with HFVIS_NO_STDIO). load reads the whole file with alloc and decodes
- * it (hfvis_obj_decode; three allocations, the file buffer freed before returning). save encodes
+ * it (hfvis_obj_decode; three allocations, the file buffer freed before returning); a NUL byte
+ * in the first 64 KiB (no OBJ has one: /dev/zero, a binary file) is HFVIS_ERR_FORMAT before
+ * anything more is read. save encodes
  * into an HFVIS_MALLOC buffer and writes a temporary file beside path, then renames it, so path is
  * either complete or untouched. Returns the decoder's / encoder's errors, HFVIS_ERR_IO if the
  * file cannot be read or written (e.g. path is a directory), HFVIS_ERR_OUT_OF_MEMORY. */

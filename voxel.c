@@ -1643,6 +1643,14 @@ HFVIS_API hfvis_status hfvis_obj_encode(const hfvis_mesh *mesh, void *out, size_
 }
 
 #ifndef HFVIS_NO_STDIO
+/* OBJ is text without a size: read to the end, unless the first 64 KiB hold a NUL byte, which no
+ * OBJ file has (/dev/zero or a binary file is refused before it is read further). */
+static hfvis_status vx_obj_sizer(const unsigned char *head, size_t n, size_t *total)
+{
+    (void)total;
+    return memchr(head, 0, n) ? HFVIS_ERR_FORMAT : HFVIS_OK;
+}
+
 HFVIS_API hfvis_status hfvis_mesh_load(const char *path, const hfvis_allocator *alloc,
                                        hfvis_mesh *out)
 {
@@ -1650,7 +1658,7 @@ HFVIS_API hfvis_status hfvis_mesh_load(const char *path, const hfvis_allocator *
     size_t size = 0;
     hfvis_status s;
     if (!path || !out) return HFVIS_ERR_INVALID_ARGUMENT;
-    s = hfvis__read_file(path, alloc, NULL, &data, &size); /* text without a size: read whole */
+    s = hfvis__read_file(path, alloc, vx_obj_sizer, &data, &size);
     if (s != HFVIS_OK) return s;
     s = hfvis_obj_decode(data, size, alloc, out);
     vx_free(alloc, data);

@@ -886,6 +886,24 @@ TEST(files_header_first)
     a = test_counting_allocator(&state, 0);
     CHECK_EQ_STATUS(hfvis_image_load(path, &a, &px, &info), HFVIS_ERR_FORMAT);
     CHECK(state.live == 0 && state.bytes <= READ_HEAD_BYTES);
+    /* text formats have no size to announce: a P2 header followed by zeros, and an OBJ of zeros
+     * through the FIFO (as /dev/zero), are refused at the NUL bytes of the head; both were read
+     * to the end before */
+    memset(junk, 0, sizeof junk);
+    memcpy(junk, "P2\n4 4\n255\n", 11);
+    a = test_counting_allocator(&state, 0);
+    CHECK_EQ_STATUS(load_through_fifo(fifo, junk, JUNK, &a, &px, &info), HFVIS_ERR_FORMAT);
+    CHECK(state.live == 0 && state.bytes <= READ_HEAD_BYTES);
+    {
+        hfvis_mesh m;
+        char obj[128];
+        memset(junk, 0, 11);
+        CHECK(write_bytes(tmp_path(obj, sizeof obj, "zeros.obj"), junk, JUNK));
+        a = test_counting_allocator(&state, 0);
+        CHECK_EQ_STATUS(hfvis_mesh_load(obj, &a, &m), HFVIS_ERR_FORMAT);
+        CHECK(state.live == 0 && state.bytes <= READ_HEAD_BYTES);
+        CHECK(remove(obj) == 0);
+    }
     CHECK(remove(path) == 0 && remove(fifo) == 0);
 }
 
