@@ -520,6 +520,17 @@ typedef struct hfvis_sweep_options {
     int ray_denominator;            /* EXACT: bound N on the direction's integer components,
                                        1..HFVIS_RAY_DENOMINATOR_MAX; 0 = max(5, ceil(K/4)), and 64
                                        for a single direction (K = 1, hfvis_sun_visibility) */
+    double max_distance;            /* R, world units: occluders farther than R from the receiver,
+                                       measured along the ray, are ignored; 0 = unlimited
+                                       (default), +INFINITY the same; < 0 or NaN is
+                                       HFVIS_ERR_INVALID_ARGUMENT. See "Search radius and tiles" */
+    int origin_x, origin_y;         /* tiles: this grid is a window of a larger raster whose cell
+                                       (origin_x, origin_y) is this grid's (0, 0); default 0, 0 */
+    int extent_width, extent_height;/* that raster's size in cells; 0, 0 = this grid is the
+                                       whole raster (default) */
+    int receiver_x, receiver_y;     /* compute only the receivers in this rectangle of the grid; */
+    int receiver_width, receiver_height; /* 0, 0 = every receiver (default); outputs outside it
+                                       are left unwritten */
 } hfvis_sweep_options;
 
 HFVIS_API hfvis_sweep_options hfvis_sweep_options_default(void);
