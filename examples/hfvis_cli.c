@@ -2306,6 +2306,26 @@ static double cli_top(const float *px, size_t n, double fallback)
     return (float)top > 0.0f ? top : fallback;
 }
 
+/* Radiance outputs scale with the inputs (sky, sun, environment, emission, albedo, specular),
+ * each bounded by the float range alone, so their product can overflow: refuse a result that is
+ * not finite where the height field has a sample, rather than write it with exit 0. */
+static int cli_check_radiance(const char *cmd, const hfvis_grid *grid, const float *out, int channels)
+{
+    int x, y, c;
+    for (y = 0; y < grid->height; y++)
+        for (x = 0; x < grid->width; x++) {
+            const size_t i = (size_t)y * (size_t)grid->width + (size_t)x;
+            if (!isfinite(grid->z[(ptrdiff_t)y * grid->stride + x])) continue;
+            for (c = 0; c < channels; c++)
+                if (!isfinite(out[i * (size_t)channels + (size_t)c]))
+                    return cli_error(CLI_EXIT_ERROR, cmd, "the result at column %d, row %d is %g: "
+                                     "the light inputs (sky, sun, environment, emission, albedo, "
+                                     "specular) overflow the float range (3.4e38); scale them down",
+                                     x, y, (double)out[i * (size_t)channels + (size_t)c]);
+        }
+    return 0;
+}
+
 /* indirect: direct light (hfvis_direct_light), then hfvis_terrain_gi. */
 static int cli_run_indirect(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
                             cli_progress_state *prog)
@@ -2380,6 +2400,7 @@ static int cli_run_indirect(const cli_args *a, const hfvis_grid *grid, hfvis_swe
             out[i] = (float)((double)out[i] - (double)base[i]);
     }
     if (s != HFVIS_OK) { rc = cli_status(cmd, s, 0); goto done; }
+    if ((rc = cli_check_radiance(cmd, grid, out, channels)) != 0) goto done;
     rc = cli_save(a, out, w, h, channels, 0.0, cli_top(out, n * (size_t)channels, 1.0));
 done:
     free(base);
@@ -2464,6 +2485,7 @@ static int cli_run_gi(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_opt
         for (b = 0; b < bounces; b++) v += (double)bounce[(size_t)b * n * (size_t)channels + i];
         out[i] = (float)v;
     }
+    if ((rc = cli_check_radiance(cmd, grid, out, channels)) != 0) goto done;
     rc = cli_save(a, out, w, h, channels, 0.0, cli_top(out, n * (size_t)channels, 1.0));
 done:
     free(out);
@@ -3514,6 +3536,15 @@ static int cli_sum(int argc, char **argv)
         }
         hi = planes == 2 ? 1.0 : cli_top(out, n, 1.0);
     }
+    if (cmd == CMD_SKY || cmd == CMD_LIGHT) /* finite sums scaled past the float range */
+        for (k = 0; k < n * (size_t)channels; k++)
+            if (!isfinite(out[k]) && isfinite(acc[(k % (size_t)channels) * n + k / (size_t)channels])) {
+                rc = cli_error(CLI_EXIT_ERROR, "sum", "the result at column %d, row %d is %g: the "
+                               "parts' sky, environment or albedo overflow the float range (3.4e38)",
+                               (int)(k / (size_t)channels % (size_t)W),
+                               (int)(k / (size_t)channels / (size_t)W), (double)out[k]);
+                goto done;
+            }
     rc = cli_save(&a, out, W, H * out_planes, channels, lo, hi);
 done:
     free(acc);
@@ -3977,6 +4008,9 @@ static int cli_run(const cli_args *a)
         break;
     }
     if (s != HFVIS_OK) { rc = cli_status(cmd, s, 0); goto done; }
+    if ((a->cmd == CMD_SKY || a->cmd == CMD_LIGHT) &&
+        (rc = cli_check_radiance(cmd, &grid, out, channels)) != 0)
+        goto done;
     if (a->cmd == CMD_HORIZON) { rc = cli_horizon_finish(a, out, w, h, lo, hi); goto done; }
     rc = cli_save(a, out, w, h * planes, channels, lo, hi);
 done:

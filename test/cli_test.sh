@@ -23,6 +23,7 @@ one='\000\000\200\077'  # 1.0f little-endian
 # env1.pfm: 4 x 2 grey lat-long map of radiance 1 (the whole sphere); env3.pfm: the same in RGB.
 { printf 'Pf\n4 2\n-1\n'; i=0; while [ $i -lt 8 ]; do printf "$one"; i=$((i + 1)); done; } > "$dir/env1.pfm"
 { printf 'PF\n4 2\n-1\n'; i=0; while [ $i -lt 24 ]; do printf "$one"; i=$((i + 1)); done; } > "$dir/env3.pfm"
+{ printf 'Pf\n4 2\n-1\n'; i=0; while [ $i -lt 8 ]; do printf '\346\261\141\177'; i=$((i + 1)); done; } > "$dir/envhuge.pfm"
 printf 'hello, I am not an image\n' > "$dir/garbage.pgm"
 # Maps of flat.pgm's size (8 x 6) for indirect: alb51.pgm all 51/255 = 0.2; emit1.pfm radiance 1;
 # emit3.pfm RGB radiance 1; neg.pfm one value -1; nanrow.pfm NaN at (0, 0) (the first sample
@@ -767,6 +768,21 @@ grep -q -- '--cell' "$dir/stderr" && ok "--cell named" || bad "--cell named"
 expect_fail "--zscale 3e38" 1 skyview "$h" --zscale 3e38 -o "$o"
 grep -q -- '--zscale' "$dir/stderr" && ok "--zscale named" || bad "--zscale named"
 expect_fail "--sky 3e38 --albedo 3e38" 2 sky "$h" --sky 3e38 --albedo 3e38 -o "$o"
+# Light inputs each within the float range whose product is not (issue: an emission map of 3e38
+# under --sky 3e38 wrote an all-NaN raster with exit 0): the result is checked, nothing written
+huge='\346\261\141\177' # 3e38f little-endian
+{ printf 'Pf\n8 6\n-1\n'; i=0; while [ $i -lt 48 ]; do printf "$huge"; i=$((i + 1)); done; } > "$dir/huge.pfm"
+awk 'BEGIN { print "P2 8 6 255"; for (i = 0; i < 48; i++) print (i % 8) * (i % 8) * 3 }' > "$dir/hill8.pgm"
+expect_fail "indirect --emission 3e38 --sky 3e38" 1 indirect "$dir/flat.pgm" --emission "$dir/huge.pfm" --sky 3e38 --bounces 2 -o "$o"
+grep -q 'overflow the float range' "$dir/stderr" && ok "indirect overflow named" || bad "indirect overflow named"
+expect_fail "indirect --albedo-map 3e38" 1 indirect "$dir/hill8.pgm" --albedo-map "$dir/huge.pfm" --bounces 2 -o "$o"
+expect_fail "gi --specular 3e38" 1 gi "$h" --specular 3e38 -o "$o"
+expect_fail "light --env 3e38 --albedo 3e38" 1 light "$dir/flat.pgm" --env "$dir/envhuge.pfm" --albedo 3e38 -o "$o"
+"$hfvis" light "$h" --env "$dir/envhuge.pfm" --albedo 3e38 --dir-range 0:8 -o "$dir/ph1.hfvs" 2> /dev/null &&
+"$hfvis" light "$h" --env "$dir/envhuge.pfm" --albedo 3e38 --dir-range 8:16 -o "$dir/ph2.hfvs" 2> /dev/null &&
+  ok "light parts of a too-bright run (their sums are finite)" || bad "light parts of a too-bright run"
+expect_fail "sum of too-bright light parts" 1 sum "$dir/ph1.hfvs" "$dir/ph2.hfvs" -o "$o"
+expect_ok "indirect --emission 1 (in range)" "$dir/c.pfm" indirect "$dir/flat.pgm" --emission "$dir/emit1.pfm" --bounces 2 -o "$dir/c.pfm"
 
 # Costs up front (issue: a 16 KB 1 x 16384 PGM made skyview allocate 2.1 GB; volgi --res 256
 # --iterations 1048576 ran with no estimate): --max-memory refuses before allocating and names
