@@ -893,13 +893,13 @@ HFVIS_API hfvis_status hfvis_image_load(const char *path, const hfvis_allocator 
 
 /* The temporary name: "<path>.tmp<8 hex digits>" beside path; when the last component would
  * then exceed HF_NAME_MAX bytes, that component is cut to leave room for the suffix (same
- * directory, same file system, so the rename stays atomic). The suffix hashes the addresses of
- * the buffer and of a local, which differ between concurrent calls in one process (and usually
+ * directory, same file system, so the rename stays atomic). The suffix hashes the address of a
+ * local of the caller (key), which differs between concurrent calls in one process (and usually
  * between processes); a name already taken is skipped. */
 #define HF_NAME_MAX 255    /* bytes of a file name on common file systems (POSIX NAME_MAX) */
 #define HF_TMP_SUFFIX 12u  /* ".tmp" and 8 hex digits */
-hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
-                              const hfvis_write_options *opts)
+hfvis_status hfvis_write_begin(const char *path, const hfvis_write_options *opts, FILE **file,
+                               char **temp_path)
 {
     static const char hex[] = "0123456789abcdef";
     size_t len, base = 0, keep, k;
@@ -908,8 +908,10 @@ hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
     uint32_t tag = 2166136261u; /* FNV-1a */
     char *tmp;
     FILE *f = NULL;
-    int attempt, ok;
-    if (!path || (!bytes && n > 0) || path[0] == '\0') return HFVIS_ERR_INVALID_ARGUMENT;
+    int attempt;
+    if (file) *file = NULL;
+    if (temp_path) *temp_path = NULL;
+    if (!path || !file || !temp_path || path[0] == '\0') return HFVIS_ERR_INVALID_ARGUMENT;
     len = strlen(path);
     if (len > SIZE_MAX - HF_TMP_SUFFIX - 1u) return HFVIS_ERR_IO;
     for (k = 0; k < len; k++)
@@ -918,7 +920,7 @@ hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
     if (len - base + HF_TMP_SUFFIX > HF_NAME_MAX) keep = base + (HF_NAME_MAX - HF_TMP_SUFFIX);
     tmp = (char *)hf_alloc(NULL, keep + HF_TMP_SUFFIX + 1u);
     if (!tmp) return HFVIS_ERR_OUT_OF_MEMORY;
-    addrs[0] = bytes;
+    addrs[0] = file;
     addrs[1] = &len;
     memcpy(raw, addrs, sizeof raw);
     for (k = 0; k < sizeof raw; k++) tag = (uint32_t)((tag ^ raw[k]) * 16777619u);
@@ -941,24 +943,50 @@ hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
         hf_free(NULL, tmp);
         return HFVIS_ERR_IO;
     }
-    ok = n == 0 || fwrite(bytes, 1, n, f) == n;
-    ok = (fflush(f) == 0) && ok;
-    ok = (fclose(f) == 0) && ok;
-    if (ok && rename(tmp, path) != 0) {
+    *file = f;
+    *temp_path = tmp;
+    return HFVIS_OK;
+}
+#undef HF_NAME_MAX
+#undef HF_TMP_SUFFIX
+
+hfvis_status hfvis_write_end(const char *path, FILE *file, char *temp_path, int commit,
+                             const hfvis_write_options *opts)
+{
+    int ok = commit != 0;
+    if (!file || !temp_path) { /* nothing was opened: release what there is */
+        if (file) fclose(file);
+        hf_free(NULL, temp_path);
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    }
+    ok = (fflush(file) == 0) && !ferror(file) && ok;
+    ok = (fclose(file) == 0) && ok;
+    if (ok && (!path || rename(temp_path, path) != 0)) {
 #if defined(_WIN32)
         /* Windows' rename does not replace an existing file: replace non-atomically. */
-        ok = remove(path) == 0 && rename(tmp, path) == 0;
+        ok = path && remove(path) == 0 && rename(temp_path, path) == 0;
 #else
         ok = 0;
 #endif
     }
-    if (!ok) remove(tmp);
+    if (!ok) remove(temp_path);
     if (opts && opts->on_temp) opts->on_temp(opts->user, NULL); /* renamed or removed */
-    hf_free(NULL, tmp);
-    return ok ? HFVIS_OK : HFVIS_ERR_IO;
+    hf_free(NULL, temp_path);
+    if (!path) return HFVIS_ERR_INVALID_ARGUMENT;
+    return ok ? HFVIS_OK : commit ? HFVIS_ERR_IO : HFVIS_OK;
 }
-#undef HF_NAME_MAX
-#undef HF_TMP_SUFFIX
+
+hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
+                              const hfvis_write_options *opts)
+{
+    FILE *f;
+    char *tmp;
+    hfvis_status s;
+    if (!path || (!bytes && n > 0) || path[0] == '\0') return HFVIS_ERR_INVALID_ARGUMENT;
+    s = hfvis_write_begin(path, opts, &f, &tmp);
+    if (s != HFVIS_OK) return s;
+    return hfvis_write_end(path, f, tmp, n == 0 || fwrite(bytes, 1, n, f) == n, opts);
+}
 
 HFVIS_API hfvis_status hfvis_pfm_save(const char *path, const float *pixels, int width,
                                       int height, int channels, ptrdiff_t stride)

@@ -187,6 +187,9 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#ifndef HFVIS_NO_STDIO
+#include <stdio.h> /* FILE, for hfvis_write_begin and hfvis_write_end */
+#endif
 
 #ifdef __cplusplus
 extern "C" {
@@ -341,6 +344,26 @@ typedef struct hfvis_write_options {
  * HFVIS_ERR_IO or HFVIS_ERR_OUT_OF_MEMORY (the name). */
 HFVIS_API hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
                                         const hfvis_write_options *opts);
+
+/* The same atomic write for a file produced piece by piece (the examples' GeoTIFF writer seeks
+ * back to patch offsets): hfvis_write_begin creates the temporary file (named and announced as
+ * above) and returns it in *file, open for binary writing, and its name in *temp_path (owned
+ * by the library); write with stdio, then call hfvis_write_end exactly once with both. With
+ * commit nonzero it flushes, closes and renames the file onto path; with commit 0, or when any
+ * of that fails (including an earlier write error, ferror), it removes the file and path is
+ * untouched. Either way it closes the file and frees temp_path.
+ * hfvis_write_begin returns HFVIS_OK, HFVIS_ERR_INVALID_ARGUMENT (a NULL or empty path, NULL
+ * file or temp_path), HFVIS_ERR_IO or HFVIS_ERR_OUT_OF_MEMORY (the name), and sets *file and
+ * *temp_path to NULL on failure. hfvis_write_end returns HFVIS_OK when path holds the new file
+ * (or, with commit 0, when the file was discarded), HFVIS_ERR_IO when it could not be written,
+ * HFVIS_ERR_INVALID_ARGUMENT for a NULL file, temp_path or path (it still releases the others).
+ * Declared only where <stdio.h> is available (not with HFVIS_NO_STDIO). */
+#ifndef HFVIS_NO_STDIO
+HFVIS_API hfvis_status hfvis_write_begin(const char *path, const hfvis_write_options *opts,
+                                         FILE **file, char **temp_path);
+HFVIS_API hfvis_status hfvis_write_end(const char *path, FILE *file, char *temp_path, int commit,
+                                       const hfvis_write_options *opts);
+#endif
 
 HFVIS_API hfvis_status hfvis_image_load(const char *path, const hfvis_allocator *alloc,
                                         float **pixels, hfvis_image_info *info);

@@ -1541,7 +1541,7 @@ static inline int ex_rio_write_tiff_file(const char *path, const ex_rio_image *i
         ex_rio_fail(err, "out of memory");
         goto done;
     }
-    o.f = ex_atomic_open(path, img, &tmpname);
+    o.f = ex_atomic_open(path, &tmpname);
     if (!o.f) {
         ex_rio_fail(err, "cannot create the file");
         goto done;
@@ -1733,7 +1733,7 @@ static inline int ex_rio_write_prj(const char *path, const ex_georef *geo, char 
     if (!geo || !geo->prj) return 0;
     prj = ex_rio_sidecar(path, ".prj");
     if (!prj) return ex_rio_fail(err, "out of memory");
-    f = ex_atomic_open(prj, geo, &tmpname);
+    f = ex_atomic_open(prj, &tmpname);
     ok = f && fputs(geo->prj, f) >= 0;
     if (!f || !ex_atomic_close(f, tmpname, prj, ok)) {
         free(prj);
@@ -1758,7 +1758,7 @@ static inline int ex_rio_write_asc(const char *path, const ex_rio_image *img, co
         if (ex_georef_cell(geo, &cell, err) != 0) return -1;
     }
     if (isnan(nd)) return ex_rio_fail(err, "an ASCII grid cannot have NoData NaN");
-    f = ex_atomic_open(path, img, &tmpname);
+    f = ex_atomic_open(path, &tmpname);
     if (!f) return ex_rio_fail(err, "cannot create the file");
     fprintf(f, "ncols %d\nnrows %d\n", img->width, img->height);
     if (geo && geo->has_transform) {
@@ -1795,7 +1795,7 @@ static inline int ex_rio_write_ehdr(const char *path, const ex_rio_image *img, c
     size_t rb = (size_t)img->width * 4u;
     row = (unsigned char *)malloc(rb);
     if (!row) return ex_rio_fail(err, "out of memory");
-    f = ex_atomic_open(path, img, &tmpname);
+    f = ex_atomic_open(path, &tmpname);
     if (!f) {
         free(row);
         return ex_rio_fail(err, "cannot create the file");
@@ -1813,7 +1813,7 @@ static inline int ex_rio_write_ehdr(const char *path, const ex_rio_image *img, c
     if (!ex_atomic_close(f, tmpname, path, ok)) return ex_rio_fail(err, "cannot write the file");
     side = ex_rio_sidecar(path, ".hdr");
     if (!side) return ex_rio_fail(err, "out of memory");
-    f = ex_atomic_open(side, img, &tmpname);
+    f = ex_atomic_open(side, &tmpname);
     if (f) {
         fprintf(f, "BYTEORDER I\nLAYOUT BIL\nNROWS %d\nNCOLS %d\nNBANDS %d\nNBITS 32\nBANDROWBYTES %lu\n"
                    "TOTALROWBYTES %lu\nPIXELTYPE FLOAT\n",

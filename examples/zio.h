@@ -484,70 +484,33 @@ static inline int ex_deflate_zlib(const unsigned char *in, size_t n, unsigned ch
 /* 4. atomic files                                                                            */
 /* ------------------------------------------------------------------------------------------ */
 
-/* Open "<path>.tmp<8 hex digits>" beside path for writing (the name is stored in *tmp_out, to be
- * passed to ex_atomic_close). The suffix hashes the path and the address of key; a name already
- * taken is skipped. NULL (and *tmp_out NULL) on failure. */
 /* Told each temporary name once it exists and NULL before it is renamed or removed, so that a
  * program's signal handler can remove it on an interrupt (the hfvis CLI sets it, as it sets
  * hfvis_write_options.on_temp); NULL: nobody is told. */
 static void (*ex_atomic_on_temp)(void *user, const char *tmp);
 
-static inline FILE *ex_atomic_open(const char *path, const void *key, char **tmp_out)
+/* The library's atomic write (hfvis_write_begin), reporting to ex_atomic_on_temp: the temporary
+ * file beside path, open for writing, its name in *tmp_out for ex_atomic_close. NULL (and
+ * *tmp_out NULL) on failure. */
+static inline FILE *ex_atomic_open(const char *path, char **tmp_out)
 {
-    static const char hex[] = "0123456789abcdef";
-    size_t len, k;
-    unsigned char raw[sizeof key];
-    uint32_t tag;
-    char *tmp;
-    FILE *f = NULL;
-    int attempt;
-    *tmp_out = NULL;
-    if (!path) return NULL;
-    len = strlen(path);
-    if (len > SIZE_MAX - 16) return NULL;
-    tmp = (char *)malloc(len + 16);
-    if (!tmp) return NULL;
-    memcpy(raw, &key, sizeof raw);
-    tag = hfvis_crc32(hfvis_crc32(0, path, len), raw, sizeof raw);
-    memcpy(tmp, path, len);
-    memcpy(tmp + len, ".tmp", 4);
-    tmp[len + 12] = '\0';
-    for (attempt = 0; attempt < 16; attempt++, tag += 0x9e3779b9u) {
-        FILE *existing;
-        for (k = 0; k < 8; k++) tmp[len + 4 + k] = hex[(tag >> (28 - 4 * k)) & 15u];
-        existing = fopen(tmp, "rb");
-        if (!existing) break;
-        fclose(existing);
-    }
-    if (attempt < 16) f = fopen(tmp, "wb");
-    if (!f) {
-        free(tmp);
-        return NULL;
-    }
-    *tmp_out = tmp;
-    if (ex_atomic_on_temp) ex_atomic_on_temp(NULL, tmp);
+    hfvis_write_options wo;
+    FILE *f;
+    wo.on_temp = ex_atomic_on_temp;
+    wo.user = NULL;
+    if (hfvis_write_begin(path, &wo, &f, tmp_out) != HFVIS_OK) return NULL;
     return f;
 }
 
-/* Finish a file from ex_atomic_open: with ok, flush, close and rename it onto path (a reader
- * never sees a partial file); otherwise (or when any of that fails) close and remove it, leaving
- * path untouched. Frees tmp. Returns 1 when path now holds the new file. */
+/* Finish a file from ex_atomic_open (hfvis_write_end): with ok, rename it onto path; otherwise
+ * (or when flushing or closing fails) remove it, leaving path untouched. Frees tmp. Returns 1
+ * when path now holds the new file. */
 static inline int ex_atomic_close(FILE *f, char *tmp, const char *path, int ok)
 {
-    ok = (fflush(f) == 0) && ok;
-    ok = (fclose(f) == 0) && ok;
-    if (ex_atomic_on_temp) ex_atomic_on_temp(NULL, NULL);
-    if (ok && rename(tmp, path) != 0) {
-#if defined(_WIN32)
-        /* Windows' rename does not replace an existing file: replace non-atomically. */
-        ok = remove(path) == 0 && rename(tmp, path) == 0;
-#else
-        ok = 0;
-#endif
-    }
-    if (!ok) remove(tmp);
-    free(tmp);
-    return ok;
+    hfvis_write_options wo;
+    wo.on_temp = ex_atomic_on_temp;
+    wo.user = NULL;
+    return hfvis_write_end(path, f, tmp, ok, &wo) == HFVIS_OK && ok;
 }
 
 #endif /* HFVIS_EXAMPLES_ZIO_H */

@@ -831,6 +831,14 @@ rm -f "$dir/zero2048.pfm"
 long=$(awk 'BEGIN { for (i = 0; i < 247; i++) printf "%c", 97 + i % 26 }').pfm
 expect_ok "a 251-byte output name" "$dir/$long" skyview "$dir/flat.pgm" --dirs 4 -o "$dir/$long"
 rm -f "$dir/$long"
+# the same through the streaming writer of GeoTIFF and ASCII-grid outputs (it once had its own
+# temporary names, without the cut)
+longt=$(awk 'BEGIN { for (i = 0; i < 247; i++) printf "%c", 97 + i % 26 }').tif
+expect_ok "a 251-byte GeoTIFF output name" "$dir/$longt" skyview "$dir/flat.pgm" --dirs 4 -o "$dir/$longt"
+rm -f "$dir/$longt"
+longa=$(awk 'BEGIN { for (i = 0; i < 247; i++) printf "%c", 97 + i % 26 }').asc
+expect_ok "a 251-byte ASCII grid output name" "$dir/$longa" skyview "$dir/flat.pgm" --dirs 4 -o "$dir/$longa"
+rm -f "$dir/$longa"
 
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"

@@ -56,6 +56,8 @@
     X(pfm_encode, S, -, "NZGOR", "INVALID_ARGUMENT BUFFER_TOO_SMALL") \
     X(pgm_encode, S, -, "NZGOFR", "INVALID_ARGUMENT BUFFER_TOO_SMALL") \
     X(write_file, S, M, "NZR", "INVALID_ARGUMENT IO") \
+    X(write_begin, S, M, "NZR", "INVALID_ARGUMENT IO") \
+    X(write_end, S, -, "NR", "INVALID_ARGUMENT IO") \
     X(image_load, S, A, "NR", "INVALID_ARGUMENT IO") \
     X(pfm_save, S, M, "NZGR", "INVALID_ARGUMENT IO") \
     X(pgm_save, S, M, "NZGFR", "INVALID_ARGUMENT IO") \
@@ -773,6 +775,70 @@ static void args_write_file(void)
     BAD('Z', INV, hfvis_write_file("", "abc", 3, NULL));
     BAD('R', IOE, hfvis_write_file(bad_dir_path("t.bin"), "abc", 3, NULL));
     BADV('R', access(tmp_path("t.bin"), F_OK) != 0);
+}
+
+/* The streaming form: a committed file replaces path, a discarded one leaves it untouched, and
+ * the temporary name is announced and withdrawn as by hfvis_write_file. */
+static void args_write_begin(void)
+{
+    FILE *f = (FILE *)&f;
+    char *tmp = (char *)&tmp;
+    hfvis_write_options wo;
+    begin("write_begin");
+    wo.on_temp = wf_on_temp;
+    wo.user = NULL;
+    wf_calls = wf_nulls = 0;
+    OK(hfvis_write_begin(tmp_path("b.bin"), &wo, &f, &tmp));
+    CHECK(f != NULL && tmp != NULL && wf_calls == 1 && wf_nulls == 0 && strcmp(wf_seen, tmp) == 0);
+    CHECK(fputs("abc", f) >= 0 && fseek(f, 0, SEEK_SET) == 0 && fputc('x', f) == 'x');
+    OK(hfvis_write_end(tmp_path("b.bin"), f, tmp, 1, &wo));
+    CHECK(wf_calls == 2 && wf_nulls == 1 && access(wf_seen, F_OK) != 0);
+    {
+        char got[8] = {0};
+        FILE *r = fopen(tmp_path("b.bin"), "rb");
+        CHECK(r != NULL);
+        if (r) { CHECK(fread(got, 1, sizeof got, r) == 3 && memcmp(got, "xbc", 3) == 0); fclose(r); }
+    }
+    /* commit 0: the file is removed and path keeps its old content */
+    OK(hfvis_write_begin(tmp_path("b.bin"), NULL, &f, &tmp));
+    CHECK(fputs("new content", f) >= 0);
+    OK(hfvis_write_end(tmp_path("b.bin"), f, tmp, 0, NULL));
+    {
+        char got[8] = {0};
+        FILE *r = fopen(tmp_path("b.bin"), "rb");
+        CHECK(r != NULL);
+        if (r) { CHECK(fread(got, 1, sizeof got, r) == 3 && memcmp(got, "xbc", 3) == 0); fclose(r); }
+    }
+    f = (FILE *)&f;
+    tmp = (char *)&tmp;
+    BAD('N', INV, hfvis_write_begin(NULL, NULL, &f, &tmp));
+    CHECK(f == NULL && tmp == NULL);
+    BAD('N', INV, hfvis_write_begin(tmp_path("t.bin"), NULL, NULL, &tmp));
+    BAD('N', INV, hfvis_write_begin(tmp_path("t.bin"), NULL, &f, NULL));
+    BAD('Z', INV, hfvis_write_begin("", NULL, &f, &tmp));
+    BAD('R', IOE, hfvis_write_begin(bad_dir_path("t.bin"), NULL, &f, &tmp));
+    CHECK(f == NULL && tmp == NULL);
+    BADV('R', access(tmp_path("t.bin"), F_OK) != 0);
+}
+
+static void args_write_end(void)
+{
+    FILE *f;
+    char *tmp;
+    begin("write_end");
+    OK(hfvis_write_begin(tmp_path("e.bin"), NULL, &f, &tmp));
+    OK(hfvis_write_end(tmp_path("e.bin"), f, tmp, 1, NULL));
+    BAD('N', INV, hfvis_write_end(tmp_path("e.bin"), NULL, NULL, 1, NULL));
+    /* a NULL path still closes the file and removes the temporary one */
+    OK(hfvis_write_begin(tmp_path("e2.bin"), NULL, &f, &tmp));
+    BAD('N', INV, hfvis_write_end(NULL, f, tmp, 1, NULL));
+    BADV('N', access(tmp_path("e2.bin"), F_OK) != 0);
+    /* the target became a directory between begin and end: the rename fails, nothing is left */
+    OK(hfvis_write_begin(tmp_path("e3"), NULL, &f, &tmp));
+    CHECK(mkdir(tmp_path("e3"), 0700) == 0);
+    CHECK(fputs("abc", f) >= 0);
+    BAD('R', IOE, hfvis_write_end(tmp_path("e3"), f, tmp, 1, NULL));
+    CHECK(rmdir(tmp_path("e3")) == 0);
 }
 
 static void args_pfm_save(void)
@@ -6553,6 +6619,15 @@ static hfvis_status io_voxels_raw_save(const char *path) { return hfvis_voxels_r
 static hfvis_status io_visfield_save(const char *path) { return hfvis_visfield_save(path, &vf_ok); }
 static hfvis_status io_partial_save(const char *path) { return hfvis_partial_save(path, &p_ok); }
 static hfvis_status io_write_file(const char *path) { return hfvis_write_file(path, "abc", 3, NULL); }
+static hfvis_status io_write_begin(const char *path)
+{
+    FILE *f;
+    char *tmp;
+    hfvis_status s = hfvis_write_begin(path, NULL, &f, &tmp);
+    if (s != HFVIS_OK) return s;
+    fputs("abc", f);
+    return hfvis_write_end(path, f, tmp, 1, NULL);
+}
 
 typedef struct io_entry {
     const char *name;
@@ -6562,6 +6637,7 @@ typedef struct io_entry {
 static const io_entry io_savers[] = {
     IOSAVE(pfm_save), IOSAVE(pgm_save), IOSAVE(pgm_range_save), IOSAVE(mesh_save), IOSAVE(binvox_save),
     IOSAVE(voxels_raw_save), IOSAVE(visfield_save), IOSAVE(partial_save), IOSAVE(write_file),
+    IOSAVE(write_begin),
 };
 #define IO_COUNT ((int)(sizeof io_savers / sizeof io_savers[0]))
 
