@@ -7954,11 +7954,11 @@ static hfvis_status hf_exact_horizon_direction(const hfvis_grid *g, int K, int k
 
 /* [P1] Eq. 5 for the uncentred sector of direction k (hf_exact_dirs): nz w sin^2 theta +
  * (nx lc + ny ls)(theta - sin 2theta/2), with the tangent-plane clamp of hf_sky_term taken
- * along the direction itself. */
-static double hf_exact_sky_term(const hf_exact_dirs *d, int k, const float *n, double t)
+ * along the direction itself, (cp, sp) = (cos, sin) of its azimuth. */
+static double hf_exact_sky_term(const hf_exact_dirs *d, int k, double cp, double sp, const float *n,
+                                double t)
 {
     double nx = (double)n[0], ny = (double)n[1], nz = (double)n[2];
-    double cp = cos(d->ray[k].azimuth), sp = sin(d->ray[k].azimuth);
     double tc = -(nx * cp + ny * sp) / nz, q, theta;
     if (t > tc) tc = t;
     q = 1.0 / (1.0 + tc * tc);
@@ -8034,7 +8034,7 @@ static hfvis_status hf_exact_sums(hf_exact *E, const hfvis_grid *g, int K, hfvis
             const float *nr = E->nrm ? E->nrm + i * 3 : NULL;
             if (isnan(t)) continue;
             if (kind == HFVIS_SUM_SKY_VIEW) E->acc[i] += wk * hf_svf_term(t);
-            else if (kind == HFVIS_SUM_SKY_LIGHT) E->acc[i] += hf_exact_sky_term(&E->d, k, nr, t);
+            else if (kind == HFVIS_SUM_SKY_LIGHT) E->acc[i] += hf_exact_sky_term(&E->d, k, cp, sp, nr, t);
             else
                 hf_env_accumulate(&eval, k, cp, sp, (double)nr[0], (double)nr[1], (double)nr[2], t,
                                   E->acc + i * (size_t)channels);
