@@ -7695,39 +7695,49 @@ static double hf_cross_height(const hfvis_grid *g, hfvis_border border, int X, i
                             (double)Y + (c->kind == 1 ? c->f : 0.0));
 }
 
-/* Interior samples of piece c after base grid point (X, Y) (see HF_EXACT_BULGE): writes up to
- * HF_EXACT_MAX_SPLIT - 1 heights h[j] at sub-step offsets du[j] from the piece's start, in
- * increasing order, and returns the count; 0 for a piece that is not concave enough, outside
- * the grid or touching a hole. */
+/* The twist z00 - z10 - z01 + z11 of the cell at p. */
 static double hf_cell_twist(const float *p, ptrdiff_t stride)
 {
     return (double)p[0] - (double)p[1] - (double)p[stride] + (double)p[stride + 1];
 }
 
-static int hf_piece_samples(const hfvis_grid *g, const double *twist, int X, int Y, const hf_cross *c,
-                            double *h, double *du)
+/* The interior samples of a piece in cell (cx, cy) whose bulge exceeds lim (hf_piece_samples). */
+static int hf_piece_fill(const hfvis_grid *g, int cx, int cy, const hf_cross *c, double bulge,
+                         double lim, double *h, double *du)
 {
-    const float *p;
-    double z00, z10, z01, z11, dfx = c->fx1 - c->fx0, dfy = c->fy1 - c->fy0, bulge, lim;
-    int m = 1, j, cx = X + c->cx, cy = Y + c->cy;
-    if (c->du == 0.0 || cx < 0 || cy < 0 || cx + 1 >= g->width || cy + 1 >= g->height) return 0;
-    p = g->z + (ptrdiff_t)cy * g->stride + cx;
-    /* the twist z00 - z10 - z01 + z11 of the cell (precomputed by the sweep: one load) */
-    bulge = c->q * (twist ? twist[(size_t)cy * (size_t)g->width + (size_t)cx] : hf_cell_twist(p, g->stride));
-    lim = HF_EXACT_BULGE * g->cell_size;
-    if (!(bulge > lim) || !isfinite(bulge)) return 0;
-    z00 = (double)p[0];
-    z10 = (double)p[1];
-    z01 = (double)p[g->stride];
-    z11 = (double)p[g->stride + 1];
+    const float *p = g->z + (ptrdiff_t)cy * g->stride + cx;
+    double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[g->stride], z11 = (double)p[g->stride + 1];
+    double dfx = c->fx1 - c->fx0, dfy = c->fy1 - c->fy0, inv_m;
+    int m = 1, j;
     while (m < HF_EXACT_MAX_SPLIT && bulge > lim * (double)m * (double)m) m *= 2;
+    inv_m = 1.0 / (double)m; /* a power of two: j * inv_m == j / m exactly */
     for (j = 1; j < m; j++) {
-        double t = (double)j / (double)m, fx = c->fx0 + t * dfx, fy = c->fy0 + t * dfy;
+        double t = (double)j * inv_m, fx = c->fx0 + t * dfx, fy = c->fy0 + t * dfy;
         double r0 = z00 + (z10 - z00) * fx, r1 = z01 + (z11 - z01) * fx;
         h[j - 1] = r0 + (r1 - r0) * fy;
         du[j - 1] = c->du * t;
     }
     return m - 1;
+}
+
+/* Interior samples of piece c after base grid point (X, Y) (see HF_EXACT_BULGE): writes up to
+ * HF_EXACT_MAX_SPLIT - 1 heights h[j] at sub-step offsets du[j] from the piece's start, in
+ * increasing order, and returns the count; 0 for a piece that is not concave enough, outside
+ * the grid or touching a hole. Inline: most pieces are rejected here. */
+static inline int hf_piece_samples(const hfvis_grid *g, const double *twist, int X, int Y,
+                                   const hf_cross *c, double *h, double *du)
+{
+    int cx = X + c->cx, cy = Y + c->cy;
+    double bulge, lim;
+    /* cx in [0, width - 2], cy in [0, height - 2] (the unsigned casts take the negatives out) */
+    if (c->du == 0.0 || (unsigned)cx >= (unsigned)(g->width - 1) || (unsigned)cy >= (unsigned)(g->height - 1))
+        return 0;
+    /* the twist z00 - z10 - z01 + z11 of the cell (precomputed by the sweep: one load) */
+    bulge = c->q * (twist ? twist[(size_t)cy * (size_t)g->width + (size_t)cx]
+                          : hf_cell_twist(g->z + (ptrdiff_t)cy * g->stride + cx, g->stride));
+    lim = HF_EXACT_BULGE * g->cell_size;
+    if (!(bulge > lim) || !isfinite(bulge)) return 0;
+    return hf_piece_fill(g, cx, cy, c, bulge, lim, h, du);
 }
 
 /* Whole periods k >= 0 of the ray from grid point (x, y) along (a, b) that can hold a crossing
