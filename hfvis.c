@@ -2827,7 +2827,7 @@ hfvis_status hfvis_sky_light_from_map(const hfvis_grid *grid, int K, double map_
 /* Sky-view factor term per direction: sin(max(alpha, 0)) = t/sqrt(1+t^2) for t > 0. */
 /* sin(atan(t)) without overflow: t/sqrt(1 + t^2), or for |t| past the square's range (heights
  * over tiny cells) sign(t)/sqrt(1 + (1/t)^2). */
-static double hf_tan_sine(double t)
+static inline double hf_tan_sine(double t)
 {
     if (fabs(t) > HF_SLOPE_SQUARE_MAX) {
         double r = 1.0 / t;
@@ -2836,7 +2836,7 @@ static double hf_tan_sine(double t)
     return t / sqrt(1.0 + t * t);
 }
 
-static double hf_svf_term(double t) { return t > 0.0 ? hf_tan_sine(t) : 0.0; }
+static inline double hf_svf_term(double t) { return t > 0.0 ? hf_tan_sine(t) : 0.0; }
 
 static void hf_svf_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdiff_t step, int n,
                         const double *t)
