@@ -2038,6 +2038,45 @@ static void hf_gather_elevations(const hf_sweep *sw, int ch, const hf_gather *G,
     }
 }
 
+/* hf_gather_elevations' common case written out (as in hf_gather_accumulate): all four taps
+ * inside the lattice and every channel's four values finite and above -pi/2. A tap of weight 0
+ * then adds a +-0 where the general routine skips it, which leaves the sums bit-identical (they
+ * start at +0.0). Returns 0, with out untouched, when the general routine must decide. */
+static int hf_gather_elevations_inside(const hf_sweep *sw, int ch, int x, int y, double *out)
+{
+    const hfvis_lattice *L = &sw->L;
+    double a = (double)x * L->ux + (double)y * L->uy, b = (double)x * L->vx + (double)y * L->vy;
+    double wa, wb, w0, w1, w2, w3, wsum;
+    const double *p;
+    ptrdiff_t cols = sw->cols;
+    int ia = (int)a, jb = (int)b, c;
+    ia -= (double)ia > a; /* floor of a lattice coordinate (within the int range) */
+    jb -= (double)jb > b;
+    wa = a - (double)ia;
+    wb = b - (double)jb;
+    ia -= L->i_min;
+    jb -= L->j_min;
+    if (ia < 0 || jb < 0 || ia + 1 >= sw->cols || jb + 1 >= sw->rows) return 0;
+    p = sw->lat + ((ptrdiff_t)jb * cols + ia) * ch;
+    for (c = 0; c < ch; c++) {
+        double t0 = p[c], t1 = p[ch + c], t2 = p[cols * ch + c], t3 = p[(cols + 1) * ch + c];
+        /* finite and > -pi/2 (NaN and -inf fail the comparisons, +inf the sum) */
+        if (!(t0 > -HF_HALF_PI && t1 > -HF_HALF_PI && t2 > -HF_HALF_PI && t3 > -HF_HALF_PI &&
+              isfinite(t0 + t1 + t2 + t3)))
+            return 0;
+    }
+    w0 = (1.0 - wa) * (1.0 - wb);
+    w1 = wa * (1.0 - wb);
+    w2 = (1.0 - wa) * wb;
+    w3 = wa * wb;
+    wsum = 0.0 + w0 + w1 + w2 + w3;
+    for (c = 0; c < ch; c++) {
+        double sum = 0.0 + w0 * p[c] + w1 * p[ch + c] + w2 * p[cols * ch + c] + w3 * p[(cols + 1) * ch + c];
+        out[c] = wsum != 1.0 ? sum / wsum : sum;
+    }
+    return 1;
+}
+
 /* Gather the ch-channel lattice elevations into ch float planes (holes NaN): channel c holds
  * quarter turn m_first + c and goes to out + c*plane_step, row stride out_stride. With the open
  * border a receiver whose first unit step toward the look direction leaves the grid sees no
@@ -2060,8 +2099,10 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
                 for (c = 0; c < ch; c++) out[(size_t)c * plane_step + (size_t)o] = (float)HF_NAN;
                 continue;
             }
-            hf_gather_setup(sw, x, y, &G);
-            hf_gather_elevations(sw, ch, &G, v);
+            if (!hf_gather_elevations_inside(sw, ch, x, y, v)) {
+                hf_gather_setup(sw, x, y, &G);
+                hf_gather_elevations(sw, ch, &G, v);
+            }
             for (c = 0; c < ch; c++) {
                 if (sw->border == HFVIS_BORDER_OPEN) {
                     double nx = (double)x + lx[c], ny = (double)y + ly[c];
