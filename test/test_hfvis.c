@@ -564,6 +564,50 @@ static int interior(int x, int y, int w, int h)
            y < h - INTERIOR_MARGIN;
 }
 
+/* The library's atan for the light terms (hfvis.c section 9), held to libm over its whole
+ * domain. HF_ATAN_MAX_ERR there is 6e-9 rad: the polynomial's minimax bound 5.76e-9 plus the
+ * rounding of its double evaluation (< 1e-15). */
+double hfvis__atan(double t);
+#define ATAN_TOL 6e-9
+
+TEST(atan_approximation)
+{
+    double worst = 0.0, arg = 0.0, e;
+    const double special[] = {0.0, 1.0, 0.5, 2.0, 1e-300, 1e300, DBL_MAX, DBL_MIN,
+                              4.9406564584124654e-324, 1e-8, 1e8, 0.41421356237309503,
+                              2.414213562373095};
+    int i, sg, bad = 0;
+    for (i = -4000000; i <= 4000000; i++) { /* [-4, 4] in steps of 1e-6 */
+        double t = (double)i * 1e-6;
+        e = fabs(hfvis__atan(t) - atan(t));
+        if (e > worst) { worst = e; arg = t; }
+    }
+    for (i = -32400; i <= 30800; i++) /* |t| from 1e-324 to 1e308, 100 per decade, both signs */
+        for (sg = -1; sg <= 1; sg += 2) {
+            double t = sg * pow(10.0, (double)i * 0.01);
+            e = fabs(hfvis__atan(t) - atan(t));
+            if (!(e <= ATAN_TOL)) bad++;
+            if (e > worst) { worst = e; arg = t; }
+        }
+    for (i = 0; i < (int)(sizeof special / sizeof special[0]); i++)
+        for (sg = -1; sg <= 1; sg += 2) {
+            double t = sg * special[i], lo = nextafter(t, -HUGE_VAL), hi = nextafter(t, HUGE_VAL);
+            if (!(fabs(hfvis__atan(t) - atan(t)) <= ATAN_TOL)) bad++;
+            if (!(fabs(hfvis__atan(lo) - atan(lo)) <= ATAN_TOL)) bad++;
+            if (!(fabs(hfvis__atan(hi) - atan(hi)) <= ATAN_TOL)) bad++;
+        }
+    printf("     atan: largest |error| %.3g rad at t = %.6g (tolerance %.0e)\n", worst, arg, ATAN_TOL);
+    CHECK(worst <= ATAN_TOL);
+    CHECK(bad == 0);
+    CHECK(fabs(hfvis__atan(HUGE_VAL) - atan(HUGE_VAL)) <= ATAN_TOL);
+    CHECK(fabs(hfvis__atan(-HUGE_VAL) - atan(-HUGE_VAL)) <= ATAN_TOL);
+    CHECK(hfvis__atan(0.0) == 0.0 && !signbit(hfvis__atan(0.0)));
+    CHECK(hfvis__atan(-0.0) == 0.0 && signbit(hfvis__atan(-0.0)));
+    CHECK(isnan(hfvis__atan(NAN)));
+    CHECK(isnan(hfvis__atan(-NAN)));
+    CHECK(hfvis__atan(1e-300) > 0.0 && hfvis__atan(-1e-300) < 0.0); /* odd, no flush to 0 */
+}
+
 TEST(flat_plane)
 {
     enum { W = 24, H = 20, K = 8 };
@@ -5369,6 +5413,7 @@ int main(int argc, char **argv)
     RUN(lattice_geometry);
     RUN(grid_sample);
     RUN(normals);
+    RUN(atan_approximation);
     RUN(flat_plane);
     RUN(tilted_plane_light);
     RUN(tilted_plane_lattice);
