@@ -392,6 +392,16 @@ static const char cli_shared_help2[] =
     "                    interpolation between lattice lines (right at walls, roofs, cliffs;\n"
     "                    'hfvis azimuths --exact' prints the directions used). visibility,\n"
     "                    indirect and gi keep the lattice\n"
+    "  --max-distance R  horizon, skyview, sky, shadow, light, visibility, indirect, hillshade:\n"
+    "                    the search radius in height units (--cell applies): occluders farther\n"
+    "                    than R along the ray are ignored (GRASS maxdistance, SAGA and RVT radius,\n"
+    "                    WhiteboxTools max_dist); 0 = unlimited (default). viewshed: its range\n"
+    "  --window X0,Y0,W,H  with a finite R (openness: --radius R): only the W x H cells from\n"
+    "                    column X0, row Y0 (clipped to IN), reading only them and a halo of\n"
+    "                    ceil(R/cell) + 1 cells (GeoTIFF strips/tiles, .bil/.flt, PFM and binary\n"
+    "                    PGM rows, by seeking); OUT (.pfm .tif .bil .flt .asc) is a piece, placed\n"
+    "                    and georeferenced at the window, with its sidecar OUT.tile; 'hfvis\n"
+    "                    mosaic' joins the pieces into the whole run's OUT (docs/tiles.md)\n"
     "  --quiet           no progress bar (shown on stderr only when it is a terminal) and no notes\n"
     "  --progress        plain progress lines on stderr instead (percent, elapsed, ETA), for logs\n"
     "                    and job schedulers, and a summary line at the end (time, cells,\n"
@@ -4408,6 +4418,17 @@ static int cli_mosaic(int argc, char **argv)
         if (i != origin && (rc = cli_piece_read(names[i], &meta[i], W, H, out,
                                                 ex_rio_format_of(names[origin]) ? &ref : NULL, NULL)) != 0)
             goto done;
+    if (!ref.has_transform && cli_tag_value(meta[0].tag, "gt", other, sizeof other) && strcmp(other, "none")) {
+        /* PFM pieces: the geotransform from the sidecar (their CRS is not kept: use raster pieces) */
+        char *q = other;
+        for (i = 0; i < 6; i++) {
+            char *comma = strchr(q, ',');
+            if (comma) *comma = '\0';
+            if (!cli_parse_real(q, &ref.gt[i])) break;
+            q = comma ? comma + 1 : q + strlen(q);
+        }
+        ref.has_transform = i == 6;
+    }
     /* NoData as the whole run had it: the input's (the pieces may have declared NaN or moved it) */
     ref.has_nodata = 0;
     if (cli_tag_value(meta[0].tag, "nodata", other, sizeof other) && strcmp(other, "none"))
