@@ -111,6 +111,15 @@ run "light whole" light "$dir/s.flt" --env "$dir/env.pfm" --dirs 8 --max-distanc
 pieces li pfm "$W1" light "$dir/s.flt" --env "$dir/env.pfm" --dirs 8 --max-distance 400 &&
 run "light mosaic tif" mosaic "$dir"/li.[1-6].pfm -o "$dir/li.mosaic.tif" &&
 same "light: RGB pieces mosaic (3 bands, default range) = whole run" "$dir/li.whole.tif" "$dir/li.mosaic.tif"
+# the other tiled commands (integer visibility counts become an integer GeoTIFF: decided on the
+# whole raster by the mosaic, as by the whole run)
+for c in visibility hillshade indirect; do
+  args="--dirs 8"; [ "$c" = hillshade ] && args="--sun-azimuth 200 --sun-elevation 12 --blend 2"
+  # shellcheck disable=SC2086
+  run "$c whole" $c "$dir/s.flt" $args --max-distance 400 -o "$dir/$c.whole.tif" &&
+  pieces "$c" tif "$W1" $c "$dir/s.flt" $args --max-distance 400 &&
+  same "$c: GeoTIFF mosaic = whole run" "$dir/$c.whole.tif" "$dir/$c.mosaic.tif"
+done
 # openness --radius: a ray march local by itself, so real halos (4 cells) tile exactly today
 run "openness whole" openness "$dir/s.flt" --radius 6 -o "$dir/op.whole.tif" &&
 pieces op tif "$W1" openness "$dir/s.flt" --radius 6 &&
