@@ -2085,9 +2085,10 @@ static int cli_window_plan(const cli_args *a, ex_rio_reader *r, const char *path
     v->gw = (int)((x1 + h < r->width ? x1 + h : r->width) - v->gx0);
     v->gh = (int)((y1 + h < r->height ? y1 + h : r->height) - v->gy0);
     if (cli_check_cost(a, v->gw, v->gh, 1) != 0) return CLI_EXIT_ERROR;
-    if ((size_t)v->gw * (size_t)v->gh > HFVIS_IMAGE_MAX_VALUES)
+    if ((size_t)v->gw * (size_t)v->gh > HFVIS_IMAGE_MAX_VALUES || v->gw > HFVIS_IMAGE_MAX_DIM ||
+        v->gh > HFVIS_IMAGE_MAX_DIM)
         return cli_error(CLI_EXIT_ERROR, "--window", "%s: the window and its halo of %d cells, %d x %d, "
-                         "exceed 2^28 values; use windows of at most %d x %d cells",
+                         "exceed 2^28 values or 2^20 rows or columns; use windows of at most %d x %d cells",
                          hfvis_status_string(HFVIS_ERR_LIMIT), v->halo, v->gw, v->gh,
                          16384 - 2 * v->halo > 1 ? 16384 - 2 * v->halo : 1,
                          16384 - 2 * v->halo > 1 ? 16384 - 2 * v->halo : 1);
@@ -4252,24 +4253,26 @@ static int cli_piece_read(const char *path, const cli_piece *m, int W, int H, fl
             ex_rio_close(&r);
             return CLI_EXIT_ERROR;
         }
-        row = cli_alloc((size_t)m->w, 1, 1);
+        row = cli_alloc((size_t)m->w, (size_t)m->h, 1); /* one band: each strip or tile decoded once */
         if (!row) {
             ex_rio_close(&r);
             return cli_status(path, HFVIS_ERR_OUT_OF_MEMORY, 0);
         }
         r.nodata_to_nan = 1;
         for (p = 0; p < m->planes; p++)
-            for (c = 0; c < m->channels; c++)
+            for (c = 0; c < m->channels; c++) {
+                if (ex_rio_read(&r, m->channels > 1 ? c : p, 0, 0, m->w, m->h, row, m->w) != 0) {
+                    cli_error(CLI_EXIT_ERROR, path, "%s", r.err);
+                    free(row);
+                    ex_rio_close(&r);
+                    return CLI_EXIT_ERROR;
+                }
                 for (y = 0; y < m->h; y++) {
                     float *dst = out + (((size_t)p * (size_t)H + (size_t)(m->y0 + y)) * (size_t)W + (size_t)m->x0) * C + (size_t)c;
-                    if (ex_rio_read(&r, m->channels > 1 ? c : p, 0, y, m->w, 1, row, m->w) != 0) {
-                        cli_error(CLI_EXIT_ERROR, path, "%s", r.err);
-                        free(row);
-                        ex_rio_close(&r);
-                        return CLI_EXIT_ERROR;
-                    }
-                    for (x = 0; x < m->w; x++) dst[(size_t)x * C] = row[x];
+                    const float *src = row + (size_t)y * (size_t)m->w;
+                    for (x = 0; x < m->w; x++) dst[(size_t)x * C] = src[x];
                 }
+            }
         free(row);
         if (keep) { /* the georeference of the piece at (0, 0) is the whole raster's */
             ex_georef_free(keep);
