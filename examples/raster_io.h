@@ -37,7 +37,7 @@
  *   5. TIFF chunk decoding     PackBits, LZW, DEFLATE, predictors, samples
  *   6. ASC and EHdr parsing
  *   7. reading                 ex_rio_open, ex_rio_open_tiff_mem, ex_rio_open_asc_mem,
- *                              ex_rio_open_ehdr_mem, ex_rio_open_netpbm, ex_rio_read, ex_rio_close,
+ *                              ex_rio_open_ehdr_mem, ex_rio_open_netpbm(_mem), ex_rio_read, ex_rio_close,
  *                              ex_georef_shift
  *   8. writing                 ex_rio_write (by extension), ex_rio_write_tiff_file
  */
@@ -1305,32 +1305,18 @@ static inline int ex_rio_open(ex_rio_reader *r, const char *path)
     return rc;
 }
 
-/* Open a PFM (Pf grey, PF colour: 3 bands) or binary PGM (P5) file for window reads: only its
- * header is parsed here (magic, width, height, scale or maxval, '#' comments as netpbm allows,
- * one whitespace byte before the samples); ex_rio_read then seeks to the rows a window needs
- * (PFM rows are stored bottom to top). Values as hfvis_image_decode gives them: PFM samples as
- * stored, PGM samples as the integers 0..maxval. No georeference. 0, or -1 with r->err. */
-static inline int ex_rio_open_netpbm(ex_rio_reader *r, const char *path)
+/* Parse a PFM (Pf grey, PF colour: 3 bands) or binary PGM (P5) header from head[0..n) (the
+ * file's first bytes; r->size, r->f or r->mem set): magic, width, height, scale or maxval, '#'
+ * comments as netpbm allows, one whitespace byte before the samples. ex_rio_read then seeks to
+ * the rows a window needs (PFM rows are stored bottom to top). Values as hfvis_image_decode
+ * gives them: PFM samples as stored, PGM samples as the integers 0..maxval. No georeference. */
+static inline int ex_rio_netpbm_parse(ex_rio_reader *r, const unsigned char *head, size_t n)
 {
-    unsigned char head[4096];
-    size_t n, i = 2;
+    size_t i = 2;
     double v[3];
-    int k, pfm;
-    long len;
-    memset(r, 0, sizeof *r);
-    r->f = fopen(path, "rb");
-    if (!r->f) return ex_rio_fail(r->err, "cannot open");
-    n = fread(head, 1, sizeof head, r->f);
-    if (fseek(r->f, 0, SEEK_END) != 0 || (len = ftell(r->f)) < 0) {
-        ex_rio_close(r);
-        return ex_rio_fail(r->err, "cannot read");
-    }
-    r->size = (uint64_t)len;
-    pfm = n >= 2 && head[0] == 'P' && (head[1] == 'f' || head[1] == 'F');
-    if (n < 2 || head[0] != 'P' || !(pfm || head[1] == '5')) {
-        ex_rio_close(r);
+    int k, pfm = n >= 2 && head[0] == 'P' && (head[1] == 'f' || head[1] == 'F');
+    if (n < 2 || head[0] != 'P' || !(pfm || head[1] == '5'))
         return ex_rio_fail(r->err, "not a PFM or binary (P5) PGM: windows are read from those, GeoTIFF or EHdr");
-    }
     for (k = 0; k < 3; k++) { /* width, height, then the scale (PFM) or maxval (PGM) */
         char tok[64];
         size_t t = 0;
@@ -1340,15 +1326,11 @@ static inline int ex_rio_open_netpbm(ex_rio_reader *r, const char *path)
         }
         while (i < n && !isspace(head[i]) && head[i] != '#' && t + 1 < sizeof tok) tok[t++] = (char)head[i++];
         tok[t] = '\0';
-        if (!t || ex_rio_number(tok, &v[k]) != 0 || (k < 2 && (v[k] < 1.0 || v[k] > EX_RIO_MAX_DIM || v[k] != floor(v[k])))) {
-            ex_rio_close(r);
+        if (!t || ex_rio_number(tok, &v[k]) != 0 || (k < 2 && !(v[k] >= 1.0 && v[k] <= EX_RIO_MAX_DIM && v[k] == floor(v[k]))))
             return ex_rio_fail(r->err, "bad or truncated header");
-        }
     }
-    if (i >= n || !isspace(head[i]) || (pfm ? !(v[2] != 0.0 && isfinite(v[2])) : !(v[2] >= 1.0 && v[2] <= 65535.0))) {
-        ex_rio_close(r);
+    if (i >= n || !isspace(head[i]) || (pfm ? !(v[2] != 0.0 && isfinite(v[2])) : !(v[2] >= 1.0 && v[2] <= 65535.0)))
         return ex_rio_fail(r->err, "bad or truncated header");
-    }
     r->format = EX_RIO_NETPBM;
     r->width = (int)v[0];
     r->height = (int)v[1];
@@ -1361,11 +1343,52 @@ static inline int ex_rio_open_netpbm(ex_rio_reader *r, const char *path)
     r->band_bytes = (uint64_t)(r->bits / 8);
     r->col_bytes = r->band_bytes * (uint64_t)r->bands;
     r->row_bytes = r->col_bytes * (uint64_t)r->width;
-    if (r->size < r->skip || (r->size - r->skip) / r->row_bytes < (uint64_t)r->height) {
-        ex_rio_close(r);
-        return ex_rio_fail(r->err, "truncated: the header announces %d x %d samples", (int)v[0], (int)v[1]);
-    }
+    if (r->size < r->skip || (r->size - r->skip) / r->row_bytes < (uint64_t)r->height)
+        return ex_rio_fail(r->err, "truncated: the header announces %d x %d samples", r->width, r->height);
     return 0;
+}
+
+/* Open a PFM or binary PGM held in memory for window reads (data must outlive the reader). */
+static inline int ex_rio_open_netpbm_mem(ex_rio_reader *r, const unsigned char *data, size_t size)
+{
+    int rc;
+    memset(r, 0, sizeof *r);
+    r->mem = data ? data : (const unsigned char *)"";
+    r->size = data ? size : 0;
+    rc = ex_rio_netpbm_parse(r, r->mem, (size_t)r->size < 4096 ? (size_t)r->size : 4096);
+    if (rc != 0) {
+        char keep[256];
+        memcpy(keep, r->err, sizeof keep);
+        ex_rio_close(r);
+        memcpy(r->err, keep, sizeof keep);
+    }
+    return rc;
+}
+
+/* Open a PFM or binary PGM file for window reads: its first 4 KiB are parsed, nothing else read. */
+static inline int ex_rio_open_netpbm(ex_rio_reader *r, const char *path)
+{
+    unsigned char head[4096];
+    size_t n;
+    long len;
+    int rc;
+    memset(r, 0, sizeof *r);
+    r->f = fopen(path, "rb");
+    if (!r->f) return ex_rio_fail(r->err, "cannot open");
+    n = fread(head, 1, sizeof head, r->f);
+    if (fseek(r->f, 0, SEEK_END) != 0 || (len = ftell(r->f)) < 0) {
+        ex_rio_close(r);
+        return ex_rio_fail(r->err, "cannot read");
+    }
+    r->size = (uint64_t)len;
+    rc = ex_rio_netpbm_parse(r, head, n);
+    if (rc != 0) {
+        char keep[256];
+        memcpy(keep, r->err, sizeof keep);
+        ex_rio_close(r);
+        memcpy(r->err, keep, sizeof keep);
+    }
+    return rc;
 }
 
 /* Move the georeference to the window whose first cell is (dx, dy) of the raster: the
