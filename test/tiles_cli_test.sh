@@ -171,6 +171,14 @@ fails "mosaic: onto a piece" 1 "refusing to replace an input" mosaic "$dir/s1.pf
 run "mosaic tif pieces" mosaic "$dir/s1.tif" "$dir/s2.tif" -o "$dir/s12.tif" &&
 run "whole tif" skyview "$dir/s.flt" $A -o "$dir/sw.tif" && same "GeoTIFF pieces mosaic = whole GeoTIFF" "$dir/sw.tif" "$dir/s12.tif"
 
+# ---- hfvis sum parts record R: parts of one R add up to the whole run, of two R are refused ----
+run "sum part R 400 a" skyview "$dir/s.flt" $A --dir-range 0:4 -o "$dir/pa.hfvs" &&
+run "sum part R 400 b" skyview "$dir/s.flt" $A --dir-range 4:8 -o "$dir/pb.hfvs" &&
+run "sum part R 500 b" skyview "$dir/s.flt" --dirs 8 --max-distance 500 --dir-range 4:8 -o "$dir/pc.hfvs" &&
+run "sum of R 400 parts" sum "$dir/pa.hfvs" "$dir/pb.hfvs" -o "$dir/psum.pfm" &&
+same "sum of --dir-range parts with R = whole run with R" "$dir/psum.pfm" "$dir/sv_flt.whole.pfm"
+fails "sum: parts of different R" 1 "max-distance=0x1.9p+8 there, 0x1.f4p+8 here" sum "$dir/pa.hfvs" "$dir/pc.hfvs" -o "$dir/x.pfm"
+
 # ---- memory: a refusal suggests a window that fits, and that window runs ----------------------
 "$hfvis" skyview "$dir/s.flt" --dirs 8 --max-distance 20 --max-memory 300K -o "$dir/x.pfm" 2> "$dir/err"
 side=$(sed -n 's/.*windows of \([0-9]*\) x [0-9]* cells fit.*/\1/p' "$dir/err")
