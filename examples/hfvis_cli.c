@@ -4473,9 +4473,10 @@ static int cli_info(int argc, char **argv)
     static const char *const fmt[5] = { "", "tiff", "asc", "ehdr", "netpbm" };
     if (argc != 3 || argv[2][0] == '-') {
         if (argc == 3 && (!strcmp(argv[2], "-h") || !strcmp(argv[2], "--help"))) {
-            printf("usage: hfvis info RASTER\nPrints width, height, bands, cell, crs, nodata and format "
-                   "of RASTER (.tif .asc .bil .flt .pfm, binary .pgm), one 'key value' per line; cell\n"
-                   "and nodata are 'none' when the file has none.\n");
+            printf("usage: hfvis info RASTER\nPrints width, height, bands, cell, origin (map X and Y of "
+                   "the upper-left corner), crs, nodata and format\nof RASTER (.tif .asc .bil .flt .pfm, "
+                   "binary .pgm), one 'key value' per line; cell, origin\nand nodata are 'none' when the "
+                   "file has none. Only the header is read.\n");
             return 0;
         }
         return cli_error(CLI_EXIT_USAGE, "info", "usage: hfvis info RASTER");
@@ -4485,6 +4486,8 @@ static int cli_info(int argc, char **argv)
     printf("width %d\nheight %d\nbands %d\n", r.width, r.height, r.bands);
     if (r.geo.has_transform && ex_georef_cell(&r.geo, &cell, why) == 0) printf("cell %.17g\n", cell);
     else printf("cell none\n");
+    if (r.geo.has_transform) printf("origin %.17g %.17g\n", r.geo.gt[0], r.geo.gt[3]); /* upper-left corner */
+    else printf("origin none\n");
     printf("crs %s", crs[r.geo.crs >= 0 && r.geo.crs < 4 ? r.geo.crs : 0]);
     if (r.geo.epsg) printf(" EPSG:%d", r.geo.epsg);
     printf("\nnodata %s\nformat %s\n", r.geo.has_nodata ? r.geo.nodata_text : "none",

@@ -193,6 +193,13 @@ else bad "--max-memory refusal: $(cat "$dir/err")"; fi
 if grep -q '^width 97$' "$dir/info" && grep -q '^height 83$' "$dir/info" && grep -q '^cell 2$' "$dir/info" &&
    grep -q '^crs projected' "$dir/info" && grep -q '^nodata -9999$' "$dir/info"; then ok "info: $(tr '\n' ' ' < "$dir/info")"
 else bad "info: $(cat "$dir/info")"; fi
+# pieces are placed where their cells lie: on a 2 m raster whose upper-left corner is
+# (500000, 4100166), window 40,30 starts 80 m east and 60 m south
+run "piece .flt at 40,30" skyview "$dir/s.flt" $A --window 40,30,20,10 -o "$dir/g.flt" &&
+"$hfvis" info "$dir/g.flt" > "$dir/info" 2>&1 && grep -q '^origin 500080 4100106$' "$dir/info" &&
+grep -q '^width 20$' "$dir/info" && ok "a .flt piece at window 40,30 has its origin 80 m east, 60 m south" || bad "piece origin: $(cat "$dir/info")"
+"$hfvis" info "$dir/s2.tif" > "$dir/info" 2>&1 && grep -q '^origin 500080 4100166$' "$dir/info" &&
+ok "a GeoTIFF piece at window 40,0 has its origin 80 m east" || bad "GeoTIFF piece origin: $(cat "$dir/info")"
 # covers W H: the tile list on stdin tiles [0,W) x [0,H) exactly (inside, disjoint, areas sum)
 covers() { awk -F, -v W="$1" -v H="$2" '{ x[NR] = $1; y[NR] = $2; w[NR] = $3; h[NR] = $4; a += $3 * $4
     if ($1 < 0 || $2 < 0 || $3 < 1 || $4 < 1 || $1 + $3 > W || $2 + $4 > H) bad = "outside: " $0 }
