@@ -1167,6 +1167,15 @@ static inline void ex_rio_close(ex_rio_reader *r)
     memset(r, 0, sizeof *r);
 }
 
+/* Close a reader whose opening failed, keeping its error message. */
+static inline void ex_rio_close_failed(ex_rio_reader *r)
+{
+    char keep[256];
+    memcpy(keep, r->err, sizeof keep);
+    ex_rio_close(r);
+    memcpy(r->err, keep, sizeof keep);
+}
+
 static inline int ex_rio_ext(const char *path, const char *ext)
 {
     size_t n = strlen(path), e = strlen(ext);
@@ -1296,12 +1305,7 @@ static inline int ex_rio_open(ex_rio_reader *r, const char *path)
         free(side);
         ex_rio_prj_crs(&r->geo);
     }
-    if (rc != 0) {
-        char keep[256];
-        memcpy(keep, r->err, sizeof keep);
-        ex_rio_close(r);
-        memcpy(r->err, keep, sizeof keep);
-    }
+    if (rc != 0) ex_rio_close_failed(r);
     return rc;
 }
 
@@ -1356,12 +1360,7 @@ static inline int ex_rio_open_netpbm_mem(ex_rio_reader *r, const unsigned char *
     r->mem = data ? data : (const unsigned char *)"";
     r->size = data ? size : 0;
     rc = ex_rio_netpbm_parse(r, r->mem, (size_t)r->size < 4096 ? (size_t)r->size : 4096);
-    if (rc != 0) {
-        char keep[256];
-        memcpy(keep, r->err, sizeof keep);
-        ex_rio_close(r);
-        memcpy(r->err, keep, sizeof keep);
-    }
+    if (rc != 0) ex_rio_close_failed(r);
     return rc;
 }
 
@@ -1382,12 +1381,7 @@ static inline int ex_rio_open_netpbm(ex_rio_reader *r, const char *path)
     }
     r->size = (uint64_t)len;
     rc = ex_rio_netpbm_parse(r, head, n);
-    if (rc != 0) {
-        char keep[256];
-        memcpy(keep, r->err, sizeof keep);
-        ex_rio_close(r);
-        memcpy(r->err, keep, sizeof keep);
-    }
+    if (rc != 0) ex_rio_close_failed(r);
     return rc;
 }
 
