@@ -93,9 +93,10 @@ cxx:
 	$(CXX) -std=c++11 -Wall -Wextra -Werror -pedantic -fsyntax-only -I. test/cxx_header.cpp
 
 # make bench follows config= and opt= (default: the release build, build/bench).
+# Its "tiles" section runs the hfvis tool (HFVIS_CLI) whole and tiled: make bench BENCH_ARGS=tiles.
 bench:
-	@$(MAKE) --no-print-directory $(BENCH)
-	@$(BENCH) $(BENCH_ARGS)
+	@$(MAKE) --no-print-directory $(BENCH) $(CLI)
+	@HFVIS_CLI=$(CLI) $(BENCH) $(BENCH_ARGS)
 
 demo: 
 	@$(MAKE) --no-print-directory config=release all

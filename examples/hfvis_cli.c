@@ -268,6 +268,7 @@ typedef struct cli_args {
         lk_has_eye, lk_has_target, lk_has_up, lk_has_radius;
     double lk_radius, lk_fov, lk_seed, lk_eye[3], lk_target[3], lk_up[3];
     double max_memory; /* --max-memory bytes, 0 = no limit (default: cli_default_max_memory) */
+    int has_window, win_x, win_y, win_w, win_h; /* --window X0,Y0,W,H (cells; docs/tiles.md) */
 } cli_args;
 
 /* ssao --method, --depth */
@@ -342,6 +343,8 @@ static const char cli_usage[] =
     "  meshao      ray-cast ambient obscurance of an OBJ mesh (Laine & Karras bit masks)\n"
     "  ssao        screen-space obscurance of a depth buffer: LSAO, HBAO, FFAO, ray traced\n"
     "  sum         add up the partial results of --dir-range runs into the single run's OUT\n"
+    "  mosaic      assemble the pieces of --window runs into the whole run's OUT\n"
+    "  info        print a raster's width, height, bands, cell, CRS and NoData\n"
     "  azimuths    print the K azimuths a run uses, in degrees, in output-plane order\n";
 
 static const char cli_shared_help[] =
@@ -389,6 +392,16 @@ static const char cli_shared_help2[] =
     "                    interpolation between lattice lines (right at walls, roofs, cliffs;\n"
     "                    'hfvis azimuths --exact' prints the directions used). visibility,\n"
     "                    indirect and gi keep the lattice\n"
+    "  --max-distance R  horizon, skyview, sky, shadow, light, visibility, indirect, hillshade:\n"
+    "                    the search radius in height units (--cell applies): occluders farther\n"
+    "                    than R along the ray are ignored (GRASS maxdistance, SAGA and RVT radius,\n"
+    "                    WhiteboxTools max_dist); 0 = unlimited (default). viewshed: its range\n"
+    "  --window X0,Y0,W,H  with a finite R (openness: --radius R): only the W x H cells from\n"
+    "                    column X0, row Y0 (clipped to IN), reading only them and a halo of\n"
+    "                    ceil(R/cell) + 1 cells (GeoTIFF strips/tiles, .bil/.flt, PFM and binary\n"
+    "                    PGM rows, by seeking); OUT (.pfm .tif .bil .flt .asc) is a piece, placed\n"
+    "                    and georeferenced at the window, with its sidecar OUT.tile; 'hfvis\n"
+    "                    mosaic' joins the pieces into the whole run's OUT (docs/tiles.md)\n"
     "  --quiet           no progress bar (shown on stderr only when it is a terminal) and no notes\n"
     "  --progress        plain progress lines on stderr instead (percent, elapsed, ETA), for logs\n"
     "                    and job schedulers, and a summary line at the end (time, cells,\n"
@@ -1378,6 +1391,10 @@ static int cli_gis_finish(cli_args *a)
 #define CLI_ONLY(c) (1u << (c))
 #define CLI_SUN (CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) \
                  | CLI_ONLY(CMD_HILLSHADE)) /* the sun flags */
+/* the sweep commands: --max-distance R is the library's search radius, --window makes a piece */
+#define CLI_SWEEP (CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_SHADOW) \
+                   | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_INDIRECT)         \
+                   | CLI_ONLY(CMD_HILLSHADE))
 /* the height-field commands: the GIS conventions apply to them */
 #define CLI_HF (CLI_ALL & ~(CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_VOLGI) \
                             | CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_MESHAO) | CLI_ONLY(CMD_SUM)))
@@ -1404,7 +1421,9 @@ static const cli_flag cli_flags[] = {
     { "--output", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VOLGI) },
     { "--fraction", 0, CLI_ONLY(CMD_VISIBILITY) }, { "--stats", 0, CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_MESHAO) },
     { "--observer", 1, CLI_ONLY(CMD_VIEWSHED) },  { "--observer-height", 1, CLI_ONLY(CMD_VIEWSHED) },
-    { "--target-height", 1, CLI_ONLY(CMD_VIEWSHED) }, { "--max-distance", 1, CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_VISFIELD) },
+    { "--target-height", 1, CLI_ONLY(CMD_VIEWSHED) },
+    { "--max-distance", 1, CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_VISFIELD) | CLI_SWEEP },
+    { "--window", 1, CLI_SWEEP | CLI_ONLY(CMD_OPENNESS) },
     { "--exact", 0, CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY)
                     | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_SHADOW) },
     { "--res", 1, CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_VOLGI) },       { "--mode", 1, CLI_ONLY(CMD_VOXELIZE) },
@@ -1572,6 +1591,23 @@ static int cli_set(cli_args *a, const char *f, const char *v)
     if (!strcmp(f, "--max-distance"))
         return cli_real(f, v, 0.0, 0, DBL_MAX, "a distance >= 0", &a->max_distance);
     if (!strcmp(f, "--exact")) { a->exact = 1; return 0; }
+    if (!strcmp(f, "--window")) { /* X0,Y0,W,H in cells; clipped to the raster when it is read */
+        long n[4];
+        const char *p = v;
+        char *end;
+        int k;
+        for (k = 0; k < 4; k++, p = end + 1) {
+            errno = 0;
+            n[k] = strtol(p, &end, 10);
+            if (end == p || errno == ERANGE || n[k] < -(long)INT_MAX / 2 || n[k] > (long)INT_MAX / 2 ||
+                (k >= 2 && n[k] < 1) || *end != (k < 3 ? ',' : '\0'))
+                return cli_error(CLI_EXIT_USAGE, f, "expected X0,Y0,W,H (cells: first column and row, "
+                                 "width and height >= 1), got '%s'", v);
+        }
+        a->has_window = 1;
+        a->win_x = (int)n[0], a->win_y = (int)n[1], a->win_w = (int)n[2], a->win_h = (int)n[3];
+        return 0;
+    }
     if (!strcmp(f, "--res")) return cli_int(f, v, 1, CLI_MAX_RES, "an integer 1..2048", &a->res);
     if (!strcmp(f, "--max-vertices"))
         return cli_int(f, v, 1, 1000000, "an integer 1..1000000", &a->max_vertices);
@@ -1615,6 +1651,28 @@ static int cli_set(cli_args *a, const char *f, const char *v)
     if (!strcmp(v, "prefix")) a->method = HFVIS_ENV_PREFIX;
     else if (!strcmp(v, "lp")) a->method = HFVIS_ENV_LP_TABLE;
     else return cli_error(CLI_EXIT_USAGE, f, "expected prefix or lp, got '%s'", v);
+    return 0;
+}
+
+/* --window: the combinations a piece cannot honour; 0 or CLI_EXIT_USAGE (reported). */
+static int cli_check_window(const cli_args *a)
+{
+    if (a->cmd == CMD_OPENNESS ? !(a->radius > 0.0) : !(a->max_distance > 0.0))
+        return cli_error(CLI_EXIT_USAGE, "--window", "needs a finite %s: without it a receiver's "
+                         "horizon depends on the whole field, so no window of it can be computed "
+                         "from the window and a halo", a->cmd == CMD_OPENNESS ? "--radius R" : "--max-distance R");
+    if (a->has_dir_range || a->out_partial)
+        return cli_error(CLI_EXIT_USAGE, "--window", "cannot be combined with --dir-range");
+    if (a->split) return cli_error(CLI_EXIT_USAGE, "--window", "cannot be combined with --split");
+    if (a->out_pgm)
+        return cli_error(CLI_EXIT_USAGE, a->out, "a piece keeps its values exactly: write .pfm, .tif, "
+                         ".bil/.flt or .asc ('hfvis mosaic' writes the .pgm)");
+    if (a->border == HFVIS_BORDER_WRAP)
+        return cli_error(CLI_EXIT_USAGE, "--window", "--border wrap joins opposite edges of the whole "
+                         "raster: not with a window");
+    if (a->albedo_map || a->emission)
+        return cli_error(CLI_EXIT_USAGE, "--window", "cannot be combined with %s (a map of the whole "
+                         "raster)", a->albedo_map ? "--albedo-map" : "--emission");
     return 0;
 }
 
@@ -1747,6 +1805,7 @@ static int cli_parse(int argc, char **argv, cli_args *a)
         if (a->output == OUT_INDIRECT && a->bounces < 1)
             return cli_error(CLI_EXIT_USAGE, "--output indirect", "needs --bounces >= 1");
     }
+    if (a->has_window && cli_check_window(a)) return CLI_EXIT_USAGE;
     if (a->cmd == CMD_GI && cli_check_gi(a)) return CLI_EXIT_USAGE;
     if (a->cmd == CMD_VOLGI && cli_check_volgi(a)) return CLI_EXIT_USAGE;
     if (a->cmd == CMD_VISFIELD && cli_check_vf(a)) return CLI_EXIT_USAGE;
@@ -1764,6 +1823,21 @@ static ex_georef cli_geo;
 static int cli_in_height;
 static float *cli_alloc(size_t a, size_t b, size_t c);
 
+/* A --window run (docs/tiles.md): the window of the raster it writes, the grid it loads (the
+ * window and a halo, clipped to the raster), and what its piece's sidecar records. */
+#define CLI_PIECE_TAG_MAX 2048 /* a piece's run tag: the command, the input's identity, ~30 parameters */
+typedef struct cli_window {
+    int active;                 /* this run computes one piece */
+    int halo;                   /* cells of halo (cli_halo), -1 unknown */
+    int x0, y0, w, h;           /* the window, clipped to the raster */
+    int gx0, gy0, gw, gh;       /* the grid loaded: window + halo, clipped */
+    int ext_w, ext_h;           /* the raster */
+    char in_id[64], crs[64], gt[160], nodata[80];
+    char tag[CLI_PIECE_TAG_MAX];
+} cli_window;
+static cli_window cli_win = { 0, -1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, "", "", "", "", "" };
+static int cli_window_plan(const cli_args *a, ex_rio_reader *r, const char *path, double cell);
+
 /* Load a GeoTIFF, ASC or EHdr IN (band --band): NoData -> NaN, the georeference kept in cli_geo,
  * *cell from it (geographic CRS refused unless --cell), --cell overriding with a note. */
 static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double *cell)
@@ -1772,15 +1846,21 @@ static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double 
     float *px;
     double rc_cell = 0.0;
     char why[256];
-    if (ex_rio_open(&r, a->in) != 0) return cli_error(CLI_EXIT_ERROR, a->in, "%s", r.err);
+    int gx = 0, gy = 0, gw, gh;
+    if ((ex_rio_format_of(a->in) ? ex_rio_open(&r, a->in) : ex_rio_open_netpbm(&r, a->in)) != 0)
+        return cli_error(CLI_EXIT_ERROR, a->in, "%s", r.err);
+    if (r.format == EX_RIO_NETPBM && r.bands != 1) {
+        ex_rio_close(&r);
+        return cli_error(CLI_EXIT_ERROR, a->in, "a height field has one channel, this image has %d", 3);
+    }
     if ((a->band ? a->band : 1) > r.bands) {
         cli_error(CLI_EXIT_ERROR, a->in, "--band %d: the raster has %d band%s", a->band, r.bands,
                   r.bands == 1 ? "" : "s");
         ex_rio_close(&r);
         return CLI_EXIT_ERROR;
     }
-    if (r.width > HFVIS_IMAGE_MAX_DIM || r.height > HFVIS_IMAGE_MAX_DIM ||
-        (size_t)r.width * (size_t)r.height > HFVIS_IMAGE_MAX_VALUES) {
+    if (!cli_win.active && (r.width > HFVIS_IMAGE_MAX_DIM || r.height > HFVIS_IMAGE_MAX_DIM ||
+        (size_t)r.width * (size_t)r.height > HFVIS_IMAGE_MAX_VALUES)) {
         cli_error(CLI_EXIT_ERROR, a->in, "%s: %d x %d cells exceed the limit of 2^28 values",
                   hfvis_status_string(HFVIS_ERR_LIMIT), r.width, r.height);
         ex_rio_close(&r);
@@ -1808,22 +1888,32 @@ static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double 
     } else if (!a->has_cell && !a->quiet) {
         fprintf(stderr, "hfvis: note: %s has no georeference: cell size 1 (give --cell)\n", a->in);
     }
-    px = cli_alloc((size_t)r.width, (size_t)r.height, 1);
+    gw = r.width, gh = r.height;
+    if (cli_win.active) { /* the window and its halo only (estimate and refusal before allocating) */
+        int rc = cli_window_plan(a, &r, a->in, *cell);
+        if (rc != 0) {
+            ex_rio_close(&r);
+            return rc;
+        }
+        gx = cli_win.gx0, gy = cli_win.gy0, gw = cli_win.gw, gh = cli_win.gh;
+    }
+    px = cli_alloc((size_t)gw, (size_t)gh, 1);
     if (!px) {
         ex_rio_close(&r);
         return cli_status(a->in, HFVIS_ERR_OUT_OF_MEMORY, 0);
     }
     r.nodata_to_nan = 1;
-    if (ex_rio_read(&r, a->band ? a->band - 1 : 0, 0, 0, r.width, r.height, px, r.width) != 0) {
+    if (ex_rio_read(&r, a->band ? a->band - 1 : 0, gx, gy, gw, gh, px, gw) != 0) {
         cli_error(CLI_EXIT_ERROR, a->in, "%s", r.err);
         free(px);
         ex_rio_close(&r);
         return CLI_EXIT_ERROR;
     }
-    *z = px; *w = r.width; *h = r.height;
+    *z = px; *w = gw; *h = gh;
     ex_georef_free(&cli_geo);
     cli_geo = r.geo; /* moved: the reader no longer owns it */
     memset(&r.geo, 0, sizeof r.geo);
+    if (cli_win.active) ex_georef_shift(&cli_geo, cli_win.x0, cli_win.y0); /* the piece's origin */
     ex_rio_close(&r);
     return 0;
 }
@@ -1887,18 +1977,135 @@ static cli_cost cli_estimate(const cli_args *a, int w, int h, int channels)
     return c;
 }
 
+static int cli_window_side(const cli_args *a, int halo, int w, int h);
 /* Print the estimate with the progress bar or the --progress lines, and refuse a run past
- * --max-memory (0 = none). */
+ * --max-memory (0 = none), suggesting a window size when the run can be tiled. */
 static int cli_check_cost(const cli_args *a, int w, int h, int channels)
 {
     const char *cmd = cli_cmd_names[a->cmd];
     cli_cost c = cli_estimate(a, w, h, channels);
     if (!a->quiet && (a->progress_lines || cli_stderr_is_terminal()))
         fprintf(stderr, "%s: estimate %.3g MiB, %.3g %s\n", cmd, c.bytes / 1048576.0, c.work, c.unit);
-    if (a->max_memory > 0.0 && c.bytes > a->max_memory)
+    if (a->max_memory > 0.0 && c.bytes > a->max_memory) {
+        char hint[200] = "";
+        if (cli_win.halo >= 0) { /* tiles: the largest square window whose grid (+ halo) fits */
+            int ww = cli_win.active ? cli_win.ext_w : w, hh = cli_win.active ? cli_win.ext_h : h;
+            int side = cli_window_side(a, cli_win.halo, ww, hh);
+            if (side > 0)
+                snprintf(hint, sizeof hint, "; windows of %d x %d cells fit (halo %d; --window X0,Y0,%d,%d, "
+                         "examples/tiles.sh)", side, side, cli_win.halo, side, side);
+            else
+                snprintf(hint, sizeof hint, "; not even a 1-cell window with its halo of %d cells fits: "
+                         "lower --max-distance", cli_win.halo);
+        } else if (a->cmd < CMD_COUNT && (CLI_ONLY(a->cmd) & CLI_SWEEP)) {
+            snprintf(hint, sizeof hint, ", or tile it: --max-distance R and --window (docs/tiles.md)");
+        }
         return cli_error(CLI_EXIT_ERROR, cmd, "needs about %.3g MiB (%.3g %s), over --max-memory %.3g "
-                         "MiB; raise --max-memory or make the run smaller (input, --dir-range, flags)",
-                         c.bytes / 1048576.0, c.work, c.unit, a->max_memory / 1048576.0);
+                         "MiB; raise --max-memory or make the run smaller (input, --dir-range, flags)%s",
+                         c.bytes / 1048576.0, c.work, c.unit, a->max_memory / 1048576.0, hint);
+    }
+    return 0;
+}
+
+/* The halo of a window run, in cells: every input cell a receiver of the window can depend on
+ * lies within it. A sweep with search radius R reads heights up to R along the ray, plus one
+ * cell for the bilinear gather of the lattice: ceil(R / cell) + 1. indirect adds R per bounce
+ * (bounce b gathers light that the terrain up to b R away received); openness marches --radius.
+ * The one place the rule lives (the library's own rule replaces it if it ever differs). */
+static int cli_halo(const cli_args *a, double cell)
+{
+    double r = a->cmd == CMD_OPENNESS ? a->radius : a->max_distance, h;
+    h = ceil(r / cell);
+    if (a->cmd == CMD_INDIRECT) h *= (double)((a->output == OUT_DIRECT ? 0 : a->bounces) + 1);
+    h += 1.0;
+    return h < (double)HFVIS_IMAGE_MAX_DIM ? (int)h : HFVIS_IMAGE_MAX_DIM;
+}
+
+/* The largest side S of a square window whose grid, S + 2 halo (clipped to the w x h raster) on
+ * each axis, fits --max-memory by cli_estimate; 0 if none does. */
+static int cli_window_side(const cli_args *a, int halo, int w, int h)
+{
+    int lo = 0, hi = w > h ? w : h;
+    while (lo < hi) {
+        int mid = lo + (hi - lo + 1) / 2;
+        double gw = (double)mid + 2.0 * halo, gh = gw;
+        if (gw > w) gw = w;
+        if (gh > h) gh = h;
+        if (cli_estimate(a, (int)gw, (int)gh, 1).bytes <= a->max_memory) lo = mid;
+        else hi = mid - 1;
+    }
+    return lo;
+}
+
+/* A file's identity without reading it whole: its size and the CRC-32 of its first and last
+ * 64 KiB (the header, the first and last rows or strips; a TIFF's directory). */
+static int cli_file_id(const char *path, char *out, size_t cap)
+{
+    enum { BLOCK = 65536 };
+    FILE *f = fopen(path, "rb");
+    unsigned char *buf = (unsigned char *)malloc(BLOCK);
+    uint32_t crc = 0;
+    long len = -1;
+    size_t n;
+    int ok = f && buf && fseek(f, 0, SEEK_END) == 0 && (len = ftell(f)) >= 0 && fseek(f, 0, SEEK_SET) == 0;
+    if (ok) {
+        n = fread(buf, 1, BLOCK, f);
+        crc = hfvis_crc32(crc, buf, n);
+        if (len > BLOCK) {
+            ok = fseek(f, len - BLOCK, SEEK_SET) == 0 && fread(buf, 1, BLOCK, f) == BLOCK;
+            crc = hfvis_crc32(crc, buf, BLOCK);
+        }
+    }
+    if (f) fclose(f);
+    free(buf);
+    snprintf(out, cap, "%lx-%08lx", (unsigned long)len, (unsigned long)crc);
+    return ok ? 0 : -1;
+}
+
+/* A --window run, once the raster's header is read: clip the window, add the halo, estimate the
+ * grid's memory (refused with a window size that fits) and record the input's identity. */
+static int cli_window_plan(const cli_args *a, ex_rio_reader *r, const char *path, double cell)
+{
+    long long x0 = a->win_x, y0 = a->win_y, x1 = x0 + a->win_w, y1 = y0 + a->win_h, h;
+    const ex_georef *g = &r->geo;
+    uint32_t crs = 0;
+    cli_window *v = &cli_win;
+    if (x0 < 0) x0 = 0;
+    if (y0 < 0) y0 = 0;
+    if (x1 > r->width) x1 = r->width;
+    if (y1 > r->height) y1 = r->height;
+    if (x0 >= x1 || y0 >= y1)
+        return cli_error(CLI_EXIT_ERROR, "--window", "%d,%d,%d,%d lies outside the raster (%d x %d cells)",
+                         a->win_x, a->win_y, a->win_w, a->win_h, r->width, r->height);
+    v->halo = cli_halo(a, cell);
+    h = v->halo;
+    v->x0 = (int)x0, v->y0 = (int)y0, v->w = (int)(x1 - x0), v->h = (int)(y1 - y0);
+    v->ext_w = r->width, v->ext_h = r->height;
+    v->gx0 = (int)(x0 - h > 0 ? x0 - h : 0), v->gy0 = (int)(y0 - h > 0 ? y0 - h : 0);
+    v->gw = (int)((x1 + h < r->width ? x1 + h : r->width) - v->gx0);
+    v->gh = (int)((y1 + h < r->height ? y1 + h : r->height) - v->gy0);
+    if (cli_check_cost(a, v->gw, v->gh, 1) != 0) return CLI_EXIT_ERROR;
+    if ((size_t)v->gw * (size_t)v->gh > HFVIS_IMAGE_MAX_VALUES || v->gw > HFVIS_IMAGE_MAX_DIM ||
+        v->gh > HFVIS_IMAGE_MAX_DIM)
+        return cli_error(CLI_EXIT_ERROR, "--window", "%s: the window and its halo of %d cells, %d x %d, "
+                         "exceed 2^28 values or 2^20 rows or columns; use windows of at most %d x %d cells",
+                         hfvis_status_string(HFVIS_ERR_LIMIT), v->halo, v->gw, v->gh,
+                         16384 - 2 * v->halo > 1 ? 16384 - 2 * v->halo : 1,
+                         16384 - 2 * v->halo > 1 ? 16384 - 2 * v->halo : 1);
+    if (cli_file_id(path, v->in_id, sizeof v->in_id) != 0)
+        return cli_error(CLI_EXIT_ERROR, path, "cannot read it to fingerprint it");
+    if (g->geokeys) crs = hfvis_crc32(crs, g->geokeys, g->n_geokeys * sizeof *g->geokeys);
+    if (g->geodoubles) crs = hfvis_crc32(crs, g->geodoubles, g->n_geodoubles * sizeof *g->geodoubles);
+    if (g->geoascii) crs = hfvis_crc32(crs, g->geoascii, g->n_geoascii);
+    if (g->prj) crs = hfvis_crc32(crs, g->prj, strlen(g->prj));
+    snprintf(v->crs, sizeof v->crs, "%d:%d:%08lx", g->crs, g->epsg, (unsigned long)crs);
+    if (g->has_transform)
+        snprintf(v->gt, sizeof v->gt, "%a,%a,%a,%a,%a,%a", g->gt[0], g->gt[1], g->gt[2], g->gt[3],
+                 g->gt[4], g->gt[5]);
+    else
+        strcpy(v->gt, "none");
+    if (g->has_nodata) snprintf(v->nodata, sizeof v->nodata, "%s", g->nodata_text);
+    else strcpy(v->nodata, "none");
     return 0;
 }
 
@@ -1912,7 +2119,7 @@ static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double
     size_t i, n;
     hfvis_status s;
     *cell = a->cell;
-    if (ex_rio_format_of(a->in)) {
+    if (ex_rio_format_of(a->in) || cli_win.active) {
         int rc = cli_load_raster(a, &px, w, h, cell);
         if (rc != 0) return rc;
     } else {
@@ -1969,7 +2176,7 @@ static float *cli_alloc(size_t a, size_t b, size_t c)
     if (a == 0 || b == 0 || c == 0 || a > SIZE_MAX / b || a * b > SIZE_MAX / c ||
         a * b * c > SIZE_MAX / sizeof(float))
         return NULL;
-    return (float *)malloc(a * b * c * sizeof(float));
+    return (float *)calloc(a * b * c, sizeof(float)); /* zeros: a window run leaves cells unwritten */
 }
 
 /* Integral outputs (viewshed 0/1, visibility counts) go into the smallest integer GeoTIFF type
@@ -2154,12 +2361,15 @@ static hfvis_status cli_partial_save(const char *path, const hfvis_partial *p)
     return cli_write_encoded(path, hfvis_partial_encode_size(p), cli_enc_partial, p);
 }
 
+static int cli_save_piece(const cli_args *a, const float *px, int w, int h, int channels, double lo,
+                          double hi);
 /* Write OUT: PFM with its channels, or a 16-bit PGM with the channel planes stacked (NoData code 0,
- * the range in its header: hfvis_pgm_range_save). */
+ * the range in its header: hfvis_pgm_range_save). A --window run writes its piece instead. */
 static int cli_save(const cli_args *a, const float *px, int w, int h, int channels, double lo,
                     double hi)
 {
     hfvis_status s;
+    if (cli_win.active) return cli_save_piece(a, px, w, h, channels, lo, hi);
     errno = 0;
     if (a->out_raster) {
         /* planes stacked top to bottom (horizon) or channels interleaved become bands */
@@ -3094,10 +3304,10 @@ static void cli_partial_tag(const cli_args *a, const hfvis_grid *grid, const hfv
                             const hfvis_env *env, char *tag)
 {
     int n = snprintf(tag, CLI_TAG_MAX, "cmd=%s dirs=%d in=%016llx cell=%a border=%d border-cells=%d "
-                     "azimuth0=%a rays=%s", cli_cmd_names[a->cmd], a->dirs,
+                     "azimuth0=%a rays=%s max-distance=%a", cli_cmd_names[a->cmd], a->dirs,
                      cli_fingerprint(grid->z, (size_t)grid->width * (size_t)grid->height),
                      grid->cell_size, (int)o->border, o->border_cells, o->azimuth0_rad,
-                     o->rays == HFVIS_RAYS_EXACT ? "exact" : "lattice");
+                     o->rays == HFVIS_RAYS_EXACT ? "exact" : "lattice", o->max_distance);
     char *t = tag + n;
     size_t left = CLI_TAG_MAX - (size_t)n;
     switch (a->cmd) {
@@ -3901,6 +4111,422 @@ static int cli_horizon_finish(const cli_args *a, float *map, int w, int h, doubl
     return rc;
 }
 
+/* ------------------------------------------------------------------------------------------ */
+/* tiles: a --window run writes a piece and its sidecar, `mosaic` assembles the pieces          */
+/* (docs/tiles.md)                                                                              */
+/* ------------------------------------------------------------------------------------------ */
+
+#define CLI_PIECE_MAGIC "HFVISTILE 1\n"
+#define CLI_PIECE_SIDECAR ".tile" /* appended to the piece's name */
+
+/* The run tag of a piece: every key that must match across the pieces of one run. The order
+ * matters: `mosaic` names the first key that differs, so the CRS and cell size come before
+ * the input's identity (a reprojected input differs in all three). Over-inclusive on purpose:
+ * every value-changing flag of every tiled command, whatever the command. */
+static void cli_piece_tag(const cli_args *a, const hfvis_grid *grid, const hfvis_sweep_options *o)
+{
+    char env_id[64] = "none", nodata_flag[40] = "none";
+    if (a->env && cli_file_id(a->env, env_id, sizeof env_id) != 0) strcpy(env_id, "unreadable");
+    if (a->has_nodata) snprintf(nodata_flag, sizeof nodata_flag, "%a", (double)(float)a->nodata);
+    snprintf(cli_win.tag, sizeof cli_win.tag,
+             "cmd=%s crs=%s cell=%a extent=%dx%d in=%s gt=%s band=%d nodata=%s set-nodata=%s zscale=%a "
+             "max-distance=%a dirs=%d border=%d border-cells=%d azimuth0=%a rays=%s convention=%d "
+             "degrees=%d svf=%d sky=%a albedo=%a sun=%a,%a,%a,%a,%d blend=%d no-shadows=%d radius=%a "
+             "negative=%d fraction=%d method=%d bounces=%d output=%d env=%s",
+             cli_cmd_names[a->cmd], cli_win.crs, grid->cell_size, cli_win.ext_w, cli_win.ext_h,
+             cli_win.in_id, cli_win.gt, a->band ? a->band : 1, cli_win.nodata, nodata_flag, a->zscale,
+             o->max_distance, a->dirs, (int)o->border, o->border_cells, o->azimuth0_rad,
+             o->rays == HFVIS_RAYS_EXACT ? "exact" : "lattice", a->convention, a->degrees, a->svf,
+             a->sky, a->albedo, a->sun_azimuth, a->sun_elevation, a->sun_radius, a->sun_irradiance,
+             a->has_sun_azimuth, a->blend, a->no_shadows, a->radius, a->negative, a->fraction,
+             a->method, a->bounces, a->output, env_id);
+}
+
+/* Commands whose default PGM range tops at the largest output value (mosaic recomputes it). */
+static int cli_range_is_top(int cmd, int fraction)
+{
+    return cmd == CMD_LIGHT || cmd == CMD_INDIRECT || (cmd == CMD_VISIBILITY && !fraction);
+}
+
+/* A --window run's output: the window cut out of each plane of the grid's result (w x h with
+ * the planes stacked), written as OUT with the georeference moved to the window, then the
+ * sidecar OUT.tile: the window, the planes and channels, the default range, the run tag. */
+static int cli_save_piece(const cli_args *a, const float *px, int w, int h, int channels, double lo,
+                          double hi)
+{
+    const cli_window v = cli_win;
+    const int planes = h / v.gh;
+    const size_t row = (size_t)v.w * (size_t)channels;
+    float *cut = cli_alloc((size_t)v.w * (size_t)v.h, (size_t)planes, (size_t)channels);
+    char *side = NULL, *text = NULL, range[96];
+    size_t len;
+    int p, y, rc;
+    hfvis_status s;
+    if (!cut) return cli_status(a->out, HFVIS_ERR_OUT_OF_MEMORY, 0);
+    for (p = 0; p < planes; p++)
+        for (y = 0; y < v.h; y++)
+            memcpy(cut + ((size_t)p * (size_t)v.h + (size_t)y) * row,
+                   px + (((size_t)p * (size_t)v.gh + (size_t)(v.y0 - v.gy0 + y)) * (size_t)w +
+                         (size_t)(v.x0 - v.gx0)) * (size_t)channels, row * sizeof(float));
+    cli_win.active = 0; /* write it as an ordinary output of v.w x v.h cells */
+    cli_in_height = v.h;
+    rc = cli_save(a, cut, v.w, v.h * planes, channels, lo, hi);
+    free(cut);
+    if (rc != 0) return rc;
+    if (cli_range_is_top(a->cmd, a->fraction)) strcpy(range, "top");
+    else snprintf(range, sizeof range, "%a:%a", lo, hi);
+    len = strlen(a->out) + sizeof CLI_PIECE_SIDECAR;
+    side = (char *)malloc(len);
+    text = (char *)malloc(CLI_PIECE_TAG_MAX + 256);
+    if (!side || !text) {
+        free(side);
+        free(text);
+        return cli_status(a->out, HFVIS_ERR_OUT_OF_MEMORY, 0);
+    }
+    snprintf(side, len, "%s%s", a->out, CLI_PIECE_SIDECAR);
+    snprintf(text, CLI_PIECE_TAG_MAX + 256, CLI_PIECE_MAGIC "window=%d,%d,%d,%d planes=%d channels=%d "
+             "range=%s\n%s\n", v.x0, v.y0, v.w, v.h, planes, channels, range, v.tag);
+    errno = 0;
+    s = cli_write(side, (unsigned char *)text, strlen(text), HFVIS_OK); /* frees text */
+    rc = s == HFVIS_OK ? 0 : cli_status(side, s, errno);
+    free(side);
+    return rc;
+}
+
+#define CLI_MOSAIC_HELP                                                                              \
+    "usage: hfvis mosaic PIECE... -o OUT [--range LO:HI] [--overwrite] [--quiet]\n"                 \
+    "Assemble the pieces of one tiled run (--max-distance R --window X0,Y0,W,H, each piece with\n"  \
+    "its sidecar PIECE.tile) into the raster the whole run writes: OUT equals the whole run's\n"    \
+    "output bit for bit (a GeoTIFF georeferenced as the whole run's). Refused, with nothing\n"     \
+    "written, naming the problem: pieces of different inputs, CRS, cell sizes, R or other\n"       \
+    "parameters, overlapping windows, and cells that no piece holds. OUT holds the whole raster\n" \
+    "in memory (W x H x planes floats); beyond that, gdalbuildvrt over GeoTIFF pieces.\n"         \
+    "  -o OUT            .pfm, .pgm (with the command's default range), .tif, .asc, .bil or .flt\n" \
+    "  --range LO:HI     .pgm only: the values mapped to codes 1 and 65535\n"                     \
+    "  --overwrite       allow OUT to be one of the pieces\n"
+
+/* One piece's sidecar, as read back. */
+typedef struct cli_piece {
+    int x0, y0, w, h, planes, channels;
+    char range[96];
+    char tag[CLI_PIECE_TAG_MAX];
+} cli_piece;
+
+static int cli_piece_meta(const char *path, cli_piece *p)
+{
+    size_t n = strlen(path) + sizeof CLI_PIECE_SIDECAR, len = 0;
+    char *side = (char *)malloc(n), *text = NULL, *line2, *line3, *end;
+    int ok = 0;
+    if (!side) return cli_status(path, HFVIS_ERR_OUT_OF_MEMORY, 0);
+    snprintf(side, n, "%s%s", path, CLI_PIECE_SIDECAR);
+    text = ex_rio_slurp(side, EX_RIO_MAX_HEADER, &len);
+    if (!text) {
+        cli_error(CLI_EXIT_ERROR, path, "no sidecar %s: not a piece of 'hfvis ... --window' (or moved "
+                  "without it)", side);
+        free(side);
+        return CLI_EXIT_ERROR;
+    }
+    line2 = strchr(text, '\n');
+    line3 = line2 ? strchr(line2 + 1, '\n') : NULL;
+    if (!strncmp(text, CLI_PIECE_MAGIC, sizeof CLI_PIECE_MAGIC - 1) && line3) {
+        *line3++ = '\0';
+        end = strchr(line3, '\n');
+        if (end) *end = '\0';
+        ok = sscanf(line2 + 1, "window=%d,%d,%d,%d planes=%d channels=%d range=%95s", &p->x0, &p->y0,
+                    &p->w, &p->h, &p->planes, &p->channels, p->range) == 7 &&
+             strlen(line3) < sizeof p->tag && p->w > 0 && p->h > 0 && p->planes > 0 && p->channels > 0;
+        if (ok) strcpy(p->tag, line3);
+    }
+    if (!ok) cli_error(CLI_EXIT_ERROR, side, "not a piece sidecar (damaged, or of another hfvis version)");
+    free(text);
+    free(side);
+    return ok ? 0 : CLI_EXIT_ERROR;
+}
+
+/* The problem a differing tag key names. */
+static const char *cli_piece_problem(const char *key)
+{
+    if (!strcmp(key, "crs")) return "different CRS";
+    if (!strcmp(key, "cell")) return "different cell sizes";
+    if (!strcmp(key, "max-distance")) return "different R (--max-distance)";
+    if (!strcmp(key, "cmd")) return "different commands";
+    if (!strcmp(key, "in") || !strcmp(key, "extent") || !strcmp(key, "gt") || !strcmp(key, "band"))
+        return "different inputs";
+    return "different parameters";
+}
+
+/* Read piece path (of sidecar m) into the mosaic out (W x H cells, planes stacked, channels
+ * interleaved), checking its size and, for a raster, its CRS and cell size against ref's. */
+static int cli_piece_read(const char *path, const cli_piece *m, int W, int H, float *out,
+                          const ex_georef *ref, ex_georef *keep)
+{
+    const size_t C = (size_t)m->channels;
+    int x, y, p, c;
+    if (ex_rio_format_of(path)) {
+        ex_rio_reader r;
+        float *row;
+        if (ex_rio_open(&r, path) != 0) return cli_error(CLI_EXIT_ERROR, path, "%s", r.err);
+        if (r.width != m->w || r.height != m->h || r.bands != m->planes * m->channels) {
+            cli_error(CLI_EXIT_ERROR, path, "%d x %d cells, %d bands: its sidecar says %d x %d, %d", r.width,
+                      r.height, r.bands, m->w, m->h, m->planes * m->channels);
+            ex_rio_close(&r);
+            return CLI_EXIT_ERROR;
+        }
+        if (ref && (ref->crs != r.geo.crs || ref->epsg != r.geo.epsg)) {
+            cli_error(CLI_EXIT_ERROR, path, "different CRS (EPSG:%d there, EPSG:%d here)", ref->epsg, r.geo.epsg);
+            ex_rio_close(&r);
+            return CLI_EXIT_ERROR;
+        }
+        if (ref && (ref->has_transform != r.geo.has_transform || ref->gt[1] != r.geo.gt[1] ||
+                    ref->gt[5] != r.geo.gt[5])) {
+            cli_error(CLI_EXIT_ERROR, path, "different cell sizes (%.10g x %.10g there, %.10g x %.10g here)",
+                      ref->gt[1], ref->gt[5], r.geo.gt[1], r.geo.gt[5]);
+            ex_rio_close(&r);
+            return CLI_EXIT_ERROR;
+        }
+        row = cli_alloc((size_t)m->w, (size_t)m->h, 1); /* one band: each strip or tile decoded once */
+        if (!row) {
+            ex_rio_close(&r);
+            return cli_status(path, HFVIS_ERR_OUT_OF_MEMORY, 0);
+        }
+        r.nodata_to_nan = 1;
+        for (p = 0; p < m->planes; p++)
+            for (c = 0; c < m->channels; c++) {
+                if (ex_rio_read(&r, m->channels > 1 ? c : p, 0, 0, m->w, m->h, row, m->w) != 0) {
+                    cli_error(CLI_EXIT_ERROR, path, "%s", r.err);
+                    free(row);
+                    ex_rio_close(&r);
+                    return CLI_EXIT_ERROR;
+                }
+                for (y = 0; y < m->h; y++) {
+                    float *dst = out + (((size_t)p * (size_t)H + (size_t)(m->y0 + y)) * (size_t)W + (size_t)m->x0) * C + (size_t)c;
+                    const float *src = row + (size_t)y * (size_t)m->w;
+                    for (x = 0; x < m->w; x++) dst[(size_t)x * C] = src[x];
+                }
+            }
+        free(row);
+        if (keep) { /* the georeference of the piece at (0, 0) is the whole raster's */
+            ex_georef_free(keep);
+            *keep = r.geo;
+            memset(&r.geo, 0, sizeof r.geo);
+        }
+        ex_rio_close(&r);
+        return 0;
+    } else {
+        hfvis_image_info info;
+        float *px = NULL;
+        hfvis_status s;
+        errno = 0;
+        s = hfvis_image_load(path, NULL, &px, &info);
+        if (s != HFVIS_OK) return cli_status(path, s, errno);
+        if (info.format != HFVIS_FORMAT_PFM || info.width != m->w || info.height != m->h * m->planes ||
+            info.channels != m->channels) {
+            hfvis_free(NULL, px);
+            return cli_error(CLI_EXIT_ERROR, path, "%d x %d x %d values: its sidecar says a PFM of %d x %d x %d",
+                             info.width, info.height, info.channels, m->w, m->h * m->planes, m->channels);
+        }
+        for (p = 0; p < m->planes; p++)
+            for (y = 0; y < m->h; y++)
+                memcpy(out + (((size_t)p * (size_t)H + (size_t)(m->y0 + y)) * (size_t)W + (size_t)m->x0) * C,
+                       px + ((size_t)p * (size_t)m->h + (size_t)y) * (size_t)m->w * C,
+                       (size_t)m->w * C * sizeof(float));
+        hfvis_free(NULL, px);
+        return 0;
+    }
+}
+
+/* `hfvis mosaic PIECE... -o OUT`: the sidecars first (one run: same tag; the windows tile the
+ * extent: inside it, no two overlapping, their areas summing to it), then the pieces into one
+ * raster, written as the whole run writes it (cli_save with the whole raster's georeference). */
+static int cli_mosaic(int argc, char **argv)
+{
+    enum { MAX_PIECES = 65536 };
+    static const char *names[MAX_PIECES];
+    cli_piece *meta = NULL;
+    cli_args a;
+    char key[64], other[CLI_PIECE_TAG_MAX], cmdname[32], ext[64];
+    int n = 0, i, j, rc = 0, W = 0, H = 0, planes, channels, origin = -1, cmd;
+    double area = 0.0, lo = 0.0, hi = 1.0;
+    float *out = NULL;
+    ex_georef ref;
+
+    memset(&a, 0, sizeof a);
+    memset(&ref, 0, sizeof ref);
+    for (i = 2; i < argc; i++) {
+        const char *arg = argv[i];
+        if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) {
+            printf("%s", CLI_MOSAIC_HELP);
+            return 0;
+        }
+        if (!strcmp(arg, "-o") || !strncmp(arg, "-o=", 3) || !strcmp(arg, "--range") || !strncmp(arg, "--range=", 8)) {
+            int is_o = arg[1] == 'o';
+            const char *eq = strchr(arg, '='), *v = eq ? eq + 1 : (i + 1 < argc ? argv[++i] : NULL);
+            if (!v) return cli_error(CLI_EXIT_USAGE, is_o ? "-o" : "--range", "missing value");
+            if (!is_o) {
+                if (cli_set(&a, "--range", v)) return CLI_EXIT_USAGE;
+                continue;
+            }
+            if (!cli_ends_with(v, ".pfm") && !cli_ends_with(v, ".pgm") && !ex_rio_format_of(v))
+                return cli_error(CLI_EXIT_USAGE, v, "unknown output type (use a .pfm, .pgm, .tif, .asc, .bil or .flt name)");
+            a.out = v;
+            a.out_pgm = cli_ends_with(v, ".pgm");
+            a.out_raster = ex_rio_format_of(v) != 0;
+            continue;
+        }
+        if (!strcmp(arg, "--quiet")) { a.quiet = 1; continue; }
+        if (!strcmp(arg, "--overwrite")) { a.overwrite = 1; continue; }
+        if (arg[0] == '-' && arg[1] != '\0')
+            return cli_error(CLI_EXIT_USAGE, arg, "unknown option (see 'hfvis mosaic --help')");
+        if (n == MAX_PIECES) return cli_error(CLI_EXIT_USAGE, arg, "more than %d pieces", MAX_PIECES);
+        names[n++] = arg;
+    }
+    if (n == 0) return cli_error(CLI_EXIT_USAGE, "mosaic", "missing PIECE files");
+    if (!a.out) return cli_error(CLI_EXIT_USAGE, "mosaic", "missing -o OUT");
+    if (a.has_range && !a.out_pgm) return cli_error(CLI_EXIT_USAGE, "--range", "applies only to .pgm output");
+    if ((rc = cli_refuse_input(a.overwrite, a.out, names, n)) != 0) return rc;
+    meta = (cli_piece *)malloc((size_t)n * sizeof *meta);
+    if (!meta) return cli_status("mosaic", HFVIS_ERR_OUT_OF_MEMORY, 0);
+
+    /* one run */
+    for (i = 0; i < n; i++) {
+        if ((rc = cli_piece_meta(names[i], &meta[i])) != 0) goto done;
+        if (i == 0) continue;
+        cli_tag_first_difference(meta[i].tag, meta[0].tag, key, sizeof key);
+        if (key[0]) {
+            char *eq = strchr(key, '=');
+            if (eq) *eq = '\0';
+            if (!cli_tag_value(meta[0].tag, key, other, sizeof other)) strcpy(other, "(none)");
+            rc = cli_error(CLI_EXIT_ERROR, names[i], "not the same run as %s: %s (%s=%s there, %s here)",
+                           names[0], cli_piece_problem(key), key, other, eq ? eq + 1 : "");
+            goto done;
+        }
+        if (meta[i].planes != meta[0].planes || meta[i].channels != meta[0].channels) {
+            rc = cli_error(CLI_EXIT_ERROR, names[i], "not the same run as %s: %d planes of %d channels there, "
+                           "%d of %d here", names[0], meta[0].planes, meta[0].channels, meta[i].planes,
+                           meta[i].channels);
+            goto done;
+        }
+    }
+    if (!cli_tag_value(meta[0].tag, "extent", ext, sizeof ext) || sscanf(ext, "%dx%d", &W, &H) != 2 ||
+        W < 1 || H < 1 || !cli_tag_value(meta[0].tag, "cmd", cmdname, sizeof cmdname)) {
+        rc = cli_error(CLI_EXIT_ERROR, names[0], "its sidecar names no extent or command");
+        goto done;
+    }
+    for (cmd = 0; cmd < CMD_COUNT && strcmp(cmdname, cli_cmd_names[cmd]); cmd++) {}
+    planes = meta[0].planes, channels = meta[0].channels;
+    /* the windows tile the extent: inside it, pairwise disjoint, areas summing to it */
+    for (i = 0; i < n; i++) {
+        const cli_piece *p = &meta[i];
+        if (p->x0 < 0 || p->y0 < 0 || p->w > W - p->x0 || p->h > H - p->y0) {
+            rc = cli_error(CLI_EXIT_ERROR, names[i], "window %d,%d,%d,%d lies outside the extent %d x %d",
+                           p->x0, p->y0, p->w, p->h, W, H);
+            goto done;
+        }
+        if (p->x0 == 0 && p->y0 == 0) origin = i;
+        area += (double)p->w * (double)p->h;
+        for (j = 0; j < i; j++) {
+            const cli_piece *q = &meta[j];
+            if (p->x0 < q->x0 + q->w && q->x0 < p->x0 + p->w && p->y0 < q->y0 + q->h && q->y0 < p->y0 + p->h) {
+                rc = cli_error(CLI_EXIT_ERROR, names[i], "overlaps %s: windows %d,%d,%d,%d and %d,%d,%d,%d "
+                               "share cells", names[j], p->x0, p->y0, p->w, p->h, q->x0, q->y0, q->w, q->h);
+                goto done;
+            }
+        }
+    }
+    if (area < (double)W * (double)H) {
+        rc = cli_error(CLI_EXIT_ERROR, "mosaic", "missing pieces: %.0f of the %d x %d cells are in no "
+                       "piece%s", (double)W * (double)H - area, W, H,
+                       origin < 0 ? " (none holds cell 0,0)" : "");
+        goto done;
+    }
+    if (planes > 1 && (long long)planes * H > HFVIS_IMAGE_MAX_DIM) {
+        rc = cli_error(CLI_EXIT_ERROR, "mosaic", "%s: %d planes of %d rows", hfvis_status_string(HFVIS_ERR_LIMIT),
+                       planes, H);
+        goto done;
+    }
+    out = cli_alloc((size_t)W * (size_t)H, (size_t)planes, (size_t)channels);
+    if (!out) { rc = cli_status("mosaic", HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
+    /* the piece at (0, 0) first: its georeference is the whole raster's and the reference of the others */
+    if ((rc = cli_piece_read(names[origin], &meta[origin], W, H, out, NULL, &ref)) != 0) goto done;
+    for (i = 0; i < n; i++)
+        if (i != origin && (rc = cli_piece_read(names[i], &meta[i], W, H, out,
+                                                ex_rio_format_of(names[origin]) ? &ref : NULL, NULL)) != 0)
+            goto done;
+    if (!ref.has_transform && cli_tag_value(meta[0].tag, "gt", other, sizeof other) && strcmp(other, "none")) {
+        /* PFM pieces: the geotransform from the sidecar (their CRS is not kept: use raster pieces) */
+        char *q = other;
+        for (i = 0; i < 6; i++) {
+            char *comma = strchr(q, ',');
+            if (comma) *comma = '\0';
+            if (!cli_parse_real(q, &ref.gt[i])) break;
+            q = comma ? comma + 1 : q + strlen(q);
+        }
+        ref.has_transform = i == 6;
+    }
+    /* NoData as the whole run had it: the input's (the pieces may have declared NaN or moved it) */
+    ref.has_nodata = 0;
+    if (cli_tag_value(meta[0].tag, "nodata", other, sizeof other) && strcmp(other, "none"))
+        ex_georef_set_nodata(&ref, other, strlen(other));
+    if (!ref.has_nodata && cli_tag_value(meta[0].tag, "set-nodata", other, sizeof other) && strcmp(other, "none") &&
+        cli_parse_real(other, &ref.nodata)) {
+        ref.has_nodata = 1;
+        snprintf(ref.nodata_text, sizeof ref.nodata_text, "%.9g", ref.nodata);
+    }
+    ex_georef_free(&cli_geo);
+    cli_geo = ref;
+    memset(&ref, 0, sizeof ref);
+    cli_in_height = H;
+    a.cmd = cmd < CMD_COUNT ? cmd : CMD_SKYVIEW;
+    a.fraction = cli_tag_value(meta[0].tag, "fraction", other, sizeof other) && !strcmp(other, "1");
+    if (!strcmp(meta[0].range, "top")) {
+        hi = cli_top(out, (size_t)W * (size_t)H * (size_t)planes * (size_t)channels, 1.0);
+    } else {
+        char *colon = strchr(meta[0].range, ':');
+        if (colon) *colon = '\0';
+        if (!colon || !cli_parse_real(meta[0].range, &lo) || !cli_parse_real(colon + 1, &hi)) lo = 0.0, hi = 1.0;
+    }
+    rc = cli_save(&a, out, W, H * planes, channels, lo, hi);
+done:
+    ex_georef_free(&ref);
+    free(out);
+    free(meta);
+    return rc;
+}
+
+/* `hfvis info RASTER`: the header of a raster (any the tool reads), one "key value" per line, for
+ * scripts (examples/tiles.sh): only the header is read. */
+static int cli_info(int argc, char **argv)
+{
+    ex_rio_reader r;
+    double cell = 0.0;
+    char why[256];
+    static const char *const crs[4] = { "unknown", "projected", "geographic", "geocentric" };
+    static const char *const fmt[5] = { "", "tiff", "asc", "ehdr", "netpbm" };
+    if (argc != 3 || argv[2][0] == '-') {
+        if (argc == 3 && (!strcmp(argv[2], "-h") || !strcmp(argv[2], "--help"))) {
+            printf("usage: hfvis info RASTER\nPrints width, height, bands, cell, origin (map X and Y of "
+                   "the upper-left corner), crs, nodata and format\nof RASTER (.tif .asc .bil .flt .pfm, "
+                   "binary .pgm), one 'key value' per line; cell, origin\nand nodata are 'none' when the "
+                   "file has none. Only the header is read.\n");
+            return 0;
+        }
+        return cli_error(CLI_EXIT_USAGE, "info", "usage: hfvis info RASTER");
+    }
+    if ((ex_rio_format_of(argv[2]) ? ex_rio_open(&r, argv[2]) : ex_rio_open_netpbm(&r, argv[2])) != 0)
+        return cli_error(CLI_EXIT_ERROR, argv[2], "%s", r.err);
+    printf("width %d\nheight %d\nbands %d\n", r.width, r.height, r.bands);
+    if (r.geo.has_transform && ex_georef_cell(&r.geo, &cell, why) == 0) printf("cell %.17g\n", cell);
+    else printf("cell none\n");
+    if (r.geo.has_transform) printf("origin %.17g %.17g\n", r.geo.gt[0], r.geo.gt[3]); /* upper-left corner */
+    else printf("origin none\n");
+    printf("crs %s", crs[r.geo.crs >= 0 && r.geo.crs < 4 ? r.geo.crs : 0]);
+    if (r.geo.epsg) printf(" EPSG:%d", r.geo.epsg);
+    printf("\nnodata %s\nformat %s\n", r.geo.has_nodata ? r.geo.nodata_text : "none",
+           fmt[r.format >= 1 && r.format <= 4 ? r.format : 0]);
+    ex_rio_close(&r);
+    return fflush(stdout) == 0 && !ferror(stdout) ? 0 : cli_error(CLI_EXIT_ERROR, "info", "cannot write to stdout");
+}
+
 static int cli_run(const cli_args *a)
 {
     const char *cmd = cli_cmd_names[a->cmd];
@@ -3921,12 +4547,25 @@ static int cli_run(const cli_args *a)
     if (a->cmd == CMD_VISFIELD) return cli_run_visfield(a);
     if (a->cmd == CMD_MESHAO) return cli_run_meshao(a);
     memset(&env, 0, sizeof env);
+    cli_win.active = a->has_window;
     if ((rc = cli_load_heights(a, &z, &w, &h, &grid.cell_size)) != 0) return rc;
     grid.z = z; grid.width = w; grid.height = h; grid.stride = w;
     opts.border = (hfvis_border)a->border;
     opts.border_cells = a->border_cells;
     opts.azimuth0_rad = a->compass ? a->azimuth0 - CLI_PI / 2.0 : a->azimuth0;
     if (a->exact && a->cmd != CMD_VIEWSHED) opts.rays = HFVIS_RAYS_EXACT;
+    if (a->cmd != CMD_VIEWSHED) opts.max_distance = a->max_distance; /* viewshed: its own range */
+    if (cli_win.active) { /* the grid is window + halo of the raster; compute the window */
+        opts.origin_x = cli_win.gx0, opts.origin_y = cli_win.gy0;
+        opts.extent_width = cli_win.ext_w, opts.extent_height = cli_win.ext_h;
+        if (a->cmd != CMD_INDIRECT) { /* indirect's bounces need every point of the grid */
+            opts.receiver_x = cli_win.x0 - cli_win.gx0, opts.receiver_y = cli_win.y0 - cli_win.gy0;
+            opts.receiver_width = cli_win.w, opts.receiver_height = cli_win.h;
+        }
+        cli_piece_tag(a, &grid, &opts);
+    } else if (a->max_distance > 0.0 && a->cmd < CMD_COUNT && (CLI_ONLY(a->cmd) & CLI_SWEEP)) {
+        cli_win.halo = cli_halo(a, grid.cell_size); /* for the window size a refusal suggests */
+    }
     prog.label = cmd; prog.base = 0; prog.total = 0;
     cli_run_cells = (double)w * (double)h;
     cli_run_directions = a->cmd == CMD_NORMALS || a->cmd == CMD_VIEWSHED ? 0
@@ -3938,7 +4577,7 @@ static int cli_run(const cli_args *a)
         opts.progress = cli_progress;
         opts.progress_user = &prog;
     }
-    if ((rc = cli_check_cost(a, w, h, a->cmd == CMD_NORMALS ? 3 : 1)) != 0) goto done;
+    if (!cli_win.active && (rc = cli_check_cost(a, w, h, a->cmd == CMD_NORMALS ? 3 : 1)) != 0) goto done;
     if (a->has_dir_range) {
         if (a->cmd == CMD_LIGHT && (rc = cli_load_env(a->env, &env_px, &env)) != 0) goto done;
         rc = cli_run_partial(a, &grid, &opts, &prog, &env);
@@ -4090,6 +4729,8 @@ int main(int argc, char **argv)
     ex_atomic_on_temp = cli_on_temp; /* the raster writers' temporary files too */
     if (argc >= 2 && !strcmp(argv[1], "sum")) return cli_sum(argc, argv);
     if (argc >= 2 && !strcmp(argv[1], "azimuths")) return cli_azimuths(argc, argv);
+    if (argc >= 2 && !strcmp(argv[1], "mosaic")) return cli_mosaic(argc, argv);
+    if (argc >= 2 && !strcmp(argv[1], "info")) return cli_info(argc, argv);
     cli_t0 = cli_now();
     rc = cli_parse(argc, argv, &a);
     if (rc != CLI_RUN) return rc;

@@ -37,7 +37,8 @@
  *   5. TIFF chunk decoding     PackBits, LZW, DEFLATE, predictors, samples
  *   6. ASC and EHdr parsing
  *   7. reading                 ex_rio_open, ex_rio_open_tiff_mem, ex_rio_open_asc_mem,
- *                              ex_rio_open_ehdr_mem, ex_rio_read, ex_rio_close
+ *                              ex_rio_open_ehdr_mem, ex_rio_open_netpbm(_mem), ex_rio_read, ex_rio_close,
+ *                              ex_georef_shift
  *   8. writing                 ex_rio_write (by extension), ex_rio_write_tiff_file
  */
 #ifndef HFVIS_EXAMPLES_RASTER_IO_H
@@ -83,7 +84,8 @@
 #define EX_RIO_MAX_HEADER 65536
 
 enum { EX_RIO_UINT = 1, EX_RIO_INT = 2, EX_RIO_FLOAT = 3 };           /* TIFF SampleFormat */
-enum { EX_RIO_TIFF = 1, EX_RIO_ASC = 2, EX_RIO_EHDR = 3 };            /* formats */
+enum { EX_RIO_TIFF = 1, EX_RIO_ASC = 2, EX_RIO_EHDR = 3,             /* formats */
+       EX_RIO_NETPBM = 4 }; /* PFM or binary PGM, opened by ex_rio_open_netpbm only */
 enum { EX_RIO_CRS_UNKNOWN = 0, EX_RIO_CRS_PROJECTED = 1, EX_RIO_CRS_GEOGRAPHIC = 2,
        EX_RIO_CRS_GEOCENTRIC = 3 };
 
@@ -130,6 +132,7 @@ typedef struct {
     /* raw (EHdr) layout: byte of (band, row, col) = skip + row * row_bytes + band * band_bytes
      * + col * col_bytes */
     uint64_t skip, row_bytes, band_bytes, col_bytes;
+    int rows_up;             /* raw rows stored bottom to top (PFM): file row = height - 1 - row */
     /* ASC: the whole grid, as parsed (NoData is matched at read time) */
     double *grid;
     /* decoding buffers and the chunk decoded last */
@@ -1164,6 +1167,15 @@ static inline void ex_rio_close(ex_rio_reader *r)
     memset(r, 0, sizeof *r);
 }
 
+/* Close a reader whose opening failed, keeping its error message. */
+static inline void ex_rio_close_failed(ex_rio_reader *r)
+{
+    char keep[256];
+    memcpy(keep, r->err, sizeof keep);
+    ex_rio_close(r);
+    memcpy(r->err, keep, sizeof keep);
+}
+
 static inline int ex_rio_ext(const char *path, const char *ext)
 {
     size_t n = strlen(path), e = strlen(ext);
@@ -1293,13 +1305,104 @@ static inline int ex_rio_open(ex_rio_reader *r, const char *path)
         free(side);
         ex_rio_prj_crs(&r->geo);
     }
-    if (rc != 0) {
-        char keep[256];
-        memcpy(keep, r->err, sizeof keep);
-        ex_rio_close(r);
-        memcpy(r->err, keep, sizeof keep);
-    }
+    if (rc != 0) ex_rio_close_failed(r);
     return rc;
+}
+
+/* Parse a PFM (Pf grey, PF colour: 3 bands) or binary PGM (P5) header from head[0..n) (the
+ * file's first bytes; r->size, r->f or r->mem set): magic, width, height, scale or maxval, '#'
+ * comments as netpbm allows, one whitespace byte before the samples. ex_rio_read then seeks to
+ * the rows a window needs (PFM rows are stored bottom to top). Values as hfvis_image_decode
+ * gives them: PFM samples as stored, PGM samples as the integers 0..maxval. No georeference. */
+static inline int ex_rio_netpbm_parse(ex_rio_reader *r, const unsigned char *head, size_t n)
+{
+    size_t i = 2;
+    double v[3];
+    int k, pfm = n >= 2 && head[0] == 'P' && (head[1] == 'f' || head[1] == 'F');
+    if (n < 2 || head[0] != 'P' || !(pfm || head[1] == '5'))
+        return ex_rio_fail(r->err, "not a PFM or binary (P5) PGM: windows are read from those, GeoTIFF or EHdr");
+    for (k = 0; k < 3; k++) { /* width, height, then the scale (PFM) or maxval (PGM) */
+        char tok[64];
+        size_t t = 0;
+        while (i < n && (isspace(head[i]) || head[i] == '#')) {
+            if (head[i] == '#') while (i < n && head[i] != '\n' && head[i] != '\r') i++;
+            else i++;
+        }
+        while (i < n && !isspace(head[i]) && head[i] != '#' && t + 1 < sizeof tok) tok[t++] = (char)head[i++];
+        tok[t] = '\0';
+        if (!t || ex_rio_number(tok, &v[k]) != 0 || (k < 2 && !(v[k] >= 1.0 && v[k] <= EX_RIO_MAX_DIM && v[k] == floor(v[k]))))
+            return ex_rio_fail(r->err, "bad or truncated header");
+    }
+    if (i >= n || !isspace(head[i]) || (pfm ? !(v[2] != 0.0 && isfinite(v[2])) : !(v[2] >= 1.0 && v[2] <= 65535.0)))
+        return ex_rio_fail(r->err, "bad or truncated header");
+    r->format = EX_RIO_NETPBM;
+    r->width = (int)v[0];
+    r->height = (int)v[1];
+    r->bands = pfm && head[1] == 'F' ? 3 : 1;
+    r->kind = pfm ? EX_RIO_FLOAT : EX_RIO_UINT;
+    r->bits = pfm ? 32 : v[2] < 256.0 ? 8 : 16;
+    r->big_endian = pfm ? v[2] > 0.0 : 1;
+    r->rows_up = pfm;
+    r->skip = (uint64_t)i + 1;
+    r->band_bytes = (uint64_t)(r->bits / 8);
+    r->col_bytes = r->band_bytes * (uint64_t)r->bands;
+    r->row_bytes = r->col_bytes * (uint64_t)r->width;
+    if (r->size < r->skip || (r->size - r->skip) / r->row_bytes < (uint64_t)r->height)
+        return ex_rio_fail(r->err, "truncated: the header announces %d x %d samples", r->width, r->height);
+    return 0;
+}
+
+/* Open a PFM or binary PGM held in memory for window reads (data must outlive the reader). */
+static inline int ex_rio_open_netpbm_mem(ex_rio_reader *r, const unsigned char *data, size_t size)
+{
+    int rc;
+    memset(r, 0, sizeof *r);
+    r->mem = data ? data : (const unsigned char *)"";
+    r->size = data ? size : 0;
+    rc = ex_rio_netpbm_parse(r, r->mem, (size_t)r->size < 4096 ? (size_t)r->size : 4096);
+    if (rc != 0) ex_rio_close_failed(r);
+    return rc;
+}
+
+/* Open a PFM or binary PGM file for window reads: its first 4 KiB are parsed, nothing else read. */
+static inline int ex_rio_open_netpbm(ex_rio_reader *r, const char *path)
+{
+    unsigned char head[4096];
+    size_t n;
+    long len;
+    int rc;
+    memset(r, 0, sizeof *r);
+    r->f = fopen(path, "rb");
+    if (!r->f) return ex_rio_fail(r->err, "cannot open");
+    n = fread(head, 1, sizeof head, r->f);
+    if (fseek(r->f, 0, SEEK_END) != 0 || (len = ftell(r->f)) < 0) {
+        ex_rio_close(r);
+        return ex_rio_fail(r->err, "cannot read");
+    }
+    r->size = (uint64_t)len;
+    rc = ex_rio_netpbm_parse(r, head, n);
+    if (rc != 0) ex_rio_close_failed(r);
+    return rc;
+}
+
+/* Move the georeference to the window whose first cell is (dx, dy) of the raster: the
+ * geotransform, and the GeoTIFF tags written verbatim (tie points name raster cells, shifted by
+ * whole cells; a ModelTransformation's translation), so a window written as a piece lands where
+ * its cells lay in the whole raster. */
+static inline void ex_georef_shift(ex_georef *g, int dx, int dy)
+{
+    size_t k;
+    if (!g->has_transform) return;
+    g->gt[0] += (double)dx * g->gt[1] + (double)dy * g->gt[2];
+    g->gt[3] += (double)dx * g->gt[4] + (double)dy * g->gt[5];
+    for (k = 0; k + 6 <= g->n_tiepoints; k += 6) {
+        g->tiepoints[k] -= (double)dx;
+        g->tiepoints[k + 1] -= (double)dy;
+    }
+    if (g->has_matrix) {
+        g->matrix[3] += (double)dx * g->matrix[0] + (double)dy * g->matrix[1];
+        g->matrix[7] += (double)dx * g->matrix[4] + (double)dy * g->matrix[5];
+    }
 }
 
 /* Decode band (0-based) of the window [x0, x0 + w) x [y0, y0 + h) into out (row stride in
@@ -1329,11 +1432,12 @@ static inline int ex_rio_read(ex_rio_reader *r, int band, int x0, int y0, int w,
                         ex_rio_cell(r, r->grid[(size_t)yy * (size_t)r->width + (size_t)xx]);
             return 0;
         }
-        if (r->format == EX_RIO_EHDR) {
+        if (r->format == EX_RIO_EHDR || r->format == EX_RIO_NETPBM) {
             size_t n = (size_t)(cx1 - cx0), need = (size_t)((n - 1) * r->col_bytes + (uint64_t)bytes);
             if (ex_rio_grow(&r->dbuf, &r->dbuf_cap, need) != 0) return ex_rio_fail(r->err, "out of memory");
             for (yy = cy0; yy < cy1; yy++) {
-                uint64_t off = r->skip + (uint64_t)yy * r->row_bytes + (uint64_t)band * r->band_bytes +
+                uint64_t fy = r->rows_up ? (uint64_t)(r->height - 1 - yy) : (uint64_t)yy;
+                uint64_t off = r->skip + fy * r->row_bytes + (uint64_t)band * r->band_bytes +
                                (uint64_t)cx0 * r->col_bytes;
                 if (ex_rio_fetch(r, off, need, r->dbuf) != 0) return ex_rio_fail(r->err, "cannot read row %lld", yy);
                 for (xx = cx0; xx < cx1; xx++)

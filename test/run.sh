@@ -33,6 +33,13 @@ if [ -f test/cli_test.sh ] && [ -x "$build/hfvis" ]; then
   if sh test/cli_test.sh "$build/hfvis" "$scratch" > "$scratch/log" 2>&1; then passed=$((passed + 1)); echo "ok   cli"
   else failed=$((failed + 1)); cat "$scratch/log"; echo "FAIL cli"; fi
 fi
+# tiles: --window pieces and hfvis mosaic (the search-radius checks print SKIP while the library
+# ignores max_distance)
+if [ -x "$build/hfvis" ]; then
+  if sh test/tiles_cli_test.sh "$build/hfvis" "$scratch" > "$scratch/log" 2>&1; then passed=$((passed + 1))
+    grep '^SKIP' "$scratch/log"; echo "ok   tiles cli: $(tail -n 1 "$scratch/log")"
+  else failed=$((failed + 1)); cat "$scratch/log"; echo "FAIL tiles cli"; fi
+fi
 # GIS rasters through the tool (GDAL interop when installed, else a printed SKIP)
 if [ -x "$build/hfvis" ]; then
   if sh test/raster_cli_test.sh "$build/hfvis" "$scratch" > "$scratch/log" 2>&1; then passed=$((passed + 1))

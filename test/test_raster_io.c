@@ -756,6 +756,95 @@ TEST(georef_cells)
     }
 }
 
+/* PFM (grey and colour, both byte orders) and binary PGM (8 and 16 bit) windows read by seeking
+ * rows (ex_rio_open_netpbm) against the crop of the library's whole decode (hfvis_image_load),
+ * headers with comments, a truncated file refused; ex_georef_shift moves the geotransform and the
+ * verbatim tie point by whole cells. */
+TEST(netpbm_windows)
+{
+    enum { W = 37, H = 29 };
+    float *src = (float *)malloc(sizeof(float) * W * H * 3), win[20 * 20 * 3];
+    int kind;
+    field(src, W, H, 3, 0, 91);
+    for (kind = 0; kind < 5; kind++) {
+        /* 0: Pf LE (library writer), 1: PF LE, 2: Pf BE with a comment, 3: P5 8-bit, 4: P5 16-bit */
+        const char *name = tpath("n.img");
+        ex_rio_reader r;
+        hfvis_image_info info;
+        float *all = NULL;
+        uint32_t s = 9;
+        int t, ch = kind == 1 ? 3 : 1;
+        if (kind <= 1) {
+            CHECK(hfvis_pfm_save(name, src, W, H, ch, W) == HFVIS_OK);
+        } else if (kind == 2) {
+            size_t n = (size_t)W * H, i;
+            unsigned char *buf = (unsigned char *)malloc(64 + n * 4);
+            int len = sprintf((char *)buf, "Pf\n# a comment\n%d %d\n1.0\n", W, H), y, x;
+            for (y = 0; y < H; y++)
+                for (x = 0; x < W; x++) { /* bottom row first, big endian */
+                    uint32_t u;
+                    unsigned char *p = buf + len + ((size_t)(H - 1 - y) * W + (size_t)x) * 4;
+                    memcpy(&u, &src[y * W + x], 4);
+                    p[0] = (unsigned char)(u >> 24); p[1] = (unsigned char)(u >> 16);
+                    p[2] = (unsigned char)(u >> 8); p[3] = (unsigned char)u;
+                }
+            spit(name, buf, (size_t)len + n * 4);
+            (void)i;
+            free(buf);
+        } else {
+            CHECK(hfvis_pgm_save(name, src, W, H, W, -200.0f, 800.0f, kind == 3 ? 255 : 65535) == HFVIS_OK);
+        }
+        CHECK(hfvis_image_load(name, NULL, &all, &info) == HFVIS_OK);
+        CHECK(ex_rio_open_netpbm(&r, name) == 0);
+        CHECK(r.width == W && r.height == H && r.bands == ch);
+        for (t = 0; all && r.width == W && t < 100; t++) {
+            int x0 = (int)(lcg(&s) % (W + 10)) - 5, y0 = (int)(lcg(&s) % (H + 10)) - 5;
+            int ww = 1 + (int)(lcg(&s) % 20), wh = 1 + (int)(lcg(&s) % 20), x, y, b, bad = 0;
+            for (b = 0; b < ch; b++) {
+                CHECK(ex_rio_read(&r, b, x0, y0, ww, wh, win, 20) == 0);
+                for (y = 0; y < wh; y++)
+                    for (x = 0; x < ww; x++) {
+                        int gx = x0 + x, gy = y0 + y;
+                        float v = win[y * 20 + x];
+                        if (gx < 0 || gy < 0 || gx >= W || gy >= H) bad += !isnan(v);
+                        else bad += memcmp(&v, all + ((size_t)gy * W + (size_t)gx) * (size_t)ch + (size_t)b, 4) != 0;
+                    }
+            }
+            CHECK(bad == 0);
+        }
+        ex_rio_close(&r);
+        hfvis_free(NULL, all);
+    }
+    { /* truncated: one row short */
+        size_t n;
+        unsigned char *file;
+        ex_rio_reader r;
+        CHECK(hfvis_pfm_save(tpath("n.img"), src, W, H, 1, W) == HFVIS_OK);
+        file = slurp(tpath("n.img"), &n);
+        if (file) spit(tpath("n.img"), file, n - (size_t)W * 4);
+        CHECK(ex_rio_open_netpbm(&r, tpath("n.img")) != 0 && strstr(r.err, "truncated") != NULL);
+        spit(tpath("n.img"), "P2\n2 2\n9\n1 2 3 4\n", 17);
+        CHECK(ex_rio_open_netpbm(&r, tpath("n.img")) != 0);
+        free(file);
+    }
+    { /* a window's georeference: 3 columns east, 2 rows south */
+        ex_georef g;
+        double tie[6] = { 0, 0, 0, 500000, 4100000, 0 };
+        memset(&g, 0, sizeof g);
+        g.has_scale = 1; g.scale[0] = 30; g.scale[1] = 30;
+        g.tiepoints = (double *)malloc(sizeof tie);
+        if (g.tiepoints) memcpy(g.tiepoints, tie, sizeof tie);
+        g.n_tiepoints = g.tiepoints ? 6 : 0;
+        ex_georef_transform(&g);
+        ex_georef_shift(&g, 3, 2);
+        CHECK(g.gt[0] == 500090.0 && g.gt[3] == 4099940.0);
+        CHECK(g.n_tiepoints == 6 && g.tiepoints[0] == -3.0 && g.tiepoints[1] == -2.0 && g.tiepoints[3] == 500000.0);
+        ex_georef_free(&g);
+    }
+    unlink(tpath("n.img"));
+    free(src);
+}
+
 int main(int argc, char **argv)
 {
     const char *base = getenv("TMPDIR");
@@ -770,6 +859,7 @@ int main(int argc, char **argv)
     RUN(tiff_round_trips);
     RUN(tiff_lzw_packbits);
     RUN(window_reads);
+    RUN(netpbm_windows);
     RUN(tiff_malformed);
     RUN(asc_ehdr);
     RUN(georef_cells);

@@ -4,7 +4,7 @@
 # replays every input once (libFuzzer -runs=0), and llvm-cov counts the lines of the decoder's
 # own functions (the public decode call and the static parsing helpers it uses).
 # usage: sh test/fuzz/coverage.sh [TARGET...]   (TARGET: pgm pfm obj binvox visfield partial geotiff
-# asc ehdr heightfield; default all)
+# asc ehdr netpbm heightfield; default all)
 # heightfield is not a decoder: its lines are the sweep's (lattice, hull, gather, normals, terms).
 # Prints "coverage fuzz_T: inputs N, decoder lines covered/total (P%)" per target, then the
 # functions with uncovered lines.
@@ -16,7 +16,7 @@ out=build/fuzz/cov; mkdir -p "$out" || exit 1
 img="hfvis_image_info_read hfvis_image_decode hf_img_is_space hf_img_is_digit hf_img_skip hf_img_number hf_img_scale hf_img_p2_samples hf_img_p5_samples hf_img_pfm_rows hf_img_parse hf_img_write_pixels"
 # the raster readers of examples/raster_io.h and the inflate of examples/zio.h
 tif="ex_rio_open_tiff_mem ex_rio_tiff_parse ex_rio_fetch ex_rio_uint ex_rio_put_uint ex_rio_bits_double ex_rio_bits_float ex_rio_type_size ex_rio_entry_value ex_rio_entry_u ex_rio_entry_doubles ex_rio_entry_fixed ex_rio_entry_chunks ex_rio_compression_name ex_georef_keys ex_georef_transform ex_georef_set_nodata ex_rio_packbits ex_rio_lzw ex_rio_unpredict2 ex_rio_unpredict3 ex_rio_grow ex_rio_chunk ex_rio_sample ex_rio_cell ex_rio_read ex_rio_close ex_inflate ex_inflate_string ex_z_bits ex_z_decode ex_z_build ex_z_codes ex_z_fixed ex_z_dynamic ex_adler32"
-targets=${*:-pgm pfm obj binvox visfield partial geotiff asc ehdr heightfield}
+targets=${*:-pgm pfm obj binvox visfield partial geotiff asc ehdr netpbm heightfield}
 for t in $targets; do
   case $t in
     pgm|pfm) fns=$img ;;
@@ -27,6 +27,7 @@ for t in $targets; do
     geotiff) fns=$tif ;;
     asc) fns="ex_rio_open_asc_mem ex_rio_parse_asc ex_rio_token ex_rio_keyeq ex_rio_number ex_georef_set_nodata ex_rio_cell ex_rio_read" ;;
     ehdr) fns="ex_rio_open_ehdr_mem ex_rio_parse_hdr ex_rio_token ex_rio_keyeq ex_rio_number ex_georef_set_nodata ex_rio_fetch ex_rio_uint ex_rio_sample ex_rio_cell ex_rio_grow ex_rio_read" ;;
+    netpbm) fns="ex_rio_open_netpbm_mem ex_rio_netpbm_parse ex_rio_number ex_rio_fetch ex_rio_uint ex_rio_sample ex_rio_cell ex_rio_grow ex_rio_read" ;;
     heightfield) fns="hf_lattice_from_u hfvis_lattice_line hf_node_inside hf_domain_pad hf_lattice_nodes_bound hf_sweep_group hf_sweep_orientation hf_gather_setup hf_gather_apply hf_gather_elevations hf_gather_planes hf_normal_at hf_sky_term hf_tan_sine hf_svf_term" ;;
     *) echo "coverage: unknown target $t"; exit 2 ;;
   esac
