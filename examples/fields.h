@@ -66,9 +66,9 @@ static inline double fields_ray_max(const hfvis_grid *g, int x, int y, double ps
     double xmax = (double)(g->width - 1), ymax = (double)(g->height - 1);
     if (fabs(cx) < 1e-15) cx = 0.0;
     if (fabs(cy) < 1e-15) cy = 0.0;
-    if (!isfinite(h0)) return NAN;
+    if (!isfinite(h0)) return (double)NAN;
     for (;;) {
-        double px = (double)x + s * cx, py = (double)y + s * cy, sx = INFINITY, sy = INFINITY, s1;
+        double px = (double)x + s * cx, py = (double)y + s * cy, sx = (double)INFINITY, sy = (double)INFINITY, s1;
         double cand[4], hs[1], hm, h1, hq, r, q, p;
         int n = 0, i;
         if (cx > 0.0) sx = (floor(px + 1e-12) + 1.0 - (double)x) / cx;

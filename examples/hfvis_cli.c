@@ -4025,7 +4025,7 @@ static int cli_run_skyview_saga(const cli_args *a, const hfvis_grid *grid, hfvis
         s = hfvis_horizon_direction(grid, K, k, opts, plane, w);
         for (i = 0; s == HFVIS_OK && i < n; i++) {
             double phi = (double)plane[i] > 0.0 ? (double)plane[i] : 0.0;
-            if (isnan(plane[i])) { acc[i] = NAN; continue; }
+            if (isnan(plane[i])) { acc[i] = (double)NAN; continue; }
             if (nrm)
                 acc[i] += (double)nrm[3 * i + 2] * cos(phi) * cos(phi) +
                           ((double)nrm[3 * i] * c + (double)nrm[3 * i + 1] * sn) *
