@@ -1460,6 +1460,46 @@ hfvis_status hfvis_line_horizons_naive(const double *distance, const double *hei
 /* 7. The sweep driver                                                                        */
 /* ========================================================================================== */
 
+/* The search radius (hfvis.h, "Search radius and tiles"; docs/search-radius.md). The hull above
+ * answers "the highest over everything behind"; a window of length R along the line needs more.
+ * Every line is cut into blocks of Rw position units anchored at global position 0 (so a tile and
+ * the whole raster cut a line at the same places). A sample i of block b sees the samples j < i
+ * with pos[i] - pos[j] <= Rw, which are (i) those of block b before it: the [P1] §5 hull
+ * restarted at the block start, and (ii) the suffix of block b - 1 from the first sample within
+ * reach: the upper hull of that suffix is built once per block right to left with an undo log
+ * (insertion k records the stack height and the slot it overwrote) and undone one insertion at a
+ * time as the window start advances; sample i reads its tangent by binary search. O(1) amortised
+ * per sample plus O(log R) per query; the answer is the larger of the two tangents. */
+typedef struct hf_win {
+    double *d, *h, *t;      /* one line: distances (hull arithmetic), heights (NaN holes), out */
+    int64_t *pos;           /* global positions (integers; units of the caller) */
+    double *ph, *pd;        /* prefix hull stack (heights, distances) */
+    int *st, *log_top, *log_slot; /* suffix hull (sample indices, st[0] rightmost), undo log */
+} hf_win;
+
+/* Bytes of the hf_win of lines of n samples. */
+#define HF_WIN_BYTES_PER_SAMPLE (5u * sizeof(double) + sizeof(int64_t) + 3u * sizeof(int))
+
+static void hf_win_carve(hf_win *w, unsigned char *b, size_t n)
+{
+    w->d = (double *)(void *)b;
+    w->h = w->d + n;
+    w->t = w->h + n;
+    w->ph = w->t + n;
+    w->pd = w->ph + n;
+    w->pos = (int64_t *)(void *)(w->pd + n);
+    w->st = (int *)(void *)(w->pos + n);
+    w->log_top = w->st + n;
+    w->log_slot = w->log_top + n;
+}
+
+static int64_t hf_floor_div64(int64_t num, int64_t den) /* den > 0 */
+{
+    int64_t q = num / den;
+    return (num % den != 0 && num < 0) ? q - 1 : q;
+}
+
+
 /* Scratch for all the sweeps of one call, carved out of a single allocation (one block per
  * call, freed before return). The base lattice of a direction group is sampled once; its four
  * quarter turns psi + m pi/2 visit the same nodes ([P1] §7) and are traversed as
@@ -1486,6 +1526,8 @@ typedef struct hf_sweep {
     double *gacc;               /* width*height*channels grid accumulator (fused light) */
     unsigned char *extra;       /* extra_size bytes for the caller (the P2 tree and line data) */
     size_t extra_size;
+    int64_t win_rw;             /* search radius in whole node steps; -1 = unlimited */
+    hf_win win;                 /* its line scratch (win_rw >= 0) */
     void *block;
     const hfvis_allocator *alloc;
 } hf_sweep;
@@ -1501,9 +1543,84 @@ static size_t hf_align_add(size_t *total, size_t count, size_t elem, int *ok)
     return off;
 }
 
+/* Is the search radius finite (hfvis.h: 0 and +INFINITY are unlimited)? */
+static int hf_radius_on(const hfvis_sweep_options *o)
+{
+    return o->max_distance > 0.0 && o->max_distance < HF_INF;
+}
+
+/* floor(r) as a window length, r >= 0, clamped to 2^52 (beyond any line) */
+static int64_t hf_radius_units(double r)
+{
+    r = floor(r);
+    return r > 4503599627370496.0 ? (int64_t)4503599627370496 : (int64_t)r;
+}
+
+/* Tile fields on their own (hfvis.h, "Search radius and tiles"); with the grid: hf_tile_fits. */
+static int hf_tile_opts_valid(const hfvis_sweep_options *o)
+{
+    int whole = o->extent_width == 0 && o->extent_height == 0;
+    if (o->origin_x < 0 || o->origin_y < 0 || o->extent_width < 0 || o->extent_height < 0 ||
+        o->receiver_x < 0 || o->receiver_y < 0 || o->receiver_width < 0 || o->receiver_height < 0)
+        return 0;
+    if ((o->extent_width == 0) != (o->extent_height == 0)) return 0;
+    if ((o->receiver_width == 0) != (o->receiver_height == 0)) return 0;
+    if (whole && (o->origin_x != 0 || o->origin_y != 0)) return 0;
+    return 1;
+}
+
+/* A grid that is a proper window of a larger raster (not the whole of it). */
+static int hf_tile_window(const hfvis_grid *g, const hfvis_sweep_options *o)
+{
+    return o->extent_width != 0 &&
+           (o->origin_x != 0 || o->origin_y != 0 || o->extent_width != g->width ||
+            o->extent_height != g->height);
+}
+
+/* The tile fields against the grid: the window inside the raster (and then a finite radius and
+ * the open border: nothing beyond the window is known), the receiver rectangle inside the grid. */
+static int hf_tile_fits(const hfvis_grid *g, const hfvis_sweep_options *o)
+{
+    if (o->extent_width != 0 && ((double)o->origin_x + (double)g->width > (double)o->extent_width ||
+                                 (double)o->origin_y + (double)g->height > (double)o->extent_height))
+        return 0;
+    if (hf_tile_window(g, o) &&
+        (!hf_radius_on(o) || (o->border != HFVIS_BORDER_OPEN && o->border != HFVIS_BORDER_DEFAULT)))
+        return 0;
+    if (o->receiver_width != 0 &&
+        ((double)o->receiver_x + (double)o->receiver_width > (double)g->width ||
+         (double)o->receiver_y + (double)o->receiver_height > (double)g->height))
+        return 0;
+    return 1;
+}
+
+/* The receiver rectangle of o as [x0, x1) x [y0, y1) (the whole grid by default). */
+static void hf_receiver_rect(const hfvis_grid *g, const hfvis_sweep_options *o, int *x0, int *y0,
+                             int *x1, int *y1)
+{
+    if (o->receiver_width == 0) {
+        *x0 = *y0 = 0;
+        *x1 = g->width;
+        *y1 = g->height;
+        return;
+    }
+    *x0 = o->receiver_x;
+    *y0 = o->receiver_y;
+    *x1 = o->receiver_x + o->receiver_width;
+    *y1 = o->receiver_y + o->receiver_height;
+}
+
+/* A finite radius, a window or a receiver rectangle: the routines outside the [P1] sweep
+ * (the P2 hull tree of section 11, openness, the direct-light driver) refuse them. */
+static int hf_sweep_opts_limited(const hfvis_sweep_options *o)
+{
+    return o && (hf_radius_on(o) || o->extent_width != 0 || o->receiver_width != 0);
+}
+
 static int hf_opts_valid(const hfvis_sweep_options *o)
 {
     return !o || (hf_border_valid(o->border) && o->border_cells >= 0 && isfinite(o->azimuth0_rad) &&
+                  o->max_distance >= 0.0 && hf_tile_opts_valid(o) &&
                   o->direction_begin >= 0 && o->direction_end >= 0 &&
                   o->direction_order >= HFVIS_DIRECTION_ORDER_DEFAULT &&
                   o->direction_order <= HFVIS_DIRECTION_ORDER_SWEEP &&
@@ -1554,7 +1671,7 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
                                          int channels, int want_gacc, size_t extra_size)
 {
     size_t total = 0, off_x = 0, nodes, gridn, off_rf, off_rl, off_cf, off_cl, off_h, off_n = 0, off_lat,
-           off_lh, off_lt, off_stk, off_gn = 0, off_ga = 0, linelen;
+           off_lh, off_lt, off_stk, off_gn = 0, off_ga = 0, off_w = 0, linelen;
     int ok = 1, D = hf_lattice_bound(g);
     unsigned char *b;
     memset(sw, 0, sizeof *sw);
@@ -1583,6 +1700,8 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     if (want_normals) off_gn = hf_align_add(&total, gridn, 3 * sizeof(float), &ok);
     if (want_gacc) off_ga = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
     if (extra_size) off_x = hf_align_add(&total, extra_size, 1, &ok);
+    sw->win_rw = hf_radius_on(o) ? hf_radius_units(o->max_distance / g->cell_size) : -1;
+    if (sw->win_rw >= 0) off_w = hf_align_add(&total, linelen, HF_WIN_BYTES_PER_SAMPLE, &ok);
     if (!ok) return HFVIS_ERR_LIMIT;
     b = (unsigned char *)hf_alloc(o->alloc, total);
     if (!b) return HFVIS_ERR_OUT_OF_MEMORY;
@@ -1601,6 +1720,7 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     sw->gacc = want_gacc ? (double *)(void *)(b + off_ga) : NULL;
     sw->extra = extra_size ? b + off_x : NULL;
     sw->extra_size = extra_size;
+    if (sw->win_rw >= 0) hf_win_carve(&sw->win, b + off_w, linelen);
     if (want_normals) {
         int x, y;
         for (y = 0; y < g->height; y++)
@@ -1790,7 +1910,7 @@ static int hf_line_span(const hf_sweep *sw, int m, int line, ptrdiff_t *node0, p
 
 /* The brute-force maximum on unit-spaced samples (docs/errata.md E5): the oracle twin of the
  * hull in hf_sweep_orientation. */
-static void hf_brute_unit(const double *h, int n, double *t)
+static void hf_brute_unit(const double *h, int n, double *t, int64_t rw)
 {
     int i, j;
     for (i = 0; i < n; i++) {
@@ -1799,7 +1919,7 @@ static void hf_brute_unit(const double *h, int n, double *t)
             t[i] = HF_NAN;
             continue;
         }
-        for (j = 0; j < i; j++) {
+        for (j = rw >= 0 && rw < i ? i - (int)rw : 0; j < i; j++) { /* within the radius */
             double s;
             if (isnan(h[j])) continue;
             s = (h[j] - h[i]) / (double)(i - j);
@@ -1831,6 +1951,79 @@ static inline double hf_hull_step(double *sh, double *sd, int *top_io, double h,
     return t;
 }
 
+/* Tangents t[i] = max over j < i with pos[i] - pos[j] <= Rw of (h[j] - h[i])/(d[i] - d[j])
+ * (-inf for none, NaN at holes), for n samples of w with increasing d and pos, Rw >= 0. */
+static void hf_window_line(const hf_win *w, int n, int64_t Rw)
+{
+    const double *d = w->d, *h = w->h;
+    const int64_t *pos = w->pos;
+    double *t = w->t, *ph = w->ph, *pd = w->pd;
+    int *st = w->st, *lt = w->log_top, *ls = w->log_slot;
+    int i, ptop = 0, stop = 0, nlog = 0, cstart = 0, have = 0, wi = 0, wend = 0;
+    int64_t cb = 0;
+    for (i = 0; i < n; i++) {
+        double hi = h[i], di = d[i], tp;
+        int64_t b;
+        if (isnan(hi)) {
+            t[i] = HF_NAN;
+            continue;
+        }
+        if (Rw <= 0) { /* nothing is within reach */
+            t[i] = -HF_INF;
+            continue;
+        }
+        b = hf_floor_div64(pos[i], Rw);
+        if (!have || b != cb) { /* a new block; the previous one is [cstart, i) */
+            int j, hw = 0; /* hw: slots below it hold data (a later insertion may overwrite a
+                              slot an earlier one popped, so every insertion saves its slot) */
+            stop = nlog = 0;
+            wi = wend = i;
+            if (have && b == cb + 1) {
+                for (j = i - 1; j >= cstart; j--) { /* its upper hull, right to left */
+                    double hj = h[j], dj = d[j];
+                    int old = stop;
+                    if (isnan(hj)) continue;
+                    while (stop >= 2 && (h[st[stop - 1]] - hj) * (d[st[stop - 2]] - dj) <=
+                                            (h[st[stop - 2]] - hj) * (d[st[stop - 1]] - dj))
+                        stop--;
+                    lt[nlog] = old;
+                    ls[nlog++] = stop < hw ? st[stop] : -1;
+                    st[stop++] = j;
+                    if (stop > hw) hw = stop;
+                }
+                wi = cstart;
+            }
+            cstart = i;
+            cb = b;
+            have = 1;
+            ptop = 0;
+        }
+        /* advance the window start: undo the insertions of the samples now out of reach */
+        for (; wi < wend && pos[i] - pos[wi] > Rw; wi++) {
+            if (isnan(h[wi])) continue;
+            nlog--;
+            st[stop - 1] = ls[nlog];
+            stop = lt[nlog];
+        }
+        tp = hf_hull_step(ph, pd, &ptop, hi, di);
+        if (stop > 0) {
+            /* the vertex of greatest slope: from the right end, the left neighbour is seen at
+               least as high up to it and lower after it (ties go farther, as the hull pops) */
+            int lo = 0, hi2 = stop - 1, k;
+            double ts;
+            while (lo < hi2) {
+                int mid = (lo + hi2) / 2, a = st[mid], c = st[mid + 1];
+                if ((h[c] - hi) * (di - d[a]) >= (h[a] - hi) * (di - d[c])) lo = mid + 1;
+                else hi2 = mid;
+            }
+            k = st[lo];
+            ts = (h[k] - hi) / (di - d[k]);
+            if (ts > tp) tp = ts;
+        }
+        t[i] = tp;
+    }
+}
+
 /* Pre-roll (docs/errata.md E8): R lattice nodes before the first in-domain node (i0, j0) of a line with
  * lattice step (di, dj), sampled with the border rule, at distances -R..-1; they occlude but
  * receive nothing. Returns the stack height. */
@@ -1848,6 +2041,34 @@ static int hf_preroll(const hf_sweep *sw, int i0, int j0, int di, int dj, double
         (void)hf_hull_step(sh, sd, &top, h, (double)(r - R));
     }
     return top;
+}
+
+/* One line under a finite search radius: the pre-roll and the nodes into the window scratch,
+ * at unit distances, positioned by their lattice coordinate along the sweep (the same for a tile
+ * and the whole raster), and through hf_window_line. */
+static void hf_sweep_line_window(hf_sweep *sw, int m, int i0, int j0, int di, int dj,
+                                 ptrdiff_t node0, ptrdiff_t step, int n)
+{
+    const hfvis_lattice *L = &sw->L;
+    const int R = sw->preroll;
+    const double inv_cs = 1.0 / sw->g->cell_size;
+    hf_win *w = &sw->win;
+    int64_t c0 = (m & 1) ? (int64_t)j0 + sw->L.j_min : (int64_t)i0 + sw->L.i_min;
+    ptrdiff_t p;
+    int r, s;
+    if (m >= 2) c0 = -c0;
+    c0 -= R;
+    for (r = 0; r < R; r++) {
+        double x, y;
+        hf_node_pos(L, i0 - (R - r) * di + L->i_min, j0 - (R - r) * dj + L->j_min, &x, &y);
+        w->h[r] = hf_sample_border(sw->g, sw->border, x, y) * inv_cs;
+    }
+    for (s = 0, p = node0; s < n; s++, p += step) w->h[R + s] = sw->h[p];
+    for (r = 0; r < R + n; r++) {
+        w->d[r] = (double)r;
+        w->pos[r] = c0 + r;
+    }
+    hf_window_line(w, R + n, sw->win_rw);
 }
 
 /* Run orientation m of the current group: copy each line (with its pre-roll) out of the
@@ -1874,8 +2095,13 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
                 sh[r] = hf_sample_border(sw->g, sw->border, x, y) * inv_cs;
             }
             for (s = 0, p = node0; s < n; s++, p += step) sh[R + s] = sw->h[p];
-            hf_brute_unit(sh, R + n, t);
+            hf_brute_unit(sh, R + n, t, sw->win_rw);
             fn(sw, ctx, m, node0, step, n, t + R);
+            continue;
+        }
+        if (sw->win_rw >= 0) { /* a finite search radius */
+            hf_sweep_line_window(sw, m, i0, j0, di, dj, node0, step, n);
+            fn(sw, ctx, m, node0, step, n, sw->win.t + R);
             continue;
         }
         if (R > 0) top = hf_preroll(sw, i0, j0, di, dj, sh, sd);
@@ -2206,7 +2432,8 @@ static void hf_store_elevation(hf_sweep *sw, void *ctx, int m, ptrdiff_t node0, 
 
 static hfvis_status hf_check_common(const hfvis_grid *grid, const hfvis_sweep_options *opts)
 {
-    if (!hf_grid_valid(grid) || !hf_opts_valid(opts)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!hf_grid_valid(grid) || !hf_opts_valid(opts) || (opts && !hf_tile_fits(grid, opts)))
+        return HFVIS_ERR_INVALID_ARGUMENT;
     return HFVIS_OK;
 }
 
@@ -2500,6 +2727,7 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
         !hf_out_fits(out_stride, H) || !isfinite(radius) || radius < 0.0 || !isfinite(step) ||
         (oo && !(oo->step_cells >= 0.0)) || (negative != 0 && negative != 1))
         return HFVIS_ERR_INVALID_ARGUMENT;
+    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
     o = hf_opts_resolve(grid, opts);
     if (radius > 0.0) { /* the march: no allocation */
         hf_surface S;
@@ -4298,6 +4526,7 @@ hfvis_status hfvis_intervisibility(const hfvis_grid *grid, int K, const hfvis_sw
     hfvis_status s;
     if (hf_check_common(grid, opts) != HFVIS_OK || K < 1 || !fn || !hf_tree_opts_valid(tree_opts))
         return HFVIS_ERR_INVALID_ARGUMENT;
+    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
     o = hf_opts_resolve(grid, opts);
     memset(&c, 0, sizeof c);
     c.tree_opts = tree_opts;
@@ -4320,6 +4549,7 @@ static hfvis_status hf_visibility_count(const hfvis_grid *grid, int K, const hfv
     hfvis_status s;
     if (!hf_light_args_valid(grid, K, opts, out, out_stride) || !hf_tree_opts_valid(tree_opts))
         return HFVIS_ERR_INVALID_ARGUMENT;
+    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
     o = hf_opts_resolve(grid, opts);
     memset(&c, 0, sizeof c);
     c.tree_opts = tree_opts;
@@ -4358,6 +4588,7 @@ static hfvis_status hf_indirect(const hfvis_grid *grid, int K, const float *exit
     if (!hf_light_args_valid(grid, K, opts, out, out_stride) || !hf_tree_opts_valid(tree_opts) ||
         !exit_radiance || channels < 1 || channels > 4 || !isfinite(sky) || !isfinite(albedo))
         return HFVIS_ERR_INVALID_ARGUMENT;
+    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
     o = hf_opts_resolve(grid, opts);
     memset(&c, 0, sizeof c);
     c.tree_opts = tree_opts;
@@ -4404,6 +4635,7 @@ hfvis_status hfvis_terrain_gi(const hfvis_grid *grid, int K, const float *direct
     if (!hf_grid_valid(grid) || !direct || !out || channels < 1 || channels > 4 || bounces < 0 ||
         K < 1 || !isfinite(albedo_value) || !hf_opts_valid(opts) || !hf_tree_opts_valid(tree_opts))
         return HFVIS_ERR_INVALID_ARGUMENT;
+    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
     if (!hf_mul_size(hf_grid_count(grid), (size_t)channels, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
     n = hf_grid_count(grid);
     exit_b = (float *)hf_alloc_array(alloc, total, sizeof(float));
@@ -4452,6 +4684,7 @@ hfvis_status hfvis_direct_light(const hfvis_grid *grid, int K, const hfvis_sun *
     if (!hf_grid_valid(grid) || K < 1 || !out || channels < 1 || channels > 4 || !isfinite(sky) ||
         !hf_opts_valid(opts) || (env && (!hf_env_valid(env) || env->channels != channels)))
         return HFVIS_ERR_INVALID_ARGUMENT;
+    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
     if (sun) {
         if (!isfinite(sun->azimuth_rad) || !isfinite(sun->elevation_rad) || !isfinite(sun->radius_rad) ||
             sun->radius_rad < 0.0 || fabs(sun->elevation_rad) > HF_HALF_PI)
@@ -7580,6 +7813,13 @@ typedef struct hf_exact {
     float *nrm;             /* width*height*3 grid normals (lighting), else NULL */
     double *acc;            /* width*height*channels sums, else NULL */
     int channels;
+    double radius;          /* a finite search radius (world units), else 0 */
+    int64_t win_rw;         /* the current direction's window, 1/16 sub-steps; -1 = unlimited */
+    hf_win win;             /* one line's samples under the radius */
+    int *win_rec;           /* their receivers: sample index ... */
+    size_t *win_tan;        /* ... and grid index */
+    int ox, oy;             /* the tile's origin in the raster (hfvis.h, "Search radius and tiles") */
+    int rx0, ry0, rx1, ry1; /* the receiver rectangle, [rx0, rx1) x [ry0, ry1) */
     void *block;
     const hfvis_allocator *alloc;
 } hf_exact;
@@ -7723,12 +7963,25 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
     const hf_cross *cr = E->cross;
     double *sd = E->sd, *sh = E->sh, ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
     const ptrdiff_t stride = g->stride;
-    int top = 0, k, e, q;
+    int top = 0, k, e, q, nw = 0, nr = 0;
+    const int win = E->win_rw >= 0; /* a finite radius: collect the samples, then hf_window_line */
+    hf_win *W = &E->win;
 #define HF_HULL_PUSH(dd, hh)                                                                     \
     do {                                                                                         \
         while (top >= 2 &&                                                                       \
                (sh[top - 2] - (hh)) * ((dd) - sd[top - 1]) >= (sh[top - 1] - (hh)) * ((dd) - sd[top - 2])) \
             top--;                                                                               \
+    } while (0)
+#define HF_EMIT(dd, hh)                                                                          \
+    do {                                                                                         \
+        if (win) {                                                                               \
+            W->d[nw] = (dd);                                                                     \
+            W->h[nw++] = (hh);                                                                   \
+        } else {                                                                                 \
+            HF_HULL_PUSH(dd, hh);                                                                \
+            sd[top] = (dd);                                                                      \
+            sh[top++] = (hh);                                                                    \
+        }                                                                                        \
     } while (0)
     for (k = hf_exact_periods(g, E->R, hx, hy, a, b); k >= 0; k--) {
         int bx = hx + k * a, by = hy + k * b;
@@ -7738,24 +7991,25 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
             while (j-- > 0) { /* the piece after crossing e, far end first */
                 if (isnan(ph[j])) continue;
                 d = -((double)k * L + (cr[e].u + pu[j]));
-                HF_HULL_PUSH(d, ph[j]);
-                sd[top] = d;
-                sh[top++] = ph[j];
+                HF_EMIT(d, ph[j]);
             }
             if ((k == 0 && e == 0) || !hf_cross_inside(g, E->R, X, Y, cr + e)) continue;
             h = hf_cross_height(g, E->border, X, Y, cr + e);
             if (isnan(h)) continue;
             d = -((double)k * L + cr[e].u);
-            HF_HULL_PUSH(d, h);
-            sd[top] = d;
-            sh[top++] = h;
+            HF_EMIT(d, h);
         }
     }
     for (q = 0;; q++) {
         int gx = hx - q * a, gy = hy - q * b, nx = gx - a, ny = gy - b;
         double h = (double)g->z[(ptrdiff_t)gy * stride + gx], d = (double)q * L;
         double *t = E->tan + (size_t)gy * (size_t)g->width + (size_t)gx;
-        if (!isfinite(h)) {
+        if (win) {
+            W->d[nw] = d;
+            W->h[nw] = isfinite(h) ? h : HF_NAN;
+            E->win_rec[nr] = nw++;
+            E->win_tan[nr++] = (size_t)gy * (size_t)g->width + (size_t)gx;
+        } else if (!isfinite(h)) {
             *t = HF_NAN;
         } else {
             HF_HULL_PUSH(d, h);
@@ -7770,21 +8024,39 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
             while (j-- > 0) {
                 if (isnan(ph[j])) continue;
                 d = (double)(q + 1) * L - (cr[e].u + pu[j]);
-                HF_HULL_PUSH(d, ph[j]);
-                sd[top] = d;
-                sh[top++] = ph[j];
+                HF_EMIT(d, ph[j]);
             }
             if (e == 0) break; /* crossing 0 is the next receiver */
             h = (double)p[0];
             h += ((double)p[cr[e].kind == 1 ? stride : 1] - h) * cr[e].f; /* as hf_cross_height */
             if (!isfinite(h)) continue;
             d = (double)(q + 1) * L - cr[e].u;
-            HF_HULL_PUSH(d, h);
-            sd[top] = d;
-            sh[top++] = h;
+            HF_EMIT(d, h);
         }
     }
+#undef HF_EMIT
 #undef HF_HULL_PUSH
+    if (win) {
+        /* positions: 16 x the sub-step along the raster's line, counted from its grid point
+           q = 0 = -floor((X a + Y b)/(a^2 + b^2)) (X, Y in the raster): a tile and the whole
+           raster put every sample at the same integer */
+        int64_t n2 = (int64_t)a * a + (int64_t)b * b;
+        int64_t dot = ((int64_t)hx + E->ox) * a + ((int64_t)hy + E->oy) * b;
+        double base = -(double)hf_floor_div64(dot, n2) * L;
+        int i;
+        for (i = 0; i < nw; i++) W->pos[i] = (int64_t)(16.0 * (base + W->d[i]));
+        hf_window_line(W, nw, E->win_rw);
+        for (i = 0; i < nr; i++) E->tan[E->win_tan[i]] = W->t[E->win_rec[i]] * scale;
+    }
+}
+
+/* The window of a finite radius R (world units) in 1/16 sub-steps: scale is the tangent factor
+ * L/(|(a, b)| cell) of hf_exact_geometry, so R scale sub-steps span R; every sample distance is
+ * a multiple of 1/16 sub-step (a crossing: whole sub-steps; a piece sample: j/m of a piece,
+ * m <= HF_EXACT_MAX_SPLIT), so "16 distance <= floor(16 R scale)" is exact. */
+static int64_t hf_exact_window(double radius, double scale)
+{
+    return hf_radius_units(16.0 * (radius * scale));
 }
 
 /* Tangents of every grid point toward ray r into E->tan (-INFINITY: no terrain, NaN: hole).
@@ -7794,6 +8066,7 @@ static void hf_exact_sweep(hf_exact *E, hf_ray r)
     const hfvis_grid *g = E->g;
     double L, scale;
     int P = hf_exact_geometry(E->cross, g, r.a, r.b, &L, &scale), x, y;
+    E->win_rw = E->radius > 0.0 ? hf_exact_window(E->radius, scale) : -1;
     for (y = 0; y < g->height; y++) {
         int xlo, xhi;
         if (y + r.b < 0 || y + r.b >= g->height) {
@@ -7814,10 +8087,11 @@ static void hf_exact_sweep(hf_exact *E, hf_ray r)
     }
 }
 
-/* Oracle twin of hf_exact_sweep for one receiver: every crossing of its own ray, the same
- * heights and quotients, the largest kept. */
+/* Oracle twin of hf_exact_sweep for one receiver: every crossing of its own ray within the
+ * window rw (1/16 sub-steps, hf_exact_window; -1 = unlimited), the same heights and quotients,
+ * the largest kept. */
 static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, const hf_cross *cr,
-                             int P, double L, double scale, int a, int b, int x, int y)
+                             int P, double L, double scale, int a, int b, int x, int y, int64_t rw)
 {
     double hr = (double)g->z[(ptrdiff_t)y * g->stride + x], best = -HF_INF;
     int k, e, kmax = hf_exact_periods(g, R, x, y, a, b);
@@ -7829,10 +8103,12 @@ static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, co
             int np = hf_piece_samples(g, NULL, x + k * a, y + k * b, cr + e, ph, pu);
             for (j = 0; j < np; j++) {
                 if (isnan(ph[j])) continue;
+                if (rw >= 0 && 16.0 * ((double)k * L + (cr[e].u + pu[j])) > (double)rw) continue;
                 s = (ph[j] - hr) / ((double)k * L + (cr[e].u + pu[j])) * scale;
                 if (s > best) best = s;
             }
             if ((k == 0 && e == 0) || !hf_cross_inside(g, R, X, Y, cr + e)) continue;
+            if (rw >= 0 && 16.0 * ((double)k * L + cr[e].u) > (double)rw) continue;
             h = hf_cross_height(g, border, X, Y, cr + e);
             if (isnan(h)) continue;
             s = (h - hr) / ((double)k * L + cr[e].u) * scale;
@@ -7849,6 +8125,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
                                   int channels)
 {
     size_t total = 0, off_ray, off_d, off_c, off_s, off_t = 0, off_w, off_n = 0, off_a = 0, gridn, cap;
+    size_t off_win = 0, off_wt = 0, off_wr = 0;
     int ok = 1, k, maxp = 1, side = g->width > g->height ? g->width : g->height;
     unsigned char *blk;
     memset(E, 0, sizeof *E);
@@ -7878,6 +8155,16 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     off_w = hf_align_add(&total, gridn, sizeof(double), &ok);
     if (want_normals) off_n = hf_align_add(&total, gridn, 3u * sizeof(float), &ok);
     if (channels) off_a = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
+    E->radius = hf_radius_on(o) ? o->max_distance : 0.0;
+    E->win_rw = -1;
+    E->ox = o->origin_x;
+    E->oy = o->origin_y;
+    hf_receiver_rect(g, o, &E->rx0, &E->ry0, &E->rx1, &E->ry1);
+    if (E->radius > 0.0) {
+        off_win = hf_align_add(&total, cap, HF_WIN_BYTES_PER_SAMPLE, &ok);
+        off_wt = hf_align_add(&total, cap, sizeof(size_t), &ok);
+        off_wr = hf_align_add(&total, cap, sizeof(int), &ok);
+    }
     if (!ok) return HFVIS_ERR_LIMIT;
     blk = (unsigned char *)hf_alloc(o->alloc, total);
     if (!blk) return HFVIS_ERR_OUT_OF_MEMORY;
@@ -7902,6 +8189,11 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     }
     E->nrm = want_normals ? (float *)(void *)(blk + off_n) : NULL;
     E->acc = channels ? (double *)(void *)(blk + off_a) : NULL;
+    if (E->radius > 0.0) {
+        hf_win_carve(&E->win, blk + off_win, cap);
+        E->win_tan = (size_t *)(void *)(blk + off_wt);
+        E->win_rec = (int *)(void *)(blk + off_wr);
+    }
     hf_exact_dirs_fill(&E->d, K, o->azimuth0_rad, E->N);
     if (want_normals) (void)hfvis_normals_compute(g, E->nrm); /* the grid normals, as floats */
     if (channels) memset(E->acc, 0, gridn * (size_t)channels * sizeof(double));
@@ -8177,7 +8469,8 @@ hfvis_status hfvis_horizon_exact_naive(const hfvis_grid *grid, int K,
         for (y = 0; y < grid->height; y++)
             for (x = 0; x < grid->width; x++)
                 p[(size_t)y * (size_t)grid->width + (size_t)x] = (float)hf_tan_to_elevation(
-                    hf_exact_march(grid, o.border, R, cr, P, L, scale, r.a, r.b, x, y));
+                    hf_exact_march(grid, o.border, R, cr, P, L, scale, r.a, r.b, x, y,
+                                   hf_radius_on(&o) ? hf_exact_window(o.max_distance, scale) : -1));
         hf_progress(&o, ++done, end - begin);
     }
     hf_free(o.alloc, cr);
