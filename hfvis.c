@@ -1254,7 +1254,8 @@ static double hf_domain_pad(int n) { return n == 1 ? HF_STRIP_HALF : HF_LATTICE_
 /* Fill the lattice for a given sweep vector u (unit; v = (-u.y, u.x)). Directions are stored
  * as look azimuth psi with u = -(cos psi, sin psi) (docs/errata.md E4: a sweep along u yields the horizon
  * toward -u). */
-static hfvis_status hf_lattice_from_u(hfvis_lattice *L, int W, int H, double ux, double uy)
+static hfvis_status hf_lattice_from_u(hfvis_lattice *L, int W, int H, double ux, double uy,
+                                      double ox, double oy)
 {
     double cx[4], cy[4], umin = DBL_MAX, umax = -DBL_MAX, vmin = DBL_MAX, vmax = -DBL_MAX;
     double rows, cols, px, py;
@@ -1265,6 +1266,8 @@ static hfvis_status hf_lattice_from_u(hfvis_lattice *L, int W, int H, double ux,
     L->vy = ux;
     L->width = W;
     L->height = H;
+    L->origin_x = ox;
+    L->origin_y = oy;
     L->azimuth_rad = atan2(-uy, -ux);
     px = W == 1 ? HF_STRIP_HALF : 0.0; /* a thin axis: the strip's corners */
     py = H == 1 ? HF_STRIP_HALF : 0.0;
@@ -1272,8 +1275,8 @@ static hfvis_status hf_lattice_from_u(hfvis_lattice *L, int W, int H, double ux,
     cx[1] = (double)(W - 1) + px; cy[1] = -py;
     cx[2] = -px; cy[2] = (double)(H - 1) + py;
     cx[3] = (double)(W - 1) + px; cy[3] = (double)(H - 1) + py;
-    for (c = 0; c < 4; c++) {
-        double a = cx[c] * L->ux + cy[c] * L->uy, b = cx[c] * L->vx + cy[c] * L->vy;
+    for (c = 0; c < 4; c++) { /* the corners in raster coordinates (tiles) */
+        double a = (cx[c] + ox) * L->ux + (cy[c] + oy) * L->uy, b = (cx[c] + ox) * L->vx + (cy[c] + oy) * L->vy;
         umin = fmin(umin, a);
         umax = fmax(umax, a);
         vmin = fmin(vmin, b);
@@ -1312,7 +1315,7 @@ hfvis_status hfvis_lattice_init(hfvis_lattice *lattice, int width, int height, d
     if (!lattice || width < 1 || height < 1 || !isfinite(azimuth_rad))
         return HFVIS_ERR_INVALID_ARGUMENT;
     hf_sweep_vector(azimuth_rad, &ux, &uy);
-    s = hf_lattice_from_u(&L, width, height, ux, uy);
+    s = hf_lattice_from_u(&L, width, height, ux, uy, 0.0, 0.0);
     if (s != HFVIS_OK) return s;
     L.azimuth_rad = azimuth_rad;
     *lattice = L;
@@ -1326,11 +1329,13 @@ size_t hfvis_lattice_size(const hfvis_lattice *L)
 }
 
 /* Position of node (i, j). Written as i*u + j*v with the two products summed, so a lattice
- * turned by a quarter turn (u' = v, v' = -u) yields bit-identical positions ([P1] §7). */
+ * turned by a quarter turn (u' = v, v' = -u) yields bit-identical positions ([P1] §7); in a tile
+ * that raster position minus the origin, exact (an integer taken from a double no smaller), so a
+ * tile and the whole raster sample the same surface point bit for bit. */
 static void hf_node_pos(const hfvis_lattice *L, int i, int j, double *x, double *y)
 {
-    *x = (double)i * L->ux + (double)j * L->vx;
-    *y = (double)i * L->uy + (double)j * L->vy;
+    *x = ((double)i * L->ux + (double)j * L->vx) - L->origin_x;
+    *y = ((double)i * L->uy + (double)j * L->vy) - L->origin_y;
 }
 
 static int hf_node_inside(const hfvis_lattice *L, int i, int j)
@@ -1344,9 +1349,11 @@ static int hf_node_inside(const hfvis_lattice *L, int i, int j)
 int hfvis_lattice_line(const hfvis_lattice *L, int j, int *i_first, int *i_last)
 {
     double lo = -DBL_MAX, hi = DBL_MAX;
-    double u[2], v[2], len[2], pad[2];
+    double u[2], v[2], len[2], pad[2], org[2];
     int a, first, last;
     if (!L || j < L->j_min || j > L->j_max) return 0;
+    org[0] = L->origin_x;
+    org[1] = L->origin_y;
     u[0] = L->ux; u[1] = L->uy;
     v[0] = L->vx; v[1] = L->vy;
     len[0] = (double)(L->width - 1);
@@ -1355,7 +1362,7 @@ int hfvis_lattice_line(const hfvis_lattice *L, int j, int *i_first, int *i_last)
     pad[1] = hf_domain_pad(L->height);
     /* Slab test per axis (docs/errata.md E5) gives the range to within rounding ... */
     for (a = 0; a < 2; a++) {
-        double off = (double)j * v[a], lo_a = pad[a] > HF_LATTICE_EPS ? -pad[a] : 0.0;
+        double off = (double)j * v[a] - org[a], lo_a = pad[a] > HF_LATTICE_EPS ? -pad[a] : 0.0;
         if (u[a] != 0.0) {
             double t0 = (lo_a - off) / u[a], t1 = (len[a] - lo_a - off) / u[a];
             lo = fmax(lo, fmin(t0, t1));
@@ -1527,6 +1534,10 @@ typedef struct hf_sweep {
     unsigned char *extra;       /* extra_size bytes for the caller (the P2 tree and line data) */
     size_t extra_size;
     int64_t win_rw;             /* search radius in whole node steps; -1 = unlimited */
+    double ox, oy;              /* tile origin in the raster (hfvis.h, "Search radius and tiles") */
+    double ext_w, ext_h;        /* the raster's size */
+    int rx0, ry0, rx1, ry1;     /* receiver rectangle [rx0, rx1) x [ry0, ry1) */
+    int rect;                   /* 1: a proper sub-rectangle (nodes far from it are skipped) */
     hf_win win;                 /* its line scratch (win_rw >= 0) */
     void *block;
     const hfvis_allocator *alloc;
@@ -1638,6 +1649,17 @@ static hfvis_sweep_options hf_opts_resolve(const hfvis_grid *g, const hfvis_swee
     return r;
 }
 
+int hfvis_tile_halo(double max_distance, double cell_size, hfvis_ray_mode rays)
+{
+    double c;
+    if (!(max_distance > 0.0) || !(max_distance < HF_INF) || !(cell_size > 0.0) ||
+        !(cell_size < HF_INF) || (rays != HFVIS_RAYS_LATTICE && rays != HFVIS_RAYS_EXACT))
+        return -1;
+    c = ceil(max_distance / cell_size) +
+        (rays == HFVIS_RAYS_EXACT ? HFVIS_TILE_HALO_EXACT : HFVIS_TILE_HALO_LATTICE);
+    return c <= (double)INT_MAX ? (int)c : -1;
+}
+
 hfvis_sweep_options hfvis_sweep_options_default(void)
 {
     hfvis_sweep_options o;
@@ -1720,6 +1742,12 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     sw->gacc = want_gacc ? (double *)(void *)(b + off_ga) : NULL;
     sw->extra = extra_size ? b + off_x : NULL;
     sw->extra_size = extra_size;
+    sw->ox = (double)o->origin_x;
+    sw->oy = (double)o->origin_y;
+    sw->ext_w = (double)(o->extent_width ? o->extent_width : g->width);
+    sw->ext_h = (double)(o->extent_height ? o->extent_height : g->height);
+    hf_receiver_rect(g, o, &sw->rx0, &sw->ry0, &sw->rx1, &sw->ry1);
+    sw->rect = sw->rx0 > 0 || sw->ry0 > 0 || sw->rx1 < g->width || sw->ry1 < g->height;
     if (sw->win_rw >= 0) hf_win_carve(&sw->win, b + off_w, linelen);
     if (want_normals) {
         int x, y;
@@ -1789,7 +1817,7 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
     int j, i, c, tj, ti;
     double inv_cs = 1.0 / g->cell_size;
     size_t n, nodes;
-    hf_lattice_from_u(L, g->width, g->height, ux, uy); /* within the bound, cannot fail */
+    hf_lattice_from_u(L, g->width, g->height, ux, uy, sw->ox, sw->oy); /* within the bound */
     sw->rows = L->j_max - L->j_min + 1;
     sw->cols = L->i_max - L->i_min + 1;
     HFVIS_ASSERT(sw->rows <= hf_lattice_bound(g) && sw->cols <= hf_lattice_bound(g));
@@ -2158,7 +2186,8 @@ typedef struct hf_gather {
 static void hf_gather_setup(const hf_sweep *sw, int x, int y, hf_gather *G)
 {
     const hfvis_lattice *L = &sw->L;
-    double a = (double)x * L->ux + (double)y * L->uy, b = (double)x * L->vx + (double)y * L->vy;
+    double gx = (double)x + sw->ox, gy = (double)y + sw->oy; /* raster coordinates (tiles) */
+    double a = gx * L->ux + gy * L->uy, b = gx * L->vx + gy * L->vy;
     double fa = floor(a), fb = floor(b);
     int q;
     G->wa = a - fa;
@@ -2274,13 +2303,13 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
     const hfvis_grid *g = sw->g;
     int x, y, c, tx, ty;
     double v[4], lx[4], ly[4];
-    double xmax = (double)(g->width - 1) + HF_LATTICE_EPS, ymax = (double)(g->height - 1) + HF_LATTICE_EPS;
+    double xmax = (sw->ext_w - 1.0) + HF_LATTICE_EPS, ymax = (sw->ext_h - 1.0) + HF_LATTICE_EPS;
     hf_gather G;
     for (c = 0; c < ch; c++) hf_look_dir(sw, m_first + c, &lx[c], &ly[c]);
-    for (ty = 0; ty < g->height; ty += HF_TILE)
-        for (tx = 0; tx < g->width; tx += HF_TILE)
-    for (y = ty; y < g->height && y < ty + HF_TILE; y++)
-        for (x = tx; x < g->width && x < tx + HF_TILE; x++) {
+    for (ty = sw->ry0; ty < sw->ry1; ty += HF_TILE)
+        for (tx = sw->rx0; tx < sw->rx1; tx += HF_TILE)
+    for (y = ty; y < sw->ry1 && y < ty + HF_TILE; y++)
+        for (x = tx; x < sw->rx1 && x < tx + HF_TILE; x++) {
             ptrdiff_t o = (ptrdiff_t)y * out_stride + x;
             if (hf_is_hole(g, x, y)) {
                 for (c = 0; c < ch; c++) out[(size_t)c * plane_step + (size_t)o] = (float)HF_NAN;
@@ -2289,8 +2318,8 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
             hf_gather_setup(sw, x, y, &G);
             hf_gather_elevations(sw, ch, &G, v);
             for (c = 0; c < ch; c++) {
-                if (sw->border == HFVIS_BORDER_OPEN) {
-                    double nx = (double)x + lx[c], ny = (double)y + ly[c];
+                if (sw->border == HFVIS_BORDER_OPEN) { /* the raster's border (tiles) */
+                    double nx = ((double)x + sw->ox) + lx[c], ny = ((double)y + sw->oy) + ly[c];
                     if (nx < -HF_LATTICE_EPS || ny < -HF_LATTICE_EPS || nx > xmax || ny > ymax)
                         v[c] = -HF_HALF_PI;
                 }
@@ -2314,20 +2343,20 @@ static void hf_gather_accumulate(hf_sweep *sw)
     double v[4];
     hf_gather G;
     int tx, ty;
-    for (ty = 0; ty < g->height; ty += HF_TILE)
-        for (tx = 0; tx < g->width; tx += HF_TILE)
-    for (y = ty; y < g->height && y < ty + HF_TILE; y++) {
+    for (ty = sw->ry0; ty < sw->ry1; ty += HF_TILE)
+        for (tx = sw->rx0; tx < sw->rx1; tx += HF_TILE)
+    for (y = ty; y < sw->ry1 && y < ty + HF_TILE; y++) {
         const float *zr = g->z + (ptrdiff_t)y * g->stride;
         double *accr = sw->gacc + (size_t)y * (size_t)g->width * (size_t)ch;
-        const double ya = (double)y * L->uy, yb = (double)y * L->vy;
-        for (x = tx; x < g->width && x < tx + HF_TILE; x++) {
+        const double ya = ((double)y + sw->oy) * L->uy, yb = ((double)y + sw->oy) * L->vy;
+        for (x = tx; x < sw->rx1 && x < tx + HF_TILE; x++) {
             double *acc = accr + (size_t)x * (size_t)ch;
             double a, b, fa, fb, wa, wb, w[4], sum, wsum;
             const double *p;
             int ia, jb, q;
             if (!isfinite(zr[x])) continue;
-            a = (double)x * L->ux + ya;
-            b = (double)x * L->vx + yb;
+            a = ((double)x + sw->ox) * L->ux + ya;
+            b = ((double)x + sw->ox) * L->vx + yb;
             /* floor of a lattice coordinate (within the int range, hf_lattice_from_u) */
             ia = (int)a;
             ia -= (double)ia > a;
@@ -2445,10 +2474,12 @@ static hfvis_status hf_horizon_lattice_impl(const hfvis_grid *grid, double azimu
     hfvis_status s;
     double ux, uy;
     size_t i, n;
-    if (hf_check_common(grid, opts) != HFVIS_OK || !out || !isfinite(azimuth_rad))
+    if (hf_check_common(grid, opts) != HFVIS_OK || !out || !isfinite(azimuth_rad) ||
+        (opts && hf_tile_window(grid, opts))) /* its nodes are those of hfvis_lattice_init */
         return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
     if ((s = hf_sweep_alloc(&sw, grid, &o, 0, 1, 0)) != HFVIS_OK) return s;
+    sw.rect = 0; /* every node: the lattice has no receivers */
     hf_sweep_vector(azimuth_rad, &ux, &uy);
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HF_NAN);
@@ -2915,8 +2946,8 @@ static void hf_fused_output(const hf_sweep *sw, double scale, double offset, flo
 {
     const hfvis_grid *g = sw->g;
     int x, y, c;
-    for (y = 0; y < g->height; y++)
-        for (x = 0; x < g->width; x++) {
+    for (y = sw->ry0; y < sw->ry1; y++) /* the receiver rectangle; the rest is left unwritten */
+        for (x = sw->rx0; x < sw->rx1; x++) {
             const double *a = sw->gacc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)channels;
             float *o = out + ((ptrdiff_t)y * out_stride + x) * channels;
             int hole = hf_is_hole(g, x, y);
@@ -3127,8 +3158,8 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
     hf_lattice_fill(&sw, HF_NAN);
     hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL);
     hf_gather_planes(&sw, 1, 0, out, 0, out_stride);
-    for (y = 0; y < grid->height; y++)
-        for (x = 0; x < grid->width; x++) {
+    for (y = sw.ry0; y < sw.ry1; y++)
+        for (x = sw.rx0; x < sw.rx1; x++) {
             float *p = out + (ptrdiff_t)y * out_stride + x;
             *p = (float)hf_sun_fraction(sun_elevation_rad, sun_radius_rad, (double)*p);
         }
@@ -7402,8 +7433,8 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
         break;
     }
     if (s == HFVIS_OK) {
-        for (y = 0; y < grid->height; y++)
-            for (x = 0; x < grid->width; x++) {
+        for (y = sw.ry0; y < sw.ry1; y++) /* the receiver rectangle */
+            for (x = sw.rx0; x < sw.rx1; x++) {
                 size_t i = ((size_t)y * (size_t)grid->width + (size_t)x) * (size_t)channels;
                 int hole = hf_is_hole(grid, x, y);
                 for (c = 0; c < channels; c++) sums[i + (size_t)c] = hole ? HF_NAN : sw.gacc[i + (size_t)c];
@@ -7820,6 +7851,7 @@ typedef struct hf_exact {
     size_t *win_tan;        /* ... and grid index */
     int ox, oy;             /* the tile's origin in the raster (hfvis.h, "Search radius and tiles") */
     int rx0, ry0, rx1, ry1; /* the receiver rectangle, [rx0, rx1) x [ry0, ry1) */
+    int rect;               /* 1: a proper sub-rectangle */
     void *block;
     const hfvis_allocator *alloc;
 } hf_exact;
@@ -8050,6 +8082,13 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
     }
 }
 
+/* Is grid index i inside the receiver rectangle? */
+static int hf_exact_receiver(const hf_exact *E, size_t i)
+{
+    int x = (int)(i % (size_t)E->g->width), y = (int)(i / (size_t)E->g->width);
+    return x >= E->rx0 && x < E->rx1 && y >= E->ry0 && y < E->ry1;
+}
+
 /* The window of a finite radius R (world units) in 1/16 sub-steps: scale is the tangent factor
  * L/(|(a, b)| cell) of hf_exact_geometry, so R scale sub-steps span R; every sample distance is
  * a multiple of 1/16 sub-step (a crossing: whole sub-steps; a piece sample: j/m of a piece,
@@ -8160,6 +8199,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     E->ox = o->origin_x;
     E->oy = o->origin_y;
     hf_receiver_rect(g, o, &E->rx0, &E->ry0, &E->rx1, &E->ry1);
+    E->rect = E->rx0 > 0 || E->ry0 > 0 || E->rx1 < g->width || E->ry1 < g->height;
     if (E->radius > 0.0) {
         off_win = hf_align_add(&total, cap, HF_WIN_BYTES_PER_SAMPLE, &ok);
         off_wt = hf_align_add(&total, cap, sizeof(size_t), &ok);
@@ -8209,7 +8249,7 @@ static hfvis_status hf_exact_horizon_map(const hfvis_grid *g, int K, const hfvis
     hf_exact E;
     hfvis_status s;
     size_t plane = hf_grid_count(g), i;
-    int k, done = 0;
+    int k, done = 0, x, y;
     if ((s = hf_exact_init(&E, g, K, o, 1, 0, 0)) != HFVIS_OK) return s;
     for (k = 0; k < K; k++) {
         int pos = hf_direction_position(o, K, k);
@@ -8217,7 +8257,11 @@ static hfvis_status hf_exact_horizon_map(const hfvis_grid *g, int K, const hfvis
         if (pos < begin || pos >= end) continue;
         hf_exact_sweep(&E, E.d.ray[k]);
         p = out + (size_t)(pos - begin) * plane;
-        for (i = 0; i < plane; i++) p[i] = (float)hf_tan_to_elevation(E.tan[i]);
+        for (y = E.ry0; y < E.ry1; y++)
+            for (x = E.rx0; x < E.rx1; x++) {
+                i = (size_t)y * (size_t)g->width + (size_t)x;
+                p[i] = (float)hf_tan_to_elevation(E.tan[i]);
+            }
         hf_progress(o, ++done, end - begin);
     }
     hf_exact_free(&E);
@@ -8233,8 +8277,8 @@ static hfvis_status hf_exact_horizon_direction(const hfvis_grid *g, int K, int k
     int x, y;
     if ((s = hf_exact_init(&E, g, K, o, 1, 0, 0)) != HFVIS_OK) return s;
     hf_exact_sweep(&E, E.d.ray[k]);
-    for (y = 0; y < g->height; y++)
-        for (x = 0; x < g->width; x++)
+    for (y = E.ry0; y < E.ry1; y++)
+        for (x = E.rx0; x < E.rx1; x++)
             out[(ptrdiff_t)y * out_stride + x] =
                 (float)hf_tan_to_elevation(E.tan[(size_t)y * (size_t)g->width + (size_t)x]);
     hf_exact_free(&E);
@@ -8322,7 +8366,7 @@ static hfvis_status hf_exact_sums(hf_exact *E, const hfvis_grid *g, int K, hfvis
         for (i = 0; i < n; i++) {
             double t = E->tan[i];
             const float *nr = E->nrm ? E->nrm + i * 3 : NULL;
-            if (isnan(t)) continue;
+            if (isnan(t) || (E->rect && !hf_exact_receiver(E, i))) continue;
             if (kind == HFVIS_SUM_SKY_VIEW) E->acc[i] += wk * hf_svf_term(t);
             else if (kind == HFVIS_SUM_SKY_LIGHT) E->acc[i] += hf_exact_sky_term(&E->d, k, nr, t);
             else
@@ -8341,8 +8385,8 @@ static void hf_exact_output(const hf_exact *E, double scale, double offset, floa
 {
     const hfvis_grid *g = E->g;
     int x, y, c, ch = E->channels;
-    for (y = 0; y < g->height; y++)
-        for (x = 0; x < g->width; x++) {
+    for (y = E->ry0; y < E->ry1; y++)
+        for (x = E->rx0; x < E->rx1; x++) {
             const double *a = E->acc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)ch;
             float *p = out + ((ptrdiff_t)y * out_stride + x) * ch;
             int hole = hf_is_hole(g, x, y);
@@ -8384,8 +8428,8 @@ static hfvis_status hf_exact_sun(const hfvis_grid *g, double azimuth, double ele
     o1.azimuth0_rad = azimuth;
     if ((s = hf_exact_init(&E, g, 1, &o1, 1, 0, 0)) != HFVIS_OK) return s;
     hf_exact_sweep(&E, E.d.ray[0]);
-    for (y = 0; y < g->height; y++)
-        for (x = 0; x < g->width; x++) {
+    for (y = E.ry0; y < E.ry1; y++)
+        for (x = E.rx0; x < E.rx1; x++) {
             double t = E.tan[(size_t)y * (size_t)g->width + (size_t)x];
             out[(ptrdiff_t)y * out_stride + x] =
                 (float)hf_sun_fraction(elevation, radius, hf_tan_to_elevation(t));
@@ -8486,8 +8530,8 @@ static hfvis_status hf_exact_direction_sums(const hfvis_grid *g, int K, hfvis_su
     hfvis_status s;
     int x, y, c;
     if ((s = hf_exact_sums(&E, g, K, kind, env, eopts, o, begin, end)) != HFVIS_OK) return s;
-    for (y = 0; y < g->height; y++)
-        for (x = 0; x < g->width; x++) {
+    for (y = E.ry0; y < E.ry1; y++)
+        for (x = E.rx0; x < E.rx1; x++) {
             size_t i = ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)E.channels;
             int hole = hf_is_hole(g, x, y);
             for (c = 0; c < E.channels; c++) sums[i + (size_t)c] = hole ? HF_NAN : E.acc[i + (size_t)c];

@@ -453,6 +453,9 @@ typedef struct hfvis_lattice {
     double ux, uy, vx, vy;      /* unit vectors, snapped to exact 0/+-1 on the axes */
     int i_min, i_max, j_min, j_max;
     int width, height;          /* of the grid */
+    double origin_x, origin_y;  /* tiles: node (i, j) lies at raster position i*u + j*v, grid
+                                   position that minus this (the sweep options' origin_x/y);
+                                   0, 0 from hfvis_lattice_init */
 } hfvis_lattice;
 
 /* Set up the lattice of look direction azimuth_rad over a width x height grid. The domain is
@@ -534,6 +537,16 @@ typedef struct hfvis_sweep_options {
 } hfvis_sweep_options;
 
 HFVIS_API hfvis_sweep_options hfvis_sweep_options_default(void);
+
+/* The halo, in cells, that a tile of a run with search radius max_distance (world units, finite
+ * and > 0), cell size cell_size and ray mode rays must carry on every side of its receiver
+ * window for its outputs to equal the whole run's bit for bit (hfvis.h, "Search radius and
+ * tiles"): ceil(max_distance / cell_size) + HFVIS_TILE_HALO_LATTICE (lattice mode) or
+ * + HFVIS_TILE_HALO_EXACT (exact rays). Clip the window plus halo to the raster. Returns -1 for
+ * an unlimited or invalid radius or cell size, or a halo beyond INT_MAX. */
+#define HFVIS_TILE_HALO_LATTICE 5 /* gather nodes within 3 cells, their taps and normals 2 more */
+#define HFVIS_TILE_HALO_EXACT 2   /* a crossing's or piece's second tap 1 more, normals 1 */
+HFVIS_API int hfvis_tile_halo(double max_distance, double cell_size, hfvis_ray_mode rays);
 
 /* The P1 hull stack along one line (Alg. 1 with the A.1 erratum fixed; ties pop).
  * For samples (distance[i], height[i]) with strictly increasing distance, writes

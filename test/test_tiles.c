@@ -137,10 +137,100 @@ TEST(exact_radius_equals_oracle)
     }
 }
 
+/* Outputs of one run: kind 0 sky-view factor (K = 16), 1 sky light (K = 12), 2 horizon map
+ * (K = 8, all planes), 3 sun visibility. out holds planes of W x H (stride W). */
+#define NKINDS 4
+static const int kind_planes[NKINDS] = {1, 1, 8, 1};
+
+static hfvis_status run_kind(int kind, const hfvis_grid *g, const hfvis_sweep_options *o, float *out)
+{
+    switch (kind) {
+    case 0: return hfvis_sky_view_factor(g, 16, o, out, g->width);
+    case 1: return hfvis_sky_light(g, 12, 1.0f, 0.8f, o, out, g->width);
+    case 2: return hfvis_horizon_map(g, 8, o, out);
+    default: return hfvis_sun_visibility(g, 0.7, 0.35, 0.02, o, out, g->width);
+    }
+}
+
+static int same_bits(float a, float b) { return memcmp(&a, &b, sizeof a) == 0; }
+
+static float tile_z[MAXN], tile_out[8 * MAXN];
+
+/* Cut a seeded field into uneven windows (the edges, 1-cell-wide rows and columns, windows
+ * reaching past the field clipped to it), run each on its window plus hfvis_tile_halo, and
+ * compare every receiver of the window with the whole run bit for bit. */
+static void check_tiles(int field, int W, int H, double cell, double R_cells, hfvis_ray_mode rays)
+{
+    static const int xs[] = {0, 1, 17, 18, 40, 57, 200}, ys[] = {0, 13, 14, 31, 32, 100};
+    hfvis_grid g = grid_of(zbuf, W, H, cell);
+    int kind;
+    make_field(field, zbuf, W, H, cell, 77u + (uint64_t)field);
+    for (kind = 0; kind < NKINDS; kind++) {
+        hfvis_sweep_options o = hfvis_sweep_options_default();
+        size_t plane = (size_t)W * (size_t)H;
+        int xi, yi, halo, bad = 0, windows = 0;
+        o.rays = rays;
+        o.max_distance = R_cells * cell;
+        halo = hfvis_tile_halo(o.max_distance, cell, rays);
+        CHECK(halo > 0);
+        CHECK_EQ_STATUS(run_kind(kind, &g, &o, out_a), HFVIS_OK);
+        for (yi = 0; ys[yi] < H; yi++)
+            for (xi = 0; xs[xi] < W; xi++) {
+                int x0 = xs[xi], y0 = ys[yi], x1 = xs[xi + 1] < W ? xs[xi + 1] : W,
+                    y1 = ys[yi + 1] < H ? ys[yi + 1] : H;
+                int tx0 = x0 - halo < 0 ? 0 : x0 - halo, ty0 = y0 - halo < 0 ? 0 : y0 - halo;
+                int tx1 = x1 + halo > W ? W : x1 + halo, ty1 = y1 + halo > H ? H : y1 + halo;
+                int tw = tx1 - tx0, th = ty1 - ty0, x, y, p;
+                hfvis_grid t = grid_of(tile_z, tw, th, cell);
+                hfvis_sweep_options to = o;
+                for (y = 0; y < th; y++)
+                    for (x = 0; x < tw; x++) tile_z[y * tw + x] = zbuf[(ty0 + y) * W + tx0 + x];
+                to.origin_x = tx0;
+                to.origin_y = ty0;
+                to.extent_width = W;
+                to.extent_height = H;
+                to.receiver_x = x0 - tx0;
+                to.receiver_y = y0 - ty0;
+                to.receiver_width = x1 - x0;
+                to.receiver_height = y1 - y0;
+                CHECK_EQ_STATUS(run_kind(kind, &t, &to, tile_out), HFVIS_OK);
+                windows++;
+                for (p = 0; p < kind_planes[kind]; p++)
+                    for (y = y0; y < y1; y++)
+                        for (x = x0; x < x1; x++)
+                            if (!same_bits(out_a[(size_t)p * plane + (size_t)(y * W + x)],
+                                           tile_out[(size_t)p * (size_t)(tw * th) + (size_t)((y - ty0) * tw + x - tx0)])) {
+                                if (bad < 3)
+                                    printf("     field %d kind %d mode %d R %g: (%d, %d) plane %d: whole %.9g tile %.9g\n",
+                                           field, kind, (int)rays, R_cells, x, y, p,
+                                           (double)out_a[(size_t)p * plane + (size_t)(y * W + x)],
+                                           (double)tile_out[(size_t)p * (size_t)(tw * th) + (size_t)((y - ty0) * tw + x - tx0)]);
+                                bad++;
+                            }
+            }
+        CHECK(windows > 12);
+        CHECK(bad == 0);
+    }
+}
+
+TEST(tiles_equal_whole_run_lattice)
+{
+    int f;
+    for (f = 0; f < 4; f++) check_tiles(f, 61, 47, f == 1 ? 1.0 : 0.75, f == 2 ? 0.6 : 6.5, HFVIS_RAYS_LATTICE);
+}
+
+TEST(tiles_equal_whole_run_exact)
+{
+    int f;
+    for (f = 0; f < 4; f++) check_tiles(f, 61, 47, f == 1 ? 1.0 : 0.75, f == 2 ? 0.6 : 6.5, HFVIS_RAYS_EXACT);
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
     RUN(lattice_radius_equals_oracle);
     RUN(exact_radius_equals_oracle);
+    RUN(tiles_equal_whole_run_lattice);
+    RUN(tiles_equal_whole_run_exact);
     return TEST_DONE();
 }
