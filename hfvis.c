@@ -1980,15 +1980,16 @@ static inline double hf_hull_step(double *sh, double *sd, int *top_io, double h,
 }
 
 /* Tangents t[i] = max over j < i with pos[i] - pos[j] <= Rw of (h[j] - h[i])/(d[i] - d[j])
- * (-inf for none, NaN at holes), for n samples of w with increasing d and pos, Rw >= 0. */
-static void hf_window_line(const hf_win *w, int n, int64_t Rw)
+ * (-inf for none, NaN at holes), for n samples of w with increasing d and pos, Rw >= 0; samples
+ * before qfrom are only occluders (t NaN). */
+static void hf_window_line(const hf_win *w, int n, int64_t Rw, int qfrom)
 {
     const double *d = w->d, *h = w->h;
     const int64_t *pos = w->pos;
     double *t = w->t, *ph = w->ph, *pd = w->pd;
     int *st = w->st, *lt = w->log_top, *ls = w->log_slot;
     int i, ptop = 0, stop = 0, nlog = 0, cstart = 0, have = 0, wi = 0, wend = 0;
-    int64_t cb = 0;
+    int64_t cb = 0, next = 0; /* the current block and the start of the next one */
     for (i = 0; i < n; i++) {
         double hi = h[i], di = d[i], tp;
         int64_t b;
@@ -2000,10 +2001,10 @@ static void hf_window_line(const hf_win *w, int n, int64_t Rw)
             t[i] = -HF_INF;
             continue;
         }
-        b = hf_floor_div64(pos[i], Rw);
-        if (!have || b != cb) { /* a new block; the previous one is [cstart, i) */
+        if (!have || pos[i] >= next) { /* a new block; the previous one is [cstart, i) */
             int j, hw = 0; /* hw: slots below it hold data (a later insertion may overwrite a
                               slot an earlier one popped, so every insertion saves its slot) */
+            b = hf_floor_div64(pos[i], Rw);
             stop = nlog = 0;
             wi = wend = i;
             if (have && b == cb + 1) {
@@ -2023,6 +2024,7 @@ static void hf_window_line(const hf_win *w, int n, int64_t Rw)
             }
             cstart = i;
             cb = b;
+            next = (b + 1) * Rw;
             have = 1;
             ptop = 0;
         }
@@ -2034,6 +2036,10 @@ static void hf_window_line(const hf_win *w, int n, int64_t Rw)
             stop = lt[nlog];
         }
         tp = hf_hull_step(ph, pd, &ptop, hi, di);
+        if (i < qfrom) { /* pushed, not asked */
+            t[i] = HF_NAN;
+            continue;
+        }
         if (stop > 0) {
             /* the vertex of greatest slope: from the right end, the left neighbour is seen at
                least as high up to it and lower after it (ties go farther, as the hull pops) */
@@ -2075,7 +2081,7 @@ static int hf_preroll(const hf_sweep *sw, int i0, int j0, int di, int dj, double
  * at unit distances, positioned by their lattice coordinate along the sweep (the same for a tile
  * and the whole raster), and through hf_window_line. */
 static void hf_sweep_line_window(hf_sweep *sw, int m, int i0, int j0, int di, int dj,
-                                 ptrdiff_t node0, ptrdiff_t step, int n)
+                                 ptrdiff_t node0, ptrdiff_t step, int n, int sfrom)
 {
     const hfvis_lattice *L = &sw->L;
     const int R = sw->preroll;
@@ -2096,7 +2102,40 @@ static void hf_sweep_line_window(hf_sweep *sw, int m, int i0, int j0, int di, in
         w->d[r] = (double)r;
         w->pos[r] = c0 + r;
     }
-    hf_window_line(w, R + n, sw->win_rw);
+    hf_window_line(w, R + n, sw->win_rw, R + sfrom);
+}
+
+/* The nodes s in [*slo, *shi] of a line (first node (i0, j0), lattice step (di, dj), n nodes)
+ * that lie within HF_RECT_MARGIN cells of the receiver rectangle: the only ones a gather of its
+ * receivers reads (the taps within two lattice steps, under 3 cells). 0 if none. */
+#define HF_RECT_MARGIN 4.0
+static int hf_line_rect(const hf_sweep *sw, int i0, int j0, int di, int dj, int n, int *slo, int *shi)
+{
+    const hfvis_lattice *L = &sw->L;
+    double p[2], c[2], lo = -DBL_MAX, hi = DBL_MAX, blo[2], bhi[2];
+    int a;
+    hf_node_pos(L, i0 + L->i_min, j0 + L->j_min, &p[0], &p[1]);
+    c[0] = (double)di * L->ux + (double)dj * L->vx;
+    c[1] = (double)di * L->uy + (double)dj * L->vy;
+    blo[0] = (double)sw->rx0 - HF_RECT_MARGIN;
+    bhi[0] = (double)(sw->rx1 - 1) + HF_RECT_MARGIN;
+    blo[1] = (double)sw->ry0 - HF_RECT_MARGIN;
+    bhi[1] = (double)(sw->ry1 - 1) + HF_RECT_MARGIN;
+    for (a = 0; a < 2; a++) {
+        if (fabs(c[a]) > 1e-12) {
+            double t0 = (blo[a] - p[a]) / c[a], t1 = (bhi[a] - p[a]) / c[a];
+            lo = fmax(lo, fmin(t0, t1));
+            hi = fmin(hi, fmax(t0, t1));
+        } else if (p[a] < blo[a] || p[a] > bhi[a]) {
+            return 0;
+        }
+    }
+    lo = fmax(floor(lo) - 1.0, 0.0);
+    hi = fmin(ceil(hi) + 1.0, (double)(n - 1));
+    if (lo > hi) return 0;
+    *slo = (int)lo;
+    *shi = (int)hi;
+    return 1;
 }
 
 /* Run orientation m of the current group: copy each line (with its pre-roll) out of the
@@ -2113,8 +2152,11 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
     for (line = 0; line < nlines; line++) {
         ptrdiff_t node0, step, p;
         int i0, j0, di, dj, n, s, r, top = 0;
+        int slo = 0, shi;
         n = hf_line_span(sw, m, line, &node0, &step, &i0, &j0, &di, &dj);
         if (n == 0) continue;
+        shi = n - 1;
+        if (!brute && sw->rect && !hf_line_rect(sw, i0, j0, di, dj, n, &slo, &shi)) continue;
         if (brute) {
             /* Oracle: copy the line (pre-roll first) and scan it (docs/errata.md E5). */
             for (r = 0; r < R; r++) {
@@ -2128,12 +2170,12 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
             continue;
         }
         if (sw->win_rw >= 0) { /* a finite search radius */
-            hf_sweep_line_window(sw, m, i0, j0, di, dj, node0, step, n);
-            fn(sw, ctx, m, node0, step, n, sw->win.t + R);
+            hf_sweep_line_window(sw, m, i0, j0, di, dj, node0, step, shi + 1, slo);
+            fn(sw, ctx, m, node0, step, shi + 1, sw->win.t + R);
             continue;
         }
         if (R > 0) top = hf_preroll(sw, i0, j0, di, dj, sh, sd);
-        for (s = 0, p = node0; s < n; s++, p += step) {
+        for (s = 0, p = node0; s <= shi; s++, p += step) {
             double h = sw->h[p];
             if (isnan(h)) {
                 t[s] = HF_NAN;
@@ -2141,7 +2183,8 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
             }
             t[s] = hf_hull_step(sh, sd, &top, h, (double)s);
         }
-        fn(sw, ctx, m, node0, step, n, t);
+        for (s = 0; s < slo; s++) t[s] = HF_NAN; /* far from every receiver */
+        fn(sw, ctx, m, node0, step, shi + 1, t);
     }
 }
 
@@ -7985,6 +8028,33 @@ static int hf_exact_periods(const hfvis_grid *g, int R, int x, int y, int a, int
     return k;
 }
 
+/* The last grid point q (hx - q a, hy - q b) of a line in the receiver rectangle (the line
+ * stops there); 0 if none is. */
+static int hf_exact_rect_span(const hf_exact *E, int hx, int hy, int a, int b, int *qhi)
+{
+    int lo = 0, hi = INT_MAX, ax;
+    for (ax = 0; ax < 2; ax++) {
+        int c = ax ? b : a, h = ax ? hy : hx, r0 = ax ? E->ry0 : E->rx0, r1 = (ax ? E->ry1 : E->rx1) - 1;
+        int l, u;
+        if (c == 0) {
+            if (h < r0 || h > r1) return 0;
+            continue;
+        }
+        if (c > 0) { /* h - q c in [r0, r1] */
+            l = -hf_floor_div(r1 - h, c);
+            u = hf_floor_div(h - r0, c);
+        } else {
+            l = -hf_floor_div(h - r0, -c);
+            u = hf_floor_div(r1 - h, -c);
+        }
+        if (l > lo) lo = l;
+        if (u < hi) hi = u;
+    }
+    if (lo > hi) return 0;
+    *qhi = hi;
+    return 1;
+}
+
 /* One line of direction (a, b) from its head (hx, hy), the grid point whose successor
  * (hx + a, hy + b) lies outside the grid: the crossings beyond the head (the CLAMP/WRAP pre-roll,
  * or the part of a step still inside the grid), then each grid point (a receiver) and the
@@ -7995,9 +8065,10 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
     const hf_cross *cr = E->cross;
     double *sd = E->sd, *sh = E->sh, ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
     const ptrdiff_t stride = g->stride;
-    int top = 0, k, e, q, nw = 0, nr = 0;
+    int top = 0, k, e, q, nw = 0, nr = 0, qhi = INT_MAX;
     const int win = E->win_rw >= 0; /* a finite radius: collect the samples, then hf_window_line */
     hf_win *W = &E->win;
+    if (E->rect && !hf_exact_rect_span(E, hx, hy, a, b, &qhi)) return; /* no receiver wanted */
 #define HF_HULL_PUSH(dd, hh)                                                                     \
     do {                                                                                         \
         while (top >= 2 &&                                                                       \
@@ -8049,7 +8120,7 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
             sd[top] = d;
             sh[top++] = h;
         }
-        if (nx < 0 || ny < 0 || nx >= g->width || ny >= g->height) break;
+        if (nx < 0 || ny < 0 || nx >= g->width || ny >= g->height || q >= qhi) break;
         for (e = P - 1; e >= 0; e--) { /* between two grid points: inside the grid */
             const float *p = g->z + (ptrdiff_t)(ny + cr[e].oy) * stride + (nx + cr[e].ox);
             int j = hf_piece_samples(g, E->twist, nx, ny, cr + e, ph, pu);
@@ -8077,7 +8148,7 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
         double base = -(double)hf_floor_div64(dot, n2) * L;
         int i;
         for (i = 0; i < nw; i++) W->pos[i] = (int64_t)(16.0 * (base + W->d[i]));
-        hf_window_line(W, nw, E->win_rw);
+        hf_window_line(W, nw, E->win_rw, 0);
         for (i = 0; i < nr; i++) E->tan[E->win_tan[i]] = W->t[E->win_rec[i]] * scale;
     }
 }

@@ -58,4 +58,5 @@ void bench_lk(int quick);
 void bench_lk_obj(int quick); /* bench_lkobj.c: the meshes of HFVIS_BENCH_MESHES */
 void bench_dirs(int quick);
 void bench_exact(int quick);
+void bench_radius(int quick);
 #endif

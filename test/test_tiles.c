@@ -225,6 +225,103 @@ TEST(tiles_equal_whole_run_exact)
     for (f = 0; f < 4; f++) check_tiles(f, 61, 47, f == 1 ? 1.0 : 0.75, f == 2 ? 0.6 : 6.5, HFVIS_RAYS_EXACT);
 }
 
+/* The receiver rectangle alone (R unlimited, the default path): the same values inside, the
+ * output untouched outside; R = +INFINITY is R = 0 bit for bit. */
+TEST(receiver_rectangle_and_unlimited)
+{
+    int W = 45, H = 33, kind, mode;
+    hfvis_grid g = grid_of(zbuf, W, H, 0.8);
+    make_field(3, zbuf, W, H, 0.8, 5u);
+    for (mode = 0; mode < 2; mode++)
+        for (kind = 0; kind < NKINDS; kind++) {
+            hfvis_sweep_options o = hfvis_sweep_options_default(), r;
+            size_t n = (size_t)kind_planes[kind] * (size_t)(W * H), i, bad = 0, touched = 0;
+            int p, x, y;
+            o.rays = mode ? HFVIS_RAYS_EXACT : HFVIS_RAYS_LATTICE;
+            CHECK_EQ_STATUS(run_kind(kind, &g, &o, out_a), HFVIS_OK);
+            r = o;
+            r.max_distance = (double)INFINITY;
+            CHECK_EQ_STATUS(run_kind(kind, &g, &r, out_b), HFVIS_OK);
+            for (i = 0; i < n; i++) bad += !same_bits(out_a[i], out_b[i]);
+            r = o;
+            r.receiver_x = 7;
+            r.receiver_y = 30;
+            r.receiver_width = 20;
+            r.receiver_height = 3;
+            for (i = 0; i < n; i++) out_b[i] = 12345.0f;
+            CHECK_EQ_STATUS(run_kind(kind, &g, &r, out_b), HFVIS_OK);
+            for (p = 0; p < kind_planes[kind]; p++)
+                for (y = 0; y < H; y++)
+                    for (x = 0; x < W; x++) {
+                        size_t q = (size_t)p * (size_t)(W * H) + (size_t)(y * W + x);
+                        int in = x >= 7 && x < 27 && y >= 30;
+                        if (in) bad += !same_bits(out_a[q], out_b[q]);
+                        else touched += out_b[q] != 12345.0f;
+                    }
+            CHECK(bad == 0);
+            CHECK(touched == 0);
+        }
+}
+
+/* R beyond the field is the unlimited horizon (to the hull tolerance); R below one cell sees no
+ * lattice node (every horizon -pi/2 in lattice mode) but still the crossings nearer than a cell
+ * in exact mode; a window needs a finite R and the open border; raw lattices refuse windows;
+ * the routines outside the sweep refuse the options. */
+TEST(radius_limits_and_arguments)
+{
+    int W = 40, H = 30, mode;
+    hfvis_grid g = grid_of(zbuf, W, H, 1.0);
+    hfvis_sweep_options o = hfvis_sweep_options_default();
+    size_t n = (size_t)8 * (size_t)(W * H), i, unequal;
+    double d;
+    make_field(2, zbuf, W, H, 1.0, 9u);
+    for (mode = 0; mode < 2; mode++) {
+        o.rays = mode ? HFVIS_RAYS_EXACT : HFVIS_RAYS_LATTICE;
+        o.max_distance = 0.0;
+        CHECK_EQ_STATUS(hfvis_horizon_map(&g, 8, &o, out_a), HFVIS_OK);
+        o.max_distance = 1000.0;
+        CHECK_EQ_STATUS(hfvis_horizon_map(&g, 8, &o, out_b), HFVIS_OK);
+        d = max_diff(out_a, out_b, n, &unequal);
+        CHECK(d >= 0.0 && d <= RADIUS_HULL_TOL);
+        o.max_distance = 0.9;
+        CHECK_EQ_STATUS(hfvis_horizon_map(&g, 8, &o, out_b), HFVIS_OK);
+        if (!mode) {
+            for (i = 0; i < n; i++) CHECK(out_b[i] == (float)(-PI / 2));
+        } else {
+            size_t above = 0;
+            for (i = 0; i < n; i++) above += out_b[i] > (float)(-PI / 2);
+            CHECK(above > 0); /* the cliffs' crossings within 0.9 cell */
+        }
+    }
+    o = hfvis_sweep_options_default();
+    o.origin_x = 3;
+    o.extent_width = W + 3;
+    o.extent_height = H;
+    CHECK_EQ_STATUS(hfvis_sky_view_factor(&g, 8, &o, out_a, W), HFVIS_ERR_INVALID_ARGUMENT);
+    o.max_distance = 5.0;
+    CHECK_EQ_STATUS(hfvis_sky_view_factor(&g, 8, &o, out_a, W), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_horizon_lattice(&g, 0.3, &o, out_a), HFVIS_ERR_INVALID_ARGUMENT);
+    o.border = HFVIS_BORDER_CLAMP;
+    CHECK_EQ_STATUS(hfvis_sky_view_factor(&g, 8, &o, out_a, W), HFVIS_ERR_INVALID_ARGUMENT);
+    o.border = HFVIS_BORDER_OPEN;
+    o.extent_width = W + 2; /* the grid reaches past the raster */
+    CHECK_EQ_STATUS(hfvis_sky_view_factor(&g, 8, &o, out_a, W), HFVIS_ERR_INVALID_ARGUMENT);
+    o = hfvis_sweep_options_default();
+    o.receiver_x = 1;
+    o.receiver_width = W;
+    o.receiver_height = 1;
+    CHECK_EQ_STATUS(hfvis_sky_view_factor(&g, 8, &o, out_a, W), HFVIS_ERR_INVALID_ARGUMENT);
+    o = hfvis_sweep_options_default();
+    o.max_distance = 5.0;
+    CHECK_EQ_STATUS(hfvis_visibility_count(&g, 8, &o, NULL, out_a, W, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_openness(&g, 8, NULL, &o, out_a, W), HFVIS_ERR_INVALID_ARGUMENT);
+    o = hfvis_sweep_options_default();
+    o.extent_width = W; /* the whole raster: no window, R may stay unlimited */
+    o.extent_height = H;
+    CHECK_EQ_STATUS(hfvis_sky_view_factor(&g, 8, &o, out_a, W), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_horizon_lattice(&g, 0.3, &o, out_a), HFVIS_OK);
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
@@ -232,5 +329,7 @@ int main(int argc, char **argv)
     RUN(exact_radius_equals_oracle);
     RUN(tiles_equal_whole_run_lattice);
     RUN(tiles_equal_whole_run_exact);
+    RUN(receiver_rectangle_and_unlimited);
+    RUN(radius_limits_and_arguments);
     return TEST_DONE();
 }
