@@ -1479,13 +1479,14 @@ hfvis_status hfvis_line_horizons_naive(const double *distance, const double *hei
  * per sample plus O(log R) per query; the answer is the larger of the two tangents. */
 typedef struct hf_win {
     double *d, *h, *t;      /* one line: distances (hull arithmetic), heights (NaN holes), out */
+    double *sm;             /* the previous block's suffix maxima of height */
     int64_t *pos;           /* global positions (integers; units of the caller) */
     double *ph, *pd;        /* prefix hull stack (heights, distances) */
     int *st, *log_top, *log_slot; /* suffix hull (sample indices, st[0] rightmost), undo log */
 } hf_win;
 
 /* Bytes of the hf_win of lines of n samples. */
-#define HF_WIN_BYTES_PER_SAMPLE (5u * sizeof(double) + sizeof(int64_t) + 3u * sizeof(int))
+#define HF_WIN_BYTES_PER_SAMPLE (6u * sizeof(double) + sizeof(int64_t) + 3u * sizeof(int))
 
 static void hf_win_carve(hf_win *w, unsigned char *b, size_t n)
 {
@@ -1494,7 +1495,8 @@ static void hf_win_carve(hf_win *w, unsigned char *b, size_t n)
     w->t = w->h + n;
     w->ph = w->t + n;
     w->pd = w->ph + n;
-    w->pos = (int64_t *)(void *)(w->pd + n);
+    w->sm = w->pd + n;
+    w->pos = (int64_t *)(void *)(w->sm + n);
     w->st = (int *)(void *)(w->pos + n);
     w->log_top = w->st + n;
     w->log_slot = w->log_top + n;
@@ -1981,18 +1983,21 @@ static inline double hf_hull_step(double *sh, double *sd, int *top_io, double h,
 
 /* Tangents t[i] = max over j < i with pos[i] - pos[j] <= Rw of (h[j] - h[i])/(d[i] - d[j])
  * (-inf for none, NaN at holes), for n samples of w with increasing d and pos, Rw >= 0; samples
- * before qfrom are only occluders (t NaN). */
-static void hf_window_line(const hf_win *w, int n, int64_t Rw, int qfrom)
+ * before qfrom, and with ask (increasing sample indices, ending past n) those not in it, are
+ * only occluders (t NaN). */
+static void hf_window_line(const hf_win *w, int n, int64_t Rw, int qfrom, const int *ask)
 {
     const double *d = w->d, *h = w->h;
     const int64_t *pos = w->pos;
-    double *t = w->t, *ph = w->ph, *pd = w->pd;
+    double *t = w->t, *ph = w->ph, *pd = w->pd, *sm = w->sm, dend = 0.0;
     int *st = w->st, *lt = w->log_top, *ls = w->log_slot;
     int i, ptop = 0, stop = 0, nlog = 0, cstart = 0, have = 0, wi = 0, wend = 0;
     int64_t cb = 0, next = 0; /* the current block and the start of the next one */
     for (i = 0; i < n; i++) {
         double hi = h[i], di = d[i], tp;
         int64_t b;
+        int asked = i >= qfrom && (!ask || i == *ask);
+        if (ask && i == *ask) ask++;
         if (isnan(hi)) {
             t[i] = HF_NAN;
             continue;
@@ -2008,10 +2013,16 @@ static void hf_window_line(const hf_win *w, int n, int64_t Rw, int qfrom)
             stop = nlog = 0;
             wi = wend = i;
             if (have && b == cb + 1) {
+                double mx = -HF_INF;
+                dend = d[i - 1];
                 for (j = i - 1; j >= cstart; j--) { /* its upper hull, right to left */
                     double hj = h[j], dj = d[j];
                     int old = stop;
-                    if (isnan(hj)) continue;
+                    if (isnan(hj)) {
+                        sm[j] = mx;
+                        continue;
+                    }
+                    sm[j] = mx = hj > mx ? hj : mx;
                     while (stop >= 2 && (h[st[stop - 1]] - hj) * (d[st[stop - 2]] - dj) <=
                                             (h[st[stop - 2]] - hj) * (d[st[stop - 1]] - dj))
                         stop--;
@@ -2036,15 +2047,22 @@ static void hf_window_line(const hf_win *w, int n, int64_t Rw, int qfrom)
             stop = lt[nlog];
         }
         tp = hf_hull_step(ph, pd, &ptop, hi, di);
-        if (i < qfrom) { /* pushed, not asked */
+        if (!asked) { /* pushed, not asked */
             t[i] = HF_NAN;
             continue;
         }
         if (stop > 0) {
             /* the vertex of greatest slope: from the right end, the left neighbour is seen at
-               least as high up to it and lower after it (ties go farther, as the hull pops) */
+               least as high up to it and lower after it (ties go farther, as the hull pops);
+               skipped when the suffix's highest sample at its nearest (numerator >= 0) or
+               farthest (< 0) distance cannot beat the prefix: rounding is monotone, so the
+               bound holds for the computed quotients too */
             int lo = 0, hi2 = stop - 1, k;
-            double ts;
+            double ts, num = sm[wi] - hi;
+            if (num / (di - (num >= 0.0 ? dend : d[wi])) <= tp) {
+                t[i] = tp;
+                continue;
+            }
             while (lo < hi2) {
                 int mid = (lo + hi2) / 2, a = st[mid], c = st[mid + 1];
                 if ((h[c] - hi) * (di - d[a]) >= (h[a] - hi) * (di - d[c])) lo = mid + 1;
@@ -2102,7 +2120,7 @@ static void hf_sweep_line_window(hf_sweep *sw, int m, int i0, int j0, int di, in
         w->d[r] = (double)r;
         w->pos[r] = c0 + r;
     }
-    hf_window_line(w, R + n, sw->win_rw, R + sfrom);
+    hf_window_line(w, R + n, sw->win_rw, R + sfrom, NULL);
 }
 
 /* The nodes s in [*slo, *shi] of a line (first node (i0, j0), lattice step (di, dj), n nodes)
@@ -8148,7 +8166,8 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
         double base = -(double)hf_floor_div64(dot, n2) * L;
         int i;
         for (i = 0; i < nw; i++) W->pos[i] = (int64_t)(16.0 * (base + W->d[i]));
-        hf_window_line(W, nw, E->win_rw, 0);
+        E->win_rec[nr] = INT_MAX; /* the list's end */
+        hf_window_line(W, nw, E->win_rw, 0, E->win_rec);
         for (i = 0; i < nr; i++) E->tan[E->win_tan[i]] = W->t[E->win_rec[i]] * scale;
     }
 }
@@ -8274,7 +8293,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     if (E->radius > 0.0) {
         off_win = hf_align_add(&total, cap, HF_WIN_BYTES_PER_SAMPLE, &ok);
         off_wt = hf_align_add(&total, cap, sizeof(size_t), &ok);
-        off_wr = hf_align_add(&total, cap, sizeof(int), &ok);
+        off_wr = hf_align_add(&total, cap + 1, sizeof(int), &ok);
     }
     if (!ok) return HFVIS_ERR_LIMIT;
     blk = (unsigned char *)hf_alloc(o->alloc, total);

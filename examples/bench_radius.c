@@ -1,8 +1,9 @@
 /* bench_radius.c - the search radius (hfvis.h, "Search radius and tiles"): the fused sky-view
- * factor at K = 16 on fBm, lattice and exact rays, unlimited and with R = 16, 64, 256, 1024
- * cells, in ns per receiver-direction and as a ratio to the unlimited sweep; then the same field
- * as 4 x 4 tiles with the halo of hfvis_tile_halo (R = 64 cells), the tiles' total time beside
- * the whole run's and the bit-for-bit comparison. */
+ * factor at K = 16 on fBm, unlimited and with R = 16, 64, 256, 1024 cells, in ns per
+ * receiver-direction and as a ratio to the unlimited sweep (lattice at 1024^2, exact rays at
+ * 512^2 to keep the run short); then a 512^2 field as 4 x 4 tiles with the halo of
+ * hfvis_tile_halo (R = 64 cells), the tiles' total time beside the whole run's and the
+ * bit-for-bit comparison. quick: everything at 256^2. */
 #define _POSIX_C_SOURCE 199309L
 #include <math.h>
 #include <stdio.h>
@@ -80,11 +81,11 @@ void bench_radius(int quick)
     static const double radii[] = {16.0, 64.0, 256.0, 1024.0};
     hfvis_field f;
     hfvis_grid g;
-    int n = quick ? 512 : (getenv("RADIUS_N") ? atoi(getenv("RADIUS_N")) : 1024), mode, r;
-    size_t cells = (size_t)n * (size_t)n;
+    int nmax = quick ? 256 : 1024, mode, r, n;
+    size_t cells = (size_t)nmax * (size_t)nmax;
     float *z = (float *)malloc(cells * sizeof(float)), *out = (float *)malloc(cells * sizeof(float)),
           *whole = (float *)malloc(cells * sizeof(float));
-    double rd = (double)cells * RADIUS_BENCH_K;
+    double rd;
     if (!z || !out || !whole) {
         printf("radius: out of memory\n");
         free(z);
@@ -97,19 +98,21 @@ void bench_radius(int quick)
     f.amplitude = 40.0;
     f.wavelength = 64.0;
     f.seed = 5;
-    hfvis_field_generate(&f, n, n, n, z);
-    g.z = z; g.width = n; g.height = n; g.stride = n; g.cell_size = 1.0;
-    printf("\n== radius: search radius R, sky-view factor %dx%d K=%d (fBm), ns per receiver-direction ==\n",
-           n, n, RADIUS_BENCH_K);
-    printf("%-8s %12s", "mode", "unlimited");
+    printf("\n== radius: search radius R (cells), sky-view factor K=%d (fBm), ns per receiver-direction ==\n",
+           RADIUS_BENCH_K);
+    printf("%-16s %10s", "mode", "unlimited");
     for (r = 0; r < 4; r++) printf("   R=%-4.0f (ratio)", radii[r]);
     printf("\n");
     for (mode = 0; mode < 2; mode++) {
         hfvis_sweep_options o = hfvis_sweep_options_default();
         double t_unl;
+        n = mode && !quick ? 512 : nmax;
+        hfvis_field_generate(&f, n, n, n, z);
+        g.z = z; g.width = n; g.height = n; g.stride = n; g.cell_size = 1.0;
+        rd = (double)n * (double)n * RADIUS_BENCH_K;
         o.rays = mode ? HFVIS_RAYS_EXACT : HFVIS_RAYS_LATTICE;
         t_unl = radius_svf(&g, &o, out);
-        printf("%-8s %12.1f", mode ? "exact" : "lattice", t_unl * 1e9 / rd);
+        printf("%-7s %4dx%-4d %10.1f", mode ? "exact" : "lattice", n, n, t_unl * 1e9 / rd);
         for (r = 0; r < 4; r++) {
             double t;
             o.max_distance = radii[r];
@@ -118,6 +121,9 @@ void bench_radius(int quick)
         }
         printf("\n");
     }
+    n = quick ? 256 : 512;
+    hfvis_field_generate(&f, n, n, n, z);
+    g.z = z; g.width = n; g.height = n; g.stride = n; g.cell_size = 1.0;
     for (mode = 0; mode < 2; mode++) {
         hfvis_sweep_options o = hfvis_sweep_options_default();
         double tw, tt;
@@ -128,7 +134,8 @@ void bench_radius(int quick)
         tw = radius_svf(&g, &o, whole);
         tt = radius_tiles(&g, &o, whole, &differ, &halo);
         printf("tiles %-7s R=64 halo %d: whole %.3f s, 4x4 tiles %.3f s (%.2fx), receivers differing "
-               "in bits: %zu of %zu\n", mode ? "exact" : "lattice", halo, tw, tt, tt / tw, differ, cells);
+               "in bits: %zu of %zu\n", mode ? "exact" : "lattice", halo, tw, tt, tt / tw, differ,
+               (size_t)n * (size_t)n);
     }
     free(z);
     free(out);
