@@ -2724,10 +2724,14 @@ static double hf_march_tan(const hf_surface *S, double px, double py, double h0,
 
 static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0, int exact_bound,
                                      const hfvis_march_options *march, const float *points,
-                                     size_t count, float *out)
+                                     size_t count, float *out, double radius)
 {
     double step = march && march->step_cells > 0.0 ? march->step_cells : 1.0;
     double maxd = march ? march->max_distance_cells : 0.0;
+    if (radius > 0.0 && radius < HF_INF) { /* the sweep options' search radius, in cells */
+        double rc = radius / S->cell_size;
+        maxd = maxd > 0.0 && maxd < rc ? maxd : rc;
+    }
     size_t i;
     int k;
     for (i = 0; i < count; i++) {
@@ -2778,7 +2782,7 @@ hfvis_status hfvis_horizon_reference(const hfvis_grid *grid, int K,
     S.border = o.border;
     S.reach = o.border == HFVIS_BORDER_OPEN ? 0.0 : (double)o.border_cells;
     return hf_reference_run(&S, K, o.azimuth0_rad, o.rays == HFVIS_RAYS_EXACT ? hf_exact_bound(&o, K) : 0,
-                            march, points, count, out);
+                            march, points, count, out, o.max_distance);
 }
 
 hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user, int width, int height,
@@ -2800,7 +2804,7 @@ hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user, int widt
     S.border = HFVIS_BORDER_OPEN;
     return hf_reference_run(&S, K, opts ? opts->azimuth0_rad : 0.0,
                             opts && opts->rays == HFVIS_RAYS_EXACT ? hf_exact_bound(opts, K) : 0, march,
-                            points, count, out);
+                            points, count, out, opts ? opts->max_distance : 0.0);
 }
 
 /* Topographic openness (Yokoyama, Shirasawa & Pike 2002): the mean zenith angle pi/2 - beta_k
@@ -7467,6 +7471,8 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
         return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
     if (hf_direction_range(&o, K, &begin, &end) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (kind == HFVIS_SUM_VISIBILITY && hf_sweep_opts_limited(&o)) /* the P2 tree: not honoured */
+        return HFVIS_ERR_INVALID_ARGUMENT;
     if (o.rays == HFVIS_RAYS_EXACT && kind != HFVIS_SUM_VISIBILITY)
         return hf_exact_direction_sums(grid, K, kind, env, eopts, &o, begin, end, sums);
     memset(&sky, 0, sizeof sky);

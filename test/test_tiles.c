@@ -293,6 +293,22 @@ TEST(radius_limits_and_arguments)
             CHECK(above > 0); /* the cliffs' crossings within 0.9 cell */
         }
     }
+    { /* the march oracle takes R from the sweep options as its max_distance_cells */
+        static float pts[2 * 20], ra[20 * 8], rb[20 * 8];
+        hfvis_march_options mo;
+        memset(&mo, 0, sizeof mo);
+        for (i = 0; i < 20; i++) {
+            pts[2 * i] = (float)(i * 2 % W);
+            pts[2 * i + 1] = (float)(i * 7 % H);
+        }
+        o = hfvis_sweep_options_default();
+        o.max_distance = 6.0;
+        CHECK_EQ_STATUS(hfvis_horizon_reference(&g, 8, &o, NULL, pts, 20, ra), HFVIS_OK);
+        o.max_distance = 0.0;
+        mo.max_distance_cells = 6.0;
+        CHECK_EQ_STATUS(hfvis_horizon_reference(&g, 8, &o, &mo, pts, 20, rb), HFVIS_OK);
+        for (i = 0; i < 160; i++) CHECK(same_bits(ra[i], rb[i]));
+    }
     o = hfvis_sweep_options_default();
     o.origin_x = 3;
     o.extent_width = W + 3;
