@@ -8,7 +8,9 @@
  *   4. Bilinear sampling and normals ([P1] §4, §7 "quad sum"; docs/errata.md E5; [P1] §7; docs/errata.md E10)
  *   5. The sweep lattice ([P1] §4, Fig. 2; docs/errata.md E5)
  *   6. The P1 hull stack along one line ([P1] §5 Alg. 1, App. A.1; [P1] §5, Alg. 1, App. A.1)
- *   7. The sweep driver: sampled lattice, four-way symmetry, borders, gather ([P1] §4, §7; docs/errata.md E5, E7, E8)
+ *   7. The sweep driver: sampled lattice, four-way symmetry, borders, gather ([P1] §4, §7; docs/errata.md E5, E7, E8);
+ *      the search radius (blocks of R, prefix and undoable suffix hulls) and tiles in raster
+ *      coordinates (docs/search-radius.md)
  *   8. Horizon outputs and the ray-march oracles ([P1] §2, [P2] §1); topographic openness (Yokoyama 2002)
  *   9. Light: uniform sky ([P1] Eq. 4-5), sky-view factor, sun visibility
  *  10. Environment light: prefix integrals and the L_p table ([P1] Eq. 6-7; docs/errata.md E9),
@@ -8272,6 +8274,12 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     E->alloc = o->alloc;
     if (E->N > HFVIS_RAY_DENOMINATOR_MAX) return HFVIS_ERR_INVALID_ARGUMENT;
     if ((double)side + 2.0 * (double)E->R + 3.0 > (double)INT_MAX / 2.0) return HFVIS_ERR_LIMIT;
+    /* a radius: sample positions (16 x sub-steps along the raster's lines) must stay exact */
+    if (hf_radius_on(o) &&
+        16.0 * (2.0 * ((double)o->origin_x + (double)o->origin_y + (double)o->extent_width +
+                       (double)o->extent_height + 2.0 * (double)side + 4.0 * (double)E->R) + 4.0) *
+                (double)E->N * (double)E->N > 4503599627370496.0)
+        return HFVIS_ERR_LIMIT;
     for (k = 0; k < K; k++) {
         hf_ray r = hf_ray_nearest(o->azimuth0_rad + 2.0 * HF_PI * (double)k / (double)K, E->N);
         int p = (r.a < 0 ? -r.a : r.a) + (r.b < 0 ? -r.b : r.b) - 1;
