@@ -1484,11 +1484,13 @@ typedef struct hf_win {
     double *sm;             /* the previous block's suffix maxima of height */
     int64_t *pos;           /* global positions (integers; units of the caller) */
     double *ph, *pd;        /* prefix hull stack (heights, distances) */
-    int *st, *log_top, *log_slot; /* suffix hull (sample indices, st[0] rightmost), undo log */
+    double *sh, *sd;        /* suffix hull (heights, distances; [0] rightmost) */
+    double *log_h, *log_d;  /* undo log: the slot each insertion overwrote ... */
+    int *log_top;           /* ... and the stack height before it */
 } hf_win;
 
 /* Bytes of the hf_win of lines of n samples. */
-#define HF_WIN_BYTES_PER_SAMPLE (6u * sizeof(double) + sizeof(int64_t) + 3u * sizeof(int))
+#define HF_WIN_BYTES_PER_SAMPLE (10u * sizeof(double) + sizeof(int64_t) + sizeof(int))
 
 static void hf_win_carve(hf_win *w, unsigned char *b, size_t n)
 {
@@ -1498,10 +1500,12 @@ static void hf_win_carve(hf_win *w, unsigned char *b, size_t n)
     w->ph = w->t + n;
     w->pd = w->ph + n;
     w->sm = w->pd + n;
-    w->pos = (int64_t *)(void *)(w->sm + n);
-    w->st = (int *)(void *)(w->pos + n);
-    w->log_top = w->st + n;
-    w->log_slot = w->log_top + n;
+    w->sh = w->sm + n;
+    w->sd = w->sh + n;
+    w->log_h = w->sd + n;
+    w->log_d = w->log_h + n;
+    w->pos = (int64_t *)(void *)(w->log_d + n);
+    w->log_top = (int *)(void *)(w->pos + n);
 }
 
 static int64_t hf_floor_div64(int64_t num, int64_t den) /* den > 0 */
@@ -1992,7 +1996,8 @@ static void hf_window_line(const hf_win *w, int n, int64_t Rw, int qfrom, const 
     const double *d = w->d, *h = w->h;
     const int64_t *pos = w->pos;
     double *t = w->t, *ph = w->ph, *pd = w->pd, *sm = w->sm, dend = 0.0;
-    int *st = w->st, *lt = w->log_top, *ls = w->log_slot;
+    double *sh = w->sh, *sd = w->sd, *lh = w->log_h, *ld = w->log_d;
+    int *lt = w->log_top;
     int i, ptop = 0, stop = 0, nlog = 0, cstart = 0, have = 0, wi = 0, wend = 0;
     int64_t cb = 0, next = 0; /* the current block and the start of the next one */
     for (i = 0; i < n; i++) {
@@ -2025,12 +2030,14 @@ static void hf_window_line(const hf_win *w, int n, int64_t Rw, int qfrom, const 
                         continue;
                     }
                     sm[j] = mx = hj > mx ? hj : mx;
-                    while (stop >= 2 && (h[st[stop - 1]] - hj) * (d[st[stop - 2]] - dj) <=
-                                            (h[st[stop - 2]] - hj) * (d[st[stop - 1]] - dj))
+                    while (stop >= 2 && (sh[stop - 1] - hj) * (sd[stop - 2] - dj) <=
+                                            (sh[stop - 2] - hj) * (sd[stop - 1] - dj))
                         stop--;
                     lt[nlog] = old;
-                    ls[nlog++] = stop < hw ? st[stop] : -1;
-                    st[stop++] = j;
+                    lh[nlog] = stop < hw ? sh[stop] : 0.0;
+                    ld[nlog++] = stop < hw ? sd[stop] : 0.0;
+                    sh[stop] = hj;
+                    sd[stop++] = dj;
                     if (stop > hw) hw = stop;
                 }
                 wi = cstart;
@@ -2045,7 +2052,8 @@ static void hf_window_line(const hf_win *w, int n, int64_t Rw, int qfrom, const 
         for (; wi < wend && pos[i] - pos[wi] > Rw; wi++) {
             if (isnan(h[wi])) continue;
             nlog--;
-            st[stop - 1] = ls[nlog];
+            sh[stop - 1] = lh[nlog];
+            sd[stop - 1] = ld[nlog];
             stop = lt[nlog];
         }
         tp = hf_hull_step(ph, pd, &ptop, hi, di);
@@ -2059,19 +2067,18 @@ static void hf_window_line(const hf_win *w, int n, int64_t Rw, int qfrom, const 
                skipped when the suffix's highest sample at its nearest (numerator >= 0) or
                farthest (< 0) distance cannot beat the prefix: rounding is monotone, so the
                bound holds for the computed quotients too */
-            int lo = 0, hi2 = stop - 1, k;
+            int lo = 0, hi2 = stop - 1;
             double ts, num = sm[wi] - hi;
             if (num / (di - (num >= 0.0 ? dend : d[wi])) <= tp) {
                 t[i] = tp;
                 continue;
             }
             while (lo < hi2) {
-                int mid = (lo + hi2) / 2, a = st[mid], c = st[mid + 1];
-                if ((h[c] - hi) * (di - d[a]) >= (h[a] - hi) * (di - d[c])) lo = mid + 1;
+                int mid = (lo + hi2) / 2;
+                if ((sh[mid + 1] - hi) * (di - sd[mid]) >= (sh[mid] - hi) * (di - sd[mid + 1])) lo = mid + 1;
                 else hi2 = mid;
             }
-            k = st[lo];
-            ts = (h[k] - hi) / (di - d[k]);
+            ts = (sh[lo] - hi) / (di - sd[lo]);
             if (ts > tp) tp = ts;
         }
         t[i] = tp;
