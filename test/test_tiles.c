@@ -225,6 +225,46 @@ TEST(tiles_equal_whole_run_exact)
     for (f = 0; f < 4; f++) check_tiles(f, 61, 47, f == 1 ? 1.0 : 0.75, f == 2 ? 0.6 : 6.5, HFVIS_RAYS_EXACT);
 }
 
+/* hfvis_direction_sums (split runs) on a tile: the raw double sums of the window equal the
+ * whole run's, both modes. */
+TEST(tiles_direction_sums)
+{
+    static double whole[MAXN], part[MAXN];
+    int W = 50, H = 36, mode, x, y;
+    hfvis_grid g = grid_of(zbuf, W, H, 1.0);
+    make_field(1, zbuf, W, H, 1.0, 3u);
+    for (mode = 0; mode < 2; mode++) {
+        hfvis_sweep_options o = hfvis_sweep_options_default(), to;
+        int x0 = 13, y0 = 9, w = 17, h = 11, halo, tx0, ty0, tw, th, bad = 0;
+        hfvis_grid t;
+        o.rays = mode ? HFVIS_RAYS_EXACT : HFVIS_RAYS_LATTICE;
+        o.max_distance = 7.5;
+        halo = hfvis_tile_halo(o.max_distance, 1.0, o.rays);
+        tx0 = x0 - halo < 0 ? 0 : x0 - halo;
+        ty0 = y0 - halo < 0 ? 0 : y0 - halo;
+        tw = (x0 + w + halo > W ? W : x0 + w + halo) - tx0;
+        th = (y0 + h + halo > H ? H : y0 + h + halo) - ty0;
+        for (y = 0; y < th; y++)
+            for (x = 0; x < tw; x++) tile_z[y * tw + x] = zbuf[(ty0 + y) * W + tx0 + x];
+        t = grid_of(tile_z, tw, th, 1.0);
+        to = o;
+        to.origin_x = tx0;
+        to.origin_y = ty0;
+        to.extent_width = W;
+        to.extent_height = H;
+        to.receiver_x = x0 - tx0;
+        to.receiver_y = y0 - ty0;
+        to.receiver_width = w;
+        to.receiver_height = h;
+        CHECK_EQ_STATUS(hfvis_direction_sums(&g, 12, HFVIS_SUM_SKY_LIGHT, NULL, NULL, &o, whole), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_direction_sums(&t, 12, HFVIS_SUM_SKY_LIGHT, NULL, NULL, &to, part), HFVIS_OK);
+        for (y = y0; y < y0 + h; y++)
+            for (x = x0; x < x0 + w; x++)
+                bad += memcmp(&whole[y * W + x], &part[(y - ty0) * tw + x - tx0], sizeof(double)) != 0;
+        CHECK(bad == 0);
+    }
+}
+
 /* The receiver rectangle alone (R unlimited, the default path): the same values inside, the
  * output untouched outside; R = +INFINITY is R = 0 bit for bit. */
 TEST(receiver_rectangle_and_unlimited)
@@ -345,6 +385,7 @@ int main(int argc, char **argv)
     RUN(exact_radius_equals_oracle);
     RUN(tiles_equal_whole_run_lattice);
     RUN(tiles_equal_whole_run_exact);
+    RUN(tiles_direction_sums);
     RUN(receiver_rectangle_and_unlimited);
     RUN(radius_limits_and_arguments);
     return TEST_DONE();
