@@ -751,8 +751,8 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *   - Cost: O(1) amortised per sample plus O(log h) per query (h the suffix hull's size), so it
  *     does not grow with R beyond that log; about 3 hull operations per sample where the
  *     unlimited sweep does 1. Measured (make bench, section radius; fBm, K = 16, sky-view factor,
- *     2-core machine under load): lattice 1024^2 1.3-1.5x the unlimited sweep's time at R = 16 to
- *     1024 cells, exact rays 512^2 1.4-2.3x (1.65x at R = 256). R = 0 or +INFINITY is the
+ *     2-core machine under load): lattice 1024^2 1.3-1.7x the unlimited sweep's time at R = 16 to
+ *     1024 cells, exact rays 512^2 1.4-2.3x (1.65-1.8x at R = 256). R = 0 or +INFINITY is the
  *     unlimited sweep's code path, bit for bit.
  *   - Memory: one line's window scratch, 92 bytes per sample of the longest line (lattice:
  *     about the grid diagonal; exact rays: the hull stack's length, plus 12 bytes per sample).
