@@ -1630,7 +1630,7 @@ static void hf_receiver_rect(const hfvis_grid *g, const hfvis_sweep_options *o, 
 }
 
 /* A finite radius, a window or a receiver rectangle: the routines outside the [P1] sweep
- * (the P2 hull tree of section 11, openness, the direct-light driver) refuse them. */
+ * (the P2 hull tree of section 11, openness) refuse them. */
 static int hf_sweep_opts_limited(const hfvis_sweep_options *o)
 {
     return o && (hf_radius_on(o) || o->extent_width != 0 || o->receiver_width != 0);
@@ -4785,11 +4785,16 @@ hfvis_status hfvis_direct_light(const hfvis_grid *grid, int K, const hfvis_sun *
     size_t n, i, total;
     float *plane;
     hfvis_status s;
-    int c;
+    int c, rx0 = 0, ry0 = 0, rx1 = 0, ry1 = 0, x, y;
     if (!hf_grid_valid(grid) || K < 1 || !out || channels < 1 || channels > 4 || !isfinite(sky) ||
-        !hf_opts_valid(opts) || (env && (!hf_env_valid(env) || env->channels != channels)))
+        !hf_opts_valid(opts) || (opts && !hf_tile_fits(grid, opts)) ||
+        (env && (!hf_env_valid(env) || env->channels != channels)))
         return HFVIS_ERR_INVALID_ARGUMENT;
-    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
+    if (opts) hf_receiver_rect(grid, opts, &rx0, &ry0, &rx1, &ry1);
+    else {
+        rx1 = grid->width;
+        ry1 = grid->height;
+    }
     if (sun) {
         if (!isfinite(sun->azimuth_rad) || !isfinite(sun->elevation_rad) || !isfinite(sun->radius_rad) ||
             sun->radius_rad < 0.0 || fabs(sun->elevation_rad) > HF_HALF_PI)
@@ -4805,8 +4810,11 @@ hfvis_status hfvis_direct_light(const hfvis_grid *grid, int K, const hfvis_sun *
     if (env) s = hfvis_env_light(grid, K, env, 1.0f, opts, NULL, plane, grid->width);
     else {
         s = hfvis_sky_light(grid, K, sky, 1.0f, opts, plane, grid->width);
-        for (i = n; s == HFVIS_OK && i-- > 0;) /* spread the one channel, back to front */
-            for (c = channels - 1; c >= 0; c--) plane[i * (size_t)channels + (size_t)c] = plane[i];
+        for (y = ry1; s == HFVIS_OK && y-- > ry0;) /* spread the one channel, back to front */
+            for (x = rx1; x-- > rx0;) {
+                i = (size_t)y * (size_t)grid->width + (size_t)x;
+                for (c = channels - 1; c >= 0; c--) plane[i * (size_t)channels + (size_t)c] = plane[i];
+            }
     }
     if (s == HFVIS_OK && sun) {
         float *vis = (float *)hf_alloc_array(alloc, n, sizeof(float));
@@ -4817,9 +4825,8 @@ hfvis_status hfvis_direct_light(const hfvis_grid *grid, int K, const hfvis_sun *
             if (s == HFVIS_OK) {
                 double lx = cos(sun->elevation_rad) * cos(sun->azimuth_rad);
                 double ly = cos(sun->elevation_rad) * sin(sun->azimuth_rad), lz = sin(sun->elevation_rad);
-                int x, y;
-                for (y = 0; y < grid->height; y++)
-                    for (x = 0; x < grid->width; x++) {
+                for (y = ry0; y < ry1; y++) /* the receiver rectangle */
+                    for (x = rx0; x < rx1; x++) {
                         double nrm[3], cosl;
                         size_t q = (size_t)y * (size_t)grid->width + (size_t)x;
                         hf_normal_at(grid, x, y, nrm);
@@ -4833,7 +4840,11 @@ hfvis_status hfvis_direct_light(const hfvis_grid *grid, int K, const hfvis_sun *
             hf_free(alloc, vis);
         }
     }
-    if (s == HFVIS_OK) memcpy(out, plane, total * sizeof(float));
+    if (s == HFVIS_OK) /* the receiver rectangle; the rest of out is left as it was */
+        for (y = ry0; y < ry1; y++) {
+            size_t q = ((size_t)y * (size_t)grid->width + (size_t)rx0) * (size_t)channels;
+            memcpy(out + q, plane + q, (size_t)(rx1 - rx0) * (size_t)channels * sizeof(float));
+        }
     hf_free(alloc, plane);
     return s;
 }

@@ -774,13 +774,13 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     computed (lattice lines are cut to the nodes within 4 cells of it, exact-ray lines stop at
  *     their last receiver in it) and the rest of the output is left as it was.
  *   - Where it applies: hfvis_horizon_map, hfvis_horizon_direction, hfvis_sky_light,
- *     hfvis_sky_view_factor, hfvis_env_light, hfvis_sun_visibility, hfvis_direction_sums (sky
- *     view, sky light, environment), both modes. R also applies to hfvis_horizon_lattice(_naive)
+ *     hfvis_sky_view_factor, hfvis_env_light, hfvis_sun_visibility, hfvis_direct_light,
+ *     hfvis_direction_sums (sky view, sky light, environment), both modes. R also applies to hfvis_horizon_lattice(_naive)
  *     (no window: its nodes are those of hfvis_lattice_init; the rectangle is ignored) and to
  *     the oracles. Refused with HFVIS_ERR_INVALID_ARGUMENT (R, a window or a rectangle): the P2
  *     hull-tree routines (hfvis_intervisibility, hfvis_visibility_count, hfvis_indirect_light,
- *     hfvis_terrain_gi, their oracles, the visibility sums), hfvis_openness (it has its own
- *     radius) and hfvis_direct_light.
+ *     hfvis_terrain_gi, their oracles, the visibility sums) and hfvis_openness (it has its own
+ *     radius).
  *   - Oracles, same cut-off: hfvis_horizon_lattice_naive (every node scans the nodes within R
  *     behind it) and hfvis_horizon_exact_naive (every receiver's own samples within R), held to
  *     the sweep bit for bit on the test fields (tolerance 1e-12 rad for last-bit ties of the

@@ -138,9 +138,10 @@ TEST(exact_radius_equals_oracle)
 }
 
 /* Outputs of one run: kind 0 sky-view factor (K = 16), 1 sky light (K = 12), 2 horizon map
- * (K = 8, all planes), 3 sun visibility. out holds planes of W x H (stride W). */
-#define NKINDS 4
-static const int kind_planes[NKINDS] = {1, 1, 8, 1};
+ * (K = 8, all planes), 3 sun visibility, 4 direct light (sun and sky). out holds planes of
+ * W x H (stride W). */
+#define NKINDS 5
+static const int kind_planes[NKINDS] = {1, 1, 8, 1, 1};
 
 static hfvis_status run_kind(int kind, const hfvis_grid *g, const hfvis_sweep_options *o, float *out)
 {
@@ -148,7 +149,16 @@ static hfvis_status run_kind(int kind, const hfvis_grid *g, const hfvis_sweep_op
     case 0: return hfvis_sky_view_factor(g, 16, o, out, g->width);
     case 1: return hfvis_sky_light(g, 12, 1.0f, 0.8f, o, out, g->width);
     case 2: return hfvis_horizon_map(g, 8, o, out);
-    default: return hfvis_sun_visibility(g, 0.7, 0.35, 0.02, o, out, g->width);
+    case 3: return hfvis_sun_visibility(g, 0.7, 0.35, 0.02, o, out, g->width);
+    default: {
+        hfvis_sun sun;
+        memset(&sun, 0, sizeof sun);
+        sun.azimuth_rad = 2.1;
+        sun.elevation_rad = 0.3;
+        sun.radius_rad = 0.01;
+        sun.irradiance[0] = 3.0f;
+        return hfvis_direct_light(g, 8, &sun, 0.5f, NULL, 1, o, out);
+    }
     }
 }
 
