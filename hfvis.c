@@ -2104,14 +2104,15 @@ static int hf_preroll(const hf_sweep *sw, int i0, int j0, int di, int dj, double
     return top;
 }
 
-/* One line under a finite search radius: the pre-roll and the nodes into the window scratch,
- * at unit distances, positioned by their lattice coordinate along the sweep (the same for a tile
- * and the whole raster), and through hf_window_line. */
-static void hf_sweep_line_window(hf_sweep *sw, int m, int i0, int j0, int di, int dj,
-                                 ptrdiff_t node0, ptrdiff_t step, int n, int sfrom)
+/* One line under a finite search radius: the pre-roll within reach (its length is returned)
+ * and the nodes into the window scratch at unit distances, positioned by their lattice
+ * coordinate along the sweep (the same for a tile and the whole raster), and through
+ * hf_window_line. */
+static int hf_sweep_line_window(hf_sweep *sw, int m, int i0, int j0, int di, int dj,
+                                ptrdiff_t node0, ptrdiff_t step, int n, int sfrom)
 {
     const hfvis_lattice *L = &sw->L;
-    const int R = sw->preroll;
+    const int R = sw->preroll < sw->win_rw ? sw->preroll : (int)sw->win_rw; /* pre-roll in reach */
     const double inv_cs = 1.0 / sw->g->cell_size;
     hf_win *w = &sw->win;
     int64_t c0 = (m & 1) ? (int64_t)j0 + sw->L.j_min : (int64_t)i0 + sw->L.i_min;
@@ -2130,6 +2131,7 @@ static void hf_sweep_line_window(hf_sweep *sw, int m, int i0, int j0, int di, in
         w->pos[r] = c0 + r;
     }
     hf_window_line(w, R + n, sw->win_rw, R + sfrom, NULL);
+    return R;
 }
 
 /* The nodes s in [*slo, *shi] of a line (first node (i0, j0), lattice step (di, dj), n nodes)
@@ -2197,8 +2199,8 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
             continue;
         }
         if (sw->win_rw >= 0) { /* a finite search radius */
-            hf_sweep_line_window(sw, m, i0, j0, di, dj, node0, step, shi + 1, slo);
-            fn(sw, ctx, m, node0, step, shi + 1, sw->win.t + R);
+            r = hf_sweep_line_window(sw, m, i0, j0, di, dj, node0, step, shi + 1, slo);
+            fn(sw, ctx, m, node0, step, shi + 1, sw->win.t + r);
             continue;
         }
         if (R > 0) top = hf_preroll(sw, i0, j0, di, dj, sh, sd);
