@@ -8,7 +8,9 @@
  *   4. Bilinear sampling and normals ([P1] §4, §7 "quad sum"; docs/errata.md E5; [P1] §7; docs/errata.md E10)
  *   5. The sweep lattice ([P1] §4, Fig. 2; docs/errata.md E5)
  *   6. The P1 hull stack along one line ([P1] §5 Alg. 1, App. A.1; [P1] §5, Alg. 1, App. A.1)
- *   7. The sweep driver: sampled lattice, four-way symmetry, borders, gather ([P1] §4, §7; docs/errata.md E5, E7, E8)
+ *   7. The sweep driver: sampled lattice, four-way symmetry, borders, gather ([P1] §4, §7; docs/errata.md E5, E7, E8);
+ *      the search radius (blocks of R, prefix and undoable suffix hulls) and tiles in raster
+ *      coordinates (docs/search-radius.md)
  *   8. Horizon outputs and the ray-march oracles ([P1] §2, [P2] §1); topographic openness (Yokoyama 2002)
  *   9. Light: uniform sky ([P1] Eq. 4-5), sky-view factor, sun visibility
  *  10. Environment light: prefix integrals and the L_p table ([P1] Eq. 6-7; docs/errata.md E9),
@@ -1282,7 +1284,8 @@ static double hf_domain_pad(int n) { return n == 1 ? HF_STRIP_HALF : HF_LATTICE_
 /* Fill the lattice for a given sweep vector u (unit; v = (-u.y, u.x)). Directions are stored
  * as look azimuth psi with u = -(cos psi, sin psi) (docs/errata.md E4: a sweep along u yields the horizon
  * toward -u). */
-static hfvis_status hf_lattice_from_u(hfvis_lattice *L, int W, int H, double ux, double uy)
+static hfvis_status hf_lattice_from_u(hfvis_lattice *L, int W, int H, double ux, double uy,
+                                      double ox, double oy)
 {
     double cx[4], cy[4], umin = DBL_MAX, umax = -DBL_MAX, vmin = DBL_MAX, vmax = -DBL_MAX;
     double rows, cols, px, py;
@@ -1293,6 +1296,8 @@ static hfvis_status hf_lattice_from_u(hfvis_lattice *L, int W, int H, double ux,
     L->vy = ux;
     L->width = W;
     L->height = H;
+    L->origin_x = ox;
+    L->origin_y = oy;
     L->azimuth_rad = atan2(-uy, -ux);
     px = W == 1 ? HF_STRIP_HALF : 0.0; /* a thin axis: the strip's corners */
     py = H == 1 ? HF_STRIP_HALF : 0.0;
@@ -1300,8 +1305,8 @@ static hfvis_status hf_lattice_from_u(hfvis_lattice *L, int W, int H, double ux,
     cx[1] = (double)(W - 1) + px; cy[1] = -py;
     cx[2] = -px; cy[2] = (double)(H - 1) + py;
     cx[3] = (double)(W - 1) + px; cy[3] = (double)(H - 1) + py;
-    for (c = 0; c < 4; c++) {
-        double a = cx[c] * L->ux + cy[c] * L->uy, b = cx[c] * L->vx + cy[c] * L->vy;
+    for (c = 0; c < 4; c++) { /* the corners in raster coordinates (tiles) */
+        double a = (cx[c] + ox) * L->ux + (cy[c] + oy) * L->uy, b = (cx[c] + ox) * L->vx + (cy[c] + oy) * L->vy;
         umin = fmin(umin, a);
         umax = fmax(umax, a);
         vmin = fmin(vmin, b);
@@ -1340,7 +1345,7 @@ hfvis_status hfvis_lattice_init(hfvis_lattice *lattice, int width, int height, d
     if (!lattice || width < 1 || height < 1 || !isfinite(azimuth_rad))
         return HFVIS_ERR_INVALID_ARGUMENT;
     hf_sweep_vector(azimuth_rad, &ux, &uy);
-    s = hf_lattice_from_u(&L, width, height, ux, uy);
+    s = hf_lattice_from_u(&L, width, height, ux, uy, 0.0, 0.0);
     if (s != HFVIS_OK) return s;
     L.azimuth_rad = azimuth_rad;
     *lattice = L;
@@ -1354,11 +1359,13 @@ size_t hfvis_lattice_size(const hfvis_lattice *L)
 }
 
 /* Position of node (i, j). Written as i*u + j*v with the two products summed, so a lattice
- * turned by a quarter turn (u' = v, v' = -u) yields bit-identical positions ([P1] §7). */
+ * turned by a quarter turn (u' = v, v' = -u) yields bit-identical positions ([P1] §7); in a tile
+ * that raster position minus the origin, exact (an integer taken from a double no smaller), so a
+ * tile and the whole raster sample the same surface point bit for bit. */
 static void hf_node_pos(const hfvis_lattice *L, int i, int j, double *x, double *y)
 {
-    *x = (double)i * L->ux + (double)j * L->vx;
-    *y = (double)i * L->uy + (double)j * L->vy;
+    *x = ((double)i * L->ux + (double)j * L->vx) - L->origin_x;
+    *y = ((double)i * L->uy + (double)j * L->vy) - L->origin_y;
 }
 
 static int hf_node_inside(const hfvis_lattice *L, int i, int j)
@@ -1372,9 +1379,11 @@ static int hf_node_inside(const hfvis_lattice *L, int i, int j)
 int hfvis_lattice_line(const hfvis_lattice *L, int j, int *i_first, int *i_last)
 {
     double lo = -DBL_MAX, hi = DBL_MAX;
-    double u[2], v[2], len[2], pad[2];
+    double u[2], v[2], len[2], pad[2], org[2];
     int a, first, last;
     if (!L || j < L->j_min || j > L->j_max) return 0;
+    org[0] = L->origin_x;
+    org[1] = L->origin_y;
     u[0] = L->ux; u[1] = L->uy;
     v[0] = L->vx; v[1] = L->vy;
     len[0] = (double)(L->width - 1);
@@ -1383,7 +1392,7 @@ int hfvis_lattice_line(const hfvis_lattice *L, int j, int *i_first, int *i_last)
     pad[1] = hf_domain_pad(L->height);
     /* Slab test per axis (docs/errata.md E5) gives the range to within rounding ... */
     for (a = 0; a < 2; a++) {
-        double off = (double)j * v[a], lo_a = pad[a] > HF_LATTICE_EPS ? -pad[a] : 0.0;
+        double off = (double)j * v[a] - org[a], lo_a = pad[a] > HF_LATTICE_EPS ? -pad[a] : 0.0;
         if (u[a] != 0.0) {
             double t0 = (lo_a - off) / u[a], t1 = (len[a] - lo_a - off) / u[a];
             lo = fmax(lo, fmin(t0, t1));
@@ -1488,6 +1497,52 @@ hfvis_status hfvis_line_horizons_naive(const double *distance, const double *hei
 /* 7. The sweep driver                                                                        */
 /* ========================================================================================== */
 
+/* The search radius (hfvis.h, "Search radius and tiles"; docs/search-radius.md). The hull above
+ * answers "the highest over everything behind"; a window of length R along the line needs more.
+ * Every line is cut into blocks of Rw position units anchored at global position 0 (so a tile and
+ * the whole raster cut a line at the same places). A sample i of block b sees the samples j < i
+ * with pos[i] - pos[j] <= Rw, which are (i) those of block b before it: the [P1] §5 hull
+ * restarted at the block start, and (ii) the suffix of block b - 1 from the first sample within
+ * reach: the upper hull of that suffix is built once per block right to left with an undo log
+ * (insertion k records the stack height and the slot it overwrote) and undone one insertion at a
+ * time as the window start advances; sample i reads its tangent by binary search. O(1) amortised
+ * per sample plus O(log R) per query; the answer is the larger of the two tangents. */
+typedef struct hf_win {
+    double *d, *h, *t;      /* one line: distances (hull arithmetic), heights (NaN holes), out */
+    double *sm;             /* the previous block's suffix maxima of height */
+    int64_t *pos;           /* global positions (integers; units of the caller) */
+    double *ph, *pd;        /* prefix hull stack (heights, distances) */
+    double *sh, *sd;        /* suffix hull (heights, distances; [0] rightmost) */
+    double *log_h, *log_d;  /* undo log: the slot each insertion overwrote ... */
+    int *log_top;           /* ... and the stack height before it */
+} hf_win;
+
+/* Bytes of the hf_win of lines of n samples. */
+#define HF_WIN_BYTES_PER_SAMPLE (10u * sizeof(double) + sizeof(int64_t) + sizeof(int))
+
+static void hf_win_carve(hf_win *w, unsigned char *b, size_t n)
+{
+    w->d = (double *)(void *)b;
+    w->h = w->d + n;
+    w->t = w->h + n;
+    w->ph = w->t + n;
+    w->pd = w->ph + n;
+    w->sm = w->pd + n;
+    w->sh = w->sm + n;
+    w->sd = w->sh + n;
+    w->log_h = w->sd + n;
+    w->log_d = w->log_h + n;
+    w->pos = (int64_t *)(void *)(w->log_d + n);
+    w->log_top = (int *)(void *)(w->pos + n);
+}
+
+static int64_t hf_floor_div64(int64_t num, int64_t den) /* den > 0 */
+{
+    int64_t q = num / den;
+    return (num % den != 0 && num < 0) ? q - 1 : q;
+}
+
+
 /* Scratch for all the sweeps of one call, carved out of a single allocation (one block per
  * call, freed before return). The base lattice of a direction group is sampled once; its four
  * quarter turns psi + m pi/2 visit the same nodes ([P1] §7) and are traversed as
@@ -1514,6 +1569,12 @@ typedef struct hf_sweep {
     double *gacc;               /* width*height*channels grid accumulator (fused light) */
     unsigned char *extra;       /* extra_size bytes for the caller (the P2 tree and line data) */
     size_t extra_size;
+    int64_t win_rw;             /* search radius in whole node steps; -1 = unlimited */
+    double ox, oy;              /* tile origin in the raster (hfvis.h, "Search radius and tiles") */
+    double ext_w, ext_h;        /* the raster's size */
+    int rx0, ry0, rx1, ry1;     /* receiver rectangle [rx0, rx1) x [ry0, ry1) */
+    int rect;                   /* 1: a proper sub-rectangle (nodes far from it are skipped) */
+    hf_win win;                 /* its line scratch (win_rw >= 0) */
     void *block;
     const hfvis_allocator *alloc;
 } hf_sweep;
@@ -1529,9 +1590,84 @@ static size_t hf_align_add(size_t *total, size_t count, size_t elem, int *ok)
     return off;
 }
 
+/* Is the search radius finite (hfvis.h: 0 and +INFINITY are unlimited)? */
+static int hf_radius_on(const hfvis_sweep_options *o)
+{
+    return o->max_distance > 0.0 && o->max_distance < HF_INF;
+}
+
+/* floor(r) as a window length, r >= 0, clamped to 2^52 (beyond any line) */
+static int64_t hf_radius_units(double r)
+{
+    r = floor(r);
+    return r > 4503599627370496.0 ? (int64_t)4503599627370496 : (int64_t)r;
+}
+
+/* Tile fields on their own (hfvis.h, "Search radius and tiles"); with the grid: hf_tile_fits. */
+static int hf_tile_opts_valid(const hfvis_sweep_options *o)
+{
+    int whole = o->extent_width == 0 && o->extent_height == 0;
+    if (o->origin_x < 0 || o->origin_y < 0 || o->extent_width < 0 || o->extent_height < 0 ||
+        o->receiver_x < 0 || o->receiver_y < 0 || o->receiver_width < 0 || o->receiver_height < 0)
+        return 0;
+    if ((o->extent_width == 0) != (o->extent_height == 0)) return 0;
+    if ((o->receiver_width == 0) != (o->receiver_height == 0)) return 0;
+    if (whole && (o->origin_x != 0 || o->origin_y != 0)) return 0;
+    return 1;
+}
+
+/* A grid that is a proper window of a larger raster (not the whole of it). */
+static int hf_tile_window(const hfvis_grid *g, const hfvis_sweep_options *o)
+{
+    return o->extent_width != 0 &&
+           (o->origin_x != 0 || o->origin_y != 0 || o->extent_width != g->width ||
+            o->extent_height != g->height);
+}
+
+/* The tile fields against the grid: the window inside the raster (and then a finite radius and
+ * the open border: nothing beyond the window is known), the receiver rectangle inside the grid. */
+static int hf_tile_fits(const hfvis_grid *g, const hfvis_sweep_options *o)
+{
+    if (o->extent_width != 0 && ((double)o->origin_x + (double)g->width > (double)o->extent_width ||
+                                 (double)o->origin_y + (double)g->height > (double)o->extent_height))
+        return 0;
+    if (hf_tile_window(g, o) &&
+        (!hf_radius_on(o) || (o->border != HFVIS_BORDER_OPEN && o->border != HFVIS_BORDER_DEFAULT)))
+        return 0;
+    if (o->receiver_width != 0 &&
+        ((double)o->receiver_x + (double)o->receiver_width > (double)g->width ||
+         (double)o->receiver_y + (double)o->receiver_height > (double)g->height))
+        return 0;
+    return 1;
+}
+
+/* The receiver rectangle of o as [x0, x1) x [y0, y1) (the whole grid by default). */
+static void hf_receiver_rect(const hfvis_grid *g, const hfvis_sweep_options *o, int *x0, int *y0,
+                             int *x1, int *y1)
+{
+    if (o->receiver_width == 0) {
+        *x0 = *y0 = 0;
+        *x1 = g->width;
+        *y1 = g->height;
+        return;
+    }
+    *x0 = o->receiver_x;
+    *y0 = o->receiver_y;
+    *x1 = o->receiver_x + o->receiver_width;
+    *y1 = o->receiver_y + o->receiver_height;
+}
+
+/* A finite radius, a window or a receiver rectangle: the routines outside the [P1] sweep
+ * (the P2 hull tree of section 11, openness) refuse them. */
+static int hf_sweep_opts_limited(const hfvis_sweep_options *o)
+{
+    return o && (hf_radius_on(o) || o->extent_width != 0 || o->receiver_width != 0);
+}
+
 static int hf_opts_valid(const hfvis_sweep_options *o)
 {
     return !o || (hf_border_valid(o->border) && o->border_cells >= 0 && isfinite(o->azimuth0_rad) &&
+                  o->max_distance >= 0.0 && hf_tile_opts_valid(o) &&
                   o->direction_begin >= 0 && o->direction_end >= 0 &&
                   o->direction_order >= HFVIS_DIRECTION_ORDER_DEFAULT &&
                   o->direction_order <= HFVIS_DIRECTION_ORDER_SWEEP &&
@@ -1547,6 +1683,17 @@ static hfvis_sweep_options hf_opts_resolve(const hfvis_grid *g, const hfvis_swee
     if (r.border == HFVIS_BORDER_DEFAULT) r.border = HFVIS_BORDER_OPEN;
     if (r.border_cells == 0) r.border_cells = g->width > g->height ? g->width : g->height;
     return r;
+}
+
+int hfvis_tile_halo(double max_distance, double cell_size, hfvis_ray_mode rays)
+{
+    double c;
+    if (!(max_distance > 0.0) || !(max_distance < HF_INF) || !(cell_size > 0.0) ||
+        !(cell_size < HF_INF) || (rays != HFVIS_RAYS_LATTICE && rays != HFVIS_RAYS_EXACT))
+        return -1;
+    c = ceil(max_distance / cell_size) +
+        (rays == HFVIS_RAYS_EXACT ? HFVIS_TILE_HALO_EXACT : HFVIS_TILE_HALO_LATTICE);
+    return c <= (double)INT_MAX ? (int)c : -1;
 }
 
 hfvis_sweep_options hfvis_sweep_options_default(void)
@@ -1582,7 +1729,7 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
                                          int channels, int want_gacc, size_t extra_size)
 {
     size_t total = 0, off_x = 0, nodes, gridn, off_rf, off_rl, off_cf, off_cl, off_h, off_n = 0, off_lat,
-           off_lh, off_lt, off_stk, off_gn = 0, off_ga = 0, linelen;
+           off_lh, off_lt, off_stk, off_gn = 0, off_ga = 0, off_w = 0, linelen;
     int ok = 1, D = hf_lattice_bound(g);
     unsigned char *b;
     memset(sw, 0, sizeof *sw);
@@ -1611,6 +1758,8 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     if (want_normals) off_gn = hf_align_add(&total, gridn, 3 * sizeof(float), &ok);
     if (want_gacc) off_ga = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
     if (extra_size) off_x = hf_align_add(&total, extra_size, 1, &ok);
+    sw->win_rw = hf_radius_on(o) ? hf_radius_units(o->max_distance / g->cell_size) : -1;
+    if (sw->win_rw >= 0) off_w = hf_align_add(&total, linelen, HF_WIN_BYTES_PER_SAMPLE, &ok);
     if (!ok) return HFVIS_ERR_LIMIT;
     b = (unsigned char *)hf_alloc(o->alloc, total);
     if (!b) return HFVIS_ERR_OUT_OF_MEMORY;
@@ -1629,6 +1778,13 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     sw->gacc = want_gacc ? (double *)(void *)(b + off_ga) : NULL;
     sw->extra = extra_size ? b + off_x : NULL;
     sw->extra_size = extra_size;
+    sw->ox = (double)o->origin_x;
+    sw->oy = (double)o->origin_y;
+    sw->ext_w = (double)(o->extent_width ? o->extent_width : g->width);
+    sw->ext_h = (double)(o->extent_height ? o->extent_height : g->height);
+    hf_receiver_rect(g, o, &sw->rx0, &sw->ry0, &sw->rx1, &sw->ry1);
+    sw->rect = sw->rx0 > 0 || sw->ry0 > 0 || sw->rx1 < g->width || sw->ry1 < g->height;
+    if (sw->win_rw >= 0) hf_win_carve(&sw->win, b + off_w, linelen);
     if (want_normals) {
         int x, y;
         for (y = 0; y < g->height; y++)
@@ -1697,7 +1853,7 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
     int j, i, c, tj, ti;
     double inv_cs = 1.0 / g->cell_size;
     size_t n, nodes;
-    hf_lattice_from_u(L, g->width, g->height, ux, uy); /* within the bound, cannot fail */
+    hf_lattice_from_u(L, g->width, g->height, ux, uy, sw->ox, sw->oy); /* within the bound */
     sw->rows = L->j_max - L->j_min + 1;
     sw->cols = L->i_max - L->i_min + 1;
     HFVIS_ASSERT(sw->rows <= hf_lattice_bound(g) && sw->cols <= hf_lattice_bound(g));
@@ -1818,7 +1974,7 @@ static int hf_line_span(const hf_sweep *sw, int m, int line, ptrdiff_t *node0, p
 
 /* The brute-force maximum on unit-spaced samples (docs/errata.md E5): the oracle twin of the
  * hull in hf_sweep_orientation. */
-static void hf_brute_unit(const double *h, int n, double *t)
+static void hf_brute_unit(const double *h, int n, double *t, int64_t rw)
 {
     int i, j;
     for (i = 0; i < n; i++) {
@@ -1827,7 +1983,7 @@ static void hf_brute_unit(const double *h, int n, double *t)
             t[i] = HF_NAN;
             continue;
         }
-        for (j = 0; j < i; j++) {
+        for (j = rw >= 0 && rw < i ? i - (int)rw : 0; j < i; j++) { /* within the radius */
             double s;
             if (isnan(h[j])) continue;
             s = (h[j] - h[i]) / (double)(i - j);
@@ -1859,6 +2015,104 @@ static inline double hf_hull_step(double *sh, double *sd, int *top_io, double h,
     return t;
 }
 
+/* Tangents t[i] = max over j < i with pos[i] - pos[j] <= Rw of (h[j] - h[i])/(d[i] - d[j])
+ * (-inf for none, NaN at holes), for n samples of w with increasing d and pos, Rw >= 0; samples
+ * before qfrom, and with ask (increasing sample indices, ending past n) those not in it, are
+ * only occluders (t NaN). */
+static void hf_window_line(const hf_win *w, int n, int64_t Rw, int qfrom, const int *ask)
+{
+    const double *d = w->d, *h = w->h;
+    const int64_t *pos = w->pos;
+    double *t = w->t, *ph = w->ph, *pd = w->pd, *sm = w->sm, dend = 0.0;
+    double *sh = w->sh, *sd = w->sd, *lh = w->log_h, *ld = w->log_d;
+    int *lt = w->log_top;
+    int i, ptop = 0, stop = 0, nlog = 0, cstart = 0, have = 0, wi = 0, wend = 0;
+    int64_t cb = 0, next = 0; /* the current block and the start of the next one */
+    for (i = 0; i < n; i++) {
+        double hi = h[i], di = d[i], tp;
+        int64_t b;
+        int asked = i >= qfrom && (!ask || i == *ask);
+        if (ask && i == *ask) ask++;
+        if (isnan(hi)) {
+            t[i] = HF_NAN;
+            continue;
+        }
+        if (Rw <= 0) { /* nothing is within reach */
+            t[i] = -HF_INF;
+            continue;
+        }
+        if (!have || pos[i] >= next) { /* a new block; the previous one is [cstart, i) */
+            int j, hw = 0; /* hw: slots below it hold data (a later insertion may overwrite a
+                              slot an earlier one popped, so every insertion saves its slot) */
+            b = hf_floor_div64(pos[i], Rw);
+            stop = nlog = 0;
+            wi = wend = i;
+            if (have && b == cb + 1) {
+                double mx = -HF_INF;
+                dend = d[i - 1];
+                for (j = i - 1; j >= cstart; j--) { /* its upper hull, right to left */
+                    double hj = h[j], dj = d[j];
+                    int old = stop;
+                    if (isnan(hj)) {
+                        sm[j] = mx;
+                        continue;
+                    }
+                    sm[j] = mx = hj > mx ? hj : mx;
+                    while (stop >= 2 && (sh[stop - 1] - hj) * (sd[stop - 2] - dj) <=
+                                            (sh[stop - 2] - hj) * (sd[stop - 1] - dj))
+                        stop--;
+                    lt[nlog] = old;
+                    lh[nlog] = stop < hw ? sh[stop] : 0.0;
+                    ld[nlog++] = stop < hw ? sd[stop] : 0.0;
+                    sh[stop] = hj;
+                    sd[stop++] = dj;
+                    if (stop > hw) hw = stop;
+                }
+                wi = cstart;
+            }
+            cstart = i;
+            cb = b;
+            next = (b + 1) * Rw;
+            have = 1;
+            ptop = 0;
+        }
+        /* advance the window start: undo the insertions of the samples now out of reach */
+        for (; wi < wend && pos[i] - pos[wi] > Rw; wi++) {
+            if (isnan(h[wi])) continue;
+            nlog--;
+            sh[stop - 1] = lh[nlog];
+            sd[stop - 1] = ld[nlog];
+            stop = lt[nlog];
+        }
+        tp = hf_hull_step(ph, pd, &ptop, hi, di);
+        if (!asked) { /* pushed, not asked */
+            t[i] = HF_NAN;
+            continue;
+        }
+        if (stop > 0) {
+            /* the vertex of greatest slope: from the right end, the left neighbour is seen at
+               least as high up to it and lower after it (ties go farther, as the hull pops);
+               skipped when the suffix's highest sample at its nearest (numerator >= 0) or
+               farthest (< 0) distance cannot beat the prefix: rounding is monotone, so the
+               bound holds for the computed quotients too */
+            int lo = 0, hi2 = stop - 1;
+            double ts, num = sm[wi] - hi;
+            if (num / (di - (num >= 0.0 ? dend : d[wi])) <= tp) {
+                t[i] = tp;
+                continue;
+            }
+            while (lo < hi2) {
+                int mid = (lo + hi2) / 2;
+                if ((sh[mid + 1] - hi) * (di - sd[mid]) >= (sh[mid] - hi) * (di - sd[mid + 1])) lo = mid + 1;
+                else hi2 = mid;
+            }
+            ts = (sh[lo] - hi) / (di - sd[lo]);
+            if (ts > tp) tp = ts;
+        }
+        t[i] = tp;
+    }
+}
+
 /* Pre-roll (docs/errata.md E8): R lattice nodes before the first in-domain node (i0, j0) of a line with
  * lattice step (di, dj), sampled with the border rule, at distances -R..-1; they occlude but
  * receive nothing. Returns the stack height. */
@@ -1878,6 +2132,69 @@ static int hf_preroll(const hf_sweep *sw, int i0, int j0, int di, int dj, double
     return top;
 }
 
+/* One line under a finite search radius: the pre-roll within reach (its length is returned)
+ * and the nodes into the window scratch at unit distances, positioned by their lattice
+ * coordinate along the sweep (the same for a tile and the whole raster), and through
+ * hf_window_line. */
+static int hf_sweep_line_window(hf_sweep *sw, int m, int i0, int j0, int di, int dj,
+                                ptrdiff_t node0, ptrdiff_t step, int n, int sfrom)
+{
+    const hfvis_lattice *L = &sw->L;
+    const int R = sw->preroll < sw->win_rw ? sw->preroll : (int)sw->win_rw; /* pre-roll in reach */
+    const double inv_cs = 1.0 / sw->g->cell_size;
+    hf_win *w = &sw->win;
+    int64_t c0 = (m & 1) ? (int64_t)j0 + sw->L.j_min : (int64_t)i0 + sw->L.i_min;
+    ptrdiff_t p;
+    int r, s;
+    if (m >= 2) c0 = -c0;
+    c0 -= R;
+    for (r = 0; r < R; r++) {
+        double x, y;
+        hf_node_pos(L, i0 - (R - r) * di + L->i_min, j0 - (R - r) * dj + L->j_min, &x, &y);
+        w->h[r] = hf_sample_border(sw->g, sw->border, x, y) * inv_cs;
+    }
+    for (s = 0, p = node0; s < n; s++, p += step) w->h[R + s] = sw->h[p];
+    for (r = 0; r < R + n; r++) {
+        w->d[r] = (double)r;
+        w->pos[r] = c0 + r;
+    }
+    hf_window_line(w, R + n, sw->win_rw, R + sfrom, NULL);
+    return R;
+}
+
+/* The nodes s in [*slo, *shi] of a line (first node (i0, j0), lattice step (di, dj), n nodes)
+ * that lie within HF_RECT_MARGIN cells of the receiver rectangle: the only ones a gather of its
+ * receivers reads (the taps within two lattice steps, under 3 cells). 0 if none. */
+#define HF_RECT_MARGIN 4.0
+static int hf_line_rect(const hf_sweep *sw, int i0, int j0, int di, int dj, int n, int *slo, int *shi)
+{
+    const hfvis_lattice *L = &sw->L;
+    double p[2], c[2], lo = -DBL_MAX, hi = DBL_MAX, blo[2], bhi[2];
+    int a;
+    hf_node_pos(L, i0 + L->i_min, j0 + L->j_min, &p[0], &p[1]);
+    c[0] = (double)di * L->ux + (double)dj * L->vx;
+    c[1] = (double)di * L->uy + (double)dj * L->vy;
+    blo[0] = (double)sw->rx0 - HF_RECT_MARGIN;
+    bhi[0] = (double)(sw->rx1 - 1) + HF_RECT_MARGIN;
+    blo[1] = (double)sw->ry0 - HF_RECT_MARGIN;
+    bhi[1] = (double)(sw->ry1 - 1) + HF_RECT_MARGIN;
+    for (a = 0; a < 2; a++) {
+        if (fabs(c[a]) > 1e-12) {
+            double t0 = (blo[a] - p[a]) / c[a], t1 = (bhi[a] - p[a]) / c[a];
+            lo = fmax(lo, fmin(t0, t1));
+            hi = fmin(hi, fmax(t0, t1));
+        } else if (p[a] < blo[a] || p[a] > bhi[a]) {
+            return 0;
+        }
+    }
+    lo = fmax(floor(lo) - 1.0, 0.0);
+    hi = fmin(ceil(hi) + 1.0, (double)(n - 1));
+    if (lo > hi) return 0;
+    *slo = (int)lo;
+    *shi = (int)hi;
+    return 1;
+}
+
 /* Run orientation m of the current group: copy each line (with its pre-roll) out of the
  * sampled lattice, find the horizons, hand them to fn. brute = 1 uses the oracle. (Sweeping
  * columns several side by side, so each row step reads whole cache lines, measured no faster:
@@ -1892,8 +2209,11 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
     for (line = 0; line < nlines; line++) {
         ptrdiff_t node0, step, p;
         int i0, j0, di, dj, n, s, r, top = 0;
+        int slo = 0, shi;
         n = hf_line_span(sw, m, line, &node0, &step, &i0, &j0, &di, &dj);
         if (n == 0) continue;
+        shi = n - 1;
+        if (!brute && sw->rect && !hf_line_rect(sw, i0, j0, di, dj, n, &slo, &shi)) continue;
         if (brute) {
             /* Oracle: copy the line (pre-roll first) and scan it (docs/errata.md E5). */
             for (r = 0; r < R; r++) {
@@ -1902,12 +2222,17 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
                 sh[r] = hf_sample_border(sw->g, sw->border, x, y) * inv_cs;
             }
             for (s = 0, p = node0; s < n; s++, p += step) sh[R + s] = sw->h[p];
-            hf_brute_unit(sh, R + n, t);
+            hf_brute_unit(sh, R + n, t, sw->win_rw);
             fn(sw, ctx, m, node0, step, n, t + R);
             continue;
         }
+        if (sw->win_rw >= 0) { /* a finite search radius */
+            r = hf_sweep_line_window(sw, m, i0, j0, di, dj, node0, step, shi + 1, slo);
+            fn(sw, ctx, m, node0, step, shi + 1, sw->win.t + r);
+            continue;
+        }
         if (R > 0) top = hf_preroll(sw, i0, j0, di, dj, sh, sd);
-        for (s = 0, p = node0; s < n; s++, p += step) {
+        for (s = 0, p = node0; s <= shi; s++, p += step) {
             double h = sw->h[p];
             if (isnan(h)) {
                 t[s] = HF_NAN;
@@ -1915,7 +2240,8 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
             }
             t[s] = hf_hull_step(sh, sd, &top, h, (double)s);
         }
-        fn(sw, ctx, m, node0, step, n, t);
+        for (s = 0; s < slo; s++) t[s] = HF_NAN; /* far from every receiver */
+        fn(sw, ctx, m, node0, step, shi + 1, t);
     }
 }
 
@@ -1960,7 +2286,8 @@ typedef struct hf_gather {
 static void hf_gather_setup(const hf_sweep *sw, int x, int y, hf_gather *G)
 {
     const hfvis_lattice *L = &sw->L;
-    double a = (double)x * L->ux + (double)y * L->uy, b = (double)x * L->vx + (double)y * L->vy;
+    double gx = (double)x + sw->ox, gy = (double)y + sw->oy; /* raster coordinates (tiles) */
+    double a = gx * L->ux + gy * L->uy, b = gx * L->vx + gy * L->vy;
     double fa = floor(a), fb = floor(b);
     int q;
     G->wa = a - fa;
@@ -2115,13 +2442,13 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
     const hfvis_grid *g = sw->g;
     int x, y, c, tx, ty;
     double v[4], lx[4], ly[4];
-    double xmax = (double)(g->width - 1) + HF_LATTICE_EPS, ymax = (double)(g->height - 1) + HF_LATTICE_EPS;
+    double xmax = (sw->ext_w - 1.0) + HF_LATTICE_EPS, ymax = (sw->ext_h - 1.0) + HF_LATTICE_EPS;
     hf_gather G;
     for (c = 0; c < ch; c++) hf_look_dir(sw, m_first + c, &lx[c], &ly[c]);
-    for (ty = 0; ty < g->height; ty += HF_TILE)
-        for (tx = 0; tx < g->width; tx += HF_TILE)
-    for (y = ty; y < g->height && y < ty + HF_TILE; y++)
-        for (x = tx; x < g->width && x < tx + HF_TILE; x++) {
+    for (ty = sw->ry0; ty < sw->ry1; ty += HF_TILE)
+        for (tx = sw->rx0; tx < sw->rx1; tx += HF_TILE)
+    for (y = ty; y < sw->ry1 && y < ty + HF_TILE; y++)
+        for (x = tx; x < sw->rx1 && x < tx + HF_TILE; x++) {
             ptrdiff_t o = (ptrdiff_t)y * out_stride + x;
             if (hf_is_hole(g, x, y)) {
                 for (c = 0; c < ch; c++) out[(size_t)c * plane_step + (size_t)o] = (float)HF_NAN;
@@ -2132,8 +2459,8 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
                 hf_gather_elevations(sw, ch, &G, v);
             }
             for (c = 0; c < ch; c++) {
-                if (sw->border == HFVIS_BORDER_OPEN) {
-                    double nx = (double)x + lx[c], ny = (double)y + ly[c];
+                if (sw->border == HFVIS_BORDER_OPEN) { /* the raster's border (tiles) */
+                    double nx = ((double)x + sw->ox) + lx[c], ny = ((double)y + sw->oy) + ly[c];
                     if (nx < -HF_LATTICE_EPS || ny < -HF_LATTICE_EPS || nx > xmax || ny > ymax)
                         v[c] = -HF_HALF_PI;
                 }
@@ -2157,20 +2484,20 @@ static void hf_gather_accumulate(hf_sweep *sw)
     double v[4];
     hf_gather G;
     int tx, ty;
-    for (ty = 0; ty < g->height; ty += HF_TILE)
-        for (tx = 0; tx < g->width; tx += HF_TILE)
-    for (y = ty; y < g->height && y < ty + HF_TILE; y++) {
+    for (ty = sw->ry0; ty < sw->ry1; ty += HF_TILE)
+        for (tx = sw->rx0; tx < sw->rx1; tx += HF_TILE)
+    for (y = ty; y < sw->ry1 && y < ty + HF_TILE; y++) {
         const float *zr = g->z + (ptrdiff_t)y * g->stride;
         double *accr = sw->gacc + (size_t)y * (size_t)g->width * (size_t)ch;
-        const double ya = (double)y * L->uy, yb = (double)y * L->vy;
-        for (x = tx; x < g->width && x < tx + HF_TILE; x++) {
+        const double ya = ((double)y + sw->oy) * L->uy, yb = ((double)y + sw->oy) * L->vy;
+        for (x = tx; x < sw->rx1 && x < tx + HF_TILE; x++) {
             double *acc = accr + (size_t)x * (size_t)ch;
             double a, b, fa, fb, wa, wb, w[4], sum, wsum;
             const double *p;
             int ia, jb, q;
             if (!isfinite(zr[x])) continue;
-            a = (double)x * L->ux + ya;
-            b = (double)x * L->vx + yb;
+            a = ((double)x + sw->ox) * L->ux + ya;
+            b = ((double)x + sw->ox) * L->vx + yb;
             /* floor of a lattice coordinate (within the int range, hf_lattice_from_u) */
             ia = (int)a;
             ia -= (double)ia > a;
@@ -2275,7 +2602,8 @@ static void hf_store_elevation(hf_sweep *sw, void *ctx, int m, ptrdiff_t node0, 
 
 static hfvis_status hf_check_common(const hfvis_grid *grid, const hfvis_sweep_options *opts)
 {
-    if (!hf_grid_valid(grid) || !hf_opts_valid(opts)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!hf_grid_valid(grid) || !hf_opts_valid(opts) || (opts && !hf_tile_fits(grid, opts)))
+        return HFVIS_ERR_INVALID_ARGUMENT;
     return HFVIS_OK;
 }
 
@@ -2287,10 +2615,12 @@ static hfvis_status hf_horizon_lattice_impl(const hfvis_grid *grid, double azimu
     hfvis_status s;
     double ux, uy;
     size_t i, n;
-    if (hf_check_common(grid, opts) != HFVIS_OK || !out || !isfinite(azimuth_rad))
+    if (hf_check_common(grid, opts) != HFVIS_OK || !out || !isfinite(azimuth_rad) ||
+        (opts && hf_tile_window(grid, opts))) /* its nodes are those of hfvis_lattice_init */
         return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
     if ((s = hf_sweep_alloc(&sw, grid, &o, 0, 1, 0)) != HFVIS_OK) return s;
+    sw.rect = 0; /* every node: the lattice has no receivers */
     hf_sweep_vector(azimuth_rad, &ux, &uy);
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HF_NAN);
@@ -2474,10 +2804,14 @@ static double hf_march_tan(const hf_surface *S, double px, double py, double h0,
 
 static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0, int exact_bound,
                                      const hfvis_march_options *march, const float *points,
-                                     size_t count, float *out)
+                                     size_t count, float *out, double radius)
 {
     double step = march && march->step_cells > 0.0 ? march->step_cells : 1.0;
     double maxd = march ? march->max_distance_cells : 0.0;
+    if (radius > 0.0 && radius < HF_INF) { /* the sweep options' search radius, in cells */
+        double rc = radius / S->cell_size;
+        maxd = maxd > 0.0 && maxd < rc ? maxd : rc;
+    }
     size_t i;
     int k;
     for (i = 0; i < count; i++) {
@@ -2528,7 +2862,7 @@ hfvis_status hfvis_horizon_reference(const hfvis_grid *grid, int K,
     S.border = o.border;
     S.reach = o.border == HFVIS_BORDER_OPEN ? 0.0 : (double)o.border_cells;
     return hf_reference_run(&S, K, o.azimuth0_rad, o.rays == HFVIS_RAYS_EXACT ? hf_exact_bound(&o, K) : 0,
-                            march, points, count, out);
+                            march, points, count, out, o.max_distance);
 }
 
 hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user, int width, int height,
@@ -2550,7 +2884,7 @@ hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user, int widt
     S.border = HFVIS_BORDER_OPEN;
     return hf_reference_run(&S, K, opts ? opts->azimuth0_rad : 0.0,
                             opts && opts->rays == HFVIS_RAYS_EXACT ? hf_exact_bound(opts, K) : 0, march,
-                            points, count, out);
+                            points, count, out, opts ? opts->max_distance : 0.0);
 }
 
 /* Topographic openness (Yokoyama, Shirasawa & Pike 2002): the mean zenith angle pi/2 - beta_k
@@ -2569,6 +2903,7 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
         !hf_out_fits(out_stride, H) || !isfinite(radius) || radius < 0.0 || !isfinite(step) ||
         (oo && !(oo->step_cells >= 0.0)) || (negative != 0 && negative != 1))
         return HFVIS_ERR_INVALID_ARGUMENT;
+    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
     o = hf_opts_resolve(grid, opts);
     if (radius > 0.0) { /* the march: no allocation */
         hf_surface S;
@@ -2783,8 +3118,8 @@ static void hf_fused_output(const hf_sweep *sw, double scale, double offset, flo
 {
     const hfvis_grid *g = sw->g;
     int x, y, c;
-    for (y = 0; y < g->height; y++)
-        for (x = 0; x < g->width; x++) {
+    for (y = sw->ry0; y < sw->ry1; y++) /* the receiver rectangle; the rest is left unwritten */
+        for (x = sw->rx0; x < sw->rx1; x++) {
             const double *a = sw->gacc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)channels;
             float *o = out + ((ptrdiff_t)y * out_stride + x) * channels;
             int hole = hf_is_hole(g, x, y);
@@ -2995,8 +3330,8 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
     hf_lattice_fill(&sw, HF_NAN);
     hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL);
     hf_gather_planes(&sw, 1, 0, out, 0, out_stride);
-    for (y = 0; y < grid->height; y++)
-        for (x = 0; x < grid->width; x++) {
+    for (y = sw.ry0; y < sw.ry1; y++)
+        for (x = sw.rx0; x < sw.rx1; x++) {
             float *p = out + (ptrdiff_t)y * out_stride + x;
             *p = (float)hf_sun_fraction(sun_elevation_rad, sun_radius_rad, (double)*p);
         }
@@ -4394,6 +4729,7 @@ hfvis_status hfvis_intervisibility(const hfvis_grid *grid, int K, const hfvis_sw
     hfvis_status s;
     if (hf_check_common(grid, opts) != HFVIS_OK || K < 1 || !fn || !hf_tree_opts_valid(tree_opts))
         return HFVIS_ERR_INVALID_ARGUMENT;
+    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
     o = hf_opts_resolve(grid, opts);
     memset(&c, 0, sizeof c);
     c.tree_opts = tree_opts;
@@ -4416,6 +4752,7 @@ static hfvis_status hf_visibility_count(const hfvis_grid *grid, int K, const hfv
     hfvis_status s;
     if (!hf_light_args_valid(grid, K, opts, out, out_stride) || !hf_tree_opts_valid(tree_opts))
         return HFVIS_ERR_INVALID_ARGUMENT;
+    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
     o = hf_opts_resolve(grid, opts);
     memset(&c, 0, sizeof c);
     c.tree_opts = tree_opts;
@@ -4454,6 +4791,7 @@ static hfvis_status hf_indirect(const hfvis_grid *grid, int K, const float *exit
     if (!hf_light_args_valid(grid, K, opts, out, out_stride) || !hf_tree_opts_valid(tree_opts) ||
         !exit_radiance || channels < 1 || channels > 4 || !isfinite(sky) || !isfinite(albedo))
         return HFVIS_ERR_INVALID_ARGUMENT;
+    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
     o = hf_opts_resolve(grid, opts);
     memset(&c, 0, sizeof c);
     c.tree_opts = tree_opts;
@@ -4500,6 +4838,7 @@ hfvis_status hfvis_terrain_gi(const hfvis_grid *grid, int K, const float *direct
     if (!hf_grid_valid(grid) || !direct || !out || channels < 1 || channels > 4 || bounces < 0 ||
         K < 1 || !isfinite(albedo_value) || !hf_opts_valid(opts) || !hf_tree_opts_valid(tree_opts))
         return HFVIS_ERR_INVALID_ARGUMENT;
+    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
     if (!hf_mul_size(hf_grid_count(grid), (size_t)channels, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
     n = hf_grid_count(grid);
     exit_b = (float *)hf_alloc_array(alloc, total, sizeof(float));
@@ -4544,10 +4883,16 @@ hfvis_status hfvis_direct_light(const hfvis_grid *grid, int K, const hfvis_sun *
     size_t n, i, total;
     float *plane;
     hfvis_status s;
-    int c;
+    int c, rx0 = 0, ry0 = 0, rx1 = 0, ry1 = 0, x, y;
     if (!hf_grid_valid(grid) || K < 1 || !out || channels < 1 || channels > 4 || !isfinite(sky) ||
-        !hf_opts_valid(opts) || (env && (!hf_env_valid(env) || env->channels != channels)))
+        !hf_opts_valid(opts) || (opts && !hf_tile_fits(grid, opts)) ||
+        (env && (!hf_env_valid(env) || env->channels != channels)))
         return HFVIS_ERR_INVALID_ARGUMENT;
+    if (opts) hf_receiver_rect(grid, opts, &rx0, &ry0, &rx1, &ry1);
+    else {
+        rx1 = grid->width;
+        ry1 = grid->height;
+    }
     if (sun) {
         if (!isfinite(sun->azimuth_rad) || !isfinite(sun->elevation_rad) || !isfinite(sun->radius_rad) ||
             sun->radius_rad < 0.0 || fabs(sun->elevation_rad) > HF_HALF_PI)
@@ -4563,8 +4908,11 @@ hfvis_status hfvis_direct_light(const hfvis_grid *grid, int K, const hfvis_sun *
     if (env) s = hfvis_env_light(grid, K, env, 1.0f, opts, NULL, plane, grid->width);
     else {
         s = hfvis_sky_light(grid, K, sky, 1.0f, opts, plane, grid->width);
-        for (i = n; s == HFVIS_OK && i-- > 0;) /* spread the one channel, back to front */
-            for (c = channels - 1; c >= 0; c--) plane[i * (size_t)channels + (size_t)c] = plane[i];
+        for (y = ry1; s == HFVIS_OK && y-- > ry0;) /* spread the one channel, back to front */
+            for (x = rx1; x-- > rx0;) {
+                i = (size_t)y * (size_t)grid->width + (size_t)x;
+                for (c = channels - 1; c >= 0; c--) plane[i * (size_t)channels + (size_t)c] = plane[i];
+            }
     }
     if (s == HFVIS_OK && sun) {
         float *vis = (float *)hf_alloc_array(alloc, n, sizeof(float));
@@ -4575,9 +4923,8 @@ hfvis_status hfvis_direct_light(const hfvis_grid *grid, int K, const hfvis_sun *
             if (s == HFVIS_OK) {
                 double lx = cos(sun->elevation_rad) * cos(sun->azimuth_rad);
                 double ly = cos(sun->elevation_rad) * sin(sun->azimuth_rad), lz = sin(sun->elevation_rad);
-                int x, y;
-                for (y = 0; y < grid->height; y++)
-                    for (x = 0; x < grid->width; x++) {
+                for (y = ry0; y < ry1; y++) /* the receiver rectangle */
+                    for (x = rx0; x < rx1; x++) {
                         double nrm[3], cosl;
                         size_t q = (size_t)y * (size_t)grid->width + (size_t)x;
                         hf_normal_at(grid, x, y, nrm);
@@ -4591,7 +4938,11 @@ hfvis_status hfvis_direct_light(const hfvis_grid *grid, int K, const hfvis_sun *
             hf_free(alloc, vis);
         }
     }
-    if (s == HFVIS_OK) memcpy(out, plane, total * sizeof(float));
+    if (s == HFVIS_OK) /* the receiver rectangle; the rest of out is left as it was */
+        for (y = ry0; y < ry1; y++) {
+            size_t q = ((size_t)y * (size_t)grid->width + (size_t)rx0) * (size_t)channels;
+            memcpy(out + q, plane + q, (size_t)(rx1 - rx0) * (size_t)channels * sizeof(float));
+        }
     hf_free(alloc, plane);
     return s;
 }
@@ -7238,6 +7589,8 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
         return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
     if (hf_direction_range(&o, K, &begin, &end) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (kind == HFVIS_SUM_VISIBILITY && hf_sweep_opts_limited(&o)) /* the P2 tree: not honoured */
+        return HFVIS_ERR_INVALID_ARGUMENT;
     if (o.rays == HFVIS_RAYS_EXACT && kind != HFVIS_SUM_VISIBILITY)
         return hf_exact_direction_sums(grid, K, kind, env, eopts, &o, begin, end, sums);
     memset(&sky, 0, sizeof sky);
@@ -7265,8 +7618,8 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
         break;
     }
     if (s == HFVIS_OK) {
-        for (y = 0; y < grid->height; y++)
-            for (x = 0; x < grid->width; x++) {
+        for (y = sw.ry0; y < sw.ry1; y++) /* the receiver rectangle */
+            for (x = sw.rx0; x < sw.rx1; x++) {
                 size_t i = ((size_t)y * (size_t)grid->width + (size_t)x) * (size_t)channels;
                 int hole = hf_is_hole(grid, x, y);
                 for (c = 0; c < channels; c++) sums[i + (size_t)c] = hole ? HF_NAN : sw.gacc[i + (size_t)c];
@@ -7678,6 +8031,14 @@ typedef struct hf_exact {
     float *nrm;             /* width*height*3 grid normals (lighting), else NULL */
     double *acc;            /* width*height*channels sums, else NULL */
     int channels;
+    double radius;          /* a finite search radius (world units), else 0 */
+    int64_t win_rw;         /* the current direction's window, 1/16 sub-steps; -1 = unlimited */
+    hf_win win;             /* one line's samples under the radius */
+    int *win_rec;           /* their receivers: sample index ... */
+    size_t *win_tan;        /* ... and grid index */
+    int ox, oy;             /* the tile's origin in the raster (hfvis.h, "Search radius and tiles") */
+    int rx0, ry0, rx1, ry1; /* the receiver rectangle, [rx0, rx1) x [ry0, ry1) */
+    int rect;               /* 1: a proper sub-rectangle */
     void *block;
     const hfvis_allocator *alloc;
 } hf_exact;
@@ -7821,6 +8182,33 @@ static int hf_exact_periods(const hfvis_grid *g, int R, int x, int y, int a, int
     return k;
 }
 
+/* The last grid point q (hx - q a, hy - q b) of a line in the receiver rectangle (the line
+ * stops there); 0 if none is. */
+static int hf_exact_rect_span(const hf_exact *E, int hx, int hy, int a, int b, int *qhi)
+{
+    int lo = 0, hi = INT_MAX, ax;
+    for (ax = 0; ax < 2; ax++) {
+        int c = ax ? b : a, h = ax ? hy : hx, r0 = ax ? E->ry0 : E->rx0, r1 = (ax ? E->ry1 : E->rx1) - 1;
+        int l, u;
+        if (c == 0) {
+            if (h < r0 || h > r1) return 0;
+            continue;
+        }
+        if (c > 0) { /* h - q c in [r0, r1] */
+            l = -hf_floor_div(r1 - h, c);
+            u = hf_floor_div(h - r0, c);
+        } else {
+            l = -hf_floor_div(h - r0, -c);
+            u = hf_floor_div(r1 - h, -c);
+        }
+        if (l > lo) lo = l;
+        if (u < hi) hi = u;
+    }
+    if (lo > hi) return 0;
+    *qhi = hi;
+    return 1;
+}
+
 /* One line of direction (a, b) from its head (hx, hy), the grid point whose successor
  * (hx + a, hy + b) lies outside the grid: the crossings beyond the head (the CLAMP/WRAP pre-roll,
  * or the part of a step still inside the grid), then each grid point (a receiver) and the
@@ -7831,12 +8219,26 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
     const hf_cross *cr = E->cross;
     double *sd = E->sd, *sh = E->sh, ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
     const ptrdiff_t stride = g->stride;
-    int top = 0, k, e, q;
+    int top = 0, k, e, q, nw = 0, nr = 0, qhi = INT_MAX;
+    const int win = E->win_rw >= 0; /* a finite radius: collect the samples, then hf_window_line */
+    hf_win *W = &E->win;
+    if (E->rect && !hf_exact_rect_span(E, hx, hy, a, b, &qhi)) return; /* no receiver wanted */
 #define HF_HULL_PUSH(dd, hh)                                                                     \
     do {                                                                                         \
         while (top >= 2 &&                                                                       \
                (sh[top - 2] - (hh)) * ((dd) - sd[top - 1]) >= (sh[top - 1] - (hh)) * ((dd) - sd[top - 2])) \
             top--;                                                                               \
+    } while (0)
+#define HF_EMIT(dd, hh)                                                                          \
+    do {                                                                                         \
+        if (win) {                                                                               \
+            W->d[nw] = (dd);                                                                     \
+            W->h[nw++] = (hh);                                                                   \
+        } else {                                                                                 \
+            HF_HULL_PUSH(dd, hh);                                                                \
+            sd[top] = (dd);                                                                      \
+            sh[top++] = (hh);                                                                    \
+        }                                                                                        \
     } while (0)
     for (k = hf_exact_periods(g, E->R, hx, hy, a, b); k >= 0; k--) {
         int bx = hx + k * a, by = hy + k * b;
@@ -7846,24 +8248,25 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
             while (j-- > 0) { /* the piece after crossing e, far end first */
                 if (isnan(ph[j])) continue;
                 d = -((double)k * L + (cr[e].u + pu[j]));
-                HF_HULL_PUSH(d, ph[j]);
-                sd[top] = d;
-                sh[top++] = ph[j];
+                HF_EMIT(d, ph[j]);
             }
             if ((k == 0 && e == 0) || !hf_cross_inside(g, E->R, X, Y, cr + e)) continue;
             h = hf_cross_height(g, E->border, X, Y, cr + e);
             if (isnan(h)) continue;
             d = -((double)k * L + cr[e].u);
-            HF_HULL_PUSH(d, h);
-            sd[top] = d;
-            sh[top++] = h;
+            HF_EMIT(d, h);
         }
     }
     for (q = 0;; q++) {
         int gx = hx - q * a, gy = hy - q * b, nx = gx - a, ny = gy - b;
         double h = (double)g->z[(ptrdiff_t)gy * stride + gx], d = (double)q * L;
         double *t = E->tan + (size_t)gy * (size_t)g->width + (size_t)gx;
-        if (!isfinite(h)) {
+        if (win) {
+            W->d[nw] = d;
+            W->h[nw] = isfinite(h) ? h : HF_NAN;
+            E->win_rec[nr] = nw++;
+            E->win_tan[nr++] = (size_t)gy * (size_t)g->width + (size_t)gx;
+        } else if (!isfinite(h)) {
             *t = HF_NAN;
         } else {
             HF_HULL_PUSH(d, h);
@@ -7871,28 +8274,54 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
             sd[top] = d;
             sh[top++] = h;
         }
-        if (nx < 0 || ny < 0 || nx >= g->width || ny >= g->height) break;
+        if (nx < 0 || ny < 0 || nx >= g->width || ny >= g->height || q >= qhi) break;
         for (e = P - 1; e >= 0; e--) { /* between two grid points: inside the grid */
             const float *p = g->z + (ptrdiff_t)(ny + cr[e].oy) * stride + (nx + cr[e].ox);
             int j = hf_piece_samples(g, E->twist, nx, ny, cr + e, ph, pu);
             while (j-- > 0) {
                 if (isnan(ph[j])) continue;
                 d = (double)(q + 1) * L - (cr[e].u + pu[j]);
-                HF_HULL_PUSH(d, ph[j]);
-                sd[top] = d;
-                sh[top++] = ph[j];
+                HF_EMIT(d, ph[j]);
             }
             if (e == 0) break; /* crossing 0 is the next receiver */
             h = (double)p[0];
             h += ((double)p[cr[e].kind == 1 ? stride : 1] - h) * cr[e].f; /* as hf_cross_height */
             if (!isfinite(h)) continue;
             d = (double)(q + 1) * L - cr[e].u;
-            HF_HULL_PUSH(d, h);
-            sd[top] = d;
-            sh[top++] = h;
+            HF_EMIT(d, h);
         }
     }
+#undef HF_EMIT
 #undef HF_HULL_PUSH
+    if (win) {
+        /* positions: 16 x the sub-step along the raster's line, counted from its grid point
+           q = 0 = -floor((X a + Y b)/(a^2 + b^2)) (X, Y in the raster): a tile and the whole
+           raster put every sample at the same integer */
+        int64_t n2 = (int64_t)a * a + (int64_t)b * b;
+        int64_t dot = ((int64_t)hx + E->ox) * a + ((int64_t)hy + E->oy) * b;
+        double base = -(double)hf_floor_div64(dot, n2) * L;
+        int i;
+        for (i = 0; i < nw; i++) W->pos[i] = (int64_t)(16.0 * (base + W->d[i]));
+        E->win_rec[nr] = INT_MAX; /* the list's end */
+        hf_window_line(W, nw, E->win_rw, 0, E->win_rec);
+        for (i = 0; i < nr; i++) E->tan[E->win_tan[i]] = W->t[E->win_rec[i]] * scale;
+    }
+}
+
+/* Is grid index i inside the receiver rectangle? */
+static int hf_exact_receiver(const hf_exact *E, size_t i)
+{
+    int x = (int)(i % (size_t)E->g->width), y = (int)(i / (size_t)E->g->width);
+    return x >= E->rx0 && x < E->rx1 && y >= E->ry0 && y < E->ry1;
+}
+
+/* The window of a finite radius R (world units) in 1/16 sub-steps: scale is the tangent factor
+ * L/(|(a, b)| cell) of hf_exact_geometry, so R scale sub-steps span R; every sample distance is
+ * a multiple of 1/16 sub-step (a crossing: whole sub-steps; a piece sample: j/m of a piece,
+ * m <= HF_EXACT_MAX_SPLIT), so "16 distance <= floor(16 R scale)" is exact. */
+static int64_t hf_exact_window(double radius, double scale)
+{
+    return hf_radius_units(16.0 * (radius * scale));
 }
 
 /* Tangents of every grid point toward ray r into E->tan (-INFINITY: no terrain, NaN: hole).
@@ -7902,6 +8331,7 @@ static void hf_exact_sweep(hf_exact *E, hf_ray r)
     const hfvis_grid *g = E->g;
     double L, scale;
     int P = hf_exact_geometry(E->cross, g, r.a, r.b, &L, &scale), x, y;
+    E->win_rw = E->radius > 0.0 ? hf_exact_window(E->radius, scale) : -1;
     for (y = 0; y < g->height; y++) {
         int xlo, xhi;
         if (y + r.b < 0 || y + r.b >= g->height) {
@@ -7922,10 +8352,11 @@ static void hf_exact_sweep(hf_exact *E, hf_ray r)
     }
 }
 
-/* Oracle twin of hf_exact_sweep for one receiver: every crossing of its own ray, the same
- * heights and quotients, the largest kept. */
+/* Oracle twin of hf_exact_sweep for one receiver: every crossing of its own ray within the
+ * window rw (1/16 sub-steps, hf_exact_window; -1 = unlimited), the same heights and quotients,
+ * the largest kept. */
 static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, const hf_cross *cr,
-                             int P, double L, double scale, int a, int b, int x, int y)
+                             int P, double L, double scale, int a, int b, int x, int y, int64_t rw)
 {
     double hr = (double)g->z[(ptrdiff_t)y * g->stride + x], best = -HF_INF;
     int k, e, kmax = hf_exact_periods(g, R, x, y, a, b);
@@ -7937,10 +8368,12 @@ static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, co
             int np = hf_piece_samples(g, NULL, x + k * a, y + k * b, cr + e, ph, pu);
             for (j = 0; j < np; j++) {
                 if (isnan(ph[j])) continue;
+                if (rw >= 0 && 16.0 * ((double)k * L + (cr[e].u + pu[j])) > (double)rw) continue;
                 s = (ph[j] - hr) / ((double)k * L + (cr[e].u + pu[j])) * scale;
                 if (s > best) best = s;
             }
             if ((k == 0 && e == 0) || !hf_cross_inside(g, R, X, Y, cr + e)) continue;
+            if (rw >= 0 && 16.0 * ((double)k * L + cr[e].u) > (double)rw) continue;
             h = hf_cross_height(g, border, X, Y, cr + e);
             if (isnan(h)) continue;
             s = (h - hr) / ((double)k * L + cr[e].u) * scale;
@@ -7957,6 +8390,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
                                   int channels)
 {
     size_t total = 0, off_ray, off_d, off_c, off_s, off_t = 0, off_w, off_n = 0, off_a = 0, gridn, cap;
+    size_t off_win = 0, off_wt = 0, off_wr = 0;
     int ok = 1, k, maxp = 1, side = g->width > g->height ? g->width : g->height;
     unsigned char *blk;
     memset(E, 0, sizeof *E);
@@ -7968,6 +8402,12 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     E->alloc = o->alloc;
     if (E->N > HFVIS_RAY_DENOMINATOR_MAX) return HFVIS_ERR_INVALID_ARGUMENT;
     if ((double)side + 2.0 * (double)E->R + 3.0 > (double)INT_MAX / 2.0) return HFVIS_ERR_LIMIT;
+    /* a radius: sample positions (16 x sub-steps along the raster's lines) must stay exact */
+    if (hf_radius_on(o) &&
+        16.0 * (2.0 * ((double)o->origin_x + (double)o->origin_y + (double)o->extent_width +
+                       (double)o->extent_height + 2.0 * (double)side + 4.0 * (double)E->R) + 4.0) *
+                (double)E->N * (double)E->N > 4503599627370496.0)
+        return HFVIS_ERR_LIMIT;
     for (k = 0; k < K; k++) {
         hf_ray r = hf_ray_nearest(o->azimuth0_rad + 2.0 * HF_PI * (double)k / (double)K, E->N);
         int p = (r.a < 0 ? -r.a : r.a) + (r.b < 0 ? -r.b : r.b) - 1;
@@ -7986,6 +8426,17 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     off_w = hf_align_add(&total, gridn, sizeof(double), &ok);
     if (want_normals) off_n = hf_align_add(&total, gridn, 3u * sizeof(float), &ok);
     if (channels) off_a = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
+    E->radius = hf_radius_on(o) ? o->max_distance : 0.0;
+    E->win_rw = -1;
+    E->ox = o->origin_x;
+    E->oy = o->origin_y;
+    hf_receiver_rect(g, o, &E->rx0, &E->ry0, &E->rx1, &E->ry1);
+    E->rect = E->rx0 > 0 || E->ry0 > 0 || E->rx1 < g->width || E->ry1 < g->height;
+    if (E->radius > 0.0) {
+        off_win = hf_align_add(&total, cap, HF_WIN_BYTES_PER_SAMPLE, &ok);
+        off_wt = hf_align_add(&total, cap, sizeof(size_t), &ok);
+        off_wr = hf_align_add(&total, cap + 1, sizeof(int), &ok);
+    }
     if (!ok) return HFVIS_ERR_LIMIT;
     blk = (unsigned char *)hf_alloc(o->alloc, total);
     if (!blk) return HFVIS_ERR_OUT_OF_MEMORY;
@@ -8010,6 +8461,11 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     }
     E->nrm = want_normals ? (float *)(void *)(blk + off_n) : NULL;
     E->acc = channels ? (double *)(void *)(blk + off_a) : NULL;
+    if (E->radius > 0.0) {
+        hf_win_carve(&E->win, blk + off_win, cap);
+        E->win_tan = (size_t *)(void *)(blk + off_wt);
+        E->win_rec = (int *)(void *)(blk + off_wr);
+    }
     hf_exact_dirs_fill(&E->d, K, o->azimuth0_rad, E->N);
     if (want_normals) (void)hfvis_normals_compute(g, E->nrm); /* the grid normals, as floats */
     if (channels) memset(E->acc, 0, gridn * (size_t)channels * sizeof(double));
@@ -8025,7 +8481,7 @@ static hfvis_status hf_exact_horizon_map(const hfvis_grid *g, int K, const hfvis
     hf_exact E;
     hfvis_status s;
     size_t plane = hf_grid_count(g), i;
-    int k, done = 0;
+    int k, done = 0, x, y;
     if ((s = hf_exact_init(&E, g, K, o, 1, 0, 0)) != HFVIS_OK) return s;
     for (k = 0; k < K; k++) {
         int pos = hf_direction_position(o, K, k);
@@ -8033,7 +8489,11 @@ static hfvis_status hf_exact_horizon_map(const hfvis_grid *g, int K, const hfvis
         if (pos < begin || pos >= end) continue;
         hf_exact_sweep(&E, E.d.ray[k]);
         p = out + (size_t)(pos - begin) * plane;
-        for (i = 0; i < plane; i++) p[i] = (float)hf_tan_to_elevation(E.tan[i]);
+        for (y = E.ry0; y < E.ry1; y++)
+            for (x = E.rx0; x < E.rx1; x++) {
+                i = (size_t)y * (size_t)g->width + (size_t)x;
+                p[i] = (float)hf_tan_to_elevation(E.tan[i]);
+            }
         hf_progress(o, ++done, end - begin);
     }
     hf_exact_free(&E);
@@ -8049,8 +8509,8 @@ static hfvis_status hf_exact_horizon_direction(const hfvis_grid *g, int K, int k
     int x, y;
     if ((s = hf_exact_init(&E, g, K, o, 1, 0, 0)) != HFVIS_OK) return s;
     hf_exact_sweep(&E, E.d.ray[k]);
-    for (y = 0; y < g->height; y++)
-        for (x = 0; x < g->width; x++)
+    for (y = E.ry0; y < E.ry1; y++)
+        for (x = E.rx0; x < E.rx1; x++)
             out[(ptrdiff_t)y * out_stride + x] =
                 (float)hf_tan_to_elevation(E.tan[(size_t)y * (size_t)g->width + (size_t)x]);
     hf_exact_free(&E);
@@ -8138,7 +8598,7 @@ static hfvis_status hf_exact_sums(hf_exact *E, const hfvis_grid *g, int K, hfvis
         for (i = 0; i < n; i++) {
             double t = E->tan[i];
             const float *nr = E->nrm ? E->nrm + i * 3 : NULL;
-            if (isnan(t)) continue;
+            if (isnan(t) || (E->rect && !hf_exact_receiver(E, i))) continue;
             if (kind == HFVIS_SUM_SKY_VIEW) E->acc[i] += wk * hf_svf_term(t);
             else if (kind == HFVIS_SUM_SKY_LIGHT) E->acc[i] += hf_exact_sky_term(&E->d, k, cp, sp, nr, t);
             else
@@ -8157,8 +8617,8 @@ static void hf_exact_output(const hf_exact *E, double scale, double offset, floa
 {
     const hfvis_grid *g = E->g;
     int x, y, c, ch = E->channels;
-    for (y = 0; y < g->height; y++)
-        for (x = 0; x < g->width; x++) {
+    for (y = E->ry0; y < E->ry1; y++)
+        for (x = E->rx0; x < E->rx1; x++) {
             const double *a = E->acc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)ch;
             float *p = out + ((ptrdiff_t)y * out_stride + x) * ch;
             int hole = hf_is_hole(g, x, y);
@@ -8200,8 +8660,8 @@ static hfvis_status hf_exact_sun(const hfvis_grid *g, double azimuth, double ele
     o1.azimuth0_rad = azimuth;
     if ((s = hf_exact_init(&E, g, 1, &o1, 1, 0, 0)) != HFVIS_OK) return s;
     hf_exact_sweep(&E, E.d.ray[0]);
-    for (y = 0; y < g->height; y++)
-        for (x = 0; x < g->width; x++) {
+    for (y = E.ry0; y < E.ry1; y++)
+        for (x = E.rx0; x < E.rx1; x++) {
             double t = E.tan[(size_t)y * (size_t)g->width + (size_t)x];
             out[(ptrdiff_t)y * out_stride + x] =
                 (float)hf_sun_fraction(elevation, radius, hf_tan_to_elevation(t));
@@ -8285,7 +8745,8 @@ hfvis_status hfvis_horizon_exact_naive(const hfvis_grid *grid, int K,
         for (y = 0; y < grid->height; y++)
             for (x = 0; x < grid->width; x++)
                 p[(size_t)y * (size_t)grid->width + (size_t)x] = (float)hf_tan_to_elevation(
-                    hf_exact_march(grid, o.border, R, cr, P, L, scale, r.a, r.b, x, y));
+                    hf_exact_march(grid, o.border, R, cr, P, L, scale, r.a, r.b, x, y,
+                                   hf_radius_on(&o) ? hf_exact_window(o.max_distance, scale) : -1));
         hf_progress(&o, ++done, end - begin);
     }
     hf_free(o.alloc, cr);
@@ -8301,8 +8762,8 @@ static hfvis_status hf_exact_direction_sums(const hfvis_grid *g, int K, hfvis_su
     hfvis_status s;
     int x, y, c;
     if ((s = hf_exact_sums(&E, g, K, kind, env, eopts, o, begin, end)) != HFVIS_OK) return s;
-    for (y = 0; y < g->height; y++)
-        for (x = 0; x < g->width; x++) {
+    for (y = E.ry0; y < E.ry1; y++)
+        for (x = E.rx0; x < E.rx1; x++) {
             size_t i = ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)E.channels;
             int hole = hf_is_hole(g, x, y);
             for (c = 0; c < E.channels; c++) sums[i + (size_t)c] = hole ? HF_NAN : E.acc[i + (size_t)c];

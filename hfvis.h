@@ -478,6 +478,9 @@ typedef struct hfvis_lattice {
     double ux, uy, vx, vy;      /* unit vectors, snapped to exact 0/+-1 on the axes */
     int i_min, i_max, j_min, j_max;
     int width, height;          /* of the grid */
+    double origin_x, origin_y;  /* tiles: node (i, j) lies at raster position i*u + j*v, grid
+                                   position that minus this (the sweep options' origin_x/y);
+                                   0, 0 from hfvis_lattice_init */
 } hfvis_lattice;
 
 /* Set up the lattice of look direction azimuth_rad over a width x height grid. The domain is
@@ -546,19 +549,34 @@ typedef struct hfvis_sweep_options {
                                        1..HFVIS_RAY_DENOMINATOR_MAX; 0 = max(5, ceil(K/4)), and 64
                                        for a single direction (K = 1, hfvis_sun_visibility) */
     double max_distance;            /* R, world units: occluders farther than R from the receiver,
-                                       measured along the ray, are ignored; 0 = unlimited
-                                       (default), +INFINITY the same; < 0 or NaN is
-                                       HFVIS_ERR_INVALID_ARGUMENT. See "Search radius and tiles" */
+                                       measured horizontally along the ray, are ignored; 0 =
+                                       unlimited (default), +INFINITY the same (today's sweep bit
+                                       for bit); < 0 or NaN is HFVIS_ERR_INVALID_ARGUMENT. See
+                                       "Search radius and tiles" */
     int origin_x, origin_y;         /* tiles: this grid is a window of a larger raster whose cell
-                                       (origin_x, origin_y) is this grid's (0, 0); default 0, 0 */
-    int extent_width, extent_height;/* that raster's size in cells; 0, 0 = this grid is the
-                                       whole raster (default) */
-    int receiver_x, receiver_y;     /* compute only the receivers in this rectangle of the grid; */
+                                       (origin_x, origin_y) is this grid's (0, 0); default 0, 0
+                                       (must be 0, 0 when extent is 0, 0) */
+    int extent_width, extent_height;/* that raster's size in cells (origin + grid size must fit
+                                       in it); 0, 0 = this grid is the whole raster (default). A
+                                       proper window needs a finite max_distance and the open
+                                       border, else HFVIS_ERR_INVALID_ARGUMENT */
+    int receiver_x, receiver_y;     /* compute only the receivers in this rectangle of the grid
+                                       (inside it, else HFVIS_ERR_INVALID_ARGUMENT); */
     int receiver_width, receiver_height; /* 0, 0 = every receiver (default); outputs outside it
-                                       are left unwritten */
+                                       are left unwritten; the work shrinks with it */
 } hfvis_sweep_options;
 
 HFVIS_API hfvis_sweep_options hfvis_sweep_options_default(void);
+
+/* The halo, in cells, that a tile of a run with search radius max_distance (world units, finite
+ * and > 0), cell size cell_size and ray mode rays must carry on every side of its receiver
+ * window for its outputs to equal the whole run's bit for bit (hfvis.h, "Search radius and
+ * tiles"): ceil(max_distance / cell_size) + HFVIS_TILE_HALO_LATTICE (lattice mode) or
+ * + HFVIS_TILE_HALO_EXACT (exact rays). Clip the window plus halo to the raster. Returns -1 for
+ * an unlimited or invalid radius or cell size, or a halo beyond INT_MAX. */
+#define HFVIS_TILE_HALO_LATTICE 5 /* gather nodes within 3 cells, their taps and normals 2 more */
+#define HFVIS_TILE_HALO_EXACT 2   /* a crossing's or piece's second tap 1 more, normals 1 */
+HFVIS_API int hfvis_tile_halo(double max_distance, double cell_size, hfvis_ray_mode rays);
 
 /* The P1 hull stack along one line (Alg. 1 with the A.1 erratum fixed; ties pop).
  * For samples (distance[i], height[i]) with strictly increasing distance, writes
@@ -728,6 +746,72 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *   - Accuracy: against the exact maximum over the bilinear surface (occluders >= 1 cell away)
  *     the exact mode is within 0.004 deg mean and 0.08 deg p99 on urban boxes, terraces with
  *     one-cell cliffs and fBm (the lattice: 1-5 deg mean, 11-35 deg p99); docs/exact-rays.md. */
+
+/* ========================================================================================== */
+/* hfvis.c - search radius and tiles                                                          */
+/* ========================================================================================== */
+/* A maximum search distance R (hfvis_sweep_options.max_distance, world units) and tiled runs:
+ * a raster too large for one run is cut into windows, each run on its window plus a halo, and
+ * the pieces equal the whole run bit for bit (the GIS tools' radius: GRASS r.horizon
+ * maxdistance, SAGA and RVT radius, WhiteboxTools max_dist).
+ *   - What R means. Exact rays: every sample (crossing or piece sample) whose horizontal
+ *     distance from the receiver along its ray is at most R occludes, no other; distances are
+ *     compared in 1/16 sub-steps of hfvis.h "Exact rays", exactly (floor(16 R L/(|(a, b)| cell))
+ *     with L the sub-steps per step). Lattice mode: every lattice node sees the nodes of its line
+ *     at most floor(R / cell_size) node steps behind it (the lattice spacing is one cell); the
+ *     receiver's value is the usual gather of its nodes (docs/errata.md E7), so its own cut-off
+ *     is R blended over the nodes within 1.5 cells. R below one cell: the lattice sees nothing
+ *     (-pi/2 everywhere but holes), exact rays still see the crossings nearer than R. R beyond
+ *     the field equals the unlimited run to the hull's rounding. With CLAMP/WRAP the border
+ *     samples count like any other within R.
+ *   - How ([P1] §5, Alg. 1 needs more: its hull answers "the highest over everything behind").
+ *     Every line is cut into blocks of length R anchored at multiples of R of the raster's line
+ *     coordinate (so a tile and the whole raster cut at the same places). A receiver in block b
+ *     sees (i) the samples of block b before it: the Alg. 1 hull stack restarted at each block
+ *     start, and (ii) the suffix of block b - 1 within R: the upper hull of block b - 1, built
+ *     once right to left with an undo log (insertion: its stack height and the slot it
+ *     overwrote) and undone one insertion at a time as the window start advances, queried by
+ *     binary search for the vertex of greatest slope. The answer is the larger of the two; the
+ *     query is skipped when the suffix's highest sample cannot beat (i) (an exact bound).
+ *   - Cost: O(1) amortised per sample plus O(log h) per query (h the suffix hull's size), so it
+ *     does not grow with R beyond that log; about 3 hull operations per sample where the
+ *     unlimited sweep does 1. Measured (make bench, section radius; fBm, K = 16, sky-view factor,
+ *     2-core machine under load): lattice 1024^2 1.3-1.7x the unlimited sweep's time at R = 16 to
+ *     1024 cells, exact rays 512^2 1.4-2.3x (1.65-1.8x at R = 256). R = 0 or +INFINITY is the
+ *     unlimited sweep's code path, bit for bit.
+ *   - Memory: one line's window scratch, 92 bytes per sample of the longest line (lattice:
+ *     about the grid diagonal; exact rays: the hull stack's length, plus 12 bytes per sample).
+ *   - Tiles. Set origin_x/y to the grid's place in the raster, extent_width/height to the
+ *     raster's size and receiver_* to the window inside the grid. Everything that depends on
+ *     position is computed in raster coordinates: lattice nodes lie at raster positions
+ *     i*u + j*v (hfvis_lattice.origin_x/y; the quarter turns of [P1] §7 likewise), the gathers
+ *     and the open-border test read raster coordinates, exact-ray lines are numbered by the
+ *     raster's grid points, and block boundaries are raster positions. A window needs a finite R
+ *     (without R every receiver may see the whole raster: HFVIS_ERR_INVALID_ARGUMENT) and the
+ *     open border (the border of a window is not the raster's).
+ *   - Halo rule: read the window plus hfvis_tile_halo(R, cell_size, rays) cells on every side,
+ *     clipped to the raster: ceil(R/cell) + 5 in lattice mode (the gather reads nodes within
+ *     3 cells, their bilinear taps and normals 2 more), ceil(R/cell) + 2 with exact rays (a
+ *     sample's second tap and the receiver's normal). The receivers of the window then equal the
+ *     whole run's bit for bit (test/test_tiles.c checks sky-view factor, sky light, horizon map
+ *     and sun visibility, both modes, on uneven windows down to one cell wide).
+ *   - The receiver rectangle on its own works with any R and border: only its receivers are
+ *     computed (lattice lines are cut to the nodes within 4 cells of it, exact-ray lines stop at
+ *     their last receiver in it) and the rest of the output is left as it was.
+ *   - Where it applies: hfvis_horizon_map, hfvis_horizon_direction, hfvis_sky_light,
+ *     hfvis_sky_view_factor, hfvis_env_light, hfvis_sun_visibility, hfvis_direct_light,
+ *     hfvis_direction_sums (sky view, sky light, environment), both modes. R also applies to hfvis_horizon_lattice(_naive)
+ *     (no window: its nodes are those of hfvis_lattice_init; the rectangle is ignored) and to
+ *     the oracles. Refused with HFVIS_ERR_INVALID_ARGUMENT (R, a window or a rectangle): the P2
+ *     hull-tree routines (hfvis_intervisibility, hfvis_visibility_count, hfvis_indirect_light,
+ *     hfvis_terrain_gi, their oracles, the visibility sums) and hfvis_openness (it has its own
+ *     radius).
+ *   - Oracles, same cut-off: hfvis_horizon_lattice_naive (every node scans the nodes within R
+ *     behind it) and hfvis_horizon_exact_naive (every receiver's own samples within R), held to
+ *     the sweep bit for bit on the test fields (tolerance 1e-12 rad for last-bit ties of the
+ *     hull's cross products); hfvis_horizon_reference marches out to min(R, max_distance_cells).
+ *     The oracles compute every receiver (the rectangle and origin do not change their values).
+ *   - Design notes and figures: docs/search-radius.md. */
 
 /* The K azimuths actually used by a run with these options (radians; azimuths[k] is plane k of
  * hfvis_horizon_map, index order) and their quadrature weights (each direction's share of the

@@ -74,6 +74,7 @@
     X(lattice_size, V, -, "N", "0") \
     X(lattice_line, V, -, "NR", "0") \
     X(sweep_options_default, P, -, "", "cannot fail") \
+    X(tile_halo, V, -, "ZGFE", "-1") \
     X(line_horizons, S, -, "NGFR", "INVALID_ARGUMENT") \
     X(line_horizons_naive, S, -, "NGFR", "INVALID_ARGUMENT") \
     X(horizon_lattice, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
@@ -591,6 +592,13 @@ static void teardown(void)
     bo = hfvis_sweep_options_default(); bo.rays = (hfvis_ray_mode)2; BAD('E', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.ray_denominator = -1; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.ray_denominator = HFVIS_RAY_DENOMINATOR_MAX + 1; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.max_distance = -1.0; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.max_distance = (double)NAN; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.origin_x = -1; bo.extent_width = bo.extent_height = 99; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.origin_y = 1; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.extent_width = 5; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.receiver_width = -1; bo.receiver_height = 1; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.receiver_height = 1; BAD('S', INV, expr); \
     } while (0)
 
 /* ========================================================================================== */
@@ -1035,6 +1043,20 @@ static void args_lattice_size(void)
     begin("lattice_size");
     CHECK(hfvis_lattice_init(&L, GW, GH, 0.3) == HFVIS_OK && hfvis_lattice_size(&L) > 0);
     BADV('N', hfvis_lattice_size(NULL) == 0);
+}
+
+static void args_tile_halo(void)
+{
+    begin("tile_halo");
+    CHECK(hfvis_tile_halo(10.0, 2.0, HFVIS_RAYS_LATTICE) == 5 + HFVIS_TILE_HALO_LATTICE);
+    CHECK(hfvis_tile_halo(10.5, 2.0, HFVIS_RAYS_EXACT) == 6 + HFVIS_TILE_HALO_EXACT);
+    BADV('Z', hfvis_tile_halo(0.0, 1.0, HFVIS_RAYS_LATTICE) == -1);
+    BADV('Z', hfvis_tile_halo(1.0, 0.0, HFVIS_RAYS_LATTICE) == -1);
+    BADV('G', hfvis_tile_halo(-1.0, 1.0, HFVIS_RAYS_LATTICE) == -1);
+    BADV('F', hfvis_tile_halo((double)INFINITY, 1.0, HFVIS_RAYS_LATTICE) == -1);
+    BADV('F', hfvis_tile_halo((double)NAN, 1.0, HFVIS_RAYS_EXACT) == -1);
+    BADV('F', hfvis_tile_halo(1e300, 1e-300, HFVIS_RAYS_EXACT) == -1);
+    BADV('E', hfvis_tile_halo(1.0, 1.0, (hfvis_ray_mode)7) == -1);
 }
 
 static void args_lattice_line(void)
