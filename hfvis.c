@@ -2400,7 +2400,8 @@ static void hf_gather_elevations(const hf_sweep *sw, int ch, const hf_gather *G,
 static int hf_gather_elevations_inside(const hf_sweep *sw, int ch, int x, int y, double *out)
 {
     const hfvis_lattice *L = &sw->L;
-    double a = (double)x * L->ux + (double)y * L->uy, b = (double)x * L->vx + (double)y * L->vy;
+    double gx = (double)x + sw->ox, gy = (double)y + sw->oy; /* raster coordinates (tiles) */
+    double a = gx * L->ux + gy * L->uy, b = gx * L->vx + gy * L->vy;
     double wa, wb, w0, w1, w2, w3, wsum;
     const double *p;
     ptrdiff_t cols = sw->cols;

@@ -1393,8 +1393,9 @@ static int cli_gis_finish(cli_args *a)
                  | CLI_ONLY(CMD_HILLSHADE)) /* the sun flags */
 /* the sweep commands: --max-distance R is the library's search radius, --window makes a piece */
 #define CLI_SWEEP (CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_SHADOW) \
-                   | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_INDIRECT)         \
-                   | CLI_ONLY(CMD_HILLSHADE))
+                   | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_HILLSHADE))
+/* the [P2] hull-tree commands: no search radius in the library (hfvis.h, "Search radius and tiles") */
+#define CLI_P2 (CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_INDIRECT))
 /* the height-field commands: the GIS conventions apply to them */
 #define CLI_HF (CLI_ALL & ~(CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_VOLGI) \
                             | CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_MESHAO) | CLI_ONLY(CMD_SUM)))
@@ -1730,6 +1731,11 @@ static int cli_parse(int argc, char **argv, cli_args *a)
         if (k == sizeof cli_flags / sizeof cli_flags[0])
             return cli_error(CLI_EXIT_USAGE, name, "unknown option (see 'hfvis %s --help')",
                              cli_cmd_names[a->cmd]);
+        if ((CLI_ONLY(a->cmd) & CLI_P2) && (!strcmp(name, "--max-distance") || !strcmp(name, "--window")))
+            return cli_error(CLI_EXIT_USAGE, name, "'%s' counts visibility over whole lines with the "
+                             "[P2] hull tree, which has no search radius, so it cannot be cut into "
+                             "windows either; run it whole (or split it with --dir-range)",
+                             cli_cmd_names[a->cmd]);
         if (!(cli_flags[k].commands & CLI_ONLY(a->cmd)))
             return cli_error(CLI_EXIT_USAGE, name, "not an option of '%s' (see 'hfvis %s --help')",
                              cli_cmd_names[a->cmd], cli_cmd_names[a->cmd]);
@@ -2008,17 +2014,22 @@ static int cli_check_cost(const cli_args *a, int w, int h, int channels)
 }
 
 /* The halo of a window run, in cells: every input cell a receiver of the window can depend on
- * lies within it. A sweep with search radius R reads heights up to R along the ray, plus one
- * cell for the bilinear gather of the lattice: ceil(R / cell) + 1. indirect adds R per bounce
- * (bounce b gathers light that the terrain up to b R away received); openness marches --radius.
- * The one place the rule lives (the library's own rule replaces it if it ever differs). */
+ * lies within it. The sweeps use the library's rule (hfvis_tile_halo: ceil(R / cell) plus the
+ * cells of the gather and the normals, by ray mode); indirect multiplies the radius by the
+ * bounces + 1 (bounce b gathers light that the terrain up to b R away received); openness
+ * marches --radius, plus one cell for its bilinear taps. */
 static int cli_halo(const cli_args *a, double cell)
 {
+    const hfvis_ray_mode rays = a->exact && a->cmd != CMD_VIEWSHED ? HFVIS_RAYS_EXACT : HFVIS_RAYS_LATTICE;
     double r = a->cmd == CMD_OPENNESS ? a->radius : a->max_distance, h;
-    h = ceil(r / cell);
-    if (a->cmd == CMD_INDIRECT) h *= (double)((a->output == OUT_DIRECT ? 0 : a->bounces) + 1);
-    h += 1.0;
-    return h < (double)HFVIS_IMAGE_MAX_DIM ? (int)h : HFVIS_IMAGE_MAX_DIM;
+    int halo;
+    if (a->cmd == CMD_OPENNESS) {
+        h = ceil(r / cell) + 1.0;
+        return h < (double)HFVIS_IMAGE_MAX_DIM ? (int)h : HFVIS_IMAGE_MAX_DIM;
+    }
+    if (a->cmd == CMD_INDIRECT) r *= (double)((a->output == OUT_DIRECT ? 0 : a->bounces) + 1);
+    halo = hfvis_tile_halo(r, cell, rays);
+    return halo >= 0 && halo < HFVIS_IMAGE_MAX_DIM ? halo : HFVIS_IMAGE_MAX_DIM;
 }
 
 /* The largest side S of a square window whose grid, S + 2 halo (clipped to the w x h raster) on
@@ -4555,7 +4566,12 @@ static int cli_run(const cli_args *a)
     opts.azimuth0_rad = a->compass ? a->azimuth0 - CLI_PI / 2.0 : a->azimuth0;
     if (a->exact && a->cmd != CMD_VIEWSHED) opts.rays = HFVIS_RAYS_EXACT;
     if (a->cmd != CMD_VIEWSHED) opts.max_distance = a->max_distance; /* viewshed: its own range */
-    if (cli_win.active) { /* the grid is window + halo of the raster; compute the window */
+    if (cli_win.active && a->cmd == CMD_OPENNESS) {
+        /* openness marches --radius per receiver: the halo holds every cell a window receiver
+         * reaches, and the window + halo grid's own border is the raster's wherever a march can
+         * meet it, so it runs as a plain grid (the library refuses a window for it) */
+        cli_piece_tag(a, &grid, &opts);
+    } else if (cli_win.active) { /* the grid is window + halo of the raster; compute the window */
         opts.origin_x = cli_win.gx0, opts.origin_y = cli_win.gy0;
         opts.extent_width = cli_win.ext_w, opts.extent_height = cli_win.ext_h;
         if (a->cmd != CMD_INDIRECT) { /* indirect's bounces need every point of the grid */
