@@ -29,6 +29,7 @@
  * Paper references: [P1] Timonen & Westerholm, "Scalable Height Field Self-Shadowing",
  * CGF 29(2), 2010 (thesis appendix A.1). Errata and choices: docs/errata.md E1-E18.
  */
+#define HFVIS__INTERNAL /* the internal block of hfvis.h: shared helpers, not API */
 #include "hfvis.h"
 
 #include <float.h>
@@ -165,6 +166,94 @@ static void *hf_alloc_array(const hfvis_allocator *a, size_t count, size_t elem)
     size_t bytes;
     if (!hf_mul_size(count, elem, &bytes)) return NULL;
     return hf_alloc(a, bytes);
+}
+
+/* The library's one copy of the allocation, checked-size and PRNG helpers (declared in the
+ * internal block of hfvis.h, used by all three .c files). */
+void *hfvis__alloc(const hfvis_allocator *a, size_t bytes)
+{
+    if (bytes == 0) return NULL;
+    if (a && a->alloc) return a->alloc(a->user, bytes);
+    return HFVIS_MALLOC(bytes);
+}
+
+void hfvis__free(const hfvis_allocator *a, void *p)
+{
+    if (!p) return;
+    if (a && a->alloc) {
+        if (a->free) a->free(a->user, p);
+        return;
+    }
+    HFVIS_FREE(p);
+}
+
+int hfvis__mul_size(size_t a, size_t b, size_t *out)
+{
+    if (a != 0 && b > SIZE_MAX / a) return 0;
+    *out = a * b;
+    return 1;
+}
+
+void *hfvis__alloc_array(const hfvis_allocator *a, size_t count, size_t elem)
+{
+    size_t bytes;
+    if (!hfvis__mul_size(count, elem, &bytes)) return NULL;
+    return hfvis__alloc(a, bytes);
+}
+
+int hfvis__plane_fits(ptrdiff_t stride, int height, int floats_per_pixel)
+{
+    return stride >= 1 && floats_per_pixel >= 1 &&
+           (size_t)height <= (size_t)PTRDIFF_MAX / ((size_t)floats_per_pixel * sizeof(float)) / (size_t)stride;
+}
+
+uint64_t hfvis__mix64(uint64_t x)
+{
+    x += 0x9E3779B97F4A7C15ull;
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+    return x ^ (x >> 31);
+}
+
+uint64_t hfvis__splitmix64(uint64_t *state)
+{
+    uint64_t z = hfvis__mix64(*state);
+    *state += 0x9E3779B97F4A7C15ull;
+    return z;
+}
+
+uint32_t hfvis__pcg32_next(hfvis__pcg32 *g)
+{
+    uint64_t old = g->state;
+    uint32_t xs, rot;
+    g->state = old * 6364136223846793005ull + g->inc;
+    xs = (uint32_t)(((old >> 18) ^ old) >> 27);
+    rot = (uint32_t)(old >> 59);
+    return (xs >> rot) | (xs << ((32u - rot) & 31u));
+}
+
+/* pcg32_srandom_r: stream selects the increment, seed the start. */
+void hfvis__pcg32_seed(hfvis__pcg32 *g, uint64_t seed, uint64_t stream)
+{
+    g->state = 0;
+    g->inc = (stream << 1) | 1u;
+    (void)hfvis__pcg32_next(g);
+    g->state += seed;
+    (void)hfvis__pcg32_next(g);
+}
+
+double hfvis__pcg32_unit(hfvis__pcg32 *g)
+{
+    uint64_t hi = hfvis__pcg32_next(g) >> 5, lo = hfvis__pcg32_next(g) >> 6;
+    return ((double)hi * 67108864.0 + (double)lo) * (1.0 / 9007199254740992.0);
+}
+
+/* Rejection below 2^32 mod n keeps every residue equally likely. */
+uint32_t hfvis__pcg32_below(hfvis__pcg32 *g, uint32_t n)
+{
+    uint32_t limit = (uint32_t)(0u - n) % n, x;
+    do x = hfvis__pcg32_next(g); while (x < limit);
+    return x % n;
 }
 
 static int hf_grid_valid(const hfvis_grid *g)
@@ -745,16 +834,6 @@ HFVIS_API hfvis_status hfvis_pgm_range_decode(const void *data, size_t size, flo
 }
 
 #ifndef HFVIS_NO_STDIO
-/* Internal, shared with voxel.c (not API; declared again there). A sizer looks at the first
- * bytes of a file (at most HFVIS__READ_HEAD, fewer if the file is shorter) and sets *total to
- * the exact size its header announces or HFVIS__READ_ALL (a text format: read to the end), or
- * returns the decoder's error for the header (refused before anything more is read). */
-#define HFVIS__READ_HEAD ((size_t)1 << 16)
-#define HFVIS__READ_ALL ((size_t)-1)
-typedef hfvis_status (*hfvis__sizer)(const unsigned char *head, size_t n, size_t *total);
-hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, hfvis__sizer sizer,
-                             unsigned char **data, size_t *size);
-
 /* Reads a file into a block from alloc: the head first; when the sizer announces a size, exactly
  * that many bytes and one more (so that trailing data reaches the decoder, which refuses it or
  * ignores it as its format says), and a file shorter than announced is HFVIS_ERR_FORMAT without

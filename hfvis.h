@@ -5553,6 +5553,77 @@ HFVIS_API hfvis_status hfvis_lk_image(hfvis_lk_method method, const hfvis_mesh *
                                       const hfvis_lk_rays *rays, const hfvis_lk_options *opts,
                                       uint32_t *masks, float *obscurance, hfvis_lk_stats *stats);
 
+/* ========================================================================================== */
+/* Internal (not API): shared by hfvis.c, ssao.c and voxel.c                                  */
+/* ========================================================================================== */
+/* Seen only by the library's own .c files, which define HFVIS__INTERNAL before including this
+ * header; user code never sees it and must not rely on it. Everything is defined once, in
+ * hfvis.c section 1 (Common) and section 2 (file reading), so ssao.c and voxel.c need hfvis.c,
+ * as the vendoring note at the top says. */
+#ifdef HFVIS__INTERNAL
+#ifndef HFVIS__INTERNAL_H
+#define HFVIS__INTERNAL_H
+#include <math.h>
+
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#endif
+
+#ifndef HFVIS_ASSERT
+#ifdef HFVIS_ENABLE_ASSERTS
+#include <assert.h>
+#define HFVIS_ASSERT(x) assert(x)
+#else
+#define HFVIS_ASSERT(x) ((void)0)
+#endif
+#endif
+
+#define HFVIS__PI 3.14159265358979323846
+#define HFVIS__HALF_PI 1.57079632679489661923
+#define HFVIS__NAN ((double)NAN)
+#define HFVIS__INF ((double)INFINITY)
+
+/* Allocation (hfvis.h "Memory"): bytes from a->alloc, or from HFVIS_MALLOC when a is NULL or has
+ * no alloc; NULL for 0 bytes or on failure. hfvis__free returns p to where hfvis__alloc took it
+ * from: a->free when a->alloc is set (nothing when that free is NULL), else HFVIS_FREE, whatever
+ * a->free says (memory from an allocator without alloc came from HFVIS_MALLOC). */
+void *hfvis__alloc(const hfvis_allocator *a, size_t bytes);
+void hfvis__free(const hfvis_allocator *a, void *p);
+/* *out = a*b; 0 (and *out untouched) on overflow (stb's mul2sizes_valid). */
+int hfvis__mul_size(size_t a, size_t b, size_t *out);
+/* count*elem bytes from hfvis__alloc; NULL on overflow, failure or a zero size. */
+void *hfvis__alloc_array(const hfvis_allocator *a, size_t count, size_t elem);
+/* 1 if a caller plane of `height` rows `stride` pixels apart (stride >= 1), floats_per_pixel
+ * floats a pixel, is addressable: every (y*stride + x)*floats_per_pixel stays below PTRDIFF_MAX
+ * bytes. */
+int hfvis__plane_fits(ptrdiff_t stride, int height, int floats_per_pixel);
+
+/* The library's PRNGs: stateless SplitMix64 (Steele, Lea, Flood 2014) hashing, its stateful
+ * stream, and PCG32 (O'Neill 2014, XSH-RR). No global state; every stream is seeded. */
+uint64_t hfvis__mix64(uint64_t x);           /* the SplitMix64 output of state x */
+uint64_t hfvis__splitmix64(uint64_t *state); /* hfvis__mix64(*state), then one step */
+typedef struct hfvis__pcg32 {
+    uint64_t state, inc;
+} hfvis__pcg32;
+void hfvis__pcg32_seed(hfvis__pcg32 *g, uint64_t seed, uint64_t stream);
+uint32_t hfvis__pcg32_next(hfvis__pcg32 *g);
+double hfvis__pcg32_unit(hfvis__pcg32 *g);               /* [0, 1), 53 bits from two draws */
+uint32_t hfvis__pcg32_below(hfvis__pcg32 *g, uint32_t n); /* [0, n), n >= 1, unbiased */
+
+#ifndef HFVIS_NO_STDIO
+/* Whole-file reading (hfvis.c section 2). A sizer looks at the first bytes of a file (at most
+ * HFVIS__READ_HEAD, fewer if the file is shorter) and sets *total to the exact size its header
+ * announces or HFVIS__READ_ALL (a text format: read to the end), or returns the decoder's error
+ * for the header (refused before anything more is read). */
+#define HFVIS__READ_HEAD ((size_t)1 << 16)
+#define HFVIS__READ_ALL ((size_t)-1)
+typedef hfvis_status (*hfvis__sizer)(const unsigned char *head, size_t n, size_t *total);
+hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, hfvis__sizer sizer,
+                             unsigned char **data, size_t *size);
+#endif
+#endif /* HFVIS__INTERNAL_H */
+#endif /* HFVIS__INTERNAL */
+
 #ifdef __cplusplus
 }
 #endif
