@@ -1,7 +1,8 @@
 /* hfvis.c - height fields. Part of hfvis (see hfvis.h for the conventions and the API).
  *
  * Contents
- *   1. Common: status strings, allocation, checked sizes, PRNG
+ *   1. Common: status strings; the library's one copy of the allocation, checked-size and PRNG
+ *      helpers (hfvis__*, declared in hfvis.h's internal block, used by ssao.c and voxel.c too)
  *   2. Codecs: PGM (P2/P5) and PFM (Pf/PF) in memory, file wrappers; the NoData-safe PGM with
  *      its range comment
  *   3. Analytic test fields
@@ -50,7 +51,6 @@
 #define HFVIS_MALLOC(size) malloc(size)
 #define HFVIS_FREE(ptr) free(ptr)
 #endif
-
 
 /* Exact rays (section 16), called from the public routines of sections 8, 9, 10 and 15. */
 /* One exact-ray direction: look vector (a, b), gcd 1, and its azimuth, unwrapped to within pi of

@@ -1,7 +1,8 @@
 /* ssao.c - screen space. Part of hfvis (see hfvis.h for the conventions and the API).
  *
  * Contents
- *   1. Common: allocation, checked sizes, the hash PRNG
+ *   1. Common: three-factor sizes and the per-pixel hash (allocation, checked sizes and the
+ *      PRNGs are hfvis.c's hfvis__ helpers)
  *   2. Camera, hardware depth linearisation, view-space reconstruction, normals from depth
  *      ([P4] §3; docs/errata.md C7)
  *   3. Falloff functions ([P3] Eq. 2-3; docs/errata.md C4)
@@ -37,7 +38,6 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-
 
 /* ========================================================================================== */
 /* 1. Common                                                                                  */
@@ -3830,7 +3830,8 @@ hfvis_status hfvis_ssao_error(const float *ao, ptrdiff_t ao_stride, const float 
 
 /* ---- 12.1 common ---------------------------------------------------------------------------- */
 
-/* Allocation and checked sizes: hfvis__alloc, hfvis__free, hfvis__mul_size (section 1). */
+/* Allocation, checked sizes and PCG32: hfvis__alloc, hfvis__free, hfvis__mul_size, hfvis__pcg32
+ * (hfvis.c section 1). */
 
 /* *acc += a*b rounded up to a multiple of 16 (one sub-array of a block); 0 on overflow. */
 static int lk_part(size_t *acc, size_t count, size_t elem)

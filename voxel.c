@@ -1,7 +1,8 @@
 /* voxel.c - meshes and volumes. Part of hfvis (see hfvis.h for the conventions and the API).
  *
  * Contents
- *   1. Common: allocation, checked sizes, mesh and grid validation, file helpers
+ *   1. Common: mesh and grid validation (allocation, checked sizes, the PRNGs and file reading
+ *      are hfvis.c's hfvis__ helpers)
  *   2. Views: GL-convention matrices, depth linearisation (thesis eq. 16, sign restored)
  *   3. Volume grids and the Volume Buffer (thesis ch. 6 §6.3; [G12] ch. 6)
  *   4. Meshes: analytic test meshes (box, spheres, torus, torus knot, height field, room,
@@ -34,7 +35,6 @@
 #ifndef HFVIS_NO_STDIO
 #include <stdio.h>
 #endif
-
 
 /* Marks internal helpers that a given build may leave unused (-Wunused-function). */
 #if defined(__GNUC__)
@@ -467,7 +467,6 @@ HFVIS_API hfvis_status hfvis_volume_merge(hfvis_volume *dst, const hfvis_volume 
  *   4e. OBJ encoder (own shortest round-trip float formatting), file wrappers
  * Every generated triangle is counter-clockwise seen from outside: (v1 - v0) x (v2 - v0) points
  * out of the enclosed volume (into the room for the room's walls). */
-
 
 /* ---- 4a. builder ------------------------------------------------------------------------ */
 
