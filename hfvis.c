@@ -904,6 +904,13 @@ HFVIS_API hfvis_status hfvis_image_load(const char *path, const hfvis_allocator 
     return s;
 }
 
+hfvis_write_options hfvis_write_options_default(void)
+{
+    hfvis_write_options o;
+    memset(&o, 0, sizeof o);
+    return o;
+}
+
 /* The temporary name: "<path>.tmp<8 hex digits>" beside path; when the last component would
  * then exceed HF_NAME_MAX bytes, that component is cut to leave room for the suffix (same
  * directory, same file system, so the rename stays atomic). The suffix hashes the addresses of
@@ -2453,6 +2460,15 @@ static int hf_points_valid(const float *points, size_t count, int K, const float
     return (count == 0 || (points && out)) && K >= 1 && count <= SIZE_MAX / (size_t)K;
 }
 
+hfvis_march_options hfvis_march_options_default(void)
+{
+    hfvis_march_options o;
+    memset(&o, 0, sizeof o);
+    o.step_cells = 1.0;
+    o.max_distance_cells = 0.0; /* until the ray leaves the grid */
+    return o;
+}
+
 hfvis_status hfvis_horizon_reference(const hfvis_grid *grid, int K,
                                      const hfvis_sweep_options *opts,
                                      const hfvis_march_options *march, const float *points,
@@ -2495,6 +2511,16 @@ hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user, int widt
     return hf_reference_run(&S, K, opts ? opts->azimuth0_rad : 0.0,
                             opts && opts->rays == HFVIS_RAYS_EXACT ? hf_exact_bound(opts, K) : 0, march,
                             points, count, out);
+}
+
+hfvis_openness_options hfvis_openness_options_default(void)
+{
+    hfvis_openness_options o;
+    memset(&o, 0, sizeof o);
+    o.radius = 0.0; /* unlimited */
+    o.negative = 0;
+    o.step_cells = 1.0;
+    return o;
 }
 
 /* Topographic openness (Yokoyama, Shirasawa & Pike 2002): the mean zenith angle pi/2 - beta_k
@@ -3492,6 +3518,15 @@ hfvis_status hfvis_env_light_from_map(const hfvis_grid *grid, int K,
 
 /* ------------------------------------------------ 6. hemisphere-integration oracle */
 
+hfvis_hemisphere_options hfvis_hemisphere_options_default(void)
+{
+    hfvis_hemisphere_options o;
+    memset(&o, 0, sizeof o);
+    o.azimuth_samples = HF_ENV_DEFAULT_AZIMUTH_SAMPLES;
+    o.zenith_samples = HF_ENV_DEFAULT_ZENITH_SAMPLES;
+    return o;
+}
+
 /* L_o = albedo/pi Int L_i V max(n.w, 0) dw ([P1] Eq. 3, the header's Lambertian convention)
  * by the midpoint rule: azimuths phi_m = 2pi (m + 1/2)/A, zenith angles
  * theta_j = pi (j + 1/2)/Z over the whole sphere [0, pi] (horizons may lie below the
@@ -3680,6 +3715,19 @@ size_t hfvis_hull_tree_size(int max_samples)
     return hf_tree_header() + total + 64; /* + alignment slack between the arrays */
 }
 
+/* SafeZoneUpdate window b2 - b1 when the options give 0 ([P2] Alg. 3; docs/errata.md E15). */
+#define HF_TREE_DEFAULT_ZONE_STEPS 4
+
+hfvis_tree_options hfvis_tree_options_default(void)
+{
+    hfvis_tree_options o;
+    memset(&o, 0, sizeof o);
+    o.order = HFVIS_TREE_DEPTH_FIRST;
+    o.safe_zone = 0;
+    o.safe_zone_steps = HF_TREE_DEFAULT_ZONE_STEPS;
+    return o;
+}
+
 hfvis_status hfvis_hull_tree_init(void *mem, size_t mem_size, int max_samples,
                                   const hfvis_tree_options *opts, hfvis_hull_tree **tree)
 {
@@ -3697,7 +3745,7 @@ hfvis_status hfvis_hull_tree_init(void *mem, size_t mem_size, int max_samples,
     t->cap = max_samples;
     t->order = opts && opts->order ? opts->order : HFVIS_TREE_DEPTH_FIRST;
     t->safe_zone = opts ? opts->safe_zone : 0;
-    t->zone_steps = opts && opts->safe_zone_steps ? opts->safe_zone_steps : 4;
+    t->zone_steps = opts && opts->safe_zone_steps ? opts->safe_zone_steps : HF_TREE_DEFAULT_ZONE_STEPS;
     p = (unsigned char *)mem + hf_tree_header();
     t->d = (double *)(void *)p;
     t->h = t->d + n;
@@ -4680,6 +4728,13 @@ static void hf_vs_ray(const hfvis_grid *g, double ox, double oy, double h_eye, d
             *cell = (h + tgt_h - h_eye) / d >= run ? off : -off;
         if ((h - tol - h_eye) / d > run) run = (h - tol - h_eye) / d;
     }
+}
+
+hfvis_viewshed_options hfvis_viewshed_options_default(void)
+{
+    hfvis_viewshed_options o;
+    memset(&o, 0, sizeof o); /* eye and targets on the surface, unlimited range */
+    return o;
 }
 
 hfvis_status hfvis_viewshed(const hfvis_grid *grid, double observer_x, double observer_y,

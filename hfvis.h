@@ -332,6 +332,9 @@ typedef struct hfvis_write_options {
     void *user;
 } hfvis_write_options;
 
+/* The defaults: no callback. */
+HFVIS_API hfvis_write_options hfvis_write_options_default(void);
+
 /* Write n bytes to path atomically, as every saver of the library does: the bytes go to a
  * temporary file beside path ("<path>.tmp<8 hex digits>"; when that name's last component would
  * exceed 255 bytes, the component is cut so the name fits), which is then renamed onto path.
@@ -592,6 +595,9 @@ typedef struct hfvis_march_options {
                                (or border_cells beyond it for CLAMP/WRAP) */
 } hfvis_march_options;
 
+/* The defaults: step_cells 1, max_distance_cells 0 (to the grid's end). */
+HFVIS_API hfvis_march_options hfvis_march_options_default(void);
+
 /* Oracle: per-receiver bilinear ray march on the grid. For every receiver point (x_i, y_i)
  * (grid units; points[2*i], points[2*i+1]) and each of the K directions, samples the surface at
  * p + s*step*(cos psi_k, sin psi_k), s = 1, 2, ... and keeps the largest elevation.
@@ -626,6 +632,9 @@ typedef struct hfvis_openness_options {
     int negative;       /* 0: positive openness; 1: negative */
     double step_cells;  /* radius > 0: march step in cells, >= 0; 0 = 1 */
 } hfvis_openness_options;
+
+/* The defaults: radius 0 (unlimited), positive openness, step_cells 1. */
+HFVIS_API hfvis_openness_options hfvis_openness_options_default(void);
 
 /* Openness at every grid point, out[y*out_stride + x]. opts: border, border_cells, azimuth0_rad,
  * alloc and progress; the direction range is not honoured (all K).
@@ -845,6 +854,9 @@ typedef struct hfvis_hemisphere_options {
     int zenith_samples;       /* zenith steps over [0, pi] (midpoint rule); 0 = 512 */
 } hfvis_hemisphere_options;
 
+/* The defaults: 256 azimuths, 512 zenith steps. */
+HFVIS_API hfvis_hemisphere_options hfvis_hemisphere_options_default(void);
+
 /* Oracle for all light paths: at receiver points[2i], points[2i+1] (grid units), numerically
  * integrates L_o = albedo/pi * Int L_i(w) V(w) max(n.w, 0) dw over the sphere, with V from the
  * exact horizon of the per-receiver ray march (hfvis_horizon_reference with the march options)
@@ -885,6 +897,9 @@ typedef struct hfvis_tree_options {
                                  only replaces the root, skip the tests; same output; 0 = off */
     int safe_zone_steps;      /* window length b2 - b1 in samples; 0 = 4 ([P2] Alg. 3; docs/errata.md E15) */
 } hfvis_tree_options;
+
+/* The defaults: HFVIS_TREE_DEPTH_FIRST, SafeZoneUpdate off, safe_zone_steps 4. */
+HFVIS_API hfvis_tree_options hfvis_tree_options_default(void);
 
 /* Bytes of caller memory for a tree of up to max_samples samples (0 if max_samples < 1 or the
  * size overflows). The memory must be aligned for double (malloc'd memory is). */
@@ -1061,6 +1076,9 @@ typedef struct hfvis_viewshed_options {
     double max_distance;      /* horizontal range in world units, >= 0; 0 = unlimited */
     const hfvis_allocator *alloc; /* reserved: neither viewshed function allocates */
 } hfvis_viewshed_options;
+
+/* The defaults: all zero (eye and targets on the surface, unlimited range). */
+HFVIS_API hfvis_viewshed_options hfvis_viewshed_options_default(void);
 
 /* Viewshed of one observer: which grid points an eye at (observer_x, observer_y) sees.
  * The eye is at surface(observer) + observer_height, the target of grid point (x, y) at
@@ -4030,6 +4048,9 @@ typedef struct hfvis_distance_options {
     const hfvis_allocator *alloc;   /* scratch; NULL = malloc/free */
 } hfvis_distance_options;
 
+/* The defaults: 100000 samples, seed 0, malloc/free. */
+HFVIS_API hfvis_distance_options hfvis_distance_options_default(void);
+
 /* Distances between a mesh X and a voxel set Y (its voxel centres), thesis Table 9 ([G12] ch. 7;
  * docs/errata.md E62): Y -> X exactly (every centre's distance to the nearest triangle, point-triangle in
  * double); X -> Y over seeded area-uniform samples of X (a lower bound of the true sup).
@@ -4295,6 +4316,9 @@ typedef struct hfvis_visfield_build_options {
     void *progress_user;
 } hfvis_visfield_build_options;
 
+/* The defaults: malloc/free, a BVH built inside, no progress callback. */
+HFVIS_API hfvis_visfield_build_options hfvis_visfield_build_options_default(void);
+
 /* Build a visibility field ([G12] Alg. 1, [G12] ch. 4, Alg. 1): for every sample k, p_k = c + R u_k,
  * w = -u_k, and every texel (i, j) of the mapping (unused rejection texels get the miss code),
  * the ray hfvis_ray{origin = (float)p_k, direction = (float)(lx t + ly b + lz w), t_min = 0,
@@ -4453,6 +4477,9 @@ typedef struct hfvis_visfield_shadow_options {
     const hfvis_allocator *alloc;   /* scratch; NULL = malloc/free */
 } hfvis_visfield_shadow_options;
 
+/* The defaults: 20 samples, bias HFVIS_VISFIELD_DEFAULT_BIAS, malloc/free. */
+HFVIS_API hfvis_visfield_shadow_options hfvis_visfield_shadow_options_default(void);
+
 /* Visibility of a spherical light (centre, radius >= 0; 0 = a point light, hard shadows) from
  * points ([G12] §4.5.2, [G12] ch. 4): per point x, `samples` points y_i on the disc of the light
  * facing x (centre + radius (dx e1 + dy e2), (dx, dy) = the concentric map of the Hammersley
@@ -4515,6 +4542,10 @@ typedef struct hfvis_visfield_reflect_options {
     double bias;          /* as hfvis_visfield_ao_options.bias */
     double offset;        /* ray origin x + offset n, world units >= 0 */
 } hfvis_visfield_reflect_options;
+
+/* The defaults: 4 rays, a perfect mirror (shininess 0), bias HFVIS_VISFIELD_DEFAULT_BIAS,
+ * offset 0. */
+HFVIS_API hfvis_visfield_reflect_options hfvis_visfield_reflect_options_default(void);
 
 /* Reflection rays of one receiver ([G12] §4.5.2 "polished" stochastic reflections): mirror
  * direction r = v - 2 (v.n) n of the incoming direction v (toward the surface) about the unit

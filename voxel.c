@@ -6617,6 +6617,9 @@ static void vx_iv_metric_free(vx_iv_metric *M)
     M->tris = NULL;
 }
 
+/* Area-uniform samples of the mesh for d(X, Y) when the options give 0 (hfvis_distance_options). */
+#define VX_IV_DEFAULT_METRIC_SAMPLES 100000
+
 /* Validates and builds the set-up (3 blocks: triangle ids, prefix sums, centres). */
 static hfvis_status vx_iv_metric_init(vx_iv_metric *M, const hfvis_mesh *mesh,
                                       const hfvis_volume_grid *grid, const uint8_t *occ,
@@ -6629,7 +6632,7 @@ static hfvis_status vx_iv_metric_init(vx_iv_metric *M, const hfvis_mesh *mesh,
     if (!occ || !vx_grid_valid(grid) || vx_mesh_check(mesh) != HFVIS_OK)
         return HFVIS_ERR_INVALID_ARGUMENT;
     M->mesh = mesh;
-    M->samples = opts && opts->sample_count ? opts->sample_count : 100000;
+    M->samples = opts && opts->sample_count ? opts->sample_count : VX_IV_DEFAULT_METRIC_SAMPLES;
     M->seed = opts ? opts->seed : 0u;
     M->alloc = opts ? opts->alloc : NULL;
     if (mesh->triangle_count > (size_t)UINT32_MAX / 2) return HFVIS_ERR_LIMIT;
@@ -6898,6 +6901,16 @@ static void vx_iv_metric_out(const vx_iv_metric *M, double sum_p, double max_p, 
     r.voxel_count = M->np;
     r.sample_count = M->samples;
     *out = r;
+}
+
+HFVIS_API hfvis_distance_options hfvis_distance_options_default(void)
+{
+    hfvis_distance_options o;
+    memset(&o, 0, sizeof o);
+    o.sample_count = VX_IV_DEFAULT_METRIC_SAMPLES;
+    o.seed = 0;
+    o.alloc = NULL;
+    return o;
 }
 
 HFVIS_API hfvis_status hfvis_voxel_distance_metrics(const hfvis_mesh *mesh,
@@ -7735,6 +7748,13 @@ static hfvis_status vx_vf_build_run(const hfvis_mesh *mesh, const hfvis_bvh *bvh
     return HFVIS_OK;
 }
 
+HFVIS_API hfvis_visfield_build_options hfvis_visfield_build_options_default(void)
+{
+    hfvis_visfield_build_options o;
+    memset(&o, 0, sizeof o); /* no allocator, a BVH built inside, no progress callback */
+    return o;
+}
+
 HFVIS_API hfvis_status hfvis_visfield_build(const hfvis_mesh *mesh,
                                             const hfvis_visfield_build_options *opts,
                                             hfvis_visfield *vf)
@@ -8326,6 +8346,16 @@ done:
     return s;
 }
 
+HFVIS_API hfvis_visfield_shadow_options hfvis_visfield_shadow_options_default(void)
+{
+    hfvis_visfield_shadow_options o;
+    memset(&o, 0, sizeof o);
+    o.samples = VX_VF_DEFAULT_SHADOW_SAMPLES;
+    o.bias = HFVIS_VISFIELD_DEFAULT_BIAS;
+    o.alloc = NULL;
+    return o;
+}
+
 HFVIS_API hfvis_status hfvis_visfield_soft_shadow(const hfvis_visfield_object *objects,
                                                   size_t object_count, const float *points,
                                                   size_t point_count,
@@ -8474,6 +8504,17 @@ static hfvis_status vx_vf_reflect_run(const hfvis_visfield_object *objects, size
             if (pass == 1) hits[i] = h;
         }
     return HFVIS_OK;
+}
+
+HFVIS_API hfvis_visfield_reflect_options hfvis_visfield_reflect_options_default(void)
+{
+    hfvis_visfield_reflect_options o;
+    memset(&o, 0, sizeof o);
+    o.rays = VX_VF_DEFAULT_REFLECT_RAYS;
+    o.shininess = 0.0; /* a perfect mirror */
+    o.bias = HFVIS_VISFIELD_DEFAULT_BIAS;
+    o.offset = 0.0;
+    return o;
 }
 
 HFVIS_API hfvis_status hfvis_visfield_reflect(const hfvis_visfield_object *objects,

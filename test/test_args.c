@@ -55,6 +55,7 @@
     X(pgm_encode_size, V, -, "ZGR", "0") \
     X(pfm_encode, S, -, "NZGOR", "INVALID_ARGUMENT BUFFER_TOO_SMALL") \
     X(pgm_encode, S, -, "NZGOFR", "INVALID_ARGUMENT BUFFER_TOO_SMALL") \
+    X(write_options_default, P, -, "", "cannot fail") \
     X(write_file, S, M, "NZR", "INVALID_ARGUMENT IO") \
     X(image_load, S, A, "NR", "INVALID_ARGUMENT IO") \
     X(pfm_save, S, M, "NZGR", "INVALID_ARGUMENT IO") \
@@ -78,8 +79,10 @@
     X(horizon_lattice_naive, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(horizon_direction, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(horizon_map, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
+    X(march_options_default, P, -, "", "cannot fail") \
     X(horizon_reference, S, -, "NZGOFESR", "INVALID_ARGUMENT") \
     X(horizon_reference_fn, S, -, "NZGFES", "INVALID_ARGUMENT") \
+    X(openness_options_default, P, -, "", "cannot fail") \
     X(openness, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(sweep_azimuths, S, A, "NZGES", "INVALID_ARGUMENT") \
     X(horizon_exact_naive, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
@@ -94,7 +97,9 @@
     X(env_table_build, S, -, "NZGOFES", "INVALID_ARGUMENT") \
     X(env_light, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(env_light_from_map, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
+    X(hemisphere_options_default, P, -, "", "cannot fail") \
     X(light_reference, S, -, "NZGOFESR", "INVALID_ARGUMENT") \
+    X(tree_options_default, P, -, "", "cannot fail") \
     X(hull_tree_size, V, -, "ZG", "0") \
     X(hull_tree_init, S, -, "NZGOESR", "INVALID_ARGUMENT BUFFER_TOO_SMALL") \
     X(hull_tree_reset, V, -, "N", "no-op for NULL") \
@@ -112,6 +117,7 @@
     X(indirect_light_naive, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(terrain_gi, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(direct_light, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
+    X(viewshed_options_default, P, -, "", "cannot fail") \
     X(viewshed, S, -, "NZGOFSR", "INVALID_ARGUMENT") \
     X(viewshed_reference, S, -, "NZGOFSR", "INVALID_ARGUMENT") \
     X(sh_eval, S, -, "NZF", "INVALID_ARGUMENT") \
@@ -280,6 +286,7 @@
     X(iv_replace_nonempty, S, -, "NZGOSR", "INVALID_ARGUMENT") \
     X(iv_occupancy, S, -, "NZGR", "INVALID_ARGUMENT") \
     X(point_triangle_distance, V, -, "N", "NaN") \
+    X(distance_options_default, P, -, "", "cannot fail") \
     X(voxel_distance_metrics, S, A, "NZGOFR", "INVALID_ARGUMENT") \
     X(voxel_distance_metrics_naive, S, A, "NZGOFR", "INVALID_ARGUMENT") \
     X(visfield_position_count, V, -, "ZGO", "0") \
@@ -293,6 +300,7 @@
     X(dirmap_from_local, S, -, "NZOFER", "INVALID_ARGUMENT") \
     X(visfield_size, V, -, "ZGOE", "0") \
     X(visfield_bounding_sphere, S, -, "NZOFR", "INVALID_ARGUMENT") \
+    X(visfield_build_options_default, P, -, "", "cannot fail") \
     X(visfield_build, S, A, "NZOFESR", "INVALID_ARGUMENT BUFFER_TOO_SMALL") \
     X(visfield_build_reference, S, -, "NZOFER", "INVALID_ARGUMENT BUFFER_TOO_SMALL") \
     X(visfield_texel, S, -, "NZGOFESR", "INVALID_ARGUMENT") \
@@ -301,10 +309,12 @@
     X(visfield_ao_options_default, P, -, "", "cannot fail") \
     X(visfield_ambient_occlusion, S, A, "NZGOFES", "INVALID_ARGUMENT") \
     X(visfield_ambient_occlusion_reference, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
+    X(visfield_shadow_options_default, P, -, "", "cannot fail") \
     X(visfield_soft_shadow, S, A, "NGOFES", "INVALID_ARGUMENT") \
     X(visfield_soft_shadow_reference, S, A, "NGOFES", "INVALID_ARGUMENT") \
     X(visfield_trace, S, -, "NZGOFES", "INVALID_ARGUMENT") \
     X(visfield_trace_reference, S, -, "NZGOFES", "INVALID_ARGUMENT") \
+    X(visfield_reflect_options_default, P, -, "", "cannot fail") \
     X(visfield_reflect, S, -, "NZGOFES", "INVALID_ARGUMENT") \
     X(visfield_reflect_reference, S, -, "NZGOFES", "INVALID_ARGUMENT") \
     X(visfield_encode_size, V, -, "NZE", "0") \
@@ -6586,6 +6596,78 @@ static void io_one(const io_entry *e)
     CHECK(test_dir_entries(sub) == before);
     CHECK_EQ_STATUS(e->fn(tmp_path(e->name)), HFVIS_OK);
     CHECK_EQ_STATUS(e->fn(tmp_path(e->name)), HFVIS_OK); /* replaces */
+}
+
+/* The option defaults added with 0.2.0: each returns the values its header comment documents
+ * (the equality of zero-initialised and default options on a call is test_api's). */
+static void args_write_options_default(void)
+{
+    hfvis_write_options o = hfvis_write_options_default();
+    begin("write_options_default");
+    CHECK(o.on_temp == NULL && o.user == NULL);
+}
+
+static void args_march_options_default(void)
+{
+    hfvis_march_options o = hfvis_march_options_default();
+    begin("march_options_default");
+    CHECK(o.step_cells == 1.0 && o.max_distance_cells == 0.0);
+}
+
+static void args_openness_options_default(void)
+{
+    hfvis_openness_options o = hfvis_openness_options_default();
+    begin("openness_options_default");
+    CHECK(o.radius == 0.0 && o.negative == 0 && o.step_cells == 1.0);
+}
+
+static void args_hemisphere_options_default(void)
+{
+    hfvis_hemisphere_options o = hfvis_hemisphere_options_default();
+    begin("hemisphere_options_default");
+    CHECK(o.azimuth_samples == 256 && o.zenith_samples == 512);
+}
+
+static void args_tree_options_default(void)
+{
+    hfvis_tree_options o = hfvis_tree_options_default();
+    begin("tree_options_default");
+    CHECK(o.order == HFVIS_TREE_DEPTH_FIRST && o.safe_zone == 0 && o.safe_zone_steps == 4);
+}
+
+static void args_viewshed_options_default(void)
+{
+    hfvis_viewshed_options o = hfvis_viewshed_options_default();
+    begin("viewshed_options_default");
+    CHECK(o.observer_height == 0.0 && o.target_height == 0.0 && o.max_distance == 0.0 && o.alloc == NULL);
+}
+
+static void args_distance_options_default(void)
+{
+    hfvis_distance_options o = hfvis_distance_options_default();
+    begin("distance_options_default");
+    CHECK(o.sample_count == 100000 && o.seed == 0 && o.alloc == NULL);
+}
+
+static void args_visfield_build_options_default(void)
+{
+    hfvis_visfield_build_options o = hfvis_visfield_build_options_default();
+    begin("visfield_build_options_default");
+    CHECK(o.alloc == NULL && o.bvh == NULL && o.progress == NULL && o.progress_user == NULL);
+}
+
+static void args_visfield_shadow_options_default(void)
+{
+    hfvis_visfield_shadow_options o = hfvis_visfield_shadow_options_default();
+    begin("visfield_shadow_options_default");
+    CHECK(o.samples == 20 && o.bias == HFVIS_VISFIELD_DEFAULT_BIAS && o.alloc == NULL);
+}
+
+static void args_visfield_reflect_options_default(void)
+{
+    hfvis_visfield_reflect_options o = hfvis_visfield_reflect_options_default();
+    begin("visfield_reflect_options_default");
+    CHECK(o.rays == 4 && o.shininess == 0.0 && o.bias == HFVIS_VISFIELD_DEFAULT_BIAS && o.offset == 0.0);
 }
 
 /* ========================================================================================== */

@@ -1914,6 +1914,29 @@ TEST(iv_alloc_failures)
     }
 }
 
+/* hfvis_distance_options: a zero struct and hfvis_distance_options_default() (100000 samples,
+ * seed 0) give the same metrics. */
+TEST(iv_metric_options_default_equals_zero)
+{
+    static uint8_t occ[8 * 8 * 8];
+    float xyz[12 * 40];
+    uint32_t idx[3 * 40];
+    hfvis_mesh m;
+    hfvis_volume_grid g;
+    hfvis_distance_metrics a, b;
+    hfvis_distance_options z, d = hfvis_distance_options_default();
+    int i, j;
+    iv_grid(&g, 8, 8, 8, 0, 0, 0, 0.125, 0.125, 0.125);
+    iv_square_mesh(xyz, idx, 0.3, &m);
+    memset(occ, 0, sizeof occ);
+    for (j = 0; j < 8; j++)
+        for (i = 0; i < 8; i++) occ[iv_lin(&g, i, j, 3)] = 1;
+    memset(&z, 0, sizeof z);
+    CHECK_EQ_STATUS(hfvis_voxel_distance_metrics(&m, &g, occ, &z, &a), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_voxel_distance_metrics(&m, &g, occ, &d, &b), HFVIS_OK);
+    CHECK(a.sample_count == 100000 && memcmp(&a, &b, sizeof a) == 0);
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
@@ -1933,6 +1956,7 @@ int main(int argc, char **argv)
     RUN(iv_occupancy_bytes);
     RUN(iv_point_triangle_distance);
     RUN(iv_metric_analytic_and_oracle);
+    RUN(iv_metric_options_default_equals_zero);
     RUN(iv_scene_injection_six_views);
     RUN(iv_scene_cleanup_keeps_box);
     RUN(iv_scene_moved_object_room);
