@@ -1339,7 +1339,7 @@ hfvis_status hfvis_lattice_init(hfvis_lattice *lattice, int width, int height, d
     return HFVIS_OK;
 }
 
-size_t hfvis_lattice_size(const hfvis_lattice *L)
+size_t hfvis_lattice_nodes(const hfvis_lattice *L)
 {
     if (!L || L->j_max < L->j_min || L->i_max < L->i_min) return 0;
     return ((size_t)(L->j_max - L->j_min) + 1) * ((size_t)(L->i_max - L->i_min) + 1);
@@ -2956,7 +2956,7 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
  * Contents
  *   1. constants, argument resolution
  *   2. sector phi-integrals of the lat-long texels, band theta-weights
- *   3. table layouts and hfvis_env_table_size / hfvis_env_table_build
+ *   3. table layouts and hfvis_env_table_floats / hfvis_env_table_build
  *   4. hf_env_eval: per node and direction evaluation (the fused sweep calls this)
  *   5. hfvis_env_light_from_map
  *   6. hfvis_light_reference (hemisphere-integration oracle)
@@ -3010,7 +3010,7 @@ typedef struct hf_env_resolved {
     size_t table_floats;
 } hf_env_resolved;
 
-/* Checks the environment's shape (not its radiance pointer: hfvis_env_table_size can be asked
+/* Checks the environment's shape (not its radiance pointer: hfvis_env_table_floats can be asked
  * before the map is loaded), K and the options; resolves defaults and the table size.
  * lp_normal_res must be odd and >= 3 (M = 1 leaves no theta_n interval to interpolate). */
 /* The radiance array (n_theta*n_phi*channels floats) must be addressable: a size that
@@ -3060,7 +3060,7 @@ static hfvis_status hf_env_resolve(const hfvis_env *env, int K, const hfvis_env_
     return HFVIS_OK;
 }
 
-size_t hfvis_env_table_size(const hfvis_env *env, int K, const hfvis_env_options *eopts)
+size_t hfvis_env_table_floats(const hfvis_env *env, int K, const hfvis_env_options *eopts)
 {
     hf_env_resolved r;
     if (hf_env_resolve(env, K, eopts, &r) != HFVIS_OK) return 0;

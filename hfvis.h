@@ -21,7 +21,7 @@
  * force: *_naive over exactly the samples the fast routine uses (held to it bit for bit, or
  * within the tolerance its documentation names), *_reference from first principles with its
  * own sampling (a ray march, a hemisphere integral, a per-voxel test); a few oracles predate
- * the suffixes (hfvis_ssao_raytrace, hfvis_lk_raycast) and say so in their comments.
+ * the suffixes (hfvis_ssao_reference, hfvis_lk_reference) and say so in their comments.
  * Production routines never call oracles; oracles cost what their comments state (often
  * quadratic) and are meant for tests and validation, not for production sizes.
  *
@@ -38,9 +38,9 @@
  *                hfvis_nlp_*
  *   Screen space hfvis_camera_perspective, hfvis_camera_from_matrix, hfvis_depth_linearize;
  *                hfvis_lsao (oracle route hfvis_lsao_direction_naive), hfvis_hbao, hfvis_ffao,
- *                hfvis_ssao_raytrace (the reference), hfvis_ssao_mipmap, hfvis_ssao_error
+ *                hfvis_ssao_reference (the reference), hfvis_ssao_mipmap, hfvis_ssao_error
  *   Meshes       hfvis_mesh_load, hfvis_rasterize, hfvis_bvh_build, hfvis_bvh_closest_hit,
- *                hfvis_lk_image ([LK]; oracle hfvis_lk_raycast)
+ *                hfvis_lk_image ([LK]; oracle hfvis_lk_reference)
  *   Voxels       hfvis_voxelize_surface, hfvis_voxelize_conservative, hfvis_voxelize_solid,
  *                hfvis_voxelize_bitmask, hfvis_iv_update (each with its *_reference),
  *                hfvis_binvox_save
@@ -469,7 +469,7 @@ HFVIS_API hfvis_status hfvis_lattice_init(hfvis_lattice *lattice, int width, int
                                           double azimuth_rad);
 
 /* Number of nodes of the lattice buffer, rows*cols; 0 for NULL or an empty lattice. */
-HFVIS_API size_t hfvis_lattice_size(const hfvis_lattice *lattice);
+HFVIS_API size_t hfvis_lattice_nodes(const hfvis_lattice *lattice);
 
 /* The in-domain node range [*i_first, *i_last] of line j; returns the count (0 if empty, if j is
  * outside j_min..j_max or lattice is NULL: outputs not written then). */
@@ -554,7 +554,7 @@ HFVIS_API hfvis_status hfvis_line_horizons_naive(const double *distance, const d
 
 /* Raw lattice output of one direction, for GPU-port diffing: the horizon elevation angle at
  * every lattice node of hfvis_lattice_init(width, height, azimuth_rad); NaN at nodes outside the
- * grid and at holes. out must hold hfvis_lattice_size() floats.
+ * grid and at holes. out must hold hfvis_lattice_nodes() floats.
  * Allocates 1 block of about 8*min(W^2+H^2, (W+H)^2/2) bytes (the sampled lattice: the largest
  * buffer over all directions, half the diagonal's square for a thin grid). Cost O(width*height). */
 HFVIS_API hfvis_status hfvis_horizon_lattice(const hfvis_grid *grid, double azimuth_rad,
@@ -815,10 +815,10 @@ typedef struct hfvis_env_options {
 HFVIS_API hfvis_env_options hfvis_env_options_default(void);
 
 /* Floats of the per-direction environment tables for method and K (0 on invalid input). */
-HFVIS_API size_t hfvis_env_table_size(const hfvis_env *env, int K, const hfvis_env_options *eopts);
+HFVIS_API size_t hfvis_env_table_floats(const hfvis_env *env, int K, const hfvis_env_options *eopts);
 
 /* Build the per-direction tables (prefix integrals or the L_p table) for directions psi_k =
- * azimuth0_rad + 2 pi k / K. table must hold hfvis_env_table_size() floats.
+ * azimuth0_rad + 2 pi k / K. table must hold hfvis_env_table_floats() floats.
  * Prefix layout: 6*K*(n_theta+1)*channels floats, table[((k*(n_theta+1) + b)*6 + q)*C + c]:
  * q = 0..2 are A_k, B_k, C_k at the band edge b*pi/n_theta; q = 3..5 band b's sector
  * phi-integrals of L, L cos(phi - psi_k), L sin(phi - psi_k) (for partial bands).
@@ -831,7 +831,7 @@ HFVIS_API hfvis_status hfvis_env_table_build(const hfvis_env *env, int K, double
 /* Environment light, fused into the sweep: out[(y*out_stride + x)*channels + c] =
  * albedo/pi * sum_k [Nz A_k + a_k B_k + b_k C_k](theta_k) (prefix) or
  * albedo * sum_k |N_p| L_p^k(theta_n, theta_h) ([P1] Eq. 6), in lattice space, gathered.
- * out_stride in pixels. Allocates 2 blocks: the tables (hfvis_env_table_size floats) and the
+ * out_stride in pixels. Allocates 2 blocks: the tables (hfvis_env_table_floats floats) and the
  * lattice scratch of hfvis_sky_light (plus channels-1 doubles per node).
  * opts->direction_begin/end select a partial sum of the K directions. */
 HFVIS_API hfvis_status hfvis_env_light(const hfvis_grid *grid, int K, const hfvis_env *env,
@@ -2379,7 +2379,7 @@ HFVIS_API hfvis_status hfvis_hbao(const hfvis_camera *cam, const float *depth,
 
 /* ---- the screen-space ray-traced reference ([P4] §8; docs/errata.md E36) --------------------------- */
 
-/* Options of hfvis_ssao_raytrace. NULL or a zero struct = the defaults in brackets. */
+/* Options of hfvis_ssao_reference. NULL or a zero struct = the defaults in brackets. */
 typedef struct hfvis_ssao_rt_options {
     const hfvis_allocator *alloc;     /* reconstructed normals only; NULL = malloc/free */
     int rays;                         /* rays per pixel [256] */
@@ -2428,7 +2428,7 @@ HFVIS_API hfvis_status hfvis_ssao_rt_options_resolve(const hfvis_ssao_rt_options
  * Deterministic for a seed. Cost O(W H R (W0 + H0)) at worst (cells per ray).
  * HFVIS_ERR_INVALID_ARGUMENT for invalid camera/options, NULL depth/ao, ao_stride < inner
  * width; HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on error. */
-HFVIS_API hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth,
+HFVIS_API hfvis_status hfvis_ssao_reference(const hfvis_camera *cam, const float *depth,
                                            const float *normals,
                                            const hfvis_ssao_rt_options *opts, float *ao,
                                            ptrdiff_t ao_stride);
@@ -2787,7 +2787,7 @@ typedef enum hfvis_blend {
 } hfvis_blend;
 
 /* The Volume Buffer (thesis ch. 6, [G12] ch. 6): `channels` floats per voxel, interleaved,
- * data[lin*channels + c], caller-owned (hfvis_volume_size floats), each channel with its blend. */
+ * data[lin*channels + c], caller-owned (hfvis_volume_floats floats), each channel with its blend. */
 typedef struct hfvis_volume {
     hfvis_volume_grid grid;
     int channels;                                /* 1..HFVIS_VOLUME_MAX_CHANNELS */
@@ -2809,9 +2809,9 @@ HFVIS_API hfvis_status hfvis_volume_grid_fit(const hfvis_mesh *mesh, int resolut
 
 /* Floats a volume of `channels` channels needs: dims[0]*dims[1]*dims[2]*channels; 0 if grid is
  * NULL or invalid or channels is outside 1..HFVIS_VOLUME_MAX_CHANNELS. */
-HFVIS_API size_t hfvis_volume_size(const hfvis_volume_grid *grid, int channels);
+HFVIS_API size_t hfvis_volume_floats(const hfvis_volume_grid *grid, int channels);
 
-/* Set up vol over caller storage of hfvis_volume_size(grid, channels) floats, every channel
+/* Set up vol over caller storage of hfvis_volume_floats(grid, channels) floats, every channel
  * blending with `blend`, every value 0. Returns HFVIS_ERR_INVALID_ARGUMENT for NULL, an invalid
  * grid, channels outside 1..32 or an unknown blend. */
 HFVIS_API hfvis_status hfvis_volume_init(hfvis_volume *vol, const hfvis_volume_grid *grid,
@@ -5073,7 +5073,7 @@ HFVIS_API hfvis_status hfvis_volgi_render(const hfvis_volgi_scene *scene,
  *                                 region of influence covers ([LK] §4);
  *   Method 2, hfvis_lk_bvh      - per receiver (any points), a BVH traversal with conservative
  *                                 node masks ([LK] §5);
- *   reference, hfvis_lk_raycast - every ray of every receiver cast through the same BVH with an
+ *   reference, hfvis_lk_reference - every ray of every receiver cast through the same BVH with an
  *                                 any-hit query ([LK] §6).
  *
  * Obscurance (hfvis.h, Conventions): W = popcount(mask)/N in [0, 1], 0 = nothing blocks ([LK] Eq. 3). The
@@ -5561,7 +5561,7 @@ HFVIS_API hfvis_status hfvis_lk_bvh(const hfvis_mesh *mesh, const hfvis_bvh *bvh
  * library's float hfvis_bvh_intersect). Arguments, outputs and errors as hfvis_lk_bvh (its
  * options mask_mode, node_mask and cull do not apply). Memory: 1 block, as hfvis_lk_bvh. Cost
  * O(rays log T). */
-HFVIS_API hfvis_status hfvis_lk_raycast(const hfvis_mesh *mesh, const hfvis_bvh *bvh,
+HFVIS_API hfvis_status hfvis_lk_reference(const hfvis_mesh *mesh, const hfvis_bvh *bvh,
                                         const hfvis_lk_rays *rays,
                                         const hfvis_lk_receivers *recv,
                                         const hfvis_lk_options *opts, uint32_t *masks,
@@ -5571,7 +5571,7 @@ HFVIS_API hfvis_status hfvis_lk_raycast(const hfvis_mesh *mesh, const hfvis_bvh 
 typedef enum hfvis_lk_method {
     HFVIS_LK_METHOD_RASTER = 1,  /* hfvis_lk_raster */
     HFVIS_LK_METHOD_BVH = 2,     /* hfvis_lk_bvh on the G-buffer receivers */
-    HFVIS_LK_METHOD_RAYCAST = 3  /* hfvis_lk_raycast on the G-buffer receivers */
+    HFVIS_LK_METHOD_RAYCAST = 3  /* hfvis_lk_reference on the G-buffer receivers */
 } hfvis_lk_method;
 
 /* The AO image of a view by any method: the G-buffer receivers (hfvis_lk_gbuffer_receivers) and

@@ -2340,7 +2340,7 @@ static double ss_rt_ray(const ss_rt *t, const double O[3], const double w[3])
     }
 }
 
-hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth, const float *normals,
+hfvis_status hfvis_ssao_reference(const hfvis_camera *cam, const float *depth, const float *normals,
                                  const hfvis_ssao_rt_options *opts, float *ao, ptrdiff_t ao_stride)
 {
     ss_cam c;
@@ -6210,7 +6210,7 @@ static hfvis_status lk_cast_watertight(const lk_ctx *c, const hfvis_bvh *bvh, co
     return HFVIS_OK;
 }
 
-HFVIS_API hfvis_status hfvis_lk_raycast(const hfvis_mesh *mesh, const hfvis_bvh *bvh,
+HFVIS_API hfvis_status hfvis_lk_reference(const hfvis_mesh *mesh, const hfvis_bvh *bvh,
                                         const hfvis_lk_rays *rays,
                                         const hfvis_lk_receivers *recv,
                                         const hfvis_lk_options *opts, uint32_t *masks,
@@ -6315,7 +6315,7 @@ HFVIS_API hfvis_status hfvis_lk_image(hfvis_lk_method method, const hfvis_mesh *
     rc.normal = nrm;
     rc.key = key;
     if (method == HFVIS_LK_METHOD_BVH) s = hfvis_lk_bvh(mesh, bvh ? bvh : &own, rays, &rc, &o, rm, ro, stats);
-    else s = hfvis_lk_raycast(mesh, bvh ? bvh : &own, rays, &rc, &o, rm, ro, stats);
+    else s = hfvis_lk_reference(mesh, bvh ? bvh : &own, rays, &rc, &o, rm, ro, stats);
     if (!bvh) hfvis_bvh_free(o.alloc, &own);
     if (s == HFVIS_OK) {
         if (masks) memset(masks, 0, sizeof(uint32_t) * npix * words);

@@ -369,7 +369,7 @@ HFVIS_API hfvis_status hfvis_volume_grid_fit(const hfvis_mesh *mesh, int resolut
     return HFVIS_OK;
 }
 
-HFVIS_API size_t hfvis_volume_size(const hfvis_volume_grid *grid, int channels)
+HFVIS_API size_t hfvis_volume_floats(const hfvis_volume_grid *grid, int channels)
 {
     size_t n;
     if (!vx_grid_valid(grid) || channels < 1 || channels > HFVIS_VOLUME_MAX_CHANNELS) return 0;
@@ -386,7 +386,7 @@ static int vx_blend_valid(hfvis_blend b)
 HFVIS_API hfvis_status hfvis_volume_init(hfvis_volume *vol, const hfvis_volume_grid *grid,
                                          int channels, float *storage, hfvis_blend blend)
 {
-    size_t n = hfvis_volume_size(grid, channels), i;
+    size_t n = hfvis_volume_floats(grid, channels), i;
     int c;
     if (!vol || !storage || n == 0 || !vx_blend_valid(blend)) return HFVIS_ERR_INVALID_ARGUMENT;
     memset(vol, 0, sizeof *vol);
@@ -402,7 +402,7 @@ HFVIS_API void hfvis_volume_clear(hfvis_volume *vol, float value)
 {
     size_t n, i;
     if (!vol || !vol->data) return;
-    n = hfvis_volume_size(&vol->grid, vol->channels);
+    n = hfvis_volume_floats(&vol->grid, vol->channels);
     for (i = 0; i < n; i++) vol->data[i] = value;
 }
 
@@ -441,7 +441,7 @@ HFVIS_API hfvis_status hfvis_volume_merge(hfvis_volume *dst, const hfvis_volume 
     int c, a;
     if (!dst || !src || !dst->data || !src->data || dst->channels != src->channels)
         return HFVIS_ERR_INVALID_ARGUMENT;
-    n = hfvis_volume_size(&dst->grid, dst->channels);
+    n = hfvis_volume_floats(&dst->grid, dst->channels);
     if (n == 0) return HFVIS_ERR_INVALID_ARGUMENT;
     for (a = 0; a < 3; a++)
         if (dst->grid.dims[a] != src->grid.dims[a]) return HFVIS_ERR_INVALID_ARGUMENT;
@@ -5707,7 +5707,7 @@ HFVIS_API hfvis_status hfvis_iv_bias(const hfvis_volume_grid *grid, const hfvis_
 static int vx_iv_volume_ok(const hfvis_volume *vol)
 {
     return vol && vol->data && vol->channels >= 1 && vol->channels <= HFVIS_VOLUME_MAX_CHANNELS
-           && hfvis_volume_size(&vol->grid, vol->channels) != 0;
+           && hfvis_volume_floats(&vol->grid, vol->channels) != 0;
 }
 
 static int vx_iv_same_grid(const hfvis_volume_grid *a, const hfvis_volume_grid *b)
@@ -6242,7 +6242,7 @@ static hfvis_status vx_iv_run(const hfvis_volume *prev, hfvis_volume *curr,
                               int single, vx_iv_count *cnt)
 {
     float *pyr = NULL;
-    size_t t, total = 0, n = hfvis_volume_size(&prev->grid, prev->channels);
+    size_t t, total = 0, n = hfvis_volume_floats(&prev->grid, prev->channels);
     if (o->conservative && count > 0) {
         for (t = 0; t < count; t++) {
             vx_iv_img im;

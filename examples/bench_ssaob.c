@@ -108,9 +108,9 @@ void bench_ssaob(int quick)
         ro.rays = rays;
         t0 = bench_now();
         ro.seed = 1;
-        hfvis_ssao_raytrace(&s.cam, s.depth, NULL, &ro, s.r1, We);
+        hfvis_ssao_reference(&s.cam, s.depth, NULL, &ro, s.r1, We);
         ro.seed = 2;
-        hfvis_ssao_raytrace(&s.cam, s.depth, NULL, &ro, s.r2, We);
+        hfvis_ssao_reference(&s.cam, s.depth, NULL, &ro, s.r2, We);
         for (i = 0; i < n; i++) {
             double d = (double)s.r1[i] - (double)s.r2[i];
             s.rm[i] = 0.5f * (s.r1[i] + s.r2[i]);

@@ -70,7 +70,7 @@
     X(grid_sample, V, -, "NZF", "NaN") \
     X(normals_compute, S, -, "NZGOFR", "INVALID_ARGUMENT") \
     X(lattice_init, S, -, "NZGOF", "INVALID_ARGUMENT LIMIT") \
-    X(lattice_size, V, -, "N", "0") \
+    X(lattice_nodes, V, -, "N", "0") \
     X(lattice_line, V, -, "NR", "0") \
     X(sweep_options_default, P, -, "", "cannot fail") \
     X(line_horizons, S, -, "NGFR", "INVALID_ARGUMENT") \
@@ -93,7 +93,7 @@
     X(sky_view_factor_from_map, S, -, "NZGOFR", "INVALID_ARGUMENT") \
     X(sun_visibility, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(env_options_default, P, -, "", "cannot fail") \
-    X(env_table_size, V, -, "NZGOES", "0") \
+    X(env_table_floats, V, -, "NZGOES", "0") \
     X(env_table_build, S, -, "NZGOFES", "INVALID_ARGUMENT") \
     X(env_light, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(env_light_from_map, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
@@ -190,7 +190,7 @@
     X(hbao, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(ssao_rt_options_default, P, -, "", "cannot fail") \
     X(ssao_rt_options_resolve, S, -, "NGOFES", "INVALID_ARGUMENT") \
-    X(ssao_raytrace, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
+    X(ssao_reference, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(ssao_scene_render, S, -, "NZGOFESR", "INVALID_ARGUMENT") \
     X(ffao_options_default, P, -, "", "cannot fail") \
     X(ffao_options_resolve, S, -, "NGOFESR", "INVALID_ARGUMENT") \
@@ -217,7 +217,7 @@
     X(depth_to_eye_z, P, -, "", "cannot fail") \
     X(eye_z_to_depth, P, -, "", "cannot fail") \
     X(volume_grid_fit, S, -, "NZGOFR", "INVALID_ARGUMENT LIMIT") \
-    X(volume_size, V, -, "NZGO", "0") \
+    X(volume_floats, V, -, "NZGO", "0") \
     X(volume_init, S, -, "NZGOFE", "INVALID_ARGUMENT") \
     X(volume_clear, V, -, "N", "no-op for NULL vol or data") \
     X(volume_write, S, -, "NZGOFER", "INVALID_ARGUMENT") \
@@ -356,7 +356,7 @@
     X(lk_gbuffer_receivers, S, A, "NZGOFER", "INVALID_ARGUMENT LIMIT") \
     X(lk_raster, S, A, "NZGOFESR", "INVALID_ARGUMENT LIMIT") \
     X(lk_bvh, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
-    X(lk_raycast, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
+    X(lk_reference, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(lk_image, S, A, "NZGOFESR", "INVALID_ARGUMENT LIMIT")
 
 /* ========================================================================================== */
@@ -973,12 +973,12 @@ static void args_lattice_init(void)
     BAD('O', LIM, hfvis_lattice_init(L, INT_MAX, INT_MAX, 0.3));
 }
 
-static void args_lattice_size(void)
+static void args_lattice_nodes(void)
 {
     hfvis_lattice L;
-    begin("lattice_size");
-    CHECK(hfvis_lattice_init(&L, GW, GH, 0.3) == HFVIS_OK && hfvis_lattice_size(&L) > 0);
-    BADV('N', hfvis_lattice_size(NULL) == 0);
+    begin("lattice_nodes");
+    CHECK(hfvis_lattice_init(&L, GW, GH, 0.3) == HFVIS_OK && hfvis_lattice_nodes(&L) > 0);
+    BADV('N', hfvis_lattice_nodes(NULL) == 0);
 }
 
 static void args_lattice_line(void)
@@ -1043,7 +1043,7 @@ static void args_horizon_lattice(void)
     float *out;
     begin("horizon_lattice");
     hfvis_lattice_init(&L, GW, GH, 0.3);
-    out = AF(hfvis_lattice_size(&L));
+    out = AF(hfvis_lattice_nodes(&L));
     OK(hfvis_horizon_lattice(&g_ok, 0.3, NULL, out));
     BAD('N', INV, hfvis_horizon_lattice(NULL, 0.3, NULL, out));
     BAD('N', INV, hfvis_horizon_lattice(&g_ok, 0.3, NULL, NULL));
@@ -1059,7 +1059,7 @@ static void args_horizon_lattice_naive(void)
     float *out;
     begin("horizon_lattice_naive");
     hfvis_lattice_init(&L, GW, GH, 0.3);
-    out = AF(hfvis_lattice_size(&L));
+    out = AF(hfvis_lattice_nodes(&L));
     OK(hfvis_horizon_lattice_naive(&g_ok, 0.3, NULL, out));
     BAD('N', INV, hfvis_horizon_lattice_naive(NULL, 0.3, NULL, out));
     BAD('N', INV, hfvis_horizon_lattice_naive(&g_ok, 0.3, NULL, NULL));
@@ -1320,28 +1320,28 @@ static void args_env_options_default(void)
     bx = hfvis_env_options_default(); bx.method = HFVIS_ENV_LP_TABLE; bx.lp_horizon_res = 1; BAD('S', INV, expr); \
     } while (0)
 
-static void args_env_table_size(void)
+static void args_env_table_floats(void)
 {
     hfvis_env_options e = hfvis_env_options_default();
     hfvis_env b = g_env;
-    begin("env_table_size");
-    CHECK(hfvis_env_table_size(&g_env, 4, NULL) > 0);
-    BADV('N', hfvis_env_table_size(NULL, 4, NULL) == 0);
-    BADV('Z', hfvis_env_table_size(&g_env, 0, NULL) == 0);
-    BADV('G', hfvis_env_table_size(&g_env, -1, NULL) == 0);
+    begin("env_table_floats");
+    CHECK(hfvis_env_table_floats(&g_env, 4, NULL) > 0);
+    BADV('N', hfvis_env_table_floats(NULL, 4, NULL) == 0);
+    BADV('Z', hfvis_env_table_floats(&g_env, 0, NULL) == 0);
+    BADV('G', hfvis_env_table_floats(&g_env, -1, NULL) == 0);
     e.method = (hfvis_env_method)99;
-    BADV('E', hfvis_env_table_size(&g_env, 4, &e) == 0);
+    BADV('E', hfvis_env_table_floats(&g_env, 4, &e) == 0);
     b.channels = 0;
-    BADV('S', hfvis_env_table_size(&b, 4, NULL) == 0);
+    BADV('S', hfvis_env_table_floats(&b, 4, NULL) == 0);
     b = g_env; b.n_theta = INT_MAX; b.channels = 4;
-    BADV('O', hfvis_env_table_size(&b, INT_MAX, NULL) == 0);
+    BADV('O', hfvis_env_table_floats(&b, INT_MAX, NULL) == 0);
 }
 
 static void args_env_table_build(void)
 {
     float *t;
     begin("env_table_build");
-    t = AF(hfvis_env_table_size(&g_env, 4, NULL));
+    t = AF(hfvis_env_table_floats(&g_env, 4, NULL));
     OK(hfvis_env_table_build(&g_env, 4, 0.0, NULL, t));
     BAD('N', INV, hfvis_env_table_build(NULL, 4, 0.0, NULL, t));
     BAD('N', INV, hfvis_env_table_build(&g_env, 4, 0.0, NULL, NULL));
@@ -3027,16 +3027,16 @@ static void args_ssao_rt_options_resolve(void)
     RT_OPT_CASES(hfvis_ssao_rt_options_resolve(&br, o));
 }
 
-static void args_ssao_raytrace(void)
+static void args_ssao_reference(void)
 {
     hfvis_ssao_rt_options o = hfvis_ssao_rt_options_default();
     float *ao;
-    begin("ssao_raytrace");
+    begin("ssao_reference");
     o.rays = 4;
     ao = AF(INNER * INNER);
-    OK(hfvis_ssao_raytrace(&cam_ok, cam_depth, cam_normals, &o, ao, INNER));
-    AO_IMAGE_CASES(hfvis_ssao_raytrace, &o);
-    RT_OPT_CASES(hfvis_ssao_raytrace(&cam_ok, cam_depth, cam_normals, &br, ao, INNER));
+    OK(hfvis_ssao_reference(&cam_ok, cam_depth, cam_normals, &o, ao, INNER));
+    AO_IMAGE_CASES(hfvis_ssao_reference, &o);
+    RT_OPT_CASES(hfvis_ssao_reference(&cam_ok, cam_depth, cam_normals, &br, ao, INNER));
 }
 
 static void args_ssao_scene_render(void)
@@ -3446,16 +3446,16 @@ static void args_volume_grid_fit(void)
     MESH_CASES(hfvis_volume_grid_fit(&bm, 4, 0.1, 0, g), INV);
 }
 
-static void args_volume_size(void)
+static void args_volume_floats(void)
 {
     hfvis_volume_grid b = vg_ok;
-    begin("volume_size");
-    CHECK(hfvis_volume_size(&vg_ok, 2) == 128);
-    BADV('N', hfvis_volume_size(NULL, 2) == 0);
-    BADV('Z', hfvis_volume_size(&vg_ok, 0) == 0);
-    BADV('O', hfvis_volume_size(&vg_ok, HFVIS_VOLUME_MAX_CHANNELS + 1) == 0);
+    begin("volume_floats");
+    CHECK(hfvis_volume_floats(&vg_ok, 2) == 128);
+    BADV('N', hfvis_volume_floats(NULL, 2) == 0);
+    BADV('Z', hfvis_volume_floats(&vg_ok, 0) == 0);
+    BADV('O', hfvis_volume_floats(&vg_ok, HFVIS_VOLUME_MAX_CHANNELS + 1) == 0);
     b.dims[0] = -1;
-    BADV('G', hfvis_volume_size(&b, 1) == 0);
+    BADV('G', hfvis_volume_floats(&b, 1) == 0);
 }
 
 static void args_volume_init(void)
@@ -5791,16 +5791,16 @@ static void args_lk_bvh(void)
     LK_RECV_CASES(hfvis_lk_bvh);
 }
 
-static void args_lk_raycast(void)
+static void args_lk_reference(void)
 {
     hfvis_lk_receivers rc = recv_ok();
     uint32_t *masks;
     float *ob;
     hfvis_lk_stats *st;
-    begin("lk_raycast");
+    begin("lk_reference");
     masks = ATN(uint32_t, 2); ob = AF(2); st = AT(hfvis_lk_stats);
-    OK(hfvis_lk_raycast(&m_box, &m_bvh, &lk_rays, &rc, NULL, masks, ob, st));
-    LK_RECV_CASES(hfvis_lk_raycast);
+    OK(hfvis_lk_reference(&m_box, &m_bvh, &lk_rays, &rc, NULL, masks, ob, st));
+    LK_RECV_CASES(hfvis_lk_reference);
 }
 
 static void args_lk_image(void)
@@ -5853,14 +5853,14 @@ SW(horizon_lattice)
     hfvis_sweep_options o = sweep_opts(al);
     hfvis_lattice L;
     hfvis_lattice_init(&L, GW, GH, 0.3);
-    return hfvis_horizon_lattice(&g_ok, 0.3, &o, AF(hfvis_lattice_size(&L)));
+    return hfvis_horizon_lattice(&g_ok, 0.3, &o, AF(hfvis_lattice_nodes(&L)));
 }
 SW(horizon_lattice_naive)
 {
     hfvis_sweep_options o = sweep_opts(al);
     hfvis_lattice L;
     hfvis_lattice_init(&L, GW, GH, 0.3);
-    return hfvis_horizon_lattice_naive(&g_ok, 0.3, &o, AF(hfvis_lattice_size(&L)));
+    return hfvis_horizon_lattice_naive(&g_ok, 0.3, &o, AF(hfvis_lattice_nodes(&L)));
 }
 SW(horizon_direction) { hfvis_sweep_options o = sweep_opts(al); return hfvis_horizon_direction(&g_ok, 4, 1, &o, AF(GW * GH), GW); }
 SW(openness) { hfvis_sweep_options o = sweep_opts(al); return hfvis_openness(&g_ok, 4, NULL, &o, AF(GW * GH), GW); }
@@ -5961,11 +5961,11 @@ SW(lsao_direction_naive)
 }
 SW(lsao) { hfvis_lsao_options o = hfvis_lsao_options_default(); o.alloc = al; return hfvis_lsao(&cam_ok, cam_depth, NULL, &o, AF(INNER * INNER), INNER); }
 SW(hbao) { hfvis_hbao_options o = hfvis_hbao_options_default(); o.alloc = al; return hfvis_hbao(&cam_ok, cam_depth, NULL, &o, AF(INNER * INNER), INNER); }
-SW(ssao_raytrace)
+SW(ssao_reference)
 {
     hfvis_ssao_rt_options o = hfvis_ssao_rt_options_default();
     o.alloc = al; o.rays = 4;
-    return hfvis_ssao_raytrace(&cam_ok, cam_depth, NULL, &o, AF(INNER * INNER), INNER);
+    return hfvis_ssao_reference(&cam_ok, cam_depth, NULL, &o, AF(INNER * INNER), INNER);
 }
 SW(ffao_table_build)
 {
@@ -6224,13 +6224,13 @@ SW(lk_bvh)
     o.alloc = al;
     return hfvis_lk_bvh(&m_box, &m_bvh, &lk_rays, &rc, &o, masks, AF(2), NULL);
 }
-SW(lk_raycast)
+SW(lk_reference)
 {
     hfvis_lk_options o = hfvis_lk_options_default();
     hfvis_lk_receivers rc = recv_ok();
     uint32_t *masks = ATN(uint32_t, 2);
     o.alloc = al;
-    return hfvis_lk_raycast(&m_box, &m_bvh, &lk_rays, &rc, &o, masks, AF(2), NULL);
+    return hfvis_lk_reference(&m_box, &m_bvh, &lk_rays, &rc, &o, masks, AF(2), NULL);
 }
 SW(lk_image)
 {
@@ -6465,7 +6465,7 @@ static const sweep_entry sweeps[] = {
     SWEEP(visibility_count), SWEEP(visibility_count_naive), SWEEP(indirect_light),
     SWEEP(indirect_light_naive), SWEEP(terrain_gi), SWEEP(direct_light), SWEEP(ns_gi),
     SWEEP(direction_sums), SWEEP(partial_decode), SWEEP(partial_load),
-    SWEEP(lsao_direction), SWEEP(lsao_direction_naive), SWEEP(lsao), SWEEP(hbao), SWEEP(ssao_raytrace),
+    SWEEP(lsao_direction), SWEEP(lsao_direction_naive), SWEEP(lsao), SWEEP(hbao), SWEEP(ssao_reference),
     SWEEP(ffao_table_build), SWEEP(ffao), SWEEP(ssao_mipmap),
     SWEEP(mesh_box), SWEEP(mesh_uv_sphere), SWEEP(mesh_icosphere), SWEEP(mesh_torus),
     SWEEP(mesh_torus_knot), SWEEP(mesh_from_grid), SWEEP(mesh_room), SWEEP(mesh_teapot),
@@ -6477,7 +6477,7 @@ static const sweep_entry sweeps[] = {
     SWEEP(visfield_soft_shadow), SWEEP(visfield_soft_shadow_reference), SWEEP(visfield_decode),
     SWEEP(visfield_load), SWEEP(volgi_propagate_step), SWEEP(volgi_propagate), SWEEP(volgi_voxelize),
     SWEEP(volgi_render), SWEEP(lk_rays_build), SWEEP(lk_rays_custom), SWEEP(lk_lut_build),
-    SWEEP(lk_gbuffer_receivers), SWEEP(lk_raster), SWEEP(lk_bvh), SWEEP(lk_raycast), SWEEP(lk_image),
+    SWEEP(lk_gbuffer_receivers), SWEEP(lk_raster), SWEEP(lk_bvh), SWEEP(lk_reference), SWEEP(lk_image),
     SWEEP_VARIANT(ffao, ffao_sparse_blur), SWEEP_VARIANT(volgi_propagate, volgi_propagate_normalized),
     SWEEP_VARIANT(lk_image, lk_image_raster), SWEEP_VARIANT(lk_image, lk_image_raycast),
     SWEEP_VARIANT(lk_raster, lk_raster_lut), SWEEP_VARIANT(iv_cleanup, iv_cleanup_two_images),
