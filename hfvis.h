@@ -1,5 +1,5 @@
 /* hfvis.h - height-field and screen-space visibility: the authoritative CPU reference.
- * Version 0.1.0. MIT licence (see LICENSE).
+ * Version 0.2.0. MIT licence (see LICENSE).
  *
  * hfvis is a pure C99, single-threaded, dependency-free library: copy this header and the
  * .c files you need (hfvis.c for height fields, ssao.c for screen space, voxel.c for meshes and
@@ -20,8 +20,9 @@
  * oracle is documented beside it ("Oracle of ...") and computes the same quantity by brute
  * force: *_naive over exactly the samples the fast routine uses (held to it bit for bit, or
  * within the tolerance its documentation names), *_reference from first principles with its
- * own sampling (a ray march, a hemisphere integral, a per-voxel test); a few oracles predate
- * the suffixes (hfvis_ssao_reference, hfvis_lk_reference) and say so in their comments.
+ * own sampling (a ray march, a hemisphere integral, a ray caster, a per-voxel test). Every
+ * oracle's name ends in one of the two (0.2.0 renamed the two that did not: see "Deprecated
+ * names" at the end of this header).
  * Production routines never call oracles; oracles cost what their comments state (often
  * quadratic) and are meant for tests and validation, not for production sizes.
  *
@@ -87,6 +88,9 @@
  *                 viewsheds, the gallery.
  *   Ports         cameras from projection matrices, bottom-up rows, LSAO's step-falloff
  *                 refusal, HBAO defaults aligned with LSAO's.
+ *   0.2.0         one API grammar: oracle suffixes, *_options_default() for every options
+ *                 struct, *_DEFAULT = 0 in every option enum, unit-named size queries (renames
+ *                 kept as deprecated aliases); one internal Common layer (hfvis__*).
  *
  * ------------------------------------------------------------------------------------------
  * QUICK START
@@ -147,7 +151,15 @@
  *   and HFVIS_FREE(ptr), malloc and free unless both are defined when the library's .c files
  *   are compiled (as stb's STBI_MALLOC; test/test_oom.c fails them on purpose).
  * Options. NULL and a zero-initialised options struct both mean the documented defaults; zero is
- *   never a valid non-default value. hfvis_*_options_default() returns the defaults filled in.
+ *   never a valid non-default value. Every options struct has hfvis_*_options_default(), which
+ *   returns the defaults filled in (bit-identical results to a zero struct); the few that also
+ *   have *_options_resolve() use it to validate and fill in a caller's struct. Every option
+ *   enum names its zero *_DEFAULT; where the documented default is itself a named choice that
+ *   has always been 0 (HFVIS_RAYS_LATTICE, HFVIS_BLEND_MAX, ...), both names stand for 0.
+ * Sizes. A *_size() query (and *_encode_size(), *_scratch_size()) counts bytes; a query that
+ *   counts elements names them: hfvis_lattice_nodes, hfvis_env_table_floats,
+ *   hfvis_volume_floats. Angles are radians everywhere (see "Angles" above; a _rad suffix only
+ *   repeats it, and no parameter takes degrees); a distance ending in _cells counts grid cells.
  *
  * What is and is not guaranteed
  *   - Same input and same binary: bit-identical output (build with -ffp-contract=off; FMA
@@ -164,7 +176,7 @@
 #define HFVIS_H
 
 #define HFVIS_VERSION_MAJOR 0
-#define HFVIS_VERSION_MINOR 1
+#define HFVIS_VERSION_MINOR 2
 #define HFVIS_VERSION_PATCH 0
 #define HFVIS_VERSION (HFVIS_VERSION_MAJOR * 10000 + HFVIS_VERSION_MINOR * 100 + HFVIS_VERSION_PATCH)
 
@@ -493,6 +505,7 @@ typedef enum hfvis_direction_order {
 
 /* How a sweep gives each receiver its horizon (see "Exact rays" below). 0 is the default. */
 typedef enum hfvis_ray_mode {
+    HFVIS_RAYS_DEFAULT = 0,   /* = LATTICE */
     HFVIS_RAYS_LATTICE = 0,   /* [P1]: lattice lines, gathered bilinearly (the GPU reference) */
     HFVIS_RAYS_EXACT = 1      /* every grid point its own ray, rational directions (beyond [P1]) */
 } hfvis_ray_mode;
@@ -2780,6 +2793,7 @@ typedef struct hfvis_volume_grid {
 /* How a written value combines with the stored one (the Volume Buffer's blend equation, thesis
  * §6.3; GL_MAX for every attachment on the GPU). */
 typedef enum hfvis_blend {
+    HFVIS_BLEND_DEFAULT = 0,  /* = MAX */
     HFVIS_BLEND_MAX = 0,      /* default (the thesis' GPU behaviour) */
     HFVIS_BLEND_REPLACE = 1,
     HFVIS_BLEND_MIN = 2,
@@ -3039,6 +3053,7 @@ HFVIS_API hfvis_status hfvis_mesh_save(const char *path, const hfvis_mesh *mesh)
  * screen (y up), i.e. the face normal (v1 - v0) x (v2 - v0) points toward the viewer (the
  * hfvis_mesh convention and GL's default glFrontFace(GL_CCW)). */
 typedef enum hfvis_cull_mode {
+    HFVIS_CULL_DEFAULT = 0, /* = NONE */
     HFVIS_CULL_NONE = 0,  /* default: both sides rasterized */
     HFVIS_CULL_BACK = 1,  /* faces pointing away from the viewer discarded */
     HFVIS_CULL_FRONT = 2  /* faces pointing toward the viewer discarded */
@@ -3046,6 +3061,7 @@ typedef enum hfvis_cull_mode {
 
 /* Coordinate frame of the normal output plane. */
 typedef enum hfvis_normal_space {
+    HFVIS_NORMAL_DEFAULT = 0, /* = WORLD */
     HFVIS_NORMAL_WORLD = 0, /* default: the mesh's frame */
     HFVIS_NORMAL_EYE = 1    /* rotated by the view matrix (eye space: x right, y up, +z toward
                                the viewer), as the screen-space AO routines expect */
@@ -3339,7 +3355,9 @@ HFVIS_API hfvis_status hfvis_bvh_intersect(const hfvis_bvh *bvh, const hfvis_mes
                                            const hfvis_ray *ray, hfvis_ray_query query,
                                            hfvis_hit_filter filter, void *user, hfvis_hit *hit);
 
-/* hfvis_bvh_intersect(bvh, mesh, ray, HFVIS_RAY_CLOSEST, NULL, NULL, hit). */
+/* hfvis_bvh_intersect(bvh, mesh, ray, HFVIS_RAY_CLOSEST, NULL, NULL, hit). Kept beside the
+ * general query (as Embree keeps rtcIntersect and rtcOccluded): the two queries nearly every
+ * caller makes, without a filter. */
 HFVIS_API hfvis_status hfvis_bvh_closest_hit(const hfvis_bvh *bvh, const hfvis_mesh *mesh,
                                              const hfvis_ray *ray, hfvis_hit *hit);
 
@@ -3398,6 +3416,7 @@ typedef void (*hfvis_voxel_fragment_fn)(const hfvis_voxel_fragment *f, float *va
  * vertex limit all three give the voxel set of the pixel-centre rule; they differ in cost and,
  * with a limit, in the holes they leave. */
 typedef enum hfvis_voxelize_method {
+    HFVIS_VOXELIZE_DEFAULT = 0, /* = PIXEL_RULE */
     /* Default. The common CPU rule ([G12] ch. 6): each pass pixel (pu, pw) whose centre lies in the
      * projected triangle gets the voxel of slab floor(z), z = the triangle plane's depth at the
      * centre. One fragment per covered pixel. No vertex limit (max_output_vertices must be 0). */
@@ -3418,6 +3437,7 @@ typedef enum hfvis_voxelize_method {
 
 /* Which sweep passes see a triangle. */
 typedef enum hfvis_voxelize_axes {
+    HFVIS_AXES_DEFAULT = 0, /* = DOMINANT */
     /* Default ([G12] §6.4): each triangle only in the pass of its dominant axis, the largest
      * |component| of its GRID-space normal (ties -> lowest axis index). */
     HFVIS_AXES_DOMINANT = 0,
@@ -3858,6 +3878,7 @@ typedef enum hfvis_iv_class {
 
 /* The bias b of eq. 17. */
 typedef enum hfvis_iv_bias_rule {
+    HFVIS_IV_BIAS_DEFAULT = 0, /* = HALF_DIAGONAL */
     HFVIS_IV_BIAS_HALF_DIAGONAL = 0, /* default: b = |cell|/2, the voxel's "radius (half
                                         diagonal)" of the text (§7.4.1); (sqrt 3/2) s for cubes */
     HFVIS_IV_BIAS_FULL_DIAGONAL = 1, /* b = |cell|: Listing 7.1 (distance between the eye-space
@@ -3867,6 +3888,7 @@ typedef enum hfvis_iv_bias_rule {
 
 /* Which depth texels decide a clear. */
 typedef enum hfvis_iv_footprint {
+    HFVIS_IV_FOOTPRINT_DEFAULT = 0, /* = CENTER */
     HFVIS_IV_FOOTPRINT_CENTER = 0,      /* default, the thesis (Listing 7.1): the one texel under
                                            the voxel centre (nearest, floor of the window
                                            coordinate, clamped to the image) */
@@ -4692,6 +4714,11 @@ HFVIS_API hfvis_status hfvis_visfield_load(const char *path, const hfvis_allocat
 #define HFVIS_VOLGI_MAX_VALUE 1e20f
 
 /* ---- 2-band SH helpers ([G12] ch. 5) ---------------------------------------------------------- */
+/* These are bands 0-1 of the order-4 SH API (same basis, index and phase): hfvis_volgi_sh_basis
+ * = the first 4 coefficients of hfvis_sh_eval, _clamped_cosine of hfvis_sh_from_zh with
+ * hfvis_zh_diffuse, _cone of hfvis_sh_from_zh with hfvis_zh_cap (test_volgi holds them equal).
+ * They stay as the volume GI's 4-coefficient kernels: its propagation evaluates them per voxel
+ * and face, where computing 16 coefficients to keep 4 would cost four times as much. */
 
 /* The 4 basis functions at the unit direction dir/|dir|. Returns HFVIS_OK, or
  * HFVIS_ERR_INVALID_ARGUMENT for NULL, a non-finite or zero dir (out untouched). */
@@ -4714,6 +4741,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_volgi_sh_cone(const double axis[
 
 /* How the flux that leaves a voxel toward a face neighbour is computed (eq. 11, [G12] ch. 5, eq. 11; docs/errata.md E59). */
 typedef enum hfvis_volgi_transfer {
+    HFVIS_VOLGI_TRANSFER_DEFAULT = 0, /* = CONE */
     /* Default: the reference kernel of docs/errata.md E59. The flux through the face toward
      * neighbour i = j + o is F = max(0, P_j . Cone(o)) per band (the SH integral of P_j over the
      * 45-degree cone about o, negative values from SH ringing clamped), and it arrives at i as a
@@ -4731,6 +4759,7 @@ typedef enum hfvis_volgi_transfer {
 
 /* What an occupied voxel does with the light S_in that arrives (the thesis' T_r). */
 typedef enum hfvis_volgi_reflection {
+    HFVIS_VOLGI_REFLECT_DEFAULT = 0, /* = MIRROR */
     /* Default, the thesis' simplification (§5.5.2): mirror S_in on the plane perpendicular to the
      * dominant axis m of the voxel's average normal (ties: lowest axis), i.e. negate band-1
      * coefficient m (index 3 for x, 1 for y, 2 for z; T_r = 1 except -1 there [I]). Keeps c_0, so
@@ -4748,6 +4777,7 @@ typedef enum hfvis_volgi_reflection {
 /* The reflectance rho of occupied voxels in the propagation (not the first bounce, whose albedo
  * is already in the injected radiance, nor the final gather, which uses the pixel's albedo). */
 typedef enum hfvis_volgi_reflectance {
+    HFVIS_VOLGI_REFLECTANCE_DEFAULT = 0, /* = THESIS */
     HFVIS_VOLGI_REFLECTANCE_THESIS = 0,   /* default: 0.5 for every band ([G12] §5.6) */
     HFVIS_VOLGI_REFLECTANCE_CONSTANT = 1, /* options.reflectance, in [0, 1] (0: pure absorbers) */
     HFVIS_VOLGI_REFLECTANCE_ALBEDO = 2    /* the voxel's albedo (hfvis_volgi_geometry.albedo, which
@@ -4756,6 +4786,7 @@ typedef enum hfvis_volgi_reflectance {
 
 /* Which face-neighbour transfers carry light. */
 typedef enum hfvis_volgi_paths {
+    HFVIS_VOLGI_PATHS_DEFAULT = 0, /* = ALL */
     /* Default, the reference kernel of docs/errata.md E59: every voxel gathers from all six neighbours, also
      * an occupied voxel from an occupied one (docs/errata.md E59: occupied sources emit into all six
      * directions). Side effect: the side lobes of a lit wall's VPLs land in the neighbouring
@@ -5583,6 +5614,19 @@ HFVIS_API hfvis_status hfvis_lk_image(hfvis_lk_method method, const hfvis_mesh *
                                       const hfvis_bvh *bvh, const hfvis_view *view,
                                       const hfvis_lk_rays *rays, const hfvis_lk_options *opts,
                                       uint32_t *masks, float *obscurance, hfvis_lk_stats *stats);
+
+/* ========================================================================================== */
+/* Deprecated names (removed in the next minor version)                                       */
+/* ========================================================================================== */
+/* 0.2.0 renamed these (README, "Migrating from 0.1.x"); the old names still compile. Define
+ * HFVIS_NO_DEPRECATED to find their uses. */
+#ifndef HFVIS_NO_DEPRECATED
+#define hfvis_ssao_raytrace hfvis_ssao_reference
+#define hfvis_lk_raycast hfvis_lk_reference
+#define hfvis_lattice_size hfvis_lattice_nodes
+#define hfvis_env_table_size hfvis_env_table_floats
+#define hfvis_volume_size hfvis_volume_floats
+#endif
 
 /* ========================================================================================== */
 /* Internal (not API): shared by hfvis.c, ssao.c and voxel.c                                  */

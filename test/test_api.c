@@ -1171,6 +1171,23 @@ TEST(allocator_free_without_alloc)
     CHECK(api_foreign_frees == 0);
 }
 
+/* The names 0.2.0 renamed still compile and call the new functions (hfvis.h, "Deprecated
+ * names"). */
+TEST(deprecated_names)
+{
+    hfvis_lattice L;
+    hfvis_volume_grid vg;
+    CHECK_EQ_STATUS(hfvis_lattice_init(&L, 5, 4, 0.3), HFVIS_OK);
+    CHECK(hfvis_lattice_size(&L) == hfvis_lattice_nodes(&L) && hfvis_lattice_size(&L) > 0);
+    CHECK(hfvis_env_table_size(NULL, 4, NULL) == 0);
+    memset(&vg, 0, sizeof vg);
+    vg.dims[0] = vg.dims[1] = vg.dims[2] = 2;
+    vg.cell[0] = vg.cell[1] = vg.cell[2] = 1.0;
+    CHECK(hfvis_volume_size(&vg, 2) == 16 && hfvis_volume_floats(&vg, 2) == 16);
+    CHECK_EQ_STATUS(hfvis_ssao_raytrace(NULL, NULL, NULL, NULL, NULL, 0), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_lk_raycast(NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
@@ -1204,5 +1221,6 @@ int main(int argc, char **argv)
     RUN(sweeps_failing_allocator);
     RUN(oracles_allocate_nothing);
     RUN(options_default_equals_zero);
+    RUN(deprecated_names);
     return TEST_DONE();
 }
