@@ -1434,7 +1434,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_min_blocking_angle(const doub
  * from the SH incident radiance U_b gathered from the exit radiance of bounce b-1; total = direct +
  * the bounces. For a diffuse surface this is, bounce by bounce, the recursion
  * L_B = emission + albedo (D + I[L_(B-1)]) of hfvis_terrain_gi. How close it comes to the exact
- * pipeline is measured in test_gi2.c against hfvis_sky_light and hfvis_indirect_light (P1/P2)
+ * pipeline is measured in test_ns_gi.c against hfvis_sky_light and hfvis_indirect_light (P1/P2)
  * and printed by the bench. */
 
 /* How omega_max is taken from a slice's blocking angles. */
@@ -1630,7 +1630,7 @@ typedef struct hfvis_ns_gi_outputs {
  * Cost: O(rw rh (m + key samples + directional lights) n) for the direct pass (about 20 ns per
  * step on one 2020s core) and O(rw rh m K C) per bounce with the cache (K the casting-set size;
  * x16 with VECTOR glossy), plus O(W H C 256) shading. Deterministic.
- * Accuracy (measured, test_gi2.c and the bench, fBm terrains): with the defaults, the direct light
+ * Accuracy (measured, test_ns_gi.c and the bench, fBm terrains): with the defaults, the direct light
  * of a uniform sky is within 1.4-2.3% RMS of P1's (hfvis_sky_light), of which about 1.8% is the
  * order-4 SH truncation itself (the SH projection of the exact horizons is that far from P1); one
  * bounce is within 0.016 (unit sky) RMS of P2's hfvis_indirect_light; hard sun shadows differ from

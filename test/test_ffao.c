@@ -1,4 +1,4 @@
-/* test_ssaob.c - tests of the P4 far-field AO part of ssao.c ([P4]):
+/* test_ffao.c - tests of the P4 far-field AO part of ssao.c ([P4]):
  * the slab integral (quadrature, closed form, table), virtual points, sector weights, the slice
  * estimator against the closed forms of T5, FFAO on the analytic scenes of §6 against the closed
  * forms and the ray-traced reference, the mipmap baseline, error metrics, the blur, goldens, bad

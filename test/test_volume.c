@@ -1,4 +1,4 @@
-/* test_voxel.c - voxel.c core: views and matrices, eq. 16 depth linearisation, grid fit and the
+/* test_volume.c - voxel.c core: views and matrices, eq. 16 depth linearisation, grid fit and the
  * Volume Buffer (voxel.c sections 1-3). */
 #include "hfvis.h"
 #include "test.h"

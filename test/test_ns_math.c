@@ -1,4 +1,4 @@
-/* test_gi.c - the Nowrouzezahrai-Snyder math layer (hfvis.c section 13). */
+/* test_ns_math.c - the Nowrouzezahrai-Snyder math layer (hfvis.c section 13). */
 #include "hfvis.h"
 #include "test.h"
 
@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* test_gi.c - tests of the Nowrouzezahrai-Snyder math layer (hfvis.c section 13): real SH,
+/* test_ns_math.c - tests of the Nowrouzezahrai-Snyder math layer (hfvis.c section 13): real SH,
  * zonal lobes, environment projection, normalized Legendre polynomials, Appendix-A wedge
  * matrices, the tangent-plane angle. Analytic cases are closed forms derived for these tests;
  * expected values are written here, nothing is read from outside the repository.

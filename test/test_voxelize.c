@@ -1,4 +1,4 @@
-/* test_vox.c - surface voxelizers and the Volume Buffer attribute path ([G12] ch. 5 Alg. 4,
+/* test_voxelize.c - surface voxelizers and the Volume Buffer attribute path ([G12] ch. 5 Alg. 4,
  * ch. 6 Alg. 5/6; [G12] ch. 6, Alg. 5-6). Exact analytic counts of the fast
  * routines against their per-voxel oracle bit for bit, the output-vertex holes, 6-separation of
  * the three-axis variant, blends, callbacks, bad arguments. */

@@ -1,4 +1,4 @@
-/* test_vf.c - 4D visibility fields ([G12] ch. 4): positional samples, direction
+/* test_visfield.c - 4D visibility fields ([G12] ch. 4): positional samples, direction
  * maps, the build against its naive oracle, the exact sphere-in-sphere maps, queries and AO /
  * shadows / reflections against ray casting, the file codec, bad arguments and failing
  * allocations. Prints the thesis-style error tables (hit/miss disagreement, mean distance error,
