@@ -1,4 +1,4 @@
-/* test_lk.c - Laine-Karras bitmask ray-cast AO (ssao.c section 5): ray sets, frames, masks, the
+/* test_lk.c - Laine-Karras bitmask ray-cast AO (ssao.c section 12): ray sets, frames, masks, the
  * plane table, the three methods (rasterization, BVH traversal, ray caster) and their exact
  * agreement, the analytic cases of culling, LOD windows, bad arguments, failing
  * allocators. */

@@ -1,5 +1,5 @@
 /* test_volume.c - voxel.c core: views and matrices, eq. 16 depth linearisation, grid fit and the
- * Volume Buffer (voxel.c sections 1-3). */
+ * Volume Buffer (voxel.c sections 2-3). */
 #include "hfvis.h"
 #include "test.h"
 
