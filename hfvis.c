@@ -6,22 +6,22 @@
  *   2. Codecs: PGM (P2/P5) and PFM (Pf/PF) in memory, file wrappers; the NoData-safe PGM with
  *      its range comment
  *   3. Analytic test fields
- *   4. Bilinear sampling and normals ([P1] §4, §7 "quad sum"; docs/errata.md E5; [P1] §7; docs/errata.md E10)
+ *   4. Bilinear sampling and normals ([P1] §4, §7 "quad sum"; docs/errata.md E5, E10)
  *   5. The sweep lattice ([P1] §4, Fig. 2; docs/errata.md E5)
- *   6. The P1 hull stack along one line ([P1] §5 Alg. 1, App. A.1; [P1] §5, Alg. 1, App. A.1)
+ *   6. The P1 hull stack along one line ([P1] §5 Alg. 1, App. A.1)
  *   7. The sweep driver: sampled lattice, four-way symmetry, borders, gather ([P1] §4, §7; docs/errata.md E5, E7, E8)
  *   8. Horizon outputs and the ray-march oracles ([P1] §2, [P2] §1); topographic openness (Yokoyama 2002)
  *   9. Light: uniform sky ([P1] Eq. 4-5), sky-view factor, sun visibility
  *  10. Environment light: prefix integrals and the L_p table ([P1] Eq. 6-7; docs/errata.md E9),
  *      the hemisphere-integration oracle
- *  11. P2: the convex-hull tree ([P2] Alg. 1-3, App. A.2; [P2] §4-7, Alg. 1-3), visible sets ([P2] §10.1),
+ *  11. P2: the convex-hull tree ([P2] §4-7, Alg. 1-3, App. A.2), visible sets ([P2] §10.1),
  *      intervisibility sweeps, visibility index, indirect light and bounces (docs/errata.md E17)
  *  12. Viewshed of one observer (Franklin & Ray 1994, R2) and its exact line-of-sight oracle
  *  13. Nowrouzezahrai-Snyder GI, math layer: real SH of order 4, zonal lobes, environment
  *      projection, normalized Legendre polynomials, Appendix-A wedge matrices ([NS09])
  *  14. Nowrouzezahrai-Snyder GI pipeline: slice scanning over the height pyramid, casting sets,
  *      wedges to SH visibility, environment, directional and key lights, diffuse and glossy
- *      bounces through the radiance pyramid, sub-sampling ([NS09] §5-9; [NS09] §3-9; [NS09] §8)
+ *      bounces through the radiance pyramid, sub-sampling ([NS09] §3-9)
  *  15. Split runs: raw per-receiver direction sums in double and the partial-sum file
  *  16. Exact rays (beyond [P1]): rational directions, every grid-line crossing and the split
  *      bulging pieces swept with the [P1] §5 hull, the per-receiver oracle, actual azimuths and
@@ -3209,7 +3209,7 @@ static double hf_env_lp_cutoff(int i, int M)
     return c < 0.0 ? 0.0 : (c > HFVIS__PI ? HFVIS__PI : c);
 }
 
-/* L_p table of one direction ([P1] Eq. 7 in its Eq. 5-consistent form, [P1] Eq. 6-7; docs/errata.md E9):
+/* L_p table of one direction ([P1] Eq. 6-7, Eq. 7 in its Eq. 5-consistent form; docs/errata.md E9):
  * L_p(theta_n, theta_h) = (1/pi)[cos theta_n A_k(c) + sin theta_n B_k(c)],
  * c = min(theta_h, theta_n + pi/2). Entries with theta_h_j < theta_n_i + pi/2 need A, B at
  * theta_h_j (shared by all i): one walk over j. The others need A, B at theta_n_i + pi/2
@@ -5333,7 +5333,7 @@ hfvis_status hfvis_nlp_eval(double z, double P[4])
     return HFVIS_OK;
 }
 
-/* vbar(sigma) = Int_{-1}^{sin sigma} P^(z) dz ([NS09] Eq. 10 with the limits of [NS09] §4, Eq. 9-13; docs/errata.md E48, E49),
+/* vbar(sigma) = Int_{-1}^{sin sigma} P^(z) dz ([NS09] Eq. 10 with the limits of §4, Eq. 9-13; docs/errata.md E48, E49),
  * from Int_{-1}^s P_l = (P_(l+1)(s) - P_(l-1)(s))/(2l+1); sigma is clamped to [-pi/2, pi/2]. */
 static void ns_vbar(double sigma, double *v)
 {
@@ -5387,7 +5387,7 @@ hfvis_status hfvis_nlp_radiance(int K, const double *omega_rad, const double *u,
             omega_rad[i] < (i == 0 ? omega_min_rad : omega_rad[i - 1]))
             return HFVIS_ERR_INVALID_ARGUMENT;
     for (k = 0; k < 4; k++) c[k] = 0.0;
-    /* [NS09] Eq. 12 with the errata of [NS09] §4, Eq. 9-13; docs/errata.md E48, E49: the integral covers z in [-1, 1] and
+    /* [NS09] Eq. 12 with the limits of §4, Eq. 9-13 (docs/errata.md E48, E49): the integral covers z in [-1, 1] and
      * u(t_(i+1)) = 0 once i + 1 >= |T| */
     for (i = 0; i < K; i++) {
         double du = u[i] - (i + 1 < K ? u[i + 1] : 0.0);

@@ -445,7 +445,7 @@ HFVIS_API hfvis_status hfvis_field_generate(const hfvis_field *field, int width,
                                            ptrdiff_t stride, float *out);
 
 /* ========================================================================================== */
-/* hfvis.c - sampling, normals and the sweep lattice ([P1] §4, §7; [P1] §4, Fig. 2; docs/errata.md E5, E7, E8; [P1] §7; docs/errata.md E10) */
+/* hfvis.c - sampling, normals and the sweep lattice ([P1] §4, Fig. 2, §7; docs/errata.md E5, E7, E8, E10) */
 /* ========================================================================================== */
 
 /* Bilinear height at grid position (x, y), clamped to the grid, in world units; NaN if a tap
@@ -488,7 +488,7 @@ HFVIS_API size_t hfvis_lattice_nodes(const hfvis_lattice *lattice);
 HFVIS_API int hfvis_lattice_line(const hfvis_lattice *lattice, int j, int *i_first, int *i_last);
 
 /* ========================================================================================== */
-/* hfvis.c - P1 horizons ([P1] §5 Alg. 1, App. A.1; [P1] §5, Alg. 1, App. A.1)                */
+/* hfvis.c - P1 horizons ([P1] §5 Alg. 1, App. A.1)                */
 /* ========================================================================================== */
 
 /* How hfvis_sweep_options.direction_begin/end count the K directions. */
@@ -745,7 +745,7 @@ HFVIS_API hfvis_status hfvis_horizon_exact_naive(const hfvis_grid *grid, int K,
                                                  const hfvis_sweep_options *opts, float *out);
 
 /* ========================================================================================== */
-/* hfvis.c - P1 light ([P1] §6 Eq. 3-7; [P1] §6-7)                                            */
+/* hfvis.c - P1 light ([P1] §6-7, Eq. 3-7)                                            */
 /* ========================================================================================== */
 
 /* [P1] Eq. 5 per sector: S_k(theta) = (Nz/K) sin^2 theta + (sin(pi/K)/pi) a (theta - sin 2theta / 2),
@@ -1155,7 +1155,7 @@ HFVIS_API hfvis_status hfvis_viewshed_reference(const hfvis_grid *grid, double o
                                                 ptrdiff_t out_stride);
 
 /* ========================================================================================== */
-/* hfvis.c - Nowrouzezahrai-Snyder GI, math layer ([NS09] §4, §6, §7, App. A; [NS09] §3-7) */
+/* hfvis.c - Nowrouzezahrai-Snyder GI, math layer ([NS09] §3-7, App. A) */
 /* ========================================================================================== */
 /* [NS09] D. Nowrouzezahrai, J. Snyder, "Fast Global Illumination on Dynamic Height Fields",
  * CGF 28(4), 2009. Errata: docs/errata.md E47-E53.
@@ -1294,8 +1294,9 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_nlp_occlusion(double sigma_rad, 
 HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_nlp_visibility(double omega_lo_rad, double omega_hi_rad,
                                                                double out[4]);
 
-/* NLP vector of the indirect radiance along one slice ([NS09] Eq. 8 and 12 with the [NS09] §4, Eq. 9-13; docs/errata.md E48, E49
- * errata: the integral covers z in [-1, 1], u(t_(i+1)) = 0 once i+1 >= |T|):
+/* NLP vector of the indirect radiance along one slice ([NS09] Eq. 8 and 12 with the limits of
+ * §4, Eq. 9-13, docs/errata.md E48, E49: the integral covers z in [-1, 1], u(t_(i+1)) = 0 once
+ * i+1 >= |T|):
  *   u(omega) = u[k] for omega_rad[k-1] <= omega < omega_rad[k] (omega_rad[-1] := omega_min_rad),
  *   0 below omega_min and above omega_rad[K-1];
  *   out = Sum_k (u[k] - u[k+1]) vbar(omega_rad[k]) - u[0] vbar(omega_min), u[K] := 0.
@@ -1368,7 +1369,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_wedges_full(hfvis_ns_wedges *
 HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_wedges_partial(hfvis_ns_wedges *set, hfvis_ns_interp interp,
                                                                   int m, double phi_a_rad, double phi_b_rad);
 
-/* From slices to SH ([NS09] Eq. 20-21, [NS09] §6, App. A; docs/errata.md E51 SLICES_TO_SH): w[j*4 + k] is the NLP vector
+/* From slices to SH ([NS09] §6, Eq. 20-21, App. A; docs/errata.md E51 SLICES_TO_SH): w[j*4 + k] is the NLP vector
  * of sample j (j = 0..m-1, from hfvis_nlp_visibility or hfvis_nlp_radiance at azimuth phi_j);
  * out = Sum_wedges Rot_z(M x_j, phi_j). One channel per call. Returns HFVIS_OK, or
  * HFVIS_ERR_INVALID_ARGUMENT for NULL or a set whose interp or sample count is invalid.
@@ -1394,7 +1395,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_min_blocking_angle(const doub
                                                                       hfvis_ns_omega_min form, double *out);
 
 /* ========================================================================================== */
-/* hfvis.c - Nowrouzezahrai-Snyder GI pipeline ([NS09] §5-9; [NS09] §3; [NS09] §8)           */
+/* hfvis.c - Nowrouzezahrai-Snyder GI pipeline ([NS09] §3-9)           */
 /* ========================================================================================== */
 /* The approximate, fast counterpart of the exact P1/P2 pipeline (hfvis_direct_light,
  * hfvis_terrain_gi): per receiver, m azimuthal slices are scanned with exponentially growing
@@ -1406,7 +1407,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_min_blocking_angle(const doub
  * Condon-Shortley phase, Ahat multipliers, NLP in z = sin(omega)) and of the whole API
  * (hfvis.h, Conventions: an open flat receiver under a uniform sky c with albedo 1 returns c).
  *
- * Slices ([NS09] §3; [NS09] §5.2, Eq. 14-17). A receiver at grid position (x, y) looking toward
+ * Slices ([NS09] §3, §5.2, Eq. 14-17). A receiver at grid position (x, y) looking toward
  * phi_j = azimuth0_rad + 2 pi j/m (phi measured like psi, from +x toward +y) takes steps
  * tau_i = 2^(i/k) cells, i = 0..n-1 (Eq. 14 in cell units); step i reads level
  * l_v(i) = max(0, i - k*o_v) of the height pyramid at the receiver and at the step point (Eq. 15:
@@ -1599,7 +1600,7 @@ typedef struct hfvis_ns_gi_outputs {
                                     receiver, for diffing a port; NaN at receivers on holes */
 } hfvis_ns_gi_outputs;
 
-/* Multi-resolution height-field global illumination ([NS09]; [NS09] §9, Fig. 6 RENDER).
+/* Multi-resolution height-field global illumination ([NS09] §9, Fig. 6 RENDER).
  * Per receiver (one per s x s block): m slices (Eq. 15-17) give V = Sum_j G_j v_j with
  * v_j = vbar(pi/2) - vbar(omega_max,j) (Eq. 11), G_j the wedge matrices rotated into place
  * (hfvis_ns_sample_matrices; m wedges with the wrap-around one); key lights add their restricted
@@ -1994,7 +1995,7 @@ HFVIS_API double hfvis_falloff_eval(const hfvis_falloff *f, double distance);
  * +INFINITY for unbounded falloffs; NaN for an invalid falloff. */
 HFVIS_API double hfvis_falloff_support(const hfvis_falloff *f);
 
-/* ---- directions and the line lattice ([P3] §5.1-5.2, [P4] §6; [P3] §5.1, [P4] §6; docs/errata.md E24) ------------ */
+/* ---- directions and the line lattice ([P3] §5.1-5.2, [P4] §6; docs/errata.md E24) ------------ */
 
 /* One azimuthal direction of a line sweep. */
 typedef struct hfvis_ssao_direction {
@@ -2117,7 +2118,7 @@ typedef enum hfvis_lsao_pop {
                                     points behind depth steps (docs/errata.md E19: 5x the error) */
 } hfvis_lsao_pop;
 
-/* How a pixel reads a direction's lattice values ([P3] §5.1, [P3] §5.1, Fig. 8; docs/errata.md E23). */
+/* How a pixel reads a direction's lattice values ([P3] §5.1, Fig. 8; docs/errata.md E23). */
 typedef enum hfvis_ssao_gather {
     HFVIS_SSAO_GATHER_DEFAULT = 0,   /* = NEAREST */
     HFVIS_SSAO_GATHER_NEAREST = 1,   /* the nearest lattice sample (the paper) */
@@ -2190,7 +2191,7 @@ HFVIS_API hfvis_status hfvis_lsao_line(const double *x, const double *y, const d
                                        const double *sin_t_eval, int n, int orthographic,
                                        const hfvis_lsao_options *opts, int *stack, double *out);
 
-/* Oracle of hfvis_lsao_line ([P3] Fig. 7; the [P3] Fig. 7 reference): for each receiver, walk
+/* Oracle of hfvis_lsao_line (the reference of [P3] Fig. 7): for each receiver, walk
  * back over the earlier points; point j is visible iff Sin(p_j - p_i) exceeds every Sin seen
  * nearer to i; among the visible points take the largest Occ(., st_cull) (ties: the higher,
  * i.e. farther visible point) and return its Occ(., st_eval) (st_eval if none). Same contract,
@@ -2238,7 +2239,7 @@ HFVIS_API hfvis_status hfvis_lsao_direction_naive(const hfvis_camera *cam, const
                                                   const hfvis_ssao_line *lines, float *values,
                                                   float *sample_depth);
 
-/* Gather one direction's lattice values into per-pixel accumulators ([P3] §5.1, [P3] §5.1, Fig. 8; docs/errata.md E23):
+/* Gather one direction's lattice values into per-pixel accumulators ([P3] §5.1, Fig. 8; docs/errata.md E23):
  * for every non-background inner pixel c (buffer texel (x + guard_x, y + guard_y), centre
  * + 0.5), the nearest lattice sample (GATHER_NEAREST) or the 2 x 2 neighbours (BILINEAR) are
  * accepted when their value is not NaN, |sample_depth - z_c| <= reject_depth * z_c and (normals
@@ -2617,7 +2618,7 @@ HFVIS_API hfvis_status hfvis_ffao_slice(const double p[2], const double n[2], co
                                         double theta_start, const hfvis_ffao_options *opts,
                                         double *obscurance, double *theta_min);
 
-/* Screen-space far-field ambient obscurance ([P4]; [P4] Alg. 2), the COS convention
+/* Screen-space far-field ambient obscurance ([P4] Alg. 2), the COS convention
  * (docs/errata.md C4: converges to the ray-traced reference, P4 Eq. 1). Per scan direction k (uniform
  * azimuths, dense lattice D_S = D_L = 1 px): the scan kernel stores per line and interval of B0
  * steps m0 = max Q.z and m1 = max(Q.z - s Q.e1) over the samples (background skipped), levels
@@ -3421,13 +3422,13 @@ typedef enum hfvis_voxelize_method {
      * projected triangle gets the voxel of slab floor(z), z = the triangle plane's depth at the
      * centre. One fragment per covered pixel. No vertex limit (max_output_vertices must be 0). */
     HFVIS_VOXELIZE_PIXEL_RULE = 0,
-    /* Geometry-shader triangle slicing ([G12] Alg. 5, [G12] ch. 6, Alg. 5; docs/errata.md E58): the triangle is clipped
+    /* Geometry-shader triangle slicing ([G12] ch. 6, Alg. 5; docs/errata.md E58): the triangle is clipped
      * (Sutherland-Hodgman against both planes of a slab) into one convex piece per slab it
      * spans, lowest slab first, and each piece is rasterised (pixel centres, top-left rule on the
      * piece's own edges) into its slab. Equals the pixel rule except where a pixel centre lies
      * within rounding (about 1e-12 voxels) of a slab plane or a triangle edge. */
     HFVIS_VOXELIZE_GS_SLICING = 1,
-    /* Pixel-shader fragment clipping ([G12] Alg. 6, [G12] ch. 6, Alg. 6; docs/errata.md E57): the whole triangle is rasterised
+    /* Pixel-shader fragment clipping ([G12] ch. 6, Alg. 6; docs/errata.md E57): the whole triangle is rasterised
      * once per slab it spans, lowest first, and a fragment is kept only in the slab that holds its
      * depth, [k, k+1) (the half-open form of the thesis' open interval). Without a limit this is
      * the pixel rule exactly; the cost grows with the slabs spanned (n passes over the
@@ -3550,7 +3551,7 @@ HFVIS_API hfvis_status hfvis_voxelize_occupancy(const hfvis_mesh *mesh,
                                                 const hfvis_voxelize_options *opts, uint8_t *occ);
 
 /* Ready-made attribute callbacks (hfvis_voxel_fragment_fn), the thesis' Volume Buffer channels
- * ([G12] §6.5, [G12] ch. 6). */
+ * ([G12] §6.5). */
 
 /* values[0] = 1 (occupancy). user unused. */
 HFVIS_API void hfvis_voxel_fragment_occupancy(const hfvis_voxel_fragment *f, float *values,
@@ -4175,7 +4176,7 @@ HFVIS_API hfvis_status hfvis_voxel_distance_metrics_naive(const hfvis_mesh *mesh
 #define HFVIS_VISFIELD_MAX_BYTES ((uint64_t)1 << 32)
 #define HFVIS_VISFIELD_FILE_HEADER 80      /* bytes before the payload in a field file */
 
-/* How the hemisphere of directions maps onto the D x D texels ([G12] §4.4.4, [G12] ch. 4, Fig. 30-34). */
+/* How the hemisphere of directions maps onto the D x D texels ([G12] §4.4.4, Fig. 30-34). */
 typedef enum hfvis_dirmap {
     HFVIS_DIRMAP_DEFAULT = 0,    /* = HFVIS_DIRMAP_CONCENTRIC */
     /* Polar ("uniform") mapping: column i is the polar angle theta = (i + 0.5)/D * pi/2 from the
@@ -4192,7 +4193,7 @@ typedef enum hfvis_dirmap {
     HFVIS_DIRMAP_CONCENTRIC = 3
 } hfvis_dirmap;
 
-/* What a texel stores ([G12] §4.6.1, [G12] ch. 4, Fig. 42; [G12] ch. 4, Alg. 1). */
+/* What a texel stores ([G12] §4.6.1, Fig. 42, ch. 4 Alg. 1). */
 typedef enum hfvis_visfield_format {
     HFVIS_VISFIELD_DEFAULT = 0,  /* = HFVIS_VISFIELD_U8 */
     /* 1 byte per texel: a hit at distance th stores q = min(254, floor(254 th/(2R) + 0.5)),
@@ -4341,7 +4342,7 @@ typedef struct hfvis_visfield_build_options {
 /* The defaults: malloc/free, a BVH built inside, no progress callback. */
 HFVIS_API hfvis_visfield_build_options hfvis_visfield_build_options_default(void);
 
-/* Build a visibility field ([G12] Alg. 1, [G12] ch. 4, Alg. 1): for every sample k, p_k = c + R u_k,
+/* Build a visibility field ([G12] ch. 4, Alg. 1): for every sample k, p_k = c + R u_k,
  * w = -u_k, and every texel (i, j) of the mapping (unused rejection texels get the miss code),
  * the ray hfvis_ray{origin = (float)p_k, direction = (float)(lx t + ly b + lz w), t_min = 0,
  * t_max = INFINITY, cull none} is cast with hfvis_bvh_closest_hit; a hit at t stores
@@ -4460,7 +4461,7 @@ typedef struct hfvis_visfield_ao_options {
 
 HFVIS_API hfvis_visfield_ao_options hfvis_visfield_ao_options_default(void);
 
-/* Ambient obscurance of receiver points from visibility fields ([G12] Alg. 2/3, [G12] ch. 4, Alg. 2-3; docs/errata.md E64):
+/* Ambient obscurance of receiver points from visibility fields ([G12] ch. 4, Alg. 2-3; docs/errata.md E64):
  * per point x with unit normal n (renormalised here), the S x S rays l = concentric((2i+1)/S - 1,
  * (2j+1)/S - 1) lifted by Malley (cosine distributed, as the thesis' pre-generated ray set) in
  * the frame hfvis_visfield_frame(n), direction lx t + ly b + lz n, from x + offset n; each object
@@ -4503,7 +4504,7 @@ typedef struct hfvis_visfield_shadow_options {
 HFVIS_API hfvis_visfield_shadow_options hfvis_visfield_shadow_options_default(void);
 
 /* Visibility of a spherical light (centre, radius >= 0; 0 = a point light, hard shadows) from
- * points ([G12] §4.5.2, [G12] ch. 4): per point x, `samples` points y_i on the disc of the light
+ * points ([G12] §4.5.2): per point x, `samples` points y_i on the disc of the light
  * facing x (centre + radius (dx e1 + dy e2), (dx, dy) = the concentric map of the Hammersley
  * point ((i + 0.5)/N, radical inverse of i in base 2), (e1, e2) = the frame of the unit vector
  * from x to the centre); the shadow ray x -> y_i of length L is blocked when some object
@@ -4739,7 +4740,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_volgi_sh_cone(const double axis[
 
 /* ---- options ------------------------------------------------------------------------------ */
 
-/* How the flux that leaves a voxel toward a face neighbour is computed (eq. 11, [G12] ch. 5, eq. 11; docs/errata.md E59). */
+/* How the flux that leaves a voxel toward a face neighbour is computed ([G12] ch. 5, eq. 11; docs/errata.md E59). */
 typedef enum hfvis_volgi_transfer {
     HFVIS_VOLGI_TRANSFER_DEFAULT = 0, /* = CONE */
     /* Default: the reference kernel of docs/errata.md E59. The flux through the face toward
@@ -4868,7 +4869,7 @@ typedef struct hfvis_volgi_energy {
                              reached surfaces in this step */
 } hfvis_volgi_energy;
 
-/* VPL injection ([G12] §5.5.1, [G12] ch. 5): prop[v] = L_v s^2 CC(n_v) per band for every voxel with
+/* VPL injection ([G12] §5.5.1): prop[v] = L_v s^2 CC(n_v) per band for every voxel with
  * occupancy > 0, a non-zero normal and radiance L_v = radiance[3v..3v+2] (outgoing radiance of the
  * lit or emissive surface, >= 0), i.e. a cosine lobe carrying the flux pi L_v s^2 (s^2: the face
  * perpendicular to the normal's dominant axis); an occupied voxel without a normal gets the
@@ -4932,7 +4933,7 @@ HFVIS_API hfvis_status hfvis_volgi_propagate(const hfvis_volgi_geometry *geometr
                                              float *prop, float *accum,
                                              hfvis_volgi_energy *energy);
 
-/* Final gather ([G12] §5.5.3, eqs. 12-15, [G12] ch. 5, eq. 12-15; docs/errata.md E60) at a surface point with unit normal n
+/* Final gather ([G12] §5.5.3, eqs. 12-15; docs/errata.md E60) at a surface point with unit normal n
  * (normalised here): with g = (p - origin)/cell - 1/2, b = floor(g), f = g - b, the trilinear
  * weights of the 8 voxels b + {0,1}^3 are applied to accum over those inside the grid with
  * occupancy > 0 only ("from the eight closest grid points only the ones corresponding to occupied
@@ -5021,7 +5022,7 @@ HFVIS_API hfvis_status hfvis_volgi_direct_irradiance(const hfvis_volgi_scene *sc
 HFVIS_API hfvis_status hfvis_volgi_grid_fit(const hfvis_mesh *mesh, int resolution,
                                             hfvis_volume_grid *out);
 
-/* Voxelization with direct lighting ([G12] ch. 5 Alg. 4, [G12] ch. 5, Alg. 4): hfvis_voxelize_surface with
+/* Voxelization with direct lighting ([G12] ch. 5, Alg. 4): hfvis_voxelize_surface with
  * HFVIS_AXES_ALL (the x, y and z slicing passes, pixel-centre rule) over scene->mesh, where each
  * fragment at position p on triangle t with normal n_t writes
  *   radiance = albedo_t E_direct(p, n_t)/pi + emission_t   (hfvis_volgi_direct_irradiance)
@@ -5210,7 +5211,7 @@ typedef enum hfvis_lk_pattern {
 /* The falloff rho(x) of the normalised occluder distance x = D/r, non-increasing, rho = 0 from
  * x = 1 on. The ray lengths realise it: l_i/r = sup{x in [0, 1] : rho(x) >= xi_i} with the
  * stratified xi_i = (pi(i) + 1/2)/N, pi a seeded random permutation (uncorrelated with the
- * directions), so P(l >= D) = rho(D) ([LK] Eq. 3, [LK] §3, Eq. 1-3). */
+ * directions), so P(l >= D) = rho(D) ([LK] §3, Eq. 1-3). */
 typedef enum hfvis_lk_falloff {
     HFVIS_LK_FALLOFF_DEFAULT = 0,   /* = CONSTANT */
     HFVIS_LK_FALLOFF_CONSTANT = 1,  /* rho = 1 on [0, 1): every l_i = r (the paper's tests) */
@@ -5439,7 +5440,7 @@ typedef enum hfvis_lk_sides {
     HFVIS_LK_SIDES_PER_TRIANGLE = 3 /* two_sided[t] != 0 marks triangle t two-sided */
 } hfvis_lk_sides;
 
-/* Method 1's bounding volume of a triangle's region of influence ([LK] §4.1, [LK] §4.1, Fig. 2-3). */
+/* Method 1's bounding volume of a triangle's region of influence ([LK] §4.1, Fig. 2-3). */
 typedef enum hfvis_lk_volume {
     HFVIS_LK_VOLUME_DEFAULT = 0, /* = AUTO */
     HFVIS_LK_VOLUME_AUTO = 1,    /* prism if R_T/r_max > alpha, else the sphere billboard */

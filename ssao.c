@@ -7,7 +7,7 @@
  *      ([P4] §3; docs/errata.md C7)
  *   3. Falloff functions ([P3] Eq. 2-3; docs/errata.md C4)
  *   4. The azimuthal line plane, uniform and box-pattern directions, the line lattice
- *      ([P3] §5.1-5.2, [P4] §6; [P3] §5.1, [P4] §6; docs/errata.md E20, E21; docs/errata.md E24)
+ *      ([P3] §5.1-5.2, [P4] §6; docs/errata.md E20, E21, E24)
  *   5. P3 line-sweep AO: the obscurity hull along one line ([P3] §4, Alg. 1) and its brute-force
  *      oracle ([P3] Fig. 7), the sweep of one direction, the per-pixel gather ([P3] §5.1), the
  *      driver ([P3] §4-5)
@@ -17,7 +17,7 @@
  *   9. P4 far-field obscurance: scan kernel (Alg. 1, sign corrected), virtual points, level
  *      hierarchy, prefix sums and sector averaging, obscurity kernel (Alg. 2), slab estimator
  *      (quadrature, L(a,b,c,d) table, closed form for rho = 1), near field, sparse 3x3, blur
- *      ([P4] §3-7; [P4] §3-11)
+ *      ([P4] §3-11)
  *  10. The mipmap baseline ([P4] §5)
  *  11. Error metrics ([P4] §8; docs/errata.md E36)
  *  12. Laine-Karras bitmask ray-cast AO: ray sets, receiver frames, exact and table triangle
@@ -730,7 +730,7 @@ double hfvis_falloff_support(const hfvis_falloff *f)
 }
 
 /* ========================================================================================== */
-/* 4. Line plane, directions, lattice ([P3] §5.1-5.2, [P4] §6; [P3] §5.1, [P4] §6; docs/errata.md E20, E21; docs/errata.md E24) */
+/* 4. Line plane, directions, lattice ([P3] §5.1-5.2, [P4] §6; docs/errata.md E20, E21, E24) */
 /* ========================================================================================== */
 
 /* e1 of screen direction (du, dv) (docs/errata.md E20, E21; unit, z = 0). */
@@ -1258,7 +1258,7 @@ static double ss_occ(const ss_fall *f, double hx, double hy, double ux, double u
     return s > st ? st + (s - st) * ss_rho(f, len) : st;
 }
 
-/* The obscurity hull along one line ([P3] Alg. 1, [P3] §4.2, Alg. 1). */
+/* The obscurity hull along one line ([P3] §4.2, Alg. 1). */
 static void ss_hull_line(const double *x, const double *y, const double *stc, const double *ste,
                          int n, int persp, double fixed, const ss_fall *f, int ties, int *stack,
                          double *out)
@@ -1455,7 +1455,7 @@ static int ss_texel(double p, int n)
     return (int)f;
 }
 
-/* sin t of the real tangent of a sample ([P3] §4.1, [P3] §4.1, Fig. 7): normal of texel (tx, ty)
+/* sin t of the real tangent of a sample ([P3] §4.1, Fig. 7): normal of texel (tx, ty)
  * projected into the plane, t = side*(-n2.y, n2.x) (side +1: toward the occluders behind, as
  * LSAO; -1: ahead, as HBAO), sin t = t.u/|t|; the fixed value without a usable normal. */
 static double ss_real_sin_t(const ss_cam *c, const float *normals, int tx, int ty,
@@ -2805,7 +2805,7 @@ double hfvis_ffao_table_lookup(const hfvis_ffao_table *t, double a, double b, do
     return ssb_lookup(t, a, b, c, d);
 }
 
-/* ---- 9.3 virtual points, sector weights, the slice estimator ([P4] §4, Eq. 2-3; [P4] §6) ------------- */
+/* ---- 9.3 virtual points, sector weights, the slice estimator ([P4] §4, Eq. 2-3, §6) ------------- */
 
 void hfvis_ffao_virtual_point(double m0, double m1, double slope, double zscale, double h[2])
 {

@@ -4,7 +4,7 @@
  *   1. Common: mesh and grid validation (allocation, checked sizes, the PRNGs and file reading
  *      are hfvis.c's hfvis__ helpers)
  *   2. Views: GL-convention matrices, depth linearisation (thesis eq. 16, sign restored)
- *   3. Volume grids and the Volume Buffer (thesis ch. 6 §6.3; [G12] ch. 6)
+ *   3. Volume grids and the Volume Buffer ([G12] §6.3)
  *   4. Meshes: analytic test meshes (box, spheres, torus, torus knot, height field, room,
  *      teapot) and the Wavefront OBJ codec
  *   5. Reference rasterizer: fixed-point top-left coverage, near clipping, ray-per-pixel oracle
@@ -298,7 +298,7 @@ HFVIS_API double hfvis_eye_z_to_depth(double z_eye, double near_plane, double fa
 }
 
 /* ========================================================================================== */
-/* 3. Volume grids and the Volume Buffer ([G12] §6.3; [G12] ch. 6)                             */
+/* 3. Volume grids and the Volume Buffer ([G12] §6.3)                                         */
 /* ========================================================================================== */
 
 /* Bounds of the vertices the triangles of a valid mesh use (a soup may carry unused vertices);
@@ -2997,7 +2997,7 @@ HFVIS_API hfvis_status hfvis_bvh_any_hit(const hfvis_bvh *bvh, const hfvis_mesh 
 /* 7. Surface voxelization into the Volume Buffer                                             */
 /*     [G12] ch. 6 (§6.4.1 Alg. 5 geometry-shader triangle slicing, §6.4.2 Alg. 6 pixel-shader */
 /*     fragment clipping, §6.6 output-vertex limit), ch. 5 §5.5.1 Alg. 4 (three axial passes   */
-/*     merged with MAX); [G12] ch. 6, Alg. 5-6; [G12] ch. 6                                    */
+/*     merged with MAX)                                                                        */
 /* ========================================================================================== */
 /*
  * Everything happens in grid space g = (p - origin)/cell, where a voxel is a unit cube. A pass
@@ -3853,7 +3853,7 @@ HFVIS_API hfvis_status hfvis_voxelize_occupancy(const hfvis_mesh *mesh,
     return HFVIS_OK;
 }
 
-/* ---- ready-made attribute callbacks ([G12] §6.5; [G12] ch. 6) ------------------------------- */
+/* ---- ready-made attribute callbacks ([G12] §6.5) ----------------------------------------- */
 
 HFVIS_API void hfvis_voxel_fragment_occupancy(const hfvis_voxel_fragment *f, float *values,
                                               void *user)
@@ -8782,7 +8782,7 @@ HFVIS_API hfvis_status hfvis_visfield_load(const char *path, const hfvis_allocat
 /* Indirect Illumination of Dynamic Scenes": Alg. 4, eqs. 7, 11-15; [G12] ch. 5)              */
 /*   GI.1 2-band SH: basis, clamped cosine, cone ([G12] ch. 5)                                */
 /*   GI.2 options, transport constants, validation                                           */
-/*   GI.3 VPL injection ([G12] §5.5.1, [G12] ch. 5)                                           */
+/*   GI.3 VPL injection ([G12] §5.5.1)                                                        */
 /*   GI.4 one propagation step (eq. 11 with the reference kernel of [G12] ch. 5, eq. 11; docs/errata.md E59): the fast */
 /*        gathering kernel, the literal reference, the energy accounting                     */
 /*   GI.5 the propagation loop (multiple bounces, §5.5.2 / §5.6)                               */

@@ -1,6 +1,6 @@
 /* bench_ssaob.c - P4 far-field AO: time per pixel at 1280(+256)x720(+144) (quick: 320(+64)x
  * 180(+36)), and error against the screen-space ray-traced reference beside the mipmap baseline's
- * error at the same sample count ([P4] §8, [P4] §8-10), on the knot-on-ground scene of the
+ * error at the same sample count ([P4] §8-10), on the knot-on-ground scene of the
  * LSAO bench (100k triangles, rasterized). The reference is noisy: it is run twice with
  * independent seeds, e_A is taken against their mean, and the RMS error is corrected for the
  * reference's own variance (E[(m - r1)^2] - E[(r1 - r2)^2]/2 is unbiased for E[(m - truth)^2]). */

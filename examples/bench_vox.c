@@ -1,4 +1,4 @@
-/* bench_vox.c - surface voxelizers ([G12] ch. 6 Alg. 5/6, ch. 5 Alg. 4; [G12] ch. 6, Alg. 5-6) on
+/* bench_vox.c - surface voxelizers ([G12] ch. 6 Alg. 5-6, ch. 5 Alg. 4) on
  * the issue's 100k-triangle torus knot at 128^3, 256^3, 512^3 (longest axis), each method beside
  * its per-voxel oracle in the same run; the same voxels written into an 8x larger grid (cost
  * follows the voxels written, not the grid volume); and a coarse icosphere whose large triangles

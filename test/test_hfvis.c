@@ -23,7 +23,7 @@ static int rng_int(int n) { return (int)(rng_next() % (uint64_t)n); }
 
 
 /* ---------------------------------------------------------------------------------------- */
-/* 1. Hull stack vs brute force ([P1] Alg. 1; docs/errata.md E1, E2; docs/errata.md E2; [P2] §6) */
+/* 1. Hull stack vs brute force ([P1] Alg. 1; docs/errata.md E1, E2; [P2] §6) */
 /* ---------------------------------------------------------------------------------------- */
 
 #define LINE_MAX_N 320
@@ -3302,7 +3302,7 @@ static void run_env_tests(void)
 
 
 
-/* test_p2.c - P2 intervisibility tests ([P2] §4-7, §10.1; docs/errata.md; [P2] §6):
+/* P2 intervisibility tests ([P2] §4-7, §10.1):
  * the convex-hull tree against the naive visible sets, the field sweeps against their oracles,
  * indirect light (band rule, furnace identity), terrain GI and direct light. */
 
@@ -3320,7 +3320,7 @@ static double p2t_unit(void) { return (double)(p2t_next() >> 11) * (1.0 / 900719
 static int p2t_int(int n) { return (int)(p2t_next() % (uint64_t)n); }
 
 /* ---------------------------------------------------------------------------------------- */
-/* 1. The hull tree against the naive visible sets (docs/errata.md E14; [P2] §6; [P2] §10.1) */
+/* 1. The hull tree against the naive visible sets (docs/errata.md E14; [P2] §6, §10.1) */
 /* ---------------------------------------------------------------------------------------- */
 
 #define P2T_NMAX 300

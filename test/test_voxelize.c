@@ -1,5 +1,5 @@
 /* test_voxelize.c - surface voxelizers and the Volume Buffer attribute path ([G12] ch. 5 Alg. 4,
- * ch. 6 Alg. 5/6; [G12] ch. 6, Alg. 5-6). Exact analytic counts of the fast
+ * ch. 6 Alg. 5-6). Exact analytic counts of the fast
  * routines against their per-voxel oracle bit for bit, the output-vertex holes, 6-separation of
  * the three-axis variant, blends, callbacks, bad arguments. */
 #include "hfvis.h"
@@ -939,7 +939,7 @@ TEST(attribute_callbacks)
 }
 
 
-/* ---- output-vertex limit: the thesis' holes ([G12] ch. 6; docs/errata.md E58; [G12] Fig. 66) ------------ */
+/* ---- output-vertex limit: the thesis' holes ([G12] ch. 6, Fig. 66; docs/errata.md E58) ------------ */
 
 /* Pixels of the pass along axis a whose column holds no voxel although its centre lies in the
  * projected triangle (the PR voxelization tells which centres are covered: one voxel each). */
