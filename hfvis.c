@@ -157,6 +157,14 @@ int hfvis__plane_fits(ptrdiff_t stride, int height, int floats_per_pixel)
            (size_t)height <= (size_t)PTRDIFF_MAX / ((size_t)floats_per_pixel * sizeof(float)) / (size_t)stride;
 }
 
+int hfvis__all_finite(const double *v, int n)
+{
+    int i;
+    for (i = 0; i < n; i++)
+        if (!isfinite(v[i])) return 0;
+    return 1;
+}
+
 uint64_t hfvis__mix64(uint64_t x)
 {
     x += 0x9E3779B97F4A7C15ull;

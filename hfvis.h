@@ -5634,8 +5634,8 @@ HFVIS_API hfvis_status hfvis_lk_image(hfvis_lk_method method, const hfvis_mesh *
 /* ========================================================================================== */
 /* Seen only by the library's own .c files, which define HFVIS__INTERNAL before including this
  * header; user code never sees it and must not rely on it. Everything is defined once, in
- * hfvis.c section 1 (Common) and section 2 (file reading), so ssao.c and voxel.c need hfvis.c,
- * as the vendoring note at the top says. */
+ * hfvis.c section 1 (Common) and section 2 (file reading), except the mesh check (voxel.c
+ * section 1), so ssao.c and voxel.c need hfvis.c, as the vendoring note at the top says. */
 #ifdef HFVIS__INTERNAL
 #ifndef HFVIS__INTERNAL_H
 #define HFVIS__INTERNAL_H
@@ -5673,6 +5673,11 @@ void *hfvis__alloc_array(const hfvis_allocator *a, size_t count, size_t elem);
  * floats a pixel, is addressable: every (y*stride + x)*floats_per_pixel stays below PTRDIFF_MAX
  * bytes. */
 int hfvis__plane_fits(ptrdiff_t stride, int height, int floats_per_pixel);
+/* 1 if v[0..n) are all finite. */
+int hfvis__all_finite(const double *v, int n);
+/* HFVIS_OK when the mesh is usable (hfvis_mesh: arrays present, indices < vertex_count, finite
+ * coordinates), else HFVIS_ERR_INVALID_ARGUMENT; O(V + T). Defined in voxel.c section 1. */
+hfvis_status hfvis__mesh_check(const hfvis_mesh *m);
 
 /* The library's PRNGs: stateless SplitMix64 (Steele, Lea, Flood 2014) hashing, its stateful
  * stream, and PCG32 (O'Neill 2014, XSH-RR). No global state; every stream is seeded. */
