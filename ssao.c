@@ -3872,27 +3872,6 @@ static void lk_cross(const double a[3], const double b[3], double out[3])
     out[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-static int lk_finite3(const double v[3])
-{
-    return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
-}
-
-/* Mesh check (as voxel.c's): arrays present, indices in range, finite coordinates. O(V + T). */
-static hfvis_status lk_mesh_check(const hfvis_mesh *m)
-{
-    size_t i;
-    if (!m) return HFVIS_ERR_INVALID_ARGUMENT;
-    if ((m->vertex_count && !m->xyz) || (m->triangle_count && !m->indices))
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    if (m->vertex_count > SIZE_MAX / 3 || m->triangle_count > SIZE_MAX / 3)
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    for (i = 0; i < 3 * m->vertex_count; i++)
-        if (!isfinite(m->xyz[i])) return HFVIS_ERR_INVALID_ARGUMENT;
-    for (i = 0; i < 3 * m->triangle_count; i++)
-        if ((size_t)m->indices[i] >= m->vertex_count) return HFVIS_ERR_INVALID_ARGUMENT;
-    return HFVIS_OK;
-}
-
 static const float *lk_vertex(const hfvis_mesh *m, size_t t, int k)
 {
     return m->xyz + 3 * (size_t)m->indices[3 * t + (size_t)k];
@@ -4411,7 +4390,7 @@ HFVIS_API hfvis_status hfvis_lk_rays_custom(int count, double radius, const doub
     for (i = 0; i < count; i++) {
         const double *d = directions + 3 * i;
         double len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-        if (!lk_finite3(d) || !(len2 > 0.0) || !isfinite(len2) || !(d[2] / sqrt(len2) > 0.0))
+        if (!hfvis__all_finite(d, 3) || !(len2 > 0.0) || !isfinite(len2) || !(d[2] / sqrt(len2) > 0.0))
             return HFVIS_ERR_INVALID_ARGUMENT;
         if (lengths && !(lengths[i] >= 0.0 && lengths[i] <= 1.0)) return HFVIS_ERR_INVALID_ARGUMENT;
     }
@@ -4542,7 +4521,7 @@ HFVIS_API hfvis_status hfvis_lk_frame(const hfvis_lk_rays *rays, const double no
 {
     lk_jit j;
     double len2;
-    if (!lk_rays_valid(rays) || !normal || !frame || !lk_finite3(normal) ||
+    if (!lk_rays_valid(rays) || !normal || !frame || !hfvis__all_finite(normal, 3) ||
         !lk_jitter_valid(jitter, rotation_max_rad, tilt_max_rad))
         return HFVIS_ERR_INVALID_ARGUMENT;
     len2 = lk_dot(normal, normal);
@@ -4837,7 +4816,7 @@ HFVIS_API hfvis_status hfvis_lk_lut_index(int resolution, const double m[3], dou
 {
     size_t node, T = (size_t)resolution;
     if (!m || !ijk || resolution < HFVIS_LK_LUT_MIN_RESOLUTION ||
-        resolution > HFVIS_LK_LUT_MAX_RESOLUTION || !lk_finite3(m) || !isfinite(d_over_r) ||
+        resolution > HFVIS_LK_LUT_MAX_RESOLUTION || !hfvis__all_finite(m, 3) || !isfinite(d_over_r) ||
         (m[0] == 0.0 && m[1] == 0.0 && m[2] == 0.0))
         return HFVIS_ERR_INVALID_ARGUMENT;
     node = lk_lut_node(resolution, m, d_over_r);
@@ -4862,7 +4841,7 @@ static int lk_lut_valid(const hfvis_lk_lut *L)
 HFVIS_API const uint32_t *hfvis_lk_lut_fetch(const hfvis_lk_lut *lut, int directions,
                                              const double m[3], double d_over_r)
 {
-    if (!lk_lut_valid(lut) || !m || !lk_finite3(m) || !isfinite(d_over_r) ||
+    if (!lk_lut_valid(lut) || !m || !hfvis__all_finite(m, 3) || !isfinite(d_over_r) ||
         (m[0] == 0.0 && m[1] == 0.0 && m[2] == 0.0))
         return NULL;
     return lk_lut_get(lut, directions, m, d_over_r);
@@ -4897,7 +4876,7 @@ HFVIS_API hfvis_status hfvis_lk_plane_mask(const hfvis_lk_rays *rays, const doub
                                            double d_over_r, uint32_t *mask)
 {
     int i;
-    if (!lk_rays_valid(rays) || !m || !mask || !lk_finite3(m) || !isfinite(d_over_r))
+    if (!lk_rays_valid(rays) || !m || !mask || !hfvis__all_finite(m, 3) || !isfinite(d_over_r))
         return HFVIS_ERR_INVALID_ARGUMENT;
     memset(mask, 0, sizeof(uint32_t) * (size_t)rays->words);
     for (i = 0; i < rays->count; i++)
@@ -4923,7 +4902,7 @@ HFVIS_API hfvis_status hfvis_lk_triangle_mask(const hfvis_lk_rays *rays, const h
     lk_tri t;
     int a;
     if (!lk_rays_valid(rays) || !position || !frame || !v0 || !v1 || !v2 || !mask ||
-        !lk_finite3(position) || !lk_frame_valid(frame) || !(r_min >= 0.0) || !(r_max >= r_min) ||
+        !hfvis__all_finite(position, 3) || !lk_frame_valid(frame) || !(r_min >= 0.0) || !(r_max >= r_min) ||
         !(r_max <= rays->radius) || !isfinite(epsilon) || !(epsilon > 0.0))
         return HFVIS_ERR_INVALID_ARGUMENT;
     for (a = 0; a < 3; a++)
@@ -4972,7 +4951,7 @@ static void lk_tri_sphere(const float *v0, const float *v1, const float *v2, dou
         for (k = 0; k < 3; k++) q[k] = lk_dot(a, a) * b[k] - lk_dot(b, b) * a[k];
         lk_cross(q, axb, t);
         for (k = 0; k < 3; k++) c[k] = C[k] + t[k] / den;
-        if (!lk_finite3(c) || !(den > 0.0)) /* (nearly) degenerate: centroid */
+        if (!hfvis__all_finite(c, 3) || !(den > 0.0)) /* (nearly) degenerate: centroid */
             for (k = 0; k < 3; k++) c[k] = (A[k] + B[k] + C[k]) / 3.0;
     }
     for (k = 0; k < 3; k++) {
@@ -5086,7 +5065,7 @@ static int lk_prism_build(const float *f0, const float *f1, const float *f2, dou
         }
     P->nv = 2 * np;
     for (k = 0; k < P->nv; k++)
-        if (!lk_finite3(P->vtx[k])) return 0;
+        if (!hfvis__all_finite(P->vtx[k], 3)) return 0;
     for (k = 0; k < 8; k++)
         if (!isfinite(P->pl[k][3])) return 0;
     return 1;
@@ -5225,7 +5204,7 @@ static hfvis_status lk_ctx_init(lk_ctx *c, const hfvis_mesh *mesh, const hfvis_l
     if (c->o.lut && (c->o.mask_mode == HFVIS_LK_MASK_LUT || c->o.node_mask == HFVIS_LK_NODE_SPHERE_LUT) &&
         c->o.lut->count != R->count)
         return HFVIS_ERR_INVALID_ARGUMENT;
-    s = lk_mesh_check(mesh);
+    s = hfvis__mesh_check(mesh);
     if (s != HFVIS_OK) return s;
     if (c->o.lod_range)
         for (t = 0; t < mesh->triangle_count; t++) {
@@ -5276,7 +5255,7 @@ static int lk_receivers_valid(const hfvis_lk_receivers *rc)
     for (i = 0; i < rc->count; i++) {
         const double *p = rc->position + 3 * i, *n = rc->normal + 3 * i;
         double l2 = lk_dot(n, n);
-        if (!lk_finite3(p) || !lk_finite3(n) || !(l2 > 0.0) || !isfinite(l2)) return 0;
+        if (!hfvis__all_finite(p, 3) || !hfvis__all_finite(n, 3) || !(l2 > 0.0) || !isfinite(l2)) return 0;
     }
     return 1;
 }
@@ -6276,7 +6255,7 @@ HFVIS_API hfvis_status hfvis_lk_image(hfvis_lk_method method, const hfvis_mesh *
         return HFVIS_ERR_INVALID_ARGUMENT;
     s = hfvis_lk_options_resolve(opts, rays->radius, &o);
     if (s != HFVIS_OK) return s;
-    s = lk_mesh_check(mesh);
+    s = hfvis__mesh_check(mesh);
     if (s != HFVIS_OK) return s;
     s = lk_cam_init(&cam, view);
     if (s != HFVIS_OK) return s;

@@ -49,7 +49,7 @@
 
 /* HFVIS_OK when the mesh is usable (hfvis_mesh: indices < vertex_count, finite coordinates),
  * else HFVIS_ERR_INVALID_ARGUMENT. O(V + T). */
-static hfvis_status vx_mesh_check(const hfvis_mesh *m)
+hfvis_status hfvis__mesh_check(const hfvis_mesh *m)
 {
     size_t i, n;
     if (!m) return HFVIS_ERR_INVALID_ARGUMENT;
@@ -101,14 +101,6 @@ HFVIS_API void hfvis_mesh_free(const hfvis_allocator *alloc, hfvis_mesh *mesh)
 
 #define VX_M(m, r, c) ((m)[(c) * 4 + (r)]) /* column-major element (row r, column c) */
 
-static int vx_all_finite(const double *v, int n)
-{
-    int i;
-    for (i = 0; i < n; i++)
-        if (!isfinite(v[i])) return 0;
-    return 1;
-}
-
 /* out = m * in (homogeneous 4-vectors). out must not alias in. */
 VX_MAYBE_UNUSED static void vx_mat4_apply(const double m[16], const double in[4], double out[4])
 {
@@ -133,7 +125,7 @@ HFVIS_API hfvis_status hfvis_mat4_invert(const double m[16], double out[16])
 {
     double a[4][8];
     int r, c, k;
-    if (!m || !out || !vx_all_finite(m, 16)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!m || !out || !hfvis__all_finite(m, 16)) return HFVIS_ERR_INVALID_ARGUMENT;
     for (r = 0; r < 4; r++)
         for (c = 0; c < 8; c++) a[r][c] = c < 4 ? VX_M(m, r, c) : (c - 4 == r ? 1.0 : 0.0);
     for (k = 0; k < 4; k++) {
@@ -170,8 +162,8 @@ HFVIS_API hfvis_status hfvis_mat4_look_at(const double eye[3], const double targ
 {
     double f[3], s[3], u[3], lf, ls;
     int i;
-    if (!eye || !target || !up || !out || !vx_all_finite(eye, 3) || !vx_all_finite(target, 3)
-        || !vx_all_finite(up, 3))
+    if (!eye || !target || !up || !out || !hfvis__all_finite(eye, 3) || !hfvis__all_finite(target, 3)
+        || !hfvis__all_finite(up, 3))
         return HFVIS_ERR_INVALID_ARGUMENT;
     for (i = 0; i < 3; i++) f[i] = target[i] - eye[i];
     lf = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
@@ -222,7 +214,7 @@ HFVIS_API hfvis_status hfvis_mat4_ortho(double left, double right, double bottom
 {
     double b[6];
     b[0] = left, b[1] = right, b[2] = bottom, b[3] = top, b[4] = near_plane, b[5] = far_plane;
-    if (!out || !vx_all_finite(b, 6) || !(left < right) || !(bottom < top)
+    if (!out || !hfvis__all_finite(b, 6) || !(left < right) || !(bottom < top)
         || !(near_plane < far_plane))
         return HFVIS_ERR_INVALID_ARGUMENT;
     memset(out, 0, 16 * sizeof *out);
@@ -328,7 +320,7 @@ HFVIS_API hfvis_status hfvis_volume_grid_fit(const hfvis_mesh *mesh, int resolut
     hfvis_volume_grid g;
     size_t total = 1;
     int a;
-    if (!out || vx_mesh_check(mesh) != HFVIS_OK || mesh->triangle_count == 0 || resolution < 1
+    if (!out || hfvis__mesh_check(mesh) != HFVIS_OK || mesh->triangle_count == 0 || resolution < 1
         || !(padding >= 0.0) || !isfinite(padding))
         return HFVIS_ERR_INVALID_ARGUMENT;
     ext_max = vx_used_bounds(mesh, lo, hi);
@@ -1140,7 +1132,7 @@ HFVIS_API hfvis_status hfvis_mesh_bounds(const hfvis_mesh *mesh, double lo[3], d
     double l[3], h[3];
     size_t v;
     int k;
-    if (!lo || !hi || vx_mesh_check(mesh) != HFVIS_OK || mesh->vertex_count == 0)
+    if (!lo || !hi || hfvis__mesh_check(mesh) != HFVIS_OK || mesh->vertex_count == 0)
         return HFVIS_ERR_INVALID_ARGUMENT;
     for (k = 0; k < 3; k++) l[k] = h[k] = (double)mesh->xyz[k];
     for (v = 1; v < mesh->vertex_count; v++) {
@@ -1559,7 +1551,7 @@ static size_t vx_mesh_obj_emit(const hfvis_mesh *m, unsigned char *out)
 
 HFVIS_API size_t hfvis_obj_encode_size(const hfvis_mesh *mesh)
 {
-    if (vx_mesh_check(mesh) != HFVIS_OK) return 0;
+    if (hfvis__mesh_check(mesh) != HFVIS_OK) return 0;
     return vx_mesh_obj_emit(mesh, NULL);
 }
 
@@ -1567,7 +1559,7 @@ HFVIS_API hfvis_status hfvis_obj_encode(const hfvis_mesh *mesh, void *out, size_
                                         size_t *written)
 {
     size_t need;
-    if (!out || !written || vx_mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!out || !written || hfvis__mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     need = vx_mesh_obj_emit(mesh, NULL);
     if (need == 0) return HFVIS_ERR_INVALID_ARGUMENT;
     if (out_capacity < need) return HFVIS_ERR_BUFFER_TOO_SMALL;
@@ -1604,7 +1596,7 @@ HFVIS_API hfvis_status hfvis_mesh_save(const char *path, const hfvis_mesh *mesh)
     size_t need, written = 0;
     unsigned char *buf;
     hfvis_status s;
-    if (!path || vx_mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!path || hfvis__mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     need = vx_mesh_obj_emit(mesh, NULL);
     if (need == 0) return HFVIS_ERR_INVALID_ARGUMENT;
     buf = (unsigned char *)hfvis__alloc(NULL, need);
@@ -1688,7 +1680,7 @@ static hfvis_status vx_raster_check(const hfvis_mesh *mesh, const hfvis_view *vi
     size_t pixels;
     if (!mesh || !view || !out) return HFVIS_ERR_INVALID_ARGUMENT;
     if (mesh->triangle_count >= (size_t)HFVIS_NO_TRIANGLE) return HFVIS_ERR_LIMIT; /* ids */
-    if (vx_mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (hfvis__mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     *opt = opts ? *opts : hfvis_raster_options_default();
     if (opt->cull != HFVIS_CULL_NONE && opt->cull != HFVIS_CULL_BACK
         && opt->cull != HFVIS_CULL_FRONT)
@@ -1698,7 +1690,7 @@ static hfvis_status vx_raster_check(const hfvis_mesh *mesh, const hfvis_view *vi
     if (opt->normal_toward_viewer != 0 && opt->normal_toward_viewer != 1)
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (view->width < 1 || view->height < 1) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (!vx_all_finite(view->view, 16) || !vx_all_finite(view->proj, 16))
+    if (!hfvis__all_finite(view->view, 16) || !hfvis__all_finite(view->proj, 16))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (!isfinite(view->near_plane) || !isfinite(view->far_plane)
         || !(view->near_plane < view->far_plane)
@@ -1954,7 +1946,7 @@ static void vx_raster_triangle(const vx_raster_ctx *ctx, const hfvis_mesh *mesh,
         if (c[j][2] > c[j][3]) code |= 16;
         if (c[j][2] < -c[j][3]) code |= 32;
         codes_and &= code;
-        if (!vx_all_finite(c[j], 5)) return;
+        if (!hfvis__all_finite(c[j], 5)) return;
         if (!(c[j][5] == c[j][5])) snapped = 0; /* NaN: needs clipping */
     }
     if (codes_and) return; /* all three outside one frustum plane */
@@ -2118,7 +2110,7 @@ HFVIS_API hfvis_status hfvis_rasterize_reference(const hfvis_mesh *mesh, const h
                 o[k] = hn[k] / hn[3];
                 d[k] = hf[k] / hf[3] - o[k];
             }
-            if (!vx_all_finite(o, 3) || !vx_all_finite(d, 3)) continue;
+            if (!hfvis__all_finite(o, 3) || !hfvis__all_finite(d, 3)) continue;
             for (t = 0; t < mesh->triangle_count; t++) {
                 const uint32_t *ix = mesh->indices + 3 * t;
                 double e[3][3], sv[3], sum, b[3], cc[3][4], zc = 0.0, wc = 0.0, zw, ze = 0.0;
@@ -2645,7 +2637,7 @@ HFVIS_API hfvis_status hfvis_bvh_build(const hfvis_mesh *mesh, const hfvis_bvh_o
     if (!mesh) return HFVIS_ERR_INVALID_ARGUMENT;
     n = mesh->triangle_count;
     if (n > HFVIS_BVH_MAX_TRIANGLES) return HFVIS_ERR_LIMIT; /* before reading the arrays */
-    st = vx_mesh_check(mesh);
+    st = hfvis__mesh_check(mesh);
     if (st != HFVIS_OK) return st;
     if (n == 0) {
         memset(out, 0, sizeof *out);
@@ -3783,7 +3775,7 @@ static hfvis_status vx_vox_surface(const hfvis_mesh *mesh, hfvis_volume *vol,
     vx_vox_sink s;
     int c;
     hfvis_status st;
-    if (vx_mesh_check(mesh) != HFVIS_OK || !vol || !vol->data || !vx_grid_valid(&vol->grid)
+    if (hfvis__mesh_check(mesh) != HFVIS_OK || !vol || !vol->data || !vx_grid_valid(&vol->grid)
         || vol->channels < 1 || vol->channels > HFVIS_VOLUME_MAX_CHANNELS)
         return HFVIS_ERR_INVALID_ARGUMENT;
     for (c = 0; c < vol->channels; c++)
@@ -3841,7 +3833,7 @@ HFVIS_API hfvis_status hfvis_voxelize_occupancy(const hfvis_mesh *mesh,
     vx_vox_cfg cfg;
     vx_vox_sink s;
     hfvis_status st;
-    if (vx_mesh_check(mesh) != HFVIS_OK || !vx_grid_valid(grid) || !occ)
+    if (hfvis__mesh_check(mesh) != HFVIS_OK || !vx_grid_valid(grid) || !occ)
         return HFVIS_ERR_INVALID_ARGUMENT;
     st = vx_vox_resolve(opts, &cfg);
     if (st != HFVIS_OK) return st;
@@ -3977,7 +3969,7 @@ static hfvis_status vx_cons_args(const hfvis_mesh *mesh, const hfvis_volume_grid
 {
     size_t v;
     int a;
-    if (!out || !vx_grid_valid(grid) || vx_mesh_check(mesh) != HFVIS_OK)
+    if (!out || !vx_grid_valid(grid) || hfvis__mesh_check(mesh) != HFVIS_OK)
         return HFVIS_ERR_INVALID_ARGUMENT;
     for (v = 0; v < mesh->vertex_count; v++)
         for (a = 0; a < 3; a++) {
@@ -4655,7 +4647,7 @@ HFVIS_API hfvis_status hfvis_voxelize_conservative(const hfvis_mesh *mesh,
     size_t t, v, n;
     vx_cons_vert *vert;
     vx_cons_bricks B;
-    if (!occ || !vx_grid_valid(grid) || vx_mesh_check(mesh) != HFVIS_OK)
+    if (!occ || !vx_grid_valid(grid) || hfvis__mesh_check(mesh) != HFVIS_OK)
         return HFVIS_ERR_INVALID_ARGUMENT;
     /* scratch: every vertex in grid space with its ranges (transformed once, and checked against
      * VX_CONS_MAX_COORD as vx_cons_args does), and the brick bits */
@@ -5071,7 +5063,7 @@ HFVIS_API hfvis_status hfvis_mesh_is_watertight(const hfvis_mesh *mesh,
     uint64_t *keys;
     size_t t, m, i;
     int ok = 1;
-    if (!result || vx_mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!result || hfvis__mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     if (mesh->triangle_count == 0) {
         *result = 1;
         return HFVIS_OK;
@@ -5776,7 +5768,7 @@ static hfvis_status vx_iv_image(const hfvis_depth_image *im, vx_iv_img *out)
     int r;
     if (!im || !im->depth) return HFVIS_ERR_INVALID_ARGUMENT;
     v = &im->view;
-    if (v->width < 1 || v->height < 1 || !vx_all_finite(v->view, 16) || !vx_all_finite(v->proj, 16)
+    if (v->width < 1 || v->height < 1 || !hfvis__all_finite(v->view, 16) || !hfvis__all_finite(v->proj, 16)
         || !isfinite(v->near_plane) || !isfinite(v->far_plane)
         || !(v->near_plane < v->far_plane) || (!v->orthographic && !(v->near_plane > 0.0)))
         return HFVIS_ERR_INVALID_ARGUMENT;
@@ -5787,7 +5779,7 @@ static hfvis_status vx_iv_image(const hfvis_depth_image *im, vx_iv_img *out)
         || !hfvis__mul_size(px, (size_t)(im->attribute_count > 0 ? im->attribute_count : 1), &na))
         return HFVIS_ERR_INVALID_ARGUMENT;
     hfvis_mat4_multiply(v->proj, v->view, m);
-    if (!vx_all_finite(m, 16)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!hfvis__all_finite(m, 16)) return HFVIS_ERR_INVALID_ARGUMENT;
     memset(out, 0, sizeof *out);
     for (r = 0; r < 4; r++) {
         out->ez[r] = VX_M(v->view, 2, r);
@@ -6044,7 +6036,7 @@ HFVIS_API hfvis_status hfvis_iv_classify(const hfvis_depth_image *image, const d
     double ez, X, Y, W;
     int px, py;
     hfvis_iv_class cls;
-    if (!out || !point || !vx_all_finite(point, 3) || !isfinite(bias) || !(bias >= 0.0))
+    if (!out || !point || !hfvis__all_finite(point, 3) || !isfinite(bias) || !(bias >= 0.0))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (vx_iv_image(image, &im) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     ez = vx_iv_row(im.ez, point[0], point[1], point[2]);
@@ -6629,7 +6621,7 @@ static hfvis_status vx_iv_metric_init(vx_iv_metric *M, const hfvis_mesh *mesh,
     double lo[3], hi[3], sum = 0.0, s = 0.0, e[3];
     int a;
     memset(M, 0, sizeof *M);
-    if (!occ || !vx_grid_valid(grid) || vx_mesh_check(mesh) != HFVIS_OK)
+    if (!occ || !vx_grid_valid(grid) || hfvis__mesh_check(mesh) != HFVIS_OK)
         return HFVIS_ERR_INVALID_ARGUMENT;
     M->mesh = mesh;
     M->samples = opts && opts->sample_count ? opts->sample_count : VX_IV_DEFAULT_METRIC_SAMPLES;
@@ -7597,7 +7589,7 @@ HFVIS_API hfvis_status hfvis_visfield_bounding_sphere(const hfvis_mesh *mesh, do
     double lo[3], hi[3], c[3], r2 = 0.0, r;
     size_t v;
     int a;
-    if (!mesh || !center || !radius || vx_mesh_check(mesh) != HFVIS_OK || mesh->vertex_count == 0)
+    if (!mesh || !center || !radius || hfvis__mesh_check(mesh) != HFVIS_OK || mesh->vertex_count == 0)
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (hfvis_mesh_bounds(mesh, lo, hi) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     for (a = 0; a < 3; a++) c[a] = 0.5 * lo[a] + 0.5 * hi[a];
@@ -7674,7 +7666,7 @@ static hfvis_status vx_vf_build_check(const hfvis_mesh *mesh, const hfvis_visfie
 {
     size_t need, v;
     double lim;
-    if (!mesh || !vf || vx_mesh_check(mesh) != HFVIS_OK || !vf->maps)
+    if (!mesh || !vf || hfvis__mesh_check(mesh) != HFVIS_OK || !vf->maps)
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (!isfinite(vf->center[0]) || !isfinite(vf->center[1]) || !isfinite(vf->center[2])
         || !isfinite(vf->radius) || !(vf->radius > 0.0) || !vx_vf_n_valid(vf->positions_n)
@@ -8042,7 +8034,7 @@ static hfvis_status vx_vf_objects_check(const hfvis_visfield_object *objects, si
         const hfvis_visfield_object *o = objects + i;
         if (!vx_vf_transform(o->object_to_world, &tmp)) return HFVIS_ERR_INVALID_ARGUMENT;
         if (reference) {
-            if (!vx_vf_params_ok(o->field) || vx_mesh_check(o->mesh) != HFVIS_OK)
+            if (!vx_vf_params_ok(o->field) || hfvis__mesh_check(o->mesh) != HFVIS_OK)
                 return HFVIS_ERR_INVALID_ARGUMENT;
             if (o->bvh && o->bvh->triangle_count != o->mesh->triangle_count)
                 return HFVIS_ERR_INVALID_ARGUMENT;
@@ -9700,7 +9692,7 @@ static hfvis_status vx_gi_scene_check(const hfvis_volgi_scene *sc)
     int l;
     if (!sc || !sc->mesh) return HFVIS_ERR_INVALID_ARGUMENT;
     if (sc->mesh->triangle_count > HFVIS_BVH_MAX_TRIANGLES) return HFVIS_ERR_LIMIT;
-    if (vx_mesh_check(sc->mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (hfvis__mesh_check(sc->mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     if (sc->light_count < 0 || sc->light_count > HFVIS_VOLGI_MAX_LIGHTS
         || (sc->light_count > 0 && !sc->lights))
         return HFVIS_ERR_INVALID_ARGUMENT;
@@ -9753,7 +9745,7 @@ HFVIS_API hfvis_status hfvis_volgi_grid_fit(const hfvis_mesh *mesh, int resoluti
     hfvis_volume_grid g;
     size_t total = 1;
     int a;
-    if (!out || vx_mesh_check(mesh) != HFVIS_OK || mesh->triangle_count == 0 || resolution < 2
+    if (!out || hfvis__mesh_check(mesh) != HFVIS_OK || mesh->triangle_count == 0 || resolution < 2
         || resolution > HFVIS_VOLGI_MAX_RESOLUTION)
         return HFVIS_ERR_INVALID_ARGUMENT;
     ext_max = vx_used_bounds(mesh, lo, hi);
