@@ -189,6 +189,8 @@
  *                       the volume GI. Define it (e.g. as a deprecation attribute) to find uses.
  *   HFVIS_NO_STDIO      define when compiling the .c files to remove the file wrappers
  *                       (hfvis_*_load / hfvis_*_save); the in-memory codecs remain.
+ *   HFVIS_NO_DEPRECATED define before including hfvis.h to drop the renamed functions' old
+ *                       names (the "Deprecated names" block at the end).
  *   HFVIS_ENABLE_ASSERTS / HFVIS_ASSERT(x)  internal invariant checks in the .c files only. */
 #ifndef HFVIS_API
 #define HFVIS_API
