@@ -1,13 +1,14 @@
 /* hfvis.c - height fields. Part of hfvis (see hfvis.h for the conventions and the API).
  *
  * Contents
- *   1. Common: status strings, allocation, checked sizes, PRNG
+ *   1. Common: status strings; the library's one copy of the allocation, checked-size and PRNG
+ *      helpers (hfvis__*, declared in hfvis.h's internal block, used by ssao.c and voxel.c too)
  *   2. Codecs: PGM (P2/P5) and PFM (Pf/PF) in memory, file wrappers; the NoData-safe PGM with
  *      its range comment
  *   3. Analytic test fields
- *   4. Bilinear sampling and normals ([P1] §4, §7 "quad sum"; docs/errata.md E5; [P1] §7; docs/errata.md E10)
+ *   4. Bilinear sampling and normals ([P1] §4, §7 "quad sum"; docs/errata.md E5, E10)
  *   5. The sweep lattice ([P1] §4, Fig. 2; docs/errata.md E5)
- *   6. The P1 hull stack along one line ([P1] §5 Alg. 1, App. A.1; [P1] §5, Alg. 1, App. A.1)
+ *   6. The P1 hull stack along one line ([P1] §5 Alg. 1, App. A.1)
  *   7. The sweep driver: sampled lattice, four-way symmetry, borders, gather ([P1] §4, §7; docs/errata.md E5, E7, E8);
  *      the search radius (blocks of R, prefix and undoable suffix hulls) and tiles in raster
  *      coordinates (docs/search-radius.md)
@@ -15,14 +16,14 @@
  *   9. Light: uniform sky ([P1] Eq. 4-5), sky-view factor, sun visibility
  *  10. Environment light: prefix integrals and the L_p table ([P1] Eq. 6-7; docs/errata.md E9),
  *      the hemisphere-integration oracle
- *  11. P2: the convex-hull tree ([P2] Alg. 1-3, App. A.2; [P2] §4-7, Alg. 1-3), visible sets ([P2] §10.1),
+ *  11. P2: the convex-hull tree ([P2] §4-7, Alg. 1-3, App. A.2), visible sets ([P2] §10.1),
  *      intervisibility sweeps, visibility index, indirect light and bounces (docs/errata.md E17)
  *  12. Viewshed of one observer (Franklin & Ray 1994, R2) and its exact line-of-sight oracle
  *  13. Nowrouzezahrai-Snyder GI, math layer: real SH of order 4, zonal lobes, environment
  *      projection, normalized Legendre polynomials, Appendix-A wedge matrices ([NS09])
  *  14. Nowrouzezahrai-Snyder GI pipeline: slice scanning over the height pyramid, casting sets,
  *      wedges to SH visibility, environment, directional and key lights, diffuse and glossy
- *      bounces through the radiance pyramid, sub-sampling ([NS09] §5-9; [NS09] §3-9; [NS09] §8)
+ *      bounces through the radiance pyramid, sub-sampling ([NS09] §3-9)
  *  15. Split runs: raw per-receiver direction sums in double and the partial-sum file
  *  16. Exact rays (beyond [P1]): rational directions, every grid-line crossing and the split
  *      bulging pieces swept with the [P1] §5 hull, the per-receiver oracle, actual azimuths and
@@ -31,6 +32,7 @@
  * Paper references: [P1] Timonen & Westerholm, "Scalable Height Field Self-Shadowing",
  * CGF 29(2), 2010 (thesis appendix A.1). Errata and choices: docs/errata.md E1-E18.
  */
+#define HFVIS__INTERNAL /* the internal block of hfvis.h: shared helpers, not API */
 #include "hfvis.h"
 
 #include <float.h>
@@ -43,19 +45,6 @@
 #include <stdio.h>
 #endif
 
-#if defined(__clang__)
-#pragma STDC FP_CONTRACT OFF
-#endif
-
-#ifndef HFVIS_ASSERT
-#ifdef HFVIS_ENABLE_ASSERTS
-#include <assert.h>
-#define HFVIS_ASSERT(x) assert(x)
-#else
-#define HFVIS_ASSERT(x) ((void)0)
-#endif
-#endif
-
 /* The allocation behind a NULL allocator (hfvis.h, "Memory"): define both to replace it. */
 #if defined(HFVIS_MALLOC) != defined(HFVIS_FREE)
 #error "define both HFVIS_MALLOC and HFVIS_FREE, or neither"
@@ -64,11 +53,6 @@
 #define HFVIS_MALLOC(size) malloc(size)
 #define HFVIS_FREE(ptr) free(ptr)
 #endif
-
-#define HF_NAN ((double)NAN)
-#define HF_INF ((double)INFINITY)
-#define HF_PI 3.14159265358979323846
-#define HF_HALF_PI 1.57079632679489661923
 
 /* Exact rays (section 16), called from the public routines of sections 8, 9, 10 and 15. */
 /* One exact-ray direction: look vector (a, b), gcd 1, and its azimuth, unwrapped to within pi of
@@ -114,24 +98,7 @@ const char *hfvis_status_string(hfvis_status status)
     return "HFVIS_ERR_UNKNOWN: unknown status code";
 }
 
-static void *hf_alloc(const hfvis_allocator *a, size_t bytes)
-{
-    if (bytes == 0) return NULL;
-    if (a && a->alloc) return a->alloc(a->user, bytes);
-    return HFVIS_MALLOC(bytes);
-}
-
-static void hf_free(const hfvis_allocator *a, void *p)
-{
-    if (!p) return;
-    if (a && a->alloc) {
-        if (a->free) a->free(a->user, p);
-        return;
-    }
-    HFVIS_FREE(p);
-}
-
-void hfvis_free(const hfvis_allocator *alloc, void *ptr) { hf_free(alloc, ptr); }
+void hfvis_free(const hfvis_allocator *alloc, void *ptr) { hfvis__free(alloc, ptr); }
 
 /* Four bits per step from a 16-entry table (entry i = the CRC register after shifting the
  * nibble i out), reflected polynomial 0xEDB88320. */
@@ -153,20 +120,100 @@ uint32_t hfvis_crc32(uint32_t crc, const void *data, size_t n)
     return ~crc;
 }
 
-/* a*b without overflow (stb's mul2sizes_valid). */
-static int hf_mul_size(size_t a, size_t b, size_t *out)
+/* The library's one copy of the allocation, checked-size and PRNG helpers (declared in the
+ * internal block of hfvis.h, used by all three .c files). */
+void *hfvis__alloc(const hfvis_allocator *a, size_t bytes)
+{
+    if (bytes == 0) return NULL;
+    if (a && a->alloc) return a->alloc(a->user, bytes);
+    return HFVIS_MALLOC(bytes);
+}
+
+void hfvis__free(const hfvis_allocator *a, void *p)
+{
+    if (!p) return;
+    if (a && a->alloc) {
+        if (a->free) a->free(a->user, p);
+        return;
+    }
+    HFVIS_FREE(p);
+}
+
+int hfvis__mul_size(size_t a, size_t b, size_t *out)
 {
     if (a != 0 && b > SIZE_MAX / a) return 0;
     *out = a * b;
     return 1;
 }
 
-/* Allocates count elements of elem bytes, or NULL on overflow or failure. */
-static void *hf_alloc_array(const hfvis_allocator *a, size_t count, size_t elem)
+void *hfvis__alloc_array(const hfvis_allocator *a, size_t count, size_t elem)
 {
     size_t bytes;
-    if (!hf_mul_size(count, elem, &bytes)) return NULL;
-    return hf_alloc(a, bytes);
+    if (!hfvis__mul_size(count, elem, &bytes)) return NULL;
+    return hfvis__alloc(a, bytes);
+}
+
+int hfvis__plane_fits(ptrdiff_t stride, int height, int floats_per_pixel)
+{
+    return stride >= 1 && floats_per_pixel >= 1 &&
+           (size_t)height <= (size_t)PTRDIFF_MAX / ((size_t)floats_per_pixel * sizeof(float)) / (size_t)stride;
+}
+
+int hfvis__all_finite(const double *v, int n)
+{
+    int i;
+    for (i = 0; i < n; i++)
+        if (!isfinite(v[i])) return 0;
+    return 1;
+}
+
+uint64_t hfvis__mix64(uint64_t x)
+{
+    x += 0x9E3779B97F4A7C15ull;
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+    return x ^ (x >> 31);
+}
+
+uint64_t hfvis__splitmix64(uint64_t *state)
+{
+    uint64_t z = hfvis__mix64(*state);
+    *state += 0x9E3779B97F4A7C15ull;
+    return z;
+}
+
+uint32_t hfvis__pcg32_next(hfvis__pcg32 *g)
+{
+    uint64_t old = g->state;
+    uint32_t xs, rot;
+    g->state = old * 6364136223846793005ull + g->inc;
+    xs = (uint32_t)(((old >> 18) ^ old) >> 27);
+    rot = (uint32_t)(old >> 59);
+    return (xs >> rot) | (xs << ((32u - rot) & 31u));
+}
+
+/* pcg32_srandom_r: stream selects the increment, seed the start. */
+void hfvis__pcg32_seed(hfvis__pcg32 *g, uint64_t seed, uint64_t stream)
+{
+    g->state = 0;
+    g->inc = (stream << 1) | 1u;
+    (void)hfvis__pcg32_next(g);
+    g->state += seed;
+    (void)hfvis__pcg32_next(g);
+}
+
+double hfvis__pcg32_unit(hfvis__pcg32 *g)
+{
+    uint64_t hi = hfvis__pcg32_next(g) >> 5, lo = hfvis__pcg32_next(g) >> 6;
+    return ((double)hi * 67108864.0 + (double)lo) * (1.0 / 9007199254740992.0);
+}
+
+/* Rejection below 2^32 mod n keeps every residue equally likely. */
+uint32_t hfvis__pcg32_below(hfvis__pcg32 *g, uint32_t n)
+{
+    uint32_t limit = (uint32_t)(0u - n) % n, x;
+    do x = hfvis__pcg32_next(g); while (x < limit);
+    return x % n;
 }
 
 static int hf_grid_valid(const hfvis_grid *g)
@@ -179,23 +226,7 @@ static int hf_grid_valid(const hfvis_grid *g)
 /* width*height as size_t (valid grids only). */
 static size_t hf_grid_count(const hfvis_grid *g) { return (size_t)g->width * (size_t)g->height; }
 
-/* 1 if an output plane of `height` rows `stride` pixels apart, up to 4 floats per pixel, is
- * addressable: every index (y*stride + x)*channels stays below PTRDIFF_MAX bytes. */
-static int hf_out_fits(ptrdiff_t stride, int height)
-{
-    return stride >= 1 && (size_t)height <= (size_t)PTRDIFF_MAX / (4 * sizeof(float)) / (size_t)stride;
-}
-
 static int hf_border_valid(hfvis_border b) { return b >= HFVIS_BORDER_DEFAULT && b <= HFVIS_BORDER_WRAP; }
-
-/* splitmix64: the library's only PRNG / hash (fixed, seeded, no global state). */
-static uint64_t hf_mix64(uint64_t x)
-{
-    x += 0x9E3779B97F4A7C15ull;
-    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-    return x ^ (x >> 31);
-}
 
 /* ========================================================================================== */
 /* 2. Codecs: PGM (netpbm pgm(5), P2/P5) and PFM (netpbm pfm(5), Pf/PF), in memory and files */
@@ -396,8 +427,8 @@ static hfvis_status hf_img_header_parse(const unsigned char *p, size_t n, hf_img
     if (w > HFVIS_IMAGE_MAX_DIM || ht > HFVIS_IMAGE_MAX_DIM) return HFVIS_ERR_LIMIT;
     h.info.width = (int)w;
     h.info.height = (int)ht;
-    if (!hf_mul_size((size_t)w, (size_t)ht, &h.values)
-        || !hf_mul_size(h.values, (size_t)h.info.channels, &h.values)
+    if (!hfvis__mul_size((size_t)w, (size_t)ht, &h.values)
+        || !hfvis__mul_size(h.values, (size_t)h.info.channels, &h.values)
         || h.values > HFVIS_IMAGE_MAX_VALUES)
         return HFVIS_ERR_LIMIT;
     h.data_offset = i;
@@ -409,7 +440,7 @@ static hfvis_status hf_img_header_parse(const unsigned char *p, size_t n, hf_img
 static int hf_img_data_bytes(const hf_img_header *h, size_t *bytes)
 {
     size_t bytes_per_value = h->info.format == HFVIS_FORMAT_PFM ? 4 : h->info.maxval < 256 ? 1 : 2;
-    return hf_mul_size(h->values, bytes_per_value, bytes);
+    return hfvis__mul_size(h->values, bytes_per_value, bytes);
 }
 
 /* Parses and validates a whole PGM/PFM held in p[0..n); see the section comment. */
@@ -511,9 +542,9 @@ static size_t hf_img_encode_size(int width, int height, int channels, int maxval
     size_t values, bytes, head;
     if (width < 1 || height < 1) return 0;
     head = hf_img_header_text(header, width, height, channels, maxval);
-    if (!hf_mul_size((size_t)width, (size_t)height, &values)
-        || !hf_mul_size(values, (size_t)channels, &values)
-        || !hf_mul_size(values, bytes_per_value, &bytes) || bytes > SIZE_MAX - head)
+    if (!hfvis__mul_size((size_t)width, (size_t)height, &values)
+        || !hfvis__mul_size(values, (size_t)channels, &values)
+        || !hfvis__mul_size(values, bytes_per_value, &bytes) || bytes > SIZE_MAX - head)
         return 0;
     return head + bytes;
 }
@@ -536,8 +567,8 @@ static int hf_img_stride_ok(int width, int height, int channels, ptrdiff_t strid
 {
     size_t last;
     if (stride < width) return 0;
-    return hf_mul_size((size_t)(height - 1), (size_t)stride, &last)
-        && hf_mul_size(last, (size_t)channels, &last) && last <= (size_t)PTRDIFF_MAX;
+    return hfvis__mul_size((size_t)(height - 1), (size_t)stride, &last)
+        && hfvis__mul_size(last, (size_t)channels, &last) && last <= (size_t)PTRDIFF_MAX;
 }
 
 HFVIS_API hfvis_status hfvis_pfm_encode(const float *pixels, int width, int height, int channels,
@@ -738,7 +769,7 @@ HFVIS_API hfvis_status hfvis_pgm_range_decode(const void *data, size_t size, flo
     n = (size_t)inf.width * (size_t)inf.height;
     for (i = 0; i < n; i++) {
         double code = (double)out[i];
-        out[i] = code == (double)HFVIS_PGM_NODATA_CODE ? (float)HF_NAN
+        out[i] = code == (double)HFVIS_PGM_NODATA_CODE ? (float)HFVIS__NAN
                  : (float)((double)lo + (code - 1.0) * ((double)hi - (double)lo) /
                                            (double)HFVIS_PGM_RANGE_CODES);
     }
@@ -747,16 +778,6 @@ HFVIS_API hfvis_status hfvis_pgm_range_decode(const void *data, size_t size, flo
 }
 
 #ifndef HFVIS_NO_STDIO
-/* Internal, shared with voxel.c (not API; declared again there). A sizer looks at the first
- * bytes of a file (at most HFVIS__READ_HEAD, fewer if the file is shorter) and sets *total to
- * the exact size its header announces or HFVIS__READ_ALL (a text format: read to the end), or
- * returns the decoder's error for the header (refused before anything more is read). */
-#define HFVIS__READ_HEAD ((size_t)1 << 16)
-#define HFVIS__READ_ALL ((size_t)-1)
-typedef hfvis_status (*hfvis__sizer)(const unsigned char *head, size_t n, size_t *total);
-hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, hfvis__sizer sizer,
-                             unsigned char **data, size_t *size);
-
 /* Reads a file into a block from alloc: the head first; when the sizer announces a size, exactly
  * that many bytes and one more (so that trailing data reaches the decoder, which refuses it or
  * ignores it as its format says), and a file shorter than announced is HFVIS_ERR_FORMAT without
@@ -769,14 +790,14 @@ hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, hf
     size_t cap = HFVIS__READ_HEAD, len, total;
     hfvis_status s;
     if (!f) return HFVIS_ERR_IO;
-    buf = (unsigned char *)hf_alloc(alloc, cap);
+    buf = (unsigned char *)hfvis__alloc(alloc, cap);
     if (!buf) {
         fclose(f);
         return HFVIS_ERR_OUT_OF_MEMORY;
     }
     len = fread(buf, 1, cap, f);
     if (ferror(f)) {
-        hf_free(alloc, buf);
+        hfvis__free(alloc, buf);
         fclose(f);
         return HFVIS_ERR_IO;
     }
@@ -785,13 +806,13 @@ hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, hf
     if (s == HFVIS_OK && total != HFVIS__READ_ALL && len < cap && len < total)
         s = HFVIS_ERR_FORMAT; /* shorter than its header says */
     if (s != HFVIS_OK) {
-        hf_free(alloc, buf);
+        hfvis__free(alloc, buf);
         fclose(f);
         return s;
     }
     if (total != HFVIS__READ_ALL) {
         if (total >= SIZE_MAX - 1u) {
-            hf_free(alloc, buf);
+            hfvis__free(alloc, buf);
             fclose(f);
             return HFVIS_ERR_LIMIT;
         }
@@ -801,24 +822,24 @@ hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, hf
             long end; /* a regular file shorter than announced is refused before allocating */
             if (fseek(f, 0, SEEK_END) == 0 && (end = ftell(f)) >= 0 &&
                 ((unsigned long)end < total && (unsigned long)end >= len)) {
-                hf_free(alloc, buf);
+                hfvis__free(alloc, buf);
                 fclose(f);
                 return HFVIS_ERR_FORMAT;
             }
             if (fseek(f, (long)len, SEEK_SET) != 0) clearerr(f); /* a pipe: still at len */
-            all = (unsigned char *)hf_alloc(alloc, total + 1u);
+            all = (unsigned char *)hfvis__alloc(alloc, total + 1u);
             if (!all) {
-                hf_free(alloc, buf);
+                hfvis__free(alloc, buf);
                 fclose(f);
                 return HFVIS_ERR_OUT_OF_MEMORY;
             }
             memcpy(all, buf, len);
-            hf_free(alloc, buf);
+            hfvis__free(alloc, buf);
             buf = all;
             len += fread(buf + len, 1, total + 1u - len, f);
             if (ferror(f) || len < total) {
                 s = ferror(f) ? HFVIS_ERR_IO : HFVIS_ERR_FORMAT;
-                hf_free(alloc, buf);
+                hfvis__free(alloc, buf);
                 fclose(f);
                 return s;
             }
@@ -829,19 +850,19 @@ hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, hf
         return HFVIS_OK;
     }
     while (len == cap) { /* read to the end, doubling */
-        unsigned char *bigger = cap > SIZE_MAX / 2 ? NULL : (unsigned char *)hf_alloc(alloc, cap * 2);
+        unsigned char *bigger = cap > SIZE_MAX / 2 ? NULL : (unsigned char *)hfvis__alloc(alloc, cap * 2);
         if (!bigger) {
-            hf_free(alloc, buf);
+            hfvis__free(alloc, buf);
             fclose(f);
             return HFVIS_ERR_OUT_OF_MEMORY;
         }
         memcpy(bigger, buf, len);
-        hf_free(alloc, buf);
+        hfvis__free(alloc, buf);
         buf = bigger;
         cap *= 2;
         len += fread(buf + len, 1, cap - len, f);
         if (ferror(f)) {
-            hf_free(alloc, buf);
+            hfvis__free(alloc, buf);
             fclose(f);
             return HFVIS_ERR_IO;
         }
@@ -880,7 +901,7 @@ HFVIS_API hfvis_status hfvis_image_load(const char *path, const hfvis_allocator 
     if (s != HFVIS_OK) return s;
     s = hf_img_parse(data, size, &h);
     if (s == HFVIS_OK) {
-        px = hf_mul_size(h.values, sizeof(float), &bytes) ? (float *)hf_alloc(alloc, bytes) : NULL;
+        px = hfvis__mul_size(h.values, sizeof(float), &bytes) ? (float *)hfvis__alloc(alloc, bytes) : NULL;
         if (px) {
             hf_img_write_pixels(data, size, &h, px);
             *pixels = px;
@@ -889,8 +910,15 @@ HFVIS_API hfvis_status hfvis_image_load(const char *path, const hfvis_allocator 
             s = HFVIS_ERR_OUT_OF_MEMORY;
         }
     }
-    hf_free(alloc, data);
+    hfvis__free(alloc, data);
     return s;
+}
+
+hfvis_write_options hfvis_write_options_default(void)
+{
+    hfvis_write_options o;
+    memset(&o, 0, sizeof o);
+    return o;
 }
 
 /* The temporary name: "<path>.tmp<8 hex digits>" beside path; when the last component would
@@ -920,7 +948,7 @@ hfvis_status hfvis_write_begin(const char *path, const hfvis_write_options *opts
         if (path[k] == '/' || path[k] == '\\') base = k + 1;
     keep = len; /* bytes of path kept before the suffix */
     if (len - base + HF_TMP_SUFFIX > HF_NAME_MAX) keep = base + (HF_NAME_MAX - HF_TMP_SUFFIX);
-    tmp = (char *)hf_alloc(NULL, keep + HF_TMP_SUFFIX + 1u);
+    tmp = (char *)hfvis__alloc(NULL, keep + HF_TMP_SUFFIX + 1u);
     if (!tmp) return HFVIS_ERR_OUT_OF_MEMORY;
     addrs[0] = file;
     addrs[1] = &len;
@@ -942,7 +970,7 @@ hfvis_status hfvis_write_begin(const char *path, const hfvis_write_options *opts
     }
     if (!f) {
         if (attempt < 16 && opts && opts->on_temp) opts->on_temp(opts->user, NULL);
-        hf_free(NULL, tmp);
+        hfvis__free(NULL, tmp);
         return HFVIS_ERR_IO;
     }
     *file = f;
@@ -958,7 +986,7 @@ hfvis_status hfvis_write_end(const char *path, FILE *file, char *temp_path, int 
     int ok = commit != 0;
     if (!file || !temp_path) { /* nothing was opened: release what there is */
         if (file) fclose(file);
-        hf_free(NULL, temp_path);
+        hfvis__free(NULL, temp_path);
         return HFVIS_ERR_INVALID_ARGUMENT;
     }
     ok = (fflush(file) == 0) && !ferror(file) && ok;
@@ -973,7 +1001,7 @@ hfvis_status hfvis_write_end(const char *path, FILE *file, char *temp_path, int 
     }
     if (!ok) remove(temp_path);
     if (opts && opts->on_temp) opts->on_temp(opts->user, NULL); /* renamed or removed */
-    hf_free(NULL, temp_path);
+    hfvis__free(NULL, temp_path);
     if (!path) return HFVIS_ERR_INVALID_ARGUMENT;
     return ok ? HFVIS_OK : commit ? HFVIS_ERR_IO : HFVIS_OK;
 }
@@ -998,11 +1026,11 @@ HFVIS_API hfvis_status hfvis_pfm_save(const char *path, const float *pixels, int
     hfvis_status s;
     if (!path || !pixels || need == 0 || !hf_img_stride_ok(width, height, channels, stride))
         return HFVIS_ERR_INVALID_ARGUMENT;
-    buf = (unsigned char *)hf_alloc(NULL, need);
+    buf = (unsigned char *)hfvis__alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_pfm_encode(pixels, width, height, channels, stride, buf, need, &written);
     if (s == HFVIS_OK) s = hfvis_write_file(path, buf, written, NULL);
-    hf_free(NULL, buf);
+    hfvis__free(NULL, buf);
     return s;
 }
 
@@ -1016,11 +1044,11 @@ HFVIS_API hfvis_status hfvis_pgm_save(const char *path, const float *pixels, int
     if (!path || !pixels || need == 0 || !isfinite(lo) || !isfinite(hi) || !(lo < hi)
         || !hf_img_stride_ok(width, height, 1, stride))
         return HFVIS_ERR_INVALID_ARGUMENT;
-    buf = (unsigned char *)hf_alloc(NULL, need);
+    buf = (unsigned char *)hfvis__alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_pgm_encode(pixels, width, height, stride, lo, hi, maxval, buf, need, &written);
     if (s == HFVIS_OK) s = hfvis_write_file(path, buf, written, NULL);
-    hf_free(NULL, buf);
+    hfvis__free(NULL, buf);
     return s;
 }
 HFVIS_API hfvis_status hfvis_pgm_range_save(const char *path, const float *pixels, int width,
@@ -1031,11 +1059,11 @@ HFVIS_API hfvis_status hfvis_pgm_range_save(const char *path, const float *pixel
     hfvis_status s;
     if (!path || !pixels || need == 0 || !hf_img_stride_ok(width, height, 1, stride))
         return HFVIS_ERR_INVALID_ARGUMENT;
-    buf = (unsigned char *)hf_alloc(NULL, need);
+    buf = (unsigned char *)hfvis__alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_pgm_range_encode(pixels, width, height, stride, lo, hi, buf, need, &written);
     if (s == HFVIS_OK) s = hfvis_write_file(path, buf, written, NULL);
-    hf_free(NULL, buf);
+    hfvis__free(NULL, buf);
     return s;
 }
 #endif /* HFVIS_NO_STDIO */
@@ -1055,7 +1083,7 @@ static double hf_value_noise(uint64_t seed, double x, double y)
     int c;
     for (c = 0; c < 4; c++) {
         uint64_t hx = (uint64_t)(ix + (c & 1)), hy = (uint64_t)(iy + (c >> 1));
-        uint64_t h = hf_mix64(seed ^ hf_mix64(hx * 0x9E3779B97F4A7C15ull ^ hf_mix64(hy)));
+        uint64_t h = hfvis__mix64(seed ^ hfvis__mix64(hx * 0x9E3779B97F4A7C15ull ^ hfvis__mix64(hy)));
         v[c] = (double)(h >> 11) * (2.0 / 9007199254740992.0) - 1.0;
     }
     fx = fx * fx * fx * (fx * (fx * 6.0 - 15.0) + 10.0);
@@ -1088,7 +1116,7 @@ double hfvis_field_height(void *field, double x, double y)
 {
     const hfvis_field *f = (const hfvis_field *)field;
     double dx, dy, r;
-    if (!hf_field_valid(f) || !isfinite(x) || !isfinite(y)) return HF_NAN;
+    if (!hf_field_valid(f) || !isfinite(x) || !isfinite(y)) return HFVIS__NAN;
     dx = x - f->x0;
     dy = y - f->y0;
     switch (f->kind) {
@@ -1103,8 +1131,8 @@ double hfvis_field_height(void *field, double x, double y)
         return r < 1.0 ? f->height + f->amplitude * sqrt(1.0 - r * r) : f->height;
     case HFVIS_FIELD_STEP: return dx >= 0.0 ? f->height + f->amplitude : f->height;
     case HFVIS_FIELD_SINUSOID:
-        return f->height + f->amplitude * sin(2.0 * HF_PI * x / f->wavelength) *
-                               sin(2.0 * HF_PI * y / f->wavelength);
+        return f->height + f->amplitude * sin(2.0 * HFVIS__PI * x / f->wavelength) *
+                               sin(2.0 * HFVIS__PI * y / f->wavelength);
     case HFVIS_FIELD_FBM: {
         int octaves = f->octaves ? f->octaves : 8, o;
         double gain = f->persistence > 0.0 ? f->persistence : 0.5;
@@ -1122,14 +1150,14 @@ double hfvis_field_height(void *field, double x, double y)
         double row = floor(dy / bh), shift = fmod(row, 2.0) != 0.0 ? 0.5 * bw : 0.0;
         double col = floor((dx + shift) / bw);
         double u = dx + shift - col * bw, v = dy - row * bh;
-        uint64_t id = hf_mix64(f->seed ^ hf_mix64((uint64_t)(int64_t)col * 0x9E3779B97F4A7C15ull ^
+        uint64_t id = hfvis__mix64(f->seed ^ hfvis__mix64((uint64_t)(int64_t)col * 0x9E3779B97F4A7C15ull ^
                                                   (uint64_t)(int64_t)row));
         double jitter = ((double)(id >> 11) * (1.0 / 9007199254740992.0) - 0.5) * 0.1;
         if (u < mortar || v < mortar) return f->height - f->amplitude;
         return f->height + f->amplitude * jitter;
     }
     }
-    return HF_NAN;
+    return HFVIS__NAN;
 }
 
 hfvis_status hfvis_field_generate(const hfvis_field *field, int width, int height,
@@ -1170,7 +1198,7 @@ static inline double hf_bilerp_taps(const float *p, ptrdiff_t stride, double fx,
     }
     if (fy == 0.0) r1 = r0;
     else if (fy != 1.0) r1 = r0 * (1.0 - fy) + r1 * fy;
-    return isfinite(r1) ? r1 : HF_NAN; /* a +-Inf tap is a hole too */
+    return isfinite(r1) ? r1 : HFVIS__NAN; /* a +-Inf tap is a hole too */
 }
 
 static double hf_bilerp(const float *z, ptrdiff_t stride, int W, int H, double x, double y)
@@ -1200,7 +1228,7 @@ static double hf_clampd(double v, double lo, double hi) { return v < lo ? lo : v
 
 double hfvis_grid_sample(const hfvis_grid *grid, double x, double y)
 {
-    if (!hf_grid_valid(grid) || isnan(x) || isnan(y)) return HF_NAN;
+    if (!hf_grid_valid(grid) || isnan(x) || isnan(y)) return HFVIS__NAN;
     return hf_bilerp(grid->z, grid->stride, grid->width, grid->height,
                      hf_clampd(x, 0.0, (double)(grid->width - 1)),
                      hf_clampd(y, 0.0, (double)(grid->height - 1)));
@@ -1226,7 +1254,7 @@ static void hf_normal_at(const hfvis_grid *g, int x, int y, double n[3])
     const float *p = g->z + (ptrdiff_t)y * g->stride + x;
     double h0 = (double)*p, gx, gy, len;
     if (!isfinite(h0)) {
-        n[0] = n[1] = n[2] = HF_NAN;
+        n[0] = n[1] = n[2] = HFVIS__NAN;
         return;
     }
     gx = hf_slope_1d(x > 0 ? (double)p[-1] : 0.0, h0, x + 1 < g->width ? (double)p[1] : 0.0,
@@ -1352,7 +1380,7 @@ hfvis_status hfvis_lattice_init(hfvis_lattice *lattice, int width, int height, d
     return HFVIS_OK;
 }
 
-size_t hfvis_lattice_size(const hfvis_lattice *L)
+size_t hfvis_lattice_nodes(const hfvis_lattice *L)
 {
     if (!L || L->j_max < L->j_min || L->i_max < L->i_min) return 0;
     return ((size_t)(L->j_max - L->j_min) + 1) * ((size_t)(L->i_max - L->i_min) + 1);
@@ -1441,7 +1469,7 @@ hfvis_status hfvis_line_horizons(const double *distance, const double *height, i
     for (i = 0; i < n; i++) {
         double d = distance[i], h = height[i];
         if (!isfinite(h)) { /* a hole never occludes and receives no value */
-            tan_out[i] = HF_NAN;
+            tan_out[i] = HFVIS__NAN;
             if (caster_out) caster_out[i] = -1;
             continue;
         }
@@ -1451,7 +1479,7 @@ hfvis_status hfvis_line_horizons(const double *distance, const double *height, i
             else break;
         }
         if (top == 0) {
-            tan_out[i] = -HF_INF;
+            tan_out[i] = -HFVIS__INF;
             if (caster_out) caster_out[i] = -1;
         } else {
             int a = stack[top - 1];
@@ -1471,10 +1499,10 @@ hfvis_status hfvis_line_horizons_naive(const double *distance, const double *hei
     for (i = 1; i < n; i++)
         if (!(distance[i] > distance[i - 1])) return HFVIS_ERR_INVALID_ARGUMENT;
     for (i = 0; i < n; i++) {
-        double best = -HF_INF;
+        double best = -HFVIS__INF;
         int caster = -1;
         if (!isfinite(height[i])) {
-            tan_out[i] = HF_NAN;
+            tan_out[i] = HFVIS__NAN;
             if (caster_out) caster_out[i] = -1;
             continue;
         }
@@ -1582,7 +1610,7 @@ typedef struct hf_sweep {
 static size_t hf_align_add(size_t *total, size_t count, size_t elem, int *ok)
 {
     size_t bytes, off = (*total + 15u) & ~(size_t)15u;
-    if (off < *total || !hf_mul_size(count, elem, &bytes) || bytes > SIZE_MAX - off) {
+    if (off < *total || !hfvis__mul_size(count, elem, &bytes) || bytes > SIZE_MAX - off) {
         *ok = 0;
         return 0;
     }
@@ -1593,7 +1621,7 @@ static size_t hf_align_add(size_t *total, size_t count, size_t elem, int *ok)
 /* Is the search radius finite (hfvis.h: 0 and +INFINITY are unlimited)? */
 static int hf_radius_on(const hfvis_sweep_options *o)
 {
-    return o->max_distance > 0.0 && o->max_distance < HF_INF;
+    return o->max_distance > 0.0 && o->max_distance < HFVIS__INF;
 }
 
 /* floor(r) as a window length, r >= 0, clamped to 2^52 (beyond any line) */
@@ -1688,8 +1716,8 @@ static hfvis_sweep_options hf_opts_resolve(const hfvis_grid *g, const hfvis_swee
 int hfvis_tile_halo(double max_distance, double cell_size, hfvis_ray_mode rays)
 {
     double c;
-    if (!(max_distance > 0.0) || !(max_distance < HF_INF) || !(cell_size > 0.0) ||
-        !(cell_size < HF_INF) || (rays != HFVIS_RAYS_LATTICE && rays != HFVIS_RAYS_EXACT))
+    if (!(max_distance > 0.0) || !(max_distance < HFVIS__INF) || !(cell_size > 0.0) ||
+        !(cell_size < HFVIS__INF) || (rays != HFVIS_RAYS_LATTICE && rays != HFVIS_RAYS_EXACT))
         return -1;
     c = ceil(max_distance / cell_size) +
         (rays == HFVIS_RAYS_EXACT ? HFVIS_TILE_HALO_EXACT : HFVIS_TILE_HALO_LATTICE);
@@ -1761,7 +1789,7 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     sw->win_rw = hf_radius_on(o) ? hf_radius_units(o->max_distance / g->cell_size) : -1;
     if (sw->win_rw >= 0) off_w = hf_align_add(&total, linelen, HF_WIN_BYTES_PER_SAMPLE, &ok);
     if (!ok) return HFVIS_ERR_LIMIT;
-    b = (unsigned char *)hf_alloc(o->alloc, total);
+    b = (unsigned char *)hfvis__alloc(o->alloc, total);
     if (!b) return HFVIS_ERR_OUT_OF_MEMORY;
     sw->block = b;
     sw->row_first = (int *)(void *)(b + off_rf);
@@ -1807,7 +1835,7 @@ static hfvis_status hf_sweep_alloc(hf_sweep *sw, const hfvis_grid *g, const hfvi
     return hf_sweep_alloc_extra(sw, g, o, want_normals, channels, want_gacc, 0);
 }
 
-static void hf_sweep_free(hf_sweep *sw) { hf_free(sw->alloc, sw->block); }
+static void hf_sweep_free(hf_sweep *sw) { hfvis__free(sw->alloc, sw->block); }
 
 /* Height (world units) at any position under the border rule: CLAMP clamps to the grid,
  * WRAP treats the field as periodic with period width x height (docs/errata.md E8). */
@@ -1835,7 +1863,7 @@ static double hf_sample_border(const hfvis_grid *g, hfvis_border border, double 
                            : (double)z[y1 * s + x0] * (1.0 - fx) + (double)z[y1 * s + x1] * fx;
             r0 = r0 * (1.0 - fy) + r1 * fy;
         }
-        return isfinite(r0) ? r0 : HF_NAN;
+        return isfinite(r0) ? r0 : HFVIS__NAN;
     }
     return hf_bilerp(g->z, g->stride, g->width, g->height,
                      hf_clampd(x, 0.0, (double)(g->width - 1)),
@@ -1859,7 +1887,7 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
     HFVIS_ASSERT(sw->rows <= hf_lattice_bound(g) && sw->cols <= hf_lattice_bound(g));
     nodes = (size_t)sw->rows * (size_t)sw->cols;
     HFVIS_ASSERT(nodes <= sw->nodes_cap);
-    for (n = 0; n < nodes; n++) sw->h[n] = HF_NAN;
+    for (n = 0; n < nodes; n++) sw->h[n] = HFVIS__NAN;
     for (c = 0; c < sw->cols; c++) {
         sw->col_first[c] = INT_MAX;
         sw->col_last[c] = -1;
@@ -1978,9 +2006,9 @@ static void hf_brute_unit(const double *h, int n, double *t, int64_t rw)
 {
     int i, j;
     for (i = 0; i < n; i++) {
-        double best = -HF_INF;
+        double best = -HFVIS__INF;
         if (isnan(h[i])) {
-            t[i] = HF_NAN;
+            t[i] = HFVIS__NAN;
             continue;
         }
         for (j = rw >= 0 && rw < i ? i - (int)rw : 0; j < i; j++) { /* within the radius */
@@ -2008,7 +2036,7 @@ static inline double hf_hull_step(double *sh, double *sd, int *top_io, double h,
     double t;
     while (top >= 2 && (sh[top - 2] - h) * (d - sd[top - 1]) >= (sh[top - 1] - h) * (d - sd[top - 2]))
         top--;
-    t = top ? (sh[top - 1] - h) / (d - sd[top - 1]) : -HF_INF;
+    t = top ? (sh[top - 1] - h) / (d - sd[top - 1]) : -HFVIS__INF;
     sd[top] = d;
     sh[top++] = h;
     *top_io = top;
@@ -2034,11 +2062,11 @@ static void hf_window_line(const hf_win *w, int n, int64_t Rw, int qfrom, const 
         int asked = i >= qfrom && (!ask || i == *ask);
         if (ask && i == *ask) ask++;
         if (isnan(hi)) {
-            t[i] = HF_NAN;
+            t[i] = HFVIS__NAN;
             continue;
         }
         if (Rw <= 0) { /* nothing is within reach */
-            t[i] = -HF_INF;
+            t[i] = -HFVIS__INF;
             continue;
         }
         if (!have || pos[i] >= next) { /* a new block; the previous one is [cstart, i) */
@@ -2048,7 +2076,7 @@ static void hf_window_line(const hf_win *w, int n, int64_t Rw, int qfrom, const 
             stop = nlog = 0;
             wi = wend = i;
             if (have && b == cb + 1) {
-                double mx = -HF_INF;
+                double mx = -HFVIS__INF;
                 dend = d[i - 1];
                 for (j = i - 1; j >= cstart; j--) { /* its upper hull, right to left */
                     double hj = h[j], dj = d[j];
@@ -2086,7 +2114,7 @@ static void hf_window_line(const hf_win *w, int n, int64_t Rw, int qfrom, const 
         }
         tp = hf_hull_step(ph, pd, &ptop, hi, di);
         if (!asked) { /* pushed, not asked */
-            t[i] = HF_NAN;
+            t[i] = HFVIS__NAN;
             continue;
         }
         if (stop > 0) {
@@ -2235,12 +2263,12 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
         for (s = 0, p = node0; s <= shi; s++, p += step) {
             double h = sw->h[p];
             if (isnan(h)) {
-                t[s] = HF_NAN;
+                t[s] = HFVIS__NAN;
                 continue;
             }
             t[s] = hf_hull_step(sh, sd, &top, h, (double)s);
         }
-        for (s = 0; s < slo; s++) t[s] = HF_NAN; /* far from every receiver */
+        for (s = 0; s < slo; s++) t[s] = HFVIS__NAN; /* far from every receiver */
         fn(sw, ctx, m, node0, step, shi + 1, t);
     }
 }
@@ -2268,7 +2296,7 @@ static void hf_direction_base(int K, int k, double azimuth0, double *ux, double 
         base = k % (K / 4);
         *m = k / (K / 4);
     }
-    hf_sweep_vector(azimuth0 + 2.0 * HF_PI * (double)base / (double)K, ux, uy);
+    hf_sweep_vector(azimuth0 + 2.0 * HFVIS__PI * (double)base / (double)K, ux, uy);
 }
 
 /* Gather (docs/errata.md E7): the value at grid point (x, y) from a lattice buffer, bilinear over the
@@ -2337,7 +2365,7 @@ static void hf_gather_apply(const hf_sweep *sw, const double *buf, int ch, const
                     bp = p;
                 }
             }
-        for (c = 0; c < ch; c++) out[c] = bp ? bp[c] : HF_NAN;
+        for (c = 0; c < ch; c++) out[c] = bp ? bp[c] : HFVIS__NAN;
     }
 }
 
@@ -2363,7 +2391,7 @@ static void hf_gather_elevations(const hf_sweep *sw, int ch, const hf_gather *G,
             v = buf[G->node[q] * ch + c];
             if (!isfinite(v)) continue;
             any = 1;
-            if (v <= -HF_HALF_PI) continue;
+            if (v <= -HFVIS__HALF_PI) continue;
             sum += G->w[q] * v;
             wsum += G->w[q];
         }
@@ -2373,14 +2401,14 @@ static void hf_gather_elevations(const hf_sweep *sw, int ch, const hf_gather *G,
              * corners), else -pi/2. */
             double best = DBL_MAX;
             int dx, dy;
-            out[c] = -HF_HALF_PI;
+            out[c] = -HFVIS__HALF_PI;
             for (dy = -1; dy <= 2; dy++)
                 for (dx = -1; dx <= 2; dx++) {
                     int i = G->ia + dx, j = G->jb + dy;
                     double ex = (double)dx - G->wa, ey = (double)dy - G->wb, d2 = ex * ex + ey * ey;
                     if (i < 0 || j < 0 || i >= sw->cols || j >= sw->rows) continue;
                     v = buf[((ptrdiff_t)j * sw->cols + i) * ch + c];
-                    if (isfinite(v) && v > -HF_HALF_PI && d2 < best) {
+                    if (isfinite(v) && v > -HFVIS__HALF_PI && d2 < best) {
                         best = d2;
                         out[c] = v;
                     }
@@ -2417,7 +2445,7 @@ static int hf_gather_elevations_inside(const hf_sweep *sw, int ch, int x, int y,
     for (c = 0; c < ch; c++) {
         double t0 = p[c], t1 = p[ch + c], t2 = p[cols * ch + c], t3 = p[(cols + 1) * ch + c];
         /* finite and > -pi/2 (NaN and -inf fail the comparisons, +inf the sum) */
-        if (!(t0 > -HF_HALF_PI && t1 > -HF_HALF_PI && t2 > -HF_HALF_PI && t3 > -HF_HALF_PI &&
+        if (!(t0 > -HFVIS__HALF_PI && t1 > -HFVIS__HALF_PI && t2 > -HFVIS__HALF_PI && t3 > -HFVIS__HALF_PI &&
               isfinite(t0 + t1 + t2 + t3)))
             return 0;
     }
@@ -2452,7 +2480,7 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
         for (x = tx; x < sw->rx1 && x < tx + HF_TILE; x++) {
             ptrdiff_t o = (ptrdiff_t)y * out_stride + x;
             if (hf_is_hole(g, x, y)) {
-                for (c = 0; c < ch; c++) out[(size_t)c * plane_step + (size_t)o] = (float)HF_NAN;
+                for (c = 0; c < ch; c++) out[(size_t)c * plane_step + (size_t)o] = (float)HFVIS__NAN;
                 continue;
             }
             if (!hf_gather_elevations_inside(sw, ch, x, y, v)) {
@@ -2463,7 +2491,7 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
                 if (sw->border == HFVIS_BORDER_OPEN) { /* the raster's border (tiles) */
                     double nx = ((double)x + sw->ox) + lx[c], ny = ((double)y + sw->oy) + ly[c];
                     if (nx < -HF_LATTICE_EPS || ny < -HF_LATTICE_EPS || nx > xmax || ny > ymax)
-                        v[c] = -HF_HALF_PI;
+                        v[c] = -HFVIS__HALF_PI;
                 }
                 out[(size_t)c * plane_step + (size_t)o] = (float)v[c];
             }
@@ -2585,8 +2613,8 @@ static void hf_lattice_fill(hf_sweep *sw, double value)
 
 static double hf_tan_to_elevation(double t)
 {
-    if (isnan(t)) return HF_NAN;
-    if (t == -HF_INF) return -HF_HALF_PI;
+    if (isnan(t)) return HFVIS__NAN;
+    if (t == -HFVIS__INF) return -HFVIS__HALF_PI;
     return atan(t);
 }
 
@@ -2624,7 +2652,7 @@ static hfvis_status hf_horizon_lattice_impl(const hfvis_grid *grid, double azimu
     sw.rect = 0; /* every node: the lattice has no receivers */
     hf_sweep_vector(azimuth_rad, &ux, &uy);
     hf_sweep_group(&sw, ux, uy);
-    hf_lattice_fill(&sw, HF_NAN);
+    hf_lattice_fill(&sw, HFVIS__NAN);
     hf_sweep_orientation(&sw, 0, brute, hf_store_elevation, NULL);
     n = (size_t)sw.rows * (size_t)sw.cols;
     for (i = 0; i < n; i++) out[i] = (float)sw.lat[i];
@@ -2659,14 +2687,14 @@ hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, int k,
     double ux, uy;
     int m;
     if (hf_check_common(grid, opts) != HFVIS_OK || !out || K < 1 || k < 0 || k >= K ||
-        out_stride < grid->width || !hf_out_fits(out_stride, grid->height))
+        out_stride < grid->width || !hfvis__plane_fits(out_stride, grid->height, 4))
         return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
     if (o.rays == HFVIS_RAYS_EXACT) return hf_exact_horizon_direction(grid, K, k, &o, out, out_stride);
     if ((s = hf_sweep_alloc(&sw, grid, &o, 0, 1, 0)) != HFVIS_OK) return s;
     hf_direction_base(K, k, o.azimuth0_rad, &ux, &uy, &m);
     hf_sweep_group(&sw, ux, uy);
-    hf_lattice_fill(&sw, HF_NAN);
+    hf_lattice_fill(&sw, HFVIS__NAN);
     hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL);
     hf_gather_planes(&sw, 1, m, out, 0, out_stride);
     hf_sweep_free(&sw);
@@ -2706,7 +2734,7 @@ static hfvis_status hf_horizon_map_range(const hfvis_grid *grid, int K, const hf
                 hf_sweep_group(&sw, ux, uy);
                 sampled = 1;
             }
-            hf_lattice_fill(&sw, HF_NAN);
+            hf_lattice_fill(&sw, HFVIS__NAN);
             hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL);
             hf_gather_planes(&sw, 1, m, out + (size_t)(pos - begin) * plane, 0, grid->width);
             hf_progress(o, ++done, end - begin);
@@ -2727,7 +2755,7 @@ hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_
     int begin, end;
     if (hf_check_common(grid, opts) != HFVIS_OK || !out || K < 1) return HFVIS_ERR_INVALID_ARGUMENT;
     plane = hf_grid_count(grid);
-    if (!hf_mul_size(plane, (size_t)K, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!hfvis__mul_size(plane, (size_t)K, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
     if (hf_direction_range(&o, K, &begin, &end) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     if (o.rays == HFVIS_RAYS_EXACT) return hf_exact_horizon_map(grid, K, &o, begin, end, out);
@@ -2741,7 +2769,7 @@ hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_
         int m0;
         hf_direction_base(K, gidx, o.azimuth0_rad, &ux, &uy, &m0);
         hf_sweep_group(&sw, ux, uy);
-        hf_lattice_fill(&sw, HF_NAN);
+        hf_lattice_fill(&sw, HFVIS__NAN);
         for (m = 0; m < per; m++) {
             hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL);
             hf_progress(&o, ++done, K);
@@ -2784,7 +2812,7 @@ static double hf_surface_height(const hf_surface *S, double x, double y)
 static double hf_march_tan(const hf_surface *S, double px, double py, double h0, double lx,
                            double ly, double step, double max_dist, double sign)
 {
-    double best = -HF_INF, xmin = -S->reach - HF_LATTICE_EPS, ymin = xmin;
+    double best = -HFVIS__INF, xmin = -S->reach - HF_LATTICE_EPS, ymin = xmin;
     double xmax = (double)(S->width - 1) + S->reach + HF_LATTICE_EPS;
     double ymax = (double)(S->height - 1) + S->reach + HF_LATTICE_EPS;
     double inv = 1.0 / S->cell_size;
@@ -2809,7 +2837,7 @@ static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0
 {
     double step = march && march->step_cells > 0.0 ? march->step_cells : 1.0;
     double maxd = march ? march->max_distance_cells : 0.0;
-    if (radius > 0.0 && radius < HF_INF) { /* the sweep options' search radius, in cells */
+    if (radius > 0.0 && radius < HFVIS__INF) { /* the sweep options' search radius, in cells */
         double rc = radius / S->cell_size;
         maxd = maxd > 0.0 && maxd < rc ? maxd : rc;
     }
@@ -2817,20 +2845,20 @@ static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0
     int k;
     for (i = 0; i < count; i++) {
         double px = (double)points[2 * i], py = (double)points[2 * i + 1], h0;
-        h0 = isfinite(px) && isfinite(py) ? hf_surface_height(S, px, py) : HF_NAN;
+        h0 = isfinite(px) && isfinite(py) ? hf_surface_height(S, px, py) : HFVIS__NAN;
         for (k = 0; k < K; k++) {
             double ux, uy, t;
             if (!isfinite(h0)) {
-                out[i * (size_t)K + (size_t)k] = HF_NAN;
+                out[i * (size_t)K + (size_t)k] = HFVIS__NAN;
                 continue;
             }
             if (exact_bound > 0) { /* exact mode: along the actual direction (a, b) */
-                hf_ray r = hf_ray_nearest(azimuth0 + 2.0 * HF_PI * (double)k / (double)K, exact_bound);
+                hf_ray r = hf_ray_nearest(azimuth0 + 2.0 * HFVIS__PI * (double)k / (double)K, exact_bound);
                 double len = sqrt((double)r.a * (double)r.a + (double)r.b * (double)r.b);
                 ux = -(double)r.a / len;
                 uy = -(double)r.b / len;
             } else {
-                hf_sweep_vector(azimuth0 + 2.0 * HF_PI * (double)k / (double)K, &ux, &uy);
+                hf_sweep_vector(azimuth0 + 2.0 * HFVIS__PI * (double)k / (double)K, &ux, &uy);
             }
             t = hf_march_tan(S, px, py, h0, -ux, -uy, step, maxd, 1.0);
             out[i * (size_t)K + (size_t)k] = (float)hf_tan_to_elevation(t);
@@ -2842,6 +2870,15 @@ static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0
 static int hf_points_valid(const float *points, size_t count, int K, const float *out)
 {
     return (count == 0 || (points && out)) && K >= 1 && count <= SIZE_MAX / (size_t)K;
+}
+
+hfvis_march_options hfvis_march_options_default(void)
+{
+    hfvis_march_options o;
+    memset(&o, 0, sizeof o);
+    o.step_cells = 1.0;
+    o.max_distance_cells = 0.0; /* until the ray leaves the grid */
+    return o;
 }
 
 hfvis_status hfvis_horizon_reference(const hfvis_grid *grid, int K,
@@ -2888,6 +2925,16 @@ hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user, int widt
                             points, count, out, opts ? opts->max_distance : 0.0);
 }
 
+hfvis_openness_options hfvis_openness_options_default(void)
+{
+    hfvis_openness_options o;
+    memset(&o, 0, sizeof o);
+    o.radius = 0.0; /* unlimited */
+    o.negative = 0;
+    o.step_cells = 1.0;
+    return o;
+}
+
 /* Topographic openness (Yokoyama, Shirasawa & Pike 2002): the mean zenith angle pi/2 - beta_k
  * of the K skylines. Radius-limited: every receiver marches each direction out to the radius
  * (hf_march_tan, the oracle's march; sign -1 marches the inverted surface for negative
@@ -2901,7 +2948,7 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
     int negative = oo ? oo->negative : 0, x, y, k;
     hfvis_sweep_options o;
     if (hf_check_common(grid, opts) != HFVIS_OK || K < 1 || !out || out_stride < W ||
-        !hf_out_fits(out_stride, H) || !isfinite(radius) || radius < 0.0 || !isfinite(step) ||
+        !hfvis__plane_fits(out_stride, H, 4) || !isfinite(radius) || radius < 0.0 || !isfinite(step) ||
         (oo && !(oo->step_cells >= 0.0)) || (negative != 0 && negative != 1))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
@@ -2920,16 +2967,16 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
             for (x = 0; x < W; x++) {
                 double h0 = (double)grid->z[(ptrdiff_t)y * grid->stride + x], sum = 0.0;
                 if (!isfinite(h0)) {
-                    out[(ptrdiff_t)y * out_stride + x] = (float)HF_NAN;
+                    out[(ptrdiff_t)y * out_stride + x] = (float)HFVIS__NAN;
                     continue;
                 }
                 for (k = 0; k < K; k++) {
                     double ux, uy, t;
-                    hf_sweep_vector(o.azimuth0_rad + 2.0 * HF_PI * (double)k / (double)K, &ux, &uy);
+                    hf_sweep_vector(o.azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K, &ux, &uy);
                     t = hf_march_tan(&S, (double)x, (double)y, h0, -ux, -uy, step, maxd,
                                      negative ? -1.0 : 1.0);
                     /* the angle as a float, as the horizon outputs (and the sweep path) hold it */
-                    sum += HF_HALF_PI - (double)(float)hf_tan_to_elevation(t);
+                    sum += HFVIS__HALF_PI - (double)(float)hf_tan_to_elevation(t);
                 }
                 out[(ptrdiff_t)y * out_stride + x] = (float)(sum / (double)K);
             }
@@ -2937,17 +2984,17 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
         }
     } else { /* the sweep: a plane, its sums and (negative) the inverted surface */
         const size_t n = hf_grid_count(grid);
-        float *plane = (float *)hf_alloc_array(o.alloc, n, sizeof(float));
-        double *sum = (double *)hf_alloc_array(o.alloc, n, sizeof(double));
-        float *inv = negative ? (float *)hf_alloc_array(o.alloc, n, sizeof(float)) : NULL;
+        float *plane = (float *)hfvis__alloc_array(o.alloc, n, sizeof(float));
+        double *sum = (double *)hfvis__alloc_array(o.alloc, n, sizeof(double));
+        float *inv = negative ? (float *)hfvis__alloc_array(o.alloc, n, sizeof(float)) : NULL;
         hfvis_sweep_options quiet = o;
         hfvis_grid g = *grid;
         hfvis_status s = HFVIS_OK;
         size_t i;
         if (!plane || !sum || (negative && !inv)) {
-            hf_free(o.alloc, inv);
-            hf_free(o.alloc, sum);
-            hf_free(o.alloc, plane);
+            hfvis__free(o.alloc, inv);
+            hfvis__free(o.alloc, sum);
+            hfvis__free(o.alloc, plane);
             return HFVIS_ERR_OUT_OF_MEMORY;
         }
         if (negative) {
@@ -2961,16 +3008,16 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
         for (i = 0; i < n; i++) sum[i] = 0.0;
         for (k = 0; k < K && s == HFVIS_OK; k++) {
             s = hfvis_horizon_direction(&g, K, k, &quiet, plane, W);
-            for (i = 0; s == HFVIS_OK && i < n; i++) sum[i] += HF_HALF_PI - (double)plane[i];
+            for (i = 0; s == HFVIS_OK && i < n; i++) sum[i] += HFVIS__HALF_PI - (double)plane[i];
             if (s == HFVIS_OK) hf_progress(&o, k + 1, K);
         }
         if (s == HFVIS_OK)
             for (y = 0; y < H; y++)
                 for (x = 0; x < W; x++)
                     out[(ptrdiff_t)y * out_stride + x] = (float)(sum[(size_t)y * (size_t)W + (size_t)x] / (double)K);
-        hf_free(o.alloc, inv);
-        hf_free(o.alloc, sum);
-        hf_free(o.alloc, plane);
+        hfvis__free(o.alloc, inv);
+        hfvis__free(o.alloc, sum);
+        hfvis__free(o.alloc, plane);
         return s;
     }
     return HFVIS_OK;
@@ -2984,9 +3031,9 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
  * [psi_k - pi/K, psi_k + pi/K] is exact (2 sin(pi/K)); the b_k term integrates to zero. */
 double hfvis_sector_weight(int K, double nz, double a, double theta)
 {
-    if (K < 1) return HF_NAN;
+    if (K < 1) return HFVIS__NAN;
     return nz / (double)K * sin(theta) * sin(theta) +
-           sin(HF_PI / (double)K) / HF_PI * a * (theta - 0.5 * sin(2.0 * theta));
+           sin(HFVIS__PI / (double)K) / HFVIS__PI * a * (theta - 0.5 * sin(2.0 * theta));
 }
 
 /* atan for the per-receiver-direction light terms (sky light, environment light, both modes):
@@ -3008,7 +3055,7 @@ static inline double hf_atan(double t)
               s2 * (0.03978123126172938 + -0.014401362402942217 * s)) +
         (s4 * s4) * 0.0024567256561116523;
     y = x * p;
-    if (big) y = HF_HALF_PI - y;
+    if (big) y = HFVIS__HALF_PI - y;
     return copysign(y, t);
 }
 
@@ -3025,14 +3072,14 @@ static inline double hf_sky_term(double t, double nz, double a, double inv_k, do
     /* nz = 0: a vertical receiver, or a float normal whose z underflowed (tiny cells): the
      * limits of tc = -a/nz; facing away (a <= 0), the direction lies below the tangent plane */
     if (nz > 0.0) tc = -a / nz;
-    else if (a > 0.0) tc = -HF_INF;
+    else if (a > 0.0) tc = -HFVIS__INF;
     else return 0.0;
     if (t > tc) tc = t;
     if (isinf(tc)) { /* tc = -inf: q = 0, tc q -> 0, theta = pi */
-        return tc > 0.0 ? 0.0 : lobe * a * HF_PI;
+        return tc > 0.0 ? 0.0 : lobe * a * HFVIS__PI;
     }
     q = 1.0 / (1.0 + tc * tc);
-    theta = HF_HALF_PI - hf_atan(tc);
+    theta = HFVIS__HALF_PI - hf_atan(tc);
     /* The term integrates a cosine over the visible arc, so it is >= 0; for a steep horizon
      * (large tc) theta - tc q cancels to about 2/(3 tc^3) and rounding can dip below 0. */
     r = nz * inv_k * q + lobe * a * (theta - tc * q);
@@ -3088,7 +3135,7 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
         hf_direction_base(K, gidx, o->azimuth0_rad, &ux, &uy, &m0);
         hf_sweep_group(sw, ux, uy);
         /* the accumulator: 0 at every in-domain node with a height, else NaN */
-        hf_lattice_fill(sw, HF_NAN);
+        hf_lattice_fill(sw, HFVIS__NAN);
         for (j = 0; j < sw->rows; j++) {
             const double *hr = sw->h + (size_t)j * (size_t)sw->cols;
             double *lr = sw->lat + (size_t)j * (size_t)sw->cols * (size_t)channels;
@@ -3124,7 +3171,7 @@ static void hf_fused_output(const hf_sweep *sw, double scale, double offset, flo
             const double *a = sw->gacc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)channels;
             float *o = out + ((ptrdiff_t)y * out_stride + x) * channels;
             int hole = hf_is_hole(g, x, y);
-            for (c = 0; c < channels; c++) o[c] = (float)(hole ? HF_NAN : offset + scale * a[c]);
+            for (c = 0; c < channels; c++) o[c] = (float)(hole ? HFVIS__NAN : offset + scale * a[c]);
         }
 }
 
@@ -3151,7 +3198,7 @@ static int hf_light_args_valid(const hfvis_grid *grid, int K, const hfvis_sweep_
                                const void *out, ptrdiff_t out_stride)
 {
     return hf_check_common(grid, opts) == HFVIS_OK && out && K >= 1 && out_stride >= grid->width &&
-           hf_out_fits(out_stride, grid->height);
+           hfvis__plane_fits(out_stride, grid->height, 4);
 }
 
 hfvis_status hfvis_sky_light(const hfvis_grid *grid, int K, float sky, float albedo,
@@ -3169,7 +3216,7 @@ hfvis_status hfvis_sky_light(const hfvis_grid *grid, int K, float sky, float alb
                               (double)sky * (double)albedo, out, out_stride);
     memset(&ctx, 0, sizeof ctx);
     ctx.inv_k = 1.0 / (double)K;
-    ctx.lobe = sin(HF_PI / (double)K) / HF_PI;
+    ctx.lobe = sin(HFVIS__PI / (double)K) / HFVIS__PI;
     if ((s = hf_fused_run(&sw, grid, K, &o, 1, 1, hf_sky_line, &ctx.f)) != HFVIS_OK) return s;
     hf_fused_output(&sw, (double)sky * (double)albedo, 0.0, out, out_stride, 1);
     hf_sweep_free(&sw);
@@ -3181,15 +3228,15 @@ static int hf_map_args_valid(const hfvis_grid *grid, int K, const float *map, co
 {
     size_t total;
     return hf_grid_valid(grid) && K >= 1 && map && out && out_stride >= grid->width &&
-           hf_out_fits(out_stride, grid->height) && hf_mul_size(hf_grid_count(grid), (size_t)K, &total);
+           hfvis__plane_fits(out_stride, grid->height, 4) && hfvis__mul_size(hf_grid_count(grid), (size_t)K, &total);
 }
 
 /* tan of a stored elevation; -pi/2 (or below) means no occluder. */
 static double hf_elevation_to_tan(double alpha)
 {
-    if (isnan(alpha)) return HF_NAN;
-    if (alpha <= -HF_HALF_PI) return -HF_INF;
-    if (alpha >= HF_HALF_PI) return HF_INF;
+    if (isnan(alpha)) return HFVIS__NAN;
+    if (alpha <= -HFVIS__HALF_PI) return -HFVIS__INF;
+    if (alpha >= HFVIS__HALF_PI) return HFVIS__INF;
     return tan(alpha);
 }
 
@@ -3204,16 +3251,16 @@ hfvis_status hfvis_sky_light_from_map(const hfvis_grid *grid, int K, double map_
     if (!hf_map_args_valid(grid, K, map, out, out_stride) || !isfinite(map_azimuth0_rad) ||
         !isfinite(sky) || !isfinite(albedo))
         return HFVIS_ERR_INVALID_ARGUMENT;
-    dirs = (double *)hf_alloc_array(alloc, (size_t)K, 2 * sizeof(double));
+    dirs = (double *)hfvis__alloc_array(alloc, (size_t)K, 2 * sizeof(double));
     if (!dirs) return HFVIS_ERR_OUT_OF_MEMORY;
     for (k = 0; k < K; k++) {
-        double psi = map_azimuth0_rad + 2.0 * HF_PI * (double)k / (double)K;
+        double psi = map_azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K;
         dirs[2 * k] = cos(psi);
         dirs[2 * k + 1] = sin(psi);
     }
     plane = hf_grid_count(grid);
     inv_k = 1.0 / (double)K;
-    lobe = sin(HF_PI / (double)K) / HF_PI;
+    lobe = sin(HFVIS__PI / (double)K) / HFVIS__PI;
     for (y = 0; y < grid->height; y++)
         for (x = 0; x < grid->width; x++) {
             size_t idx = (size_t)y * (size_t)grid->width + (size_t)x;
@@ -3225,7 +3272,7 @@ hfvis_status hfvis_sky_light_from_map(const hfvis_grid *grid, int K, double map_
             }
             out[(ptrdiff_t)y * out_stride + x] = (float)((double)sky * (double)albedo * sum);
         }
-    hf_free(alloc, dirs);
+    hfvis__free(alloc, dirs);
     return HFVIS_OK;
 }
 
@@ -3286,10 +3333,10 @@ hfvis_status hfvis_sky_view_factor_from_map(const hfvis_grid *grid, int K, const
         for (x = 0; x < grid->width; x++) {
             size_t idx = (size_t)y * (size_t)grid->width + (size_t)x;
             double sum = 0.0;
-            if (hf_is_hole(grid, x, y)) sum = HF_NAN;
+            if (hf_is_hole(grid, x, y)) sum = HFVIS__NAN;
             for (k = 0; k < K; k++) {
                 double a = (double)map[(size_t)k * plane + idx];
-                sum += a > 0.0 ? sin(a) : (isnan(a) ? HF_NAN : 0.0);
+                sum += a > 0.0 ? sin(a) : (isnan(a) ? HFVIS__NAN : 0.0);
             }
             out[(ptrdiff_t)y * out_stride + x] = (float)(1.0 - sum / (double)K);
         }
@@ -3302,10 +3349,10 @@ hfvis_status hfvis_sky_view_factor_from_map(const hfvis_grid *grid, int K, const
 static double hf_sun_fraction(double e, double r, double alpha)
 {
     double d;
-    if (isnan(alpha)) return HF_NAN;
+    if (isnan(alpha)) return HFVIS__NAN;
     if (r <= 0.0) return e > alpha ? 1.0 : 0.0;
     d = hf_clampd((e - alpha) / r, -1.0, 1.0);
-    return 1.0 - (acos(d) - d * sqrt(1.0 - d * d)) / HF_PI;
+    return 1.0 - (acos(d) - d * sqrt(1.0 - d * d)) / HFVIS__PI;
 }
 
 hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad,
@@ -3318,8 +3365,8 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
     double ux, uy;
     int x, y;
     if (hf_check_common(grid, opts) != HFVIS_OK || !out || out_stride < grid->width ||
-        !hf_out_fits(out_stride, grid->height) || !isfinite(sun_azimuth_rad) || !isfinite(sun_elevation_rad) || !isfinite(sun_radius_rad) ||
-        sun_radius_rad < 0.0 || sun_elevation_rad < -HF_HALF_PI || sun_elevation_rad > HF_HALF_PI)
+        !hfvis__plane_fits(out_stride, grid->height, 4) || !isfinite(sun_azimuth_rad) || !isfinite(sun_elevation_rad) || !isfinite(sun_radius_rad) ||
+        sun_radius_rad < 0.0 || sun_elevation_rad < -HFVIS__HALF_PI || sun_elevation_rad > HFVIS__HALF_PI)
         return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
     if (o.rays == HFVIS_RAYS_EXACT)
@@ -3328,7 +3375,7 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
     if ((s = hf_sweep_alloc(&sw, grid, &o, 0, 1, 0)) != HFVIS_OK) return s;
     hf_sweep_vector(sun_azimuth_rad, &ux, &uy);
     hf_sweep_group(&sw, ux, uy);
-    hf_lattice_fill(&sw, HF_NAN);
+    hf_lattice_fill(&sw, HFVIS__NAN);
     hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL);
     hf_gather_planes(&sw, 1, 0, out, 0, out_stride);
     for (y = sw.ry0; y < sw.ry1; y++)
@@ -3349,7 +3396,7 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
  * Contents
  *   1. constants, argument resolution
  *   2. sector phi-integrals of the lat-long texels, band theta-weights
- *   3. table layouts and hfvis_env_table_size / hfvis_env_table_build
+ *   3. table layouts and hfvis_env_table_floats / hfvis_env_table_build
  *   4. hf_env_eval: per node and direction evaluation (the fused sweep calls this)
  *   5. hfvis_env_light_from_map
  *   6. hfvis_light_reference (hemisphere-integration oracle)
@@ -3403,7 +3450,7 @@ typedef struct hf_env_resolved {
     size_t table_floats;
 } hf_env_resolved;
 
-/* Checks the environment's shape (not its radiance pointer: hfvis_env_table_size can be asked
+/* Checks the environment's shape (not its radiance pointer: hfvis_env_table_floats can be asked
  * before the map is loaded), K and the options; resolves defaults and the table size.
  * lp_normal_res must be odd and >= 3 (M = 1 leaves no theta_n interval to interpolate). */
 /* The radiance array (n_theta*n_phi*channels floats) must be addressable: a size that
@@ -3411,8 +3458,8 @@ typedef struct hf_env_resolved {
 static int hf_env_size_ok(const hfvis_env *env)
 {
     size_t n, bytes;
-    return hf_mul_size((size_t)env->n_theta, (size_t)env->n_phi, &n) &&
-           hf_mul_size(n, (size_t)env->channels, &n) && hf_mul_size(n, sizeof(float), &bytes);
+    return hfvis__mul_size((size_t)env->n_theta, (size_t)env->n_phi, &n) &&
+           hfvis__mul_size(n, (size_t)env->channels, &n) && hfvis__mul_size(n, sizeof(float), &bytes);
 }
 
 static hfvis_status hf_env_resolve(const hfvis_env *env, int K, const hfvis_env_options *eopts,
@@ -3435,17 +3482,17 @@ static hfvis_status hf_env_resolve(const hfvis_env *env, int K, const hfvis_env_
         /* the L_p resolutions are validated only when the L_p table is used */
         if (o.lp_normal_res < 3 || o.lp_normal_res % 2 == 0 || o.lp_horizon_res < 2)
             return HFVIS_ERR_INVALID_ARGUMENT;
-        if (!hf_mul_size((size_t)K, (size_t)o.lp_normal_res, &n) ||
-            !hf_mul_size(n, (size_t)o.lp_horizon_res, &n) ||
-            !hf_mul_size(n, (size_t)env->channels, &n))
+        if (!hfvis__mul_size((size_t)K, (size_t)o.lp_normal_res, &n) ||
+            !hfvis__mul_size(n, (size_t)o.lp_horizon_res, &n) ||
+            !hfvis__mul_size(n, (size_t)env->channels, &n))
             return HFVIS_ERR_INVALID_ARGUMENT;
     } else {
-        if (!hf_mul_size((size_t)K, (size_t)env->n_theta + 1u, &n) ||
-            !hf_mul_size(n, (size_t)HF_ENV_PREFIX_RECORD * (size_t)env->channels, &n))
+        if (!hfvis__mul_size((size_t)K, (size_t)env->n_theta + 1u, &n) ||
+            !hfvis__mul_size(n, (size_t)HF_ENV_PREFIX_RECORD * (size_t)env->channels, &n))
             return HFVIS_ERR_INVALID_ARGUMENT;
     }
     /* every table index is later formed in size_t; bytes must be representable too */
-    if (!hf_mul_size(n, sizeof(float), &bytes)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!hfvis__mul_size(n, sizeof(float), &bytes)) return HFVIS_ERR_INVALID_ARGUMENT;
     r->method = o.method;
     r->lp_normal_res = o.lp_normal_res;
     r->lp_horizon_res = o.lp_horizon_res;
@@ -3453,7 +3500,7 @@ static hfvis_status hf_env_resolve(const hfvis_env *env, int K, const hfvis_env_
     return HFVIS_OK;
 }
 
-size_t hfvis_env_table_size(const hfvis_env *env, int K, const hfvis_env_options *eopts)
+size_t hfvis_env_table_floats(const hfvis_env *env, int K, const hfvis_env_options *eopts)
 {
     hf_env_resolved r;
     if (hf_env_resolve(env, K, eopts, &r) != HFVIS_OK) return 0;
@@ -3471,13 +3518,13 @@ typedef struct hf_env_sector {
 static hf_env_sector hf_env_sector_of(int K, double azimuth0_rad, int k)
 {
     hf_env_sector s;
-    double psi = azimuth0_rad + (2.0 * HF_PI) * (double)k / (double)K;
-    double st = fmod(psi - HF_PI / (double)K, (2.0 * HF_PI));
-    if (st < 0.0) st += (2.0 * HF_PI);
-    if (st >= (2.0 * HF_PI)) st = 0.0; /* -tiny + 2pi may round up to 2pi */
+    double psi = azimuth0_rad + (2.0 * HFVIS__PI) * (double)k / (double)K;
+    double st = fmod(psi - HFVIS__PI / (double)K, (2.0 * HFVIS__PI));
+    if (st < 0.0) st += (2.0 * HFVIS__PI);
+    if (st >= (2.0 * HFVIS__PI)) st = 0.0; /* -tiny + 2pi may round up to 2pi */
     s.start = st;
-    s.width = (2.0 * HF_PI) / (double)K;
-    s.centre = st + HF_PI / (double)K;
+    s.width = (2.0 * HFVIS__PI) / (double)K;
+    s.centre = st + HFVIS__PI / (double)K;
     return s;
 }
 
@@ -3493,15 +3540,15 @@ static void hf_env_band_sector(const hfvis_env *env, int t, const hf_env_sector 
     const int P = env->n_phi, C = env->channels;
     const double end = s->start + s->width;
     const float *row = env->radiance + (size_t)t * (size_t)P * (size_t)C;
-    int p = (int)floor(s->start * (double)P / (2.0 * HF_PI)) - 1, c;
+    int p = (int)floor(s->start * (double)P / (2.0 * HFVIS__PI)) - 1, c;
     for (c = 0; c < C; c++) {
         a0[c] = 0.0;
         a1[c] = 0.0;
         if (a2 != NULL) a2[c] = 0.0;
     }
     for (;; p++) {
-        double lo = (2.0 * HF_PI) * (double)p / (double)P;
-        double hi = (2.0 * HF_PI) * (double)(p + 1) / (double)P;
+        double lo = (2.0 * HFVIS__PI) * (double)p / (double)P;
+        double hi = (2.0 * HFVIS__PI) * (double)(p + 1) / (double)P;
         double f1, f2, len, wc, ws;
         const float *px;
         if (lo >= end) break;
@@ -3537,7 +3584,7 @@ static void hf_env_theta_weights(double theta, double theta0, double *wa, double
 /* Band edge theta_b = b*pi/T; the build and the evaluator must use this same expression. */
 static double hf_env_band_edge(int b, int T)
 {
-    return HF_PI * (double)b / (double)T;
+    return HFVIS__PI * (double)b / (double)T;
 }
 
 /* ---------------------------------------------------------- 3. hfvis_env_table_build */
@@ -3589,20 +3636,20 @@ static void hf_env_walk_eval(hf_env_prefix_walk *w, double theta, double *A, dou
 /* L_p axes (docs/errata.md E9); the build and the evaluator use these expressions. */
 static double hf_env_lp_normal_angle(int i, int M)
 {
-    return HF_PI * ((double)i / (double)(M - 1) - 0.5);
+    return HFVIS__PI * ((double)i / (double)(M - 1) - 0.5);
 }
 static double hf_env_lp_horizon_angle(int j, int Th)
 {
-    return HF_PI * (double)j / (double)(Th - 1);
+    return HFVIS__PI * (double)j / (double)(Th - 1);
 }
 /* Eq. 7 upper limit theta_n + pi/2, clamped to [0, pi] against rounding at i = 0 and M-1. */
 static double hf_env_lp_cutoff(int i, int M)
 {
-    double c = hf_env_lp_normal_angle(i, M) + HF_HALF_PI;
-    return c < 0.0 ? 0.0 : (c > HF_PI ? HF_PI : c);
+    double c = hf_env_lp_normal_angle(i, M) + HFVIS__HALF_PI;
+    return c < 0.0 ? 0.0 : (c > HFVIS__PI ? HFVIS__PI : c);
 }
 
-/* L_p table of one direction ([P1] Eq. 7 in its Eq. 5-consistent form, [P1] Eq. 6-7; docs/errata.md E9):
+/* L_p table of one direction ([P1] Eq. 6-7, Eq. 7 in its Eq. 5-consistent form; docs/errata.md E9):
  * L_p(theta_n, theta_h) = (1/pi)[cos theta_n A_k(c) + sin theta_n B_k(c)],
  * c = min(theta_h, theta_n + pi/2). Entries with theta_h_j < theta_n_i + pi/2 need A, B at
  * theta_h_j (shared by all i): one walk over j. The others need A, B at theta_n_i + pi/2
@@ -3623,7 +3670,7 @@ static void hf_env_build_lp_direction(const hfvis_env *env, const hf_env_sector 
             float *e;
             if (!(th < hf_env_lp_cutoff(i, M))) continue; /* second walk */
             e = tab + ((size_t)i * (size_t)Th + (size_t)j) * (size_t)C;
-            for (c = 0; c < C; c++) e[c] = (float)((cn * A[c] + sn * B[c]) / HF_PI);
+            for (c = 0; c < C; c++) e[c] = (float)((cn * A[c] + sn * B[c]) / HFVIS__PI);
         }
     }
     hf_env_walk_start(&w, env, s);
@@ -3635,7 +3682,7 @@ static void hf_env_build_lp_direction(const hfvis_env *env, const hf_env_sector 
             float *e;
             if (hf_env_lp_horizon_angle(j, Th) < cut) continue; /* first walk */
             e = tab + ((size_t)i * (size_t)Th + (size_t)j) * (size_t)C;
-            for (c = 0; c < C; c++) e[c] = (float)((cn * A[c] + sn * B[c]) / HF_PI);
+            for (c = 0; c < C; c++) e[c] = (float)((cn * A[c] + sn * B[c]) / HFVIS__PI);
         }
     }
 }
@@ -3754,23 +3801,23 @@ static void hf_env_accumulate(const hf_env_eval *e, int k, double cos_psi, doubl
 {
     const int C = e->channels;
     const double a = nx * cos_psi + ny * sin_psi;
-    double theta_h = HF_HALF_PI - hf_atan(tan_h);
+    double theta_h = HFVIS__HALF_PI - hf_atan(tan_h);
     int c;
     if (isnan(theta_h) || isnan(a) || isnan(nz)) {
-        for (c = 0; c < C; c++) acc[c] += HF_NAN;
+        for (c = 0; c < C; c++) acc[c] += HFVIS__NAN;
         return;
     }
     if (theta_h < 0.0) theta_h = 0.0;
-    if (theta_h > HF_PI) theta_h = HF_PI;
+    if (theta_h > HFVIS__PI) theta_h = HFVIS__PI;
     if (e->method == HFVIS_ENV_LP_TABLE) {
         const int M = e->lp_normal_res, Th = e->lp_horizon_res;
         double np = sqrt(a * a + nz * nz), tn = nz > 0.0 ? hf_atan(a / nz) : atan2(a, nz), fi, fj, u, v;
         int i0, j0;
         const float *t00, *t01, *t10, *t11;
-        if (tn < -HF_HALF_PI) tn = -HF_HALF_PI;
-        if (tn > HF_HALF_PI) tn = HF_HALF_PI;
-        fi = (tn / HF_PI + 0.5) * (double)(M - 1); /* (M-1)/2 exactly for tn = 0 */
-        fj = theta_h / HF_PI * (double)(Th - 1);
+        if (tn < -HFVIS__HALF_PI) tn = -HFVIS__HALF_PI;
+        if (tn > HFVIS__HALF_PI) tn = HFVIS__HALF_PI;
+        fi = (tn / HFVIS__PI + 0.5) * (double)(M - 1); /* (M-1)/2 exactly for tn = 0 */
+        fj = theta_h / HFVIS__PI * (double)(Th - 1);
         i0 = (int)fi;
         if (i0 > M - 2) i0 = M - 2;
         if (i0 < 0) i0 = 0;
@@ -3792,12 +3839,12 @@ static void hf_env_accumulate(const hf_env_eval *e, int k, double cos_psi, doubl
     } else {
         const int T = e->env->n_theta;
         const double b = -nx * sin_psi + ny * cos_psi;
-        double theta = theta_h, tc = HF_HALF_PI + (nz > 0.0 ? hf_atan(a / nz) : atan2(a, nz)), wa, wb;
+        double theta = theta_h, tc = HFVIS__HALF_PI + (nz > 0.0 ? hf_atan(a / nz) : atan2(a, nz)), wa, wb;
         const float *rec;
         int band;
         if (tc < theta) theta = tc;
         if (theta <= 0.0) return; /* every prefix integral is 0 at theta = 0 */
-        band = (int)(theta * (double)T / HF_PI);
+        band = (int)(theta * (double)T / HFVIS__PI);
         if (band > T - 1) band = T - 1;
         hf_env_theta_weights(theta, hf_env_band_edge(band, T), &wa, &wb);
         rec = e->table + ((size_t)k * ((size_t)T + 1u) + (size_t)band) * HF_ENV_PREFIX_RECORD *
@@ -3806,13 +3853,13 @@ static void hf_env_accumulate(const hf_env_eval *e, int k, double cos_psi, doubl
             double A = (double)rec[0 * C + c] + (double)rec[3 * C + c] * wa;
             double B = (double)rec[1 * C + c] + (double)rec[4 * C + c] * wb;
             double Cs = (double)rec[2 * C + c] + (double)rec[5 * C + c] * wb;
-            acc[c] += (nz * A + a * B + b * Cs) / HF_PI;
+            acc[c] += (nz * A + a * B + b * Cs) / HFVIS__PI;
         }
     }
 }
 
 /* Allocate (1 block from alloc), build and bind the tables of one call; *table receives the
- * block for hf_free. For the lead's hfvis_env_light. */
+ * block for hfvis__free. For the lead's hfvis_env_light. */
 static hfvis_status hf_env_tables_create(const hfvis_env *env, int K, double azimuth0_rad,
                                          const hfvis_env_options *eopts,
                                          const hfvis_allocator *alloc, float **table,
@@ -3823,12 +3870,12 @@ static hfvis_status hf_env_tables_create(const hfvis_env *env, int K, double azi
     float *t;
     if (st != HFVIS_OK) return st;
     if (env->radiance == NULL || !isfinite(azimuth0_rad)) return HFVIS_ERR_INVALID_ARGUMENT;
-    t = (float *)hf_alloc(alloc, r.table_floats * sizeof(float));
+    t = (float *)hfvis__alloc(alloc, r.table_floats * sizeof(float));
     if (t == NULL) return HFVIS_ERR_OUT_OF_MEMORY;
     st = hfvis_env_table_build(env, K, azimuth0_rad, eopts, t);
     if (st == HFVIS_OK) st = hf_env_eval_init(e, env, K, eopts, t);
     if (st != HFVIS_OK) {
-        hf_free(alloc, t);
+        hfvis__free(alloc, t);
         return st;
     }
     *table = t;
@@ -3859,28 +3906,28 @@ hfvis_status hfvis_env_light_from_map(const hfvis_grid *grid, int K,
     int x, y, k, c, C;
     if (!hf_grid_valid(grid) || K < 1 || !isfinite(map_azimuth0_rad) || map == NULL ||
         !hf_env_valid(env) || !isfinite(albedo) || out == NULL ||
-        out_stride < (ptrdiff_t)grid->width || !hf_out_fits(out_stride, grid->height))
+        out_stride < (ptrdiff_t)grid->width || !hfvis__plane_fits(out_stride, grid->height, 4))
         return HFVIS_ERR_INVALID_ARGUMENT;
     st = hf_env_resolve(env, K, eopts, &r);
     if (st != HFVIS_OK) return st;
     C = env->channels;
     /* map holds K planes of W*H; out's last index and the normal buffer must be addressable */
-    if (!hf_mul_size((size_t)grid->width, (size_t)grid->height, &plane) ||
-        !hf_mul_size(plane, (size_t)K, &mapn) || !hf_mul_size(plane, 3u * sizeof(float), &n3) ||
-        !hf_mul_size((size_t)out_stride, (size_t)grid->height, &last) ||
-        !hf_mul_size(last, (size_t)C, &last))
+    if (!hfvis__mul_size((size_t)grid->width, (size_t)grid->height, &plane) ||
+        !hfvis__mul_size(plane, (size_t)K, &mapn) || !hfvis__mul_size(plane, 3u * sizeof(float), &n3) ||
+        !hfvis__mul_size((size_t)out_stride, (size_t)grid->height, &last) ||
+        !hfvis__mul_size(last, (size_t)C, &last))
         return HFVIS_ERR_INVALID_ARGUMENT;
-    normals = (float *)hf_alloc(alloc, n3);
+    normals = (float *)hfvis__alloc(alloc, n3);
     if (normals == NULL) return HFVIS_ERR_OUT_OF_MEMORY;
     st = hf_env_tables_create(env, K, map_azimuth0_rad, eopts, alloc, &table, &e);
     if (st != HFVIS_OK) {
-        hf_free(alloc, normals);
+        hfvis__free(alloc, normals);
         return st;
     }
     st = hfvis_normals_compute(grid, normals);
     if (st != HFVIS_OK) {
-        hf_free(alloc, table);
-        hf_free(alloc, normals);
+        hfvis__free(alloc, table);
+        hfvis__free(alloc, normals);
         return st;
     }
     for (y = 0; y < grid->height; y++) {
@@ -3892,7 +3939,7 @@ hfvis_status hfvis_env_light_from_map(const hfvis_grid *grid, int K,
             int hole = !isfinite(grid->z[(size_t)y * (size_t)grid->stride + (size_t)x]);
             for (k = 0; k < K && !hole; k++) {
                 double alpha = (double)map[(size_t)k * plane + g];
-                double psi = map_azimuth0_rad + (2.0 * HF_PI) * (double)k / (double)K;
+                double psi = map_azimuth0_rad + (2.0 * HFVIS__PI) * (double)k / (double)K;
                 if (!isfinite(alpha)) {
                     hole = 1;
                     break;
@@ -3901,15 +3948,24 @@ hfvis_status hfvis_env_light_from_map(const hfvis_grid *grid, int K,
                                   (double)n[2], hf_elevation_to_tan(alpha), acc);
             }
             for (c = 0; c < C; c++)
-                o[c] = (float)(hole ? HF_NAN : (double)albedo * acc[c]);
+                o[c] = (float)(hole ? HFVIS__NAN : (double)albedo * acc[c]);
         }
     }
-    hf_free(alloc, table);
-    hf_free(alloc, normals);
+    hfvis__free(alloc, table);
+    hfvis__free(alloc, normals);
     return HFVIS_OK;
 }
 
 /* ------------------------------------------------ 6. hemisphere-integration oracle */
+
+hfvis_hemisphere_options hfvis_hemisphere_options_default(void)
+{
+    hfvis_hemisphere_options o;
+    memset(&o, 0, sizeof o);
+    o.azimuth_samples = HF_ENV_DEFAULT_AZIMUTH_SAMPLES;
+    o.zenith_samples = HF_ENV_DEFAULT_ZENITH_SAMPLES;
+    return o;
+}
 
 /* L_o = albedo/pi Int L_i V max(n.w, 0) dw ([P1] Eq. 3, the header's Lambertian convention)
  * by the midpoint rule: azimuths phi_m = 2pi (m + 1/2)/A, zenith angles
@@ -3958,8 +4014,8 @@ hfvis_status hfvis_light_reference(const hfvis_grid *grid, const hfvis_env *env,
     T = env->n_theta;
     P = env->n_phi;
     if (count == 0) return HFVIS_OK;
-    if (points == NULL || normals == NULL || out == NULL || !hf_mul_size(count, 3u, &tmp) ||
-        !hf_mul_size(count, (size_t)C, &tmp))
+    if (points == NULL || normals == NULL || out == NULL || !hfvis__mul_size(count, 3u, &tmp) ||
+        !hfvis__mul_size(count, (size_t)C, &tmp))
         return HFVIS_ERR_INVALID_ARGUMENT;
     /* validated up front so that the per-receiver march cannot fail half-way */
     for (i = 0; i < 2u * count; i++)
@@ -3967,7 +4023,7 @@ hfvis_status hfvis_light_reference(const hfvis_grid *grid, const hfvis_env *env,
     so = opts != NULL ? *opts : hfvis_sweep_options_default();
     so.progress = NULL;
     so.progress_user = NULL;
-    scale = ((2.0 * HF_PI) / (double)A) * (HF_PI / (double)Z) * (double)albedo / HF_PI;
+    scale = ((2.0 * HFVIS__PI) / (double)A) * (HFVIS__PI / (double)Z) * (double)albedo / HFVIS__PI;
     for (i = 0; i < count; i++) {
         const double nx = (double)normals[3u * i], ny = (double)normals[3u * i + 1u],
                      nz = (double)normals[3u * i + 2u];
@@ -3976,9 +4032,9 @@ hfvis_status hfvis_light_reference(const hfvis_grid *grid, const hfvis_env *env,
                            isnan(hfvis_grid_sample(grid, (double)points[2u * i],
                                                    (double)points[2u * i + 1u]));
         for (m = 0; m < A && !bad; m++) {
-            double phi = (2.0 * HF_PI) * ((double)m + 0.5) / (double)A;
+            double phi = (2.0 * HFVIS__PI) * ((double)m + 0.5) / (double)A;
             double cp = cos(phi), sp = sin(phi), limit;
-            int col = (int)(phi * (double)P / (2.0 * HF_PI));
+            int col = (int)(phi * (double)P / (2.0 * HFVIS__PI));
             float alpha;
             hfvis_status st;
             if (col > P - 1) col = P - 1;
@@ -3990,23 +4046,23 @@ hfvis_status hfvis_light_reference(const hfvis_grid *grid, const hfvis_env *env,
                 break;
             }
             /* visible iff pi/2 - theta > alpha, i.e. theta < pi/2 - alpha */
-            limit = HF_HALF_PI - (double)alpha;
+            limit = HFVIS__HALF_PI - (double)alpha;
             for (j = 0; j < Z; j++) {
-                double theta = HF_PI * ((double)j + 0.5) / (double)Z;
+                double theta = HFVIS__PI * ((double)j + 0.5) / (double)Z;
                 double st_ = sin(theta), cosine;
                 const float *L;
                 int row;
                 if (!(theta < limit)) break;
                 cosine = st_ * (nx * cp + ny * sp) + nz * cos(theta);
                 if (!(cosine > 0.0)) continue;
-                row = (int)(theta * (double)T / HF_PI);
+                row = (int)(theta * (double)T / HFVIS__PI);
                 if (row > T - 1) row = T - 1;
                 L = env->radiance + ((size_t)row * (size_t)P + (size_t)col) * (size_t)C;
                 for (c = 0; c < C; c++) acc[c] += (double)L[c] * cosine * st_;
             }
         }
         for (c = 0; c < C; c++)
-            out[i * (size_t)C + (size_t)c] = (float)(bad ? HF_NAN : acc[c] * scale);
+            out[i * (size_t)C + (size_t)c] = (float)(bad ? HFVIS__NAN : acc[c] * scale);
     }
     return HFVIS_OK;
 }
@@ -4058,7 +4114,7 @@ hfvis_status hfvis_env_light(const hfvis_grid *grid, int K, const hfvis_env *env
         hf_fused_output(&sw, (double)albedo, 0.0, out, out_stride, env->channels);
         hf_sweep_free(&sw);
     }
-    hf_free(o.alloc, table);
+    hfvis__free(o.alloc, table);
     return s;
 }
 
@@ -4095,8 +4151,21 @@ size_t hfvis_hull_tree_size(int max_samples)
     if (max_samples < 1) return 0;
     n = (size_t)max_samples;
     per = 2 * sizeof(double) + 5 * sizeof(int) + 2 * sizeof(signed char);
-    if (!hf_mul_size(n, per, &total) || total > SIZE_MAX - hf_tree_header() - 64) return 0;
+    if (!hfvis__mul_size(n, per, &total) || total > SIZE_MAX - hf_tree_header() - 64) return 0;
     return hf_tree_header() + total + 64; /* + alignment slack between the arrays */
+}
+
+/* SafeZoneUpdate window b2 - b1 when the options give 0 ([P2] Alg. 3; docs/errata.md E15). */
+#define HF_TREE_DEFAULT_ZONE_STEPS 4
+
+hfvis_tree_options hfvis_tree_options_default(void)
+{
+    hfvis_tree_options o;
+    memset(&o, 0, sizeof o);
+    o.order = HFVIS_TREE_DEPTH_FIRST;
+    o.safe_zone = 0;
+    o.safe_zone_steps = HF_TREE_DEFAULT_ZONE_STEPS;
+    return o;
 }
 
 hfvis_status hfvis_hull_tree_init(void *mem, size_t mem_size, int max_samples,
@@ -4116,7 +4185,7 @@ hfvis_status hfvis_hull_tree_init(void *mem, size_t mem_size, int max_samples,
     t->cap = max_samples;
     t->order = opts && opts->order ? opts->order : HFVIS_TREE_DEPTH_FIRST;
     t->safe_zone = opts ? opts->safe_zone : 0;
-    t->zone_steps = opts && opts->safe_zone_steps ? opts->safe_zone_steps : 4;
+    t->zone_steps = opts && opts->safe_zone_steps ? opts->safe_zone_steps : HF_TREE_DEFAULT_ZONE_STEPS;
     p = (unsigned char *)mem + hf_tree_header();
     t->d = (double *)(void *)p;
     t->h = t->d + n;
@@ -4164,7 +4233,7 @@ static void hf_tree_unlink(hfvis_hull_tree *t, int x, int r)
  * concave). */
 static void hf_tree_zone_refresh(hfvis_hull_tree *t, int r)
 {
-    double step = r > 0 ? t->d[r] - t->d[r - 1] : 1.0, h1 = HF_INF, h2 = HF_INF, scale = 0.0;
+    double step = r > 0 ? t->d[r] - t->d[r - 1] : 1.0, h1 = HFVIS__INF, h2 = HFVIS__INF, scale = 0.0;
     int c;
     t->zone_b1 = t->d[r];
     t->zone_b2 = t->d[r] + step * (double)t->zone_steps;
@@ -4330,7 +4399,7 @@ static int hf_visible_from_horizons(const double *d, const double *h, int s, con
     int r, count = 0;
     for (r = 0; r < m; r++) {
         int next = r + 1 < m ? H[r + 1] : s, q = H[r];
-        double lim = r + 1 < m ? hf_slope_from(d, h, s, H[r + 1]) : -HF_INF;
+        double lim = r + 1 < m ? hf_slope_from(d, h, s, H[r + 1]) : -HFVIS__INF;
         for (; q < next; q++) {
             if (!isfinite(h[q])) continue;
             if (q != H[r] && !(hf_slope_from(d, h, s, q) >= lim)) break;
@@ -4363,7 +4432,7 @@ int hfvis_line_visible_from_horizons(const double *distance, const double *heigh
  * its slope is >= the running maximum. Written near to far into tmp order reversed on output. */
 static int hf_visible_naive(const double *d, const double *h, int s, int *out, int cap)
 {
-    double best = -HF_INF;
+    double best = -HFVIS__INF;
     int q, count = 0, i;
     for (q = s - 1; q >= 0; q--) {
         double t;
@@ -4376,7 +4445,7 @@ static int hf_visible_naive(const double *d, const double *h, int s, int *out, i
     }
     /* second pass writes farthest first without scratch */
     i = count;
-    best = -HF_INF;
+    best = -HFVIS__INF;
     for (q = s - 1; q >= 0; q--) {
         double t;
         if (!isfinite(h[q])) continue;
@@ -4400,14 +4469,14 @@ int hfvis_line_visible_naive(const double *distance, const double *height, int r
 int hfvis_line_local_horizons_naive(const double *distance, const double *height, int receiver,
                                     int *out, int cap)
 {
-    double best = -HF_INF;
+    double best = -HFVIS__INF;
     int q, count = 0, prev_visible = 0, i;
     if (!hf_line_args_ok(distance, height, receiver, cap, out)) return -1;
     /* visible flags near to far; a horizon is a visible sample whose farther neighbour (the next
      * finite sample outward) is not visible, or the farthest finite sample if visible */
     for (i = 0; i < 2; i++) {
         int k = count;
-        best = -HF_INF;
+        best = -HFVIS__INF;
         prev_visible = 0;
         count = 0;
         for (q = receiver - 1; q >= -1; q--) {
@@ -4697,16 +4766,16 @@ static void hf_p2_indirect(hf_sweep *sw, hf_p2_ctx *c, ptrdiff_t node, int s, co
     (void)nh;
     c->st.visible += (double)nv;
     if (isnan(nz)) {
-        for (q = 0; q < ch; q++) sw->lat[node * ch + q] += HF_NAN;
+        for (q = 0; q < ch; q++) sw->lat[node * ch + q] += HFVIS__NAN;
         return;
     }
     w_prev = nv ? hf_sky_term(hf_slope_from(c->ld, c->lh, s, vis[0]), nz, a, c->inv_k, c->lobe)
-                : hf_sky_term(-HF_INF, nz, a, c->inv_k, c->lobe);
+                : hf_sky_term(-HFVIS__INF, nz, a, c->inv_k, c->lobe);
     for (q = 0; q < ch; q++) acc[q] = c->sky * w_prev;
     for (j = 0; j < nv; j++) {
         double w_next = j + 1 < nv
                             ? hf_sky_term(hf_slope_from(c->ld, c->lh, s, vis[j + 1]), nz, a, c->inv_k, c->lobe)
-                            : hf_sky_term(-HF_INF, nz, a, c->inv_k, c->lobe);
+                            : hf_sky_term(-HFVIS__INF, nz, a, c->inv_k, c->lobe);
         const double *L = c->le + (size_t)vis[j] * (size_t)ch;
         for (q = 0; q < ch; q++) acc[q] += L[q] * (w_next - w_prev);
         w_prev = w_next;
@@ -4802,7 +4871,7 @@ static hfvis_status hf_indirect(const hfvis_grid *grid, int K, const float *exit
     c.channels = channels;
     c.sky = (double)sky;
     c.inv_k = 1.0 / (double)K;
-    c.lobe = sin(HF_PI / (double)K) / HF_PI;
+    c.lobe = sin(HFVIS__PI / (double)K) / HFVIS__PI;
     if ((s = hf_p2_run(&sw, grid, K, &o, channels, 1, &c)) != HFVIS_OK) return s;
     hf_fused_output(&sw, (double)albedo, 0.0, out, out_stride, channels);
     hf_sweep_free(&sw);
@@ -4840,13 +4909,13 @@ hfvis_status hfvis_terrain_gi(const hfvis_grid *grid, int K, const float *direct
         K < 1 || !isfinite(albedo_value) || !hf_opts_valid(opts) || !hf_tree_opts_valid(tree_opts))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
-    if (!hf_mul_size(hf_grid_count(grid), (size_t)channels, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!hfvis__mul_size(hf_grid_count(grid), (size_t)channels, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
     n = hf_grid_count(grid);
-    exit_b = (float *)hf_alloc_array(alloc, total, sizeof(float));
-    ind = (float *)hf_alloc_array(alloc, total, sizeof(float));
+    exit_b = (float *)hfvis__alloc_array(alloc, total, sizeof(float));
+    ind = (float *)hfvis__alloc_array(alloc, total, sizeof(float));
     if (!exit_b || !ind) {
-        hf_free(alloc, ind);
-        hf_free(alloc, exit_b);
+        hfvis__free(alloc, ind);
+        hfvis__free(alloc, exit_b);
         return HFVIS_ERR_OUT_OF_MEMORY;
     }
     /* L_0 = emission + albedo * direct */
@@ -4870,8 +4939,8 @@ hfvis_status hfvis_terrain_gi(const hfvis_grid *grid, int K, const float *direct
             }
     }
     if (s == HFVIS_OK) memcpy(out, exit_b, total * sizeof(float));
-    hf_free(alloc, ind);
-    hf_free(alloc, exit_b);
+    hfvis__free(alloc, ind);
+    hfvis__free(alloc, exit_b);
     return s;
 }
 
@@ -4896,14 +4965,14 @@ hfvis_status hfvis_direct_light(const hfvis_grid *grid, int K, const hfvis_sun *
     }
     if (sun) {
         if (!isfinite(sun->azimuth_rad) || !isfinite(sun->elevation_rad) || !isfinite(sun->radius_rad) ||
-            sun->radius_rad < 0.0 || fabs(sun->elevation_rad) > HF_HALF_PI)
+            sun->radius_rad < 0.0 || fabs(sun->elevation_rad) > HFVIS__HALF_PI)
             return HFVIS_ERR_INVALID_ARGUMENT;
         for (c = 0; c < channels; c++)
             if (!isfinite(sun->irradiance[c])) return HFVIS_ERR_INVALID_ARGUMENT;
     }
     n = hf_grid_count(grid);
-    if (!hf_mul_size(n, (size_t)channels, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
-    plane = (float *)hf_alloc_array(alloc, total, sizeof(float));
+    if (!hfvis__mul_size(n, (size_t)channels, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
+    plane = (float *)hfvis__alloc_array(alloc, total, sizeof(float));
     if (!plane) return HFVIS_ERR_OUT_OF_MEMORY;
     /* sky part, written to plane first so that out stays untouched on failure */
     if (env) s = hfvis_env_light(grid, K, env, 1.0f, opts, NULL, plane, grid->width);
@@ -4916,7 +4985,7 @@ hfvis_status hfvis_direct_light(const hfvis_grid *grid, int K, const hfvis_sun *
             }
     }
     if (s == HFVIS_OK && sun) {
-        float *vis = (float *)hf_alloc_array(alloc, n, sizeof(float));
+        float *vis = (float *)hfvis__alloc_array(alloc, n, sizeof(float));
         if (!vis) s = HFVIS_ERR_OUT_OF_MEMORY;
         else {
             s = hfvis_sun_visibility(grid, sun->azimuth_rad, sun->elevation_rad, sun->radius_rad, opts,
@@ -4933,10 +5002,10 @@ hfvis_status hfvis_direct_light(const hfvis_grid *grid, int K, const hfvis_sun *
                         if (cosl < 0.0) cosl = 0.0;
                         for (c = 0; c < channels; c++)
                             plane[q * (size_t)channels + (size_t)c] +=
-                                (float)((double)sun->irradiance[c] / HF_PI * cosl * (double)vis[q]);
+                                (float)((double)sun->irradiance[c] / HFVIS__PI * cosl * (double)vis[q]);
                     }
             }
-            hf_free(alloc, vis);
+            hfvis__free(alloc, vis);
         }
     }
     if (s == HFVIS_OK) /* the receiver rectangle; the rest of out is left as it was */
@@ -4944,7 +5013,7 @@ hfvis_status hfvis_direct_light(const hfvis_grid *grid, int K, const hfvis_sun *
             size_t q = ((size_t)y * (size_t)grid->width + (size_t)rx0) * (size_t)channels;
             memcpy(out + q, plane + q, (size_t)(rx1 - rx0) * (size_t)channels * sizeof(float));
         }
-    hf_free(alloc, plane);
+    hfvis__free(alloc, plane);
     return s;
 }
 
@@ -4998,7 +5067,7 @@ static int hf_vs_options(const hfvis_viewshed_options *opts, double cell_size, d
     *obs_h = o.observer_height;
     *tgt_h = o.target_height;
     r = o.max_distance / cell_size; /* may overflow to +inf: unlimited in effect */
-    *range2 = o.max_distance > 0.0 ? r * r : HF_INF;
+    *range2 = o.max_distance > 0.0 ? r * r : HFVIS__INF;
     return 1;
 }
 
@@ -5055,7 +5124,7 @@ static double hf_vs_prepare(const hfvis_grid *g, double ox, double oy, double ra
             int finite = isfinite(zr[x]);
             int keep = eye_ok && finite && dx * dx + dy * dy <= range2;
             if (finite && fabsf(zr[x]) > zmax) zmax = fabsf(zr[x]);
-            o[x] = keep ? fill : (float)HF_NAN;
+            o[x] = keep ? fill : (float)HFVIS__NAN;
         }
     }
     return (double)zmax;
@@ -5089,7 +5158,7 @@ static void hf_vs_ray(const hfvis_grid *g, double ox, double oy, double h_eye, d
     double maj0 = xmajor ? ox : oy, min0 = xmajor ? oy : ox;
     double dmaj = xmajor ? dx : dy, dmin = xmajor ? dy : dx;
     int end = xmajor ? tx : ty, minor_max = xmajor ? g->height - 1 : g->width - 1;
-    double rate, per_unit, run = -HF_INF;
+    double rate, per_unit, run = -HFVIS__INF;
     int sgn, m;
     if (dmaj == 0.0) return; /* the perimeter cell is the observer itself */
     rate = dmin / dmaj;                   /* minor advance per major cell */
@@ -5117,10 +5186,17 @@ static void hf_vs_ray(const hfvis_grid *g, double ox, double oy, double h_eye, d
     }
 }
 
+hfvis_viewshed_options hfvis_viewshed_options_default(void)
+{
+    hfvis_viewshed_options o;
+    memset(&o, 0, sizeof o); /* eye and targets on the surface, unlimited range */
+    return o;
+}
+
 hfvis_status hfvis_viewshed(const hfvis_grid *grid, double observer_x, double observer_y,
                             const hfvis_viewshed_options *opts, float *out, ptrdiff_t out_stride)
 {
-    double obs_h, tgt_h, range2, h_eye, tol, d_stop = HF_INF;
+    double obs_h, tgt_h, range2, h_eye, tol, d_stop = HFVIS__INF;
     int x0 = 0, y0 = 0, x1, y1, x, y, ix, iy;
     if (!hf_vs_args_valid(grid, observer_x, observer_y, out, out_stride) ||
         !hf_vs_options(opts, grid ? grid->cell_size : 1.0, &obs_h, &tgt_h, &range2))
@@ -5131,7 +5207,7 @@ hfvis_status hfvis_viewshed(const hfvis_grid *grid, double observer_x, double ob
     if (!isfinite(h_eye)) return HFVIS_OK; /* the eye stands on a hole: no value anywhere */
     x1 = grid->width - 1;
     y1 = grid->height - 1;
-    if (range2 < HF_INF) {
+    if (range2 < HFVIS__INF) {
         /* rays to the border of the bounding square of the range circle, clipped to the grid */
         double r = sqrt(range2), a;
         d_stop = r + 1.0;
@@ -5321,7 +5397,7 @@ static double ns_sh_norm(int l, int mu)
     double r = 1.0;
     int i;
     for (i = l - mu + 1; i <= l + mu; i++) r /= (double)i;   /* (l-mu)!/(l+mu)! */
-    return sqrt((double)(2 * l + 1) / (4.0 * HF_PI) * r);
+    return sqrt((double)(2 * l + 1) / (4.0 * HFVIS__PI) * r);
 }
 
 /* ------------------------------------------- 2. exact polynomial and trigonometric integrals */
@@ -5574,9 +5650,9 @@ hfvis_status hfvis_zh_diffuse(double Ahat[4])
     if (Ahat == NULL) return HFVIS_ERR_INVALID_ARGUMENT;
     /* 2 pi Int_0^1 z P_l(z) dz: the clamped cosine's raw ZH (sqrt(pi)/2, sqrt(pi/3),
      * sqrt(5 pi)/8, 0) of [NS09] §7 times sqrt(4 pi/(2l+1)) */
-    Ahat[0] = HF_PI;
-    Ahat[1] = 2.0 * HF_PI / 3.0;
-    Ahat[2] = HF_PI / 4.0;
+    Ahat[0] = HFVIS__PI;
+    Ahat[1] = 2.0 * HFVIS__PI / 3.0;
+    Ahat[2] = HFVIS__PI / 4.0;
     Ahat[3] = 0.0;
     return HFVIS_OK;
 }
@@ -5594,7 +5670,7 @@ hfvis_status hfvis_zh_cap(double half_angle_rad, double Ahat[4])
 {
     double c, P[5];
     int l;
-    if (Ahat == NULL || !isfinite(half_angle_rad) || half_angle_rad < 0.0 || half_angle_rad > HF_PI)
+    if (Ahat == NULL || !isfinite(half_angle_rad) || half_angle_rad < 0.0 || half_angle_rad > HFVIS__PI)
         return HFVIS_ERR_INVALID_ARGUMENT;
     /* [NS09] §6: Ahat_l = 2 pi Int_c^1 P_l = 2 pi (P_(l-1)(c) - P_(l+1)(c))/(2l+1), P_-1 := 1 */
     c = cos(half_angle_rad);
@@ -5649,8 +5725,8 @@ hfvis_status hfvis_sh_project_env(const hfvis_env *env, double *out)
     int T, P, C, t, p0, nb, b, c, l, m, i;
     if (env == NULL || out == NULL || env->radiance == NULL || env->n_theta < 1 ||
         env->n_phi < 1 || env->channels < 1 || env->channels > 4 ||
-        !hf_mul_size((size_t)env->n_theta, (size_t)env->n_phi, &n) ||
-        !hf_mul_size(n, (size_t)env->channels, &n) || !hf_env_size_ok(env))
+        !hfvis__mul_size((size_t)env->n_theta, (size_t)env->n_phi, &n) ||
+        !hfvis__mul_size(n, (size_t)env->channels, &n) || !hf_env_size_ok(env))
         return HFVIS_ERR_INVALID_ARGUMENT;
     T = env->n_theta;
     P = env->n_phi;
@@ -5662,7 +5738,7 @@ hfvis_status hfvis_sh_project_env(const hfvis_env *env, double *out)
         nb = P - p0 < NS_ENV_BLOCK ? P - p0 : NS_ENV_BLOCK;
         ns_env_phi_block(p0, nb, P, F);
         for (t = 0; t < T; t++) {
-            double th0 = HF_PI * (double)t / (double)T, th1 = HF_PI * (double)(t + 1) / (double)T;
+            double th0 = HFVIS__PI * (double)t / (double)T, th1 = HFVIS__PI * (double)(t + 1) / (double)T;
             double row[4][7], band[4][4];
             const float *L = env->radiance + ((size_t)t * (size_t)P + (size_t)p0) * (size_t)C;
             for (c = 0; c < C; c++)
@@ -5713,13 +5789,13 @@ hfvis_status hfvis_nlp_eval(double z, double P[4])
     return HFVIS_OK;
 }
 
-/* vbar(sigma) = Int_{-1}^{sin sigma} P^(z) dz ([NS09] Eq. 10 with the limits of [NS09] §4, Eq. 9-13; docs/errata.md E48, E49),
+/* vbar(sigma) = Int_{-1}^{sin sigma} P^(z) dz ([NS09] Eq. 10 with the limits of §4, Eq. 9-13; docs/errata.md E48, E49),
  * from Int_{-1}^s P_l = (P_(l+1)(s) - P_(l-1)(s))/(2l+1); sigma is clamped to [-pi/2, pi/2]. */
 static void ns_vbar(double sigma, double *v)
 {
     double s, s2;
-    if (sigma <= -HF_HALF_PI) s = -1.0;
-    else if (sigma >= HF_HALF_PI) s = 1.0;
+    if (sigma <= -HFVIS__HALF_PI) s = -1.0;
+    else if (sigma >= HFVIS__HALF_PI) s = 1.0;
     else s = sin(sigma);
     s2 = s * s;
     v[0] = NS_NLP0 * (s + 1.0);
@@ -5741,8 +5817,8 @@ hfvis_status hfvis_nlp_visibility(double omega_lo_rad, double omega_hi_rad, doub
     int k;
     if (out == NULL || !isfinite(omega_lo_rad) || !isfinite(omega_hi_rad))
         return HFVIS_ERR_INVALID_ARGUMENT;
-    lo = omega_lo_rad < -HF_HALF_PI ? -HF_HALF_PI : omega_lo_rad;
-    hi = omega_hi_rad > HF_HALF_PI ? HF_HALF_PI : omega_hi_rad;
+    lo = omega_lo_rad < -HFVIS__HALF_PI ? -HFVIS__HALF_PI : omega_lo_rad;
+    hi = omega_hi_rad > HFVIS__HALF_PI ? HFVIS__HALF_PI : omega_hi_rad;
     if (!(hi > lo)) {
         for (k = 0; k < 4; k++) out[k] = 0.0;
         return HFVIS_OK;
@@ -5767,7 +5843,7 @@ hfvis_status hfvis_nlp_radiance(int K, const double *omega_rad, const double *u,
             omega_rad[i] < (i == 0 ? omega_min_rad : omega_rad[i - 1]))
             return HFVIS_ERR_INVALID_ARGUMENT;
     for (k = 0; k < 4; k++) c[k] = 0.0;
-    /* [NS09] Eq. 12 with the errata of [NS09] §4, Eq. 9-13; docs/errata.md E48, E49: the integral covers z in [-1, 1] and
+    /* [NS09] Eq. 12 with the limits of §4, Eq. 9-13 (docs/errata.md E48, E49): the integral covers z in [-1, 1] and
      * u(t_(i+1)) = 0 once i + 1 >= |T| */
     for (i = 0; i < K; i++) {
         double du = u[i] - (i + 1 < K ? u[i + 1] : 0.0);
@@ -5827,7 +5903,7 @@ hfvis_status hfvis_ns_wedge_matrix(hfvis_ns_interp interp, double dphi_rad, doub
         for (mu = 0; mu <= l; mu++)
             for (k = 0; k < 4; k++) {
                 ns_nlp_poly(k, q);
-                A[l][mu][k] = ns_alp_band_integral(l, mu, q, k, 0.0, HF_PI);
+                A[l][mu][k] = ns_alp_band_integral(l, mu, q, k, 0.0, HFVIS__PI);
             }
     for (m = -3; m <= 3; m++) {
         double mc[4], ms[4], mom[4];
@@ -6063,7 +6139,7 @@ hfvis_status hfvis_ns_bspline_max(int n, const double *omega_rad, double *out)
     for (j = 0; j < n; j++)
         if (!isfinite(omega_rad[j])) return HFVIS_ERR_INVALID_ARGUMENT;
     if (n == 0) {
-        *out = -HF_HALF_PI;
+        *out = -HFVIS__HALF_PI;
         return HFVIS_OK;
     }
     /* Eq. 16: knots S(j) and midpoints S(j + 1/2) of the uniform cubic B-spline, ends replicated */
@@ -6096,7 +6172,7 @@ static inline double hf_ns_fatan(double t)
     if (a <= 1.0) return 0.78539816339744831 * t - t * (a - 1.0) * (0.2447 + 0.0663 * a);
     r = 1.0 / t;
     a = fabs(r);
-    return (t > 0.0 ? HF_HALF_PI : -HF_HALF_PI) - (0.78539816339744831 * r - r * (a - 1.0) * (0.2447 + 0.0663 * a));
+    return (t > 0.0 ? HFVIS__HALF_PI : -HFVIS__HALF_PI) - (0.78539816339744831 * r - r * (a - 1.0) * (0.2447 + 0.0663 * a));
 }
 
 /* Eq. 16 on the tangents t[0..n-1] (n >= 1): the value hfvis_ns_bspline_max gives for their
@@ -6105,7 +6181,7 @@ static inline double hf_ns_fatan(double t)
  * still hold the maximum are evaluated with atan. w: n doubles of scratch, ap: 3n. */
 static double hf_ns_omax_bspline(const double *t, int n, double *w, double *ap)
 {
-    double amax = -HF_INF, best = -HF_INF, thr, *sk = ap + n;
+    double amax = -HFVIS__INF, best = -HFVIS__INF, thr, *sk = ap + n;
     int i, j;
     for (i = 0; i < n; i++) {
         w[i] = 3.0;
@@ -6250,7 +6326,7 @@ static void hf_ns_filter(const float *src, int sw, int sh, float *dst, int dw, i
                 for (c = 0; c < C; c++) acc[c] += w[t] * r[c];
                 den += w[t] * r[C];
             }
-            for (c = 0; c < C; c++) o[c] = den > 0.0 ? (float)(acc[c] / den) : (float)HF_NAN;
+            for (c = 0; c < C; c++) o[c] = den > 0.0 ? (float)(acc[c] / den) : (float)HFVIS__NAN;
         }
     }
 }
@@ -6627,13 +6703,13 @@ static hfvis_status hf_ns_setup(hf_ns_ctx *c, const hfvis_grid *grid, const hfvi
     if (sc->env_sh)
         for (i = 0; i < NS_SH_N * c->C; i++)
             if (!isfinite(sc->env_sh[i])) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (!hf_mul_size(hf_grid_count(grid), (size_t)c->C * 16u, &t) ||
-        !hf_mul_size(t, (size_t)bounces + 1u, &t) || !hf_mul_size(t, sizeof(double), &t))
+    if (!hfvis__mul_size(hf_grid_count(grid), (size_t)c->C * 16u, &t) ||
+        !hfvis__mul_size(t, (size_t)bounces + 1u, &t) || !hfvis__mul_size(t, sizeof(double), &t))
         return HFVIS_ERR_INVALID_ARGUMENT;
     for (i = 0; i < sc->light_count; i++) {
         const hfvis_sun *L = &sc->lights[i];
         if (!isfinite(L->azimuth_rad) || !isfinite(L->elevation_rad) || !isfinite(L->radius_rad) ||
-            fabs(L->elevation_rad) > HF_HALF_PI || L->radius_rad < 0.0 || L->radius_rad > HF_HALF_PI)
+            fabs(L->elevation_rad) > HFVIS__HALF_PI || L->radius_rad < 0.0 || L->radius_rad > HFVIS__HALF_PI)
             return HFVIS_ERR_INVALID_ARGUMENT;
         for (ch = 0; ch < c->C; ch++)
             if (!isfinite(L->irradiance[ch])) return HFVIS_ERR_INVALID_ARGUMENT;
@@ -6675,7 +6751,7 @@ static hfvis_status hf_ns_setup(hf_ns_ctx *c, const hfvis_grid *grid, const hfvi
     for (i = 0; i < sc->light_count; i++) {
         const hfvis_sun *L = &sc->lights[i];
         if (L->radius_rad > 0.0 && c->o.key_mode != HFVIS_NS_KEY_ENVIRONMENT &&
-            !(L->radius_rad < HF_HALF_PI - fabs(L->elevation_rad)))
+            !(L->radius_rad < HFVIS__HALF_PI - fabs(L->elevation_rad)))
             c->env_scan = 1; /* a cap holding the zenith uses the environment slices */
     }
     c->rec_d = NS_SH_N * (1 + c->nkey) + c->ndir;
@@ -6698,7 +6774,7 @@ typedef struct hf_ns_arena {
 static void *hf_ns_take(hf_ns_arena *a, size_t count, size_t elem)
 {
     size_t bytes, start;
-    if (!hf_mul_size(count, elem, &bytes) || a->used > SIZE_MAX - 15u) {
+    if (!hfvis__mul_size(count, elem, &bytes) || a->used > SIZE_MAX - 15u) {
         a->overflow = 1;
         return NULL;
     }
@@ -6788,8 +6864,8 @@ static void hf_ns_carve(hf_ns_ctx *c, hf_ns_arena *A)
     /* block 4: the bounces' buffers and pyramids */
     if (c->B > 0) {
         size_t words = 0;
-        if (c->cwords > 0 && (!hf_mul_size((size_t)c->Rw * (size_t)c->Rh, m, &words) ||
-                              !hf_mul_size(words, (size_t)c->cwords, &words)))
+        if (c->cwords > 0 && (!hfvis__mul_size((size_t)c->Rw * (size_t)c->Rh, m, &words) ||
+                              !hfvis__mul_size(words, (size_t)c->cwords, &words)))
             A[3].overflow = 1;
         c->cmask = c->cwords > 0 ? (uint64_t *)hf_ns_take(&A[3], words, sizeof(uint64_t)) : NULL;
         c->exitbuf = (float *)hf_ns_take(&A[3], hf_grid_count(c->g), C * sizeof(float));
@@ -6917,7 +6993,7 @@ static void hf_ns_omega_min(const hf_ns_ctx *c, const double *N, double cph, dou
         if (d > 1.0) d = 1.0;
         if (d < -1.0) d = -1.0;
         *s_min = -d;                       /* sin(-asin d) */
-        *t_min = fabs(d) < 1.0 ? -d / sqrt(1.0 - d * d) : (d > 0.0 ? -HF_INF : HF_INF);
+        *t_min = fabs(d) < 1.0 ? -d / sqrt(1.0 - d * d) : (d > 0.0 ? -HFVIS__INF : HFVIS__INF);
     } else {
         *s_min = -d / sqrt(d * d + N[2] * N[2]); /* sin(atan2(-d, N_z)) */
         *t_min = -d / N[2];
@@ -6951,7 +7027,7 @@ static void hf_ns_direct_rec(hf_ns_ctx *c, double X, double Y, const double *N, 
     int j, q, nv;
     for (q = 0; q < c->rec_d; q++) rec[q] = 0.0;
     if (!hf_ns_recv_at(c, X, Y, N, &r)) {
-        rec[0] = HF_NAN;
+        rec[0] = HFVIS__NAN;
         return;
     }
     if (c->env_scan)
@@ -7104,7 +7180,7 @@ static void hf_ns_bounce_rec(hf_ns_ctx *c, double X, double Y, const double *N, 
     int j, q, ch, K, i;
     for (q = 0; q < c->rec_b; q++) rec[q] = 0.0;
     if (!hf_ns_recv_at(c, X, Y, N, &r)) {
-        rec[0] = HF_NAN;
+        rec[0] = HFVIS__NAN;
         return;
     }
     for (j = 0; j < c->m; j++) {
@@ -7257,10 +7333,10 @@ static void hf_ns_shade_row(hf_ns_ctx *c, int b, int y, const hfvis_ns_gi_output
         double N[3], FN[NS_SH_N], FR[NS_SH_N], R[3], nv = 0.0;
         if (!isfinite(c->g->z[(ptrdiff_t)y * c->g->stride + x])) {
             for (ch = 0; ch < C; ch++) {
-                if (b == 0 && out->direct) out->direct[o0 + (size_t)ch] = (float)HF_NAN;
-                if (bo) bo[o0 + (size_t)ch] = (float)HF_NAN;
-                if (out->total) out->total[o0 + (size_t)ch] = (float)HF_NAN;
-                if (c->exitbuf && b < c->B) c->exitbuf[o0 + (size_t)ch] = (float)HF_NAN;
+                if (b == 0 && out->direct) out->direct[o0 + (size_t)ch] = (float)HFVIS__NAN;
+                if (bo) bo[o0 + (size_t)ch] = (float)HFVIS__NAN;
+                if (out->total) out->total[o0 + (size_t)ch] = (float)HFVIS__NAN;
+                if (c->exitbuf && b < c->B) c->exitbuf[o0 + (size_t)ch] = (float)HFVIS__NAN;
             }
             continue;
         }
@@ -7283,7 +7359,7 @@ static void hf_ns_shade_row(hf_ns_ctx *c, int b, int y, const hfvis_ns_gi_output
             const double rho = sc->albedo_map ? (double)sc->albedo_map[oi] : (double)sc->albedo[ch];
             double E, Gl = 0.0, val, ex;
             if (isnan(r[0])) {
-                val = ex = HF_NAN;
+                val = ex = HFVIS__NAN;
             } else if (b == 0) {
                 const double emis = sc->emission ? (double)sc->emission[oi] : 0.0;
                 const int sh_dirs = c->o.directional == HFVIS_NS_DIRECTIONAL_SH;
@@ -7302,13 +7378,13 @@ static void hf_ns_shade_row(hf_ns_ctx *c, int b, int y, const hfvis_ns_gi_output
                             Gl += D->E0[ch] * vis *
                                   hf_ns_phong(c->S, R[0] * D->d[0] + R[1] * D->d[1] + R[2] * D->d[2]);
                     }
-                ex = emis + rho / HF_PI * E;
+                ex = emis + rho / HFVIS__PI * E;
                 val = ex + c->rho_s * Gl;
             } else {
                 const double *U = r + (size_t)ch * NS_SH_N;
                 E = hf_ns_dot16(FN, U);
                 if (c->gloss) Gl = hf_ns_dot16(FR, U);
-                ex = rho / HF_PI * E;
+                ex = rho / HFVIS__PI * E;
                 val = ex + c->rho_s * Gl;
             }
             if (c->o.glossy == HFVIS_NS_GLOSSY_SCALAR) ex = val;
@@ -7342,11 +7418,11 @@ static void hf_ns_pass(hf_ns_ctx *c, int b, const hfvis_ns_gi_outputs *out, int 
                 else hf_ns_bounce_rec(c, X, Y, N, r, mask);
             } else {
                 for (q = 0; q < rec; q++) r[q] = 0.0;
-                r[0] = HF_NAN;
+                r[0] = HFVIS__NAN;
             }
             if (b == 0 && c->want_vis && out->visibility)
                 for (q = 0; q < NS_SH_N; q++)
-                    out->visibility[ri * NS_SH_N + (size_t)q] = isnan(r[0]) ? (float)HF_NAN : (float)r[q];
+                    out->visibility[ri * NS_SH_N + (size_t)q] = isnan(r[0]) ? (float)HFVIS__NAN : (float)r[q];
             if (c->gvec && b < c->B) {
                 /* the glossy pyramid's input: I_0 = L * V (+ the directional lights as SH deltas), or
                  * I_b = U_b ([NS09] §5.3) */
@@ -7357,7 +7433,7 @@ static void hf_ns_pass(hf_ns_ctx *c, int b, const hfvis_ns_gi_outputs *out, int 
                     else
                         for (q = 0; q < NS_SH_N; q++) I[q] = r[(size_t)ch * NS_SH_N + (size_t)q];
                     for (q = 0; q < NS_SH_N; q++)
-                        Ib[(size_t)ch * NS_SH_N + (size_t)q] = isnan(r[0]) ? (float)HF_NAN : (float)I[q];
+                        Ib[(size_t)ch * NS_SH_N + (size_t)q] = isnan(r[0]) ? (float)HFVIS__NAN : (float)I[q];
                 }
             }
         }
@@ -7439,11 +7515,11 @@ static void hf_ns_tables(hf_ns_ctx *c)
                 hf_ns_key *K = &c->keys[kk++];
                 double vb[4], Vbox[NS_SH_N];
                 double lmin = e - L->radius_rad, lmax = e + L->radius_rad, Lk[4 * NS_SH_N];
-                if (lmin < -HF_HALF_PI) lmin = -HF_HALF_PI;
-                if (lmax > HF_HALF_PI) lmax = HF_HALF_PI;
+                if (lmin < -HFVIS__HALF_PI) lmin = -HFVIS__HALF_PI;
+                if (lmax > HFVIS__HALF_PI) lmax = HFVIS__HALF_PI;
                 K->sin_lmin = sin(lmin);
                 K->sin_lmax = sin(lmax);
-                K->full = !(L->radius_rad < HF_HALF_PI - fabs(e));
+                K->full = !(L->radius_rad < HFVIS__HALF_PI - fabs(e));
                 if (!K->full) {
                     /* azimuth extent phi_c +- asin(sin alpha / cos e), key_directions samples */
                     double half = asin(sa / ce), pa = psi - half, pb = psi + half;
@@ -7458,7 +7534,7 @@ static void hf_ns_tables(hf_ns_ctx *c)
                 }
                 /* RATIO: L per unit irradiance and its overlap with the unoccluded box */
                 for (i = 0; i < NS_SH_N; i++) {
-                    K->Ls[i] = i < nb ? F[i] / (HF_PI * sa * sa) : 0.0;
+                    K->Ls[i] = i < nb ? F[i] / (HFVIS__PI * sa * sa) : 0.0;
                     Vbox[i] = 0.0;
                 }
                 for (ch = 0; ch < 4; ch++) K->E0[ch] = ch < C ? (double)L->irradiance[ch] : 0.0;
@@ -7469,7 +7545,7 @@ static void hf_ns_tables(hf_ns_ctx *c)
                 dst = Lk;
                 for (ch = 0; ch < C; ch++)
                     for (i = 0; i < NS_SH_N; i++)
-                        dst[ch * NS_SH_N + i] = i < nb ? (double)L->irradiance[ch] / (HF_PI * sa * sa) * F[i] : 0.0;
+                        dst[ch * NS_SH_N + i] = i < nb ? (double)L->irradiance[ch] / (HFVIS__PI * sa * sa) * F[i] : 0.0;
                 /* T[ch][r][j] = Sum_i Gamma_ijr L_i: the SH product L * V as a matrix on V */
                 for (ch = 0; ch < C; ch++)
                     for (i = 0; i < NS_SH_N; i++)
@@ -7483,7 +7559,7 @@ static void hf_ns_tables(hf_ns_ctx *c)
             } else {
                 for (ch = 0; ch < C; ch++)
                     for (i = 0; i < nb; i++)
-                        Lenv[ch * NS_SH_N + i] += (double)L->irradiance[ch] / (HF_PI * sa * sa) * F[i];
+                        Lenv[ch * NS_SH_N + i] += (double)L->irradiance[ch] / (HFVIS__PI * sa * sa) * F[i];
             }
         }
     }
@@ -7520,16 +7596,16 @@ hfvis_status hfvis_ns_gi(const hfvis_grid *grid, const hfvis_ns_scene *scene,
     if ((s = hf_ns_setup(&c, grid, scene, opts, out->bounces, out->visibility != NULL)) != HFVIS_OK)
         return s;
     plane = hf_grid_count(grid) * (size_t)c.C; /* checked by hf_ns_setup */
-    if (!hf_mul_size(plane, (size_t)c.B, &t) ||
-        !hf_mul_size((size_t)c.Rw * (size_t)c.Rh, NS_SH_N, &t) || !hf_ns_measure(&c, bytes))
+    if (!hfvis__mul_size(plane, (size_t)c.B, &t) ||
+        !hfvis__mul_size((size_t)c.Rw * (size_t)c.Rh, NS_SH_N, &t) || !hf_ns_measure(&c, bytes))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (!out->direct && !out->bounce && !out->total && !out->visibility) return HFVIS_OK;
     alloc = c.o.alloc;
     for (q = 0; q < 4; q++) {
         if (bytes[q] == 0) continue;
-        blk[q] = hf_alloc(alloc, bytes[q]);
+        blk[q] = hfvis__alloc(alloc, bytes[q]);
         if (blk[q] == NULL) {
-            while (q-- > 0) hf_free(alloc, blk[q]);
+            while (q-- > 0) hfvis__free(alloc, blk[q]);
             return HFVIS_ERR_OUT_OF_MEMORY;
         }
     }
@@ -7541,7 +7617,7 @@ hfvis_status hfvis_ns_gi(const hfvis_grid *grid, const hfvis_ns_scene *scene,
     for (y = 0; y < c.H; y++)
         for (x = 0; x < c.W; x++) {
             float z = grid->z[(ptrdiff_t)y * grid->stride + x];
-            c.hp[0].img[(size_t)y * (size_t)c.W + (size_t)x] = isfinite(z) ? z : (float)HF_NAN;
+            c.hp[0].img[(size_t)y * (size_t)c.W + (size_t)x] = isfinite(z) ? z : (float)HFVIS__NAN;
             if (!isfinite(z)) c.holes = 1;
         }
     hf_ns_pyr_build(c.hp, c.Lv, c.k, 1, c.border, c.kern, c.row);
@@ -7560,7 +7636,7 @@ hfvis_status hfvis_ns_gi(const hfvis_grid *grid, const hfvis_ns_scene *scene,
         hf_ns_pass(&c, b, out, &done, total);
         c.cfilled = 1;
     }
-    for (q = 3; q >= 0; q--) hf_free(alloc, blk[q]);
+    for (q = 3; q >= 0; q--) hfvis__free(alloc, blk[q]);
     return HFVIS_OK;
 }
 
@@ -7601,7 +7677,7 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
         break;
     case HFVIS_SUM_SKY_LIGHT:
         sky.inv_k = 1.0 / (double)K;
-        sky.lobe = sin(HF_PI / (double)K) / HF_PI;
+        sky.lobe = sin(HFVIS__PI / (double)K) / HFVIS__PI;
         s = hf_fused_run(&sw, grid, K, &o, 1, 1, hf_sky_line, &sky.f);
         break;
     case HFVIS_SUM_ENV_LIGHT:
@@ -7623,11 +7699,11 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
             for (x = sw.rx0; x < sw.rx1; x++) {
                 size_t i = ((size_t)y * (size_t)grid->width + (size_t)x) * (size_t)channels;
                 int hole = hf_is_hole(grid, x, y);
-                for (c = 0; c < channels; c++) sums[i + (size_t)c] = hole ? HF_NAN : sw.gacc[i + (size_t)c];
+                for (c = 0; c < channels; c++) sums[i + (size_t)c] = hole ? HFVIS__NAN : sw.gacc[i + (size_t)c];
             }
         hf_sweep_free(&sw);
     }
-    hf_free(o.alloc, table);
+    hfvis__free(o.alloc, table);
     return s;
 }
 
@@ -7646,7 +7722,7 @@ static int hf_partial_valid(const hfvis_partial *p, size_t *values, size_t *tag_
         p->begin >= p->end || p->end > p->directions)
         return 0;
     n = (size_t)p->width * (size_t)p->height;
-    if (!hf_mul_size(n, (size_t)p->planes, &n) || (unsigned long long)n > HFVIS_PARTIAL_MAX_VALUES ||
+    if (!hfvis__mul_size(n, (size_t)p->planes, &n) || (unsigned long long)n > HFVIS_PARTIAL_MAX_VALUES ||
         n > SIZE_MAX / 8u)
         return 0;
     for (t = 0; t <= HFVIS_PARTIAL_MAX_TAG && p->tag[t] != '\0'; t++)
@@ -7690,7 +7766,7 @@ size_t hfvis_partial_encode_size(const hfvis_partial *p)
     size_t values, tag_len, head, bytes;
     if (!hf_partial_valid(p, &values, &tag_len)) return 0;
     head = HF_PARTIAL_MAGIC_LEN + hf_partial_numbers(p, line) + tag_len + 1u + HF_PARTIAL_CRC_LEN;
-    if (!hf_mul_size(values, 8u, &bytes) || bytes > SIZE_MAX - head) return 0;
+    if (!hfvis__mul_size(values, 8u, &bytes) || bytes > SIZE_MAX - head) return 0;
     return head + bytes;
 }
 
@@ -7769,7 +7845,7 @@ static hfvis_status hf_partial_header(const unsigned char *d, size_t size, hfvis
     if (r->width > HFVIS_IMAGE_MAX_DIM || r->height > HFVIS_IMAGE_MAX_DIM || r->planes > HFVIS_PARTIAL_MAX_PLANES)
         return HFVIS_ERR_LIMIT;
     values = (size_t)r->width * (size_t)r->height;
-    if (!hf_mul_size(values, (size_t)r->planes, &values) ||
+    if (!hfvis__mul_size(values, (size_t)r->planes, &values) ||
         (unsigned long long)values > HFVIS_PARTIAL_MAX_VALUES || values > SIZE_MAX / 8u)
         return HFVIS_ERR_LIMIT;
     *tag_at = tag0;
@@ -7812,7 +7888,7 @@ hfvis_status hfvis_partial_decode(const void *data, size_t size, const hfvis_all
         crc |= (uint32_t)d[size - HF_PARTIAL_CRC_LEN + k] << (8u * k);
     if (hfvis_crc32(0, d, size - HF_PARTIAL_CRC_LEN) != crc) return HFVIS_ERR_FORMAT;
     block = bytes + tag_len + 1u;
-    mem = (unsigned char *)hf_alloc(alloc, block);
+    mem = (unsigned char *)hfvis__alloc(alloc, block);
     if (!mem) return HFVIS_ERR_OUT_OF_MEMORY;
     r.sums = (double *)(void *)mem;
     for (k = 0; k < values; k++) {
@@ -7832,7 +7908,7 @@ hfvis_status hfvis_partial_decode(const void *data, size_t size, const hfvis_all
 void hfvis_partial_free(const hfvis_allocator *alloc, hfvis_partial *p)
 {
     if (!p) return;
-    hf_free(alloc, p->sums);
+    hfvis__free(alloc, p->sums);
     p->sums = NULL;
     p->tag = NULL;
 }
@@ -7844,11 +7920,11 @@ hfvis_status hfvis_partial_save(const char *path, const hfvis_partial *p)
     unsigned char *buf;
     hfvis_status s;
     if (!path || need == 0) return HFVIS_ERR_INVALID_ARGUMENT;
-    buf = (unsigned char *)hf_alloc(NULL, need);
+    buf = (unsigned char *)hfvis__alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_partial_encode(p, buf, need, &written);
     if (s == HFVIS_OK) s = hfvis_write_file(path, buf, written, NULL);
-    hf_free(NULL, buf);
+    hfvis__free(NULL, buf);
     return s;
 }
 
@@ -7861,7 +7937,7 @@ hfvis_status hfvis_partial_load(const char *path, const hfvis_allocator *alloc, 
     s = hfvis__read_file(path, alloc, hf_partial_sizer, &data, &size);
     if (s != HFVIS_OK) return s;
     s = hfvis_partial_decode(data, size, alloc, p);
-    hf_free(alloc, data);
+    hfvis__free(alloc, data);
     return s;
 }
 #endif /* HFVIS_NO_STDIO */
@@ -7918,15 +7994,15 @@ static int hf_exact_bound(const hfvis_sweep_options *o, int K)
 static hf_ray hf_ray_nearest(double psi, int N)
 {
     hf_ray r;
-    double t = psi - 2.0 * HF_PI * floor(psi / (2.0 * HF_PI)), rr, th, tn, best;
+    double t = psi - 2.0 * HFVIS__PI * floor(psi / (2.0 * HFVIS__PI)), rr, th, tn, best;
     int q, mirror, a, c, ba = 1, bb = 0, x, y, turn;
-    q = (int)floor(t / HF_HALF_PI);
+    q = (int)floor(t / HFVIS__HALF_PI);
     if (q > 3) q = 3;
     if (q < 0) q = 0;
-    rr = t - (double)q * HF_HALF_PI;
+    rr = t - (double)q * HFVIS__HALF_PI;
     if (rr < 0.0) rr = 0.0;
-    mirror = rr > 0.25 * HF_PI;
-    th = mirror ? HF_HALF_PI - rr : rr;
+    mirror = rr > 0.25 * HFVIS__PI;
+    th = mirror ? HFVIS__HALF_PI - rr : rr;
     tn = tan(th);
     best = th; /* (1, 0) */
     for (a = 1; a <= N; a++) {
@@ -7952,7 +8028,7 @@ static hf_ray hf_ray_nearest(double psi, int N)
     }
     r.a = x;
     r.b = y;
-    r.azimuth = psi + remainder(atan2((double)y, (double)x) - psi, 2.0 * HF_PI);
+    r.azimuth = psi + remainder(atan2((double)y, (double)x) - psi, 2.0 * HFVIS__PI);
     return r;
 }
 
@@ -7971,12 +8047,12 @@ static void hf_exact_dirs_fill(hf_exact_dirs *d, int K, double azimuth0, int N)
     int k;
     double prev, *Q = d->lo; /* edges in quanta relative to azimuth0, first */
     for (k = 0; k < K; k++)
-        d->ray[k] = hf_ray_nearest(azimuth0 + 2.0 * HF_PI * (double)k / (double)K, N);
+        d->ray[k] = hf_ray_nearest(azimuth0 + 2.0 * HFVIS__PI * (double)k / (double)K, N);
     d->K = K;
-    prev = d->ray[K - 1].azimuth - 2.0 * HF_PI - azimuth0;
+    prev = d->ray[K - 1].azimuth - 2.0 * HFVIS__PI - azimuth0;
     for (k = 0; k < K; k++) {
         double cur = d->ray[k].azimuth - azimuth0;
-        Q[k] = floor(0.5 * (prev + cur) / (2.0 * HF_PI) * HF_EXACT_QUANTUM + 0.5);
+        Q[k] = floor(0.5 * (prev + cur) / (2.0 * HFVIS__PI) * HF_EXACT_QUANTUM + 0.5);
         if (k > 0 && Q[k] < Q[k - 1]) Q[k] = Q[k - 1]; /* rounding never makes a sector negative */
         prev = cur;
     }
@@ -7986,9 +8062,9 @@ static void hf_exact_dirs_fill(hf_exact_dirs *d, int K, double azimuth0, int N)
         d->w[k] = qhi > Q[k] ? (qhi - Q[k]) / HF_EXACT_QUANTUM : 0.0;
     }
     for (k = 0; k < K; k++) {
-        double lo = azimuth0 + Q[k] * (2.0 * HF_PI / HF_EXACT_QUANTUM);
-        double hi = azimuth0 + d->hi[k] * (2.0 * HF_PI / HF_EXACT_QUANTUM);
-        double mid = 0.5 * (lo + hi), sh = sin(HF_PI * d->w[k]) / HF_PI;
+        double lo = azimuth0 + Q[k] * (2.0 * HFVIS__PI / HF_EXACT_QUANTUM);
+        double hi = azimuth0 + d->hi[k] * (2.0 * HFVIS__PI / HF_EXACT_QUANTUM);
+        double mid = 0.5 * (lo + hi), sh = sin(HFVIS__PI * d->w[k]) / HFVIS__PI;
         d->lo[k] = lo;
         d->hi[k] = hi;
         d->lc[k] = cos(mid) * sh; /* (sin hi - sin lo)/2pi in difference form */
@@ -8120,7 +8196,7 @@ static double hf_cross_height(const hfvis_grid *g, hfvis_border border, int X, i
         const float *p = g->z + (ptrdiff_t)Y * g->stride + X;
         h = (double)p[0];
         if (c->kind != 0) h += ((double)p[c->kind == 1 ? g->stride : 1] - h) * c->f; /* exact on flats */
-        return isfinite(h) ? h : HF_NAN;
+        return isfinite(h) ? h : HFVIS__NAN;
     }
     return hf_sample_border(g, border, (double)X + (c->kind == 2 ? c->f : 0.0),
                             (double)Y + (c->kind == 1 ? c->f : 0.0));
@@ -8264,14 +8340,14 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
         double *t = E->tan + (size_t)gy * (size_t)g->width + (size_t)gx;
         if (win) {
             W->d[nw] = d;
-            W->h[nw] = isfinite(h) ? h : HF_NAN;
+            W->h[nw] = isfinite(h) ? h : HFVIS__NAN;
             E->win_rec[nr] = nw++;
             E->win_tan[nr++] = (size_t)gy * (size_t)g->width + (size_t)gx;
         } else if (!isfinite(h)) {
-            *t = HF_NAN;
+            *t = HFVIS__NAN;
         } else {
             HF_HULL_PUSH(d, h);
-            *t = top ? (sh[top - 1] - h) / (d - sd[top - 1]) * scale : -HF_INF;
+            *t = top ? (sh[top - 1] - h) / (d - sd[top - 1]) * scale : -HFVIS__INF;
             sd[top] = d;
             sh[top++] = h;
         }
@@ -8359,9 +8435,9 @@ static void hf_exact_sweep(hf_exact *E, hf_ray r)
 static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, const hf_cross *cr,
                              int P, double L, double scale, int a, int b, int x, int y, int64_t rw)
 {
-    double hr = (double)g->z[(ptrdiff_t)y * g->stride + x], best = -HF_INF;
+    double hr = (double)g->z[(ptrdiff_t)y * g->stride + x], best = -HFVIS__INF;
     int k, e, kmax = hf_exact_periods(g, R, x, y, a, b);
-    if (!isfinite(hr)) return HF_NAN;
+    if (!isfinite(hr)) return HFVIS__NAN;
     for (k = 0; k <= kmax; k++)
         for (e = 0; e < P; e++) {
             int X = x + k * a + cr[e].ox, Y = y + k * b + cr[e].oy, j;
@@ -8410,7 +8486,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
                 (double)E->N * (double)E->N > 4503599627370496.0)
         return HFVIS_ERR_LIMIT;
     for (k = 0; k < K; k++) {
-        hf_ray r = hf_ray_nearest(o->azimuth0_rad + 2.0 * HF_PI * (double)k / (double)K, E->N);
+        hf_ray r = hf_ray_nearest(o->azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K, E->N);
         int p = (r.a < 0 ? -r.a : r.a) + (r.b < 0 ? -r.b : r.b) - 1;
         if (p > maxp) maxp = p;
     }
@@ -8439,7 +8515,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
         off_wr = hf_align_add(&total, cap + 1, sizeof(int), &ok);
     }
     if (!ok) return HFVIS_ERR_LIMIT;
-    blk = (unsigned char *)hf_alloc(o->alloc, total);
+    blk = (unsigned char *)hfvis__alloc(o->alloc, total);
     if (!blk) return HFVIS_ERR_OUT_OF_MEMORY;
     E->block = blk;
     E->d.ray = (hf_ray *)(void *)(blk + off_ray);
@@ -8473,7 +8549,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     return HFVIS_OK;
 }
 
-static void hf_exact_free(hf_exact *E) { hf_free(E->alloc, E->block); }
+static void hf_exact_free(hf_exact *E) { hfvis__free(E->alloc, E->block); }
 
 /* The horizon planes of positions [begin, end) (direction_order), as hfvis_horizon_map. */
 static hfvis_status hf_exact_horizon_map(const hfvis_grid *g, int K, const hfvis_sweep_options *o,
@@ -8529,7 +8605,7 @@ static double hf_exact_sky_term(const hf_exact_dirs *d, int k, double cp, double
     double tc = -(nx * cp + ny * sp) / nz, q, theta;
     if (t > tc) tc = t;
     q = 1.0 / (1.0 + tc * tc);
-    theta = HF_HALF_PI - hf_atan(tc);
+    theta = HFVIS__HALF_PI - hf_atan(tc);
     return nz * d->w[k] * q + (nx * d->lc[k] + ny * d->ls[k]) * (theta - tc * q);
 }
 
@@ -8544,13 +8620,13 @@ static hfvis_status hf_exact_env_tables(const hf_exact_dirs *d, const hfvis_env 
     float *t;
     int k;
     if (st != HFVIS_OK) return st;
-    t = (float *)hf_alloc(alloc, r.table_floats * sizeof(float));
+    t = (float *)hfvis__alloc(alloc, r.table_floats * sizeof(float));
     if (t == NULL) return HFVIS_ERR_OUT_OF_MEMORY;
     for (k = 0; k < d->K; k++) {
         hf_env_sector s;
-        double st0 = fmod(d->lo[k], 2.0 * HF_PI);
-        if (st0 < 0.0) st0 += 2.0 * HF_PI;
-        if (st0 >= 2.0 * HF_PI) st0 = 0.0;
+        double st0 = fmod(d->lo[k], 2.0 * HFVIS__PI);
+        if (st0 < 0.0) st0 += 2.0 * HFVIS__PI;
+        if (st0 >= 2.0 * HFVIS__PI) st0 = 0.0;
         s.start = st0;
         s.width = d->hi[k] - d->lo[k];
         s.centre = st0 + (d->ray[k].azimuth - d->lo[k]);
@@ -8564,7 +8640,7 @@ static hfvis_status hf_exact_env_tables(const hf_exact_dirs *d, const hfvis_env 
     }
     st = hf_env_eval_init(e, env, d->K, eopts, t);
     if (st != HFVIS_OK) {
-        hf_free(alloc, t);
+        hfvis__free(alloc, t);
         return st;
     }
     *table = t;
@@ -8608,7 +8684,7 @@ static hfvis_status hf_exact_sums(hf_exact *E, const hfvis_grid *g, int K, hfvis
         }
         hf_progress(o, ++done, end - begin);
     }
-    hf_free(o->alloc, table);
+    hfvis__free(o->alloc, table);
     return HFVIS_OK;
 }
 
@@ -8623,7 +8699,7 @@ static void hf_exact_output(const hf_exact *E, double scale, double offset, floa
             const double *a = E->acc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)ch;
             float *p = out + ((ptrdiff_t)y * out_stride + x) * ch;
             int hole = hf_is_hole(g, x, y);
-            for (c = 0; c < ch; c++) p[c] = (float)(hole ? HF_NAN : offset + scale * a[c]);
+            for (c = 0; c < ch; c++) p[c] = (float)(hole ? HFVIS__NAN : offset + scale * a[c]);
         }
 }
 
@@ -8682,7 +8758,7 @@ hfvis_status hfvis_sweep_azimuths(int K, const hfvis_sweep_options *opts, double
     if (opts) o = *opts;
     if (o.rays != HFVIS_RAYS_EXACT) {
         for (k = 0; k < K; k++) {
-            if (azimuths) azimuths[k] = o.azimuth0_rad + 2.0 * HF_PI * (double)k / (double)K;
+            if (azimuths) azimuths[k] = o.azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K;
             if (weights) weights[k] = 1.0 / (double)K;
         }
         return HFVIS_OK;
@@ -8690,11 +8766,11 @@ hfvis_status hfvis_sweep_azimuths(int K, const hfvis_sweep_options *opts, double
     N = hf_exact_bound(&o, K);
     if (N > HFVIS_RAY_DENOMINATOR_MAX) return HFVIS_ERR_INVALID_ARGUMENT;
     if (!weights) { /* no scratch needed */
-        for (k = 0; k < K; k++) azimuths[k] = hf_ray_nearest(o.azimuth0_rad + 2.0 * HF_PI * (double)k / (double)K, N).azimuth;
+        for (k = 0; k < K; k++) azimuths[k] = hf_ray_nearest(o.azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K, N).azimuth;
         return HFVIS_OK;
     }
     memset(&d, 0, sizeof d);
-    d.ray = (hf_ray *)hf_alloc_array(o.alloc, (size_t)K, sizeof(hf_ray) + 5u * sizeof(double));
+    d.ray = (hf_ray *)hfvis__alloc_array(o.alloc, (size_t)K, sizeof(hf_ray) + 5u * sizeof(double));
     if (!d.ray) return HFVIS_ERR_OUT_OF_MEMORY;
     d.w = (double *)(void *)(d.ray + K);
     d.lc = d.w + K;
@@ -8706,7 +8782,7 @@ hfvis_status hfvis_sweep_azimuths(int K, const hfvis_sweep_options *opts, double
         if (azimuths) azimuths[k] = d.ray[k].azimuth;
         weights[k] = d.w[k];
     }
-    hf_free(o.alloc, d.ray);
+    hfvis__free(o.alloc, d.ray);
     return HFVIS_OK;
 }
 
@@ -8719,7 +8795,7 @@ hfvis_status hfvis_horizon_exact_naive(const hfvis_grid *grid, int K,
     int N, k, begin, end, x, y, maxp = 1, R, done = 0;
     if (hf_check_common(grid, opts) != HFVIS_OK || !out || K < 1) return HFVIS_ERR_INVALID_ARGUMENT;
     plane = hf_grid_count(grid);
-    if (!hf_mul_size(plane, (size_t)K, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!hfvis__mul_size(plane, (size_t)K, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
     if (hf_direction_range(&o, K, &begin, &end) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     N = hf_exact_bound(&o, K);
@@ -8729,15 +8805,15 @@ hfvis_status hfvis_horizon_exact_naive(const hfvis_grid *grid, int K,
         (double)INT_MAX / 2.0)
         return HFVIS_ERR_LIMIT;
     for (k = 0; k < K; k++) {
-        hf_ray r = hf_ray_nearest(o.azimuth0_rad + 2.0 * HF_PI * (double)k / (double)K, N);
+        hf_ray r = hf_ray_nearest(o.azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K, N);
         int p = (r.a < 0 ? -r.a : r.a) + (r.b < 0 ? -r.b : r.b) - 1;
         if (p > maxp) maxp = p;
     }
-    cr = (hf_cross *)hf_alloc_array(o.alloc, (size_t)maxp, sizeof(hf_cross));
+    cr = (hf_cross *)hfvis__alloc_array(o.alloc, (size_t)maxp, sizeof(hf_cross));
     if (!cr) return HFVIS_ERR_OUT_OF_MEMORY;
     for (k = 0; k < K; k++) {
         int pos = hf_direction_position(&o, K, k), P;
-        hf_ray r = hf_ray_nearest(o.azimuth0_rad + 2.0 * HF_PI * (double)k / (double)K, N);
+        hf_ray r = hf_ray_nearest(o.azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K, N);
         double L, scale;
         float *p;
         if (pos < begin || pos >= end) continue;
@@ -8750,7 +8826,7 @@ hfvis_status hfvis_horizon_exact_naive(const hfvis_grid *grid, int K,
                                    hf_radius_on(&o) ? hf_exact_window(o.max_distance, scale) : -1));
         hf_progress(&o, ++done, end - begin);
     }
-    hf_free(o.alloc, cr);
+    hfvis__free(o.alloc, cr);
     return HFVIS_OK;
 }
 
@@ -8767,7 +8843,7 @@ static hfvis_status hf_exact_direction_sums(const hfvis_grid *g, int K, hfvis_su
         for (x = E.rx0; x < E.rx1; x++) {
             size_t i = ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)E.channels;
             int hole = hf_is_hole(g, x, y);
-            for (c = 0; c < E.channels; c++) sums[i + (size_t)c] = hole ? HF_NAN : E.acc[i + (size_t)c];
+            for (c = 0; c < E.channels; c++) sums[i + (size_t)c] = hole ? HFVIS__NAN : E.acc[i + (size_t)c];
         }
     hf_exact_free(&E);
     return HFVIS_OK;

@@ -1,5 +1,5 @@
 /* hfvis.h - height-field and screen-space visibility: the authoritative CPU reference.
- * Version 0.1.0. MIT licence (see LICENSE).
+ * Version 0.2.0. MIT licence (see LICENSE).
  *
  * hfvis is a pure C99, single-threaded, dependency-free library: copy this header and the
  * .c files you need (hfvis.c for height fields, ssao.c for screen space, voxel.c for meshes and
@@ -20,8 +20,9 @@
  * oracle is documented beside it ("Oracle of ...") and computes the same quantity by brute
  * force: *_naive over exactly the samples the fast routine uses (held to it bit for bit, or
  * within the tolerance its documentation names), *_reference from first principles with its
- * own sampling (a ray march, a hemisphere integral, a per-voxel test); a few oracles predate
- * the suffixes (hfvis_ssao_raytrace, hfvis_lk_raycast) and say so in their comments.
+ * own sampling (a ray march, a hemisphere integral, a ray caster, a per-voxel test). Every
+ * oracle's name ends in one of the two (0.2.0 renamed the two that did not: see "Deprecated
+ * names" at the end of this header).
  * Production routines never call oracles; oracles cost what their comments state (often
  * quadratic) and are meant for tests and validation, not for production sizes.
  *
@@ -38,9 +39,9 @@
  *                hfvis_nlp_*
  *   Screen space hfvis_camera_perspective, hfvis_camera_from_matrix, hfvis_depth_linearize;
  *                hfvis_lsao (oracle route hfvis_lsao_direction_naive), hfvis_hbao, hfvis_ffao,
- *                hfvis_ssao_raytrace (the reference), hfvis_ssao_mipmap, hfvis_ssao_error
+ *                hfvis_ssao_reference (the reference), hfvis_ssao_mipmap, hfvis_ssao_error
  *   Meshes       hfvis_mesh_load, hfvis_rasterize, hfvis_bvh_build, hfvis_bvh_closest_hit,
- *                hfvis_lk_image ([LK]; oracle hfvis_lk_raycast)
+ *                hfvis_lk_image ([LK]; oracle hfvis_lk_reference)
  *   Voxels       hfvis_voxelize_surface, hfvis_voxelize_conservative, hfvis_voxelize_solid,
  *                hfvis_voxelize_bitmask, hfvis_iv_update (each with its *_reference),
  *                hfvis_binvox_save
@@ -87,6 +88,9 @@
  *                 viewsheds, the gallery.
  *   Ports         cameras from projection matrices, bottom-up rows, LSAO's step-falloff
  *                 refusal, HBAO defaults aligned with LSAO's.
+ *   0.2.0         one API grammar: oracle suffixes, *_options_default() for every options
+ *                 struct, *_DEFAULT = 0 in every option enum, unit-named size queries (renames
+ *                 kept as deprecated aliases); one internal Common layer (hfvis__*).
  *
  * ------------------------------------------------------------------------------------------
  * QUICK START
@@ -147,7 +151,15 @@
  *   and HFVIS_FREE(ptr), malloc and free unless both are defined when the library's .c files
  *   are compiled (as stb's STBI_MALLOC; test/test_oom.c fails them on purpose).
  * Options. NULL and a zero-initialised options struct both mean the documented defaults; zero is
- *   never a valid non-default value. hfvis_*_options_default() returns the defaults filled in.
+ *   never a valid non-default value. Every options struct has hfvis_*_options_default(), which
+ *   returns the defaults filled in (bit-identical results to a zero struct); the few that also
+ *   have *_options_resolve() use it to validate and fill in a caller's struct. Every option
+ *   enum names its zero *_DEFAULT; where the documented default is itself a named choice that
+ *   has always been 0 (HFVIS_RAYS_LATTICE, HFVIS_BLEND_MAX, ...), both names stand for 0.
+ * Sizes. A *_size() query (and *_encode_size(), *_scratch_size()) counts bytes; a query that
+ *   counts elements names them: hfvis_lattice_nodes, hfvis_env_table_floats,
+ *   hfvis_volume_floats. Angles are radians everywhere (see "Angles" above; a _rad suffix only
+ *   repeats it, and no parameter takes degrees); a distance ending in _cells counts grid cells.
  *
  * What is and is not guaranteed
  *   - Same input and same binary: bit-identical output (build with -ffp-contract=off; FMA
@@ -166,7 +178,7 @@
 #define HFVIS_H
 
 #define HFVIS_VERSION_MAJOR 0
-#define HFVIS_VERSION_MINOR 1
+#define HFVIS_VERSION_MINOR 2
 #define HFVIS_VERSION_PATCH 0
 #define HFVIS_VERSION (HFVIS_VERSION_MAJOR * 10000 + HFVIS_VERSION_MINOR * 100 + HFVIS_VERSION_PATCH)
 
@@ -179,6 +191,8 @@
  *                       the volume GI. Define it (e.g. as a deprecation attribute) to find uses.
  *   HFVIS_NO_STDIO      define when compiling the .c files to remove the file wrappers
  *                       (hfvis_*_load / hfvis_*_save); the in-memory codecs remain.
+ *   HFVIS_NO_DEPRECATED define before including hfvis.h to drop the renamed functions' old
+ *                       names (the "Deprecated names" block at the end).
  *   HFVIS_ENABLE_ASSERTS / HFVIS_ASSERT(x)  internal invariant checks in the .c files only. */
 #ifndef HFVIS_API
 #define HFVIS_API
@@ -337,6 +351,9 @@ typedef struct hfvis_write_options {
     void *user;
 } hfvis_write_options;
 
+/* The defaults: no callback. */
+HFVIS_API hfvis_write_options hfvis_write_options_default(void);
+
 /* Write n bytes to path atomically, as every saver of the library does: the bytes go to a
  * temporary file beside path ("<path>.tmp<8 hex digits>"; when that name's last component would
  * exceed 255 bytes, the component is cut so the name fits), which is then renamed onto path.
@@ -455,7 +472,7 @@ HFVIS_API hfvis_status hfvis_field_generate(const hfvis_field *field, int width,
                                            ptrdiff_t stride, float *out);
 
 /* ========================================================================================== */
-/* hfvis.c - sampling, normals and the sweep lattice ([P1] §4, §7; [P1] §4, Fig. 2; docs/errata.md E5, E7, E8; [P1] §7; docs/errata.md E10) */
+/* hfvis.c - sampling, normals and the sweep lattice ([P1] §4, Fig. 2, §7; docs/errata.md E5, E7, E8, E10) */
 /* ========================================================================================== */
 
 /* Bilinear height at grid position (x, y), clamped to the grid, in world units; NaN if a tap
@@ -494,14 +511,14 @@ HFVIS_API hfvis_status hfvis_lattice_init(hfvis_lattice *lattice, int width, int
                                           double azimuth_rad);
 
 /* Number of nodes of the lattice buffer, rows*cols; 0 for NULL or an empty lattice. */
-HFVIS_API size_t hfvis_lattice_size(const hfvis_lattice *lattice);
+HFVIS_API size_t hfvis_lattice_nodes(const hfvis_lattice *lattice);
 
 /* The in-domain node range [*i_first, *i_last] of line j; returns the count (0 if empty, if j is
  * outside j_min..j_max or lattice is NULL: outputs not written then). */
 HFVIS_API int hfvis_lattice_line(const hfvis_lattice *lattice, int j, int *i_first, int *i_last);
 
 /* ========================================================================================== */
-/* hfvis.c - P1 horizons ([P1] §5 Alg. 1, App. A.1; [P1] §5, Alg. 1, App. A.1)                */
+/* hfvis.c - P1 horizons ([P1] §5 Alg. 1, App. A.1)                */
 /* ========================================================================================== */
 
 /* How hfvis_sweep_options.direction_begin/end count the K directions. */
@@ -518,6 +535,7 @@ typedef enum hfvis_direction_order {
 
 /* How a sweep gives each receiver its horizon (see "Exact rays" below). 0 is the default. */
 typedef enum hfvis_ray_mode {
+    HFVIS_RAYS_DEFAULT = 0,   /* = LATTICE */
     HFVIS_RAYS_LATTICE = 0,   /* [P1]: lattice lines, gathered bilinearly (the GPU reference) */
     HFVIS_RAYS_EXACT = 1      /* every grid point its own ray, rational directions (beyond [P1]) */
 } hfvis_ray_mode;
@@ -594,7 +612,7 @@ HFVIS_API hfvis_status hfvis_line_horizons_naive(const double *distance, const d
 
 /* Raw lattice output of one direction, for GPU-port diffing: the horizon elevation angle at
  * every lattice node of hfvis_lattice_init(width, height, azimuth_rad); NaN at nodes outside the
- * grid and at holes. out must hold hfvis_lattice_size() floats.
+ * grid and at holes. out must hold hfvis_lattice_nodes() floats.
  * Allocates 1 block of about 8*min(W^2+H^2, (W+H)^2/2) bytes (the sampled lattice: the largest
  * buffer over all directions, half the diagonal's square for a thin grid). Cost O(width*height). */
 HFVIS_API hfvis_status hfvis_horizon_lattice(const hfvis_grid *grid, double azimuth_rad,
@@ -635,6 +653,9 @@ typedef struct hfvis_march_options {
                                (or border_cells beyond it for CLAMP/WRAP) */
 } hfvis_march_options;
 
+/* The defaults: step_cells 1, max_distance_cells 0 (to the grid's end). */
+HFVIS_API hfvis_march_options hfvis_march_options_default(void);
+
 /* Oracle: per-receiver bilinear ray march on the grid. For every receiver point (x_i, y_i)
  * (grid units; points[2*i], points[2*i+1]) and each of the K directions, samples the surface at
  * p + s*step*(cos psi_k, sin psi_k), s = 1, 2, ... and keeps the largest elevation.
@@ -669,6 +690,9 @@ typedef struct hfvis_openness_options {
     int negative;       /* 0: positive openness; 1: negative */
     double step_cells;  /* radius > 0: march step in cells, >= 0; 0 = 1 */
 } hfvis_openness_options;
+
+/* The defaults: radius 0 (unlimited), positive openness, step_cells 1. */
+HFVIS_API hfvis_openness_options hfvis_openness_options_default(void);
 
 /* Openness at every grid point, out[y*out_stride + x]. opts: border, border_cells, azimuth0_rad,
  * alloc and progress; the direction range is not honoured (all K).
@@ -832,7 +856,7 @@ HFVIS_API hfvis_status hfvis_horizon_exact_naive(const hfvis_grid *grid, int K,
                                                  const hfvis_sweep_options *opts, float *out);
 
 /* ========================================================================================== */
-/* hfvis.c - P1 light ([P1] §6 Eq. 3-7; [P1] §6-7)                                            */
+/* hfvis.c - P1 light ([P1] §6-7, Eq. 3-7)                                            */
 /* ========================================================================================== */
 
 /* [P1] Eq. 5 per sector: S_k(theta) = (Nz/K) sin^2 theta + (sin(pi/K)/pi) a (theta - sin 2theta / 2),
@@ -915,10 +939,10 @@ typedef struct hfvis_env_options {
 HFVIS_API hfvis_env_options hfvis_env_options_default(void);
 
 /* Floats of the per-direction environment tables for method and K (0 on invalid input). */
-HFVIS_API size_t hfvis_env_table_size(const hfvis_env *env, int K, const hfvis_env_options *eopts);
+HFVIS_API size_t hfvis_env_table_floats(const hfvis_env *env, int K, const hfvis_env_options *eopts);
 
 /* Build the per-direction tables (prefix integrals or the L_p table) for directions psi_k =
- * azimuth0_rad + 2 pi k / K. table must hold hfvis_env_table_size() floats.
+ * azimuth0_rad + 2 pi k / K. table must hold hfvis_env_table_floats() floats.
  * Prefix layout: 6*K*(n_theta+1)*channels floats, table[((k*(n_theta+1) + b)*6 + q)*C + c]:
  * q = 0..2 are A_k, B_k, C_k at the band edge b*pi/n_theta; q = 3..5 band b's sector
  * phi-integrals of L, L cos(phi - psi_k), L sin(phi - psi_k) (for partial bands).
@@ -931,7 +955,7 @@ HFVIS_API hfvis_status hfvis_env_table_build(const hfvis_env *env, int K, double
 /* Environment light, fused into the sweep: out[(y*out_stride + x)*channels + c] =
  * albedo/pi * sum_k [Nz A_k + a_k B_k + b_k C_k](theta_k) (prefix) or
  * albedo * sum_k |N_p| L_p^k(theta_n, theta_h) ([P1] Eq. 6), in lattice space, gathered.
- * out_stride in pixels. Allocates 2 blocks: the tables (hfvis_env_table_size floats) and the
+ * out_stride in pixels. Allocates 2 blocks: the tables (hfvis_env_table_floats floats) and the
  * lattice scratch of hfvis_sky_light (plus channels-1 doubles per node).
  * opts->direction_begin/end select a partial sum of the K directions. */
 HFVIS_API hfvis_status hfvis_env_light(const hfvis_grid *grid, int K, const hfvis_env *env,
@@ -953,6 +977,9 @@ typedef struct hfvis_hemisphere_options {
     int azimuth_samples;      /* azimuths integrated (midpoint rule); 0 = 256 */
     int zenith_samples;       /* zenith steps over [0, pi] (midpoint rule); 0 = 512 */
 } hfvis_hemisphere_options;
+
+/* The defaults: 256 azimuths, 512 zenith steps. */
+HFVIS_API hfvis_hemisphere_options hfvis_hemisphere_options_default(void);
 
 /* Oracle for all light paths: at receiver points[2i], points[2i+1] (grid units), numerically
  * integrates L_o = albedo/pi * Int L_i(w) V(w) max(n.w, 0) dw over the sphere, with V from the
@@ -994,6 +1021,9 @@ typedef struct hfvis_tree_options {
                                  only replaces the root, skip the tests; same output; 0 = off */
     int safe_zone_steps;      /* window length b2 - b1 in samples; 0 = 4 ([P2] Alg. 3; docs/errata.md E15) */
 } hfvis_tree_options;
+
+/* The defaults: HFVIS_TREE_DEPTH_FIRST, SafeZoneUpdate off, safe_zone_steps 4. */
+HFVIS_API hfvis_tree_options hfvis_tree_options_default(void);
 
 /* Bytes of caller memory for a tree of up to max_samples samples (0 if max_samples < 1 or the
  * size overflows). The memory must be aligned for double (malloc'd memory is). */
@@ -1171,6 +1201,9 @@ typedef struct hfvis_viewshed_options {
     const hfvis_allocator *alloc; /* reserved: neither viewshed function allocates */
 } hfvis_viewshed_options;
 
+/* The defaults: all zero (eye and targets on the surface, unlimited range). */
+HFVIS_API hfvis_viewshed_options hfvis_viewshed_options_default(void);
+
 /* Viewshed of one observer: which grid points an eye at (observer_x, observer_y) sees.
  * The eye is at surface(observer) + observer_height, the target of grid point (x, y) at
  * z(x, y) + target_height, the terrain is the bilinear surface (CONVENTIONS; holes never
@@ -1233,7 +1266,7 @@ HFVIS_API hfvis_status hfvis_viewshed_reference(const hfvis_grid *grid, double o
                                                 ptrdiff_t out_stride);
 
 /* ========================================================================================== */
-/* hfvis.c - Nowrouzezahrai-Snyder GI, math layer ([NS09] §4, §6, §7, App. A; [NS09] §3-7) */
+/* hfvis.c - Nowrouzezahrai-Snyder GI, math layer ([NS09] §3-7, App. A) */
 /* ========================================================================================== */
 /* [NS09] D. Nowrouzezahrai, J. Snyder, "Fast Global Illumination on Dynamic Height Fields",
  * CGF 28(4), 2009. Errata: docs/errata.md E47-E53.
@@ -1372,8 +1405,9 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_nlp_occlusion(double sigma_rad, 
 HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_nlp_visibility(double omega_lo_rad, double omega_hi_rad,
                                                                double out[4]);
 
-/* NLP vector of the indirect radiance along one slice ([NS09] Eq. 8 and 12 with the [NS09] §4, Eq. 9-13; docs/errata.md E48, E49
- * errata: the integral covers z in [-1, 1], u(t_(i+1)) = 0 once i+1 >= |T|):
+/* NLP vector of the indirect radiance along one slice ([NS09] Eq. 8 and 12 with the limits of
+ * §4, Eq. 9-13, docs/errata.md E48, E49: the integral covers z in [-1, 1], u(t_(i+1)) = 0 once
+ * i+1 >= |T|):
  *   u(omega) = u[k] for omega_rad[k-1] <= omega < omega_rad[k] (omega_rad[-1] := omega_min_rad),
  *   0 below omega_min and above omega_rad[K-1];
  *   out = Sum_k (u[k] - u[k+1]) vbar(omega_rad[k]) - u[0] vbar(omega_min), u[K] := 0.
@@ -1446,7 +1480,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_wedges_full(hfvis_ns_wedges *
 HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_wedges_partial(hfvis_ns_wedges *set, hfvis_ns_interp interp,
                                                                   int m, double phi_a_rad, double phi_b_rad);
 
-/* From slices to SH ([NS09] Eq. 20-21, [NS09] §6, App. A; docs/errata.md E51 SLICES_TO_SH): w[j*4 + k] is the NLP vector
+/* From slices to SH ([NS09] §6, Eq. 20-21, App. A; docs/errata.md E51 SLICES_TO_SH): w[j*4 + k] is the NLP vector
  * of sample j (j = 0..m-1, from hfvis_nlp_visibility or hfvis_nlp_radiance at azimuth phi_j);
  * out = Sum_wedges Rot_z(M x_j, phi_j). One channel per call. Returns HFVIS_OK, or
  * HFVIS_ERR_INVALID_ARGUMENT for NULL or a set whose interp or sample count is invalid.
@@ -1472,7 +1506,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_min_blocking_angle(const doub
                                                                       hfvis_ns_omega_min form, double *out);
 
 /* ========================================================================================== */
-/* hfvis.c - Nowrouzezahrai-Snyder GI pipeline ([NS09] §5-9; [NS09] §3; [NS09] §8)           */
+/* hfvis.c - Nowrouzezahrai-Snyder GI pipeline ([NS09] §3-9)           */
 /* ========================================================================================== */
 /* The approximate, fast counterpart of the exact P1/P2 pipeline (hfvis_direct_light,
  * hfvis_terrain_gi): per receiver, m azimuthal slices are scanned with exponentially growing
@@ -1484,7 +1518,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_min_blocking_angle(const doub
  * Condon-Shortley phase, Ahat multipliers, NLP in z = sin(omega)) and of the whole API
  * (hfvis.h, Conventions: an open flat receiver under a uniform sky c with albedo 1 returns c).
  *
- * Slices ([NS09] §3; [NS09] §5.2, Eq. 14-17). A receiver at grid position (x, y) looking toward
+ * Slices ([NS09] §3, §5.2, Eq. 14-17). A receiver at grid position (x, y) looking toward
  * phi_j = azimuth0_rad + 2 pi j/m (phi measured like psi, from +x toward +y) takes steps
  * tau_i = 2^(i/k) cells, i = 0..n-1 (Eq. 14 in cell units); step i reads level
  * l_v(i) = max(0, i - k*o_v) of the height pyramid at the receiver and at the step point (Eq. 15:
@@ -1512,7 +1546,7 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_ns_min_blocking_angle(const doub
  * from the SH incident radiance U_b gathered from the exit radiance of bounce b-1; total = direct +
  * the bounces. For a diffuse surface this is, bounce by bounce, the recursion
  * L_B = emission + albedo (D + I[L_(B-1)]) of hfvis_terrain_gi. How close it comes to the exact
- * pipeline is measured in test_gi2.c against hfvis_sky_light and hfvis_indirect_light (P1/P2)
+ * pipeline is measured in test_ns_gi.c against hfvis_sky_light and hfvis_indirect_light (P1/P2)
  * and printed by the bench. */
 
 /* How omega_max is taken from a slice's blocking angles. */
@@ -1677,7 +1711,7 @@ typedef struct hfvis_ns_gi_outputs {
                                     receiver, for diffing a port; NaN at receivers on holes */
 } hfvis_ns_gi_outputs;
 
-/* Multi-resolution height-field global illumination ([NS09]; [NS09] §9, Fig. 6 RENDER).
+/* Multi-resolution height-field global illumination ([NS09] §9, Fig. 6 RENDER).
  * Per receiver (one per s x s block): m slices (Eq. 15-17) give V = Sum_j G_j v_j with
  * v_j = vbar(pi/2) - vbar(omega_max,j) (Eq. 11), G_j the wedge matrices rotated into place
  * (hfvis_ns_sample_matrices; m wedges with the wrap-around one); key lights add their restricted
@@ -1708,7 +1742,7 @@ typedef struct hfvis_ns_gi_outputs {
  * Cost: O(rw rh (m + key samples + directional lights) n) for the direct pass (about 20 ns per
  * step on one 2020s core) and O(rw rh m K C) per bounce with the cache (K the casting-set size;
  * x16 with VECTOR glossy), plus O(W H C 256) shading. Deterministic.
- * Accuracy (measured, test_gi2.c and the bench, fBm terrains): with the defaults, the direct light
+ * Accuracy (measured, test_ns_gi.c and the bench, fBm terrains): with the defaults, the direct light
  * of a uniform sky is within 1.4-2.3% RMS of P1's (hfvis_sky_light), of which about 1.8% is the
  * order-4 SH truncation itself (the SH projection of the exact horizons is that far from P1); one
  * bounce is within 0.016 (unit sky) RMS of P2's hfvis_indirect_light; hard sun shadows differ from
@@ -2072,7 +2106,7 @@ HFVIS_API double hfvis_falloff_eval(const hfvis_falloff *f, double distance);
  * +INFINITY for unbounded falloffs; NaN for an invalid falloff. */
 HFVIS_API double hfvis_falloff_support(const hfvis_falloff *f);
 
-/* ---- directions and the line lattice ([P3] §5.1-5.2, [P4] §6; [P3] §5.1, [P4] §6; docs/errata.md E24) ------------ */
+/* ---- directions and the line lattice ([P3] §5.1-5.2, [P4] §6; docs/errata.md E24) ------------ */
 
 /* One azimuthal direction of a line sweep. */
 typedef struct hfvis_ssao_direction {
@@ -2195,7 +2229,7 @@ typedef enum hfvis_lsao_pop {
                                     points behind depth steps (docs/errata.md E19: 5x the error) */
 } hfvis_lsao_pop;
 
-/* How a pixel reads a direction's lattice values ([P3] §5.1, [P3] §5.1, Fig. 8; docs/errata.md E23). */
+/* How a pixel reads a direction's lattice values ([P3] §5.1, Fig. 8; docs/errata.md E23). */
 typedef enum hfvis_ssao_gather {
     HFVIS_SSAO_GATHER_DEFAULT = 0,   /* = NEAREST */
     HFVIS_SSAO_GATHER_NEAREST = 1,   /* the nearest lattice sample (the paper) */
@@ -2268,7 +2302,7 @@ HFVIS_API hfvis_status hfvis_lsao_line(const double *x, const double *y, const d
                                        const double *sin_t_eval, int n, int orthographic,
                                        const hfvis_lsao_options *opts, int *stack, double *out);
 
-/* Oracle of hfvis_lsao_line ([P3] Fig. 7; the [P3] Fig. 7 reference): for each receiver, walk
+/* Oracle of hfvis_lsao_line (the reference of [P3] Fig. 7): for each receiver, walk
  * back over the earlier points; point j is visible iff Sin(p_j - p_i) exceeds every Sin seen
  * nearer to i; among the visible points take the largest Occ(., st_cull) (ties: the higher,
  * i.e. farther visible point) and return its Occ(., st_eval) (st_eval if none). Same contract,
@@ -2316,7 +2350,7 @@ HFVIS_API hfvis_status hfvis_lsao_direction_naive(const hfvis_camera *cam, const
                                                   const hfvis_ssao_line *lines, float *values,
                                                   float *sample_depth);
 
-/* Gather one direction's lattice values into per-pixel accumulators ([P3] §5.1, [P3] §5.1, Fig. 8; docs/errata.md E23):
+/* Gather one direction's lattice values into per-pixel accumulators ([P3] §5.1, Fig. 8; docs/errata.md E23):
  * for every non-background inner pixel c (buffer texel (x + guard_x, y + guard_y), centre
  * + 0.5), the nearest lattice sample (GATHER_NEAREST) or the 2 x 2 neighbours (BILINEAR) are
  * accepted when their value is not NaN, |sample_depth - z_c| <= reject_depth * z_c and (normals
@@ -2470,7 +2504,7 @@ HFVIS_API hfvis_status hfvis_hbao(const hfvis_camera *cam, const float *depth,
 
 /* ---- the screen-space ray-traced reference ([P4] §8; docs/errata.md E36) --------------------------- */
 
-/* Options of hfvis_ssao_raytrace. NULL or a zero struct = the defaults in brackets. */
+/* Options of hfvis_ssao_reference. NULL or a zero struct = the defaults in brackets. */
 typedef struct hfvis_ssao_rt_options {
     const hfvis_allocator *alloc;     /* reconstructed normals only; NULL = malloc/free */
     int rays;                         /* rays per pixel [256] */
@@ -2519,7 +2553,7 @@ HFVIS_API hfvis_status hfvis_ssao_rt_options_resolve(const hfvis_ssao_rt_options
  * Deterministic for a seed. Cost O(W H R (W0 + H0)) at worst (cells per ray).
  * HFVIS_ERR_INVALID_ARGUMENT for invalid camera/options, NULL depth/ao, ao_stride < inner
  * width; HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on error. */
-HFVIS_API hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth,
+HFVIS_API hfvis_status hfvis_ssao_reference(const hfvis_camera *cam, const float *depth,
                                            const float *normals,
                                            const hfvis_ssao_rt_options *opts, float *ao,
                                            ptrdiff_t ao_stride);
@@ -2695,7 +2729,7 @@ HFVIS_API hfvis_status hfvis_ffao_slice(const double p[2], const double n[2], co
                                         double theta_start, const hfvis_ffao_options *opts,
                                         double *obscurance, double *theta_min);
 
-/* Screen-space far-field ambient obscurance ([P4]; [P4] Alg. 2), the COS convention
+/* Screen-space far-field ambient obscurance ([P4] Alg. 2), the COS convention
  * (docs/errata.md C4: converges to the ray-traced reference, P4 Eq. 1). Per scan direction k (uniform
  * azimuths, dense lattice D_S = D_L = 1 px): the scan kernel stores per line and interval of B0
  * steps m0 = max Q.z and m1 = max(Q.z - s Q.e1) over the samples (background skipped), levels
@@ -2871,6 +2905,7 @@ typedef struct hfvis_volume_grid {
 /* How a written value combines with the stored one (the Volume Buffer's blend equation, thesis
  * §6.3; GL_MAX for every attachment on the GPU). */
 typedef enum hfvis_blend {
+    HFVIS_BLEND_DEFAULT = 0,  /* = MAX */
     HFVIS_BLEND_MAX = 0,      /* default (the thesis' GPU behaviour) */
     HFVIS_BLEND_REPLACE = 1,
     HFVIS_BLEND_MIN = 2,
@@ -2878,7 +2913,7 @@ typedef enum hfvis_blend {
 } hfvis_blend;
 
 /* The Volume Buffer (thesis ch. 6, [G12] ch. 6): `channels` floats per voxel, interleaved,
- * data[lin*channels + c], caller-owned (hfvis_volume_size floats), each channel with its blend. */
+ * data[lin*channels + c], caller-owned (hfvis_volume_floats floats), each channel with its blend. */
 typedef struct hfvis_volume {
     hfvis_volume_grid grid;
     int channels;                                /* 1..HFVIS_VOLUME_MAX_CHANNELS */
@@ -2900,9 +2935,9 @@ HFVIS_API hfvis_status hfvis_volume_grid_fit(const hfvis_mesh *mesh, int resolut
 
 /* Floats a volume of `channels` channels needs: dims[0]*dims[1]*dims[2]*channels; 0 if grid is
  * NULL or invalid or channels is outside 1..HFVIS_VOLUME_MAX_CHANNELS. */
-HFVIS_API size_t hfvis_volume_size(const hfvis_volume_grid *grid, int channels);
+HFVIS_API size_t hfvis_volume_floats(const hfvis_volume_grid *grid, int channels);
 
-/* Set up vol over caller storage of hfvis_volume_size(grid, channels) floats, every channel
+/* Set up vol over caller storage of hfvis_volume_floats(grid, channels) floats, every channel
  * blending with `blend`, every value 0. Returns HFVIS_ERR_INVALID_ARGUMENT for NULL, an invalid
  * grid, channels outside 1..32 or an unknown blend. */
 HFVIS_API hfvis_status hfvis_volume_init(hfvis_volume *vol, const hfvis_volume_grid *grid,
@@ -3130,6 +3165,7 @@ HFVIS_API hfvis_status hfvis_mesh_save(const char *path, const hfvis_mesh *mesh)
  * screen (y up), i.e. the face normal (v1 - v0) x (v2 - v0) points toward the viewer (the
  * hfvis_mesh convention and GL's default glFrontFace(GL_CCW)). */
 typedef enum hfvis_cull_mode {
+    HFVIS_CULL_DEFAULT = 0, /* = NONE */
     HFVIS_CULL_NONE = 0,  /* default: both sides rasterized */
     HFVIS_CULL_BACK = 1,  /* faces pointing away from the viewer discarded */
     HFVIS_CULL_FRONT = 2  /* faces pointing toward the viewer discarded */
@@ -3137,6 +3173,7 @@ typedef enum hfvis_cull_mode {
 
 /* Coordinate frame of the normal output plane. */
 typedef enum hfvis_normal_space {
+    HFVIS_NORMAL_DEFAULT = 0, /* = WORLD */
     HFVIS_NORMAL_WORLD = 0, /* default: the mesh's frame */
     HFVIS_NORMAL_EYE = 1    /* rotated by the view matrix (eye space: x right, y up, +z toward
                                the viewer), as the screen-space AO routines expect */
@@ -3430,7 +3467,9 @@ HFVIS_API hfvis_status hfvis_bvh_intersect(const hfvis_bvh *bvh, const hfvis_mes
                                            const hfvis_ray *ray, hfvis_ray_query query,
                                            hfvis_hit_filter filter, void *user, hfvis_hit *hit);
 
-/* hfvis_bvh_intersect(bvh, mesh, ray, HFVIS_RAY_CLOSEST, NULL, NULL, hit). */
+/* hfvis_bvh_intersect(bvh, mesh, ray, HFVIS_RAY_CLOSEST, NULL, NULL, hit). Kept beside the
+ * general query (as Embree keeps rtcIntersect and rtcOccluded): the two queries nearly every
+ * caller makes, without a filter. */
 HFVIS_API hfvis_status hfvis_bvh_closest_hit(const hfvis_bvh *bvh, const hfvis_mesh *mesh,
                                              const hfvis_ray *ray, hfvis_hit *hit);
 
@@ -3489,17 +3528,18 @@ typedef void (*hfvis_voxel_fragment_fn)(const hfvis_voxel_fragment *f, float *va
  * vertex limit all three give the voxel set of the pixel-centre rule; they differ in cost and,
  * with a limit, in the holes they leave. */
 typedef enum hfvis_voxelize_method {
+    HFVIS_VOXELIZE_DEFAULT = 0, /* = PIXEL_RULE */
     /* Default. The common CPU rule ([G12] ch. 6): each pass pixel (pu, pw) whose centre lies in the
      * projected triangle gets the voxel of slab floor(z), z = the triangle plane's depth at the
      * centre. One fragment per covered pixel. No vertex limit (max_output_vertices must be 0). */
     HFVIS_VOXELIZE_PIXEL_RULE = 0,
-    /* Geometry-shader triangle slicing ([G12] Alg. 5, [G12] ch. 6, Alg. 5; docs/errata.md E58): the triangle is clipped
+    /* Geometry-shader triangle slicing ([G12] ch. 6, Alg. 5; docs/errata.md E58): the triangle is clipped
      * (Sutherland-Hodgman against both planes of a slab) into one convex piece per slab it
      * spans, lowest slab first, and each piece is rasterised (pixel centres, top-left rule on the
      * piece's own edges) into its slab. Equals the pixel rule except where a pixel centre lies
      * within rounding (about 1e-12 voxels) of a slab plane or a triangle edge. */
     HFVIS_VOXELIZE_GS_SLICING = 1,
-    /* Pixel-shader fragment clipping ([G12] Alg. 6, [G12] ch. 6, Alg. 6; docs/errata.md E57): the whole triangle is rasterised
+    /* Pixel-shader fragment clipping ([G12] ch. 6, Alg. 6; docs/errata.md E57): the whole triangle is rasterised
      * once per slab it spans, lowest first, and a fragment is kept only in the slab that holds its
      * depth, [k, k+1) (the half-open form of the thesis' open interval). Without a limit this is
      * the pixel rule exactly; the cost grows with the slabs spanned (n passes over the
@@ -3509,6 +3549,7 @@ typedef enum hfvis_voxelize_method {
 
 /* Which sweep passes see a triangle. */
 typedef enum hfvis_voxelize_axes {
+    HFVIS_AXES_DEFAULT = 0, /* = DOMINANT */
     /* Default ([G12] §6.4): each triangle only in the pass of its dominant axis, the largest
      * |component| of its GRID-space normal (ties -> lowest axis index). */
     HFVIS_AXES_DOMINANT = 0,
@@ -3621,7 +3662,7 @@ HFVIS_API hfvis_status hfvis_voxelize_occupancy(const hfvis_mesh *mesh,
                                                 const hfvis_voxelize_options *opts, uint8_t *occ);
 
 /* Ready-made attribute callbacks (hfvis_voxel_fragment_fn), the thesis' Volume Buffer channels
- * ([G12] §6.5, [G12] ch. 6). */
+ * ([G12] §6.5). */
 
 /* values[0] = 1 (occupancy). user unused. */
 HFVIS_API void hfvis_voxel_fragment_occupancy(const hfvis_voxel_fragment *f, float *values,
@@ -3949,6 +3990,7 @@ typedef enum hfvis_iv_class {
 
 /* The bias b of eq. 17. */
 typedef enum hfvis_iv_bias_rule {
+    HFVIS_IV_BIAS_DEFAULT = 0, /* = HALF_DIAGONAL */
     HFVIS_IV_BIAS_HALF_DIAGONAL = 0, /* default: b = |cell|/2, the voxel's "radius (half
                                         diagonal)" of the text (§7.4.1); (sqrt 3/2) s for cubes */
     HFVIS_IV_BIAS_FULL_DIAGONAL = 1, /* b = |cell|: Listing 7.1 (distance between the eye-space
@@ -3958,6 +4000,7 @@ typedef enum hfvis_iv_bias_rule {
 
 /* Which depth texels decide a clear. */
 typedef enum hfvis_iv_footprint {
+    HFVIS_IV_FOOTPRINT_DEFAULT = 0, /* = CENTER */
     HFVIS_IV_FOOTPRINT_CENTER = 0,      /* default, the thesis (Listing 7.1): the one texel under
                                            the voxel centre (nearest, floor of the window
                                            coordinate, clamped to the image) */
@@ -4139,6 +4182,9 @@ typedef struct hfvis_distance_options {
     const hfvis_allocator *alloc;   /* scratch; NULL = malloc/free */
 } hfvis_distance_options;
 
+/* The defaults: 100000 samples, seed 0, malloc/free. */
+HFVIS_API hfvis_distance_options hfvis_distance_options_default(void);
+
 /* Distances between a mesh X and a voxel set Y (its voxel centres), thesis Table 9 ([G12] ch. 7;
  * docs/errata.md E62): Y -> X exactly (every centre's distance to the nearest triangle, point-triangle in
  * double); X -> Y over seeded area-uniform samples of X (a lower bound of the true sup).
@@ -4241,7 +4287,7 @@ HFVIS_API hfvis_status hfvis_voxel_distance_metrics_naive(const hfvis_mesh *mesh
 #define HFVIS_VISFIELD_MAX_BYTES ((uint64_t)1 << 32)
 #define HFVIS_VISFIELD_FILE_HEADER 80      /* bytes before the payload in a field file */
 
-/* How the hemisphere of directions maps onto the D x D texels ([G12] §4.4.4, [G12] ch. 4, Fig. 30-34). */
+/* How the hemisphere of directions maps onto the D x D texels ([G12] §4.4.4, Fig. 30-34). */
 typedef enum hfvis_dirmap {
     HFVIS_DIRMAP_DEFAULT = 0,    /* = HFVIS_DIRMAP_CONCENTRIC */
     /* Polar ("uniform") mapping: column i is the polar angle theta = (i + 0.5)/D * pi/2 from the
@@ -4258,7 +4304,7 @@ typedef enum hfvis_dirmap {
     HFVIS_DIRMAP_CONCENTRIC = 3
 } hfvis_dirmap;
 
-/* What a texel stores ([G12] §4.6.1, [G12] ch. 4, Fig. 42; [G12] ch. 4, Alg. 1). */
+/* What a texel stores ([G12] §4.6.1, Fig. 42, ch. 4 Alg. 1). */
 typedef enum hfvis_visfield_format {
     HFVIS_VISFIELD_DEFAULT = 0,  /* = HFVIS_VISFIELD_U8 */
     /* 1 byte per texel: a hit at distance th stores q = min(254, floor(254 th/(2R) + 0.5)),
@@ -4404,7 +4450,10 @@ typedef struct hfvis_visfield_build_options {
     void *progress_user;
 } hfvis_visfield_build_options;
 
-/* Build a visibility field ([G12] Alg. 1, [G12] ch. 4, Alg. 1): for every sample k, p_k = c + R u_k,
+/* The defaults: malloc/free, a BVH built inside, no progress callback. */
+HFVIS_API hfvis_visfield_build_options hfvis_visfield_build_options_default(void);
+
+/* Build a visibility field ([G12] ch. 4, Alg. 1): for every sample k, p_k = c + R u_k,
  * w = -u_k, and every texel (i, j) of the mapping (unused rejection texels get the miss code),
  * the ray hfvis_ray{origin = (float)p_k, direction = (float)(lx t + ly b + lz w), t_min = 0,
  * t_max = INFINITY, cull none} is cast with hfvis_bvh_closest_hit; a hit at t stores
@@ -4523,7 +4572,7 @@ typedef struct hfvis_visfield_ao_options {
 
 HFVIS_API hfvis_visfield_ao_options hfvis_visfield_ao_options_default(void);
 
-/* Ambient obscurance of receiver points from visibility fields ([G12] Alg. 2/3, [G12] ch. 4, Alg. 2-3; docs/errata.md E64):
+/* Ambient obscurance of receiver points from visibility fields ([G12] ch. 4, Alg. 2-3; docs/errata.md E64):
  * per point x with unit normal n (renormalised here), the S x S rays l = concentric((2i+1)/S - 1,
  * (2j+1)/S - 1) lifted by Malley (cosine distributed, as the thesis' pre-generated ray set) in
  * the frame hfvis_visfield_frame(n), direction lx t + ly b + lz n, from x + offset n; each object
@@ -4562,8 +4611,11 @@ typedef struct hfvis_visfield_shadow_options {
     const hfvis_allocator *alloc;   /* scratch; NULL = malloc/free */
 } hfvis_visfield_shadow_options;
 
+/* The defaults: 20 samples, bias HFVIS_VISFIELD_DEFAULT_BIAS, malloc/free. */
+HFVIS_API hfvis_visfield_shadow_options hfvis_visfield_shadow_options_default(void);
+
 /* Visibility of a spherical light (centre, radius >= 0; 0 = a point light, hard shadows) from
- * points ([G12] §4.5.2, [G12] ch. 4): per point x, `samples` points y_i on the disc of the light
+ * points ([G12] §4.5.2): per point x, `samples` points y_i on the disc of the light
  * facing x (centre + radius (dx e1 + dy e2), (dx, dy) = the concentric map of the Hammersley
  * point ((i + 0.5)/N, radical inverse of i in base 2), (e1, e2) = the frame of the unit vector
  * from x to the centre); the shadow ray x -> y_i of length L is blocked when some object
@@ -4624,6 +4676,10 @@ typedef struct hfvis_visfield_reflect_options {
     double bias;          /* as hfvis_visfield_ao_options.bias */
     double offset;        /* ray origin x + offset n, world units >= 0 */
 } hfvis_visfield_reflect_options;
+
+/* The defaults: 4 rays, a perfect mirror (shininess 0), bias HFVIS_VISFIELD_DEFAULT_BIAS,
+ * offset 0. */
+HFVIS_API hfvis_visfield_reflect_options hfvis_visfield_reflect_options_default(void);
 
 /* Reflection rays of one receiver ([G12] §4.5.2 "polished" stochastic reflections): mirror
  * direction r = v - 2 (v.n) n of the incoming direction v (toward the surface) about the unit
@@ -4770,6 +4826,11 @@ HFVIS_API hfvis_status hfvis_visfield_load(const char *path, const hfvis_allocat
 #define HFVIS_VOLGI_MAX_VALUE 1e20f
 
 /* ---- 2-band SH helpers ([G12] ch. 5) ---------------------------------------------------------- */
+/* These are bands 0-1 of the order-4 SH API (same basis, index and phase): hfvis_volgi_sh_basis
+ * = the first 4 coefficients of hfvis_sh_eval, _clamped_cosine of hfvis_sh_from_zh with
+ * hfvis_zh_diffuse, _cone of hfvis_sh_from_zh with hfvis_zh_cap (test_volgi holds them equal).
+ * They stay as the volume GI's 4-coefficient kernels: its propagation evaluates them per voxel
+ * and face, where computing 16 coefficients to keep 4 would cost four times as much. */
 
 /* The 4 basis functions at the unit direction dir/|dir|. Returns HFVIS_OK, or
  * HFVIS_ERR_INVALID_ARGUMENT for NULL, a non-finite or zero dir (out untouched). */
@@ -4790,8 +4851,9 @@ HFVIS_API HFVIS_EXPERIMENTAL hfvis_status hfvis_volgi_sh_cone(const double axis[
 
 /* ---- options ------------------------------------------------------------------------------ */
 
-/* How the flux that leaves a voxel toward a face neighbour is computed (eq. 11, [G12] ch. 5, eq. 11; docs/errata.md E59). */
+/* How the flux that leaves a voxel toward a face neighbour is computed ([G12] ch. 5, eq. 11; docs/errata.md E59). */
 typedef enum hfvis_volgi_transfer {
+    HFVIS_VOLGI_TRANSFER_DEFAULT = 0, /* = CONE */
     /* Default: the reference kernel of docs/errata.md E59. The flux through the face toward
      * neighbour i = j + o is F = max(0, P_j . Cone(o)) per band (the SH integral of P_j over the
      * 45-degree cone about o, negative values from SH ringing clamped), and it arrives at i as a
@@ -4809,6 +4871,7 @@ typedef enum hfvis_volgi_transfer {
 
 /* What an occupied voxel does with the light S_in that arrives (the thesis' T_r). */
 typedef enum hfvis_volgi_reflection {
+    HFVIS_VOLGI_REFLECT_DEFAULT = 0, /* = MIRROR */
     /* Default, the thesis' simplification (§5.5.2): mirror S_in on the plane perpendicular to the
      * dominant axis m of the voxel's average normal (ties: lowest axis), i.e. negate band-1
      * coefficient m (index 3 for x, 1 for y, 2 for z; T_r = 1 except -1 there [I]). Keeps c_0, so
@@ -4826,6 +4889,7 @@ typedef enum hfvis_volgi_reflection {
 /* The reflectance rho of occupied voxels in the propagation (not the first bounce, whose albedo
  * is already in the injected radiance, nor the final gather, which uses the pixel's albedo). */
 typedef enum hfvis_volgi_reflectance {
+    HFVIS_VOLGI_REFLECTANCE_DEFAULT = 0, /* = THESIS */
     HFVIS_VOLGI_REFLECTANCE_THESIS = 0,   /* default: 0.5 for every band ([G12] §5.6) */
     HFVIS_VOLGI_REFLECTANCE_CONSTANT = 1, /* options.reflectance, in [0, 1] (0: pure absorbers) */
     HFVIS_VOLGI_REFLECTANCE_ALBEDO = 2    /* the voxel's albedo (hfvis_volgi_geometry.albedo, which
@@ -4834,6 +4898,7 @@ typedef enum hfvis_volgi_reflectance {
 
 /* Which face-neighbour transfers carry light. */
 typedef enum hfvis_volgi_paths {
+    HFVIS_VOLGI_PATHS_DEFAULT = 0, /* = ALL */
     /* Default, the reference kernel of docs/errata.md E59: every voxel gathers from all six neighbours, also
      * an occupied voxel from an occupied one (docs/errata.md E59: occupied sources emit into all six
      * directions). Side effect: the side lobes of a lit wall's VPLs land in the neighbouring
@@ -4915,7 +4980,7 @@ typedef struct hfvis_volgi_energy {
                              reached surfaces in this step */
 } hfvis_volgi_energy;
 
-/* VPL injection ([G12] §5.5.1, [G12] ch. 5): prop[v] = L_v s^2 CC(n_v) per band for every voxel with
+/* VPL injection ([G12] §5.5.1): prop[v] = L_v s^2 CC(n_v) per band for every voxel with
  * occupancy > 0, a non-zero normal and radiance L_v = radiance[3v..3v+2] (outgoing radiance of the
  * lit or emissive surface, >= 0), i.e. a cosine lobe carrying the flux pi L_v s^2 (s^2: the face
  * perpendicular to the normal's dominant axis); an occupied voxel without a normal gets the
@@ -4979,7 +5044,7 @@ HFVIS_API hfvis_status hfvis_volgi_propagate(const hfvis_volgi_geometry *geometr
                                              float *prop, float *accum,
                                              hfvis_volgi_energy *energy);
 
-/* Final gather ([G12] §5.5.3, eqs. 12-15, [G12] ch. 5, eq. 12-15; docs/errata.md E60) at a surface point with unit normal n
+/* Final gather ([G12] §5.5.3, eqs. 12-15; docs/errata.md E60) at a surface point with unit normal n
  * (normalised here): with g = (p - origin)/cell - 1/2, b = floor(g), f = g - b, the trilinear
  * weights of the 8 voxels b + {0,1}^3 are applied to accum over those inside the grid with
  * occupancy > 0 only ("from the eight closest grid points only the ones corresponding to occupied
@@ -5068,7 +5133,7 @@ HFVIS_API hfvis_status hfvis_volgi_direct_irradiance(const hfvis_volgi_scene *sc
 HFVIS_API hfvis_status hfvis_volgi_grid_fit(const hfvis_mesh *mesh, int resolution,
                                             hfvis_volume_grid *out);
 
-/* Voxelization with direct lighting ([G12] ch. 5 Alg. 4, [G12] ch. 5, Alg. 4): hfvis_voxelize_surface with
+/* Voxelization with direct lighting ([G12] ch. 5, Alg. 4): hfvis_voxelize_surface with
  * HFVIS_AXES_ALL (the x, y and z slicing passes, pixel-centre rule) over scene->mesh, where each
  * fragment at position p on triangle t with normal n_t writes
  *   radiance = albedo_t E_direct(p, n_t)/pi + emission_t   (hfvis_volgi_direct_irradiance)
@@ -5151,7 +5216,7 @@ HFVIS_API hfvis_status hfvis_volgi_render(const hfvis_volgi_scene *scene,
  *                                 region of influence covers ([LK] §4);
  *   Method 2, hfvis_lk_bvh      - per receiver (any points), a BVH traversal with conservative
  *                                 node masks ([LK] §5);
- *   reference, hfvis_lk_raycast - every ray of every receiver cast through the same BVH with an
+ *   reference, hfvis_lk_reference - every ray of every receiver cast through the same BVH with an
  *                                 any-hit query ([LK] §6).
  *
  * Obscurance (hfvis.h, Conventions): W = popcount(mask)/N in [0, 1], 0 = nothing blocks ([LK] Eq. 3). The
@@ -5257,7 +5322,7 @@ typedef enum hfvis_lk_pattern {
 /* The falloff rho(x) of the normalised occluder distance x = D/r, non-increasing, rho = 0 from
  * x = 1 on. The ray lengths realise it: l_i/r = sup{x in [0, 1] : rho(x) >= xi_i} with the
  * stratified xi_i = (pi(i) + 1/2)/N, pi a seeded random permutation (uncorrelated with the
- * directions), so P(l >= D) = rho(D) ([LK] Eq. 3, [LK] §3, Eq. 1-3). */
+ * directions), so P(l >= D) = rho(D) ([LK] §3, Eq. 1-3). */
 typedef enum hfvis_lk_falloff {
     HFVIS_LK_FALLOFF_DEFAULT = 0,   /* = CONSTANT */
     HFVIS_LK_FALLOFF_CONSTANT = 1,  /* rho = 1 on [0, 1): every l_i = r (the paper's tests) */
@@ -5486,7 +5551,7 @@ typedef enum hfvis_lk_sides {
     HFVIS_LK_SIDES_PER_TRIANGLE = 3 /* two_sided[t] != 0 marks triangle t two-sided */
 } hfvis_lk_sides;
 
-/* Method 1's bounding volume of a triangle's region of influence ([LK] §4.1, [LK] §4.1, Fig. 2-3). */
+/* Method 1's bounding volume of a triangle's region of influence ([LK] §4.1, Fig. 2-3). */
 typedef enum hfvis_lk_volume {
     HFVIS_LK_VOLUME_DEFAULT = 0, /* = AUTO */
     HFVIS_LK_VOLUME_AUTO = 1,    /* prism if R_T/r_max > alpha, else the sphere billboard */
@@ -5639,7 +5704,7 @@ HFVIS_API hfvis_status hfvis_lk_bvh(const hfvis_mesh *mesh, const hfvis_bvh *bvh
  * library's float hfvis_bvh_intersect). Arguments, outputs and errors as hfvis_lk_bvh (its
  * options mask_mode, node_mask and cull do not apply). Memory: 1 block, as hfvis_lk_bvh. Cost
  * O(rays log T). */
-HFVIS_API hfvis_status hfvis_lk_raycast(const hfvis_mesh *mesh, const hfvis_bvh *bvh,
+HFVIS_API hfvis_status hfvis_lk_reference(const hfvis_mesh *mesh, const hfvis_bvh *bvh,
                                         const hfvis_lk_rays *rays,
                                         const hfvis_lk_receivers *recv,
                                         const hfvis_lk_options *opts, uint32_t *masks,
@@ -5649,7 +5714,7 @@ HFVIS_API hfvis_status hfvis_lk_raycast(const hfvis_mesh *mesh, const hfvis_bvh 
 typedef enum hfvis_lk_method {
     HFVIS_LK_METHOD_RASTER = 1,  /* hfvis_lk_raster */
     HFVIS_LK_METHOD_BVH = 2,     /* hfvis_lk_bvh on the G-buffer receivers */
-    HFVIS_LK_METHOD_RAYCAST = 3  /* hfvis_lk_raycast on the G-buffer receivers */
+    HFVIS_LK_METHOD_RAYCAST = 3  /* hfvis_lk_reference on the G-buffer receivers */
 } hfvis_lk_method;
 
 /* The AO image of a view by any method: the G-buffer receivers (hfvis_lk_gbuffer_receivers) and
@@ -5661,6 +5726,95 @@ HFVIS_API hfvis_status hfvis_lk_image(hfvis_lk_method method, const hfvis_mesh *
                                       const hfvis_bvh *bvh, const hfvis_view *view,
                                       const hfvis_lk_rays *rays, const hfvis_lk_options *opts,
                                       uint32_t *masks, float *obscurance, hfvis_lk_stats *stats);
+
+/* ========================================================================================== */
+/* Deprecated names (removed in the next minor version)                                       */
+/* ========================================================================================== */
+/* 0.2.0 renamed these (README, "Migrating from 0.1.x"); the old names still compile. Define
+ * HFVIS_NO_DEPRECATED to find their uses. */
+#ifndef HFVIS_NO_DEPRECATED
+#define hfvis_ssao_raytrace hfvis_ssao_reference
+#define hfvis_lk_raycast hfvis_lk_reference
+#define hfvis_lattice_size hfvis_lattice_nodes
+#define hfvis_env_table_size hfvis_env_table_floats
+#define hfvis_volume_size hfvis_volume_floats
+#endif
+
+/* ========================================================================================== */
+/* Internal (not API): shared by hfvis.c, ssao.c and voxel.c                                  */
+/* ========================================================================================== */
+/* Seen only by the library's own .c files, which define HFVIS__INTERNAL before including this
+ * header; user code never sees it and must not rely on it. Everything is defined once, in
+ * hfvis.c section 1 (Common) and section 2 (file reading), except the mesh check (voxel.c
+ * section 1), so ssao.c and voxel.c need hfvis.c, as the vendoring note at the top says. */
+#ifdef HFVIS__INTERNAL
+#ifndef HFVIS__INTERNAL_H
+#define HFVIS__INTERNAL_H
+#include <math.h>
+
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#endif
+
+#ifndef HFVIS_ASSERT
+#ifdef HFVIS_ENABLE_ASSERTS
+#include <assert.h>
+#define HFVIS_ASSERT(x) assert(x)
+#else
+#define HFVIS_ASSERT(x) ((void)0)
+#endif
+#endif
+
+#define HFVIS__PI 3.14159265358979323846
+#define HFVIS__HALF_PI 1.57079632679489661923
+#define HFVIS__NAN ((double)NAN)
+#define HFVIS__INF ((double)INFINITY)
+
+/* Allocation (hfvis.h "Memory"): bytes from a->alloc, or from HFVIS_MALLOC when a is NULL or has
+ * no alloc; NULL for 0 bytes or on failure. hfvis__free returns p to where hfvis__alloc took it
+ * from: a->free when a->alloc is set (nothing when that free is NULL), else HFVIS_FREE, whatever
+ * a->free says (memory from an allocator without alloc came from HFVIS_MALLOC). */
+void *hfvis__alloc(const hfvis_allocator *a, size_t bytes);
+void hfvis__free(const hfvis_allocator *a, void *p);
+/* *out = a*b; 0 (and *out untouched) on overflow (stb's mul2sizes_valid). */
+int hfvis__mul_size(size_t a, size_t b, size_t *out);
+/* count*elem bytes from hfvis__alloc; NULL on overflow, failure or a zero size. */
+void *hfvis__alloc_array(const hfvis_allocator *a, size_t count, size_t elem);
+/* 1 if a caller plane of `height` rows `stride` pixels apart (stride >= 1), floats_per_pixel
+ * floats a pixel, is addressable: every (y*stride + x)*floats_per_pixel stays below PTRDIFF_MAX
+ * bytes. */
+int hfvis__plane_fits(ptrdiff_t stride, int height, int floats_per_pixel);
+/* 1 if v[0..n) are all finite. */
+int hfvis__all_finite(const double *v, int n);
+/* HFVIS_OK when the mesh is usable (hfvis_mesh: arrays present, indices < vertex_count, finite
+ * coordinates), else HFVIS_ERR_INVALID_ARGUMENT; O(V + T). Defined in voxel.c section 1. */
+hfvis_status hfvis__mesh_check(const hfvis_mesh *m);
+
+/* The library's PRNGs: stateless SplitMix64 (Steele, Lea, Flood 2014) hashing, its stateful
+ * stream, and PCG32 (O'Neill 2014, XSH-RR). No global state; every stream is seeded. */
+uint64_t hfvis__mix64(uint64_t x);           /* the SplitMix64 output of state x */
+uint64_t hfvis__splitmix64(uint64_t *state); /* hfvis__mix64(*state), then one step */
+typedef struct hfvis__pcg32 {
+    uint64_t state, inc;
+} hfvis__pcg32;
+void hfvis__pcg32_seed(hfvis__pcg32 *g, uint64_t seed, uint64_t stream);
+uint32_t hfvis__pcg32_next(hfvis__pcg32 *g);
+double hfvis__pcg32_unit(hfvis__pcg32 *g);               /* [0, 1), 53 bits from two draws */
+uint32_t hfvis__pcg32_below(hfvis__pcg32 *g, uint32_t n); /* [0, n), n >= 1, unbiased */
+
+#ifndef HFVIS_NO_STDIO
+/* Whole-file reading (hfvis.c section 2). A sizer looks at the first bytes of a file (at most
+ * HFVIS__READ_HEAD, fewer if the file is shorter) and sets *total to the exact size its header
+ * announces or HFVIS__READ_ALL (a text format: read to the end), or returns the decoder's error
+ * for the header (refused before anything more is read). */
+#define HFVIS__READ_HEAD ((size_t)1 << 16)
+#define HFVIS__READ_ALL ((size_t)-1)
+typedef hfvis_status (*hfvis__sizer)(const unsigned char *head, size_t n, size_t *total);
+hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc, hfvis__sizer sizer,
+                             unsigned char **data, size_t *size);
+#endif
+#endif /* HFVIS__INTERNAL_H */
+#endif /* HFVIS__INTERNAL */
 
 #ifdef __cplusplus
 }

@@ -1,12 +1,13 @@
 /* ssao.c - screen space. Part of hfvis (see hfvis.h for the conventions and the API).
  *
  * Contents
- *   1. Common: allocation, checked sizes, the hash PRNG
+ *   1. Common: three-factor sizes and the per-pixel hash (allocation, checked sizes and the
+ *      PRNGs are hfvis.c's hfvis__ helpers)
  *   2. Camera, hardware depth linearisation, view-space reconstruction, normals from depth
  *      ([P4] §3; docs/errata.md C7)
  *   3. Falloff functions ([P3] Eq. 2-3; docs/errata.md C4)
  *   4. The azimuthal line plane, uniform and box-pattern directions, the line lattice
- *      ([P3] §5.1-5.2, [P4] §6; [P3] §5.1, [P4] §6; docs/errata.md E20, E21; docs/errata.md E24)
+ *      ([P3] §5.1-5.2, [P4] §6; docs/errata.md E20, E21, E24)
  *   5. P3 line-sweep AO: the obscurity hull along one line ([P3] §4, Alg. 1) and its brute-force
  *      oracle ([P3] Fig. 7), the sweep of one direction, the per-pixel gather ([P3] §5.1), the
  *      driver ([P3] §4-5)
@@ -16,7 +17,7 @@
  *   9. P4 far-field obscurance: scan kernel (Alg. 1, sign corrected), virtual points, level
  *      hierarchy, prefix sums and sector averaging, obscurity kernel (Alg. 2), slab estimator
  *      (quadrature, L(a,b,c,d) table, closed form for rho = 1), near field, sparse 3x3, blur
- *      ([P4] §3-7; [P4] §3-11)
+ *      ([P4] §3-11)
  *  10. The mipmap baseline ([P4] §5)
  *  11. Error metrics ([P4] §8; docs/errata.md E36)
  *  12. Laine-Karras bitmask ray-cast AO: ray sets, receiver frames, exact and table triangle
@@ -28,6 +29,7 @@
  * thesis). Errata and choices: docs/errata.md
  * E19-E38.
  */
+#define HFVIS__INTERNAL /* the internal block of hfvis.h: shared helpers, not API */
 #include "hfvis.h"
 
 #include <float.h>
@@ -37,94 +39,23 @@
 #include <stdlib.h>
 #include <string.h>
 
-#if defined(__clang__)
-#pragma STDC FP_CONTRACT OFF
-#endif
-
-#ifndef HFVIS_ASSERT
-#ifdef HFVIS_ENABLE_ASSERTS
-#include <assert.h>
-#define HFVIS_ASSERT(x) assert(x)
-#else
-#define HFVIS_ASSERT(x) ((void)0)
-#endif
-#endif
-
-/* The allocation behind a NULL allocator (hfvis.h, "Memory"): define both to replace it. */
-#if defined(HFVIS_MALLOC) != defined(HFVIS_FREE)
-#error "define both HFVIS_MALLOC and HFVIS_FREE, or neither"
-#endif
-#ifndef HFVIS_MALLOC
-#define HFVIS_MALLOC(size) malloc(size)
-#define HFVIS_FREE(ptr) free(ptr)
-#endif
-
-#define SS_PI 3.14159265358979323846
-#define SS_INF ((double)INFINITY)
-#define SS_NAN ((double)NAN)
-
 /* ========================================================================================== */
 /* 1. Common                                                                                  */
 /* ========================================================================================== */
-
-static void *ss_alloc(const hfvis_allocator *a, size_t bytes)
-{
-    if (bytes == 0) return NULL;
-    if (a && a->alloc) return a->alloc(a->user, bytes);
-    return HFVIS_MALLOC(bytes);
-}
-
-/* Memory from an allocator without alloc came from HFVIS_MALLOC: it goes back to HFVIS_FREE,
- * whatever free says (hfvis.c's hf_free does the same). */
-static void ss_free(const hfvis_allocator *a, void *p)
-{
-    if (!p) return;
-    if (a && a->alloc) {
-        if (a->free) a->free(a->user, p);
-        return;
-    }
-    HFVIS_FREE(p);
-}
-
-/* a*b into *out; 1 if it does not overflow. */
-static int ss_mul(size_t a, size_t b, size_t *out)
-{
-    if (a != 0 && b > SIZE_MAX / a) return 0;
-    *out = a * b;
-    return 1;
-}
-
-/* 1 if a caller plane of `height` rows `stride` floats apart (stride >= 1) is addressable:
- * height*stride floats fit in PTRDIFF_MAX bytes, so y*stride + x never overflows. */
-static int ss_plane_fits(ptrdiff_t stride, int height)
-{
-    return stride >= 1 && (size_t)height <= (size_t)PTRDIFF_MAX / sizeof(float) / (size_t)stride;
-}
 
 /* a*b*c bytes, 0 on overflow (callers never ask for 0 bytes). */
 static size_t ss_bytes3(size_t a, size_t b, size_t c)
 {
     size_t t, u;
-    if (!ss_mul(a, b, &t) || !ss_mul(t, c, &u)) return 0;
+    if (!hfvis__mul_size(a, b, &t) || !hfvis__mul_size(t, c, &u)) return 0;
     return u;
-}
-
-static int ss_finite(double v) { return v == v && v - v == 0.0; }
-
-/* SplitMix64 finaliser: the library's stateless hash PRNG (no global state). */
-static uint64_t ss_mix(uint64_t z)
-{
-    z += 0x9E3779B97F4A7C15ull;
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
 }
 
 /* Uniform double in [0, 1) from (a, b, c, seed). */
 static double ss_hash01(uint32_t a, uint32_t b, uint32_t c, uint32_t seed)
 {
-    uint64_t h = ss_mix(((uint64_t)seed << 32) ^ (uint64_t)a);
-    h = ss_mix(h ^ ((uint64_t)b << 32) ^ (uint64_t)c);
+    uint64_t h = hfvis__mix64(((uint64_t)seed << 32) ^ (uint64_t)a);
+    h = hfvis__mix64(h ^ ((uint64_t)b << 32) ^ (uint64_t)c);
     return (double)(h >> 11) * (1.0 / 9007199254740992.0);
 }
 
@@ -154,22 +85,22 @@ hfvis_status hfvis_camera_check(const hfvis_camera *cam)
     if (cam->guard_x >= (cam->width + 1) / 2 || cam->guard_y >= (cam->height + 1) / 2)
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (cam->projection == HFVIS_CAMERA_PERSPECTIVE) {
-        if (!(ss_finite(cam->fx) && cam->fx > 0.0 && ss_finite(cam->fy) && cam->fy > 0.0))
+        if (!(isfinite(cam->fx) && cam->fx > 0.0 && isfinite(cam->fy) && cam->fy > 0.0))
             return HFVIS_ERR_INVALID_ARGUMENT;
     } else if (cam->projection == HFVIS_CAMERA_ORTHOGRAPHIC) {
-        if (!(ss_finite(cam->scale_x) && cam->scale_x > 0.0 && ss_finite(cam->scale_y) &&
+        if (!(isfinite(cam->scale_x) && cam->scale_x > 0.0 && isfinite(cam->scale_y) &&
               cam->scale_y > 0.0))
             return HFVIS_ERR_INVALID_ARGUMENT;
     } else {
         return HFVIS_ERR_INVALID_ARGUMENT;
     }
-    if (!ss_finite(cam->cx) || !ss_finite(cam->cy)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!isfinite(cam->cx) || !isfinite(cam->cy)) return HFVIS_ERR_INVALID_ARGUMENT;
     if (!(cam->far_depth >= 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
     if (cam->width > HFVIS_SSAO_MAX_SIZE || cam->height > HFVIS_SSAO_MAX_SIZE)
         return HFVIS_ERR_LIMIT;
     {
         size_t st = (size_t)(cam->stride ? cam->stride : cam->width), n;
-        if (!ss_mul(st, (size_t)cam->height, &n) || !ss_mul(n, 3 * sizeof(float), &n) ||
+        if (!hfvis__mul_size(st, (size_t)cam->height, &n) || !hfvis__mul_size(n, 3 * sizeof(float), &n) ||
             n > (size_t)PTRDIFF_MAX)
             return HFVIS_ERR_LIMIT;
     }
@@ -200,7 +131,7 @@ static hfvis_status ss_cam_load(const hfvis_camera *cam, ss_cam *c)
         c->sx = cam->scale_x;
         c->sy = cam->scale_y;
     }
-    c->far_d = cam->far_depth > 0.0 ? cam->far_depth : SS_INF;
+    c->far_d = cam->far_depth > 0.0 ? cam->far_depth : HFVIS__INF;
     return HFVIS_OK;
 }
 
@@ -225,7 +156,7 @@ hfvis_status hfvis_camera_perspective(hfvis_camera *cam, int width, int height, 
     hfvis_camera c;
     hfvis_status s;
     double f;
-    if (!cam || !(fov_y_rad > 0.0 && fov_y_rad < SS_PI)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!cam || !(fov_y_rad > 0.0 && fov_y_rad < HFVIS__PI)) return HFVIS_ERR_INVALID_ARGUMENT;
     memset(&c, 0, sizeof c);
     c.width = width;
     c.height = height;
@@ -238,7 +169,7 @@ hfvis_status hfvis_camera_perspective(hfvis_camera *cam, int width, int height, 
     s = hfvis_camera_check(&c);
     if (s != HFVIS_OK) return s;
     f = 0.5 * (double)(height - 2 * guard_y) / tan(0.5 * fov_y_rad);
-    if (!(ss_finite(f) && f > 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!(isfinite(f) && f > 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
     c.fx = c.fy = f;
     *cam = c;
     return HFVIS_OK;
@@ -249,7 +180,7 @@ hfvis_status hfvis_camera_orthographic(hfvis_camera *cam, int width, int height,
 {
     hfvis_camera c;
     hfvis_status s;
-    if (!cam || !(ss_finite(pixel_size) && pixel_size > 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!cam || !(isfinite(pixel_size) && pixel_size > 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
     memset(&c, 0, sizeof c);
     c.width = width;
     c.height = height;
@@ -276,7 +207,7 @@ hfvis_status hfvis_camera_from_view(hfvis_camera *cam, const struct hfvis_view *
     if (!cam || !view) return HFVIS_ERR_INVALID_ARGUMENT;
     P = view->proj;
     for (i = 0; i < 16; i++)
-        if (!ss_finite(P[i])) return HFVIS_ERR_INVALID_ARGUMENT;
+        if (!isfinite(P[i])) return HFVIS_ERR_INVALID_ARGUMENT;
     W = (double)view->width;
     H = (double)view->height;
     memset(&c, 0, sizeof c);
@@ -327,7 +258,7 @@ hfvis_status hfvis_camera_from_view(hfvis_camera *cam, const struct hfvis_view *
 static int ss_depth_form(int ortho, double alpha, double beta, hfvis_projection_depth *pd)
 {
     double n, f;
-    if (!ss_finite(alpha) || !ss_finite(beta) || beta == 0.0) return 0;
+    if (!isfinite(alpha) || !isfinite(beta) || beta == 0.0) return 0;
     if (ortho) {
         if (beta > 0.0) { /* d(n) = 0, d(f) = 1 */
             n = -alpha / beta;
@@ -338,14 +269,14 @@ static int ss_depth_form(int ortho, double alpha, double beta, hfvis_projection_
             f = -alpha / beta;
             pd->encoding = HFVIS_DEPTH_REVERSED_Z;
         }
-        if (!(n >= 0.0 && f > n && ss_finite(f))) return 0;
+        if (!(n >= 0.0 && f > n && isfinite(f))) return 0;
     } else if (alpha == 1.0 && beta < 0.0) { /* d = 1 - n/z */
         n = -beta;
-        f = SS_INF;
+        f = HFVIS__INF;
         pd->encoding = HFVIS_DEPTH_INFINITE_FAR;
     } else if (alpha == 0.0 && beta > 0.0) { /* d = n/z */
         n = beta;
-        f = SS_INF;
+        f = HFVIS__INF;
         pd->encoding = HFVIS_DEPTH_REVERSED_INFINITE;
     } else {
         if (beta < 0.0) { /* d = f/(f - n) - f n/((f - n) z) */
@@ -357,9 +288,9 @@ static int ss_depth_form(int ortho, double alpha, double beta, hfvis_projection_
             f = -beta / alpha;
             pd->encoding = HFVIS_DEPTH_REVERSED_Z;
         }
-        if (!(n > 0.0 && f > n && ss_finite(f))) return 0;
+        if (!(n > 0.0 && f > n && isfinite(f))) return 0;
     }
-    if (!(n > 0.0 || (ortho && n == 0.0)) || !ss_finite(n)) return 0;
+    if (!(n > 0.0 || (ortho && n == 0.0)) || !isfinite(n)) return 0;
     pd->orthographic = ortho;
     pd->near_plane = n;
     pd->far_plane = f;
@@ -378,7 +309,7 @@ hfvis_status hfvis_camera_from_matrix(hfvis_camera *cam, const double m[16],
     if (!cam || !m || (clip != HFVIS_CLIP_DEPTH_GL && clip != HFVIS_CLIP_DEPTH_ZERO_TO_ONE))
         return HFVIS_ERR_INVALID_ARGUMENT;
     for (k = 0; k < 16; k++)
-        if (!ss_finite(m[k])) return HFVIS_ERR_INVALID_ARGUMENT;
+        if (!isfinite(m[k])) return HFVIS_ERR_INVALID_ARGUMENT;
     for (r = 0; r < 4; r++)
         for (k = 0; k < 4; k++) A[r][k] = m[4 * k + r];
     /* clip = A v; no shear between x and y, and x, y independent of the view z offset */
@@ -427,13 +358,13 @@ hfvis_status hfvis_camera_from_matrix(hfvis_camera *cam, const double m[16],
     }
     if (!ss_depth_form(ortho, alpha, beta, &pd)) return HFVIS_ERR_INVALID_ARGUMENT;
     /* The far plane as a float depth buffer holds it, so a cleared pixel is background. */
-    if (ss_finite(pd.far_plane)) {
+    if (isfinite(pd.far_plane)) {
         double ff = (double)(float)pd.far_plane;
         c.far_depth = ff < pd.far_plane ? ff : pd.far_plane;
     }
     st = hfvis_camera_check(&c);
     if (st != HFVIS_OK) return st;
-    if (c.projection == HFVIS_CAMERA_PERSPECTIVE && !(ss_finite(c.fx) && ss_finite(c.fy)))
+    if (c.projection == HFVIS_CAMERA_PERSPECTIVE && !(isfinite(c.fx) && isfinite(c.fy)))
         return HFVIS_ERR_INVALID_ARGUMENT;
     *cam = c;
     if (depth) *depth = pd;
@@ -446,7 +377,7 @@ hfvis_status hfvis_camera_unproject(const hfvis_camera *cam, double u, double v,
     ss_cam c;
     hfvis_status s = ss_cam_load(cam, &c);
     if (s != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (!out || !ss_finite(u) || !ss_finite(v) || !ss_finite(depth))
+    if (!out || !isfinite(u) || !isfinite(v) || !isfinite(depth))
         return HFVIS_ERR_INVALID_ARGUMENT;
     ss_unproject(&c, u, v, depth, out);
     return HFVIS_OK;
@@ -459,7 +390,7 @@ hfvis_status hfvis_camera_project(const hfvis_camera *cam, const double p[3], do
     double d;
     hfvis_status s = ss_cam_load(cam, &c);
     if (s != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (!p || !u || !v || !depth || !ss_finite(p[0]) || !ss_finite(p[1]) || !ss_finite(p[2]))
+    if (!p || !u || !v || !depth || !isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]))
         return HFVIS_ERR_INVALID_ARGUMENT;
     d = -p[2];
     if (c.persp) {
@@ -480,22 +411,22 @@ static int ss_depth_params(hfvis_depth_encoding e, int ortho, double n, double f
     if (ortho != 0 && ortho != 1) return 0;
     if (e < HFVIS_DEPTH_GL || e > HFVIS_DEPTH_REVERSED_INFINITE) return 0;
     if (e == HFVIS_DEPTH_INFINITE_FAR || e == HFVIS_DEPTH_REVERSED_INFINITE)
-        return !ortho && ss_finite(n) && n > 0.0;
-    if (!ss_finite(n) || !ss_finite(f) || !(n < f)) return 0;
+        return !ortho && isfinite(n) && n > 0.0;
+    if (!isfinite(n) || !isfinite(f) || !(n < f)) return 0;
     return ortho ? n >= 0.0 : n > 0.0;
 }
 
 double hfvis_depth_linear(double d, hfvis_depth_encoding e, int ortho, double n, double f)
 {
     double z;
-    if (!ss_depth_params(e, ortho, n, f)) return SS_NAN;
-    if (!ss_finite(d)) return SS_INF;
+    if (!ss_depth_params(e, ortho, n, f)) return HFVIS__NAN;
+    if (!isfinite(d)) return HFVIS__INF;
     if (e == HFVIS_DEPTH_GL_NDC) {
-        if (!(d >= -1.0 && d <= 1.0)) return SS_INF;
+        if (!(d >= -1.0 && d <= 1.0)) return HFVIS__INF;
         d = 0.5 * (d + 1.0);
         e = HFVIS_DEPTH_GL;
     }
-    if (!(d >= 0.0 && d <= 1.0)) return SS_INF;
+    if (!(d >= 0.0 && d <= 1.0)) return HFVIS__INF;
     switch (e) {
     case HFVIS_DEPTH_GL:
     case HFVIS_DEPTH_D3D:
@@ -505,20 +436,20 @@ double hfvis_depth_linear(double d, hfvis_depth_encoding e, int ortho, double n,
         z = ortho ? f - d * (f - n) : n * f / (n + d * (f - n));
         break;
     case HFVIS_DEPTH_INFINITE_FAR:
-        z = d < 1.0 ? n / (1.0 - d) : SS_INF;
+        z = d < 1.0 ? n / (1.0 - d) : HFVIS__INF;
         break;
     default: /* HFVIS_DEPTH_REVERSED_INFINITE */
-        z = d > 0.0 ? n / d : SS_INF;
+        z = d > 0.0 ? n / d : HFVIS__INF;
         break;
     }
-    return ss_finite(z) ? z : SS_INF;
+    return isfinite(z) ? z : HFVIS__INF;
 }
 
 double hfvis_depth_hardware(double z, hfvis_depth_encoding e, int ortho, double n, double f)
 {
     double d;
-    if (!ss_depth_params(e, ortho, n, f) || z != z) return SS_NAN;
-    if (!ortho && !(z > 0.0)) return SS_NAN;
+    if (!ss_depth_params(e, ortho, n, f) || z != z) return HFVIS__NAN;
+    if (!ortho && !(z > 0.0)) return HFVIS__NAN;
     switch (e) {
     case HFVIS_DEPTH_GL:
     case HFVIS_DEPTH_GL_NDC:
@@ -545,7 +476,7 @@ hfvis_status hfvis_depth_linearize(const float *in, int width, int height, ptrdi
 {
     int x, y;
     if (!in || !out || width < 1 || height < 1 || in_stride < width || out_stride < width ||
-        !ss_plane_fits(in_stride, height) || !ss_plane_fits(out_stride, height))
+        !hfvis__plane_fits(in_stride, height, 1) || !hfvis__plane_fits(out_stride, height, 1))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (!ss_depth_params(e, ortho, n, f)) return HFVIS_ERR_INVALID_ARGUMENT;
     for (y = 0; y < height; y++) {
@@ -574,7 +505,7 @@ static void ss_cross3(const double a[3], const double b[3], double out[3])
 static int ss_normalize3(double v[3])
 {
     double l = sqrt(ss_dot3(v, v));
-    if (!(l > 0.0) || !ss_finite(l)) return 0;
+    if (!(l > 0.0) || !isfinite(l)) return 0;
     v[0] /= l;
     v[1] /= l;
     v[2] /= l;
@@ -702,13 +633,13 @@ hfvis_status hfvis_falloff_check(const hfvis_falloff *f)
     case HFVIS_FALLOFF_INV_QUADRATIC:
     case HFVIS_FALLOFF_EXPONENTIAL:
     case HFVIS_FALLOFF_STEP:
-        return ss_finite(f->param) && f->param > 0.0 ? HFVIS_OK : HFVIS_ERR_INVALID_ARGUMENT;
+        return isfinite(f->param) && f->param > 0.0 ? HFVIS_OK : HFVIS_ERR_INVALID_ARGUMENT;
     case HFVIS_FALLOFF_HBAO:
-        if (!(ss_finite(f->param) && f->param > 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
-        return ss_finite(f->hbao_c) && f->hbao_c >= 0.0 ? HFVIS_OK : HFVIS_ERR_INVALID_ARGUMENT;
+        if (!(isfinite(f->param) && f->param > 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
+        return isfinite(f->hbao_c) && f->hbao_c >= 0.0 ? HFVIS_OK : HFVIS_ERR_INVALID_ARGUMENT;
     case HFVIS_FALLOFF_CUSTOM:
         if (!f->fn) return HFVIS_ERR_INVALID_ARGUMENT;
-        return ss_finite(f->param) && f->param >= 0.0 ? HFVIS_OK : HFVIS_ERR_INVALID_ARGUMENT;
+        return isfinite(f->param) && f->param >= 0.0 ? HFVIS_OK : HFVIS_ERR_INVALID_ARGUMENT;
     }
     return HFVIS_ERR_INVALID_ARGUMENT;
 }
@@ -727,7 +658,7 @@ static hfvis_status ss_fall_load(const hfvis_falloff *f, ss_fall *o)
     memset(o, 0, sizeof *o);
     o->kind = f->kind == HFVIS_FALLOFF_DEFAULT ? HFVIS_FALLOFF_NONE : (int)f->kind;
     o->a = f->param;
-    o->support = SS_INF;
+    o->support = HFVIS__INF;
     switch (o->kind) {
     case HFVIS_FALLOFF_HBAO:
         o->c = f->hbao_c > 0.0 ? f->hbao_c : 0.3;
@@ -787,19 +718,19 @@ static double ss_rho_general(const ss_fall *f, double d)
 double hfvis_falloff_eval(const hfvis_falloff *f, double distance)
 {
     ss_fall o;
-    if (ss_fall_load(f, &o) != HFVIS_OK || distance != distance) return SS_NAN;
+    if (ss_fall_load(f, &o) != HFVIS_OK || distance != distance) return HFVIS__NAN;
     return ss_rho(&o, distance);
 }
 
 double hfvis_falloff_support(const hfvis_falloff *f)
 {
     ss_fall o;
-    if (ss_fall_load(f, &o) != HFVIS_OK) return SS_NAN;
+    if (ss_fall_load(f, &o) != HFVIS_OK) return HFVIS__NAN;
     return o.support;
 }
 
 /* ========================================================================================== */
-/* 4. Line plane, directions, lattice ([P3] §5.1-5.2, [P4] §6; [P3] §5.1, [P4] §6; docs/errata.md E20, E21; docs/errata.md E24) */
+/* 4. Line plane, directions, lattice ([P3] §5.1-5.2, [P4] §6; docs/errata.md E20, E21, E24) */
 /* ========================================================================================== */
 
 /* e1 of screen direction (du, dv) (docs/errata.md E20, E21; unit, z = 0). */
@@ -842,8 +773,8 @@ hfvis_status hfvis_camera_line_plane(const hfvis_camera *cam, const double ref[3
     ss_cam c;
     double a[3], b[3];
     if (ss_cam_load(cam, &c) != HFVIS_OK || !ref || !e1 || !yhat) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (!ss_finite(ref[0]) || !ss_finite(ref[1]) || !ss_finite(ref[2]) || !ss_finite(du) ||
-        !ss_finite(dv) || (du == 0.0 && dv == 0.0))
+    if (!isfinite(ref[0]) || !isfinite(ref[1]) || !isfinite(ref[2]) || !isfinite(du) ||
+        !isfinite(dv) || (du == 0.0 && dv == 0.0))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (c.persp && !(ref[2] < 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
     ss_plane_e1(&c, du, dv, a);
@@ -856,7 +787,7 @@ hfvis_status hfvis_camera_line_plane(const hfvis_camera *cam, const double ref[3
 
 #define SS_MIN_STEP (1.0 / 64.0)
 
-static int ss_step_ok(double s) { return ss_finite(s) && s >= SS_MIN_STEP && s <= (double)HFVIS_SSAO_MAX_SIZE; }
+static int ss_step_ok(double s) { return isfinite(s) && s >= SS_MIN_STEP && s <= (double)HFVIS_SSAO_MAX_SIZE; }
 
 /* Snap components within 1e-15 of 0 or +-1. */
 static double ss_snap_unit(double v)
@@ -871,11 +802,11 @@ hfvis_status hfvis_ssao_directions_uniform(int K, double azimuth0_rad, double st
                                            double spacing, hfvis_ssao_direction *out)
 {
     int k;
-    if (!out || K < 1 || K > HFVIS_SSAO_MAX_DIRECTIONS || !ss_finite(azimuth0_rad) ||
+    if (!out || K < 1 || K > HFVIS_SSAO_MAX_DIRECTIONS || !isfinite(azimuth0_rad) ||
         !ss_step_ok(step) || !ss_step_ok(spacing))
         return HFVIS_ERR_INVALID_ARGUMENT;
     for (k = 0; k < K; k++) {
-        double psi = azimuth0_rad + 2.0 * SS_PI * (double)k / (double)K;
+        double psi = azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K;
         hfvis_ssao_direction *d = &out[k];
         d->dx = ss_snap_unit(cos(psi));
         d->dy = ss_snap_unit(sin(psi));
@@ -892,7 +823,7 @@ hfvis_status hfvis_ssao_directions_uniform(int K, double azimuth0_rad, double st
 static double ss_azimuth(double i, double j)
 {
     double a = atan2(j, i);
-    return a < 0.0 ? a + 2.0 * SS_PI : a;
+    return a < 0.0 ? a + 2.0 * HFVIS__PI : a;
 }
 
 hfvis_status hfvis_ssao_directions_box(int n, int scale, double spacing,
@@ -943,8 +874,8 @@ hfvis_status hfvis_ssao_directions_box(int n, int scale, double spacing,
         double a0 = ss_azimuth(out[(k + K - 1) % K].step_x, out[(k + K - 1) % K].step_y);
         double a2 = ss_azimuth(out[(k + 1) % K].step_x, out[(k + 1) % K].step_y);
         double gap = a2 - a0;
-        if (gap < 0.0) gap += 2.0 * SS_PI;
-        out[k].weight = gap / (4.0 * SS_PI);
+        if (gap < 0.0) gap += 2.0 * HFVIS__PI;
+        out[k].weight = gap / (4.0 * HFVIS__PI);
     }
     return HFVIS_OK;
 }
@@ -952,8 +883,8 @@ hfvis_status hfvis_ssao_directions_box(int n, int scale, double spacing,
 static int ss_dir_ok(const hfvis_ssao_direction *d)
 {
     double l;
-    if (!d || !ss_finite(d->dx) || !ss_finite(d->dy) || !ss_step_ok(d->step) ||
-        !ss_step_ok(d->spacing) || !ss_finite(d->step_x) || !ss_finite(d->step_y))
+    if (!d || !isfinite(d->dx) || !isfinite(d->dy) || !ss_step_ok(d->step) ||
+        !ss_step_ok(d->spacing) || !isfinite(d->step_x) || !isfinite(d->step_y))
         return 0;
     l = d->dx * d->dx + d->dy * d->dy;
     if (fabs(l - 1.0) > 1e-9) return 0;
@@ -968,7 +899,7 @@ static void ss_line_range(const ss_cam *c, const hfvis_ssao_lattice *L, int j, h
 {
     const double eps = 1e-7;
     double s = L->s_first + (double)j * L->dir.spacing;
-    double ox = s * L->px, oy = s * L->py, tlo = -SS_INF, thi = SS_INF;
+    double ox = s * L->px, oy = s * L->py, tlo = -HFVIS__INF, thi = HFVIS__INF;
     double D[2], O[2], lo[2], hi[2];
     double fa, fb;
     int a;
@@ -1010,7 +941,7 @@ static hfvis_status ss_lattice_init(const ss_cam *c, const hfvis_ssao_direction 
                                     hfvis_ssao_lattice *lat)
 {
     hfvis_ssao_lattice L;
-    double cu[4], cv[4], smin = SS_INF, smax = -SS_INF, tmin = SS_INF, span, nl;
+    double cu[4], cv[4], smin = HFVIS__INF, smax = -HFVIS__INF, tmin = HFVIS__INF, span, nl;
     size_t total = 0;
     int k, j, maxc = 0;
     memset(&L, 0, sizeof L);
@@ -1117,7 +1048,7 @@ static int ss_nearest(const hfvis_ssao_lattice *L, const hfvis_ssao_line *lines,
 int hfvis_ssao_lattice_nearest(const hfvis_ssao_lattice *lat, const hfvis_ssao_line *lines,
                                double u, double v, int *line, int *step)
 {
-    if (!lat || !lines || !line || !step || !ss_finite(u) || !ss_finite(v)) return 0;
+    if (!lat || !lines || !line || !step || !isfinite(u) || !isfinite(v)) return 0;
     if (!(lat->dir.spacing > 0.0) || !(lat->dir.step > 0.0)) return 0;
     return ss_nearest(lat, lines, u, v, line, step);
 }
@@ -1214,8 +1145,8 @@ hfvis_status hfvis_lsao_options_resolve(const hfvis_lsao_options *in, hfvis_lsao
     if (K < 1 || K > HFVIS_SSAO_MAX_DIRECTIONS) return HFVIS_ERR_INVALID_ARGUMENT;
     o.directions = K;
     if (o.pattern == HFVIS_SSAO_PATTERN_DEFAULT) o.pattern = HFVIS_SSAO_PATTERN_BOX;
-    if (o.box_scale < 0 || !ss_finite(o.step) || !ss_finite(o.spacing) ||
-        !ss_finite(o.azimuth0_rad))
+    if (o.box_scale < 0 || !isfinite(o.step) || !isfinite(o.spacing) ||
+        !isfinite(o.azimuth0_rad))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (o.box_scale == 0) o.box_scale = 1;
     if (o.step == 0.0) o.step = 1.0;
@@ -1234,11 +1165,11 @@ hfvis_status hfvis_lsao_options_resolve(const hfvis_lsao_options *in, hfvis_lsao
         if (!o.custom_directions) return HFVIS_ERR_INVALID_ARGUMENT;
         for (k = 0; k < K; k++) {
             const hfvis_ssao_direction *d = &o.custom_directions[k];
-            if (!ss_dir_ok(d) || !ss_finite(d->weight) || d->weight < 0.0)
+            if (!ss_dir_ok(d) || !isfinite(d->weight) || d->weight < 0.0)
                 return HFVIS_ERR_INVALID_ARGUMENT;
             ws += d->weight;
         }
-        if (!(ws > 0.0) || !ss_finite(ws)) return HFVIS_ERR_INVALID_ARGUMENT;
+        if (!(ws > 0.0) || !isfinite(ws)) return HFVIS_ERR_INVALID_ARGUMENT;
         break;
     }
     default:
@@ -1319,7 +1250,7 @@ static double ss_occ(const ss_fall *f, double hx, double hy, double ux, double u
 {
     double len = sqrt(hx * hx + hy * hy), s;
     if (!(len > tiny)) {
-        *sin_out = -SS_INF;
+        *sin_out = -HFVIS__INF;
         return st;
     }
     s = (hx * ux + hy * uy) / len;
@@ -1327,7 +1258,7 @@ static double ss_occ(const ss_fall *f, double hx, double hy, double ux, double u
     return s > st ? st + (s - st) * ss_rho(f, len) : st;
 }
 
-/* The obscurity hull along one line ([P3] Alg. 1, [P3] §4.2, Alg. 1). */
+/* The obscurity hull along one line ([P3] §4.2, Alg. 1). */
 static void ss_hull_line(const double *x, const double *y, const double *stc, const double *ste,
                          int n, int persp, double fixed, const ss_fall *f, int ties, int *stack,
                          double *out)
@@ -1335,14 +1266,14 @@ static void ss_hull_line(const double *x, const double *y, const double *stc, co
     int top = 0, i;
     for (i = 0; i < n; i++) {
         double px = x[i], py = y[i], r, ux, uy, sc, se, tiny, o1 = 0.0, s1 = 0.0, o2, s2;
-        if (!ss_finite(px) || !ss_finite(py)) {
-            out[i] = SS_NAN;
+        if (!isfinite(px) || !isfinite(py)) {
+            out[i] = HFVIS__NAN;
             continue;
         }
         r = sqrt(px * px + py * py);
         if (persp) {
             if (!(r > 0.0)) {
-                out[i] = SS_NAN;
+                out[i] = HFVIS__NAN;
                 continue;
             }
             ux = -px / r; /* l.7: unit vector towards the camera */
@@ -1378,7 +1309,7 @@ static void ss_hull_line(const double *x, const double *y, const double *stc, co
             double s;
             out[i] = ss_occ(f, x[a] - px, y[a] - py, ux, uy, se, tiny, &s);
         }
-        if (top == 0 || s1 != -SS_INF) stack[top++] = i; /* l.21 (coincident points skipped) */
+        if (top == 0 || s1 != -HFVIS__INF) stack[top++] = i; /* l.21 (coincident points skipped) */
     }
 }
 
@@ -1389,16 +1320,16 @@ static void ss_hull_line_naive(const double *x, const double *y, const double *s
 {
     int i, j;
     for (i = 0; i < n; i++) {
-        double px = x[i], py = y[i], r, ux, uy, sc, se, tiny, maxs = -SS_INF, bo = 0.0, bs = 0.0;
+        double px = x[i], py = y[i], r, ux, uy, sc, se, tiny, maxs = -HFVIS__INF, bo = 0.0, bs = 0.0;
         int best = -1;
-        if (!ss_finite(px) || !ss_finite(py)) {
-            out[i] = SS_NAN;
+        if (!isfinite(px) || !isfinite(py)) {
+            out[i] = HFVIS__NAN;
             continue;
         }
         r = sqrt(px * px + py * py);
         if (persp) {
             if (!(r > 0.0)) {
-                out[i] = SS_NAN;
+                out[i] = HFVIS__NAN;
                 continue;
             }
             ux = -px / r;
@@ -1412,7 +1343,7 @@ static void ss_hull_line_naive(const double *x, const double *y, const double *s
         se = ste ? ste[i] : fixed;
         for (j = i - 1; j >= 0; j--) {
             double s, o;
-            if (!ss_finite(x[j]) || !ss_finite(y[j])) continue;
+            if (!isfinite(x[j]) || !isfinite(y[j])) continue;
             if (persp && !(x[j] * x[j] + y[j] * y[j] > 0.0)) continue;
             o = ss_occ(f, x[j] - px, y[j] - py, ux, uy, sc, tiny, &s);
             if (!(s > maxs)) continue; /* hidden behind a nearer point */
@@ -1480,7 +1411,7 @@ static double ss_sample(const ss_cam *c, const float *depth, int bilinear, doubl
         z = ss_tex(c, depth, tx, ty);
         *qu = (double)tx + 0.5;
         *qv = (double)ty + 0.5;
-        return ss_bg(c, z) ? SS_NAN : z;
+        return ss_bg(c, z) ? HFVIS__NAN : z;
     } else {
         double a = u - 0.5, b = v - 0.5, fa, fb, z00, z10, z01, z11;
         int x0, y0, x1, y1;
@@ -1504,7 +1435,7 @@ static double ss_sample(const ss_cam *c, const float *depth, int bilinear, doubl
         *qv = v;
         if ((fa < 1.0 && fb < 1.0 && ss_bg(c, z00)) || (fa > 0.0 && fb < 1.0 && ss_bg(c, z10)) ||
             (fa < 1.0 && fb > 0.0 && ss_bg(c, z01)) || (fa > 0.0 && fb > 0.0 && ss_bg(c, z11)))
-            return SS_NAN;
+            return HFVIS__NAN;
         if (fa == 0.0) z10 = z00, z11 = z01; /* zero weights never touch a background tap */
         if (fb == 0.0) z01 = z00, z11 = z10;
         if (fa == 1.0) z00 = z10, z01 = z11;
@@ -1524,7 +1455,7 @@ static int ss_texel(double p, int n)
     return (int)f;
 }
 
-/* sin t of the real tangent of a sample ([P3] §4.1, [P3] §4.1, Fig. 7): normal of texel (tx, ty)
+/* sin t of the real tangent of a sample ([P3] §4.1, Fig. 7): normal of texel (tx, ty)
  * projected into the plane, t = side*(-n2.y, n2.x) (side +1: toward the occluders behind, as
  * LSAO; -1: ahead, as HBAO), sin t = t.u/|t|; the fixed value without a usable normal. */
 static double ss_real_sin_t(const ss_cam *c, const float *normals, int tx, int ty,
@@ -1541,7 +1472,7 @@ static double ss_real_sin_t(const ss_cam *c, const float *normals, int tx, int t
     tx2 = -side * n2y;
     ty2 = side * n2x;
     l = sqrt(tx2 * tx2 + ty2 * ty2);
-    if (!(l > 1e-12) || !ss_finite(l)) return fixed;
+    if (!(l > 1e-12) || !isfinite(l)) return fixed;
     return (tx2 * ux + ty2 * uy) / l;
 }
 
@@ -1599,14 +1530,14 @@ static void ss_line_points(const ss_cam *c, const ss_cfg *g, const float *depth,
             z = ss_sample(c, depth, 1, u, v, tx, ty, &qu, &qv);
         } else { /* ss_sample's NEAREST branch, inline */
             z = ss_tex(c, depth, tx, ty);
-            if (ss_bg(c, z)) z = SS_NAN;
+            if (ss_bg(c, z)) z = HFVIS__NAN;
             qu = (double)tx + 0.5;
             qv = (double)ty + 0.5;
             if (g->exact && !integral) ss_onto_line(ln->x0, ln->y0, d->dx, d->dy, &qu, &qv);
         }
         if (zs) zs[k] = (float)z;
         if (z != z) {
-            x[k] = y[k] = SS_NAN;
+            x[k] = y[k] = HFVIS__NAN;
             if (st_real) st_real[k] = g->fixed;
             continue;
         }
@@ -1660,12 +1591,12 @@ static int ss_lattice_ok(const hfvis_ssao_lattice *L, const hfvis_ssao_line *lin
     size_t off = 0;
     int j;
     if (!L || !lines || !ss_dir_ok(&L->dir) || L->line_count < 0 || L->max_line_samples < 0 ||
-        !ss_finite(L->s_first) || !ss_finite(L->t_min) || !ss_finite(L->px) || !ss_finite(L->py))
+        !isfinite(L->s_first) || !isfinite(L->t_min) || !isfinite(L->px) || !isfinite(L->py))
         return 0;
     for (j = 0; j < L->line_count; j++) {
         const hfvis_ssao_line *ln = &lines[j];
         if (ln->count < 0 || ln->count > L->max_line_samples || ln->offset != off ||
-            !ss_finite(ln->x0) || !ss_finite(ln->y0) ||
+            !isfinite(ln->x0) || !isfinite(ln->y0) ||
             (ln->count > 0 && ln->first > INT_MAX - ln->count))
             return 0;
         off += (size_t)ln->count;
@@ -1695,20 +1626,20 @@ static hfvis_status ss_lsao_direction(const hfvis_camera *cam, const float *dept
     if (!bytes) return HFVIS_ERR_OUT_OF_MEMORY;
     if (g.tangent != HFVIS_SSAO_TANGENT_FIXED && !normals) {
         nb = ss_bytes3((size_t)c.stride, (size_t)c.H, 3 * sizeof(float));
-        nrm = (float *)ss_alloc(o.alloc, nb);
+        nrm = (float *)hfvis__alloc(o.alloc, nb);
         if (!nrm) return HFVIS_ERR_OUT_OF_MEMORY;
         ss_normals_fill(&c, depth, nrm);
         normals = nrm;
     }
-    blk = ss_alloc(o.alloc, bytes);
+    blk = hfvis__alloc(o.alloc, bytes);
     if (!blk) {
-        ss_free(o.alloc, nrm);
+        hfvis__free(o.alloc, nrm);
         return HFVIS_ERR_OUT_OF_MEMORY;
     }
     ss_lsao_sweep_dir(&c, &g, depth, normals, lat, lines, (double *)blk,
                       (int *)((double *)blk + 4 * M), naive, values, sample_depth);
-    ss_free(o.alloc, blk);
-    ss_free(o.alloc, nrm);
+    hfvis__free(o.alloc, blk);
+    hfvis__free(o.alloc, nrm);
     return HFVIS_OK;
 }
 
@@ -1869,7 +1800,7 @@ hfvis_status hfvis_lsao_gather(const hfvis_camera *cam, const float *depth, cons
     hfvis_lsao_options o;
     if (ss_cam_load(cam, &c) != HFVIS_OK || hfvis_lsao_options_resolve(opts, &o) != HFVIS_OK ||
         !depth || !values || !sample_depth || !sum || !weight || !ss_lattice_ok(lat, lines) ||
-        !ss_finite(lat->dir.weight))
+        !isfinite(lat->dir.weight))
         return HFVIS_ERR_INVALID_ARGUMENT;
     ss_cfg_from_lsao(&o, &g);
     ss_gather_dir(&c, &g, depth, normals, lat, lines, values, sample_depth, sum, weight);
@@ -1912,11 +1843,11 @@ hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth, const float
         return HFVIS_ERR_INVALID_ARGUMENT;
     W = c.W - 2 * c.gx;
     H = c.H - 2 * c.gy;
-    if (ao_stride < W || !ss_plane_fits(ao_stride, H)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (ao_stride < W || !hfvis__plane_fits(ao_stride, H, 1)) return HFVIS_ERR_INVALID_ARGUMENT;
     ss_cfg_from_lsao(&o, &g);
     K = o.directions;
-    if (!ss_mul((size_t)W, (size_t)H, &npix)) return HFVIS_ERR_LIMIT;
-    dirs = (hfvis_ssao_direction *)ss_alloc(o.alloc, sizeof *dirs * (size_t)K);
+    if (!hfvis__mul_size((size_t)W, (size_t)H, &npix)) return HFVIS_ERR_LIMIT;
+    dirs = (hfvis_ssao_direction *)hfvis__alloc(o.alloc, sizeof *dirs * (size_t)K);
     if (!dirs) return HFVIS_ERR_OUT_OF_MEMORY;
     ss_lsao_dirs(&o, dirs);
     for (k = 0; k < K; k++) {
@@ -1929,17 +1860,17 @@ hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth, const float
     s = HFVIS_ERR_OUT_OF_MEMORY;
     if (g.tangent != HFVIS_SSAO_TANGENT_FIXED && !normals) {
         b = ss_bytes3((size_t)c.stride, (size_t)c.H, 3 * sizeof(float));
-        if (!b || !(nrm = (float *)ss_alloc(o.alloc, b))) goto done;
+        if (!b || !(nrm = (float *)hfvis__alloc(o.alloc, b))) goto done;
         ss_normals_fill(&c, depth, nrm);
     }
     b = ss_bytes3((size_t)(maxl > 0 ? maxl : 1), 1, sizeof *lines);
-    if (!b || !(lines = (hfvis_ssao_line *)ss_alloc(o.alloc, b))) goto done;
+    if (!b || !(lines = (hfvis_ssao_line *)hfvis__alloc(o.alloc, b))) goto done;
     b = ss_bytes3(maxs > 0 ? maxs : 1, 2, sizeof(float));
-    if (!b || !(vals = (float *)ss_alloc(o.alloc, b))) goto done;
+    if (!b || !(vals = (float *)hfvis__alloc(o.alloc, b))) goto done;
     b = ss_bytes3((size_t)(maxm > 0 ? maxm : 1), 1, 4 * sizeof(double) + sizeof(int));
-    if (!b || !(scratch = (double *)ss_alloc(o.alloc, b))) goto done;
+    if (!b || !(scratch = (double *)hfvis__alloc(o.alloc, b))) goto done;
     b = ss_bytes3(npix, 2, sizeof(double));
-    if (!b || !(acc = (double *)ss_alloc(o.alloc, b))) goto done;
+    if (!b || !(acc = (double *)hfvis__alloc(o.alloc, b))) goto done;
     for (b = 0; b < 2 * npix; b++) acc[b] = 0.0;
     for (k = 0; k < K; k++) {
         ss_lattice_init(&c, &dirs[k], &lat);
@@ -1953,12 +1884,12 @@ hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth, const float
     ss_finish(&c, depth, acc, acc + npix, ao, ao_stride);
     s = HFVIS_OK;
 done:
-    ss_free(o.alloc, acc);
-    ss_free(o.alloc, scratch);
-    ss_free(o.alloc, vals);
-    ss_free(o.alloc, lines);
-    ss_free(o.alloc, nrm);
-    ss_free(o.alloc, dirs);
+    hfvis__free(o.alloc, acc);
+    hfvis__free(o.alloc, scratch);
+    hfvis__free(o.alloc, vals);
+    hfvis__free(o.alloc, lines);
+    hfvis__free(o.alloc, nrm);
+    hfvis__free(o.alloc, dirs);
     return s;
 }
 
@@ -1992,24 +1923,24 @@ hfvis_status hfvis_hbao_options_resolve(const hfvis_hbao_options *in, hfvis_hbao
     if (in) o = *in;
     else memset(&o, 0, sizeof o);
     K = o.directions ? o.directions : SS_HBAO_DEFAULT_K;
-    if (K < 1 || K > HFVIS_SSAO_MAX_DIRECTIONS || !ss_finite(o.azimuth0_rad))
+    if (K < 1 || K > HFVIS_SSAO_MAX_DIRECTIONS || !isfinite(o.azimuth0_rad))
         return HFVIS_ERR_INVALID_ARGUMENT;
     o.directions = K;
     if (o.custom_directions) {
         double ws = 0.0;
         for (k = 0; k < K; k++) {
             const hfvis_ssao_direction *d = &o.custom_directions[k];
-            if (!ss_dir_ok(d) || !ss_finite(d->weight) || d->weight < 0.0)
+            if (!ss_dir_ok(d) || !isfinite(d->weight) || d->weight < 0.0)
                 return HFVIS_ERR_INVALID_ARGUMENT;
             ws += d->weight;
         }
-        if (!(ws > 0.0) || !ss_finite(ws)) return HFVIS_ERR_INVALID_ARGUMENT;
+        if (!(ws > 0.0) || !isfinite(ws)) return HFVIS_ERR_INVALID_ARGUMENT;
     }
     if (o.variant == HFVIS_HBAO_DEFAULT) o.variant = HFVIS_HBAO_INCREMENTAL;
     if (o.variant < HFVIS_HBAO_INCREMENTAL || o.variant > HFVIS_HBAO_LARGEST_OCCLUDER)
         return HFVIS_ERR_INVALID_ARGUMENT;
-    if (o.steps < 0 || !ss_finite(o.step_px) || !ss_finite(o.radius) || o.radius < 0.0 ||
-        !ss_finite(o.max_radius_px) || o.max_radius_px < 0.0)
+    if (o.steps < 0 || !isfinite(o.step_px) || !isfinite(o.radius) || o.radius < 0.0 ||
+        !isfinite(o.max_radius_px) || o.max_radius_px < 0.0)
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (o.step_px == 0.0) o.step_px = 1.0;
     if (!ss_step_ok(o.step_px)) return HFVIS_ERR_INVALID_ARGUMENT;
@@ -2053,7 +1984,7 @@ static double ss_hbao_pixel(const ss_cam *c, const hfvis_hbao_options *o, const 
     if (!(maxr < diag)) maxr = diag; /* no sample beyond the diagonal is inside the buffer (and
                                         ceil(R_px / step) then fits an int) */
     if (o->jitter != HFVIS_HBAO_JITTER_NONE)
-        rot = 2.0 * SS_PI / (double)K * ss_hash01((uint32_t)x, (uint32_t)y, 0u, o->seed);
+        rot = 2.0 * HFVIS__PI / (double)K * ss_hash01((uint32_t)x, (uint32_t)y, 0u, o->seed);
     if (o->jitter == HFVIS_HBAO_JITTER_ROTATION_STEP)
         xi = 1.0 - ss_hash01((uint32_t)x, (uint32_t)y, 1u, o->seed); /* (0, 1] */
     for (k = 0; k < K; k++) {
@@ -2065,7 +1996,7 @@ static double ss_hbao_pixel(const ss_cam *c, const hfvis_hbao_options *o, const 
             dy = dirs[k].dy;
             w = dirs[k].weight;
         } else {
-            double psi = o->azimuth0_rad + 2.0 * SS_PI * (double)k / (double)K + rot;
+            double psi = o->azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K + rot;
             dx = ss_snap_unit(cos(psi));
             dy = ss_snap_unit(sin(psi));
             w = 1.0 / (double)K;
@@ -2087,7 +2018,7 @@ static double ss_hbao_pixel(const ss_cam *c, const hfvis_hbao_options *o, const 
                  ? ss_real_sin_t(c, normals, x, y, e1, yh, exact, ux, uy, -1.0, o->fixed_sin_t)
                  : o->fixed_sin_t;
         /* screen radius of the view-space radius along e1 at the receiver's depth */
-        if (support < SS_INF) {
+        if (support < HFVIS__INF) {
             double a = c->persp ? zc * sqrt(dx * c->ifx * dx * c->ifx + dy * c->ify * dy * c->ify)
                                 : sqrt(dx * c->sx * dx * c->sx + dy * c->sy * dy * c->sy);
             rpx = support / a;
@@ -2159,12 +2090,12 @@ hfvis_status hfvis_hbao(const hfvis_camera *cam, const float *depth, const float
         !depth || !ao)
         return HFVIS_ERR_INVALID_ARGUMENT;
     W = c.W - 2 * c.gx;
-    if (ao_stride < W || !ss_plane_fits(ao_stride, c.H - 2 * c.gy)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (ao_stride < W || !hfvis__plane_fits(ao_stride, c.H - 2 * c.gy, 1)) return HFVIS_ERR_INVALID_ARGUMENT;
     ss_fall_load(&o.falloff, &f);
     support = o.radius > 0.0 ? o.radius : f.support;
     if (o.tangent == HFVIS_SSAO_TANGENT_REAL && !normals) {
         size_t b = ss_bytes3((size_t)c.stride, (size_t)c.H, 3 * sizeof(float));
-        if (!b || !(nrm = (float *)ss_alloc(o.alloc, b))) return HFVIS_ERR_OUT_OF_MEMORY;
+        if (!b || !(nrm = (float *)hfvis__alloc(o.alloc, b))) return HFVIS_ERR_OUT_OF_MEMORY;
         ss_normals_fill(&c, depth, nrm);
         normals = nrm;
     }
@@ -2177,7 +2108,7 @@ hfvis_status hfvis_hbao(const hfvis_camera *cam, const float *depth, const float
             }
             ao[(ptrdiff_t)(y - c.gy) * ao_stride + (x - c.gx)] = (float)a;
         }
-    ss_free(o.alloc, nrm);
+    hfvis__free(o.alloc, nrm);
     return HFVIS_OK;
 }
 
@@ -2209,8 +2140,8 @@ hfvis_status hfvis_ssao_rt_options_resolve(const hfvis_ssao_rt_options *in,
     if (in) o = *in;
     else memset(&o, 0, sizeof o);
     if (o.rays < 0 || o.refine_iterations < 0 || o.refine_iterations > 64 ||
-        !ss_finite(o.thickness) || o.thickness < 0.0 ||
-        !ss_finite(o.bias) || o.bias < 0.0 || !ss_finite(o.max_distance) || o.max_distance < 0.0)
+        !isfinite(o.thickness) || o.thickness < 0.0 ||
+        !isfinite(o.bias) || o.bias < 0.0 || !isfinite(o.max_distance) || o.max_distance < 0.0)
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (o.rays == 0) o.rays = SS_RT_DEFAULT_RAYS;
     if (o.refine_iterations == 0) o.refine_iterations = SS_RT_DEFAULT_REFINE;
@@ -2267,11 +2198,11 @@ static double ss_rt_cross(const ss_cam *c, const double O[3], const double w[3],
             den = w[1];
         }
     }
-    if (den == 0.0) return SS_INF;
+    if (den == 0.0) return HFVIS__INF;
     s = num / den;
     /* the screen coordinate is monotone along the ray: a crossing behind the origin means the
      * coordinate tends to an asymptote (the vanishing point) short of k */
-    return s >= 0.0 ? s : SS_INF;
+    return s >= 0.0 ? s : HFVIS__INF;
 }
 
 /* Screen position of O + s w. */
@@ -2295,7 +2226,7 @@ static double ss_rt_bilinear(const ss_rt *t, int ix, int iy, double u, double v)
     double a = u - ((double)ix + 0.5), b = v - ((double)iy + 0.5);
     double z00 = ss_tex(c, t->depth, ix, iy), z10 = ss_tex(c, t->depth, ix + 1, iy);
     double z01 = ss_tex(c, t->depth, ix, iy + 1), z11 = ss_tex(c, t->depth, ix + 1, iy + 1);
-    if (ss_bg(c, z00) || ss_bg(c, z10) || ss_bg(c, z01) || ss_bg(c, z11)) return SS_NAN;
+    if (ss_bg(c, z00) || ss_bg(c, z10) || ss_bg(c, z01) || ss_bg(c, z11)) return HFVIS__NAN;
     a = a < 0.0 ? 0.0 : (a > 1.0 ? 1.0 : a);
     b = b < 0.0 ? 0.0 : (b > 1.0 ? 1.0 : b);
     return (1.0 - b) * ((1.0 - a) * z00 + a * z10) + b * ((1.0 - a) * z01 + a * z11);
@@ -2316,7 +2247,7 @@ static int ss_rt_in(const ss_rt *t, double d, double zb)
 static double ss_rt_ray(const ss_rt *t, const double O[3], const double w[3])
 {
     const ss_cam *c = t->c;
-    double off = t->bil ? 0.5 : 0.0, u, v, s = 0.0, d0 = -O[2], s_eye = SS_INF;
+    double off = t->bil ? 0.5 : 0.0, u, v, s = 0.0, d0 = -O[2], s_eye = HFVIS__INF;
     double thick = t->o->thickness;
     int ix, iy, su, sv, nx = t->bil ? c->W - 1 : c->W, ny = t->bil ? c->H - 1 : c->H;
     if (c->persp) {
@@ -2335,15 +2266,15 @@ static double ss_rt_ray(const ss_rt *t, const double O[3], const double w[3])
     if (ix >= nx || iy >= ny) return -1.0;
     for (;;) {
         double s_u = su > 0 ? ss_rt_cross(c, O, w, 0, (double)(ix + 1) + off)
-                            : (su < 0 ? ss_rt_cross(c, O, w, 0, (double)ix + off) : SS_INF);
+                            : (su < 0 ? ss_rt_cross(c, O, w, 0, (double)ix + off) : HFVIS__INF);
         double s_v = sv > 0 ? ss_rt_cross(c, O, w, 1, (double)(iy + 1) + off)
-                            : (sv < 0 ? ss_rt_cross(c, O, w, 1, (double)iy + off) : SS_INF);
+                            : (sv < 0 ? ss_rt_cross(c, O, w, 1, (double)iy + off) : HFVIS__INF);
         double s_next = s_u < s_v ? s_u : s_v, s_end = s_next, da, db;
         int last = 0;
         if (!(s_end >= s)) s_end = s;
         if (s_end >= t->maxdist) { s_end = t->maxdist; last = 1; }
         if (s_end >= s_eye) { s_end = s_eye; last = 1; }
-        if (s_end == SS_INF) { /* the ray stays in this cell: the field is constant along it */
+        if (s_end == HFVIS__INF) { /* the ray stays in this cell: the field is constant along it */
             double zb, qu, qv;
             if (w[2] >= 0.0) return -1.0;
             zb = t->bil ? ss_rt_bilinear(t, ix, iy, u, v)
@@ -2409,7 +2340,7 @@ static double ss_rt_ray(const ss_rt *t, const double O[3], const double w[3])
     }
 }
 
-hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth, const float *normals,
+hfvis_status hfvis_ssao_reference(const hfvis_camera *cam, const float *depth, const float *normals,
                                  const hfvis_ssao_rt_options *opts, float *ao, ptrdiff_t ao_stride)
 {
     ss_cam c;
@@ -2422,11 +2353,11 @@ hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth, co
         !depth || !ao)
         return HFVIS_ERR_INVALID_ARGUMENT;
     W = c.W - 2 * c.gx;
-    if (ao_stride < W || !ss_plane_fits(ao_stride, c.H - 2 * c.gy)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (ao_stride < W || !hfvis__plane_fits(ao_stride, c.H - 2 * c.gy, 1)) return HFVIS_ERR_INVALID_ARGUMENT;
     ss_fall_load(&o.falloff, &f);
     if (!normals) {
         size_t b = ss_bytes3((size_t)c.stride, (size_t)c.H, 3 * sizeof(float));
-        if (!b || !(nrm = (float *)ss_alloc(o.alloc, b))) return HFVIS_ERR_OUT_OF_MEMORY;
+        if (!b || !(nrm = (float *)hfvis__alloc(o.alloc, b))) return HFVIS_ERR_OUT_OF_MEMORY;
         ss_normals_fill(&c, depth, nrm);
         normals = nrm;
     }
@@ -2435,7 +2366,7 @@ hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth, co
     t.o = &o;
     t.bil = o.sampling == HFVIS_SSAO_SAMPLING_BILINEAR;
     t.maxdist = o.max_distance > 0.0 ? o.max_distance : f.support;
-    t.zmin = SS_INF;
+    t.zmin = HFVIS__INF;
     t.zmax = 0.0;
     for (y = 0; y < c.H; y++)
         for (x = 0; x < c.W; x++) {
@@ -2486,7 +2417,7 @@ hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth, co
                     if (u1 >= 1.0) u1 -= 1.0;
                     if (u2 >= 1.0) u2 -= 1.0;
                     rr = sqrt(u1);
-                    ph = 2.0 * SS_PI * u2;
+                    ph = 2.0 * HFVIS__PI * u2;
                     lx = rr * cos(ph);
                     ly = rr * sin(ph);
                     lz = sqrt(1.0 - u1 > 0.0 ? 1.0 - u1 : 0.0);
@@ -2500,7 +2431,7 @@ hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth, co
             }
             ao[(ptrdiff_t)(y - c.gy) * ao_stride + (x - c.gx)] = (float)a;
         }
-    ss_free(o.alloc, nrm);
+    hfvis__free(o.alloc, nrm);
     return HFVIS_OK;
 }
 
@@ -2510,16 +2441,16 @@ hfvis_status hfvis_ssao_raytrace(const hfvis_camera *cam, const float *depth, co
 
 static int ss_scene_ok(const hfvis_ssao_scene *s)
 {
-    if (!s || !ss_finite(s->base_depth) || !(s->base_depth > 0.0)) return 0;
+    if (!s || !isfinite(s->base_depth) || !(s->base_depth > 0.0)) return 0;
     switch (s->kind) {
     case HFVIS_SSAO_SCENE_PLANE:
-        return ss_finite(s->slope_x) && ss_finite(s->slope_y);
+        return isfinite(s->slope_x) && isfinite(s->slope_y);
     case HFVIS_SSAO_SCENE_STEP:
-        return ss_finite(s->x0) && ss_finite(s->height) && s->base_depth - s->height > 0.0;
+        return isfinite(s->x0) && isfinite(s->height) && s->base_depth - s->height > 0.0;
     case HFVIS_SSAO_SCENE_VGROOVE:
-        return ss_finite(s->x0) && s->angle > 0.0 && s->angle < 0.5 * SS_PI;
+        return isfinite(s->x0) && s->angle > 0.0 && s->angle < 0.5 * HFVIS__PI;
     case HFVIS_SSAO_SCENE_PIT:
-        return ss_finite(s->x0) && ss_finite(s->y0) && ss_finite(s->radius) && s->radius > 0.0;
+        return isfinite(s->x0) && isfinite(s->y0) && isfinite(s->radius) && s->radius > 0.0;
     }
     return 0;
 }
@@ -2527,7 +2458,7 @@ static int ss_scene_ok(const hfvis_ssao_scene *s)
 /* Keep candidate t if valid and smaller. */
 static void ss_take(double t, int ok, double *best, int *which, int id)
 {
-    if (ok && t > 0.0 && ss_finite(t) && t < *best) {
+    if (ok && t > 0.0 && isfinite(t) && t < *best) {
         *best = t;
         *which = id;
     }
@@ -2537,7 +2468,7 @@ static void ss_take(double t, int ok, double *best, int *which, int id)
  * vertical through (rx, ry); perspective rays are t (rx, ry, -1). */
 static double ss_scene_hit(const hfvis_ssao_scene *s, int persp, double rx, double ry, double n[3])
 {
-    double Z0 = s->base_depth, best = SS_INF, x;
+    double Z0 = s->base_depth, best = HFVIS__INF, x;
     int which = -1;
     n[0] = n[1] = 0.0;
     n[2] = 1.0;
@@ -2677,7 +2608,7 @@ static void ssb_gauss(int n, double *x, double *w)
 {
     int i, j, it;
     for (i = 0; i < n; i++) {
-        double z = cos(SS_PI * ((double)i + 0.75) / ((double)n + 0.5)), pp = 1.0;
+        double z = cos(HFVIS__PI * ((double)i + 0.75) / ((double)n + 0.5)), pp = 1.0;
         for (it = 0; it < 100; it++) {
             double p1 = 1.0, p2 = 0.0, z1;
             for (j = 0; j < n; j++) {
@@ -2698,10 +2629,10 @@ static void ssb_gauss(int n, double *x, double *w)
 /* The integration range of L for (c, d): [lo0, hi0] = [max(d - pi/2, 0), min(c, d + pi/2, pi)]. */
 static void ssb_range(double c, double d, double *lo0, double *hi0)
 {
-    double lo = d - 0.5 * SS_PI, hi = d + 0.5 * SS_PI;
+    double lo = d - 0.5 * HFVIS__PI, hi = d + 0.5 * HFVIS__PI;
     if (lo < 0.0) lo = 0.0;
     if (hi > c) hi = c;
-    if (hi > SS_PI) hi = SS_PI;
+    if (hi > HFVIS__PI) hi = HFVIS__PI;
     *lo0 = lo;
     *hi0 = hi;
 }
@@ -2731,7 +2662,7 @@ static double ssb_quad(const ss_fall *f, double A, double B, double b, double c,
 double hfvis_ffao_slab_rho1(double a, double theta_hi, double c, double d)
 {
     double lo, hi;
-    if (!ss_finite(a) || theta_hi != theta_hi || !ss_finite(c) || !ss_finite(d)) return SS_NAN;
+    if (!isfinite(a) || theta_hi != theta_hi || !isfinite(c) || !isfinite(d)) return HFVIS__NAN;
     ssb_range(c, d, &lo, &hi);
     if (a > lo) lo = a;
     if (theta_hi < hi) hi = theta_hi;
@@ -2743,9 +2674,9 @@ double hfvis_ffao_slab_integral(const hfvis_falloff *falloff, double a, double t
 {
     ss_fall f;
     double x[SSB_MAX_NODES], w[SSB_MAX_NODES], lo, hi;
-    if (ss_fall_load(falloff, &f) != HFVIS_OK || !ss_finite(a) || theta_hi != theta_hi ||
-        !(b >= 0.0) || !ss_finite(c) || !ss_finite(d) || nodes < 1 || nodes > SSB_MAX_NODES)
-        return SS_NAN;
+    if (ss_fall_load(falloff, &f) != HFVIS_OK || !isfinite(a) || theta_hi != theta_hi ||
+        !(b >= 0.0) || !isfinite(c) || !isfinite(d) || nodes < 1 || nodes > SSB_MAX_NODES)
+        return HFVIS__NAN;
     ssb_range(c, d, &lo, &hi);
     if (a > lo) lo = a;
     if (theta_hi < hi) hi = theta_hi;
@@ -2780,10 +2711,10 @@ hfvis_status hfvis_ffao_table_build(const hfvis_falloff *falloff, int na, int nb
         else if (f.kind == HFVIS_FALLOFF_CUSTOM) b_ref = f.a > 0.0 ? f.a : 1.0;
         else b_ref = f.a;
     }
-    if (!(ss_finite(b_ref) && b_ref > 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!(isfinite(b_ref) && b_ref > 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
     cells = ss_bytes3((size_t)na * (size_t)nb, (size_t)nc * (size_t)nd, sizeof(float));
     if (!cells) return HFVIS_ERR_LIMIT;
-    v = (float *)ss_alloc(alloc, cells);
+    v = (float *)hfvis__alloc(alloc, cells);
     if (!v) return HFVIS_ERR_OUT_OF_MEMORY;
     ssb_gauss(8, x, w);
     for (id = 0; id < nd; id++)
@@ -2792,18 +2723,18 @@ hfvis_status hfvis_ffao_table_build(const hfvis_falloff *falloff, int na, int nb
                 double u = (double)ib / (double)(nb - 1), b, d, c, lo0, hi0, acc = 0.0;
                 float *row = v + (((size_t)id * (size_t)nc + (size_t)ic) * (size_t)nb + (size_t)ib) *
                                      (size_t)na;
-                b = u < 1.0 ? b_ref * u / (1.0 - u) : SS_INF;
-                c = 0.5 * SS_PI + 0.5 * SS_PI * (double)ic / (double)(nc - 1);
-                d = -0.5 * SS_PI + SS_PI * (double)id / (double)(nd - 1);
+                b = u < 1.0 ? b_ref * u / (1.0 - u) : HFVIS__INF;
+                c = 0.5 * HFVIS__PI + 0.5 * HFVIS__PI * (double)ic / (double)(nc - 1);
+                d = -0.5 * HFVIS__PI + HFVIS__PI * (double)id / (double)(nd - 1);
                 ssb_range(c, d, &lo0, &hi0);
                 row[na - 1] = 0.0f;
                 for (ia = na - 2; ia >= 0; ia--) {
-                    double A = SS_PI * (double)ia / (double)(na - 1);
-                    double B = SS_PI * (double)(ia + 1) / (double)(na - 1);
+                    double A = HFVIS__PI * (double)ia / (double)(na - 1);
+                    double B = HFVIS__PI * (double)(ia + 1) / (double)(na - 1);
                     if (A < lo0) A = lo0;
                     if (B > hi0) B = hi0;
                     if (B > A) {
-                        if (b < SS_INF) acc += ssb_quad(&f, A, B, b, c, d, 8, x, w);
+                        if (b < HFVIS__INF) acc += ssb_quad(&f, A, B, b, c, d, 8, x, w);
                         else if (f.kind == HFVIS_FALLOFF_NONE) acc += ssb_F(B, d) - ssb_F(A, d);
                     }
                     row[ia] = (float)acc;
@@ -2822,7 +2753,7 @@ hfvis_status hfvis_ffao_table_build(const hfvis_falloff *falloff, int na, int nb
 void hfvis_ffao_table_free(hfvis_ffao_table *t)
 {
     if (!t) return;
-    ss_free(t->alloc, t->values);
+    hfvis__free(t->alloc, t->values);
     memset(t, 0, sizeof *t);
 }
 
@@ -2830,7 +2761,7 @@ static int ssb_table_ok(const hfvis_ffao_table *t)
 {
     return t && t->values && t->na >= 2 && t->nb >= 2 && t->nc >= 2 && t->nd >= 2 &&
            t->na <= SSB_TABLE_MAX && t->nb <= SSB_TABLE_MAX && t->nc <= SSB_TABLE_MAX &&
-           t->nd <= SSB_TABLE_MAX && ss_finite(t->b_ref) && t->b_ref > 0.0;
+           t->nd <= SSB_TABLE_MAX && isfinite(t->b_ref) && t->b_ref > 0.0;
 }
 
 /* Cell index and fraction of v on a uniform axis [lo, hi] with n points. */
@@ -2852,10 +2783,10 @@ static double ssb_lookup(const hfvis_ffao_table *t, double a, double b, double c
     int ia, ib, ic, id, k;
     double fa, fb, fc, fd, u, s = 0.0;
     u = b > 0.0 ? b / (b + t->b_ref) : 0.0;
-    ssb_axis(a, 0.0, SS_PI, t->na, &ia, &fa);
+    ssb_axis(a, 0.0, HFVIS__PI, t->na, &ia, &fa);
     ssb_axis(u, 0.0, 1.0, t->nb, &ib, &fb);
-    ssb_axis(c, 0.5 * SS_PI, SS_PI, t->nc, &ic, &fc);
-    ssb_axis(d, -0.5 * SS_PI, 0.5 * SS_PI, t->nd, &id, &fd);
+    ssb_axis(c, 0.5 * HFVIS__PI, HFVIS__PI, t->nc, &ic, &fc);
+    ssb_axis(d, -0.5 * HFVIS__PI, 0.5 * HFVIS__PI, t->nd, &id, &fd);
     for (k = 0; k < 8; k++) {
         int kb = k & 1, kc = (k >> 1) & 1, kd = (k >> 2) & 1;
         double wgt = (kb ? fb : 1.0 - fb) * (kc ? fc : 1.0 - fc) * (kd ? fd : 1.0 - fd);
@@ -2870,11 +2801,11 @@ static double ssb_lookup(const hfvis_ffao_table *t, double a, double b, double c
 
 double hfvis_ffao_table_lookup(const hfvis_ffao_table *t, double a, double b, double c, double d)
 {
-    if (!ssb_table_ok(t) || a != a || b != b || c != c || d != d) return SS_NAN;
+    if (!ssb_table_ok(t) || a != a || b != b || c != c || d != d) return HFVIS__NAN;
     return ssb_lookup(t, a, b, c, d);
 }
 
-/* ---- 9.3 virtual points, sector weights, the slice estimator ([P4] §4, Eq. 2-3; [P4] §6) ------------- */
+/* ---- 9.3 virtual points, sector weights, the slice estimator ([P4] §4, Eq. 2-3, §6) ------------- */
 
 void hfvis_ffao_virtual_point(double m0, double m1, double slope, double zscale, double h[2])
 {
@@ -2908,14 +2839,14 @@ double hfvis_ffao_sector_weight(const hfvis_camera *cam, const double p[3], doub
 {
     ss_cam c;
     double ea[3], eb[3], v[3] = {0.0, 0.0, 1.0};
-    if (ss_cam_load(cam, &c) != HFVIS_OK || !p || !ss_finite(phi_lo) || !ss_finite(phi_hi) ||
-        !(phi_hi > phi_lo) || phi_hi - phi_lo >= SS_PI)
-        return SS_NAN;
+    if (ss_cam_load(cam, &c) != HFVIS_OK || !p || !isfinite(phi_lo) || !isfinite(phi_hi) ||
+        !(phi_hi > phi_lo) || phi_hi - phi_lo >= HFVIS__PI)
+        return HFVIS__NAN;
     if (c.persp) {
         v[0] = p[0];
         v[1] = p[1];
         v[2] = p[2];
-        if (!(p[2] < 0.0) || !ss_normalize3(v)) return SS_NAN;
+        if (!(p[2] < 0.0) || !ss_normalize3(v)) return HFVIS__NAN;
     }
     ssb_e1_phi(&c, phi_lo, ea);
     ssb_e1_phi(&c, phi_hi, eb);
@@ -2962,7 +2893,7 @@ static double ssb_pseudo(double s, double c)
     double q;
     if (s > 0.0) q = c / (s + fabs(c));
     else if (s < 0.0) q = c / (fabs(c) - s);
-    else return SS_NAN;
+    else return HFVIS__NAN;
     return s > 0.0 ? 1.0 - q : q - 1.0;
 }
 
@@ -2970,9 +2901,9 @@ static ssb_hz ssb_hz_init(double th)
 {
     ssb_hz h;
     h.th = th;
-    if (th == SS_PI) h.ps = 2.0; /* the start of every slice: nothing seen yet */
-    else if (th > -SS_PI && th < SS_PI) h.ps = ssb_pseudo(sin(th), cos(th));
-    else h.ps = th > SS_PI ? SS_INF : SS_NAN;
+    if (th == HFVIS__PI) h.ps = 2.0; /* the start of every slice: nothing seen yet */
+    else if (th > -HFVIS__PI && th < HFVIS__PI) h.ps = ssb_pseudo(sin(th), cos(th));
+    else h.ps = th > HFVIS__PI ? HFVIS__INF : HFVIS__NAN;
     return h;
 }
 
@@ -2987,7 +2918,7 @@ static double ssb_slab(const ssb_est *e, const ssb_rx *r, double hx, double hy, 
     if (!(a < hz->th)) return 0.0;
     if (r->ortho) {
         b = fabs(hx - r->px);
-        c = SS_PI;
+        c = HFVIS__PI;
     } else {
         double hl = sqrt(hx * hx + hy * hy);
         b = fabs(r->px * hy - r->py * hx) / hl;
@@ -3083,8 +3014,8 @@ hfvis_status hfvis_ffao_slice(const double p[2], const double n[2], const double
     int i;
     if (hfvis_ffao_options_resolve(opts, &o) != HFVIS_OK || !p || !n || count < 0 ||
         (count > 0 && (!hx || !hy)) || (orthographic != 0 && orthographic != 1) ||
-        theta_start != theta_start || !ss_finite(p[0]) || !ss_finite(p[1]) || !ss_finite(n[0]) ||
-        !ss_finite(n[1]) || !obscurance)
+        theta_start != theta_start || !isfinite(p[0]) || !isfinite(p[1]) || !isfinite(n[0]) ||
+        !isfinite(n[1]) || !obscurance)
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (!orthographic && !(p[0] * p[0] + p[1] * p[1] > 0.0)) return HFVIS_ERR_INVALID_ARGUMENT;
     if (o.estimator == HFVIS_FFAO_L_TABLE && !o.table) return HFVIS_ERR_INVALID_ARGUMENT;
@@ -3093,7 +3024,7 @@ hfvis_status hfvis_ffao_slice(const double p[2], const double n[2], const double
     ssb_rx_init(&r, orthographic, p[0], p[1], n[0], n[1]);
     th = ssb_hz_init(theta_start);
     for (i = 0; i < count; i++) {
-        if (!ss_finite(hx[i]) || !ss_finite(hy[i])) continue;
+        if (!isfinite(hx[i]) || !isfinite(hy[i])) continue;
         if (!orthographic && !(hx[i] * hx[i] + hy[i] * hy[i] > 0.0)) continue;
         acc += ssb_slab(&e, &r, hx[i], hy[i], &th);
     }
@@ -3134,16 +3065,16 @@ hfvis_status hfvis_ffao_options_resolve(const hfvis_ffao_options *in, hfvis_ffao
     if (o.mip_directions == 0) o.mip_directions = 16;
     if (o.directions < 3 || o.directions > HFVIS_SSAO_MAX_DIRECTIONS || o.segments < 1 ||
         o.segments > 64 || o.b0 < 1 || o.b0 > 4096 || o.levels < 0 || o.levels > SSB_MAX_LEVELS ||
-        !(ss_finite(o.level_gamma) && o.level_gamma > 0.0) ||
-        !(ss_finite(o.receiver_slope) && o.receiver_slope < 0.0) || !ss_finite(o.azimuth0_rad) ||
+        !(isfinite(o.level_gamma) && o.level_gamma > 0.0) ||
+        !(isfinite(o.receiver_slope) && o.receiver_slope < 0.0) || !isfinite(o.azimuth0_rad) ||
         (o.averaging != HFVIS_FFAO_AVERAGE_ON && o.averaging != HFVIS_FFAO_AVERAGE_OFF) ||
         (o.jitter != 0 && o.jitter != 1) || (o.sparse != 0 && o.sparse != 1) ||
-        (o.blur != 0 && o.blur != 1) || !(ss_finite(o.thickness) && o.thickness >= 0.0) ||
+        (o.blur != 0 && o.blur != 1) || !(isfinite(o.thickness) && o.thickness >= 0.0) ||
         (o.sampling != HFVIS_SSAO_SAMPLING_NEAREST && o.sampling != HFVIS_SSAO_SAMPLING_BILINEAR) ||
         (o.near_field != HFVIS_FFAO_NEAR_NONE && o.near_field != HFVIS_FFAO_NEAR_DIRECT) ||
         o.quad_nodes < 1 || o.quad_nodes > SSB_MAX_NODES || o.blur_radius < 0 ||
-        o.blur_radius > 64 || !(ss_finite(o.blur_threshold) && o.blur_threshold >= 0.0) ||
-        !(ss_finite(o.mip_growth) && o.mip_growth >= 1.0 && o.mip_growth <= 16.0) ||
+        o.blur_radius > 64 || !(isfinite(o.blur_threshold) && o.blur_threshold >= 0.0) ||
+        !(isfinite(o.mip_growth) && o.mip_growth >= 1.0 && o.mip_growth <= 16.0) ||
         o.mip_directions < 3 || o.mip_directions > HFVIS_SSAO_MAX_DIRECTIONS ||
         (int)o.estimator < 0 || (int)o.estimator > (int)HFVIS_FFAO_L_CLOSED_FORM ||
         (o.sparse && o.directions % 9 != 0) || hfvis_falloff_check(&o.falloff) != HFVIS_OK)
@@ -3211,8 +3142,8 @@ static void ssb_scan(const ssb_ctx *x, ssb_dir *dd, double *mem)
     for (n = 0; n < dd->nlev; n++) {
         dd->pre[n] = mem;
         for (k = 0; k < (size_t)dd->nj[n] * nl1; k++) {
-            mem[3 * k] = -SS_INF;
-            mem[3 * k + 1] = -SS_INF;
+            mem[3 * k] = -HFVIS__INF;
+            mem[3 * k + 1] = -HFVIS__INF;
             mem[3 * k + 2] = 0.0;
         }
         mem += (size_t)dd->nj[n] * nl1 * 3;
@@ -3295,9 +3226,9 @@ static void ssb_pixel_dir(const ssb_ctx *x, const ssb_dir *dd, double cu, double
 {
     const ss_cam *c = &x->c;
     double P[3], yh[3], v[3], zs, t_pix, jx, far0, In = 0.0, wsec = 0.0, Ifar = 0.0;
-    double dphi = 2.0 * SS_PI / ((double)x->o.directions * (double)x->o.segments), wseg[64];
+    double dphi = 2.0 * HFVIS__PI / ((double)x->o.directions * (double)x->o.segments), wseg[64];
     ssb_rx r;
-    ssb_hz thn = ssb_hz_init(SS_PI);
+    ssb_hz thn = ssb_hz_init(HFVIS__PI);
     int S = x->o.segments, g, J0, b0 = x->o.b0;
     ss_unproject(c, cu, cv, z, P);
     ss_plane_yhat(c, dd->e1, P, yh);
@@ -3328,7 +3259,7 @@ static void ssb_pixel_dir(const ssb_ctx *x, const ssb_dir *dd, double cu, double
     for (g = 0; g < S; g++) {
         double wg = wseg[g], Ig = 0.0;
         ssb_hz th = thn;
-        double alo = -SS_PI / (double)x->o.directions + dphi * (double)g + jit * 0.5 * dphi;
+        double alo = -HFVIS__PI / (double)x->o.directions + dphi * (double)g + jit * 0.5 * dphi;
         double ahi = alo + dphi, tlo = tan(alo), thi = tan(ahi), amid = tan(0.5 * (alo + ahi));
         long long q = J0; /* the far field starts at step q * b0, a multiple of b0 */
         while (q * b0 <= dd->smax) {
@@ -3453,8 +3384,8 @@ hfvis_status hfvis_ssao_bilateral_blur(const float *in, ptrdiff_t in_stride, int
                                        ptrdiff_t out_stride)
 {
     if (!in || !out || width < 1 || height < 1 || in_stride < width || out_stride < width ||
-        !ss_plane_fits(in_stride, height) || !ss_plane_fits(out_stride, height) ||
-        radius < 0 || radius > 64 || !(ss_finite(threshold) && threshold >= 0.0) || in == out)
+        !hfvis__plane_fits(in_stride, height, 1) || !hfvis__plane_fits(out_stride, height, 1) ||
+        radius < 0 || radius > 64 || !(isfinite(threshold) && threshold >= 0.0) || in == out)
         return HFVIS_ERR_INVALID_ARGUMENT;
     ssb_blur(in, in_stride, width, height, radius, threshold, out, out_stride);
     return HFVIS_OK;
@@ -3471,7 +3402,7 @@ static hfvis_status ssb_setup(ssb_ctx *x, const hfvis_camera *cam, const float *
     memset(own, 0, sizeof *own);
     if (ss_cam_load(cam, &x->c) != HFVIS_OK || hfvis_ffao_options_resolve(opts, &x->o) != HFVIS_OK ||
         !depth || !ao || ao_stride < x->c.W - 2 * x->c.gx ||
-        !ss_plane_fits(ao_stride, x->c.H - 2 * x->c.gy))
+        !hfvis__plane_fits(ao_stride, x->c.H - 2 * x->c.gy, 1))
         return HFVIS_ERR_INVALID_ARGUMENT;
     x->depth = depth;
     x->bil = x->o.sampling == HFVIS_SSAO_SAMPLING_BILINEAR;
@@ -3511,11 +3442,11 @@ hfvis_status hfvis_ffao(const hfvis_camera *cam, const float *depth, const float
     s = HFVIS_ERR_OUT_OF_MEMORY;
     if (!normals) {
         b = ss_bytes3((size_t)c->stride, (size_t)c->H, 3 * sizeof(float));
-        if (!b || !(nrm = (float *)ss_alloc(al, b))) goto done;
+        if (!b || !(nrm = (float *)hfvis__alloc(al, b))) goto done;
         ss_normals_fill(c, depth, nrm);
         normals = nrm;
     }
-    if (!(dirs = (hfvis_ssao_direction *)ss_alloc(al, (size_t)K * sizeof *dirs))) goto done;
+    if (!(dirs = (hfvis_ssao_direction *)hfvis__alloc(al, (size_t)K * sizeof *dirs))) goto done;
     hfvis_ssao_directions_uniform(K, x.o.azimuth0_rad, 1.0, 1.0, dirs);
     for (k = 0; k < K; k++) { /* sizes: the largest direction */
         s = ss_lattice_init(c, &dirs[k], &dd.lat);
@@ -3523,7 +3454,7 @@ hfvis_status hfvis_ffao(const hfvis_camera *cam, const float *depth, const float
         if ((size_t)dd.lat.line_count > maxlines) maxlines = (size_t)dd.lat.line_count;
     }
     s = HFVIS_ERR_OUT_OF_MEMORY;
-    if (!(dd.lines = (hfvis_ssao_line *)ss_alloc(al, maxlines * sizeof *dd.lines))) goto done;
+    if (!(dd.lines = (hfvis_ssao_line *)hfvis__alloc(al, maxlines * sizeof *dd.lines))) goto done;
     for (k = 0; k < K; k++) {
         size_t t;
         ss_lattice_init(c, &dirs[k], &dd.lat);
@@ -3532,20 +3463,20 @@ hfvis_status hfvis_ffao(const hfvis_camera *cam, const float *depth, const float
         if (t > maxpre) maxpre = t;
     }
     b = ss_bytes3(maxpre, 1, sizeof(double));
-    if (!b || !(pre = (double *)ss_alloc(al, b))) goto done;
+    if (!b || !(pre = (double *)hfvis__alloc(al, b))) goto done;
     /* per pixel: ao sum; sparse adds far sum, far weight and the box mask */
     b = ss_bytes3(npix, x.o.sparse ? 4 : 1, sizeof(double));
-    if (!b || !(acc = (double *)ss_alloc(al, b))) goto done;
+    if (!b || !(acc = (double *)hfvis__alloc(al, b))) goto done;
     memset(acc, 0, b);
     for (k = 0; k < K; k++) {
         int g;
         ss_lattice_init(c, &dirs[k], &dd.lat);
         ss_lattice_fill(c, &dd.lat, dd.lines);
         ssb_dir_size(&x, &dd);
-        dd.phi = x.o.azimuth0_rad + 2.0 * SS_PI * (double)k / (double)K;
+        dd.phi = x.o.azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K;
         ss_plane_e1(c, dirs[k].dx, dirs[k].dy, dd.e1);
         for (g = 0; g <= x.o.segments; g++)
-            ssb_e1_phi(c, dd.phi - SS_PI / (double)K + 2.0 * SS_PI * (double)g / ((double)K * (double)x.o.segments),
+            ssb_e1_phi(c, dd.phi - HFVIS__PI / (double)K + 2.0 * HFVIS__PI * (double)g / ((double)K * (double)x.o.segments),
                        dd.eb[g]);
         ssb_scan(&x, &dd, pre);
         for (py = 0; py < H; py++)
@@ -3578,7 +3509,7 @@ hfvis_status hfvis_ffao(const hfvis_camera *cam, const float *depth, const float
     if (!x.o.sparse) {
         for (py = 0; py < H; py++)
             for (px = 0; px < W; px++) {
-                double a = acc[(size_t)py * (size_t)W + (size_t)px] / SS_PI;
+                double a = acc[(size_t)py * (size_t)W + (size_t)px] / HFVIS__PI;
                 if (ss_bg(c, ss_tex(c, depth, px + c->gx, py + c->gy))) a = 0.0;
                 ao[(ptrdiff_t)py * ao_stride + px] = (float)(a > 0.0 ? (a < 1.0 ? a : 1.0) : 0.0);
             }
@@ -3605,7 +3536,7 @@ hfvis_status hfvis_ffao(const hfvis_camera *cam, const float *depth, const float
                         fsum += acc[npix + q];
                         wsum += acc[2 * npix + q];
                     }
-                a = res[o] / SS_PI + (wsum > 0.0 ? 2.0 * fsum / wsum : 0.0); /* (1/pi) 2 pi fsum/wsum */
+                a = res[o] / HFVIS__PI + (wsum > 0.0 ? 2.0 * fsum / wsum : 0.0); /* (1/pi) 2 pi fsum/wsum */
                 acc[3 * npix + o] = a; /* staged: neighbours still need the far sums */
             }
         for (py = 0; py < H; py++)
@@ -3626,11 +3557,11 @@ hfvis_status hfvis_ffao(const hfvis_camera *cam, const float *depth, const float
     }
     s = HFVIS_OK;
 done:
-    ss_free(al, acc);
-    ss_free(al, pre);
-    ss_free(al, dd.lines);
-    ss_free(al, dirs);
-    ss_free(al, nrm);
+    hfvis__free(al, acc);
+    hfvis__free(al, pre);
+    hfvis__free(al, dd.lines);
+    hfvis__free(al, dirs);
+    hfvis__free(al, nrm);
     if (own.values) hfvis_ffao_table_free(&own);
     return s;
 }
@@ -3683,7 +3614,7 @@ static double ssb_mip_tap(const float *m, int w, int h, int l, double u, double 
         acc += wt * z;
         ws += wt;
     }
-    return ws > 0.0 ? acc / ws : SS_NAN;
+    return ws > 0.0 ? acc / ws : HFVIS__NAN;
 }
 
 hfvis_status hfvis_ssao_mipmap(const hfvis_camera *cam, const float *depth, const float *normals,
@@ -3707,22 +3638,22 @@ hfvis_status hfvis_ssao_mipmap(const hfvis_camera *cam, const float *depth, cons
     s = HFVIS_ERR_OUT_OF_MEMORY;
     if (!normals) {
         b = ss_bytes3((size_t)c->stride, (size_t)c->H, 3 * sizeof(float));
-        if (!b || !(nrm = (float *)ss_alloc(al, b))) goto done;
+        if (!b || !(nrm = (float *)hfvis__alloc(al, b))) goto done;
         ss_normals_fill(c, depth, nrm);
         normals = nrm;
     }
     nl = ssb_mip_layout(c, lw, lh, off, &tot);
     b = ss_bytes3(tot, 1, sizeof(float));
-    if (!b || !(mip = (float *)ss_alloc(al, b))) goto done;
+    if (!b || !(mip = (float *)hfvis__alloc(al, b))) goto done;
     for (j = 0; j < c->H; j++) /* level 0: depth, NaN for background */
         for (i = 0; i < c->W; i++) {
             double z = ss_tex(c, depth, i, j);
-            mip[(size_t)j * (size_t)c->W + (size_t)i] = ss_bg(c, z) ? (float)SS_NAN : (float)z;
+            mip[(size_t)j * (size_t)c->W + (size_t)i] = ss_bg(c, z) ? (float)HFVIS__NAN : (float)z;
         }
     for (l = 1; l < nl; l++) /* averaged mips (continuous) or min-depth "max" mips (thickness) */
         for (j = 0; j < lh[l]; j++)
             for (i = 0; i < lw[l]; i++) {
-                double acc = 0.0, mn = SS_INF;
+                double acc = 0.0, mn = HFVIS__INF;
                 int q, n = 0;
                 for (q = 0; q < 4; q++) {
                     int xx = 2 * i + (q & 1), yy = 2 * j + (q >> 1);
@@ -3735,7 +3666,7 @@ hfvis_status hfvis_ssao_mipmap(const hfvis_camera *cam, const float *depth, cons
                     n++;
                 }
                 mip[off[l] + (size_t)j * (size_t)lw[l] + (size_t)i] =
-                    n ? (float)(x.o.thickness > 0.0 ? mn : acc / (double)n) : (float)SS_NAN;
+                    n ? (float)(x.o.thickness > 0.0 ? mn : acc / (double)n) : (float)HFVIS__NAN;
             }
     for (py = 0; py < H; py++)
         for (px = 0; px < W; px++) {
@@ -3751,22 +3682,22 @@ hfvis_status hfvis_ssao_mipmap(const hfvis_camera *cam, const float *depth, cons
             if (c->persp) ss_normalize3(v);
             else v[0] = v[1] = 0.0, v[2] = 1.0;
             for (k = 0; k < K; k++) {
-                double phi = x.o.azimuth0_rad + 2.0 * SS_PI * (double)k / (double)K;
+                double phi = x.o.azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K;
                 double D[2], e1[3], ea[3], eb[3], yh[3], zs, I = 0.0, dist, step, tmax;
-                ssb_hz th = ssb_hz_init(SS_PI);
+                ssb_hz th = ssb_hz_init(HFVIS__PI);
                 double cu = (double)tx + 0.5, cv = (double)ty + 0.5, t1;
                 ssb_rx r;
                 int last = 0;
                 D[0] = cos(phi);
                 D[1] = sin(phi);
                 ss_plane_e1(c, D[0], D[1], e1);
-                ssb_e1_phi(c, phi - SS_PI / (double)K, ea);
-                ssb_e1_phi(c, phi + SS_PI / (double)K, eb);
+                ssb_e1_phi(c, phi - HFVIS__PI / (double)K, ea);
+                ssb_e1_phi(c, phi + HFVIS__PI / (double)K, eb);
                 ss_plane_yhat(c, e1, P, yh);
                 zs = c->persp ? 1.0 / yh[2] : 1.0;
                 ssb_rx_init(&r, !c->persp, ss_dot3(P, e1), P[2] * zs, ss_dot3(nv, e1), ss_dot3(nv, yh));
                 /* distance to the texel-centre rectangle's edge along D */
-                tmax = SS_INF;
+                tmax = HFVIS__INF;
                 for (i = 0; i < 2; i++) {
                     double pc = i ? cv : cu, hi = (double)(i ? c->H : c->W) - 0.5;
                     if (D[i] > 1e-12) t1 = (hi - pc) / D[i];
@@ -3786,7 +3717,7 @@ hfvis_status hfvis_ssao_mipmap(const hfvis_camera *cam, const float *depth, cons
                     }
                     u = cu + dist * D[0];
                     vv = cv + dist * D[1];
-                    lam = 2.0 * dist * tan(SS_PI / (double)K);
+                    lam = 2.0 * dist * tan(HFVIS__PI / (double)K);
                     lam = lam > 1.0 ? log(lam) / log(2.0) : 0.0;
                     if (lam > (double)(nl - 1)) lam = (double)(nl - 1);
                     l0 = (int)lam;
@@ -3806,13 +3737,13 @@ hfvis_status hfvis_ssao_mipmap(const hfvis_camera *cam, const float *depth, cons
                 }
                 sum += ssb_wedge(ea, eb, v) * I;
             }
-            a = sum / SS_PI;
+            a = sum / HFVIS__PI;
             ao[(ptrdiff_t)py * ao_stride + px] = (float)(a > 0.0 ? (a < 1.0 ? a : 1.0) : 0.0);
         }
     s = HFVIS_OK;
 done:
-    ss_free(al, mip);
-    ss_free(al, nrm);
+    hfvis__free(al, mip);
+    hfvis__free(al, nrm);
     if (own.values) hfvis_ffao_table_free(&own);
     return s;
 }
@@ -3831,15 +3762,15 @@ hfvis_status hfvis_ssao_error(const float *ao, ptrdiff_t ao_stride, const float 
     int x, y;
     if (!ao || !ref || !stats || width < 1 || height < 1 || ao_stride < width ||
         ref_stride < width || (error_image && error_stride < width) ||
-        !ss_plane_fits(ao_stride, height) || !ss_plane_fits(ref_stride, height) ||
-        (error_image && !ss_plane_fits(error_stride, height)) ||
-        !(ss_finite(tolerance) && tolerance >= 0.0) || (relative != 0 && relative != 1))
+        !hfvis__plane_fits(ao_stride, height, 1) || !hfvis__plane_fits(ref_stride, height, 1) ||
+        (error_image && !hfvis__plane_fits(error_stride, height, 1)) ||
+        !(isfinite(tolerance) && tolerance >= 0.0) || (relative != 0 && relative != 1))
         return HFVIS_ERR_INVALID_ARGUMENT;
     for (y = 0; y < height; y++)
         for (x = 0; x < width; x++) {
             double a = (double)ao[(ptrdiff_t)y * ao_stride + x];
             double r = (double)ref[(ptrdiff_t)y * ref_stride + x], e;
-            if (!ss_finite(a) || !ss_finite(r)) {
+            if (!isfinite(a) || !isfinite(r)) {
                 if (error_image) error_image[(ptrdiff_t)y * error_stride + x] = 1.0f;
                 continue;
             }
@@ -3891,8 +3822,6 @@ hfvis_status hfvis_ssao_error(const float *ao, ptrdiff_t ao_stride, const float 
  * node masks, volumes, slab tests) is applied only with margins (relative 1e-9 or more) far
  * above the rounding of that predicate (about 1e-15 relative). */
 
-#define LK_PI 3.14159265358979323846
-#define LK_INF ((double)INFINITY)
 #define LK_DISC_R2 (1.0 - 0x1p-20)  /* disc points have x^2 + y^2 < this, so u_z >= 2^-10 */
 #define LK_CONE_PAD 1e-9            /* word cones are widened by this angle (radians) */
 #define LK_MARGIN 1e-9              /* relative margin of every work-skipping test */
@@ -3901,13 +3830,14 @@ hfvis_status hfvis_ssao_error(const float *ao, ptrdiff_t ao_stride, const float 
 
 /* ---- 12.1 common ---------------------------------------------------------------------------- */
 
-/* Allocation and checked sizes: ss_alloc, ss_free, ss_mul (section 1). */
+/* Allocation, checked sizes and PCG32: hfvis__alloc, hfvis__free, hfvis__mul_size, hfvis__pcg32
+ * (hfvis.c section 1). */
 
 /* *acc += a*b rounded up to a multiple of 16 (one sub-array of a block); 0 on overflow. */
 static int lk_part(size_t *acc, size_t count, size_t elem)
 {
     size_t bytes;
-    if (!ss_mul(count, elem, &bytes) || bytes > SIZE_MAX - 15) return 0;
+    if (!hfvis__mul_size(count, elem, &bytes) || bytes > SIZE_MAX - 15) return 0;
     bytes = (bytes + 15) & ~(size_t)15;
     if (*acc > SIZE_MAX - bytes) return 0;
     *acc += bytes;
@@ -3930,54 +3860,6 @@ static int lk_popcount(uint32_t x)
     return (int)((x * 0x01010101u) >> 24);
 }
 
-/* PCG32 (M. O'Neill, pcg-random.org, XSH-RR), seeded with (seed, stream). */
-typedef struct lk_pcg {
-    uint64_t state, inc;
-} lk_pcg;
-
-static uint32_t lk_pcg_next(lk_pcg *g)
-{
-    uint64_t old = g->state;
-    uint32_t xs, rot;
-    g->state = old * 6364136223846793005ull + g->inc;
-    xs = (uint32_t)(((old >> 18) ^ old) >> 27);
-    rot = (uint32_t)(old >> 59);
-    return (xs >> rot) | (xs << ((32u - rot) & 31u));
-}
-
-static void lk_pcg_seed(lk_pcg *g, uint64_t seed, uint64_t stream)
-{
-    g->state = 0;
-    g->inc = (stream << 1) | 1u;
-    (void)lk_pcg_next(g);
-    g->state += seed;
-    (void)lk_pcg_next(g);
-}
-
-/* Uniform in [0, 1) with 53 bits. */
-static double lk_pcg_unit(lk_pcg *g)
-{
-    uint64_t hi = lk_pcg_next(g) >> 5, lo = lk_pcg_next(g) >> 6;
-    return ((double)hi * 67108864.0 + (double)lo) * (1.0 / 9007199254740992.0);
-}
-
-/* Uniform integer in [0, n), n >= 1 (Lemire-free rejection: unbiased). */
-static uint32_t lk_pcg_below(lk_pcg *g, uint32_t n)
-{
-    uint32_t limit = (uint32_t)(0u - n) % n, x;
-    do x = lk_pcg_next(g); while (x < limit);
-    return x % n;
-}
-
-/* SplitMix64 (Steele, Lea, Flood 2014). */
-static uint64_t lk_splitmix(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
 static double lk_dot(const double a[3], const double b[3])
 {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -3988,27 +3870,6 @@ static void lk_cross(const double a[3], const double b[3], double out[3])
     out[0] = a[1] * b[2] - a[2] * b[1];
     out[1] = a[2] * b[0] - a[0] * b[2];
     out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static int lk_finite3(const double v[3])
-{
-    return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
-}
-
-/* Mesh check (as voxel.c's): arrays present, indices in range, finite coordinates. O(V + T). */
-static hfvis_status lk_mesh_check(const hfvis_mesh *m)
-{
-    size_t i;
-    if (!m) return HFVIS_ERR_INVALID_ARGUMENT;
-    if ((m->vertex_count && !m->xyz) || (m->triangle_count && !m->indices))
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    if (m->vertex_count > SIZE_MAX / 3 || m->triangle_count > SIZE_MAX / 3)
-        return HFVIS_ERR_INVALID_ARGUMENT;
-    for (i = 0; i < 3 * m->vertex_count; i++)
-        if (!isfinite(m->xyz[i])) return HFVIS_ERR_INVALID_ARGUMENT;
-    for (i = 0; i < 3 * m->triangle_count; i++)
-        if ((size_t)m->indices[i] >= m->vertex_count) return HFVIS_ERR_INVALID_ARGUMENT;
-    return HFVIS_OK;
 }
 
 static const float *lk_vertex(const hfvis_mesh *m, size_t t, int k)
@@ -4178,9 +4039,9 @@ static void lk_lloyd_pass(lk_sites *g, double *xy, const double *dens, size_t nd
         }
 }
 
-static void lk_disc_uniform(lk_pcg *g, double *x, double *y)
+static void lk_disc_uniform(hfvis__pcg32 *g, double *x, double *y)
 {
-    double r = sqrt(lk_pcg_unit(g) * LK_DISC_R2), t = 2.0 * LK_PI * lk_pcg_unit(g);
+    double r = sqrt(hfvis__pcg32_unit(g) * LK_DISC_R2), t = 2.0 * HFVIS__PI * hfvis__pcg32_unit(g);
     *x = r * cos(t);
     *y = r * sin(t);
 }
@@ -4196,10 +4057,10 @@ static void lk_concentric(double a, double b, double *x, double *y)
     }
     if (fabs(a) > fabs(b)) {
         r = a;
-        phi = (LK_PI / 4.0) * (b / a);
+        phi = (HFVIS__PI / 4.0) * (b / a);
     } else {
         r = b;
-        phi = LK_PI / 2.0 - (LK_PI / 4.0) * (a / b);
+        phi = HFVIS__PI / 2.0 - (HFVIS__PI / 4.0) * (a / b);
     }
     *x = r * cos(phi);
     *y = r * sin(phi);
@@ -4208,7 +4069,7 @@ static void lk_concentric(double a, double b, double *x, double *y)
 /* The Lloyd / Voronoi-jitter disc of [LK] §3; docs/errata.md E44 DISC_SAMPLES, into xy (2n). torus != 0: the same
  * relaxation on the periodic square [-1, 1)^2 (no boundary, so no rim bias), then the concentric
  * map onto the disc. */
-static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *g,
+static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, hfvis__pcg32 *g,
                                   const hfvis_allocator *alloc, int torus, double *xy)
 {
     int G = o->density_resolution, B = 1, i, it;
@@ -4219,7 +4080,7 @@ static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *
     lk_sites sites;
     while (B * B * 2 < n) B++; /* about two sites per cell */
     if (G == 0) { /* adaptive: about 48 density points per site, at least 64 x 64 */
-        G = (int)ceil(sqrt(48.0 * n * (torus ? 1.0 : 4.0 / LK_PI)));
+        G = (int)ceil(sqrt(48.0 * n * (torus ? 1.0 : 4.0 / HFVIS__PI)));
         if (G < 64) G = 64;
     }
     for (i = 0; i < G; i++) { /* density points: centres of G x G cells (inside the disc) */
@@ -4236,7 +4097,7 @@ static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *
         !lk_part(&bytes, (size_t)B * (size_t)B + 1, sizeof(int)) ||
         !lk_part(&bytes, (size_t)n, sizeof(int)) || !lk_part(&bytes, (size_t)n, 2 * sizeof(double)))
         return HFVIS_ERR_LIMIT; /* only on 32-bit size_t */
-    block = (unsigned char *)ss_alloc(alloc, bytes);
+    block = (unsigned char *)hfvis__alloc(alloc, bytes);
     if (!block) return HFVIS_ERR_OUT_OF_MEMORY;
     cur = block;
     dens = (double *)lk_take(&cur, nd, 2 * sizeof(double));
@@ -4266,8 +4127,8 @@ static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *
     }
     for (i = 0; i < n; i++) { /* 1. random points */
         if (torus) {
-            xy[2 * i] = lk_wrap(2.0 * lk_pcg_unit(g) - 1.0);
-            xy[2 * i + 1] = lk_wrap(2.0 * lk_pcg_unit(g) - 1.0);
+            xy[2 * i] = lk_wrap(2.0 * hfvis__pcg32_unit(g) - 1.0);
+            xy[2 * i + 1] = lk_wrap(2.0 * hfvis__pcg32_unit(g) - 1.0);
         } else {
             lk_disc_uniform(g, xy + 2 * i, xy + 2 * i + 1);
         }
@@ -4297,8 +4158,8 @@ static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *
         jit[2 * i + 1] = xy[2 * i + 1];
         if (b[0] > b[2]) continue; /* no density point: keep the site */
         for (a = 0; a < LK_JITTER_ATTEMPTS; a++) {
-            double qx = xy[2 * i] + b[0] - h + (b[2] - b[0] + 2.0 * h) * lk_pcg_unit(g);
-            double qy = xy[2 * i + 1] + b[1] - h + (b[3] - b[1] + 2.0 * h) * lk_pcg_unit(g);
+            double qx = xy[2 * i] + b[0] - h + (b[2] - b[0] + 2.0 * h) * hfvis__pcg32_unit(g);
+            double qy = xy[2 * i + 1] + b[1] - h + (b[3] - b[1] + 2.0 * h) * hfvis__pcg32_unit(g);
             if (torus) {
                 qx = lk_wrap(qx);
                 qy = lk_wrap(qy);
@@ -4324,7 +4185,7 @@ static hfvis_status lk_disc_lloyd(int n, const hfvis_lk_ray_options *o, lk_pcg *
             xy[2 * i + 1] = sc * y;
         }
     }
-    ss_free(alloc, block);
+    hfvis__free(alloc, block);
     return HFVIS_OK;
 }
 
@@ -4349,7 +4210,7 @@ static int lk_cmp_u64(const void *a, const void *b)
 static void lk_rays_finish(hfvis_lk_rays *r)
 {
     int w, i;
-    double emin = LK_INF;
+    double emin = HFVIS__INF;
     for (i = 0; i < r->count; i++) {
         double e = asin(r->direction[3 * i + 2]);
         if (e < emin) emin = e;
@@ -4360,7 +4221,7 @@ static void lk_rays_finish(hfvis_lk_rays *r)
         if (r->length[i] != 1.0) r->equal_lengths = 0;
     for (w = 0; w < r->words; w++) {
         int i0 = 32 * w, i1 = i0 + 32 < r->count ? i0 + 32 : r->count;
-        double ax = 0.0, ay = 0.0, az = 0.0, len, cmin = 1.0, th, lmin = LK_INF, lmax = 0.0;
+        double ax = 0.0, ay = 0.0, az = 0.0, len, cmin = 1.0, th, lmin = HFVIS__INF, lmax = 0.0;
         double *c = r->word_cone + 7 * w;
         for (i = i0; i < i1; i++) {
             ax += r->direction[3 * i];
@@ -4380,7 +4241,7 @@ static void lk_rays_finish(hfvis_lk_rays *r)
         if (cmin > 1.0) cmin = 1.0;
         if (cmin < -1.0) cmin = -1.0;
         th = acos(cmin) + LK_CONE_PAD;
-        if (th > LK_PI) th = LK_PI;
+        if (th > HFVIS__PI) th = HFVIS__PI;
         c[3] = cos(th);
         c[4] = sin(th);
         c[5] = lmin;
@@ -4394,7 +4255,7 @@ static hfvis_status lk_rays_alloc(int count, double radius, const hfvis_allocato
 {
     int words = (count + 31) / 32;
     size_t doubles = 7 * (size_t)count + 7 * (size_t)words;
-    double *block = (double *)ss_alloc(alloc, doubles * sizeof(double));
+    double *block = (double *)hfvis__alloc(alloc, doubles * sizeof(double));
     if (!block) return HFVIS_ERR_OUT_OF_MEMORY;
     memset(r, 0, sizeof *r);
     r->count = count;
@@ -4434,7 +4295,7 @@ HFVIS_API hfvis_status hfvis_lk_rays_build(int count, double radius,
     hfvis_lk_ray_options o = hfvis_lk_ray_options_default();
     hfvis_lk_rays r;
     hfvis_status s;
-    lk_pcg g;
+    hfvis__pcg32 g;
     uint64_t *keys;
     double *xy;
     int i;
@@ -4470,11 +4331,11 @@ HFVIS_API hfvis_status hfvis_lk_rays_build(int count, double radius,
     /* the disc points go to `point` (2n doubles), the sort keys to `length` (n, as u64) */
     xy = r.point;
     keys = (uint64_t *)(void *)r.length;
-    lk_pcg_seed(&g, o.seed, 0x4C4B31u);
+    hfvis__pcg32_seed(&g, o.seed, 0x4C4B31u);
     if (o.pattern == HFVIS_LK_PATTERN_LLOYD || o.pattern == HFVIS_LK_PATTERN_LLOYD_TORUS) {
         s = lk_disc_lloyd(count, &o, &g, o.alloc, o.pattern == HFVIS_LK_PATTERN_LLOYD_TORUS, xy);
         if (s != HFVIS_OK) {
-            ss_free(o.alloc, r.direction);
+            hfvis__free(o.alloc, r.direction);
             return s;
         }
     } else {
@@ -4496,12 +4357,12 @@ HFVIS_API hfvis_status hfvis_lk_rays_build(int count, double radius,
     }
     /* lengths: xi_i = (perm(i) + 1/2)/N, perm a seeded random permutation (stream 2) */
     {
-        lk_pcg g2;
+        hfvis__pcg32 g2;
         uint32_t *perm = (uint32_t *)(void *)r.point; /* point is free again */
-        lk_pcg_seed(&g2, o.seed, 0x4C4B32u);
+        hfvis__pcg32_seed(&g2, o.seed, 0x4C4B32u);
         for (i = 0; i < count; i++) perm[i] = (uint32_t)i;
         for (i = count - 1; i > 0; i--) {
-            uint32_t j = lk_pcg_below(&g2, (uint32_t)i + 1u), t = perm[i];
+            uint32_t j = hfvis__pcg32_below(&g2, (uint32_t)i + 1u), t = perm[i];
             perm[i] = perm[j];
             perm[j] = t;
         }
@@ -4529,7 +4390,7 @@ HFVIS_API hfvis_status hfvis_lk_rays_custom(int count, double radius, const doub
     for (i = 0; i < count; i++) {
         const double *d = directions + 3 * i;
         double len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-        if (!lk_finite3(d) || !(len2 > 0.0) || !isfinite(len2) || !(d[2] / sqrt(len2) > 0.0))
+        if (!hfvis__all_finite(d, 3) || !(len2 > 0.0) || !isfinite(len2) || !(d[2] / sqrt(len2) > 0.0))
             return HFVIS_ERR_INVALID_ARGUMENT;
         if (lengths && !(lengths[i] >= 0.0 && lengths[i] <= 1.0)) return HFVIS_ERR_INVALID_ARGUMENT;
     }
@@ -4551,7 +4412,7 @@ HFVIS_API hfvis_status hfvis_lk_rays_custom(int count, double radius, const doub
 HFVIS_API void hfvis_lk_rays_free(const hfvis_allocator *alloc, hfvis_lk_rays *rays)
 {
     if (!rays) return;
-    ss_free(alloc, rays->direction);
+    hfvis__free(alloc, rays->direction);
     memset(rays, 0, sizeof *rays);
 }
 
@@ -4603,7 +4464,7 @@ static void lk_jit_init(lk_jit *j, const hfvis_lk_rays *r, hfvis_lk_jitter mode,
 {
     j->none = mode == HFVIS_LK_JITTER_NONE;
     if (mode == HFVIS_LK_JITTER_DEFAULT) {
-        rot = LK_PI;
+        rot = HFVIS__PI;
         tilt = HFVIS_LK_DEFAULT_TILT;
     }
     j->rot = rot;
@@ -4628,10 +4489,10 @@ static void lk_frame_make(const lk_jit *j, const double normal[3], uint64_t key,
     }
     {
         uint64_t s = j->seed ^ (key * 0xD1B54A32D192ED03ull);
-        double x1 = (double)(lk_splitmix(&s) >> 11) * (1.0 / 9007199254740992.0);
-        double x2 = (double)(lk_splitmix(&s) >> 11) * (1.0 / 9007199254740992.0);
-        double x3 = (double)(lk_splitmix(&s) >> 11) * (1.0 / 9007199254740992.0);
-        double dl = j->tilt * x1, ph = 2.0 * LK_PI * x2, psi = j->rot * (2.0 * x3 - 1.0);
+        double x1 = (double)(hfvis__splitmix64(&s) >> 11) * (1.0 / 9007199254740992.0);
+        double x2 = (double)(hfvis__splitmix64(&s) >> 11) * (1.0 / 9007199254740992.0);
+        double x3 = (double)(hfvis__splitmix64(&s) >> 11) * (1.0 / 9007199254740992.0);
+        double dl = j->tilt * x1, ph = 2.0 * HFVIS__PI * x2, psi = j->rot * (2.0 * x3 - 1.0);
         double np[3], x0[3], y0[3], cd = cos(dl), sd = sin(dl), cp = cos(ph), sp = sin(ph);
         double cs = cos(psi), sn = sin(psi);
         for (a = 0; a < 3; a++) np[a] = cd * n[a] + sd * (cp * t1[a] + sp * t2[a]);
@@ -4649,8 +4510,8 @@ static void lk_frame_make(const lk_jit *j, const double normal[3], uint64_t key,
 static int lk_jitter_valid(hfvis_lk_jitter mode, double rot, double tilt)
 {
     if (mode == HFVIS_LK_JITTER_DEFAULT || mode == HFVIS_LK_JITTER_NONE) return 1;
-    return mode == HFVIS_LK_JITTER_CUSTOM && rot >= 0.0 && rot <= LK_PI && tilt >= 0.0 &&
-           tilt <= 0.5 * LK_PI;
+    return mode == HFVIS_LK_JITTER_CUSTOM && rot >= 0.0 && rot <= HFVIS__PI && tilt >= 0.0 &&
+           tilt <= 0.5 * HFVIS__PI;
 }
 
 HFVIS_API hfvis_status hfvis_lk_frame(const hfvis_lk_rays *rays, const double normal[3],
@@ -4660,7 +4521,7 @@ HFVIS_API hfvis_status hfvis_lk_frame(const hfvis_lk_rays *rays, const double no
 {
     lk_jit j;
     double len2;
-    if (!lk_rays_valid(rays) || !normal || !frame || !lk_finite3(normal) ||
+    if (!lk_rays_valid(rays) || !normal || !frame || !hfvis__all_finite(normal, 3) ||
         !lk_jitter_valid(jitter, rotation_max_rad, tilt_max_rad))
         return HFVIS_ERR_INVALID_ARGUMENT;
     len2 = lk_dot(normal, normal);
@@ -4714,8 +4575,8 @@ static void lk_tri_setup(lk_tri *t, const double F[9], const double p[3], const 
 {
     double a[3], b[3], c[3], u[3], w[3], n[3], len2, len, h, d;
     int k;
-    t->dr = LK_INF;
-    t->drmin = LK_INF;
+    t->dr = HFVIS__INF;
+    t->drmin = HFVIS__INF;
     if (lk_world_degenerate(v0, v1, v2)) {
         memset(t->e, 0, sizeof t->e);
         t->m[0] = t->m[1] = t->m[2] = 0.0;
@@ -4790,7 +4651,7 @@ static void lk_mask_exact(const hfvis_lk_rays *R, const lk_tri *t, const uint32_
 {
     double eh[9], lim;
     int w, k, i;
-    if (t->dr == LK_INF) {
+    if (t->dr == HFVIS__INF) {
         memset(out, 0, sizeof(uint32_t) * (size_t)R->words);
         return;
     }
@@ -4843,8 +4704,8 @@ HFVIS_API size_t hfvis_lk_lut_bytes(int resolution, int count, int two_tables)
     if (resolution < HFVIS_LK_LUT_MIN_RESOLUTION || resolution > HFVIS_LK_LUT_MAX_RESOLUTION ||
         words == 0)
         return 0;
-    if (!ss_mul((size_t)resolution, (size_t)resolution, &n) || !ss_mul(n, (size_t)resolution, &n) ||
-        !ss_mul(n, (size_t)words * sizeof(uint32_t), &b) || !ss_mul(b, two_tables ? 2 : 1, &b))
+    if (!hfvis__mul_size((size_t)resolution, (size_t)resolution, &n) || !hfvis__mul_size(n, (size_t)resolution, &n) ||
+        !hfvis__mul_size(n, (size_t)words * sizeof(uint32_t), &b) || !hfvis__mul_size(b, two_tables ? 2 : 1, &b))
         return 0;
     return b;
 }
@@ -4910,12 +4771,12 @@ HFVIS_API hfvis_status hfvis_lk_lut_build(const hfvis_lk_rays *rays, int resolut
     L.count = rays->count;
     L.words = rays->words;
     L.bytes = all;
-    L.masks = (uint32_t *)ss_alloc(alloc, one);
+    L.masks = (uint32_t *)hfvis__alloc(alloc, one);
     if (!L.masks) return HFVIS_ERR_OUT_OF_MEMORY;
     if (!rays->equal_lengths) {
-        L.directions = (uint32_t *)ss_alloc(alloc, one);
+        L.directions = (uint32_t *)hfvis__alloc(alloc, one);
         if (!L.directions) {
-            ss_free(alloc, L.masks);
+            hfvis__free(alloc, L.masks);
             return HFVIS_ERR_OUT_OF_MEMORY;
         }
     }
@@ -4928,8 +4789,8 @@ HFVIS_API hfvis_status hfvis_lk_lut_build(const hfvis_lk_rays *rays, int resolut
 HFVIS_API void hfvis_lk_lut_free(const hfvis_allocator *alloc, hfvis_lk_lut *lut)
 {
     if (!lut) return;
-    ss_free(alloc, lut->directions);
-    ss_free(alloc, lut->masks);
+    hfvis__free(alloc, lut->directions);
+    hfvis__free(alloc, lut->masks);
     memset(lut, 0, sizeof *lut);
 }
 
@@ -4955,7 +4816,7 @@ HFVIS_API hfvis_status hfvis_lk_lut_index(int resolution, const double m[3], dou
 {
     size_t node, T = (size_t)resolution;
     if (!m || !ijk || resolution < HFVIS_LK_LUT_MIN_RESOLUTION ||
-        resolution > HFVIS_LK_LUT_MAX_RESOLUTION || !lk_finite3(m) || !isfinite(d_over_r) ||
+        resolution > HFVIS_LK_LUT_MAX_RESOLUTION || !hfvis__all_finite(m, 3) || !isfinite(d_over_r) ||
         (m[0] == 0.0 && m[1] == 0.0 && m[2] == 0.0))
         return HFVIS_ERR_INVALID_ARGUMENT;
     node = lk_lut_node(resolution, m, d_over_r);
@@ -4980,7 +4841,7 @@ static int lk_lut_valid(const hfvis_lk_lut *L)
 HFVIS_API const uint32_t *hfvis_lk_lut_fetch(const hfvis_lk_lut *lut, int directions,
                                              const double m[3], double d_over_r)
 {
-    if (!lk_lut_valid(lut) || !m || !lk_finite3(m) || !isfinite(d_over_r) ||
+    if (!lk_lut_valid(lut) || !m || !hfvis__all_finite(m, 3) || !isfinite(d_over_r) ||
         (m[0] == 0.0 && m[1] == 0.0 && m[2] == 0.0))
         return NULL;
     return lk_lut_get(lut, directions, m, d_over_r);
@@ -4993,7 +4854,7 @@ static void lk_mask_lut(const hfvis_lk_lut *L, const lk_tri *t, uint32_t *out)
 {
     const uint32_t *pl;
     int w, k;
-    if (t->dr == LK_INF || t->dr > 1.0) {
+    if (t->dr == HFVIS__INF || t->dr > 1.0) {
         memset(out, 0, sizeof(uint32_t) * (size_t)L->words);
         return;
     }
@@ -5015,7 +4876,7 @@ HFVIS_API hfvis_status hfvis_lk_plane_mask(const hfvis_lk_rays *rays, const doub
                                            double d_over_r, uint32_t *mask)
 {
     int i;
-    if (!lk_rays_valid(rays) || !m || !mask || !lk_finite3(m) || !isfinite(d_over_r))
+    if (!lk_rays_valid(rays) || !m || !mask || !hfvis__all_finite(m, 3) || !isfinite(d_over_r))
         return HFVIS_ERR_INVALID_ARGUMENT;
     memset(mask, 0, sizeof(uint32_t) * (size_t)rays->words);
     for (i = 0; i < rays->count; i++)
@@ -5041,7 +4902,7 @@ HFVIS_API hfvis_status hfvis_lk_triangle_mask(const hfvis_lk_rays *rays, const h
     lk_tri t;
     int a;
     if (!lk_rays_valid(rays) || !position || !frame || !v0 || !v1 || !v2 || !mask ||
-        !lk_finite3(position) || !lk_frame_valid(frame) || !(r_min >= 0.0) || !(r_max >= r_min) ||
+        !hfvis__all_finite(position, 3) || !lk_frame_valid(frame) || !(r_min >= 0.0) || !(r_max >= r_min) ||
         !(r_max <= rays->radius) || !isfinite(epsilon) || !(epsilon > 0.0))
         return HFVIS_ERR_INVALID_ARGUMENT;
     for (a = 0; a < 3; a++)
@@ -5090,7 +4951,7 @@ static void lk_tri_sphere(const float *v0, const float *v1, const float *v2, dou
         for (k = 0; k < 3; k++) q[k] = lk_dot(a, a) * b[k] - lk_dot(b, b) * a[k];
         lk_cross(q, axb, t);
         for (k = 0; k < 3; k++) c[k] = C[k] + t[k] / den;
-        if (!lk_finite3(c) || !(den > 0.0)) /* (nearly) degenerate: centroid */
+        if (!hfvis__all_finite(c, 3) || !(den > 0.0)) /* (nearly) degenerate: centroid */
             for (k = 0; k < 3; k++) c[k] = (A[k] + B[k] + C[k]) / 3.0;
     }
     for (k = 0; k < 3; k++) {
@@ -5204,7 +5065,7 @@ static int lk_prism_build(const float *f0, const float *f1, const float *f2, dou
         }
     P->nv = 2 * np;
     for (k = 0; k < P->nv; k++)
-        if (!lk_finite3(P->vtx[k])) return 0;
+        if (!hfvis__all_finite(P->vtx[k], 3)) return 0;
     for (k = 0; k < 8; k++)
         if (!isfinite(P->pl[k][3])) return 0;
     return 1;
@@ -5214,7 +5075,7 @@ static int lk_prism_build(const float *f0, const float *f1, const float *f2, dou
 static int lk_prism_clip(const lk_prism *P, const double o[3], const double D[3], double *t_in,
                          double *t_out)
 {
-    double ti = -LK_INF, to = LK_INF;
+    double ti = -HFVIS__INF, to = HFVIS__INF;
     int k;
     for (k = 0; k < 8; k++) {
         double num = P->pl[k][3] - lk_dot(P->pl[k], o), den = lk_dot(P->pl[k], D);
@@ -5299,7 +5160,7 @@ HFVIS_API hfvis_status hfvis_lk_options_resolve(const hfvis_lk_options *in, doub
     if (!lk_jitter_valid(o.jitter, o.rotation_max_rad, o.tilt_max_rad))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (o.jitter == HFVIS_LK_JITTER_DEFAULT) {
-        o.rotation_max_rad = LK_PI;
+        o.rotation_max_rad = HFVIS__PI;
         o.tilt_max_rad = HFVIS_LK_DEFAULT_TILT;
     } else if (o.jitter == HFVIS_LK_JITTER_NONE) {
         o.rotation_max_rad = 0.0;
@@ -5343,7 +5204,7 @@ static hfvis_status lk_ctx_init(lk_ctx *c, const hfvis_mesh *mesh, const hfvis_l
     if (c->o.lut && (c->o.mask_mode == HFVIS_LK_MASK_LUT || c->o.node_mask == HFVIS_LK_NODE_SPHERE_LUT) &&
         c->o.lut->count != R->count)
         return HFVIS_ERR_INVALID_ARGUMENT;
-    s = lk_mesh_check(mesh);
+    s = hfvis__mesh_check(mesh);
     if (s != HFVIS_OK) return s;
     if (c->o.lod_range)
         for (t = 0; t < mesh->triangle_count; t++) {
@@ -5394,7 +5255,7 @@ static int lk_receivers_valid(const hfvis_lk_receivers *rc)
     for (i = 0; i < rc->count; i++) {
         const double *p = rc->position + 3 * i, *n = rc->normal + 3 * i;
         double l2 = lk_dot(n, n);
-        if (!lk_finite3(p) || !lk_finite3(n) || !(l2 > 0.0) || !isfinite(l2)) return 0;
+        if (!hfvis__all_finite(p, 3) || !hfvis__all_finite(n, 3) || !(l2 > 0.0) || !isfinite(l2)) return 0;
     }
     return 1;
 }
@@ -5445,7 +5306,7 @@ static double lk_depth(const lk_cam *c, const double x[3])
  * the eye (w <= 0) or the projection is not finite. */
 static void lk_screen_box(const lk_cam *c, const double (*pts)[3], int n, int box[4])
 {
-    double mnx = LK_INF, mny = LK_INF, mxx = -LK_INF, mxy = -LK_INF, f;
+    double mnx = HFVIS__INF, mny = HFVIS__INF, mxx = -HFVIS__INF, mxy = -HFVIS__INF, f;
     int k;
     for (k = 0; k < n; k++) {
         const double *p = pts[k];
@@ -5494,7 +5355,7 @@ static hfvis_status lk_gbuffer_run(const hfvis_mesh *mesh, const hfvis_view *vie
     n = (size_t)view->width * (size_t)view->height;
     if (!lk_part(&bytes, n, sizeof(uint32_t)) || !lk_part(&bytes, n, 2 * sizeof(float)))
         return HFVIS_ERR_LIMIT; /* only on 32-bit size_t */
-    block = (unsigned char *)ss_alloc(alloc, bytes);
+    block = (unsigned char *)hfvis__alloc(alloc, bytes);
     if (!block) return HFVIS_ERR_OUT_OF_MEMORY;
     cur = block;
     memset(&ro, 0, sizeof ro);
@@ -5505,7 +5366,7 @@ static hfvis_status lk_gbuffer_run(const hfvis_mesh *mesh, const hfvis_view *vie
     out.barycentric = (float *)lk_take(&cur, n, 2 * sizeof(float));
     s = hfvis_rasterize(mesh, view, &ro, &out);
     if (s != HFVIS_OK) {
-        ss_free(alloc, block);
+        hfvis__free(alloc, block);
         return s;
     }
     *ids = out.triangle_id;
@@ -5558,7 +5419,7 @@ HFVIS_API hfvis_status hfvis_lk_gbuffer_receivers(const hfvis_mesh *mesh, const 
         k++;
     }
     *count = k;
-    ss_free(o.alloc, ids);
+    hfvis__free(o.alloc, ids);
     return HFVIS_OK;
 }
 
@@ -5589,7 +5450,7 @@ HFVIS_API hfvis_status hfvis_lk_raster(const hfvis_mesh *mesh, const hfvis_view 
     if (view->width > HFVIS_RASTER_MAX_SIZE || view->height > HFVIS_RASTER_MAX_SIZE)
         return HFVIS_ERR_LIMIT;
     npix = (size_t)view->width * (size_t)view->height;
-    if (!ss_mul(npix, (size_t)words, &maskwords) || maskwords > SIZE_MAX / sizeof(uint32_t))
+    if (!hfvis__mul_size(npix, (size_t)words, &maskwords) || maskwords > SIZE_MAX / sizeof(uint32_t))
         return HFVIS_ERR_LIMIT;
     s = lk_gbuffer_run(mesh, view, ctx.o.gbuffer_cull, ctx.o.alloc, &ids, &bary);
     if (s != HFVIS_OK) return s;
@@ -5597,12 +5458,12 @@ HFVIS_API hfvis_status hfvis_lk_raster(const hfvis_mesh *mesh, const hfvis_view 
     if (!lk_part(&bytes, npix, sizeof(int32_t)) || !lk_part(&bytes, nrec, LK_REC * sizeof(double)) ||
         !lk_part(&bytes, (size_t)words, sizeof(uint32_t)) ||
         (!masks && !lk_part(&bytes, nrec, (size_t)words * sizeof(uint32_t)))) {
-        ss_free(ctx.o.alloc, ids);
+        hfvis__free(ctx.o.alloc, ids);
         return HFVIS_ERR_LIMIT; /* only on 32-bit size_t */
     }
-    block = (unsigned char *)ss_alloc(ctx.o.alloc, bytes);
+    block = (unsigned char *)hfvis__alloc(ctx.o.alloc, bytes);
     if (!block) {
-        ss_free(ctx.o.alloc, ids);
+        hfvis__free(ctx.o.alloc, ids);
         return HFVIS_ERR_OUT_OF_MEMORY;
     }
     cur = block;
@@ -5624,7 +5485,7 @@ HFVIS_API hfvis_status hfvis_lk_raster(const hfvis_mesh *mesh, const hfvis_view 
         r[12] = lk_depth(&cam, r);
         recidx[i] = (int32_t)nrec++;
     }
-    ss_free(ctx.o.alloc, ids);
+    hfvis__free(ctx.o.alloc, ids);
     /* occlusion buffers cleared (step 2); masks[pixel] or acc[receiver] */
     memset(acc, 0, sizeof(uint32_t) * (masks ? maskwords : nrec * (size_t)words));
     memset(&st, 0, sizeof st);
@@ -5777,7 +5638,7 @@ HFVIS_API hfvis_status hfvis_lk_raster(const hfvis_mesh *mesh, const hfvis_view 
     st.receivers = nrec;
     st.rays = (uint64_t)nrec * (uint64_t)rays->count;
     if (stats) *stats = st;
-    ss_free(ctx.o.alloc, block);
+    hfvis__free(ctx.o.alloc, block);
     return HFVIS_OK;
 }
 
@@ -5857,7 +5718,7 @@ static hfvis_status lk_trav_init(lk_trav *tv, const lk_ctx *c, const hfvis_bvh *
         !lk_part(&bytes, LK_STACK, (1 + (size_t)c->words) * sizeof(uint32_t)) ||
         !lk_part(&bytes, 2 * (size_t)c->words, sizeof(uint32_t)))
         return HFVIS_ERR_LIMIT; /* only on 32-bit size_t */
-    tv->block = (unsigned char *)ss_alloc(c->o.alloc, bytes);
+    tv->block = (unsigned char *)hfvis__alloc(c->o.alloc, bytes);
     if (!tv->block) return HFVIS_ERR_OUT_OF_MEMORY;
     cur = tv->block;
     tv->td = (double *)lk_take(&cur, T, 4 * sizeof(double));
@@ -5867,7 +5728,7 @@ static hfvis_status lk_trav_init(lk_trav *tv, const lk_ctx *c, const hfvis_bvh *
     tv->tmask = tv->C + c->words;
     s = lk_bvh_check(bvh, c->mesh, depth);
     if (s != HFVIS_OK) {
-        ss_free(c->o.alloc, tv->block);
+        hfvis__free(c->o.alloc, tv->block);
         return s;
     }
     lk_tri_table(c->mesh, tv->td);
@@ -5886,7 +5747,7 @@ static hfvis_status lk_explicit_init(lk_ctx *c, const hfvis_mesh *mesh, const hf
     s = lk_ctx_init(c, mesh, rays, opts);
     if (s != HFVIS_OK) return s;
     if (!lk_receivers_valid(recv)) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (!ss_mul(recv->count, (size_t)rays->words, &words) || words > SIZE_MAX / sizeof(uint32_t))
+    if (!hfvis__mul_size(recv->count, (size_t)rays->words, &words) || words > SIZE_MAX / sizeof(uint32_t))
         return HFVIS_ERR_LIMIT;
     return HFVIS_OK;
 }
@@ -6193,7 +6054,7 @@ HFVIS_API hfvis_status hfvis_lk_bvh(const hfvis_mesh *mesh, const hfvis_bvh *bvh
     st.receivers = recv->count;
     st.rays = (uint64_t)recv->count * (uint64_t)rays->count;
     if (stats) *stats = st;
-    ss_free(c.o.alloc, tv.block);
+    hfvis__free(c.o.alloc, tv.block);
     return HFVIS_OK;
 }
 
@@ -6204,7 +6065,7 @@ HFVIS_API hfvis_status hfvis_lk_bvh(const hfvis_mesh *mesh, const hfvis_bvh *bvh
 static int lk_slab(const hfvis_bvh_node *nd, const double p[3], const double D[3],
                    const double inv[3])
 {
-    double tn = -LK_INF, tf = LK_INF;
+    double tn = -HFVIS__INF, tf = HFVIS__INF;
     int a;
     for (a = 0; a < 3; a++) {
         double lo = (double)nd->lo[a], hi = (double)nd->hi[a], t0, t1;
@@ -6328,7 +6189,7 @@ static hfvis_status lk_cast_watertight(const lk_ctx *c, const hfvis_bvh *bvh, co
     return HFVIS_OK;
 }
 
-HFVIS_API hfvis_status hfvis_lk_raycast(const hfvis_mesh *mesh, const hfvis_bvh *bvh,
+HFVIS_API hfvis_status hfvis_lk_reference(const hfvis_mesh *mesh, const hfvis_bvh *bvh,
                                         const hfvis_lk_rays *rays,
                                         const hfvis_lk_receivers *recv,
                                         const hfvis_lk_options *opts, uint32_t *masks,
@@ -6365,7 +6226,7 @@ HFVIS_API hfvis_status hfvis_lk_raycast(const hfvis_mesh *mesh, const hfvis_bvh 
     st.receivers = recv->count;
     st.rays = (uint64_t)recv->count * (uint64_t)rays->count;
     if (s == HFVIS_OK && stats) *stats = st;
-    ss_free(c.o.alloc, tv.block);
+    hfvis__free(c.o.alloc, tv.block);
     return s;
 }
 
@@ -6394,7 +6255,7 @@ HFVIS_API hfvis_status hfvis_lk_image(hfvis_lk_method method, const hfvis_mesh *
         return HFVIS_ERR_INVALID_ARGUMENT;
     s = hfvis_lk_options_resolve(opts, rays->radius, &o);
     if (s != HFVIS_OK) return s;
-    s = lk_mesh_check(mesh);
+    s = hfvis__mesh_check(mesh);
     if (s != HFVIS_OK) return s;
     s = lk_cam_init(&cam, view);
     if (s != HFVIS_OK) return s;
@@ -6406,7 +6267,7 @@ HFVIS_API hfvis_status hfvis_lk_image(hfvis_lk_method method, const hfvis_mesh *
         (masks && !lk_part(&bytes, npix, words * sizeof(uint32_t))) ||
         (obscurance && !lk_part(&bytes, npix, sizeof(float))))
         return HFVIS_ERR_LIMIT;
-    block = (unsigned char *)ss_alloc(o.alloc, bytes);
+    block = (unsigned char *)hfvis__alloc(o.alloc, bytes);
     if (!block) return HFVIS_ERR_OUT_OF_MEMORY;
     cur = block;
     pos = (double *)lk_take(&cur, npix, 3 * sizeof(double));
@@ -6416,7 +6277,7 @@ HFVIS_API hfvis_status hfvis_lk_image(hfvis_lk_method method, const hfvis_mesh *
     if (obscurance) ro = (float *)lk_take(&cur, npix, sizeof(float));
     s = hfvis_lk_gbuffer_receivers(mesh, view, &o, pos, nrm, key, &count);
     if (s != HFVIS_OK) {
-        ss_free(o.alloc, block);
+        hfvis__free(o.alloc, block);
         return s;
     }
     if (!bvh) {
@@ -6424,7 +6285,7 @@ HFVIS_API hfvis_status hfvis_lk_image(hfvis_lk_method method, const hfvis_mesh *
         bo.alloc = o.alloc;
         s = hfvis_bvh_build(mesh, &bo, &own);
         if (s != HFVIS_OK) {
-            ss_free(o.alloc, block);
+            hfvis__free(o.alloc, block);
             return s;
         }
     }
@@ -6433,7 +6294,7 @@ HFVIS_API hfvis_status hfvis_lk_image(hfvis_lk_method method, const hfvis_mesh *
     rc.normal = nrm;
     rc.key = key;
     if (method == HFVIS_LK_METHOD_BVH) s = hfvis_lk_bvh(mesh, bvh ? bvh : &own, rays, &rc, &o, rm, ro, stats);
-    else s = hfvis_lk_raycast(mesh, bvh ? bvh : &own, rays, &rc, &o, rm, ro, stats);
+    else s = hfvis_lk_reference(mesh, bvh ? bvh : &own, rays, &rc, &o, rm, ro, stats);
     if (!bvh) hfvis_bvh_free(o.alloc, &own);
     if (s == HFVIS_OK) {
         if (masks) memset(masks, 0, sizeof(uint32_t) * npix * words);
@@ -6444,6 +6305,6 @@ HFVIS_API hfvis_status hfvis_lk_image(hfvis_lk_method method, const hfvis_mesh *
             if (obscurance) obscurance[key[i]] = ro[i];
         }
     }
-    ss_free(o.alloc, block);
+    hfvis__free(o.alloc, block);
     return s;
 }

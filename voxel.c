@@ -1,9 +1,10 @@
 /* voxel.c - meshes and volumes. Part of hfvis (see hfvis.h for the conventions and the API).
  *
  * Contents
- *   1. Common: allocation, checked sizes, mesh and grid validation, file helpers
+ *   1. Common: mesh and grid validation (allocation, checked sizes, the PRNGs and file reading
+ *      are hfvis.c's hfvis__ helpers)
  *   2. Views: GL-convention matrices, depth linearisation (thesis eq. 16, sign restored)
- *   3. Volume grids and the Volume Buffer (thesis ch. 6 §6.3; [G12] ch. 6)
+ *   3. Volume grids and the Volume Buffer ([G12] §6.3)
  *   4. Meshes: analytic test meshes (box, spheres, torus, torus knot, height field, room,
  *      teapot) and the Wavefront OBJ codec
  *   5. Reference rasterizer: fixed-point top-left coverage, near clipping, ray-per-pixel oracle
@@ -22,6 +23,7 @@
  * methods for dynamic environments", PhD thesis, Univ. of Cyprus, 2012. Errata and choices:
  * docs/errata.md E54-E66.
  */
+#define HFVIS__INTERNAL /* the internal block of hfvis.h: shared helpers, not API */
 #include "hfvis.h"
 
 #include <float.h>
@@ -34,30 +36,6 @@
 #include <stdio.h>
 #endif
 
-#if defined(__clang__)
-#pragma STDC FP_CONTRACT OFF
-#endif
-
-#ifndef HFVIS_ASSERT
-#ifdef HFVIS_ENABLE_ASSERTS
-#include <assert.h>
-#define HFVIS_ASSERT(x) assert(x)
-#else
-#define HFVIS_ASSERT(x) ((void)0)
-#endif
-#endif
-
-/* The allocation behind a NULL allocator (hfvis.h, "Memory"): define both to replace it. */
-#if defined(HFVIS_MALLOC) != defined(HFVIS_FREE)
-#error "define both HFVIS_MALLOC and HFVIS_FREE, or neither"
-#endif
-#ifndef HFVIS_MALLOC
-#define HFVIS_MALLOC(size) malloc(size)
-#define HFVIS_FREE(ptr) free(ptr)
-#endif
-
-#define VX_PI 3.14159265358979323846
-
 /* Marks internal helpers that a given build may leave unused (-Wunused-function). */
 #if defined(__GNUC__)
 #define VX_MAYBE_UNUSED __attribute__((unused))
@@ -69,51 +47,9 @@
 /* 1. Common                                                                                  */
 /* ========================================================================================== */
 
-#ifndef HFVIS_NO_STDIO
-/* Internal, defined in hfvis.c (section 2): whole-file read into a block from alloc, and an
- * atomic write (temporary file renamed onto path: the target is complete or untouched). */
-hfvis_status hfvis__read_file(const char *path, const hfvis_allocator *alloc,
-                             hfvis_status (*sizer)(const unsigned char *head, size_t n, size_t *total),
-                             unsigned char **data, size_t *size);
-#endif
-
-static void *vx_alloc(const hfvis_allocator *a, size_t bytes)
-{
-    if (bytes == 0) return NULL;
-    if (a && a->alloc) return a->alloc(a->user, bytes);
-    return HFVIS_MALLOC(bytes);
-}
-
-/* As ss_free and hf_free: without alloc, the memory came from HFVIS_MALLOC. */
-static void vx_free(const hfvis_allocator *a, void *p)
-{
-    if (!p) return;
-    if (a && a->alloc) {
-        if (a->free) a->free(a->user, p);
-        return;
-    }
-    HFVIS_FREE(p);
-}
-
-/* *out = a*b; returns 0 (and leaves *out alone) on overflow. */
-static int vx_mul_size(size_t a, size_t b, size_t *out)
-{
-    if (a != 0 && b > SIZE_MAX / a) return 0;
-    *out = a * b;
-    return 1;
-}
-
-/* count*elem bytes from alloc; NULL on overflow, failure or count 0. */
-VX_MAYBE_UNUSED static void *vx_alloc_array(const hfvis_allocator *a, size_t count, size_t elem)
-{
-    size_t bytes;
-    if (!vx_mul_size(count, elem, &bytes)) return NULL;
-    return vx_alloc(a, bytes);
-}
-
 /* HFVIS_OK when the mesh is usable (hfvis_mesh: indices < vertex_count, finite coordinates),
  * else HFVIS_ERR_INVALID_ARGUMENT. O(V + T). */
-static hfvis_status vx_mesh_check(const hfvis_mesh *m)
+hfvis_status hfvis__mesh_check(const hfvis_mesh *m)
 {
     size_t i, n;
     if (!m) return HFVIS_ERR_INVALID_ARGUMENT;
@@ -139,7 +75,7 @@ static int vx_grid_valid(const hfvis_volume_grid *g)
         if (g->dims[a] < 1 || !isfinite(g->origin[a]) || !isfinite(g->cell[a])
             || !(g->cell[a] > 0.0))
             return 0;
-        if (!vx_mul_size(n, (size_t)g->dims[a], &n)) return 0;
+        if (!hfvis__mul_size(n, (size_t)g->dims[a], &n)) return 0;
     }
     return n <= HFVIS_VOLUME_MAX_VOXELS;
 }
@@ -154,8 +90,8 @@ HFVIS_API void hfvis_mesh_free(const hfvis_allocator *alloc, hfvis_mesh *mesh)
 {
     if (!mesh) return;
     /* The arrays are const for the mesh's users; the generators and decoders own them. */
-    vx_free(alloc, (void *)(uintptr_t)mesh->xyz);
-    vx_free(alloc, (void *)(uintptr_t)mesh->indices);
+    hfvis__free(alloc, (void *)(uintptr_t)mesh->xyz);
+    hfvis__free(alloc, (void *)(uintptr_t)mesh->indices);
     memset(mesh, 0, sizeof *mesh);
 }
 
@@ -164,14 +100,6 @@ HFVIS_API void hfvis_mesh_free(const hfvis_allocator *alloc, hfvis_mesh *mesh)
 /* ========================================================================================== */
 
 #define VX_M(m, r, c) ((m)[(c) * 4 + (r)]) /* column-major element (row r, column c) */
-
-static int vx_all_finite(const double *v, int n)
-{
-    int i;
-    for (i = 0; i < n; i++)
-        if (!isfinite(v[i])) return 0;
-    return 1;
-}
 
 /* out = m * in (homogeneous 4-vectors). out must not alias in. */
 VX_MAYBE_UNUSED static void vx_mat4_apply(const double m[16], const double in[4], double out[4])
@@ -197,7 +125,7 @@ HFVIS_API hfvis_status hfvis_mat4_invert(const double m[16], double out[16])
 {
     double a[4][8];
     int r, c, k;
-    if (!m || !out || !vx_all_finite(m, 16)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!m || !out || !hfvis__all_finite(m, 16)) return HFVIS_ERR_INVALID_ARGUMENT;
     for (r = 0; r < 4; r++)
         for (c = 0; c < 8; c++) a[r][c] = c < 4 ? VX_M(m, r, c) : (c - 4 == r ? 1.0 : 0.0);
     for (k = 0; k < 4; k++) {
@@ -234,8 +162,8 @@ HFVIS_API hfvis_status hfvis_mat4_look_at(const double eye[3], const double targ
 {
     double f[3], s[3], u[3], lf, ls;
     int i;
-    if (!eye || !target || !up || !out || !vx_all_finite(eye, 3) || !vx_all_finite(target, 3)
-        || !vx_all_finite(up, 3))
+    if (!eye || !target || !up || !out || !hfvis__all_finite(eye, 3) || !hfvis__all_finite(target, 3)
+        || !hfvis__all_finite(up, 3))
         return HFVIS_ERR_INVALID_ARGUMENT;
     for (i = 0; i < 3; i++) f[i] = target[i] - eye[i];
     lf = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
@@ -268,7 +196,7 @@ HFVIS_API hfvis_status hfvis_mat4_perspective(double fov_y_rad, double aspect, d
                                               double far_plane, double out[16])
 {
     double t;
-    if (!out || !(fov_y_rad > 0.0 && fov_y_rad < VX_PI) || !(aspect > 0.0) || !isfinite(aspect)
+    if (!out || !(fov_y_rad > 0.0 && fov_y_rad < HFVIS__PI) || !(aspect > 0.0) || !isfinite(aspect)
         || !(near_plane > 0.0) || !(far_plane > near_plane) || !isfinite(far_plane))
         return HFVIS_ERR_INVALID_ARGUMENT;
     t = 1.0 / tan(0.5 * fov_y_rad);
@@ -286,7 +214,7 @@ HFVIS_API hfvis_status hfvis_mat4_ortho(double left, double right, double bottom
 {
     double b[6];
     b[0] = left, b[1] = right, b[2] = bottom, b[3] = top, b[4] = near_plane, b[5] = far_plane;
-    if (!out || !vx_all_finite(b, 6) || !(left < right) || !(bottom < top)
+    if (!out || !hfvis__all_finite(b, 6) || !(left < right) || !(bottom < top)
         || !(near_plane < far_plane))
         return HFVIS_ERR_INVALID_ARGUMENT;
     memset(out, 0, 16 * sizeof *out);
@@ -362,7 +290,7 @@ HFVIS_API double hfvis_eye_z_to_depth(double z_eye, double near_plane, double fa
 }
 
 /* ========================================================================================== */
-/* 3. Volume grids and the Volume Buffer ([G12] §6.3; [G12] ch. 6)                             */
+/* 3. Volume grids and the Volume Buffer ([G12] §6.3)                                         */
 /* ========================================================================================== */
 
 /* Bounds of the vertices the triangles of a valid mesh use (a soup may carry unused vertices);
@@ -392,7 +320,7 @@ HFVIS_API hfvis_status hfvis_volume_grid_fit(const hfvis_mesh *mesh, int resolut
     hfvis_volume_grid g;
     size_t total = 1;
     int a;
-    if (!out || vx_mesh_check(mesh) != HFVIS_OK || mesh->triangle_count == 0 || resolution < 1
+    if (!out || hfvis__mesh_check(mesh) != HFVIS_OK || mesh->triangle_count == 0 || resolution < 1
         || !(padding >= 0.0) || !isfinite(padding))
         return HFVIS_ERR_INVALID_ARGUMENT;
     ext_max = vx_used_bounds(mesh, lo, hi);
@@ -426,18 +354,18 @@ HFVIS_API hfvis_status hfvis_volume_grid_fit(const hfvis_mesh *mesh, int resolut
             g.origin[a] = 0.5 * (lo[a] + hi[a]) - 0.5 * (double)g.dims[a] * cell_max;
         }
         if (!(g.cell[a] > 0.0) || !isfinite(g.origin[a])) return HFVIS_ERR_INVALID_ARGUMENT;
-        if (!vx_mul_size(total, (size_t)g.dims[a], &total) || total > HFVIS_VOLUME_MAX_VOXELS)
+        if (!hfvis__mul_size(total, (size_t)g.dims[a], &total) || total > HFVIS_VOLUME_MAX_VOXELS)
             return HFVIS_ERR_LIMIT;
     }
     *out = g;
     return HFVIS_OK;
 }
 
-HFVIS_API size_t hfvis_volume_size(const hfvis_volume_grid *grid, int channels)
+HFVIS_API size_t hfvis_volume_floats(const hfvis_volume_grid *grid, int channels)
 {
     size_t n;
     if (!vx_grid_valid(grid) || channels < 1 || channels > HFVIS_VOLUME_MAX_CHANNELS) return 0;
-    if (!vx_mul_size(vx_grid_voxels(grid), (size_t)channels, &n)) return 0;
+    if (!hfvis__mul_size(vx_grid_voxels(grid), (size_t)channels, &n)) return 0;
     return n;
 }
 
@@ -450,7 +378,7 @@ static int vx_blend_valid(hfvis_blend b)
 HFVIS_API hfvis_status hfvis_volume_init(hfvis_volume *vol, const hfvis_volume_grid *grid,
                                          int channels, float *storage, hfvis_blend blend)
 {
-    size_t n = hfvis_volume_size(grid, channels), i;
+    size_t n = hfvis_volume_floats(grid, channels), i;
     int c;
     if (!vol || !storage || n == 0 || !vx_blend_valid(blend)) return HFVIS_ERR_INVALID_ARGUMENT;
     memset(vol, 0, sizeof *vol);
@@ -466,7 +394,7 @@ HFVIS_API void hfvis_volume_clear(hfvis_volume *vol, float value)
 {
     size_t n, i;
     if (!vol || !vol->data) return;
-    n = hfvis_volume_size(&vol->grid, vol->channels);
+    n = hfvis_volume_floats(&vol->grid, vol->channels);
     for (i = 0; i < n; i++) vol->data[i] = value;
 }
 
@@ -505,7 +433,7 @@ HFVIS_API hfvis_status hfvis_volume_merge(hfvis_volume *dst, const hfvis_volume 
     int c, a;
     if (!dst || !src || !dst->data || !src->data || dst->channels != src->channels)
         return HFVIS_ERR_INVALID_ARGUMENT;
-    n = hfvis_volume_size(&dst->grid, dst->channels);
+    n = hfvis_volume_floats(&dst->grid, dst->channels);
     if (n == 0) return HFVIS_ERR_INVALID_ARGUMENT;
     for (a = 0; a < 3; a++)
         if (dst->grid.dims[a] != src->grid.dims[a]) return HFVIS_ERR_INVALID_ARGUMENT;
@@ -532,8 +460,6 @@ HFVIS_API hfvis_status hfvis_volume_merge(hfvis_volume *dst, const hfvis_volume 
  * Every generated triangle is counter-clockwise seen from outside: (v1 - v0) x (v2 - v0) points
  * out of the enclosed volume (into the room for the room's walls). */
 
-#define VX_MESH_PI 3.14159265358979323846
-
 /* ---- 4a. builder ------------------------------------------------------------------------ */
 
 typedef struct vx_mesh_builder {
@@ -550,13 +476,13 @@ static hfvis_status vx_mesh_builder_init(vx_mesh_builder *b, const hfvis_allocat
     memset(b, 0, sizeof *b);
     if (nv > HFVIS_MESH_MAX_VERTICES || nt > HFVIS_MESH_MAX_TRIANGLES) return HFVIS_ERR_LIMIT;
     if (nv > 0) {
-        b->xyz = (float *)vx_alloc_array(alloc, nv, 3 * sizeof(float));
+        b->xyz = (float *)hfvis__alloc_array(alloc, nv, 3 * sizeof(float));
         if (!b->xyz) return HFVIS_ERR_OUT_OF_MEMORY;
     }
     if (nt > 0) {
-        b->idx = (uint32_t *)vx_alloc_array(alloc, nt, 3 * sizeof(uint32_t));
+        b->idx = (uint32_t *)hfvis__alloc_array(alloc, nt, 3 * sizeof(uint32_t));
         if (!b->idx) {
-            vx_free(alloc, b->xyz);
+            hfvis__free(alloc, b->xyz);
             b->xyz = NULL;
             return HFVIS_ERR_OUT_OF_MEMORY;
         }
@@ -568,8 +494,8 @@ static hfvis_status vx_mesh_builder_init(vx_mesh_builder *b, const hfvis_allocat
 
 static void vx_mesh_builder_free(vx_mesh_builder *b, const hfvis_allocator *alloc)
 {
-    vx_free(alloc, b->xyz);
-    vx_free(alloc, b->idx);
+    hfvis__free(alloc, b->xyz);
+    hfvis__free(alloc, b->idx);
     b->xyz = NULL;
     b->idx = NULL;
 }
@@ -627,7 +553,7 @@ static int vx_mesh_point_ok(const double c[3])
 static size_t vx_mesh_mul(size_t a, size_t b)
 {
     size_t r;
-    return vx_mul_size(a, b, &r) ? r : SIZE_MAX;
+    return hfvis__mul_size(a, b, &r) ? r : SIZE_MAX;
 }
 static size_t vx_mesh_add(size_t a, size_t b) { return a > SIZE_MAX - b ? SIZE_MAX : a + b; }
 
@@ -676,7 +602,7 @@ static void vx_mesh_revolve(vx_mesh_builder *b, const double c[3], const double 
     top = vx_mesh_v(b, c[0], c[1], c[2] + z[0]);
     for (i = 1; i < m; i++) {
         for (j = 0; j < slices; j++) {
-            double phi = 2.0 * VX_MESH_PI * (double)j / (double)slices;
+            double phi = 2.0 * HFVIS__PI * (double)j / (double)slices;
             vx_mesh_v(b, c[0] + rho[i] * cos(phi), c[1] + rho[i] * sin(phi), c[2] + z[i]);
         }
     }
@@ -716,10 +642,10 @@ HFVIS_API hfvis_status hfvis_mesh_uv_sphere(const hfvis_allocator *alloc, const 
     nv = vx_mesh_add(vx_mesh_mul(m - 1, (size_t)slices), 2);
     nt = vx_mesh_mul(vx_mesh_mul(2, (size_t)slices), m - 1);
     if (nv > HFVIS_MESH_MAX_VERTICES || nt > HFVIS_MESH_MAX_TRIANGLES) return HFVIS_ERR_LIMIT;
-    prof = (double *)vx_alloc_array(alloc, m + 1, 2 * sizeof(double));
+    prof = (double *)hfvis__alloc_array(alloc, m + 1, 2 * sizeof(double));
     if (!prof) return HFVIS_ERR_OUT_OF_MEMORY;
     for (i = 0; i <= m; i++) { /* theta_i = pi i / stacks from the north pole */
-        double th = VX_MESH_PI * (double)i / (double)m;
+        double th = HFVIS__PI * (double)i / (double)m;
         prof[i] = (i == 0 || i == m) ? 0.0 : r * sin(th);
         prof[m + 1 + i] = (i == 0) ? r : (i == m) ? -r : r * cos(th);
     }
@@ -728,7 +654,7 @@ HFVIS_API hfvis_status hfvis_mesh_uv_sphere(const hfvis_allocator *alloc, const 
         vx_mesh_revolve(&b, c, prof, prof + m + 1, m, (size_t)slices);
         s = vx_mesh_builder_finish(&b, alloc, out);
     }
-    vx_free(alloc, prof);
+    hfvis__free(alloc, prof);
     return s;
 }
 
@@ -802,13 +728,13 @@ HFVIS_API hfvis_status hfvis_mesh_icosphere(const hfvis_allocator *alloc, const 
     em.mask = cap - 1;
     s = vx_mesh_builder_init(&b, alloc, nv, nt);
     if (s != HFVIS_OK) return s;
-    unit = (double *)vx_alloc_array(alloc, nv, 3 * sizeof(double));
-    em.keys = (uint64_t *)vx_alloc_array(alloc, cap, sizeof(uint64_t));
-    em.vals = (uint32_t *)vx_alloc_array(alloc, cap, sizeof(uint32_t));
+    unit = (double *)hfvis__alloc_array(alloc, nv, 3 * sizeof(double));
+    em.keys = (uint64_t *)hfvis__alloc_array(alloc, cap, sizeof(uint64_t));
+    em.vals = (uint32_t *)hfvis__alloc_array(alloc, cap, sizeof(uint32_t));
     if (!unit || !em.keys || !em.vals) {
-        vx_free(alloc, em.vals);
-        vx_free(alloc, em.keys);
-        vx_free(alloc, unit);
+        hfvis__free(alloc, em.vals);
+        hfvis__free(alloc, em.keys);
+        hfvis__free(alloc, unit);
         vx_mesh_builder_free(&b, alloc);
         return HFVIS_ERR_OUT_OF_MEMORY;
     }
@@ -853,9 +779,9 @@ HFVIS_API hfvis_status hfvis_mesh_icosphere(const hfvis_allocator *alloc, const 
     for (v = 0; v < nv; v++)
         vx_mesh_v(&b, c[0] + r * unit[3 * v], c[1] + r * unit[3 * v + 1], c[2] + r * unit[3 * v + 2]);
     b.nt = nt;
-    vx_free(alloc, em.vals);
-    vx_free(alloc, em.keys);
-    vx_free(alloc, unit);
+    hfvis__free(alloc, em.vals);
+    hfvis__free(alloc, em.keys);
+    hfvis__free(alloc, unit);
     return vx_mesh_builder_finish(&b, alloc, out);
 }
 
@@ -893,9 +819,9 @@ HFVIS_API hfvis_status hfvis_mesh_torus(const hfvis_allocator *alloc, const doub
     s = vx_mesh_builder_init(&b, alloc, nv, nt);
     if (s != HFVIS_OK) return s;
     for (i = 0; i < n; i++) {
-        double u = 2.0 * VX_MESH_PI * (double)i / (double)n, cu = cos(u), su = sin(u);
+        double u = 2.0 * HFVIS__PI * (double)i / (double)n, cu = cos(u), su = sin(u);
         for (j = 0; j < m; j++) {
-            double w = 2.0 * VX_MESH_PI * (double)j / (double)m;
+            double w = 2.0 * HFVIS__PI * (double)j / (double)m;
             double rho = R + r * cos(w);
             vx_mesh_v(&b, c[0] + rho * cu, c[1] + rho * su, c[2] + r * sin(w));
         }
@@ -937,7 +863,7 @@ HFVIS_API hfvis_status hfvis_mesh_torus_knot(const hfvis_allocator *alloc, const
         /* centre line C(t) = ((R + a cos qt) cos pt, (R + a cos qt) sin pt, a sin qt) and its
          * derivative T; frame N = the part of C orthogonal to T (C is never parallel to T on
          * these knots), B = N x T (unit): T x B = N, so the ring pattern is outward. */
-        double t = 2.0 * VX_MESH_PI * (double)i / (double)n;
+        double t = 2.0 * HFVIS__PI * (double)i / (double)n;
         double cp = cos((double)p * t), sp = sin((double)p * t);
         double cq = cos((double)q * t), sq = sin((double)q * t);
         double rho = R + a * cq, C[3], T[3], N[3], B[3], len, d;
@@ -958,7 +884,7 @@ HFVIS_API hfvis_status hfvis_mesh_torus_knot(const hfvis_allocator *alloc, const
         B[1] = N[2] * T[0] - N[0] * T[2];
         B[2] = N[0] * T[1] - N[1] * T[0];
         for (j = 0; j < m; j++) {
-            double w = 2.0 * VX_MESH_PI * (double)j / (double)m, cw = cos(w), sw = sin(w);
+            double w = 2.0 * HFVIS__PI * (double)j / (double)m, cw = cos(w), sw = sin(w);
             vx_mesh_v(&b, c[0] + C[0] + tube * (cw * N[0] + sw * B[0]),
                       c[1] + C[1] + tube * (cw * N[1] + sw * B[1]),
                       c[2] + C[2] + tube * (cw * N[2] + sw * B[2]));
@@ -989,7 +915,7 @@ HFVIS_API hfvis_status hfvis_mesh_from_grid(const hfvis_allocator *alloc, const 
     npts = vx_mesh_mul(W, H);
     if (npts > HFVIS_MESH_MAX_VERTICES) return HFVIS_ERR_LIMIT;
     /* pass 1: triangles kept (all three corners finite) and vertices they use */
-    remap = (uint32_t *)vx_alloc_array(alloc, npts, sizeof(uint32_t));
+    remap = (uint32_t *)hfvis__alloc_array(alloc, npts, sizeof(uint32_t));
     if (!remap) return HFVIS_ERR_OUT_OF_MEMORY;
     for (x = 0; x < npts; x++) remap[x] = 0;
 #define VX_MESH_Z(xx, yy) g->z[(ptrdiff_t)(yy) * g->stride + (ptrdiff_t)(xx)]
@@ -1014,12 +940,12 @@ HFVIS_API hfvis_status hfvis_mesh_from_grid(const hfvis_allocator *alloc, const 
         if (remap[x]) remap[x] = (uint32_t)nv++;
         else remap[x] = UINT32_MAX;
     if (nt > HFVIS_MESH_MAX_TRIANGLES) {
-        vx_free(alloc, remap);
+        hfvis__free(alloc, remap);
         return HFVIS_ERR_LIMIT;
     }
     s = vx_mesh_builder_init(&b, alloc, nv, nt);
     if (s != HFVIS_OK) {
-        vx_free(alloc, remap);
+        hfvis__free(alloc, remap);
         return s;
     }
     for (y = 0; y < H; y++)
@@ -1039,7 +965,7 @@ HFVIS_API hfvis_status hfvis_mesh_from_grid(const hfvis_allocator *alloc, const 
     }
 #undef VX_MESH_OK
 #undef VX_MESH_Z
-    vx_free(alloc, remap);
+    hfvis__free(alloc, remap);
     return vx_mesh_builder_finish(&b, alloc, out);
 }
 
@@ -1072,7 +998,7 @@ HFVIS_API hfvis_status hfvis_mesh_room(const hfvis_allocator *alloc, hfvis_mesh 
 {
     vx_mesh_builder b;
     hfvis_status s;
-    const double deg17 = 17.0 * VX_MESH_PI / 180.0;
+    const double deg17 = 17.0 * HFVIS__PI / 180.0;
     if (!out) return HFVIS_ERR_INVALID_ARGUMENT;
     s = vx_mesh_builder_init(&b, alloc, 24, 30);
     if (s != HFVIS_OK) return s;
@@ -1159,7 +1085,7 @@ HFVIS_API hfvis_status hfvis_mesh_teapot(const hfvis_allocator *alloc, int n, hf
     nv = vx_mesh_add(vx_mesh_add(vx_mesh_mul(m - 1, slices), 2), vx_mesh_mul(2, tube_v));
     nt = vx_mesh_add(vx_mesh_mul(2 * slices, m - 1), vx_mesh_mul(2, tube_t));
     if (nv > HFVIS_MESH_MAX_VERTICES || nt > HFVIS_MESH_MAX_TRIANGLES) return HFVIS_ERR_LIMIT;
-    prof = (double *)vx_alloc_array(alloc, m + 1, 2 * sizeof(double));
+    prof = (double *)hfvis__alloc_array(alloc, m + 1, 2 * sizeof(double));
     if (!prof) return HFVIS_ERR_OUT_OF_MEMORY;
     for (i = 0; i <= m; i++) {
         double pt[2];
@@ -1170,11 +1096,11 @@ HFVIS_API hfvis_status hfvis_mesh_teapot(const hfvis_allocator *alloc, int n, hf
     }
     s = vx_mesh_builder_init(&b, alloc, nv, nt);
     if (s != HFVIS_OK) {
-        vx_free(alloc, prof);
+        hfvis__free(alloc, prof);
         return s;
     }
     vx_mesh_revolve(&b, zero, prof, prof + m + 1, m, slices);
-    vx_free(alloc, prof);
+    hfvis__free(alloc, prof);
     for (which = 0; which < 2; which++) {
         size_t base = b.nv;
         for (i = 0; i < along; i++) {
@@ -1189,7 +1115,7 @@ HFVIS_API hfvis_status hfvis_mesh_teapot(const hfvis_allocator *alloc, int n, hf
             N[1] = 0.0;
             N[2] = T[0];
             for (j = 0; j < around; j++) {
-                double w = 2.0 * VX_MESH_PI * (double)j / (double)around, cw = cos(w), sw = sin(w);
+                double w = 2.0 * HFVIS__PI * (double)j / (double)around, cw = cos(w), sw = sin(w);
                 vx_mesh_v(&b, P[0] + rad * (cw * N[0] + sw * Bv[0]), rad * sw * Bv[1],
                           P[2] + rad * (cw * N[2] + sw * Bv[2]));
             }
@@ -1206,7 +1132,7 @@ HFVIS_API hfvis_status hfvis_mesh_bounds(const hfvis_mesh *mesh, double lo[3], d
     double l[3], h[3];
     size_t v;
     int k;
-    if (!lo || !hi || vx_mesh_check(mesh) != HFVIS_OK || mesh->vertex_count == 0)
+    if (!lo || !hi || hfvis__mesh_check(mesh) != HFVIS_OK || mesh->vertex_count == 0)
         return HFVIS_ERR_INVALID_ARGUMENT;
     for (k = 0; k < 3; k++) l[k] = h[k] = (double)mesh->xyz[k];
     for (v = 1; v < mesh->vertex_count; v++) {
@@ -1625,7 +1551,7 @@ static size_t vx_mesh_obj_emit(const hfvis_mesh *m, unsigned char *out)
 
 HFVIS_API size_t hfvis_obj_encode_size(const hfvis_mesh *mesh)
 {
-    if (vx_mesh_check(mesh) != HFVIS_OK) return 0;
+    if (hfvis__mesh_check(mesh) != HFVIS_OK) return 0;
     return vx_mesh_obj_emit(mesh, NULL);
 }
 
@@ -1633,7 +1559,7 @@ HFVIS_API hfvis_status hfvis_obj_encode(const hfvis_mesh *mesh, void *out, size_
                                         size_t *written)
 {
     size_t need;
-    if (!out || !written || vx_mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!out || !written || hfvis__mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     need = vx_mesh_obj_emit(mesh, NULL);
     if (need == 0) return HFVIS_ERR_INVALID_ARGUMENT;
     if (out_capacity < need) return HFVIS_ERR_BUFFER_TOO_SMALL;
@@ -1661,7 +1587,7 @@ HFVIS_API hfvis_status hfvis_mesh_load(const char *path, const hfvis_allocator *
     s = hfvis__read_file(path, alloc, vx_obj_sizer, &data, &size);
     if (s != HFVIS_OK) return s;
     s = hfvis_obj_decode(data, size, alloc, out);
-    vx_free(alloc, data);
+    hfvis__free(alloc, data);
     return s;
 }
 
@@ -1670,14 +1596,14 @@ HFVIS_API hfvis_status hfvis_mesh_save(const char *path, const hfvis_mesh *mesh)
     size_t need, written = 0;
     unsigned char *buf;
     hfvis_status s;
-    if (!path || vx_mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!path || hfvis__mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     need = vx_mesh_obj_emit(mesh, NULL);
     if (need == 0) return HFVIS_ERR_INVALID_ARGUMENT;
-    buf = (unsigned char *)vx_alloc(NULL, need);
+    buf = (unsigned char *)hfvis__alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     written = vx_mesh_obj_emit(mesh, buf);
     s = hfvis_write_file(path, buf, written, NULL);
-    vx_free(NULL, buf);
+    hfvis__free(NULL, buf);
     return s;
 }
 #endif /* HFVIS_NO_STDIO */
@@ -1754,7 +1680,7 @@ static hfvis_status vx_raster_check(const hfvis_mesh *mesh, const hfvis_view *vi
     size_t pixels;
     if (!mesh || !view || !out) return HFVIS_ERR_INVALID_ARGUMENT;
     if (mesh->triangle_count >= (size_t)HFVIS_NO_TRIANGLE) return HFVIS_ERR_LIMIT; /* ids */
-    if (vx_mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (hfvis__mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     *opt = opts ? *opts : hfvis_raster_options_default();
     if (opt->cull != HFVIS_CULL_NONE && opt->cull != HFVIS_CULL_BACK
         && opt->cull != HFVIS_CULL_FRONT)
@@ -1764,7 +1690,7 @@ static hfvis_status vx_raster_check(const hfvis_mesh *mesh, const hfvis_view *vi
     if (opt->normal_toward_viewer != 0 && opt->normal_toward_viewer != 1)
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (view->width < 1 || view->height < 1) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (!vx_all_finite(view->view, 16) || !vx_all_finite(view->proj, 16))
+    if (!hfvis__all_finite(view->view, 16) || !hfvis__all_finite(view->proj, 16))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (!isfinite(view->near_plane) || !isfinite(view->far_plane)
         || !(view->near_plane < view->far_plane)
@@ -1772,7 +1698,7 @@ static hfvis_status vx_raster_check(const hfvis_mesh *mesh, const hfvis_view *vi
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (view->width > HFVIS_RASTER_MAX_SIZE || view->height > HFVIS_RASTER_MAX_SIZE)
         return HFVIS_ERR_LIMIT;
-    if (!vx_mul_size((size_t)view->width, (size_t)view->height, &pixels))
+    if (!hfvis__mul_size((size_t)view->width, (size_t)view->height, &pixels))
         return HFVIS_ERR_LIMIT; /* cannot happen with the size limit; kept for the invariant */
     return HFVIS_OK;
 }
@@ -2020,7 +1946,7 @@ static void vx_raster_triangle(const vx_raster_ctx *ctx, const hfvis_mesh *mesh,
         if (c[j][2] > c[j][3]) code |= 16;
         if (c[j][2] < -c[j][3]) code |= 32;
         codes_and &= code;
-        if (!vx_all_finite(c[j], 5)) return;
+        if (!hfvis__all_finite(c[j], 5)) return;
         if (!(c[j][5] == c[j][5])) snapped = 0; /* NaN: needs clipping */
     }
     if (codes_and) return; /* all three outside one frustum plane */
@@ -2099,11 +2025,11 @@ HFVIS_API hfvis_status hfvis_rasterize(const hfvis_mesh *mesh, const hfvis_view 
     pixels = (size_t)view->width * (size_t)view->height;
     vcount = mesh->vertex_count;
     /* one block: depth buffer, column and row NDC, the vertex cache */
-    if (!vx_mul_size(vcount, VX_RASTER_VSTRIDE, &n_doubles) || n_doubles > SIZE_MAX - pixels
+    if (!hfvis__mul_size(vcount, VX_RASTER_VSTRIDE, &n_doubles) || n_doubles > SIZE_MAX - pixels
         || n_doubles + pixels > SIZE_MAX - (size_t)view->width - (size_t)view->height)
         return HFVIS_ERR_OUT_OF_MEMORY;
     n_doubles += pixels + (size_t)view->width + (size_t)view->height;
-    block = (double *)vx_alloc_array(opt.alloc, n_doubles, sizeof(double));
+    block = (double *)hfvis__alloc_array(opt.alloc, n_doubles, sizeof(double));
     if (!block) return HFVIS_ERR_OUT_OF_MEMORY;
     ndc_x = block + pixels;
     ndc_y = ndc_x + view->width;
@@ -2144,7 +2070,7 @@ HFVIS_API hfvis_status hfvis_rasterize(const hfvis_mesh *mesh, const hfvis_view 
     ctx.want_attr = out->linear_depth || out->normal || out->barycentric;
     for (tid = 0; (size_t)tid < mesh->triangle_count; tid++)
         vx_raster_triangle(&ctx, mesh, view, &opt, vcache, tid, gx, gy);
-    vx_free(opt.alloc, block);
+    hfvis__free(opt.alloc, block);
     return HFVIS_OK;
 }
 
@@ -2184,7 +2110,7 @@ HFVIS_API hfvis_status hfvis_rasterize_reference(const hfvis_mesh *mesh, const h
                 o[k] = hn[k] / hn[3];
                 d[k] = hf[k] / hf[3] - o[k];
             }
-            if (!vx_all_finite(o, 3) || !vx_all_finite(d, 3)) continue;
+            if (!hfvis__all_finite(o, 3) || !hfvis__all_finite(d, 3)) continue;
             for (t = 0; t < mesh->triangle_count; t++) {
                 const uint32_t *ix = mesh->indices + 3 * t;
                 double e[3][3], sv[3], sum, b[3], cc[3][4], zc = 0.0, wc = 0.0, zw, ze = 0.0;
@@ -2711,7 +2637,7 @@ HFVIS_API hfvis_status hfvis_bvh_build(const hfvis_mesh *mesh, const hfvis_bvh_o
     if (!mesh) return HFVIS_ERR_INVALID_ARGUMENT;
     n = mesh->triangle_count;
     if (n > HFVIS_BVH_MAX_TRIANGLES) return HFVIS_ERR_LIMIT; /* before reading the arrays */
-    st = vx_mesh_check(mesh);
+    st = hfvis__mesh_check(mesh);
     if (st != HFVIS_OK) return st;
     if (n == 0) {
         memset(out, 0, sizeof *out);
@@ -2719,11 +2645,11 @@ HFVIS_API hfvis_status hfvis_bvh_build(const hfvis_mesh *mesh, const hfvis_bvh_o
         return HFVIS_OK;
     }
     max_nodes = 2 * n - 1;
-    order = (uint32_t *)vx_alloc_array(alloc, n, sizeof *order);
+    order = (uint32_t *)hfvis__alloc_array(alloc, n, sizeof *order);
     if (!order) goto oom;
-    prims = (vx_bvh_prim *)vx_alloc_array(alloc, n, sizeof *prims);
+    prims = (vx_bvh_prim *)hfvis__alloc_array(alloc, n, sizeof *prims);
     if (!prims) goto oom;
-    tmp = (hfvis_bvh_node *)vx_alloc_array(alloc, max_nodes, sizeof *tmp);
+    tmp = (hfvis_bvh_node *)hfvis__alloc_array(alloc, max_nodes, sizeof *tmp);
     if (!tmp) goto oom;
 
     for (i = 0; i < n; i++) {
@@ -2888,14 +2814,14 @@ HFVIS_API hfvis_status hfvis_bvh_build(const hfvis_mesh *mesh, const hfvis_bvh_o
     }
     HFVIS_ASSERT(max_depth <= HFVIS_BVH_MAX_DEPTH);
 
-    nodes = (hfvis_bvh_node *)vx_alloc_array(alloc, next, sizeof *nodes);
+    nodes = (hfvis_bvh_node *)hfvis__alloc_array(alloc, next, sizeof *nodes);
     if (!nodes) goto oom;
     for (i = 0; i < next; i++) {
         nodes[i] = tmp[i];
         vx_bvh_pad(nodes + i);
     }
-    vx_free(alloc, tmp);
-    vx_free(alloc, prims);
+    hfvis__free(alloc, tmp);
+    hfvis__free(alloc, prims);
     out->nodes = nodes;
     out->node_count = next;
     out->tri_order = order;
@@ -2905,17 +2831,17 @@ HFVIS_API hfvis_status hfvis_bvh_build(const hfvis_mesh *mesh, const hfvis_bvh_o
     out->max_leaf_size = max_leaf;
     return HFVIS_OK;
 oom:
-    vx_free(alloc, tmp);
-    vx_free(alloc, prims);
-    vx_free(alloc, order);
+    hfvis__free(alloc, tmp);
+    hfvis__free(alloc, prims);
+    hfvis__free(alloc, order);
     return HFVIS_ERR_OUT_OF_MEMORY;
 }
 
 HFVIS_API void hfvis_bvh_free(const hfvis_allocator *alloc, hfvis_bvh *bvh)
 {
     if (!bvh) return;
-    vx_free(alloc, bvh->nodes);
-    vx_free(alloc, bvh->tri_order);
+    hfvis__free(alloc, bvh->nodes);
+    hfvis__free(alloc, bvh->tri_order);
     memset(bvh, 0, sizeof *bvh);
 }
 
@@ -3063,7 +2989,7 @@ HFVIS_API hfvis_status hfvis_bvh_any_hit(const hfvis_bvh *bvh, const hfvis_mesh 
 /* 7. Surface voxelization into the Volume Buffer                                             */
 /*     [G12] ch. 6 (§6.4.1 Alg. 5 geometry-shader triangle slicing, §6.4.2 Alg. 6 pixel-shader */
 /*     fragment clipping, §6.6 output-vertex limit), ch. 5 §5.5.1 Alg. 4 (three axial passes   */
-/*     merged with MAX); [G12] ch. 6, Alg. 5-6; [G12] ch. 6                                    */
+/*     merged with MAX)                                                                        */
 /* ========================================================================================== */
 /*
  * Everything happens in grid space g = (p - origin)/cell, where a voxel is a unit cube. A pass
@@ -3849,7 +3775,7 @@ static hfvis_status vx_vox_surface(const hfvis_mesh *mesh, hfvis_volume *vol,
     vx_vox_sink s;
     int c;
     hfvis_status st;
-    if (vx_mesh_check(mesh) != HFVIS_OK || !vol || !vol->data || !vx_grid_valid(&vol->grid)
+    if (hfvis__mesh_check(mesh) != HFVIS_OK || !vol || !vol->data || !vx_grid_valid(&vol->grid)
         || vol->channels < 1 || vol->channels > HFVIS_VOLUME_MAX_CHANNELS)
         return HFVIS_ERR_INVALID_ARGUMENT;
     for (c = 0; c < vol->channels; c++)
@@ -3907,7 +3833,7 @@ HFVIS_API hfvis_status hfvis_voxelize_occupancy(const hfvis_mesh *mesh,
     vx_vox_cfg cfg;
     vx_vox_sink s;
     hfvis_status st;
-    if (vx_mesh_check(mesh) != HFVIS_OK || !vx_grid_valid(grid) || !occ)
+    if (hfvis__mesh_check(mesh) != HFVIS_OK || !vx_grid_valid(grid) || !occ)
         return HFVIS_ERR_INVALID_ARGUMENT;
     st = vx_vox_resolve(opts, &cfg);
     if (st != HFVIS_OK) return st;
@@ -3919,7 +3845,7 @@ HFVIS_API hfvis_status hfvis_voxelize_occupancy(const hfvis_mesh *mesh,
     return HFVIS_OK;
 }
 
-/* ---- ready-made attribute callbacks ([G12] §6.5; [G12] ch. 6) ------------------------------- */
+/* ---- ready-made attribute callbacks ([G12] §6.5) ----------------------------------------- */
 
 HFVIS_API void hfvis_voxel_fragment_occupancy(const hfvis_voxel_fragment *f, float *values,
                                               void *user)
@@ -3976,7 +3902,7 @@ HFVIS_API void hfvis_voxel_fragment_attributes(const hfvis_voxel_fragment *f, fl
         float e[3] = { 0.0f, 0.0f, 0.0f };
         if (at->irradiance) at->irradiance(f->position, f->normal, e, at->irradiance_user);
         for (i = 0; i < 3; i++) {
-            double L = (double)alb[i] * (double)e[i] / VX_PI;
+            double L = (double)alb[i] * (double)e[i] / HFVIS__PI;
             if (at->emission) L += (double)at->emission[3 * (size_t)f->triangle + (size_t)i];
             values[c++] = (float)L;
         }
@@ -4043,7 +3969,7 @@ static hfvis_status vx_cons_args(const hfvis_mesh *mesh, const hfvis_volume_grid
 {
     size_t v;
     int a;
-    if (!out || !vx_grid_valid(grid) || vx_mesh_check(mesh) != HFVIS_OK)
+    if (!out || !vx_grid_valid(grid) || hfvis__mesh_check(mesh) != HFVIS_OK)
         return HFVIS_ERR_INVALID_ARGUMENT;
     for (v = 0; v < mesh->vertex_count; v++)
         for (a = 0; a < 3; a++) {
@@ -4672,7 +4598,7 @@ static uint64_t *vx_cons_bricks_init(vx_cons_bricks *B, const hfvis_volume_grid 
     B->bs[1] = B->nb[0];
     B->bs[2] = B->nb[0] * B->nb[1];
     words = B->bs[2] * B->nb[2]; /* about voxels / 64: no overflow for a valid grid */
-    B->w = (uint64_t *)vx_alloc_array(alloc, words, sizeof(uint64_t));
+    B->w = (uint64_t *)hfvis__alloc_array(alloc, words, sizeof(uint64_t));
     if (B->w) memset(B->w, 0, words * sizeof(uint64_t));
     return B->w;
 }
@@ -4721,11 +4647,11 @@ HFVIS_API hfvis_status hfvis_voxelize_conservative(const hfvis_mesh *mesh,
     size_t t, v, n;
     vx_cons_vert *vert;
     vx_cons_bricks B;
-    if (!occ || !vx_grid_valid(grid) || vx_mesh_check(mesh) != HFVIS_OK)
+    if (!occ || !vx_grid_valid(grid) || hfvis__mesh_check(mesh) != HFVIS_OK)
         return HFVIS_ERR_INVALID_ARGUMENT;
     /* scratch: every vertex in grid space with its ranges (transformed once, and checked against
      * VX_CONS_MAX_COORD as vx_cons_args does), and the brick bits */
-    vert = (vx_cons_vert *)vx_alloc_array(alloc, mesh->vertex_count, sizeof(vx_cons_vert));
+    vert = (vx_cons_vert *)hfvis__alloc_array(alloc, mesh->vertex_count, sizeof(vx_cons_vert));
     if (!vert && mesh->vertex_count) return HFVIS_ERR_OUT_OF_MEMORY;
     for (v = 0; v < mesh->vertex_count; v++) {
         vx_cons_vert *p = vert + v;
@@ -4735,7 +4661,7 @@ HFVIS_API hfvis_status hfvis_voxelize_conservative(const hfvis_mesh *mesh,
             double g = vx_cons_gc(grid, a, mesh->xyz[3 * v + (size_t)a]), l, h;
             const double top = (double)grid->dims[a];
             if (!(fabs(g) <= VX_CONS_MAX_COORD)) {
-                vx_free(alloc, vert);
+                hfvis__free(alloc, vert);
                 return HFVIS_ERR_LIMIT;
             }
             p->g[a] = g;
@@ -4747,7 +4673,7 @@ HFVIS_API hfvis_status hfvis_voxelize_conservative(const hfvis_mesh *mesh,
         }
     }
     if (!vx_cons_bricks_init(&B, grid, alloc)) {
-        vx_free(alloc, vert);
+        hfvis__free(alloc, vert);
         return HFVIS_ERR_OUT_OF_MEMORY;
     }
     for (t = 0; t < mesh->triangle_count; t++) {
@@ -4789,8 +4715,8 @@ HFVIS_API hfvis_status hfvis_voxelize_conservative(const hfvis_mesh *mesh,
                          &B);
     }
     n = vx_cons_bricks_emit(&B, grid, occ);
-    vx_free(alloc, B.w);
-    vx_free(alloc, vert);
+    hfvis__free(alloc, B.w);
+    hfvis__free(alloc, vert);
     if (count) *count = n;
     return HFVIS_OK;
 }
@@ -5004,7 +4930,7 @@ HFVIS_API hfvis_status hfvis_voxelize_solid(const hfvis_mesh *mesh, const hfvis_
     if ((size_t)grid->dims[0] * (size_t)grid->dims[2] > ncol)
         ncol = (size_t)grid->dims[0] * (size_t)grid->dims[2];
     memset(&c, 0, sizeof c);
-    c.colpar = (uint8_t *)vx_alloc(alloc, ncol);
+    c.colpar = (uint8_t *)hfvis__alloc(alloc, ncol);
     if (!c.colpar) return HFVIS_ERR_OUT_OF_MEMORY;
     if (!allow_open) {
         /* pass 1: along EACH of the three axes every column must be crossed an even number of
@@ -5019,7 +4945,7 @@ HFVIS_API hfvis_status hfvis_voxelize_solid(const hfvis_mesh *mesh, const hfvis_
             vx_cons_raster_mesh(mesh, grid, b, vx_cons_solid_pixel, &c);
             for (i = 0; i < nb; i++)
                 if (c.colpar[i]) {
-                    vx_free(alloc, c.colpar);
+                    hfvis__free(alloc, c.colpar);
                     return HFVIS_ERR_FORMAT;
                 }
         }
@@ -5067,7 +4993,7 @@ HFVIS_API hfvis_status hfvis_voxelize_solid(const hfvis_mesh *mesh, const hfvis_
                         occ[(size_t)iu * stride[u] + (size_t)iw * stride[w] + (size_t)k * stride[a]] = 0;
     }
     for (i = 0; i < nvox; i++) n += occ[i];
-    vx_free(alloc, c.colpar);
+    hfvis__free(alloc, c.colpar);
     if (count) *count = n;
     return HFVIS_OK;
 }
@@ -5115,7 +5041,7 @@ HFVIS_API hfvis_status hfvis_voxelize_solid_reference(const hfvis_mesh *mesh,
                     wsum += vx_cons_solid_angle(v[0], v[1], v[2]);
                 }
                 /* generalized winding number (Jacobson et al. 2013); parity of its rounding */
-                wn = floor(fabs(wsum) / (4.0 * VX_PI) + 0.5);
+                wn = floor(fabs(wsum) / (4.0 * HFVIS__PI) + 0.5);
                 occ[idx] = (uint8_t)(fmod(wn, 2.0) == 1.0);
                 n += occ[idx];
             }
@@ -5137,13 +5063,13 @@ HFVIS_API hfvis_status hfvis_mesh_is_watertight(const hfvis_mesh *mesh,
     uint64_t *keys;
     size_t t, m, i;
     int ok = 1;
-    if (!result || vx_mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!result || hfvis__mesh_check(mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     if (mesh->triangle_count == 0) {
         *result = 1;
         return HFVIS_OK;
     }
     /* every directed edge a -> b as the key a << 32 | b */
-    keys = (uint64_t *)vx_alloc_array(alloc, mesh->triangle_count, 3 * sizeof(uint64_t));
+    keys = (uint64_t *)hfvis__alloc_array(alloc, mesh->triangle_count, 3 * sizeof(uint64_t));
     if (!keys) return HFVIS_ERR_OUT_OF_MEMORY;
     m = 3 * mesh->triangle_count;
     for (t = 0; t < mesh->triangle_count && ok; t++) {
@@ -5162,7 +5088,7 @@ HFVIS_API hfvis_status hfvis_mesh_is_watertight(const hfvis_mesh *mesh,
         if (i + 1 < m && keys[i + 1] == keys[i]) ok = 0;
         else if (!bsearch(&rev, keys, m, sizeof *keys, vx_cons_key_cmp)) ok = 0;
     }
-    vx_free(alloc, keys);
+    hfvis__free(alloc, keys);
     *result = ok;
     return HFVIS_OK;
 }
@@ -5439,8 +5365,8 @@ static int vx_cons_binvox_side(const hfvis_volume_grid *g)
     int d = g->dims[0] > g->dims[1] ? g->dims[0] : g->dims[1];
     size_t dd = 1;
     if (g->dims[2] > d) d = g->dims[2];
-    if (!vx_mul_size(dd, (size_t)d, &dd) || !vx_mul_size(dd, (size_t)d, &dd)
-        || !vx_mul_size(dd, (size_t)d, &dd) || dd > HFVIS_VOLUME_MAX_VOXELS
+    if (!hfvis__mul_size(dd, (size_t)d, &dd) || !hfvis__mul_size(dd, (size_t)d, &dd)
+        || !hfvis__mul_size(dd, (size_t)d, &dd) || dd > HFVIS_VOLUME_MAX_VOXELS
         || !isfinite((double)d * vx_cons_max3(g->cell[0], g->cell[1], g->cell[2])))
         return 0;
     return d;
@@ -5599,7 +5525,7 @@ HFVIS_API hfvis_status hfvis_binvox_decode(const void *data, size_t size,
     if (!have_dim || dims[0] != dims[1] || dims[1] != dims[2]) return HFVIS_ERR_FORMAT;
     if (dims[0] > (unsigned long)INT_MAX) return HFVIS_ERR_LIMIT;
     D = (size_t)dims[0];
-    if (!vx_mul_size(D, D, &DD) || !vx_mul_size(DD, D, &total) || total > HFVIS_VOLUME_MAX_VOXELS)
+    if (!hfvis__mul_size(D, D, &DD) || !hfvis__mul_size(DD, D, &total) || total > HFVIS_VOLUME_MAX_VOXELS)
         return HFVIS_ERR_LIMIT;
     for (a = 0; a < 3; a++) {
         g.dims[a] = (int)D;
@@ -5615,7 +5541,7 @@ HFVIS_API hfvis_status hfvis_binvox_decode(const void *data, size_t size,
         if (got > total) return HFVIS_ERR_FORMAT;
     }
     if (got != total) return HFVIS_ERR_FORMAT;
-    o = (uint8_t *)vx_alloc(alloc, total);
+    o = (uint8_t *)hfvis__alloc(alloc, total);
     if (!o) return HFVIS_ERR_OUT_OF_MEMORY;
     {
         size_t x = 0, y = 0, z = 0; /* binvox order: y fastest, then z, then x */
@@ -5648,11 +5574,11 @@ HFVIS_API hfvis_status hfvis_binvox_save(const char *path, const hfvis_volume_gr
     if (!path || !occ || !vx_grid_valid(grid)) return HFVIS_ERR_INVALID_ARGUMENT;
     if (vx_cons_binvox_side(grid) == 0) return HFVIS_ERR_LIMIT;
     need = hfvis_binvox_encode_size(grid, occ);
-    buf = (unsigned char *)vx_alloc(NULL, need);
+    buf = (unsigned char *)hfvis__alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_binvox_encode(grid, occ, buf, need, &written);
     if (s == HFVIS_OK) s = hfvis_write_file(path, buf, written, NULL);
-    vx_free(NULL, buf);
+    hfvis__free(NULL, buf);
     return s;
 }
 
@@ -5675,7 +5601,7 @@ HFVIS_API hfvis_status hfvis_binvox_load(const char *path, const hfvis_allocator
     s = hfvis__read_file(path, alloc, vx_binvox_sizer, &data, &size);
     if (s != HFVIS_OK) return s;
     s = hfvis_binvox_decode(data, size, alloc, grid, occ);
-    vx_free(alloc, data);
+    hfvis__free(alloc, data);
     return s;
 }
 
@@ -5773,7 +5699,7 @@ HFVIS_API hfvis_status hfvis_iv_bias(const hfvis_volume_grid *grid, const hfvis_
 static int vx_iv_volume_ok(const hfvis_volume *vol)
 {
     return vol && vol->data && vol->channels >= 1 && vol->channels <= HFVIS_VOLUME_MAX_CHANNELS
-           && hfvis_volume_size(&vol->grid, vol->channels) != 0;
+           && hfvis_volume_floats(&vol->grid, vol->channels) != 0;
 }
 
 static int vx_iv_same_grid(const hfvis_volume_grid *a, const hfvis_volume_grid *b)
@@ -5842,18 +5768,18 @@ static hfvis_status vx_iv_image(const hfvis_depth_image *im, vx_iv_img *out)
     int r;
     if (!im || !im->depth) return HFVIS_ERR_INVALID_ARGUMENT;
     v = &im->view;
-    if (v->width < 1 || v->height < 1 || !vx_all_finite(v->view, 16) || !vx_all_finite(v->proj, 16)
+    if (v->width < 1 || v->height < 1 || !hfvis__all_finite(v->view, 16) || !hfvis__all_finite(v->proj, 16)
         || !isfinite(v->near_plane) || !isfinite(v->far_plane)
         || !(v->near_plane < v->far_plane) || (!v->orthographic && !(v->near_plane > 0.0)))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (im->attribute_count < 0 || im->attribute_count > HFVIS_VOLUME_MAX_CHANNELS
         || (im->attribute_count > 0 && !im->attributes))
         return HFVIS_ERR_INVALID_ARGUMENT;
-    if (!vx_mul_size((size_t)v->width, (size_t)v->height, &px)
-        || !vx_mul_size(px, (size_t)(im->attribute_count > 0 ? im->attribute_count : 1), &na))
+    if (!hfvis__mul_size((size_t)v->width, (size_t)v->height, &px)
+        || !hfvis__mul_size(px, (size_t)(im->attribute_count > 0 ? im->attribute_count : 1), &na))
         return HFVIS_ERR_INVALID_ARGUMENT;
     hfvis_mat4_multiply(v->proj, v->view, m);
-    if (!vx_all_finite(m, 16)) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!hfvis__all_finite(m, 16)) return HFVIS_ERR_INVALID_ARGUMENT;
     memset(out, 0, sizeof *out);
     for (r = 0; r < 4; r++) {
         out->ez[r] = VX_M(v->view, 2, r);
@@ -6054,7 +5980,7 @@ static size_t vx_iv_pyr_layout(vx_iv_img *im)
         im->lev_w[L] = w;
         im->lev_h[L] = h;
         im->lev_off[L] = total;
-        if (!vx_mul_size((size_t)w, (size_t)h, &n) || total > SIZE_MAX - n) return 0;
+        if (!hfvis__mul_size((size_t)w, (size_t)h, &n) || total > SIZE_MAX - n) return 0;
         total += n;
     }
     im->levels = L + 1;
@@ -6110,7 +6036,7 @@ HFVIS_API hfvis_status hfvis_iv_classify(const hfvis_depth_image *image, const d
     double ez, X, Y, W;
     int px, py;
     hfvis_iv_class cls;
-    if (!out || !point || !vx_all_finite(point, 3) || !isfinite(bias) || !(bias >= 0.0))
+    if (!out || !point || !hfvis__all_finite(point, 3) || !isfinite(bias) || !(bias >= 0.0))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (vx_iv_image(image, &im) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     ez = vx_iv_row(im.ez, point[0], point[1], point[2]);
@@ -6308,7 +6234,7 @@ static hfvis_status vx_iv_run(const hfvis_volume *prev, hfvis_volume *curr,
                               int single, vx_iv_count *cnt)
 {
     float *pyr = NULL;
-    size_t t, total = 0, n = hfvis_volume_size(&prev->grid, prev->channels);
+    size_t t, total = 0, n = hfvis_volume_floats(&prev->grid, prev->channels);
     if (o->conservative && count > 0) {
         for (t = 0; t < count; t++) {
             vx_iv_img im;
@@ -6320,7 +6246,7 @@ static hfvis_status vx_iv_run(const hfvis_volume *prev, hfvis_volume *curr,
             total += s;
         }
         if (total > 0) {
-            pyr = (float *)vx_alloc_array(o->alloc, total, sizeof(float));
+            pyr = (float *)hfvis__alloc_array(o->alloc, total, sizeof(float));
             if (!pyr) return HFVIS_ERR_OUT_OF_MEMORY;
         }
     }
@@ -6340,7 +6266,7 @@ static hfvis_status vx_iv_run(const hfvis_volume *prev, hfvis_volume *curr,
         vx_iv_pass(t == 0 ? prev->data : curr->data, curr->data, &prev->grid, prev->channels, &im,
                    o, single, map, cnt);
     }
-    vx_free(o->alloc, pyr);
+    hfvis__free(o->alloc, pyr);
     return HFVIS_OK;
 }
 
@@ -6649,37 +6575,6 @@ HFVIS_API double hfvis_point_triangle_distance(const double p[3], const double a
     return sqrt(vx_iv_tri_d2(p, a, b, c));
 }
 
-/* PCG32 (O'Neill 2014), the library's own small PRNG. */
-typedef struct vx_iv_rng {
-    uint64_t state, inc;
-} vx_iv_rng;
-
-static uint32_t vx_iv_rng_next(vx_iv_rng *r)
-{
-    uint64_t old = r->state;
-    uint32_t xs, rot;
-    r->state = old * 6364136223846793005ull + r->inc;
-    xs = (uint32_t)(((old >> 18) ^ old) >> 27);
-    rot = (uint32_t)(old >> 59);
-    return (xs >> rot) | (xs << ((32u - rot) & 31u));
-}
-
-static void vx_iv_rng_seed(vx_iv_rng *r, uint64_t seed)
-{
-    r->state = 0u;
-    r->inc = (0xda3e39cb94b95bdbull << 1u) | 1u;
-    (void)vx_iv_rng_next(r);
-    r->state += seed ^ 0x853c49e6748fea9bull;
-    (void)vx_iv_rng_next(r);
-}
-
-/* Uniform double in [0, 1) with 53 random bits. */
-static double vx_iv_rng_unit(vx_iv_rng *r)
-{
-    uint32_t a = vx_iv_rng_next(r) >> 5, b = vx_iv_rng_next(r) >> 6;
-    return ((double)a * 67108864.0 + (double)b) * (1.0 / 9007199254740992.0);
-}
-
 /* Shared set-up of the metric: the positive-area triangles, their area prefix sums, the voxel
  * centres, the bounding-box diagonal and a coordinate scale for the pruning margin. */
 typedef struct vx_iv_metric {
@@ -6706,13 +6601,16 @@ static void vx_iv_tri_vertices(const hfvis_mesh *m, size_t t, double v[3][3])
 
 static void vx_iv_metric_free(vx_iv_metric *M)
 {
-    vx_free(M->alloc, M->pts);
-    vx_free(M->alloc, M->cdf);
-    vx_free(M->alloc, M->tris);
+    hfvis__free(M->alloc, M->pts);
+    hfvis__free(M->alloc, M->cdf);
+    hfvis__free(M->alloc, M->tris);
     M->pts = NULL;
     M->cdf = NULL;
     M->tris = NULL;
 }
+
+/* Area-uniform samples of the mesh for d(X, Y) when the options give 0 (hfvis_distance_options). */
+#define VX_IV_DEFAULT_METRIC_SAMPLES 100000
 
 /* Validates and builds the set-up (3 blocks: triangle ids, prefix sums, centres). */
 static hfvis_status vx_iv_metric_init(vx_iv_metric *M, const hfvis_mesh *mesh,
@@ -6723,10 +6621,10 @@ static hfvis_status vx_iv_metric_init(vx_iv_metric *M, const hfvis_mesh *mesh,
     double lo[3], hi[3], sum = 0.0, s = 0.0, e[3];
     int a;
     memset(M, 0, sizeof *M);
-    if (!occ || !vx_grid_valid(grid) || vx_mesh_check(mesh) != HFVIS_OK)
+    if (!occ || !vx_grid_valid(grid) || hfvis__mesh_check(mesh) != HFVIS_OK)
         return HFVIS_ERR_INVALID_ARGUMENT;
     M->mesh = mesh;
-    M->samples = opts && opts->sample_count ? opts->sample_count : 100000;
+    M->samples = opts && opts->sample_count ? opts->sample_count : VX_IV_DEFAULT_METRIC_SAMPLES;
     M->seed = opts ? opts->seed : 0u;
     M->alloc = opts ? opts->alloc : NULL;
     if (mesh->triangle_count > (size_t)UINT32_MAX / 2) return HFVIS_ERR_LIMIT;
@@ -6760,10 +6658,10 @@ static hfvis_status vx_iv_metric_init(vx_iv_metric *M, const hfvis_mesh *mesh,
     }
     M->diag = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
     M->scale2 = s;
-    M->tris = (uint32_t *)vx_alloc_array(M->alloc, nt, sizeof(uint32_t));
+    M->tris = (uint32_t *)hfvis__alloc_array(M->alloc, nt, sizeof(uint32_t));
     if (!M->tris) return HFVIS_ERR_OUT_OF_MEMORY;
-    M->cdf = (double *)vx_alloc_array(M->alloc, nt, sizeof(double));
-    M->pts = (double *)vx_alloc_array(M->alloc, 3 * np, sizeof(double));
+    M->cdf = (double *)hfvis__alloc_array(M->alloc, nt, sizeof(double));
+    M->pts = (double *)hfvis__alloc_array(M->alloc, 3 * np, sizeof(double));
     if (!M->cdf || !M->pts) {
         vx_iv_metric_free(M);
         return HFVIS_ERR_OUT_OF_MEMORY;
@@ -6805,9 +6703,9 @@ static hfvis_status vx_iv_metric_init(vx_iv_metric *M, const hfvis_mesh *mesh,
 }
 
 /* Sample s of the mesh (the same sequence for the fast path and the oracle). */
-static void vx_iv_metric_sample(const vx_iv_metric *M, vx_iv_rng *r, double out[3])
+static void vx_iv_metric_sample(const vx_iv_metric *M, hfvis__pcg32 *r, double out[3])
 {
-    double u = vx_iv_rng_unit(r) * M->cdf[M->nt - 1], r2 = vx_iv_rng_unit(r), r3 = vx_iv_rng_unit(r);
+    double u = hfvis__pcg32_unit(r) * M->cdf[M->nt - 1], r2 = hfvis__pcg32_unit(r), r3 = hfvis__pcg32_unit(r);
     double v[3][3], su = sqrt(r2), w0 = 1.0 - su, w1 = su * (1.0 - r3), w2 = su * r3;
     size_t lo = 0, hi = M->nt - 1;
     int a;
@@ -6876,10 +6774,10 @@ static hfvis_status vx_iv_bvh_build(vx_iv_bvh *b, size_t n, const double *lo, co
     uint32_t stack[VX_IV_STACK];
     memset(b, 0, sizeof *b);
     if (n > (size_t)UINT32_MAX / 2) return HFVIS_ERR_LIMIT;
-    if (!vx_mul_size(nn, sizeof(vx_iv_node), &bytes_nodes)
-        || !vx_mul_size(n, sizeof(uint32_t), &bytes_items) || bytes_nodes > SIZE_MAX - bytes_items)
+    if (!hfvis__mul_size(nn, sizeof(vx_iv_node), &bytes_nodes)
+        || !hfvis__mul_size(n, sizeof(uint32_t), &bytes_items) || bytes_nodes > SIZE_MAX - bytes_items)
         return HFVIS_ERR_LIMIT;
-    b->block = vx_alloc(alloc, bytes_nodes + bytes_items);
+    b->block = hfvis__alloc(alloc, bytes_nodes + bytes_items);
     if (!b->block) return HFVIS_ERR_OUT_OF_MEMORY;
     b->nodes = (vx_iv_node *)b->block;
     b->items = (uint32_t *)(void *)((unsigned char *)b->block + bytes_nodes);
@@ -6997,6 +6895,16 @@ static void vx_iv_metric_out(const vx_iv_metric *M, double sum_p, double max_p, 
     *out = r;
 }
 
+HFVIS_API hfvis_distance_options hfvis_distance_options_default(void)
+{
+    hfvis_distance_options o;
+    memset(&o, 0, sizeof o);
+    o.sample_count = VX_IV_DEFAULT_METRIC_SAMPLES;
+    o.seed = 0;
+    o.alloc = NULL;
+    return o;
+}
+
 HFVIS_API hfvis_status hfvis_voxel_distance_metrics(const hfvis_mesh *mesh,
                                                     const hfvis_volume_grid *grid,
                                                     const uint8_t *occupancy,
@@ -7005,7 +6913,7 @@ HFVIS_API hfvis_status hfvis_voxel_distance_metrics(const hfvis_mesh *mesh,
 {
     vx_iv_metric M;
     vx_iv_bvh tb, pb;
-    vx_iv_rng rng;
+    hfvis__pcg32 rng;
     double *box = NULL, sum_p = 0.0, max_p = 0.0, sum_s = 0.0, max_s = 0.0;
     size_t t, s;
     hfvis_status st;
@@ -7013,7 +6921,7 @@ HFVIS_API hfvis_status hfvis_voxel_distance_metrics(const hfvis_mesh *mesh,
     st = vx_iv_metric_init(&M, mesh, grid, occupancy, opts);
     if (st != HFVIS_OK) return st;
     /* triangle boxes (lo: first 3 nt doubles, hi: next 3 nt) */
-    box = (double *)vx_alloc_array(M.alloc, 6 * M.nt, sizeof(double));
+    box = (double *)hfvis__alloc_array(M.alloc, 6 * M.nt, sizeof(double));
     if (!box) {
         vx_iv_metric_free(&M);
         return HFVIS_ERR_OUT_OF_MEMORY;
@@ -7034,14 +6942,14 @@ HFVIS_API hfvis_status hfvis_voxel_distance_metrics(const hfvis_mesh *mesh,
     }
     st = vx_iv_bvh_build(&tb, M.nt, box, box + 3 * M.nt, M.alloc);
     if (st != HFVIS_OK) {
-        vx_free(M.alloc, box);
+        hfvis__free(M.alloc, box);
         vx_iv_metric_free(&M);
         return st;
     }
     st = vx_iv_bvh_build(&pb, M.np, M.pts, M.pts, M.alloc);
     if (st != HFVIS_OK) {
-        vx_free(M.alloc, tb.block);
-        vx_free(M.alloc, box);
+        hfvis__free(M.alloc, tb.block);
+        hfvis__free(M.alloc, box);
         vx_iv_metric_free(&M);
         return st;
     }
@@ -7052,7 +6960,7 @@ HFVIS_API hfvis_status hfvis_voxel_distance_metrics(const hfvis_mesh *mesh,
         if (d > max_p) max_p = d;
     }
     /* X -> Y: area-uniform samples of the mesh to the nearest voxel centre */
-    vx_iv_rng_seed(&rng, M.seed);
+    hfvis__pcg32_seed(&rng, (M.seed) ^ 0x853c49e6748fea9bull, 0xda3e39cb94b95bdbull);
     for (s = 0; s < M.samples; s++) {
         double q[3], d;
         vx_iv_metric_sample(&M, &rng, q);
@@ -7061,9 +6969,9 @@ HFVIS_API hfvis_status hfvis_voxel_distance_metrics(const hfvis_mesh *mesh,
         if (d > max_s) max_s = d;
     }
     vx_iv_metric_out(&M, sum_p, max_p, sum_s, max_s, out);
-    vx_free(M.alloc, pb.block);
-    vx_free(M.alloc, tb.block);
-    vx_free(M.alloc, box);
+    hfvis__free(M.alloc, pb.block);
+    hfvis__free(M.alloc, tb.block);
+    hfvis__free(M.alloc, box);
     vx_iv_metric_free(&M);
     return HFVIS_OK;
 }
@@ -7075,7 +6983,7 @@ HFVIS_API hfvis_status hfvis_voxel_distance_metrics_naive(const hfvis_mesh *mesh
                                                           hfvis_distance_metrics *out)
 {
     vx_iv_metric M;
-    vx_iv_rng rng;
+    hfvis__pcg32 rng;
     double sum_p = 0.0, max_p = 0.0, sum_s = 0.0, max_s = 0.0;
     size_t t, s;
     hfvis_status st;
@@ -7094,7 +7002,7 @@ HFVIS_API hfvis_status hfvis_voxel_distance_metrics_naive(const hfvis_mesh *mesh
         sum_p += d;
         if (d > max_p) max_p = d;
     }
-    vx_iv_rng_seed(&rng, M.seed);
+    hfvis__pcg32_seed(&rng, (M.seed) ^ 0x853c49e6748fea9bull, 0xda3e39cb94b95bdbull);
     for (s = 0; s < M.samples; s++) {
         double q[3], best = HUGE_VAL, d;
         size_t p;
@@ -7346,7 +7254,7 @@ HFVIS_API void hfvis_visfield_frame(const double w[3], double t[3], double b[3])
     b[2] = -w[1];
 }
 
-#define VX_VF_QPI (VX_PI / 4.0)
+#define VX_VF_QPI (HFVIS__PI / 4.0)
 
 HFVIS_API void hfvis_concentric_square_to_disk(double a, double b, double *x, double *y)
 {
@@ -7376,7 +7284,7 @@ HFVIS_API void hfvis_concentric_disk_to_square(double x, double y, double *a, do
         return;
     }
     phi = atan2(y, x);
-    if (phi < -VX_VF_QPI) phi += 2.0 * VX_PI;
+    if (phi < -VX_VF_QPI) phi += 2.0 * HFVIS__PI;
     if (phi < VX_VF_QPI) { *a = r; *b = r * (phi / VX_VF_QPI); }
     else if (phi < 3.0 * VX_VF_QPI) { *b = r; *a = r * (2.0 - phi / VX_VF_QPI); }
     else if (phi < 5.0 * VX_VF_QPI) { *a = -r; *b = -r * (phi / VX_VF_QPI - 4.0); }
@@ -7413,8 +7321,8 @@ static int vx_vf_texel_of(double A, int D)
 static int vx_vf_to_local(hfvis_dirmap m, int D, int i, int j, double l[3])
 {
     if (m == HFVIS_DIRMAP_POLAR) {
-        double th = ((double)i + 0.5) / (double)D * (VX_PI / 2.0);
-        double ph = ((double)j + 0.5) / (double)D * (2.0 * VX_PI);
+        double th = ((double)i + 0.5) / (double)D * (HFVIS__PI / 2.0);
+        double ph = ((double)j + 0.5) / (double)D * (2.0 * HFVIS__PI);
         l[0] = sin(th) * cos(ph);
         l[1] = sin(th) * sin(ph);
         l[2] = cos(th);
@@ -7448,9 +7356,9 @@ static int vx_vf_from_local(hfvis_dirmap m, int D, const double l[3], int *i, in
     if (m == HFVIS_DIRMAP_POLAR) {
         double lz = l[2] > 1.0 ? 1.0 : l[2], th = acos(lz), ph = atan2(l[1], l[0]);
         double fi, fj;
-        if (ph < 0.0) ph += 2.0 * VX_PI;
-        fi = floor(th / (VX_PI / 2.0) * (double)D);
-        fj = floor(ph / (2.0 * VX_PI) * (double)D);
+        if (ph < 0.0) ph += 2.0 * HFVIS__PI;
+        fi = floor(th / (HFVIS__PI / 2.0) * (double)D);
+        fj = floor(ph / (2.0 * HFVIS__PI) * (double)D);
         *i = fi >= (double)D ? D - 1 : (fi < 0.0 ? 0 : (int)fi);
         *j = fj >= (double)D ? D - 1 : (fj < 0.0 ? 0 : (int)fj);
         return 1;
@@ -7681,7 +7589,7 @@ HFVIS_API hfvis_status hfvis_visfield_bounding_sphere(const hfvis_mesh *mesh, do
     double lo[3], hi[3], c[3], r2 = 0.0, r;
     size_t v;
     int a;
-    if (!mesh || !center || !radius || vx_mesh_check(mesh) != HFVIS_OK || mesh->vertex_count == 0)
+    if (!mesh || !center || !radius || hfvis__mesh_check(mesh) != HFVIS_OK || mesh->vertex_count == 0)
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (hfvis_mesh_bounds(mesh, lo, hi) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     for (a = 0; a < 3; a++) c[a] = 0.5 * lo[a] + 0.5 * hi[a];
@@ -7758,7 +7666,7 @@ static hfvis_status vx_vf_build_check(const hfvis_mesh *mesh, const hfvis_visfie
 {
     size_t need, v;
     double lim;
-    if (!mesh || !vf || vx_mesh_check(mesh) != HFVIS_OK || !vf->maps)
+    if (!mesh || !vf || hfvis__mesh_check(mesh) != HFVIS_OK || !vf->maps)
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (!isfinite(vf->center[0]) || !isfinite(vf->center[1]) || !isfinite(vf->center[2])
         || !isfinite(vf->radius) || !(vf->radius > 0.0) || !vx_vf_n_valid(vf->positions_n)
@@ -7830,6 +7738,13 @@ static hfvis_status vx_vf_build_run(const hfvis_mesh *mesh, const hfvis_bvh *bvh
     vf->avg_distance = central ? sum / (double)central : 0.5;
     if (vf->avg_distance > 1.0) vf->avg_distance = 1.0;
     return HFVIS_OK;
+}
+
+HFVIS_API hfvis_visfield_build_options hfvis_visfield_build_options_default(void)
+{
+    hfvis_visfield_build_options o;
+    memset(&o, 0, sizeof o); /* no allocator, a BVH built inside, no progress callback */
+    return o;
 }
 
 HFVIS_API hfvis_status hfvis_visfield_build(const hfvis_mesh *mesh,
@@ -8119,7 +8034,7 @@ static hfvis_status vx_vf_objects_check(const hfvis_visfield_object *objects, si
         const hfvis_visfield_object *o = objects + i;
         if (!vx_vf_transform(o->object_to_world, &tmp)) return HFVIS_ERR_INVALID_ARGUMENT;
         if (reference) {
-            if (!vx_vf_params_ok(o->field) || vx_mesh_check(o->mesh) != HFVIS_OK)
+            if (!vx_vf_params_ok(o->field) || hfvis__mesh_check(o->mesh) != HFVIS_OK)
                 return HFVIS_ERR_INVALID_ARGUMENT;
             if (o->bvh && o->bvh->triangle_count != o->mesh->triangle_count)
                 return HFVIS_ERR_INVALID_ARGUMENT;
@@ -8209,7 +8124,7 @@ static hfvis_status vx_vf_insts(const hfvis_visfield_object *objects, size_t cou
     vx_vf_inst *in;
     *out = NULL;
     if (count == 0) return HFVIS_OK;
-    in = (vx_vf_inst *)vx_alloc_array(alloc, count, sizeof *in);
+    in = (vx_vf_inst *)hfvis__alloc_array(alloc, count, sizeof *in);
     if (!in) return HFVIS_ERR_OUT_OF_MEMORY;
     for (i = 0; i < count; i++) vx_vf_inst_make(objects + i, bias_frac, in + i);
     *out = in;
@@ -8256,7 +8171,7 @@ static hfvis_status vx_vf_ao_run(const hfvis_visfield_object *objects, size_t co
     S = (size_t)o.rays_sqrt;
     nr = S * S;
     /* the pre-generated hemisphere ray set ([G12] §4.5.1): concentric grid + Malley */
-    rays = (double *)vx_alloc_array(alloc, nr, 3 * sizeof(double));
+    rays = (double *)hfvis__alloc_array(alloc, nr, 3 * sizeof(double));
     if (!rays) return HFVIS_ERR_OUT_OF_MEMORY;
     for (j = 0; j < o.rays_sqrt; j++)
         for (i = 0; i < o.rays_sqrt; i++) {
@@ -8271,7 +8186,7 @@ static hfvis_status vx_vf_ao_run(const hfvis_visfield_object *objects, size_t co
     s = vx_vf_insts(objects, count, bias_frac, alloc, &in);
     if (s != HFVIS_OK) goto done;
     if (reference) {
-        res = (float *)vx_alloc_array(alloc, pc, sizeof(float));
+        res = (float *)hfvis__alloc_array(alloc, pc, sizeof(float));
         if (!res) { s = HFVIS_ERR_OUT_OF_MEMORY; goto done; }
     }
     for (p = 0; p < pc; p++) {
@@ -8312,9 +8227,9 @@ static hfvis_status vx_vf_ao_run(const hfvis_visfield_object *objects, size_t co
     if (reference) memcpy(out, res, pc * sizeof(float));
     s = HFVIS_OK;
 done:
-    vx_free(alloc, res);
-    vx_free(alloc, in);
-    vx_free(alloc, rays);
+    hfvis__free(alloc, res);
+    hfvis__free(alloc, in);
+    hfvis__free(alloc, rays);
     return s;
 }
 
@@ -8368,7 +8283,7 @@ static hfvis_status vx_vf_shadow_run(const hfvis_visfield_object *objects, size_
     if (s != HFVIS_OK) return s;
     if (pc && !vx_vf_points_ok(points, NULL, pc)) return HFVIS_ERR_INVALID_ARGUMENT;
     if (pc == 0) return HFVIS_OK;
-    disk = (double *)vx_alloc_array(alloc, (size_t)N, 2 * sizeof(double));
+    disk = (double *)hfvis__alloc_array(alloc, (size_t)N, 2 * sizeof(double));
     if (!disk) return HFVIS_ERR_OUT_OF_MEMORY;
     for (i = 0; i < N; i++) /* Hammersley points on the light's disc */
         hfvis_concentric_square_to_disk(2.0 * (((double)i + 0.5) / (double)N) - 1.0,
@@ -8377,7 +8292,7 @@ static hfvis_status vx_vf_shadow_run(const hfvis_visfield_object *objects, size_
     s = vx_vf_insts(objects, count, bias_frac, alloc, &in);
     if (s != HFVIS_OK) goto done;
     if (reference) {
-        res = (float *)vx_alloc_array(alloc, pc, sizeof(float));
+        res = (float *)hfvis__alloc_array(alloc, pc, sizeof(float));
         if (!res) { s = HFVIS_ERR_OUT_OF_MEMORY; goto done; }
     }
     for (p = 0; p < pc; p++) {
@@ -8417,10 +8332,20 @@ static hfvis_status vx_vf_shadow_run(const hfvis_visfield_object *objects, size_
     if (reference) memcpy(out, res, pc * sizeof(float));
     s = HFVIS_OK;
 done:
-    vx_free(alloc, res);
-    vx_free(alloc, in);
-    vx_free(alloc, disk);
+    hfvis__free(alloc, res);
+    hfvis__free(alloc, in);
+    hfvis__free(alloc, disk);
     return s;
+}
+
+HFVIS_API hfvis_visfield_shadow_options hfvis_visfield_shadow_options_default(void)
+{
+    hfvis_visfield_shadow_options o;
+    memset(&o, 0, sizeof o);
+    o.samples = VX_VF_DEFAULT_SHADOW_SAMPLES;
+    o.bias = HFVIS_VISFIELD_DEFAULT_BIAS;
+    o.alloc = NULL;
+    return o;
 }
 
 HFVIS_API hfvis_status hfvis_visfield_soft_shadow(const hfvis_visfield_object *objects,
@@ -8522,7 +8447,7 @@ static void vx_vf_lobe_dir(int i, int N, double shin, const double r[3], const d
     if (shin > 0.0) {
         double c = pow(((double)i + 0.5) / (double)N, 1.0 / (shin + 1.0));
         double sn = sqrt(c < 1.0 ? 1.0 - c * c : 0.0);
-        double ph = 2.0 * VX_PI * vx_vf_radical2((uint32_t)i);
+        double ph = 2.0 * HFVIS__PI * vx_vf_radical2((uint32_t)i);
         for (a = 0; a < 3; a++) d[a] = sn * cos(ph) * t[a] + sn * sin(ph) * b[a] + c * r[a];
     } else {
         for (a = 0; a < 3; a++) d[a] = r[a];
@@ -8571,6 +8496,17 @@ static hfvis_status vx_vf_reflect_run(const hfvis_visfield_object *objects, size
             if (pass == 1) hits[i] = h;
         }
     return HFVIS_OK;
+}
+
+HFVIS_API hfvis_visfield_reflect_options hfvis_visfield_reflect_options_default(void)
+{
+    hfvis_visfield_reflect_options o;
+    memset(&o, 0, sizeof o);
+    o.rays = VX_VF_DEFAULT_REFLECT_RAYS;
+    o.shininess = 0.0; /* a perfect mirror */
+    o.bias = HFVIS_VISFIELD_DEFAULT_BIAS;
+    o.offset = 0.0;
+    return o;
 }
 
 HFVIS_API hfvis_status hfvis_visfield_reflect(const hfvis_visfield_object *objects,
@@ -8768,7 +8704,7 @@ HFVIS_API hfvis_status hfvis_visfield_decode(const void *data, size_t size,
     p += HFVIS_VISFIELD_FILE_HEADER;
     if (!vx_vf_payload_ok(p, vf.format, vf.mapping, vf.positions_n, vf.dir_res, (size_t)want))
         return HFVIS_ERR_FORMAT;
-    maps = (unsigned char *)vx_alloc(alloc, (size_t)want);
+    maps = (unsigned char *)hfvis__alloc(alloc, (size_t)want);
     if (!maps) return HFVIS_ERR_OUT_OF_MEMORY;
     if (vf.format == HFVIS_VISFIELD_F32) {
         for (i = 0; i < (size_t)want; i += 4) {
@@ -8787,7 +8723,7 @@ HFVIS_API hfvis_status hfvis_visfield_decode(const void *data, size_t size,
 HFVIS_API void hfvis_visfield_free(const hfvis_allocator *alloc, hfvis_visfield *vf)
 {
     if (!vf) return;
-    vx_free(alloc, vf->maps);
+    hfvis__free(alloc, vf->maps);
     memset(vf, 0, sizeof *vf);
 }
 
@@ -8798,11 +8734,11 @@ HFVIS_API hfvis_status hfvis_visfield_save(const char *path, const hfvis_visfiel
     unsigned char *buf;
     hfvis_status s;
     if (!path || need == 0) return HFVIS_ERR_INVALID_ARGUMENT;
-    buf = (unsigned char *)vx_alloc(NULL, need);
+    buf = (unsigned char *)hfvis__alloc(NULL, need);
     if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
     s = hfvis_visfield_encode(vf, buf, need, &written);
     if (s == HFVIS_OK) s = hfvis_write_file(path, buf, written, NULL);
-    vx_free(NULL, buf);
+    hfvis__free(NULL, buf);
     return s;
 }
 
@@ -8828,7 +8764,7 @@ HFVIS_API hfvis_status hfvis_visfield_load(const char *path, const hfvis_allocat
     s = hfvis__read_file(path, alloc, vx_vf_sizer, &data, &size);
     if (s != HFVIS_OK) return s;
     s = hfvis_visfield_decode(data, size, alloc, out);
-    vx_free(alloc, data);
+    hfvis__free(alloc, data);
     return s;
 }
 #endif
@@ -8838,7 +8774,7 @@ HFVIS_API hfvis_status hfvis_visfield_load(const char *path, const hfvis_allocat
 /* Indirect Illumination of Dynamic Scenes": Alg. 4, eqs. 7, 11-15; [G12] ch. 5)              */
 /*   GI.1 2-band SH: basis, clamped cosine, cone ([G12] ch. 5)                                */
 /*   GI.2 options, transport constants, validation                                           */
-/*   GI.3 VPL injection ([G12] §5.5.1, [G12] ch. 5)                                           */
+/*   GI.3 VPL injection ([G12] §5.5.1)                                                        */
 /*   GI.4 one propagation step (eq. 11 with the reference kernel of [G12] ch. 5, eq. 11; docs/errata.md E59): the fast */
 /*        gathering kernel, the literal reference, the energy accounting                     */
 /*   GI.5 the propagation loop (multiple bounces, §5.5.2 / §5.6)                               */
@@ -8884,8 +8820,8 @@ HFVIS_API hfvis_status hfvis_volgi_sh_basis(const double dir[3], double out[4])
 {
     double u[3], k;
     if (!out || !vx_gi_unit(dir, u)) return HFVIS_ERR_INVALID_ARGUMENT;
-    k = sqrt(3.0 / (4.0 * VX_PI));
-    out[0] = 0.5 / sqrt(VX_PI);
+    k = sqrt(3.0 / (4.0 * HFVIS__PI));
+    out[0] = 0.5 / sqrt(HFVIS__PI);
     out[1] = k * u[1], out[2] = k * u[2], out[3] = k * u[0];
     return HFVIS_OK;
 }
@@ -8895,8 +8831,8 @@ HFVIS_API hfvis_status hfvis_volgi_sh_clamped_cosine(const double normal[3], dou
     double u[3], k;
     if (!out || !vx_gi_unit(normal, u)) return HFVIS_ERR_INVALID_ARGUMENT;
     /* Int max(0, n.w) Y00 = pi/(2 sqrt pi); Int max(0, n.w) 0.4886 (n.w) = 0.4886 * 2 pi/3 */
-    k = sqrt(VX_PI / 3.0);
-    out[0] = 0.5 * sqrt(VX_PI);
+    k = sqrt(HFVIS__PI / 3.0);
+    out[0] = 0.5 * sqrt(HFVIS__PI);
     out[1] = k * u[1], out[2] = k * u[2], out[3] = k * u[0];
     return HFVIS_OK;
 }
@@ -8906,12 +8842,12 @@ HFVIS_API hfvis_status hfvis_volgi_sh_cone(const double axis[3], double half_ang
 {
     double u[3], k, s;
     if (!out || !vx_gi_unit(axis, u) || !isfinite(half_angle_rad) || !(half_angle_rad > 0.0)
-        || half_angle_rad > VX_PI)
+        || half_angle_rad > HFVIS__PI)
         return HFVIS_ERR_INVALID_ARGUMENT;
     /* Int_cone Y00 = 2 pi (1 - cos a)/(2 sqrt pi); Int_cone 0.4886 cos t = 0.4886 pi sin^2 a */
     s = sin(half_angle_rad);
-    k = 0.5 * sqrt(3.0 * VX_PI) * (s * s);
-    out[0] = sqrt(VX_PI) * (1.0 - cos(half_angle_rad));
+    k = 0.5 * sqrt(3.0 * HFVIS__PI) * (s * s);
+    out[0] = sqrt(HFVIS__PI) * (1.0 - cos(half_angle_rad));
     out[1] = k * u[1], out[2] = k * u[2], out[3] = k * u[0];
     return HFVIS_OK;
 }
@@ -9029,28 +8965,28 @@ static void vx_gi_consts_init(vx_gi_consts *k)
         double e[3] = { 0.0, 0.0, 0.0 };
         int ax = d / 2;
         e[ax] = (d & 1) ? -1.0 : 1.0;
-        (void)hfvis_volgi_sh_cone(e, 0.25 * VX_PI, k->cone[d]);
+        (void)hfvis_volgi_sh_cone(e, 0.25 * HFVIS__PI, k->cone[d]);
         (void)hfvis_volgi_sh_clamped_cosine(e, k->cc[d]);
         k->sb[d] = k->cone[d][vx_gi_band1[ax]];
         k->sc[d] = k->cc[d][vx_gi_band1[ax]];
     }
     for (d = 0; d < 6; d++) {
         int q;
-        for (q = 0; q < 4; q++) k->ccpi[d][q] = k->cc[d][q] / VX_PI;
+        for (q = 0; q < 4; q++) k->ccpi[d][q] = k->cc[d][q] / HFVIS__PI;
         k->k1[d] = k->ccpi[d][vx_gi_band1[d / 2]];
     }
     k->a = k->cone[0][0];
     k->c0 = k->cc[0][0];
     k->k0 = k->ccpi[0][0];
     k->lobe = k->cc[0][3] / k->cc[0][0];
-    k->flux = 2.0 * sqrt(VX_PI);
+    k->flux = 2.0 * sqrt(HFVIS__PI);
 }
 
 /* Voxel count of a valid grid, or 0 when an SH volume of it would overflow size_t. */
 static size_t vx_gi_voxels(const hfvis_volume_grid *g)
 {
     size_t n = vx_grid_voxels(g), bytes;
-    if (!vx_mul_size(n, (size_t)VX_GI_F * sizeof(double), &bytes)) return 0;
+    if (!hfvis__mul_size(n, (size_t)VX_GI_F * sizeof(double), &bytes)) return 0;
     return n;
 }
 
@@ -9478,7 +9414,7 @@ static hfvis_status vx_gi_step_entry(const hfvis_volgi_geometry *g, const hfvis_
     s = vx_gi_transport_check(g, o, pin, acc, &cfg, &n);
     if (s != HFVIS_OK) return s;
     if (cfg.transfer == HFVIS_VOLGI_TRANSFER_CONE_NORMALIZED && !reference) {
-        scale = (double *)vx_alloc_array(cfg.alloc, n, 3 * sizeof(double));
+        scale = (double *)hfvis__alloc_array(cfg.alloc, n, 3 * sizeof(double));
         if (!scale) return HFVIS_ERR_OUT_OF_MEMORY;
     }
     memset(&en, 0, sizeof en);
@@ -9490,7 +9426,7 @@ static hfvis_status vx_gi_step_entry(const hfvis_volgi_geometry *g, const hfvis_
     if (energy) vx_gi_energy_sources(&c);
     if (reference) vx_gi_step_reference(&c);
     else vx_gi_step_fast(&c);
-    vx_free(cfg.alloc, scale);
+    hfvis__free(cfg.alloc, scale);
     if (energy) *energy = en;
     return HFVIS_OK;
 }
@@ -9542,11 +9478,11 @@ static void vx_gi_propagate_run(const hfvis_volgi_geometry *g, const vx_gi_cfg *
 static size_t vx_gi_loop_scratch(const vx_gi_cfg *cfg, size_t n, size_t *scale_off)
 {
     size_t a, b = 0;
-    if (!vx_mul_size(n, VX_GI_F * sizeof(float), &a)) return 0;
+    if (!hfvis__mul_size(n, VX_GI_F * sizeof(float), &a)) return 0;
     a = (a + sizeof(double) - 1) / sizeof(double) * sizeof(double);
     *scale_off = a;
     if (cfg->transfer == HFVIS_VOLGI_TRANSFER_CONE_NORMALIZED
-        && (!vx_mul_size(n, 3 * sizeof(double), &b) || b > SIZE_MAX - a))
+        && (!hfvis__mul_size(n, 3 * sizeof(double), &b) || b > SIZE_MAX - a))
         return 0;
     return a + b;
 }
@@ -9567,12 +9503,12 @@ HFVIS_API hfvis_status hfvis_volgi_propagate(const hfvis_volgi_geometry *geometr
     if (iterations == 0) return HFVIS_OK;
     bytes = vx_gi_loop_scratch(&cfg, n, &off);
     if (bytes == 0) return HFVIS_ERR_LIMIT;
-    block = (unsigned char *)vx_alloc(cfg.alloc, bytes);
+    block = (unsigned char *)hfvis__alloc(cfg.alloc, bytes);
     if (!block) return HFVIS_ERR_OUT_OF_MEMORY;
     vx_gi_propagate_run(geometry, &cfg, iterations, prop, accum, energy, (float *)(void *)block,
                         cfg.transfer == HFVIS_VOLGI_TRANSFER_CONE_NORMALIZED
                             ? (double *)(void *)(block + off) : NULL, n);
-    vx_free(cfg.alloc, block);
+    hfvis__free(cfg.alloc, block);
     return HFVIS_OK;
 }
 
@@ -9665,7 +9601,7 @@ static int vx_gi_light_ok(const hfvis_volgi_light *L)
     case HFVIS_VOLGI_LIGHT_SPOT:
         return vx_gi_vec_ok(L->position, 0) && vx_gi_vec_ok(L->direction, 1)
                && L->spot_inner_rad >= 0.0 && L->spot_inner_rad <= L->spot_outer_rad
-               && L->spot_outer_rad > 0.0 && L->spot_outer_rad <= VX_PI;
+               && L->spot_outer_rad > 0.0 && L->spot_outer_rad <= HFVIS__PI;
     case HFVIS_VOLGI_LIGHT_DIRECTIONAL: return vx_gi_vec_ok(L->direction, 1);
     }
     return 0;
@@ -9756,7 +9692,7 @@ static hfvis_status vx_gi_scene_check(const hfvis_volgi_scene *sc)
     int l;
     if (!sc || !sc->mesh) return HFVIS_ERR_INVALID_ARGUMENT;
     if (sc->mesh->triangle_count > HFVIS_BVH_MAX_TRIANGLES) return HFVIS_ERR_LIMIT;
-    if (vx_mesh_check(sc->mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
+    if (hfvis__mesh_check(sc->mesh) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
     if (sc->light_count < 0 || sc->light_count > HFVIS_VOLGI_MAX_LIGHTS
         || (sc->light_count > 0 && !sc->lights))
         return HFVIS_ERR_INVALID_ARGUMENT;
@@ -9809,7 +9745,7 @@ HFVIS_API hfvis_status hfvis_volgi_grid_fit(const hfvis_mesh *mesh, int resoluti
     hfvis_volume_grid g;
     size_t total = 1;
     int a;
-    if (!out || vx_mesh_check(mesh) != HFVIS_OK || mesh->triangle_count == 0 || resolution < 2
+    if (!out || hfvis__mesh_check(mesh) != HFVIS_OK || mesh->triangle_count == 0 || resolution < 2
         || resolution > HFVIS_VOLGI_MAX_RESOLUTION)
         return HFVIS_ERR_INVALID_ARGUMENT;
     ext_max = vx_used_bounds(mesh, lo, hi);
@@ -9822,7 +9758,7 @@ HFVIS_API hfvis_status hfvis_volgi_grid_fit(const hfvis_mesh *mesh, int resoluti
         g.cell[a] = s;
         g.origin[a] = 0.5 * (lo[a] + hi[a]) - 0.5 * nn * s;
         if (!(s > 0.0) || !isfinite(g.origin[a])) return HFVIS_ERR_INVALID_ARGUMENT;
-        if (!vx_mul_size(total, (size_t)g.dims[a], &total) || total > HFVIS_VOLUME_MAX_VOXELS)
+        if (!hfvis__mul_size(total, (size_t)g.dims[a], &total) || total > HFVIS_VOLUME_MAX_VOXELS)
             return HFVIS_ERR_LIMIT;
     }
     *out = g;
@@ -9855,7 +9791,7 @@ static void vx_gi_fragment(const hfvis_voxel_fragment *f, float *values, void *u
     /* radiosity from direct light with shadows, plus emission ([G12] §5.5.1), as radiance */
     vx_gi_direct(u->sc, u->bvh, u->bias, p, n, f->triangle, E);
     for (b = 0; b < 3; b++) {
-        double L = (double)values[4 + b] * E[b] / VX_PI;
+        double L = (double)values[4 + b] * E[b] / HFVIS__PI;
         if (u->sc->emission) L += (double)u->sc->emission[3 * t + (size_t)b];
         values[7 + b] = (float)L;
     }
@@ -9867,7 +9803,7 @@ static hfvis_status vx_gi_voxelize(const hfvis_volgi_scene *sc, const hfvis_bvh 
                                    float *nrm, float *alb, float *rad, size_t *fragments)
 {
     size_t n = vx_grid_voxels(grid), v, count = 0;
-    float *block = (float *)vx_alloc_array(cfg->alloc, n, VX_GI_VCH * sizeof(float));
+    float *block = (float *)hfvis__alloc_array(cfg->alloc, n, VX_GI_VCH * sizeof(float));
     hfvis_volume vol;
     hfvis_voxelize_options vo = hfvis_voxelize_options_default();
     vx_gi_frag_user fu;
@@ -9898,7 +9834,7 @@ static hfvis_status vx_gi_voxelize(const hfvis_volgi_scene *sc, const hfvis_bvh 
             rad[3 * v + (size_t)b] = q[7 + b];
         }
     }
-    vx_free(cfg->alloc, block);
+    hfvis__free(cfg->alloc, block);
     if (fragments) *fragments = count;
     return s;
 }
@@ -9948,7 +9884,7 @@ HFVIS_API hfvis_status hfvis_volgi_voxelize(const hfvis_volgi_scene *scene,
 /* Flux of one band summed over an SH volume. */
 static void vx_gi_flux_sum(const float *sh, size_t n, double out[3])
 {
-    const double k = 2.0 * sqrt(VX_PI);
+    const double k = 2.0 * sqrt(HFVIS__PI);
     size_t v;
     int b;
     out[0] = out[1] = out[2] = 0.0;
@@ -9999,7 +9935,7 @@ HFVIS_API hfvis_status hfvis_volgi_render(const hfvis_volgi_scene *scene,
     pixels = (size_t)view->width * (size_t)view->height;
 
     /* G-buffer: normal (3), barycentrics (2), triangle id (1) per pixel, one block */
-    gbuf = (float *)vx_alloc_array(cfg.alloc, pixels, 5 * sizeof(float) + sizeof(uint32_t));
+    gbuf = (float *)hfvis__alloc_array(cfg.alloc, pixels, 5 * sizeof(float) + sizeof(uint32_t));
     if (!gbuf) return HFVIS_ERR_OUT_OF_MEMORY;
     tri = (uint32_t *)(void *)(gbuf + 5 * pixels);
     memset(&rout, 0, sizeof rout);
@@ -10013,7 +9949,7 @@ HFVIS_API hfvis_status hfvis_volgi_render(const hfvis_volgi_scene *scene,
     if (s != HFVIS_OK) goto done;
 
     /* geometry volume: occupancy, normal, albedo, radiance (10 floats per voxel) */
-    gvol = (float *)vx_alloc_array(cfg.alloc, n, 10 * sizeof(float));
+    gvol = (float *)hfvis__alloc_array(cfg.alloc, n, 10 * sizeof(float));
     if (!gvol) { s = HFVIS_ERR_OUT_OF_MEMORY; goto done; }
     s = vx_gi_voxelize(scene, bvh, &G, &cfg, gvol, gvol + n, gvol + 4 * n, gvol + 7 * n, &frags);
     if (s != HFVIS_OK) goto done;
@@ -10023,7 +9959,7 @@ HFVIS_API hfvis_status hfvis_volgi_render(const hfvis_volgi_scene *scene,
     geo.albedo = gvol + 4 * n;
 
     /* SH volumes: P (propagation) and A (accumulation) */
-    sh = (float *)vx_alloc_array(cfg.alloc, n, 2 * VX_GI_F * sizeof(float));
+    sh = (float *)hfvis__alloc_array(cfg.alloc, n, 2 * VX_GI_F * sizeof(float));
     if (!sh) { s = HFVIS_ERR_OUT_OF_MEMORY; goto done; }
     s = hfvis_volgi_inject(&geo, gvol + 7 * n, sh);
     if (s != HFVIS_OK) goto done;
@@ -10057,8 +9993,8 @@ HFVIS_API hfvis_status hfvis_volgi_render(const hfvis_volgi_scene *scene,
             for (b = 0; b < 3; b++) {
                 double al = scene->albedo ? (double)scene->albedo[3 * t + (size_t)b] : 1.0;
                 double em = scene->emission ? (double)scene->emission[3 * t + (size_t)b] : 0.0;
-                d[b] = (float)(em + al * Ed[b] / VX_PI);
-                id[b] = (float)(al * Ei[b] / VX_PI);
+                d[b] = (float)(em + al * Ed[b] / HFVIS__PI);
+                id[b] = (float)(al * Ei[b] / HFVIS__PI);
             }
             inf.covered_pixels++;
         }
@@ -10073,9 +10009,9 @@ HFVIS_API hfvis_status hfvis_volgi_render(const hfvis_volgi_scene *scene,
     for (v = 0; v < n; v++) inf.occupied += gvol[v] > 0.0f;
     if (info) *info = inf;
 done:
-    vx_free(cfg.alloc, sh);
-    vx_free(cfg.alloc, gvol);
+    hfvis__free(cfg.alloc, sh);
+    hfvis__free(cfg.alloc, gvol);
     hfvis_bvh_free(cfg.alloc, &own);
-    vx_free(cfg.alloc, gbuf);
+    hfvis__free(cfg.alloc, gbuf);
     return s;
 }

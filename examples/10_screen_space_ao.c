@@ -90,7 +90,7 @@ int main(int argc, char **argv)
         hfvis_ssao_rt_options o = hfvis_ssao_rt_options_default();
         o.falloff = fo;
         o.rays = 48;
-        if (hfvis_ssao_raytrace(&cam, depth, nrm, &o, ao[3], IW) != HFVIS_OK) goto fail;
+        if (hfvis_ssao_reference(&cam, depth, nrm, &o, ao[3], IW) != HFVIS_OK) goto fail;
     }
     for (k = 0; k < 4; k++)
         for (y = 0; y < IH; y++)

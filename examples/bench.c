@@ -80,7 +80,7 @@ static void bench_others(int n)
     printf("\n%-38s%4d^2 %12s %12s %9s\n", "other routines at", n, "fast", "baseline", "ratio");
     /* P1 hull vs the per-line brute force on the same lattice (one direction, 30 deg). */
     hfvis_lattice_init(&L, n, n, 0.5235987755982988);
-    nodes = hfvis_lattice_size(&L);
+    nodes = hfvis_lattice_nodes(&L);
     lat = (float *)xmalloc(sizeof(float) * nodes);
     t0 = bench_now();
     if ((s = hfvis_horizon_lattice(&g, 0.5235987755982988, NULL, lat)) != HFVIS_OK) die("lattice", s);

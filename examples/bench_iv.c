@@ -75,7 +75,7 @@ static double bench_iv_geometric(const hfvis_mesh *m, hfvis_volume *vol, double 
 
 static size_t bench_iv_nonempty(const hfvis_volume *v)
 {
-    size_t n = hfvis_volume_size(&v->grid, v->channels) / (size_t)v->channels, i, c = 0;
+    size_t n = hfvis_volume_floats(&v->grid, v->channels) / (size_t)v->channels, i, c = 0;
     int ch;
     for (i = 0; i < n; i++)
         for (ch = 0; ch < v->channels; ch++)
@@ -148,7 +148,7 @@ void bench_iv(int quick)
                t_sp = 1e30, t_full = 1e30, t_spf = 1e30, t_inpl = 1e30, voxels;
         size_t n, nonempty, cleared = 0, cleared_cons = 0, inj_pts = 0, injg_pts = 0, turned_on = 0;
         if (hfvis_volume_grid_fit(&m, res, 0.02, 1, &g) != HFVIS_OK) break;
-        n = hfvis_volume_size(&g, ch);
+        n = hfvis_volume_floats(&g, ch);
         voxels = (double)g.dims[0] * (double)g.dims[1] * (double)g.dims[2];
         prev_data = (float *)malloc(n * sizeof(float));
         curr_data = (float *)malloc(n * sizeof(float));

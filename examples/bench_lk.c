@@ -191,7 +191,7 @@ static int bench_lk_method(int method, const hfvis_mesh *m, const hfvis_bvh *bvh
     t0 = bench_now();
     if (method == 0) s = hfvis_lk_raster(m, v, rays, opts, NULL, ob, &out->st);
     else if (method == 1) s = hfvis_lk_bvh(m, bvh, rays, &rc, opts, NULL, ob, &out->st);
-    else s = hfvis_lk_raycast(m, bvh, rays, &rc, opts, NULL, ob, &out->st);
+    else s = hfvis_lk_reference(m, bvh, rays, &rc, opts, NULL, ob, &out->st);
     out->sec = bench_now() - t0;
     out->rays = (double)out->st.rays;
     out->blocked = (double)out->st.rays_blocked;

@@ -67,7 +67,7 @@ static double bench_lkobj_mean(const hfvis_mesh *m, const hfvis_bvh *bvh,
     ro.pattern = pattern;
     ro.seed = seed;
     if (hfvis_lk_rays_build(n, radius, &ro, &rays) != HFVIS_OK) return (double)NAN;
-    if (hfvis_lk_raycast(m, bvh, &rays, rc, NULL, NULL, obs, NULL) != HFVIS_OK) sum = (double)NAN;
+    if (hfvis_lk_reference(m, bvh, &rays, rc, NULL, NULL, obs, NULL) != HFVIS_OK) sum = (double)NAN;
     hfvis_lk_rays_free(NULL, &rays);
     for (i = 0; i < rc->count; i++) sum += (double)obs[i];
     return sum / (double)rc->count;
@@ -124,7 +124,7 @@ static double bench_lkobj_reference(const hfvis_mesh *m, const hfvis_bvh *bvh,
             o.jitter = HFVIS_LK_JITTER_CUSTOM;
             o.rotation_max_rad = BENCH_LKOBJ_PI;
             o.tilt_max_rad = 0.0;
-            ok = hfvis_lk_raycast(m, bvh, &rays, &sub, &o, NULL, obs, NULL) == HFVIS_OK;
+            ok = hfvis_lk_reference(m, bvh, &rays, &sub, &o, NULL, obs, NULL) == HFVIS_OK;
         }
         hfvis_lk_rays_free(NULL, &rays);
         for (i = 0; i < q; i++) s += (double)obs[i];

@@ -1,6 +1,6 @@
 /* bench_ssaob.c - P4 far-field AO: time per pixel at 1280(+256)x720(+144) (quick: 320(+64)x
  * 180(+36)), and error against the screen-space ray-traced reference beside the mipmap baseline's
- * error at the same sample count ([P4] §8, [P4] §8-10), on the knot-on-ground scene of the
+ * error at the same sample count ([P4] §8-10), on the knot-on-ground scene of the
  * LSAO bench (100k triangles, rasterized). The reference is noisy: it is run twice with
  * independent seeds, e_A is taken against their mean, and the RMS error is corrected for the
  * reference's own variance (E[(m - r1)^2] - E[(r1 - r2)^2]/2 is unbiased for E[(m - truth)^2]). */
@@ -108,9 +108,9 @@ void bench_ssaob(int quick)
         ro.rays = rays;
         t0 = bench_now();
         ro.seed = 1;
-        hfvis_ssao_raytrace(&s.cam, s.depth, NULL, &ro, s.r1, We);
+        hfvis_ssao_reference(&s.cam, s.depth, NULL, &ro, s.r1, We);
         ro.seed = 2;
-        hfvis_ssao_raytrace(&s.cam, s.depth, NULL, &ro, s.r2, We);
+        hfvis_ssao_reference(&s.cam, s.depth, NULL, &ro, s.r2, We);
         for (i = 0; i < n; i++) {
             double d = (double)s.r1[i] - (double)s.r2[i];
             s.rm[i] = 0.5f * (s.r1[i] + s.r2[i]);

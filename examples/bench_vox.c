@@ -1,4 +1,4 @@
-/* bench_vox.c - surface voxelizers ([G12] ch. 6 Alg. 5/6, ch. 5 Alg. 4; [G12] ch. 6, Alg. 5-6) on
+/* bench_vox.c - surface voxelizers ([G12] ch. 6 Alg. 5-6, ch. 5 Alg. 4) on
  * the issue's 100k-triangle torus knot at 128^3, 256^3, 512^3 (longest axis), each method beside
  * its per-voxel oracle in the same run; the same voxels written into an 8x larger grid (cost
  * follows the voxels written, not the grid volume); and a coarse icosphere whose large triangles
@@ -33,7 +33,7 @@ static double bench_vox_time(const hfvis_mesh *m, hfvis_volume *vol, const hfvis
 
 static size_t bench_vox_occupied(const hfvis_volume *vol)
 {
-    size_t n = hfvis_volume_size(&vol->grid, 1), i, c = 0;
+    size_t n = hfvis_volume_floats(&vol->grid, 1), i, c = 0;
     for (i = 0; i < n; i++) c += vol->data[i * (size_t)vol->channels] != 0.0f;
     return c;
 }
@@ -99,7 +99,7 @@ void bench_vox(int quick)
         float *st;
         char gname[32];
         if (hfvis_volume_grid_fit(&m, res[ri], 0.01, 0, &g) != HFVIS_OK) break;
-        st = (float *)malloc(sizeof(float) * hfvis_volume_size(&g, 1));
+        st = (float *)malloc(sizeof(float) * hfvis_volume_floats(&g, 1));
         if (!st || hfvis_volume_init(&vol, &g, 1, st, HFVIS_BLEND_MAX) != HFVIS_OK) {
             free(st);
             break;
@@ -117,7 +117,7 @@ void bench_vox(int quick)
                 big.origin[a] -= (double)(g.dims[a] / 2) * g.cell[a];
                 big.dims[a] = 2 * g.dims[a];
             }
-            bst = (float *)malloc(sizeof(float) * hfvis_volume_size(&big, 1));
+            bst = (float *)malloc(sizeof(float) * hfvis_volume_floats(&big, 1));
             if (bst && hfvis_volume_init(&bvol, &big, 1, bst, HFVIS_BLEND_MAX) == HFVIS_OK) {
                 hfvis_voxelize_options o = hfvis_voxelize_options_default();
                 size_t f1 = 0, f2 = 0;
@@ -143,7 +143,7 @@ void bench_vox(int quick)
         char gname[32];
         int r = quick ? 128 : 512;
         if (hfvis_volume_grid_fit(&m, r, 0.01, 0, &g) == HFVIS_OK
-            && (st = (float *)malloc(sizeof(float) * hfvis_volume_size(&g, 1))) != NULL
+            && (st = (float *)malloc(sizeof(float) * hfvis_volume_floats(&g, 1))) != NULL
             && hfvis_volume_init(&vol, &g, 1, st, HFVIS_BLEND_MAX) == HFVIS_OK) {
             printf("Large triangles: icosphere, %zu triangles\n", m.triangle_count);
             sprintf(gname, "%dx%dx%d", g.dims[0], g.dims[1], g.dims[2]);

@@ -2848,7 +2848,7 @@ static int cli_run_ssao(const cli_args *a)
     } else {
         hfvis_ssao_rt_options o = hfvis_ssao_rt_options_default();
         o.falloff = fo;
-        s = hfvis_ssao_raytrace(&cam, depth, NULL, &o, ao, W);
+        s = hfvis_ssao_reference(&cam, depth, NULL, &o, ao, W);
     }
     if (s != HFVIS_OK) { rc = cli_status("ssao", s, 0); goto done; }
     rc = cli_save(a, ao, W, H, 1, 0.0, 1.0);

@@ -954,6 +954,23 @@ TEST(files_load_failing_allocator)
     CHECK(remove(path) == 0 && remove(fifo) == 0);
 }
 
+/* hfvis_write_options: a zero struct and hfvis_write_options_default() write the same file. */
+TEST(files_write_options_default)
+{
+    static const unsigned char bytes[5] = {1, 2, 3, 4, 5};
+    unsigned char a[16], b[16];
+    char pa[160], pb[160];
+    hfvis_write_options z, d = hfvis_write_options_default();
+    memset(&z, 0, sizeof z);
+    sprintf(pa, "%s/wz.bin", test_dir);
+    sprintf(pb, "%s/wd.bin", test_dir);
+    CHECK_EQ_STATUS(hfvis_write_file(pa, bytes, sizeof bytes, &z), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_write_file(pb, bytes, sizeof bytes, &d), HFVIS_OK);
+    CHECK(read_bytes(pa, a, sizeof a) == sizeof bytes && read_bytes(pb, b, sizeof b) == sizeof bytes);
+    CHECK(memcmp(a, bytes, sizeof bytes) == 0 && memcmp(b, bytes, sizeof bytes) == 0);
+    CHECK(remove(pa) == 0 && remove(pb) == 0);
+}
+
 TEST(files_teardown)
 {
     CHECK(test_dir_entries(test_dir) == 0);
@@ -1078,6 +1095,43 @@ TEST(oracles_allocate_nothing)
     CHECK(state.allocs == 0);
 }
 
+/* The options added with 0.2.0's *_options_default(): a zero struct (the documented defaults)
+ * and the filled-in defaults give bit-identical results on one call each. */
+TEST(options_default_equals_zero)
+{
+    static float a[SWEEP_K * SWEEP_W * SWEEP_H], b[SWEEP_K * SWEEP_W * SWEEP_H];
+    hfvis_grid g = sweep_grid();
+    float pts[4] = {3.0f, 4.0f, 10.5f, 8.25f}, nrm[6] = {0, 0, 1, 0, 0, 1};
+    hfvis_march_options mz, md = hfvis_march_options_default();
+    hfvis_openness_options oz, od = hfvis_openness_options_default();
+    hfvis_hemisphere_options hz, hd = hfvis_hemisphere_options_default();
+    hfvis_tree_options tz, td = hfvis_tree_options_default();
+    hfvis_viewshed_options vz, vd = hfvis_viewshed_options_default();
+    memset(&mz, 0, sizeof mz);
+    memset(&oz, 0, sizeof oz);
+    memset(&hz, 0, sizeof hz);
+    memset(&tz, 0, sizeof tz);
+    memset(&vz, 0, sizeof vz);
+    memset(a, 0, sizeof a);
+    memset(b, 0xff, sizeof b);
+    CHECK_EQ_STATUS(hfvis_horizon_reference(&g, SWEEP_K, NULL, &mz, pts, 2, a), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_horizon_reference(&g, SWEEP_K, NULL, &md, pts, 2, b), HFVIS_OK);
+    CHECK(memcmp(a, b, 2 * SWEEP_K * sizeof(float)) == 0);
+    od.radius = oz.radius = 5.0; /* the marching path, where step_cells applies */
+    CHECK_EQ_STATUS(hfvis_openness(&g, SWEEP_K, &oz, NULL, a, SWEEP_W), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_openness(&g, SWEEP_K, &od, NULL, b, SWEEP_W), HFVIS_OK);
+    CHECK(memcmp(a, b, SWEEP_W * SWEEP_H * sizeof(float)) == 0);
+    CHECK_EQ_STATUS(hfvis_light_reference(&g, NULL, 1.0f, NULL, NULL, &hz, pts, nrm, 2, a), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_light_reference(&g, NULL, 1.0f, NULL, NULL, &hd, pts, nrm, 2, b), HFVIS_OK);
+    CHECK(memcmp(a, b, 2 * sizeof(float)) == 0);
+    CHECK_EQ_STATUS(hfvis_visibility_count(&g, SWEEP_K, NULL, &tz, a, SWEEP_W, NULL), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_visibility_count(&g, SWEEP_K, NULL, &td, b, SWEEP_W, NULL), HFVIS_OK);
+    CHECK(memcmp(a, b, SWEEP_W * SWEEP_H * sizeof(float)) == 0);
+    CHECK_EQ_STATUS(hfvis_viewshed(&g, 11.0, 8.0, &vz, a, SWEEP_W), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_viewshed(&g, 11.0, 8.0, &vd, b, SWEEP_W), HFVIS_OK);
+    CHECK(memcmp(a, b, SWEEP_W * SWEEP_H * sizeof(float)) == 0);
+}
+
 /* An allocator with free but no alloc: every block came from HFVIS_MALLOC, so the library
  * frees it with HFVIS_FREE and never hands it to free (ssao.c and voxel.c once did: a mesh
  * from hfvis_mesh_box went to the caller's free). */
@@ -1117,6 +1171,23 @@ TEST(allocator_free_without_alloc)
     CHECK(api_foreign_frees == 0);
 }
 
+/* The names 0.2.0 renamed still compile and call the new functions (hfvis.h, "Deprecated
+ * names"). */
+TEST(deprecated_names)
+{
+    hfvis_lattice L;
+    hfvis_volume_grid vg;
+    CHECK_EQ_STATUS(hfvis_lattice_init(&L, 5, 4, 0.3), HFVIS_OK);
+    CHECK(hfvis_lattice_size(&L) == hfvis_lattice_nodes(&L) && hfvis_lattice_size(&L) > 0);
+    CHECK(hfvis_env_table_size(NULL, 4, NULL) == 0);
+    memset(&vg, 0, sizeof vg);
+    vg.dims[0] = vg.dims[1] = vg.dims[2] = 2;
+    vg.cell[0] = vg.cell[1] = vg.cell[2] = 1.0;
+    CHECK(hfvis_volume_size(&vg, 2) == 16 && hfvis_volume_floats(&vg, 2) == 16);
+    CHECK_EQ_STATUS(hfvis_ssao_raytrace(NULL, NULL, NULL, NULL, NULL, 0), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_lk_raycast(NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
@@ -1144,9 +1215,12 @@ int main(int argc, char **argv)
     RUN(files_errors);
     RUN(files_header_first);
     RUN(files_load_failing_allocator);
+    RUN(files_write_options_default);
     RUN(files_teardown);
     /* Height-field routines */
     RUN(sweeps_failing_allocator);
     RUN(oracles_allocate_nothing);
+    RUN(options_default_equals_zero);
+    RUN(deprecated_names);
     return TEST_DONE();
 }

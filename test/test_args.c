@@ -55,6 +55,7 @@
     X(pgm_encode_size, V, -, "ZGR", "0") \
     X(pfm_encode, S, -, "NZGOR", "INVALID_ARGUMENT BUFFER_TOO_SMALL") \
     X(pgm_encode, S, -, "NZGOFR", "INVALID_ARGUMENT BUFFER_TOO_SMALL") \
+    X(write_options_default, P, -, "", "cannot fail") \
     X(write_file, S, M, "NZR", "INVALID_ARGUMENT IO") \
     X(write_begin, S, M, "NZR", "INVALID_ARGUMENT IO") \
     X(write_end, S, -, "NR", "INVALID_ARGUMENT IO") \
@@ -71,7 +72,7 @@
     X(grid_sample, V, -, "NZF", "NaN") \
     X(normals_compute, S, -, "NZGOFR", "INVALID_ARGUMENT") \
     X(lattice_init, S, -, "NZGOF", "INVALID_ARGUMENT LIMIT") \
-    X(lattice_size, V, -, "N", "0") \
+    X(lattice_nodes, V, -, "N", "0") \
     X(lattice_line, V, -, "NR", "0") \
     X(sweep_options_default, P, -, "", "cannot fail") \
     X(tile_halo, V, -, "ZGFE", "-1") \
@@ -81,8 +82,10 @@
     X(horizon_lattice_naive, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(horizon_direction, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(horizon_map, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
+    X(march_options_default, P, -, "", "cannot fail") \
     X(horizon_reference, S, -, "NZGOFESR", "INVALID_ARGUMENT") \
     X(horizon_reference_fn, S, -, "NZGFES", "INVALID_ARGUMENT") \
+    X(openness_options_default, P, -, "", "cannot fail") \
     X(openness, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(sweep_azimuths, S, A, "NZGES", "INVALID_ARGUMENT") \
     X(horizon_exact_naive, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
@@ -93,11 +96,13 @@
     X(sky_view_factor_from_map, S, -, "NZGOFR", "INVALID_ARGUMENT") \
     X(sun_visibility, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(env_options_default, P, -, "", "cannot fail") \
-    X(env_table_size, V, -, "NZGOES", "0") \
+    X(env_table_floats, V, -, "NZGOES", "0") \
     X(env_table_build, S, -, "NZGOFES", "INVALID_ARGUMENT") \
     X(env_light, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(env_light_from_map, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
+    X(hemisphere_options_default, P, -, "", "cannot fail") \
     X(light_reference, S, -, "NZGOFESR", "INVALID_ARGUMENT") \
+    X(tree_options_default, P, -, "", "cannot fail") \
     X(hull_tree_size, V, -, "ZG", "0") \
     X(hull_tree_init, S, -, "NZGOESR", "INVALID_ARGUMENT BUFFER_TOO_SMALL") \
     X(hull_tree_reset, V, -, "N", "no-op for NULL") \
@@ -115,6 +120,7 @@
     X(indirect_light_naive, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(terrain_gi, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(direct_light, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
+    X(viewshed_options_default, P, -, "", "cannot fail") \
     X(viewshed, S, -, "NZGOFSR", "INVALID_ARGUMENT") \
     X(viewshed_reference, S, -, "NZGOFSR", "INVALID_ARGUMENT") \
     X(sh_eval, S, -, "NZF", "INVALID_ARGUMENT") \
@@ -187,7 +193,7 @@
     X(hbao, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(ssao_rt_options_default, P, -, "", "cannot fail") \
     X(ssao_rt_options_resolve, S, -, "NGOFES", "INVALID_ARGUMENT") \
-    X(ssao_raytrace, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
+    X(ssao_reference, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(ssao_scene_render, S, -, "NZGOFESR", "INVALID_ARGUMENT") \
     X(ffao_options_default, P, -, "", "cannot fail") \
     X(ffao_options_resolve, S, -, "NGOFESR", "INVALID_ARGUMENT") \
@@ -214,7 +220,7 @@
     X(depth_to_eye_z, P, -, "", "cannot fail") \
     X(eye_z_to_depth, P, -, "", "cannot fail") \
     X(volume_grid_fit, S, -, "NZGOFR", "INVALID_ARGUMENT LIMIT") \
-    X(volume_size, V, -, "NZGO", "0") \
+    X(volume_floats, V, -, "NZGO", "0") \
     X(volume_init, S, -, "NZGOFE", "INVALID_ARGUMENT") \
     X(volume_clear, V, -, "N", "no-op for NULL vol or data") \
     X(volume_write, S, -, "NZGOFER", "INVALID_ARGUMENT") \
@@ -283,6 +289,7 @@
     X(iv_replace_nonempty, S, -, "NZGOSR", "INVALID_ARGUMENT") \
     X(iv_occupancy, S, -, "NZGR", "INVALID_ARGUMENT") \
     X(point_triangle_distance, V, -, "N", "NaN") \
+    X(distance_options_default, P, -, "", "cannot fail") \
     X(voxel_distance_metrics, S, A, "NZGOFR", "INVALID_ARGUMENT") \
     X(voxel_distance_metrics_naive, S, A, "NZGOFR", "INVALID_ARGUMENT") \
     X(visfield_position_count, V, -, "ZGO", "0") \
@@ -296,6 +303,7 @@
     X(dirmap_from_local, S, -, "NZOFER", "INVALID_ARGUMENT") \
     X(visfield_size, V, -, "ZGOE", "0") \
     X(visfield_bounding_sphere, S, -, "NZOFR", "INVALID_ARGUMENT") \
+    X(visfield_build_options_default, P, -, "", "cannot fail") \
     X(visfield_build, S, A, "NZOFESR", "INVALID_ARGUMENT BUFFER_TOO_SMALL") \
     X(visfield_build_reference, S, -, "NZOFER", "INVALID_ARGUMENT BUFFER_TOO_SMALL") \
     X(visfield_texel, S, -, "NZGOFESR", "INVALID_ARGUMENT") \
@@ -304,10 +312,12 @@
     X(visfield_ao_options_default, P, -, "", "cannot fail") \
     X(visfield_ambient_occlusion, S, A, "NZGOFES", "INVALID_ARGUMENT") \
     X(visfield_ambient_occlusion_reference, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
+    X(visfield_shadow_options_default, P, -, "", "cannot fail") \
     X(visfield_soft_shadow, S, A, "NGOFES", "INVALID_ARGUMENT") \
     X(visfield_soft_shadow_reference, S, A, "NGOFES", "INVALID_ARGUMENT") \
     X(visfield_trace, S, -, "NZGOFES", "INVALID_ARGUMENT") \
     X(visfield_trace_reference, S, -, "NZGOFES", "INVALID_ARGUMENT") \
+    X(visfield_reflect_options_default, P, -, "", "cannot fail") \
     X(visfield_reflect, S, -, "NZGOFES", "INVALID_ARGUMENT") \
     X(visfield_reflect_reference, S, -, "NZGOFES", "INVALID_ARGUMENT") \
     X(visfield_encode_size, V, -, "NZE", "0") \
@@ -349,7 +359,7 @@
     X(lk_gbuffer_receivers, S, A, "NZGOFER", "INVALID_ARGUMENT LIMIT") \
     X(lk_raster, S, A, "NZGOFESR", "INVALID_ARGUMENT LIMIT") \
     X(lk_bvh, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
-    X(lk_raycast, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
+    X(lk_reference, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(lk_image, S, A, "NZGOFESR", "INVALID_ARGUMENT LIMIT")
 
 /* ========================================================================================== */
@@ -1037,12 +1047,12 @@ static void args_lattice_init(void)
     BAD('O', LIM, hfvis_lattice_init(L, INT_MAX, INT_MAX, 0.3));
 }
 
-static void args_lattice_size(void)
+static void args_lattice_nodes(void)
 {
     hfvis_lattice L;
-    begin("lattice_size");
-    CHECK(hfvis_lattice_init(&L, GW, GH, 0.3) == HFVIS_OK && hfvis_lattice_size(&L) > 0);
-    BADV('N', hfvis_lattice_size(NULL) == 0);
+    begin("lattice_nodes");
+    CHECK(hfvis_lattice_init(&L, GW, GH, 0.3) == HFVIS_OK && hfvis_lattice_nodes(&L) > 0);
+    BADV('N', hfvis_lattice_nodes(NULL) == 0);
 }
 
 static void args_tile_halo(void)
@@ -1121,7 +1131,7 @@ static void args_horizon_lattice(void)
     float *out;
     begin("horizon_lattice");
     hfvis_lattice_init(&L, GW, GH, 0.3);
-    out = AF(hfvis_lattice_size(&L));
+    out = AF(hfvis_lattice_nodes(&L));
     OK(hfvis_horizon_lattice(&g_ok, 0.3, NULL, out));
     BAD('N', INV, hfvis_horizon_lattice(NULL, 0.3, NULL, out));
     BAD('N', INV, hfvis_horizon_lattice(&g_ok, 0.3, NULL, NULL));
@@ -1137,7 +1147,7 @@ static void args_horizon_lattice_naive(void)
     float *out;
     begin("horizon_lattice_naive");
     hfvis_lattice_init(&L, GW, GH, 0.3);
-    out = AF(hfvis_lattice_size(&L));
+    out = AF(hfvis_lattice_nodes(&L));
     OK(hfvis_horizon_lattice_naive(&g_ok, 0.3, NULL, out));
     BAD('N', INV, hfvis_horizon_lattice_naive(NULL, 0.3, NULL, out));
     BAD('N', INV, hfvis_horizon_lattice_naive(&g_ok, 0.3, NULL, NULL));
@@ -1398,28 +1408,28 @@ static void args_env_options_default(void)
     bx = hfvis_env_options_default(); bx.method = HFVIS_ENV_LP_TABLE; bx.lp_horizon_res = 1; BAD('S', INV, expr); \
     } while (0)
 
-static void args_env_table_size(void)
+static void args_env_table_floats(void)
 {
     hfvis_env_options e = hfvis_env_options_default();
     hfvis_env b = g_env;
-    begin("env_table_size");
-    CHECK(hfvis_env_table_size(&g_env, 4, NULL) > 0);
-    BADV('N', hfvis_env_table_size(NULL, 4, NULL) == 0);
-    BADV('Z', hfvis_env_table_size(&g_env, 0, NULL) == 0);
-    BADV('G', hfvis_env_table_size(&g_env, -1, NULL) == 0);
+    begin("env_table_floats");
+    CHECK(hfvis_env_table_floats(&g_env, 4, NULL) > 0);
+    BADV('N', hfvis_env_table_floats(NULL, 4, NULL) == 0);
+    BADV('Z', hfvis_env_table_floats(&g_env, 0, NULL) == 0);
+    BADV('G', hfvis_env_table_floats(&g_env, -1, NULL) == 0);
     e.method = (hfvis_env_method)99;
-    BADV('E', hfvis_env_table_size(&g_env, 4, &e) == 0);
+    BADV('E', hfvis_env_table_floats(&g_env, 4, &e) == 0);
     b.channels = 0;
-    BADV('S', hfvis_env_table_size(&b, 4, NULL) == 0);
+    BADV('S', hfvis_env_table_floats(&b, 4, NULL) == 0);
     b = g_env; b.n_theta = INT_MAX; b.channels = 4;
-    BADV('O', hfvis_env_table_size(&b, INT_MAX, NULL) == 0);
+    BADV('O', hfvis_env_table_floats(&b, INT_MAX, NULL) == 0);
 }
 
 static void args_env_table_build(void)
 {
     float *t;
     begin("env_table_build");
-    t = AF(hfvis_env_table_size(&g_env, 4, NULL));
+    t = AF(hfvis_env_table_floats(&g_env, 4, NULL));
     OK(hfvis_env_table_build(&g_env, 4, 0.0, NULL, t));
     BAD('N', INV, hfvis_env_table_build(NULL, 4, 0.0, NULL, t));
     BAD('N', INV, hfvis_env_table_build(&g_env, 4, 0.0, NULL, NULL));
@@ -3105,16 +3115,16 @@ static void args_ssao_rt_options_resolve(void)
     RT_OPT_CASES(hfvis_ssao_rt_options_resolve(&br, o));
 }
 
-static void args_ssao_raytrace(void)
+static void args_ssao_reference(void)
 {
     hfvis_ssao_rt_options o = hfvis_ssao_rt_options_default();
     float *ao;
-    begin("ssao_raytrace");
+    begin("ssao_reference");
     o.rays = 4;
     ao = AF(INNER * INNER);
-    OK(hfvis_ssao_raytrace(&cam_ok, cam_depth, cam_normals, &o, ao, INNER));
-    AO_IMAGE_CASES(hfvis_ssao_raytrace, &o);
-    RT_OPT_CASES(hfvis_ssao_raytrace(&cam_ok, cam_depth, cam_normals, &br, ao, INNER));
+    OK(hfvis_ssao_reference(&cam_ok, cam_depth, cam_normals, &o, ao, INNER));
+    AO_IMAGE_CASES(hfvis_ssao_reference, &o);
+    RT_OPT_CASES(hfvis_ssao_reference(&cam_ok, cam_depth, cam_normals, &br, ao, INNER));
 }
 
 static void args_ssao_scene_render(void)
@@ -3524,16 +3534,16 @@ static void args_volume_grid_fit(void)
     MESH_CASES(hfvis_volume_grid_fit(&bm, 4, 0.1, 0, g), INV);
 }
 
-static void args_volume_size(void)
+static void args_volume_floats(void)
 {
     hfvis_volume_grid b = vg_ok;
-    begin("volume_size");
-    CHECK(hfvis_volume_size(&vg_ok, 2) == 128);
-    BADV('N', hfvis_volume_size(NULL, 2) == 0);
-    BADV('Z', hfvis_volume_size(&vg_ok, 0) == 0);
-    BADV('O', hfvis_volume_size(&vg_ok, HFVIS_VOLUME_MAX_CHANNELS + 1) == 0);
+    begin("volume_floats");
+    CHECK(hfvis_volume_floats(&vg_ok, 2) == 128);
+    BADV('N', hfvis_volume_floats(NULL, 2) == 0);
+    BADV('Z', hfvis_volume_floats(&vg_ok, 0) == 0);
+    BADV('O', hfvis_volume_floats(&vg_ok, HFVIS_VOLUME_MAX_CHANNELS + 1) == 0);
     b.dims[0] = -1;
-    BADV('G', hfvis_volume_size(&b, 1) == 0);
+    BADV('G', hfvis_volume_floats(&b, 1) == 0);
 }
 
 static void args_volume_init(void)
@@ -5869,16 +5879,16 @@ static void args_lk_bvh(void)
     LK_RECV_CASES(hfvis_lk_bvh);
 }
 
-static void args_lk_raycast(void)
+static void args_lk_reference(void)
 {
     hfvis_lk_receivers rc = recv_ok();
     uint32_t *masks;
     float *ob;
     hfvis_lk_stats *st;
-    begin("lk_raycast");
+    begin("lk_reference");
     masks = ATN(uint32_t, 2); ob = AF(2); st = AT(hfvis_lk_stats);
-    OK(hfvis_lk_raycast(&m_box, &m_bvh, &lk_rays, &rc, NULL, masks, ob, st));
-    LK_RECV_CASES(hfvis_lk_raycast);
+    OK(hfvis_lk_reference(&m_box, &m_bvh, &lk_rays, &rc, NULL, masks, ob, st));
+    LK_RECV_CASES(hfvis_lk_reference);
 }
 
 static void args_lk_image(void)
@@ -5931,14 +5941,14 @@ SW(horizon_lattice)
     hfvis_sweep_options o = sweep_opts(al);
     hfvis_lattice L;
     hfvis_lattice_init(&L, GW, GH, 0.3);
-    return hfvis_horizon_lattice(&g_ok, 0.3, &o, AF(hfvis_lattice_size(&L)));
+    return hfvis_horizon_lattice(&g_ok, 0.3, &o, AF(hfvis_lattice_nodes(&L)));
 }
 SW(horizon_lattice_naive)
 {
     hfvis_sweep_options o = sweep_opts(al);
     hfvis_lattice L;
     hfvis_lattice_init(&L, GW, GH, 0.3);
-    return hfvis_horizon_lattice_naive(&g_ok, 0.3, &o, AF(hfvis_lattice_size(&L)));
+    return hfvis_horizon_lattice_naive(&g_ok, 0.3, &o, AF(hfvis_lattice_nodes(&L)));
 }
 SW(horizon_direction) { hfvis_sweep_options o = sweep_opts(al); return hfvis_horizon_direction(&g_ok, 4, 1, &o, AF(GW * GH), GW); }
 SW(openness) { hfvis_sweep_options o = sweep_opts(al); return hfvis_openness(&g_ok, 4, NULL, &o, AF(GW * GH), GW); }
@@ -6039,11 +6049,11 @@ SW(lsao_direction_naive)
 }
 SW(lsao) { hfvis_lsao_options o = hfvis_lsao_options_default(); o.alloc = al; return hfvis_lsao(&cam_ok, cam_depth, NULL, &o, AF(INNER * INNER), INNER); }
 SW(hbao) { hfvis_hbao_options o = hfvis_hbao_options_default(); o.alloc = al; return hfvis_hbao(&cam_ok, cam_depth, NULL, &o, AF(INNER * INNER), INNER); }
-SW(ssao_raytrace)
+SW(ssao_reference)
 {
     hfvis_ssao_rt_options o = hfvis_ssao_rt_options_default();
     o.alloc = al; o.rays = 4;
-    return hfvis_ssao_raytrace(&cam_ok, cam_depth, NULL, &o, AF(INNER * INNER), INNER);
+    return hfvis_ssao_reference(&cam_ok, cam_depth, NULL, &o, AF(INNER * INNER), INNER);
 }
 SW(ffao_table_build)
 {
@@ -6302,13 +6312,13 @@ SW(lk_bvh)
     o.alloc = al;
     return hfvis_lk_bvh(&m_box, &m_bvh, &lk_rays, &rc, &o, masks, AF(2), NULL);
 }
-SW(lk_raycast)
+SW(lk_reference)
 {
     hfvis_lk_options o = hfvis_lk_options_default();
     hfvis_lk_receivers rc = recv_ok();
     uint32_t *masks = ATN(uint32_t, 2);
     o.alloc = al;
-    return hfvis_lk_raycast(&m_box, &m_bvh, &lk_rays, &rc, &o, masks, AF(2), NULL);
+    return hfvis_lk_reference(&m_box, &m_bvh, &lk_rays, &rc, &o, masks, AF(2), NULL);
 }
 SW(lk_image)
 {
@@ -6543,7 +6553,7 @@ static const sweep_entry sweeps[] = {
     SWEEP(visibility_count), SWEEP(visibility_count_naive), SWEEP(indirect_light),
     SWEEP(indirect_light_naive), SWEEP(terrain_gi), SWEEP(direct_light), SWEEP(ns_gi),
     SWEEP(direction_sums), SWEEP(partial_decode), SWEEP(partial_load),
-    SWEEP(lsao_direction), SWEEP(lsao_direction_naive), SWEEP(lsao), SWEEP(hbao), SWEEP(ssao_raytrace),
+    SWEEP(lsao_direction), SWEEP(lsao_direction_naive), SWEEP(lsao), SWEEP(hbao), SWEEP(ssao_reference),
     SWEEP(ffao_table_build), SWEEP(ffao), SWEEP(ssao_mipmap),
     SWEEP(mesh_box), SWEEP(mesh_uv_sphere), SWEEP(mesh_icosphere), SWEEP(mesh_torus),
     SWEEP(mesh_torus_knot), SWEEP(mesh_from_grid), SWEEP(mesh_room), SWEEP(mesh_teapot),
@@ -6555,7 +6565,7 @@ static const sweep_entry sweeps[] = {
     SWEEP(visfield_soft_shadow), SWEEP(visfield_soft_shadow_reference), SWEEP(visfield_decode),
     SWEEP(visfield_load), SWEEP(volgi_propagate_step), SWEEP(volgi_propagate), SWEEP(volgi_voxelize),
     SWEEP(volgi_render), SWEEP(lk_rays_build), SWEEP(lk_rays_custom), SWEEP(lk_lut_build),
-    SWEEP(lk_gbuffer_receivers), SWEEP(lk_raster), SWEEP(lk_bvh), SWEEP(lk_raycast), SWEEP(lk_image),
+    SWEEP(lk_gbuffer_receivers), SWEEP(lk_raster), SWEEP(lk_bvh), SWEEP(lk_reference), SWEEP(lk_image),
     SWEEP_VARIANT(ffao, ffao_sparse_blur), SWEEP_VARIANT(volgi_propagate, volgi_propagate_normalized),
     SWEEP_VARIANT(lk_image, lk_image_raster), SWEEP_VARIANT(lk_image, lk_image_raycast),
     SWEEP_VARIANT(lk_raster, lk_raster_lut), SWEEP_VARIANT(iv_cleanup, iv_cleanup_two_images),
@@ -6684,6 +6694,78 @@ static void io_one(const io_entry *e)
     CHECK(test_dir_entries(sub) == before);
     CHECK_EQ_STATUS(e->fn(tmp_path(e->name)), HFVIS_OK);
     CHECK_EQ_STATUS(e->fn(tmp_path(e->name)), HFVIS_OK); /* replaces */
+}
+
+/* The option defaults added with 0.2.0: each returns the values its header comment documents
+ * (the equality of zero-initialised and default options on a call is test_api's). */
+static void args_write_options_default(void)
+{
+    hfvis_write_options o = hfvis_write_options_default();
+    begin("write_options_default");
+    CHECK(o.on_temp == NULL && o.user == NULL);
+}
+
+static void args_march_options_default(void)
+{
+    hfvis_march_options o = hfvis_march_options_default();
+    begin("march_options_default");
+    CHECK(o.step_cells == 1.0 && o.max_distance_cells == 0.0);
+}
+
+static void args_openness_options_default(void)
+{
+    hfvis_openness_options o = hfvis_openness_options_default();
+    begin("openness_options_default");
+    CHECK(o.radius == 0.0 && o.negative == 0 && o.step_cells == 1.0);
+}
+
+static void args_hemisphere_options_default(void)
+{
+    hfvis_hemisphere_options o = hfvis_hemisphere_options_default();
+    begin("hemisphere_options_default");
+    CHECK(o.azimuth_samples == 256 && o.zenith_samples == 512);
+}
+
+static void args_tree_options_default(void)
+{
+    hfvis_tree_options o = hfvis_tree_options_default();
+    begin("tree_options_default");
+    CHECK(o.order == HFVIS_TREE_DEPTH_FIRST && o.safe_zone == 0 && o.safe_zone_steps == 4);
+}
+
+static void args_viewshed_options_default(void)
+{
+    hfvis_viewshed_options o = hfvis_viewshed_options_default();
+    begin("viewshed_options_default");
+    CHECK(o.observer_height == 0.0 && o.target_height == 0.0 && o.max_distance == 0.0 && o.alloc == NULL);
+}
+
+static void args_distance_options_default(void)
+{
+    hfvis_distance_options o = hfvis_distance_options_default();
+    begin("distance_options_default");
+    CHECK(o.sample_count == 100000 && o.seed == 0 && o.alloc == NULL);
+}
+
+static void args_visfield_build_options_default(void)
+{
+    hfvis_visfield_build_options o = hfvis_visfield_build_options_default();
+    begin("visfield_build_options_default");
+    CHECK(o.alloc == NULL && o.bvh == NULL && o.progress == NULL && o.progress_user == NULL);
+}
+
+static void args_visfield_shadow_options_default(void)
+{
+    hfvis_visfield_shadow_options o = hfvis_visfield_shadow_options_default();
+    begin("visfield_shadow_options_default");
+    CHECK(o.samples == 20 && o.bias == HFVIS_VISFIELD_DEFAULT_BIAS && o.alloc == NULL);
+}
+
+static void args_visfield_reflect_options_default(void)
+{
+    hfvis_visfield_reflect_options o = hfvis_visfield_reflect_options_default();
+    begin("visfield_reflect_options_default");
+    CHECK(o.rays == 4 && o.shininess == 0.0 && o.bias == HFVIS_VISFIELD_DEFAULT_BIAS && o.offset == 0.0);
 }
 
 /* ========================================================================================== */

@@ -1,4 +1,4 @@
-/* test_bvh.c - BVH, watertight ray-triangle test and ray queries (voxel.c section 2a).
+/* test_bvh.c - BVH, watertight ray-triangle test and ray queries (voxel.c section 6).
  * The BVH queries are held to their naive oracles with EXACT equality (t, triangle, u, v, front
  * bits; any-hit verdicts) on seeded rays over several meshes and every leaf size. */
 #include "hfvis.h"

@@ -23,7 +23,7 @@ static int rng_int(int n) { return (int)(rng_next() % (uint64_t)n); }
 
 
 /* ---------------------------------------------------------------------------------------- */
-/* 1. Hull stack vs brute force ([P1] Alg. 1; docs/errata.md E1, E2; docs/errata.md E2; [P2] §6) */
+/* 1. Hull stack vs brute force ([P1] Alg. 1; docs/errata.md E1, E2; [P2] §6) */
 /* ---------------------------------------------------------------------------------------- */
 
 #define LINE_MAX_N 320
@@ -278,7 +278,7 @@ TEST(horizon_lattice_vs_naive)
                 size_t n;
                 float *fast, *slow;
                 CHECK_EQ_STATUS(hfvis_lattice_init(&L, w, h, az), HFVIS_OK);
-                n = hfvis_lattice_size(&L);
+                n = hfvis_lattice_nodes(&L);
                 fast = (float *)malloc(sizeof(float) * n);
                 slow = (float *)malloc(sizeof(float) * n);
                 CHECK(fast && slow);
@@ -364,7 +364,7 @@ TEST(lattice_geometry)
         total = lattice_walk(&L, &lines, &ok);
         CHECK(ok);
         CHECK(lines == 64 && total == 64L * 64L);
-        CHECK(hfvis_lattice_size(&L) == 64u * 64u);
+        CHECK(hfvis_lattice_nodes(&L) == 64u * 64u);
         for (j = L.j_min; j <= L.j_max; j++) every64 &= hfvis_lattice_line(&L, j, &i0, &i1) == 64;
         CHECK(every64);
         /* snapped: exact 0 / +-1 components */
@@ -381,7 +381,7 @@ TEST(lattice_geometry)
     CHECK(total == 4050);
     CHECK(L.j_max - L.j_min + 1 == 89);
     CHECK(L.i_max - L.i_min + 1 == 90);
-    CHECK(hfvis_lattice_size(&L) == 90u * 89u);
+    CHECK(hfvis_lattice_nodes(&L) == 90u * 89u);
     /* random azimuths and non-square grids: the same invariants */
     rng_seed(99);
     for (a = 0, ok = 1; a < 200; a++) {
@@ -389,7 +389,7 @@ TEST(lattice_geometry)
         double az = (rng_unit() * 6.0 - 2.0) * PI;
         if (hfvis_lattice_init(&L, w, h, az) != HFVIS_OK) { ok = 0; continue; }
         total = lattice_walk(&L, &lines, &ok);
-        if ((size_t)(L.j_max - L.j_min + 1) * (size_t)(L.i_max - L.i_min + 1) != hfvis_lattice_size(&L))
+        if ((size_t)(L.j_max - L.j_min + 1) * (size_t)(L.i_max - L.i_min + 1) != hfvis_lattice_nodes(&L))
             ok = 0;
         /* nodes of a unit lattice in the (W-1) x (H-1) rectangle: its area, +- about half
          * the perimeter (docs/errata.md E5 "(W-1)(H-1) + boundary") */
@@ -794,7 +794,7 @@ TEST(tilted_plane_lattice)
             hfvis_lattice L;
             int j, i, cols;
             CHECK_EQ_STATUS(hfvis_lattice_init(&L, W, H, psi), HFVIS_OK);
-            lat = (float *)malloc(sizeof(float) * hfvis_lattice_size(&L));
+            lat = (float *)malloc(sizeof(float) * hfvis_lattice_nodes(&L));
             CHECK(lat != NULL);
             if (!lat) { free(z); return; }
             CHECK_EQ_STATUS(hfvis_horizon_lattice(&grid, psi, NULL, lat), HFVIS_OK);
@@ -2562,52 +2562,52 @@ TEST(env_table_size)
     hfvis_env env = {rad, 256, 64, 3};
     hfvis_env_options lp = {HFVIS_ENV_LP_TABLE, 0, 0}, o;
     /* prefix: 6*K*(T+1)*C; L_p: K*M*Th*C ([P1] Eq. 6-7; docs/errata.md E9 space figures) */
-    CHECK(hfvis_env_table_size(&env, 64, NULL) == (size_t)6 * 64 * 257 * 3);
-    CHECK(hfvis_env_table_size(&env, 64, &lp) == (size_t)64 * 15 * 257 * 3);
+    CHECK(hfvis_env_table_floats(&env, 64, NULL) == (size_t)6 * 64 * 257 * 3);
+    CHECK(hfvis_env_table_floats(&env, 64, &lp) == (size_t)64 * 15 * 257 * 3);
     lp.lp_normal_res = 7;
     lp.lp_horizon_res = 2;
-    CHECK(hfvis_env_table_size(&env, 5, &lp) == (size_t)5 * 7 * 2 * 3);
+    CHECK(hfvis_env_table_floats(&env, 5, &lp) == (size_t)5 * 7 * 2 * 3);
     env.radiance = NULL; /* a size query does not need the radiance */
-    CHECK(hfvis_env_table_size(&env, 1, NULL) == (size_t)6 * 257 * 3);
+    CHECK(hfvis_env_table_floats(&env, 1, NULL) == (size_t)6 * 257 * 3);
     /* invalid input */
-    CHECK(hfvis_env_table_size(NULL, 4, NULL) == 0);
-    CHECK(hfvis_env_table_size(&env, 0, NULL) == 0);
+    CHECK(hfvis_env_table_floats(NULL, 4, NULL) == 0);
+    CHECK(hfvis_env_table_floats(&env, 0, NULL) == 0);
     o = lp;
     o.lp_normal_res = 16;
-    CHECK(hfvis_env_table_size(&env, 4, &o) == 0);
+    CHECK(hfvis_env_table_floats(&env, 4, &o) == 0);
     o.lp_normal_res = 1;
-    CHECK(hfvis_env_table_size(&env, 4, &o) == 0);
+    CHECK(hfvis_env_table_floats(&env, 4, &o) == 0);
     o.lp_normal_res = -3;
-    CHECK(hfvis_env_table_size(&env, 4, &o) == 0);
+    CHECK(hfvis_env_table_floats(&env, 4, &o) == 0);
     o = lp;
     o.lp_horizon_res = 1;
-    CHECK(hfvis_env_table_size(&env, 4, &o) == 0);
+    CHECK(hfvis_env_table_floats(&env, 4, &o) == 0);
     o = lp;
     o.method = (hfvis_env_method)7;
-    CHECK(hfvis_env_table_size(&env, 4, &o) == 0);
+    CHECK(hfvis_env_table_floats(&env, 4, &o) == 0);
     /* the L_p resolutions are not looked at by the prefix method */
     o.method = HFVIS_ENV_PREFIX;
     o.lp_normal_res = 16;
-    CHECK(hfvis_env_table_size(&env, 4, &o) != 0);
+    CHECK(hfvis_env_table_floats(&env, 4, &o) != 0);
     env.channels = 0;
-    CHECK(hfvis_env_table_size(&env, 4, NULL) == 0);
+    CHECK(hfvis_env_table_floats(&env, 4, NULL) == 0);
     env.channels = 5;
-    CHECK(hfvis_env_table_size(&env, 4, NULL) == 0);
+    CHECK(hfvis_env_table_floats(&env, 4, NULL) == 0);
     env.channels = 1;
     env.n_theta = 0;
-    CHECK(hfvis_env_table_size(&env, 4, NULL) == 0);
+    CHECK(hfvis_env_table_floats(&env, 4, NULL) == 0);
     env.n_theta = 1;
     env.n_phi = 0;
-    CHECK(hfvis_env_table_size(&env, 4, NULL) == 0);
+    CHECK(hfvis_env_table_floats(&env, 4, NULL) == 0);
     /* overflow */
     env.n_phi = 1;
     env.n_theta = 2147483647;
     env.channels = 4;
-    CHECK(hfvis_env_table_size(&env, 2147483647, NULL) == 0);
+    CHECK(hfvis_env_table_floats(&env, 2147483647, NULL) == 0);
     o = lp;
     o.lp_normal_res = 2147483647;
     o.lp_horizon_res = 2147483647;
-    CHECK(hfvis_env_table_size(&env, 2147483647, &o) == 0);
+    CHECK(hfvis_env_table_floats(&env, 2147483647, &o) == 0);
 }
 
 TEST(env_table_build_bad_arguments)
@@ -2658,7 +2658,7 @@ TEST(env_prefix_table_layout)
     hfvis_env env = {rad, T, P, C};
     const double cval[C] = {1.5, 0.25};
     int i, k, b, c;
-    size_t n = hfvis_env_table_size(&env, K, NULL);
+    size_t n = hfvis_env_table_floats(&env, K, NULL);
     CHECK(n == (size_t)6 * K * (T + 1) * C);
     for (i = 0; i < T * P; i++)
         for (c = 0; c < C; c++) rad[i * C + c] = (float)cval[c];
@@ -2692,7 +2692,7 @@ TEST(env_lp_table_layout)
     hfvis_env_options o = {HFVIS_ENV_LP_TABLE, M, TH};
     float table[K * M * TH];
     int k, i, j;
-    CHECK(hfvis_env_table_size(&env, K, &o) == (size_t)K * M * TH);
+    CHECK(hfvis_env_table_floats(&env, K, &o) == (size_t)K * M * TH);
     CHECK_EQ_STATUS(hfvis_env_table_build(&env, K, 0.0, &o, table), HFVIS_OK);
     for (k = 0; k < K; k++)
         for (i = 0; i < M; i++)
@@ -3346,7 +3346,7 @@ static void run_env_tests(void)
 
 
 
-/* test_p2.c - P2 intervisibility tests ([P2] §4-7, §10.1; docs/errata.md; [P2] §6):
+/* P2 intervisibility tests ([P2] §4-7, §10.1):
  * the convex-hull tree against the naive visible sets, the field sweeps against their oracles,
  * indirect light (band rule, furnace identity), terrain GI and direct light. */
 
@@ -3364,7 +3364,7 @@ static double p2t_unit(void) { return (double)(p2t_next() >> 11) * (1.0 / 900719
 static int p2t_int(int n) { return (int)(p2t_next() % (uint64_t)n); }
 
 /* ---------------------------------------------------------------------------------------- */
-/* 1. The hull tree against the naive visible sets (docs/errata.md E14; [P2] §6; [P2] §10.1) */
+/* 1. The hull tree against the naive visible sets (docs/errata.md E14; [P2] §6, §10.1) */
 /* ---------------------------------------------------------------------------------------- */
 
 #define P2T_NMAX 300

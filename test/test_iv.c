@@ -1182,6 +1182,19 @@ static void iv_square_mesh(float *xyz, uint32_t *idx, double zc, hfvis_mesh *m)
     m->xyz = xyz, m->vertex_count = 4, m->indices = idx, m->triangle_count = 2;
 }
 
+/* The metric's analytic scene: the unit square at z = 0.3 over an 8^3 grid of 1/8 cells whose
+ * layer k = 3 is occupied. */
+static void iv_layer_scene(hfvis_volume_grid *g, float *xyz, uint32_t *idx, hfvis_mesh *m,
+                           uint8_t *occ, size_t occ_size)
+{
+    int i, j;
+    iv_grid(g, 8, 8, 8, 0, 0, 0, 0.125, 0.125, 0.125);
+    iv_square_mesh(xyz, idx, 0.3, m);
+    memset(occ, 0, occ_size);
+    for (j = 0; j < 8; j++)
+        for (i = 0; i < 8; i++) occ[iv_lin(g, i, j, 3)] = 1;
+}
+
 TEST(iv_metric_analytic_and_oracle)
 {
     static uint8_t occ[16 * 16 * 16];
@@ -1191,14 +1204,10 @@ TEST(iv_metric_analytic_and_oracle)
     hfvis_volume_grid g;
     hfvis_distance_metrics a, b;
     hfvis_distance_options o;
-    int i, j, k, trial;
+    int i, k, trial;
     /* one layer of centres at z = (k + 0.5)/8 under the square at zc: every centre is exactly
      * |z_k - zc| from the mesh; mesh -> centres between that and sqrt(2 (1/16)^2 + dz^2) */
-    iv_grid(&g, 8, 8, 8, 0, 0, 0, 0.125, 0.125, 0.125);
-    iv_square_mesh(xyz, idx, 0.3, &m);
-    memset(occ, 0, sizeof occ);
-    for (j = 0; j < 8; j++)
-        for (i = 0; i < 8; i++) occ[iv_lin(&g, i, j, 3)] = 1;
+    iv_layer_scene(&g, xyz, idx, &m, occ, sizeof occ);
     memset(&o, 0, sizeof o);
     o.sample_count = 5000;
     CHECK_EQ_STATUS(hfvis_voxel_distance_metrics(&m, &g, occ, &o, &a), HFVIS_OK);
@@ -1914,6 +1923,24 @@ TEST(iv_alloc_failures)
     }
 }
 
+/* hfvis_distance_options: a zero struct and hfvis_distance_options_default() (100000 samples,
+ * seed 0) give the same metrics. */
+TEST(iv_metric_options_default_equals_zero)
+{
+    static uint8_t occ[8 * 8 * 8];
+    float xyz[12 * 40];
+    uint32_t idx[3 * 40];
+    hfvis_mesh m;
+    hfvis_volume_grid g;
+    hfvis_distance_metrics a, b;
+    hfvis_distance_options z, d = hfvis_distance_options_default();
+    iv_layer_scene(&g, xyz, idx, &m, occ, sizeof occ);
+    memset(&z, 0, sizeof z);
+    CHECK_EQ_STATUS(hfvis_voxel_distance_metrics(&m, &g, occ, &z, &a), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_voxel_distance_metrics(&m, &g, occ, &d, &b), HFVIS_OK);
+    CHECK(a.sample_count == 100000 && memcmp(&a, &b, sizeof a) == 0);
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
@@ -1933,6 +1960,7 @@ int main(int argc, char **argv)
     RUN(iv_occupancy_bytes);
     RUN(iv_point_triangle_distance);
     RUN(iv_metric_analytic_and_oracle);
+    RUN(iv_metric_options_default_equals_zero);
     RUN(iv_scene_injection_six_views);
     RUN(iv_scene_cleanup_keeps_box);
     RUN(iv_scene_moved_object_room);

@@ -1,4 +1,4 @@
-/* test_lk.c - Laine-Karras bitmask ray-cast AO (ssao.c section 5): ray sets, frames, masks, the
+/* test_lk.c - Laine-Karras bitmask ray-cast AO (ssao.c section 12): ray sets, frames, masks, the
  * plane table, the three methods (rasterization, BVH traversal, ray caster) and their exact
  * agreement, the analytic cases of culling, LOD windows, bad arguments, failing
  * allocators. */
@@ -205,7 +205,7 @@ static int origin_count(const hfvis_mesh *m, const hfvis_lk_rays *rays, const hf
     *agree = 0;
     if (hfvis_bvh_build(m, NULL, &b) != HFVIS_OK) return -1;
     if (hfvis_lk_bvh(m, &b, rays, &rc, &o, m2, NULL, NULL) == HFVIS_OK &&
-        hfvis_lk_raycast(m, &b, rays, &rc, &o, m3, NULL, NULL) == HFVIS_OK) {
+        hfvis_lk_reference(m, &b, rays, &rc, &o, m3, NULL, NULL) == HFVIS_OK) {
         *agree = memcmp(m2, m3, sizeof(uint32_t) * (size_t)rays->words) == 0;
         bits = count_bits(m2, rays->words);
     }
@@ -241,7 +241,7 @@ static long three_way(const hfvis_mesh *m, const hfvis_view *v, const hfvis_lk_r
     rc.key = key;
     if (hfvis_lk_raster(m, v, rays, opts, m1, NULL, st1) != HFVIS_OK) goto done;
     if (hfvis_lk_bvh(m, &b, rays, &rc, opts, m2, NULL, st2) != HFVIS_OK) goto done;
-    if (hfvis_lk_raycast(m, &b, rays, &rc, opts, m3, NULL, NULL) != HFVIS_OK) goto done;
+    if (hfvis_lk_reference(m, &b, rays, &rc, opts, m3, NULL, NULL) != HFVIS_OK) goto done;
     bad = 0;
     if (blocked) *blocked = 0;
     for (k = 0; k < n; k++) {
@@ -1431,7 +1431,7 @@ TEST(three_methods_identical_on_soups)
             rc.key = NULL;
             CHECK_EQ_STATUS(hfvis_bvh_build(&m, NULL, &b), HFVIS_OK);
             CHECK_EQ_STATUS(hfvis_lk_bvh(&m, &b, &rays, &rc, &o, a2, ob, NULL), HFVIS_OK);
-            CHECK_EQ_STATUS(hfvis_lk_raycast(&m, &b, &rays, &rc, &o, a3, NULL, NULL), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_lk_reference(&m, &b, &rays, &rc, &o, a3, NULL, NULL), HFVIS_OK);
             CHECK(memcmp(a2, a3, sizeof(uint32_t) * R * (size_t)rays.words) == 0);
             for (i = 0, j = 0; i < R; i++)
                 j += ob[i] != (float)((double)count_bits(a2 + (size_t)i * (size_t)rays.words, rays.words) / rays.count);
@@ -1677,9 +1677,9 @@ TEST(watertight_caster_and_lut_modes)
     for (sides = 1; sides <= 2; sides++) {
         o.sides = (hfvis_lk_sides)sides;
         o.raycast_test = HFVIS_LK_RAYCAST_EXACT;
-        CHECK_EQ_STATUS(hfvis_lk_raycast(&m, &b, &rays, &rc, &o, ex, NULL, NULL), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_lk_reference(&m, &b, &rays, &rc, &o, ex, NULL, NULL), HFVIS_OK);
         o.raycast_test = HFVIS_LK_RAYCAST_WATERTIGHT;
-        CHECK_EQ_STATUS(hfvis_lk_raycast(&m, &b, &rays, &rc, &o, wt, NULL, NULL), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_lk_reference(&m, &b, &rays, &rc, &o, wt, NULL, NULL), HFVIS_OK);
         for (i = 0, diff = 0, blocked = 0; i < n * words; i++) {
             uint32_t x = ex[i] ^ wt[i];
             diff += count_bits(&x, 1);
@@ -1714,9 +1714,9 @@ TEST(watertight_caster_and_lut_modes)
         o.sides = HFVIS_LK_SIDES_PER_TRIANGLE;
         o.two_sided = two;
         CHECK_EQ_STATUS(hfvis_bvh_build(&smm, NULL, &sb), HFVIS_OK);
-        CHECK_EQ_STATUS(hfvis_lk_raycast(&smm, &sb, &rays, &src, &o, ex, NULL, NULL), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_lk_reference(&smm, &sb, &rays, &src, &o, ex, NULL, NULL), HFVIS_OK);
         o.raycast_test = HFVIS_LK_RAYCAST_WATERTIGHT;
-        CHECK_EQ_STATUS(hfvis_lk_raycast(&smm, &sb, &rays, &src, &o, wt, NULL, NULL), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_lk_reference(&smm, &sb, &rays, &src, &o, wt, NULL, NULL), HFVIS_OK);
         for (i = 0, diff = 0, blocked = 0; i < (size_t)R * words; i++) {
             uint32_t x = ex[i] ^ wt[i];
             diff += count_bits(&x, 1);
@@ -1733,7 +1733,7 @@ TEST(watertight_caster_and_lut_modes)
     /* LUT masks in Methods 1 and 2 (T = 64): close to exact, not identical */
     o = hfvis_lk_options_default();
     CHECK_EQ_STATUS(hfvis_lk_lut_build(&rays, 64, NULL, &L), HFVIS_OK);
-    CHECK_EQ_STATUS(hfvis_lk_raycast(&m, &b, &rays, &rc, &o, ex, NULL, NULL), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_lk_reference(&m, &b, &rays, &rc, &o, ex, NULL, NULL), HFVIS_OK);
     o.mask_mode = HFVIS_LK_MASK_LUT;
     o.lut = &L;
     CHECK_EQ_STATUS(hfvis_lk_bvh(&m, &b, &rays, &rc, &o, lu, NULL, NULL), HFVIS_OK);
@@ -1935,8 +1935,8 @@ TEST(methods_bad_args)
     CHECK_EQ_STATUS(hfvis_lk_bvh(&m, NULL, &rays, &rc, NULL, masks, NULL, &st), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_lk_bvh(&m, &b, &rays, NULL, NULL, masks, NULL, &st), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_lk_bvh(&m, &b, &rays, &rc, NULL, NULL, NULL, &st), HFVIS_ERR_INVALID_ARGUMENT);
-    CHECK_EQ_STATUS(hfvis_lk_raycast(&m, &b, NULL, &rc, NULL, masks, NULL, &st), HFVIS_ERR_INVALID_ARGUMENT);
-    CHECK_EQ_STATUS(hfvis_lk_raycast(&m, &b, &rays, &rc, NULL, NULL, NULL, &st), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_lk_reference(&m, &b, NULL, &rc, NULL, masks, NULL, &st), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_lk_reference(&m, &b, &rays, &rc, NULL, NULL, NULL, &st), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_lk_gbuffer_receivers(&m, &v, NULL, NULL, n, NULL, &cnt), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_lk_gbuffer_receivers(&m, &v, NULL, p, n, NULL, NULL), HFVIS_ERR_INVALID_ARGUMENT);
     /* invalid ray set */
@@ -1952,7 +1952,7 @@ TEST(methods_bad_args)
     CHECK_EQ_STATUS(hfvis_lk_raster(&bad_mesh, &v, &rays, NULL, masks, NULL, &st), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_lk_bvh(&bad_mesh, &b, &rays, &rc, NULL, masks, NULL, &st), HFVIS_ERR_INVALID_ARGUMENT);
     tm.xyz[4] = (float)NAN;
-    CHECK_EQ_STATUS(hfvis_lk_raycast(&m, &b, &rays, &rc, NULL, masks, NULL, &st), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_lk_reference(&m, &b, &rays, &rc, NULL, masks, NULL, &st), HFVIS_ERR_INVALID_ARGUMENT);
     tm.xyz[4] = 0.0f;
     /* receivers: NaN position, zero normal */
     p[0] = (double)NAN;
@@ -1961,7 +1961,7 @@ TEST(methods_bad_args)
     n[5] = 0.0;
     n[3] = 0.0;
     n[4] = 0.0;
-    CHECK_EQ_STATUS(hfvis_lk_raycast(&m, &b, &rays, &rc, NULL, masks, NULL, &st), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_lk_reference(&m, &b, &rays, &rc, NULL, masks, NULL, &st), HFVIS_ERR_INVALID_ARGUMENT);
     n[5] = 1.0;
     /* view: zero size, non-finite matrix */
     bv = v;
@@ -1997,7 +1997,7 @@ TEST(methods_bad_args)
         bb = b;
         bb.nodes = nodes;
         nodes[0].left_or_first = 0; /* child not after its parent (a cycle) */
-        CHECK_EQ_STATUS(hfvis_lk_raycast(&m, &bb, &rays, &rc, NULL, masks, NULL, &st), HFVIS_ERR_INVALID_ARGUMENT);
+        CHECK_EQ_STATUS(hfvis_lk_reference(&m, &bb, &rays, &rc, NULL, masks, NULL, &st), HFVIS_ERR_INVALID_ARGUMENT);
         memcpy(nodes, b.nodes, sizeof(hfvis_bvh_node) * b.node_count);
         for (i = 0; i < b.node_count && nodes[i].count == 0; i++) {}
         nodes[i].left_or_first = (uint32_t)b.triangle_count; /* leaf range past tri_order */
@@ -2022,7 +2022,7 @@ TEST(methods_bad_args)
         CHECK_EQ_STATUS(hfvis_bvh_build(&empty, NULL, &eb), HFVIS_OK);
         CHECK_EQ_STATUS(hfvis_lk_bvh(&empty, &eb, &rays, &rc, NULL, masks, ob, NULL), HFVIS_OK);
         CHECK(masks[0] == 0 && ob[0] == 0.0f && ob[1] == 0.0f);
-        CHECK_EQ_STATUS(hfvis_lk_raycast(&empty, &eb, &rays, &rc, NULL, masks, ob, NULL), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_lk_reference(&empty, &eb, &rays, &rc, NULL, masks, ob, NULL), HFVIS_OK);
         CHECK(masks[1] == 0 && ob[1] == 0.0f);
         hfvis_bvh_free(NULL, &eb);
     }
@@ -2074,7 +2074,7 @@ TEST(methods_alloc_failures)
             case 0: s = hfvis_lk_raster(&m, &v, &rays, &o, masks, ob, NULL); break;
             case 1: s = hfvis_lk_raster(&m, &v, &rays, &o, NULL, ob, NULL); break;
             case 2: s = hfvis_lk_bvh(&m, &b, &rays, &rc, &o, masks, ob, NULL); break;
-            case 3: s = hfvis_lk_raycast(&m, &b, &rays, &rc, &o, masks, ob, NULL); break;
+            case 3: s = hfvis_lk_reference(&m, &b, &rays, &rc, &o, masks, ob, NULL); break;
             case 4: s = hfvis_lk_image(HFVIS_LK_METHOD_BVH, &m, NULL, &v, &rays, &o, masks, ob, NULL); break;
             case 5: s = hfvis_lk_image(HFVIS_LK_METHOD_RAYCAST, &m, &b, &v, &rays, &o, NULL, ob, NULL); break;
             default: s = hfvis_lk_gbuffer_receivers(&m, &v, &o, gp, gn, NULL, &got); break;

@@ -1,4 +1,4 @@
-/* test_mesh.c - analytic meshes, bounds and the Wavefront OBJ codec (voxel.c section 1). */
+/* test_mesh.c - analytic meshes, bounds and the Wavefront OBJ codec (voxel.c section 4). */
 #include "hfvis.h"
 #include "test.h"
 

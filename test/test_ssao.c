@@ -1259,7 +1259,7 @@ TEST(raytrace_step_cos)
         for (f = 0; f < 3; f++) {
             o.falloff.kind = f == 0 ? HFVIS_FALLOFF_NONE : (f == 1 ? HFVIS_FALLOFF_INV_QUADRATIC : HFVIS_FALLOFF_STEP);
             o.falloff.param = f == 1 ? 0.8 : 2.0;
-            CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, nrm, &o, ao, IW), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_ssao_reference(&c, depth, nrm, &o, ao, IW), HFVIS_OK);
             for (x = 0; x < IW; x++) {
                 double P[3], L, want, got = col_mean(ao, IW, IH, x);
                 hfvis_camera_unproject(&c, GX + x + 0.5, GY + 0.5, (double)depth[GY * W0 + GX + x], P);
@@ -1296,7 +1296,7 @@ TEST(raytrace_groove_pit_cos)
         CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, depth, nrm), HFVIS_OK);
         o.rays = RAYS;
         o.falloff.kind = HFVIS_FALLOFF_NONE;
-        CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, nrm, &o, ao, IW), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_ssao_reference(&c, depth, nrm, &o, ao, IW), HFVIS_OK);
         got = (double)ao[1 * IW + 1];
         want = 1.0 - cos(0.7);
         printf("  RT groove %s: %.5f closed %.5f\n", m ? "persp" : "ortho", got, want);
@@ -1310,7 +1310,7 @@ TEST(raytrace_groove_pit_cos)
         for (f = 0; f < 3; f++) {
             o.falloff.kind = f == 0 ? HFVIS_FALLOFF_NONE : (f == 1 ? HFVIS_FALLOFF_INV_QUADRATIC : HFVIS_FALLOFF_STEP);
             o.falloff.param = f == 1 ? 1.0 : 2.0;
-            CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, nrm, &o, ao, IW), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_ssao_reference(&c, depth, nrm, &o, ao, IW), HFVIS_OK);
             got = (double)ao[1 * IW + 1];
             want = f == 0 ? 0.5 : (f == 1 ? cos_pit_q(Rb, 1.0) : cos_pit_R(Rb, 2.0));
             printf("  RT pit %s rho%d: %.5f closed %.5f\n", m ? "persp" : "ortho", f, got, want);
@@ -1338,7 +1338,7 @@ TEST(raytrace_plane_zero)
         if (m == 0) CHECK_EQ_STATUS(hfvis_camera_orthographic(&c, W0, H0, 2, 2, 0.1), HFVIS_OK);
         else CHECK_EQ_STATUS(hfvis_camera_perspective(&c, W0, H0, 2, 2, 1.0), HFVIS_OK);
         CHECK_EQ_STATUS(hfvis_ssao_scene_render(&c, &sc, depth, NULL), HFVIS_OK);
-        CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, NULL, &o, ao, W0 - 4), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_ssao_reference(&c, depth, NULL, &o, ao, W0 - 4), HFVIS_OK);
         for (i = 0; i < (W0 - 4) * (H0 - 4); i++) if (ao[i] != 0.0f) bad++;
     }
     CHECK(bad == 0);
@@ -1458,12 +1458,12 @@ TEST(raytrace_thickness_and_seed)
         }
     o.rays = 64;
     o.sampling = HFVIS_SSAO_SAMPLING_NEAREST;
-    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, nrm, &o, a1, IW), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_ssao_reference(&c, depth, nrm, &o, a1, IW), HFVIS_OK);
     o.thickness = 1e6;
-    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, nrm, &o, a2, IW), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_ssao_reference(&c, depth, nrm, &o, a2, IW), HFVIS_OK);
     CHECK(memcmp(a1, a2, sizeof a1) == 0);
     o.thickness = 0.3;
-    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, nrm, &o, a2, IW), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_ssao_reference(&c, depth, nrm, &o, a2, IW), HFVIS_OK);
     for (i = 0; i < IW * IH; i++) {
         if (a2[i] > a1[i]) bad++;
         if (a2[i] < a1[i]) less++;
@@ -1472,11 +1472,11 @@ TEST(raytrace_thickness_and_seed)
     /* seeds */
     o.thickness = 0.0;
     o.seed = 1;
-    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, nrm, &o, a2, IW), HFVIS_OK);
-    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, nrm, &o, a3, IW), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_ssao_reference(&c, depth, nrm, &o, a2, IW), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_ssao_reference(&c, depth, nrm, &o, a3, IW), HFVIS_OK);
     CHECK(memcmp(a2, a3, sizeof a2) == 0);
     o.seed = 2;
-    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&c, depth, nrm, &o, a3, IW), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_ssao_reference(&c, depth, nrm, &o, a3, IW), HFVIS_OK);
     for (i = 0; i < IW * IH; i++) diff += a2[i] != a3[i];
     CHECK(diff > 0);
 }
@@ -1512,7 +1512,7 @@ TEST(hbao_rt_bad_args_and_oom)
 #define BAD_H(stmt) do { hb = h; stmt; CHECK_EQ_STATUS(hfvis_hbao_options_resolve(&hb, &hr), HFVIS_ERR_INVALID_ARGUMENT); \
         CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, nrm, &hb, ao, W), HFVIS_ERR_INVALID_ARGUMENT); } while (0)
 #define BAD_R(stmt) do { rb = r; stmt; CHECK_EQ_STATUS(hfvis_ssao_rt_options_resolve(&rb, &rr), HFVIS_ERR_INVALID_ARGUMENT); \
-        CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, nrm, &rb, ao, W), HFVIS_ERR_INVALID_ARGUMENT); } while (0)
+        CHECK_EQ_STATUS(hfvis_ssao_reference(&cam, depth, nrm, &rb, ao, W), HFVIS_ERR_INVALID_ARGUMENT); } while (0)
     BAD_H(hb.directions = -2);
     BAD_H(hb.directions = HFVIS_SSAO_MAX_DIRECTIONS + 1);
     BAD_H(hb.azimuth0_rad = (double)NAN);
@@ -1542,10 +1542,10 @@ TEST(hbao_rt_bad_args_and_oom)
     CHECK_EQ_STATUS(hfvis_hbao(&cam, NULL, nrm, &h, ao, W), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, nrm, &h, NULL, W), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, nrm, &h, ao, W - 3), HFVIS_ERR_INVALID_ARGUMENT);
-    CHECK_EQ_STATUS(hfvis_ssao_raytrace(NULL, depth, nrm, &r, ao, W), HFVIS_ERR_INVALID_ARGUMENT);
-    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, NULL, nrm, &r, ao, W), HFVIS_ERR_INVALID_ARGUMENT);
-    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, nrm, &r, NULL, W), HFVIS_ERR_INVALID_ARGUMENT);
-    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, nrm, &r, ao, W - 3), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_ssao_reference(NULL, depth, nrm, &r, ao, W), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_ssao_reference(&cam, NULL, nrm, &r, ao, W), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_ssao_reference(&cam, depth, nrm, &r, NULL, W), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_ssao_reference(&cam, depth, nrm, &r, ao, W - 3), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK(memcmp(ao, keep, sizeof ao) == 0);
     al.alloc = test_count_alloc;
     al.free = test_count_free;
@@ -1556,7 +1556,7 @@ TEST(hbao_rt_bad_args_and_oom)
     /* normals given or a fixed tangent: nothing allocated */
     memset(&cnt, 0, sizeof cnt);
     CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, nrm, &h, ref, W), HFVIS_OK);
-    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, nrm, &r, ref, W), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_ssao_reference(&cam, depth, nrm, &r, ref, W), HFVIS_OK);
     hb = h;
     hb.tangent = HFVIS_SSAO_TANGENT_FIXED;
     CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, NULL, &hb, ref, W), HFVIS_OK);
@@ -1568,8 +1568,8 @@ TEST(hbao_rt_bad_args_and_oom)
     CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, nrm, &h, ref, W), HFVIS_OK);
     CHECK_EQ_STATUS(hfvis_hbao(&cam, depth, NULL, &h, ao, W), HFVIS_OK);
     CHECK(cnt.allocs == 1 && cnt.live == 0 && memcmp(ao, ref, sizeof ao) == 0);
-    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, nrm, &r, ref, W), HFVIS_OK);
-    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, NULL, &r, ao, W), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_ssao_reference(&cam, depth, nrm, &r, ref, W), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_ssao_reference(&cam, depth, NULL, &r, ao, W), HFVIS_OK);
     CHECK(cnt.allocs == 2 && cnt.live == 0 && memcmp(ao, ref, sizeof ao) == 0);
     for (i = 0; i < W * H; i++) ao[i] = keep[i];
     memset(&cnt, 0, sizeof cnt);
@@ -1578,7 +1578,7 @@ TEST(hbao_rt_bad_args_and_oom)
     CHECK(cnt.live == 0);
     memset(&cnt, 0, sizeof cnt);
     cnt.fail_at = 1;
-    CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, NULL, &r, ao, W), HFVIS_ERR_OUT_OF_MEMORY);
+    CHECK_EQ_STATUS(hfvis_ssao_reference(&cam, depth, NULL, &r, ao, W), HFVIS_ERR_OUT_OF_MEMORY);
     CHECK(cnt.live == 0);
     CHECK(memcmp(ao, keep, sizeof ao) == 0);
 }
@@ -1835,9 +1835,9 @@ TEST(ffao_vs_raytrace_scenes)
         ro.falloff = fo.falloff;
         ro.rays = FFAO_SCENE_RAYS;
         ro.seed = 1;
-        CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, nrm, &ro, r1, IW), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_ssao_reference(&cam, depth, nrm, &ro, r1, IW), HFVIS_OK);
         ro.seed = 2;
-        CHECK_EQ_STATUS(hfvis_ssao_raytrace(&cam, depth, nrm, &ro, r2, IW), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_ssao_reference(&cam, depth, nrm, &ro, r2, IW), HFVIS_OK);
         for (i = 0; i < IW * IH; i++) {
             double d = (double)r1[i] - (double)r2[i];
             rm[i] = 0.5f * (r1[i] + r2[i]);

@@ -94,7 +94,7 @@ TEST(lattice_radius_equals_oracle)
                     o.border_cells = b == 0 ? 0 : 11;
                     o.max_distance = radii_cells[r] * cell;
                     CHECK_EQ_STATUS(hfvis_lattice_init(&L, W, H, az), HFVIS_OK);
-                    n = hfvis_lattice_size(&L);
+                    n = hfvis_lattice_nodes(&L);
                     CHECK_EQ_STATUS(hfvis_horizon_lattice(&g, az, &o, out_a), HFVIS_OK);
                     CHECK_EQ_STATUS(hfvis_horizon_lattice_naive(&g, az, &o, out_b), HFVIS_OK);
                     d = max_diff(out_a, out_b, n, &unequal);

@@ -238,6 +238,34 @@ TEST(volgi_sh_projection_quadrature)
 
 /* ---- GI.3 injection ------------------------------------------------------------------ */
 
+/* The 2-band helpers are bands 0-1 of the order-4 SH API (hfvis.h, "2-band SH helpers"). */
+#define VOLGI_SH_AGREE 1e-14 /* two evaluation orders of the same closed forms, a few ulps apart */
+TEST(volgi_sh_is_bands_0_1)
+{
+    const double dirs[4][3] = {{0.3, -0.5, 0.8}, {0.0, 0.0, -2.0}, {-1.0, 4.0, 0.5}, {7.0, 0.1, 0.0}};
+    const double angles[3] = {0.2, 0.25 * PI, 2.5};
+    double Y[16], S[16], Ahat[4], v[4];
+    int d, a, i;
+    for (d = 0; d < 4; d++) {
+        double len = sqrt(dirs[d][0] * dirs[d][0] + dirs[d][1] * dirs[d][1] + dirs[d][2] * dirs[d][2]);
+        double u[3];
+        for (i = 0; i < 3; i++) u[i] = dirs[d][i] / len;
+        CHECK_EQ_STATUS(hfvis_sh_eval(u, Y), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_volgi_sh_basis(dirs[d], v), HFVIS_OK);
+        for (i = 0; i < 4; i++) CHECK_NEAR(v[i], Y[i], VOLGI_SH_AGREE, VOLGI_SH_AGREE);
+        CHECK_EQ_STATUS(hfvis_zh_diffuse(Ahat), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_sh_from_zh(Ahat, dirs[d], S), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_volgi_sh_clamped_cosine(dirs[d], v), HFVIS_OK);
+        for (i = 0; i < 4; i++) CHECK_NEAR(v[i], S[i], VOLGI_SH_AGREE, VOLGI_SH_AGREE);
+        for (a = 0; a < 3; a++) {
+            CHECK_EQ_STATUS(hfvis_zh_cap(angles[a], Ahat), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_sh_from_zh(Ahat, dirs[d], S), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_volgi_sh_cone(dirs[d], angles[a], v), HFVIS_OK);
+            for (i = 0; i < 4; i++) CHECK_NEAR(v[i], S[i], VOLGI_SH_AGREE, VOLGI_SH_AGREE);
+        }
+    }
+}
+
 TEST(volgi_inject)
 {
     tg t;
@@ -1623,6 +1651,7 @@ int main(int argc, char **argv)
     TEST_INIT(argc, argv);
     RUN(volgi_sh_constants);
     RUN(volgi_sh_projection_quadrature);
+    RUN(volgi_sh_is_bands_0_1);
     RUN(volgi_inject);
     RUN(volgi_first_step_fluxes);
     RUN(volgi_border_escape);

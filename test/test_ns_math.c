@@ -1,4 +1,7 @@
-/* test_gi.c - the Nowrouzezahrai-Snyder math layer (hfvis.c section 13). */
+/* test_ns_math.c - tests of the Nowrouzezahrai-Snyder math layer (hfvis.c section 13): real SH,
+ * zonal lobes, environment projection, normalized Legendre polynomials, Appendix-A wedge
+ * matrices, the tangent-plane angle. Analytic cases are closed forms derived for these tests;
+ * expected values are written here, nothing is read from outside the repository. */
 #include "hfvis.h"
 #include "test.h"
 
@@ -7,11 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* test_gi.c - tests of the Nowrouzezahrai-Snyder math layer (hfvis.c section 13): real SH,
- * zonal lobes, environment projection, normalized Legendre polynomials, Appendix-A wedge
- * matrices, the tangent-plane angle. Analytic cases are closed forms derived for these tests;
- * expected values are written here, nothing is read from outside the repository.
- * Defines run_gi_tests(); needs hfvis.h, test.h, math.h, stdio.h, stdlib.h, string.h included. */
 
 /* Rounding of sums of O(100) double terms of size O(1). */
 #define GI_TOL_ROUND 1e-13

@@ -1,4 +1,4 @@
-/* test_cons.c - binary voxelizers (voxel.c section "cons"): the triangle-box SAT, conservative
+/* test_binary_voxel.c - binary voxelizers (voxel.c section 8): the triangle-box SAT, conservative
  * voxelization (fast path == per-voxel SAT reference, bit for bit), solid voxelization by parity
  * (== generalized winding number reference; box and sphere counts), watertightness, the bitmask
  * voxelizer, the .binvox codec and the raw writer. Spec voxel §3.9, §3.13. */

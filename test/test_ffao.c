@@ -1,4 +1,4 @@
-/* test_ssaob.c - tests of the P4 far-field AO part of ssao.c ([P4]):
+/* test_ffao.c - tests of the P4 far-field AO part of ssao.c ([P4]):
  * the slab integral (quadrature, closed form, table), virtual points, sector weights, the slice
  * estimator against the closed forms of T5, FFAO on the analytic scenes of §6 against the closed
  * forms and the ray-traced reference, the mipmap baseline, error metrics, the blur, goldens, bad
@@ -300,7 +300,7 @@ TEST(ffao_closed_forms)
         }
         CHECK(scene_make(&s, 0, 128, 96, 24, 18, pix, &sc));
         CHECK_EQ_STATUS(hfvis_ffao(&s.cam, s.depth, s.nrm, &o, s.a, s.IW), HFVIS_OK);
-        CHECK_EQ_STATUS(hfvis_ssao_raytrace(&s.cam, s.depth, s.nrm, &ro, s.b, s.IW), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_ssao_reference(&s.cam, s.depth, s.nrm, &ro, s.b, s.IW), HFVIS_OK);
         py = s.IH / 2;
         if (cse == 0) { /* floor receiver 9.5 px (0.95 units) before the cliff */
             px = s.IW / 2 - 10;
@@ -361,7 +361,7 @@ TEST(ffao_vs_raytrace_perspective)
             o.directions = 8;
             o.sparse = 0;
             o.jitter = 0;
-            CHECK_EQ_STATUS(hfvis_ssao_raytrace(&s.cam, s.depth, s.nrm, &ro, s.b, s.IW), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_ssao_reference(&s.cam, s.depth, s.nrm, &ro, s.b, s.IW), HFVIS_OK);
             CHECK_EQ_STATUS(hfvis_ffao(&s.cam, s.depth, s.nrm, &o, s.a, s.IW), HFVIS_OK);
             CHECK_EQ_STATUS(hfvis_ssao_error(s.a, s.IW, s.b, s.IW, s.IW, s.IH, 0.05, 0, &e, NULL, 0), HFVIS_OK);
             CHECK_EQ_STATUS(hfvis_ssao_mipmap(&s.cam, s.depth, s.nrm, &o, c, s.IW), HFVIS_OK);
@@ -587,7 +587,7 @@ TEST(goldens)
         hfvis_ssao_rt_options ro = hfvis_ssao_rt_options_default();
         ro.falloff = q;
         ro.rays = 64;
-        CHECK_EQ_STATUS(hfvis_ssao_raytrace(&s.cam, s.depth, s.nrm, &ro, s.a, s.IW), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_ssao_reference(&s.cam, s.depth, s.nrm, &ro, s.a, s.IW), HFVIS_OK);
         test_golden("pit_raytrace", s.a, s.IW, s.IH, TOL_GOLDEN);
     }
     scene_free(&s);

@@ -1,5 +1,5 @@
-/* test_voxel.c - voxel.c core: views and matrices, eq. 16 depth linearisation, grid fit and the
- * Volume Buffer (voxel.c sections 1-3). */
+/* test_volume.c - voxel.c core: views and matrices, eq. 16 depth linearisation, grid fit and the
+ * Volume Buffer (voxel.c sections 2-3). */
 #include "hfvis.h"
 #include "test.h"
 
@@ -213,9 +213,9 @@ TEST(volume_buffer)
     memset(&g, 0, sizeof g);
     g.dims[0] = 2, g.dims[1] = 3, g.dims[2] = 4;
     g.cell[0] = g.cell[1] = g.cell[2] = 0.5;
-    CHECK(hfvis_volume_size(&g, 4) == 96);
-    CHECK(hfvis_volume_size(&g, 0) == 0 && hfvis_volume_size(&g, 33) == 0);
-    CHECK(hfvis_volume_size(NULL, 1) == 0);
+    CHECK(hfvis_volume_floats(&g, 4) == 96);
+    CHECK(hfvis_volume_floats(&g, 0) == 0 && hfvis_volume_floats(&g, 33) == 0);
+    CHECK(hfvis_volume_floats(NULL, 1) == 0);
     CHECK_EQ_STATUS(hfvis_volume_init(&v, &g, 4, store, (hfvis_blend)9), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK_EQ_STATUS(hfvis_volume_init(&v, &g, 4, NULL, HFVIS_BLEND_MAX), HFVIS_ERR_INVALID_ARGUMENT);
     memset(store, 0xff, sizeof store);

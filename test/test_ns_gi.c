@@ -1,4 +1,4 @@
-/* test_gi2.c - the Nowrouzezahrai-Snyder GI pipeline (hfvis.c section 14): hfvis_ns_gi end to end.
+/* test_ns_gi.c - the Nowrouzezahrai-Snyder GI pipeline (hfvis.c section 14): hfvis_ns_gi end to end.
  * Analytic cases are the exact pipeline it is
  * checked against is P1 (hfvis_sky_light) and P2 (hfvis_indirect_light). Expected values are
  * written here or assembled from the math layer (section 13), never read from outside. */

@@ -1,5 +1,5 @@
-/* test_vox.c - surface voxelizers and the Volume Buffer attribute path ([G12] ch. 5 Alg. 4,
- * ch. 6 Alg. 5/6; [G12] ch. 6, Alg. 5-6). Exact analytic counts of the fast
+/* test_voxelize.c - surface voxelizers and the Volume Buffer attribute path ([G12] ch. 5 Alg. 4,
+ * ch. 6 Alg. 5-6). Exact analytic counts of the fast
  * routines against their per-voxel oracle bit for bit, the output-vertex holes, 6-separation of
  * the three-axis variant, blends, callbacks, bad arguments. */
 #include "hfvis.h"
@@ -102,7 +102,7 @@ static void vox_box(vox_soup *s, const double lo[3], const double hi[3])
 
 static float *vox_storage(const hfvis_volume_grid *g, int channels)
 {
-    size_t n = hfvis_volume_size(g, channels);
+    size_t n = hfvis_volume_floats(g, channels);
     return (float *)malloc(sizeof(float) * (n ? n : 1));
 }
 
@@ -121,7 +121,7 @@ static size_t vox_count(const hfvis_mesh *m, const hfvis_volume_grid *g, const h
                         uint8_t *occ_out)
 {
     float *a = vox_storage(g, 1), *b = vox_storage(g, 1);
-    size_t n = hfvis_volume_size(g, 1), fa = 0, fb = 0, cnt = 0, i;
+    size_t n = hfvis_volume_floats(g, 1), fa = 0, fb = 0, cnt = 0, i;
     uint8_t *occ = (uint8_t *)malloc(n);
     hfvis_volume va, vb;
     CHECK_EQ_STATUS(hfvis_volume_init(&va, g, 1, a, HFVIS_BLEND_MAX), HFVIS_OK);
@@ -348,7 +348,7 @@ static int vox_same(const hfvis_mesh *m, const hfvis_volume_grid *g, const hfvis
                     size_t *frags)
 {
     static const hfvis_blend bl[4] = { HFVIS_BLEND_MAX, HFVIS_BLEND_REPLACE, HFVIS_BLEND_MIN, HFVIS_BLEND_ADD };
-    size_t n = hfvis_volume_size(g, VOX_CB_CHANNELS), fa = 0, fb = 0, ca = 0, cb = 0;
+    size_t n = hfvis_volume_floats(g, VOX_CB_CHANNELS), fa = 0, fb = 0, ca = 0, cb = 0;
     float *a = vox_storage(g, VOX_CB_CHANNELS), *b = vox_storage(g, VOX_CB_CHANNELS);
     hfvis_volume va, vb;
     hfvis_voxelize_options o = *oin;
@@ -504,7 +504,7 @@ TEST(fragment_clipping_is_pixel_rule)
         size_t ca = 0, cb = 0;
         f.method = HFVIS_VOXELIZE_FRAGMENT_CLIPPING;
         CHECK_EQ_STATUS(hfvis_volume_grid_fit(&m, res[trial], 0.02, 0, &g), HFVIS_OK);
-        n = hfvis_volume_size(&g, VOX_CB_CHANNELS);
+        n = hfvis_volume_floats(&g, VOX_CB_CHANNELS);
         a = vox_storage(&g, VOX_CB_CHANNELS);
         b = vox_storage(&g, VOX_CB_CHANNELS);
         hfvis_volume_init(&va, &g, VOX_CB_CHANNELS, a, HFVIS_BLEND_ADD);
@@ -615,7 +615,7 @@ TEST(all_axes_superset_and_max_merge)
             hfvis_voxelize_options o = vox_opts(vox_methods[mi], HFVIS_AXES_ALL, 0);
             int a, merged_equal;
             CHECK_EQ_STATUS(hfvis_volume_grid_fit(&m, r ? 70 : 31, 0.03, 1, &g), HFVIS_OK);
-            n = hfvis_volume_size(&g, VOX_CB_CHANNELS);
+            n = hfvis_volume_floats(&g, VOX_CB_CHANNELS);
             all = vox_storage(&g, VOX_CB_CHANNELS);
             dom = vox_storage(&g, VOX_CB_CHANNELS);
             hfvis_volume_init(&vall, &g, VOX_CB_CHANNELS, all, HFVIS_BLEND_MAX);
@@ -680,7 +680,7 @@ TEST(blend_ops)
                 float *st = vox_storage(&g, 2);
                 hfvis_volume v;
                 hfvis_voxelize_options o = vox_opts(vox_methods[mi], HFVIS_AXES_DOMINANT, 0);
-                size_t i, n = hfvis_volume_size(&g, 1), both = 0, one = 0, bad = 0, frags = 0;
+                size_t i, n = hfvis_volume_floats(&g, 1), both = 0, one = 0, bad = 0, frags = 0;
                 hfvis_volume_init(&v, &g, 2, st, ops[oi]);
                 v.blend[1] = HFVIS_BLEND_ADD; /* channel 1 counts the fragments per voxel */
                 if (ops[oi] == HFVIS_BLEND_MIN)
@@ -858,7 +858,7 @@ TEST(attribute_callbacks)
     float *st;
     hfvis_volume v;
     hfvis_voxelize_options o = hfvis_voxelize_options_default();
-    size_t i, n = hfvis_volume_size(&g, 1), hit = 0, bad = 0, frags = 0;
+    size_t i, n = hfvis_volume_floats(&g, 1), hit = 0, bad = 0, frags = 0;
     int nc, ch_occ, ch_n, ch_alb, ch_rad;
     hfvis_voxel_fragment fr;
     float vals[HFVIS_VOLUME_MAX_CHANNELS];
@@ -939,7 +939,7 @@ TEST(attribute_callbacks)
 }
 
 
-/* ---- output-vertex limit: the thesis' holes ([G12] ch. 6; docs/errata.md E58; [G12] Fig. 66) ------------ */
+/* ---- output-vertex limit: the thesis' holes ([G12] ch. 6, Fig. 66; docs/errata.md E58) ------------ */
 
 /* Pixels of the pass along axis a whose column holds no voxel although its centre lies in the
  * projected triangle (the PR voxelization tells which centres are covered: one voxel each). */
@@ -1452,7 +1452,7 @@ TEST(no_allocation)
     CHECK_EQ_STATUS(hfvis_mesh_torus(NULL, c0, 1.0, 0.4, 24, 12, &m), HFVIS_OK);
     CHECK_EQ_STATUS(hfvis_volume_grid_fit(&m, 24, 0.05, 0, &g), HFVIS_OK);
     st = vox_storage(&g, 4);
-    occ = (uint8_t *)malloc(hfvis_volume_size(&g, 1));
+    occ = (uint8_t *)malloc(hfvis_volume_floats(&g, 1));
     hfvis_volume_init(&v, &g, 4, st, HFVIS_BLEND_ADD);
     for (mi = 0; mi < 3; mi++)
         for (ai = 0; ai < 2; ai++) {

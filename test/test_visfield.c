@@ -1,4 +1,4 @@
-/* test_vf.c - 4D visibility fields ([G12] ch. 4): positional samples, direction
+/* test_visfield.c - 4D visibility fields ([G12] ch. 4): positional samples, direction
  * maps, the build against its naive oracle, the exact sphere-in-sphere maps, queries and AO /
  * shadows / reflections against ray casting, the file codec, bad arguments and failing
  * allocations. Prints the thesis-style error tables (hit/miss disagreement, mean distance error,
@@ -1726,6 +1726,47 @@ TEST(vf_regression_huge_radius_query)
     hfvis_mesh_free(NULL, &ico);
 }
 
+/* The options added with 0.2.0's *_options_default(): a zero struct and the filled-in defaults
+ * give bit-identical fields, shadows and reflections. */
+TEST(vf_options_default_equals_zero)
+{
+    const double c0[3] = {0.0, 0.0, 0.0}, light[3] = {0.3, 0.2, 4.0};
+    const double p[3] = {0.1, -0.2, -1.5}, up[3] = {0.0, 0.0, 1.0}, inc[3] = {0.3, 0.1, -1.0};
+    float pts[3 * 4] = {0.0f, 0.0f, -1.5f, 0.4f, 0.1f, -1.2f, -0.9f, 0.3f, -2.0f, 2.0f, 2.0f, -1.0f};
+    float sz[4], sd[4];
+    hfvis_visfield_trace_hit rz[4], rd[4];
+    hfvis_mesh ico;
+    hfvis_bvh bvh;
+    hfvis_visfield a, b;
+    hfvis_visfield_object ob;
+    hfvis_visfield_build_options bz, bd = hfvis_visfield_build_options_default();
+    hfvis_visfield_shadow_options shz, shd = hfvis_visfield_shadow_options_default();
+    hfvis_visfield_reflect_options rfz, rfd = hfvis_visfield_reflect_options_default();
+    memset(&bz, 0, sizeof bz);
+    memset(&shz, 0, sizeof shz);
+    memset(&rfz, 0, sizeof rfz);
+    CHECK_EQ_STATUS(hfvis_mesh_icosphere(NULL, c0, 0.5, 2, &ico), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_bvh_build(&ico, NULL, &bvh), HFVIS_OK);
+    CHECK(field_init(&a, c0, 0.8, 4, 8, HFVIS_DIRMAP_CONCENTRIC, HFVIS_VISFIELD_U8));
+    CHECK(field_init(&b, c0, 0.8, 4, 8, HFVIS_DIRMAP_CONCENTRIC, HFVIS_VISFIELD_U8));
+    CHECK_EQ_STATUS(hfvis_visfield_build(&ico, &bz, &a), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_visfield_build(&ico, &bd, &b), HFVIS_OK);
+    CHECK(a.maps_size == b.maps_size && memcmp(a.maps, b.maps, a.maps_size) == 0);
+    ob = make_object(&a, &ico, &bvh);
+    CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pts, 4, light, 1.0, &shz, sz), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_visfield_soft_shadow(&ob, 1, pts, 4, light, 1.0, &shd, sd), HFVIS_OK);
+    CHECK(memcmp(sz, sd, sizeof sz) == 0);
+    memset(rz, 0, sizeof rz);
+    memset(rd, 0, sizeof rd);
+    CHECK_EQ_STATUS(hfvis_visfield_reflect(&ob, 1, p, up, inc, &rfz, rz), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_visfield_reflect(&ob, 1, p, up, inc, &rfd, rd), HFVIS_OK);
+    CHECK(memcmp(rz, rd, sizeof rz) == 0);
+    field_done(&a);
+    field_done(&b);
+    hfvis_bvh_free(NULL, &bvh);
+    hfvis_mesh_free(NULL, &ico);
+}
+
 int main(int argc, char **argv)
 {
     const char *only = argc > 1 && argv[1][0] != '-' ? argv[1] : NULL;
@@ -1746,6 +1787,7 @@ int main(int argc, char **argv)
     RUN_IF(vf_multi_object);
     RUN_IF(vf_shadows);
     RUN_IF(vf_trace_reflect);
+    RUN_IF(vf_options_default_equals_zero);
     RUN_IF(vf_table_meshes);
     RUN_IF(vf_codec);
     RUN_IF(vf_bad_arguments);
