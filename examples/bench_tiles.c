@@ -1,6 +1,6 @@
 /* bench_tiles.c - rasters larger than memory through the hfvis tool (docs/tiles.md): an N x N
  * fBm field at 1 m cells written as .flt, `hfvis skyview --max-distance 1000` over it whole and
- * as 16 windows (4 x 4, halo 1001 cells) joined by `hfvis mosaic`, each a child process: wall
+ * as 16 windows (4 x 4, halo hfvis_tile_halo: 1005 cells) joined by `hfvis mosaic`, each a child process: wall
  * time and peak memory (ru_maxrss from wait4) of each, and whether the mosaic equals the whole
  * run bit for bit; then the peak memory per grid cell of each tiled command, whole, on a
  * 1024 x 1024 field (the README's figures). N = 8192 (quick: 1024, R = 100 m). The tool is
@@ -112,7 +112,7 @@ void bench_tiles(int quick)
     snprintf(dir, sizeof dir, "%s/hfvis_bench_tiles.XXXXXX", tmp);
     if (!mkdtemp(dir)) { printf("tiles: cannot create a folder in %s\n", tmp); return; }
     printf("\n== tiles: %d x %d fBm at 1 m, skyview K = 16, R = %s m (halo %d cells), whole vs 16 "
-           "windows + mosaic (%s)\n", n, n, R, atoi(R) + 1, cli);
+           "windows + mosaic (%s)\n", n, n, R, hfvis_tile_halo(atof(R), 1.0, HFVIS_RAYS_LATTICE), cli);
     if (tiles_field(dir, "dem", n) != 0) { printf("tiles: cannot write the field in %s\n", dir); return; }
     snprintf(in, sizeof in, "%s/dem.flt", dir);
     snprintf(whole, sizeof whole, "%s/whole.tif", dir);

@@ -11,7 +11,7 @@
 #           shadow, light, hillshade, openness; visibility and indirect 100; horizon 152 + 4 K;
 #           README, "Tiles": the figure --max-memory is checked against)
 #   -c CELL the cell size when RASTER has no georeference (PFM, PGM), as --cell
-# The halo is ceil(R / cell) + 1 cells (the rule hfvis applies); a tile of S x S cells loads at
+# The halo is ceil(R / cell) + 5 cells (hfvis_tile_halo in lattice mode; --exact needs 3 fewer); a tile of S x S cells loads at
 # most (S + 2 halo)^2 cells, so S = floor(sqrt(BUDGET / B)) - 2 halo.
 # HFVIS names the hfvis program (default: hfvis on the PATH).
 # Example: sh examples/tiles.sh dtm.tif 1000 4G > tiles.txt
@@ -41,7 +41,7 @@ printf '%s\n' "$info" | awk -v R="$2" -v budget="$3" -v bpc="$bpc" -v cellflag="
     if (m > 1) b = substr(b, 1, length(b) - 1)
     if (b !~ /^[0-9]*\.?[0-9]+$/) { print "tiles.sh: BUDGET must be bytes with an optional K, M, G or T, got " budget > "/dev/stderr"; exit 2 }
     bytes = b * m
-    q = R / cell; halo = int(q); if (halo < q) halo++; halo++          # ceil(R / cell) + 1
+    q = R / cell; halo = int(q); if (halo < q) halo++; halo += 5        # ceil(R / cell) + 5, hfvis_tile_halo (lattice)
     g = int(sqrt(bytes / bpc)); while ((g + 1) * (g + 1) * bpc <= bytes) g++; while (g > 0 && g * g * bpc > bytes) g--
     S = g - 2 * halo
     if (S < 1) { printf "tiles.sh: %s bytes hold a grid of %d x %d cells, not even one cell with its halo of %d on each side: raise the budget\n", budget, g, g, halo > "/dev/stderr"; exit 1 }
