@@ -46,7 +46,7 @@ LDLIBS := -lm
 LIBSRC := hfvis.c ssao.c voxel.c
 LIBOBJ := $(LIBSRC:%.c=$(BUILD)/obj/%.o)
 LIB := $(BUILD)/libhfvis.a
-EXAMPLES := $(patsubst examples/%.c,$(BUILD)/examples/%,$(filter-out examples/hfvis_cli.c examples/bench%.c examples/common.c,$(wildcard examples/*.c)))
+EXAMPLES := $(patsubst examples/%.c,$(BUILD)/examples/%,$(wildcard examples/*.c))
 CLI := $(BUILD)/hfvis
 BENCH := $(BUILD)/bench
 TESTS := $(patsubst test/%.c,$(BUILD)/test/%,$(wildcard test/test_*.c))
@@ -66,12 +66,12 @@ $(LIB): $(LIBOBJ)
 $(BUILD)/examples/%: examples/%.c examples/common.h examples/fields.h $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -I. $< $(LIB) $(LDLIBS) -o $@
-$(CLI): examples/hfvis_cli.c examples/common.h $(LIB)
+$(CLI): examples/cli/hfvis_cli.c examples/common.h $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -I. $< $(LIB) $(LDLIBS) -o $@
-$(BENCH): examples/bench.c $(wildcard examples/bench_*.c) examples/bench.h examples/common.h examples/fields.h $(LIB)
+$(BENCH): examples/bench/bench.c $(wildcard examples/bench/bench_*.c) examples/bench/bench.h examples/common.h examples/fields.h $(LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(ALL_CFLAGS) -I. examples/bench.c $(wildcard examples/bench_*.c) $(LIB) $(LDLIBS) -o $@
+	$(CC) $(ALL_CFLAGS) -I. examples/bench/bench.c $(wildcard examples/bench/bench_*.c) $(LIB) $(LDLIBS) -o $@
 $(BUILD)/test/%: test/%.c test/test.h test/test_dir.h examples/fields.h $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -I. $< $(LIB) $(LDLIBS) -o $@
@@ -101,7 +101,7 @@ bench:
 demo: 
 	@$(MAKE) --no-print-directory config=release all
 	@mkdir -p out
-	@for e in $(patsubst examples/%.c,build/examples/%,$(filter-out examples/hfvis_cli.c examples/bench%.c,$(wildcard examples/*.c))); do \
+	@for e in $(patsubst examples/%.c,build/examples/%,$(wildcard examples/*.c)); do \
 	  echo "demo: $$e"; $$e out || exit 1; done
 	@echo "demo: gallery written to out/"; ls out
 

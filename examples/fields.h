@@ -1,5 +1,5 @@
 /* fields.h - test fields that break lattice horizons, and the exact bilinear maximum along a ray.
- * Shared by test/test_exact.c, examples/bench_exact.c and examples/14_exact_rays.c (one copy).
+ * Shared by test/test_exact.c, examples/bench/bench_exact.c and examples/14_exact_rays.c (one copy).
  *   fields_urban     flat ground with random box buildings (a DSM), heights in world units
  *   fields_terraces  a stepped hill: flat treads and one-cell cliffs of a given angle
  *   fields_ray_max   the largest elevation over the bilinear surface along a ray, exactly

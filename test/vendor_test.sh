@@ -14,7 +14,7 @@ rm -rf "$dir"; mkdir -p "$dir/vendor" "$dir/app" "$dir/out" || exit 1
 fail() { echo "FAIL vendor: $1"; rm -rf "$dir"; exit 1; }
 
 cp hfvis.h hfvis.c ssao.c voxel.c "$dir/vendor/" || fail "copy"
-cp examples/common.h examples/png_write.h examples/zio.h examples/raster_io.h examples/fields.h examples/0*.c examples/1*.c examples/hfvis_cli.c "$dir/app/" || fail "copy"
+cp examples/common.h examples/png_write.h examples/zio.h examples/raster_io.h examples/fields.h examples/0*.c examples/1*.c examples/cli/hfvis_cli.c "$dir/app/" || fail "copy"
 # shellcheck disable=SC2086 # $flags is a list of flags
 (cd "$dir/vendor" && $cc $flags -c hfvis.c && $cc $flags -c ssao.c && $cc $flags -c voxel.c) \
   > "$dir/log" 2>&1 || { cat "$dir/log"; fail "$cc $flags -c hfvis.c ssao.c voxel.c"; }

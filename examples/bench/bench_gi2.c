@@ -50,7 +50,7 @@ static void bench_gi2_progress(void *user, int done, int total)
     if (done % c->rows == 0 && done / c->rows <= BENCH_GI2_B + 1) c->end[done / c->rows - 1] = bench_now() - c->t0;
 }
 
-/* The bench terrain of examples/bench.c: fBm, amplitude n/8, base wavelength n/4, seed 3. */
+/* The bench terrain of examples/bench/bench.c: fBm, amplitude n/8, base wavelength n/4, seed 3. */
 static void bench_gi2_terrain(float *z, int n)
 {
     hfvis_field f;

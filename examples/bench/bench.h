@@ -1,5 +1,5 @@
 /* bench.h - the benchmark sections of `make bench` that live in examples/bench_*.c, one file per
- * library module; examples/bench.c's main calls each (quick = the short `bench quick` run). */
+ * library module; examples/bench/bench.c's main calls each (quick = the short `bench quick` run). */
 #ifndef HFVIS_BENCH_H
 #define HFVIS_BENCH_H
 

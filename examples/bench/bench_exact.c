@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "bench.h"
-#include "fields.h"
+#include "../fields.h"
 
 #define EXACT_BENCH_K 16
 #define EXACT_BENCH_PTS 1500

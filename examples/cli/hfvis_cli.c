@@ -23,8 +23,8 @@
 #define CLI_HAVE_SIGACTION 1
 #endif
 #include <time.h>
-#include "common.h"
-#include "raster_io.h"
+#include "../common.h"
+#include "../raster_io.h"
 
 #define CLI_PI 3.14159265358979323846
 #define CLI_FLT_MAX ((double)FLT_MAX)                 /* largest value a float flag may take */
