@@ -28,13 +28,18 @@
  *
  * Contents (main entry points per task; every section below documents its building blocks)
  *   Files        hfvis_image_load, hfvis_pfm_save, hfvis_pgm_save; the in-memory codecs
- *                hfvis_image_decode, hfvis_pfm_encode, hfvis_pgm_encode
+ *                hfvis_image_decode, hfvis_pfm_encode, hfvis_pgm_encode; atomic writes
+ *                hfvis_write_file, hfvis_write_begin / hfvis_write_end
  *   Terrain      hfvis_horizon_map, hfvis_horizon_direction (oracles hfvis_horizon_reference,
  *                hfvis_horizon_lattice_naive); hfvis_sky_view_factor, hfvis_sky_light,
  *                hfvis_sun_visibility, hfvis_env_light (oracle hfvis_light_reference);
  *                hfvis_intervisibility, hfvis_visibility_count, hfvis_indirect_light,
  *                hfvis_terrain_gi (oracles *_naive); hfvis_viewshed (hfvis_viewshed_reference);
- *                split runs: hfvis_direction_sums and the partial-sum file hfvis_partial_*
+ *                split runs: hfvis_direction_sums and the partial-sum file hfvis_partial_*;
+ *                exact per-receiver rays (hfvis_sweep_options.rays, hfvis_sweep_azimuths;
+ *                oracle hfvis_horizon_exact_naive); a search radius and tiles
+ *                (hfvis_sweep_options.max_distance, origin, extent, receiver rectangle;
+ *                hfvis_tile_halo)
  *   Terrain GI   hfvis_ns_gi ([NS09]); the SH, ZH and NLP helpers hfvis_sh_*, hfvis_zh_*,
  *                hfvis_nlp_*
  *   Screen space hfvis_camera_perspective, hfvis_camera_from_matrix, hfvis_depth_linearize;
@@ -88,9 +93,13 @@
  *                 viewsheds, the gallery.
  *   Ports         cameras from projection matrices, bottom-up rows, LSAO's step-falloff
  *                 refusal, HBAO defaults aligned with LSAO's.
+ *   Exact rays    every receiver its own ray along the nearest rational direction, the
+ *                 directions weighted by their share of the circle (beyond [P1]).
  *   0.2.0         one API grammar: oracle suffixes, *_options_default() for every options
  *                 struct, *_DEFAULT = 0 in every option enum, unit-named size queries (renames
- *                 kept as deprecated aliases); one internal Common layer (hfvis__*).
+ *                 kept as deprecated aliases); one internal Common layer (hfvis__*); a search
+ *                 radius with tiles that equal the whole run bit for bit; streaming atomic
+ *                 writes.
  *
  * ------------------------------------------------------------------------------------------
  * QUICK START
