@@ -826,10 +826,21 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     hfvis_sky_view_factor, hfvis_env_light, hfvis_sun_visibility, hfvis_direct_light,
  *     hfvis_direction_sums (sky view, sky light, environment), both modes. R also applies to hfvis_horizon_lattice(_naive)
  *     (no window: its nodes are those of hfvis_lattice_init; the rectangle is ignored) and to
- *     the oracles. Refused with HFVIS_ERR_INVALID_ARGUMENT (R, a window or a rectangle): the P2
- *     hull-tree routines (hfvis_intervisibility, hfvis_visibility_count, hfvis_indirect_light,
- *     hfvis_terrain_gi, their oracles, the visibility sums) and hfvis_openness (it has its own
- *     radius).
+ *     the oracles. Refused with HFVIS_ERR_INVALID_ARGUMENT (R, a window or a rectangle):
+ *     hfvis_openness (it has its own radius).
+ *   - The P2 hull-tree routines (hfvis_intervisibility, hfvis_visibility_count,
+ *     hfvis_indirect_light, hfvis_terrain_gi, their oracles, the visibility sums; lattice mode
+ *     only) honour R and refuse a window or a rectangle (HFVIS_ERR_INVALID_ARGUMENT). Rule: a
+ *     sample counts for a receiver when it is visible (as without R: only nearer samples decide
+ *     that) and at most floor(R / cell_size) node steps behind it, the lattice sweep's window.
+ *     So a visible set with R is the unlimited one cut at R, the horizons listed to the callback
+ *     are the minimal horizons within R, and indirect light gives the sky the band above the
+ *     farthest visible sample within R (its sky part is hfvis_sky_light with the same R). The
+ *     tree itself is unchanged (every sample is pushed: visibility within R needs all nearer
+ *     samples, and a tree node's descendants are all farther than it, [P2] Eq. 2); the visible
+ *     enumeration skips the horizon runs that end beyond R and lists no sample beyond it, so
+ *     the listing and the consumers' work shrink with R, the tree's does not. The naive oracles
+ *     stop their outward walk at R; counts equal the tree's bit for bit (test/test_hfvis.c).
  *   - Oracles, same cut-off: hfvis_horizon_lattice_naive (every node scans the nodes within R
  *     behind it) and hfvis_horizon_exact_naive (every receiver's own samples within R), held to
  *     the sweep bit for bit on the test fields (tolerance 1e-12 rad for last-bit ties of the
