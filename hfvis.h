@@ -840,7 +840,8 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     samples, and a tree node's descendants are all farther than it, [P2] Eq. 2); the visible
  *     enumeration skips the horizon runs that end beyond R and lists no sample beyond it, so
  *     the listing and the consumers' work shrink with R, the tree's does not. The naive oracles
- *     stop their outward walk at R; counts equal the tree's bit for bit (test/test_hfvis.c).
+ *     stop their outward walk at R; they agree with the tree with R as they do without it
+ *     (test/test_hfvis.c, p2t_radius_*).
  *   - Oracles, same cut-off: hfvis_horizon_lattice_naive (every node scans the nodes within R
  *     behind it) and hfvis_horizon_exact_naive (every receiver's own samples within R), held to
  *     the sweep bit for bit on the test fields (tolerance 1e-12 rad for last-bit ties of the
@@ -1136,7 +1137,10 @@ HFVIS_API hfvis_status hfvis_visibility_count(const hfvis_grid *grid, int K,
                                               ptrdiff_t out_stride, hfvis_visibility_stats *stats);
 
 /* Oracle: the same counts from the naive visible sets ([P2] §1 on the same lattice).
- * Equal to hfvis_visibility_count exactly. Cost O(K*W*H*N). */
+ * Equal to hfvis_visibility_count exactly, except on samples collinear with the receiver up to
+ * the last bit (bilinear ramps off a box edge, e.g.), where the tree's cross products and these
+ * quotients may break the tie differently (a zero-width band: indirect light agrees).
+ * Cost O(K*W*H*N). */
 HFVIS_API hfvis_status hfvis_visibility_count_naive(const hfvis_grid *grid, int K,
                                                     const hfvis_sweep_options *opts, float *out,
                                                     ptrdiff_t out_stride,
