@@ -1686,10 +1686,17 @@ static void hf_receiver_rect(const hfvis_grid *g, const hfvis_sweep_options *o, 
 }
 
 /* A finite radius, a window or a receiver rectangle: the routines outside the [P1] sweep
- * (the P2 hull tree of section 11, openness) refuse them. */
+ * (openness) refuse them. */
 static int hf_sweep_opts_limited(const hfvis_sweep_options *o)
 {
     return o && (hf_radius_on(o) || o->extent_width != 0 || o->receiver_width != 0);
+}
+
+/* A window or a receiver rectangle: the P2 hull-tree routines of section 11 refuse them (they
+ * honour the radius). */
+static int hf_p2_opts_limited(const hfvis_sweep_options *o)
+{
+    return o && (o->extent_width != 0 || o->receiver_width != 0);
 }
 
 static int hf_opts_valid(const hfvis_sweep_options *o)
@@ -4392,17 +4399,23 @@ int hfvis_hull_tree_horizons(const hfvis_hull_tree *tree, int minimal, int *out,
 }
 
 /* Enumerate the visible samples from a horizon list ([P2] §10.1), farthest first, skipping holes.
- * The q < next guard keeps runs of spurious horizons from overlapping. */
+ * The q < next guard keeps runs of spurious horizons from overlapping. Only samples q >= qmin
+ * are listed (the search radius; 0 = all): each run of visible samples starts at its horizon and
+ * is cut, not changed, by the radius, so a run that ends before qmin is skipped unwalked and
+ * the others are walked as without it. */
 static int hf_visible_from_horizons(const double *d, const double *h, int s, const int *H, int m,
-                                    int *out, int cap)
+                                    int qmin, int *out, int cap)
 {
     int r, count = 0;
     for (r = 0; r < m; r++) {
         int next = r + 1 < m ? H[r + 1] : s, q = H[r];
-        double lim = r + 1 < m ? hf_slope_from(d, h, s, H[r + 1]) : -HFVIS__INF;
+        double lim;
+        if (next <= qmin) continue;
+        lim = r + 1 < m ? hf_slope_from(d, h, s, H[r + 1]) : -HFVIS__INF;
         for (; q < next; q++) {
             if (!isfinite(h[q])) continue;
             if (q != H[r] && !(hf_slope_from(d, h, s, q) >= lim)) break;
+            if (q < qmin) continue;
             if (count < cap) out[count] = q;
             count++;
         }
@@ -4425,16 +4438,19 @@ int hfvis_line_visible_from_horizons(const double *distance, const double *heigh
     for (r = 0; r < m; r++)
         if (horizons[r] < 0 || horizons[r] >= receiver || (r > 0 && horizons[r] <= horizons[r - 1]))
             return -1;
-    return hf_visible_from_horizons(distance, height, receiver, horizons, m, out, cap);
+    return hf_visible_from_horizons(distance, height, receiver, horizons, m, 0, out, cap);
 }
 
 /* The naive visible set ([P2] §10.1): walking outward from the receiver, a sample is visible when
- * its slope is >= the running maximum. Written near to far into tmp order reversed on output. */
-static int hf_visible_naive(const double *d, const double *h, int s, int *out, int cap)
+ * its slope is >= the running maximum. Counted near to far, then written farthest first. The
+ * walk stops at the first sample more than win behind the receiver (the search radius in the
+ * line's distance units; negative = the whole line): a sample's visibility depends only on the
+ * nearer ones. */
+static int hf_visible_naive(const double *d, const double *h, int s, double win, int *out, int cap)
 {
     double best = -HFVIS__INF;
     int q, count = 0, i;
-    for (q = s - 1; q >= 0; q--) {
+    for (q = s - 1; q >= 0 && !(win >= 0.0 && d[s] - d[q] > win); q--) {
         double t;
         if (!isfinite(h[q])) continue;
         t = hf_slope_from(d, h, s, q);
@@ -4446,7 +4462,7 @@ static int hf_visible_naive(const double *d, const double *h, int s, int *out, i
     /* second pass writes farthest first without scratch */
     i = count;
     best = -HFVIS__INF;
-    for (q = s - 1; q >= 0; q--) {
+    for (q = s - 1; q >= 0 && !(win >= 0.0 && d[s] - d[q] > win); q--) {
         double t;
         if (!isfinite(h[q])) continue;
         t = hf_slope_from(d, h, s, q);
@@ -4463,7 +4479,7 @@ int hfvis_line_visible_naive(const double *distance, const double *height, int r
                              int cap)
 {
     if (!hf_line_args_ok(distance, height, receiver, cap, out)) return -1;
-    return hf_visible_naive(distance, height, receiver, out, cap);
+    return hf_visible_naive(distance, height, receiver, -1.0, out, cap);
 }
 
 int hfvis_line_local_horizons_naive(const double *distance, const double *height, int receiver,
@@ -4526,6 +4542,8 @@ struct hf_p2_ctx {
     int *vis, *hz;
     double *lat_exit;           /* per group: exit radiance at the lattice nodes */
     int npre;                   /* pre-roll samples pushed on the current line */
+    double win;                 /* search radius in node steps, floor(R / cell); -1 = unlimited */
+    int qmin;                   /* the current receiver's farthest sample within win */
     /* consumers */
     const float *exit;          /* grid exit radiance, channels interleaved (indirect) */
     int channels;
@@ -4653,9 +4671,12 @@ static void hf_p2_orient(hf_sweep *sw, int m, hf_fused *f)
     for (line = 0; line < nlines; line++) {
         ptrdiff_t node0, step, p;
         int i0, j0, di, dj, n, s, r, k = 0, q;
+        int qmin = 0; /* the farthest pushed sample within the radius of the current receiver */
         n = hf_line_span(sw, m, line, &node0, &step, &i0, &j0, &di, &dj);
         if (n == 0) continue;
         hfvis_hull_tree_reset(c->tree);
+        /* every pre-roll node is pushed, with R too: the event's minimal-horizon filter reads a
+         * horizon's farther neighbour (hf_p2_event), which may lie beyond R */
         for (r = 0; r < R; r++) {
             double x, y, h;
             hf_node_pos(L, i0 - (R - r) * di + L->i_min, j0 - (R - r) * dj + L->j_min, &x, &y);
@@ -4681,7 +4702,7 @@ static void hf_p2_orient(hf_sweep *sw, int m, hf_fused *f)
             c->wh[k] = h * cs;
             if (ch) memcpy(c->le + (size_t)k * (size_t)ch, c->lat_exit + (size_t)p * (size_t)ch, sizeof(double) * (size_t)ch);
             if (c->naive) {
-                nv = hf_visible_naive(c->ld, c->lh, k, c->vis, c->len);
+                nv = hf_visible_naive(c->ld, c->lh, k, c->win, c->vis, c->len);
                 c->st.iterations += (double)k;
             } else {
                 long long before = c->tree->iterations;
@@ -4689,7 +4710,10 @@ static void hf_p2_orient(hf_sweep *sw, int m, hf_fused *f)
                 c->st.iterations += (double)(c->tree->iterations - before);
                 c->st.horizons += (double)nh;
                 nh = hfvis_hull_tree_horizons(c->tree, 0, c->hz, c->len);
-                nv = hf_visible_from_horizons(c->ld, c->lh, k, c->hz, nh, c->vis, c->len);
+                if (c->win >= 0.0)
+                    while (c->ld[k] - c->ld[qmin] > c->win) qmin++;
+                c->qmin = qmin;
+                nv = hf_visible_from_horizons(c->ld, c->lh, k, c->hz, nh, qmin, c->vis, c->len);
             }
             c->st.receivers += 1.0;
             c->fn(sw, c, p, k, c->vis, nv, c->hz, nh);
@@ -4703,6 +4727,11 @@ static hfvis_status hf_p2_run(hf_sweep *sw, const hfvis_grid *grid, int K, hfvis
 {
     int ok = 1;
     if (o->rays == HFVIS_RAYS_EXACT) return HFVIS_ERR_INVALID_ARGUMENT; /* lattices only (hfvis.h) */
+    if (hf_p2_opts_limited(o)) return HFVIS_ERR_INVALID_ARGUMENT;
+    /* The radius is the tree consumers' (hf_p2_orient: floor(R / cell) node steps, as the
+     * lattice sweep's window); the shared driver then runs exactly as without it. */
+    c->win = hf_radius_on(o) ? (double)hf_radius_units(o->max_distance / grid->cell_size) : -1.0;
+    o->max_distance = 0.0;
     if (c->tree_opts && (c->tree_opts->order < HFVIS_TREE_DEFAULT ||
                          c->tree_opts->order > HFVIS_TREE_BREADTH_FIRST || c->tree_opts->safe_zone < 0 ||
                          c->tree_opts->safe_zone > 1 || c->tree_opts->safe_zone_steps < 0))
@@ -4735,8 +4764,8 @@ static void hf_p2_event(hf_sweep *sw, hf_p2_ctx *c, ptrdiff_t node, int s, const
     int i, m = 0;
     const int cols = sw->cols;
     c->st.visible += (double)nv;
-    for (i = 0; i < nh; i++) /* the minimal filter of docs/errata.md E14 */
-        if (hz[i] == 0 || hf_slope_from(c->ld, c->lh, s, hz[i] - 1) < hf_slope_from(c->ld, c->lh, s, hz[i]))
+    for (i = 0; i < nh; i++) /* within the radius; the minimal filter of docs/errata.md E14 */
+        if (hz[i] >= c->qmin && (hz[i] == 0 || hf_slope_from(c->ld, c->lh, s, hz[i] - 1) < hf_slope_from(c->ld, c->lh, s, hz[i])))
             c->hz[m++] = hz[i];
     e.k = c->f.k;
     hf_node_pos(&sw->L, (int)(node % cols) + sw->L.i_min, (int)(node / cols) + sw->L.j_min, &e.x, &e.y);
@@ -4799,7 +4828,7 @@ hfvis_status hfvis_intervisibility(const hfvis_grid *grid, int K, const hfvis_sw
     hfvis_status s;
     if (hf_check_common(grid, opts) != HFVIS_OK || K < 1 || !fn || !hf_tree_opts_valid(tree_opts))
         return HFVIS_ERR_INVALID_ARGUMENT;
-    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
+    if (hf_p2_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* no windows here */
     o = hf_opts_resolve(grid, opts);
     memset(&c, 0, sizeof c);
     c.tree_opts = tree_opts;
@@ -4822,7 +4851,7 @@ static hfvis_status hf_visibility_count(const hfvis_grid *grid, int K, const hfv
     hfvis_status s;
     if (!hf_light_args_valid(grid, K, opts, out, out_stride) || !hf_tree_opts_valid(tree_opts))
         return HFVIS_ERR_INVALID_ARGUMENT;
-    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
+    if (hf_p2_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* no windows here */
     o = hf_opts_resolve(grid, opts);
     memset(&c, 0, sizeof c);
     c.tree_opts = tree_opts;
@@ -4861,7 +4890,7 @@ static hfvis_status hf_indirect(const hfvis_grid *grid, int K, const float *exit
     if (!hf_light_args_valid(grid, K, opts, out, out_stride) || !hf_tree_opts_valid(tree_opts) ||
         !exit_radiance || channels < 1 || channels > 4 || !isfinite(sky) || !isfinite(albedo))
         return HFVIS_ERR_INVALID_ARGUMENT;
-    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
+    if (hf_p2_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* no windows here */
     o = hf_opts_resolve(grid, opts);
     memset(&c, 0, sizeof c);
     c.tree_opts = tree_opts;
@@ -4908,7 +4937,7 @@ hfvis_status hfvis_terrain_gi(const hfvis_grid *grid, int K, const float *direct
     if (!hf_grid_valid(grid) || !direct || !out || channels < 1 || channels > 4 || bounces < 0 ||
         K < 1 || !isfinite(albedo_value) || !hf_opts_valid(opts) || !hf_tree_opts_valid(tree_opts))
         return HFVIS_ERR_INVALID_ARGUMENT;
-    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
+    if (hf_p2_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* no windows here */
     if (!hfvis__mul_size(hf_grid_count(grid), (size_t)channels, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
     n = hf_grid_count(grid);
     exit_b = (float *)hfvis__alloc_array(alloc, total, sizeof(float));
@@ -7666,7 +7695,7 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
         return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
     if (hf_direction_range(&o, K, &begin, &end) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
-    if (kind == HFVIS_SUM_VISIBILITY && hf_sweep_opts_limited(&o)) /* the P2 tree: not honoured */
+    if (kind == HFVIS_SUM_VISIBILITY && hf_p2_opts_limited(&o)) /* the P2 tree: no windows */
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (o.rays == HFVIS_RAYS_EXACT && kind != HFVIS_SUM_VISIBILITY)
         return hf_exact_direction_sums(grid, K, kind, env, eopts, &o, begin, end, sums);

@@ -835,10 +835,22 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     hfvis_sky_view_factor, hfvis_env_light, hfvis_sun_visibility, hfvis_direct_light,
  *     hfvis_direction_sums (sky view, sky light, environment), both modes. R also applies to hfvis_horizon_lattice(_naive)
  *     (no window: its nodes are those of hfvis_lattice_init; the rectangle is ignored) and to
- *     the oracles. Refused with HFVIS_ERR_INVALID_ARGUMENT (R, a window or a rectangle): the P2
- *     hull-tree routines (hfvis_intervisibility, hfvis_visibility_count, hfvis_indirect_light,
- *     hfvis_terrain_gi, their oracles, the visibility sums) and hfvis_openness (it has its own
- *     radius).
+ *     the oracles. Refused with HFVIS_ERR_INVALID_ARGUMENT (R, a window or a rectangle):
+ *     hfvis_openness (it has its own radius).
+ *   - The P2 hull-tree routines (hfvis_intervisibility, hfvis_visibility_count,
+ *     hfvis_indirect_light, hfvis_terrain_gi, their oracles, the visibility sums; lattice mode
+ *     only) honour R and refuse a window or a rectangle (HFVIS_ERR_INVALID_ARGUMENT). Rule: a
+ *     sample counts for a receiver when it is visible (as without R: only nearer samples decide
+ *     that) and at most floor(R / cell_size) node steps behind it, the lattice sweep's window.
+ *     So a visible set with R is the unlimited one cut at R, the horizons listed to the callback
+ *     are the minimal horizons within R, and indirect light gives the sky the band above the
+ *     farthest visible sample within R (its sky part is hfvis_sky_light with the same R). The
+ *     tree itself is unchanged (every sample is pushed: visibility within R needs all nearer
+ *     samples, and a tree node's descendants are all farther than it, [P2] Eq. 2); the visible
+ *     enumeration skips the horizon runs that end beyond R and lists no sample beyond it, so
+ *     the listing and the consumers' work shrink with R, the tree's does not. The naive oracles
+ *     stop their outward walk at R; they agree with the tree with R as they do without it
+ *     (test/test_hfvis.c, p2t_radius_*).
  *   - Oracles, same cut-off: hfvis_horizon_lattice_naive (every node scans the nodes within R
  *     behind it) and hfvis_horizon_exact_naive (every receiver's own samples within R), held to
  *     the sweep bit for bit on the test fields (tolerance 1e-12 rad for last-bit ties of the
@@ -1134,7 +1146,10 @@ HFVIS_API hfvis_status hfvis_visibility_count(const hfvis_grid *grid, int K,
                                               ptrdiff_t out_stride, hfvis_visibility_stats *stats);
 
 /* Oracle: the same counts from the naive visible sets ([P2] §1 on the same lattice).
- * Equal to hfvis_visibility_count exactly. Cost O(K*W*H*N). */
+ * Equal to hfvis_visibility_count exactly, except on samples collinear with the receiver up to
+ * the last bit (bilinear ramps off a box edge, e.g.), where the tree's cross products and these
+ * quotients may break the tie differently (a zero-width band: indirect light agrees).
+ * Cost O(K*W*H*N). */
 HFVIS_API hfvis_status hfvis_visibility_count_naive(const hfvis_grid *grid, int K,
                                                     const hfvis_sweep_options *opts, float *out,
                                                     ptrdiff_t out_stride,

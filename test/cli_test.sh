@@ -153,6 +153,24 @@ expect_ok "visibility pgm --fraction --border clamp" "$dir/v.pgm" visibility "$h
 expect_ok "visibility --stats --fraction" "$dir/vs.pfm" visibility "$h" --stats --fraction --compass -o "$dir/vs.pfm"
 grep -q '^iterations per receiver-direction (t_a): ' "$dir/stdout" && grep -q '^visible/tested: 0\.' "$dir/stdout" \
   && ok "visibility --stats prints t_a and visible/tested" || bad "visibility --stats: $(cat "$dir/stdout")"
+# --max-distance on the [P2] commands: a count with R never exceeds the unlimited one, R beyond
+# the field (24 x 20 cells, cell 1) is the unlimited run byte for byte; --window stays refused
+expect_ok "visibility --max-distance 3" "$dir/v3.pfm" visibility "$h" --dirs 8 --max-distance 3 -o "$dir/v3.pfm"
+if [ "$little_endian" = 1 ]; then
+  # the 24 x 20 floats are the last 1920 bytes of each PFM
+  if tail -c 1920 "$dir/v.pfm" | od -An -v -tf4 | tr -s ' ' '\n' | grep -v '^$' > "$dir/v.txt" &&
+     tail -c 1920 "$dir/v3.pfm" | od -An -v -tf4 | tr -s ' ' '\n' | grep -v '^$' > "$dir/v3.txt" &&
+     [ "$(wc -l < "$dir/v3.txt")" -eq 480 ] &&
+     paste "$dir/v3.txt" "$dir/v.txt" | awk 'NF != 2 || $1 > $2 { bad = 1 } $1 < $2 { less = 1 }
+                                             END { exit bad || !less }'
+  then ok "visibility: R = 3 counts <= unlimited, some fewer"; else bad "visibility: R = 3 counts not <= unlimited"; fi
+else ok "visibility R <= unlimited: skipped (big-endian host)"; fi
+expect_ok "visibility --max-distance 1000" "$dir/vR.pfm" visibility "$h" --dirs 8 --max-distance 1000 -o "$dir/vR.pfm"
+cmp -s "$dir/v.pfm" "$dir/vR.pfm" && ok "visibility: R beyond the field = unlimited, byte for byte" || bad "visibility: R beyond the field differs"
+expect_ok "indirect --max-distance 1000" "$dir/iR.pfm" indirect "$h" --max-distance 1000 -o "$dir/iR.pfm"
+cmp -s "$dir/i.pfm" "$dir/iR.pfm" && ok "indirect: R beyond the field = unlimited, byte for byte" || bad "indirect: R beyond the field differs"
+expect_ok "indirect --max-distance 2.5" "$dir/i25.pfm" indirect "$h" --max-distance 2.5 --bounces 2 -o "$dir/i25.pfm"
+expect_fail "visibility --window" 2 visibility "$h" --max-distance 3 --window 0,0,5,5 -o "$fdir/x.pfm"
 
 # ---- closed forms on a flat field, 8 x 6 ---------------------------------------------------
 # The last pixel of a PGM file is (7, 5), the south-east corner; of a PFM (rows stored bottom

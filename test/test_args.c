@@ -611,6 +611,17 @@ static void teardown(void)
     bo = hfvis_sweep_options_default(); bo.receiver_height = 1; BAD('S', INV, expr); \
     } while (0)
 
+/* The P2 hull-tree routines honour a search radius but refuse a window (a proper one: finite
+ * radius, open border) and a receiver rectangle, both valid elsewhere; substituted as &bo. */
+#define P2_RADIUS_CASES(expr) do { hfvis_sweep_options bo; \
+    bo = hfvis_sweep_options_default(); bo.max_distance = 2.5; OK(expr); \
+    bo = hfvis_sweep_options_default(); bo.max_distance = (double)INFINITY; OK(expr); \
+    bo = hfvis_sweep_options_default(); bo.max_distance = 2.5; bo.receiver_width = bo.receiver_height = 1; \
+    BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.max_distance = 2.5; bo.origin_x = 1; \
+    bo.extent_width = GW + 1; bo.extent_height = GH; BAD('S', INV, expr); \
+    } while (0)
+
 /* ========================================================================================== */
 /* hfvis.c: status, codecs, fields, sampling, lattice, horizons, light                        */
 /* ========================================================================================== */
@@ -1674,6 +1685,7 @@ static void args_intervisibility(void)
     begin("intervisibility");
     st = AT(hfvis_visibility_stats);
     OK(hfvis_intervisibility(&g_ok, 4, NULL, NULL, vis_cb, &calls, st));
+    P2_RADIUS_CASES(hfvis_intervisibility(&g_ok, 4, &bo, NULL, vis_cb, &calls, st)); /* calls: OK rows */
     calls = 0;
     BAD('N', INV, hfvis_intervisibility(NULL, 4, NULL, NULL, vis_cb, &calls, st));
     BAD('N', INV, hfvis_intervisibility(&g_ok, 4, NULL, NULL, NULL, &calls, st));
@@ -1701,6 +1713,7 @@ static void args_visibility_count(void)
     BAD('O', INV, hfvis_visibility_count(&g_ok, 4, NULL, NULL, out, PTRDIFF_MAX, st));
     GRID_CASES(hfvis_visibility_count(&bg, 4, NULL, NULL, out, GW, st));
     SWEEP_OPT_CASES(hfvis_visibility_count(&g_ok, 4, &bo, NULL, out, GW, st));
+    P2_RADIUS_CASES(hfvis_visibility_count(&g_ok, 4, &bo, NULL, out, GW, st));
     TREE_OPT_CASES(hfvis_visibility_count(&g_ok, 4, NULL, &bt, out, GW, st));
 }
 
@@ -1720,6 +1733,7 @@ static void args_visibility_count_naive(void)
     BAD('O', INV, hfvis_visibility_count_naive(&g_ok, 4, NULL, out, PTRDIFF_MAX, st));
     GRID_CASES(hfvis_visibility_count_naive(&bg, 4, NULL, out, GW, st));
     SWEEP_OPT_CASES(hfvis_visibility_count_naive(&g_ok, 4, &bo, out, GW, st));
+    P2_RADIUS_CASES(hfvis_visibility_count_naive(&g_ok, 4, &bo, out, GW, st));
 }
 
 static float ex_rad[GW * GH * 2];
@@ -1743,6 +1757,7 @@ static void args_indirect_light(void)
     BAD('O', INV, hfvis_indirect_light(&g_ok, 4, ex_rad, 1, 1.0f, 0.5f, NULL, NULL, out, PTRDIFF_MAX));
     GRID_CASES(hfvis_indirect_light(&bg, 4, ex_rad, 1, 1.0f, 0.5f, NULL, NULL, out, GW));
     SWEEP_OPT_CASES(hfvis_indirect_light(&g_ok, 4, ex_rad, 1, 1.0f, 0.5f, &bo, NULL, out, GW));
+    P2_RADIUS_CASES(hfvis_indirect_light(&g_ok, 4, ex_rad, 1, 1.0f, 0.5f, &bo, NULL, out, GW));
     TREE_OPT_CASES(hfvis_indirect_light(&g_ok, 4, ex_rad, 1, 1.0f, 0.5f, NULL, &bt, out, GW));
 }
 
@@ -1764,6 +1779,7 @@ static void args_indirect_light_naive(void)
     BAD('O', INV, hfvis_indirect_light_naive(&g_ok, 4, ex_rad, 1, 1.0f, 0.5f, NULL, out, PTRDIFF_MAX));
     GRID_CASES(hfvis_indirect_light_naive(&bg, 4, ex_rad, 1, 1.0f, 0.5f, NULL, out, GW));
     SWEEP_OPT_CASES(hfvis_indirect_light_naive(&g_ok, 4, ex_rad, 1, 1.0f, 0.5f, &bo, out, GW));
+    P2_RADIUS_CASES(hfvis_indirect_light_naive(&g_ok, 4, ex_rad, 1, 1.0f, 0.5f, &bo, out, GW));
 }
 
 static void args_terrain_gi(void)
@@ -1782,6 +1798,7 @@ static void args_terrain_gi(void)
     BAD('F', INV, hfvis_terrain_gi(&g_ok, 4, ex_rad, NULL, NULL, (double)NAN, 1, 1, NULL, NULL, out));
     GRID_CASES(hfvis_terrain_gi(&bg, 4, ex_rad, NULL, NULL, 0.5f, 1, 1, NULL, NULL, out));
     SWEEP_OPT_CASES(hfvis_terrain_gi(&g_ok, 4, ex_rad, NULL, NULL, 0.5f, 1, 1, &bo, NULL, out));
+    P2_RADIUS_CASES(hfvis_terrain_gi(&g_ok, 4, ex_rad, NULL, NULL, 0.5f, 1, 1, &bo, NULL, out));
     TREE_OPT_CASES(hfvis_terrain_gi(&g_ok, 4, ex_rad, NULL, NULL, 0.5f, 1, 1, NULL, &bt, out));
 }
 
@@ -2327,6 +2344,7 @@ static void args_direction_sums(void)
     GRID_CASES(hfvis_direction_sums(&bg, 4, HFVIS_SUM_VISIBILITY, NULL, NULL, NULL, sums));
     SWEEP_OPT_CASES(hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_SKY_LIGHT, NULL, NULL, &bo, sums));
     SWEEP_OPT_CASES(hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_ENV_LIGHT, &g_env, NULL, &bo, sums));
+    P2_RADIUS_CASES(hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_VISIBILITY, NULL, NULL, &bo, sums));
     ENV_CASES(hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_ENV_LIGHT, &be, NULL, NULL, sums));
     EOPT_CASES(hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_ENV_LIGHT, &g_env, &bx, NULL, sums));
 }

@@ -2,6 +2,7 @@
  * hull stack, normals and light; closed forms for planes, valleys and pits). */
 #include "../hfvis.h"
 #include "test.h"
+#include "../examples/fields.h"
 
 #include <float.h>
 #include <stdint.h>
@@ -3879,14 +3880,223 @@ TEST(p2t_visibility_flat)
     CHECK(bad == 0);
 }
 
+/* The search radius on the tree ([P2] §4-7 with hfvis_sweep_options.max_distance): a sample
+ * counts when it is visible and no more than floor(R / cell) node steps behind the receiver.
+ * Fields: fBm (with holes), urban boxes, terraces with 80-degree one-cell cliffs; R below one
+ * cell, a few cells and beyond the field; every border. The tree is held to the naive sets bit
+ * for bit (counts; fBm and terraces) and to P2T_IND_REL (indirect light, all fields); R beyond
+ * the field equals no R bit for bit; a count with R never exceeds the unlimited one; R below one
+ * cell sees nothing. On the urban field the counts of tree and naive differ without R already:
+ * bilinear ramps off a box edge put samples on one line up to the last bit, where the tree's
+ * cross products and the naive quotients break the tie differently (a zero-width band, so
+ * indirect light agrees); p2t_radius_lists holds the tree's lists there to its own unlimited
+ * lists cut at R. */
+static void p2t_radius_field(int f, float *z, double cell)
+{
+    if (f == 0) p2t_field(0, P2T_W, P2T_H, 71, 1, z);
+    else if (f == 1) fields_urban(z, P2T_W, P2T_H, 9, 72);
+    else fields_terraces(z, P2T_W, P2T_H, cell, 3.0, 80.0, 73);
+}
+
+TEST(p2t_radius_vs_naive)
+{
+    static float z[P2T_W * P2T_H], ex[P2T_W * P2T_H * 2];
+    static float a[P2T_H * P2T_W * 2], b[P2T_H * P2T_W * 2], u[P2T_H * P2T_W * 2], un[P2T_H * P2T_W];
+    static const double radii[5] = {0.6, 1.0, 3.5, 8.0, 1e6}; /* cells */
+    const size_t n = (size_t)P2T_W * (size_t)P2T_H;
+    hfvis_grid g;
+    int f, ri, bi, i, mism_count = 0, bad_ind = 0, over = 0, far_diff = 0, near_nonzero = 0, ties = 0;
+    double maxrel = 0.0;
+    p2t_seed(606);
+    for (i = 0; i < P2T_W * P2T_H * 2; i++) ex[i] = (float)(1.5 * p2t_unit());
+    for (f = 0; f < 3; f++) {
+        g.z = z;
+        g.width = P2T_W;
+        g.height = P2T_H;
+        g.stride = P2T_W;
+        g.cell_size = f == 1 ? 1.0 : 0.75;
+        p2t_radius_field(f, z, g.cell_size);
+        for (bi = 0; bi < 3; bi++) {
+            hfvis_sweep_options o = hfvis_sweep_options_default();
+            hfvis_tree_options to;
+            int K = bi == 1 ? 5 : 8;
+            memset(&to, 0, sizeof to);
+            to.order = bi == 2 ? HFVIS_TREE_BREADTH_FIRST : HFVIS_TREE_DEPTH_FIRST;
+            to.safe_zone = bi == 1;
+            o.border = bi == 0 ? HFVIS_BORDER_OPEN : bi == 1 ? HFVIS_BORDER_CLAMP : HFVIS_BORDER_WRAP;
+            o.border_cells = bi == 1 ? 13 : 0;
+            o.azimuth0_rad = 0.15 * (double)bi;
+            CHECK_EQ_STATUS(hfvis_visibility_count(&g, K, &o, &to, u, P2T_W, NULL), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_visibility_count_naive(&g, K, &o, un, P2T_W, NULL), HFVIS_OK);
+            for (i = 0; i < (int)n; i++) ties += f == 1 && u[i] != un[i];
+            for (ri = 0; ri < 5; ri++) {
+                hfvis_visibility_stats st, sn;
+                o.max_distance = radii[ri] * g.cell_size;
+                CHECK_EQ_STATUS(hfvis_visibility_count(&g, K, &o, &to, a, P2T_W, &st), HFVIS_OK);
+                CHECK_EQ_STATUS(hfvis_visibility_count_naive(&g, K, &o, b, P2T_W, &sn), HFVIS_OK);
+                for (i = 0; i < (int)n; i++) {
+                    if (memcmp(&a[i], &b[i], sizeof(float)) != 0 && f != 1 && mism_count++ < 3)
+                        fprintf(stderr, "  field %d border %d R %g cells: tree and naive counts differ at %d\n",
+                                f, bi, radii[ri], i);
+                    if (!isnan(a[i]) && a[i] > u[i]) over++;
+                    if (radii[ri] < 1.0 && !isnan(a[i]) && a[i] != 0.0f) near_nonzero++;
+                }
+                if (ri == 4 && memcmp(a, u, sizeof(float) * n) != 0) far_diff++;
+                CHECK_EQ_STATUS(hfvis_indirect_light(&g, K, ex, 2, 0.4f, 0.9f, &o, &to, a, P2T_W), HFVIS_OK);
+                CHECK_EQ_STATUS(hfvis_indirect_light_naive(&g, K, ex, 2, 0.4f, 0.9f, &o, b, P2T_W), HFVIS_OK);
+                for (i = 0; i < (int)n * 2; i++) {
+                    double x = (double)a[i], y = (double)b[i];
+                    if (isnan(x) || isnan(y)) {
+                        if (!(isnan(x) && isnan(y))) bad_ind++;
+                        continue;
+                    }
+                    if (x != y && fabs(x - y) > maxrel * fabs(y)) maxrel = fabs(x - y) / fabs(y);
+                    if (!(fabs(x - y) <= P2T_IND_REL * fabs(y))) bad_ind++;
+                }
+            }
+        }
+    }
+    CHECK(mism_count == 0);
+    CHECK(bad_ind == 0);
+    CHECK(over == 0);
+    CHECK(far_diff == 0);
+    CHECK(near_nonzero == 0);
+    printf("  radius: counts tree = naive bit for bit on fBm and terraces (urban: %d points differ without "
+           "R, ties); indirect max rel diff %.3g\n", ties, maxrel);
+}
+
+/* The urban field's lists at line level: every event of a run with R lists exactly the samples of
+ * the same event without R that lie within floor(R / cell) cells (compared by distance: the run
+ * with R skips pre-roll samples beyond R, so indices shift), visible samples and horizons. */
+typedef struct p2t_rl {
+    int record;        /* 1: store the unlimited lists; 0: compare */
+    double win;        /* cells */
+    double *buf;       /* per event: receiver distance, nv, nh, then the distances */
+    size_t cap, at;
+    int bad, events;
+} p2t_rl;
+
+static void p2t_rl_fn(void *user, const hfvis_visibility_event *e)
+{
+    p2t_rl *u = (p2t_rl *)user;
+    const double d0 = e->distance[e->receiver];
+    int i, nv = 0, nh = 0, sv, sh;
+    u->events++;
+    if (u->record) {
+        if (u->at + 3 + (size_t)e->visible_count + (size_t)e->horizon_count > u->cap) {
+            u->bad++;
+            return;
+        }
+        u->buf[u->at++] = d0;
+        u->buf[u->at++] = (double)e->visible_count;
+        u->buf[u->at++] = (double)e->horizon_count;
+        for (i = 0; i < e->visible_count; i++) u->buf[u->at++] = e->distance[e->visible[i]];
+        for (i = 0; i < e->horizon_count; i++) u->buf[u->at++] = e->distance[e->horizons[i]];
+        return;
+    }
+    if (u->at + 3 > u->cap || u->buf[u->at] != d0) {
+        u->bad++;
+        return;
+    }
+    sv = (int)u->buf[u->at + 1];
+    sh = (int)u->buf[u->at + 2];
+    u->at += 3;
+    for (i = 0; i < sv; i++, u->at++)
+        if ((d0 - u->buf[u->at]) / 2.0 <= u->win && (nv >= e->visible_count || e->distance[e->visible[nv++]] != u->buf[u->at]))
+            u->bad++;
+    for (i = 0; i < sh; i++, u->at++)
+        if ((d0 - u->buf[u->at]) / 2.0 <= u->win && (nh >= e->horizon_count || e->distance[e->horizons[nh++]] != u->buf[u->at]))
+            u->bad++;
+    if (nv != e->visible_count || nh != e->horizon_count) u->bad++;
+}
+
+TEST(p2t_radius_lists)
+{
+    static float z[P2T_W * P2T_H];
+    static const double radii[4] = {0.6, 3.5, 8.0, 1e6};
+    hfvis_grid g;
+    p2t_rl u;
+    int bi, ri;
+    g.z = z;
+    g.width = P2T_W;
+    g.height = P2T_H;
+    g.stride = P2T_W;
+    g.cell_size = 2.0; /* a power of two: world distances divide back to whole cells exactly */
+    fields_urban(z, P2T_W, P2T_H, 9, 72);
+    memset(&u, 0, sizeof u);
+    u.cap = (size_t)1 << 21;
+    u.buf = (double *)malloc(u.cap * sizeof(double));
+    CHECK(u.buf != NULL);
+    if (!u.buf) return;
+    for (bi = 0; bi < 3; bi++) {
+        hfvis_sweep_options o = hfvis_sweep_options_default();
+        o.border = bi == 0 ? HFVIS_BORDER_OPEN : bi == 1 ? HFVIS_BORDER_CLAMP : HFVIS_BORDER_WRAP;
+        o.border_cells = bi == 1 ? 13 : 0;
+        o.azimuth0_rad = 0.15;
+        u.record = 1;
+        u.at = 0;
+        CHECK_EQ_STATUS(hfvis_intervisibility(&g, 5, &o, NULL, p2t_rl_fn, &u, NULL), HFVIS_OK);
+        for (ri = 0; ri < 4; ri++) {
+            u.record = 0;
+            u.at = 0;
+            u.win = floor(radii[ri]);
+            o.max_distance = radii[ri] * g.cell_size;
+            CHECK_EQ_STATUS(hfvis_intervisibility(&g, 5, &o, NULL, p2t_rl_fn, &u, NULL), HFVIS_OK);
+        }
+    }
+    CHECK(u.bad == 0 && u.events > 0);
+    free(u.buf);
+}
+
+/* R = 0 and R = +INFINITY are today's path: the same bits as no options; a window or a receiver
+ * rectangle is still refused. */
+TEST(p2t_radius_unlimited)
+{
+    static float z[P2T_W * P2T_H], a[P2T_W * P2T_H], b[P2T_W * P2T_H];
+    hfvis_grid g;
+    hfvis_sweep_options o = hfvis_sweep_options_default();
+    g.z = z;
+    g.width = P2T_W;
+    g.height = P2T_H;
+    g.stride = P2T_W;
+    g.cell_size = 1.0;
+    p2t_field(0, P2T_W, P2T_H, 81, 0, z);
+    CHECK_EQ_STATUS(hfvis_visibility_count(&g, 6, NULL, NULL, a, P2T_W, NULL), HFVIS_OK);
+    o.max_distance = (double)INFINITY;
+    CHECK_EQ_STATUS(hfvis_visibility_count(&g, 6, &o, NULL, b, P2T_W, NULL), HFVIS_OK);
+    CHECK(memcmp(a, b, sizeof a) == 0);
+    o.max_distance = 0.0;
+    CHECK_EQ_STATUS(hfvis_visibility_count(&g, 6, &o, NULL, b, P2T_W, NULL), HFVIS_OK);
+    CHECK(memcmp(a, b, sizeof a) == 0);
+    o.max_distance = 5.0;
+    o.receiver_width = o.receiver_height = 3;
+    CHECK_EQ_STATUS(hfvis_visibility_count(&g, 6, &o, NULL, b, P2T_W, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    o.receiver_width = o.receiver_height = 0;
+    o.extent_width = P2T_W + 4;
+    o.extent_height = P2T_H;
+    CHECK_EQ_STATUS(hfvis_visibility_count(&g, 6, &o, NULL, b, P2T_W, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+}
+
 /* The callback's lists against the oracles on the event's own arrays. */
 typedef struct p2t_iv {
     int K, axis, W, H;
+    double win; /* search radius in cells, floor(R / cell); -1 = unlimited */
     const hfvis_grid *g;
     double events, visible;
     int bad_vis, bad_hz, bad_arr, bad_pos;
     int kseen[8];
 } p2t_iv;
+
+/* Keep the samples of list[0..n) no more than win cells from the receiver (cell a power of two:
+ * the world distances divide back to whole cells exactly); win < 0 keeps all. */
+static int p2t_within(const hfvis_visibility_event *e, double cell, double win, int *list, int n)
+{
+    int i, m = 0;
+    if (win < 0.0) return n;
+    for (i = 0; i < n; i++)
+        if ((e->distance[e->receiver] - e->distance[list[i]]) / cell <= win) list[m++] = list[i];
+    return m;
+}
 
 static void p2t_iv_fn(void *user, const hfvis_visibility_event *e)
 {
@@ -3904,8 +4114,10 @@ static void p2t_iv_fn(void *user, const hfvis_visibility_event *e)
         if (!(e->distance[i] > e->distance[i - 1]) || !isfinite(e->height[i - 1])) u->bad_arr++;
     if (!isfinite(e->height[e->receiver])) u->bad_arr++;
     n = hfvis_line_visible_naive(e->distance, e->height, e->receiver, buf, 4096);
+    n = p2t_within(e, u->g->cell_size, u->win, buf, n);
     if (!p2t_same_ints(e->visible, e->visible_count, buf, n)) u->bad_vis++;
     n = hfvis_line_local_horizons_naive(e->distance, e->height, e->receiver, buf, 4096);
+    n = p2t_within(e, u->g->cell_size, u->win, buf, n);
     if (!p2t_same_ints(e->horizons, e->horizon_count, buf, n)) u->bad_hz++;
     /* the receiver is a lattice node in the grid; on the axis directions a grid point whose
      * height is the grid's (cell_size a power of two: the cell-unit round trip is exact) */
@@ -3940,6 +4152,9 @@ TEST(p2t_intervisibility)
                 p2t_iv u;
                 memset(&u, 0, sizeof u);
                 memset(&to, 0, sizeof to);
+                /* a search radius of 6 cells on the second field: lists cut, not changed */
+                u.win = kind == 1 ? 6.0 : -1.0;
+                o.max_distance = kind == 1 ? 6.5 * g.cell_size : 0.0;
                 to.order = bi == 1 ? HFVIS_TREE_BREADTH_FIRST : HFVIS_TREE_DEFAULT;
                 to.safe_zone = ki == 2;
                 u.K = Ks[ki];
@@ -4128,11 +4343,14 @@ TEST(p2t_indirect_sky_only)
     for (holes = 0; holes < 2; holes++) {
         p2t_field(holes, P2T_W, P2T_H, 51, holes, z);
         for (ki = 0; ki < 3; ki++)
-            for (bi = 0; bi < 3; bi++) {
+            for (bi = 0; bi < 9; bi++) {
+                /* bi / 3: unlimited, R = 2.5 and 9 cells: the sky owns the band above the
+                 * farthest visible sample within R, the horizon within R of the radius sweep */
                 hfvis_sweep_options o = hfvis_sweep_options_default();
                 int K = ki == 0 ? 3 : ki == 1 ? 4 : 8;
-                o.border = bi == 0 ? HFVIS_BORDER_OPEN : bi == 1 ? HFVIS_BORDER_CLAMP : HFVIS_BORDER_WRAP;
+                o.border = bi % 3 == 0 ? HFVIS_BORDER_OPEN : bi % 3 == 1 ? HFVIS_BORDER_CLAMP : HFVIS_BORDER_WRAP;
                 o.azimuth0_rad = ki == 0 ? 0.2 : 0.0;
+                o.max_distance = bi / 3 == 0 ? 0.0 : bi / 3 == 1 ? 2.5 * g.cell_size : 9.0 * g.cell_size;
                 CHECK_EQ_STATUS(hfvis_indirect_light(&g, K, ex, 2, 1.3f, 0.7f, &o, NULL, a, P2T_W), HFVIS_OK);
                 CHECK_EQ_STATUS(hfvis_sky_light(&g, K, 1.3f, 0.7f, &o, b, P2T_W), HFVIS_OK);
                 for (i = 0; i < P2T_W * P2T_H; i++) {
@@ -4617,6 +4835,9 @@ static void run_p2_tests(void)
     RUN(p2t_line_holes);
     RUN(p2t_visibility_count);
     RUN(p2t_visibility_flat);
+    RUN(p2t_radius_vs_naive);
+    RUN(p2t_radius_lists);
+    RUN(p2t_radius_unlimited);
     RUN(p2t_intervisibility);
     RUN(p2t_indirect_vs_naive);
     RUN(p2t_indirect_furnace);

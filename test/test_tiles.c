@@ -378,9 +378,12 @@ TEST(radius_limits_and_arguments)
     o.receiver_height = 1;
     CHECK_EQ_STATUS(hfvis_sky_view_factor(&g, 8, &o, out_a, W), HFVIS_ERR_INVALID_ARGUMENT);
     o = hfvis_sweep_options_default();
-    o.max_distance = 5.0;
-    CHECK_EQ_STATUS(hfvis_visibility_count(&g, 8, &o, NULL, out_a, W, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    o.max_distance = 5.0; /* the P2 tree honours R (test_hfvis.c, p2t_radius_*) but no rectangle */
+    CHECK_EQ_STATUS(hfvis_visibility_count(&g, 8, &o, NULL, out_a, W, NULL), HFVIS_OK);
     CHECK_EQ_STATUS(hfvis_openness(&g, 8, NULL, &o, out_a, W), HFVIS_ERR_INVALID_ARGUMENT);
+    o.receiver_width = o.receiver_height = 2;
+    CHECK_EQ_STATUS(hfvis_visibility_count(&g, 8, &o, NULL, out_a, W, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+    o.receiver_width = o.receiver_height = 0;
     o = hfvis_sweep_options_default();
     o.extent_width = W; /* the whole raster: no window, R may stay unlimited */
     o.extent_height = H;

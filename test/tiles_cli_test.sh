@@ -128,9 +128,9 @@ grep -q 'extent=97x83 ' "$dir/op.2.tif.tile" && ok "sidecar records the extent" 
 grep -q 'max-distance=0x1.9p+8 ' "$dir/sv_flt.1.pfm.tile" && ok "sidecar records R" || bad "sidecar R"
 
 # ---- refusals ---------------------------------------------------------------------------------
-# the [P2] hull-tree commands have no search radius in the library: refused with the reason
-fails "visibility --max-distance" 2 "no search radius" visibility "$dir/s.flt" --dirs 8 --max-distance 400 -o "$dir/x.tif"
-fails "indirect --window" 2 "no search radius" indirect "$dir/s.flt" --dirs 8 --window 0,0,10,10 -o "$dir/x.tif"
+# the [P2] hull-tree commands honour R but compute no windows: refused with the reason
+fails "visibility --window" 2 "computes no windows" visibility "$dir/s.flt" --dirs 8 --max-distance 400 --window 0,0,10,10 -o "$dir/x.tif"
+fails "indirect --window" 2 "computes no windows" indirect "$dir/s.flt" --dirs 8 --window 0,0,10,10 -o "$dir/x.tif"
 fails "window without R" 2 "needs a finite --max-distance" skyview "$dir/s.flt" --window 0,0,10,10 -o "$dir/x.pfm"
 fails "openness window without --radius" 2 "needs a finite --radius" openness "$dir/s.flt" --window 0,0,10,10 -o "$dir/x.pfm"
 fails "window outside the raster" 1 "lies outside the raster" skyview "$dir/s.flt" --max-distance 10 --window 97,0,5,5 -o "$dir/x.pfm"

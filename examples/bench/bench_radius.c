@@ -3,7 +3,9 @@
  * receiver-direction and as a ratio to the unlimited sweep (lattice at 1024^2, exact rays at
  * 512^2 to keep the run short); then a 512^2 field as 4 x 4 tiles with the halo of
  * hfvis_tile_halo (R = 64 cells), the tiles' total time beside the whole run's and the
- * bit-for-bit comparison. quick: everything at 256^2. */
+ * bit-for-bit comparison; then the [P2] visibility index (hfvis_visibility_count, the hull tree)
+ * at 512^2, unlimited and with R = 16, 64, 256 cells, with the visible samples per
+ * receiver-direction. quick: everything at 256^2. */
 #define _POSIX_C_SOURCE 199309L
 #include <math.h>
 #include <stdio.h>
@@ -136,6 +138,28 @@ void bench_radius(int quick)
         printf("tiles %-7s R=64 halo %d: whole %.3f s, 4x4 tiles %.3f s (%.2fx), receivers differing "
                "in bits: %zu of %zu\n", mode ? "exact" : "lattice", halo, tw, tt, tt / tw, differ,
                (size_t)n * (size_t)n);
+    }
+    /* the [P2] tree: the tree is built as without R, the visible listing and count shrink */
+    {
+        static const double vr[] = {0.0, 16.0, 64.0, 256.0};
+        printf("visibility %4dx%-4d K=%d, ns per receiver-direction (visible samples each):", n, n,
+               RADIUS_BENCH_K);
+        for (r = 0; r < 4; r++) {
+            hfvis_sweep_options o = hfvis_sweep_options_default();
+            hfvis_visibility_stats st;
+            double t0, t;
+            o.max_distance = vr[r];
+            t0 = bench_now();
+            if (hfvis_visibility_count(&g, RADIUS_BENCH_K, &o, NULL, out, n, &st) != HFVIS_OK) {
+                printf(" failed\n");
+                break;
+            }
+            t = bench_now() - t0;
+            if (r == 0) printf(" unlimited");
+            else printf("  R=%.0f", vr[r]);
+            printf(" %.1f (%.1f)", t * 1e9 / st.receivers, st.visible / st.receivers);
+        }
+        printf("\n");
     }
     free(z);
     free(out);

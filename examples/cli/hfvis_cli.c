@@ -395,8 +395,11 @@ static const char cli_shared_help2[] =
     "  --max-distance R  horizon, skyview, sky, shadow, light, visibility, indirect, hillshade:\n"
     "                    the search radius in height units (--cell applies): occluders farther\n"
     "                    than R along the ray are ignored (GRASS maxdistance, SAGA and RVT radius,\n"
-    "                    WhiteboxTools max_dist); 0 = unlimited (default). viewshed: its range\n"
-    "  --window X0,Y0,W,H  with a finite R (openness: --radius R): only the W x H cells from\n"
+    "                    WhiteboxTools max_dist); 0 = unlimited (default). visibility and\n"
+    "                    indirect: visible samples farther than R are not counted or gathered.\n"
+    "                    viewshed: its range\n"
+    "  --window X0,Y0,W,H  with a finite R (openness: --radius R; not visibility, indirect): only\n"
+    "                    the W x H cells from\n"
     "                    column X0, row Y0 (clipped to IN), reading only them and a halo of\n"
     "                    ceil(R/cell) + 1 cells (GeoTIFF strips/tiles, .bil/.flt, PFM and binary\n"
     "                    PGM rows, by seeking); OUT (.pfm .tif .bil .flt .asc) is a piece, placed\n"
@@ -1394,7 +1397,8 @@ static int cli_gis_finish(cli_args *a)
 /* the sweep commands: --max-distance R is the library's search radius, --window makes a piece */
 #define CLI_SWEEP (CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_SHADOW) \
                    | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_HILLSHADE))
-/* the [P2] hull-tree commands: no search radius in the library (hfvis.h, "Search radius and tiles") */
+/* the [P2] hull-tree commands: a search radius but no windows in the library (hfvis.h, "Search
+ * radius and tiles") */
 #define CLI_P2 (CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_INDIRECT))
 /* the height-field commands: the GIS conventions apply to them */
 #define CLI_HF (CLI_ALL & ~(CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_VOLGI) \
@@ -1423,7 +1427,7 @@ static const cli_flag cli_flags[] = {
     { "--fraction", 0, CLI_ONLY(CMD_VISIBILITY) }, { "--stats", 0, CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_MESHAO) },
     { "--observer", 1, CLI_ONLY(CMD_VIEWSHED) },  { "--observer-height", 1, CLI_ONLY(CMD_VIEWSHED) },
     { "--target-height", 1, CLI_ONLY(CMD_VIEWSHED) },
-    { "--max-distance", 1, CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_VISFIELD) | CLI_SWEEP },
+    { "--max-distance", 1, CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_VISFIELD) | CLI_SWEEP | CLI_P2 },
     { "--window", 1, CLI_SWEEP | CLI_ONLY(CMD_OPENNESS) },
     { "--exact", 0, CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY)
                     | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_SHADOW) },
@@ -1731,11 +1735,10 @@ static int cli_parse(int argc, char **argv, cli_args *a)
         if (k == sizeof cli_flags / sizeof cli_flags[0])
             return cli_error(CLI_EXIT_USAGE, name, "unknown option (see 'hfvis %s --help')",
                              cli_cmd_names[a->cmd]);
-        if ((CLI_ONLY(a->cmd) & CLI_P2) && (!strcmp(name, "--max-distance") || !strcmp(name, "--window")))
-            return cli_error(CLI_EXIT_USAGE, name, "'%s' counts visibility over whole lines with the "
-                             "[P2] hull tree, which has no search radius, so it cannot be cut into "
-                             "windows either; run it whole (or split it with --dir-range)",
-                             cli_cmd_names[a->cmd]);
+        if ((CLI_ONLY(a->cmd) & CLI_P2) && !strcmp(name, "--window"))
+            return cli_error(CLI_EXIT_USAGE, name, "'%s' sweeps whole lattice lines with the [P2] "
+                             "hull tree, which honours --max-distance but computes no windows; run "
+                             "it whole (or split it with --dir-range)", cli_cmd_names[a->cmd]);
         if (!(cli_flags[k].commands & CLI_ONLY(a->cmd)))
             return cli_error(CLI_EXIT_USAGE, name, "not an option of '%s' (see 'hfvis %s --help')",
                              cli_cmd_names[a->cmd], cli_cmd_names[a->cmd]);
