@@ -77,6 +77,26 @@ static inline hfvis_allocator test_counting_allocator(test_counting *c, long fai
     return a;
 }
 
+/* Largest |a - b| over n values, counting the unequal ones in *unequal; -1 when a NaN of one
+ * side meets a number of the other. */
+static inline double test_max_diff(const float *a, const float *b, size_t n, size_t *unequal)
+{
+    double m = 0.0;
+    size_t i;
+    *unequal = 0;
+    for (i = 0; i < n; i++) {
+        if (isnan(a[i]) || isnan(b[i])) {
+            if (!(isnan(a[i]) && isnan(b[i]))) return -1.0;
+            continue;
+        }
+        if (a[i] != b[i]) {
+            (*unequal)++;
+            if (fabs((double)a[i] - (double)b[i]) > m) m = fabs((double)a[i] - (double)b[i]);
+        }
+    }
+    return m;
+}
+
 /* The golden check every test program uses: img (w x h floats) against test/golden/NAME.pfm
  * (the programs run from the repository root). A value differs when it is NaN where the golden
  * is not (or the reverse) or farther than tol from it. With --update-golden the file is

@@ -47,32 +47,13 @@ static hfvis_sweep_options exact_opts(double az0, hfvis_border border, int N)
     return o;
 }
 
-/* Largest |sweep - oracle| over all planes (NaN must match NaN); -1 when NaNs differ. */
-static double max_diff(const float *a, const float *b, size_t n, size_t *unequal)
-{
-    double m = 0.0;
-    size_t i;
-    *unequal = 0;
-    for (i = 0; i < n; i++) {
-        if (isnan(a[i]) || isnan(b[i])) {
-            if (!(isnan(a[i]) && isnan(b[i]))) return -1.0;
-            continue;
-        }
-        if (a[i] != b[i]) {
-            (*unequal)++;
-            if (fabs((double)a[i] - (double)b[i]) > m) m = fabs((double)a[i] - (double)b[i]);
-        }
-    }
-    return m;
-}
-
 static void check_against_oracle(const hfvis_grid *g, int K, const hfvis_sweep_options *o)
 {
     size_t n = (size_t)K * (size_t)g->width * (size_t)g->height, unequal;
     double d;
     CHECK_EQ_STATUS(hfvis_horizon_map(g, K, o, out_a), HFVIS_OK);
     CHECK_EQ_STATUS(hfvis_horizon_exact_naive(g, K, o, out_b), HFVIS_OK);
-    d = max_diff(out_a, out_b, n, &unequal);
+    d = test_max_diff(out_a, out_b, n, &unequal);
     CHECK(d >= 0.0 && d <= EXACT_HULL_TOL);
     if (unequal) printf("     note: %zu of %zu values differ in the last bits (max %.3g)\n", unequal, n, d);
 }

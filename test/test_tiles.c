@@ -52,25 +52,6 @@ static void make_field(int f, float *z, int W, int H, double cell, uint64_t seed
     }
 }
 
-/* Largest |a - b| over n values; -1 when NaNs differ. */
-static double max_diff(const float *a, const float *b, size_t n, size_t *unequal)
-{
-    double m = 0.0;
-    size_t i;
-    *unequal = 0;
-    for (i = 0; i < n; i++) {
-        if (isnan(a[i]) || isnan(b[i])) {
-            if (!(isnan(a[i]) && isnan(b[i]))) return -1.0;
-            continue;
-        }
-        if (a[i] != b[i]) {
-            (*unequal)++;
-            if (fabs((double)a[i] - (double)b[i]) > m) m = fabs((double)a[i] - (double)b[i]);
-        }
-    }
-    return m;
-}
-
 static const double radii_cells[] = {0.4, 1.0, 2.5, 7.0, 19.5, 1e6};
 
 /* Lattice mode: hfvis_horizon_lattice with R against hfvis_horizon_lattice_naive with R. */
@@ -97,7 +78,7 @@ TEST(lattice_radius_equals_oracle)
                     n = hfvis_lattice_nodes(&L);
                     CHECK_EQ_STATUS(hfvis_horizon_lattice(&g, az, &o, out_a), HFVIS_OK);
                     CHECK_EQ_STATUS(hfvis_horizon_lattice_naive(&g, az, &o, out_b), HFVIS_OK);
-                    d = max_diff(out_a, out_b, n, &unequal);
+                    d = test_max_diff(out_a, out_b, n, &unequal);
                     CHECK(d >= 0.0 && d <= RADIUS_HULL_TOL);
                     if (d < 0.0 || d > RADIUS_HULL_TOL)
                         printf("     field %d R %g cells border %d az %g: diff %g (%zu)\n", f,
@@ -128,7 +109,7 @@ TEST(exact_radius_equals_oracle)
                 o.max_distance = radii_cells[r] * cell;
                 CHECK_EQ_STATUS(hfvis_horizon_map(&g, K, &o, out_a), HFVIS_OK);
                 CHECK_EQ_STATUS(hfvis_horizon_exact_naive(&g, K, &o, out_b), HFVIS_OK);
-                d = max_diff(out_a, out_b, (size_t)K * (size_t)(W * H), &unequal);
+                d = test_max_diff(out_a, out_b, (size_t)K * (size_t)(W * H), &unequal);
                 CHECK(d >= 0.0 && d <= RADIUS_HULL_TOL);
                 if (d < 0.0 || d > RADIUS_HULL_TOL)
                     printf("     field %d R %g cells border %d: diff %g (%zu)\n", f, radii_cells[r], b,
@@ -331,7 +312,7 @@ TEST(radius_limits_and_arguments)
         CHECK_EQ_STATUS(hfvis_horizon_map(&g, 8, &o, out_a), HFVIS_OK);
         o.max_distance = 1000.0;
         CHECK_EQ_STATUS(hfvis_horizon_map(&g, 8, &o, out_b), HFVIS_OK);
-        d = max_diff(out_a, out_b, n, &unequal);
+        d = test_max_diff(out_a, out_b, n, &unequal);
         CHECK(d >= 0.0 && d <= RADIUS_HULL_TOL);
         o.max_distance = 0.9;
         CHECK_EQ_STATUS(hfvis_horizon_map(&g, 8, &o, out_b), HFVIS_OK);
