@@ -1582,6 +1582,8 @@ typedef struct hf_sweep {
     hfvis_border border;
     int preroll;                /* cells of CLAMP/WRAP pre-roll before each line (docs/errata.md E8) */
     int want_normals;
+    int nrm_finite;             /* every grid normal finite (want_normals): the sampling's
+                                   four-tap sum needs no hole test */
     int channels;               /* of the lattice accumulator */
     hfvis_lattice L;            /* base lattice of the current group */
     int rows, cols;
@@ -1821,7 +1823,7 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     sw->rect = sw->rx0 > 0 || sw->ry0 > 0 || sw->rx1 < g->width || sw->ry1 < g->height;
     if (sw->win_rw >= 0) hf_win_carve(&sw->win, b + off_w, linelen);
     if (want_normals) {
-        int x, y;
+        int x, y, fin = 1;
         for (y = 0; y < g->height; y++)
             for (x = 0; x < g->width; x++) {
                 double n[3];
@@ -1830,7 +1832,9 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
                 p[0] = (float)n[0];
                 p[1] = (float)n[1];
                 p[2] = (float)n[2];
+                fin &= isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
             }
+        sw->nrm_finite = fin;
     }
     if (want_gacc) memset(sw->gacc, 0, gridn * (size_t)channels * sizeof(double));
     return HFVIS_OK;
@@ -1887,74 +1891,94 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
     hfvis_lattice *L = &sw->L;
     int j, i, c, tj, ti;
     double inv_cs = 1.0 / g->cell_size;
-    size_t n, nodes;
+    size_t nodes;
     hf_lattice_from_u(L, g->width, g->height, ux, uy, sw->ox, sw->oy); /* within the bound */
     sw->rows = L->j_max - L->j_min + 1;
     sw->cols = L->i_max - L->i_min + 1;
     HFVIS_ASSERT(sw->rows <= hf_lattice_bound(g) && sw->cols <= hf_lattice_bound(g));
     nodes = (size_t)sw->rows * (size_t)sw->cols;
     HFVIS_ASSERT(nodes <= sw->nodes_cap);
-    for (n = 0; n < nodes; n++) sw->h[n] = HFVIS__NAN;
     for (c = 0; c < sw->cols; c++) {
         sw->col_first[c] = INT_MAX;
         sw->col_last[c] = -1;
     }
     for (j = 0; j < sw->rows; j++) {
         int first, last;
+        double *hr = sw->h + (size_t)j * (size_t)sw->cols;
         if (!hfvis_lattice_line(L, j + L->j_min, &first, &last)) {
             sw->row_first[j] = 1;
             sw->row_last[j] = 0;
+            for (i = 0; i < sw->cols; i++) hr[i] = HFVIS__NAN;
             continue;
         }
         sw->row_first[j] = first - L->i_min;
         sw->row_last[j] = last - L->i_min;
+        /* NaN outside the row's span; the span itself is sampled below */
+        for (i = 0; i < sw->row_first[j]; i++) hr[i] = HFVIS__NAN;
+        for (i = sw->row_last[j] + 1; i < sw->cols; i++) hr[i] = HFVIS__NAN;
         for (i = sw->row_first[j]; i <= sw->row_last[j]; i++) {
             if (j < sw->col_first[i]) sw->col_first[i] = j;
             if (j > sw->col_last[i]) sw->col_last[i] = j;
         }
     }
-    for (tj = 0; tj < sw->rows; tj += HF_TILE)
-        for (ti = 0; ti < sw->cols; ti += HF_TILE)
-    for (j = tj; j < sw->rows && j < tj + HF_TILE; j++) {
-        double *hr = sw->h + (size_t)j * (size_t)sw->cols;
+    {
+    /* Per-group and per-row invariants in locals: the stores to hr and no (double, float) could
+     * alias the lattice's and the grid's double fields, so the compiler reloaded them at every
+     * node. Node positions as hf_node_pos (the same expressions, so the same bits). */
+    const double ux_ = L->ux, uy_ = L->uy, vx_ = L->vx, vy_ = L->vy;
+    const double ox_ = L->origin_x, oy_ = L->origin_y;
+    const double xmax = (double)(g->width - 1), ymax = (double)(g->height - 1);
+    const int W = g->width, H = g->height, i_min = L->i_min, j_min = L->j_min;
+    const int cols = sw->cols, rows = sw->rows, want_normals = sw->want_normals;
+    const ptrdiff_t stride = g->stride;
+    const float *z = g->z, *grid_nrm = sw->grid_nrm;
+    float *nrm = sw->nrm;
+    const int four_taps = W > 1 && H > 1, nrm_finite = want_normals && sw->nrm_finite;
+    for (tj = 0; tj < rows; tj += HF_TILE)
+        for (ti = 0; ti < cols; ti += HF_TILE)
+    for (j = tj; j < rows && j < tj + HF_TILE; j++) {
+        double *hr = sw->h + (size_t)j * (size_t)cols;
+        const double jd = (double)(j + j_min), jvx = jd * vx_, jvy = jd * vy_;
         int first = sw->row_first[j] > ti ? sw->row_first[j] : ti;
         int last = sw->row_last[j] < ti + HF_TILE - 1 ? sw->row_last[j] : ti + HF_TILE - 1;
         for (i = first; i <= last; i++) {
-            double x, y, fx = 0.0, fy = 0.0, w[4];
+            const double id = (double)(i + i_min);
+            double x = (id * ux_ + jvx) - ox_, y = (id * uy_ + jvy) - oy_;
+            double fx = 0.0, fy = 0.0, w[4];
             int x0 = 0, y0 = 0, q;
-            hf_node_pos(L, i + L->i_min, j + L->j_min, &x, &y);
-            x = hf_clampd(x, 0.0, (double)(g->width - 1));
-            y = hf_clampd(y, 0.0, (double)(g->height - 1));
+            x = hf_clampd(x, 0.0, xmax);
+            y = hf_clampd(y, 0.0, ymax);
             /* Bilinear taps (docs/errata.md E5), shared by the height and, for lighting, the normal
              * ([P1] §7: normals bilinearly filtered, then renormalised). Zero-weight taps are
              * never read, so holes do not leak into exact sample positions. */
             /* the cell of hf_bilerp: x >= 0 after the clamp, so (int)x is floor(x) */
-            if (g->width > 1) {
-                x0 = (int)x < g->width - 2 ? (int)x : g->width - 2;
+            if (W > 1) {
+                x0 = (int)x < W - 2 ? (int)x : W - 2;
                 fx = x - (double)x0;
             }
-            if (g->height > 1) {
-                y0 = (int)y < g->height - 2 ? (int)y : g->height - 2;
+            if (H > 1) {
+                y0 = (int)y < H - 2 ? (int)y : H - 2;
                 fy = y - (double)y0;
             }
-            hr[i] = hf_bilerp_taps(g->z + (ptrdiff_t)y0 * g->stride + x0, g->stride, fx, fy) * inv_cs;
-            if (sw->want_normals) {
+            hr[i] = hf_bilerp_taps(z + (ptrdiff_t)y0 * stride + x0, stride, fx, fy) * inv_cs;
+            if (want_normals) {
                 double n0 = 0.0, n1 = 0.0, n2 = 0.0, inv;
-                float *no = sw->nrm + ((size_t)j * (size_t)sw->cols + (size_t)i) * 3;
-                const float *np = sw->grid_nrm + ((size_t)y0 * (size_t)g->width + (size_t)x0) * 3;
+                float *no = nrm + ((size_t)j * (size_t)cols + (size_t)i) * 3;
+                const float *np = grid_nrm + ((size_t)y0 * (size_t)W + (size_t)x0) * 3;
                 w[0] = (1.0 - fx) * (1.0 - fy);
                 w[1] = fx * (1.0 - fy);
                 w[2] = (1.0 - fx) * fy;
                 w[3] = fx * fy;
-                if (g->width > 1 && g->height > 1) {
+                if (four_taps) {
                     /* all four taps in the grid: summed without the zero-weight test, which is
-                     * bit-identical while they are finite (w*n of w == 0 is a +-0) */
-                    const float *r = np + (ptrdiff_t)g->width * 3;
+                     * bit-identical while they are finite (w*n of w == 0 is a +-0); the hole
+                     * test only when some grid normal is not finite */
+                    const float *r = np + (ptrdiff_t)W * 3;
                     n0 = 0.0 + w[0] * (double)np[0] + w[1] * (double)np[3] + w[2] * (double)r[0] + w[3] * (double)r[3];
                     n1 = 0.0 + w[0] * (double)np[1] + w[1] * (double)np[4] + w[2] * (double)r[1] + w[3] * (double)r[4];
                     n2 = 0.0 + w[0] * (double)np[2] + w[1] * (double)np[5] + w[2] * (double)r[2] + w[3] * (double)r[5];
                     q = 4;
-                    if (!isfinite(n0 + n1 + n2)) { /* a hole's NaN normal: tap by tap */
+                    if (!nrm_finite && !isfinite(n0 + n1 + n2)) { /* a hole's NaN normal: tap by tap */
                         n0 = n1 = n2 = 0.0;
                         q = 0;
                     }
@@ -1964,7 +1988,7 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
                 for (; q < 4; q++) {
                     const float *t3;
                     if (w[q] == 0.0) continue;
-                    t3 = np + ((q >> 1) * (ptrdiff_t)g->width + (q & 1)) * 3;
+                    t3 = np + ((q >> 1) * (ptrdiff_t)W + (q & 1)) * 3;
                     n0 += w[q] * (double)t3[0];
                     n1 += w[q] * (double)t3[1];
                     n2 += w[q] * (double)t3[2];
@@ -1975,6 +1999,7 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
                 no[2] = (float)(n2 * inv);
             }
         }
+    }
     }
 }
 
