@@ -1891,13 +1891,11 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
     hfvis_lattice *L = &sw->L;
     int j, i, c, tj, ti;
     double inv_cs = 1.0 / g->cell_size;
-    size_t nodes;
     hf_lattice_from_u(L, g->width, g->height, ux, uy, sw->ox, sw->oy); /* within the bound */
     sw->rows = L->j_max - L->j_min + 1;
     sw->cols = L->i_max - L->i_min + 1;
     HFVIS_ASSERT(sw->rows <= hf_lattice_bound(g) && sw->cols <= hf_lattice_bound(g));
-    nodes = (size_t)sw->rows * (size_t)sw->cols;
-    HFVIS_ASSERT(nodes <= sw->nodes_cap);
+    HFVIS_ASSERT((size_t)sw->rows * (size_t)sw->cols <= sw->nodes_cap);
     for (c = 0; c < sw->cols; c++) {
         sw->col_first[c] = INT_MAX;
         sw->col_last[c] = -1;
