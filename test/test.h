@@ -77,6 +77,18 @@ static inline hfvis_allocator test_counting_allocator(test_counting *c, long fai
     return a;
 }
 
+/* A height grid over z with stride W. */
+static inline hfvis_grid test_grid(const float *z, int W, int H, double cell)
+{
+    hfvis_grid g;
+    g.z = z;
+    g.width = W;
+    g.height = H;
+    g.stride = W;
+    g.cell_size = cell;
+    return g;
+}
+
 /* Largest |a - b| over n values, counting the unequal ones in *unequal; -1 when a NaN of one
  * side meets a number of the other. */
 static inline double test_max_diff(const float *a, const float *b, size_t n, size_t *unequal)

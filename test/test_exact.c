@@ -26,17 +26,6 @@
 
 static float zbuf[160 * 160], out_a[16 * 160 * 160], out_b[16 * 160 * 160];
 
-static hfvis_grid grid_of(float *z, int W, int H, double cell)
-{
-    hfvis_grid g;
-    g.z = z;
-    g.width = W;
-    g.height = H;
-    g.stride = W;
-    g.cell_size = cell;
-    return g;
-}
-
 static hfvis_sweep_options exact_opts(double az0, hfvis_border border, int N)
 {
     hfvis_sweep_options o = hfvis_sweep_options_default();
@@ -78,7 +67,7 @@ TEST(sweep_equals_oracle_random)
     int i, b;
     for (seed = 1; seed <= 3; seed++) {
         int W = 17 + (int)seed * 5, H = 13 + (int)seed * 3;
-        hfvis_grid g = grid_of(zbuf, W, H, 0.5 + (double)seed * 0.7);
+        hfvis_grid g = test_grid(zbuf, W, H, 0.5 + (double)seed * 0.7);
         uint64_t s = seed;
         int j;
         fbm(zbuf, W, H, 6.0, 5.0, seed);
@@ -99,10 +88,10 @@ TEST(sweep_equals_oracle_hard_fields)
     hfvis_grid g;
     int x, y;
     fields_urban(zbuf, 48, 40, 9, 7);
-    g = grid_of(zbuf, 48, 40, 1.0);
+    g = test_grid(zbuf, 48, 40, 1.0);
     check_against_oracle(&g, 16, &o);
     fields_terraces(zbuf, 44, 33, 1.0, 4.0, 80.0, 3);
-    g = grid_of(zbuf, 44, 33, 1.0);
+    g = test_grid(zbuf, 44, 33, 1.0);
     check_against_oracle(&g, 16, &o);
     o.ray_denominator = 9;
     check_against_oracle(&g, 7, &o);
@@ -112,7 +101,7 @@ TEST(sweep_equals_oracle_hard_fields)
         for (x = 0; x < 40; x++)
             if ((x - 20) * (x - 20) + (y - 20) * (y - 20) < 30 || x == 0 || (x + y) % 17 == 0)
                 zbuf[y * 40 + x] = (float)NAN;
-    g = grid_of(zbuf, 40, 40, 1.0);
+    g = test_grid(zbuf, 40, 40, 1.0);
     o = exact_opts(0.2, HFVIS_BORDER_CLAMP, 0);
     o.border_cells = 6;
     check_against_oracle(&g, 16, &o);
@@ -122,11 +111,11 @@ TEST(sweep_equals_oracle_hard_fields)
     check_against_oracle(&g, 16, &o);
     /* 1xN, Nx1, 1x1 */
     fbm(zbuf, 23, 1, 3.0, 4.0, 5);
-    g = grid_of(zbuf, 23, 1, 1.0);
+    g = test_grid(zbuf, 23, 1, 1.0);
     check_against_oracle(&g, 8, &o);
-    g = grid_of(zbuf, 1, 23, 1.0);
+    g = test_grid(zbuf, 1, 23, 1.0);
     check_against_oracle(&g, 8, &o);
-    g = grid_of(zbuf, 1, 1, 1.0);
+    g = test_grid(zbuf, 1, 1, 1.0);
     check_against_oracle(&g, 4, &o);
     CHECK(out_a[0] == (float)(-PI / 2));
 }
@@ -136,7 +125,7 @@ TEST(sweep_equals_oracle_hard_fields)
 TEST(holes_never_occlude)
 {
     hfvis_sweep_options o = exact_opts(0.1, HFVIS_BORDER_OPEN, 0);
-    hfvis_grid g = grid_of(zbuf, 30, 24, 1.0);
+    hfvis_grid g = test_grid(zbuf, 30, 24, 1.0);
     size_t i, n = 16u * 30u * 24u;
     int x, y, bad = 0;
     for (y = 0; y < 24; y++)
@@ -155,7 +144,7 @@ TEST(tilted_plane_is_exact)
 {
     hfvis_sweep_options o = exact_opts(0.05, HFVIS_BORDER_OPEN, 0);
     double az[16];
-    hfvis_grid g = grid_of(zbuf, 31, 27, 2.0);
+    hfvis_grid g = test_grid(zbuf, 31, 27, 2.0);
     int x, y, k, bad = 0;
     for (y = 0; y < 27; y++)
         for (x = 0; x < 31; x++) zbuf[y * 31 + x] = (float)(0.75 * x - 0.5 * y);
@@ -179,7 +168,7 @@ TEST(wall_closed_form)
 {
     hfvis_sweep_options o = exact_opts(0.0, HFVIS_BORDER_OPEN, 0);
     double az[16], A = 12.0, cell = 0.5;
-    hfvis_grid g = grid_of(zbuf, 60, 50, cell);
+    hfvis_grid g = test_grid(zbuf, 60, 50, cell);
     int x, y, k, bad = 0, checked = 0, x0 = 40;
     for (y = 0; y < 50; y++)
         for (x = 0; x < 60; x++) zbuf[y * 60 + x] = x >= x0 ? (float)A : 0.0f;
@@ -228,7 +217,7 @@ TEST(box_closed_form)
     hfvis_sweep_options o = exact_opts(0.3, HFVIS_BORDER_OPEN, 0);
     double az[16], A = 20.0;
     int x, y, k, bad = 0, hits = 0, bx0 = 25, bx1 = 34, by0 = 18, by1 = 29;
-    hfvis_grid g = grid_of(zbuf, 64, 48, 1.0);
+    hfvis_grid g = test_grid(zbuf, 64, 48, 1.0);
     for (y = 0; y < 48; y++)
         for (x = 0; x < 64; x++) zbuf[y * 64 + x] = (x >= bx0 && x <= bx1 && y >= by0 && y <= by1) ? (float)A : 0.0f;
     CHECK_EQ_STATUS(hfvis_horizon_map(&g, 16, &o, out_a), HFVIS_OK);
@@ -303,7 +292,7 @@ TEST(azimuths_and_weights)
 TEST(flat_field_quadrature_exact)
 {
     static const int Ks[] = {1, 5, 7, 16, 64};
-    hfvis_grid g = grid_of(zbuf, 21, 17, 1.5);
+    hfvis_grid g = test_grid(zbuf, 21, 17, 1.5);
     int i, j;
     for (j = 0; j < 21 * 17; j++) zbuf[j] = 4.0f;
     for (i = 0; i < 5; i++) {
@@ -325,7 +314,7 @@ TEST(flat_field_quadrature_exact)
 TEST(light_consistent_with_map)
 {
     hfvis_sweep_options o = exact_opts(0.1, HFVIS_BORDER_OPEN, 0), lat = hfvis_sweep_options_default();
-    hfvis_grid g = grid_of(zbuf, 40, 36, 2.0);
+    hfvis_grid g = test_grid(zbuf, 40, 36, 2.0);
     double w[16];
     static float svf_l[40 * 36], sky_e[40 * 36], sky_l[40 * 36];
     float env_px[4 * 8];
@@ -379,7 +368,7 @@ TEST(light_consistent_with_map)
 TEST(split_runs)
 {
     hfvis_sweep_options o = exact_opts(0.0, HFVIS_BORDER_OPEN, 0);
-    hfvis_grid g = grid_of(zbuf, 33, 29, 1.0);
+    hfvis_grid g = test_grid(zbuf, 33, 29, 1.0);
     static double full[33 * 29], part[33 * 29], acc[33 * 29];
     static float svf[33 * 29], share[33 * 29], sacc[33 * 29];
     size_t plane = 33u * 29u;
@@ -419,7 +408,7 @@ TEST(split_runs)
 TEST(modes_and_arguments)
 {
     hfvis_sweep_options o = exact_opts(0.0, HFVIS_BORDER_OPEN, 0);
-    hfvis_grid g = grid_of(zbuf, 20, 20, 1.0);
+    hfvis_grid g = test_grid(zbuf, 20, 20, 1.0);
     float ex[20 * 20];
     double s[20 * 20];
     int j, bad = 0;
@@ -450,7 +439,7 @@ TEST(modes_and_arguments)
 TEST(allocation_failures)
 {
     hfvis_sweep_options o = exact_opts(0.0, HFVIS_BORDER_OPEN, 0);
-    hfvis_grid g = grid_of(zbuf, 12, 10, 1.0);
+    hfvis_grid g = test_grid(zbuf, 12, 10, 1.0);
     test_counting c;
     hfvis_allocator a = test_counting_allocator(&c, 1);
     double w[8];
@@ -555,14 +544,14 @@ TEST(accuracy_against_exact_bilinear_max)
 {
     hfvis_grid g;
     fields_urban(zbuf, 128, 128, 40, 1);
-    g = grid_of(zbuf, 128, 128, 1.0);
+    g = test_grid(zbuf, 128, 128, 1.0);
     accuracy("urban", &g, 3);
     svf_next_to_walls(&g);
     fields_terraces(zbuf, 96, 72, 1.0, 5.0, 80.0, 2);
-    g = grid_of(zbuf, 96, 72, 1.0);
+    g = test_grid(zbuf, 96, 72, 1.0);
     accuracy("terraces", &g, 2);
     fbm(zbuf, 96, 72, 20.0, 24.0, 3);
-    g = grid_of(zbuf, 96, 72, 1.0);
+    g = test_grid(zbuf, 96, 72, 1.0);
     accuracy("fbm", &g, 2);
 }
 

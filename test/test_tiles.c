@@ -16,17 +16,6 @@
 #define MAXN (96 * 80)
 static float zbuf[MAXN], out_a[16 * MAXN], out_b[16 * MAXN];
 
-static hfvis_grid grid_of(float *z, int W, int H, double cell)
-{
-    hfvis_grid g;
-    g.z = z;
-    g.width = W;
-    g.height = H;
-    g.stride = W;
-    g.cell_size = cell;
-    return g;
-}
-
 static void fbm(float *z, int W, int H, double amp, double wl, uint64_t seed)
 {
     hfvis_field f;
@@ -62,7 +51,7 @@ TEST(lattice_radius_equals_oracle)
     for (f = 0; f < 4; f++) {
         int W = 37 + 6 * f, H = 29 + 4 * f;
         double cell = f == 1 ? 1.0 : 0.5 + 0.3 * (double)f;
-        hfvis_grid g = grid_of(zbuf, W, H, cell);
+        hfvis_grid g = test_grid(zbuf, W, H, cell);
         make_field(f, zbuf, W, H, cell, 11u + (uint64_t)f);
         for (r = 0; r < 6; r++)
             for (b = 0; b < 3; b++)
@@ -95,7 +84,7 @@ TEST(exact_radius_equals_oracle)
     for (f = 0; f < 4; f++) {
         int W = 33 + 5 * f, H = 27 + 3 * f, K = 12;
         double cell = f == 1 ? 1.0 : 0.5 + 0.3 * (double)f;
-        hfvis_grid g = grid_of(zbuf, W, H, cell);
+        hfvis_grid g = test_grid(zbuf, W, H, cell);
         make_field(f, zbuf, W, H, cell, 21u + (uint64_t)f);
         for (r = 0; r < 6; r++)
             for (b = 0; b < 3; b++) {
@@ -153,7 +142,7 @@ static float tile_z[MAXN], tile_out[8 * MAXN];
 static void check_tiles(int field, int W, int H, double cell, double R_cells, hfvis_ray_mode rays)
 {
     static const int xs[] = {0, 1, 17, 18, 40, 57, 200}, ys[] = {0, 13, 14, 31, 32, 100};
-    hfvis_grid g = grid_of(zbuf, W, H, cell);
+    hfvis_grid g = test_grid(zbuf, W, H, cell);
     int kind;
     make_field(field, zbuf, W, H, cell, 77u + (uint64_t)field);
     for (kind = 0; kind < NKINDS; kind++) {
@@ -172,7 +161,7 @@ static void check_tiles(int field, int W, int H, double cell, double R_cells, hf
                 int tx0 = x0 - halo < 0 ? 0 : x0 - halo, ty0 = y0 - halo < 0 ? 0 : y0 - halo;
                 int tx1 = x1 + halo > W ? W : x1 + halo, ty1 = y1 + halo > H ? H : y1 + halo;
                 int tw = tx1 - tx0, th = ty1 - ty0, x, y, p;
-                hfvis_grid t = grid_of(tile_z, tw, th, cell);
+                hfvis_grid t = test_grid(tile_z, tw, th, cell);
                 hfvis_sweep_options to = o;
                 for (y = 0; y < th; y++)
                     for (x = 0; x < tw; x++) tile_z[y * tw + x] = zbuf[(ty0 + y) * W + tx0 + x];
@@ -222,7 +211,7 @@ TEST(tiles_direction_sums)
 {
     static double whole[MAXN], part[MAXN];
     int W = 50, H = 36, mode, x, y;
-    hfvis_grid g = grid_of(zbuf, W, H, 1.0);
+    hfvis_grid g = test_grid(zbuf, W, H, 1.0);
     make_field(1, zbuf, W, H, 1.0, 3u);
     for (mode = 0; mode < 2; mode++) {
         hfvis_sweep_options o = hfvis_sweep_options_default(), to;
@@ -237,7 +226,7 @@ TEST(tiles_direction_sums)
         th = (y0 + h + halo > H ? H : y0 + h + halo) - ty0;
         for (y = 0; y < th; y++)
             for (x = 0; x < tw; x++) tile_z[y * tw + x] = zbuf[(ty0 + y) * W + tx0 + x];
-        t = grid_of(tile_z, tw, th, 1.0);
+        t = test_grid(tile_z, tw, th, 1.0);
         to = o;
         to.origin_x = tx0;
         to.origin_y = ty0;
@@ -261,7 +250,7 @@ TEST(tiles_direction_sums)
 TEST(receiver_rectangle_and_unlimited)
 {
     int W = 45, H = 33, kind, mode;
-    hfvis_grid g = grid_of(zbuf, W, H, 0.8);
+    hfvis_grid g = test_grid(zbuf, W, H, 0.8);
     make_field(3, zbuf, W, H, 0.8, 5u);
     for (mode = 0; mode < 2; mode++)
         for (kind = 0; kind < NKINDS; kind++) {
@@ -301,7 +290,7 @@ TEST(receiver_rectangle_and_unlimited)
 TEST(radius_limits_and_arguments)
 {
     int W = 40, H = 30, mode;
-    hfvis_grid g = grid_of(zbuf, W, H, 1.0);
+    hfvis_grid g = test_grid(zbuf, W, H, 1.0);
     hfvis_sweep_options o = hfvis_sweep_options_default();
     size_t n = (size_t)8 * (size_t)(W * H), i, unequal;
     double d;
