@@ -2637,6 +2637,31 @@ static void hf_lattice_fill(hf_sweep *sw, double value)
     for (i = 0; i < n; i++) sw->lat[i] = value;
 }
 
+/* The fused accumulator of the current group: 0 at every in-domain node with a height, else NaN;
+ * one pass, row by row (outside the row's span NaN, inside it by the height). */
+static void hf_lattice_zero(hf_sweep *sw)
+{
+    const int cols = sw->cols, rows = sw->rows, ch = sw->channels;
+    const double *h = sw->h;
+    double *lat = sw->lat;
+    int j, i, c;
+    for (j = 0; j < rows; j++) {
+        const double *hr = h + (size_t)j * (size_t)cols;
+        double *lr = lat + (size_t)j * (size_t)cols * (size_t)ch;
+        const int first = sw->row_first[j], last = sw->row_last[j];
+        if (ch == 1) {
+            for (i = 0; i < first && i < cols; i++) lr[i] = HFVIS__NAN;
+            for (i = first; i <= last; i++) lr[i] = isnan(hr[i]) ? HFVIS__NAN : 0.0;
+            for (i = last + 1 > first ? last + 1 : first; i < cols; i++) lr[i] = HFVIS__NAN;
+            continue;
+        }
+        for (i = 0; i < cols; i++) {
+            const double v = i >= first && i <= last && !isnan(hr[i]) ? 0.0 : HFVIS__NAN;
+            for (c = 0; c < ch; c++) lr[(size_t)i * (size_t)ch + (size_t)c] = v;
+        }
+    }
+}
+
 /* ========================================================================================== */
 /* 8. Horizon outputs and the ray-march oracles                                               */
 /* ========================================================================================== */
@@ -3156,7 +3181,7 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
     groups = K / per;
     for (gidx = 0; gidx < groups; gidx++) {
         double ux, uy;
-        int m0, any = 0, j;
+        int m0, any = 0;
         for (m = 0; m < per; m++) {
             int pos = hf_direction_position(o, K, gidx + m * groups);
             any |= pos >= begin && pos < end;
@@ -3164,16 +3189,7 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
         if (!any) continue;
         hf_direction_base(K, gidx, o->azimuth0_rad, &ux, &uy, &m0);
         hf_sweep_group(sw, ux, uy);
-        /* the accumulator: 0 at every in-domain node with a height, else NaN */
-        hf_lattice_fill(sw, HFVIS__NAN);
-        for (j = 0; j < sw->rows; j++) {
-            const double *hr = sw->h + (size_t)j * (size_t)sw->cols;
-            double *lr = sw->lat + (size_t)j * (size_t)sw->cols * (size_t)channels;
-            int i, c;
-            for (i = sw->row_first[j]; i <= sw->row_last[j]; i++)
-                if (!isnan(hr[i]))
-                    for (c = 0; c < channels; c++) lr[(size_t)i * (size_t)channels + (size_t)c] = 0.0;
-        }
+        hf_lattice_zero(sw);
         if (ctx->group) ctx->group(sw, ctx);
         for (m = 0; m < per; m++) {
             int k = gidx + m * groups, pos = hf_direction_position(o, K, k);
