@@ -2543,20 +2543,30 @@ static void hf_gather_accumulate(hf_sweep *sw)
     double v[4];
     hf_gather G;
     int tx, ty;
-    for (ty = sw->ry0; ty < sw->ry1; ty += HF_TILE)
-        for (tx = sw->rx0; tx < sw->rx1; tx += HF_TILE)
-    for (y = ty; y < sw->ry1 && y < ty + HF_TILE; y++) {
-        const float *zr = g->z + (ptrdiff_t)y * g->stride;
-        double *accr = sw->gacc + (size_t)y * (size_t)g->width * (size_t)ch;
-        const double ya = ((double)y + sw->oy) * L->uy, yb = ((double)y + sw->oy) * L->vy;
-        for (x = tx; x < sw->rx1 && x < tx + HF_TILE; x++) {
+    /* invariants in locals: the stores to acc (double) could alias the lattice's and the
+     * sweep's double fields, so the compiler reloaded them at every grid point */
+    const double ox = sw->ox, oy = sw->oy, ux = L->ux, uy = L->uy, vx = L->vx, vy = L->vy;
+    const int i_min = L->i_min, j_min = L->j_min, icols = sw->cols, rows = sw->rows;
+    const int rx0 = sw->rx0, rx1 = sw->rx1, ry0 = sw->ry0, ry1 = sw->ry1;
+    const float *z = g->z;
+    const ptrdiff_t zstride = g->stride;
+    double *gacc = sw->gacc;
+    const size_t gw = (size_t)g->width;
+    for (ty = ry0; ty < ry1; ty += HF_TILE)
+        for (tx = rx0; tx < rx1; tx += HF_TILE)
+    for (y = ty; y < ry1 && y < ty + HF_TILE; y++) {
+        const float *zr = z + (ptrdiff_t)y * zstride;
+        double *accr = gacc + (size_t)y * gw * (size_t)ch;
+        const double ya = ((double)y + oy) * uy, yb = ((double)y + oy) * vy;
+        const int xe = rx1 < tx + HF_TILE ? rx1 : tx + HF_TILE;
+        for (x = tx; x < xe; x++) {
             double *acc = accr + (size_t)x * (size_t)ch;
             double a, b, fa, fb, wa, wb, w[4], sum, wsum;
             const double *p;
             int ia, jb, q;
             if (!isfinite(zr[x])) continue;
-            a = ((double)x + sw->ox) * L->ux + ya;
-            b = ((double)x + sw->ox) * L->vx + yb;
+            a = ((double)x + ox) * ux + ya;
+            b = ((double)x + ox) * vx + yb;
             /* floor of a lattice coordinate (within the int range, hf_lattice_from_u) */
             ia = (int)a;
             ia -= (double)ia > a;
@@ -2564,9 +2574,9 @@ static void hf_gather_accumulate(hf_sweep *sw)
             jb -= (double)jb > b;
             fa = (double)ia;
             fb = (double)jb;
-            ia -= L->i_min;
-            jb -= L->j_min;
-            if (ia < 0 || jb < 0 || ia + 1 >= sw->cols || jb + 1 >= sw->rows) {
+            ia -= i_min;
+            jb -= j_min;
+            if (ia < 0 || jb < 0 || ia + 1 >= icols || jb + 1 >= rows) {
                 hf_gather_setup(sw, x, y, &G);
                 hf_gather_apply(sw, lat, ch, &G, v);
                 for (c = 0; c < ch; c++) acc[c] += v[c];
