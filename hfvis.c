@@ -2532,19 +2532,79 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
  * inside the lattice with some finite weight, is hf_gather_setup + hf_gather_apply written out
  * without the tap table: a tap with zero weight or a non-finite value adds +0.0 instead of being
  * skipped, which leaves every sum bit-identical (a sum started at +0.0 is never -0.0, and
- * x + 0.0 == x otherwise). Everything else takes the general routine. */
+ * x + 0.0 == x otherwise). Everything else takes the general routine.
+ * hf_gather_cell: the floor of the lattice coordinates (a, b) of a grid point (within the int
+ * range, hf_lattice_from_u), as buffer indices (ia, jb), and the fractions; 0 when the four taps
+ * are not all inside the lattice. */
+static inline int hf_gather_cell(double a, double b, int i_min, int j_min, int cols, int rows,
+                                 int *ia_out, int *jb_out, double *wa, double *wb)
+{
+    int ia = (int)a, jb = (int)b;
+    ia -= (double)ia > a;
+    jb -= (double)jb > b;
+    *wa = a - (double)ia;
+    *wb = b - (double)jb;
+    ia -= i_min;
+    jb -= j_min;
+    *ia_out = ia;
+    *jb_out = jb;
+    return ia >= 0 && jb >= 0 && ia + 1 < cols && jb + 1 < rows;
+}
+
+/* One grid point (x, y) at lattice coordinates (a, b), any channel count, added to acc. */
+static void hf_gather_point(const hf_sweep *sw, int x, int y, double a, double b, double *acc)
+{
+    const double *lat = sw->lat;
+    const ptrdiff_t cols = sw->cols;
+    const int ch = sw->channels;
+    double wa, wb, w[4], wq[4], wsum, sum, v[4];
+    const double *tp[4], *p;
+    int ia, jb, q, c;
+    if (!hf_gather_cell(a, b, sw->L.i_min, sw->L.j_min, sw->cols, sw->rows, &ia, &jb, &wa, &wb)) {
+        hf_gather G;
+        hf_gather_setup(sw, x, y, &G);
+        hf_gather_apply(sw, lat, ch, &G, v);
+        for (c = 0; c < ch; c++) acc[c] += v[c];
+        return;
+    }
+    w[0] = (1.0 - wa) * (1.0 - wb);
+    w[1] = wa * (1.0 - wb);
+    w[2] = (1.0 - wa) * wb;
+    w[3] = wa * wb;
+    p = lat + ((ptrdiff_t)jb * cols + ia) * ch;
+    tp[0] = p;
+    tp[1] = p + ch;
+    tp[2] = p + cols * ch;
+    tp[3] = p + (cols + 1) * ch;
+    wsum = 0.0;
+    for (q = 0; q < 4; q++) {
+        wq[q] = w[q] != 0.0 && isfinite(tp[q][0]) ? w[q] : 0.0;
+        wsum += wq[q];
+    }
+    if (!(wsum > 0.0)) {
+        hf_gather G;
+        hf_gather_setup(sw, x, y, &G);
+        hf_gather_apply(sw, lat, ch, &G, v);
+        for (c = 0; c < ch; c++) acc[c] += v[c];
+        return;
+    }
+    for (c = 0; c < ch; c++) {
+        sum = 0.0;
+        for (q = 0; q < 4; q++) sum += wq[q] != 0.0 ? wq[q] * tp[q][c] : 0.0;
+        acc[c] += wsum != 1.0 ? sum / wsum : sum;
+    }
+}
+
+/* The grid loop; one channel with its four taps inside and finite is summed here, everything
+ * else goes through hf_gather_point (out of line, so this loop keeps its invariants in
+ * registers). */
 static void hf_gather_accumulate(hf_sweep *sw)
 {
     const hfvis_grid *g = sw->g;
     const hfvis_lattice *L = &sw->L;
     const double *lat = sw->lat;
     const ptrdiff_t cols = sw->cols;
-    int x, y, c, ch = sw->channels;
-    double v[4];
-    hf_gather G;
-    int tx, ty;
-    /* invariants in locals: the stores to acc (double) could alias the lattice's and the
-     * sweep's double fields, so the compiler reloaded them at every grid point */
+    const int ch = sw->channels;
     const double ox = sw->ox, oy = sw->oy, ux = L->ux, uy = L->uy, vx = L->vx, vy = L->vy;
     const int i_min = L->i_min, j_min = L->j_min, icols = sw->cols, rows = sw->rows;
     const int rx0 = sw->rx0, rx1 = sw->rx1, ry0 = sw->ry0, ry1 = sw->ry1;
@@ -2552,6 +2612,7 @@ static void hf_gather_accumulate(hf_sweep *sw)
     const ptrdiff_t zstride = g->stride;
     double *gacc = sw->gacc;
     const size_t gw = (size_t)g->width;
+    int x, y, tx, ty;
     for (ty = ry0; ty < ry1; ty += HF_TILE)
         for (tx = rx0; tx < rx1; tx += HF_TILE)
     for (y = ty; y < ry1 && y < ty + HF_TILE; y++) {
@@ -2561,82 +2622,31 @@ static void hf_gather_accumulate(hf_sweep *sw)
         const int xe = rx1 < tx + HF_TILE ? rx1 : tx + HF_TILE;
         for (x = tx; x < xe; x++) {
             double *acc = accr + (size_t)x * (size_t)ch;
-            double a, b, fa, fb, wa, wb, w[4], sum, wsum;
+            double a, b, wa, wb, t0, t1, t2, t3, w0, w1, w2, w3;
             const double *p;
-            int ia, jb, q;
+            int ia, jb;
             if (!isfinite(zr[x])) continue;
             a = ((double)x + ox) * ux + ya;
             b = ((double)x + ox) * vx + yb;
-            /* floor of a lattice coordinate (within the int range, hf_lattice_from_u) */
-            ia = (int)a;
-            ia -= (double)ia > a;
-            jb = (int)b;
-            jb -= (double)jb > b;
-            fa = (double)ia;
-            fb = (double)jb;
-            ia -= i_min;
-            jb -= j_min;
-            if (ia < 0 || jb < 0 || ia + 1 >= icols || jb + 1 >= rows) {
-                hf_gather_setup(sw, x, y, &G);
-                hf_gather_apply(sw, lat, ch, &G, v);
-                for (c = 0; c < ch; c++) acc[c] += v[c];
-                continue;
-            }
-            wa = a - fa;
-            wb = b - fb;
-            w[0] = (1.0 - wa) * (1.0 - wb);
-            w[1] = wa * (1.0 - wb);
-            w[2] = (1.0 - wa) * wb;
-            w[3] = wa * wb;
-            p = lat + ((ptrdiff_t)jb * cols + ia) * ch;
-            if (ch == 1) {
-                double t0 = p[0], t1 = p[1], t2 = p[cols], t3 = p[cols + 1], w0, w1, w2, w3;
+            if (ch == 1 && hf_gather_cell(a, b, i_min, j_min, icols, rows, &ia, &jb, &wa, &wb)) {
+                p = lat + (ptrdiff_t)jb * cols + ia;
+                t0 = p[0];
+                t1 = p[1];
+                t2 = p[cols];
+                t3 = p[cols + 1];
                 if (isfinite(t0 + t1 + t2 + t3)) { /* all finite: w*t of w == 0 is a +-0 too */
-                    wsum = 0.0 + w[0] + w[1] + w[2] + w[3];
-                    sum = 0.0 + w[0] * t0 + w[1] * t1 + w[2] * t2 + w[3] * t3;
+                    double wsum, sum;
+                    w0 = (1.0 - wa) * (1.0 - wb);
+                    w1 = wa * (1.0 - wb);
+                    w2 = (1.0 - wa) * wb;
+                    w3 = wa * wb;
+                    wsum = 0.0 + w0 + w1 + w2 + w3;
+                    sum = 0.0 + w0 * t0 + w1 * t1 + w2 * t2 + w3 * t3;
                     acc[0] += wsum != 1.0 ? sum / wsum : sum;
                     continue;
                 }
-                w0 = w[0] != 0.0 && isfinite(t0) ? w[0] : 0.0;
-                w1 = w[1] != 0.0 && isfinite(t1) ? w[1] : 0.0;
-                w2 = w[2] != 0.0 && isfinite(t2) ? w[2] : 0.0;
-                w3 = w[3] != 0.0 && isfinite(t3) ? w[3] : 0.0;
-                wsum = 0.0 + w0 + w1 + w2 + w3;
-                if (!(wsum > 0.0)) {
-                    hf_gather_setup(sw, x, y, &G);
-                    hf_gather_apply(sw, lat, ch, &G, v);
-                    acc[0] += v[0];
-                    continue;
-                }
-                sum = 0.0 + (w0 != 0.0 ? w0 * t0 : 0.0) + (w1 != 0.0 ? w1 * t1 : 0.0) +
-                      (w2 != 0.0 ? w2 * t2 : 0.0) + (w3 != 0.0 ? w3 * t3 : 0.0);
-                acc[0] += wsum != 1.0 ? sum / wsum : sum;
-                continue;
             }
-            {
-                const double *tp[4];
-                double wq[4];
-                tp[0] = p;
-                tp[1] = p + ch;
-                tp[2] = p + cols * ch;
-                tp[3] = p + (cols + 1) * ch;
-                wsum = 0.0;
-                for (q = 0; q < 4; q++) {
-                    wq[q] = w[q] != 0.0 && isfinite(tp[q][0]) ? w[q] : 0.0;
-                    wsum += wq[q];
-                }
-                if (!(wsum > 0.0)) {
-                    hf_gather_setup(sw, x, y, &G);
-                    hf_gather_apply(sw, lat, ch, &G, v);
-                    for (c = 0; c < ch; c++) acc[c] += v[c];
-                    continue;
-                }
-                for (c = 0; c < ch; c++) {
-                    sum = 0.0;
-                    for (q = 0; q < 4; q++) sum += wq[q] != 0.0 ? wq[q] * tp[q][c] : 0.0;
-                    acc[c] += wsum != 1.0 ? sum / wsum : sum;
-                }
-            }
+            hf_gather_point(sw, x, y, a, b, acc);
         }
     }
 }
