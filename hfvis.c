@@ -1545,15 +1545,18 @@ typedef struct hf_win {
     int *log_top;           /* ... and the stack height before it */
 } hf_win;
 
-/* Bytes of the hf_win of lines of n samples. */
-#define HF_WIN_BYTES_PER_SAMPLE (10u * sizeof(double) + sizeof(int64_t) + sizeof(int))
+/* Bytes of the hf_win of lines of n >= 2 samples (ten doubles a sample, and the two NaN slots
+ * below the prefix stack that hf_hull_step reads, within an eleventh). */
+#define HF_WIN_BYTES_PER_SAMPLE (11u * sizeof(double) + sizeof(int64_t) + sizeof(int))
 
 static void hf_win_carve(hf_win *w, unsigned char *b, size_t n)
 {
+    HFVIS_ASSERT(n >= 2);
     w->d = (double *)(void *)b;
     w->h = w->d + n;
     w->t = w->h + n;
-    w->ph = w->t + n;
+    w->t[n] = w->t[n + 1] = HFVIS__NAN; /* ph[-2], ph[-1] */
+    w->ph = w->t + n + 2;
     w->pd = w->ph + n;
     w->sm = w->pd + n;
     w->sh = w->sm + n;
@@ -1789,9 +1792,9 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     off_h = hf_align_add(&total, nodes, sizeof(double), &ok);
     if (want_normals) off_n = hf_align_add(&total, nodes, 3 * sizeof(float), &ok);
     off_lat = hf_align_add(&total, nodes, (size_t)channels * sizeof(double), &ok);
-    off_lh = hf_align_add(&total, linelen, sizeof(double), &ok);
+    off_lh = hf_align_add(&total, linelen + 2, sizeof(double), &ok); /* + the hull's NaN slots */
     off_lt = hf_align_add(&total, linelen, sizeof(double), &ok);
-    off_stk = hf_align_add(&total, linelen, sizeof(double), &ok);
+    off_stk = hf_align_add(&total, linelen + 2, sizeof(double), &ok);
     if (want_normals) off_gn = hf_align_add(&total, gridn, 3 * sizeof(float), &ok);
     if (want_gacc) off_ga = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
     if (extra_size) off_x = hf_align_add(&total, extra_size, 1, &ok);
@@ -1808,9 +1811,11 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     sw->h = (double *)(void *)(b + off_h);
     sw->nrm = want_normals ? (float *)(void *)(b + off_n) : NULL;
     sw->lat = (double *)(void *)(b + off_lat);
-    sw->lh = (double *)(void *)(b + off_lh);
+    sw->lh = (double *)(void *)(b + off_lh) + 2;
+    sw->lh[-2] = sw->lh[-1] = HFVIS__NAN; /* below the hull stack (hf_hull_step) */
     sw->lt = (double *)(void *)(b + off_lt);
-    sw->sd = (double *)(void *)(b + off_stk);
+    sw->sd = (double *)(void *)(b + off_stk) + 2;
+    sw->sd[-2] = sw->sd[-1] = HFVIS__NAN;
     sw->grid_nrm = want_normals ? (float *)(void *)(b + off_gn) : NULL;
     sw->gacc = want_gacc ? (double *)(void *)(b + off_ga) : NULL;
     sw->extra = extra_size ? b + off_x : NULL;
@@ -2059,17 +2064,33 @@ typedef void (*hf_line_fn)(hf_sweep *sw, void *ctx, int m, ptrdiff_t node0, ptrd
 /* One step of the hull stack (sh, sd, top) for the sample (d, h) ([P1] Alg. 1; docs/errata.md E1, E2, the arithmetic of
  * hfvis_line_horizons with distance = node index): pop while the second entry is seen at least as
  * high, then return the tangent to the top (-inf on an empty stack) and push. (Pop decisions
- * taken without branches measured slower: they chain every step on the previous one's loads.) */
-static inline double hf_hull_step(double *sh, double *sd, int *top_io, double h, double d)
+ * taken without branches measured slower: they chain every step on the previous one's loads.)
+ * sh[-2] and sh[-1] are NaN and sd[-2], sd[-1] readable: with fewer than two entries the test
+ * reads a NaN and fails, as top >= 2 would (h is not NaN), one compare and branch less a test. */
+static inline double hf_hull_step(double *sh, double *sd, ptrdiff_t *top_io, double h, double d)
 {
-    int top = *top_io;
-    double t;
-    while (top >= 2 && (sh[top - 2] - h) * (d - sd[top - 1]) >= (sh[top - 1] - h) * (d - sd[top - 2]))
-        top--;
-    t = top ? (sh[top - 1] - h) / (d - sd[top - 1]) : -HFVIS__INF;
-    sd[top] = d;
-    sh[top++] = h;
-    *top_io = top;
+    ptrdiff_t k = *top_io;
+    double t, a1 = sh[k - 1] - h, b1 = d - sd[k - 1], a2, b2;
+    for (;;) { /* two tests a round, the top's differences alternating between (a1, b1) and (a2, b2) */
+        a2 = sh[k - 2] - h;
+        b2 = d - sd[k - 2];
+        if (!(a2 * b1 >= a1 * b2)) {
+            t = a1 / b1;
+            break;
+        }
+        k--;
+        a1 = sh[k - 2] - h;
+        b1 = d - sd[k - 2];
+        if (!(a1 * b2 >= a2 * b1)) {
+            t = a2 / b2;
+            break;
+        }
+        k--;
+    }
+    if (k == 0) t = -HFVIS__INF;
+    sd[k] = d;
+    sh[k] = h;
+    *top_io = k + 1;
     return t;
 }
 
@@ -2084,7 +2105,8 @@ static void hf_window_line(const hf_win *w, int n, int64_t Rw, int qfrom, const 
     double *t = w->t, *ph = w->ph, *pd = w->pd, *sm = w->sm, dend = 0.0;
     double *sh = w->sh, *sd = w->sd, *lh = w->log_h, *ld = w->log_d;
     int *lt = w->log_top;
-    int i, ptop = 0, stop = 0, nlog = 0, cstart = 0, have = 0, wi = 0, wend = 0;
+    int i, stop = 0, nlog = 0, cstart = 0, have = 0, wi = 0, wend = 0;
+    ptrdiff_t ptop = 0;
     int64_t cb = 0, next = 0; /* the current block and the start of the next one */
     for (i = 0; i < n; i++) {
         double hi = h[i], di = d[i], tp;
@@ -2174,12 +2196,13 @@ static void hf_window_line(const hf_win *w, int n, int64_t Rw, int qfrom, const 
 /* Pre-roll (docs/errata.md E8): R lattice nodes before the first in-domain node (i0, j0) of a line with
  * lattice step (di, dj), sampled with the border rule, at distances -R..-1; they occlude but
  * receive nothing. Returns the stack height. */
-static int hf_preroll(const hf_sweep *sw, int i0, int j0, int di, int dj, double *sh, double *sd)
+static ptrdiff_t hf_preroll(const hf_sweep *sw, int i0, int j0, int di, int dj, double *sh, double *sd)
 {
     const hfvis_lattice *L = &sw->L;
     const int R = sw->preroll;
     const double inv_cs = 1.0 / sw->g->cell_size;
-    int r, top = 0;
+    int r;
+    ptrdiff_t top = 0;
     for (r = 0; r < R; r++) {
         double x, y, h;
         hf_node_pos(L, i0 - (R - r) * di + L->i_min, j0 - (R - r) * dj + L->j_min, &x, &y);
@@ -2253,6 +2276,10 @@ static int hf_line_rect(const hf_sweep *sw, int i0, int j0, int di, int dj, int 
     return 1;
 }
 
+static inline double hf_svf_term(double t);
+static void hf_svf_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdiff_t step, int n,
+                        const double *t);
+
 /* Run orientation m of the current group: copy each line (with its pre-roll) out of the
  * sampled lattice, find the horizons, hand them to fn. brute = 1 uses the oracle. (Sweeping
  * columns several side by side, so each row step reads whole cache lines, measured no faster:
@@ -2265,8 +2292,8 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
     const double inv_cs = 1.0 / sw->g->cell_size;
     double *sd = sw->sd, *sh = sw->lh, *t = sw->lt;
     for (line = 0; line < nlines; line++) {
-        ptrdiff_t node0, step, p;
-        int i0, j0, di, dj, n, s, r, top = 0;
+        ptrdiff_t node0, step, p, top = 0;
+        int i0, j0, di, dj, n, s, r;
         int slo = 0, shi;
         n = hf_line_span(sw, m, line, &node0, &step, &i0, &j0, &di, &dj);
         if (n == 0) continue;
@@ -2290,13 +2317,31 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
             continue;
         }
         if (R > 0) top = hf_preroll(sw, i0, j0, di, dj, sh, sd);
-        for (s = 0, p = node0; s <= shi; s++, p += step) {
-            double h = sw->h[p];
-            if (isnan(h)) {
-                t[s] = HFVIS__NAN;
-                continue;
+        if (fn == hf_svf_line) {
+            /* the sky-view factor's consumer inline: each node's term added as its tangent is
+             * found (the same additions in the same order as hf_svf_line's) */
+            const double *hv = sw->h;
+            double *lat = sw->lat, ds = 0.0; /* ds == s (integers, exact) */
+            for (s = 0, p = node0; s < slo; s++, p += step, ds += 1.0) /* occluders only */
+                if (!isnan(hv[p])) (void)hf_hull_step(sh, sd, &top, hv[p], ds);
+            for (; s <= shi; s++, p += step, ds += 1.0) {
+                double h = hv[p];
+                if (isnan(h)) continue;
+                lat[p] += hf_svf_term(hf_hull_step(sh, sd, &top, h, ds));
             }
-            t[s] = hf_hull_step(sh, sd, &top, h, (double)s);
+            continue;
+        }
+        {
+            const double *hv = sw->h;
+            double ds = 0.0;
+            for (s = 0, p = node0; s <= shi; s++, p += step, ds += 1.0) {
+                double h = hv[p];
+                if (isnan(h)) {
+                    t[s] = HFVIS__NAN;
+                    continue;
+                }
+                t[s] = hf_hull_step(sh, sd, &top, h, ds);
+            }
         }
         for (s = 0; s < slo; s++) t[s] = HFVIS__NAN; /* far from every receiver */
         fn(sw, ctx, m, node0, step, shi + 1, t);
