@@ -2585,10 +2585,17 @@ static inline int hf_gather_cell(double a, double b, int i_min, int j_min, int c
                                  int *ia_out, int *jb_out, double *wa, double *wb)
 {
     int ia = (int)a, jb = (int)b;
-    ia -= (double)ia > a;
-    jb -= (double)jb > b;
-    *wa = a - (double)ia;
-    *wb = b - (double)jb;
+    double fa = (double)ia, fb = (double)jb;
+    if (fa > a) { /* truncated up (a < 0): one less; fa - 1.0 is exact */
+        ia--;
+        fa -= 1.0;
+    }
+    if (fb > b) {
+        jb--;
+        fb -= 1.0;
+    }
+    *wa = a - fa;
+    *wb = b - fb;
     ia -= i_min;
     jb -= j_min;
     *ia_out = ia;
