@@ -2067,10 +2067,11 @@ typedef void (*hf_line_fn)(hf_sweep *sw, void *ctx, int m, ptrdiff_t node0, ptrd
  * taken without branches measured slower: they chain every step on the previous one's loads.)
  * sh[-2] and sh[-1] are NaN and sd[-2], sd[-1] readable: with fewer than two entries the test
  * reads a NaN and fails, as top >= 2 would (h is not NaN), one compare and branch less a test. */
-static inline double hf_hull_step(double *sh, double *sd, ptrdiff_t *top_io, double h, double d)
+static inline double hf_hull_push(double *sh, double *sd, ptrdiff_t *top_io, double h, double d,
+                                  double a1, double b1)
 {
     ptrdiff_t k = *top_io;
-    double t, a1 = sh[k - 1] - h, b1 = d - sd[k - 1], a2, b2;
+    double t, a2, b2;
     for (;;) { /* two tests a round, the top's differences alternating between (a1, b1) and (a2, b2) */
         a2 = sh[k - 2] - h;
         b2 = d - sd[k - 2];
@@ -2092,6 +2093,16 @@ static inline double hf_hull_step(double *sh, double *sd, ptrdiff_t *top_io, dou
     sh[k] = h;
     *top_io = k + 1;
     return t;
+}
+
+/* The step with the top's differences read from the stack. hf_hull_push takes them from the
+ * caller: when the top is the line's previous node (the step before pushed it, one unit back),
+ * they are (h_prev - h, 1.0) exactly, and the compiler drops the product by b1 and, when nothing
+ * pops, the division. */
+static inline double hf_hull_step(double *sh, double *sd, ptrdiff_t *top_io, double h, double d)
+{
+    const ptrdiff_t k = *top_io;
+    return hf_hull_push(sh, sd, top_io, h, d, sh[k - 1] - h, d - sd[k - 1]);
 }
 
 /* Tangents t[i] = max over j < i with pos[i] - pos[j] <= Rw of (h[j] - h[i])/(d[i] - d[j])
@@ -2324,23 +2335,41 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
             double *lat = sw->lat, ds = 0.0; /* ds == s (integers, exact) */
             for (s = 0, p = node0; s < slo; s++, p += step, ds += 1.0) /* occluders only */
                 if (!isnan(hv[p])) (void)hf_hull_step(sh, sd, &top, hv[p], ds);
-            for (; s <= shi; s++, p += step, ds += 1.0) {
-                double h = hv[p];
-                if (isnan(h)) continue;
+            while (s <= shi) { /* a run of nodes without holes: the inner loop */
+                double h = hv[p], hp;
+                if (isnan(h)) {
+                    s++, p += step, ds += 1.0;
+                    continue;
+                }
                 lat[p] += hf_svf_term(hf_hull_step(sh, sd, &top, h, ds));
+                for (hp = h, s++, p += step, ds += 1.0; s <= shi; s++, p += step, ds += 1.0) {
+                    h = hv[p];
+                    if (isnan(h)) break;
+                    lat[p] += hf_svf_term(hf_hull_push(sh, sd, &top, h, ds, hp - h, 1.0));
+                    hp = h;
+                }
             }
             continue;
         }
         {
             const double *hv = sw->h;
             double ds = 0.0;
-            for (s = 0, p = node0; s <= shi; s++, p += step, ds += 1.0) {
-                double h = hv[p];
+            s = 0;
+            p = node0;
+            while (s <= shi) { /* as in the sky-view factor's walk above */
+                double h = hv[p], hp;
                 if (isnan(h)) {
                     t[s] = HFVIS__NAN;
+                    s++, p += step, ds += 1.0;
                     continue;
                 }
                 t[s] = hf_hull_step(sh, sd, &top, h, ds);
+                for (hp = h, s++, p += step, ds += 1.0; s <= shi; s++, p += step, ds += 1.0) {
+                    h = hv[p];
+                    if (isnan(h)) break;
+                    t[s] = hf_hull_push(sh, sd, &top, h, ds, hp - h, 1.0);
+                    hp = h;
+                }
             }
         }
         for (s = 0; s < slo; s++) t[s] = HFVIS__NAN; /* far from every receiver */
