@@ -2063,16 +2063,18 @@ typedef void (*hf_line_fn)(hf_sweep *sw, void *ctx, int m, ptrdiff_t node0, ptrd
 
 /* One step of the hull stack (sh, sd, top) for the sample (d, h) ([P1] Alg. 1; docs/errata.md E1, E2, the arithmetic of
  * hfvis_line_horizons with distance = node index): pop while the second entry is seen at least as
- * high, then return the tangent to the top (-inf on an empty stack) and push. (Pop decisions
- * taken without branches measured slower: they chain every step on the previous one's loads.)
- * sh[-2] and sh[-1] are NaN and sd[-2], sd[-1] readable: with fewer than two entries the test
- * reads a NaN and fails, as top >= 2 would (h is not NaN), one compare and branch less a test. */
+ * high, then return the tangent to the top and push. (Pop decisions taken without branches
+ * measured slower: they chain every step on the previous one's loads.) (a1, b1) are the top's
+ * differences (sh[top-1] - h, d - sd[top-1]); the stack is not empty (hf_hull_step answers -inf
+ * for an empty one). sh[-2] and sh[-1] are NaN and sd[-2], sd[-1] readable: with one entry the
+ * test reads a NaN and fails, as top >= 2 would (h is not NaN), one compare and branch less a
+ * test. Two tests a round, the top's differences alternating between (a1, b1) and (a2, b2). */
 static inline double hf_hull_push(double *sh, double *sd, ptrdiff_t *top_io, double h, double d,
                                   double a1, double b1)
 {
     ptrdiff_t k = *top_io;
     double t, a2, b2;
-    for (;;) { /* two tests a round, the top's differences alternating between (a1, b1) and (a2, b2) */
+    for (;;) {
         a2 = sh[k - 2] - h;
         b2 = d - sd[k - 2];
         if (!(a2 * b1 >= a1 * b2)) {
@@ -2088,7 +2090,6 @@ static inline double hf_hull_push(double *sh, double *sd, ptrdiff_t *top_io, dou
         }
         k--;
     }
-    if (k == 0) t = -HFVIS__INF;
     sd[k] = d;
     sh[k] = h;
     *top_io = k + 1;
@@ -2102,7 +2103,8 @@ static inline double hf_hull_push(double *sh, double *sd, ptrdiff_t *top_io, dou
 static inline double hf_hull_step(double *sh, double *sd, ptrdiff_t *top_io, double h, double d)
 {
     const ptrdiff_t k = *top_io;
-    return hf_hull_push(sh, sd, top_io, h, d, sh[k - 1] - h, d - sd[k - 1]);
+    const double t = hf_hull_push(sh, sd, top_io, h, d, sh[k - 1] - h, d - sd[k - 1]);
+    return k ? t : -HFVIS__INF; /* an empty stack: nothing behind */
 }
 
 /* Tangents t[i] = max over j < i with pos[i] - pos[j] <= Rw of (h[j] - h[i])/(d[i] - d[j])
