@@ -3229,13 +3229,17 @@ static void hf_sky_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdif
                         const double *t)
 {
     const hf_sky_ctx *c = (const hf_sky_ctx *)vctx;
+    /* in locals: the store to lat could alias the context, so gcc reloaded them at every node */
+    const double lx = c->f.lx, ly = c->f.ly, inv_k = c->inv_k, lobe = c->lobe;
+    const float *nrm = sw->nrm;
+    double *lat = sw->lat;
     int s;
     (void)m;
     for (s = 0; s < n; s++, node0 += step) {
-        const float *nr = sw->nrm + node0 * 3;
-        double a = (double)nr[0] * c->f.lx + (double)nr[1] * c->f.ly;
+        const float *nr = nrm + node0 * 3;
+        double a = (double)nr[0] * lx + (double)nr[1] * ly;
         if (isnan(t[s])) continue;
-        sw->lat[node0] += hf_sky_term(t[s], (double)nr[2], a, c->inv_k, c->lobe);
+        lat[node0] += hf_sky_term(t[s], (double)nr[2], a, inv_k, lobe);
     }
 }
 
