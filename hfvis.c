@@ -2579,10 +2579,17 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
     double v[4], lx[4], ly[4];
     double xmax = (sw->ext_w - 1.0) + HF_LATTICE_EPS, ymax = (sw->ext_h - 1.0) + HF_LATTICE_EPS;
     hf_gather G;
+    /* The open border's test can fire only within one cell of the raster's edge: a point at
+     * least one cell inside (raster column in [1, ext_w - 2], row likewise) plus a look
+     * direction of components in [-1, 1] stays inside (the rounding of the sum is monotone). */
+    const int open = sw->border == HFVIS_BORDER_OPEN;
+    const double in_x0 = 1.0 - sw->ox, in_x1 = (sw->ext_w - 2.0) - sw->ox; /* exact integers */
+    const double in_y0 = 1.0 - sw->oy, in_y1 = (sw->ext_h - 2.0) - sw->oy;
     for (c = 0; c < ch; c++) hf_look_dir(sw, m_first + c, &lx[c], &ly[c]);
     for (ty = sw->ry0; ty < sw->ry1; ty += HF_TILE)
         for (tx = sw->rx0; tx < sw->rx1; tx += HF_TILE)
-    for (y = ty; y < sw->ry1 && y < ty + HF_TILE; y++)
+    for (y = ty; y < sw->ry1 && y < ty + HF_TILE; y++) {
+        const int edge_row = open && !((double)y >= in_y0 && (double)y <= in_y1);
         for (x = tx; x < sw->rx1 && x < tx + HF_TILE; x++) {
             ptrdiff_t o = (ptrdiff_t)y * out_stride + x;
             if (hf_is_hole(g, x, y)) {
@@ -2593,15 +2600,23 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
                 hf_gather_setup(sw, x, y, &G);
                 hf_gather_elevations(sw, ch, &G, v);
             }
-            for (c = 0; c < ch; c++) {
-                if (sw->border == HFVIS_BORDER_OPEN) { /* the raster's border (tiles) */
+            if (edge_row || (open && !((double)x >= in_x0 && (double)x <= in_x1)))
+                for (c = 0; c < ch; c++) { /* the raster's border (tiles) */
                     double nx = ((double)x + sw->ox) + lx[c], ny = ((double)y + sw->oy) + ly[c];
                     if (nx < -HF_LATTICE_EPS || ny < -HF_LATTICE_EPS || nx > xmax || ny > ymax)
                         v[c] = -HFVIS__HALF_PI;
                 }
-                out[(size_t)c * plane_step + (size_t)o] = (float)v[c];
+            if (ch == 4) { /* a group's four quarter turns, the common case, unrolled */
+                float *q = out + o;
+                q[0] = (float)v[0];
+                q[plane_step] = (float)v[1];
+                q[2 * plane_step] = (float)v[2];
+                q[3 * plane_step] = (float)v[3];
+            } else {
+                for (c = 0; c < ch; c++) out[(size_t)c * plane_step + (size_t)o] = (float)v[c];
             }
         }
+    }
 }
 
 /* Gather the lattice accumulator into the grid accumulator. The common case, all four taps
@@ -3335,13 +3350,17 @@ static void hf_sky_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdif
                         const double *t)
 {
     const hf_sky_ctx *c = (const hf_sky_ctx *)vctx;
+    /* in locals: the store to lat could alias the context, so gcc reloaded them at every node */
+    const double lx = c->f.lx, ly = c->f.ly, inv_k = c->inv_k, lobe = c->lobe;
+    const float *nrm = sw->nrm;
+    double *lat = sw->lat;
     int s;
     (void)m;
     for (s = 0; s < n; s++, node0 += step) {
-        const float *nr = sw->nrm + node0 * 3;
-        double a = (double)nr[0] * c->f.lx + (double)nr[1] * c->f.ly;
+        const float *nr = nrm + node0 * 3;
+        double a = (double)nr[0] * lx + (double)nr[1] * ly;
         if (isnan(t[s])) continue;
-        sw->lat[node0] += hf_sky_term(t[s], (double)nr[2], a, c->inv_k, c->lobe);
+        lat[node0] += hf_sky_term(t[s], (double)nr[2], a, inv_k, lobe);
     }
 }
 
