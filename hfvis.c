@@ -2292,6 +2292,64 @@ static int hf_line_rect(const hf_sweep *sw, int i0, int j0, int di, int dj, int 
 static inline double hf_svf_term(double t);
 static void hf_svf_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdiff_t step, int n,
                         const double *t);
+static inline double hf_sky_term(double t, double nz, double a, double inv_k, double lobe);
+static void hf_sky_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdiff_t step, int n,
+                        const double *t);
+static void hf_sky_constants(const void *vctx, double c[4]);
+
+/* What the line walk does with each tangent t at node p (s-th of the line). The kind is a
+ * constant at each call of hf_walk_line, so the compiler writes one walk per kind. The two sums
+ * add each term as hf_svf_line and hf_sky_line would (the same additions in the same order), so
+ * their tangents are never stored and read back. */
+enum { HF_WALK_STORE, HF_WALK_SVF, HF_WALK_SKY };
+
+static HFVIS__ALWAYS_INLINE void hf_walk_emit(int kind, double *lat, const float *nrm, const double sky[4],
+                                double *t, int s, ptrdiff_t p, double tan)
+{
+    if (kind == HF_WALK_STORE) {
+        t[s] = tan;
+    } else if (kind == HF_WALK_SVF) {
+        lat[p] += hf_svf_term(tan); /* a NaN tan (overflowing heights) adds 0; hf_svf_line skips it */
+    } else if (!isnan(tan)) {
+        const float *nr = nrm + p * 3;
+        double a = (double)nr[0] * sky[0] + (double)nr[1] * sky[1];
+        lat[p] += hf_sky_term(tan, (double)nr[2], a, sky[2], sky[3]);
+    }
+}
+
+/* The unlimited hull walk along one line (hull stack sh, sd of height top after the pre-roll):
+ * nodes s < slo only occlude (their t is NaN), nodes slo..shi receive. The line is walked in runs
+ * of nodes without holes; inside a run the hull's top is the previous node one unit back, so
+ * hf_hull_push gets its differences as (h_prev - h, 1.0) and, with no pop, the division by 1.0
+ * drops out (the same bits as hf_hull_step). */
+static HFVIS__ALWAYS_INLINE void hf_walk_line(hf_sweep *sw, int kind, const double sky[4], ptrdiff_t node0,
+                                ptrdiff_t step, int slo, int shi, ptrdiff_t top, double *t)
+{
+    double *sd = sw->sd, *sh = sw->lh, *lat = sw->lat, ds = 0.0; /* ds == s (integers, exact) */
+    const double *hv = sw->h;
+    const float *nrm = sw->nrm;
+    ptrdiff_t p = node0;
+    int s;
+    for (s = 0; s < slo; s++, p += step, ds += 1.0) { /* occluders only */
+        if (!isnan(hv[p])) (void)hf_hull_step(sh, sd, &top, hv[p], ds);
+        if (kind == HF_WALK_STORE) t[s] = HFVIS__NAN; /* far from every receiver */
+    }
+    while (s <= shi) { /* a run of nodes without holes: the inner loop */
+        double h = hv[p], hp;
+        if (isnan(h)) {
+            if (kind == HF_WALK_STORE) t[s] = HFVIS__NAN;
+            s++, p += step, ds += 1.0;
+            continue;
+        }
+        hf_walk_emit(kind, lat, nrm, sky, t, s, p, hf_hull_step(sh, sd, &top, h, ds));
+        for (hp = h, s++, p += step, ds += 1.0; s <= shi; s++, p += step, ds += 1.0) {
+            h = hv[p];
+            if (isnan(h)) break;
+            hf_walk_emit(kind, lat, nrm, sky, t, s, p, hf_hull_push(sh, sd, &top, h, ds, hp - h, 1.0));
+            hp = h;
+        }
+    }
+}
 
 /* Run orientation m of the current group: copy each line (with its pre-roll) out of the
  * sampled lattice, find the horizons, hand them to fn. brute = 1 uses the oracle. (Sweeping
@@ -2331,51 +2389,15 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
         }
         if (R > 0) top = hf_preroll(sw, i0, j0, di, dj, sh, sd);
         if (fn == hf_svf_line) {
-            /* the sky-view factor's consumer inline: each node's term added as its tangent is
-             * found (the same additions in the same order as hf_svf_line's) */
-            const double *hv = sw->h;
-            double *lat = sw->lat, ds = 0.0; /* ds == s (integers, exact) */
-            for (s = 0, p = node0; s < slo; s++, p += step, ds += 1.0) /* occluders only */
-                if (!isnan(hv[p])) (void)hf_hull_step(sh, sd, &top, hv[p], ds);
-            while (s <= shi) { /* a run of nodes without holes: the inner loop */
-                double h = hv[p], hp;
-                if (isnan(h)) {
-                    s++, p += step, ds += 1.0;
-                    continue;
-                }
-                lat[p] += hf_svf_term(hf_hull_step(sh, sd, &top, h, ds));
-                for (hp = h, s++, p += step, ds += 1.0; s <= shi; s++, p += step, ds += 1.0) {
-                    h = hv[p];
-                    if (isnan(h)) break;
-                    lat[p] += hf_svf_term(hf_hull_push(sh, sd, &top, h, ds, hp - h, 1.0));
-                    hp = h;
-                }
-            }
-            continue;
+            hf_walk_line(sw, HF_WALK_SVF, NULL, node0, step, slo, shi, top, t);
+        } else if (fn == hf_sky_line) {
+            double sky[4];
+            hf_sky_constants(ctx, sky);
+            hf_walk_line(sw, HF_WALK_SKY, sky, node0, step, slo, shi, top, t);
+        } else {
+            hf_walk_line(sw, HF_WALK_STORE, NULL, node0, step, slo, shi, top, t);
+            fn(sw, ctx, m, node0, step, shi + 1, t);
         }
-        {
-            const double *hv = sw->h;
-            double ds = 0.0;
-            s = 0;
-            p = node0;
-            while (s <= shi) { /* as in the sky-view factor's walk above */
-                double h = hv[p], hp;
-                if (isnan(h)) {
-                    t[s] = HFVIS__NAN;
-                    s++, p += step, ds += 1.0;
-                    continue;
-                }
-                t[s] = hf_hull_step(sh, sd, &top, h, ds);
-                for (hp = h, s++, p += step, ds += 1.0; s <= shi; s++, p += step, ds += 1.0) {
-                    h = hv[p];
-                    if (isnan(h)) break;
-                    t[s] = hf_hull_push(sh, sd, &top, h, ds, hp - h, 1.0);
-                    hp = h;
-                }
-            }
-        }
-        for (s = 0; s < slo; s++) t[s] = HFVIS__NAN; /* far from every receiver */
-        fn(sw, ctx, m, node0, step, shi + 1, t);
     }
 }
 
@@ -3345,6 +3367,16 @@ typedef struct hf_sky_ctx {
     hf_fused f;
     double inv_k, lobe;
 } hf_sky_ctx;
+
+/* The sky term's constants for hf_walk_line: look direction, 1/K, the lobe factor. */
+static void hf_sky_constants(const void *vctx, double c[4])
+{
+    const hf_sky_ctx *sc = (const hf_sky_ctx *)vctx;
+    c[0] = sc->f.lx;
+    c[1] = sc->f.ly;
+    c[2] = sc->inv_k;
+    c[3] = sc->lobe;
+}
 
 static void hf_sky_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdiff_t step, int n,
                         const double *t)

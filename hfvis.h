@@ -5789,6 +5789,14 @@ HFVIS_API hfvis_status hfvis_lk_image(hfvis_lk_method method, const hfvis_mesh *
 #endif
 #endif
 
+/* An inner-loop helper forced inline (GCC, Clang), else left to the compiler: the hot loops
+ * that pass a constant to one (hf_walk_line's kind) or reload stored values (voxel.c) rely on it. */
+#if defined(__GNUC__)
+#define HFVIS__ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define HFVIS__ALWAYS_INLINE inline
+#endif
+
 #define HFVIS__PI 3.14159265358979323846
 #define HFVIS__HALF_PI 1.57079632679489661923
 #define HFVIS__NAN ((double)NAN)

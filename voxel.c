@@ -2206,11 +2206,7 @@ HFVIS_API hfvis_status hfvis_rasterize_reference(const hfvis_mesh *mesh, const h
  * off-plane rounding of a computed hit point (about gamma * box size) near box faces. */
 #define VX_BVH_PAD 0x1p-18
 /* The two inner-loop tests are forced inline (GCC/Clang), else left to the compiler. */
-#if defined(__GNUC__)
-#define VX_BVH_INLINE inline __attribute__((always_inline))
-#else
-#define VX_BVH_INLINE inline
-#endif
+#define VX_BVH_INLINE HFVIS__ALWAYS_INLINE
 /* SAH constants ([LK] §6; docs/errata.md E46: C_trav = C_tri = 1). */
 #define VX_BVH_C_TRAV 1.0
 #define VX_BVH_C_TRI 1.0
@@ -8789,11 +8785,7 @@ HFVIS_API hfvis_status hfvis_visfield_load(const char *path, const hfvis_allocat
 
 /* The per-voxel tail of the fast kernel is forced inline: called out of line, its vector loads
  * of the just-stored accumulators miss store-to-load forwarding (a 2x slowdown measured). */
-#if defined(__GNUC__)
-#define VX_GI_INLINE static inline __attribute__((always_inline))
-#else
-#define VX_GI_INLINE static
-#endif
+#define VX_GI_INLINE static HFVIS__ALWAYS_INLINE
 
 /* ---- GI.1 2-band SH (hfvis.h conventions: real, orthonormal, no Condon-Shortley phase, index l(l+1)+m:
  *      0 = Y00, 1 = y, 2 = z, 3 = x) ------------------------------------------------------ */
