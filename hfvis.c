@@ -2549,6 +2549,31 @@ static void hf_gather_elevations(const hf_sweep *sw, int ch, const hf_gather *G,
     }
 }
 
+/* The floor of the lattice coordinates (a, b) of a grid point (within the int range,
+ * hf_lattice_from_u), as buffer indices (ia, jb), and the fractions; 0 when the four taps are
+ * not all inside the lattice. */
+static inline int hf_gather_cell(double a, double b, int i_min, int j_min, int cols, int rows,
+                                 int *ia_out, int *jb_out, double *wa, double *wb)
+{
+    int ia = (int)a, jb = (int)b;
+    double fa = (double)ia, fb = (double)jb;
+    if (fa > a) { /* truncated up (a < 0): one less; fa - 1.0 is exact */
+        ia--;
+        fa -= 1.0;
+    }
+    if (fb > b) {
+        jb--;
+        fb -= 1.0;
+    }
+    *wa = a - fa;
+    *wb = b - fb;
+    ia -= i_min;
+    jb -= j_min;
+    *ia_out = ia;
+    *jb_out = jb;
+    return ia >= 0 && jb >= 0 && ia + 1 < cols && jb + 1 < rows;
+}
+
 /* hf_gather_elevations' common case written out (as in hf_gather_accumulate): all four taps
  * inside the lattice and every channel's four values finite and above -pi/2. A tap of weight 0
  * then adds a +-0 where the general routine skips it, which leaves the sums bit-identical (they
@@ -2561,14 +2586,8 @@ static int hf_gather_elevations_inside(const hf_sweep *sw, int ch, int x, int y,
     double wa, wb, w0, w1, w2, w3, wsum;
     const double *p;
     ptrdiff_t cols = sw->cols;
-    int ia = (int)a, jb = (int)b, c;
-    ia -= (double)ia > a; /* floor of a lattice coordinate (within the int range) */
-    jb -= (double)jb > b;
-    wa = a - (double)ia;
-    wb = b - (double)jb;
-    ia -= L->i_min;
-    jb -= L->j_min;
-    if (ia < 0 || jb < 0 || ia + 1 >= sw->cols || jb + 1 >= sw->rows) return 0;
+    int ia, jb, c;
+    if (!hf_gather_cell(a, b, L->i_min, L->j_min, sw->cols, sw->rows, &ia, &jb, &wa, &wb)) return 0;
     p = sw->lat + ((ptrdiff_t)jb * cols + ia) * ch;
     for (c = 0; c < ch; c++) {
         double t0 = p[c], t1 = p[ch + c], t2 = p[cols * ch + c], t3 = p[(cols + 1) * ch + c];
@@ -2645,32 +2664,7 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
  * inside the lattice with some finite weight, is hf_gather_setup + hf_gather_apply written out
  * without the tap table: a tap with zero weight or a non-finite value adds +0.0 instead of being
  * skipped, which leaves every sum bit-identical (a sum started at +0.0 is never -0.0, and
- * x + 0.0 == x otherwise). Everything else takes the general routine.
- * hf_gather_cell: the floor of the lattice coordinates (a, b) of a grid point (within the int
- * range, hf_lattice_from_u), as buffer indices (ia, jb), and the fractions; 0 when the four taps
- * are not all inside the lattice. */
-static inline int hf_gather_cell(double a, double b, int i_min, int j_min, int cols, int rows,
-                                 int *ia_out, int *jb_out, double *wa, double *wb)
-{
-    int ia = (int)a, jb = (int)b;
-    double fa = (double)ia, fb = (double)jb;
-    if (fa > a) { /* truncated up (a < 0): one less; fa - 1.0 is exact */
-        ia--;
-        fa -= 1.0;
-    }
-    if (fb > b) {
-        jb--;
-        fb -= 1.0;
-    }
-    *wa = a - fa;
-    *wb = b - fb;
-    ia -= i_min;
-    jb -= j_min;
-    *ia_out = ia;
-    *jb_out = jb;
-    return ia >= 0 && jb >= 0 && ia + 1 < cols && jb + 1 < rows;
-}
-
+ * x + 0.0 == x otherwise). Everything else takes the general routine. */
 /* One grid point (x, y) at lattice coordinates (a, b), any channel count, added to acc. (With
  * the two fallbacks merged into one, gcc 12 -O2 inlines this into the grid loop, which then
  * spills its invariants again: 26.8 -> 30.2 instructions per rd, docs/performance.md.) */
