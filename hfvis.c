@@ -2773,6 +2773,23 @@ static void hf_lattice_fill(hf_sweep *sw, double value)
     for (i = 0; i < n; i++) sw->lat[i] = value;
 }
 
+/* hf_lattice_fill outside the rows' spans only, for a lattice whose every in-span node the
+ * sweeps then write (each quarter turn's line walk stores every node of its lines; not so with
+ * a receiver rectangle, which cuts lines short). */
+static void hf_lattice_fill_outside(hf_sweep *sw, double value)
+{
+    const size_t ch = (size_t)sw->channels;
+    int j;
+    for (j = 0; j < sw->rows; j++) {
+        double *lr = sw->lat + (size_t)j * (size_t)sw->cols * ch;
+        const int first = sw->row_first[j] <= sw->row_last[j] ? sw->row_first[j] : sw->cols;
+        size_t i, a = (size_t)first * ch, b = (size_t)(sw->row_last[j] + 1) * ch, n = (size_t)sw->cols * ch;
+        if (first == sw->cols) b = n;
+        for (i = 0; i < a; i++) lr[i] = value;
+        for (i = b; i < n; i++) lr[i] = value;
+    }
+}
+
 /* The fused accumulator of the current group: 0 at every in-domain node with a height, else NaN;
  * one pass, row by row (outside the row's span NaN, inside it by the height). */
 static void hf_lattice_zero(hf_sweep *sw)
@@ -2960,7 +2977,8 @@ hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_
         int m0;
         hf_direction_base(K, gidx, o.azimuth0_rad, &ux, &uy, &m0);
         hf_sweep_group(&sw, ux, uy);
-        hf_lattice_fill(&sw, HFVIS__NAN);
+        if (sw.rect) hf_lattice_fill(&sw, HFVIS__NAN);
+        else hf_lattice_fill_outside(&sw, HFVIS__NAN);
         for (m = 0; m < per; m++) {
             hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL);
             hf_progress(&o, ++done, K);
