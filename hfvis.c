@@ -8131,6 +8131,8 @@ static void hf_exact_dirs_fill(hf_exact_dirs *d, int K, double azimuth0, int N)
 typedef struct hf_cross {
     int ox, oy, kind;
     double f, u;
+    ptrdiff_t zoff, zstep; /* its first tap from g in the grid's heights, and its second from that */
+    ptrdiff_t toff;        /* the cell of its piece from g in the twist plane (width-major) */
     /* the piece from this crossing to the next (or to g + (a, b)): inside cell (cx, cy) (offsets
        from g), from (fx0, fy0) to (fx1, fy1) in cell coordinates, du sub-steps long */
     int cx, cy;
@@ -8154,7 +8156,8 @@ typedef struct hf_exact {
     int N;                  /* denominator bound */
     hf_exact_dirs d;
     hf_cross *cross;        /* the current direction's crossings, up to 2N - 1 */
-    double *sd, *sh;        /* hull stack: distances (sub-steps), heights (world units) */
+    double *sd, *sh;        /* one line's samples, then its hull stack: distances (sub-steps),
+                               heights (world units) */
     double *tan;            /* width*height tangents of the current direction, NaN at holes */
     double *twist;          /* width*height cell twists (hf_cell_twist), cell (x, y) at y*width + x */
     float *nrm;             /* width*height*3 grid normals (lighting), else NULL */
@@ -8163,8 +8166,7 @@ typedef struct hf_exact {
     double radius;          /* a finite search radius (world units), else 0 */
     int64_t win_rw;         /* the current direction's window, 1/16 sub-steps; -1 = unlimited */
     hf_win win;             /* one line's samples under the radius */
-    int *win_rec;           /* their receivers: sample index ... */
-    size_t *win_tan;        /* ... and grid index */
+    int *rec;               /* one line's receivers: their sample indices, then INT_MAX */
     int ox, oy;             /* the tile's origin in the raster (hfvis.h, "Search radius and tiles") */
     int rx0, ry0, rx1, ry1; /* the receiver rectangle, [rx0, rx1) x [ry0, ry1) */
     int rect;               /* 1: a proper sub-rectangle */
@@ -8228,6 +8230,12 @@ static int hf_exact_geometry(hf_cross *cross, const hfvis_grid *g, int a, int b,
     *L = (double)A * (double)B;
     *scale = *L / (len * g->cell_size);
     hf_exact_pieces(cross, n, a, b, *L);
+    for (ja = 0; ja < n; ja++) {
+        hf_cross *c = cross + ja;
+        c->zoff = (ptrdiff_t)c->oy * g->stride + c->ox;
+        c->zstep = c->kind == 1 ? g->stride : 1;
+        c->toff = (ptrdiff_t)c->cy * (ptrdiff_t)g->width + c->cx;
+    }
     return n;
 }
 
@@ -8338,102 +8346,150 @@ static int hf_exact_rect_span(const hf_exact *E, int hx, int hy, int a, int b, i
     return 1;
 }
 
-/* One line of direction (a, b) from its head (hx, hy), the grid point whose successor
- * (hx + a, hy + b) lies outside the grid: the crossings beyond the head (the CLAMP/WRAP pre-roll,
- * or the part of a step still inside the grid), then each grid point (a receiver) and the
- * crossings behind it, through the [P1] §5 hull stack. */
-static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, double L, double scale)
+/* The samples of one line of direction (a, b) from its head (hx, hy), the grid point whose
+ * successor (hx + a, hy + b) lies outside the grid, to its grid point qn, in sweep order of
+ * increasing distance (sub-steps from the head) into (sd, sh): the crossings beyond the head (the
+ * CLAMP/WRAP pre-roll, or the part of a step still inside the grid), then each grid point q (a
+ * receiver, rec[q] its sample; a hole keeps height NaN) and the crossings and piece samples
+ * behind it. Crossings at holes are left out. Returns the count (the arrays hold one more). */
+static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int P, double L, int qn,
+                            double *sd, double *sh, int *rec)
 {
     const hfvis_grid *g = E->g;
     const hf_cross *cr = E->cross;
-    double *sd = E->sd, *sh = E->sh, ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
-    const ptrdiff_t stride = g->stride;
-    int top = 0, k, e, q, nw = 0, nr = 0, qhi = INT_MAX;
-    const int win = E->win_rw >= 0; /* a finite radius: collect the samples, then hf_window_line */
-    hf_win *W = &E->win;
-    if (E->rect && !hf_exact_rect_span(E, hx, hy, a, b, &qhi)) return; /* no receiver wanted */
-#define HF_HULL_PUSH(dd, hh)                                                                     \
-    do {                                                                                         \
-        while (top >= 2 &&                                                                       \
-               (sh[top - 2] - (hh)) * ((dd) - sd[top - 1]) >= (sh[top - 1] - (hh)) * ((dd) - sd[top - 2])) \
-            top--;                                                                               \
-    } while (0)
-#define HF_EMIT(dd, hh)                                                                          \
-    do {                                                                                         \
-        if (win) {                                                                               \
-            W->d[nw] = (dd);                                                                     \
-            W->h[nw++] = (hh);                                                                   \
-        } else {                                                                                 \
-            HF_HULL_PUSH(dd, hh);                                                                \
-            sd[top] = (dd);                                                                      \
-            sh[top++] = (hh);                                                                    \
-        }                                                                                        \
-    } while (0)
+    const ptrdiff_t z0 = (ptrdiff_t)hy * g->stride + hx, zstep = (ptrdiff_t)b * g->stride + a;
+    const ptrdiff_t w0 = (ptrdiff_t)hy * g->width + hx, wstep = (ptrdiff_t)b * g->width + a;
+    const double lim = HF_EXACT_BULGE * g->cell_size;
+    const int pieces = a != 0 && b != 0; /* along a grid line the surface is linear */
+    double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
+    int n = 0, k, e, q, j;
     for (k = hf_exact_periods(g, E->R, hx, hy, a, b); k >= 0; k--) {
         int bx = hx + k * a, by = hy + k * b;
         for (e = P - 1; e >= 0; e--) {
-            int X = bx + cr[e].ox, Y = by + cr[e].oy, j = hf_piece_samples(g, E->twist, bx, by, cr + e, ph, pu);
-            double h, d;
+            int X = bx + cr[e].ox, Y = by + cr[e].oy;
+            double h;
+            j = hf_piece_samples(g, E->twist, bx, by, cr + e, ph, pu);
             while (j-- > 0) { /* the piece after crossing e, far end first */
                 if (isnan(ph[j])) continue;
-                d = -((double)k * L + (cr[e].u + pu[j]));
-                HF_EMIT(d, ph[j]);
+                sd[n] = -((double)k * L + (cr[e].u + pu[j]));
+                sh[n++] = ph[j];
             }
             if ((k == 0 && e == 0) || !hf_cross_inside(g, E->R, X, Y, cr + e)) continue;
             h = hf_cross_height(g, E->border, X, Y, cr + e);
             if (isnan(h)) continue;
-            d = -((double)k * L + cr[e].u);
-            HF_EMIT(d, h);
+            sd[n] = -((double)k * L + cr[e].u);
+            sh[n++] = h;
         }
     }
     for (q = 0;; q++) {
-        int gx = hx - q * a, gy = hy - q * b, nx = gx - a, ny = gy - b;
-        double h = (double)g->z[(ptrdiff_t)gy * stride + gx], d = (double)q * L;
-        double *t = E->tan + (size_t)gy * (size_t)g->width + (size_t)gx;
-        if (win) {
-            W->d[nw] = d;
-            W->h[nw] = isfinite(h) ? h : HFVIS__NAN;
-            E->win_rec[nr] = nw++;
-            E->win_tan[nr++] = (size_t)gy * (size_t)g->width + (size_t)gx;
-        } else if (!isfinite(h)) {
-            *t = HFVIS__NAN;
-        } else {
-            HF_HULL_PUSH(d, h);
-            *t = top ? (sh[top - 1] - h) / (d - sd[top - 1]) * scale : -HFVIS__INF;
+        const ptrdiff_t zq = z0 - (ptrdiff_t)q * zstep;
+        const float *zn;
+        const double *tw;
+        double h = (double)g->z[zq], base;
+        sd[n] = (double)q * L;
+        sh[n] = isfinite(h) ? h : HFVIS__NAN;
+        rec[q] = n++;
+        if (q == qn) break;
+        /* between grid points q and q + 1, both inside the grid, so are the crossings and cells */
+        zn = g->z + (zq - zstep);
+        tw = E->twist + (w0 - (ptrdiff_t)(q + 1) * wstep);
+        base = (double)(q + 1) * L;
+        for (e = P - 1;; e--) {
+            const hf_cross *c = cr + e;
+            if (pieces) { /* hf_piece_samples' test, the cell known to be inside */
+                double bulge = c->q * tw[c->toff];
+                if (bulge > lim && bulge < HFVIS__INF) {
+                    j = hf_piece_fill(g, hx - (q + 1) * a + c->cx, hy - (q + 1) * b + c->cy, c, bulge, lim, ph, pu);
+                    while (j-- > 0) { /* far end first */
+                        if (isnan(ph[j])) continue;
+                        sd[n] = base - (c->u + pu[j]);
+                        sh[n++] = ph[j];
+                    }
+                }
+            }
+            if (e == 0) break; /* crossing 0 is grid point q + 1 */
+            h = (double)zn[c->zoff];
+            h += ((double)zn[c->zoff + c->zstep] - h) * c->f; /* as hf_cross_height */
+            sd[n] = base - c->u;
+            sh[n] = h;
+            n += isfinite(h) ? 1 : 0; /* a hole: overwritten by the next sample */
+        }
+    }
+    return n;
+}
+
+/* Pop the [P1] §5 hull stack (sd, sh) of top entries for the sample (d, h) (Alg. 1, ties pop, as
+ * hfvis_line_horizons); returns the new top. The first test apart: on rough terrain most samples
+ * pop exactly one entry, and a branch of its own predicts that better than the loop's. */
+static inline int hf_exact_pop(const double *sd, const double *sh, int top, double d, double h)
+{
+#define HF_EXACT_BELOW (top >= 2 && (sh[top - 2] - h) * (d - sd[top - 1]) >= (sh[top - 1] - h) * (d - sd[top - 2]))
+    if (HF_EXACT_BELOW) {
+        top--;
+        while (HF_EXACT_BELOW) top--;
+    }
+#undef HF_EXACT_BELOW
+    return top;
+}
+
+/* The hull pass over the samples of hf_exact_samples, in place (the stack never outgrows the
+ * samples read): receiver r (sample rec[r]) writes tan[t0 - r tstep] = the tangent of the hull at
+ * its turn times scale (-INFINITY: nothing before it, NaN: a hole). */
+static void hf_exact_hull(double *sd, double *sh, const int *rec, int nrec, double scale, double *tan,
+                          ptrdiff_t t0, ptrdiff_t tstep)
+{
+    int i = 0, top = 0, r;
+    for (r = 0; r < nrec; r++) {
+        double d, h;
+        for (; i < rec[r]; i++) {
+            d = sd[i];
+            h = sh[i];
+            top = hf_exact_pop(sd, sh, top, d, h);
             sd[top] = d;
             sh[top++] = h;
         }
-        if (nx < 0 || ny < 0 || nx >= g->width || ny >= g->height || q >= qhi) break;
-        for (e = P - 1; e >= 0; e--) { /* between two grid points: inside the grid */
-            const float *p = g->z + (ptrdiff_t)(ny + cr[e].oy) * stride + (nx + cr[e].ox);
-            int j = hf_piece_samples(g, E->twist, nx, ny, cr + e, ph, pu);
-            while (j-- > 0) {
-                if (isnan(ph[j])) continue;
-                d = (double)(q + 1) * L - (cr[e].u + pu[j]);
-                HF_EMIT(d, ph[j]);
-            }
-            if (e == 0) break; /* crossing 0 is the next receiver */
-            h = (double)p[0];
-            h += ((double)p[cr[e].kind == 1 ? stride : 1] - h) * cr[e].f; /* as hf_cross_height */
-            if (!isfinite(h)) continue;
-            d = (double)(q + 1) * L - cr[e].u;
-            HF_EMIT(d, h);
+        d = sd[i];
+        h = sh[i++];
+        if (isnan(h)) {
+            tan[t0 - (ptrdiff_t)r * tstep] = HFVIS__NAN;
+            continue;
         }
+        top = hf_exact_pop(sd, sh, top, d, h);
+        tan[t0 - (ptrdiff_t)r * tstep] = top ? (sh[top - 1] - h) / (d - sd[top - 1]) * scale : -HFVIS__INF;
+        sd[top] = d;
+        sh[top++] = h;
     }
-#undef HF_EMIT
-#undef HF_HULL_PUSH
-    if (win) {
+}
+
+/* One line of direction (a, b) from its head (hx, hy) (hf_exact_samples): the tangents of its
+ * grid points up to the last one in the receiver rectangle, by the hull or, under a finite
+ * radius, by hf_window_line. */
+static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, double L, double scale)
+{
+    const hfvis_grid *g = E->g;
+    const ptrdiff_t t0 = (ptrdiff_t)hy * g->width + hx, tstep = (ptrdiff_t)b * g->width + a;
+    int qn = hf_exact_periods(g, 0, hx, hy, -a, -b), qhi, n, q; /* the last grid point */
+    if (E->rect) {
+        if (!hf_exact_rect_span(E, hx, hy, a, b, &qhi)) return; /* no receiver wanted */
+        if (qhi < qn) qn = qhi;
+    }
+    if (E->win_rw < 0) {
+        hf_exact_samples(E, hx, hy, a, b, P, L, qn, E->sd, E->sh, E->rec);
+        hf_exact_hull(E->sd, E->sh, E->rec, qn + 1, scale, E->tan, t0, tstep);
+    } else {
         /* positions: 16 x the sub-step along the raster's line, counted from its grid point
            q = 0 = -floor((X a + Y b)/(a^2 + b^2)) (X, Y in the raster): a tile and the whole
            raster put every sample at the same integer */
+        hf_win *W = &E->win;
         int64_t n2 = (int64_t)a * a + (int64_t)b * b;
         int64_t dot = ((int64_t)hx + E->ox) * a + ((int64_t)hy + E->oy) * b;
         double base = -(double)hf_floor_div64(dot, n2) * L;
         int i;
-        for (i = 0; i < nw; i++) W->pos[i] = (int64_t)(16.0 * (base + W->d[i]));
-        E->win_rec[nr] = INT_MAX; /* the list's end */
-        hf_window_line(W, nw, E->win_rw, 0, E->win_rec);
-        for (i = 0; i < nr; i++) E->tan[E->win_tan[i]] = W->t[E->win_rec[i]] * scale;
+        n = hf_exact_samples(E, hx, hy, a, b, P, L, qn, W->d, W->h, E->rec);
+        for (i = 0; i < n; i++) W->pos[i] = (int64_t)(16.0 * (base + W->d[i]));
+        E->rec[qn + 1] = INT_MAX; /* the list's end */
+        hf_window_line(W, n, E->win_rw, 0, E->rec);
+        for (q = 0; q <= qn; q++) E->tan[t0 - (ptrdiff_t)q * tstep] = W->t[E->rec[q]] * scale;
     }
 }
 
@@ -8512,14 +8568,14 @@ static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, co
 }
 
 /* Scratch of one exact-mode call, one block: the K directions and their quadrature, the
- * crossings, the hull stack (one line's crossings at most), the tangent plane, and optionally
+ * crossings, one line's samples and receivers (the hull stack in place), the tangent plane, and optionally
  * grid normals and a channels-deep accumulator. */
 static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
                                   const hfvis_sweep_options *o, int want_tan, int want_normals,
                                   int channels)
 {
     size_t total = 0, off_ray, off_d, off_c, off_s, off_t = 0, off_w, off_n = 0, off_a = 0, gridn, cap;
-    size_t off_win = 0, off_wt = 0, off_wr = 0;
+    size_t off_win = 0, off_r;
     int ok = 1, k, maxp = 1, side = g->width > g->height ? g->width : g->height;
     unsigned char *blk;
     memset(E, 0, sizeof *E);
@@ -8561,11 +8617,8 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     E->oy = o->origin_y;
     hf_receiver_rect(g, o, &E->rx0, &E->ry0, &E->rx1, &E->ry1);
     E->rect = E->rx0 > 0 || E->ry0 > 0 || E->rx1 < g->width || E->ry1 < g->height;
-    if (E->radius > 0.0) {
-        off_win = hf_align_add(&total, cap, HF_WIN_BYTES_PER_SAMPLE, &ok);
-        off_wt = hf_align_add(&total, cap, sizeof(size_t), &ok);
-        off_wr = hf_align_add(&total, cap + 1, sizeof(int), &ok);
-    }
+    if (E->radius > 0.0) off_win = hf_align_add(&total, cap, HF_WIN_BYTES_PER_SAMPLE, &ok);
+    off_r = hf_align_add(&total, cap + 1, sizeof(int), &ok);
     if (!ok) return HFVIS_ERR_LIMIT;
     blk = (unsigned char *)hfvis__alloc(o->alloc, total);
     if (!blk) return HFVIS_ERR_OUT_OF_MEMORY;
@@ -8590,11 +8643,8 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     }
     E->nrm = want_normals ? (float *)(void *)(blk + off_n) : NULL;
     E->acc = channels ? (double *)(void *)(blk + off_a) : NULL;
-    if (E->radius > 0.0) {
-        hf_win_carve(&E->win, blk + off_win, cap);
-        E->win_tan = (size_t *)(void *)(blk + off_wt);
-        E->win_rec = (int *)(void *)(blk + off_wr);
-    }
+    if (E->radius > 0.0) hf_win_carve(&E->win, blk + off_win, cap);
+    E->rec = (int *)(void *)(blk + off_r);
     hf_exact_dirs_fill(&E->d, K, o->azimuth0_rad, E->N);
     if (want_normals) (void)hfvis_normals_compute(g, E->nrm); /* the grid normals, as floats */
     if (channels) memset(E->acc, 0, gridn * (size_t)channels * sizeof(double));
