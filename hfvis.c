@@ -8132,7 +8132,9 @@ typedef struct hf_cross {
     int ox, oy, kind;
     double f, u;
     ptrdiff_t zoff, zstep; /* its first tap from g in the grid's heights, and its second from that */
-    ptrdiff_t toff;        /* the cell of its piece from g in the twist plane (width-major) */
+    ptrdiff_t toff, coff;  /* the cell of its piece from g: in the twist plane (width-major), and
+                              its tap (0, 0) in the grid's heights */
+    double mfx, mfy, mu;   /* the piece's midpoint: cell coordinates, distance from g (sub-steps) */
     /* the piece from this crossing to the next (or to g + (a, b)): inside cell (cx, cy) (offsets
        from g), from (fx0, fy0) to (fx1, fy1) in cell coordinates, du sub-steps long */
     int cx, cy;
@@ -8235,6 +8237,10 @@ static int hf_exact_geometry(hf_cross *cross, const hfvis_grid *g, int a, int b,
         c->zoff = (ptrdiff_t)c->oy * g->stride + c->ox;
         c->zstep = c->kind == 1 ? g->stride : 1;
         c->toff = (ptrdiff_t)c->cy * (ptrdiff_t)g->width + c->cx;
+        c->coff = (ptrdiff_t)c->cy * g->stride + c->cx;
+        c->mfx = c->fx0 + 0.5 * (c->fx1 - c->fx0); /* hf_piece_fill's sample at t = 1/2, bit for bit */
+        c->mfy = c->fy0 + 0.5 * (c->fy1 - c->fy0);
+        c->mu = c->u + c->du * 0.5;
     }
     return n;
 }
@@ -8359,7 +8365,7 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
     const hf_cross *cr = E->cross;
     const ptrdiff_t z0 = (ptrdiff_t)hy * g->stride + hx, zstep = (ptrdiff_t)b * g->stride + a;
     const ptrdiff_t w0 = (ptrdiff_t)hy * g->width + hx, wstep = (ptrdiff_t)b * g->width + a;
-    const double lim = HF_EXACT_BULGE * g->cell_size;
+    const double lim = HF_EXACT_BULGE * g->cell_size, lim4 = lim * 4.0; /* hf_piece_fill: m >= 4 */
     const int pieces = a != 0 && b != 0; /* along a grid line the surface is linear */
     double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
     int n = 0, k, e, q, j;
@@ -8398,13 +8404,23 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
             const hf_cross *c = cr + e;
             if (pieces) { /* hf_piece_samples' test, the cell known to be inside */
                 double bulge = c->q * tw[c->toff];
-                if (bulge > lim && bulge < HFVIS__INF) {
+                if (bulge > lim4 && bulge < HFVIS__INF) { /* split into 4 or more: rare */
                     j = hf_piece_fill(g, hx - (q + 1) * a + c->cx, hy - (q + 1) * b + c->cy, c, bulge, lim, ph, pu);
                     while (j-- > 0) { /* far end first */
                         if (isnan(ph[j])) continue;
                         sd[n] = base - (c->u + pu[j]);
                         sh[n++] = ph[j];
                     }
+                } else { /* split in two or not at all: the midpoint, kept for a split without a
+                            branch (on rough terrain about a quarter of the pieces split, at
+                            random); a kept one has four finite taps, so a finite height */
+                    const float *p = zn + c->coff;
+                    double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[g->stride];
+                    double z11 = (double)p[g->stride + 1];
+                    double r0 = z00 + (z10 - z00) * c->mfx, r1 = z01 + (z11 - z01) * c->mfx;
+                    sd[n] = base - c->mu;
+                    sh[n] = r0 + (r1 - r0) * c->mfy;
+                    n += (bulge > lim) & (bulge < HFVIS__INF);
                 }
             }
             if (e == 0) break; /* crossing 0 is grid point q + 1 */
