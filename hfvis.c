@@ -8161,7 +8161,8 @@ typedef struct hf_exact {
     double *sd, *sh;        /* one line's samples, then its hull stack: distances (sub-steps),
                                heights (world units) */
     double *tan;            /* width*height tangents of the current direction, NaN at holes */
-    double *twist;          /* width*height cell twists (hf_cell_twist), cell (x, y) at y*width + x */
+    double *twist;          /* width*height cell twists (hf_cell_twist; NaN if not finite), cell
+                               (x, y) at y*width + x */
     float *nrm;             /* width*height*3 grid normals (lighting), else NULL */
     double *acc;            /* width*height*channels sums, else NULL */
     int channels;
@@ -8274,12 +8275,12 @@ static double hf_cell_twist(const float *p, ptrdiff_t stride)
     return (double)p[0] - (double)p[1] - (double)p[stride] + (double)p[stride + 1];
 }
 
-/* The interior samples of a piece in cell (cx, cy) whose bulge exceeds lim (hf_piece_samples). */
-static int hf_piece_fill(const hfvis_grid *g, int cx, int cy, const hf_cross *c, double bulge,
-                         double lim, double *h, double *du)
+/* The interior samples of a piece in the cell whose tap (0, 0) is p (row stride `stride`), its
+ * bulge above lim (hf_piece_samples). */
+static int hf_piece_fill(const float *p, ptrdiff_t stride, const hf_cross *c, double bulge, double lim,
+                         double *h, double *du)
 {
-    const float *p = g->z + (ptrdiff_t)cy * g->stride + cx;
-    double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[g->stride], z11 = (double)p[g->stride + 1];
+    double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[stride], z11 = (double)p[stride + 1];
     double dfx = c->fx1 - c->fx0, dfy = c->fy1 - c->fy0, inv_m;
     int m = 1, j;
     while (m < HF_EXACT_MAX_SPLIT && bulge > lim * (double)m * (double)m) m *= 2;
@@ -8310,7 +8311,7 @@ static inline int hf_piece_samples(const hfvis_grid *g, const double *twist, int
                           : hf_cell_twist(g->z + (ptrdiff_t)cy * g->stride + cx, g->stride));
     lim = HF_EXACT_BULGE * g->cell_size;
     if (!(bulge > lim) || !isfinite(bulge)) return 0;
-    return hf_piece_fill(g, cx, cy, c, bulge, lim, h, du);
+    return hf_piece_fill(g->z + (ptrdiff_t)cy * g->stride + cx, g->stride, c, bulge, lim, h, du);
 }
 
 /* Whole periods k >= 0 of the ray from grid point (x, y) along (a, b) that can hold a crossing
@@ -8352,6 +8353,36 @@ static int hf_exact_rect_span(const hf_exact *E, int hx, int hy, int a, int b, i
     return 1;
 }
 
+/* The interior samples of piece c of the inner part of a line (between two grid points inside
+ * the grid, so its cell is inside too), zn and tw at the nearer grid point's height and twist,
+ * appended to (sd, sh) from index n far end first at distances base - offset; returns the new
+ * count. hf_piece_samples' test and samples, bit for bit (the twist plane holds NaN for
+ * non-finite twists, so the bulge is finite or NaN). */
+static inline int hf_exact_piece(const hfvis_grid *g, const hf_cross *c, const float *zn, const double *tw,
+                                 double base, double lim, double *sd, double *sh, int n)
+{
+    double bulge = c->q * tw[c->toff];
+    if (bulge > 4.0 * lim) { /* split into 4 or more (hf_piece_fill's m >= 4): rare */
+        double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
+        int j = hf_piece_fill(zn + c->coff, g->stride, c, bulge, lim, ph, pu);
+        while (j-- > 0) { /* far end first */
+            sd[n] = base - (c->u + pu[j]);
+            sh[n++] = ph[j];
+        }
+    } else { /* split in two or not at all: the midpoint, kept for a split without a branch (on
+                rough terrain about a quarter of the pieces split, at random); a kept one has four
+                finite taps, so a finite height */
+        const float *p = zn + c->coff;
+        double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[g->stride];
+        double z11 = (double)p[g->stride + 1];
+        double r0 = z00 + (z10 - z00) * c->mfx, r1 = z01 + (z11 - z01) * c->mfx;
+        sd[n] = base - c->mu;
+        sh[n] = r0 + (r1 - r0) * c->mfy;
+        n += bulge > lim ? 1 : 0;
+    }
+    return n;
+}
+
 /* The samples of one line of direction (a, b) from its head (hx, hy), the grid point whose
  * successor (hx + a, hy + b) lies outside the grid, to its grid point qn, in sweep order of
  * increasing distance (sub-steps from the head) into (sd, sh): the crossings beyond the head (the
@@ -8365,7 +8396,7 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
     const hf_cross *cr = E->cross;
     const ptrdiff_t z0 = (ptrdiff_t)hy * g->stride + hx, zstep = (ptrdiff_t)b * g->stride + a;
     const ptrdiff_t w0 = (ptrdiff_t)hy * g->width + hx, wstep = (ptrdiff_t)b * g->width + a;
-    const double lim = HF_EXACT_BULGE * g->cell_size, lim4 = lim * 4.0; /* hf_piece_fill: m >= 4 */
+    const double lim = HF_EXACT_BULGE * g->cell_size;
     const int pieces = a != 0 && b != 0; /* along a grid line the surface is linear */
     double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
     int n = 0, k, e, q, j;
@@ -8400,36 +8431,17 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
         zn = g->z + (zq - zstep);
         tw = E->twist + (w0 - (ptrdiff_t)(q + 1) * wstep);
         base = (double)(q + 1) * L;
-        for (e = P - 1;; e--) {
+        if (!pieces) continue; /* an axis: grid point q + 1 is the next sample */
+        for (e = P - 1; e > 0; e--) { /* the piece after crossing e, then crossing e */
             const hf_cross *c = cr + e;
-            if (pieces) { /* hf_piece_samples' test, the cell known to be inside */
-                double bulge = c->q * tw[c->toff];
-                if (bulge > lim4 && bulge < HFVIS__INF) { /* split into 4 or more: rare */
-                    j = hf_piece_fill(g, hx - (q + 1) * a + c->cx, hy - (q + 1) * b + c->cy, c, bulge, lim, ph, pu);
-                    while (j-- > 0) { /* far end first */
-                        if (isnan(ph[j])) continue;
-                        sd[n] = base - (c->u + pu[j]);
-                        sh[n++] = ph[j];
-                    }
-                } else { /* split in two or not at all: the midpoint, kept for a split without a
-                            branch (on rough terrain about a quarter of the pieces split, at
-                            random); a kept one has four finite taps, so a finite height */
-                    const float *p = zn + c->coff;
-                    double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[g->stride];
-                    double z11 = (double)p[g->stride + 1];
-                    double r0 = z00 + (z10 - z00) * c->mfx, r1 = z01 + (z11 - z01) * c->mfx;
-                    sd[n] = base - c->mu;
-                    sh[n] = r0 + (r1 - r0) * c->mfy;
-                    n += (bulge > lim) & (bulge < HFVIS__INF);
-                }
-            }
-            if (e == 0) break; /* crossing 0 is grid point q + 1 */
+            n = hf_exact_piece(g, c, zn, tw, base, lim, sd, sh, n);
             h = (double)zn[c->zoff];
             h += ((double)zn[c->zoff + c->zstep] - h) * c->f; /* as hf_cross_height */
             sd[n] = base - c->u;
             sh[n] = h;
             n += isfinite(h) ? 1 : 0; /* a hole: overwritten by the next sample */
         }
+        n = hf_exact_piece(g, cr, zn, tw, base, lim, sd, sh, n); /* crossing 0 is grid point q + 1 */
     }
     return n;
 }
@@ -8654,8 +8666,10 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
         int x, y;
         for (y = 0; y + 1 < g->height; y++)
             for (x = 0; x + 1 < g->width; x++)
-                E->twist[(size_t)y * (size_t)g->width + (size_t)x] =
-                    hf_cell_twist(g->z + (ptrdiff_t)y * g->stride + x, g->stride);
+            {
+                double t = hf_cell_twist(g->z + (ptrdiff_t)y * g->stride + x, g->stride);
+                E->twist[(size_t)y * (size_t)g->width + (size_t)x] = isfinite(t) ? t : HFVIS__NAN;
+            }
     }
     E->nrm = want_normals ? (float *)(void *)(blk + off_n) : NULL;
     E->acc = channels ? (double *)(void *)(blk + off_a) : NULL;
