@@ -8132,8 +8132,7 @@ typedef struct hf_cross {
     int ox, oy, kind;
     double f, u;
     ptrdiff_t zoff, zstep; /* its first tap from g in the grid's heights, and its second from that */
-    ptrdiff_t toff, coff;  /* the cell of its piece from g: in the twist plane (width-major), and
-                              its tap (0, 0) in the grid's heights */
+    ptrdiff_t coff;        /* the tap (0, 0) of its piece's cell from g in the grid's heights */
     double mfx, mfy, mu;   /* the piece's midpoint: cell coordinates, distance from g (sub-steps) */
     /* the piece from this crossing to the next (or to g + (a, b)): inside cell (cx, cy) (offsets
        from g), from (fx0, fy0) to (fx1, fy1) in cell coordinates, du sub-steps long */
@@ -8161,8 +8160,6 @@ typedef struct hf_exact {
     double *sd, *sh;        /* one line's samples, then its hull stack: distances (sub-steps),
                                heights (world units) */
     double *tan;            /* width*height tangents of the current direction, NaN at holes */
-    double *twist;          /* width*height cell twists (hf_cell_twist; NaN if not finite), cell
-                               (x, y) at y*width + x */
     float *nrm;             /* width*height*3 grid normals (lighting), else NULL */
     double *acc;            /* width*height*channels sums, else NULL */
     int channels;
@@ -8237,7 +8234,6 @@ static int hf_exact_geometry(hf_cross *cross, const hfvis_grid *g, int a, int b,
         hf_cross *c = cross + ja;
         c->zoff = (ptrdiff_t)c->oy * g->stride + c->ox;
         c->zstep = c->kind == 1 ? g->stride : 1;
-        c->toff = (ptrdiff_t)c->cy * (ptrdiff_t)g->width + c->cx;
         c->coff = (ptrdiff_t)c->cy * g->stride + c->cx;
         c->mfx = c->fx0 + 0.5 * (c->fx1 - c->fx0); /* hf_piece_fill's sample at t = 1/2, bit for bit */
         c->mfy = c->fy0 + 0.5 * (c->fy1 - c->fy0);
@@ -8270,7 +8266,7 @@ static double hf_cross_height(const hfvis_grid *g, hfvis_border border, int X, i
 }
 
 /* The twist z00 - z10 - z01 + z11 of the cell at p. */
-static double hf_cell_twist(const float *p, ptrdiff_t stride)
+static inline double hf_cell_twist(const float *p, ptrdiff_t stride)
 {
     return (double)p[0] - (double)p[1] - (double)p[stride] + (double)p[stride + 1];
 }
@@ -8298,17 +8294,15 @@ static int hf_piece_fill(const float *p, ptrdiff_t stride, const hf_cross *c, do
  * HF_EXACT_MAX_SPLIT - 1 heights h[j] at sub-step offsets du[j] from the piece's start, in
  * increasing order, and returns the count; 0 for a piece that is not concave enough, outside
  * the grid or touching a hole. Inline: most pieces are rejected here. */
-static inline int hf_piece_samples(const hfvis_grid *g, const double *twist, int X, int Y,
-                                   const hf_cross *c, double *h, double *du)
+static inline int hf_piece_samples(const hfvis_grid *g, int X, int Y, const hf_cross *c, double *h,
+                                   double *du)
 {
     int cx = X + c->cx, cy = Y + c->cy;
     double bulge, lim;
     /* cx in [0, width - 2], cy in [0, height - 2] (the unsigned casts take the negatives out) */
     if (c->du == 0.0 || (unsigned)cx >= (unsigned)(g->width - 1) || (unsigned)cy >= (unsigned)(g->height - 1))
         return 0;
-    /* the twist z00 - z10 - z01 + z11 of the cell (precomputed by the sweep: one load) */
-    bulge = c->q * (twist ? twist[(size_t)cy * (size_t)g->width + (size_t)cx]
-                          : hf_cell_twist(g->z + (ptrdiff_t)cy * g->stride + cx, g->stride));
+    bulge = c->q * hf_cell_twist(g->z + (ptrdiff_t)cy * g->stride + cx, g->stride);
     lim = HF_EXACT_BULGE * g->cell_size;
     if (!(bulge > lim) || !isfinite(bulge)) return 0;
     return hf_piece_fill(g->z + (ptrdiff_t)cy * g->stride + cx, g->stride, c, bulge, lim, h, du);
@@ -8354,17 +8348,19 @@ static int hf_exact_rect_span(const hf_exact *E, int hx, int hy, int a, int b, i
 }
 
 /* The interior samples of piece c of the inner part of a line (between two grid points inside
- * the grid, so its cell is inside too), zn and tw at the nearer grid point's height and twist,
- * appended to (sd, sh) from index n far end first at distances base - offset; returns the new
- * count. hf_piece_samples' test and samples, bit for bit (the twist plane holds NaN for
- * non-finite twists, so the bulge is finite or NaN). */
-static inline int hf_exact_piece(const hfvis_grid *g, const hf_cross *c, const float *zn, const double *tw,
-                                 double base, double lim, double *sd, double *sh, int n)
+ * the grid, so its cell is inside too), zn at the nearer grid point's height, appended to
+ * (sd, sh) from index n far end first at distances base - offset; returns the new count.
+ * hf_piece_samples' test and samples, bit for bit; the twist from the four taps the midpoint
+ * reads anyway. */
+static inline int hf_exact_piece(const hfvis_grid *g, const hf_cross *c, const float *zn, double base,
+                                 double lim, double *sd, double *sh, int n)
 {
-    double bulge = c->q * tw[c->toff];
-    if (bulge > 4.0 * lim) { /* split into 4 or more (hf_piece_fill's m >= 4): rare */
+    const float *p = zn + c->coff;
+    double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[g->stride];
+    double z11 = (double)p[g->stride + 1], bulge = c->q * hf_cell_twist(p, g->stride);
+    if (bulge > 4.0 * lim && bulge < HFVIS__INF) { /* split into 4 or more (hf_piece_fill's m >= 4): rare */
         double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
-        int j = hf_piece_fill(zn + c->coff, g->stride, c, bulge, lim, ph, pu);
+        int j = hf_piece_fill(p, g->stride, c, bulge, lim, ph, pu);
         while (j-- > 0) { /* far end first */
             sd[n] = base - (c->u + pu[j]);
             sh[n++] = ph[j];
@@ -8372,13 +8368,10 @@ static inline int hf_exact_piece(const hfvis_grid *g, const hf_cross *c, const f
     } else { /* split in two or not at all: the midpoint, kept for a split without a branch (on
                 rough terrain about a quarter of the pieces split, at random); a kept one has four
                 finite taps, so a finite height */
-        const float *p = zn + c->coff;
-        double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[g->stride];
-        double z11 = (double)p[g->stride + 1];
         double r0 = z00 + (z10 - z00) * c->mfx, r1 = z01 + (z11 - z01) * c->mfx;
         sd[n] = base - c->mu;
         sh[n] = r0 + (r1 - r0) * c->mfy;
-        n += bulge > lim ? 1 : 0;
+        n += (bulge > lim) & (bulge < HFVIS__INF);
     }
     return n;
 }
@@ -8395,7 +8388,6 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
     const hfvis_grid *g = E->g;
     const hf_cross *cr = E->cross;
     const ptrdiff_t z0 = (ptrdiff_t)hy * g->stride + hx, zstep = (ptrdiff_t)b * g->stride + a;
-    const ptrdiff_t w0 = (ptrdiff_t)hy * g->width + hx, wstep = (ptrdiff_t)b * g->width + a;
     const double lim = HF_EXACT_BULGE * g->cell_size;
     const int pieces = a != 0 && b != 0; /* along a grid line the surface is linear */
     double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
@@ -8405,7 +8397,7 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
         for (e = P - 1; e >= 0; e--) {
             int X = bx + cr[e].ox, Y = by + cr[e].oy;
             double h;
-            j = hf_piece_samples(g, E->twist, bx, by, cr + e, ph, pu);
+            j = hf_piece_samples(g, bx, by, cr + e, ph, pu);
             while (j-- > 0) { /* the piece after crossing e, far end first */
                 if (isnan(ph[j])) continue;
                 sd[n] = -((double)k * L + (cr[e].u + pu[j]));
@@ -8421,7 +8413,6 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
     for (q = 0;; q++) {
         const ptrdiff_t zq = z0 - (ptrdiff_t)q * zstep;
         const float *zn;
-        const double *tw;
         double h = (double)g->z[zq], base;
         sd[n] = (double)q * L;
         sh[n] = isfinite(h) ? h : HFVIS__NAN;
@@ -8429,19 +8420,18 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
         if (q == qn) break;
         /* between grid points q and q + 1, both inside the grid, so are the crossings and cells */
         zn = g->z + (zq - zstep);
-        tw = E->twist + (w0 - (ptrdiff_t)(q + 1) * wstep);
         base = (double)(q + 1) * L;
         if (!pieces) continue; /* an axis: grid point q + 1 is the next sample */
         for (e = P - 1; e > 0; e--) { /* the piece after crossing e, then crossing e */
             const hf_cross *c = cr + e;
-            n = hf_exact_piece(g, c, zn, tw, base, lim, sd, sh, n);
+            n = hf_exact_piece(g, c, zn, base, lim, sd, sh, n);
             h = (double)zn[c->zoff];
             h += ((double)zn[c->zoff + c->zstep] - h) * c->f; /* as hf_cross_height */
             sd[n] = base - c->u;
             sh[n] = h;
             n += isfinite(h) ? 1 : 0; /* a hole: overwritten by the next sample */
         }
-        n = hf_exact_piece(g, cr, zn, tw, base, lim, sd, sh, n); /* crossing 0 is grid point q + 1 */
+        n = hf_exact_piece(g, cr, zn, base, lim, sd, sh, n); /* crossing 0 is grid point q + 1 */
     }
     return n;
 }
@@ -8578,7 +8568,7 @@ static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, co
         for (e = 0; e < P; e++) {
             int X = x + k * a + cr[e].ox, Y = y + k * b + cr[e].oy, j;
             double h, s, ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
-            int np = hf_piece_samples(g, NULL, x + k * a, y + k * b, cr + e, ph, pu);
+            int np = hf_piece_samples(g, x + k * a, y + k * b, cr + e, ph, pu);
             for (j = 0; j < np; j++) {
                 if (isnan(ph[j])) continue;
                 if (rw >= 0 && 16.0 * ((double)k * L + (cr[e].u + pu[j])) > (double)rw) continue;
@@ -8602,7 +8592,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
                                   const hfvis_sweep_options *o, int want_tan, int want_normals,
                                   int channels)
 {
-    size_t total = 0, off_ray, off_d, off_c, off_s, off_t = 0, off_w, off_n = 0, off_a = 0, gridn, cap;
+    size_t total = 0, off_ray, off_d, off_c, off_s, off_t = 0, off_n = 0, off_a = 0, gridn, cap;
     size_t off_win = 0, off_r;
     int ok = 1, k, maxp = 1, side = g->width > g->height ? g->width : g->height;
     unsigned char *blk;
@@ -8636,7 +8626,6 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     off_c = hf_align_add(&total, (size_t)maxp, sizeof(hf_cross), &ok);
     off_s = hf_align_add(&total, cap, 2u * sizeof(double), &ok);
     if (want_tan) off_t = hf_align_add(&total, gridn, sizeof(double), &ok);
-    off_w = hf_align_add(&total, gridn, sizeof(double), &ok);
     if (want_normals) off_n = hf_align_add(&total, gridn, 3u * sizeof(float), &ok);
     if (channels) off_a = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
     E->radius = hf_radius_on(o) ? o->max_distance : 0.0;
@@ -8661,16 +8650,6 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     E->sd = (double *)(void *)(blk + off_s);
     E->sh = E->sd + cap;
     E->tan = want_tan ? (double *)(void *)(blk + off_t) : NULL;
-    E->twist = (double *)(void *)(blk + off_w);
-    {
-        int x, y;
-        for (y = 0; y + 1 < g->height; y++)
-            for (x = 0; x + 1 < g->width; x++)
-            {
-                double t = hf_cell_twist(g->z + (ptrdiff_t)y * g->stride + x, g->stride);
-                E->twist[(size_t)y * (size_t)g->width + (size_t)x] = isfinite(t) ? t : HFVIS__NAN;
-            }
-    }
     E->nrm = want_normals ? (float *)(void *)(blk + off_n) : NULL;
     E->acc = channels ? (double *)(void *)(blk + off_a) : NULL;
     if (E->radius > 0.0) hf_win_carve(&E->win, blk + off_win, cap);
