@@ -8511,13 +8511,6 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
     }
 }
 
-/* Is grid index i inside the receiver rectangle? */
-static int hf_exact_receiver(const hf_exact *E, size_t i)
-{
-    int x = (int)(i % (size_t)E->g->width), y = (int)(i / (size_t)E->g->width);
-    return x >= E->rx0 && x < E->rx1 && y >= E->ry0 && y < E->ry1;
-}
-
 /* The window of a finite radius R (world units) in 1/16 sub-steps: scale is the tangent factor
  * L/(|(a, b)| cell) of hf_exact_geometry, so R scale sub-steps span R; every sample distance is
  * a multiple of 1/16 sub-step (a crossing: whole sub-steps; a piece sample: j/m of a piece,
@@ -8769,8 +8762,7 @@ static hfvis_status hf_exact_sums(hf_exact *E, const hfvis_grid *g, int K, hfvis
     hfvis_status s;
     hf_env_eval eval;
     float *table = NULL;
-    int channels = kind == HFVIS_SUM_ENV_LIGHT ? env->channels : 1, k, done = 0;
-    size_t i, n = hf_grid_count(g);
+    int channels = kind == HFVIS_SUM_ENV_LIGHT ? env->channels : 1, k, done = 0, x, y;
     if ((s = hf_exact_init(E, g, K, o, 1, kind != HFVIS_SUM_SKY_VIEW, channels)) != HFVIS_OK) return s;
     if (kind == HFVIS_SUM_ENV_LIGHT &&
         (s = hf_exact_env_tables(&E->d, env, eopts, o->alloc, &table, &eval)) != HFVIS_OK) {
@@ -8783,15 +8775,25 @@ static hfvis_status hf_exact_sums(hf_exact *E, const hfvis_grid *g, int K, hfvis
         double cp = cos(E->d.ray[k].azimuth), sp = sin(E->d.ray[k].azimuth);
         if (pos < begin || pos >= end) continue;
         hf_exact_sweep(E, E->d.ray[k]);
-        for (i = 0; i < n; i++) {
-            double t = E->tan[i];
-            const float *nr = E->nrm ? E->nrm + i * 3 : NULL;
-            if (isnan(t) || (E->rect && !hf_exact_receiver(E, i))) continue;
-            if (kind == HFVIS_SUM_SKY_VIEW) E->acc[i] += wk * hf_svf_term(t);
-            else if (kind == HFVIS_SUM_SKY_LIGHT) E->acc[i] += hf_exact_sky_term(&E->d, k, cp, sp, nr, t);
-            else
-                hf_env_accumulate(&eval, k, cp, sp, (double)nr[0], (double)nr[1], (double)nr[2], t,
-                                  E->acc + i * (size_t)channels);
+        for (y = E->ry0; y < E->ry1; y++) { /* the receiver rectangle, one loop per kind */
+            size_t r = (size_t)y * (size_t)g->width, i;
+            const double *tr = E->tan + r;
+            double *ar = E->acc + r * (size_t)channels;
+            if (kind == HFVIS_SUM_SKY_VIEW) {
+                for (x = E->rx0; x < E->rx1; x++)
+                    if (!isnan(tr[x])) ar[x] += wk * hf_svf_term(tr[x]);
+            } else if (kind == HFVIS_SUM_SKY_LIGHT) {
+                for (x = E->rx0; x < E->rx1; x++)
+                    if (!isnan(tr[x])) ar[x] += hf_exact_sky_term(&E->d, k, cp, sp, E->nrm + (r + (size_t)x) * 3, tr[x]);
+            } else {
+                for (x = E->rx0; x < E->rx1; x++) {
+                    const float *nr = E->nrm + (r + (size_t)x) * 3;
+                    if (isnan(tr[x])) continue;
+                    i = r + (size_t)x;
+                    hf_env_accumulate(&eval, k, cp, sp, (double)nr[0], (double)nr[1], (double)nr[2], tr[x],
+                                      E->acc + i * (size_t)channels);
+                }
+            }
         }
         hf_progress(o, ++done, end - begin);
     }
