@@ -8437,16 +8437,11 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
 }
 
 /* Pop the [P1] §5 hull stack (sd, sh) of top entries for the sample (d, h) (Alg. 1, ties pop, as
- * hfvis_line_horizons); returns the new top. The first test apart: on rough terrain most samples
- * pop exactly one entry, and a branch of its own predicts that better than the loop's. */
+ * hfvis_line_horizons); returns the new top. */
 static inline int hf_exact_pop(const double *sd, const double *sh, int top, double d, double h)
 {
-#define HF_EXACT_BELOW (top >= 2 && (sh[top - 2] - h) * (d - sd[top - 1]) >= (sh[top - 1] - h) * (d - sd[top - 2]))
-    if (HF_EXACT_BELOW) {
+    while (top >= 2 && (sh[top - 2] - h) * (d - sd[top - 1]) >= (sh[top - 1] - h) * (d - sd[top - 2]))
         top--;
-        while (HF_EXACT_BELOW) top--;
-    }
-#undef HF_EXACT_BELOW
     return top;
 }
 
