@@ -8586,8 +8586,8 @@ static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, co
 }
 
 /* Scratch of one exact-mode call, one block: the K directions and their quadrature, the
- * crossings, one line's samples and receivers (the hull stack in place), the tangent plane, and optionally
- * grid normals and a channels-deep accumulator. */
+ * crossings, one line's samples and receivers (the hull stack in place), the tangent plane, and
+ * optionally grid normals and a channels-deep accumulator. */
 static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
                                   const hfvis_sweep_options *o, int want_tan, int want_normals,
                                   int channels)
@@ -8791,7 +8791,8 @@ static hfvis_status hf_exact_sums(hf_exact *E, const hfvis_grid *g, int K, hfvis
                     if (!isnan(tr[x])) ar[x] += wk * hf_svf_term(tr[x]);
             } else if (kind == HFVIS_SUM_SKY_LIGHT) {
                 for (x = E->rx0; x < E->rx1; x++)
-                    if (!isnan(tr[x])) ar[x] += hf_exact_sky_term(&E->d, k, cp, sp, E->nrm + (r + (size_t)x) * 3, tr[x]);
+                    if (!isnan(tr[x]))
+                        ar[x] += hf_exact_sky_term(&E->d, k, cp, sp, E->nrm + (r + (size_t)x) * 3, tr[x]);
             } else {
                 for (x = E->rx0; x < E->rx1; x++) {
                     const float *nr = E->nrm + (r + (size_t)x) * 3;
