@@ -8324,6 +8324,9 @@ static void hf_exact_dirs_fill(hf_exact_dirs *d, int K, double azimuth0, int N)
 typedef struct hf_cross {
     int ox, oy, kind;
     double f, u;
+    ptrdiff_t zoff, zstep; /* its first tap from g in the grid's heights, and its second from that */
+    ptrdiff_t coff;        /* the tap (0, 0) of its piece's cell from g in the grid's heights */
+    double mfx, mfy, mu;   /* the piece's midpoint: cell coordinates, distance from g (sub-steps) */
     /* the piece from this crossing to the next (or to g + (a, b)): inside cell (cx, cy) (offsets
        from g), from (fx0, fy0) to (fx1, fy1) in cell coordinates, du sub-steps long */
     int cx, cy;
@@ -8347,17 +8350,17 @@ typedef struct hf_exact {
     int N;                  /* denominator bound */
     hf_exact_dirs d;
     hf_cross *cross;        /* the current direction's crossings, up to 2N - 1 */
-    double *sd, *sh;        /* hull stack: distances (sub-steps), heights (world units) */
+    double *sd, *sh;        /* one line's samples, then its hull stack: distances (sub-steps),
+                               heights (world units) */
     double *tan;            /* width*height tangents of the current direction, NaN at holes */
-    double *twist;          /* width*height cell twists (hf_cell_twist), cell (x, y) at y*width + x */
     float *nrm;             /* width*height*3 grid normals (lighting), else NULL */
     double *acc;            /* width*height*channels sums, else NULL */
     int channels;
     double radius;          /* a finite search radius (world units), else 0 */
     int64_t win_rw;         /* the current direction's window, 1/16 sub-steps; -1 = unlimited */
     hf_win win;             /* one line's samples under the radius */
-    int *win_rec;           /* their receivers: sample index ... */
-    size_t *win_tan;        /* ... and grid index */
+    int *rec;               /* one line's receivers: their sample indices, then INT_MAX */
+    int eager;              /* the next line's pieces eager (HF_EXACT_EAGER_SHARE) */
     int ox, oy;             /* the tile's origin in the raster (hfvis.h, "Search radius and tiles") */
     int rx0, ry0, rx1, ry1; /* the receiver rectangle, [rx0, rx1) x [ry0, ry1) */
     int rect;               /* 1: a proper sub-rectangle */
@@ -8421,6 +8424,15 @@ static int hf_exact_geometry(hf_cross *cross, const hfvis_grid *g, int a, int b,
     *L = (double)A * (double)B;
     *scale = *L / (len * g->cell_size);
     hf_exact_pieces(cross, n, a, b, *L);
+    for (ja = 0; ja < n; ja++) {
+        hf_cross *c = cross + ja;
+        c->zoff = (ptrdiff_t)c->oy * g->stride + c->ox;
+        c->zstep = c->kind == 1 ? g->stride : 1;
+        c->coff = (ptrdiff_t)c->cy * g->stride + c->cx;
+        c->mfx = c->fx0 + 0.5 * (c->fx1 - c->fx0); /* hf_piece_fill's sample at t = 1/2, bit for bit */
+        c->mfy = c->fy0 + 0.5 * (c->fy1 - c->fy0);
+        c->mu = c->u + c->du * 0.5;
+    }
     return n;
 }
 
@@ -8448,17 +8460,17 @@ static double hf_cross_height(const hfvis_grid *g, hfvis_border border, int X, i
 }
 
 /* The twist z00 - z10 - z01 + z11 of the cell at p. */
-static double hf_cell_twist(const float *p, ptrdiff_t stride)
+static inline double hf_cell_twist(const float *p, ptrdiff_t stride)
 {
     return (double)p[0] - (double)p[1] - (double)p[stride] + (double)p[stride + 1];
 }
 
-/* The interior samples of a piece in cell (cx, cy) whose bulge exceeds lim (hf_piece_samples). */
-static int hf_piece_fill(const hfvis_grid *g, int cx, int cy, const hf_cross *c, double bulge,
-                         double lim, double *h, double *du)
+/* The interior samples of a piece in the cell whose tap (0, 0) is p (row stride `stride`), its
+ * bulge above lim (hf_piece_samples). */
+static int hf_piece_fill(const float *p, ptrdiff_t stride, const hf_cross *c, double bulge, double lim,
+                         double *h, double *du)
 {
-    const float *p = g->z + (ptrdiff_t)cy * g->stride + cx;
-    double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[g->stride], z11 = (double)p[g->stride + 1];
+    double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[stride], z11 = (double)p[stride + 1];
     double dfx = c->fx1 - c->fx0, dfy = c->fy1 - c->fy0, inv_m;
     int m = 1, j;
     while (m < HF_EXACT_MAX_SPLIT && bulge > lim * (double)m * (double)m) m *= 2;
@@ -8476,20 +8488,18 @@ static int hf_piece_fill(const hfvis_grid *g, int cx, int cy, const hf_cross *c,
  * HF_EXACT_MAX_SPLIT - 1 heights h[j] at sub-step offsets du[j] from the piece's start, in
  * increasing order, and returns the count; 0 for a piece that is not concave enough, outside
  * the grid or touching a hole. Inline: most pieces are rejected here. */
-static inline int hf_piece_samples(const hfvis_grid *g, const double *twist, int X, int Y,
-                                   const hf_cross *c, double *h, double *du)
+static inline int hf_piece_samples(const hfvis_grid *g, int X, int Y, const hf_cross *c, double *h,
+                                   double *du)
 {
     int cx = X + c->cx, cy = Y + c->cy;
     double bulge, lim;
     /* cx in [0, width - 2], cy in [0, height - 2] (the unsigned casts take the negatives out) */
     if (c->du == 0.0 || (unsigned)cx >= (unsigned)(g->width - 1) || (unsigned)cy >= (unsigned)(g->height - 1))
         return 0;
-    /* the twist z00 - z10 - z01 + z11 of the cell (precomputed by the sweep: one load) */
-    bulge = c->q * (twist ? twist[(size_t)cy * (size_t)g->width + (size_t)cx]
-                          : hf_cell_twist(g->z + (ptrdiff_t)cy * g->stride + cx, g->stride));
+    bulge = c->q * hf_cell_twist(g->z + (ptrdiff_t)cy * g->stride + cx, g->stride);
     lim = HF_EXACT_BULGE * g->cell_size;
     if (!(bulge > lim) || !isfinite(bulge)) return 0;
-    return hf_piece_fill(g, cx, cy, c, bulge, lim, h, du);
+    return hf_piece_fill(g->z + (ptrdiff_t)cy * g->stride + cx, g->stride, c, bulge, lim, h, du);
 }
 
 /* Whole periods k >= 0 of the ray from grid point (x, y) along (a, b) that can hold a crossing
@@ -8531,110 +8541,173 @@ static int hf_exact_rect_span(const hf_exact *E, int hx, int hy, int a, int b, i
     return 1;
 }
 
-/* One line of direction (a, b) from its head (hx, hy), the grid point whose successor
- * (hx + a, hy + b) lies outside the grid: the crossings beyond the head (the CLAMP/WRAP pre-roll,
- * or the part of a step still inside the grid), then each grid point (a receiver) and the
- * crossings behind it, through the [P1] §5 hull stack. */
-static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, double L, double scale)
+/* Pieces that split, as a share of those tested, above which a line computes every piece's
+ * midpoint and keeps it without a branch (hf_exact_piece, eager): on rough terrain a quarter of
+ * the pieces split at random and the branch mispredicts (fBm 512^2: eager 8 ns/rd faster); on
+ * flat roofs and ground almost none split and the branch is free (urban 512^2: 7 ns/rd slower
+ * eager). Decided per line from the line before; the output is the same either way. */
+#define HF_EXACT_EAGER_SHARE (1.0 / 16.0)
+
+/* The interior samples of piece c of the inner part of a line (between two grid points inside
+ * the grid, so its cell is inside too), zn at the nearer grid point's height, appended to
+ * (sd, sh) from index n far end first at distances base - offset; returns the new count and
+ * counts a split in *splits. hf_piece_samples' test and samples, bit for bit; the twist from the
+ * four taps the midpoint reads. eager: the midpoint of a piece split in two (most splits) is
+ * written for every piece and kept by the test's outcome, without a branch. */
+static inline int hf_exact_piece(const hfvis_grid *g, const hf_cross *c, const float *zn, double base,
+                                 double lim, double *sd, double *sh, int n, int eager, int *splits)
+{
+    const float *p = zn + c->coff;
+    double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[g->stride];
+    double z11 = (double)p[g->stride + 1], bulge = c->q * hf_cell_twist(p, g->stride);
+    int split = (bulge > lim) & (bulge < HFVIS__INF);
+    *splits += split;
+    if (bulge > 4.0 * lim && bulge < HFVIS__INF) { /* split into 4 or more (hf_piece_fill's m >= 4): rare */
+        double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
+        int j = hf_piece_fill(p, g->stride, c, bulge, lim, ph, pu);
+        while (j-- > 0) { /* far end first */
+            sd[n] = base - (c->u + pu[j]);
+            sh[n++] = ph[j];
+        }
+    } else if (eager || split) { /* split in two (a kept one has four finite taps: a finite height) */
+        double r0 = z00 + (z10 - z00) * c->mfx, r1 = z01 + (z11 - z01) * c->mfx;
+        sd[n] = base - c->mu;
+        sh[n] = r0 + (r1 - r0) * c->mfy;
+        n += split;
+    }
+    return n;
+}
+
+/* The samples of one line of direction (a, b) from its head (hx, hy), the grid point whose
+ * successor (hx + a, hy + b) lies outside the grid, to its grid point qn, in sweep order of
+ * increasing distance (sub-steps from the head) into (sd, sh): the crossings beyond the head (the
+ * CLAMP/WRAP pre-roll, or the part of a step still inside the grid), then each grid point q (a
+ * receiver, rec[q] its sample; a hole keeps height NaN) and the crossings and piece samples
+ * behind it. Crossings at holes are left out. Returns the count (the arrays hold one more).
+ * *eager_io: this line's pieces eager (hf_exact_piece); set for the next from this one's splits. */
+static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int P, double L, int qn,
+                            double *sd, double *sh, int *rec, int *eager_io)
 {
     const hfvis_grid *g = E->g;
     const hf_cross *cr = E->cross;
-    double *sd = E->sd, *sh = E->sh, ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
-    const ptrdiff_t stride = g->stride;
-    int top = 0, k, e, q, nw = 0, nr = 0, qhi = INT_MAX;
-    const int win = E->win_rw >= 0; /* a finite radius: collect the samples, then hf_window_line */
-    hf_win *W = &E->win;
-    if (E->rect && !hf_exact_rect_span(E, hx, hy, a, b, &qhi)) return; /* no receiver wanted */
-#define HF_HULL_PUSH(dd, hh)                                                                     \
-    do {                                                                                         \
-        while (top >= 2 &&                                                                       \
-               (sh[top - 2] - (hh)) * ((dd) - sd[top - 1]) >= (sh[top - 1] - (hh)) * ((dd) - sd[top - 2])) \
-            top--;                                                                               \
-    } while (0)
-#define HF_EMIT(dd, hh)                                                                          \
-    do {                                                                                         \
-        if (win) {                                                                               \
-            W->d[nw] = (dd);                                                                     \
-            W->h[nw++] = (hh);                                                                   \
-        } else {                                                                                 \
-            HF_HULL_PUSH(dd, hh);                                                                \
-            sd[top] = (dd);                                                                      \
-            sh[top++] = (hh);                                                                    \
-        }                                                                                        \
-    } while (0)
+    const ptrdiff_t z0 = (ptrdiff_t)hy * g->stride + hx, zstep = (ptrdiff_t)b * g->stride + a;
+    const double lim = HF_EXACT_BULGE * g->cell_size;
+    const int pieces = a != 0 && b != 0; /* along a grid line the surface is linear */
+    double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
+    int n = 0, k, e, q, j, splits = 0, eager = *eager_io;
     for (k = hf_exact_periods(g, E->R, hx, hy, a, b); k >= 0; k--) {
         int bx = hx + k * a, by = hy + k * b;
         for (e = P - 1; e >= 0; e--) {
-            int X = bx + cr[e].ox, Y = by + cr[e].oy, j = hf_piece_samples(g, E->twist, bx, by, cr + e, ph, pu);
-            double h, d;
+            int X = bx + cr[e].ox, Y = by + cr[e].oy;
+            double h;
+            j = hf_piece_samples(g, bx, by, cr + e, ph, pu);
             while (j-- > 0) { /* the piece after crossing e, far end first */
                 if (isnan(ph[j])) continue;
-                d = -((double)k * L + (cr[e].u + pu[j]));
-                HF_EMIT(d, ph[j]);
+                sd[n] = -((double)k * L + (cr[e].u + pu[j]));
+                sh[n++] = ph[j];
             }
             if ((k == 0 && e == 0) || !hf_cross_inside(g, E->R, X, Y, cr + e)) continue;
             h = hf_cross_height(g, E->border, X, Y, cr + e);
             if (isnan(h)) continue;
-            d = -((double)k * L + cr[e].u);
-            HF_EMIT(d, h);
+            sd[n] = -((double)k * L + cr[e].u);
+            sh[n++] = h;
         }
     }
     for (q = 0;; q++) {
-        int gx = hx - q * a, gy = hy - q * b, nx = gx - a, ny = gy - b;
-        double h = (double)g->z[(ptrdiff_t)gy * stride + gx], d = (double)q * L;
-        double *t = E->tan + (size_t)gy * (size_t)g->width + (size_t)gx;
-        if (win) {
-            W->d[nw] = d;
-            W->h[nw] = isfinite(h) ? h : HFVIS__NAN;
-            E->win_rec[nr] = nw++;
-            E->win_tan[nr++] = (size_t)gy * (size_t)g->width + (size_t)gx;
-        } else if (!isfinite(h)) {
-            *t = HFVIS__NAN;
-        } else {
-            HF_HULL_PUSH(d, h);
-            *t = top ? (sh[top - 1] - h) / (d - sd[top - 1]) * scale : -HFVIS__INF;
+        const ptrdiff_t zq = z0 - (ptrdiff_t)q * zstep;
+        const float *zn;
+        double h = (double)g->z[zq], base;
+        sd[n] = (double)q * L;
+        sh[n] = isfinite(h) ? h : HFVIS__NAN;
+        rec[q] = n++;
+        if (q == qn) break;
+        /* between grid points q and q + 1, both inside the grid, so are the crossings and cells */
+        zn = g->z + (zq - zstep);
+        base = (double)(q + 1) * L;
+        if (!pieces) continue; /* an axis: grid point q + 1 is the next sample */
+        for (e = P - 1; e > 0; e--) { /* the piece after crossing e, then crossing e */
+            const hf_cross *c = cr + e;
+            n = hf_exact_piece(g, c, zn, base, lim, sd, sh, n, eager, &splits);
+            h = (double)zn[c->zoff];
+            h += ((double)zn[c->zoff + c->zstep] - h) * c->f; /* as hf_cross_height */
+            sd[n] = base - c->u;
+            sh[n] = h;
+            n += isfinite(h) ? 1 : 0; /* a hole: overwritten by the next sample */
+        }
+        n = hf_exact_piece(g, cr, zn, base, lim, sd, sh, n, eager, &splits); /* crossing 0: point q + 1 */
+    }
+    if (pieces && qn > 0) *eager_io = (double)splits > HF_EXACT_EAGER_SHARE * (double)qn * (double)P;
+    return n;
+}
+
+/* Pop the [P1] §5 hull stack (sd, sh) of top entries for the sample (d, h) (Alg. 1, ties pop, as
+ * hfvis_line_horizons); returns the new top. */
+static inline int hf_exact_pop(const double *sd, const double *sh, int top, double d, double h)
+{
+    while (top >= 2 && (sh[top - 2] - h) * (d - sd[top - 1]) >= (sh[top - 1] - h) * (d - sd[top - 2]))
+        top--;
+    return top;
+}
+
+/* The hull pass over the samples of hf_exact_samples, in place (the stack never outgrows the
+ * samples read): receiver r (sample rec[r]) writes tan[t0 - r tstep] = the tangent of the hull at
+ * its turn times scale (-INFINITY: nothing before it, NaN: a hole). */
+static void hf_exact_hull(double *sd, double *sh, const int *rec, int nrec, double scale, double *tan,
+                          ptrdiff_t t0, ptrdiff_t tstep)
+{
+    int i = 0, top = 0, r;
+    for (r = 0; r < nrec; r++) {
+        double d, h;
+        for (; i < rec[r]; i++) {
+            d = sd[i];
+            h = sh[i];
+            top = hf_exact_pop(sd, sh, top, d, h);
             sd[top] = d;
             sh[top++] = h;
         }
-        if (nx < 0 || ny < 0 || nx >= g->width || ny >= g->height || q >= qhi) break;
-        for (e = P - 1; e >= 0; e--) { /* between two grid points: inside the grid */
-            const float *p = g->z + (ptrdiff_t)(ny + cr[e].oy) * stride + (nx + cr[e].ox);
-            int j = hf_piece_samples(g, E->twist, nx, ny, cr + e, ph, pu);
-            while (j-- > 0) {
-                if (isnan(ph[j])) continue;
-                d = (double)(q + 1) * L - (cr[e].u + pu[j]);
-                HF_EMIT(d, ph[j]);
-            }
-            if (e == 0) break; /* crossing 0 is the next receiver */
-            h = (double)p[0];
-            h += ((double)p[cr[e].kind == 1 ? stride : 1] - h) * cr[e].f; /* as hf_cross_height */
-            if (!isfinite(h)) continue;
-            d = (double)(q + 1) * L - cr[e].u;
-            HF_EMIT(d, h);
+        d = sd[i];
+        h = sh[i++];
+        if (isnan(h)) {
+            tan[t0 - (ptrdiff_t)r * tstep] = HFVIS__NAN;
+            continue;
         }
+        top = hf_exact_pop(sd, sh, top, d, h);
+        tan[t0 - (ptrdiff_t)r * tstep] = top ? (sh[top - 1] - h) / (d - sd[top - 1]) * scale : -HFVIS__INF;
+        sd[top] = d;
+        sh[top++] = h;
     }
-#undef HF_EMIT
-#undef HF_HULL_PUSH
-    if (win) {
+}
+
+/* One line of direction (a, b) from its head (hx, hy) (hf_exact_samples): the tangents of its
+ * grid points up to the last one in the receiver rectangle, by the hull or, under a finite
+ * radius, by hf_window_line. */
+static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, double L, double scale)
+{
+    const hfvis_grid *g = E->g;
+    const ptrdiff_t t0 = (ptrdiff_t)hy * g->width + hx, tstep = (ptrdiff_t)b * g->width + a;
+    int qn = hf_exact_periods(g, 0, hx, hy, -a, -b), qhi, n, q; /* the last grid point */
+    if (E->rect) {
+        if (!hf_exact_rect_span(E, hx, hy, a, b, &qhi)) return; /* no receiver wanted */
+        if (qhi < qn) qn = qhi;
+    }
+    if (E->win_rw < 0) {
+        hf_exact_samples(E, hx, hy, a, b, P, L, qn, E->sd, E->sh, E->rec, &E->eager);
+        hf_exact_hull(E->sd, E->sh, E->rec, qn + 1, scale, E->tan, t0, tstep);
+    } else {
         /* positions: 16 x the sub-step along the raster's line, counted from its grid point
            q = 0 = -floor((X a + Y b)/(a^2 + b^2)) (X, Y in the raster): a tile and the whole
            raster put every sample at the same integer */
+        hf_win *W = &E->win;
         int64_t n2 = (int64_t)a * a + (int64_t)b * b;
         int64_t dot = ((int64_t)hx + E->ox) * a + ((int64_t)hy + E->oy) * b;
         double base = -(double)hf_floor_div64(dot, n2) * L;
         int i;
-        for (i = 0; i < nw; i++) W->pos[i] = (int64_t)(16.0 * (base + W->d[i]));
-        E->win_rec[nr] = INT_MAX; /* the list's end */
-        hf_window_line(W, nw, E->win_rw, 0, E->win_rec);
-        for (i = 0; i < nr; i++) E->tan[E->win_tan[i]] = W->t[E->win_rec[i]] * scale;
+        n = hf_exact_samples(E, hx, hy, a, b, P, L, qn, W->d, W->h, E->rec, &E->eager);
+        for (i = 0; i < n; i++) W->pos[i] = (int64_t)(16.0 * (base + W->d[i]));
+        E->rec[qn + 1] = INT_MAX; /* the list's end */
+        hf_window_line(W, n, E->win_rw, 0, E->rec);
+        for (q = 0; q <= qn; q++) E->tan[t0 - (ptrdiff_t)q * tstep] = W->t[E->rec[q]] * scale;
     }
-}
-
-/* Is grid index i inside the receiver rectangle? */
-static int hf_exact_receiver(const hf_exact *E, size_t i)
-{
-    int x = (int)(i % (size_t)E->g->width), y = (int)(i / (size_t)E->g->width);
-    return x >= E->rx0 && x < E->rx1 && y >= E->ry0 && y < E->ry1;
 }
 
 /* The window of a finite radius R (world units) in 1/16 sub-steps: scale is the tangent factor
@@ -8654,6 +8727,7 @@ static void hf_exact_sweep(hf_exact *E, hf_ray r)
     double L, scale;
     int P = hf_exact_geometry(E->cross, g, r.a, r.b, &L, &scale), x, y;
     E->win_rw = E->radius > 0.0 ? hf_exact_window(E->radius, scale) : -1;
+    E->eager = 0;
     for (y = 0; y < g->height; y++) {
         int xlo, xhi;
         if (y + r.b < 0 || y + r.b >= g->height) {
@@ -8687,7 +8761,7 @@ static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, co
         for (e = 0; e < P; e++) {
             int X = x + k * a + cr[e].ox, Y = y + k * b + cr[e].oy, j;
             double h, s, ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
-            int np = hf_piece_samples(g, NULL, x + k * a, y + k * b, cr + e, ph, pu);
+            int np = hf_piece_samples(g, x + k * a, y + k * b, cr + e, ph, pu);
             for (j = 0; j < np; j++) {
                 if (isnan(ph[j])) continue;
                 if (rw >= 0 && 16.0 * ((double)k * L + (cr[e].u + pu[j])) > (double)rw) continue;
@@ -8705,14 +8779,14 @@ static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, co
 }
 
 /* Scratch of one exact-mode call, one block: the K directions and their quadrature, the
- * crossings, the hull stack (one line's crossings at most), the tangent plane, and optionally
- * grid normals and a channels-deep accumulator. */
+ * crossings, one line's samples and receivers (the hull stack in place), the tangent plane, and
+ * optionally grid normals and a channels-deep accumulator. */
 static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
                                   const hfvis_sweep_options *o, int want_tan, int want_normals,
                                   int channels)
 {
-    size_t total = 0, off_ray, off_d, off_c, off_s, off_t = 0, off_w, off_n = 0, off_a = 0, gridn, cap;
-    size_t off_win = 0, off_wt = 0, off_wr = 0;
+    size_t total = 0, off_ray, off_d, off_c, off_s, off_t = 0, off_n = 0, off_a = 0, gridn, cap;
+    size_t off_win = 0, off_r;
     int ok = 1, k, maxp = 1, side = g->width > g->height ? g->width : g->height;
     unsigned char *blk;
     memset(E, 0, sizeof *E);
@@ -8745,7 +8819,6 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     off_c = hf_align_add(&total, (size_t)maxp, sizeof(hf_cross), &ok);
     off_s = hf_align_add(&total, cap, 2u * sizeof(double), &ok);
     if (want_tan) off_t = hf_align_add(&total, gridn, sizeof(double), &ok);
-    off_w = hf_align_add(&total, gridn, sizeof(double), &ok);
     if (want_normals) off_n = hf_align_add(&total, gridn, 3u * sizeof(float), &ok);
     if (channels) off_a = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
     E->radius = hf_radius_on(o) ? o->max_distance : 0.0;
@@ -8754,11 +8827,8 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     E->oy = o->origin_y;
     hf_receiver_rect(g, o, &E->rx0, &E->ry0, &E->rx1, &E->ry1);
     E->rect = E->rx0 > 0 || E->ry0 > 0 || E->rx1 < g->width || E->ry1 < g->height;
-    if (E->radius > 0.0) {
-        off_win = hf_align_add(&total, cap, HF_WIN_BYTES_PER_SAMPLE, &ok);
-        off_wt = hf_align_add(&total, cap, sizeof(size_t), &ok);
-        off_wr = hf_align_add(&total, cap + 1, sizeof(int), &ok);
-    }
+    if (E->radius > 0.0) off_win = hf_align_add(&total, cap, HF_WIN_BYTES_PER_SAMPLE, &ok);
+    off_r = hf_align_add(&total, cap + 1, sizeof(int), &ok);
     if (!ok) return HFVIS_ERR_LIMIT;
     blk = (unsigned char *)hfvis__alloc(o->alloc, total);
     if (!blk) return HFVIS_ERR_OUT_OF_MEMORY;
@@ -8773,21 +8843,10 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     E->sd = (double *)(void *)(blk + off_s);
     E->sh = E->sd + cap;
     E->tan = want_tan ? (double *)(void *)(blk + off_t) : NULL;
-    E->twist = (double *)(void *)(blk + off_w);
-    {
-        int x, y;
-        for (y = 0; y + 1 < g->height; y++)
-            for (x = 0; x + 1 < g->width; x++)
-                E->twist[(size_t)y * (size_t)g->width + (size_t)x] =
-                    hf_cell_twist(g->z + (ptrdiff_t)y * g->stride + x, g->stride);
-    }
     E->nrm = want_normals ? (float *)(void *)(blk + off_n) : NULL;
     E->acc = channels ? (double *)(void *)(blk + off_a) : NULL;
-    if (E->radius > 0.0) {
-        hf_win_carve(&E->win, blk + off_win, cap);
-        E->win_tan = (size_t *)(void *)(blk + off_wt);
-        E->win_rec = (int *)(void *)(blk + off_wr);
-    }
+    if (E->radius > 0.0) hf_win_carve(&E->win, blk + off_win, cap);
+    E->rec = (int *)(void *)(blk + off_r);
     hf_exact_dirs_fill(&E->d, K, o->azimuth0_rad, E->N);
     if (want_normals) (void)hfvis_normals_compute(g, E->nrm); /* the grid normals, as floats */
     if (channels) memset(E->acc, 0, gridn * (size_t)channels * sizeof(double));
@@ -8903,8 +8962,7 @@ static hfvis_status hf_exact_sums(hf_exact *E, const hfvis_grid *g, int K, hfvis
     hfvis_status s;
     hf_env_eval eval;
     float *table = NULL;
-    int channels = kind == HFVIS_SUM_ENV_LIGHT ? env->channels : 1, k, done = 0;
-    size_t i, n = hf_grid_count(g);
+    int channels = kind == HFVIS_SUM_ENV_LIGHT ? env->channels : 1, k, done = 0, x, y;
     if ((s = hf_exact_init(E, g, K, o, 1, kind != HFVIS_SUM_SKY_VIEW, channels)) != HFVIS_OK) return s;
     if (kind == HFVIS_SUM_ENV_LIGHT &&
         (s = hf_exact_env_tables(&E->d, env, eopts, o->alloc, &table, &eval)) != HFVIS_OK) {
@@ -8917,15 +8975,26 @@ static hfvis_status hf_exact_sums(hf_exact *E, const hfvis_grid *g, int K, hfvis
         double cp = cos(E->d.ray[k].azimuth), sp = sin(E->d.ray[k].azimuth);
         if (pos < begin || pos >= end) continue;
         hf_exact_sweep(E, E->d.ray[k]);
-        for (i = 0; i < n; i++) {
-            double t = E->tan[i];
-            const float *nr = E->nrm ? E->nrm + i * 3 : NULL;
-            if (isnan(t) || (E->rect && !hf_exact_receiver(E, i))) continue;
-            if (kind == HFVIS_SUM_SKY_VIEW) E->acc[i] += wk * hf_svf_term(t);
-            else if (kind == HFVIS_SUM_SKY_LIGHT) E->acc[i] += hf_exact_sky_term(&E->d, k, cp, sp, nr, t);
-            else
-                hf_env_accumulate(&eval, k, cp, sp, (double)nr[0], (double)nr[1], (double)nr[2], t,
-                                  E->acc + i * (size_t)channels);
+        for (y = E->ry0; y < E->ry1; y++) { /* the receiver rectangle, one loop per kind */
+            size_t r = (size_t)y * (size_t)g->width, i;
+            const double *tr = E->tan + r;
+            double *ar = E->acc + r * (size_t)channels;
+            if (kind == HFVIS_SUM_SKY_VIEW) {
+                for (x = E->rx0; x < E->rx1; x++)
+                    if (!isnan(tr[x])) ar[x] += wk * hf_svf_term(tr[x]);
+            } else if (kind == HFVIS_SUM_SKY_LIGHT) {
+                for (x = E->rx0; x < E->rx1; x++)
+                    if (!isnan(tr[x]))
+                        ar[x] += hf_exact_sky_term(&E->d, k, cp, sp, E->nrm + (r + (size_t)x) * 3, tr[x]);
+            } else {
+                for (x = E->rx0; x < E->rx1; x++) {
+                    const float *nr = E->nrm + (r + (size_t)x) * 3;
+                    if (isnan(tr[x])) continue;
+                    i = r + (size_t)x;
+                    hf_env_accumulate(&eval, k, cp, sp, (double)nr[0], (double)nr[1], (double)nr[2], tr[x],
+                                      E->acc + i * (size_t)channels);
+                }
+            }
         }
         hf_progress(o, ++done, end - begin);
     }
