@@ -813,7 +813,7 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     1024 cells, exact rays 512^2 1.4-2.3x (1.65-1.8x at R = 256). R = 0 or +INFINITY is the
  *     unlimited sweep's code path, bit for bit.
  *   - Memory: one line's window scratch, 100 bytes per sample of the longest line (lattice:
- *     about the grid diagonal; exact rays: the hull stack's length, plus 12 bytes per sample).
+ *     about the grid diagonal; exact rays: the hull stack's length, plus 4 bytes per sample).
  *   - Tiles. Set origin_x/y to the grid's place in the raster, extent_width/height to the
  *     raster's size and receiver_* to the window inside the grid. Everything that depends on
  *     position is computed in raster coordinates: lattice nodes lie at raster positions
