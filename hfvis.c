@@ -8640,41 +8640,26 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
     return n;
 }
 
-/* Pop the [P1] §5 hull stack (sd, sh) of top entries for the sample (d, h) (Alg. 1, ties pop, as
- * hfvis_line_horizons); returns the new top. */
-static inline int hf_exact_pop(const double *sd, const double *sh, int top, double d, double h)
-{
-    while (top >= 2 && (sh[top - 2] - h) * (d - sd[top - 1]) >= (sh[top - 1] - h) * (d - sd[top - 2]))
-        top--;
-    return top;
-}
-
 /* The hull pass over the samples of hf_exact_samples, in place (the stack never outgrows the
- * samples read): receiver r (sample rec[r]) writes tan[t0 - r tstep] = the tangent of the hull at
- * its turn times scale (-INFINITY: nothing before it, NaN: a hole). */
+ * samples read; two NaN slots below it, as hf_hull_step needs): the [P1] §5 hull stack (Alg. 1,
+ * ties pop, as hfvis_line_horizons) steps over every sample, and receiver r (sample rec[r])
+ * writes tan[t0 - r tstep] = the tangent of the hull at its turn times scale (-INFINITY: nothing
+ * before it, NaN: a hole). */
 static void hf_exact_hull(double *sd, double *sh, const int *rec, int nrec, double scale, double *tan,
                           ptrdiff_t t0, ptrdiff_t tstep)
 {
-    int i = 0, top = 0, r;
+    ptrdiff_t top = 0;
+    int i = 0, r;
     for (r = 0; r < nrec; r++) {
         double d, h;
-        for (; i < rec[r]; i++) {
-            d = sd[i];
-            h = sh[i];
-            top = hf_exact_pop(sd, sh, top, d, h);
-            sd[top] = d;
-            sh[top++] = h;
-        }
+        for (; i < rec[r]; i++) (void)hf_hull_step(sh, sd, &top, sh[i], sd[i]);
         d = sd[i];
         h = sh[i++];
         if (isnan(h)) {
             tan[t0 - (ptrdiff_t)r * tstep] = HFVIS__NAN;
             continue;
         }
-        top = hf_exact_pop(sd, sh, top, d, h);
-        tan[t0 - (ptrdiff_t)r * tstep] = top ? (sh[top - 1] - h) / (d - sd[top - 1]) * scale : -HFVIS__INF;
-        sd[top] = d;
-        sh[top++] = h;
+        tan[t0 - (ptrdiff_t)r * tstep] = hf_hull_step(sh, sd, &top, h, d) * scale; /* scale > 0 */
     }
 }
 
@@ -8817,7 +8802,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     off_ray = hf_align_add(&total, (size_t)K, sizeof(hf_ray), &ok);
     off_d = hf_align_add(&total, (size_t)K * 5u, sizeof(double), &ok);
     off_c = hf_align_add(&total, (size_t)maxp, sizeof(hf_cross), &ok);
-    off_s = hf_align_add(&total, cap, 2u * sizeof(double), &ok);
+    off_s = hf_align_add(&total, cap + 2u, 2u * sizeof(double), &ok); /* + the hull's NaN slots */
     if (want_tan) off_t = hf_align_add(&total, gridn, sizeof(double), &ok);
     if (want_normals) off_n = hf_align_add(&total, gridn, 3u * sizeof(float), &ok);
     if (channels) off_a = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
@@ -8840,8 +8825,9 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     E->d.lo = E->d.ls + K;
     E->d.hi = E->d.lo + K;
     E->cross = (hf_cross *)(void *)(blk + off_c);
-    E->sd = (double *)(void *)(blk + off_s);
-    E->sh = E->sd + cap;
+    E->sd = (double *)(void *)(blk + off_s) + 2;
+    E->sh = E->sd + cap + 2;
+    E->sd[-2] = E->sd[-1] = E->sh[-2] = E->sh[-1] = HFVIS__NAN; /* below the stack: hf_hull_step */
     E->tan = want_tan ? (double *)(void *)(blk + off_t) : NULL;
     E->nrm = want_normals ? (float *)(void *)(blk + off_n) : NULL;
     E->acc = channels ? (double *)(void *)(blk + off_a) : NULL;
