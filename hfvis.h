@@ -753,9 +753,9 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     where the lattice costs about one node, so a larger N buys smaller deviations with longer
  *     sweeps: K = 16 with the default N = 5 takes directions (1,0), (5,2), (1,1), (2,5): 3.5
  *     crossings per receiver-direction on average, plus the interior samples below. Measured
- *     (make bench, section exact): the horizon map 0.5-0.7x the lattice map's time on urban
- *     DSMs (no gather), 1.5-2.1x on fBm rough at the cell scale; the fused sky-view factor
- *     1.0-1.3x and 2.1-3.3x.
+ *     (make bench, section exact, 512^2 and 1024^2, K = 16): the horizon map 0.65-0.85x the
+ *     lattice map's time on urban DSMs (no gather), 1.2-2.3x on fBm rough at the cell scale;
+ *     the fused sky-view factor 1.2-2.1x and 2.1-4.1x.
  *   - Quadrature: every direction integral uses the actual azimuths phi_k. Direction k owns the
  *     sector between the midpoints to its neighbours (edges rounded to multiples of 2^-40 turn,
  *     so the shares w_k are exact and add up to exactly 1): the sky-view factor is
