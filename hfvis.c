@@ -8640,60 +8640,37 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
     return n;
 }
 
-/* A sample's gap below the chord of its neighbours, as a share of the sum of the three heights'
- * magnitudes, above which hf_exact_thin drops it: the hull's tests round each height difference
- * to within a few units of 2^-53 of these heights, so 2^-30 of them is never a rounding tie. */
-#define HF_EXACT_THIN_TOL (1.0 / 1073741824.0)
-
-/* Drops, in place and without a branch, every sample of hf_exact_samples that is not a receiver
- * and lies more than HF_EXACT_THIN_TOL below the chord of its two finite neighbours: the slopes
- * of a run of such samples increase, so each lies below the chord of the samples kept around the
- * run and is on no upper hull of a prefix past it ([P1] §5): it is never a receiver's horizon.
- * The receivers' indices rec[] are moved with their samples. Unlimited lines only: under a
- * radius the chord's far end can be out of a receiver's reach. */
-static void hf_exact_thin(double *sd, double *sh, int *rec, int nrec)
-{
-    double dp = HFVIS__NAN, hp = HFVIS__NAN; /* the sample before, as read (none before 0) */
-    int i = 0, w = 0, r;
-    for (r = 0; r < nrec; r++) {
-        for (; i < rec[r]; i++) { /* sample i + 1 is not overwritten yet: w <= i */
-            const double dc = sd[i], hc = sh[i], dn = sd[i + 1], hn = sh[i + 1];
-            const double gap = (hn - hc) * (dc - dp) - (hc - hp) * (dn - dc); /* NaN at a hole */
-            sd[w] = dc;
-            sh[w] = hc;
-            w += !(gap > HF_EXACT_THIN_TOL * (fabs(hp) + fabs(hc) + fabs(hn)) * (dn - dp));
-            dp = dc;
-            hp = hc;
-        }
-        dp = sd[i];
-        hp = sh[i++];
-        sd[w] = dp;
-        sh[w] = hp;
-        rec[r] = w++;
-    }
-}
-
 /* The hull pass over the samples of hf_exact_samples, in place (the stack never outgrows the
  * samples read; two NaN slots below it, as hf_hull_step needs): the [P1] §5 hull stack (Alg. 1,
  * ties pop, as hfvis_line_horizons) steps over every sample, and receiver r (sample rec[r])
  * writes tan[t0 - r tstep] = the tangent of the hull at its turn times scale (-INFINITY: nothing
- * before it, NaN: a hole). */
-static void hf_exact_hull(double *sd, double *sh, int *rec, int nrec, double scale, double *tan,
+ * before it, NaN: a hole). The top is always the sample pushed last, so its differences come
+ * from registers (hf_hull_push) rather than from the stack just stored. */
+static void hf_exact_hull(double *sd, double *sh, const int *rec, int nrec, double scale, double *tan,
                           ptrdiff_t t0, ptrdiff_t tstep)
 {
     ptrdiff_t top = 0;
+    double dt = 0.0, ht = HFVIS__NAN; /* the stack's top, sample last pushed (none: NaN) */
     int i = 0, r;
-    hf_exact_thin(sd, sh, rec, nrec);
     for (r = 0; r < nrec; r++) {
-        double d, h;
-        for (; i < rec[r]; i++) (void)hf_hull_step(sh, sd, &top, sh[i], sd[i]);
+        double d, h, t;
+        for (; i < rec[r]; i++) {
+            d = sd[i];
+            h = sh[i];
+            (void)hf_hull_push(sh, sd, &top, h, d, ht - h, d - dt);
+            dt = d;
+            ht = h;
+        }
         d = sd[i];
         h = sh[i++];
         if (isnan(h)) {
             tan[t0 - (ptrdiff_t)r * tstep] = HFVIS__NAN;
             continue;
         }
-        tan[t0 - (ptrdiff_t)r * tstep] = hf_hull_step(sh, sd, &top, h, d) * scale; /* scale > 0 */
+        t = hf_hull_push(sh, sd, &top, h, d, ht - h, d - dt);
+        tan[t0 - (ptrdiff_t)r * tstep] = (isnan(ht) ? -HFVIS__INF : t) * scale; /* scale > 0 */
+        dt = d;
+        ht = h;
     }
 }
 
