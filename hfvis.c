@@ -8644,22 +8644,33 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
  * samples read; two NaN slots below it, as hf_hull_step needs): the [P1] §5 hull stack (Alg. 1,
  * ties pop, as hfvis_line_horizons) steps over every sample, and receiver r (sample rec[r])
  * writes tan[t0 - r tstep] = the tangent of the hull at its turn times scale (-INFINITY: nothing
- * before it, NaN: a hole). */
+ * before it, NaN: a hole). The top is always the sample pushed last, so its differences come
+ * from registers (hf_hull_push) rather than from the stack just stored. */
 static void hf_exact_hull(double *sd, double *sh, const int *rec, int nrec, double scale, double *tan,
                           ptrdiff_t t0, ptrdiff_t tstep)
 {
     ptrdiff_t top = 0;
+    double dt = 0.0, ht = HFVIS__NAN; /* the stack's top, sample last pushed (none: NaN) */
     int i = 0, r;
     for (r = 0; r < nrec; r++) {
-        double d, h;
-        for (; i < rec[r]; i++) (void)hf_hull_step(sh, sd, &top, sh[i], sd[i]);
+        double d, h, t;
+        for (; i < rec[r]; i++) {
+            d = sd[i];
+            h = sh[i];
+            (void)hf_hull_push(sh, sd, &top, h, d, ht - h, d - dt);
+            dt = d;
+            ht = h;
+        }
         d = sd[i];
         h = sh[i++];
         if (isnan(h)) {
             tan[t0 - (ptrdiff_t)r * tstep] = HFVIS__NAN;
             continue;
         }
-        tan[t0 - (ptrdiff_t)r * tstep] = hf_hull_step(sh, sd, &top, h, d) * scale; /* scale > 0 */
+        t = hf_hull_push(sh, sd, &top, h, d, ht - h, d - dt);
+        tan[t0 - (ptrdiff_t)r * tstep] = (isnan(ht) ? -HFVIS__INF : t) * scale; /* scale > 0 */
+        dt = d;
+        ht = h;
     }
 }
 
