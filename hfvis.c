@@ -2290,17 +2290,13 @@ static int hf_line_rect(const hf_sweep *sw, int i0, int j0, int di, int dj, int 
 }
 
 static inline double hf_svf_term(double t);
-static void hf_svf_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdiff_t step, int n,
-                        const double *t);
 static inline double hf_sky_term(double t, double nz, double a, double inv_k, double lobe);
-static void hf_sky_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdiff_t step, int n,
-                        const double *t);
-static void hf_sky_constants(const void *vctx, double c[4]);
 
-/* What the line walk does with each tangent t at node p (s-th of the line). The kind is a
- * constant at each call of hf_walk_line, so the compiler writes one walk per kind. The two sums
- * add each term as hf_svf_line and hf_sky_line would (the same additions in the same order), so
- * their tangents are never stored and read back. */
+/* What is done with each tangent t at node p (s-th of a line): stored for the line's consumer,
+ * or the sky-view or sky term added to the accumulator there (the sums' one copy: hf_svf_line
+ * and hf_sky_line call it too). The kind is a constant at each call of hf_walk_line, so the
+ * compiler writes one walk per kind, and the sums' tangents are never stored and read back.
+ * sky: look direction (x, y), 1/K, the lobe factor. */
 enum { HF_WALK_STORE, HF_WALK_SVF, HF_WALK_SKY };
 
 static HFVIS__ALWAYS_INLINE void hf_walk_emit(int kind, double *lat, const float *nrm, const double sky[4],
@@ -2309,7 +2305,7 @@ static HFVIS__ALWAYS_INLINE void hf_walk_emit(int kind, double *lat, const float
     if (kind == HF_WALK_STORE) {
         t[s] = tan;
     } else if (kind == HF_WALK_SVF) {
-        lat[p] += hf_svf_term(tan); /* a NaN tan (overflowing heights) adds 0; hf_svf_line skips it */
+        lat[p] += hf_svf_term(tan); /* a NaN tan (overflowing heights) adds +0: no change */
     } else if (!isnan(tan)) {
         const float *nr = nrm + p * 3;
         double a = (double)nr[0] * sky[0] + (double)nr[1] * sky[1];
@@ -2352,10 +2348,13 @@ static HFVIS__ALWAYS_INLINE void hf_walk_line(hf_sweep *sw, int kind, const doub
 }
 
 /* Run orientation m of the current group: copy each line (with its pre-roll) out of the
- * sampled lattice, find the horizons, hand them to fn. brute = 1 uses the oracle. (Sweeping
+ * sampled lattice, find the horizons, hand them to fn. brute = 1 uses the oracle. walk
+ * (HF_WALK_SVF, HF_WALK_SKY with its constants sky) adds that sum inside the unlimited walk
+ * instead; fn, its same sum, still serves the windowed and oracle paths. (Sweeping
  * columns several side by side, so each row step reads whole cache lines, measured no faster:
  * docs/performance.md.) */
-static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, void *ctx)
+static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, void *ctx, int walk,
+                                 const double sky[4])
 {
     int nlines = (m & 1) ? sw->cols : sw->rows, line;
     const hfvis_lattice *L = &sw->L;
@@ -2388,11 +2387,9 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
             continue;
         }
         if (R > 0) top = hf_preroll(sw, i0, j0, di, dj, sh, sd);
-        if (fn == hf_svf_line) {
+        if (walk == HF_WALK_SVF) {
             hf_walk_line(sw, HF_WALK_SVF, NULL, node0, step, slo, shi, top, t);
-        } else if (fn == hf_sky_line) {
-            double sky[4];
-            hf_sky_constants(ctx, sky);
+        } else if (walk == HF_WALK_SKY) {
             hf_walk_line(sw, HF_WALK_SKY, sky, node0, step, slo, shi, top, t);
         } else {
             hf_walk_line(sw, HF_WALK_STORE, NULL, node0, step, slo, shi, top, t);
@@ -2665,10 +2662,10 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
  * without the tap table: a tap with zero weight or a non-finite value adds +0.0 instead of being
  * skipped, which leaves every sum bit-identical (a sum started at +0.0 is never -0.0, and
  * x + 0.0 == x otherwise). Everything else takes the general routine. */
-/* One grid point (x, y) at lattice coordinates (a, b), any channel count, added to acc. (With
- * the two fallbacks merged into one, gcc 12 -O2 inlines this into the grid loop, which then
- * spills its invariants again: 26.8 -> 30.2 instructions per rd, docs/performance.md.) */
-static void hf_gather_point(const hf_sweep *sw, int x, int y, double a, double b, double *acc)
+/* One grid point (x, y) at lattice coordinates (a, b), any channel count, added to acc. Kept out
+ * of line: inlined into the grid loop (as gcc 12 -O2 chose once its callers changed), the loop
+ * spills its invariants again, 26.8 -> 30.2 instructions per rd (docs/performance.md). */
+static HFVIS__NOINLINE void hf_gather_point(const hf_sweep *sw, int x, int y, double a, double b, double *acc)
 {
     const double *lat = sw->lat;
     const ptrdiff_t cols = sw->cols;
@@ -2861,7 +2858,7 @@ static hfvis_status hf_horizon_lattice_impl(const hfvis_grid *grid, double azimu
     hf_sweep_vector(azimuth_rad, &ux, &uy);
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HFVIS__NAN);
-    hf_sweep_orientation(&sw, 0, brute, hf_store_elevation, NULL);
+    hf_sweep_orientation(&sw, 0, brute, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
     n = (size_t)sw.rows * (size_t)sw.cols;
     for (i = 0; i < n; i++) out[i] = (float)sw.lat[i];
     hf_sweep_free(&sw);
@@ -2903,7 +2900,7 @@ hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, int k,
     hf_direction_base(K, k, o.azimuth0_rad, &ux, &uy, &m);
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HFVIS__NAN);
-    hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL);
+    hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
     hf_gather_planes(&sw, 1, m, out, 0, out_stride);
     hf_sweep_free(&sw);
     hf_progress(&o, 1, 1);
@@ -2943,7 +2940,7 @@ static hfvis_status hf_horizon_map_range(const hfvis_grid *grid, int K, const hf
                 sampled = 1;
             }
             hf_lattice_fill(&sw, HFVIS__NAN);
-            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL);
+            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
             hf_gather_planes(&sw, 1, m, out + (size_t)(pos - begin) * plane, 0, grid->width);
             hf_progress(o, ++done, end - begin);
         }
@@ -2980,7 +2977,7 @@ hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_
         if (sw.rect) hf_lattice_fill(&sw, HFVIS__NAN);
         else hf_lattice_fill_outside(&sw, HFVIS__NAN);
         for (m = 0; m < per; m++) {
-            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL);
+            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
             hf_progress(&o, ++done, K);
         }
         /* plane k = gidx + m*groups: channel m lands m*groups planes further on */
@@ -3299,6 +3296,8 @@ static inline double hf_sky_term(double t, double nz, double a, double inv_k, do
 typedef struct hf_fused {
     int K, k;
     double lx, ly;          /* look direction of direction k */
+    int walk;               /* HF_WALK_SVF, HF_WALK_SKY: fn's sum added inside the line walk */
+    double inv_k, lobe;     /* the sky term's 1/K and lobe factor (hf_sky_setup) */
     size_t extra_size;      /* extra scratch bytes the consumer needs (sw->extra) */
     /* optional hooks: after a group's lattice is sampled, and instead of the P1 line walk */
     void (*group)(hf_sweep *sw, struct hf_fused *ctx);
@@ -3352,7 +3351,10 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
             ctx->k = k;
             hf_look_dir(sw, m, &ctx->lx, &ctx->ly);
             if (ctx->orient) ctx->orient(sw, m, ctx);
-            else hf_sweep_orientation(sw, m, 0, fn, ctx);
+            else {
+                const double sky[4] = {ctx->lx, ctx->ly, ctx->inv_k, ctx->lobe};
+                hf_sweep_orientation(sw, m, 0, fn, ctx, ctx->walk, sky);
+            }
             hf_progress(o, ++done, end - begin);
         }
         hf_gather_accumulate(sw);
@@ -3375,37 +3377,27 @@ static void hf_fused_output(const hf_sweep *sw, double scale, double offset, flo
         }
 }
 
-typedef struct hf_sky_ctx {
-    hf_fused f;
-    double inv_k, lobe;
-} hf_sky_ctx;
-
-/* The sky term's constants for hf_walk_line: look direction, 1/K, the lobe factor. */
-static void hf_sky_constants(const void *vctx, double c[4])
+/* The fused sky light's consumer: [P1] Eq. 5 per direction (hf_sky_term), inside the line
+ * walk; hf_sky_line is the same sum over a line's stored tangents (windowed and oracle paths). */
+static void hf_sky_setup(hf_fused *f, int K)
 {
-    const hf_sky_ctx *sc = (const hf_sky_ctx *)vctx;
-    c[0] = sc->f.lx;
-    c[1] = sc->f.ly;
-    c[2] = sc->inv_k;
-    c[3] = sc->lobe;
+    f->walk = HF_WALK_SKY;
+    f->inv_k = 1.0 / (double)K;
+    f->lobe = sin(HFVIS__PI / (double)K) / HFVIS__PI;
 }
 
 static void hf_sky_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdiff_t step, int n,
                         const double *t)
 {
-    const hf_sky_ctx *c = (const hf_sky_ctx *)vctx;
+    const hf_fused *c = (const hf_fused *)vctx;
     /* in locals: the store to lat could alias the context, so gcc reloaded them at every node */
-    const double lx = c->f.lx, ly = c->f.ly, inv_k = c->inv_k, lobe = c->lobe;
+    const double sky[4] = {c->lx, c->ly, c->inv_k, c->lobe};
     const float *nrm = sw->nrm;
     double *lat = sw->lat;
     int s;
     (void)m;
-    for (s = 0; s < n; s++, node0 += step) {
-        const float *nr = nrm + node0 * 3;
-        double a = (double)nr[0] * lx + (double)nr[1] * ly;
-        if (isnan(t[s])) continue;
-        lat[node0] += hf_sky_term(t[s], (double)nr[2], a, inv_k, lobe);
-    }
+    for (s = 0; s < n; s++, node0 += step)
+        if (!isnan(t[s])) hf_walk_emit(HF_WALK_SKY, lat, nrm, sky, NULL, s, node0, t[s]);
 }
 
 static int hf_light_args_valid(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
@@ -3420,7 +3412,7 @@ hfvis_status hfvis_sky_light(const hfvis_grid *grid, int K, float sky, float alb
 {
     hfvis_sweep_options o;
     hf_sweep sw;
-    hf_sky_ctx ctx;
+    hf_fused ctx;
     hfvis_status s;
     if (!hf_light_args_valid(grid, K, opts, out, out_stride) || !isfinite(sky) || !isfinite(albedo))
         return HFVIS_ERR_INVALID_ARGUMENT;
@@ -3429,9 +3421,8 @@ hfvis_status hfvis_sky_light(const hfvis_grid *grid, int K, float sky, float alb
         return hf_exact_light(grid, K, HFVIS_SUM_SKY_LIGHT, NULL, NULL, &o,
                               (double)sky * (double)albedo, out, out_stride);
     memset(&ctx, 0, sizeof ctx);
-    ctx.inv_k = 1.0 / (double)K;
-    ctx.lobe = sin(HFVIS__PI / (double)K) / HFVIS__PI;
-    if ((s = hf_fused_run(&sw, grid, K, &o, 1, 1, hf_sky_line, &ctx.f)) != HFVIS_OK) return s;
+    hf_sky_setup(&ctx, K);
+    if ((s = hf_fused_run(&sw, grid, K, &o, 1, 1, hf_sky_line, &ctx)) != HFVIS_OK) return s;
     hf_fused_output(&sw, (double)sky * (double)albedo, 0.0, out, out_stride, 1);
     hf_sweep_free(&sw);
     return HFVIS_OK;
@@ -3520,7 +3511,7 @@ static void hf_svf_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdif
     (void)vctx;
     (void)m;
     for (s = 0; s < n; s++, node0 += step)
-        if (!isnan(t[s])) sw->lat[node0] += hf_svf_term(t[s]);
+        if (!isnan(t[s])) hf_walk_emit(HF_WALK_SVF, sw->lat, NULL, NULL, NULL, s, node0, t[s]);
 }
 
 hfvis_status hfvis_sky_view_factor(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
@@ -3537,6 +3528,7 @@ hfvis_status hfvis_sky_view_factor(const hfvis_grid *grid, int K, const hfvis_sw
         return hf_exact_light(grid, K, HFVIS_SUM_SKY_VIEW, NULL, NULL, &o, -1.0 / (double)K, out,
                               out_stride);
     memset(&ctx, 0, sizeof ctx);
+    ctx.walk = HF_WALK_SVF;
     if ((s = hf_direction_range(&o, K, &begin, &end)) != HFVIS_OK) return s;
     if ((s = hf_fused_run(&sw, grid, K, &o, 1, 0, hf_svf_line, &ctx)) != HFVIS_OK) return s;
     /* A partial range returns its share of 1 - (1/K) sum, so partial results add up to SVF. */
@@ -3599,7 +3591,7 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
     hf_sweep_vector(sun_azimuth_rad, &ux, &uy);
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HFVIS__NAN);
-    hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL);
+    hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
     hf_gather_planes(&sw, 1, 0, out, 0, out_stride);
     for (y = sw.ry0; y < sw.ry1; y++)
         for (x = sw.rx0; x < sw.rx1; x++) {
@@ -7899,7 +7891,7 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
 {
     hfvis_sweep_options o;
     hf_sweep sw;
-    hf_sky_ctx sky;
+    hf_fused sky;
     hf_env_ctx ec;
     hf_env_eval eval;
     hf_p2_ctx p2;
@@ -7918,12 +7910,12 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
     memset(&sky, 0, sizeof sky);
     switch (kind) {
     case HFVIS_SUM_SKY_VIEW:
-        s = hf_fused_run(&sw, grid, K, &o, 1, 0, hf_svf_line, &sky.f);
+        sky.walk = HF_WALK_SVF;
+        s = hf_fused_run(&sw, grid, K, &o, 1, 0, hf_svf_line, &sky);
         break;
     case HFVIS_SUM_SKY_LIGHT:
-        sky.inv_k = 1.0 / (double)K;
-        sky.lobe = sin(HFVIS__PI / (double)K) / HFVIS__PI;
-        s = hf_fused_run(&sw, grid, K, &o, 1, 1, hf_sky_line, &sky.f);
+        hf_sky_setup(&sky, K);
+        s = hf_fused_run(&sw, grid, K, &o, 1, 1, hf_sky_line, &sky);
         break;
     case HFVIS_SUM_ENV_LIGHT:
         channels = env->channels;

@@ -5790,11 +5790,15 @@ HFVIS_API hfvis_status hfvis_lk_image(hfvis_lk_method method, const hfvis_mesh *
 #endif
 
 /* An inner-loop helper forced inline (GCC, Clang), else left to the compiler: the hot loops
- * that pass a constant to one (hf_walk_line's kind) or reload stored values (voxel.c) rely on it. */
+ * that pass a constant to one (hf_walk_line's kind) or reload stored values (voxel.c) rely on it.
+ * HFVIS__NOINLINE keeps a rare path out of a hot loop (hf_gather_point), whose registers it
+ * would otherwise take. */
 #if defined(__GNUC__)
 #define HFVIS__ALWAYS_INLINE inline __attribute__((always_inline))
+#define HFVIS__NOINLINE __attribute__((noinline))
 #else
 #define HFVIS__ALWAYS_INLINE inline
+#define HFVIS__NOINLINE
 #endif
 
 #define HFVIS__PI 3.14159265358979323846
