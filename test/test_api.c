@@ -1003,11 +1003,7 @@ static hfvis_grid sweep_grid(void)
     f.seed = 11;
     hfvis_field_generate(&f, SWEEP_W, SWEEP_H, SWEEP_W, sweep_z);
     sweep_z[5 * SWEEP_W + 7] = (float)NAN; /* a hole, so the hole paths run too */
-    g.z = sweep_z;
-    g.width = SWEEP_W;
-    g.height = SWEEP_H;
-    g.stride = SWEEP_W;
-    g.cell_size = 1.5;
+    g = test_grid(sweep_z, SWEEP_W, SWEEP_H, 1.5);
     return g;
 }
 

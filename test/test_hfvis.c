@@ -3764,11 +3764,7 @@ TEST(p2t_visibility_count)
     hfvis_grid g;
     int kind, ki, bi, holes, i, k, runs = 0, mismatch = 0;
     double tree_it = 0, naive_it = 0;
-    g.z = z;
-    g.width = P2T_W;
-    g.height = P2T_H;
-    g.stride = P2T_W;
-    g.cell_size = 1.5;
+    g = test_grid(z, P2T_W, P2T_H, 1.5);
     for (kind = 0; kind < 2; kind++)
         for (holes = 0; holes < 2; holes++) {
             p2t_field(kind, P2T_W, P2T_H, (uint64_t)(11 + kind), holes, z);
@@ -3859,11 +3855,7 @@ TEST(p2t_visibility_flat)
     hfvis_sweep_options o = hfvis_sweep_options_default();
     int x, y, bad = 0, bi;
     p2t_field(2, P2T_W, P2T_H, 1, 0, z);
-    g.z = z;
-    g.width = P2T_W;
-    g.height = P2T_H;
-    g.stride = P2T_W;
-    g.cell_size = 0.7;
+    g = test_grid(z, P2T_W, P2T_H, 0.7);
     for (bi = 0; bi < 3; bi++) {
         o.border = bi == 0 ? HFVIS_BORDER_OPEN : bi == 1 ? HFVIS_BORDER_CLAMP : HFVIS_BORDER_WRAP;
         /* K = 1, psi = 0: looking toward +x, the samples x+1..W-1 (pre-roll not counted) */
@@ -3910,11 +3902,7 @@ TEST(p2t_radius_vs_naive)
     p2t_seed(606);
     for (i = 0; i < P2T_W * P2T_H * 2; i++) ex[i] = (float)(1.5 * p2t_unit());
     for (f = 0; f < 3; f++) {
-        g.z = z;
-        g.width = P2T_W;
-        g.height = P2T_H;
-        g.stride = P2T_W;
-        g.cell_size = f == 1 ? 1.0 : 0.75;
+        g = test_grid(z, P2T_W, P2T_H, f == 1 ? 1.0 : 0.75);
         p2t_radius_field(f, z, g.cell_size);
         for (bi = 0; bi < 3; bi++) {
             hfvis_sweep_options o = hfvis_sweep_options_default();
@@ -4055,11 +4043,7 @@ TEST(p2t_radius_unlimited)
     static float z[P2T_W * P2T_H], a[P2T_W * P2T_H], b[P2T_W * P2T_H];
     hfvis_grid g;
     hfvis_sweep_options o = hfvis_sweep_options_default();
-    g.z = z;
-    g.width = P2T_W;
-    g.height = P2T_H;
-    g.stride = P2T_W;
-    g.cell_size = 1.0;
+    g = test_grid(z, P2T_W, P2T_H, 1.0);
     p2t_field(0, P2T_W, P2T_H, 81, 0, z);
     CHECK_EQ_STATUS(hfvis_visibility_count(&g, 6, NULL, NULL, a, P2T_W, NULL), HFVIS_OK);
     o.max_distance = (double)INFINITY;
@@ -4137,11 +4121,7 @@ TEST(p2t_intervisibility)
     static const int Ks[3] = {4, 3, 8};
     hfvis_grid g;
     int kind, ki, bi, k;
-    g.z = z;
-    g.width = P2T_W;
-    g.height = P2T_H;
-    g.stride = P2T_W;
-    g.cell_size = 2.0;
+    g = test_grid(z, P2T_W, P2T_H, 2.0);
     for (kind = 0; kind < 2; kind++) {
         p2t_field(kind, P2T_W, P2T_H, (uint64_t)(21 + kind), kind, z);
         for (ki = 0; ki < 3; ki++)
@@ -4191,11 +4171,7 @@ TEST(p2t_indirect_vs_naive)
     hfvis_grid g;
     int ch, bi, i, holes, bad = 0, exact = 0, total = 0;
     double maxrel = 0.0;
-    g.z = z;
-    g.width = P2T_W;
-    g.height = P2T_H;
-    g.stride = P2T_W;
-    g.cell_size = 1.0;
+    g = test_grid(z, P2T_W, P2T_H, 1.0);
     p2t_seed(4242);
     for (i = 0; i < P2T_W * P2T_H * 3; i++) ex[i] = (float)(2.0 * p2t_unit());
     for (holes = 0; holes < 2; holes++) {
@@ -4267,11 +4243,7 @@ TEST(p2t_indirect_furnace)
     hfvis_grid g;
     int kind, ki, bi, i, x, y, bad = 0;
     double maxrel = 0.0, maxrel_diag = 0.0;
-    g.z = z;
-    g.width = P2T_W;
-    g.height = P2T_H;
-    g.stride = P2T_W;
-    g.cell_size = 1.0;
+    g = test_grid(z, P2T_W, P2T_H, 1.0);
     for (i = 0; i < P2T_W * P2T_H * 2; i++) ex[i] = cval;
     for (kind = 0; kind < 4; kind++) {
         if (kind == 1) continue;
@@ -4334,11 +4306,7 @@ TEST(p2t_indirect_sky_only)
     hfvis_grid g;
     int holes, ki, bi, i, bad = 0, exact = 0, total = 0;
     double maxrel = 0.0;
-    g.z = z;
-    g.width = P2T_W;
-    g.height = P2T_H;
-    g.stride = P2T_W;
-    g.cell_size = 0.5;
+    g = test_grid(z, P2T_W, P2T_H, 0.5);
     for (i = 0; i < P2T_W * P2T_H * 2; i++) ex[i] = 0.0f;
     for (holes = 0; holes < 2; holes++) {
         p2t_field(holes, P2T_W, P2T_H, 51, holes, z);
@@ -4392,11 +4360,7 @@ TEST(p2t_indirect_valley)
     f.x0 = 16.0;
     f.slope = 1.0;
     CHECK_EQ_STATUS(hfvis_field_generate(&f, W, H, W, z), HFVIS_OK);
-    g.z = z;
-    g.width = W;
-    g.height = H;
-    g.stride = W;
-    g.cell_size = 1.0;
+    g = test_grid(z, W, H, 1.0);
     for (i = 0; i < W * H; i++) ex[i] = Ls, one[i] = 1.0f;
     for (ki = 0; ki < 3; ki++) {
         int K = ki == 0 ? 4 : ki == 1 ? 8 : 16;
@@ -4450,11 +4414,7 @@ TEST(p2t_terrain_gi)
     hfvis_field f;
     int i, b, x, y, bounces, bad = 0;
     double E[6];
-    g.z = z;
-    g.width = W;
-    g.height = H;
-    g.stride = W;
-    g.cell_size = 1.0;
+    g = test_grid(z, W, H, 1.0);
     p2t_seed(99);
     for (i = 0; i < W * H * C; i++) {
         direct[i] = (float)(0.5 + p2t_unit());
@@ -4527,11 +4487,7 @@ TEST(p2t_terrain_gi_oom)
     hfvis_sweep_options o = hfvis_sweep_options_default();
     test_counting cnt;
     int n, k, i, untouched = 1;
-    g.z = z;
-    g.width = W;
-    g.height = H;
-    g.stride = W;
-    g.cell_size = 1.0;
+    g = test_grid(z, W, H, 1.0);
     p2t_field(0, W, H, 3, 0, z);
     for (i = 0; i < W * H * 2; i++) direct[i] = 1.0f;
     memset(&cnt, 0, sizeof cnt);
@@ -4570,11 +4526,7 @@ TEST(p2t_direct_light)
     hfvis_sun sun;
     hfvis_env env;
     int x, y, c, i, bad = 0;
-    g.z = z;
-    g.width = W;
-    g.height = H;
-    g.stride = W;
-    g.cell_size = 1.0;
+    g = test_grid(z, W, H, 1.0);
     memset(&sun, 0, sizeof sun);
     sun.irradiance[0] = 3.0f;
     sun.irradiance[1] = 2.0f;
@@ -4679,11 +4631,7 @@ TEST(p2t_bad_arguments)
     const int W = P2T_BW;
     int i;
     float *out = p2t_bout;
-    g.z = z;
-    g.width = P2T_BW;
-    g.height = P2T_BH;
-    g.stride = P2T_BW;
-    g.cell_size = 1.0;
+    g = test_grid(z, P2T_BW, P2T_BH, 1.0);
     p2t_field(0, P2T_BW, P2T_BH, 2, 0, z);
     for (i = 0; i < P2T_BN; i++) ex[i] = 1.0f;
     for (i = 0; i < 4 * 4 * 2; i++) envrad[i] = 1.0f;

@@ -359,11 +359,7 @@ static hfvis_status gen_call(int which, const hfvis_allocator *a, hfvis_mesh *m)
     static const double c[3] = {0.5, 0.25, -1.0}, lo[3] = {0, 0, 0}, hi[3] = {1, 2, 3};
     static float z[12] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11};
     hfvis_grid g;
-    g.z = z;
-    g.width = 4;
-    g.height = 3;
-    g.stride = 4;
-    g.cell_size = 1.0;
+    g = test_grid(z, 4, 3, 1.0);
     switch (which) {
     case 0: return hfvis_mesh_box(a, lo, hi, m);
     case 1: return hfvis_mesh_uv_sphere(a, c, 1.0, 8, 5, m);
@@ -565,11 +561,7 @@ TEST(from_grid_holes)
         for (x = 0; x < W; x++) z[y * W + x] = (float)(x + 10 * y);
     z[1 * W + 2] = NAN;       /* interior hole: drops its 6 triangles */
     z[4 * W + 5] = INFINITY;  /* corner hole: drops both triangles of the last cell */
-    g.z = z;
-    g.width = W;
-    g.height = H;
-    g.stride = W;
-    g.cell_size = 2.0;
+    g = test_grid(z, W, H, 2.0);
     for (y = 0; y + 1 < H; y++)
         for (x = 0; x + 1 < W; x++) {
             int a = isfinite(z[y * W + x]), b = isfinite(z[y * W + x + 1]);
@@ -633,11 +625,7 @@ TEST(from_grid_vs_bilinear)
     hfvis_mesh m;
     int x, y, bad = 0;
     for (x = 0; x < W * H; x++) z[x] = (float)(rng_next() % 1000) / 64.0f; /* exact sums */
-    g.z = z;
-    g.width = W;
-    g.height = H;
-    g.stride = W;
-    g.cell_size = 1.0;
+    g = test_grid(z, W, H, 1.0);
     CHECK_EQ_STATUS(hfvis_mesh_from_grid(NULL, &g, &m), HFVIS_OK);
     for (y = 0; y + 1 < H; y++)
         for (x = 0; x + 1 < W; x++) {

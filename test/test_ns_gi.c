@@ -47,16 +47,7 @@ static double ns_rand(void)
     return (double)(ns_state >> 11) * (1.0 / 9007199254740992.0);
 }
 
-static hfvis_grid ns_grid(const float *z, int w, int h)
-{
-    hfvis_grid g;
-    g.z = z;
-    g.width = w;
-    g.height = h;
-    g.stride = w;
-    g.cell_size = 1.0;
-    return g;
-}
+static hfvis_grid ns_grid(const float *z, int w, int h) { return test_grid(z, w, h, 1.0); }
 
 static void ns_uniform_sky(double *env, int C, double c)
 {
