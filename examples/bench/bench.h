@@ -19,7 +19,7 @@ static inline double bench_now(void)
 
 /* An allocator (hfvis_allocator with user = a bench_tracker) that records the peak number of
  * bytes live: the library's scratch memory. */
-typedef struct bench_tracker { size_t live, peak; } bench_tracker;
+typedef struct bench_tracker { size_t live, peak, total; } bench_tracker;
 typedef struct bench_block { size_t size; double align; } bench_block;
 static inline void *bench_track_alloc(void *user, size_t size)
 {
@@ -28,6 +28,7 @@ static inline void *bench_track_alloc(void *user, size_t size)
     if (!b) return NULL;
     b->size = size;
     t->live += size;
+    t->total += size;
     if (t->live > t->peak) t->peak = t->live;
     return b + 1;
 }
@@ -39,6 +40,23 @@ static inline void bench_track_free(void *user, void *p)
     b = (bench_block *)p - 1;
     t->live -= b->size;
     free(b);
+}
+/* An allocator (user = a bench_arena) that hands out pieces of one block the caller keeps
+ * across calls and never frees them: what an engine does to call the library every frame
+ * without allocating. Reset used to 0 before each call. */
+typedef struct bench_arena { unsigned char *base; size_t cap, used; } bench_arena;
+static inline void *bench_arena_alloc(void *user, size_t size)
+{
+    bench_arena *a = (bench_arena *)user;
+    size_t at = (a->used + 63u) & ~(size_t)63u;
+    if (at > a->cap || size > a->cap - at) return NULL;
+    a->used = at + size;
+    return a->base + at;
+}
+static inline void bench_arena_free(void *user, void *p)
+{
+    (void)user;
+    (void)p;
 }
 void bench_mesh(int quick);
 void bench_raster(int quick);
