@@ -379,8 +379,8 @@ int main(int argc, char **argv)
 /* The three routines of bench_horizon again with their scratch in one block that was touched
  * before (bench_arena): the time of a caller that reuses its scratch, without the first-touch page
  * faults of a fresh allocation (about 11 us per 4 KiB page on the VM docs/performance.md was
- * measured on). cap: the most any of the three allocated in one call. */
-static void bench_horizon_reused(const hfvis_grid *g, int K, float *map, float *light, size_t cap_a, size_t cap_b)
+ * measured on). cap: the most bytes any of the three allocates in one call. */
+static void bench_horizon_reused(const hfvis_grid *g, int K, float *map, float *light, size_t cap)
 {
     bench_arena arena;
     hfvis_allocator al = {bench_arena_alloc, bench_arena_free, NULL};
@@ -388,7 +388,7 @@ static void bench_horizon_reused(const hfvis_grid *g, int K, float *map, float *
     double t0, t[3], rd = (double)g->width * (double)g->height * (double)K;
     hfvis_status s;
     int r;
-    arena.cap = (cap_a > cap_b ? cap_a : cap_b) + 64u * 64u; /* room for the 64-byte alignment */
+    arena.cap = cap;
     arena.base = (unsigned char *)xmalloc(arena.cap);
     memset(arena.base, 0, arena.cap); /* the first touch, outside the timing */
     al.user = &arena;
@@ -434,7 +434,7 @@ static void bench_horizon(int quick)
             int K = Ks[ki], P = quick ? 64 : 256;
             float *map = (float *)xmalloc(sizeof(float) * cells * (size_t)K);
             float *pts = sample_points(n, P), *ref = (float *)xmalloc(sizeof(float) * (size_t)P * (size_t)K);
-            bench_tracker tm = {0, 0, 0}, ts = {0, 0, 0}, tv = {0, 0, 0};
+            bench_tracker tm = {0, 0, 0, 0}, ts = {0, 0, 0, 0}, tv = {0, 0, 0, 0};
             hfvis_allocator am = {bench_track_alloc, bench_track_free, NULL}, as = am, av = am;
             hfvis_sweep_options om = hfvis_sweep_options_default(), os = om, ov = om;
             double t0, t_map, t_sky, t_svf, t_ref, rd = (double)cells * (double)K;
@@ -461,8 +461,14 @@ static void bench_horizon(int quick)
             printf("%4d^2 %4d | %9.2f %7.1fM | %9.2f %7.1fM | %9.2f %7.1fM | %9.1f %6.0fx %6.0fx %6.0fx\n",
                    n, K, t_map, (double)tm.peak / 1048576.0, t_sky, (double)ts.peak / 1048576.0, t_svf,
                    (double)tv.peak / 1048576.0, t_ref, t_ref / t_map, t_ref / t_sky, t_ref / t_svf);
-            if (K == 64) bench_horizon_reused(&g, K, map, light, tm.total > ts.total ? tm.total : ts.total,
-                                              tv.total);
+            if (K == 64) {
+                const bench_tracker *tr[3] = {&tm, &ts, &tv};
+                size_t cap = 0;
+                int i;
+                for (i = 0; i < 3; i++) /* with room for the arena's 64-byte alignment */
+                    if (tr[i]->total + 64u * tr[i]->count > cap) cap = tr[i]->total + 64u * tr[i]->count;
+                bench_horizon_reused(&g, K, map, light, cap);
+            }
             fflush(stdout);
             free(map);
             free(pts);

@@ -18,8 +18,8 @@ static inline double bench_now(void)
 }
 
 /* An allocator (hfvis_allocator with user = a bench_tracker) that records the peak number of
- * bytes live: the library's scratch memory. */
-typedef struct bench_tracker { size_t live, peak, total; } bench_tracker;
+ * bytes live (the library's scratch memory), and the bytes and blocks it allocated in all. */
+typedef struct bench_tracker { size_t live, peak, total, count; } bench_tracker;
 typedef struct bench_block { size_t size; double align; } bench_block;
 static inline void *bench_track_alloc(void *user, size_t size)
 {
@@ -29,6 +29,7 @@ static inline void *bench_track_alloc(void *user, size_t size)
     b->size = size;
     t->live += size;
     t->total += size;
+    t->count++;
     if (t->live > t->peak) t->peak = t->live;
     return b + 1;
 }

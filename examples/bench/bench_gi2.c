@@ -83,7 +83,7 @@ static void bench_gi2_exact(const hfvis_grid *g, float *L, double *t, size_t *pe
     hfvis_sun sun = bench_gi2_sun();
     hfvis_sweep_options so = hfvis_sweep_options_default();
     hfvis_allocator al;
-    bench_tracker tr = {0, 0, 0};
+    bench_tracker tr = {0, 0, 0, 0};
     hfvis_status s;
     double t0 = bench_now();
     size_t i;
@@ -120,7 +120,7 @@ static void bench_gi2_ns(const hfvis_grid *g, int s, int bounces, float *tot, do
     hfvis_ns_gi_options o;
     hfvis_ns_gi_outputs out;
     hfvis_allocator al;
-    bench_tracker tr = {0, 0, 0};
+    bench_tracker tr = {0, 0, 0, 0};
     bench_gi2_clock ck;
     hfvis_status st;
     size_t i;
