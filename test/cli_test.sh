@@ -808,6 +808,17 @@ expect_ok "indirect --emission 1 (in range)" "$dir/c.pfm" indirect "$dir/flat.pg
 awk 'BEGIN { print "P2 1 16384 255"; for (i = 0; i < 16384; i++) print 0 }' > "$dir/thin.pgm"
 expect_fail "skyview 1 x 16384 over --max-memory 100M" 1 skyview "$dir/thin.pgm" --max-memory 100M -o "$o"
 grep -q 'needs about' "$dir/stderr" && ok "--max-memory: the estimate is named" || bad "--max-memory: the estimate is named"
+# the estimate counts the output's channels, read from the maps' headers before they are loaded:
+# an RGB environment or emission map needs more than a grey one
+mib() { sed -n 's/.*needs about \([0-9.e+-]*\) MiB.*/\1/p' "$dir/stderr"; }
+expect_fail "light, grey env, over --max-memory 1K" 1 light "$h" --env "$dir/env1.pfm" --max-memory 1K -o "$o"; m1=$(mib)
+expect_fail "light, RGB env, over --max-memory 1K" 1 light "$h" --env "$dir/env3.pfm" --max-memory 1K -o "$o"; m3=$(mib)
+awk -v a="$m1" -v b="$m3" 'BEGIN { exit !(a > 0 && b > 1.2 * a) }' &&
+  ok "estimate: RGB light $m3 MiB > grey $m1 MiB" || bad "estimate: RGB light '$m3' MiB not above grey '$m1' MiB"
+expect_fail "indirect, grey, over --max-memory 1K" 1 indirect "$f" --albedo 0.5 --max-memory 1K -o "$o"; m1=$(mib)
+expect_fail "indirect, RGB emission, over --max-memory 1K" 1 indirect "$f" --emission "$dir/emit3.pfm" --max-memory 1K -o "$o"; m3=$(mib)
+awk -v a="$m1" -v b="$m3" 'BEGIN { exit !(a > 0 && b > 1.2 * a) }' &&
+  ok "estimate: RGB indirect $m3 MiB > grey $m1 MiB" || bad "estimate: RGB indirect '$m3' MiB not above grey '$m1' MiB"
 expect_fail "volgi 256^3 x 2^20 over --max-memory 512M" 1 volgi --room --res 256 --iterations 1048576 --max-memory 512M -o "$o"
 expect_fail "--max-memory 1X" 2 skyview "$h" --max-memory 1X -o "$o"
 expect_ok "--max-memory 0 (no limit)" "$dir/mm.pfm" skyview "$h" --max-memory 0 -o "$dir/mm.pfm"

@@ -1986,7 +1986,26 @@ static cli_cost cli_estimate(const cli_args *a, int w, int h, int channels)
     return c;
 }
 
-static int cli_window_side(const cli_args *a, int halo, int w, int h);
+/* The channels of a height-field command's output, for the estimate before anything is loaded:
+ * light has ENV's, indirect the most of ENV, --albedo-map and --emission (PGM or PFM: their
+ * headers only are read), normals 3, the rest 1. A header that cannot be read counts 1; the
+ * load reports it. */
+static int cli_out_channels(const cli_args *a)
+{
+    const char *maps[3] = {a->env, NULL, NULL};
+    int channels = a->cmd == CMD_NORMALS ? 3 : 1, i;
+    if (a->cmd != CMD_LIGHT && a->cmd != CMD_INDIRECT) return channels;
+    if (a->cmd == CMD_INDIRECT) maps[1] = a->albedo_map, maps[2] = a->emission;
+    for (i = 0; i < 3; i++) {
+        ex_rio_reader r;
+        if (!maps[i] || ex_rio_open_netpbm(&r, maps[i]) != 0) continue;
+        if (r.bands > channels) channels = r.bands;
+        ex_rio_close(&r);
+    }
+    return channels;
+}
+
+static int cli_window_side(const cli_args *a, int halo, int w, int h, int channels);
 /* Print the estimate with the progress bar or the --progress lines, and refuse a run past
  * --max-memory (0 = none), suggesting a window size when the run can be tiled. */
 static int cli_check_cost(const cli_args *a, int w, int h, int channels)
@@ -1999,7 +2018,7 @@ static int cli_check_cost(const cli_args *a, int w, int h, int channels)
         char hint[200] = "";
         if (cli_win.halo >= 0) { /* tiles: the largest square window whose grid (+ halo) fits */
             int ww = cli_win.active ? cli_win.ext_w : w, hh = cli_win.active ? cli_win.ext_h : h;
-            int side = cli_window_side(a, cli_win.halo, ww, hh);
+            int side = cli_window_side(a, cli_win.halo, ww, hh, channels);
             if (side > 0)
                 snprintf(hint, sizeof hint, "; windows of %d x %d cells fit (halo %d; --window X0,Y0,%d,%d, "
                          "examples/tiles.sh)", side, side, cli_win.halo, side, side);
@@ -2037,7 +2056,7 @@ static int cli_halo(const cli_args *a, double cell)
 
 /* The largest side S of a square window whose grid, S + 2 halo (clipped to the w x h raster) on
  * each axis, fits --max-memory by cli_estimate; 0 if none does. */
-static int cli_window_side(const cli_args *a, int halo, int w, int h)
+static int cli_window_side(const cli_args *a, int halo, int w, int h, int channels)
 {
     int lo = 0, hi = w > h ? w : h;
     while (lo < hi) {
@@ -2045,7 +2064,7 @@ static int cli_window_side(const cli_args *a, int halo, int w, int h)
         double gw = (double)mid + 2.0 * halo, gh = gw;
         if (gw > w) gw = w;
         if (gh > h) gh = h;
-        if (cli_estimate(a, (int)gw, (int)gh, 1).bytes <= a->max_memory) lo = mid;
+        if (cli_estimate(a, (int)gw, (int)gh, channels).bytes <= a->max_memory) lo = mid;
         else hi = mid - 1;
     }
     return lo;
@@ -2098,7 +2117,7 @@ static int cli_window_plan(const cli_args *a, ex_rio_reader *r, const char *path
     v->gx0 = (int)(x0 - h > 0 ? x0 - h : 0), v->gy0 = (int)(y0 - h > 0 ? y0 - h : 0);
     v->gw = (int)((x1 + h < r->width ? x1 + h : r->width) - v->gx0);
     v->gh = (int)((y1 + h < r->height ? y1 + h : r->height) - v->gy0);
-    if (cli_check_cost(a, v->gw, v->gh, 1) != 0) return CLI_EXIT_ERROR;
+    if (cli_check_cost(a, v->gw, v->gh, cli_out_channels(a)) != 0) return CLI_EXIT_ERROR;
     if ((size_t)v->gw * (size_t)v->gh > HFVIS_IMAGE_MAX_VALUES || v->gw > HFVIS_IMAGE_MAX_DIM ||
         v->gh > HFVIS_IMAGE_MAX_DIM)
         return cli_error(CLI_EXIT_ERROR, "--window", "%s: the window and its halo of %d cells, %d x %d, "
@@ -4596,7 +4615,7 @@ static int cli_run(const cli_args *a)
         opts.progress = cli_progress;
         opts.progress_user = &prog;
     }
-    if (!cli_win.active && (rc = cli_check_cost(a, w, h, a->cmd == CMD_NORMALS ? 3 : 1)) != 0) goto done;
+    if (!cli_win.active && (rc = cli_check_cost(a, w, h, cli_out_channels(a))) != 0) goto done;
     if (a->has_dir_range) {
         if (a->cmd == CMD_LIGHT && (rc = cli_load_env(a->env, &env_px, &env)) != 0) goto done;
         rc = cli_run_partial(a, &grid, &opts, &prog, &env);
