@@ -31,7 +31,8 @@
  *
  * Contents
  *   1. types and limits        ex_georef, ex_rio_reader, ex_rio_image, ex_rio_write_options
- *   2. georeference            ex_georef_free, ex_georef_cell, GeoKey parsing
+ *   2. georeference            ex_georef_free, ex_georef_cell, GeoKey parsing, a .prj's WKT as
+ *                              GeoKeys (ex_rio_prj_geokeys) and an ESRI PE string as a .prj
  *   3. byte sources            memory or FILE, bounded reads
  *   4. TIFF structure          header, IFD walk, tags, layout checks
  *   5. TIFF chunk decoding     PackBits, LZW, DEFLATE, predictors, samples
@@ -204,6 +205,105 @@ static inline int ex_georef_cell(const ex_georef *g, double *cell, char *err)
     return 0;
 }
 
+/* CRS kind of a WKT: GEOGCS/GEOGCRS at the top = geographic, PROJCS/PROJCRS = projected. */
+static inline int ex_rio_wkt_crs(const char *p)
+{
+    while (p && isspace((unsigned char)*p)) p++;
+    if (!p) return EX_RIO_CRS_UNKNOWN;
+    if (!strncmp(p, "PROJCS", 6) || !strncmp(p, "PROJCRS", 7)) return EX_RIO_CRS_PROJECTED;
+    if (!strncmp(p, "GEOGCS", 6) || !strncmp(p, "GEOGCRS", 7) || !strncmp(p, "GEODCRS", 7))
+        return EX_RIO_CRS_GEOGRAPHIC;
+    return EX_RIO_CRS_UNKNOWN;
+}
+
+/* The WKT that GeoAsciiParams carries as "ESRI PE String = WKT|" (how ArcGIS, and hfvis for a
+ * .prj, write a CRS that has no EPSG code into a GeoTIFF), and its length; NULL if none. */
+static inline const char *ex_rio_pe_string(const ex_georef *g, size_t *len)
+{
+    static const char tag[] = "ESRI PE String = ";
+    const char *a = g->geoascii, *p, *end;
+    size_t n = g->n_geoascii;
+    if (!a || n < sizeof tag) return NULL;
+    for (p = a; (size_t)(p - a) + sizeof tag - 1 <= n; p++) {
+        if (memcmp(p, tag, sizeof tag - 1) != 0) continue;
+        p += sizeof tag - 1;
+        for (end = p; (size_t)(end - a) < n && *end != '|' && *end != '\0'; end++) {}
+        *len = (size_t)(end - p);
+        return *len ? p : NULL;
+    }
+    return NULL;
+}
+
+/* The EPSG code a WKT names for itself, AUTHORITY["EPSG","n"] (WKT 1) or ID["EPSG",n] (WKT 2)
+ * directly inside its outermost node (codes deeper in name its parts: datum, unit); 0 if none. */
+static inline int ex_rio_wkt_epsg(const char *w)
+{
+    int depth = 0, quoted = 0;
+    const char *p;
+    for (p = w; *p; p++) {
+        if (*p == '"') quoted = !quoted; /* WKT doubles a quote inside a string: toggles twice */
+        if (quoted || *p == '"') continue;
+        if (*p == '[' || *p == '(') depth++;
+        else if (*p == ']' || *p == ')') depth--;
+        else if (depth == 1 && (p == w || !isalpha((unsigned char)p[-1])) &&
+                 (!strncmp(p, "AUTHORITY[", 10) || !strncmp(p, "ID[", 3))) {
+            const char *q = strchr(p, '[') + 1;
+            char *end;
+            long v;
+            while (isspace((unsigned char)*q)) q++;
+            if (strncmp(q, "\"EPSG\"", 6) != 0) continue;
+            for (q += 6; isspace((unsigned char)*q) || *q == ','; q++) {}
+            if (*q == '"') q++;
+            v = strtol(q, &end, 10);
+            if (end != q && v > 0 && v < 32767) return (int)v;
+        }
+    }
+    return 0;
+}
+
+/* The longest WKT put into a citation: GDAL reads PCSCitationGeoKey into a 2400-byte buffer. */
+#define EX_RIO_MAX_PE_STRING 2300
+
+/* GeoKeys for a GeoTIFF of a raster whose CRS is the WKT of a .prj (GeoTIFF 1.1 §7.1): the
+ * model (projected or geographic) and PixelIsArea, and the EPSG code the WKT names for itself in
+ * ProjectedCSTypeGeoKey or GeographicTypeGeoKey; a WKT without one goes whole into
+ * PCSCitationGeoKey as "ESRI PE String = WKT" under a user-defined model (32767), the form
+ * ArcGIS writes and GDAL reads. Fills keys[16] and, for the citation, *ascii (malloc'd,
+ * *n_ascii bytes with the NUL); returns the number of shorts, 0 when there is nothing to write
+ * (no .prj, neither projected nor geographic, too long, out of memory). */
+static inline size_t ex_rio_prj_geokeys(const char *prj, uint64_t keys[16], char **ascii, size_t *n_ascii)
+{
+    static const char tag[] = "ESRI PE String = ";
+    int crs = ex_rio_wkt_crs(prj), epsg;
+    size_t len;
+    *ascii = NULL;
+    *n_ascii = 0;
+    if (crs != EX_RIO_CRS_PROJECTED && crs != EX_RIO_CRS_GEOGRAPHIC) return 0;
+    while (isspace((unsigned char)*prj)) prj++;
+    for (len = strlen(prj); len > 0 && isspace((unsigned char)prj[len - 1]); len--) {}
+    keys[0] = 1, keys[1] = 1, keys[2] = 0, keys[3] = 3;       /* version 1.1.0, three keys */
+    keys[4] = 1024, keys[5] = 0, keys[6] = 1;                  /* GTModelTypeGeoKey */
+    keys[8] = 1025, keys[9] = 0, keys[10] = 1, keys[11] = 1;   /* GTRasterTypeGeoKey: PixelIsArea */
+    epsg = ex_rio_wkt_epsg(prj);
+    if (epsg > 0) {
+        keys[7] = (uint64_t)crs;
+        keys[12] = crs == EX_RIO_CRS_PROJECTED ? 3072 : 2048, keys[13] = 0, keys[14] = 1;
+        keys[15] = (uint64_t)epsg;
+        return 16;
+    }
+    if (len > EX_RIO_MAX_PE_STRING || memchr(prj, '|', len)) return 0;
+    *ascii = (char *)malloc(sizeof tag + len + 1);
+    if (!*ascii) return 0;
+    memcpy(*ascii, tag, sizeof tag - 1);
+    memcpy(*ascii + sizeof tag - 1, prj, len);
+    (*ascii)[sizeof tag - 1 + len] = '|';
+    (*ascii)[sizeof tag + len] = '\0';
+    *n_ascii = sizeof tag + len + 1;
+    keys[7] = 32767;                                           /* user-defined model */
+    keys[12] = 3073, keys[13] = 34737, keys[14] = (uint64_t)(sizeof tag + len), keys[15] = 0;
+    return 16;
+}
+
 /* Read GTModelType, GTRasterType and the EPSG code from the key directory (GeoTIFF 1.1 §7.1:
  * header KeyDirectoryVersion, KeyRevision, MinorRevision, NumberOfKeys; then per key KeyID,
  * TIFFTagLocation, Count, Value_Offset). -1 when the directory is malformed. */
@@ -225,6 +325,18 @@ static inline int ex_georef_keys(ex_georef *g, char *err)
         else if (e[0] == 2048 && e[3] != 0 && e[3] != 32767 && g->epsg == 0) g->epsg = e[3];
     }
     return 0;
+}
+
+/* A user-defined model whose WKT rides in an ESRI PE string: its kind from the WKT. */
+static inline void ex_georef_pe_crs(ex_georef *g)
+{
+    size_t len;
+    const char *w = g->crs == EX_RIO_CRS_UNKNOWN ? ex_rio_pe_string(g, &len) : NULL;
+    if (w) {
+        char head[16] = {0};
+        memcpy(head, w, len < sizeof head - 1 ? len : sizeof head - 1);
+        g->crs = ex_rio_wkt_crs(head);
+    }
 }
 
 /* The geotransform from ModelTransformation, or from ModelPixelScale + one ModelTiepoint
@@ -674,6 +786,7 @@ static inline int ex_rio_tiff_parse(ex_rio_reader *r)
         if (ex_rio_chunk_check(r, v, &rowb, &need, &full) != 0) return -1;
     }
     if (r->geo.n_geokeys && ex_georef_keys(&r->geo, r->err) != 0) return -1;
+    if (r->geo.n_geokeys) ex_georef_pe_crs(&r->geo);
     ex_georef_transform(&r->geo);
     return 0;
 }
@@ -1140,15 +1253,11 @@ static inline int ex_rio_parse_hdr(ex_rio_reader *r, const char *text, size_t n,
     return 0;
 }
 
-/* CRS kind from .prj WKT: GEOGCS/GEOGCRS at the top = geographic, PROJCS/PROJCRS = projected. */
+/* CRS kind from .prj WKT. */
 static inline void ex_rio_prj_crs(ex_georef *g)
 {
-    const char *p = g->prj;
-    while (p && isspace((unsigned char)*p)) p++;
-    if (!p) return;
-    if (!strncmp(p, "PROJCS", 6) || !strncmp(p, "PROJCRS", 7)) g->crs = EX_RIO_CRS_PROJECTED;
-    else if (!strncmp(p, "GEOGCS", 6) || !strncmp(p, "GEOGCRS", 7) || !strncmp(p, "GEODCRS", 7))
-        g->crs = EX_RIO_CRS_GEOGRAPHIC;
+    int crs = ex_rio_wkt_crs(g->prj);
+    if (crs != EX_RIO_CRS_UNKNOWN) g->crs = crs;
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -1589,6 +1698,9 @@ static inline int ex_rio_write_tiff_file(const char *path, const ex_rio_image *i
     uint64_t cw, ch, across, down, per_plane, nchunks, k, rowb, chunkb, raw_total, bound;
     uint64_t *offsets = NULL, *counts = NULL, u_w, u_h, u_bps[1], u_comp, u_photo = 1, u_spp, u_rps, u_cw, u_ch;
     uint64_t u_planar = spp > 1 ? 2 : 1, u_fmt, u_pred, *u_extra = NULL, *u_bpsv = NULL, *u_fmtv = NULL, *u_keys = NULL;
+    uint64_t prj_keys[16];
+    char *prj_ascii = NULL;
+    size_t n_prj_keys = 0, n_prj_ascii = 0;
     unsigned char *chunk = NULL, *z = NULL, *tmp = NULL;
     size_t zcap = 0;
     char *tmpname = NULL;
@@ -1623,9 +1735,12 @@ static inline int ex_rio_write_tiff_file(const char *path, const ex_rio_image *i
         return ex_rio_fail(err, "too many or too large strips/tiles");
     chunkb = rowb * ch;
     raw_total = chunkb * nchunks;
+    if (geo && !geo->n_geokeys && geo->prj) /* a .prj's CRS as GeoKeys (ex_rio_prj_geokeys) */
+        n_prj_keys = ex_rio_prj_geokeys(geo->prj, prj_keys, &prj_ascii, &n_prj_ascii);
     /* the file size bound: header, data (deflate never exceeds ex_deflate_bound), IFD and arrays */
     bound = 16 + (opt.deflate ? ex_deflate_bound((size_t)chunkb) : chunkb) * nchunks + 16 * nchunks + 8192 +
-            (geo ? 8 * (geo->n_tiepoints + geo->n_geodoubles) + 2 * geo->n_geokeys + geo->n_geoascii : 0);
+            (geo ? 8 * (geo->n_tiepoints + geo->n_geodoubles) + 2 * geo->n_geokeys + geo->n_geoascii : 0) +
+            2 * n_prj_keys + n_prj_ascii;
     (void)raw_total;
     memset(&o, 0, sizeof o);
     o.be = opt.big_endian;
@@ -1757,6 +1872,9 @@ static inline int ex_rio_write_tiff_file(const char *path, const ex_rio_image *i
         EX_RIO_TAG(34735, 3, geo->n_geokeys, u_keys);
         if (geo->n_geodoubles) EX_RIO_TAG(34736, 12, geo->n_geodoubles, geo->geodoubles);
         if (geo->n_geoascii) EX_RIO_TAG(34737, 2, geo->n_geoascii, geo->geoascii);
+    } else if (n_prj_keys) {
+        EX_RIO_TAG(34735, 3, n_prj_keys, prj_keys);
+        if (n_prj_ascii) EX_RIO_TAG(34737, 2, n_prj_ascii, prj_ascii);
     }
     if (geo && geo->has_nodata) {
         size_t L = strlen(geo->nodata_text);
@@ -1818,6 +1936,7 @@ done:
     free(u_fmtv);
     free(u_extra);
     free(u_keys);
+    free(prj_ascii);
     return rc;
 }
 
@@ -1828,17 +1947,22 @@ static inline void ex_rio_fmt(char *buf, size_t cap, double v, int is_float)
     else snprintf(buf, cap, is_float ? "%.9g" : "%.17g", v);
 }
 
-/* The .prj of geo (when it has one) beside path, atomically. */
+/* The .prj of geo beside path, atomically: its .prj, or the WKT of a GeoTIFF's ESRI PE string
+ * (a CRS given by an EPSG code alone has no WKT here: no .prj). */
 static inline int ex_rio_write_prj(const char *path, const ex_georef *geo, char *err)
 {
     char *prj, *tmpname = NULL;
+    const char *wkt = geo ? geo->prj : NULL;
+    size_t len = 0;
     FILE *f;
     int ok;
-    if (!geo || !geo->prj) return 0;
+    if (geo && !wkt) wkt = ex_rio_pe_string(geo, &len);
+    else if (wkt) len = strlen(wkt);
+    if (!wkt) return 0;
     prj = ex_rio_sidecar(path, ".prj");
     if (!prj) return ex_rio_fail(err, "out of memory");
     f = ex_atomic_open(prj, &tmpname);
-    ok = f && fputs(geo->prj, f) >= 0;
+    ok = f && fwrite(wkt, 1, len, f) == len && (geo->prj || fputc('\n', f) != EOF);
     if (!f || !ex_atomic_close(f, tmpname, prj, ok)) {
         free(prj);
         return ex_rio_fail(err, "cannot write the .prj");

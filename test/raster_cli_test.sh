@@ -56,6 +56,23 @@ run "band 3 of the horizon GeoTIFF" skyview "$dir/h.tif" --band 3 --dirs 4 --cel
 fails "--band beyond the bands" skyview "$dir/h.tif" --band 5 -o "$dir/x.flt"
 fails "--band on a PGM" skyview "$dir/dem.pgm" --band 2 -o "$dir/x.flt"
 
+# ---- the CRS across formats: a .prj into GeoKeys (its EPSG code, else the WKT as an ESRI PE
+# string) and a PE string back into a .prj ------------------------------------------------------
+run "asc + .prj -> tif" skyview "$dir/dem.asc" --dirs 4 -o "$dir/prj.tif" && "$hfvis" info "$dir/prj.tif" | grep -qx 'crs projected EPSG:32633' \
+  && ok "asc + .prj (EPSG 32633) -> tif: ProjectedCSTypeGeoKey 32633" || bad "asc -> tif CRS: $("$hfvis" info "$dir/prj.tif" | grep crs)"
+cp "$dir/dem.asc" "$dir/esri.asc"
+printf 'PROJCS["WGS_1984_UTM_Zone_33N",GEOGCS["GCS_WGS_1984",DATUM["D_WGS_1984",SPHEROID["WGS_1984",6378137.0,298.257223563]],PRIMEM["Greenwich",0.0],UNIT["Degree",0.0174532925199433]],PROJECTION["Transverse_Mercator"],PARAMETER["False_Easting",500000.0],PARAMETER["False_Northing",0.0],PARAMETER["Central_Meridian",15.0],PARAMETER["Scale_Factor",0.9996],PARAMETER["Latitude_Of_Origin",0.0],UNIT["Meter",1.0]]\n' > "$dir/esri.prj"
+run "esri .prj -> tif" skyview "$dir/esri.asc" --dirs 4 -o "$dir/pe.tif" && "$hfvis" info "$dir/pe.tif" | grep -qx 'crs projected' \
+  && ok "asc + ESRI .prj (no EPSG code) -> tif: projected, read back from the PE string" || bad "PE string tif: $("$hfvis" info "$dir/pe.tif" | grep crs)"
+run "pe tif -> asc" skyview "$dir/pe.tif" --dirs 4 -o "$dir/pe.asc" && same "the PE string's WKT back into a .prj, as it was" "$dir/esri.prj" "$dir/pe.prj"
+run "pe tif -> flt" skyview "$dir/pe.tif" --dirs 4 -o "$dir/pe2.flt" && same "... and beside an EHdr output" "$dir/esri.prj" "$dir/pe2.prj"
+run "epsg tif -> asc" skyview "$dir/prj.tif" --dirs 4 -o "$dir/ep.asc" && [ ! -e "$dir/ep.prj" ] \
+  && ok "a CRS given by an EPSG code alone writes no .prj (no WKT without a database)" || bad "an EPSG-only tif wrote ep.prj"
+cp "$dir/dem.asc" "$dir/geog.asc"
+printf 'GEOGCS["GCS_WGS_1984",DATUM["D_WGS_1984",SPHEROID["WGS_1984",6378137.0,298.257223563]],PRIMEM["Greenwich",0.0],UNIT["Degree",0.0174532925199433]]\n' > "$dir/geog.prj"
+run "geographic .prj -> tif" skyview "$dir/geog.asc" --cell 30 --dirs 4 -o "$dir/geog.tif" && \
+  fails "a GeoTIFF with a geographic PE string is refused as the .prj was" skyview "$dir/geog.tif" -o "$dir/x.flt"
+
 # ---- notes on stderr ------------------------------------------------------------------------
 run "pgm without --cell" skyview "$dir/dem.pgm" --dirs 4 -o "$dir/n.flt" && grep -q '^hfvis: note: .*cell size: using 1' "$dir/err" \
   && [ "$(wc -l < "$dir/err" | tr -d ' ')" = 1 ] && ok "no cell size: one note line" || bad "no-cell note: $(cat "$dir/err")"
@@ -114,6 +131,12 @@ if command -v gdal_translate > /dev/null 2>&1 && command -v gdalinfo > /dev/null
   gt -of EHdr "$dir/svf.asc" "$dir/asc_gdal.flt" && cmp -s "$dir/asc_gdal.flt" "$dir/svf2.flt" \
     && ok "GDAL reads hfvis's ASC (%.9g round trips)" || bad "GDAL ASC read differs"
   gdalinfo "$dir/svf.asc" | grep -q 'EPSG",32633' && ok "GDAL sees the .prj carried with the ASC" || bad "ASC .prj not seen by GDAL"
+  gdalinfo "$dir/prj.tif" | grep -q 'ID\["EPSG",32633\]' && ok "GDAL sees EPSG:32633 in the GeoTIFF of an ASC + .prj" \
+    || bad "GDAL: no EPSG:32633 in prj.tif"
+  gdalinfo "$dir/pe.tif" > "$dir/pe.info" 2>&1
+  grep -q 'Transverse Mercator' "$dir/pe.info" && grep -q 'Longitude of natural origin",15' "$dir/pe.info" \
+    && ! grep -qi 'warning\|error' "$dir/pe.info" && ok "GDAL reads the ESRI PE string: Transverse Mercator, central meridian 15" \
+    || bad "GDAL on the PE string: $(sed -n 3,6p "$dir/pe.info")"
   gt -of EHdr "$dir/asc.flt" "$dir/flt_gdal.flt" && same "GDAL reads hfvis's EHdr .flt" "$dir/asc.flt" "$dir/flt_gdal.flt"
   gt -of EHdr "$dir/h.tif" "$dir/h_gdal.bil" && same "GDAL reads the 4-band horizon GeoTIFF = hfvis's BIL" "$dir/h.bil" "$dir/h_gdal.bil"
   gdalinfo "$dir/h.tif" | grep -c '^Band ' | grep -qx 4 && ok "gdalinfo: 4 bands" || bad "horizon GeoTIFF bands"

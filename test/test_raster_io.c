@@ -3,7 +3,8 @@
  * BigTIFF; LZW and PackBits files built here with reference encoders; window reads against the
  * whole read, and a window that never touches a corrupted tile; hand-built malformed files
  * (truncated IFDs, offsets past the end, huge tile counts, IFD loops, bad LZW/deflate streams,
- * strips claiming impossible sizes) refused with a message. Writes into a temporary folder. */
+ * strips claiming impossible sizes) refused with a message; a .prj's CRS as GeoKeys (EPSG code or
+ * ESRI PE string) and back. Writes into a temporary folder. */
 #define _POSIX_C_SOURCE 200809L /* mkdtemp, rmdir */
 #include "test.h"
 #include "test_dir.h"
@@ -756,6 +757,60 @@ TEST(georef_cells)
     }
 }
 
+/* A .prj's CRS as GeoKeys and back: the EPSG code is the one the WKT names at its top level
+ * (never a nested datum's or base CRS's), a WKT without one becomes an ESRI PE string that the
+ * reader classifies and ex_rio_pe_string returns whole; too long or neither kind: no keys. */
+TEST(prj_geokeys)
+{
+    static const char esri[] = "PROJCS[\"UTM_33N\",GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\","
+                               "SPHEROID[\"WGS_1984\",6378137.0,298.257223563]],PRIMEM[\"Greenwich\",0.0],"
+                               "UNIT[\"Degree\",0.0174532925199433]],PROJECTION[\"Transverse_Mercator\"],"
+                               "UNIT[\"Meter\",1.0]]";
+    uint64_t k[16];
+    char *ascii = NULL, err[256];
+    size_t n_ascii = 0, len = 0, i;
+    uint16_t k16[16];
+    ex_georef g;
+    const char *pe;
+    /* the top-level code, not the nested GEOGCS's 4326 or the unit's 9001 */
+    CHECK(ex_rio_wkt_epsg("PROJCS[\"x\",GEOGCS[\"y\",AUTHORITY[\"EPSG\",\"4326\"]],UNIT[\"m\",1,"
+                          "AUTHORITY[\"EPSG\",\"9001\"]],AUTHORITY[\"EPSG\",\"32633\"]]") == 32633);
+    CHECK(ex_rio_wkt_epsg("PROJCS[\"x\",GEOGCS[\"y\",AUTHORITY[\"EPSG\",\"4326\"]]]") == 0);
+    CHECK(ex_rio_wkt_epsg("PROJCRS[\"x\",BASEGEOGCRS[\"y\",ID[\"EPSG\",4326]],ID[\"EPSG\",32633]]") == 32633);
+    CHECK(ex_rio_wkt_epsg("PROJCS[\"a \"\"quoted\"\" [name\",AUTHORITY[\"EPSG\",\"3035\"]]") == 3035);
+    CHECK(ex_rio_wkt_epsg("PROJCS[\"x\",AUTHORITY[\"ESRI\",\"102003\"]]") == 0);
+    CHECK(ex_rio_prj_geokeys("GEOGCS[\"y\",AUTHORITY[\"EPSG\",\"4326\"]]\n", k, &ascii, &n_ascii) == 16 &&
+          k[7] == EX_RIO_CRS_GEOGRAPHIC && k[12] == 2048 && k[15] == 4326 && !ascii);
+    CHECK(ex_rio_prj_geokeys("LOCAL_CS[\"z\"]", k, &ascii, &n_ascii) == 0 && !ascii);
+    /* no code: a PE string under a user-defined model, read back */
+    CHECK(ex_rio_prj_geokeys(esri, k, &ascii, &n_ascii) == 16 && ascii && k[7] == 32767 && k[12] == 3073 &&
+          k[13] == 34737 && k[14] == n_ascii - 1 && ascii[n_ascii - 2] == '|' && ascii[n_ascii - 1] == '\0');
+    for (i = 0; i < 16; i++) k16[i] = (uint16_t)k[i];
+    memset(&g, 0, sizeof g);
+    g.geokeys = k16; g.n_geokeys = 16; g.geoascii = ascii; g.n_geoascii = n_ascii;
+    CHECK(ex_georef_keys(&g, err) == 0 && g.crs == EX_RIO_CRS_UNKNOWN && g.epsg == 0);
+    ex_georef_pe_crs(&g);
+    CHECK(g.crs == EX_RIO_CRS_PROJECTED);
+    pe = ex_rio_pe_string(&g, &len);
+    CHECK(pe && len == strlen(esri) && memcmp(pe, esri, len) == 0);
+    g.n_geoascii = 20; /* cut after three characters of the WKT, then inside the tag */
+    CHECK(ex_rio_pe_string(&g, &len) == pe && len == 3);
+    g.n_geoascii = 10;
+    CHECK(ex_rio_pe_string(&g, &len) == NULL);
+    free(ascii);
+    {
+        char *big = (char *)malloc(EX_RIO_MAX_PE_STRING + 64);
+        if (big) {
+            memset(big, ' ', EX_RIO_MAX_PE_STRING + 63);
+            memcpy(big, "PROJCS[\"long\"", 13);
+            big[EX_RIO_MAX_PE_STRING + 62] = ']';
+            big[EX_RIO_MAX_PE_STRING + 63] = '\0';
+            CHECK(ex_rio_prj_geokeys(big, k, &ascii, &n_ascii) == 0 && !ascii);
+            free(big);
+        }
+    }
+}
+
 /* PFM (grey and colour, both byte orders) and binary PGM (8 and 16 bit) windows read by seeking
  * rows (ex_rio_open_netpbm) against the crop of the library's whole decode (hfvis_image_load),
  * headers with comments, a truncated file refused; ex_georef_shift moves the geotransform and the
@@ -863,6 +918,7 @@ int main(int argc, char **argv)
     RUN(tiff_malformed);
     RUN(asc_ehdr);
     RUN(georef_cells);
+    RUN(prj_geokeys);
     {
         const char *names[] = { "rt.tif", "u.tif", "c.tif", "w.tif", "w.flt", "w.hdr", "t.tif", "m.tif", "a.asc",
                                 "a.prj", "e.flt", "e.bil", "e.hdr", "e.prj" };

@@ -2,7 +2,8 @@
  * input either is refused with a message or opens; an opened image then decodes a corner window,
  * the far corner and a window hanging over the edges of every band it has (up to 4), each either
  * refused with a message or filled, NaN outside the raster. Memory stays bounded by the reader's
- * limits (EX_RIO_MAX_CHUNK per strip/tile, the codecs' ratio bounds, counts within the file).
+ * limits (EX_RIO_MAX_CHUNK per strip/tile, the codecs' ratio bounds, counts within the file); an
+ * ESRI PE string found in GeoAsciiParams lies inside it.
  * Seeds: test/fuzz/seeds/geotiff. Built and run by `make fuzz`. */
 #include "examples/raster_io.h"
 #include <stdint.h>
@@ -21,6 +22,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         return 0;
     }
     if (r.width < 1 || r.height < 1 || r.bands < 1 || r.nchunks == 0 || !r.offsets || !r.counts) abort();
+    { /* an ESRI PE string lies inside GeoAsciiParams */
+        size_t len = 0;
+        const char *pe = ex_rio_pe_string(&r.geo, &len);
+        if (pe && (pe < r.geo.geoascii || len == 0 || (size_t)(pe - r.geo.geoascii) + len > r.geo.n_geoascii)) abort();
+    }
     r.nodata_to_nan = (int)(size & 1);
     for (b = 0; b < r.bands && b < 4; b++) {
         int x[3] = { 0, r.width - 1, -3 }, y[3] = { 0, r.height - 1, r.height - 2 };
