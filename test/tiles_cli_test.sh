@@ -107,8 +107,11 @@ same "skyview: mosaic to .pgm = whole run's .pgm (its default range)" "$dir/svp.
 # light with an RGB environment (values 0.5, 1, 2: exact bytes), 3-channel pieces
 LC_ALL=C awk 'BEGIN { printf "PF\n8 4\n-1.0\n"; for (i = 0; i < 32; i++) { printf "%c%c%c%c", 0, 0, 0, 63
   printf "%c%c%c%c", 0, 0, 128, 63; printf "%c%c%c%c", 0, 0, 0, 64 } }' > "$dir/env.pfm"
-run "light whole" light "$dir/s.flt" --env "$dir/env.pfm" --dirs 8 --max-distance 400 -o "$dir/li.whole.tif" &&
-pieces li pfm "$W1" light "$dir/s.flt" --env "$dir/env.pfm" --dirs 8 --max-distance 400 &&
+# (the field without its .prj: PFM pieces carry no CRS, so the GeoTIFF mosaic of them has the
+# geotransform but no GeoKeys, while a whole run of s.flt gets them from s.prj; docs/tiles.md)
+cp "$dir/s.flt" "$dir/n.flt"; cp "$dir/s.hdr" "$dir/n.hdr"
+run "light whole" light "$dir/n.flt" --env "$dir/env.pfm" --dirs 8 --max-distance 400 -o "$dir/li.whole.tif" &&
+pieces li pfm "$W1" light "$dir/n.flt" --env "$dir/env.pfm" --dirs 8 --max-distance 400 &&
 run "light mosaic tif" mosaic "$dir"/li.[1-6].pfm -o "$dir/li.mosaic.tif" &&
 same "light: RGB pieces mosaic (3 bands, default range) = whole run" "$dir/li.whole.tif" "$dir/li.mosaic.tif"
 # hillshade's cast shadows: sun visibility with the radius, pieces as GeoTIFF
