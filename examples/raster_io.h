@@ -270,7 +270,7 @@ static inline int ex_rio_wkt_epsg(const char *w)
  * PCSCitationGeoKey as "ESRI PE String = WKT" under a user-defined model (32767), the form
  * ArcGIS writes and GDAL reads. Fills keys[16] and, for the citation, *ascii (malloc'd,
  * *n_ascii bytes with the NUL); returns the number of shorts, 0 when there is nothing to write
- * (no .prj, neither projected nor geographic, too long, out of memory). */
+ * (neither projected nor geographic, or too long), SIZE_MAX when out of memory. */
 static inline size_t ex_rio_prj_geokeys(const char *prj, uint64_t keys[16], char **ascii, size_t *n_ascii)
 {
     static const char tag[] = "ESRI PE String = ";
@@ -293,7 +293,7 @@ static inline size_t ex_rio_prj_geokeys(const char *prj, uint64_t keys[16], char
     }
     if (len > EX_RIO_MAX_PE_STRING || memchr(prj, '|', len)) return 0;
     *ascii = (char *)malloc(sizeof tag + len + 1);
-    if (!*ascii) return 0;
+    if (!*ascii) return SIZE_MAX;
     memcpy(*ascii, tag, sizeof tag - 1);
     memcpy(*ascii + sizeof tag - 1, prj, len);
     (*ascii)[sizeof tag - 1 + len] = '|';
@@ -1735,8 +1735,10 @@ static inline int ex_rio_write_tiff_file(const char *path, const ex_rio_image *i
         return ex_rio_fail(err, "too many or too large strips/tiles");
     chunkb = rowb * ch;
     raw_total = chunkb * nchunks;
-    if (geo && !geo->n_geokeys && geo->prj) /* a .prj's CRS as GeoKeys (ex_rio_prj_geokeys) */
+    if (geo && !geo->n_geokeys && geo->prj) { /* a .prj's CRS as GeoKeys (ex_rio_prj_geokeys) */
         n_prj_keys = ex_rio_prj_geokeys(geo->prj, prj_keys, &prj_ascii, &n_prj_ascii);
+        if (n_prj_keys == SIZE_MAX) return ex_rio_fail(err, "out of memory");
+    }
     /* the file size bound: header, data (deflate never exceeds ex_deflate_bound), IFD and arrays */
     bound = 16 + (opt.deflate ? ex_deflate_bound((size_t)chunkb) : chunkb) * nchunks + 16 * nchunks + 8192 +
             (geo ? 8 * (geo->n_tiepoints + geo->n_geodoubles) + 2 * geo->n_geokeys + geo->n_geoascii : 0) +
