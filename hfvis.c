@@ -2657,14 +2657,13 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
     }
 }
 
-/* Gather the lattice accumulator into the grid accumulator. The common case, all four taps
- * inside the lattice with some finite weight, is hf_gather_setup + hf_gather_apply written out
- * without the tap table: a tap with zero weight or a non-finite value adds +0.0 instead of being
- * skipped, which leaves every sum bit-identical (a sum started at +0.0 is never -0.0, and
- * x + 0.0 == x otherwise). Everything else takes the general routine. */
-/* One grid point (x, y) at lattice coordinates (a, b), any channel count, added to acc. Kept out
- * of line: inlined into the grid loop (as gcc 12 -O2 chose once its callers changed), the loop
- * spills its invariants again, 26.8 -> 30.2 instructions per rd (docs/performance.md). */
+/* One grid point (x, y) at lattice coordinates (a, b), any channel count, added to acc. The
+ * common case, all four taps inside the lattice with some finite weight, is hf_gather_setup +
+ * hf_gather_apply written out without the tap table: a tap with zero weight or a non-finite
+ * value adds +0.0 instead of being skipped, which leaves every sum bit-identical (a sum started
+ * at +0.0 is never -0.0, and x + 0.0 == x otherwise); everything else takes the general routine.
+ * Kept out of line: inlined into the grid loop (as gcc 12 -O2 chose once its callers changed),
+ * the loop spills its invariants again, 26.8 -> 30.2 instructions per rd (docs/performance.md). */
 static HFVIS__NOINLINE void hf_gather_point(const hf_sweep *sw, int x, int y, double a, double b, double *acc)
 {
     const double *lat = sw->lat;
@@ -2708,9 +2707,9 @@ static HFVIS__NOINLINE void hf_gather_point(const hf_sweep *sw, int x, int y, do
     }
 }
 
-/* The grid loop; one channel with its four taps inside and finite is summed here, everything
- * else goes through hf_gather_point (out of line, so this loop keeps its invariants in
- * registers). */
+/* Gather the lattice accumulator into the grid accumulator. One channel with its four taps
+ * inside and finite is summed here, everything else goes through hf_gather_point (out of line,
+ * so this loop keeps its invariants in registers). */
 static void hf_gather_accumulate(hf_sweep *sw)
 {
     const hfvis_grid *g = sw->g;
@@ -3481,27 +3480,30 @@ hfvis_status hfvis_sky_light_from_map(const hfvis_grid *grid, int K, double map_
     return HFVIS_OK;
 }
 
-/* Sky-view factor term per direction: sin(max(alpha, 0)) = t/sqrt(1+t^2) for t > 0. */
-/* sin(atan(t)) without overflow: t/sqrt(1 + t^2), or for |t| past the square's range (heights
- * over tiny cells) sign(t)/sqrt(1 + (1/t)^2). */
-static inline double hf_tan_sine(double t)
+/* sin(atan(t)) for t >= 0 (or NaN) without overflow: t/sqrt(1 + t^2), or past the square's range
+ * (heights over tiny cells) 1/sqrt(1 + (1/t)^2). */
+static inline double hf_tan_sine_nonneg(double t)
 {
-    if (fabs(t) > HF_SLOPE_SQUARE_MAX) {
-        double r = 1.0 / t;
-        return (t > 0.0 ? 1.0 : -1.0) / sqrt(1.0 + r * r);
-    }
-    return t / sqrt(1.0 + t * t);
-}
-
-/* hf_tan_sine of t > 0 written for the sign it has (no fabs, no sign select; the same bits). */
-static inline double hf_svf_term(double t)
-{
-    if (!(t > 0.0)) return 0.0;
     if (t > HF_SLOPE_SQUARE_MAX) {
         double r = 1.0 / t;
         return 1.0 / sqrt(1.0 + r * r);
     }
     return t / sqrt(1.0 + t * t);
+}
+
+/* sin(atan(t)) of any sign: odd, and both forms are exact under negation (the same bits as
+ * computing with t's own sign). */
+static inline double hf_tan_sine(double t)
+{
+    return t < 0.0 ? -hf_tan_sine_nonneg(-t) : hf_tan_sine_nonneg(t);
+}
+
+/* Sky-view factor term per direction: sin(max(alpha, 0)) = hf_tan_sine(t) for t > 0, else 0
+ * (the sweeps' hot loops call it: no sign handling). */
+static inline double hf_svf_term(double t)
+{
+    if (!(t > 0.0)) return 0.0;
+    return hf_tan_sine_nonneg(t);
 }
 
 static void hf_svf_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdiff_t step, int n,
