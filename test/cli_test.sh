@@ -506,6 +506,21 @@ expect_fail "azimuths without --dirs" 2 azimuths --exact
 expect_fail "azimuths --dirs 0" 2 azimuths --dirs 0
 expect_fail "azimuths unknown option" 2 azimuths --dirs 4 -o "$fdir/x.txt"
 expect_fail "azimuths --azimuth0 nan" 2 azimuths --dirs 4 --azimuth0 nan
+# azimuths shares the run commands' parsing: IN is taken, --azimuth0 1e20 is refused as skyview refuses it
+[ "$("$hfvis" azimuths "$h" --dirs 4 --azimuth0 10 | tr '\n' ' ')" = "10 100 190 280 " ] && ok "azimuths IN --dirs 4" || bad "azimuths IN --dirs 4"
+expect_fail "azimuths --azimuth0 1e20" 2 azimuths --dirs 4 --azimuth0 1e20
+grep -q -- '--azimuth0' "$dir/stderr" && ok "azimuths --azimuth0 1e20: names the flag" || bad "azimuths --azimuth0 1e20: $(cat "$dir/stderr")"
+expect_fail "azimuths of a file that is not a raster" 1 azimuths "$dir/garbage.pgm" --dirs 4
+# a flag a command does not use is refused by name; a bad value names its flag and range
+expect_fail "skyview --sun-elevation" 2 skyview "$h" --sun-elevation 20 -o "$fdir/x.pfm"
+grep -qF 'hfvis: skyview: --sun-elevation is not used by skyview' "$dir/stderr" && ok "skyview --sun-elevation: named" || bad "skyview --sun-elevation: $(cat "$dir/stderr")"
+expect_fail "viewshed --dirs" 2 viewshed "$h" --observer-grid 3,3 --dirs 8 -o "$fdir/x.pfm"
+expect_fail "viewshed --border clamp" 2 viewshed "$h" --observer-grid 3,3 --border clamp -o "$fdir/x.pfm"
+expect_fail "normals --convention" 2 normals "$h" --convention grass -o "$fdir/x.pfm"
+expect_fail "voxelize --range" 2 voxelize "$dir/hill.pgm" --res 4 --range 0:1 -o "$fdir/x.raw"
+expect_fail "ssao --method lsao --dirs 4" 2 ssao "$dir/hill.pgm" --method lsao --dirs 4 -o "$fdir/x.pfm"
+grep -q -- '--dirs.*multiple of 8' "$dir/stderr" && ok "ssao lsao --dirs 4: names --dirs and its range" || bad "ssao lsao --dirs 4: $(cat "$dir/stderr")"
+"$hfvis" info "$dir/envhuge.pfm" | grep -qx 'format pfm' && ok "info: a PFM is pfm" || bad "info: PFM format"
 "$hfvis" skyview "$h" --dirs 16 --dir-range 0:16 -o "$dir/whole.hfvs" 2> /dev/null
 "$hfvis" sum "$dir/whole.hfvs" -o "$dir/whole.pfm" 2> /dev/null
 "$hfvis" skyview "$h" --dirs 16 -o "$dir/single.pfm" 2> /dev/null
@@ -699,7 +714,7 @@ expect_ok "viewshed --curvature" "$dir/vc.pfm" viewshed "$dir/line.pgm" --cell 1
 expect_floats "viewshed --curvature (k = 0.13): horizon after column 121" "$dir/vc.pfm" 720 0 1 1 0 0
 expect_stdout "viewshed --target visible" "target 12100,0 (column 121, row 0): visible"
 expect_stdout "viewshed --target hidden" "target 12200,0 (column 122, row 0): hidden"
-expect_stdout "viewshed --target outside" "target 99999,0 (column -1, row -1): outside the grid"
+expect_stdout "viewshed --target outside: where it was given" "target 99999,0 (column 999.99, row 0): outside the grid"
 expect_ok "viewshed --curvature --refraction 0" "$dir/vc00.pfm" viewshed "$dir/line.pgm" --cell 100 --observer 0,0 --observer-height 10 --curvature --refraction 0 --exact -o "$dir/vc00.pfm"
 expect_floats "viewshed --curvature (k = 0): horizon after column 113" "$dir/vc00.pfm" 752 0 1 1 0 0
 
@@ -868,6 +883,49 @@ rm -f "$dir/$longt"
 longa=$(awk 'BEGIN { for (i = 0; i < 247; i++) printf "%c", 97 + i % 26 }').asc
 expect_ok "a 251-byte ASCII grid output name" "$dir/$longa" skyview "$dir/flat.pgm" --dirs 4 -o "$dir/$longa"
 rm -f "$dir/$longa"
+
+# ---- every command x every flag, from the tables ('hfvis --list-commands', '--list-flags') ----
+# A flag the command does not use: exit 2, one line "hfvis: CMD: FLAG is not used by CMD". A flag
+# it uses, given the value '@bad' (or none for a switch): never refused as unused or unknown,
+# and a refusal of the value is one line naming the flag. Every flag of the table in docs/cli.md.
+"$hfvis" --list-flags > "$dir/flags" && "$hfvis" --list-commands > "$dir/commands" &&
+  [ -s "$dir/flags" ] && [ -s "$dir/commands" ] && ok "--list-flags, --list-commands" || bad "--list-flags, --list-commands"
+[ "$(wc -l < "$dir/commands" | tr -d ' ')" = "$("$hfvis" --help | sed -n '/^commands:/,/^$/p' | grep -c '^  [a-z]')" ] &&
+  ok "--list-commands: the commands of --help" || bad "--list-commands differs from --help"
+walk_bad=0; walk_n=0
+walk_fail() { walk_bad=$((walk_bad + 1)); echo "FAIL cli walk: $1"; }
+while read -r c; do # one run per pair, no other process: the walk is ~2,000 runs
+  used=" $("$hfvis" --list-flags "$c" | cut -f1 | tr '\n' ' ') "
+  while IFS='	' read -r f v cmds; do
+    walk_n=$((walk_n + 1))
+    if [ "$v" = - ]; then err=$("$hfvis" "$c" "$f" 2>&1 > /dev/null); rc=$?
+    else err=$("$hfvis" "$c" "$f" @bad 2>&1 > /dev/null); rc=$?; fi
+    case "$err" in *"
+"*) n=2 ;; "") n=0 ;; *) n=1 ;; esac
+    case "$used" in
+    *" $f "*)
+      case ",$cmds," in *",$c,"*) ;; *) walk_fail "$c $f: --list-flags disagree" ;; esac
+      case "$err" in *"is not used by"* | *"unknown option"*) walk_fail "$c uses $f but refused it: $err" ;; esac
+      if [ "$rc" -ne 0 ] && [ "$n" -ne 1 ]; then walk_fail "$c $f: exit $rc with $n lines"; fi
+      case "$err" in *expected*) case "$err" in *"$f"*) ;; *) walk_fail "$c $f @bad: not named in: $err" ;; esac ;; esac ;;
+    *)
+      case "$rc $n $err" in "2 1 hfvis: $c: $f is not used by $c"*) ;; *) walk_fail "$c does not use $f: exit $rc: $err" ;; esac ;;
+    esac
+  done < "$dir/flags"
+done < "$dir/commands"
+[ "$walk_bad" -eq 0 ] && ok "walk: $walk_n command x flag pairs" || bad "walk: $walk_bad of $walk_n pairs"
+# every refusal of a bad number names the flag and its range
+"$hfvis" skyview "$h" --dirs 0 -o "$fdir/x.pfm" 2> "$dir/werr"
+grep -q -- '--dirs.*1\.\.65536' "$dir/werr" && ok "--dirs 0: flag and range" || bad "--dirs 0: $(cat "$dir/werr")"
+here=$(cd "$(dirname "$0")" && pwd)
+if [ -f "$here/../docs/cli.md" ]; then
+  missing=$(cut -f1 "$dir/flags" | while read -r f; do grep -qF -- "\`$f" "$here/../docs/cli.md" || printf '%s ' "$f"; done)
+  [ -z "$missing" ] && ok "docs/cli.md names every flag" || bad "docs/cli.md lacks: $missing"
+  missing=$(while read -r c; do grep -qF -- "\`$c\`" "$here/../docs/cli.md" || printf '%s ' "$c"; done < "$dir/commands")
+  [ -z "$missing" ] && ok "docs/cli.md names every command" || bad "docs/cli.md lacks commands: $missing"
+else
+  echo "SKIP cli docs/cli.md: not beside the script"
+fi
 
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"

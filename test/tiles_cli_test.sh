@@ -126,6 +126,12 @@ done
 run "openness whole" openness "$dir/s.flt" --radius 6 -o "$dir/op.whole.tif" &&
 pieces op tif "$W1" openness "$dir/s.flt" --radius 6 &&
 same "openness --radius 6 (halo 4 cells): mosaic = whole run" "$dir/op.whole.tif" "$dir/op.mosaic.tif"
+# --border clamp: openness windows march a plain grid whose edges are the raster's where a march
+# meets them, so clamp tiles exactly; a sweep's clamped lines start outside the whole raster: refused
+run "openness clamp whole" openness "$dir/s.flt" --radius 6 --border clamp -o "$dir/opc.whole.tif" &&
+pieces opc tif "$W1" openness "$dir/s.flt" --radius 6 --border clamp &&
+same "openness --radius 6 --border clamp: mosaic = whole run" "$dir/opc.whole.tif" "$dir/opc.mosaic.tif"
+fails "skyview --border clamp --window" 2 "--border clamp" skyview "$dir/s.flt" --max-distance 400 --border clamp --window 0,0,10,10 -o "$dir/x.pfm"
 grep -q '^window=40,0,1,30 planes=1 channels=1 range=' "$dir/op.2.tif.tile" && ok "sidecar records the window" || bad "sidecar: $(head -n 2 "$dir/op.2.tif.tile")"
 grep -q 'extent=97x83 ' "$dir/op.2.tif.tile" && ok "sidecar records the extent" || bad "sidecar extent"
 grep -q 'max-distance=0x1.9p+8 ' "$dir/sv_flt.1.pfm.tile" && ok "sidecar records R" || bad "sidecar R"
@@ -142,7 +148,7 @@ fails "PGM piece" 2 "keeps its values" skyview "$dir/s.flt" --max-distance 10 --
 fails "window with --dir-range" 2 "dir-range" skyview "$dir/s.flt" --max-distance 10 --window 0,0,5,5 --dir-range 0:4 -o "$dir/x.hfvs"
 printf 'P2\n3 3\n9\n1 2 3 4 5 6 7 8 9\n' > "$dir/p2.pgm"
 fails "window of a P2 PGM" 1 "binary (P5)" skyview "$dir/p2.pgm" --max-distance 10 --window 0,0,5,5 -o "$dir/x.pfm"
-fails "window not on viewshed" 2 "not an option" viewshed "$dir/s.flt" --observer-grid 3,3 --window 0,0,5,5 -o "$dir/x.pfm"
+fails "window not on viewshed" 2 "--window is not used by viewshed" viewshed "$dir/s.flt" --observer-grid 3,3 --window 0,0,5,5 -o "$dir/x.pfm"
 # a second field of the same size, the same field with another CRS, another cell size
 field 97 83 8 "$dir/t"
 cp "$dir/s.prj" "$dir/t.prj"

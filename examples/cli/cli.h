@@ -48,14 +48,10 @@
 #define CLI_EXIT_USAGE 2
 #define CLI_RUN (-1)                              /* parse_args: go on and run the command */
 
+/* The commands, in the order of `hfvis --help`; each is one row of cli_commands (main.c). */
 enum { CMD_HORIZON, CMD_SKYVIEW, CMD_SKY, CMD_SHADOW, CMD_LIGHT, CMD_NORMALS, CMD_INDIRECT,
-       CMD_VISIBILITY, CMD_VIEWSHED, CMD_VOXELIZE, CMD_GI, CMD_SSAO, CMD_VOLGI, CMD_VISFIELD, CMD_MESHAO,
-       CMD_HILLSHADE, CMD_OPENNESS, CMD_SUM, CMD_COUNT };
-static const char *const cli_cmd_names[CMD_COUNT] = {
-    "horizon", "skyview", "sky", "shadow", "light", "normals", "indirect", "visibility",
-    "viewshed", "voxelize", "gi", "ssao", "volgi", "visfield", "meshao", "hillshade", "openness",
-    "sum"
-};
+       CMD_GI, CMD_VISIBILITY, CMD_VIEWSHED, CMD_HILLSHADE, CMD_OPENNESS, CMD_VOXELIZE, CMD_VOLGI,
+       CMD_VISFIELD, CMD_MESHAO, CMD_SSAO, CMD_SUM, CMD_MOSAIC, CMD_INFO, CMD_AZIMUTHS, CMD_COUNT };
 
 /* voxelize --mode, --axis, --method */
 enum { VOX_SURFACE, VOX_CONSERVATIVE, VOX_SOLID };
@@ -122,19 +118,51 @@ static const char *const cli_conv_names[3] = { "compass", "grass", "grid" };
 #define CLI_EARTH_RADIUS 6371000.0 /* mean Earth radius in metres (IUGG), --earth-radius default */
 #define CLI_REFRACTION 0.13        /* the usual refraction coefficient (ArcGIS's default) */
 
-#define CLI_ALL ((1u << CMD_COUNT) - 1u)
-#define CLI_ONLY(c) (1u << (c))
+/* Sets of commands, for the flag table (flags.c): bit CLI_ONLY(c) is command c. */
+#define CLI_ONLY(c) (1ul << (c))
+#define CLI_ALL ((1ul << CMD_COUNT) - 1ul)
+/* the height-field commands: IN is a raster of heights (--cell, --zscale, --nodata, --band) */
+#define CLI_HF (CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_SHADOW) \
+                | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_NORMALS) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) \
+                | CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_HILLSHADE) \
+                | CLI_ONLY(CMD_OPENNESS))
+/* the commands that parse with cli_parse and write OUT (--progress, --max-memory) */
+#define CLI_RUNS (CLI_HF | CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_VISFIELD) \
+                  | CLI_ONLY(CMD_MESHAO) | CLI_ONLY(CMD_SSAO))
+/* every command that writes OUT (-o, --quiet, --overwrite); those that can write a PGM (--range) */
+#define CLI_OUT (CLI_RUNS | CLI_ONLY(CMD_SUM) | CLI_ONLY(CMD_MOSAIC))
+#define CLI_PGM (CLI_OUT & ~CLI_ONLY(CMD_VOXELIZE))
+/* the commands of K azimuth directions (--dirs K, --azimuth0) */
+#define CLI_DIRS (CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT) \
+                  | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VISIBILITY) \
+                  | CLI_ONLY(CMD_OPENNESS) | CLI_ONLY(CMD_AZIMUTHS))
 #define CLI_SUN (CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) \
                  | CLI_ONLY(CMD_HILLSHADE)) /* the sun flags */
+/* the commands with azimuth flags (--convention, --radians, --compass) */
+#define CLI_ANGLES (CLI_DIRS | CLI_SUN)
+/* the commands that sweep lines over the grid, which start outside it (--border) */
+#define CLI_BORDER (CLI_ANGLES & ~CLI_ONLY(CMD_AZIMUTHS))
 /* the sweep commands: --max-distance R is the library's search radius, --window makes a piece */
 #define CLI_SWEEP (CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_SHADOW) \
                    | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_HILLSHADE))
 /* the [P2] hull-tree commands: a search radius but no windows in the library (hfvis.h, "Search
  * radius and tiles") */
 #define CLI_P2 (CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_INDIRECT))
-/* the height-field commands: the GIS conventions apply to them */
-#define CLI_HF (CLI_ALL & ~(CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_VOLGI) \
-                            | CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_MESHAO) | CLI_ONLY(CMD_SUM)))
+
+/* A command (main.c, cli_commands): its name and one-line summary for `hfvis --help`, its --help
+ * text, whether it needs IN and OUT and is estimated before it runs (cli_check_cost), the check
+ * of its flags' combinations (NULL: none), and how it runs: run takes the parsed arguments
+ * (cli_parse); main, for the commands with lists of inputs (sum, mosaic, info), takes the
+ * command line. Exactly one of run and main is set. */
+enum { CLI_IN_NEEDED = 1, CLI_OUT_NEEDED = 2, CLI_COST_FIRST = 4 };
+typedef struct cli_command {
+    const char *name, *summary, *help;
+    int io; /* CLI_IN_NEEDED, CLI_OUT_NEEDED; CLI_COST_FIRST: estimated from the flags, before run */
+    int (*check)(const cli_args *a);
+    int (*run)(const cli_args *a);
+    int (*main)(int argc, char **argv);
+} cli_command;
+static const cli_command cli_commands[CMD_COUNT]; /* defined in main.c */
 
 static int cli_bar_open; /* a progress line is on stderr without its newline yet */
 
@@ -202,6 +230,7 @@ static int cli_line_pct = -1;     /* and its percentage */
 #define CLI_PIECE_MAGIC "HFVISTILE 1\n"
 #define CLI_PIECE_SIDECAR ".tile" /* appended to the piece's name */
 
+/* One piece's sidecar, as read back. */
 typedef struct cli_piece {
     int x0, y0, w, h, planes, channels;
     char range[96];
@@ -209,7 +238,6 @@ typedef struct cli_piece {
 } cli_piece;
 
 /* prototypes, by file */
-/* help.c */
 /* progress.c */
 static int cli_error(int code, const char *what, const char *fmt, ...);
 static int cli_status(const char *what, hfvis_status s, int saved_errno);
@@ -226,6 +254,12 @@ static int cli_real(const char *flag, const char *s, double lo, int lo_open, dou
                     const char *expect, double *out);
 static int cli_int(const char *flag, const char *s, long lo, long hi, const char *expect, int *out);
 static int cli_ends_with(const char *s, const char *ext);
+static int cli_command_of(const char *name);
+static size_t cli_flag_of(const char *name);
+static int cli_refuse_flag(int cmd, const char *arg);
+static int cli_help(int cmd);
+static int cli_list_commands(int argc);
+static int cli_list_flags(int argc, char **argv);
 static int cli_set(cli_args *a, const char *f, const char *v);
 static int cli_check_window(const cli_args *a);
 static int cli_parse(int argc, char **argv, cli_args *a);
@@ -243,7 +277,8 @@ static int cli_integral_type(const cli_args *a, const float *px, size_t n, ex_ge
 static void cli_georef(const cli_args *a, double cell, double gt[6]);
 static int cli_map_to_grid(const cli_args *a, double cell, double X, double Y, double *x, double *y);
 static int cli_info(int argc, char **argv);
-static int cli_azimuths(int argc, char **argv);
+static int cli_check_azimuths(const cli_args *a);
+static int cli_run_azimuths(const cli_args *a);
 /* write.c */
 static void cli_on_temp(void *user, const char *tmp);
 static void cli_on_signal(int sig);
@@ -279,9 +314,10 @@ static int cli_halo(const cli_args *a, double cell);
 static int cli_window_side(const cli_args *a, int halo, int w, int h, int channels);
 static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double *cell);
 static float *cli_alloc(size_t a, size_t b, size_t c);
-static int cli_run(const cli_args *a);
+static int cli_run_heights(const cli_args *a);
 /* sweeps.c */
 static int cli_set_gi(cli_args *a, const char *f, const char *v);
+static int cli_check_light_flags(const cli_args *a);
 static int cli_check_gi(const cli_args *a);
 static int cli_load_env(const char *path, float **px, hfvis_env *env);
 static int cli_load_map(const char *path, const hfvis_grid *grid, float **px, int *channels);
@@ -291,7 +327,10 @@ static int cli_check_radiance(const char *cmd, const hfvis_grid *grid, const flo
 static int cli_run_gi(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
                   cli_progress_state *prog);
 static int cli_horizon_finish(const cli_args *a, float *map, int w, int h, double lo, double hi);
+static int cli_check_shadow(const cli_args *a);
+static int cli_check_light(const cli_args *a);
 /* p2.c */
+static int cli_check_indirect(const cli_args *a);
 static int cli_run_indirect(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
                             cli_progress_state *prog);
 static int cli_run_visibility(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
@@ -306,8 +345,10 @@ static int cli_run_skyview_saga(const cli_args *a, const hfvis_grid *grid, hfvis
                                 cli_progress_state *prog, float *out);
 static int cli_run_gis(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
                        cli_progress_state *prog);
+static int cli_check_viewshed(const cli_args *a);
 /* screen.c */
 static int cli_set_ssao(cli_args *a, const char *f, const char *v);
+static int cli_check_ssao(const cli_args *a);
 static int cli_run_ssao(const cli_args *a);
 /* meshes.c */
 static void cli_lk_defaults(cli_args *a);
@@ -322,6 +363,7 @@ static int cli_volgi_reals(const char *s, size_t len, double *out, int min, int 
 static int cli_volgi_light(cli_args *a, const char *v);
 static int cli_set_volgi(cli_args *a, const char *f, const char *v);
 static int cli_check_volgi(const cli_args *a);
+static int cli_check_voxelize(const cli_args *a);
 static int cli_run_voxelize(const cli_args *a);
 static int cli_run_meshao(const cli_args *a);
 static int cli_vf_build(const cli_args *a);
@@ -353,5 +395,6 @@ static int cli_piece_read(const char *path, const cli_piece *m, int W, int H, fl
                           const ex_georef *ref, ex_georef *keep);
 static int cli_mosaic(int argc, char **argv);
 /* main.c */
+static int cli_commands_complete(void);
 
 #endif /* HFVIS_CLI_H */

@@ -3,42 +3,6 @@
  * combinations. Owns: cli_args' contents. May call: progress.c (errors), gis.c (GIS flags), the
  * command families' flag setters and checks (sweeps.c, screen.c, meshes.c). */
 
-#define CLI_VOLGI_FLAGS                                                                      \
-    { "--room", 0, CLI_ONLY(CMD_VOLGI) }, { "--iterations", 1, CLI_ONLY(CMD_VOLGI) },        \
-    { "--light", 1, CLI_ONLY(CMD_VOLGI) }, { "--eye", 1, CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO) },              \
-    { "--target", 1, CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO) | CLI_ONLY(CMD_VIEWSHED) }, { "--up", 1, CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO) },              \
-    { "--fov", 1, CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO) }, { "--size", 1, CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_MESHAO) },               \
-    { "--transfer", 1, CLI_ONLY(CMD_VOLGI) }, { "--paths", 1, CLI_ONLY(CMD_VOLGI) },         \
-    { "--reflection", 1, CLI_ONLY(CMD_VOLGI) }, { "--reflectance", 1, CLI_ONLY(CMD_VOLGI) }
-
-
-#define CLI_VF_FLAGS                                                                              \
-    { "--positions", 1, CLI_ONLY(CMD_VISFIELD) }, { "--format", 1, CLI_ONLY(CMD_VISFIELD) },      \
-    { "--mapping", 1, CLI_ONLY(CMD_VISFIELD) }, { "--ao", 0, CLI_ONLY(CMD_VISFIELD) },            \
-    { "--ground", 1, CLI_ONLY(CMD_VISFIELD) }, { "--extent", 1, CLI_ONLY(CMD_VISFIELD) },         \
-    { "--rays", 1, CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_MESHAO) },                                                      \
-    { "--bias", 1, CLI_ONLY(CMD_VISFIELD) }, { "--reference", 1, CLI_ONLY(CMD_VISFIELD) }
-
-
-#define CLI_LK_FLAGS                                                                          \
-    { "--falloff", 1, CLI_ONLY(CMD_MESHAO) }, { "--two-sided", 0, CLI_ONLY(CMD_MESHAO) },     \
-    { "--lut", 1, CLI_ONLY(CMD_MESHAO) }, { "--seed", 1, CLI_ONLY(CMD_MESHAO) },              \
-    { "--no-jitter", 0, CLI_ONLY(CMD_MESHAO) }, { "--pattern", 1, CLI_ONLY(CMD_MESHAO) }
-
-#define CLI_GI_FLAGS                                                                         \
-    { "--order", 1, CLI_ONLY(CMD_GI) }, { "--subsample", 1, CLI_ONLY(CMD_GI) },              \
-    { "--specular", 1, CLI_ONLY(CMD_GI) }, { "--shininess", 1, CLI_ONLY(CMD_GI) }
-
-
-#define CLI_GIS_FLAGS                                                                             \
-    { "--convention", 1, CLI_HF }, { "--radians", 0, CLI_HF }, { "--overwrite", 0, CLI_ALL },     \
-    { "--progress", 0, CLI_ALL }, { "--azimuth", 1, CLI_ONLY(CMD_HORIZON) },                      \
-    { "--split", 0, CLI_ONLY(CMD_HORIZON) }, { "--observer-grid", 1, CLI_ONLY(CMD_VIEWSHED) },    \
-    { "--curvature", 0, CLI_ONLY(CMD_VIEWSHED) }, { "--refraction", 1, CLI_ONLY(CMD_VIEWSHED) },  \
-    { "--earth-radius", 1, CLI_ONLY(CMD_VIEWSHED) }, { "--svf", 1, CLI_ONLY(CMD_SKYVIEW) },       \
-    { "--blend", 1, CLI_ONLY(CMD_HILLSHADE) }, { "--no-shadows", 0, CLI_ONLY(CMD_HILLSHADE) },    \
-    { "--negative", 0, CLI_ONLY(CMD_OPENNESS) }
-
 /* A finite number with nothing else in s (no leading space, no trailing characters). */
 static int cli_parse_real(const char *s, double *out)
 {
@@ -87,48 +51,272 @@ static int cli_ends_with(const char *s, const char *ext)
     return 1;
 }
 
-typedef struct cli_flag { const char *name; int has_value; unsigned commands; } cli_flag;
+/* The flags: name, value (its placeholder in the help; NULL: the flag takes none), the commands
+ * that use it, and for the shared options their --help entry (the others are described in their
+ * commands' help). A command refuses by name every flag whose row does not list it; `hfvis
+ * --list-flags [CMD]` prints this table, test/cli_test.sh walks it. */
+typedef struct cli_flag {
+    const char *name, *value;
+    unsigned long commands; /* CLI_ONLY(CMD_...) bits */
+    const char *help;
+} cli_flag;
 static const cli_flag cli_flags[] = {
-    { "-o", 1, CLI_ALL },           { "--range", 1, CLI_ALL },       { "--cell", 1, CLI_ALL },
-    { "--zscale", 1, CLI_ALL },     { "--nodata", 1, CLI_ALL },      { "--dirs", 1, CLI_ALL },
-    { "--azimuth0", 1, CLI_ALL },   { "--compass", 0, CLI_ALL },     { "--degrees", 0, CLI_ALL },
-    { "--border", 1, CLI_ALL },     { "--border-cells", 1, CLI_ALL }, { "--quiet", 0, CLI_ALL },
-    { "--band", 1, CLI_ALL },
-    { "--max-memory", 1, CLI_ALL },
-    { "--dir-range", 1, CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY)
-                        | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VISIBILITY) },
-    { "--sky", 1, CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
-    { "--albedo", 1, CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI)
-                  | CLI_ONLY(CMD_VOLGI) },
-    { "--sun-azimuth", 1, CLI_SUN },              { "--sun-elevation", 1, CLI_SUN },
-    { "--sun-radius", 1, CLI_SUN },               { "--math", 0, CLI_SUN },
-    { "--env", 1, CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
-    { "--method", 1, CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_SSAO)
-                     | CLI_ONLY(CMD_MESHAO) },
-    { "--sun-irradiance", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) }, { "--albedo-map", 1, CLI_ONLY(CMD_INDIRECT) },
-    { "--emission", 1, CLI_ONLY(CMD_INDIRECT) },  { "--bounces", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
-    { "--output", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VOLGI) },
-    { "--fraction", 0, CLI_ONLY(CMD_VISIBILITY) }, { "--stats", 0, CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_MESHAO) },
-    { "--observer", 1, CLI_ONLY(CMD_VIEWSHED) },  { "--observer-height", 1, CLI_ONLY(CMD_VIEWSHED) },
-    { "--target-height", 1, CLI_ONLY(CMD_VIEWSHED) },
-    { "--max-distance", 1, CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_VISFIELD) | CLI_SWEEP | CLI_P2 },
-    { "--window", 1, CLI_SWEEP | CLI_ONLY(CMD_OPENNESS) },
-    { "--exact", 0, CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY)
-                    | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_SHADOW) },
-    { "--res", 1, CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_VOLGI) },       { "--mode", 1, CLI_ONLY(CMD_VOXELIZE) },
-    { "--axis", 1, CLI_ONLY(CMD_VOXELIZE) },  
-    { "--max-vertices", 1, CLI_ONLY(CMD_VOXELIZE) }, { "--padding", 1, CLI_ONLY(CMD_VOXELIZE) },
-    { "--open", 0, CLI_ONLY(CMD_VOXELIZE) },
-    CLI_GI_FLAGS,
-    CLI_VOLGI_FLAGS,
-    CLI_VF_FLAGS,
-    CLI_LK_FLAGS,
-    { "--fov-y", 1, CLI_ONLY(CMD_SSAO) },         { "--ortho", 1, CLI_ONLY(CMD_SSAO) },
-    { "--radius", 1, CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_MESHAO) | CLI_ONLY(CMD_OPENNESS) },        { "--guard", 1, CLI_ONLY(CMD_SSAO) },
-    { "--depth", 1, CLI_ONLY(CMD_SSAO) },         { "--near", 1, CLI_ONLY(CMD_SSAO) },
-    { "--far", 1, CLI_ONLY(CMD_SSAO) },
-    CLI_GIS_FLAGS
+    { "-o", "OUT", CLI_OUT,
+      "output file, required: *.pfm writes PFM floats, *.pgm a 16-bit PGM;\n"
+      "                    a PGM of a 3-channel result stacks the channels as planes, top to bottom;\n"
+      "                    PGM code 0 is NoData and LO..HI map to 1..65535, recorded in the header\n"
+      "                    comment \"# hfvis range LO HI nodata 0\"\n"
+      "                    *.tif a GeoTIFF (tiled, DEFLATE; Float32, or the smallest integer type\n"
+      "                    for viewshed and visibility counts), *.asc an ESRI ASCII grid,\n"
+      "                    *.bil/*.flt raw floats + .hdr: these carry IN's georeference and NoData\n"
+      "                    (planes and channels become bands)\n" },
+    { "--band", "N", CLI_HF,
+      "IN is a multi-band raster: use band N (1-based, default 1)\n" },
+    { "--range", "LO:HI", CLI_PGM,
+      ".pgm only: the values mapped to 0 and 65535 (default per command)\n" },
+    { "--cell", "S", CLI_HF,
+      "distance between samples, in height units (default: the cell size of a\n"
+      "                    georeferenced IN (.tif, .asc, .bil/.flt), else 1 with a note)\n" },
+    { "--zscale", "Z", CLI_HF,
+      "multiply input values by Z, non-zero (default 1)\n" },
+    { "--nodata", "V", CLI_HF,
+      "input values equal to V are holes: no occlusion, output NaN (PGM code 0)\n" },
+    { "--dirs", "K", CLI_DIRS | CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_VISFIELD),
+      "number of azimuth directions, 1..65536 (default 16)\n" },
+    { "--convention", "C", CLI_ANGLES,
+      "how azimuths are read and directions ordered (height-field commands):\n"
+      "                    compass (default): bearings clockwise from north, direction k at\n"
+      "                    azimuth0 + 360k/K; grass: counter-clockwise from east (r.horizon,\n"
+      "                    r.sun), direction k at azimuth0 + 360k/K counter-clockwise; grid: the\n"
+      "                    library's psi, from east toward south (x toward y; the old --math)\n" },
+    { "--azimuth0", "A", CLI_DIRS,
+      "azimuth of direction 0 in the convention (default: compass 0 = north;\n"
+      "                    grass and grid 0 = east). Degrees (before 0.2: radians); see --radians\n" },
+    { "--radians", NULL, CLI_ANGLES,
+      "angle flags (--azimuth0, --azimuth, --sun-*) in radians, not degrees\n" },
+    { "--compass", NULL, CLI_ANGLES,
+      "the same as --convention compass (the default)\n" },
+    { "--degrees", NULL, CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_OPENNESS),
+      "angle outputs in degrees instead of radians\n" },
+    { "--dir-range", "A:B", CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT)
+                      | CLI_ONLY(CMD_VISIBILITY),
+      "horizon, skyview, sky, light, visibility: only the directions at\n"
+      "                    positions A..B-1 of the K (0 <= A < B <= K) in sweep order (with K a\n"
+      "                    multiple of 4, each 4 consecutive positions are the quarter turns\n"
+      "                    k, k+K/4, k+K/2, k+3K/4 that share one lattice: give A and B as\n"
+      "                    multiples of 4 and each part costs its share of the run); OUT (*.hfvs)\n"
+      "                    is then a partial result, and 'hfvis sum' adds the parts of a split\n"
+      "                    into the single run's OUT\n" },
+    { "--border", "MODE", CLI_BORDER,
+      "open (nothing outside the grid, default), clamp (edge heights extend\n"
+      "                    outward) or wrap (periodic field)\n" },
+    { "--border-cells", "N", CLI_BORDER,
+      "clamp/wrap: lines start N cells outside the grid, 1..1048576\n"
+      "                    (default max(width, height))\n" },
+    { "--exact", NULL, CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY)
+                      | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_AZIMUTHS),
+      "horizon, skyview, sky, light, shadow: exact rays (beyond [P1]): every\n"
+      "                    sample gets its own ray along the nearest rational direction, no\n"
+      "                    interpolation between lattice lines (right at walls, roofs, cliffs;\n"
+      "                    'hfvis azimuths --exact' prints the directions used). visibility,\n"
+      "                    indirect and gi keep the lattice\n" },
+    { "--max-distance", "R", CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_VISFIELD) | CLI_SWEEP | CLI_P2,
+      "horizon, skyview, sky, shadow, light, visibility, indirect, hillshade:\n"
+      "                    the search radius in height units (--cell applies): occluders farther\n"
+      "                    than R along the ray are ignored (GRASS maxdistance, SAGA and RVT radius,\n"
+      "                    WhiteboxTools max_dist); 0 = unlimited (default). visibility and\n"
+      "                    indirect: visible samples farther than R are not counted or gathered.\n"
+      "                    viewshed: its range\n" },
+    { "--window", "X0,Y0,W,H", CLI_SWEEP | CLI_ONLY(CMD_OPENNESS),
+      "with a finite R (openness: --radius R; not visibility, indirect): only\n"
+      "                    the W x H cells from\n"
+      "                    column X0, row Y0 (clipped to IN), reading only them and a halo of\n"
+      "                    ceil(R/cell) + 1 cells (GeoTIFF strips/tiles, .bil/.flt, PFM and binary\n"
+      "                    PGM rows, by seeking); OUT (.pfm .tif .bil .flt .asc) is a piece, placed\n"
+      "                    and georeferenced at the window, with its sidecar OUT.tile; 'hfvis\n"
+      "                    mosaic' joins the pieces into the whole run's OUT (docs/tiles.md)\n" },
+    { "--quiet", NULL, CLI_OUT,
+      "no progress bar (shown on stderr only when it is a terminal) and no notes\n" },
+    { "--progress", NULL, CLI_RUNS,
+      "plain progress lines on stderr instead (percent, elapsed, ETA), for logs\n"
+      "                    and job schedulers, and a summary line at the end (time, cells,\n"
+      "                    directions); runs over 10 s end with the summary anyway (not --quiet)\n" },
+    { "--overwrite", NULL, CLI_OUT,
+      "allow OUT to be one of the inputs (refused otherwise: same file,\n"
+      "                    through hard and symbolic links too)\n" },
+    { "--max-memory", "B", CLI_RUNS,
+      "refuse a run whose estimated memory exceeds B bytes (suffix K, M, G or\n"
+      "                    T: powers of 1024; 0 = no limit); default half of the physical memory\n"
+      "                    where the system reports it (sysconf), else no limit. The estimate and\n"
+      "                    the work (lattice nodes swept, rays, voxel updates) are printed on\n"
+      "                    stderr with the progress bar\n" },
+    { "--sky", "C", CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI), NULL },
+    { "--albedo", "A", CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT)
+                     | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VOLGI), NULL },
+    { "--sun-azimuth", "DEG", CLI_SUN, NULL },
+    { "--sun-elevation", "DEG", CLI_SUN, NULL },
+    { "--sun-radius", "DEG", CLI_SUN, NULL },
+    { "--math", NULL, CLI_SUN, NULL },
+    { "--env", "ENV", CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI), NULL },
+    { "--method", "M", CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_SSAO)
+                     | CLI_ONLY(CMD_MESHAO), NULL },
+    { "--sun-irradiance", "E", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI), NULL },
+    { "--albedo-map", "MAP", CLI_ONLY(CMD_INDIRECT), NULL },
+    { "--emission", "MAP", CLI_ONLY(CMD_INDIRECT), NULL },
+    { "--bounces", "B", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI), NULL },
+    { "--output", "WHAT", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VOLGI), NULL },
+    { "--fraction", NULL, CLI_ONLY(CMD_VISIBILITY), NULL },
+    { "--stats", NULL, CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_MESHAO), NULL },
+    { "--observer", "X,Y", CLI_ONLY(CMD_VIEWSHED), NULL },
+    { "--observer-height", "H", CLI_ONLY(CMD_VIEWSHED), NULL },
+    { "--target-height", "H", CLI_ONLY(CMD_VIEWSHED), NULL },
+    { "--res", "N", CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_VOLGI), NULL },
+    { "--mode", "M", CLI_ONLY(CMD_VOXELIZE), NULL },
+    { "--axis", "A", CLI_ONLY(CMD_VOXELIZE), NULL },
+    { "--max-vertices", "N", CLI_ONLY(CMD_VOXELIZE), NULL },
+    { "--padding", "P", CLI_ONLY(CMD_VOXELIZE), NULL },
+    { "--open", NULL, CLI_ONLY(CMD_VOXELIZE), NULL },
+    { "--order", "O", CLI_ONLY(CMD_GI), NULL },
+    { "--subsample", "S", CLI_ONLY(CMD_GI), NULL },
+    { "--specular", "S", CLI_ONLY(CMD_GI), NULL },
+    { "--shininess", "N", CLI_ONLY(CMD_GI), NULL },
+    { "--room", NULL, CLI_ONLY(CMD_VOLGI), NULL },
+    { "--iterations", "I", CLI_ONLY(CMD_VOLGI), NULL },
+    { "--light", "SPEC", CLI_ONLY(CMD_VOLGI), NULL },
+    { "--eye", "X,Y,Z", CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO), NULL },
+    { "--target", "POINT", CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO)
+                     | CLI_ONLY(CMD_VIEWSHED), NULL },
+    { "--up", "X,Y,Z", CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO), NULL },
+    { "--fov", "DEG", CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO), NULL },
+    { "--size", "WxH", CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_MESHAO), NULL },
+    { "--transfer", "T", CLI_ONLY(CMD_VOLGI), NULL },
+    { "--paths", "P", CLI_ONLY(CMD_VOLGI), NULL },
+    { "--reflection", "R", CLI_ONLY(CMD_VOLGI), NULL },
+    { "--reflectance", "R", CLI_ONLY(CMD_VOLGI), NULL },
+    { "--positions", "K", CLI_ONLY(CMD_VISFIELD), NULL },
+    { "--format", "F", CLI_ONLY(CMD_VISFIELD), NULL },
+    { "--mapping", "M", CLI_ONLY(CMD_VISFIELD), NULL },
+    { "--ao", NULL, CLI_ONLY(CMD_VISFIELD), NULL },
+    { "--ground", "Z", CLI_ONLY(CMD_VISFIELD), NULL },
+    { "--extent", "E", CLI_ONLY(CMD_VISFIELD), NULL },
+    { "--rays", "N", CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_MESHAO), NULL },
+    { "--bias", "B", CLI_ONLY(CMD_VISFIELD), NULL },
+    { "--reference", "MESH", CLI_ONLY(CMD_VISFIELD), NULL },
+    { "--falloff", "F", CLI_ONLY(CMD_MESHAO), NULL },
+    { "--two-sided", NULL, CLI_ONLY(CMD_MESHAO), NULL },
+    { "--lut", "T", CLI_ONLY(CMD_MESHAO), NULL },
+    { "--seed", "S", CLI_ONLY(CMD_MESHAO), NULL },
+    { "--no-jitter", NULL, CLI_ONLY(CMD_MESHAO), NULL },
+    { "--pattern", "P", CLI_ONLY(CMD_MESHAO), NULL },
+    { "--fov-y", "DEG", CLI_ONLY(CMD_SSAO), NULL },
+    { "--ortho", "SCALE", CLI_ONLY(CMD_SSAO), NULL },
+    { "--radius", "R", CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_MESHAO) | CLI_ONLY(CMD_OPENNESS), NULL },
+    { "--guard", "PIXELS", CLI_ONLY(CMD_SSAO), NULL },
+    { "--depth", "ENC", CLI_ONLY(CMD_SSAO), NULL },
+    { "--near", "N", CLI_ONLY(CMD_SSAO), NULL },
+    { "--far", "F", CLI_ONLY(CMD_SSAO), NULL },
+    { "--azimuth", "A", CLI_ONLY(CMD_HORIZON), NULL },
+    { "--split", NULL, CLI_ONLY(CMD_HORIZON), NULL },
+    { "--observer-grid", "C,R", CLI_ONLY(CMD_VIEWSHED), NULL },
+    { "--curvature", NULL, CLI_ONLY(CMD_VIEWSHED), NULL },
+    { "--refraction", "K", CLI_ONLY(CMD_VIEWSHED), NULL },
+    { "--earth-radius", "R", CLI_ONLY(CMD_VIEWSHED), NULL },
+    { "--svf", "D", CLI_ONLY(CMD_SKYVIEW), NULL },
+    { "--blend", "N", CLI_ONLY(CMD_HILLSHADE), NULL },
+    { "--no-shadows", NULL, CLI_ONLY(CMD_HILLSHADE), NULL },
+    { "--negative", NULL, CLI_ONLY(CMD_OPENNESS), NULL },
 };
+#define CLI_NFLAGS (sizeof cli_flags / sizeof cli_flags[0])
+
+/* The command named name, or -1. */
+static int cli_command_of(const char *name)
+{
+    int c;
+    for (c = 0; c < CMD_COUNT; c++)
+        if (!strcmp(name, cli_commands[c].name)) return c;
+    return -1;
+}
+
+/* The row of flag name in cli_flags, or CLI_NFLAGS. */
+static size_t cli_flag_of(const char *name)
+{
+    size_t k;
+    for (k = 0; k < CLI_NFLAGS; k++)
+        if (!strcmp(name, cli_flags[k].name)) break;
+    return k;
+}
+
+/* A flag that command cmd does not take (arg: "--name" or "--name=value"): refused by name,
+ * "not used" when the table has it, else unknown. Returns CLI_EXIT_USAGE. */
+static int cli_refuse_flag(int cmd, const char *arg)
+{
+    const char *name = cli_commands[cmd].name, *eq = strchr(arg, '=');
+    char flag[64];
+    size_t n = eq ? (size_t)(eq - arg) : strlen(arg);
+    if (n >= sizeof flag) n = sizeof flag - 1;
+    memcpy(flag, arg, n);
+    flag[n] = '\0';
+    if (cli_flag_of(flag) == CLI_NFLAGS)
+        return cli_error(CLI_EXIT_USAGE, flag, "unknown option (see 'hfvis %s --help')", name);
+    return cli_error(CLI_EXIT_USAGE, name, "%s is not used by %s (see 'hfvis %s --help')", flag, name, name);
+}
+
+/* `hfvis --help` (cmd < 0: the usage, the commands and every shared option) or `hfvis CMD
+ * --help` (the command's help and the shared options it uses), from the tables; returns 0. */
+static int cli_help(int cmd)
+{
+    size_t k;
+    int c;
+    if (cmd < 0) {
+        printf("%s", cli_usage);
+        for (c = 0; c < CMD_COUNT; c++) printf("  %-11s %s\n", cli_commands[c].name, cli_commands[c].summary);
+        printf("\nshared options (each command's --help lists those it uses; it refuses the others):\n");
+    } else if (cli_commands[cmd].main) { /* sum, mosaic, info: their help lists their options */
+        printf("%s", cli_commands[cmd].help);
+        return 0;
+    } else {
+        printf("%s\nshared options of %s:\n", cli_commands[cmd].help, cli_commands[cmd].name);
+    }
+    for (k = 0; k < CLI_NFLAGS; k++) {
+        const cli_flag *f = &cli_flags[k];
+        char label[64];
+        if (!f->help || (cmd >= 0 && !(f->commands & CLI_ONLY(cmd)))) continue;
+        snprintf(label, sizeof label, "%s%s%s", f->name, f->value ? " " : "", f->value ? f->value : "");
+        printf("  %-16s  %s", label, f->help);
+    }
+    printf("%s", cli_help_tail);
+    return 0;
+}
+
+/* `hfvis --list-commands`: the commands, one per line (for scripts and tests). */
+static int cli_list_commands(int argc)
+{
+    int c;
+    if (argc != 2) return cli_error(CLI_EXIT_USAGE, "--list-commands", "takes no argument");
+    for (c = 0; c < CMD_COUNT; c++) printf("%s\n", cli_commands[c].name);
+    return fflush(stdout) == 0 && !ferror(stdout) ? 0 : cli_error(CLI_EXIT_ERROR, "stdout", "write error");
+}
+
+/* `hfvis --list-flags [COMMAND]`: one flag per line, "NAME VALUE COMMANDS" separated by tabs
+ * (VALUE "-" for a flag without one, COMMANDS the commands that use it, comma-separated); with
+ * COMMAND, only the flags it uses. */
+static int cli_list_flags(int argc, char **argv)
+{
+    int cmd = -1, c;
+    size_t k;
+    if (argc > 3) return cli_error(CLI_EXIT_USAGE, "--list-flags", "takes at most one COMMAND");
+    if (argc == 3 && (cmd = cli_command_of(argv[2])) < 0)
+        return cli_error(CLI_EXIT_USAGE, argv[2], "unknown command (try 'hfvis --list-commands')");
+    for (k = 0; k < CLI_NFLAGS; k++) {
+        const char *sep = "";
+        if (cmd >= 0 && !(cli_flags[k].commands & CLI_ONLY(cmd))) continue;
+        printf("%s\t%s\t", cli_flags[k].name, cli_flags[k].value ? cli_flags[k].value : "-");
+        for (c = 0; c < CMD_COUNT; c++)
+            if (cli_flags[k].commands & CLI_ONLY(c)) printf("%s%s", sep, cli_commands[c].name), sep = ",";
+        printf("\n");
+    }
+    return fflush(stdout) == 0 && !ferror(stdout) ? 0 : cli_error(CLI_EXIT_ERROR, "stdout", "write error");
+}
 
 /* Apply one recognised flag; returns 0 or CLI_EXIT_USAGE (message printed). */
 static int cli_set(cli_args *a, const char *f, const char *v)
@@ -359,6 +547,10 @@ static int cli_check_window(const cli_args *a)
     if (a->border == HFVIS_BORDER_WRAP)
         return cli_error(CLI_EXIT_USAGE, "--window", "--border wrap joins opposite edges of the whole "
                          "raster: not with a window");
+    if (a->border == HFVIS_BORDER_CLAMP && a->cmd != CMD_OPENNESS) /* openness marches a plain grid */
+        return cli_error(CLI_EXIT_USAGE, "--border clamp", "a sweep's clamped lines start outside the "
+                         "whole raster, which a window's lines do not: not with --window (run whole, "
+                         "or --border open; openness --radius windows take clamp)");
     if (a->albedo_map || a->emission)
         return cli_error(CLI_EXIT_USAGE, "--window", "cannot be combined with %s (a map of the whole "
                          "raster)", a->albedo_map ? "--albedo-map" : "--emission");
@@ -382,18 +574,14 @@ static int cli_parse(int argc, char **argv, cli_args *a)
     if (argc < 2) return cli_error(CLI_EXIT_USAGE, "usage", "missing COMMAND (try 'hfvis --help')");
     if (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help") || !strcmp(argv[1], "help")) {
         if (argc > 2 && strcmp(argv[1], "help") == 0) {
-            for (c = 0; c < CMD_COUNT; c++)
-                if (!strcmp(argv[2], cli_cmd_names[c])) {
-                    printf("%s%s%s", cli_cmd_help[c], cli_shared_help, cli_shared_help2);
-                    return 0;
-                }
-            return cli_error(CLI_EXIT_USAGE, argv[2], "unknown command (try 'hfvis --help')");
+            if ((c = cli_command_of(argv[2])) < 0)
+                return cli_error(CLI_EXIT_USAGE, argv[2], "unknown command (try 'hfvis --help')");
+            return cli_help(c);
         }
-        printf("%s%s%s", cli_usage, cli_shared_help, cli_shared_help2);
-        return 0;
+        return cli_help(-1);
     }
-    for (c = 0; c < CMD_COUNT && strcmp(argv[1], cli_cmd_names[c]); c++) {}
-    if (c == CMD_COUNT) return cli_error(CLI_EXIT_USAGE, argv[1], "unknown command (try 'hfvis --help')");
+    if ((c = cli_command_of(argv[1])) < 0)
+        return cli_error(CLI_EXIT_USAGE, argv[1], "unknown command (try 'hfvis --help')");
     a->cmd = c;
     for (i = 2; i < argc; i++) {
         const char *arg = argv[i], *value = NULL, *eq;
@@ -405,28 +593,20 @@ static int cli_parse(int argc, char **argv, cli_args *a)
             continue;
         }
         if (!strcmp(arg, "--")) { positional_only = 1; continue; }
-        if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) {
-            printf("%s%s%s", cli_cmd_help[a->cmd], cli_shared_help, cli_shared_help2);
-            return 0;
-        }
+        if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) return cli_help(a->cmd);
         eq = strchr(arg, '=');
         n = eq ? (size_t)(eq - arg) : strlen(arg);
         if (n >= sizeof name) n = sizeof name - 1;
         memcpy(name, arg, n);
         name[n] = '\0';
-        for (k = 0; k < sizeof cli_flags / sizeof cli_flags[0]; k++)
-            if (!strcmp(name, cli_flags[k].name)) break;
-        if (k == sizeof cli_flags / sizeof cli_flags[0])
-            return cli_error(CLI_EXIT_USAGE, name, "unknown option (see 'hfvis %s --help')",
-                             cli_cmd_names[a->cmd]);
+        if ((k = cli_flag_of(name)) == CLI_NFLAGS) return cli_refuse_flag(a->cmd, name);
         if ((CLI_ONLY(a->cmd) & CLI_P2) && !strcmp(name, "--window"))
-            return cli_error(CLI_EXIT_USAGE, name, "'%s' sweeps whole lattice lines with the [P2] "
-                             "hull tree, which honours --max-distance but computes no windows; run "
-                             "it whole (or split it with --dir-range)", cli_cmd_names[a->cmd]);
-        if (!(cli_flags[k].commands & CLI_ONLY(a->cmd)))
-            return cli_error(CLI_EXIT_USAGE, name, "not an option of '%s' (see 'hfvis %s --help')",
-                             cli_cmd_names[a->cmd], cli_cmd_names[a->cmd]);
-        if (cli_flags[k].has_value) {
+            return cli_error(CLI_EXIT_USAGE, cli_commands[a->cmd].name, "--window is not used by %s: "
+                             "it sweeps whole lattice lines with the [P2] hull tree, which honours "
+                             "--max-distance but computes no windows; run it whole (or split it with "
+                             "--dir-range)", cli_commands[a->cmd].name);
+        if (!(cli_flags[k].commands & CLI_ONLY(a->cmd))) return cli_refuse_flag(a->cmd, name);
+        if (cli_flags[k].value) {
             if (eq) value = eq + 1;
             else if (i + 1 < argc) value = argv[++i];
             else return cli_error(CLI_EXIT_USAGE, name, "missing value");
@@ -435,9 +615,10 @@ static int cli_parse(int argc, char **argv, cli_args *a)
         }
         if (cli_set(a, name, value)) return CLI_EXIT_USAGE;
     }
-    if (!a->in && !(a->cmd == CMD_VOLGI && a->room))
-        return cli_error(CLI_EXIT_USAGE, cli_cmd_names[a->cmd], "missing input file IN");
-    if (!a->out) return cli_error(CLI_EXIT_USAGE, cli_cmd_names[a->cmd], "missing -o OUT");
+    if (!a->in && (cli_commands[a->cmd].io & CLI_IN_NEEDED) && !(a->cmd == CMD_VOLGI && a->room))
+        return cli_error(CLI_EXIT_USAGE, cli_commands[a->cmd].name, "missing input file IN");
+    if (!a->out && (cli_commands[a->cmd].io & CLI_OUT_NEEDED))
+        return cli_error(CLI_EXIT_USAGE, cli_commands[a->cmd].name, "missing -o OUT");
     if (a->sky * a->albedo > CLI_FLT_MAX) /* the sky light's scale: outputs would be inf */
         return cli_error(CLI_EXIT_USAGE, "--sky/--albedo", "%g x %g exceeds the float range (3.4e38)",
                          a->sky, a->albedo);
@@ -456,52 +637,7 @@ static int cli_parse(int argc, char **argv, cli_args *a)
         if (a->stats)
             return cli_error(CLI_EXIT_USAGE, "--stats", "cannot be combined with --dir-range");
     }
-    if (a->cmd == CMD_SHADOW && !a->has_sun_azimuth)
-        return cli_error(CLI_EXIT_USAGE, "shadow", "missing --sun-azimuth DEG");
-    if (a->cmd == CMD_SHADOW && !a->has_sun_elevation)
-        return cli_error(CLI_EXIT_USAGE, "shadow", "missing --sun-elevation DEG");
-    if (a->cmd == CMD_VIEWSHED && !a->has_observer)
-        return cli_error(CLI_EXIT_USAGE, "viewshed", "missing --observer X,Y");
-    if (a->cmd == CMD_VOXELIZE) {
-        const char *m = a->vox_mode == VOX_SOLID ? "solid" : "conservative";
-        if (!a->res) return cli_error(CLI_EXIT_USAGE, "voxelize", "missing --res N");
-        if (a->vox_mode != VOX_SURFACE && (a->vox_method != HFVIS_VOXELIZE_PIXEL_RULE || a->max_vertices))
-            return cli_error(CLI_EXIT_USAGE, a->max_vertices ? "--max-vertices" : "--method",
-                             "applies only to --mode surface, not %s", m);
-        if (a->vox_mode == VOX_CONSERVATIVE && a->vox_axis != AXIS_DEFAULT)
-            return cli_error(CLI_EXIT_USAGE, "--axis", "does not apply to --mode conservative");
-        if (a->vox_mode == VOX_SOLID && (a->vox_axis == AXIS_DOMINANT || a->vox_axis == AXIS_ALL))
-            return cli_error(CLI_EXIT_USAGE, "--axis", "--mode solid takes x, y or z");
-        if (a->open_mesh && a->vox_mode != VOX_SOLID)
-            return cli_error(CLI_EXIT_USAGE, "--open", "applies only to --mode solid");
-        if (a->max_vertices && a->vox_method == HFVIS_VOXELIZE_PIXEL_RULE)
-            return cli_error(CLI_EXIT_USAGE, "--max-vertices", "needs --method slicing or clipping");
-    }
-    if (a->cmd == CMD_LIGHT && !a->env)
-        return cli_error(CLI_EXIT_USAGE, "light", "missing --env ENV.pfm");
-    if (a->cmd == CMD_INDIRECT) {
-        int sun = a->has_sun_azimuth || a->has_sun_elevation;
-        if (a->has_sun_azimuth && !a->has_sun_elevation)
-            return cli_error(CLI_EXIT_USAGE, "--sun-azimuth", "needs --sun-elevation DEG");
-        if (a->has_sun_elevation && !a->has_sun_azimuth)
-            return cli_error(CLI_EXIT_USAGE, "--sun-elevation", "needs --sun-azimuth DEG");
-        if (!sun && (a->has_sun_radius || a->has_sun_irradiance || a->math))
-            return cli_error(CLI_EXIT_USAGE, a->has_sun_radius ? "--sun-radius" :
-                             a->has_sun_irradiance ? "--sun-irradiance" : "--math",
-                             "needs a sun (--sun-azimuth and --sun-elevation)");
-        if (a->has_albedo && a->albedo_map)
-            return cli_error(CLI_EXIT_USAGE, "--albedo-map", "cannot be combined with --albedo");
-        if (a->has_sky && a->env)
-            return cli_error(CLI_EXIT_USAGE, "--env", "cannot be combined with --sky");
-        if (a->output == OUT_DIRECT && a->has_bounces)
-            return cli_error(CLI_EXIT_USAGE, "--bounces", "has no effect with --output direct");
-        if (a->output == OUT_INDIRECT && a->bounces < 1)
-            return cli_error(CLI_EXIT_USAGE, "--output indirect", "needs --bounces >= 1");
-    }
+    if (cli_commands[a->cmd].check && cli_commands[a->cmd].check(a)) return CLI_EXIT_USAGE;
     if (a->has_window && cli_check_window(a)) return CLI_EXIT_USAGE;
-    if (a->cmd == CMD_GI && cli_check_gi(a)) return CLI_EXIT_USAGE;
-    if (a->cmd == CMD_VOLGI && cli_check_volgi(a)) return CLI_EXIT_USAGE;
-    if (a->cmd == CMD_VISFIELD && cli_check_vf(a)) return CLI_EXIT_USAGE;
-    if (a->cmd == CMD_MESHAO && cli_check_lk(a)) return CLI_EXIT_USAGE;
     return CLI_RUN;
 }

@@ -354,17 +354,14 @@ static int cli_info(int argc, char **argv)
     double cell = 0.0;
     char why[256];
     static const char *const crs[4] = { "unknown", "projected", "geographic", "geocentric" };
-    static const char *const fmt[5] = { "", "tiff", "asc", "ehdr", "netpbm" };
-    if (argc != 3 || argv[2][0] == '-') {
-        if (argc == 3 && (!strcmp(argv[2], "-h") || !strcmp(argv[2], "--help"))) {
-            printf("usage: hfvis info RASTER\nPrints width, height, bands, cell, origin (map X and Y of "
-                   "the upper-left corner), crs, nodata and format\nof RASTER (.tif .asc .bil .flt .pfm, "
-                   "binary .pgm), one 'key value' per line; cell, origin\nand nodata are 'none' when the "
-                   "file has none. Only the header is read.\n");
-            return 0;
+    static const char *const fmt[5] = { "", "tiff", "asc", "ehdr", "pgm" };
+    int i;
+    for (i = 2; i < argc; i++) /* info takes no flag: each is refused by name */
+        if (argv[i][0] == '-' && argv[i][1] != '\0') {
+            if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) return cli_help(CMD_INFO);
+            return cli_refuse_flag(CMD_INFO, argv[i]);
         }
-        return cli_error(CLI_EXIT_USAGE, "info", "usage: hfvis info RASTER");
-    }
+    if (argc != 3) return cli_error(CLI_EXIT_USAGE, "info", "usage: hfvis info RASTER");
     if ((ex_rio_format_of(argv[2]) ? ex_rio_open(&r, argv[2]) : ex_rio_open_netpbm(&r, argv[2])) != 0)
         return cli_error(CLI_EXIT_ERROR, argv[2], "%s", r.err);
     printf("width %d\nheight %d\nbands %d\n", r.width, r.height, r.bands);
@@ -375,49 +372,44 @@ static int cli_info(int argc, char **argv)
     printf("crs %s", crs[r.geo.crs >= 0 && r.geo.crs < 4 ? r.geo.crs : 0]);
     if (r.geo.epsg) printf(" EPSG:%d", r.geo.epsg);
     printf("\nnodata %s\nformat %s\n", r.geo.has_nodata ? r.geo.nodata_text : "none",
-           fmt[r.format >= 1 && r.format <= 4 ? r.format : 0]);
+           r.format == EX_RIO_NETPBM && r.kind == EX_RIO_FLOAT ? "pfm" /* a PFM, not a PGM */
+           : fmt[r.format >= 1 && r.format <= 4 ? r.format : 0]);
     ex_rio_close(&r);
     return fflush(stdout) == 0 && !ferror(stdout) ? 0 : cli_error(CLI_EXIT_ERROR, "info", "cannot write to stdout");
 }
 
-/* hfvis azimuths: the directions of a run (hfvis_sweep_azimuths), one per line. */
-static int cli_azimuths(int argc, char **argv)
+/* azimuths: --dirs is required (the run commands default to 16, but a list of "the" azimuths
+ * without K would be a guess). */
+static int cli_check_azimuths(const cli_args *a)
+{
+    return a->has_dirs ? 0 : cli_error(CLI_EXIT_USAGE, "azimuths", "needs --dirs K");
+}
+
+/* hfvis azimuths [IN]: the directions of a run (hfvis_sweep_azimuths), one per line, from the
+ * flags as cli_parse and cli_gis_finish read them for the run commands (a->azimuth0 is psi_0).
+ * IN, when given, is read as a run reads it (a GIS raster's header only): the directions do not
+ * depend on it, but a file the run would refuse is refused here too. */
+static int cli_run_azimuths(const cli_args *a)
 {
     hfvis_sweep_options o = hfvis_sweep_options_default();
-    double az0 = 0.0, *az;
-    int i, K = 16, conv = CONV_COMPASS, radians = 0, has_dirs = 0, k, c, rc;
-    for (i = 2; i < argc; i++) {
-        const char *f = argv[i], *v = NULL, *eq = strchr(f, '=');
-        char name[32];
-        size_t n = eq ? (size_t)(eq - f) : strlen(f);
-        if (!strcmp(f, "-h") || !strcmp(f, "--help")) {
-            printf("%s", cli_azimuths_help);
-            return 0;
-        }
-        if (n >= sizeof name) n = sizeof name - 1;
-        memcpy(name, f, n);
-        name[n] = '\0';
-        if (!strcmp(name, "--exact") && !eq) { o.rays = HFVIS_RAYS_EXACT; continue; }
-        if (!strcmp(name, "--compass") && !eq) { conv = CONV_COMPASS; continue; }
-        if (!strcmp(name, "--radians") && !eq) { radians = 1; continue; }
-        if (strcmp(name, "--dirs") && strcmp(name, "--azimuth0") && strcmp(name, "--convention"))
-            return cli_error(CLI_EXIT_USAGE, f, "unknown option (see 'hfvis azimuths --help')");
-        if (eq) v = eq + 1;
-        else if (i + 1 < argc) v = argv[++i];
-        else return cli_error(CLI_EXIT_USAGE, name, "needs a value");
-        if (!strcmp(name, "--dirs")) {
-            if ((rc = cli_int(name, v, 1, CLI_MAX_DIRS, "an integer 1..65536", &K)) != 0) return rc;
-            has_dirs = 1;
-        } else if (!strcmp(name, "--convention")) {
-            for (c = 0; c < 3 && strcmp(v, cli_conv_names[c]); c++) {}
-            if (c == 3) return cli_error(CLI_EXIT_USAGE, name, "expected compass, grass or grid, got '%s'", v);
-            conv = c;
-        } else if (!cli_parse_real(v, &az0)) {
-            return cli_error(CLI_EXIT_USAGE, name, "expected a finite angle, got '%s'", v);
-        }
+    const int K = a->dirs;
+    double *az;
+    int k;
+    if (a->in && ex_rio_format_of(a->in)) { /* a GIS raster: its header */
+        ex_rio_reader r;
+        if (ex_rio_open(&r, a->in) != 0) return cli_error(CLI_EXIT_ERROR, a->in, "%s", r.err);
+        ex_rio_close(&r);
+    } else if (a->in) { /* PGM or PFM: read as the run reads it */
+        hfvis_image_info info;
+        float *px = NULL;
+        hfvis_status s;
+        errno = 0;
+        s = hfvis_image_load(a->in, NULL, &px, &info);
+        if (s != HFVIS_OK) return cli_status(a->in, s, errno);
+        hfvis_free(NULL, px);
     }
-    if (!has_dirs) return cli_error(CLI_EXIT_USAGE, "azimuths", "needs --dirs K");
-    o.azimuth0_rad = cli_psi(conv, radians ? az0 * (180.0 / CLI_PI) : az0);
+    if (a->exact) o.rays = HFVIS_RAYS_EXACT;
+    o.azimuth0_rad = a->azimuth0;
     az = (double *)malloc((size_t)K * sizeof(double));
     if (!az) return cli_status("azimuths", HFVIS_ERR_OUT_OF_MEMORY, 0);
     if (hfvis_sweep_azimuths(K, &o, az, NULL) != HFVIS_OK) {
@@ -425,7 +417,7 @@ static int cli_azimuths(int argc, char **argv)
         return cli_error(CLI_EXIT_USAGE, "--azimuth0", "not a usable azimuth");
     }
     for (k = 0; k < K; k++) /* GRASS's direction k is the library's (K - k) mod K */
-        printf("%.17g\n", cli_from_psi(conv, az[conv == CONV_GRASS ? (K - k) % K : k]));
+        printf("%.17g\n", cli_from_psi(a->convention, az[a->convention == CONV_GRASS ? (K - k) % K : k]));
     free(az);
-    return 0;
+    return fflush(stdout) == 0 && !ferror(stdout) ? 0 : cli_error(CLI_EXIT_ERROR, "stdout", "write error");
 }

@@ -50,10 +50,15 @@ static int cli_run_viewshed(const cli_args *a, const hfvis_grid *grid, float *ou
     if (s != HFVIS_OK) return cli_status("viewshed", s, 0);
     for (t = 0; t < a->ntargets; t++) { /* the verdict of the sample nearest to each target */
         double X = a->targets[2 * t], Y = a->targets[2 * t + 1], x, y;
-        const char *verdict = "outside the grid";
-        long c = -1, r = -1;
-        if (cli_map_to_grid(a, grid->cell_size, X, Y, &x, &y) && x > -0.5 && x < w - 0.5 &&
-            y > -0.5 && y < h - 0.5) {
+        const char *verdict;
+        long c, r;
+        const int mapped = cli_map_to_grid(a, grid->cell_size, X, Y, &x, &y);
+        if (!mapped || !(x > -0.5 && x < w - 0.5 && y > -0.5 && y < h - 0.5)) {
+            /* where the target is, as given: not a sample's indices, which it has none of */
+            if (mapped) printf("target %.10g,%.10g (column %.10g, row %.10g): outside the grid\n", X, Y, x, y);
+            else printf("target %.10g,%.10g: outside the grid\n", X, Y);
+            continue;
+        } else {
             float v;
             c = (long)floor(x + 0.5), r = (long)floor(y + 0.5);
             v = out[(size_t)r * (size_t)w + (size_t)c];
@@ -178,7 +183,7 @@ static int cli_run_gis(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_op
     float *out = cli_alloc((size_t)w, (size_t)h, 1);
     double lo = 0.0, hi = 1.0;
     int rc;
-    if (!out) return cli_status(cli_cmd_names[a->cmd], HFVIS_ERR_OUT_OF_MEMORY, 0);
+    if (!out) return cli_status(cli_commands[a->cmd].name, HFVIS_ERR_OUT_OF_MEMORY, 0);
     if (a->cmd == CMD_VIEWSHED) {
         rc = cli_run_viewshed(a, grid, out);
     } else if (a->cmd == CMD_HILLSHADE) {
@@ -187,10 +192,18 @@ static int cli_run_gis(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_op
     } else if (a->cmd == CMD_OPENNESS) {
         hi = a->degrees ? 180.0 : CLI_PI; /* 0 .. 180 degrees */
         rc = cli_run_openness(a, grid, opts, prog, out);
-    } else {
+    } else if (a->cmd == CMD_SKYVIEW) {
         rc = cli_run_skyview_saga(a, grid, opts, prog, out);
+    } else {
+        rc = cli_error(CLI_EXIT_ERROR, cli_commands[a->cmd].name, "internal error: not a GIS product");
     }
     if (rc == 0) rc = cli_save(a, out, w, h, 1, lo, hi);
     free(out);
     return rc;
+}
+
+/* viewshed: the observer is required. */
+static int cli_check_viewshed(const cli_args *a)
+{
+    return a->has_observer ? 0 : cli_error(CLI_EXIT_USAGE, "viewshed", "missing --observer X,Y");
 }

@@ -2,6 +2,7 @@
  * ([G12] ch. 5) and `voxelize`: their flags, checks and runs.
  * May call: progress.c, flags.c's primitives, write.c. */
 
+/* meshao's defaults (called for every command; harmless for the others). */
 static void cli_lk_defaults(cli_args *a)
 {
     a->lk_method = HFVIS_LK_METHOD_BVH;
@@ -344,6 +345,26 @@ static int cli_check_volgi(const cli_args *a)
     return 0;
 }
 
+/* Combinations `voxelize` rejects; returns 0 or CLI_EXIT_USAGE (message printed). */
+static int cli_check_voxelize(const cli_args *a)
+{
+    const char *m = a->vox_mode == VOX_SOLID ? "solid" : "conservative";
+    if (!a->res) return cli_error(CLI_EXIT_USAGE, "voxelize", "missing --res N");
+    if (a->vox_mode != VOX_SURFACE && (a->vox_method != HFVIS_VOXELIZE_PIXEL_RULE || a->max_vertices))
+        return cli_error(CLI_EXIT_USAGE, a->max_vertices ? "--max-vertices" : "--method",
+                         "applies only to --mode surface, not %s", m);
+    if (a->vox_mode == VOX_CONSERVATIVE && a->vox_axis != AXIS_DEFAULT)
+        return cli_error(CLI_EXIT_USAGE, "--axis", "does not apply to --mode conservative");
+    if (a->vox_mode == VOX_SOLID && (a->vox_axis == AXIS_DOMINANT || a->vox_axis == AXIS_ALL))
+        return cli_error(CLI_EXIT_USAGE, "--axis", "--mode solid takes x, y or z");
+    if (a->open_mesh && a->vox_mode != VOX_SOLID)
+        return cli_error(CLI_EXIT_USAGE, "--open", "applies only to --mode solid");
+    if (a->max_vertices && a->vox_method == HFVIS_VOXELIZE_PIXEL_RULE)
+        return cli_error(CLI_EXIT_USAGE, "--max-vertices", "needs --method slicing or clipping");
+    return 0;
+}
+
+/* voxelize: MESH.obj -> a cubic-voxel grid fitted to the mesh -> .binvox or .raw. */
 static int cli_run_voxelize(const cli_args *a)
 {
     hfvis_mesh mesh;

@@ -1,6 +1,15 @@
 /* p2.c - the [P2] hull-tree commands: `indirect` (direct light, then interreflections) and
  * `visibility` (the visibility index). May call: progress.c, sweeps.c's maps, write.c. */
 
+/* Combinations `indirect` rejects; returns 0 or CLI_EXIT_USAGE (message printed). */
+static int cli_check_indirect(const cli_args *a)
+{
+    if (a->has_albedo && a->albedo_map)
+        return cli_error(CLI_EXIT_USAGE, "--albedo-map", "cannot be combined with --albedo");
+    return cli_check_light_flags(a);
+}
+
+/* indirect: direct light (hfvis_direct_light), then hfvis_terrain_gi. */
 static int cli_run_indirect(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
                             cli_progress_state *prog)
 {

@@ -79,7 +79,7 @@ static int cli_out_channels(const cli_args *a)
  * --max-memory (0 = none), suggesting a window size when the run can be tiled. */
 static int cli_check_cost(const cli_args *a, int w, int h, int channels)
 {
-    const char *cmd = cli_cmd_names[a->cmd];
+    const char *cmd = cli_commands[a->cmd].name;
     cli_cost c = cli_estimate(a, w, h, channels);
     if (!a->quiet && (a->progress_lines || cli_stderr_is_terminal()))
         fprintf(stderr, "%s: estimate %.3g MiB, %.3g %s\n", cmd, c.bytes / 1048576.0, c.work, c.unit);
@@ -209,9 +209,12 @@ static float *cli_alloc(size_t a, size_t b, size_t c)
     return (float *)calloc(a * b * c, sizeof(float)); /* zeros: a window run leaves cells unwritten */
 }
 
-static int cli_run(const cli_args *a)
+/* The height-field commands: load IN, set up the sweep options, the window and the progress,
+ * then run the command (its own function for indirect, visibility, gi and the GIS products) and
+ * write OUT. */
+static int cli_run_heights(const cli_args *a)
 {
-    const char *cmd = cli_cmd_names[a->cmd];
+    const char *cmd = cli_commands[a->cmd].name;
     cli_progress_state prog;
     float *z = NULL, *out = NULL, *env_px = NULL;
     int w = 0, h = 0, rc, channels = 1, planes = 1;
@@ -221,13 +224,6 @@ static int cli_run(const cli_args *a)
     hfvis_env env;
     hfvis_status s = HFVIS_OK;
 
-    if (a->cmd == CMD_VOXELIZE || a->cmd == CMD_VOLGI || a->cmd == CMD_VISFIELD || a->cmd == CMD_MESHAO)
-        if ((rc = cli_check_cost(a, 0, 0, 1)) != 0) return rc;
-    if (a->cmd == CMD_VOXELIZE) return cli_run_voxelize(a);
-    if (a->cmd == CMD_SSAO) return cli_run_ssao(a);
-    if (a->cmd == CMD_VOLGI) return cli_run_volgi(a);
-    if (a->cmd == CMD_VISFIELD) return cli_run_visfield(a);
-    if (a->cmd == CMD_MESHAO) return cli_run_meshao(a);
     memset(&env, 0, sizeof env);
     cli_win.active = a->has_window;
     if ((rc = cli_load_heights(a, &z, &w, &h, &grid.cell_size)) != 0) return rc;
@@ -329,9 +325,12 @@ static int cli_run(const cli_args *a)
         if (s == HFVIS_OK) hi = cli_top(out, (size_t)w * (size_t)h * (size_t)channels, 1.0);
         break;
     }
-    default: /* CMD_NORMALS */
+    case CMD_NORMALS:
         s = hfvis_normals_compute(&grid, out);
         break;
+    default: /* a command of the table whose run is this function but has no case here */
+        rc = cli_error(CLI_EXIT_ERROR, cmd, "internal error: no height-field run for this command");
+        goto done;
     }
     if (s != HFVIS_OK) { rc = cli_status(cmd, s, 0); goto done; }
     if ((a->cmd == CMD_SKY || a->cmd == CMD_LIGHT) &&

@@ -34,6 +34,21 @@ static int cli_set_ssao(cli_args *a, const char *f, const char *v)
     return -1;
 }
 
+/* The methods' direction counts (hfvis.h): the flag is named, not the library's status. LSAO's
+ * default box pattern takes rings of 8 directions (hfvis_ssao_directions_box). */
+static int cli_check_ssao(const cli_args *a)
+{
+    if (!a->has_dirs || a->ssao_method == SSAO_RAYTRACE) return 0;
+    if (a->ssao_method == SSAO_LSAO && (a->dirs % 8 != 0 || a->dirs > HFVIS_SSAO_MAX_DIRECTIONS))
+        return cli_error(CLI_EXIT_USAGE, "--dirs", "ssao --method lsao takes a multiple of 8 in "
+                         "8..%d directions, got %d", HFVIS_SSAO_MAX_DIRECTIONS, a->dirs);
+    if (a->dirs > HFVIS_SSAO_MAX_DIRECTIONS || (a->ssao_method == SSAO_FFAO && a->dirs < 3))
+        return cli_error(CLI_EXIT_USAGE, "--dirs", "ssao --method %s takes %d..%d directions, got %d",
+                         a->ssao_method == SSAO_HBAO ? "hbao" : "ffao", a->ssao_method == SSAO_FFAO ? 3 : 1,
+                         HFVIS_SSAO_MAX_DIRECTIONS, a->dirs);
+    return 0;
+}
+
 /* ssao: a depth buffer (linear, or hardware depth linearised first) -> obscurance of the inner
  * pixels by the chosen method. */
 static int cli_run_ssao(const cli_args *a)
@@ -44,12 +59,6 @@ static int cli_run_ssao(const cli_args *a)
     hfvis_falloff fo;
     hfvis_status s;
     int rc = 0, gx, gy, W, H;
-    /* the methods' direction counts (hfvis.h): the flag is named, not the library's status */
-    if (a->has_dirs && a->ssao_method != SSAO_RAYTRACE &&
-        (a->dirs > HFVIS_SSAO_MAX_DIRECTIONS || (a->ssao_method == SSAO_FFAO && a->dirs < 3)))
-        return cli_error(CLI_EXIT_USAGE, "--dirs", "ssao --method %s takes %d..%d directions, got %d",
-                         a->ssao_method == SSAO_LSAO ? "lsao" : a->ssao_method == SSAO_HBAO ? "hbao" : "ffao",
-                         a->ssao_method == SSAO_FFAO ? 3 : 1, HFVIS_SSAO_MAX_DIRECTIONS, a->dirs);
     errno = 0;
     s = hfvis_image_load(a->in, NULL, &depth, &info);
     if (s != HFVIS_OK) return cli_status(a->in, s, errno);
@@ -120,5 +129,3 @@ done:
     hfvis_free(NULL, depth);
     return rc;
 }
-
-/* voxelize: MESH.obj -> a cubic-voxel grid fitted to the mesh -> .binvox or .raw. */

@@ -23,7 +23,7 @@ static void cli_partial_tag(const cli_args *a, const hfvis_grid *grid, const hfv
                             const hfvis_env *env, char *tag)
 {
     int n = snprintf(tag, CLI_TAG_MAX, "cmd=%s dirs=%d in=%016llx cell=%a border=%d border-cells=%d "
-                     "azimuth0=%a rays=%s max-distance=%a", cli_cmd_names[a->cmd], a->dirs,
+                     "azimuth0=%a rays=%s max-distance=%a", cli_commands[a->cmd].name, a->dirs,
                      cli_fingerprint(grid->z, (size_t)grid->width * (size_t)grid->height),
                      grid->cell_size, (int)o->border, o->border_cells, o->azimuth0_rad,
                      o->rays == HFVIS_RAYS_EXACT ? "exact" : "lattice", o->max_distance);
@@ -48,7 +48,7 @@ static void cli_partial_tag(const cli_args *a, const hfvis_grid *grid, const hfv
 static int cli_run_partial(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
                            cli_progress_state *prog, const hfvis_env *env)
 {
-    const char *cmd = cli_cmd_names[a->cmd];
+    const char *cmd = cli_commands[a->cmd].name;
     const size_t n = (size_t)grid->width * (size_t)grid->height;
     const int count = a->dir_end - a->dir_begin;
     int planes = 1, channels = 1, c;
@@ -257,7 +257,7 @@ static int cli_sum_check(const char *path, int cmd, const hfvis_partial *p)
         if (!(v >= lo && v <= hi && isfinite(v)))
             return cli_error(CLI_EXIT_ERROR, path, "value %.17g at index %lu lies outside the domain "
                              "[%g, %g] of a %s part: the file is damaged", v, (unsigned long)k, lo, hi,
-                             cli_cmd_names[cmd]);
+                             cli_commands[cmd].name);
     }
     return 0;
 }
@@ -284,10 +284,7 @@ static int cli_sum(int argc, char **argv)
     memset(&a, 0, sizeof a);
     for (i = 2; i < argc; i++) {
         const char *arg = argv[i];
-        if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) {
-            printf("%s", cli_cmd_help[CMD_SUM]);
-            return 0;
-        }
+        if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) return cli_help(CMD_SUM);
         if (!strcmp(arg, "-o") || !strncmp(arg, "-o=", 3) || !strcmp(arg, "--range") ||
             !strncmp(arg, "--range=", 8)) {
             int is_o = arg[1] == 'o';
@@ -306,7 +303,7 @@ static int cli_sum(int argc, char **argv)
         if (!strcmp(arg, "--quiet")) continue;
         if (!strcmp(arg, "--overwrite")) { a.overwrite = 1; continue; }
         if (arg[0] == '-' && arg[1] != '\0')
-            return cli_error(CLI_EXIT_USAGE, arg, "unknown option (see 'hfvis sum --help')");
+            return cli_refuse_flag(CMD_SUM, arg);
         if (nparts == MAX_PARTS) return cli_error(CLI_EXIT_USAGE, arg, "more than %d parts", MAX_PARTS);
         names[nparts++] = arg;
     }
@@ -324,7 +321,7 @@ static int cli_sum(int argc, char **argv)
     }
     /* the first part decides the run; every other part must be the same run */
     if (!cli_tag_value(meta[0].tag, "cmd", name, sizeof name)) name[0] = '\0';
-    for (cmd = 0; cmd < CMD_COUNT && strcmp(name, cli_cmd_names[cmd]); cmd++) {}
+    for (cmd = 0; cmd < CMD_COUNT && strcmp(name, cli_commands[cmd].name); cmd++) {}
     if (cmd != CMD_HORIZON && cmd != CMD_SKYVIEW && cmd != CMD_SKY && cmd != CMD_LIGHT &&
         cmd != CMD_VISIBILITY) {
         rc = cli_error(CLI_EXIT_ERROR, names[0], "not a partial result of hfvis horizon, skyview, sky, "

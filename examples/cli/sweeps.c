@@ -19,8 +19,10 @@ static int cli_set_gi(cli_args *a, const char *f, const char *v)
     return -1;
 }
 
-/* Combinations `gi` rejects; returns 0 or CLI_EXIT_USAGE (message printed). */
-static int cli_check_gi(const cli_args *a)
+/* The light flags `gi` and `indirect` share: the sun needs both angles (and its other flags a
+ * sun), the sky and an environment exclude each other, --output agrees with --bounces; returns 0
+ * or CLI_EXIT_USAGE (message printed). */
+static int cli_check_light_flags(const cli_args *a)
 {
     int sun = a->has_sun_azimuth || a->has_sun_elevation;
     if (a->has_sun_azimuth && !a->has_sun_elevation)
@@ -31,8 +33,6 @@ static int cli_check_gi(const cli_args *a)
         return cli_error(CLI_EXIT_USAGE, a->has_sun_radius ? "--sun-radius" :
                          a->has_sun_irradiance ? "--sun-irradiance" : "--math",
                          "needs a sun (--sun-azimuth and --sun-elevation)");
-    if (a->has_shininess && !a->has_specular)
-        return cli_error(CLI_EXIT_USAGE, "--shininess", "needs --specular S");
     if (a->has_sky && a->env)
         return cli_error(CLI_EXIT_USAGE, "--env", "cannot be combined with --sky");
     if (a->output == OUT_DIRECT && a->has_bounces)
@@ -42,8 +42,15 @@ static int cli_check_gi(const cli_args *a)
     return 0;
 }
 
+/* Combinations `gi` rejects; returns 0 or CLI_EXIT_USAGE (message printed). */
+static int cli_check_gi(const cli_args *a)
+{
+    if (a->has_shininess && !a->has_specular)
+        return cli_error(CLI_EXIT_USAGE, "--shininess", "needs --specular S");
+    return cli_check_light_flags(a);
+}
 
-/* meshao's defaults (called for every command; harmless for the others). */
+
 
 /* Load a lat-long environment map (any image the codecs read). */
 static int cli_load_env(const char *path, float **px, hfvis_env *env)
@@ -146,7 +153,6 @@ static int cli_check_radiance(const char *cmd, const hfvis_grid *grid, const flo
     return 0;
 }
 
-/* indirect: direct light (hfvis_direct_light), then hfvis_terrain_gi. */
 
 /* gi: hfvis_ns_gi with a uniform sky or a projected environment, and an optional sun. */
 static int cli_run_gi(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
@@ -272,4 +278,18 @@ static int cli_horizon_finish(const cli_args *a, float *map, int w, int h, doubl
         rc = cli_save(&one, map + (size_t)k * n, w, h, 1, lo, hi);
     }
     return rc;
+}
+
+/* shadow: the sun's position is required. */
+static int cli_check_shadow(const cli_args *a)
+{
+    if (!a->has_sun_azimuth) return cli_error(CLI_EXIT_USAGE, "shadow", "missing --sun-azimuth DEG");
+    if (!a->has_sun_elevation) return cli_error(CLI_EXIT_USAGE, "shadow", "missing --sun-elevation DEG");
+    return 0;
+}
+
+/* light: the environment map is required. */
+static int cli_check_light(const cli_args *a)
+{
+    return a->env ? 0 : cli_error(CLI_EXIT_USAGE, "light", "missing --env ENV.pfm");
 }

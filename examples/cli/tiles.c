@@ -89,7 +89,7 @@ static void cli_piece_tag(const cli_args *a, const hfvis_grid *grid, const hfvis
              "max-distance=%a dirs=%d border=%d border-cells=%d azimuth0=%a rays=%s convention=%d "
              "degrees=%d svf=%d sky=%a albedo=%a sun=%a,%a,%a,%a,%d blend=%d no-shadows=%d radius=%a "
              "negative=%d fraction=%d method=%d bounces=%d output=%d env=%s",
-             cli_cmd_names[a->cmd], cli_win.crs, grid->cell_size, cli_win.ext_w, cli_win.ext_h,
+             cli_commands[a->cmd].name, cli_win.crs, grid->cell_size, cli_win.ext_w, cli_win.ext_h,
              cli_win.in_id, cli_win.gt, a->band ? a->band : 1, cli_win.nodata, nodata_flag, a->zscale,
              o->max_distance, a->dirs, (int)o->border, o->border_cells, o->azimuth0_rad,
              o->rays == HFVIS_RAYS_EXACT ? "exact" : "lattice", a->convention, a->degrees, a->svf,
@@ -292,10 +292,7 @@ static int cli_mosaic(int argc, char **argv)
     memset(&ref, 0, sizeof ref);
     for (i = 2; i < argc; i++) {
         const char *arg = argv[i];
-        if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) {
-            printf("%s", CLI_MOSAIC_HELP);
-            return 0;
-        }
+        if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) return cli_help(CMD_MOSAIC);
         if (!strcmp(arg, "-o") || !strncmp(arg, "-o=", 3) || !strcmp(arg, "--range") || !strncmp(arg, "--range=", 8)) {
             int is_o = arg[1] == 'o';
             const char *eq = strchr(arg, '='), *v = eq ? eq + 1 : (i + 1 < argc ? argv[++i] : NULL);
@@ -314,7 +311,7 @@ static int cli_mosaic(int argc, char **argv)
         if (!strcmp(arg, "--quiet")) { a.quiet = 1; continue; }
         if (!strcmp(arg, "--overwrite")) { a.overwrite = 1; continue; }
         if (arg[0] == '-' && arg[1] != '\0')
-            return cli_error(CLI_EXIT_USAGE, arg, "unknown option (see 'hfvis mosaic --help')");
+            return cli_refuse_flag(CMD_MOSAIC, arg);
         if (n == MAX_PIECES) return cli_error(CLI_EXIT_USAGE, arg, "more than %d pieces", MAX_PIECES);
         names[n++] = arg;
     }
@@ -350,7 +347,7 @@ static int cli_mosaic(int argc, char **argv)
         rc = cli_error(CLI_EXIT_ERROR, names[0], "its sidecar names no extent or command");
         goto done;
     }
-    for (cmd = 0; cmd < CMD_COUNT && strcmp(cmdname, cli_cmd_names[cmd]); cmd++) {}
+    for (cmd = 0; cmd < CMD_COUNT && strcmp(cmdname, cli_commands[cmd].name); cmd++) {}
     planes = meta[0].planes, channels = meta[0].channels;
     /* the windows tile the extent: inside it, pairwise disjoint, areas summing to it */
     for (i = 0; i < n; i++) {
