@@ -174,10 +174,8 @@ typedef struct cli_progress_state {
     long long total;  /* units of the whole run */
 } cli_progress_state;
 
-/* The georeference of a raster IN, carried to a raster OUT (cli_save); the rows of IN, to
- * recognise stacked output planes. The CLI's one piece of global state besides the bar. */
+/* The georeference of a raster IN, carried to a raster OUT (cli_save). */
 static ex_georef cli_geo;
-static int cli_in_height;
 
 /* A --window run (docs/tiles.md): the window of the raster it writes, the grid it loads (the
  * window and a halo, clipped to the raster), and what its piece's sidecar records. */
@@ -192,6 +190,15 @@ typedef struct cli_window {
     char tag[CLI_PIECE_TAG_MAX];
 } cli_window;
 static cli_window cli_win = { 0, -1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, "", "", "", "", "" };
+
+/* What a command writes, handed to cli_save: `planes` planes of w x h cells stacked top to bottom
+ * (horizon: one per direction), each cell `channels` interleaved values (light: the
+ * environment's), and the default PGM range [lo, hi]. A raster OUT gets planes x channels bands. */
+typedef struct cli_output {
+    const float *px;
+    int w, h, planes, channels;
+    double lo, hi;
+} cli_output;
 
 /* What a run is expected to cost before it allocates: bytes at its peak and units of work. */
 typedef struct cli_cost {
@@ -297,12 +304,9 @@ static hfvis_status cli_binvox_save(const char *path, const hfvis_volume_grid *g
 static hfvis_status cli_voxels_raw_save(const char *path, const hfvis_volume_grid *grid, const uint8_t *occ);
 static hfvis_status cli_visfield_save(const char *path, const hfvis_visfield *vf);
 static hfvis_status cli_partial_save(const char *path, const hfvis_partial *p);
-static int cli_save_piece(const cli_args *a, const float *px, int w, int h, int channels, double lo,
-                          double hi);
-/* Write OUT: PFM with its channels, or a 16-bit PGM with the channel planes stacked (NoData code 0,
- * the range in its header: hfvis_pgm_range_save). A --window run writes its piece instead. */
-static int cli_save(const cli_args *a, const float *px, int w, int h, int channels, double lo,
-                    double hi);
+static cli_output cli_output_of(const float *px, int w, int h, int planes, int channels, double lo,
+                                double hi);
+static int cli_save(const cli_args *a, cli_output out);
 static int cli_same_file(const char *x, const char *y);
 static int cli_refuse_input(int overwrite, const char *out, const char *const *inputs, int n);
 static int cli_refuse_inputs(const cli_args *a, const char *out);
@@ -387,8 +391,7 @@ static int cli_file_id(const char *path, char *out, size_t cap);
 static int cli_window_plan(const cli_args *a, ex_rio_reader *r, const char *path, double cell);
 static void cli_piece_tag(const cli_args *a, const hfvis_grid *grid, const hfvis_sweep_options *o);
 static int cli_range_is_top(int cmd, int fraction);
-static int cli_save_piece(const cli_args *a, const float *px, int w, int h, int channels, double lo,
-                          double hi);
+static int cli_save_piece(const cli_args *a, cli_output out);
 static int cli_piece_meta(const char *path, cli_piece *p);
 static const char *cli_piece_problem(const char *key);
 static int cli_piece_read(const char *path, const cli_piece *m, int W, int H, float *out,

@@ -197,7 +197,7 @@ static int cli_run_gis(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_op
     } else {
         rc = cli_error(CLI_EXIT_ERROR, cli_commands[a->cmd].name, "internal error: not a GIS product");
     }
-    if (rc == 0) rc = cli_save(a, out, w, h, 1, lo, hi);
+    if (rc == 0) rc = cli_save(a, cli_output_of(out, w, h, 1, 1, lo, hi));
     free(out);
     return rc;
 }

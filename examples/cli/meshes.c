@@ -540,7 +540,7 @@ static int cli_run_meshao(const cli_args *a)
             goto done;
         }
     }
-    rc = cli_save(a, out, a->lk_width, a->lk_height, 1, 0.0, 1.0);
+    rc = cli_save(a, cli_output_of(out, a->lk_width, a->lk_height, 1, 1, 0.0, 1.0));
 done:
     free(out);
     hfvis_lk_lut_free(NULL, &lut);
@@ -665,7 +665,7 @@ static int cli_vf_ao(const cli_args *a)
         s = hfvis_visfield_ambient_occlusion(&ob, 1, pts, nrm, n, &o, ao);
     }
     if (s != HFVIS_OK) { rc = cli_status("visfield", s, 0); goto done; }
-    rc = cli_save(a, ao, W, H, 1, 0.0, 1.0);
+    rc = cli_save(a, cli_output_of(ao, W, H, 1, 1, 0.0, 1.0));
     if (rc == 0 && !a->quiet) {
         double mean = 0.0;
         for (p = 0; p < n; p++) mean += (double)ao[p];
@@ -781,7 +781,7 @@ static int cli_run_volgi(const cli_args *a)
         goto done;
     }
     if (s != HFVIS_OK) { rc = cli_status(cmd, s, 0); goto done; }
-    rc = cli_save(a, img, w, h, 3, 0.0, cli_top(img, 3 * n, 1.0));
+    rc = cli_save(a, cli_output_of(img, w, h, 1, 3, 0.0, cli_top(img, 3 * n, 1.0)));
     if (rc == 0 && !a->quiet)
         printf("volgi: %zu triangles, %d x %d x %d voxels of %.6g, %zu occupied (%zu fragments), %d "
                "iterations; VPL flux %.6g, recorded at surfaces %.6g, still travelling %.6g (red band); "

@@ -84,7 +84,7 @@ static int cli_run_indirect(const cli_args *a, const hfvis_grid *grid, hfvis_swe
     }
     if (s != HFVIS_OK) { rc = cli_status(cmd, s, 0); goto done; }
     if ((rc = cli_check_radiance(cmd, grid, out, channels)) != 0) goto done;
-    rc = cli_save(a, out, w, h, channels, 0.0, cli_top(out, n * (size_t)channels, 1.0));
+    rc = cli_save(a, cli_output_of(out, w, h, 1, channels, 0.0, cli_top(out, n * (size_t)channels, 1.0)));
 done:
     free(base);
     free(out);
@@ -144,7 +144,7 @@ static int cli_run_visibility(const cli_args *a, const hfvis_grid *grid, hfvis_s
         if (fflush(stdout) != 0 || ferror(stdout))
             rc = cli_error(CLI_EXIT_ERROR, "stdout", "%s (OUT not written)", strerror(errno));
     }
-    if (rc == 0) rc = cli_save(a, out, w, h, 1, 0.0, a->fraction ? 1.0 : cli_top(out, n, 1.0));
+    if (rc == 0) rc = cli_save(a, cli_output_of(out, w, h, 1, 1, 0.0, a->fraction ? 1.0 : cli_top(out, n, 1.0)));
     free(tested);
     free(flat_z);
     free(out);

@@ -195,7 +195,6 @@ static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double
         cli_geo.nodata = (double)nodata;
         snprintf(cli_geo.nodata_text, sizeof cli_geo.nodata_text, "%.9g", (double)nodata);
     }
-    cli_in_height = *h;
     *z = px;
     return 0;
 }
@@ -337,7 +336,7 @@ static int cli_run_heights(const cli_args *a)
         (rc = cli_check_radiance(cmd, &grid, out, channels)) != 0)
         goto done;
     if (a->cmd == CMD_HORIZON) { rc = cli_horizon_finish(a, out, w, h, lo, hi); goto done; }
-    rc = cli_save(a, out, w, h * planes, channels, lo, hi);
+    rc = cli_save(a, cli_output_of(out, w, h, planes, channels, lo, hi));
 done:
     if (cli_bar_open) { fputc('\n', stderr); cli_bar_open = 0; } /* a bar that fell short */
     free(out);

@@ -123,7 +123,7 @@ static int cli_run_ssao(const cli_args *a)
         s = hfvis_ssao_reference(&cam, depth, NULL, &o, ao, W);
     }
     if (s != HFVIS_OK) { rc = cli_status("ssao", s, 0); goto done; }
-    rc = cli_save(a, ao, W, H, 1, 0.0, 1.0);
+    rc = cli_save(a, cli_output_of(ao, W, H, 1, 1, 0.0, 1.0));
 done:
     free(ao);
     hfvis_free(NULL, depth);

@@ -466,7 +466,7 @@ static int cli_sum(int argc, char **argv)
                                (int)(k / (size_t)channels / (size_t)W), (double)out[k]);
                 goto done;
             }
-    rc = cli_save(&a, out, W, H * out_planes, channels, lo, hi);
+    rc = cli_save(&a, cli_output_of(out, W, H, out_planes, channels, lo, hi));
 done:
     free(acc);
     free(out);

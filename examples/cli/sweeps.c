@@ -228,7 +228,7 @@ static int cli_run_gi(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_opt
         out[i] = (float)v;
     }
     if ((rc = cli_check_radiance(cmd, grid, out, channels)) != 0) goto done;
-    rc = cli_save(a, out, w, h, channels, 0.0, cli_top(out, n * (size_t)channels, 1.0));
+    rc = cli_save(a, cli_output_of(out, w, h, 1, channels, 0.0, cli_top(out, n * (size_t)channels, 1.0)));
 done:
     free(out);
     free(bounce);
@@ -256,7 +256,7 @@ static int cli_horizon_finish(const cli_args *a, float *map, int w, int h, doubl
         }
         free(tmp);
     }
-    if (!a->split) return cli_save(a, map, w, h * K, 1, lo, hi);
+    if (!a->split) return cli_save(a, cli_output_of(map, w, h, K, 1, lo, hi));
     for (k = 0; k < K && rc == 0; k++) {
         cli_args one = *a;
         char name[4096];
@@ -275,7 +275,7 @@ static int cli_horizon_finish(const cli_args *a, float *map, int w, int h, doubl
         if (len < 0 || (size_t)len >= sizeof name) return cli_error(CLI_EXIT_ERROR, a->out, "name too long");
         if ((rc = cli_refuse_inputs(a, name)) != 0) return rc;
         one.out = name;
-        rc = cli_save(&one, map + (size_t)k * n, w, h, 1, lo, hi);
+        rc = cli_save(&one, cli_output_of(map + (size_t)k * n, w, h, 1, 1, lo, hi));
     }
     return rc;
 }

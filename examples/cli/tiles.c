@@ -107,11 +107,12 @@ static int cli_range_is_top(int cmd, int fraction)
 /* A --window run's output: the window cut out of each plane of the grid's result (w x h with
  * the planes stacked), written as OUT with the georeference moved to the window, then the
  * sidecar OUT.tile: the window, the planes and channels, the default range, the run tag. */
-static int cli_save_piece(const cli_args *a, const float *px, int w, int h, int channels, double lo,
-                          double hi)
+static int cli_save_piece(const cli_args *a, cli_output out)
 {
     const cli_window v = cli_win;
-    const int planes = h / v.gh;
+    const float *px = out.px;
+    const int w = out.w, planes = out.planes, channels = out.channels;
+    const double lo = out.lo, hi = out.hi;
     const size_t row = (size_t)v.w * (size_t)channels;
     float *cut = cli_alloc((size_t)v.w * (size_t)v.h, (size_t)planes, (size_t)channels);
     char *side = NULL, *text = NULL, range[96];
@@ -125,8 +126,7 @@ static int cli_save_piece(const cli_args *a, const float *px, int w, int h, int 
                    px + (((size_t)p * (size_t)v.gh + (size_t)(v.y0 - v.gy0 + y)) * (size_t)w +
                          (size_t)(v.x0 - v.gx0)) * (size_t)channels, row * sizeof(float));
     cli_win.active = 0; /* write it as an ordinary output of v.w x v.h cells */
-    cli_in_height = v.h;
-    rc = cli_save(a, cut, v.w, v.h * planes, channels, lo, hi);
+    rc = cli_save(a, cli_output_of(cut, v.w, v.h, planes, channels, lo, hi));
     free(cut);
     if (rc != 0) return rc;
     if (cli_range_is_top(a->cmd, a->fraction)) strcpy(range, "top");
@@ -410,7 +410,6 @@ static int cli_mosaic(int argc, char **argv)
     ex_georef_free(&cli_geo);
     cli_geo = ref;
     memset(&ref, 0, sizeof ref);
-    cli_in_height = H;
     a.cmd = cmd < CMD_COUNT ? cmd : CMD_SKYVIEW;
     a.fraction = cli_tag_value(meta[0].tag, "fraction", other, sizeof other) && !strcmp(other, "1");
     if (!strcmp(meta[0].range, "top")) {
@@ -420,7 +419,7 @@ static int cli_mosaic(int argc, char **argv)
         if (colon) *colon = '\0';
         if (!colon || !cli_parse_real(meta[0].range, &lo) || !cli_parse_real(colon + 1, &hi)) lo = 0.0, hi = 1.0;
     }
-    rc = cli_save(&a, out, W, H * planes, channels, lo, hi);
+    rc = cli_save(&a, cli_output_of(out, W, H, planes, channels, lo, hi));
 done:
     ex_georef_free(&ref);
     free(out);

@@ -130,19 +130,28 @@ static hfvis_status cli_partial_save(const char *path, const hfvis_partial *p)
     return cli_write_encoded(path, hfvis_partial_encode_size(p), cli_enc_partial, p);
 }
 
-static int cli_save_piece(const cli_args *a, const float *px, int w, int h, int channels, double lo,
-                          double hi);
+/* The descriptor of planes x (w x h) cells of `channels` values with default range [lo, hi]. */
+static cli_output cli_output_of(const float *px, int w, int h, int planes, int channels, double lo,
+                                double hi)
+{
+    cli_output o;
+    o.px = px, o.w = w, o.h = h, o.planes = planes, o.channels = channels, o.lo = lo, o.hi = hi;
+    return o;
+}
+
 /* Write OUT: PFM with its channels, or a 16-bit PGM with the channel planes stacked (NoData code 0,
  * the range in its header: hfvis_pgm_range_save). A --window run writes its piece instead. */
-static int cli_save(const cli_args *a, const float *px, int w, int h, int channels, double lo,
-                    double hi)
+static int cli_save(const cli_args *a, cli_output out)
 {
+    const float *px = out.px;
+    const int w = out.w, h = out.h * out.planes, channels = out.channels;
+    double lo = out.lo, hi = out.hi;
     hfvis_status s;
-    if (cli_win.active) return cli_save_piece(a, px, w, h, channels, lo, hi);
+    if (cli_win.active) return cli_save_piece(a, out);
     errno = 0;
     if (a->out_raster) {
         /* planes stacked top to bottom (horizon) or channels interleaved become bands */
-        int planes = cli_in_height > 0 && h % cli_in_height == 0 ? h / cli_in_height : 1;
+        const int planes = out.planes; /* planes and channels become bands */
         ex_rio_image img;
         ex_rio_write_options o;
         ex_georef g = cli_geo; /* shallow: only the NoData fields change, on the copy */
