@@ -1607,6 +1607,9 @@ typedef struct hf_sweep {
     double ext_w, ext_h;        /* the raster's size */
     int rx0, ry0, rx1, ry1;     /* receiver rectangle [rx0, rx1) x [ry0, ry1) */
     int rect;                   /* 1: a proper sub-rectangle (nodes far from it are skipped) */
+    int parts, part;            /* bands across the direction (hfvis_sun_visibility), 0 = off */
+    double part_b0, part_span;  /* the receivers' lattice b range: its start and length */
+    int band_j0, band_j1;       /* the lattice rows near the band (all rows without bands) */
     hf_win win;                 /* its line scratch (win_rw >= 0) */
     void *block;
     const hfvis_allocator *alloc;
@@ -1704,6 +1707,15 @@ static int hf_p2_opts_limited(const hfvis_sweep_options *o)
     return o && (o->extent_width != 0 || o->receiver_width != 0);
 }
 
+/* part_index/part_count: 0, 0 or 0 <= index < count <= HF_PARTS_MAX (hfvis_sun_visibility). */
+#define HF_PARTS_MAX 65536
+static int hf_parts_valid(const hfvis_sweep_options *o)
+{
+    return (o->part_index == 0 && o->part_count == 0) ||
+           (o->part_count >= 1 && o->part_count <= HF_PARTS_MAX && o->part_index >= 0 &&
+            o->part_index < o->part_count);
+}
+
 static int hf_opts_valid(const hfvis_sweep_options *o)
 {
     return !o || (hf_border_valid(o->border) && o->border_cells >= 0 && isfinite(o->azimuth0_rad) &&
@@ -1712,7 +1724,8 @@ static int hf_opts_valid(const hfvis_sweep_options *o)
                   o->direction_order >= HFVIS_DIRECTION_ORDER_DEFAULT &&
                   o->direction_order <= HFVIS_DIRECTION_ORDER_SWEEP &&
                   (o->rays == HFVIS_RAYS_LATTICE || o->rays == HFVIS_RAYS_EXACT) &&
-                  o->ray_denominator >= 0 && o->ray_denominator <= HFVIS_RAY_DENOMINATOR_MAX);
+                  o->ray_denominator >= 0 && o->ray_denominator <= HFVIS_RAY_DENOMINATOR_MAX &&
+                  hf_parts_valid(o) && o->part_count <= 1); /* bands: hfvis_sun_visibility's own */
 }
 
 /* Resolved options (NULL or zero fields = defaults). */
@@ -1890,6 +1903,73 @@ static double hf_sample_border(const hfvis_grid *g, hfvis_border border, double 
  * column, and the heights (cell units) at every in-domain node. */
 #define HF_TILE 32 /* lattice and grid loops run in tiles so both sides stay in cache */
 
+#define HF_RECT_MARGIN 4.0 /* cells around a receiver rectangle (band) whose nodes a gather reads */
+
+/* Bands across the direction (hfvis_sweep_options part_index/part_count): the receivers'
+ * lattice coordinate b (across the lines) over the receiver rectangle, cut into parts equal
+ * lengths; each receiver is in the band of its own b, computed by the same expression in every
+ * call, so the bands of separate calls tile the receivers. Lines far from the band are skipped
+ * (hf_line_rect), which is what lets threads share one direction's lines. */
+static void hf_sweep_parts(hf_sweep *sw, const hfvis_sweep_options *o)
+{
+    sw->parts = o->part_count > 1 ? o->part_count : 0;
+    sw->part = o->part_index;
+    if (sw->parts) sw->rect = 1; /* hf_line_rect skips the lines far from the band */
+}
+
+/* The band's geometry, once the direction's lattice is set (hf_sweep_group): the receivers' b
+ * range over the rectangle, and the lattice rows [band_j0, band_j1] whose lines lie within
+ * HF_RECT_MARGIN of the band (b grows by one per row: v is a unit vector). Rows outside are
+ * neither sampled nor filled nor read. */
+static void hf_sweep_band(hf_sweep *sw)
+{
+    const hfvis_lattice *L = &sw->L;
+    double lo = HFVIS__INF, hi = -HFVIS__INF, px, py, b0, b1, q0, q1, j0, j1;
+    int c;
+    for (c = 0; c < 4; c++) {
+        double x = (double)(c & 1 ? sw->rx1 - 1 : sw->rx0) + sw->ox;
+        double y = (double)(c & 2 ? sw->ry1 - 1 : sw->ry0) + sw->oy;
+        double b = x * L->vx + y * L->vy;
+        lo = b < lo ? b : lo;
+        hi = b > hi ? b : hi;
+    }
+    sw->part_b0 = lo;
+    sw->part_span = hi - lo;
+    hf_node_pos(L, L->i_min, L->j_min, &px, &py);
+    b0 = (px + sw->ox) * L->vx + (py + sw->oy) * L->vy;
+    hf_node_pos(L, L->i_min, L->j_min + 1, &px, &py);
+    b1 = (px + sw->ox) * L->vx + (py + sw->oy) * L->vy - b0;
+    q0 = lo + (hi - lo) * (double)sw->part / (double)sw->parts - HF_RECT_MARGIN;
+    q1 = lo + (hi - lo) * (double)(sw->part + 1) / (double)sw->parts + HF_RECT_MARGIN;
+    j0 = (q0 - b0) / b1;
+    j1 = (q1 - b0) / b1;
+    if (j0 > j1) {
+        double t = j0;
+        j0 = j1;
+        j1 = t;
+    }
+    j0 = floor(j0) - 1.0;
+    j1 = ceil(j1) + 1.0;
+    sw->band_j0 = j0 < 0.0 ? 0 : j0 > (double)sw->rows ? sw->rows : (int)j0;
+    sw->band_j1 = j1 < 0.0 ? -1 : j1 > (double)(sw->rows - 1) ? sw->rows - 1 : (int)j1;
+}
+
+/* The band of lattice coordinate b, 0..parts-1. */
+static int hf_band_of(double b, double b0, double span, int parts)
+{
+    double q = span > 0.0 ? (b - b0) / span * (double)parts : 0.0;
+    return q <= 0.0 ? 0 : q >= (double)(parts - 1) ? parts - 1 : (int)q;
+}
+
+/* 1 if receiver (x, y) is one of this call's: no bands, or in its band. */
+static int hf_sweep_mine(const hf_sweep *sw, int x, int y)
+{
+    const hfvis_lattice *L = &sw->L;
+    if (!sw->parts) return 1;
+    return hf_band_of(((double)x + sw->ox) * L->vx + ((double)y + sw->oy) * L->vy, sw->part_b0,
+                      sw->part_span, sw->parts) == sw->part;
+}
+
 static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
 {
     const hfvis_grid *g = sw->g;
@@ -1901,6 +1981,9 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
     sw->cols = L->i_max - L->i_min + 1;
     HFVIS_ASSERT(sw->rows <= hf_lattice_bound(g) && sw->cols <= hf_lattice_bound(g));
     HFVIS_ASSERT((size_t)sw->rows * (size_t)sw->cols <= sw->nodes_cap);
+    sw->band_j0 = 0;
+    sw->band_j1 = sw->rows - 1;
+    if (sw->parts) hf_sweep_band(sw);
     for (c = 0; c < sw->cols; c++) {
         sw->col_first[c] = INT_MAX;
         sw->col_last[c] = -1;
@@ -1908,6 +1991,11 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
     for (j = 0; j < sw->rows; j++) {
         int first, last;
         double *hr = sw->h + (size_t)j * (size_t)sw->cols;
+        if (j < sw->band_j0 || j > sw->band_j1) { /* another band's line: left untouched */
+            sw->row_first[j] = 1;
+            sw->row_last[j] = 0;
+            continue;
+        }
         if (!hfvis_lattice_line(L, j + L->j_min, &first, &last)) {
             sw->row_first[j] = 1;
             sw->row_last[j] = 0;
@@ -2259,13 +2347,18 @@ static int hf_sweep_line_window(hf_sweep *sw, int m, int i0, int j0, int di, int
 /* The nodes s in [*slo, *shi] of a line (first node (i0, j0), lattice step (di, dj), n nodes)
  * that lie within HF_RECT_MARGIN cells of the receiver rectangle: the only ones a gather of its
  * receivers reads (the taps within two lattice steps, under 3 cells). 0 if none. */
-#define HF_RECT_MARGIN 4.0
 static int hf_line_rect(const hf_sweep *sw, int i0, int j0, int di, int dj, int n, int *slo, int *shi)
 {
     const hfvis_lattice *L = &sw->L;
     double p[2], c[2], lo = -DBL_MAX, hi = DBL_MAX, blo[2], bhi[2];
     int a;
     hf_node_pos(L, i0 + L->i_min, j0 + L->j_min, &p[0], &p[1]);
+    if (sw->parts) { /* the band's b range, widened like the rectangle */
+        double bl = (p[0] + sw->ox) * L->vx + (p[1] + sw->oy) * L->vy;
+        double q0 = sw->part_b0 + sw->part_span * (double)sw->part / (double)sw->parts;
+        double q1 = sw->part_b0 + sw->part_span * (double)(sw->part + 1) / (double)sw->parts;
+        if (bl < q0 - HF_RECT_MARGIN || bl > q1 + HF_RECT_MARGIN) return 0;
+    }
     c[0] = (double)di * L->ux + (double)dj * L->vx;
     c[1] = (double)di * L->uy + (double)dj * L->vy;
     blo[0] = (double)sw->rx0 - HF_RECT_MARGIN;
@@ -2630,6 +2723,7 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
         const int edge_row = open && !((double)y >= in_y0 && (double)y <= in_y1);
         for (x = tx; x < sw->rx1 && x < tx + HF_TILE; x++) {
             ptrdiff_t o = (ptrdiff_t)y * out_stride + x;
+            if (sw->parts && !hf_sweep_mine(sw, x, y)) continue; /* another band's */
             if (hf_is_hole(g, x, y)) {
                 for (c = 0; c < ch; c++) out[(size_t)c * plane_step + (size_t)o] = (float)HFVIS__NAN;
                 continue;
@@ -2765,8 +2859,10 @@ static void hf_gather_accumulate(hf_sweep *sw)
 
 static void hf_lattice_fill(hf_sweep *sw, double value)
 {
-    size_t i, n = (size_t)sw->rows * (size_t)sw->cols * (size_t)sw->channels;
-    for (i = 0; i < n; i++) sw->lat[i] = value;
+    const size_t row = (size_t)sw->cols * (size_t)sw->channels;
+    size_t i, n = sw->band_j1 < sw->band_j0 ? 0 : (size_t)(sw->band_j1 - sw->band_j0 + 1) * row;
+    double *lat = sw->lat + (size_t)sw->band_j0 * row; /* the band's rows (every row without) */
+    for (i = 0; i < n; i++) lat[i] = value;
 }
 
 /* hf_lattice_fill outside the rows' spans only, for a lattice whose every in-span node the
@@ -3605,12 +3701,17 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
                                   double sun_elevation_rad, double sun_radius_rad,
                                   const hfvis_sweep_options *opts, float *out, ptrdiff_t out_stride)
 {
-    hfvis_sweep_options o;
+    hfvis_sweep_options o, whole;
     hf_sweep sw;
     hfvis_status s;
     double ux, uy;
     int x, y;
-    if (hf_check_common(grid, opts) != HFVIS_OK || !out || out_stride < grid->width ||
+    if (opts) { /* the bands are this call's own: checked here, refused elsewhere */
+        whole = *opts;
+        if (!hf_parts_valid(opts)) return HFVIS_ERR_INVALID_ARGUMENT;
+        whole.part_index = whole.part_count = 0;
+    }
+    if (hf_check_common(grid, opts ? &whole : NULL) != HFVIS_OK || !out || out_stride < grid->width ||
         !hfvis__plane_fits(out_stride, grid->height, 4) || !isfinite(sun_azimuth_rad) || !isfinite(sun_elevation_rad) || !isfinite(sun_radius_rad) ||
         sun_radius_rad < 0.0 || sun_elevation_rad < -HFVIS__HALF_PI || sun_elevation_rad > HFVIS__HALF_PI)
         return HFVIS_ERR_INVALID_ARGUMENT;
@@ -3620,6 +3721,7 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
                             out_stride);
     if ((s = hf_sweep_alloc(&sw, grid, &o, 0, 1, 0)) != HFVIS_OK) return s;
     hf_sweep_vector(sun_azimuth_rad, &ux, &uy);
+    hf_sweep_parts(&sw, &o);
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HFVIS__NAN);
     hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
@@ -3627,6 +3729,7 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
     for (y = sw.ry0; y < sw.ry1; y++)
         for (x = sw.rx0; x < sw.rx1; x++) {
             float *p = out + (ptrdiff_t)y * out_stride + x;
+            if (!hf_sweep_mine(&sw, x, y)) continue;
             *p = (float)hf_sun_fraction(sun_elevation_rad, sun_radius_rad, (double)*p);
         }
     hf_sweep_free(&sw);
@@ -8387,9 +8490,38 @@ typedef struct hf_exact {
     int ox, oy;             /* the tile's origin in the raster (hfvis.h, "Search radius and tiles") */
     int rx0, ry0, rx1, ry1; /* the receiver rectangle, [rx0, rx1) x [ry0, ry1) */
     int rect;               /* 1: a proper sub-rectangle */
+    int parts, part;        /* bands across the direction (hfvis_sun_visibility), 0 = off */
+    int64_t c0, cspan;      /* the receivers' line index c = x*b - y*a: its least value, count */
     void *block;
     const hfvis_allocator *alloc;
 } hf_exact;
+
+/* Bands across an exact direction (a, b) (hfvis_sweep_options part_index/part_count): the
+ * receivers of a line share c = x*b - y*a, an integer, so the bands are ranges of c over the
+ * receiver rectangle and a line is swept by exactly one call. */
+static void hf_exact_parts(hf_exact *E, const hfvis_sweep_options *o, hf_ray r)
+{
+    int64_t lo = INT64_MAX, hi = INT64_MIN;
+    int c;
+    E->parts = o->part_count > 1 ? o->part_count : 0;
+    E->part = o->part_index;
+    for (c = 0; c < 4; c++) {
+        int64_t x = c & 1 ? E->rx1 - 1 : E->rx0, y = c & 2 ? E->ry1 - 1 : E->ry0;
+        int64_t v = x * (int64_t)r.b - y * (int64_t)r.a;
+        lo = v < lo ? v : lo;
+        hi = v > hi ? v : hi;
+    }
+    E->c0 = lo;
+    E->cspan = hi - lo + 1;
+}
+
+/* 1 if the line through receiver (x, y) along (a, b) is one of this call's. */
+static int hf_exact_mine(const hf_exact *E, int x, int y, hf_ray r)
+{
+    int64_t v = (int64_t)x * (int64_t)r.b - (int64_t)y * (int64_t)r.a;
+    if (!E->parts) return 1;
+    return (v - E->c0) * (int64_t)E->parts / E->cspan == (int64_t)E->part;
+}
 
 /* The piece after each crossing e (to crossing e + 1, the last one to the next grid point at
  * u = L): its cell, found from its midpoint, and its ends in that cell's coordinates. */
@@ -8763,7 +8895,8 @@ static void hf_exact_sweep(hf_exact *E, hf_ray r)
         }
         if (xlo < 0) xlo = 0;
         if (xhi > g->width - 1) xhi = g->width - 1;
-        for (x = xlo; x <= xhi; x++) hf_exact_line(E, x, y, r.a, r.b, P, L, scale);
+        for (x = xlo; x <= xhi; x++)
+            if (hf_exact_mine(E, x, y, r)) hf_exact_line(E, x, y, r.a, r.b, P, L, scale);
     }
 }
 
@@ -9070,10 +9203,12 @@ static hfvis_status hf_exact_sun(const hfvis_grid *g, double azimuth, double ele
     int x, y;
     o1.azimuth0_rad = azimuth;
     if ((s = hf_exact_init(&E, g, 1, &o1, 1, 0, 0)) != HFVIS_OK) return s;
+    hf_exact_parts(&E, o, E.d.ray[0]);
     hf_exact_sweep(&E, E.d.ray[0]);
     for (y = E.ry0; y < E.ry1; y++)
         for (x = E.rx0; x < E.rx1; x++) {
             double t = E.tan[(size_t)y * (size_t)g->width + (size_t)x];
+            if (!hf_exact_mine(&E, x, y, E.d.ray[0])) continue;
             out[(ptrdiff_t)y * out_stride + x] =
                 (float)hf_sun_fraction(elevation, radius, hf_tan_to_elevation(t));
         }

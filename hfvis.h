@@ -148,6 +148,17 @@
  *   overflows PTRDIFF_MAX, is HFVIS_ERR_INVALID_ARGUMENT like any other bad size. The library never
  *   prints, never exits, never aborts on input, and has no global mutable state: every
  *   function is reentrant and may run concurrently on different outputs.
+ * Threads. The library starts none. Inputs (grids, environments, tables, options, meshes) are
+ *   only read, so any number of calls may share them while no call writes them; an allocator
+ *   shared by concurrent calls must itself be thread-safe (give each thread its own). Outputs
+ *   must not overlap, with one exception: the bands of hfvis_sun_visibility (sweep options
+ *   part_index/part_count) write disjoint cells, so the part_count calls of one sun may write
+ *   one out concurrently. Splitting a run over threads without changing a bit: the sums by
+ *   direction range (hfvis_direction_sums: one quarter-turn group, or in exact mode one
+ *   direction, per part, added in order), the horizon map by plane range, one sun by bands,
+ *   and any receiver-local result by windows ("Search radius and tiles"). The hfvis tool's
+ *   --threads does exactly that; test/thread_test.c runs these calls concurrently on shared
+ *   inputs under ThreadSanitizer (make sanitize).
  * Memory. The caller owns every output and sizes it with the documented formula or a *_size()
  *   query. Scratch comes from the optional allocator in the options (NULL = malloc/free);
  *   test/test_args.c's allocator sweep lists every function that allocates and fails each of
@@ -591,6 +602,17 @@ typedef struct hfvis_sweep_options {
                                        (inside it, else HFVIS_ERR_INVALID_ARGUMENT); */
     int receiver_width, receiver_height; /* 0, 0 = every receiver (default); outputs outside it
                                        are left unwritten; the work shrinks with it */
+    int part_index, part_count;     /* hfvis_sun_visibility only (both ray modes): compute only the
+                                       receivers of band part_index of part_count bands across the
+                                       sun's direction (each receiver belongs to the band of its
+                                       distance across the sweep lines), so that threads can share
+                                       one call's lines: every receiver is in exactly one band, its
+                                       output equals the whole call's bit for bit, cells of the
+                                       other bands are left unwritten (the calls may then write one
+                                       out concurrently, see "Threads"). 0, 0 = every receiver
+                                       (default); else 0 <= part_index < part_count <= 65536
+                                       (HFVIS_ERR_INVALID_ARGUMENT otherwise, and from every other
+                                       routine for part_count > 1) */
 } hfvis_sweep_options;
 
 HFVIS_API hfvis_sweep_options hfvis_sweep_options_default(void);

@@ -609,6 +609,11 @@ static void teardown(void)
     bo = hfvis_sweep_options_default(); bo.extent_width = 5; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.receiver_width = -1; bo.receiver_height = 1; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.receiver_height = 1; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.part_count = -1; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.part_index = 1; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.part_index = 2; bo.part_count = 2; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.part_index = -1; bo.part_count = 2; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.part_count = 65537; BAD('S', INV, expr); \
     } while (0)
 
 /* The P2 hull-tree routines honour a search radius but refuse a window (a proper one: finite
@@ -1400,6 +1405,22 @@ static void args_sun_visibility(void)
     BAD('O', INV, hfvis_sun_visibility(&g_ok, 0.3, 0.4, 0.01, NULL, out, PTRDIFF_MAX));
     GRID_CASES(hfvis_sun_visibility(&bg, 0.3, 0.4, 0.01, NULL, out, GW));
     SWEEP_OPT_CASES(hfvis_sun_visibility(&g_ok, 0.3, 0.4, 0.01, &bo, out, GW));
+    { /* bands across the sun: its own; every other routine refuses them */
+        hfvis_sweep_options po = hfvis_sweep_options_default();
+        float *map = AF(GW * GH * 4);
+        po.part_index = 2;
+        po.part_count = 3;
+        OK(hfvis_sun_visibility(&g_ok, 0.3, 0.4, 0.01, &po, out, GW));
+        po.rays = HFVIS_RAYS_EXACT;
+        OK(hfvis_sun_visibility(&g_ok, 0.3, 0.4, 0.01, &po, out, GW));
+        po.rays = HFVIS_RAYS_LATTICE;
+        BAD('S', INV, hfvis_sky_view_factor(&g_ok, 4, &po, out, GW));
+        BAD('S', INV, hfvis_horizon_direction(&g_ok, 4, 1, &po, out, GW));
+        BAD('S', INV, hfvis_horizon_map(&g_ok, 4, &po, map));
+        po.part_index = 0;
+        po.part_count = 1; /* one band is every receiver: accepted everywhere */
+        OK(hfvis_sky_view_factor(&g_ok, 4, &po, out, GW));
+    }
 }
 
 static void args_env_options_default(void)
