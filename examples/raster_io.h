@@ -1649,7 +1649,7 @@ typedef struct {
 
 static inline void ex_rio_emit(ex_rio_out *o, const void *p, size_t n)
 {
-    if (o->ok && n && fwrite(p, 1, n, o->f) != n) o->ok = 0;
+    if (o->ok && n && HFVIS_FWRITE(p, 1, n, o->f) != n) o->ok = 0;
     o->pos += n;
 }
 
@@ -1949,116 +1949,172 @@ static inline void ex_rio_fmt(char *buf, size_t cap, double v, int is_float)
     else snprintf(buf, cap, is_float ? "%.9g" : "%.17g", v);
 }
 
-/* The .prj of geo beside path, atomically: its .prj, or the WKT of a GeoTIFF's ESRI PE string
- * (a CRS given by an EPSG code alone has no WKT here: no .prj). */
-static inline int ex_rio_write_prj(const char *path, const ex_georef *geo, char *err)
+/* printf into the output (a line of a text header). */
+static inline void ex_rio_emitf(ex_rio_out *o, const char *fmt, ...)
 {
-    char *prj, *tmpname = NULL;
+    char line[512];
+    int n;
+    va_list ap;
+    va_start(ap, fmt);
+    n = vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    if (n < 0 || (size_t)n >= sizeof line) o->ok = 0;
+    else ex_rio_emit(o, line, (size_t)n);
+}
+
+/* Add the .prj of geo beside path to the set p: its .prj, or the WKT of a GeoTIFF's ESRI PE
+ * string; without either, a .prj left beside path by an earlier output is removed with the
+ * set (a CRS given by an EPSG code alone has no WKT here). *prj_out is the name (free it after
+ * ex_publish_end). Returns 0, or -1 (out of memory). */
+static inline int ex_rio_publish_prj(ex_publish *p, const char *path, const ex_georef *geo, char **prj_out,
+                                     char *err)
+{
     const char *wkt = geo ? geo->prj : NULL;
     size_t len = 0;
-    FILE *f;
-    int ok;
+    ex_rio_out o;
     if (geo && !wkt) wkt = ex_rio_pe_string(geo, &len);
     else if (wkt) len = strlen(wkt);
-    if (!wkt) return 0;
-    prj = ex_rio_sidecar(path, ".prj");
-    if (!prj) return ex_rio_fail(err, "out of memory");
-    f = ex_atomic_open(prj, &tmpname);
-    ok = f && fwrite(wkt, 1, len, f) == len && (geo->prj || fputc('\n', f) != EOF);
-    if (!f || !ex_atomic_close(f, tmpname, prj, ok)) {
-        free(prj);
-        return ex_rio_fail(err, "cannot write the .prj");
+    *prj_out = ex_rio_sidecar(path, ".prj");
+    if (!*prj_out) return ex_rio_fail(err, "out of memory");
+    if (!wkt) {
+        ex_publish_absent(p, *prj_out);
+        return 0;
     }
-    free(prj);
+    memset(&o, 0, sizeof o);
+    o.f = ex_publish_open(p, *prj_out);
+    o.ok = o.f != NULL;
+    ex_rio_emit(&o, wkt, len);
+    if (!geo->prj) ex_rio_emit(&o, "\n", 1);
+    ex_publish_close(p, o.f, o.ok);
     return 0;
 }
 
-/* Write band 0 of img as an ESRI ASCII grid (+ the .prj of geo when it has one). NaN cells are
- * written as the NoData value (geo's, else -9999). */
+/* Publish the set p; its names are freed. Returns 0, or -1 with "cannot write the file". */
+static inline int ex_rio_publish(ex_publish *p, char **names, int n, char *err)
+{
+    int ok = ex_publish_end(p), i;
+    for (i = 0; i < n; i++) free(names[i]);
+    return ok ? 0 : ex_rio_fail(err, "cannot write the file");
+}
+
+/* Write band 0 of img as an ESRI ASCII grid (+ the .prj of geo when it has one), published
+ * together (ex_publish). NaN cells are written as the NoData value (geo's, else -9999). */
 static inline int ex_rio_write_asc(const char *path, const ex_rio_image *img, const ex_georef *geo, char *err)
 {
-    char *tmpname = NULL, num[64];
-    FILE *f;
-    int x, y, ok = 1;
+    char num[64], *names[1] = {NULL}, *line;
+    ex_publish pub;
+    ex_rio_out o;
+    int x, y;
     double cell = 1.0, nd = geo && geo->has_nodata ? geo->nodata : -9999.0;
     const char *ndt = geo && geo->has_nodata ? geo->nodata_text : "-9999";
+    size_t cap, ndl = strlen(ndt);
     if (img->bands != 1) return ex_rio_fail(err, "an ASCII grid holds one band; this output has %d (write .tif or .bil)",
                                             img->bands);
     if (geo && geo->has_transform) {
         if (ex_georef_cell(geo, &cell, err) != 0) return -1;
     }
     if (isnan(nd)) return ex_rio_fail(err, "an ASCII grid cannot have NoData NaN");
-    f = ex_atomic_open(path, &tmpname);
-    if (!f) return ex_rio_fail(err, "cannot create the file");
-    fprintf(f, "ncols %d\nnrows %d\n", img->width, img->height);
-    if (geo && geo->has_transform) {
-        fprintf(f, "xllcorner %.17g\nyllcorner %.17g\ncellsize %.17g\n", geo->gt[0],
-                geo->gt[3] + geo->gt[5] * (double)img->height, cell);
-    } else {
-        fprintf(f, "xllcorner 0\nyllcorner 0\ncellsize 1\n");
+    /* one row of text: each cell at most max(16, strlen(NoData)) characters and a separator */
+    cap = ((ndl > 16 ? ndl : 16) + 1) * (size_t)img->width;
+    line = (size_t)img->width < SIZE_MAX / 128 ? (char *)malloc(cap) : NULL;
+    if (!line) return ex_rio_fail(err, "out of memory");
+    ex_publish_init(&pub);
+    memset(&o, 0, sizeof o);
+    o.f = ex_publish_open(&pub, path);
+    if (!o.f) {
+        free(line);
+        ex_publish_end(&pub);
+        return ex_rio_fail(err, "cannot create the file");
     }
-    fprintf(f, "NODATA_value %s\n", ndt);
-    for (y = 0; y < img->height && ok; y++) {
+    o.ok = 1;
+    ex_rio_emitf(&o, "ncols %d\nnrows %d\n", img->width, img->height);
+    if (geo && geo->has_transform)
+        ex_rio_emitf(&o, "xllcorner %.17g\nyllcorner %.17g\ncellsize %.17g\n", geo->gt[0],
+                     geo->gt[3] + geo->gt[5] * (double)img->height, cell);
+    else
+        ex_rio_emitf(&o, "xllcorner 0\nyllcorner 0\ncellsize 1\n");
+    ex_rio_emitf(&o, "NODATA_value %s\n", ndt);
+    for (y = 0; y < img->height && o.ok; y++) {
+        size_t n = 0;
         for (x = 0; x < img->width; x++) {
             float v = img->data[(size_t)y * img->row_step + (size_t)x * img->pixel_step];
-            if (isnan(v)) fputs(ndt, f);
-            else {
+            size_t k;
+            if (isnan(v)) {
+                memcpy(line + n, ndt, ndl);
+                k = ndl;
+            } else {
                 ex_rio_fmt(num, sizeof num, (double)v, 1);
-                fputs(num, f);
+                k = strlen(num);
+                memcpy(line + n, num, k);
             }
-            fputc(x + 1 < img->width ? ' ' : '\n', f);
+            n += k;
+            line[n++] = x + 1 < img->width ? ' ' : '\n';
         }
-        if (ferror(f)) ok = 0;
+        ex_rio_emit(&o, line, n);
     }
-    (void)nd;
-    if (!ex_atomic_close(f, tmpname, path, ok)) return ex_rio_fail(err, "cannot write the file");
-    return ex_rio_write_prj(path, geo, err);
+    free(line);
+    ex_publish_close(&pub, o.f, o.ok);
+    if (ex_rio_publish_prj(&pub, path, geo, &names[0], err) != 0) {
+        ex_publish_end(&pub);
+        return -1;
+    }
+    return ex_rio_publish(&pub, names, 1, err);
 }
 
-/* Write img as EHdr (.bil/.flt data + .hdr [+ .prj]): 32-bit floats, BIL, little endian. */
+/* Write img as EHdr (.bil/.flt data + .hdr [+ .prj]): 32-bit floats, BIL, little endian; the
+ * files are published together (ex_publish). */
 static inline int ex_rio_write_ehdr(const char *path, const ex_rio_image *img, const ex_georef *geo, char *err)
 {
-    char *tmpname = NULL, *side;
-    FILE *f;
-    int x, y, b, ok = 1;
+    char *names[2] = {NULL, NULL};
+    ex_publish pub;
+    ex_rio_out o;
+    int x, y, b;
     unsigned char *row;
     size_t rb = (size_t)img->width * 4u;
     row = (unsigned char *)malloc(rb);
     if (!row) return ex_rio_fail(err, "out of memory");
-    f = ex_atomic_open(path, &tmpname);
-    if (!f) {
+    ex_publish_init(&pub);
+    memset(&o, 0, sizeof o);
+    o.f = ex_publish_open(&pub, path);
+    if (!o.f) {
         free(row);
+        ex_publish_end(&pub);
         return ex_rio_fail(err, "cannot create the file");
     }
-    for (y = 0; y < img->height && ok; y++)
-        for (b = 0; b < img->bands && ok; b++) {
+    o.ok = 1;
+    for (y = 0; y < img->height && o.ok; y++)
+        for (b = 0; b < img->bands && o.ok; b++) {
             for (x = 0; x < img->width; x++)
                 ex_rio_encode_sample(row + (size_t)x * 4u,
                                      img->data[(size_t)b * img->band_step + (size_t)y * img->row_step +
                                                (size_t)x * img->pixel_step],
                                      EX_RIO_FLOAT, 32, 0, geo);
-            ok = fwrite(row, 1, rb, f) == rb;
+            ex_rio_emit(&o, row, rb);
         }
     free(row);
-    if (!ex_atomic_close(f, tmpname, path, ok)) return ex_rio_fail(err, "cannot write the file");
-    side = ex_rio_sidecar(path, ".hdr");
-    if (!side) return ex_rio_fail(err, "out of memory");
-    f = ex_atomic_open(side, &tmpname);
-    if (f) {
-        fprintf(f, "BYTEORDER I\nLAYOUT BIL\nNROWS %d\nNCOLS %d\nNBANDS %d\nNBITS 32\nBANDROWBYTES %lu\n"
-                   "TOTALROWBYTES %lu\nPIXELTYPE FLOAT\n",
-                img->height, img->width, img->bands, (unsigned long)rb, (unsigned long)(rb * (size_t)img->bands));
-        if (geo && geo->has_transform)
-            fprintf(f, "ULXMAP %.17g\nULYMAP %.17g\nXDIM %.17g\nYDIM %.17g\n", geo->gt[0] + 0.5 * geo->gt[1],
-                    geo->gt[3] + 0.5 * geo->gt[5], geo->gt[1], -geo->gt[5]);
-        if (geo && geo->has_nodata) fprintf(f, "NODATA %s\n", geo->nodata_text);
+    ex_publish_close(&pub, o.f, o.ok);
+    names[0] = ex_rio_sidecar(path, ".hdr");
+    if (!names[0]) {
+        ex_publish_end(&pub);
+        return ex_rio_fail(err, "out of memory");
     }
-    if (!f || !ex_atomic_close(f, tmpname, side, !ferror(f))) {
-        free(side);
-        return ex_rio_fail(err, "cannot write the .hdr");
+    memset(&o, 0, sizeof o);
+    o.f = ex_publish_open(&pub, names[0]);
+    o.ok = o.f != NULL;
+    ex_rio_emitf(&o, "BYTEORDER I\nLAYOUT BIL\nNROWS %d\nNCOLS %d\nNBANDS %d\nNBITS 32\nBANDROWBYTES %lu\n"
+                     "TOTALROWBYTES %lu\nPIXELTYPE FLOAT\n",
+                 img->height, img->width, img->bands, (unsigned long)rb, (unsigned long)(rb * (size_t)img->bands));
+    if (geo && geo->has_transform)
+        ex_rio_emitf(&o, "ULXMAP %.17g\nULYMAP %.17g\nXDIM %.17g\nYDIM %.17g\n", geo->gt[0] + 0.5 * geo->gt[1],
+                     geo->gt[3] + 0.5 * geo->gt[5], geo->gt[1], -geo->gt[5]);
+    if (geo && geo->has_nodata) ex_rio_emitf(&o, "NODATA %s\n", geo->nodata_text);
+    ex_publish_close(&pub, o.f, o.ok);
+    if (ex_rio_publish_prj(&pub, path, geo, &names[1], err) != 0) {
+        ex_publish_end(&pub);
+        free(names[0]);
+        return -1;
     }
-    free(side);
-    return ex_rio_write_prj(path, geo, err);
+    return ex_rio_publish(&pub, names, 2, err);
 }
 
 /* Write img by the extension of path (.tif/.tiff with opt, .asc, .bil/.flt). */
