@@ -404,6 +404,7 @@ static inline int ex_georef_set_nodata(ex_georef *g, const char *text, size_t le
     memcpy(buf, text, len);
     buf[len] = '\0';
     v = strtod(buf, &end);
+    if (memchr(buf, 'x', len) || memchr(buf, 'X', len)) return -1; /* hexadecimal: not a number */
     if (end == buf || *end != '\0') {
         size_t i;
         for (i = 0; i < len; i++) buf[i] = (char)tolower((unsigned char)buf[i]);
@@ -1072,14 +1073,15 @@ static inline double ex_rio_sample(const unsigned char *p, int kind, int bits, i
     return (double)v;
 }
 
-/* A sample as stored into the caller's float: NoData to NaN when asked. */
+/* A sample as stored into the caller's float: NoData to NaN when asked; a value that is not
+ * finite as a float (+-Inf, NaN, a Float64 or decimal beyond +-FLT_MAX) is a hole, NaN, as
+ * hfvis.h takes every non-finite height. */
 static inline float ex_rio_cell(const ex_rio_reader *r, double v)
 {
     if (r->nodata_to_nan && r->geo.has_nodata &&
         (v == r->geo.nodata || (isnan(v) && isnan(r->geo.nodata))))
         return (float)NAN;
-    if (v > (double)FLT_MAX) return (float)INFINITY;
-    if (v < -(double)FLT_MAX) return -(float)INFINITY;
+    if (!(fabs(v) <= (double)FLT_MAX)) return (float)NAN;
     return (float)v;
 }
 
@@ -1109,10 +1111,12 @@ static inline int ex_rio_keyeq(const char *a, const char *b)
     return *a == '\0' && *b == '\0';
 }
 
+/* A whole token as a number: decimal, or the words inf, infinity and nan (strtod's); never
+ * hexadecimal ("0x10" is not a number to GDAL either). 0, or -1. */
 static inline int ex_rio_number(const char *s, double *v)
 {
     char *end;
-    if (!*s) return -1;
+    if (!*s || strchr(s, 'x') || strchr(s, 'X')) return -1;
     *v = strtod(s, &end);
     return *end == '\0' ? 0 : -1;
 }
@@ -1263,6 +1267,12 @@ static inline int ex_rio_parse_hdr(ex_rio_reader *r, const char *text, size_t n,
     b = (uint64_t)r->bands;
     bytes = (uint64_t)r->bits / 8u;
     r->skip = (uint64_t)skip;
+    /* BANDROWBYTES and TOTALROWBYTES may pad rows, never cut them (rows would overlap) */
+    if ((layout != 1 && brb >= 0 && (uint64_t)brb < w * bytes) ||
+        (layout != 2 && trb >= 0 && (uint64_t)trb < (layout == 0 && brb >= 0 ? (uint64_t)brb * (b - 1) + w * bytes
+                                                                              : w * bytes * b)))
+        return ex_rio_fail(r->err, ".hdr BANDROWBYTES %g or TOTALROWBYTES %g is shorter than a row of %llu bytes",
+                           brb, trb, (unsigned long long)(w * bytes * (layout == 2 ? 1 : b)));
     if (layout == 0) { /* BIL: row of band 0, row of band 1, ... */
         r->col_bytes = bytes;
         r->band_bytes = brb >= 0 ? (uint64_t)brb : w * bytes;

@@ -843,6 +843,52 @@ TEST(pixel_scale_counts)
     CHECK(open_err(buf, 400, "zero pixel size"));
 }
 
+/* Heights that are not finite as floats are holes (NaN), as hfvis.h takes every non-finite
+ * height: +-Inf and a Float64 1e300 in a GeoTIFF, 1e39 in an ASC. Hexadecimal is not a number
+ * (NoData "0x10", an ASC value "0x10"); a TOTALROWBYTES shorter than a row is refused. */
+TEST(non_finite_and_hex)
+{
+    unsigned char buf[4096];
+    uint32_t e[9][4] = { { 256, 3, 1, 2 }, { 257, 3, 1, 2 }, { 258, 3, 1, 64 }, { 259, 3, 1, 1 },
+                         { 273, 4, 1, 200 }, { 277, 3, 1, 1 }, { 278, 3, 1, 2 }, { 279, 4, 1, 32 },
+                         { 339, 3, 1, 3 } };
+    double d[4];
+    float v[4];
+    ex_rio_reader r;
+    int k;
+    static const char *const refused[] = {
+        "ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value 0x10\n1 2\n",
+        "ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n0x10 2\n",
+        "ncols 0x2\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n"};
+    static const unsigned char raw[16] = {0};
+    d[0] = 1e300; d[1] = (double)INFINITY; d[2] = -(double)INFINITY; d[3] = 7.5;
+    memset(buf, 0, sizeof buf);
+    mini_tiff(buf, e, 9, 0);
+    for (k = 0; k < 4; k++) { uint64_t u; memcpy(&u, &d[k], 8); ex_rio_put_uint(buf + 200 + 8 * k, u, 8, 0); }
+    CHECK(ex_rio_open_tiff_mem(&r, buf, 232) == 0 && ex_rio_read(&r, 0, 0, 0, 2, 2, v, 2) == 0);
+    CHECK(isnan(v[0]) && isnan(v[1]) && isnan(v[2]) && v[3] == 7.5f);
+    ex_rio_close(&r);
+    {
+        static const char a[] = "ncols 3\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n1e39 -1e39 5\n";
+        CHECK(ex_rio_open_asc_mem(&r, a, strlen(a)) == 0 && ex_rio_read(&r, 0, 0, 0, 3, 1, v, 3) == 0);
+        CHECK(isnan(v[0]) && isnan(v[1]) && v[2] == 5.0f);
+        ex_rio_close(&r);
+    }
+    for (k = 0; k < 3; k++) {
+        CHECK(ex_rio_open_asc_mem(&r, refused[k], strlen(refused[k])) != 0 && r.err[0] != '\0');
+        ex_rio_close(&r);
+    }
+    for (k = 0; k < 3; k++) {
+        static const char *const h[3] = {"NROWS 2\nNCOLS 2\nNBITS 32\nPIXELTYPE FLOAT\nNODATA 0x10\n",
+                                          "NROWS 2\nNCOLS 2\nNBITS 32\nPIXELTYPE FLOAT\nTOTALROWBYTES 4\n",
+                                          "NROWS 2\nNCOLS 2\nNBITS 32\nPIXELTYPE FLOAT\nTOTALROWBYTES 8\n"};
+        int rc = ex_rio_open_ehdr_mem(&r, h[k], strlen(h[k]), raw, 16, 0);
+        CHECK(k == 2 ? rc == 0 : rc != 0 && r.err[0] != '\0');
+        CHECK(k != 1 || strstr(r.err, "shorter than a row"));
+        ex_rio_close(&r);
+    }
+}
+
 TEST(georef_cells)
 {
     ex_georef g;
@@ -1034,6 +1080,7 @@ int main(int argc, char **argv)
     RUN(asc_ehdr);
     RUN(orientation);
     RUN(pixel_scale_counts);
+    RUN(non_finite_and_hex);
     RUN(georef_cells);
     RUN(prj_geokeys);
     {
