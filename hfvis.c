@@ -53,6 +53,22 @@
 #define HFVIS_MALLOC(size) malloc(size)
 #define HFVIS_FREE(ptr) free(ptr)
 #endif
+/* The stdio calls of the write path (hfvis.h, "Files"): each may be defined to a replacement
+ * with the same signature (test/test_wfault.c fails them one call at a time). */
+#ifndef HFVIS_NO_STDIO
+#ifndef HFVIS_FWRITE
+#define HFVIS_FWRITE(ptr, size, n, file) fwrite(ptr, size, n, file)
+#endif
+#ifndef HFVIS_FFLUSH
+#define HFVIS_FFLUSH(file) fflush(file)
+#endif
+#ifndef HFVIS_FCLOSE
+#define HFVIS_FCLOSE(file) fclose(file)
+#endif
+#ifndef HFVIS_RENAME
+#define HFVIS_RENAME(from, to) rename(from, to)
+#endif
+#endif
 
 /* Exact rays (section 16), called from the public routines of sections 8, 9, 10 and 15. */
 /* One exact-ray direction: look vector (a, b), gcd 1, and its azimuth, unwrapped to within pi of
@@ -983,27 +999,27 @@ hfvis_status hfvis_write_begin(const char *path, const hfvis_write_options *opts
 hfvis_status hfvis_write_end(const char *path, FILE *file, char *temp_path, int commit,
                              const hfvis_write_options *opts)
 {
-    int ok = commit != 0;
+    int ok;
     if (!file || !temp_path) { /* nothing was opened: release what there is */
-        if (file) fclose(file);
+        if (file) HFVIS_FCLOSE(file);
         hfvis__free(NULL, temp_path);
         return HFVIS_ERR_INVALID_ARGUMENT;
     }
-    ok = (fflush(file) == 0) && !ferror(file) && ok;
-    ok = (fclose(file) == 0) && ok;
-    if (ok && (!path || rename(temp_path, path) != 0)) {
+    ok = (HFVIS_FFLUSH(file) == 0) && !ferror(file);
+    ok = (HFVIS_FCLOSE(file) == 0) && ok; /* closed even when the flush failed */
+    if (ok && commit && (!path || HFVIS_RENAME(temp_path, path) != 0)) {
 #if defined(_WIN32)
         /* Windows' rename does not replace an existing file: replace non-atomically. */
-        ok = path && remove(path) == 0 && rename(temp_path, path) == 0;
+        ok = path && remove(path) == 0 && HFVIS_RENAME(temp_path, path) == 0;
 #else
         ok = 0;
 #endif
     }
-    if (!ok) remove(temp_path);
+    if (!ok || !commit) remove(temp_path);
     if (opts && opts->on_temp) opts->on_temp(opts->user, NULL); /* renamed or removed */
     hfvis__free(NULL, temp_path);
     if (!path) return HFVIS_ERR_INVALID_ARGUMENT;
-    return ok ? HFVIS_OK : commit ? HFVIS_ERR_IO : HFVIS_OK;
+    return !commit || ok ? HFVIS_OK : HFVIS_ERR_IO;
 }
 
 hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
@@ -1015,7 +1031,11 @@ hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
     if (!path || (!bytes && n > 0) || path[0] == '\0') return HFVIS_ERR_INVALID_ARGUMENT;
     s = hfvis_write_begin(path, opts, &f, &tmp);
     if (s != HFVIS_OK) return s;
-    return hfvis_write_end(path, f, tmp, n == 0 || fwrite(bytes, 1, n, f) == n, opts);
+    if (n > 0 && HFVIS_FWRITE(bytes, 1, n, f) != n) { /* short write (disk full, size limit) */
+        hfvis_write_end(path, f, tmp, 0, opts);
+        return HFVIS_ERR_IO;
+    }
+    return hfvis_write_end(path, f, tmp, 1, opts);
 }
 
 HFVIS_API hfvis_status hfvis_pfm_save(const char *path, const float *pixels, int width,

@@ -379,8 +379,16 @@ HFVIS_API hfvis_write_options hfvis_write_options_default(void);
  * exceed 255 bytes, the component is cut so the name fits), which is then renamed onto path.
  * path is either complete or untouched; on failure the temporary file is removed. bytes may be
  * NULL when n is 0. A symbolic link at path is replaced by the file, not written through.
- * Returns HFVIS_OK, HFVIS_ERR_INVALID_ARGUMENT (NULL or empty path, NULL bytes with n > 0),
- * HFVIS_ERR_IO or HFVIS_ERR_OUT_OF_MEMORY (the name). */
+ * Returns HFVIS_OK only when path holds all n bytes; HFVIS_ERR_IO when the file cannot be
+ * created, or on any short fwrite (disk full, file-size limit), failed fflush or fclose (a
+ * delayed write error) or failed rename, each of which leaves path untouched and no temporary
+ * file; HFVIS_ERR_INVALID_ARGUMENT (NULL or empty path, NULL bytes with n > 0) or
+ * HFVIS_ERR_OUT_OF_MEMORY (the name). Every saver of the library (hfvis_pfm_save,
+ * hfvis_pgm_save, hfvis_pgm_range_save, hfvis_mesh_save, hfvis_binvox_save, ...) returns this
+ * status unchanged.
+ * Test hooks: the write path calls HFVIS_FWRITE, HFVIS_FFLUSH, HFVIS_FCLOSE and HFVIS_RENAME,
+ * which are fwrite, fflush, fclose and rename unless defined (same signatures) when the
+ * library's .c files are compiled; test/test_wfault.c fails each call of every writer in turn. */
 HFVIS_API hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
                                         const hfvis_write_options *opts);
 
@@ -394,7 +402,8 @@ HFVIS_API hfvis_status hfvis_write_file(const char *path, const void *bytes, siz
  * hfvis_write_begin returns HFVIS_OK, HFVIS_ERR_INVALID_ARGUMENT (a NULL or empty path, NULL
  * file or temp_path), HFVIS_ERR_IO or HFVIS_ERR_OUT_OF_MEMORY (the name), and sets *file and
  * *temp_path to NULL on failure. hfvis_write_end returns HFVIS_OK when path holds the new file
- * (or, with commit 0, when the file was discarded), HFVIS_ERR_IO when it could not be written,
+ * (or, with commit 0, when the file was discarded), HFVIS_ERR_IO when it could not be written
+ * (a write error seen by ferror, a failed fflush, fclose or rename: path is untouched),
  * HFVIS_ERR_INVALID_ARGUMENT for a NULL file, temp_path or path (it still releases the others).
  * Declared only where <stdio.h> is available (not with HFVIS_NO_STDIO). */
 #ifndef HFVIS_NO_STDIO
