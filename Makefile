@@ -52,7 +52,7 @@ BENCH := $(BUILD)/bench
 TESTS := $(patsubst test/%.c,$(BUILD)/test/%,$(wildcard test/test_*.c))
 FUZZERS := $(patsubst test/fuzz/%.c,%,$(wildcard test/fuzz/fuzz_*.c))
 
-.PHONY: all lib examples test check sanitize fuzz bench demo install symbols cxx update-golden clean run-tests
+.PHONY: all lib examples test check sanitize scale-test fuzz bench demo install symbols cxx update-golden clean run-tests
 all: $(LIB) $(CLI) $(EXAMPLES)
 lib: $(LIB)
 examples: $(EXAMPLES) $(CLI)
@@ -82,6 +82,11 @@ test check:
 	@$(MAKE) --no-print-directory config=test werror=1 run-tests
 sanitize:
 	@$(MAKE) --no-print-directory config=sanitize werror=1 run-tests
+# make scale-test: the README's scale-out recipes on GNU parallel, xargs -P and a private
+# single-node Slurm (test/scale_test.sh, ~30 s); prints "SKIP: reason" where they are missing.
+scale-test:
+	@$(MAKE) --no-print-directory config=test werror=1 build/test/hfvis
+	@sh test/scale_test.sh build/test/hfvis
 run-tests: $(TESTS) $(EXAMPLES) $(CLI) $(BENCH)
 	@CC="$(CC)" CFLAGS="$(OPT) $(CFLAGS)" sh test/run.sh $(BUILD) "$(CXX)"
 
