@@ -52,7 +52,7 @@ BENCH := $(BUILD)/bench
 TESTS := $(patsubst test/%.c,$(BUILD)/test/%,$(wildcard test/test_*.c))
 FUZZERS := $(patsubst test/fuzz/%.c,%,$(wildcard test/fuzz/fuzz_*.c))
 
-.PHONY: all lib examples test check sanitize tsan fuzz bench demo install symbols cxx update-golden clean run-tests
+.PHONY: all lib examples test check sanitize tsan scale-test fuzz bench demo install symbols cxx update-golden clean run-tests
 all: $(LIB) $(CLI) $(EXAMPLES)
 lib: $(LIB)
 examples: $(EXAMPLES) $(CLI)
@@ -98,6 +98,11 @@ tsan:
 	  TSAN_OPTIONS=halt_on_error=1 build/tsan/thread_test > build/tsan/log 2>&1 && tail -n 1 build/tsan/log && echo "tsan: no data race" || \
 	  { cat build/tsan/log; echo "tsan: FAILED"; exit 1; }; \
 	else echo "SKIP tsan: $(CC) has no ThreadSanitizer runtime"; fi
+# make scale-test: the README's scale-out recipes on GNU parallel, xargs -P and a private
+# single-node Slurm (test/scale_test.sh, ~30 s); prints "SKIP: reason" where they are missing.
+scale-test:
+	@$(MAKE) --no-print-directory config=test werror=1 build/test/hfvis
+	@sh test/scale_test.sh build/test/hfvis
 run-tests: $(TESTS) $(EXAMPLES) $(CLI) $(BENCH) $(THREAD_TEST)
 	@CC="$(CC)" CFLAGS="$(OPT) $(CFLAGS)" sh test/run.sh $(BUILD) "$(CXX)"
 
