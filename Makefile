@@ -190,3 +190,10 @@ determinism:
 .PHONY: fuzz-coverage
 fuzz-coverage:
 	@sh test/fuzz/coverage.sh
+
+# make solar-rsun: hfvis_solar_irradiation against GRASS r.sun on flat ground and 30 deg planes,
+# 4 latitudes x 4 days (test/solar_rsun.sh, about 2 minutes: not part of make test); SKIPs
+# without `grass` (Debian: grass-core).
+.PHONY: solar-rsun
+solar-rsun:
+	@CC="$(CC)" sh test/solar_rsun.sh

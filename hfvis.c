@@ -28,6 +28,10 @@
  *  16. Exact rays (beyond [P1]): rational directions, every grid-line crossing and the split
  *      bulging pieces swept with the [P1] §5 hull, the per-receiver oracle, actual azimuths and
  *      their quadrature, the exact-mode light paths
+ *  17. Solar radiation: NREL SPA (Reda & Andreas 2004/2008), r.sun's solar geometry and its ESRA
+ *      clear sky (Suri & Hofierka 2004; Rigollier et al. 2000), time steps with sunrise and
+ *      sunset inside the step, irradiation over the exact horizon map, and its oracle
+ *      (docs/solar.md)
  *
  * Paper references: [P1] Timonen & Westerholm, "Scalable Height Field Self-Shadowing",
  * CGF 29(2), 2010 (thesis appendix A.1). Errata and choices: docs/errata.md E1-E18.
@@ -9336,4 +9340,1074 @@ static hfvis_status hf_exact_direction_sums(const hfvis_grid *g, int K, hfvis_su
         }
     hf_exact_free(&E);
     return HFVIS_OK;
+}
+
+/* ========================================================================================== */
+/* 17. Solar radiation                                                                        */
+/* ========================================================================================== */
+/* NREL's SPA (Reda & Andreas 2004/2008), r.sun's solar geometry and its ESRA clear sky
+ * (Suri & Hofierka 2004; Rigollier et al. 2000), integrated over time over the exact-ray
+ * horizon map of section 16, and its oracle. Errata and choices: docs/solar.md. */
+
+/* ------------------------------------------------- 1. SPA: periodic terms (Tables A4.2-A4.3) */
+/* Earth periodic terms A_i cos(B_i + C_i JME) of VSOP87 as SPA truncates them (Table A4.2), the
+ * series L0..L5, B0..B1, R0..R4 one after another. */
+static const double hf_spa_terms[][3] = {
+    {175347046.0, 0, 0}, {3341656.0, 4.6692568, 6283.07585}, {34894.0, 4.6261, 12566.1517},
+    {3497.0, 2.7441, 5753.3849}, {3418.0, 2.8289, 3.5231}, {3136.0, 3.6277, 77713.7715},
+    {2676.0, 4.4181, 7860.4194}, {2343.0, 6.1352, 3930.2097}, {1324.0, 0.7425, 11506.7698},
+    {1273.0, 2.0371, 529.691}, {1199.0, 1.1096, 1577.3435}, {990, 5.233, 5884.927},
+    {902, 2.045, 26.298}, {857, 3.508, 398.149}, {780, 1.179, 5223.694}, {753, 2.533, 5507.553},
+    {505, 4.583, 18849.228}, {492, 4.205, 775.523}, {357, 2.92, 0.067}, {317, 5.849, 11790.629},
+    {284, 1.899, 796.298}, {271, 0.315, 10977.079}, {243, 0.345, 5486.778}, {206, 4.806, 2544.314},
+    {205, 1.869, 5573.143}, {202, 2.458, 6069.777}, {156, 0.833, 213.299}, {132, 3.411, 2942.463},
+    {126, 1.083, 20.775}, {115, 0.645, 0.98}, {103, 0.636, 4694.003}, {102, 0.976, 15720.839},
+    {102, 4.267, 7.114}, {99, 6.21, 2146.17}, {98, 0.68, 155.42}, {86, 5.98, 161000.69},
+    {85, 1.3, 6275.96}, {85, 3.67, 71430.7}, {80, 1.81, 17260.15}, {79, 3.04, 12036.46},
+    {75, 1.76, 5088.63}, {74, 3.5, 3154.69}, {74, 4.68, 801.82}, {70, 0.83, 9437.76},
+    {62, 3.98, 8827.39}, {61, 1.82, 7084.9}, {57, 2.78, 6286.6}, {56, 4.39, 14143.5},
+    {56, 3.47, 6279.55}, {52, 0.19, 12139.55}, {52, 1.33, 1748.02}, {51, 0.28, 5856.48},
+    {49, 0.49, 1194.45}, {41, 5.37, 8429.24}, {41, 2.4, 19651.05}, {39, 6.17, 10447.39},
+    {37, 6.04, 10213.29}, {37, 2.57, 1059.38}, {36, 1.71, 2352.87}, {36, 1.78, 6812.77},
+    {33, 0.59, 17789.85}, {30, 0.44, 83996.85}, {30, 2.74, 1349.87}, {25, 3.16, 4690.48},
+    {628331966747.0, 0, 0}, {206059.0, 2.678235, 6283.07585}, {4303.0, 2.6351, 12566.1517},
+    {425.0, 1.59, 3.523}, {119.0, 5.796, 26.298}, {109.0, 2.966, 1577.344}, {93, 2.59, 18849.23},
+    {72, 1.14, 529.69}, {68, 1.87, 398.15}, {67, 4.41, 5507.55}, {59, 2.89, 5223.69},
+    {56, 2.17, 155.42}, {45, 0.4, 796.3}, {36, 0.47, 775.52}, {29, 2.65, 7.11}, {21, 5.34, 0.98},
+    {19, 1.85, 5486.78}, {19, 4.97, 213.3}, {17, 2.99, 6275.96}, {16, 0.03, 2544.31},
+    {16, 1.43, 2146.17}, {15, 1.21, 10977.08}, {12, 2.83, 1748.02}, {12, 3.26, 5088.63},
+    {12, 5.27, 1194.45}, {12, 2.08, 4694}, {11, 0.77, 553.57}, {10, 1.3, 6286.6},
+    {10, 4.24, 1349.87}, {9, 2.7, 242.73}, {9, 5.64, 951.72}, {8, 5.3, 2352.87},
+    {6, 2.65, 9437.76}, {6, 4.67, 4690.48}, {52919.0, 0, 0}, {8720.0, 1.0721, 6283.0758},
+    {309.0, 0.867, 12566.152}, {27, 0.05, 3.52}, {16, 5.19, 26.3}, {16, 3.68, 155.42},
+    {10, 0.76, 18849.23}, {9, 2.06, 77713.77}, {7, 0.83, 775.52}, {5, 4.66, 1577.34},
+    {4, 1.03, 7.11}, {4, 3.44, 5573.14}, {3, 5.14, 796.3}, {3, 6.05, 5507.55}, {3, 1.19, 242.73},
+    {3, 6.12, 529.69}, {3, 0.31, 398.15}, {3, 2.28, 553.57}, {2, 4.38, 5223.69}, {2, 3.75, 0.98},
+    {289.0, 5.844, 6283.076}, {35, 0, 0}, {17, 5.49, 12566.15}, {3, 5.2, 155.42}, {1, 4.72, 3.52},
+    {1, 5.3, 18849.23}, {1, 5.97, 242.73}, {114.0, 3.142, 0}, {8, 4.13, 6283.08},
+    {1, 3.84, 12566.15}, {1, 3.14, 0}, {280.0, 3.199, 84334.662}, {102.0, 5.422, 5507.553},
+    {80, 3.88, 5223.69}, {44, 3.7, 2352.87}, {32, 4, 1577.34}, {9, 3.9, 5507.55},
+    {6, 1.73, 5223.69}, {100013989.0, 0, 0}, {1670700.0, 3.0984635, 6283.07585},
+    {13956.0, 3.05525, 12566.1517}, {3084.0, 5.1985, 77713.7715}, {1628.0, 1.1739, 5753.3849},
+    {1576.0, 2.8469, 7860.4194}, {925.0, 5.453, 11506.77}, {542.0, 4.564, 3930.21},
+    {472.0, 3.661, 5884.927}, {346.0, 0.964, 5507.553}, {329.0, 5.9, 5223.694},
+    {307.0, 0.299, 5573.143}, {243.0, 4.273, 11790.629}, {212.0, 5.847, 1577.344},
+    {186.0, 5.022, 10977.079}, {175.0, 3.012, 18849.228}, {110.0, 5.055, 5486.778},
+    {98, 0.89, 6069.78}, {86, 5.69, 15720.84}, {86, 1.27, 161000.69}, {65, 0.27, 17260.15},
+    {63, 0.92, 529.69}, {57, 2.01, 83996.85}, {56, 5.24, 71430.7}, {49, 3.25, 2544.31},
+    {47, 2.58, 775.52}, {45, 5.54, 9437.76}, {43, 6.01, 6275.96}, {39, 5.36, 4694},
+    {38, 2.39, 8827.39}, {37, 0.83, 19651.05}, {37, 4.9, 12139.55}, {36, 1.67, 12036.46},
+    {35, 1.84, 2942.46}, {33, 0.24, 7084.9}, {32, 0.18, 5088.63}, {32, 1.78, 398.15},
+    {28, 1.21, 6286.6}, {28, 1.9, 6279.55}, {26, 4.59, 10447.39}, {103019.0, 1.10749, 6283.07585},
+    {1721.0, 1.0644, 12566.1517}, {702.0, 3.142, 0}, {32, 1.02, 18849.23}, {31, 2.84, 5507.55},
+    {25, 1.32, 5223.69}, {18, 1.42, 1577.34}, {10, 5.91, 10977.08}, {9, 1.42, 6275.96},
+    {9, 0.27, 5486.78}, {4359.0, 5.7846, 6283.0758}, {124.0, 5.579, 12566.152}, {12, 3.14, 0},
+    {9, 3.63, 77713.77}, {6, 1.87, 5573.14}, {3, 5.47, 18849.23}, {145.0, 4.273, 6283.076},
+    {7, 3.92, 12566.15}, {4, 2.56, 6283.08}
+};
+/* rows of L0..L5, B0..B1, R0..R4 in hf_spa_terms */
+static const short hf_spa_series[14] = {0, 64, 98, 118, 125, 128, 129, 134, 136, 176, 186, 192, 194, 195};
+static const double hf_spa_nutation[63][9] = {
+    {0, 0, 0, 0, 1, -171996, -174.2, 92025, 8.9}, {-2, 0, 0, 2, 2, -13187, -1.6, 5736, -3.1},
+    {0, 0, 0, 2, 2, -2274, -0.2, 977, -0.5}, {0, 0, 0, 0, 2, 2062, 0.2, -895, 0.5},
+    {0, 1, 0, 0, 0, 1426, -3.4, 54, -0.1}, {0, 0, 1, 0, 0, 712, 0.1, -7, 0},
+    {-2, 1, 0, 2, 2, -517, 1.2, 224, -0.6}, {0, 0, 0, 2, 1, -386, -0.4, 200, 0},
+    {0, 0, 1, 2, 2, -301, 0, 129, -0.1}, {-2, -1, 0, 2, 2, 217, -0.5, -95, 0.3},
+    {-2, 0, 1, 0, 0, -158, 0, 0, 0}, {-2, 0, 0, 2, 1, 129, 0.1, -70, 0},
+    {0, 0, -1, 2, 2, 123, 0, -53, 0}, {2, 0, 0, 0, 0, 63, 0, 0, 0},
+    {0, 0, 1, 0, 1, 63, 0.1, -33, 0}, {2, 0, -1, 2, 2, -59, 0, 26, 0},
+    {0, 0, -1, 0, 1, -58, -0.1, 32, 0}, {0, 0, 1, 2, 1, -51, 0, 27, 0},
+    {-2, 0, 2, 0, 0, 48, 0, 0, 0}, {0, 0, -2, 2, 1, 46, 0, -24, 0}, {2, 0, 0, 2, 2, -38, 0, 16, 0},
+    {0, 0, 2, 2, 2, -31, 0, 13, 0}, {0, 0, 2, 0, 0, 29, 0, 0, 0}, {-2, 0, 1, 2, 2, 29, 0, -12, 0},
+    {0, 0, 0, 2, 0, 26, 0, 0, 0}, {-2, 0, 0, 2, 0, -22, 0, 0, 0}, {0, 0, -1, 2, 1, 21, 0, -10, 0},
+    {0, 2, 0, 0, 0, 17, -0.1, 0, 0}, {2, 0, -1, 0, 1, 16, 0, -8, 0},
+    {-2, 2, 0, 2, 2, -16, 0.1, 7, 0}, {0, 1, 0, 0, 1, -15, 0, 9, 0},
+    {-2, 0, 1, 0, 1, -13, 0, 7, 0}, {0, -1, 0, 0, 1, -12, 0, 6, 0}, {0, 0, 2, -2, 0, 11, 0, 0, 0},
+    {2, 0, -1, 2, 1, -10, 0, 5, 0}, {2, 0, 1, 2, 2, -8, 0, 3, 0}, {0, 1, 0, 2, 2, 7, 0, -3, 0},
+    {-2, 1, 1, 0, 0, -7, 0, 0, 0}, {0, -1, 0, 2, 2, -7, 0, 3, 0}, {2, 0, 0, 2, 1, -7, 0, 3, 0},
+    {2, 0, 1, 0, 0, 6, 0, 0, 0}, {-2, 0, 2, 2, 2, 6, 0, -3, 0}, {-2, 0, 1, 2, 1, 6, 0, -3, 0},
+    {2, 0, -2, 0, 1, -6, 0, 3, 0}, {2, 0, 0, 0, 1, -6, 0, 3, 0}, {0, -1, 1, 0, 0, 5, 0, 0, 0},
+    {-2, -1, 0, 2, 1, -5, 0, 3, 0}, {-2, 0, 0, 0, 1, -5, 0, 3, 0}, {0, 0, 2, 2, 1, -5, 0, 3, 0},
+    {-2, 0, 2, 0, 1, 4, 0, 0, 0}, {-2, 1, 0, 2, 1, 4, 0, 0, 0}, {0, 0, 1, -2, 0, 4, 0, 0, 0},
+    {-1, 0, 1, 0, 0, -4, 0, 0, 0}, {-2, 1, 0, 0, 0, -4, 0, 0, 0}, {1, 0, 0, 0, 0, -4, 0, 0, 0},
+    {0, 0, 1, 2, 0, 3, 0, 0, 0}, {0, 0, -2, 2, 2, -3, 0, 0, 0}, {-1, -1, 1, 0, 0, -3, 0, 0, 0},
+    {0, 1, 1, 0, 0, -3, 0, 0, 0}, {0, -1, 1, 2, 2, -3, 0, 0, 0}, {2, -1, -1, 2, 2, -3, 0, 0, 0},
+    {0, 0, 3, 2, 2, -3, 0, 0, 0}, {2, -1, 0, 2, 2, -3, 0, 0, 0}
+};
+
+/* ---------------------------------------------------------------------- 2. SPA: the steps */
+#define HF_DEG (HFVIS__PI / 180.0)
+
+/* x mod 360 in [0, 360). */
+static double hf_deg360(double x)
+{
+    double r = fmod(x, 360.0);
+    return r < 0.0 ? r + 360.0 : r;
+}
+
+/* Sum of series s of the terms (Eq. 9): sum_i A_i cos(B_i + C_i jme). */
+static double hf_spa_series_sum(int s, double jme)
+{
+    double sum = 0.0;
+    int i;
+    for (i = hf_spa_series[s]; i < hf_spa_series[s + 1]; i++)
+        sum += hf_spa_terms[i][0] * cos(hf_spa_terms[i][1] + hf_spa_terms[i][2] * jme);
+    return sum;
+}
+
+/* One of L, B, R (Eq. 10-11): (X0 + X1 jme + X2 jme^2 + ...)/1e8 over series [first, first+n). */
+static double hf_spa_poly(int first, int n, double jme)
+{
+    double sum = 0.0;
+    int i;
+    for (i = n - 1; i >= 0; i--) sum = sum * jme + hf_spa_series_sum(first + i, jme);
+    return sum / 1e8;
+}
+
+/* Days in a month of the proleptic calendar SPA uses (Julian before 1582-10-15). */
+static int hf_month_days(int year, int month)
+{
+    static const int d[12] = { 31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31 };
+    int leap;
+    if (month == 2) {
+        leap = year > 1582 ? ((year % 4 == 0 && year % 100 != 0) || year % 400 == 0) : (year % 4 == 0);
+        return 28 + leap;
+    }
+    return d[month - 1];
+}
+
+/* The Julian day of a calendar date and a day fraction (SPA Eq. 4, Meeus 1998 Eq. 7.1). */
+static double hf_julian_day(int year, int month, double day)
+{
+    double y = (double)year, m = (double)month, b = 0.0, jd;
+    if (month < 3) {
+        y -= 1.0;
+        m += 12.0;
+    }
+    jd = floor(365.25 * (y + 4716.0)) + floor(30.6001 * (m + 1.0)) + day - 1524.5;
+    if (jd > 2299160.0) {
+        double a = floor(y / 100.0);
+        b = 2.0 - a + floor(a / 4.0);
+    }
+    return jd + b;
+}
+
+/* The instant's part of SPA (everything before the observer's place): Eq. 4-31 and the
+ * equatorial horizontal parallax (Eq. 33). Angles in degrees here, as the paper's equations. */
+typedef struct hf_spa_sun {
+    double jd, jde, L, B, R, dpsi, deps, eps, lambda, nu, alpha, delta, xi;
+} hf_spa_sun;
+
+static void hf_spa_instant(double jd, double delta_t, hf_spa_sun *s)
+{
+    double jc, jce, jme, x[5], theta, beta, u, eps0, nu0, lr, er, br;
+    int i, j;
+    s->jd = jd;
+    s->jde = jd + delta_t / 86400.0;
+    jc = (jd - 2451545.0) / 36525.0;
+    jce = (s->jde - 2451545.0) / 36525.0;
+    jme = jce / 10.0;
+    s->L = hf_deg360(hf_spa_poly(0, 6, jme) / HF_DEG);
+    s->B = hf_spa_poly(6, 2, jme) / HF_DEG;
+    s->R = hf_spa_poly(8, 5, jme);
+    theta = hf_deg360(s->L + 180.0);                         /* Eq. 13-14 */
+    beta = -s->B;
+    /* Nutation (Eq. 15-23): mean elongation of the moon, anomalies, argument of latitude and
+     * the longitude of the ascending node, each a cubic in JCE. */
+    x[0] = 297.85036 + jce * (445267.111480 + jce * (-0.0019142 + jce / 189474.0));
+    x[1] = 357.52772 + jce * (35999.050340 + jce * (-0.0001603 - jce / 300000.0));
+    x[2] = 134.96298 + jce * (477198.867398 + jce * (0.0086972 + jce / 56250.0));
+    x[3] = 93.27191 + jce * (483202.017538 + jce * (-0.0036825 + jce / 327270.0));
+    x[4] = 125.04452 + jce * (-1934.136261 + jce * (0.0020708 + jce / 450000.0));
+    s->dpsi = 0.0;
+    s->deps = 0.0;
+    for (i = 0; i < 63; i++) {
+        const double *t = hf_spa_nutation[i];
+        double arg = 0.0;
+        for (j = 0; j < 5; j++) arg += x[j] * t[j];
+        arg *= HF_DEG;
+        s->dpsi += (t[5] + t[6] * jce) * sin(arg);
+        s->deps += (t[7] + t[8] * jce) * cos(arg);
+    }
+    s->dpsi /= 36000000.0;
+    s->deps /= 36000000.0;
+    u = jme / 10.0;                                          /* Eq. 24, arc seconds */
+    eps0 = 84381.448 + u * (-4680.93 + u * (-1.55 + u * (1999.25 + u * (-51.38 + u * (-249.67 +
+           u * (-39.05 + u * (7.12 + u * (27.87 + u * (5.79 + u * 2.45)))))))));
+    s->eps = eps0 / 3600.0 + s->deps;                        /* Eq. 25 */
+    s->lambda = theta + s->dpsi - 20.4898 / (3600.0 * s->R); /* Eq. 26-27 */
+    nu0 = hf_deg360(280.46061837 + 360.98564736629 * (jd - 2451545.0) +
+                    jc * jc * (0.000387933 - jc / 38710000.0));  /* Eq. 28 */
+    er = s->eps * HF_DEG;
+    s->nu = nu0 + s->dpsi * cos(er);                         /* Eq. 29 */
+    lr = s->lambda * HF_DEG;
+    br = beta * HF_DEG;
+    s->alpha = hf_deg360(atan2(sin(lr) * cos(er) - tan(br) * sin(er), cos(lr)) / HF_DEG); /* Eq. 30 */
+    s->delta = asin(sin(br) * cos(er) + cos(br) * sin(er) * sin(lr)) / HF_DEG;              /* Eq. 31 */
+    s->xi = 8.794 / (3600.0 * s->R);                         /* Eq. 33 */
+}
+
+/* The observer's part (Eq. 32-46): topocentric position, optional refraction. lat, lon in
+ * degrees, elevation in metres. */
+typedef struct hf_spa_place {
+    double H, delta_p, H_p, e0, e, zenith, azimuth;
+} hf_spa_place;
+
+static void hf_spa_at(const hf_spa_sun *s, double lat, double lon, double elev, int refraction,
+                      double pressure, double temperature, double atmos_refract,
+                      hf_spa_place *p)
+{
+    double H, phi = lat * HF_DEG, u, x, y, xi = s->xi * HF_DEG, d = s->delta * HF_DEG, hr, da,
+           dp, hp, e0, gamma;
+    H = hf_deg360(s->nu + lon - s->alpha);                  /* Eq. 32 */
+    hr = H * HF_DEG;
+    u = atan(0.99664719 * tan(phi));                         /* Eq. 34-36 */
+    x = cos(u) + elev / 6378140.0 * cos(phi);
+    y = 0.99664719 * sin(u) + elev / 6378140.0 * sin(phi);
+    da = atan2(-x * sin(xi) * sin(hr), cos(d) - x * sin(xi) * cos(hr));        /* Eq. 37 */
+    dp = atan2((sin(d) - y * sin(xi)) * cos(da), cos(d) - x * sin(xi) * cos(hr)); /* Eq. 38 */
+    hp = hr - da;                                            /* Eq. 40 */
+    e0 = asin(sin(phi) * sin(dp) + cos(phi) * cos(dp) * cos(hp)) / HF_DEG;     /* Eq. 41 */
+    p->H = H;
+    p->delta_p = dp / HF_DEG;
+    p->H_p = hp / HF_DEG;
+    p->e0 = e0;
+    p->e = e0;
+    if (refraction && e0 >= -(0.26667 + atmos_refract))    /* Eq. 42-43 */
+        p->e = e0 + pressure / 1010.0 * 283.0 / (273.0 + temperature) * 1.02 /
+                        (60.0 * tan((e0 + 10.3 / (e0 + 5.11)) * HF_DEG));
+    p->zenith = 90.0 - p->e;                                 /* Eq. 44 */
+    gamma = atan2(sin(hp), cos(hp) * sin(phi) - tan(dp) * cos(phi)) / HF_DEG;   /* Eq. 45 */
+    p->azimuth = hf_deg360(gamma + 180.0);                   /* Eq. 46 */
+}
+
+static int hf_in(double v, double lo, double hi) { return v >= lo && v <= hi; }
+
+static int hf_date_valid(int year, int month, int day)
+{
+    if (year < -2000 || year > 6000 || month < 1 || month > 12 || day < 1) return 0;
+    if (year == 1582 && month == 10 && day > 4 && day < 15) return 0; /* the calendar reform */
+    return day <= hf_month_days(year, month);
+}
+
+hfvis_status hfvis_spa(const hfvis_spa_input *in, hfvis_spa_result *out)
+{
+    hf_spa_sun s;
+    hf_spa_place p;
+    double jd;
+    if (!in || !out || !hf_date_valid(in->year, in->month, in->day) || in->hour < 0 ||
+        in->hour > 24 || in->minute < 0 || in->minute > 59 || !hf_in(in->second, 0.0, 60.0) ||
+        (in->hour == 24 && (in->minute != 0 || in->second != 0.0)) ||
+        !(fabs(in->delta_ut1) < 1.0) || !hf_in(in->delta_t, -8000.0, 8000.0) ||
+        !hf_in(in->latitude_rad, -HFVIS__HALF_PI, HFVIS__HALF_PI) ||
+        !hf_in(in->longitude_rad, -HFVIS__PI, HFVIS__PI) || !(in->elevation_m >= -6500000.0) ||
+        !isfinite(in->elevation_m) || (in->refraction != 0 && in->refraction != 1) ||
+        (in->refraction && (!(in->pressure_mbar > 0.0 && in->pressure_mbar <= 5000.0) ||
+                            !(in->temperature_c > -273.0 && in->temperature_c <= 6000.0) ||
+                            !hf_in(in->atmos_refract_rad, 0.0, 0.1))))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    jd = hf_julian_day(in->year, in->month,
+                       (double)in->day + ((double)in->hour + ((double)in->minute +
+                       (in->second + in->delta_ut1) / 60.0) / 60.0) / 24.0);
+    hf_spa_instant(jd, in->delta_t, &s);
+    hf_spa_at(&s, in->latitude_rad / HF_DEG, in->longitude_rad / HF_DEG, in->elevation_m,
+              in->refraction, in->pressure_mbar, in->temperature_c, in->atmos_refract_rad / HF_DEG,
+              &p);
+    out->jd = s.jd;
+    out->jde = s.jde;
+    out->helio_longitude = s.L * HF_DEG;
+    out->helio_latitude = s.B * HF_DEG;
+    out->radius_au = s.R;
+    out->nutation_longitude = s.dpsi * HF_DEG;
+    out->nutation_obliquity = s.deps * HF_DEG;
+    out->obliquity = s.eps * HF_DEG;
+    out->apparent_longitude = hf_deg360(s.lambda) * HF_DEG;
+    out->sidereal_time = hf_deg360(s.nu) * HF_DEG;
+    out->right_ascension = s.alpha * HF_DEG;
+    out->declination = s.delta * HF_DEG;
+    out->hour_angle = p.H * HF_DEG;
+    out->topo_declination = p.delta_p * HF_DEG;
+    out->topo_hour_angle = p.H_p * HF_DEG;
+    out->elevation = p.e * HF_DEG;
+    out->zenith = p.zenith * HF_DEG;
+    out->azimuth = p.azimuth * HF_DEG;
+    return HFVIS_OK;
+}
+
+/* ------------------------------------------------- 3. r.sun's solar geometry and ESRA sky */
+static double hf_rsun_day_angle(int day) { return 2.0 * HFVIS__PI * (double)day / 365.25; }
+
+hfvis_status hfvis_rsun_sun_position(int day, double solar_hour, double latitude_rad,
+                                     hfvis_rsun_sun *out)
+{
+    double d, dec, w, sl, cl, sd, cd, sh, east, north, c;
+    if (!out || day < 1 || day > 366 || !isfinite(solar_hour) ||
+        !hf_in(latitude_rad, -HFVIS__HALF_PI, HFVIS__HALF_PI))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    d = hf_rsun_day_angle(day);
+    dec = asin(0.3978 * sin(d - 1.4 + 0.0355 * sin(d - 0.0489)));
+    w = (solar_hour - 12.0) * (HFVIS__PI / 12.0);
+    sl = sin(latitude_rad);
+    cl = cos(latitude_rad);
+    sd = sin(dec);
+    cd = cos(dec);
+    sh = cl * cd * cos(w) + sl * sd;
+    east = -cd * sin(w);
+    north = cl * sd - sl * cd * cos(w);
+    out->declination = dec;
+    out->hour_angle = w;
+    out->elevation = asin(sh > 1.0 ? 1.0 : sh < -1.0 ? -1.0 : sh);
+    out->azimuth = atan2(east, north);
+    if (out->azimuth < 0.0) out->azimuth += 2.0 * HFVIS__PI;
+    out->extraterrestrial = 1367.0 * (1.0 + 0.03344 * cos(d - 0.048869));
+    /* cos(w0) = -tan(lat) tan(dec) at sunrise (true elevation 0), r.sun's com_par_const */
+    c = cl * cd > 1e-12 ? -(sl * sd) / (cl * cd) : (sl * sd > 0.0 ? -2.0 : 2.0);
+    if (c < -1.0) {
+        out->sunrise_hour = 0.0;
+        out->sunset_hour = 24.0;
+    } else if (c > 1.0) {
+        out->sunrise_hour = 12.0;
+        out->sunset_hour = 12.0;
+    } else {
+        double h = acos(c) * 12.0 / HFVIS__PI;
+        out->sunrise_hour = 12.0 - h;
+        out->sunset_hour = 12.0 + h;
+    }
+    return HFVIS_OK;
+}
+
+/* ESRA relative optical air mass at true elevation h (rad) and pressure ratio p: the elevation
+ * refracted by ESRA's fit, then Kasten & Young 1989 (Rigollier et al. 2000 Eq. 3-5). */
+static double hf_esra_air_mass(double h, double p)
+{
+    double dr = 0.061359 * (0.1594 + h * (1.123 + 0.065656 * h)) / (1.0 + h * (28.9344 + 277.3971 * h));
+    double hr = h + dr;
+    return p / (sin(hr) + 0.50572 * pow(hr / HF_DEG + 6.07995, -1.6364));
+}
+
+/* Rayleigh optical thickness at air mass m (Kasten 1996 as ESRA fits it, Eq. 6-7). */
+static double hf_esra_rayleigh(double m)
+{
+    if (m <= 20.0)
+        return 1.0 / (6.6296 + m * (1.7513 + m * (-0.1202 + m * (0.0065 - m * 0.00013))));
+    return 1.0 / (10.4 + 0.718 * m);
+}
+
+/* Beam normal transmittance exp(-0.8662 TL m dR(m)) (Eq. 2). */
+static double hf_esra_beam_trans(double h, double p, double linke)
+{
+    double m = hf_esra_air_mass(h, p);
+    return exp(-0.8662 * linke * m * hf_esra_rayleigh(m));
+}
+
+/* Diffuse transmission Tn(TL) times the angular function Fd(h) (Eq. 10-14): dh = G0 Tn Fd. */
+static double hf_esra_diffuse_factor(double sinh, double linke)
+{
+    double tn = -0.015843 + linke * (0.030543 + 0.0003797 * linke);
+    double a1 = 0.26463 + linke * (-0.061581 + 0.0031408 * linke);
+    double a2 = 2.04020 + linke * (0.018945 - 0.011161 * linke);
+    double a3 = -1.3025 + linke * (0.039231 + 0.0085079 * linke);
+    if (a1 * tn < 0.0022) a1 = 0.0022 / tn;
+    return tn * (a1 + a2 * sinh + a3 * sinh * sinh);
+}
+
+/* Pressure ratio of a height (ESRA's scale height 8434.5 m). */
+static double hf_esra_pressure(double height_m) { return exp(-height_m / 8434.5); }
+
+hfvis_status hfvis_esra_clear_sky(double g0, double elevation_rad, double height_m, double linke,
+                                  double out[3])
+{
+    double sh;
+    if (!out || !(g0 >= 0.0) || !isfinite(g0) || !hf_in(elevation_rad, -HFVIS__HALF_PI, HFVIS__HALF_PI) ||
+        !isfinite(height_m) || !(linke > 0.0 && linke <= 10.0))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!(elevation_rad > 0.0)) {
+        out[0] = out[1] = out[2] = 0.0;
+        return HFVIS_OK;
+    }
+    sh = sin(elevation_rad);
+    out[0] = g0 * hf_esra_beam_trans(elevation_rad, hf_esra_pressure(height_m), linke);
+    out[1] = out[0] * sh;
+    out[2] = g0 * hf_esra_diffuse_factor(sh, linke);
+    return HFVIS_OK;
+}
+
+/* ------------------------------------------------------------- 4. inputs, options, steps */
+#define HF_SOLAR_STEP_DEFAULT 0.25    /* hours: 15 minutes */
+#define HF_SOLAR_K_DEFAULT 64         /* directions of the horizon map */
+#define HF_SOLAR_KR_DEFAULT 16        /* directions of the TERRAIN gather */
+#define HF_SOLAR_DELTA_T_DEFAULT 69.0 /* s, TT - UT1 around 2020-2030 */
+#define HF_SOLAR_DAYS_MAX 36600       /* a century of days */
+#define HF_SOLAR_K_MAX 4096
+#define HF_SOLAR_BISECTIONS 40        /* sunrise to 24 h / 2^40: far below a second */
+#define HF_SOLAR_SLOPE_FLAT 1e-9      /* rad: below this a receiver is horizontal (r.sun's
+                                         slope != 0 test, robust to float normals) */
+#define HF_SOLAR_REFRACT_P 1013.25    /* mbar and deg C of the refraction option: the */
+#define HF_SOLAR_REFRACT_T 10.0       /* standard atmosphere SPA's example assumes */
+#define HF_SOLAR_REFRACT_SUNRISE 0.5667 /* deg */
+
+hfvis_solar_input hfvis_solar_input_default(void)
+{
+    hfvis_solar_input in;
+    memset(&in, 0, sizeof in);
+    in.year = 2026;
+    in.month = 6;
+    in.day = 21;
+    in.days = 1;
+    in.linke = 3.0;
+    in.albedo = 0.2;
+    return in;
+}
+
+hfvis_solar_options hfvis_solar_options_default(void)
+{
+    hfvis_solar_options o;
+    memset(&o, 0, sizeof o);
+    o.model = HFVIS_SUN_SPA;
+    o.step_hours = HF_SOLAR_STEP_DEFAULT;
+    o.directions = HF_SOLAR_K_DEFAULT;
+    o.delta_t = HF_SOLAR_DELTA_T_DEFAULT;
+    o.reflected_directions = HF_SOLAR_KR_DEFAULT;
+    return o;
+}
+
+/* The date n days after (y, m, d). */
+static void hf_date_add(int *y, int *m, int *d, int n)
+{
+    while (n-- > 0) {
+        if (++*d > hf_month_days(*y, *m)) {
+            *d = 1;
+            if (++*m > 12) {
+                *m = 1;
+                ++*y;
+            }
+        }
+    }
+}
+
+static int hf_day_of_year(int y, int m, int d)
+{
+    int k, n = d;
+    for (k = 1; k < m; k++) n += hf_month_days(y, k);
+    return n;
+}
+
+static int hf_solar_input_valid(const hfvis_solar_input *in)
+{
+    return in && hf_in(in->latitude_rad, -HFVIS__HALF_PI, HFVIS__HALF_PI) &&
+           hf_in(in->longitude_rad, -HFVIS__PI, HFVIS__PI) && isfinite(in->height_m) &&
+           in->height_m >= -6500000.0 && hf_date_valid(in->year, in->month, in->day) &&
+           (in->instant == 0 || in->instant == 1) &&
+           (in->instant ? hf_in(in->hour, 0.0, 24.0) : (in->days >= 1 && in->days <= HF_SOLAR_DAYS_MAX)) &&
+           hf_in(in->utc_offset_hours, -14.0, 14.0) && in->linke > 0.0 && in->linke <= 10.0 &&
+           hf_in(in->albedo, 0.0, 1.0);
+}
+
+static int hf_solar_opts_valid(const hfvis_solar_options *o)
+{
+    int k;
+    const hfvis_sweep_options *s;
+    if (!o) return 1;
+    s = o->sweep;
+    if (o->model < HFVIS_SUN_MODEL_DEFAULT || o->model > HFVIS_SUN_RSUN || !(o->step_hours >= 0.0) ||
+        o->step_hours > 24.0 || o->directions < 0 || o->directions > HF_SOLAR_K_MAX ||
+        (o->no_shading != 0 && o->no_shading != 1) || !hf_in(o->sun_radius_rad, 0.0, 0.1) ||
+        (o->refraction != 0 && o->refraction != 1) || !hf_in(o->delta_t, -8000.0, 8000.0) ||
+        o->diffuse < HFVIS_SOLAR_DIFFUSE_DEFAULT || o->diffuse > HFVIS_SOLAR_DIFFUSE_HORIZON ||
+        o->reflected < HFVIS_SOLAR_REFLECTED_DEFAULT || o->reflected > HFVIS_SOLAR_REFLECTED_TERRAIN ||
+        o->reflected_directions < 0 || o->reflected_directions > HF_SOLAR_K_MAX ||
+        o->bands < HFVIS_SOLAR_BANDS_DEFAULT || o->bands > HFVIS_SOLAR_BANDS_MONTH)
+        return 0;
+    if (s && (!hf_opts_valid(s) || s->extent_width != 0 || s->receiver_width != 0)) return 0;
+    if (o->linke_monthly)
+        for (k = 0; k < 12; k++)
+            if (!(o->linke_monthly[k] > 0.0f && o->linke_monthly[k] <= 10.0f)) return 0;
+    return 1;
+}
+
+int hfvis_solar_band_count(const hfvis_solar_input *input, const hfvis_solar_options *opts)
+{
+    int y, m, d, n;
+    if (!hf_solar_input_valid(input) || !hf_solar_opts_valid(opts)) return -1;
+    if (input->instant || !opts || opts->bands == HFVIS_SOLAR_BANDS_TOTAL) return 1;
+    if (opts->bands == HFVIS_SOLAR_BANDS_DAY) return input->days;
+    y = input->year;
+    m = input->month;
+    d = input->day;
+    hf_date_add(&y, &m, &d, input->days - 1);
+    n = (y - input->year) * 12 + (m - input->month) + 1;
+    return n;
+}
+
+/* One time step: the sun (true elevation h for the atmosphere, the direction for shading and
+ * incidence), the extraterrestrial irradiance, the step's weight in hours (1 for an instant) and
+ * its band and month. */
+typedef struct hf_solar_step {
+    double h, sinh, g0, sx, sy, sz, psi, elev, weight;
+    double linke;       /* the month's Linke factor (or input->linke) */
+    double m0;          /* ESRA air mass at sea level (pressure ratio 1) */
+    double fd;          /* ESRA diffuse factor Tn*Fd for this step's Linke factor */
+    int band, month;
+} hf_solar_step;
+
+typedef struct hf_solar_ctx {
+    hfvis_solar_input in;
+    hfvis_solar_options o;
+    int bands;
+} hf_solar_ctx;
+
+/* Sun of the SPA model at local civil hour t of day (y, m, d): true and shading elevation. */
+static void hf_solar_spa_sun(const hf_solar_ctx *c, int y, int m, int d, double t,
+                             double *h_true, double *elev, double *azimuth, double *g0)
+{
+    hf_spa_sun s;
+    hf_spa_place p;
+    double jd = hf_julian_day(y, m, (double)d + (t - c->in.utc_offset_hours) / 24.0);
+    hf_spa_instant(jd, c->o.delta_t, &s);
+    hf_spa_at(&s, c->in.latitude_rad / HF_DEG, c->in.longitude_rad / HF_DEG, c->in.height_m,
+              c->o.refraction, HF_SOLAR_REFRACT_P, HF_SOLAR_REFRACT_T, HF_SOLAR_REFRACT_SUNRISE, &p);
+    *h_true = p.e0 * HF_DEG;
+    *elev = p.e * HF_DEG;
+    *azimuth = p.azimuth * HF_DEG;
+    *g0 = 1367.0 / (s.R * s.R);
+}
+
+static double hf_solar_spa_h(const hf_solar_ctx *c, int y, int m, int d, double t)
+{
+    double h, e, a, g;
+    hf_solar_spa_sun(c, y, m, d, t, &h, &e, &a, &g);
+    return h;
+}
+
+/* Fill a step from the sun's true elevation h, shading elevation elev and compass azimuth. */
+static void hf_solar_step_set(const hf_solar_ctx *c, hf_solar_step *st, double h, double elev,
+                              double azimuth, double g0, double weight, int band, int month)
+{
+    double ce = cos(elev);
+    st->h = h;
+    st->sinh = sin(h);
+    st->elev = elev;
+    st->g0 = g0;
+    st->sx = ce * sin(azimuth);   /* east = +x */
+    st->sy = -ce * cos(azimuth);  /* south = +y */
+    st->sz = sin(elev);
+    st->psi = azimuth - HFVIS__HALF_PI;
+    if (st->psi < 0.0) st->psi += 2.0 * HFVIS__PI;
+    st->weight = weight;
+    st->band = band;
+    st->month = month;
+    st->linke = c->o.linke_monthly ? (double)c->o.linke_monthly[month - 1] : c->in.linke;
+    st->m0 = hf_esra_air_mass(h, 1.0);
+    st->fd = hf_esra_diffuse_factor(st->sinh, st->linke);
+}
+
+/* The steps of the period, sun above the horizon only, in time order. steps NULL: count only. */
+static size_t hf_solar_steps(const hf_solar_ctx *c, hf_solar_step *steps)
+{
+    size_t n = 0;
+    int y = c->in.year, m = c->in.month, d = c->in.day, day, days = c->in.instant ? 1 : c->in.days;
+    int band_month0 = c->in.year * 12 + c->in.month;
+    double step = c->o.step_hours;
+    for (day = 0; day < days; day++, hf_date_add(&y, &m, &d, 1)) {
+        int band = c->o.bands == HFVIS_SOLAR_BANDS_DAY ? day
+                 : c->o.bands == HFVIS_SOLAR_BANDS_MONTH ? y * 12 + m - band_month0 : 0;
+        if (c->o.model == HFVIS_SUN_RSUN) {
+            int doy = hf_day_of_year(y, m, d);
+            hfvis_rsun_sun r;
+            double ang, last, dang = step * (HFVIS__PI / 12.0), first;
+            int k;
+            if (c->in.instant) {
+                hfvis_rsun_sun_position(doy, c->in.hour, c->in.latitude_rad, &r);
+                if (r.elevation > 0.0) {
+                    if (steps) hf_solar_step_set(c, steps + n, r.elevation, r.elevation, r.azimuth,
+                                                 r.extraterrestrial, 1.0, band, m);
+                    n++;
+                }
+                continue;
+            }
+            hfvis_rsun_sun_position(doy, 12.0, c->in.latitude_rad, &r);
+            /* r.sun's schedule (joules2): the first step half a step after the start of the
+             * step that holds sunrise, or one and a half when sunrise lies in its second half;
+             * then every step while the hour angle has not passed sunset's */
+            k = (int)(r.sunrise_hour / step);
+            first = (r.sunrise_hour - (double)k * step > 0.5 * step) ? ((double)k + 1.5) * step
+                                                                      : ((double)k + 0.5) * step;
+            ang = (first - 12.0) * (HFVIS__PI / 12.0);
+            last = (r.sunset_hour - 12.0) * (HFVIS__PI / 12.0);
+            for (;;) {
+                hfvis_rsun_sun q;
+                hfvis_rsun_sun_position(doy, 12.0 + ang * (12.0 / HFVIS__PI), c->in.latitude_rad, &q);
+                if (q.elevation > 0.0) {
+                    if (steps) hf_solar_step_set(c, steps + n, q.elevation, q.elevation, q.azimuth,
+                                                 q.extraterrestrial, step, band, m);
+                    n++;
+                }
+                ang += dang;
+                if (ang > last) break;
+            }
+        } else if (c->in.instant) {
+            double h, e, a, g;
+            hf_solar_spa_sun(c, y, m, d, c->in.hour, &h, &e, &a, &g);
+            if (h > 0.0) {
+                if (steps) hf_solar_step_set(c, steps + n, h, e, a, g, 1.0, band, m);
+                n++;
+            }
+        } else {
+            double t0 = 0.0, h0 = hf_solar_spa_h(c, y, m, d, 0.0);
+            while (t0 < 24.0) {
+                double t1 = t0 + step > 24.0 ? 24.0 : t0 + step, h1 = hf_solar_spa_h(c, y, m, d, t1);
+                double a = t0, b = t1;
+                int lit = 1;
+                if (!(h0 > 0.0) && !(h1 > 0.0)) {
+                    lit = 0;
+                } else if (!(h0 > 0.0) || !(h1 > 0.0)) {
+                    /* sunrise or sunset inside the step: bisect the true elevation's zero */
+                    double lo = t0, hi = t1;
+                    int it;
+                    for (it = 0; it < HF_SOLAR_BISECTIONS; it++) {
+                        double mid = 0.5 * (lo + hi), hm = hf_solar_spa_h(c, y, m, d, mid);
+                        if ((hm > 0.0) == (h1 > 0.0)) hi = mid;
+                        else lo = mid;
+                    }
+                    if (h1 > 0.0) a = hi;
+                    else b = lo;
+                }
+                if (lit && b > a) {
+                    double h, e, az, g;
+                    hf_solar_spa_sun(c, y, m, d, 0.5 * (a + b), &h, &e, &az, &g);
+                    if (h > 0.0) {
+                        if (steps) hf_solar_step_set(c, steps + n, h, e, az, g, b - a, band, m);
+                        n++;
+                    }
+                }
+                t0 = t1;
+                h0 = h1;
+            }
+        }
+    }
+    return n;
+}
+
+/* ------------------------------------------------------------- 5. the atmosphere per point */
+/* Per-sample constants: pressure ratio of its height, normal, slope terms of Muneer's model,
+ * Linke factor (map), albedo, real-sky coefficients and the visible-sky ratio of HORIZON. */
+typedef struct hf_solar_point {
+    double p, nx, ny, nz, sin_slope, r_sky, fg, albedo, cbh, cdh, sky_ratio, linke;
+    int tilted, linke_map;
+} hf_solar_point;
+
+static void hf_solar_point_init(const hf_solar_ctx *c, const hfvis_grid *g, int x, int y,
+                                hf_solar_point *pt)
+{
+    size_t i = (size_t)y * (size_t)g->width + (size_t)x;
+    double n[3], slope;
+    hf_normal_at(g, x, y, n);
+    pt->p = hf_esra_pressure((double)g->z[(ptrdiff_t)y * g->stride + x]);
+    pt->nx = n[0];
+    pt->ny = n[1];
+    pt->nz = n[2];
+    slope = acos(n[2] > 1.0 ? 1.0 : n[2]);
+    pt->tilted = slope > HF_SOLAR_SLOPE_FLAT;
+    pt->sin_slope = sin(slope);
+    pt->r_sky = 0.5 * (1.0 + cos(slope));
+    /* Muneer's sky-brightness function of the slope (r.sun's fg) */
+    pt->fg = sin(slope) - slope * cos(slope) - HFVIS__PI * sin(0.5 * slope) * sin(0.5 * slope);
+    pt->albedo = c->o.albedo_map ? (double)c->o.albedo_map[i] : c->in.albedo;
+    pt->cbh = c->o.coeff_bh ? (double)c->o.coeff_bh[i] : 1.0;
+    pt->cdh = c->o.coeff_dh ? (double)c->o.coeff_dh[i] : 1.0;
+    pt->linke_map = c->o.linke_map != NULL;
+    pt->linke = c->o.linke_map ? (double)c->o.linke_map[i] : 0.0;
+    pt->sky_ratio = 1.0;
+}
+
+/* Visible fraction of the sun at elevation elev over horizon elevation hor: the centre's test,
+ * or the disc's segment above the horizon line (hfvis_sun_visibility's formula). */
+static double hf_solar_visible(double elev, double hor, double radius)
+{
+    double d;
+    if (isnan(hor)) return HFVIS__NAN;
+    if (radius <= 0.0) return elev > hor ? 1.0 : 0.0;
+    d = (elev - hor) / radius;
+    if (d >= 1.0) return 1.0;
+    if (d <= -1.0) return 0.0;
+    return 1.0 - (acos(d) - d * sqrt(1.0 - d * d)) / HFVIS__PI;
+}
+
+/* One step at one point (r.sun's brad and drad, Suri & Hofierka 2004 Eq. 1-21 with ESRA):
+ * adds weight * (beam, diffuse, reflected on the flat-ground model, sunshine) to acc.
+ * vis: the visible fraction of the sun (1 without shading). horizon: HORIZON diffuse. */
+static void hf_solar_point_step(const hf_solar_step *st, const hf_solar_point *pt, double vis,
+                                int horizon, double acc[4])
+{
+    double linke = pt->linke_map ? pt->linke : st->linke, m, bh, sh, beam = 0.0, dh, fx, diff, gh;
+    double bg, cs, kb, w = st->weight;
+    int lit;
+    sh = pt->nx * st->sx + pt->ny * st->sy + pt->nz * st->sz; /* cos of the incidence angle */
+    m = pt->p * st->m0;
+    lit = vis > 0.0 && sh > 0.0;
+    if (lit) {
+        bh = pt->cbh * st->g0 * st->sinh * exp(-0.8662 * linke * m * hf_esra_rayleigh(m));
+        beam = (pt->tilted ? bh * sh / st->sinh : bh) * vis;
+        acc[3] += w * vis;
+    } else {
+        bh = 0.0; /* r.sun: no beam in shadow, and so no beam part in kb or the reflection */
+    }
+    dh = pt->cdh * st->g0 * (pt->linke_map ? hf_esra_diffuse_factor(st->sinh, linke) : st->fd);
+    gh = bh * (vis > 0.0 ? vis : 0.0) + dh;
+    if (pt->tilted || horizon) {
+        kb = bh / (st->g0 * st->sinh);
+        if (!lit) { /* shadow, or the sun behind the receiver's plane */
+            bg = pt->r_sky + pt->fg * 0.252271;
+            cs = 0.0;
+        } else {
+            bg = ((0.00263 - kb * (0.712 + 0.6883 * kb)) * pt->fg + pt->r_sky) * (1.0 - kb);
+            if (st->h >= 0.1 || !pt->tilted)
+                cs = kb * sh / st->sinh;
+            else /* low sun: Muneer's form with the horizontal direction (r.sun) */
+                cs = kb * (pt->nx * st->sx + pt->ny * st->sy) / cos(st->elev) /
+                     (0.1 - 0.008 * st->h);
+            cs *= vis;
+        }
+        fx = bg * pt->sky_ratio + cs;
+        diff = dh * fx;
+    } else {
+        diff = dh;
+    }
+    acc[0] += w * beam;
+    acc[1] += w * diff;
+    acc[2] += w * (pt->tilted ? pt->albedo * gh * (1.0 - pt->nz) * 0.5 : 0.0);
+}
+
+/* ------------------------------------------------------------ 6. driver, fast and oracle */
+/* Validate, resolve the options, count the steps and bands. */
+static hfvis_status hf_solar_setup(const hfvis_grid *g, const hfvis_solar_input *in,
+                                   const hfvis_solar_options *opts, const hfvis_solar_output *out,
+                                   hf_solar_ctx *c)
+{
+    size_t i, n;
+    if (!hf_grid_valid(g) || !out || !hf_solar_input_valid(in) || !hf_solar_opts_valid(opts) ||
+        (!out->beam && !out->diffuse && !out->reflected && !out->global && !out->sun_hours))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    c->in = *in;
+    c->o = hfvis_solar_options_default();
+    if (opts) {
+        c->o = *opts;
+        if (c->o.model == HFVIS_SUN_MODEL_DEFAULT) c->o.model = HFVIS_SUN_SPA;
+        if (c->o.step_hours == 0.0) c->o.step_hours = HF_SOLAR_STEP_DEFAULT;
+        if (c->o.directions == 0) c->o.directions = HF_SOLAR_K_DEFAULT;
+        if (c->o.delta_t == 0.0) c->o.delta_t = HF_SOLAR_DELTA_T_DEFAULT;
+        if (c->o.reflected_directions == 0) c->o.reflected_directions = HF_SOLAR_KR_DEFAULT;
+    }
+    c->bands = hfvis_solar_band_count(in, opts);
+    n = hf_grid_count(g);
+    if (n > SIZE_MAX / sizeof(double) / 8 || (size_t)c->bands > SIZE_MAX / sizeof(float) / 8 / n)
+        return HFVIS_ERR_LIMIT;
+    for (i = 0; i < n; i++) { /* the per-sample maps: NaN only at holes */
+        size_t zi = (i / (size_t)g->width) * (size_t)g->stride + i % (size_t)g->width;
+        if (!isfinite(g->z[zi])) continue;
+        if ((c->o.linke_map && !(c->o.linke_map[i] > 0.0f && c->o.linke_map[i] <= 10.0f)) ||
+            (c->o.albedo_map && !(c->o.albedo_map[i] >= 0.0f && c->o.albedo_map[i] <= 1.0f)) ||
+            (c->o.coeff_bh && !(c->o.coeff_bh[i] >= 0.0f && c->o.coeff_bh[i] <= 1e6f)) ||
+            (c->o.coeff_dh && !(c->o.coeff_dh[i] >= 0.0f && c->o.coeff_dh[i] <= 1e6f)))
+            return HFVIS_ERR_INVALID_ARGUMENT;
+    }
+    return HFVIS_OK;
+}
+
+/* The sweep options of the horizon map (exact rays) and of the TERRAIN gather (lattice). */
+static hfvis_sweep_options hf_solar_sweep(const hf_solar_ctx *c, hfvis_ray_mode rays)
+{
+    hfvis_sweep_options s = c->o.sweep ? *c->o.sweep : hfvis_sweep_options_default();
+    s.rays = rays;
+    s.ray_denominator = 0;
+    s.azimuth0_rad = 0.0;
+    s.direction_begin = s.direction_end = 0;
+    s.direction_order = HFVIS_DIRECTION_ORDER_DEFAULT;
+    return s;
+}
+
+/* Write the accumulated sums acc[(band*n + i)*4 + q] (beam, diffuse, reflected, sunshine) to the
+ * outputs; terrain: the TERRAIN reflected term per band (replaces q = 2). */
+static void hf_solar_store(const hfvis_grid *g, const hf_solar_ctx *c, const double *acc,
+                           const float *terrain, const hfvis_solar_output *out)
+{
+    size_t n = hf_grid_count(g), i;
+    int b;
+    for (b = 0; b < c->bands; b++)
+        for (i = 0; i < n; i++) {
+            size_t j = (size_t)b * n + i;
+            const double *a = acc + j * 4;
+            int hole = !isfinite(g->z[(i / (size_t)g->width) * (size_t)g->stride + i % (size_t)g->width]);
+            double r = terrain ? (double)terrain[j] : a[2];
+            if (out->beam) out->beam[j] = hole ? (float)HFVIS__NAN : (float)a[0];
+            if (out->diffuse) out->diffuse[j] = hole ? (float)HFVIS__NAN : (float)a[1];
+            if (out->reflected) out->reflected[j] = hole ? (float)HFVIS__NAN : (float)r;
+            if (out->global) out->global[j] = hole ? (float)HFVIS__NAN : (float)(a[0] + a[1] + r);
+            if (out->sun_hours) out->sun_hours[j] = hole ? (float)HFVIS__NAN : (float)a[3];
+        }
+}
+
+/* TERRAIN: per band, the [P2] gather of exit irradiance albedo * (beam + diffuse). */
+static hfvis_status hf_solar_terrain(const hfvis_grid *g, const hf_solar_ctx *c, const double *acc,
+                                     int naive, float **terrain_out)
+{
+    size_t n = hf_grid_count(g), i;
+    float *exit_r, *terr;
+    hfvis_sweep_options s = hf_solar_sweep(c, HFVIS_RAYS_LATTICE);
+    const hfvis_allocator *al = s.alloc;
+    hfvis_status st = HFVIS_OK;
+    int b;
+    exit_r = (float *)hfvis__alloc_array(al, n, sizeof(float));
+    terr = (float *)hfvis__alloc_array(al, n * (size_t)c->bands, sizeof(float));
+    if (!exit_r || !terr) {
+        hfvis__free(al, exit_r);
+        hfvis__free(al, terr);
+        return HFVIS_ERR_OUT_OF_MEMORY;
+    }
+    for (b = 0; b < c->bands && st == HFVIS_OK; b++) {
+        for (i = 0; i < n; i++) {
+            const double *a = acc + ((size_t)b * n + i) * 4;
+            double alb = c->o.albedo_map ? (double)c->o.albedo_map[i] : c->in.albedo;
+            exit_r[i] = (float)(alb * (a[0] + a[1]));
+            if (!isfinite(exit_r[i])) exit_r[i] = 0.0f; /* holes reflect nothing */
+        }
+        st = naive ? hfvis_indirect_light_naive(g, c->o.reflected_directions, exit_r, 1, 0.0f, 1.0f,
+                                                &s, terr + (size_t)b * n, g->width)
+                   : hfvis_indirect_light(g, c->o.reflected_directions, exit_r, 1, 0.0f, 1.0f, &s,
+                                          NULL, terr + (size_t)b * n, g->width);
+    }
+    hfvis__free(al, exit_r);
+    if (st != HFVIS_OK) {
+        hfvis__free(al, terr);
+        return st;
+    }
+    *terrain_out = terr;
+    return HFVIS_OK;
+}
+
+/* Locate azimuth psi among the map's actual azimuths az[0..K) (increasing, spanning one turn):
+ * the two neighbours k0, k1 and the weight of k1. */
+static void hf_solar_bracket(const double *az, int K, double psi, int *k0, int *k1, double *w)
+{
+    double turn = 2.0 * HFVIS__PI, a0 = az[0], span, lo, hi;
+    int k;
+    psi = fmod(psi - a0, turn);
+    if (psi < 0.0) psi += turn;
+    psi += a0;
+    for (k = 0; k + 1 < K && az[k + 1] <= psi; k++) {}
+    lo = az[k];
+    hi = k + 1 < K ? az[k + 1] : a0 + turn;
+    span = hi - lo;
+    *k0 = k;
+    *k1 = k + 1 < K ? k + 1 : 0;
+    *w = span > 0.0 ? (psi - lo) / span : 0.0;
+}
+
+/* Shared by the fast routine and the oracle: setup, steps, per-sample state. */
+typedef struct hf_solar_run {
+    hf_solar_ctx c;
+    hf_solar_step *steps;
+    size_t nsteps;
+    hf_solar_point *pts;
+    double *acc;
+    const hfvis_allocator *al;
+} hf_solar_run;
+
+static void hf_solar_run_free(hf_solar_run *r)
+{
+    hfvis__free(r->al, r->steps);
+    hfvis__free(r->al, r->pts);
+    hfvis__free(r->al, r->acc);
+}
+
+static hfvis_status hf_solar_run_init(const hfvis_grid *g, const hfvis_solar_input *in,
+                                      const hfvis_solar_options *opts,
+                                      const hfvis_solar_output *out, hf_solar_run *r)
+{
+    hfvis_status st;
+    size_t n, i;
+    memset(r, 0, sizeof *r);
+    if ((st = hf_solar_setup(g, in, opts, out, &r->c)) != HFVIS_OK) return st;
+    r->al = r->c.o.sweep ? r->c.o.sweep->alloc : NULL;
+    n = hf_grid_count(g);
+    r->nsteps = hf_solar_steps(&r->c, NULL);
+    r->steps = (hf_solar_step *)hfvis__alloc_array(r->al, r->nsteps + 1, sizeof(hf_solar_step));
+    r->pts = (hf_solar_point *)hfvis__alloc_array(r->al, n, sizeof(hf_solar_point));
+    r->acc = (double *)hfvis__alloc_array(r->al, n * (size_t)r->c.bands, 4 * sizeof(double));
+    if (!r->steps || !r->pts || !r->acc) {
+        hf_solar_run_free(r);
+        return HFVIS_ERR_OUT_OF_MEMORY;
+    }
+    hf_solar_steps(&r->c, r->steps);
+    for (i = 0; i < n * (size_t)r->c.bands * 4; i++) r->acc[i] = 0.0;
+    for (i = 0; i < n; i++)
+        hf_solar_point_init(&r->c, g, (int)(i % (size_t)g->width), (int)(i / (size_t)g->width), r->pts + i);
+    return HFVIS_OK;
+}
+
+static hfvis_status hf_solar_finish(const hfvis_grid *g, hf_solar_run *r, int naive,
+                                    const hfvis_solar_output *out)
+{
+    float *terr = NULL;
+    hfvis_status st = HFVIS_OK;
+    if (r->c.o.reflected == HFVIS_SOLAR_REFLECTED_TERRAIN &&
+        (st = hf_solar_terrain(g, &r->c, r->acc, naive, &terr)) != HFVIS_OK) {
+        hf_solar_run_free(r);
+        return st;
+    }
+    hf_solar_store(g, &r->c, r->acc, terr, out);
+    hfvis__free(r->al, terr);
+    hf_solar_run_free(r);
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_input *in,
+                                     const hfvis_solar_options *opts, const hfvis_solar_output *out)
+{
+    hf_solar_run r;
+    hfvis_status st;
+    hfvis_sweep_options s;
+    float *map = NULL, *cellmap = NULL, *sky = NULL;
+    double *az = NULL;
+    int K, *kk = NULL;
+    double *kw = NULL;
+    size_t n, i, q;
+    if ((st = hf_solar_run_init(g, in, opts, out, &r)) != HFVIS_OK) return st;
+    n = hf_grid_count(g);
+    K = r.c.o.directions;
+    s = hf_solar_sweep(&r.c, HFVIS_RAYS_EXACT);
+    if (!r.c.o.no_shading || r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON) {
+        if (n > SIZE_MAX / sizeof(float) / (size_t)K) {
+            hf_solar_run_free(&r);
+            return HFVIS_ERR_LIMIT;
+        }
+        az = (double *)hfvis__alloc_array(r.al, (size_t)K, sizeof(double));
+        kk = (int *)hfvis__alloc_array(r.al, r.nsteps + 1, 2 * sizeof(int));
+        kw = (double *)hfvis__alloc_array(r.al, r.nsteps + 1, sizeof(double));
+        map = (float *)hfvis__alloc_array(r.al, n * (size_t)K, sizeof(float));
+        if (!az || !kk || !kw || !map) st = HFVIS_ERR_OUT_OF_MEMORY;
+        if (st == HFVIS_OK) st = hfvis_sweep_azimuths(K, &s, az, NULL);
+        if (st == HFVIS_OK) st = hfvis_horizon_map(g, K, &s, map);
+        if (st == HFVIS_OK && r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON) {
+            sky = (float *)hfvis__alloc_array(r.al, n, sizeof(float));
+            if (!sky) st = HFVIS_ERR_OUT_OF_MEMORY;
+            else st = hfvis_sky_light(g, K, 1.0f, 1.0f, &s, sky, g->width);
+        }
+        if (st == HFVIS_OK) { /* sample-major: each sample's K horizons side by side */
+            cellmap = (float *)hfvis__alloc_array(r.al, n * (size_t)K, sizeof(float));
+            if (!cellmap) st = HFVIS_ERR_OUT_OF_MEMORY;
+        }
+        if (st == HFVIS_OK) {
+            int k;
+            for (k = 0; k < K; k++)
+                for (i = 0; i < n; i++) cellmap[i * (size_t)K + (size_t)k] = map[(size_t)k * n + i];
+            for (q = 0; q < r.nsteps; q++)
+                hf_solar_bracket(az, K, r.steps[q].psi, kk + 2 * q, kk + 2 * q + 1, kw + q);
+        }
+        hfvis__free(r.al, map);
+        map = NULL;
+    }
+    if (st == HFVIS_OK) {
+        int horizon = r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON;
+        for (i = 0; i < n; i++) {
+            hf_solar_point *pt = r.pts + i;
+            const float *hz = cellmap ? cellmap + i * (size_t)K : NULL;
+            double acc[4] = { 0.0, 0.0, 0.0, 0.0 };
+            int band = r.nsteps ? r.steps[0].band : 0;
+            if (!isfinite(pt->p) || isnan(pt->nz)) continue;
+            if (sky) pt->sky_ratio = (double)sky[i] / pt->r_sky;
+            for (q = 0; q < r.nsteps; q++) {
+                const hf_solar_step *stp = r.steps + q;
+                double vis = 1.0;
+                if (stp->band != band) {
+                    double *a = r.acc + ((size_t)band * n + i) * 4;
+                    a[0] = acc[0]; a[1] = acc[1]; a[2] = acc[2]; a[3] = acc[3];
+                    acc[0] = acc[1] = acc[2] = acc[3] = 0.0;
+                    band = stp->band;
+                }
+                if (!r.c.o.no_shading) {
+                    double hor = (1.0 - kw[q]) * (double)hz[kk[2 * q]] + kw[q] * (double)hz[kk[2 * q + 1]];
+                    vis = hf_solar_visible(stp->elev, hor, r.c.o.sun_radius_rad);
+                }
+                hf_solar_point_step(stp, pt, vis, horizon, acc);
+            }
+            {
+                double *a = r.acc + ((size_t)band * n + i) * 4;
+                a[0] = acc[0]; a[1] = acc[1]; a[2] = acc[2]; a[3] = acc[3];
+            }
+        }
+    }
+    hfvis__free(r.al, az);
+    hfvis__free(r.al, kk);
+    hfvis__free(r.al, kw);
+    hfvis__free(r.al, cellmap);
+    hfvis__free(r.al, sky);
+    if (st != HFVIS_OK) {
+        hf_solar_run_free(&r);
+        return st;
+    }
+    return hf_solar_finish(g, &r, 0, out);
+}
+
+#define HF_SOLAR_REF_DENOM 1024 /* the oracle's ray toward the sun: within 0.002 deg of it */
+#define HF_SOLAR_REF_DIRS 4      /* the oracle integrates the visible sky over 4K directions */
+
+hfvis_status hfvis_solar_irradiation_reference(const hfvis_grid *g, const hfvis_solar_input *in,
+                                               const hfvis_solar_options *opts,
+                                               const hfvis_solar_output *out)
+{
+    hf_solar_run r;
+    hfvis_status st;
+    hfvis_sweep_options s;
+    float *hor = NULL;
+    double *az = NULL;
+    size_t n, i, q;
+    int KR;
+    if ((st = hf_solar_run_init(g, in, opts, out, &r)) != HFVIS_OK) return st;
+    n = hf_grid_count(g);
+    s = hf_solar_sweep(&r.c, HFVIS_RAYS_EXACT);
+    KR = HF_SOLAR_REF_DIRS * r.c.o.directions;
+    hor = (float *)hfvis__alloc_array(r.al, n * (size_t)HF_SOLAR_REF_DIRS, (size_t)r.c.o.directions * sizeof(float));
+    az = (double *)hfvis__alloc_array(r.al, (size_t)KR, sizeof(double));
+    if (!hor || !az) st = HFVIS_ERR_OUT_OF_MEMORY;
+    if (st == HFVIS_OK && r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON) {
+        /* the visible sky: [P1] Eq. 5 per sector over the exact horizons of 4K directions, each
+         * receiver's own rays (hfvis_horizon_exact_naive) along their actual azimuths */
+        int k;
+        st = hfvis_sweep_azimuths(KR, &s, az, NULL);
+        if (st == HFVIS_OK) st = hfvis_horizon_exact_naive(g, KR, &s, hor);
+        for (i = 0; i < n && st == HFVIS_OK; i++) {
+            hf_solar_point *pt = r.pts + i;
+            double v = 0.0;
+            for (k = 0; k < KR; k++) {
+                double a = pt->nx * cos(az[k]) + pt->ny * sin(az[k]);
+                double t = tan((double)hor[(size_t)k * n + i]), tc = -a / pt->nz;
+                if (isnan(t) || t < tc) t = tc;
+                v += hfvis_sector_weight(KR, pt->nz, a, HFVIS__HALF_PI - atan(t));
+            }
+            pt->sky_ratio = v / pt->r_sky;
+        }
+    }
+    s.ray_denominator = HF_SOLAR_REF_DENOM;
+    for (q = 0; q < r.nsteps && st == HFVIS_OK; q++) {
+        const hf_solar_step *stp = r.steps + q;
+        if (!r.c.o.no_shading) { /* each receiver's own exact ray toward the sun */
+            s.azimuth0_rad = stp->psi;
+            st = hfvis_horizon_exact_naive(g, 1, &s, hor);
+        }
+        for (i = 0; i < n && st == HFVIS_OK; i++) {
+            hf_solar_point *pt = r.pts + i;
+            double vis = r.c.o.no_shading ? 1.0 : hf_solar_visible(stp->elev, (double)hor[i], r.c.o.sun_radius_rad);
+            if (!isfinite(pt->p) || isnan(pt->nz) || isnan(vis)) continue;
+            hf_solar_point_step(stp, pt, vis, r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON,
+                                r.acc + ((size_t)stp->band * n + i) * 4);
+        }
+    }
+    hfvis__free(r.al, hor);
+    hfvis__free(r.al, az);
+    if (st != HFVIS_OK) {
+        hf_solar_run_free(&r);
+        return st;
+    }
+    return hf_solar_finish(g, &r, 1, out);
 }
