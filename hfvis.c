@@ -8193,8 +8193,10 @@ hfvis_status hfvis_partial_load(const char *path, const hfvis_allocator *alloc, 
  * line, an exact point of the surface. Every line is swept from its far end with the hull stack
  * of [P1] §5 (Alg. 1) over all its crossings, and each grid point on it reads the tangent of the
  * hull at its turn: the maximum over every crossing of its own ray, no interpolation between
- * lines. Distances are integers in units of 1/(|a||b|) of the step |(a, b)|, so the hull and the
- * per-receiver oracle (hfvis_horizon_exact_naive) compute the same quotients from the same heights.
+ * lines. Distances are integers in units of 1/(|a||b|) of the step |(a, b)|. Each receiver also
+ * takes the near-field limit t -> 0+ of its first cell (and under a radius the window's end),
+ * where the supremum is often no sample at all; the per-receiver oracle
+ * (hfvis_horizon_exact_naive) is the supremum over t > 0, every piece maximized in closed form.
  * Directions are the nearest representable ones (hfvis.h, "Exact rays"); the light integrals weight
  * each by its share of the circle. */
 
@@ -8459,41 +8461,66 @@ static inline double hf_cell_twist(const float *p, ptrdiff_t stride)
     return (double)p[0] - (double)p[1] - (double)p[stride] + (double)p[stride + 1];
 }
 
-/* The interior samples of a piece in the cell whose tap (0, 0) is p (row stride `stride`), its
- * bulge above lim (hf_piece_samples). */
-static int hf_piece_fill(const float *p, ptrdiff_t stride, const hf_cross *c, double bulge, double lim,
-                         double *h, double *du)
+/* The four taps of cell (cx, cy) under the border rule into z (z00, z10, z01, z11): inside the
+ * grid, or for CLAMP/WRAP within the reach R beyond it (clamped or wrapped taps, the cells of
+ * hf_sample_border's surface); 0 outside that or when a tap is a hole. */
+static int hf_exact_cell_taps(const hfvis_grid *g, hfvis_border border, int R, int cx, int cy, double *z)
 {
-    double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[stride], z11 = (double)p[stride + 1];
+    int j;
+    if (cx >= 0 && cy >= 0 && cx + 1 < g->width && cy + 1 < g->height) {
+        const float *p = g->z + (ptrdiff_t)cy * g->stride + cx;
+        z[0] = (double)p[0];
+        z[1] = (double)p[1];
+        z[2] = (double)p[g->stride];
+        z[3] = (double)p[g->stride + 1];
+    } else {
+        if (border == HFVIS_BORDER_OPEN || cx < -R || cy < -R || cx + 1 > g->width - 1 + R ||
+            cy + 1 > g->height - 1 + R)
+            return 0;
+        for (j = 0; j < 4; j++) {
+            int X = cx + (j & 1), Y = cy + (j >> 1);
+            if (border == HFVIS_BORDER_WRAP) {
+                X = (X % g->width + g->width) % g->width;
+                Y = (Y % g->height + g->height) % g->height;
+            } else {
+                X = X < 0 ? 0 : (X > g->width - 1 ? g->width - 1 : X);
+                Y = Y < 0 ? 0 : (Y > g->height - 1 ? g->height - 1 : Y);
+            }
+            z[j] = (double)g->z[(ptrdiff_t)Y * g->stride + X];
+        }
+    }
+    return isfinite(z[0]) && isfinite(z[1]) && isfinite(z[2]) && isfinite(z[3]);
+}
+
+/* The interior samples of a piece in the cell of taps z (z00, z10, z01, z11), its bulge above
+ * lim (hf_piece_samples). */
+static int hf_piece_fill(const double *z, const hf_cross *c, double bulge, double lim, double *h, double *du)
+{
     double dfx = c->fx1 - c->fx0, dfy = c->fy1 - c->fy0, inv_m;
     int m = 1, j;
     while (m < HF_EXACT_MAX_SPLIT && bulge > lim * (double)m * (double)m) m *= 2;
     inv_m = 1.0 / (double)m; /* a power of two: j * inv_m == j / m exactly */
     for (j = 1; j < m; j++) {
         double t = (double)j * inv_m, fx = c->fx0 + t * dfx, fy = c->fy0 + t * dfy;
-        double r0 = z00 + (z10 - z00) * fx, r1 = z01 + (z11 - z01) * fx;
+        double r0 = z[0] + (z[1] - z[0]) * fx, r1 = z[2] + (z[3] - z[2]) * fx;
         h[j - 1] = r0 + (r1 - r0) * fy;
         du[j - 1] = c->du * t;
     }
     return m - 1;
 }
 
-/* Interior samples of piece c after base grid point (X, Y) (see HF_EXACT_BULGE): writes up to
- * HF_EXACT_MAX_SPLIT - 1 heights h[j] at sub-step offsets du[j] from the piece's start, in
- * increasing order, and returns the count; 0 for a piece that is not concave enough, outside
- * the grid or touching a hole. Inline: most pieces are rejected here. */
-static inline int hf_piece_samples(const hfvis_grid *g, int X, int Y, const hf_cross *c, double *h,
-                                   double *du)
+/* Interior samples of piece c after base grid point (X, Y) (see HF_EXACT_BULGE), its cell's taps
+ * under the border rule (hf_exact_cell_taps): writes up to HF_EXACT_MAX_SPLIT - 1 heights h[j]
+ * at sub-step offsets du[j] from the piece's start, in increasing order, and returns the count;
+ * 0 for a piece that is not concave enough, out of reach or touching a hole. */
+static int hf_piece_samples(const hfvis_grid *g, hfvis_border border, int R, int X, int Y,
+                            const hf_cross *c, double *h, double *du)
 {
-    int cx = X + c->cx, cy = Y + c->cy;
-    double bulge, lim;
-    /* cx in [0, width - 2], cy in [0, height - 2] (the unsigned casts take the negatives out) */
-    if (c->du == 0.0 || (unsigned)cx >= (unsigned)(g->width - 1) || (unsigned)cy >= (unsigned)(g->height - 1))
-        return 0;
-    bulge = c->q * hf_cell_twist(g->z + (ptrdiff_t)cy * g->stride + cx, g->stride);
-    lim = HF_EXACT_BULGE * g->cell_size;
+    double z[4], bulge, lim = HF_EXACT_BULGE * g->cell_size;
+    if (c->du == 0.0 || !hf_exact_cell_taps(g, border, R, X + c->cx, Y + c->cy, z)) return 0;
+    bulge = c->q * (z[0] - z[1] - z[2] + z[3]); /* hf_cell_twist's bits */
     if (!(bulge > lim) || !isfinite(bulge)) return 0;
-    return hf_piece_fill(g->z + (ptrdiff_t)cy * g->stride + cx, g->stride, c, bulge, lim, h, du);
+    return hf_piece_fill(z, c, bulge, lim, h, du);
 }
 
 /* Whole periods k >= 0 of the ray from grid point (x, y) along (a, b) that can hold a crossing
@@ -8557,8 +8584,13 @@ static inline int hf_exact_piece(const hfvis_grid *g, const hf_cross *c, const f
     int split = (bulge > lim) & (bulge < HFVIS__INF);
     *splits += split;
     if (bulge > 4.0 * lim && bulge < HFVIS__INF) { /* split into 4 or more (hf_piece_fill's m >= 4): rare */
-        double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
-        int j = hf_piece_fill(p, g->stride, c, bulge, lim, ph, pu);
+        double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT], z[4];
+        int j;
+        z[0] = z00;
+        z[1] = z10;
+        z[2] = z01;
+        z[3] = z11;
+        j = hf_piece_fill(z, c, bulge, lim, ph, pu);
         while (j-- > 0) { /* far end first */
             sd[n] = base - (c->u + pu[j]);
             sh[n++] = ph[j];
@@ -8594,7 +8626,7 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
         for (e = P - 1; e >= 0; e--) {
             int X = bx + cr[e].ox, Y = by + cr[e].oy;
             double h;
-            j = hf_piece_samples(g, bx, by, cr + e, ph, pu);
+            j = hf_piece_samples(g, E->border, E->R, bx, by, cr + e, ph, pu);
             while (j-- > 0) { /* the piece after crossing e, far end first */
                 if (isnan(ph[j])) continue;
                 sd[n] = -((double)k * L + (cr[e].u + pu[j]));
@@ -8709,6 +8741,83 @@ static int64_t hf_exact_window(double radius, double scale)
     return hf_radius_units(16.0 * (radius * scale));
 }
 
+/* The near-field term of a receiver at grid point (x, y), height hr: the t -> 0+ limit of the
+ * elevation tangent along (a, b), the slope of the bilinear cell the ray leaves by at its corner
+ * (x, y), (dz/dx |a| + dz/dy |b|) / (|(a, b)| cell) with the corner's two edge differences
+ * (the twist is second order). -INFINITY on the axes (the surface along a grid line is linear,
+ * so the limit is the first grid point's own tangent) and where that cell is out of reach or
+ * touches a hole. den = hf_exact_den(a, b, cell). The sweep and hfvis_horizon_exact_naive both
+ * call it: the same bits. */
+static double hf_exact_first_slope(const hfvis_grid *g, hfvis_border border, int R, int x, int y,
+                                   int a, int b, double hr, double den)
+{
+    int cx = a < 0 ? x - 1 : x, cy = b < 0 ? y - 1 : y, A = a < 0 ? -a : a, B = b < 0 ? -b : b;
+    double z[4], zx, zy;
+    if (A == 0 || B == 0 || !hf_exact_cell_taps(g, border, R, cx, cy, z)) return -HFVIS__INF;
+    zx = z[(cy == y ? 0 : 2) + (cx == x ? 1 : 0)]; /* the tap (x + sign a, y) */
+    zy = z[(cy == y ? 2 : 0) + (cx == x ? 0 : 1)]; /* the tap (x, y + sign b) */
+    return ((zx - hr) * (double)A + (zy - hr) * (double)B) / den;
+}
+
+/* |(a, b)| cell, the first-slope denominator (one expression for the sweep and the oracle). */
+static double hf_exact_den(const hfvis_grid *g, int a, int b)
+{
+    return sqrt((double)a * (double)a + (double)b * (double)b) * g->cell_size;
+}
+
+/* The far end of a receiver's window: under a radius, the surface point at exactly ucut
+ * sub-steps (hf_exact_window / 16) along its ray (a, b) from grid point (x, y), height hr, as a
+ * tangent per sub-step (the supremum within R can lie there, between two samples). Its cell is the
+ * one the ray is in just before the cut (along an axis, the cell beside the line, the next one
+ * where that is out of reach); -INFINITY where no such cell is in reach with four finite taps. */
+static double hf_exact_cut(const hfvis_grid *g, hfvis_border border, int R, int x, int y, int a, int b,
+                           double L, double ucut, double hr)
+{
+    double px = (double)x + ucut * (double)a / L, py = (double)y + ucut * (double)b / L, z[4], fx, fy;
+    int cx, cy;
+    if (!(ucut > 0.0) || fabs(px) > (double)INT_MAX / 2.0 || fabs(py) > (double)INT_MAX / 2.0) return -HFVIS__INF;
+    cx = a > 0 ? (int)ceil(px) - 1 : (int)floor(px);
+    cy = b > 0 ? (int)ceil(py) - 1 : (int)floor(py);
+    if (!hf_exact_cell_taps(g, border, R, cx, cy, z)) {
+        if (a == 0 && hf_exact_cell_taps(g, border, R, cx - 1, cy, z)) cx--;
+        else if (b == 0 && hf_exact_cell_taps(g, border, R, cx, cy - 1, z)) cy--;
+        else return -HFVIS__INF;
+    }
+    fx = px - (double)cx;
+    fy = py - (double)cy;
+    {
+        double r0 = z[0] + (z[1] - z[0]) * fx, r1 = z[2] + (z[3] - z[2]) * fx;
+        return (r0 + (r1 - r0) * fy - hr) / ucut;
+    }
+}
+
+/* The per-receiver terms over the receiver rectangle: each tangent becomes the largest of the
+ * hull's, the first piece's t -> 0+ limit (hf_exact_first_slope) and, under a radius, the
+ * window's far end (hf_exact_cut); holes stay NaN. */
+static void hf_exact_near(hf_exact *E, int a, int b, double L, double scale)
+{
+    const hfvis_grid *g = E->g;
+    const double den = hf_exact_den(g, a, b), ucut = (double)E->win_rw / 16.0;
+    const int diag = a != 0 && b != 0;
+    int x, y;
+    for (y = E->ry0; y < E->ry1; y++) {
+        double *t = E->tan + (size_t)y * (size_t)g->width;
+        const float *z = g->z + (ptrdiff_t)y * g->stride;
+        for (x = E->rx0; x < E->rx1; x++) {
+            double s;
+            if (isnan(t[x])) continue;
+            if (diag) {
+                s = hf_exact_first_slope(g, E->border, E->R, x, y, a, b, (double)z[x], den);
+                if (s > t[x]) t[x] = s;
+            }
+            if (E->win_rw >= 0) {
+                s = hf_exact_cut(g, E->border, E->R, x, y, a, b, L, ucut, (double)z[x]) * scale;
+                if (s > t[x]) t[x] = s;
+            }
+        }
+    }
+}
+
 /* Tangents of every grid point toward ray r into E->tan (-INFINITY: no terrain, NaN: hole).
  * Heads are enumerated row by row, so consecutive lines are neighbours. */
 static void hf_exact_sweep(hf_exact *E, hf_ray r)
@@ -8736,36 +8845,78 @@ static void hf_exact_sweep(hf_exact *E, hf_ray r)
         if (xhi > g->width - 1) xhi = g->width - 1;
         for (x = xlo; x <= xhi; x++) hf_exact_line(E, x, y, r.a, r.b, P, L, scale);
     }
+    if ((r.a != 0 && r.b != 0) || E->win_rw >= 0) hf_exact_near(E, r.a, r.b, L, scale);
 }
 
-/* Oracle twin of hf_exact_sweep for one receiver: every crossing of its own ray within the
- * window rw (1/16 sub-steps, hf_exact_window; -1 = unlimited), the same heights and quotients,
- * the largest kept. */
+/* The supremum of (h(u) - hr)/u (height per sub-step) over the interior of piece c (cell taps z,
+ * hf_exact_cell_taps) starting u0 > 0 sub-steps from the receiver and cut at umax: along the
+ * piece h(t) = H0 + H1 t + H2 t^2, t in [0, 1], u = u0 + t du; its stationary points solve
+ * H2 du t^2 + 2 H2 u0 t + H1 u0 - (H0 - hr) du = 0. Candidates: the roots inside (0, 1) and
+ * before the cut (the crossings at the ends and the cut are points of their own); none in the
+ * first piece (u0 = 0, where the tangent is linear in t: hf_exact_first_slope). -INFINITY if none. */
+static double hf_exact_piece_sup(const double *z, const hf_cross *c, double u0, double hr, double umax)
+{
+    double w = z[0] - z[1] - z[2] + z[3], dfx = c->fx1 - c->fx0, dfy = c->fy1 - c->fy0;
+    double H0 = z[0] + (z[1] - z[0]) * c->fx0 + (z[2] - z[0]) * c->fy0 + w * c->fx0 * c->fy0;
+    double H1 = (z[1] - z[0]) * dfx + (z[2] - z[0]) * dfy + w * (c->fx0 * dfy + c->fy0 * dfx);
+    double H2 = w * dfx * dfy, al = H2 * c->du, be = 2.0 * H2 * u0, ga = H1 * u0 - (H0 - hr) * c->du;
+    double t1 = 1.0, best = -HFVIS__INF, root[2], disc;
+    int n = 0, i;
+    if (u0 + c->du > umax) { /* the cut (its own point: hf_exact_cut) */
+        t1 = (umax - u0) / c->du;
+        if (!(t1 > 0.0)) return best;
+    }
+    disc = be * be - 4.0 * al * ga;
+    if (u0 > 0.0 && al != 0.0 && disc >= 0.0) { /* u0 = 0 (the first piece): linear in t */
+        double q = -0.5 * (be + (be < 0.0 ? -sqrt(disc) : sqrt(disc)));
+        if (q != 0.0) {
+            root[n++] = q / al;
+            root[n++] = ga / q;
+        }
+    }
+    for (i = 0; i < n; i++) {
+        double t = root[i], s;
+        if (!(t > 0.0 && t <= t1)) continue;
+        s = (H0 + (H1 + H2 * t) * t - hr) / (u0 + t * c->du);
+        if (s > best) best = s;
+    }
+    return best;
+}
+
+/* Oracle of the exact mode for one receiver: the supremum over t > 0 of the elevation tangent
+ * along its own ray over the bilinear surface, within the window rw (1/16 sub-steps,
+ * hf_exact_window; -1 = unlimited): every crossing (hf_cross_height, the sweep's heights), every
+ * piece's interior in closed form (hf_exact_piece_sup), the window's far end (hf_exact_cut) and
+ * the first piece's t -> 0+ limit (hf_exact_first_slope); the largest kept. */
 static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, const hf_cross *cr,
                              int P, double L, double scale, int a, int b, int x, int y, int64_t rw)
 {
-    double hr = (double)g->z[(ptrdiff_t)y * g->stride + x], best = -HFVIS__INF;
+    double hr = (double)g->z[(ptrdiff_t)y * g->stride + x], best = -HFVIS__INF, s;
+    double umax = rw >= 0 ? (double)rw / 16.0 : HFVIS__INF;
     int k, e, kmax = hf_exact_periods(g, R, x, y, a, b);
     if (!isfinite(hr)) return HFVIS__NAN;
     for (k = 0; k <= kmax; k++)
         for (e = 0; e < P; e++) {
-            int X = x + k * a + cr[e].ox, Y = y + k * b + cr[e].oy, j;
-            double h, s, ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
-            int np = hf_piece_samples(g, x + k * a, y + k * b, cr + e, ph, pu);
-            for (j = 0; j < np; j++) {
-                if (isnan(ph[j])) continue;
-                if (rw >= 0 && 16.0 * ((double)k * L + (cr[e].u + pu[j])) > (double)rw) continue;
-                s = (ph[j] - hr) / ((double)k * L + (cr[e].u + pu[j])) * scale;
+            int X = x + k * a + cr[e].ox, Y = y + k * b + cr[e].oy;
+            double h, z[4], u = (double)k * L + cr[e].u;
+            if (cr[e].du > 0.0 && u < umax &&
+                hf_exact_cell_taps(g, border, R, x + k * a + cr[e].cx, y + k * b + cr[e].cy, z)) {
+                s = hf_exact_piece_sup(z, cr + e, u, hr, umax) * scale;
                 if (s > best) best = s;
             }
             if ((k == 0 && e == 0) || !hf_cross_inside(g, R, X, Y, cr + e)) continue;
-            if (rw >= 0 && 16.0 * ((double)k * L + cr[e].u) > (double)rw) continue;
+            if (rw >= 0 && 16.0 * u > (double)rw) continue;
             h = hf_cross_height(g, border, X, Y, cr + e);
             if (isnan(h)) continue;
-            s = (h - hr) / ((double)k * L + cr[e].u) * scale;
+            s = (h - hr) / u * scale;
             if (s > best) best = s;
         }
-    return best;
+    if (rw >= 0) {
+        s = hf_exact_cut(g, border, R, x, y, a, b, L, umax, hr) * scale;
+        if (s > best) best = s;
+    }
+    hr = hf_exact_first_slope(g, border, R, x, y, a, b, hr, hf_exact_den(g, a, b));
+    return hr > best ? hr : best;
 }
 
 /* Scratch of one exact-mode call, one block: the K directions and their quadrature, the
@@ -8801,9 +8952,9 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     }
     gridn = hf_grid_count(g);
     /* a line crosses each grid line once (W + H + 4R of them within reach) and has at most
-       W + H pieces inside the grid, each split at most HF_EXACT_MAX_SPLIT - 1 times */
+       W + H + 4R + 2 pieces within reach, each split at most HF_EXACT_MAX_SPLIT - 1 times */
     cap = (size_t)g->width + (size_t)g->height + 4u * (size_t)E->R + 8u +
-          ((size_t)g->width + (size_t)g->height + 2u) * (HF_EXACT_MAX_SPLIT - 1);
+          ((size_t)g->width + (size_t)g->height + 4u * (size_t)E->R + 2u) * (HF_EXACT_MAX_SPLIT - 1);
     off_ray = hf_align_add(&total, (size_t)K, sizeof(hf_ray), &ok);
     off_d = hf_align_add(&total, (size_t)K * 5u, sizeof(double), &ok);
     off_c = hf_align_add(&total, (size_t)maxp, sizeof(hf_cross), &ok);
