@@ -8461,18 +8461,18 @@ static inline double hf_cell_twist(const float *p, ptrdiff_t stride)
     return (double)p[0] - (double)p[1] - (double)p[stride] + (double)p[stride + 1];
 }
 
-/* The four taps of cell (cx, cy) under the border rule into z (z00, z10, z01, z11): inside the
- * grid, or for CLAMP/WRAP within the reach R beyond it (clamped or wrapped taps, the cells of
- * hf_sample_border's surface); 0 outside that or when a tap is a hole. */
-static int hf_exact_cell_taps(const hfvis_grid *g, hfvis_border border, int R, int cx, int cy, double *z)
+/* The four taps of cell (cx, cy) under the border rule into z (z00, z10, z01, z11: a 2 x 2 cell
+ * of row stride 2): inside the grid, or for CLAMP/WRAP within the reach R beyond it (clamped or
+ * wrapped taps, the cells of hf_sample_border's surface); 0 outside that or when a tap is a hole. */
+static int hf_exact_cell_taps(const hfvis_grid *g, hfvis_border border, int R, int cx, int cy, float *z)
 {
     int j;
     if (cx >= 0 && cy >= 0 && cx + 1 < g->width && cy + 1 < g->height) {
         const float *p = g->z + (ptrdiff_t)cy * g->stride + cx;
-        z[0] = (double)p[0];
-        z[1] = (double)p[1];
-        z[2] = (double)p[g->stride];
-        z[3] = (double)p[g->stride + 1];
+        z[0] = p[0];
+        z[1] = p[1];
+        z[2] = p[g->stride];
+        z[3] = p[g->stride + 1];
     } else {
         if (border == HFVIS_BORDER_OPEN || cx < -R || cy < -R || cx + 1 > g->width - 1 + R ||
             cy + 1 > g->height - 1 + R)
@@ -8486,23 +8486,25 @@ static int hf_exact_cell_taps(const hfvis_grid *g, hfvis_border border, int R, i
                 X = X < 0 ? 0 : (X > g->width - 1 ? g->width - 1 : X);
                 Y = Y < 0 ? 0 : (Y > g->height - 1 ? g->height - 1 : Y);
             }
-            z[j] = (double)g->z[(ptrdiff_t)Y * g->stride + X];
+            z[j] = g->z[(ptrdiff_t)Y * g->stride + X];
         }
     }
     return isfinite(z[0]) && isfinite(z[1]) && isfinite(z[2]) && isfinite(z[3]);
 }
 
-/* The interior samples of a piece in the cell of taps z (z00, z10, z01, z11), its bulge above
- * lim (hf_piece_samples). */
-static int hf_piece_fill(const double *z, const hf_cross *c, double bulge, double lim, double *h, double *du)
+/* The interior samples of a piece in the cell whose tap (0, 0) is p (row stride `stride`), its
+ * bulge above lim (hf_piece_samples). */
+static int hf_piece_fill(const float *p, ptrdiff_t stride, const hf_cross *c, double bulge, double lim,
+                         double *h, double *du)
 {
+    double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[stride], z11 = (double)p[stride + 1];
     double dfx = c->fx1 - c->fx0, dfy = c->fy1 - c->fy0, inv_m;
     int m = 1, j;
     while (m < HF_EXACT_MAX_SPLIT && bulge > lim * (double)m * (double)m) m *= 2;
     inv_m = 1.0 / (double)m; /* a power of two: j * inv_m == j / m exactly */
     for (j = 1; j < m; j++) {
         double t = (double)j * inv_m, fx = c->fx0 + t * dfx, fy = c->fy0 + t * dfy;
-        double r0 = z[0] + (z[1] - z[0]) * fx, r1 = z[2] + (z[3] - z[2]) * fx;
+        double r0 = z00 + (z10 - z00) * fx, r1 = z01 + (z11 - z01) * fx;
         h[j - 1] = r0 + (r1 - r0) * fy;
         du[j - 1] = c->du * t;
     }
@@ -8516,11 +8518,12 @@ static int hf_piece_fill(const double *z, const hf_cross *c, double bulge, doubl
 static int hf_piece_samples(const hfvis_grid *g, hfvis_border border, int R, int X, int Y,
                             const hf_cross *c, double *h, double *du)
 {
-    double z[4], bulge, lim = HF_EXACT_BULGE * g->cell_size;
+    float z[4];
+    double bulge, lim = HF_EXACT_BULGE * g->cell_size;
     if (c->du == 0.0 || !hf_exact_cell_taps(g, border, R, X + c->cx, Y + c->cy, z)) return 0;
-    bulge = c->q * (z[0] - z[1] - z[2] + z[3]); /* hf_cell_twist's bits */
+    bulge = c->q * hf_cell_twist(z, 2);
     if (!(bulge > lim) || !isfinite(bulge)) return 0;
-    return hf_piece_fill(z, c, bulge, lim, h, du);
+    return hf_piece_fill(z, 2, c, bulge, lim, h, du);
 }
 
 /* Whole periods k >= 0 of the ray from grid point (x, y) along (a, b) that can hold a crossing
@@ -8584,13 +8587,8 @@ static inline int hf_exact_piece(const hfvis_grid *g, const hf_cross *c, const f
     int split = (bulge > lim) & (bulge < HFVIS__INF);
     *splits += split;
     if (bulge > 4.0 * lim && bulge < HFVIS__INF) { /* split into 4 or more (hf_piece_fill's m >= 4): rare */
-        double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT], z[4];
-        int j;
-        z[0] = z00;
-        z[1] = z10;
-        z[2] = z01;
-        z[3] = z11;
-        j = hf_piece_fill(z, c, bulge, lim, ph, pu);
+        double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
+        int j = hf_piece_fill(p, g->stride, c, bulge, lim, ph, pu);
         while (j-- > 0) { /* far end first */
             sd[n] = base - (c->u + pu[j]);
             sh[n++] = ph[j];
@@ -8746,23 +8744,24 @@ static int64_t hf_exact_window(double radius, double scale)
  * (x, y), (dz/dx |a| + dz/dy |b|) / (|(a, b)| cell) with the corner's two edge differences
  * (the twist is second order). -INFINITY on the axes (the surface along a grid line is linear,
  * so the limit is the first grid point's own tangent) and where that cell is out of reach or
- * touches a hole. den = hf_exact_den(a, b, cell). The sweep and hfvis_horizon_exact_naive both
- * call it: the same bits. */
+ * touches a hole. inv_den = hf_exact_inv_den. The sweep (its inner cells inline, the same
+ * expression) and hfvis_horizon_exact_naive both compute it so: the same bits. */
 static double hf_exact_first_slope(const hfvis_grid *g, hfvis_border border, int R, int x, int y,
-                                   int a, int b, double hr, double den)
+                                   int a, int b, double hr, double inv_den)
 {
     int cx = a < 0 ? x - 1 : x, cy = b < 0 ? y - 1 : y, A = a < 0 ? -a : a, B = b < 0 ? -b : b;
-    double z[4], zx, zy;
+    float z[4];
+    double zx, zy;
     if (A == 0 || B == 0 || !hf_exact_cell_taps(g, border, R, cx, cy, z)) return -HFVIS__INF;
-    zx = z[(cy == y ? 0 : 2) + (cx == x ? 1 : 0)]; /* the tap (x + sign a, y) */
-    zy = z[(cy == y ? 2 : 0) + (cx == x ? 0 : 1)]; /* the tap (x, y + sign b) */
-    return ((zx - hr) * (double)A + (zy - hr) * (double)B) / den;
+    zx = (double)z[(cy == y ? 0 : 2) + (cx == x ? 1 : 0)]; /* the tap (x + sign a, y) */
+    zy = (double)z[(cy == y ? 2 : 0) + (cx == x ? 0 : 1)]; /* the tap (x, y + sign b) */
+    return ((zx - hr) * (double)A + (zy - hr) * (double)B) * inv_den;
 }
 
-/* |(a, b)| cell, the first-slope denominator (one expression for the sweep and the oracle). */
-static double hf_exact_den(const hfvis_grid *g, int a, int b)
+/* 1 / (|(a, b)| cell), the first slope's factor (one expression for the sweep and the oracle). */
+static double hf_exact_inv_den(const hfvis_grid *g, int a, int b)
 {
-    return sqrt((double)a * (double)a + (double)b * (double)b) * g->cell_size;
+    return 1.0 / (sqrt((double)a * (double)a + (double)b * (double)b) * g->cell_size);
 }
 
 /* The far end of a receiver's window: under a radius, the surface point at exactly ucut
@@ -8773,7 +8772,8 @@ static double hf_exact_den(const hfvis_grid *g, int a, int b)
 static double hf_exact_cut(const hfvis_grid *g, hfvis_border border, int R, int x, int y, int a, int b,
                            double L, double ucut, double hr)
 {
-    double px = (double)x + ucut * (double)a / L, py = (double)y + ucut * (double)b / L, z[4], fx, fy;
+    double px = (double)x + ucut * (double)a / L, py = (double)y + ucut * (double)b / L, fx, fy;
+    float z[4];
     int cx, cy;
     if (!(ucut > 0.0) || fabs(px) > (double)INT_MAX / 2.0 || fabs(py) > (double)INT_MAX / 2.0) return -HFVIS__INF;
     cx = a > 0 ? (int)ceil(px) - 1 : (int)floor(px);
@@ -8786,7 +8786,8 @@ static double hf_exact_cut(const hfvis_grid *g, hfvis_border border, int R, int 
     fx = px - (double)cx;
     fy = py - (double)cy;
     {
-        double r0 = z[0] + (z[1] - z[0]) * fx, r1 = z[2] + (z[3] - z[2]) * fx;
+        double z0 = (double)z[0], z1 = (double)z[1], z2 = (double)z[2], z3 = (double)z[3];
+        double r0 = z0 + (z1 - z0) * fx, r1 = z2 + (z3 - z2) * fx;
         return (r0 + (r1 - r0) * fy - hr) / ucut;
     }
 }
@@ -8797,17 +8798,30 @@ static double hf_exact_cut(const hfvis_grid *g, hfvis_border border, int R, int 
 static void hf_exact_near(hf_exact *E, int a, int b, double L, double scale)
 {
     const hfvis_grid *g = E->g;
-    const double den = hf_exact_den(g, a, b), ucut = (double)E->win_rw / 16.0;
+    const double inv_den = hf_exact_inv_den(g, a, b), ucut = (double)E->win_rw / 16.0;
+    const double Ad = (double)(a < 0 ? -a : a), Bd = (double)(b < 0 ? -b : b);
     const int diag = a != 0 && b != 0;
     int x, y;
     for (y = E->ry0; y < E->ry1; y++) {
         double *t = E->tan + (size_t)y * (size_t)g->width;
         const float *z = g->z + (ptrdiff_t)y * g->stride;
+        /* the first cells inside the grid: its taps read directly (hf_exact_first_slope's bits) */
+        const int cy = b < 0 ? y - 1 : y, sx = a < 0 ? -1 : 1;
+        const ptrdiff_t sy = b < 0 ? -g->stride : g->stride;
+        const int in_row = cy >= 0 && cy + 1 < g->height;
         for (x = E->rx0; x < E->rx1; x++) {
             double s;
             if (isnan(t[x])) continue;
             if (diag) {
-                s = hf_exact_first_slope(g, E->border, E->R, x, y, a, b, (double)z[x], den);
+                int cx = a < 0 ? x - 1 : x;
+                if (in_row && cx >= 0 && cx + 1 < g->width) {
+                    /* finite s: finite zx and zy (|s| <= 2^128 4096 / den); then zd decides */
+                    double hr = (double)z[x], zx = (double)z[x + sx], zy = (double)z[x + sy];
+                    s = ((zx - hr) * Ad + (zy - hr) * Bd) * inv_den;
+                    if (!isfinite(s) || !isfinite(z[x + sx + sy])) s = -HFVIS__INF;
+                } else {
+                    s = hf_exact_first_slope(g, E->border, E->R, x, y, a, b, (double)z[x], inv_den);
+                }
                 if (s > t[x]) t[x] = s;
             }
             if (E->win_rw >= 0) {
@@ -8854,14 +8868,22 @@ static void hf_exact_sweep(hf_exact *E, hf_ray r)
  * H2 du t^2 + 2 H2 u0 t + H1 u0 - (H0 - hr) du = 0. Candidates: the roots inside (0, 1) and
  * before the cut (the crossings at the ends and the cut are points of their own); none in the
  * first piece (u0 = 0, where the tangent is linear in t: hf_exact_first_slope). -INFINITY if none. */
-static double hf_exact_piece_sup(const double *z, const hf_cross *c, double u0, double hr, double umax)
+static double hf_exact_piece_sup(const float *zf, const hf_cross *c, double u0, double hr, double umax)
 {
-    double w = z[0] - z[1] - z[2] + z[3], dfx = c->fx1 - c->fx0, dfy = c->fy1 - c->fy0;
-    double H0 = z[0] + (z[1] - z[0]) * c->fx0 + (z[2] - z[0]) * c->fy0 + w * c->fx0 * c->fy0;
-    double H1 = (z[1] - z[0]) * dfx + (z[2] - z[0]) * dfy + w * (c->fx0 * dfy + c->fy0 * dfx);
-    double H2 = w * dfx * dfy, al = H2 * c->du, be = 2.0 * H2 * u0, ga = H1 * u0 - (H0 - hr) * c->du;
+    double z[4], w, dfx = c->fx1 - c->fx0, dfy = c->fy1 - c->fy0, H0, H1, H2, al, be, ga;
     double t1 = 1.0, best = -HFVIS__INF, root[2], disc;
     int n = 0, i;
+    z[0] = (double)zf[0];
+    z[1] = (double)zf[1];
+    z[2] = (double)zf[2];
+    z[3] = (double)zf[3];
+    w = z[0] - z[1] - z[2] + z[3];
+    H0 = z[0] + (z[1] - z[0]) * c->fx0 + (z[2] - z[0]) * c->fy0 + w * c->fx0 * c->fy0;
+    H1 = (z[1] - z[0]) * dfx + (z[2] - z[0]) * dfy + w * (c->fx0 * dfy + c->fy0 * dfx);
+    H2 = w * dfx * dfy;
+    al = H2 * c->du;
+    be = 2.0 * H2 * u0;
+    ga = H1 * u0 - (H0 - hr) * c->du;
     if (u0 + c->du > umax) { /* the cut (its own point: hf_exact_cut) */
         t1 = (umax - u0) / c->du;
         if (!(t1 > 0.0)) return best;
@@ -8898,7 +8920,8 @@ static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, co
     for (k = 0; k <= kmax; k++)
         for (e = 0; e < P; e++) {
             int X = x + k * a + cr[e].ox, Y = y + k * b + cr[e].oy;
-            double h, z[4], u = (double)k * L + cr[e].u;
+            double h, u = (double)k * L + cr[e].u;
+            float z[4];
             if (cr[e].du > 0.0 && u < umax &&
                 hf_exact_cell_taps(g, border, R, x + k * a + cr[e].cx, y + k * b + cr[e].cy, z)) {
                 s = hf_exact_piece_sup(z, cr + e, u, hr, umax) * scale;
@@ -8915,7 +8938,7 @@ static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, co
         s = hf_exact_cut(g, border, R, x, y, a, b, L, umax, hr) * scale;
         if (s > best) best = s;
     }
-    hr = hf_exact_first_slope(g, border, R, x, y, a, b, hr, hf_exact_den(g, a, b));
+    hr = hf_exact_first_slope(g, border, R, x, y, a, b, hr, hf_exact_inv_den(g, a, b));
     return hr > best ? hr : best;
 }
 
