@@ -3057,7 +3057,7 @@ static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0
                 out[i * (size_t)K + (size_t)k] = HFVIS__NAN;
                 continue;
             }
-            if (exact_bound > 0) { /* exact mode: along the actual direction (a, b) */
+            if (exact_bound != 0) { /* exact mode: along the actual direction (a, b) */
                 hf_ray r = hf_ray_nearest(azimuth0 + 2.0 * HFVIS__PI * (double)k / (double)K, exact_bound);
                 double len = sqrt((double)r.a * (double)r.a + (double)r.b * (double)r.b);
                 ux = -(double)r.a / len;
@@ -8221,17 +8221,31 @@ static int hf_floor_div(int num, int den) /* den > 0 */
     return (num % den != 0 && num < 0) ? q - 1 : q;
 }
 
-/* The resolved denominator bound of a run of K directions (hfvis.h). */
+/* The default rule for 32 < K <= 360 (hfvis.h, "Exact rays"): the cheapest direction (smallest
+ * |a| + |b|: a line's sweep costs |a| + |b| - 1 crossings per receiver) within HF_EXACT_TAU of
+ * psi_k, searched up to denominator HF_EXACT_CHEAP_N (which always holds one: for any slope some
+ * p/q with q <= 256 lies within 1/256 of it, Dirichlet, and 1/256 rad < 0.25 deg). The nearest
+ * direction with N = ceil(K/4) costs |a| + |b| ~ 0.8 N on average (K = 256: 51.5, K = 360: 73);
+ * the cheapest within 0.25 deg costs 12-21 at every K in that range. 0.25 deg <= a quarter of
+ * the sector 360/K deg there, so the chosen azimuths keep their order. */
+#define HF_EXACT_TAU (0.25 * HFVIS__PI / 180.0)
+#define HF_EXACT_CHEAP_N 256
+#define HF_EXACT_CHEAP_KMAX 360
+
+/* The resolved direction rule of a run of K directions (hfvis.h): N > 0, the nearest direction
+ * with max(|a|, |b|) <= N; -HF_EXACT_CHEAP_N, the cheapest within HF_EXACT_TAU. */
 static int hf_exact_bound(const hfvis_sweep_options *o, int K)
 {
     if (o->ray_denominator > 0) return o->ray_denominator;
     if (K == 1) return HF_EXACT_SUN_DENOMINATOR;
+    if (K > 32 && K <= HF_EXACT_CHEAP_KMAX) return -HF_EXACT_CHEAP_N;
     return (K + 3) / 4 > HF_EXACT_MIN_DENOMINATOR ? (K + 3) / 4 : HF_EXACT_MIN_DENOMINATOR;
 }
 
-/* Nearest direction (a, b), gcd 1, max(|a|, |b|) <= N, to azimuth psi; ties go to the smaller
- * |a| + |b| (the cheaper sweep). Searched in the first octant: for each a, the two b beside
- * a tan(theta). */
+/* The direction of rule N (hf_exact_bound) for azimuth psi. N > 0: the nearest (a, b), gcd 1,
+ * max(|a|, |b|) <= N; ties go to the smaller |a| + |b| (the cheaper sweep). N < 0: the smallest
+ * |a| + |b| with max(|a|, |b|) <= -N within HF_EXACT_TAU of psi; ties go to the nearer. Searched
+ * in the first octant: for each a, the two b beside a tan(theta). */
 static hf_ray hf_ray_nearest(double psi, int N)
 {
     hf_ray r;
@@ -8246,6 +8260,25 @@ static hf_ray hf_ray_nearest(double psi, int N)
     th = mirror ? HFVIS__HALF_PI - rr : rr;
     tn = tan(th);
     best = th; /* (1, 0) */
+    if (N < 0) { /* the cheapest within HF_EXACT_TAU; a + b only grows with a */
+        int cost = INT_MAX;
+        for (a = 1; a <= -N && a < cost; a++) {
+            double bf = floor((double)a * tn);
+            for (c = 0; c < 2; c++) {
+                int b = (int)bf + c;
+                double dev;
+                if (b < 0 || b > a || hf_gcd(a, b) != 1) continue;
+                dev = fabs(atan2((double)b, (double)a) - th);
+                if (dev <= HF_EXACT_TAU && (a + b < cost || (a + b == cost && dev < best))) {
+                    cost = a + b;
+                    best = dev;
+                    ba = a;
+                    bb = b;
+                }
+            }
+        }
+        N = cost == INT_MAX ? -N : 0; /* none (never, see HF_EXACT_CHEAP_N): the nearest */
+    }
     for (a = 1; a <= N; a++) {
         double bf = floor((double)a * tn);
         for (c = 0; c < 2; c++) {

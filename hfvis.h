@@ -577,7 +577,9 @@ typedef struct hfvis_sweep_options {
     hfvis_direction_order direction_order; /* how direction_begin/end count; default INDEX */
     hfvis_ray_mode rays;            /* default HFVIS_RAYS_LATTICE; EXACT: see "Exact rays" */
     int ray_denominator;            /* EXACT: bound N on the direction's integer components,
-                                       1..HFVIS_RAY_DENOMINATOR_MAX; 0 = max(5, ceil(K/4)), and 64
+                                       1..HFVIS_RAY_DENOMINATOR_MAX (the nearest direction);
+                                       0 = the default rule of "Exact rays": max(5, ceil(K/4)),
+                                       the cheapest within 0.25 deg for 32 < K <= 360, and 64
                                        for a single direction (K = 1, hfvis_sun_visibility) */
     double max_distance;            /* R, world units: occluders farther than R from the receiver,
                                        measured horizontally along the ray, are ignored; 0 =
@@ -761,18 +763,24 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     with one-cell cliffs and fBm, all pairs, negative horizons and the near field included,
  *     mean <= 0.005 deg and p99 <= 0.15 deg measured; the stated bound, held by test_exact.c
  *     on hold-out fields, is HFVIS_EXACT_SUP_MEAN_DEG / HFVIS_EXACT_SUP_P99_DEG (docs/exact-rays.md).
- *   - Rule: direction k is the representable direction nearest to psi_k = azimuth0 + 2 pi k/K
- *     (ties: the smaller |a| + |b|). hfvis_sweep_azimuths returns the K azimuths actually used
- *     and their quadrature weights. The default N = max(5, ceil(K/4)) (64 for K = 1). Largest
- *     deviation from psi_k with the default N and azimuth0 = 0: K = 4, 8: 0; K = 16, 32: 0.70
- *     deg; K = 64: 0.18; K = 128: 0.09; K = 256: 0.15; K = 7: 1.18 (K = 1, N = 64: <= 0.45).
+ *   - Rule: with opts->ray_denominator = N > 0, direction k is the representable direction
+ *     nearest to psi_k = azimuth0 + 2 pi k/K (ties: the smaller |a| + |b|). The default (0):
+ *     K = 1: N = 64; K <= 32 and K > 360: N = max(5, ceil(K/4)), nearest; 32 < K <= 360: the
+ *     cheapest direction (smallest |a| + |b|, ties: the nearer; max(|a|, |b|) <= 256) within
+ *     0.25 deg of psi_k, a quarter sector or less, so the azimuths keep their order.
+ *     hfvis_sweep_azimuths returns the K azimuths actually used and their quadrature weights.
+ *     Largest deviation from psi_k with the default and azimuth0 = 0: K = 4, 8: 0; K = 16, 32:
+ *     0.70 deg; K = 64: 0.18; K = 128: 0.20; K = 256: 0.23; K = 360: 0.245; K = 7: 1.18
+ *     (K = 1: <= 0.45).
  *   - Cost: a direction costs |a| + |b| - 1 crossings per receiver (1 on the axes and diagonals)
- *     where the lattice costs about one node, so a larger N buys smaller deviations with longer
- *     sweeps: K = 16 with the default N = 5 takes directions (1,0), (5,2), (1,1), (2,5): 3.5
- *     crossings per receiver-direction on average, plus the interior samples below. Measured
- *     (make bench, section exact, 512^2 and 1024^2, K = 16): the horizon map 0.65-0.85x the
- *     lattice map's time on urban DSMs (no gather), 1.2-2.3x on fBm rough at the cell scale;
- *     the fused sky-view factor 1.2-2.1x and 2.1-4.1x.
+ *     where the lattice costs about one node, so closer directions cost longer sweeps: K = 16
+ *     takes directions (1,0), (5,2), (1,1), (2,5): 3.5 crossings per receiver-direction on
+ *     average, plus the interior samples below. The mean |a| + |b| of the default directions:
+ *     K = 16: 4.2, K = 64: 11.7, K = 256: 15.5, K = 360: 20.5 (the nearest with N = ceil(K/4)
+ *     would take 12.1, 51.5, 73). Measured (make bench, section exact, 512^2 and 1024^2,
+ *     K = 16): the horizon map 0.65-0.85x the lattice map's time on urban DSMs (no gather),
+ *     1.2-2.3x on fBm rough at the cell scale; the fused sky-view factor 1.2-2.1x and 2.1-4.1x;
+ *     at K = 64-360 on fBm 512^2 about 10-20x (docs/exact-rays.md, "Cost at large K").
  *   - Quadrature: every direction integral uses the actual azimuths phi_k. Direction k owns the
  *     sector between the midpoints to its neighbours (edges rounded to multiples of 2^-40 turn,
  *     so the shares w_k are exact and add up to exactly 1): the sky-view factor is

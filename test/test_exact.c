@@ -281,8 +281,8 @@ TEST(box_closed_form)
 /* Directions: the nearest rational ones, the documented deviations, exact weights. */
 TEST(azimuths_and_weights)
 {
-    static const int Ks[] = {1, 4, 8, 16, 32, 64, 128, 256, 7};
-    double az[256], w[256];
+    static const int Ks[] = {1, 4, 8, 16, 32, 64, 128, 256, 7, 360};
+    double az[360], w[360];
     hfvis_sweep_options lat = hfvis_sweep_options_default(), o = exact_opts(0.0, HFVIS_BORDER_OPEN, 0);
     int i, k;
     lat.azimuth0_rad = 0.25;
@@ -291,7 +291,7 @@ TEST(azimuths_and_weights)
         CHECK(az[k] == 0.25 + 2.0 * PI * (double)k / 8.0);
         CHECK(w[k] == 1.0 / 8.0);
     }
-    for (i = 0; i < 9; i++) {
+    for (i = 0; i < 10; i++) {
         int K = Ks[i];
         double sum = 0.0, dev = 0.0;
         CHECK_EQ_STATUS(hfvis_sweep_azimuths(K, &o, az, w), HFVIS_OK);
@@ -304,7 +304,8 @@ TEST(azimuths_and_weights)
         CHECK(sum == 1.0); /* exactly: edges are multiples of 2^-40 turn */
         if (K == 4 || K == 8) CHECK(dev < 1e-12);
         if (K == 16 || K == 32) CHECK(dev < 0.71);
-        if (K >= 64 && K <= 256) CHECK(dev < 0.35);
+        if (K >= 64 && K <= 360) CHECK(dev <= 0.25 + 1e-12); /* the cheapest within 0.25 deg */
+        for (k = 1; k < K; k++) CHECK(az[k] > az[k - 1]); /* the order kept */
         printf("     K = %3d: largest deviation %.3f deg\n", K, dev);
     }
     CHECK_EQ_STATUS(hfvis_sweep_azimuths(0, &o, az, w), HFVIS_ERR_INVALID_ARGUMENT);
