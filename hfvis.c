@@ -3190,7 +3190,7 @@ static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0
                 out[i * (size_t)K + (size_t)k] = HFVIS__NAN;
                 continue;
             }
-            if (exact_bound > 0) { /* exact mode: along the actual direction (a, b) */
+            if (exact_bound != 0) { /* exact mode: along the actual direction (a, b) */
                 hf_ray r = hf_ray_nearest(azimuth0 + 2.0 * HFVIS__PI * (double)k / (double)K, exact_bound);
                 double len = sqrt((double)r.a * (double)r.a + (double)r.b * (double)r.b);
                 ux = -(double)r.a / len;
@@ -8349,8 +8349,10 @@ hfvis_status hfvis_partial_load(const char *path, const hfvis_allocator *alloc, 
  * line, an exact point of the surface. Every line is swept from its far end with the hull stack
  * of [P1] §5 (Alg. 1) over all its crossings, and each grid point on it reads the tangent of the
  * hull at its turn: the maximum over every crossing of its own ray, no interpolation between
- * lines. Distances are integers in units of 1/(|a||b|) of the step |(a, b)|, so the hull and the
- * per-receiver oracle (hfvis_horizon_exact_naive) compute the same quotients from the same heights.
+ * lines. Distances are integers in units of 1/(|a||b|) of the step |(a, b)|. Each receiver also
+ * takes the near-field limit t -> 0+ of its first cell (and under a radius the window's end),
+ * where the supremum is often no sample at all; the per-receiver oracle
+ * (hfvis_horizon_exact_naive) is the supremum over t > 0, every piece maximized in closed form.
  * Directions are the nearest representable ones (hfvis.h, "Exact rays"); the light integrals weight
  * each by its share of the circle. */
 
@@ -8375,17 +8377,31 @@ static int hf_floor_div(int num, int den) /* den > 0 */
     return (num % den != 0 && num < 0) ? q - 1 : q;
 }
 
-/* The resolved denominator bound of a run of K directions (hfvis.h). */
+/* The default rule for 32 < K <= 360 (hfvis.h, "Exact rays"): the cheapest direction (smallest
+ * |a| + |b|: a line's sweep costs |a| + |b| - 1 crossings per receiver) within HF_EXACT_TAU of
+ * psi_k, searched up to denominator HF_EXACT_CHEAP_N (which always holds one: for any slope some
+ * p/q with q <= 256 lies within 1/256 of it, Dirichlet, and 1/256 rad < 0.25 deg). The nearest
+ * direction with N = ceil(K/4) costs |a| + |b| ~ 0.8 N on average (K = 256: 51.5, K = 360: 73);
+ * the cheapest within 0.25 deg costs 12-21 at every K in that range. 0.25 deg <= a quarter of
+ * the sector 360/K deg there, so the chosen azimuths keep their order. */
+#define HF_EXACT_TAU (0.25 * HFVIS__PI / 180.0)
+#define HF_EXACT_CHEAP_N 256
+#define HF_EXACT_CHEAP_KMAX 360
+
+/* The resolved direction rule of a run of K directions (hfvis.h): N > 0, the nearest direction
+ * with max(|a|, |b|) <= N; -HF_EXACT_CHEAP_N, the cheapest within HF_EXACT_TAU. */
 static int hf_exact_bound(const hfvis_sweep_options *o, int K)
 {
     if (o->ray_denominator > 0) return o->ray_denominator;
     if (K == 1) return HF_EXACT_SUN_DENOMINATOR;
+    if (K > 32 && K <= HF_EXACT_CHEAP_KMAX) return -HF_EXACT_CHEAP_N;
     return (K + 3) / 4 > HF_EXACT_MIN_DENOMINATOR ? (K + 3) / 4 : HF_EXACT_MIN_DENOMINATOR;
 }
 
-/* Nearest direction (a, b), gcd 1, max(|a|, |b|) <= N, to azimuth psi; ties go to the smaller
- * |a| + |b| (the cheaper sweep). Searched in the first octant: for each a, the two b beside
- * a tan(theta). */
+/* The direction of rule N (hf_exact_bound) for azimuth psi. N > 0: the nearest (a, b), gcd 1,
+ * max(|a|, |b|) <= N; ties go to the smaller |a| + |b| (the cheaper sweep). N < 0: the smallest
+ * |a| + |b| with max(|a|, |b|) <= -N within HF_EXACT_TAU of psi; ties go to the nearer. Searched
+ * in the first octant: for each a, the two b beside a tan(theta). */
 static hf_ray hf_ray_nearest(double psi, int N)
 {
     hf_ray r;
@@ -8400,6 +8416,25 @@ static hf_ray hf_ray_nearest(double psi, int N)
     th = mirror ? HFVIS__HALF_PI - rr : rr;
     tn = tan(th);
     best = th; /* (1, 0) */
+    if (N < 0) { /* the cheapest within HF_EXACT_TAU; a + b only grows with a */
+        int cost = INT_MAX;
+        for (a = 1; a <= -N && a < cost; a++) {
+            double bf = floor((double)a * tn);
+            for (c = 0; c < 2; c++) {
+                int b = (int)bf + c;
+                double dev;
+                if (b < 0 || b > a || hf_gcd(a, b) != 1) continue;
+                dev = fabs(atan2((double)b, (double)a) - th);
+                if (dev <= HF_EXACT_TAU && (a + b < cost || (a + b == cost && dev < best))) {
+                    cost = a + b;
+                    best = dev;
+                    ba = a;
+                    bb = b;
+                }
+            }
+        }
+        N = cost == INT_MAX ? -N : 0; /* none (never, see HF_EXACT_CHEAP_N): the nearest */
+    }
     for (a = 1; a <= N; a++) {
         double bf = floor((double)a * tn);
         for (c = 0; c < 2; c++) {
@@ -8644,6 +8679,37 @@ static inline double hf_cell_twist(const float *p, ptrdiff_t stride)
     return (double)p[0] - (double)p[1] - (double)p[stride] + (double)p[stride + 1];
 }
 
+/* The four taps of cell (cx, cy) under the border rule into z (z00, z10, z01, z11: a 2 x 2 cell
+ * of row stride 2): inside the grid, or for CLAMP/WRAP within the reach R beyond it (clamped or
+ * wrapped taps, the cells of hf_sample_border's surface); 0 outside that or when a tap is a hole. */
+static int hf_exact_cell_taps(const hfvis_grid *g, hfvis_border border, int R, int cx, int cy, float *z)
+{
+    int j;
+    if (cx >= 0 && cy >= 0 && cx + 1 < g->width && cy + 1 < g->height) {
+        const float *p = g->z + (ptrdiff_t)cy * g->stride + cx;
+        z[0] = p[0];
+        z[1] = p[1];
+        z[2] = p[g->stride];
+        z[3] = p[g->stride + 1];
+    } else {
+        if (border == HFVIS_BORDER_OPEN || cx < -R || cy < -R || cx + 1 > g->width - 1 + R ||
+            cy + 1 > g->height - 1 + R)
+            return 0;
+        for (j = 0; j < 4; j++) {
+            int X = cx + (j & 1), Y = cy + (j >> 1);
+            if (border == HFVIS_BORDER_WRAP) {
+                X = (X % g->width + g->width) % g->width;
+                Y = (Y % g->height + g->height) % g->height;
+            } else {
+                X = X < 0 ? 0 : (X > g->width - 1 ? g->width - 1 : X);
+                Y = Y < 0 ? 0 : (Y > g->height - 1 ? g->height - 1 : Y);
+            }
+            z[j] = g->z[(ptrdiff_t)Y * g->stride + X];
+        }
+    }
+    return isfinite(z[0]) && isfinite(z[1]) && isfinite(z[2]) && isfinite(z[3]);
+}
+
 /* The interior samples of a piece in the cell whose tap (0, 0) is p (row stride `stride`), its
  * bulge above lim (hf_piece_samples). */
 static int hf_piece_fill(const float *p, ptrdiff_t stride, const hf_cross *c, double bulge, double lim,
@@ -8663,22 +8729,19 @@ static int hf_piece_fill(const float *p, ptrdiff_t stride, const hf_cross *c, do
     return m - 1;
 }
 
-/* Interior samples of piece c after base grid point (X, Y) (see HF_EXACT_BULGE): writes up to
- * HF_EXACT_MAX_SPLIT - 1 heights h[j] at sub-step offsets du[j] from the piece's start, in
- * increasing order, and returns the count; 0 for a piece that is not concave enough, outside
- * the grid or touching a hole. Inline: most pieces are rejected here. */
-static inline int hf_piece_samples(const hfvis_grid *g, int X, int Y, const hf_cross *c, double *h,
-                                   double *du)
+/* Interior samples of piece c after base grid point (X, Y) (see HF_EXACT_BULGE), its cell's taps
+ * under the border rule (hf_exact_cell_taps): writes up to HF_EXACT_MAX_SPLIT - 1 heights h[j]
+ * at sub-step offsets du[j] from the piece's start, in increasing order, and returns the count;
+ * 0 for a piece that is not concave enough, out of reach or touching a hole. */
+static int hf_piece_samples(const hfvis_grid *g, hfvis_border border, int R, int X, int Y,
+                            const hf_cross *c, double *h, double *du)
 {
-    int cx = X + c->cx, cy = Y + c->cy;
-    double bulge, lim;
-    /* cx in [0, width - 2], cy in [0, height - 2] (the unsigned casts take the negatives out) */
-    if (c->du == 0.0 || (unsigned)cx >= (unsigned)(g->width - 1) || (unsigned)cy >= (unsigned)(g->height - 1))
-        return 0;
-    bulge = c->q * hf_cell_twist(g->z + (ptrdiff_t)cy * g->stride + cx, g->stride);
-    lim = HF_EXACT_BULGE * g->cell_size;
+    float z[4];
+    double bulge, lim = HF_EXACT_BULGE * g->cell_size;
+    if (c->du == 0.0 || !hf_exact_cell_taps(g, border, R, X + c->cx, Y + c->cy, z)) return 0;
+    bulge = c->q * hf_cell_twist(z, 2);
     if (!(bulge > lim) || !isfinite(bulge)) return 0;
-    return hf_piece_fill(g->z + (ptrdiff_t)cy * g->stride + cx, g->stride, c, bulge, lim, h, du);
+    return hf_piece_fill(z, 2, c, bulge, lim, h, du);
 }
 
 /* Whole periods k >= 0 of the ray from grid point (x, y) along (a, b) that can hold a crossing
@@ -8779,7 +8842,7 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
         for (e = P - 1; e >= 0; e--) {
             int X = bx + cr[e].ox, Y = by + cr[e].oy;
             double h;
-            j = hf_piece_samples(g, bx, by, cr + e, ph, pu);
+            j = hf_piece_samples(g, E->border, E->R, bx, by, cr + e, ph, pu);
             while (j-- > 0) { /* the piece after crossing e, far end first */
                 if (isnan(ph[j])) continue;
                 sd[n] = -((double)k * L + (cr[e].u + pu[j]));
@@ -8894,6 +8957,99 @@ static int64_t hf_exact_window(double radius, double scale)
     return hf_radius_units(16.0 * (radius * scale));
 }
 
+/* The near-field term of a receiver at grid point (x, y), height hr: the t -> 0+ limit of the
+ * elevation tangent along (a, b), the slope of the bilinear cell the ray leaves by at its corner
+ * (x, y), (dz/dx |a| + dz/dy |b|) / (|(a, b)| cell) with the corner's two edge differences
+ * (the twist is second order). -INFINITY on the axes (the surface along a grid line is linear,
+ * so the limit is the first grid point's own tangent) and where that cell is out of reach or
+ * touches a hole. inv_den = hf_exact_inv_den. The sweep (its inner cells inline, the same
+ * expression) and hfvis_horizon_exact_naive both compute it so: the same bits. */
+static double hf_exact_first_slope(const hfvis_grid *g, hfvis_border border, int R, int x, int y,
+                                   int a, int b, double hr, double inv_den)
+{
+    int cx = a < 0 ? x - 1 : x, cy = b < 0 ? y - 1 : y, A = a < 0 ? -a : a, B = b < 0 ? -b : b;
+    float z[4];
+    double zx, zy;
+    if (A == 0 || B == 0 || !hf_exact_cell_taps(g, border, R, cx, cy, z)) return -HFVIS__INF;
+    zx = (double)z[(cy == y ? 0 : 2) + (cx == x ? 1 : 0)]; /* the tap (x + sign a, y) */
+    zy = (double)z[(cy == y ? 2 : 0) + (cx == x ? 0 : 1)]; /* the tap (x, y + sign b) */
+    return ((zx - hr) * (double)A + (zy - hr) * (double)B) * inv_den;
+}
+
+/* 1 / (|(a, b)| cell), the first slope's factor (one expression for the sweep and the oracle). */
+static double hf_exact_inv_den(const hfvis_grid *g, int a, int b)
+{
+    return 1.0 / (sqrt((double)a * (double)a + (double)b * (double)b) * g->cell_size);
+}
+
+/* The far end of a receiver's window: under a radius, the surface point at exactly ucut
+ * sub-steps (hf_exact_window / 16) along its ray (a, b) from grid point (x, y), height hr, as a
+ * tangent per sub-step (the supremum within R can lie there, between two samples). Its cell is the
+ * one the ray is in just before the cut (along an axis, the cell beside the line, the next one
+ * where that is out of reach); -INFINITY where no such cell is in reach with four finite taps. */
+static double hf_exact_cut(const hfvis_grid *g, hfvis_border border, int R, int x, int y, int a, int b,
+                           double L, double ucut, double hr)
+{
+    double px = (double)x + ucut * (double)a / L, py = (double)y + ucut * (double)b / L, fx, fy;
+    float z[4];
+    int cx, cy;
+    if (!(ucut > 0.0) || fabs(px) > (double)INT_MAX / 2.0 || fabs(py) > (double)INT_MAX / 2.0) return -HFVIS__INF;
+    cx = a > 0 ? (int)ceil(px) - 1 : (int)floor(px);
+    cy = b > 0 ? (int)ceil(py) - 1 : (int)floor(py);
+    if (!hf_exact_cell_taps(g, border, R, cx, cy, z)) {
+        if (a == 0 && hf_exact_cell_taps(g, border, R, cx - 1, cy, z)) cx--;
+        else if (b == 0 && hf_exact_cell_taps(g, border, R, cx, cy - 1, z)) cy--;
+        else return -HFVIS__INF;
+    }
+    fx = px - (double)cx;
+    fy = py - (double)cy;
+    {
+        double z0 = (double)z[0], z1 = (double)z[1], z2 = (double)z[2], z3 = (double)z[3];
+        double r0 = z0 + (z1 - z0) * fx, r1 = z2 + (z3 - z2) * fx;
+        return (r0 + (r1 - r0) * fy - hr) / ucut;
+    }
+}
+
+/* The per-receiver terms over the receiver rectangle: each tangent becomes the largest of the
+ * hull's, the first piece's t -> 0+ limit (hf_exact_first_slope) and, under a radius, the
+ * window's far end (hf_exact_cut); holes stay NaN. */
+static void hf_exact_near(hf_exact *E, int a, int b, double L, double scale)
+{
+    const hfvis_grid *g = E->g;
+    const double inv_den = hf_exact_inv_den(g, a, b), ucut = (double)E->win_rw / 16.0;
+    const double Ad = (double)(a < 0 ? -a : a), Bd = (double)(b < 0 ? -b : b);
+    const int diag = a != 0 && b != 0;
+    int x, y;
+    for (y = E->ry0; y < E->ry1; y++) {
+        double *t = E->tan + (size_t)y * (size_t)g->width;
+        const float *z = g->z + (ptrdiff_t)y * g->stride;
+        /* the first cells inside the grid: its taps read directly (hf_exact_first_slope's bits) */
+        const int cy = b < 0 ? y - 1 : y, sx = a < 0 ? -1 : 1;
+        const ptrdiff_t sy = b < 0 ? -g->stride : g->stride;
+        const int in_row = cy >= 0 && cy + 1 < g->height;
+        for (x = E->rx0; x < E->rx1; x++) {
+            double s;
+            if (isnan(t[x])) continue;
+            if (diag) {
+                int cx = a < 0 ? x - 1 : x;
+                if (in_row && cx >= 0 && cx + 1 < g->width) {
+                    /* finite s: finite zx and zy (|s| <= 2^128 4096 / den); then zd decides */
+                    double hr = (double)z[x], zx = (double)z[x + sx], zy = (double)z[x + sy];
+                    s = ((zx - hr) * Ad + (zy - hr) * Bd) * inv_den;
+                    if (!isfinite(s) || !isfinite(z[x + sx + sy])) s = -HFVIS__INF;
+                } else {
+                    s = hf_exact_first_slope(g, E->border, E->R, x, y, a, b, (double)z[x], inv_den);
+                }
+                if (s > t[x]) t[x] = s;
+            }
+            if (E->win_rw >= 0) {
+                s = hf_exact_cut(g, E->border, E->R, x, y, a, b, L, ucut, (double)z[x]) * scale;
+                if (s > t[x]) t[x] = s;
+            }
+        }
+    }
+}
+
 /* Tangents of every grid point toward ray r into E->tan (-INFINITY: no terrain, NaN: hole).
  * Heads are enumerated row by row, so consecutive lines are neighbours. */
 static void hf_exact_sweep(hf_exact *E, hf_ray r)
@@ -8922,36 +9078,87 @@ static void hf_exact_sweep(hf_exact *E, hf_ray r)
         for (x = xlo; x <= xhi; x++)
             if (hf_exact_mine(E, x, y, r)) hf_exact_line(E, x, y, r.a, r.b, P, L, scale);
     }
+    if ((r.a != 0 && r.b != 0) || E->win_rw >= 0) hf_exact_near(E, r.a, r.b, L, scale);
 }
 
-/* Oracle twin of hf_exact_sweep for one receiver: every crossing of its own ray within the
- * window rw (1/16 sub-steps, hf_exact_window; -1 = unlimited), the same heights and quotients,
- * the largest kept. */
+/* The supremum of (h(u) - hr)/u (height per sub-step) over the interior of piece c (cell taps z,
+ * hf_exact_cell_taps) starting u0 > 0 sub-steps from the receiver and cut at umax: along the
+ * piece h(t) = H0 + H1 t + H2 t^2, t in [0, 1], u = u0 + t du; its stationary points solve
+ * H2 du t^2 + 2 H2 u0 t + H1 u0 - (H0 - hr) du = 0. Candidates: the roots inside (0, 1) and
+ * before the cut (the crossings at the ends and the cut are points of their own); none in the
+ * first piece (u0 = 0, where the tangent is linear in t: hf_exact_first_slope). -INFINITY if none. */
+static double hf_exact_piece_sup(const float *zf, const hf_cross *c, double u0, double hr, double umax)
+{
+    double z[4], w, dfx = c->fx1 - c->fx0, dfy = c->fy1 - c->fy0, H0, H1, H2, al, be, ga;
+    double t1 = 1.0, best = -HFVIS__INF, root[2], disc;
+    int n = 0, i;
+    z[0] = (double)zf[0];
+    z[1] = (double)zf[1];
+    z[2] = (double)zf[2];
+    z[3] = (double)zf[3];
+    w = z[0] - z[1] - z[2] + z[3];
+    H0 = z[0] + (z[1] - z[0]) * c->fx0 + (z[2] - z[0]) * c->fy0 + w * c->fx0 * c->fy0;
+    H1 = (z[1] - z[0]) * dfx + (z[2] - z[0]) * dfy + w * (c->fx0 * dfy + c->fy0 * dfx);
+    H2 = w * dfx * dfy;
+    al = H2 * c->du;
+    be = 2.0 * H2 * u0;
+    ga = H1 * u0 - (H0 - hr) * c->du;
+    if (u0 + c->du > umax) { /* the cut (its own point: hf_exact_cut) */
+        t1 = (umax - u0) / c->du;
+        if (!(t1 > 0.0)) return best;
+    }
+    disc = be * be - 4.0 * al * ga;
+    if (u0 > 0.0 && al != 0.0 && disc >= 0.0) { /* u0 = 0 (the first piece): linear in t */
+        double q = -0.5 * (be + (be < 0.0 ? -sqrt(disc) : sqrt(disc)));
+        if (q != 0.0) {
+            root[n++] = q / al;
+            root[n++] = ga / q;
+        }
+    }
+    for (i = 0; i < n; i++) {
+        double t = root[i], s;
+        if (!(t > 0.0 && t <= t1)) continue;
+        s = (H0 + (H1 + H2 * t) * t - hr) / (u0 + t * c->du);
+        if (s > best) best = s;
+    }
+    return best;
+}
+
+/* Oracle of the exact mode for one receiver: the supremum over t > 0 of the elevation tangent
+ * along its own ray over the bilinear surface, within the window rw (1/16 sub-steps,
+ * hf_exact_window; -1 = unlimited): every crossing (hf_cross_height, the sweep's heights), every
+ * piece's interior in closed form (hf_exact_piece_sup), the window's far end (hf_exact_cut) and
+ * the first piece's t -> 0+ limit (hf_exact_first_slope); the largest kept. */
 static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, const hf_cross *cr,
                              int P, double L, double scale, int a, int b, int x, int y, int64_t rw)
 {
-    double hr = (double)g->z[(ptrdiff_t)y * g->stride + x], best = -HFVIS__INF;
+    double hr = (double)g->z[(ptrdiff_t)y * g->stride + x], best = -HFVIS__INF, s;
+    double umax = rw >= 0 ? (double)rw / 16.0 : HFVIS__INF;
     int k, e, kmax = hf_exact_periods(g, R, x, y, a, b);
     if (!isfinite(hr)) return HFVIS__NAN;
     for (k = 0; k <= kmax; k++)
         for (e = 0; e < P; e++) {
-            int X = x + k * a + cr[e].ox, Y = y + k * b + cr[e].oy, j;
-            double h, s, ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
-            int np = hf_piece_samples(g, x + k * a, y + k * b, cr + e, ph, pu);
-            for (j = 0; j < np; j++) {
-                if (isnan(ph[j])) continue;
-                if (rw >= 0 && 16.0 * ((double)k * L + (cr[e].u + pu[j])) > (double)rw) continue;
-                s = (ph[j] - hr) / ((double)k * L + (cr[e].u + pu[j])) * scale;
+            int X = x + k * a + cr[e].ox, Y = y + k * b + cr[e].oy;
+            double h, u = (double)k * L + cr[e].u;
+            float z[4];
+            if (cr[e].du > 0.0 && u < umax &&
+                hf_exact_cell_taps(g, border, R, x + k * a + cr[e].cx, y + k * b + cr[e].cy, z)) {
+                s = hf_exact_piece_sup(z, cr + e, u, hr, umax) * scale;
                 if (s > best) best = s;
             }
             if ((k == 0 && e == 0) || !hf_cross_inside(g, R, X, Y, cr + e)) continue;
-            if (rw >= 0 && 16.0 * ((double)k * L + cr[e].u) > (double)rw) continue;
+            if (rw >= 0 && 16.0 * u > (double)rw) continue;
             h = hf_cross_height(g, border, X, Y, cr + e);
             if (isnan(h)) continue;
-            s = (h - hr) / ((double)k * L + cr[e].u) * scale;
+            s = (h - hr) / u * scale;
             if (s > best) best = s;
         }
-    return best;
+    if (rw >= 0) {
+        s = hf_exact_cut(g, border, R, x, y, a, b, L, umax, hr) * scale;
+        if (s > best) best = s;
+    }
+    hr = hf_exact_first_slope(g, border, R, x, y, a, b, hr, hf_exact_inv_den(g, a, b));
+    return hr > best ? hr : best;
 }
 
 /* Scratch of one exact-mode call, one block: the K directions and their quadrature, the
@@ -8987,9 +9194,9 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     }
     gridn = hf_grid_count(g);
     /* a line crosses each grid line once (W + H + 4R of them within reach) and has at most
-       W + H pieces inside the grid, each split at most HF_EXACT_MAX_SPLIT - 1 times */
+       W + H + 4R + 2 pieces within reach, each split at most HF_EXACT_MAX_SPLIT - 1 times */
     cap = (size_t)g->width + (size_t)g->height + 4u * (size_t)E->R + 8u +
-          ((size_t)g->width + (size_t)g->height + 2u) * (HF_EXACT_MAX_SPLIT - 1);
+          ((size_t)g->width + (size_t)g->height + 4u * (size_t)E->R + 2u) * (HF_EXACT_MAX_SPLIT - 1);
     off_ray = hf_align_add(&total, (size_t)K, sizeof(hf_ray), &ok);
     off_d = hf_align_add(&total, (size_t)K * 5u, sizeof(double), &ok);
     off_c = hf_align_add(&total, (size_t)maxp, sizeof(hf_cross), &ok);

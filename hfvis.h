@@ -131,7 +131,11 @@
  * Horizon values are elevation angles alpha in [-pi/2, pi/2] above the horizontal plane: the
  *   largest elevation under which the receiver sees terrain toward psi. A receiver that sees no
  *   terrain in that direction (open border) gets alpha = -pi/2. Internally the sweep keeps the
- *   tangent t = tan(alpha) in double.
+ *   tangent t = tan(alpha) in double. Which definition each mode computes: the lattice mode
+ *   keeps [P1] as published (the maximum over the nodes of the lattice lines, gathered; [P1]
+ *   §4-§7); exact rays (see "Exact rays") approach the supremum over t > 0 of
+ *   atan((h(p + t d) - h(p)) / t) over the bilinear surface along the ray, next to the receiver
+ *   included, and their oracle hfvis_horizon_exact_naive computes that supremum.
  * Borders. HFVIS_BORDER_OPEN (default, as in the papers): nothing exists outside the grid.
  *   HFVIS_BORDER_CLAMP: edge heights extend outward. HFVIS_BORDER_WRAP: the field is periodic
  *   with period width x height (tileable fields).
@@ -595,7 +599,9 @@ typedef struct hfvis_sweep_options {
     hfvis_direction_order direction_order; /* how direction_begin/end count; default INDEX */
     hfvis_ray_mode rays;            /* default HFVIS_RAYS_LATTICE; EXACT: see "Exact rays" */
     int ray_denominator;            /* EXACT: bound N on the direction's integer components,
-                                       1..HFVIS_RAY_DENOMINATOR_MAX; 0 = max(5, ceil(K/4)), and 64
+                                       1..HFVIS_RAY_DENOMINATOR_MAX (the nearest direction);
+                                       0 = the default rule of "Exact rays": max(5, ceil(K/4)),
+                                       the cheapest within 0.25 deg for 32 < K <= 360, and 64
                                        for a single direction (K = 1, hfvis_sun_visibility) */
     double max_distance;            /* R, world units: occluders farther than R from the receiver,
                                        measured horizontally along the ray, are ignored; 0 =
@@ -778,22 +784,41 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     brings the bulge below 1/64 cell of height (power-of-two spacing keeps every distance
  *     exact in double). Pieces outside the grid or touching a hole are not split.
  *   - Each line is swept from its far end with the hull stack of [P1] §5 (Alg. 1) over all its
- *     samples; each grid point reads the hull's tangent at its turn. The result is, bit for bit,
- *     the maximum elevation over every sample of the receiver's own ray (hfvis_horizon_exact_naive
- *     is that maximum computed receiver by receiver). Along an axis the crossings are the grid
- *     points only (the surface is linear along a grid line).
- *   - Rule: direction k is the representable direction nearest to psi_k = azimuth0 + 2 pi k/K
- *     (ties: the smaller |a| + |b|). hfvis_sweep_azimuths returns the K azimuths actually used
- *     and their quadrature weights. The default N = max(5, ceil(K/4)) (64 for K = 1). Largest
- *     deviation from psi_k with the default N and azimuth0 = 0: K = 4, 8: 0; K = 16, 32: 0.70
- *     deg; K = 64: 0.18; K = 128: 0.09; K = 256: 0.15; K = 7: 1.18 (K = 1, N = 64: <= 0.45).
+ *     samples; each grid point reads the hull's tangent at its turn: the maximum elevation over
+ *     every sample of its own ray. Along an axis the crossings are the grid points only (the
+ *     surface is linear along a grid line).
+ *   - Near field: next to the receiver the supremum is often no sample at all but the limit
+ *     t -> 0+ (a receiver on a convex edge looking down: the slope of the cell the ray leaves
+ *     by, at its corner, toward psi). Each receiver also takes that limit, (dz/dx |a| +
+ *     dz/dy |b|) / (|(a, b)| cell) from the corner's two edge differences, and under a search
+ *     radius the surface point exactly at the window's end (between two samples).
+ *   - Definition and bound (HFVIS_EXACT_SUP_*_DEG): hfvis_horizon_exact_naive computes, receiver
+ *     by receiver, the supremum over t > 0 of the elevation along the ray over the bilinear
+ *     surface (within R under a radius): every crossing, every piece's stationary points in
+ *     closed form, the t -> 0+ limit and the window's end. The sweep is never above it (every
+ *     sample lies on the surface) and below it only where a piece's tangent point falls between
+ *     its samples (pieces beyond the first are sampled, not maximized): on urban boxes, terraces
+ *     with one-cell cliffs and fBm, all pairs, negative horizons and the near field included,
+ *     mean <= 0.005 deg and p99 <= 0.15 deg measured; the stated bound, held by test_exact.c
+ *     on hold-out fields, is HFVIS_EXACT_SUP_MEAN_DEG / HFVIS_EXACT_SUP_P99_DEG (docs/exact-rays.md).
+ *   - Rule: with opts->ray_denominator = N > 0, direction k is the representable direction
+ *     nearest to psi_k = azimuth0 + 2 pi k/K (ties: the smaller |a| + |b|). The default (0):
+ *     K = 1: N = 64; K <= 32 and K > 360: N = max(5, ceil(K/4)), nearest; 32 < K <= 360: the
+ *     cheapest direction (smallest |a| + |b|, ties: the nearer; max(|a|, |b|) <= 256) within
+ *     0.25 deg of psi_k, a quarter sector or less, so the azimuths keep their order.
+ *     hfvis_sweep_azimuths returns the K azimuths actually used and their quadrature weights.
+ *     Largest deviation from psi_k with the default and azimuth0 = 0: K = 4, 8: 0; K = 16, 32:
+ *     0.70 deg; K = 64: 0.18; K = 128: 0.20; K = 256: 0.23; K = 360: 0.245; K = 7: 1.18
+ *     (K = 1: <= 0.45).
  *   - Cost: a direction costs |a| + |b| - 1 crossings per receiver (1 on the axes and diagonals)
- *     where the lattice costs about one node, so a larger N buys smaller deviations with longer
- *     sweeps: K = 16 with the default N = 5 takes directions (1,0), (5,2), (1,1), (2,5): 3.5
- *     crossings per receiver-direction on average, plus the interior samples below. Measured
- *     (make bench, section exact, 512^2 and 1024^2, K = 16): the horizon map 0.65-0.85x the
- *     lattice map's time on urban DSMs (no gather), 1.2-2.3x on fBm rough at the cell scale;
- *     the fused sky-view factor 1.2-2.1x and 2.1-4.1x.
+ *     where the lattice costs about one node, so closer directions cost longer sweeps: K = 16
+ *     takes directions (1,0), (5,2), (1,1), (2,5): 3.5 crossings per receiver-direction on
+ *     average, plus the interior samples below. The mean |a| + |b| of the default directions:
+ *     K = 16: 4.2, K = 64: 11.7, K = 256: 15.5, K = 360: 20.5 (the nearest with N = ceil(K/4)
+ *     would take 12.1, 51.5, 73). Measured (make bench, section exact, 512^2 and 1024^2,
+ *     K = 16): the horizon map 0.65-0.85x the lattice map's time on urban DSMs (no gather),
+ *     1.2-2.3x on fBm rough at the cell scale; the fused sky-view factor 1.2-2.1x and 2.1-4.1x;
+ *     at K = 64-360 on fBm 512^2 about 10-20x (docs/exact-rays.md, "Cost at large K").
  *   - Quadrature: every direction integral uses the actual azimuths phi_k. Direction k owns the
  *     sector between the midpoints to its neighbours (edges rounded to multiples of 2^-40 turn,
  *     so the shares w_k are exact and add up to exactly 1): the sky-view factor is
@@ -814,9 +839,9 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *   - Outputs are written at grid points directly (no gather). Scratch: one block of about
  *     8*width*height bytes (plus 12 for normals and 8*channels for the lighting sums) and the
  *     hull stack, 16*(16*(W + H + 2) + 4*border_cells) bytes.
- *   - Accuracy: against the exact maximum over the bilinear surface (occluders >= 1 cell away)
- *     the exact mode is within 0.004 deg mean and 0.08 deg p99 on urban boxes, terraces with
- *     one-cell cliffs and fBm (the lattice: 1-5 deg mean, 11-35 deg p99); docs/exact-rays.md. */
+ *   - Accuracy: against the supremum over the bilinear surface (every pair) the exact mode is
+ *     within 0.003 deg mean and 0.08 deg p99 on urban boxes, terraces with one-cell cliffs and
+ *     fBm (the lattice: 2-6 deg mean, 23-70 deg p99); docs/exact-rays.md. */
 
 /* ========================================================================================== */
 /* hfvis.c - search radius and tiles                                                          */
@@ -832,7 +857,8 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     at most floor(R / cell_size) node steps behind it (the lattice spacing is one cell); the
  *     receiver's value is the usual gather of its nodes (docs/errata.md E7), so its own cut-off
  *     is R blended over the nodes within 1.5 cells. R below one cell: the lattice sees nothing
- *     (-pi/2 everywhere but holes), exact rays still see the crossings nearer than R. R beyond
+ *     (-pi/2 everywhere but holes), exact rays still see the crossings nearer than R, the first
+ *     cell's t -> 0+ limit and the point at R ("Exact rays", near field). R beyond
  *     the field equals the unlimited run to the hull's rounding. With CLAMP/WRAP the border
  *     samples count like any other within R.
  *   - How ([P1] §5, Alg. 1 needs more: its hull answers "the highest over everything behind").
@@ -890,9 +916,10 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     stop their outward walk at R; they agree with the tree with R as they do without it
  *     (test/test_hfvis.c, p2t_radius_*).
  *   - Oracles, same cut-off: hfvis_horizon_lattice_naive (every node scans the nodes within R
- *     behind it) and hfvis_horizon_exact_naive (every receiver's own samples within R), held to
- *     the sweep bit for bit on the test fields (tolerance 1e-12 rad for last-bit ties of the
- *     hull's cross products); hfvis_horizon_reference marches out to min(R, max_distance_cells).
+ *     behind it), held to the sweep bit for bit on the test fields (tolerance 1e-12 rad for
+ *     last-bit ties of the hull's cross products), and hfvis_horizon_exact_naive (the supremum
+ *     within R: the sweep never above it, within HFVIS_EXACT_SUP_MEAN_DEG on average);
+ *     hfvis_horizon_reference marches out to min(R, max_distance_cells).
  *     The oracles compute every receiver (the rectangle and origin do not change their values).
  *   - Design notes and figures: docs/search-radius.md. */
 
@@ -906,10 +933,19 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
 HFVIS_API hfvis_status hfvis_sweep_azimuths(int K, const hfvis_sweep_options *opts,
                                             double *azimuths, double *weights);
 
-/* Oracle for the exact mode: for every grid point and direction, the maximum elevation over every
- * sample of its own ray (grid-line crossings and the interior samples of bulging pieces; the same
- * heights and quotients as the sweep), receiver by receiver. Always exact rays, whatever opts->rays says; otherwise the layout, range, border and
- * hole rules of hfvis_horizon_map. Equal to hfvis_horizon_map in exact mode bit for bit.
+/* The exact mode's horizons below the supremum of hfvis_horizon_exact_naive, over all receivers
+ * and directions of a field ("Exact rays", "Definition and bound"): mean and 99th percentile. */
+#define HFVIS_EXACT_SUP_MEAN_DEG 0.15
+#define HFVIS_EXACT_SUP_P99_DEG 1.5
+
+/* Oracle for the exact mode: for every grid point and direction, the supremum over t > 0 of the
+ * elevation along its own ray over the bilinear surface (within R under a radius), receiver by
+ * receiver: every grid-line crossing (the sweep's heights), every piece's stationary points in
+ * closed form, the first piece's t -> 0+ limit and the window's end ("Exact rays"). Pieces count
+ * where their cell is in reach (CLAMP/WRAP: border_cells beyond the grid) with four finite taps.
+ * Always exact rays, whatever opts->rays says; otherwise the layout, range, border and hole rules
+ * of hfvis_horizon_map. hfvis_horizon_map in exact mode is never above it and within the bound
+ * stated in "Exact rays".
  * Allocates 1 block (2N crossings). Cost O(K*width*height*(max(W, H) + border_cells)). */
 HFVIS_API hfvis_status hfvis_horizon_exact_naive(const hfvis_grid *grid, int K,
                                                  const hfvis_sweep_options *opts, float *out);
