@@ -3,7 +3,7 @@
  * band" (10 % per side: 1280(+256) x 720(+144)), K = 8 and 16, falloff radii from a few pixels to
  * the whole screen. HBAO runs at matching quality: the same box directions and integer steps
  * as LSAO (every texel of the direction's pattern up to the falloff's support, the brute force
- * LSAO's hull replaces, [P3] Fig. 7), so the two differ only by the gather and the hull's
+ * LSAO's hull replaces, [P3] Fig. 7; its screen-radius cap lifted to the buffer diagonal), so the two differ only by the gather and the hull's
  * degenerate cases (mean |d| printed). Its step count grows with the radius, as [P3] Table 1.
  * For large radii HBAO is timed on a band of rows through the image centre (its cost per pixel
  * there is printed; the band is where the knot is, so it is not cheaper than the average). */
@@ -184,6 +184,10 @@ void bench_ssao(int quick)
                 ho.tangent = HFVIS_SSAO_TANGENT_FIXED;
                 ho.plane = HFVIS_SSAO_PLANE_PAPER;
                 ho.falloff = lo.falloff;
+                /* march to the falloff's support at every radius (the default screen-radius cap
+                 * would stop HBAO short of it at R >= 1 and compare unequal quality): the cap is
+                 * the buffer diagonal, which hfvis_hbao takes as "no cap" */
+                ho.max_radius_px = sqrt((double)W0 * (double)W0 + (double)H0 * (double)H0);
                 /* a band small enough for ~1-2 s: cost ~ K (R_px / 2.4 px) samples per pixel */
                 cost = (double)K * (R * 125.0 * (double)W / 1280.0 / 2.4 + 1.0);
                 if (cost > 2.0 * (double)W) cost = 2.0 * (double)W; /* capped by the buffer */
