@@ -6,7 +6,8 @@
  * LSAO's hull replaces, [P3] Fig. 7; its screen-radius cap lifted to the buffer diagonal), so the two differ only by the gather and the hull's
  * degenerate cases (mean |d| printed). Its step count grows with the radius, as [P3] Table 1.
  * For large radii HBAO is timed on a band of rows through the image centre (its cost per pixel
- * there is printed; the band is where the knot is, so it is not cheaper than the average). */
+ * there is printed; the band is where the knot is, so it is not cheaper than the average).
+ * Times are process CPU time (single-threaded; the machine may be shared). */
 #define _POSIX_C_SOURCE 199309L
 #include "bench.h"
 #include "hfvis.h"
@@ -65,9 +66,9 @@ static double bench_ssao_lsao(const hfvis_camera *cam, const float *depth,
     double best = 1e30;
     int r;
     for (r = 0; r < reps; r++) {
-        double t0 = bench_now(), t;
+        double t0 = bench_cpu_now(), t;
         if (hfvis_lsao(cam, depth, NULL, o, ao, cam->width - 2 * cam->guard_x) != HFVIS_OK) return -1.0;
-        t = bench_now() - t0;
+        t = bench_cpu_now() - t0;
         if (t < best) best = t;
     }
     return best;
@@ -85,9 +86,9 @@ static double bench_ssao_hbao(const hfvis_camera *cam, const float *depth,
     skip = (IH - rows) / 2;
     band.guard_y = cam->guard_y + skip;
     rows = cam->height - 2 * band.guard_y;
-    t0 = bench_now();
+    t0 = bench_cpu_now();
     if (hfvis_hbao(&band, depth, NULL, o, ao + (size_t)skip * (size_t)IW, IW) != HFVIS_OK) return -1.0;
-    t = bench_now() - t0;
+    t = bench_cpu_now() - t0;
     return t * (double)IH / (double)rows; /* per whole image */
 }
 
@@ -111,12 +112,12 @@ static void bench_ssao_breakdown(const hfvis_camera *cam, const float *depth,
         lines = (hfvis_ssao_line *)malloc(sizeof *lines * (size_t)L.line_count);
         vals = (float *)malloc(sizeof(float) * 2 * L.sample_count);
         hfvis_ssao_lattice_lines(cam, &L, lines);
-        t0 = bench_now();
+        t0 = bench_cpu_now();
         hfvis_lsao_direction(cam, depth, NULL, o, &L, lines, vals, vals + L.sample_count);
-        *t_sweep += bench_now() - t0;
-        t0 = bench_now();
+        *t_sweep += bench_cpu_now() - t0;
+        t0 = bench_cpu_now();
         hfvis_lsao_gather(cam, depth, NULL, o, &L, lines, vals, vals + L.sample_count, acc, acc + n);
-        *t_gather += bench_now() - t0;
+        *t_gather += bench_cpu_now() - t0;
         free(vals);
         free(lines);
     }
