@@ -682,7 +682,7 @@ static hfvis_status ss_fall_load(const hfvis_falloff *f, ss_fall *o)
 static double ss_rho_general(const ss_fall *f, double d);
 
 /* rho(d): the rational falloffs inline, the rest out of line. */
-static double ss_rho(const ss_fall *f, double d)
+static inline double ss_rho(const ss_fall *f, double d)
 {
     if (f->kind == HFVIS_FALLOFF_INV_QUADRATIC) return f->a / (f->a + d * d);
     if (f->kind == HFVIS_FALLOFF_HBAO) {
@@ -1245,7 +1245,7 @@ static void ss_cfg_from_lsao(const hfvis_lsao_options *o, ss_cfg *g)
 
 /* Occ of point (hx, hy) = occluder - receiver seen along zenith (ux, uy) with tangent st
  * ([P3] Alg. 1 l.25-29); *sin_out = Sin(h) (-inf for a coincident point, which casts st). */
-static double ss_occ(const ss_fall *f, double hx, double hy, double ux, double uy, double st,
+static inline double ss_occ(const ss_fall *f, double hx, double hy, double ux, double uy, double st,
                      double tiny, double *sin_out)
 {
     double len = sqrt(hx * hx + hy * hy), s;
