@@ -1717,13 +1717,6 @@ static void hf_receiver_rect(const hfvis_grid *g, const hfvis_sweep_options *o, 
     *y1 = o->receiver_y + o->receiver_height;
 }
 
-/* A finite radius, a window or a receiver rectangle: the routines outside the [P1] sweep
- * (openness) refuse them. */
-static int hf_sweep_opts_limited(const hfvis_sweep_options *o)
-{
-    return o && (hf_radius_on(o) || o->extent_width != 0 || o->receiver_width != 0);
-}
-
 /* A window or a receiver rectangle: the P2 hull-tree routines of section 11 refuse them (they
  * honour the radius). */
 static int hf_p2_opts_limited(const hfvis_sweep_options *o)
@@ -3278,9 +3271,13 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
         !isfinite(radius) || radius < 0.0 || !isfinite(step) || (oo && !(oo->step_cells >= 0.0)) ||
         (negative != 0 && negative != 1 && negative != 2) || (negative == 2 && H > INT_MAX / 2))
         return HFVIS_ERR_INVALID_ARGUMENT;
-    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
+    /* a radius honours a receiver rectangle (each receiver's march is its own); a search radius
+     * or a window is not honoured here, nor a rectangle without a radius */
+    if (opts && (hf_radius_on(opts) || opts->extent_width != 0 || (radius == 0.0 && opts->receiver_width != 0)))
+        return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
     if (radius > 0.0) { /* the march: no allocation; both signs from one walk when negative == 2 */
+        int rx0, ry0, rx1, ry1;
         hf_surface S;
         const double maxd = radius / grid->cell_size;
         const int which = negative == 2 ? 3 : negative ? 2 : 1;
@@ -3291,8 +3288,9 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
         S.cell_size = grid->cell_size;
         S.border = o.border;
         S.reach = o.border == HFVIS_BORDER_OPEN ? 0.0 : (double)o.border_cells;
-        for (y = 0; y < H; y++) {
-            for (x = 0; x < W; x++) {
+        hf_receiver_rect(grid, &o, &rx0, &ry0, &rx1, &ry1);
+        for (y = ry0; y < ry1; y++) {
+            for (x = rx0; x < rx1; x++) {
                 const ptrdiff_t i = (ptrdiff_t)y * out_stride + x;
                 double h0 = (double)grid->z[(ptrdiff_t)y * grid->stride + x], sum[2] = {0.0, 0.0};
                 if (!isfinite(h0)) {
@@ -3314,7 +3312,7 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
                 } else
                     out[i] = (float)(sum[negative] / (double)K);
             }
-            hf_progress(&o, y + 1, H);
+            hf_progress(&o, y - ry0 + 1, ry1 - ry0);
         }
     } else if (negative == 2) { /* the sweep: the positive plane, then the negative one */
         hfvis_openness_options one = *oo;

@@ -746,7 +746,10 @@ typedef struct hfvis_openness_options {
 HFVIS_API hfvis_openness_options hfvis_openness_options_default(void);
 
 /* Openness at every grid point, out[y*out_stride + x]. opts: border, border_cells, azimuth0_rad,
- * alloc and progress; the direction range is not honoured (all K).
+ * alloc and progress, and with radius > 0 the receiver rectangle (its cells only are written, each
+ * equal to the whole call's bit for bit: threads split one call by row bands); the direction
+ * range is not honoured (all K); a search radius (max_distance), a window, or a rectangle
+ * without a radius is HFVIS_ERR_INVALID_ARGUMENT.
  * radius > 0: the per-receiver march of hfvis_horizon_reference out to the radius, at step_cells
  *   (so the same bilinear samples as the oracle with max_distance_cells = radius/cell_size),
  *   O(K*W*H*radius/(cell_size*step_cells)); no allocation; progress once per row. Both signs

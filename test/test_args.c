@@ -1288,6 +1288,20 @@ static void args_openness(void)
     oo.negative = -1; BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
     GRID_CASES(hfvis_openness(&bg, 4, NULL, NULL, out, GW));
     SWEEP_OPT_CASES(hfvis_openness(&g_ok, 4, NULL, &bo, out, GW));
+    { /* a receiver rectangle with a radius; not without one, nor a search radius or a window */
+        hfvis_sweep_options ro = hfvis_sweep_options_default();
+        ro.receiver_x = ro.receiver_y = 1;
+        ro.receiver_width = ro.receiver_height = 2;
+        oo.negative = 0;
+        oo.radius = 2.0;
+        OK(hfvis_openness(&g_ok, 4, &oo, &ro, out, GW));
+        oo.radius = 0.0;
+        BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, &ro, out, GW));
+        ro = hfvis_sweep_options_default();
+        ro.max_distance = 2.0;
+        oo.radius = 2.0;
+        BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, &ro, out, GW));
+    }
 }
 
 static void args_sweep_azimuths(void)

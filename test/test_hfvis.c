@@ -1990,6 +1990,27 @@ TEST(openness_closed_forms_and_oracle)
                 CHECK(memcmp(both + N, one, sizeof one) == 0);
                 CHECK(isnan(both[7 * W + 9]) && isnan(both[N + 7 * W + 9]));
             }
+        /* with a radius, row bands (receiver rectangles) tile the whole call bit for bit */
+        for (r = 0; r < 2; r++) {
+            const int cut[4] = {0, 13, 14, H};
+            int q;
+            oo.radius = radii[r];
+            oo.negative = 2;
+            o.border = r ? HFVIS_BORDER_CLAMP : HFVIS_BORDER_OPEN;
+            CHECK_EQ_STATUS(hfvis_openness(&g, 12, &oo, &o, both, W), HFVIS_OK);
+            {
+                static float bands[2 * N];
+                for (i = 0; i < 2 * N; i++) bands[i] = -5.0f;
+                for (q = 0; q < 3; q++) {
+                    hfvis_sweep_options bo = o;
+                    bo.receiver_y = cut[q];
+                    bo.receiver_height = cut[q + 1] - cut[q];
+                    bo.receiver_width = W;
+                    CHECK_EQ_STATUS(hfvis_openness(&g, 12, &oo, &bo, bands, W), HFVIS_OK);
+                }
+                CHECK(memcmp(both, bands, sizeof bands) == 0);
+            }
+        }
         o.border = HFVIS_BORDER_OPEN;
         o.azimuth0_rad = 0.0;
         oo.negative = 0;
