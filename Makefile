@@ -68,7 +68,7 @@ $(BUILD)/examples/%: examples/%.c examples/common.h examples/fields.h $(LIB)
 	$(CC) $(ALL_CFLAGS) -I. $< $(LIB) $(LDLIBS) -o $@
 $(CLI): $(wildcard examples/cli/*.c) examples/cli/cli.h examples/common.h examples/raster_io.h $(LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(ALL_CFLAGS) -I. examples/cli/main.c $(LIB) $(LDLIBS) -o $@
+	$(CC) $(ALL_CFLAGS) $(PTHREAD) -I. examples/cli/main.c $(LIB) $(LDLIBS) -o $@
 $(BENCH): examples/bench/bench.c $(wildcard examples/bench/bench_*.c) examples/bench/bench.h examples/common.h examples/fields.h $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -I. examples/bench/bench.c $(wildcard examples/bench/bench_*.c) $(LIB) $(LDLIBS) -o $@

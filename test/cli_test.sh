@@ -884,6 +884,63 @@ longa=$(awk 'BEGIN { for (i = 0; i < 247; i++) printf "%c", 97 + i % 26 }').asc
 expect_ok "a 251-byte ASCII grid output name" "$dir/$longa" skyview "$dir/flat.pgm" --dirs 4 -o "$dir/$longa"
 rm -f "$dir/$longa"
 
+# ---- --threads: every split command's output is the one-thread run's byte for byte ------------
+# rough.pgm: 61 x 53 ridges with a one-cell wall and NoData holes (value 0, --nodata 0)
+awk 'BEGIN { w = 61; h = 53; print "P2"; print w, h; print 65535
+  for (y = 0; y < h; y++) { s = ""; for (x = 0; x < w; x++) {
+    v = int(30000 + 9000 * sin(x / 4.3) * cos(y / 3.1) + 4000 * sin((x + 2 * y) / 2.2))
+    if (x == 30) v += 20000; if ((x * 7 + y * 13) % 97 == 0) v = 0; s = s " " v }; print s } }' > "$dir/rough.pgm"
+r=$dir/rough.pgm
+while IFS='|' read -r name args; do
+  [ -n "$name" ] || continue
+  # shellcheck disable=SC2086 # $args is a list of flags
+  for t in 1 2 3; do "$hfvis" $args "$r" --nodata 0 --cell 3 --quiet --threads $t -o "$dir/thr$t.pfm" 2> "$dir/terr" || break; done
+  if [ -s "$dir/thr3.pfm" ] && cmp -s "$dir/thr1.pfm" "$dir/thr2.pfm" && cmp -s "$dir/thr1.pfm" "$dir/thr3.pfm"; then ok "--threads 1/2/3 equal: $name"
+  else bad "--threads 1/2/3 differ or fail: $name $(cat "$dir/terr")"; fi
+  rm -f "$dir"/thr?.pfm
+done <<EOF
+horizon K=16|horizon --dirs 16
+horizon K=10|horizon --dirs 10 --convention grass
+horizon exact|horizon --dirs 12 --exact
+skyview K=16|skyview --dirs 16
+skyview K=7|skyview --dirs 7 --azimuth0 10
+skyview exact|skyview --dirs 16 --exact
+skyview radius clamp|skyview --dirs 16 --max-distance 40 --border clamp
+sky|sky --dirs 16 --sky 2 --albedo 0.5
+sky exact|sky --dirs 8 --exact
+light rgb|light --dirs 8 --env $dir/env3.pfm
+light exact|light --dirs 12 --exact --env $dir/env1.pfm
+shadow|shadow --sun-azimuth 315 --sun-elevation 10
+shadow exact disc|shadow --sun-azimuth 100 --sun-elevation 5 --exact --sun-radius 0.27
+hillshade|hillshade --sun-azimuth 315 --sun-elevation 15
+hillshade lattice blend|hillshade --lattice --blend 3
+openness both|openness --radius 20 --both
+openness clamp|openness --radius 12 --border clamp --negative
+EOF
+# a window piece is the same on any number of threads too (windows read PFM: heights from the tool)
+"$hfvis" hillshade "$r" --nodata 0 --no-shadows --quiet -o "$dir/rough.pfm"
+for t in 1 2; do "$hfvis" skyview "$dir/rough.pfm" --cell 0.05 --max-distance 1.5 --window 10,8,30,25 --threads $t \
+  --quiet -o "$dir/win$t.pfm" 2> "$dir/terr"; done
+cmp -s "$dir/win1.pfm" "$dir/win2.pfm" && ok "--threads with --window: the piece is the same" || bad "--threads with --window: $(cat "$dir/terr")"
+"$hfvis" skyview "$r" --dirs 16 --dir-range 0:8 --threads 2 -o "$fdir/p.hfvs" 2> "$dir/terr"
+[ $? -eq 2 ] && grep -q -- '--threads' "$dir/terr" && ok "--threads 2 with --dir-range refused by name" || bad "--threads with --dir-range: $(cat "$dir/terr")"
+"$hfvis" openness "$r" --threads 2 -o "$fdir/o.pfm" 2> "$dir/terr"
+[ $? -eq 2 ] && grep -q -- '--threads' "$dir/terr" && ok "openness --threads 2 without --radius refused by name" || bad "openness --threads: $(cat "$dir/terr")"
+"$hfvis" viewshed "$r" --observer 5,5 --threads 2 -o "$fdir/v.pfm" 2> "$dir/terr"
+[ $? -eq 2 ] && grep -q -- '--threads is not used by viewshed' "$dir/terr" && ok "viewshed refuses --threads by name" || bad "viewshed --threads: $(cat "$dir/terr")"
+# hillshade's shadows are those of shadow --exact: every cell it darkens is dark, lit cells keep
+# the local shading (--no-shadows)
+"$hfvis" hillshade "$r" --nodata 0 --cell 3 --sun-azimuth 300 --sun-elevation 12 --quiet -o "$dir/hs.pfm" &&
+"$hfvis" shadow "$r" --nodata 0 --cell 3 --sun-azimuth 300 --sun-elevation 12 --exact --quiet -o "$dir/sx.pfm" &&
+"$hfvis" hillshade "$r" --nodata 0 --cell 3 --sun-azimuth 300 --sun-elevation 12 --no-shadows --quiet -o "$dir/hn.pfm"
+if [ -s "$dir/hs.pfm" ] && [ -s "$dir/sx.pfm" ] && [ -s "$dir/hn.pfm" ]; then
+  for f in sx hs hn; do tail -c +$(($(head -3 "$dir/$f.pfm" | wc -c) + 1)) "$dir/$f.pfm" | od -An -v -tf4 -w4 > "$dir/$f.txt"; done
+  res=$(paste "$dir/sx.txt" "$dir/hs.txt" "$dir/hn.txt" | awk '$1 == "nan" || $1 == "-nan" { next }
+    $1 == 0 { dark++; if ($2 != 0) miss++ } $1 == 1 && $2 != $3 { lit++ } END { printf "%d %d %d", dark, miss, lit }')
+  set -- $res
+  [ "$1" -gt 0 ] && [ "$2" -eq 0 ] && [ "$3" -eq 0 ] && ok "hillshade shadows = shadow --exact ($1 shadow cells)" || bad "hillshade vs shadow --exact: dark $1, missed $2, lit changed $3"
+else bad "hillshade/shadow --exact did not run"; fi
+
 # ---- every command x every flag, from the tables ('hfvis --list-commands', '--list-flags') ----
 # A flag the command does not use: exit 2, one line "hfvis: CMD: FLAG is not used by CMD". A flag
 # it uses, given the value '@bad' (or none for a switch): never refused as unused or unknown,

@@ -101,6 +101,8 @@ typedef struct cli_args {
     double lk_radius, lk_fov, lk_seed, lk_eye[3], lk_target[3], lk_up[3];
     double max_memory; /* --max-memory bytes, 0 = no limit (default: cli_default_max_memory) */
     int has_window, win_x, win_y, win_w, win_h; /* --window X0,Y0,W,H (cells; docs/tiles.md) */
+    int threads, has_threads; /* --threads N (threads.c); default the online cores */
+    int lattice;              /* hillshade --lattice: lattice-mode shadows (default exact rays) */
 } cli_args;
 
 /* ssao --method, --depth */
@@ -145,6 +147,9 @@ static const char *const cli_conv_names[3] = { "compass", "grass", "grid" };
 /* the sweep commands: --max-distance R is the library's search radius, --window makes a piece */
 #define CLI_SWEEP (CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_SHADOW) \
                    | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_HILLSHADE))
+/* the commands whose work splits over threads bit for bit (--threads, threads.c) */
+#define CLI_THREADED (CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT) \
+                      | CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_HILLSHADE) | CLI_ONLY(CMD_OPENNESS))
 /* the [P2] hull-tree commands: a search radius but no windows in the library (hfvis.h, "Search
  * radius and tiles") */
 #define CLI_P2 (CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_INDIRECT))

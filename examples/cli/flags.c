@@ -114,7 +114,8 @@ static const cli_flag cli_flags[] = {
       "clamp/wrap: lines start N cells outside the grid, 1..1048576\n"
       "                    (default max(width, height))\n" },
     { "--exact", NULL, CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY)
-                      | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_AZIMUTHS),
+                      | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_AZIMUTHS)
+                      | CLI_ONLY(CMD_HILLSHADE),
       "horizon, skyview, sky, light, shadow: exact rays (beyond [P1]): every\n"
       "                    sample gets its own ray along the nearest rational direction, no\n"
       "                    interpolation between lattice lines (right at walls, roofs, cliffs;\n"
@@ -150,6 +151,10 @@ static const cli_flag cli_flags[] = {
       "                    where the system reports it (sysconf), else no limit. The estimate and\n"
       "                    the work (lattice nodes swept, rays, voxel updates) are printed on\n"
       "                    stderr with the progress bar\n" },
+    { "--threads", "N", CLI_THREADED,
+      "horizon, skyview, sky, light, shadow, hillshade, openness --radius: run\n"
+      "                    on N threads, 1..256 (default: the online cores); the output is the\n"
+      "                    one-thread run's bit for bit (directions, bands across the sun, rows)\n" },
     { "--sky", "C", CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI), NULL },
     { "--albedo", "A", CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT)
                      | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VOLGI), NULL },
@@ -225,6 +230,8 @@ static const cli_flag cli_flags[] = {
     { "--blend", "N", CLI_ONLY(CMD_HILLSHADE), NULL },
     { "--no-shadows", NULL, CLI_ONLY(CMD_HILLSHADE), NULL },
     { "--negative", NULL, CLI_ONLY(CMD_OPENNESS), NULL },
+    { "--both", NULL, CLI_ONLY(CMD_OPENNESS), NULL },
+    { "--lattice", NULL, CLI_ONLY(CMD_HILLSHADE), NULL },
 };
 #define CLI_NFLAGS (sizeof cli_flags / sizeof cli_flags[0])
 
@@ -468,6 +475,10 @@ static int cli_set(cli_args *a, const char *f, const char *v)
     if (!strcmp(f, "--max-distance"))
         return cli_real(f, v, 0.0, 0, DBL_MAX, "a distance >= 0", &a->max_distance);
     if (!strcmp(f, "--exact")) { a->exact = 1; return 0; }
+    if (!strcmp(f, "--threads")) {
+        a->has_threads = 1;
+        return cli_int(f, v, 1, CLI_THREADS_MAX, "an integer 1..256", &a->threads);
+    }
     if (!strcmp(f, "--window")) { /* X0,Y0,W,H in cells; clipped to the raster when it is read */
         long n[4];
         const char *p = v;
@@ -564,6 +575,7 @@ static int cli_parse(int argc, char **argv, cli_args *a)
     memset(a, 0, sizeof *a);
     a->cell = 1.0; a->zscale = 1.0; a->dirs = 16; a->sky = 1.0; a->albedo = 1.0;
     a->max_memory = cli_default_max_memory();
+    a->threads = cli_threads_online();
     a->border = HFVIS_BORDER_OPEN; a->method = HFVIS_ENV_PREFIX;
     a->bounces = 1; a->sun_irradiance = CLI_PI; a->output = OUT_TOTAL;
     a->order = 4; a->subsample = 1;
@@ -636,7 +648,19 @@ static int cli_parse(int argc, char **argv, cli_args *a)
                              "%d:%d", a->dirs, a->dir_begin, a->dir_end);
         if (a->stats)
             return cli_error(CLI_EXIT_USAGE, "--stats", "cannot be combined with --dir-range");
+        if (a->has_threads && a->threads > 1)
+            return cli_error(CLI_EXIT_USAGE, "--threads", "a --dir-range part runs on one thread: "
+                             "split the range into more parts instead");
+        a->threads = 1;
     }
+    if (a->cmd == CMD_HILLSHADE) { /* a GIS product: exact shadows unless --lattice */
+        if (a->lattice && a->exact)
+            return cli_error(CLI_EXIT_USAGE, "--lattice", "cannot be combined with --exact");
+        a->exact = !a->lattice;
+    }
+    if (a->has_threads && a->threads > 1 && a->cmd == CMD_OPENNESS && !(a->radius > 0.0))
+        return cli_error(CLI_EXIT_USAGE, "--threads", "openness splits over threads with --radius R "
+                         "only (unlimited openness runs on one thread)");
     if (cli_commands[a->cmd].check && cli_commands[a->cmd].check(a)) return CLI_EXIT_USAGE;
     if (a->has_window && cli_check_window(a)) return CLI_EXIT_USAGE;
     return CLI_RUN;

@@ -126,7 +126,13 @@ static int cli_set_gis(cli_args *a, const char *f, const char *v)
     }
     if (!strcmp(f, "--blend")) return cli_int(f, v, 1, 360, "a count of sun directions 1..360", &a->blend);
     if (!strcmp(f, "--no-shadows")) { a->no_shadows = 1; return 0; }
-    if (!strcmp(f, "--negative")) { a->negative = 1; return 0; }
+    if (!strcmp(f, "--negative") || !strcmp(f, "--both")) {
+        if (a->negative != 0)
+            return cli_error(CLI_EXIT_USAGE, f, "give one of --negative and --both");
+        a->negative = !strcmp(f, "--both") ? 2 : 1; /* hfvis_openness_options.negative */
+        return 0;
+    }
+    if (!strcmp(f, "--lattice")) { a->lattice = 1; return 0; }
     if (a->cmd == CMD_OPENNESS && !strcmp(f, "--radius")) {
         a->has_radius = 1;
         return cli_real(f, v, 0.0, 0, DBL_MAX, "a distance >= 0 (0 = unlimited)", &a->radius);

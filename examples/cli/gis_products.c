@@ -74,8 +74,9 @@ static int cli_run_viewshed(const cli_args *a, const hfvis_grid *grid, float *ou
 
 /* hillshade: H = (1/N) sum_j max(n . l_j, 0) V_j over N suns spread evenly in azimuth from
  * --sun-azimuth (N = --blend), n the grid normal, l_j the direction of sun j's centre and V_j its
- * visibility from the exact sweep (hfvis_sun_visibility: 0/1, or the visible fraction of a disc
- * of --sun-radius), V_j = 1 with --no-shadows. In [0, 1]; NaN at holes. */
+ * visibility from exact rays (hfvis_sun_visibility: 0/1, or the visible fraction of a disc of
+ * --sun-radius; --lattice: the lattice sweep), V_j = 1 with --no-shadows. In [0, 1]; NaN at
+ * holes. A GIS product: the shadows are those of `shadow --exact`, cell for cell. */
 static int cli_run_hillshade(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
                              cli_progress_state *prog, float *out)
 {
@@ -97,7 +98,7 @@ static int cli_run_hillshade(const cli_args *a, const hfvis_grid *grid, hfvis_sw
             for (i = 0; i < n; i++) vis[i] = 1.0f;
             if (opts->progress) opts->progress(opts->progress_user, 1, 1);
         } else {
-            s = hfvis_sun_visibility(grid, psi, el, a->sun_radius * (CLI_PI / 180.0), opts, vis, w);
+            s = cli_threaded_sun(grid, psi, el, a->sun_radius * (CLI_PI / 180.0), opts, a->threads, vis, w);
         }
         for (i = 0; s == HFVIS_OK && i < n; i++) {
             double d = (double)nrm[3 * i] * l[0] + (double)nrm[3 * i + 1] * l[1] + (double)nrm[3 * i + 2] * l[2];
@@ -124,9 +125,10 @@ static int cli_run_openness(const cli_args *a, const hfvis_grid *grid, hfvis_swe
     memset(&oo, 0, sizeof oo);
     oo.radius = a->radius;
     oo.negative = a->negative;
-    prog->total = a->radius > 0.0 ? grid->height : a->dirs; /* rows of the march, or directions */
-    s = hfvis_openness(grid, a->dirs, &oo, opts, out, grid->width);
+    prog->total = a->radius > 0.0 ? grid->height : a->dirs * (a->negative == 2 ? 2 : 1);
+    s = cli_threaded_openness(grid, a->dirs, &oo, opts, a->threads, out);
     if (s != HFVIS_OK) return cli_status("openness", s, 0);
+    if (a->negative == 2) n *= 2; /* --both: positive, then negative */
     if (a->degrees)
         for (i = 0; i < n; i++) out[i] = (float)((double)out[i] * (180.0 / CLI_PI));
     return 0;
@@ -180,7 +182,8 @@ static int cli_run_gis(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_op
                        cli_progress_state *prog)
 {
     const int w = grid->width, h = grid->height;
-    float *out = cli_alloc((size_t)w, (size_t)h, 1);
+    const int planes = a->cmd == CMD_OPENNESS && a->negative == 2 ? 2 : 1; /* openness --both */
+    float *out = cli_alloc((size_t)w, (size_t)h, (size_t)planes);
     double lo = 0.0, hi = 1.0;
     int rc;
     if (!out) return cli_status(cli_commands[a->cmd].name, HFVIS_ERR_OUT_OF_MEMORY, 0);
@@ -197,7 +200,7 @@ static int cli_run_gis(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_op
     } else {
         rc = cli_error(CLI_EXIT_ERROR, cli_commands[a->cmd].name, "internal error: not a GIS product");
     }
-    if (rc == 0) rc = cli_save(a, cli_output_of(out, w, h, 1, 1, lo, hi));
+    if (rc == 0) rc = cli_save(a, cli_output_of(out, w, h, planes, 1, lo, hi));
     free(out);
     return rc;
 }

@@ -114,9 +114,9 @@
 
 #define CLI_HILLSHADE_HELP                                                                           \
     "usage: hfvis hillshade IN -o OUT [--sun-azimuth A] [--sun-elevation E] [--sun-radius R]\n"    \
-    "         [--blend N] [--no-shadows] [options]\n"                                              \
+    "         [--blend N] [--no-shadows] [--lattice] [options]\n"                                  \
     "Shaded relief with cast shadows: H = (1/N) sum_j max(n . l_j, 0) V_j, n the grid normal, l_j\n" \
-    "the direction of sun j and V_j its visibility from the exact sweep toward it (0 in shadow,\n" \
+    "the direction of sun j and V_j its visibility from exact rays toward it (0 in shadow,\n" \
     "1 lit; with --sun-radius the visible fraction of the sun disc: soft shadows). In [0, 1];\n"   \
     "without shadows it is the classic hillshade cos(zenith) cos(slope) + sin(zenith) sin(slope)\n" \
     "cos(azimuth - aspect) (gdaldem hillshade / 255). NaN at holes. Default PGM range 0:1.\n"     \
@@ -124,10 +124,13 @@
     "  --sun-elevation E elevation of the sun, -90..90 (default 45)\n"                            \
     "  --sun-radius R    angular radius of the sun disc, 0..90 (default 0; the real sun 0.27)\n"  \
     "  --blend N         multi-directional: N suns at A + 360 j/N, averaged (default 1)\n"         \
-    "  --no-shadows      V_j = 1: the local hillshade only\n"
+    "  --no-shadows      V_j = 1: the local hillshade only\n"                                    \
+    "  --lattice         shadows from the [P1] lattice sweep instead of exact rays (faster; misses\n" \
+    "                    shadow cells next to walls and cliffs; --exact names the default)\n"
 
 #define CLI_OPENNESS_HELP                                                                            \
-    "usage: hfvis openness IN -o OUT [--radius R] [--negative] [--dirs K] [--degrees] [options]\n" \
+    "usage: hfvis openness IN -o OUT [--radius R] [--negative | --both] [--dirs K] [--degrees]\n" \
+    "         [options]\n"                                                                          \
     "Topographic openness (Yokoyama, Shirasawa & Pike 2002): the mean over K directions of the\n"  \
     "zenith angle pi/2 - beta_k, beta_k the largest elevation angle of the terrain within the\n"   \
     "horizontal distance R (positive openness); --negative: the mean nadir angle pi/2 + delta_k,\n" \
@@ -138,6 +141,8 @@
     "                    unlimited: the exact sweep, O(K W H)); R > 0: a bilinear ray march in\n"  \
     "                    1-cell steps, O(K W H R/cell) (RVT's and SAGA's radius); hfvis_openness\n" \
     "  --negative        negative openness\n"                                                      \
+    "  --both            positive and negative openness in one run (one march serves both):\n"    \
+    "                    OUT holds two planes (bands), positive then negative\n"                   \
     "  --dirs K          directions (default 8, the paper's)\n"                                     \
     "  --degrees         output in degrees (default radians)\n"                                     \
     "Default PGM range 0:pi (0:180 with --degrees).\n"

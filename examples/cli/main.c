@@ -6,6 +6,7 @@
 #include "cli.h"
 #include "help.c"
 #include "progress.c"
+#include "threads.c"
 #include "flags.c"
 #include "gis.c"
 #include "write.c"

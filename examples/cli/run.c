@@ -295,7 +295,8 @@ static int cli_run_heights(const cli_args *a)
 
     switch (a->cmd) {
     case CMD_HORIZON:
-        s = hfvis_horizon_map(&grid, a->dirs, &opts, out);
+        s = a->threads > 1 ? cli_threaded_horizon_map(&grid, a->dirs, &opts, a->threads, out)
+                           : hfvis_horizon_map(&grid, a->dirs, &opts, out);
         if (s == HFVIS_OK && a->degrees) {
             size_t i, n = (size_t)w * (size_t)h * (size_t)planes;
             for (i = 0; i < n; i++) out[i] = (float)((double)out[i] * (180.0 / CLI_PI));
@@ -303,24 +304,30 @@ static int cli_run_heights(const cli_args *a)
         }
         break;
     case CMD_SKYVIEW:
-        s = hfvis_sky_view_factor(&grid, a->dirs, &opts, out, w);
+        s = a->threads > 1 ? cli_threaded_light(CMD_SKYVIEW, &grid, a->dirs, 0.0, NULL, NULL, &opts,
+                                                a->threads, 1, out)
+                           : hfvis_sky_view_factor(&grid, a->dirs, &opts, out, w);
         break;
     case CMD_SKY:
-        s = hfvis_sky_light(&grid, a->dirs, (float)a->sky, (float)a->albedo, &opts, out, w);
+        s = a->threads > 1 ? cli_threaded_light(CMD_SKY, &grid, a->dirs,
+                                                (double)(float)a->sky * (double)(float)a->albedo, NULL,
+                                                NULL, &opts, a->threads, 1, out)
+                           : hfvis_sky_light(&grid, a->dirs, (float)a->sky, (float)a->albedo, &opts, out, w);
         if (a->sky * a->albedo <= CLI_FLT_MAX && (float)(a->sky * a->albedo) > 0.0f)
             hi = a->sky * a->albedo;
         break;
     case CMD_SHADOW: {
         double bearing_or_psi = a->math ? a->sun_azimuth : a->sun_azimuth - 90.0;
-        s = hfvis_sun_visibility(&grid, bearing_or_psi * (CLI_PI / 180.0),
-                                 a->sun_elevation * (CLI_PI / 180.0),
-                                 a->sun_radius * (CLI_PI / 180.0), &opts, out, w);
+        s = cli_threaded_sun(&grid, bearing_or_psi * (CLI_PI / 180.0), a->sun_elevation * (CLI_PI / 180.0),
+                             a->sun_radius * (CLI_PI / 180.0), &opts, a->threads, out, w);
         break;
     }
     case CMD_LIGHT: {
         hfvis_env_options eopts = hfvis_env_options_default();
         eopts.method = (hfvis_env_method)a->method;
-        s = hfvis_env_light(&grid, a->dirs, &env, (float)a->albedo, &opts, &eopts, out, w);
+        s = a->threads > 1 ? cli_threaded_light(CMD_LIGHT, &grid, a->dirs, (double)(float)a->albedo, &env,
+                                                &eopts, &opts, a->threads, channels, out)
+                           : hfvis_env_light(&grid, a->dirs, &env, (float)a->albedo, &opts, &eopts, out, w);
         if (s == HFVIS_OK) hi = cli_top(out, (size_t)w * (size_t)h * (size_t)channels, 1.0);
         break;
     }

@@ -424,7 +424,7 @@ static int cli_sum(int argc, char **argv)
         hfvis_partial_free(NULL, &p);
     }
     if (cmd == CMD_SKYVIEW) {
-        for (k = 0; k < n; k++) out[k] = (float)(1.0 + (-1.0 / (double)K) * acc[k]);
+        for (k = 0; k < n; k++) out[k] = cli_sum_finish(CMD_SKYVIEW, K, 0.0, acc[k]);
     } else if (cmd == CMD_SKY) {
         double sky = 0.0, albedo = 0.0, scale;
         if (!cli_tag_real(meta[0].tag, "sky", &sky) || !cli_tag_real(meta[0].tag, "albedo", &albedo)) {
@@ -432,7 +432,7 @@ static int cli_sum(int argc, char **argv)
             goto done;
         }
         scale = (double)(float)sky * (double)(float)albedo; /* the floats the single run passes */
-        for (k = 0; k < n; k++) out[k] = (float)(0.0 + scale * acc[k]);
+        for (k = 0; k < n; k++) out[k] = cli_sum_finish(CMD_SKY, K, scale, acc[k]);
         if (sky * albedo <= CLI_FLT_MAX && (float)(sky * albedo) > 0.0f) hi = sky * albedo;
     } else if (cmd == CMD_LIGHT) {
         double albedo = 0.0;
@@ -444,7 +444,7 @@ static int cli_sum(int argc, char **argv)
         for (k = 0; k < n; k++)
             for (c = 0; c < channels; c++)
                 out[k * (size_t)channels + (size_t)c] =
-                    (float)(0.0 + (double)(float)albedo * acc[(size_t)c * n + k]);
+                    cli_sum_finish(CMD_LIGHT, K, (double)(float)albedo, acc[(size_t)c * n + k]);
         hi = cli_top(out, n * (size_t)channels, 1.0);
     } else if (cmd == CMD_VISIBILITY) { /* with --fraction plane 1 holds the flat field's counts */
         for (k = 0; k < n; k++) {

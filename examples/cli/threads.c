@@ -1,0 +1,405 @@
+/* threads.c - --threads: the work of one run split over POSIX threads so that the output equals
+ * the one-thread run's bit for bit (hfvis.h, "Threads"): the direction sums by quarter-turn group
+ * (lattice) or by direction (exact) added in order, the horizon map by plane range, one sun by
+ * bands across its direction, and receiver-local results by row bands with a halo. The library
+ * stays single-threaded; every call here is one of its reentrant calls on shared inputs. Without
+ * POSIX threads (CLI_HAVE_THREADS 0) every split runs its units in order on the calling thread.
+ * May call: progress.c (through the progress callbacks it wraps). */
+
+#if defined(_POSIX_THREADS) && _POSIX_THREADS > 0 && !defined(CLI_NO_THREADS)
+#include <pthread.h>
+#define CLI_HAVE_THREADS 1
+#else
+#define CLI_HAVE_THREADS 0
+#endif
+
+#define CLI_THREADS_MAX 256 /* --threads' upper bound */
+
+/* The online cores (sysconf), the default of --threads; 1 where unknown or without threads. */
+static int cli_threads_online(void)
+{
+#if CLI_HAVE_THREADS && defined(_SC_NPROCESSORS_ONLN)
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : n > CLI_THREADS_MAX ? CLI_THREADS_MAX : (int)n;
+#else
+    return 1;
+#endif
+}
+
+/* One split run: units 0..units-1, taken in increasing order by the threads; each unit's result
+ * goes to its thread's scratch and is then merged in unit order (merge is called for unit u only
+ * after units 0..u-1 were merged, under the lock, so merges never overlap and keep the order). */
+typedef struct cli_split cli_split;
+typedef hfvis_status (*cli_unit_fn)(cli_split *sp, int unit, int thread, hfvis_sweep_options *o);
+typedef void (*cli_merge_fn)(cli_split *sp, int unit, int thread);
+struct cli_split {
+    int units, threads;
+    cli_unit_fn unit;
+    cli_merge_fn merge;                  /* NULL: units write disjoint outputs, no merge */
+    void *ctx;                           /* the caller's */
+    const hfvis_sweep_options *opts;     /* copied per unit; progress replaced */
+    int next, merged;                    /* next unit to take; units merged so far */
+    hfvis_status status;                 /* the first failure (by unit order of discovery) */
+    long long done, total;               /* progress: library calls' steps over all threads */
+#if CLI_HAVE_THREADS
+    pthread_mutex_t lock;
+    pthread_cond_t turn;
+#endif
+};
+
+static void cli_split_lock(cli_split *sp)
+{
+#if CLI_HAVE_THREADS
+    pthread_mutex_lock(&sp->lock);
+#else
+    (void)sp;
+#endif
+}
+
+static void cli_split_unlock(cli_split *sp)
+{
+#if CLI_HAVE_THREADS
+    pthread_mutex_unlock(&sp->lock);
+#else
+    (void)sp;
+#endif
+}
+
+/* The library's progress callback of one unit: one step of all threads' work, reported through
+ * the run's own callback (bar or lines) under the lock, so the count covers every thread. */
+typedef struct cli_unit_progress {
+    cli_split *sp;
+    int last; /* this unit's steps reported so far */
+} cli_unit_progress;
+
+static void cli_split_progress(void *user, int done, int total)
+{
+    cli_unit_progress *up = (cli_unit_progress *)user;
+    cli_split *sp = up->sp;
+    (void)total;
+    cli_split_lock(sp);
+    if (done > up->last) {
+        sp->done += done - up->last;
+        up->last = done;
+        if (sp->opts->progress && sp->total > 0)
+            sp->opts->progress(sp->opts->progress_user, (int)(sp->done < INT_MAX ? sp->done : INT_MAX),
+                               (int)(sp->total < INT_MAX ? sp->total : INT_MAX));
+    }
+    cli_split_unlock(sp);
+}
+
+typedef struct cli_worker {
+    cli_split *sp;
+    int thread;
+} cli_worker;
+
+static void *cli_split_worker(void *arg)
+{
+    cli_split *sp = ((cli_worker *)arg)->sp;
+    const int thread = ((cli_worker *)arg)->thread;
+    for (;;) {
+        hfvis_sweep_options o = *sp->opts;
+        cli_unit_progress up;
+        hfvis_status s;
+        int u;
+        cli_split_lock(sp);
+        u = sp->status == HFVIS_OK && sp->next < sp->units ? sp->next++ : -1;
+        cli_split_unlock(sp);
+        if (u < 0) break;
+        up.sp = sp;
+        up.last = 0;
+        o.progress = cli_split_progress;
+        o.progress_user = &up;
+        s = sp->unit(sp, u, thread, &o);
+        cli_split_lock(sp);
+        if (s != HFVIS_OK && sp->status == HFVIS_OK) sp->status = s;
+#if CLI_HAVE_THREADS
+        while (sp->merge && sp->merged != u && sp->status == HFVIS_OK) pthread_cond_wait(&sp->turn, &sp->lock);
+#endif
+        if (sp->merge && sp->status == HFVIS_OK) sp->merge(sp, u, thread);
+        sp->merged = u + 1;
+#if CLI_HAVE_THREADS
+        pthread_cond_broadcast(&sp->turn);
+#endif
+        cli_split_unlock(sp);
+    }
+    return NULL;
+}
+
+/* Run the split on sp->threads threads (the calling thread is one of them). */
+static hfvis_status cli_split_run(cli_split *sp)
+{
+    cli_worker args[CLI_THREADS_MAX];
+    int t;
+    sp->next = sp->merged = 0;
+    sp->status = HFVIS_OK;
+    sp->done = 0;
+    if (sp->threads > sp->units) sp->threads = sp->units;
+    if (sp->threads < 1) sp->threads = 1;
+    for (t = 0; t < sp->threads; t++) {
+        args[t].sp = sp;
+        args[t].thread = t;
+    }
+#if CLI_HAVE_THREADS
+    {
+        pthread_t tid[CLI_THREADS_MAX];
+        int started = 0;
+        pthread_mutex_init(&sp->lock, NULL);
+        pthread_cond_init(&sp->turn, NULL);
+        for (t = 1; t < sp->threads; t++) /* a thread that cannot start leaves its share to others */
+            if (pthread_create(&tid[started], NULL, cli_split_worker, &args[t]) == 0) started++;
+        cli_split_worker(&args[0]);
+        for (t = 0; t < started; t++) pthread_join(tid[t], NULL);
+        pthread_cond_destroy(&sp->turn);
+        pthread_mutex_destroy(&sp->lock);
+    }
+#else
+    cli_split_worker(&args[0]);
+#endif
+    return sp->status;
+}
+
+/* The finish of a sum S of K directions as the single run computes it (hfvis.h, split runs):
+ * the sky-view factor 1 - S/K, the sky light and environment light scale * S, where scale is
+ * the product of the floats the run passes (sky * albedo, or albedo). */
+static float cli_sum_finish(int cmd, int K, double scale, double S)
+{
+    if (cmd == CMD_SKYVIEW) return (float)(1.0 + (-1.0 / (double)K) * S);
+    return (float)(0.0 + scale * S);
+}
+
+/* ---- the direction sums (skyview, sky, light): one quarter-turn group (lattice, K % 4 == 0, in
+ * sweep order) or one direction (exact rays, or K % 4 != 0) per unit, each into its thread's
+ * scratch, added in unit order: the additions of the single run, one unit at a time (hfvis.h,
+ * split runs), so the sums and their finish are its bits. */
+typedef struct cli_sums_split {
+    const hfvis_grid *grid;
+    int K, per, channels;
+    hfvis_sum_kind kind;
+    const hfvis_env *env;
+    const hfvis_env_options *eopts;
+    size_t count;       /* values per sums array: width * height * channels */
+    double *scratch;    /* threads * count */
+    double *acc;        /* count: S */
+} cli_sums_split;
+
+static hfvis_status cli_sums_unit(cli_split *sp, int u, int thread, hfvis_sweep_options *o)
+{
+    cli_sums_split *j = (cli_sums_split *)sp->ctx;
+    o->direction_order = o->rays == HFVIS_RAYS_EXACT ? HFVIS_DIRECTION_ORDER_INDEX : HFVIS_DIRECTION_ORDER_SWEEP;
+    o->direction_begin = u * j->per;
+    o->direction_end = u * j->per + j->per;
+    return hfvis_direction_sums(j->grid, j->K, j->kind, j->env, j->eopts, o,
+                                j->scratch + (size_t)thread * j->count);
+}
+
+static void cli_sums_merge(cli_split *sp, int u, int thread)
+{
+    cli_sums_split *j = (cli_sums_split *)sp->ctx;
+    const double *part = j->scratch + (size_t)thread * j->count;
+    size_t i;
+    if (u == 0) memcpy(j->acc, part, j->count * sizeof(double));
+    else for (i = 0; i < j->count; i++) j->acc[i] += part[i];
+}
+
+/* S of kind over all K directions into acc (count = width*height*channels doubles, interleaved
+ * channels as hfvis_direction_sums), on `threads` threads; the caller finishes it. */
+static hfvis_status cli_threaded_sums(const hfvis_grid *grid, int K, hfvis_sum_kind kind,
+                                      const hfvis_env *env, const hfvis_env_options *eopts,
+                                      const hfvis_sweep_options *opts, int threads, int channels,
+                                      double *acc)
+{
+    cli_sums_split j;
+    cli_split sp;
+    hfvis_status s;
+    memset(&j, 0, sizeof j);
+    memset(&sp, 0, sizeof sp);
+    j.grid = grid;
+    j.K = K;
+    j.kind = kind;
+    j.env = env;
+    j.eopts = eopts;
+    j.channels = channels;
+    j.per = opts->rays != HFVIS_RAYS_EXACT && K % 4 == 0 ? 4 : 1;
+    j.count = (size_t)grid->width * (size_t)grid->height * (size_t)channels;
+    j.acc = acc;
+    sp.units = K / j.per;
+    sp.threads = threads;
+    if (sp.threads > sp.units) sp.threads = sp.units;
+    j.scratch = (double *)malloc(j.count * (size_t)sp.threads * sizeof(double)); /* count <= 2^28*4 */
+    if (!j.scratch) return HFVIS_ERR_OUT_OF_MEMORY;
+    sp.unit = cli_sums_unit;
+    sp.merge = cli_sums_merge;
+    sp.ctx = &j;
+    sp.opts = opts;
+    sp.total = K;
+    s = cli_split_run(&sp);
+    free(j.scratch);
+    return s;
+}
+
+/* skyview, sky or light (cmd) over all K directions on `threads` threads: S by
+ * cli_threaded_sums, finished as the single run (scale: sky * albedo, or albedo, as the floats the
+ * run passes), out[(y*width + x)*channels + c]. */
+static hfvis_status cli_threaded_light(int cmd, const hfvis_grid *grid, int K, double scale,
+                                       const hfvis_env *env, const hfvis_env_options *eopts,
+                                       const hfvis_sweep_options *opts, int threads, int channels,
+                                       float *out)
+{
+    const hfvis_sum_kind kind = cmd == CMD_SKYVIEW ? HFVIS_SUM_SKY_VIEW
+                                : cmd == CMD_SKY ? HFVIS_SUM_SKY_LIGHT : HFVIS_SUM_ENV_LIGHT;
+    const size_t count = (size_t)grid->width * (size_t)grid->height * (size_t)channels;
+    double *acc = (double *)malloc(count * sizeof(double));
+    hfvis_status s;
+    size_t i;
+    if (!acc) return HFVIS_ERR_OUT_OF_MEMORY;
+    s = cli_threaded_sums(grid, K, kind, env, eopts, opts, threads, channels, acc);
+    for (i = 0; s == HFVIS_OK && i < count; i++) out[i] = cli_sum_finish(cmd, K, scale, acc[i]);
+    free(acc);
+    return s;
+}
+
+/* ---- the horizon map: one quarter-turn group per unit (lattice, K % 4 == 0: its four planes in
+ * sweep order, copied to their direction index) or one direction (written in place). */
+typedef struct cli_map_split {
+    const hfvis_grid *grid;
+    int K, per;
+    size_t n;           /* width * height */
+    float *scratch;     /* threads * 4 planes (groups) */
+    float *out;         /* K planes, direction index order */
+} cli_map_split;
+
+static hfvis_status cli_map_unit(cli_split *sp, int u, int thread, hfvis_sweep_options *o)
+{
+    cli_map_split *j = (cli_map_split *)sp->ctx;
+    hfvis_status s;
+    int m;
+    if (j->per == 1) { /* one direction, index order: its plane in place */
+        o->direction_order = HFVIS_DIRECTION_ORDER_INDEX;
+        o->direction_begin = u;
+        o->direction_end = u + 1;
+        return hfvis_horizon_map(j->grid, j->K, o, j->out + (size_t)u * j->n);
+    }
+    o->direction_order = HFVIS_DIRECTION_ORDER_SWEEP; /* positions 4u..4u+3: directions u + m K/4 */
+    o->direction_begin = 4 * u;
+    o->direction_end = 4 * u + 4;
+    s = hfvis_horizon_map(j->grid, j->K, o, j->scratch + (size_t)thread * 4 * j->n);
+    if (s == HFVIS_OK)
+        for (m = 0; m < 4; m++)
+            memcpy(j->out + (size_t)(u + m * (j->K / 4)) * j->n, j->scratch + ((size_t)thread * 4 + (size_t)m) * j->n,
+                   j->n * sizeof(float));
+    return s;
+}
+
+static hfvis_status cli_threaded_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
+                                             int threads, float *out)
+{
+    cli_map_split j;
+    cli_split sp;
+    hfvis_status s;
+    memset(&j, 0, sizeof j);
+    memset(&sp, 0, sizeof sp);
+    j.grid = grid;
+    j.K = K;
+    j.per = opts->rays != HFVIS_RAYS_EXACT && K % 4 == 0 ? 4 : 1;
+    j.n = (size_t)grid->width * (size_t)grid->height;
+    j.out = out;
+    sp.units = K / j.per;
+    sp.threads = threads > sp.units ? sp.units : threads;
+    if (j.per == 4) {
+        j.scratch = (float *)malloc(j.n * 4u * (size_t)sp.threads * sizeof(float));
+        if (!j.scratch) return HFVIS_ERR_OUT_OF_MEMORY;
+    }
+    sp.unit = cli_map_unit;
+    sp.ctx = &j;
+    sp.opts = opts;
+    sp.total = K;
+    s = cli_split_run(&sp);
+    free(j.scratch);
+    return s;
+}
+
+/* ---- one sun: bands across its direction (sweep options part_index/part_count), several per
+ * thread so that the short bands at the corners balance; every band writes its own cells of out. */
+typedef struct cli_sun_split {
+    const hfvis_grid *grid;
+    double azimuth, elevation, radius;
+    float *out;
+    ptrdiff_t stride;
+    int bands;
+} cli_sun_split;
+
+static hfvis_status cli_sun_unit(cli_split *sp, int u, int thread, hfvis_sweep_options *o)
+{
+    cli_sun_split *j = (cli_sun_split *)sp->ctx;
+    (void)thread;
+    o->part_index = u;
+    o->part_count = j->bands;
+    return hfvis_sun_visibility(j->grid, j->azimuth, j->elevation, j->radius, o, j->out, j->stride);
+}
+
+#define CLI_SUN_BANDS_PER_THREAD 4 /* load balance against the bands' sampling margins */
+static hfvis_status cli_threaded_sun(const hfvis_grid *grid, double azimuth, double elevation,
+                                     double radius, const hfvis_sweep_options *opts, int threads,
+                                     float *out, ptrdiff_t stride)
+{
+    cli_sun_split j;
+    cli_split sp;
+    if (threads <= 1) return hfvis_sun_visibility(grid, azimuth, elevation, radius, opts, out, stride);
+    memset(&sp, 0, sizeof sp);
+    j.grid = grid;
+    j.azimuth = azimuth;
+    j.elevation = elevation;
+    j.radius = radius;
+    j.out = out;
+    j.stride = stride;
+    j.bands = threads * CLI_SUN_BANDS_PER_THREAD;
+    sp.units = j.bands;
+    sp.threads = threads;
+    sp.unit = cli_sun_unit;
+    sp.ctx = &j;
+    sp.opts = opts;
+    sp.total = j.bands;
+    return cli_split_run(&sp);
+}
+
+/* ---- openness with a radius: row bands (receiver rectangles), each its own rows of out. */
+typedef struct cli_open_split {
+    const hfvis_grid *grid;
+    int K, rows;
+    const hfvis_openness_options *oo;
+    float *out;
+} cli_open_split;
+
+static hfvis_status cli_open_unit(cli_split *sp, int u, int thread, hfvis_sweep_options *o)
+{
+    cli_open_split *j = (cli_open_split *)sp->ctx;
+    (void)thread;
+    o->receiver_x = 0;
+    o->receiver_width = j->grid->width;
+    o->receiver_y = u * j->rows;
+    o->receiver_height = j->grid->height - o->receiver_y < j->rows ? j->grid->height - o->receiver_y : j->rows;
+    return hfvis_openness(j->grid, j->K, j->oo, o, j->out, j->grid->width);
+}
+
+#define CLI_OPEN_ROWS 16 /* rows per unit */
+static hfvis_status cli_threaded_openness(const hfvis_grid *grid, int K, const hfvis_openness_options *oo,
+                                          const hfvis_sweep_options *opts, int threads, float *out)
+{
+    cli_open_split j;
+    cli_split sp;
+    if (threads <= 1 || oo->radius <= 0.0) return hfvis_openness(grid, K, oo, opts, out, grid->width);
+    memset(&sp, 0, sizeof sp);
+    j.grid = grid;
+    j.K = K;
+    j.oo = oo;
+    j.out = out;
+    j.rows = CLI_OPEN_ROWS;
+    sp.units = (grid->height + j.rows - 1) / j.rows;
+    sp.threads = threads;
+    sp.unit = cli_open_unit;
+    sp.ctx = &j;
+    sp.opts = opts;
+    sp.total = grid->height;
+    return cli_split_run(&sp);
+}
