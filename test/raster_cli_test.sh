@@ -86,8 +86,9 @@ bil16() { # bil16 NAME FLIPX FLIPY: dem.pgm's heights as NAME.bil (unsigned 16-b
     "$([ "$2" = 1 ] && echo -30 || echo 30)" "$([ "$3" = 1 ] && echo -30 || echo 30)" > "$dir/$1.hdr"; }
 bil16 nu 0 0; bil16 su 0 1; bil16 mi 1 0
 for c in hillshade skyview; do
-  run "$c north-up" $c "$dir/nu.bil" --dirs 8 -o "$dir/o_nu.flt" && run "$c south-up" $c "$dir/su.bil" --dirs 8 -o "$dir/o_su.flt" \
-    && run "$c mirrored" $c "$dir/mi.bil" --dirs 8 -o "$dir/o_mi.flt" \
+  f=--dirs=8; [ "$c" = hillshade ] && f=--sun-azimuth=135 # the flags each command takes
+  run "$c north-up" $c "$dir/nu.bil" $f -o "$dir/o_nu.flt" && run "$c south-up" $c "$dir/su.bil" $f -o "$dir/o_su.flt" \
+    && run "$c mirrored" $c "$dir/mi.bil" $f -o "$dir/o_mi.flt" \
     && same "$c: south-up EHdr (YDIM -30) = north-up, bit for bit" "$dir/o_nu.flt" "$dir/o_su.flt" \
     && same "$c: mirrored EHdr (XDIM -30) = north-up, bit for bit" "$dir/o_nu.flt" "$dir/o_mi.flt"
 done
