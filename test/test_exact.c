@@ -542,7 +542,7 @@ static double golden(const hfvis_grid *g, int x, int y, double c, double s, doub
 
 static double indep_sup(const hfvis_grid *g, int x, int y, double psi)
 {
-    static double v[8192];
+    static double v[12288];
     double c = cos(psi), s = sin(psi), h0 = (double)g->z[(ptrdiff_t)y * g->stride + x], best, e = 1e-4;
     double tmax = 1e300, step = 1.0 / SUP_DENSE;
     int n, j, b1 = -1, b2 = -1;
@@ -555,12 +555,13 @@ static double indep_sup(const hfvis_grid *g, int x, int y, double psi)
     if (!(tmax > 1e-9)) return -PI / 2;
     best = 2.0 * tan_at(g, x, y, c, s, h0, e) - tan_at(g, x, y, c, s, h0, 2.0 * e);
     n = (int)floor(tmax / step);
-    for (j = 1; j <= n + 1 && j < 8192; j++) {
+    if (n > 12286) n = 12286; /* rays up to 255 cells (the test fields: at most 181) */
+    for (j = 1; j <= n + 1; j++) {
         v[j] = tan_at(g, x, y, c, s, h0, j <= n ? j * step : tmax);
         if (b1 < 0 || v[j] > v[b1]) b1 = j;
     }
     v[0] = best;
-    for (j = 1; j <= n + 1 && j < 8192; j++) /* the second local maximum */
+    for (j = 1; j <= n + 1; j++) /* the second local maximum */
         if (j != b1 && v[j] >= v[j - 1] && (j == n + 1 || v[j] >= v[j + 1]) && (b2 < 0 || v[j] > v[b2])) b2 = j;
     for (j = 0; j < 2; j++) {
         int i = j ? b2 : b1;
