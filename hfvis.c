@@ -2290,18 +2290,27 @@ static int hf_line_rect(const hf_sweep *sw, int i0, int j0, int di, int dj, int 
 }
 
 static inline double hf_svf_term(double t);
+static inline double hf_sky_term(double t, double nz, double a, double inv_k, double lobe);
 
 /* What is done with each tangent t at node p (s-th of a line): stored for the line's consumer,
- * or the sky-view term added to the accumulator there (the sum's one copy: hf_svf_line calls it
- * too). The kind is a constant at each call of hf_walk_line, so the compiler writes one walk per
- * kind, and the sum's tangents are never stored and read back. (The sky light's term is
- * evaluated per line from stored tangents, in batches the compiler vectorizes: hf_sky_line.) */
-enum { HF_WALK_STORE, HF_WALK_SVF };
+ * or the sky-view or sky term added to the accumulator there (the sums' one copy: hf_svf_line
+ * and hf_sky_line call it too). The kind is a constant at each call of hf_walk_line, so the
+ * compiler writes one walk per kind, and the sums' tangents are never stored and read back.
+ * sky: look direction (x, y), 1/K, the lobe factor. */
+enum { HF_WALK_STORE, HF_WALK_SVF, HF_WALK_SKY };
 
-static HFVIS__ALWAYS_INLINE void hf_walk_emit(int kind, double *lat, double *t, int s, ptrdiff_t p, double tan)
+static HFVIS__ALWAYS_INLINE void hf_walk_emit(int kind, double *lat, const float *nrm, const double sky[4],
+                                double *t, int s, ptrdiff_t p, double tan)
 {
-    if (kind == HF_WALK_STORE) t[s] = tan;
-    else lat[p] += hf_svf_term(tan); /* a NaN tan (overflowing heights) adds +0: no change */
+    if (kind == HF_WALK_STORE) {
+        t[s] = tan;
+    } else if (kind == HF_WALK_SVF) {
+        lat[p] += hf_svf_term(tan); /* a NaN tan (overflowing heights) adds +0: no change */
+    } else if (!isnan(tan)) {
+        const float *nr = nrm + p * 3;
+        double a = (double)nr[0] * sky[0] + (double)nr[1] * sky[1];
+        lat[p] += hf_sky_term(tan, (double)nr[2], a, sky[2], sky[3]);
+    }
 }
 
 /* The unlimited hull walk along one line (hull stack sh, sd of height top after the pre-roll):
@@ -2309,11 +2318,12 @@ static HFVIS__ALWAYS_INLINE void hf_walk_emit(int kind, double *lat, double *t, 
  * of nodes without holes; inside a run the hull's top is the previous node one unit back, so
  * hf_hull_push gets its differences as (h_prev - h, 1.0) and, with no pop, the division by 1.0
  * drops out (the same bits as hf_hull_step). */
-static HFVIS__ALWAYS_INLINE void hf_walk_line(hf_sweep *sw, int kind, ptrdiff_t node0,
+static HFVIS__ALWAYS_INLINE void hf_walk_line(hf_sweep *sw, int kind, const double sky[4], ptrdiff_t node0,
                                 ptrdiff_t step, int slo, int shi, ptrdiff_t top, double *t)
 {
     double *sd = sw->sd, *sh = sw->lh, *lat = sw->lat, ds = 0.0; /* ds == s (integers, exact) */
     const double *hv = sw->h;
+    const float *nrm = sw->nrm;
     ptrdiff_t p = node0;
     int s;
     for (s = 0; s < slo; s++, p += step, ds += 1.0) { /* occluders only */
@@ -2327,11 +2337,11 @@ static HFVIS__ALWAYS_INLINE void hf_walk_line(hf_sweep *sw, int kind, ptrdiff_t 
             s++, p += step, ds += 1.0;
             continue;
         }
-        hf_walk_emit(kind, lat, t, s, p, hf_hull_step(sh, sd, &top, h, ds));
+        hf_walk_emit(kind, lat, nrm, sky, t, s, p, hf_hull_step(sh, sd, &top, h, ds));
         for (hp = h, s++, p += step, ds += 1.0; s <= shi; s++, p += step, ds += 1.0) {
             h = hv[p];
             if (isnan(h)) break;
-            hf_walk_emit(kind, lat, t, s, p, hf_hull_push(sh, sd, &top, h, ds, hp - h, 1.0));
+            hf_walk_emit(kind, lat, nrm, sky, t, s, p, hf_hull_push(sh, sd, &top, h, ds, hp - h, 1.0));
             hp = h;
         }
     }
@@ -2339,11 +2349,12 @@ static HFVIS__ALWAYS_INLINE void hf_walk_line(hf_sweep *sw, int kind, ptrdiff_t 
 
 /* Run orientation m of the current group: copy each line (with its pre-roll) out of the
  * sampled lattice, find the horizons, hand them to fn. brute = 1 uses the oracle. walk
- * (HF_WALK_SVF) adds that sum inside the unlimited walk
+ * (HF_WALK_SVF, HF_WALK_SKY with its constants sky) adds that sum inside the unlimited walk
  * instead; fn, its same sum, still serves the windowed and oracle paths. (Sweeping
  * columns several side by side, so each row step reads whole cache lines, measured no faster:
  * docs/performance.md.) */
-static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, void *ctx, int walk)
+static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, void *ctx, int walk,
+                                 const double sky[4])
 {
     int nlines = (m & 1) ? sw->cols : sw->rows, line;
     const hfvis_lattice *L = &sw->L;
@@ -2377,9 +2388,11 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
         }
         if (R > 0) top = hf_preroll(sw, i0, j0, di, dj, sh, sd);
         if (walk == HF_WALK_SVF) {
-            hf_walk_line(sw, HF_WALK_SVF, node0, step, slo, shi, top, t);
+            hf_walk_line(sw, HF_WALK_SVF, NULL, node0, step, slo, shi, top, t);
+        } else if (walk == HF_WALK_SKY) {
+            hf_walk_line(sw, HF_WALK_SKY, sky, node0, step, slo, shi, top, t);
         } else {
-            hf_walk_line(sw, HF_WALK_STORE, node0, step, slo, shi, top, t);
+            hf_walk_line(sw, HF_WALK_STORE, NULL, node0, step, slo, shi, top, t);
             fn(sw, ctx, m, node0, step, shi + 1, t);
         }
     }
@@ -2844,7 +2857,7 @@ static hfvis_status hf_horizon_lattice_impl(const hfvis_grid *grid, double azimu
     hf_sweep_vector(azimuth_rad, &ux, &uy);
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HFVIS__NAN);
-    hf_sweep_orientation(&sw, 0, brute, hf_store_elevation, NULL, HF_WALK_STORE);
+    hf_sweep_orientation(&sw, 0, brute, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
     n = (size_t)sw.rows * (size_t)sw.cols;
     for (i = 0; i < n; i++) out[i] = (float)sw.lat[i];
     hf_sweep_free(&sw);
@@ -2886,7 +2899,7 @@ hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, int k,
     hf_direction_base(K, k, o.azimuth0_rad, &ux, &uy, &m);
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HFVIS__NAN);
-    hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE);
+    hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
     hf_gather_planes(&sw, 1, m, out, 0, out_stride);
     hf_sweep_free(&sw);
     hf_progress(&o, 1, 1);
@@ -2926,7 +2939,7 @@ static hfvis_status hf_horizon_map_range(const hfvis_grid *grid, int K, const hf
                 sampled = 1;
             }
             hf_lattice_fill(&sw, HFVIS__NAN);
-            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE);
+            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
             hf_gather_planes(&sw, 1, m, out + (size_t)(pos - begin) * plane, 0, grid->width);
             hf_progress(o, ++done, end - begin);
         }
@@ -2963,7 +2976,7 @@ hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_
         if (sw.rect) hf_lattice_fill(&sw, HFVIS__NAN);
         else hf_lattice_fill_outside(&sw, HFVIS__NAN);
         for (m = 0; m < per; m++) {
-            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE);
+            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
             hf_progress(&o, ++done, K);
         }
         /* plane k = gidx + m*groups: channel m lands m*groups planes further on */
@@ -3285,7 +3298,7 @@ static inline double hf_sky_term(double t, double nz, double a, double inv_k, do
 typedef struct hf_fused {
     int K, k;
     double lx, ly;          /* look direction of direction k */
-    int walk;               /* HF_WALK_SVF: fn's sum added inside the line walk */
+    int walk;               /* HF_WALK_SVF, HF_WALK_SKY: fn's sum added inside the line walk */
     double inv_k, lobe;     /* the sky term's 1/K and lobe factor (hf_sky_setup) */
     size_t extra_size;      /* extra scratch bytes the consumer needs (sw->extra) */
     /* optional hooks: after a group's lattice is sampled, and instead of the P1 line walk */
@@ -3340,7 +3353,10 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
             ctx->k = k;
             hf_look_dir(sw, m, &ctx->lx, &ctx->ly);
             if (ctx->orient) ctx->orient(sw, m, ctx);
-            else hf_sweep_orientation(sw, m, 0, fn, ctx, ctx->walk);
+            else {
+                const double sky[4] = {ctx->lx, ctx->ly, ctx->inv_k, ctx->lobe};
+                hf_sweep_orientation(sw, m, 0, fn, ctx, ctx->walk, sky);
+            }
             hf_progress(o, ++done, end - begin);
         }
         hf_gather_accumulate(sw);
@@ -3363,8 +3379,8 @@ static void hf_fused_output(const hf_sweep *sw, double scale, double offset, flo
         }
 }
 
-/* The fused sky light's consumer: [P1] Eq. 5 per direction over each line's stored tangents
- * (hf_sky_line, every path: unlimited, windowed, oracle). */
+/* The fused sky light's consumer: [P1] Eq. 5 per direction (hf_sky_term), inside the line
+ * walk; hf_sky_line is the same sum over a line's stored tangents (windowed and oracle paths). */
 static void hf_sky_setup(hf_fused *f, int K)
 {
     f->walk = HF_WALK_STORE;
@@ -3555,7 +3571,7 @@ static void hf_svf_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdif
     (void)vctx;
     (void)m;
     for (s = 0; s < n; s++, node0 += step)
-        if (!isnan(t[s])) hf_walk_emit(HF_WALK_SVF, sw->lat, NULL, s, node0, t[s]);
+        if (!isnan(t[s])) hf_walk_emit(HF_WALK_SVF, sw->lat, NULL, NULL, NULL, s, node0, t[s]);
 }
 
 hfvis_status hfvis_sky_view_factor(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
@@ -3635,7 +3651,7 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
     hf_sweep_vector(sun_azimuth_rad, &ux, &uy);
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HFVIS__NAN);
-    hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL, HF_WALK_STORE);
+    hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
     hf_gather_planes(&sw, 1, 0, out, 0, out_stride);
     for (y = sw.ry0; y < sw.ry1; y++)
         for (x = sw.rx0; x < sw.rx1; x++) {
