@@ -3247,22 +3247,19 @@ double hfvis_sector_weight(int K, double nz, double a, double theta)
  * polynomial x P(x^2) of degree 17 on [0, 1], minimax for the absolute error (Remez exchange),
  * P evaluated by Estrin's scheme. Oracles and the angle outputs (horizon maps) keep libm's atan. */
 #define HF_ATAN_MAX_ERR 6e-9 /* rad, |hfvis__atan - atan| (Remez bound 5.76e-9): 1/20 of a float ulp at pi/2 */
-static inline double hf_atan_poly(double x) /* atan x on [0, 1] */
+static inline double hf_atan(double t)
 {
-    double s = x * x, s2 = s * s, s4 = s2 * s2, p;
+    double x = fabs(t), s, s2, s4, p, y;
+    int big = x > 1.0; /* false for NaN, which then runs through as NaN */
+    if (big) x = 1.0 / x;
+    s = x * x;
+    s2 = s * s;
+    s4 = s2 * s2;
     p = ((0.9999998863830964 + -0.3333259702893892 * s) + s2 * (0.19985906780335758 + -0.1416122929275394 * s)) +
         s4 * ((0.1049894642938515 + -0.07234858062458693 * s) +
               s2 * (0.03978123126172938 + -0.014401362402942217 * s)) +
         (s4 * s4) * 0.0024567256561116523;
-    return x * p;
-}
-
-static inline double hf_atan(double t)
-{
-    double x = fabs(t), y;
-    int big = x > 1.0; /* false for NaN, which then runs through as NaN */
-    if (big) x = 1.0 / x;
-    y = hf_atan_poly(x);
+    y = x * p;
     if (big) y = HFVIS__HALF_PI - y;
     return copysign(y, t);
 }
@@ -3383,78 +3380,23 @@ static void hf_fused_output(const hf_sweep *sw, double scale, double offset, flo
  * walk; hf_sky_line is the same sum over a line's stored tangents (windowed and oracle paths). */
 static void hf_sky_setup(hf_fused *f, int K)
 {
-    f->walk = HF_WALK_STORE;
+    f->walk = HF_WALK_SKY;
     f->inv_k = 1.0 / (double)K;
     f->lobe = sin(HFVIS__PI / (double)K) / HFVIS__PI;
 }
 
-/* hf_sky_term over HF_SKY_BATCH nodes in two loops without branches or calls, which the compiler
- * vectorizes (gcc 12 at -O2 and -O3): the same operations in the same order as hf_sky_term and
- * hf_atan, their branches as selects, so the same bits. A select between an arithmetic result and
- * something else would be turned back into a branch around the arithmetic, which then may not be
- * executed unconditionally (it could raise a floating-point exception): the reciprocal of the
- * atan's range reduction is therefore formed for every node in the first loop, and the
- * reduction's pi/2 - y written as b pi/2 + (1 - 2b) y with b in {0, 1} (exact either way, y >= 0).
- * A node that hf_sky_term answers by a branch (t NaN, nz <= 0 or NaN, an infinite clamped tangent)
- * gets -1 (a term is >= 0), and the caller takes it through hf_sky_term. */
-#define HF_SKY_BATCH 16
-static void hf_sky_batch(const double *restrict t, const double *restrict nz, const double *restrict a,
-                         double inv_k, double lobe, double *restrict r)
-{
-    double tcb[HF_SKY_BATCH], rxb[HF_SKY_BATCH];
-    int j;
-    for (j = 0; j < HF_SKY_BATCH; j++) {
-        double tc = -a[j] / nz[j];
-        tc = t[j] > tc ? t[j] : tc;
-        tcb[j] = tc;
-        rxb[j] = 1.0 / fabs(tc);
-    }
-    for (j = 0; j < HF_SKY_BATCH; j++) {
-        double tc = tcb[j], x = fabs(tc), big = x > 1.0 ? 1.0 : 0.0, y, q, v;
-        y = hf_atan_poly(x > 1.0 ? rxb[j] : x);
-        y = copysign(big * HFVIS__HALF_PI + (1.0 - 2.0 * big) * y, tc);
-        q = 1.0 / (1.0 + tc * tc);
-        v = nz[j] * inv_k * q + lobe * a[j] * ((HFVIS__HALF_PI - y) - tc * q);
-        v = v > 0.0 ? v : 0.0;
-        v = x <= DBL_MAX ? v : -1.0;
-        v = nz[j] > 0.0 ? v : -1.0;
-        r[j] = t[j] == t[j] ? v : -1.0;
-    }
-}
-
-/* The fused sky light's line consumer: [P1] Eq. 5 per direction over a line's stored tangents,
- * HF_SKY_BATCH nodes at a time: each node's tangent, nz and n.l gathered into arrays (structure
- * of arrays), hf_sky_batch, the terms added to the accumulator. */
 static void hf_sky_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdiff_t step, int n,
                         const double *t)
 {
     const hf_fused *c = (const hf_fused *)vctx;
     /* in locals: the store to lat could alias the context, so gcc reloaded them at every node */
-    const double lx = c->lx, ly = c->ly, inv_k = c->inv_k, lobe = c->lobe;
+    const double sky[4] = {c->lx, c->ly, c->inv_k, c->lobe};
     const float *nrm = sw->nrm;
-    double *lat = sw->lat, tb[HF_SKY_BATCH], nzb[HF_SKY_BATCH], ab[HF_SKY_BATCH], rb[HF_SKY_BATCH];
-    int s0, j;
+    double *lat = sw->lat;
+    int s;
     (void)m;
-    for (s0 = 0; s0 < n; s0 += HF_SKY_BATCH) {
-        int cnt = n - s0 < HF_SKY_BATCH ? n - s0 : HF_SKY_BATCH;
-        ptrdiff_t p = node0 + (ptrdiff_t)s0 * step;
-        for (j = 0; j < cnt; j++, p += step) {
-            const float *nr = nrm + p * 3;
-            tb[j] = t[s0 + j];
-            nzb[j] = (double)nr[2];
-            ab[j] = (double)nr[0] * lx + (double)nr[1] * ly;
-        }
-        for (; j < HF_SKY_BATCH; j++) tb[j] = HFVIS__NAN, nzb[j] = 1.0, ab[j] = 0.0;
-        hf_sky_batch(tb, nzb, ab, inv_k, lobe, rb);
-        for (j = 0, p = node0 + (ptrdiff_t)s0 * step; j < cnt; j++, p += step) {
-            double v = rb[j];
-            if (v < 0.0) {
-                if (isnan(tb[j])) continue;
-                v = hf_sky_term(tb[j], nzb[j], ab[j], inv_k, lobe);
-            }
-            lat[p] += v;
-        }
-    }
+    for (s = 0; s < n; s++, node0 += step)
+        if (!isnan(t[s])) hf_walk_emit(HF_WALK_SKY, lat, nrm, sky, NULL, s, node0, t[s]);
 }
 
 static int hf_light_args_valid(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
