@@ -1243,19 +1243,29 @@ static void ss_cfg_from_lsao(const hfvis_lsao_options *o, ss_cfg *g)
     g->rej_n = o->reject_normal;
 }
 
+/* In two steps, for the hull, which needs Occ only where Sin decides nothing: ss_sin gives
+ * Sin(h) and |h| (-inf for a coincident point), ss_occ_of the Occ from them (st for s = -inf). */
+static inline double ss_sin(double hx, double hy, double ux, double uy, double tiny, double *len_out)
+{
+    double len = sqrt(hx * hx + hy * hy);
+    *len_out = len;
+    if (!(len > tiny)) return -HFVIS__INF;
+    return (hx * ux + hy * uy) / len;
+}
+
+static inline double ss_occ_of(const ss_fall *f, double s, double len, double st)
+{
+    return s > st ? st + (s - st) * ss_rho(f, len) : st;
+}
+
 /* Occ of point (hx, hy) = occluder - receiver seen along zenith (ux, uy) with tangent st
  * ([P3] Alg. 1 l.25-29); *sin_out = Sin(h) (-inf for a coincident point, which casts st). */
 static inline double ss_occ(const ss_fall *f, double hx, double hy, double ux, double uy, double st,
-                     double tiny, double *sin_out)
+                            double tiny, double *sin_out)
 {
-    double len = sqrt(hx * hx + hy * hy), s;
-    if (!(len > tiny)) {
-        *sin_out = -HFVIS__INF;
-        return st;
-    }
-    s = (hx * ux + hy * uy) / len;
-    *sin_out = s;
-    return s > st ? st + (s - st) * ss_rho(f, len) : st;
+    double len;
+    *sin_out = ss_sin(hx, hy, ux, uy, tiny, &len);
+    return ss_occ_of(f, *sin_out, len, st);
 }
 
 /* The obscurity hull along one line ([P3] §4.2, Alg. 1). */
@@ -1265,7 +1275,8 @@ static void ss_hull_line(const double *x, const double *y, const double *stc, co
 {
     int top = 0, i;
     for (i = 0; i < n; i++) {
-        double px = x[i], py = y[i], r, ux, uy, sc, se, tiny, o1 = 0.0, s1 = 0.0, o2, s2;
+        double px = x[i], py = y[i], r, ux, uy, sc, se, tiny, o1 = 0.0, s1 = 0.0, o2, s2, len1 = 0.0, len2;
+        int have1 = 0;
         if (!isfinite(px) || !isfinite(py)) {
             out[i] = HFVIS__NAN;
             continue;
@@ -1285,25 +1296,28 @@ static void ss_hull_line(const double *x, const double *y, const double *stc, co
         tiny = SS_COINCIDENT * (fabs(px) + fabs(py));
         sc = stc ? stc[i] : fixed;
         se = ste ? ste[i] : fixed;
+        /* Occ (o1, o2) is formed only where the Sin test (s1 < s2) leaves the pop to it: the same
+         * values and decisions as evaluating both tests (no side effects), fewer divisions */
         if (top >= 1) {
             int a = stack[top - 1];
-            o1 = ss_occ(f, x[a] - px, y[a] - py, ux, uy, sc, tiny, &s1);
+            s1 = ss_sin(x[a] - px, y[a] - py, ux, uy, tiny, &len1);
         }
         while (top >= 2) { /* l.12-18 */
             int b = stack[top - 2];
-            o2 = ss_occ(f, x[b] - px, y[b] - py, ux, uy, sc, tiny, &s2);
-            if ((ties ? o1 <= o2 : o1 < o2) && s1 < s2) {
-                top--;
-                o1 = o2;
-                s1 = s2;
-            } else {
-                break;
-            }
+            s2 = ss_sin(x[b] - px, y[b] - py, ux, uy, tiny, &len2);
+            if (!(s1 < s2)) break;
+            if (!have1) o1 = ss_occ_of(f, s1, len1, sc), have1 = 1;
+            o2 = ss_occ_of(f, s2, len2, sc);
+            if (!(ties ? o1 <= o2 : o1 < o2)) break;
+            top--;
+            o1 = o2;
+            s1 = s2;
+            len1 = len2;
         }
         if (top == 0) {
             out[i] = se; /* no occluder yet: rho = 0 (docs/errata.md E27) */
         } else if (se == sc) {
-            out[i] = o1; /* l.20 */
+            out[i] = have1 ? o1 : ss_occ_of(f, s1, len1, sc); /* l.20 */
         } else {
             int a = stack[top - 1];
             double s;
@@ -1850,8 +1864,8 @@ have:
 /* Gather nd directions into sum / weight (inner pixels, row-major W) in one pass over the
  * pixels: each pixel's two accumulators are read once, the directions' terms added in order (the
  * same additions as one pass per direction), and written once. With a few directions per pass
- * (hfvis_lsao: SS_GATHER_GROUP), the accumulators' memory traffic, which bounded the gather,
- * is shared. */
+ * (hfvis_lsao: SS_GATHER_GROUP), the pixel loop, the depth test and the accumulators' loads and
+ * stores are shared by the group. */
 static void ss_gather_dirs(const ss_cam *c, const ss_cfg *g, const float *depth,
                            const float *normals, const ss_gdir *G, int nd, double *sum, double *wsum)
 {
