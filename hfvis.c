@@ -2400,18 +2400,27 @@ static int hf_line_rect(const hf_sweep *sw, int i0, int j0, int di, int dj, int 
 }
 
 static inline double hf_svf_term(double t);
+static inline double hf_sky_term(double t, double nz, double a, double inv_k, double lobe);
 
 /* What is done with each tangent t at node p (s-th of a line): stored for the line's consumer,
- * or the sky-view term added to the accumulator there (the sum's one copy: hf_svf_line calls it
- * too). The kind is a constant at each call of hf_walk_line, so the compiler writes one walk per
- * kind, and the sum's tangents are never stored and read back. (The sky light's term is
- * evaluated per line from stored tangents, in batches the compiler vectorizes: hf_sky_line.) */
-enum { HF_WALK_STORE, HF_WALK_SVF };
+ * or the sky-view or sky term added to the accumulator there (the sums' one copy: hf_svf_line
+ * and hf_sky_line call it too). The kind is a constant at each call of hf_walk_line, so the
+ * compiler writes one walk per kind, and the sums' tangents are never stored and read back.
+ * sky: look direction (x, y), 1/K, the lobe factor. */
+enum { HF_WALK_STORE, HF_WALK_SVF, HF_WALK_SKY };
 
-static HFVIS__ALWAYS_INLINE void hf_walk_emit(int kind, double *lat, double *t, int s, ptrdiff_t p, double tan)
+static HFVIS__ALWAYS_INLINE void hf_walk_emit(int kind, double *lat, const float *nrm, const double sky[4],
+                                double *t, int s, ptrdiff_t p, double tan)
 {
-    if (kind == HF_WALK_STORE) t[s] = tan;
-    else lat[p] += hf_svf_term(tan); /* a NaN tan (overflowing heights) adds +0: no change */
+    if (kind == HF_WALK_STORE) {
+        t[s] = tan;
+    } else if (kind == HF_WALK_SVF) {
+        lat[p] += hf_svf_term(tan); /* a NaN tan (overflowing heights) adds +0: no change */
+    } else if (!isnan(tan)) {
+        const float *nr = nrm + p * 3;
+        double a = (double)nr[0] * sky[0] + (double)nr[1] * sky[1];
+        lat[p] += hf_sky_term(tan, (double)nr[2], a, sky[2], sky[3]);
+    }
 }
 
 /* The unlimited hull walk along one line (hull stack sh, sd of height top after the pre-roll):
@@ -2419,11 +2428,12 @@ static HFVIS__ALWAYS_INLINE void hf_walk_emit(int kind, double *lat, double *t, 
  * of nodes without holes; inside a run the hull's top is the previous node one unit back, so
  * hf_hull_push gets its differences as (h_prev - h, 1.0) and, with no pop, the division by 1.0
  * drops out (the same bits as hf_hull_step). */
-static HFVIS__ALWAYS_INLINE void hf_walk_line(hf_sweep *sw, int kind, ptrdiff_t node0,
+static HFVIS__ALWAYS_INLINE void hf_walk_line(hf_sweep *sw, int kind, const double sky[4], ptrdiff_t node0,
                                 ptrdiff_t step, int slo, int shi, ptrdiff_t top, double *t)
 {
     double *sd = sw->sd, *sh = sw->lh, *lat = sw->lat, ds = 0.0; /* ds == s (integers, exact) */
     const double *hv = sw->h;
+    const float *nrm = sw->nrm;
     ptrdiff_t p = node0;
     int s;
     for (s = 0; s < slo; s++, p += step, ds += 1.0) { /* occluders only */
@@ -2437,11 +2447,11 @@ static HFVIS__ALWAYS_INLINE void hf_walk_line(hf_sweep *sw, int kind, ptrdiff_t 
             s++, p += step, ds += 1.0;
             continue;
         }
-        hf_walk_emit(kind, lat, t, s, p, hf_hull_step(sh, sd, &top, h, ds));
+        hf_walk_emit(kind, lat, nrm, sky, t, s, p, hf_hull_step(sh, sd, &top, h, ds));
         for (hp = h, s++, p += step, ds += 1.0; s <= shi; s++, p += step, ds += 1.0) {
             h = hv[p];
             if (isnan(h)) break;
-            hf_walk_emit(kind, lat, t, s, p, hf_hull_push(sh, sd, &top, h, ds, hp - h, 1.0));
+            hf_walk_emit(kind, lat, nrm, sky, t, s, p, hf_hull_push(sh, sd, &top, h, ds, hp - h, 1.0));
             hp = h;
         }
     }
@@ -2449,11 +2459,12 @@ static HFVIS__ALWAYS_INLINE void hf_walk_line(hf_sweep *sw, int kind, ptrdiff_t 
 
 /* Run orientation m of the current group: copy each line (with its pre-roll) out of the
  * sampled lattice, find the horizons, hand them to fn. brute = 1 uses the oracle. walk
- * (HF_WALK_SVF) adds that sum inside the unlimited walk
+ * (HF_WALK_SVF, HF_WALK_SKY with its constants sky) adds that sum inside the unlimited walk
  * instead; fn, its same sum, still serves the windowed and oracle paths. (Sweeping
  * columns several side by side, so each row step reads whole cache lines, measured no faster:
  * docs/performance.md.) */
-static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, void *ctx, int walk)
+static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, void *ctx, int walk,
+                                 const double sky[4])
 {
     int nlines = (m & 1) ? sw->cols : sw->rows, line;
     const hfvis_lattice *L = &sw->L;
@@ -2487,9 +2498,11 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
         }
         if (R > 0) top = hf_preroll(sw, i0, j0, di, dj, sh, sd);
         if (walk == HF_WALK_SVF) {
-            hf_walk_line(sw, HF_WALK_SVF, node0, step, slo, shi, top, t);
+            hf_walk_line(sw, HF_WALK_SVF, NULL, node0, step, slo, shi, top, t);
+        } else if (walk == HF_WALK_SKY) {
+            hf_walk_line(sw, HF_WALK_SKY, sky, node0, step, slo, shi, top, t);
         } else {
-            hf_walk_line(sw, HF_WALK_STORE, node0, step, slo, shi, top, t);
+            hf_walk_line(sw, HF_WALK_STORE, NULL, node0, step, slo, shi, top, t);
             fn(sw, ctx, m, node0, step, shi + 1, t);
         }
     }
@@ -2957,7 +2970,7 @@ static hfvis_status hf_horizon_lattice_impl(const hfvis_grid *grid, double azimu
     hf_sweep_vector(azimuth_rad, &ux, &uy);
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HFVIS__NAN);
-    hf_sweep_orientation(&sw, 0, brute, hf_store_elevation, NULL, HF_WALK_STORE);
+    hf_sweep_orientation(&sw, 0, brute, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
     n = (size_t)sw.rows * (size_t)sw.cols;
     for (i = 0; i < n; i++) out[i] = (float)sw.lat[i];
     hf_sweep_free(&sw);
@@ -2999,7 +3012,7 @@ hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, int k,
     hf_direction_base(K, k, o.azimuth0_rad, &ux, &uy, &m);
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HFVIS__NAN);
-    hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE);
+    hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
     hf_gather_planes(&sw, 1, m, out, 0, out_stride);
     hf_sweep_free(&sw);
     hf_progress(&o, 1, 1);
@@ -3039,7 +3052,7 @@ static hfvis_status hf_horizon_map_range(const hfvis_grid *grid, int K, const hf
                 sampled = 1;
             }
             hf_lattice_fill(&sw, HFVIS__NAN);
-            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE);
+            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
             hf_gather_planes(&sw, 1, m, out + (size_t)(pos - begin) * plane, 0, grid->width);
             hf_progress(o, ++done, end - begin);
         }
@@ -3076,7 +3089,7 @@ hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_
         if (sw.rect) hf_lattice_fill(&sw, HFVIS__NAN);
         else hf_lattice_fill_outside(&sw, HFVIS__NAN);
         for (m = 0; m < per; m++) {
-            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE);
+            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
             hf_progress(&o, ++done, K);
         }
         /* plane k = gidx + m*groups: channel m lands m*groups planes further on */
@@ -3381,22 +3394,19 @@ double hfvis_sector_weight(int K, double nz, double a, double theta)
  * polynomial x P(x^2) of degree 17 on [0, 1], minimax for the absolute error (Remez exchange),
  * P evaluated by Estrin's scheme. Oracles and the angle outputs (horizon maps) keep libm's atan. */
 #define HF_ATAN_MAX_ERR 6e-9 /* rad, |hfvis__atan - atan| (Remez bound 5.76e-9): 1/20 of a float ulp at pi/2 */
-static inline double hf_atan_poly(double x) /* atan x on [0, 1] */
+static inline double hf_atan(double t)
 {
-    double s = x * x, s2 = s * s, s4 = s2 * s2, p;
+    double x = fabs(t), s, s2, s4, p, y;
+    int big = x > 1.0; /* false for NaN, which then runs through as NaN */
+    if (big) x = 1.0 / x;
+    s = x * x;
+    s2 = s * s;
+    s4 = s2 * s2;
     p = ((0.9999998863830964 + -0.3333259702893892 * s) + s2 * (0.19985906780335758 + -0.1416122929275394 * s)) +
         s4 * ((0.1049894642938515 + -0.07234858062458693 * s) +
               s2 * (0.03978123126172938 + -0.014401362402942217 * s)) +
         (s4 * s4) * 0.0024567256561116523;
-    return x * p;
-}
-
-static inline double hf_atan(double t)
-{
-    double x = fabs(t), y;
-    int big = x > 1.0; /* false for NaN, which then runs through as NaN */
-    if (big) x = 1.0 / x;
-    y = hf_atan_poly(x);
+    y = x * p;
     if (big) y = HFVIS__HALF_PI - y;
     return copysign(y, t);
 }
@@ -3432,7 +3442,7 @@ static inline double hf_sky_term(double t, double nz, double a, double inv_k, do
 typedef struct hf_fused {
     int K, k;
     double lx, ly;          /* look direction of direction k */
-    int walk;               /* HF_WALK_SVF: fn's sum added inside the line walk */
+    int walk;               /* HF_WALK_SVF, HF_WALK_SKY: fn's sum added inside the line walk */
     double inv_k, lobe;     /* the sky term's 1/K and lobe factor (hf_sky_setup) */
     size_t extra_size;      /* extra scratch bytes the consumer needs (sw->extra) */
     /* optional hooks: after a group's lattice is sampled, and instead of the P1 line walk */
@@ -3487,7 +3497,10 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
             ctx->k = k;
             hf_look_dir(sw, m, &ctx->lx, &ctx->ly);
             if (ctx->orient) ctx->orient(sw, m, ctx);
-            else hf_sweep_orientation(sw, m, 0, fn, ctx, ctx->walk);
+            else {
+                const double sky[4] = {ctx->lx, ctx->ly, ctx->inv_k, ctx->lobe};
+                hf_sweep_orientation(sw, m, 0, fn, ctx, ctx->walk, sky);
+            }
             hf_progress(o, ++done, end - begin);
         }
         hf_gather_accumulate(sw);
@@ -3510,82 +3523,27 @@ static void hf_fused_output(const hf_sweep *sw, double scale, double offset, flo
         }
 }
 
-/* The fused sky light's consumer: [P1] Eq. 5 per direction over each line's stored tangents
- * (hf_sky_line, every path: unlimited, windowed, oracle). */
+/* The fused sky light's consumer: [P1] Eq. 5 per direction (hf_sky_term), inside the line
+ * walk; hf_sky_line is the same sum over a line's stored tangents (windowed and oracle paths). */
 static void hf_sky_setup(hf_fused *f, int K)
 {
-    f->walk = HF_WALK_STORE;
+    f->walk = HF_WALK_SKY;
     f->inv_k = 1.0 / (double)K;
     f->lobe = sin(HFVIS__PI / (double)K) / HFVIS__PI;
 }
 
-/* hf_sky_term over HF_SKY_BATCH nodes in two loops without branches or calls, which the compiler
- * vectorizes (gcc 12 at -O2 and -O3): the same operations in the same order as hf_sky_term and
- * hf_atan, their branches as selects, so the same bits. A select between an arithmetic result and
- * something else would be turned back into a branch around the arithmetic, which then may not be
- * executed unconditionally (it could raise a floating-point exception): the reciprocal of the
- * atan's range reduction is therefore formed for every node in the first loop, and the
- * reduction's pi/2 - y written as b pi/2 + (1 - 2b) y with b in {0, 1} (exact either way, y >= 0).
- * A node that hf_sky_term answers by a branch (t NaN, nz <= 0 or NaN, an infinite clamped tangent)
- * gets -1 (a term is >= 0), and the caller takes it through hf_sky_term. */
-#define HF_SKY_BATCH 16
-static void hf_sky_batch(const double *restrict t, const double *restrict nz, const double *restrict a,
-                         double inv_k, double lobe, double *restrict r)
-{
-    double tcb[HF_SKY_BATCH], rxb[HF_SKY_BATCH];
-    int j;
-    for (j = 0; j < HF_SKY_BATCH; j++) {
-        double tc = -a[j] / nz[j];
-        tc = t[j] > tc ? t[j] : tc;
-        tcb[j] = tc;
-        rxb[j] = 1.0 / fabs(tc);
-    }
-    for (j = 0; j < HF_SKY_BATCH; j++) {
-        double tc = tcb[j], x = fabs(tc), big = x > 1.0 ? 1.0 : 0.0, y, q, v;
-        y = hf_atan_poly(x > 1.0 ? rxb[j] : x);
-        y = copysign(big * HFVIS__HALF_PI + (1.0 - 2.0 * big) * y, tc);
-        q = 1.0 / (1.0 + tc * tc);
-        v = nz[j] * inv_k * q + lobe * a[j] * ((HFVIS__HALF_PI - y) - tc * q);
-        v = v > 0.0 ? v : 0.0;
-        v = x <= DBL_MAX ? v : -1.0;
-        v = nz[j] > 0.0 ? v : -1.0;
-        r[j] = t[j] == t[j] ? v : -1.0;
-    }
-}
-
-/* The fused sky light's line consumer: [P1] Eq. 5 per direction over a line's stored tangents,
- * HF_SKY_BATCH nodes at a time: each node's tangent, nz and n.l gathered into arrays (structure
- * of arrays), hf_sky_batch, the terms added to the accumulator. */
 static void hf_sky_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdiff_t step, int n,
                         const double *t)
 {
     const hf_fused *c = (const hf_fused *)vctx;
     /* in locals: the store to lat could alias the context, so gcc reloaded them at every node */
-    const double lx = c->lx, ly = c->ly, inv_k = c->inv_k, lobe = c->lobe;
+    const double sky[4] = {c->lx, c->ly, c->inv_k, c->lobe};
     const float *nrm = sw->nrm;
-    double *lat = sw->lat, tb[HF_SKY_BATCH], nzb[HF_SKY_BATCH], ab[HF_SKY_BATCH], rb[HF_SKY_BATCH];
-    int s0, j;
+    double *lat = sw->lat;
+    int s;
     (void)m;
-    for (s0 = 0; s0 < n; s0 += HF_SKY_BATCH) {
-        int cnt = n - s0 < HF_SKY_BATCH ? n - s0 : HF_SKY_BATCH;
-        ptrdiff_t p = node0 + (ptrdiff_t)s0 * step;
-        for (j = 0; j < cnt; j++, p += step) {
-            const float *nr = nrm + p * 3;
-            tb[j] = t[s0 + j];
-            nzb[j] = (double)nr[2];
-            ab[j] = (double)nr[0] * lx + (double)nr[1] * ly;
-        }
-        for (; j < HF_SKY_BATCH; j++) tb[j] = HFVIS__NAN, nzb[j] = 1.0, ab[j] = 0.0;
-        hf_sky_batch(tb, nzb, ab, inv_k, lobe, rb);
-        for (j = 0, p = node0 + (ptrdiff_t)s0 * step; j < cnt; j++, p += step) {
-            double v = rb[j];
-            if (v < 0.0) {
-                if (isnan(tb[j])) continue;
-                v = hf_sky_term(tb[j], nzb[j], ab[j], inv_k, lobe);
-            }
-            lat[p] += v;
-        }
-    }
+    for (s = 0; s < n; s++, node0 += step)
+        if (!isnan(t[s])) hf_walk_emit(HF_WALK_SKY, lat, nrm, sky, NULL, s, node0, t[s]);
 }
 
 static int hf_light_args_valid(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
@@ -3702,7 +3660,7 @@ static void hf_svf_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdif
     (void)vctx;
     (void)m;
     for (s = 0; s < n; s++, node0 += step)
-        if (!isnan(t[s])) hf_walk_emit(HF_WALK_SVF, sw->lat, NULL, s, node0, t[s]);
+        if (!isnan(t[s])) hf_walk_emit(HF_WALK_SVF, sw->lat, NULL, NULL, NULL, s, node0, t[s]);
 }
 
 hfvis_status hfvis_sky_view_factor(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
@@ -3788,7 +3746,7 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
     hf_sweep_parts(&sw, &o);
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HFVIS__NAN);
-    hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL, HF_WALK_STORE);
+    hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
     hf_gather_planes(&sw, 1, 0, out, 0, out_stride);
     for (y = sw.ry0; y < sw.ry1; y++)
         for (x = sw.rx0; x < sw.rx1; x++) {

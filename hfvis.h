@@ -2700,8 +2700,9 @@ HFVIS_API hfvis_status hfvis_lsao_gather(const hfvis_camera *cam, const float *d
  * the inner (width - 2 guard_x) x (height - 2 guard_y) pixels, obscurance (SA convention,
  * docs/errata.md C4), the falloff over view-space distance. Work is O(K W0 H0 / (D_S D_L)) for the
  * sweeps and O(K W H) for the gathers, independent of the falloff radius; memory O(W0 H0)
- * whatever K is (one direction at a time). Allocates 5 blocks (directions, lines, the lattice
- * buffers 8 bytes/sample, the line scratch, the 16-byte/pixel accumulators) plus 1 for
+ * whatever K is (up to four directions at a time: four are swept, then gathered in one pass).
+ * Allocates 5 blocks (directions, lines of four directions, their lattice buffers 8
+ * bytes/sample each, the line scratch, the 16-byte/pixel accumulators) plus 1 for
  * reconstructed normals (real tangents without normals). HFVIS_ERR_INVALID_ARGUMENT for an
  * invalid camera or options, NULL depth/ao, ao_stride < inner width; HFVIS_ERR_LIMIT for a
  * lattice over 2^31 samples; HFVIS_ERR_OUT_OF_MEMORY. Outputs untouched on error.

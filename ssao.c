@@ -1243,19 +1243,29 @@ static void ss_cfg_from_lsao(const hfvis_lsao_options *o, ss_cfg *g)
     g->rej_n = o->reject_normal;
 }
 
+/* In two steps, for the hull, which needs Occ only where Sin decides nothing: ss_sin gives
+ * Sin(h) and |h| (-inf for a coincident point), ss_occ_of the Occ from them (st for s = -inf). */
+static inline double ss_sin(double hx, double hy, double ux, double uy, double tiny, double *len_out)
+{
+    double len = sqrt(hx * hx + hy * hy);
+    *len_out = len;
+    if (!(len > tiny)) return -HFVIS__INF;
+    return (hx * ux + hy * uy) / len;
+}
+
+static inline double ss_occ_of(const ss_fall *f, double s, double len, double st)
+{
+    return s > st ? st + (s - st) * ss_rho(f, len) : st;
+}
+
 /* Occ of point (hx, hy) = occluder - receiver seen along zenith (ux, uy) with tangent st
  * ([P3] Alg. 1 l.25-29); *sin_out = Sin(h) (-inf for a coincident point, which casts st). */
 static inline double ss_occ(const ss_fall *f, double hx, double hy, double ux, double uy, double st,
-                     double tiny, double *sin_out)
+                            double tiny, double *sin_out)
 {
-    double len = sqrt(hx * hx + hy * hy), s;
-    if (!(len > tiny)) {
-        *sin_out = -HFVIS__INF;
-        return st;
-    }
-    s = (hx * ux + hy * uy) / len;
-    *sin_out = s;
-    return s > st ? st + (s - st) * ss_rho(f, len) : st;
+    double len;
+    *sin_out = ss_sin(hx, hy, ux, uy, tiny, &len);
+    return ss_occ_of(f, *sin_out, len, st);
 }
 
 /* The obscurity hull along one line ([P3] §4.2, Alg. 1). */
@@ -1265,7 +1275,8 @@ static void ss_hull_line(const double *x, const double *y, const double *stc, co
 {
     int top = 0, i;
     for (i = 0; i < n; i++) {
-        double px = x[i], py = y[i], r, ux, uy, sc, se, tiny, o1 = 0.0, s1 = 0.0, o2, s2;
+        double px = x[i], py = y[i], r, ux, uy, sc, se, tiny, o1 = 0.0, s1 = 0.0, o2, s2, len1 = 0.0, len2;
+        int have1 = 0;
         if (!isfinite(px) || !isfinite(py)) {
             out[i] = HFVIS__NAN;
             continue;
@@ -1285,25 +1296,28 @@ static void ss_hull_line(const double *x, const double *y, const double *stc, co
         tiny = SS_COINCIDENT * (fabs(px) + fabs(py));
         sc = stc ? stc[i] : fixed;
         se = ste ? ste[i] : fixed;
+        /* Occ (o1, o2) is formed only where the Sin test (s1 < s2) leaves the pop to it: the same
+         * values and decisions as evaluating both tests (no side effects), fewer divisions */
         if (top >= 1) {
             int a = stack[top - 1];
-            o1 = ss_occ(f, x[a] - px, y[a] - py, ux, uy, sc, tiny, &s1);
+            s1 = ss_sin(x[a] - px, y[a] - py, ux, uy, tiny, &len1);
         }
         while (top >= 2) { /* l.12-18 */
             int b = stack[top - 2];
-            o2 = ss_occ(f, x[b] - px, y[b] - py, ux, uy, sc, tiny, &s2);
-            if ((ties ? o1 <= o2 : o1 < o2) && s1 < s2) {
-                top--;
-                o1 = o2;
-                s1 = s2;
-            } else {
-                break;
-            }
+            s2 = ss_sin(x[b] - px, y[b] - py, ux, uy, tiny, &len2);
+            if (!(s1 < s2)) break;
+            if (!have1) o1 = ss_occ_of(f, s1, len1, sc), have1 = 1;
+            o2 = ss_occ_of(f, s2, len2, sc);
+            if (!(ties ? o1 <= o2 : o1 < o2)) break;
+            top--;
+            o1 = o2;
+            s1 = s2;
+            len1 = len2;
         }
         if (top == 0) {
             out[i] = se; /* no occluder yet: rho = 0 (docs/errata.md E27) */
         } else if (se == sc) {
-            out[i] = o1; /* l.20 */
+            out[i] = have1 ? o1 : ss_occ_of(f, s1, len1, sc); /* l.20 */
         } else {
             int a = stack[top - 1];
             double s;
@@ -1761,79 +1775,120 @@ static int ss_fallback(const ss_cam *c, const ss_cfg *g, const float *normals,
     return found;
 }
 
-/* Gather one direction into sum / weight (inner pixels, row-major W). */
-static void ss_gather_dir(const ss_cam *c, const ss_cfg *g, const float *depth,
-                          const float *normals, const hfvis_ssao_lattice *L,
-                          const hfvis_ssao_line *lines, const float *values, const float *sdepth,
-                          double *sum, double *wsum)
+#define SS_GATHER_GROUP 4 /* directions swept, then gathered in one pass (hfvis_lsao) */
+
+/* One direction of the gather: its lattice, lines, values and sample depths, and the constants
+ * of its pixel-to-lattice map (in locals: loaded from the lattice at every pixel, they were
+ * reloaded after every store to the accumulators, which may alias them). */
+typedef struct ss_gdir {
+    const hfvis_ssao_lattice *L;
+    const hfvis_ssao_line *lines;
+    const float *values, *sdepth;
+    double w, ids, idl, R2, px, py, s_first, ddx, ddy, t_min, jmax;
+} ss_gdir;
+
+static void ss_gdir_set(ss_gdir *G, const hfvis_ssao_lattice *L, const hfvis_ssao_line *lines,
+                        const float *values, const float *sdepth)
 {
     const hfvis_ssao_direction *d = &L->dir;
-    int W = c->W - 2 * c->gx, x, y, nlines = L->line_count, nearest = g->gather == HFVIS_SSAO_GATHER_NEAREST;
-    double w = d->weight, ids = 1.0 / d->step, idl = 1.0 / d->spacing;
-    double R2 = 2.0 * sqrt(0.25 * d->step * d->step + 0.25 * d->spacing * d->spacing);
-    /* in locals: the stores to sum and wsum may alias the lattice's and the camera's doubles, so
-     * they were reloaded at every pixel */
-    const double px = L->px, py = L->py, s_first = L->s_first, ddx = d->dx, ddy = d->dy, t_min = L->t_min,
-                 rej_z = g->rej_z, far_d = c->far_d, jmax = (double)nlines - 0.5;
-    if (nlines < 1) return;
+    G->L = L;
+    G->lines = lines;
+    G->values = values;
+    G->sdepth = sdepth;
+    G->w = d->weight;
+    G->ids = 1.0 / d->step;
+    G->idl = 1.0 / d->spacing;
+    G->R2 = 2.0 * sqrt(0.25 * d->step * d->step + 0.25 * d->spacing * d->spacing);
+    G->px = L->px;
+    G->py = L->py;
+    G->s_first = L->s_first;
+    G->ddx = d->dx;
+    G->ddy = d->dy;
+    G->t_min = L->t_min;
+    G->jmax = (double)L->line_count - 0.5;
+}
+
+/* Direction G's value for the receiver at (u, v) of depth zc (normal nc or NULL): 1 and *val if a
+ * sample is accepted, else 0. */
+static inline int ss_gather_at(const ss_cam *c, const ss_cfg *g, const float *normals, const ss_gdir *G,
+                        double u, double v, double zc, const float *nc, double *val)
+{
+    const hfvis_ssao_lattice *L = G->L;
+    const hfvis_ssao_line *lines = G->lines;
+    const float *values = G->values, *sdepth = G->sdepth;
+    double jf = (u * G->px + v * G->py - G->s_first) * G->idl, tf = (u * G->ddx + v * G->ddy - G->t_min) * G->ids;
+    int ok = 0, nlines = L->line_count;
+    *val = 0.0;
+    if (g->gather == HFVIS_SSAO_GATHER_NEAREST) {
+        int j, i;
+        /* fast path of ss_nearest: the rounded line and step lie inside the lattice */
+        if (jf > -0.5 && jf < G->jmax && tf > -0.5 && tf < 2147483647.0) {
+            const hfvis_ssao_line *ln;
+            j = (int)(jf + 0.5);
+            i = (int)(tf + 0.5);
+            ln = &lines[j];
+            if (i >= ln->first && i < ln->first + ln->count) {
+                size_t idx = ln->offset + (size_t)(i - ln->first);
+                double zs = (double)sdepth[idx];
+                *val = (double)values[idx];
+                ok = *val == *val && zs == zs && (g->rej_z < 0.0 || fabs(zs - zc) <= g->rej_z * zc);
+                if (ok && nc) ok = ss_accept(c, g, normals, L, ln, i, values, sdepth, zc, nc, val);
+                goto have;
+            }
+        }
+        if (ss_nearest(L, lines, u, v, &j, &i))
+            ok = ss_accept(c, g, normals, L, &lines[j], i, values, sdepth, zc, nc, val);
+    } else {
+        double fj = floor(jf), fi = floor(tf), aj = jf - fj, ai = tf - fi, ws = 0.0, vs = 0.0;
+        int dj, di;
+        for (dj = 0; dj < 2; dj++)
+            for (di = 0; di < 2; di++) {
+                double wt = (dj ? aj : 1.0 - aj) * (di ? ai : 1.0 - ai), vv;
+                double jj = fj + (double)dj, ii = fi + (double)di;
+                if (!(wt > 0.0) || jj < 0.0 || jj >= (double)nlines) continue;
+                if (!ss_accept(c, g, normals, L, &lines[(int)jj], (int)ii, values, sdepth, zc, nc, &vv))
+                    continue;
+                ws += wt;
+                vs += wt * vv;
+            }
+        if (ws > 0.0) {
+            *val = vs / ws;
+            ok = 1;
+        }
+    }
+have:
+    if (!ok) ok = ss_fallback(c, g, normals, L, lines, values, sdepth, u, v, zc, nc, G->R2, val);
+    return ok;
+}
+
+/* Gather nd directions into sum / weight (inner pixels, row-major W) in one pass over the
+ * pixels: each pixel's two accumulators are read once, the directions' terms added in order (the
+ * same additions as one pass per direction), and written once. With a few directions per pass
+ * (hfvis_lsao: SS_GATHER_GROUP), the pixel loop, the depth test and the accumulators' loads and
+ * stores are shared by the group. */
+static void ss_gather_dirs(const ss_cam *c, const ss_cfg *g, const float *depth,
+                           const float *normals, const ss_gdir *G, int nd, double *sum, double *wsum)
+{
+    int W = c->W - 2 * c->gx, x, y, k;
+    const double far_d = c->far_d;
     for (y = c->gy; y < c->H - c->gy; y++) {
         double v = (double)y + 0.5;
         const float *drow = depth + ss_index(c, 0, y);
         size_t orow = (size_t)(y - c->gy) * (size_t)W - (size_t)c->gx; /* + x: pixel x's slot (mod 2^n) */
         for (x = c->gx; x < c->W - c->gx; x++) {
-            double u = (double)x + 0.5, zc = (double)drow[x], val = 0.0;
+            double u = (double)x + 0.5, zc = (double)drow[x], s, ws;
             const float *nc = normals ? normals + 3 * ss_index(c, x, y) : NULL;
-            double jf, tf;
-            int ok = 0;
             if (!(zc > 0.0 && zc < far_d)) continue; /* ss_bg */
-            jf = (u * px + v * py - s_first) * idl;
-            tf = (u * ddx + v * ddy - t_min) * ids;
-            if (nearest) {
-                int j, i;
-                /* fast path of ss_nearest: the rounded line and step lie inside the lattice */
-                if (jf > -0.5 && jf < jmax && tf > -0.5 && tf < 2147483647.0) {
-                    const hfvis_ssao_line *ln;
-                    j = (int)(jf + 0.5);
-                    i = (int)(tf + 0.5);
-                    ln = &lines[j];
-                    if (i >= ln->first && i < ln->first + ln->count) {
-                        size_t idx = ln->offset + (size_t)(i - ln->first);
-                        double zs = (double)sdepth[idx];
-                        val = (double)values[idx];
-                        ok = val == val && zs == zs && (rej_z < 0.0 || fabs(zs - zc) <= rej_z * zc);
-                        if (ok && nc)
-                            ok = ss_accept(c, g, normals, L, ln, i, values, sdepth, zc, nc, &val);
-                        goto have;
-                    }
-                }
-                if (ss_nearest(L, lines, u, v, &j, &i))
-                    ok = ss_accept(c, g, normals, L, &lines[j], i, values, sdepth, zc, nc, &val);
-            } else {
-                double fj = floor(jf), fi = floor(tf), aj = jf - fj, ai = tf - fi, ws = 0.0,
-                       vs = 0.0;
-                int dj, di;
-                for (dj = 0; dj < 2; dj++)
-                    for (di = 0; di < 2; di++) {
-                        double wt = (dj ? aj : 1.0 - aj) * (di ? ai : 1.0 - ai), vv;
-                        double jj = fj + (double)dj, ii = fi + (double)di;
-                        if (!(wt > 0.0) || jj < 0.0 || jj >= (double)nlines) continue;
-                        if (!ss_accept(c, g, normals, L, &lines[(int)jj], (int)ii, values,
-                                       sdepth, zc, nc, &vv))
-                            continue;
-                        ws += wt;
-                        vs += wt * vv;
-                    }
-                if (ws > 0.0) {
-                    val = vs / ws;
-                    ok = 1;
-                }
+            s = sum[orow + (size_t)x];
+            ws = wsum[orow + (size_t)x];
+            for (k = 0; k < nd; k++) {
+                double val;
+                if (G[k].L->line_count < 1 || !ss_gather_at(c, g, normals, &G[k], u, v, zc, nc, &val)) continue;
+                s += G[k].w * val;
+                ws += G[k].w;
             }
-        have:
-            if (!ok)
-                ok = ss_fallback(c, g, normals, L, lines, values, sdepth, u, v, zc, nc, R2, &val);
-            if (!ok) continue;
-            sum[orow + (size_t)x] += w * val;
-            wsum[orow + (size_t)x] += w;
+            sum[orow + (size_t)x] = s;
+            wsum[orow + (size_t)x] = ws;
         }
     }
 }
@@ -1845,13 +1900,15 @@ hfvis_status hfvis_lsao_gather(const hfvis_camera *cam, const float *depth, cons
 {
     ss_cam c;
     ss_cfg g;
+    ss_gdir G;
     hfvis_lsao_options o;
     if (ss_cam_load(cam, &c) != HFVIS_OK || hfvis_lsao_options_resolve(opts, &o) != HFVIS_OK ||
         !depth || !values || !sample_depth || !sum || !weight || !ss_lattice_ok(lat, lines) ||
         !isfinite(lat->dir.weight))
         return HFVIS_ERR_INVALID_ARGUMENT;
     ss_cfg_from_lsao(&o, &g);
-    ss_gather_dir(&c, &g, depth, normals, lat, lines, values, sample_depth, sum, weight);
+    ss_gdir_set(&G, lat, lines, values, sample_depth);
+    ss_gather_dirs(&c, &g, depth, normals, &G, 1, sum, weight);
     return HFVIS_OK;
 }
 
@@ -1879,12 +1936,13 @@ hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth, const float
     ss_cfg g;
     hfvis_lsao_options o;
     hfvis_ssao_direction *dirs = NULL;
-    hfvis_ssao_lattice lat;
+    hfvis_ssao_lattice lat, glat[SS_GATHER_GROUP];
+    ss_gdir G[SS_GATHER_GROUP];
     hfvis_ssao_line *lines = NULL;
     float *nrm = NULL, *vals = NULL;
     double *scratch = NULL, *acc = NULL;
-    size_t maxs = 0, npix, b;
-    int K, k, maxl = 0, maxm = 0, W, H;
+    size_t maxs = 0, npix, b, ms, ml;
+    int K, k, k0, maxl = 0, maxm = 0, W, H;
     hfvis_status s = HFVIS_OK;
     if (ss_cam_load(cam, &c) != HFVIS_OK || hfvis_lsao_options_resolve(opts, &o) != HFVIS_OK ||
         !depth || !ao)
@@ -1911,23 +1969,29 @@ hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth, const float
         if (!b || !(nrm = (float *)hfvis__alloc(o.alloc, b))) goto done;
         ss_normals_fill(&c, depth, nrm);
     }
-    b = ss_bytes3((size_t)(maxl > 0 ? maxl : 1), 1, sizeof *lines);
+    ml = (size_t)(maxl > 0 ? maxl : 1);
+    ms = maxs > 0 ? maxs : 1;
+    b = ss_bytes3(ml, SS_GATHER_GROUP, sizeof *lines);
     if (!b || !(lines = (hfvis_ssao_line *)hfvis__alloc(o.alloc, b))) goto done;
-    b = ss_bytes3(maxs > 0 ? maxs : 1, 2, sizeof(float));
+    b = ss_bytes3(ms, 2 * SS_GATHER_GROUP, sizeof(float));
     if (!b || !(vals = (float *)hfvis__alloc(o.alloc, b))) goto done;
     b = ss_bytes3((size_t)(maxm > 0 ? maxm : 1), 1, 4 * sizeof(double) + sizeof(int));
     if (!b || !(scratch = (double *)hfvis__alloc(o.alloc, b))) goto done;
     b = ss_bytes3(npix, 2, sizeof(double));
     if (!b || !(acc = (double *)hfvis__alloc(o.alloc, b))) goto done;
     for (b = 0; b < 2 * npix; b++) acc[b] = 0.0;
-    for (k = 0; k < K; k++) {
-        ss_lattice_init(&c, &dirs[k], &lat);
-        ss_lattice_fill(&c, &lat, lines);
-        ss_lsao_sweep_dir(&c, &g, depth, nrm ? nrm : normals, &lat, lines, scratch,
-                          (int *)(scratch + 4 * (size_t)(maxm > 0 ? maxm : 1)), 0, vals,
-                          vals + (maxs > 0 ? maxs : 1));
-        ss_gather_dir(&c, &g, depth, normals, &lat, lines, vals, vals + (maxs > 0 ? maxs : 1),
-                      acc, acc + npix);
+    for (k0 = 0; k0 < K; k0 += SS_GATHER_GROUP) { /* sweep a group of directions, gather it */
+        int nd = K - k0 < SS_GATHER_GROUP ? K - k0 : SS_GATHER_GROUP;
+        for (k = 0; k < nd; k++) {
+            hfvis_ssao_line *lk = lines + (size_t)k * ml;
+            float *vk = vals + (size_t)k * 2 * ms;
+            ss_lattice_init(&c, &dirs[k0 + k], &glat[k]);
+            ss_lattice_fill(&c, &glat[k], lk);
+            ss_lsao_sweep_dir(&c, &g, depth, nrm ? nrm : normals, &glat[k], lk, scratch,
+                              (int *)(scratch + 4 * (size_t)(maxm > 0 ? maxm : 1)), 0, vk, vk + ms);
+            ss_gdir_set(&G[k], &glat[k], lk, vk, vk + ms);
+        }
+        ss_gather_dirs(&c, &g, depth, normals, G, nd, acc, acc + npix);
     }
     ss_finish(&c, depth, acc, acc + npix, ao, ao_stride);
     s = HFVIS_OK;
