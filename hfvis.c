@@ -1221,7 +1221,7 @@ static inline double hf_bilerp_taps(const float *p, ptrdiff_t stride, double fx,
     return isfinite(r1) ? r1 : HFVIS__NAN; /* a +-Inf tap is a hole too */
 }
 
-static double hf_bilerp(const float *z, ptrdiff_t stride, int W, int H, double x, double y)
+static inline double hf_bilerp(const float *z, ptrdiff_t stride, int W, int H, double x, double y)
 {
     int x0, y0;
     double fx, fy;
@@ -3023,7 +3023,7 @@ typedef struct hf_surface {
     double reach;              /* how far beyond the grid the march continues (cells) */
 } hf_surface;
 
-static double hf_surface_height(const hf_surface *S, double x, double y)
+static inline double hf_surface_height(const hf_surface *S, double x, double y)
 {
     if (S->fn) return S->fn(S->user, x, y);
     if (x >= 0.0 && y >= 0.0 && x <= (double)(S->width - 1) && y <= (double)(S->height - 1))
@@ -3032,15 +3032,17 @@ static double hf_surface_height(const hf_surface *S, double x, double y)
 }
 
 /* Per-receiver march ([P2] §1; P2's "naive method"): samples at p + s*step*l,
- * s = 1, 2, ..., while inside the grid (plus the border reach), keeping the largest slope; sign
- * -1 takes the slopes of the inverted surface -z (negative openness). */
-static double hf_march_tan(const hf_surface *S, double px, double py, double h0, double lx,
-                           double ly, double step, double max_dist, double sign)
+ * s = 1, 2, ..., while inside the grid (plus the border reach), keeping the largest slope.
+ * which = 1: best[0] = the largest (h - h0)/d (the terrain); which = 2: best[1] = the largest
+ * (h0 - h)/d (the inverted surface -z, negative openness); which = 3: both over the same walk,
+ * each equal to its own march bit for bit ((h0 - h) is -(h - h0) exactly). */
+static void hf_march_slopes(const hf_surface *S, double px, double py, double h0, double lx,
+                            double ly, double step, double max_dist, int which, double best[2])
 {
-    double best = -HFVIS__INF, xmin = -S->reach - HF_LATTICE_EPS, ymin = xmin;
+    double xmin = -S->reach - HF_LATTICE_EPS, ymin = xmin;
     double xmax = (double)(S->width - 1) + S->reach + HF_LATTICE_EPS;
     double ymax = (double)(S->height - 1) + S->reach + HF_LATTICE_EPS;
-    double inv = 1.0 / S->cell_size;
+    double inv = 1.0 / S->cell_size, up = -HFVIS__INF, low = HFVIS__INF;
     long s;
     for (s = 1;; s++) {
         double d = (double)s * step, x = px + d * lx, y = py + d * ly, h, t;
@@ -3050,10 +3052,21 @@ static double hf_march_tan(const hf_surface *S, double px, double py, double h0,
         y = y < 0.0 && y > -HF_LATTICE_EPS ? 0.0 : y;
         h = hf_surface_height(S, x, y);
         if (!isfinite(h)) continue;
-        t = (sign > 0.0 ? h - h0 : h0 - h) * inv / d;
-        if (t > best) best = t;
+        t = (h - h0) * inv / d; /* (h0 - h) * inv / d is exactly -t */
+        up = t > up ? t : up;
+        low = t < low ? t : low;
     }
-    return best;
+    best[0] = which & 1 ? up : -HFVIS__INF;
+    best[1] = which & 2 ? -low : -HFVIS__INF;
+}
+
+/* The march's largest slope of the terrain (sign > 0) or of -z (sign < 0). */
+static double hf_march_tan(const hf_surface *S, double px, double py, double h0, double lx,
+                           double ly, double step, double max_dist, double sign)
+{
+    double best[2];
+    hf_march_slopes(S, px, py, h0, lx, ly, step, max_dist, sign > 0.0 ? 1 : 2, best);
+    return sign > 0.0 ? best[0] : best[1];
 }
 
 static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0, int exact_bound,
@@ -3171,16 +3184,19 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
     const int W = grid ? grid->width : 0, H = grid ? grid->height : 0;
     double radius = oo ? oo->radius : 0.0, step = oo && oo->step_cells > 0.0 ? oo->step_cells : 1.0;
     int negative = oo ? oo->negative : 0, x, y, k;
+    const ptrdiff_t second = (ptrdiff_t)H * out_stride; /* negative == 2: the negative plane */
     hfvis_sweep_options o;
     if (hf_check_common(grid, opts) != HFVIS_OK || K < 1 || !out || out_stride < W ||
-        !hfvis__plane_fits(out_stride, H, 4) || !isfinite(radius) || radius < 0.0 || !isfinite(step) ||
-        (oo && !(oo->step_cells >= 0.0)) || (negative != 0 && negative != 1))
+        !hfvis__plane_fits(out_stride, negative == 2 && H <= INT_MAX / 2 ? 2 * H : H, 4) ||
+        !isfinite(radius) || radius < 0.0 || !isfinite(step) || (oo && !(oo->step_cells >= 0.0)) ||
+        (negative != 0 && negative != 1 && negative != 2) || (negative == 2 && H > INT_MAX / 2))
         return HFVIS_ERR_INVALID_ARGUMENT;
     if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
     o = hf_opts_resolve(grid, opts);
-    if (radius > 0.0) { /* the march: no allocation */
+    if (radius > 0.0) { /* the march: no allocation; both signs from one walk when negative == 2 */
         hf_surface S;
         const double maxd = radius / grid->cell_size;
+        const int which = negative == 2 ? 3 : negative ? 2 : 1;
         memset(&S, 0, sizeof S);
         S.g = grid;
         S.width = W;
@@ -3190,23 +3206,36 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
         S.reach = o.border == HFVIS_BORDER_OPEN ? 0.0 : (double)o.border_cells;
         for (y = 0; y < H; y++) {
             for (x = 0; x < W; x++) {
-                double h0 = (double)grid->z[(ptrdiff_t)y * grid->stride + x], sum = 0.0;
+                const ptrdiff_t i = (ptrdiff_t)y * out_stride + x;
+                double h0 = (double)grid->z[(ptrdiff_t)y * grid->stride + x], sum[2] = {0.0, 0.0};
                 if (!isfinite(h0)) {
-                    out[(ptrdiff_t)y * out_stride + x] = (float)HFVIS__NAN;
+                    out[i] = (float)HFVIS__NAN;
+                    if (negative == 2) out[second + i] = (float)HFVIS__NAN;
                     continue;
                 }
                 for (k = 0; k < K; k++) {
-                    double ux, uy, t;
+                    double ux, uy, best[2];
                     hf_sweep_vector(o.azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K, &ux, &uy);
-                    t = hf_march_tan(&S, (double)x, (double)y, h0, -ux, -uy, step, maxd,
-                                     negative ? -1.0 : 1.0);
-                    /* the angle as a float, as the horizon outputs (and the sweep path) hold it */
-                    sum += HFVIS__HALF_PI - (double)(float)hf_tan_to_elevation(t);
+                    hf_march_slopes(&S, (double)x, (double)y, h0, -ux, -uy, step, maxd, which, best);
+                    /* each angle as a float, as the horizon outputs (and the sweep path) hold it */
+                    if (which & 1) sum[0] += HFVIS__HALF_PI - (double)(float)hf_tan_to_elevation(best[0]);
+                    if (which & 2) sum[1] += HFVIS__HALF_PI - (double)(float)hf_tan_to_elevation(best[1]);
                 }
-                out[(ptrdiff_t)y * out_stride + x] = (float)(sum / (double)K);
+                if (negative == 2) {
+                    out[i] = (float)(sum[0] / (double)K);
+                    out[second + i] = (float)(sum[1] / (double)K);
+                } else
+                    out[i] = (float)(sum[negative] / (double)K);
             }
             hf_progress(&o, y + 1, H);
         }
+    } else if (negative == 2) { /* the sweep: the positive plane, then the negative one */
+        hfvis_openness_options one = *oo;
+        hfvis_status s;
+        one.negative = 0;
+        if ((s = hfvis_openness(grid, K, &one, opts, out, out_stride)) != HFVIS_OK) return s;
+        one.negative = 1;
+        return hfvis_openness(grid, K, &one, opts, out + second, out_stride);
     } else { /* the sweep: a plane, its sums and (negative) the inverted surface */
         const size_t n = hf_grid_count(grid);
         float *plane = (float *)hfvis__alloc_array(o.alloc, n, sizeof(float));

@@ -705,7 +705,10 @@ HFVIS_API hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user
  * beta = -pi/2 (use HFVIS_BORDER_CLAMP to extend the edges). NaN at holes. */
 typedef struct hfvis_openness_options {
     double radius;      /* search distance in world units, >= 0; 0 = unlimited */
-    int negative;       /* 0: positive openness; 1: negative */
+    int negative;       /* 0: positive openness; 1: negative; 2: both, positive in out's first
+                           height rows and negative in the next height rows (out must hold
+                           2*height rows of out_stride); each plane equals its own run's bit
+                           for bit, and with radius > 0 one march serves both signs */
     double step_cells;  /* radius > 0: march step in cells, >= 0; 0 = 1 */
 } hfvis_openness_options;
 
@@ -716,15 +719,17 @@ HFVIS_API hfvis_openness_options hfvis_openness_options_default(void);
  * alloc and progress; the direction range is not honoured (all K).
  * radius > 0: the per-receiver march of hfvis_horizon_reference out to the radius, at step_cells
  *   (so the same bilinear samples as the oracle with max_distance_cells = radius/cell_size),
- *   O(K*W*H*radius/(cell_size*step_cells)); no allocation; progress once per row.
+ *   O(K*W*H*radius/(cell_size*step_cells)); no allocation; progress once per row. Both signs
+ *   (negative = 2) walk each ray once.
  * radius = 0: the exact sweep, hfvis_horizon_direction per direction, O(K*W*H); allocates
  *   W*H floats and W*H doubles (and W*H floats for negative) plus each sweep's scratch;
- *   progress once per direction. Both ways each angle is rounded to float (as the horizon
+ *   progress once per direction (both signs: the positive run, then the negative one, each
+ *   counting its K directions). Both ways each angle is rounded to float (as the horizon
  *   outputs hold it) and the K of a sample are summed in double, so with axis directions
  *   (K = 4, azimuth0 0) the sweep equals the march with a radius beyond the grid bit for bit;
  *   otherwise they differ by the gather tolerance of hfvis_horizon_direction.
  * Returns HFVIS_ERR_INVALID_ARGUMENT (bad grid, options, K < 1, out NULL, out_stride < width,
- * negative or non-finite radius or step, negative not 0/1), HFVIS_ERR_OUT_OF_MEMORY or
+ * negative or non-finite radius or step, negative not 0, 1 or 2), HFVIS_ERR_OUT_OF_MEMORY or
  * HFVIS_ERR_LIMIT (the sweep's). */
 HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_options *oo,
                                       const hfvis_sweep_options *opts, float *out,

@@ -1257,6 +1257,9 @@ static void args_openness(void)
     oo.radius = 2.0;
     oo.negative = 1;
     OK(hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
+    oo.negative = 2; /* both: two planes */
+    OK(hfvis_openness(&g_ok, 4, &oo, NULL, AF(2 * GW * GH), GW));
+    oo.negative = 1;
     BAD('N', INV, hfvis_openness(NULL, 4, NULL, NULL, out, GW));
     BAD('N', INV, hfvis_openness(&g_ok, 4, NULL, NULL, NULL, GW));
     BAD('Z', INV, hfvis_openness(&g_ok, 0, NULL, NULL, out, GW));
@@ -1268,7 +1271,8 @@ static void args_openness(void)
     oo.radius = (double)INFINITY; BAD('F', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
     oo.radius = 1.0; oo.step_cells = -1.0; BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
     oo.step_cells = (double)NAN; BAD('F', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
-    oo.step_cells = 0.0; oo.negative = 2; BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
+    oo.step_cells = 0.0; oo.negative = 3; BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
+    oo.negative = -1; BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
     GRID_CASES(hfvis_openness(&bg, 4, NULL, NULL, out, GW));
     SWEEP_OPT_CASES(hfvis_openness(&g_ok, 4, NULL, &bo, out, GW));
 }

@@ -1900,6 +1900,32 @@ TEST(openness_closed_forms_and_oracle)
         CHECK(n == N - 1 && d[n / 2] <= P2_TOL_GATHER_MEDIAN && d[n - 1] <= P2_TOL_GATHER_MAX);
         o.azimuth0_rad = 0.0;
     }
+    /* both signs in one call (negative = 2): each plane equals its own run bit for bit, with a
+     * radius (one march for both) and unlimited, open and clamped borders, holes included */
+    {
+        static float both[2 * N], one[N];
+        static const double radii[3] = {4.0, 1e6, 0.0};
+        int r, b;
+        for (b = 0; b < 2; b++)
+            for (r = 0; r < 3; r++) {
+                o.border = b ? HFVIS_BORDER_CLAMP : HFVIS_BORDER_OPEN;
+                o.azimuth0_rad = 0.2;
+                oo.radius = radii[r];
+                oo.negative = 2;
+                CHECK_EQ_STATUS(hfvis_openness(&g, 12, &oo, &o, both, W), HFVIS_OK);
+                oo.negative = 0;
+                CHECK_EQ_STATUS(hfvis_openness(&g, 12, &oo, &o, one, W), HFVIS_OK);
+                CHECK(memcmp(both, one, sizeof one) == 0);
+                oo.negative = 1;
+                CHECK_EQ_STATUS(hfvis_openness(&g, 12, &oo, &o, one, W), HFVIS_OK);
+                CHECK(memcmp(both + N, one, sizeof one) == 0);
+                CHECK(isnan(both[7 * W + 9]) && isnan(both[N + 7 * W + 9]));
+            }
+        o.border = HFVIS_BORDER_OPEN;
+        o.azimuth0_rad = 0.0;
+        oo.negative = 0;
+        oo.radius = 0.0;
+    }
     /* bad arguments, outputs untouched */
     out[0] = 42.0f;
     CHECK_EQ_STATUS(hfvis_openness(NULL, 4, NULL, NULL, out, W), HFVIS_ERR_INVALID_ARGUMENT);
@@ -1914,7 +1940,7 @@ TEST(openness_closed_forms_and_oracle)
     oo.step_cells = -1.0;
     CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, NULL, out, W), HFVIS_ERR_INVALID_ARGUMENT);
     oo.step_cells = 0.0;
-    oo.negative = 2;
+    oo.negative = 3;
     CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, NULL, out, W), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK(out[0] == 42.0f);
 }
