@@ -869,6 +869,29 @@ longa=$(awk 'BEGIN { for (i = 0; i < 247; i++) printf "%c", 97 + i % 26 }').asc
 expect_ok "a 251-byte ASCII grid output name" "$dir/$longa" skyview "$dir/flat.pgm" --dirs 4 -o "$dir/$longa"
 rm -f "$dir/$longa"
 
+# ---- a file-size limit (ulimit -f, SIGXFSZ ignored: the write fails with EFBIG, as on a full
+# disk): every output format exits 1 with one line, the previous output (and its sidecars) stays
+# byte for byte, and no temporary file is left ----------------------------------------------
+awk 'BEGIN { w = 100; h = 100; print "P2"; print w, h; print 65535
+  for (y = 0; y < h; y++) { s = ""; for (x = 0; x < w; x++) s = s " " int(30000 + 9000 * sin(x * 0.7) * cos(y * 0.45) + (x * 37 + y * 91) % 997); print s } }' > "$dir/noisy.pgm"
+mkdir -p "$dir/fsz"
+for ext in pfm pgm tif asc flt bil; do
+  rm -f "$dir/fsz/"*
+  if "$hfvis" skyview "$dir/noisy.pgm" --cell 1 --dirs 4 -o "$dir/fsz/o.$ext" > /dev/null 2>&1; then
+    mkdir -p "$dir/fsz_old"; rm -f "$dir/fsz_old/"*; cp "$dir/fsz/"* "$dir/fsz_old/"
+    ( trap '' XFSZ; ulimit -f 8; exec "$hfvis" skyview "$dir/noisy.pgm" --cell 1 --dirs 8 -o "$dir/fsz/o.$ext" ) > /dev/null 2> "$dir/err"; rc=$?
+    same=1; for f in "$dir/fsz_old/"*; do cmp -s "$f" "$dir/fsz/$(basename "$f")" || same=0; done
+    n_old=$(ls "$dir/fsz_old" | wc -l); n_new=$(ls "$dir/fsz" | wc -l)
+    if [ "$rc" -eq 1 ] && [ "$(wc -l < "$dir/err" | tr -d ' ')" = 1 ] && [ "$same" = 1 ] && [ "$n_old" = "$n_new" ]; then
+      ok "file-size limit, .$ext: exit 1, one line, the old output intact, no temporary file: $(cat "$dir/err")"
+    else bad "file-size limit, .$ext: exit $rc, same $same, files $n_old -> $n_new: $(head -n 2 "$dir/err")"; fi
+  else bad "file-size limit, .$ext: the unlimited run failed"; fi
+done
+rm -f "$dir/fsz/"*
+( trap '' XFSZ; ulimit -f 8; exec "$hfvis" voxelize "$dir/cube.obj" --res 80 --mode solid -o "$dir/fsz/v.raw" ) > /dev/null 2> "$dir/err"; rc=$?
+[ "$rc" -eq 1 ] && [ -z "$(ls "$dir/fsz")" ] && ok "file-size limit, voxelize .raw: exit 1, nothing left: $(cat "$dir/err")" \
+  || bad "file-size limit, voxelize .raw: exit $rc, left $(ls "$dir/fsz")"
+
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
