@@ -53,22 +53,6 @@
 #define HFVIS_MALLOC(size) malloc(size)
 #define HFVIS_FREE(ptr) free(ptr)
 #endif
-/* The stdio calls of the write path (hfvis.h, "Files"): each may be defined to a replacement
- * with the same signature (test/test_wfault.c fails them one call at a time). */
-#ifndef HFVIS_NO_STDIO
-#ifndef HFVIS_FWRITE
-#define HFVIS_FWRITE(ptr, size, n, file) fwrite(ptr, size, n, file)
-#endif
-#ifndef HFVIS_FFLUSH
-#define HFVIS_FFLUSH(file) fflush(file)
-#endif
-#ifndef HFVIS_FCLOSE
-#define HFVIS_FCLOSE(file) fclose(file)
-#endif
-#ifndef HFVIS_RENAME
-#define HFVIS_RENAME(from, to) rename(from, to)
-#endif
-#endif
 
 /* Exact rays (section 16), called from the public routines of sections 8, 9, 10 and 15. */
 /* One exact-ray direction: look vector (a, b), gcd 1, and its azimuth, unwrapped to within pi of

@@ -401,6 +401,19 @@ HFVIS_API hfvis_status hfvis_write_file(const char *path, const void *bytes, siz
  * HFVIS_ERR_INVALID_ARGUMENT for a NULL file, temp_path or path (it still releases the others).
  * Declared only where <stdio.h> is available (not with HFVIS_NO_STDIO). */
 #ifndef HFVIS_NO_STDIO
+/* The write path's stdio calls (see hfvis_write_file, "Test hooks"; examples/zio.h uses them too). */
+#ifndef HFVIS_FWRITE
+#define HFVIS_FWRITE(ptr, size, n, file) fwrite(ptr, size, n, file)
+#endif
+#ifndef HFVIS_FFLUSH
+#define HFVIS_FFLUSH(file) fflush(file)
+#endif
+#ifndef HFVIS_FCLOSE
+#define HFVIS_FCLOSE(file) fclose(file)
+#endif
+#ifndef HFVIS_RENAME
+#define HFVIS_RENAME(from, to) rename(from, to)
+#endif
 HFVIS_API hfvis_status hfvis_write_begin(const char *path, const hfvis_write_options *opts,
                                          FILE **file, char **temp_path);
 HFVIS_API hfvis_status hfvis_write_end(const char *path, FILE *file, char *temp_path, int commit,

@@ -14,14 +14,7 @@
 
 static char tdir[256];
 
-static char *tpath(const char *name)
-{
-    static char p[4][512];
-    static int k;
-    k = (k + 1) & 3;
-    snprintf(p[k], sizeof p[k], "%s/%s", tdir, name);
-    return p[k];
-}
+static char *tpath(const char *name) { return test_dir_path(tdir, name); }
 
 static unsigned char *slurp(const char *path, size_t *n)
 {
