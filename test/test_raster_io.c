@@ -830,6 +830,10 @@ TEST(pixel_scale_counts)
     e[9][2] = 3; /* no tie point */
     mini_tiff(buf, e, 10, 0);
     CHECK(open_err(buf, 400, "no ModelTiepoint"));
+    sc[0] = (double)INFINITY; /* an infinite scale: refused (info printed "origin -nan -nan") */
+    { uint64_t u; memcpy(&u, &sc[0], 8); ex_rio_put_uint(buf + 300, u, 8, 0); }
+    mini_tiff(buf, e, 11, 0);
+    CHECK(open_err(buf, 400, "non-finite"));
     sc[0] = 0.0; /* zero scale */
     { uint64_t u; memcpy(&u, &sc[0], 8); ex_rio_put_uint(buf + 300, u, 8, 0); }
     mini_tiff(buf, e, 11, 0);
