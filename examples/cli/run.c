@@ -219,13 +219,16 @@ static float *cli_alloc(size_t a, size_t b, size_t c)
 }
 
 /* IN's size (and cell size, 0 when unknown) from its header alone, for --max-memory before
- * the heights are loaded: 1, or 0 when the header cannot be read this way (an ASCII PGM: the
- * load then reports or checks it). An ASC grid's text is parsed, within its file's size. */
+ * the heights are loaded: 1, or 0 when the header cannot be read this way (an ASCII PGM, and an
+ * ASC grid, whose text is parsed whole: the load then reports or checks it, its memory bounded
+ * by the file's size). */
 static int cli_peek_size(const cli_args *a, int *w, int *h, double *cell)
 {
     ex_rio_reader r;
     char why[256];
-    if ((ex_rio_format_of(a->in) ? ex_rio_open(&r, a->in) : ex_rio_open_netpbm(&r, a->in)) != 0) {
+    int fmt = ex_rio_format_of(a->in);
+    if (fmt == EX_RIO_ASC) return 0;
+    if ((fmt ? ex_rio_open(&r, a->in) : ex_rio_open_netpbm(&r, a->in)) != 0) {
         ex_rio_close(&r);
         return 0;
     }
