@@ -57,22 +57,6 @@
 #define HFVIS_MALLOC(size) malloc(size)
 #define HFVIS_FREE(ptr) free(ptr)
 #endif
-/* The stdio calls of the write path (hfvis.h, "Files"): each may be defined to a replacement
- * with the same signature (test/test_wfault.c fails them one call at a time). */
-#ifndef HFVIS_NO_STDIO
-#ifndef HFVIS_FWRITE
-#define HFVIS_FWRITE(ptr, size, n, file) fwrite(ptr, size, n, file)
-#endif
-#ifndef HFVIS_FFLUSH
-#define HFVIS_FFLUSH(file) fflush(file)
-#endif
-#ifndef HFVIS_FCLOSE
-#define HFVIS_FCLOSE(file) fclose(file)
-#endif
-#ifndef HFVIS_RENAME
-#define HFVIS_RENAME(from, to) rename(from, to)
-#endif
-#endif
 
 /* Exact rays (section 16), called from the public routines of sections 8, 9, 10 and 15. */
 /* One exact-ray direction: look vector (a, b), gcd 1, and its azimuth, unwrapped to within pi of
@@ -1627,6 +1611,7 @@ typedef struct hf_sweep {
     unsigned char *extra;       /* extra_size bytes for the caller (the P2 tree and line data) */
     size_t extra_size;
     int64_t win_rw;             /* search radius in whole node steps; -1 = unlimited */
+    double radius_cells;        /* the search radius in cells, 0 = unlimited (hf_stranded_tan) */
     double ox, oy;              /* tile origin in the raster (hfvis.h, "Search radius and tiles") */
     double ext_w, ext_h;        /* the raster's size */
     int rx0, ry0, rx1, ry1;     /* receiver rectangle [rx0, rx1) x [ry0, ry1) */
@@ -1829,6 +1814,7 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     if (want_gacc) off_ga = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
     if (extra_size) off_x = hf_align_add(&total, extra_size, 1, &ok);
     sw->win_rw = hf_radius_on(o) ? hf_radius_units(o->max_distance / g->cell_size) : -1;
+    sw->radius_cells = hf_radius_on(o) ? o->max_distance / g->cell_size : 0.0;
     if (sw->win_rw >= 0) off_w = hf_align_add(&total, linelen, HF_WIN_BYTES_PER_SAMPLE, &ok);
     if (!ok) return HFVIS_ERR_LIMIT;
     b = (unsigned char *)hfvis__alloc(o->alloc, total);
@@ -2609,6 +2595,15 @@ static int hf_is_hole(const hfvis_grid *g, int x, int y)
     return !isfinite(g->z[(ptrdiff_t)y * g->stride + x]);
 }
 
+/* A stranded receiver: a grid point with a finite height whose lattice neighbourhood (the
+ * gather's 4 x 4 nodes) holds no finite node, as between holes, where every node's bilinear
+ * sample touches a hole. Its horizon is still defined (holes never occlude), so it is not
+ * left NaN: hf_stranded_tan takes the tangent toward the look direction (lx, ly) from the
+ * per-receiver march of the oracle (hf_march_tan: unit steps, bilinear, holes skipped, the
+ * sweep's border and search radius), the value hfvis_horizon_reference gives there. */
+static double hf_stranded_tan(const hf_sweep *sw, int x, int y, double lx, double ly);
+static double hf_tan_to_elevation(double t);
+
 /* Gather of elevation angles. Channel by channel, nodes without a caster (alpha = -pi/2: the
  * first node of each line, which sees nothing) take part only when no neighbouring node has a
  * caster: a receiver between a line start and its successor lies inside the grid and does see
@@ -2748,6 +2743,8 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
             if (!hf_gather_elevations_inside(sw, ch, x, y, v)) {
                 hf_gather_setup(sw, x, y, &G);
                 hf_gather_elevations(sw, ch, &G, v);
+                for (c = 0; c < ch; c++) /* a stranded receiver */
+                    if (isnan(v[c])) v[c] = hf_tan_to_elevation(hf_stranded_tan(sw, x, y, lx[c], ly[c]));
             }
             if (edge_row || (open && !((double)x >= in_x0 && (double)x <= in_x1)))
                 for (c = 0; c < ch; c++) { /* the raster's border (tiles) */
@@ -3162,6 +3159,20 @@ static double hf_march_tan(const hf_surface *S, double px, double py, double h0,
     return sign > 0.0 ? best[0] : best[1];
 }
 
+static double hf_stranded_tan(const hf_sweep *sw, int x, int y, double lx, double ly)
+{
+    hf_surface S;
+    memset(&S, 0, sizeof S);
+    S.g = sw->g;
+    S.width = sw->g->width;
+    S.height = sw->g->height;
+    S.cell_size = sw->g->cell_size;
+    S.border = sw->border;
+    S.reach = (double)sw->preroll;
+    return hf_march_tan(&S, (double)x, (double)y, (double)sw->g->z[(ptrdiff_t)y * sw->g->stride + x], lx, ly,
+                        1.0, sw->radius_cells, 1.0);
+}
+
 static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0, int exact_bound,
                                      const hfvis_march_options *march, const float *points,
                                      size_t count, float *out, double radius)
@@ -3463,6 +3474,54 @@ static hfvis_status hf_direction_range(const hfvis_sweep_options *o, int K, int 
     return HFVIS_OK;
 }
 
+#define HF_STRANDED_MAX_CH 16 /* channels of a consumer the stranded pass serves (env maps: 1-4) */
+
+/* The fused consumers' stranded receivers (hf_stranded_tan): a grid point whose gather found no
+ * finite node holds NaN in sw->gacc. Its sum over the directions [begin, end) is made again
+ * from the march, direction by direction, through the consumer's own line function on a
+ * one-node lattice whose normal is the grid normal (one-sided beside holes). A consumer
+ * without a line function (its own orientation hook) keeps NaN there. */
+static void hf_fused_stranded(hf_sweep *sw, int K, const hfvis_sweep_options *o, int begin, int end,
+                              hf_line_fn fn, hf_fused *ctx)
+{
+    const hfvis_grid *g = sw->g;
+    const int ch = sw->channels;
+    double *lat = sw->lat, one[HF_STRANDED_MAX_CH];
+    float *nrm = sw->nrm, n1[3];
+    int x, y, c, k;
+    if (!fn || ch > HF_STRANDED_MAX_CH) return;
+    for (y = sw->ry0; y < sw->ry1; y++)
+        for (x = sw->rx0; x < sw->rx1; x++) {
+            double *acc = sw->gacc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)ch, nd[3];
+            int stranded = 0;
+            if (hf_is_hole(g, x, y)) continue;
+            for (c = 0; c < ch; c++) stranded |= isnan(acc[c]);
+            if (!stranded) continue;
+            hf_normal_at(g, x, y, nd);
+            n1[0] = (float)nd[0];
+            n1[1] = (float)nd[1];
+            n1[2] = (float)nd[2];
+            for (c = 0; c < ch; c++) one[c] = 0.0;
+            sw->lat = one;
+            sw->nrm = n1;
+            for (k = 0; k < K; k++) {
+                int pos = hf_direction_position(o, K, k);
+                double ux, uy, t;
+                if (pos < begin || pos >= end) continue;
+                hf_sweep_vector(o->azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K, &ux, &uy);
+                ctx->K = K;
+                ctx->k = k;
+                ctx->lx = -ux;
+                ctx->ly = -uy;
+                t = hf_stranded_tan(sw, x, y, -ux, -uy);
+                fn(sw, ctx, 0, 0, 1, 1, &t);
+            }
+            sw->lat = lat;
+            sw->nrm = nrm;
+            for (c = 0; c < ch; c++) acc[c] = one[c];
+        }
+}
+
 /* The fused pipeline of [P1] §7 ("lighting computed in lattice space ... fused"): for each
  * group, sample the lattice once, run the quarter turns in [begin, end), accumulate the
  * consumer's per-node term in the lattice accumulator, gather it once into sw->gacc.
@@ -3505,6 +3564,7 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
         }
         hf_gather_accumulate(sw);
     }
+    hf_fused_stranded(sw, K, o, begin, end, fn, ctx);
     return HFVIS_OK;
 }
 

@@ -141,6 +141,11 @@
  *   with period width x height (tileable fields).
  * No-data. A non-finite height (NaN, +-Inf) marks a hole. A hole never occludes, receives no
  *   value (output NaN) and a bilinear sample touching a hole with non-zero weight is a hole.
+ *   Every receiver with a finite height gets a value: one stranded between holes, where the
+ *   lattice holds no finite node near it, takes the per-receiver march of the oracle
+ *   (hfvis_horizon_reference) toward each direction instead of the gathered lattice (horizon
+ *   maps and every lattice product built on them or on the fused sums; hfvis_indirect_light
+ *   alone still leaves NaN there). Grid normals are one-sided beside holes.
  * Obscurance and light. Obscurance outputs lie in [0, 1] (0 = nothing blocks). Lighting outputs
  *   are radiance with the Lambertian convention L_o = albedo/pi * Int L_i V (n.w) dw, so an
  *   unoccluded flat receiver under a uniform sky of radiance c with albedo 1 returns c.
@@ -413,6 +418,19 @@ HFVIS_API hfvis_status hfvis_write_file(const char *path, const void *bytes, siz
  * HFVIS_ERR_INVALID_ARGUMENT for a NULL file, temp_path or path (it still releases the others).
  * Declared only where <stdio.h> is available (not with HFVIS_NO_STDIO). */
 #ifndef HFVIS_NO_STDIO
+/* The write path's stdio calls (see hfvis_write_file, "Test hooks"; examples/zio.h uses them too). */
+#ifndef HFVIS_FWRITE
+#define HFVIS_FWRITE(ptr, size, n, file) fwrite(ptr, size, n, file)
+#endif
+#ifndef HFVIS_FFLUSH
+#define HFVIS_FFLUSH(file) fflush(file)
+#endif
+#ifndef HFVIS_FCLOSE
+#define HFVIS_FCLOSE(file) fclose(file)
+#endif
+#ifndef HFVIS_RENAME
+#define HFVIS_RENAME(from, to) rename(from, to)
+#endif
 HFVIS_API hfvis_status hfvis_write_begin(const char *path, const hfvis_write_options *opts,
                                          FILE **file, char **temp_path);
 HFVIS_API hfvis_status hfvis_write_end(const char *path, FILE *file, char *temp_path, int commit,

@@ -149,14 +149,28 @@ typedef struct {
     int cached_be;           /* its samples are big-endian (after predictor 3) */
 } ex_rio_reader;
 
+/* One metadata item of a written GeoTIFF (GDAL_METADATA, TIFF tag 42112, as GDAL writes and
+ * gdalinfo shows it): band 0 = the dataset's, band b >= 1 = band b's. */
+typedef struct {
+    const char *name, *value;
+    int band;
+} ex_rio_meta;
+
 /* Write options; zero = defaults (striped, uncompressed, Float32, little endian, BigTIFF only
- * when needed). */
+ * when needed, no metadata). */
 typedef struct {
     int kind, bits;          /* sample type: 0/0 = Float32; EX_RIO_UINT/INT with 8/16/32 bits */
     int tiled, tile_size;    /* tile_size: a multiple of 16, default 256 */
     int rows_per_strip;      /* default: rows of about 64 KiB */
     int deflate, predictor;  /* predictor 2 (integers) or 3 (floats) with deflate */
     int big_endian, bigtiff; /* bigtiff: 1 always, 0 when the file would pass 4 GiB */
+    /* GeoTIFF only, in GDAL_METADATA: band_names (NULL, or one per band, NULL entries skipped)
+     * become the bands' descriptions, unit (NULL or "") every band's unit type, meta[0..n_meta)
+     * dataset and band items */
+    const char *const *band_names;
+    const char *unit;
+    const ex_rio_meta *meta;
+    int n_meta;
 } ex_rio_write_options;
 
 /* Cells to write: sample (band b, column x, row y) = data[b band_step + y row_step + x
@@ -1783,6 +1797,93 @@ static inline void ex_rio_emit_values(ex_rio_out *o, const ex_rio_tag *t)
     }
 }
 
+/* Append s to the growing text *buf (*len bytes used of *cap), XML-escaped when esc; 0, or -1
+ * out of memory. */
+static inline int ex_rio_cat(char **buf, size_t *len, size_t *cap, const char *s, int esc)
+{
+    for (; *s; s++) {
+        const char *piece = NULL;
+        char one[2];
+        size_t n;
+        if (esc && *s == '&') piece = "&amp;";
+        else if (esc && *s == '<') piece = "&lt;";
+        else if (esc && *s == '>') piece = "&gt;";
+        else if (esc && *s == '"') piece = "&quot;";
+        else {
+            one[0] = *s;
+            one[1] = '\0';
+            piece = one;
+        }
+        n = strlen(piece);
+        if (*len + n + 1 > *cap) {
+            size_t nc = *cap ? *cap * 2 : 256;
+            char *nb;
+            while (nc < *len + n + 1) nc *= 2;
+            nb = (char *)realloc(*buf, nc);
+            if (!nb) return -1;
+            *buf = nb;
+            *cap = nc;
+        }
+        memcpy(*buf + *len, piece, n + 1);
+        *len += n;
+    }
+    return 0;
+}
+
+/* One <Item name="NAME" [sample="S"] [role="ROLE"]>VALUE</Item> (sample 0-based, -1 none). */
+static inline int ex_rio_xml_item(char **buf, size_t *len, size_t *cap, const char *name, int sample,
+                                  const char *role, const char *value)
+{
+    char num[32];
+    int bad = ex_rio_cat(buf, len, cap, "  <Item name=\"", 0) || ex_rio_cat(buf, len, cap, name, 1) ||
+              ex_rio_cat(buf, len, cap, "\"", 0);
+    if (!bad && sample >= 0) {
+        snprintf(num, sizeof num, " sample=\"%d\"", sample);
+        bad = ex_rio_cat(buf, len, cap, num, 0);
+    }
+    if (!bad && role)
+        bad = ex_rio_cat(buf, len, cap, " role=\"", 0) || ex_rio_cat(buf, len, cap, role, 0) ||
+              ex_rio_cat(buf, len, cap, "\"", 0);
+    return bad || ex_rio_cat(buf, len, cap, ">", 0) || ex_rio_cat(buf, len, cap, value, 1) ||
+           ex_rio_cat(buf, len, cap, "</Item>\n", 0) ? -1 : 0;
+}
+
+/* The GDAL_METADATA XML of the options' band names, unit and items for bands bands; *xml NULL
+ * when there is none. 0, or -1 out of memory. */
+static inline int ex_rio_gdal_metadata(const ex_rio_write_options *o, int bands, char **xml)
+{
+    size_t len = 0, cap = 0;
+    int b, i, bad = 0, any = 0;
+    *xml = NULL;
+    bad = ex_rio_cat(xml, &len, &cap, "<GDALMetadata>\n", 0);
+    for (i = 0; !bad && i < o->n_meta; i++)
+        if (o->meta[i].band == 0 && o->meta[i].name && o->meta[i].value) {
+            bad = ex_rio_xml_item(xml, &len, &cap, o->meta[i].name, -1, NULL, o->meta[i].value);
+            any = 1;
+        }
+    for (b = 0; !bad && b < bands; b++) {
+        if (o->band_names && o->band_names[b]) {
+            bad = ex_rio_xml_item(xml, &len, &cap, "DESCRIPTION", b, "description", o->band_names[b]);
+            any = 1;
+        }
+        if (!bad && o->unit && o->unit[0]) {
+            bad = ex_rio_xml_item(xml, &len, &cap, "UNITTYPE", b, "unittype", o->unit);
+            any = 1;
+        }
+        for (i = 0; !bad && i < o->n_meta; i++)
+            if (o->meta[i].band == b + 1 && o->meta[i].name && o->meta[i].value) {
+                bad = ex_rio_xml_item(xml, &len, &cap, o->meta[i].name, b, NULL, o->meta[i].value);
+                any = 1;
+            }
+    }
+    if (!bad) bad = ex_rio_cat(xml, &len, &cap, "</GDALMetadata>", 0);
+    if (bad || !any) {
+        free(*xml);
+        *xml = NULL;
+    }
+    return bad ? -1 : 0;
+}
+
 /* Write img as a TIFF at path (atomically) with the georeference of geo (may be NULL). */
 static inline int ex_rio_write_tiff_file(const char *path, const ex_rio_image *img, const ex_georef *geo,
                                          const ex_rio_write_options *opt_in, char *err)
@@ -1799,7 +1900,7 @@ static inline int ex_rio_write_tiff_file(const char *path, const ex_rio_image *i
     size_t n_prj_keys = 0, n_prj_ascii = 0;
     unsigned char *chunk = NULL, *z = NULL, *tmp = NULL;
     size_t zcap = 0;
-    char *tmpname = NULL;
+    char *tmpname = NULL, *xml = NULL;
     double tie[6], scale[3], mt[16];
     int fx = geo && geo->has_transform && geo->flip_x, fy = geo && geo->has_transform && geo->flip_y;
     int placed = geo && (geo->has_transform || geo->has_scale || geo->has_matrix);
@@ -1833,14 +1934,18 @@ static inline int ex_rio_write_tiff_file(const char *path, const ex_rio_image *i
         return ex_rio_fail(err, "too many or too large strips/tiles");
     chunkb = rowb * ch;
     raw_total = chunkb * nchunks;
+    if (ex_rio_gdal_metadata(&opt, spp, &xml) != 0) return ex_rio_fail(err, "out of memory");
     if (geo && !geo->n_geokeys && geo->prj) { /* a .prj's CRS as GeoKeys (ex_rio_prj_geokeys) */
         n_prj_keys = ex_rio_prj_geokeys(geo->prj, prj_keys, &prj_ascii, &n_prj_ascii);
-        if (n_prj_keys == SIZE_MAX) return ex_rio_fail(err, "out of memory");
+        if (n_prj_keys == SIZE_MAX) {
+            free(xml);
+            return ex_rio_fail(err, "out of memory");
+        }
     }
     /* the file size bound: header, data (deflate never exceeds ex_deflate_bound), IFD and arrays */
     bound = 16 + (opt.deflate ? ex_deflate_bound((size_t)chunkb) : chunkb) * nchunks + 16 * nchunks + 8192 +
             (geo ? 8 * (geo->n_tiepoints + geo->n_geodoubles) + 2 * geo->n_geokeys + geo->n_geoascii : 0) +
-            2 * n_prj_keys + n_prj_ascii;
+            2 * n_prj_keys + n_prj_ascii + (xml ? strlen(xml) + 2 : 0);
     (void)raw_total;
     memset(&o, 0, sizeof o);
     o.be = opt.big_endian;
@@ -1993,6 +2098,7 @@ static inline int ex_rio_write_tiff_file(const char *path, const ex_rio_image *i
         EX_RIO_TAG(34735, 3, n_prj_keys, prj_keys);
         if (n_prj_ascii) EX_RIO_TAG(34737, 2, n_prj_ascii, prj_ascii);
     }
+    if (xml) EX_RIO_TAG(42112, 2, strlen(xml) + 1, xml); /* GDAL_METADATA */
     if (geo && geo->has_nodata) {
         size_t L = strlen(geo->nodata_text);
         memcpy(nodata, geo->nodata_text, L + 1);
@@ -2054,6 +2160,7 @@ done:
     free(u_extra);
     free(u_keys);
     free(prj_ascii);
+    free(xml);
     return rc;
 }
 
@@ -2062,6 +2169,50 @@ static inline void ex_rio_fmt(char *buf, size_t cap, double v, int is_float)
 {
     if (isnan(v)) snprintf(buf, cap, "nan");
     else snprintf(buf, cap, is_float ? "%.9g" : "%.17g", v);
+}
+
+/* The WKT (1, with its EPSG authority, as GDAL writes it) of the CRS of an EPSG code that needs
+ * no database: WGS 84 (4326), WGS 84 / UTM zones 1-60 north (32601-32660) and south
+ * (32701-32760), ETRS89 / UTM zones 28-38 north (25828-25838). Into buf (cap bytes); 0 when
+ * the code is not one of these (or buf is too small). */
+static inline size_t ex_rio_epsg_wkt(int epsg, char *buf, size_t cap)
+{
+    static const char wgs84[] =
+        "GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563,AUTHORITY[\"EPSG\",\"7030\"]],"
+        "AUTHORITY[\"EPSG\",\"6326\"]],PRIMEM[\"Greenwich\",0,AUTHORITY[\"EPSG\",\"8901\"]],"
+        "UNIT[\"degree\",0.0174532925199433,AUTHORITY[\"EPSG\",\"9122\"]],AUTHORITY[\"EPSG\",\"4326\"]]";
+    static const char etrs89[] =
+        "GEOGCS[\"ETRS89\",DATUM[\"European_Terrestrial_Reference_System_1989\",SPHEROID[\"GRS 1980\",6378137,"
+        "298.257222101,AUTHORITY[\"EPSG\",\"7019\"]],TOWGS84[0,0,0,0,0,0,0],AUTHORITY[\"EPSG\",\"6258\"]],"
+        "PRIMEM[\"Greenwich\",0,AUTHORITY[\"EPSG\",\"8901\"]],UNIT[\"degree\",0.0174532925199433,"
+        "AUTHORITY[\"EPSG\",\"9122\"]],AUTHORITY[\"EPSG\",\"4258\"]]";
+    int zone, south = 0, n;
+    const char *geog, *name;
+    if (epsg == 4326) n = snprintf(buf, cap, "%s", wgs84);
+    else {
+        if (epsg >= 32601 && epsg <= 32660) zone = epsg - 32600, geog = wgs84, name = "WGS 84";
+        else if (epsg >= 32701 && epsg <= 32760) zone = epsg - 32700, geog = wgs84, name = "WGS 84", south = 1;
+        else if (epsg >= 25828 && epsg <= 25838) zone = epsg - 25800, geog = etrs89, name = "ETRS89";
+        else return 0;
+        n = snprintf(buf, cap,
+                     "PROJCS[\"%s / UTM zone %d%c\",%s,PROJECTION[\"Transverse_Mercator\"],"
+                     "PARAMETER[\"latitude_of_origin\",0],PARAMETER[\"central_meridian\",%d],"
+                     "PARAMETER[\"scale_factor\",0.9996],PARAMETER[\"false_easting\",500000],"
+                     "PARAMETER[\"false_northing\",%d],UNIT[\"metre\",1,AUTHORITY[\"EPSG\",\"9001\"]],"
+                     "AXIS[\"Easting\",EAST],AXIS[\"Northing\",NORTH],AUTHORITY[\"EPSG\",\"%d\"]]",
+                     name, zone, south ? 'S' : 'N', geog, 6 * zone - 183, south ? 10000000 : 0, epsg);
+    }
+    return n > 0 && (size_t)n < cap ? (size_t)n : 0;
+}
+
+/* 1 when an ASC or EHdr output of geo would carry no CRS although geo has one: no .prj text, no
+ * ESRI PE string, and an EPSG code ex_rio_epsg_wkt cannot describe (the caller says so). */
+static inline int ex_rio_crs_lost(const ex_georef *geo)
+{
+    char wkt[1024];
+    size_t len;
+    return geo && !geo->prj && !ex_rio_pe_string(geo, &len) && geo->epsg > 0 &&
+           ex_rio_epsg_wkt(geo->epsg, wkt, sizeof wkt) == 0;
 }
 
 /* printf into the output (a line of a text header). */
@@ -2077,18 +2228,21 @@ static inline void ex_rio_emitf(ex_rio_out *o, const char *fmt, ...)
     else ex_rio_emit(o, line, (size_t)n);
 }
 
-/* Add the .prj of geo beside path to the set p: its .prj, or the WKT of a GeoTIFF's ESRI PE
- * string; without either, a .prj left beside path by an earlier output is removed with the
- * set (a CRS given by an EPSG code alone has no WKT here). *prj_out is the name (free it after
- * ex_publish_end). Returns 0, or -1 (out of memory). */
+/* Add the .prj of geo beside path to the set p: its .prj, the WKT of a GeoTIFF's ESRI PE
+ * string, or that of its EPSG code (ex_rio_epsg_wkt); without any, a .prj left beside path by an
+ * earlier output is removed with the set (ex_rio_crs_lost tells the caller). *prj_out is the
+ * name (free it after ex_publish_end). Returns 0, or -1 (out of memory). */
 static inline int ex_rio_publish_prj(ex_publish *p, const char *path, const ex_georef *geo, char **prj_out,
                                      char *err)
 {
     const char *wkt = geo ? geo->prj : NULL;
+    char epsg_wkt[1024];
     size_t len = 0;
     ex_rio_out o;
     if (geo && !wkt) wkt = ex_rio_pe_string(geo, &len);
     else if (wkt) len = strlen(wkt);
+    if (geo && !wkt && geo->epsg > 0 && (len = ex_rio_epsg_wkt(geo->epsg, epsg_wkt, sizeof epsg_wkt)) > 0)
+        wkt = epsg_wkt;
     *prj_out = ex_rio_sidecar(path, ".prj");
     if (!*prj_out) return ex_rio_fail(err, "out of memory");
     if (!wkt) {

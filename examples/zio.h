@@ -24,21 +24,6 @@
 
 #include "hfvis.h"
 
-/* The stdio calls of the write path, as in hfvis.c (hfvis.h, hfvis_write_file): fwrite, fflush,
- * fclose and rename unless defined before this header (test/test_wfault.c fails them in turn). */
-#ifndef HFVIS_FWRITE
-#define HFVIS_FWRITE(ptr, size, n, file) fwrite(ptr, size, n, file)
-#endif
-#ifndef HFVIS_FFLUSH
-#define HFVIS_FFLUSH(file) fflush(file)
-#endif
-#ifndef HFVIS_FCLOSE
-#define HFVIS_FCLOSE(file) fclose(file)
-#endif
-#ifndef HFVIS_RENAME
-#define HFVIS_RENAME(from, to) rename(from, to)
-#endif
-
 /* ------------------------------------------------------------------------------------------ */
 /* 1. checksums                                                                               */
 /* ------------------------------------------------------------------------------------------ */

@@ -884,6 +884,49 @@ longa=$(awk 'BEGIN { for (i = 0; i < 247; i++) printf "%c", 97 + i % 26 }').asc
 expect_ok "a 251-byte ASCII grid output name" "$dir/$longa" skyview "$dir/flat.pgm" --dirs 4 -o "$dir/$longa"
 rm -f "$dir/$longa"
 
+# ---- +-Inf heights are holes (hfvis.h), not a --cell refusal; --max-memory is checked against
+# the header's size before the heights are read (a 16000 x 16000 PFM header over a sparse file,
+# under a 300 MB address-space limit: the refusal, never an out-of-memory) --------------------
+inf='\000\000\200\177'; minf='\000\000\200\377'
+{ printf 'Pf\n3 2\n-1\n'; printf "$inf$one$one$one$minf$one"; } > "$dir/inf.pfm"
+"$hfvis" skyview "$dir/inf.pfm" --cell 1 --dirs 4 -o "$dir/inf_svf.pfm" > /dev/null 2> "$dir/err"; rc=$?
+[ "$rc" -eq 0 ] && [ ! -s "$dir/err" ] && [ -s "$dir/inf_svf.pfm" ] \
+  && ok "+-Inf heights are holes: exit 0, no message" || bad "+-Inf heights: exit $rc: $(cat "$dir/err")"
+{ printf 'Pf\n2 1\n-1\n'; printf "$inf$inf"; } > "$dir/allinf.pfm"
+"$hfvis" skyview "$dir/allinf.pfm" --dirs 4 -o "$dir/x.pfm" > /dev/null 2> "$dir/err"
+grep -q -- '^hfvis: --cell' "$dir/err" && bad "an all-Inf raster blames --cell: $(cat "$dir/err")" || ok "an all-Inf raster does not blame --cell"
+rm -f "$dir/x.pfm"
+printf 'Pf\n16000 16000\n-1\n' > "$dir/huge.pfm"
+if dd if=/dev/zero of="$dir/huge.pfm" bs=1 count=1 seek=1024000017 conv=notrunc 2> /dev/null; then
+  ( ulimit -v 300000; exec "$hfvis" skyview "$dir/huge.pfm" --max-memory 10M -o "$dir/fail/h.pfm" ) > /dev/null 2> "$dir/err"; rc=$?
+  [ "$rc" -eq 1 ] && grep -q 'over --max-memory' "$dir/err" && [ "$(wc -l < "$dir/err" | tr -d ' ')" = 1 ] \
+    && ok "--max-memory refuses from the header, before loading 1 GB: $(cat "$dir/err")" \
+    || bad "--max-memory on a 16000^2 header: exit $rc: $(head -n 2 "$dir/err")"
+else echo "SKIP cannot make a sparse 1 GB file (--max-memory before loading)"; fi
+rm -f "$dir/huge.pfm"
+
+# ---- a file-size limit (ulimit -f, SIGXFSZ ignored: the write fails with EFBIG, as on a full
+# disk): every output format exits 1 with one line, the previous output (and its sidecars) stays
+# byte for byte, and no temporary file is left ----------------------------------------------
+awk 'BEGIN { w = 100; h = 100; print "P2"; print w, h; print 65535
+  for (y = 0; y < h; y++) { s = ""; for (x = 0; x < w; x++) s = s " " int(30000 + 9000 * sin(x * 0.7) * cos(y * 0.45) + (x * 37 + y * 91) % 997); print s } }' > "$dir/noisy.pgm"
+mkdir -p "$dir/fsz"
+for ext in pfm pgm tif asc flt bil; do
+  rm -f "$dir/fsz/"*
+  if "$hfvis" skyview "$dir/noisy.pgm" --cell 1 --dirs 4 -o "$dir/fsz/o.$ext" > /dev/null 2>&1; then
+    mkdir -p "$dir/fsz_old"; rm -f "$dir/fsz_old/"*; cp "$dir/fsz/"* "$dir/fsz_old/"
+    ( trap '' XFSZ; ulimit -f 8; exec "$hfvis" skyview "$dir/noisy.pgm" --cell 1 --dirs 8 -o "$dir/fsz/o.$ext" ) > /dev/null 2> "$dir/err"; rc=$?
+    same=1; for f in "$dir/fsz_old/"*; do cmp -s "$f" "$dir/fsz/$(basename "$f")" || same=0; done
+    n_old=$(ls "$dir/fsz_old" | wc -l); n_new=$(ls "$dir/fsz" | wc -l)
+    if [ "$rc" -eq 1 ] && [ "$(wc -l < "$dir/err" | tr -d ' ')" = 1 ] && [ "$same" = 1 ] && [ "$n_old" = "$n_new" ]; then
+      ok "file-size limit, .$ext: exit 1, one line, the old output intact, no temporary file: $(cat "$dir/err")"
+    else bad "file-size limit, .$ext: exit $rc, same $same, files $n_old -> $n_new: $(head -n 2 "$dir/err")"; fi
+  else bad "file-size limit, .$ext: the unlimited run failed"; fi
+done
+rm -f "$dir/fsz/"*
+( trap '' XFSZ; ulimit -f 8; exec "$hfvis" voxelize "$dir/cube.obj" --res 80 --mode solid -o "$dir/fsz/v.raw" ) > /dev/null 2> "$dir/err"; rc=$?
+[ "$rc" -eq 1 ] && [ -z "$(ls "$dir/fsz")" ] && ok "file-size limit, voxelize .raw: exit 1, nothing left: $(cat "$dir/err")" \
+  || bad "file-size limit, voxelize .raw: exit $rc, left $(ls "$dir/fsz")"
 # ---- --threads: every split command's output is the one-thread run's byte for byte ------------
 # rough.pgm: 61 x 53 ridges with a one-cell wall and NoData holes (value 0, --nodata 0)
 awk 'BEGIN { w = 61; h = 53; print "P2"; print w, h; print 65535

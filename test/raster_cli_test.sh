@@ -66,8 +66,12 @@ run "esri .prj -> tif" skyview "$dir/esri.asc" --dirs 4 -o "$dir/pe.tif" && "$hf
   && ok "asc + ESRI .prj (no EPSG code) -> tif: projected, read back from the PE string" || bad "PE string tif: $("$hfvis" info "$dir/pe.tif" | grep crs)"
 run "pe tif -> asc" skyview "$dir/pe.tif" --dirs 4 -o "$dir/pe.asc" && same "the PE string's WKT back into a .prj, as it was" "$dir/esri.prj" "$dir/pe.prj"
 run "pe tif -> flt" skyview "$dir/pe.tif" --dirs 4 -o "$dir/pe2.flt" && same "... and beside an EHdr output" "$dir/esri.prj" "$dir/pe2.prj"
-run "epsg tif -> asc" skyview "$dir/prj.tif" --dirs 4 -o "$dir/ep.asc" && [ ! -e "$dir/ep.prj" ] \
-  && ok "a CRS given by an EPSG code alone writes no .prj (no WKT without a database)" || bad "an EPSG-only tif wrote ep.prj"
+run "epsg tif -> asc" skyview "$dir/prj.tif" --dirs 4 -o "$dir/ep.asc" && grep -q 'UTM zone 33N.*AUTHORITY\["EPSG","32633"\]\]$' "$dir/ep.prj" \
+  && ok "a CRS given by an EPSG code alone (UTM 33N) gets its WKT in a .prj" || bad "EPSG-only tif -> asc: .prj $(cat "$dir/ep.prj" 2>&1)"
+if command -v gdalsrsinfo > /dev/null 2>&1; then
+  gdalsrsinfo -e "$dir/ep.prj" 2>&1 | grep -q 'EPSG:32633' && ok "GDAL identifies the written .prj as EPSG:32633" \
+    || bad "gdalsrsinfo of the UTM .prj: $(gdalsrsinfo -e "$dir/ep.prj" 2>&1 | head -3)"
+else echo "SKIP gdalsrsinfo not found (.prj identification)"; fi
 cp "$dir/dem.asc" "$dir/geog.asc"
 printf 'GEOGCS["GCS_WGS_1984",DATUM["D_WGS_1984",SPHEROID["WGS_1984",6378137.0,298.257223563]],PRIMEM["Greenwich",0.0],UNIT["Degree",0.0174532925199433]]\n' > "$dir/geog.prj"
 run "geographic .prj -> tif" skyview "$dir/geog.asc" --cell 30 --dirs 4 -o "$dir/geog.tif" && \

@@ -3,6 +3,7 @@
 #ifndef HFVIS_TEST_DIR_H
 #define HFVIS_TEST_DIR_H
 #include <dirent.h>
+#include <stdio.h>
 #include <string.h>
 
 /* Entries of a directory except . and .. (-1 if it cannot be opened). */
@@ -16,6 +17,16 @@ static int test_dir_entries(const char *dir)
         if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0) n++;
     closedir(d);
     return n;
+}
+
+/* "dir/name" in one of 8 rotating buffers (a call's result stays valid for 7 more calls). */
+static inline char *test_dir_path(const char *dir, const char *name)
+{
+    static char p[8][512];
+    static int k;
+    k = (k + 1) & 7;
+    snprintf(p[k], sizeof p[k], "%s/%s", dir, name);
+    return p[k];
 }
 
 #endif

@@ -14,14 +14,7 @@
 
 static char tdir[256];
 
-static char *tpath(const char *name)
-{
-    static char p[4][512];
-    static int k;
-    k = (k + 1) & 3;
-    snprintf(p[k], sizeof p[k], "%s/%s", tdir, name);
-    return p[k];
-}
+static char *tpath(const char *name) { return test_dir_path(tdir, name); }
 
 static unsigned char *slurp(const char *path, size_t *n)
 {
@@ -837,6 +830,10 @@ TEST(pixel_scale_counts)
     e[9][2] = 3; /* no tie point */
     mini_tiff(buf, e, 10, 0);
     CHECK(open_err(buf, 400, "no ModelTiepoint"));
+    sc[0] = (double)INFINITY; /* an infinite scale: refused (info printed "origin -nan -nan") */
+    { uint64_t u; memcpy(&u, &sc[0], 8); ex_rio_put_uint(buf + 300, u, 8, 0); }
+    mini_tiff(buf, e, 11, 0);
+    CHECK(open_err(buf, 400, "non-finite"));
     sc[0] = 0.0; /* zero scale */
     { uint64_t u; memcpy(&u, &sc[0], 8); ex_rio_put_uint(buf + 300, u, 8, 0); }
     mini_tiff(buf, e, 11, 0);
@@ -887,6 +884,93 @@ TEST(non_finite_and_hex)
         CHECK(k != 1 || strstr(r.err, "shorter than a row"));
         ex_rio_close(&r);
     }
+}
+
+/* An EPSG-only CRS reaches ASC/EHdr outputs as a .prj where the WKT needs no database (UTM on
+ * WGS 84 north and south, ETRS89); other codes are reported lost. Band descriptions, unit and
+ * metadata items go into GDAL_METADATA (escaped), and gdalinfo shows them (SKIP without it). */
+TEST(epsg_prj_and_metadata)
+{
+    static const struct { int epsg; const char *want; } cases[] = {
+        {32633, "\"WGS 84 / UTM zone 33N\""}, {32733, "PARAMETER[\"false_northing\",10000000]"},
+        {25832, "\"ETRS89 / UTM zone 32N\""}, {32601, "PARAMETER[\"central_meridian\",-177]"}, {4326, "GEOGCS[\"WGS 84\""}};
+    float z[2 * 3 * 4];
+    ex_rio_image img;
+    ex_georef g;
+    ex_rio_reader r;
+    ex_rio_write_options o;
+    ex_rio_meta items[2];
+    const char *names[2] = {"azimuth 0.00 deg", "a<b&c \"q\""};
+    char err[256];
+    size_t n, k;
+    unsigned char *b;
+    field(z, 4, 3, 2, 0, 9);
+    img.data = z; img.width = 4; img.height = 3; img.bands = 1; img.band_step = 12; img.row_step = 4; img.pixel_step = 1;
+    for (k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        memset(&g, 0, sizeof g);
+        g.has_transform = 1; g.gt[0] = 500000; g.gt[1] = 30; g.gt[3] = 4100000; g.gt[5] = -30;
+        g.epsg = cases[k].epsg; g.crs = EX_RIO_CRS_PROJECTED;
+        CHECK(!ex_rio_crs_lost(&g));
+        CHECK(ex_rio_write(tpath("e.asc"), &img, &g, NULL, err) == 0);
+        b = slurp(tpath("e.prj"), &n);
+        CHECK(b && strstr((char *)b, cases[k].want) && ex_rio_wkt_epsg((char *)b) == cases[k].epsg);
+        free(b);
+        CHECK(ex_rio_open(&r, tpath("e.asc")) == 0 && r.geo.prj && ex_rio_wkt_epsg(r.geo.prj) == cases[k].epsg);
+        ex_rio_close(&r);
+    }
+    g.epsg = 2056; /* CH1903+ / LV95: no WKT without a database, no .prj (the old one removed) */
+    CHECK(ex_rio_crs_lost(&g));
+    CHECK(ex_rio_write(tpath("e.asc"), &img, &g, NULL, err) == 0);
+    CHECK(access(tpath("e.prj"), F_OK) != 0);
+    remove(tpath("e.asc"));
+    /* GDAL_METADATA */
+    memset(&o, 0, sizeof o);
+    o.band_names = names;
+    o.unit = "degree";
+    items[0].name = "convention"; items[0].value = "elevation angle"; items[0].band = 0;
+    items[1].name = "azimuth"; items[1].value = "90"; items[1].band = 2;
+    o.meta = items;
+    o.n_meta = 2;
+    img.bands = 2;
+    CHECK(ex_rio_write(tpath("md.tif"), &img, NULL, &o, err) == 0);
+    b = slurp(tpath("md.tif"), &n);
+    CHECK(b != NULL);
+    if (b) {
+        static const char *const want[] = {
+            "<Item name=\"convention\">elevation angle</Item>",
+            "<Item name=\"DESCRIPTION\" sample=\"0\" role=\"description\">azimuth 0.00 deg</Item>",
+            "<Item name=\"DESCRIPTION\" sample=\"1\" role=\"description\">a&lt;b&amp;c &quot;q&quot;</Item>",
+            "<Item name=\"UNITTYPE\" sample=\"1\" role=\"unittype\">degree</Item>",
+            "<Item name=\"azimuth\" sample=\"1\">90</Item>"};
+        size_t i, j;
+        for (i = 0; i < sizeof want / sizeof want[0]; i++) {
+            size_t L = strlen(want[i]);
+            int found = 0;
+            for (j = 0; j + L <= n && !found; j++) found = memcmp(b + j, want[i], L) == 0;
+            CHECK(found);
+        }
+        free(b);
+    }
+    CHECK(read_all(tpath("md.tif"), 1, z, &img.width, &img.height, NULL) == 0); /* still a TIFF we read */
+    if (system("gdalinfo --version > /dev/null 2>&1") == 0) {
+        char cmd[600], line[512];
+        int desc = 0, unit = 0, conv = 0, az = 0;
+        FILE *p;
+        snprintf(cmd, sizeof cmd, "gdalinfo '%s' 2>&1", tpath("md.tif"));
+        p = popen(cmd, "r");
+        while (p && fgets(line, sizeof line, p)) {
+            /* (GDAL 3.6 shows the second name cut at its '&', "a<b": its reader's, the XML is escaped) */
+            desc += strstr(line, "Description = azimuth 0.00 deg") != NULL || strstr(line, "Description = a<b") != NULL;
+            unit += strstr(line, "Unit Type: degree") != NULL;
+            conv += strstr(line, "convention=elevation angle") != NULL;
+            az += strstr(line, "azimuth=90") != NULL;
+        }
+        if (p) pclose(p);
+        CHECK(desc == 2 && unit == 2 && conv == 1 && az == 1);
+    } else {
+        printf("     SKIP gdalinfo not found (GDAL_METADATA as GDAL reads it)\n");
+    }
+    remove(tpath("md.tif"));
 }
 
 TEST(georef_cells)
@@ -1081,6 +1165,7 @@ int main(int argc, char **argv)
     RUN(orientation);
     RUN(pixel_scale_counts);
     RUN(non_finite_and_hex);
+    RUN(epsg_prj_and_metadata);
     RUN(georef_cells);
     RUN(prj_geokeys);
     {

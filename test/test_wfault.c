@@ -53,14 +53,7 @@ static int wf_rename(const char *a, const char *b) { return wf_fail(WF_RENAME) ?
 
 static char wf_dir[64];
 
-static char *wf_path(const char *name)
-{
-    static char p[8][384];
-    static int k;
-    k = (k + 1) & 7;
-    snprintf(p[k], sizeof p[k], "%s/%s", wf_dir, name);
-    return p[k];
-}
+static char *wf_path(const char *name) { return test_dir_path(wf_dir, name); }
 
 /* The whole file into a malloc'd block (*n bytes); NULL when absent. */
 static unsigned char *wf_read(const char *path, size_t *n)

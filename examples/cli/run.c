@@ -174,8 +174,12 @@ static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double
             px[i] = (float)NAN;
             continue;
         }
+        if (!isfinite(v)) { /* NaN, +-Inf: a hole (hfvis.h, "No-data") */
+            px[i] = (float)NAN;
+            continue;
+        }
         px[i] = v * zscale;
-        if (isfinite(v) && !isfinite(px[i])) { /* not a hole: refused, never silently one */
+        if (!isfinite(px[i])) { /* not a hole: refused, never silently one */
             hfvis_free(NULL, px);
             return cli_error(CLI_EXIT_ERROR, "--zscale", "%g times the value %g at (%lu, %lu) "
                              "exceeds the float range (3.4e38)", a->zscale, (double)v,
@@ -186,9 +190,14 @@ static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double
     /* heights in cells (z / cell, in double) and their squares must stay finite */
     if (top / *cell > CLI_MAX_RELIEF || *cell < DBL_MIN) {
         hfvis_free(NULL, px);
-        return cli_error(CLI_EXIT_ERROR, "--cell", "%g is too small for heights up to %g: their ratio "
-                         "must stay below %g (and the cell at least %g)", *cell, top, CLI_MAX_RELIEF,
-                         DBL_MIN);
+        if (a->has_cell)
+            return cli_error(CLI_EXIT_ERROR, "--cell", "%g is too small for heights up to %g: their ratio "
+                             "must stay below %g (and the cell at least %g)", *cell, top, CLI_MAX_RELIEF,
+                             DBL_MIN);
+        return cli_error(CLI_EXIT_ERROR, a->in, "heights up to %g over cells of %g (%s): their ratio must stay "
+                         "below %g; give --cell in the heights' unit or scale them with --zscale", top, *cell,
+                         ex_rio_format_of(a->in) ? "the raster's cell size" : "no cell size given: 1",
+                         CLI_MAX_RELIEF);
     }
     if (a->has_nodata && !cli_geo.has_nodata) { /* --nodata is the outputs' NoData too */
         cli_geo.has_nodata = 1;
@@ -208,6 +217,28 @@ static float *cli_alloc(size_t a, size_t b, size_t c)
     return (float *)calloc(a * b * c, sizeof(float)); /* zeros: a window run leaves cells unwritten */
 }
 
+/* IN's size (and cell size, 0 when unknown) from its header alone, for --max-memory before
+ * the heights are loaded: 1, or 0 when the header cannot be read this way (an ASCII PGM, and an
+ * ASC grid, whose text is parsed whole: the load then reports or checks it, its memory bounded
+ * by the file's size). */
+static int cli_peek_size(const cli_args *a, int *w, int *h, double *cell)
+{
+    ex_rio_reader r;
+    char why[256];
+    int fmt = ex_rio_format_of(a->in);
+    if (fmt == EX_RIO_ASC) return 0;
+    if ((fmt ? ex_rio_open(&r, a->in) : ex_rio_open_netpbm(&r, a->in)) != 0) {
+        ex_rio_close(&r);
+        return 0;
+    }
+    *w = r.width;
+    *h = r.height;
+    *cell = a->has_cell ? a->cell : 0.0;
+    if (!a->has_cell && r.geo.has_transform && ex_georef_cell(&r.geo, cell, why) != 0) *cell = 0.0;
+    ex_rio_close(&r);
+    return 1;
+}
+
 /* The height-field commands: load IN, set up the sweep options, the window and the progress,
  * then run the command (its own function for indirect, visibility, gi and the GIS products) and
  * write OUT. */
@@ -216,7 +247,7 @@ static int cli_run_heights(const cli_args *a)
     const char *cmd = cli_commands[a->cmd].name;
     cli_progress_state prog;
     float *z = NULL, *out = NULL, *env_px = NULL;
-    int w = 0, h = 0, rc, channels = 1, planes = 1;
+    int w = 0, h = 0, rc, channels = 1, planes = 1, checked = 0;
     double lo = 0.0, hi = 1.0;
     hfvis_grid grid;
     hfvis_sweep_options opts = hfvis_sweep_options_default();
@@ -225,6 +256,16 @@ static int cli_run_heights(const cli_args *a)
 
     memset(&env, 0, sizeof env);
     cli_win.active = a->has_window;
+    if (!cli_win.active) { /* --max-memory from the header's size, before the heights are read */
+        double pcell = 0.0;
+        int pw, ph;
+        if (cli_peek_size(a, &pw, &ph, &pcell)) {
+            if (a->max_distance > 0.0 && pcell > 0.0 && a->cmd < CMD_COUNT && (CLI_ONLY(a->cmd) & CLI_SWEEP))
+                cli_win.halo = cli_halo(a, pcell);
+            if ((rc = cli_check_cost(a, pw, ph, cli_out_channels(a))) != 0) return rc;
+            checked = 1;
+        }
+    }
     if ((rc = cli_load_heights(a, &z, &w, &h, &grid.cell_size)) != 0) return rc;
     grid.z = z; grid.width = w; grid.height = h; grid.stride = w;
     opts.border = (hfvis_border)a->border;
@@ -259,7 +300,7 @@ static int cli_run_heights(const cli_args *a)
         opts.progress = cli_progress;
         opts.progress_user = &prog;
     }
-    if (!cli_win.active && (rc = cli_check_cost(a, w, h, cli_out_channels(a))) != 0) goto done;
+    if (!cli_win.active && !checked && (rc = cli_check_cost(a, w, h, cli_out_channels(a))) != 0) goto done;
     if (a->has_dir_range) {
         if (a->cmd == CMD_LIGHT && (rc = cli_load_env(a->env, &env_px, &env)) != 0) goto done;
         rc = cli_run_partial(a, &grid, &opts, &prog, &env);

@@ -186,6 +186,9 @@ static int cli_save(const cli_args *a, cli_output out)
                     break;
                 }
         if (ex_rio_write(a->out, &img, &g, &o, why) != 0) return cli_error(CLI_EXIT_ERROR, a->out, "%s", why);
+        if (ex_rio_format_of(a->out) != EX_RIO_TIFF && ex_rio_crs_lost(&g) && !a->quiet)
+            fprintf(stderr, "hfvis: note: %s has no .prj: the input's CRS EPSG:%d has no WKT here (write .tif "
+                    "to keep it, or copy a .prj beside it)\n", a->out, g.epsg);
         if (moved && !a->quiet)
             fprintf(stderr, "hfvis: note: %s: the input's NoData %s is a value of this output: holes are "
                     "written as %s\n", a->out, cli_geo.nodata_text, g.has_nodata ? g.nodata_text : "NaN");
