@@ -28,6 +28,10 @@
  *  16. Exact rays (beyond [P1]): rational directions, every grid-line crossing and the split
  *      bulging pieces swept with the [P1] §5 hull, the per-receiver oracle, actual azimuths and
  *      their quadrature, the exact-mode light paths
+ *  17. Solar radiation: NREL SPA (Reda & Andreas 2004/2008), r.sun's solar geometry and its ESRA
+ *      clear sky (Suri & Hofierka 2004; Rigollier et al. 2000), time steps with sunrise and
+ *      sunset inside the step, irradiation over the exact horizon map, and its oracle
+ *      (docs/solar.md)
  *
  * Paper references: [P1] Timonen & Westerholm, "Scalable Height Field Self-Shadowing",
  * CGF 29(2), 2010 (thesis appendix A.1). Errata and choices: docs/errata.md E1-E18.
@@ -52,6 +56,22 @@
 #ifndef HFVIS_MALLOC
 #define HFVIS_MALLOC(size) malloc(size)
 #define HFVIS_FREE(ptr) free(ptr)
+#endif
+/* The stdio calls of the write path (hfvis.h, "Files"): each may be defined to a replacement
+ * with the same signature (test/test_wfault.c fails them one call at a time). */
+#ifndef HFVIS_NO_STDIO
+#ifndef HFVIS_FWRITE
+#define HFVIS_FWRITE(ptr, size, n, file) fwrite(ptr, size, n, file)
+#endif
+#ifndef HFVIS_FFLUSH
+#define HFVIS_FFLUSH(file) fflush(file)
+#endif
+#ifndef HFVIS_FCLOSE
+#define HFVIS_FCLOSE(file) fclose(file)
+#endif
+#ifndef HFVIS_RENAME
+#define HFVIS_RENAME(from, to) rename(from, to)
+#endif
 #endif
 
 /* Exact rays (section 16), called from the public routines of sections 8, 9, 10 and 15. */
@@ -983,27 +1003,27 @@ hfvis_status hfvis_write_begin(const char *path, const hfvis_write_options *opts
 hfvis_status hfvis_write_end(const char *path, FILE *file, char *temp_path, int commit,
                              const hfvis_write_options *opts)
 {
-    int ok = commit != 0;
+    int ok;
     if (!file || !temp_path) { /* nothing was opened: release what there is */
-        if (file) fclose(file);
+        if (file) HFVIS_FCLOSE(file);
         hfvis__free(NULL, temp_path);
         return HFVIS_ERR_INVALID_ARGUMENT;
     }
-    ok = (fflush(file) == 0) && !ferror(file) && ok;
-    ok = (fclose(file) == 0) && ok;
-    if (ok && (!path || rename(temp_path, path) != 0)) {
+    ok = (HFVIS_FFLUSH(file) == 0) && !ferror(file);
+    ok = (HFVIS_FCLOSE(file) == 0) && ok; /* closed even when the flush failed */
+    if (ok && commit && (!path || HFVIS_RENAME(temp_path, path) != 0)) {
 #if defined(_WIN32)
         /* Windows' rename does not replace an existing file: replace non-atomically. */
-        ok = path && remove(path) == 0 && rename(temp_path, path) == 0;
+        ok = path && remove(path) == 0 && HFVIS_RENAME(temp_path, path) == 0;
 #else
         ok = 0;
 #endif
     }
-    if (!ok) remove(temp_path);
+    if (!ok || !commit) remove(temp_path);
     if (opts && opts->on_temp) opts->on_temp(opts->user, NULL); /* renamed or removed */
     hfvis__free(NULL, temp_path);
     if (!path) return HFVIS_ERR_INVALID_ARGUMENT;
-    return ok ? HFVIS_OK : commit ? HFVIS_ERR_IO : HFVIS_OK;
+    return !commit || ok ? HFVIS_OK : HFVIS_ERR_IO;
 }
 
 hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
@@ -1015,7 +1035,11 @@ hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
     if (!path || (!bytes && n > 0) || path[0] == '\0') return HFVIS_ERR_INVALID_ARGUMENT;
     s = hfvis_write_begin(path, opts, &f, &tmp);
     if (s != HFVIS_OK) return s;
-    return hfvis_write_end(path, f, tmp, n == 0 || fwrite(bytes, 1, n, f) == n, opts);
+    if (n > 0 && HFVIS_FWRITE(bytes, 1, n, f) != n) { /* short write (disk full, size limit) */
+        hfvis_write_end(path, f, tmp, 0, opts);
+        return HFVIS_ERR_IO;
+    }
+    return hfvis_write_end(path, f, tmp, 1, opts);
 }
 
 HFVIS_API hfvis_status hfvis_pfm_save(const char *path, const float *pixels, int width,
@@ -1201,7 +1225,7 @@ static inline double hf_bilerp_taps(const float *p, ptrdiff_t stride, double fx,
     return isfinite(r1) ? r1 : HFVIS__NAN; /* a +-Inf tap is a hole too */
 }
 
-static double hf_bilerp(const float *z, ptrdiff_t stride, int W, int H, double x, double y)
+static inline double hf_bilerp(const float *z, ptrdiff_t stride, int W, int H, double x, double y)
 {
     int x0, y0;
     double fx, fy;
@@ -1607,6 +1631,9 @@ typedef struct hf_sweep {
     double ext_w, ext_h;        /* the raster's size */
     int rx0, ry0, rx1, ry1;     /* receiver rectangle [rx0, rx1) x [ry0, ry1) */
     int rect;                   /* 1: a proper sub-rectangle (nodes far from it are skipped) */
+    int parts, part;            /* bands across the direction (hfvis_sun_visibility), 0 = off */
+    double part_b0, part_span;  /* the receivers' lattice b range: its start and length */
+    int band_j0, band_j1;       /* the lattice rows near the band (all rows without bands) */
     hf_win win;                 /* its line scratch (win_rw >= 0) */
     void *block;
     const hfvis_allocator *alloc;
@@ -1690,18 +1717,20 @@ static void hf_receiver_rect(const hfvis_grid *g, const hfvis_sweep_options *o, 
     *y1 = o->receiver_y + o->receiver_height;
 }
 
-/* A finite radius, a window or a receiver rectangle: the routines outside the [P1] sweep
- * (openness) refuse them. */
-static int hf_sweep_opts_limited(const hfvis_sweep_options *o)
-{
-    return o && (hf_radius_on(o) || o->extent_width != 0 || o->receiver_width != 0);
-}
-
 /* A window or a receiver rectangle: the P2 hull-tree routines of section 11 refuse them (they
  * honour the radius). */
 static int hf_p2_opts_limited(const hfvis_sweep_options *o)
 {
     return o && (o->extent_width != 0 || o->receiver_width != 0);
+}
+
+/* part_index/part_count: 0, 0 or 0 <= index < count <= HF_PARTS_MAX (hfvis_sun_visibility). */
+#define HF_PARTS_MAX 65536
+static int hf_parts_valid(const hfvis_sweep_options *o)
+{
+    return (o->part_index == 0 && o->part_count == 0) ||
+           (o->part_count >= 1 && o->part_count <= HF_PARTS_MAX && o->part_index >= 0 &&
+            o->part_index < o->part_count);
 }
 
 static int hf_opts_valid(const hfvis_sweep_options *o)
@@ -1712,7 +1741,8 @@ static int hf_opts_valid(const hfvis_sweep_options *o)
                   o->direction_order >= HFVIS_DIRECTION_ORDER_DEFAULT &&
                   o->direction_order <= HFVIS_DIRECTION_ORDER_SWEEP &&
                   (o->rays == HFVIS_RAYS_LATTICE || o->rays == HFVIS_RAYS_EXACT) &&
-                  o->ray_denominator >= 0 && o->ray_denominator <= HFVIS_RAY_DENOMINATOR_MAX);
+                  o->ray_denominator >= 0 && o->ray_denominator <= HFVIS_RAY_DENOMINATOR_MAX &&
+                  hf_parts_valid(o) && o->part_count <= 1); /* bands: hfvis_sun_visibility's own */
 }
 
 /* Resolved options (NULL or zero fields = defaults). */
@@ -1890,6 +1920,73 @@ static double hf_sample_border(const hfvis_grid *g, hfvis_border border, double 
  * column, and the heights (cell units) at every in-domain node. */
 #define HF_TILE 32 /* lattice and grid loops run in tiles so both sides stay in cache */
 
+#define HF_RECT_MARGIN 4.0 /* cells around a receiver rectangle (band) whose nodes a gather reads */
+
+/* Bands across the direction (hfvis_sweep_options part_index/part_count): the receivers'
+ * lattice coordinate b (across the lines) over the receiver rectangle, cut into parts equal
+ * lengths; each receiver is in the band of its own b, computed by the same expression in every
+ * call, so the bands of separate calls tile the receivers. Lines far from the band are skipped
+ * (hf_line_rect), which is what lets threads share one direction's lines. */
+static void hf_sweep_parts(hf_sweep *sw, const hfvis_sweep_options *o)
+{
+    sw->parts = o->part_count > 1 ? o->part_count : 0;
+    sw->part = o->part_index;
+    if (sw->parts) sw->rect = 1; /* hf_line_rect skips the lines far from the band */
+}
+
+/* The band's geometry, once the direction's lattice is set (hf_sweep_group): the receivers' b
+ * range over the rectangle, and the lattice rows [band_j0, band_j1] whose lines lie within
+ * HF_RECT_MARGIN of the band (b grows by one per row: v is a unit vector). Rows outside are
+ * neither sampled nor filled nor read. */
+static void hf_sweep_band(hf_sweep *sw)
+{
+    const hfvis_lattice *L = &sw->L;
+    double lo = HFVIS__INF, hi = -HFVIS__INF, px, py, b0, b1, q0, q1, j0, j1;
+    int c;
+    for (c = 0; c < 4; c++) {
+        double x = (double)(c & 1 ? sw->rx1 - 1 : sw->rx0) + sw->ox;
+        double y = (double)(c & 2 ? sw->ry1 - 1 : sw->ry0) + sw->oy;
+        double b = x * L->vx + y * L->vy;
+        lo = b < lo ? b : lo;
+        hi = b > hi ? b : hi;
+    }
+    sw->part_b0 = lo;
+    sw->part_span = hi - lo;
+    hf_node_pos(L, L->i_min, L->j_min, &px, &py);
+    b0 = (px + sw->ox) * L->vx + (py + sw->oy) * L->vy;
+    hf_node_pos(L, L->i_min, L->j_min + 1, &px, &py);
+    b1 = (px + sw->ox) * L->vx + (py + sw->oy) * L->vy - b0;
+    q0 = lo + (hi - lo) * (double)sw->part / (double)sw->parts - HF_RECT_MARGIN;
+    q1 = lo + (hi - lo) * (double)(sw->part + 1) / (double)sw->parts + HF_RECT_MARGIN;
+    j0 = (q0 - b0) / b1;
+    j1 = (q1 - b0) / b1;
+    if (j0 > j1) {
+        double t = j0;
+        j0 = j1;
+        j1 = t;
+    }
+    j0 = floor(j0) - 1.0;
+    j1 = ceil(j1) + 1.0;
+    sw->band_j0 = j0 < 0.0 ? 0 : j0 > (double)sw->rows ? sw->rows : (int)j0;
+    sw->band_j1 = j1 < 0.0 ? -1 : j1 > (double)(sw->rows - 1) ? sw->rows - 1 : (int)j1;
+}
+
+/* The band of lattice coordinate b, 0..parts-1. */
+static int hf_band_of(double b, double b0, double span, int parts)
+{
+    double q = span > 0.0 ? (b - b0) / span * (double)parts : 0.0;
+    return q <= 0.0 ? 0 : q >= (double)(parts - 1) ? parts - 1 : (int)q;
+}
+
+/* 1 if receiver (x, y) is one of this call's: no bands, or in its band. */
+static int hf_sweep_mine(const hf_sweep *sw, int x, int y)
+{
+    const hfvis_lattice *L = &sw->L;
+    if (!sw->parts) return 1;
+    return hf_band_of(((double)x + sw->ox) * L->vx + ((double)y + sw->oy) * L->vy, sw->part_b0,
+                      sw->part_span, sw->parts) == sw->part;
+}
+
 static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
 {
     const hfvis_grid *g = sw->g;
@@ -1901,6 +1998,9 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
     sw->cols = L->i_max - L->i_min + 1;
     HFVIS_ASSERT(sw->rows <= hf_lattice_bound(g) && sw->cols <= hf_lattice_bound(g));
     HFVIS_ASSERT((size_t)sw->rows * (size_t)sw->cols <= sw->nodes_cap);
+    sw->band_j0 = 0;
+    sw->band_j1 = sw->rows - 1;
+    if (sw->parts) hf_sweep_band(sw);
     for (c = 0; c < sw->cols; c++) {
         sw->col_first[c] = INT_MAX;
         sw->col_last[c] = -1;
@@ -1908,6 +2008,11 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
     for (j = 0; j < sw->rows; j++) {
         int first, last;
         double *hr = sw->h + (size_t)j * (size_t)sw->cols;
+        if (j < sw->band_j0 || j > sw->band_j1) { /* another band's line: left untouched */
+            sw->row_first[j] = 1;
+            sw->row_last[j] = 0;
+            continue;
+        }
         if (!hfvis_lattice_line(L, j + L->j_min, &first, &last)) {
             sw->row_first[j] = 1;
             sw->row_last[j] = 0;
@@ -2259,13 +2364,18 @@ static int hf_sweep_line_window(hf_sweep *sw, int m, int i0, int j0, int di, int
 /* The nodes s in [*slo, *shi] of a line (first node (i0, j0), lattice step (di, dj), n nodes)
  * that lie within HF_RECT_MARGIN cells of the receiver rectangle: the only ones a gather of its
  * receivers reads (the taps within two lattice steps, under 3 cells). 0 if none. */
-#define HF_RECT_MARGIN 4.0
 static int hf_line_rect(const hf_sweep *sw, int i0, int j0, int di, int dj, int n, int *slo, int *shi)
 {
     const hfvis_lattice *L = &sw->L;
     double p[2], c[2], lo = -DBL_MAX, hi = DBL_MAX, blo[2], bhi[2];
     int a;
     hf_node_pos(L, i0 + L->i_min, j0 + L->j_min, &p[0], &p[1]);
+    if (sw->parts) { /* the band's b range, widened like the rectangle */
+        double bl = (p[0] + sw->ox) * L->vx + (p[1] + sw->oy) * L->vy;
+        double q0 = sw->part_b0 + sw->part_span * (double)sw->part / (double)sw->parts;
+        double q1 = sw->part_b0 + sw->part_span * (double)(sw->part + 1) / (double)sw->parts;
+        if (bl < q0 - HF_RECT_MARGIN || bl > q1 + HF_RECT_MARGIN) return 0;
+    }
     c[0] = (double)di * L->ux + (double)dj * L->vx;
     c[1] = (double)di * L->uy + (double)dj * L->vy;
     blo[0] = (double)sw->rx0 - HF_RECT_MARGIN;
@@ -2290,27 +2400,18 @@ static int hf_line_rect(const hf_sweep *sw, int i0, int j0, int di, int dj, int 
 }
 
 static inline double hf_svf_term(double t);
-static inline double hf_sky_term(double t, double nz, double a, double inv_k, double lobe);
 
 /* What is done with each tangent t at node p (s-th of a line): stored for the line's consumer,
- * or the sky-view or sky term added to the accumulator there (the sums' one copy: hf_svf_line
- * and hf_sky_line call it too). The kind is a constant at each call of hf_walk_line, so the
- * compiler writes one walk per kind, and the sums' tangents are never stored and read back.
- * sky: look direction (x, y), 1/K, the lobe factor. */
-enum { HF_WALK_STORE, HF_WALK_SVF, HF_WALK_SKY };
+ * or the sky-view term added to the accumulator there (the sum's one copy: hf_svf_line calls it
+ * too). The kind is a constant at each call of hf_walk_line, so the compiler writes one walk per
+ * kind, and the sum's tangents are never stored and read back. (The sky light's term is
+ * evaluated per line from stored tangents, in batches the compiler vectorizes: hf_sky_line.) */
+enum { HF_WALK_STORE, HF_WALK_SVF };
 
-static HFVIS__ALWAYS_INLINE void hf_walk_emit(int kind, double *lat, const float *nrm, const double sky[4],
-                                double *t, int s, ptrdiff_t p, double tan)
+static HFVIS__ALWAYS_INLINE void hf_walk_emit(int kind, double *lat, double *t, int s, ptrdiff_t p, double tan)
 {
-    if (kind == HF_WALK_STORE) {
-        t[s] = tan;
-    } else if (kind == HF_WALK_SVF) {
-        lat[p] += hf_svf_term(tan); /* a NaN tan (overflowing heights) adds +0: no change */
-    } else if (!isnan(tan)) {
-        const float *nr = nrm + p * 3;
-        double a = (double)nr[0] * sky[0] + (double)nr[1] * sky[1];
-        lat[p] += hf_sky_term(tan, (double)nr[2], a, sky[2], sky[3]);
-    }
+    if (kind == HF_WALK_STORE) t[s] = tan;
+    else lat[p] += hf_svf_term(tan); /* a NaN tan (overflowing heights) adds +0: no change */
 }
 
 /* The unlimited hull walk along one line (hull stack sh, sd of height top after the pre-roll):
@@ -2318,12 +2419,11 @@ static HFVIS__ALWAYS_INLINE void hf_walk_emit(int kind, double *lat, const float
  * of nodes without holes; inside a run the hull's top is the previous node one unit back, so
  * hf_hull_push gets its differences as (h_prev - h, 1.0) and, with no pop, the division by 1.0
  * drops out (the same bits as hf_hull_step). */
-static HFVIS__ALWAYS_INLINE void hf_walk_line(hf_sweep *sw, int kind, const double sky[4], ptrdiff_t node0,
+static HFVIS__ALWAYS_INLINE void hf_walk_line(hf_sweep *sw, int kind, ptrdiff_t node0,
                                 ptrdiff_t step, int slo, int shi, ptrdiff_t top, double *t)
 {
     double *sd = sw->sd, *sh = sw->lh, *lat = sw->lat, ds = 0.0; /* ds == s (integers, exact) */
     const double *hv = sw->h;
-    const float *nrm = sw->nrm;
     ptrdiff_t p = node0;
     int s;
     for (s = 0; s < slo; s++, p += step, ds += 1.0) { /* occluders only */
@@ -2337,11 +2437,11 @@ static HFVIS__ALWAYS_INLINE void hf_walk_line(hf_sweep *sw, int kind, const doub
             s++, p += step, ds += 1.0;
             continue;
         }
-        hf_walk_emit(kind, lat, nrm, sky, t, s, p, hf_hull_step(sh, sd, &top, h, ds));
+        hf_walk_emit(kind, lat, t, s, p, hf_hull_step(sh, sd, &top, h, ds));
         for (hp = h, s++, p += step, ds += 1.0; s <= shi; s++, p += step, ds += 1.0) {
             h = hv[p];
             if (isnan(h)) break;
-            hf_walk_emit(kind, lat, nrm, sky, t, s, p, hf_hull_push(sh, sd, &top, h, ds, hp - h, 1.0));
+            hf_walk_emit(kind, lat, t, s, p, hf_hull_push(sh, sd, &top, h, ds, hp - h, 1.0));
             hp = h;
         }
     }
@@ -2349,12 +2449,11 @@ static HFVIS__ALWAYS_INLINE void hf_walk_line(hf_sweep *sw, int kind, const doub
 
 /* Run orientation m of the current group: copy each line (with its pre-roll) out of the
  * sampled lattice, find the horizons, hand them to fn. brute = 1 uses the oracle. walk
- * (HF_WALK_SVF, HF_WALK_SKY with its constants sky) adds that sum inside the unlimited walk
+ * (HF_WALK_SVF) adds that sum inside the unlimited walk
  * instead; fn, its same sum, still serves the windowed and oracle paths. (Sweeping
  * columns several side by side, so each row step reads whole cache lines, measured no faster:
  * docs/performance.md.) */
-static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, void *ctx, int walk,
-                                 const double sky[4])
+static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, void *ctx, int walk)
 {
     int nlines = (m & 1) ? sw->cols : sw->rows, line;
     const hfvis_lattice *L = &sw->L;
@@ -2388,11 +2487,9 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
         }
         if (R > 0) top = hf_preroll(sw, i0, j0, di, dj, sh, sd);
         if (walk == HF_WALK_SVF) {
-            hf_walk_line(sw, HF_WALK_SVF, NULL, node0, step, slo, shi, top, t);
-        } else if (walk == HF_WALK_SKY) {
-            hf_walk_line(sw, HF_WALK_SKY, sky, node0, step, slo, shi, top, t);
+            hf_walk_line(sw, HF_WALK_SVF, node0, step, slo, shi, top, t);
         } else {
-            hf_walk_line(sw, HF_WALK_STORE, NULL, node0, step, slo, shi, top, t);
+            hf_walk_line(sw, HF_WALK_STORE, node0, step, slo, shi, top, t);
             fn(sw, ctx, m, node0, step, shi + 1, t);
         }
     }
@@ -2630,6 +2727,7 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
         const int edge_row = open && !((double)y >= in_y0 && (double)y <= in_y1);
         for (x = tx; x < sw->rx1 && x < tx + HF_TILE; x++) {
             ptrdiff_t o = (ptrdiff_t)y * out_stride + x;
+            if (sw->parts && !hf_sweep_mine(sw, x, y)) continue; /* another band's */
             if (hf_is_hole(g, x, y)) {
                 for (c = 0; c < ch; c++) out[(size_t)c * plane_step + (size_t)o] = (float)HFVIS__NAN;
                 continue;
@@ -2765,8 +2863,10 @@ static void hf_gather_accumulate(hf_sweep *sw)
 
 static void hf_lattice_fill(hf_sweep *sw, double value)
 {
-    size_t i, n = (size_t)sw->rows * (size_t)sw->cols * (size_t)sw->channels;
-    for (i = 0; i < n; i++) sw->lat[i] = value;
+    const size_t row = (size_t)sw->cols * (size_t)sw->channels;
+    size_t i, n = sw->band_j1 < sw->band_j0 ? 0 : (size_t)(sw->band_j1 - sw->band_j0 + 1) * row;
+    double *lat = sw->lat + (size_t)sw->band_j0 * row; /* the band's rows (every row without) */
+    for (i = 0; i < n; i++) lat[i] = value;
 }
 
 /* hf_lattice_fill outside the rows' spans only, for a lattice whose every in-span node the
@@ -2857,7 +2957,7 @@ static hfvis_status hf_horizon_lattice_impl(const hfvis_grid *grid, double azimu
     hf_sweep_vector(azimuth_rad, &ux, &uy);
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HFVIS__NAN);
-    hf_sweep_orientation(&sw, 0, brute, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
+    hf_sweep_orientation(&sw, 0, brute, hf_store_elevation, NULL, HF_WALK_STORE);
     n = (size_t)sw.rows * (size_t)sw.cols;
     for (i = 0; i < n; i++) out[i] = (float)sw.lat[i];
     hf_sweep_free(&sw);
@@ -2899,7 +2999,7 @@ hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, int k,
     hf_direction_base(K, k, o.azimuth0_rad, &ux, &uy, &m);
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HFVIS__NAN);
-    hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
+    hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE);
     hf_gather_planes(&sw, 1, m, out, 0, out_stride);
     hf_sweep_free(&sw);
     hf_progress(&o, 1, 1);
@@ -2939,7 +3039,7 @@ static hfvis_status hf_horizon_map_range(const hfvis_grid *grid, int K, const hf
                 sampled = 1;
             }
             hf_lattice_fill(&sw, HFVIS__NAN);
-            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
+            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE);
             hf_gather_planes(&sw, 1, m, out + (size_t)(pos - begin) * plane, 0, grid->width);
             hf_progress(o, ++done, end - begin);
         }
@@ -2976,7 +3076,7 @@ hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_
         if (sw.rect) hf_lattice_fill(&sw, HFVIS__NAN);
         else hf_lattice_fill_outside(&sw, HFVIS__NAN);
         for (m = 0; m < per; m++) {
-            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
+            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE);
             hf_progress(&o, ++done, K);
         }
         /* plane k = gidx + m*groups: channel m lands m*groups planes further on */
@@ -3003,7 +3103,7 @@ typedef struct hf_surface {
     double reach;              /* how far beyond the grid the march continues (cells) */
 } hf_surface;
 
-static double hf_surface_height(const hf_surface *S, double x, double y)
+static inline double hf_surface_height(const hf_surface *S, double x, double y)
 {
     if (S->fn) return S->fn(S->user, x, y);
     if (x >= 0.0 && y >= 0.0 && x <= (double)(S->width - 1) && y <= (double)(S->height - 1))
@@ -3012,15 +3112,17 @@ static double hf_surface_height(const hf_surface *S, double x, double y)
 }
 
 /* Per-receiver march ([P2] §1; P2's "naive method"): samples at p + s*step*l,
- * s = 1, 2, ..., while inside the grid (plus the border reach), keeping the largest slope; sign
- * -1 takes the slopes of the inverted surface -z (negative openness). */
-static double hf_march_tan(const hf_surface *S, double px, double py, double h0, double lx,
-                           double ly, double step, double max_dist, double sign)
+ * s = 1, 2, ..., while inside the grid (plus the border reach), keeping the largest slope.
+ * which = 1: best[0] = the largest (h - h0)/d (the terrain); which = 2: best[1] = the largest
+ * (h0 - h)/d (the inverted surface -z, negative openness); which = 3: both over the same walk,
+ * each equal to its own march bit for bit ((h0 - h) is -(h - h0) exactly). */
+static void hf_march_slopes(const hf_surface *S, double px, double py, double h0, double lx,
+                            double ly, double step, double max_dist, int which, double best[2])
 {
-    double best = -HFVIS__INF, xmin = -S->reach - HF_LATTICE_EPS, ymin = xmin;
+    double xmin = -S->reach - HF_LATTICE_EPS, ymin = xmin;
     double xmax = (double)(S->width - 1) + S->reach + HF_LATTICE_EPS;
     double ymax = (double)(S->height - 1) + S->reach + HF_LATTICE_EPS;
-    double inv = 1.0 / S->cell_size;
+    double inv = 1.0 / S->cell_size, up = -HFVIS__INF, low = HFVIS__INF;
     long s;
     for (s = 1;; s++) {
         double d = (double)s * step, x = px + d * lx, y = py + d * ly, h, t;
@@ -3030,10 +3132,21 @@ static double hf_march_tan(const hf_surface *S, double px, double py, double h0,
         y = y < 0.0 && y > -HF_LATTICE_EPS ? 0.0 : y;
         h = hf_surface_height(S, x, y);
         if (!isfinite(h)) continue;
-        t = (sign > 0.0 ? h - h0 : h0 - h) * inv / d;
-        if (t > best) best = t;
+        t = (h - h0) * inv / d; /* (h0 - h) * inv / d is exactly -t */
+        up = t > up ? t : up;
+        low = t < low ? t : low;
     }
-    return best;
+    best[0] = which & 1 ? up : -HFVIS__INF;
+    best[1] = which & 2 ? -low : -HFVIS__INF;
+}
+
+/* The march's largest slope of the terrain (sign > 0) or of -z (sign < 0). */
+static double hf_march_tan(const hf_surface *S, double px, double py, double h0, double lx,
+                           double ly, double step, double max_dist, double sign)
+{
+    double best[2];
+    hf_march_slopes(S, px, py, h0, lx, ly, step, max_dist, sign > 0.0 ? 1 : 2, best);
+    return sign > 0.0 ? best[0] : best[1];
 }
 
 static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0, int exact_bound,
@@ -3057,7 +3170,7 @@ static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0
                 out[i * (size_t)K + (size_t)k] = HFVIS__NAN;
                 continue;
             }
-            if (exact_bound > 0) { /* exact mode: along the actual direction (a, b) */
+            if (exact_bound != 0) { /* exact mode: along the actual direction (a, b) */
                 hf_ray r = hf_ray_nearest(azimuth0 + 2.0 * HFVIS__PI * (double)k / (double)K, exact_bound);
                 double len = sqrt((double)r.a * (double)r.a + (double)r.b * (double)r.b);
                 ux = -(double)r.a / len;
@@ -3151,16 +3264,23 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
     const int W = grid ? grid->width : 0, H = grid ? grid->height : 0;
     double radius = oo ? oo->radius : 0.0, step = oo && oo->step_cells > 0.0 ? oo->step_cells : 1.0;
     int negative = oo ? oo->negative : 0, x, y, k;
+    const ptrdiff_t second = (ptrdiff_t)H * out_stride; /* negative == 2: the negative plane */
     hfvis_sweep_options o;
     if (hf_check_common(grid, opts) != HFVIS_OK || K < 1 || !out || out_stride < W ||
-        !hfvis__plane_fits(out_stride, H, 4) || !isfinite(radius) || radius < 0.0 || !isfinite(step) ||
-        (oo && !(oo->step_cells >= 0.0)) || (negative != 0 && negative != 1))
+        !hfvis__plane_fits(out_stride, negative == 2 && H <= INT_MAX / 2 ? 2 * H : H, 4) ||
+        !isfinite(radius) || radius < 0.0 || !isfinite(step) || (oo && !(oo->step_cells >= 0.0)) ||
+        (negative != 0 && negative != 1 && negative != 2) || (negative == 2 && H > INT_MAX / 2))
         return HFVIS_ERR_INVALID_ARGUMENT;
-    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
+    /* a radius honours a receiver rectangle (each receiver's march is its own); a search radius
+     * or a window is not honoured here, nor a rectangle without a radius */
+    if (opts && (hf_radius_on(opts) || opts->extent_width != 0 || (radius == 0.0 && opts->receiver_width != 0)))
+        return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
-    if (radius > 0.0) { /* the march: no allocation */
+    if (radius > 0.0) { /* the march: no allocation; both signs from one walk when negative == 2 */
+        int rx0, ry0, rx1, ry1;
         hf_surface S;
         const double maxd = radius / grid->cell_size;
+        const int which = negative == 2 ? 3 : negative ? 2 : 1;
         memset(&S, 0, sizeof S);
         S.g = grid;
         S.width = W;
@@ -3168,25 +3288,39 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
         S.cell_size = grid->cell_size;
         S.border = o.border;
         S.reach = o.border == HFVIS_BORDER_OPEN ? 0.0 : (double)o.border_cells;
-        for (y = 0; y < H; y++) {
-            for (x = 0; x < W; x++) {
-                double h0 = (double)grid->z[(ptrdiff_t)y * grid->stride + x], sum = 0.0;
+        hf_receiver_rect(grid, &o, &rx0, &ry0, &rx1, &ry1);
+        for (y = ry0; y < ry1; y++) {
+            for (x = rx0; x < rx1; x++) {
+                const ptrdiff_t i = (ptrdiff_t)y * out_stride + x;
+                double h0 = (double)grid->z[(ptrdiff_t)y * grid->stride + x], sum[2] = {0.0, 0.0};
                 if (!isfinite(h0)) {
-                    out[(ptrdiff_t)y * out_stride + x] = (float)HFVIS__NAN;
+                    out[i] = (float)HFVIS__NAN;
+                    if (negative == 2) out[second + i] = (float)HFVIS__NAN;
                     continue;
                 }
                 for (k = 0; k < K; k++) {
-                    double ux, uy, t;
+                    double ux, uy, best[2];
                     hf_sweep_vector(o.azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K, &ux, &uy);
-                    t = hf_march_tan(&S, (double)x, (double)y, h0, -ux, -uy, step, maxd,
-                                     negative ? -1.0 : 1.0);
-                    /* the angle as a float, as the horizon outputs (and the sweep path) hold it */
-                    sum += HFVIS__HALF_PI - (double)(float)hf_tan_to_elevation(t);
+                    hf_march_slopes(&S, (double)x, (double)y, h0, -ux, -uy, step, maxd, which, best);
+                    /* each angle as a float, as the horizon outputs (and the sweep path) hold it */
+                    if (which & 1) sum[0] += HFVIS__HALF_PI - (double)(float)hf_tan_to_elevation(best[0]);
+                    if (which & 2) sum[1] += HFVIS__HALF_PI - (double)(float)hf_tan_to_elevation(best[1]);
                 }
-                out[(ptrdiff_t)y * out_stride + x] = (float)(sum / (double)K);
+                if (negative == 2) {
+                    out[i] = (float)(sum[0] / (double)K);
+                    out[second + i] = (float)(sum[1] / (double)K);
+                } else
+                    out[i] = (float)(sum[negative] / (double)K);
             }
-            hf_progress(&o, y + 1, H);
+            hf_progress(&o, y - ry0 + 1, ry1 - ry0);
         }
+    } else if (negative == 2) { /* the sweep: the positive plane, then the negative one */
+        hfvis_openness_options one = *oo;
+        hfvis_status s;
+        one.negative = 0;
+        if ((s = hfvis_openness(grid, K, &one, opts, out, out_stride)) != HFVIS_OK) return s;
+        one.negative = 1;
+        return hfvis_openness(grid, K, &one, opts, out + second, out_stride);
     } else { /* the sweep: a plane, its sums and (negative) the inverted surface */
         const size_t n = hf_grid_count(grid);
         float *plane = (float *)hfvis__alloc_array(o.alloc, n, sizeof(float));
@@ -3247,19 +3381,22 @@ double hfvis_sector_weight(int K, double nz, double a, double theta)
  * polynomial x P(x^2) of degree 17 on [0, 1], minimax for the absolute error (Remez exchange),
  * P evaluated by Estrin's scheme. Oracles and the angle outputs (horizon maps) keep libm's atan. */
 #define HF_ATAN_MAX_ERR 6e-9 /* rad, |hfvis__atan - atan| (Remez bound 5.76e-9): 1/20 of a float ulp at pi/2 */
-static inline double hf_atan(double t)
+static inline double hf_atan_poly(double x) /* atan x on [0, 1] */
 {
-    double x = fabs(t), s, s2, s4, p, y;
-    int big = x > 1.0; /* false for NaN, which then runs through as NaN */
-    if (big) x = 1.0 / x;
-    s = x * x;
-    s2 = s * s;
-    s4 = s2 * s2;
+    double s = x * x, s2 = s * s, s4 = s2 * s2, p;
     p = ((0.9999998863830964 + -0.3333259702893892 * s) + s2 * (0.19985906780335758 + -0.1416122929275394 * s)) +
         s4 * ((0.1049894642938515 + -0.07234858062458693 * s) +
               s2 * (0.03978123126172938 + -0.014401362402942217 * s)) +
         (s4 * s4) * 0.0024567256561116523;
-    y = x * p;
+    return x * p;
+}
+
+static inline double hf_atan(double t)
+{
+    double x = fabs(t), y;
+    int big = x > 1.0; /* false for NaN, which then runs through as NaN */
+    if (big) x = 1.0 / x;
+    y = hf_atan_poly(x);
     if (big) y = HFVIS__HALF_PI - y;
     return copysign(y, t);
 }
@@ -3295,7 +3432,7 @@ static inline double hf_sky_term(double t, double nz, double a, double inv_k, do
 typedef struct hf_fused {
     int K, k;
     double lx, ly;          /* look direction of direction k */
-    int walk;               /* HF_WALK_SVF, HF_WALK_SKY: fn's sum added inside the line walk */
+    int walk;               /* HF_WALK_SVF: fn's sum added inside the line walk */
     double inv_k, lobe;     /* the sky term's 1/K and lobe factor (hf_sky_setup) */
     size_t extra_size;      /* extra scratch bytes the consumer needs (sw->extra) */
     /* optional hooks: after a group's lattice is sampled, and instead of the P1 line walk */
@@ -3350,10 +3487,7 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
             ctx->k = k;
             hf_look_dir(sw, m, &ctx->lx, &ctx->ly);
             if (ctx->orient) ctx->orient(sw, m, ctx);
-            else {
-                const double sky[4] = {ctx->lx, ctx->ly, ctx->inv_k, ctx->lobe};
-                hf_sweep_orientation(sw, m, 0, fn, ctx, ctx->walk, sky);
-            }
+            else hf_sweep_orientation(sw, m, 0, fn, ctx, ctx->walk);
             hf_progress(o, ++done, end - begin);
         }
         hf_gather_accumulate(sw);
@@ -3376,27 +3510,82 @@ static void hf_fused_output(const hf_sweep *sw, double scale, double offset, flo
         }
 }
 
-/* The fused sky light's consumer: [P1] Eq. 5 per direction (hf_sky_term), inside the line
- * walk; hf_sky_line is the same sum over a line's stored tangents (windowed and oracle paths). */
+/* The fused sky light's consumer: [P1] Eq. 5 per direction over each line's stored tangents
+ * (hf_sky_line, every path: unlimited, windowed, oracle). */
 static void hf_sky_setup(hf_fused *f, int K)
 {
-    f->walk = HF_WALK_SKY;
+    f->walk = HF_WALK_STORE;
     f->inv_k = 1.0 / (double)K;
     f->lobe = sin(HFVIS__PI / (double)K) / HFVIS__PI;
 }
 
+/* hf_sky_term over HF_SKY_BATCH nodes in two loops without branches or calls, which the compiler
+ * vectorizes (gcc 12 at -O2 and -O3): the same operations in the same order as hf_sky_term and
+ * hf_atan, their branches as selects, so the same bits. A select between an arithmetic result and
+ * something else would be turned back into a branch around the arithmetic, which then may not be
+ * executed unconditionally (it could raise a floating-point exception): the reciprocal of the
+ * atan's range reduction is therefore formed for every node in the first loop, and the
+ * reduction's pi/2 - y written as b pi/2 + (1 - 2b) y with b in {0, 1} (exact either way, y >= 0).
+ * A node that hf_sky_term answers by a branch (t NaN, nz <= 0 or NaN, an infinite clamped tangent)
+ * gets -1 (a term is >= 0), and the caller takes it through hf_sky_term. */
+#define HF_SKY_BATCH 16
+static void hf_sky_batch(const double *restrict t, const double *restrict nz, const double *restrict a,
+                         double inv_k, double lobe, double *restrict r)
+{
+    double tcb[HF_SKY_BATCH], rxb[HF_SKY_BATCH];
+    int j;
+    for (j = 0; j < HF_SKY_BATCH; j++) {
+        double tc = -a[j] / nz[j];
+        tc = t[j] > tc ? t[j] : tc;
+        tcb[j] = tc;
+        rxb[j] = 1.0 / fabs(tc);
+    }
+    for (j = 0; j < HF_SKY_BATCH; j++) {
+        double tc = tcb[j], x = fabs(tc), big = x > 1.0 ? 1.0 : 0.0, y, q, v;
+        y = hf_atan_poly(x > 1.0 ? rxb[j] : x);
+        y = copysign(big * HFVIS__HALF_PI + (1.0 - 2.0 * big) * y, tc);
+        q = 1.0 / (1.0 + tc * tc);
+        v = nz[j] * inv_k * q + lobe * a[j] * ((HFVIS__HALF_PI - y) - tc * q);
+        v = v > 0.0 ? v : 0.0;
+        v = x <= DBL_MAX ? v : -1.0;
+        v = nz[j] > 0.0 ? v : -1.0;
+        r[j] = t[j] == t[j] ? v : -1.0;
+    }
+}
+
+/* The fused sky light's line consumer: [P1] Eq. 5 per direction over a line's stored tangents,
+ * HF_SKY_BATCH nodes at a time: each node's tangent, nz and n.l gathered into arrays (structure
+ * of arrays), hf_sky_batch, the terms added to the accumulator. */
 static void hf_sky_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdiff_t step, int n,
                         const double *t)
 {
     const hf_fused *c = (const hf_fused *)vctx;
     /* in locals: the store to lat could alias the context, so gcc reloaded them at every node */
-    const double sky[4] = {c->lx, c->ly, c->inv_k, c->lobe};
+    const double lx = c->lx, ly = c->ly, inv_k = c->inv_k, lobe = c->lobe;
     const float *nrm = sw->nrm;
-    double *lat = sw->lat;
-    int s;
+    double *lat = sw->lat, tb[HF_SKY_BATCH], nzb[HF_SKY_BATCH], ab[HF_SKY_BATCH], rb[HF_SKY_BATCH];
+    int s0, j;
     (void)m;
-    for (s = 0; s < n; s++, node0 += step)
-        if (!isnan(t[s])) hf_walk_emit(HF_WALK_SKY, lat, nrm, sky, NULL, s, node0, t[s]);
+    for (s0 = 0; s0 < n; s0 += HF_SKY_BATCH) {
+        int cnt = n - s0 < HF_SKY_BATCH ? n - s0 : HF_SKY_BATCH;
+        ptrdiff_t p = node0 + (ptrdiff_t)s0 * step;
+        for (j = 0; j < cnt; j++, p += step) {
+            const float *nr = nrm + p * 3;
+            tb[j] = t[s0 + j];
+            nzb[j] = (double)nr[2];
+            ab[j] = (double)nr[0] * lx + (double)nr[1] * ly;
+        }
+        for (; j < HF_SKY_BATCH; j++) tb[j] = HFVIS__NAN, nzb[j] = 1.0, ab[j] = 0.0;
+        hf_sky_batch(tb, nzb, ab, inv_k, lobe, rb);
+        for (j = 0, p = node0 + (ptrdiff_t)s0 * step; j < cnt; j++, p += step) {
+            double v = rb[j];
+            if (v < 0.0) {
+                if (isnan(tb[j])) continue;
+                v = hf_sky_term(tb[j], nzb[j], ab[j], inv_k, lobe);
+            }
+            lat[p] += v;
+        }
+    }
 }
 
 static int hf_light_args_valid(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
@@ -3513,7 +3702,7 @@ static void hf_svf_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdif
     (void)vctx;
     (void)m;
     for (s = 0; s < n; s++, node0 += step)
-        if (!isnan(t[s])) hf_walk_emit(HF_WALK_SVF, sw->lat, NULL, NULL, NULL, s, node0, t[s]);
+        if (!isnan(t[s])) hf_walk_emit(HF_WALK_SVF, sw->lat, NULL, s, node0, t[s]);
 }
 
 hfvis_status hfvis_sky_view_factor(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
@@ -3576,12 +3765,17 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
                                   double sun_elevation_rad, double sun_radius_rad,
                                   const hfvis_sweep_options *opts, float *out, ptrdiff_t out_stride)
 {
-    hfvis_sweep_options o;
+    hfvis_sweep_options o, whole;
     hf_sweep sw;
     hfvis_status s;
     double ux, uy;
     int x, y;
-    if (hf_check_common(grid, opts) != HFVIS_OK || !out || out_stride < grid->width ||
+    if (opts) { /* the bands are this call's own: checked here, refused elsewhere */
+        whole = *opts;
+        if (!hf_parts_valid(opts)) return HFVIS_ERR_INVALID_ARGUMENT;
+        whole.part_index = whole.part_count = 0;
+    }
+    if (hf_check_common(grid, opts ? &whole : NULL) != HFVIS_OK || !out || out_stride < grid->width ||
         !hfvis__plane_fits(out_stride, grid->height, 4) || !isfinite(sun_azimuth_rad) || !isfinite(sun_elevation_rad) || !isfinite(sun_radius_rad) ||
         sun_radius_rad < 0.0 || sun_elevation_rad < -HFVIS__HALF_PI || sun_elevation_rad > HFVIS__HALF_PI)
         return HFVIS_ERR_INVALID_ARGUMENT;
@@ -3591,13 +3785,15 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
                             out_stride);
     if ((s = hf_sweep_alloc(&sw, grid, &o, 0, 1, 0)) != HFVIS_OK) return s;
     hf_sweep_vector(sun_azimuth_rad, &ux, &uy);
+    hf_sweep_parts(&sw, &o);
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HFVIS__NAN);
-    hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
+    hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL, HF_WALK_STORE);
     hf_gather_planes(&sw, 1, 0, out, 0, out_stride);
     for (y = sw.ry0; y < sw.ry1; y++)
         for (x = sw.rx0; x < sw.rx1; x++) {
             float *p = out + (ptrdiff_t)y * out_stride + x;
+            if (!hf_sweep_mine(&sw, x, y)) continue;
             *p = (float)hf_sun_fraction(sun_elevation_rad, sun_radius_rad, (double)*p);
         }
     hf_sweep_free(&sw);
@@ -8193,8 +8389,10 @@ hfvis_status hfvis_partial_load(const char *path, const hfvis_allocator *alloc, 
  * line, an exact point of the surface. Every line is swept from its far end with the hull stack
  * of [P1] §5 (Alg. 1) over all its crossings, and each grid point on it reads the tangent of the
  * hull at its turn: the maximum over every crossing of its own ray, no interpolation between
- * lines. Distances are integers in units of 1/(|a||b|) of the step |(a, b)|, so the hull and the
- * per-receiver oracle (hfvis_horizon_exact_naive) compute the same quotients from the same heights.
+ * lines. Distances are integers in units of 1/(|a||b|) of the step |(a, b)|. Each receiver also
+ * takes the near-field limit t -> 0+ of its first cell (and under a radius the window's end),
+ * where the supremum is often no sample at all; the per-receiver oracle
+ * (hfvis_horizon_exact_naive) is the supremum over t > 0, every piece maximized in closed form.
  * Directions are the nearest representable ones (hfvis.h, "Exact rays"); the light integrals weight
  * each by its share of the circle. */
 
@@ -8219,17 +8417,31 @@ static int hf_floor_div(int num, int den) /* den > 0 */
     return (num % den != 0 && num < 0) ? q - 1 : q;
 }
 
-/* The resolved denominator bound of a run of K directions (hfvis.h). */
+/* The default rule for 32 < K <= 360 (hfvis.h, "Exact rays"): the cheapest direction (smallest
+ * |a| + |b|: a line's sweep costs |a| + |b| - 1 crossings per receiver) within HF_EXACT_TAU of
+ * psi_k, searched up to denominator HF_EXACT_CHEAP_N (which always holds one: for any slope some
+ * p/q with q <= 256 lies within 1/256 of it, Dirichlet, and 1/256 rad < 0.25 deg). The nearest
+ * direction with N = ceil(K/4) costs |a| + |b| ~ 0.8 N on average (K = 256: 51.5, K = 360: 73);
+ * the cheapest within 0.25 deg costs 12-21 at every K in that range. 0.25 deg <= a quarter of
+ * the sector 360/K deg there, so the chosen azimuths keep their order. */
+#define HF_EXACT_TAU (0.25 * HFVIS__PI / 180.0)
+#define HF_EXACT_CHEAP_N 256
+#define HF_EXACT_CHEAP_KMAX 360
+
+/* The resolved direction rule of a run of K directions (hfvis.h): N > 0, the nearest direction
+ * with max(|a|, |b|) <= N; -HF_EXACT_CHEAP_N, the cheapest within HF_EXACT_TAU. */
 static int hf_exact_bound(const hfvis_sweep_options *o, int K)
 {
     if (o->ray_denominator > 0) return o->ray_denominator;
     if (K == 1) return HF_EXACT_SUN_DENOMINATOR;
+    if (K > 32 && K <= HF_EXACT_CHEAP_KMAX) return -HF_EXACT_CHEAP_N;
     return (K + 3) / 4 > HF_EXACT_MIN_DENOMINATOR ? (K + 3) / 4 : HF_EXACT_MIN_DENOMINATOR;
 }
 
-/* Nearest direction (a, b), gcd 1, max(|a|, |b|) <= N, to azimuth psi; ties go to the smaller
- * |a| + |b| (the cheaper sweep). Searched in the first octant: for each a, the two b beside
- * a tan(theta). */
+/* The direction of rule N (hf_exact_bound) for azimuth psi. N > 0: the nearest (a, b), gcd 1,
+ * max(|a|, |b|) <= N; ties go to the smaller |a| + |b| (the cheaper sweep). N < 0: the smallest
+ * |a| + |b| with max(|a|, |b|) <= -N within HF_EXACT_TAU of psi; ties go to the nearer. Searched
+ * in the first octant: for each a, the two b beside a tan(theta). */
 static hf_ray hf_ray_nearest(double psi, int N)
 {
     hf_ray r;
@@ -8244,6 +8456,25 @@ static hf_ray hf_ray_nearest(double psi, int N)
     th = mirror ? HFVIS__HALF_PI - rr : rr;
     tn = tan(th);
     best = th; /* (1, 0) */
+    if (N < 0) { /* the cheapest within HF_EXACT_TAU; a + b only grows with a */
+        int cost = INT_MAX;
+        for (a = 1; a <= -N && a < cost; a++) {
+            double bf = floor((double)a * tn);
+            for (c = 0; c < 2; c++) {
+                int b = (int)bf + c;
+                double dev;
+                if (b < 0 || b > a || hf_gcd(a, b) != 1) continue;
+                dev = fabs(atan2((double)b, (double)a) - th);
+                if (dev <= HF_EXACT_TAU && (a + b < cost || (a + b == cost && dev < best))) {
+                    cost = a + b;
+                    best = dev;
+                    ba = a;
+                    bb = b;
+                }
+            }
+        }
+        N = cost == INT_MAX ? -N : 0; /* none (never, see HF_EXACT_CHEAP_N): the nearest */
+    }
     for (a = 1; a <= N; a++) {
         double bf = floor((double)a * tn);
         for (c = 0; c < 2; c++) {
@@ -8358,9 +8589,38 @@ typedef struct hf_exact {
     int ox, oy;             /* the tile's origin in the raster (hfvis.h, "Search radius and tiles") */
     int rx0, ry0, rx1, ry1; /* the receiver rectangle, [rx0, rx1) x [ry0, ry1) */
     int rect;               /* 1: a proper sub-rectangle */
+    int parts, part;        /* bands across the direction (hfvis_sun_visibility), 0 = off */
+    int64_t c0, cspan;      /* the receivers' line index c = x*b - y*a: its least value, count */
     void *block;
     const hfvis_allocator *alloc;
 } hf_exact;
+
+/* Bands across an exact direction (a, b) (hfvis_sweep_options part_index/part_count): the
+ * receivers of a line share c = x*b - y*a, an integer, so the bands are ranges of c over the
+ * receiver rectangle and a line is swept by exactly one call. */
+static void hf_exact_parts(hf_exact *E, const hfvis_sweep_options *o, hf_ray r)
+{
+    int64_t lo = INT64_MAX, hi = INT64_MIN;
+    int c;
+    E->parts = o->part_count > 1 ? o->part_count : 0;
+    E->part = o->part_index;
+    for (c = 0; c < 4; c++) {
+        int64_t x = c & 1 ? E->rx1 - 1 : E->rx0, y = c & 2 ? E->ry1 - 1 : E->ry0;
+        int64_t v = x * (int64_t)r.b - y * (int64_t)r.a;
+        lo = v < lo ? v : lo;
+        hi = v > hi ? v : hi;
+    }
+    E->c0 = lo;
+    E->cspan = hi - lo + 1;
+}
+
+/* 1 if the line through receiver (x, y) along (a, b) is one of this call's. */
+static int hf_exact_mine(const hf_exact *E, int x, int y, hf_ray r)
+{
+    int64_t v = (int64_t)x * (int64_t)r.b - (int64_t)y * (int64_t)r.a;
+    if (!E->parts) return 1;
+    return (v - E->c0) * (int64_t)E->parts / E->cspan == (int64_t)E->part;
+}
 
 /* The piece after each crossing e (to crossing e + 1, the last one to the next grid point at
  * u = L): its cell, found from its midpoint, and its ends in that cell's coordinates. */
@@ -8459,6 +8719,37 @@ static inline double hf_cell_twist(const float *p, ptrdiff_t stride)
     return (double)p[0] - (double)p[1] - (double)p[stride] + (double)p[stride + 1];
 }
 
+/* The four taps of cell (cx, cy) under the border rule into z (z00, z10, z01, z11: a 2 x 2 cell
+ * of row stride 2): inside the grid, or for CLAMP/WRAP within the reach R beyond it (clamped or
+ * wrapped taps, the cells of hf_sample_border's surface); 0 outside that or when a tap is a hole. */
+static int hf_exact_cell_taps(const hfvis_grid *g, hfvis_border border, int R, int cx, int cy, float *z)
+{
+    int j;
+    if (cx >= 0 && cy >= 0 && cx + 1 < g->width && cy + 1 < g->height) {
+        const float *p = g->z + (ptrdiff_t)cy * g->stride + cx;
+        z[0] = p[0];
+        z[1] = p[1];
+        z[2] = p[g->stride];
+        z[3] = p[g->stride + 1];
+    } else {
+        if (border == HFVIS_BORDER_OPEN || cx < -R || cy < -R || cx + 1 > g->width - 1 + R ||
+            cy + 1 > g->height - 1 + R)
+            return 0;
+        for (j = 0; j < 4; j++) {
+            int X = cx + (j & 1), Y = cy + (j >> 1);
+            if (border == HFVIS_BORDER_WRAP) {
+                X = (X % g->width + g->width) % g->width;
+                Y = (Y % g->height + g->height) % g->height;
+            } else {
+                X = X < 0 ? 0 : (X > g->width - 1 ? g->width - 1 : X);
+                Y = Y < 0 ? 0 : (Y > g->height - 1 ? g->height - 1 : Y);
+            }
+            z[j] = g->z[(ptrdiff_t)Y * g->stride + X];
+        }
+    }
+    return isfinite(z[0]) && isfinite(z[1]) && isfinite(z[2]) && isfinite(z[3]);
+}
+
 /* The interior samples of a piece in the cell whose tap (0, 0) is p (row stride `stride`), its
  * bulge above lim (hf_piece_samples). */
 static int hf_piece_fill(const float *p, ptrdiff_t stride, const hf_cross *c, double bulge, double lim,
@@ -8478,22 +8769,19 @@ static int hf_piece_fill(const float *p, ptrdiff_t stride, const hf_cross *c, do
     return m - 1;
 }
 
-/* Interior samples of piece c after base grid point (X, Y) (see HF_EXACT_BULGE): writes up to
- * HF_EXACT_MAX_SPLIT - 1 heights h[j] at sub-step offsets du[j] from the piece's start, in
- * increasing order, and returns the count; 0 for a piece that is not concave enough, outside
- * the grid or touching a hole. Inline: most pieces are rejected here. */
-static inline int hf_piece_samples(const hfvis_grid *g, int X, int Y, const hf_cross *c, double *h,
-                                   double *du)
+/* Interior samples of piece c after base grid point (X, Y) (see HF_EXACT_BULGE), its cell's taps
+ * under the border rule (hf_exact_cell_taps): writes up to HF_EXACT_MAX_SPLIT - 1 heights h[j]
+ * at sub-step offsets du[j] from the piece's start, in increasing order, and returns the count;
+ * 0 for a piece that is not concave enough, out of reach or touching a hole. */
+static int hf_piece_samples(const hfvis_grid *g, hfvis_border border, int R, int X, int Y,
+                            const hf_cross *c, double *h, double *du)
 {
-    int cx = X + c->cx, cy = Y + c->cy;
-    double bulge, lim;
-    /* cx in [0, width - 2], cy in [0, height - 2] (the unsigned casts take the negatives out) */
-    if (c->du == 0.0 || (unsigned)cx >= (unsigned)(g->width - 1) || (unsigned)cy >= (unsigned)(g->height - 1))
-        return 0;
-    bulge = c->q * hf_cell_twist(g->z + (ptrdiff_t)cy * g->stride + cx, g->stride);
-    lim = HF_EXACT_BULGE * g->cell_size;
+    float z[4];
+    double bulge, lim = HF_EXACT_BULGE * g->cell_size;
+    if (c->du == 0.0 || !hf_exact_cell_taps(g, border, R, X + c->cx, Y + c->cy, z)) return 0;
+    bulge = c->q * hf_cell_twist(z, 2);
     if (!(bulge > lim) || !isfinite(bulge)) return 0;
-    return hf_piece_fill(g->z + (ptrdiff_t)cy * g->stride + cx, g->stride, c, bulge, lim, h, du);
+    return hf_piece_fill(z, 2, c, bulge, lim, h, du);
 }
 
 /* Whole periods k >= 0 of the ray from grid point (x, y) along (a, b) that can hold a crossing
@@ -8594,7 +8882,7 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
         for (e = P - 1; e >= 0; e--) {
             int X = bx + cr[e].ox, Y = by + cr[e].oy;
             double h;
-            j = hf_piece_samples(g, bx, by, cr + e, ph, pu);
+            j = hf_piece_samples(g, E->border, E->R, bx, by, cr + e, ph, pu);
             while (j-- > 0) { /* the piece after crossing e, far end first */
                 if (isnan(ph[j])) continue;
                 sd[n] = -((double)k * L + (cr[e].u + pu[j]));
@@ -8709,6 +8997,99 @@ static int64_t hf_exact_window(double radius, double scale)
     return hf_radius_units(16.0 * (radius * scale));
 }
 
+/* The near-field term of a receiver at grid point (x, y), height hr: the t -> 0+ limit of the
+ * elevation tangent along (a, b), the slope of the bilinear cell the ray leaves by at its corner
+ * (x, y), (dz/dx |a| + dz/dy |b|) / (|(a, b)| cell) with the corner's two edge differences
+ * (the twist is second order). -INFINITY on the axes (the surface along a grid line is linear,
+ * so the limit is the first grid point's own tangent) and where that cell is out of reach or
+ * touches a hole. inv_den = hf_exact_inv_den. The sweep (its inner cells inline, the same
+ * expression) and hfvis_horizon_exact_naive both compute it so: the same bits. */
+static double hf_exact_first_slope(const hfvis_grid *g, hfvis_border border, int R, int x, int y,
+                                   int a, int b, double hr, double inv_den)
+{
+    int cx = a < 0 ? x - 1 : x, cy = b < 0 ? y - 1 : y, A = a < 0 ? -a : a, B = b < 0 ? -b : b;
+    float z[4];
+    double zx, zy;
+    if (A == 0 || B == 0 || !hf_exact_cell_taps(g, border, R, cx, cy, z)) return -HFVIS__INF;
+    zx = (double)z[(cy == y ? 0 : 2) + (cx == x ? 1 : 0)]; /* the tap (x + sign a, y) */
+    zy = (double)z[(cy == y ? 2 : 0) + (cx == x ? 0 : 1)]; /* the tap (x, y + sign b) */
+    return ((zx - hr) * (double)A + (zy - hr) * (double)B) * inv_den;
+}
+
+/* 1 / (|(a, b)| cell), the first slope's factor (one expression for the sweep and the oracle). */
+static double hf_exact_inv_den(const hfvis_grid *g, int a, int b)
+{
+    return 1.0 / (sqrt((double)a * (double)a + (double)b * (double)b) * g->cell_size);
+}
+
+/* The far end of a receiver's window: under a radius, the surface point at exactly ucut
+ * sub-steps (hf_exact_window / 16) along its ray (a, b) from grid point (x, y), height hr, as a
+ * tangent per sub-step (the supremum within R can lie there, between two samples). Its cell is the
+ * one the ray is in just before the cut (along an axis, the cell beside the line, the next one
+ * where that is out of reach); -INFINITY where no such cell is in reach with four finite taps. */
+static double hf_exact_cut(const hfvis_grid *g, hfvis_border border, int R, int x, int y, int a, int b,
+                           double L, double ucut, double hr)
+{
+    double px = (double)x + ucut * (double)a / L, py = (double)y + ucut * (double)b / L, fx, fy;
+    float z[4];
+    int cx, cy;
+    if (!(ucut > 0.0) || fabs(px) > (double)INT_MAX / 2.0 || fabs(py) > (double)INT_MAX / 2.0) return -HFVIS__INF;
+    cx = a > 0 ? (int)ceil(px) - 1 : (int)floor(px);
+    cy = b > 0 ? (int)ceil(py) - 1 : (int)floor(py);
+    if (!hf_exact_cell_taps(g, border, R, cx, cy, z)) {
+        if (a == 0 && hf_exact_cell_taps(g, border, R, cx - 1, cy, z)) cx--;
+        else if (b == 0 && hf_exact_cell_taps(g, border, R, cx, cy - 1, z)) cy--;
+        else return -HFVIS__INF;
+    }
+    fx = px - (double)cx;
+    fy = py - (double)cy;
+    {
+        double z0 = (double)z[0], z1 = (double)z[1], z2 = (double)z[2], z3 = (double)z[3];
+        double r0 = z0 + (z1 - z0) * fx, r1 = z2 + (z3 - z2) * fx;
+        return (r0 + (r1 - r0) * fy - hr) / ucut;
+    }
+}
+
+/* The per-receiver terms over the receiver rectangle: each tangent becomes the largest of the
+ * hull's, the first piece's t -> 0+ limit (hf_exact_first_slope) and, under a radius, the
+ * window's far end (hf_exact_cut); holes stay NaN. */
+static void hf_exact_near(hf_exact *E, int a, int b, double L, double scale)
+{
+    const hfvis_grid *g = E->g;
+    const double inv_den = hf_exact_inv_den(g, a, b), ucut = (double)E->win_rw / 16.0;
+    const double Ad = (double)(a < 0 ? -a : a), Bd = (double)(b < 0 ? -b : b);
+    const int diag = a != 0 && b != 0;
+    int x, y;
+    for (y = E->ry0; y < E->ry1; y++) {
+        double *t = E->tan + (size_t)y * (size_t)g->width;
+        const float *z = g->z + (ptrdiff_t)y * g->stride;
+        /* the first cells inside the grid: its taps read directly (hf_exact_first_slope's bits) */
+        const int cy = b < 0 ? y - 1 : y, sx = a < 0 ? -1 : 1;
+        const ptrdiff_t sy = b < 0 ? -g->stride : g->stride;
+        const int in_row = cy >= 0 && cy + 1 < g->height;
+        for (x = E->rx0; x < E->rx1; x++) {
+            double s;
+            if (isnan(t[x])) continue;
+            if (diag) {
+                int cx = a < 0 ? x - 1 : x;
+                if (in_row && cx >= 0 && cx + 1 < g->width) {
+                    /* finite s: finite zx and zy (|s| <= 2^128 4096 / den); then zd decides */
+                    double hr = (double)z[x], zx = (double)z[x + sx], zy = (double)z[x + sy];
+                    s = ((zx - hr) * Ad + (zy - hr) * Bd) * inv_den;
+                    if (!isfinite(s) || !isfinite(z[x + sx + sy])) s = -HFVIS__INF;
+                } else {
+                    s = hf_exact_first_slope(g, E->border, E->R, x, y, a, b, (double)z[x], inv_den);
+                }
+                if (s > t[x]) t[x] = s;
+            }
+            if (E->win_rw >= 0) {
+                s = hf_exact_cut(g, E->border, E->R, x, y, a, b, L, ucut, (double)z[x]) * scale;
+                if (s > t[x]) t[x] = s;
+            }
+        }
+    }
+}
+
 /* Tangents of every grid point toward ray r into E->tan (-INFINITY: no terrain, NaN: hole).
  * Heads are enumerated row by row, so consecutive lines are neighbours. */
 static void hf_exact_sweep(hf_exact *E, hf_ray r)
@@ -8734,38 +9115,90 @@ static void hf_exact_sweep(hf_exact *E, hf_ray r)
         }
         if (xlo < 0) xlo = 0;
         if (xhi > g->width - 1) xhi = g->width - 1;
-        for (x = xlo; x <= xhi; x++) hf_exact_line(E, x, y, r.a, r.b, P, L, scale);
+        for (x = xlo; x <= xhi; x++)
+            if (hf_exact_mine(E, x, y, r)) hf_exact_line(E, x, y, r.a, r.b, P, L, scale);
     }
+    if ((r.a != 0 && r.b != 0) || E->win_rw >= 0) hf_exact_near(E, r.a, r.b, L, scale);
 }
 
-/* Oracle twin of hf_exact_sweep for one receiver: every crossing of its own ray within the
- * window rw (1/16 sub-steps, hf_exact_window; -1 = unlimited), the same heights and quotients,
- * the largest kept. */
+/* The supremum of (h(u) - hr)/u (height per sub-step) over the interior of piece c (cell taps z,
+ * hf_exact_cell_taps) starting u0 > 0 sub-steps from the receiver and cut at umax: along the
+ * piece h(t) = H0 + H1 t + H2 t^2, t in [0, 1], u = u0 + t du; its stationary points solve
+ * H2 du t^2 + 2 H2 u0 t + H1 u0 - (H0 - hr) du = 0. Candidates: the roots inside (0, 1) and
+ * before the cut (the crossings at the ends and the cut are points of their own); none in the
+ * first piece (u0 = 0, where the tangent is linear in t: hf_exact_first_slope). -INFINITY if none. */
+static double hf_exact_piece_sup(const float *zf, const hf_cross *c, double u0, double hr, double umax)
+{
+    double z[4], w, dfx = c->fx1 - c->fx0, dfy = c->fy1 - c->fy0, H0, H1, H2, al, be, ga;
+    double t1 = 1.0, best = -HFVIS__INF, root[2], disc;
+    int n = 0, i;
+    z[0] = (double)zf[0];
+    z[1] = (double)zf[1];
+    z[2] = (double)zf[2];
+    z[3] = (double)zf[3];
+    w = z[0] - z[1] - z[2] + z[3];
+    H0 = z[0] + (z[1] - z[0]) * c->fx0 + (z[2] - z[0]) * c->fy0 + w * c->fx0 * c->fy0;
+    H1 = (z[1] - z[0]) * dfx + (z[2] - z[0]) * dfy + w * (c->fx0 * dfy + c->fy0 * dfx);
+    H2 = w * dfx * dfy;
+    al = H2 * c->du;
+    be = 2.0 * H2 * u0;
+    ga = H1 * u0 - (H0 - hr) * c->du;
+    if (u0 + c->du > umax) { /* the cut (its own point: hf_exact_cut) */
+        t1 = (umax - u0) / c->du;
+        if (!(t1 > 0.0)) return best;
+    }
+    disc = be * be - 4.0 * al * ga;
+    if (u0 > 0.0 && al != 0.0 && disc >= 0.0) { /* u0 = 0 (the first piece): linear in t */
+        double q = -0.5 * (be + (be < 0.0 ? -sqrt(disc) : sqrt(disc)));
+        if (q != 0.0) {
+            root[n++] = q / al;
+            root[n++] = ga / q;
+        }
+    }
+    for (i = 0; i < n; i++) {
+        double t = root[i], s;
+        if (!(t > 0.0 && t <= t1)) continue;
+        s = (H0 + (H1 + H2 * t) * t - hr) / (u0 + t * c->du);
+        if (s > best) best = s;
+    }
+    return best;
+}
+
+/* Oracle of the exact mode for one receiver: the supremum over t > 0 of the elevation tangent
+ * along its own ray over the bilinear surface, within the window rw (1/16 sub-steps,
+ * hf_exact_window; -1 = unlimited): every crossing (hf_cross_height, the sweep's heights), every
+ * piece's interior in closed form (hf_exact_piece_sup), the window's far end (hf_exact_cut) and
+ * the first piece's t -> 0+ limit (hf_exact_first_slope); the largest kept. */
 static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, const hf_cross *cr,
                              int P, double L, double scale, int a, int b, int x, int y, int64_t rw)
 {
-    double hr = (double)g->z[(ptrdiff_t)y * g->stride + x], best = -HFVIS__INF;
+    double hr = (double)g->z[(ptrdiff_t)y * g->stride + x], best = -HFVIS__INF, s;
+    double umax = rw >= 0 ? (double)rw / 16.0 : HFVIS__INF;
     int k, e, kmax = hf_exact_periods(g, R, x, y, a, b);
     if (!isfinite(hr)) return HFVIS__NAN;
     for (k = 0; k <= kmax; k++)
         for (e = 0; e < P; e++) {
-            int X = x + k * a + cr[e].ox, Y = y + k * b + cr[e].oy, j;
-            double h, s, ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
-            int np = hf_piece_samples(g, x + k * a, y + k * b, cr + e, ph, pu);
-            for (j = 0; j < np; j++) {
-                if (isnan(ph[j])) continue;
-                if (rw >= 0 && 16.0 * ((double)k * L + (cr[e].u + pu[j])) > (double)rw) continue;
-                s = (ph[j] - hr) / ((double)k * L + (cr[e].u + pu[j])) * scale;
+            int X = x + k * a + cr[e].ox, Y = y + k * b + cr[e].oy;
+            double h, u = (double)k * L + cr[e].u;
+            float z[4];
+            if (cr[e].du > 0.0 && u < umax &&
+                hf_exact_cell_taps(g, border, R, x + k * a + cr[e].cx, y + k * b + cr[e].cy, z)) {
+                s = hf_exact_piece_sup(z, cr + e, u, hr, umax) * scale;
                 if (s > best) best = s;
             }
             if ((k == 0 && e == 0) || !hf_cross_inside(g, R, X, Y, cr + e)) continue;
-            if (rw >= 0 && 16.0 * ((double)k * L + cr[e].u) > (double)rw) continue;
+            if (rw >= 0 && 16.0 * u > (double)rw) continue;
             h = hf_cross_height(g, border, X, Y, cr + e);
             if (isnan(h)) continue;
-            s = (h - hr) / ((double)k * L + cr[e].u) * scale;
+            s = (h - hr) / u * scale;
             if (s > best) best = s;
         }
-    return best;
+    if (rw >= 0) {
+        s = hf_exact_cut(g, border, R, x, y, a, b, L, umax, hr) * scale;
+        if (s > best) best = s;
+    }
+    hr = hf_exact_first_slope(g, border, R, x, y, a, b, hr, hf_exact_inv_den(g, a, b));
+    return hr > best ? hr : best;
 }
 
 /* Scratch of one exact-mode call, one block: the K directions and their quadrature, the
@@ -8801,9 +9234,9 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     }
     gridn = hf_grid_count(g);
     /* a line crosses each grid line once (W + H + 4R of them within reach) and has at most
-       W + H pieces inside the grid, each split at most HF_EXACT_MAX_SPLIT - 1 times */
+       W + H + 4R + 2 pieces within reach, each split at most HF_EXACT_MAX_SPLIT - 1 times */
     cap = (size_t)g->width + (size_t)g->height + 4u * (size_t)E->R + 8u +
-          ((size_t)g->width + (size_t)g->height + 2u) * (HF_EXACT_MAX_SPLIT - 1);
+          ((size_t)g->width + (size_t)g->height + 4u * (size_t)E->R + 2u) * (HF_EXACT_MAX_SPLIT - 1);
     off_ray = hf_align_add(&total, (size_t)K, sizeof(hf_ray), &ok);
     off_d = hf_align_add(&total, (size_t)K * 5u, sizeof(double), &ok);
     off_c = hf_align_add(&total, (size_t)maxp, sizeof(hf_cross), &ok);
@@ -9041,10 +9474,12 @@ static hfvis_status hf_exact_sun(const hfvis_grid *g, double azimuth, double ele
     int x, y;
     o1.azimuth0_rad = azimuth;
     if ((s = hf_exact_init(&E, g, 1, &o1, 1, 0, 0)) != HFVIS_OK) return s;
+    hf_exact_parts(&E, o, E.d.ray[0]);
     hf_exact_sweep(&E, E.d.ray[0]);
     for (y = E.ry0; y < E.ry1; y++)
         for (x = E.rx0; x < E.rx1; x++) {
             double t = E.tan[(size_t)y * (size_t)g->width + (size_t)x];
+            if (!hf_exact_mine(&E, x, y, E.d.ray[0])) continue;
             out[(ptrdiff_t)y * out_stride + x] =
                 (float)hf_sun_fraction(elevation, radius, hf_tan_to_elevation(t));
         }
@@ -9152,4 +9587,1074 @@ static hfvis_status hf_exact_direction_sums(const hfvis_grid *g, int K, hfvis_su
         }
     hf_exact_free(&E);
     return HFVIS_OK;
+}
+
+/* ========================================================================================== */
+/* 17. Solar radiation                                                                        */
+/* ========================================================================================== */
+/* NREL's SPA (Reda & Andreas 2004/2008), r.sun's solar geometry and its ESRA clear sky
+ * (Suri & Hofierka 2004; Rigollier et al. 2000), integrated over time over the exact-ray
+ * horizon map of section 16, and its oracle. Errata and choices: docs/solar.md. */
+
+/* ------------------------------------------------- 1. SPA: periodic terms (Tables A4.2-A4.3) */
+/* Earth periodic terms A_i cos(B_i + C_i JME) of VSOP87 as SPA truncates them (Table A4.2), the
+ * series L0..L5, B0..B1, R0..R4 one after another. */
+static const double hf_spa_terms[][3] = {
+    {175347046.0, 0, 0}, {3341656.0, 4.6692568, 6283.07585}, {34894.0, 4.6261, 12566.1517},
+    {3497.0, 2.7441, 5753.3849}, {3418.0, 2.8289, 3.5231}, {3136.0, 3.6277, 77713.7715},
+    {2676.0, 4.4181, 7860.4194}, {2343.0, 6.1352, 3930.2097}, {1324.0, 0.7425, 11506.7698},
+    {1273.0, 2.0371, 529.691}, {1199.0, 1.1096, 1577.3435}, {990, 5.233, 5884.927},
+    {902, 2.045, 26.298}, {857, 3.508, 398.149}, {780, 1.179, 5223.694}, {753, 2.533, 5507.553},
+    {505, 4.583, 18849.228}, {492, 4.205, 775.523}, {357, 2.92, 0.067}, {317, 5.849, 11790.629},
+    {284, 1.899, 796.298}, {271, 0.315, 10977.079}, {243, 0.345, 5486.778}, {206, 4.806, 2544.314},
+    {205, 1.869, 5573.143}, {202, 2.458, 6069.777}, {156, 0.833, 213.299}, {132, 3.411, 2942.463},
+    {126, 1.083, 20.775}, {115, 0.645, 0.98}, {103, 0.636, 4694.003}, {102, 0.976, 15720.839},
+    {102, 4.267, 7.114}, {99, 6.21, 2146.17}, {98, 0.68, 155.42}, {86, 5.98, 161000.69},
+    {85, 1.3, 6275.96}, {85, 3.67, 71430.7}, {80, 1.81, 17260.15}, {79, 3.04, 12036.46},
+    {75, 1.76, 5088.63}, {74, 3.5, 3154.69}, {74, 4.68, 801.82}, {70, 0.83, 9437.76},
+    {62, 3.98, 8827.39}, {61, 1.82, 7084.9}, {57, 2.78, 6286.6}, {56, 4.39, 14143.5},
+    {56, 3.47, 6279.55}, {52, 0.19, 12139.55}, {52, 1.33, 1748.02}, {51, 0.28, 5856.48},
+    {49, 0.49, 1194.45}, {41, 5.37, 8429.24}, {41, 2.4, 19651.05}, {39, 6.17, 10447.39},
+    {37, 6.04, 10213.29}, {37, 2.57, 1059.38}, {36, 1.71, 2352.87}, {36, 1.78, 6812.77},
+    {33, 0.59, 17789.85}, {30, 0.44, 83996.85}, {30, 2.74, 1349.87}, {25, 3.16, 4690.48},
+    {628331966747.0, 0, 0}, {206059.0, 2.678235, 6283.07585}, {4303.0, 2.6351, 12566.1517},
+    {425.0, 1.59, 3.523}, {119.0, 5.796, 26.298}, {109.0, 2.966, 1577.344}, {93, 2.59, 18849.23},
+    {72, 1.14, 529.69}, {68, 1.87, 398.15}, {67, 4.41, 5507.55}, {59, 2.89, 5223.69},
+    {56, 2.17, 155.42}, {45, 0.4, 796.3}, {36, 0.47, 775.52}, {29, 2.65, 7.11}, {21, 5.34, 0.98},
+    {19, 1.85, 5486.78}, {19, 4.97, 213.3}, {17, 2.99, 6275.96}, {16, 0.03, 2544.31},
+    {16, 1.43, 2146.17}, {15, 1.21, 10977.08}, {12, 2.83, 1748.02}, {12, 3.26, 5088.63},
+    {12, 5.27, 1194.45}, {12, 2.08, 4694}, {11, 0.77, 553.57}, {10, 1.3, 6286.6},
+    {10, 4.24, 1349.87}, {9, 2.7, 242.73}, {9, 5.64, 951.72}, {8, 5.3, 2352.87},
+    {6, 2.65, 9437.76}, {6, 4.67, 4690.48}, {52919.0, 0, 0}, {8720.0, 1.0721, 6283.0758},
+    {309.0, 0.867, 12566.152}, {27, 0.05, 3.52}, {16, 5.19, 26.3}, {16, 3.68, 155.42},
+    {10, 0.76, 18849.23}, {9, 2.06, 77713.77}, {7, 0.83, 775.52}, {5, 4.66, 1577.34},
+    {4, 1.03, 7.11}, {4, 3.44, 5573.14}, {3, 5.14, 796.3}, {3, 6.05, 5507.55}, {3, 1.19, 242.73},
+    {3, 6.12, 529.69}, {3, 0.31, 398.15}, {3, 2.28, 553.57}, {2, 4.38, 5223.69}, {2, 3.75, 0.98},
+    {289.0, 5.844, 6283.076}, {35, 0, 0}, {17, 5.49, 12566.15}, {3, 5.2, 155.42}, {1, 4.72, 3.52},
+    {1, 5.3, 18849.23}, {1, 5.97, 242.73}, {114.0, 3.142, 0}, {8, 4.13, 6283.08},
+    {1, 3.84, 12566.15}, {1, 3.14, 0}, {280.0, 3.199, 84334.662}, {102.0, 5.422, 5507.553},
+    {80, 3.88, 5223.69}, {44, 3.7, 2352.87}, {32, 4, 1577.34}, {9, 3.9, 5507.55},
+    {6, 1.73, 5223.69}, {100013989.0, 0, 0}, {1670700.0, 3.0984635, 6283.07585},
+    {13956.0, 3.05525, 12566.1517}, {3084.0, 5.1985, 77713.7715}, {1628.0, 1.1739, 5753.3849},
+    {1576.0, 2.8469, 7860.4194}, {925.0, 5.453, 11506.77}, {542.0, 4.564, 3930.21},
+    {472.0, 3.661, 5884.927}, {346.0, 0.964, 5507.553}, {329.0, 5.9, 5223.694},
+    {307.0, 0.299, 5573.143}, {243.0, 4.273, 11790.629}, {212.0, 5.847, 1577.344},
+    {186.0, 5.022, 10977.079}, {175.0, 3.012, 18849.228}, {110.0, 5.055, 5486.778},
+    {98, 0.89, 6069.78}, {86, 5.69, 15720.84}, {86, 1.27, 161000.69}, {65, 0.27, 17260.15},
+    {63, 0.92, 529.69}, {57, 2.01, 83996.85}, {56, 5.24, 71430.7}, {49, 3.25, 2544.31},
+    {47, 2.58, 775.52}, {45, 5.54, 9437.76}, {43, 6.01, 6275.96}, {39, 5.36, 4694},
+    {38, 2.39, 8827.39}, {37, 0.83, 19651.05}, {37, 4.9, 12139.55}, {36, 1.67, 12036.46},
+    {35, 1.84, 2942.46}, {33, 0.24, 7084.9}, {32, 0.18, 5088.63}, {32, 1.78, 398.15},
+    {28, 1.21, 6286.6}, {28, 1.9, 6279.55}, {26, 4.59, 10447.39}, {103019.0, 1.10749, 6283.07585},
+    {1721.0, 1.0644, 12566.1517}, {702.0, 3.142, 0}, {32, 1.02, 18849.23}, {31, 2.84, 5507.55},
+    {25, 1.32, 5223.69}, {18, 1.42, 1577.34}, {10, 5.91, 10977.08}, {9, 1.42, 6275.96},
+    {9, 0.27, 5486.78}, {4359.0, 5.7846, 6283.0758}, {124.0, 5.579, 12566.152}, {12, 3.14, 0},
+    {9, 3.63, 77713.77}, {6, 1.87, 5573.14}, {3, 5.47, 18849.23}, {145.0, 4.273, 6283.076},
+    {7, 3.92, 12566.15}, {4, 2.56, 6283.08}
+};
+/* rows of L0..L5, B0..B1, R0..R4 in hf_spa_terms */
+static const short hf_spa_series[14] = {0, 64, 98, 118, 125, 128, 129, 134, 136, 176, 186, 192, 194, 195};
+static const double hf_spa_nutation[63][9] = {
+    {0, 0, 0, 0, 1, -171996, -174.2, 92025, 8.9}, {-2, 0, 0, 2, 2, -13187, -1.6, 5736, -3.1},
+    {0, 0, 0, 2, 2, -2274, -0.2, 977, -0.5}, {0, 0, 0, 0, 2, 2062, 0.2, -895, 0.5},
+    {0, 1, 0, 0, 0, 1426, -3.4, 54, -0.1}, {0, 0, 1, 0, 0, 712, 0.1, -7, 0},
+    {-2, 1, 0, 2, 2, -517, 1.2, 224, -0.6}, {0, 0, 0, 2, 1, -386, -0.4, 200, 0},
+    {0, 0, 1, 2, 2, -301, 0, 129, -0.1}, {-2, -1, 0, 2, 2, 217, -0.5, -95, 0.3},
+    {-2, 0, 1, 0, 0, -158, 0, 0, 0}, {-2, 0, 0, 2, 1, 129, 0.1, -70, 0},
+    {0, 0, -1, 2, 2, 123, 0, -53, 0}, {2, 0, 0, 0, 0, 63, 0, 0, 0},
+    {0, 0, 1, 0, 1, 63, 0.1, -33, 0}, {2, 0, -1, 2, 2, -59, 0, 26, 0},
+    {0, 0, -1, 0, 1, -58, -0.1, 32, 0}, {0, 0, 1, 2, 1, -51, 0, 27, 0},
+    {-2, 0, 2, 0, 0, 48, 0, 0, 0}, {0, 0, -2, 2, 1, 46, 0, -24, 0}, {2, 0, 0, 2, 2, -38, 0, 16, 0},
+    {0, 0, 2, 2, 2, -31, 0, 13, 0}, {0, 0, 2, 0, 0, 29, 0, 0, 0}, {-2, 0, 1, 2, 2, 29, 0, -12, 0},
+    {0, 0, 0, 2, 0, 26, 0, 0, 0}, {-2, 0, 0, 2, 0, -22, 0, 0, 0}, {0, 0, -1, 2, 1, 21, 0, -10, 0},
+    {0, 2, 0, 0, 0, 17, -0.1, 0, 0}, {2, 0, -1, 0, 1, 16, 0, -8, 0},
+    {-2, 2, 0, 2, 2, -16, 0.1, 7, 0}, {0, 1, 0, 0, 1, -15, 0, 9, 0},
+    {-2, 0, 1, 0, 1, -13, 0, 7, 0}, {0, -1, 0, 0, 1, -12, 0, 6, 0}, {0, 0, 2, -2, 0, 11, 0, 0, 0},
+    {2, 0, -1, 2, 1, -10, 0, 5, 0}, {2, 0, 1, 2, 2, -8, 0, 3, 0}, {0, 1, 0, 2, 2, 7, 0, -3, 0},
+    {-2, 1, 1, 0, 0, -7, 0, 0, 0}, {0, -1, 0, 2, 2, -7, 0, 3, 0}, {2, 0, 0, 2, 1, -7, 0, 3, 0},
+    {2, 0, 1, 0, 0, 6, 0, 0, 0}, {-2, 0, 2, 2, 2, 6, 0, -3, 0}, {-2, 0, 1, 2, 1, 6, 0, -3, 0},
+    {2, 0, -2, 0, 1, -6, 0, 3, 0}, {2, 0, 0, 0, 1, -6, 0, 3, 0}, {0, -1, 1, 0, 0, 5, 0, 0, 0},
+    {-2, -1, 0, 2, 1, -5, 0, 3, 0}, {-2, 0, 0, 0, 1, -5, 0, 3, 0}, {0, 0, 2, 2, 1, -5, 0, 3, 0},
+    {-2, 0, 2, 0, 1, 4, 0, 0, 0}, {-2, 1, 0, 2, 1, 4, 0, 0, 0}, {0, 0, 1, -2, 0, 4, 0, 0, 0},
+    {-1, 0, 1, 0, 0, -4, 0, 0, 0}, {-2, 1, 0, 0, 0, -4, 0, 0, 0}, {1, 0, 0, 0, 0, -4, 0, 0, 0},
+    {0, 0, 1, 2, 0, 3, 0, 0, 0}, {0, 0, -2, 2, 2, -3, 0, 0, 0}, {-1, -1, 1, 0, 0, -3, 0, 0, 0},
+    {0, 1, 1, 0, 0, -3, 0, 0, 0}, {0, -1, 1, 2, 2, -3, 0, 0, 0}, {2, -1, -1, 2, 2, -3, 0, 0, 0},
+    {0, 0, 3, 2, 2, -3, 0, 0, 0}, {2, -1, 0, 2, 2, -3, 0, 0, 0}
+};
+
+/* ---------------------------------------------------------------------- 2. SPA: the steps */
+#define HF_DEG (HFVIS__PI / 180.0)
+
+/* x mod 360 in [0, 360). */
+static double hf_deg360(double x)
+{
+    double r = fmod(x, 360.0);
+    return r < 0.0 ? r + 360.0 : r;
+}
+
+/* Sum of series s of the terms (Eq. 9): sum_i A_i cos(B_i + C_i jme). */
+static double hf_spa_series_sum(int s, double jme)
+{
+    double sum = 0.0;
+    int i;
+    for (i = hf_spa_series[s]; i < hf_spa_series[s + 1]; i++)
+        sum += hf_spa_terms[i][0] * cos(hf_spa_terms[i][1] + hf_spa_terms[i][2] * jme);
+    return sum;
+}
+
+/* One of L, B, R (Eq. 10-11): (X0 + X1 jme + X2 jme^2 + ...)/1e8 over series [first, first+n). */
+static double hf_spa_poly(int first, int n, double jme)
+{
+    double sum = 0.0;
+    int i;
+    for (i = n - 1; i >= 0; i--) sum = sum * jme + hf_spa_series_sum(first + i, jme);
+    return sum / 1e8;
+}
+
+/* Days in a month of the proleptic calendar SPA uses (Julian before 1582-10-15). */
+static int hf_month_days(int year, int month)
+{
+    static const int d[12] = { 31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31 };
+    int leap;
+    if (month == 2) {
+        leap = year > 1582 ? ((year % 4 == 0 && year % 100 != 0) || year % 400 == 0) : (year % 4 == 0);
+        return 28 + leap;
+    }
+    return d[month - 1];
+}
+
+/* The Julian day of a calendar date and a day fraction (SPA Eq. 4, Meeus 1998 Eq. 7.1). */
+static double hf_julian_day(int year, int month, double day)
+{
+    double y = (double)year, m = (double)month, b = 0.0, jd;
+    if (month < 3) {
+        y -= 1.0;
+        m += 12.0;
+    }
+    jd = floor(365.25 * (y + 4716.0)) + floor(30.6001 * (m + 1.0)) + day - 1524.5;
+    if (jd > 2299160.0) {
+        double a = floor(y / 100.0);
+        b = 2.0 - a + floor(a / 4.0);
+    }
+    return jd + b;
+}
+
+/* The instant's part of SPA (everything before the observer's place): Eq. 4-31 and the
+ * equatorial horizontal parallax (Eq. 33). Angles in degrees here, as the paper's equations. */
+typedef struct hf_spa_sun {
+    double jd, jde, L, B, R, dpsi, deps, eps, lambda, nu, alpha, delta, xi;
+} hf_spa_sun;
+
+static void hf_spa_instant(double jd, double delta_t, hf_spa_sun *s)
+{
+    double jc, jce, jme, x[5], theta, beta, u, eps0, nu0, lr, er, br;
+    int i, j;
+    s->jd = jd;
+    s->jde = jd + delta_t / 86400.0;
+    jc = (jd - 2451545.0) / 36525.0;
+    jce = (s->jde - 2451545.0) / 36525.0;
+    jme = jce / 10.0;
+    s->L = hf_deg360(hf_spa_poly(0, 6, jme) / HF_DEG);
+    s->B = hf_spa_poly(6, 2, jme) / HF_DEG;
+    s->R = hf_spa_poly(8, 5, jme);
+    theta = hf_deg360(s->L + 180.0);                         /* Eq. 13-14 */
+    beta = -s->B;
+    /* Nutation (Eq. 15-23): mean elongation of the moon, anomalies, argument of latitude and
+     * the longitude of the ascending node, each a cubic in JCE. */
+    x[0] = 297.85036 + jce * (445267.111480 + jce * (-0.0019142 + jce / 189474.0));
+    x[1] = 357.52772 + jce * (35999.050340 + jce * (-0.0001603 - jce / 300000.0));
+    x[2] = 134.96298 + jce * (477198.867398 + jce * (0.0086972 + jce / 56250.0));
+    x[3] = 93.27191 + jce * (483202.017538 + jce * (-0.0036825 + jce / 327270.0));
+    x[4] = 125.04452 + jce * (-1934.136261 + jce * (0.0020708 + jce / 450000.0));
+    s->dpsi = 0.0;
+    s->deps = 0.0;
+    for (i = 0; i < 63; i++) {
+        const double *t = hf_spa_nutation[i];
+        double arg = 0.0;
+        for (j = 0; j < 5; j++) arg += x[j] * t[j];
+        arg *= HF_DEG;
+        s->dpsi += (t[5] + t[6] * jce) * sin(arg);
+        s->deps += (t[7] + t[8] * jce) * cos(arg);
+    }
+    s->dpsi /= 36000000.0;
+    s->deps /= 36000000.0;
+    u = jme / 10.0;                                          /* Eq. 24, arc seconds */
+    eps0 = 84381.448 + u * (-4680.93 + u * (-1.55 + u * (1999.25 + u * (-51.38 + u * (-249.67 +
+           u * (-39.05 + u * (7.12 + u * (27.87 + u * (5.79 + u * 2.45)))))))));
+    s->eps = eps0 / 3600.0 + s->deps;                        /* Eq. 25 */
+    s->lambda = theta + s->dpsi - 20.4898 / (3600.0 * s->R); /* Eq. 26-27 */
+    nu0 = hf_deg360(280.46061837 + 360.98564736629 * (jd - 2451545.0) +
+                    jc * jc * (0.000387933 - jc / 38710000.0));  /* Eq. 28 */
+    er = s->eps * HF_DEG;
+    s->nu = nu0 + s->dpsi * cos(er);                         /* Eq. 29 */
+    lr = s->lambda * HF_DEG;
+    br = beta * HF_DEG;
+    s->alpha = hf_deg360(atan2(sin(lr) * cos(er) - tan(br) * sin(er), cos(lr)) / HF_DEG); /* Eq. 30 */
+    s->delta = asin(sin(br) * cos(er) + cos(br) * sin(er) * sin(lr)) / HF_DEG;              /* Eq. 31 */
+    s->xi = 8.794 / (3600.0 * s->R);                         /* Eq. 33 */
+}
+
+/* The observer's part (Eq. 32-46): topocentric position, optional refraction. lat, lon in
+ * degrees, elevation in metres. */
+typedef struct hf_spa_place {
+    double H, delta_p, H_p, e0, e, zenith, azimuth;
+} hf_spa_place;
+
+static void hf_spa_at(const hf_spa_sun *s, double lat, double lon, double elev, int refraction,
+                      double pressure, double temperature, double atmos_refract,
+                      hf_spa_place *p)
+{
+    double H, phi = lat * HF_DEG, u, x, y, xi = s->xi * HF_DEG, d = s->delta * HF_DEG, hr, da,
+           dp, hp, e0, gamma;
+    H = hf_deg360(s->nu + lon - s->alpha);                  /* Eq. 32 */
+    hr = H * HF_DEG;
+    u = atan(0.99664719 * tan(phi));                         /* Eq. 34-36 */
+    x = cos(u) + elev / 6378140.0 * cos(phi);
+    y = 0.99664719 * sin(u) + elev / 6378140.0 * sin(phi);
+    da = atan2(-x * sin(xi) * sin(hr), cos(d) - x * sin(xi) * cos(hr));        /* Eq. 37 */
+    dp = atan2((sin(d) - y * sin(xi)) * cos(da), cos(d) - x * sin(xi) * cos(hr)); /* Eq. 38 */
+    hp = hr - da;                                            /* Eq. 40 */
+    e0 = asin(sin(phi) * sin(dp) + cos(phi) * cos(dp) * cos(hp)) / HF_DEG;     /* Eq. 41 */
+    p->H = H;
+    p->delta_p = dp / HF_DEG;
+    p->H_p = hp / HF_DEG;
+    p->e0 = e0;
+    p->e = e0;
+    if (refraction && e0 >= -(0.26667 + atmos_refract))    /* Eq. 42-43 */
+        p->e = e0 + pressure / 1010.0 * 283.0 / (273.0 + temperature) * 1.02 /
+                        (60.0 * tan((e0 + 10.3 / (e0 + 5.11)) * HF_DEG));
+    p->zenith = 90.0 - p->e;                                 /* Eq. 44 */
+    gamma = atan2(sin(hp), cos(hp) * sin(phi) - tan(dp) * cos(phi)) / HF_DEG;   /* Eq. 45 */
+    p->azimuth = hf_deg360(gamma + 180.0);                   /* Eq. 46 */
+}
+
+static int hf_in(double v, double lo, double hi) { return v >= lo && v <= hi; }
+
+static int hf_date_valid(int year, int month, int day)
+{
+    if (year < -2000 || year > 6000 || month < 1 || month > 12 || day < 1) return 0;
+    if (year == 1582 && month == 10 && day > 4 && day < 15) return 0; /* the calendar reform */
+    return day <= hf_month_days(year, month);
+}
+
+hfvis_status hfvis_spa(const hfvis_spa_input *in, hfvis_spa_result *out)
+{
+    hf_spa_sun s;
+    hf_spa_place p;
+    double jd;
+    if (!in || !out || !hf_date_valid(in->year, in->month, in->day) || in->hour < 0 ||
+        in->hour > 24 || in->minute < 0 || in->minute > 59 || !hf_in(in->second, 0.0, 60.0) ||
+        (in->hour == 24 && (in->minute != 0 || in->second != 0.0)) ||
+        !(fabs(in->delta_ut1) < 1.0) || !hf_in(in->delta_t, -8000.0, 8000.0) ||
+        !hf_in(in->latitude_rad, -HFVIS__HALF_PI, HFVIS__HALF_PI) ||
+        !hf_in(in->longitude_rad, -HFVIS__PI, HFVIS__PI) || !(in->elevation_m >= -6500000.0) ||
+        !isfinite(in->elevation_m) || (in->refraction != 0 && in->refraction != 1) ||
+        (in->refraction && (!(in->pressure_mbar > 0.0 && in->pressure_mbar <= 5000.0) ||
+                            !(in->temperature_c > -273.0 && in->temperature_c <= 6000.0) ||
+                            !hf_in(in->atmos_refract_rad, 0.0, 0.1))))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    jd = hf_julian_day(in->year, in->month,
+                       (double)in->day + ((double)in->hour + ((double)in->minute +
+                       (in->second + in->delta_ut1) / 60.0) / 60.0) / 24.0);
+    hf_spa_instant(jd, in->delta_t, &s);
+    hf_spa_at(&s, in->latitude_rad / HF_DEG, in->longitude_rad / HF_DEG, in->elevation_m,
+              in->refraction, in->pressure_mbar, in->temperature_c, in->atmos_refract_rad / HF_DEG,
+              &p);
+    out->jd = s.jd;
+    out->jde = s.jde;
+    out->helio_longitude = s.L * HF_DEG;
+    out->helio_latitude = s.B * HF_DEG;
+    out->radius_au = s.R;
+    out->nutation_longitude = s.dpsi * HF_DEG;
+    out->nutation_obliquity = s.deps * HF_DEG;
+    out->obliquity = s.eps * HF_DEG;
+    out->apparent_longitude = hf_deg360(s.lambda) * HF_DEG;
+    out->sidereal_time = hf_deg360(s.nu) * HF_DEG;
+    out->right_ascension = s.alpha * HF_DEG;
+    out->declination = s.delta * HF_DEG;
+    out->hour_angle = p.H * HF_DEG;
+    out->topo_declination = p.delta_p * HF_DEG;
+    out->topo_hour_angle = p.H_p * HF_DEG;
+    out->elevation = p.e * HF_DEG;
+    out->zenith = p.zenith * HF_DEG;
+    out->azimuth = p.azimuth * HF_DEG;
+    return HFVIS_OK;
+}
+
+/* ------------------------------------------------- 3. r.sun's solar geometry and ESRA sky */
+static double hf_rsun_day_angle(int day) { return 2.0 * HFVIS__PI * (double)day / 365.25; }
+
+hfvis_status hfvis_rsun_sun_position(int day, double solar_hour, double latitude_rad,
+                                     hfvis_rsun_sun *out)
+{
+    double d, dec, w, sl, cl, sd, cd, sh, east, north, c;
+    if (!out || day < 1 || day > 366 || !isfinite(solar_hour) ||
+        !hf_in(latitude_rad, -HFVIS__HALF_PI, HFVIS__HALF_PI))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    d = hf_rsun_day_angle(day);
+    dec = asin(0.3978 * sin(d - 1.4 + 0.0355 * sin(d - 0.0489)));
+    w = (solar_hour - 12.0) * (HFVIS__PI / 12.0);
+    sl = sin(latitude_rad);
+    cl = cos(latitude_rad);
+    sd = sin(dec);
+    cd = cos(dec);
+    sh = cl * cd * cos(w) + sl * sd;
+    east = -cd * sin(w);
+    north = cl * sd - sl * cd * cos(w);
+    out->declination = dec;
+    out->hour_angle = w;
+    out->elevation = asin(sh > 1.0 ? 1.0 : sh < -1.0 ? -1.0 : sh);
+    out->azimuth = atan2(east, north);
+    if (out->azimuth < 0.0) out->azimuth += 2.0 * HFVIS__PI;
+    out->extraterrestrial = 1367.0 * (1.0 + 0.03344 * cos(d - 0.048869));
+    /* cos(w0) = -tan(lat) tan(dec) at sunrise (true elevation 0), r.sun's com_par_const */
+    c = cl * cd > 1e-12 ? -(sl * sd) / (cl * cd) : (sl * sd > 0.0 ? -2.0 : 2.0);
+    if (c < -1.0) {
+        out->sunrise_hour = 0.0;
+        out->sunset_hour = 24.0;
+    } else if (c > 1.0) {
+        out->sunrise_hour = 12.0;
+        out->sunset_hour = 12.0;
+    } else {
+        double h = acos(c) * 12.0 / HFVIS__PI;
+        out->sunrise_hour = 12.0 - h;
+        out->sunset_hour = 12.0 + h;
+    }
+    return HFVIS_OK;
+}
+
+/* ESRA relative optical air mass at true elevation h (rad) and pressure ratio p: the elevation
+ * refracted by ESRA's fit, then Kasten & Young 1989 (Rigollier et al. 2000 Eq. 3-5). */
+static double hf_esra_air_mass(double h, double p)
+{
+    double dr = 0.061359 * (0.1594 + h * (1.123 + 0.065656 * h)) / (1.0 + h * (28.9344 + 277.3971 * h));
+    double hr = h + dr;
+    return p / (sin(hr) + 0.50572 * pow(hr / HF_DEG + 6.07995, -1.6364));
+}
+
+/* Rayleigh optical thickness at air mass m (Kasten 1996 as ESRA fits it, Eq. 6-7). */
+static double hf_esra_rayleigh(double m)
+{
+    if (m <= 20.0)
+        return 1.0 / (6.6296 + m * (1.7513 + m * (-0.1202 + m * (0.0065 - m * 0.00013))));
+    return 1.0 / (10.4 + 0.718 * m);
+}
+
+/* Beam normal transmittance exp(-0.8662 TL m dR(m)) (Eq. 2). */
+static double hf_esra_beam_trans(double h, double p, double linke)
+{
+    double m = hf_esra_air_mass(h, p);
+    return exp(-0.8662 * linke * m * hf_esra_rayleigh(m));
+}
+
+/* Diffuse transmission Tn(TL) times the angular function Fd(h) (Eq. 10-14): dh = G0 Tn Fd. */
+static double hf_esra_diffuse_factor(double sinh, double linke)
+{
+    double tn = -0.015843 + linke * (0.030543 + 0.0003797 * linke);
+    double a1 = 0.26463 + linke * (-0.061581 + 0.0031408 * linke);
+    double a2 = 2.04020 + linke * (0.018945 - 0.011161 * linke);
+    double a3 = -1.3025 + linke * (0.039231 + 0.0085079 * linke);
+    if (a1 * tn < 0.0022) a1 = 0.0022 / tn;
+    return tn * (a1 + a2 * sinh + a3 * sinh * sinh);
+}
+
+/* Pressure ratio of a height (ESRA's scale height 8434.5 m). */
+static double hf_esra_pressure(double height_m) { return exp(-height_m / 8434.5); }
+
+hfvis_status hfvis_esra_clear_sky(double g0, double elevation_rad, double height_m, double linke,
+                                  double out[3])
+{
+    double sh;
+    if (!out || !(g0 >= 0.0) || !isfinite(g0) || !hf_in(elevation_rad, -HFVIS__HALF_PI, HFVIS__HALF_PI) ||
+        !isfinite(height_m) || !(linke > 0.0 && linke <= 10.0))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    if (!(elevation_rad > 0.0)) {
+        out[0] = out[1] = out[2] = 0.0;
+        return HFVIS_OK;
+    }
+    sh = sin(elevation_rad);
+    out[0] = g0 * hf_esra_beam_trans(elevation_rad, hf_esra_pressure(height_m), linke);
+    out[1] = out[0] * sh;
+    out[2] = g0 * hf_esra_diffuse_factor(sh, linke);
+    return HFVIS_OK;
+}
+
+/* ------------------------------------------------------------- 4. inputs, options, steps */
+#define HF_SOLAR_STEP_DEFAULT 0.25    /* hours: 15 minutes */
+#define HF_SOLAR_K_DEFAULT 64         /* directions of the horizon map */
+#define HF_SOLAR_KR_DEFAULT 16        /* directions of the TERRAIN gather */
+#define HF_SOLAR_DELTA_T_DEFAULT 69.0 /* s, TT - UT1 around 2020-2030 */
+#define HF_SOLAR_DAYS_MAX 36600       /* a century of days */
+#define HF_SOLAR_K_MAX 4096
+#define HF_SOLAR_BISECTIONS 40        /* sunrise to 24 h / 2^40: far below a second */
+#define HF_SOLAR_SLOPE_FLAT 1e-9      /* rad: below this a receiver is horizontal (r.sun's
+                                         slope != 0 test, robust to float normals) */
+#define HF_SOLAR_REFRACT_P 1013.25    /* mbar and deg C of the refraction option: the */
+#define HF_SOLAR_REFRACT_T 10.0       /* standard atmosphere SPA's example assumes */
+#define HF_SOLAR_REFRACT_SUNRISE 0.5667 /* deg */
+
+hfvis_solar_input hfvis_solar_input_default(void)
+{
+    hfvis_solar_input in;
+    memset(&in, 0, sizeof in);
+    in.year = 2026;
+    in.month = 6;
+    in.day = 21;
+    in.days = 1;
+    in.linke = 3.0;
+    in.albedo = 0.2;
+    return in;
+}
+
+hfvis_solar_options hfvis_solar_options_default(void)
+{
+    hfvis_solar_options o;
+    memset(&o, 0, sizeof o);
+    o.model = HFVIS_SUN_SPA;
+    o.step_hours = HF_SOLAR_STEP_DEFAULT;
+    o.directions = HF_SOLAR_K_DEFAULT;
+    o.delta_t = HF_SOLAR_DELTA_T_DEFAULT;
+    o.reflected_directions = HF_SOLAR_KR_DEFAULT;
+    return o;
+}
+
+/* The date n days after (y, m, d). */
+static void hf_date_add(int *y, int *m, int *d, int n)
+{
+    while (n-- > 0) {
+        if (++*d > hf_month_days(*y, *m)) {
+            *d = 1;
+            if (++*m > 12) {
+                *m = 1;
+                ++*y;
+            }
+        }
+    }
+}
+
+static int hf_day_of_year(int y, int m, int d)
+{
+    int k, n = d;
+    for (k = 1; k < m; k++) n += hf_month_days(y, k);
+    return n;
+}
+
+static int hf_solar_input_valid(const hfvis_solar_input *in)
+{
+    return in && hf_in(in->latitude_rad, -HFVIS__HALF_PI, HFVIS__HALF_PI) &&
+           hf_in(in->longitude_rad, -HFVIS__PI, HFVIS__PI) && isfinite(in->height_m) &&
+           in->height_m >= -6500000.0 && hf_date_valid(in->year, in->month, in->day) &&
+           (in->instant == 0 || in->instant == 1) &&
+           (in->instant ? hf_in(in->hour, 0.0, 24.0) : (in->days >= 1 && in->days <= HF_SOLAR_DAYS_MAX)) &&
+           hf_in(in->utc_offset_hours, -14.0, 14.0) && in->linke > 0.0 && in->linke <= 10.0 &&
+           hf_in(in->albedo, 0.0, 1.0);
+}
+
+static int hf_solar_opts_valid(const hfvis_solar_options *o)
+{
+    int k;
+    const hfvis_sweep_options *s;
+    if (!o) return 1;
+    s = o->sweep;
+    if (o->model < HFVIS_SUN_MODEL_DEFAULT || o->model > HFVIS_SUN_RSUN || !(o->step_hours >= 0.0) ||
+        o->step_hours > 24.0 || o->directions < 0 || o->directions > HF_SOLAR_K_MAX ||
+        (o->no_shading != 0 && o->no_shading != 1) || !hf_in(o->sun_radius_rad, 0.0, 0.1) ||
+        (o->refraction != 0 && o->refraction != 1) || !hf_in(o->delta_t, -8000.0, 8000.0) ||
+        o->diffuse < HFVIS_SOLAR_DIFFUSE_DEFAULT || o->diffuse > HFVIS_SOLAR_DIFFUSE_HORIZON ||
+        o->reflected < HFVIS_SOLAR_REFLECTED_DEFAULT || o->reflected > HFVIS_SOLAR_REFLECTED_TERRAIN ||
+        o->reflected_directions < 0 || o->reflected_directions > HF_SOLAR_K_MAX ||
+        o->bands < HFVIS_SOLAR_BANDS_DEFAULT || o->bands > HFVIS_SOLAR_BANDS_MONTH)
+        return 0;
+    if (s && (!hf_opts_valid(s) || s->extent_width != 0 || s->receiver_width != 0)) return 0;
+    if (o->linke_monthly)
+        for (k = 0; k < 12; k++)
+            if (!(o->linke_monthly[k] > 0.0f && o->linke_monthly[k] <= 10.0f)) return 0;
+    return 1;
+}
+
+int hfvis_solar_band_count(const hfvis_solar_input *input, const hfvis_solar_options *opts)
+{
+    int y, m, d, n;
+    if (!hf_solar_input_valid(input) || !hf_solar_opts_valid(opts)) return -1;
+    if (input->instant || !opts || opts->bands == HFVIS_SOLAR_BANDS_TOTAL) return 1;
+    if (opts->bands == HFVIS_SOLAR_BANDS_DAY) return input->days;
+    y = input->year;
+    m = input->month;
+    d = input->day;
+    hf_date_add(&y, &m, &d, input->days - 1);
+    n = (y - input->year) * 12 + (m - input->month) + 1;
+    return n;
+}
+
+/* One time step: the sun (true elevation h for the atmosphere, the direction for shading and
+ * incidence), the extraterrestrial irradiance, the step's weight in hours (1 for an instant) and
+ * its band and month. */
+typedef struct hf_solar_step {
+    double h, sinh, g0, sx, sy, sz, psi, elev, weight;
+    double linke;       /* the month's Linke factor (or input->linke) */
+    double m0;          /* ESRA air mass at sea level (pressure ratio 1) */
+    double fd;          /* ESRA diffuse factor Tn*Fd for this step's Linke factor */
+    int band, month;
+} hf_solar_step;
+
+typedef struct hf_solar_ctx {
+    hfvis_solar_input in;
+    hfvis_solar_options o;
+    int bands;
+} hf_solar_ctx;
+
+/* Sun of the SPA model at local civil hour t of day (y, m, d): true and shading elevation. */
+static void hf_solar_spa_sun(const hf_solar_ctx *c, int y, int m, int d, double t,
+                             double *h_true, double *elev, double *azimuth, double *g0)
+{
+    hf_spa_sun s;
+    hf_spa_place p;
+    double jd = hf_julian_day(y, m, (double)d + (t - c->in.utc_offset_hours) / 24.0);
+    hf_spa_instant(jd, c->o.delta_t, &s);
+    hf_spa_at(&s, c->in.latitude_rad / HF_DEG, c->in.longitude_rad / HF_DEG, c->in.height_m,
+              c->o.refraction, HF_SOLAR_REFRACT_P, HF_SOLAR_REFRACT_T, HF_SOLAR_REFRACT_SUNRISE, &p);
+    *h_true = p.e0 * HF_DEG;
+    *elev = p.e * HF_DEG;
+    *azimuth = p.azimuth * HF_DEG;
+    *g0 = 1367.0 / (s.R * s.R);
+}
+
+static double hf_solar_spa_h(const hf_solar_ctx *c, int y, int m, int d, double t)
+{
+    double h, e, a, g;
+    hf_solar_spa_sun(c, y, m, d, t, &h, &e, &a, &g);
+    return h;
+}
+
+/* Fill a step from the sun's true elevation h, shading elevation elev and compass azimuth. */
+static void hf_solar_step_set(const hf_solar_ctx *c, hf_solar_step *st, double h, double elev,
+                              double azimuth, double g0, double weight, int band, int month)
+{
+    double ce = cos(elev);
+    st->h = h;
+    st->sinh = sin(h);
+    st->elev = elev;
+    st->g0 = g0;
+    st->sx = ce * sin(azimuth);   /* east = +x */
+    st->sy = -ce * cos(azimuth);  /* south = +y */
+    st->sz = sin(elev);
+    st->psi = azimuth - HFVIS__HALF_PI;
+    if (st->psi < 0.0) st->psi += 2.0 * HFVIS__PI;
+    st->weight = weight;
+    st->band = band;
+    st->month = month;
+    st->linke = c->o.linke_monthly ? (double)c->o.linke_monthly[month - 1] : c->in.linke;
+    st->m0 = hf_esra_air_mass(h, 1.0);
+    st->fd = hf_esra_diffuse_factor(st->sinh, st->linke);
+}
+
+/* The steps of the period, sun above the horizon only, in time order. steps NULL: count only. */
+static size_t hf_solar_steps(const hf_solar_ctx *c, hf_solar_step *steps)
+{
+    size_t n = 0;
+    int y = c->in.year, m = c->in.month, d = c->in.day, day, days = c->in.instant ? 1 : c->in.days;
+    int band_month0 = c->in.year * 12 + c->in.month;
+    double step = c->o.step_hours;
+    for (day = 0; day < days; day++, hf_date_add(&y, &m, &d, 1)) {
+        int band = c->o.bands == HFVIS_SOLAR_BANDS_DAY ? day
+                 : c->o.bands == HFVIS_SOLAR_BANDS_MONTH ? y * 12 + m - band_month0 : 0;
+        if (c->o.model == HFVIS_SUN_RSUN) {
+            int doy = hf_day_of_year(y, m, d);
+            hfvis_rsun_sun r;
+            double ang, last, dang = step * (HFVIS__PI / 12.0), first;
+            int k;
+            if (c->in.instant) {
+                hfvis_rsun_sun_position(doy, c->in.hour, c->in.latitude_rad, &r);
+                if (r.elevation > 0.0) {
+                    if (steps) hf_solar_step_set(c, steps + n, r.elevation, r.elevation, r.azimuth,
+                                                 r.extraterrestrial, 1.0, band, m);
+                    n++;
+                }
+                continue;
+            }
+            hfvis_rsun_sun_position(doy, 12.0, c->in.latitude_rad, &r);
+            /* r.sun's schedule (joules2): the first step half a step after the start of the
+             * step that holds sunrise, or one and a half when sunrise lies in its second half;
+             * then every step while the hour angle has not passed sunset's */
+            k = (int)(r.sunrise_hour / step);
+            first = (r.sunrise_hour - (double)k * step > 0.5 * step) ? ((double)k + 1.5) * step
+                                                                      : ((double)k + 0.5) * step;
+            ang = (first - 12.0) * (HFVIS__PI / 12.0);
+            last = (r.sunset_hour - 12.0) * (HFVIS__PI / 12.0);
+            for (;;) {
+                hfvis_rsun_sun q;
+                hfvis_rsun_sun_position(doy, 12.0 + ang * (12.0 / HFVIS__PI), c->in.latitude_rad, &q);
+                if (q.elevation > 0.0) {
+                    if (steps) hf_solar_step_set(c, steps + n, q.elevation, q.elevation, q.azimuth,
+                                                 q.extraterrestrial, step, band, m);
+                    n++;
+                }
+                ang += dang;
+                if (ang > last) break;
+            }
+        } else if (c->in.instant) {
+            double h, e, a, g;
+            hf_solar_spa_sun(c, y, m, d, c->in.hour, &h, &e, &a, &g);
+            if (h > 0.0) {
+                if (steps) hf_solar_step_set(c, steps + n, h, e, a, g, 1.0, band, m);
+                n++;
+            }
+        } else {
+            double t0 = 0.0, h0 = hf_solar_spa_h(c, y, m, d, 0.0);
+            while (t0 < 24.0) {
+                double t1 = t0 + step > 24.0 ? 24.0 : t0 + step, h1 = hf_solar_spa_h(c, y, m, d, t1);
+                double a = t0, b = t1;
+                int lit = 1;
+                if (!(h0 > 0.0) && !(h1 > 0.0)) {
+                    lit = 0;
+                } else if (!(h0 > 0.0) || !(h1 > 0.0)) {
+                    /* sunrise or sunset inside the step: bisect the true elevation's zero */
+                    double lo = t0, hi = t1;
+                    int it;
+                    for (it = 0; it < HF_SOLAR_BISECTIONS; it++) {
+                        double mid = 0.5 * (lo + hi), hm = hf_solar_spa_h(c, y, m, d, mid);
+                        if ((hm > 0.0) == (h1 > 0.0)) hi = mid;
+                        else lo = mid;
+                    }
+                    if (h1 > 0.0) a = hi;
+                    else b = lo;
+                }
+                if (lit && b > a) {
+                    double h, e, az, g;
+                    hf_solar_spa_sun(c, y, m, d, 0.5 * (a + b), &h, &e, &az, &g);
+                    if (h > 0.0) {
+                        if (steps) hf_solar_step_set(c, steps + n, h, e, az, g, b - a, band, m);
+                        n++;
+                    }
+                }
+                t0 = t1;
+                h0 = h1;
+            }
+        }
+    }
+    return n;
+}
+
+/* ------------------------------------------------------------- 5. the atmosphere per point */
+/* Per-sample constants: pressure ratio of its height, normal, slope terms of Muneer's model,
+ * Linke factor (map), albedo, real-sky coefficients and the visible-sky ratio of HORIZON. */
+typedef struct hf_solar_point {
+    double p, nx, ny, nz, sin_slope, r_sky, fg, albedo, cbh, cdh, sky_ratio, linke;
+    int tilted, linke_map;
+} hf_solar_point;
+
+static void hf_solar_point_init(const hf_solar_ctx *c, const hfvis_grid *g, int x, int y,
+                                hf_solar_point *pt)
+{
+    size_t i = (size_t)y * (size_t)g->width + (size_t)x;
+    double n[3], slope;
+    hf_normal_at(g, x, y, n);
+    pt->p = hf_esra_pressure((double)g->z[(ptrdiff_t)y * g->stride + x]);
+    pt->nx = n[0];
+    pt->ny = n[1];
+    pt->nz = n[2];
+    slope = acos(n[2] > 1.0 ? 1.0 : n[2]);
+    pt->tilted = slope > HF_SOLAR_SLOPE_FLAT;
+    pt->sin_slope = sin(slope);
+    pt->r_sky = 0.5 * (1.0 + cos(slope));
+    /* Muneer's sky-brightness function of the slope (r.sun's fg) */
+    pt->fg = sin(slope) - slope * cos(slope) - HFVIS__PI * sin(0.5 * slope) * sin(0.5 * slope);
+    pt->albedo = c->o.albedo_map ? (double)c->o.albedo_map[i] : c->in.albedo;
+    pt->cbh = c->o.coeff_bh ? (double)c->o.coeff_bh[i] : 1.0;
+    pt->cdh = c->o.coeff_dh ? (double)c->o.coeff_dh[i] : 1.0;
+    pt->linke_map = c->o.linke_map != NULL;
+    pt->linke = c->o.linke_map ? (double)c->o.linke_map[i] : 0.0;
+    pt->sky_ratio = 1.0;
+}
+
+/* Visible fraction of the sun at elevation elev over horizon elevation hor: the centre's test,
+ * or the disc's segment above the horizon line (hfvis_sun_visibility's formula). */
+static double hf_solar_visible(double elev, double hor, double radius)
+{
+    double d;
+    if (isnan(hor)) return HFVIS__NAN;
+    if (radius <= 0.0) return elev > hor ? 1.0 : 0.0;
+    d = (elev - hor) / radius;
+    if (d >= 1.0) return 1.0;
+    if (d <= -1.0) return 0.0;
+    return 1.0 - (acos(d) - d * sqrt(1.0 - d * d)) / HFVIS__PI;
+}
+
+/* One step at one point (r.sun's brad and drad, Suri & Hofierka 2004 Eq. 1-21 with ESRA):
+ * adds weight * (beam, diffuse, reflected on the flat-ground model, sunshine) to acc.
+ * vis: the visible fraction of the sun (1 without shading). horizon: HORIZON diffuse. */
+static void hf_solar_point_step(const hf_solar_step *st, const hf_solar_point *pt, double vis,
+                                int horizon, double acc[4])
+{
+    double linke = pt->linke_map ? pt->linke : st->linke, m, bh, sh, beam = 0.0, dh, fx, diff, gh;
+    double bg, cs, kb, w = st->weight;
+    int lit;
+    sh = pt->nx * st->sx + pt->ny * st->sy + pt->nz * st->sz; /* cos of the incidence angle */
+    m = pt->p * st->m0;
+    lit = vis > 0.0 && sh > 0.0;
+    if (lit) {
+        bh = pt->cbh * st->g0 * st->sinh * exp(-0.8662 * linke * m * hf_esra_rayleigh(m));
+        beam = (pt->tilted ? bh * sh / st->sinh : bh) * vis;
+        acc[3] += w * vis;
+    } else {
+        bh = 0.0; /* r.sun: no beam in shadow, and so no beam part in kb or the reflection */
+    }
+    dh = pt->cdh * st->g0 * (pt->linke_map ? hf_esra_diffuse_factor(st->sinh, linke) : st->fd);
+    gh = bh * (vis > 0.0 ? vis : 0.0) + dh;
+    if (pt->tilted || horizon) {
+        kb = bh / (st->g0 * st->sinh);
+        if (!lit) { /* shadow, or the sun behind the receiver's plane */
+            bg = pt->r_sky + pt->fg * 0.252271;
+            cs = 0.0;
+        } else {
+            bg = ((0.00263 - kb * (0.712 + 0.6883 * kb)) * pt->fg + pt->r_sky) * (1.0 - kb);
+            if (st->h >= 0.1 || !pt->tilted)
+                cs = kb * sh / st->sinh;
+            else /* low sun: Muneer's form with the horizontal direction (r.sun) */
+                cs = kb * (pt->nx * st->sx + pt->ny * st->sy) / cos(st->elev) /
+                     (0.1 - 0.008 * st->h);
+            cs *= vis;
+        }
+        fx = bg * pt->sky_ratio + cs;
+        diff = dh * fx;
+    } else {
+        diff = dh;
+    }
+    acc[0] += w * beam;
+    acc[1] += w * diff;
+    acc[2] += w * (pt->tilted ? pt->albedo * gh * (1.0 - pt->nz) * 0.5 : 0.0);
+}
+
+/* ------------------------------------------------------------ 6. driver, fast and oracle */
+/* Validate, resolve the options, count the steps and bands. */
+static hfvis_status hf_solar_setup(const hfvis_grid *g, const hfvis_solar_input *in,
+                                   const hfvis_solar_options *opts, const hfvis_solar_output *out,
+                                   hf_solar_ctx *c)
+{
+    size_t i, n;
+    if (!hf_grid_valid(g) || !out || !hf_solar_input_valid(in) || !hf_solar_opts_valid(opts) ||
+        (!out->beam && !out->diffuse && !out->reflected && !out->global && !out->sun_hours))
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    c->in = *in;
+    c->o = hfvis_solar_options_default();
+    if (opts) {
+        c->o = *opts;
+        if (c->o.model == HFVIS_SUN_MODEL_DEFAULT) c->o.model = HFVIS_SUN_SPA;
+        if (c->o.step_hours == 0.0) c->o.step_hours = HF_SOLAR_STEP_DEFAULT;
+        if (c->o.directions == 0) c->o.directions = HF_SOLAR_K_DEFAULT;
+        if (c->o.delta_t == 0.0) c->o.delta_t = HF_SOLAR_DELTA_T_DEFAULT;
+        if (c->o.reflected_directions == 0) c->o.reflected_directions = HF_SOLAR_KR_DEFAULT;
+    }
+    c->bands = hfvis_solar_band_count(in, opts);
+    n = hf_grid_count(g);
+    if (n > SIZE_MAX / sizeof(double) / 8 || (size_t)c->bands > SIZE_MAX / sizeof(float) / 8 / n)
+        return HFVIS_ERR_LIMIT;
+    for (i = 0; i < n; i++) { /* the per-sample maps: NaN only at holes */
+        size_t zi = (i / (size_t)g->width) * (size_t)g->stride + i % (size_t)g->width;
+        if (!isfinite(g->z[zi])) continue;
+        if ((c->o.linke_map && !(c->o.linke_map[i] > 0.0f && c->o.linke_map[i] <= 10.0f)) ||
+            (c->o.albedo_map && !(c->o.albedo_map[i] >= 0.0f && c->o.albedo_map[i] <= 1.0f)) ||
+            (c->o.coeff_bh && !(c->o.coeff_bh[i] >= 0.0f && c->o.coeff_bh[i] <= 1e6f)) ||
+            (c->o.coeff_dh && !(c->o.coeff_dh[i] >= 0.0f && c->o.coeff_dh[i] <= 1e6f)))
+            return HFVIS_ERR_INVALID_ARGUMENT;
+    }
+    return HFVIS_OK;
+}
+
+/* The sweep options of the horizon map (exact rays) and of the TERRAIN gather (lattice). */
+static hfvis_sweep_options hf_solar_sweep(const hf_solar_ctx *c, hfvis_ray_mode rays)
+{
+    hfvis_sweep_options s = c->o.sweep ? *c->o.sweep : hfvis_sweep_options_default();
+    s.rays = rays;
+    s.ray_denominator = 0;
+    s.azimuth0_rad = 0.0;
+    s.direction_begin = s.direction_end = 0;
+    s.direction_order = HFVIS_DIRECTION_ORDER_DEFAULT;
+    return s;
+}
+
+/* Write the accumulated sums acc[(band*n + i)*4 + q] (beam, diffuse, reflected, sunshine) to the
+ * outputs; terrain: the TERRAIN reflected term per band (replaces q = 2). */
+static void hf_solar_store(const hfvis_grid *g, const hf_solar_ctx *c, const double *acc,
+                           const float *terrain, const hfvis_solar_output *out)
+{
+    size_t n = hf_grid_count(g), i;
+    int b;
+    for (b = 0; b < c->bands; b++)
+        for (i = 0; i < n; i++) {
+            size_t j = (size_t)b * n + i;
+            const double *a = acc + j * 4;
+            int hole = !isfinite(g->z[(i / (size_t)g->width) * (size_t)g->stride + i % (size_t)g->width]);
+            double r = terrain ? (double)terrain[j] : a[2];
+            if (out->beam) out->beam[j] = hole ? (float)HFVIS__NAN : (float)a[0];
+            if (out->diffuse) out->diffuse[j] = hole ? (float)HFVIS__NAN : (float)a[1];
+            if (out->reflected) out->reflected[j] = hole ? (float)HFVIS__NAN : (float)r;
+            if (out->global) out->global[j] = hole ? (float)HFVIS__NAN : (float)(a[0] + a[1] + r);
+            if (out->sun_hours) out->sun_hours[j] = hole ? (float)HFVIS__NAN : (float)a[3];
+        }
+}
+
+/* TERRAIN: per band, the [P2] gather of exit irradiance albedo * (beam + diffuse). */
+static hfvis_status hf_solar_terrain(const hfvis_grid *g, const hf_solar_ctx *c, const double *acc,
+                                     int naive, float **terrain_out)
+{
+    size_t n = hf_grid_count(g), i;
+    float *exit_r, *terr;
+    hfvis_sweep_options s = hf_solar_sweep(c, HFVIS_RAYS_LATTICE);
+    const hfvis_allocator *al = s.alloc;
+    hfvis_status st = HFVIS_OK;
+    int b;
+    exit_r = (float *)hfvis__alloc_array(al, n, sizeof(float));
+    terr = (float *)hfvis__alloc_array(al, n * (size_t)c->bands, sizeof(float));
+    if (!exit_r || !terr) {
+        hfvis__free(al, exit_r);
+        hfvis__free(al, terr);
+        return HFVIS_ERR_OUT_OF_MEMORY;
+    }
+    for (b = 0; b < c->bands && st == HFVIS_OK; b++) {
+        for (i = 0; i < n; i++) {
+            const double *a = acc + ((size_t)b * n + i) * 4;
+            double alb = c->o.albedo_map ? (double)c->o.albedo_map[i] : c->in.albedo;
+            exit_r[i] = (float)(alb * (a[0] + a[1]));
+            if (!isfinite(exit_r[i])) exit_r[i] = 0.0f; /* holes reflect nothing */
+        }
+        st = naive ? hfvis_indirect_light_naive(g, c->o.reflected_directions, exit_r, 1, 0.0f, 1.0f,
+                                                &s, terr + (size_t)b * n, g->width)
+                   : hfvis_indirect_light(g, c->o.reflected_directions, exit_r, 1, 0.0f, 1.0f, &s,
+                                          NULL, terr + (size_t)b * n, g->width);
+    }
+    hfvis__free(al, exit_r);
+    if (st != HFVIS_OK) {
+        hfvis__free(al, terr);
+        return st;
+    }
+    *terrain_out = terr;
+    return HFVIS_OK;
+}
+
+/* Locate azimuth psi among the map's actual azimuths az[0..K) (increasing, spanning one turn):
+ * the two neighbours k0, k1 and the weight of k1. */
+static void hf_solar_bracket(const double *az, int K, double psi, int *k0, int *k1, double *w)
+{
+    double turn = 2.0 * HFVIS__PI, a0 = az[0], span, lo, hi;
+    int k;
+    psi = fmod(psi - a0, turn);
+    if (psi < 0.0) psi += turn;
+    psi += a0;
+    for (k = 0; k + 1 < K && az[k + 1] <= psi; k++) {}
+    lo = az[k];
+    hi = k + 1 < K ? az[k + 1] : a0 + turn;
+    span = hi - lo;
+    *k0 = k;
+    *k1 = k + 1 < K ? k + 1 : 0;
+    *w = span > 0.0 ? (psi - lo) / span : 0.0;
+}
+
+/* Shared by the fast routine and the oracle: setup, steps, per-sample state. */
+typedef struct hf_solar_run {
+    hf_solar_ctx c;
+    hf_solar_step *steps;
+    size_t nsteps;
+    hf_solar_point *pts;
+    double *acc;
+    const hfvis_allocator *al;
+} hf_solar_run;
+
+static void hf_solar_run_free(hf_solar_run *r)
+{
+    hfvis__free(r->al, r->steps);
+    hfvis__free(r->al, r->pts);
+    hfvis__free(r->al, r->acc);
+}
+
+static hfvis_status hf_solar_run_init(const hfvis_grid *g, const hfvis_solar_input *in,
+                                      const hfvis_solar_options *opts,
+                                      const hfvis_solar_output *out, hf_solar_run *r)
+{
+    hfvis_status st;
+    size_t n, i;
+    memset(r, 0, sizeof *r);
+    if ((st = hf_solar_setup(g, in, opts, out, &r->c)) != HFVIS_OK) return st;
+    r->al = r->c.o.sweep ? r->c.o.sweep->alloc : NULL;
+    n = hf_grid_count(g);
+    r->nsteps = hf_solar_steps(&r->c, NULL);
+    r->steps = (hf_solar_step *)hfvis__alloc_array(r->al, r->nsteps + 1, sizeof(hf_solar_step));
+    r->pts = (hf_solar_point *)hfvis__alloc_array(r->al, n, sizeof(hf_solar_point));
+    r->acc = (double *)hfvis__alloc_array(r->al, n * (size_t)r->c.bands, 4 * sizeof(double));
+    if (!r->steps || !r->pts || !r->acc) {
+        hf_solar_run_free(r);
+        return HFVIS_ERR_OUT_OF_MEMORY;
+    }
+    hf_solar_steps(&r->c, r->steps);
+    for (i = 0; i < n * (size_t)r->c.bands * 4; i++) r->acc[i] = 0.0;
+    for (i = 0; i < n; i++)
+        hf_solar_point_init(&r->c, g, (int)(i % (size_t)g->width), (int)(i / (size_t)g->width), r->pts + i);
+    return HFVIS_OK;
+}
+
+static hfvis_status hf_solar_finish(const hfvis_grid *g, hf_solar_run *r, int naive,
+                                    const hfvis_solar_output *out)
+{
+    float *terr = NULL;
+    hfvis_status st = HFVIS_OK;
+    if (r->c.o.reflected == HFVIS_SOLAR_REFLECTED_TERRAIN &&
+        (st = hf_solar_terrain(g, &r->c, r->acc, naive, &terr)) != HFVIS_OK) {
+        hf_solar_run_free(r);
+        return st;
+    }
+    hf_solar_store(g, &r->c, r->acc, terr, out);
+    hfvis__free(r->al, terr);
+    hf_solar_run_free(r);
+    return HFVIS_OK;
+}
+
+hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_input *in,
+                                     const hfvis_solar_options *opts, const hfvis_solar_output *out)
+{
+    hf_solar_run r;
+    hfvis_status st;
+    hfvis_sweep_options s;
+    float *map = NULL, *cellmap = NULL, *sky = NULL;
+    double *az = NULL;
+    int K, *kk = NULL;
+    double *kw = NULL;
+    size_t n, i, q;
+    if ((st = hf_solar_run_init(g, in, opts, out, &r)) != HFVIS_OK) return st;
+    n = hf_grid_count(g);
+    K = r.c.o.directions;
+    s = hf_solar_sweep(&r.c, HFVIS_RAYS_EXACT);
+    if (!r.c.o.no_shading || r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON) {
+        if (n > SIZE_MAX / sizeof(float) / (size_t)K) {
+            hf_solar_run_free(&r);
+            return HFVIS_ERR_LIMIT;
+        }
+        az = (double *)hfvis__alloc_array(r.al, (size_t)K, sizeof(double));
+        kk = (int *)hfvis__alloc_array(r.al, r.nsteps + 1, 2 * sizeof(int));
+        kw = (double *)hfvis__alloc_array(r.al, r.nsteps + 1, sizeof(double));
+        map = (float *)hfvis__alloc_array(r.al, n * (size_t)K, sizeof(float));
+        if (!az || !kk || !kw || !map) st = HFVIS_ERR_OUT_OF_MEMORY;
+        if (st == HFVIS_OK) st = hfvis_sweep_azimuths(K, &s, az, NULL);
+        if (st == HFVIS_OK) st = hfvis_horizon_map(g, K, &s, map);
+        if (st == HFVIS_OK && r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON) {
+            sky = (float *)hfvis__alloc_array(r.al, n, sizeof(float));
+            if (!sky) st = HFVIS_ERR_OUT_OF_MEMORY;
+            else st = hfvis_sky_light(g, K, 1.0f, 1.0f, &s, sky, g->width);
+        }
+        if (st == HFVIS_OK) { /* sample-major: each sample's K horizons side by side */
+            cellmap = (float *)hfvis__alloc_array(r.al, n * (size_t)K, sizeof(float));
+            if (!cellmap) st = HFVIS_ERR_OUT_OF_MEMORY;
+        }
+        if (st == HFVIS_OK) {
+            int k;
+            for (k = 0; k < K; k++)
+                for (i = 0; i < n; i++) cellmap[i * (size_t)K + (size_t)k] = map[(size_t)k * n + i];
+            for (q = 0; q < r.nsteps; q++)
+                hf_solar_bracket(az, K, r.steps[q].psi, kk + 2 * q, kk + 2 * q + 1, kw + q);
+        }
+        hfvis__free(r.al, map);
+        map = NULL;
+    }
+    if (st == HFVIS_OK) {
+        int horizon = r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON;
+        for (i = 0; i < n; i++) {
+            hf_solar_point *pt = r.pts + i;
+            const float *hz = cellmap ? cellmap + i * (size_t)K : NULL;
+            double acc[4] = { 0.0, 0.0, 0.0, 0.0 };
+            int band = r.nsteps ? r.steps[0].band : 0;
+            if (!isfinite(pt->p) || isnan(pt->nz)) continue;
+            if (sky) pt->sky_ratio = (double)sky[i] / pt->r_sky;
+            for (q = 0; q < r.nsteps; q++) {
+                const hf_solar_step *stp = r.steps + q;
+                double vis = 1.0;
+                if (stp->band != band) {
+                    double *a = r.acc + ((size_t)band * n + i) * 4;
+                    a[0] = acc[0]; a[1] = acc[1]; a[2] = acc[2]; a[3] = acc[3];
+                    acc[0] = acc[1] = acc[2] = acc[3] = 0.0;
+                    band = stp->band;
+                }
+                if (!r.c.o.no_shading) {
+                    double hor = (1.0 - kw[q]) * (double)hz[kk[2 * q]] + kw[q] * (double)hz[kk[2 * q + 1]];
+                    vis = hf_solar_visible(stp->elev, hor, r.c.o.sun_radius_rad);
+                }
+                hf_solar_point_step(stp, pt, vis, horizon, acc);
+            }
+            {
+                double *a = r.acc + ((size_t)band * n + i) * 4;
+                a[0] = acc[0]; a[1] = acc[1]; a[2] = acc[2]; a[3] = acc[3];
+            }
+        }
+    }
+    hfvis__free(r.al, az);
+    hfvis__free(r.al, kk);
+    hfvis__free(r.al, kw);
+    hfvis__free(r.al, cellmap);
+    hfvis__free(r.al, sky);
+    if (st != HFVIS_OK) {
+        hf_solar_run_free(&r);
+        return st;
+    }
+    return hf_solar_finish(g, &r, 0, out);
+}
+
+#define HF_SOLAR_REF_DENOM 1024 /* the oracle's ray toward the sun: within 0.002 deg of it */
+#define HF_SOLAR_REF_DIRS 4      /* the oracle integrates the visible sky over 4K directions */
+
+hfvis_status hfvis_solar_irradiation_reference(const hfvis_grid *g, const hfvis_solar_input *in,
+                                               const hfvis_solar_options *opts,
+                                               const hfvis_solar_output *out)
+{
+    hf_solar_run r;
+    hfvis_status st;
+    hfvis_sweep_options s;
+    float *hor = NULL;
+    double *az = NULL;
+    size_t n, i, q;
+    int KR;
+    if ((st = hf_solar_run_init(g, in, opts, out, &r)) != HFVIS_OK) return st;
+    n = hf_grid_count(g);
+    s = hf_solar_sweep(&r.c, HFVIS_RAYS_EXACT);
+    KR = HF_SOLAR_REF_DIRS * r.c.o.directions;
+    hor = (float *)hfvis__alloc_array(r.al, n * (size_t)HF_SOLAR_REF_DIRS, (size_t)r.c.o.directions * sizeof(float));
+    az = (double *)hfvis__alloc_array(r.al, (size_t)KR, sizeof(double));
+    if (!hor || !az) st = HFVIS_ERR_OUT_OF_MEMORY;
+    if (st == HFVIS_OK && r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON) {
+        /* the visible sky: [P1] Eq. 5 per sector over the exact horizons of 4K directions, each
+         * receiver's own rays (hfvis_horizon_exact_naive) along their actual azimuths */
+        int k;
+        st = hfvis_sweep_azimuths(KR, &s, az, NULL);
+        if (st == HFVIS_OK) st = hfvis_horizon_exact_naive(g, KR, &s, hor);
+        for (i = 0; i < n && st == HFVIS_OK; i++) {
+            hf_solar_point *pt = r.pts + i;
+            double v = 0.0;
+            for (k = 0; k < KR; k++) {
+                double a = pt->nx * cos(az[k]) + pt->ny * sin(az[k]);
+                double t = tan((double)hor[(size_t)k * n + i]), tc = -a / pt->nz;
+                if (isnan(t) || t < tc) t = tc;
+                v += hfvis_sector_weight(KR, pt->nz, a, HFVIS__HALF_PI - atan(t));
+            }
+            pt->sky_ratio = v / pt->r_sky;
+        }
+    }
+    s.ray_denominator = HF_SOLAR_REF_DENOM;
+    for (q = 0; q < r.nsteps && st == HFVIS_OK; q++) {
+        const hf_solar_step *stp = r.steps + q;
+        if (!r.c.o.no_shading) { /* each receiver's own exact ray toward the sun */
+            s.azimuth0_rad = stp->psi;
+            st = hfvis_horizon_exact_naive(g, 1, &s, hor);
+        }
+        for (i = 0; i < n && st == HFVIS_OK; i++) {
+            hf_solar_point *pt = r.pts + i;
+            double vis = r.c.o.no_shading ? 1.0 : hf_solar_visible(stp->elev, (double)hor[i], r.c.o.sun_radius_rad);
+            if (!isfinite(pt->p) || isnan(pt->nz) || isnan(vis)) continue;
+            hf_solar_point_step(stp, pt, vis, r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON,
+                                r.acc + ((size_t)stp->band * n + i) * 4);
+        }
+    }
+    hfvis__free(r.al, hor);
+    hfvis__free(r.al, az);
+    if (st != HFVIS_OK) {
+        hf_solar_run_free(&r);
+        return st;
+    }
+    return hf_solar_finish(g, &r, 1, out);
 }

@@ -35,6 +35,8 @@
  *                hfvis_sun_visibility, hfvis_env_light (oracle hfvis_light_reference);
  *                hfvis_intervisibility, hfvis_visibility_count, hfvis_indirect_light,
  *                hfvis_terrain_gi (oracles *_naive); hfvis_viewshed (hfvis_viewshed_reference);
+ *                solar radiation: hfvis_spa, hfvis_rsun_sun_position, hfvis_esra_clear_sky,
+ *                hfvis_solar_irradiation (oracle hfvis_solar_irradiation_reference);
  *                split runs: hfvis_direction_sums and the partial-sum file hfvis_partial_*;
  *                exact per-receiver rays (hfvis_sweep_options.rays, hfvis_sweep_azimuths;
  *                oracle hfvis_horizon_exact_naive); a search radius and tiles
@@ -129,7 +131,11 @@
  * Horizon values are elevation angles alpha in [-pi/2, pi/2] above the horizontal plane: the
  *   largest elevation under which the receiver sees terrain toward psi. A receiver that sees no
  *   terrain in that direction (open border) gets alpha = -pi/2. Internally the sweep keeps the
- *   tangent t = tan(alpha) in double.
+ *   tangent t = tan(alpha) in double. Which definition each mode computes: the lattice mode
+ *   keeps [P1] as published (the maximum over the nodes of the lattice lines, gathered; [P1]
+ *   §4-§7); exact rays (see "Exact rays") approach the supremum over t > 0 of
+ *   atan((h(p + t d) - h(p)) / t) over the bilinear surface along the ray, next to the receiver
+ *   included, and their oracle hfvis_horizon_exact_naive computes that supremum.
  * Borders. HFVIS_BORDER_OPEN (default, as in the papers): nothing exists outside the grid.
  *   HFVIS_BORDER_CLAMP: edge heights extend outward. HFVIS_BORDER_WRAP: the field is periodic
  *   with period width x height (tileable fields).
@@ -148,6 +154,17 @@
  *   overflows PTRDIFF_MAX, is HFVIS_ERR_INVALID_ARGUMENT like any other bad size. The library never
  *   prints, never exits, never aborts on input, and has no global mutable state: every
  *   function is reentrant and may run concurrently on different outputs.
+ * Threads. The library starts none. Inputs (grids, environments, tables, options, meshes) are
+ *   only read, so any number of calls may share them while no call writes them; an allocator
+ *   shared by concurrent calls must itself be thread-safe (give each thread its own). Outputs
+ *   must not overlap, with one exception: the bands of hfvis_sun_visibility (sweep options
+ *   part_index/part_count) write disjoint cells, so the part_count calls of one sun may write
+ *   one out concurrently. Splitting a run over threads without changing a bit: the sums by
+ *   direction range (hfvis_direction_sums: one quarter-turn group, or in exact mode one
+ *   direction, per part, added in order), the horizon map by plane range, one sun by bands,
+ *   and any receiver-local result by windows ("Search radius and tiles"). The hfvis tool's
+ *   --threads does exactly that; test/thread_test.c runs these calls concurrently on shared
+ *   inputs under ThreadSanitizer (make sanitize).
  * Memory. The caller owns every output and sizes it with the documented formula or a *_size()
  *   query. Scratch comes from the optional allocator in the options (NULL = malloc/free);
  *   test/test_args.c's allocator sweep lists every function that allocates and fails each of
@@ -368,8 +385,16 @@ HFVIS_API hfvis_write_options hfvis_write_options_default(void);
  * exceed 255 bytes, the component is cut so the name fits), which is then renamed onto path.
  * path is either complete or untouched; on failure the temporary file is removed. bytes may be
  * NULL when n is 0. A symbolic link at path is replaced by the file, not written through.
- * Returns HFVIS_OK, HFVIS_ERR_INVALID_ARGUMENT (NULL or empty path, NULL bytes with n > 0),
- * HFVIS_ERR_IO or HFVIS_ERR_OUT_OF_MEMORY (the name). */
+ * Returns HFVIS_OK only when path holds all n bytes; HFVIS_ERR_IO when the file cannot be
+ * created, or on any short fwrite (disk full, file-size limit), failed fflush or fclose (a
+ * delayed write error) or failed rename, each of which leaves path untouched and no temporary
+ * file; HFVIS_ERR_INVALID_ARGUMENT (NULL or empty path, NULL bytes with n > 0) or
+ * HFVIS_ERR_OUT_OF_MEMORY (the name). Every saver of the library (hfvis_pfm_save,
+ * hfvis_pgm_save, hfvis_pgm_range_save, hfvis_mesh_save, hfvis_binvox_save, ...) returns this
+ * status unchanged.
+ * Test hooks: the write path calls HFVIS_FWRITE, HFVIS_FFLUSH, HFVIS_FCLOSE and HFVIS_RENAME,
+ * which are fwrite, fflush, fclose and rename unless defined (same signatures) when the
+ * library's .c files are compiled; test/test_wfault.c fails each call of every writer in turn. */
 HFVIS_API hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
                                         const hfvis_write_options *opts);
 
@@ -383,7 +408,8 @@ HFVIS_API hfvis_status hfvis_write_file(const char *path, const void *bytes, siz
  * hfvis_write_begin returns HFVIS_OK, HFVIS_ERR_INVALID_ARGUMENT (a NULL or empty path, NULL
  * file or temp_path), HFVIS_ERR_IO or HFVIS_ERR_OUT_OF_MEMORY (the name), and sets *file and
  * *temp_path to NULL on failure. hfvis_write_end returns HFVIS_OK when path holds the new file
- * (or, with commit 0, when the file was discarded), HFVIS_ERR_IO when it could not be written,
+ * (or, with commit 0, when the file was discarded), HFVIS_ERR_IO when it could not be written
+ * (a write error seen by ferror, a failed fflush, fclose or rename: path is untouched),
  * HFVIS_ERR_INVALID_ARGUMENT for a NULL file, temp_path or path (it still releases the others).
  * Declared only where <stdio.h> is available (not with HFVIS_NO_STDIO). */
 #ifndef HFVIS_NO_STDIO
@@ -573,7 +599,9 @@ typedef struct hfvis_sweep_options {
     hfvis_direction_order direction_order; /* how direction_begin/end count; default INDEX */
     hfvis_ray_mode rays;            /* default HFVIS_RAYS_LATTICE; EXACT: see "Exact rays" */
     int ray_denominator;            /* EXACT: bound N on the direction's integer components,
-                                       1..HFVIS_RAY_DENOMINATOR_MAX; 0 = max(5, ceil(K/4)), and 64
+                                       1..HFVIS_RAY_DENOMINATOR_MAX (the nearest direction);
+                                       0 = the default rule of "Exact rays": max(5, ceil(K/4)),
+                                       the cheapest within 0.25 deg for 32 < K <= 360, and 64
                                        for a single direction (K = 1, hfvis_sun_visibility) */
     double max_distance;            /* R, world units: occluders farther than R from the receiver,
                                        measured horizontally along the ray, are ignored; 0 =
@@ -591,6 +619,17 @@ typedef struct hfvis_sweep_options {
                                        (inside it, else HFVIS_ERR_INVALID_ARGUMENT); */
     int receiver_width, receiver_height; /* 0, 0 = every receiver (default); outputs outside it
                                        are left unwritten; the work shrinks with it */
+    int part_index, part_count;     /* hfvis_sun_visibility only (both ray modes): compute only the
+                                       receivers of band part_index of part_count bands across the
+                                       sun's direction (each receiver belongs to the band of its
+                                       distance across the sweep lines), so that threads can share
+                                       one call's lines: every receiver is in exactly one band, its
+                                       output equals the whole call's bit for bit, cells of the
+                                       other bands are left unwritten (the calls may then write one
+                                       out concurrently, see "Threads"). 0, 0 = every receiver
+                                       (default); else 0 <= part_index < part_count <= 65536
+                                       (HFVIS_ERR_INVALID_ARGUMENT otherwise, and from every other
+                                       routine for part_count > 1) */
 } hfvis_sweep_options;
 
 HFVIS_API hfvis_sweep_options hfvis_sweep_options_default(void);
@@ -696,7 +735,10 @@ HFVIS_API hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user
  * beta = -pi/2 (use HFVIS_BORDER_CLAMP to extend the edges). NaN at holes. */
 typedef struct hfvis_openness_options {
     double radius;      /* search distance in world units, >= 0; 0 = unlimited */
-    int negative;       /* 0: positive openness; 1: negative */
+    int negative;       /* 0: positive openness; 1: negative; 2: both, positive in out's first
+                           height rows and negative in the next height rows (out must hold
+                           2*height rows of out_stride); each plane equals its own run's bit
+                           for bit, and with radius > 0 one march serves both signs */
     double step_cells;  /* radius > 0: march step in cells, >= 0; 0 = 1 */
 } hfvis_openness_options;
 
@@ -704,18 +746,23 @@ typedef struct hfvis_openness_options {
 HFVIS_API hfvis_openness_options hfvis_openness_options_default(void);
 
 /* Openness at every grid point, out[y*out_stride + x]. opts: border, border_cells, azimuth0_rad,
- * alloc and progress; the direction range is not honoured (all K).
+ * alloc and progress, and with radius > 0 the receiver rectangle (its cells only are written, each
+ * equal to the whole call's bit for bit: threads split one call by row bands); the direction
+ * range is not honoured (all K); a search radius (max_distance), a window, or a rectangle
+ * without a radius is HFVIS_ERR_INVALID_ARGUMENT.
  * radius > 0: the per-receiver march of hfvis_horizon_reference out to the radius, at step_cells
  *   (so the same bilinear samples as the oracle with max_distance_cells = radius/cell_size),
- *   O(K*W*H*radius/(cell_size*step_cells)); no allocation; progress once per row.
+ *   O(K*W*H*radius/(cell_size*step_cells)); no allocation; progress once per row. Both signs
+ *   (negative = 2) walk each ray once.
  * radius = 0: the exact sweep, hfvis_horizon_direction per direction, O(K*W*H); allocates
  *   W*H floats and W*H doubles (and W*H floats for negative) plus each sweep's scratch;
- *   progress once per direction. Both ways each angle is rounded to float (as the horizon
+ *   progress once per direction (both signs: the positive run, then the negative one, each
+ *   counting its K directions). Both ways each angle is rounded to float (as the horizon
  *   outputs hold it) and the K of a sample are summed in double, so with axis directions
  *   (K = 4, azimuth0 0) the sweep equals the march with a radius beyond the grid bit for bit;
  *   otherwise they differ by the gather tolerance of hfvis_horizon_direction.
  * Returns HFVIS_ERR_INVALID_ARGUMENT (bad grid, options, K < 1, out NULL, out_stride < width,
- * negative or non-finite radius or step, negative not 0/1), HFVIS_ERR_OUT_OF_MEMORY or
+ * negative or non-finite radius or step, negative not 0, 1 or 2), HFVIS_ERR_OUT_OF_MEMORY or
  * HFVIS_ERR_LIMIT (the sweep's). */
 HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_options *oo,
                                       const hfvis_sweep_options *opts, float *out,
@@ -740,22 +787,41 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     brings the bulge below 1/64 cell of height (power-of-two spacing keeps every distance
  *     exact in double). Pieces outside the grid or touching a hole are not split.
  *   - Each line is swept from its far end with the hull stack of [P1] §5 (Alg. 1) over all its
- *     samples; each grid point reads the hull's tangent at its turn. The result is, bit for bit,
- *     the maximum elevation over every sample of the receiver's own ray (hfvis_horizon_exact_naive
- *     is that maximum computed receiver by receiver). Along an axis the crossings are the grid
- *     points only (the surface is linear along a grid line).
- *   - Rule: direction k is the representable direction nearest to psi_k = azimuth0 + 2 pi k/K
- *     (ties: the smaller |a| + |b|). hfvis_sweep_azimuths returns the K azimuths actually used
- *     and their quadrature weights. The default N = max(5, ceil(K/4)) (64 for K = 1). Largest
- *     deviation from psi_k with the default N and azimuth0 = 0: K = 4, 8: 0; K = 16, 32: 0.70
- *     deg; K = 64: 0.18; K = 128: 0.09; K = 256: 0.15; K = 7: 1.18 (K = 1, N = 64: <= 0.45).
+ *     samples; each grid point reads the hull's tangent at its turn: the maximum elevation over
+ *     every sample of its own ray. Along an axis the crossings are the grid points only (the
+ *     surface is linear along a grid line).
+ *   - Near field: next to the receiver the supremum is often no sample at all but the limit
+ *     t -> 0+ (a receiver on a convex edge looking down: the slope of the cell the ray leaves
+ *     by, at its corner, toward psi). Each receiver also takes that limit, (dz/dx |a| +
+ *     dz/dy |b|) / (|(a, b)| cell) from the corner's two edge differences, and under a search
+ *     radius the surface point exactly at the window's end (between two samples).
+ *   - Definition and bound (HFVIS_EXACT_SUP_*_DEG): hfvis_horizon_exact_naive computes, receiver
+ *     by receiver, the supremum over t > 0 of the elevation along the ray over the bilinear
+ *     surface (within R under a radius): every crossing, every piece's stationary points in
+ *     closed form, the t -> 0+ limit and the window's end. The sweep is never above it (every
+ *     sample lies on the surface) and below it only where a piece's tangent point falls between
+ *     its samples (pieces beyond the first are sampled, not maximized): on urban boxes, terraces
+ *     with one-cell cliffs and fBm, all pairs, negative horizons and the near field included,
+ *     mean <= 0.005 deg and p99 <= 0.15 deg measured; the stated bound, held by test_exact.c
+ *     on hold-out fields, is HFVIS_EXACT_SUP_MEAN_DEG / HFVIS_EXACT_SUP_P99_DEG (docs/exact-rays.md).
+ *   - Rule: with opts->ray_denominator = N > 0, direction k is the representable direction
+ *     nearest to psi_k = azimuth0 + 2 pi k/K (ties: the smaller |a| + |b|). The default (0):
+ *     K = 1: N = 64; K <= 32 and K > 360: N = max(5, ceil(K/4)), nearest; 32 < K <= 360: the
+ *     cheapest direction (smallest |a| + |b|, ties: the nearer; max(|a|, |b|) <= 256) within
+ *     0.25 deg of psi_k, a quarter sector or less, so the azimuths keep their order.
+ *     hfvis_sweep_azimuths returns the K azimuths actually used and their quadrature weights.
+ *     Largest deviation from psi_k with the default and azimuth0 = 0: K = 4, 8: 0; K = 16, 32:
+ *     0.70 deg; K = 64: 0.18; K = 128: 0.20; K = 256: 0.23; K = 360: 0.245; K = 7: 1.18
+ *     (K = 1: <= 0.45).
  *   - Cost: a direction costs |a| + |b| - 1 crossings per receiver (1 on the axes and diagonals)
- *     where the lattice costs about one node, so a larger N buys smaller deviations with longer
- *     sweeps: K = 16 with the default N = 5 takes directions (1,0), (5,2), (1,1), (2,5): 3.5
- *     crossings per receiver-direction on average, plus the interior samples below. Measured
- *     (make bench, section exact, 512^2 and 1024^2, K = 16): the horizon map 0.65-0.85x the
- *     lattice map's time on urban DSMs (no gather), 1.2-2.3x on fBm rough at the cell scale;
- *     the fused sky-view factor 1.2-2.1x and 2.1-4.1x.
+ *     where the lattice costs about one node, so closer directions cost longer sweeps: K = 16
+ *     takes directions (1,0), (5,2), (1,1), (2,5): 3.5 crossings per receiver-direction on
+ *     average, plus the interior samples below. The mean |a| + |b| of the default directions:
+ *     K = 16: 4.2, K = 64: 11.7, K = 256: 15.5, K = 360: 20.5 (the nearest with N = ceil(K/4)
+ *     would take 12.1, 51.5, 73). Measured (make bench, section exact, 512^2 and 1024^2,
+ *     K = 16): the horizon map 0.65-0.85x the lattice map's time on urban DSMs (no gather),
+ *     1.2-2.3x on fBm rough at the cell scale; the fused sky-view factor 1.2-2.1x and 2.1-4.1x;
+ *     at K = 64-360 on fBm 512^2 about 10-20x (docs/exact-rays.md, "Cost at large K").
  *   - Quadrature: every direction integral uses the actual azimuths phi_k. Direction k owns the
  *     sector between the midpoints to its neighbours (edges rounded to multiples of 2^-40 turn,
  *     so the shares w_k are exact and add up to exactly 1): the sky-view factor is
@@ -776,9 +842,9 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *   - Outputs are written at grid points directly (no gather). Scratch: one block of about
  *     8*width*height bytes (plus 12 for normals and 8*channels for the lighting sums) and the
  *     hull stack, 16*(16*(W + H + 2) + 4*border_cells) bytes.
- *   - Accuracy: against the exact maximum over the bilinear surface (occluders >= 1 cell away)
- *     the exact mode is within 0.004 deg mean and 0.08 deg p99 on urban boxes, terraces with
- *     one-cell cliffs and fBm (the lattice: 1-5 deg mean, 11-35 deg p99); docs/exact-rays.md. */
+ *   - Accuracy: against the supremum over the bilinear surface (every pair) the exact mode is
+ *     within 0.003 deg mean and 0.08 deg p99 on urban boxes, terraces with one-cell cliffs and
+ *     fBm (the lattice: 2-6 deg mean, 23-70 deg p99); docs/exact-rays.md. */
 
 /* ========================================================================================== */
 /* hfvis.c - search radius and tiles                                                          */
@@ -794,7 +860,8 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     at most floor(R / cell_size) node steps behind it (the lattice spacing is one cell); the
  *     receiver's value is the usual gather of its nodes (docs/errata.md E7), so its own cut-off
  *     is R blended over the nodes within 1.5 cells. R below one cell: the lattice sees nothing
- *     (-pi/2 everywhere but holes), exact rays still see the crossings nearer than R. R beyond
+ *     (-pi/2 everywhere but holes), exact rays still see the crossings nearer than R, the first
+ *     cell's t -> 0+ limit and the point at R ("Exact rays", near field). R beyond
  *     the field equals the unlimited run to the hull's rounding. With CLAMP/WRAP the border
  *     samples count like any other within R.
  *   - How ([P1] §5, Alg. 1 needs more: its hull answers "the highest over everything behind").
@@ -852,9 +919,10 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     stop their outward walk at R; they agree with the tree with R as they do without it
  *     (test/test_hfvis.c, p2t_radius_*).
  *   - Oracles, same cut-off: hfvis_horizon_lattice_naive (every node scans the nodes within R
- *     behind it) and hfvis_horizon_exact_naive (every receiver's own samples within R), held to
- *     the sweep bit for bit on the test fields (tolerance 1e-12 rad for last-bit ties of the
- *     hull's cross products); hfvis_horizon_reference marches out to min(R, max_distance_cells).
+ *     behind it), held to the sweep bit for bit on the test fields (tolerance 1e-12 rad for
+ *     last-bit ties of the hull's cross products), and hfvis_horizon_exact_naive (the supremum
+ *     within R: the sweep never above it, within HFVIS_EXACT_SUP_MEAN_DEG on average);
+ *     hfvis_horizon_reference marches out to min(R, max_distance_cells).
  *     The oracles compute every receiver (the rectangle and origin do not change their values).
  *   - Design notes and figures: docs/search-radius.md. */
 
@@ -868,10 +936,19 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
 HFVIS_API hfvis_status hfvis_sweep_azimuths(int K, const hfvis_sweep_options *opts,
                                             double *azimuths, double *weights);
 
-/* Oracle for the exact mode: for every grid point and direction, the maximum elevation over every
- * sample of its own ray (grid-line crossings and the interior samples of bulging pieces; the same
- * heights and quotients as the sweep), receiver by receiver. Always exact rays, whatever opts->rays says; otherwise the layout, range, border and
- * hole rules of hfvis_horizon_map. Equal to hfvis_horizon_map in exact mode bit for bit.
+/* The exact mode's horizons below the supremum of hfvis_horizon_exact_naive, over all receivers
+ * and directions of a field ("Exact rays", "Definition and bound"): mean and 99th percentile. */
+#define HFVIS_EXACT_SUP_MEAN_DEG 0.15
+#define HFVIS_EXACT_SUP_P99_DEG 1.5
+
+/* Oracle for the exact mode: for every grid point and direction, the supremum over t > 0 of the
+ * elevation along its own ray over the bilinear surface (within R under a radius), receiver by
+ * receiver: every grid-line crossing (the sweep's heights), every piece's stationary points in
+ * closed form, the first piece's t -> 0+ limit and the window's end ("Exact rays"). Pieces count
+ * where their cell is in reach (CLAMP/WRAP: border_cells beyond the grid) with four finite taps.
+ * Always exact rays, whatever opts->rays says; otherwise the layout, range, border and hole rules
+ * of hfvis_horizon_map. hfvis_horizon_map in exact mode is never above it and within the bound
+ * stated in "Exact rays".
  * Allocates 1 block (2N crossings). Cost O(K*width*height*(max(W, H) + border_cells)). */
 HFVIS_API hfvis_status hfvis_horizon_exact_naive(const hfvis_grid *grid, int K,
                                                  const hfvis_sweep_options *opts, float *out);
@@ -1211,6 +1288,230 @@ typedef struct hfvis_sun {
 HFVIS_API hfvis_status hfvis_direct_light(const hfvis_grid *grid, int K, const hfvis_sun *sun,
                                           float sky, const hfvis_env *env, int channels,
                                           const hfvis_sweep_options *opts, float *out);
+
+/* ========================================================================================== */
+/* hfvis.c - solar radiation (NREL SPA; r.sun's ESRA clear sky over exact horizons)           */
+/* ========================================================================================== */
+/* Sun position, clear-sky irradiance and its time integral over a height field, shaded by the
+ * exact-ray horizons (hfvis.h "Exact rays"). The atmosphere is the one GRASS r.sun computes
+ * (Suri & Hofierka 2004, "A New GIS-based Solar Radiation Model", Transactions in GIS 8(2); the
+ * ESRA model, Rigollier, Bauer & Wald 2000, Solar Energy 68(1)), so r.sun's numbers can be
+ * reproduced; the sun comes from NREL's Solar Position Algorithm (Reda & Andreas 2004, Solar
+ * Energy 76(5), revised 2008, NREL/TP-560-34302; +-0.0003 deg from -2000 to 6000) or from
+ * r.sun's own declination and solar time. docs/solar.md has the equations, the errata and the
+ * measured accuracy and speed. Units: W/m^2 for an instant, Wh/m^2 for a period, hours for
+ * sunshine duration; angles in radians like the rest of the API. */
+
+/* Input of hfvis_spa: one instant (UTC calendar date and time) at one place. */
+typedef struct hfvis_spa_input {
+    int year, month, day;     /* Gregorian from 1582-10-15, Julian before; year -2000..6000 */
+    int hour, minute;         /* UTC, 0..24 (24:00:00 = next day's 00:00), 0..59 */
+    double second;            /* [0, 60] */
+    double delta_ut1;         /* UT1 - UTC in seconds, (-1, 1) (IERS bulletins; 0 is fine) */
+    double delta_t;           /* TT - UT1 in seconds, |delta_t| <= 8000 (about 69 s in 2020-2030) */
+    double latitude_rad;      /* geodetic, [-pi/2, pi/2] */
+    double longitude_rad;     /* east positive, [-pi, pi] */
+    double elevation_m;       /* above the ellipsoid, >= -6500000 */
+    double pressure_mbar;     /* refraction only: annual mean local pressure, (0, 5000] */
+    double temperature_c;     /* refraction only: annual mean temperature, (-273, 6000] */
+    double atmos_refract_rad; /* refraction only: the refraction at sunrise and sunset (SPA's
+                                 0.5667 deg); the correction applies while the true elevation
+                                 is >= -(sun radius 0.26667 deg + this), [0, 0.1] */
+    int refraction;           /* 1: apparent (refracted) elevation, SPA Eq. 41-43; 0: true */
+} hfvis_spa_input;
+
+/* hfvis_spa's results: the intermediate values of the paper's example table, then the answer.
+ * Angles in radians; longitudes and right ascensions in [0, 2 pi). */
+typedef struct hfvis_spa_result {
+    double jd, jde;              /* Julian day (UT) and Julian ephemeris day */
+    double helio_longitude;      /* L, Earth heliocentric (SPA Eq. 9-10) */
+    double helio_latitude;       /* B */
+    double radius_au;            /* R, Earth-Sun distance in AU */
+    double nutation_longitude;   /* delta psi (Eq. 22) */
+    double nutation_obliquity;   /* delta epsilon (Eq. 23) */
+    double obliquity;            /* epsilon, true obliquity of the ecliptic (Eq. 25) */
+    double apparent_longitude;   /* lambda, apparent sun longitude (Eq. 27) */
+    double sidereal_time;        /* nu, apparent sidereal time at Greenwich (Eq. 29) */
+    double right_ascension;      /* alpha, geocentric (Eq. 30) */
+    double declination;          /* delta, geocentric (Eq. 31) */
+    double hour_angle;           /* H, observer local (Eq. 32) */
+    double topo_declination;     /* delta', topocentric (Eq. 38) */
+    double topo_hour_angle;      /* H', topocentric (Eq. 39) */
+    double elevation;            /* e, topocentric; refracted when in->refraction (Eq. 43) */
+    double zenith;               /* theta = pi/2 - e (Eq. 44) */
+    double azimuth;              /* Phi, from north toward east (Eq. 46); the hfvis look
+                                    azimuth of the sun is Phi - pi/2 */
+} hfvis_spa_result;
+
+/* NREL's Solar Position Algorithm (Reda & Andreas 2004/2008): the tables of periodic terms of
+ * VSOP87 (Table A4.2) and the nutation series (Table A4.3), aberration, topocentric parallax and
+ * optionally the refraction correction. Accuracy +-0.0003 deg (the paper); test/test_solar.c
+ * holds it to the paper's example (Table A5.1) within 1e-6 deg and to an independent
+ * low-precision algorithm (Meeus 1998 ch. 25, +-0.01 deg) over a grid of instants and places.
+ * Returns HFVIS_ERR_INVALID_ARGUMENT for NULL or a field out of its range (a date that does not
+ * exist: February 30, month 13, ...). No allocation; about 250 sines and cosines. */
+HFVIS_API hfvis_status hfvis_spa(const hfvis_spa_input *in, hfvis_spa_result *out);
+
+/* r.sun's solar geometry, for reproducing r.sun: the declination of day of year `day`
+ * (1..366) delta = asin(0.3978 sin(d - 1.4 + 0.0355 sin(d - 0.0489))), d = 2 pi day / 365.25
+ * (r.sun's com_declin, sign flipped back to the usual convention), the hour angle
+ * omega = (solar_hour - 12) * pi/12 of local solar time, the true elevation and the azimuth Phi
+ * (from north toward east) at latitude_rad, the day's sunrise and sunset in solar hours
+ * (0 and 24 under the midnight sun, 12 and 12 in the polar night) and r.sun's extraterrestrial
+ * irradiance 1367 (1 + 0.03344 cos(d - 0.048869)) W/m^2. Returns HFVIS_ERR_INVALID_ARGUMENT for
+ * NULL, a day outside 1..366, a non-finite hour or a latitude outside [-pi/2, pi/2]. */
+typedef struct hfvis_rsun_sun {
+    double declination, hour_angle, elevation, azimuth;
+    double sunrise_hour, sunset_hour;
+    double extraterrestrial;     /* W/m^2 on a surface facing the sun, top of the atmosphere */
+} hfvis_rsun_sun;
+HFVIS_API hfvis_status hfvis_rsun_sun_position(int day, double solar_hour, double latitude_rad,
+                                               hfvis_rsun_sun *out);
+
+/* The ESRA clear sky as r.sun computes it, for a sun of true elevation elevation_rad > 0 over a
+ * point height_m above sea level, Linke turbidity linke in (0, 10] and extraterrestrial normal
+ * irradiance g0 (W/m^2): out[0] = beam normal irradiance, out[1] = beam on the horizontal,
+ * out[2] = diffuse on the horizontal (W/m^2). Relative optical air mass: Kasten & Young 1989
+ * with ESRA's refraction of the elevation and the elevation correction exp(-height/8434.5);
+ * Rayleigh optical thickness (Kasten 1996 as ESRA fits it); diffuse transmission and angular
+ * function of ESRA (Rigollier et al. 2000, Eq. 10-14). Elevation <= 0 gives 0, 0, 0.
+ * HFVIS_ERR_INVALID_ARGUMENT for NULL or a non-finite or out-of-range argument. */
+HFVIS_API hfvis_status hfvis_esra_clear_sky(double g0, double elevation_rad, double height_m,
+                                            double linke, double out[3]);
+
+/* Which sun: 0 is the default (SPA). */
+typedef enum hfvis_sun_model {
+    HFVIS_SUN_MODEL_DEFAULT = 0, /* = SPA */
+    HFVIS_SUN_SPA = 1,           /* hfvis_spa at civil times UTC + utc_offset_hours; the
+                                    extraterrestrial irradiance is 1367/R^2 */
+    HFVIS_SUN_RSUN = 2           /* hfvis_rsun_sun_position: times are local solar time, the
+                                    days are days of the year, and each day is stepped as
+                                    r.sun steps it (the first step half a step or one and a half
+                                    after sunrise, then every step while before sunset) */
+} hfvis_sun_model;
+
+/* The sky diffuse term on a receiver. 0 is the default (r.sun's). */
+typedef enum hfvis_solar_diffuse {
+    HFVIS_SOLAR_DIFFUSE_DEFAULT = 0,
+    HFVIS_SOLAR_DIFFUSE_RSUN = 0,    /* Muneer's model on the local slope only, as r.sun */
+    HFVIS_SOLAR_DIFFUSE_HORIZON = 1  /* beyond r.sun: the isotropic part of Muneer's model over
+                                        the sky the receiver actually sees (scaled by V/r_sky,
+                                        V the cosine-weighted visible sky of the exact horizon,
+                                        hfvis_sky_light with sky 1, r_sky = (1 + cos slope)/2),
+                                        the circumsolar part shaded with the beam */
+} hfvis_solar_diffuse;
+
+/* The ground-reflected term. 0 is the default (r.sun's). */
+typedef enum hfvis_solar_reflected {
+    HFVIS_SOLAR_REFLECTED_DEFAULT = 0,
+    HFVIS_SOLAR_REFLECTED_RSUN = 0,   /* albedo * (beam + diffuse on the horizontal) *
+                                         (1 - cos slope)/2: an infinite flat ground */
+    HFVIS_SOLAR_REFLECTED_TERRAIN = 1 /* beyond r.sun: the light reflected by the terrain the
+                                         receiver actually sees ([P2] hfvis_indirect_light of
+                                         exit irradiance albedo * (beam + diffuse) of each
+                                         sample, lattice mode, reflected_directions directions);
+                                         one bounce */
+} hfvis_solar_reflected;
+
+/* Bands of the outputs. 0 is the default (one band: the whole period). */
+typedef enum hfvis_solar_bands {
+    HFVIS_SOLAR_BANDS_DEFAULT = 0,
+    HFVIS_SOLAR_BANDS_TOTAL = 0,  /* one band */
+    HFVIS_SOLAR_BANDS_DAY = 1,    /* one band per day of the period */
+    HFVIS_SOLAR_BANDS_MONTH = 2   /* one band per calendar month the period touches */
+} hfvis_solar_bands;
+
+/* What to compute: the site, the period and the surface. hfvis_solar_input_default() fills in
+ * linke 3, albedo 0.2, days 1, 2026-06-21; latitude and longitude are the caller's to set. */
+typedef struct hfvis_solar_input {
+    double latitude_rad;      /* the sun is computed at this one place for the whole grid */
+    double longitude_rad;     /* (east positive); SPA needs it, RSUN ignores it */
+    double height_m;          /* SPA's observer height; the air mass uses each sample's z */
+    int year, month, day;     /* first day; RSUN steps day of the year from it */
+    int days;                 /* >= 1 days from the first (ignored for an instant) */
+    int instant;              /* 1: one instant at `hour` of the first day: W/m^2 outputs */
+    double hour;              /* instant: [0, 24], UTC + utc_offset_hours (solar time in RSUN) */
+    double utc_offset_hours;  /* SPA: the days and the instant are local civil time UTC +
+                                 this, [-14, 14] */
+    double linke;             /* Linke turbidity (0, 10] */
+    double albedo;            /* ground albedo [0, 1] */
+} hfvis_solar_input;
+
+HFVIS_API hfvis_solar_input hfvis_solar_input_default(void);
+
+/* Options of hfvis_solar_irradiation; NULL or zero = the defaults. */
+typedef struct hfvis_solar_options {
+    hfvis_sun_model model;       /* default SPA */
+    double step_hours;           /* integration step, (0, 24]; 0 = 0.25 (15 minutes) */
+    int directions;              /* K of the exact horizon map read per time step; 0 = 64 */
+    int no_shading;              /* 1: no terrain shading (r.sun without -s) */
+    double sun_radius_rad;       /* 0: hard shadows (the sun's centre); > 0: the visible fraction
+                                    of a disc of this angular radius (hfvis_sun_visibility's
+                                    formula) scales the beam and the circumsolar diffuse */
+    int refraction;              /* SPA: 1 = apparent sun direction for shading and incidence */
+    double delta_t;              /* SPA: TT - UT1 in s; 0 = 69 */
+    const float *linke_monthly;  /* 12 values (January first) replacing input->linke, or NULL */
+    const float *linke_map;      /* per sample [y*width + x], replacing both, or NULL */
+    const float *albedo_map;     /* per sample, replacing input->albedo, or NULL */
+    const float *coeff_bh;       /* r.sun's real-sky beam coefficient per sample, or NULL (1) */
+    const float *coeff_dh;       /* r.sun's real-sky diffuse coefficient per sample, or NULL (1) */
+    hfvis_solar_diffuse diffuse;
+    hfvis_solar_reflected reflected;
+    int reflected_directions;    /* TERRAIN: K of the [P2] gather; 0 = 16 */
+    hfvis_solar_bands bands;
+    const hfvis_sweep_options *sweep; /* border, search radius, allocator, progress; its rays
+                                    field is ignored (the horizon map is always exact rays) and
+                                    its window and rectangle must be unset */
+} hfvis_solar_options;
+
+HFVIS_API hfvis_solar_options hfvis_solar_options_default(void);
+
+/* The outputs: each NULL or bands*width*height floats, band b at [b*width*height + y*width + x]:
+ * beam, diffuse and reflected on the receiver's own surface (normal from the grid, hfvis.h
+ * "Grids"), their sum, and the hours of direct sun (beam > 0; weighted by the visible disc
+ * fraction). NaN at holes. At least one must be set. */
+typedef struct hfvis_solar_output {
+    float *beam, *diffuse, *reflected, *global, *sun_hours;
+} hfvis_solar_output;
+
+/* The number of bands the outputs hold for this input and options (1, days, or the months
+ * touched), or -1 for an invalid input. */
+HFVIS_API int hfvis_solar_band_count(const hfvis_solar_input *input,
+                                     const hfvis_solar_options *opts);
+
+/* Irradiance (input->instant) or irradiation over a period on every grid point. Per time step:
+ * the sun at the site; the beam is shaded by the exact horizon toward the sun, read from one
+ * exact-ray horizon map of K directions made once (hfvis_horizon_map, HFVIS_RAYS_EXACT) and
+ * interpolated linearly in azimuth between its two nearest directions; then r.sun's ESRA
+ * atmosphere per sample (its height for the air mass, its Linke factor, albedo and
+ * coefficients). Steps (SPA): the day's civil hours cut at step_hours, each evaluated at its
+ * middle; the step holding sunrise or sunset is evaluated at the middle of its sunlit part
+ * (found by bisection of the true elevation) and weighted by that part's length. RSUN: r.sun's
+ * steps. The sun counts while its true elevation is above 0.
+ * Memory: K*4 bytes per sample for the map (K = 64: 256 bytes), 20 bytes per sample of state,
+ * plus the outputs; HORIZON adds 4 bytes per sample, TERRAIN the [P2] sweep's scratch.
+ * Cost: the map (hfvis.h "Exact rays") plus O(steps*width*height).
+ * Accuracy against hfvis_solar_irradiation_reference: docs/solar.md and test/test_solar.c.
+ * Returns HFVIS_ERR_INVALID_ARGUMENT (NULL, no output, bad input or option: a date that does
+ * not exist, linke outside (0, 10], albedo outside [0, 1], a latitude outside [-pi/2, pi/2]),
+ * HFVIS_ERR_OUT_OF_MEMORY or HFVIS_ERR_LIMIT (sizes). Polar night gives 0 (not an error). */
+HFVIS_API hfvis_status hfvis_solar_irradiation(const hfvis_grid *grid,
+                                               const hfvis_solar_input *input,
+                                               const hfvis_solar_options *opts,
+                                               const hfvis_solar_output *out);
+
+/* Oracle: the same steps and the same atmosphere per step and grid point, with the horizon
+ * toward the sun's own azimuth from first principles at every step: each receiver's own exact
+ * ray (hfvis_horizon_exact_naive, K = 1, ray_denominator 1024: within 0.002 deg of the sun's
+ * azimuth); the visible sky of HORIZON integrated over 4K directions of the same rays ([P1]
+ * Eq. 5 per sector); TERRAIN gathered by hfvis_indirect_light_naive; summed naively in double.
+ * (The bilinear ray march hfvis_horizon_reference is not used: its samples within the first
+ * cell measure the bilinear patch's own directional slope, which the solar model counts as the
+ * receiver's incidence angle instead; docs/solar.md.) Cost O(steps*width*height*max(W, H)). */
+HFVIS_API hfvis_status hfvis_solar_irradiation_reference(const hfvis_grid *grid,
+                                                         const hfvis_solar_input *input,
+                                                         const hfvis_solar_options *opts,
+                                                         const hfvis_solar_output *out);
 
 /* ========================================================================================== */
 /* hfvis.c - viewshed of one observer (Franklin & Ray 1994, R2)                               */

@@ -120,6 +120,14 @@
     X(indirect_light_naive, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(terrain_gi, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(direct_light, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
+    X(spa, S, -, "NGFR", "INVALID_ARGUMENT") \
+    X(rsun_sun_position, S, -, "NZGFR", "INVALID_ARGUMENT") \
+    X(esra_clear_sky, S, -, "NGFR", "INVALID_ARGUMENT") \
+    X(solar_input_default, P, -, "", "cannot fail") \
+    X(solar_options_default, P, -, "", "cannot fail") \
+    X(solar_band_count, V, -, "NZE", "-1") \
+    X(solar_irradiation, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
+    X(solar_irradiation_reference, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(viewshed_options_default, P, -, "", "cannot fail") \
     X(viewshed, S, -, "NZGOFSR", "INVALID_ARGUMENT") \
     X(viewshed_reference, S, -, "NZGOFSR", "INVALID_ARGUMENT") \
@@ -609,6 +617,11 @@ static void teardown(void)
     bo = hfvis_sweep_options_default(); bo.extent_width = 5; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.receiver_width = -1; bo.receiver_height = 1; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.receiver_height = 1; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.part_count = -1; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.part_index = 1; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.part_index = 2; bo.part_count = 2; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.part_index = -1; bo.part_count = 2; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.part_count = 65537; BAD('S', INV, expr); \
     } while (0)
 
 /* The P2 hull-tree routines honour a search radius but refuse a window (a proper one: finite
@@ -1257,6 +1270,9 @@ static void args_openness(void)
     oo.radius = 2.0;
     oo.negative = 1;
     OK(hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
+    oo.negative = 2; /* both: two planes */
+    OK(hfvis_openness(&g_ok, 4, &oo, NULL, AF(2 * GW * GH), GW));
+    oo.negative = 1;
     BAD('N', INV, hfvis_openness(NULL, 4, NULL, NULL, out, GW));
     BAD('N', INV, hfvis_openness(&g_ok, 4, NULL, NULL, NULL, GW));
     BAD('Z', INV, hfvis_openness(&g_ok, 0, NULL, NULL, out, GW));
@@ -1268,9 +1284,24 @@ static void args_openness(void)
     oo.radius = (double)INFINITY; BAD('F', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
     oo.radius = 1.0; oo.step_cells = -1.0; BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
     oo.step_cells = (double)NAN; BAD('F', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
-    oo.step_cells = 0.0; oo.negative = 2; BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
+    oo.step_cells = 0.0; oo.negative = 3; BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
+    oo.negative = -1; BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
     GRID_CASES(hfvis_openness(&bg, 4, NULL, NULL, out, GW));
     SWEEP_OPT_CASES(hfvis_openness(&g_ok, 4, NULL, &bo, out, GW));
+    { /* a receiver rectangle with a radius; not without one, nor a search radius or a window */
+        hfvis_sweep_options ro = hfvis_sweep_options_default();
+        ro.receiver_x = ro.receiver_y = 1;
+        ro.receiver_width = ro.receiver_height = 2;
+        oo.negative = 0;
+        oo.radius = 2.0;
+        OK(hfvis_openness(&g_ok, 4, &oo, &ro, out, GW));
+        oo.radius = 0.0;
+        BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, &ro, out, GW));
+        ro = hfvis_sweep_options_default();
+        ro.max_distance = 2.0;
+        oo.radius = 2.0;
+        BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, &ro, out, GW));
+    }
 }
 
 static void args_sweep_azimuths(void)
@@ -1396,6 +1427,22 @@ static void args_sun_visibility(void)
     BAD('O', INV, hfvis_sun_visibility(&g_ok, 0.3, 0.4, 0.01, NULL, out, PTRDIFF_MAX));
     GRID_CASES(hfvis_sun_visibility(&bg, 0.3, 0.4, 0.01, NULL, out, GW));
     SWEEP_OPT_CASES(hfvis_sun_visibility(&g_ok, 0.3, 0.4, 0.01, &bo, out, GW));
+    { /* bands across the sun: its own; every other routine refuses them */
+        hfvis_sweep_options po = hfvis_sweep_options_default();
+        float *map = AF(GW * GH * 4);
+        po.part_index = 2;
+        po.part_count = 3;
+        OK(hfvis_sun_visibility(&g_ok, 0.3, 0.4, 0.01, &po, out, GW));
+        po.rays = HFVIS_RAYS_EXACT;
+        OK(hfvis_sun_visibility(&g_ok, 0.3, 0.4, 0.01, &po, out, GW));
+        po.rays = HFVIS_RAYS_LATTICE;
+        BAD('S', INV, hfvis_sky_view_factor(&g_ok, 4, &po, out, GW));
+        BAD('S', INV, hfvis_horizon_direction(&g_ok, 4, 1, &po, out, GW));
+        BAD('S', INV, hfvis_horizon_map(&g_ok, 4, &po, map));
+        po.part_index = 0;
+        po.part_count = 1; /* one band is every receiver: accepted everywhere */
+        OK(hfvis_sky_view_factor(&g_ok, 4, &po, out, GW));
+    }
 }
 
 static void args_env_options_default(void)
@@ -1737,6 +1784,152 @@ static void args_visibility_count_naive(void)
 }
 
 static float ex_rad[GW * GH * 2];
+
+/* Solar radiation: one valid instant and site, then each invalid field. */
+static hfvis_spa_input spa_ok(void)
+{
+    hfvis_spa_input in;
+    memset(&in, 0, sizeof in);
+    in.year = 2026; in.month = 6; in.day = 21; in.hour = 12;
+    in.delta_t = 69.0;
+    in.latitude_rad = 0.8; in.longitude_rad = 0.2;
+    return in;
+}
+
+static void args_spa(void)
+{
+    hfvis_spa_input in = spa_ok(), b;
+    hfvis_spa_result *r;
+    begin("spa");
+    r = (hfvis_spa_result *)out_bytes(sizeof *r);
+    OK(hfvis_spa(&in, r));
+    BAD('N', INV, hfvis_spa(NULL, r));
+    BAD('N', INV, hfvis_spa(&in, NULL));
+    b = in; b.minute = -1; BAD('G', INV, hfvis_spa(&b, r));
+    b = in; b.second = (double)NAN; BAD('F', INV, hfvis_spa(&b, r));
+    b = in; b.delta_t = (double)INFINITY; BAD('F', INV, hfvis_spa(&b, r));
+    b = in; b.month = 13; BAD('R', INV, hfvis_spa(&b, r));
+    b = in; b.month = 2; b.day = 30; BAD('R', INV, hfvis_spa(&b, r));
+    b = in; b.latitude_rad = 1.6; BAD('R', INV, hfvis_spa(&b, r));
+    b = in; b.refraction = 1; b.pressure_mbar = 0.0; BAD('R', INV, hfvis_spa(&b, r));
+}
+
+static void args_rsun_sun_position(void)
+{
+    hfvis_rsun_sun *r;
+    begin("rsun_sun_position");
+    r = (hfvis_rsun_sun *)out_bytes(sizeof *r);
+    OK(hfvis_rsun_sun_position(172, 12.0, 0.8, r));
+    BAD('N', INV, hfvis_rsun_sun_position(172, 12.0, 0.8, NULL));
+    BAD('Z', INV, hfvis_rsun_sun_position(0, 12.0, 0.8, r));
+    BAD('G', INV, hfvis_rsun_sun_position(-1, 12.0, 0.8, r));
+    BAD('F', INV, hfvis_rsun_sun_position(172, (double)NAN, 0.8, r));
+    BAD('R', INV, hfvis_rsun_sun_position(367, 12.0, 0.8, r));
+    BAD('R', INV, hfvis_rsun_sun_position(172, 12.0, 1.6, r));
+}
+
+static void args_esra_clear_sky(void)
+{
+    double *r;
+    begin("esra_clear_sky");
+    r = (double *)out_bytes(3 * sizeof *r);
+    OK(hfvis_esra_clear_sky(1367.0, 0.5, 100.0, 3.0, r));
+    BAD('N', INV, hfvis_esra_clear_sky(1367.0, 0.5, 100.0, 3.0, NULL));
+    BAD('G', INV, hfvis_esra_clear_sky(-1.0, 0.5, 100.0, 3.0, r));
+    BAD('F', INV, hfvis_esra_clear_sky(1367.0, (double)NAN, 100.0, 3.0, r));
+    BAD('F', INV, hfvis_esra_clear_sky(1367.0, 0.5, (double)INFINITY, 3.0, r));
+    BAD('R', INV, hfvis_esra_clear_sky(1367.0, 0.5, 100.0, 10.5, r));
+    BAD('R', INV, hfvis_esra_clear_sky(1367.0, 0.5, 100.0, 0.0, r));
+}
+
+static void args_solar_input_default(void)
+{
+    hfvis_solar_input in = hfvis_solar_input_default();
+    begin("solar_input_default");
+    CHECK(in.linke == 3.0 && in.albedo == 0.2 && in.days == 1 && in.instant == 0);
+}
+
+static void args_solar_options_default(void)
+{
+    hfvis_solar_options o = hfvis_solar_options_default();
+    begin("solar_options_default");
+    CHECK(o.model == HFVIS_SUN_SPA && o.step_hours == 0.25 && o.directions == 64 && o.sweep == NULL);
+}
+
+static hfvis_solar_input solar_in_ok(void)
+{
+    hfvis_solar_input in = hfvis_solar_input_default();
+    in.latitude_rad = 0.8;
+    in.longitude_rad = 0.2;
+    return in;
+}
+
+static void args_solar_band_count(void)
+{
+    hfvis_solar_input in = solar_in_ok(), b;
+    hfvis_solar_options o = hfvis_solar_options_default();
+    begin("solar_band_count");
+    BADV('N', hfvis_solar_band_count(NULL, NULL) == -1);
+    b = in; b.days = 0; BADV('Z', hfvis_solar_band_count(&b, NULL) == -1);
+    o.bands = (hfvis_solar_bands)9; BADV('E', hfvis_solar_band_count(&in, &o) == -1);
+    CHECK(hfvis_solar_band_count(&in, NULL) == 1);
+}
+
+typedef hfvis_status (*solar_fn)(const hfvis_grid *, const hfvis_solar_input *,
+                                 const hfvis_solar_options *, const hfvis_solar_output *);
+
+static void solar_args(const char *name, solar_fn fn)
+{
+    hfvis_solar_input in = solar_in_ok(), b;
+    hfvis_solar_options o = hfvis_solar_options_default(), bo2;
+    hfvis_solar_output out, none;
+    static float lk[GW * GH], monthly[12];
+    int i;
+    begin(name);
+    memset(&out, 0, sizeof out);
+    memset(&none, 0, sizeof none);
+    out.global = AF(GW * GH);
+    out.sun_hours = AF(GW * GH);
+    o.directions = 8;
+    for (i = 0; i < GW * GH; i++) lk[i] = 3.0f;
+    for (i = 0; i < 12; i++) monthly[i] = 3.0f;
+    OK(fn(&g_ok, &in, &o, &out));
+    BAD('N', INV, fn(&g_ok, NULL, &o, &out));
+    BAD('N', INV, fn(&g_ok, &in, &o, NULL));
+    BAD('N', INV, fn(&g_ok, &in, &o, &none));
+    b = in; b.days = 0; BAD('Z', INV, fn(&g_ok, &b, &o, &out));
+    b = in; b.albedo = -0.1; BAD('G', INV, fn(&g_ok, &b, &o, &out));
+    b = in; b.latitude_rad = (double)NAN; BAD('F', INV, fn(&g_ok, &b, &o, &out));
+    b = in; b.month = 2; b.day = 29; BAD('R', INV, fn(&g_ok, &b, &o, &out));
+    b = in; b.linke = 10.5; BAD('R', INV, fn(&g_ok, &b, &o, &out));
+    b = in; b.albedo = 1.5; BAD('R', INV, fn(&g_ok, &b, &o, &out));
+    b = in; b.latitude_rad = 1.6; BAD('R', INV, fn(&g_ok, &b, &o, &out));
+    b = in; b.days = 36601; BAD('O', INV, fn(&g_ok, &b, &o, &out));
+    bo2 = o; bo2.model = (hfvis_sun_model)7; BAD('E', INV, fn(&g_ok, &in, &bo2, &out));
+    bo2 = o; bo2.diffuse = (hfvis_solar_diffuse)7; BAD('E', INV, fn(&g_ok, &in, &bo2, &out));
+    bo2 = o; bo2.step_hours = -0.25; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));
+    bo2 = o; bo2.sun_radius_rad = 1.0; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));
+    bo2 = o; bo2.directions = -1; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));
+    bo2 = o; lk[5] = 0.0f; bo2.linke_map = lk; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));
+    lk[5] = 3.0f;
+    bo2 = o; monthly[3] = 11.0f; bo2.linke_monthly = monthly; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));
+    monthly[3] = 3.0f;
+    GRID_CASES(fn(&bg, &in, &o, &out));
+    {
+        hfvis_sweep_options bo;
+        bo2 = o;
+        bo2.sweep = &bo;
+        bo = hfvis_sweep_options_default(); bo.border = (hfvis_border)99; BAD('E', INV, fn(&g_ok, &in, &bo2, &out));
+        bo = hfvis_sweep_options_default(); bo.max_distance = -1.0; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));
+        bo = hfvis_sweep_options_default(); bo.receiver_width = bo.receiver_height = 1; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));
+    }
+}
+
+static void args_solar_irradiation(void) { solar_args("solar_irradiation", hfvis_solar_irradiation); }
+static void args_solar_irradiation_reference(void)
+{
+    solar_args("solar_irradiation_reference", hfvis_solar_irradiation_reference);
+}
 
 static void args_indirect_light(void)
 {
@@ -6022,6 +6215,34 @@ SW(direct_light)
     sun.azimuth_rad = 0.3; sun.elevation_rad = 0.5; sun.radius_rad = 0.01; sun.irradiance[0] = 1.0f;
     return hfvis_direct_light(&g_ok, 4, &sun, 1.0f, &g_env, 1, &o, AF(GW * GH));
 }
+SW(solar_irradiation)
+{
+    hfvis_sweep_options o = sweep_opts(al);
+    hfvis_solar_options so = hfvis_solar_options_default();
+    hfvis_solar_input in = solar_in_ok();
+    hfvis_solar_output out;
+    memset(&out, 0, sizeof out);
+    out.global = AF(GW * GH);
+    so.sweep = &o;
+    so.directions = 8;
+    so.diffuse = HFVIS_SOLAR_DIFFUSE_HORIZON;
+    so.reflected = HFVIS_SOLAR_REFLECTED_TERRAIN;
+    return hfvis_solar_irradiation(&g_ok, &in, &so, &out);
+}
+SW(solar_irradiation_reference)
+{
+    hfvis_sweep_options o = sweep_opts(al);
+    hfvis_solar_options so = hfvis_solar_options_default();
+    hfvis_solar_input in = solar_in_ok();
+    hfvis_solar_output out;
+    memset(&out, 0, sizeof out);
+    out.global = AF(GW * GH);
+    so.sweep = &o;
+    so.directions = 8;
+    so.diffuse = HFVIS_SOLAR_DIFFUSE_HORIZON;
+    so.reflected = HFVIS_SOLAR_REFLECTED_TERRAIN;
+    return hfvis_solar_irradiation_reference(&g_ok, &in, &so, &out);
+}
 SW(ns_gi)
 {
     hfvis_ns_scene sc = ns_scene_ok();
@@ -6569,7 +6790,7 @@ static const sweep_entry sweeps[] = {
     SWEEP_VARIANT(env_light, env_light_exact),
     SWEEP(sun_visibility), SWEEP(env_light), SWEEP(env_light_from_map), SWEEP(intervisibility),
     SWEEP(visibility_count), SWEEP(visibility_count_naive), SWEEP(indirect_light),
-    SWEEP(indirect_light_naive), SWEEP(terrain_gi), SWEEP(direct_light), SWEEP(ns_gi),
+    SWEEP(indirect_light_naive), SWEEP(terrain_gi), SWEEP(direct_light), SWEEP(solar_irradiation), SWEEP(solar_irradiation_reference), SWEEP(ns_gi),
     SWEEP(direction_sums), SWEEP(partial_decode), SWEEP(partial_load),
     SWEEP(lsao_direction), SWEEP(lsao_direction_naive), SWEEP(lsao), SWEEP(hbao), SWEEP(ssao_reference),
     SWEEP(ffao_table_build), SWEEP(ffao), SWEEP(ssao_mipmap),
