@@ -1,6 +1,7 @@
 /* tiles.c - tiles (docs/tiles.md): a --window run plans its window and halo, writes a piece and
- * its sidecar (.tile) with the run tag; `mosaic` checks the pieces and assembles them.
- * Owns: the window of the run (cli_win). May call: progress.c, gis.c, write.c, run.c's estimate. */
+ * its sidecar (.tile) with the run tag and the checksum of its values; `mosaic` checks the pieces
+ * and assembles them. Owns: the window of the run (cli_win). May call: progress.c, gis.c,
+ * write.c, run.c's estimate, split.c's cli_fnv_value. */
 
 /* A file's identity without reading it whole: its size and the CRC-32 of its first and last
  * 64 KiB (the header, the first and last rows or strips; a TIFF's directory). */
