@@ -99,10 +99,13 @@ tsan:
 	  { cat build/tsan/log; echo "tsan: FAILED"; exit 1; }; \
 	else echo "SKIP tsan: $(CC) has no ThreadSanitizer runtime"; fi
 # make scale-test: the README's scale-out recipes on GNU parallel, xargs -P and a private
-# single-node Slurm (test/scale_test.sh, ~30 s); prints "SKIP: reason" where they are missing.
+# single-node Slurm (test/scale_test.sh, ~30 s), then every output format under a file-size limit
+# and injected write-path failures (test/fault_cli_test.sh, 1-4 min); each prints "SKIP: reason"
+# for what is missing (the engines, strace).
 scale-test:
 	@$(MAKE) --no-print-directory config=test werror=1 build/test/hfvis
 	@sh test/scale_test.sh build/test/hfvis
+	@sh test/fault_cli_test.sh build/test/hfvis
 run-tests: $(TESTS) $(EXAMPLES) $(CLI) $(BENCH) $(THREAD_TEST)
 	@CC="$(CC)" CFLAGS="$(OPT) $(CFLAGS)" sh test/run.sh $(BUILD) "$(CXX)"
 

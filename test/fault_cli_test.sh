@@ -1,9 +1,9 @@
 #!/bin/sh
 # fault_cli_test.sh - every output format of the hfvis tool under a failing disk: a file-size
 # limit (ulimit -f, with SIGXFSZ at its default action and ignored) and, where strace is
-# installed, an injected failure (ENOSPC, EIO) of the write path's system calls: write, close,
-# rename (and fsync, fdatasync where the tool calls them), at the first, second, middle and last
-# call after the output's temporary file is created.
+# installed, an injected failure (ENOSPC, EIO) of the write path's system calls: openat, write,
+# close, rename (and fsync, fdatasync where the tool calls them), at the first, second, middle and
+# last call from the creation of the output's temporary file on.
 # Each case runs with OUT absent and with OUT holding older contents. A run that exits 0 must have
 # written exactly the good run's files; a run that fails must exit non-zero with exactly one
 # stderr line "hfvis...", leave OUT as it was (absent, or its older bytes), leave every other file
@@ -124,12 +124,12 @@ IFS=$oldifs
 [ "$good_ok" = 1 ] || { echo "fault: $passed passed, $failed failed"; exit 1; }
 
 # picks TRACE: "syscall N" lines: for each write-path call, its numbers (per thread, as strace's
-# when= counts) among the calls after the first file created by the thread that created it:
-# the first, second, middle and last
+# when= counts) among the calls of the thread that created the first file, from that creation
+# on: the first, second, middle and last
 picks() { awk '
   { tid = $1; call = $2; sub(/\(.*/, "", call); cnt[tid, call]++
     if (!start && (call == "openat" || call == "open" || call == "creat") && ($0 ~ /O_CREAT/ || call == "creat") && $0 !~ /= -1/) { start = 1; t = tid }
-    if (start && tid == t && (call == "write" || call == "close" || call == "rename" || call == "renameat" || call == "renameat2" || call == "fsync" || call == "fdatasync")) {
+    if (start && tid == t && (call == "openat" || call == "write" || call == "close" || call == "rename" || call == "renameat" || call == "renameat2" || call == "fsync" || call == "fdatasync")) {
       k = ++m[call]; num[call, k] = cnt[tid, call] } }
   END { for (c in m) { n = m[c]; print c, num[c, 1]; if (n > 1) print c, num[c, 2]
           if (n > 2) print c, num[c, int((n + 1) / 2)]; if (n > 3) print c, num[c, n] } }' "$1" | sort -u; }

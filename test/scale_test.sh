@@ -173,10 +173,11 @@ EOF
     ok "slurm: the failed task's log names the error: $(grep '^hfvis' "$log" | tail -n 1)"
   else bad "slurm: the failed task's log has no error line: $(tail -n 2 "$log" 2> /dev/null)"; fi
   rmdir "$piece"
-  if [ -n "$(ls pieces | grep -Ev '^svf_[0-9_]*\.tif(\.tile)?$')" ] || [ -e "$piece.tile" ] \
+  # (the sidecar is written before the piece: the failed task's new sidecar may stay, alone)
+  if [ -n "$(ls pieces | grep -Ev '^svf_[0-9_]*\.tif(\.tile)?$')" ] || [ -e "$piece" ] \
      || [ "$(ls pieces | grep -c '\.tif$')" -ne $((N - 1)) ]; then
-    bad "slurm: the failed task left a piece, a sidecar or a temporary file: $(ls pieces | tr '\n' ' ')"
-  else ok "slurm: the failed task left no piece, sidecar or temporary file ($((N - 1)) pieces)"; fi
+    bad "slurm: the failed task left a piece or a temporary file: $(ls pieces | tr '\n' ' ')"
+  else ok "slurm: the failed task left no piece and no temporary file ($((N - 1)) pieces)"; fi
   i=0; reason=; while [ "$i" -lt 60 ]; do
     reason=$(squeue -h -j "$mosaic" -o '%T %r' 2> /dev/null); [ "$reason" = "PENDING DependencyNeverSatisfied" ] && break
     sleep 0.5; i=$((i + 1)); done

@@ -178,7 +178,35 @@ fails "mosaic: missing piece" 1 "missing pieces: 4731 of the 97 x 83 cells" mosa
 fails "mosaic: missing rows" 1 "missing pieces: 171 of" mosaic "$dir/s1.pfm" "$dir/m2.pfm" -o "$dir/x.pfm"
 fails "mosaic: no sidecar" 1 "no sidecar" mosaic "$dir/s1.pfm" "$dir/sv_flt.whole.pfm" -o "$dir/x.pfm"
 fails "mosaic: onto a piece" 1 "refusing to replace an input" mosaic "$dir/s1.pfm" "$dir/s2.pfm" -o "$dir/s2.pfm"
-[ -f "$dir/x.pfm" ] && bad "a refused mosaic wrote its output" || ok "refused mosaics wrote nothing"
+# pieces against their sidecars: each piece's values carry a checksum in its sidecar and each
+# raster piece's own origin must lie where its sidecar's window puts it. Pieces 1 and 2 have the
+# same size, so swapping them (or their sidecars) changes nothing but where their data lands.
+Q="0,0,32,83 32,0,32,83 64,0,33,83"
+pieces q pfm "$Q" skyview "$dir/s.flt" $A && same "3 pieces (PFM) = whole run" "$dir/q.mosaic.pfm" "$dir/sv_flt.whole.pfm"
+pieces q tif "$Q" skyview "$dir/s.flt" $A && same "3 pieces (GeoTIFF) = whole run" "$dir/q.mosaic.tif" "$dir/skyviewlattice.whole.tif"
+# tampered SET EXT: a copy of the q pieces in $dir/SET
+tampered() { rm -rf "${dir:?}/$1"; mkdir "$dir/$1" && cp "$dir"/q.[123].$2 "$dir"/q.[123].$2.tile "$dir/$1/"; }
+for e in pfm tif; do
+  why="its values differ from those its sidecar"; [ "$e" = tif ] && why="its own origin lies"
+  tampered sw $e; mv "$dir/sw/q.1.$e" "$dir/sw/t"; mv "$dir/sw/q.2.$e" "$dir/sw/q.1.$e"; mv "$dir/sw/t" "$dir/sw/q.2.$e"
+  fails "mosaic: swapped $e pieces" 1 "$why" mosaic "$dir"/sw/q.[123].$e -o "$dir/x.$e"
+  tampered sw $e; mv "$dir/sw/q.1.$e.tile" "$dir/sw/t"; mv "$dir/sw/q.2.$e.tile" "$dir/sw/q.1.$e.tile"; mv "$dir/sw/t" "$dir/sw/q.2.$e.tile"
+  fails "mosaic: swapped $e sidecars" 1 "$why" mosaic "$dir"/sw/q.[123].$e -o "$dir/x.$e"
+done
+tampered ed pfm; printf '\001' | dd of="$dir/ed/q.2.pfm" bs=1 seek=400 conv=notrunc 2> /dev/null
+fails "mosaic: an edited pixel" 1 "its values differ from those its sidecar" mosaic "$dir"/ed/q.[123].pfm -o "$dir/x.pfm"
+tampered ed pfm; sed 's/^HFVISTILE 2$/HFVISTILE 1/' "$dir/q.2.pfm.tile" > "$dir/ed/q.2.pfm.tile"
+fails "mosaic: a version-1 sidecar (no checksum)" 1 "not a piece sidecar" mosaic "$dir"/ed/q.[123].pfm -o "$dir/x.pfm"
+# a --dirs 16 run, and its window 2 rerun with --dirs 4 whose piece or sidecar did not land
+pieces k pfm "$Q" skyview "$dir/s.flt" --dirs 16 --max-distance 400 &&
+run "piece k2 --dirs 4" skyview "$dir/s.flt" --dirs 4 --max-distance 400 --window 32,0,32,83 -o "$dir/k4.pfm"
+tampered st pfm; cp "$dir"/k.[123].pfm "$dir"/k.[123].pfm.tile "$dir/st/"; cp "$dir/k4.pfm.tile" "$dir/st/k.2.pfm.tile"
+fails "mosaic: a stale --dirs 4 sidecar among --dirs 16 pieces" 1 "different parameters (dirs=16 there, 4 here)" mosaic "$dir"/st/k.[123].pfm -o "$dir/x.pfm"
+cp "$dir/k.2.pfm.tile" "$dir/st/k.2.pfm.tile"; cp "$dir/k4.pfm" "$dir/st/k.2.pfm"
+fails "mosaic: a --dirs 4 piece under its --dirs 16 sidecar" 1 "its values differ from those its sidecar" mosaic "$dir"/st/k.[123].pfm -o "$dir/x.pfm"
+cp "$dir/k.2.pfm" "$dir/st/k.2.pfm"
+run "mosaic k restored" mosaic "$dir"/st/k.[123].pfm -o "$dir/k.restored.pfm" && same "the restored pieces mosaic as before" "$dir/k.mosaic.pfm" "$dir/k.restored.pfm"
+[ -f "$dir/x.pfm" ] || [ -f "$dir/x.tif" ] && bad "a refused mosaic wrote its output" || ok "refused mosaics wrote nothing"
 run "mosaic tif pieces" mosaic "$dir/s1.tif" "$dir/s2.tif" -o "$dir/s12.tif" &&
 run "whole tif" skyview "$dir/s.flt" $A -o "$dir/sw.tif" && same "GeoTIFF pieces mosaic = whole GeoTIFF" "$dir/sw.tif" "$dir/s12.tif"
 

@@ -239,12 +239,16 @@ static int cli_run_directions;    /* directions of the run (0: none), for the su
 static double cli_line_last;      /* when the last --progress line was printed */
 static int cli_line_pct = -1;     /* and its percentage */
 
-#define CLI_PIECE_MAGIC "HFVISTILE 1\n"
+#define CLI_PIECE_MAGIC "HFVISTILE 2\n" /* 2: the values= checksum; a version-1 sidecar is refused */
 #define CLI_PIECE_SIDECAR ".tile" /* appended to the piece's name */
+/* How far (in cells) a piece's own origin may lie from where its sidecar's window puts it: the
+ * text formats carry the origin in 17 digits, a misplaced piece is off by whole cells. */
+#define CLI_PIECE_ORIGIN_TOLERANCE 1e-3
 
 /* One piece's sidecar, as read back. */
 typedef struct cli_piece {
     int x0, y0, w, h, planes, channels;
+    unsigned long long values; /* the checksum of its values (cli_fnv_value) */
     char range[96];
     char tag[CLI_PIECE_TAG_MAX];
 } cli_piece;
@@ -400,7 +404,7 @@ static int cli_save_piece(const cli_args *a, cli_output out);
 static int cli_piece_meta(const char *path, cli_piece *p);
 static const char *cli_piece_problem(const char *key);
 static int cli_piece_read(const char *path, const cli_piece *m, int W, int H, float *out,
-                          const ex_georef *ref, ex_georef *keep);
+                          const ex_georef *whole, const ex_georef *ref, ex_georef *keep);
 static int cli_mosaic(int argc, char **argv);
 /* main.c */
 static int cli_commands_complete(void);

@@ -3,17 +3,26 @@
  * single run's OUT. May call: progress.c, flags.c's primitives, sweeps.c, write.c. */
 
 
-/* FNV-1a 64 over the bytes of n floats (the loaded input, or an environment map). */
+/* FNV-1a 64 of one value, folded into h (start: CLI_FNV_OFFSET): the value's IEEE bits, least
+ * significant byte first (the same on every byte order), every NaN as one quiet NaN and -0 as +0,
+ * so that a piece's values hash the same in every format that holds them exactly. */
+#define CLI_FNV_OFFSET 14695981039346656037ull
+static unsigned long long cli_fnv_value(unsigned long long h, float v)
+{
+    uint32_t bits = 0x7fc00000u;
+    int b;
+    if (v == 0.0f) bits = 0;
+    else if (!isnan(v)) memcpy(&bits, &v, sizeof bits);
+    for (b = 0; b < 4; b++) h = (h ^ ((bits >> (8 * b)) & 0xffu)) * 1099511628211ull;
+    return h;
+}
+
+/* FNV-1a 64 over n floats (the loaded input, or an environment map). */
 static unsigned long long cli_fingerprint(const float *v, size_t n)
 {
-    unsigned long long h = 14695981039346656037ull;
+    unsigned long long h = CLI_FNV_OFFSET;
     size_t i;
-    int b;
-    for (i = 0; i < n; i++) {
-        unsigned char raw[sizeof(float)];
-        memcpy(raw, &v[i], sizeof raw);
-        for (b = 0; b < (int)sizeof raw; b++) h = (h ^ raw[b]) * 1099511628211ull;
-    }
+    for (i = 0; i < n; i++) h = cli_fnv_value(h, v[i]);
     return h;
 }
 

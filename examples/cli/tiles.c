@@ -1,6 +1,7 @@
 /* tiles.c - tiles (docs/tiles.md): a --window run plans its window and halo, writes a piece and
- * its sidecar (.tile) with the run tag; `mosaic` checks the pieces and assembles them.
- * Owns: the window of the run (cli_win). May call: progress.c, gis.c, write.c, run.c's estimate. */
+ * its sidecar (.tile) with the run tag and the checksum of its values; `mosaic` checks the pieces
+ * and assembles them. Owns: the window of the run (cli_win). May call: progress.c, gis.c,
+ * write.c, run.c's estimate, split.c's cli_fnv_value. */
 
 /* A file's identity without reading it whole: its size and the CRC-32 of its first and last
  * 64 KiB (the header, the first and last rows or strips; a TIFF's directory). */
@@ -105,8 +106,12 @@ static int cli_range_is_top(int cmd, int fraction)
 }
 
 /* A --window run's output: the window cut out of each plane of the grid's result (w x h with
- * the planes stacked), written as OUT with the georeference moved to the window, then the
- * sidecar OUT.tile: the window, the planes and channels, the default range, the run tag. */
+ * the planes stacked), its sidecar OUT.tile (the window, the planes and channels, the default
+ * range, the checksum of the values, the run tag), then the piece OUT with the georeference moved
+ * to the window. Each is written to a temporary name and renamed; the sidecar goes first, so a
+ * failure leaves OUT as it was, and one between the two renames leaves a sidecar whose checksum
+ * the old piece does not match: `mosaic` refuses that pair, as it refuses an old piece beside the
+ * sidecar of another run. */
 static int cli_save_piece(const cli_args *a, cli_output out)
 {
     const cli_window v = cli_win;
@@ -115,8 +120,10 @@ static int cli_save_piece(const cli_args *a, cli_output out)
     const double lo = out.lo, hi = out.hi;
     const size_t row = (size_t)v.w * (size_t)channels;
     float *cut = cli_alloc((size_t)v.w * (size_t)v.h, (size_t)planes, (size_t)channels);
+    const size_t n = (size_t)v.w * (size_t)v.h * (size_t)planes * (size_t)channels;
     char *side = NULL, *text = NULL, range[96];
-    size_t len;
+    unsigned long long sum = CLI_FNV_OFFSET;
+    size_t len, i;
     int p, y, rc;
     hfvis_status s;
     if (!cut) return cli_status(a->out, HFVIS_ERR_OUT_OF_MEMORY, 0);
@@ -125,10 +132,7 @@ static int cli_save_piece(const cli_args *a, cli_output out)
             memcpy(cut + ((size_t)p * (size_t)v.h + (size_t)y) * row,
                    px + (((size_t)p * (size_t)v.gh + (size_t)(v.y0 - v.gy0 + y)) * (size_t)w +
                          (size_t)(v.x0 - v.gx0)) * (size_t)channels, row * sizeof(float));
-    cli_win.active = 0; /* write it as an ordinary output of v.w x v.h cells */
-    rc = cli_save(a, cli_output_of(cut, v.w, v.h, planes, channels, lo, hi));
-    free(cut);
-    if (rc != 0) return rc;
+    for (i = 0; i < n; i++) sum = cli_fnv_value(sum, cut[i]);
     if (cli_range_is_top(a->cmd, a->fraction)) strcpy(range, "top");
     else snprintf(range, sizeof range, "%a:%a", lo, hi);
     len = strlen(a->out) + sizeof CLI_PIECE_SIDECAR;
@@ -137,15 +141,21 @@ static int cli_save_piece(const cli_args *a, cli_output out)
     if (!side || !text) {
         free(side);
         free(text);
+        free(cut);
         return cli_status(a->out, HFVIS_ERR_OUT_OF_MEMORY, 0);
     }
     snprintf(side, len, "%s%s", a->out, CLI_PIECE_SIDECAR);
     snprintf(text, CLI_PIECE_TAG_MAX + 256, CLI_PIECE_MAGIC "window=%d,%d,%d,%d planes=%d channels=%d "
-             "range=%s\n%s\n", v.x0, v.y0, v.w, v.h, planes, channels, range, v.tag);
+             "range=%s values=%016llx\n%s\n", v.x0, v.y0, v.w, v.h, planes, channels, range, sum, v.tag);
     errno = 0;
     s = cli_write(side, (unsigned char *)text, strlen(text), HFVIS_OK); /* frees text */
     rc = s == HFVIS_OK ? 0 : cli_status(side, s, errno);
     free(side);
+    if (rc == 0) {
+        cli_win.active = 0; /* write it as an ordinary output of v.w x v.h cells */
+        rc = cli_save(a, cli_output_of(cut, v.w, v.h, planes, channels, lo, hi));
+    }
+    free(cut);
     return rc;
 }
 
@@ -170,8 +180,8 @@ static int cli_piece_meta(const char *path, cli_piece *p)
         *line3++ = '\0';
         end = strchr(line3, '\n');
         if (end) *end = '\0';
-        ok = sscanf(line2 + 1, "window=%d,%d,%d,%d planes=%d channels=%d range=%95s", &p->x0, &p->y0,
-                    &p->w, &p->h, &p->planes, &p->channels, p->range) == 7 &&
+        ok = sscanf(line2 + 1, "window=%d,%d,%d,%d planes=%d channels=%d range=%95s values=%llx", &p->x0,
+                    &p->y0, &p->w, &p->h, &p->planes, &p->channels, p->range, &p->values) == 8 &&
              strlen(line3) < sizeof p->tag && p->w > 0 && p->h > 0 && p->planes > 0 && p->channels > 0;
         if (ok) strcpy(p->tag, line3);
     }
@@ -193,10 +203,34 @@ static const char *cli_piece_problem(const char *key)
     return "different parameters";
 }
 
+/* The refusal of a piece whose values are not the ones its sidecar records. */
+static int cli_piece_stale(const char *path)
+{
+    return cli_error(CLI_EXIT_ERROR, path, "its values differ from those its sidecar %s%s records (an edited "
+                     "or swapped piece, or a sidecar of another run): rerun this window", path, CLI_PIECE_SIDECAR);
+}
+
+/* The checksum of piece m's values once read into the mosaic out (cli_save_piece's order). */
+static unsigned long long cli_piece_sum(const cli_piece *m, int W, int H, const float *out)
+{
+    const size_t C = (size_t)m->channels, row = (size_t)m->w * C;
+    unsigned long long sum = CLI_FNV_OFFSET;
+    size_t i;
+    int p, y;
+    for (p = 0; p < m->planes; p++)
+        for (y = 0; y < m->h; y++) {
+            const float *src = out + (((size_t)p * (size_t)H + (size_t)(m->y0 + y)) * (size_t)W + (size_t)m->x0) * C;
+            for (i = 0; i < row; i++) sum = cli_fnv_value(sum, src[i]);
+        }
+    return sum;
+}
+
 /* Read piece path (of sidecar m) into the mosaic out (W x H cells, planes stacked, channels
- * interleaved), checking its size and, for a raster, its CRS and cell size against ref's. */
+ * interleaved), checking its size, its values against the sidecar's checksum and, for a raster,
+ * its own origin against where whole (the whole raster's georeference, or NULL) puts m's window
+ * and its CRS and cell size against ref's. */
 static int cli_piece_read(const char *path, const cli_piece *m, int W, int H, float *out,
-                          const ex_georef *ref, ex_georef *keep)
+                          const ex_georef *whole, const ex_georef *ref, ex_georef *keep)
 {
     const size_t C = (size_t)m->channels;
     int x, y, p, c;
@@ -209,6 +243,21 @@ static int cli_piece_read(const char *path, const cli_piece *m, int W, int H, fl
                       r.height, r.bands, m->w, m->h, m->planes * m->channels);
             ex_rio_close(&r);
             return CLI_EXIT_ERROR;
+        }
+        if (whole && whole->has_transform && r.geo.has_transform) {
+            ex_georef at = *whole; /* shallow: only the geotransform is used */
+            const double cx = fabs(at.gt[1]) + fabs(at.gt[2]), cy = fabs(at.gt[4]) + fabs(at.gt[5]);
+            double dx, dy;
+            at.n_tiepoints = 0, at.has_matrix = 0;
+            ex_georef_shift(&at, m->x0, m->y0);
+            dx = r.geo.gt[0] - at.gt[0], dy = r.geo.gt[3] - at.gt[3];
+            if (!(fabs(dx) <= CLI_PIECE_ORIGIN_TOLERANCE * cx && fabs(dy) <= CLI_PIECE_ORIGIN_TOLERANCE * cy)) {
+                cli_error(CLI_EXIT_ERROR, path, "its own origin lies %.6g, %.6g map units from window %d,%d,%d,%d "
+                          "of its sidecar %s%s (a swapped piece or sidecar)", dx, dy, m->x0, m->y0, m->w, m->h,
+                          path, CLI_PIECE_SIDECAR);
+                ex_rio_close(&r);
+                return CLI_EXIT_ERROR;
+            }
         }
         if (ref && (ref->crs != r.geo.crs || ref->epsg != r.geo.epsg)) {
             cli_error(CLI_EXIT_ERROR, path, "different CRS (EPSG:%d there, EPSG:%d here)", ref->epsg, r.geo.epsg);
@@ -243,6 +292,10 @@ static int cli_piece_read(const char *path, const cli_piece *m, int W, int H, fl
                 }
             }
         free(row);
+        if (cli_piece_sum(m, W, H, out) != m->values) {
+            ex_rio_close(&r);
+            return cli_piece_stale(path);
+        }
         if (keep) { /* the georeference of the piece at (0, 0) is the whole raster's */
             ex_georef_free(keep);
             *keep = r.geo;
@@ -269,7 +322,7 @@ static int cli_piece_read(const char *path, const cli_piece *m, int W, int H, fl
                        px + ((size_t)p * (size_t)m->h + (size_t)y) * (size_t)m->w * C,
                        (size_t)m->w * C * sizeof(float));
         hfvis_free(NULL, px);
-        return 0;
+        return cli_piece_sum(m, W, H, out) == m->values ? 0 : cli_piece_stale(path);
     }
 }
 
@@ -286,10 +339,11 @@ static int cli_mosaic(int argc, char **argv)
     int n = 0, i, j, rc = 0, W = 0, H = 0, planes, channels, origin = -1, cmd;
     double area = 0.0, lo = 0.0, hi = 1.0;
     float *out = NULL;
-    ex_georef ref;
+    ex_georef ref, whole;
 
     memset(&a, 0, sizeof a);
     memset(&ref, 0, sizeof ref);
+    memset(&whole, 0, sizeof whole);
     for (i = 2; i < argc; i++) {
         const char *arg = argv[i];
         if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) return cli_help(CMD_MOSAIC);
@@ -381,22 +435,27 @@ static int cli_mosaic(int argc, char **argv)
     }
     out = cli_alloc((size_t)W * (size_t)H, (size_t)planes, (size_t)channels);
     if (!out) { rc = cli_status("mosaic", HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
-    /* the piece at (0, 0) first: its georeference is the whole raster's and the reference of the others */
-    if ((rc = cli_piece_read(names[origin], &meta[origin], W, H, out, NULL, &ref)) != 0) goto done;
-    for (i = 0; i < n; i++)
-        if (i != origin && (rc = cli_piece_read(names[i], &meta[i], W, H, out,
-                                                ex_rio_format_of(names[origin]) ? &ref : NULL, NULL)) != 0)
-            goto done;
-    if (!ref.has_transform && cli_tag_value(meta[0].tag, "gt", other, sizeof other) && strcmp(other, "none")) {
-        /* PFM pieces: the geotransform from the sidecar (their CRS is not kept: use raster pieces) */
+    /* the whole raster's geotransform, as the run's tag records it: where each piece belongs */
+    if (cli_tag_value(meta[0].tag, "gt", other, sizeof other) && strcmp(other, "none")) {
         char *q = other;
         for (i = 0; i < 6; i++) {
             char *comma = strchr(q, ',');
             if (comma) *comma = '\0';
-            if (!cli_parse_real(q, &ref.gt[i])) break;
+            if (!cli_parse_real(q, &whole.gt[i])) break;
             q = comma ? comma + 1 : q + strlen(q);
         }
-        ref.has_transform = i == 6;
+        whole.has_transform = i == 6;
+    }
+    /* the piece at (0, 0) first: its georeference is the whole raster's and the reference of the others */
+    if ((rc = cli_piece_read(names[origin], &meta[origin], W, H, out, &whole, NULL, &ref)) != 0) goto done;
+    for (i = 0; i < n; i++)
+        if (i != origin && (rc = cli_piece_read(names[i], &meta[i], W, H, out, &whole,
+                                                ex_rio_format_of(names[origin]) ? &ref : NULL, NULL)) != 0)
+            goto done;
+    if (!ref.has_transform && whole.has_transform) {
+        /* PFM pieces: the geotransform from the sidecar (their CRS is not kept: use raster pieces) */
+        memcpy(ref.gt, whole.gt, sizeof ref.gt);
+        ref.has_transform = 1;
     }
     /* NoData as the whole run had it: the input's (the pieces may have declared NaN or moved it) */
     ref.has_nodata = 0;

@@ -1,6 +1,6 @@
 /* write.c - safe writing: every file goes through hfvis_write_file, whose temporary name is kept
  * here so that SIGINT, SIGTERM and SIGHUP remove it (the handler unlinks it and re-raises the
- * signal); the encoders of the library's formats; cli_save (PFM, PGM and the GIS rasters); the
+ * signal; SIGXFSZ is ignored, so a file-size limit is a write error); the encoders of the library's formats; cli_save (PFM, PGM and the GIS rasters); the
  * refusal to write over an input. Owns: the temporary-file name. May call: progress.c, gis.c,
  * tiles.c (pieces), the library's encoders and examples/raster_io.h. */
 
@@ -29,7 +29,8 @@ static void cli_on_signal(int sig)
     raise(sig);
 }
 
-/* Install the handler for SIGINT, SIGTERM and SIGHUP, leaving an ignored signal ignored. */
+/* Install the handler for SIGINT, SIGTERM and SIGHUP, leaving an ignored signal ignored; ignore
+ * SIGXFSZ. */
 static void cli_signals(void)
 {
     static const int sigs[3] = { SIGINT, SIGTERM, SIGHUP };
@@ -42,6 +43,16 @@ static void cli_signals(void)
         if (sigaction(sigs[i], NULL, &old) == 0 && old.sa_handler == SIG_IGN) continue;
         sigaction(sigs[i], &sa, NULL);
     }
+#ifdef SIGXFSZ
+    { /* past a file-size limit (ulimit -f), a write fails with EFBIG and is reported, instead of
+       * the signal ending the run silently and leaving the temporary file */
+        struct sigaction ign;
+        memset(&ign, 0, sizeof ign);
+        ign.sa_handler = SIG_IGN;
+        sigemptyset(&ign.sa_mask);
+        sigaction(SIGXFSZ, &ign, NULL);
+    }
+#endif
 }
 #else
 static void cli_signals(void) {}
