@@ -52,7 +52,7 @@ BENCH := $(BUILD)/bench
 TESTS := $(patsubst test/%.c,$(BUILD)/test/%,$(wildcard test/test_*.c))
 FUZZERS := $(patsubst test/fuzz/%.c,%,$(wildcard test/fuzz/fuzz_*.c))
 
-.PHONY: all lib examples test check sanitize fuzz bench demo install symbols cxx update-golden clean run-tests
+.PHONY: all lib examples test check sanitize tsan scale-test fuzz bench demo install symbols cxx update-golden clean run-tests
 all: $(LIB) $(CLI) $(EXAMPLES)
 lib: $(LIB)
 examples: $(EXAMPLES) $(CLI)
@@ -66,15 +66,21 @@ $(LIB): $(LIBOBJ)
 $(BUILD)/examples/%: examples/%.c examples/common.h examples/fields.h $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -I. $< $(LIB) $(LDLIBS) -o $@
-$(CLI): examples/cli/hfvis_cli.c examples/common.h $(LIB)
+$(CLI): $(wildcard examples/cli/*.c) examples/cli/cli.h examples/common.h examples/raster_io.h $(LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(ALL_CFLAGS) -I. $< $(LIB) $(LDLIBS) -o $@
+	$(CC) $(ALL_CFLAGS) -I. examples/cli/main.c $(LIB) $(LDLIBS) -o $@
 $(BENCH): examples/bench/bench.c $(wildcard examples/bench/bench_*.c) examples/bench/bench.h examples/common.h examples/fields.h $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -I. examples/bench/bench.c $(wildcard examples/bench/bench_*.c) $(LIB) $(LDLIBS) -o $@
 $(BUILD)/test/%: test/%.c test/test.h test/test_dir.h examples/fields.h $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -I. $< $(LIB) $(LDLIBS) -o $@
+# The library's calls run concurrently (hfvis.h, "Threads"): POSIX threads, test only.
+PTHREAD ?= -pthread
+THREAD_TEST := $(BUILD)/thread/thread_test
+$(THREAD_TEST): test/thread_test.c test/test.h $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) $(PTHREAD) -I. $< $(LIB) $(LDLIBS) -o $@
 
 # make test: -Werror, every test program, the examples as smoke tests, the C++ header compile
 # and the symbol-prefix check; the last line is "tests: N passed, M failed".
@@ -82,7 +88,22 @@ test check:
 	@$(MAKE) --no-print-directory config=test werror=1 run-tests
 sanitize:
 	@$(MAKE) --no-print-directory config=sanitize werror=1 run-tests
-run-tests: $(TESTS) $(EXAMPLES) $(CLI) $(BENCH)
+	@$(MAKE) --no-print-directory tsan
+# make tsan: test/thread_test.c under ThreadSanitizer (part of make sanitize); SKIP when the
+# compiler has no TSan runtime.
+tsan:
+	@mkdir -p build/tsan
+	@if printf 'int main(void){return 0;}\n' | $(CC) -fsanitize=thread $(PTHREAD) -x c - -o build/tsan/probe 2>/dev/null; then \
+	  $(CC) $(BASEFLAGS) -Werror -O1 -g -fsanitize=thread $(PTHREAD) -I. test/thread_test.c $(LIBSRC) $(LDLIBS) -o build/tsan/thread_test && \
+	  TSAN_OPTIONS=halt_on_error=1 build/tsan/thread_test > build/tsan/log 2>&1 && tail -n 1 build/tsan/log && echo "tsan: no data race" || \
+	  { cat build/tsan/log; echo "tsan: FAILED"; exit 1; }; \
+	else echo "SKIP tsan: $(CC) has no ThreadSanitizer runtime"; fi
+# make scale-test: the README's scale-out recipes on GNU parallel, xargs -P and a private
+# single-node Slurm (test/scale_test.sh, ~30 s); prints "SKIP: reason" where they are missing.
+scale-test:
+	@$(MAKE) --no-print-directory config=test werror=1 build/test/hfvis
+	@sh test/scale_test.sh build/test/hfvis
+run-tests: $(TESTS) $(EXAMPLES) $(CLI) $(BENCH) $(THREAD_TEST)
 	@CC="$(CC)" CFLAGS="$(OPT) $(CFLAGS)" sh test/run.sh $(BUILD) "$(CXX)"
 
 symbols: $(LIB)

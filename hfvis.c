@@ -57,6 +57,22 @@
 #define HFVIS_MALLOC(size) malloc(size)
 #define HFVIS_FREE(ptr) free(ptr)
 #endif
+/* The stdio calls of the write path (hfvis.h, "Files"): each may be defined to a replacement
+ * with the same signature (test/test_wfault.c fails them one call at a time). */
+#ifndef HFVIS_NO_STDIO
+#ifndef HFVIS_FWRITE
+#define HFVIS_FWRITE(ptr, size, n, file) fwrite(ptr, size, n, file)
+#endif
+#ifndef HFVIS_FFLUSH
+#define HFVIS_FFLUSH(file) fflush(file)
+#endif
+#ifndef HFVIS_FCLOSE
+#define HFVIS_FCLOSE(file) fclose(file)
+#endif
+#ifndef HFVIS_RENAME
+#define HFVIS_RENAME(from, to) rename(from, to)
+#endif
+#endif
 
 /* Exact rays (section 16), called from the public routines of sections 8, 9, 10 and 15. */
 /* One exact-ray direction: look vector (a, b), gcd 1, and its azimuth, unwrapped to within pi of
@@ -987,27 +1003,27 @@ hfvis_status hfvis_write_begin(const char *path, const hfvis_write_options *opts
 hfvis_status hfvis_write_end(const char *path, FILE *file, char *temp_path, int commit,
                              const hfvis_write_options *opts)
 {
-    int ok = commit != 0;
+    int ok;
     if (!file || !temp_path) { /* nothing was opened: release what there is */
-        if (file) fclose(file);
+        if (file) HFVIS_FCLOSE(file);
         hfvis__free(NULL, temp_path);
         return HFVIS_ERR_INVALID_ARGUMENT;
     }
-    ok = (fflush(file) == 0) && !ferror(file) && ok;
-    ok = (fclose(file) == 0) && ok;
-    if (ok && (!path || rename(temp_path, path) != 0)) {
+    ok = (HFVIS_FFLUSH(file) == 0) && !ferror(file);
+    ok = (HFVIS_FCLOSE(file) == 0) && ok; /* closed even when the flush failed */
+    if (ok && commit && (!path || HFVIS_RENAME(temp_path, path) != 0)) {
 #if defined(_WIN32)
         /* Windows' rename does not replace an existing file: replace non-atomically. */
-        ok = path && remove(path) == 0 && rename(temp_path, path) == 0;
+        ok = path && remove(path) == 0 && HFVIS_RENAME(temp_path, path) == 0;
 #else
         ok = 0;
 #endif
     }
-    if (!ok) remove(temp_path);
+    if (!ok || !commit) remove(temp_path);
     if (opts && opts->on_temp) opts->on_temp(opts->user, NULL); /* renamed or removed */
     hfvis__free(NULL, temp_path);
     if (!path) return HFVIS_ERR_INVALID_ARGUMENT;
-    return ok ? HFVIS_OK : commit ? HFVIS_ERR_IO : HFVIS_OK;
+    return !commit || ok ? HFVIS_OK : HFVIS_ERR_IO;
 }
 
 hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
@@ -1019,7 +1035,11 @@ hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
     if (!path || (!bytes && n > 0) || path[0] == '\0') return HFVIS_ERR_INVALID_ARGUMENT;
     s = hfvis_write_begin(path, opts, &f, &tmp);
     if (s != HFVIS_OK) return s;
-    return hfvis_write_end(path, f, tmp, n == 0 || fwrite(bytes, 1, n, f) == n, opts);
+    if (n > 0 && HFVIS_FWRITE(bytes, 1, n, f) != n) { /* short write (disk full, size limit) */
+        hfvis_write_end(path, f, tmp, 0, opts);
+        return HFVIS_ERR_IO;
+    }
+    return hfvis_write_end(path, f, tmp, 1, opts);
 }
 
 HFVIS_API hfvis_status hfvis_pfm_save(const char *path, const float *pixels, int width,
@@ -1205,7 +1225,7 @@ static inline double hf_bilerp_taps(const float *p, ptrdiff_t stride, double fx,
     return isfinite(r1) ? r1 : HFVIS__NAN; /* a +-Inf tap is a hole too */
 }
 
-static double hf_bilerp(const float *z, ptrdiff_t stride, int W, int H, double x, double y)
+static inline double hf_bilerp(const float *z, ptrdiff_t stride, int W, int H, double x, double y)
 {
     int x0, y0;
     double fx, fy;
@@ -1611,6 +1631,9 @@ typedef struct hf_sweep {
     double ext_w, ext_h;        /* the raster's size */
     int rx0, ry0, rx1, ry1;     /* receiver rectangle [rx0, rx1) x [ry0, ry1) */
     int rect;                   /* 1: a proper sub-rectangle (nodes far from it are skipped) */
+    int parts, part;            /* bands across the direction (hfvis_sun_visibility), 0 = off */
+    double part_b0, part_span;  /* the receivers' lattice b range: its start and length */
+    int band_j0, band_j1;       /* the lattice rows near the band (all rows without bands) */
     hf_win win;                 /* its line scratch (win_rw >= 0) */
     void *block;
     const hfvis_allocator *alloc;
@@ -1694,18 +1717,20 @@ static void hf_receiver_rect(const hfvis_grid *g, const hfvis_sweep_options *o, 
     *y1 = o->receiver_y + o->receiver_height;
 }
 
-/* A finite radius, a window or a receiver rectangle: the routines outside the [P1] sweep
- * (openness) refuse them. */
-static int hf_sweep_opts_limited(const hfvis_sweep_options *o)
-{
-    return o && (hf_radius_on(o) || o->extent_width != 0 || o->receiver_width != 0);
-}
-
 /* A window or a receiver rectangle: the P2 hull-tree routines of section 11 refuse them (they
  * honour the radius). */
 static int hf_p2_opts_limited(const hfvis_sweep_options *o)
 {
     return o && (o->extent_width != 0 || o->receiver_width != 0);
+}
+
+/* part_index/part_count: 0, 0 or 0 <= index < count <= HF_PARTS_MAX (hfvis_sun_visibility). */
+#define HF_PARTS_MAX 65536
+static int hf_parts_valid(const hfvis_sweep_options *o)
+{
+    return (o->part_index == 0 && o->part_count == 0) ||
+           (o->part_count >= 1 && o->part_count <= HF_PARTS_MAX && o->part_index >= 0 &&
+            o->part_index < o->part_count);
 }
 
 static int hf_opts_valid(const hfvis_sweep_options *o)
@@ -1716,7 +1741,8 @@ static int hf_opts_valid(const hfvis_sweep_options *o)
                   o->direction_order >= HFVIS_DIRECTION_ORDER_DEFAULT &&
                   o->direction_order <= HFVIS_DIRECTION_ORDER_SWEEP &&
                   (o->rays == HFVIS_RAYS_LATTICE || o->rays == HFVIS_RAYS_EXACT) &&
-                  o->ray_denominator >= 0 && o->ray_denominator <= HFVIS_RAY_DENOMINATOR_MAX);
+                  o->ray_denominator >= 0 && o->ray_denominator <= HFVIS_RAY_DENOMINATOR_MAX &&
+                  hf_parts_valid(o) && o->part_count <= 1); /* bands: hfvis_sun_visibility's own */
 }
 
 /* Resolved options (NULL or zero fields = defaults). */
@@ -1894,6 +1920,73 @@ static double hf_sample_border(const hfvis_grid *g, hfvis_border border, double 
  * column, and the heights (cell units) at every in-domain node. */
 #define HF_TILE 32 /* lattice and grid loops run in tiles so both sides stay in cache */
 
+#define HF_RECT_MARGIN 4.0 /* cells around a receiver rectangle (band) whose nodes a gather reads */
+
+/* Bands across the direction (hfvis_sweep_options part_index/part_count): the receivers'
+ * lattice coordinate b (across the lines) over the receiver rectangle, cut into parts equal
+ * lengths; each receiver is in the band of its own b, computed by the same expression in every
+ * call, so the bands of separate calls tile the receivers. Lines far from the band are skipped
+ * (hf_line_rect), which is what lets threads share one direction's lines. */
+static void hf_sweep_parts(hf_sweep *sw, const hfvis_sweep_options *o)
+{
+    sw->parts = o->part_count > 1 ? o->part_count : 0;
+    sw->part = o->part_index;
+    if (sw->parts) sw->rect = 1; /* hf_line_rect skips the lines far from the band */
+}
+
+/* The band's geometry, once the direction's lattice is set (hf_sweep_group): the receivers' b
+ * range over the rectangle, and the lattice rows [band_j0, band_j1] whose lines lie within
+ * HF_RECT_MARGIN of the band (b grows by one per row: v is a unit vector). Rows outside are
+ * neither sampled nor filled nor read. */
+static void hf_sweep_band(hf_sweep *sw)
+{
+    const hfvis_lattice *L = &sw->L;
+    double lo = HFVIS__INF, hi = -HFVIS__INF, px, py, b0, b1, q0, q1, j0, j1;
+    int c;
+    for (c = 0; c < 4; c++) {
+        double x = (double)(c & 1 ? sw->rx1 - 1 : sw->rx0) + sw->ox;
+        double y = (double)(c & 2 ? sw->ry1 - 1 : sw->ry0) + sw->oy;
+        double b = x * L->vx + y * L->vy;
+        lo = b < lo ? b : lo;
+        hi = b > hi ? b : hi;
+    }
+    sw->part_b0 = lo;
+    sw->part_span = hi - lo;
+    hf_node_pos(L, L->i_min, L->j_min, &px, &py);
+    b0 = (px + sw->ox) * L->vx + (py + sw->oy) * L->vy;
+    hf_node_pos(L, L->i_min, L->j_min + 1, &px, &py);
+    b1 = (px + sw->ox) * L->vx + (py + sw->oy) * L->vy - b0;
+    q0 = lo + (hi - lo) * (double)sw->part / (double)sw->parts - HF_RECT_MARGIN;
+    q1 = lo + (hi - lo) * (double)(sw->part + 1) / (double)sw->parts + HF_RECT_MARGIN;
+    j0 = (q0 - b0) / b1;
+    j1 = (q1 - b0) / b1;
+    if (j0 > j1) {
+        double t = j0;
+        j0 = j1;
+        j1 = t;
+    }
+    j0 = floor(j0) - 1.0;
+    j1 = ceil(j1) + 1.0;
+    sw->band_j0 = j0 < 0.0 ? 0 : j0 > (double)sw->rows ? sw->rows : (int)j0;
+    sw->band_j1 = j1 < 0.0 ? -1 : j1 > (double)(sw->rows - 1) ? sw->rows - 1 : (int)j1;
+}
+
+/* The band of lattice coordinate b, 0..parts-1. */
+static int hf_band_of(double b, double b0, double span, int parts)
+{
+    double q = span > 0.0 ? (b - b0) / span * (double)parts : 0.0;
+    return q <= 0.0 ? 0 : q >= (double)(parts - 1) ? parts - 1 : (int)q;
+}
+
+/* 1 if receiver (x, y) is one of this call's: no bands, or in its band. */
+static int hf_sweep_mine(const hf_sweep *sw, int x, int y)
+{
+    const hfvis_lattice *L = &sw->L;
+    if (!sw->parts) return 1;
+    return hf_band_of(((double)x + sw->ox) * L->vx + ((double)y + sw->oy) * L->vy, sw->part_b0,
+                      sw->part_span, sw->parts) == sw->part;
+}
+
 static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
 {
     const hfvis_grid *g = sw->g;
@@ -1905,6 +1998,9 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
     sw->cols = L->i_max - L->i_min + 1;
     HFVIS_ASSERT(sw->rows <= hf_lattice_bound(g) && sw->cols <= hf_lattice_bound(g));
     HFVIS_ASSERT((size_t)sw->rows * (size_t)sw->cols <= sw->nodes_cap);
+    sw->band_j0 = 0;
+    sw->band_j1 = sw->rows - 1;
+    if (sw->parts) hf_sweep_band(sw);
     for (c = 0; c < sw->cols; c++) {
         sw->col_first[c] = INT_MAX;
         sw->col_last[c] = -1;
@@ -1912,6 +2008,11 @@ static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
     for (j = 0; j < sw->rows; j++) {
         int first, last;
         double *hr = sw->h + (size_t)j * (size_t)sw->cols;
+        if (j < sw->band_j0 || j > sw->band_j1) { /* another band's line: left untouched */
+            sw->row_first[j] = 1;
+            sw->row_last[j] = 0;
+            continue;
+        }
         if (!hfvis_lattice_line(L, j + L->j_min, &first, &last)) {
             sw->row_first[j] = 1;
             sw->row_last[j] = 0;
@@ -2263,13 +2364,18 @@ static int hf_sweep_line_window(hf_sweep *sw, int m, int i0, int j0, int di, int
 /* The nodes s in [*slo, *shi] of a line (first node (i0, j0), lattice step (di, dj), n nodes)
  * that lie within HF_RECT_MARGIN cells of the receiver rectangle: the only ones a gather of its
  * receivers reads (the taps within two lattice steps, under 3 cells). 0 if none. */
-#define HF_RECT_MARGIN 4.0
 static int hf_line_rect(const hf_sweep *sw, int i0, int j0, int di, int dj, int n, int *slo, int *shi)
 {
     const hfvis_lattice *L = &sw->L;
     double p[2], c[2], lo = -DBL_MAX, hi = DBL_MAX, blo[2], bhi[2];
     int a;
     hf_node_pos(L, i0 + L->i_min, j0 + L->j_min, &p[0], &p[1]);
+    if (sw->parts) { /* the band's b range, widened like the rectangle */
+        double bl = (p[0] + sw->ox) * L->vx + (p[1] + sw->oy) * L->vy;
+        double q0 = sw->part_b0 + sw->part_span * (double)sw->part / (double)sw->parts;
+        double q1 = sw->part_b0 + sw->part_span * (double)(sw->part + 1) / (double)sw->parts;
+        if (bl < q0 - HF_RECT_MARGIN || bl > q1 + HF_RECT_MARGIN) return 0;
+    }
     c[0] = (double)di * L->ux + (double)dj * L->vx;
     c[1] = (double)di * L->uy + (double)dj * L->vy;
     blo[0] = (double)sw->rx0 - HF_RECT_MARGIN;
@@ -2294,27 +2400,18 @@ static int hf_line_rect(const hf_sweep *sw, int i0, int j0, int di, int dj, int 
 }
 
 static inline double hf_svf_term(double t);
-static inline double hf_sky_term(double t, double nz, double a, double inv_k, double lobe);
 
 /* What is done with each tangent t at node p (s-th of a line): stored for the line's consumer,
- * or the sky-view or sky term added to the accumulator there (the sums' one copy: hf_svf_line
- * and hf_sky_line call it too). The kind is a constant at each call of hf_walk_line, so the
- * compiler writes one walk per kind, and the sums' tangents are never stored and read back.
- * sky: look direction (x, y), 1/K, the lobe factor. */
-enum { HF_WALK_STORE, HF_WALK_SVF, HF_WALK_SKY };
+ * or the sky-view term added to the accumulator there (the sum's one copy: hf_svf_line calls it
+ * too). The kind is a constant at each call of hf_walk_line, so the compiler writes one walk per
+ * kind, and the sum's tangents are never stored and read back. (The sky light's term is
+ * evaluated per line from stored tangents, in batches the compiler vectorizes: hf_sky_line.) */
+enum { HF_WALK_STORE, HF_WALK_SVF };
 
-static HFVIS__ALWAYS_INLINE void hf_walk_emit(int kind, double *lat, const float *nrm, const double sky[4],
-                                double *t, int s, ptrdiff_t p, double tan)
+static HFVIS__ALWAYS_INLINE void hf_walk_emit(int kind, double *lat, double *t, int s, ptrdiff_t p, double tan)
 {
-    if (kind == HF_WALK_STORE) {
-        t[s] = tan;
-    } else if (kind == HF_WALK_SVF) {
-        lat[p] += hf_svf_term(tan); /* a NaN tan (overflowing heights) adds +0: no change */
-    } else if (!isnan(tan)) {
-        const float *nr = nrm + p * 3;
-        double a = (double)nr[0] * sky[0] + (double)nr[1] * sky[1];
-        lat[p] += hf_sky_term(tan, (double)nr[2], a, sky[2], sky[3]);
-    }
+    if (kind == HF_WALK_STORE) t[s] = tan;
+    else lat[p] += hf_svf_term(tan); /* a NaN tan (overflowing heights) adds +0: no change */
 }
 
 /* The unlimited hull walk along one line (hull stack sh, sd of height top after the pre-roll):
@@ -2322,12 +2419,11 @@ static HFVIS__ALWAYS_INLINE void hf_walk_emit(int kind, double *lat, const float
  * of nodes without holes; inside a run the hull's top is the previous node one unit back, so
  * hf_hull_push gets its differences as (h_prev - h, 1.0) and, with no pop, the division by 1.0
  * drops out (the same bits as hf_hull_step). */
-static HFVIS__ALWAYS_INLINE void hf_walk_line(hf_sweep *sw, int kind, const double sky[4], ptrdiff_t node0,
+static HFVIS__ALWAYS_INLINE void hf_walk_line(hf_sweep *sw, int kind, ptrdiff_t node0,
                                 ptrdiff_t step, int slo, int shi, ptrdiff_t top, double *t)
 {
     double *sd = sw->sd, *sh = sw->lh, *lat = sw->lat, ds = 0.0; /* ds == s (integers, exact) */
     const double *hv = sw->h;
-    const float *nrm = sw->nrm;
     ptrdiff_t p = node0;
     int s;
     for (s = 0; s < slo; s++, p += step, ds += 1.0) { /* occluders only */
@@ -2341,11 +2437,11 @@ static HFVIS__ALWAYS_INLINE void hf_walk_line(hf_sweep *sw, int kind, const doub
             s++, p += step, ds += 1.0;
             continue;
         }
-        hf_walk_emit(kind, lat, nrm, sky, t, s, p, hf_hull_step(sh, sd, &top, h, ds));
+        hf_walk_emit(kind, lat, t, s, p, hf_hull_step(sh, sd, &top, h, ds));
         for (hp = h, s++, p += step, ds += 1.0; s <= shi; s++, p += step, ds += 1.0) {
             h = hv[p];
             if (isnan(h)) break;
-            hf_walk_emit(kind, lat, nrm, sky, t, s, p, hf_hull_push(sh, sd, &top, h, ds, hp - h, 1.0));
+            hf_walk_emit(kind, lat, t, s, p, hf_hull_push(sh, sd, &top, h, ds, hp - h, 1.0));
             hp = h;
         }
     }
@@ -2353,12 +2449,11 @@ static HFVIS__ALWAYS_INLINE void hf_walk_line(hf_sweep *sw, int kind, const doub
 
 /* Run orientation m of the current group: copy each line (with its pre-roll) out of the
  * sampled lattice, find the horizons, hand them to fn. brute = 1 uses the oracle. walk
- * (HF_WALK_SVF, HF_WALK_SKY with its constants sky) adds that sum inside the unlimited walk
+ * (HF_WALK_SVF) adds that sum inside the unlimited walk
  * instead; fn, its same sum, still serves the windowed and oracle paths. (Sweeping
  * columns several side by side, so each row step reads whole cache lines, measured no faster:
  * docs/performance.md.) */
-static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, void *ctx, int walk,
-                                 const double sky[4])
+static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, void *ctx, int walk)
 {
     int nlines = (m & 1) ? sw->cols : sw->rows, line;
     const hfvis_lattice *L = &sw->L;
@@ -2392,11 +2487,9 @@ static void hf_sweep_orientation(hf_sweep *sw, int m, int brute, hf_line_fn fn, 
         }
         if (R > 0) top = hf_preroll(sw, i0, j0, di, dj, sh, sd);
         if (walk == HF_WALK_SVF) {
-            hf_walk_line(sw, HF_WALK_SVF, NULL, node0, step, slo, shi, top, t);
-        } else if (walk == HF_WALK_SKY) {
-            hf_walk_line(sw, HF_WALK_SKY, sky, node0, step, slo, shi, top, t);
+            hf_walk_line(sw, HF_WALK_SVF, node0, step, slo, shi, top, t);
         } else {
-            hf_walk_line(sw, HF_WALK_STORE, NULL, node0, step, slo, shi, top, t);
+            hf_walk_line(sw, HF_WALK_STORE, node0, step, slo, shi, top, t);
             fn(sw, ctx, m, node0, step, shi + 1, t);
         }
     }
@@ -2634,6 +2727,7 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
         const int edge_row = open && !((double)y >= in_y0 && (double)y <= in_y1);
         for (x = tx; x < sw->rx1 && x < tx + HF_TILE; x++) {
             ptrdiff_t o = (ptrdiff_t)y * out_stride + x;
+            if (sw->parts && !hf_sweep_mine(sw, x, y)) continue; /* another band's */
             if (hf_is_hole(g, x, y)) {
                 for (c = 0; c < ch; c++) out[(size_t)c * plane_step + (size_t)o] = (float)HFVIS__NAN;
                 continue;
@@ -2769,8 +2863,10 @@ static void hf_gather_accumulate(hf_sweep *sw)
 
 static void hf_lattice_fill(hf_sweep *sw, double value)
 {
-    size_t i, n = (size_t)sw->rows * (size_t)sw->cols * (size_t)sw->channels;
-    for (i = 0; i < n; i++) sw->lat[i] = value;
+    const size_t row = (size_t)sw->cols * (size_t)sw->channels;
+    size_t i, n = sw->band_j1 < sw->band_j0 ? 0 : (size_t)(sw->band_j1 - sw->band_j0 + 1) * row;
+    double *lat = sw->lat + (size_t)sw->band_j0 * row; /* the band's rows (every row without) */
+    for (i = 0; i < n; i++) lat[i] = value;
 }
 
 /* hf_lattice_fill outside the rows' spans only, for a lattice whose every in-span node the
@@ -2861,7 +2957,7 @@ static hfvis_status hf_horizon_lattice_impl(const hfvis_grid *grid, double azimu
     hf_sweep_vector(azimuth_rad, &ux, &uy);
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HFVIS__NAN);
-    hf_sweep_orientation(&sw, 0, brute, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
+    hf_sweep_orientation(&sw, 0, brute, hf_store_elevation, NULL, HF_WALK_STORE);
     n = (size_t)sw.rows * (size_t)sw.cols;
     for (i = 0; i < n; i++) out[i] = (float)sw.lat[i];
     hf_sweep_free(&sw);
@@ -2903,7 +2999,7 @@ hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, int k,
     hf_direction_base(K, k, o.azimuth0_rad, &ux, &uy, &m);
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HFVIS__NAN);
-    hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
+    hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE);
     hf_gather_planes(&sw, 1, m, out, 0, out_stride);
     hf_sweep_free(&sw);
     hf_progress(&o, 1, 1);
@@ -2943,7 +3039,7 @@ static hfvis_status hf_horizon_map_range(const hfvis_grid *grid, int K, const hf
                 sampled = 1;
             }
             hf_lattice_fill(&sw, HFVIS__NAN);
-            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
+            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE);
             hf_gather_planes(&sw, 1, m, out + (size_t)(pos - begin) * plane, 0, grid->width);
             hf_progress(o, ++done, end - begin);
         }
@@ -2980,7 +3076,7 @@ hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_
         if (sw.rect) hf_lattice_fill(&sw, HFVIS__NAN);
         else hf_lattice_fill_outside(&sw, HFVIS__NAN);
         for (m = 0; m < per; m++) {
-            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
+            hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE);
             hf_progress(&o, ++done, K);
         }
         /* plane k = gidx + m*groups: channel m lands m*groups planes further on */
@@ -3007,7 +3103,7 @@ typedef struct hf_surface {
     double reach;              /* how far beyond the grid the march continues (cells) */
 } hf_surface;
 
-static double hf_surface_height(const hf_surface *S, double x, double y)
+static inline double hf_surface_height(const hf_surface *S, double x, double y)
 {
     if (S->fn) return S->fn(S->user, x, y);
     if (x >= 0.0 && y >= 0.0 && x <= (double)(S->width - 1) && y <= (double)(S->height - 1))
@@ -3016,15 +3112,17 @@ static double hf_surface_height(const hf_surface *S, double x, double y)
 }
 
 /* Per-receiver march ([P2] §1; P2's "naive method"): samples at p + s*step*l,
- * s = 1, 2, ..., while inside the grid (plus the border reach), keeping the largest slope; sign
- * -1 takes the slopes of the inverted surface -z (negative openness). */
-static double hf_march_tan(const hf_surface *S, double px, double py, double h0, double lx,
-                           double ly, double step, double max_dist, double sign)
+ * s = 1, 2, ..., while inside the grid (plus the border reach), keeping the largest slope.
+ * which = 1: best[0] = the largest (h - h0)/d (the terrain); which = 2: best[1] = the largest
+ * (h0 - h)/d (the inverted surface -z, negative openness); which = 3: both over the same walk,
+ * each equal to its own march bit for bit ((h0 - h) is -(h - h0) exactly). */
+static void hf_march_slopes(const hf_surface *S, double px, double py, double h0, double lx,
+                            double ly, double step, double max_dist, int which, double best[2])
 {
-    double best = -HFVIS__INF, xmin = -S->reach - HF_LATTICE_EPS, ymin = xmin;
+    double xmin = -S->reach - HF_LATTICE_EPS, ymin = xmin;
     double xmax = (double)(S->width - 1) + S->reach + HF_LATTICE_EPS;
     double ymax = (double)(S->height - 1) + S->reach + HF_LATTICE_EPS;
-    double inv = 1.0 / S->cell_size;
+    double inv = 1.0 / S->cell_size, up = -HFVIS__INF, low = HFVIS__INF;
     long s;
     for (s = 1;; s++) {
         double d = (double)s * step, x = px + d * lx, y = py + d * ly, h, t;
@@ -3034,10 +3132,21 @@ static double hf_march_tan(const hf_surface *S, double px, double py, double h0,
         y = y < 0.0 && y > -HF_LATTICE_EPS ? 0.0 : y;
         h = hf_surface_height(S, x, y);
         if (!isfinite(h)) continue;
-        t = (sign > 0.0 ? h - h0 : h0 - h) * inv / d;
-        if (t > best) best = t;
+        t = (h - h0) * inv / d; /* (h0 - h) * inv / d is exactly -t */
+        up = t > up ? t : up;
+        low = t < low ? t : low;
     }
-    return best;
+    best[0] = which & 1 ? up : -HFVIS__INF;
+    best[1] = which & 2 ? -low : -HFVIS__INF;
+}
+
+/* The march's largest slope of the terrain (sign > 0) or of -z (sign < 0). */
+static double hf_march_tan(const hf_surface *S, double px, double py, double h0, double lx,
+                           double ly, double step, double max_dist, double sign)
+{
+    double best[2];
+    hf_march_slopes(S, px, py, h0, lx, ly, step, max_dist, sign > 0.0 ? 1 : 2, best);
+    return sign > 0.0 ? best[0] : best[1];
 }
 
 static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0, int exact_bound,
@@ -3061,7 +3170,7 @@ static hfvis_status hf_reference_run(const hf_surface *S, int K, double azimuth0
                 out[i * (size_t)K + (size_t)k] = HFVIS__NAN;
                 continue;
             }
-            if (exact_bound > 0) { /* exact mode: along the actual direction (a, b) */
+            if (exact_bound != 0) { /* exact mode: along the actual direction (a, b) */
                 hf_ray r = hf_ray_nearest(azimuth0 + 2.0 * HFVIS__PI * (double)k / (double)K, exact_bound);
                 double len = sqrt((double)r.a * (double)r.a + (double)r.b * (double)r.b);
                 ux = -(double)r.a / len;
@@ -3155,16 +3264,23 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
     const int W = grid ? grid->width : 0, H = grid ? grid->height : 0;
     double radius = oo ? oo->radius : 0.0, step = oo && oo->step_cells > 0.0 ? oo->step_cells : 1.0;
     int negative = oo ? oo->negative : 0, x, y, k;
+    const ptrdiff_t second = (ptrdiff_t)H * out_stride; /* negative == 2: the negative plane */
     hfvis_sweep_options o;
     if (hf_check_common(grid, opts) != HFVIS_OK || K < 1 || !out || out_stride < W ||
-        !hfvis__plane_fits(out_stride, H, 4) || !isfinite(radius) || radius < 0.0 || !isfinite(step) ||
-        (oo && !(oo->step_cells >= 0.0)) || (negative != 0 && negative != 1))
+        !hfvis__plane_fits(out_stride, negative == 2 && H <= INT_MAX / 2 ? 2 * H : H, 4) ||
+        !isfinite(radius) || radius < 0.0 || !isfinite(step) || (oo && !(oo->step_cells >= 0.0)) ||
+        (negative != 0 && negative != 1 && negative != 2) || (negative == 2 && H > INT_MAX / 2))
         return HFVIS_ERR_INVALID_ARGUMENT;
-    if (hf_sweep_opts_limited(opts)) return HFVIS_ERR_INVALID_ARGUMENT; /* not honoured here */
+    /* a radius honours a receiver rectangle (each receiver's march is its own); a search radius
+     * or a window is not honoured here, nor a rectangle without a radius */
+    if (opts && (hf_radius_on(opts) || opts->extent_width != 0 || (radius == 0.0 && opts->receiver_width != 0)))
+        return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
-    if (radius > 0.0) { /* the march: no allocation */
+    if (radius > 0.0) { /* the march: no allocation; both signs from one walk when negative == 2 */
+        int rx0, ry0, rx1, ry1;
         hf_surface S;
         const double maxd = radius / grid->cell_size;
+        const int which = negative == 2 ? 3 : negative ? 2 : 1;
         memset(&S, 0, sizeof S);
         S.g = grid;
         S.width = W;
@@ -3172,25 +3288,39 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
         S.cell_size = grid->cell_size;
         S.border = o.border;
         S.reach = o.border == HFVIS_BORDER_OPEN ? 0.0 : (double)o.border_cells;
-        for (y = 0; y < H; y++) {
-            for (x = 0; x < W; x++) {
-                double h0 = (double)grid->z[(ptrdiff_t)y * grid->stride + x], sum = 0.0;
+        hf_receiver_rect(grid, &o, &rx0, &ry0, &rx1, &ry1);
+        for (y = ry0; y < ry1; y++) {
+            for (x = rx0; x < rx1; x++) {
+                const ptrdiff_t i = (ptrdiff_t)y * out_stride + x;
+                double h0 = (double)grid->z[(ptrdiff_t)y * grid->stride + x], sum[2] = {0.0, 0.0};
                 if (!isfinite(h0)) {
-                    out[(ptrdiff_t)y * out_stride + x] = (float)HFVIS__NAN;
+                    out[i] = (float)HFVIS__NAN;
+                    if (negative == 2) out[second + i] = (float)HFVIS__NAN;
                     continue;
                 }
                 for (k = 0; k < K; k++) {
-                    double ux, uy, t;
+                    double ux, uy, best[2];
                     hf_sweep_vector(o.azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K, &ux, &uy);
-                    t = hf_march_tan(&S, (double)x, (double)y, h0, -ux, -uy, step, maxd,
-                                     negative ? -1.0 : 1.0);
-                    /* the angle as a float, as the horizon outputs (and the sweep path) hold it */
-                    sum += HFVIS__HALF_PI - (double)(float)hf_tan_to_elevation(t);
+                    hf_march_slopes(&S, (double)x, (double)y, h0, -ux, -uy, step, maxd, which, best);
+                    /* each angle as a float, as the horizon outputs (and the sweep path) hold it */
+                    if (which & 1) sum[0] += HFVIS__HALF_PI - (double)(float)hf_tan_to_elevation(best[0]);
+                    if (which & 2) sum[1] += HFVIS__HALF_PI - (double)(float)hf_tan_to_elevation(best[1]);
                 }
-                out[(ptrdiff_t)y * out_stride + x] = (float)(sum / (double)K);
+                if (negative == 2) {
+                    out[i] = (float)(sum[0] / (double)K);
+                    out[second + i] = (float)(sum[1] / (double)K);
+                } else
+                    out[i] = (float)(sum[negative] / (double)K);
             }
-            hf_progress(&o, y + 1, H);
+            hf_progress(&o, y - ry0 + 1, ry1 - ry0);
         }
+    } else if (negative == 2) { /* the sweep: the positive plane, then the negative one */
+        hfvis_openness_options one = *oo;
+        hfvis_status s;
+        one.negative = 0;
+        if ((s = hfvis_openness(grid, K, &one, opts, out, out_stride)) != HFVIS_OK) return s;
+        one.negative = 1;
+        return hfvis_openness(grid, K, &one, opts, out + second, out_stride);
     } else { /* the sweep: a plane, its sums and (negative) the inverted surface */
         const size_t n = hf_grid_count(grid);
         float *plane = (float *)hfvis__alloc_array(o.alloc, n, sizeof(float));
@@ -3251,19 +3381,22 @@ double hfvis_sector_weight(int K, double nz, double a, double theta)
  * polynomial x P(x^2) of degree 17 on [0, 1], minimax for the absolute error (Remez exchange),
  * P evaluated by Estrin's scheme. Oracles and the angle outputs (horizon maps) keep libm's atan. */
 #define HF_ATAN_MAX_ERR 6e-9 /* rad, |hfvis__atan - atan| (Remez bound 5.76e-9): 1/20 of a float ulp at pi/2 */
-static inline double hf_atan(double t)
+static inline double hf_atan_poly(double x) /* atan x on [0, 1] */
 {
-    double x = fabs(t), s, s2, s4, p, y;
-    int big = x > 1.0; /* false for NaN, which then runs through as NaN */
-    if (big) x = 1.0 / x;
-    s = x * x;
-    s2 = s * s;
-    s4 = s2 * s2;
+    double s = x * x, s2 = s * s, s4 = s2 * s2, p;
     p = ((0.9999998863830964 + -0.3333259702893892 * s) + s2 * (0.19985906780335758 + -0.1416122929275394 * s)) +
         s4 * ((0.1049894642938515 + -0.07234858062458693 * s) +
               s2 * (0.03978123126172938 + -0.014401362402942217 * s)) +
         (s4 * s4) * 0.0024567256561116523;
-    y = x * p;
+    return x * p;
+}
+
+static inline double hf_atan(double t)
+{
+    double x = fabs(t), y;
+    int big = x > 1.0; /* false for NaN, which then runs through as NaN */
+    if (big) x = 1.0 / x;
+    y = hf_atan_poly(x);
     if (big) y = HFVIS__HALF_PI - y;
     return copysign(y, t);
 }
@@ -3299,7 +3432,7 @@ static inline double hf_sky_term(double t, double nz, double a, double inv_k, do
 typedef struct hf_fused {
     int K, k;
     double lx, ly;          /* look direction of direction k */
-    int walk;               /* HF_WALK_SVF, HF_WALK_SKY: fn's sum added inside the line walk */
+    int walk;               /* HF_WALK_SVF: fn's sum added inside the line walk */
     double inv_k, lobe;     /* the sky term's 1/K and lobe factor (hf_sky_setup) */
     size_t extra_size;      /* extra scratch bytes the consumer needs (sw->extra) */
     /* optional hooks: after a group's lattice is sampled, and instead of the P1 line walk */
@@ -3354,10 +3487,7 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
             ctx->k = k;
             hf_look_dir(sw, m, &ctx->lx, &ctx->ly);
             if (ctx->orient) ctx->orient(sw, m, ctx);
-            else {
-                const double sky[4] = {ctx->lx, ctx->ly, ctx->inv_k, ctx->lobe};
-                hf_sweep_orientation(sw, m, 0, fn, ctx, ctx->walk, sky);
-            }
+            else hf_sweep_orientation(sw, m, 0, fn, ctx, ctx->walk);
             hf_progress(o, ++done, end - begin);
         }
         hf_gather_accumulate(sw);
@@ -3380,27 +3510,82 @@ static void hf_fused_output(const hf_sweep *sw, double scale, double offset, flo
         }
 }
 
-/* The fused sky light's consumer: [P1] Eq. 5 per direction (hf_sky_term), inside the line
- * walk; hf_sky_line is the same sum over a line's stored tangents (windowed and oracle paths). */
+/* The fused sky light's consumer: [P1] Eq. 5 per direction over each line's stored tangents
+ * (hf_sky_line, every path: unlimited, windowed, oracle). */
 static void hf_sky_setup(hf_fused *f, int K)
 {
-    f->walk = HF_WALK_SKY;
+    f->walk = HF_WALK_STORE;
     f->inv_k = 1.0 / (double)K;
     f->lobe = sin(HFVIS__PI / (double)K) / HFVIS__PI;
 }
 
+/* hf_sky_term over HF_SKY_BATCH nodes in two loops without branches or calls, which the compiler
+ * vectorizes (gcc 12 at -O2 and -O3): the same operations in the same order as hf_sky_term and
+ * hf_atan, their branches as selects, so the same bits. A select between an arithmetic result and
+ * something else would be turned back into a branch around the arithmetic, which then may not be
+ * executed unconditionally (it could raise a floating-point exception): the reciprocal of the
+ * atan's range reduction is therefore formed for every node in the first loop, and the
+ * reduction's pi/2 - y written as b pi/2 + (1 - 2b) y with b in {0, 1} (exact either way, y >= 0).
+ * A node that hf_sky_term answers by a branch (t NaN, nz <= 0 or NaN, an infinite clamped tangent)
+ * gets -1 (a term is >= 0), and the caller takes it through hf_sky_term. */
+#define HF_SKY_BATCH 16
+static void hf_sky_batch(const double *restrict t, const double *restrict nz, const double *restrict a,
+                         double inv_k, double lobe, double *restrict r)
+{
+    double tcb[HF_SKY_BATCH], rxb[HF_SKY_BATCH];
+    int j;
+    for (j = 0; j < HF_SKY_BATCH; j++) {
+        double tc = -a[j] / nz[j];
+        tc = t[j] > tc ? t[j] : tc;
+        tcb[j] = tc;
+        rxb[j] = 1.0 / fabs(tc);
+    }
+    for (j = 0; j < HF_SKY_BATCH; j++) {
+        double tc = tcb[j], x = fabs(tc), big = x > 1.0 ? 1.0 : 0.0, y, q, v;
+        y = hf_atan_poly(x > 1.0 ? rxb[j] : x);
+        y = copysign(big * HFVIS__HALF_PI + (1.0 - 2.0 * big) * y, tc);
+        q = 1.0 / (1.0 + tc * tc);
+        v = nz[j] * inv_k * q + lobe * a[j] * ((HFVIS__HALF_PI - y) - tc * q);
+        v = v > 0.0 ? v : 0.0;
+        v = x <= DBL_MAX ? v : -1.0;
+        v = nz[j] > 0.0 ? v : -1.0;
+        r[j] = t[j] == t[j] ? v : -1.0;
+    }
+}
+
+/* The fused sky light's line consumer: [P1] Eq. 5 per direction over a line's stored tangents,
+ * HF_SKY_BATCH nodes at a time: each node's tangent, nz and n.l gathered into arrays (structure
+ * of arrays), hf_sky_batch, the terms added to the accumulator. */
 static void hf_sky_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdiff_t step, int n,
                         const double *t)
 {
     const hf_fused *c = (const hf_fused *)vctx;
     /* in locals: the store to lat could alias the context, so gcc reloaded them at every node */
-    const double sky[4] = {c->lx, c->ly, c->inv_k, c->lobe};
+    const double lx = c->lx, ly = c->ly, inv_k = c->inv_k, lobe = c->lobe;
     const float *nrm = sw->nrm;
-    double *lat = sw->lat;
-    int s;
+    double *lat = sw->lat, tb[HF_SKY_BATCH], nzb[HF_SKY_BATCH], ab[HF_SKY_BATCH], rb[HF_SKY_BATCH];
+    int s0, j;
     (void)m;
-    for (s = 0; s < n; s++, node0 += step)
-        if (!isnan(t[s])) hf_walk_emit(HF_WALK_SKY, lat, nrm, sky, NULL, s, node0, t[s]);
+    for (s0 = 0; s0 < n; s0 += HF_SKY_BATCH) {
+        int cnt = n - s0 < HF_SKY_BATCH ? n - s0 : HF_SKY_BATCH;
+        ptrdiff_t p = node0 + (ptrdiff_t)s0 * step;
+        for (j = 0; j < cnt; j++, p += step) {
+            const float *nr = nrm + p * 3;
+            tb[j] = t[s0 + j];
+            nzb[j] = (double)nr[2];
+            ab[j] = (double)nr[0] * lx + (double)nr[1] * ly;
+        }
+        for (; j < HF_SKY_BATCH; j++) tb[j] = HFVIS__NAN, nzb[j] = 1.0, ab[j] = 0.0;
+        hf_sky_batch(tb, nzb, ab, inv_k, lobe, rb);
+        for (j = 0, p = node0 + (ptrdiff_t)s0 * step; j < cnt; j++, p += step) {
+            double v = rb[j];
+            if (v < 0.0) {
+                if (isnan(tb[j])) continue;
+                v = hf_sky_term(tb[j], nzb[j], ab[j], inv_k, lobe);
+            }
+            lat[p] += v;
+        }
+    }
 }
 
 static int hf_light_args_valid(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
@@ -3517,7 +3702,7 @@ static void hf_svf_line(hf_sweep *sw, void *vctx, int m, ptrdiff_t node0, ptrdif
     (void)vctx;
     (void)m;
     for (s = 0; s < n; s++, node0 += step)
-        if (!isnan(t[s])) hf_walk_emit(HF_WALK_SVF, sw->lat, NULL, NULL, NULL, s, node0, t[s]);
+        if (!isnan(t[s])) hf_walk_emit(HF_WALK_SVF, sw->lat, NULL, s, node0, t[s]);
 }
 
 hfvis_status hfvis_sky_view_factor(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
@@ -3580,12 +3765,17 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
                                   double sun_elevation_rad, double sun_radius_rad,
                                   const hfvis_sweep_options *opts, float *out, ptrdiff_t out_stride)
 {
-    hfvis_sweep_options o;
+    hfvis_sweep_options o, whole;
     hf_sweep sw;
     hfvis_status s;
     double ux, uy;
     int x, y;
-    if (hf_check_common(grid, opts) != HFVIS_OK || !out || out_stride < grid->width ||
+    if (opts) { /* the bands are this call's own: checked here, refused elsewhere */
+        whole = *opts;
+        if (!hf_parts_valid(opts)) return HFVIS_ERR_INVALID_ARGUMENT;
+        whole.part_index = whole.part_count = 0;
+    }
+    if (hf_check_common(grid, opts ? &whole : NULL) != HFVIS_OK || !out || out_stride < grid->width ||
         !hfvis__plane_fits(out_stride, grid->height, 4) || !isfinite(sun_azimuth_rad) || !isfinite(sun_elevation_rad) || !isfinite(sun_radius_rad) ||
         sun_radius_rad < 0.0 || sun_elevation_rad < -HFVIS__HALF_PI || sun_elevation_rad > HFVIS__HALF_PI)
         return HFVIS_ERR_INVALID_ARGUMENT;
@@ -3595,13 +3785,15 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
                             out_stride);
     if ((s = hf_sweep_alloc(&sw, grid, &o, 0, 1, 0)) != HFVIS_OK) return s;
     hf_sweep_vector(sun_azimuth_rad, &ux, &uy);
+    hf_sweep_parts(&sw, &o);
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HFVIS__NAN);
-    hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
+    hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL, HF_WALK_STORE);
     hf_gather_planes(&sw, 1, 0, out, 0, out_stride);
     for (y = sw.ry0; y < sw.ry1; y++)
         for (x = sw.rx0; x < sw.rx1; x++) {
             float *p = out + (ptrdiff_t)y * out_stride + x;
+            if (!hf_sweep_mine(&sw, x, y)) continue;
             *p = (float)hf_sun_fraction(sun_elevation_rad, sun_radius_rad, (double)*p);
         }
     hf_sweep_free(&sw);
@@ -8197,8 +8389,10 @@ hfvis_status hfvis_partial_load(const char *path, const hfvis_allocator *alloc, 
  * line, an exact point of the surface. Every line is swept from its far end with the hull stack
  * of [P1] §5 (Alg. 1) over all its crossings, and each grid point on it reads the tangent of the
  * hull at its turn: the maximum over every crossing of its own ray, no interpolation between
- * lines. Distances are integers in units of 1/(|a||b|) of the step |(a, b)|, so the hull and the
- * per-receiver oracle (hfvis_horizon_exact_naive) compute the same quotients from the same heights.
+ * lines. Distances are integers in units of 1/(|a||b|) of the step |(a, b)|. Each receiver also
+ * takes the near-field limit t -> 0+ of its first cell (and under a radius the window's end),
+ * where the supremum is often no sample at all; the per-receiver oracle
+ * (hfvis_horizon_exact_naive) is the supremum over t > 0, every piece maximized in closed form.
  * Directions are the nearest representable ones (hfvis.h, "Exact rays"); the light integrals weight
  * each by its share of the circle. */
 
@@ -8223,17 +8417,31 @@ static int hf_floor_div(int num, int den) /* den > 0 */
     return (num % den != 0 && num < 0) ? q - 1 : q;
 }
 
-/* The resolved denominator bound of a run of K directions (hfvis.h). */
+/* The default rule for 32 < K <= 360 (hfvis.h, "Exact rays"): the cheapest direction (smallest
+ * |a| + |b|: a line's sweep costs |a| + |b| - 1 crossings per receiver) within HF_EXACT_TAU of
+ * psi_k, searched up to denominator HF_EXACT_CHEAP_N (which always holds one: for any slope some
+ * p/q with q <= 256 lies within 1/256 of it, Dirichlet, and 1/256 rad < 0.25 deg). The nearest
+ * direction with N = ceil(K/4) costs |a| + |b| ~ 0.8 N on average (K = 256: 51.5, K = 360: 73);
+ * the cheapest within 0.25 deg costs 12-21 at every K in that range. 0.25 deg <= a quarter of
+ * the sector 360/K deg there, so the chosen azimuths keep their order. */
+#define HF_EXACT_TAU (0.25 * HFVIS__PI / 180.0)
+#define HF_EXACT_CHEAP_N 256
+#define HF_EXACT_CHEAP_KMAX 360
+
+/* The resolved direction rule of a run of K directions (hfvis.h): N > 0, the nearest direction
+ * with max(|a|, |b|) <= N; -HF_EXACT_CHEAP_N, the cheapest within HF_EXACT_TAU. */
 static int hf_exact_bound(const hfvis_sweep_options *o, int K)
 {
     if (o->ray_denominator > 0) return o->ray_denominator;
     if (K == 1) return HF_EXACT_SUN_DENOMINATOR;
+    if (K > 32 && K <= HF_EXACT_CHEAP_KMAX) return -HF_EXACT_CHEAP_N;
     return (K + 3) / 4 > HF_EXACT_MIN_DENOMINATOR ? (K + 3) / 4 : HF_EXACT_MIN_DENOMINATOR;
 }
 
-/* Nearest direction (a, b), gcd 1, max(|a|, |b|) <= N, to azimuth psi; ties go to the smaller
- * |a| + |b| (the cheaper sweep). Searched in the first octant: for each a, the two b beside
- * a tan(theta). */
+/* The direction of rule N (hf_exact_bound) for azimuth psi. N > 0: the nearest (a, b), gcd 1,
+ * max(|a|, |b|) <= N; ties go to the smaller |a| + |b| (the cheaper sweep). N < 0: the smallest
+ * |a| + |b| with max(|a|, |b|) <= -N within HF_EXACT_TAU of psi; ties go to the nearer. Searched
+ * in the first octant: for each a, the two b beside a tan(theta). */
 static hf_ray hf_ray_nearest(double psi, int N)
 {
     hf_ray r;
@@ -8248,6 +8456,25 @@ static hf_ray hf_ray_nearest(double psi, int N)
     th = mirror ? HFVIS__HALF_PI - rr : rr;
     tn = tan(th);
     best = th; /* (1, 0) */
+    if (N < 0) { /* the cheapest within HF_EXACT_TAU; a + b only grows with a */
+        int cost = INT_MAX;
+        for (a = 1; a <= -N && a < cost; a++) {
+            double bf = floor((double)a * tn);
+            for (c = 0; c < 2; c++) {
+                int b = (int)bf + c;
+                double dev;
+                if (b < 0 || b > a || hf_gcd(a, b) != 1) continue;
+                dev = fabs(atan2((double)b, (double)a) - th);
+                if (dev <= HF_EXACT_TAU && (a + b < cost || (a + b == cost && dev < best))) {
+                    cost = a + b;
+                    best = dev;
+                    ba = a;
+                    bb = b;
+                }
+            }
+        }
+        N = cost == INT_MAX ? -N : 0; /* none (never, see HF_EXACT_CHEAP_N): the nearest */
+    }
     for (a = 1; a <= N; a++) {
         double bf = floor((double)a * tn);
         for (c = 0; c < 2; c++) {
@@ -8362,9 +8589,38 @@ typedef struct hf_exact {
     int ox, oy;             /* the tile's origin in the raster (hfvis.h, "Search radius and tiles") */
     int rx0, ry0, rx1, ry1; /* the receiver rectangle, [rx0, rx1) x [ry0, ry1) */
     int rect;               /* 1: a proper sub-rectangle */
+    int parts, part;        /* bands across the direction (hfvis_sun_visibility), 0 = off */
+    int64_t c0, cspan;      /* the receivers' line index c = x*b - y*a: its least value, count */
     void *block;
     const hfvis_allocator *alloc;
 } hf_exact;
+
+/* Bands across an exact direction (a, b) (hfvis_sweep_options part_index/part_count): the
+ * receivers of a line share c = x*b - y*a, an integer, so the bands are ranges of c over the
+ * receiver rectangle and a line is swept by exactly one call. */
+static void hf_exact_parts(hf_exact *E, const hfvis_sweep_options *o, hf_ray r)
+{
+    int64_t lo = INT64_MAX, hi = INT64_MIN;
+    int c;
+    E->parts = o->part_count > 1 ? o->part_count : 0;
+    E->part = o->part_index;
+    for (c = 0; c < 4; c++) {
+        int64_t x = c & 1 ? E->rx1 - 1 : E->rx0, y = c & 2 ? E->ry1 - 1 : E->ry0;
+        int64_t v = x * (int64_t)r.b - y * (int64_t)r.a;
+        lo = v < lo ? v : lo;
+        hi = v > hi ? v : hi;
+    }
+    E->c0 = lo;
+    E->cspan = hi - lo + 1;
+}
+
+/* 1 if the line through receiver (x, y) along (a, b) is one of this call's. */
+static int hf_exact_mine(const hf_exact *E, int x, int y, hf_ray r)
+{
+    int64_t v = (int64_t)x * (int64_t)r.b - (int64_t)y * (int64_t)r.a;
+    if (!E->parts) return 1;
+    return (v - E->c0) * (int64_t)E->parts / E->cspan == (int64_t)E->part;
+}
 
 /* The piece after each crossing e (to crossing e + 1, the last one to the next grid point at
  * u = L): its cell, found from its midpoint, and its ends in that cell's coordinates. */
@@ -8463,6 +8719,37 @@ static inline double hf_cell_twist(const float *p, ptrdiff_t stride)
     return (double)p[0] - (double)p[1] - (double)p[stride] + (double)p[stride + 1];
 }
 
+/* The four taps of cell (cx, cy) under the border rule into z (z00, z10, z01, z11: a 2 x 2 cell
+ * of row stride 2): inside the grid, or for CLAMP/WRAP within the reach R beyond it (clamped or
+ * wrapped taps, the cells of hf_sample_border's surface); 0 outside that or when a tap is a hole. */
+static int hf_exact_cell_taps(const hfvis_grid *g, hfvis_border border, int R, int cx, int cy, float *z)
+{
+    int j;
+    if (cx >= 0 && cy >= 0 && cx + 1 < g->width && cy + 1 < g->height) {
+        const float *p = g->z + (ptrdiff_t)cy * g->stride + cx;
+        z[0] = p[0];
+        z[1] = p[1];
+        z[2] = p[g->stride];
+        z[3] = p[g->stride + 1];
+    } else {
+        if (border == HFVIS_BORDER_OPEN || cx < -R || cy < -R || cx + 1 > g->width - 1 + R ||
+            cy + 1 > g->height - 1 + R)
+            return 0;
+        for (j = 0; j < 4; j++) {
+            int X = cx + (j & 1), Y = cy + (j >> 1);
+            if (border == HFVIS_BORDER_WRAP) {
+                X = (X % g->width + g->width) % g->width;
+                Y = (Y % g->height + g->height) % g->height;
+            } else {
+                X = X < 0 ? 0 : (X > g->width - 1 ? g->width - 1 : X);
+                Y = Y < 0 ? 0 : (Y > g->height - 1 ? g->height - 1 : Y);
+            }
+            z[j] = g->z[(ptrdiff_t)Y * g->stride + X];
+        }
+    }
+    return isfinite(z[0]) && isfinite(z[1]) && isfinite(z[2]) && isfinite(z[3]);
+}
+
 /* The interior samples of a piece in the cell whose tap (0, 0) is p (row stride `stride`), its
  * bulge above lim (hf_piece_samples). */
 static int hf_piece_fill(const float *p, ptrdiff_t stride, const hf_cross *c, double bulge, double lim,
@@ -8482,22 +8769,19 @@ static int hf_piece_fill(const float *p, ptrdiff_t stride, const hf_cross *c, do
     return m - 1;
 }
 
-/* Interior samples of piece c after base grid point (X, Y) (see HF_EXACT_BULGE): writes up to
- * HF_EXACT_MAX_SPLIT - 1 heights h[j] at sub-step offsets du[j] from the piece's start, in
- * increasing order, and returns the count; 0 for a piece that is not concave enough, outside
- * the grid or touching a hole. Inline: most pieces are rejected here. */
-static inline int hf_piece_samples(const hfvis_grid *g, int X, int Y, const hf_cross *c, double *h,
-                                   double *du)
+/* Interior samples of piece c after base grid point (X, Y) (see HF_EXACT_BULGE), its cell's taps
+ * under the border rule (hf_exact_cell_taps): writes up to HF_EXACT_MAX_SPLIT - 1 heights h[j]
+ * at sub-step offsets du[j] from the piece's start, in increasing order, and returns the count;
+ * 0 for a piece that is not concave enough, out of reach or touching a hole. */
+static int hf_piece_samples(const hfvis_grid *g, hfvis_border border, int R, int X, int Y,
+                            const hf_cross *c, double *h, double *du)
 {
-    int cx = X + c->cx, cy = Y + c->cy;
-    double bulge, lim;
-    /* cx in [0, width - 2], cy in [0, height - 2] (the unsigned casts take the negatives out) */
-    if (c->du == 0.0 || (unsigned)cx >= (unsigned)(g->width - 1) || (unsigned)cy >= (unsigned)(g->height - 1))
-        return 0;
-    bulge = c->q * hf_cell_twist(g->z + (ptrdiff_t)cy * g->stride + cx, g->stride);
-    lim = HF_EXACT_BULGE * g->cell_size;
+    float z[4];
+    double bulge, lim = HF_EXACT_BULGE * g->cell_size;
+    if (c->du == 0.0 || !hf_exact_cell_taps(g, border, R, X + c->cx, Y + c->cy, z)) return 0;
+    bulge = c->q * hf_cell_twist(z, 2);
     if (!(bulge > lim) || !isfinite(bulge)) return 0;
-    return hf_piece_fill(g->z + (ptrdiff_t)cy * g->stride + cx, g->stride, c, bulge, lim, h, du);
+    return hf_piece_fill(z, 2, c, bulge, lim, h, du);
 }
 
 /* Whole periods k >= 0 of the ray from grid point (x, y) along (a, b) that can hold a crossing
@@ -8598,7 +8882,7 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
         for (e = P - 1; e >= 0; e--) {
             int X = bx + cr[e].ox, Y = by + cr[e].oy;
             double h;
-            j = hf_piece_samples(g, bx, by, cr + e, ph, pu);
+            j = hf_piece_samples(g, E->border, E->R, bx, by, cr + e, ph, pu);
             while (j-- > 0) { /* the piece after crossing e, far end first */
                 if (isnan(ph[j])) continue;
                 sd[n] = -((double)k * L + (cr[e].u + pu[j]));
@@ -8713,6 +8997,99 @@ static int64_t hf_exact_window(double radius, double scale)
     return hf_radius_units(16.0 * (radius * scale));
 }
 
+/* The near-field term of a receiver at grid point (x, y), height hr: the t -> 0+ limit of the
+ * elevation tangent along (a, b), the slope of the bilinear cell the ray leaves by at its corner
+ * (x, y), (dz/dx |a| + dz/dy |b|) / (|(a, b)| cell) with the corner's two edge differences
+ * (the twist is second order). -INFINITY on the axes (the surface along a grid line is linear,
+ * so the limit is the first grid point's own tangent) and where that cell is out of reach or
+ * touches a hole. inv_den = hf_exact_inv_den. The sweep (its inner cells inline, the same
+ * expression) and hfvis_horizon_exact_naive both compute it so: the same bits. */
+static double hf_exact_first_slope(const hfvis_grid *g, hfvis_border border, int R, int x, int y,
+                                   int a, int b, double hr, double inv_den)
+{
+    int cx = a < 0 ? x - 1 : x, cy = b < 0 ? y - 1 : y, A = a < 0 ? -a : a, B = b < 0 ? -b : b;
+    float z[4];
+    double zx, zy;
+    if (A == 0 || B == 0 || !hf_exact_cell_taps(g, border, R, cx, cy, z)) return -HFVIS__INF;
+    zx = (double)z[(cy == y ? 0 : 2) + (cx == x ? 1 : 0)]; /* the tap (x + sign a, y) */
+    zy = (double)z[(cy == y ? 2 : 0) + (cx == x ? 0 : 1)]; /* the tap (x, y + sign b) */
+    return ((zx - hr) * (double)A + (zy - hr) * (double)B) * inv_den;
+}
+
+/* 1 / (|(a, b)| cell), the first slope's factor (one expression for the sweep and the oracle). */
+static double hf_exact_inv_den(const hfvis_grid *g, int a, int b)
+{
+    return 1.0 / (sqrt((double)a * (double)a + (double)b * (double)b) * g->cell_size);
+}
+
+/* The far end of a receiver's window: under a radius, the surface point at exactly ucut
+ * sub-steps (hf_exact_window / 16) along its ray (a, b) from grid point (x, y), height hr, as a
+ * tangent per sub-step (the supremum within R can lie there, between two samples). Its cell is the
+ * one the ray is in just before the cut (along an axis, the cell beside the line, the next one
+ * where that is out of reach); -INFINITY where no such cell is in reach with four finite taps. */
+static double hf_exact_cut(const hfvis_grid *g, hfvis_border border, int R, int x, int y, int a, int b,
+                           double L, double ucut, double hr)
+{
+    double px = (double)x + ucut * (double)a / L, py = (double)y + ucut * (double)b / L, fx, fy;
+    float z[4];
+    int cx, cy;
+    if (!(ucut > 0.0) || fabs(px) > (double)INT_MAX / 2.0 || fabs(py) > (double)INT_MAX / 2.0) return -HFVIS__INF;
+    cx = a > 0 ? (int)ceil(px) - 1 : (int)floor(px);
+    cy = b > 0 ? (int)ceil(py) - 1 : (int)floor(py);
+    if (!hf_exact_cell_taps(g, border, R, cx, cy, z)) {
+        if (a == 0 && hf_exact_cell_taps(g, border, R, cx - 1, cy, z)) cx--;
+        else if (b == 0 && hf_exact_cell_taps(g, border, R, cx, cy - 1, z)) cy--;
+        else return -HFVIS__INF;
+    }
+    fx = px - (double)cx;
+    fy = py - (double)cy;
+    {
+        double z0 = (double)z[0], z1 = (double)z[1], z2 = (double)z[2], z3 = (double)z[3];
+        double r0 = z0 + (z1 - z0) * fx, r1 = z2 + (z3 - z2) * fx;
+        return (r0 + (r1 - r0) * fy - hr) / ucut;
+    }
+}
+
+/* The per-receiver terms over the receiver rectangle: each tangent becomes the largest of the
+ * hull's, the first piece's t -> 0+ limit (hf_exact_first_slope) and, under a radius, the
+ * window's far end (hf_exact_cut); holes stay NaN. */
+static void hf_exact_near(hf_exact *E, int a, int b, double L, double scale)
+{
+    const hfvis_grid *g = E->g;
+    const double inv_den = hf_exact_inv_den(g, a, b), ucut = (double)E->win_rw / 16.0;
+    const double Ad = (double)(a < 0 ? -a : a), Bd = (double)(b < 0 ? -b : b);
+    const int diag = a != 0 && b != 0;
+    int x, y;
+    for (y = E->ry0; y < E->ry1; y++) {
+        double *t = E->tan + (size_t)y * (size_t)g->width;
+        const float *z = g->z + (ptrdiff_t)y * g->stride;
+        /* the first cells inside the grid: its taps read directly (hf_exact_first_slope's bits) */
+        const int cy = b < 0 ? y - 1 : y, sx = a < 0 ? -1 : 1;
+        const ptrdiff_t sy = b < 0 ? -g->stride : g->stride;
+        const int in_row = cy >= 0 && cy + 1 < g->height;
+        for (x = E->rx0; x < E->rx1; x++) {
+            double s;
+            if (isnan(t[x])) continue;
+            if (diag) {
+                int cx = a < 0 ? x - 1 : x;
+                if (in_row && cx >= 0 && cx + 1 < g->width) {
+                    /* finite s: finite zx and zy (|s| <= 2^128 4096 / den); then zd decides */
+                    double hr = (double)z[x], zx = (double)z[x + sx], zy = (double)z[x + sy];
+                    s = ((zx - hr) * Ad + (zy - hr) * Bd) * inv_den;
+                    if (!isfinite(s) || !isfinite(z[x + sx + sy])) s = -HFVIS__INF;
+                } else {
+                    s = hf_exact_first_slope(g, E->border, E->R, x, y, a, b, (double)z[x], inv_den);
+                }
+                if (s > t[x]) t[x] = s;
+            }
+            if (E->win_rw >= 0) {
+                s = hf_exact_cut(g, E->border, E->R, x, y, a, b, L, ucut, (double)z[x]) * scale;
+                if (s > t[x]) t[x] = s;
+            }
+        }
+    }
+}
+
 /* Tangents of every grid point toward ray r into E->tan (-INFINITY: no terrain, NaN: hole).
  * Heads are enumerated row by row, so consecutive lines are neighbours. */
 static void hf_exact_sweep(hf_exact *E, hf_ray r)
@@ -8738,38 +9115,90 @@ static void hf_exact_sweep(hf_exact *E, hf_ray r)
         }
         if (xlo < 0) xlo = 0;
         if (xhi > g->width - 1) xhi = g->width - 1;
-        for (x = xlo; x <= xhi; x++) hf_exact_line(E, x, y, r.a, r.b, P, L, scale);
+        for (x = xlo; x <= xhi; x++)
+            if (hf_exact_mine(E, x, y, r)) hf_exact_line(E, x, y, r.a, r.b, P, L, scale);
     }
+    if ((r.a != 0 && r.b != 0) || E->win_rw >= 0) hf_exact_near(E, r.a, r.b, L, scale);
 }
 
-/* Oracle twin of hf_exact_sweep for one receiver: every crossing of its own ray within the
- * window rw (1/16 sub-steps, hf_exact_window; -1 = unlimited), the same heights and quotients,
- * the largest kept. */
+/* The supremum of (h(u) - hr)/u (height per sub-step) over the interior of piece c (cell taps z,
+ * hf_exact_cell_taps) starting u0 > 0 sub-steps from the receiver and cut at umax: along the
+ * piece h(t) = H0 + H1 t + H2 t^2, t in [0, 1], u = u0 + t du; its stationary points solve
+ * H2 du t^2 + 2 H2 u0 t + H1 u0 - (H0 - hr) du = 0. Candidates: the roots inside (0, 1) and
+ * before the cut (the crossings at the ends and the cut are points of their own); none in the
+ * first piece (u0 = 0, where the tangent is linear in t: hf_exact_first_slope). -INFINITY if none. */
+static double hf_exact_piece_sup(const float *zf, const hf_cross *c, double u0, double hr, double umax)
+{
+    double z[4], w, dfx = c->fx1 - c->fx0, dfy = c->fy1 - c->fy0, H0, H1, H2, al, be, ga;
+    double t1 = 1.0, best = -HFVIS__INF, root[2], disc;
+    int n = 0, i;
+    z[0] = (double)zf[0];
+    z[1] = (double)zf[1];
+    z[2] = (double)zf[2];
+    z[3] = (double)zf[3];
+    w = z[0] - z[1] - z[2] + z[3];
+    H0 = z[0] + (z[1] - z[0]) * c->fx0 + (z[2] - z[0]) * c->fy0 + w * c->fx0 * c->fy0;
+    H1 = (z[1] - z[0]) * dfx + (z[2] - z[0]) * dfy + w * (c->fx0 * dfy + c->fy0 * dfx);
+    H2 = w * dfx * dfy;
+    al = H2 * c->du;
+    be = 2.0 * H2 * u0;
+    ga = H1 * u0 - (H0 - hr) * c->du;
+    if (u0 + c->du > umax) { /* the cut (its own point: hf_exact_cut) */
+        t1 = (umax - u0) / c->du;
+        if (!(t1 > 0.0)) return best;
+    }
+    disc = be * be - 4.0 * al * ga;
+    if (u0 > 0.0 && al != 0.0 && disc >= 0.0) { /* u0 = 0 (the first piece): linear in t */
+        double q = -0.5 * (be + (be < 0.0 ? -sqrt(disc) : sqrt(disc)));
+        if (q != 0.0) {
+            root[n++] = q / al;
+            root[n++] = ga / q;
+        }
+    }
+    for (i = 0; i < n; i++) {
+        double t = root[i], s;
+        if (!(t > 0.0 && t <= t1)) continue;
+        s = (H0 + (H1 + H2 * t) * t - hr) / (u0 + t * c->du);
+        if (s > best) best = s;
+    }
+    return best;
+}
+
+/* Oracle of the exact mode for one receiver: the supremum over t > 0 of the elevation tangent
+ * along its own ray over the bilinear surface, within the window rw (1/16 sub-steps,
+ * hf_exact_window; -1 = unlimited): every crossing (hf_cross_height, the sweep's heights), every
+ * piece's interior in closed form (hf_exact_piece_sup), the window's far end (hf_exact_cut) and
+ * the first piece's t -> 0+ limit (hf_exact_first_slope); the largest kept. */
 static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, const hf_cross *cr,
                              int P, double L, double scale, int a, int b, int x, int y, int64_t rw)
 {
-    double hr = (double)g->z[(ptrdiff_t)y * g->stride + x], best = -HFVIS__INF;
+    double hr = (double)g->z[(ptrdiff_t)y * g->stride + x], best = -HFVIS__INF, s;
+    double umax = rw >= 0 ? (double)rw / 16.0 : HFVIS__INF;
     int k, e, kmax = hf_exact_periods(g, R, x, y, a, b);
     if (!isfinite(hr)) return HFVIS__NAN;
     for (k = 0; k <= kmax; k++)
         for (e = 0; e < P; e++) {
-            int X = x + k * a + cr[e].ox, Y = y + k * b + cr[e].oy, j;
-            double h, s, ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
-            int np = hf_piece_samples(g, x + k * a, y + k * b, cr + e, ph, pu);
-            for (j = 0; j < np; j++) {
-                if (isnan(ph[j])) continue;
-                if (rw >= 0 && 16.0 * ((double)k * L + (cr[e].u + pu[j])) > (double)rw) continue;
-                s = (ph[j] - hr) / ((double)k * L + (cr[e].u + pu[j])) * scale;
+            int X = x + k * a + cr[e].ox, Y = y + k * b + cr[e].oy;
+            double h, u = (double)k * L + cr[e].u;
+            float z[4];
+            if (cr[e].du > 0.0 && u < umax &&
+                hf_exact_cell_taps(g, border, R, x + k * a + cr[e].cx, y + k * b + cr[e].cy, z)) {
+                s = hf_exact_piece_sup(z, cr + e, u, hr, umax) * scale;
                 if (s > best) best = s;
             }
             if ((k == 0 && e == 0) || !hf_cross_inside(g, R, X, Y, cr + e)) continue;
-            if (rw >= 0 && 16.0 * ((double)k * L + cr[e].u) > (double)rw) continue;
+            if (rw >= 0 && 16.0 * u > (double)rw) continue;
             h = hf_cross_height(g, border, X, Y, cr + e);
             if (isnan(h)) continue;
-            s = (h - hr) / ((double)k * L + cr[e].u) * scale;
+            s = (h - hr) / u * scale;
             if (s > best) best = s;
         }
-    return best;
+    if (rw >= 0) {
+        s = hf_exact_cut(g, border, R, x, y, a, b, L, umax, hr) * scale;
+        if (s > best) best = s;
+    }
+    hr = hf_exact_first_slope(g, border, R, x, y, a, b, hr, hf_exact_inv_den(g, a, b));
+    return hr > best ? hr : best;
 }
 
 /* Scratch of one exact-mode call, one block: the K directions and their quadrature, the
@@ -8805,9 +9234,9 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     }
     gridn = hf_grid_count(g);
     /* a line crosses each grid line once (W + H + 4R of them within reach) and has at most
-       W + H pieces inside the grid, each split at most HF_EXACT_MAX_SPLIT - 1 times */
+       W + H + 4R + 2 pieces within reach, each split at most HF_EXACT_MAX_SPLIT - 1 times */
     cap = (size_t)g->width + (size_t)g->height + 4u * (size_t)E->R + 8u +
-          ((size_t)g->width + (size_t)g->height + 2u) * (HF_EXACT_MAX_SPLIT - 1);
+          ((size_t)g->width + (size_t)g->height + 4u * (size_t)E->R + 2u) * (HF_EXACT_MAX_SPLIT - 1);
     off_ray = hf_align_add(&total, (size_t)K, sizeof(hf_ray), &ok);
     off_d = hf_align_add(&total, (size_t)K * 5u, sizeof(double), &ok);
     off_c = hf_align_add(&total, (size_t)maxp, sizeof(hf_cross), &ok);
@@ -9045,10 +9474,12 @@ static hfvis_status hf_exact_sun(const hfvis_grid *g, double azimuth, double ele
     int x, y;
     o1.azimuth0_rad = azimuth;
     if ((s = hf_exact_init(&E, g, 1, &o1, 1, 0, 0)) != HFVIS_OK) return s;
+    hf_exact_parts(&E, o, E.d.ray[0]);
     hf_exact_sweep(&E, E.d.ray[0]);
     for (y = E.ry0; y < E.ry1; y++)
         for (x = E.rx0; x < E.rx1; x++) {
             double t = E.tan[(size_t)y * (size_t)g->width + (size_t)x];
+            if (!hf_exact_mine(&E, x, y, E.d.ray[0])) continue;
             out[(ptrdiff_t)y * out_stride + x] =
                 (float)hf_sun_fraction(elevation, radius, hf_tan_to_elevation(t));
         }

@@ -131,7 +131,11 @@
  * Horizon values are elevation angles alpha in [-pi/2, pi/2] above the horizontal plane: the
  *   largest elevation under which the receiver sees terrain toward psi. A receiver that sees no
  *   terrain in that direction (open border) gets alpha = -pi/2. Internally the sweep keeps the
- *   tangent t = tan(alpha) in double.
+ *   tangent t = tan(alpha) in double. Which definition each mode computes: the lattice mode
+ *   keeps [P1] as published (the maximum over the nodes of the lattice lines, gathered; [P1]
+ *   §4-§7); exact rays (see "Exact rays") approach the supremum over t > 0 of
+ *   atan((h(p + t d) - h(p)) / t) over the bilinear surface along the ray, next to the receiver
+ *   included, and their oracle hfvis_horizon_exact_naive computes that supremum.
  * Borders. HFVIS_BORDER_OPEN (default, as in the papers): nothing exists outside the grid.
  *   HFVIS_BORDER_CLAMP: edge heights extend outward. HFVIS_BORDER_WRAP: the field is periodic
  *   with period width x height (tileable fields).
@@ -150,6 +154,17 @@
  *   overflows PTRDIFF_MAX, is HFVIS_ERR_INVALID_ARGUMENT like any other bad size. The library never
  *   prints, never exits, never aborts on input, and has no global mutable state: every
  *   function is reentrant and may run concurrently on different outputs.
+ * Threads. The library starts none. Inputs (grids, environments, tables, options, meshes) are
+ *   only read, so any number of calls may share them while no call writes them; an allocator
+ *   shared by concurrent calls must itself be thread-safe (give each thread its own). Outputs
+ *   must not overlap, with one exception: the bands of hfvis_sun_visibility (sweep options
+ *   part_index/part_count) write disjoint cells, so the part_count calls of one sun may write
+ *   one out concurrently. Splitting a run over threads without changing a bit: the sums by
+ *   direction range (hfvis_direction_sums: one quarter-turn group, or in exact mode one
+ *   direction, per part, added in order), the horizon map by plane range, one sun by bands,
+ *   and any receiver-local result by windows ("Search radius and tiles"). The hfvis tool's
+ *   --threads does exactly that; test/thread_test.c runs these calls concurrently on shared
+ *   inputs under ThreadSanitizer (make sanitize).
  * Memory. The caller owns every output and sizes it with the documented formula or a *_size()
  *   query. Scratch comes from the optional allocator in the options (NULL = malloc/free);
  *   test/test_args.c's allocator sweep lists every function that allocates and fails each of
@@ -370,8 +385,16 @@ HFVIS_API hfvis_write_options hfvis_write_options_default(void);
  * exceed 255 bytes, the component is cut so the name fits), which is then renamed onto path.
  * path is either complete or untouched; on failure the temporary file is removed. bytes may be
  * NULL when n is 0. A symbolic link at path is replaced by the file, not written through.
- * Returns HFVIS_OK, HFVIS_ERR_INVALID_ARGUMENT (NULL or empty path, NULL bytes with n > 0),
- * HFVIS_ERR_IO or HFVIS_ERR_OUT_OF_MEMORY (the name). */
+ * Returns HFVIS_OK only when path holds all n bytes; HFVIS_ERR_IO when the file cannot be
+ * created, or on any short fwrite (disk full, file-size limit), failed fflush or fclose (a
+ * delayed write error) or failed rename, each of which leaves path untouched and no temporary
+ * file; HFVIS_ERR_INVALID_ARGUMENT (NULL or empty path, NULL bytes with n > 0) or
+ * HFVIS_ERR_OUT_OF_MEMORY (the name). Every saver of the library (hfvis_pfm_save,
+ * hfvis_pgm_save, hfvis_pgm_range_save, hfvis_mesh_save, hfvis_binvox_save, ...) returns this
+ * status unchanged.
+ * Test hooks: the write path calls HFVIS_FWRITE, HFVIS_FFLUSH, HFVIS_FCLOSE and HFVIS_RENAME,
+ * which are fwrite, fflush, fclose and rename unless defined (same signatures) when the
+ * library's .c files are compiled; test/test_wfault.c fails each call of every writer in turn. */
 HFVIS_API hfvis_status hfvis_write_file(const char *path, const void *bytes, size_t n,
                                         const hfvis_write_options *opts);
 
@@ -385,7 +408,8 @@ HFVIS_API hfvis_status hfvis_write_file(const char *path, const void *bytes, siz
  * hfvis_write_begin returns HFVIS_OK, HFVIS_ERR_INVALID_ARGUMENT (a NULL or empty path, NULL
  * file or temp_path), HFVIS_ERR_IO or HFVIS_ERR_OUT_OF_MEMORY (the name), and sets *file and
  * *temp_path to NULL on failure. hfvis_write_end returns HFVIS_OK when path holds the new file
- * (or, with commit 0, when the file was discarded), HFVIS_ERR_IO when it could not be written,
+ * (or, with commit 0, when the file was discarded), HFVIS_ERR_IO when it could not be written
+ * (a write error seen by ferror, a failed fflush, fclose or rename: path is untouched),
  * HFVIS_ERR_INVALID_ARGUMENT for a NULL file, temp_path or path (it still releases the others).
  * Declared only where <stdio.h> is available (not with HFVIS_NO_STDIO). */
 #ifndef HFVIS_NO_STDIO
@@ -575,7 +599,9 @@ typedef struct hfvis_sweep_options {
     hfvis_direction_order direction_order; /* how direction_begin/end count; default INDEX */
     hfvis_ray_mode rays;            /* default HFVIS_RAYS_LATTICE; EXACT: see "Exact rays" */
     int ray_denominator;            /* EXACT: bound N on the direction's integer components,
-                                       1..HFVIS_RAY_DENOMINATOR_MAX; 0 = max(5, ceil(K/4)), and 64
+                                       1..HFVIS_RAY_DENOMINATOR_MAX (the nearest direction);
+                                       0 = the default rule of "Exact rays": max(5, ceil(K/4)),
+                                       the cheapest within 0.25 deg for 32 < K <= 360, and 64
                                        for a single direction (K = 1, hfvis_sun_visibility) */
     double max_distance;            /* R, world units: occluders farther than R from the receiver,
                                        measured horizontally along the ray, are ignored; 0 =
@@ -593,6 +619,17 @@ typedef struct hfvis_sweep_options {
                                        (inside it, else HFVIS_ERR_INVALID_ARGUMENT); */
     int receiver_width, receiver_height; /* 0, 0 = every receiver (default); outputs outside it
                                        are left unwritten; the work shrinks with it */
+    int part_index, part_count;     /* hfvis_sun_visibility only (both ray modes): compute only the
+                                       receivers of band part_index of part_count bands across the
+                                       sun's direction (each receiver belongs to the band of its
+                                       distance across the sweep lines), so that threads can share
+                                       one call's lines: every receiver is in exactly one band, its
+                                       output equals the whole call's bit for bit, cells of the
+                                       other bands are left unwritten (the calls may then write one
+                                       out concurrently, see "Threads"). 0, 0 = every receiver
+                                       (default); else 0 <= part_index < part_count <= 65536
+                                       (HFVIS_ERR_INVALID_ARGUMENT otherwise, and from every other
+                                       routine for part_count > 1) */
 } hfvis_sweep_options;
 
 HFVIS_API hfvis_sweep_options hfvis_sweep_options_default(void);
@@ -698,7 +735,10 @@ HFVIS_API hfvis_status hfvis_horizon_reference_fn(hfvis_height_fn fn, void *user
  * beta = -pi/2 (use HFVIS_BORDER_CLAMP to extend the edges). NaN at holes. */
 typedef struct hfvis_openness_options {
     double radius;      /* search distance in world units, >= 0; 0 = unlimited */
-    int negative;       /* 0: positive openness; 1: negative */
+    int negative;       /* 0: positive openness; 1: negative; 2: both, positive in out's first
+                           height rows and negative in the next height rows (out must hold
+                           2*height rows of out_stride); each plane equals its own run's bit
+                           for bit, and with radius > 0 one march serves both signs */
     double step_cells;  /* radius > 0: march step in cells, >= 0; 0 = 1 */
 } hfvis_openness_options;
 
@@ -706,18 +746,23 @@ typedef struct hfvis_openness_options {
 HFVIS_API hfvis_openness_options hfvis_openness_options_default(void);
 
 /* Openness at every grid point, out[y*out_stride + x]. opts: border, border_cells, azimuth0_rad,
- * alloc and progress; the direction range is not honoured (all K).
+ * alloc and progress, and with radius > 0 the receiver rectangle (its cells only are written, each
+ * equal to the whole call's bit for bit: threads split one call by row bands); the direction
+ * range is not honoured (all K); a search radius (max_distance), a window, or a rectangle
+ * without a radius is HFVIS_ERR_INVALID_ARGUMENT.
  * radius > 0: the per-receiver march of hfvis_horizon_reference out to the radius, at step_cells
  *   (so the same bilinear samples as the oracle with max_distance_cells = radius/cell_size),
- *   O(K*W*H*radius/(cell_size*step_cells)); no allocation; progress once per row.
+ *   O(K*W*H*radius/(cell_size*step_cells)); no allocation; progress once per row. Both signs
+ *   (negative = 2) walk each ray once.
  * radius = 0: the exact sweep, hfvis_horizon_direction per direction, O(K*W*H); allocates
  *   W*H floats and W*H doubles (and W*H floats for negative) plus each sweep's scratch;
- *   progress once per direction. Both ways each angle is rounded to float (as the horizon
+ *   progress once per direction (both signs: the positive run, then the negative one, each
+ *   counting its K directions). Both ways each angle is rounded to float (as the horizon
  *   outputs hold it) and the K of a sample are summed in double, so with axis directions
  *   (K = 4, azimuth0 0) the sweep equals the march with a radius beyond the grid bit for bit;
  *   otherwise they differ by the gather tolerance of hfvis_horizon_direction.
  * Returns HFVIS_ERR_INVALID_ARGUMENT (bad grid, options, K < 1, out NULL, out_stride < width,
- * negative or non-finite radius or step, negative not 0/1), HFVIS_ERR_OUT_OF_MEMORY or
+ * negative or non-finite radius or step, negative not 0, 1 or 2), HFVIS_ERR_OUT_OF_MEMORY or
  * HFVIS_ERR_LIMIT (the sweep's). */
 HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_options *oo,
                                       const hfvis_sweep_options *opts, float *out,
@@ -742,22 +787,41 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     brings the bulge below 1/64 cell of height (power-of-two spacing keeps every distance
  *     exact in double). Pieces outside the grid or touching a hole are not split.
  *   - Each line is swept from its far end with the hull stack of [P1] §5 (Alg. 1) over all its
- *     samples; each grid point reads the hull's tangent at its turn. The result is, bit for bit,
- *     the maximum elevation over every sample of the receiver's own ray (hfvis_horizon_exact_naive
- *     is that maximum computed receiver by receiver). Along an axis the crossings are the grid
- *     points only (the surface is linear along a grid line).
- *   - Rule: direction k is the representable direction nearest to psi_k = azimuth0 + 2 pi k/K
- *     (ties: the smaller |a| + |b|). hfvis_sweep_azimuths returns the K azimuths actually used
- *     and their quadrature weights. The default N = max(5, ceil(K/4)) (64 for K = 1). Largest
- *     deviation from psi_k with the default N and azimuth0 = 0: K = 4, 8: 0; K = 16, 32: 0.70
- *     deg; K = 64: 0.18; K = 128: 0.09; K = 256: 0.15; K = 7: 1.18 (K = 1, N = 64: <= 0.45).
+ *     samples; each grid point reads the hull's tangent at its turn: the maximum elevation over
+ *     every sample of its own ray. Along an axis the crossings are the grid points only (the
+ *     surface is linear along a grid line).
+ *   - Near field: next to the receiver the supremum is often no sample at all but the limit
+ *     t -> 0+ (a receiver on a convex edge looking down: the slope of the cell the ray leaves
+ *     by, at its corner, toward psi). Each receiver also takes that limit, (dz/dx |a| +
+ *     dz/dy |b|) / (|(a, b)| cell) from the corner's two edge differences, and under a search
+ *     radius the surface point exactly at the window's end (between two samples).
+ *   - Definition and bound (HFVIS_EXACT_SUP_*_DEG): hfvis_horizon_exact_naive computes, receiver
+ *     by receiver, the supremum over t > 0 of the elevation along the ray over the bilinear
+ *     surface (within R under a radius): every crossing, every piece's stationary points in
+ *     closed form, the t -> 0+ limit and the window's end. The sweep is never above it (every
+ *     sample lies on the surface) and below it only where a piece's tangent point falls between
+ *     its samples (pieces beyond the first are sampled, not maximized): on urban boxes, terraces
+ *     with one-cell cliffs and fBm, all pairs, negative horizons and the near field included,
+ *     mean <= 0.005 deg and p99 <= 0.15 deg measured; the stated bound, held by test_exact.c
+ *     on hold-out fields, is HFVIS_EXACT_SUP_MEAN_DEG / HFVIS_EXACT_SUP_P99_DEG (docs/exact-rays.md).
+ *   - Rule: with opts->ray_denominator = N > 0, direction k is the representable direction
+ *     nearest to psi_k = azimuth0 + 2 pi k/K (ties: the smaller |a| + |b|). The default (0):
+ *     K = 1: N = 64; K <= 32 and K > 360: N = max(5, ceil(K/4)), nearest; 32 < K <= 360: the
+ *     cheapest direction (smallest |a| + |b|, ties: the nearer; max(|a|, |b|) <= 256) within
+ *     0.25 deg of psi_k, a quarter sector or less, so the azimuths keep their order.
+ *     hfvis_sweep_azimuths returns the K azimuths actually used and their quadrature weights.
+ *     Largest deviation from psi_k with the default and azimuth0 = 0: K = 4, 8: 0; K = 16, 32:
+ *     0.70 deg; K = 64: 0.18; K = 128: 0.20; K = 256: 0.23; K = 360: 0.245; K = 7: 1.18
+ *     (K = 1: <= 0.45).
  *   - Cost: a direction costs |a| + |b| - 1 crossings per receiver (1 on the axes and diagonals)
- *     where the lattice costs about one node, so a larger N buys smaller deviations with longer
- *     sweeps: K = 16 with the default N = 5 takes directions (1,0), (5,2), (1,1), (2,5): 3.5
- *     crossings per receiver-direction on average, plus the interior samples below. Measured
- *     (make bench, section exact, 512^2 and 1024^2, K = 16): the horizon map 0.65-0.85x the
- *     lattice map's time on urban DSMs (no gather), 1.2-2.3x on fBm rough at the cell scale;
- *     the fused sky-view factor 1.2-2.1x and 2.1-4.1x.
+ *     where the lattice costs about one node, so closer directions cost longer sweeps: K = 16
+ *     takes directions (1,0), (5,2), (1,1), (2,5): 3.5 crossings per receiver-direction on
+ *     average, plus the interior samples below. The mean |a| + |b| of the default directions:
+ *     K = 16: 4.2, K = 64: 11.7, K = 256: 15.5, K = 360: 20.5 (the nearest with N = ceil(K/4)
+ *     would take 12.1, 51.5, 73). Measured (make bench, section exact, 512^2 and 1024^2,
+ *     K = 16): the horizon map 0.65-0.85x the lattice map's time on urban DSMs (no gather),
+ *     1.2-2.3x on fBm rough at the cell scale; the fused sky-view factor 1.2-2.1x and 2.1-4.1x;
+ *     at K = 64-360 on fBm 512^2 about 10-20x (docs/exact-rays.md, "Cost at large K").
  *   - Quadrature: every direction integral uses the actual azimuths phi_k. Direction k owns the
  *     sector between the midpoints to its neighbours (edges rounded to multiples of 2^-40 turn,
  *     so the shares w_k are exact and add up to exactly 1): the sky-view factor is
@@ -778,9 +842,9 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *   - Outputs are written at grid points directly (no gather). Scratch: one block of about
  *     8*width*height bytes (plus 12 for normals and 8*channels for the lighting sums) and the
  *     hull stack, 16*(16*(W + H + 2) + 4*border_cells) bytes.
- *   - Accuracy: against the exact maximum over the bilinear surface (occluders >= 1 cell away)
- *     the exact mode is within 0.004 deg mean and 0.08 deg p99 on urban boxes, terraces with
- *     one-cell cliffs and fBm (the lattice: 1-5 deg mean, 11-35 deg p99); docs/exact-rays.md. */
+ *   - Accuracy: against the supremum over the bilinear surface (every pair) the exact mode is
+ *     within 0.003 deg mean and 0.08 deg p99 on urban boxes, terraces with one-cell cliffs and
+ *     fBm (the lattice: 2-6 deg mean, 23-70 deg p99); docs/exact-rays.md. */
 
 /* ========================================================================================== */
 /* hfvis.c - search radius and tiles                                                          */
@@ -796,7 +860,8 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     at most floor(R / cell_size) node steps behind it (the lattice spacing is one cell); the
  *     receiver's value is the usual gather of its nodes (docs/errata.md E7), so its own cut-off
  *     is R blended over the nodes within 1.5 cells. R below one cell: the lattice sees nothing
- *     (-pi/2 everywhere but holes), exact rays still see the crossings nearer than R. R beyond
+ *     (-pi/2 everywhere but holes), exact rays still see the crossings nearer than R, the first
+ *     cell's t -> 0+ limit and the point at R ("Exact rays", near field). R beyond
  *     the field equals the unlimited run to the hull's rounding. With CLAMP/WRAP the border
  *     samples count like any other within R.
  *   - How ([P1] §5, Alg. 1 needs more: its hull answers "the highest over everything behind").
@@ -854,9 +919,10 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     stop their outward walk at R; they agree with the tree with R as they do without it
  *     (test/test_hfvis.c, p2t_radius_*).
  *   - Oracles, same cut-off: hfvis_horizon_lattice_naive (every node scans the nodes within R
- *     behind it) and hfvis_horizon_exact_naive (every receiver's own samples within R), held to
- *     the sweep bit for bit on the test fields (tolerance 1e-12 rad for last-bit ties of the
- *     hull's cross products); hfvis_horizon_reference marches out to min(R, max_distance_cells).
+ *     behind it), held to the sweep bit for bit on the test fields (tolerance 1e-12 rad for
+ *     last-bit ties of the hull's cross products), and hfvis_horizon_exact_naive (the supremum
+ *     within R: the sweep never above it, within HFVIS_EXACT_SUP_MEAN_DEG on average);
+ *     hfvis_horizon_reference marches out to min(R, max_distance_cells).
  *     The oracles compute every receiver (the rectangle and origin do not change their values).
  *   - Design notes and figures: docs/search-radius.md. */
 
@@ -870,10 +936,19 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
 HFVIS_API hfvis_status hfvis_sweep_azimuths(int K, const hfvis_sweep_options *opts,
                                             double *azimuths, double *weights);
 
-/* Oracle for the exact mode: for every grid point and direction, the maximum elevation over every
- * sample of its own ray (grid-line crossings and the interior samples of bulging pieces; the same
- * heights and quotients as the sweep), receiver by receiver. Always exact rays, whatever opts->rays says; otherwise the layout, range, border and
- * hole rules of hfvis_horizon_map. Equal to hfvis_horizon_map in exact mode bit for bit.
+/* The exact mode's horizons below the supremum of hfvis_horizon_exact_naive, over all receivers
+ * and directions of a field ("Exact rays", "Definition and bound"): mean and 99th percentile. */
+#define HFVIS_EXACT_SUP_MEAN_DEG 0.15
+#define HFVIS_EXACT_SUP_P99_DEG 1.5
+
+/* Oracle for the exact mode: for every grid point and direction, the supremum over t > 0 of the
+ * elevation along its own ray over the bilinear surface (within R under a radius), receiver by
+ * receiver: every grid-line crossing (the sweep's heights), every piece's stationary points in
+ * closed form, the first piece's t -> 0+ limit and the window's end ("Exact rays"). Pieces count
+ * where their cell is in reach (CLAMP/WRAP: border_cells beyond the grid) with four finite taps.
+ * Always exact rays, whatever opts->rays says; otherwise the layout, range, border and hole rules
+ * of hfvis_horizon_map. hfvis_horizon_map in exact mode is never above it and within the bound
+ * stated in "Exact rays".
  * Allocates 1 block (2N crossings). Cost O(K*width*height*(max(W, H) + border_cells)). */
 HFVIS_API hfvis_status hfvis_horizon_exact_naive(const hfvis_grid *grid, int K,
                                                  const hfvis_sweep_options *opts, float *out);

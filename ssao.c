@@ -682,7 +682,7 @@ static hfvis_status ss_fall_load(const hfvis_falloff *f, ss_fall *o)
 static double ss_rho_general(const ss_fall *f, double d);
 
 /* rho(d): the rational falloffs inline, the rest out of line. */
-static double ss_rho(const ss_fall *f, double d)
+static inline double ss_rho(const ss_fall *f, double d)
 {
     if (f->kind == HFVIS_FALLOFF_INV_QUADRATIC) return f->a / (f->a + d * d);
     if (f->kind == HFVIS_FALLOFF_HBAO) {
@@ -1245,7 +1245,7 @@ static void ss_cfg_from_lsao(const hfvis_lsao_options *o, ss_cfg *g)
 
 /* Occ of point (hx, hy) = occluder - receiver seen along zenith (ux, uy) with tangent st
  * ([P3] Alg. 1 l.25-29); *sin_out = Sin(h) (-inf for a coincident point, which casts st). */
-static double ss_occ(const ss_fall *f, double hx, double hy, double ux, double uy, double st,
+static inline double ss_occ(const ss_fall *f, double hx, double hy, double ux, double uy, double st,
                      double tiny, double *sin_out)
 {
     double len = sqrt(hx * hx + hy * hy), s;
@@ -1488,6 +1488,47 @@ static void ss_onto_line(double u0, double v0, double dx, double dy, double *u, 
     *v = v0 + t * dy;
 }
 
+/* ss_line_points' common case written out: nearest texels of an integer box step (sx, sy) from
+ * texel (tx0, ty0), the fixed tangent, and the whole line inside the buffer (checked at its two
+ * ends; the texels in between lie between them), so no clamps; the depth pointer stepped, the
+ * unprojection and the plane coordinates inline with the same arithmetic (the same bits).
+ * Returns 0, writing nothing, when the line leaves the buffer. */
+static int ss_line_points_inside(const ss_cam *c, const ss_cfg *g, const float *depth, int n, int tx0,
+                                 int ty0, int sx, int sy, const double e1[3], const double yh[3],
+                                 double *x, double *y, float *zs)
+{
+    const double tlx = (double)tx0 + (double)(n - 1) * (double)sx, tly = (double)ty0 + (double)(n - 1) * (double)sy;
+    const double cx = c->cx, cy = c->cy, ifx = c->ifx, ify = c->ify, osx = c->sx, osy = c->sy,
+                 far_d = c->far_d, e0 = e1[0], e1y = e1[1], e2 = e1[2], y0 = yh[0], y1 = yh[1],
+                 y2 = yh[2];
+    const float *dp;
+    ptrdiff_t dstep;
+    int k, tx = tx0, ty = ty0, persp = c->persp, exact = g->exact;
+    if (!(tlx >= 0.0 && tlx <= (double)(c->W - 1) && tly >= 0.0 && tly <= (double)(c->H - 1))) return 0;
+    dp = depth + ss_index(c, tx0, ty0);
+    dstep = (ptrdiff_t)sy * c->row_step + sx;
+    for (k = 0; k < n; k++, dp += dstep, tx += sx, ty += sy) {
+        double z = (double)*dp, u = (double)tx + 0.5, v = (double)ty + 0.5, q0, q1, q2;
+        if (!(z > 0.0 && z < far_d)) { /* ss_bg: background */
+            if (zs) zs[k] = (float)HFVIS__NAN;
+            x[k] = y[k] = HFVIS__NAN;
+            continue;
+        }
+        if (zs) zs[k] = (float)z;
+        if (persp) {
+            q0 = (u - cx) * z * ifx;
+            q1 = -(v - cy) * z * ify;
+        } else {
+            q0 = (u - cx) * osx;
+            q1 = -(v - cy) * osy;
+        }
+        q2 = -z;
+        x[k] = q0 * e0 + q1 * e1y + q2 * e2;
+        y[k] = exact ? q0 * y0 + q1 * y1 + q2 * y2 : q2;
+    }
+    return 1;
+}
+
 /* The 2D samples of one lattice line: x, y (NaN at holes), real-tangent sines (if wanted),
  * sample depths. */
 static void ss_line_points(const ss_cam *c, const ss_cfg *g, const float *depth,
@@ -1511,6 +1552,10 @@ static void ss_line_points(const ss_cam *c, const ss_cfg *g, const float *depth,
         fx0 = ln->x0 + (double)ln->first * d->step_x - (double)tx0;
         fy0 = ln->y0 + (double)ln->first * d->step_y - (double)ty0;
     }
+    if (integral && !bil && !st_real && ln->count > 0 &&
+        ss_line_points_inside(c, g, depth, ln->count, tx0, ty0, (int)d->step_x, (int)d->step_y, e1, yh,
+                              x, y, zs))
+        return;
     for (k = 0; k < ln->count; k++) {
         int i = ln->first + k, tx, ty;
         double u = ln->x0 + (double)i * d->step_x, v = ln->y0 + (double)i * d->step_y, qu, qv, z,
@@ -1723,25 +1768,30 @@ static void ss_gather_dir(const ss_cam *c, const ss_cfg *g, const float *depth,
                           double *sum, double *wsum)
 {
     const hfvis_ssao_direction *d = &L->dir;
-    int W = c->W - 2 * c->gx, x, y, nlines = L->line_count;
+    int W = c->W - 2 * c->gx, x, y, nlines = L->line_count, nearest = g->gather == HFVIS_SSAO_GATHER_NEAREST;
     double w = d->weight, ids = 1.0 / d->step, idl = 1.0 / d->spacing;
     double R2 = 2.0 * sqrt(0.25 * d->step * d->step + 0.25 * d->spacing * d->spacing);
+    /* in locals: the stores to sum and wsum may alias the lattice's and the camera's doubles, so
+     * they were reloaded at every pixel */
+    const double px = L->px, py = L->py, s_first = L->s_first, ddx = d->dx, ddy = d->dy, t_min = L->t_min,
+                 rej_z = g->rej_z, far_d = c->far_d, jmax = (double)nlines - 0.5;
     if (nlines < 1) return;
     for (y = c->gy; y < c->H - c->gy; y++) {
         double v = (double)y + 0.5;
+        const float *drow = depth + ss_index(c, 0, y);
+        size_t orow = (size_t)(y - c->gy) * (size_t)W - (size_t)c->gx; /* + x: pixel x's slot (mod 2^n) */
         for (x = c->gx; x < c->W - c->gx; x++) {
-            double u = (double)x + 0.5, zc = ss_tex(c, depth, x, y), val = 0.0;
+            double u = (double)x + 0.5, zc = (double)drow[x], val = 0.0;
             const float *nc = normals ? normals + 3 * ss_index(c, x, y) : NULL;
             double jf, tf;
             int ok = 0;
-            size_t o;
-            if (ss_bg(c, zc)) continue;
-            jf = (u * L->px + v * L->py - L->s_first) * idl;
-            tf = (u * d->dx + v * d->dy - L->t_min) * ids;
-            if (g->gather == HFVIS_SSAO_GATHER_NEAREST) {
+            if (!(zc > 0.0 && zc < far_d)) continue; /* ss_bg */
+            jf = (u * px + v * py - s_first) * idl;
+            tf = (u * ddx + v * ddy - t_min) * ids;
+            if (nearest) {
                 int j, i;
                 /* fast path of ss_nearest: the rounded line and step lie inside the lattice */
-                if (jf > -0.5 && jf < (double)nlines - 0.5 && tf > -0.5 && tf < 2147483647.0) {
+                if (jf > -0.5 && jf < jmax && tf > -0.5 && tf < 2147483647.0) {
                     const hfvis_ssao_line *ln;
                     j = (int)(jf + 0.5);
                     i = (int)(tf + 0.5);
@@ -1750,8 +1800,7 @@ static void ss_gather_dir(const ss_cam *c, const ss_cfg *g, const float *depth,
                         size_t idx = ln->offset + (size_t)(i - ln->first);
                         double zs = (double)sdepth[idx];
                         val = (double)values[idx];
-                        ok = val == val && zs == zs &&
-                             (g->rej_z < 0.0 || fabs(zs - zc) <= g->rej_z * zc);
+                        ok = val == val && zs == zs && (rej_z < 0.0 || fabs(zs - zc) <= rej_z * zc);
                         if (ok && nc)
                             ok = ss_accept(c, g, normals, L, ln, i, values, sdepth, zc, nc, &val);
                         goto have;
@@ -1783,9 +1832,8 @@ static void ss_gather_dir(const ss_cam *c, const ss_cfg *g, const float *depth,
             if (!ok)
                 ok = ss_fallback(c, g, normals, L, lines, values, sdepth, u, v, zc, nc, R2, &val);
             if (!ok) continue;
-            o = (size_t)(y - c->gy) * (size_t)W + (size_t)(x - c->gx);
-            sum[o] += w * val;
-            wsum[o] += w;
+            sum[orow + (size_t)x] += w * val;
+            wsum[orow + (size_t)x] += w;
         }
     }
 }

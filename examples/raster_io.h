@@ -102,6 +102,12 @@ typedef struct {
     int crs;                 /* EX_RIO_CRS_* from GTModelTypeGeoKey or the .prj */
     int epsg;                /* ProjectedCSTypeGeoKey or GeographicTypeGeoKey; 0 unknown */
     int pixel_is_point;      /* GTRasterTypeGeoKey = 2 */
+    /* The file's orientation: its columns run west (flip_x) or its rows north (flip_y), as a
+     * negative pixel width or a positive pixel height say (a ModelTransformation, a negative
+     * ModelPixelScale, a negative EHdr YDIM). gt and ex_rio_read always give the raster
+     * north-up, west to east; a GeoTIFF written with these flags set stores it back in the
+     * file's orientation (its ModelTransformation says so), an ASC or EHdr north-up. */
+    int flip_x, flip_y;
     /* the TIFF tags, verbatim (NULL/0 when absent) */
     int has_scale, has_matrix;
     double scale[3], matrix[16];
@@ -194,10 +200,10 @@ static inline int ex_georef_cell(const ex_georef *g, double *cell, char *err)
     if (g->gt[2] != 0.0 || g->gt[4] != 0.0)
         return ex_rio_fail(err, "a rotated or sheared geotransform is not supported (square, "
                            "north-up cells are needed): warp it with gdalwarp first");
-    dx = fabs(g->gt[1]);
-    dy = fabs(g->gt[5]);
+    dx = g->gt[1];
+    dy = -g->gt[5]; /* the readers give every raster north-up (ex_georef_orient) */
     if (!(dx > 0.0) || !(dy > 0.0) || !isfinite(dx) || !isfinite(dy))
-        return ex_rio_fail(err, "invalid cell size %g x %g", dx, dy);
+        return ex_rio_fail(err, "invalid cell size %g x %g", g->gt[1], g->gt[5]);
     if (fabs(dx - dy) > 1e-9 * dx)
         return ex_rio_fail(err, "cells of %.10g x %.10g are not square: resample with "
                            "gdalwarp -tr S S first", dx, dy);
@@ -362,6 +368,31 @@ static inline void ex_georef_transform(ex_georef *g)
     }
 }
 
+/* A transform with a negative pixel width or a positive pixel height (and no rotation) as the
+ * north-up raster, west to east, that ex_rio_read returns: gt describes that raster and
+ * flip_x / flip_y record the file's orientation (the GeoTIFF tags, in the file's orientation,
+ * are dropped: a written GeoTIFF gets a ModelTransformation from gt and the flags). */
+static inline void ex_georef_orient(ex_georef *g, int width, int height)
+{
+    if (!g->has_transform || g->gt[2] != 0.0 || g->gt[4] != 0.0) return;
+    if (g->gt[1] < 0.0) {
+        g->gt[0] += g->gt[1] * (double)width;
+        g->gt[1] = -g->gt[1];
+        g->flip_x = 1;
+    }
+    if (g->gt[5] > 0.0) {
+        g->gt[3] += g->gt[5] * (double)height;
+        g->gt[5] = -g->gt[5];
+        g->flip_y = 1;
+    }
+    if (g->flip_x || g->flip_y) {
+        free(g->tiepoints);
+        g->tiepoints = NULL;
+        g->n_tiepoints = 0;
+        g->has_scale = g->has_matrix = 0;
+    }
+}
+
 /* NoData from its text (GDAL_NODATA, NODATA_value): a number, "nan", "inf", "-inf". */
 static inline int ex_georef_set_nodata(ex_georef *g, const char *text, size_t len)
 {
@@ -373,6 +404,7 @@ static inline int ex_georef_set_nodata(ex_georef *g, const char *text, size_t le
     memcpy(buf, text, len);
     buf[len] = '\0';
     v = strtod(buf, &end);
+    if (memchr(buf, 'x', len) || memchr(buf, 'X', len)) return -1; /* hexadecimal: not a number */
     if (end == buf || *end != '\0') {
         size_t i;
         for (i = 0; i < len; i++) buf[i] = (char)tolower((unsigned char)buf[i]);
@@ -510,14 +542,20 @@ static inline int ex_rio_entry_doubles(ex_rio_reader *r, const ex_rio_entry *e, 
     return 0;
 }
 
-/* A tag of exactly want numbers (ModelPixelScale, ModelTransformation) into dst; *has = 1. A
- * tag of another length is ignored, as GDAL does. */
+/* A tag of want numbers (ModelTransformation: 16) into dst; *has = 1. ModelPixelScale (want 3)
+ * may hold 2 (X and Y: GDAL reads those, Z is then 0) or more (the first 3 are kept). A tag of
+ * another length is refused: ignoring it would run with cell 1. */
 static inline int ex_rio_entry_fixed(ex_rio_reader *r, const ex_rio_entry *e, double *dst, size_t want, int *has)
 {
-    size_t i;
+    size_t i, n = want;
     uint64_t u;
-    if (e->count != want) return 0;
-    for (i = 0; i < want; i++)
+    if (want == 3 && e->count >= 2) n = e->count < 3 ? (size_t)e->count : 3;
+    else if (e->count != want)
+        return ex_rio_fail(r->err, "TIFF tag %u (%s) holds %llu values, not %u", e->tag,
+                           e->tag == 33550 ? "ModelPixelScale" : "ModelTransformation",
+                           (unsigned long long)e->count, (unsigned)want);
+    for (i = n; i < want; i++) dst[i] = 0.0;
+    for (i = 0; i < n; i++)
         if (ex_rio_entry_value(r, e, i, dst + i, &u) != 0)
             return ex_rio_fail(r->err, "TIFF tag %u: values past the end of the file or of a non-numeric type",
                                e->tag);
@@ -788,6 +826,17 @@ static inline int ex_rio_tiff_parse(ex_rio_reader *r)
     if (r->geo.n_geokeys && ex_georef_keys(&r->geo, r->err) != 0) return -1;
     if (r->geo.n_geokeys) ex_georef_pe_crs(&r->geo);
     ex_georef_transform(&r->geo);
+    if (r->geo.has_scale && !r->geo.has_matrix && r->geo.n_tiepoints < 6)
+        return ex_rio_fail(r->err, "GeoTIFF with a ModelPixelScale but no ModelTiepoint: no georeference");
+    if (r->geo.has_transform) {
+        int k;
+        for (k = 0; k < 6; k++)
+            if (!isfinite(r->geo.gt[k])) return ex_rio_fail(r->err, "GeoTIFF geotransform with a non-finite value");
+        if (r->geo.gt[1] * r->geo.gt[5] - r->geo.gt[2] * r->geo.gt[4] == 0.0)
+            return ex_rio_fail(r->err, "GeoTIFF with a zero pixel size (ModelPixelScale %g %g)", r->geo.gt[1],
+                               -r->geo.gt[5]);
+    }
+    ex_georef_orient(&r->geo, r->width, r->height);
     return 0;
 }
 
@@ -1024,14 +1073,15 @@ static inline double ex_rio_sample(const unsigned char *p, int kind, int bits, i
     return (double)v;
 }
 
-/* A sample as stored into the caller's float: NoData to NaN when asked. */
+/* A sample as stored into the caller's float: NoData to NaN when asked; a value that is not
+ * finite as a float (+-Inf, NaN, a Float64 or decimal beyond +-FLT_MAX) is a hole, NaN, as
+ * hfvis.h takes every non-finite height. */
 static inline float ex_rio_cell(const ex_rio_reader *r, double v)
 {
     if (r->nodata_to_nan && r->geo.has_nodata &&
         (v == r->geo.nodata || (isnan(v) && isnan(r->geo.nodata))))
         return (float)NAN;
-    if (v > (double)FLT_MAX) return (float)INFINITY;
-    if (v < -(double)FLT_MAX) return -(float)INFINITY;
+    if (!(fabs(v) <= (double)FLT_MAX)) return (float)NAN;
     return (float)v;
 }
 
@@ -1061,10 +1111,12 @@ static inline int ex_rio_keyeq(const char *a, const char *b)
     return *a == '\0' && *b == '\0';
 }
 
+/* A whole token as a number: decimal, or the words inf, infinity and nan (strtod's); never
+ * hexadecimal ("0x10" is not a number to GDAL either). 0, or -1. */
 static inline int ex_rio_number(const char *s, double *v)
 {
     char *end;
-    if (!*s) return -1;
+    if (!*s || strchr(s, 'x') || strchr(s, 'X')) return -1;
     *v = strtod(s, &end);
     return *end == '\0' ? 0 : -1;
 }
@@ -1215,6 +1267,12 @@ static inline int ex_rio_parse_hdr(ex_rio_reader *r, const char *text, size_t n,
     b = (uint64_t)r->bands;
     bytes = (uint64_t)r->bits / 8u;
     r->skip = (uint64_t)skip;
+    /* BANDROWBYTES and TOTALROWBYTES may pad rows, never cut them (rows would overlap) */
+    if ((layout != 1 && brb >= 0 && (uint64_t)brb < w * bytes) ||
+        (layout != 2 && trb >= 0 && (uint64_t)trb < (layout == 0 && brb >= 0 ? (uint64_t)brb * (b - 1) + w * bytes
+                                                                              : w * bytes * b)))
+        return ex_rio_fail(r->err, ".hdr BANDROWBYTES %g or TOTALROWBYTES %g is shorter than a row of %llu bytes",
+                           brb, trb, (unsigned long long)(w * bytes * (layout == 2 ? 1 : b)));
     if (layout == 0) { /* BIL: row of band 0, row of band 1, ... */
         r->col_bytes = bytes;
         r->band_bytes = brb >= 0 ? (uint64_t)brb : w * bytes;
@@ -1237,12 +1295,20 @@ static inline int ex_rio_parse_hdr(ex_rio_reader *r, const char *text, size_t n,
     if (need < r->skip || need > r->size)
         return ex_rio_fail(r->err, "raw data file holds %llu bytes, the .hdr describes %llu", (unsigned long long)r->size,
                            (unsigned long long)need);
-    if (!isnan(ulx) && !isnan(uly) && xdim > 0 && ydim > 0) {
+    /* A cell size that is given must be usable (not silently cell 1): XDIM and YDIM nonzero and
+     * finite (a negative YDIM is a raster stored south-up and a negative XDIM one stored east to
+     * west, as GDAL reads them: ex_georef_orient), cellsize positive. */
+    if ((!isnan(xdim) || !isnan(ydim)) && !(isfinite(xdim) && isfinite(ydim) && xdim != 0.0 && ydim != 0.0))
+        return ex_rio_fail(r->err, ".hdr XDIM %g YDIM %g: both must be given and nonzero", xdim, ydim);
+    if (!isnan(cell) && !(cell > 0.0 && isfinite(cell)))
+        return ex_rio_fail(r->err, ".hdr cellsize %g: must be positive", cell);
+    if (!isnan(ulx) && !isnan(uly) && !isnan(xdim)) {
         r->geo.has_transform = 1;
         r->geo.gt[0] = ulx - 0.5 * xdim; /* ULXMAP/ULYMAP name the centre of the first cell */
         r->geo.gt[1] = xdim;
         r->geo.gt[3] = uly + 0.5 * ydim;
         r->geo.gt[5] = -ydim;
+        ex_georef_orient(&r->geo, r->width, r->height);
     } else if (!isnan(xll) && !isnan(yll) && cell > 0) {
         r->geo.has_transform = 1;
         r->geo.gt[0] = xll - (xcenter ? 0.5 * cell : 0.0);
@@ -1517,8 +1583,8 @@ static inline void ex_georef_shift(ex_georef *g, int dx, int dy)
 /* Decode band (0-based) of the window [x0, x0 + w) x [y0, y0 + h) into out (row stride in
  * floats); cells outside the raster are NaN. Only the strips/tiles (or raw rows) the window
  * touches are read. 0, or -1 with r->err. */
-static inline int ex_rio_read(ex_rio_reader *r, int band, int x0, int y0, int w, int h, float *out,
-                              ptrdiff_t stride)
+static inline int ex_rio_read_stored(ex_rio_reader *r, int band, int x0, int y0, int w, int h, float *out,
+                                     ptrdiff_t stride)
 {
     long long yy, xx;
     int bytes = r->bits / 8;
@@ -1581,6 +1647,36 @@ static inline int ex_rio_read(ex_rio_reader *r, int band, int x0, int y0, int w,
             }
         }
     }
+    return 0;
+}
+
+/* ex_rio_read: the window of the north-up raster (ex_georef_orient) from the file's orientation:
+ * the mirrored window, then its rows and columns reversed in place. */
+static inline int ex_rio_read(ex_rio_reader *r, int band, int x0, int y0, int w, int h, float *out,
+                              ptrdiff_t stride)
+{
+    int fx = r->geo.flip_x, fy = r->geo.flip_y, y, x;
+    if (fx) x0 = (int)((long long)r->width - x0 - w);
+    if (fy) y0 = (int)((long long)r->height - y0 - h);
+    if (ex_rio_read_stored(r, band, x0, y0, w, h, out, stride) != 0) return -1;
+    if (fy && w >= 1 && stride >= w)
+        for (y = 0; y < h / 2; y++) {
+            float *a = out + (ptrdiff_t)y * stride, *b = out + (ptrdiff_t)(h - 1 - y) * stride;
+            for (x = 0; x < w; x++) {
+                float t = a[x];
+                a[x] = b[x];
+                b[x] = t;
+            }
+        }
+    if (fx && w >= 1 && stride >= w)
+        for (y = 0; y < h; y++) {
+            float *a = out + (ptrdiff_t)y * stride;
+            for (x = 0; x < w / 2; x++) {
+                float t = a[x];
+                a[x] = a[w - 1 - x];
+                a[w - 1 - x] = t;
+            }
+        }
     return 0;
 }
 
@@ -1649,7 +1745,7 @@ typedef struct {
 
 static inline void ex_rio_emit(ex_rio_out *o, const void *p, size_t n)
 {
-    if (o->ok && n && fwrite(p, 1, n, o->f) != n) o->ok = 0;
+    if (o->ok && n && HFVIS_FWRITE(p, 1, n, o->f) != n) o->ok = 0;
     o->pos += n;
 }
 
@@ -1704,7 +1800,9 @@ static inline int ex_rio_write_tiff_file(const char *path, const ex_rio_image *i
     unsigned char *chunk = NULL, *z = NULL, *tmp = NULL;
     size_t zcap = 0;
     char *tmpname = NULL;
-    double tie[6], scale[3];
+    double tie[6], scale[3], mt[16];
+    int fx = geo && geo->has_transform && geo->flip_x, fy = geo && geo->has_transform && geo->flip_y;
+    int placed = geo && (geo->has_transform || geo->has_scale || geo->has_matrix);
     char nodata[64];
     uint64_t ifd_pos, data_end;
     int rc = -1;
@@ -1789,9 +1887,12 @@ static inline int ex_rio_write_tiff_file(const char *path, const ex_rio_image *i
                 for (x = 0; x < cw; x++) {
                     uint64_t gx = a * cw + x;
                     float v = 0.0f;
-                    if (gx < (uint64_t)img->width && gy < (uint64_t)img->height)
-                        v = img->data[(size_t)b * img->band_step + (size_t)gy * img->row_step +
-                                      (size_t)gx * img->pixel_step];
+                    if (gx < (uint64_t)img->width && gy < (uint64_t)img->height) {
+                        uint64_t sx = fx ? (uint64_t)img->width - 1 - gx : gx;
+                        uint64_t sy = fy ? (uint64_t)img->height - 1 - gy : gy;
+                        v = img->data[(size_t)b * img->band_step + (size_t)sy * img->row_step +
+                                      (size_t)sx * img->pixel_step];
+                    }
                     ex_rio_encode_sample(row + x * (uint64_t)bytes, v, kind, bits, o.be, geo);
                 }
                 if (opt.deflate && opt.predictor >= 2)
@@ -1858,15 +1959,29 @@ static inline int ex_rio_write_tiff_file(const char *path, const ex_rio_image *i
         if (geo->has_scale) EX_RIO_TAG(33550, 12, 3, geo->scale);
         if (geo->n_tiepoints) EX_RIO_TAG(33922, 12, geo->n_tiepoints, geo->tiepoints);
         if (geo->has_matrix) EX_RIO_TAG(34264, 12, 16, geo->matrix);
-    } else if (geo && geo->has_transform) {
-        if (geo->gt[2] == 0.0 && geo->gt[4] == 0.0) {
-            scale[0] = geo->gt[1]; scale[1] = -geo->gt[5]; scale[2] = 0.0;
-            tie[0] = tie[1] = tie[2] = tie[5] = 0.0; tie[3] = geo->gt[0]; tie[4] = geo->gt[3];
-            EX_RIO_TAG(33550, 12, 3, scale);
-            EX_RIO_TAG(33922, 12, 6, tie);
+    } else if (geo && geo->has_transform && (fx || fy || geo->gt[2] != 0.0 || geo->gt[4] != 0.0)) {
+        /* a ModelTransformation: rotated, or in the file's orientation (ex_georef_orient) */
+        memset(mt, 0, sizeof mt);
+        mt[0] = fx ? -geo->gt[1] : geo->gt[1];
+        mt[1] = geo->gt[2];
+        mt[4] = geo->gt[4];
+        mt[5] = fy ? -geo->gt[5] : geo->gt[5];
+        mt[3] = geo->gt[0] + (fx ? geo->gt[1] * (double)img->width : 0.0);
+        mt[7] = geo->gt[3] + (fy ? geo->gt[5] * (double)img->height : 0.0);
+        if (geo->pixel_is_point && geo->n_geokeys) { /* the GeoKeys say PixelIsPoint: a cell centre */
+            mt[3] += 0.5 * mt[0];
+            mt[7] += 0.5 * mt[5];
         }
+        mt[10] = mt[15] = 1.0;
+        EX_RIO_TAG(34264, 12, 16, mt);
+    } else if (geo && geo->has_transform) {
+        scale[0] = geo->gt[1]; scale[1] = -geo->gt[5]; scale[2] = 0.0;
+        tie[0] = tie[1] = tie[2] = tie[5] = 0.0; tie[3] = geo->gt[0]; tie[4] = geo->gt[3];
+        EX_RIO_TAG(33550, 12, 3, scale);
+        EX_RIO_TAG(33922, 12, 6, tie);
     }
-    if (geo && geo->n_geokeys) {
+    /* a CRS only with a georeference (a GeoTIFF with a CRS but no geotransform places nothing) */
+    if (geo && geo->n_geokeys && placed) {
         size_t q;
         u_keys = (uint64_t *)malloc(geo->n_geokeys * sizeof(uint64_t));
         if (!u_keys) { ex_rio_fail(err, "out of memory"); goto fail; }
@@ -1874,7 +1989,7 @@ static inline int ex_rio_write_tiff_file(const char *path, const ex_rio_image *i
         EX_RIO_TAG(34735, 3, geo->n_geokeys, u_keys);
         if (geo->n_geodoubles) EX_RIO_TAG(34736, 12, geo->n_geodoubles, geo->geodoubles);
         if (geo->n_geoascii) EX_RIO_TAG(34737, 2, geo->n_geoascii, geo->geoascii);
-    } else if (n_prj_keys) {
+    } else if (n_prj_keys && placed) {
         EX_RIO_TAG(34735, 3, n_prj_keys, prj_keys);
         if (n_prj_ascii) EX_RIO_TAG(34737, 2, n_prj_ascii, prj_ascii);
     }
@@ -1949,116 +2064,172 @@ static inline void ex_rio_fmt(char *buf, size_t cap, double v, int is_float)
     else snprintf(buf, cap, is_float ? "%.9g" : "%.17g", v);
 }
 
-/* The .prj of geo beside path, atomically: its .prj, or the WKT of a GeoTIFF's ESRI PE string
- * (a CRS given by an EPSG code alone has no WKT here: no .prj). */
-static inline int ex_rio_write_prj(const char *path, const ex_georef *geo, char *err)
+/* printf into the output (a line of a text header). */
+static inline void ex_rio_emitf(ex_rio_out *o, const char *fmt, ...)
 {
-    char *prj, *tmpname = NULL;
+    char line[512];
+    int n;
+    va_list ap;
+    va_start(ap, fmt);
+    n = vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    if (n < 0 || (size_t)n >= sizeof line) o->ok = 0;
+    else ex_rio_emit(o, line, (size_t)n);
+}
+
+/* Add the .prj of geo beside path to the set p: its .prj, or the WKT of a GeoTIFF's ESRI PE
+ * string; without either, a .prj left beside path by an earlier output is removed with the
+ * set (a CRS given by an EPSG code alone has no WKT here). *prj_out is the name (free it after
+ * ex_publish_end). Returns 0, or -1 (out of memory). */
+static inline int ex_rio_publish_prj(ex_publish *p, const char *path, const ex_georef *geo, char **prj_out,
+                                     char *err)
+{
     const char *wkt = geo ? geo->prj : NULL;
     size_t len = 0;
-    FILE *f;
-    int ok;
+    ex_rio_out o;
     if (geo && !wkt) wkt = ex_rio_pe_string(geo, &len);
     else if (wkt) len = strlen(wkt);
-    if (!wkt) return 0;
-    prj = ex_rio_sidecar(path, ".prj");
-    if (!prj) return ex_rio_fail(err, "out of memory");
-    f = ex_atomic_open(prj, &tmpname);
-    ok = f && fwrite(wkt, 1, len, f) == len && (geo->prj || fputc('\n', f) != EOF);
-    if (!f || !ex_atomic_close(f, tmpname, prj, ok)) {
-        free(prj);
-        return ex_rio_fail(err, "cannot write the .prj");
+    *prj_out = ex_rio_sidecar(path, ".prj");
+    if (!*prj_out) return ex_rio_fail(err, "out of memory");
+    if (!wkt) {
+        ex_publish_absent(p, *prj_out);
+        return 0;
     }
-    free(prj);
+    memset(&o, 0, sizeof o);
+    o.f = ex_publish_open(p, *prj_out);
+    o.ok = o.f != NULL;
+    ex_rio_emit(&o, wkt, len);
+    if (!geo->prj) ex_rio_emit(&o, "\n", 1);
+    ex_publish_close(p, o.f, o.ok);
     return 0;
 }
 
-/* Write band 0 of img as an ESRI ASCII grid (+ the .prj of geo when it has one). NaN cells are
- * written as the NoData value (geo's, else -9999). */
+/* Publish the set p; its names are freed. Returns 0, or -1 with "cannot write the file". */
+static inline int ex_rio_publish(ex_publish *p, char **names, int n, char *err)
+{
+    int ok = ex_publish_end(p), i;
+    for (i = 0; i < n; i++) free(names[i]);
+    return ok ? 0 : ex_rio_fail(err, "cannot write the file");
+}
+
+/* Write band 0 of img as an ESRI ASCII grid (+ the .prj of geo when it has one), published
+ * together (ex_publish). NaN cells are written as the NoData value (geo's, else -9999). */
 static inline int ex_rio_write_asc(const char *path, const ex_rio_image *img, const ex_georef *geo, char *err)
 {
-    char *tmpname = NULL, num[64];
-    FILE *f;
-    int x, y, ok = 1;
+    char num[64], *names[1] = {NULL}, *line;
+    ex_publish pub;
+    ex_rio_out o;
+    int x, y;
     double cell = 1.0, nd = geo && geo->has_nodata ? geo->nodata : -9999.0;
     const char *ndt = geo && geo->has_nodata ? geo->nodata_text : "-9999";
+    size_t cap, ndl = strlen(ndt);
     if (img->bands != 1) return ex_rio_fail(err, "an ASCII grid holds one band; this output has %d (write .tif or .bil)",
                                             img->bands);
     if (geo && geo->has_transform) {
         if (ex_georef_cell(geo, &cell, err) != 0) return -1;
     }
     if (isnan(nd)) return ex_rio_fail(err, "an ASCII grid cannot have NoData NaN");
-    f = ex_atomic_open(path, &tmpname);
-    if (!f) return ex_rio_fail(err, "cannot create the file");
-    fprintf(f, "ncols %d\nnrows %d\n", img->width, img->height);
-    if (geo && geo->has_transform) {
-        fprintf(f, "xllcorner %.17g\nyllcorner %.17g\ncellsize %.17g\n", geo->gt[0],
-                geo->gt[3] + geo->gt[5] * (double)img->height, cell);
-    } else {
-        fprintf(f, "xllcorner 0\nyllcorner 0\ncellsize 1\n");
+    /* one row of text: each cell at most max(16, strlen(NoData)) characters and a separator */
+    cap = ((ndl > 16 ? ndl : 16) + 1) * (size_t)img->width;
+    line = (size_t)img->width < SIZE_MAX / 128 ? (char *)malloc(cap) : NULL;
+    if (!line) return ex_rio_fail(err, "out of memory");
+    ex_publish_init(&pub);
+    memset(&o, 0, sizeof o);
+    o.f = ex_publish_open(&pub, path);
+    if (!o.f) {
+        free(line);
+        ex_publish_end(&pub);
+        return ex_rio_fail(err, "cannot create the file");
     }
-    fprintf(f, "NODATA_value %s\n", ndt);
-    for (y = 0; y < img->height && ok; y++) {
+    o.ok = 1;
+    ex_rio_emitf(&o, "ncols %d\nnrows %d\n", img->width, img->height);
+    if (geo && geo->has_transform)
+        ex_rio_emitf(&o, "xllcorner %.17g\nyllcorner %.17g\ncellsize %.17g\n", geo->gt[0],
+                     geo->gt[3] + geo->gt[5] * (double)img->height, cell);
+    else
+        ex_rio_emitf(&o, "xllcorner 0\nyllcorner 0\ncellsize 1\n");
+    ex_rio_emitf(&o, "NODATA_value %s\n", ndt);
+    for (y = 0; y < img->height && o.ok; y++) {
+        size_t n = 0;
         for (x = 0; x < img->width; x++) {
             float v = img->data[(size_t)y * img->row_step + (size_t)x * img->pixel_step];
-            if (isnan(v)) fputs(ndt, f);
-            else {
+            size_t k;
+            if (isnan(v)) {
+                memcpy(line + n, ndt, ndl);
+                k = ndl;
+            } else {
                 ex_rio_fmt(num, sizeof num, (double)v, 1);
-                fputs(num, f);
+                k = strlen(num);
+                memcpy(line + n, num, k);
             }
-            fputc(x + 1 < img->width ? ' ' : '\n', f);
+            n += k;
+            line[n++] = x + 1 < img->width ? ' ' : '\n';
         }
-        if (ferror(f)) ok = 0;
+        ex_rio_emit(&o, line, n);
     }
-    (void)nd;
-    if (!ex_atomic_close(f, tmpname, path, ok)) return ex_rio_fail(err, "cannot write the file");
-    return ex_rio_write_prj(path, geo, err);
+    free(line);
+    ex_publish_close(&pub, o.f, o.ok);
+    if (ex_rio_publish_prj(&pub, path, geo, &names[0], err) != 0) {
+        ex_publish_end(&pub);
+        return -1;
+    }
+    return ex_rio_publish(&pub, names, 1, err);
 }
 
-/* Write img as EHdr (.bil/.flt data + .hdr [+ .prj]): 32-bit floats, BIL, little endian. */
+/* Write img as EHdr (.bil/.flt data + .hdr [+ .prj]): 32-bit floats, BIL, little endian; the
+ * files are published together (ex_publish). */
 static inline int ex_rio_write_ehdr(const char *path, const ex_rio_image *img, const ex_georef *geo, char *err)
 {
-    char *tmpname = NULL, *side;
-    FILE *f;
-    int x, y, b, ok = 1;
+    char *names[2] = {NULL, NULL};
+    ex_publish pub;
+    ex_rio_out o;
+    int x, y, b;
     unsigned char *row;
     size_t rb = (size_t)img->width * 4u;
     row = (unsigned char *)malloc(rb);
     if (!row) return ex_rio_fail(err, "out of memory");
-    f = ex_atomic_open(path, &tmpname);
-    if (!f) {
+    ex_publish_init(&pub);
+    memset(&o, 0, sizeof o);
+    o.f = ex_publish_open(&pub, path);
+    if (!o.f) {
         free(row);
+        ex_publish_end(&pub);
         return ex_rio_fail(err, "cannot create the file");
     }
-    for (y = 0; y < img->height && ok; y++)
-        for (b = 0; b < img->bands && ok; b++) {
+    o.ok = 1;
+    for (y = 0; y < img->height && o.ok; y++)
+        for (b = 0; b < img->bands && o.ok; b++) {
             for (x = 0; x < img->width; x++)
                 ex_rio_encode_sample(row + (size_t)x * 4u,
                                      img->data[(size_t)b * img->band_step + (size_t)y * img->row_step +
                                                (size_t)x * img->pixel_step],
                                      EX_RIO_FLOAT, 32, 0, geo);
-            ok = fwrite(row, 1, rb, f) == rb;
+            ex_rio_emit(&o, row, rb);
         }
     free(row);
-    if (!ex_atomic_close(f, tmpname, path, ok)) return ex_rio_fail(err, "cannot write the file");
-    side = ex_rio_sidecar(path, ".hdr");
-    if (!side) return ex_rio_fail(err, "out of memory");
-    f = ex_atomic_open(side, &tmpname);
-    if (f) {
-        fprintf(f, "BYTEORDER I\nLAYOUT BIL\nNROWS %d\nNCOLS %d\nNBANDS %d\nNBITS 32\nBANDROWBYTES %lu\n"
-                   "TOTALROWBYTES %lu\nPIXELTYPE FLOAT\n",
-                img->height, img->width, img->bands, (unsigned long)rb, (unsigned long)(rb * (size_t)img->bands));
-        if (geo && geo->has_transform)
-            fprintf(f, "ULXMAP %.17g\nULYMAP %.17g\nXDIM %.17g\nYDIM %.17g\n", geo->gt[0] + 0.5 * geo->gt[1],
-                    geo->gt[3] + 0.5 * geo->gt[5], geo->gt[1], -geo->gt[5]);
-        if (geo && geo->has_nodata) fprintf(f, "NODATA %s\n", geo->nodata_text);
+    ex_publish_close(&pub, o.f, o.ok);
+    names[0] = ex_rio_sidecar(path, ".hdr");
+    if (!names[0]) {
+        ex_publish_end(&pub);
+        return ex_rio_fail(err, "out of memory");
     }
-    if (!f || !ex_atomic_close(f, tmpname, side, !ferror(f))) {
-        free(side);
-        return ex_rio_fail(err, "cannot write the .hdr");
+    memset(&o, 0, sizeof o);
+    o.f = ex_publish_open(&pub, names[0]);
+    o.ok = o.f != NULL;
+    ex_rio_emitf(&o, "BYTEORDER I\nLAYOUT BIL\nNROWS %d\nNCOLS %d\nNBANDS %d\nNBITS 32\nBANDROWBYTES %lu\n"
+                     "TOTALROWBYTES %lu\nPIXELTYPE FLOAT\n",
+                 img->height, img->width, img->bands, (unsigned long)rb, (unsigned long)(rb * (size_t)img->bands));
+    if (geo && geo->has_transform)
+        ex_rio_emitf(&o, "ULXMAP %.17g\nULYMAP %.17g\nXDIM %.17g\nYDIM %.17g\n", geo->gt[0] + 0.5 * geo->gt[1],
+                     geo->gt[3] + 0.5 * geo->gt[5], geo->gt[1], -geo->gt[5]);
+    if (geo && geo->has_nodata) ex_rio_emitf(&o, "NODATA %s\n", geo->nodata_text);
+    ex_publish_close(&pub, o.f, o.ok);
+    if (ex_rio_publish_prj(&pub, path, geo, &names[1], err) != 0) {
+        ex_publish_end(&pub);
+        free(names[0]);
+        return -1;
     }
-    free(side);
-    return ex_rio_write_prj(path, geo, err);
+    return ex_rio_publish(&pub, names, 2, err);
 }
 
 /* Write img by the extension of path (.tif/.tiff with opt, .asc, .bil/.flt). */

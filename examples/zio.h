@@ -10,7 +10,8 @@
  *   2. inflate          ex_inflate: a zlib or raw deflate stream into a buffer of known size
  *   3. deflate          ex_deflate_bound, ex_deflate_zlib: LZ77 (hash chains) + fixed Huffman,
  *                       a stored block instead when that is shorter
- *   4. atomic files     ex_atomic_open, ex_atomic_close
+ *   4. atomic files     ex_atomic_open, ex_atomic_close; ex_publish_* (a file and its
+ *                       sidecars replaced together)
  */
 #ifndef HFVIS_EXAMPLES_ZIO_H
 #define HFVIS_EXAMPLES_ZIO_H
@@ -22,6 +23,21 @@
 #include <string.h>
 
 #include "hfvis.h"
+
+/* The stdio calls of the write path, as in hfvis.c (hfvis.h, hfvis_write_file): fwrite, fflush,
+ * fclose and rename unless defined before this header (test/test_wfault.c fails them in turn). */
+#ifndef HFVIS_FWRITE
+#define HFVIS_FWRITE(ptr, size, n, file) fwrite(ptr, size, n, file)
+#endif
+#ifndef HFVIS_FFLUSH
+#define HFVIS_FFLUSH(file) fflush(file)
+#endif
+#ifndef HFVIS_FCLOSE
+#define HFVIS_FCLOSE(file) fclose(file)
+#endif
+#ifndef HFVIS_RENAME
+#define HFVIS_RENAME(from, to) rename(from, to)
+#endif
 
 /* ------------------------------------------------------------------------------------------ */
 /* 1. checksums                                                                               */
@@ -511,6 +527,115 @@ static inline int ex_atomic_close(FILE *f, char *tmp, const char *path, int ok)
     wo.on_temp = ex_atomic_on_temp;
     wo.user = NULL;
     return hfvis_write_end(path, f, tmp, ok, &wo) == HFVIS_OK && ok;
+}
+
+/* A file and its sidecars (an ASCII grid and its .prj, a .bil and its .hdr and .prj) replaced
+ * together, so that no failure leaves a new sidecar beside old data or the reverse: every new
+ * file is written completely to its own temporary file first (ex_publish_open, then
+ * ex_publish_close); ex_publish_end then moves each existing target aside, renames each new file
+ * in (a target listed with ex_publish_absent, a stale sidecar the new output lacks, is only
+ * moved aside) and, once all are in place, removes the old ones. When any write, close or
+ * rename fails, the new files are removed and the old ones renamed back: every target is as it
+ * was. (An interrupt during the renames can leave the old files under their aside names
+ * "<target>.tmp<hex>", never a mixed set under the targets' names.) */
+#define EX_PUBLISH_MAX 4
+typedef struct {
+    int n, ok;
+    const char *path[EX_PUBLISH_MAX]; /* the targets (the caller's strings) */
+    char *tmp[EX_PUBLISH_MAX];        /* the closed temporary file of each, NULL: to be absent */
+} ex_publish;
+
+static inline void ex_publish_init(ex_publish *p)
+{
+    memset(p, 0, sizeof *p);
+    p->ok = 1;
+}
+
+/* The temporary file of the next target, open for writing; NULL on failure (then the set fails). */
+static inline FILE *ex_publish_open(ex_publish *p, const char *path)
+{
+    hfvis_write_options wo;
+    FILE *f = NULL;
+    char *tmp = NULL;
+    if (!p->ok || p->n >= EX_PUBLISH_MAX) {
+        p->ok = 0;
+        return NULL;
+    }
+    wo.on_temp = ex_atomic_on_temp;
+    wo.user = NULL;
+    if (hfvis_write_begin(path, &wo, &f, &tmp) != HFVIS_OK) {
+        p->ok = 0;
+        return NULL;
+    }
+    p->path[p->n] = path;
+    p->tmp[p->n++] = tmp;
+    return f;
+}
+
+/* path is to be absent once the set is published (moved aside with the others, then removed). */
+static inline void ex_publish_absent(ex_publish *p, const char *path)
+{
+    if (p->n >= EX_PUBLISH_MAX) {
+        p->ok = 0;
+        return;
+    }
+    p->path[p->n] = path;
+    p->tmp[p->n++] = NULL;
+}
+
+/* Flush and close a file of ex_publish_open; ok 0 (a write of the caller failed), a write error
+ * or a failed flush or close fails the set. */
+static inline void ex_publish_close(ex_publish *p, FILE *f, int ok)
+{
+    if (!f) return;
+    ok = HFVIS_FFLUSH(f) == 0 && !ferror(f) && ok;
+    if (HFVIS_FCLOSE(f) != 0) ok = 0;
+    if (!ok) p->ok = 0;
+}
+
+/* Publish the set (see above) and release it. Returns 1 when every target holds its new file
+ * (or is absent as asked), 0 when every target is as it was. */
+static inline int ex_publish_end(ex_publish *p)
+{
+    char *aside[EX_PUBLISH_MAX];
+    int placed[EX_PUBLISH_MAX], i, ok = p->ok;
+    for (i = 0; i < p->n; i++) {
+        aside[i] = NULL;
+        placed[i] = 0;
+    }
+    for (i = 0; ok && i < p->n; i++) { /* the old files aside, under fresh temporary names */
+        FILE *e = fopen(p->path[i], "rb"), *f = NULL;
+        if (!e) continue; /* absent (an unreadable target fails at its rename below) */
+        fclose(e);
+        if (hfvis_write_begin(p->path[i], NULL, &f, &aside[i]) != HFVIS_OK) {
+            ok = 0;
+            break;
+        }
+        fclose(f);
+        remove(aside[i]); /* the name is free again (Windows' rename does not replace) */
+        if (HFVIS_RENAME(p->path[i], aside[i]) != 0) {
+            hfvis_free(NULL, aside[i]);
+            aside[i] = NULL;
+            ok = 0;
+        }
+    }
+    for (i = 0; ok && i < p->n; i++) /* the new files in */
+        if (p->tmp[i]) ok = placed[i] = HFVIS_RENAME(p->tmp[i], p->path[i]) == 0;
+    for (i = 0; i < p->n; i++) {
+        if (!ok && placed[i]) remove(p->path[i]);
+        if (aside[i]) {
+            if (ok) remove(aside[i]);
+            else HFVIS_RENAME(aside[i], p->path[i]); /* back (if this fails, the old file stays aside) */
+            hfvis_free(NULL, aside[i]);
+        }
+        if (p->tmp[i]) {
+            if (!placed[i]) remove(p->tmp[i]);
+            hfvis_free(NULL, p->tmp[i]);
+        }
+    }
+    if (ex_atomic_on_temp) ex_atomic_on_temp(NULL, NULL);
+    p->n = 0;
+    return ok;
 }
 
 #endif /* HFVIS_EXAMPLES_ZIO_H */

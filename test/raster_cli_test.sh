@@ -73,6 +73,34 @@ printf 'GEOGCS["GCS_WGS_1984",DATUM["D_WGS_1984",SPHEROID["WGS_1984",6378137.0,2
 run "geographic .prj -> tif" skyview "$dir/geog.asc" --cell 30 --dirs 4 -o "$dir/geog.tif" && \
   fails "a GeoTIFF with a geographic PE string is refused as the .prj was" skyview "$dir/geog.tif" -o "$dir/x.flt"
 
+# ---- orientation: the same terrain stored south-up (EHdr YDIM < 0) and mirrored (XDIM < 0) ---
+# 16-bit EHdr grids of dem.pgm's heights, rows (or columns) reversed in the file; the outputs
+# (north-up for EHdr) equal those of the north-up grid bit for bit, and a GeoTIFF written from
+# the south-up input is south-up again and reads back to the same raster
+bil16() { # bil16 NAME FLIPX FLIPY: dem.pgm's heights as NAME.bil (unsigned 16-bit, little endian)
+  printf "$(tail -n +4 "$dir/dem.pgm" | awk -v fx="$2" -v fy="$3" '{ for (i = 1; i <= NF; i++) v[NR - 1, i - 1] = $i }
+    END { w = 41; h = 33; for (y = 0; y < h; y++) for (x = 0; x < w; x++) {
+      t = v[fy ? h - 1 - y : y, fx ? w - 1 - x : x]; printf "\\%03o\\%03o", t % 256, int(t / 256) } }')" > "$dir/$1.bil"
+  printf 'NROWS 33\nNCOLS 41\nNBITS 16\nPIXELTYPE UNSIGNEDINT\nBYTEORDER I\nNODATA 0\nULXMAP %s\nULYMAP %s\nXDIM %s\nYDIM %s\n' \
+    "$([ "$2" = 1 ] && echo 501215 || echo 500015)" "$([ "$3" = 1 ] && echo 4100015 || echo 4100975)" \
+    "$([ "$2" = 1 ] && echo -30 || echo 30)" "$([ "$3" = 1 ] && echo -30 || echo 30)" > "$dir/$1.hdr"; }
+bil16 nu 0 0; bil16 su 0 1; bil16 mi 1 0
+for c in hillshade skyview; do
+  run "$c north-up" $c "$dir/nu.bil" --dirs 8 -o "$dir/o_nu.flt" && run "$c south-up" $c "$dir/su.bil" --dirs 8 -o "$dir/o_su.flt" \
+    && run "$c mirrored" $c "$dir/mi.bil" --dirs 8 -o "$dir/o_mi.flt" \
+    && same "$c: south-up EHdr (YDIM -30) = north-up, bit for bit" "$dir/o_nu.flt" "$dir/o_su.flt" \
+    && same "$c: mirrored EHdr (XDIM -30) = north-up, bit for bit" "$dir/o_nu.flt" "$dir/o_mi.flt"
+done
+run "south-up -> tif" skyview "$dir/su.bil" --dirs 8 -o "$dir/su.tif" && run "north-up -> tif" skyview "$dir/nu.bil" --dirs 8 -o "$dir/nu.tif" \
+  && run "south-up tif in" hillshade "$dir/su.tif" -o "$dir/su2.flt" && run "north-up tif in" hillshade "$dir/nu.tif" -o "$dir/nu2.flt" \
+  && same "a GeoTIFF written from a south-up input reads back as the same raster" "$dir/nu2.flt" "$dir/su2.flt"
+if command -v gdalinfo > /dev/null 2>&1; then
+  gdalinfo "$dir/su.tif" | grep -q 'Pixel Size = (30.000000000000000,30.000000000000000)' \
+    && gdalinfo "$dir/su.tif" | grep -q 'Origin = (500000.000000000000000,4100000.000000000000000)' \
+    && ok "GDAL: the GeoTIFF of a south-up input is stored south-up (origin at the south-west corner)" \
+    || bad "south-up GeoTIFF as GDAL sees it: $(gdalinfo "$dir/su.tif" | grep -E 'Origin|Pixel Size')"
+else echo "SKIP gdalinfo not found (south-up GeoTIFF check)"; fi
+
 # ---- notes on stderr ------------------------------------------------------------------------
 run "pgm without --cell" skyview "$dir/dem.pgm" --dirs 4 -o "$dir/n.flt" && grep -q '^hfvis: note: .*cell size: using 1' "$dir/err" \
   && [ "$(wc -l < "$dir/err" | tr -d ' ')" = 1 ] && ok "no cell size: one note line" || bad "no-cell note: $(cat "$dir/err")"

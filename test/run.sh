@@ -15,6 +15,12 @@ for t in "$build"/test/test_*; do
   passed=$((passed + n - f)); failed=$((failed + f))
   if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then failed=$((failed + 1)); echo "FAIL $t exit $rc"; fi
 done
+# the library's calls on threads (hfvis.h, "Threads"), built with -pthread
+if [ -x "$build/thread/thread_test" ]; then
+  "$build/thread/thread_test" > "$scratch/log" 2>&1; rc=$?
+  if [ "$rc" -eq 0 ] && grep -q '^RESULT .*failed=0' "$scratch/log"; then passed=$((passed + 1)); echo "ok   thread_test: $(tail -n 1 "$scratch/log")"
+  else failed=$((failed + 1)); cat "$scratch/log"; echo "FAIL thread_test (exit $rc)"; fi
+fi
 for e in "$build"/examples/*; do
   [ -x "$e" ] || continue
   if "$e" "$scratch" > "$scratch/log" 2>&1; then passed=$((passed + 1)); echo "ok   example $(basename "$e")"

@@ -617,6 +617,11 @@ static void teardown(void)
     bo = hfvis_sweep_options_default(); bo.extent_width = 5; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.receiver_width = -1; bo.receiver_height = 1; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.receiver_height = 1; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.part_count = -1; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.part_index = 1; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.part_index = 2; bo.part_count = 2; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.part_index = -1; bo.part_count = 2; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.part_count = 65537; BAD('S', INV, expr); \
     } while (0)
 
 /* The P2 hull-tree routines honour a search radius but refuse a window (a proper one: finite
@@ -1265,6 +1270,9 @@ static void args_openness(void)
     oo.radius = 2.0;
     oo.negative = 1;
     OK(hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
+    oo.negative = 2; /* both: two planes */
+    OK(hfvis_openness(&g_ok, 4, &oo, NULL, AF(2 * GW * GH), GW));
+    oo.negative = 1;
     BAD('N', INV, hfvis_openness(NULL, 4, NULL, NULL, out, GW));
     BAD('N', INV, hfvis_openness(&g_ok, 4, NULL, NULL, NULL, GW));
     BAD('Z', INV, hfvis_openness(&g_ok, 0, NULL, NULL, out, GW));
@@ -1276,9 +1284,24 @@ static void args_openness(void)
     oo.radius = (double)INFINITY; BAD('F', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
     oo.radius = 1.0; oo.step_cells = -1.0; BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
     oo.step_cells = (double)NAN; BAD('F', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
-    oo.step_cells = 0.0; oo.negative = 2; BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
+    oo.step_cells = 0.0; oo.negative = 3; BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
+    oo.negative = -1; BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, NULL, out, GW));
     GRID_CASES(hfvis_openness(&bg, 4, NULL, NULL, out, GW));
     SWEEP_OPT_CASES(hfvis_openness(&g_ok, 4, NULL, &bo, out, GW));
+    { /* a receiver rectangle with a radius; not without one, nor a search radius or a window */
+        hfvis_sweep_options ro = hfvis_sweep_options_default();
+        ro.receiver_x = ro.receiver_y = 1;
+        ro.receiver_width = ro.receiver_height = 2;
+        oo.negative = 0;
+        oo.radius = 2.0;
+        OK(hfvis_openness(&g_ok, 4, &oo, &ro, out, GW));
+        oo.radius = 0.0;
+        BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, &ro, out, GW));
+        ro = hfvis_sweep_options_default();
+        ro.max_distance = 2.0;
+        oo.radius = 2.0;
+        BAD('S', INV, hfvis_openness(&g_ok, 4, &oo, &ro, out, GW));
+    }
 }
 
 static void args_sweep_azimuths(void)
@@ -1404,6 +1427,22 @@ static void args_sun_visibility(void)
     BAD('O', INV, hfvis_sun_visibility(&g_ok, 0.3, 0.4, 0.01, NULL, out, PTRDIFF_MAX));
     GRID_CASES(hfvis_sun_visibility(&bg, 0.3, 0.4, 0.01, NULL, out, GW));
     SWEEP_OPT_CASES(hfvis_sun_visibility(&g_ok, 0.3, 0.4, 0.01, &bo, out, GW));
+    { /* bands across the sun: its own; every other routine refuses them */
+        hfvis_sweep_options po = hfvis_sweep_options_default();
+        float *map = AF(GW * GH * 4);
+        po.part_index = 2;
+        po.part_count = 3;
+        OK(hfvis_sun_visibility(&g_ok, 0.3, 0.4, 0.01, &po, out, GW));
+        po.rays = HFVIS_RAYS_EXACT;
+        OK(hfvis_sun_visibility(&g_ok, 0.3, 0.4, 0.01, &po, out, GW));
+        po.rays = HFVIS_RAYS_LATTICE;
+        BAD('S', INV, hfvis_sky_view_factor(&g_ok, 4, &po, out, GW));
+        BAD('S', INV, hfvis_horizon_direction(&g_ok, 4, 1, &po, out, GW));
+        BAD('S', INV, hfvis_horizon_map(&g_ok, 4, &po, map));
+        po.part_index = 0;
+        po.part_count = 1; /* one band is every receiver: accepted everywhere */
+        OK(hfvis_sky_view_factor(&g_ok, 4, &po, out, GW));
+    }
 }
 
 static void args_env_options_default(void)

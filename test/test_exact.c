@@ -1,28 +1,26 @@
-/* test_exact.c - exact rays (hfvis.h, "Exact rays"): the sweep against its per-receiver oracle
- * on fields that break lattices (walls, boxes, terraces with one-cell cliffs, holes, borders),
- * closed-form horizons, the rational directions and their quadrature, split runs, and the
- * accuracy against the exact maximum over the bilinear surface. */
+/* test_exact.c - exact rays (hfvis.h, "Exact rays"): the sweep against its supremum oracle on
+ * fields that break lattices (walls, boxes, terraces with one-cell cliffs, holes, borders), the
+ * oracle against an independent maximization, closed-form horizons, the rational directions and
+ * their quadrature, split runs, and the accuracy against the supremum over the bilinear surface. */
 #include "test.h"
 #include "../examples/fields.h"
 
 #include <stdint.h>
 
 #define PI 3.14159265358979323846
-/* The hull's pop test compares cross products where the oracle compares quotients: on slopes
- * equal to the last bits the two may keep different (equally high) casters. */
+/* The sweep's samples and the oracle's closed forms reach equal heights by different expressions
+ * (the hull's cross products, the oracle's quotients): their last-bit differences. */
 #define EXACT_HULL_TOL 1e-12
 /* Closed-form horizons (planes, walls, boxes) recomputed in double by another route. */
 #define CLOSED_FORM_TOL 1e-9
-/* Accuracy against the exact bilinear maximum, occluders >= 1 cell away (issue 16's targets:
- * mean 0.15 deg, p99 1.5 deg; measured with the concave pieces split at 1/64 cell: urban
- * 0.000/0.011, terraces 0.002/0.038, fBm 0.004/0.081; the lattice on the same pairs 2.2/35,
- * 4.6/34, 1.3/11). */
-#define ACC_MEAN_DEG 0.15
-#define ACC_P99_DEG 1.5
 /* Lattice and exact sky-view factor and sky light on a smooth sinusoid, two cells from the
  * border: they differ by the lattice's gather error and the directions' deviation (0.7 deg at
  * K = 16); measured 0.020 (SVF) and 0.008 (sky). */
 #define MODES_AGREE_TOL 0.03
+/* The sweep below the supremum (its oracle, or indep_sup) over all pairs of a field: the header's
+ * stated bound (hfvis.h, "Exact rays": the pieces beyond the first are sampled, not maximized). */
+#define SUP_MEAN_DEG HFVIS_EXACT_SUP_MEAN_DEG
+#define SUP_P99_DEG HFVIS_EXACT_SUP_P99_DEG
 
 static float zbuf[160 * 160], out_a[16 * 160 * 160], out_b[16 * 160 * 160];
 
@@ -36,15 +34,45 @@ static hfvis_sweep_options exact_opts(double az0, hfvis_border border, int N)
     return o;
 }
 
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The sweep against the supremum oracle: never above it (every sample lies on the surface), the
+ * same holes and the same "no terrain", and within SUP_MEAN_DEG / SUP_P99_DEG of it over all
+ * pairs (the sweep samples the pieces beyond the first instead of maximizing them). */
 static void check_against_oracle(const hfvis_grid *g, int K, const hfvis_sweep_options *o)
 {
-    size_t n = (size_t)K * (size_t)g->width * (size_t)g->height, unequal;
-    double d;
+    static double errs[16 * 160 * 160];
+    size_t n = (size_t)K * (size_t)g->width * (size_t)g->height, i, m = 0;
+    double above = 0.0, sum = 0.0, worst = 0.0, p99;
+    int bad = 0;
     CHECK_EQ_STATUS(hfvis_horizon_map(g, K, o, out_a), HFVIS_OK);
     CHECK_EQ_STATUS(hfvis_horizon_exact_naive(g, K, o, out_b), HFVIS_OK);
-    d = test_max_diff(out_a, out_b, n, &unequal);
-    CHECK(d >= 0.0 && d <= EXACT_HULL_TOL);
-    if (unequal) printf("     note: %zu of %zu values differ in the last bits (max %.3g)\n", unequal, n, d);
+    for (i = 0; i < n; i++) {
+        double d;
+        if (isnan(out_a[i]) || isnan(out_b[i])) {
+            bad += !(isnan(out_a[i]) && isnan(out_b[i]));
+            continue;
+        }
+        bad += (out_a[i] == (float)(-PI / 2)) != (out_b[i] == (float)(-PI / 2));
+        d = (double)out_a[i] - (double)out_b[i];
+        if (d > above) above = d;
+        errs[m++] = -d * 180.0 / PI;
+        sum += -d * 180.0 / PI;
+        if (-d > worst) worst = -d;
+    }
+    CHECK(bad == 0);
+    CHECK(above <= EXACT_HULL_TOL + 1e-6); /* + the float output's rounding */
+    if (m == 0) return;
+    qsort(errs, m, sizeof(double), cmp_double);
+    p99 = errs[(size_t)(0.99 * (double)(m - 1))];
+    CHECK(sum / (double)m <= SUP_MEAN_DEG);
+    CHECK(p99 <= SUP_P99_DEG);
+    printf("     %dx%d K=%d border %d: below the supremum mean %.4f deg, p99 %.3f, max %.2f\n", g->width,
+           g->height, K, (int)o->border, sum / (double)m, p99, worst * 180.0 / PI);
 }
 
 static void fbm(float *z, int W, int H, double amp, double wl, uint64_t seed)
@@ -253,8 +281,8 @@ TEST(box_closed_form)
 /* Directions: the nearest rational ones, the documented deviations, exact weights. */
 TEST(azimuths_and_weights)
 {
-    static const int Ks[] = {1, 4, 8, 16, 32, 64, 128, 256, 7};
-    double az[256], w[256];
+    static const int Ks[] = {1, 4, 8, 16, 32, 64, 128, 256, 7, 360};
+    double az[360], w[360];
     hfvis_sweep_options lat = hfvis_sweep_options_default(), o = exact_opts(0.0, HFVIS_BORDER_OPEN, 0);
     int i, k;
     lat.azimuth0_rad = 0.25;
@@ -263,7 +291,7 @@ TEST(azimuths_and_weights)
         CHECK(az[k] == 0.25 + 2.0 * PI * (double)k / 8.0);
         CHECK(w[k] == 1.0 / 8.0);
     }
-    for (i = 0; i < 9; i++) {
+    for (i = 0; i < 10; i++) {
         int K = Ks[i];
         double sum = 0.0, dev = 0.0;
         CHECK_EQ_STATUS(hfvis_sweep_azimuths(K, &o, az, w), HFVIS_OK);
@@ -276,7 +304,8 @@ TEST(azimuths_and_weights)
         CHECK(sum == 1.0); /* exactly: edges are multiples of 2^-40 turn */
         if (K == 4 || K == 8) CHECK(dev < 1e-12);
         if (K == 16 || K == 32) CHECK(dev < 0.71);
-        if (K >= 64 && K <= 256) CHECK(dev < 0.35);
+        if (K >= 64 && K <= 360) CHECK(dev <= 0.25 + 1e-12); /* the cheapest within 0.25 deg */
+        for (k = 1; k < K; k++) CHECK(az[k] > az[k - 1]); /* the order kept */
         printf("     K = %3d: largest deviation %.3f deg\n", K, dev);
     }
     CHECK_EQ_STATUS(hfvis_sweep_azimuths(0, &o, az, w), HFVIS_ERR_INVALID_ARGUMENT);
@@ -459,15 +488,129 @@ TEST(allocation_failures)
     CHECK(c.live == 0);
 }
 
-static int cmp_double(const void *a, const void *b)
+/* An independent supremum over t > 0 of the elevation along a ray over the bilinear surface
+ * (open border), written here from scratch: dense samples every 1/SUP_DENSE cell, the t -> 0+
+ * limit by Richardson extrapolation (inside the first cell the tangent is linear in t, so
+ * 2 s(e) - s(2e) is its limit), then golden-section refinement around the best two local maxima.
+ * Returns the elevation (radians), -pi/2 if the ray leaves at once, NaN at a hole. */
+#define SUP_DENSE 48
+static double bil(const hfvis_grid *g, double px, double py)
 {
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
+    int X = (int)floor(px), Y = (int)floor(py);
+    double fx, fy;
+    const float *p;
+    if (X > g->width - 2) X = g->width - 2;
+    if (Y > g->height - 2) Y = g->height - 2;
+    if (X < 0) X = 0;
+    if (Y < 0) Y = 0;
+    fx = px - X;
+    fy = py - Y;
+    p = g->z + (ptrdiff_t)Y * g->stride + X;
+    if (g->width == 1 || g->height == 1) return (double)NAN;
+    return ((double)p[0] * (1 - fx) + (double)p[1] * fx) * (1 - fy) +
+           ((double)p[g->stride] * (1 - fx) + (double)p[g->stride + 1] * fx) * fy;
 }
 
-/* Accuracy against the exact bilinear maximum (occluders >= 1 cell away: pairs whose maximum lies
- * nearer are left out), off-axis directions included, on the three fields of the issue at test
- * size, and the lattice mode measured beside it (printed). */
+static double tan_at(const hfvis_grid *g, int x, int y, double c, double s, double h0, double t)
+{
+    return (bil(g, x + t * c, y + t * s) - h0) / (t * g->cell_size);
+}
+
+static double golden(const hfvis_grid *g, int x, int y, double c, double s, double h0, double lo, double hi)
+{
+    const double r = 0.6180339887498949;
+    double a = lo, b = hi, m1 = b - r * (b - a), m2 = a + r * (b - a);
+    double f1 = tan_at(g, x, y, c, s, h0, m1), f2 = tan_at(g, x, y, c, s, h0, m2);
+    int it;
+    for (it = 0; it < 60; it++) {
+        if (f1 < f2) {
+            a = m1;
+            m1 = m2;
+            f1 = f2;
+            m2 = a + r * (b - a);
+            f2 = tan_at(g, x, y, c, s, h0, m2);
+        } else {
+            b = m2;
+            m2 = m1;
+            f2 = f1;
+            m1 = b - r * (b - a);
+            f1 = tan_at(g, x, y, c, s, h0, m1);
+        }
+    }
+    return f1 > f2 ? f1 : f2;
+}
+
+static double indep_sup(const hfvis_grid *g, int x, int y, double psi)
+{
+    static double v[8192];
+    double c = cos(psi), s = sin(psi), h0 = (double)g->z[(ptrdiff_t)y * g->stride + x], best, e = 1e-4;
+    double tmax = 1e300, step = 1.0 / SUP_DENSE;
+    int n, j, b1 = -1, b2 = -1;
+    if (fabs(c) < 1e-12) c = 0.0;
+    if (fabs(s) < 1e-12) s = 0.0;
+    if (c > 0) tmax = ((g->width - 1) - x) / c;
+    if (c < 0) tmax = -x / c;
+    if (s > 0 && ((g->height - 1) - y) / s < tmax) tmax = ((g->height - 1) - y) / s;
+    if (s < 0 && -y / s < tmax) tmax = -y / s;
+    if (!(tmax > 1e-9)) return -PI / 2;
+    best = 2.0 * tan_at(g, x, y, c, s, h0, e) - tan_at(g, x, y, c, s, h0, 2.0 * e);
+    n = (int)floor(tmax / step);
+    for (j = 1; j <= n + 1 && j < 8192; j++) {
+        v[j] = tan_at(g, x, y, c, s, h0, j <= n ? j * step : tmax);
+        if (b1 < 0 || v[j] > v[b1]) b1 = j;
+    }
+    v[0] = best;
+    for (j = 1; j <= n + 1 && j < 8192; j++) /* the second local maximum */
+        if (j != b1 && v[j] >= v[j - 1] && (j == n + 1 || v[j] >= v[j + 1]) && (b2 < 0 || v[j] > v[b2])) b2 = j;
+    for (j = 0; j < 2; j++) {
+        int i = j ? b2 : b1;
+        double lo, hi, f;
+        if (i < 1) continue;
+        lo = (i - 1) * step;
+        hi = i <= n ? (i + 1) * step : tmax;
+        if (hi > tmax) hi = tmax;
+        if (lo < 1e-9) lo = 1e-9;
+        f = golden(g, x, y, c, s, h0, lo, hi);
+        if (v[i] > f) f = v[i];
+        if (f > best) best = f;
+    }
+    if (isnan(h0)) return (double)NAN;
+    return atan(best);
+}
+
+/* The oracle is the supremum: hfvis_horizon_exact_naive against indep_sup on every receiver and
+ * direction of the fields that break lattices (the near field and the saddles included). */
+#define INDEP_TOL 2e-6 /* rad: the float output (6e-8 of pi/2) and the golden section's tolerance */
+TEST(oracle_is_the_supremum)
+{
+    hfvis_sweep_options o = exact_opts(0.2, HFVIS_BORDER_OPEN, 0);
+    double az[16], worst = 0.0;
+    int f, k, x, y, n = 0, bad = 0;
+    for (f = 0; f < 3; f++) {
+        int W = 40, H = 30;
+        hfvis_grid g = test_grid(zbuf, W, H, f == 2 ? 0.5 : 1.0);
+        if (f == 0) fields_urban(zbuf, W, H, 8, 77);
+        if (f == 1) fields_terraces(zbuf, W, H, 1.0, 3.0, 80.0, 9);
+        if (f == 2) fbm(zbuf, W, H, 8.0, 6.0, 41);
+        CHECK_EQ_STATUS(hfvis_horizon_exact_naive(&g, 16, &o, out_b), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_sweep_azimuths(16, &o, az, NULL), HFVIS_OK);
+        for (k = 0; k < 16; k++)
+            for (y = 0; y < H; y++)
+                for (x = 0; x < W; x++) {
+                    double ref = indep_sup(&g, x, y, az[k]), got = out_b[(size_t)k * (size_t)(W * H) + (size_t)(y * W + x)];
+                    double d = fabs(got - ref);
+                    n++;
+                    if (!(d <= INDEP_TOL)) bad++;
+                    if (d > worst) worst = d;
+                }
+    }
+    printf("     oracle - independent supremum: largest %.2g rad over %d pairs\n", worst, n);
+    CHECK(bad == 0);
+}
+
+/* Accuracy against the supremum over t > 0 (indep_sup), every pair (the near field, negative
+ * horizons and off-axis directions included), on hold-out fields of the three kinds of the issue
+ * at test size (seeds no constant was tuned on), and the lattice mode measured beside it (printed). */
 static void accuracy(const char *name, const hfvis_grid *g, int stride_pts)
 {
     hfvis_sweep_options o = exact_opts(0.0, HFVIS_BORDER_OPEN, 0), lat = hfvis_sweep_options_default();
@@ -483,9 +626,9 @@ static void accuracy(const char *name, const hfvis_grid *g, int stride_pts)
         for (k = 0; k < 16; k++)
             for (y = 0; y < g->height; y += stride_pts)
                 for (x = (y / stride_pts) % stride_pts; x < g->width; x += stride_pts) {
-                    double arg = 0.0, ref = fields_ray_max(g, x, y, az[k], 0.0, &arg), got, e;
+                    double ref = indep_sup(g, x, y, az[k]), got, e;
                     got = (m ? out_b : out_a)[(size_t)k * plane + (size_t)y * (size_t)g->width + (size_t)x];
-                    if (!isfinite(ref) || ref <= -1.5 || arg < 1.0) continue;
+                    if (isnan(ref)) continue; /* holes only: every other pair counts */
                     e = fabs(got - ref) * 180.0 / PI;
                     errs[m][n++] = e;
                     sum[m] += e;
@@ -499,8 +642,8 @@ static void accuracy(const char *name, const hfvis_grid *g, int stride_pts)
         p99 = e[r];
         printf("     %-9s %s: mean %.3f deg, p99 %.3f deg (%zu pairs)\n", name, m ? "lattice" : "exact  ", mean, p99, n);
         if (m == 0) {
-            CHECK(mean <= ACC_MEAN_DEG);
-            CHECK(p99 <= ACC_P99_DEG);
+            CHECK(mean <= SUP_MEAN_DEG);
+            CHECK(p99 <= SUP_P99_DEG);
         }
     }
 }
@@ -543,16 +686,21 @@ static void svf_next_to_walls(const hfvis_grid *g)
 TEST(accuracy_against_exact_bilinear_max)
 {
     hfvis_grid g;
+    uint64_t seed;
     fields_urban(zbuf, 128, 128, 40, 1);
     g = test_grid(zbuf, 128, 128, 1.0);
-    accuracy("urban", &g, 3);
     svf_next_to_walls(&g);
-    fields_terraces(zbuf, 96, 72, 1.0, 5.0, 80.0, 2);
-    g = test_grid(zbuf, 96, 72, 1.0);
-    accuracy("terraces", &g, 2);
-    fbm(zbuf, 96, 72, 20.0, 24.0, 3);
-    g = test_grid(zbuf, 96, 72, 1.0);
-    accuracy("fbm", &g, 2);
+    for (seed = 1; seed <= 21; seed += 20) { /* the fields of docs/exact-rays.md, then hold-out ones */
+        fields_urban(zbuf, 128, 128, 40, seed);
+        g = test_grid(zbuf, 128, 128, 1.0);
+        accuracy("urban", &g, 5);
+        fields_terraces(zbuf, 96, 72, 1.0, 5.0, 80.0, seed + 1);
+        g = test_grid(zbuf, 96, 72, 1.0);
+        accuracy("terraces", &g, 3);
+        fbm(zbuf, 96, 72, 20.0, 24.0, seed + 2);
+        g = test_grid(zbuf, 96, 72, 1.0);
+        accuracy("fbm", &g, 3);
+    }
 }
 
 int main(int argc, char **argv)
@@ -570,6 +718,7 @@ int main(int argc, char **argv)
     RUN(split_runs);
     RUN(modes_and_arguments);
     RUN(allocation_failures);
+    RUN(oracle_is_the_supremum);
     RUN(accuracy_against_exact_bilinear_max);
     return TEST_DONE();
 }

@@ -1776,6 +1776,75 @@ TEST(p2_gather_vs_oracle_fbm)
 
 #define OPEN_TOL 1e-6 /* closed forms: float output of double sums of exact slopes */
 
+/* Bands across the sun (part_index/part_count): on a seeded fBm with holes and a one-cell
+ * cliff, in both ray modes, for axis, diagonal and oblique suns, with and without a receiver
+ * rectangle and a window, the parts of every count write each receiver exactly once, with the
+ * whole call's value bit for bit, and nothing outside the receivers. */
+TEST(sun_bands_tile_the_whole_call)
+{
+    enum { W = 61, H = 47, N = W * H };
+    static float z[N], whole[N], part[N], seen[N];
+    static const double az[5] = {0.0, 0.7853981633974483, 1.9, 3.6, 5.497787143782138};
+    static const int counts[3] = {2, 3, 7};
+    const float sentinel = -7.0f;
+    hfvis_grid g;
+    int mode, a, c, p, setup;
+    size_t i;
+    p2_fbm(z, W, H, 29, 8.0);
+    for (i = 0; i < N; i += 37) z[i] = NAN;
+    for (i = 0; i < N; i++)
+        if (i % W == 30) z[i] += 12.0f; /* a one-cell wall */
+    p2_grid_init(&g, z, W, H);
+    for (mode = 0; mode < 2; mode++)
+        for (setup = 0; setup < 3; setup++)
+            for (a = 0; a < 5; a++) {
+                hfvis_sweep_options o = hfvis_sweep_options_default();
+                size_t written_twice = 0, missing = 0, differ = 0, outside = 0;
+                int x, y, rx0 = 0, ry0 = 0, rx1 = W, ry1 = H;
+                o.rays = mode ? HFVIS_RAYS_EXACT : HFVIS_RAYS_LATTICE;
+                if (setup == 1) { /* a receiver rectangle */
+                    o.receiver_x = rx0 = 7;
+                    o.receiver_y = ry0 = 5;
+                    o.receiver_width = 40;
+                    o.receiver_height = 30;
+                    rx1 = 47;
+                    ry1 = 35;
+                } else if (setup == 2) { /* a window of a larger raster, finite radius */
+                    o.max_distance = 9.0;
+                    o.origin_x = 3;
+                    o.origin_y = 2;
+                    o.extent_width = W + 10;
+                    o.extent_height = H + 6;
+                }
+                for (i = 0; i < N; i++) whole[i] = sentinel;
+                CHECK_EQ_STATUS(hfvis_sun_visibility(&g, az[a], 0.25, 0.01, &o, whole, W), HFVIS_OK);
+                for (c = 0; c < 3; c++) {
+                    for (i = 0; i < N; i++) seen[i] = 0.0f;
+                    for (p = 0; p < counts[c]; p++) {
+                        o.part_index = p;
+                        o.part_count = counts[c];
+                        for (i = 0; i < N; i++) part[i] = sentinel;
+                        CHECK_EQ_STATUS(hfvis_sun_visibility(&g, az[a], 0.25, 0.01, &o, part, W), HFVIS_OK);
+                        for (i = 0; i < N; i++) {
+                            if (part[i] == sentinel) continue;
+                            seen[i] += 1.0f;
+                            differ += !(part[i] == whole[i] || (isnan(part[i]) && isnan(whole[i])));
+                        }
+                    }
+                    o.part_index = o.part_count = 0;
+                    for (y = 0; y < H; y++)
+                        for (x = 0; x < W; x++) {
+                            float k = seen[(size_t)y * W + (size_t)x];
+                            int in = x >= rx0 && x < rx1 && y >= ry0 && y < ry1;
+                            written_twice += k > 1.0f;
+                            missing += in && k == 0.0f;
+                            outside += !in && k != 0.0f;
+                        }
+                }
+                CHECK(written_twice == 0 && missing == 0 && differ == 0 && outside == 0);
+            }
+}
+
 /* Openness on fields with closed forms, the radius, negative = positive of -z bit for bit, and
  * the sweep (radius 0) against the march (a radius beyond the grid). */
 TEST(openness_closed_forms_and_oracle)
@@ -1900,6 +1969,53 @@ TEST(openness_closed_forms_and_oracle)
         CHECK(n == N - 1 && d[n / 2] <= P2_TOL_GATHER_MEDIAN && d[n - 1] <= P2_TOL_GATHER_MAX);
         o.azimuth0_rad = 0.0;
     }
+    /* both signs in one call (negative = 2): each plane equals its own run bit for bit, with a
+     * radius (one march for both) and unlimited, open and clamped borders, holes included */
+    {
+        static float both[2 * N], one[N];
+        static const double radii[3] = {4.0, 1e6, 0.0};
+        int r, b;
+        for (b = 0; b < 2; b++)
+            for (r = 0; r < 3; r++) {
+                o.border = b ? HFVIS_BORDER_CLAMP : HFVIS_BORDER_OPEN;
+                o.azimuth0_rad = 0.2;
+                oo.radius = radii[r];
+                oo.negative = 2;
+                CHECK_EQ_STATUS(hfvis_openness(&g, 12, &oo, &o, both, W), HFVIS_OK);
+                oo.negative = 0;
+                CHECK_EQ_STATUS(hfvis_openness(&g, 12, &oo, &o, one, W), HFVIS_OK);
+                CHECK(memcmp(both, one, sizeof one) == 0);
+                oo.negative = 1;
+                CHECK_EQ_STATUS(hfvis_openness(&g, 12, &oo, &o, one, W), HFVIS_OK);
+                CHECK(memcmp(both + N, one, sizeof one) == 0);
+                CHECK(isnan(both[7 * W + 9]) && isnan(both[N + 7 * W + 9]));
+            }
+        /* with a radius, row bands (receiver rectangles) tile the whole call bit for bit */
+        for (r = 0; r < 2; r++) {
+            const int cut[4] = {0, 13, 14, H};
+            int q;
+            oo.radius = radii[r];
+            oo.negative = 2;
+            o.border = r ? HFVIS_BORDER_CLAMP : HFVIS_BORDER_OPEN;
+            CHECK_EQ_STATUS(hfvis_openness(&g, 12, &oo, &o, both, W), HFVIS_OK);
+            {
+                static float bands[2 * N];
+                for (i = 0; i < 2 * N; i++) bands[i] = -5.0f;
+                for (q = 0; q < 3; q++) {
+                    hfvis_sweep_options bo = o;
+                    bo.receiver_y = cut[q];
+                    bo.receiver_height = cut[q + 1] - cut[q];
+                    bo.receiver_width = W;
+                    CHECK_EQ_STATUS(hfvis_openness(&g, 12, &oo, &bo, bands, W), HFVIS_OK);
+                }
+                CHECK(memcmp(both, bands, sizeof bands) == 0);
+            }
+        }
+        o.border = HFVIS_BORDER_OPEN;
+        o.azimuth0_rad = 0.0;
+        oo.negative = 0;
+        oo.radius = 0.0;
+    }
     /* bad arguments, outputs untouched */
     out[0] = 42.0f;
     CHECK_EQ_STATUS(hfvis_openness(NULL, 4, NULL, NULL, out, W), HFVIS_ERR_INVALID_ARGUMENT);
@@ -1914,7 +2030,7 @@ TEST(openness_closed_forms_and_oracle)
     oo.step_cells = -1.0;
     CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, NULL, out, W), HFVIS_ERR_INVALID_ARGUMENT);
     oo.step_cells = 0.0;
-    oo.negative = 2;
+    oo.negative = 3;
     CHECK_EQ_STATUS(hfvis_openness(&g, 4, &oo, NULL, out, W), HFVIS_ERR_INVALID_ARGUMENT);
     CHECK(out[0] == 42.0f);
 }
@@ -2462,6 +2578,7 @@ TEST(p2_env_consistency)
 
 static void run_part2_tests(void)
 {
+    RUN(sun_bands_tile_the_whole_call);
     RUN(p2_linf_pit_apex);
     RUN(p2_cone_pit_apex);
     RUN(p2_step_axis_exact);

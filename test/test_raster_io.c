@@ -728,6 +728,167 @@ TEST(asc_ehdr)
     ex_georef_free(&g);
 }
 
+/* South-up and mirrored rasters (a positive pixel height, a negative pixel width or a negative
+ * ModelPixelScale X, a negative EHdr YDIM) read north-up, west to east: the same cells, the
+ * same geotransform, windows included; a GeoTIFF written from such an input stores the raster
+ * in the input's orientation again (ModelTransformation), an ASC north-up. Each stored file is
+ * built here by reversing the rows or columns of the north-up field. */
+TEST(orientation)
+{
+    enum { W = 7, H = 5 };
+    static const double gt[6] = {500000.0, 30.0, 0.0, 4100000.0, 0.0, -30.0};
+    float z[W * H], stored[W * H], got[W * H], win[9];
+    int v, x, y, w, h, k;
+    char err[256];
+    ex_rio_image img;
+    ex_rio_reader r;
+    field(z, W, H, 1, 0, 5);
+    img.width = W; img.height = H; img.bands = 1; img.band_step = W * H; img.row_step = W; img.pixel_step = 1;
+    for (v = 0; v < 4; v++) { /* 0 north-up, 1 south-up, 2 mirrored (matrix), 3 both (negative scale X) */
+        int fx = v >= 2, fy = v == 1 || v == 3;
+        char name[32];
+        ex_georef g;
+        double tie[6] = {0, 0, 0, 0, 0, 0};
+        memset(&g, 0, sizeof g);
+        for (y = 0; y < H; y++)
+            for (x = 0; x < W; x++) stored[y * W + x] = z[(fy ? H - 1 - y : y) * W + (fx ? W - 1 - x : x)];
+        if (v == 2) {
+            g.has_matrix = 1;
+            g.matrix[0] = -30.0; g.matrix[3] = gt[0] + 30.0 * W; g.matrix[5] = -30.0; g.matrix[7] = gt[3];
+            g.matrix[10] = g.matrix[15] = 1.0;
+        } else {
+            g.has_scale = 1;
+            g.scale[0] = fx ? -30.0 : 30.0; g.scale[1] = fy ? -30.0 : 30.0;
+            tie[3] = fx ? gt[0] + 30.0 * W : gt[0];
+            tie[4] = fy ? gt[3] - 30.0 * H : gt[3];
+            g.tiepoints = tie; g.n_tiepoints = 6;
+        }
+        img.data = stored;
+        snprintf(name, sizeof name, "o%d.tif", v);
+        CHECK(ex_rio_write(tpath(name), &img, &g, NULL, err) == 0);
+        CHECK(read_all(tpath(name), 0, got, &w, &h, &r) == 0);
+        CHECK(same_bits(z, got, W * H));
+        for (k = 0; k < 6; k++) CHECK(r.geo.gt[k] == gt[k]);
+        CHECK(r.geo.flip_x == fx && r.geo.flip_y == fy);
+        /* a window inside and one past the corner (NaN outside) */
+        CHECK(ex_rio_read(&r, 0, 2, 1, 3, 3, win, 3) == 0);
+        for (y = 0; y < 3; y++)
+            for (x = 0; x < 3; x++) CHECK(same_bits(&win[y * 3 + x], &z[(1 + y) * W + 2 + x], 1));
+        CHECK(ex_rio_read(&r, 0, -1, -1, 3, 3, win, 3) == 0);
+        CHECK(isnan(win[0]) && isnan(win[2]) && isnan(win[6]) && same_bits(&win[4], &z[0], 1) &&
+              same_bits(&win[8], &z[W + 1], 1));
+        /* written back: in the input's orientation (GeoTIFF), north-up (ASC) */
+        img.data = z;
+        CHECK(ex_rio_write(tpath("back.tif"), &img, &r.geo, NULL, err) == 0);
+        CHECK(ex_rio_write(tpath("back.asc"), &img, &r.geo, NULL, err) == 0);
+        ex_rio_close(&r);
+        CHECK(read_all(tpath("back.tif"), 0, got, &w, &h, &r) == 0);
+        CHECK(same_bits(z, got, W * H) && r.geo.flip_x == fx && r.geo.flip_y == fy);
+        for (k = 0; k < 6; k++) CHECK(r.geo.gt[k] == gt[k]);
+        ex_rio_close(&r);
+        CHECK(read_all(tpath("back.asc"), 0, got, &w, &h, &r) == 0);
+        CHECK(same_bits(z, got, W * H) && !r.geo.flip_x && !r.geo.flip_y && r.geo.gt[0] == gt[0] && r.geo.gt[3] == gt[3]);
+        ex_rio_close(&r);
+    }
+    /* EHdr: a negative YDIM is a south-up file, as GDAL reads it; XDIM/YDIM 0 and cellsize 0
+     * or below are refused (never cell 1) */
+    {
+        static const char su[] = "NROWS 2\nNCOLS 2\nNBITS 32\nPIXELTYPE FLOAT\nULXMAP 15\nULYMAP 15\nXDIM 10\nYDIM -10\n";
+        static const char *const bad[] = {
+            "NROWS 2\nNCOLS 2\nNBITS 32\nPIXELTYPE FLOAT\nULXMAP 15\nULYMAP 15\nXDIM 0\nYDIM 10\n",
+            "NROWS 2\nNCOLS 2\nNBITS 32\nPIXELTYPE FLOAT\nULXMAP 15\nULYMAP 15\nXDIM 10\n",
+            "ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 0\n",
+            "ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize -5\n"};
+        static const unsigned char d[16] = {0, 0, 0x80, 0x3f, 0, 0, 0, 0x40, 0, 0, 0x40, 0x40, 0, 0, 0x80, 0x40};
+        float o[4]; /* 1, 2, 3, 4 as little-endian floats */
+        CHECK(ex_rio_open_ehdr_mem(&r, su, strlen(su), d, 16, 0) == 0 && r.geo.flip_y && !r.geo.flip_x);
+        CHECK(r.geo.gt[0] == 10.0 && r.geo.gt[3] == 30.0 && r.geo.gt[5] == -10.0);
+        CHECK(ex_rio_read(&r, 0, 0, 0, 2, 2, o, 2) == 0 && o[0] == 3.0f && o[1] == 4.0f && o[2] == 1.0f && o[3] == 2.0f);
+        ex_rio_close(&r);
+        for (k = 0; k < 4; k++) {
+            CHECK(ex_rio_open_ehdr_mem(&r, bad[k], strlen(bad[k]), d, 16, k >= 2) != 0 && r.err[0] != '\0');
+            ex_rio_close(&r);
+        }
+    }
+}
+
+/* ModelPixelScale with two values (X, Y) is read as GDAL reads it; with one value, or a scale
+ * without a tie point, or a zero scale, the file is refused: never cell 1 in silence. */
+TEST(pixel_scale_counts)
+{
+    unsigned char buf[4096];
+    /* a 2 x 2 Float32 strip image (data at 200) with ModelPixelScale at 300, ModelTiepoint at 340 */
+    uint32_t e[11][4] = { { 256, 3, 1, 2 }, { 257, 3, 1, 2 }, { 258, 3, 1, 32 }, { 259, 3, 1, 1 },
+                          { 273, 4, 1, 200 }, { 277, 3, 1, 1 }, { 278, 3, 1, 2 }, { 279, 4, 1, 16 },
+                          { 339, 3, 1, 3 }, { 33550, 12, 2, 300 }, { 33922, 12, 6, 340 } };
+    double sc[3] = {90.0, 90.0, 0.0}, tie[6] = {0, 0, 0, 1000.0, 2000.0, 0};
+    ex_rio_reader r;
+    int k;
+    memset(buf, 0, sizeof buf);
+    for (k = 0; k < 3; k++) { uint64_t u; memcpy(&u, &sc[k], 8); ex_rio_put_uint(buf + 300 + 8 * k, u, 8, 0); }
+    for (k = 0; k < 6; k++) { uint64_t u; memcpy(&u, &tie[k], 8); ex_rio_put_uint(buf + 340 + 8 * k, u, 8, 0); }
+    mini_tiff(buf, e, 11, 0);
+    CHECK(ex_rio_open_tiff_mem(&r, buf, 400) == 0 && r.geo.has_transform && r.geo.gt[1] == 90.0 &&
+          r.geo.gt[5] == -90.0 && r.geo.gt[0] == 1000.0 && r.geo.gt[3] == 2000.0);
+    ex_rio_close(&r);
+    e[9][2] = 1; /* one value */
+    mini_tiff(buf, e, 11, 0);
+    CHECK(open_err(buf, 400, "ModelPixelScale"));
+    e[9][2] = 3; /* no tie point */
+    mini_tiff(buf, e, 10, 0);
+    CHECK(open_err(buf, 400, "no ModelTiepoint"));
+    sc[0] = 0.0; /* zero scale */
+    { uint64_t u; memcpy(&u, &sc[0], 8); ex_rio_put_uint(buf + 300, u, 8, 0); }
+    mini_tiff(buf, e, 11, 0);
+    CHECK(open_err(buf, 400, "zero pixel size"));
+}
+
+/* Heights that are not finite as floats are holes (NaN), as hfvis.h takes every non-finite
+ * height: +-Inf and a Float64 1e300 in a GeoTIFF, 1e39 in an ASC. Hexadecimal is not a number
+ * (NoData "0x10", an ASC value "0x10"); a TOTALROWBYTES shorter than a row is refused. */
+TEST(non_finite_and_hex)
+{
+    unsigned char buf[4096];
+    uint32_t e[9][4] = { { 256, 3, 1, 2 }, { 257, 3, 1, 2 }, { 258, 3, 1, 64 }, { 259, 3, 1, 1 },
+                         { 273, 4, 1, 200 }, { 277, 3, 1, 1 }, { 278, 3, 1, 2 }, { 279, 4, 1, 32 },
+                         { 339, 3, 1, 3 } };
+    double d[4];
+    float v[4];
+    ex_rio_reader r;
+    int k;
+    static const char *const refused[] = {
+        "ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value 0x10\n1 2\n",
+        "ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n0x10 2\n",
+        "ncols 0x2\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n"};
+    static const unsigned char raw[16] = {0};
+    d[0] = 1e300; d[1] = (double)INFINITY; d[2] = -(double)INFINITY; d[3] = 7.5;
+    memset(buf, 0, sizeof buf);
+    mini_tiff(buf, e, 9, 0);
+    for (k = 0; k < 4; k++) { uint64_t u; memcpy(&u, &d[k], 8); ex_rio_put_uint(buf + 200 + 8 * k, u, 8, 0); }
+    CHECK(ex_rio_open_tiff_mem(&r, buf, 232) == 0 && ex_rio_read(&r, 0, 0, 0, 2, 2, v, 2) == 0);
+    CHECK(isnan(v[0]) && isnan(v[1]) && isnan(v[2]) && v[3] == 7.5f);
+    ex_rio_close(&r);
+    {
+        static const char a[] = "ncols 3\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n1e39 -1e39 5\n";
+        CHECK(ex_rio_open_asc_mem(&r, a, strlen(a)) == 0 && ex_rio_read(&r, 0, 0, 0, 3, 1, v, 3) == 0);
+        CHECK(isnan(v[0]) && isnan(v[1]) && v[2] == 5.0f);
+        ex_rio_close(&r);
+    }
+    for (k = 0; k < 3; k++) {
+        CHECK(ex_rio_open_asc_mem(&r, refused[k], strlen(refused[k])) != 0 && r.err[0] != '\0');
+        ex_rio_close(&r);
+    }
+    for (k = 0; k < 3; k++) {
+        static const char *const h[3] = {"NROWS 2\nNCOLS 2\nNBITS 32\nPIXELTYPE FLOAT\nNODATA 0x10\n",
+                                          "NROWS 2\nNCOLS 2\nNBITS 32\nPIXELTYPE FLOAT\nTOTALROWBYTES 4\n",
+                                          "NROWS 2\nNCOLS 2\nNBITS 32\nPIXELTYPE FLOAT\nTOTALROWBYTES 8\n"};
+        int rc = ex_rio_open_ehdr_mem(&r, h[k], strlen(h[k]), raw, 16, 0);
+        CHECK(k == 2 ? rc == 0 : rc != 0 && r.err[0] != '\0');
+        CHECK(k != 1 || strstr(r.err, "shorter than a row"));
+        ex_rio_close(&r);
+    }
+}
+
 TEST(georef_cells)
 {
     ex_georef g;
@@ -917,11 +1078,15 @@ int main(int argc, char **argv)
     RUN(netpbm_windows);
     RUN(tiff_malformed);
     RUN(asc_ehdr);
+    RUN(orientation);
+    RUN(pixel_scale_counts);
+    RUN(non_finite_and_hex);
     RUN(georef_cells);
     RUN(prj_geokeys);
     {
         const char *names[] = { "rt.tif", "u.tif", "c.tif", "w.tif", "w.flt", "w.hdr", "t.tif", "m.tif", "a.asc",
-                                "a.prj", "e.flt", "e.bil", "e.hdr", "e.prj" };
+                                "a.prj", "e.flt", "e.bil", "e.hdr", "e.prj", "o0.tif", "o1.tif", "o2.tif", "o3.tif",
+                                "back.tif", "back.asc" };
         size_t i;
         for (i = 0; i < sizeof names / sizeof names[0]; i++) remove(tpath(names[i]));
         CHECK(test_dir_entries(tdir) == 0); /* no temporary file left by a writer */

@@ -15,12 +15,12 @@ fail() { echo "FAIL vendor: $1"; rm -rf "$dir"; exit 1; }
 
 cp hfvis.h hfvis.c ssao.c voxel.c "$dir/vendor/" || fail "copy"
 cp examples/common.h examples/png_write.h examples/zio.h examples/raster_io.h examples/fields.h examples/0*.c examples/1*.c "$dir/app/" || fail "copy"
-mkdir -p "$dir/app/cli" && cp examples/cli/hfvis_cli.c "$dir/app/cli/" || fail "copy" # the tool beside, as in examples/
+mkdir -p "$dir/app/cli" && cp examples/cli/*.c examples/cli/*.h "$dir/app/cli/" || fail "copy" # the tool beside, as in examples/
 # shellcheck disable=SC2086 # $flags is a list of flags
 (cd "$dir/vendor" && $cc $flags -c hfvis.c && $cc $flags -c ssao.c && $cc $flags -c voxel.c) \
   > "$dir/log" 2>&1 || { cat "$dir/log"; fail "$cc $flags -c hfvis.c ssao.c voxel.c"; }
 n=0
-for src in "$dir"/app/*.c "$dir"/app/cli/hfvis_cli.c; do
+for src in "$dir"/app/*.c "$dir"/app/cli/main.c; do # main.c includes the other files of cli/
   prog=${src%.c}
   # shellcheck disable=SC2086
   $cc $flags -I"$dir/vendor" "$src" "$dir/vendor/hfvis.o" "$dir/vendor/ssao.o" "$dir/vendor/voxel.o" -lm -o "$prog" \
@@ -32,6 +32,6 @@ done
 for f in 02_sky_light.pgm 02_sky_view_factor.pgm; do
   [ -s "$dir/out/$f" ] || fail "02_sky_view_factor did not write $f"
 done
-"$dir/app/cli/hfvis_cli" --help > /dev/null 2>&1 || fail "hfvis --help failed"
+"$dir/app/cli/main" --help > /dev/null 2>&1 || fail "hfvis --help failed"
 rm -rf "$dir"
 echo "ok   vendor ($n programs built with $cc $flags from the four library files alone; 02_sky_view_factor ran)"

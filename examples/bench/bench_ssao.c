@@ -3,10 +3,11 @@
  * band" (10 % per side: 1280(+256) x 720(+144)), K = 8 and 16, falloff radii from a few pixels to
  * the whole screen. HBAO runs at matching quality: the same box directions and integer steps
  * as LSAO (every texel of the direction's pattern up to the falloff's support, the brute force
- * LSAO's hull replaces, [P3] Fig. 7), so the two differ only by the gather and the hull's
+ * LSAO's hull replaces, [P3] Fig. 7; its screen-radius cap lifted to the buffer diagonal), so the two differ only by the gather and the hull's
  * degenerate cases (mean |d| printed). Its step count grows with the radius, as [P3] Table 1.
  * For large radii HBAO is timed on a band of rows through the image centre (its cost per pixel
- * there is printed; the band is where the knot is, so it is not cheaper than the average). */
+ * there is printed; the band is where the knot is, so it is not cheaper than the average).
+ * Times are process CPU time (single-threaded; the machine may be shared). */
 #define _POSIX_C_SOURCE 199309L
 #include "bench.h"
 #include "hfvis.h"
@@ -65,9 +66,9 @@ static double bench_ssao_lsao(const hfvis_camera *cam, const float *depth,
     double best = 1e30;
     int r;
     for (r = 0; r < reps; r++) {
-        double t0 = bench_now(), t;
+        double t0 = bench_cpu_now(), t;
         if (hfvis_lsao(cam, depth, NULL, o, ao, cam->width - 2 * cam->guard_x) != HFVIS_OK) return -1.0;
-        t = bench_now() - t0;
+        t = bench_cpu_now() - t0;
         if (t < best) best = t;
     }
     return best;
@@ -85,9 +86,9 @@ static double bench_ssao_hbao(const hfvis_camera *cam, const float *depth,
     skip = (IH - rows) / 2;
     band.guard_y = cam->guard_y + skip;
     rows = cam->height - 2 * band.guard_y;
-    t0 = bench_now();
+    t0 = bench_cpu_now();
     if (hfvis_hbao(&band, depth, NULL, o, ao + (size_t)skip * (size_t)IW, IW) != HFVIS_OK) return -1.0;
-    t = bench_now() - t0;
+    t = bench_cpu_now() - t0;
     return t * (double)IH / (double)rows; /* per whole image */
 }
 
@@ -111,12 +112,12 @@ static void bench_ssao_breakdown(const hfvis_camera *cam, const float *depth,
         lines = (hfvis_ssao_line *)malloc(sizeof *lines * (size_t)L.line_count);
         vals = (float *)malloc(sizeof(float) * 2 * L.sample_count);
         hfvis_ssao_lattice_lines(cam, &L, lines);
-        t0 = bench_now();
+        t0 = bench_cpu_now();
         hfvis_lsao_direction(cam, depth, NULL, o, &L, lines, vals, vals + L.sample_count);
-        *t_sweep += bench_now() - t0;
-        t0 = bench_now();
+        *t_sweep += bench_cpu_now() - t0;
+        t0 = bench_cpu_now();
         hfvis_lsao_gather(cam, depth, NULL, o, &L, lines, vals, vals + L.sample_count, acc, acc + n);
-        *t_gather += bench_now() - t0;
+        *t_gather += bench_cpu_now() - t0;
         free(vals);
         free(lines);
     }
@@ -184,6 +185,10 @@ void bench_ssao(int quick)
                 ho.tangent = HFVIS_SSAO_TANGENT_FIXED;
                 ho.plane = HFVIS_SSAO_PLANE_PAPER;
                 ho.falloff = lo.falloff;
+                /* march to the falloff's support at every radius (the default screen-radius cap
+                 * would stop HBAO short of it at R >= 1 and compare unequal quality): the cap is
+                 * the buffer diagonal, which hfvis_hbao takes as "no cap" */
+                ho.max_radius_px = sqrt((double)W0 * (double)W0 + (double)H0 * (double)H0);
                 /* a band small enough for ~1-2 s: cost ~ K (R_px / 2.4 px) samples per pixel */
                 cost = (double)K * (R * 125.0 * (double)W / 1280.0 / 2.4 + 1.0);
                 if (cost > 2.0 * (double)W) cost = 2.0 * (double)W; /* capped by the buffer */

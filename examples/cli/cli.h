@@ -1,0 +1,357 @@
+/* cli.h - the `hfvis` command-line tool's shared declarations (README.md, CLI): limits, the
+ * commands, the parsed arguments (cli_args), the types several files share, the run's file-scope
+ * state and the prototypes of every function. The tool is one translation unit (main.c includes
+ * every file once), so everything here is static. Files by concern:
+ *   main.c          the entry point        help.c          the help texts
+ *   flags.c         flag table and parser  progress.c      errors, progress bar and lines
+ *   gis.c           conventions, rasters   run.c           estimate, loading, cli_run
+ *   write.c         safe writing, signals  sweeps.c        sweep helpers, gi, horizon planes
+ *   p2.c            indirect, visibility   gis_products.c  viewshed, hillshade, openness
+ *   screen.c        ssao                   meshes.c        meshao, visfield, volgi, voxelize
+ *   split.c         --dir-range and sum    tiles.c         --window pieces and mosaic
+ * Every file is read and written through the library's codecs (hfvis_image_load, the encoders
+ * and hfvis_write_file) or examples/raster_io.h (GeoTIFF, ASC, EHdr), so the tool exercises what
+ * a vendoring user gets; an interrupt (SIGINT, SIGTERM, SIGHUP) removes the temporary file of a
+ * write in progress. Errors: one line "hfvis: <what>: <why>" on stderr, exit 1 (2 for usage
+ * errors); exit 0 means OUT is complete. */
+#ifndef HFVIS_CLI_H
+#define HFVIS_CLI_H
+#define _POSIX_C_SOURCE 200809L /* isatty() under -std=c99 */
+#include <ctype.h>
+#include <errno.h>
+#include <float.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <signal.h>
+#if defined(__unix__) || (defined(__APPLE__) && defined(__MACH__))
+#include <sys/stat.h> /* stat(): an output that is an input */
+#include <unistd.h>
+#define CLI_HAVE_ISATTY 1
+#define CLI_HAVE_SIGACTION 1
+#endif
+#include <time.h>
+#include "../common.h"
+#include "../raster_io.h"
+
+#define CLI_PI 3.14159265358979323846
+#define CLI_FLT_MAX ((double)FLT_MAX)                 /* largest value a float flag may take */
+#define CLI_MAX_DIRS 65536                        /* --dirs upper bound */
+#define CLI_HORIZON_MAX_VALUES HFVIS_IMAGE_MAX_VALUES /* K*W*H limit of `horizon` (2^28 floats, 1 GiB) */
+#define CLI_MAX_BOUNCES 1000                      /* --bounces upper bound (one sweep each) */
+#define CLI_MAX_TARGETS 64                        /* viewshed --target points per run */
+#define CLI_MAX_RELIEF 1e150 /* |height| / cell: the slopes' squares stay far below DBL_MAX */
+#define CLI_EXIT_ERROR 1
+#define CLI_EXIT_USAGE 2
+#define CLI_RUN (-1)                              /* parse_args: go on and run the command */
+
+enum { CMD_HORIZON, CMD_SKYVIEW, CMD_SKY, CMD_SHADOW, CMD_LIGHT, CMD_NORMALS, CMD_INDIRECT,
+       CMD_VISIBILITY, CMD_VIEWSHED, CMD_VOXELIZE, CMD_GI, CMD_SSAO, CMD_VOLGI, CMD_VISFIELD, CMD_MESHAO,
+       CMD_HILLSHADE, CMD_OPENNESS, CMD_SUM, CMD_COUNT };
+static const char *const cli_cmd_names[CMD_COUNT] = {
+    "horizon", "skyview", "sky", "shadow", "light", "normals", "indirect", "visibility",
+    "viewshed", "voxelize", "gi", "ssao", "volgi", "visfield", "meshao", "hillshade", "openness",
+    "sum"
+};
+
+/* voxelize --mode, --axis, --method */
+enum { VOX_SURFACE, VOX_CONSERVATIVE, VOX_SOLID };
+enum { AXIS_DEFAULT, AXIS_DOMINANT, AXIS_ALL, AXIS_X, AXIS_Y, AXIS_Z };
+#define CLI_MAX_RES 2048 /* --res upper bound (the grid limit is 2^31 voxels) */
+
+/* indirect --output */
+enum { OUT_TOTAL, OUT_DIRECT, OUT_INDIRECT };
+
+#define CLI_VOLGI_MAX_LIGHTS 8
+
+typedef struct cli_args {
+    int cmd;
+    int has_dir_range, dir_begin, dir_end, out_partial; /* --dir-range A:B, -o *.hfvs */
+    const char *in, *out, *env, *albedo_map, *emission;
+    int out_pgm, out_raster, band, has_cell; /* -o *.tif/.asc/.bil/.flt; --band N (1-based) */
+    double cell, zscale, azimuth0, nodata, range_lo, range_hi;
+    double sky, albedo, sun_azimuth, sun_elevation, sun_radius, sun_irradiance;
+    int dirs, border, border_cells, method, bounces, output;
+    int compass, degrees, quiet, math, fraction, stats;
+    int has_nodata, has_range, has_sun_azimuth, has_sun_elevation, has_sun_radius;
+    int has_sun_irradiance, has_sky, has_albedo, has_bounces;
+    double observer_x, observer_y, observer_height, target_height, max_distance;
+    int has_observer, exact;
+    int res, vox_mode, vox_axis, vox_method, max_vertices, open_mesh, out_binvox;
+    double padding;
+    /* GIS conventions, map coordinates, hillshade, openness, safety, progress (CLI_GIS_HELP) */
+    int convention, has_convention, radians, has_azimuth0, has_azimuth, split, overwrite;
+    int progress_lines, observer_grid, curvature, svf, blend, negative, no_shadows, ntargets;
+    int has_geotransform, has_radius, has_refraction, has_earth_radius;
+    double azimuth, refraction, earth_radius, radius, targets[2 * CLI_MAX_TARGETS];
+    double geotransform[6]; /* GDAL order; set by a georeferenced input (else cli_georef's default) */
+    int order, subsample, has_dirs, has_specular, has_shininess;
+    double specular, shininess;
+    int ssao_method, ssao_depth, ssao_has_ortho, ssao_has_near, ssao_has_far, ssao_guard;
+    double ssao_fov, ssao_ortho, ssao_radius, ssao_near, ssao_far;
+    int room, iterations, vg_nlights, vg_has_eye, vg_has_target, vg_width, vg_height, vg_transfer,
+        vg_paths, vg_reflection, vg_rho_albedo, vg_has_rho;
+    double vg_eye[3], vg_target[3], vg_up[3], vg_fov, vg_rho;
+    hfvis_volgi_light vg_lights[CLI_VOLGI_MAX_LIGHTS];
+    int vf_positions, vf_format, vf_mapping, vf_ao, vf_rays, vf_has_size;
+    int vf_has_extent, vf_has_ground, vf_has_bias;
+    double vf_extent, vf_ground, vf_bias;
+    const char *vf_reference;
+    int lk_method, lk_rays, lk_pattern, lk_falloff, lk_width, lk_height, lk_two_sided, lk_lut, lk_no_jitter,
+        lk_has_eye, lk_has_target, lk_has_up, lk_has_radius;
+    double lk_radius, lk_fov, lk_seed, lk_eye[3], lk_target[3], lk_up[3];
+    double max_memory; /* --max-memory bytes, 0 = no limit (default: cli_default_max_memory) */
+    int has_window, win_x, win_y, win_w, win_h; /* --window X0,Y0,W,H (cells; docs/tiles.md) */
+} cli_args;
+
+/* ssao --method, --depth */
+enum { SSAO_LSAO, SSAO_HBAO, SSAO_FFAO, SSAO_RAYTRACE };
+enum { SSAO_DEPTH_LINEAR, SSAO_DEPTH_GL, SSAO_DEPTH_D3D, SSAO_DEPTH_REVERSED };
+
+/* --convention: how an azimuth flag's value is read and in which sense directions k advance.
+ * The library's psi runs from east toward south (+x toward +y, rows down): clockwise on a
+ * north-up map. */
+enum { CONV_COMPASS, CONV_GRASS, CONV_GRID };
+static const char *const cli_conv_names[3] = { "compass", "grass", "grid" };
+
+#define CLI_SUMMARY_SECONDS 10.0 /* runs at least this long end with a summary line on stderr */
+
+#define CLI_EARTH_RADIUS 6371000.0 /* mean Earth radius in metres (IUGG), --earth-radius default */
+#define CLI_REFRACTION 0.13        /* the usual refraction coefficient (ArcGIS's default) */
+
+#define CLI_ALL ((1u << CMD_COUNT) - 1u)
+#define CLI_ONLY(c) (1u << (c))
+#define CLI_SUN (CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) \
+                 | CLI_ONLY(CMD_HILLSHADE)) /* the sun flags */
+/* the sweep commands: --max-distance R is the library's search radius, --window makes a piece */
+#define CLI_SWEEP (CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_SHADOW) \
+                   | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_HILLSHADE))
+/* the [P2] hull-tree commands: a search radius but no windows in the library (hfvis.h, "Search
+ * radius and tiles") */
+#define CLI_P2 (CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_INDIRECT))
+/* the height-field commands: the GIS conventions apply to them */
+#define CLI_HF (CLI_ALL & ~(CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_VOLGI) \
+                            | CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_MESHAO) | CLI_ONLY(CMD_SUM)))
+
+static int cli_bar_open; /* a progress line is on stderr without its newline yet */
+
+/* One progress bar over several library calls: each call reports its own done/total, the bar
+ * shows base + done out of the run's total (its units are directions; 0 = each call's total). */
+typedef struct cli_progress_state {
+    const char *label;
+    long long base;   /* units finished by the calls before the current one */
+    long long total;  /* units of the whole run */
+} cli_progress_state;
+
+/* The georeference of a raster IN, carried to a raster OUT (cli_save); the rows of IN, to
+ * recognise stacked output planes. The CLI's one piece of global state besides the bar. */
+static ex_georef cli_geo;
+static int cli_in_height;
+
+/* A --window run (docs/tiles.md): the window of the raster it writes, the grid it loads (the
+ * window and a halo, clipped to the raster), and what its piece's sidecar records. */
+#define CLI_PIECE_TAG_MAX 2048 /* a piece's run tag: the command, the input's identity, ~30 parameters */
+typedef struct cli_window {
+    int active;                 /* this run computes one piece */
+    int halo;                   /* cells of halo (cli_halo), -1 unknown */
+    int x0, y0, w, h;           /* the window, clipped to the raster */
+    int gx0, gy0, gw, gh;       /* the grid loaded: window + halo, clipped */
+    int ext_w, ext_h;           /* the raster */
+    char in_id[64], crs[64], gt[160], nodata[80];
+    char tag[CLI_PIECE_TAG_MAX];
+} cli_window;
+static cli_window cli_win = { 0, -1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, "", "", "", "", "" };
+
+/* What a run is expected to cost before it allocates: bytes at its peak and units of work. */
+typedef struct cli_cost {
+    double bytes, work;
+    const char *unit;
+} cli_cost;
+
+/* The library's savers, through cli_write: encode into memory (need bytes), then write. */
+typedef hfvis_status (*cli_encoder)(const void *what, void *out, size_t cap, size_t *written);
+
+typedef struct cli_image { /* the arguments of hfvis_pfm_encode / hfvis_pgm_range_encode */
+    const float *px;
+    int w, h, channels;
+    ptrdiff_t stride;
+    float lo, hi;
+} cli_image;
+typedef struct cli_voxels {
+    const hfvis_volume_grid *grid;
+    const uint8_t *occ;
+} cli_voxels;
+
+#define CLI_TAG_MAX 1024 /* our tags: the command, fingerprints and a dozen parameters */
+
+/* One part's header and a copy of its tag (pass 1 of `sum` keeps these, not the sums). */
+typedef struct cli_part {
+    int width, height, planes, directions, begin, end;
+    char *tag;
+} cli_part;
+
+static double cli_t0;             /* start of the run, cli_now() */
+static double cli_run_cells;      /* grid samples of the run, for the summary line */
+static int cli_run_directions;    /* directions of the run (0: none), for the summary line */
+static double cli_line_last;      /* when the last --progress line was printed */
+static int cli_line_pct = -1;     /* and its percentage */
+
+#define CLI_PIECE_MAGIC "HFVISTILE 1\n"
+#define CLI_PIECE_SIDECAR ".tile" /* appended to the piece's name */
+
+typedef struct cli_piece {
+    int x0, y0, w, h, planes, channels;
+    char range[96];
+    char tag[CLI_PIECE_TAG_MAX];
+} cli_piece;
+
+/* prototypes, by file */
+/* help.c */
+/* progress.c */
+static int cli_error(int code, const char *what, const char *fmt, ...);
+static int cli_status(const char *what, hfvis_status s, int saved_errno);
+static void cli_progress_advance(cli_progress_state *p, int done, int total, long long *now,
+                                 long long *all);
+static void cli_progress(void *user, int done, int total);
+static double cli_default_max_memory(void);
+static int cli_stderr_is_terminal(void);
+static double cli_now(void);
+static void cli_progress_line(void *user, int done, int total);
+/* flags.c */
+static int cli_parse_real(const char *s, double *out);
+static int cli_real(const char *flag, const char *s, double lo, int lo_open, double hi,
+                    const char *expect, double *out);
+static int cli_int(const char *flag, const char *s, long lo, long hi, const char *expect, int *out);
+static int cli_ends_with(const char *s, const char *ext);
+static int cli_set(cli_args *a, const char *f, const char *v);
+static int cli_check_window(const cli_args *a);
+static int cli_parse(int argc, char **argv, cli_args *a);
+/* gis.c */
+static double cli_deg(const cli_args *a, double v);
+static double cli_psi(int conv, double deg);
+static double cli_from_psi(int conv, double psi);
+static int cli_lib_direction(const cli_args *a, int k);
+static int cli_pair(const char *f, const char *v, const char *what, double *x, double *y);
+static int cli_set_gis(cli_args *a, const char *f, const char *v);
+static int cli_gis_finish(cli_args *a);
+static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double *cell);
+static int cli_integral_type(const cli_args *a, const float *px, size_t n, ex_georef *g,
+                             ex_rio_write_options *o);
+static void cli_georef(const cli_args *a, double cell, double gt[6]);
+static int cli_map_to_grid(const cli_args *a, double cell, double X, double Y, double *x, double *y);
+static int cli_info(int argc, char **argv);
+static int cli_azimuths(int argc, char **argv);
+/* write.c */
+static void cli_on_temp(void *user, const char *tmp);
+static void cli_on_signal(int sig);
+static void cli_signals(void);
+static hfvis_status cli_write(const char *path, unsigned char *bytes, size_t n, hfvis_status s);
+static hfvis_status cli_write_encoded(const char *path, size_t need, cli_encoder encode, const void *what);
+static hfvis_status cli_enc_pfm(const void *what, void *out, size_t cap, size_t *written);
+static hfvis_status cli_enc_binvox(const void *what, void *out, size_t cap, size_t *written);
+static hfvis_status cli_enc_visfield(const void *what, void *out, size_t cap, size_t *written);
+static hfvis_status cli_enc_partial(const void *what, void *out, size_t cap, size_t *written);
+static hfvis_status cli_pfm_save(const char *path, const float *px, int w, int h, int channels, ptrdiff_t stride);
+static hfvis_status cli_enc_pgm_range(const void *what, void *out, size_t cap, size_t *written);
+static hfvis_status cli_pgm_save(const char *path, const float *px, int w, int h, ptrdiff_t stride,
+                                 float lo, float hi);
+static hfvis_status cli_binvox_save(const char *path, const hfvis_volume_grid *grid, const uint8_t *occ);
+static hfvis_status cli_voxels_raw_save(const char *path, const hfvis_volume_grid *grid, const uint8_t *occ);
+static hfvis_status cli_visfield_save(const char *path, const hfvis_visfield *vf);
+static hfvis_status cli_partial_save(const char *path, const hfvis_partial *p);
+static int cli_save_piece(const cli_args *a, const float *px, int w, int h, int channels, double lo,
+                          double hi);
+/* Write OUT: PFM with its channels, or a 16-bit PGM with the channel planes stacked (NoData code 0,
+ * the range in its header: hfvis_pgm_range_save). A --window run writes its piece instead. */
+static int cli_save(const cli_args *a, const float *px, int w, int h, int channels, double lo,
+                    double hi);
+static int cli_same_file(const char *x, const char *y);
+static int cli_refuse_input(int overwrite, const char *out, const char *const *inputs, int n);
+static int cli_refuse_inputs(const cli_args *a, const char *out);
+/* run.c */
+static cli_cost cli_estimate(const cli_args *a, int w, int h, int channels);
+static int cli_out_channels(const cli_args *a);
+static int cli_check_cost(const cli_args *a, int w, int h, int channels);
+static int cli_halo(const cli_args *a, double cell);
+static int cli_window_side(const cli_args *a, int halo, int w, int h, int channels);
+static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double *cell);
+static float *cli_alloc(size_t a, size_t b, size_t c);
+static int cli_run(const cli_args *a);
+/* sweeps.c */
+static int cli_set_gi(cli_args *a, const char *f, const char *v);
+static int cli_check_gi(const cli_args *a);
+static int cli_load_env(const char *path, float **px, hfvis_env *env);
+static int cli_load_map(const char *path, const hfvis_grid *grid, float **px, int *channels);
+static int cli_widen(float **px, size_t n, int channels);
+static double cli_top(const float *px, size_t n, double fallback);
+static int cli_check_radiance(const char *cmd, const hfvis_grid *grid, const float *out, int channels);
+static int cli_run_gi(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
+                  cli_progress_state *prog);
+static int cli_horizon_finish(const cli_args *a, float *map, int w, int h, double lo, double hi);
+/* p2.c */
+static int cli_run_indirect(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
+                            cli_progress_state *prog);
+static int cli_run_visibility(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
+                              cli_progress_state *prog);
+/* gis_products.c */
+static int cli_run_viewshed(const cli_args *a, const hfvis_grid *grid, float *out);
+static int cli_run_hillshade(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
+                             cli_progress_state *prog, float *out);
+static int cli_run_openness(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
+                            cli_progress_state *prog, float *out);
+static int cli_run_skyview_saga(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
+                                cli_progress_state *prog, float *out);
+static int cli_run_gis(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
+                       cli_progress_state *prog);
+/* screen.c */
+static int cli_set_ssao(cli_args *a, const char *f, const char *v);
+static int cli_run_ssao(const cli_args *a);
+/* meshes.c */
+static void cli_lk_defaults(cli_args *a);
+static int cli_xyz(const char *f, const char *v, double out[3]);
+static int cli_size(const char *f, const char *v, int *width, int *height);
+static int cli_set_lk(cli_args *a, const char *f, const char *v);
+static int cli_check_lk(const cli_args *a);
+static int cli_set_vf(cli_args *a, const char *f, const char *v);
+static int cli_check_vf(const cli_args *a);
+static void cli_volgi_defaults(cli_args *a);
+static int cli_volgi_reals(const char *s, size_t len, double *out, int min, int max);
+static int cli_volgi_light(cli_args *a, const char *v);
+static int cli_set_volgi(cli_args *a, const char *f, const char *v);
+static int cli_check_volgi(const cli_args *a);
+static int cli_run_voxelize(const cli_args *a);
+static int cli_run_meshao(const cli_args *a);
+static int cli_vf_build(const cli_args *a);
+static int cli_vf_ao(const cli_args *a);
+static int cli_run_visfield(const cli_args *a);
+static int cli_run_volgi(const cli_args *a);
+/* split.c */
+static unsigned long long cli_fingerprint(const float *v, size_t n);
+static void cli_partial_tag(const cli_args *a, const hfvis_grid *grid, const hfvis_sweep_options *o,
+                            const hfvis_env *env, char *tag);
+static int cli_run_partial(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
+                           cli_progress_state *prog, const hfvis_env *env);
+static int cli_tag_value(const char *tag, const char *key, char *out, size_t cap);
+static void cli_tag_first_difference(const char *a, const char *b, char *out, size_t cap);
+static int cli_tag_real(const char *tag, const char *key, double *v);
+static int cli_sum_load(const char *path, hfvis_partial *p, cli_part *m);
+static int cli_sum_check(const char *path, int cmd, const hfvis_partial *p);
+static int cli_sum(int argc, char **argv);
+/* tiles.c */
+static int cli_file_id(const char *path, char *out, size_t cap);
+static int cli_window_plan(const cli_args *a, ex_rio_reader *r, const char *path, double cell);
+static void cli_piece_tag(const cli_args *a, const hfvis_grid *grid, const hfvis_sweep_options *o);
+static int cli_range_is_top(int cmd, int fraction);
+static int cli_save_piece(const cli_args *a, const float *px, int w, int h, int channels, double lo,
+                          double hi);
+static int cli_piece_meta(const char *path, cli_piece *p);
+static const char *cli_piece_problem(const char *key);
+static int cli_piece_read(const char *path, const cli_piece *m, int W, int H, float *out,
+                          const ex_georef *ref, ex_georef *keep);
+static int cli_mosaic(int argc, char **argv);
+/* main.c */
+
+#endif /* HFVIS_CLI_H */

@@ -1,0 +1,348 @@
+/* run.c - running a height-field or image command: the cost estimate and --max-memory check,
+ * the halo and window size of tiled runs, loading the heights, and cli_run, which dispatches a
+ * parsed command to its family. May call: every command family, write.c, gis.c, tiles.c, split.c,
+ * progress.c. */
+
+/* The estimate of a command on a w x h input (height fields, ssao) or from its flags (meshes,
+ * volumes). Height fields: input, output, the sweep's lattice (about min(W^2 + H^2,
+ * (W + H)^2/2) nodes of 8-byte heights, 12-byte normals and 8 bytes a channel), the grid
+ * accumulator; the work is K sweeps over the lattice. A model of the allocations, not a bound
+ * on them (the file buffers of the codecs come on top for a moment). */
+static cli_cost cli_estimate(const cli_args *a, int w, int h, int channels)
+{
+    cli_cost c;
+    double n = (double)w * (double)h, W = (double)w, H = (double)h, K = (double)a->dirs, lat, ch = channels;
+    double diag2 = W * W + H * H, thin = (W + H) * (W + H) / 2.0;
+    lat = diag2 < thin ? diag2 : thin;
+    c.bytes = 0.0, c.work = 0.0, c.unit = "lattice nodes swept";
+    switch (a->cmd) {
+    case CMD_VOXELIZE:
+        c.bytes = pow((double)a->res, 3.0), c.work = c.bytes, c.unit = "voxels";
+        return c;
+    case CMD_VOLGI:
+        c.bytes = pow((double)a->res, 3.0) * 4.0 * 16.0 + (double)a->vg_width * (double)a->vg_height * 12.0;
+        c.work = pow((double)a->res, 3.0) * (double)a->iterations, c.unit = "voxel updates";
+        return c;
+    case CMD_VISFIELD:
+        if (a->vf_ao) {
+            c.bytes = (double)a->vg_width * (double)a->vg_height * 4.0;
+            c.work = c.bytes / 4.0 * (double)(a->vf_rays ? a->vf_rays : 64), c.unit = "rays";
+        } else {
+            double P = (double)(a->vf_positions ? a->vf_positions : 82), D = (double)(a->has_dirs ? a->dirs : 16);
+            c.bytes = P * 2.0 * D * D * 4.0, c.work = P * 2.0 * D * D, c.unit = "direction texels";
+        }
+        return c;
+    case CMD_MESHAO:
+        c.bytes = (double)a->lk_width * (double)a->lk_height * 16.0;
+        c.work = (double)a->lk_width * (double)a->lk_height * (double)(a->lk_rays ? a->lk_rays : 64);
+        c.unit = "rays";
+        return c;
+    case CMD_SSAO:
+        c.bytes = n * 8.0, c.work = n * (a->has_dirs ? K : 16.0) * (W > H ? W : H) / 4.0, c.unit = "depth samples";
+        return c;
+    case CMD_VIEWSHED:
+        c.bytes = n * 8.0, c.work = (W + H) * (W > H ? W : H), c.unit = "line-of-sight steps";
+        return c;
+    case CMD_HORIZON: ch = 4.0; break;
+    case CMD_GI: c.bytes = n * 4.0 * 64.0; break; /* the NS09 pyramids and SH planes */
+    default: break;
+    }
+    c.bytes += n * 4.0 + n * 4.0 * (a->cmd == CMD_HORIZON ? K : (double)channels); /* in, out */
+    c.bytes += lat * (8.0 + 12.0 + 8.0 * ch) + n * (12.0 + 8.0 * ch);             /* sweep */
+    if (a->cmd == CMD_VISIBILITY || a->cmd == CMD_INDIRECT) c.bytes += lat * 8.0 * ch;
+    c.work = K * (n + lat / 4.0);
+    if (a->cmd == CMD_INDIRECT) c.work *= (double)(a->bounces + 1);
+    if (a->cmd == CMD_VISIBILITY && a->fraction) c.work *= 2.0;
+    return c;
+}
+
+/* The channels of a height-field command's output, for the estimate before anything is loaded:
+ * light has ENV's, indirect the most of ENV, --albedo-map and --emission (PGM or PFM: their
+ * headers only are read), normals 3, the rest 1. A header that cannot be read counts 1; the
+ * load reports it. */
+static int cli_out_channels(const cli_args *a)
+{
+    const char *maps[3] = {a->env, NULL, NULL};
+    int channels = a->cmd == CMD_NORMALS ? 3 : 1, i;
+    if (a->cmd != CMD_LIGHT && a->cmd != CMD_INDIRECT) return channels;
+    if (a->cmd == CMD_INDIRECT) maps[1] = a->albedo_map, maps[2] = a->emission;
+    for (i = 0; i < 3; i++) {
+        ex_rio_reader r;
+        if (!maps[i] || ex_rio_open_netpbm(&r, maps[i]) != 0) continue;
+        if (r.bands > channels) channels = r.bands;
+        ex_rio_close(&r);
+    }
+    return channels;
+}
+
+/* Print the estimate with the progress bar or the --progress lines, and refuse a run past
+ * --max-memory (0 = none), suggesting a window size when the run can be tiled. */
+static int cli_check_cost(const cli_args *a, int w, int h, int channels)
+{
+    const char *cmd = cli_cmd_names[a->cmd];
+    cli_cost c = cli_estimate(a, w, h, channels);
+    if (!a->quiet && (a->progress_lines || cli_stderr_is_terminal()))
+        fprintf(stderr, "%s: estimate %.3g MiB, %.3g %s\n", cmd, c.bytes / 1048576.0, c.work, c.unit);
+    if (a->max_memory > 0.0 && c.bytes > a->max_memory) {
+        char hint[200] = "";
+        if (cli_win.halo >= 0) { /* tiles: the largest square window whose grid (+ halo) fits */
+            int ww = cli_win.active ? cli_win.ext_w : w, hh = cli_win.active ? cli_win.ext_h : h;
+            int side = cli_window_side(a, cli_win.halo, ww, hh, channels);
+            if (side > 0)
+                snprintf(hint, sizeof hint, "; windows of %d x %d cells fit (halo %d; --window X0,Y0,%d,%d, "
+                         "examples/tiles.sh)", side, side, cli_win.halo, side, side);
+            else
+                snprintf(hint, sizeof hint, "; not even a 1-cell window with its halo of %d cells fits: "
+                         "lower --max-distance", cli_win.halo);
+        } else if (a->cmd < CMD_COUNT && (CLI_ONLY(a->cmd) & CLI_SWEEP)) {
+            snprintf(hint, sizeof hint, ", or tile it: --max-distance R and --window (docs/tiles.md)");
+        }
+        return cli_error(CLI_EXIT_ERROR, cmd, "needs about %.3g MiB (%.3g %s), over --max-memory %.3g "
+                         "MiB; raise --max-memory or make the run smaller (input, --dir-range, flags)%s",
+                         c.bytes / 1048576.0, c.work, c.unit, a->max_memory / 1048576.0, hint);
+    }
+    return 0;
+}
+
+/* The halo of a window run, in cells: every input cell a receiver of the window can depend on
+ * lies within it. The sweeps use the library's rule (hfvis_tile_halo: ceil(R / cell) plus the
+ * cells of the gather and the normals, by ray mode); indirect multiplies the radius by the
+ * bounces + 1 (bounce b gathers light that the terrain up to b R away received); openness
+ * marches --radius, plus one cell for its bilinear taps. */
+static int cli_halo(const cli_args *a, double cell)
+{
+    const hfvis_ray_mode rays = a->exact && a->cmd != CMD_VIEWSHED ? HFVIS_RAYS_EXACT : HFVIS_RAYS_LATTICE;
+    double r = a->cmd == CMD_OPENNESS ? a->radius : a->max_distance, h;
+    int halo;
+    if (a->cmd == CMD_OPENNESS) {
+        h = ceil(r / cell) + 1.0;
+        return h < (double)HFVIS_IMAGE_MAX_DIM ? (int)h : HFVIS_IMAGE_MAX_DIM;
+    }
+    if (a->cmd == CMD_INDIRECT) r *= (double)((a->output == OUT_DIRECT ? 0 : a->bounces) + 1);
+    halo = hfvis_tile_halo(r, cell, rays);
+    return halo >= 0 && halo < HFVIS_IMAGE_MAX_DIM ? halo : HFVIS_IMAGE_MAX_DIM;
+}
+
+/* The largest side S of a square window whose grid, S + 2 halo (clipped to the w x h raster) on
+ * each axis, fits --max-memory by cli_estimate; 0 if none does. */
+static int cli_window_side(const cli_args *a, int halo, int w, int h, int channels)
+{
+    int lo = 0, hi = w > h ? w : h;
+    while (lo < hi) {
+        int mid = lo + (hi - lo + 1) / 2;
+        double gw = (double)mid + 2.0 * halo, gh = gw;
+        if (gw > w) gw = w;
+        if (gh > h) gh = h;
+        if (cli_estimate(a, (int)gw, (int)gh, channels).bytes <= a->max_memory) lo = mid;
+        else hi = mid - 1;
+    }
+    return lo;
+}
+
+/* Load IN as a one-channel height field; --nodata values become NaN, the rest are scaled.
+ * *cell: --cell, else the raster's cell size, else 1 (with a note unless --quiet). */
+static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double *cell)
+{
+    hfvis_image_info info;
+    float *px = NULL, zscale = (float)a->zscale, nodata = (float)a->nodata;
+    double top = 0.0; /* largest |height| */
+    size_t i, n;
+    hfvis_status s;
+    *cell = a->cell;
+    if (ex_rio_format_of(a->in) || cli_win.active) {
+        int rc = cli_load_raster(a, &px, w, h, cell);
+        if (rc != 0) return rc;
+    } else {
+        if (a->band > 1)
+            return cli_error(CLI_EXIT_ERROR, a->in, "--band %d: a PFM/PGM height field has one band", a->band);
+        errno = 0;
+        s = hfvis_image_load(a->in, NULL, &px, &info);
+        if (s != HFVIS_OK) return cli_status(a->in, s, errno);
+        if (info.channels != 1) {
+            hfvis_free(NULL, px);
+            return cli_error(CLI_EXIT_ERROR, a->in, "a height field has one channel, this image has %d",
+                             info.channels);
+        }
+        if (!a->has_cell && !a->quiet)
+            fprintf(stderr, "hfvis: note: %s has no cell size: using 1 (give --cell)\n", a->in);
+        *w = info.width; *h = info.height;
+    }
+    n = (size_t)*w * (size_t)*h; /* <= HFVIS_IMAGE_MAX_VALUES (decoder limit) */
+    for (i = 0; i < n; i++) {
+        float v = px[i];
+        if (a->has_nodata && v == nodata) {
+            px[i] = (float)NAN;
+            continue;
+        }
+        px[i] = v * zscale;
+        if (isfinite(v) && !isfinite(px[i])) { /* not a hole: refused, never silently one */
+            hfvis_free(NULL, px);
+            return cli_error(CLI_EXIT_ERROR, "--zscale", "%g times the value %g at (%lu, %lu) "
+                             "exceeds the float range (3.4e38)", a->zscale, (double)v,
+                             (unsigned long)(i % (size_t)*w), (unsigned long)(i / (size_t)*w));
+        }
+        if (fabs((double)px[i]) > top) top = fabs((double)px[i]);
+    }
+    /* heights in cells (z / cell, in double) and their squares must stay finite */
+    if (top / *cell > CLI_MAX_RELIEF || *cell < DBL_MIN) {
+        hfvis_free(NULL, px);
+        return cli_error(CLI_EXIT_ERROR, "--cell", "%g is too small for heights up to %g: their ratio "
+                         "must stay below %g (and the cell at least %g)", *cell, top, CLI_MAX_RELIEF,
+                         DBL_MIN);
+    }
+    if (a->has_nodata && !cli_geo.has_nodata) { /* --nodata is the outputs' NoData too */
+        cli_geo.has_nodata = 1;
+        cli_geo.nodata = (double)nodata;
+        snprintf(cli_geo.nodata_text, sizeof cli_geo.nodata_text, "%.9g", (double)nodata);
+    }
+    cli_in_height = *h;
+    *z = px;
+    return 0;
+}
+
+/* Allocate count floats, count = a*b*c with overflow check. */
+static float *cli_alloc(size_t a, size_t b, size_t c)
+{
+    if (a == 0 || b == 0 || c == 0 || a > SIZE_MAX / b || a * b > SIZE_MAX / c ||
+        a * b * c > SIZE_MAX / sizeof(float))
+        return NULL;
+    return (float *)calloc(a * b * c, sizeof(float)); /* zeros: a window run leaves cells unwritten */
+}
+
+static int cli_run(const cli_args *a)
+{
+    const char *cmd = cli_cmd_names[a->cmd];
+    cli_progress_state prog;
+    float *z = NULL, *out = NULL, *env_px = NULL;
+    int w = 0, h = 0, rc, channels = 1, planes = 1;
+    double lo = 0.0, hi = 1.0;
+    hfvis_grid grid;
+    hfvis_sweep_options opts = hfvis_sweep_options_default();
+    hfvis_env env;
+    hfvis_status s = HFVIS_OK;
+
+    if (a->cmd == CMD_VOXELIZE || a->cmd == CMD_VOLGI || a->cmd == CMD_VISFIELD || a->cmd == CMD_MESHAO)
+        if ((rc = cli_check_cost(a, 0, 0, 1)) != 0) return rc;
+    if (a->cmd == CMD_VOXELIZE) return cli_run_voxelize(a);
+    if (a->cmd == CMD_SSAO) return cli_run_ssao(a);
+    if (a->cmd == CMD_VOLGI) return cli_run_volgi(a);
+    if (a->cmd == CMD_VISFIELD) return cli_run_visfield(a);
+    if (a->cmd == CMD_MESHAO) return cli_run_meshao(a);
+    memset(&env, 0, sizeof env);
+    cli_win.active = a->has_window;
+    if ((rc = cli_load_heights(a, &z, &w, &h, &grid.cell_size)) != 0) return rc;
+    grid.z = z; grid.width = w; grid.height = h; grid.stride = w;
+    opts.border = (hfvis_border)a->border;
+    opts.border_cells = a->border_cells;
+    opts.azimuth0_rad = a->compass ? a->azimuth0 - CLI_PI / 2.0 : a->azimuth0;
+    if (a->exact && a->cmd != CMD_VIEWSHED) opts.rays = HFVIS_RAYS_EXACT;
+    if (a->cmd != CMD_VIEWSHED) opts.max_distance = a->max_distance; /* viewshed: its own range */
+    if (cli_win.active && a->cmd == CMD_OPENNESS) {
+        /* openness marches --radius per receiver: the halo holds every cell a window receiver
+         * reaches, and the window + halo grid's own border is the raster's wherever a march can
+         * meet it, so it runs as a plain grid (the library refuses a window for it) */
+        cli_piece_tag(a, &grid, &opts);
+    } else if (cli_win.active) { /* the grid is window + halo of the raster; compute the window */
+        opts.origin_x = cli_win.gx0, opts.origin_y = cli_win.gy0;
+        opts.extent_width = cli_win.ext_w, opts.extent_height = cli_win.ext_h;
+        if (a->cmd != CMD_INDIRECT) { /* indirect's bounces need every point of the grid */
+            opts.receiver_x = cli_win.x0 - cli_win.gx0, opts.receiver_y = cli_win.y0 - cli_win.gy0;
+            opts.receiver_width = cli_win.w, opts.receiver_height = cli_win.h;
+        }
+        cli_piece_tag(a, &grid, &opts);
+    } else if (a->max_distance > 0.0 && a->cmd < CMD_COUNT && (CLI_ONLY(a->cmd) & CLI_SWEEP)) {
+        cli_win.halo = cli_halo(a, grid.cell_size); /* for the window size a refusal suggests */
+    }
+    prog.label = cmd; prog.base = 0; prog.total = 0;
+    cli_run_cells = (double)w * (double)h;
+    cli_run_directions = a->cmd == CMD_NORMALS || a->cmd == CMD_VIEWSHED ? 0
+                         : a->cmd == CMD_SHADOW ? 1 : a->dirs;
+    if (a->progress_lines && !a->quiet) {
+        opts.progress = cli_progress_line;
+        opts.progress_user = &prog;
+    } else if (!a->quiet && cli_stderr_is_terminal()) {
+        opts.progress = cli_progress;
+        opts.progress_user = &prog;
+    }
+    if (!cli_win.active && (rc = cli_check_cost(a, w, h, cli_out_channels(a))) != 0) goto done;
+    if (a->has_dir_range) {
+        if (a->cmd == CMD_LIGHT && (rc = cli_load_env(a->env, &env_px, &env)) != 0) goto done;
+        rc = cli_run_partial(a, &grid, &opts, &prog, &env);
+        goto done;
+    }
+    if (a->cmd == CMD_INDIRECT) { rc = cli_run_indirect(a, &grid, &opts, &prog); goto done; }
+    if (a->cmd == CMD_VISIBILITY) { rc = cli_run_visibility(a, &grid, &opts, &prog); goto done; }
+    if (a->cmd == CMD_GI) { rc = cli_run_gi(a, &grid, &opts, &prog); goto done; }
+    if (a->cmd == CMD_VIEWSHED || a->cmd == CMD_HILLSHADE || a->cmd == CMD_OPENNESS ||
+        (a->cmd == CMD_SKYVIEW && a->svf != 0)) {
+        rc = cli_run_gis(a, &grid, &opts, &prog);
+        goto done;
+    }
+    if (a->cmd == CMD_HORIZON) {
+        size_t values = (size_t)w * (size_t)h; /* <= 2^28, so the product below cannot overflow */
+        planes = a->dirs;
+        if ((size_t)planes > CLI_HORIZON_MAX_VALUES / values ||
+            (long long)planes * h > HFVIS_IMAGE_MAX_DIM) {
+            rc = cli_error(CLI_EXIT_ERROR, cmd, "%s: %d planes of %d x %d exceed the limit of "
+                           "2^28 values and %d rows; use fewer --dirs, or skyview/sky/light",
+                           hfvis_status_string(HFVIS_ERR_LIMIT), planes, w, h, HFVIS_IMAGE_MAX_DIM);
+            goto done;
+        }
+        lo = -CLI_PI / 2.0; hi = CLI_PI / 2.0;
+    } else if (a->cmd == CMD_NORMALS) {
+        channels = 3; lo = -1.0;
+    } else if (a->cmd == CMD_LIGHT) {
+        if ((rc = cli_load_env(a->env, &env_px, &env)) != 0) goto done;
+        channels = env.channels;
+    }
+    out = cli_alloc((size_t)w * (size_t)h, (size_t)planes, (size_t)channels);
+    if (!out) { rc = cli_status(cmd, HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
+
+    switch (a->cmd) {
+    case CMD_HORIZON:
+        s = hfvis_horizon_map(&grid, a->dirs, &opts, out);
+        if (s == HFVIS_OK && a->degrees) {
+            size_t i, n = (size_t)w * (size_t)h * (size_t)planes;
+            for (i = 0; i < n; i++) out[i] = (float)((double)out[i] * (180.0 / CLI_PI));
+            lo = -90.0; hi = 90.0;
+        }
+        break;
+    case CMD_SKYVIEW:
+        s = hfvis_sky_view_factor(&grid, a->dirs, &opts, out, w);
+        break;
+    case CMD_SKY:
+        s = hfvis_sky_light(&grid, a->dirs, (float)a->sky, (float)a->albedo, &opts, out, w);
+        if (a->sky * a->albedo <= CLI_FLT_MAX && (float)(a->sky * a->albedo) > 0.0f)
+            hi = a->sky * a->albedo;
+        break;
+    case CMD_SHADOW: {
+        double bearing_or_psi = a->math ? a->sun_azimuth : a->sun_azimuth - 90.0;
+        s = hfvis_sun_visibility(&grid, bearing_or_psi * (CLI_PI / 180.0),
+                                 a->sun_elevation * (CLI_PI / 180.0),
+                                 a->sun_radius * (CLI_PI / 180.0), &opts, out, w);
+        break;
+    }
+    case CMD_LIGHT: {
+        hfvis_env_options eopts = hfvis_env_options_default();
+        eopts.method = (hfvis_env_method)a->method;
+        s = hfvis_env_light(&grid, a->dirs, &env, (float)a->albedo, &opts, &eopts, out, w);
+        if (s == HFVIS_OK) hi = cli_top(out, (size_t)w * (size_t)h * (size_t)channels, 1.0);
+        break;
+    }
+    default: /* CMD_NORMALS */
+        s = hfvis_normals_compute(&grid, out);
+        break;
+    }
+    if (s != HFVIS_OK) { rc = cli_status(cmd, s, 0); goto done; }
+    if ((a->cmd == CMD_SKY || a->cmd == CMD_LIGHT) &&
+        (rc = cli_check_radiance(cmd, &grid, out, channels)) != 0)
+        goto done;
+    if (a->cmd == CMD_HORIZON) { rc = cli_horizon_finish(a, out, w, h, lo, hi); goto done; }
+    rc = cli_save(a, out, w, h * planes, channels, lo, hi);
+done:
+    if (cli_bar_open) { fputc('\n', stderr); cli_bar_open = 0; } /* a bar that fell short */
+    free(out);
+    hfvis_free(NULL, env_px);
+    hfvis_free(NULL, z);
+    return rc;
+}

@@ -1,0 +1,275 @@
+/* sweeps.c - the sweep commands' helpers and `gi`: environment and per-sample maps, the radiance
+ * overflow check, gi's flags and run, and the horizon's planes per file (--split).
+ * May call: progress.c, gis.c, write.c. */
+
+/* The flags only `gi` has; -1 if f is none of them. */
+static int cli_set_gi(cli_args *a, const char *f, const char *v)
+{
+    if (!strcmp(f, "--order")) return cli_int(f, v, 1, 4, "an integer 1..4", &a->order);
+    if (!strcmp(f, "--subsample"))
+        return cli_int(f, v, 1, HFVIS_NS_MAX_SUBSAMPLE, "an integer 1..64", &a->subsample);
+    if (!strcmp(f, "--specular")) {
+        a->has_specular = 1;
+        return cli_real(f, v, 0.0, 0, CLI_FLT_MAX, "a weight >= 0", &a->specular);
+    }
+    if (!strcmp(f, "--shininess")) {
+        a->has_shininess = 1;
+        return cli_real(f, v, 0.0, 1, CLI_FLT_MAX, "an exponent > 0", &a->shininess);
+    }
+    return -1;
+}
+
+/* Combinations `gi` rejects; returns 0 or CLI_EXIT_USAGE (message printed). */
+static int cli_check_gi(const cli_args *a)
+{
+    int sun = a->has_sun_azimuth || a->has_sun_elevation;
+    if (a->has_sun_azimuth && !a->has_sun_elevation)
+        return cli_error(CLI_EXIT_USAGE, "--sun-azimuth", "needs --sun-elevation DEG");
+    if (a->has_sun_elevation && !a->has_sun_azimuth)
+        return cli_error(CLI_EXIT_USAGE, "--sun-elevation", "needs --sun-azimuth DEG");
+    if (!sun && (a->has_sun_radius || a->has_sun_irradiance || a->math))
+        return cli_error(CLI_EXIT_USAGE, a->has_sun_radius ? "--sun-radius" :
+                         a->has_sun_irradiance ? "--sun-irradiance" : "--math",
+                         "needs a sun (--sun-azimuth and --sun-elevation)");
+    if (a->has_shininess && !a->has_specular)
+        return cli_error(CLI_EXIT_USAGE, "--shininess", "needs --specular S");
+    if (a->has_sky && a->env)
+        return cli_error(CLI_EXIT_USAGE, "--env", "cannot be combined with --sky");
+    if (a->output == OUT_DIRECT && a->has_bounces)
+        return cli_error(CLI_EXIT_USAGE, "--bounces", "has no effect with --output direct");
+    if (a->output == OUT_INDIRECT && a->bounces < 1)
+        return cli_error(CLI_EXIT_USAGE, "--output indirect", "needs --bounces >= 1");
+    return 0;
+}
+
+
+/* meshao's defaults (called for every command; harmless for the others). */
+
+/* Load a lat-long environment map (any image the codecs read). */
+static int cli_load_env(const char *path, float **px, hfvis_env *env)
+{
+    hfvis_image_info info;
+    hfvis_status s;
+    errno = 0;
+    size_t i, n;
+    s = hfvis_image_load(path, NULL, px, &info);
+    if (s != HFVIS_OK) return cli_status(path, s, errno);
+    env->radiance = *px; env->n_theta = info.height; env->n_phi = info.width;
+    env->channels = info.channels;
+    n = (size_t)info.width * (size_t)info.height * (size_t)info.channels;
+    for (i = 0; i < n; i++) /* radiance: finite and >= 0 (a NaN or negative sky is no light) */
+        if (!((*px)[i] >= 0.0f && (*px)[i] <= FLT_MAX)) {
+            size_t pix = i / (size_t)info.channels;
+            return cli_error(CLI_EXIT_ERROR, path, "radiance %g at (%lu, %lu): must be finite and >= 0",
+                             (double)(*px)[i], (unsigned long)(pix % (size_t)info.width),
+                             (unsigned long)(pix / (size_t)info.width));
+        }
+    return 0;
+}
+
+/* Load a per-sample map of the height field's size (indirect --albedo-map, --emission): PGM
+ * values divided by the file's maxval, PFM values as stored; every value finite and >= 0
+ * wherever the height field has no hole. */
+static int cli_load_map(const char *path, const hfvis_grid *grid, float **px, int *channels)
+{
+    hfvis_image_info info;
+    float *m = NULL;
+    size_t i, n = (size_t)grid->width * (size_t)grid->height;
+    int c;
+    hfvis_status s;
+    errno = 0;
+    s = hfvis_image_load(path, NULL, &m, &info);
+    if (s != HFVIS_OK) return cli_status(path, s, errno);
+    if (info.width != grid->width || info.height != grid->height) {
+        hfvis_free(NULL, m);
+        return cli_error(CLI_EXIT_ERROR, path, "%d x %d samples, but IN has %d x %d", info.width,
+                         info.height, grid->width, grid->height);
+    }
+    for (i = 0; i < n; i++)
+        for (c = 0; c < info.channels; c++) {
+            float *v = m + i * (size_t)info.channels + (size_t)c;
+            if (info.format == HFVIS_FORMAT_PGM) *v = (float)((double)*v / (double)info.maxval);
+            if (isfinite(grid->z[i]) && !(isfinite(*v) && *v >= 0.0f)) {
+                double bad = (double)*v;
+                hfvis_free(NULL, m);
+                return cli_error(CLI_EXIT_ERROR, path, "value %g at column %d, row %d is not a "
+                                 "finite number >= 0", bad, (int)(i % (size_t)grid->width),
+                                 (int)(i / (size_t)grid->width));
+            }
+        }
+    *px = m;
+    *channels = info.channels;
+    return 0;
+}
+
+/* Give a one-channel array of n samples `channels` channels (each a copy), replacing *px. */
+static int cli_widen(float **px, size_t n, int channels)
+{
+    size_t i;
+    int c;
+    float *w = cli_alloc(n, (size_t)channels, 1);
+    if (!w) return cli_status("indirect", HFVIS_ERR_OUT_OF_MEMORY, 0);
+    for (i = 0; i < n; i++)
+        for (c = 0; c < channels; c++) w[i * (size_t)channels + (size_t)c] = (*px)[i];
+    hfvis_free(NULL, *px);
+    *px = w;
+    return 0;
+}
+
+/* Largest finite value of px[0..n), or fallback if none is > 0: the top of a default PGM range. */
+static double cli_top(const float *px, size_t n, double fallback)
+{
+    size_t i;
+    double top = 0.0;
+    for (i = 0; i < n; i++)
+        if (isfinite(px[i]) && (double)px[i] > top) top = (double)px[i];
+    return (float)top > 0.0f ? top : fallback;
+}
+
+/* Radiance outputs scale with the inputs (sky, sun, environment, emission, albedo, specular),
+ * each bounded by the float range alone, so their product can overflow: refuse a result that is
+ * not finite where the height field has a sample, rather than write it with exit 0. */
+static int cli_check_radiance(const char *cmd, const hfvis_grid *grid, const float *out, int channels)
+{
+    int x, y, c;
+    for (y = 0; y < grid->height; y++)
+        for (x = 0; x < grid->width; x++) {
+            const size_t i = (size_t)y * (size_t)grid->width + (size_t)x;
+            if (!isfinite(grid->z[(ptrdiff_t)y * grid->stride + x])) continue;
+            for (c = 0; c < channels; c++)
+                if (!isfinite(out[i * (size_t)channels + (size_t)c]))
+                    return cli_error(CLI_EXIT_ERROR, cmd, "the result at column %d, row %d is %g: "
+                                     "the light inputs (sky, sun, environment, emission, albedo, "
+                                     "specular) overflow the float range (3.4e38); scale them down",
+                                     x, y, (double)out[i * (size_t)channels + (size_t)c]);
+        }
+    return 0;
+}
+
+/* indirect: direct light (hfvis_direct_light), then hfvis_terrain_gi. */
+
+/* gi: hfvis_ns_gi with a uniform sky or a projected environment, and an optional sun. */
+static int cli_run_gi(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
+                  cli_progress_state *prog)
+{
+    const char *cmd = "gi";
+    const int w = grid->width, h = grid->height;
+    const size_t n = (size_t)w * (size_t)h;
+    const int bounces = a->output == OUT_DIRECT ? 0 : a->bounces;
+    float *env_px = NULL, *direct = NULL, *bounce = NULL, *out = NULL;
+    double env_sh[4 * HFVIS_SH_COEFFS];
+    int channels = 1, rc = 0, c, b;
+    hfvis_env env;
+    hfvis_sun sun;
+    hfvis_ns_scene scene;
+    hfvis_ns_gi_options o = hfvis_ns_gi_options_default();
+    hfvis_ns_gi_outputs res;
+    hfvis_status s;
+    size_t i;
+
+    memset(&env, 0, sizeof env);
+    memset(&sun, 0, sizeof sun);
+    memset(&scene, 0, sizeof scene);
+    memset(&res, 0, sizeof res);
+    memset(env_sh, 0, sizeof env_sh);
+    if (a->env) {
+        if ((rc = cli_load_env(a->env, &env_px, &env)) != 0) goto done;
+        channels = env.channels;
+        s = hfvis_sh_project_env(&env, env_sh); /* the environment as order-4 SH ([NS09] §7) */
+        if (s != HFVIS_OK) { rc = cli_status(a->env, s, 0); goto done; }
+    } else {
+        env_sh[0] = 2.0 * sqrt(CLI_PI) * a->sky; /* a uniform sky c: Int c Y_00 = 2 sqrt(pi) c */
+    }
+    scene.channels = channels;
+    scene.env_sh = env_sh;
+    for (c = 0; c < 4; c++) scene.albedo[c] = (float)a->albedo;
+    scene.specular = (float)a->specular;
+    scene.shininess = (float)(a->has_shininess ? a->shininess : 32.0);
+    if (a->has_sun_azimuth) {
+        double psi_deg = a->math ? a->sun_azimuth : a->sun_azimuth - 90.0;
+        sun.azimuth_rad = psi_deg * (CLI_PI / 180.0);
+        sun.elevation_rad = a->sun_elevation * (CLI_PI / 180.0);
+        sun.radius_rad = a->sun_radius * (CLI_PI / 180.0);
+        for (c = 0; c < 4; c++) sun.irradiance[c] = (float)a->sun_irradiance;
+        scene.lights = &sun;
+        scene.light_count = 1;
+    }
+    o.directions = a->has_dirs ? a->dirs : 32;
+    o.sh_order = a->order;
+    o.subsample = a->subsample;
+    o.border = opts->border;
+    o.azimuth0_rad = opts->azimuth0_rad;
+    o.key_mode = HFVIS_NS_KEY_RATIO; /* a disc sun keeps its brightness (see hfvis.h) */
+    o.progress = opts->progress;
+    o.progress_user = opts->progress_user;
+    prog->total = 0; /* the library reports receiver rows over all passes */
+
+    direct = cli_alloc(n, (size_t)channels, 1);
+    out = cli_alloc(n, (size_t)channels, 1);
+    if (bounces > 0) bounce = cli_alloc(n, (size_t)channels, (size_t)bounces);
+    if (!direct || !out || (bounces > 0 && !bounce)) {
+        rc = cli_status(cmd, HFVIS_ERR_OUT_OF_MEMORY, 0);
+        goto done;
+    }
+    res.bounces = bounces;
+    res.direct = direct;
+    res.bounce = bounce;
+    s = hfvis_ns_gi(grid, &scene, &o, &res);
+    if (s != HFVIS_OK) { rc = cli_status(cmd, s, 0); goto done; }
+    for (i = 0; i < n * (size_t)channels; i++) {
+        double v = a->output == OUT_INDIRECT ? 0.0 : (double)direct[i];
+        for (b = 0; b < bounces; b++) v += (double)bounce[(size_t)b * n * (size_t)channels + i];
+        out[i] = (float)v;
+    }
+    if ((rc = cli_check_radiance(cmd, grid, out, channels)) != 0) goto done;
+    rc = cli_save(a, out, w, h, channels, 0.0, cli_top(out, n * (size_t)channels, 1.0));
+done:
+    free(out);
+    free(bounce);
+    free(direct);
+    hfvis_free(NULL, env_px);
+    return rc;
+}
+
+/* horizon, after the sweep: the planes in the user's convention's order (GRASS's run
+ * counter-clockwise) and, with --split, one file per direction named OUT's stem + "_" + the
+ * direction's azimuth in degrees in the convention (as r.horizon names its maps: "_045", or
+ * "_022_500" for 22.5), else the stacked map. */
+static int cli_horizon_finish(const cli_args *a, float *map, int w, int h, double lo, double hi)
+{
+    const size_t n = (size_t)w * (size_t)h;
+    const int K = a->dirs;
+    int k, rc = 0;
+    if (a->convention == CONV_GRASS && K > 2) { /* plane k <- library plane (K - k) % K, in place */
+        float *tmp = cli_alloc(n, 1, 1);
+        if (!tmp) return cli_status("horizon", HFVIS_ERR_OUT_OF_MEMORY, 0);
+        for (k = 1; k < K - k; k++) {
+            memcpy(tmp, map + (size_t)k * n, n * sizeof(float));
+            memcpy(map + (size_t)k * n, map + (size_t)(K - k) * n, n * sizeof(float));
+            memcpy(map + (size_t)(K - k) * n, tmp, n * sizeof(float));
+        }
+        free(tmp);
+    }
+    if (!a->split) return cli_save(a, map, w, h * K, 1, lo, hi);
+    for (k = 0; k < K && rc == 0; k++) {
+        cli_args one = *a;
+        char name[4096];
+        const char *dot = strrchr(a->out, '.');
+        const double psi = a->azimuth0 + 2.0 * CLI_PI * cli_lib_direction(a, k) / K;
+        double deg = cli_from_psi(a->convention, psi);
+        long whole = (long)floor(deg), milli = (long)floor((deg - (double)whole) * 1000.0 + 0.5);
+        size_t stem = dot ? (size_t)(dot - a->out) : strlen(a->out);
+        int len;
+        if (milli == 1000) whole++, milli = 0;
+        if (milli == 0)
+            len = snprintf(name, sizeof name, "%.*s_%03ld%s", (int)stem, a->out, whole, a->out + stem);
+        else
+            len = snprintf(name, sizeof name, "%.*s_%03ld_%03ld%s", (int)stem, a->out, whole, milli,
+                           a->out + stem);
+        if (len < 0 || (size_t)len >= sizeof name) return cli_error(CLI_EXIT_ERROR, a->out, "name too long");
+        if ((rc = cli_refuse_inputs(a, name)) != 0) return rc;
+        one.out = name;
+        rc = cli_save(&one, map + (size_t)k * n, w, h, 1, lo, hi);
+    }
+    return rc;
+}

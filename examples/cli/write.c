@@ -1,0 +1,239 @@
+/* write.c - safe writing: every file goes through hfvis_write_file, whose temporary name is kept
+ * here so that SIGINT, SIGTERM and SIGHUP remove it (the handler unlinks it and re-raises the
+ * signal); the encoders of the library's formats; cli_save (PFM, PGM and the GIS rasters); the
+ * refusal to write over an input. Owns: the temporary-file name. May call: progress.c, gis.c,
+ * tiles.c (pieces), the library's encoders and examples/raster_io.h. */
+
+#define CLI_TMP_CAP 4096 /* longest temporary name the handler can remove (PATH_MAX on Linux) */
+static char cli_tmp_name[CLI_TMP_CAP];
+static volatile sig_atomic_t cli_tmp_armed; /* cli_tmp_name names a file that may exist */
+
+/* hfvis_write_options.on_temp: armed only after the name is complete, disarmed before it changes. */
+static void cli_on_temp(void *user, const char *tmp)
+{
+    size_t n = tmp ? strlen(tmp) : 0;
+    (void)user;
+    cli_tmp_armed = 0;
+    if (!tmp || n >= CLI_TMP_CAP) return;
+    memcpy(cli_tmp_name, tmp, n + 1);
+    cli_tmp_armed = 1;
+}
+
+#ifdef CLI_HAVE_SIGACTION
+/* Async-signal-safe: unlink the temporary file, restore the default action and re-raise, so the
+ * exit status says which signal ended the run (130 for SIGINT, 143 for SIGTERM in a shell). */
+static void cli_on_signal(int sig)
+{
+    if (cli_tmp_armed) unlink(cli_tmp_name);
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+/* Install the handler for SIGINT, SIGTERM and SIGHUP, leaving an ignored signal ignored. */
+static void cli_signals(void)
+{
+    static const int sigs[3] = { SIGINT, SIGTERM, SIGHUP };
+    int i;
+    for (i = 0; i < 3; i++) {
+        struct sigaction sa, old;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = cli_on_signal;
+        sigemptyset(&sa.sa_mask);
+        if (sigaction(sigs[i], NULL, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+        sigaction(sigs[i], &sa, NULL);
+    }
+}
+#else
+static void cli_signals(void) {}
+#endif
+
+/* Write n bytes to path (hfvis_write_file with the temporary name recorded), freeing bytes. */
+static hfvis_status cli_write(const char *path, unsigned char *bytes, size_t n, hfvis_status s)
+{
+    hfvis_write_options wo;
+    wo.on_temp = cli_on_temp;
+    wo.user = NULL;
+    if (s == HFVIS_OK) s = hfvis_write_file(path, bytes, n, &wo);
+    free(bytes);
+    return s;
+}
+
+static hfvis_status cli_write_encoded(const char *path, size_t need, cli_encoder encode, const void *what)
+{
+    unsigned char *buf = need ? (unsigned char *)malloc(need) : NULL;
+    size_t written = 0;
+    hfvis_status s;
+    if (!buf) return need ? HFVIS_ERR_OUT_OF_MEMORY : HFVIS_ERR_INVALID_ARGUMENT;
+    s = encode(what, buf, need, &written);
+    return cli_write(path, buf, written, s);
+}
+
+static hfvis_status cli_enc_pfm(const void *what, void *out, size_t cap, size_t *written)
+{
+    const cli_image *m = (const cli_image *)what;
+    return hfvis_pfm_encode(m->px, m->w, m->h, m->channels, m->stride, out, cap, written);
+}
+static hfvis_status cli_enc_binvox(const void *what, void *out, size_t cap, size_t *written)
+{
+    const cli_voxels *v = (const cli_voxels *)what;
+    return hfvis_binvox_encode(v->grid, v->occ, out, cap, written);
+}
+static hfvis_status cli_enc_visfield(const void *what, void *out, size_t cap, size_t *written)
+{
+    return hfvis_visfield_encode((const hfvis_visfield *)what, out, cap, written);
+}
+static hfvis_status cli_enc_partial(const void *what, void *out, size_t cap, size_t *written)
+{
+    return hfvis_partial_encode((const hfvis_partial *)what, out, cap, written);
+}
+static hfvis_status cli_pfm_save(const char *path, const float *px, int w, int h, int channels, ptrdiff_t stride)
+{
+    cli_image m;
+    memset(&m, 0, sizeof m);
+    m.px = px, m.w = w, m.h = h, m.channels = channels, m.stride = stride;
+    return cli_write_encoded(path, hfvis_pfm_encode_size(w, h, channels), cli_enc_pfm, &m);
+}
+static hfvis_status cli_enc_pgm_range(const void *what, void *out, size_t cap, size_t *written)
+{
+    const cli_image *m = (const cli_image *)what;
+    return hfvis_pgm_range_encode(m->px, m->w, m->h, m->stride, m->lo, m->hi, out, cap, written);
+}
+/* A NoData-safe 16-bit PGM with its range in the header (hfvis_pgm_range_encode). */
+static hfvis_status cli_pgm_save(const char *path, const float *px, int w, int h, ptrdiff_t stride,
+                                 float lo, float hi)
+{
+    cli_image m;
+    memset(&m, 0, sizeof m);
+    m.px = px, m.w = w, m.h = h, m.stride = stride, m.lo = lo, m.hi = hi;
+    return cli_write_encoded(path, hfvis_pgm_range_encode_size(w, h, lo, hi), cli_enc_pgm_range, &m);
+}
+static hfvis_status cli_binvox_save(const char *path, const hfvis_volume_grid *grid, const uint8_t *occ)
+{
+    cli_voxels v;
+    v.grid = grid, v.occ = occ;
+    return cli_write_encoded(path, hfvis_binvox_encode_size(grid, occ), cli_enc_binvox, &v);
+}
+static hfvis_status cli_voxels_raw_save(const char *path, const hfvis_volume_grid *grid, const uint8_t *occ)
+{
+    hfvis_write_options wo;
+    size_t n = (size_t)grid->dims[0] * (size_t)grid->dims[1] * (size_t)grid->dims[2];
+    wo.on_temp = cli_on_temp;
+    wo.user = NULL;
+    return hfvis_write_file(path, occ, n, &wo);
+}
+static hfvis_status cli_visfield_save(const char *path, const hfvis_visfield *vf)
+{
+    return cli_write_encoded(path, hfvis_visfield_encode_size(vf), cli_enc_visfield, vf);
+}
+static hfvis_status cli_partial_save(const char *path, const hfvis_partial *p)
+{
+    return cli_write_encoded(path, hfvis_partial_encode_size(p), cli_enc_partial, p);
+}
+
+static int cli_save_piece(const cli_args *a, const float *px, int w, int h, int channels, double lo,
+                          double hi);
+/* Write OUT: PFM with its channels, or a 16-bit PGM with the channel planes stacked (NoData code 0,
+ * the range in its header: hfvis_pgm_range_save). A --window run writes its piece instead. */
+static int cli_save(const cli_args *a, const float *px, int w, int h, int channels, double lo,
+                    double hi)
+{
+    hfvis_status s;
+    if (cli_win.active) return cli_save_piece(a, px, w, h, channels, lo, hi);
+    errno = 0;
+    if (a->out_raster) {
+        /* planes stacked top to bottom (horizon) or channels interleaved become bands */
+        int planes = cli_in_height > 0 && h % cli_in_height == 0 ? h / cli_in_height : 1;
+        ex_rio_image img;
+        ex_rio_write_options o;
+        ex_georef g = cli_geo; /* shallow: only the NoData fields change, on the copy */
+        char why[256];
+        size_t i, n = (size_t)w * (size_t)h * (size_t)channels;
+        int moved = 0;
+        img.data = px;
+        img.width = w;
+        img.height = h / planes;
+        img.bands = planes * channels;
+        img.pixel_step = (size_t)channels;
+        img.row_step = (size_t)w * (size_t)channels;
+        img.band_step = channels > 1 ? 1 : (size_t)w * (size_t)img.height;
+        memset(&o, 0, sizeof o);
+        o.tiled = 1;
+        o.deflate = 1;
+        o.predictor = 3;
+        if (g.has_nodata) /* the input's NoData, unless the output has it as a real value */
+            for (i = 0; i < n; i++)
+                if (!isnan(px[i]) && (double)px[i] == g.nodata) {
+                    moved = 1;
+                    g.has_nodata = 0;
+                    break;
+                }
+        if ((ex_rio_format_of(a->out) != EX_RIO_TIFF || !cli_integral_type(a, px, n, &g, &o)) && !g.has_nodata)
+            /* NaN cells: declare NoData NaN */
+            for (i = 0; i < n; i++)
+                if (isnan(px[i])) {
+                    g.has_nodata = 1;
+                    g.nodata = (double)NAN;
+                    strcpy(g.nodata_text, "nan");
+                    break;
+                }
+        if (ex_rio_write(a->out, &img, &g, &o, why) != 0) return cli_error(CLI_EXIT_ERROR, a->out, "%s", why);
+        if (moved && !a->quiet)
+            fprintf(stderr, "hfvis: note: %s: the input's NoData %s is a value of this output: holes are "
+                    "written as %s\n", a->out, cli_geo.nodata_text, g.has_nodata ? g.nodata_text : "NaN");
+        return 0;
+    }
+    if (!a->out_pgm) {
+        s = cli_pfm_save(a->out, px, w, h, channels, w);
+    } else {
+        if (a->has_range) { lo = a->range_lo; hi = a->range_hi; }
+        if (channels == 1) {
+            s = cli_pgm_save(a->out, px, w, h, w, (float)lo, (float)hi);
+        } else {
+            size_t n = (size_t)w * (size_t)h, i;
+            int c;
+            float *planes = cli_alloc(n, (size_t)channels, 1);
+            if (!planes) return cli_status(a->out, HFVIS_ERR_OUT_OF_MEMORY, 0);
+            for (c = 0; c < channels; c++)
+                for (i = 0; i < n; i++) planes[(size_t)c * n + i] = px[i * (size_t)channels + (size_t)c];
+            if ((long long)h * channels > INT_MAX) s = HFVIS_ERR_LIMIT;
+            else s = cli_pgm_save(a->out, planes, w, h * channels, w, (float)lo, (float)hi);
+            free(planes);
+        }
+    }
+    if (s != HFVIS_OK) return cli_status(a->out, s, errno);
+    return 0;
+}
+
+/* Whether paths x and y name one file (same device and inode: hard links and symbolic links
+ * too); 0 when either does not exist. */
+static int cli_same_file(const char *x, const char *y)
+{
+#ifdef CLI_HAVE_ISATTY
+    struct stat sx, sy;
+    if (stat(x, &sx) != 0 || stat(y, &sy) != 0) return 0;
+    return sx.st_dev == sy.st_dev && sx.st_ino == sy.st_ino;
+#else
+    return strcmp(x, y) == 0;
+#endif
+}
+
+/* Refuse to write out over one of the n inputs (NULL entries skipped) unless --overwrite:
+ * 0, or CLI_EXIT_ERROR after one error line. */
+static int cli_refuse_input(int overwrite, const char *out, const char *const *inputs, int n)
+{
+    int i;
+    for (i = 0; i < n && !overwrite; i++)
+        if (inputs[i] && cli_same_file(out, inputs[i]))
+            return cli_error(CLI_EXIT_ERROR, out, "is the input %s: refusing to replace an input "
+                             "(give --overwrite to do so)", inputs[i]);
+    return 0;
+}
+
+/* Every input of a command against out. */
+static int cli_refuse_inputs(const cli_args *a, const char *out)
+{
+    const char *inputs[5];
+    inputs[0] = a->in, inputs[1] = a->env, inputs[2] = a->albedo_map, inputs[3] = a->emission;
+    inputs[4] = a->vf_reference;
+    return cli_refuse_input(a->overwrite, out, inputs, 5);
+}
