@@ -9,6 +9,7 @@
  *   p2.c            indirect, visibility   gis_products.c  viewshed, hillshade, openness
  *   screen.c        ssao                   meshes.c        meshao, visfield, volgi, voxelize
  *   split.c         --dir-range and sum    tiles.c         --window pieces and mosaic
+ *   solar.c         solar: dates, site, irradiation
  * Every file is read and written through the library's codecs (hfvis_image_load, the encoders
  * and hfvis_write_file) or examples/raster_io.h (GeoTIFF, ASC, EHdr), so the tool exercises what
  * a vendoring user gets; an interrupt (SIGINT, SIGTERM, SIGHUP) removes the temporary file of a
@@ -50,11 +51,11 @@
 
 enum { CMD_HORIZON, CMD_SKYVIEW, CMD_SKY, CMD_SHADOW, CMD_LIGHT, CMD_NORMALS, CMD_INDIRECT,
        CMD_VISIBILITY, CMD_VIEWSHED, CMD_VOXELIZE, CMD_GI, CMD_SSAO, CMD_VOLGI, CMD_VISFIELD, CMD_MESHAO,
-       CMD_HILLSHADE, CMD_OPENNESS, CMD_SUM, CMD_COUNT };
+       CMD_HILLSHADE, CMD_OPENNESS, CMD_SOLAR, CMD_SUM, CMD_COUNT };
 static const char *const cli_cmd_names[CMD_COUNT] = {
     "horizon", "skyview", "sky", "shadow", "light", "normals", "indirect", "visibility",
     "viewshed", "voxelize", "gi", "ssao", "volgi", "visfield", "meshao", "hillshade", "openness",
-    "sum"
+    "solar", "sum"
 };
 
 /* voxelize --mode, --axis, --method */
@@ -105,6 +106,13 @@ typedef struct cli_args {
     double lk_radius, lk_fov, lk_seed, lk_eye[3], lk_target[3], lk_up[3];
     double max_memory; /* --max-memory bytes, 0 = no limit (default: cli_default_max_memory) */
     int has_window, win_x, win_y, win_w, win_h; /* --window X0,Y0,W,H (cells; docs/tiles.md) */
+    /* solar (solar.c): dates, times, atmosphere, site, extra outputs (beam, diffuse, reflected,
+     * sun hours) */
+    int sol_y, sol_m, sol_d, sol_ey, sol_em, sol_ed, sol_has_start, sol_has_end, sol_days;
+    int sol_instant, sol_solar_time, sol_has_lat, sol_has_lon, sol_has_offset, sol_has_linke;
+    int sol_has_linke_monthly, sol_bands;
+    double sol_hour, sol_step, sol_lat, sol_lon, sol_offset, sol_linke, sol_linke_monthly[12];
+    const char *sol_linke_map, *sol_out[4];
 } cli_args;
 
 /* ssao --method, --depth */
@@ -352,6 +360,12 @@ static const char *cli_piece_problem(const char *key);
 static int cli_piece_read(const char *path, const cli_piece *m, int W, int H, float *out,
                           const ex_georef *ref, ex_georef *keep);
 static int cli_mosaic(int argc, char **argv);
+/* solar.c */
+static int cli_solar_date(const char *f, const char *v, int *y, int *m, int *d);
+static long cli_solar_day_number(int y, int m, int d);
+static int cli_set_solar(cli_args *a, const char *f, const char *v);
+static int cli_check_solar(cli_args *a);
+static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts);
 /* main.c */
 
 #endif /* HFVIS_CLI_H */

@@ -30,6 +30,17 @@
     { "--specular", 1, CLI_ONLY(CMD_GI) }, { "--shininess", 1, CLI_ONLY(CMD_GI) }
 
 
+#define CLI_SOLAR_FLAGS                                                                            \
+    { "--day", 1, CLI_ONLY(CMD_SOLAR) }, { "--start", 1, CLI_ONLY(CMD_SOLAR) },                   \
+    { "--end", 1, CLI_ONLY(CMD_SOLAR) }, { "--time", 1, CLI_ONLY(CMD_SOLAR) },                    \
+    { "--step", 1, CLI_ONLY(CMD_SOLAR) }, { "--linke", 1, CLI_ONLY(CMD_SOLAR) },                  \
+    { "--linke-monthly", 1, CLI_ONLY(CMD_SOLAR) }, { "--linke-map", 1, CLI_ONLY(CMD_SOLAR) },     \
+    { "--latitude", 1, CLI_ONLY(CMD_SOLAR) }, { "--longitude", 1, CLI_ONLY(CMD_SOLAR) },          \
+    { "--utc-offset", 1, CLI_ONLY(CMD_SOLAR) }, { "--solar-time", 0, CLI_ONLY(CMD_SOLAR) },       \
+    { "--bands", 1, CLI_ONLY(CMD_SOLAR) }, { "--beam", 1, CLI_ONLY(CMD_SOLAR) },                  \
+    { "--diffuse", 1, CLI_ONLY(CMD_SOLAR) }, { "--reflected", 1, CLI_ONLY(CMD_SOLAR) },           \
+    { "--sun-hours", 1, CLI_ONLY(CMD_SOLAR) }
+
 #define CLI_GIS_FLAGS                                                                             \
     { "--convention", 1, CLI_HF }, { "--radians", 0, CLI_HF }, { "--overwrite", 0, CLI_ALL },     \
     { "--progress", 0, CLI_ALL }, { "--azimuth", 1, CLI_ONLY(CMD_HORIZON) },                      \
@@ -99,19 +110,20 @@ static const cli_flag cli_flags[] = {
                         | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VISIBILITY) },
     { "--sky", 1, CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
     { "--albedo", 1, CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI)
-                  | CLI_ONLY(CMD_VOLGI) },
+                  | CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_SOLAR) },
     { "--sun-azimuth", 1, CLI_SUN },              { "--sun-elevation", 1, CLI_SUN },
-    { "--sun-radius", 1, CLI_SUN },               { "--math", 0, CLI_SUN },
+    { "--sun-radius", 1, CLI_SUN | CLI_ONLY(CMD_SOLAR) },               { "--math", 0, CLI_SUN },
     { "--env", 1, CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
     { "--method", 1, CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_SSAO)
                      | CLI_ONLY(CMD_MESHAO) },
-    { "--sun-irradiance", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) }, { "--albedo-map", 1, CLI_ONLY(CMD_INDIRECT) },
+    { "--sun-irradiance", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) }, { "--albedo-map", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_SOLAR) },
     { "--emission", 1, CLI_ONLY(CMD_INDIRECT) },  { "--bounces", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) },
     { "--output", 1, CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VOLGI) },
     { "--fraction", 0, CLI_ONLY(CMD_VISIBILITY) }, { "--stats", 0, CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_MESHAO) },
     { "--observer", 1, CLI_ONLY(CMD_VIEWSHED) },  { "--observer-height", 1, CLI_ONLY(CMD_VIEWSHED) },
     { "--target-height", 1, CLI_ONLY(CMD_VIEWSHED) },
-    { "--max-distance", 1, CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_VISFIELD) | CLI_SWEEP | CLI_P2 },
+    { "--max-distance", 1, CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_VISFIELD) | CLI_SWEEP | CLI_P2
+                           | CLI_ONLY(CMD_SOLAR) },
     { "--window", 1, CLI_SWEEP | CLI_ONLY(CMD_OPENNESS) },
     { "--exact", 0, CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY)
                     | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_SHADOW) },
@@ -127,6 +139,7 @@ static const cli_flag cli_flags[] = {
     { "--radius", 1, CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_MESHAO) | CLI_ONLY(CMD_OPENNESS) },        { "--guard", 1, CLI_ONLY(CMD_SSAO) },
     { "--depth", 1, CLI_ONLY(CMD_SSAO) },         { "--near", 1, CLI_ONLY(CMD_SSAO) },
     { "--far", 1, CLI_ONLY(CMD_SSAO) },
+    CLI_SOLAR_FLAGS,
     CLI_GIS_FLAGS
 };
 
@@ -139,6 +152,10 @@ static int cli_set(cli_args *a, const char *f, const char *v)
     }
     if (a->cmd == CMD_MESHAO) {
         int r = cli_set_lk(a, f, v);
+        if (r >= 0) return r;
+    }
+    if (a->cmd == CMD_SOLAR) {
+        int r = cli_set_solar(a, f, v);
         if (r >= 0) return r;
     }
     if (!strcmp(f, "-o") && a->cmd == CMD_VISFIELD) return cli_set_vf(a, f, v);
@@ -455,6 +472,10 @@ static int cli_parse(int argc, char **argv, cli_args *a)
                              "%d:%d", a->dirs, a->dir_begin, a->dir_end);
         if (a->stats)
             return cli_error(CLI_EXIT_USAGE, "--stats", "cannot be combined with --dir-range");
+    }
+    if (a->cmd == CMD_SOLAR) {
+        int r = cli_check_solar(a);
+        if (r) return r;
     }
     if (a->cmd == CMD_SHADOW && !a->has_sun_azimuth)
         return cli_error(CLI_EXIT_USAGE, "shadow", "missing --sun-azimuth DEG");

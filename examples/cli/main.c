@@ -16,6 +16,7 @@
 #include "meshes.c"
 #include "split.c"
 #include "tiles.c"
+#include "solar.c"
 
 int main(int argc, char **argv)
 {
