@@ -9940,12 +9940,22 @@ static double hf_esra_rayleigh(double m)
     return 1.0 / (10.4 + 0.718 * m);
 }
 
-/* Beam normal transmittance exp(-0.8662 TL m dR(m)) (Eq. 2). */
-static double hf_esra_beam_trans(double h, double p, double linke)
+/* Beam normal transmittance exp(-0.8662 TL m dR(m)) at air mass m (Eq. 2). */
+static double hf_esra_beam_trans_m(double m, double linke)
 {
-    double m = hf_esra_air_mass(h, p);
     return exp(-0.8662 * linke * m * hf_esra_rayleigh(m));
 }
+
+/* The same at true elevation h and pressure ratio p. */
+static double hf_esra_beam_trans(double h, double p, double linke)
+{
+    return hf_esra_beam_trans_m(hf_esra_air_mass(h, p), linke);
+}
+
+/* Muneer's model (r.sun's drad): the sky-brightness part of the background diffuse per unit F_g,
+ * (0.00263 - 0.712 kb - 0.6883 kb^2)(1 - kb), and the low-sun circumsolar divisor. */
+static double hf_muneer_fg_part(double kb) { return (0.00263 - kb * (0.712 + 0.6883 * kb)) * (1.0 - kb); }
+static double hf_muneer_low_sun(double h) { return 0.1 - 0.008 * h; }
 
 /* Diffuse transmission Tn(TL) times the angular function Fd(h) (Eq. 10-14): dh = G0 Tn Fd. */
 static double hf_esra_diffuse_factor(double sinh, double linke)
@@ -10293,7 +10303,7 @@ static void hf_solar_point_step(const hf_solar_step *st, const hf_solar_point *p
     m = pt->p * st->m0;
     lit = vis > 0.0 && sh > 0.0;
     if (lit) {
-        bh = pt->cbh * st->g0 * st->sinh * exp(-0.8662 * linke * m * hf_esra_rayleigh(m));
+        bh = pt->cbh * st->g0 * st->sinh * hf_esra_beam_trans_m(m, linke);
         beam = (pt->tilted ? bh * sh / st->sinh : bh) * vis;
         acc[3] += w * vis;
     } else {
@@ -10307,12 +10317,12 @@ static void hf_solar_point_step(const hf_solar_step *st, const hf_solar_point *p
             bg = pt->r_sky + pt->fg * 0.252271;
             cs = 0.0;
         } else {
-            bg = ((0.00263 - kb * (0.712 + 0.6883 * kb)) * pt->fg + pt->r_sky) * (1.0 - kb);
+            bg = hf_muneer_fg_part(kb) * pt->fg + pt->r_sky * (1.0 - kb);
             if (st->h >= 0.1 || !pt->tilted)
                 cs = kb * sh / st->sinh;
             else /* low sun: Muneer's form with the horizontal direction (r.sun) */
                 cs = kb * (pt->nx * st->sx + pt->ny * st->sy) / cos(st->elev) /
-                     (0.1 - 0.008 * st->h);
+                     hf_muneer_low_sun(st->h);
             cs *= vis;
         }
         fx = bg * pt->sky_ratio + cs;
@@ -10557,13 +10567,13 @@ static int hf_solar_sectors_apply(const hf_solar_ctx *c, size_t nsteps)
 static void hf_solar_entry_sums(const hf_solar_step *st, double p, double *q)
 {
     double w = st->weight, m = p * st->m0;
-    double b = st->g0 * exp(-0.8662 * st->linke * m * hf_esra_rayleigh(m));
+    double b = st->g0 * hf_esra_beam_trans_m(m, st->linke);
     double kb = b / st->g0, dh = st->g0 * st->fd, lo;
     q[HF_SQ_BX] = w * b * st->sx;
     q[HF_SQ_BY] = w * b * st->sy;
     q[HF_SQ_BZ] = w * b * st->sz;
     q[HF_SQ_BH] = w * b * st->sinh;
-    q[HF_SQ_FG] = w * dh * (0.00263 - kb * (0.712 + 0.6883 * kb)) * (1.0 - kb);
+    q[HF_SQ_FG] = w * dh * hf_muneer_fg_part(kb);
     q[HF_SQ_RS] = w * dh * (1.0 - kb);
     q[HF_SQ_AX] = w * dh * kb * st->sx / st->sinh;
     q[HF_SQ_AY] = w * dh * kb * st->sy / st->sinh;
@@ -10573,7 +10583,7 @@ static void hf_solar_entry_sums(const hf_solar_step *st, double p, double *q)
         q[HF_SQ_TY] = q[HF_SQ_AY];
         q[HF_SQ_TZ] = q[HF_SQ_AZ];
     } else {
-        lo = w * dh * kb / (cos(st->elev) * (0.1 - 0.008 * st->h));
+        lo = w * dh * kb / (cos(st->elev) * hf_muneer_low_sun(st->h));
         q[HF_SQ_TX] = lo * st->sx;
         q[HF_SQ_TY] = lo * st->sy;
         q[HF_SQ_TZ] = 0.0;
