@@ -9963,12 +9963,22 @@ static double hf_esra_rayleigh(double m)
     return 1.0 / (10.4 + 0.718 * m);
 }
 
-/* Beam normal transmittance exp(-0.8662 TL m dR(m)) (Eq. 2). */
-static double hf_esra_beam_trans(double h, double p, double linke)
+/* Beam normal transmittance exp(-0.8662 TL m dR(m)) at air mass m (Eq. 2). */
+static double hf_esra_beam_trans_m(double m, double linke)
 {
-    double m = hf_esra_air_mass(h, p);
     return exp(-0.8662 * linke * m * hf_esra_rayleigh(m));
 }
+
+/* The same at true elevation h and pressure ratio p. */
+static double hf_esra_beam_trans(double h, double p, double linke)
+{
+    return hf_esra_beam_trans_m(hf_esra_air_mass(h, p), linke);
+}
+
+/* Muneer's model (r.sun's drad): the sky-brightness part of the background diffuse per unit F_g,
+ * (0.00263 - 0.712 kb - 0.6883 kb^2)(1 - kb), and the low-sun circumsolar divisor. */
+static double hf_muneer_fg_part(double kb) { return (0.00263 - kb * (0.712 + 0.6883 * kb)) * (1.0 - kb); }
+static double hf_muneer_low_sun(double h) { return 0.1 - 0.008 * h; }
 
 /* Diffuse transmission Tn(TL) times the angular function Fd(h) (Eq. 10-14): dh = G0 Tn Fd. */
 static double hf_esra_diffuse_factor(double sinh, double linke)
@@ -10316,7 +10326,7 @@ static void hf_solar_point_step(const hf_solar_step *st, const hf_solar_point *p
     m = pt->p * st->m0;
     lit = vis > 0.0 && sh > 0.0;
     if (lit) {
-        bh = pt->cbh * st->g0 * st->sinh * exp(-0.8662 * linke * m * hf_esra_rayleigh(m));
+        bh = pt->cbh * st->g0 * st->sinh * hf_esra_beam_trans_m(m, linke);
         beam = (pt->tilted ? bh * sh / st->sinh : bh) * vis;
         acc[3] += w * vis;
     } else {
@@ -10330,12 +10340,12 @@ static void hf_solar_point_step(const hf_solar_step *st, const hf_solar_point *p
             bg = pt->r_sky + pt->fg * 0.252271;
             cs = 0.0;
         } else {
-            bg = ((0.00263 - kb * (0.712 + 0.6883 * kb)) * pt->fg + pt->r_sky) * (1.0 - kb);
+            bg = hf_muneer_fg_part(kb) * pt->fg + pt->r_sky * (1.0 - kb);
             if (st->h >= 0.1 || !pt->tilted)
                 cs = kb * sh / st->sinh;
             else /* low sun: Muneer's form with the horizontal direction (r.sun) */
                 cs = kb * (pt->nx * st->sx + pt->ny * st->sy) / cos(st->elev) /
-                     (0.1 - 0.008 * st->h);
+                     hf_muneer_low_sun(st->h);
             cs *= vis;
         }
         fx = bg * pt->sky_ratio + cs;
@@ -10531,6 +10541,227 @@ static hfvis_status hf_solar_finish(const hfvis_grid *g, hf_solar_run *r, int na
     return HFVIS_OK;
 }
 
+/* ---------------------------------------------- 7. the sector sums (fast path of a period) */
+/* With one Linke factor per step, no coefficient rasters and a hard sun, every term of section 5
+ * is linear in per-sample constants (the normal, r_sky, F_g, the sky ratio, the albedo) once a
+ * step is known to be lit or not, and the pressure ratio p enters only through B0c(p). So the
+ * steps are binned by azimuth (HF_SOLAR_BINS_PER_DIR bins per map direction), sorted by tan(e)
+ * in each bin and summed from the top; a sample reads, per bin, the suffix above its threshold
+ * max(the tangent of its horizon interpolated linearly from the map's two directions to the
+ * bin's centre, its tangent plane toward the centre) by binary search. p enters by quadratic Lagrange interpolation over three pressure
+ * nodes spanning the grid's heights. Cost O(bands * bins * (log S + 3 HF_SOLAR_Q)) per sample
+ * instead of O(S): taken when the steps outnumber HF_SOLAR_SECTOR_MIN per bin. docs/solar.md. */
+#define HF_SOLAR_BINS_PER_DIR 4
+#define HF_SOLAR_SECTOR_MIN 4
+#define HF_SOLAR_NODES 3
+#define HF_SOLAR_P_LINEAR 0.02 /* below this range of p, B0c(p) is linear to 4e-6 of itself */
+enum { /* the per-entry sums (times the step weight and the interpolation share) */
+    HF_SQ_BX, HF_SQ_BY, HF_SQ_BZ, /* B0c s: beam = n . this */
+    HF_SQ_BH,                     /* B0c sin h: the reflected term's beam */
+    HF_SQ_FG, HF_SQ_RS,           /* Dh P1(kb) and Dh (1 - kb): the background diffuse */
+    HF_SQ_AX, HF_SQ_AY, HF_SQ_AZ, /* Dh kb s / sin h: circumsolar, horizontal receivers */
+    HF_SQ_TX, HF_SQ_TY, HF_SQ_TZ, /* the same for tilted ones (Muneer's low-sun form below 0.1) */
+    HF_SQ_DH,                     /* Dh while lit */
+    HF_SQ_HOURS,                  /* the weight: sunshine */
+    HF_SOLAR_Q
+};
+
+typedef struct hf_solar_entry {
+    double t;    /* tan of the shading elevation */
+    size_t step;
+} hf_solar_entry;
+
+static int hf_solar_entry_cmp(const void *a, const void *b)
+{
+    double x = ((const hf_solar_entry *)a)->t, y = ((const hf_solar_entry *)b)->t;
+    return x < y ? -1 : x > y;
+}
+
+/* The sector path is exact for the model of section 5 up to the lit test at each direction's
+ * own azimuth and the pressure interpolation; it needs per-step constants. */
+static int hf_solar_sectors_apply(const hf_solar_ctx *c, size_t nsteps)
+{
+    return !c->o.linke_map && !c->o.coeff_bh && !c->o.coeff_dh && c->o.sun_radius_rad == 0.0 &&
+           !c->o.no_shading && !c->in.instant &&
+           nsteps / (size_t)c->bands > (size_t)HF_SOLAR_SECTOR_MIN * HF_SOLAR_BINS_PER_DIR * (size_t)c->o.directions;
+}
+
+/* One entry's sums at pressure ratio p into q[HF_SOLAR_Q]. */
+static void hf_solar_entry_sums(const hf_solar_step *st, double p, double *q)
+{
+    double w = st->weight, m = p * st->m0;
+    double b = st->g0 * hf_esra_beam_trans_m(m, st->linke);
+    double kb = b / st->g0, dh = st->g0 * st->fd, lo;
+    q[HF_SQ_BX] = w * b * st->sx;
+    q[HF_SQ_BY] = w * b * st->sy;
+    q[HF_SQ_BZ] = w * b * st->sz;
+    q[HF_SQ_BH] = w * b * st->sinh;
+    q[HF_SQ_FG] = w * dh * hf_muneer_fg_part(kb);
+    q[HF_SQ_RS] = w * dh * (1.0 - kb);
+    q[HF_SQ_AX] = w * dh * kb * st->sx / st->sinh;
+    q[HF_SQ_AY] = w * dh * kb * st->sy / st->sinh;
+    q[HF_SQ_AZ] = w * dh * kb * st->sz / st->sinh;
+    if (st->h >= 0.1) {
+        q[HF_SQ_TX] = q[HF_SQ_AX];
+        q[HF_SQ_TY] = q[HF_SQ_AY];
+        q[HF_SQ_TZ] = q[HF_SQ_AZ];
+    } else {
+        lo = w * dh * kb / (cos(st->elev) * hf_muneer_low_sun(st->h));
+        q[HF_SQ_TX] = lo * st->sx;
+        q[HF_SQ_TY] = lo * st->sy;
+        q[HF_SQ_TZ] = 0.0;
+    }
+    q[HF_SQ_DH] = w * dh;
+    q[HF_SQ_HOURS] = w;
+}
+
+static hfvis_status hf_solar_sectors(const hfvis_grid *g, hf_solar_run *r, int K, const double *az,
+                                     const float *cellmap, const float *sky)
+{
+    int NB = HF_SOLAR_BINS_PER_DIR * K, j, b, nn;
+    size_t n = hf_grid_count(g), ngroups = (size_t)r->c.bands * (size_t)NB, q, i, e;
+    size_t *start = NULL, *fill = NULL;
+    hf_solar_entry *ent = NULL;
+    int *bk = NULL, *nonempty = NULL, *nne = NULL;
+    double *sums = NULL, *tdh = NULL, *bw = NULL, *bdir = NULL, *th = NULL, pn[HF_SOLAR_NODES],
+           zmin = HFVIS__INF, zmax = -HFVIS__INF, turn = 2.0 * HFVIS__PI;
+    start = (size_t *)hfvis__alloc_array(r->al, ngroups + 1, sizeof(size_t));
+    fill = (size_t *)hfvis__alloc_array(r->al, ngroups + 1, sizeof(size_t));
+    ent = (hf_solar_entry *)hfvis__alloc_array(r->al, r->nsteps + 1, sizeof(hf_solar_entry));
+    sums = (double *)hfvis__alloc_array(r->al, r->nsteps + 1, sizeof(double) * HF_SOLAR_NODES * HF_SOLAR_Q);
+    tdh = (double *)hfvis__alloc_array(r->al, (size_t)r->c.bands, sizeof(double));
+    bk = (int *)hfvis__alloc_array(r->al, (size_t)NB, 2 * sizeof(int));
+    bw = (double *)hfvis__alloc_array(r->al, (size_t)NB, sizeof(double));
+    bdir = (double *)hfvis__alloc_array(r->al, (size_t)NB, 2 * sizeof(double));
+    nonempty = (int *)hfvis__alloc_array(r->al, ngroups, sizeof(int));
+    nne = (int *)hfvis__alloc_array(r->al, (size_t)r->c.bands, sizeof(int));
+    th = (double *)hfvis__alloc_array(r->al, (size_t)K, sizeof(double));
+    if (!start || !fill || !ent || !sums || !tdh || !bk || !bw || !bdir || !nonempty || !nne || !th) {
+        hfvis__free(r->al, start); hfvis__free(r->al, fill); hfvis__free(r->al, ent);
+        hfvis__free(r->al, sums); hfvis__free(r->al, tdh); hfvis__free(r->al, bk);
+        hfvis__free(r->al, bw); hfvis__free(r->al, bdir); hfvis__free(r->al, nonempty);
+        hfvis__free(r->al, nne); hfvis__free(r->al, th);
+        return HFVIS_ERR_OUT_OF_MEMORY;
+    }
+    /* the bins: centre psi_b = 2 pi b / NB, its two map directions and weight, its look vector */
+    for (b = 0; b < NB; b++) {
+        double psi = turn * (double)b / (double)NB;
+        hf_solar_bracket(az, K, psi, bk + 2 * b, bk + 2 * b + 1, bw + b);
+        bdir[2 * b] = cos(psi);
+        bdir[2 * b + 1] = sin(psi);
+    }
+    /* group the steps by (band, bin), each group sorted by tan e */
+    for (i = 0; i <= ngroups; i++) start[i] = 0;
+    for (b = 0; b < r->c.bands; b++) tdh[b] = 0.0;
+    for (q = 0; q < r->nsteps; q++) {
+        const hf_solar_step *st = r->steps + q;
+        int bin = (int)floor(st->psi / turn * (double)NB + 0.5) % NB;
+        tdh[st->band] += st->weight * st->g0 * st->fd;
+        start[(size_t)st->band * (size_t)NB + (size_t)bin + 1]++;
+    }
+    for (i = 0; i < ngroups; i++) start[i + 1] += start[i];
+    for (i = 0; i <= ngroups; i++) fill[i] = start[i];
+    for (q = 0; q < r->nsteps; q++) {
+        const hf_solar_step *st = r->steps + q;
+        int bin = (int)floor(st->psi / turn * (double)NB + 0.5) % NB;
+        hf_solar_entry *en = ent + fill[(size_t)st->band * (size_t)NB + (size_t)bin]++;
+        en->t = tan(st->elev);
+        en->step = q;
+    }
+    for (b = 0; b < r->c.bands; b++) {
+        nne[b] = 0;
+        for (j = 0; j < NB; j++) {
+            size_t gi = (size_t)b * (size_t)NB + (size_t)j;
+            if (start[gi + 1] == start[gi]) continue;
+            nonempty[(size_t)b * (size_t)NB + (size_t)nne[b]++] = j;
+            if (start[gi + 1] - start[gi] > 1)
+                qsort(ent + start[gi], start[gi + 1] - start[gi], sizeof(hf_solar_entry), hf_solar_entry_cmp);
+        }
+    }
+    /* pressure nodes over the grid's heights, and each group's sums from the top */
+    for (i = 0; i < n; i++) {
+        double z = (double)g->z[(i / (size_t)g->width) * (size_t)g->stride + i % (size_t)g->width];
+        if (!isfinite(z)) continue;
+        if (z < zmin) zmin = z;
+        if (z > zmax) zmax = z;
+    }
+    if (!(zmin <= zmax)) zmin = zmax = 0.0;
+    /* one node on a flat grid, two (linear) over a small range of p, else three (quadratic) */
+    nn = zmin == zmax ? 1 : hf_esra_pressure(zmin) - hf_esra_pressure(zmax) < HF_SOLAR_P_LINEAR ? 2 : 3;
+    for (j = 0; j < nn; j++)
+        pn[j] = hf_esra_pressure(nn == 1 ? zmin : zmax + (zmin - zmax) * (double)j / (double)(nn - 1));
+    for (i = 0; i < ngroups; i++) {
+        double acc[HF_SOLAR_NODES * HF_SOLAR_Q];
+        int a;
+        for (a = 0; a < HF_SOLAR_NODES * HF_SOLAR_Q; a++) acc[a] = 0.0;
+        for (e = start[i + 1]; e-- > start[i];) {
+            double *s = sums + e * (size_t)nn * HF_SOLAR_Q;
+            for (j = 0; j < nn; j++) {
+                hf_solar_entry_sums(r->steps + ent[e].step, pn[j], s + j * HF_SOLAR_Q);
+                for (a = 0; a < HF_SOLAR_Q; a++) s[j * HF_SOLAR_Q + a] = acc[j * HF_SOLAR_Q + a] += s[j * HF_SOLAR_Q + a];
+            }
+        }
+    }
+    /* per sample: the suffix of each bin above its threshold */
+    for (i = 0; i < n; i++) {
+        hf_solar_point *pt = r->pts + i;
+        const float *hz = cellmap + i * (size_t)K;
+        double L[HF_SOLAR_NODES];
+        int horizon = r->c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON;
+        if (!isfinite(pt->p) || isnan(pt->nz)) continue;
+        if (sky) pt->sky_ratio = (double)sky[i] / pt->r_sky;
+        for (j = 0; j < K; j++) th[j] = tan((double)hz[j]);
+        for (j = 0; j < nn; j++) { /* Lagrange weights of p */
+            int m;
+            L[j] = 1.0;
+            for (m = 0; m < nn; m++)
+                if (m != j) L[j] *= (pt->p - pn[m]) / (pn[j] - pn[m]);
+        }
+        for (b = 0; b < r->c.bands; b++) {
+            double S[HF_SOLAR_NODES * HF_SOLAR_Q], T[HF_SOLAR_Q], *a = r->acc + ((size_t)b * n + i) * 4;
+            int t, u;
+            for (t = 0; t < nn * HF_SOLAR_Q; t++) S[t] = 0.0;
+            for (u = 0; u < nne[b]; u++) {
+                int bin = nonempty[(size_t)b * (size_t)NB + (size_t)u];
+                size_t gi = (size_t)b * (size_t)NB + (size_t)bin, lo = start[gi], hi = start[gi + 1];
+                double thr = (1.0 - bw[bin]) * th[bk[2 * bin]] + bw[bin] * th[bk[2 * bin + 1]], tc;
+                const double *s;
+                tc = pt->nz > 0.0 ? -(pt->nx * bdir[2 * bin] + pt->ny * bdir[2 * bin + 1]) / pt->nz : HFVIS__INF;
+                if (!(thr >= tc)) thr = tc; /* the receiver's own tangent plane (and NaN) */
+                if (!(ent[hi - 1].t > thr)) continue;
+                while (lo < hi) { /* the first entry above the threshold */
+                    size_t mid = lo + (hi - lo) / 2;
+                    if (ent[mid].t > thr) hi = mid;
+                    else lo = mid + 1;
+                }
+                s = sums + lo * (size_t)nn * HF_SOLAR_Q;
+                for (t = 0; t < nn * HF_SOLAR_Q; t++) S[t] += s[t];
+            }
+            for (t = 0; t < HF_SOLAR_Q; t++) {
+                T[t] = 0.0;
+                for (j = 0; j < nn; j++) T[t] += L[j] * S[j * HF_SOLAR_Q + t];
+            }
+            a[0] = pt->nx * T[HF_SQ_BX] + pt->ny * T[HF_SQ_BY] + pt->nz * T[HF_SQ_BZ];
+            if (pt->tilted || horizon) {
+                double bg = (pt->fg * T[HF_SQ_FG] + pt->r_sky * T[HF_SQ_RS]) * pt->sky_ratio;
+                double shade = (tdh[b] - T[HF_SQ_DH]) * (pt->r_sky + pt->fg * 0.252271) * pt->sky_ratio;
+                a[1] = bg + shade + (pt->tilted ? pt->nx * T[HF_SQ_TX] + pt->ny * T[HF_SQ_TY] + pt->nz * T[HF_SQ_TZ]
+                                                : pt->nx * T[HF_SQ_AX] + pt->ny * T[HF_SQ_AY] + pt->nz * T[HF_SQ_AZ]);
+            } else {
+                a[1] = tdh[b];
+            }
+            a[2] = pt->tilted ? pt->albedo * (T[HF_SQ_BH] + tdh[b]) * (1.0 - pt->nz) * 0.5 : 0.0;
+            a[3] = T[HF_SQ_HOURS];
+        }
+    }
+    hfvis__free(r->al, start); hfvis__free(r->al, fill); hfvis__free(r->al, ent);
+    hfvis__free(r->al, sums); hfvis__free(r->al, tdh); hfvis__free(r->al, bk);
+    hfvis__free(r->al, bw); hfvis__free(r->al, bdir); hfvis__free(r->al, nonempty);
+    hfvis__free(r->al, nne); hfvis__free(r->al, th);
+    return HFVIS_OK;
+}
+
+/* -------------------------------------------------------------------- 8. the public routines */
 hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_input *in,
                                      const hfvis_solar_options *opts, const hfvis_solar_output *out)
 {
@@ -10577,7 +10808,9 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
         hfvis__free(r.al, map);
         map = NULL;
     }
-    if (st == HFVIS_OK) {
+    if (st == HFVIS_OK && cellmap && hf_solar_sectors_apply(&r.c, r.nsteps)) {
+        st = hf_solar_sectors(g, &r, K, az, cellmap, sky);
+    } else if (st == HFVIS_OK) {
         int horizon = r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON;
         for (i = 0; i < n; i++) {
             hf_solar_point *pt = r.pts + i;

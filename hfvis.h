@@ -1508,9 +1508,19 @@ HFVIS_API int hfvis_solar_band_count(const hfvis_solar_input *input,
  * middle; the step holding sunrise or sunset is evaluated at the middle of its sunlit part
  * (found by bisection of the true elevation) and weighted by that part's length. RSUN: r.sun's
  * steps. The sun counts while its true elevation is above 0.
- * Memory: K*4 bytes per sample for the map (K = 64: 256 bytes), 20 bytes per sample of state,
- * plus the outputs; HORIZON adds 4 bytes per sample, TERRAIN the [P2] sweep's scratch.
- * Cost: the map (hfvis.h "Exact rays") plus O(steps*width*height).
+ * Long periods (more than 16 sunlit steps per map direction and band) with one Linke factor per
+ * step (a value or monthly values), no coefficient rasters and a hard sun take the sector sums
+ * instead of the step loop: the steps binned by azimuth (4 bins per map direction), sorted by
+ * elevation and summed from the top (every term is linear in per-sample constants once a step
+ * is lit or not; the air mass's height enters by interpolation over 1-3 pressure nodes), so a
+ * sample costs O(bins * log steps) instead of O(steps); its lit test is taken at the bin's
+ * centre (within 0.7 deg of the step's azimuth at K = 64).
+ * Memory: K*8 bytes per sample for the map and its sample-major copy (K = 64: 512 bytes at the
+ * peak), 120 bytes per sample of state and 32 per sample and band of sums, plus the outputs;
+ * HORIZON adds 4 bytes per sample, TERRAIN the [P2] sweep's scratch; the sector sums about
+ * 350 bytes per sunlit step.
+ * Cost: the map (hfvis.h "Exact rays") plus O(steps*width*height), or with the sector sums
+ * O(steps log steps + bands*K*width*height*log steps).
  * Accuracy against hfvis_solar_irradiation_reference: docs/solar.md and test/test_solar.c.
  * Returns HFVIS_ERR_INVALID_ARGUMENT (NULL, no output, bad input or option: a date that does
  * not exist, linke outside (0, 10], albedo outside [0, 1], a latitude outside [-pi/2, pi/2]),

@@ -1027,6 +1027,36 @@ else
   echo "SKIP cli docs/cli.md: not beside the script"
 fi
 
+# ---- solar (docs/solar.md) ----------------------------------------------------------------
+# utm.asc + utm.prj: 8 x 6 cells of 10 m in UTM 33N whose centre lies at E 500040, N 5000030:
+# latitude 45.1538 (the meridian arc to 45 deg, 4984944 m, times 0.9996 is N 4982950; 17080 m more
+# of northing is 0.1538 deg), longitude 15.0005, by the inverse Transverse Mercator.
+awk 'BEGIN { print "ncols 8"; print "nrows 6"; print "xllcorner 500000"; print "yllcorner 5000000"
+  print "cellsize 10"; for (y = 0; y < 6; y++) { s = ""; for (x = 0; x < 8; x++) s = s " " (100 + x); print s } }' > "$dir/utm.asc"
+printf 'PROJCS["WGS 84 / UTM zone 33N",GEOGCS["WGS 84",DATUM["WGS_1984",SPHEROID["WGS 84",6378137,298.257223563]],PRIMEM["Greenwich",0],UNIT["degree",0.0174532925199433]],PROJECTION["Transverse_Mercator"],PARAMETER["latitude_of_origin",0],PARAMETER["central_meridian",15],PARAMETER["scale_factor",0.9996],PARAMETER["false_easting",500000],PARAMETER["false_northing",0],UNIT["metre",1]]\n' > "$dir/utm.prj"
+expect_ok "solar: a day on flat ground" "$dir/sol.pfm" solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --utc-offset 1 --dirs 8 -o "$dir/sol.pfm"
+expect_ok "solar: instant, parts and sun hours" "$dir/solh.pfm" solar "$dir/hill.pgm" --latitude -35 --longitude 150 --day 2026-01-10 --time 12:30 --utc-offset 10 --dirs 8 --beam "$dir/solb.pfm" --diffuse "$dir/sold.pfm" --reflected "$dir/solr.pfm" --sun-hours "$dir/solh.pfm" -o "$dir/solg.pfm"
+[ -s "$dir/solb.pfm" ] && [ -s "$dir/sold.pfm" ] && [ -s "$dir/solr.pfm" ] && ok "solar: the four extra outputs written" || bad "solar: an extra output missing"
+expect_ok "solar: polar night gives 0" "$dir/night.pfm" solar "$dir/flat.pgm" --latitude 80 --longitude 15 --day 2026-12-21 --dirs 8 -o "$dir/night.pfm"
+expect_bytes "solar: polar night is 0 Wh/m^2" "$dir/night.pfm" 4 "00 00 00 00"
+expect_ok "solar: r.sun's solar time, monthly Linke, month bands" "$dir/solm.pfm" solar "$dir/hill.pgm" --latitude 46 --longitude 15 --start 2026-01-30 --end 2026-02-02 --solar-time --linke-monthly 2,2,3,3,4,4,4,4,3,3,2,2 --bands month --step 1h --dirs 8 -o "$dir/solm.pfm"
+[ "$(head -c 20 "$dir/solm.pfm" | sed -n 2p)" = "24 40" ] && ok "solar: 2 month bands stacked (24 x 40)" || bad "solar: month bands: $(head -c 20 "$dir/solm.pfm" | sed -n 2p)"
+"$hfvis" solar "$dir/utm.asc" --day 2026-06-21 --dirs 8 --progress -o "$dir/utm.tif" > "$dir/stdout" 2> "$dir/stderr"
+grep -q '^hfvis solar: site 45\.153[78][0-9]*, 15\.0005[0-9]* ' "$dir/stderr" && "$hfvis" info "$dir/utm.tif" | grep -q 'crs projected' \
+  && ok "solar: UTM 33N asc + .prj: the site by the inverse projection, GeoTIFF with the CRS" \
+  || bad "solar: UTM site or CRS: $(grep site "$dir/stderr") $("$hfvis" info "$dir/utm.tif" | grep crs)"
+expect_fail "solar: no latitude (no CRS)" 1 solar "$dir/flat.pgm" --day 2026-06-21 -o "$fdir/x.pfm"
+expect_fail "solar: a date that does not exist" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-02-29 -o "$fdir/x.pfm"
+expect_fail "solar: Linke outside (0, 10]" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --linke 0 -o "$fdir/x.pfm"
+expect_fail "solar: albedo outside [0, 1]" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --albedo 1.2 -o "$fdir/x.pfm"
+expect_fail "solar: latitude without longitude" 2 solar "$dir/flat.pgm" --latitude 46 --day 2026-06-21 -o "$fdir/x.pfm"
+expect_fail "solar: --time with a range" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --start 2026-06-01 --end 2026-06-02 --time 12:00 -o "$fdir/x.pfm"
+expect_fail "solar: --solar-time with --utc-offset" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --solar-time --utc-offset 1 -o "$fdir/x.pfm"
+expect_fail "solar: no date" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 -o "$fdir/x.pfm"
+expect_fail "solar: --window" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --window 0,0,2,2 -o "$fdir/x.pfm"
+expect_fail "solar: bad --step" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --step 25h -o "$fdir/x.pfm"
+expect_fail "solar: bad --linke-monthly" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --linke-monthly 3,3 -o "$fdir/x.pfm"
+
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

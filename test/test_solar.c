@@ -395,6 +395,33 @@ TEST(random_terrains_against_oracle)
     }
 }
 
+/* A period long enough for the sector sums (more than 4 steps per azimuth bin: hfvis.c section
+ * 17.7) against the oracle, on the same terrains. */
+TEST(sector_sums_against_oracle)
+{
+    hfvis_grid g = test_grid(zbuf, W, H, 1.0);
+    int c;
+    for (c = 0; c < 5; c++) {
+        hfvis_solar_input in = site(c == 2 ? -35.0 : 46.0, 3 + 2 * c, 1);
+        hfvis_solar_options o = hfvis_solar_options_default();
+        double m, sh;
+        int x, y;
+        char name[40];
+        in.days = 30; /* at least 1200 sunlit steps: above 4 per bin of K = 64 (4 bins each) */
+        if (c == 0) plane(zbuf, W, H, 1.0, 30.0, 1.5 * PI); /* north */
+        else if (c == 1)
+            for (y = 0; y < H; y++)
+                for (x = 0; x < W; x++) zbuf[y * W + x] = (y == 12) ? 6.0f : 0.0f;
+        else fbm(zbuf, W, H, 6.0, 8.0, (uint64_t)c);
+        if (c == 3) o.diffuse = HFVIS_SOLAR_DIFFUSE_HORIZON;
+        if (c == 4) o.model = HFVIS_SUN_RSUN;
+        run_pair(&g, &in, &o);
+        snprintf(name, sizeof name, "30 days, case %d", c);
+        compare_oracle(name, &m, &sh);
+        CHECK(m <= ORACLE_MEAN_REL && sh <= CELL_BEAM_SHARE);
+    }
+}
+
 TEST(horizon_diffuse_and_terrain_reflection)
 {
     hfvis_grid g = test_grid(zbuf, W, H, 1.0);
@@ -576,8 +603,9 @@ TEST(allocation_failures)
     int which;
     oa.beam = a[0]; oa.diffuse = a[1]; oa.reflected = a[2]; oa.global = a[3]; oa.sun_hours = a[4];
     for (which = 0; which < 36; which++) zbuf[which] = (float)(which % 5);
-    for (which = 0; which < 2; which++) {
+    for (which = 0; which < 3; which++) { /* fast one day, oracle, fast 40 days (sector sums) */
         long k;
+        in.days = which == 2 ? 40 : 1;
         for (k = 1; k < 200; k++) {
             test_counting cnt;
             hfvis_allocator al = test_counting_allocator(&cnt, k);
@@ -588,7 +616,8 @@ TEST(allocation_failures)
             o.sweep = &sw;
             o.diffuse = HFVIS_SOLAR_DIFFUSE_HORIZON;
             o.reflected = HFVIS_SOLAR_REFLECTED_TERRAIN;
-            st = which ? hfvis_solar_irradiation_reference(&g, &in, &o, &oa) : hfvis_solar_irradiation(&g, &in, &o, &oa);
+            o.directions = 8;
+            st = which == 1 ? hfvis_solar_irradiation_reference(&g, &in, &o, &oa) : hfvis_solar_irradiation(&g, &in, &o, &oa);
             CHECK(cnt.live == 0);
             if (st == HFVIS_OK) break;
             CHECK_EQ_STATUS(st, HFVIS_ERR_OUT_OF_MEMORY);
@@ -609,6 +638,7 @@ int main(int argc, char **argv)
     RUN(tilted_planes_shade_only_behind_themselves);
     RUN(wall_and_pit_against_oracle);
     RUN(random_terrains_against_oracle);
+    RUN(sector_sums_against_oracle);
     RUN(horizon_diffuse_and_terrain_reflection);
     RUN(sunrise_and_sunset_inside_the_step);
     RUN(polar_night_and_bands);

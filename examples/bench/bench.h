@@ -86,6 +86,7 @@ void bench_lk(int quick);
 void bench_lk_obj(int quick); /* bench_lkobj.c: the meshes of HFVIS_BENCH_MESHES */
 void bench_dirs(int quick);
 void bench_exact(int quick);
-void bench_tiles(int quick); /* bench_tiles.c: the hfvis tool whole vs tiled ($HFVIS_CLI) */
+void bench_tiles(int quick);
+void bench_solar(int quick); /* bench_solar.c: the DEMs of $HFVIS_BENCH_DEMS (else an fBm) */ /* bench_tiles.c: the hfvis tool whole vs tiled ($HFVIS_CLI) */
 void bench_radius(int quick);
 #endif

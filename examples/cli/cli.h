@@ -9,6 +9,7 @@
  *   p2.c            indirect, visibility   gis_products.c  viewshed, hillshade, openness
  *   screen.c        ssao                   meshes.c        meshao, visfield, volgi, voxelize
  *   split.c         --dir-range and sum    tiles.c         --window pieces and mosaic
+ *   solar.c         solar: dates, site, irradiation
  * Every file is read and written through the library's codecs (hfvis_image_load, the encoders
  * and hfvis_write_file) or examples/raster_io.h (GeoTIFF, ASC, EHdr), so the tool exercises what
  * a vendoring user gets; an interrupt (SIGINT, SIGTERM, SIGHUP) removes the temporary file of a
@@ -50,8 +51,9 @@
 
 /* The commands, in the order of `hfvis --help`; each is one row of cli_commands (main.c). */
 enum { CMD_HORIZON, CMD_SKYVIEW, CMD_SKY, CMD_SHADOW, CMD_LIGHT, CMD_NORMALS, CMD_INDIRECT,
-       CMD_GI, CMD_VISIBILITY, CMD_VIEWSHED, CMD_HILLSHADE, CMD_OPENNESS, CMD_VOXELIZE, CMD_VOLGI,
-       CMD_VISFIELD, CMD_MESHAO, CMD_SSAO, CMD_SUM, CMD_MOSAIC, CMD_INFO, CMD_AZIMUTHS, CMD_COUNT };
+       CMD_GI, CMD_VISIBILITY, CMD_VIEWSHED, CMD_HILLSHADE, CMD_OPENNESS, CMD_SOLAR, CMD_VOXELIZE,
+       CMD_VOLGI, CMD_VISFIELD, CMD_MESHAO, CMD_SSAO, CMD_SUM, CMD_MOSAIC, CMD_INFO, CMD_AZIMUTHS,
+       CMD_COUNT };
 
 /* voxelize --mode, --axis, --method */
 enum { VOX_SURFACE, VOX_CONSERVATIVE, VOX_SOLID };
@@ -103,6 +105,13 @@ typedef struct cli_args {
     int has_window, win_x, win_y, win_w, win_h; /* --window X0,Y0,W,H (cells; docs/tiles.md) */
     int threads, has_threads; /* --threads N (threads.c); default the online cores */
     int lattice;              /* hillshade --lattice: lattice-mode shadows (default exact rays) */
+    /* solar (solar.c): dates, times, atmosphere, site, extra outputs (beam, diffuse, reflected,
+     * sun hours) */
+    int sol_y, sol_m, sol_d, sol_ey, sol_em, sol_ed, sol_has_start, sol_has_end;
+    int sol_instant, sol_solar_time, sol_has_lat, sol_has_lon, sol_has_offset, sol_has_linke;
+    int sol_has_linke_monthly, sol_bands;
+    double sol_hour, sol_step, sol_lat, sol_lon, sol_offset, sol_linke, sol_linke_monthly[12];
+    const char *sol_linke_map, *sol_out[4];
 } cli_args;
 
 /* ssao --method, --depth */
@@ -127,13 +136,13 @@ static const char *const cli_conv_names[3] = { "compass", "grass", "grid" };
 #define CLI_HF (CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_SHADOW) \
                 | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_NORMALS) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) \
                 | CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_HILLSHADE) \
-                | CLI_ONLY(CMD_OPENNESS))
+                | CLI_ONLY(CMD_OPENNESS) | CLI_ONLY(CMD_SOLAR))
 /* the commands that parse with cli_parse and write OUT (--progress, --max-memory) */
 #define CLI_RUNS (CLI_HF | CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_VISFIELD) \
                   | CLI_ONLY(CMD_MESHAO) | CLI_ONLY(CMD_SSAO))
 /* every command that writes OUT (-o, --quiet, --overwrite); those that can write a PGM (--range) */
 #define CLI_OUT (CLI_RUNS | CLI_ONLY(CMD_SUM) | CLI_ONLY(CMD_MOSAIC))
-#define CLI_PGM (CLI_OUT & ~CLI_ONLY(CMD_VOXELIZE))
+#define CLI_PGM (CLI_OUT & ~(CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_SOLAR)))
 /* the commands of K azimuth directions (--dirs K, --azimuth0) */
 #define CLI_DIRS (CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT) \
                   | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VISIBILITY) \
@@ -406,6 +415,13 @@ static const char *cli_piece_problem(const char *key);
 static int cli_piece_read(const char *path, const cli_piece *m, int W, int H, float *out,
                           const ex_georef *whole, const ex_georef *ref, ex_georef *keep);
 static int cli_mosaic(int argc, char **argv);
+/* solar.c */
+static int cli_solar_date(const char *f, const char *v, int *y, int *m, int *d);
+static long cli_solar_day_number(int y, int m, int d);
+static int cli_set_solar(cli_args *a, const char *f, const char *v);
+static int cli_solar_days(const cli_args *a);
+static int cli_check_solar(const cli_args *a);
+static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts);
 /* main.c */
 static int cli_commands_complete(void);
 

@@ -81,7 +81,7 @@ static const cli_flag cli_flags[] = {
       "multiply input values by Z, non-zero (default 1)\n" },
     { "--nodata", "V", CLI_HF,
       "input values equal to V are holes: no occlusion, output NaN (PGM code 0)\n" },
-    { "--dirs", "K", CLI_DIRS | CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_VISFIELD),
+    { "--dirs", "K", CLI_DIRS | CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_SOLAR),
       "number of azimuth directions, 1..65536 (default 16)\n" },
     { "--convention", "C", CLI_ANGLES,
       "how azimuths are read and directions ordered (height-field commands):\n"
@@ -107,10 +107,10 @@ static const cli_flag cli_flags[] = {
       "                    multiples of 4 and each part costs its share of the run); OUT (*.hfvs)\n"
       "                    is then a partial result, and 'hfvis sum' adds the parts of a split\n"
       "                    into the single run's OUT\n" },
-    { "--border", "MODE", CLI_BORDER,
+    { "--border", "MODE", CLI_BORDER | CLI_ONLY(CMD_SOLAR),
       "open (nothing outside the grid, default), clamp (edge heights extend\n"
       "                    outward) or wrap (periodic field)\n" },
-    { "--border-cells", "N", CLI_BORDER,
+    { "--border-cells", "N", CLI_BORDER | CLI_ONLY(CMD_SOLAR),
       "clamp/wrap: lines start N cells outside the grid, 1..1048576\n"
       "                    (default max(width, height))\n" },
     { "--exact", NULL, CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY)
@@ -121,7 +121,8 @@ static const cli_flag cli_flags[] = {
       "                    interpolation between lattice lines (right at walls, roofs, cliffs;\n"
       "                    'hfvis azimuths --exact' prints the directions used). visibility,\n"
       "                    indirect and gi keep the lattice\n" },
-    { "--max-distance", "R", CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_VISFIELD) | CLI_SWEEP | CLI_P2,
+    { "--max-distance", "R", CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_VISFIELD) | CLI_SWEEP | CLI_P2
+                           | CLI_ONLY(CMD_SOLAR),
       "horizon, skyview, sky, shadow, light, visibility, indirect, hillshade:\n"
       "                    the search radius in height units (--cell applies): occluders farther\n"
       "                    than R along the ray are ignored (GRASS maxdistance, SAGA and RVT radius,\n"
@@ -157,16 +158,16 @@ static const cli_flag cli_flags[] = {
       "                    one-thread run's bit for bit (directions, bands across the sun, rows)\n" },
     { "--sky", "C", CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI), NULL },
     { "--albedo", "A", CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT)
-                     | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VOLGI), NULL },
+                     | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_SOLAR), NULL },
     { "--sun-azimuth", "DEG", CLI_SUN, NULL },
     { "--sun-elevation", "DEG", CLI_SUN, NULL },
-    { "--sun-radius", "DEG", CLI_SUN, NULL },
+    { "--sun-radius", "DEG", CLI_SUN | CLI_ONLY(CMD_SOLAR), NULL },
     { "--math", NULL, CLI_SUN, NULL },
     { "--env", "ENV", CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI), NULL },
     { "--method", "M", CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_SSAO)
                      | CLI_ONLY(CMD_MESHAO), NULL },
     { "--sun-irradiance", "E", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI), NULL },
-    { "--albedo-map", "MAP", CLI_ONLY(CMD_INDIRECT), NULL },
+    { "--albedo-map", "MAP", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_SOLAR), NULL },
     { "--emission", "MAP", CLI_ONLY(CMD_INDIRECT), NULL },
     { "--bounces", "B", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI), NULL },
     { "--output", "WHAT", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VOLGI), NULL },
@@ -232,6 +233,23 @@ static const cli_flag cli_flags[] = {
     { "--negative", NULL, CLI_ONLY(CMD_OPENNESS), NULL },
     { "--both", NULL, CLI_ONLY(CMD_OPENNESS), NULL },
     { "--lattice", NULL, CLI_ONLY(CMD_HILLSHADE), NULL },
+    { "--day", "DATE", CLI_ONLY(CMD_SOLAR), NULL },
+    { "--start", "DATE", CLI_ONLY(CMD_SOLAR), NULL },
+    { "--end", "DATE", CLI_ONLY(CMD_SOLAR), NULL },
+    { "--time", "HH:MM", CLI_ONLY(CMD_SOLAR), NULL },
+    { "--step", "S", CLI_ONLY(CMD_SOLAR), NULL },
+    { "--linke", "L", CLI_ONLY(CMD_SOLAR), NULL },
+    { "--linke-monthly", "L1,...,L12", CLI_ONLY(CMD_SOLAR), NULL },
+    { "--linke-map", "MAP", CLI_ONLY(CMD_SOLAR), NULL },
+    { "--latitude", "DEG", CLI_ONLY(CMD_SOLAR), NULL },
+    { "--longitude", "DEG", CLI_ONLY(CMD_SOLAR), NULL },
+    { "--utc-offset", "H", CLI_ONLY(CMD_SOLAR), NULL },
+    { "--solar-time", NULL, CLI_ONLY(CMD_SOLAR), NULL },
+    { "--bands", "day|month", CLI_ONLY(CMD_SOLAR), NULL },
+    { "--beam", "OUT", CLI_ONLY(CMD_SOLAR), NULL },
+    { "--diffuse", "OUT", CLI_ONLY(CMD_SOLAR), NULL },
+    { "--reflected", "OUT", CLI_ONLY(CMD_SOLAR), NULL },
+    { "--sun-hours", "OUT", CLI_ONLY(CMD_SOLAR), NULL },
 };
 #define CLI_NFLAGS (sizeof cli_flags / sizeof cli_flags[0])
 
@@ -334,6 +352,10 @@ static int cli_set(cli_args *a, const char *f, const char *v)
     }
     if (a->cmd == CMD_MESHAO) {
         int r = cli_set_lk(a, f, v);
+        if (r >= 0) return r;
+    }
+    if (a->cmd == CMD_SOLAR) {
+        int r = cli_set_solar(a, f, v);
         if (r >= 0) return r;
     }
     if (!strcmp(f, "-o") && a->cmd == CMD_VISFIELD) return cli_set_vf(a, f, v);

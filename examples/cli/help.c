@@ -45,6 +45,33 @@
     "Prints the grid, the voxel counts and the light budget unless --quiet. Default PGM range\n"   \
     "0:the largest output value.\n"
 
+#define CLI_SOLAR_HELP                                                                              \
+    "usage: hfvis solar DEM --day YYYY-MM-DD | --start DATE --end DATE [--step 15m] [--time HH:MM]\n" \
+    "         [--linke L | --linke-monthly L1,...,L12 | --linke-map L.pfm] [--albedo A |\n"          \
+    "         --albedo-map A.pfm] -o GLOBAL [--beam B] [--diffuse D] [--reflected R]\n"             \
+    "         [--sun-hours H] [--latitude DEG --longitude DEG] [--utc-offset H | --solar-time]\n"    \
+    "         [--bands day|month] [--sun-radius DEG] [--dirs K] [--max-distance R]\n"              \
+    "Clear-sky solar irradiation (Wh/m^2) of a day or a date range, or irradiance (W/m^2) at\n"     \
+    "--time, on every cell: r.sun's ESRA atmosphere (Suri & Hofierka 2004), the sun from NREL's\n"  \
+    "SPA (Reda & Andreas 2004/2008), the beam shaded by exact horizons (docs/solar.md).\n"          \
+    "  --day DATE        one day (local civil day; --time HH:MM: that instant)\n"                   \
+    "  --start, --end    a date range, both days included\n"                                        \
+    "  --step S          time step: 15m (default), 1h, 0.5h; a bare number is minutes\n"            \
+    "  --linke L         Linke turbidity, (0, 10] (default 3); --linke-monthly: 12 values from\n"   \
+    "                    January; --linke-map: a PFM/PGM of the DEM's size\n"                       \
+    "  --albedo A        ground albedo, [0, 1] (default 0.2); --albedo-map: per cell\n"             \
+    "  -o GLOBAL         global irradiation; --beam, --diffuse, --reflected, --sun-hours write\n"    \
+    "                    the parts and the hours of direct sun (.pfm, .tif, .asc, .bil, .flt)\n"    \
+    "  --latitude, --longitude  the site in degrees (east positive); default: the centre of a\n"    \
+    "                    raster in a Transverse Mercator CRS (UTM EPSG 326zz/327zz/258zz or a\n"     \
+    "                    WKT), by the inverse projection; else an error\n"                         \
+    "  --utc-offset H    dates and --time are UTC + H (default 0); --solar-time: local solar time\n" \
+    "                    and r.sun's solar geometry and steps (r.sun's convention)\n"               \
+    "  --bands day|month one band per day or per calendar month, stacked like horizon planes\n"     \
+    "  --sun-radius DEG  shade the sun's disc (default: its centre); --dirs K: directions of the\n" \
+    "                    exact horizon map (default 64)\n"                                          \
+    "Polar night gives 0. With --progress the site's latitude and longitude go to stderr.\n"
+
 #define CLI_VF_HELP                                                                                  \
     "usage: hfvis visfield MESH.obj -o FIELD.hfvf [--positions K] [--dirs D] [--format F]\n"        \
     "                      [--mapping M]\n"                                                          \

@@ -18,6 +18,7 @@
 #include "meshes.c"
 #include "split.c"
 #include "tiles.c"
+#include "solar.c"
 
 /* The commands: one row each (the order of `hfvis --help`). Adding a command: its CMD_ value in
  * cli.h's enum, its --help text (help.c), its flags' rows (flags.c: add the command's bit to
@@ -49,6 +50,8 @@ static const cli_command cli_commands[CMD_COUNT] = {
       CLI_HILLSHADE_HELP, CLI_HF_IO, NULL, cli_run_heights, NULL },
     { "openness", "positive or negative topographic openness (Yokoyama et al. 2002)",
       CLI_OPENNESS_HELP, CLI_HF_IO, NULL, cli_run_heights, NULL },
+    { "solar", "clear-sky solar irradiation of a day or a date range over exact horizons",
+      CLI_SOLAR_HELP, CLI_HF_IO, cli_check_solar, cli_run_heights, NULL },
     { "voxelize", "voxels of an OBJ mesh: surface, conservative or solid (.binvox or .raw)",
       CLI_VOXELIZE_HELP, CLI_MESH_IO, cli_check_voxelize, cli_run_voxelize, NULL },
     { "volgi", "direct + indirect light of an OBJ mesh or the test room ([G12] ch. 5)",

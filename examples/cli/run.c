@@ -45,6 +45,10 @@ static cli_cost cli_estimate(const cli_args *a, int w, int h, int channels)
         return c;
     case CMD_HORIZON: ch = 4.0; break;
     case CMD_GI: c.bytes = n * 4.0 * 64.0; break; /* the NS09 pyramids and SH planes */
+    case CMD_SOLAR: /* the K = 64 map twice (sweep and sample-major), state, outputs, the map's sweeps */
+        c.bytes = n * (8.0 * 64.0 + 160.0 + 20.0);
+        c.work = 64.0 * 16.0 * n, c.unit = "ray crossings";
+        return c;
     default: break;
     }
     c.bytes += n * 4.0 + n * 4.0 * (a->cmd == CMD_HORIZON ? K : (double)channels); /* in, out */
@@ -292,7 +296,7 @@ static int cli_run_heights(const cli_args *a)
     prog.label = cmd; prog.base = 0; prog.total = 0;
     cli_run_cells = (double)w * (double)h;
     cli_run_directions = a->cmd == CMD_NORMALS || a->cmd == CMD_VIEWSHED ? 0
-                         : a->cmd == CMD_SHADOW ? 1 : a->dirs;
+                         : a->cmd == CMD_SHADOW ? 1 : a->cmd == CMD_SOLAR && !a->has_dirs ? 64 : a->dirs;
     if (a->progress_lines && !a->quiet) {
         opts.progress = cli_progress_line;
         opts.progress_user = &prog;
@@ -309,6 +313,7 @@ static int cli_run_heights(const cli_args *a)
     if (a->cmd == CMD_INDIRECT) { rc = cli_run_indirect(a, &grid, &opts, &prog); goto done; }
     if (a->cmd == CMD_VISIBILITY) { rc = cli_run_visibility(a, &grid, &opts, &prog); goto done; }
     if (a->cmd == CMD_GI) { rc = cli_run_gi(a, &grid, &opts, &prog); goto done; }
+    if (a->cmd == CMD_SOLAR) { rc = cli_run_solar(a, &grid, &opts); goto done; }
     if (a->cmd == CMD_VIEWSHED || a->cmd == CMD_HILLSHADE || a->cmd == CMD_OPENNESS ||
         (a->cmd == CMD_SKYVIEW && a->svf != 0)) {
         rc = cli_run_gis(a, &grid, &opts, &prog);

@@ -1,0 +1,135 @@
+/* bench_solar.c - hfvis_solar_irradiation beside its oracle (hfvis.h, "solar radiation"): one
+ * day (day 172, 15-minute steps, Linke 3, albedo 0.2) on a DEM, the horizon map's share of the
+ * time, the cost per receiver and per receiver-step; then fast and oracle on a crop, their ratio
+ * and the oracle's agreement (mean |fast - oracle| / oracle of the daily global and beam).
+ * The DEMs come from HFVIS_BENCH_DEMS, a directory holding colorado_srtm_512_90m.pfm (SRTM,
+ * 90 m, 40.2 N 105.6 W) and slovenia_lidar_1000_1m.pfm (lidar DTM, 1 m, 46.5 N 15.8 E); without
+ * it a 512^2 fBm with 90 m cells stands in:
+ *   HFVIS_BENCH_DEMS=/path/to/dems BENCH_ARGS=solar make bench
+ * docs/solar.md holds the figures. */
+#define _POSIX_C_SOURCE 199309L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "bench.h"
+#include "../fields.h"
+
+#define SOLAR_CROP 96 /* the oracle's crop: it costs O(steps * W * H * max(W, H)) */
+#define SOLAR_DEG (3.14159265358979323846 / 180.0)
+
+typedef struct solar_site { const char *file, *name; double cell, lat, lon; int days; } solar_site;
+
+static int solar_run(const hfvis_grid *g, const hfvis_solar_input *in, const hfvis_solar_options *o,
+                     int oracle, float *beam, float *global, double *seconds)
+{
+    hfvis_solar_output out;
+    double t0;
+    hfvis_status st;
+    memset(&out, 0, sizeof out);
+    out.beam = beam;
+    out.global = global;
+    t0 = bench_now();
+    st = oracle ? hfvis_solar_irradiation_reference(g, in, o, &out) : hfvis_solar_irradiation(g, in, o, &out);
+    *seconds = bench_now() - t0;
+    return st == HFVIS_OK;
+}
+
+static void solar_dem(const solar_site *s, float *z, int w, int h, int quick)
+{
+    hfvis_grid g;
+    hfvis_solar_input in = hfvis_solar_input_default();
+    hfvis_solar_options o = hfvis_solar_options_default();
+    hfvis_sweep_options sw = hfvis_sweep_options_default();
+    size_t n = (size_t)w * (size_t)h, i;
+    float *b1 = (float *)malloc(n * sizeof(float)), *g1 = (float *)malloc(n * sizeof(float));
+    float *map = (float *)malloc(n * (size_t)64 * sizeof(float));
+    float *cz = (float *)malloc((size_t)SOLAR_CROP * SOLAR_CROP * sizeof(float));
+    static float cb[2][SOLAR_CROP * SOLAR_CROP], cg[2][SOLAR_CROP * SOLAR_CROP];
+    double t_fast = 1e30, t_map = 1e30, t, t_or, t_cf, sum_g = 0.0, sum_b = 0.0, mean = 0.0;
+    int rep, x, y, nb = 0;
+    if (!b1 || !g1 || !map || !cz) {
+        printf("  %s: out of memory\n", s->name);
+        free(b1); free(g1); free(map); free(cz);
+        return;
+    }
+    g.z = z; g.width = w; g.height = h; g.stride = w; g.cell_size = s->cell;
+    in.latitude_rad = s->lat * SOLAR_DEG;
+    in.longitude_rad = s->lon * SOLAR_DEG;
+    in.utc_offset_hours = s->lon / 15.0 > 0 ? 1.0 : -7.0;
+    in.days = s->days;
+    for (rep = 0; rep < (quick ? 1 : 2); rep++) { /* the minimum of the runs: a shared machine */
+        if (!solar_run(&g, &in, &o, 0, b1, g1, &t)) { printf("  %s: failed\n", s->name); break; }
+        if (t < t_fast) t_fast = t;
+        sw.rays = HFVIS_RAYS_EXACT;
+        t = bench_now();
+        hfvis_horizon_map(&g, 64, &sw, map);
+        t = bench_now() - t;
+        if (t < t_map) t_map = t;
+    }
+    for (i = 0; i < n; i++) mean += (double)g1[i];
+    printf("  %-34s %4d x %-4d %3d day(s): %7.2f s (horizon map K = 64: %.2f s), %.2f us/receiver, "
+           "mean global %.0f Wh/m^2\n", s->name, w, h, s->days, t_fast, t_map, t_fast * 1e6 / (double)n,
+           mean / (double)n);
+    /* fast and oracle on the central crop */
+    for (y = 0; y < SOLAR_CROP; y++)
+        for (x = 0; x < SOLAR_CROP; x++)
+            cz[y * SOLAR_CROP + x] = z[(size_t)(h / 2 - SOLAR_CROP / 2 + y) * (size_t)w + (size_t)(w / 2 - SOLAR_CROP / 2 + x)];
+    g.z = cz; g.width = g.height = SOLAR_CROP; g.stride = SOLAR_CROP;
+    in.days = 1;
+    if (!solar_run(&g, &in, &o, 0, cb[0], cg[0], &t_cf) || !solar_run(&g, &in, &o, 1, cb[1], cg[1], &t_or)) {
+        printf("  %s crop: failed\n", s->name);
+    } else {
+        for (i = 0; i < (size_t)SOLAR_CROP * SOLAR_CROP; i++) {
+            sum_g += fabs((double)cg[0][i] - (double)cg[1][i]) / ((double)cg[1][i] > 1.0 ? (double)cg[1][i] : 1.0);
+            if (cb[1][i] > 1.0f) {
+                sum_b += fabs((double)cb[0][i] - (double)cb[1][i]) / (double)cb[1][i];
+                nb++;
+            }
+        }
+        printf("  %-34s crop %d^2, 1 day: fast %.3f s, oracle %.2f s (%.0fx); mean |fast - oracle| / oracle: "
+               "global %.4f %%, beam %.4f %%\n", s->name, SOLAR_CROP, t_cf, t_or, t_or / t_cf,
+               100.0 * sum_g / (double)(SOLAR_CROP * SOLAR_CROP), nb ? 100.0 * sum_b / nb : 0.0);
+    }
+    free(b1); free(g1); free(map); free(cz);
+}
+
+void bench_solar(int quick)
+{
+    static const solar_site sites[2] = {
+        {"colorado_srtm_512_90m.pfm", "Colorado SRTM (90 m), day 172", 90.0, 40.24, -105.53, 1},
+        {"slovenia_lidar_1000_1m.pfm", "Slovenia lidar DTM (1 m), day 172", 1.0, 46.47, 15.83, 1},
+    };
+    const char *dir = getenv("HFVIS_BENCH_DEMS");
+    int k, ran = 0;
+    printf("\nSolar irradiation (hfvis_solar_irradiation, SPA sun, 15-minute steps, K = 64 exact horizon map;\n"
+           "one thread; times are the minimum of %d runs):\n", quick ? 1 : 2);
+    for (k = 0; dir && *dir && k < 2; k++) {
+        char path[4096];
+        float *z = NULL;
+        hfvis_image_info info;
+        snprintf(path, sizeof path, "%s/%s", dir, sites[k].file);
+        if (hfvis_image_load(path, NULL, &z, &info) != HFVIS_OK) {
+            printf("  %s: cannot load\n", path);
+            continue;
+        }
+        solar_dem(&sites[k], z, info.width, info.height, quick);
+        hfvis_free(NULL, z);
+        ran++;
+    }
+    if (!ran) {
+        static const solar_site fbm = {"", "fBm 512^2 (90 m cells), day 172", 90.0, 40.24, -105.53, 1};
+        hfvis_field f;
+        float *z = (float *)malloc((size_t)512 * 512 * sizeof(float));
+        if (!z) return;
+        memset(&f, 0, sizeof f);
+        f.kind = HFVIS_FIELD_FBM;
+        f.amplitude = 1500.0;
+        f.wavelength = 200.0;
+        f.seed = 5;
+        hfvis_field_generate(&f, 512, 512, 512, z);
+        printf("  (HFVIS_BENCH_DEMS unset: a synthetic field)\n");
+        solar_dem(&fbm, z, 512, 512, quick);
+        free(z);
+    }
+}

@@ -1,0 +1,333 @@
+/* solar.c - `hfvis solar`: clear-sky irradiation (or irradiance) over the exact horizons
+ * (hfvis_solar_irradiation; docs/solar.md): the dates and times, the Linke and albedo inputs, the
+ * site from the raster's Transverse Mercator CRS (UTM and others, by the inverse projection) or
+ * --latitude/--longitude, and the extra outputs. May call: progress.c, flags.c (numbers),
+ * sweeps.c (cli_load_map), write.c (cli_save). */
+
+#define CLI_SOLAR_MAX_DAYS 36600 /* hfvis_solar_irradiation's limit: a century */
+
+/* "YYYY-MM-DD" into y, m, d (the library checks that the date exists). */
+static int cli_solar_date(const char *f, const char *v, int *y, int *m, int *d)
+{
+    char tail;
+    if (sscanf(v, "%d-%d-%d%c", y, m, d, &tail) != 3)
+        return cli_error(CLI_EXIT_USAGE, f, "expected a date YYYY-MM-DD, got '%s'", v);
+    return 0;
+}
+
+/* Days from 0000-03-01 of a proleptic Gregorian date (for --start/--end differences). */
+static long cli_solar_day_number(int y, int m, int d)
+{
+    long yy = (long)y - (m < 3), era = (yy >= 0 ? yy : yy - 399) / 400, yoe = yy - era * 400;
+    long doy = (153L * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1, doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+    return era * 146097 + doe;
+}
+
+static int cli_set_solar(cli_args *a, const char *f, const char *v)
+{
+    if (!strcmp(f, "--day") || !strcmp(f, "--start"))
+        return cli_solar_date(f, v, &a->sol_y, &a->sol_m, &a->sol_d) ? CLI_EXIT_USAGE : (a->sol_has_start = 1, 0);
+    if (!strcmp(f, "--end"))
+        return cli_solar_date(f, v, &a->sol_ey, &a->sol_em, &a->sol_ed) ? CLI_EXIT_USAGE : (a->sol_has_end = 1, 0);
+    if (!strcmp(f, "--time")) { /* HH:MM */
+        int hh, mm;
+        char tail;
+        if (sscanf(v, "%d:%d%c", &hh, &mm, &tail) != 2 || hh < 0 || hh > 24 || mm < 0 || mm > 59 ||
+            (hh == 24 && mm != 0))
+            return cli_error(CLI_EXIT_USAGE, f, "expected HH:MM (00:00-24:00), got '%s'", v);
+        a->sol_instant = 1;
+        a->sol_hour = hh + mm / 60.0;
+        return 0;
+    }
+    if (!strcmp(f, "--step")) { /* 15m, 1h, 0.5h; a bare number is minutes */
+        char buf[64];
+        size_t n = strlen(v);
+        double s, scale = 1.0 / 60.0;
+        if (n == 0 || n >= sizeof buf) return cli_error(CLI_EXIT_USAGE, f, "expected a step like 15m or 1h, got '%s'", v);
+        memcpy(buf, v, n + 1);
+        if (buf[n - 1] == 'm' || buf[n - 1] == 'h') scale = buf[n - 1] == 'h' ? 1.0 : 1.0 / 60.0, buf[n - 1] = '\0';
+        if (!cli_parse_real(buf, &s) || !(s > 0.0) || s * scale > 24.0)
+            return cli_error(CLI_EXIT_USAGE, f, "expected a step in (0, 24h] like 15m or 1h, got '%s'", v);
+        a->sol_step = s * scale;
+        return 0;
+    }
+    if (!strcmp(f, "--linke"))
+        return cli_real(f, v, 0.0, 1, 10.0, "a Linke turbidity factor in (0, 10]", &a->sol_linke) ? CLI_EXIT_USAGE
+                                                                                          : (a->sol_has_linke = 1, 0);
+    if (!strcmp(f, "--linke-monthly")) { /* 12 values, January first */
+        const char *p = v;
+        int k;
+        for (k = 0; k < 12; k++) {
+            char buf[64];
+            size_t n = strcspn(p, ",");
+            if (n == 0 || n >= sizeof buf) break;
+            memcpy(buf, p, n);
+            buf[n] = '\0';
+            if (!cli_parse_real(buf, &a->sol_linke_monthly[k]) || !(a->sol_linke_monthly[k] > 0.0) ||
+                a->sol_linke_monthly[k] > 10.0)
+                break;
+            p += n;
+            if (k < 11) {
+                if (*p != ',') break;
+                p++;
+            }
+        }
+        if (k < 12 || *p != '\0')
+            return cli_error(CLI_EXIT_USAGE, f, "expected 12 Linke factors in (0, 10], January first, "
+                             "separated by commas, got '%s'", v);
+        a->sol_has_linke_monthly = 1;
+        return 0;
+    }
+    if (!strcmp(f, "--linke-map")) { a->sol_linke_map = v; return 0; }
+    if (!strcmp(f, "--latitude"))
+        return cli_real(f, v, -90.0, 0, 90.0, "a latitude in degrees, -90..90", &a->sol_lat) ? CLI_EXIT_USAGE
+                                                                                        : (a->sol_has_lat = 1, 0);
+    if (!strcmp(f, "--longitude"))
+        return cli_real(f, v, -180.0, 0, 180.0, "a longitude in degrees, -180..180 (east positive)", &a->sol_lon)
+                   ? CLI_EXIT_USAGE : (a->sol_has_lon = 1, 0);
+    if (!strcmp(f, "--utc-offset"))
+        return cli_real(f, v, -14.0, 0, 14.0, "hours east of UTC, -14..14", &a->sol_offset) ? CLI_EXIT_USAGE
+                                                                                      : (a->sol_has_offset = 1, 0);
+    if (!strcmp(f, "--solar-time")) { a->sol_solar_time = 1; return 0; }
+    if (!strcmp(f, "--bands")) {
+        if (!strcmp(v, "day")) a->sol_bands = HFVIS_SOLAR_BANDS_DAY;
+        else if (!strcmp(v, "month")) a->sol_bands = HFVIS_SOLAR_BANDS_MONTH;
+        else return cli_error(CLI_EXIT_USAGE, f, "expected day or month, got '%s'", v);
+        return 0;
+    }
+    if (!strcmp(f, "--beam") || !strcmp(f, "--diffuse") || !strcmp(f, "--reflected") || !strcmp(f, "--sun-hours")) {
+        if (!ex_rio_format_of(v) && !cli_ends_with(v, ".pfm"))
+            return cli_error(CLI_EXIT_USAGE, v, "unknown output type (use a .pfm, .tif, .asc, .bil or .flt name)");
+        if (!strcmp(f, "--beam")) a->sol_out[0] = v;
+        else if (!strcmp(f, "--diffuse")) a->sol_out[1] = v;
+        else if (!strcmp(f, "--reflected")) a->sol_out[2] = v;
+        else a->sol_out[3] = v;
+        return 0;
+    }
+    return -1;
+}
+
+/* The days of the run: 1 for --day, --start to --end both included (cli_check_solar bounds it). */
+static int cli_solar_days(const cli_args *a)
+{
+    if (!a->sol_has_end) return 1;
+    return (int)(cli_solar_day_number(a->sol_ey, a->sol_em, a->sol_ed) -
+                 cli_solar_day_number(a->sol_y, a->sol_m, a->sol_d)) + 1;
+}
+
+/* The combinations (after every flag is read): the command row's check (main.c). */
+static int cli_check_solar(const cli_args *a)
+{
+    if (!a->sol_has_start) return cli_error(CLI_EXIT_USAGE, "solar", "missing --day DATE or --start DATE --end DATE");
+    if (a->sol_has_end) {
+        long d = cli_solar_day_number(a->sol_ey, a->sol_em, a->sol_ed) - cli_solar_day_number(a->sol_y, a->sol_m, a->sol_d);
+        if (a->sol_instant) return cli_error(CLI_EXIT_USAGE, "--time", "is an instant: give --day, not --start/--end");
+        if (d < 0 || d >= CLI_SOLAR_MAX_DAYS)
+            return cli_error(CLI_EXIT_USAGE, "--end", "expected a date from --start to %d days after it",
+                             CLI_SOLAR_MAX_DAYS - 1);
+    }
+    if (a->sol_solar_time && a->sol_has_offset)
+        return cli_error(CLI_EXIT_USAGE, "--solar-time", "times are local solar time: no --utc-offset");
+    if (a->has_albedo && !(a->albedo >= 0.0 && a->albedo <= 1.0))
+        return cli_error(CLI_EXIT_USAGE, "--albedo", "expected an albedo in [0, 1], got %g", a->albedo);
+    if (a->sol_has_lat != a->sol_has_lon)
+        return cli_error(CLI_EXIT_USAGE, a->sol_has_lat ? "--latitude" : "--longitude",
+                         "give both --latitude and --longitude");
+    if (a->out_pgm || a->out_partial)
+        return cli_error(CLI_EXIT_USAGE, a->out, "solar writes .pfm, .tif, .asc, .bil or .flt");
+    { /* dates that exist (the library's calendar) */
+        hfvis_solar_input in = hfvis_solar_input_default();
+        in.year = a->sol_y, in.month = a->sol_m, in.day = a->sol_d;
+        if (hfvis_solar_band_count(&in, NULL) < 0)
+            return cli_error(CLI_EXIT_USAGE, a->sol_has_end ? "--start" : "--day", "%04d-%02d-%02d is not "
+                             "a date of the calendar", a->sol_y, a->sol_m, a->sol_d);
+        in.year = a->sol_ey, in.month = a->sol_em, in.day = a->sol_ed;
+        if (a->sol_has_end && hfvis_solar_band_count(&in, NULL) < 0)
+            return cli_error(CLI_EXIT_USAGE, "--end", "%04d-%02d-%02d is not a date of the calendar",
+                             a->sol_ey, a->sol_em, a->sol_ed);
+    }
+    return 0;
+}
+
+/* Transverse Mercator, inverse (Snyder 1987, USGS PP 1395, Eq. 8-12 and 3-21, 7-19 ... 7-26 for
+ * the ellipsoid): map (x, y) in metres to latitude and longitude in degrees. */
+typedef struct cli_tm { double a, f, k0, lon0, lat0, x0, y0; } cli_tm;
+
+static double cli_tm_meridian(double a, double e2, double phi)
+{
+    double e4 = e2 * e2, e6 = e4 * e2;
+    return a * ((1.0 - e2 / 4.0 - 3.0 * e4 / 64.0 - 5.0 * e6 / 256.0) * phi -
+                (3.0 * e2 / 8.0 + 3.0 * e4 / 32.0 + 45.0 * e6 / 1024.0) * sin(2.0 * phi) +
+                (15.0 * e4 / 256.0 + 45.0 * e6 / 1024.0) * sin(4.0 * phi) - (35.0 * e6 / 3072.0) * sin(6.0 * phi));
+}
+
+static void cli_tm_inverse(const cli_tm *t, double x, double y, double *lat, double *lon)
+{
+    double e2 = t->f * (2.0 - t->f), ep2 = e2 / (1.0 - e2), r = CLI_PI / 180.0;
+    double M = cli_tm_meridian(t->a, e2, t->lat0 * r) + (y - t->y0) / t->k0;
+    double mu = M / (t->a * (1.0 - e2 / 4.0 - 3.0 * e2 * e2 / 64.0 - 5.0 * e2 * e2 * e2 / 256.0));
+    double e1 = (1.0 - sqrt(1.0 - e2)) / (1.0 + sqrt(1.0 - e2));
+    double p1 = mu + (1.5 * e1 - 27.0 * e1 * e1 * e1 / 32.0) * sin(2.0 * mu) +
+                (21.0 * e1 * e1 / 16.0 - 55.0 * e1 * e1 * e1 * e1 / 32.0) * sin(4.0 * mu) +
+                (151.0 * e1 * e1 * e1 / 96.0) * sin(6.0 * mu) + (1097.0 * e1 * e1 * e1 * e1 / 512.0) * sin(8.0 * mu);
+    double c1 = ep2 * cos(p1) * cos(p1), t1 = tan(p1) * tan(p1), s = sin(p1);
+    double n1 = t->a / sqrt(1.0 - e2 * s * s), r1 = t->a * (1.0 - e2) / pow(1.0 - e2 * s * s, 1.5);
+    double D = (x - t->x0) / (n1 * t->k0), D2 = D * D;
+    *lat = (p1 - (n1 * tan(p1) / r1) *
+                     (D2 / 2.0 - (5.0 + 3.0 * t1 + 10.0 * c1 - 4.0 * c1 * c1 - 9.0 * ep2) * D2 * D2 / 24.0 +
+                      (61.0 + 90.0 * t1 + 298.0 * c1 + 45.0 * t1 * t1 - 252.0 * ep2 - 3.0 * c1 * c1) * D2 * D2 * D2 / 720.0)) / r;
+    *lon = t->lon0 + (D - (1.0 + 2.0 * t1 + c1) * D2 * D / 6.0 +
+                      (5.0 - 2.0 * c1 + 28.0 * t1 - 3.0 * c1 * c1 + 8.0 * ep2 + 24.0 * t1 * t1) * D2 * D2 * D / 120.0) /
+                         cos(p1) / r;
+}
+
+/* A WKT PARAMETER["name", value] (case-insensitive name); 1 if found. */
+static int cli_wkt_param(const char *wkt, const char *name, double *v)
+{
+    const char *p = wkt;
+    size_t n = strlen(name);
+    while ((p = strstr(p, "PARAMETER[\"")) != NULL) {
+        size_t i;
+        p += 11;
+        for (i = 0; i < n && p[i] && tolower((unsigned char)p[i]) == tolower((unsigned char)name[i]); i++) {}
+        if (i == n && p[n] == '"') return sscanf(p + n + 1, " ,%lf", v) == 1;
+    }
+    return 0;
+}
+
+/* The raster's Transverse Mercator, if it has one: UTM by EPSG (WGS 84 326zz north, 327zz south;
+ * ETRS89 258zz), or a WKT (.prj, GeoTIFF citation) naming Transverse_Mercator with its
+ * parameters. */
+static int cli_solar_tm(const ex_georef *g, cli_tm *t)
+{
+    const char *wkt = g->prj ? g->prj : g->geoascii;
+    int zone = 0, south = 0;
+    t->a = 6378137.0;
+    t->f = 1.0 / 298.257223563; /* WGS 84 (GRS 80 differs by 1e-10 in f) */
+    t->lat0 = 0.0;
+    if (g->epsg > 32600 && g->epsg <= 32660) zone = g->epsg - 32600;
+    else if (g->epsg > 32700 && g->epsg <= 32760) zone = g->epsg - 32700, south = 1;
+    else if (g->epsg >= 25828 && g->epsg <= 25838) zone = g->epsg - 25800;
+    if (zone) {
+        t->k0 = 0.9996;
+        t->lon0 = -183.0 + 6.0 * zone;
+        t->x0 = 500000.0;
+        t->y0 = south ? 10000000.0 : 0.0;
+        return 1;
+    }
+    if (wkt && (strstr(wkt, "Transverse_Mercator") || strstr(wkt, "TRANSVERSE_MERCATOR") ||
+                strstr(wkt, "Transverse Mercator"))) {
+        double v;
+        const char *sp = strstr(wkt, "SPHEROID[\"");
+        t->k0 = cli_wkt_param(wkt, "scale_factor", &v) ? v : 1.0;
+        t->lon0 = cli_wkt_param(wkt, "central_meridian", &v) ? v : 0.0;
+        t->lat0 = cli_wkt_param(wkt, "latitude_of_origin", &v) ? v : 0.0;
+        t->x0 = cli_wkt_param(wkt, "false_easting", &v) ? v : 0.0;
+        t->y0 = cli_wkt_param(wkt, "false_northing", &v) ? v : 0.0;
+        if (sp && (sp = strchr(sp + 10, '"')) != NULL) {
+            double a, inv_f;
+            if (sscanf(sp + 1, " ,%lf ,%lf", &a, &inv_f) == 2 && a > 6e6 && a < 7e6 && inv_f > 250.0) {
+                t->a = a;
+                t->f = 1.0 / inv_f;
+            }
+        }
+        return 1;
+    }
+    return 0;
+}
+
+static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts)
+{
+    const int w = grid->width, h = grid->height;
+    hfvis_solar_input in = hfvis_solar_input_default();
+    hfvis_solar_options so = hfvis_solar_options_default();
+    hfvis_solar_output out;
+    float *planes[5] = { NULL, NULL, NULL, NULL, NULL }, *albedo = NULL, *linke = NULL, monthly[12];
+    const char *paths[5];
+    cli_tm tm;
+    hfvis_status s;
+    int rc = 0, bands, k, ch;
+    double lat = a->sol_lat, lon = a->sol_lon;
+    if (!a->sol_has_lat) { /* the raster's centre by its CRS */
+        double gt[6], X, Y;
+        if (!cli_geo.has_transform || !cli_solar_tm(&cli_geo, &tm))
+            return cli_error(CLI_EXIT_ERROR, "solar", "the latitude is unknown: IN has no Transverse "
+                             "Mercator CRS (UTM, EPSG 326zz/327zz/258zz, or a WKT); give --latitude "
+                             "and --longitude");
+        cli_georef(a, grid->cell_size, gt);
+        X = gt[0] + gt[1] * (w / 2.0) + gt[2] * (h / 2.0);
+        Y = gt[3] + gt[4] * (w / 2.0) + gt[5] * (h / 2.0);
+        cli_tm_inverse(&tm, X, Y, &lat, &lon);
+        if (!(fabs(lat) <= 90.0) || !(fabs(lon) <= 360.0))
+            return cli_error(CLI_EXIT_ERROR, "solar", "the raster's centre does not map to a latitude");
+        while (lon > 180.0) lon -= 360.0;
+        while (lon < -180.0) lon += 360.0;
+    }
+    if (a->progress_lines && !a->quiet)
+        fprintf(stderr, "hfvis solar: site %.5f, %.5f (latitude, longitude of the grid's centre)\n", lat, lon);
+    in.latitude_rad = lat * (CLI_PI / 180.0);
+    in.longitude_rad = lon * (CLI_PI / 180.0);
+    in.year = a->sol_y;
+    in.month = a->sol_m;
+    in.day = a->sol_d;
+    in.days = cli_solar_days(a);
+    in.instant = a->sol_instant;
+    in.hour = a->sol_hour;
+    in.utc_offset_hours = a->sol_offset;
+    if (a->sol_has_linke) in.linke = a->sol_linke;
+    in.albedo = a->has_albedo ? a->albedo : 0.2;
+    so.model = a->sol_solar_time ? HFVIS_SUN_RSUN : HFVIS_SUN_SPA;
+    if (a->sol_step > 0.0) so.step_hours = a->sol_step;
+    if (a->has_dirs) so.directions = a->dirs;
+    if (a->has_sun_radius) so.sun_radius_rad = a->sun_radius * (CLI_PI / 180.0);
+    so.bands = (hfvis_solar_bands)a->sol_bands;
+    so.sweep = opts;
+    if (a->sol_has_linke_monthly) {
+        for (k = 0; k < 12; k++) monthly[k] = (float)a->sol_linke_monthly[k];
+        so.linke_monthly = monthly;
+    }
+    if (a->albedo_map) {
+        if ((rc = cli_load_map(a->albedo_map, grid, &albedo, &ch)) != 0) return rc;
+        so.albedo_map = albedo;
+    }
+    if (a->sol_linke_map && (rc = cli_load_map(a->sol_linke_map, grid, &linke, &ch)) != 0) goto done;
+    so.linke_map = linke;
+    bands = hfvis_solar_band_count(&in, &so);
+    if (bands < 1) {
+        rc = cli_error(CLI_EXIT_ERROR, "solar", "an input is out of range (latitude %g, longitude %g)", lat, lon);
+        goto done;
+    }
+    if ((long long)bands * h > HFVIS_IMAGE_MAX_DIM) {
+        rc = cli_error(CLI_EXIT_ERROR, "--bands", "%d bands of %d rows exceed %d rows", bands, h, HFVIS_IMAGE_MAX_DIM);
+        goto done;
+    }
+    paths[0] = a->sol_out[0]; paths[1] = a->sol_out[1]; paths[2] = a->sol_out[2];
+    paths[3] = a->out; paths[4] = a->sol_out[3];
+    for (k = 0; k < 5; k++)
+        if (paths[k] && !(planes[k] = cli_alloc((size_t)w * (size_t)h, (size_t)bands, 1))) {
+            rc = cli_status("solar", HFVIS_ERR_OUT_OF_MEMORY, 0);
+            goto done;
+        }
+    out.beam = planes[0]; out.diffuse = planes[1]; out.reflected = planes[2];
+    out.global = planes[3]; out.sun_hours = planes[4];
+    s = hfvis_solar_irradiation(grid, &in, &so, &out);
+    if (s == HFVIS_ERR_INVALID_ARGUMENT && (a->sol_linke_map || a->albedo_map)) {
+        rc = cli_error(CLI_EXIT_ERROR, a->sol_linke_map ? a->sol_linke_map : a->albedo_map,
+                       "a value out of range (Linke (0, 10], albedo [0, 1])");
+        goto done;
+    }
+    if (s != HFVIS_OK) { rc = cli_status("solar", s, 0); goto done; }
+    for (k = 0; k < 5 && rc == 0; k++) {
+        cli_args b = *a;
+        if (!paths[k]) continue;
+        b.out = paths[k];
+        b.out_pgm = 0;
+        b.out_raster = ex_rio_format_of(paths[k]) != 0;
+        rc = cli_save(&b, cli_output_of(planes[k], w, h, bands, 1, 0.0, 1.0));
+    }
+done:
+    for (k = 0; k < 5; k++) free(planes[k]);
+    hfvis_free(NULL, albedo);
+    hfvis_free(NULL, linke);
+    return rc;
+}
