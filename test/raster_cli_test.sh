@@ -106,6 +106,24 @@ if command -v gdalinfo > /dev/null 2>&1; then
     || bad "south-up GeoTIFF as GDAL sees it: $(gdalinfo "$dir/su.tif" | grep -E 'Origin|Pixel Size')"
 else echo "SKIP gdalinfo not found (south-up GeoTIFF check)"; fi
 
+# ---- horizon azimuths: the directions actually used, in file names and band descriptions ------
+# exact rays at K = 24 use the rational direction (4, 1) for the nominal 15 deg: 14.036 deg
+run "horizon --exact --split" horizon "$dir/dem.asc" --dirs 24 --exact --split -o "$dir/hx.flt" \
+  && [ -f "$dir/hx_014_036.flt" ] && [ ! -f "$dir/hx_015.flt" ] && [ -f "$dir/hx_045.flt" ] \
+  && ok "exact --split names each file by the azimuth used (hx_014_036, not hx_015)" \
+  || bad "exact split names: $(ls "$dir"/hx_0* 2>/dev/null | head -3 | tr '\n' ' ')"
+run "horizon lattice --split" horizon "$dir/dem.asc" --dirs 24 --split -o "$dir/hl.flt" \
+  && [ -f "$dir/hl_015.flt" ] && ok "lattice --split keeps the nominal azimuths (hl_015)" || bad "lattice split names"
+run "horizon --exact tif" horizon "$dir/dem.asc" --dirs 24 --exact -o "$dir/hx.tif"
+if command -v gdalinfo > /dev/null 2>&1; then
+  info=$(gdalinfo "$dir/hx.tif")
+  echo "$info" | grep -q 'Description = azimuth 14.036 deg compass' && echo "$info" | grep -q 'AZIMUTH=14.036243' \
+    && echo "$info" | grep -q 'CONVENTION=compass' && echo "$info" | grep -q 'RAYS=exact' \
+    && [ "$(echo "$info" | grep -c 'Description = azimuth')" = 24 ] \
+    && ok "GDAL: a horizon GeoTIFF names each band's azimuth (24 bands), the convention and the rays" \
+    || bad "horizon band descriptions as GDAL sees them: $(echo "$info" | grep -m 3 -E 'Description|AZIMUTH')"
+else echo "SKIP gdalinfo not found (horizon band descriptions)"; fi
+
 # ---- notes on stderr ------------------------------------------------------------------------
 run "pgm without --cell" skyview "$dir/dem.pgm" --dirs 4 -o "$dir/n.flt" && grep -q '^hfvis: note: .*cell size: using 1' "$dir/err" \
   && [ "$(wc -l < "$dir/err" | tr -d ' ')" = 1 ] && ok "no cell size: one note line" || bad "no-cell note: $(cat "$dir/err")"

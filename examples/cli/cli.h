@@ -212,6 +212,12 @@ typedef struct cli_output {
     const float *px;
     int w, h, planes, channels;
     double lo, hi;
+    /* GeoTIFF: each band's description (NULL or planes*channels names), the bands' unit and
+     * metadata items (GDAL_METADATA, shown by gdalinfo); NULL/0 = none */
+    const char *const *band_names;
+    const char *unit;
+    const ex_rio_meta *meta;
+    int n_meta;
 } cli_output;
 
 /* What a run is expected to cost before it allocates: bytes at its peak and units of work. */

@@ -257,7 +257,9 @@ static const char cli_help_tail[] =
     "                    --radians): the same as --dirs 1 --azimuth0 A\n" \
     "  --split           one file per direction instead of the stack (as r.horizon writes one\n" \
     "                    map per direction), named OUT's stem + \"_\" + the direction's azimuth in\n" \
-    "                    the convention in degrees: hor.pfm -> hor_000.pfm, hor_022_500.pfm (22.5)\n" \
+    "                    the convention in degrees: hor.pfm -> hor_000.pfm, hor_022_500.pfm (22.5);\n" \
+    "                    with --exact the azimuth the ray actually takes (hor_014_036 for the\n" \
+    "                    nominal 15 at K = 24). A GeoTIFF names each band's azimuth (gdalinfo)\n" \
     "Planes follow the convention: compass clockwise from azimuth0 (north by default), grass\n" \
     "counter-clockwise from azimuth0 (east by default), grid clockwise from east.\n" \
     "Default PGM range -1.5707963:1.5707963 (-90:90 with --degrees).\n"

@@ -237,14 +237,35 @@ done:
     return rc;
 }
 
+/* The azimuth in the user's convention, in degrees, of the direction that plane k holds: the one
+ * the run actually used (exact rays: the rational direction (a, b) nearest the nominal one,
+ * hfvis_sweep_azimuths), so that names and band descriptions never claim the nominal azimuth. */
+static double cli_plane_azimuth(const cli_args *a, const double *used, int k)
+{
+    const int K = a->dirs, kl = cli_lib_direction(a, k);
+    const double nominal = a->azimuth0 + 2.0 * CLI_PI * kl / K;
+    const double lib0 = a->compass ? a->azimuth0 - CLI_PI / 2.0 : a->azimuth0; /* as cli_run_heights */
+    double psi = nominal;
+    if (used) psi += used[kl] - (lib0 + 2.0 * CLI_PI * (double)kl / (double)K);
+    return cli_from_psi(a->convention, psi);
+}
+
 /* horizon, after the sweep: the planes in the user's convention's order (GRASS's run
  * counter-clockwise) and, with --split, one file per direction named OUT's stem + "_" + the
  * direction's azimuth in degrees in the convention (as r.horizon names its maps: "_045", or
- * "_022_500" for 22.5), else the stacked map. */
+ * "_022_500" for 22.5; exact rays: the azimuth actually used, e.g. "_014_036"), else the stacked
+ * map. A GeoTIFF names each band's azimuth (description "azimuth 14.036 deg compass") and carries
+ * AZIMUTH per band and CONVENTION, UNIT, RAYS for the dataset, as gdalinfo shows them. */
 static int cli_horizon_finish(const cli_args *a, float *map, int w, int h, double lo, double hi)
 {
     const size_t n = (size_t)w * (size_t)h;
     const int K = a->dirs;
+    const char *unit = a->degrees ? "degree" : "radian";
+    char (*names)[64] = NULL, (*values)[32] = NULL;
+    const char **band = NULL;
+    ex_rio_meta *meta = NULL;
+    double *used = NULL;
+    cli_output out;
     int k, rc = 0;
     if (a->convention == CONV_GRASS && K > 2) { /* plane k <- library plane (K - k) % K, in place */
         float *tmp = cli_alloc(n, 1, 1);
@@ -256,13 +277,45 @@ static int cli_horizon_finish(const cli_args *a, float *map, int w, int h, doubl
         }
         free(tmp);
     }
-    if (!a->split) return cli_save(a, cli_output_of(map, w, h, K, 1, lo, hi));
+    names = (char (*)[64])malloc((size_t)K * sizeof *names);
+    values = (char (*)[32])malloc((size_t)K * sizeof *values);
+    band = (const char **)malloc((size_t)K * sizeof *band);
+    meta = (ex_rio_meta *)malloc(((size_t)K + 3) * sizeof *meta);
+    if (a->exact) used = (double *)malloc((size_t)K * sizeof *used);
+    if (!names || !values || !band || !meta || (a->exact && !used)) {
+        rc = cli_status("horizon", HFVIS_ERR_OUT_OF_MEMORY, 0);
+        goto done;
+    }
+    if (used) {
+        hfvis_sweep_options o = hfvis_sweep_options_default();
+        o.rays = HFVIS_RAYS_EXACT;
+        o.azimuth0_rad = a->compass ? a->azimuth0 - CLI_PI / 2.0 : a->azimuth0;
+        if (hfvis_sweep_azimuths(K, &o, used, NULL) != HFVIS_OK) {
+            rc = cli_error(CLI_EXIT_ERROR, "horizon", "internal error: the exact azimuths");
+            goto done;
+        }
+    }
+    meta[0].name = "CONVENTION", meta[0].value = cli_conv_names[a->convention], meta[0].band = 0;
+    meta[1].name = "UNIT", meta[1].value = unit, meta[1].band = 0;
+    meta[2].name = "RAYS", meta[2].value = a->exact ? "exact" : "lattice", meta[2].band = 0;
+    for (k = 0; k < K; k++) {
+        const double deg = cli_plane_azimuth(a, used, k);
+        snprintf(names[k], sizeof names[k], "azimuth %.3f deg %s", deg, cli_conv_names[a->convention]);
+        snprintf(values[k], sizeof values[k], "%.6f", deg);
+        band[k] = names[k];
+        meta[3 + k].name = "AZIMUTH", meta[3 + k].value = values[k], meta[3 + k].band = k + 1;
+    }
+    if (!a->split) {
+        out = cli_output_of(map, w, h, K, 1, lo, hi);
+        out.band_names = band, out.unit = unit, out.meta = meta, out.n_meta = K + 3;
+        rc = cli_save(a, out);
+        goto done;
+    }
     for (k = 0; k < K && rc == 0; k++) {
         cli_args one = *a;
         char name[4096];
         const char *dot = strrchr(a->out, '.');
-        const double psi = a->azimuth0 + 2.0 * CLI_PI * cli_lib_direction(a, k) / K;
-        double deg = cli_from_psi(a->convention, psi);
+        double deg = cli_plane_azimuth(a, used, k);
         long whole = (long)floor(deg), milli = (long)floor((deg - (double)whole) * 1000.0 + 0.5);
         size_t stem = dot ? (size_t)(dot - a->out) : strlen(a->out);
         int len;
@@ -272,11 +325,28 @@ static int cli_horizon_finish(const cli_args *a, float *map, int w, int h, doubl
         else
             len = snprintf(name, sizeof name, "%.*s_%03ld_%03ld%s", (int)stem, a->out, whole, milli,
                            a->out + stem);
-        if (len < 0 || (size_t)len >= sizeof name) return cli_error(CLI_EXIT_ERROR, a->out, "name too long");
-        if ((rc = cli_refuse_inputs(a, name)) != 0) return rc;
+        if (len < 0 || (size_t)len >= sizeof name) {
+            rc = cli_error(CLI_EXIT_ERROR, a->out, "name too long");
+            break;
+        }
+        if ((rc = cli_refuse_inputs(a, name)) != 0) break;
         one.out = name;
-        rc = cli_save(&one, cli_output_of(map + (size_t)k * n, w, h, 1, 1, lo, hi));
+        {
+            ex_rio_meta m[4]; /* the dataset's items and this direction's AZIMUTH, on band 1 */
+            memcpy(m, meta, 4 * sizeof *m);
+            m[3] = meta[3 + k];
+            m[3].band = 1;
+            out = cli_output_of(map + (size_t)k * n, w, h, 1, 1, lo, hi);
+            out.band_names = band + k, out.unit = unit, out.meta = m, out.n_meta = 4;
+            rc = cli_save(&one, out);
+        }
     }
+done:
+    free(used);
+    free(meta);
+    free(band);
+    free(values);
+    free(names);
     return rc;
 }
 

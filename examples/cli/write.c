@@ -146,6 +146,7 @@ static cli_output cli_output_of(const float *px, int w, int h, int planes, int c
                                 double hi)
 {
     cli_output o;
+    memset(&o, 0, sizeof o);
     o.px = px, o.w = w, o.h = h, o.planes = planes, o.channels = channels, o.lo = lo, o.hi = hi;
     return o;
 }
@@ -196,6 +197,10 @@ static int cli_save(const cli_args *a, cli_output out)
                     strcpy(g.nodata_text, "nan");
                     break;
                 }
+        o.band_names = out.band_names;
+        o.unit = out.unit;
+        o.meta = out.meta;
+        o.n_meta = out.n_meta;
         if (ex_rio_write(a->out, &img, &g, &o, why) != 0) return cli_error(CLI_EXIT_ERROR, a->out, "%s", why);
         if (ex_rio_format_of(a->out) != EX_RIO_TIFF && ex_rio_crs_lost(&g) && !a->quiet)
             fprintf(stderr, "hfvis: note: %s has no .prj: the input's CRS EPSG:%d has no WKT here (write .tif "
