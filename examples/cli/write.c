@@ -250,7 +250,7 @@ static int cli_same_file(const char *x, const char *y)
 static int cli_refuse_input(int overwrite, const char *out, const char *const *inputs, int n)
 {
     int i;
-    for (i = 0; i < n && !overwrite; i++)
+    for (i = 0; i < n && !overwrite && out; i++) /* out: NULL for a command that writes none */
         if (inputs[i] && cli_same_file(out, inputs[i]))
             return cli_error(CLI_EXIT_ERROR, out, "is the input %s: refusing to replace an input "
                              "(give --overwrite to do so)", inputs[i]);
