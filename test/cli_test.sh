@@ -990,13 +990,16 @@ else bad "hillshade/shadow --exact did not run"; fi
 # and a refusal of the value is one line naming the flag. Every flag of the table in docs/cli.md.
 "$hfvis" --list-flags > "$dir/flags" && "$hfvis" --list-commands > "$dir/commands" &&
   [ -s "$dir/flags" ] && [ -s "$dir/commands" ] && ok "--list-flags, --list-commands" || bad "--list-flags, --list-commands"
+awk -F'	' 'NF != 7 || $4 !~ /^(-|int|real|text|choice|list|date|bytes)$/ { bad = 1 }
+  END { exit bad }' "$dir/flags" &&
+  ok "--list-flags: NAME VALUE COMMANDS TYPE RANGE DEFAULT UNIT" || bad "--list-flags columns"
 [ "$(wc -l < "$dir/commands" | tr -d ' ')" = "$("$hfvis" --help | sed -n '/^commands:/,/^$/p' | grep -c '^  [a-z]')" ] &&
   ok "--list-commands: the commands of --help" || bad "--list-commands differs from --help"
 walk_bad=0; walk_n=0
 walk_fail() { walk_bad=$((walk_bad + 1)); echo "FAIL cli walk: $1"; }
 while read -r c; do # one run per pair, no other process: the walk is ~2,000 runs
   used=" $("$hfvis" --list-flags "$c" | cut -f1 | tr '\n' ' ') "
-  while IFS='	' read -r f v cmds; do
+  while IFS='	' read -r f v cmds _columns; do
     walk_n=$((walk_n + 1))
     if [ "$v" = - ]; then err=$("$hfvis" "$c" "$f" 2>&1 > /dev/null); rc=$?
     else err=$("$hfvis" "$c" "$f" @bad 2>&1 > /dev/null); rc=$?; fi

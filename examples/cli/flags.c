@@ -1,7 +1,8 @@
-/* flags.c - the command line: the table of flags (name, value, the commands that take it), the
- * parsing primitives (cli_real, cli_int) and cli_parse, which applies each flag and checks the
- * combinations. Owns: cli_args' contents. May call: progress.c (errors), gis.c (GIS flags), the
- * command families' flag setters and checks (sweeps.c, screen.c, meshes.c). */
+/* flags.c - the command line: the table of flags (name, value, the commands that take it, type,
+ * range, default, unit), the parsing primitives (cli_real, cli_int, cli_set_number) and cli_parse,
+ * which applies each flag and checks the combinations. Owns: cli_args' contents. May call:
+ * progress.c (errors), gis.c (GIS flags), the command families' flag setters and checks (sweeps.c,
+ * screen.c, meshes.c). */
 
 /* A finite number with nothing else in s (no leading space, no trailing characters). */
 static int cli_parse_real(const char *s, double *out)
@@ -51,17 +52,50 @@ static int cli_ends_with(const char *s, const char *ext)
     return 1;
 }
 
+/* What a flag's value is: the type column of `hfvis --list-flags`. */
+enum {
+    CLI_V_NONE,   /* a switch: no value */
+    CLI_V_INT,    /* an integer */
+    CLI_V_REAL,   /* a finite number */
+    CLI_V_TEXT,   /* a file name or a specification read by its command */
+    CLI_V_CHOICE, /* one of a few words */
+    CLI_V_LIST,   /* numbers joined by ',', ':' or 'x' (pairs, points, windows, sizes) */
+    CLI_V_DATE,   /* a date or a time of day */
+    CLI_V_BYTES   /* a size in bytes with an optional K, M, G or T */
+};
+static const char *const cli_kind_names[] = {"-", "int", "real", "text", "choice", "list", "date",
+                                             "bytes"};
+
 /* The flags: name, value (its placeholder in the help; NULL: the flag takes none), the commands
- * that use it, and for the shared options their --help entry (the others are described in their
- * commands' help). A command refuses by name every flag whose row does not list it; `hfvis
- * --list-flags [CMD]` prints this table, test/cli_test.sh walks it. */
+ * that use it, its value's type, range, default and unit, and for the shared options their --help
+ * entry (the others are described in their commands' help). A command refuses by name every flag
+ * whose row does not list it; `hfvis --list-flags [CMD]` prints this table, test/cli_test.sh walks
+ * it. A numeric row with a field ("at") is parsed from the row alone by cli_set_number: the value
+ * must lie in [lo, hi] (lo excluded when lo_open), else the refusal names the flag and says
+ * "expected <rule>"; the others (at 0) are parsed by hand-written setters, because their syntax is
+ * special or the field they set depends on the command. */
 typedef struct cli_flag {
     const char *name, *value;
     unsigned long commands; /* CLI_ONLY(CMD_...) bits */
+    int kind;               /* CLI_V_... */
+    double lo, hi;          /* CLI_V_INT, CLI_V_REAL rows with a field: the accepted range */
+    int lo_open;            /* lo itself refused */
+    const char *rule;       /* the range in words, for the refusal: "expected <rule>, got '<v>'" */
+    const char *def, *unit; /* the default and the unit, in words (NULL: none) */
+    size_t at, has;         /* offsetof the cli_args field it sets (int or double by kind; 0: a
+                               hand-written setter), and of its has_ field (0: none) */
     const char *help;
 } cli_flag;
+#define CLI_HAS(field) offsetof(cli_args, field)
+#define CLI_SWITCH CLI_V_NONE, 0.0, 0.0, 0, NULL, "off", NULL, 0, 0
+#define CLI_TYPED(kind) kind, 0.0, 0.0, 0, NULL, NULL, NULL, 0, 0
+#define CLI_INT_AT(lo, hi, rule, def, unit, field, has) \
+    CLI_V_INT, lo, hi, 0, rule, def, unit, offsetof(cli_args, field), has
+#define CLI_REAL_AT(lo, lo_open, hi, rule, def, unit, field, has) \
+    CLI_V_REAL, lo, hi, lo_open, rule, def, unit, offsetof(cli_args, field), has
 static const cli_flag cli_flags[] = {
     { "-o", "OUT", CLI_OUT,
+      CLI_TYPED(CLI_V_TEXT),
       "output file, required: *.pfm writes PFM floats, *.pgm a 16-bit PGM;\n"
       "                    a PGM of a 3-channel result stacks the channels as planes, top to bottom;\n"
       "                    PGM code 0 is NoData and LO..HI map to 1..65535, recorded in the header\n"
@@ -71,35 +105,50 @@ static const cli_flag cli_flags[] = {
       "                    *.bil/*.flt raw floats + .hdr: these carry IN's georeference and NoData\n"
       "                    (planes and channels become bands)\n" },
     { "--band", "N", CLI_HF,
+      CLI_INT_AT(1, EX_RIO_MAX_BANDS, "a band number 1..65535", "1", NULL, band, 0),
       "IN is a multi-band raster: use band N (1-based, default 1)\n" },
     { "--range", "LO:HI", CLI_PGM,
+      CLI_TYPED(CLI_V_LIST),
       ".pgm only: the values mapped to 0 and 65535 (default per command)\n" },
     { "--cell", "S", CLI_HF,
+      CLI_REAL_AT(0.0, 1, DBL_MAX, "a number > 0",
+                 "georef or 1", "height units", cell, CLI_HAS(has_cell)),
       "distance between samples, in height units (default: the cell size of a\n"
       "                    georeferenced IN (.tif, .asc, .bil/.flt), else 1 with a note)\n" },
     { "--zscale", "Z", CLI_HF,
+      CLI_REAL_AT(-CLI_FLT_MAX, 0, CLI_FLT_MAX, "a non-zero number", "1", NULL, zscale, 0),
       "multiply input values by Z, non-zero (default 1)\n" },
     { "--nodata", "V", CLI_HF,
+      CLI_REAL_AT(-CLI_FLT_MAX, 0, CLI_FLT_MAX, "a finite number",
+                 "none", "height units", nodata, CLI_HAS(has_nodata)),
       "input values equal to V are holes: no occlusion, output NaN (PGM code 0)\n" },
     { "--dirs", "K", CLI_DIRS | CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_SOLAR),
+      CLI_INT_AT(1, CLI_MAX_DIRS, "an integer 1..65536",
+                 "16", "directions", dirs, CLI_HAS(has_dirs)),
       "number of azimuth directions, 1..65536 (default 16)\n" },
     { "--convention", "C", CLI_ANGLES,
+      CLI_TYPED(CLI_V_CHOICE),
       "how azimuths are read and directions ordered (height-field commands):\n"
       "                    compass (default): bearings clockwise from north, direction k at\n"
       "                    azimuth0 + 360k/K; grass: counter-clockwise from east (r.horizon,\n"
       "                    r.sun), direction k at azimuth0 + 360k/K counter-clockwise; grid: the\n"
       "                    library's psi, from east toward south (x toward y; the old --math)\n" },
     { "--azimuth0", "A", CLI_DIRS,
+      CLI_TYPED(CLI_V_REAL),
       "azimuth of direction 0 in the convention (default: compass 0 = north;\n"
       "                    grass and grid 0 = east). Degrees (before 0.2: radians); see --radians\n" },
     { "--radians", NULL, CLI_ANGLES,
+      CLI_SWITCH,
       "angle flags (--azimuth0, --azimuth, --sun-*) in radians, not degrees\n" },
     { "--compass", NULL, CLI_ANGLES,
+      CLI_SWITCH,
       "the same as --convention compass (the default)\n" },
     { "--degrees", NULL, CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_OPENNESS),
+      CLI_SWITCH,
       "angle outputs in degrees instead of radians\n" },
     { "--dir-range", "A:B", CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT)
                       | CLI_ONLY(CMD_VISIBILITY),
+      CLI_TYPED(CLI_V_LIST),
       "horizon, skyview, sky, light, visibility: only the directions at\n"
       "                    positions A..B-1 of the K (0 <= A < B <= K) in sweep order (with K a\n"
       "                    multiple of 4, each 4 consecutive positions are the quarter turns\n"
@@ -108,14 +157,18 @@ static const cli_flag cli_flags[] = {
       "                    is then a partial result, and 'hfvis sum' adds the parts of a split\n"
       "                    into the single run's OUT\n" },
     { "--border", "MODE", CLI_BORDER | CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_CHOICE),
       "open (nothing outside the grid, default), clamp (edge heights extend\n"
       "                    outward) or wrap (periodic field)\n" },
     { "--border-cells", "N", CLI_BORDER | CLI_ONLY(CMD_SOLAR),
+      CLI_INT_AT(1, HFVIS_IMAGE_MAX_DIM, "an integer 1..1048576",
+                 "max(W,H)", "cells", border_cells, 0),
       "clamp/wrap: lines start N cells outside the grid, 1..1048576\n"
       "                    (default max(width, height))\n" },
     { "--exact", NULL, CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY)
                       | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_AZIMUTHS)
                       | CLI_ONLY(CMD_HILLSHADE),
+      CLI_SWITCH,
       "horizon, skyview, sky, light, shadow: exact rays (beyond [P1]): every\n"
       "                    sample gets its own ray along the nearest rational direction, no\n"
       "                    interpolation between lattice lines (right at walls, roofs, cliffs;\n"
@@ -123,6 +176,8 @@ static const cli_flag cli_flags[] = {
       "                    indirect and gi keep the lattice\n" },
     { "--max-distance", "R", CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_VISFIELD) | CLI_SWEEP | CLI_P2
                            | CLI_ONLY(CMD_SOLAR),
+      CLI_REAL_AT(0.0, 0, DBL_MAX, "a distance >= 0",
+                 "0 (unlimited)", "height units", max_distance, 0),
       "horizon, skyview, sky, shadow, light, visibility, indirect, hillshade:\n"
       "                    the search radius in height units (--cell applies): occluders farther\n"
       "                    than R along the ray are ignored (GRASS maxdistance, SAGA and RVT radius,\n"
@@ -130,6 +185,7 @@ static const cli_flag cli_flags[] = {
       "                    indirect: visible samples farther than R are not counted or gathered.\n"
       "                    viewshed: its range\n" },
     { "--window", "X0,Y0,W,H", CLI_SWEEP | CLI_ONLY(CMD_OPENNESS),
+      CLI_TYPED(CLI_V_LIST),
       "with a finite R (openness: --radius R; not visibility, indirect): only\n"
       "                    the W x H cells from\n"
       "                    column X0, row Y0 (clipped to IN), reading only them and a halo of\n"
@@ -138,118 +194,224 @@ static const cli_flag cli_flags[] = {
       "                    and georeferenced at the window, with its sidecar OUT.tile; 'hfvis\n"
       "                    mosaic' joins the pieces into the whole run's OUT (docs/tiles.md)\n" },
     { "--quiet", NULL, CLI_OUT,
+      CLI_SWITCH,
       "no progress bar (shown on stderr only when it is a terminal) and no notes\n" },
     { "--progress", NULL, CLI_RUNS,
+      CLI_SWITCH,
       "plain progress lines on stderr instead (percent, elapsed, ETA), for logs\n"
       "                    and job schedulers, and a summary line at the end (time, cells,\n"
       "                    directions); runs over 10 s end with the summary anyway (not --quiet)\n" },
     { "--overwrite", NULL, CLI_OUT,
+      CLI_SWITCH,
       "allow OUT to be one of the inputs (refused otherwise: same file,\n"
       "                    through hard and symbolic links too)\n" },
     { "--max-memory", "B", CLI_RUNS,
+      CLI_TYPED(CLI_V_BYTES),
       "refuse a run whose estimated memory exceeds B bytes (suffix K, M, G or\n"
       "                    T: powers of 1024; 0 = no limit); default half of the physical memory\n"
       "                    where the system reports it (sysconf), else no limit. The estimate and\n"
       "                    the work (lattice nodes swept, rays, voxel updates) are printed on\n"
       "                    stderr with the progress bar\n" },
     { "--threads", "N", CLI_THREADED,
+      CLI_INT_AT(1, CLI_THREADS_MAX, "an integer 1..256",
+                 "online cores", "threads", threads, CLI_HAS(has_threads)),
       "horizon, skyview, sky, light, shadow, hillshade, openness --radius: run\n"
       "                    on N threads, 1..256 (default: the online cores); the output is the\n"
       "                    one-thread run's bit for bit (directions, bands across the sun, rows)\n" },
-    { "--sky", "C", CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI), NULL },
+    { "--sky", "C", CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI),
+      CLI_REAL_AT(0.0, 0, CLI_FLT_MAX, "a radiance >= 0",
+                 "1", "radiance", sky, CLI_HAS(has_sky)), NULL },
     { "--albedo", "A", CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT)
-                     | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_SOLAR), NULL },
-    { "--sun-azimuth", "DEG", CLI_SUN, NULL },
-    { "--sun-elevation", "DEG", CLI_SUN, NULL },
-    { "--sun-radius", "DEG", CLI_SUN | CLI_ONLY(CMD_SOLAR), NULL },
-    { "--math", NULL, CLI_SUN, NULL },
-    { "--env", "ENV", CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI), NULL },
+                     | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_SOLAR),
+      CLI_REAL_AT(0.0, 0, CLI_FLT_MAX, "an albedo >= 0",
+                 "per command", NULL, albedo, CLI_HAS(has_albedo)), NULL },
+    { "--sun-azimuth", "DEG", CLI_SUN,
+      CLI_REAL_AT(-DBL_MAX, 0, DBL_MAX, "a finite angle in degrees",
+                 "per command", "degrees", sun_azimuth, CLI_HAS(has_sun_azimuth)), NULL },
+    { "--sun-elevation", "DEG", CLI_SUN,
+      CLI_REAL_AT(-90.0, 0, 90.0, "degrees in -90..90",
+                 "per command", "degrees", sun_elevation, CLI_HAS(has_sun_elevation)), NULL },
+    { "--sun-radius", "DEG", CLI_SUN | CLI_ONLY(CMD_SOLAR),
+      CLI_REAL_AT(0.0, 0, 90.0, "degrees in 0..90",
+                 "0", "degrees", sun_radius, CLI_HAS(has_sun_radius)), NULL },
+    { "--math", NULL, CLI_SUN,
+      CLI_SWITCH, NULL },
+    { "--env", "ENV", CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI),
+      CLI_TYPED(CLI_V_TEXT), NULL },
     { "--method", "M", CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_SSAO)
-                     | CLI_ONLY(CMD_MESHAO), NULL },
-    { "--sun-irradiance", "E", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI), NULL },
-    { "--albedo-map", "MAP", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_SOLAR), NULL },
-    { "--emission", "MAP", CLI_ONLY(CMD_INDIRECT), NULL },
-    { "--bounces", "B", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI), NULL },
-    { "--output", "WHAT", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VOLGI), NULL },
-    { "--fraction", NULL, CLI_ONLY(CMD_VISIBILITY), NULL },
-    { "--stats", NULL, CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_MESHAO), NULL },
-    { "--observer", "X,Y", CLI_ONLY(CMD_VIEWSHED), NULL },
-    { "--observer-height", "H", CLI_ONLY(CMD_VIEWSHED), NULL },
-    { "--target-height", "H", CLI_ONLY(CMD_VIEWSHED), NULL },
-    { "--res", "N", CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_VOLGI), NULL },
-    { "--mode", "M", CLI_ONLY(CMD_VOXELIZE), NULL },
-    { "--axis", "A", CLI_ONLY(CMD_VOXELIZE), NULL },
-    { "--max-vertices", "N", CLI_ONLY(CMD_VOXELIZE), NULL },
-    { "--padding", "P", CLI_ONLY(CMD_VOXELIZE), NULL },
-    { "--open", NULL, CLI_ONLY(CMD_VOXELIZE), NULL },
-    { "--order", "O", CLI_ONLY(CMD_GI), NULL },
-    { "--subsample", "S", CLI_ONLY(CMD_GI), NULL },
-    { "--specular", "S", CLI_ONLY(CMD_GI), NULL },
-    { "--shininess", "N", CLI_ONLY(CMD_GI), NULL },
-    { "--room", NULL, CLI_ONLY(CMD_VOLGI), NULL },
-    { "--iterations", "I", CLI_ONLY(CMD_VOLGI), NULL },
-    { "--light", "SPEC", CLI_ONLY(CMD_VOLGI), NULL },
-    { "--eye", "X,Y,Z", CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO), NULL },
+                     | CLI_ONLY(CMD_MESHAO),
+      CLI_TYPED(CLI_V_CHOICE), NULL },
+    { "--sun-irradiance", "E", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI),
+      CLI_REAL_AT(0.0, 0, CLI_FLT_MAX, "an irradiance >= 0",
+                 "pi", "irradiance", sun_irradiance, CLI_HAS(has_sun_irradiance)), NULL },
+    { "--albedo-map", "MAP", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_TEXT), NULL },
+    { "--emission", "MAP", CLI_ONLY(CMD_INDIRECT),
+      CLI_TYPED(CLI_V_TEXT), NULL },
+    { "--bounces", "B", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI),
+      CLI_INT_AT(0, CLI_MAX_BOUNCES, "an integer 0..1000",
+                 "1", "bounces", bounces, CLI_HAS(has_bounces)), NULL },
+    { "--output", "WHAT", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VOLGI),
+      CLI_TYPED(CLI_V_CHOICE), NULL },
+    { "--fraction", NULL, CLI_ONLY(CMD_VISIBILITY),
+      CLI_SWITCH, NULL },
+    { "--stats", NULL, CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_MESHAO),
+      CLI_SWITCH, NULL },
+    { "--observer", "X,Y", CLI_ONLY(CMD_VIEWSHED),
+      CLI_TYPED(CLI_V_LIST), NULL },
+    { "--observer-height", "H", CLI_ONLY(CMD_VIEWSHED),
+      CLI_REAL_AT(0.0, 0, DBL_MAX, "a height >= 0",
+                 "0", "height units", observer_height, 0), NULL },
+    { "--target-height", "H", CLI_ONLY(CMD_VIEWSHED),
+      CLI_REAL_AT(0.0, 0, DBL_MAX, "a height >= 0", "0", "height units", target_height, 0), NULL },
+    { "--res", "N", CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_VOLGI),
+      CLI_INT_AT(1, CLI_MAX_RES, "an integer 1..2048", "per command", "voxels", res, 0), NULL },
+    { "--mode", "M", CLI_ONLY(CMD_VOXELIZE),
+      CLI_TYPED(CLI_V_CHOICE), NULL },
+    { "--axis", "A", CLI_ONLY(CMD_VOXELIZE),
+      CLI_TYPED(CLI_V_CHOICE), NULL },
+    { "--max-vertices", "N", CLI_ONLY(CMD_VOXELIZE),
+      CLI_INT_AT(1, 1000000, "an integer 1..1000000",
+                 "per method", "vertices", max_vertices, 0), NULL },
+    { "--padding", "P", CLI_ONLY(CMD_VOXELIZE),
+      CLI_REAL_AT(0.0, 0, 1.0, "a fraction in 0..1", "0", NULL, padding, 0), NULL },
+    { "--open", NULL, CLI_ONLY(CMD_VOXELIZE),
+      CLI_SWITCH, NULL },
+    { "--order", "O", CLI_ONLY(CMD_GI),
+      CLI_TYPED(CLI_V_INT), NULL },
+    { "--subsample", "S", CLI_ONLY(CMD_GI),
+      CLI_TYPED(CLI_V_INT), NULL },
+    { "--specular", "S", CLI_ONLY(CMD_GI),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--shininess", "N", CLI_ONLY(CMD_GI),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--room", NULL, CLI_ONLY(CMD_VOLGI),
+      CLI_SWITCH, NULL },
+    { "--iterations", "I", CLI_ONLY(CMD_VOLGI),
+      CLI_TYPED(CLI_V_INT), NULL },
+    { "--light", "SPEC", CLI_ONLY(CMD_VOLGI),
+      CLI_TYPED(CLI_V_TEXT), NULL },
+    { "--eye", "X,Y,Z", CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO),
+      CLI_TYPED(CLI_V_LIST), NULL },
     { "--target", "POINT", CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO)
-                     | CLI_ONLY(CMD_VIEWSHED), NULL },
-    { "--up", "X,Y,Z", CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO), NULL },
-    { "--fov", "DEG", CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO), NULL },
-    { "--size", "WxH", CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_MESHAO), NULL },
-    { "--transfer", "T", CLI_ONLY(CMD_VOLGI), NULL },
-    { "--paths", "P", CLI_ONLY(CMD_VOLGI), NULL },
-    { "--reflection", "R", CLI_ONLY(CMD_VOLGI), NULL },
-    { "--reflectance", "R", CLI_ONLY(CMD_VOLGI), NULL },
-    { "--positions", "K", CLI_ONLY(CMD_VISFIELD), NULL },
-    { "--format", "F", CLI_ONLY(CMD_VISFIELD), NULL },
-    { "--mapping", "M", CLI_ONLY(CMD_VISFIELD), NULL },
-    { "--ao", NULL, CLI_ONLY(CMD_VISFIELD), NULL },
-    { "--ground", "Z", CLI_ONLY(CMD_VISFIELD), NULL },
-    { "--extent", "E", CLI_ONLY(CMD_VISFIELD), NULL },
-    { "--rays", "N", CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_MESHAO), NULL },
-    { "--bias", "B", CLI_ONLY(CMD_VISFIELD), NULL },
-    { "--reference", "MESH", CLI_ONLY(CMD_VISFIELD), NULL },
-    { "--falloff", "F", CLI_ONLY(CMD_MESHAO), NULL },
-    { "--two-sided", NULL, CLI_ONLY(CMD_MESHAO), NULL },
-    { "--lut", "T", CLI_ONLY(CMD_MESHAO), NULL },
-    { "--seed", "S", CLI_ONLY(CMD_MESHAO), NULL },
-    { "--no-jitter", NULL, CLI_ONLY(CMD_MESHAO), NULL },
-    { "--pattern", "P", CLI_ONLY(CMD_MESHAO), NULL },
-    { "--fov-y", "DEG", CLI_ONLY(CMD_SSAO), NULL },
-    { "--ortho", "SCALE", CLI_ONLY(CMD_SSAO), NULL },
-    { "--radius", "R", CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_MESHAO) | CLI_ONLY(CMD_OPENNESS), NULL },
-    { "--guard", "PIXELS", CLI_ONLY(CMD_SSAO), NULL },
-    { "--depth", "ENC", CLI_ONLY(CMD_SSAO), NULL },
-    { "--near", "N", CLI_ONLY(CMD_SSAO), NULL },
-    { "--far", "F", CLI_ONLY(CMD_SSAO), NULL },
-    { "--azimuth", "A", CLI_ONLY(CMD_HORIZON), NULL },
-    { "--split", NULL, CLI_ONLY(CMD_HORIZON), NULL },
-    { "--observer-grid", "C,R", CLI_ONLY(CMD_VIEWSHED), NULL },
-    { "--curvature", NULL, CLI_ONLY(CMD_VIEWSHED), NULL },
-    { "--refraction", "K", CLI_ONLY(CMD_VIEWSHED), NULL },
-    { "--earth-radius", "R", CLI_ONLY(CMD_VIEWSHED), NULL },
-    { "--svf", "D", CLI_ONLY(CMD_SKYVIEW), NULL },
-    { "--blend", "N", CLI_ONLY(CMD_HILLSHADE), NULL },
-    { "--no-shadows", NULL, CLI_ONLY(CMD_HILLSHADE), NULL },
-    { "--negative", NULL, CLI_ONLY(CMD_OPENNESS), NULL },
-    { "--both", NULL, CLI_ONLY(CMD_OPENNESS), NULL },
-    { "--lattice", NULL, CLI_ONLY(CMD_HILLSHADE), NULL },
-    { "--day", "DATE", CLI_ONLY(CMD_SOLAR), NULL },
-    { "--start", "DATE", CLI_ONLY(CMD_SOLAR), NULL },
-    { "--end", "DATE", CLI_ONLY(CMD_SOLAR), NULL },
-    { "--time", "HH:MM", CLI_ONLY(CMD_SOLAR), NULL },
-    { "--step", "S", CLI_ONLY(CMD_SOLAR), NULL },
-    { "--linke", "L", CLI_ONLY(CMD_SOLAR), NULL },
-    { "--linke-monthly", "L1,...,L12", CLI_ONLY(CMD_SOLAR), NULL },
-    { "--linke-map", "MAP", CLI_ONLY(CMD_SOLAR), NULL },
-    { "--latitude", "DEG", CLI_ONLY(CMD_SOLAR), NULL },
-    { "--longitude", "DEG", CLI_ONLY(CMD_SOLAR), NULL },
-    { "--utc-offset", "H", CLI_ONLY(CMD_SOLAR), NULL },
-    { "--solar-time", NULL, CLI_ONLY(CMD_SOLAR), NULL },
-    { "--bands", "day|month", CLI_ONLY(CMD_SOLAR), NULL },
-    { "--beam", "OUT", CLI_ONLY(CMD_SOLAR), NULL },
-    { "--diffuse", "OUT", CLI_ONLY(CMD_SOLAR), NULL },
-    { "--reflected", "OUT", CLI_ONLY(CMD_SOLAR), NULL },
-    { "--sun-hours", "OUT", CLI_ONLY(CMD_SOLAR), NULL },
+                     | CLI_ONLY(CMD_VIEWSHED),
+      CLI_TYPED(CLI_V_LIST), NULL },
+    { "--up", "X,Y,Z", CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO),
+      CLI_TYPED(CLI_V_LIST), NULL },
+    { "--fov", "DEG", CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--size", "WxH", CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_MESHAO),
+      CLI_TYPED(CLI_V_LIST), NULL },
+    { "--transfer", "T", CLI_ONLY(CMD_VOLGI),
+      CLI_TYPED(CLI_V_CHOICE), NULL },
+    { "--paths", "P", CLI_ONLY(CMD_VOLGI),
+      CLI_TYPED(CLI_V_CHOICE), NULL },
+    { "--reflection", "R", CLI_ONLY(CMD_VOLGI),
+      CLI_TYPED(CLI_V_CHOICE), NULL },
+    { "--reflectance", "R", CLI_ONLY(CMD_VOLGI),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--positions", "K", CLI_ONLY(CMD_VISFIELD),
+      CLI_TYPED(CLI_V_INT), NULL },
+    { "--format", "F", CLI_ONLY(CMD_VISFIELD),
+      CLI_TYPED(CLI_V_CHOICE), NULL },
+    { "--mapping", "M", CLI_ONLY(CMD_VISFIELD),
+      CLI_TYPED(CLI_V_CHOICE), NULL },
+    { "--ao", NULL, CLI_ONLY(CMD_VISFIELD),
+      CLI_SWITCH, NULL },
+    { "--ground", "Z", CLI_ONLY(CMD_VISFIELD),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--extent", "E", CLI_ONLY(CMD_VISFIELD),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--rays", "N", CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_MESHAO),
+      CLI_TYPED(CLI_V_INT), NULL },
+    { "--bias", "B", CLI_ONLY(CMD_VISFIELD),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--reference", "MESH", CLI_ONLY(CMD_VISFIELD),
+      CLI_TYPED(CLI_V_TEXT), NULL },
+    { "--falloff", "F", CLI_ONLY(CMD_MESHAO),
+      CLI_TYPED(CLI_V_CHOICE), NULL },
+    { "--two-sided", NULL, CLI_ONLY(CMD_MESHAO),
+      CLI_SWITCH, NULL },
+    { "--lut", "T", CLI_ONLY(CMD_MESHAO),
+      CLI_TYPED(CLI_V_INT), NULL },
+    { "--seed", "S", CLI_ONLY(CMD_MESHAO),
+      CLI_TYPED(CLI_V_INT), NULL },
+    { "--no-jitter", NULL, CLI_ONLY(CMD_MESHAO),
+      CLI_SWITCH, NULL },
+    { "--pattern", "P", CLI_ONLY(CMD_MESHAO),
+      CLI_TYPED(CLI_V_CHOICE), NULL },
+    { "--fov-y", "DEG", CLI_ONLY(CMD_SSAO),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--ortho", "SCALE", CLI_ONLY(CMD_SSAO),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--radius", "R", CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_MESHAO) | CLI_ONLY(CMD_OPENNESS),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--guard", "PIXELS", CLI_ONLY(CMD_SSAO),
+      CLI_TYPED(CLI_V_INT), NULL },
+    { "--depth", "ENC", CLI_ONLY(CMD_SSAO),
+      CLI_TYPED(CLI_V_CHOICE), NULL },
+    { "--near", "N", CLI_ONLY(CMD_SSAO),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--far", "F", CLI_ONLY(CMD_SSAO),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--azimuth", "A", CLI_ONLY(CMD_HORIZON),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--split", NULL, CLI_ONLY(CMD_HORIZON),
+      CLI_SWITCH, NULL },
+    { "--observer-grid", "C,R", CLI_ONLY(CMD_VIEWSHED),
+      CLI_TYPED(CLI_V_LIST), NULL },
+    { "--curvature", NULL, CLI_ONLY(CMD_VIEWSHED),
+      CLI_SWITCH, NULL },
+    { "--refraction", "K", CLI_ONLY(CMD_VIEWSHED),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--earth-radius", "R", CLI_ONLY(CMD_VIEWSHED),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--svf", "D", CLI_ONLY(CMD_SKYVIEW),
+      CLI_TYPED(CLI_V_CHOICE), NULL },
+    { "--blend", "N", CLI_ONLY(CMD_HILLSHADE),
+      CLI_TYPED(CLI_V_INT), NULL },
+    { "--no-shadows", NULL, CLI_ONLY(CMD_HILLSHADE),
+      CLI_SWITCH, NULL },
+    { "--negative", NULL, CLI_ONLY(CMD_OPENNESS),
+      CLI_SWITCH, NULL },
+    { "--both", NULL, CLI_ONLY(CMD_OPENNESS),
+      CLI_SWITCH, NULL },
+    { "--lattice", NULL, CLI_ONLY(CMD_HILLSHADE),
+      CLI_SWITCH, NULL },
+    { "--day", "DATE", CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_DATE), NULL },
+    { "--start", "DATE", CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_DATE), NULL },
+    { "--end", "DATE", CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_DATE), NULL },
+    { "--time", "HH:MM", CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_DATE), NULL },
+    { "--step", "S", CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--linke", "L", CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--linke-monthly", "L1,...,L12", CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_LIST), NULL },
+    { "--linke-map", "MAP", CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_TEXT), NULL },
+    { "--latitude", "DEG", CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--longitude", "DEG", CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--utc-offset", "H", CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--solar-time", NULL, CLI_ONLY(CMD_SOLAR),
+      CLI_SWITCH, NULL },
+    { "--bands", "day|month", CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_CHOICE), NULL },
+    { "--beam", "OUT", CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_TEXT), NULL },
+    { "--diffuse", "OUT", CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_TEXT), NULL },
+    { "--reflected", "OUT", CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_TEXT), NULL },
+    { "--sun-hours", "OUT", CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_TEXT), NULL },
 };
 #define CLI_NFLAGS (sizeof cli_flags / sizeof cli_flags[0])
 
@@ -269,6 +431,20 @@ static size_t cli_flag_of(const char *name)
     for (k = 0; k < CLI_NFLAGS; k++)
         if (!strcmp(name, cli_flags[k].name)) break;
     return k;
+}
+
+/* A numeric flag from its row (row->at != 0): v parsed as the row's kind, checked against
+ * [lo, hi] (lo excluded when lo_open), stored in the row's cli_args field and its has_ field set;
+ * returns 0 or CLI_EXIT_USAGE ("expected <rule>, got '<v>'", naming the flag). */
+static int cli_set_number(cli_args *a, const cli_flag *row, const char *v)
+{
+    char *base = (char *)a;
+    if (row->has) *(int *)(void *)(base + row->has) = 1;
+    if (row->kind == CLI_V_INT)
+        return cli_int(row->name, v, (long)row->lo, (long)row->hi, row->rule,
+                       (int *)(void *)(base + row->at));
+    return cli_real(row->name, v, row->lo, row->lo_open, row->hi, row->rule,
+                    (double *)(void *)(base + row->at));
 }
 
 /* A flag that command cmd does not take (arg: "--name" or "--name=value"): refused by name,
@@ -322,9 +498,21 @@ static int cli_list_commands(int argc)
     return fflush(stdout) == 0 && !ferror(stdout) ? 0 : cli_error(CLI_EXIT_ERROR, "stdout", "write error");
 }
 
-/* `hfvis --list-flags [COMMAND]`: one flag per line, "NAME VALUE COMMANDS" separated by tabs
- * (VALUE "-" for a flag without one, COMMANDS the commands that use it, comma-separated); with
- * COMMAND, only the flags it uses. */
+/* One end of a range in --list-flags: "inf" beyond the float range (no limit), else %g; open
+ * (lower end only): "(" or "[" before it. */
+static void cli_print_bound(double x, const char *open)
+{
+    if (open) printf("%s", open);
+    if (fabs(x) >= CLI_FLT_MAX) printf("%sinf", x < 0.0 ? "-" : "");
+    else printf("%g", x);
+}
+
+/* `hfvis --list-flags [COMMAND]`: one flag per line, "NAME VALUE COMMANDS TYPE RANGE DEFAULT
+ * UNIT" separated by tabs (VALUE "-" for a flag without one, COMMANDS the commands that use it,
+ * comma-separated; TYPE int, real, text, choice, list, date, bytes or "-" for a switch; RANGE
+ * "[LO,HI]" or "(LO,HI]" for reals, "[LO..HI]" for integers, "inf" for no limit, "-" where a
+ * hand-written setter checks the value; "-" for no default or unit); with COMMAND, only the flags
+ * it uses. */
 static int cli_list_flags(int argc, char **argv)
 {
     int cmd = -1, c;
@@ -334,11 +522,21 @@ static int cli_list_flags(int argc, char **argv)
         return cli_error(CLI_EXIT_USAGE, argv[2], "unknown command (try 'hfvis --list-commands')");
     for (k = 0; k < CLI_NFLAGS; k++) {
         const char *sep = "";
-        if (cmd >= 0 && !(cli_flags[k].commands & CLI_ONLY(cmd))) continue;
-        printf("%s\t%s\t", cli_flags[k].name, cli_flags[k].value ? cli_flags[k].value : "-");
+        const cli_flag *f = &cli_flags[k];
+        if (cmd >= 0 && !(f->commands & CLI_ONLY(cmd))) continue;
+        printf("%s\t%s\t", f->name, f->value ? f->value : "-");
         for (c = 0; c < CMD_COUNT; c++)
-            if (cli_flags[k].commands & CLI_ONLY(c)) printf("%s%s", sep, cli_commands[c].name), sep = ",";
-        printf("\n");
+            if (f->commands & CLI_ONLY(c)) printf("%s%s", sep, cli_commands[c].name), sep = ",";
+        printf("\t%s\t", cli_kind_names[f->kind]);
+        if (f->at) {
+            cli_print_bound(f->lo, f->lo_open ? "(" : "[");
+            printf("%s", f->kind == CLI_V_INT ? ".." : ",");
+            cli_print_bound(f->hi, NULL);
+            printf("]");
+        } else {
+            printf("-");
+        }
+        printf("\t%s\t%s\n", f->def ? f->def : "-", f->unit ? f->unit : "-");
     }
     return fflush(stdout) == 0 && !ferror(stdout) ? 0 : cli_error(CLI_EXIT_ERROR, "stdout", "write error");
 }
@@ -422,23 +620,16 @@ static int cli_set(cli_args *a, const char *f, const char *v)
         a->max_memory = m;
         return 0;
     }
-    if (!strcmp(f, "--cell")) {
-        a->has_cell = 1;
-        return cli_real(f, v, 0.0, 1, DBL_MAX, "a number > 0", &a->cell);
+    {
+        size_t k = cli_flag_of(f);
+        const cli_flag *row = k < CLI_NFLAGS ? &cli_flags[k] : NULL;
+        if (row && row->at) { /* a numeric flag of the table: its row says its range and field */
+            if (cli_set_number(a, row, v)) return CLI_EXIT_USAGE;
+            if (!strcmp(f, "--zscale") && (float)a->zscale == 0.0f) /* non-zero as a float too */
+                return cli_error(CLI_EXIT_USAGE, f, "expected a non-zero number, got '%s'", v);
+            return 0;
+        }
     }
-    if (!strcmp(f, "--band")) return cli_int(f, v, 1, EX_RIO_MAX_BANDS, "a band number 1..65535", &a->band);
-    if (!strcmp(f, "--zscale")) {
-        if (cli_real(f, v, -CLI_FLT_MAX, 0, CLI_FLT_MAX, "a non-zero number", &a->zscale)) return CLI_EXIT_USAGE;
-        if ((float)a->zscale == 0.0f)
-            return cli_error(CLI_EXIT_USAGE, f, "expected a non-zero number, got '%s'", v);
-        return 0;
-    }
-    if (!strcmp(f, "--nodata")) {
-        a->has_nodata = 1;
-        return cli_real(f, v, -CLI_FLT_MAX, 0, CLI_FLT_MAX, "a finite number", &a->nodata);
-    }
-    if (!strcmp(f, "--dirs")) a->has_dirs = 1;
-    if (!strcmp(f, "--dirs")) return cli_int(f, v, 1, CLI_MAX_DIRS, "an integer 1..65536", &a->dirs);
     if (!strcmp(f, "--degrees")) { a->degrees = 1; return 0; }
     if (!strcmp(f, "--quiet")) { a->quiet = 1; return 0; }
     if (!strcmp(f, "--border")) {
@@ -448,26 +639,8 @@ static int cli_set(cli_args *a, const char *f, const char *v)
         else return cli_error(CLI_EXIT_USAGE, f, "expected open, clamp or wrap, got '%s'", v);
         return 0;
     }
-    if (!strcmp(f, "--border-cells"))
-        return cli_int(f, v, 1, HFVIS_IMAGE_MAX_DIM, "an integer 1..1048576", &a->border_cells);
-    if (!strcmp(f, "--sky")) {
-        a->has_sky = 1;
-        return cli_real(f, v, 0.0, 0, CLI_FLT_MAX, "a radiance >= 0", &a->sky);
-    }
-    if (!strcmp(f, "--albedo")) {
-        a->has_albedo = 1;
-        return cli_real(f, v, 0.0, 0, CLI_FLT_MAX, "an albedo >= 0", &a->albedo);
-    }
-    if (!strcmp(f, "--sun-irradiance")) {
-        a->has_sun_irradiance = 1;
-        return cli_real(f, v, 0.0, 0, CLI_FLT_MAX, "an irradiance >= 0", &a->sun_irradiance);
-    }
     if (!strcmp(f, "--albedo-map")) { a->albedo_map = v; return 0; }
     if (!strcmp(f, "--emission")) { a->emission = v; return 0; }
-    if (!strcmp(f, "--bounces")) {
-        a->has_bounces = 1;
-        return cli_int(f, v, 0, CLI_MAX_BOUNCES, "an integer 0..1000", &a->bounces);
-    }
     if (!strcmp(f, "--output")) {
         if (!strcmp(v, "total")) a->output = OUT_TOTAL;
         else if (!strcmp(v, "direct")) a->output = OUT_DIRECT;
@@ -477,30 +650,8 @@ static int cli_set(cli_args *a, const char *f, const char *v)
     }
     if (!strcmp(f, "--fraction")) { a->fraction = 1; return 0; }
     if (!strcmp(f, "--stats")) { a->stats = 1; return 0; }
-    if (!strcmp(f, "--sun-azimuth")) {
-        a->has_sun_azimuth = 1;
-        return cli_real(f, v, -DBL_MAX, 0, DBL_MAX, "a finite angle in degrees", &a->sun_azimuth);
-    }
-    if (!strcmp(f, "--sun-elevation")) {
-        a->has_sun_elevation = 1;
-        return cli_real(f, v, -90.0, 0, 90.0, "degrees in -90..90", &a->sun_elevation);
-    }
-    if (!strcmp(f, "--sun-radius")) {
-        a->has_sun_radius = 1;
-        return cli_real(f, v, 0.0, 0, 90.0, "degrees in 0..90", &a->sun_radius);
-    }
     if (!strcmp(f, "--env")) { a->env = v; return 0; }
-    if (!strcmp(f, "--observer-height"))
-        return cli_real(f, v, 0.0, 0, DBL_MAX, "a height >= 0", &a->observer_height);
-    if (!strcmp(f, "--target-height"))
-        return cli_real(f, v, 0.0, 0, DBL_MAX, "a height >= 0", &a->target_height);
-    if (!strcmp(f, "--max-distance"))
-        return cli_real(f, v, 0.0, 0, DBL_MAX, "a distance >= 0", &a->max_distance);
     if (!strcmp(f, "--exact")) { a->exact = 1; return 0; }
-    if (!strcmp(f, "--threads")) {
-        a->has_threads = 1;
-        return cli_int(f, v, 1, CLI_THREADS_MAX, "an integer 1..256", &a->threads);
-    }
     if (!strcmp(f, "--window")) { /* X0,Y0,W,H in cells; clipped to the raster when it is read */
         long n[4];
         const char *p = v;
@@ -518,10 +669,6 @@ static int cli_set(cli_args *a, const char *f, const char *v)
         a->win_x = (int)n[0], a->win_y = (int)n[1], a->win_w = (int)n[2], a->win_h = (int)n[3];
         return 0;
     }
-    if (!strcmp(f, "--res")) return cli_int(f, v, 1, CLI_MAX_RES, "an integer 1..2048", &a->res);
-    if (!strcmp(f, "--max-vertices"))
-        return cli_int(f, v, 1, 1000000, "an integer 1..1000000", &a->max_vertices);
-    if (!strcmp(f, "--padding")) return cli_real(f, v, 0.0, 0, 1.0, "a fraction in 0..1", &a->padding);
     if (!strcmp(f, "--open")) { a->open_mesh = 1; return 0; }
     if (!strcmp(f, "--mode")) {
         if (!strcmp(v, "surface")) a->vox_mode = VOX_SURFACE;
