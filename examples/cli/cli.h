@@ -66,6 +66,17 @@ enum { OUT_TOTAL, OUT_DIRECT, OUT_INDIRECT };
 
 #define CLI_VOLGI_MAX_LIGHTS 8
 
+/* What a run reports while and after it runs: its clock, the last --progress line and the
+ * summary line's figures. main owns one per run; commands reach it through cli_args.run, the
+ * progress callbacks through cli_progress_state.run. */
+typedef struct cli_run_state {
+    double t0;        /* start of the run, cli_now() */
+    double cells;     /* grid samples of the run, for the summary line */
+    int directions;   /* directions of the run (0: none), for the summary line */
+    double line_last; /* when the last --progress line was printed */
+    int line_pct;     /* and its percentage (-1: none yet) */
+} cli_run_state;
+
 typedef struct cli_args {
     int cmd;
     int has_dir_range, dir_begin, dir_end, out_partial; /* --dir-range A:B, -o *.hfvs */
@@ -113,6 +124,7 @@ typedef struct cli_args {
     int sol_has_linke_monthly, sol_bands;
     double sol_hour, sol_step, sol_lat, sol_lon, sol_offset, sol_linke, sol_linke_monthly[12];
     const char *sol_linke_map, *sol_out[4];
+    cli_run_state *run; /* main's run state (NULL in sum, mosaic, info) */
 } cli_args;
 
 /* ssao --method, --depth */
@@ -187,6 +199,7 @@ typedef struct cli_progress_state {
     const char *label;
     long long base;   /* units finished by the calls before the current one */
     long long total;  /* units of the whole run */
+    cli_run_state *run; /* the clock and the last line of --progress */
 } cli_progress_state;
 
 /* The georeference of a raster IN, carried to a raster OUT (cli_save). */
@@ -248,12 +261,6 @@ typedef struct cli_part {
     int width, height, planes, directions, begin, end;
     char *tag;
 } cli_part;
-
-static double cli_t0;             /* start of the run, cli_now() */
-static double cli_run_cells;      /* grid samples of the run, for the summary line */
-static int cli_run_directions;    /* directions of the run (0: none), for the summary line */
-static double cli_line_last;      /* when the last --progress line was printed */
-static int cli_line_pct = -1;     /* and its percentage */
 
 #define CLI_PIECE_MAGIC "HFVISTILE 2\n" /* 2: the values= checksum; a version-1 sidecar is refused */
 #define CLI_PIECE_SIDECAR ".tile" /* appended to the piece's name */

@@ -190,7 +190,7 @@ static int cli_run_gis(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_op
     if (a->cmd == CMD_VIEWSHED) {
         rc = cli_run_viewshed(a, grid, out);
     } else if (a->cmd == CMD_HILLSHADE) {
-        cli_run_directions = a->blend;
+        a->run->directions = a->blend;
         rc = cli_run_hillshade(a, grid, opts, prog, out);
     } else if (a->cmd == CMD_OPENNESS) {
         hi = a->degrees ? 180.0 : CLI_PI; /* 0 .. 180 degrees */

@@ -86,6 +86,7 @@ static int cli_commands_complete(void)
 int main(int argc, char **argv)
 {
     cli_args a;
+    cli_run_state run;
     int rc;
     if ((rc = cli_commands_complete()) != 0) return rc;
     cli_signals();
@@ -94,19 +95,22 @@ int main(int argc, char **argv)
     if (argc >= 2 && !strcmp(argv[1], "--list-flags")) return cli_list_flags(argc, argv);
     if (argc >= 2 && (rc = cli_command_of(argv[1])) >= 0 && cli_commands[rc].main)
         return cli_commands[rc].main(argc, argv);
-    cli_t0 = cli_now();
+    memset(&run, 0, sizeof run);
+    run.t0 = cli_now();
+    run.line_pct = -1;
     rc = cli_parse(argc, argv, &a);
     if (rc != CLI_RUN) return rc;
+    a.run = &run;
     if ((rc = cli_gis_finish(&a)) != 0) return rc;
     if ((rc = cli_refuse_inputs(&a, a.out)) != 0) return rc;
     if ((cli_commands[a.cmd].io & CLI_COST_FIRST) && (rc = cli_check_cost(&a, 0, 0, 1)) != 0) return rc;
     rc = cli_commands[a.cmd].run(&a);
     ex_georef_free(&cli_geo);
-    if (rc == 0 && !a.quiet && a.out && (a.progress_lines || cli_now() - cli_t0 >= CLI_SUMMARY_SECONDS)) {
-        fprintf(stderr, "hfvis %s: done in %.1f s", cli_commands[a.cmd].name, cli_now() - cli_t0);
-        if (cli_run_cells > 0.0) fprintf(stderr, ": %.0f cells", cli_run_cells);
-        if (cli_run_directions > 0) fprintf(stderr, ", %d direction%s", cli_run_directions,
-                                            cli_run_directions == 1 ? "" : "s");
+    if (rc == 0 && !a.quiet && a.out && (a.progress_lines || cli_now() - run.t0 >= CLI_SUMMARY_SECONDS)) {
+        fprintf(stderr, "hfvis %s: done in %.1f s", cli_commands[a.cmd].name, cli_now() - run.t0);
+        if (run.cells > 0.0) fprintf(stderr, ": %.0f cells", run.cells);
+        if (run.directions > 0) fprintf(stderr, ", %d direction%s", run.directions,
+                                        run.directions == 1 ? "" : "s");
         fprintf(stderr, " -> %s\n", a.out);
     }
     return rc;

@@ -586,7 +586,7 @@ static int cli_vf_build(const cli_args *a)
     vf.maps = malloc(bytes);
     vf.maps_size = bytes;
     if (!vf.maps) { rc = cli_status("visfield", HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
-    prog.label = "visfield"; prog.base = 0; prog.total = 0;
+    prog.label = "visfield"; prog.base = 0; prog.total = 0; prog.run = a->run;
     if (!a->quiet && cli_stderr_is_terminal()) {
         bo.progress = cli_progress;
         bo.progress_user = &prog;

@@ -89,11 +89,11 @@ static void cli_progress_line(void *user, int done, int total)
 {
     cli_progress_state *p = (cli_progress_state *)user;
     long long all, now;
-    double t = cli_now() - cli_t0;
+    double t = cli_now() - p->run->t0;
     int pct;
     cli_progress_advance(p, done, total, &now, &all);
     pct = all > 0 ? (int)(now * 100 / all) : 100;
-    if (pct >= cli_line_pct + 5 || now == all || t - cli_line_last >= 30.0) {
+    if (pct >= p->run->line_pct + 5 || now == all || t - p->run->line_last >= 30.0) {
         if (now >= all)
             fprintf(stderr, "hfvis %s: 100%% (%lld/%lld), %.1f s\n", p->label, now, all, t);
         else if (now > 0)
@@ -102,7 +102,7 @@ static void cli_progress_line(void *user, int done, int total)
         else
             fprintf(stderr, "hfvis %s: 0%% (0/%lld), %.0f s elapsed\n", p->label, all, t);
         fflush(stderr);
-        cli_line_pct = pct;
-        cli_line_last = t;
+        p->run->line_pct = pct;
+        p->run->line_last = t;
     }
 }

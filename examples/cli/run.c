@@ -293,9 +293,9 @@ static int cli_run_heights(const cli_args *a)
     } else if (a->max_distance > 0.0 && a->cmd < CMD_COUNT && (CLI_ONLY(a->cmd) & CLI_SWEEP)) {
         cli_win.halo = cli_halo(a, grid.cell_size); /* for the window size a refusal suggests */
     }
-    prog.label = cmd; prog.base = 0; prog.total = 0;
-    cli_run_cells = (double)w * (double)h;
-    cli_run_directions = a->cmd == CMD_NORMALS || a->cmd == CMD_VIEWSHED ? 0
+    prog.label = cmd; prog.base = 0; prog.total = 0; prog.run = a->run;
+    a->run->cells = (double)w * (double)h;
+    a->run->directions = a->cmd == CMD_NORMALS || a->cmd == CMD_VIEWSHED ? 0
                          : a->cmd == CMD_SHADOW ? 1 : a->cmd == CMD_SOLAR && !a->has_dirs ? 64 : a->dirs;
     if (a->progress_lines && !a->quiet) {
         opts.progress = cli_progress_line;
