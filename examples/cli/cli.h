@@ -1,6 +1,6 @@
 /* cli.h - the `hfvis` command-line tool's shared declarations (README.md, CLI): limits, the
- * commands, the parsed arguments (cli_args), the types several files share, the run's file-scope
- * state and the prototypes of every function. The tool is one translation unit (main.c includes
+ * commands, the parsed arguments (cli_args), the types several files share, the run's state
+ * (cli_run_state, reached through cli_args.run) and the prototypes of every function. The tool is one translation unit (main.c includes
  * every file once), so everything here is static. Files by concern:
  *   main.c          the entry point        help.c          the help texts
  *   flags.c         flag table and parser  progress.c      errors, progress bar and lines
@@ -66,10 +66,25 @@ enum { OUT_TOTAL, OUT_DIRECT, OUT_INDIRECT };
 
 #define CLI_VOLGI_MAX_LIGHTS 8
 
-/* What a run reports while and after it runs: its clock, the last --progress line and the
- * summary line's figures. main owns one per run; commands reach it through cli_args.run, the
+/* A --window run (docs/tiles.md): the window of the raster it writes, the grid it loads (the
+ * window and a halo, clipped to the raster), and what its piece's sidecar records. */
+#define CLI_PIECE_TAG_MAX 2048 /* a piece's run tag: the command, the input's identity, ~30 parameters */
+typedef struct cli_window {
+    int active;                 /* this run computes one piece */
+    int halo;                   /* cells of halo (cli_halo), -1 unknown */
+    int x0, y0, w, h;           /* the window, clipped to the raster */
+    int gx0, gy0, gw, gh;       /* the grid loaded: window + halo, clipped */
+    int ext_w, ext_h;           /* the raster */
+    char in_id[64], crs[64], gt[160], nodata[80];
+    char tag[CLI_PIECE_TAG_MAX];
+} cli_window;
+/* The state of one run: the georeference of a raster IN carried to a raster OUT, the --window
+ * piece, the clock, the last --progress line and the summary line's figures. main (and sum,
+ * mosaic) own one per run, set up by cli_run_init; commands reach it through cli_args.run, the
  * progress callbacks through cli_progress_state.run. */
 typedef struct cli_run_state {
+    ex_georef geo;    /* the georeference of a raster IN, carried to a raster OUT (cli_save) */
+    cli_window win;   /* a --window run's piece */
     double t0;        /* start of the run, cli_now() */
     double cells;     /* grid samples of the run, for the summary line */
     int directions;   /* directions of the run (0: none), for the summary line */
@@ -124,7 +139,7 @@ typedef struct cli_args {
     int sol_has_linke_monthly, sol_bands;
     double sol_hour, sol_step, sol_lat, sol_lon, sol_offset, sol_linke, sol_linke_monthly[12];
     const char *sol_linke_map, *sol_out[4];
-    cli_run_state *run; /* main's run state (NULL in sum, mosaic, info) */
+    cli_run_state *run; /* the run's state (cli_run_init) */
 } cli_args;
 
 /* ssao --method, --depth */
@@ -202,22 +217,6 @@ typedef struct cli_progress_state {
     cli_run_state *run; /* the clock and the last line of --progress */
 } cli_progress_state;
 
-/* The georeference of a raster IN, carried to a raster OUT (cli_save). */
-static ex_georef cli_geo;
-
-/* A --window run (docs/tiles.md): the window of the raster it writes, the grid it loads (the
- * window and a halo, clipped to the raster), and what its piece's sidecar records. */
-#define CLI_PIECE_TAG_MAX 2048 /* a piece's run tag: the command, the input's identity, ~30 parameters */
-typedef struct cli_window {
-    int active;                 /* this run computes one piece */
-    int halo;                   /* cells of halo (cli_halo), -1 unknown */
-    int x0, y0, w, h;           /* the window, clipped to the raster */
-    int gx0, gy0, gw, gh;       /* the grid loaded: window + halo, clipped */
-    int ext_w, ext_h;           /* the raster */
-    char in_id[64], crs[64], gt[160], nodata[80];
-    char tag[CLI_PIECE_TAG_MAX];
-} cli_window;
-static cli_window cli_win = { 0, -1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, "", "", "", "", "" };
 
 /* What a command writes, handed to cli_save: `planes` planes of w x h cells stacked top to bottom
  * (horizon: one per direction), each cell `channels` interleaved values (light: the

@@ -1,7 +1,7 @@
 /* gis.c - GIS conventions and georeference: angle units, azimuth conventions (compass, grass,
  * grid), the GIS flags, map coordinates, loading a GeoTIFF/ASC/EHdr raster with its georeference,
  * the integer GeoTIFF types of integral outputs, and the `info` and `azimuths` commands.
- * Owns: the georeference of the run (cli_geo). May call: progress.c, flags.c's primitives,
+ * Owns: the georeference of the run (cli_run_state.geo). May call: progress.c, flags.c's primitives,
  * tiles.c's window plan, examples/raster_io.h. */
 
 /* An angle flag's value in degrees (it was given in radians with --radians). */
@@ -198,7 +198,7 @@ static int cli_gis_finish(cli_args *a)
     return 0;
 }
 
-/* Load a GeoTIFF, ASC or EHdr IN (band --band): NoData -> NaN, the georeference kept in cli_geo,
+/* Load a GeoTIFF, ASC or EHdr IN (band --band): NoData -> NaN, the georeference kept in a->run->geo,
  * *cell from it (geographic CRS refused unless --cell), --cell overriding with a note. */
 static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double *cell)
 {
@@ -219,7 +219,7 @@ static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double 
         ex_rio_close(&r);
         return CLI_EXIT_ERROR;
     }
-    if (!cli_win.active && (r.width > HFVIS_IMAGE_MAX_DIM || r.height > HFVIS_IMAGE_MAX_DIM ||
+    if (!a->run->win.active && (r.width > HFVIS_IMAGE_MAX_DIM || r.height > HFVIS_IMAGE_MAX_DIM ||
         (size_t)r.width * (size_t)r.height > HFVIS_IMAGE_MAX_VALUES)) {
         cli_error(CLI_EXIT_ERROR, a->in, "%s: %d x %d cells exceed the limit of 2^28 values",
                   hfvis_status_string(HFVIS_ERR_LIMIT), r.width, r.height);
@@ -249,13 +249,13 @@ static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double 
         fprintf(stderr, "hfvis: note: %s has no georeference: cell size 1 (give --cell)\n", a->in);
     }
     gw = r.width, gh = r.height;
-    if (cli_win.active) { /* the window and its halo only (estimate and refusal before allocating) */
+    if (a->run->win.active) { /* the window and its halo only (estimate and refusal before allocating) */
         int rc = cli_window_plan(a, &r, a->in, *cell);
         if (rc != 0) {
             ex_rio_close(&r);
             return rc;
         }
-        gx = cli_win.gx0, gy = cli_win.gy0, gw = cli_win.gw, gh = cli_win.gh;
+        gx = a->run->win.gx0, gy = a->run->win.gy0, gw = a->run->win.gw, gh = a->run->win.gh;
     }
     px = cli_alloc((size_t)gw, (size_t)gh, 1);
     if (!px) {
@@ -270,10 +270,10 @@ static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double 
         return CLI_EXIT_ERROR;
     }
     *z = px; *w = gw; *h = gh;
-    ex_georef_free(&cli_geo);
-    cli_geo = r.geo; /* moved: the reader no longer owns it */
+    ex_georef_free(&a->run->geo);
+    a->run->geo = r.geo; /* moved: the reader no longer owns it */
     memset(&r.geo, 0, sizeof r.geo);
-    if (cli_win.active) ex_georef_shift(&cli_geo, cli_win.x0, cli_win.y0); /* the piece's origin */
+    if (a->run->win.active) ex_georef_shift(&a->run->geo, a->run->win.x0, a->run->win.y0); /* the piece's origin */
     ex_rio_close(&r);
     return 0;
 }
@@ -330,8 +330,8 @@ static void cli_georef(const cli_args *a, double cell, double gt[6])
         for (i = 0; i < 6; i++) gt[i] = a->geotransform[i];
         return;
     }
-    if (cli_geo.has_transform) { /* a georeferenced input (GeoTIFF, ASC, EHdr) */
-        for (i = 0; i < 6; i++) gt[i] = cli_geo.gt[i];
+    if (a->run->geo.has_transform) { /* a georeferenced input (GeoTIFF, ASC, EHdr) */
+        for (i = 0; i < 6; i++) gt[i] = a->run->geo.gt[i];
         return;
     }
     gt[0] = -0.5 * cell, gt[1] = cell, gt[2] = 0.0;

@@ -95,9 +95,7 @@ int main(int argc, char **argv)
     if (argc >= 2 && !strcmp(argv[1], "--list-flags")) return cli_list_flags(argc, argv);
     if (argc >= 2 && (rc = cli_command_of(argv[1])) >= 0 && cli_commands[rc].main)
         return cli_commands[rc].main(argc, argv);
-    memset(&run, 0, sizeof run);
-    run.t0 = cli_now();
-    run.line_pct = -1;
+    cli_run_init(&run);
     rc = cli_parse(argc, argv, &a);
     if (rc != CLI_RUN) return rc;
     a.run = &run;
@@ -105,7 +103,7 @@ int main(int argc, char **argv)
     if ((rc = cli_refuse_inputs(&a, a.out)) != 0) return rc;
     if ((cli_commands[a.cmd].io & CLI_COST_FIRST) && (rc = cli_check_cost(&a, 0, 0, 1)) != 0) return rc;
     rc = cli_commands[a.cmd].run(&a);
-    ex_georef_free(&cli_geo);
+    ex_georef_free(&run.geo);
     if (rc == 0 && !a.quiet && a.out && (a.progress_lines || cli_now() - run.t0 >= CLI_SUMMARY_SECONDS)) {
         fprintf(stderr, "hfvis %s: done in %.1f s", cli_commands[a.cmd].name, cli_now() - run.t0);
         if (run.cells > 0.0) fprintf(stderr, ": %.0f cells", run.cells);

@@ -25,6 +25,15 @@ static int cli_status(const char *what, hfvis_status s, int saved_errno)
 }
 
 
+/* A run's state before the run: no georeference, no window, the clock started now. */
+static void cli_run_init(cli_run_state *run)
+{
+    memset(run, 0, sizeof *run);
+    run->win.halo = -1;
+    run->t0 = cli_now();
+    run->line_pct = -1;
+}
+
 /* One library report (done of total) as the run's units now of all; the base moves on when a
  * call completes. */
 static void cli_progress_advance(cli_progress_state *p, int done, int total, long long *now,

@@ -89,15 +89,15 @@ static int cli_check_cost(const cli_args *a, int w, int h, int channels)
         fprintf(stderr, "%s: estimate %.3g MiB, %.3g %s\n", cmd, c.bytes / 1048576.0, c.work, c.unit);
     if (a->max_memory > 0.0 && c.bytes > a->max_memory) {
         char hint[200] = "";
-        if (cli_win.halo >= 0) { /* tiles: the largest square window whose grid (+ halo) fits */
-            int ww = cli_win.active ? cli_win.ext_w : w, hh = cli_win.active ? cli_win.ext_h : h;
-            int side = cli_window_side(a, cli_win.halo, ww, hh, channels);
+        if (a->run->win.halo >= 0) { /* tiles: the largest square window whose grid (+ halo) fits */
+            int ww = a->run->win.active ? a->run->win.ext_w : w, hh = a->run->win.active ? a->run->win.ext_h : h;
+            int side = cli_window_side(a, a->run->win.halo, ww, hh, channels);
             if (side > 0)
                 snprintf(hint, sizeof hint, "; windows of %d x %d cells fit (halo %d; --window X0,Y0,%d,%d, "
-                         "examples/tiles.sh)", side, side, cli_win.halo, side, side);
+                         "examples/tiles.sh)", side, side, a->run->win.halo, side, side);
             else
                 snprintf(hint, sizeof hint, "; not even a 1-cell window with its halo of %d cells fits: "
-                         "lower --max-distance", cli_win.halo);
+                         "lower --max-distance", a->run->win.halo);
         } else if (a->cmd < CMD_COUNT && (CLI_ONLY(a->cmd) & CLI_SWEEP)) {
             snprintf(hint, sizeof hint, ", or tile it: --max-distance R and --window (docs/tiles.md)");
         }
@@ -153,7 +153,7 @@ static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double
     size_t i, n;
     hfvis_status s;
     *cell = a->cell;
-    if (ex_rio_format_of(a->in) || cli_win.active) {
+    if (ex_rio_format_of(a->in) || a->run->win.active) {
         int rc = cli_load_raster(a, &px, w, h, cell);
         if (rc != 0) return rc;
     } else {
@@ -203,10 +203,10 @@ static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double
                          ex_rio_format_of(a->in) ? "the raster's cell size" : "no cell size given: 1",
                          CLI_MAX_RELIEF);
     }
-    if (a->has_nodata && !cli_geo.has_nodata) { /* --nodata is the outputs' NoData too */
-        cli_geo.has_nodata = 1;
-        cli_geo.nodata = (double)nodata;
-        snprintf(cli_geo.nodata_text, sizeof cli_geo.nodata_text, "%.9g", (double)nodata);
+    if (a->has_nodata && !a->run->geo.has_nodata) { /* --nodata is the outputs' NoData too */
+        a->run->geo.has_nodata = 1;
+        a->run->geo.nodata = (double)nodata;
+        snprintf(a->run->geo.nodata_text, sizeof a->run->geo.nodata_text, "%.9g", (double)nodata);
     }
     *z = px;
     return 0;
@@ -259,13 +259,13 @@ static int cli_run_heights(const cli_args *a)
     hfvis_status s = HFVIS_OK;
 
     memset(&env, 0, sizeof env);
-    cli_win.active = a->has_window;
-    if (!cli_win.active) { /* --max-memory from the header's size, before the heights are read */
+    a->run->win.active = a->has_window;
+    if (!a->run->win.active) { /* --max-memory from the header's size, before the heights are read */
         double pcell = 0.0;
         int pw, ph;
         if (cli_peek_size(a, &pw, &ph, &pcell)) {
             if (a->max_distance > 0.0 && pcell > 0.0 && a->cmd < CMD_COUNT && (CLI_ONLY(a->cmd) & CLI_SWEEP))
-                cli_win.halo = cli_halo(a, pcell);
+                a->run->win.halo = cli_halo(a, pcell);
             if ((rc = cli_check_cost(a, pw, ph, cli_out_channels(a))) != 0) return rc;
             checked = 1;
         }
@@ -277,21 +277,21 @@ static int cli_run_heights(const cli_args *a)
     opts.azimuth0_rad = a->compass ? a->azimuth0 - CLI_PI / 2.0 : a->azimuth0;
     if (a->exact && a->cmd != CMD_VIEWSHED) opts.rays = HFVIS_RAYS_EXACT;
     if (a->cmd != CMD_VIEWSHED) opts.max_distance = a->max_distance; /* viewshed: its own range */
-    if (cli_win.active && a->cmd == CMD_OPENNESS) {
+    if (a->run->win.active && a->cmd == CMD_OPENNESS) {
         /* openness marches --radius per receiver: the halo holds every cell a window receiver
          * reaches, and the window + halo grid's own border is the raster's wherever a march can
          * meet it, so it runs as a plain grid (the library refuses a window for it) */
         cli_piece_tag(a, &grid, &opts);
-    } else if (cli_win.active) { /* the grid is window + halo of the raster; compute the window */
-        opts.origin_x = cli_win.gx0, opts.origin_y = cli_win.gy0;
-        opts.extent_width = cli_win.ext_w, opts.extent_height = cli_win.ext_h;
+    } else if (a->run->win.active) { /* the grid is window + halo of the raster; compute the window */
+        opts.origin_x = a->run->win.gx0, opts.origin_y = a->run->win.gy0;
+        opts.extent_width = a->run->win.ext_w, opts.extent_height = a->run->win.ext_h;
         if (a->cmd != CMD_INDIRECT) { /* indirect's bounces need every point of the grid */
-            opts.receiver_x = cli_win.x0 - cli_win.gx0, opts.receiver_y = cli_win.y0 - cli_win.gy0;
-            opts.receiver_width = cli_win.w, opts.receiver_height = cli_win.h;
+            opts.receiver_x = a->run->win.x0 - a->run->win.gx0, opts.receiver_y = a->run->win.y0 - a->run->win.gy0;
+            opts.receiver_width = a->run->win.w, opts.receiver_height = a->run->win.h;
         }
         cli_piece_tag(a, &grid, &opts);
     } else if (a->max_distance > 0.0 && a->cmd < CMD_COUNT && (CLI_ONLY(a->cmd) & CLI_SWEEP)) {
-        cli_win.halo = cli_halo(a, grid.cell_size); /* for the window size a refusal suggests */
+        a->run->win.halo = cli_halo(a, grid.cell_size); /* for the window size a refusal suggests */
     }
     prog.label = cmd; prog.base = 0; prog.total = 0; prog.run = a->run;
     a->run->cells = (double)w * (double)h;
@@ -304,7 +304,7 @@ static int cli_run_heights(const cli_args *a)
         opts.progress = cli_progress;
         opts.progress_user = &prog;
     }
-    if (!cli_win.active && !checked && (rc = cli_check_cost(a, w, h, cli_out_channels(a))) != 0) goto done;
+    if (!a->run->win.active && !checked && (rc = cli_check_cost(a, w, h, cli_out_channels(a))) != 0) goto done;
     if (a->has_dir_range) {
         if (a->cmd == CMD_LIGHT && (rc = cli_load_env(a->env, &env_px, &env)) != 0) goto done;
         rc = cli_run_partial(a, &grid, &opts, &prog, &env);

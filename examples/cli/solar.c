@@ -250,7 +250,7 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     double lat = a->sol_lat, lon = a->sol_lon;
     if (!a->sol_has_lat) { /* the raster's centre by its CRS */
         double gt[6], X, Y;
-        if (!cli_geo.has_transform || !cli_solar_tm(&cli_geo, &tm))
+        if (!a->run->geo.has_transform || !cli_solar_tm(&a->run->geo, &tm))
             return cli_error(CLI_EXIT_ERROR, "solar", "the latitude is unknown: IN has no Transverse "
                              "Mercator CRS (UTM, EPSG 326zz/327zz/258zz, or a WKT); give --latitude "
                              "and --longitude");

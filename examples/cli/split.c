@@ -283,6 +283,7 @@ static int cli_sum(int argc, char **argv)
     static const char *names[MAX_PARTS];
     static int order[MAX_PARTS];
     cli_args a;
+    cli_run_state run;
     const char *cmdname = "sum";
     char name[32], key[64], other[64];
     int nparts = 0, i, j, rc = 0, cmd, K, W, H, planes, channels = 1, out_planes = 1, deg = 0;
@@ -291,6 +292,8 @@ static int cli_sum(int argc, char **argv)
     size_t n, k;
 
     memset(&a, 0, sizeof a);
+    cli_run_init(&run);
+    a.run = &run;
     for (i = 2; i < argc; i++) {
         const char *arg = argv[i];
         if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) return cli_help(CMD_SUM);

@@ -1,6 +1,6 @@
 /* tiles.c - tiles (docs/tiles.md): a --window run plans its window and halo, writes a piece and
  * its sidecar (.tile) with the run tag and the checksum of its values; `mosaic` checks the pieces
- * and assembles them. Owns: the window of the run (cli_win). May call: progress.c, gis.c,
+ * and assembles them. Owns: the window of the run (cli_run_state.win). May call: progress.c, gis.c,
  * write.c, run.c's estimate, split.c's cli_fnv_value. */
 
 /* A file's identity without reading it whole: its size and the CRC-32 of its first and last
@@ -35,7 +35,7 @@ static int cli_window_plan(const cli_args *a, ex_rio_reader *r, const char *path
     long long x0 = a->win_x, y0 = a->win_y, x1 = x0 + a->win_w, y1 = y0 + a->win_h, h;
     const ex_georef *g = &r->geo;
     uint32_t crs = 0;
-    cli_window *v = &cli_win;
+    cli_window *v = &a->run->win;
     if (x0 < 0) x0 = 0;
     if (y0 < 0) y0 = 0;
     if (x1 > r->width) x1 = r->width;
@@ -85,13 +85,13 @@ static void cli_piece_tag(const cli_args *a, const hfvis_grid *grid, const hfvis
     char env_id[64] = "none", nodata_flag[40] = "none";
     if (a->env && cli_file_id(a->env, env_id, sizeof env_id) != 0) strcpy(env_id, "unreadable");
     if (a->has_nodata) snprintf(nodata_flag, sizeof nodata_flag, "%a", (double)(float)a->nodata);
-    snprintf(cli_win.tag, sizeof cli_win.tag,
+    snprintf(a->run->win.tag, sizeof a->run->win.tag,
              "cmd=%s crs=%s cell=%a extent=%dx%d in=%s gt=%s band=%d nodata=%s set-nodata=%s zscale=%a "
              "max-distance=%a dirs=%d border=%d border-cells=%d azimuth0=%a rays=%s convention=%d "
              "degrees=%d svf=%d sky=%a albedo=%a sun=%a,%a,%a,%a,%d blend=%d no-shadows=%d radius=%a "
              "negative=%d fraction=%d method=%d bounces=%d output=%d env=%s",
-             cli_commands[a->cmd].name, cli_win.crs, grid->cell_size, cli_win.ext_w, cli_win.ext_h,
-             cli_win.in_id, cli_win.gt, a->band ? a->band : 1, cli_win.nodata, nodata_flag, a->zscale,
+             cli_commands[a->cmd].name, a->run->win.crs, grid->cell_size, a->run->win.ext_w, a->run->win.ext_h,
+             a->run->win.in_id, a->run->win.gt, a->band ? a->band : 1, a->run->win.nodata, nodata_flag, a->zscale,
              o->max_distance, a->dirs, (int)o->border, o->border_cells, o->azimuth0_rad,
              o->rays == HFVIS_RAYS_EXACT ? "exact" : "lattice", a->convention, a->degrees, a->svf,
              a->sky, a->albedo, a->sun_azimuth, a->sun_elevation, a->sun_radius, a->sun_irradiance,
@@ -114,7 +114,7 @@ static int cli_range_is_top(int cmd, int fraction)
  * sidecar of another run. */
 static int cli_save_piece(const cli_args *a, cli_output out)
 {
-    const cli_window v = cli_win;
+    const cli_window v = a->run->win;
     const float *px = out.px;
     const int w = out.w, planes = out.planes, channels = out.channels;
     const double lo = out.lo, hi = out.hi;
@@ -152,7 +152,7 @@ static int cli_save_piece(const cli_args *a, cli_output out)
     rc = s == HFVIS_OK ? 0 : cli_status(side, s, errno);
     free(side);
     if (rc == 0) {
-        cli_win.active = 0; /* write it as an ordinary output of v.w x v.h cells */
+        a->run->win.active = 0; /* write it as an ordinary output of v.w x v.h cells */
         rc = cli_save(a, cli_output_of(cut, v.w, v.h, planes, channels, lo, hi));
     }
     free(cut);
@@ -335,6 +335,7 @@ static int cli_mosaic(int argc, char **argv)
     static const char *names[MAX_PIECES];
     cli_piece *meta = NULL;
     cli_args a;
+    cli_run_state run;
     char key[64], other[CLI_PIECE_TAG_MAX], cmdname[32], ext[64];
     int n = 0, i, j, rc = 0, W = 0, H = 0, planes, channels, origin = -1, cmd;
     double area = 0.0, lo = 0.0, hi = 1.0;
@@ -342,6 +343,8 @@ static int cli_mosaic(int argc, char **argv)
     ex_georef ref, whole;
 
     memset(&a, 0, sizeof a);
+    cli_run_init(&run);
+    a.run = &run;
     memset(&ref, 0, sizeof ref);
     memset(&whole, 0, sizeof whole);
     for (i = 2; i < argc; i++) {
@@ -466,8 +469,8 @@ static int cli_mosaic(int argc, char **argv)
         ref.has_nodata = 1;
         snprintf(ref.nodata_text, sizeof ref.nodata_text, "%.9g", ref.nodata);
     }
-    ex_georef_free(&cli_geo);
-    cli_geo = ref;
+    ex_georef_free(&run.geo);
+    run.geo = ref;
     memset(&ref, 0, sizeof ref);
     a.cmd = cmd < CMD_COUNT ? cmd : CMD_SKYVIEW;
     a.fraction = cli_tag_value(meta[0].tag, "fraction", other, sizeof other) && !strcmp(other, "1");
@@ -481,6 +484,7 @@ static int cli_mosaic(int argc, char **argv)
     rc = cli_save(&a, cli_output_of(out, W, H, planes, channels, lo, hi));
 done:
     ex_georef_free(&ref);
+    ex_georef_free(&run.geo);
     free(out);
     free(meta);
     return rc;

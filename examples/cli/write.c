@@ -159,14 +159,14 @@ static int cli_save(const cli_args *a, cli_output out)
     const int w = out.w, h = out.h * out.planes, channels = out.channels;
     double lo = out.lo, hi = out.hi;
     hfvis_status s;
-    if (cli_win.active) return cli_save_piece(a, out);
+    if (a->run->win.active) return cli_save_piece(a, out);
     errno = 0;
     if (a->out_raster) {
         /* planes stacked top to bottom (horizon) or channels interleaved become bands */
         const int planes = out.planes; /* planes and channels become bands */
         ex_rio_image img;
         ex_rio_write_options o;
-        ex_georef g = cli_geo; /* shallow: only the NoData fields change, on the copy */
+        ex_georef g = a->run->geo; /* shallow: only the NoData fields change, on the copy */
         char why[256];
         size_t i, n = (size_t)w * (size_t)h * (size_t)channels;
         int moved = 0;
@@ -207,7 +207,7 @@ static int cli_save(const cli_args *a, cli_output out)
                     "to keep it, or copy a .prj beside it)\n", a->out, g.epsg);
         if (moved && !a->quiet)
             fprintf(stderr, "hfvis: note: %s: the input's NoData %s is a value of this output: holes are "
-                    "written as %s\n", a->out, cli_geo.nodata_text, g.has_nodata ? g.nodata_text : "NaN");
+                    "written as %s\n", a->out, a->run->geo.nodata_text, g.has_nodata ? g.nodata_text : "NaN");
         return 0;
     }
     if (!a->out_pgm) {
