@@ -108,14 +108,6 @@ static int cli_set_gis(cli_args *a, const char *f, const char *v)
                             &a->targets[2 * a->ntargets - 1]);
         }
         if (!strcmp(f, "--curvature")) { a->curvature = 1; return 0; }
-        if (!strcmp(f, "--refraction")) {
-            a->has_refraction = 1;
-            return cli_real(f, v, -1.0, 0, 1.0, "a coefficient in -1..1", &a->refraction);
-        }
-        if (!strcmp(f, "--earth-radius")) {
-            a->has_earth_radius = 1;
-            return cli_real(f, v, 0.0, 1, 1e12, "a radius > 0 (metres)", &a->earth_radius);
-        }
     }
     if (!strcmp(f, "--svf")) {
         static const char *const names[3] = { "zaksek", "saga", "visible" };
@@ -124,7 +116,6 @@ static int cli_set_gis(cli_args *a, const char *f, const char *v)
             if (!strcmp(v, names[k])) { a->svf = k; return 0; }
         return cli_error(CLI_EXIT_USAGE, f, "expected zaksek, saga or visible, got '%s'", v);
     }
-    if (!strcmp(f, "--blend")) return cli_int(f, v, 1, 360, "a count of sun directions 1..360", &a->blend);
     if (!strcmp(f, "--no-shadows")) { a->no_shadows = 1; return 0; }
     if (!strcmp(f, "--negative") || !strcmp(f, "--both")) {
         if (a->negative != 0)

@@ -155,20 +155,8 @@ static int cli_set_vf(cli_args *a, const char *f, const char *v)
     }
     if (!strcmp(f, "--ao")) { a->vf_ao = 1; return 0; }
     if (!strcmp(f, "--size")) { a->vf_has_size = 1; return -1; } /* WxH parsed by volgi's code */
-    if (!strcmp(f, "--ground")) {
-        a->vf_has_ground = 1;
-        return cli_real(f, v, -CLI_FLT_MAX, 0, CLI_FLT_MAX, "a finite height", &a->vf_ground);
-    }
-    if (!strcmp(f, "--extent")) {
-        a->vf_has_extent = 1;
-        return cli_real(f, v, 0.0, 1, CLI_FLT_MAX, "a half-size > 0", &a->vf_extent);
-    }
     if (!strcmp(f, "--rays"))
         return cli_int(f, v, 1, HFVIS_VISFIELD_MAX_RAYS_SQRT, "an integer 1..256", &a->vf_rays);
-    if (!strcmp(f, "--bias")) {
-        a->vf_has_bias = 1;
-        return cli_real(f, v, 0.0, 0, 1.0, "a fraction of the radius in 0..1", &a->vf_bias);
-    }
     if (!strcmp(f, "--reference")) { a->vf_reference = v; return 0; }
     return -1;
 }
@@ -296,8 +284,6 @@ static int cli_volgi_light(cli_args *a, const char *v)
 static int cli_set_volgi(cli_args *a, const char *f, const char *v)
 {
     if (!strcmp(f, "--room")) { a->room = 1; return 0; }
-    if (!strcmp(f, "--iterations"))
-        return cli_int(f, v, 1, HFVIS_VOLGI_MAX_ITERATIONS, "an integer 1..1048576", &a->iterations);
     if (!strcmp(f, "--light")) return cli_volgi_light(a, v);
     if (!strcmp(f, "--eye") || !strcmp(f, "--target") || !strcmp(f, "--up")) {
         if (f[2] == 'e') a->vg_has_eye = 1;
