@@ -233,6 +233,18 @@ typedef struct cli_output {
     int n_meta;
 } cli_output;
 
+/* A horizon map's labels for a GeoTIFF: each band's description ("azimuth 14.036 deg compass")
+ * and AZIMUTH, and the dataset's CONVENTION, UNIT and RAYS (GDAL_METADATA, shown by gdalinfo). */
+typedef struct cli_labels {
+    char (*names)[64], (*values)[32];
+    const char **band;
+    ex_rio_meta *meta; /* 3 dataset items, then one AZIMUTH per band */
+    double *used;      /* exact rays: the azimuths the run used (hfvis_sweep_azimuths) */
+    const char *unit;
+} cli_labels;
+static void cli_labels_free(cli_labels *L);
+static int cli_horizon_labels(const cli_args *a, cli_labels *L);
+
 /* What a run is expected to cost before it allocates: bytes at its peak and units of work. */
 typedef struct cli_cost {
     double bytes, work;

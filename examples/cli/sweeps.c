@@ -250,21 +250,65 @@ static double cli_plane_azimuth(const cli_args *a, const double *used, int k)
     return cli_from_psi(a->convention, psi);
 }
 
+static void cli_labels_free(cli_labels *L)
+{
+    free(L->used);
+    free(L->meta);
+    free(L->band);
+    free(L->values);
+    free(L->names);
+    memset(L, 0, sizeof *L);
+}
+
+/* The labels of a horizon run with a's directions (dirs, azimuth0, convention, exact, degrees);
+ * 0, or an error printed. */
+static int cli_horizon_labels(const cli_args *a, cli_labels *L)
+{
+    const int K = a->dirs;
+    int k;
+    memset(L, 0, sizeof *L);
+    L->unit = a->degrees ? "degree" : "radian";
+    L->names = (char (*)[64])malloc((size_t)K * sizeof *L->names);
+    L->values = (char (*)[32])malloc((size_t)K * sizeof *L->values);
+    L->band = (const char **)malloc((size_t)K * sizeof *L->band);
+    L->meta = (ex_rio_meta *)malloc(((size_t)K + 3) * sizeof *L->meta);
+    if (a->exact) L->used = (double *)malloc((size_t)K * sizeof *L->used);
+    if (!L->names || !L->values || !L->band || !L->meta || (a->exact && !L->used)) {
+        cli_labels_free(L);
+        return cli_status("horizon", HFVIS_ERR_OUT_OF_MEMORY, 0);
+    }
+    if (L->used) {
+        hfvis_sweep_options o = hfvis_sweep_options_default();
+        o.rays = HFVIS_RAYS_EXACT;
+        o.azimuth0_rad = a->compass ? a->azimuth0 - CLI_PI / 2.0 : a->azimuth0;
+        if (hfvis_sweep_azimuths(K, &o, L->used, NULL) != HFVIS_OK) {
+            cli_labels_free(L);
+            return cli_error(CLI_EXIT_ERROR, "horizon", "internal error: the exact azimuths");
+        }
+    }
+    L->meta[0].name = "CONVENTION", L->meta[0].value = cli_conv_names[a->convention], L->meta[0].band = 0;
+    L->meta[1].name = "UNIT", L->meta[1].value = L->unit, L->meta[1].band = 0;
+    L->meta[2].name = "RAYS", L->meta[2].value = a->exact ? "exact" : "lattice", L->meta[2].band = 0;
+    for (k = 0; k < K; k++) {
+        const double deg = cli_plane_azimuth(a, L->used, k);
+        snprintf(L->names[k], sizeof L->names[k], "azimuth %.3f deg %s", deg, cli_conv_names[a->convention]);
+        snprintf(L->values[k], sizeof L->values[k], "%.6f", deg);
+        L->band[k] = L->names[k];
+        L->meta[3 + k].name = "AZIMUTH", L->meta[3 + k].value = L->values[k], L->meta[3 + k].band = k + 1;
+    }
+    return 0;
+}
+
 /* horizon, after the sweep: the planes in the user's convention's order (GRASS's run
  * counter-clockwise) and, with --split, one file per direction named OUT's stem + "_" + the
  * direction's azimuth in degrees in the convention (as r.horizon names its maps: "_045", or
  * "_022_500" for 22.5; exact rays: the azimuth actually used, e.g. "_014_036"), else the stacked
- * map. A GeoTIFF names each band's azimuth (description "azimuth 14.036 deg compass") and carries
- * AZIMUTH per band and CONVENTION, UNIT, RAYS for the dataset, as gdalinfo shows them. */
+ * map; a GeoTIFF carries the labels (cli_horizon_labels). */
 static int cli_horizon_finish(const cli_args *a, float *map, int w, int h, double lo, double hi)
 {
     const size_t n = (size_t)w * (size_t)h;
     const int K = a->dirs;
-    const char *unit = a->degrees ? "degree" : "radian";
-    char (*names)[64] = NULL, (*values)[32] = NULL;
-    const char **band = NULL;
-    ex_rio_meta *meta = NULL;
-    double *used = NULL;
+    cli_labels L;
     cli_output out;
     int k, rc = 0;
     if (a->convention == CONV_GRASS && K > 2) { /* plane k <- library plane (K - k) % K, in place */
@@ -277,47 +321,22 @@ static int cli_horizon_finish(const cli_args *a, float *map, int w, int h, doubl
         }
         free(tmp);
     }
-    names = (char (*)[64])malloc((size_t)K * sizeof *names);
-    values = (char (*)[32])malloc((size_t)K * sizeof *values);
-    band = (const char **)malloc((size_t)K * sizeof *band);
-    meta = (ex_rio_meta *)malloc(((size_t)K + 3) * sizeof *meta);
-    if (a->exact) used = (double *)malloc((size_t)K * sizeof *used);
-    if (!names || !values || !band || !meta || (a->exact && !used)) {
-        rc = cli_status("horizon", HFVIS_ERR_OUT_OF_MEMORY, 0);
-        goto done;
-    }
-    if (used) {
-        hfvis_sweep_options o = hfvis_sweep_options_default();
-        o.rays = HFVIS_RAYS_EXACT;
-        o.azimuth0_rad = a->compass ? a->azimuth0 - CLI_PI / 2.0 : a->azimuth0;
-        if (hfvis_sweep_azimuths(K, &o, used, NULL) != HFVIS_OK) {
-            rc = cli_error(CLI_EXIT_ERROR, "horizon", "internal error: the exact azimuths");
-            goto done;
-        }
-    }
-    meta[0].name = "CONVENTION", meta[0].value = cli_conv_names[a->convention], meta[0].band = 0;
-    meta[1].name = "UNIT", meta[1].value = unit, meta[1].band = 0;
-    meta[2].name = "RAYS", meta[2].value = a->exact ? "exact" : "lattice", meta[2].band = 0;
-    for (k = 0; k < K; k++) {
-        const double deg = cli_plane_azimuth(a, used, k);
-        snprintf(names[k], sizeof names[k], "azimuth %.3f deg %s", deg, cli_conv_names[a->convention]);
-        snprintf(values[k], sizeof values[k], "%.6f", deg);
-        band[k] = names[k];
-        meta[3 + k].name = "AZIMUTH", meta[3 + k].value = values[k], meta[3 + k].band = k + 1;
-    }
+    if ((rc = cli_horizon_labels(a, &L)) != 0) return rc;
     if (!a->split) {
         out = cli_output_of(map, w, h, K, 1, lo, hi);
-        out.band_names = band, out.unit = unit, out.meta = meta, out.n_meta = K + 3;
+        out.band_names = L.band, out.unit = L.unit, out.meta = L.meta, out.n_meta = K + 3;
         rc = cli_save(a, out);
-        goto done;
+        cli_labels_free(&L);
+        return rc;
     }
     for (k = 0; k < K && rc == 0; k++) {
         cli_args one = *a;
         char name[4096];
         const char *dot = strrchr(a->out, '.');
-        double deg = cli_plane_azimuth(a, used, k);
+        double deg = cli_plane_azimuth(a, L.used, k);
         long whole = (long)floor(deg), milli = (long)floor((deg - (double)whole) * 1000.0 + 0.5);
         size_t stem = dot ? (size_t)(dot - a->out) : strlen(a->out);
+        ex_rio_meta m[4]; /* the dataset's items and this direction's AZIMUTH, on band 1 */
         int len;
         if (milli == 1000) whole++, milli = 0;
         if (milli == 0)
@@ -331,22 +350,14 @@ static int cli_horizon_finish(const cli_args *a, float *map, int w, int h, doubl
         }
         if ((rc = cli_refuse_inputs(a, name)) != 0) break;
         one.out = name;
-        {
-            ex_rio_meta m[4]; /* the dataset's items and this direction's AZIMUTH, on band 1 */
-            memcpy(m, meta, 4 * sizeof *m);
-            m[3] = meta[3 + k];
-            m[3].band = 1;
-            out = cli_output_of(map + (size_t)k * n, w, h, 1, 1, lo, hi);
-            out.band_names = band + k, out.unit = unit, out.meta = m, out.n_meta = 4;
-            rc = cli_save(&one, out);
-        }
+        memcpy(m, L.meta, 3 * sizeof *m);
+        m[3] = L.meta[3 + k];
+        m[3].band = 1;
+        out = cli_output_of(map + (size_t)k * n, w, h, 1, 1, lo, hi);
+        out.band_names = L.band + k, out.unit = L.unit, out.meta = m, out.n_meta = 4;
+        rc = cli_save(&one, out);
     }
-done:
-    free(used);
-    free(meta);
-    free(band);
-    free(values);
-    free(names);
+    cli_labels_free(&L);
     return rc;
 }
 

@@ -153,7 +153,10 @@ static int cli_save_piece(const cli_args *a, cli_output out)
     free(side);
     if (rc == 0) {
         a->run->win.active = 0; /* write it as an ordinary output of v.w x v.h cells */
-        rc = cli_save(a, cli_output_of(cut, v.w, v.h, planes, channels, lo, hi));
+        cli_output piece = cli_output_of(cut, v.w, v.h, planes, channels, lo, hi);
+        piece.band_names = out.band_names, piece.unit = out.unit; /* the whole run's labels */
+        piece.meta = out.meta, piece.n_meta = out.n_meta;
+        rc = cli_save(a, piece);
     }
     free(cut);
     return rc;
@@ -481,7 +484,30 @@ static int cli_mosaic(int argc, char **argv)
         if (colon) *colon = '\0';
         if (!colon || !cli_parse_real(meta[0].range, &lo) || !cli_parse_real(colon + 1, &hi)) lo = 0.0, hi = 1.0;
     }
-    rc = cli_save(&a, cli_output_of(out, W, H, planes, channels, lo, hi));
+    {
+        cli_output whole_out = cli_output_of(out, W, H, planes, channels, lo, hi);
+        cli_labels L;
+        memset(&L, 0, sizeof L);
+        if (a.cmd == CMD_HORIZON) { /* the whole run's band labels, from the run's tag */
+            double az0 = 0.0, deg = 0.0, conv = 0.0, dirs = 0.0;
+            char rays[16] = "";
+            if (cli_tag_real(meta[0].tag, "dirs", &dirs) && cli_tag_real(meta[0].tag, "azimuth0", &az0) &&
+                cli_tag_real(meta[0].tag, "convention", &conv) && cli_tag_real(meta[0].tag, "degrees", &deg) &&
+                cli_tag_value(meta[0].tag, "rays", rays, sizeof rays) && dirs == (double)planes &&
+                conv >= 0.0 && conv <= 2.0) {
+                a.dirs = planes;
+                a.azimuth0 = az0; /* the library's psi_0 (cli_piece_tag) */
+                a.convention = (int)conv;
+                a.degrees = deg != 0.0;
+                a.exact = !strcmp(rays, "exact");
+                if ((rc = cli_horizon_labels(&a, &L)) != 0) goto done;
+                whole_out.band_names = L.band, whole_out.unit = L.unit;
+                whole_out.meta = L.meta, whole_out.n_meta = planes + 3;
+            }
+        }
+        rc = cli_save(&a, whole_out);
+        cli_labels_free(&L);
+    }
 done:
     ex_georef_free(&ref);
     ex_georef_free(&run.geo);
