@@ -1,7 +1,7 @@
 /* cli.h - the `hfvis` command-line tool's shared declarations (README.md, CLI): limits, the
  * commands, the parsed arguments (cli_args), the types several files share, the run's state
- * (cli_run_state, reached through cli_args.run) and the prototypes of every function. The tool is one translation unit (main.c includes
- * every file once), so everything here is static. Files by concern:
+ * (cli_run_state, reached through cli_args.run) and the prototypes of every function. The tool
+ * is one translation unit (main.c includes every file once), so everything here is static. Files by concern:
  *   main.c          the entry point        help.c          the help texts
  *   flags.c         flag table and parser  progress.c      errors, progress bar and lines
  *   gis.c           conventions, rasters   run.c           estimate, loading, cli_run

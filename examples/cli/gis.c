@@ -1,8 +1,8 @@
 /* gis.c - GIS conventions and georeference: angle units, azimuth conventions (compass, grass,
  * grid), the GIS flags, map coordinates, loading a GeoTIFF/ASC/EHdr raster with its georeference,
  * the integer GeoTIFF types of integral outputs, and the `info` and `azimuths` commands.
- * Owns: the georeference of the run (cli_run_state.geo). May call: progress.c, flags.c's primitives,
- * tiles.c's window plan, examples/raster_io.h. */
+ * Owns: the georeference of the run (cli_run_state.geo). May call: progress.c, flags.c's
+ * primitives, tiles.c's window plan, examples/raster_io.h. */
 
 /* An angle flag's value in degrees (it was given in radians with --radians). */
 static double cli_deg(const cli_args *a, double v)
@@ -189,8 +189,8 @@ static int cli_gis_finish(cli_args *a)
     return 0;
 }
 
-/* Load a GeoTIFF, ASC or EHdr IN (band --band): NoData -> NaN, the georeference kept in a->run->geo,
- * *cell from it (geographic CRS refused unless --cell), --cell overriding with a note. */
+/* Load a GeoTIFF, ASC or EHdr IN (band --band): NoData -> NaN, the georeference kept in
+ * a->run->geo, *cell from it (geographic CRS refused unless --cell), --cell overriding with a note. */
 static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double *cell)
 {
     ex_rio_reader r;
@@ -240,7 +240,7 @@ static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double 
         fprintf(stderr, "hfvis: note: %s has no georeference: cell size 1 (give --cell)\n", a->in);
     }
     gw = r.width, gh = r.height;
-    if (a->run->win.active) { /* the window and its halo only (estimate and refusal before allocating) */
+    if (a->run->win.active) { /* the window and its halo only (estimate, refusal before allocating) */
         int rc = cli_window_plan(a, &r, a->in, *cell);
         if (rc != 0) {
             ex_rio_close(&r);
@@ -264,7 +264,8 @@ static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double 
     ex_georef_free(&a->run->geo);
     a->run->geo = r.geo; /* moved: the reader no longer owns it */
     memset(&r.geo, 0, sizeof r.geo);
-    if (a->run->win.active) ex_georef_shift(&a->run->geo, a->run->win.x0, a->run->win.y0); /* the piece's origin */
+    if (a->run->win.active) /* the piece's origin */
+        ex_georef_shift(&a->run->geo, a->run->win.x0, a->run->win.y0);
     ex_rio_close(&r);
     return 0;
 }

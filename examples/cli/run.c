@@ -90,7 +90,8 @@ static int cli_check_cost(const cli_args *a, int w, int h, int channels)
     if (a->max_memory > 0.0 && c.bytes > a->max_memory) {
         char hint[200] = "";
         if (a->run->win.halo >= 0) { /* tiles: the largest square window whose grid (+ halo) fits */
-            int ww = a->run->win.active ? a->run->win.ext_w : w, hh = a->run->win.active ? a->run->win.ext_h : h;
+            const cli_window *win = &a->run->win;
+            int ww = win->active ? win->ext_w : w, hh = win->active ? win->ext_h : h;
             int side = cli_window_side(a, a->run->win.halo, ww, hh, channels);
             if (side > 0)
                 snprintf(hint, sizeof hint, "; windows of %d x %d cells fit (halo %d; --window X0,Y0,%d,%d, "
@@ -286,7 +287,8 @@ static int cli_run_heights(const cli_args *a)
         opts.origin_x = a->run->win.gx0, opts.origin_y = a->run->win.gy0;
         opts.extent_width = a->run->win.ext_w, opts.extent_height = a->run->win.ext_h;
         if (a->cmd != CMD_INDIRECT) { /* indirect's bounces need every point of the grid */
-            opts.receiver_x = a->run->win.x0 - a->run->win.gx0, opts.receiver_y = a->run->win.y0 - a->run->win.gy0;
+            opts.receiver_x = a->run->win.x0 - a->run->win.gx0;
+            opts.receiver_y = a->run->win.y0 - a->run->win.gy0;
             opts.receiver_width = a->run->win.w, opts.receiver_height = a->run->win.h;
         }
         cli_piece_tag(a, &grid, &opts);

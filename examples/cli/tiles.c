@@ -83,15 +83,16 @@ static int cli_window_plan(const cli_args *a, ex_rio_reader *r, const char *path
 static void cli_piece_tag(const cli_args *a, const hfvis_grid *grid, const hfvis_sweep_options *o)
 {
     char env_id[64] = "none", nodata_flag[40] = "none";
+    cli_window *win = &a->run->win;
     if (a->env && cli_file_id(a->env, env_id, sizeof env_id) != 0) strcpy(env_id, "unreadable");
     if (a->has_nodata) snprintf(nodata_flag, sizeof nodata_flag, "%a", (double)(float)a->nodata);
-    snprintf(a->run->win.tag, sizeof a->run->win.tag,
+    snprintf(win->tag, sizeof win->tag,
              "cmd=%s crs=%s cell=%a extent=%dx%d in=%s gt=%s band=%d nodata=%s set-nodata=%s zscale=%a "
              "max-distance=%a dirs=%d border=%d border-cells=%d azimuth0=%a rays=%s convention=%d "
              "degrees=%d svf=%d sky=%a albedo=%a sun=%a,%a,%a,%a,%d blend=%d no-shadows=%d radius=%a "
              "negative=%d fraction=%d method=%d bounces=%d output=%d env=%s",
-             cli_commands[a->cmd].name, a->run->win.crs, grid->cell_size, a->run->win.ext_w, a->run->win.ext_h,
-             a->run->win.in_id, a->run->win.gt, a->band ? a->band : 1, a->run->win.nodata, nodata_flag, a->zscale,
+             cli_commands[a->cmd].name, win->crs, grid->cell_size, win->ext_w, win->ext_h,
+             win->in_id, win->gt, a->band ? a->band : 1, win->nodata, nodata_flag, a->zscale,
              o->max_distance, a->dirs, (int)o->border, o->border_cells, o->azimuth0_rad,
              o->rays == HFVIS_RAYS_EXACT ? "exact" : "lattice", a->convention, a->degrees, a->svf,
              a->sky, a->albedo, a->sun_azimuth, a->sun_elevation, a->sun_radius, a->sun_irradiance,
