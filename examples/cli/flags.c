@@ -154,8 +154,10 @@ static const cli_flag cli_flags[] = {
       "                    stderr with the progress bar\n" },
     { "--threads", "N", CLI_THREADED,
       "horizon, skyview, sky, light, shadow, hillshade, openness --radius: run\n"
-      "                    on N threads, 1..256 (default: the online cores); the output is the\n"
-      "                    one-thread run's bit for bit (directions, bands across the sun, rows)\n" },
+      "                    on N threads, 0..256 (0: the online cores; default 1); the output is\n"
+      "                    the one-thread run's bit for bit (directions, bands across the sun,\n"
+      "                    rows). Each thread holds its own lattice: where first-touch page faults\n"
+      "                    are slow (VMs), more threads can be slower (docs/performance.md)\n" },
     { "--sky", "C", CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI), NULL },
     { "--albedo", "A", CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT)
                      | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_SOLAR), NULL },
@@ -499,7 +501,10 @@ static int cli_set(cli_args *a, const char *f, const char *v)
     if (!strcmp(f, "--exact")) { a->exact = 1; return 0; }
     if (!strcmp(f, "--threads")) {
         a->has_threads = 1;
-        return cli_int(f, v, 1, CLI_THREADS_MAX, "an integer 1..256", &a->threads);
+        if (cli_int(f, v, 0, CLI_THREADS_MAX, "an integer 0..256 (0: the online cores)", &a->threads))
+            return CLI_EXIT_USAGE;
+        if (a->threads == 0) a->threads = cli_threads_online();
+        return 0;
     }
     if (!strcmp(f, "--window")) { /* X0,Y0,W,H in cells; clipped to the raster when it is read */
         long n[4];
@@ -597,7 +602,7 @@ static int cli_parse(int argc, char **argv, cli_args *a)
     memset(a, 0, sizeof *a);
     a->cell = 1.0; a->zscale = 1.0; a->dirs = 16; a->sky = 1.0; a->albedo = 1.0;
     a->max_memory = cli_default_max_memory();
-    a->threads = cli_threads_online();
+    a->threads = 1; /* not the online cores: see --threads' help and docs/performance.md */
     a->border = HFVIS_BORDER_OPEN; a->method = HFVIS_ENV_PREFIX;
     a->bounces = 1; a->sun_irradiance = CLI_PI; a->output = OUT_TOTAL;
     a->order = 4; a->subsample = 1;
