@@ -960,6 +960,9 @@ hillshade lattice blend|hillshade --lattice --blend 3
 openness both|openness --radius 20 --both
 openness clamp|openness --radius 12 --border clamp --negative
 EOF
+"$hfvis" skyview "$r" --nodata 0 --cell 3 --quiet --threads 0 -o "$dir/thr0.pfm" && "$hfvis" skyview "$r" --nodata 0 --cell 3 \
+  --quiet -o "$dir/thr1.pfm" && cmp -s "$dir/thr0.pfm" "$dir/thr1.pfm" && ok "--threads 0 (the online cores) = the default run" \
+  || bad "--threads 0"
 # a window piece is the same on any number of threads too (windows read PFM: heights from the tool)
 "$hfvis" hillshade "$r" --nodata 0 --no-shadows --quiet -o "$dir/rough.pfm"
 for t in 1 2; do "$hfvis" skyview "$dir/rough.pfm" --cell 0.05 --max-distance 1.5 --window 10,8,30,25 --threads $t \

@@ -213,11 +213,13 @@ static const cli_flag cli_flags[] = {
       "                    the work (lattice nodes swept, rays, voxel updates) are printed on\n"
       "                    stderr with the progress bar\n" },
     { "--threads", "N", CLI_THREADED,
-      CLI_INT_AT(1, CLI_THREADS_MAX, "an integer 1..256",
-                 "online cores", "threads", threads, CLI_HAS(has_threads)),
+      CLI_INT_AT(0, CLI_THREADS_MAX, "an integer 0..256 (0: the online cores)",
+                 "1", "threads", threads, CLI_HAS(has_threads)),
       "horizon, skyview, sky, light, shadow, hillshade, openness --radius: run\n"
-      "                    on N threads, 1..256 (default: the online cores); the output is the\n"
-      "                    one-thread run's bit for bit (directions, bands across the sun, rows)\n" },
+      "                    on N threads, 0..256 (0: the online cores; default 1); the output is\n"
+      "                    the one-thread run's bit for bit (directions, bands across the sun,\n"
+      "                    rows). Each thread holds its own lattice: where first-touch page faults\n"
+      "                    are slow (VMs), more threads can be slower (docs/performance.md)\n" },
     { "--sky", "C", CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI),
       CLI_REAL_AT(0.0, 0, CLI_FLT_MAX, "a radiance >= 0",
                  "1", "radiance", sky, CLI_HAS(has_sky)), NULL },
@@ -750,7 +752,7 @@ static int cli_parse(int argc, char **argv, cli_args *a)
     memset(a, 0, sizeof *a);
     a->cell = 1.0; a->zscale = 1.0; a->dirs = 16; a->sky = 1.0; a->albedo = 1.0;
     a->max_memory = cli_default_max_memory();
-    a->threads = cli_threads_online();
+    a->threads = 1; /* not the online cores: see --threads' help and docs/performance.md */
     a->border = HFVIS_BORDER_OPEN; a->method = HFVIS_ENV_PREFIX;
     a->bounces = 1; a->sun_irradiance = CLI_PI; a->output = OUT_TOTAL;
     a->order = 4; a->subsample = 1;
@@ -806,6 +808,7 @@ static int cli_parse(int argc, char **argv, cli_args *a)
         return cli_error(CLI_EXIT_USAGE, cli_commands[a->cmd].name, "missing input file IN");
     if (!a->out && (cli_commands[a->cmd].io & CLI_OUT_NEEDED))
         return cli_error(CLI_EXIT_USAGE, cli_commands[a->cmd].name, "missing -o OUT");
+    if (a->threads == 0) a->threads = cli_threads_online(); /* --threads 0 */
     if (a->sky * a->albedo > CLI_FLT_MAX) /* the sky light's scale: outputs would be inf */
         return cli_error(CLI_EXIT_USAGE, "--sky/--albedo", "%g x %g exceeds the float range (3.4e38)",
                          a->sky, a->albedo);

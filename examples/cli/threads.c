@@ -88,6 +88,56 @@ static void cli_split_progress(void *user, int done, int total)
     cli_split_unlock(sp);
 }
 
+/* Each thread's allocator keeps the blocks the library frees and hands them back at its next
+ * call of the same size: a unit's lattice and accumulator are page-faulted once per thread, not
+ * once per unit (a first touch costs about 11 us per 4 KiB page on this project's VMs:
+ * docs/performance.md). Blocks beyond CLI_KEEP_BLOCKS go straight to malloc/free. */
+#define CLI_KEEP_BLOCKS 16
+typedef struct cli_keep {
+    void *ptr[CLI_KEEP_BLOCKS];
+    size_t size[CLI_KEEP_BLOCKS];
+    int used[CLI_KEEP_BLOCKS], n;
+} cli_keep;
+
+static void *cli_keep_alloc(void *user, size_t size)
+{
+    cli_keep *k = (cli_keep *)user;
+    int i, best = -1;
+    void *p;
+    for (i = 0; i < k->n; i++) /* the smallest kept block that fits */
+        if (!k->used[i] && k->size[i] >= size && (best < 0 || k->size[i] < k->size[best])) best = i;
+    if (best >= 0) {
+        k->used[best] = 1;
+        return k->ptr[best];
+    }
+    p = malloc(size ? size : 1);
+    if (p && k->n < CLI_KEEP_BLOCKS) {
+        k->ptr[k->n] = p;
+        k->size[k->n] = size;
+        k->used[k->n++] = 1;
+    }
+    return p;
+}
+
+static void cli_keep_free(void *user, void *ptr)
+{
+    cli_keep *k = (cli_keep *)user;
+    int i;
+    for (i = 0; i < k->n; i++)
+        if (k->ptr[i] == ptr) {
+            k->used[i] = 0;
+            return;
+        }
+    free(ptr);
+}
+
+static void cli_keep_release(cli_keep *k)
+{
+    int i;
+    for (i = 0; i < k->n; i++) free(k->ptr[i]);
+    k->n = 0;
+}
+
 typedef struct cli_worker {
     cli_split *sp;
     int thread;
@@ -97,6 +147,12 @@ static void *cli_split_worker(void *arg)
 {
     cli_split *sp = ((cli_worker *)arg)->sp;
     const int thread = ((cli_worker *)arg)->thread;
+    cli_keep keep;
+    hfvis_allocator alloc;
+    memset(&keep, 0, sizeof keep);
+    alloc.alloc = cli_keep_alloc;
+    alloc.free = cli_keep_free;
+    alloc.user = &keep;
     for (;;) {
         hfvis_sweep_options o = *sp->opts;
         cli_unit_progress up;
@@ -110,6 +166,7 @@ static void *cli_split_worker(void *arg)
         up.last = 0;
         o.progress = cli_split_progress;
         o.progress_user = &up;
+        o.alloc = &alloc;
         s = sp->unit(sp, u, thread, &o);
         cli_split_lock(sp);
         if (s != HFVIS_OK && sp->status == HFVIS_OK) sp->status = s;
@@ -123,6 +180,7 @@ static void *cli_split_worker(void *arg)
 #endif
         cli_split_unlock(sp);
     }
+    cli_keep_release(&keep);
     return NULL;
 }
 
