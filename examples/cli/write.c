@@ -1,22 +1,28 @@
 /* write.c - safe writing: every file goes through hfvis_write_file, whose temporary name is kept
  * here so that SIGINT, SIGTERM and SIGHUP remove it (the handler unlinks it and re-raises the
  * signal; SIGXFSZ is ignored, so a file-size limit is a write error); the encoders of the library's formats; cli_save (PFM, PGM and the GIS rasters); the
- * refusal to write over an input. Owns: the temporary-file name. May call: progress.c, gis.c,
+ * refusal to write over an input. Owns: the temporary-file names. May call: progress.c, gis.c,
  * tiles.c (pieces), the library's encoders and examples/raster_io.h. */
 
 #define CLI_TMP_CAP 4096 /* longest temporary name the handler can remove (PATH_MAX on Linux) */
-static char cli_tmp_name[CLI_TMP_CAP];
-static volatile sig_atomic_t cli_tmp_armed; /* cli_tmp_name names a file that may exist */
+#define CLI_TMP_SLOTS 8  /* temporary files alive at once: a raster with its sidecars (ex_publish) */
+static char cli_tmp_name[CLI_TMP_SLOTS][CLI_TMP_CAP];
+static volatile sig_atomic_t cli_tmp_armed; /* cli_tmp_name[0..armed) name files that may exist */
 
-/* hfvis_write_options.on_temp: armed only after the name is complete, disarmed before it changes. */
+/* hfvis_write_options.on_temp: each new temporary name takes the next slot and is armed only
+ * once it is complete; NULL (the file, or the whole set, renamed or removed) disarms them all. */
 static void cli_on_temp(void *user, const char *tmp)
 {
     size_t n = tmp ? strlen(tmp) : 0;
+    int k = cli_tmp_armed;
     (void)user;
-    cli_tmp_armed = 0;
-    if (!tmp || n >= CLI_TMP_CAP) return;
-    memcpy(cli_tmp_name, tmp, n + 1);
-    cli_tmp_armed = 1;
+    if (!tmp) {
+        cli_tmp_armed = 0;
+        return;
+    }
+    if (n >= CLI_TMP_CAP || k >= CLI_TMP_SLOTS) return;
+    memcpy(cli_tmp_name[k], tmp, n + 1);
+    cli_tmp_armed = k + 1;
 }
 
 #ifdef CLI_HAVE_SIGACTION
@@ -24,7 +30,8 @@ static void cli_on_temp(void *user, const char *tmp)
  * exit status says which signal ended the run (130 for SIGINT, 143 for SIGTERM in a shell). */
 static void cli_on_signal(int sig)
 {
-    if (cli_tmp_armed) unlink(cli_tmp_name);
+    int k;
+    for (k = 0; k < cli_tmp_armed; k++) unlink(cli_tmp_name[k]);
     signal(sig, SIG_DFL);
     raise(sig);
 }
