@@ -1,7 +1,7 @@
 /* threads.c - --threads: the work of one run split over POSIX threads so that the output equals
  * the one-thread run's bit for bit (hfvis.h, "Threads"): the direction sums by quarter-turn group
  * (lattice) or by direction (exact) added in order, the horizon map by plane range, one sun by
- * bands across its direction, and receiver-local results by row bands with a halo. The library
+ * bands across its direction, and openness --radius by row bands (receiver rectangles). The library
  * stays single-threaded; every call here is one of its reentrant calls on shared inputs. Without
  * POSIX threads (CLI_HAVE_THREADS 0) every split runs its units in order on the calling thread.
  * May call: progress.c (through the progress callbacks it wraps). */
@@ -15,7 +15,7 @@
 
 #define CLI_THREADS_MAX 256 /* --threads' upper bound */
 
-/* The online cores (sysconf), the default of --threads; 1 where unknown or without threads. */
+/* The online cores (sysconf), what --threads 0 asks for; 1 where unknown or without threads. */
 static int cli_threads_online(void)
 {
 #if CLI_HAVE_THREADS && defined(_SC_NPROCESSORS_ONLN)
