@@ -478,6 +478,24 @@ split4 "split sky 4 ways" sky pfm 0:5 5:6 6:11 11:12 -- --dirs 12 --sky 2 --albe
 split4 "split light 4 ways (RGB)" light pfm 0:3 3:8 8:13 13:16 -- --dirs 16 --env "$dir/env3.pfm" --albedo 0.8
 split4 "split light --method lp" light pfm 0:1 1:2 2:3 3:8 -- --dirs 8 --env "$dir/env1.pfm" --method lp
 split4 "split visibility 4 ways" visibility pfm 0:2 2:4 4:6 6:8 -- --dirs 8
+# a raster OUT: the sum writes the single run's GeoTIFF byte for byte, with the horizon's band
+# labels (rebuilt from the parts' tags) and visibility's integer counts
+split4 "split horizon --exact --convention grid, GeoTIFF with its band labels" horizon tif 0:4 4:8 -- --dirs 8 --exact --convention grid --degrees
+if command -v gdalinfo > /dev/null 2>&1; then
+  gdalinfo "$dir/single.tif" | grep 'Description = ' > "$dir/desc_single"
+  gdalinfo "$dir/summed.tif" | grep 'Description = ' > "$dir/desc_summed"
+  [ "$(wc -l < "$dir/desc_summed")" -eq 8 ] && cmp -s "$dir/desc_single" "$dir/desc_summed" &&
+    ok "sum: the GeoTIFF's 8 band descriptions are the single run's (gdalinfo)" ||
+    bad "sum: band descriptions: $(head -n 2 "$dir/desc_summed")"
+else
+  echo "SKIP cli sum band descriptions: no gdalinfo (the byte comparison above covers them)"
+fi
+split4 "split visibility, GeoTIFF" visibility tif 0:4 4:8 -- --dirs 8
+awk 'BEGIN { print "ncols 8"; print "nrows 6"; print "xllcorner 500000"; print "yllcorner 5000000"
+  print "cellsize 10"; for (y = 0; y < 6; y++) { s = ""; for (x = 0; x < 8; x++) s = s " " (100 + x * y); print s } }' > "$dir/geo.asc"
+"$hfvis" skyview "$dir/geo.asc" --dirs 8 --dir-range 0:8 -o "$dir/geo.hfvs" 2> /dev/null
+expect_fail "sum: a raster OUT of a georeferenced run's parts (the parts carry no georeference)" 1 sum "$dir/geo.hfvs" -o "$fdir/x.tif"
+grep -q 'georeferenced' "$dir/stderr" && ok "sum: georeference refusal named" || bad "sum: georeference refusal: $(cat "$dir/stderr")"
 split4 "split visibility --fraction" visibility pfm 0:3 3:4 4:7 7:8 -- --dirs 8 --fraction --zscale 3
 # exact rays (--exact): split runs and sums as for the lattice; mixing modes is refused
 split4 "split horizon --exact" horizon pfm 0:3 3:8 8:13 13:16 -- --dirs 16 --exact

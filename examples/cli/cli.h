@@ -247,6 +247,7 @@ typedef struct cli_labels {
 } cli_labels;
 static void cli_labels_free(cli_labels *L);
 static int cli_horizon_labels(const cli_args *a, cli_labels *L);
+static int cli_horizon_labels_of_tag(const char *tag, int planes, cli_labels *L);
 
 /* What a run is expected to cost before it allocates: bytes at its peak and units of work. */
 struct cli_cost {

@@ -282,6 +282,30 @@ static int cli_horizon_labels(const cli_args *a, cli_labels *L)
     return 0;
 }
 
+/* A horizon map's labels rebuilt from the tag of its run (a piece's sidecar for mosaic, a partial
+ * result for sum): its dirs (which must be planes), azimuth0 (the library's psi_0), convention,
+ * degrees and rays. Returns 0 with L zeroed (no labels: a tag of an older hfvis) when a key is
+ * missing or names another count, 0 with L filled, or an error (reported). */
+static int cli_horizon_labels_of_tag(const char *tag, int planes, cli_labels *L)
+{
+    cli_args a;
+    double az0 = 0.0, deg = 0.0, conv = 0.0, dirs = 0.0;
+    char rays[16] = "";
+    memset(&a, 0, sizeof a);
+    memset(L, 0, sizeof *L);
+    if (!cli_tag_real(tag, "dirs", &dirs) || !cli_tag_real(tag, "azimuth0", &az0) ||
+        !cli_tag_real(tag, "convention", &conv) || !cli_tag_real(tag, "degrees", &deg) ||
+        !cli_tag_value(tag, "rays", rays, sizeof rays) || dirs != (double)planes || !(conv >= 0.0 && conv <= 2.0))
+        return 0;
+    a.cmd = CMD_HORIZON;
+    a.dirs = planes;
+    a.azimuth0 = az0; /* psi_0 itself: a.compass is 0 */
+    a.convention = (int)conv;
+    a.degrees = deg != 0.0;
+    a.exact = !strcmp(rays, "exact");
+    return cli_horizon_labels(&a, L);
+}
+
 /* horizon, after the sweep: the planes in the user's convention's order (GRASS's run
  * counter-clockwise) and, with --split, one file per direction named OUT's stem + "_" + the
  * direction's azimuth in degrees in the convention (as r.horizon names its maps: "_045", or

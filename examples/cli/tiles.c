@@ -490,18 +490,8 @@ static int cli_mosaic(int argc, char **argv)
         cli_labels L;
         memset(&L, 0, sizeof L);
         if (a.cmd == CMD_HORIZON) { /* the whole run's band labels, from the run's tag */
-            double az0 = 0.0, deg = 0.0, conv = 0.0, dirs = 0.0;
-            char rays[16] = "";
-            if (cli_tag_real(meta[0].tag, "dirs", &dirs) && cli_tag_real(meta[0].tag, "azimuth0", &az0) &&
-                cli_tag_real(meta[0].tag, "convention", &conv) && cli_tag_real(meta[0].tag, "degrees", &deg) &&
-                cli_tag_value(meta[0].tag, "rays", rays, sizeof rays) && dirs == (double)planes &&
-                conv >= 0.0 && conv <= 2.0) {
-                a.dirs = planes;
-                a.azimuth0 = az0; /* the library's psi_0 (cli_piece_tag) */
-                a.convention = (int)conv;
-                a.degrees = deg != 0.0;
-                a.exact = !strcmp(rays, "exact");
-                if ((rc = cli_horizon_labels(&a, &L)) != 0) goto done;
+            if ((rc = cli_horizon_labels_of_tag(meta[0].tag, planes, &L)) != 0) goto done;
+            if (L.band) {
                 whole_out.band_names = L.band, whole_out.unit = L.unit;
                 whole_out.meta = L.meta, whole_out.n_meta = planes + 3;
             }
