@@ -1053,6 +1053,17 @@ done < "$dir/commands"
 [ "$walk_bad" -eq 0 ] && ok "walk: $walk_n command x flag pairs" || bad "walk: $walk_bad of $walk_n pairs"
 [ "$walk_bad" -eq 0 ] && [ "$help_n" -gt 0 ] && ok "every command's --help: the type, range, default and unit of its $help_n options as in --list-flags" ||
   bad "--help values: $help_n lines checked"
+# No mutable state at file scope: the binary's writable objects (.data, .bss) are the C runtime's
+# and the signal handler's temporary-file names (cli_tmp_name, cli_tmp_armed, and common.h's
+# ex_atomic_on_temp hook that reports the raster writers' to it). Needs an nm that prints sections.
+if nm -f sysv "$hfvis" > "$dir/nm" 2> /dev/null && grep -q '|\.bss' "$dir/nm"; then
+  extra=$(awk -F'|' '$4 ~ /OBJECT/ && $7 ~ /^\.(data|bss)$/ { gsub(/ /, "", $1); print $1 }' "$dir/nm" |
+    grep -v -e '@' -e '^__' -e '^completed\.' -e '^cli_tmp_name$' -e '^cli_tmp_armed$' -e '^ex_atomic_on_temp$' | tr '\n' ' ')
+  [ -z "$extra" ] && ok "no mutable objects but the signal handler's temporary-file names (nm)" ||
+    bad "mutable objects at file or function scope: $extra"
+else
+  echo "SKIP cli mutable objects: no 'nm -f sysv' with sections"
+fi
 # every refusal of a bad number names the flag and its range
 "$hfvis" skyview "$h" --dirs 0 -o "$fdir/x.pfm" 2> "$dir/werr"
 grep -q -- '--dirs.*1\.\.65536' "$dir/werr" && ok "--dirs 0: flag and range" || bad "--dirs 0: $(cat "$dir/werr")"

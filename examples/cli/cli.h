@@ -79,7 +79,7 @@ typedef struct cli_window {
     char tag[CLI_PIECE_TAG_MAX];
 } cli_window;
 /* The state of one run: the georeference of a raster IN carried to a raster OUT, the --window
- * piece, the clock, the last --progress line and the summary line's figures. main (and sum,
+ * piece, the clock, the last --progress line or the progress bar, and the summary line's figures. main (and sum,
  * mosaic) own one per run, set up by cli_run_init; commands reach it through cli_args.run, the
  * progress callbacks through cli_progress_state.run. */
 typedef struct cli_run_state {
@@ -90,6 +90,7 @@ typedef struct cli_run_state {
     int directions;   /* directions of the run (0: none), for the summary line */
     double line_last; /* when the last --progress line was printed */
     int line_pct;     /* and its percentage (-1: none yet) */
+    int bar_open;     /* the progress bar's line is on stderr without its newline (cli_progress) */
 } cli_run_state;
 
 typedef struct cli_args {
@@ -209,8 +210,6 @@ typedef struct cli_command {
 } cli_command;
 static const cli_command cli_commands[CMD_COUNT]; /* defined in main.c */
 
-static int cli_bar_open; /* a progress line is on stderr without its newline yet */
-
 /* One progress bar over several library calls: each call reports its own done/total, the bar
  * shows base + done out of the run's total (its units are directions; 0 = each call's total). */
 typedef struct cli_progress_state {
@@ -298,6 +297,7 @@ static int cli_status(const char *what, hfvis_status s, int saved_errno);
 static void cli_progress_advance(cli_progress_state *p, int done, int total, long long *now,
                                  long long *all);
 static void cli_progress(void *user, int done, int total);
+static void cli_progress_end(cli_run_state *run, int rc);
 static double cli_default_max_memory(void);
 static int cli_stderr_is_terminal(void);
 static double cli_now(void);
@@ -447,6 +447,7 @@ static int cli_tag_real(const char *tag, const char *key, double *v);
 static int cli_sum_load(const char *path, hfvis_partial *p, cli_part *m);
 static int cli_sum_check(const char *path, int cmd, const hfvis_partial *p);
 static int cli_sum(int argc, char **argv);
+static int cli_sum_parts(int argc, char **argv, const char **names, cli_part *meta, int *order);
 /* tiles.c */
 static int cli_file_id(const char *path, char *out, size_t cap);
 static int cli_window_plan(const cli_args *a, ex_rio_reader *r, const char *path, double cell);
@@ -458,6 +459,7 @@ static const char *cli_piece_problem(const char *key);
 static int cli_piece_read(const char *path, const cli_piece *m, int W, int H, float *out,
                           const ex_georef *whole, const ex_georef *ref, ex_georef *keep);
 static int cli_mosaic(int argc, char **argv);
+static int cli_mosaic_pieces(int argc, char **argv, const char **names);
 /* solar.c */
 static int cli_solar_date(const char *f, const char *v, int *y, int *m, int *d);
 static long cli_solar_day_number(int y, int m, int d);

@@ -547,7 +547,7 @@ static int cli_vf_build(const cli_args *a)
                fmt_names[vf.format], vf.center[0], vf.center[1], vf.center[2], vf.radius,
                hfvis_visfield_encode_size(&vf));
 done:
-    if (cli_bar_open) { fputc('\n', stderr); cli_bar_open = 0; }
+    cli_progress_end(a->run, rc);
     free(vf.maps);
     hfvis_mesh_free(NULL, &mesh);
     return rc;

@@ -448,7 +448,7 @@ static int cli_run_heights(const cli_args *a)
     if (a->cmd == CMD_HORIZON) { rc = cli_horizon_finish(a, out, w, h, lo, hi); goto done; }
     rc = cli_save(a, cli_output_of(out, w, h, planes, channels, lo, hi));
 done:
-    if (cli_bar_open) { fputc('\n', stderr); cli_bar_open = 0; } /* a bar that fell short */
+    cli_progress_end(a->run, rc); /* a bar that fell short */
     free(out);
     hfvis_free(NULL, env_px);
     hfvis_free(NULL, z);

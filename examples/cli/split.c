@@ -282,10 +282,22 @@ static int cli_sum_check(const char *path, int cmd, const hfvis_partial *p)
 
 static int cli_sum(int argc, char **argv)
 {
+    /* per part (at most argc): its name, header and tag, and its place in direction order */
+    const char **names = (const char **)calloc((size_t)argc, sizeof *names);
+    cli_part *meta = (cli_part *)calloc((size_t)argc, sizeof *meta);
+    int *order = (int *)calloc((size_t)argc, sizeof *order), rc;
+    if (!names || !meta || !order) rc = cli_status("sum", HFVIS_ERR_OUT_OF_MEMORY, 0);
+    else rc = cli_sum_parts(argc, argv, names, meta, order);
+    free(order);
+    free(meta);
+    free((void *)names);
+    return rc;
+}
+
+/* cli_sum with its per-part arrays. */
+static int cli_sum_parts(int argc, char **argv, const char **names, cli_part *meta, int *order)
+{
     enum { MAX_PARTS = 4096 };
-    static cli_part meta[MAX_PARTS];
-    static const char *names[MAX_PARTS];
-    static int order[MAX_PARTS];
     cli_args a;
     cli_run_state run;
     const char *cmdname = "sum";

@@ -335,8 +335,16 @@ static int cli_piece_read(const char *path, const cli_piece *m, int W, int H, fl
  * raster, written as the whole run writes it (cli_save with the whole raster's georeference). */
 static int cli_mosaic(int argc, char **argv)
 {
+    const char **names = (const char **)calloc((size_t)argc, sizeof *names); /* the pieces */
+    int rc = names ? cli_mosaic_pieces(argc, argv, names) : cli_status("mosaic", HFVIS_ERR_OUT_OF_MEMORY, 0);
+    free((void *)names);
+    return rc;
+}
+
+/* cli_mosaic with the array of its pieces' names (at most argc). */
+static int cli_mosaic_pieces(int argc, char **argv, const char **names)
+{
     enum { MAX_PIECES = 65536 };
-    static const char *names[MAX_PIECES];
     cli_piece *meta = NULL;
     cli_args a;
     cli_run_state run;
