@@ -996,16 +996,27 @@ else bad "hillshade/shadow --exact did not run"; fi
 # and a refusal of the value is one line naming the flag. Every flag of the table in docs/cli.md.
 "$hfvis" --list-flags > "$dir/flags" && "$hfvis" --list-commands > "$dir/commands" &&
   [ -s "$dir/flags" ] && [ -s "$dir/commands" ] && ok "--list-flags, --list-commands" || bad "--list-flags, --list-commands"
-awk -F'	' 'NF != 7 || $4 !~ /^(-|int|real|text|choice|list|date|bytes)$/ { bad = 1 }
+awk -F'	' 'NF != 7 || $4 !~ /^(-|int|real|text|choice|list|date|bytes|duration)$/ { bad = 1 }
   END { exit bad }' "$dir/flags" &&
   ok "--list-flags: NAME VALUE COMMANDS TYPE RANGE DEFAULT UNIT" || bad "--list-flags columns"
 [ "$(wc -l < "$dir/commands" | tr -d ' ')" = "$("$hfvis" --help | sed -n '/^commands:/,/^$/p' | grep -c '^  [a-z]')" ] &&
   ok "--list-commands: the commands of --help" || bad "--list-commands differs from --help"
-walk_bad=0; walk_n=0
+walk_bad=0; walk_n=0; help_n=0
 walk_fail() { walk_bad=$((walk_bad + 1)); echo "FAIL cli walk: $1"; }
 while read -r c; do # one run per pair, no other process: the walk is ~2,000 runs
-  used=" $("$hfvis" --list-flags "$c" | cut -f1 | tr '\n' ' ') "
+  "$hfvis" --list-flags "$c" > "$dir/cflags"
+  used=" $(cut -f1 "$dir/cflags" | tr '\n' ' ') "
+  # --list-flags CMD: exactly the rows of the whole table whose COMMANDS name CMD
+  awk -F'	' -v c="$c" 'index("," $3 ",", "," c ",")' "$dir/flags" | cmp -s - "$dir/cflags" ||
+    walk_fail "$c: --list-flags $c is not the table's rows naming $c"
+  # 'hfvis CMD --help' ends with each option's type, range, default and unit: --list-flags' columns
+  "$hfvis" "$c" --help | sed -n '/^values of /,$p' | sed 1d > "$dir/chelp"
+  awk -F'	' '{ s = sprintf("  %-18s  %s", $1 ($2 == "-" ? "" : " " $2), $4 == "-" ? "switch" : $4)
+    if ($5 != "-") s = s " in " $5; if ($6 != "-") s = s ", default " $6; if ($7 != "-") s = s ", unit " $7
+    print s }' "$dir/cflags" | cmp -s - "$dir/chelp" && help_n=$((help_n + $(wc -l < "$dir/chelp"))) ||
+    walk_fail "$c --help: its options' values differ from --list-flags $c"
   while IFS='	' read -r f v cmds _columns; do
+    case ",$cmds," in *",$c,"*) ;; *) case "$used" in *" $f "*) continue ;; esac ;; esac # another meaning's row
     walk_n=$((walk_n + 1))
     if [ "$v" = - ]; then err=$("$hfvis" "$c" "$f" 2>&1 > /dev/null); rc=$?
     else err=$("$hfvis" "$c" "$f" @bad 2>&1 > /dev/null); rc=$?; fi
@@ -1013,7 +1024,6 @@ while read -r c; do # one run per pair, no other process: the walk is ~2,000 run
 "*) n=2 ;; "") n=0 ;; *) n=1 ;; esac
     case "$used" in
     *" $f "*)
-      case ",$cmds," in *",$c,"*) ;; *) walk_fail "$c $f: --list-flags disagree" ;; esac
       case "$err" in *"is not used by"* | *"unknown option"*) walk_fail "$c uses $f but refused it: $err" ;; esac
       if [ "$rc" -ne 0 ] && [ "$n" -ne 1 ]; then walk_fail "$c $f: exit $rc with $n lines"; fi
       case "$err" in *expected*) case "$err" in *"$f"*) ;; *) walk_fail "$c $f @bad: not named in: $err" ;; esac ;; esac ;;
@@ -1023,6 +1033,8 @@ while read -r c; do # one run per pair, no other process: the walk is ~2,000 run
   done < "$dir/flags"
 done < "$dir/commands"
 [ "$walk_bad" -eq 0 ] && ok "walk: $walk_n command x flag pairs" || bad "walk: $walk_bad of $walk_n pairs"
+[ "$walk_bad" -eq 0 ] && [ "$help_n" -gt 0 ] && ok "every command's --help: the type, range, default and unit of its $help_n options as in --list-flags" ||
+  bad "--help values: $help_n lines checked"
 # every refusal of a bad number names the flag and its range
 "$hfvis" skyview "$h" --dirs 0 -o "$fdir/x.pfm" 2> "$dir/werr"
 grep -q -- '--dirs.*1\.\.65536' "$dir/werr" && ok "--dirs 0: flag and range" || bad "--dirs 0: $(cat "$dir/werr")"

@@ -195,14 +195,17 @@ static const char *const cli_conv_names[3] = { "compass", "grass", "grid" };
 
 /* A command (main.c, cli_commands): its name and one-line summary for `hfvis --help`, its --help
  * text, whether it needs IN and OUT and is estimated before it runs (cli_check_cost), the check
- * of its flags' combinations (NULL: none), and how it runs: run takes the parsed arguments
+ * of its flags' combinations (NULL: none), its memory and work estimate (run.c; set exactly for
+ * the commands that take --max-memory), and how it runs: run takes the parsed arguments
  * (cli_parse); main, for the commands with lists of inputs (sum, mosaic, info), takes the
- * command line. Exactly one of run and main is set. */
+ * command line. Exactly one of run and main is set; main.c checks the table before running. */
+typedef struct cli_cost cli_cost;
 enum { CLI_IN_NEEDED = 1, CLI_OUT_NEEDED = 2, CLI_COST_FIRST = 4 };
 typedef struct cli_command {
     const char *name, *summary, *help;
     int io; /* CLI_IN_NEEDED, CLI_OUT_NEEDED; CLI_COST_FIRST: estimated from the flags, before run */
     int (*check)(const cli_args *a);
+    cli_cost (*estimate)(const cli_args *a, int w, int h, int channels);
     int (*run)(const cli_args *a);
     int (*main)(int argc, char **argv);
 } cli_command;
@@ -248,10 +251,10 @@ static void cli_labels_free(cli_labels *L);
 static int cli_horizon_labels(const cli_args *a, cli_labels *L);
 
 /* What a run is expected to cost before it allocates: bytes at its peak and units of work. */
-typedef struct cli_cost {
+struct cli_cost {
     double bytes, work;
     const char *unit;
-} cli_cost;
+};
 
 /* The library's savers, through cli_write: encode into memory (need bytes), then write. */
 typedef hfvis_status (*cli_encoder)(const void *what, void *out, size_t cap, size_t *written);
@@ -307,7 +310,8 @@ static int cli_real(const char *flag, const char *s, double lo, int lo_open, dou
 static int cli_int(const char *flag, const char *s, long lo, long hi, const char *expect, int *out);
 static int cli_ends_with(const char *s, const char *ext);
 static int cli_command_of(const char *name);
-static size_t cli_flag_of(const char *name);
+static size_t cli_flag_for(const char *name, int cmd);
+static void cli_flag_defaults(cli_args *a);
 static int cli_refuse_flag(int cmd, const char *arg);
 static int cli_help(int cmd);
 static int cli_list_commands(int argc);
@@ -356,7 +360,21 @@ static int cli_same_file(const char *x, const char *y);
 static int cli_refuse_input(int overwrite, const char *out, const char *const *inputs, int n);
 static int cli_refuse_inputs(const cli_args *a, const char *out);
 /* run.c */
-static cli_cost cli_estimate(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_cost_of(double bytes, double work, const char *unit);
+static cli_cost cli_sweep_cost(const cli_args *a, int w, int h, double out, double ch, double cell_bytes,
+                               double node_bytes);
+static cli_cost cli_estimate_sweep(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_horizon(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_gi(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_visibility(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_indirect(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_solar(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_viewshed(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_ssao(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_voxelize(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_volgi(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_visfield(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_meshao(const cli_args *a, int w, int h, int channels);
 static int cli_out_channels(const cli_args *a);
 static int cli_check_cost(const cli_args *a, int w, int h, int channels);
 static int cli_halo(const cli_args *a, double cell);
@@ -365,7 +383,6 @@ static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double
 static float *cli_alloc(size_t a, size_t b, size_t c);
 static int cli_run_heights(const cli_args *a);
 /* sweeps.c */
-static int cli_set_gi(cli_args *a, const char *f, const char *v);
 static int cli_check_light_flags(const cli_args *a);
 static int cli_check_gi(const cli_args *a);
 static int cli_load_env(const char *path, float **px, hfvis_env *env);
