@@ -969,6 +969,7 @@ horizon exact|horizon --dirs 12 --exact
 skyview K=16|skyview --dirs 16
 skyview K=7|skyview --dirs 7 --azimuth0 10
 skyview exact|skyview --dirs 16 --exact
+skyview exact radius clamp|skyview --dirs 20 --exact --max-distance 40 --border clamp
 skyview radius clamp|skyview --dirs 16 --max-distance 40 --border clamp
 sky|sky --dirs 16 --sky 2 --albedo 0.5
 sky exact|sky --dirs 8 --exact
@@ -989,6 +990,9 @@ EOF
 for t in 1 2; do "$hfvis" skyview "$dir/rough.pfm" --cell 0.05 --max-distance 1.5 --window 10,8,30,25 --threads $t \
   --quiet -o "$dir/win$t.pfm" 2> "$dir/terr"; done
 cmp -s "$dir/win1.pfm" "$dir/win2.pfm" && ok "--threads with --window: the piece is the same" || bad "--threads with --window: $(cat "$dir/terr")"
+for t in 1 3; do "$hfvis" sky "$dir/rough.pfm" --exact --cell 0.05 --max-distance 1.5 --window 10,8,30,25 --threads $t \
+  --quiet -o "$dir/win$t.pfm" 2> "$dir/terr"; done
+cmp -s "$dir/win1.pfm" "$dir/win3.pfm" && ok "--threads with --window, exact bands: the piece is the same" || bad "--threads with --window, exact: $(cat "$dir/terr")"
 "$hfvis" skyview "$r" --dirs 16 --dir-range 0:8 --threads 2 -o "$fdir/p.hfvs" 2> "$dir/terr"
 [ $? -eq 2 ] && grep -q -- '--threads' "$dir/terr" && ok "--threads 2 with --dir-range refused by name" || bad "--threads with --dir-range: $(cat "$dir/terr")"
 "$hfvis" openness "$r" --threads 2 -o "$fdir/o.pfm" 2> "$dir/terr"

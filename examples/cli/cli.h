@@ -18,6 +18,7 @@
 #ifndef HFVIS_CLI_H
 #define HFVIS_CLI_H
 #define _POSIX_C_SOURCE 200809L /* isatty() under -std=c99 */
+#define _DEFAULT_SOURCE /* glibc: madvise's MADV_HUGEPAGE beside it (threads.c, cli_huge_alloc) */
 #include <ctype.h>
 #include <errno.h>
 #include <float.h>
@@ -31,6 +32,7 @@
 #include <signal.h>
 #if defined(__unix__) || (defined(__APPLE__) && defined(__MACH__))
 #include <sys/stat.h> /* stat(): an output that is an input */
+#include <sys/mman.h> /* madvise(): large blocks on huge pages (threads.c) */
 #include <unistd.h>
 #define CLI_HAVE_ISATTY 1
 #define CLI_HAVE_SIGACTION 1

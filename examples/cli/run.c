@@ -274,7 +274,9 @@ static float *cli_alloc(size_t a, size_t b, size_t c)
     if (a == 0 || b == 0 || c == 0 || a > SIZE_MAX / b || a * b > SIZE_MAX / c ||
         a * b * c > SIZE_MAX / sizeof(float))
         return NULL;
-    return (float *)calloc(a * b * c, sizeof(float)); /* zeros: a window run leaves cells unwritten */
+    float *p = (float *)cli_huge_malloc(a * b * c * sizeof(float)); /* huge pages where offered */
+    if (p) memset(p, 0, a * b * c * sizeof(float)); /* zeros: a window run leaves cells unwritten */
+    return p;
 }
 
 /* IN's size (and cell size, 0 when unknown) from its header alone, for --max-memory before
@@ -333,6 +335,7 @@ static int cli_run_heights(const cli_args *a)
     opts.azimuth0_rad = a->compass ? a->azimuth0 - CLI_PI / 2.0 : a->azimuth0;
     if (a->exact && a->cmd != CMD_VIEWSHED) opts.rays = HFVIS_RAYS_EXACT;
     if (a->cmd != CMD_VIEWSHED) opts.max_distance = a->max_distance; /* viewshed: its own range */
+    opts.alloc = &cli_huge_allocator; /* lattices and planes on huge pages where offered (threads.c) */
     if (a->run->win.active && a->cmd == CMD_OPENNESS) {
         /* openness marches --radius per receiver: the halo holds every cell a window receiver
          * reaches, and the window + halo grid's own border is the raster's wherever a march can
