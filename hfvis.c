@@ -11052,10 +11052,10 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
             return HFVIS_ERR_LIMIT;
         }
         az = (double *)hfvis__alloc_array(r.al, (size_t)K, sizeof(double));
-        map = (float *)hfvis__alloc_array(r.al, n * (size_t)K, sizeof(float));
-        if (!az || !map) st = HFVIS_ERR_OUT_OF_MEMORY;
+        map = r.c.o.horizon_map ? NULL : (float *)hfvis__alloc_array(r.al, n * (size_t)K, sizeof(float));
+        if (!az || (!map && !r.c.o.horizon_map)) st = HFVIS_ERR_OUT_OF_MEMORY;
         if (st == HFVIS_OK) st = hfvis_sweep_azimuths(K, &s, az, NULL);
-        if (st == HFVIS_OK) st = hfvis_horizon_map(g, K, &s, map);
+        if (st == HFVIS_OK && !r.c.o.horizon_map) st = hfvis_horizon_map(g, K, &s, map);
         if (st == HFVIS_OK && r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON) {
             sky = (float *)hfvis__alloc_array(r.al, n, sizeof(float));
             if (!sky) st = HFVIS_ERR_OUT_OF_MEMORY;
@@ -11066,9 +11066,10 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
             if (!cellmap) st = HFVIS_ERR_OUT_OF_MEMORY;
         }
         if (st == HFVIS_OK) {
+            const float *src = r.c.o.horizon_map ? r.c.o.horizon_map : map;
             int k;
             for (k = 0; k < K; k++)
-                for (i = 0; i < n; i++) cellmap[i * (size_t)K + (size_t)k] = map[(size_t)k * n + i];
+                for (i = 0; i < n; i++) cellmap[i * (size_t)K + (size_t)k] = src[(size_t)k * n + i];
         }
         hfvis__free(r.al, map);
         map = NULL;

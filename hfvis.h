@@ -1495,6 +1495,12 @@ typedef struct hfvis_solar_options {
     const hfvis_sweep_options *sweep; /* border, search radius, allocator, progress; its rays
                                     field is ignored (the horizon map is always exact rays) and
                                     its window and rectangle must be unset */
+    const float *horizon_map;    /* NULL: the fast routine makes its exact horizon map itself;
+                                    else the caller's, directions*width*height floats exactly as
+                                    hfvis_horizon_map writes them for these K directions with
+                                    HFVIS_RAYS_EXACT and the sweep options above (azimuth0 0,
+                                    every direction): e.g. made on several threads (the results
+                                    are then bit for bit those of NULL). The oracle ignores it */
 } hfvis_solar_options;
 
 HFVIS_API hfvis_solar_options hfvis_solar_options_default(void);

@@ -1068,6 +1068,9 @@ if [ "$little_endian" = 1 ]; then
     && ok "solar: the south row gets more than the north row ($south, $north Wh/m^2)" \
     || bad "solar: per-cell sites: south $south, north $north"
 fi
+expect_ok "solar --threads 3 (the horizon map by directions)" "$dir/solt3.pfm" solar "$dir/hill.pgm" --latitude 46 --longitude 15 --start 2026-03-01 --end 2026-03-05 --threads 3 -o "$dir/solt3.pfm"
+expect_ok "solar --threads 1" "$dir/solt1.pfm" solar "$dir/hill.pgm" --latitude 46 --longitude 15 --start 2026-03-01 --end 2026-03-05 -o "$dir/solt1.pfm"
+cmp -s "$dir/solt1.pfm" "$dir/solt3.pfm" && ok "solar --threads 3 equals one thread bit for bit" || bad "solar --threads 3 differs from one thread"
 expect_fail "solar: no latitude (no CRS)" 1 solar "$dir/flat.pgm" --day 2026-06-21 -o "$fdir/x.pfm"
 expect_fail "solar: a date that does not exist" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-02-29 -o "$fdir/x.pfm"
 expect_fail "solar: Linke outside (0, 10]" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --linke 0 -o "$fdir/x.pfm"

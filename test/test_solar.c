@@ -706,6 +706,31 @@ TEST(sites_convergence_and_bad_maps)
     CHECK_EQ_STATUS(hfvis_solar_irradiation(&g, &in, &bo, &b), HFVIS_ERR_INVALID_ARGUMENT);
 }
 
+/* A horizon map made by the caller (as hfvis_horizon_map writes it: e.g. on threads) gives the
+ * fast routine's results bit for bit, for a day (the step loop) and 30 days (the sector sums). */
+TEST(caller_horizon_map_bit_identical)
+{
+    hfvis_grid g = test_grid(zbuf, W, H, 1.0);
+    static float one[5][W * H], map[64 * W * H];
+    hfvis_sweep_options sw = hfvis_sweep_options_default();
+    int days, k, i;
+    fbm(zbuf, W, H, 6.0, 8.0, 9);
+    sw.rays = HFVIS_RAYS_EXACT;
+    CHECK_EQ_STATUS(hfvis_horizon_map(&g, 64, &sw, map), HFVIS_OK);
+    for (days = 1; days <= 30; days += 29) {
+        hfvis_solar_input in = site(-20.0, 9, 1);
+        hfvis_solar_options o = hfvis_solar_options_default();
+        hfvis_solar_output a = outs(one), b = outs(ob);
+        in.days = days;
+        o.diffuse = HFVIS_SOLAR_DIFFUSE_HORIZON;
+        CHECK_EQ_STATUS(hfvis_solar_irradiation(&g, &in, &o, &a), HFVIS_OK);
+        o.horizon_map = map;
+        CHECK_EQ_STATUS(hfvis_solar_irradiation(&g, &in, &o, &b), HFVIS_OK);
+        for (k = 0; k < 5; k++)
+            for (i = 0; i < W * H; i++) CHECK(memcmp(&one[k][i], &ob[k][i], sizeof(float)) == 0);
+    }
+}
+
 TEST(maps_holes_and_bad_input)
 {
     hfvis_grid g = test_grid(zbuf, 6, 6, 1.0);
@@ -817,6 +842,7 @@ int main(int argc, char **argv)
     RUN(sites_across_degrees_against_oracle);
     RUN(sites_blocks_within_tolerance);
     RUN(sites_convergence_and_bad_maps);
+    RUN(caller_horizon_map_bit_identical);
     RUN(maps_holes_and_bad_input);
     RUN(allocation_failures);
     return TEST_DONE();

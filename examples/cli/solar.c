@@ -244,6 +244,7 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     hfvis_solar_output out;
     float *planes[5] = { NULL, NULL, NULL, NULL, NULL }, *albedo = NULL, *linke = NULL, monthly[12];
     double *lats = NULL, *lons = NULL;
+    float *hmap = NULL;
     const char *paths[5];
     cli_tm tm;
     hfvis_status s;
@@ -328,6 +329,24 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
         }
     out.beam = planes[0]; out.diffuse = planes[1]; out.reflected = planes[2];
     out.global = planes[3]; out.sun_hours = planes[4];
+    if (a->threads > 1) { /* the exact horizon map by directions over the threads (bit for bit) */
+        hfvis_sweep_options ms = *opts;
+        int K = so.directions;
+        ms.rays = HFVIS_RAYS_EXACT; /* as the library's own map (hfvis_solar_options.horizon_map) */
+        ms.ray_denominator = 0;
+        ms.azimuth0_rad = 0.0;
+        ms.direction_begin = ms.direction_end = 0;
+        ms.direction_order = HFVIS_DIRECTION_ORDER_DEFAULT;
+        if (!(hmap = cli_alloc((size_t)w * (size_t)h, (size_t)K, 1))) {
+            rc = cli_status("solar", HFVIS_ERR_OUT_OF_MEMORY, 0);
+            goto done;
+        }
+        if ((s = cli_threaded_horizon_map(grid, K, &ms, a->threads, hmap)) != HFVIS_OK) {
+            rc = cli_status("solar", s, 0);
+            goto done;
+        }
+        so.horizon_map = hmap;
+    }
     s = hfvis_solar_irradiation(grid, &in, &so, &out);
     if (s == HFVIS_ERR_INVALID_ARGUMENT && (a->sol_linke_map || a->albedo_map)) {
         rc = cli_error(CLI_EXIT_ERROR, a->sol_linke_map ? a->sol_linke_map : a->albedo_map,
@@ -348,5 +367,6 @@ done:
     hfvis_free(NULL, albedo);
     hfvis_free(NULL, linke);
     free(lats);
+    free(hmap);
     return rc;
 }
