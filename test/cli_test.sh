@@ -1099,6 +1099,23 @@ expect_ok "solar: r.sun's solar time, monthly Linke, month bands" "$dir/solm.pfm
 grep -q '^hfvis solar: site 45\.153[78][0-9]*, 15\.0005[0-9]* ' "$dir/stderr" && "$hfvis" info "$dir/utm.tif" | grep -q 'crs projected' \
   && ok "solar: UTM 33N asc + .prj: the site by the inverse projection, GeoTIFF with the CRS" \
   || bad "solar: UTM site or CRS: $(grep site "$dir/stderr") $("$hfvis" info "$dir/utm.tif" | grep crs)"
+# tall.asc: 2 x 40 cells of 10 km in UTM 33N, 45.0 to 48.6 deg north: each cell its own site (by
+# the inverse projection), so on December 21 the south row (the PFM's first) gets more than the
+# north row (its last); one site for the whole grid would give the two the same.
+awk 'BEGIN { print "ncols 2"; print "nrows 40"; print "xllcorner 490000"; print "yllcorner 5000000"
+  print "cellsize 10000"; for (y = 0; y < 40; y++) print " 0 0" }' > "$dir/tall.asc"
+cp "$dir/utm.prj" "$dir/tall.prj"
+expect_ok "solar: per-cell sites over 3.6 deg of latitude" "$dir/tall.pfm" solar "$dir/tall.asc" --day 2026-12-21 --dirs 8 -o "$dir/tall.pfm"
+if [ "$little_endian" = 1 ]; then
+  south=$(od -An -tf4 -j $(($(wc -c < "$dir/tall.pfm") - 320)) -N 4 "$dir/tall.pfm" | tr -d ' ')
+  north=$(tail -c 4 "$dir/tall.pfm" | od -An -tf4 | tr -d ' ')
+  awk -v s="$south" -v n="$north" 'BEGIN { exit !(s > 1.15 * n && n > 0) }' \
+    && ok "solar: the south row gets more than the north row ($south, $north Wh/m^2)" \
+    || bad "solar: per-cell sites: south $south, north $north"
+fi
+expect_ok "solar --threads 3 (the horizon map by directions)" "$dir/solt3.pfm" solar "$dir/hill.pgm" --latitude 46 --longitude 15 --start 2026-03-01 --end 2026-03-05 --threads 3 -o "$dir/solt3.pfm"
+expect_ok "solar --threads 1" "$dir/solt1.pfm" solar "$dir/hill.pgm" --latitude 46 --longitude 15 --start 2026-03-01 --end 2026-03-05 -o "$dir/solt1.pfm"
+cmp -s "$dir/solt1.pfm" "$dir/solt3.pfm" && ok "solar --threads 3 equals one thread bit for bit" || bad "solar --threads 3 differs from one thread"
 expect_fail "solar: no latitude (no CRS)" 1 solar "$dir/flat.pgm" --day 2026-06-21 -o "$fdir/x.pfm"
 expect_fail "solar: a date that does not exist" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-02-29 -o "$fdir/x.pfm"
 expect_fail "solar: Linke outside (0, 10]" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --linke 0 -o "$fdir/x.pfm"

@@ -189,7 +189,8 @@ static const char *const cli_conv_names[3] = { "compass", "grass", "grid" };
                    | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_HILLSHADE))
 /* the commands whose work splits over threads bit for bit (--threads, threads.c) */
 #define CLI_THREADED (CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT) \
-                      | CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_HILLSHADE) | CLI_ONLY(CMD_OPENNESS))
+                      | CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_HILLSHADE) | CLI_ONLY(CMD_OPENNESS) \
+                      | CLI_ONLY(CMD_SOLAR))
 /* the [P2] hull-tree commands: a search radius but no windows in the library (hfvis.h, "Search
  * radius and tiles") */
 #define CLI_P2 (CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_INDIRECT))
