@@ -3456,6 +3456,8 @@ typedef struct hf_fused {
     int walk;               /* HF_WALK_SVF, HF_WALK_SKY: fn's sum added inside the line walk */
     double inv_k, lobe;     /* the sky term's 1/K and lobe factor (hf_sky_setup) */
     size_t extra_size;      /* extra scratch bytes the consumer needs (sw->extra) */
+    double *gacc_out;       /* NULL, or the caller's array to use as the grid accumulator
+                               (hfvis_direction_sums' sums): zeroed over the receiver rectangle */
     /* optional hooks: after a group's lattice is sampled, and instead of the P1 line walk */
     void (*group)(hf_sweep *sw, struct hf_fused *ctx);
     void (*orient)(hf_sweep *sw, int m, struct hf_fused *ctx);
@@ -3533,8 +3535,15 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
     hfvis_status s;
     int begin, end, per, groups, gidx, m, done = 0;
     if ((s = hf_direction_range(o, K, &begin, &end)) != HFVIS_OK) return s;
-    if ((s = hf_sweep_alloc_extra(sw, grid, o, want_normals, channels, 1, ctx->extra_size)) != HFVIS_OK)
+    if ((s = hf_sweep_alloc_extra(sw, grid, o, want_normals, channels, !ctx->gacc_out, ctx->extra_size)) != HFVIS_OK)
         return s;
+    if (ctx->gacc_out) { /* the caller's array: the receiver rectangle's values start at 0 */
+        int y;
+        sw->gacc = ctx->gacc_out;
+        for (y = sw->ry0; y < sw->ry1; y++)
+            memset(sw->gacc + ((size_t)y * (size_t)grid->width + (size_t)sw->rx0) * (size_t)channels, 0,
+                   (size_t)(sw->rx1 - sw->rx0) * (size_t)channels * sizeof(double));
+    }
     per = K % 4 == 0 ? 4 : 1;
     groups = K / per;
     for (gidx = 0; gidx < groups; gidx++) {
@@ -8130,6 +8139,7 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
     if (o.rays == HFVIS_RAYS_EXACT && kind != HFVIS_SUM_VISIBILITY)
         return hf_exact_direction_sums(grid, K, kind, env, eopts, &o, begin, end, sums);
     memset(&sky, 0, sizeof sky);
+    sky.gacc_out = sums; /* the grid accumulator is sums itself: no copy */
     switch (kind) {
     case HFVIS_SUM_SKY_VIEW:
         sky.walk = HF_WALK_SVF;
@@ -8145,6 +8155,7 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
         if (s != HFVIS_OK) return s;
         memset(&ec, 0, sizeof ec);
         ec.e = &eval;
+        ec.f.gacc_out = sums;
         s = hf_fused_run(&sw, grid, K, &o, channels, 1, hf_env_line, &ec.f);
         break;
     default: /* HFVIS_SUM_VISIBILITY */
@@ -8154,11 +8165,13 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
         break;
     }
     if (s == HFVIS_OK) {
-        for (y = sw.ry0; y < sw.ry1; y++) /* the receiver rectangle */
+        for (y = sw.ry0; y < sw.ry1; y++) /* the receiver rectangle (in place but for P2's) */
             for (x = sw.rx0; x < sw.rx1; x++) {
                 size_t i = ((size_t)y * (size_t)grid->width + (size_t)x) * (size_t)channels;
-                int hole = hf_is_hole(grid, x, y);
-                for (c = 0; c < channels; c++) sums[i + (size_t)c] = hole ? HFVIS__NAN : sw.gacc[i + (size_t)c];
+                if (hf_is_hole(grid, x, y))
+                    for (c = 0; c < channels; c++) sums[i + (size_t)c] = HFVIS__NAN;
+                else if (sw.gacc != sums)
+                    for (c = 0; c < channels; c++) sums[i + (size_t)c] = sw.gacc[i + (size_t)c];
             }
         hf_sweep_free(&sw);
     }
