@@ -97,16 +97,13 @@ typedef struct cli_flag {
 #define CLI_HAS(field) offsetof(cli_args, field)
 #define CLI_SWITCH CLI_V_NONE, 0.0, 0.0, 0, NULL, 0.0, "off", NULL, 0, 0, NULL, NULL
 #define CLI_TYPED(kind) kind, 0.0, 0.0, 0, NULL, 0.0, NULL, NULL, 0, 0, NULL, NULL
+#define CLI_WORDS(kind, def) kind, 0.0, 0.0, 0, NULL, 0.0, def, NULL, 0, 0, NULL, NULL /* its default */
 #define CLI_NUMBER(kind, lo, lo_open, hi, rule, dv, def, unit, field, has, word, then) \
     kind, lo, hi, lo_open, rule, dv, def, unit, offsetof(cli_args, field), has, word, then
 #define CLI_INT_AT(lo, hi, rule, dv, def, unit, field, has) \
     CLI_NUMBER(CLI_V_INT, lo, 0, hi, rule, dv, def, unit, field, has, NULL, NULL)
 #define CLI_REAL_AT(lo, lo_open, hi, rule, dv, def, unit, field, has) \
     CLI_NUMBER(CLI_V_REAL, lo, lo_open, hi, rule, dv, def, unit, field, has, NULL, NULL)
-/* the then hooks (defined after the table) */
-static int cli_then_zscale(cli_args *a, const char *v);
-static int cli_then_positions(cli_args *a, const char *v);
-static int cli_then_reflectance(cli_args *a, const char *v);
 static const cli_flag cli_flags[] = {
     { "-o", "OUT", CLI_OUT,
       CLI_TYPED(CLI_V_TEXT),
@@ -122,7 +119,7 @@ static const cli_flag cli_flags[] = {
       CLI_INT_AT(1, EX_RIO_MAX_BANDS, "a band number 1..65535", 0.0, "1", NULL, band, 0),
       "IN is a multi-band raster: use band N (1-based, default 1)\n" },
     { "--range", "LO:HI", CLI_PGM,
-      CLI_TYPED(CLI_V_LIST),
+      CLI_WORDS(CLI_V_LIST, "per command"),
       ".pgm only: the values mapped to 0 and 65535 (default per command)\n" },
     { "--cell", "S", CLI_HF,
       CLI_REAL_AT(0.0, 1, DBL_MAX, "a number > 0", 1.0, "georef or 1", "height units", cell,
@@ -142,7 +139,7 @@ static const cli_flag cli_flags[] = {
                  dirs, CLI_HAS(has_dirs)),
       "number of azimuth directions, 1..65536 (default 16)\n" },
     { "--convention", "C", CLI_ANGLES,
-      CLI_TYPED(CLI_V_CHOICE),
+      CLI_WORDS(CLI_V_CHOICE, "compass"),
       "how azimuths are read and directions ordered (height-field commands):\n"
       "                    compass (default): bearings clockwise from north, direction k at\n"
       "                    azimuth0 + 360k/K; grass: counter-clockwise from east (r.horizon,\n"
@@ -174,7 +171,7 @@ static const cli_flag cli_flags[] = {
       "                    is then a partial result, and 'hfvis sum' adds the parts of a split\n"
       "                    into the single run's OUT\n" },
     { "--border", "MODE", CLI_BORDER | CLI_ONLY(CMD_SOLAR),
-      CLI_TYPED(CLI_V_CHOICE),
+      CLI_WORDS(CLI_V_CHOICE, "open"),
       "open (nothing outside the grid, default), clamp (edge heights extend\n"
       "                    outward) or wrap (periodic field)\n" },
     { "--border-cells", "N", CLI_BORDER | CLI_ONLY(CMD_SOLAR),
@@ -223,7 +220,7 @@ static const cli_flag cli_flags[] = {
       "allow OUT to be one of the inputs (refused otherwise: same file,\n"
       "                    through hard and symbolic links too)\n" },
     { "--max-memory", "B", CLI_RUNS,
-      CLI_TYPED(CLI_V_BYTES),
+      CLI_WORDS(CLI_V_BYTES, "half the physical memory"),
       "refuse a run whose estimated memory exceeds B bytes (suffix K, M, G or\n"
       "                    T: powers of 1024; 0 = no limit); default half of the physical memory\n"
       "                    where the system reports it (sysconf), else no limit. The estimate and\n"
@@ -260,7 +257,7 @@ static const cli_flag cli_flags[] = {
       CLI_TYPED(CLI_V_TEXT), NULL },
     { "--method", "M", CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_SSAO)
                      | CLI_ONLY(CMD_MESHAO),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "per command"), NULL },
     { "--sun-irradiance", "E", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI),
       CLI_REAL_AT(0.0, 0, CLI_FLT_MAX, "an irradiance >= 0", CLI_PI, "pi", "irradiance",
                   sun_irradiance, CLI_HAS(has_sun_irradiance)), NULL },
@@ -272,7 +269,7 @@ static const cli_flag cli_flags[] = {
       CLI_INT_AT(0, CLI_MAX_BOUNCES, "an integer 0..1000", 1.0, NULL, "bounces", bounces,
                  CLI_HAS(has_bounces)), NULL },
     { "--output", "WHAT", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VOLGI),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "total"), NULL },
     { "--fraction", NULL, CLI_ONLY(CMD_VISIBILITY),
       CLI_SWITCH, NULL },
     { "--stats", NULL, CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_MESHAO),
@@ -289,9 +286,9 @@ static const cli_flag cli_flags[] = {
       CLI_INT_AT(1, CLI_MAX_RES, "an integer 1..2048", 0.0, "per command", "voxels", res, 0),
                  NULL },
     { "--mode", "M", CLI_ONLY(CMD_VOXELIZE),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "surface"), NULL },
     { "--axis", "A", CLI_ONLY(CMD_VOXELIZE),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "dominant (solid: z)"), NULL },
     { "--max-vertices", "N", CLI_ONLY(CMD_VOXELIZE),
       CLI_INT_AT(1, 1000000, "an integer 1..1000000", 0.0, "per method", "vertices", max_vertices,
                  0), NULL },
@@ -330,13 +327,13 @@ static const cli_flag cli_flags[] = {
     { "--fov", "DEG", CLI_ONLY(CMD_MESHAO),
       CLI_REAL_AT(1.0, 0, 179.0, "degrees in 1..179", 45.0, NULL, "degrees", lk_fov, 0), NULL },
     { "--size", "WxH", CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_MESHAO),
-      CLI_TYPED(CLI_V_LIST), NULL },
+      CLI_WORDS(CLI_V_LIST, "per command"), NULL },
     { "--transfer", "T", CLI_ONLY(CMD_VOLGI),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "cone"), NULL },
     { "--paths", "P", CLI_ONLY(CMD_VOLGI),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "all"), NULL },
     { "--reflection", "R", CLI_ONLY(CMD_VOLGI),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "mirror"), NULL },
     { "--reflectance", "R", CLI_ONLY(CMD_VOLGI),
       CLI_NUMBER(CLI_V_REAL, 0.0, 0, 1.0, "a reflectance in 0..1 or 'albedo'", 0.0,
                  "0.5", NULL, vg_rho, CLI_HAS(vg_has_rho), "albedo",
@@ -345,9 +342,9 @@ static const cli_flag cli_flags[] = {
       CLI_NUMBER(CLI_V_INT, 1, 0, INT_MAX, "a count 2(2n^2+2n+1) such as 290, 1090 or 4226",
                  0.0, "4226", "positions", vf_positions, 0, NULL, cli_then_positions), NULL },
     { "--format", "F", CLI_ONLY(CMD_VISFIELD),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "u8"), NULL },
     { "--mapping", "M", CLI_ONLY(CMD_VISFIELD),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "concentric"), NULL },
     { "--ao", NULL, CLI_ONLY(CMD_VISFIELD),
       CLI_SWITCH, NULL },
     { "--ground", "Z", CLI_ONLY(CMD_VISFIELD),
@@ -368,7 +365,7 @@ static const cli_flag cli_flags[] = {
     { "--reference", "MESH", CLI_ONLY(CMD_VISFIELD),
       CLI_TYPED(CLI_V_TEXT), NULL },
     { "--falloff", "F", CLI_ONLY(CMD_MESHAO),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "constant"), NULL },
     { "--two-sided", NULL, CLI_ONLY(CMD_MESHAO),
       CLI_SWITCH, NULL },
     { "--lut", "T", CLI_ONLY(CMD_MESHAO),
@@ -380,7 +377,7 @@ static const cli_flag cli_flags[] = {
     { "--no-jitter", NULL, CLI_ONLY(CMD_MESHAO),
       CLI_SWITCH, NULL },
     { "--pattern", "P", CLI_ONLY(CMD_MESHAO),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "torus"), NULL },
     { "--fov-y", "DEG", CLI_ONLY(CMD_SSAO),
       CLI_REAL_AT(0.0, 1, 179.999, "degrees in (0, 180)", 60.0, NULL, "degrees", ssao_fov, 0),
                   NULL },
@@ -401,7 +398,7 @@ static const cli_flag cli_flags[] = {
       CLI_INT_AT(0, 65536, "an integer 0..65536", -1.0, "W/10 and H/10", "pixels", ssao_guard, 0),
                  NULL },
     { "--depth", "ENC", CLI_ONLY(CMD_SSAO),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "linear"), NULL },
     { "--near", "N", CLI_ONLY(CMD_SSAO),
       CLI_REAL_AT(-CLI_FLT_MAX, 0, CLI_FLT_MAX, "a finite distance", 0.0, "none", "view units",
                   ssao_near, CLI_HAS(ssao_has_near)), NULL },
@@ -425,7 +422,7 @@ static const cli_flag cli_flags[] = {
       CLI_REAL_AT(0.0, 1, 1e12, "a radius > 0 (metres)", CLI_EARTH_RADIUS, NULL, "metres",
                   earth_radius, CLI_HAS(has_earth_radius)), NULL },
     { "--svf", "D", CLI_ONLY(CMD_SKYVIEW),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "zaksek"), NULL },
     { "--blend", "N", CLI_ONLY(CMD_HILLSHADE),
       CLI_INT_AT(1, 360, "a count of sun directions 1..360", 0.0, "1", "suns", blend, 0), NULL },
     { "--no-shadows", NULL, CLI_ONLY(CMD_HILLSHADE),
@@ -466,7 +463,7 @@ static const cli_flag cli_flags[] = {
     { "--solar-time", NULL, CLI_ONLY(CMD_SOLAR),
       CLI_SWITCH, NULL },
     { "--bands", "day|month", CLI_ONLY(CMD_SOLAR),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "one (the total)"), NULL },
     { "--beam", "OUT", CLI_ONLY(CMD_SOLAR),
       CLI_TYPED(CLI_V_TEXT), NULL },
     { "--diffuse", "OUT", CLI_ONLY(CMD_SOLAR),

@@ -41,7 +41,7 @@ static void cli_partial_tag(const cli_args *a, const hfvis_grid *grid, const hfv
     char *t = tag + n;
     size_t left = CLI_TAG_MAX - (size_t)n;
     switch (a->cmd) {
-    case CMD_HORIZON: /* and what `sum` needs for the planes' order and labels */
+    case CMD_HORIZON: /* and the convention, from which `sum` rebuilds the band labels */
         snprintf(t, left, " degrees=%d convention=%d", a->degrees, a->convention);
         break;
     case CMD_SKY: snprintf(t, left, " sky=%a albedo=%a", a->sky, a->albedo); break;
