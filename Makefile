@@ -206,3 +206,10 @@ fuzz-coverage:
 .PHONY: solar-rsun
 solar-rsun:
 	@CC="$(CC)" sh test/solar_rsun.sh
+# make solar-ephem: hfvis_spa against PyEphem (an independent implementation) over 2000 instants
+# and places, both hemispheres, polar day and night (test/solar_ephem.sh, under a minute); SKIPs
+# without python3's ephem (Debian: python3-ephem). make solar-check runs both comparisons.
+.PHONY: solar-ephem solar-check
+solar-ephem:
+	@CC="$(CC)" sh test/solar_ephem.sh
+solar-check: solar-ephem solar-rsun
