@@ -5155,9 +5155,106 @@ static void hf_p2_orient(hf_sweep *sw, int m, hf_fused *f)
     }
 }
 
+/* The P2 consumers' stranded receivers (hf_stranded_tan's rule, for visible sets): a grid point
+ * with a finite height whose gather found no finite node holds NaN in sw->gacc. Its line toward
+ * each direction of [begin, end) is made by the oracle's march instead of the lattice: unit
+ * steps from the receiver along the look direction, bilinear heights and exit radiance, holes
+ * skipped, out of the grid and then the sweep's pre-roll steps under the border rule (so at
+ * most the lattice line's length: c->len). hf_visible_naive finds the visible set (the search
+ * radius c->win included) and the consumer adds its term to a one-node lattice whose normal is
+ * the grid normal (one-sided beside holes). The statistics stay the lattice sweep's. */
+static void hf_p2_stranded(hf_sweep *sw, int K, const hfvis_sweep_options *o, hf_p2_ctx *c)
+{
+    const hfvis_grid *g = sw->g;
+    const int ch = sw->channels, cc = c->channels;
+    const double inv_cs = 1.0 / g->cell_size, xmax = (double)(g->width - 1) + HF_LATTICE_EPS,
+                 ymax = (double)(g->height - 1) + HF_LATTICE_EPS;
+    double *lat = sw->lat, one[4];
+    float *nrm = sw->nrm, n1[3];
+    hfvis_visibility_stats st = c->st;
+    int x, y, q, k, begin, end;
+    if (!c->ld || ch > 4 || hf_direction_range(o, K, &begin, &end) != HFVIS_OK) return;
+    for (y = sw->ry0; y < sw->ry1; y++)
+        for (x = sw->rx0; x < sw->rx1; x++) {
+            double *acc = sw->gacc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)ch, nd[3];
+            int stranded = 0;
+            if (hf_is_hole(g, x, y)) continue;
+            for (q = 0; q < ch; q++) stranded |= isnan(acc[q]);
+            if (!stranded) continue;
+            if (sw->nrm) {
+                hf_normal_at(g, x, y, nd);
+                n1[0] = (float)nd[0];
+                n1[1] = (float)nd[1];
+                n1[2] = (float)nd[2];
+                sw->nrm = n1;
+            }
+            for (q = 0; q < ch; q++) one[q] = 0.0;
+            sw->lat = one;
+            for (k = 0; k < K; k++) {
+                int pos = hf_direction_position(o, K, k), n = 0, out = 0, i, nv;
+                double ux, uy, d;
+                if (pos < begin || pos >= end) continue;
+                hf_sweep_vector(o->azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K, &ux, &uy);
+                c->f.K = K;
+                c->f.k = k;
+                c->f.lx = -ux;
+                c->f.ly = -uy;
+                /* near to far: in-grid steps, then the pre-roll; reversed below (far first) */
+                for (d = 1.0; n + 1 < c->len; d += 1.0) {
+                    double px = (double)x - d * ux, py = (double)y - d * uy, h;
+                    if (px < -HF_LATTICE_EPS || py < -HF_LATTICE_EPS || px > xmax || py > ymax) {
+                        if (out == sw->preroll) break;
+                        out++;
+                    }
+                    px = px < 0.0 && px > -HF_LATTICE_EPS ? 0.0 : px; /* as hf_march_slopes */
+                    py = py < 0.0 && py > -HF_LATTICE_EPS ? 0.0 : py;
+                    h = hf_sample_border(g, sw->border, px, py) * inv_cs;
+                    if (isnan(h)) continue;
+                    c->ld[n] = -d;
+                    c->lh[n] = h;
+                    if (cc) hf_sample_channels(g, sw->border, c->exit, cc, px, py, c->le + (size_t)n * (size_t)cc);
+                    c->vis[n] = out > 0; /* outside the grid: a pre-roll sample */
+                    n++;
+                }
+                c->npre = 0;
+                for (i = 0; i < n / 2; i++) { /* far first, as a lattice line */
+                    int j = n - 1 - i, t, e;
+                    double v = c->ld[i];
+                    c->ld[i] = c->ld[j];
+                    c->ld[j] = v;
+                    v = c->lh[i];
+                    c->lh[i] = c->lh[j];
+                    c->lh[j] = v;
+                    t = c->vis[i];
+                    c->vis[i] = c->vis[j];
+                    c->vis[j] = t;
+                    for (e = 0; e < cc; e++) {
+                        v = c->le[(size_t)i * (size_t)cc + (size_t)e];
+                        c->le[(size_t)i * (size_t)cc + (size_t)e] = c->le[(size_t)j * (size_t)cc + (size_t)e];
+                        c->le[(size_t)j * (size_t)cc + (size_t)e] = v;
+                    }
+                }
+                for (i = 0; i < n; i++) c->npre += c->vis[i];
+                c->ld[n] = 0.0;
+                c->lh[n] = (double)g->z[(ptrdiff_t)y * g->stride + x] * inv_cs;
+                for (i = 0; i <= n; i++) {
+                    c->wd[i] = c->ld[i] * g->cell_size;
+                    c->wh[i] = c->lh[i] * g->cell_size;
+                }
+                nv = hf_visible_naive(c->ld, c->lh, n, c->win, c->vis, c->len);
+                c->fn(sw, c, 0, n, c->vis, nv, c->hz, 0);
+            }
+            sw->lat = lat;
+            sw->nrm = nrm;
+            for (q = 0; q < ch; q++) acc[q] = one[q];
+        }
+    c->st = st;
+}
+
 static hfvis_status hf_p2_run(hf_sweep *sw, const hfvis_grid *grid, int K, hfvis_sweep_options *o,
                               int out_channels, int want_normals, hf_p2_ctx *c)
 {
+    hfvis_status s;
     int ok = 1;
     if (o->rays == HFVIS_RAYS_EXACT) return HFVIS_ERR_INVALID_ARGUMENT; /* lattices only (hfvis.h) */
     if (hf_p2_opts_limited(o)) return HFVIS_ERR_INVALID_ARGUMENT;
@@ -5173,7 +5270,9 @@ static hfvis_status hf_p2_run(hf_sweep *sw, const hfvis_grid *grid, int K, hfvis
     if (!ok) return HFVIS_ERR_LIMIT;
     c->f.group = hf_p2_group;
     c->f.orient = hf_p2_orient;
-    return hf_fused_run(sw, grid, K, o, out_channels, want_normals, NULL, &c->f);
+    if ((s = hf_fused_run(sw, grid, K, o, out_channels, want_normals, NULL, &c->f)) != HFVIS_OK) return s;
+    if (!c->user_fn) hf_p2_stranded(sw, K, o, c); /* the gathered outputs (not the events) */
+    return HFVIS_OK;
 }
 
 /* Consumer: visible in-grid samples per receiver (the visibility index). */

@@ -144,8 +144,10 @@
  *   Every receiver with a finite height gets a value: one stranded between holes, where the
  *   lattice holds no finite node near it, takes the per-receiver march of the oracle
  *   (hfvis_horizon_reference) toward each direction instead of the gathered lattice (horizon
- *   maps and every lattice product built on them or on the fused sums; hfvis_indirect_light
- *   alone still leaves NaN there). Grid normals are one-sided beside holes.
+ *   maps and every lattice product built on them or on the fused sums; for
+ *   hfvis_indirect_light and hfvis_visibility_count the march's samples form the receiver's
+ *   line: out of the grid, then border_cells pre-roll steps). Grid normals are one-sided beside
+ *   holes.
  * Obscurance and light. Obscurance outputs lie in [0, 1] (0 = nothing blocks). Lighting outputs
  *   are radiance with the Lambertian convention L_o = albedo/pi * Int L_i V (n.w) dw, so an
  *   unoccluded flat receiver under a uniform sky of radiance c with albedo 1 returns c.
