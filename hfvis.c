@@ -3456,6 +3456,8 @@ typedef struct hf_fused {
     int walk;               /* HF_WALK_SVF, HF_WALK_SKY: fn's sum added inside the line walk */
     double inv_k, lobe;     /* the sky term's 1/K and lobe factor (hf_sky_setup) */
     size_t extra_size;      /* extra scratch bytes the consumer needs (sw->extra) */
+    double *gacc_out;       /* NULL, or the caller's array to use as the grid accumulator
+                               (hfvis_direction_sums' sums): zeroed over the receiver rectangle */
     /* optional hooks: after a group's lattice is sampled, and instead of the P1 line walk */
     void (*group)(hf_sweep *sw, struct hf_fused *ctx);
     void (*orient)(hf_sweep *sw, int m, struct hf_fused *ctx);
@@ -3533,8 +3535,15 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
     hfvis_status s;
     int begin, end, per, groups, gidx, m, done = 0;
     if ((s = hf_direction_range(o, K, &begin, &end)) != HFVIS_OK) return s;
-    if ((s = hf_sweep_alloc_extra(sw, grid, o, want_normals, channels, 1, ctx->extra_size)) != HFVIS_OK)
+    if ((s = hf_sweep_alloc_extra(sw, grid, o, want_normals, channels, !ctx->gacc_out, ctx->extra_size)) != HFVIS_OK)
         return s;
+    if (ctx->gacc_out) { /* the caller's array: the receiver rectangle's values start at 0 */
+        int y;
+        sw->gacc = ctx->gacc_out;
+        for (y = sw->ry0; y < sw->ry1; y++)
+            memset(sw->gacc + ((size_t)y * (size_t)grid->width + (size_t)sw->rx0) * (size_t)channels, 0,
+                   (size_t)(sw->rx1 - sw->rx0) * (size_t)channels * sizeof(double));
+    }
     per = K % 4 == 0 ? 4 : 1;
     groups = K / per;
     for (gidx = 0; gidx < groups; gidx++) {
@@ -8114,8 +8123,14 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
     float *table = NULL;
     hfvis_status s;
     int channels = 1, begin, end, x, y, c;
-    if (hf_check_common(grid, opts) != HFVIS_OK || !sums || K < 1 || kind < HFVIS_SUM_SKY_VIEW ||
-        kind > HFVIS_SUM_VISIBILITY || (kind == HFVIS_SUM_ENV_LIGHT && !hf_env_valid(env)))
+    if (opts) { /* bands: exact rays only (below), the rest checked as for one call */
+        o = *opts;
+        if (!hf_parts_valid(opts)) return HFVIS_ERR_INVALID_ARGUMENT;
+        o.part_index = o.part_count = 0;
+    }
+    if (hf_check_common(grid, opts ? &o : NULL) != HFVIS_OK || !sums || K < 1 || kind < HFVIS_SUM_SKY_VIEW ||
+        kind > HFVIS_SUM_VISIBILITY || (kind == HFVIS_SUM_ENV_LIGHT && !hf_env_valid(env)) ||
+        (opts && opts->part_count > 1 && (opts->rays != HFVIS_RAYS_EXACT || kind == HFVIS_SUM_VISIBILITY)))
         return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
     if (hf_direction_range(&o, K, &begin, &end) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
@@ -8124,6 +8139,7 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
     if (o.rays == HFVIS_RAYS_EXACT && kind != HFVIS_SUM_VISIBILITY)
         return hf_exact_direction_sums(grid, K, kind, env, eopts, &o, begin, end, sums);
     memset(&sky, 0, sizeof sky);
+    sky.gacc_out = sums; /* the grid accumulator is sums itself: no copy */
     switch (kind) {
     case HFVIS_SUM_SKY_VIEW:
         sky.walk = HF_WALK_SVF;
@@ -8139,6 +8155,7 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
         if (s != HFVIS_OK) return s;
         memset(&ec, 0, sizeof ec);
         ec.e = &eval;
+        ec.f.gacc_out = sums;
         s = hf_fused_run(&sw, grid, K, &o, channels, 1, hf_env_line, &ec.f);
         break;
     default: /* HFVIS_SUM_VISIBILITY */
@@ -8148,11 +8165,13 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
         break;
     }
     if (s == HFVIS_OK) {
-        for (y = sw.ry0; y < sw.ry1; y++) /* the receiver rectangle */
+        for (y = sw.ry0; y < sw.ry1; y++) /* the receiver rectangle (in place but for P2's) */
             for (x = sw.rx0; x < sw.rx1; x++) {
                 size_t i = ((size_t)y * (size_t)grid->width + (size_t)x) * (size_t)channels;
-                int hole = hf_is_hole(grid, x, y);
-                for (c = 0; c < channels; c++) sums[i + (size_t)c] = hole ? HFVIS__NAN : sw.gacc[i + (size_t)c];
+                if (hf_is_hole(grid, x, y))
+                    for (c = 0; c < channels; c++) sums[i + (size_t)c] = HFVIS__NAN;
+                else if (sw.gacc != sums)
+                    for (c = 0; c < channels; c++) sums[i + (size_t)c] = sw.gacc[i + (size_t)c];
             }
         hf_sweep_free(&sw);
     }
@@ -8609,8 +8628,9 @@ typedef struct hf_exact {
     int ox, oy;             /* the tile's origin in the raster (hfvis.h, "Search radius and tiles") */
     int rx0, ry0, rx1, ry1; /* the receiver rectangle, [rx0, rx1) x [ry0, ry1) */
     int rect;               /* 1: a proper sub-rectangle */
-    int parts, part;        /* bands across the direction (hfvis_sun_visibility), 0 = off */
+    int parts, part;        /* bands across the direction (part_index/part_count), 0 = off */
     int64_t c0, cspan;      /* the receivers' line index c = x*b - y*a: its least value, count */
+    int64_t clo, chi;       /* this band's lines: clo <= c <= chi */
     void *block;
     const hfvis_allocator *alloc;
 } hf_exact;
@@ -8632,14 +8652,42 @@ static void hf_exact_parts(hf_exact *E, const hfvis_sweep_options *o, hf_ray r)
     }
     E->c0 = lo;
     E->cspan = hi - lo + 1;
+    /* band p holds the c with floor((c - c0) parts / cspan) == p, i.e. the c - c0 from
+       ceil(p cspan / parts) to ceil((p + 1) cspan / parts) - 1 */
+    E->clo = lo + ((int64_t)E->part * E->cspan + E->parts - 1) / (E->parts ? E->parts : 1);
+    E->chi = lo + ((int64_t)(E->part + 1) * E->cspan + E->parts - 1) / (E->parts ? E->parts : 1) - 1;
 }
 
 /* 1 if the line through receiver (x, y) along (a, b) is one of this call's. */
 static int hf_exact_mine(const hf_exact *E, int x, int y, hf_ray r)
 {
     int64_t v = (int64_t)x * (int64_t)r.b - (int64_t)y * (int64_t)r.a;
-    if (!E->parts) return 1;
-    return (v - E->c0) * (int64_t)E->parts / E->cspan == (int64_t)E->part;
+    return !E->parts || (v >= E->clo && v <= E->chi);
+}
+
+/* This call's receivers in row y of the receiver rectangle: [*x0, *x1), the x whose line
+ * (hf_exact_mine) is its own; c = x*b - y*a is monotone in x, so they are one run. */
+static void hf_exact_span(const hf_exact *E, int y, hf_ray r, int *x0, int *x1)
+{
+    int64_t lo = E->rx0, hi = (int64_t)E->rx1 - 1, ya = (int64_t)y * (int64_t)r.a, b = r.b;
+    if (E->parts && b == 0) { /* c = -y*a along the whole row */
+        if (-ya < E->clo || -ya > E->chi) hi = lo - 1;
+    } else if (E->parts) { /* clo <= x b - y a <= chi */
+        int64_t p = E->clo + ya, q = E->chi + ya, t;
+        if (b < 0) { /* x|b| between -q and -p */
+            t = p;
+            p = -q;
+            q = -t;
+            b = -b;
+        }
+        t = -hf_floor_div64(-p, b); /* ceil(p / b) */
+        if (t > lo) lo = t;
+        t = hf_floor_div64(q, b);
+        if (t < hi) hi = t;
+    }
+    if (hi < lo) hi = lo - 1;
+    *x0 = (int)lo;
+    *x1 = (int)(hi + 1);
 }
 
 /* The piece after each crossing e (to crossing e + 1, the last one to the next grid point at
@@ -9089,9 +9137,10 @@ static void hf_exact_near(hf_exact *E, hf_ray r, double L, double scale)
         const int cy = b < 0 ? y - 1 : y, sx = a < 0 ? -1 : 1;
         const ptrdiff_t sy = b < 0 ? -g->stride : g->stride;
         const int in_row = cy >= 0 && cy + 1 < g->height;
-        for (x = E->rx0; x < E->rx1; x++) {
+        int x0, x1;
+        hf_exact_span(E, y, r, &x0, &x1); /* this call's lines: the others' were not swept */
+        for (x = x0; x < x1; x++) {
             double s;
-            if (E->parts && !hf_exact_mine(E, x, y, r)) continue; /* another call's line */
             if (isnan(t[x])) continue;
             if (diag) {
                 int cx = a < 0 ? x - 1 : x;
@@ -9226,7 +9275,8 @@ static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, co
 
 /* Scratch of one exact-mode call, one block: the K directions and their quadrature, the
  * crossings, one line's samples and receivers (the hull stack in place), the tangent plane, and
- * optionally grid normals and a channels-deep accumulator. */
+ * optionally grid normals (want_normals 1; 2: room for them, filled by the caller) and a
+ * channels-deep accumulator. */
 static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
                                   const hfvis_sweep_options *o, int want_tan, int want_normals,
                                   int channels)
@@ -9295,7 +9345,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     if (E->radius > 0.0) hf_win_carve(&E->win, blk + off_win, cap);
     E->rec = (int *)(void *)(blk + off_r);
     hf_exact_dirs_fill(&E->d, K, o->azimuth0_rad, E->N);
-    if (want_normals) (void)hfvis_normals_compute(g, E->nrm); /* the grid normals, as floats */
+    if (want_normals == 1) (void)hfvis_normals_compute(g, E->nrm); /* the grid normals, as floats */
     if (channels) memset(E->acc, 0, gridn * (size_t)channels * sizeof(double));
     return HFVIS_OK;
 }
@@ -9401,16 +9451,24 @@ static hfvis_status hf_exact_env_tables(const hf_exact_dirs *d, const hfvis_env 
 /* The per-receiver direction sums S of hfvis_direction_sums for kind (SKY_VIEW, SKY_LIGHT or
  * ENV_LIGHT) over positions [begin, end), in exact mode: T_k = K w_k sin(max(alpha_k, 0)) for the
  * sky-view factor (so the finish 1 - S/K is unchanged), hf_exact_sky_term for the sky, the
- * environment tables of the exact sectors. On HFVIS_OK E->acc holds S (the caller frees E). */
+ * environment tables of the exact sectors. On HFVIS_OK E->acc holds S (the caller frees E).
+ * With bands (o->part_count > 1) each direction's terms go only to the receivers on its band's
+ * lines (hf_exact_span) and are added to the caller's running sums `add` instead (holes NaN);
+ * the normals are then made per receiver and direction, as the grid's would be, not for the
+ * whole grid. */
 static hfvis_status hf_exact_sums(hf_exact *E, const hfvis_grid *g, int K, hfvis_sum_kind kind,
                                   const hfvis_env *env, const hfvis_env_options *eopts,
-                                  const hfvis_sweep_options *o, int begin, int end)
+                                  const hfvis_sweep_options *o, int begin, int end, double *add)
 {
     hfvis_status s;
     hf_env_eval eval;
     float *table = NULL;
-    int channels = kind == HFVIS_SUM_ENV_LIGHT ? env->channels : 1, k, done = 0, x, y;
-    if ((s = hf_exact_init(E, g, K, o, 1, kind != HFVIS_SUM_SKY_VIEW, channels)) != HFVIS_OK) return s;
+    int channels = kind == HFVIS_SUM_ENV_LIGHT ? env->channels : 1, k, done = 0, x, y, x0, x1, c;
+    const int banded = o->part_count > 1;
+    if ((s = hf_exact_init(E, g, K, o, 1, kind == HFVIS_SUM_SKY_VIEW ? 0 : banded ? 2 : 1,
+                           banded ? 0 : channels)) != HFVIS_OK)
+        return s;
+    E->channels = channels;
     if (kind == HFVIS_SUM_ENV_LIGHT &&
         (s = hf_exact_env_tables(&E->d, env, eopts, o->alloc, &table, &eval)) != HFVIS_OK) {
         hf_exact_free(E);
@@ -9421,25 +9479,39 @@ static hfvis_status hf_exact_sums(hf_exact *E, const hfvis_grid *g, int K, hfvis
         double wk = (double)K * E->d.w[k];
         double cp = cos(E->d.ray[k].azimuth), sp = sin(E->d.ray[k].azimuth);
         if (pos < begin || pos >= end) continue;
+        hf_exact_parts(E, o, E->d.ray[k]);
         hf_exact_sweep(E, E->d.ray[k]);
-        for (y = E->ry0; y < E->ry1; y++) { /* the receiver rectangle, one loop per kind */
+        for (y = E->ry0; y < E->ry1; y++) { /* the receiver rectangle (band), one loop per kind */
             size_t r = (size_t)y * (size_t)g->width, i;
             const double *tr = E->tan + r;
-            double *ar = E->acc + r * (size_t)channels;
+            double *acc = banded ? add : E->acc, *ar = acc + r * (size_t)channels;
+            hf_exact_span(E, y, E->d.ray[k], &x0, &x1);
+            for (x = x0; banded && x < x1; x++) { /* a band's holes and normals */
+                double n[3];
+                float *nr = E->nrm ? E->nrm + (r + (size_t)x) * 3 : NULL;
+                if (hf_is_hole(g, x, y))
+                    for (c = 0; c < channels; c++) ar[(size_t)x * (size_t)channels + (size_t)c] = HFVIS__NAN;
+                else if (nr) { /* hfvis_normals_compute's bits */
+                    hf_normal_at(g, x, y, n);
+                    nr[0] = (float)n[0];
+                    nr[1] = (float)n[1];
+                    nr[2] = (float)n[2];
+                }
+            }
             if (kind == HFVIS_SUM_SKY_VIEW) {
-                for (x = E->rx0; x < E->rx1; x++)
+                for (x = x0; x < x1; x++)
                     if (!isnan(tr[x])) ar[x] += wk * hf_svf_term(tr[x]);
             } else if (kind == HFVIS_SUM_SKY_LIGHT) {
-                for (x = E->rx0; x < E->rx1; x++)
+                for (x = x0; x < x1; x++)
                     if (!isnan(tr[x]))
                         ar[x] += hf_exact_sky_term(&E->d, k, cp, sp, E->nrm + (r + (size_t)x) * 3, tr[x]);
             } else {
-                for (x = E->rx0; x < E->rx1; x++) {
+                for (x = x0; x < x1; x++) {
                     const float *nr = E->nrm + (r + (size_t)x) * 3;
                     if (isnan(tr[x])) continue;
                     i = r + (size_t)x;
                     hf_env_accumulate(&eval, k, cp, sp, (double)nr[0], (double)nr[1], (double)nr[2], tr[x],
-                                      E->acc + i * (size_t)channels);
+                                      acc + i * (size_t)channels);
                 }
             }
         }
@@ -9475,7 +9547,7 @@ static hfvis_status hf_exact_light(const hfvis_grid *g, int K, hfvis_sum_kind ki
     int begin, end, k;
     double offset = 0.0;
     if ((s = hf_direction_range(o, K, &begin, &end)) != HFVIS_OK) return s;
-    if ((s = hf_exact_sums(&E, g, K, kind, env, eopts, o, begin, end)) != HFVIS_OK) return s;
+    if ((s = hf_exact_sums(&E, g, K, kind, env, eopts, o, begin, end, NULL)) != HFVIS_OK) return s;
     if (kind == HFVIS_SUM_SKY_VIEW) /* the range's share of 1 - S/K: its weights, exact */
         for (k = 0; k < K; k++) {
             int pos = hf_direction_position(o, K, k);
@@ -9494,18 +9566,19 @@ static hfvis_status hf_exact_sun(const hfvis_grid *g, double azimuth, double ele
     hfvis_sweep_options o1 = *o;
     hf_exact E;
     hfvis_status s;
-    int x, y;
+    int x, y, x0, x1;
     o1.azimuth0_rad = azimuth;
     if ((s = hf_exact_init(&E, g, 1, &o1, 1, 0, 0)) != HFVIS_OK) return s;
     hf_exact_parts(&E, o, E.d.ray[0]);
     hf_exact_sweep(&E, E.d.ray[0]);
-    for (y = E.ry0; y < E.ry1; y++)
-        for (x = E.rx0; x < E.rx1; x++) {
+    for (y = E.ry0; y < E.ry1; y++) {
+        hf_exact_span(&E, y, E.d.ray[0], &x0, &x1); /* the band's receivers of the row */
+        for (x = x0; x < x1; x++) {
             double t = E.tan[(size_t)y * (size_t)g->width + (size_t)x];
-            if (!hf_exact_mine(&E, x, y, E.d.ray[0])) continue;
             out[(ptrdiff_t)y * out_stride + x] =
                 (float)hf_sun_fraction(elevation, radius, hf_tan_to_elevation(t));
         }
+    }
     hf_exact_free(&E);
     hf_progress(o, 1, 1);
     return HFVIS_OK;
@@ -9601,8 +9674,8 @@ static hfvis_status hf_exact_direction_sums(const hfvis_grid *g, int K, hfvis_su
     hf_exact E;
     hfvis_status s;
     int x, y, c;
-    if ((s = hf_exact_sums(&E, g, K, kind, env, eopts, o, begin, end)) != HFVIS_OK) return s;
-    for (y = E.ry0; y < E.ry1; y++)
+    if ((s = hf_exact_sums(&E, g, K, kind, env, eopts, o, begin, end, sums)) != HFVIS_OK) return s;
+    for (y = E.ry0; o->part_count <= 1 && y < E.ry1; y++) /* bands added to sums in place */
         for (x = E.rx0; x < E.rx1; x++) {
             size_t i = ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)E.channels;
             int hole = hf_is_hole(g, x, y);

@@ -162,11 +162,12 @@
  * Threads. The library starts none. Inputs (grids, environments, tables, options, meshes) are
  *   only read, so any number of calls may share them while no call writes them; an allocator
  *   shared by concurrent calls must itself be thread-safe (give each thread its own). Outputs
- *   must not overlap, with one exception: the bands of hfvis_sun_visibility (sweep options
- *   part_index/part_count) write disjoint cells, so the part_count calls of one sun may write
- *   one out concurrently. Splitting a run over threads without changing a bit: the sums by
- *   direction range (hfvis_direction_sums: one quarter-turn group, or in exact mode one
- *   direction, per part, added in order), the horizon map by plane range, one sun by bands,
+ *   must not overlap, with one exception: bands (sweep options part_index/part_count) write
+ *   disjoint cells, so the part_count calls of one sun (hfvis_sun_visibility), or of one
+ *   direction of exact-mode sums (hfvis_direction_sums), may write one out concurrently.
+ *   Splitting a run over threads without changing a bit: the lattice sums by quarter-turn group
+ *   (hfvis_direction_sums, one group per part, added in order), the exact sums by bands of one
+ *   direction at a time (added in place), the horizon map by plane range, one sun by bands,
  *   and any receiver-local result by windows ("Search radius and tiles"). The hfvis tool's
  *   --threads does exactly that; test/thread_test.c runs these calls concurrently on shared
  *   inputs under ThreadSanitizer (make sanitize).
@@ -637,17 +638,18 @@ typedef struct hfvis_sweep_options {
                                        (inside it, else HFVIS_ERR_INVALID_ARGUMENT); */
     int receiver_width, receiver_height; /* 0, 0 = every receiver (default); outputs outside it
                                        are left unwritten; the work shrinks with it */
-    int part_index, part_count;     /* hfvis_sun_visibility only (both ray modes): compute only the
-                                       receivers of band part_index of part_count bands across the
-                                       sun's direction (each receiver belongs to the band of its
-                                       distance across the sweep lines), so that threads can share
-                                       one call's lines: every receiver is in exactly one band, its
-                                       output equals the whole call's bit for bit, cells of the
-                                       other bands are left unwritten (the calls may then write one
-                                       out concurrently, see "Threads"). 0, 0 = every receiver
-                                       (default); else 0 <= part_index < part_count <= 65536
-                                       (HFVIS_ERR_INVALID_ARGUMENT otherwise, and from every other
-                                       routine for part_count > 1) */
+    int part_index, part_count;     /* hfvis_sun_visibility (both ray modes) and, in exact mode,
+                                       hfvis_direction_sums: compute only the receivers of band
+                                       part_index of part_count bands across each direction (each
+                                       receiver belongs to the band of its distance across the
+                                       sweep lines), so that threads can share one call's lines:
+                                       every receiver is in exactly one band, its output equals
+                                       the whole call's bit for bit, cells of the other bands are
+                                       left alone (the calls may then write one out concurrently,
+                                       see "Threads"; hfvis_direction_sums adds to its sums then).
+                                       0, 0 = every receiver (default); else 0 <= part_index <
+                                       part_count <= 65536 (HFVIS_ERR_INVALID_ARGUMENT otherwise,
+                                       and from every other routine and mode for part_count > 1) */
 } hfvis_sweep_options;
 
 HFVIS_API hfvis_sweep_options hfvis_sweep_options_default(void);
@@ -2187,8 +2189,17 @@ typedef enum hfvis_sum_kind {
  * sums[(y*width + x)*channels + c]: channels = env->channels for HFVIS_SUM_ENV_LIGHT, else 1;
  * NaN at holes. env and eopts are used by HFVIS_SUM_ENV_LIGHT only (env required there, else
  * may be NULL). Scratch: that of the matching routine (hfvis_sky_light etc.).
+ * Bands (exact rays, sky view / sky light / environment, opts->part_count > 1): the call ADDS
+ * each direction's terms, direction by direction in index order, to sums at the receivers on
+ * its band's lines of that direction (NaN at their holes) and leaves every other value alone;
+ * sums then holds a running S. Calling the part_count bands of direction k, then those of
+ * k + 1, ..., on sums zeroed once adds each receiver's terms in the whole call's order, so S is
+ * its bits; the bands of one direction write disjoint cells (the hfvis tool runs them
+ * concurrently, one direction at a time). Scratch then: one tangent plane (8 bytes a cell) and
+ * line buffers, no accumulator.
  * Returns HFVIS_OK, HFVIS_ERR_INVALID_ARGUMENT (NULL grid or sums, K < 1, bad range, unknown
- * kind, missing env), HFVIS_ERR_LIMIT or HFVIS_ERR_OUT_OF_MEMORY. Cost O((e-b)*width*height). */
+ * kind, missing env, bands in lattice mode or for the visibility index), HFVIS_ERR_LIMIT or
+ * HFVIS_ERR_OUT_OF_MEMORY. Cost O((e-b)*width*height), a band its share. */
 HFVIS_API hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind kind,
                                             const hfvis_env *env, const hfvis_env_options *eopts,
                                             const hfvis_sweep_options *opts, double *sums);

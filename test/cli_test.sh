@@ -478,6 +478,24 @@ split4 "split sky 4 ways" sky pfm 0:5 5:6 6:11 11:12 -- --dirs 12 --sky 2 --albe
 split4 "split light 4 ways (RGB)" light pfm 0:3 3:8 8:13 13:16 -- --dirs 16 --env "$dir/env3.pfm" --albedo 0.8
 split4 "split light --method lp" light pfm 0:1 1:2 2:3 3:8 -- --dirs 8 --env "$dir/env1.pfm" --method lp
 split4 "split visibility 4 ways" visibility pfm 0:2 2:4 4:6 6:8 -- --dirs 8
+# a raster OUT: the sum writes the single run's GeoTIFF byte for byte, with the horizon's band
+# labels (rebuilt from the parts' tags) and visibility's integer counts
+split4 "split horizon --exact --convention grid, GeoTIFF with its band labels" horizon tif 0:4 4:8 -- --dirs 8 --exact --convention grid --degrees
+if command -v gdalinfo > /dev/null 2>&1; then
+  gdalinfo "$dir/single.tif" | grep 'Description = ' > "$dir/desc_single"
+  gdalinfo "$dir/summed.tif" | grep 'Description = ' > "$dir/desc_summed"
+  [ "$(wc -l < "$dir/desc_summed")" -eq 8 ] && cmp -s "$dir/desc_single" "$dir/desc_summed" &&
+    ok "sum: the GeoTIFF's 8 band descriptions are the single run's (gdalinfo)" ||
+    bad "sum: band descriptions: $(head -n 2 "$dir/desc_summed")"
+else
+  echo "SKIP cli sum band descriptions: no gdalinfo (the byte comparison above covers them)"
+fi
+split4 "split visibility, GeoTIFF" visibility tif 0:4 4:8 -- --dirs 8
+awk 'BEGIN { print "ncols 8"; print "nrows 6"; print "xllcorner 500000"; print "yllcorner 5000000"
+  print "cellsize 10"; for (y = 0; y < 6; y++) { s = ""; for (x = 0; x < 8; x++) s = s " " (100 + x * y); print s } }' > "$dir/geo.asc"
+"$hfvis" skyview "$dir/geo.asc" --dirs 8 --dir-range 0:8 -o "$dir/geo.hfvs" 2> /dev/null
+expect_fail "sum: a raster OUT of a georeferenced run's parts (the parts carry no georeference)" 1 sum "$dir/geo.hfvs" -o "$fdir/x.tif"
+grep -q 'georeferenced' "$dir/stderr" && ok "sum: georeference refusal named" || bad "sum: georeference refusal: $(cat "$dir/stderr")"
 split4 "split visibility --fraction" visibility pfm 0:3 3:4 4:7 7:8 -- --dirs 8 --fraction --zscale 3
 # exact rays (--exact): split runs and sums as for the lattice; mixing modes is refused
 split4 "split horizon --exact" horizon pfm 0:3 3:8 8:13 13:16 -- --dirs 16 --exact
@@ -951,6 +969,7 @@ horizon exact|horizon --dirs 12 --exact
 skyview K=16|skyview --dirs 16
 skyview K=7|skyview --dirs 7 --azimuth0 10
 skyview exact|skyview --dirs 16 --exact
+skyview exact radius clamp|skyview --dirs 20 --exact --max-distance 40 --border clamp
 skyview radius clamp|skyview --dirs 16 --max-distance 40 --border clamp
 sky|sky --dirs 16 --sky 2 --albedo 0.5
 sky exact|sky --dirs 8 --exact
@@ -971,6 +990,9 @@ EOF
 for t in 1 2; do "$hfvis" skyview "$dir/rough.pfm" --cell 0.05 --max-distance 1.5 --window 10,8,30,25 --threads $t \
   --quiet -o "$dir/win$t.pfm" 2> "$dir/terr"; done
 cmp -s "$dir/win1.pfm" "$dir/win2.pfm" && ok "--threads with --window: the piece is the same" || bad "--threads with --window: $(cat "$dir/terr")"
+for t in 1 3; do "$hfvis" sky "$dir/rough.pfm" --exact --cell 0.05 --max-distance 1.5 --window 10,8,30,25 --threads $t \
+  --quiet -o "$dir/win$t.pfm" 2> "$dir/terr"; done
+cmp -s "$dir/win1.pfm" "$dir/win3.pfm" && ok "--threads with --window, exact bands: the piece is the same" || bad "--threads with --window, exact: $(cat "$dir/terr")"
 "$hfvis" skyview "$r" --dirs 16 --dir-range 0:8 --threads 2 -o "$fdir/p.hfvs" 2> "$dir/terr"
 [ $? -eq 2 ] && grep -q -- '--threads' "$dir/terr" && ok "--threads 2 with --dir-range refused by name" || bad "--threads with --dir-range: $(cat "$dir/terr")"
 "$hfvis" openness "$r" --threads 2 -o "$fdir/o.pfm" 2> "$dir/terr"
@@ -996,16 +1018,27 @@ else bad "hillshade/shadow --exact did not run"; fi
 # and a refusal of the value is one line naming the flag. Every flag of the table in docs/cli.md.
 "$hfvis" --list-flags > "$dir/flags" && "$hfvis" --list-commands > "$dir/commands" &&
   [ -s "$dir/flags" ] && [ -s "$dir/commands" ] && ok "--list-flags, --list-commands" || bad "--list-flags, --list-commands"
-awk -F'	' 'NF != 7 || $4 !~ /^(-|int|real|text|choice|list|date|bytes)$/ { bad = 1 }
+awk -F'	' 'NF != 7 || $4 !~ /^(-|int|real|text|choice|list|date|bytes|duration)$/ { bad = 1 }
   END { exit bad }' "$dir/flags" &&
   ok "--list-flags: NAME VALUE COMMANDS TYPE RANGE DEFAULT UNIT" || bad "--list-flags columns"
 [ "$(wc -l < "$dir/commands" | tr -d ' ')" = "$("$hfvis" --help | sed -n '/^commands:/,/^$/p' | grep -c '^  [a-z]')" ] &&
   ok "--list-commands: the commands of --help" || bad "--list-commands differs from --help"
-walk_bad=0; walk_n=0
+walk_bad=0; walk_n=0; help_n=0
 walk_fail() { walk_bad=$((walk_bad + 1)); echo "FAIL cli walk: $1"; }
 while read -r c; do # one run per pair, no other process: the walk is ~2,000 runs
-  used=" $("$hfvis" --list-flags "$c" | cut -f1 | tr '\n' ' ') "
+  "$hfvis" --list-flags "$c" > "$dir/cflags"
+  used=" $(cut -f1 "$dir/cflags" | tr '\n' ' ') "
+  # --list-flags CMD: exactly the rows of the whole table whose COMMANDS name CMD
+  awk -F'	' -v c="$c" 'index("," $3 ",", "," c ",")' "$dir/flags" | cmp -s - "$dir/cflags" ||
+    walk_fail "$c: --list-flags $c is not the table's rows naming $c"
+  # 'hfvis CMD --help' ends with each option's type, range, default and unit: --list-flags' columns
+  "$hfvis" "$c" --help | sed -n '/^values of /,$p' | sed 1d > "$dir/chelp"
+  awk -F'	' '{ s = sprintf("  %-18s  %s", $1 ($2 == "-" ? "" : " " $2), $4 == "-" ? "switch" : $4)
+    if ($5 != "-") s = s " in " $5; if ($6 != "-") s = s ", default " $6; if ($7 != "-") s = s ", unit " $7
+    print s }' "$dir/cflags" | cmp -s - "$dir/chelp" && help_n=$((help_n + $(wc -l < "$dir/chelp"))) ||
+    walk_fail "$c --help: its options' values differ from --list-flags $c"
   while IFS='	' read -r f v cmds _columns; do
+    case ",$cmds," in *",$c,"*) ;; *) case "$used" in *" $f "*) continue ;; esac ;; esac # another meaning's row
     walk_n=$((walk_n + 1))
     if [ "$v" = - ]; then err=$("$hfvis" "$c" "$f" 2>&1 > /dev/null); rc=$?
     else err=$("$hfvis" "$c" "$f" @bad 2>&1 > /dev/null); rc=$?; fi
@@ -1013,7 +1046,6 @@ while read -r c; do # one run per pair, no other process: the walk is ~2,000 run
 "*) n=2 ;; "") n=0 ;; *) n=1 ;; esac
     case "$used" in
     *" $f "*)
-      case ",$cmds," in *",$c,"*) ;; *) walk_fail "$c $f: --list-flags disagree" ;; esac
       case "$err" in *"is not used by"* | *"unknown option"*) walk_fail "$c uses $f but refused it: $err" ;; esac
       if [ "$rc" -ne 0 ] && [ "$n" -ne 1 ]; then walk_fail "$c $f: exit $rc with $n lines"; fi
       case "$err" in *expected*) case "$err" in *"$f"*) ;; *) walk_fail "$c $f @bad: not named in: $err" ;; esac ;; esac ;;
@@ -1023,6 +1055,19 @@ while read -r c; do # one run per pair, no other process: the walk is ~2,000 run
   done < "$dir/flags"
 done < "$dir/commands"
 [ "$walk_bad" -eq 0 ] && ok "walk: $walk_n command x flag pairs" || bad "walk: $walk_bad of $walk_n pairs"
+[ "$walk_bad" -eq 0 ] && [ "$help_n" -gt 0 ] && ok "every command's --help: the type, range, default and unit of its $help_n options as in --list-flags" ||
+  bad "--help values: $help_n lines checked"
+# No mutable state at file scope: the binary's writable objects (.data, .bss) are the C runtime's
+# and the signal handler's temporary-file names (cli_tmp_name, cli_tmp_armed, and common.h's
+# ex_atomic_on_temp hook that reports the raster writers' to it). Needs an nm that prints sections.
+if nm -f sysv "$hfvis" > "$dir/nm" 2> /dev/null && grep -q '|\.bss' "$dir/nm"; then
+  extra=$(awk -F'|' '$4 ~ /OBJECT/ && $7 ~ /^\.(data|bss)$/ { gsub(/ /, "", $1); print $1 }' "$dir/nm" |
+    grep -v -e '@' -e '^__' -e '^completed\.' -e '^cli_tmp_name$' -e '^cli_tmp_armed$' -e '^ex_atomic_on_temp$' | tr '\n' ' ')
+  [ -z "$extra" ] && ok "no mutable objects but the signal handler's temporary-file names (nm)" ||
+    bad "mutable objects at file or function scope: $extra"
+else
+  echo "SKIP cli mutable objects: no 'nm -f sysv' with sections"
+fi
 # every refusal of a bad number names the flag and its range
 "$hfvis" skyview "$h" --dirs 0 -o "$fdir/x.pfm" 2> "$dir/werr"
 grep -q -- '--dirs.*1\.\.65536' "$dir/werr" && ok "--dirs 0: flag and range" || bad "--dirs 0: $(cat "$dir/werr")"

@@ -237,14 +237,8 @@ static const double PI = 3.14159265358979323846;
 /* A seeded fBm field (fBm-style random terrain) into a new buffer. */
 static float *make_fbm(int w, int h, uint64_t seed, double amplitude, double wavelength)
 {
-    hfvis_field f;
     float *z = (float *)malloc(sizeof(float) * (size_t)w * (size_t)h);
-    memset(&f, 0, sizeof f);
-    f.kind = HFVIS_FIELD_FBM;
-    f.amplitude = amplitude;
-    f.wavelength = wavelength;
-    f.seed = seed;
-    if (z && hfvis_field_generate(&f, w, h, w, z) != HFVIS_OK) { free(z); z = NULL; }
+    if (z && test_fbm(z, w, h, amplitude, wavelength, 0, seed) != HFVIS_OK) { free(z); z = NULL; }
     return z;
 }
 
@@ -1675,22 +1669,9 @@ TEST(p2_hemisphere_sweep)
 
 /* ---------------------------------------------------------------- gather vs oracle (§3.3, §6) */
 
-/* Seeded fBm test field: value noise, base wavelength 16 cells (octaves 0 = 8). */
-static void p2_fbm_octaves(float *z, int w, int h, uint64_t seed, double amplitude, int octaves)
-{
-    hfvis_field f;
-    memset(&f, 0, sizeof f);
-    f.kind = HFVIS_FIELD_FBM;
-    f.amplitude = amplitude;
-    f.wavelength = 16.0;
-    f.seed = seed;
-    f.octaves = octaves;
-    (void)hfvis_field_generate(&f, w, h, w, z);
-}
-
 static void p2_fbm(float *z, int w, int h, uint64_t seed, double amplitude)
 {
-    p2_fbm_octaves(z, w, h, seed, amplitude, 0);
+    (void)test_fbm(z, w, h, amplitude, 16.0, 0, seed);
 }
 
 static int p2_cmp_double(const void *a, const void *b)
@@ -2169,7 +2150,7 @@ TEST(p2_sky_light_fused_map_oracle)
     double mean, mx, ef = 0.0, em = 0.0, efm = 0.0, emm = 0.0;
     size_t n = 0, i;
     int x, y;
-    p2_fbm_octaves(z, W, H, 3, 4.0, 4);
+    (void)test_fbm(z, W, H, 4.0, 16.0, 4, 3);
     p2_grid_init(&g, z, W, H);
     o.azimuth0_rad = 0.3;
     CHECK_EQ_STATUS(hfvis_sky_light(&g, K, 1.0f, 1.0f, &o, fused, W), HFVIS_OK);
@@ -2222,7 +2203,7 @@ TEST(p2_sky_view_factor_cases)
     double mean, mx, want;
     int i, y, bad = 0;
     /* fused vs from-map on 4-octave fBm */
-    p2_fbm_octaves(z, W, H, 3, 4.0, 4);
+    (void)test_fbm(z, W, H, 4.0, 16.0, 4, 3);
     p2_grid_init(&g, z, W, H);
     o.azimuth0_rad = 0.3;
     CHECK_EQ_STATUS(hfvis_sky_view_factor(&g, K, &o, fused, W), HFVIS_OK);
@@ -2513,7 +2494,7 @@ TEST(p2_env_consistency)
     hfvis_sweep_options o = hfvis_sweep_options_default();
     double e_prefix = 0.0, e_lp = 0.0, e_flat = 0.0, e_flat_odd = 0.0, e_axis = 0.0;
     int c, i;
-    p2_fbm_octaves(z, W, H, 9, 4.0, 4);
+    (void)test_fbm(z, W, H, 4.0, 16.0, 4, 9);
     p2_grid_init(&g, z, W, H);
     p2_env_fill(rad, NT, NP, base, 0.0);
     env.radiance = rad;
@@ -4959,13 +4940,7 @@ static hfvis_viewshed_options vs_opts(double observer_height, double target_heig
 static float *vs_fbm(int w, int h, uint64_t seed, double amplitude, double wavelength)
 {
     float *z = vs_floats((size_t)w * (size_t)h, 0.0f);
-    hfvis_field f;
-    memset(&f, 0, sizeof f);
-    f.kind = HFVIS_FIELD_FBM;
-    f.amplitude = amplitude;
-    f.wavelength = wavelength;
-    f.seed = seed;
-    if (z && hfvis_field_generate(&f, w, h, w, z) != HFVIS_OK) {
+    if (z && test_fbm(z, w, h, amplitude, wavelength, 0, seed) != HFVIS_OK) {
         free(z);
         return NULL;
     }

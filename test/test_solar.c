@@ -370,17 +370,6 @@ TEST(wall_and_pit_against_oracle)
     CHECK(ob[4][12 * W + 12] < ob[4][2 * W + 2]); /* fewer sunny hours at the bottom */
 }
 
-static void fbm(float *z, int w, int h, double amp, double wl, uint64_t seed)
-{
-    hfvis_field f;
-    memset(&f, 0, sizeof f);
-    f.kind = HFVIS_FIELD_FBM;
-    f.amplitude = amp;
-    f.wavelength = wl;
-    f.seed = seed;
-    hfvis_field_generate(&f, w, h, w, z);
-}
-
 TEST(random_terrains_against_oracle)
 {
     hfvis_grid g = test_grid(zbuf, W, H, 1.0);
@@ -390,7 +379,7 @@ TEST(random_terrains_against_oracle)
         hfvis_solar_options o = hfvis_solar_options_default();
         double m, c;
         char name[32];
-        fbm(zbuf, W, H, 6.0, 8.0, seed);
+        (void)test_fbm(zbuf, W, H, 6.0, 8.0, 0, seed);
         if (seed == 3) o.model = HFVIS_SUN_RSUN;
         if (seed == 4) o.sun_radius_rad = 0.00465;
         run_pair(&g, &in, &o);
@@ -417,7 +406,7 @@ TEST(sector_sums_against_oracle)
         else if (c == 1)
             for (y = 0; y < H; y++)
                 for (x = 0; x < W; x++) zbuf[y * W + x] = (y == 12) ? 6.0f : 0.0f;
-        else fbm(zbuf, W, H, 6.0, 8.0, (uint64_t)c);
+        else (void)test_fbm(zbuf, W, H, 6.0, 8.0, 0, (uint64_t)c);
         if (c == 3) o.diffuse = HFVIS_SOLAR_DIFFUSE_HORIZON;
         if (c == 4) o.model = HFVIS_SUN_RSUN;
         run_pair(&g, &in, &o);

@@ -1,8 +1,9 @@
 /* thread_test.c - the library's calls run concurrently on shared inputs, as the hfvis tool's
  * --threads runs them (hfvis.h, "Threads"), and the split results equal one call's bit for bit:
  * one sun's bands writing one output, the per-direction sums of quarter-turn groups (lattice) and
- * single directions (exact) added in order and finished as the single run finishes them, and the
- * horizon map's plane ranges writing one map. Built with -pthread; make sanitize also builds it
+ * single directions (exact) added in order and finished as the single run finishes them, the
+ * exact sums by bands of one direction at a time added in place, and the horizon map's plane
+ * ranges writing one map. Built with -pthread; make sanitize also builds it
  * under ThreadSanitizer, which reports any data race among these calls. */
 #define _POSIX_C_SOURCE 200809L
 #include <pthread.h>
@@ -21,7 +22,9 @@ typedef struct job {
     int next;          /* the next unit to take (under lock) */
     pthread_mutex_t lock;
     float *out;        /* shared output (bands, horizon map) */
-    double *unit_sums; /* per unit sums (sums: unit u at unit_sums + u*TN) */
+    double *unit_sums; /* per unit sums (sums: unit u at unit_sums + u*TN; bands: shared) */
+    hfvis_sweep_options opts; /* bands: the direction and mode */
+    hfvis_sum_kind kind;      /* bands */
     hfvis_status status[64];
 } job;
 
@@ -67,6 +70,20 @@ static void *sums_worker(void *p)
         }
         j->status[u] = hfvis_direction_sums(&g_grid, TK, HFVIS_SUM_SKY_VIEW, NULL, NULL, &o,
                                             j->unit_sums + (size_t)u * TN);
+    }
+    return NULL;
+}
+
+/* A band of one direction of exact-mode sums, added in place to the shared running sums. */
+static void *band_sums_worker(void *p)
+{
+    job *j = (job *)p;
+    int u;
+    while ((u = job_take(j)) >= 0) {
+        hfvis_sweep_options o = j->opts;
+        o.part_index = u;
+        o.part_count = j->parts;
+        j->status[u] = hfvis_direction_sums(&g_grid, TK, j->kind, NULL, NULL, &o, j->unit_sums);
     }
     return NULL;
 }
@@ -174,6 +191,58 @@ TEST(direction_sums_concurrently)
     pthread_mutex_destroy(&j.lock);
 }
 
+static int same_sums(const double *a, const double *b, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; i++)
+        if (!(a[i] == b[i] || (isnan(a[i]) && isnan(b[i])))) return 0;
+    return 1;
+}
+
+/* Exact-mode sums by bands of one direction at a time (7 bands over 4 threads, then the next
+ * direction), added in place to one array zeroed once: the whole call's S bit for bit, for the
+ * sky-view factor and the sky light, over the grid and over a receiver rectangle (whose outside
+ * stays untouched). A band that lost or doubled a line would change S. */
+TEST(exact_band_sums_concurrently)
+{
+    static double whole[TN], banded[TN];
+    job j;
+    int kind, rect, k, u;
+    size_t i;
+    memset(&j, 0, sizeof j);
+    pthread_mutex_init(&j.lock, NULL);
+    for (kind = HFVIS_SUM_SKY_VIEW; kind <= HFVIS_SUM_SKY_LIGHT; kind++)
+        for (rect = 0; rect < 2; rect++) {
+            hfvis_sweep_options o = hfvis_sweep_options_default();
+            o.rays = HFVIS_RAYS_EXACT;
+            o.azimuth0_rad = 0.3;
+            if (rect) {
+                o.receiver_x = 11;
+                o.receiver_y = 7;
+                o.receiver_width = 50;
+                o.receiver_height = 61;
+            }
+            for (i = 0; i < TN; i++) whole[i] = banded[i] = -7.0; /* the outside stays -7 */
+            CHECK_EQ_STATUS(hfvis_direction_sums(&g_grid, TK, (hfvis_sum_kind)kind, NULL, NULL, &o, whole), HFVIS_OK);
+            for (i = 0; i < TN; i++) {
+                int x = (int)(i % TW), y = (int)(i / TW);
+                if (!rect || (x >= 11 && x < 61 && y >= 7 && y < 68)) banded[i] = 0.0;
+            }
+            j.kind = (hfvis_sum_kind)kind;
+            j.parts = 7;
+            j.unit_sums = banded;
+            for (k = 0; k < TK; k++) { /* one direction at a time, its bands concurrently */
+                j.opts = o;
+                j.opts.direction_begin = k;
+                j.opts.direction_end = k + 1;
+                run_threads(&j, band_sums_worker);
+                for (u = 0; u < j.parts; u++) CHECK_EQ_STATUS(j.status[u], HFVIS_OK);
+            }
+            CHECK(same_sums(whole, banded, TN));
+        }
+    pthread_mutex_destroy(&j.lock);
+}
+
 TEST(horizon_map_planes_concurrently)
 {
     static float whole[TK * TN], shared[TK * TN];
@@ -202,6 +271,7 @@ int main(int argc, char **argv)
     field_init();
     RUN(sun_bands_concurrently);
     RUN(direction_sums_concurrently);
+    RUN(exact_band_sums_concurrently);
     RUN(horizon_map_planes_concurrently);
     return TEST_DONE();
 }

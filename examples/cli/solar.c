@@ -39,21 +39,6 @@ static int cli_set_solar(cli_args *a, const char *f, const char *v)
         a->sol_hour = hh + mm / 60.0;
         return 0;
     }
-    if (!strcmp(f, "--step")) { /* 15m, 1h, 0.5h; a bare number is minutes */
-        char buf[64];
-        size_t n = strlen(v);
-        double s, scale = 1.0 / 60.0;
-        if (n == 0 || n >= sizeof buf) return cli_error(CLI_EXIT_USAGE, f, "expected a step like 15m or 1h, got '%s'", v);
-        memcpy(buf, v, n + 1);
-        if (buf[n - 1] == 'm' || buf[n - 1] == 'h') scale = buf[n - 1] == 'h' ? 1.0 : 1.0 / 60.0, buf[n - 1] = '\0';
-        if (!cli_parse_real(buf, &s) || !(s > 0.0) || s * scale > 24.0)
-            return cli_error(CLI_EXIT_USAGE, f, "expected a step in (0, 24h] like 15m or 1h, got '%s'", v);
-        a->sol_step = s * scale;
-        return 0;
-    }
-    if (!strcmp(f, "--linke"))
-        return cli_real(f, v, 0.0, 1, 10.0, "a Linke turbidity factor in (0, 10]", &a->sol_linke) ? CLI_EXIT_USAGE
-                                                                                          : (a->sol_has_linke = 1, 0);
     if (!strcmp(f, "--linke-monthly")) { /* 12 values, January first */
         const char *p = v;
         int k;
@@ -79,15 +64,6 @@ static int cli_set_solar(cli_args *a, const char *f, const char *v)
         return 0;
     }
     if (!strcmp(f, "--linke-map")) { a->sol_linke_map = v; return 0; }
-    if (!strcmp(f, "--latitude"))
-        return cli_real(f, v, -90.0, 0, 90.0, "a latitude in degrees, -90..90", &a->sol_lat) ? CLI_EXIT_USAGE
-                                                                                        : (a->sol_has_lat = 1, 0);
-    if (!strcmp(f, "--longitude"))
-        return cli_real(f, v, -180.0, 0, 180.0, "a longitude in degrees, -180..180 (east positive)", &a->sol_lon)
-                   ? CLI_EXIT_USAGE : (a->sol_has_lon = 1, 0);
-    if (!strcmp(f, "--utc-offset"))
-        return cli_real(f, v, -14.0, 0, 14.0, "hours east of UTC, -14..14", &a->sol_offset) ? CLI_EXIT_USAGE
-                                                                                      : (a->sol_has_offset = 1, 0);
     if (!strcmp(f, "--solar-time")) { a->sol_solar_time = 1; return 0; }
     if (!strcmp(f, "--bands")) {
         if (!strcmp(v, "day")) a->sol_bands = HFVIS_SOLAR_BANDS_DAY;
