@@ -560,7 +560,7 @@ TEST(sites_constant_maps_equal_one_site)
     hfvis_grid g = test_grid(zbuf, S, S, 1.0);
     static float one[5][W * H];
     int days, k, i;
-    fbm(zbuf, S, S, 6.0, 8.0, 7);
+    (void)test_fbm(zbuf, S, S, 6.0, 8.0, 0, 7);
     for (days = 1; days <= 30; days += 29) { /* the step loop and the sector sums */
         hfvis_solar_input in = site(46.0, 6, 1);
         hfvis_solar_options o = hfvis_solar_options_default();
@@ -616,7 +616,7 @@ TEST(sites_across_degrees_against_oracle)
         printf("     open ground, %+.0f..%+.0f deg, %s: largest |fast-oracle|/oracle %.2e\n", lat0, lat1,
                month == 6 ? "June 21" : "Dec 21", worst);
         if (c == 0 || c == 3) { /* terrain: the per-sample suns through the shading */
-            fbm(zbuf, S, S, 4.0, 6.0, (uint64_t)(11 + c));
+            (void)test_fbm(zbuf, S, S, 4.0, 6.0, 0, (uint64_t)(11 + c));
             run_pair(&g, &in, &o);
             snprintf(name, sizeof name, "fbm %+.0f..%+.0f deg", lat0, lat1);
             compare_oracle_wh(S, S, name, &m, &sh);
@@ -643,7 +643,7 @@ TEST(sites_blocks_within_tolerance)
         printf("     open ground, 0.3 deg, %s: mean |fast-oracle|/oracle %.2e\n", c ? "south" : "north", sum / (S * S));
         CHECK(sum / (S * S) <= SITE_BLOCK_REL);
         if (c) continue;
-        fbm(zbuf, S, S, 4.0, 6.0, 21);
+        (void)test_fbm(zbuf, S, S, 4.0, 6.0, 0, 21);
         run_pair(&g, &in, &o);
         compare_oracle_wh(S, S, "fbm, 0.3 deg, north", &m, &sh);
         CHECK(m <= ORACLE_MEAN_REL && sh <= CELL_BEAM_SHARE);
@@ -703,7 +703,7 @@ TEST(caller_horizon_map_bit_identical)
     static float one[5][W * H], map[64 * W * H];
     hfvis_sweep_options sw = hfvis_sweep_options_default();
     int days, k, i;
-    fbm(zbuf, W, H, 6.0, 8.0, 9);
+    (void)test_fbm(zbuf, W, H, 6.0, 8.0, 0, 9);
     sw.rays = HFVIS_RAYS_EXACT;
     CHECK_EQ_STATUS(hfvis_horizon_map(&g, 64, &sw, map), HFVIS_OK);
     for (days = 1; days <= 30; days += 29) {
