@@ -126,7 +126,7 @@ cxx:
 # Its "tiles" section runs the hfvis tool (HFVIS_CLI) whole and tiled: make bench BENCH_ARGS=tiles.
 bench:
 	@$(MAKE) --no-print-directory $(BENCH) $(CLI)
-	@HFVIS_CLI=$(CLI) $(BENCH) $(BENCH_ARGS)
+	@HFVIS_CLI=$(CLI) HFVIS_BENCH_GRASS=examples/bench/solar_grass.sh $(BENCH) $(BENCH_ARGS)
 
 demo: 
 	@$(MAKE) --no-print-directory config=release all
