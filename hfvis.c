@@ -1606,7 +1606,8 @@ typedef struct hf_sweep {
     double *lat;                /* rows*cols*channels output / accumulator */
     double *lh, *lt;            /* one line: stack heights (or the oracle's copy), tangents */
     double *sd;                 /* hull stack distances (heights in lh) */
-    float *grid_nrm;            /* width*height*3 grid normals (want_normals) */
+    const float *grid_nrm;      /* width*height*3 grid normals (want_normals): the scratch's,
+                                   or the caller's (sweep options normals) */
     double *gacc;               /* width*height*channels grid accumulator (fused light) */
     unsigned char *extra;       /* extra_size bytes for the caller (the P2 tree and line data) */
     size_t extra_size;
@@ -1810,7 +1811,7 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     off_lh = hf_align_add(&total, linelen + 2, sizeof(double), &ok); /* + the hull's NaN slots */
     off_lt = hf_align_add(&total, linelen, sizeof(double), &ok);
     off_stk = hf_align_add(&total, linelen + 2, sizeof(double), &ok);
-    if (want_normals) off_gn = hf_align_add(&total, gridn, 3 * sizeof(float), &ok);
+    if (want_normals && !o->normals) off_gn = hf_align_add(&total, gridn, 3 * sizeof(float), &ok);
     if (want_gacc) off_ga = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
     if (extra_size) off_x = hf_align_add(&total, extra_size, 1, &ok);
     sw->win_rw = hf_radius_on(o) ? hf_radius_units(o->max_distance / g->cell_size) : -1;
@@ -1832,7 +1833,7 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     sw->lt = (double *)(void *)(b + off_lt);
     sw->sd = (double *)(void *)(b + off_stk) + 2;
     sw->sd[-2] = sw->sd[-1] = HFVIS__NAN;
-    sw->grid_nrm = want_normals ? (float *)(void *)(b + off_gn) : NULL;
+    sw->grid_nrm = !want_normals ? NULL : o->normals ? o->normals : (const float *)(const void *)(b + off_gn);
     sw->gacc = want_gacc ? (double *)(void *)(b + off_ga) : NULL;
     sw->extra = extra_size ? b + off_x : NULL;
     sw->extra_size = extra_size;
@@ -1843,17 +1844,20 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     hf_receiver_rect(g, o, &sw->rx0, &sw->ry0, &sw->rx1, &sw->ry1);
     sw->rect = sw->rx0 > 0 || sw->ry0 > 0 || sw->rx1 < g->width || sw->ry1 < g->height;
     if (sw->win_rw >= 0) hf_win_carve(&sw->win, b + off_w, linelen);
-    if (want_normals) {
+    if (want_normals) { /* made here (hfvis_normals_compute's bits) unless the caller gave them */
         int x, y, fin = 1;
+        float *own = o->normals ? NULL : (float *)(void *)(b + off_gn);
         for (y = 0; y < g->height; y++)
             for (x = 0; x < g->width; x++) {
-                double n[3];
-                float *p = sw->grid_nrm + ((size_t)y * (size_t)g->width + (size_t)x) * 3;
-                hf_normal_at(g, x, y, n);
-                p[0] = (float)n[0];
-                p[1] = (float)n[1];
-                p[2] = (float)n[2];
-                fin &= isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
+                const size_t i = ((size_t)y * (size_t)g->width + (size_t)x) * 3;
+                if (own) {
+                    double n[3];
+                    hf_normal_at(g, x, y, n);
+                    own[i] = (float)n[0];
+                    own[i + 1] = (float)n[1];
+                    own[i + 2] = (float)n[2];
+                }
+                fin &= isfinite(sw->grid_nrm[i]) && isfinite(sw->grid_nrm[i + 1]) && isfinite(sw->grid_nrm[i + 2]);
             }
         sw->nrm_finite = fin;
     }
@@ -8617,7 +8621,9 @@ typedef struct hf_exact {
     double *sd, *sh;        /* one line's samples, then its hull stack: distances (sub-steps),
                                heights (world units) */
     double *tan;            /* width*height tangents of the current direction, NaN at holes */
-    float *nrm;             /* width*height*3 grid normals (lighting), else NULL */
+    const float *nrm;       /* width*height*3 grid normals (lighting): the scratch's or the
+                               caller's (sweep options normals), else NULL */
+    float *nrm_own;         /* the scratch's normals, NULL when given */
     double *acc;            /* width*height*channels sums, else NULL */
     int channels;
     double radius;          /* a finite search radius (world units), else 0 */
@@ -9315,7 +9321,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     off_c = hf_align_add(&total, (size_t)maxp, sizeof(hf_cross), &ok);
     off_s = hf_align_add(&total, cap + 2u, 2u * sizeof(double), &ok); /* + the hull's NaN slots */
     if (want_tan) off_t = hf_align_add(&total, gridn, sizeof(double), &ok);
-    if (want_normals) off_n = hf_align_add(&total, gridn, 3u * sizeof(float), &ok);
+    if (want_normals && !o->normals) off_n = hf_align_add(&total, gridn, 3u * sizeof(float), &ok);
     if (channels) off_a = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
     E->radius = hf_radius_on(o) ? o->max_distance : 0.0;
     E->win_rw = -1;
@@ -9340,12 +9346,13 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     E->sh = E->sd + cap + 2;
     E->sd[-2] = E->sd[-1] = E->sh[-2] = E->sh[-1] = HFVIS__NAN; /* below the stack: hf_hull_step */
     E->tan = want_tan ? (double *)(void *)(blk + off_t) : NULL;
-    E->nrm = want_normals ? (float *)(void *)(blk + off_n) : NULL;
+    E->nrm_own = want_normals && !o->normals ? (float *)(void *)(blk + off_n) : NULL;
+    E->nrm = want_normals && o->normals ? o->normals : E->nrm_own;
     E->acc = channels ? (double *)(void *)(blk + off_a) : NULL;
     if (E->radius > 0.0) hf_win_carve(&E->win, blk + off_win, cap);
     E->rec = (int *)(void *)(blk + off_r);
     hf_exact_dirs_fill(&E->d, K, o->azimuth0_rad, E->N);
-    if (want_normals == 1) (void)hfvis_normals_compute(g, E->nrm); /* the grid normals, as floats */
+    if (want_normals == 1 && E->nrm_own) (void)hfvis_normals_compute(g, E->nrm_own); /* as floats */
     if (channels) memset(E->acc, 0, gridn * (size_t)channels * sizeof(double));
     return HFVIS_OK;
 }
@@ -9486,9 +9493,9 @@ static hfvis_status hf_exact_sums(hf_exact *E, const hfvis_grid *g, int K, hfvis
             const double *tr = E->tan + r;
             double *acc = banded ? add : E->acc, *ar = acc + r * (size_t)channels;
             hf_exact_span(E, y, E->d.ray[k], &x0, &x1);
-            for (x = x0; banded && x < x1; x++) { /* a band's holes and normals */
+            for (x = x0; banded && x < x1; x++) { /* a band's holes and normals (unless given) */
                 double n[3];
-                float *nr = E->nrm ? E->nrm + (r + (size_t)x) * 3 : NULL;
+                float *nr = E->nrm_own ? E->nrm_own + (r + (size_t)x) * 3 : NULL;
                 if (hf_is_hole(g, x, y))
                     for (c = 0; c < channels; c++) ar[(size_t)x * (size_t)channels + (size_t)c] = HFVIS__NAN;
                 else if (nr) { /* hfvis_normals_compute's bits */
