@@ -1968,13 +1968,42 @@ static int hf_band_of(double b, double b0, double span, int parts)
     return q <= 0.0 ? 0 : q >= (double)(parts - 1) ? parts - 1 : (int)q;
 }
 
-/* 1 if receiver (x, y) is one of this call's: no bands, or in its band. */
-static int hf_sweep_mine(const hf_sweep *sw, int x, int y)
+/* The band of receiver (x, y) (sw->parts > 0). */
+static int hf_sweep_band_at(const hf_sweep *sw, int x, int y)
 {
     const hfvis_lattice *L = &sw->L;
-    if (!sw->parts) return 1;
     return hf_band_of(((double)x + sw->ox) * L->vx + ((double)y + sw->oy) * L->vy, sw->part_b0,
-                      sw->part_span, sw->parts) == sw->part;
+                      sw->part_span, sw->parts);
+}
+
+/* The first x in [rx0, rx1] of row y whose band is at or past t in the row's order (band
+ * non-decreasing in x when inc, else non-increasing); rx1 if none. */
+static int hf_sweep_first(const hf_sweep *sw, int y, int inc, int t)
+{
+    int lo = sw->rx0, hi = sw->rx1;
+    while (lo < hi) {
+        int mid = lo + (hi - lo) / 2, b = hf_sweep_band_at(sw, mid, y);
+        if (inc ? b >= t : b <= t) hi = mid;
+        else lo = mid + 1;
+    }
+    return lo;
+}
+
+/* This call's receivers in row y of the receiver rectangle: [*x0, *x1). Along a row every
+ * rounding step of a receiver's b (x + ox, times vx, plus a constant, minus b0, over the span,
+ * times parts) is monotone in x, so its band is, and the band's receivers are one run, found by
+ * bisection with the very test of hf_sweep_band_at: a band costs its share, not a scan. */
+static void hf_sweep_span(const hf_sweep *sw, int y, int *x0, int *x1)
+{
+    const int inc = sw->L.vx >= 0.0;
+    if (!sw->parts) {
+        *x0 = sw->rx0;
+        *x1 = sw->rx1;
+        return;
+    }
+    *x0 = hf_sweep_first(sw, y, inc, sw->part);
+    *x1 = hf_sweep_first(sw, y, inc, inc ? sw->part + 1 : sw->part - 1);
+    if (*x1 < *x0) *x1 = *x0;
 }
 
 static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
@@ -2732,14 +2761,18 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
     const int open = sw->border == HFVIS_BORDER_OPEN;
     const double in_x0 = 1.0 - sw->ox, in_x1 = (sw->ext_w - 2.0) - sw->ox; /* exact integers */
     const double in_y0 = 1.0 - sw->oy, in_y1 = (sw->ext_h - 2.0) - sw->oy;
+    const int tile_w = sw->parts ? sw->rx1 - sw->rx0 : HF_TILE; /* a band: whole rows, its span */
     for (c = 0; c < ch; c++) hf_look_dir(sw, m_first + c, &lx[c], &ly[c]);
     for (ty = sw->ry0; ty < sw->ry1; ty += HF_TILE)
-        for (tx = sw->rx0; tx < sw->rx1; tx += HF_TILE)
+        for (tx = sw->rx0; tx < sw->rx1; tx += tile_w)
     for (y = ty; y < sw->ry1 && y < ty + HF_TILE; y++) {
         const int edge_row = open && !((double)y >= in_y0 && (double)y <= in_y1);
-        for (x = tx; x < sw->rx1 && x < tx + HF_TILE; x++) {
+        int xs, xe;
+        hf_sweep_span(sw, y, &xs, &xe); /* this band's receivers of the row (all without bands) */
+        if (xs < tx) xs = tx;
+        if (xe > tx + tile_w) xe = tx + tile_w;
+        for (x = xs; x < xe; x++) {
             ptrdiff_t o = (ptrdiff_t)y * out_stride + x;
-            if (sw->parts && !hf_sweep_mine(sw, x, y)) continue; /* another band's */
             if (hf_is_hole(g, x, y)) {
                 for (c = 0; c < ch; c++) out[(size_t)c * plane_step + (size_t)o] = (float)HFVIS__NAN;
                 continue;
@@ -3821,12 +3854,14 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
     hf_lattice_fill(&sw, HFVIS__NAN);
     hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
     hf_gather_planes(&sw, 1, 0, out, 0, out_stride);
-    for (y = sw.ry0; y < sw.ry1; y++)
-        for (x = sw.rx0; x < sw.rx1; x++) {
+    for (y = sw.ry0; y < sw.ry1; y++) {
+        int x0, x1;
+        hf_sweep_span(&sw, y, &x0, &x1); /* the band's receivers of the row */
+        for (x = x0; x < x1; x++) {
             float *p = out + (ptrdiff_t)y * out_stride + x;
-            if (!hf_sweep_mine(&sw, x, y)) continue;
             *p = (float)hf_sun_fraction(sun_elevation_rad, sun_radius_rad, (double)*p);
         }
+    }
     hf_sweep_free(&sw);
     hf_progress(&o, 1, 1);
     return HFVIS_OK;
