@@ -1606,7 +1606,8 @@ typedef struct hf_sweep {
     double *lat;                /* rows*cols*channels output / accumulator */
     double *lh, *lt;            /* one line: stack heights (or the oracle's copy), tangents */
     double *sd;                 /* hull stack distances (heights in lh) */
-    float *grid_nrm;            /* width*height*3 grid normals (want_normals) */
+    const float *grid_nrm;      /* width*height*3 grid normals (want_normals): the scratch's,
+                                   or the caller's (sweep options normals) */
     double *gacc;               /* width*height*channels grid accumulator (fused light) */
     unsigned char *extra;       /* extra_size bytes for the caller (the P2 tree and line data) */
     size_t extra_size;
@@ -1810,7 +1811,7 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     off_lh = hf_align_add(&total, linelen + 2, sizeof(double), &ok); /* + the hull's NaN slots */
     off_lt = hf_align_add(&total, linelen, sizeof(double), &ok);
     off_stk = hf_align_add(&total, linelen + 2, sizeof(double), &ok);
-    if (want_normals) off_gn = hf_align_add(&total, gridn, 3 * sizeof(float), &ok);
+    if (want_normals && !o->normals) off_gn = hf_align_add(&total, gridn, 3 * sizeof(float), &ok);
     if (want_gacc) off_ga = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
     if (extra_size) off_x = hf_align_add(&total, extra_size, 1, &ok);
     sw->win_rw = hf_radius_on(o) ? hf_radius_units(o->max_distance / g->cell_size) : -1;
@@ -1832,7 +1833,7 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     sw->lt = (double *)(void *)(b + off_lt);
     sw->sd = (double *)(void *)(b + off_stk) + 2;
     sw->sd[-2] = sw->sd[-1] = HFVIS__NAN;
-    sw->grid_nrm = want_normals ? (float *)(void *)(b + off_gn) : NULL;
+    sw->grid_nrm = !want_normals ? NULL : o->normals ? o->normals : (const float *)(const void *)(b + off_gn);
     sw->gacc = want_gacc ? (double *)(void *)(b + off_ga) : NULL;
     sw->extra = extra_size ? b + off_x : NULL;
     sw->extra_size = extra_size;
@@ -1843,17 +1844,20 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     hf_receiver_rect(g, o, &sw->rx0, &sw->ry0, &sw->rx1, &sw->ry1);
     sw->rect = sw->rx0 > 0 || sw->ry0 > 0 || sw->rx1 < g->width || sw->ry1 < g->height;
     if (sw->win_rw >= 0) hf_win_carve(&sw->win, b + off_w, linelen);
-    if (want_normals) {
+    if (want_normals) { /* made here (hfvis_normals_compute's bits) unless the caller gave them */
         int x, y, fin = 1;
+        float *own = o->normals ? NULL : (float *)(void *)(b + off_gn);
         for (y = 0; y < g->height; y++)
             for (x = 0; x < g->width; x++) {
-                double n[3];
-                float *p = sw->grid_nrm + ((size_t)y * (size_t)g->width + (size_t)x) * 3;
-                hf_normal_at(g, x, y, n);
-                p[0] = (float)n[0];
-                p[1] = (float)n[1];
-                p[2] = (float)n[2];
-                fin &= isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
+                const size_t i = ((size_t)y * (size_t)g->width + (size_t)x) * 3;
+                if (own) {
+                    double n[3];
+                    hf_normal_at(g, x, y, n);
+                    own[i] = (float)n[0];
+                    own[i + 1] = (float)n[1];
+                    own[i + 2] = (float)n[2];
+                }
+                fin &= isfinite(sw->grid_nrm[i]) && isfinite(sw->grid_nrm[i + 1]) && isfinite(sw->grid_nrm[i + 2]);
             }
         sw->nrm_finite = fin;
     }
@@ -1964,13 +1968,42 @@ static int hf_band_of(double b, double b0, double span, int parts)
     return q <= 0.0 ? 0 : q >= (double)(parts - 1) ? parts - 1 : (int)q;
 }
 
-/* 1 if receiver (x, y) is one of this call's: no bands, or in its band. */
-static int hf_sweep_mine(const hf_sweep *sw, int x, int y)
+/* The band of receiver (x, y) (sw->parts > 0). */
+static int hf_sweep_band_at(const hf_sweep *sw, int x, int y)
 {
     const hfvis_lattice *L = &sw->L;
-    if (!sw->parts) return 1;
     return hf_band_of(((double)x + sw->ox) * L->vx + ((double)y + sw->oy) * L->vy, sw->part_b0,
-                      sw->part_span, sw->parts) == sw->part;
+                      sw->part_span, sw->parts);
+}
+
+/* The first x in [rx0, rx1] of row y whose band is at or past t in the row's order (band
+ * non-decreasing in x when inc, else non-increasing); rx1 if none. */
+static int hf_sweep_first(const hf_sweep *sw, int y, int inc, int t)
+{
+    int lo = sw->rx0, hi = sw->rx1;
+    while (lo < hi) {
+        int mid = lo + (hi - lo) / 2, b = hf_sweep_band_at(sw, mid, y);
+        if (inc ? b >= t : b <= t) hi = mid;
+        else lo = mid + 1;
+    }
+    return lo;
+}
+
+/* This call's receivers in row y of the receiver rectangle: [*x0, *x1). Along a row every
+ * rounding step of a receiver's b (x + ox, times vx, plus a constant, minus b0, over the span,
+ * times parts) is monotone in x, so its band is, and the band's receivers are one run, found by
+ * bisection with the very test of hf_sweep_band_at: a band costs its share, not a scan. */
+static void hf_sweep_span(const hf_sweep *sw, int y, int *x0, int *x1)
+{
+    const int inc = sw->L.vx >= 0.0;
+    if (!sw->parts) {
+        *x0 = sw->rx0;
+        *x1 = sw->rx1;
+        return;
+    }
+    *x0 = hf_sweep_first(sw, y, inc, sw->part);
+    *x1 = hf_sweep_first(sw, y, inc, inc ? sw->part + 1 : sw->part - 1);
+    if (*x1 < *x0) *x1 = *x0;
 }
 
 static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
@@ -2728,14 +2761,18 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
     const int open = sw->border == HFVIS_BORDER_OPEN;
     const double in_x0 = 1.0 - sw->ox, in_x1 = (sw->ext_w - 2.0) - sw->ox; /* exact integers */
     const double in_y0 = 1.0 - sw->oy, in_y1 = (sw->ext_h - 2.0) - sw->oy;
+    const int tile_w = sw->parts ? sw->rx1 - sw->rx0 : HF_TILE; /* a band: whole rows, its span */
     for (c = 0; c < ch; c++) hf_look_dir(sw, m_first + c, &lx[c], &ly[c]);
     for (ty = sw->ry0; ty < sw->ry1; ty += HF_TILE)
-        for (tx = sw->rx0; tx < sw->rx1; tx += HF_TILE)
+        for (tx = sw->rx0; tx < sw->rx1; tx += tile_w)
     for (y = ty; y < sw->ry1 && y < ty + HF_TILE; y++) {
         const int edge_row = open && !((double)y >= in_y0 && (double)y <= in_y1);
-        for (x = tx; x < sw->rx1 && x < tx + HF_TILE; x++) {
+        int xs, xe;
+        hf_sweep_span(sw, y, &xs, &xe); /* this band's receivers of the row (all without bands) */
+        if (xs < tx) xs = tx;
+        if (xe > tx + tile_w) xe = tx + tile_w;
+        for (x = xs; x < xe; x++) {
             ptrdiff_t o = (ptrdiff_t)y * out_stride + x;
-            if (sw->parts && !hf_sweep_mine(sw, x, y)) continue; /* another band's */
             if (hf_is_hole(g, x, y)) {
                 for (c = 0; c < ch; c++) out[(size_t)c * plane_step + (size_t)o] = (float)HFVIS__NAN;
                 continue;
@@ -3817,12 +3854,14 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
     hf_lattice_fill(&sw, HFVIS__NAN);
     hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
     hf_gather_planes(&sw, 1, 0, out, 0, out_stride);
-    for (y = sw.ry0; y < sw.ry1; y++)
-        for (x = sw.rx0; x < sw.rx1; x++) {
+    for (y = sw.ry0; y < sw.ry1; y++) {
+        int x0, x1;
+        hf_sweep_span(&sw, y, &x0, &x1); /* the band's receivers of the row */
+        for (x = x0; x < x1; x++) {
             float *p = out + (ptrdiff_t)y * out_stride + x;
-            if (!hf_sweep_mine(&sw, x, y)) continue;
             *p = (float)hf_sun_fraction(sun_elevation_rad, sun_radius_rad, (double)*p);
         }
+    }
     hf_sweep_free(&sw);
     hf_progress(&o, 1, 1);
     return HFVIS_OK;
@@ -8716,7 +8755,9 @@ typedef struct hf_exact {
     double *sd, *sh;        /* one line's samples, then its hull stack: distances (sub-steps),
                                heights (world units) */
     double *tan;            /* width*height tangents of the current direction, NaN at holes */
-    float *nrm;             /* width*height*3 grid normals (lighting), else NULL */
+    const float *nrm;       /* width*height*3 grid normals (lighting): the scratch's or the
+                               caller's (sweep options normals), else NULL */
+    float *nrm_own;         /* the scratch's normals, NULL when given */
     double *acc;            /* width*height*channels sums, else NULL */
     int channels;
     double radius;          /* a finite search radius (world units), else 0 */
@@ -9414,7 +9455,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     off_c = hf_align_add(&total, (size_t)maxp, sizeof(hf_cross), &ok);
     off_s = hf_align_add(&total, cap + 2u, 2u * sizeof(double), &ok); /* + the hull's NaN slots */
     if (want_tan) off_t = hf_align_add(&total, gridn, sizeof(double), &ok);
-    if (want_normals) off_n = hf_align_add(&total, gridn, 3u * sizeof(float), &ok);
+    if (want_normals && !o->normals) off_n = hf_align_add(&total, gridn, 3u * sizeof(float), &ok);
     if (channels) off_a = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
     E->radius = hf_radius_on(o) ? o->max_distance : 0.0;
     E->win_rw = -1;
@@ -9439,12 +9480,13 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     E->sh = E->sd + cap + 2;
     E->sd[-2] = E->sd[-1] = E->sh[-2] = E->sh[-1] = HFVIS__NAN; /* below the stack: hf_hull_step */
     E->tan = want_tan ? (double *)(void *)(blk + off_t) : NULL;
-    E->nrm = want_normals ? (float *)(void *)(blk + off_n) : NULL;
+    E->nrm_own = want_normals && !o->normals ? (float *)(void *)(blk + off_n) : NULL;
+    E->nrm = want_normals && o->normals ? o->normals : E->nrm_own;
     E->acc = channels ? (double *)(void *)(blk + off_a) : NULL;
     if (E->radius > 0.0) hf_win_carve(&E->win, blk + off_win, cap);
     E->rec = (int *)(void *)(blk + off_r);
     hf_exact_dirs_fill(&E->d, K, o->azimuth0_rad, E->N);
-    if (want_normals == 1) (void)hfvis_normals_compute(g, E->nrm); /* the grid normals, as floats */
+    if (want_normals == 1 && E->nrm_own) (void)hfvis_normals_compute(g, E->nrm_own); /* as floats */
     if (channels) memset(E->acc, 0, gridn * (size_t)channels * sizeof(double));
     return HFVIS_OK;
 }
@@ -9585,9 +9627,9 @@ static hfvis_status hf_exact_sums(hf_exact *E, const hfvis_grid *g, int K, hfvis
             const double *tr = E->tan + r;
             double *acc = banded ? add : E->acc, *ar = acc + r * (size_t)channels;
             hf_exact_span(E, y, E->d.ray[k], &x0, &x1);
-            for (x = x0; banded && x < x1; x++) { /* a band's holes and normals */
+            for (x = x0; banded && x < x1; x++) { /* a band's holes and normals (unless given) */
                 double n[3];
-                float *nr = E->nrm ? E->nrm + (r + (size_t)x) * 3 : NULL;
+                float *nr = E->nrm_own ? E->nrm_own + (r + (size_t)x) * 3 : NULL;
                 if (hf_is_hole(g, x, y))
                     for (c = 0; c < channels; c++) ar[(size_t)x * (size_t)channels + (size_t)c] = HFVIS__NAN;
                 else if (nr) { /* hfvis_normals_compute's bits */

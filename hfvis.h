@@ -652,6 +652,15 @@ typedef struct hfvis_sweep_options {
                                        0, 0 = every receiver (default); else 0 <= part_index <
                                        part_count <= 65536 (HFVIS_ERR_INVALID_ARGUMENT otherwise,
                                        and from every other routine and mode for part_count > 1) */
+    const float *normals;           /* NULL (default), or this grid's normals exactly as
+                                       hfvis_normals_compute writes them (width*height*3 floats),
+                                       only read: the sweeps that light the terrain (sky light,
+                                       environment light and their hfvis_direction_sums in both
+                                       ray modes, the [P2] indirect gather) read them instead of
+                                       computing them in their scratch,
+                                       so that the calls of a split run (hfvis.h, "Threads")
+                                       compute them once and share them. Other values change the
+                                       results (they are not checked) */
 } hfvis_sweep_options;
 
 HFVIS_API hfvis_sweep_options hfvis_sweep_options_default(void);

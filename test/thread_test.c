@@ -2,8 +2,8 @@
  * --threads runs them (hfvis.h, "Threads"), and the split results equal one call's bit for bit:
  * one sun's bands writing one output, the per-direction sums of quarter-turn groups (lattice) and
  * single directions (exact) added in order and finished as the single run finishes them, the
- * exact sums by bands of one direction at a time added in place, and the horizon map's plane
- * ranges writing one map. Built with -pthread; make sanitize also builds it
+ * exact sums by bands of one direction at a time added in place, the grid normals given once
+ * and shared, and the horizon map's plane ranges writing one map. Built with -pthread; make sanitize also builds it
  * under ThreadSanitizer, which reports any data race among these calls. */
 #define _POSIX_C_SOURCE 200809L
 #include <pthread.h>
@@ -60,6 +60,7 @@ static void *sums_worker(void *p)
         hfvis_sweep_options o = hfvis_sweep_options_default();
         o.rays = (hfvis_ray_mode)j->mode;
         o.azimuth0_rad = 0.3;
+        o.normals = j->opts.normals; /* shared by every unit (sky light) */
         if (j->mode == HFVIS_RAYS_LATTICE) {
             o.direction_order = HFVIS_DIRECTION_ORDER_SWEEP;
             o.direction_begin = 4 * u;
@@ -68,7 +69,7 @@ static void *sums_worker(void *p)
             o.direction_begin = u;
             o.direction_end = u + 1;
         }
-        j->status[u] = hfvis_direction_sums(&g_grid, TK, HFVIS_SUM_SKY_VIEW, NULL, NULL, &o,
+        j->status[u] = hfvis_direction_sums(&g_grid, TK, j->kind, NULL, NULL, &o,
                                             j->unit_sums + (size_t)u * TN);
     }
     return NULL;
@@ -171,6 +172,7 @@ TEST(direction_sums_concurrently)
     size_t i;
     memset(&j, 0, sizeof j);
     pthread_mutex_init(&j.lock, NULL);
+    j.kind = HFVIS_SUM_SKY_VIEW;
     for (mode = HFVIS_RAYS_LATTICE; mode <= HFVIS_RAYS_EXACT; mode++) {
         hfvis_sweep_options o = hfvis_sweep_options_default();
         o.rays = (hfvis_ray_mode)mode;
@@ -199,6 +201,44 @@ static int same_sums(const double *a, const double *b, size_t n)
     return 1;
 }
 
+/* The grid normals given once (sweep options normals, hfvis_normals_compute's) and shared by
+ * concurrent calls: the sky light equals the calls that make their own, whole (both modes) and
+ * split by quarter-turn groups added in order (lattice). A normal off by one float would show. */
+TEST(given_normals_shared)
+{
+    static float nrm[TN * 3], whole[TN], given[TN];
+    static double unit[TK * TN], acc[TN], sums[TN];
+    job j;
+    int mode, u;
+    size_t i;
+    memset(&j, 0, sizeof j);
+    pthread_mutex_init(&j.lock, NULL);
+    CHECK_EQ_STATUS(hfvis_normals_compute(&g_grid, nrm), HFVIS_OK);
+    for (mode = HFVIS_RAYS_LATTICE; mode <= HFVIS_RAYS_EXACT; mode++) {
+        hfvis_sweep_options o = hfvis_sweep_options_default();
+        o.rays = (hfvis_ray_mode)mode;
+        o.azimuth0_rad = 0.3;
+        CHECK_EQ_STATUS(hfvis_sky_light(&g_grid, TK, 1.5f, 0.7f, &o, whole, TW), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_direction_sums(&g_grid, TK, HFVIS_SUM_SKY_LIGHT, NULL, NULL, &o, sums), HFVIS_OK);
+        o.normals = nrm;
+        CHECK_EQ_STATUS(hfvis_sky_light(&g_grid, TK, 1.5f, 0.7f, &o, given, TW), HFVIS_OK);
+        CHECK(same(whole, given, TN));
+        if (mode != HFVIS_RAYS_LATTICE) continue;
+        j.mode = mode;
+        j.kind = HFVIS_SUM_SKY_LIGHT;
+        j.opts.normals = nrm;
+        j.parts = TK / 4;
+        j.unit_sums = unit;
+        run_threads(&j, sums_worker);
+        for (u = 0; u < j.parts; u++) CHECK_EQ_STATUS(j.status[u], HFVIS_OK);
+        for (i = 0; i < TN; i++) acc[i] = unit[i];
+        for (u = 1; u < j.parts; u++)
+            for (i = 0; i < TN; i++) acc[i] += unit[(size_t)u * TN + i];
+        CHECK(same_sums(sums, acc, TN));
+    }
+    pthread_mutex_destroy(&j.lock);
+}
+
 /* Exact-mode sums by bands of one direction at a time (7 bands over 4 threads, then the next
  * direction), added in place to one array zeroed once: the whole call's S bit for bit, for the
  * sky-view factor and the sky light, over the grid and over a receiver rectangle (whose outside
@@ -206,11 +246,13 @@ static int same_sums(const double *a, const double *b, size_t n)
 TEST(exact_band_sums_concurrently)
 {
     static double whole[TN], banded[TN];
+    static float nrm[TN * 3];
     job j;
     int kind, rect, k, u;
     size_t i;
     memset(&j, 0, sizeof j);
     pthread_mutex_init(&j.lock, NULL);
+    CHECK_EQ_STATUS(hfvis_normals_compute(&g_grid, nrm), HFVIS_OK);
     for (kind = HFVIS_SUM_SKY_VIEW; kind <= HFVIS_SUM_SKY_LIGHT; kind++)
         for (rect = 0; rect < 2; rect++) {
             hfvis_sweep_options o = hfvis_sweep_options_default();
@@ -233,6 +275,7 @@ TEST(exact_band_sums_concurrently)
             j.unit_sums = banded;
             for (k = 0; k < TK; k++) { /* one direction at a time, its bands concurrently */
                 j.opts = o;
+                j.opts.normals = rect ? nrm : NULL; /* given (shared) or each band's own */
                 j.opts.direction_begin = k;
                 j.opts.direction_end = k + 1;
                 run_threads(&j, band_sums_worker);
@@ -272,6 +315,7 @@ int main(int argc, char **argv)
     RUN(sun_bands_concurrently);
     RUN(direction_sums_concurrently);
     RUN(exact_band_sums_concurrently);
+    RUN(given_normals_shared);
     RUN(horizon_map_planes_concurrently);
     return TEST_DONE();
 }

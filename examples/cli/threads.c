@@ -368,7 +368,8 @@ static hfvis_status cli_threaded_sums(const hfvis_grid *grid, int K, hfvis_sum_k
 
 /* skyview, sky or light (cmd) over all K directions on `threads` threads: S by
  * cli_threaded_sums, finished as the single run (scale: sky * albedo, or albedo, as the floats the
- * run passes), out[(y*width + x)*channels + c]. */
+ * run passes), out[(y*width + x)*channels + c]. The lit commands compute the grid normals once
+ * and give them to every unit (sweep options normals) instead of each call making its own. */
 static hfvis_status cli_threaded_light(int cmd, const hfvis_grid *grid, int K, double scale,
                                        const hfvis_env *env, const hfvis_env_options *eopts,
                                        const hfvis_sweep_options *opts, int threads, int channels,
@@ -376,13 +377,21 @@ static hfvis_status cli_threaded_light(int cmd, const hfvis_grid *grid, int K, d
 {
     const hfvis_sum_kind kind = cmd == CMD_SKYVIEW ? HFVIS_SUM_SKY_VIEW
                                 : cmd == CMD_SKY ? HFVIS_SUM_SKY_LIGHT : HFVIS_SUM_ENV_LIGHT;
-    const size_t count = (size_t)grid->width * (size_t)grid->height * (size_t)channels;
+    const size_t n = (size_t)grid->width * (size_t)grid->height, count = n * (size_t)channels;
     double *acc = (double *)cli_huge_malloc(count * sizeof(double));
-    hfvis_status s;
+    float *nrm = NULL;
+    hfvis_sweep_options o = *opts;
+    hfvis_status s = HFVIS_OK;
     size_t i;
     if (!acc) return HFVIS_ERR_OUT_OF_MEMORY;
-    s = cli_threaded_sums(grid, K, kind, env, eopts, opts, threads, channels, acc);
+    if (cmd != CMD_SKYVIEW && !o.normals) { /* the grid normals once, shared by every unit */
+        nrm = n <= SIZE_MAX / (3 * sizeof(float)) ? (float *)cli_huge_malloc(n * 3 * sizeof(float)) : NULL;
+        s = nrm ? hfvis_normals_compute(grid, nrm) : HFVIS_ERR_OUT_OF_MEMORY;
+        o.normals = nrm;
+    }
+    if (s == HFVIS_OK) s = cli_threaded_sums(grid, K, kind, env, eopts, &o, threads, channels, acc);
     for (i = 0; s == HFVIS_OK && i < count; i++) out[i] = cli_sum_finish(cmd, K, scale, acc[i]);
+    free(nrm);
     free(acc);
     return s;
 }
