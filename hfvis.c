@@ -9334,7 +9334,7 @@ static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int bo
                     double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[S], z11 = (double)p[S + 1];
                     double r0 = z00 + (z10 - z00) * mfx, r1 = z01 + (z11 - z01) * mfx;
                     double tt = (r0 + (r1 - r0) * mfy - (double)zr[x]) * im;
-                    double bulge = c->q * hf_cell_twist(p, S), rx = row[x];
+                    double bulge = c->q * (z00 - z10 - z01 + z11), rx = row[x]; /* hf_cell_twist */
                     rx = tt > rx ? tt : rx;
                     if (bulge > lim4 && bulge < HFVIS__INF)
                         rx = hf_near_fill(p, S, c, bulge, lim, o[i].u, (double)zr[x], scale, rx);
