@@ -888,7 +888,7 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     0.10-0.30 deg mean and 1.7-8.3 deg p99 from the supremum, all pairs (walls and cliffs seen
  *     or missed half a cell across), held to HFVIS_EXACT_FAR_MEAN_DEG / _P99_DEG. Receiver
  *     rectangles and sun bands equal the whole run bit for bit (a receiver's value depends on
- *     its own position only). Scratch: 20 bytes more per sample of a line and 8*width bytes.
+ *     its own position only). Scratch: 12 bytes more per sample of a line and 8*width bytes.
  *     Cost and figures: docs/exact-rays.md, "Near and far field".
  *   - Accuracy: against the supremum over the bilinear surface (every pair) the exact mode is
  *     within 0.01 deg mean and 0.25 deg p99 on urban boxes, terraces with one-cell cliffs and
