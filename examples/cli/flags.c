@@ -218,8 +218,8 @@ static const cli_flag cli_flags[] = {
       "horizon, skyview, sky, light, shadow, hillshade, openness --radius: run\n"
       "                    on N threads, 0..256 (0: the online cores; default 1); the output is\n"
       "                    the one-thread run's bit for bit (directions, bands across the sun,\n"
-      "                    rows). Each thread holds its own lattice: where first-touch page faults\n"
-      "                    are slow (VMs), more threads can be slower (docs/performance.md)\n" },
+      "                    rows). Each thread adds its own lattice (--exact: a tangent plane)\n"
+      "                    to the peak memory (docs/performance.md, Threads)\n" },
     { "--sky", "C", CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI),
       CLI_REAL_AT(0.0, 0, CLI_FLT_MAX, "a radiance >= 0",
                  "1", "radiance", sky, CLI_HAS(has_sky)), NULL },
