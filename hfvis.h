@@ -144,8 +144,10 @@
  *   Every receiver with a finite height gets a value: one stranded between holes, where the
  *   lattice holds no finite node near it, takes the per-receiver march of the oracle
  *   (hfvis_horizon_reference) toward each direction instead of the gathered lattice (horizon
- *   maps and every lattice product built on them or on the fused sums; hfvis_indirect_light
- *   alone still leaves NaN there). Grid normals are one-sided beside holes.
+ *   maps and every lattice product built on them or on the fused sums; for
+ *   hfvis_indirect_light and hfvis_visibility_count the march's samples form the receiver's
+ *   line: out of the grid, then border_cells pre-roll steps). Grid normals are one-sided beside
+ *   holes.
  * Obscurance and light. Obscurance outputs lie in [0, 1] (0 = nothing blocks). Lighting outputs
  *   are radiance with the Lambertian convention L_o = albedo/pi * Int L_i V (n.w) dw, so an
  *   unoccluded flat receiver under a uniform sky of radiance c with albedo 1 returns c.
@@ -1455,8 +1457,17 @@ typedef enum hfvis_solar_bands {
 /* What to compute: the site, the period and the surface. hfvis_solar_input_default() fills in
  * linke 3, albedo 0.2, days 1, 2026-06-21; latitude and longitude are the caller's to set. */
 typedef struct hfvis_solar_input {
-    double latitude_rad;      /* the sun is computed at this one place for the whole grid */
-    double longitude_rad;     /* (east positive); SPA needs it, RSUN ignores it */
+    double latitude_rad;      /* the site when the maps below are NULL: the sun is computed at */
+    double longitude_rad;     /* this one place for the whole grid (east positive; SPA needs
+                                 the longitude, RSUN ignores it) */
+    const double *latitude_map;  /* per sample [y*width + x], radians (geodetic latitude in
+                                    [-pi/2, pi/2], longitude east positive in [-pi, pi]), both or */
+    const double *longitude_map; /* neither: each sample's own site, e.g. the inverse projection
+                                    of its CRS. The grid's up direction (-y) is then taken at the
+                                    true azimuth the maps give it (the meridian convergence, from
+                                    their differences along y, along x on a one-row grid), and the
+                                    sun is computed per block of samples whose local frames are
+                                    within opts->site_tolerance_rad of the block centre's */
     double height_m;          /* SPA's observer height; the air mass uses each sample's z */
     int year, month, day;     /* first day; RSUN steps day of the year from it */
     int days;                 /* >= 1 days from the first (ignored for an instant) */
@@ -1490,9 +1501,19 @@ typedef struct hfvis_solar_options {
     hfvis_solar_reflected reflected;
     int reflected_directions;    /* TERRAIN: K of the [P2] gather; 0 = 16 */
     hfvis_solar_bands bands;
+    double site_tolerance_rad;   /* with input->latitude_map: the largest rotation between a
+                                    sample's local frame (east, north, up turned by the
+                                    convergence) and its block centre's, (0, 0.1]; 0 = 0.05 deg.
+                                    Every sun direction of a sample is within it of its own */
     const hfvis_sweep_options *sweep; /* border, search radius, allocator, progress; its rays
                                     field is ignored (the horizon map is always exact rays) and
                                     its window and rectangle must be unset */
+    const float *horizon_map;    /* NULL: the fast routine makes its exact horizon map itself;
+                                    else the caller's, directions*width*height floats exactly as
+                                    hfvis_horizon_map writes them for these K directions with
+                                    HFVIS_RAYS_EXACT and the sweep options above (azimuth0 0,
+                                    every direction): e.g. made on several threads (the results
+                                    are then bit for bit those of NULL). The oracle ignores it */
 } hfvis_solar_options;
 
 HFVIS_API hfvis_solar_options hfvis_solar_options_default(void);
@@ -1511,7 +1532,10 @@ HFVIS_API int hfvis_solar_band_count(const hfvis_solar_input *input,
                                      const hfvis_solar_options *opts);
 
 /* Irradiance (input->instant) or irradiation over a period on every grid point. Per time step:
- * the sun at the site; the beam is shaded by the exact horizon toward the sun, read from one
+ * the sun at the site (with input->latitude_map: at the centre of each block of samples whose
+ * local frames lie within opts->site_tolerance_rad of the centre's, quadtree halving from the
+ * whole grid; the steps, sunrise and sunset are then each block's own, SPA's instant part taken
+ * once per hour of the period and interpolated, within 2e-6 deg); the beam is shaded by the exact horizon toward the sun, read from one
  * exact-ray horizon map of K directions made once (hfvis_horizon_map, HFVIS_RAYS_EXACT) and
  * interpolated linearly in azimuth between its two nearest directions; then r.sun's ESRA
  * atmosphere per sample (its height for the air mass, its Linke factor, albedo and
@@ -1529,9 +1553,10 @@ HFVIS_API int hfvis_solar_band_count(const hfvis_solar_input *input,
  * Memory: K*8 bytes per sample for the map and its sample-major copy (K = 64: 512 bytes at the
  * peak), 120 bytes per sample of state and 32 per sample and band of sums, plus the outputs;
  * HORIZON adds 4 bytes per sample, TERRAIN the [P2] sweep's scratch; the sector sums about
- * 350 bytes per sunlit step.
+ * 350 bytes per sunlit step; per-sample sites 1 KB per day of the period (the hourly table)
+ * and 56 bytes per block.
  * Cost: the map (hfvis.h "Exact rays") plus O(steps*width*height), or with the sector sums
- * O(steps log steps + bands*K*width*height*log steps).
+ * O(steps log steps + bands*K*width*height*log steps), the steps' part once per block.
  * Accuracy against hfvis_solar_irradiation_reference: docs/solar.md and test/test_solar.c.
  * Returns HFVIS_ERR_INVALID_ARGUMENT (NULL, no output, bad input or option: a date that does
  * not exist, linke outside (0, 10], albedo outside [0, 1], a latitude outside [-pi/2, pi/2]),
@@ -1541,14 +1566,16 @@ HFVIS_API hfvis_status hfvis_solar_irradiation(const hfvis_grid *grid,
                                                const hfvis_solar_options *opts,
                                                const hfvis_solar_output *out);
 
-/* Oracle: the same steps and the same atmosphere per step and grid point, with the horizon
+/* Oracle: the same steps (with input->latitude_map: each sample's own steps at its own site, the
+ * full SPA at every instant) and the same atmosphere per step and grid point, with the horizon
  * toward the sun's own azimuth from first principles at every step: each receiver's own exact
  * ray (hfvis_horizon_exact_naive, K = 1, ray_denominator 1024: within 0.002 deg of the sun's
  * azimuth); the visible sky of HORIZON integrated over 4K directions of the same rays ([P1]
  * Eq. 5 per sector); TERRAIN gathered by hfvis_indirect_light_naive; summed naively in double.
  * (The bilinear ray march hfvis_horizon_reference is not used: its samples within the first
  * cell measure the bilinear patch's own directional slope, which the solar model counts as the
- * receiver's incidence angle instead; docs/solar.md.) Cost O(steps*width*height*max(W, H)). */
+ * receiver's incidence angle instead; docs/solar.md.) Cost O(steps*width*height*max(W, H)),
+ * with the maps O(steps*width*height*(SPA + ray_denominator)). */
 HFVIS_API hfvis_status hfvis_solar_irradiation_reference(const hfvis_grid *grid,
                                                          const hfvis_solar_input *input,
                                                          const hfvis_solar_options *opts,

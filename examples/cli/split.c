@@ -31,15 +31,19 @@ static unsigned long long cli_fingerprint(const float *v, size_t n)
 static void cli_partial_tag(const cli_args *a, const hfvis_grid *grid, const hfvis_sweep_options *o,
                             const hfvis_env *env, char *tag)
 {
+    const ex_georef *g = &a->run->geo;
     int n = snprintf(tag, CLI_TAG_MAX, "cmd=%s dirs=%d in=%016llx cell=%a border=%d border-cells=%d "
-                     "azimuth0=%a rays=%s max-distance=%a", cli_commands[a->cmd].name, a->dirs,
+                     "azimuth0=%a rays=%s max-distance=%a georef=%d", cli_commands[a->cmd].name, a->dirs,
                      cli_fingerprint(grid->z, (size_t)grid->width * (size_t)grid->height),
                      grid->cell_size, (int)o->border, o->border_cells, o->azimuth0_rad,
-                     o->rays == HFVIS_RAYS_EXACT ? "exact" : "lattice", o->max_distance);
+                     o->rays == HFVIS_RAYS_EXACT ? "exact" : "lattice", o->max_distance,
+                     g->has_transform || g->crs || g->epsg || g->has_nodata || g->prj || g->n_geokeys);
     char *t = tag + n;
     size_t left = CLI_TAG_MAX - (size_t)n;
     switch (a->cmd) {
-    case CMD_HORIZON: snprintf(t, left, " degrees=%d", a->degrees); break;
+    case CMD_HORIZON: /* and the convention, from which `sum` rebuilds the band labels */
+        snprintf(t, left, " degrees=%d convention=%d", a->degrees, a->convention);
+        break;
     case CMD_SKY: snprintf(t, left, " sky=%a albedo=%a", a->sky, a->albedo); break;
     case CMD_LIGHT:
         snprintf(t, left, " env=%016llx env-size=%dx%dx%d albedo=%a method=%d",
@@ -278,10 +282,22 @@ static int cli_sum_check(const char *path, int cmd, const hfvis_partial *p)
 
 static int cli_sum(int argc, char **argv)
 {
+    /* per part (at most argc): its name, header and tag, and its place in direction order */
+    const char **names = (const char **)calloc((size_t)argc, sizeof *names);
+    cli_part *meta = (cli_part *)calloc((size_t)argc, sizeof *meta);
+    int *order = (int *)calloc((size_t)argc, sizeof *order), rc;
+    if (!names || !meta || !order) rc = cli_status("sum", HFVIS_ERR_OUT_OF_MEMORY, 0);
+    else rc = cli_sum_parts(argc, argv, names, meta, order);
+    free(order);
+    free(meta);
+    free((void *)names);
+    return rc;
+}
+
+/* cli_sum with its per-part arrays. */
+static int cli_sum_parts(int argc, char **argv, const char **names, cli_part *meta, int *order)
+{
     enum { MAX_PARTS = 4096 };
-    static cli_part meta[MAX_PARTS];
-    static const char *names[MAX_PARTS];
-    static int order[MAX_PARTS];
     cli_args a;
     cli_run_state run;
     const char *cmdname = "sum";
@@ -303,10 +319,12 @@ static int cli_sum(int argc, char **argv)
             const char *eq = strchr(arg, '='), *v = eq ? eq + 1 : (i + 1 < argc ? argv[++i] : NULL);
             if (!v) return cli_error(CLI_EXIT_USAGE, is_o ? "-o" : "--range", "missing value");
             if (is_o) {
-                if (!cli_ends_with(v, ".pfm") && !cli_ends_with(v, ".pgm"))
-                    return cli_error(CLI_EXIT_USAGE, v, "unknown output type (use a .pfm or .pgm name)");
+                if (!cli_ends_with(v, ".pfm") && !cli_ends_with(v, ".pgm") && !ex_rio_format_of(v))
+                    return cli_error(CLI_EXIT_USAGE, v, "unknown output type (use a .pfm, .pgm, .tif, "
+                                     ".asc, .bil or .flt name)");
                 a.out = v;
                 a.out_pgm = cli_ends_with(v, ".pgm");
+                a.out_raster = !a.out_pgm && !cli_ends_with(v, ".pfm");
             } else if (cli_set(&a, "--range", v)) {
                 return CLI_EXIT_USAGE;
             }
@@ -341,6 +359,14 @@ static int cli_sum(int argc, char **argv)
         goto done;
     }
     K = meta[0].directions, W = meta[0].width, H = meta[0].height, planes = meta[0].planes;
+    if (a.out_raster && cli_tag_value(meta[0].tag, "georef", name, sizeof name) && strcmp(name, "0")) {
+        rc = cli_error(CLI_EXIT_ERROR, a.out, "the parts come from a georeferenced raster, whose "
+                       "georeference a partial result does not carry: write .pfm or .pgm, or run "
+                       "whole (or in --window pieces and 'hfvis mosaic')");
+        goto done;
+    }
+    a.cmd = cmd; /* the single run's command and flags, for cli_save (visibility's integer counts) */
+    a.fraction = cmd == CMD_VISIBILITY && planes == 2;
     for (i = 1; i < nparts; i++) {
         const cli_part *p = &meta[i];
         if (p->width != W || p->height != H || p->directions != K ||
@@ -425,7 +451,7 @@ static int cli_sum(int argc, char **argv)
             for (j = 0; j < p.planes; j++) {
                 int pos = p.begin + j, kk = K % 4 ? pos : pos / 4 + (pos % 4) * (K / 4);
                 const double *src = p.sums + (size_t)j * n;
-                float *dst = out + (size_t)kk * n;
+                float *dst = out + (size_t)kk * n; /* (a split horizon is compass or grid) */
                 for (k = 0; k < n; k++) dst[k] = deg ? (float)(src[k] * (180.0 / CLI_PI)) : (float)src[k];
             }
         } else if (i == 0) {
@@ -478,7 +504,15 @@ static int cli_sum(int argc, char **argv)
                                (int)(k / (size_t)channels / (size_t)W), (double)out[k]);
                 goto done;
             }
-    rc = cli_save(&a, cli_output_of(out, W, H, out_planes, channels, lo, hi));
+    {
+        cli_output whole = cli_output_of(out, W, H, out_planes, channels, lo, hi);
+        cli_labels L;
+        memset(&L, 0, sizeof L);
+        if (cmd == CMD_HORIZON && (rc = cli_horizon_labels_of_tag(meta[0].tag, K, &L)) != 0) goto done;
+        if (L.band) whole.band_names = L.band, whole.unit = L.unit, whole.meta = L.meta, whole.n_meta = K + 3;
+        rc = cli_save(&a, whole);
+        cli_labels_free(&L);
+    }
 done:
     free(acc);
     free(out);
