@@ -3535,9 +3535,8 @@ static void hf_fused_stranded(hf_sweep *sw, int K, const hfvis_sweep_options *o,
         for (x = sw->rx0; x < sw->rx1; x++) {
             double *acc = sw->gacc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)ch, nd[3];
             int stranded = 0;
-            if (hf_is_hole(g, x, y)) continue;
             for (c = 0; c < ch; c++) stranded |= isnan(acc[c]);
-            if (!stranded) continue;
+            if (!stranded || hf_is_hole(g, x, y)) continue; /* the NaN test first: it rules out most */
             hf_normal_at(g, x, y, nd);
             n1[0] = (float)nd[0];
             n1[1] = (float)nd[1];

@@ -99,7 +99,7 @@ static hfvis_status cli_write(const char *path, unsigned char *bytes, size_t n, 
 
 static hfvis_status cli_write_encoded(const char *path, size_t need, cli_encoder encode, const void *what)
 {
-    unsigned char *buf = need ? (unsigned char *)malloc(need) : NULL;
+    unsigned char *buf = need ? (unsigned char *)cli_huge_malloc(need) : NULL; /* threads.c */
     size_t written = 0;
     hfvis_status s;
     if (!buf) return need ? HFVIS_ERR_OUT_OF_MEMORY : HFVIS_ERR_INVALID_ARGUMENT;
