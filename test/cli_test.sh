@@ -546,7 +546,21 @@ expect_fail "sum refuses parts of another origin" 1 sum "$dir/geo_a.hfvs" "$dir/
 grep -q 'georeference (geotransform' "$dir/stderr" && ok "sum: another origin named" || bad "sum: another origin: $(cat "$dir/stderr")"
 expect_fail "sum refuses parts of another CRS, even to .pfm" 1 sum "$dir/geo_a.hfvs" "$dir/geo_c.hfvs" -o "$fdir/x.pfm"
 grep -q "georeference (CRS: the .prj's WKT)" "$dir/stderr" && ok "sum: another CRS named" || bad "sum: another CRS: $(cat "$dir/stderr")"
-# a part of hfvis 0.2 and before (tag "georef=1", no geo=; made here by rewriting the tag and its
+# a georeference too long for the tag (a 3.5 kB .prj): the parts still sum to .pfm, a raster OUT
+# is refused in one line, and their fingerprint keeps them apart from other georeferences' parts
+cp "$dir/geo.asc" "$dir/geo_long.asc"
+longname=$(awk 'BEGIN { for (i = 0; i < 3200; i++) printf "%c", 97 + i % 26 }')
+sed "s/WGS_1984_UTM_Zone_33N/$longname/" "$dir/geo.prj" > "$dir/geo_long.prj"
+"$hfvis" skyview "$dir/geo_long.asc" --dirs 8 --dir-range 0:4 -o "$dir/geo_l1.hfvs" 2> /dev/null
+"$hfvis" skyview "$dir/geo_long.asc" --dirs 8 --dir-range 4:8 -o "$dir/geo_l2.hfvs" 2> /dev/null
+"$hfvis" skyview "$dir/geo_long.asc" --dirs 8 -o "$dir/geo_long_single.pfm" 2> /dev/null
+"$hfvis" sum "$dir/geo_l1.hfvs" "$dir/geo_l2.hfvs" -o "$dir/geo_long_sum.pfm" 2> "$dir/stderr" &&
+  cmp -s "$dir/geo_long_single.pfm" "$dir/geo_long_sum.pfm" && ok "sum: parts of a long georeference to .pfm" ||
+  bad "sum: parts of a long georeference to .pfm: $(cat "$dir/stderr")"
+expect_fail "sum refuses a raster OUT of a georeference too long for the tag" 1 sum "$dir/geo_l1.hfvs" "$dir/geo_l2.hfvs" -o "$fdir/x.tif"
+grep -q 'too long for a part' "$dir/stderr" && ok "sum: the long georeference named" || bad "sum: long georeference: $(cat "$dir/stderr")"
+expect_fail "sum refuses a long georeference's part beside another's" 1 sum "$dir/geo_l1.hfvs" "$dir/geo_b.hfvs" -o "$fdir/x.pfm"
+# a part of an older hfvis (tag "georef=1", no geo=; made here by rewriting the tag and its
 # CRC-32, which gzip's trailer holds) is refused, never summed without its georeference
 if command -v gzip > /dev/null 2>&1; then
   part=$dir/geo_a.hfvs; total=$(wc -c < "$part"); head3=$(head -n 3 "$part" | wc -c)

@@ -98,8 +98,8 @@ static void cli_b64_encode(const unsigned char *b, size_t n, char *out)
 {
     size_t i;
     for (i = 0; i < n; i += 3) {
-        unsigned long v = (unsigned long)b[i] << 16 | (i + 1 < n ? (unsigned long)b[i + 1] << 8 : 0) |
-                          (i + 2 < n ? b[i + 2] : 0);
+        unsigned long v = (unsigned long)b[i] << 16 |
+                          (i + 1 < n ? (unsigned long)b[i + 1] << 8 : 0) | (i + 2 < n ? b[i + 2] : 0);
         size_t k, m = n - i >= 3 ? 4 : n - i + 1;
         for (k = 0; k < m; k++) *out++ = cli_b64[v >> (18 - 6 * k) & 63u];
     }
@@ -170,7 +170,8 @@ static int cli_geo_get_array(cli_geo_reader *r, size_t size, void **out, size_t 
     unsigned long count;
     *out = NULL;
     *n = 0;
-    if (cli_geo_get_uint(r, &count, 4) || count > EX_RIO_MAX_GEO || count * size > r->n - r->at) return -1;
+    if (cli_geo_get_uint(r, &count, 4) || count > EX_RIO_MAX_GEO || count * size > r->n - r->at)
+        return -1;
     if (count == 0) return 0;
     *out = calloc(count * size + extra, 1);
     if (!*out) return -1;
@@ -192,16 +193,18 @@ static int cli_geo_decode(const char *text, ex_georef *g)
     if (!b) return -1;
     r.b = b, r.at = 0, r.n = cli_b64_decode(text, b);
     bad = r.n == (size_t)-1 || cli_geo_get_uint(&r, &flags, 1) || flags > 127 ||
-          cli_geo_get_uint(&r, &crs, 1) || crs > EX_RIO_CRS_GEOCENTRIC || cli_geo_get_uint(&r, &epsg, 4) ||
-          epsg > 0x7fffffffUL;
+          cli_geo_get_uint(&r, &crs, 1) || crs > EX_RIO_CRS_GEOCENTRIC ||
+          cli_geo_get_uint(&r, &epsg, 4) || epsg > 0x7fffffffUL;
     if (!bad) {
         g->has_transform = (flags & 1) != 0, g->has_nodata = (flags & 2) != 0;
-        g->pixel_is_point = (flags & 4) != 0, g->flip_x = (flags & 8) != 0, g->flip_y = (flags & 16) != 0;
+        g->pixel_is_point = (flags & 4) != 0;
+        g->flip_x = (flags & 8) != 0, g->flip_y = (flags & 16) != 0;
         g->has_scale = (flags & 32) != 0, g->has_matrix = (flags & 64) != 0;
         g->crs = (int)crs, g->epsg = (int)epsg;
         bad = (g->has_transform && cli_geo_get_reals(&r, g->gt, 6)) ||
-              (g->has_nodata && (cli_geo_get_reals(&r, &g->nodata, 1) || cli_geo_get_uint(&r, &nd, 1) ||
-                                 nd >= sizeof g->nodata_text || cli_geo_get(&r, g->nodata_text, nd))) ||
+              (g->has_nodata && (cli_geo_get_reals(&r, &g->nodata, 1) ||
+                                 cli_geo_get_uint(&r, &nd, 1) || nd >= sizeof g->nodata_text ||
+                                 cli_geo_get(&r, g->nodata_text, nd))) ||
               (g->has_scale && cli_geo_get_reals(&r, g->scale, 3)) ||
               (g->has_matrix && cli_geo_get_reals(&r, g->matrix, 16));
     }
@@ -222,7 +225,8 @@ static int cli_geo_decode(const char *text, ex_georef *g)
           cli_geo_get(&r, (g->geoascii = (char *)arr), g->n_geoascii);
     if (!bad) {
         size_t n_prj = 0;
-        bad = cli_geo_get_array(&r, 1, &arr, &n_prj, 1) || cli_geo_get(&r, (g->prj = (char *)arr), n_prj) ||
+        bad = cli_geo_get_array(&r, 1, &arr, &n_prj, 1) ||
+              cli_geo_get(&r, (g->prj = (char *)arr), n_prj) ||
               strlen(g->prj ? g->prj : "") != n_prj || r.at != r.n;
     }
     free(b);
@@ -234,7 +238,7 @@ static int cli_geo_decode(const char *text, ex_georef *g)
  * parameter that changes the sums or their finish, as key=value (reals as exact hexadecimal
  * floats), then "geo=" and the input's georeference (cli_geo_encode), or "geo=long-" and its
  * FNV-1a 64 when that would pass the library's tag limit; `sum` compares tags token by token.
- * (Parts of hfvis 0.2 and before have "georef=0|1" instead of "geo=" and carry no georeference.)
+ * (Parts of an older hfvis have "georef=0|1" instead of "geo=" and carry no georeference.)
  * Returns 0, or -1 when memory runs out. */
 static int cli_partial_tag(const cli_args *a, const hfvis_grid *grid, const hfvis_sweep_options *o,
                            const hfvis_env *env, char *tag)
@@ -463,7 +467,8 @@ static const char *cli_geo_difference(const char *a, const char *b)
         what = "georeference (geotransform: origin or cell size)";
     else if (ga.has_nodata != gb.has_nodata || strcmp(ga.nodata_text, gb.nodata_text))
         what = "georeference (NoData)";
-    else if (ga.flip_x != gb.flip_x || ga.flip_y != gb.flip_y || ga.pixel_is_point != gb.pixel_is_point)
+    else if (ga.flip_x != gb.flip_x || ga.flip_y != gb.flip_y ||
+             ga.pixel_is_point != gb.pixel_is_point)
         what = "georeference (orientation or raster type)";
     else if (strcmp(ga.prj ? ga.prj : "", gb.prj ? gb.prj : ""))
         what = "georeference (CRS: the .prj's WKT)";
@@ -472,8 +477,10 @@ static const char *cli_geo_difference(const char *a, const char *b)
         what = "georeference (CRS: GeoKeys)";
     else {
         for (i = 0; i < ga.n_geokeys && ga.geokeys[i] == gb.geokeys[i]; i++) {}
-        if (i < ga.n_geokeys || (ga.n_geoascii && memcmp(ga.geoascii, gb.geoascii, ga.n_geoascii)) ||
-            (ga.n_geodoubles && memcmp(ga.geodoubles, gb.geodoubles, ga.n_geodoubles * sizeof(double))))
+        if (i < ga.n_geokeys ||
+            (ga.n_geoascii && memcmp(ga.geoascii, gb.geoascii, ga.n_geoascii)) ||
+            (ga.n_geodoubles &&
+             memcmp(ga.geodoubles, gb.geodoubles, ga.n_geodoubles * sizeof(double))))
             what = "georeference (CRS: GeoKeys)";
         else
             what = "georeference (GeoTIFF tie points, scale or transformation)";
@@ -655,7 +662,7 @@ static int cli_sum_parts(int argc, char **argv, const char **names, cli_part *me
         goto done;
     }
     K = meta[0].directions, W = meta[0].width, H = meta[0].height, planes = meta[0].planes;
-    for (i = 0; i < nparts; i++) /* parts of hfvis 0.2 and before: no georeference to check */
+    for (i = 0; i < nparts; i++) /* parts of an older hfvis: no georeference to check */
         if (!cli_tag_geo(meta[i].tag)) {
             rc = cli_error(CLI_EXIT_ERROR, names[i], "a part written by an older hfvis (its tag has "
                            "georef=, not the input's georeference geo=): rerun its --dir-range with "
