@@ -479,11 +479,12 @@ split4() {
   name=$1; cmd=$2; ext=$3; shift 3; ranges=""
   while [ "$1" != "--" ]; do ranges="$ranges $1"; shift; done; shift
   rm -f "$dir"/part_*.hfvs
-  "$hfvis" "$cmd" "$h" "$@" -o "$dir/single.$ext" 2> "$dir/stderr" || { bad "$name: single run: $(cat "$dir/stderr")"; return; }
+  in=${split_in:-$h} # the input: hill.pgm unless split_in names another
+  "$hfvis" "$cmd" "$in" "$@" -o "$dir/single.$ext" 2> "$dir/stderr" || { bad "$name: single run: $(cat "$dir/stderr")"; return; }
   parts=""
   for r in $ranges; do
     p=$dir/part_${r%%:*}.hfvs
-    "$hfvis" "$cmd" "$h" "$@" --dir-range "$r" -o "$p" 2> "$dir/stderr" || { bad "$name: part $r: $(cat "$dir/stderr")"; return; }
+    "$hfvis" "$cmd" "$in" "$@" --dir-range "$r" -o "$p" 2> "$dir/stderr" || { bad "$name: part $r: $(cat "$dir/stderr")"; return; }
     parts="$p $parts"
   done
   # shellcheck disable=SC2086
@@ -513,11 +514,66 @@ else
   echo "SKIP cli sum band descriptions: no gdalinfo (the byte comparison above covers them)"
 fi
 split4 "split visibility, GeoTIFF" visibility tif 0:4 4:8 -- --dirs 8
-awk 'BEGIN { print "ncols 8"; print "nrows 6"; print "xllcorner 500000"; print "yllcorner 5000000"
-  print "cellsize 10"; for (y = 0; y < 6; y++) { s = ""; for (x = 0; x < 8; x++) s = s " " (100 + x * y); print s } }' > "$dir/geo.asc"
-"$hfvis" skyview "$dir/geo.asc" --dirs 8 --dir-range 0:8 -o "$dir/geo.hfvs" 2> /dev/null
-expect_fail "sum: a raster OUT of a georeferenced run's parts (the parts carry no georeference)" 1 sum "$dir/geo.hfvs" -o "$fdir/x.tif"
-grep -q 'georeferenced' "$dir/stderr" && ok "sum: georeference refusal named" || bad "sum: georeference refusal: $(cat "$dir/stderr")"
+# georeferenced parts carry the input's georeference (the tag's geo=): their sum writes the
+# single run's GeoTIFF, ASC + .prj and EHdr + .hdr + .prj byte for byte. geo.tif: a GeoTIFF with
+# GeoKeys, an ESRI PE string (from the .prj), NoData and a hole, made from geo.asc + geo.prj
+awk 'BEGIN { print "ncols 9"; print "nrows 7"; print "xllcorner 500000"; print "yllcorner 5000000"
+  print "cellsize 10"; print "NODATA_value -9999"; for (y = 0; y < 7; y++) { s = ""
+  for (x = 0; x < 9; x++) s = s " " (x == 4 && y == 3 ? -9999 : 100 + x * y + (7 * x + 3 * y) % 5); print s } }' > "$dir/geo.asc"
+printf '%s' 'PROJCS["WGS_1984_UTM_Zone_33N",GEOGCS["GCS_WGS_1984",DATUM["D_WGS_1984",SPHEROID["WGS_1984",6378137.0,298.257223563]],PRIMEM["Greenwich",0.0],UNIT["Degree",0.0174532925199433]],PROJECTION["Transverse_Mercator"],PARAMETER["False_Easting",500000.0],PARAMETER["False_Northing",0.0],PARAMETER["Central_Meridian",15.0],PARAMETER["Scale_Factor",0.9996],PARAMETER["Latitude_Of_Origin",0.0],UNIT["Meter",1.0]]' > "$dir/geo.prj"
+"$hfvis" hillshade "$dir/geo.asc" --quiet -o "$dir/geo.tif" 2> "$dir/stderr" || bad "sum: making geo.tif: $(cat "$dir/stderr")"
+split_in=$dir/geo.tif
+split4 "split horizon of a GeoTIFF, GeoTIFF" horizon tif 0:2 2:5 5:8 -- --dirs 8 --degrees
+split4 "split skyview of a GeoTIFF, GeoTIFF" skyview tif 0:4 4:8 -- --dirs 8 --border clamp
+split4 "split skyview of a GeoTIFF, ASC" skyview asc 0:3 3:8 -- --dirs 8
+cmp -s "$dir/single.prj" "$dir/summed.prj" && ok "sum: the ASC's .prj is the single run's" ||
+  bad "sum: the ASC's .prj differs from the single run's"
+split4 "split horizon of a GeoTIFF, EHdr" horizon bil 0:4 4:8 -- --dirs 8
+cmp -s "$dir/single.hdr" "$dir/summed.hdr" && cmp -s "$dir/single.prj" "$dir/summed.prj" &&
+  ok "sum: the EHdr's .hdr and .prj are the single run's" || bad "sum: the EHdr's .hdr or .prj differs"
+split_in=$dir/geo.asc
+split4 "split skyview of an ASC + .prj, ASC" skyview asc 0:4 4:8 -- --dirs 8
+cmp -s "$dir/single.prj" "$dir/summed.prj" && ok "sum: the ASC input's .prj reaches the sum's" ||
+  bad "sum: the ASC input's .prj: the sum's differs from the single run's"
+split_in=
+# parts whose inputs have the same heights but another georeference are refused, naming what differs
+sed 's/xllcorner 500000/xllcorner 500010/' "$dir/geo.asc" > "$dir/geo_moved.asc"; cp "$dir/geo.prj" "$dir/geo_moved.prj"
+cp "$dir/geo.asc" "$dir/geo_noprj.asc"
+"$hfvis" skyview "$dir/geo.asc" --dirs 8 --dir-range 0:4 -o "$dir/geo_a.hfvs" 2> /dev/null
+"$hfvis" skyview "$dir/geo_moved.asc" --dirs 8 --dir-range 4:8 -o "$dir/geo_b.hfvs" 2> /dev/null
+"$hfvis" skyview "$dir/geo_noprj.asc" --dirs 8 --dir-range 4:8 -o "$dir/geo_c.hfvs" 2> /dev/null
+expect_fail "sum refuses parts of another origin" 1 sum "$dir/geo_a.hfvs" "$dir/geo_b.hfvs" -o "$fdir/x.tif"
+grep -q 'georeference (geotransform' "$dir/stderr" && ok "sum: another origin named" || bad "sum: another origin: $(cat "$dir/stderr")"
+expect_fail "sum refuses parts of another CRS, even to .pfm" 1 sum "$dir/geo_a.hfvs" "$dir/geo_c.hfvs" -o "$fdir/x.pfm"
+grep -q "georeference (CRS: the .prj's WKT)" "$dir/stderr" && ok "sum: another CRS named" || bad "sum: another CRS: $(cat "$dir/stderr")"
+# a georeference too long for the tag (a 3.5 kB .prj): the parts still sum to .pfm, a raster OUT
+# is refused in one line, and their fingerprint keeps them apart from other georeferences' parts
+cp "$dir/geo.asc" "$dir/geo_long.asc"
+longname=$(awk 'BEGIN { for (i = 0; i < 3200; i++) printf "%c", 97 + i % 26 }')
+sed "s/WGS_1984_UTM_Zone_33N/$longname/" "$dir/geo.prj" > "$dir/geo_long.prj"
+"$hfvis" skyview "$dir/geo_long.asc" --dirs 8 --dir-range 0:4 -o "$dir/geo_l1.hfvs" 2> /dev/null
+"$hfvis" skyview "$dir/geo_long.asc" --dirs 8 --dir-range 4:8 -o "$dir/geo_l2.hfvs" 2> /dev/null
+"$hfvis" skyview "$dir/geo_long.asc" --dirs 8 -o "$dir/geo_long_single.pfm" 2> /dev/null
+"$hfvis" sum "$dir/geo_l1.hfvs" "$dir/geo_l2.hfvs" -o "$dir/geo_long_sum.pfm" 2> "$dir/stderr" &&
+  cmp -s "$dir/geo_long_single.pfm" "$dir/geo_long_sum.pfm" && ok "sum: parts of a long georeference to .pfm" ||
+  bad "sum: parts of a long georeference to .pfm: $(cat "$dir/stderr")"
+expect_fail "sum refuses a raster OUT of a georeference too long for the tag" 1 sum "$dir/geo_l1.hfvs" "$dir/geo_l2.hfvs" -o "$fdir/x.tif"
+grep -q 'too long for a part' "$dir/stderr" && ok "sum: the long georeference named" || bad "sum: long georeference: $(cat "$dir/stderr")"
+expect_fail "sum refuses a long georeference's part beside another's" 1 sum "$dir/geo_l1.hfvs" "$dir/geo_b.hfvs" -o "$fdir/x.pfm"
+# a part of an older hfvis (tag "georef=1", no geo=; made here by rewriting the tag and its
+# CRC-32, which gzip's trailer holds) is refused, never summed without its georeference
+if command -v gzip > /dev/null 2>&1; then
+  part=$dir/geo_a.hfvs; total=$(wc -c < "$part"); head3=$(head -n 3 "$part" | wc -c)
+  { head -n 2 "$part"; sed -n 3p "$part" | sed 's/ geo=[^ ]*$/ georef=1/'
+    head -c $((total - 4)) "$part" | tail -c +$((head3 + 1)); } > "$dir/old.body"
+  { cat "$dir/old.body"; gzip -c < "$dir/old.body" | tail -c 8 | head -c 4; } > "$dir/old.hfvs"
+  "$hfvis" sum "$dir/old.hfvs" -o "$dir/old.pfm" 2> "$dir/stderr"
+  grep -q 'older hfvis.*rerun its --dir-range' "$dir/stderr" && ok "sum refuses a part of an older hfvis (no geo=)" ||
+    bad "sum: older part: $(cat "$dir/stderr")"
+  rm -f "$dir/old.pfm"
+else
+  echo "SKIP cli sum of an older part: no gzip"
+fi
 split4 "split visibility --fraction" visibility pfm 0:3 3:4 4:7 7:8 -- --dirs 8 --fraction --zscale 3
 # exact rays (--exact): split runs and sums as for the lattice; mixing modes is refused
 split4 "split horizon --exact" horizon pfm 0:3 3:8 8:13 13:16 -- --dirs 16 --exact

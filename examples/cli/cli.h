@@ -273,6 +273,14 @@ typedef struct cli_voxels {
 
 #define CLI_TAG_MAX 1024 /* our tags: the command, fingerprints and a dozen parameters */
 
+/* A part's georeference being encoded into b[0..cap) (split.c, cli_geo_encode): n counts every
+ * byte, and over is set when they do not fit. */
+typedef struct cli_geo_bytes {
+    unsigned char *b;
+    size_t n, cap;
+    int over;
+} cli_geo_bytes;
+
 /* One part's header and a copy of its tag (pass 1 of `sum` keeps these, not the sums). */
 typedef struct cli_part {
     int width, height, planes, directions, begin, end;
@@ -445,13 +453,18 @@ static int cli_run_visfield(const cli_args *a);
 static int cli_run_volgi(const cli_args *a);
 /* split.c */
 static unsigned long long cli_fingerprint(const float *v, size_t n);
-static void cli_partial_tag(const cli_args *a, const hfvis_grid *grid, const hfvis_sweep_options *o,
-                            const hfvis_env *env, char *tag);
+static int cli_partial_tag(const cli_args *a, const hfvis_grid *grid, const hfvis_sweep_options *o,
+                           const hfvis_env *env, char *tag);
 static int cli_run_partial(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
                            cli_progress_state *prog, const hfvis_env *env);
 static int cli_tag_value(const char *tag, const char *key, char *out, size_t cap);
 static void cli_tag_first_difference(const char *a, const char *b, char *out, size_t cap);
 static int cli_tag_real(const char *tag, const char *key, double *v);
+static void cli_geo_encode(const ex_georef *g, cli_geo_bytes *o);
+static int cli_geo_decode(const char *text, ex_georef *g);
+static const char *cli_tag_geo(const char *tag);
+static int cli_geo_decode_token(const char *v, ex_georef *g);
+static const char *cli_geo_difference(const char *a, const char *b);
 static int cli_sum_load(const char *path, hfvis_partial *p, cli_part *m);
 static int cli_sum_check(const char *path, int cmd, const hfvis_partial *p);
 static int cli_sum(int argc, char **argv);
