@@ -1493,8 +1493,9 @@ typedef struct hfvis_solar_input {
     double latitude_rad;      /* the site when the maps below are NULL: the sun is computed at */
     double longitude_rad;     /* this one place for the whole grid (east positive; SPA needs
                                  the longitude, RSUN ignores it) */
-    const double *latitude_map;  /* per sample [y*width + x], radians (geodetic latitude in
-                                    [-pi/2, pi/2], longitude east positive in [-pi, pi]), both or */
+    const double *latitude_map;  /* per sample [y*width + x] (holes too), radians (geodetic
+                                    latitude in [-pi/2, pi/2], longitude east positive in
+                                    [-pi, pi]), both or */
     const double *longitude_map; /* neither: each sample's own site, e.g. the inverse projection
                                     of its CRS. The grid's up direction (-y) is then taken at the
                                     true azimuth the maps give it (the meridian convergence, from
