@@ -171,13 +171,14 @@ for c in $cases; do IFS=$oldifs
 done
 IFS=$oldifs
 # ---- an interrupt while a raster's set of files is published ----------------------------------
-# A raster with its sidecars (.asc + .prj, .bil + .hdr + .prj) replacing an older set: strace
+# A raster alone (.pfm, .pgm) or with its sidecars (.asc + .prj, .bil + .hdr + .prj) replacing an
+# older set: strace
 # holds one call of the write path for a second (the creation of each temporary file, each
 # rename: the older files moved aside, the new ones moved in) and SIGINT or SIGTERM (in turn)
 # is sent meanwhile. Afterwards no temporary file may remain and the set must be the older one
 # or the new one, whole, never a mix; an exit 0 must have written the new one.
 if [ "$have_strace" = 1 ]; then
-  for set in "asc|o.asc o.prj" "bil|o.bil o.hdr o.prj"; do
+  for set in "pfm|o.pfm" "pgm|o.pgm" "asc|o.asc o.prj" "bil|o.bil o.hdr o.prj"; do
     ext=${set%%|*}; files=${set#*|}; before_n=$failed; n0=$runs
     args="skyview $in/dem.asc --dirs 8 --quiet -o o.$ext"; oldargs="skyview $in/dem.asc --dirs 4 --quiet -o o.$ext"
     g=$dir/sig_good; prepare "$g" new; (cd "$g" && "$hfvis" $args > /dev/null 2>&1) || bad "sig $ext: the good run failed"

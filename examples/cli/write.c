@@ -86,13 +86,38 @@ static void cli_signals(void)
 static void cli_signals(void) {}
 #endif
 
-/* Write n bytes to path (hfvis_write_file with the temporary name recorded), freeing bytes. */
-static hfvis_status cli_write(const char *path, unsigned char *bytes, size_t n, hfvis_status s)
+/* hfvis_write_file's on_temp in cli_write_file: name the file for the handler, then let the held
+ * signals through (user: 1 while they are held). */
+static void cli_on_temp_release(void *user, const char *tmp)
+{
+    int *held = (int *)user;
+    cli_on_temp(NULL, tmp);
+    if (tmp && *held) {
+        *held = 0;
+        ex_atomic_hold(0);
+    }
+}
+
+/* hfvis_write_file with its temporary name recorded. The signals wait (ex_atomic_hold) from
+ * before the file is created until the library has named it, so that no interrupt falls between
+ * the two and leaves the file behind. */
+static hfvis_status cli_write_file(const char *path, const void *bytes, size_t n)
 {
     hfvis_write_options wo;
-    wo.on_temp = cli_on_temp;
-    wo.user = NULL;
-    if (s == HFVIS_OK) s = hfvis_write_file(path, bytes, n, &wo);
+    hfvis_status s;
+    int held = ex_atomic_hold != NULL;
+    wo.on_temp = cli_on_temp_release;
+    wo.user = &held;
+    if (held) ex_atomic_hold(1);
+    s = hfvis_write_file(path, bytes, n, &wo);
+    if (held) ex_atomic_hold(0); /* the file was never created */
+    return s;
+}
+
+/* Write n bytes to path (cli_write_file), freeing bytes. */
+static hfvis_status cli_write(const char *path, unsigned char *bytes, size_t n, hfvis_status s)
+{
+    if (s == HFVIS_OK) s = cli_write_file(path, bytes, n);
     free(bytes);
     return s;
 }
@@ -154,11 +179,8 @@ static hfvis_status cli_binvox_save(const char *path, const hfvis_volume_grid *g
 }
 static hfvis_status cli_voxels_raw_save(const char *path, const hfvis_volume_grid *grid, const uint8_t *occ)
 {
-    hfvis_write_options wo;
     size_t n = (size_t)grid->dims[0] * (size_t)grid->dims[1] * (size_t)grid->dims[2];
-    wo.on_temp = cli_on_temp;
-    wo.user = NULL;
-    return hfvis_write_file(path, occ, n, &wo);
+    return cli_write_file(path, occ, n);
 }
 static hfvis_status cli_visfield_save(const char *path, const hfvis_visfield *vf)
 {
