@@ -52,7 +52,7 @@ BENCH := $(BUILD)/bench
 TESTS := $(patsubst test/%.c,$(BUILD)/test/%,$(wildcard test/test_*.c))
 FUZZERS := $(patsubst test/fuzz/%.c,%,$(wildcard test/fuzz/fuzz_*.c))
 
-.PHONY: all lib examples test check sanitize tsan scale-test fuzz bench demo install symbols cxx update-golden clean run-tests
+.PHONY: all lib examples test check sanitize tsan scale-test fuzz bench demo install symbols cxx update-golden clean run-tests test-programs
 all: $(LIB) $(CLI) $(EXAMPLES)
 lib: $(LIB)
 examples: $(EXAMPLES) $(CLI)
@@ -83,10 +83,15 @@ $(THREAD_TEST): test/thread_test.c test/test.h $(LIB)
 	$(CC) $(ALL_CFLAGS) $(PTHREAD) -I. $< $(LIB) $(LDLIBS) -o $@
 
 # make test: -Werror, every test program, the examples as smoke tests, the C++ header compile
-# and the symbol-prefix check; the last line is "tests: N passed, M failed".
+# and the symbol-prefix check; the last line is "tests: N passed, M failed". JOBS (default 2) is
+# the build's -j (unless make was given its own -j) and the number of test steps run at once.
+JOBS ?= 2
+JOBS_FLAG = $(if $(filter -j%,$(MAKEFLAGS)),,-j$(JOBS))
 test check:
+	@$(MAKE) --no-print-directory $(JOBS_FLAG) config=test werror=1 test-programs
 	@$(MAKE) --no-print-directory config=test werror=1 run-tests
 sanitize:
+	@$(MAKE) --no-print-directory $(JOBS_FLAG) config=sanitize werror=1 test-programs
 	@$(MAKE) --no-print-directory config=sanitize werror=1 run-tests
 	@$(MAKE) --no-print-directory tsan
 # make tsan: test/thread_test.c under ThreadSanitizer (part of make sanitize); SKIP when the
@@ -106,8 +111,9 @@ scale-test:
 	@$(MAKE) --no-print-directory config=test werror=1 build/test/hfvis
 	@sh test/scale_test.sh build/test/hfvis
 	@sh test/fault_cli_test.sh build/test/hfvis
-run-tests: $(TESTS) $(EXAMPLES) $(CLI) $(BENCH) $(THREAD_TEST)
-	@CC="$(CC)" CFLAGS="$(OPT) $(CFLAGS)" sh test/run.sh $(BUILD) "$(CXX)"
+test-programs: $(TESTS) $(EXAMPLES) $(CLI) $(BENCH) $(THREAD_TEST)
+run-tests: test-programs
+	@CC="$(CC)" CFLAGS="$(OPT) $(CFLAGS)" TEST_JOBS="$(JOBS)" sh test/run.sh $(BUILD) "$(CXX)"
 
 symbols: $(LIB)
 	@bad=$$(nm -g --defined-only $(LIB) | awk 'NF==3 && $$2 ~ /[TDBRC]/ {print $$3}' | grep -v '^hfvis_' || true); \
@@ -120,7 +126,7 @@ cxx:
 # Its "tiles" section runs the hfvis tool (HFVIS_CLI) whole and tiled: make bench BENCH_ARGS=tiles.
 bench:
 	@$(MAKE) --no-print-directory $(BENCH) $(CLI)
-	@HFVIS_CLI=$(CLI) $(BENCH) $(BENCH_ARGS)
+	@HFVIS_CLI=$(CLI) HFVIS_BENCH_GRASS=examples/bench/solar_grass.sh $(BENCH) $(BENCH_ARGS)
 
 demo: 
 	@$(MAKE) --no-print-directory config=release all
@@ -200,3 +206,10 @@ fuzz-coverage:
 .PHONY: solar-rsun
 solar-rsun:
 	@CC="$(CC)" sh test/solar_rsun.sh
+# make solar-ephem: hfvis_spa against PyEphem (an independent implementation) over 2000 instants
+# and places, both hemispheres, polar day and night (test/solar_ephem.sh, under a minute); SKIPs
+# without python3's ephem (Debian: python3-ephem). make solar-check runs both comparisons.
+.PHONY: solar-ephem solar-check
+solar-ephem:
+	@CC="$(CC)" sh test/solar_ephem.sh
+solar-check: solar-ephem solar-rsun

@@ -31,8 +31,8 @@
  *      and their quadrature, the exact-mode light paths
  *  17. Solar radiation: NREL SPA (Reda & Andreas 2004/2008), r.sun's solar geometry and its ESRA
  *      clear sky (Suri & Hofierka 2004; Rigollier et al. 2000), time steps with sunrise and
- *      sunset inside the step, irradiation over the exact horizon map, and its oracle
- *      (docs/solar.md)
+ *      sunset inside the step, per-sample sites by blocks of one sun, irradiation over the
+ *      exact horizon map, and its oracle (docs/solar.md)
  *
  * Paper references: [P1] Timonen & Westerholm, "Scalable Height Field Self-Shadowing",
  * CGF 29(2), 2010 (thesis appendix A.1). Errata and choices: docs/errata.md E1-E18.
@@ -1607,7 +1607,8 @@ typedef struct hf_sweep {
     double *lat;                /* rows*cols*channels output / accumulator */
     double *lh, *lt;            /* one line: stack heights (or the oracle's copy), tangents */
     double *sd;                 /* hull stack distances (heights in lh) */
-    float *grid_nrm;            /* width*height*3 grid normals (want_normals) */
+    const float *grid_nrm;      /* width*height*3 grid normals (want_normals): the scratch's,
+                                   or the caller's (sweep options normals) */
     double *gacc;               /* width*height*channels grid accumulator (fused light) */
     unsigned char *extra;       /* extra_size bytes for the caller (the P2 tree and line data) */
     size_t extra_size;
@@ -1812,7 +1813,7 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     off_lh = hf_align_add(&total, linelen + 2, sizeof(double), &ok); /* + the hull's NaN slots */
     off_lt = hf_align_add(&total, linelen, sizeof(double), &ok);
     off_stk = hf_align_add(&total, linelen + 2, sizeof(double), &ok);
-    if (want_normals) off_gn = hf_align_add(&total, gridn, 3 * sizeof(float), &ok);
+    if (want_normals && !o->normals) off_gn = hf_align_add(&total, gridn, 3 * sizeof(float), &ok);
     if (want_gacc) off_ga = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
     if (extra_size) off_x = hf_align_add(&total, extra_size, 1, &ok);
     sw->win_rw = hf_radius_on(o) ? hf_radius_units(o->max_distance / g->cell_size) : -1;
@@ -1834,7 +1835,7 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     sw->lt = (double *)(void *)(b + off_lt);
     sw->sd = (double *)(void *)(b + off_stk) + 2;
     sw->sd[-2] = sw->sd[-1] = HFVIS__NAN;
-    sw->grid_nrm = want_normals ? (float *)(void *)(b + off_gn) : NULL;
+    sw->grid_nrm = !want_normals ? NULL : o->normals ? o->normals : (const float *)(const void *)(b + off_gn);
     sw->gacc = want_gacc ? (double *)(void *)(b + off_ga) : NULL;
     sw->extra = extra_size ? b + off_x : NULL;
     sw->extra_size = extra_size;
@@ -1845,17 +1846,20 @@ static hfvis_status hf_sweep_alloc_extra(hf_sweep *sw, const hfvis_grid *g,
     hf_receiver_rect(g, o, &sw->rx0, &sw->ry0, &sw->rx1, &sw->ry1);
     sw->rect = sw->rx0 > 0 || sw->ry0 > 0 || sw->rx1 < g->width || sw->ry1 < g->height;
     if (sw->win_rw >= 0) hf_win_carve(&sw->win, b + off_w, linelen);
-    if (want_normals) {
+    if (want_normals) { /* made here (hfvis_normals_compute's bits) unless the caller gave them */
         int x, y, fin = 1;
+        float *own = o->normals ? NULL : (float *)(void *)(b + off_gn);
         for (y = 0; y < g->height; y++)
             for (x = 0; x < g->width; x++) {
-                double n[3];
-                float *p = sw->grid_nrm + ((size_t)y * (size_t)g->width + (size_t)x) * 3;
-                hf_normal_at(g, x, y, n);
-                p[0] = (float)n[0];
-                p[1] = (float)n[1];
-                p[2] = (float)n[2];
-                fin &= isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
+                const size_t i = ((size_t)y * (size_t)g->width + (size_t)x) * 3;
+                if (own) {
+                    double n[3];
+                    hf_normal_at(g, x, y, n);
+                    own[i] = (float)n[0];
+                    own[i + 1] = (float)n[1];
+                    own[i + 2] = (float)n[2];
+                }
+                fin &= isfinite(sw->grid_nrm[i]) && isfinite(sw->grid_nrm[i + 1]) && isfinite(sw->grid_nrm[i + 2]);
             }
         sw->nrm_finite = fin;
     }
@@ -1966,13 +1970,42 @@ static int hf_band_of(double b, double b0, double span, int parts)
     return q <= 0.0 ? 0 : q >= (double)(parts - 1) ? parts - 1 : (int)q;
 }
 
-/* 1 if receiver (x, y) is one of this call's: no bands, or in its band. */
-static int hf_sweep_mine(const hf_sweep *sw, int x, int y)
+/* The band of receiver (x, y) (sw->parts > 0). */
+static int hf_sweep_band_at(const hf_sweep *sw, int x, int y)
 {
     const hfvis_lattice *L = &sw->L;
-    if (!sw->parts) return 1;
     return hf_band_of(((double)x + sw->ox) * L->vx + ((double)y + sw->oy) * L->vy, sw->part_b0,
-                      sw->part_span, sw->parts) == sw->part;
+                      sw->part_span, sw->parts);
+}
+
+/* The first x in [rx0, rx1] of row y whose band is at or past t in the row's order (band
+ * non-decreasing in x when inc, else non-increasing); rx1 if none. */
+static int hf_sweep_first(const hf_sweep *sw, int y, int inc, int t)
+{
+    int lo = sw->rx0, hi = sw->rx1;
+    while (lo < hi) {
+        int mid = lo + (hi - lo) / 2, b = hf_sweep_band_at(sw, mid, y);
+        if (inc ? b >= t : b <= t) hi = mid;
+        else lo = mid + 1;
+    }
+    return lo;
+}
+
+/* This call's receivers in row y of the receiver rectangle: [*x0, *x1). Along a row every
+ * rounding step of a receiver's b (x + ox, times vx, plus a constant, minus b0, over the span,
+ * times parts) is monotone in x, so its band is, and the band's receivers are one run, found by
+ * bisection with the very test of hf_sweep_band_at: a band costs its share, not a scan. */
+static void hf_sweep_span(const hf_sweep *sw, int y, int *x0, int *x1)
+{
+    const int inc = sw->L.vx >= 0.0;
+    if (!sw->parts) {
+        *x0 = sw->rx0;
+        *x1 = sw->rx1;
+        return;
+    }
+    *x0 = hf_sweep_first(sw, y, inc, sw->part);
+    *x1 = hf_sweep_first(sw, y, inc, inc ? sw->part + 1 : sw->part - 1);
+    if (*x1 < *x0) *x1 = *x0;
 }
 
 static void hf_sweep_group(hf_sweep *sw, double ux, double uy)
@@ -2730,14 +2763,18 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
     const int open = sw->border == HFVIS_BORDER_OPEN;
     const double in_x0 = 1.0 - sw->ox, in_x1 = (sw->ext_w - 2.0) - sw->ox; /* exact integers */
     const double in_y0 = 1.0 - sw->oy, in_y1 = (sw->ext_h - 2.0) - sw->oy;
+    const int tile_w = sw->parts ? sw->rx1 - sw->rx0 : HF_TILE; /* a band: whole rows, its span */
     for (c = 0; c < ch; c++) hf_look_dir(sw, m_first + c, &lx[c], &ly[c]);
     for (ty = sw->ry0; ty < sw->ry1; ty += HF_TILE)
-        for (tx = sw->rx0; tx < sw->rx1; tx += HF_TILE)
+        for (tx = sw->rx0; tx < sw->rx1; tx += tile_w)
     for (y = ty; y < sw->ry1 && y < ty + HF_TILE; y++) {
         const int edge_row = open && !((double)y >= in_y0 && (double)y <= in_y1);
-        for (x = tx; x < sw->rx1 && x < tx + HF_TILE; x++) {
+        int xs, xe;
+        hf_sweep_span(sw, y, &xs, &xe); /* this band's receivers of the row (all without bands) */
+        if (xs < tx) xs = tx;
+        if (xe > tx + tile_w) xe = tx + tile_w;
+        for (x = xs; x < xe; x++) {
             ptrdiff_t o = (ptrdiff_t)y * out_stride + x;
-            if (sw->parts && !hf_sweep_mine(sw, x, y)) continue; /* another band's */
             if (hf_is_hole(g, x, y)) {
                 for (c = 0; c < ch; c++) out[(size_t)c * plane_step + (size_t)o] = (float)HFVIS__NAN;
                 continue;
@@ -3458,6 +3495,8 @@ typedef struct hf_fused {
     int walk;               /* HF_WALK_SVF, HF_WALK_SKY: fn's sum added inside the line walk */
     double inv_k, lobe;     /* the sky term's 1/K and lobe factor (hf_sky_setup) */
     size_t extra_size;      /* extra scratch bytes the consumer needs (sw->extra) */
+    double *gacc_out;       /* NULL, or the caller's array to use as the grid accumulator
+                               (hfvis_direction_sums' sums): zeroed over the receiver rectangle */
     /* optional hooks: after a group's lattice is sampled, and instead of the P1 line walk */
     void (*group)(hf_sweep *sw, struct hf_fused *ctx);
     void (*orient)(hf_sweep *sw, int m, struct hf_fused *ctx);
@@ -3496,9 +3535,8 @@ static void hf_fused_stranded(hf_sweep *sw, int K, const hfvis_sweep_options *o,
         for (x = sw->rx0; x < sw->rx1; x++) {
             double *acc = sw->gacc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)ch, nd[3];
             int stranded = 0;
-            if (hf_is_hole(g, x, y)) continue;
             for (c = 0; c < ch; c++) stranded |= isnan(acc[c]);
-            if (!stranded) continue;
+            if (!stranded || hf_is_hole(g, x, y)) continue; /* the NaN test first: it rules out most */
             hf_normal_at(g, x, y, nd);
             n1[0] = (float)nd[0];
             n1[1] = (float)nd[1];
@@ -3535,8 +3573,15 @@ static hfvis_status hf_fused_run(hf_sweep *sw, const hfvis_grid *grid, int K,
     hfvis_status s;
     int begin, end, per, groups, gidx, m, done = 0;
     if ((s = hf_direction_range(o, K, &begin, &end)) != HFVIS_OK) return s;
-    if ((s = hf_sweep_alloc_extra(sw, grid, o, want_normals, channels, 1, ctx->extra_size)) != HFVIS_OK)
+    if ((s = hf_sweep_alloc_extra(sw, grid, o, want_normals, channels, !ctx->gacc_out, ctx->extra_size)) != HFVIS_OK)
         return s;
+    if (ctx->gacc_out) { /* the caller's array: the receiver rectangle's values start at 0 */
+        int y;
+        sw->gacc = ctx->gacc_out;
+        for (y = sw->ry0; y < sw->ry1; y++)
+            memset(sw->gacc + ((size_t)y * (size_t)grid->width + (size_t)sw->rx0) * (size_t)channels, 0,
+                   (size_t)(sw->rx1 - sw->rx0) * (size_t)channels * sizeof(double));
+    }
     per = K % 4 == 0 ? 4 : 1;
     groups = K / per;
     for (gidx = 0; gidx < groups; gidx++) {
@@ -3810,12 +3855,14 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
     hf_lattice_fill(&sw, HFVIS__NAN);
     hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
     hf_gather_planes(&sw, 1, 0, out, 0, out_stride);
-    for (y = sw.ry0; y < sw.ry1; y++)
-        for (x = sw.rx0; x < sw.rx1; x++) {
+    for (y = sw.ry0; y < sw.ry1; y++) {
+        int x0, x1;
+        hf_sweep_span(&sw, y, &x0, &x1); /* the band's receivers of the row */
+        for (x = x0; x < x1; x++) {
             float *p = out + (ptrdiff_t)y * out_stride + x;
-            if (!hf_sweep_mine(&sw, x, y)) continue;
             *p = (float)hf_sun_fraction(sun_elevation_rad, sun_radius_rad, (double)*p);
         }
+    }
     hf_sweep_free(&sw);
     hf_progress(&o, 1, 1);
     return HFVIS_OK;
@@ -5148,9 +5195,106 @@ static void hf_p2_orient(hf_sweep *sw, int m, hf_fused *f)
     }
 }
 
+/* The P2 consumers' stranded receivers (hf_stranded_tan's rule, for visible sets): a grid point
+ * with a finite height whose gather found no finite node holds NaN in sw->gacc. Its line toward
+ * each direction of [begin, end) is made by the oracle's march instead of the lattice: unit
+ * steps from the receiver along the look direction, bilinear heights and exit radiance, holes
+ * skipped, out of the grid and then the sweep's pre-roll steps under the border rule (so at
+ * most the lattice line's length: c->len). hf_visible_naive finds the visible set (the search
+ * radius c->win included) and the consumer adds its term to a one-node lattice whose normal is
+ * the grid normal (one-sided beside holes). The statistics stay the lattice sweep's. */
+static void hf_p2_stranded(hf_sweep *sw, int K, const hfvis_sweep_options *o, hf_p2_ctx *c)
+{
+    const hfvis_grid *g = sw->g;
+    const int ch = sw->channels, cc = c->channels;
+    const double inv_cs = 1.0 / g->cell_size, xmax = (double)(g->width - 1) + HF_LATTICE_EPS,
+                 ymax = (double)(g->height - 1) + HF_LATTICE_EPS;
+    double *lat = sw->lat, one[4];
+    float *nrm = sw->nrm, n1[3];
+    hfvis_visibility_stats st = c->st;
+    int x, y, q, k, begin, end;
+    if (!c->ld || ch > 4 || hf_direction_range(o, K, &begin, &end) != HFVIS_OK) return;
+    for (y = sw->ry0; y < sw->ry1; y++)
+        for (x = sw->rx0; x < sw->rx1; x++) {
+            double *acc = sw->gacc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)ch, nd[3];
+            int stranded = 0;
+            if (hf_is_hole(g, x, y)) continue;
+            for (q = 0; q < ch; q++) stranded |= isnan(acc[q]);
+            if (!stranded) continue;
+            if (sw->nrm) {
+                hf_normal_at(g, x, y, nd);
+                n1[0] = (float)nd[0];
+                n1[1] = (float)nd[1];
+                n1[2] = (float)nd[2];
+                sw->nrm = n1;
+            }
+            for (q = 0; q < ch; q++) one[q] = 0.0;
+            sw->lat = one;
+            for (k = 0; k < K; k++) {
+                int pos = hf_direction_position(o, K, k), n = 0, out = 0, i, nv;
+                double ux, uy, d;
+                if (pos < begin || pos >= end) continue;
+                hf_sweep_vector(o->azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K, &ux, &uy);
+                c->f.K = K;
+                c->f.k = k;
+                c->f.lx = -ux;
+                c->f.ly = -uy;
+                /* near to far: in-grid steps, then the pre-roll; reversed below (far first) */
+                for (d = 1.0; n + 1 < c->len; d += 1.0) {
+                    double px = (double)x - d * ux, py = (double)y - d * uy, h;
+                    if (px < -HF_LATTICE_EPS || py < -HF_LATTICE_EPS || px > xmax || py > ymax) {
+                        if (out == sw->preroll) break;
+                        out++;
+                    }
+                    px = px < 0.0 && px > -HF_LATTICE_EPS ? 0.0 : px; /* as hf_march_slopes */
+                    py = py < 0.0 && py > -HF_LATTICE_EPS ? 0.0 : py;
+                    h = hf_sample_border(g, sw->border, px, py) * inv_cs;
+                    if (isnan(h)) continue;
+                    c->ld[n] = -d;
+                    c->lh[n] = h;
+                    if (cc) hf_sample_channels(g, sw->border, c->exit, cc, px, py, c->le + (size_t)n * (size_t)cc);
+                    c->vis[n] = out > 0; /* outside the grid: a pre-roll sample */
+                    n++;
+                }
+                c->npre = 0;
+                for (i = 0; i < n / 2; i++) { /* far first, as a lattice line */
+                    int j = n - 1 - i, t, e;
+                    double v = c->ld[i];
+                    c->ld[i] = c->ld[j];
+                    c->ld[j] = v;
+                    v = c->lh[i];
+                    c->lh[i] = c->lh[j];
+                    c->lh[j] = v;
+                    t = c->vis[i];
+                    c->vis[i] = c->vis[j];
+                    c->vis[j] = t;
+                    for (e = 0; e < cc; e++) {
+                        v = c->le[(size_t)i * (size_t)cc + (size_t)e];
+                        c->le[(size_t)i * (size_t)cc + (size_t)e] = c->le[(size_t)j * (size_t)cc + (size_t)e];
+                        c->le[(size_t)j * (size_t)cc + (size_t)e] = v;
+                    }
+                }
+                for (i = 0; i < n; i++) c->npre += c->vis[i];
+                c->ld[n] = 0.0;
+                c->lh[n] = (double)g->z[(ptrdiff_t)y * g->stride + x] * inv_cs;
+                for (i = 0; i <= n; i++) {
+                    c->wd[i] = c->ld[i] * g->cell_size;
+                    c->wh[i] = c->lh[i] * g->cell_size;
+                }
+                nv = hf_visible_naive(c->ld, c->lh, n, c->win, c->vis, c->len);
+                c->fn(sw, c, 0, n, c->vis, nv, c->hz, 0);
+            }
+            sw->lat = lat;
+            sw->nrm = nrm;
+            for (q = 0; q < ch; q++) acc[q] = one[q];
+        }
+    c->st = st;
+}
+
 static hfvis_status hf_p2_run(hf_sweep *sw, const hfvis_grid *grid, int K, hfvis_sweep_options *o,
                               int out_channels, int want_normals, hf_p2_ctx *c)
 {
+    hfvis_status s;
     int ok = 1;
     if (o->rays == HFVIS_RAYS_EXACT) return HFVIS_ERR_INVALID_ARGUMENT; /* lattices only (hfvis.h) */
     if (hf_p2_opts_limited(o)) return HFVIS_ERR_INVALID_ARGUMENT;
@@ -5166,7 +5310,9 @@ static hfvis_status hf_p2_run(hf_sweep *sw, const hfvis_grid *grid, int K, hfvis
     if (!ok) return HFVIS_ERR_LIMIT;
     c->f.group = hf_p2_group;
     c->f.orient = hf_p2_orient;
-    return hf_fused_run(sw, grid, K, o, out_channels, want_normals, NULL, &c->f);
+    if ((s = hf_fused_run(sw, grid, K, o, out_channels, want_normals, NULL, &c->f)) != HFVIS_OK) return s;
+    if (!c->user_fn) hf_p2_stranded(sw, K, o, c); /* the gathered outputs (not the events) */
+    return HFVIS_OK;
 }
 
 /* Consumer: visible in-grid samples per receiver (the visibility index). */
@@ -8116,8 +8262,14 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
     float *table = NULL;
     hfvis_status s;
     int channels = 1, begin, end, x, y, c;
-    if (hf_check_common(grid, opts) != HFVIS_OK || !sums || K < 1 || kind < HFVIS_SUM_SKY_VIEW ||
-        kind > HFVIS_SUM_VISIBILITY || (kind == HFVIS_SUM_ENV_LIGHT && !hf_env_valid(env)))
+    if (opts) { /* bands: exact rays only (below), the rest checked as for one call */
+        o = *opts;
+        if (!hf_parts_valid(opts)) return HFVIS_ERR_INVALID_ARGUMENT;
+        o.part_index = o.part_count = 0;
+    }
+    if (hf_check_common(grid, opts ? &o : NULL) != HFVIS_OK || !sums || K < 1 || kind < HFVIS_SUM_SKY_VIEW ||
+        kind > HFVIS_SUM_VISIBILITY || (kind == HFVIS_SUM_ENV_LIGHT && !hf_env_valid(env)) ||
+        (opts && opts->part_count > 1 && (opts->rays != HFVIS_RAYS_EXACT || kind == HFVIS_SUM_VISIBILITY)))
         return HFVIS_ERR_INVALID_ARGUMENT;
     o = hf_opts_resolve(grid, opts);
     if (hf_direction_range(&o, K, &begin, &end) != HFVIS_OK) return HFVIS_ERR_INVALID_ARGUMENT;
@@ -8126,6 +8278,7 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
     if (o.rays == HFVIS_RAYS_EXACT && kind != HFVIS_SUM_VISIBILITY)
         return hf_exact_direction_sums(grid, K, kind, env, eopts, &o, begin, end, sums);
     memset(&sky, 0, sizeof sky);
+    sky.gacc_out = sums; /* the grid accumulator is sums itself: no copy */
     switch (kind) {
     case HFVIS_SUM_SKY_VIEW:
         sky.walk = HF_WALK_SVF;
@@ -8141,6 +8294,7 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
         if (s != HFVIS_OK) return s;
         memset(&ec, 0, sizeof ec);
         ec.e = &eval;
+        ec.f.gacc_out = sums;
         s = hf_fused_run(&sw, grid, K, &o, channels, 1, hf_env_line, &ec.f);
         break;
     default: /* HFVIS_SUM_VISIBILITY */
@@ -8150,11 +8304,13 @@ hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind 
         break;
     }
     if (s == HFVIS_OK) {
-        for (y = sw.ry0; y < sw.ry1; y++) /* the receiver rectangle */
+        for (y = sw.ry0; y < sw.ry1; y++) /* the receiver rectangle (in place but for P2's) */
             for (x = sw.rx0; x < sw.rx1; x++) {
                 size_t i = ((size_t)y * (size_t)grid->width + (size_t)x) * (size_t)channels;
-                int hole = hf_is_hole(grid, x, y);
-                for (c = 0; c < channels; c++) sums[i + (size_t)c] = hole ? HFVIS__NAN : sw.gacc[i + (size_t)c];
+                if (hf_is_hole(grid, x, y))
+                    for (c = 0; c < channels; c++) sums[i + (size_t)c] = HFVIS__NAN;
+                else if (sw.gacc != sums)
+                    for (c = 0; c < channels; c++) sums[i + (size_t)c] = sw.gacc[i + (size_t)c];
             }
         hf_sweep_free(&sw);
     }
@@ -8600,7 +8756,9 @@ typedef struct hf_exact {
     double *sd, *sh;        /* one line's samples, then its hull stack: distances (sub-steps),
                                heights (world units) */
     double *tan;            /* width*height tangents of the current direction, NaN at holes */
-    float *nrm;             /* width*height*3 grid normals (lighting), else NULL */
+    const float *nrm;       /* width*height*3 grid normals (lighting): the scratch's or the
+                               caller's (sweep options normals), else NULL */
+    float *nrm_own;         /* the scratch's normals, NULL when given */
     double *acc;            /* width*height*channels sums, else NULL */
     int channels;
     double radius;          /* a finite search radius (world units), else 0 */
@@ -8611,8 +8769,9 @@ typedef struct hf_exact {
     int ox, oy;             /* the tile's origin in the raster (hfvis.h, "Search radius and tiles") */
     int rx0, ry0, rx1, ry1; /* the receiver rectangle, [rx0, rx1) x [ry0, ry1) */
     int rect;               /* 1: a proper sub-rectangle */
-    int parts, part;        /* bands across the direction (hfvis_sun_visibility), 0 = off */
+    int parts, part;        /* bands across the direction (part_index/part_count), 0 = off */
     int64_t c0, cspan;      /* the receivers' line index c = x*b - y*a: its least value, count */
+    int64_t clo, chi;       /* this band's lines: clo <= c <= chi */
     int near;               /* ray_near_cells: D > 0, the near and far field (hf_far_field) */
     int ray_a, ray_b;       /* the direction being swept */
     int inf;                /* the grid holds an infinite height (hf_near_field) */
@@ -8642,14 +8801,42 @@ static void hf_exact_parts(hf_exact *E, const hfvis_sweep_options *o, hf_ray r)
     }
     E->c0 = lo;
     E->cspan = hi - lo + 1;
+    /* band p holds the c with floor((c - c0) parts / cspan) == p, i.e. the c - c0 from
+       ceil(p cspan / parts) to ceil((p + 1) cspan / parts) - 1 */
+    E->clo = lo + ((int64_t)E->part * E->cspan + E->parts - 1) / (E->parts ? E->parts : 1);
+    E->chi = lo + ((int64_t)(E->part + 1) * E->cspan + E->parts - 1) / (E->parts ? E->parts : 1) - 1;
 }
 
 /* 1 if the line through receiver (x, y) along (a, b) is one of this call's. */
 static int hf_exact_mine(const hf_exact *E, int x, int y, hf_ray r)
 {
     int64_t v = (int64_t)x * (int64_t)r.b - (int64_t)y * (int64_t)r.a;
-    if (!E->parts) return 1;
-    return (v - E->c0) * (int64_t)E->parts / E->cspan == (int64_t)E->part;
+    return !E->parts || (v >= E->clo && v <= E->chi);
+}
+
+/* This call's receivers in row y of the receiver rectangle: [*x0, *x1), the x whose line
+ * (hf_exact_mine) is its own; c = x*b - y*a is monotone in x, so they are one run. */
+static void hf_exact_span(const hf_exact *E, int y, hf_ray r, int *x0, int *x1)
+{
+    int64_t lo = E->rx0, hi = (int64_t)E->rx1 - 1, ya = (int64_t)y * (int64_t)r.a, b = r.b;
+    if (E->parts && b == 0) { /* c = -y*a along the whole row */
+        if (-ya < E->clo || -ya > E->chi) hi = lo - 1;
+    } else if (E->parts) { /* clo <= x b - y a <= chi */
+        int64_t p = E->clo + ya, q = E->chi + ya, t;
+        if (b < 0) { /* x|b| between -q and -p */
+            t = p;
+            p = -q;
+            q = -t;
+            b = -b;
+        }
+        t = -hf_floor_div64(-p, b); /* ceil(p / b) */
+        if (t > lo) lo = t;
+        t = hf_floor_div64(q, b);
+        if (t < hi) hi = t;
+    }
+    if (hi < lo) hi = lo - 1;
+    *x0 = (int)lo;
+    *x1 = (int)(hi + 1);
 }
 
 /* The piece after each crossing e (to crossing e + 1, the last one to the next grid point at
@@ -9099,9 +9286,10 @@ static void hf_exact_near(hf_exact *E, hf_ray r, double L, double scale)
         const int cy = b < 0 ? y - 1 : y, sx = a < 0 ? -1 : 1;
         const ptrdiff_t sy = b < 0 ? -g->stride : g->stride;
         const int in_row = cy >= 0 && cy + 1 < g->height;
-        for (x = E->rx0; x < E->rx1; x++) {
+        int x0, x1;
+        hf_exact_span(E, y, r, &x0, &x1); /* this call's lines: the others' were not swept */
+        for (x = x0; x < x1; x++) {
             double s;
-            if (E->parts && !hf_exact_mine(E, x, y, r)) continue; /* another call's line */
             if (isnan(t[x])) continue;
             if (diag) {
                 int cx = a < 0 ? x - 1 : x;
@@ -9723,7 +9911,8 @@ static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, co
 
 /* Scratch of one exact-mode call, one block: the K directions and their quadrature, the
  * crossings, one line's samples and receivers (the hull stack in place), the tangent plane, and
- * optionally grid normals and a channels-deep accumulator. */
+ * optionally grid normals (want_normals 1; 2: room for them, filled by the caller) and a
+ * channels-deep accumulator. */
 static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
                                   const hfvis_sweep_options *o, int want_tan, int want_normals,
                                   int channels)
@@ -9762,7 +9951,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     off_c = hf_align_add(&total, (size_t)maxp, sizeof(hf_cross), &ok);
     off_s = hf_align_add(&total, cap + 2u, 2u * sizeof(double), &ok); /* + the hull's NaN slots */
     if (want_tan) off_t = hf_align_add(&total, gridn, sizeof(double), &ok);
-    if (want_normals) off_n = hf_align_add(&total, gridn, 3u * sizeof(float), &ok);
+    if (want_normals && !o->normals) off_n = hf_align_add(&total, gridn, 3u * sizeof(float), &ok);
     if (channels) off_a = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
     E->radius = hf_radius_on(o) ? o->max_distance : 0.0;
     E->win_rw = -1;
@@ -9795,7 +9984,8 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     E->sh = E->sd + cap + 2;
     E->sd[-2] = E->sd[-1] = E->sh[-2] = E->sh[-1] = HFVIS__NAN; /* below the stack: hf_hull_step */
     E->tan = want_tan ? (double *)(void *)(blk + off_t) : NULL;
-    E->nrm = want_normals ? (float *)(void *)(blk + off_n) : NULL;
+    E->nrm_own = want_normals && !o->normals ? (float *)(void *)(blk + off_n) : NULL;
+    E->nrm = want_normals && o->normals ? o->normals : E->nrm_own;
     E->acc = channels ? (double *)(void *)(blk + off_a) : NULL;
     if (E->radius > 0.0) hf_win_carve(&E->win, blk + off_win, cap);
     E->rec = (int *)(void *)(blk + off_r);
@@ -9812,7 +10002,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
         }
     }
     hf_exact_dirs_fill(&E->d, K, o->azimuth0_rad, E->N);
-    if (want_normals) (void)hfvis_normals_compute(g, E->nrm); /* the grid normals, as floats */
+    if (want_normals == 1 && E->nrm_own) (void)hfvis_normals_compute(g, E->nrm_own); /* as floats */
     if (channels) memset(E->acc, 0, gridn * (size_t)channels * sizeof(double));
     return HFVIS_OK;
 }
@@ -9918,16 +10108,24 @@ static hfvis_status hf_exact_env_tables(const hf_exact_dirs *d, const hfvis_env 
 /* The per-receiver direction sums S of hfvis_direction_sums for kind (SKY_VIEW, SKY_LIGHT or
  * ENV_LIGHT) over positions [begin, end), in exact mode: T_k = K w_k sin(max(alpha_k, 0)) for the
  * sky-view factor (so the finish 1 - S/K is unchanged), hf_exact_sky_term for the sky, the
- * environment tables of the exact sectors. On HFVIS_OK E->acc holds S (the caller frees E). */
+ * environment tables of the exact sectors. On HFVIS_OK E->acc holds S (the caller frees E).
+ * With bands (o->part_count > 1) each direction's terms go only to the receivers on its band's
+ * lines (hf_exact_span) and are added to the caller's running sums `add` instead (holes NaN);
+ * the normals are then made per receiver and direction, as the grid's would be, not for the
+ * whole grid. */
 static hfvis_status hf_exact_sums(hf_exact *E, const hfvis_grid *g, int K, hfvis_sum_kind kind,
                                   const hfvis_env *env, const hfvis_env_options *eopts,
-                                  const hfvis_sweep_options *o, int begin, int end)
+                                  const hfvis_sweep_options *o, int begin, int end, double *add)
 {
     hfvis_status s;
     hf_env_eval eval;
     float *table = NULL;
-    int channels = kind == HFVIS_SUM_ENV_LIGHT ? env->channels : 1, k, done = 0, x, y;
-    if ((s = hf_exact_init(E, g, K, o, 1, kind != HFVIS_SUM_SKY_VIEW, channels)) != HFVIS_OK) return s;
+    int channels = kind == HFVIS_SUM_ENV_LIGHT ? env->channels : 1, k, done = 0, x, y, x0, x1, c;
+    const int banded = o->part_count > 1;
+    if ((s = hf_exact_init(E, g, K, o, 1, kind == HFVIS_SUM_SKY_VIEW ? 0 : banded ? 2 : 1,
+                           banded ? 0 : channels)) != HFVIS_OK)
+        return s;
+    E->channels = channels;
     if (kind == HFVIS_SUM_ENV_LIGHT &&
         (s = hf_exact_env_tables(&E->d, env, eopts, o->alloc, &table, &eval)) != HFVIS_OK) {
         hf_exact_free(E);
@@ -9938,25 +10136,39 @@ static hfvis_status hf_exact_sums(hf_exact *E, const hfvis_grid *g, int K, hfvis
         double wk = (double)K * E->d.w[k];
         double cp = cos(E->d.ray[k].azimuth), sp = sin(E->d.ray[k].azimuth);
         if (pos < begin || pos >= end) continue;
+        hf_exact_parts(E, o, E->d.ray[k]);
         hf_exact_sweep(E, E->d.ray[k]);
-        for (y = E->ry0; y < E->ry1; y++) { /* the receiver rectangle, one loop per kind */
+        for (y = E->ry0; y < E->ry1; y++) { /* the receiver rectangle (band), one loop per kind */
             size_t r = (size_t)y * (size_t)g->width, i;
             const double *tr = E->tan + r;
-            double *ar = E->acc + r * (size_t)channels;
+            double *acc = banded ? add : E->acc, *ar = acc + r * (size_t)channels;
+            hf_exact_span(E, y, E->d.ray[k], &x0, &x1);
+            for (x = x0; banded && x < x1; x++) { /* a band's holes and normals (unless given) */
+                double n[3];
+                float *nr = E->nrm_own ? E->nrm_own + (r + (size_t)x) * 3 : NULL;
+                if (hf_is_hole(g, x, y))
+                    for (c = 0; c < channels; c++) ar[(size_t)x * (size_t)channels + (size_t)c] = HFVIS__NAN;
+                else if (nr) { /* hfvis_normals_compute's bits */
+                    hf_normal_at(g, x, y, n);
+                    nr[0] = (float)n[0];
+                    nr[1] = (float)n[1];
+                    nr[2] = (float)n[2];
+                }
+            }
             if (kind == HFVIS_SUM_SKY_VIEW) {
-                for (x = E->rx0; x < E->rx1; x++)
+                for (x = x0; x < x1; x++)
                     if (!isnan(tr[x])) ar[x] += wk * hf_svf_term(tr[x]);
             } else if (kind == HFVIS_SUM_SKY_LIGHT) {
-                for (x = E->rx0; x < E->rx1; x++)
+                for (x = x0; x < x1; x++)
                     if (!isnan(tr[x]))
                         ar[x] += hf_exact_sky_term(&E->d, k, cp, sp, E->nrm + (r + (size_t)x) * 3, tr[x]);
             } else {
-                for (x = E->rx0; x < E->rx1; x++) {
+                for (x = x0; x < x1; x++) {
                     const float *nr = E->nrm + (r + (size_t)x) * 3;
                     if (isnan(tr[x])) continue;
                     i = r + (size_t)x;
                     hf_env_accumulate(&eval, k, cp, sp, (double)nr[0], (double)nr[1], (double)nr[2], tr[x],
-                                      E->acc + i * (size_t)channels);
+                                      acc + i * (size_t)channels);
                 }
             }
         }
@@ -9992,7 +10204,7 @@ static hfvis_status hf_exact_light(const hfvis_grid *g, int K, hfvis_sum_kind ki
     int begin, end, k;
     double offset = 0.0;
     if ((s = hf_direction_range(o, K, &begin, &end)) != HFVIS_OK) return s;
-    if ((s = hf_exact_sums(&E, g, K, kind, env, eopts, o, begin, end)) != HFVIS_OK) return s;
+    if ((s = hf_exact_sums(&E, g, K, kind, env, eopts, o, begin, end, NULL)) != HFVIS_OK) return s;
     if (kind == HFVIS_SUM_SKY_VIEW) /* the range's share of 1 - S/K: its weights, exact */
         for (k = 0; k < K; k++) {
             int pos = hf_direction_position(o, K, k);
@@ -10011,18 +10223,19 @@ static hfvis_status hf_exact_sun(const hfvis_grid *g, double azimuth, double ele
     hfvis_sweep_options o1 = *o;
     hf_exact E;
     hfvis_status s;
-    int x, y;
+    int x, y, x0, x1;
     o1.azimuth0_rad = azimuth;
     if ((s = hf_exact_init(&E, g, 1, &o1, 1, 0, 0)) != HFVIS_OK) return s;
     hf_exact_parts(&E, o, E.d.ray[0]);
     hf_exact_sweep(&E, E.d.ray[0]);
-    for (y = E.ry0; y < E.ry1; y++)
-        for (x = E.rx0; x < E.rx1; x++) {
+    for (y = E.ry0; y < E.ry1; y++) {
+        hf_exact_span(&E, y, E.d.ray[0], &x0, &x1); /* the band's receivers of the row */
+        for (x = x0; x < x1; x++) {
             double t = E.tan[(size_t)y * (size_t)g->width + (size_t)x];
-            if (!hf_exact_mine(&E, x, y, E.d.ray[0])) continue;
             out[(ptrdiff_t)y * out_stride + x] =
                 (float)hf_sun_fraction(elevation, radius, hf_tan_to_elevation(t));
         }
+    }
     hf_exact_free(&E);
     hf_progress(o, 1, 1);
     return HFVIS_OK;
@@ -10118,8 +10331,8 @@ static hfvis_status hf_exact_direction_sums(const hfvis_grid *g, int K, hfvis_su
     hf_exact E;
     hfvis_status s;
     int x, y, c;
-    if ((s = hf_exact_sums(&E, g, K, kind, env, eopts, o, begin, end)) != HFVIS_OK) return s;
-    for (y = E.ry0; y < E.ry1; y++)
+    if ((s = hf_exact_sums(&E, g, K, kind, env, eopts, o, begin, end, sums)) != HFVIS_OK) return s;
+    for (y = E.ry0; o->part_count <= 1 && y < E.ry1; y++) /* bands added to sums in place */
         for (x = E.rx0; x < E.rx1; x++) {
             size_t i = ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)E.channels;
             int hole = hf_is_hole(g, x, y);
@@ -10542,6 +10755,8 @@ hfvis_status hfvis_esra_clear_sky(double g0, double elevation_rad, double height
 #define HF_SOLAR_REFRACT_P 1013.25    /* mbar and deg C of the refraction option: the */
 #define HF_SOLAR_REFRACT_T 10.0       /* standard atmosphere SPA's example assumes */
 #define HF_SOLAR_REFRACT_SUNRISE 0.5667 /* deg */
+#define HF_SOLAR_SITE_TOL_DEFAULT (0.05 * HF_DEG) /* rad: per-sample sites share the sun of a
+                                         block centre within this rotation of their frames */
 
 hfvis_solar_input hfvis_solar_input_default(void)
 {
@@ -10565,6 +10780,7 @@ hfvis_solar_options hfvis_solar_options_default(void)
     o.directions = HF_SOLAR_K_DEFAULT;
     o.delta_t = HF_SOLAR_DELTA_T_DEFAULT;
     o.reflected_directions = HF_SOLAR_KR_DEFAULT;
+    o.site_tolerance_rad = HF_SOLAR_SITE_TOL_DEFAULT;
     return o;
 }
 
@@ -10597,7 +10813,7 @@ static int hf_solar_input_valid(const hfvis_solar_input *in)
            (in->instant == 0 || in->instant == 1) &&
            (in->instant ? hf_in(in->hour, 0.0, 24.0) : (in->days >= 1 && in->days <= HF_SOLAR_DAYS_MAX)) &&
            hf_in(in->utc_offset_hours, -14.0, 14.0) && in->linke > 0.0 && in->linke <= 10.0 &&
-           hf_in(in->albedo, 0.0, 1.0);
+           hf_in(in->albedo, 0.0, 1.0) && (in->latitude_map != NULL) == (in->longitude_map != NULL);
 }
 
 static int hf_solar_opts_valid(const hfvis_solar_options *o)
@@ -10613,7 +10829,8 @@ static int hf_solar_opts_valid(const hfvis_solar_options *o)
         o->diffuse < HFVIS_SOLAR_DIFFUSE_DEFAULT || o->diffuse > HFVIS_SOLAR_DIFFUSE_HORIZON ||
         o->reflected < HFVIS_SOLAR_REFLECTED_DEFAULT || o->reflected > HFVIS_SOLAR_REFLECTED_TERRAIN ||
         o->reflected_directions < 0 || o->reflected_directions > HF_SOLAR_K_MAX ||
-        o->bands < HFVIS_SOLAR_BANDS_DEFAULT || o->bands > HFVIS_SOLAR_BANDS_MONTH)
+        o->bands < HFVIS_SOLAR_BANDS_DEFAULT || o->bands > HFVIS_SOLAR_BANDS_MONTH ||
+        !hf_in(o->site_tolerance_rad, 0.0, 0.1))
         return 0;
     if (s && (!hf_opts_valid(s) || s->extent_width != 0 || s->receiver_width != 0)) return 0;
     if (o->linke_monthly)
@@ -10647,32 +10864,85 @@ typedef struct hf_solar_step {
     int band, month;
 } hf_solar_step;
 
+/* SPA's instant part (hf_spa_sun's alpha, delta, nu, xi, R) on the hours 0..24 of each day of
+ * the period, shared by the blocks of a run with per-sample sites (section 17.6). nu is stored
+ * less Earth's sidereal rate, alpha unwrapped along the day, so both interpolate linearly. */
+#define HF_SOLAR_EPH_PER_DAY 25
+#define HF_SOLAR_SIDEREAL_RATE 360.98564736629 /* deg per day (SPA Eq. 28) */
+typedef struct hf_spa_eph {
+    double alpha, delta, nu, xi, R;
+} hf_spa_eph;
+
 typedef struct hf_solar_ctx {
     hfvis_solar_input in;
     hfvis_solar_options o;
     int bands;
+    double lat, lon;         /* the current site, radians */
+    double gamma;            /* the true azimuth of the grid's up direction there */
+    const hf_spa_eph *eph;   /* NULL: full SPA per instant; else the hourly instant table */
 } hf_solar_ctx;
 
-/* Sun of the SPA model at local civil hour t of day (y, m, d): true and shading elevation. */
-static void hf_solar_spa_sun(const hf_solar_ctx *c, int y, int m, int d, double t,
+/* The Julian day of local civil hour t of day (y, m, d). */
+static double hf_solar_jd(const hf_solar_ctx *c, int y, int m, int d, double t)
+{
+    return hf_julian_day(y, m, (double)d + (t - c->in.utc_offset_hours) / 24.0);
+}
+
+static double hf_wrap180(double x) { return x - 360.0 * floor((x + 180.0) / 360.0); }
+
+/* Fill the hourly table of `days` days from the first (HF_SOLAR_EPH_PER_DAY rows per day). */
+static void hf_solar_eph_fill(const hf_solar_ctx *c, int days, hf_spa_eph *e)
+{
+    int y = c->in.year, m = c->in.month, d = c->in.day, day, k;
+    for (day = 0; day < days; day++, hf_date_add(&y, &m, &d, 1)) {
+        hf_spa_eph *row = e + (size_t)day * HF_SOLAR_EPH_PER_DAY;
+        for (k = 0; k < HF_SOLAR_EPH_PER_DAY; k++) {
+            hf_spa_sun s;
+            hf_spa_instant(hf_solar_jd(c, y, m, d, (double)k), c->o.delta_t, &s);
+            row[k].alpha = k ? row[k - 1].alpha + hf_wrap180(s.alpha - row[k - 1].alpha) : s.alpha;
+            row[k].nu = s.nu - HF_SOLAR_SIDEREAL_RATE * (double)k / 24.0;
+            if (k) row[k].nu = row[k - 1].nu + hf_wrap180(row[k].nu - row[k - 1].nu);
+            row[k].delta = s.delta;
+            row[k].xi = s.xi;
+            row[k].R = s.R;
+        }
+    }
+}
+
+/* Sun of the SPA model at local civil hour t of day (y, m, d), the period's day `day`: true and
+ * shading elevation, compass azimuth in the grid (the true azimuth less gamma) and G0. With the
+ * hourly table the instant part is interpolated linearly between its two hours: within
+ * 2e-6 deg of the full SPA (the declination's curvature, at most 0.007 deg/day^2, times
+ * (1/24 day)^2/8; test_solar.c's per-sample tests compare against the oracle's full SPA). */
+static void hf_solar_spa_sun(const hf_solar_ctx *c, int y, int m, int d, int day, double t,
                              double *h_true, double *elev, double *azimuth, double *g0)
 {
     hf_spa_sun s;
     hf_spa_place p;
-    double jd = hf_julian_day(y, m, (double)d + (t - c->in.utc_offset_hours) / 24.0);
-    hf_spa_instant(jd, c->o.delta_t, &s);
-    hf_spa_at(&s, c->in.latitude_rad / HF_DEG, c->in.longitude_rad / HF_DEG, c->in.height_m,
-              c->o.refraction, HF_SOLAR_REFRACT_P, HF_SOLAR_REFRACT_T, HF_SOLAR_REFRACT_SUNRISE, &p);
+    if (c->eph) {
+        int k = t >= 24.0 ? 23 : t <= 0.0 ? 0 : (int)t;
+        const hf_spa_eph *e0 = c->eph + (size_t)day * HF_SOLAR_EPH_PER_DAY + k, *e1 = e0 + 1;
+        double f = t - (double)k;
+        s.alpha = e0->alpha + f * (e1->alpha - e0->alpha);
+        s.delta = e0->delta + f * (e1->delta - e0->delta);
+        s.nu = e0->nu + f * (e1->nu - e0->nu) + HF_SOLAR_SIDEREAL_RATE * t / 24.0;
+        s.xi = e0->xi + f * (e1->xi - e0->xi);
+        s.R = e0->R + f * (e1->R - e0->R);
+    } else {
+        hf_spa_instant(hf_solar_jd(c, y, m, d, t), c->o.delta_t, &s);
+    }
+    hf_spa_at(&s, c->lat / HF_DEG, c->lon / HF_DEG, c->in.height_m, c->o.refraction,
+              HF_SOLAR_REFRACT_P, HF_SOLAR_REFRACT_T, HF_SOLAR_REFRACT_SUNRISE, &p);
     *h_true = p.e0 * HF_DEG;
     *elev = p.e * HF_DEG;
     *azimuth = p.azimuth * HF_DEG;
     *g0 = 1367.0 / (s.R * s.R);
 }
 
-static double hf_solar_spa_h(const hf_solar_ctx *c, int y, int m, int d, double t)
+static double hf_solar_spa_h(const hf_solar_ctx *c, int y, int m, int d, int day, double t)
 {
     double h, e, a, g;
-    hf_solar_spa_sun(c, y, m, d, t, &h, &e, &a, &g);
+    hf_solar_spa_sun(c, y, m, d, day, t, &h, &e, &a, &g);
     return h;
 }
 
@@ -10681,6 +10951,7 @@ static void hf_solar_step_set(const hf_solar_ctx *c, hf_solar_step *st, double h
                               double azimuth, double g0, double weight, int band, int month)
 {
     double ce = cos(elev);
+    azimuth -= c->gamma; /* true north to the grid's up direction */
     st->h = h;
     st->sinh = sin(h);
     st->elev = elev;
@@ -10689,7 +10960,8 @@ static void hf_solar_step_set(const hf_solar_ctx *c, hf_solar_step *st, double h
     st->sy = -ce * cos(azimuth);  /* south = +y */
     st->sz = sin(elev);
     st->psi = azimuth - HFVIS__HALF_PI;
-    if (st->psi < 0.0) st->psi += 2.0 * HFVIS__PI;
+    while (st->psi < 0.0) st->psi += 2.0 * HFVIS__PI;
+    while (st->psi >= 2.0 * HFVIS__PI) st->psi -= 2.0 * HFVIS__PI;
     st->weight = weight;
     st->band = band;
     st->month = month;
@@ -10714,7 +10986,7 @@ static size_t hf_solar_steps(const hf_solar_ctx *c, hf_solar_step *steps)
             double ang, last, dang = step * (HFVIS__PI / 12.0), first;
             int k;
             if (c->in.instant) {
-                hfvis_rsun_sun_position(doy, c->in.hour, c->in.latitude_rad, &r);
+                hfvis_rsun_sun_position(doy, c->in.hour, c->lat, &r);
                 if (r.elevation > 0.0) {
                     if (steps) hf_solar_step_set(c, steps + n, r.elevation, r.elevation, r.azimuth,
                                                  r.extraterrestrial, 1.0, band, m);
@@ -10722,7 +10994,7 @@ static size_t hf_solar_steps(const hf_solar_ctx *c, hf_solar_step *steps)
                 }
                 continue;
             }
-            hfvis_rsun_sun_position(doy, 12.0, c->in.latitude_rad, &r);
+            hfvis_rsun_sun_position(doy, 12.0, c->lat, &r);
             /* r.sun's schedule (joules2): the first step half a step after the start of the
              * step that holds sunrise, or one and a half when sunrise lies in its second half;
              * then every step while the hour angle has not passed sunset's */
@@ -10733,7 +11005,7 @@ static size_t hf_solar_steps(const hf_solar_ctx *c, hf_solar_step *steps)
             last = (r.sunset_hour - 12.0) * (HFVIS__PI / 12.0);
             for (;;) {
                 hfvis_rsun_sun q;
-                hfvis_rsun_sun_position(doy, 12.0 + ang * (12.0 / HFVIS__PI), c->in.latitude_rad, &q);
+                hfvis_rsun_sun_position(doy, 12.0 + ang * (12.0 / HFVIS__PI), c->lat, &q);
                 if (q.elevation > 0.0) {
                     if (steps) hf_solar_step_set(c, steps + n, q.elevation, q.elevation, q.azimuth,
                                                  q.extraterrestrial, step, band, m);
@@ -10744,15 +11016,15 @@ static size_t hf_solar_steps(const hf_solar_ctx *c, hf_solar_step *steps)
             }
         } else if (c->in.instant) {
             double h, e, a, g;
-            hf_solar_spa_sun(c, y, m, d, c->in.hour, &h, &e, &a, &g);
+            hf_solar_spa_sun(c, y, m, d, day, c->in.hour, &h, &e, &a, &g);
             if (h > 0.0) {
                 if (steps) hf_solar_step_set(c, steps + n, h, e, a, g, 1.0, band, m);
                 n++;
             }
         } else {
-            double t0 = 0.0, h0 = hf_solar_spa_h(c, y, m, d, 0.0);
+            double t0 = 0.0, h0 = hf_solar_spa_h(c, y, m, d, day, 0.0);
             while (t0 < 24.0) {
-                double t1 = t0 + step > 24.0 ? 24.0 : t0 + step, h1 = hf_solar_spa_h(c, y, m, d, t1);
+                double t1 = t0 + step > 24.0 ? 24.0 : t0 + step, h1 = hf_solar_spa_h(c, y, m, d, day, t1);
                 double a = t0, b = t1;
                 int lit = 1;
                 if (!(h0 > 0.0) && !(h1 > 0.0)) {
@@ -10762,7 +11034,7 @@ static size_t hf_solar_steps(const hf_solar_ctx *c, hf_solar_step *steps)
                     double lo = t0, hi = t1;
                     int it;
                     for (it = 0; it < HF_SOLAR_BISECTIONS; it++) {
-                        double mid = 0.5 * (lo + hi), hm = hf_solar_spa_h(c, y, m, d, mid);
+                        double mid = 0.5 * (lo + hi), hm = hf_solar_spa_h(c, y, m, d, day, mid);
                         if ((hm > 0.0) == (h1 > 0.0)) hi = mid;
                         else lo = mid;
                     }
@@ -10771,7 +11043,7 @@ static size_t hf_solar_steps(const hf_solar_ctx *c, hf_solar_step *steps)
                 }
                 if (lit && b > a) {
                     double h, e, az, g;
-                    hf_solar_spa_sun(c, y, m, d, 0.5 * (a + b), &h, &e, &az, &g);
+                    hf_solar_spa_sun(c, y, m, d, day, 0.5 * (a + b), &h, &e, &az, &g);
                     if (h > 0.0) {
                         if (steps) hf_solar_step_set(c, steps + n, h, e, az, g, b - a, band, m);
                         n++;
@@ -10886,6 +11158,10 @@ static hfvis_status hf_solar_setup(const hfvis_grid *g, const hfvis_solar_input 
         (!out->beam && !out->diffuse && !out->reflected && !out->global && !out->sun_hours))
         return HFVIS_ERR_INVALID_ARGUMENT;
     c->in = *in;
+    c->lat = in->latitude_rad;
+    c->lon = in->longitude_rad;
+    c->gamma = 0.0;
+    c->eph = NULL;
     c->o = hfvis_solar_options_default();
     if (opts) {
         c->o = *opts;
@@ -10894,6 +11170,7 @@ static hfvis_status hf_solar_setup(const hfvis_grid *g, const hfvis_solar_input 
         if (c->o.directions == 0) c->o.directions = HF_SOLAR_K_DEFAULT;
         if (c->o.delta_t == 0.0) c->o.delta_t = HF_SOLAR_DELTA_T_DEFAULT;
         if (c->o.reflected_directions == 0) c->o.reflected_directions = HF_SOLAR_KR_DEFAULT;
+        if (c->o.site_tolerance_rad == 0.0) c->o.site_tolerance_rad = HF_SOLAR_SITE_TOL_DEFAULT;
     }
     c->bands = hfvis_solar_band_count(in, opts);
     n = hf_grid_count(g);
@@ -10908,6 +11185,10 @@ static hfvis_status hf_solar_setup(const hfvis_grid *g, const hfvis_solar_input 
             (c->o.coeff_dh && !(c->o.coeff_dh[i] >= 0.0f && c->o.coeff_dh[i] <= 1e6f)))
             return HFVIS_ERR_INVALID_ARGUMENT;
     }
+    for (i = 0; in->latitude_map && i < n; i++) /* the sites: everywhere (holes too: differences) */
+        if (!hf_in(in->latitude_map[i], -HFVIS__HALF_PI, HFVIS__HALF_PI) ||
+            !hf_in(in->longitude_map[i], -HFVIS__PI, HFVIS__PI))
+            return HFVIS_ERR_INVALID_ARGUMENT;
     return HFVIS_OK;
 }
 
@@ -11000,11 +11281,117 @@ static void hf_solar_bracket(const double *az, int K, double psi, int *k0, int *
     *w = span > 0.0 ? (psi - lo) / span : 0.0;
 }
 
+/* Per-sample sites (the input's latitude and longitude maps): frames, blocks. */
+static double hf_wrap_pi(double x) { return x - 2.0 * HFVIS__PI * floor((x + HFVIS__PI) / (2.0 * HFVIS__PI)); }
+
+/* Sample (x, y)'s site from the input's maps: latitude, longitude, and gamma, the true azimuth
+ * of the grid's up direction (-y): from the maps' central differences along y (one-sided at the
+ * border), along x on a one-row grid (the azimuth of +x less 90 deg), 0 where they do not
+ * change. */
+static void hf_solar_site_of(const hfvis_grid *g, const hfvis_solar_input *in, int x, int y,
+                             double *lat, double *lon, double *gamma)
+{
+    const double *la = in->latitude_map, *lo = in->longitude_map;
+    size_t w = (size_t)g->width, i = (size_t)y * w + (size_t)x, a, b;
+    double dn, de, turn = 0.0;
+    *lat = la[i];
+    *lon = lo[i];
+    if (g->height > 1) { /* a: the row above (up), b: the row below */
+        a = (size_t)(y > 0 ? y - 1 : y) * w + (size_t)x;
+        b = (size_t)(y + 1 < g->height ? y + 1 : y) * w + (size_t)x;
+    } else { /* a: east, b: west */
+        a = (size_t)y * w + (size_t)(x + 1 < g->width ? x + 1 : x);
+        b = (size_t)y * w + (size_t)(x > 0 ? x - 1 : x);
+        turn = HFVIS__HALF_PI;
+    }
+    dn = la[a] - la[b];
+    de = hf_wrap_pi(lo[a] - lo[b]) * cos(*lat);
+    *gamma = dn == 0.0 && de == 0.0 ? 0.0 : hf_wrap_pi(atan2(de, dn) - turn);
+}
+
+/* A site's local frame in Earth-fixed axes, rows: the grid's +x (east turned by gamma), its up
+ * direction (north turned by gamma), the zenith (the geodetic normal). */
+static void hf_solar_frame(double lat, double lon, double gamma, double f[9])
+{
+    double sp = sin(lat), cp = cos(lat), sl = sin(lon), cl = cos(lon), sg = sin(gamma), cg = cos(gamma);
+    double E[3], N[3];
+    int k;
+    E[0] = -sl; E[1] = cl; E[2] = 0.0;
+    N[0] = -sp * cl; N[1] = -sp * sl; N[2] = cp;
+    for (k = 0; k < 3; k++) {
+        f[k] = cg * E[k] - sg * N[k];
+        f[3 + k] = cg * N[k] + sg * E[k];
+    }
+    f[6] = cp * cl; f[7] = cp * sl; f[8] = sp;
+}
+
+/* The angle of the rotation between two frames: acos((trace(A B^T) - 1) / 2). */
+static double hf_solar_frame_angle(const double a[9], const double b[9])
+{
+    double t = 0.0;
+    int k;
+    for (k = 0; k < 9; k++) t += a[k] * b[k];
+    t = 0.5 * (t - 1.0);
+    return acos(t > 1.0 ? 1.0 : t < -1.0 ? -1.0 : t);
+}
+
+/* A block of samples sharing the sun of its centre sample's site. */
+typedef struct hf_solar_block {
+    int x0, y0, x1, y1;
+    double lat, lon, gamma;
+} hf_solar_block;
+
+typedef struct hf_solar_blocks {
+    hf_solar_block *b;
+    size_t n, cap;
+    const hfvis_allocator *al;
+} hf_solar_blocks;
+
+/* Split [x0, x1) x [y0, y1) in halves (both axes) until every sample's frame is within tol of
+ * the centre sample's; append the blocks. Every sun direction seen in a frame turns by at most
+ * that angle, so the block's sun is within tol of each sample's own. */
+static hfvis_status hf_solar_split(const hfvis_grid *g, const hfvis_solar_input *in, double tol,
+                                   int x0, int y0, int x1, int y1, hf_solar_blocks *B)
+{
+    int cx = x0 + (x1 - x0 - 1) / 2, cy = y0 + (y1 - y0 - 1) / 2, x, y, ok = 1;
+    double fc[9], f[9], lat, lon, gam, la, lo, ga;
+    hfvis_status st;
+    hf_solar_site_of(g, in, cx, cy, &lat, &lon, &gam);
+    hf_solar_frame(lat, lon, gam, fc);
+    for (y = y0; y < y1 && ok; y++)
+        for (x = x0; x < x1 && ok; x++) {
+            hf_solar_site_of(g, in, x, y, &la, &lo, &ga);
+            hf_solar_frame(la, lo, ga, f);
+            ok = hf_solar_frame_angle(f, fc) <= tol;
+        }
+    if (!ok && (x1 - x0 > 1 || y1 - y0 > 1)) {
+        int xm = x1 - x0 > 1 ? x0 + (x1 - x0) / 2 : x1, ym = y1 - y0 > 1 ? y0 + (y1 - y0) / 2 : y1;
+        if ((st = hf_solar_split(g, in, tol, x0, y0, xm, ym, B)) != HFVIS_OK) return st;
+        if (xm < x1 && (st = hf_solar_split(g, in, tol, xm, y0, x1, ym, B)) != HFVIS_OK) return st;
+        if (ym < y1 && (st = hf_solar_split(g, in, tol, x0, ym, xm, y1, B)) != HFVIS_OK) return st;
+        if (xm < x1 && ym < y1) return hf_solar_split(g, in, tol, xm, ym, x1, y1, B);
+        return HFVIS_OK;
+    }
+    if (B->n == B->cap) { /* grow by doubling */
+        size_t cap = B->cap ? 2 * B->cap : 16;
+        hf_solar_block *nb = (hf_solar_block *)hfvis__alloc_array(B->al, cap, sizeof(hf_solar_block));
+        if (!nb) return HFVIS_ERR_OUT_OF_MEMORY;
+        if (B->n) memcpy(nb, B->b, B->n * sizeof(hf_solar_block));
+        hfvis__free(B->al, B->b);
+        B->b = nb;
+        B->cap = cap;
+    }
+    B->b[B->n].x0 = x0; B->b[B->n].y0 = y0; B->b[B->n].x1 = x1; B->b[B->n].y1 = y1;
+    B->b[B->n].lat = lat; B->b[B->n].lon = lon; B->b[B->n].gamma = gam;
+    B->n++;
+    return HFVIS_OK;
+}
+
 /* Shared by the fast routine and the oracle: setup, steps, per-sample state. */
 typedef struct hf_solar_run {
     hf_solar_ctx c;
     hf_solar_step *steps;
-    size_t nsteps;
+    size_t nsteps, cap;
     hf_solar_point *pts;
     double *acc;
     const hfvis_allocator *al;
@@ -11017,6 +11404,20 @@ static void hf_solar_run_free(hf_solar_run *r)
     hfvis__free(r->al, r->acc);
 }
 
+/* The steps of the current site (r->c's), in r->steps (grown as needed). */
+static hfvis_status hf_solar_run_steps(hf_solar_run *r)
+{
+    r->nsteps = hf_solar_steps(&r->c, NULL);
+    if (!r->steps || r->nsteps + 1 > r->cap) {
+        hfvis__free(r->al, r->steps);
+        r->cap = r->nsteps + 1;
+        r->steps = (hf_solar_step *)hfvis__alloc_array(r->al, r->cap, sizeof(hf_solar_step));
+        if (!r->steps) return HFVIS_ERR_OUT_OF_MEMORY;
+    }
+    hf_solar_steps(&r->c, r->steps);
+    return HFVIS_OK;
+}
+
 static hfvis_status hf_solar_run_init(const hfvis_grid *g, const hfvis_solar_input *in,
                                       const hfvis_solar_options *opts,
                                       const hfvis_solar_output *out, hf_solar_run *r)
@@ -11027,15 +11428,12 @@ static hfvis_status hf_solar_run_init(const hfvis_grid *g, const hfvis_solar_inp
     if ((st = hf_solar_setup(g, in, opts, out, &r->c)) != HFVIS_OK) return st;
     r->al = r->c.o.sweep ? r->c.o.sweep->alloc : NULL;
     n = hf_grid_count(g);
-    r->nsteps = hf_solar_steps(&r->c, NULL);
-    r->steps = (hf_solar_step *)hfvis__alloc_array(r->al, r->nsteps + 1, sizeof(hf_solar_step));
     r->pts = (hf_solar_point *)hfvis__alloc_array(r->al, n, sizeof(hf_solar_point));
     r->acc = (double *)hfvis__alloc_array(r->al, n * (size_t)r->c.bands, 4 * sizeof(double));
-    if (!r->steps || !r->pts || !r->acc) {
+    if (!r->pts || !r->acc || hf_solar_run_steps(r) != HFVIS_OK) {
         hf_solar_run_free(r);
         return HFVIS_ERR_OUT_OF_MEMORY;
     }
-    hf_solar_steps(&r->c, r->steps);
     for (i = 0; i < n * (size_t)r->c.bands * 4; i++) r->acc[i] = 0.0;
     for (i = 0; i < n; i++)
         hf_solar_point_init(&r->c, g, (int)(i % (size_t)g->width), (int)(i / (size_t)g->width), r->pts + i);
@@ -11065,8 +11463,9 @@ static hfvis_status hf_solar_finish(const hfvis_grid *g, hf_solar_run *r, int na
  * steps are binned by azimuth (HF_SOLAR_BINS_PER_DIR bins per map direction), sorted by tan(e)
  * in each bin and summed from the top; a sample reads, per bin, the suffix above its threshold
  * max(the tangent of its horizon interpolated linearly from the map's two directions to the
- * bin's centre, its tangent plane toward the centre) by binary search. p enters by quadratic Lagrange interpolation over three pressure
- * nodes spanning the grid's heights. Cost O(bands * bins * (log S + 3 HF_SOLAR_Q)) per sample
+ * bin's centre, its tangent plane toward the centre) by binary search. p enters by quadratic
+ * Lagrange interpolation over three pressure nodes spanning the block's heights (one block of
+ * hf_solar_run_blocks per call). Cost O(bands * bins * (log S + 3 HF_SOLAR_Q)) per sample
  * instead of O(S): taken when the steps outnumber HF_SOLAR_SECTOR_MIN per bin. docs/solar.md. */
 #define HF_SOLAR_BINS_PER_DIR 4
 #define HF_SOLAR_SECTOR_MIN 4
@@ -11133,9 +11532,9 @@ static void hf_solar_entry_sums(const hf_solar_step *st, double p, double *q)
 }
 
 static hfvis_status hf_solar_sectors(const hfvis_grid *g, hf_solar_run *r, int K, const double *az,
-                                     const float *cellmap, const float *sky)
+                                     const float *cellmap, const float *sky, const hf_solar_block *blk)
 {
-    int NB = HF_SOLAR_BINS_PER_DIR * K, j, b, nn;
+    int NB = HF_SOLAR_BINS_PER_DIR * K, j, b, nn, x, y;
     size_t n = hf_grid_count(g), ngroups = (size_t)r->c.bands * (size_t)NB, q, i, e;
     size_t *start = NULL, *fill = NULL;
     hf_solar_entry *ent = NULL;
@@ -11195,13 +11594,14 @@ static hfvis_status hf_solar_sectors(const hfvis_grid *g, hf_solar_run *r, int K
                 qsort(ent + start[gi], start[gi + 1] - start[gi], sizeof(hf_solar_entry), hf_solar_entry_cmp);
         }
     }
-    /* pressure nodes over the grid's heights, and each group's sums from the top */
-    for (i = 0; i < n; i++) {
-        double z = (double)g->z[(i / (size_t)g->width) * (size_t)g->stride + i % (size_t)g->width];
-        if (!isfinite(z)) continue;
-        if (z < zmin) zmin = z;
-        if (z > zmax) zmax = z;
-    }
+    /* pressure nodes over the block's heights, and each group's sums from the top */
+    for (y = blk->y0; y < blk->y1; y++)
+        for (x = blk->x0; x < blk->x1; x++) {
+            double z = (double)g->z[(ptrdiff_t)y * g->stride + x];
+            if (!isfinite(z)) continue;
+            if (z < zmin) zmin = z;
+            if (z > zmax) zmax = z;
+        }
     if (!(zmin <= zmax)) zmin = zmax = 0.0;
     /* one node on a flat grid, two (linear) over a small range of p, else three (quadratic) */
     nn = zmin == zmax ? 1 : hf_esra_pressure(zmin) - hf_esra_pressure(zmax) < HF_SOLAR_P_LINEAR ? 2 : 3;
@@ -11220,57 +11620,58 @@ static hfvis_status hf_solar_sectors(const hfvis_grid *g, hf_solar_run *r, int K
         }
     }
     /* per sample: the suffix of each bin above its threshold */
-    for (i = 0; i < n; i++) {
-        hf_solar_point *pt = r->pts + i;
-        const float *hz = cellmap + i * (size_t)K;
-        double L[HF_SOLAR_NODES];
-        int horizon = r->c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON;
-        if (!isfinite(pt->p) || isnan(pt->nz)) continue;
-        if (sky) pt->sky_ratio = (double)sky[i] / pt->r_sky;
-        for (j = 0; j < K; j++) th[j] = tan((double)hz[j]);
-        for (j = 0; j < nn; j++) { /* Lagrange weights of p */
-            int m;
-            L[j] = 1.0;
-            for (m = 0; m < nn; m++)
-                if (m != j) L[j] *= (pt->p - pn[m]) / (pn[j] - pn[m]);
-        }
-        for (b = 0; b < r->c.bands; b++) {
-            double S[HF_SOLAR_NODES * HF_SOLAR_Q], T[HF_SOLAR_Q], *a = r->acc + ((size_t)b * n + i) * 4;
-            int t, u;
-            for (t = 0; t < nn * HF_SOLAR_Q; t++) S[t] = 0.0;
-            for (u = 0; u < nne[b]; u++) {
-                int bin = nonempty[(size_t)b * (size_t)NB + (size_t)u];
-                size_t gi = (size_t)b * (size_t)NB + (size_t)bin, lo = start[gi], hi = start[gi + 1];
-                double thr = (1.0 - bw[bin]) * th[bk[2 * bin]] + bw[bin] * th[bk[2 * bin + 1]], tc;
-                const double *s;
-                tc = pt->nz > 0.0 ? -(pt->nx * bdir[2 * bin] + pt->ny * bdir[2 * bin + 1]) / pt->nz : HFVIS__INF;
-                if (!(thr >= tc)) thr = tc; /* the receiver's own tangent plane (and NaN) */
-                if (!(ent[hi - 1].t > thr)) continue;
-                while (lo < hi) { /* the first entry above the threshold */
-                    size_t mid = lo + (hi - lo) / 2;
-                    if (ent[mid].t > thr) hi = mid;
-                    else lo = mid + 1;
+    for (y = blk->y0; y < blk->y1; y++)
+        for (x = blk->x0; x < blk->x1; x++) {
+            hf_solar_point *pt = r->pts + (i = (size_t)y * (size_t)g->width + (size_t)x);
+            const float *hz = cellmap + i * (size_t)K;
+            double L[HF_SOLAR_NODES];
+            int horizon = r->c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON;
+            if (!isfinite(pt->p) || isnan(pt->nz)) continue;
+            if (sky) pt->sky_ratio = (double)sky[i] / pt->r_sky;
+            for (j = 0; j < K; j++) th[j] = tan((double)hz[j]);
+            for (j = 0; j < nn; j++) { /* Lagrange weights of p */
+                int m;
+                L[j] = 1.0;
+                for (m = 0; m < nn; m++)
+                    if (m != j) L[j] *= (pt->p - pn[m]) / (pn[j] - pn[m]);
+            }
+            for (b = 0; b < r->c.bands; b++) {
+                double S[HF_SOLAR_NODES * HF_SOLAR_Q], T[HF_SOLAR_Q], *a = r->acc + ((size_t)b * n + i) * 4;
+                int t, u;
+                for (t = 0; t < nn * HF_SOLAR_Q; t++) S[t] = 0.0;
+                for (u = 0; u < nne[b]; u++) {
+                    int bin = nonempty[(size_t)b * (size_t)NB + (size_t)u];
+                    size_t gi = (size_t)b * (size_t)NB + (size_t)bin, lo = start[gi], hi = start[gi + 1];
+                    double thr = (1.0 - bw[bin]) * th[bk[2 * bin]] + bw[bin] * th[bk[2 * bin + 1]], tc;
+                    const double *s;
+                    tc = pt->nz > 0.0 ? -(pt->nx * bdir[2 * bin] + pt->ny * bdir[2 * bin + 1]) / pt->nz : HFVIS__INF;
+                    if (!(thr >= tc)) thr = tc; /* the receiver's own tangent plane (and NaN) */
+                    if (!(ent[hi - 1].t > thr)) continue;
+                    while (lo < hi) { /* the first entry above the threshold */
+                        size_t mid = lo + (hi - lo) / 2;
+                        if (ent[mid].t > thr) hi = mid;
+                        else lo = mid + 1;
+                    }
+                    s = sums + lo * (size_t)nn * HF_SOLAR_Q;
+                    for (t = 0; t < nn * HF_SOLAR_Q; t++) S[t] += s[t];
                 }
-                s = sums + lo * (size_t)nn * HF_SOLAR_Q;
-                for (t = 0; t < nn * HF_SOLAR_Q; t++) S[t] += s[t];
+                for (t = 0; t < HF_SOLAR_Q; t++) {
+                    T[t] = 0.0;
+                    for (j = 0; j < nn; j++) T[t] += L[j] * S[j * HF_SOLAR_Q + t];
+                }
+                a[0] = pt->nx * T[HF_SQ_BX] + pt->ny * T[HF_SQ_BY] + pt->nz * T[HF_SQ_BZ];
+                if (pt->tilted || horizon) {
+                    double bg = (pt->fg * T[HF_SQ_FG] + pt->r_sky * T[HF_SQ_RS]) * pt->sky_ratio;
+                    double shade = (tdh[b] - T[HF_SQ_DH]) * (pt->r_sky + pt->fg * 0.252271) * pt->sky_ratio;
+                    a[1] = bg + shade + (pt->tilted ? pt->nx * T[HF_SQ_TX] + pt->ny * T[HF_SQ_TY] + pt->nz * T[HF_SQ_TZ]
+                                                    : pt->nx * T[HF_SQ_AX] + pt->ny * T[HF_SQ_AY] + pt->nz * T[HF_SQ_AZ]);
+                } else {
+                    a[1] = tdh[b];
+                }
+                a[2] = pt->tilted ? pt->albedo * (T[HF_SQ_BH] + tdh[b]) * (1.0 - pt->nz) * 0.5 : 0.0;
+                a[3] = T[HF_SQ_HOURS];
             }
-            for (t = 0; t < HF_SOLAR_Q; t++) {
-                T[t] = 0.0;
-                for (j = 0; j < nn; j++) T[t] += L[j] * S[j * HF_SOLAR_Q + t];
-            }
-            a[0] = pt->nx * T[HF_SQ_BX] + pt->ny * T[HF_SQ_BY] + pt->nz * T[HF_SQ_BZ];
-            if (pt->tilted || horizon) {
-                double bg = (pt->fg * T[HF_SQ_FG] + pt->r_sky * T[HF_SQ_RS]) * pt->sky_ratio;
-                double shade = (tdh[b] - T[HF_SQ_DH]) * (pt->r_sky + pt->fg * 0.252271) * pt->sky_ratio;
-                a[1] = bg + shade + (pt->tilted ? pt->nx * T[HF_SQ_TX] + pt->ny * T[HF_SQ_TY] + pt->nz * T[HF_SQ_TZ]
-                                                : pt->nx * T[HF_SQ_AX] + pt->ny * T[HF_SQ_AY] + pt->nz * T[HF_SQ_AZ]);
-            } else {
-                a[1] = tdh[b];
-            }
-            a[2] = pt->tilted ? pt->albedo * (T[HF_SQ_BH] + tdh[b]) * (1.0 - pt->nz) * 0.5 : 0.0;
-            a[3] = T[HF_SQ_HOURS];
         }
-    }
     hfvis__free(r->al, start); hfvis__free(r->al, fill); hfvis__free(r->al, ent);
     hfvis__free(r->al, sums); hfvis__free(r->al, tdh); hfvis__free(r->al, bk);
     hfvis__free(r->al, bw); hfvis__free(r->al, bdir); hfvis__free(r->al, nonempty);
@@ -11278,18 +11679,99 @@ static hfvis_status hf_solar_sectors(const hfvis_grid *g, hf_solar_run *r, int K
     return HFVIS_OK;
 }
 
+/* The step loop over one block's samples (the fast path when the sector sums do not apply). */
+static void hf_solar_loop(const hfvis_grid *g, hf_solar_run *r, int K, const float *cellmap,
+                          const float *sky, const int *kk, const double *kw, const hf_solar_block *blk)
+{
+    size_t n = hf_grid_count(g), q;
+    int horizon = r->c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON, x, y;
+    for (y = blk->y0; y < blk->y1; y++)
+        for (x = blk->x0; x < blk->x1; x++) {
+            size_t i = (size_t)y * (size_t)g->width + (size_t)x;
+            hf_solar_point *pt = r->pts + i;
+            const float *hz = cellmap ? cellmap + i * (size_t)K : NULL;
+            double acc[4] = { 0.0, 0.0, 0.0, 0.0 }, *a;
+            int band = r->nsteps ? r->steps[0].band : 0;
+            if (!isfinite(pt->p) || isnan(pt->nz)) continue;
+            if (sky) pt->sky_ratio = (double)sky[i] / pt->r_sky;
+            for (q = 0; q < r->nsteps; q++) {
+                const hf_solar_step *stp = r->steps + q;
+                double vis = 1.0;
+                if (stp->band != band) {
+                    a = r->acc + ((size_t)band * n + i) * 4;
+                    a[0] = acc[0]; a[1] = acc[1]; a[2] = acc[2]; a[3] = acc[3];
+                    acc[0] = acc[1] = acc[2] = acc[3] = 0.0;
+                    band = stp->band;
+                }
+                if (!r->c.o.no_shading) {
+                    double hor = (1.0 - kw[q]) * (double)hz[kk[2 * q]] + kw[q] * (double)hz[kk[2 * q + 1]];
+                    vis = hf_solar_visible(stp->elev, hor, r->c.o.sun_radius_rad);
+                }
+                hf_solar_point_step(stp, pt, vis, horizon, acc);
+            }
+            a = r->acc + ((size_t)band * n + i) * 4;
+            a[0] = acc[0]; a[1] = acc[1]; a[2] = acc[2]; a[3] = acc[3];
+        }
+}
+
+/* The blocks of the run: the whole grid at the input's site, or hf_solar_split of the maps
+ * (then SPA's instant part from the hourly table when there is more than one block). */
+static hfvis_status hf_solar_run_blocks(const hfvis_grid *g, hf_solar_run *r, hf_solar_blocks *B,
+                                        hf_spa_eph **eph)
+{
+    hfvis_status st;
+    int days = r->c.in.instant ? 1 : r->c.in.days;
+    memset(B, 0, sizeof *B);
+    B->al = r->al;
+    *eph = NULL;
+    if (!r->c.in.latitude_map) {
+        B->b = (hf_solar_block *)hfvis__alloc_array(r->al, 1, sizeof(hf_solar_block));
+        if (!B->b) return HFVIS_ERR_OUT_OF_MEMORY;
+        B->b[0].x0 = B->b[0].y0 = 0;
+        B->b[0].x1 = g->width;
+        B->b[0].y1 = g->height;
+        B->b[0].lat = r->c.lat;
+        B->b[0].lon = r->c.lon;
+        B->b[0].gamma = 0.0;
+        B->n = B->cap = 1;
+        return HFVIS_OK;
+    }
+    st = hf_solar_split(g, &r->c.in, r->c.o.site_tolerance_rad, 0, 0, g->width, g->height, B);
+    if (st == HFVIS_OK && B->n > 1 && r->c.o.model != HFVIS_SUN_RSUN) {
+        *eph = (hf_spa_eph *)hfvis__alloc_array(r->al, (size_t)days * HF_SOLAR_EPH_PER_DAY, sizeof(hf_spa_eph));
+        if (!*eph) st = HFVIS_ERR_OUT_OF_MEMORY;
+        else hf_solar_eph_fill(&r->c, days, *eph);
+    }
+    if (st != HFVIS_OK) {
+        hfvis__free(r->al, B->b);
+        B->b = NULL;
+    }
+    return st;
+}
+
+/* Set the run's site to a block's (its steps anew when the grid has more than one site). */
+static hfvis_status hf_solar_run_site(hf_solar_run *r, const hf_solar_block *blk)
+{
+    if (!r->c.in.latitude_map) return HFVIS_OK;
+    r->c.lat = blk->lat;
+    r->c.lon = blk->lon;
+    r->c.gamma = blk->gamma;
+    return hf_solar_run_steps(r);
+}
+
 /* -------------------------------------------------------------------- 8. the public routines */
 hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_input *in,
                                      const hfvis_solar_options *opts, const hfvis_solar_output *out)
 {
     hf_solar_run r;
+    hf_solar_blocks B;
+    hf_spa_eph *eph = NULL;
     hfvis_status st;
     hfvis_sweep_options s;
     float *map = NULL, *cellmap = NULL, *sky = NULL;
     double *az = NULL;
-    int K, *kk = NULL;
-    double *kw = NULL;
-    size_t n, i, q;
+    int K;
+    size_t n, i, bi;
     if ((st = hf_solar_run_init(g, in, opts, out, &r)) != HFVIS_OK) return st;
     n = hf_grid_count(g);
     K = r.c.o.directions;
@@ -11300,12 +11782,10 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
             return HFVIS_ERR_LIMIT;
         }
         az = (double *)hfvis__alloc_array(r.al, (size_t)K, sizeof(double));
-        kk = (int *)hfvis__alloc_array(r.al, r.nsteps + 1, 2 * sizeof(int));
-        kw = (double *)hfvis__alloc_array(r.al, r.nsteps + 1, sizeof(double));
-        map = (float *)hfvis__alloc_array(r.al, n * (size_t)K, sizeof(float));
-        if (!az || !kk || !kw || !map) st = HFVIS_ERR_OUT_OF_MEMORY;
+        map = r.c.o.horizon_map ? NULL : (float *)hfvis__alloc_array(r.al, n * (size_t)K, sizeof(float));
+        if (!az || (!map && !r.c.o.horizon_map)) st = HFVIS_ERR_OUT_OF_MEMORY;
         if (st == HFVIS_OK) st = hfvis_sweep_azimuths(K, &s, az, NULL);
-        if (st == HFVIS_OK) st = hfvis_horizon_map(g, K, &s, map);
+        if (st == HFVIS_OK && !r.c.o.horizon_map) st = hfvis_horizon_map(g, K, &s, map);
         if (st == HFVIS_OK && r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON) {
             sky = (float *)hfvis__alloc_array(r.al, n, sizeof(float));
             if (!sky) st = HFVIS_ERR_OUT_OF_MEMORY;
@@ -11316,50 +11796,42 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
             if (!cellmap) st = HFVIS_ERR_OUT_OF_MEMORY;
         }
         if (st == HFVIS_OK) {
+            const float *src = r.c.o.horizon_map ? r.c.o.horizon_map : map;
             int k;
             for (k = 0; k < K; k++)
-                for (i = 0; i < n; i++) cellmap[i * (size_t)K + (size_t)k] = map[(size_t)k * n + i];
-            for (q = 0; q < r.nsteps; q++)
-                hf_solar_bracket(az, K, r.steps[q].psi, kk + 2 * q, kk + 2 * q + 1, kw + q);
+                for (i = 0; i < n; i++) cellmap[i * (size_t)K + (size_t)k] = src[(size_t)k * n + i];
         }
         hfvis__free(r.al, map);
         map = NULL;
     }
-    if (st == HFVIS_OK && cellmap && hf_solar_sectors_apply(&r.c, r.nsteps)) {
-        st = hf_solar_sectors(g, &r, K, az, cellmap, sky);
-    } else if (st == HFVIS_OK) {
-        int horizon = r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON;
-        for (i = 0; i < n; i++) {
-            hf_solar_point *pt = r.pts + i;
-            const float *hz = cellmap ? cellmap + i * (size_t)K : NULL;
-            double acc[4] = { 0.0, 0.0, 0.0, 0.0 };
-            int band = r.nsteps ? r.steps[0].band : 0;
-            if (!isfinite(pt->p) || isnan(pt->nz)) continue;
-            if (sky) pt->sky_ratio = (double)sky[i] / pt->r_sky;
-            for (q = 0; q < r.nsteps; q++) {
-                const hf_solar_step *stp = r.steps + q;
-                double vis = 1.0;
-                if (stp->band != band) {
-                    double *a = r.acc + ((size_t)band * n + i) * 4;
-                    a[0] = acc[0]; a[1] = acc[1]; a[2] = acc[2]; a[3] = acc[3];
-                    acc[0] = acc[1] = acc[2] = acc[3] = 0.0;
-                    band = stp->band;
-                }
-                if (!r.c.o.no_shading) {
-                    double hor = (1.0 - kw[q]) * (double)hz[kk[2 * q]] + kw[q] * (double)hz[kk[2 * q + 1]];
-                    vis = hf_solar_visible(stp->elev, hor, r.c.o.sun_radius_rad);
-                }
-                hf_solar_point_step(stp, pt, vis, horizon, acc);
-            }
-            {
-                double *a = r.acc + ((size_t)band * n + i) * 4;
-                a[0] = acc[0]; a[1] = acc[1]; a[2] = acc[2]; a[3] = acc[3];
-            }
+    B.b = NULL;
+    B.n = 0;
+    if (st == HFVIS_OK) st = hf_solar_run_blocks(g, &r, &B, &eph);
+    r.c.eph = eph;
+    for (bi = 0; bi < B.n && st == HFVIS_OK; bi++) {
+        const hf_solar_block *blk = B.b + bi;
+        int *kk = NULL;
+        double *kw = NULL;
+        size_t q;
+        if ((st = hf_solar_run_site(&r, blk)) != HFVIS_OK) break;
+        if (cellmap && hf_solar_sectors_apply(&r.c, r.nsteps)) {
+            st = hf_solar_sectors(g, &r, K, az, cellmap, sky, blk);
+            continue;
         }
+        if (cellmap) { /* each step's two map directions and weight */
+            kk = (int *)hfvis__alloc_array(r.al, r.nsteps + 1, 2 * sizeof(int));
+            kw = (double *)hfvis__alloc_array(r.al, r.nsteps + 1, sizeof(double));
+            if (!kk || !kw) st = HFVIS_ERR_OUT_OF_MEMORY;
+            for (q = 0; q < r.nsteps && st == HFVIS_OK; q++)
+                hf_solar_bracket(az, K, r.steps[q].psi, kk + 2 * q, kk + 2 * q + 1, kw + q);
+        }
+        if (st == HFVIS_OK) hf_solar_loop(g, &r, K, cellmap, sky, kk, kw, blk);
+        hfvis__free(r.al, kk);
+        hfvis__free(r.al, kw);
     }
+    hfvis__free(r.al, B.b);
+    hfvis__free(r.al, eph);
     hfvis__free(r.al, az);
-    hfvis__free(r.al, kk);
-    hfvis__free(r.al, kw);
     hfvis__free(r.al, cellmap);
     hfvis__free(r.al, sky);
     if (st != HFVIS_OK) {
@@ -11371,6 +11843,50 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
 
 #define HF_SOLAR_REF_DENOM 1024 /* the oracle's ray toward the sun: within 0.002 deg of it */
 #define HF_SOLAR_REF_DIRS 4      /* the oracle integrates the visible sky over 4K directions */
+
+/* The oracle with per-sample sites: sample (x, y)'s own exact ray toward grid azimuth psi (as
+ * hfvis_horizon_exact_naive's, denominator HF_SOLAR_REF_DENOM); o resolved, cr of
+ * 2 HF_SOLAR_REF_DENOM entries. */
+static double hf_solar_ray(const hfvis_grid *g, const hfvis_sweep_options *o, hf_cross *cr,
+                           double psi, int x, int y)
+{
+    hf_ray ray = hf_ray_nearest(psi, HF_SOLAR_REF_DENOM);
+    double L, scale;
+    int P = hf_exact_geometry(cr, g, ray.a, ray.b, &L, &scale);
+    return hf_tan_to_elevation(hf_exact_march(g, o->border, o->border == HFVIS_BORDER_OPEN ? 0 : o->border_cells,
+                                              cr, P, L, scale, ray.a, ray.b, x, y,
+                                              hf_radius_on(o) ? hf_exact_window(o->max_distance, scale) : -1));
+}
+
+/* The oracle's steps with per-sample sites: each sample's own site and steps (full SPA at every
+ * instant, sunrise and sunset bisected there) and its own ray toward each step's sun. */
+static hfvis_status hf_solar_reference_sites(const hfvis_grid *g, hf_solar_run *r,
+                                             const hfvis_sweep_options *s)
+{
+    hfvis_sweep_options o = hf_opts_resolve(g, s);
+    hf_cross *cr = (hf_cross *)hfvis__alloc_array(r->al, 2 * HF_SOLAR_REF_DENOM + 2, sizeof(hf_cross));
+    hfvis_status st = cr ? HFVIS_OK : HFVIS_ERR_OUT_OF_MEMORY;
+    size_t n = hf_grid_count(g), q;
+    int x, y;
+    for (y = 0; y < g->height && st == HFVIS_OK; y++)
+        for (x = 0; x < g->width && st == HFVIS_OK; x++) {
+            size_t i = (size_t)y * (size_t)g->width + (size_t)x;
+            hf_solar_point *pt = r->pts + i;
+            if (!isfinite(pt->p) || isnan(pt->nz)) continue;
+            hf_solar_site_of(g, &r->c.in, x, y, &r->c.lat, &r->c.lon, &r->c.gamma);
+            if ((st = hf_solar_run_steps(r)) != HFVIS_OK) break;
+            for (q = 0; q < r->nsteps; q++) {
+                const hf_solar_step *stp = r->steps + q;
+                double vis = r->c.o.no_shading ? 1.0
+                           : hf_solar_visible(stp->elev, hf_solar_ray(g, &o, cr, stp->psi, x, y), r->c.o.sun_radius_rad);
+                if (isnan(vis)) continue;
+                hf_solar_point_step(stp, pt, vis, r->c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON,
+                                    r->acc + ((size_t)stp->band * n + i) * 4);
+            }
+        }
+    hfvis__free(r->al, cr);
+    return st;
+}
 
 hfvis_status hfvis_solar_irradiation_reference(const hfvis_grid *g, const hfvis_solar_input *in,
                                                const hfvis_solar_options *opts,
@@ -11409,7 +11925,8 @@ hfvis_status hfvis_solar_irradiation_reference(const hfvis_grid *g, const hfvis_
         }
     }
     s.ray_denominator = HF_SOLAR_REF_DENOM;
-    for (q = 0; q < r.nsteps && st == HFVIS_OK; q++) {
+    if (st == HFVIS_OK && r.c.in.latitude_map) st = hf_solar_reference_sites(g, &r, &s);
+    for (q = 0; q < r.nsteps && st == HFVIS_OK && !r.c.in.latitude_map; q++) {
         const hf_solar_step *stp = r.steps + q;
         if (!r.c.o.no_shading) { /* each receiver's own exact ray toward the sun */
             s.azimuth0_rad = stp->psi;

@@ -144,8 +144,10 @@
  *   Every receiver with a finite height gets a value: one stranded between holes, where the
  *   lattice holds no finite node near it, takes the per-receiver march of the oracle
  *   (hfvis_horizon_reference) toward each direction instead of the gathered lattice (horizon
- *   maps and every lattice product built on them or on the fused sums; hfvis_indirect_light
- *   alone still leaves NaN there). Grid normals are one-sided beside holes.
+ *   maps and every lattice product built on them or on the fused sums; for
+ *   hfvis_indirect_light and hfvis_visibility_count the march's samples form the receiver's
+ *   line: out of the grid, then border_cells pre-roll steps). Grid normals are one-sided beside
+ *   holes.
  * Obscurance and light. Obscurance outputs lie in [0, 1] (0 = nothing blocks). Lighting outputs
  *   are radiance with the Lambertian convention L_o = albedo/pi * Int L_i V (n.w) dw, so an
  *   unoccluded flat receiver under a uniform sky of radiance c with albedo 1 returns c.
@@ -162,11 +164,12 @@
  * Threads. The library starts none. Inputs (grids, environments, tables, options, meshes) are
  *   only read, so any number of calls may share them while no call writes them; an allocator
  *   shared by concurrent calls must itself be thread-safe (give each thread its own). Outputs
- *   must not overlap, with one exception: the bands of hfvis_sun_visibility (sweep options
- *   part_index/part_count) write disjoint cells, so the part_count calls of one sun may write
- *   one out concurrently. Splitting a run over threads without changing a bit: the sums by
- *   direction range (hfvis_direction_sums: one quarter-turn group, or in exact mode one
- *   direction, per part, added in order), the horizon map by plane range, one sun by bands,
+ *   must not overlap, with one exception: bands (sweep options part_index/part_count) write
+ *   disjoint cells, so the part_count calls of one sun (hfvis_sun_visibility), or of one
+ *   direction of exact-mode sums (hfvis_direction_sums), may write one out concurrently.
+ *   Splitting a run over threads without changing a bit: the lattice sums by quarter-turn group
+ *   (hfvis_direction_sums, one group per part, added in order), the exact sums by bands of one
+ *   direction at a time (added in place), the horizon map by plane range, one sun by bands,
  *   and any receiver-local result by windows ("Search radius and tiles"). The hfvis tool's
  *   --threads does exactly that; test/thread_test.c runs these calls concurrently on shared
  *   inputs under ThreadSanitizer (make sanitize).
@@ -639,17 +642,27 @@ typedef struct hfvis_sweep_options {
                                        (inside it, else HFVIS_ERR_INVALID_ARGUMENT); */
     int receiver_width, receiver_height; /* 0, 0 = every receiver (default); outputs outside it
                                        are left unwritten; the work shrinks with it */
-    int part_index, part_count;     /* hfvis_sun_visibility only (both ray modes): compute only the
-                                       receivers of band part_index of part_count bands across the
-                                       sun's direction (each receiver belongs to the band of its
-                                       distance across the sweep lines), so that threads can share
-                                       one call's lines: every receiver is in exactly one band, its
-                                       output equals the whole call's bit for bit, cells of the
-                                       other bands are left unwritten (the calls may then write one
-                                       out concurrently, see "Threads"). 0, 0 = every receiver
-                                       (default); else 0 <= part_index < part_count <= 65536
-                                       (HFVIS_ERR_INVALID_ARGUMENT otherwise, and from every other
-                                       routine for part_count > 1) */
+    int part_index, part_count;     /* hfvis_sun_visibility (both ray modes) and, in exact mode,
+                                       hfvis_direction_sums: compute only the receivers of band
+                                       part_index of part_count bands across each direction (each
+                                       receiver belongs to the band of its distance across the
+                                       sweep lines), so that threads can share one call's lines:
+                                       every receiver is in exactly one band, its output equals
+                                       the whole call's bit for bit, cells of the other bands are
+                                       left alone (the calls may then write one out concurrently,
+                                       see "Threads"; hfvis_direction_sums adds to its sums then).
+                                       0, 0 = every receiver (default); else 0 <= part_index <
+                                       part_count <= 65536 (HFVIS_ERR_INVALID_ARGUMENT otherwise,
+                                       and from every other routine and mode for part_count > 1) */
+    const float *normals;           /* NULL (default), or this grid's normals exactly as
+                                       hfvis_normals_compute writes them (width*height*3 floats),
+                                       only read: the sweeps that light the terrain (sky light,
+                                       environment light and their hfvis_direction_sums in both
+                                       ray modes, the [P2] indirect gather) read them instead of
+                                       computing them in their scratch,
+                                       so that the calls of a split run (hfvis.h, "Threads")
+                                       compute them once and share them. Other values change the
+                                       results (they are not checked) */
     int ray_near_cells;             /* EXACT: D, 0 = every sample of every ray (default); D > 0:
                                        each receiver's own ray within D cells, a far field shared
                                        by the receivers within half a cell of it beyond (hfvis.h
@@ -1477,8 +1490,18 @@ typedef enum hfvis_solar_bands {
 /* What to compute: the site, the period and the surface. hfvis_solar_input_default() fills in
  * linke 3, albedo 0.2, days 1, 2026-06-21; latitude and longitude are the caller's to set. */
 typedef struct hfvis_solar_input {
-    double latitude_rad;      /* the sun is computed at this one place for the whole grid */
-    double longitude_rad;     /* (east positive); SPA needs it, RSUN ignores it */
+    double latitude_rad;      /* the site when the maps below are NULL: the sun is computed at */
+    double longitude_rad;     /* this one place for the whole grid (east positive; SPA needs
+                                 the longitude, RSUN ignores it) */
+    const double *latitude_map;  /* per sample [y*width + x] (holes too), radians (geodetic
+                                    latitude in [-pi/2, pi/2], longitude east positive in
+                                    [-pi, pi]), both or */
+    const double *longitude_map; /* neither: each sample's own site, e.g. the inverse projection
+                                    of its CRS. The grid's up direction (-y) is then taken at the
+                                    true azimuth the maps give it (the meridian convergence, from
+                                    their differences along y, along x on a one-row grid), and the
+                                    sun is computed per block of samples whose local frames are
+                                    within opts->site_tolerance_rad of the block centre's */
     double height_m;          /* SPA's observer height; the air mass uses each sample's z */
     int year, month, day;     /* first day; RSUN steps day of the year from it */
     int days;                 /* >= 1 days from the first (ignored for an instant) */
@@ -1512,9 +1535,19 @@ typedef struct hfvis_solar_options {
     hfvis_solar_reflected reflected;
     int reflected_directions;    /* TERRAIN: K of the [P2] gather; 0 = 16 */
     hfvis_solar_bands bands;
+    double site_tolerance_rad;   /* with input->latitude_map: the largest rotation between a
+                                    sample's local frame (east, north, up turned by the
+                                    convergence) and its block centre's, (0, 0.1]; 0 = 0.05 deg.
+                                    Every sun direction of a sample is within it of its own */
     const hfvis_sweep_options *sweep; /* border, search radius, allocator, progress; its rays
                                     field is ignored (the horizon map is always exact rays) and
                                     its window and rectangle must be unset */
+    const float *horizon_map;    /* NULL: the fast routine makes its exact horizon map itself;
+                                    else the caller's, directions*width*height floats exactly as
+                                    hfvis_horizon_map writes them for these K directions with
+                                    HFVIS_RAYS_EXACT and the sweep options above (azimuth0 0,
+                                    every direction): e.g. made on several threads (the results
+                                    are then bit for bit those of NULL). The oracle ignores it */
 } hfvis_solar_options;
 
 HFVIS_API hfvis_solar_options hfvis_solar_options_default(void);
@@ -1533,7 +1566,10 @@ HFVIS_API int hfvis_solar_band_count(const hfvis_solar_input *input,
                                      const hfvis_solar_options *opts);
 
 /* Irradiance (input->instant) or irradiation over a period on every grid point. Per time step:
- * the sun at the site; the beam is shaded by the exact horizon toward the sun, read from one
+ * the sun at the site (with input->latitude_map: at the centre of each block of samples whose
+ * local frames lie within opts->site_tolerance_rad of the centre's, quadtree halving from the
+ * whole grid; the steps, sunrise and sunset are then each block's own, SPA's instant part taken
+ * once per hour of the period and interpolated, within 2e-6 deg); the beam is shaded by the exact horizon toward the sun, read from one
  * exact-ray horizon map of K directions made once (hfvis_horizon_map, HFVIS_RAYS_EXACT) and
  * interpolated linearly in azimuth between its two nearest directions; then r.sun's ESRA
  * atmosphere per sample (its height for the air mass, its Linke factor, albedo and
@@ -1551,9 +1587,10 @@ HFVIS_API int hfvis_solar_band_count(const hfvis_solar_input *input,
  * Memory: K*8 bytes per sample for the map and its sample-major copy (K = 64: 512 bytes at the
  * peak), 120 bytes per sample of state and 32 per sample and band of sums, plus the outputs;
  * HORIZON adds 4 bytes per sample, TERRAIN the [P2] sweep's scratch; the sector sums about
- * 350 bytes per sunlit step.
+ * 350 bytes per sunlit step; per-sample sites 1 KB per day of the period (the hourly table)
+ * and 56 bytes per block.
  * Cost: the map (hfvis.h "Exact rays") plus O(steps*width*height), or with the sector sums
- * O(steps log steps + bands*K*width*height*log steps).
+ * O(steps log steps + bands*K*width*height*log steps), the steps' part once per block.
  * Accuracy against hfvis_solar_irradiation_reference: docs/solar.md and test/test_solar.c.
  * Returns HFVIS_ERR_INVALID_ARGUMENT (NULL, no output, bad input or option: a date that does
  * not exist, linke outside (0, 10], albedo outside [0, 1], a latitude outside [-pi/2, pi/2]),
@@ -1563,14 +1600,16 @@ HFVIS_API hfvis_status hfvis_solar_irradiation(const hfvis_grid *grid,
                                                const hfvis_solar_options *opts,
                                                const hfvis_solar_output *out);
 
-/* Oracle: the same steps and the same atmosphere per step and grid point, with the horizon
+/* Oracle: the same steps (with input->latitude_map: each sample's own steps at its own site, the
+ * full SPA at every instant) and the same atmosphere per step and grid point, with the horizon
  * toward the sun's own azimuth from first principles at every step: each receiver's own exact
  * ray (hfvis_horizon_exact_naive, K = 1, ray_denominator 1024: within 0.002 deg of the sun's
  * azimuth); the visible sky of HORIZON integrated over 4K directions of the same rays ([P1]
  * Eq. 5 per sector); TERRAIN gathered by hfvis_indirect_light_naive; summed naively in double.
  * (The bilinear ray march hfvis_horizon_reference is not used: its samples within the first
  * cell measure the bilinear patch's own directional slope, which the solar model counts as the
- * receiver's incidence angle instead; docs/solar.md.) Cost O(steps*width*height*max(W, H)). */
+ * receiver's incidence angle instead; docs/solar.md.) Cost O(steps*width*height*max(W, H)),
+ * with the maps O(steps*width*height*(SPA + ray_denominator)). */
 HFVIS_API hfvis_status hfvis_solar_irradiation_reference(const hfvis_grid *grid,
                                                          const hfvis_solar_input *input,
                                                          const hfvis_solar_options *opts,
@@ -2195,8 +2234,17 @@ typedef enum hfvis_sum_kind {
  * sums[(y*width + x)*channels + c]: channels = env->channels for HFVIS_SUM_ENV_LIGHT, else 1;
  * NaN at holes. env and eopts are used by HFVIS_SUM_ENV_LIGHT only (env required there, else
  * may be NULL). Scratch: that of the matching routine (hfvis_sky_light etc.).
+ * Bands (exact rays, sky view / sky light / environment, opts->part_count > 1): the call ADDS
+ * each direction's terms, direction by direction in index order, to sums at the receivers on
+ * its band's lines of that direction (NaN at their holes) and leaves every other value alone;
+ * sums then holds a running S. Calling the part_count bands of direction k, then those of
+ * k + 1, ..., on sums zeroed once adds each receiver's terms in the whole call's order, so S is
+ * its bits; the bands of one direction write disjoint cells (the hfvis tool runs them
+ * concurrently, one direction at a time). Scratch then: one tangent plane (8 bytes a cell) and
+ * line buffers, no accumulator.
  * Returns HFVIS_OK, HFVIS_ERR_INVALID_ARGUMENT (NULL grid or sums, K < 1, bad range, unknown
- * kind, missing env), HFVIS_ERR_LIMIT or HFVIS_ERR_OUT_OF_MEMORY. Cost O((e-b)*width*height). */
+ * kind, missing env, bands in lattice mode or for the visibility index), HFVIS_ERR_LIMIT or
+ * HFVIS_ERR_OUT_OF_MEMORY. Cost O((e-b)*width*height), a band its share. */
 HFVIS_API hfvis_status hfvis_direction_sums(const hfvis_grid *grid, int K, hfvis_sum_kind kind,
                                             const hfvis_env *env, const hfvis_env_options *eopts,
                                             const hfvis_sweep_options *opts, double *sums);

@@ -490,6 +490,22 @@ static inline int ex_deflate_zlib(const unsigned char *in, size_t n, unsigned ch
  * hfvis_write_options.on_temp); NULL: nobody is told. */
 static void (*ex_atomic_on_temp)(void *user, const char *tmp);
 
+/* Told 1 before a step whose files an interrupt handler cannot know yet (a temporary file until
+ * hfvis_write_begin has reported it; the renames of ex_publish_end, whose files it never knows)
+ * and 0 after it: the hfvis CLI holds SIGINT, SIGTERM and SIGHUP meanwhile, so that an interrupt
+ * finds every temporary file reported and a set of files whole, the old one or the new one.
+ * NULL: nothing is held. */
+static void (*ex_atomic_hold)(int hold);
+static inline hfvis_status ex_atomic_begin(const char *path, const hfvis_write_options *wo, FILE **f,
+                                           char **tmp)
+{
+    hfvis_status s;
+    if (ex_atomic_hold) ex_atomic_hold(1);
+    s = hfvis_write_begin(path, wo, f, tmp);
+    if (ex_atomic_hold) ex_atomic_hold(0);
+    return s;
+}
+
 /* The library's atomic write (hfvis_write_begin), reporting to ex_atomic_on_temp: the temporary
  * file beside path, open for writing, its name in *tmp_out for ex_atomic_close. NULL (and
  * *tmp_out NULL) on failure. */
@@ -499,7 +515,7 @@ static inline FILE *ex_atomic_open(const char *path, char **tmp_out)
     FILE *f;
     wo.on_temp = ex_atomic_on_temp;
     wo.user = NULL;
-    if (hfvis_write_begin(path, &wo, &f, tmp_out) != HFVIS_OK) return NULL;
+    if (ex_atomic_begin(path, &wo, &f, tmp_out) != HFVIS_OK) return NULL;
     return f;
 }
 
@@ -521,8 +537,8 @@ static inline int ex_atomic_close(FILE *f, char *tmp, const char *path, int ok)
  * in (a target listed with ex_publish_absent, a stale sidecar the new output lacks, is only
  * moved aside) and, once all are in place, removes the old ones. When any write, close or
  * rename fails, the new files are removed and the old ones renamed back: every target is as it
- * was. (An interrupt during the renames can leave the old files under their aside names
- * "<target>.tmp<hex>", never a mixed set under the targets' names.) */
+ * was. An interrupt held by ex_atomic_hold during the renames finds the set whole (without the
+ * hold it could leave the old files under their aside names "<target>.tmp<hex>"). */
 #define EX_PUBLISH_MAX 4
 typedef struct {
     int n, ok;
@@ -548,7 +564,7 @@ static inline FILE *ex_publish_open(ex_publish *p, const char *path)
     }
     wo.on_temp = ex_atomic_on_temp;
     wo.user = NULL;
-    if (hfvis_write_begin(path, &wo, &f, &tmp) != HFVIS_OK) {
+    if (ex_atomic_begin(path, &wo, &f, &tmp) != HFVIS_OK) {
         p->ok = 0;
         return NULL;
     }
@@ -588,6 +604,7 @@ static inline int ex_publish_end(ex_publish *p)
         aside[i] = NULL;
         placed[i] = 0;
     }
+    if (ex_atomic_hold) ex_atomic_hold(1); /* an interrupt waits for the whole set */
     for (i = 0; ok && i < p->n; i++) { /* the old files aside, under fresh temporary names */
         FILE *e = fopen(p->path[i], "rb"), *f = NULL;
         if (!e) continue; /* absent (an unreadable target fails at its rename below) */
@@ -619,6 +636,7 @@ static inline int ex_publish_end(ex_publish *p)
         }
     }
     if (ex_atomic_on_temp) ex_atomic_on_temp(NULL, NULL);
+    if (ex_atomic_hold) ex_atomic_hold(0);
     p->n = 0;
     return ok;
 }

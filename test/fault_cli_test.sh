@@ -11,6 +11,7 @@
 # and leave no temporary file. For a --window piece, the mosaic of the piece beside the other
 # pieces must then either refuse or equal the mosaic of the older run: no piece is left with a
 # sidecar of another run.
+# Last, SIGINT and SIGTERM while a raster and its sidecars are published (strace holds each call).
 # The strace part prints "SKIP: strace ..." without strace (or where ptrace is not permitted).
 # usage: sh test/fault_cli_test.sh BUILD/hfvis [SCRATCHDIR]
 hfvis=$1
@@ -169,5 +170,52 @@ for c in $cases; do IFS=$oldifs
   IFS=$IFS_NL
 done
 IFS=$oldifs
+# ---- an interrupt while a raster's set of files is published ----------------------------------
+# A raster with its sidecars (.asc + .prj, .bil + .hdr + .prj) replacing an older set: strace
+# holds one call of the write path for a second (the creation of each temporary file, each
+# rename: the older files moved aside, the new ones moved in) and SIGINT or SIGTERM (in turn)
+# is sent meanwhile. Afterwards no temporary file may remain and the set must be the older one
+# or the new one, whole, never a mix; an exit 0 must have written the new one.
+if [ "$have_strace" = 1 ]; then
+  for set in "asc|o.asc o.prj" "bil|o.bil o.hdr o.prj"; do
+    ext=${set%%|*}; files=${set#*|}; before_n=$failed; n0=$runs
+    args="skyview $in/dem.asc --dirs 8 --quiet -o o.$ext"; oldargs="skyview $in/dem.asc --dirs 4 --quiet -o o.$ext"
+    g=$dir/sig_good; prepare "$g" new; (cd "$g" && "$hfvis" $args > /dev/null 2>&1) || bad "sig $ext: the good run failed"
+    prepare "$dir/t" old o.$ext "" "$oldargs"
+    (cd "$dir/t" && strace -f -o "$dir/sig.trace" -e trace=openat,rename,renameat,renameat2 "$hfvis" $args > /dev/null 2>&1)
+    # the held calls: "CALL N", N counted among the traced calls of that name
+    points=$(awk '{ call = $2; sub(/\(.*/, "", call); cnt[call]++
+        if (call ~ /^rename/ || (call == "openat" && $0 ~ /O_CREAT/)) print call, cnt[call] }' "$dir/sig.trace")
+    oldifs=$IFS; IFS=$IFS_NL; i=0
+    for pt in $points; do IFS=$oldifs
+      call=${pt% *}; k=${pt#* }; i=$((i + 1)); sig=INT; [ $((i % 2)) -eq 0 ] && sig=TERM
+      d=$dir/run; prepare "$d" old o.$ext "" "$oldargs"; before=$(state "$d"); rm -f "$dir/sig.trace" "$dir/sig.sent"
+      # the poller: once the trace shows call number k begun (strace prints it before holding
+      # it), signal the tool. The tool runs in the foreground: a background job has SIGINT ignored.
+      ( j=0; while [ $j -lt 400 ]; do
+          if [ -f "$dir/sig.trace" ] && [ "$(grep -c " $call(" "$dir/sig.trace")" -ge "$k" ]; then
+            kill -"$sig" "$(awk 'NR == 1 { print $1 }' "$dir/sig.trace")" 2> /dev/null && : > "$dir/sig.sent"; exit 0
+          fi
+          sleep 0.05; j=$((j + 1)); done ) &
+      poller=$!
+      # (an inner shell waits for strace, so that its "Terminated" line goes to /dev/null)
+      sh -c 'cd "$1" && shift && "$@"; exit $?' sh "$d" strace -f -o "$dir/sig.trace" -e trace="$call" \
+        -e inject="$call":delay_enter=1000000:when="$k" "$hfvis" $args > /dev/null 2>&1
+      rc=$?; wait "$poller"; runs=$((runs + 1))
+      label="sig $ext: SIG$sig while $call #$k is held (exit $rc)"
+      temps=$(ls -A "$d" | grep '\.tmp[0-9a-f]\{8\}$')
+      now=$(state "$d"); new=1; for f in $files; do cmp -s "$d/$f" "$g/$f" || new=0; done
+      if [ ! -f "$dir/sig.sent" ]; then bad "$label: the tool was not signalled while held"
+      elif [ -n "$temps" ]; then bad "$label: temporary files left: $(echo $temps)"
+      elif [ "$rc" -eq 0 ] && [ "$new" = 0 ]; then bad "$label: exit 0 without the new set"
+      elif [ "$now" != "$before" ] && [ "$new" = 0 ]; then bad "$label: neither the older set nor the new one: $(ls -A "$d" | tr '\n' ' ')"
+      fi
+      IFS=$IFS_NL
+    done
+    IFS=$oldifs
+    [ "$runs" -gt "$n0" ] || bad "sig $ext: no write-path call found in the trace"
+    [ "$failed" -eq "$before_n" ] && ok "sig $ext: SIGINT/SIGTERM during each of $((runs - n0)) held calls of publishing o.$ext and its sidecars: no temporary file, the older set or the new one whole"
+  done
+fi
 echo "fault: $passed passed, $failed failed ($runs faulty runs)"
 [ "$failed" -eq 0 ]

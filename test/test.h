@@ -91,6 +91,20 @@ static inline hfvis_grid test_grid(const float *z, int W, int H, double cell)
 
 /* Largest |a - b| over n values, counting the unequal ones in *unequal; -1 when a NaN of one
  * side meets a number of the other. */
+/* A seeded fBm field from the library's analytic generator (octaves 0: the library's default). */
+static inline hfvis_status test_fbm(float *z, int w, int h, double amplitude, double wavelength, int octaves,
+                                    uint64_t seed)
+{
+    hfvis_field f;
+    memset(&f, 0, sizeof f);
+    f.kind = HFVIS_FIELD_FBM;
+    f.amplitude = amplitude;
+    f.wavelength = wavelength;
+    f.octaves = octaves;
+    f.seed = seed;
+    return hfvis_field_generate(&f, w, h, w, z);
+}
+
 static inline double test_max_diff(const float *a, const float *b, size_t n, size_t *unequal)
 {
     double m = 0.0;

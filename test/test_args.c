@@ -2535,6 +2535,15 @@ static void args_direction_sums(void)
     BAD('E', INV, hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_SKY_VIEW, NULL, NULL, &o, sums));
     o = hfvis_sweep_options_default(); o.direction_order = (hfvis_direction_order)-1;
     BAD('E', INV, hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_ENV_LIGHT, &g_env, NULL, &o, sums));
+    o = hfvis_sweep_options_default(); o.part_index = 1; o.part_count = 3; /* bands: exact rays only */
+    BAD('S', INV, hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_SKY_VIEW, NULL, NULL, &o, sums));
+    o.rays = HFVIS_RAYS_EXACT;
+    OK(hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_SKY_VIEW, NULL, NULL, &o, sums));
+    OK(hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_SKY_LIGHT, NULL, NULL, &o, sums));
+    OK(hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_ENV_LIGHT, &g_env, NULL, &o, sums));
+    BAD('S', INV, hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_VISIBILITY, NULL, NULL, &o, sums));
+    o.part_index = 3;
+    BAD('S', INV, hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_SKY_VIEW, NULL, NULL, &o, sums));
     GRID_CASES(hfvis_direction_sums(&bg, 4, HFVIS_SUM_SKY_VIEW, NULL, NULL, NULL, sums));
     GRID_CASES(hfvis_direction_sums(&bg, 4, HFVIS_SUM_VISIBILITY, NULL, NULL, NULL, sums));
     SWEEP_OPT_CASES(hfvis_direction_sums(&g_ok, 4, HFVIS_SUM_SKY_LIGHT, NULL, NULL, &bo, sums));

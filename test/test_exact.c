@@ -75,17 +75,6 @@ static void check_against_oracle(const hfvis_grid *g, int K, const hfvis_sweep_o
            g->height, K, (int)o->border, sum / (double)m, p99, worst * 180.0 / PI);
 }
 
-static void fbm(float *z, int W, int H, double amp, double wl, uint64_t seed)
-{
-    hfvis_field f;
-    memset(&f, 0, sizeof f);
-    f.kind = HFVIS_FIELD_FBM;
-    f.amplitude = amp;
-    f.wavelength = wl;
-    f.seed = seed;
-    hfvis_field_generate(&f, W, H, W, z);
-}
-
 /* Sweep == oracle on seeded random fields, several K, azimuth0, bounds and all borders. */
 TEST(sweep_equals_oracle_random)
 {
@@ -98,7 +87,7 @@ TEST(sweep_equals_oracle_random)
         hfvis_grid g = test_grid(zbuf, W, H, 0.5 + (double)seed * 0.7);
         uint64_t s = seed;
         int j;
-        fbm(zbuf, W, H, 6.0, 5.0, seed);
+        (void)test_fbm(zbuf, W, H, 6.0, 5.0, 0, seed);
         for (j = 0; j < W * H; j++) zbuf[j] += (float)(2.0 * fields_uniform(&s)); /* rough */
         for (i = 0; i < 5; i++)
             for (b = 0; b < 3; b++) {
@@ -138,7 +127,7 @@ TEST(sweep_equals_oracle_hard_fields)
     o.border = HFVIS_BORDER_OPEN;
     check_against_oracle(&g, 16, &o);
     /* 1xN, Nx1, 1x1 */
-    fbm(zbuf, 23, 1, 3.0, 4.0, 5);
+    (void)test_fbm(zbuf, 23, 1, 3.0, 4.0, 0, 5);
     g = test_grid(zbuf, 23, 1, 1.0);
     check_against_oracle(&g, 8, &o);
     g = test_grid(zbuf, 1, 23, 1.0);
@@ -592,7 +581,7 @@ TEST(oracle_is_the_supremum)
         hfvis_grid g = test_grid(zbuf, W, H, f == 2 ? 0.5 : 1.0);
         if (f == 0) fields_urban(zbuf, W, H, 8, 77);
         if (f == 1) fields_terraces(zbuf, W, H, 1.0, 3.0, 80.0, 9);
-        if (f == 2) fbm(zbuf, W, H, 8.0, 6.0, 41);
+        if (f == 2) (void)test_fbm(zbuf, W, H, 8.0, 6.0, 0, 41);
         CHECK_EQ_STATUS(hfvis_horizon_exact_naive(&g, 16, &o, out_b), HFVIS_OK);
         CHECK_EQ_STATUS(hfvis_sweep_azimuths(16, &o, az, NULL), HFVIS_OK);
         for (k = 0; k < 16; k++)
@@ -698,7 +687,7 @@ TEST(accuracy_against_exact_bilinear_max)
         fields_terraces(zbuf, 96, 72, 1.0, 5.0, 80.0, seed + 1);
         g = test_grid(zbuf, 96, 72, 1.0);
         accuracy("terraces", &g, 3);
-        fbm(zbuf, 96, 72, 20.0, 24.0, seed + 2);
+        (void)test_fbm(zbuf, 96, 72, 20.0, 24.0, 0, seed + 2);
         g = test_grid(zbuf, 96, 72, 1.0);
         accuracy("fbm", &g, 3);
     }
@@ -758,7 +747,7 @@ TEST(near_far_against_oracle)
             far_against_oracle("urban", &g, Ks[i], HFVIS_BORDER_OPEN, &mean, &p99);
             fields_terraces(zbuf, 96, 72, 1.0, 5.0, 80.0, seed + 1);
             far_against_oracle("terraces", &g, Ks[i], HFVIS_BORDER_OPEN, &mean, &p99);
-            fbm(zbuf, 96, 72, 20.0, 24.0, seed + 2);
+            (void)test_fbm(zbuf, 96, 72, 20.0, 24.0, 0, seed + 2);
             far_against_oracle("fbm", &g, Ks[i], i ? HFVIS_BORDER_CLAMP : HFVIS_BORDER_WRAP, &mean, &p99);
         }
 }

@@ -237,14 +237,8 @@ static const double PI = 3.14159265358979323846;
 /* A seeded fBm field (fBm-style random terrain) into a new buffer. */
 static float *make_fbm(int w, int h, uint64_t seed, double amplitude, double wavelength)
 {
-    hfvis_field f;
     float *z = (float *)malloc(sizeof(float) * (size_t)w * (size_t)h);
-    memset(&f, 0, sizeof f);
-    f.kind = HFVIS_FIELD_FBM;
-    f.amplitude = amplitude;
-    f.wavelength = wavelength;
-    f.seed = seed;
-    if (z && hfvis_field_generate(&f, w, h, w, z) != HFVIS_OK) { free(z); z = NULL; }
+    if (z && test_fbm(z, w, h, amplitude, wavelength, 0, seed) != HFVIS_OK) { free(z); z = NULL; }
     return z;
 }
 
@@ -1675,22 +1669,9 @@ TEST(p2_hemisphere_sweep)
 
 /* ---------------------------------------------------------------- gather vs oracle (§3.3, §6) */
 
-/* Seeded fBm test field: value noise, base wavelength 16 cells (octaves 0 = 8). */
-static void p2_fbm_octaves(float *z, int w, int h, uint64_t seed, double amplitude, int octaves)
-{
-    hfvis_field f;
-    memset(&f, 0, sizeof f);
-    f.kind = HFVIS_FIELD_FBM;
-    f.amplitude = amplitude;
-    f.wavelength = 16.0;
-    f.seed = seed;
-    f.octaves = octaves;
-    (void)hfvis_field_generate(&f, w, h, w, z);
-}
-
 static void p2_fbm(float *z, int w, int h, uint64_t seed, double amplitude)
 {
-    p2_fbm_octaves(z, w, h, seed, amplitude, 0);
+    (void)test_fbm(z, w, h, amplitude, 16.0, 0, seed);
 }
 
 static int p2_cmp_double(const void *a, const void *b)
@@ -2169,7 +2150,7 @@ TEST(p2_sky_light_fused_map_oracle)
     double mean, mx, ef = 0.0, em = 0.0, efm = 0.0, emm = 0.0;
     size_t n = 0, i;
     int x, y;
-    p2_fbm_octaves(z, W, H, 3, 4.0, 4);
+    (void)test_fbm(z, W, H, 4.0, 16.0, 4, 3);
     p2_grid_init(&g, z, W, H);
     o.azimuth0_rad = 0.3;
     CHECK_EQ_STATUS(hfvis_sky_light(&g, K, 1.0f, 1.0f, &o, fused, W), HFVIS_OK);
@@ -2222,7 +2203,7 @@ TEST(p2_sky_view_factor_cases)
     double mean, mx, want;
     int i, y, bad = 0;
     /* fused vs from-map on 4-octave fBm */
-    p2_fbm_octaves(z, W, H, 3, 4.0, 4);
+    (void)test_fbm(z, W, H, 4.0, 16.0, 4, 3);
     p2_grid_init(&g, z, W, H);
     o.azimuth0_rad = 0.3;
     CHECK_EQ_STATUS(hfvis_sky_view_factor(&g, K, &o, fused, W), HFVIS_OK);
@@ -2513,7 +2494,7 @@ TEST(p2_env_consistency)
     hfvis_sweep_options o = hfvis_sweep_options_default();
     double e_prefix = 0.0, e_lp = 0.0, e_flat = 0.0, e_flat_odd = 0.0, e_axis = 0.0;
     int c, i;
-    p2_fbm_octaves(z, W, H, 9, 4.0, 4);
+    (void)test_fbm(z, W, H, 4.0, 16.0, 4, 9);
     p2_grid_init(&g, z, W, H);
     p2_env_fill(rad, NT, NP, base, 0.0);
     env.radiance = rad;
@@ -4441,9 +4422,9 @@ TEST(p2t_indirect_sky_only)
                 for (i = 0; i < P2T_W * P2T_H; i++) {
                     double u0 = (double)a[2 * i], u1 = (double)a[2 * i + 1], v = (double)b[i];
                     if (isnan(v) || isnan(u0) || isnan(u1)) {
-                        /* (indirect light keeps NaN at a receiver stranded between holes, where
-                         * the sky light takes the march: hf_fused_stranded) */
-                        if (!(isnan(u0) && isnan(u1) && (isnan(v) || isfinite(z[i])))) bad++;
+                        /* both NaN at holes only: a receiver stranded between holes takes
+                         * the march in both (hf_fused_stranded, hf_p2_stranded) */
+                        if (!(isnan(u0) && isnan(u1) && isnan(v))) bad++;
                         continue;
                     }
                     total++;
@@ -4959,13 +4940,7 @@ static hfvis_viewshed_options vs_opts(double observer_height, double target_heig
 static float *vs_fbm(int w, int h, uint64_t seed, double amplitude, double wavelength)
 {
     float *z = vs_floats((size_t)w * (size_t)h, 0.0f);
-    hfvis_field f;
-    memset(&f, 0, sizeof f);
-    f.kind = HFVIS_FIELD_FBM;
-    f.amplitude = amplitude;
-    f.wavelength = wavelength;
-    f.seed = seed;
-    if (z && hfvis_field_generate(&f, w, h, w, z) != HFVIS_OK) {
+    if (z && test_fbm(z, w, h, amplitude, wavelength, 0, seed) != HFVIS_OK) {
         free(z);
         return NULL;
     }
@@ -5692,10 +5667,11 @@ static void run_viewshed_tests(void)
 /* Receivers stranded between holes: fBm with a NoData disc with a ragged rim and four 7 x 7
  * NoData blocks, each with its centre cell finite: cells whose every lattice node touches a
  * hole. Every finite cell gets a finite value from every lattice product (horizon map, sky-view
- * factor, sky light, unlimited openness, sun visibility), and at the blocks' centres (stranded
- * for certain: no finite node within 2 cells, but where a node lies on the cell itself) the
- * lattice horizon equals the per-receiver march (hfvis_horizon_reference) and the sky-view
- * factor the one of the march's horizons. */
+ * factor, sky light, unlimited openness, sun visibility, indirect light and its oracle, the
+ * visibility count), and at the blocks' centres (stranded for certain: no finite node within 2
+ * cells, but where a node lies on the cell itself) the lattice horizon equals the per-receiver
+ * march (hfvis_horizon_reference), the sky-view factor the one of the march's horizons, indirect
+ * light from black terrain the sky light, and the visibility count its oracle's. */
 #define STRANDED_ALPHA_TOL 1e-6 /* radians: the lattice's look vectors are quarter turns of one
                                    vector, the oracle's cos/sin of each angle (last-bit apart) */
 #define STRANDED_SVF_TOL 1e-6   /* the SVF term in double from the tangent vs from float angles */
@@ -5706,6 +5682,7 @@ TEST(holes_strand_no_cell)
     hfvis_grid g;
     float *z = (float *)malloc(sizeof(float) * W * H), *map = (float *)malloc(sizeof(float) * K * W * H);
     float *o = (float *)malloc(sizeof(float) * W * H), ref[K], pt[2];
+    float *ex = (float *)malloc(sizeof(float) * 3 * W * H), *ind = (float *)malloc(sizeof(float) * 3 * W * H);
     hfvis_openness_options oo;
     int x, y, k, out_kind, stranded = 0;
     memset(&f, 0, sizeof f);
@@ -5722,16 +5699,22 @@ TEST(holes_strand_no_cell)
     g.z = z; g.width = W; g.height = H; g.stride = W; g.cell_size = 1.0;
     memset(&oo, 0, sizeof oo);
     CHECK_EQ_STATUS(hfvis_horizon_map(&g, K, NULL, map), HFVIS_OK);
-    for (out_kind = 0; out_kind < 4; out_kind++) {
-        int lost = 0;
+    for (x = 0; x < 3 * W * H; x++) ex[x] = 0.25f + (float)(x % 7) * 0.125f;
+    for (out_kind = 0; out_kind < 7; out_kind++) {
+        int lost = 0, ch = out_kind == 5 ? 3 : 1;
+        float *v = out_kind >= 4 && out_kind <= 5 ? ind : o;
         if (out_kind == 0) CHECK_EQ_STATUS(hfvis_sky_view_factor(&g, K, NULL, o, W), HFVIS_OK);
         if (out_kind == 1) CHECK_EQ_STATUS(hfvis_sky_light(&g, K, 1.0f, 1.0f, NULL, o, W), HFVIS_OK);
         if (out_kind == 2) CHECK_EQ_STATUS(hfvis_openness(&g, K, &oo, NULL, o, W), HFVIS_OK);
         if (out_kind == 3) CHECK_EQ_STATUS(hfvis_sun_visibility(&g, 2.4, 0.3, 0.0, NULL, o, W), HFVIS_OK);
+        if (out_kind == 4) CHECK_EQ_STATUS(hfvis_indirect_light(&g, K, ex, 1, 0.5f, 0.8f, NULL, NULL, ind, W), HFVIS_OK);
+        if (out_kind == 5) CHECK_EQ_STATUS(hfvis_indirect_light_naive(&g, K, ex, 3, 0.5f, 0.8f, NULL, ind, W), HFVIS_OK);
+        if (out_kind == 6) CHECK_EQ_STATUS(hfvis_visibility_count(&g, K, NULL, NULL, o, W, NULL), HFVIS_OK);
         for (y = 0; y < H; y++)
             for (x = 0; x < W; x++) {
-                int finite = isfinite(z[y * W + x]);
-                if (finite ? !isfinite(o[y * W + x]) : !isnan(o[y * W + x])) lost++;
+                int finite = isfinite(z[y * W + x]), c;
+                for (c = 0; c < ch; c++)
+                    if (finite ? !isfinite(v[(y * W + x) * ch + c]) : !isnan(v[(y * W + x) * ch + c])) lost++;
                 if (out_kind == 0)
                     for (k = 0; k < K; k++)
                         if (finite ? !isfinite(map[(size_t)k * W * H + y * W + x]) : !isnan(map[(size_t)k * W * H + y * W + x])) lost++;
@@ -5755,6 +5738,20 @@ TEST(holes_strand_no_cell)
             CHECK_NEAR(o[y * W + x], 1.0 - svf / K, STRANDED_SVF_TOL, 0.0);
         }
     CHECK(stranded == 4);
+    /* indirect light with black terrain is the uniform-sky light (hfvis.h), at the stranded
+     * centres too, where both take the march; the counts there are the naive oracle's */
+    for (x = 0; x < W * H; x++) ex[x] = 0.0f;
+    CHECK_EQ_STATUS(hfvis_indirect_light(&g, K, ex, 1, 1.0f, 0.7f, NULL, NULL, ind, W), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_sky_light(&g, K, 1.0f, 0.7f, NULL, o, W), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_visibility_count_naive(&g, K, NULL, map, W, NULL), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_visibility_count(&g, K, NULL, NULL, map + W * H, W, NULL), HFVIS_OK);
+    for (y = 24; y < 41; y += 16)
+        for (x = 50; x < 63; x += 12) {
+            CHECK_NEAR(ind[y * W + x], o[y * W + x], 0.0, P2T_SKY_REL);
+            CHECK(map[y * W + x] == map[W * H + y * W + x] && map[y * W + x] >= 1.0f);
+        }
+    free(ex);
+    free(ind);
     free(z);
     free(map);
     free(o);

@@ -84,19 +84,6 @@ static void ns_fill(float *z, int n, float v)
     for (i = 0; i < n; i++) z[i] = v;
 }
 
-/* fBm terrain of the given amplitude and wavelength (cells). */
-static void ns_fbm(float *z, int w, int h, double amplitude, double wavelength, unsigned seed)
-{
-    hfvis_field f;
-    memset(&f, 0, sizeof f);
-    f.kind = HFVIS_FIELD_FBM;
-    f.amplitude = amplitude;
-    f.wavelength = wavelength;
-    f.octaves = 5;
-    f.seed = seed;
-    (void)hfvis_field_generate(&f, w, h, w, z);
-}
-
 /* Shade with the diffuse lobe at normal N: (1/pi) Sum Ahat_l Y_lm(N) I_lm (albedo 1). */
 static double ns_diffuse(const double *N, const double *I)
 {
@@ -416,7 +403,7 @@ TEST(ns_closure)
             for (y = 0; y < H; y++)
                 for (x = 0; x < W; x++) z[y * W + x] = (float)(0.75 * fabs((double)(x - 16)));
         } else {
-            ns_fbm(z, W, H, 9.0, 12.0, 5u);
+            (void)test_fbm(z, W, H, 9.0, 12.0, 5, 5);
         }
         ns_uniform_sky(env, 1, 1.0);
         sc = ns_scene(1, env, 1.0f);
@@ -841,7 +828,7 @@ TEST(ns_subsample)
     printf("  plane: 2x2 / 4x4 sub-sampling vs 1x1, worst interior difference %.3g\n", worst);
     CHECK(worst < 1e-6);
     /* smooth fBm with one bounce of an emission pattern */
-    ns_fbm(z, W, H, 5.0, 24.0, 11u);
+    (void)test_fbm(z, W, H, 5.0, 24.0, 5, 11);
     for (x = 0; x < W * H; x++) em[x] = (float)(0.5 + 0.5 * ns_rand());
     sc = ns_scene(1, env, 0.7f);
     sc.emission = em;
@@ -881,7 +868,7 @@ TEST(ns_wrap_shift)
     hfvis_ns_gi_outputs out;
     int x, y, s, n = 0;
     double worst = 0.0;
-    ns_fbm(z, N, N, 8.0, 16.0, 21u);
+    (void)test_fbm(z, N, N, 8.0, 16.0, 5, 21);
     for (y = 0; y < N; y++)
         for (x = 0; x < N; x++) z2[y * N + x] = z[y * N + (x + SH) % N];
     ns_uniform_sky(env, 1, 1.0);
@@ -1043,7 +1030,7 @@ TEST(ns_convergence)
     ns_conv cv;
     double em[6 * 4], ek[5 * 4], eo[5 * 4], es[4 * 4], eb[4], floor1 = 0.0, floor2 = 0.0;
     int i, x, y, n = 0, r;
-    ns_fbm(z, N, N, 6.0, 20.0, 7u);
+    (void)test_fbm(z, N, N, 6.0, 20.0, 5, 7);
     /* the exact pipeline: P1 uniform-sky light (K = 256 sweeps), P2 indirect light of its exit */
     CHECK_EQ_STATUS(hfvis_sky_light(&g, K, 1.0f, 1.0f, NULL, p1, N), HFVIS_OK);
     memcpy(ex, p1, sizeof ex);
@@ -1162,7 +1149,7 @@ TEST(ns_bad_args)
     hfvis_sun L;
     size_t bytes = 77;
     int i, cs;
-    ns_fbm(z, W, H, 2.0, 4.0, 3u);
+    (void)test_fbm(z, W, H, 2.0, 4.0, 5, 3);
     ns_uniform_sky(env, 1, 1.0);
     sc = ns_scene(1, env, 0.5f);
     memset(&L, 0, sizeof L);
@@ -1302,7 +1289,7 @@ TEST(ns_alloc_failures)
     test_counting cnt;
     size_t bytes = 0;
     int k, i, total_allocs;
-    ns_fbm(z, W, H, 4.0, 8.0, 9u);
+    (void)test_fbm(z, W, H, 4.0, 8.0, 5, 9);
     z[5 * W + 6] = NAN;
     for (i = 0; i < W * H * C; i++) em[i] = (float)(0.1 * ns_rand());
     ns_uniform_sky(env, C, 0.9);
@@ -1384,7 +1371,7 @@ TEST(ns_progress)
     hfvis_ns_gi_options o;
     hfvis_ns_gi_outputs out = ns_out(2, NULL, NULL, t, NULL);
     int p[2] = {0, 0};
-    ns_fbm(z, W, H, 2.0, 5.0, 1u);
+    (void)test_fbm(z, W, H, 2.0, 5.0, 5, 1);
     ns_uniform_sky(env, 1, 1.0);
     sc = ns_scene(1, env, 0.5f);
     memset(&o, 0, sizeof o);

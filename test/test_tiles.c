@@ -19,17 +19,6 @@
 #define MAXN (96 * 80)
 static float zbuf[MAXN], out_a[16 * MAXN], out_b[16 * MAXN];
 
-static void fbm(float *z, int W, int H, double amp, double wl, uint64_t seed)
-{
-    hfvis_field f;
-    memset(&f, 0, sizeof f);
-    f.kind = HFVIS_FIELD_FBM;
-    f.amplitude = amp;
-    f.wavelength = wl;
-    f.seed = seed;
-    hfvis_field_generate(&f, W, H, W, z);
-}
-
 /* Field number f (0 fBm, 1 urban boxes, 2 terraces with 80-degree one-cell cliffs, 3 fBm with
  * holes) of W x H, seeded. */
 static void make_field(int f, float *z, int W, int H, double cell, uint64_t seed)
@@ -37,7 +26,7 @@ static void make_field(int f, float *z, int W, int H, double cell, uint64_t seed
     int i;
     if (f == 1) fields_urban(z, W, H, W * H / 180 + 2, seed);
     else if (f == 2) fields_terraces(z, W, H, cell, 4.0, 80.0, seed);
-    else fbm(z, W, H, 8.0 * cell, 9.0, seed);
+    else (void)test_fbm(z, W, H, 8.0 * cell, 9.0, 0, seed);
     if (f == 3) {
         uint64_t s = seed;
         for (i = 0; i < W * H / 40; i++) z[(int)(fields_uniform(&s) * (double)(W * H))] = (float)NAN;

@@ -6,8 +6,10 @@
  * 90 m, 40.2 N 105.6 W) and slovenia_lidar_1000_1m.pfm (lidar DTM, 1 m, 46.5 N 15.8 E); without
  * it a 512^2 fBm with 90 m cells stands in:
  *   HFVIS_BENCH_DEMS=/path/to/dems BENCH_ARGS=solar make bench
- * docs/solar.md holds the figures. */
-#define _POSIX_C_SOURCE 199309L
+ * On the Colorado tile, GRASS r.sun is timed in the same run (examples/bench/solar_grass.sh, named
+ * by HFVIS_BENCH_GRASS, which make bench sets: r.sun with its own shadowing, and r.horizon at 5 deg
+ * + r.sun), or SKIP is printed where GRASS is absent. docs/solar.md holds the figures. */
+#define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,7 +20,7 @@
 #define SOLAR_CROP 96 /* the oracle's crop: it costs O(steps * W * H * max(W, H)) */
 #define SOLAR_DEG (3.14159265358979323846 / 180.0)
 
-typedef struct solar_site { const char *file, *name; double cell, lat, lon; int days; } solar_site;
+typedef struct solar_site { const char *file, *name; double cell, lat, lon; int days, utm_zone; } solar_site;
 
 static int solar_run(const hfvis_grid *g, const hfvis_solar_input *in, const hfvis_solar_options *o,
                      int oracle, float *beam, float *global, double *seconds)
@@ -33,6 +35,51 @@ static int solar_run(const hfvis_grid *g, const hfvis_solar_input *in, const hfv
     st = oracle ? hfvis_solar_irradiation_reference(g, in, o, &out) : hfvis_solar_irradiation(g, in, o, &out);
     *seconds = bench_now() - t0;
     return st == HFVIS_OK;
+}
+
+/* GRASS's times for the DEM (solar_grass.sh through popen): the DEM as an ESRI ASCII grid placed
+ * in UTM zone `zone` north around (lat, lon) (the meridian arc and the parallel's scale: within
+ * metres, enough for r.sun's site), then the script's lines. */
+static void solar_grass(const solar_site *s, const float *z, int w, int h, int zone, double t_fast)
+{
+    const char *script = getenv("HFVIS_BENCH_GRASS"), *tmp = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
+    char dir[512], asc[600], cmd[2048], line[256];
+    double la = s->lat * SOLAR_DEG, dl = (s->lon - (-183.0 + 6.0 * zone)) * SOLAR_DEG;
+    double E = 500000.0 + 0.9996 * 6378137.0 * cos(la) * dl;
+    double N = 0.9996 * (111132.954 * s->lat - 16038.509 * sin(2.0 * la) + 16.833 * sin(4.0 * la));
+    double t_sh = -1.0, t_hor = -1.0, t_rh = -1.0, mean = 0.0;
+    FILE *f;
+    int x, y;
+    if (!script || !*script) { printf("  r.sun: SKIP (HFVIS_BENCH_GRASS unset: run through make bench)\n"); return; }
+    snprintf(dir, sizeof dir, "%s/hfvis_bench_solar.XXXXXX", tmp);
+    if (!mkdtemp(dir)) { printf("  r.sun: SKIP (cannot create a folder in %s)\n", tmp); return; }
+    snprintf(asc, sizeof asc, "%s/dem.asc", dir);
+    if (!(f = fopen(asc, "w"))) { printf("  r.sun: SKIP (cannot write %s)\n", asc); return; }
+    fprintf(f, "ncols %d\nnrows %d\nxllcorner %.3f\nyllcorner %.3f\ncellsize %g\nNODATA_value -9999\n", w, h,
+            E - 0.5 * w * s->cell, N - 0.5 * h * s->cell, s->cell);
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            float v = z[(size_t)y * (size_t)w + (size_t)x];
+            fprintf(f, x + 1 < w ? "%.3f " : "%.3f\n", isfinite(v) ? (double)v : -9999.0);
+        }
+    if (fclose(f) != 0) { printf("  r.sun: SKIP (cannot write %s)\n", asc); remove(asc); remove(dir); return; }
+    snprintf(cmd, sizeof cmd, "sh '%s' '%s' %d '%s'", script, asc, 32600 + zone, dir);
+    if ((f = popen(cmd, "r")) != NULL) {
+        while (fgets(line, sizeof line, f)) {
+            if (!strncmp(line, "SKIP", 4)) printf("  r.sun: %s", line);
+            sscanf(line, "rsun_shadow %lf", &t_sh);
+            sscanf(line, "rhorizon %lf", &t_hor);
+            sscanf(line, "rsun_horizon %lf", &t_rh);
+            sscanf(line, "rsun_mean %lf", &mean);
+        }
+        pclose(f);
+    }
+    remove(asc);
+    remove(dir);
+    if (t_sh < 0.0 || t_hor < 0.0 || t_rh < 0.0) { printf("  r.sun: no timing (GRASS absent or failed)\n"); return; }
+    printf("  GRASS r.sun, same DEM and day (nprocs=1): own shadowing %.2f s (hfvis %.1fx faster); "
+           "r.horizon 5 deg %.2f s + r.sun %.2f s = %.2f s (hfvis %.1fx); r.sun mean global %.0f Wh/m^2\n",
+           t_sh, t_sh / t_fast, t_hor, t_rh, t_hor + t_rh, (t_hor + t_rh) / t_fast, mean);
 }
 
 static void solar_dem(const solar_site *s, float *z, int w, int h, int quick)
@@ -71,6 +118,23 @@ static void solar_dem(const solar_site *s, float *z, int w, int h, int quick)
     printf("  %-34s %4d x %-4d %3d day(s): %7.2f s (horizon map K = 64: %.2f s), %.2f us/receiver, "
            "mean global %.0f Wh/m^2\n", s->name, w, h, s->days, t_fast, t_map, t_fast * 1e6 / (double)n,
            mean / (double)n);
+    { /* where the time goes: the map, then the atmosphere per receiver and sunlit step */
+        hfvis_grid one;
+        hfvis_solar_options fo = o;
+        hfvis_solar_output so;
+        float z0 = 0.0f, hours = 0.0f;
+        double steps;
+        one.z = &z0; one.width = one.height = one.stride = 1; one.cell_size = s->cell;
+        fo.no_shading = 1;
+        memset(&so, 0, sizeof so);
+        so.sun_hours = &hours;
+        hfvis_solar_irradiation(&one, &in, &fo, &so);
+        steps = ceil((double)hours / 0.25) + 1.0;
+        printf("  %-34s after the map: %.2f s = %.0f ns per receiver and sunlit step (%.0f steps); "
+               "memory %d bytes per receiver at the peak (the map and its copy: 8 K) + 120 + 32 per band\n",
+               "", t_fast - t_map, (t_fast - t_map) * 1e9 / ((double)n * steps), steps, 8 * 64);
+    }
+    if (s->utm_zone) solar_grass(s, z, w, h, s->utm_zone, t_fast);
     /* fast and oracle on the central crop */
     for (y = 0; y < SOLAR_CROP; y++)
         for (x = 0; x < SOLAR_CROP; x++)
@@ -97,8 +161,8 @@ static void solar_dem(const solar_site *s, float *z, int w, int h, int quick)
 void bench_solar(int quick)
 {
     static const solar_site sites[2] = {
-        {"colorado_srtm_512_90m.pfm", "Colorado SRTM (90 m), day 172", 90.0, 40.24, -105.53, 1},
-        {"slovenia_lidar_1000_1m.pfm", "Slovenia lidar DTM (1 m), day 172", 1.0, 46.47, 15.83, 1},
+        {"colorado_srtm_512_90m.pfm", "Colorado SRTM (90 m), day 172", 90.0, 40.24, -105.53, 1, 13},
+        {"slovenia_lidar_1000_1m.pfm", "Slovenia lidar DTM (1 m), day 172", 1.0, 46.47, 15.83, 1, 0},
     };
     const char *dir = getenv("HFVIS_BENCH_DEMS");
     int k, ran = 0;
@@ -118,7 +182,7 @@ void bench_solar(int quick)
         ran++;
     }
     if (!ran) {
-        static const solar_site fbm = {"", "fBm 512^2 (90 m cells), day 172", 90.0, 40.24, -105.53, 1};
+        static const solar_site fbm = {"", "fBm 512^2 (90 m cells), day 172", 90.0, 40.24, -105.53, 1, 0};
         hfvis_field f;
         float *z = (float *)malloc((size_t)512 * 512 * sizeof(float));
         if (!z) return;

@@ -18,6 +18,7 @@
 #ifndef HFVIS_CLI_H
 #define HFVIS_CLI_H
 #define _POSIX_C_SOURCE 200809L /* isatty() under -std=c99 */
+#define _DEFAULT_SOURCE /* glibc: madvise's MADV_HUGEPAGE beside it (threads.c, cli_huge_alloc) */
 #include <ctype.h>
 #include <errno.h>
 #include <float.h>
@@ -31,6 +32,7 @@
 #include <signal.h>
 #if defined(__unix__) || (defined(__APPLE__) && defined(__MACH__))
 #include <sys/stat.h> /* stat(): an output that is an input */
+#include <sys/mman.h> /* madvise(): large blocks on huge pages (threads.c) */
 #include <unistd.h>
 #define CLI_HAVE_ISATTY 1
 #define CLI_HAVE_SIGACTION 1
@@ -79,7 +81,7 @@ typedef struct cli_window {
     char tag[CLI_PIECE_TAG_MAX];
 } cli_window;
 /* The state of one run: the georeference of a raster IN carried to a raster OUT, the --window
- * piece, the clock, the last --progress line and the summary line's figures. main (and sum,
+ * piece, the clock, the last --progress line or the progress bar, and the summary line's figures. main (and sum,
  * mosaic) own one per run, set up by cli_run_init; commands reach it through cli_args.run, the
  * progress callbacks through cli_progress_state.run. */
 typedef struct cli_run_state {
@@ -90,6 +92,7 @@ typedef struct cli_run_state {
     int directions;   /* directions of the run (0: none), for the summary line */
     double line_last; /* when the last --progress line was printed */
     int line_pct;     /* and its percentage (-1: none yet) */
+    int bar_open;     /* the progress bar's line is on stderr without its newline (cli_progress) */
 } cli_run_state;
 
 typedef struct cli_args {
@@ -186,27 +189,29 @@ static const char *const cli_conv_names[3] = { "compass", "grass", "grid" };
                    | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_HILLSHADE))
 /* the commands whose work splits over threads bit for bit (--threads, threads.c) */
 #define CLI_THREADED (CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT) \
-                      | CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_HILLSHADE) | CLI_ONLY(CMD_OPENNESS))
+                      | CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_HILLSHADE) | CLI_ONLY(CMD_OPENNESS) \
+                      | CLI_ONLY(CMD_SOLAR))
 /* the [P2] hull-tree commands: a search radius but no windows in the library (hfvis.h, "Search
  * radius and tiles") */
 #define CLI_P2 (CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_INDIRECT))
 
 /* A command (main.c, cli_commands): its name and one-line summary for `hfvis --help`, its --help
  * text, whether it needs IN and OUT and is estimated before it runs (cli_check_cost), the check
- * of its flags' combinations (NULL: none), and how it runs: run takes the parsed arguments
+ * of its flags' combinations (NULL: none), its memory and work estimate (run.c; set exactly for
+ * the commands that take --max-memory), and how it runs: run takes the parsed arguments
  * (cli_parse); main, for the commands with lists of inputs (sum, mosaic, info), takes the
- * command line. Exactly one of run and main is set. */
+ * command line. Exactly one of run and main is set; main.c checks the table before running. */
+typedef struct cli_cost cli_cost;
 enum { CLI_IN_NEEDED = 1, CLI_OUT_NEEDED = 2, CLI_COST_FIRST = 4 };
 typedef struct cli_command {
     const char *name, *summary, *help;
     int io; /* CLI_IN_NEEDED, CLI_OUT_NEEDED; CLI_COST_FIRST: estimated from the flags, before run */
     int (*check)(const cli_args *a);
+    cli_cost (*estimate)(const cli_args *a, int w, int h, int channels);
     int (*run)(const cli_args *a);
     int (*main)(int argc, char **argv);
 } cli_command;
 static const cli_command cli_commands[CMD_COUNT]; /* defined in main.c */
-
-static int cli_bar_open; /* a progress line is on stderr without its newline yet */
 
 /* One progress bar over several library calls: each call reports its own done/total, the bar
  * shows base + done out of the run's total (its units are directions; 0 = each call's total). */
@@ -244,12 +249,13 @@ typedef struct cli_labels {
 } cli_labels;
 static void cli_labels_free(cli_labels *L);
 static int cli_horizon_labels(const cli_args *a, cli_labels *L);
+static int cli_horizon_labels_of_tag(const char *tag, int planes, cli_labels *L);
 
 /* What a run is expected to cost before it allocates: bytes at its peak and units of work. */
-typedef struct cli_cost {
+struct cli_cost {
     double bytes, work;
     const char *unit;
-} cli_cost;
+};
 
 /* The library's savers, through cli_write: encode into memory (need bytes), then write. */
 typedef hfvis_status (*cli_encoder)(const void *what, void *out, size_t cap, size_t *written);
@@ -266,6 +272,14 @@ typedef struct cli_voxels {
 } cli_voxels;
 
 #define CLI_TAG_MAX 1024 /* our tags: the command, fingerprints and a dozen parameters */
+
+/* A part's georeference being encoded into b[0..cap) (split.c, cli_geo_encode): n counts every
+ * byte, and over is set when they do not fit. */
+typedef struct cli_geo_bytes {
+    unsigned char *b;
+    size_t n, cap;
+    int over;
+} cli_geo_bytes;
 
 /* One part's header and a copy of its tag (pass 1 of `sum` keeps these, not the sums). */
 typedef struct cli_part {
@@ -294,6 +308,7 @@ static int cli_status(const char *what, hfvis_status s, int saved_errno);
 static void cli_progress_advance(cli_progress_state *p, int done, int total, long long *now,
                                  long long *all);
 static void cli_progress(void *user, int done, int total);
+static void cli_progress_end(cli_run_state *run, int rc);
 static double cli_default_max_memory(void);
 static int cli_stderr_is_terminal(void);
 static double cli_now(void);
@@ -305,7 +320,13 @@ static int cli_real(const char *flag, const char *s, double lo, int lo_open, dou
 static int cli_int(const char *flag, const char *s, long lo, long hi, const char *expect, int *out);
 static int cli_ends_with(const char *s, const char *ext);
 static int cli_command_of(const char *name);
-static size_t cli_flag_of(const char *name);
+static size_t cli_flag_for(const char *name, int cmd);
+static void cli_flag_defaults(cli_args *a);
+static int cli_then_zscale(cli_args *a, const char *v);
+static int cli_then_positions(cli_args *a, const char *v);
+static int cli_then_reflectance(cli_args *a, const char *v);
+static void cli_flag_number(double x, char *out, size_t cap);
+static void cli_help_values(int cmd);
 static int cli_refuse_flag(int cmd, const char *arg);
 static int cli_help(int cmd);
 static int cli_list_commands(int argc);
@@ -354,7 +375,21 @@ static int cli_same_file(const char *x, const char *y);
 static int cli_refuse_input(int overwrite, const char *out, const char *const *inputs, int n);
 static int cli_refuse_inputs(const cli_args *a, const char *out);
 /* run.c */
-static cli_cost cli_estimate(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_cost_of(double bytes, double work, const char *unit);
+static cli_cost cli_sweep_cost(const cli_args *a, int w, int h, double out, double ch, double cell_bytes,
+                               double node_bytes);
+static cli_cost cli_estimate_sweep(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_horizon(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_gi(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_visibility(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_indirect(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_solar(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_viewshed(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_ssao(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_voxelize(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_volgi(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_visfield(const cli_args *a, int w, int h, int channels);
+static cli_cost cli_estimate_meshao(const cli_args *a, int w, int h, int channels);
 static int cli_out_channels(const cli_args *a);
 static int cli_check_cost(const cli_args *a, int w, int h, int channels);
 static int cli_halo(const cli_args *a, double cell);
@@ -363,7 +398,6 @@ static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double
 static float *cli_alloc(size_t a, size_t b, size_t c);
 static int cli_run_heights(const cli_args *a);
 /* sweeps.c */
-static int cli_set_gi(cli_args *a, const char *f, const char *v);
 static int cli_check_light_flags(const cli_args *a);
 static int cli_check_gi(const cli_args *a);
 static int cli_load_env(const char *path, float **px, hfvis_env *env);
@@ -419,16 +453,22 @@ static int cli_run_visfield(const cli_args *a);
 static int cli_run_volgi(const cli_args *a);
 /* split.c */
 static unsigned long long cli_fingerprint(const float *v, size_t n);
-static void cli_partial_tag(const cli_args *a, const hfvis_grid *grid, const hfvis_sweep_options *o,
-                            const hfvis_env *env, char *tag);
+static int cli_partial_tag(const cli_args *a, const hfvis_grid *grid, const hfvis_sweep_options *o,
+                           const hfvis_env *env, char *tag);
 static int cli_run_partial(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
                            cli_progress_state *prog, const hfvis_env *env);
 static int cli_tag_value(const char *tag, const char *key, char *out, size_t cap);
 static void cli_tag_first_difference(const char *a, const char *b, char *out, size_t cap);
 static int cli_tag_real(const char *tag, const char *key, double *v);
+static void cli_geo_encode(const ex_georef *g, cli_geo_bytes *o);
+static int cli_geo_decode(const char *text, ex_georef *g);
+static const char *cli_tag_geo(const char *tag);
+static int cli_geo_decode_token(const char *v, ex_georef *g);
+static const char *cli_geo_difference(const char *a, const char *b);
 static int cli_sum_load(const char *path, hfvis_partial *p, cli_part *m);
 static int cli_sum_check(const char *path, int cmd, const hfvis_partial *p);
 static int cli_sum(int argc, char **argv);
+static int cli_sum_parts(int argc, char **argv, const char **names, cli_part *meta, int *order);
 /* tiles.c */
 static int cli_file_id(const char *path, char *out, size_t cap);
 static int cli_window_plan(const cli_args *a, ex_rio_reader *r, const char *path, double cell);
@@ -440,6 +480,7 @@ static const char *cli_piece_problem(const char *key);
 static int cli_piece_read(const char *path, const cli_piece *m, int W, int H, float *out,
                           const ex_georef *whole, const ex_georef *ref, ex_georef *keep);
 static int cli_mosaic(int argc, char **argv);
+static int cli_mosaic_pieces(int argc, char **argv, const char **names);
 /* solar.c */
 static int cli_solar_date(const char *f, const char *v, int *y, int *m, int *d);
 static long cli_solar_day_number(int y, int m, int d);

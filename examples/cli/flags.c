@@ -61,38 +61,49 @@ enum {
     CLI_V_CHOICE, /* one of a few words */
     CLI_V_LIST,   /* numbers joined by ',', ':' or 'x' (pairs, points, windows, sizes) */
     CLI_V_DATE,   /* a date or a time of day */
-    CLI_V_BYTES   /* a size in bytes with an optional K, M, G or T */
+    CLI_V_BYTES,  /* a size in bytes with an optional K, M, G or T */
+    CLI_V_DURATION /* hours: a number with m (minutes, also without a suffix) or h */
 };
 static const char *const cli_kind_names[] = {"-", "int", "real", "text", "choice", "list", "date",
-                                             "bytes"};
+                                             "bytes", "duration"};
 
 /* The flags: name, value (its placeholder in the help; NULL: the flag takes none), the commands
  * that use it, its value's type, range, default and unit, and for the shared options their --help
  * entry (the others are described in their commands' help). A command refuses by name every flag
- * whose row does not list it; `hfvis --list-flags [CMD]` prints this table, test/cli_test.sh walks
- * it. A numeric row with a field ("at") is parsed from the row alone by cli_set_number: the value
- * must lie in [lo, hi] (lo excluded when lo_open), else the refusal names the flag and says
- * "expected <rule>"; the others (at 0) are parsed by hand-written setters, because their syntax is
- * special or the field they set depends on the command. */
+ * whose row does not list it; `hfvis --list-flags [CMD]` prints this table, `hfvis CMD --help`
+ * its rows for CMD, test/cli_test.sh walks it. A flag whose meaning depends on the command
+ * (--rays, --fov, --radius) has one row per meaning, with disjoint commands (cli_flag_for).
+ * A numeric row (int, real, duration) has a field ("at"): cli_parse stores its default dv there
+ * before reading the command line, and cli_set_number parses it from the row alone: the value must
+ * lie in [lo, hi] (lo excluded when lo_open), else the refusal names the flag and says "expected
+ * <rule>"; its "then" hook, if any, checks or converts the stored value afterwards. The other
+ * rows (at 0) are parsed by their commands' setters: their syntax is not a number. */
 typedef struct cli_flag {
     const char *name, *value;
     unsigned long commands; /* CLI_ONLY(CMD_...) bits */
     int kind;               /* CLI_V_... */
-    double lo, hi;          /* CLI_V_INT, CLI_V_REAL rows with a field: the accepted range */
+    double lo, hi;          /* CLI_V_INT, CLI_V_REAL, CLI_V_DURATION rows: the accepted range */
     int lo_open;            /* lo itself refused */
     const char *rule;       /* the range in words, for the refusal: "expected <rule>, got '<v>'" */
-    const char *def, *unit; /* the default and the unit, in words (NULL: none) */
+    double dv;              /* what the field holds without the flag */
+    const char *def, *unit; /* the default in words where dv is a "not given" mark or reads
+                               better so (NULL: dv itself), and the unit (NULL: none) */
     size_t at, has;         /* offsetof the cli_args field it sets (int or double by kind; 0: a
-                               hand-written setter), and of its has_ field (0: none) */
+                               command's setter), and of its has_ field (0: none) */
+    const char *word;       /* a word taken instead of a number (the field keeps dv; then sees it) */
+    int (*then)(cli_args *a, const char *v); /* after the value is stored: 0 or CLI_EXIT_USAGE */
     const char *help;
 } cli_flag;
 #define CLI_HAS(field) offsetof(cli_args, field)
-#define CLI_SWITCH CLI_V_NONE, 0.0, 0.0, 0, NULL, "off", NULL, 0, 0
-#define CLI_TYPED(kind) kind, 0.0, 0.0, 0, NULL, NULL, NULL, 0, 0
-#define CLI_INT_AT(lo, hi, rule, def, unit, field, has) \
-    CLI_V_INT, lo, hi, 0, rule, def, unit, offsetof(cli_args, field), has
-#define CLI_REAL_AT(lo, lo_open, hi, rule, def, unit, field, has) \
-    CLI_V_REAL, lo, hi, lo_open, rule, def, unit, offsetof(cli_args, field), has
+#define CLI_SWITCH CLI_V_NONE, 0.0, 0.0, 0, NULL, 0.0, "off", NULL, 0, 0, NULL, NULL
+#define CLI_TYPED(kind) kind, 0.0, 0.0, 0, NULL, 0.0, NULL, NULL, 0, 0, NULL, NULL
+#define CLI_WORDS(kind, def) kind, 0.0, 0.0, 0, NULL, 0.0, def, NULL, 0, 0, NULL, NULL /* its default */
+#define CLI_NUMBER(kind, lo, lo_open, hi, rule, dv, def, unit, field, has, word, then) \
+    kind, lo, hi, lo_open, rule, dv, def, unit, offsetof(cli_args, field), has, word, then
+#define CLI_INT_AT(lo, hi, rule, dv, def, unit, field, has) \
+    CLI_NUMBER(CLI_V_INT, lo, 0, hi, rule, dv, def, unit, field, has, NULL, NULL)
+#define CLI_REAL_AT(lo, lo_open, hi, rule, dv, def, unit, field, has) \
+    CLI_NUMBER(CLI_V_REAL, lo, lo_open, hi, rule, dv, def, unit, field, has, NULL, NULL)
 static const cli_flag cli_flags[] = {
     { "-o", "OUT", CLI_OUT,
       CLI_TYPED(CLI_V_TEXT),
@@ -105,36 +116,39 @@ static const cli_flag cli_flags[] = {
       "                    *.bil/*.flt raw floats + .hdr: these carry IN's georeference and NoData\n"
       "                    (planes and channels become bands)\n" },
     { "--band", "N", CLI_HF,
-      CLI_INT_AT(1, EX_RIO_MAX_BANDS, "a band number 1..65535", "1", NULL, band, 0),
+      CLI_INT_AT(1, EX_RIO_MAX_BANDS, "a band number 1..65535", 0.0, "1", NULL, band, 0),
       "IN is a multi-band raster: use band N (1-based, default 1)\n" },
     { "--range", "LO:HI", CLI_PGM,
-      CLI_TYPED(CLI_V_LIST),
+      CLI_WORDS(CLI_V_LIST, "per command"),
       ".pgm only: the values mapped to 0 and 65535 (default per command)\n" },
     { "--cell", "S", CLI_HF,
-      CLI_REAL_AT(0.0, 1, DBL_MAX, "a number > 0",
-                 "georef or 1", "height units", cell, CLI_HAS(has_cell)),
+      CLI_REAL_AT(0.0, 1, DBL_MAX, "a number > 0", 1.0, "georef or 1", "height units", cell,
+                  CLI_HAS(has_cell)),
       "distance between samples, in height units (default: the cell size of a\n"
       "                    georeferenced IN (.tif, .asc, .bil/.flt), else 1 with a note)\n" },
     { "--zscale", "Z", CLI_HF,
-      CLI_REAL_AT(-CLI_FLT_MAX, 0, CLI_FLT_MAX, "a non-zero number", "1", NULL, zscale, 0),
+      CLI_NUMBER(CLI_V_REAL, -CLI_FLT_MAX, 0, CLI_FLT_MAX, "a non-zero number", 1.0, NULL, NULL,
+                 zscale, 0, NULL, cli_then_zscale),
       "multiply input values by Z, non-zero (default 1)\n" },
     { "--nodata", "V", CLI_HF,
-      CLI_REAL_AT(-CLI_FLT_MAX, 0, CLI_FLT_MAX, "a finite number",
-                 "none", "height units", nodata, CLI_HAS(has_nodata)),
+      CLI_REAL_AT(-CLI_FLT_MAX, 0, CLI_FLT_MAX, "a finite number", 0.0, "none", "height units",
+                  nodata, CLI_HAS(has_nodata)),
       "input values equal to V are holes: no occlusion, output NaN (PGM code 0)\n" },
     { "--dirs", "K", CLI_DIRS | CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_SOLAR),
-      CLI_INT_AT(1, CLI_MAX_DIRS, "an integer 1..65536",
-                 "16", "directions", dirs, CLI_HAS(has_dirs)),
+      CLI_INT_AT(1, CLI_MAX_DIRS, "an integer 1..65536", 16.0, "16 (openness 8)", "directions",
+                 dirs, CLI_HAS(has_dirs)),
       "number of azimuth directions, 1..65536 (default 16)\n" },
     { "--convention", "C", CLI_ANGLES,
-      CLI_TYPED(CLI_V_CHOICE),
+      CLI_WORDS(CLI_V_CHOICE, "compass"),
       "how azimuths are read and directions ordered (height-field commands):\n"
       "                    compass (default): bearings clockwise from north, direction k at\n"
       "                    azimuth0 + 360k/K; grass: counter-clockwise from east (r.horizon,\n"
       "                    r.sun), direction k at azimuth0 + 360k/K counter-clockwise; grid: the\n"
       "                    library's psi, from east toward south (x toward y; the old --math)\n" },
     { "--azimuth0", "A", CLI_DIRS,
-      CLI_TYPED(CLI_V_REAL),
+      CLI_REAL_AT(-1e6, 0, 1e6, "a finite angle (degrees, or radians with --radians)", 0.0,
+                  "compass 0 = north; grass, grid 0 = east", "degrees (radians with --radians)",
+                  azimuth0, CLI_HAS(has_azimuth0)),
       "azimuth of direction 0 in the convention (default: compass 0 = north;\n"
       "                    grass and grid 0 = east). Degrees (before 0.2: radians); see --radians\n" },
     { "--radians", NULL, CLI_ANGLES,
@@ -157,12 +171,12 @@ static const cli_flag cli_flags[] = {
       "                    is then a partial result, and 'hfvis sum' adds the parts of a split\n"
       "                    into the single run's OUT\n" },
     { "--border", "MODE", CLI_BORDER | CLI_ONLY(CMD_SOLAR),
-      CLI_TYPED(CLI_V_CHOICE),
+      CLI_WORDS(CLI_V_CHOICE, "open"),
       "open (nothing outside the grid, default), clamp (edge heights extend\n"
       "                    outward) or wrap (periodic field)\n" },
     { "--border-cells", "N", CLI_BORDER | CLI_ONLY(CMD_SOLAR),
-      CLI_INT_AT(1, HFVIS_IMAGE_MAX_DIM, "an integer 1..1048576",
-                 "max(W,H)", "cells", border_cells, 0),
+      CLI_INT_AT(1, HFVIS_IMAGE_MAX_DIM, "an integer 1..1048576", 0.0, "max(W,H)", "cells",
+                 border_cells, 0),
       "clamp/wrap: lines start N cells outside the grid, 1..1048576\n"
       "                    (default max(width, height))\n" },
     { "--exact", NULL, CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY)
@@ -176,8 +190,8 @@ static const cli_flag cli_flags[] = {
       "                    indirect and gi keep the lattice\n" },
     { "--max-distance", "R", CLI_ONLY(CMD_VIEWSHED) | CLI_ONLY(CMD_VISFIELD) | CLI_SWEEP | CLI_P2
                            | CLI_ONLY(CMD_SOLAR),
-      CLI_REAL_AT(0.0, 0, DBL_MAX, "a distance >= 0",
-                 "0 (unlimited)", "height units", max_distance, 0),
+      CLI_REAL_AT(0.0, 0, DBL_MAX, "a distance >= 0", 0.0, "0 (unlimited)", "height units",
+                  max_distance, 0),
       "horizon, skyview, sky, shadow, light, visibility, indirect, hillshade:\n"
       "                    the search radius in height units (--cell applies): occluders farther\n"
       "                    than R along the ray are ignored (GRASS maxdistance, SAGA and RVT radius,\n"
@@ -206,55 +220,56 @@ static const cli_flag cli_flags[] = {
       "allow OUT to be one of the inputs (refused otherwise: same file,\n"
       "                    through hard and symbolic links too)\n" },
     { "--max-memory", "B", CLI_RUNS,
-      CLI_TYPED(CLI_V_BYTES),
+      CLI_WORDS(CLI_V_BYTES, "half the physical memory"),
       "refuse a run whose estimated memory exceeds B bytes (suffix K, M, G or\n"
       "                    T: powers of 1024; 0 = no limit); default half of the physical memory\n"
       "                    where the system reports it (sysconf), else no limit. The estimate and\n"
       "                    the work (lattice nodes swept, rays, voxel updates) are printed on\n"
       "                    stderr with the progress bar\n" },
     { "--threads", "N", CLI_THREADED,
-      CLI_INT_AT(0, CLI_THREADS_MAX, "an integer 0..256 (0: the online cores)",
-                 "1", "threads", threads, CLI_HAS(has_threads)),
-      "horizon, skyview, sky, light, shadow, hillshade, openness --radius: run\n"
-      "                    on N threads, 0..256 (0: the online cores; default 1); the output is\n"
-      "                    the one-thread run's bit for bit (directions, bands across the sun,\n"
-      "                    rows). Each thread holds its own lattice: where first-touch page faults\n"
-      "                    are slow (VMs), more threads can be slower (docs/performance.md)\n" },
+      CLI_INT_AT(0, CLI_THREADS_MAX, "an integer 0..256 (0: the online cores)", 1.0, NULL,
+                 "threads", threads, CLI_HAS(has_threads)),
+      "horizon, skyview, sky, light, shadow, hillshade, openness --radius, solar:\n"
+      "                    run on N threads, 0..256 (0: the online cores; default 1); the output\n"
+      "                    is the one-thread run's bit for bit (directions, bands across the sun,\n"
+      "                    rows; solar: its exact horizon map by directions). Each thread adds its\n"
+      "                    own lattice (--exact: a tangent plane) to the peak memory\n"
+      "                    (docs/performance.md, Threads)\n" },
     { "--sky", "C", CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI),
-      CLI_REAL_AT(0.0, 0, CLI_FLT_MAX, "a radiance >= 0",
-                 "1", "radiance", sky, CLI_HAS(has_sky)), NULL },
+      CLI_REAL_AT(0.0, 0, CLI_FLT_MAX, "a radiance >= 0", 1.0, NULL, "radiance", sky,
+                  CLI_HAS(has_sky)), NULL },
     { "--albedo", "A", CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT)
                      | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_SOLAR),
-      CLI_REAL_AT(0.0, 0, CLI_FLT_MAX, "an albedo >= 0",
-                 "per command", NULL, albedo, CLI_HAS(has_albedo)), NULL },
+      CLI_REAL_AT(0.0, 0, CLI_FLT_MAX, "an albedo >= 0", 1.0, "per command", NULL, albedo,
+                  CLI_HAS(has_albedo)), NULL },
     { "--sun-azimuth", "DEG", CLI_SUN,
-      CLI_REAL_AT(-DBL_MAX, 0, DBL_MAX, "a finite angle in degrees",
-                 "per command", "degrees", sun_azimuth, CLI_HAS(has_sun_azimuth)), NULL },
+      CLI_REAL_AT(-DBL_MAX, 0, DBL_MAX, "a finite angle in degrees", 0.0, "per command", "degrees",
+                  sun_azimuth, CLI_HAS(has_sun_azimuth)), NULL },
     { "--sun-elevation", "DEG", CLI_SUN,
-      CLI_REAL_AT(-90.0, 0, 90.0, "degrees in -90..90",
-                 "per command", "degrees", sun_elevation, CLI_HAS(has_sun_elevation)), NULL },
+      CLI_REAL_AT(-90.0, 0, 90.0, "degrees in -90..90", 0.0, "per command", "degrees",
+                  sun_elevation, CLI_HAS(has_sun_elevation)), NULL },
     { "--sun-radius", "DEG", CLI_SUN | CLI_ONLY(CMD_SOLAR),
-      CLI_REAL_AT(0.0, 0, 90.0, "degrees in 0..90",
-                 "0", "degrees", sun_radius, CLI_HAS(has_sun_radius)), NULL },
+      CLI_REAL_AT(0.0, 0, 90.0, "degrees in 0..90", 0.0, NULL, "degrees", sun_radius,
+                  CLI_HAS(has_sun_radius)), NULL },
     { "--math", NULL, CLI_SUN,
       CLI_SWITCH, NULL },
     { "--env", "ENV", CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI),
       CLI_TYPED(CLI_V_TEXT), NULL },
     { "--method", "M", CLI_ONLY(CMD_LIGHT) | CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_SSAO)
                      | CLI_ONLY(CMD_MESHAO),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "per command"), NULL },
     { "--sun-irradiance", "E", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI),
-      CLI_REAL_AT(0.0, 0, CLI_FLT_MAX, "an irradiance >= 0",
-                 "pi", "irradiance", sun_irradiance, CLI_HAS(has_sun_irradiance)), NULL },
+      CLI_REAL_AT(0.0, 0, CLI_FLT_MAX, "an irradiance >= 0", CLI_PI, "pi", "irradiance",
+                  sun_irradiance, CLI_HAS(has_sun_irradiance)), NULL },
     { "--albedo-map", "MAP", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_SOLAR),
       CLI_TYPED(CLI_V_TEXT), NULL },
     { "--emission", "MAP", CLI_ONLY(CMD_INDIRECT),
       CLI_TYPED(CLI_V_TEXT), NULL },
     { "--bounces", "B", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI),
-      CLI_INT_AT(0, CLI_MAX_BOUNCES, "an integer 0..1000",
-                 "1", "bounces", bounces, CLI_HAS(has_bounces)), NULL },
+      CLI_INT_AT(0, CLI_MAX_BOUNCES, "an integer 0..1000", 1.0, NULL, "bounces", bounces,
+                 CLI_HAS(has_bounces)), NULL },
     { "--output", "WHAT", CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VOLGI),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "total"), NULL },
     { "--fraction", NULL, CLI_ONLY(CMD_VISIBILITY),
       CLI_SWITCH, NULL },
     { "--stats", NULL, CLI_ONLY(CMD_VISIBILITY) | CLI_ONLY(CMD_MESHAO),
@@ -262,35 +277,41 @@ static const cli_flag cli_flags[] = {
     { "--observer", "X,Y", CLI_ONLY(CMD_VIEWSHED),
       CLI_TYPED(CLI_V_LIST), NULL },
     { "--observer-height", "H", CLI_ONLY(CMD_VIEWSHED),
-      CLI_REAL_AT(0.0, 0, DBL_MAX, "a height >= 0",
-                 "0", "height units", observer_height, 0), NULL },
+      CLI_REAL_AT(0.0, 0, DBL_MAX, "a height >= 0", 0.0, NULL, "height units", observer_height, 0),
+                  NULL },
     { "--target-height", "H", CLI_ONLY(CMD_VIEWSHED),
-      CLI_REAL_AT(0.0, 0, DBL_MAX, "a height >= 0", "0", "height units", target_height, 0), NULL },
+      CLI_REAL_AT(0.0, 0, DBL_MAX, "a height >= 0", 0.0, NULL, "height units", target_height, 0),
+                  NULL },
     { "--res", "N", CLI_ONLY(CMD_VOXELIZE) | CLI_ONLY(CMD_VOLGI),
-      CLI_INT_AT(1, CLI_MAX_RES, "an integer 1..2048", "per command", "voxels", res, 0), NULL },
+      CLI_INT_AT(1, CLI_MAX_RES, "an integer 1..2048", 0.0, "per command", "voxels", res, 0),
+                 NULL },
     { "--mode", "M", CLI_ONLY(CMD_VOXELIZE),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "surface"), NULL },
     { "--axis", "A", CLI_ONLY(CMD_VOXELIZE),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "dominant (solid: z)"), NULL },
     { "--max-vertices", "N", CLI_ONLY(CMD_VOXELIZE),
-      CLI_INT_AT(1, 1000000, "an integer 1..1000000",
-                 "per method", "vertices", max_vertices, 0), NULL },
+      CLI_INT_AT(1, 1000000, "an integer 1..1000000", 0.0, "per method", "vertices", max_vertices,
+                 0), NULL },
     { "--padding", "P", CLI_ONLY(CMD_VOXELIZE),
-      CLI_REAL_AT(0.0, 0, 1.0, "a fraction in 0..1", "0", NULL, padding, 0), NULL },
+      CLI_REAL_AT(0.0, 0, 1.0, "a fraction in 0..1", 0.0, NULL, NULL, padding, 0), NULL },
     { "--open", NULL, CLI_ONLY(CMD_VOXELIZE),
       CLI_SWITCH, NULL },
     { "--order", "O", CLI_ONLY(CMD_GI),
-      CLI_TYPED(CLI_V_INT), NULL },
+      CLI_INT_AT(1, 4, "an integer 1..4", 4.0, NULL, "SH order", order, 0), NULL },
     { "--subsample", "S", CLI_ONLY(CMD_GI),
-      CLI_TYPED(CLI_V_INT), NULL },
+      CLI_INT_AT(1, HFVIS_NS_MAX_SUBSAMPLE, "an integer 1..64", 1.0, NULL, "cells per side",
+                 subsample, 0), NULL },
     { "--specular", "S", CLI_ONLY(CMD_GI),
-      CLI_TYPED(CLI_V_REAL), NULL },
+      CLI_REAL_AT(0.0, 0, CLI_FLT_MAX, "a weight >= 0", 0.0, NULL, NULL, specular,
+                  CLI_HAS(has_specular)), NULL },
     { "--shininess", "N", CLI_ONLY(CMD_GI),
-      CLI_TYPED(CLI_V_REAL), NULL },
+      CLI_REAL_AT(0.0, 1, CLI_FLT_MAX, "an exponent > 0", 32.0, NULL, NULL, shininess,
+                  CLI_HAS(has_shininess)), NULL },
     { "--room", NULL, CLI_ONLY(CMD_VOLGI),
       CLI_SWITCH, NULL },
     { "--iterations", "I", CLI_ONLY(CMD_VOLGI),
-      CLI_INT_AT(1, HFVIS_VOLGI_MAX_ITERATIONS, "an integer 1..1048576", "64", "steps",
+      CLI_INT_AT(1, HFVIS_VOLGI_MAX_ITERATIONS, "an integer 1..1048576",
+                 HFVIS_VOLGI_DEFAULT_ITERATIONS, NULL, "steps",
                  iterations, 0), NULL },
     { "--light", "SPEC", CLI_ONLY(CMD_VOLGI),
       CLI_TYPED(CLI_V_TEXT), NULL },
@@ -301,67 +322,93 @@ static const cli_flag cli_flags[] = {
       CLI_TYPED(CLI_V_LIST), NULL },
     { "--up", "X,Y,Z", CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO),
       CLI_TYPED(CLI_V_LIST), NULL },
-    { "--fov", "DEG", CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_MESHAO),
-      CLI_TYPED(CLI_V_REAL), NULL },
+    { "--fov", "DEG", CLI_ONLY(CMD_VOLGI),
+      CLI_REAL_AT(1.0, 0, 179.0, "degrees in 1..179", 40.0, NULL, "degrees", vg_fov, 0), NULL },
+    { "--fov", "DEG", CLI_ONLY(CMD_MESHAO),
+      CLI_REAL_AT(1.0, 0, 179.0, "degrees in 1..179", 45.0, NULL, "degrees", lk_fov, 0), NULL },
     { "--size", "WxH", CLI_ONLY(CMD_VOLGI) | CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_MESHAO),
-      CLI_TYPED(CLI_V_LIST), NULL },
+      CLI_WORDS(CLI_V_LIST, "per command"), NULL },
     { "--transfer", "T", CLI_ONLY(CMD_VOLGI),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "cone"), NULL },
     { "--paths", "P", CLI_ONLY(CMD_VOLGI),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "all"), NULL },
     { "--reflection", "R", CLI_ONLY(CMD_VOLGI),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "mirror"), NULL },
     { "--reflectance", "R", CLI_ONLY(CMD_VOLGI),
-      CLI_TYPED(CLI_V_REAL), NULL },
+      CLI_NUMBER(CLI_V_REAL, 0.0, 0, 1.0, "a reflectance in 0..1 or 'albedo'", 0.0,
+                 "0.5", NULL, vg_rho, CLI_HAS(vg_has_rho), "albedo",
+                 cli_then_reflectance), NULL },
     { "--positions", "K", CLI_ONLY(CMD_VISFIELD),
-      CLI_TYPED(CLI_V_INT), NULL },
+      CLI_NUMBER(CLI_V_INT, 1, 0, INT_MAX, "a count 2(2n^2+2n+1) such as 290, 1090 or 4226",
+                 0.0, "4226", "positions", vf_positions, 0, NULL, cli_then_positions), NULL },
     { "--format", "F", CLI_ONLY(CMD_VISFIELD),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "u8"), NULL },
     { "--mapping", "M", CLI_ONLY(CMD_VISFIELD),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "concentric"), NULL },
     { "--ao", NULL, CLI_ONLY(CMD_VISFIELD),
       CLI_SWITCH, NULL },
     { "--ground", "Z", CLI_ONLY(CMD_VISFIELD),
-      CLI_REAL_AT(-CLI_FLT_MAX, 0, CLI_FLT_MAX, "a finite height", "per field", "object units",
+      CLI_REAL_AT(-CLI_FLT_MAX, 0, CLI_FLT_MAX, "a finite height", 0.0, "per field", "object units",
                  vf_ground, CLI_HAS(vf_has_ground)), NULL },
     { "--extent", "E", CLI_ONLY(CMD_VISFIELD),
-      CLI_REAL_AT(0.0, 1, CLI_FLT_MAX, "a half-size > 0", "1.5 radii", "object units", vf_extent,
-                 CLI_HAS(vf_has_extent)), NULL },
-    { "--rays", "N", CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_MESHAO),
-      CLI_TYPED(CLI_V_INT), NULL },
+      CLI_REAL_AT(0.0, 1, CLI_FLT_MAX, "a half-size > 0", 0.0, "1.5 radii", "object units",
+                  vf_extent, CLI_HAS(vf_has_extent)), NULL },
+    { "--rays", "S", CLI_ONLY(CMD_VISFIELD),
+      CLI_INT_AT(1, HFVIS_VISFIELD_MAX_RAYS_SQRT, "an integer 1..256", 0.0, "16", "rays per side",
+                 vf_rays, 0), NULL },
+    { "--rays", "N", CLI_ONLY(CMD_MESHAO),
+      CLI_INT_AT(1, HFVIS_LK_MAX_RAYS, "an integer 1..4096", 128.0, NULL, "rays", lk_rays, 0),
+                 NULL },
     { "--bias", "B", CLI_ONLY(CMD_VISFIELD),
-      CLI_REAL_AT(0.0, 0, 1.0, "a fraction of the radius in 0..1", "0.02", "radii", vf_bias,
+      CLI_REAL_AT(0.0, 0, 1.0, "a fraction of the radius in 0..1", 0.0, "0.02", "radii", vf_bias,
                  CLI_HAS(vf_has_bias)), NULL },
     { "--reference", "MESH", CLI_ONLY(CMD_VISFIELD),
       CLI_TYPED(CLI_V_TEXT), NULL },
     { "--falloff", "F", CLI_ONLY(CMD_MESHAO),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "constant"), NULL },
     { "--two-sided", NULL, CLI_ONLY(CMD_MESHAO),
       CLI_SWITCH, NULL },
     { "--lut", "T", CLI_ONLY(CMD_MESHAO),
-      CLI_TYPED(CLI_V_INT), NULL },
+      CLI_INT_AT(HFVIS_LK_LUT_MIN_RESOLUTION, HFVIS_LK_LUT_MAX_RESOLUTION,
+                 "a table resolution 2..1024", 0.0, "none", "nodes per side", lk_lut, 0), NULL },
     { "--seed", "S", CLI_ONLY(CMD_MESHAO),
-      CLI_TYPED(CLI_V_INT), NULL },
+      CLI_REAL_AT(0.0, 0, 9007199254740992.0, "an integer 0..2^53", 0.0, NULL, NULL, lk_seed, 0),
+                  NULL },
     { "--no-jitter", NULL, CLI_ONLY(CMD_MESHAO),
       CLI_SWITCH, NULL },
     { "--pattern", "P", CLI_ONLY(CMD_MESHAO),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "torus"), NULL },
     { "--fov-y", "DEG", CLI_ONLY(CMD_SSAO),
-      CLI_TYPED(CLI_V_REAL), NULL },
+      CLI_REAL_AT(0.0, 1, 179.999, "degrees in (0, 180)", 60.0, NULL, "degrees", ssao_fov, 0),
+                  NULL },
     { "--ortho", "SCALE", CLI_ONLY(CMD_SSAO),
-      CLI_TYPED(CLI_V_REAL), NULL },
-    { "--radius", "R", CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_MESHAO) | CLI_ONLY(CMD_OPENNESS),
-      CLI_TYPED(CLI_V_REAL), NULL },
+      CLI_REAL_AT(0.0, 1, CLI_FLT_MAX, "a scale > 0", 0.0, "none (perspective)",
+                  "view units per pixel", ssao_ortho, CLI_HAS(ssao_has_ortho)), NULL },
+    { "--radius", "R", CLI_ONLY(CMD_SSAO),
+      CLI_REAL_AT(0.0, 1, CLI_FLT_MAX, "a radius > 0", 0.0, "none (rho = 1)", "view units",
+                  ssao_radius, 0), NULL },
+    { "--radius", "R", CLI_ONLY(CMD_MESHAO),
+      CLI_REAL_AT(0.0, 1, CLI_FLT_MAX, "a radius > 0", 0.0, "0.1 x the mesh's diagonal",
+                  "mesh units",
+                  lk_radius, CLI_HAS(lk_has_radius)), NULL },
+    { "--radius", "R", CLI_ONLY(CMD_OPENNESS),
+      CLI_REAL_AT(0.0, 0, DBL_MAX, "a distance >= 0 (0 = unlimited)", 0.0, "0 (unlimited)",
+                  "height units", radius, CLI_HAS(has_radius)), NULL },
     { "--guard", "PIXELS", CLI_ONLY(CMD_SSAO),
-      CLI_TYPED(CLI_V_INT), NULL },
+      CLI_INT_AT(0, 65536, "an integer 0..65536", -1.0, "W/10 and H/10", "pixels", ssao_guard, 0),
+                 NULL },
     { "--depth", "ENC", CLI_ONLY(CMD_SSAO),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "linear"), NULL },
     { "--near", "N", CLI_ONLY(CMD_SSAO),
-      CLI_TYPED(CLI_V_REAL), NULL },
+      CLI_REAL_AT(-CLI_FLT_MAX, 0, CLI_FLT_MAX, "a finite distance", 0.0, "none", "view units",
+                  ssao_near, CLI_HAS(ssao_has_near)), NULL },
     { "--far", "F", CLI_ONLY(CMD_SSAO),
-      CLI_TYPED(CLI_V_REAL), NULL },
+      CLI_REAL_AT(-CLI_FLT_MAX, 0, CLI_FLT_MAX, "a finite distance", 0.0, "none", "view units",
+                  ssao_far, CLI_HAS(ssao_has_far)), NULL },
     { "--azimuth", "A", CLI_ONLY(CMD_HORIZON),
-      CLI_TYPED(CLI_V_REAL), NULL },
+      CLI_REAL_AT(-1e6, 0, 1e6, "a finite angle (degrees, or radians with --radians)", 0.0,
+                  "none (K directions)", "degrees (radians with --radians)", azimuth,
+                  CLI_HAS(has_azimuth)), NULL },
     { "--split", NULL, CLI_ONLY(CMD_HORIZON),
       CLI_SWITCH, NULL },
     { "--observer-grid", "C,R", CLI_ONLY(CMD_VIEWSHED),
@@ -369,15 +416,15 @@ static const cli_flag cli_flags[] = {
     { "--curvature", NULL, CLI_ONLY(CMD_VIEWSHED),
       CLI_SWITCH, NULL },
     { "--refraction", "K", CLI_ONLY(CMD_VIEWSHED),
-      CLI_REAL_AT(-1.0, 0, 1.0, "a coefficient in -1..1", "0.13", NULL, refraction,
+      CLI_REAL_AT(-1.0, 0, 1.0, "a coefficient in -1..1", CLI_REFRACTION, NULL, NULL, refraction,
                  CLI_HAS(has_refraction)), NULL },
     { "--earth-radius", "R", CLI_ONLY(CMD_VIEWSHED),
-      CLI_REAL_AT(0.0, 1, 1e12, "a radius > 0 (metres)", "6371000", "metres", earth_radius,
-                 CLI_HAS(has_earth_radius)), NULL },
+      CLI_REAL_AT(0.0, 1, 1e12, "a radius > 0 (metres)", CLI_EARTH_RADIUS, NULL, "metres",
+                  earth_radius, CLI_HAS(has_earth_radius)), NULL },
     { "--svf", "D", CLI_ONLY(CMD_SKYVIEW),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "zaksek"), NULL },
     { "--blend", "N", CLI_ONLY(CMD_HILLSHADE),
-      CLI_INT_AT(1, 360, "a count of sun directions 1..360", "1", "suns", blend, 0), NULL },
+      CLI_INT_AT(1, 360, "a count of sun directions 1..360", 0.0, "1", "suns", blend, 0), NULL },
     { "--no-shadows", NULL, CLI_ONLY(CMD_HILLSHADE),
       CLI_SWITCH, NULL },
     { "--negative", NULL, CLI_ONLY(CMD_OPENNESS),
@@ -395,23 +442,28 @@ static const cli_flag cli_flags[] = {
     { "--time", "HH:MM", CLI_ONLY(CMD_SOLAR),
       CLI_TYPED(CLI_V_DATE), NULL },
     { "--step", "S", CLI_ONLY(CMD_SOLAR),
-      CLI_TYPED(CLI_V_REAL), NULL },
+      CLI_NUMBER(CLI_V_DURATION, 0.0, 1, 24.0, "a step in (0, 24h] like 15m or 1h", 0.0, "15m",
+                 "hours", sol_step, 0, NULL, NULL), NULL },
     { "--linke", "L", CLI_ONLY(CMD_SOLAR),
-      CLI_TYPED(CLI_V_REAL), NULL },
+      CLI_REAL_AT(0.0, 1, 10.0, "a Linke turbidity factor in (0, 10]", 0.0, "3", NULL, sol_linke,
+                  CLI_HAS(sol_has_linke)), NULL },
     { "--linke-monthly", "L1,...,L12", CLI_ONLY(CMD_SOLAR),
       CLI_TYPED(CLI_V_LIST), NULL },
     { "--linke-map", "MAP", CLI_ONLY(CMD_SOLAR),
       CLI_TYPED(CLI_V_TEXT), NULL },
     { "--latitude", "DEG", CLI_ONLY(CMD_SOLAR),
-      CLI_TYPED(CLI_V_REAL), NULL },
+      CLI_REAL_AT(-90.0, 0, 90.0, "a latitude in degrees, -90..90", 0.0, "IN's CRS", "degrees",
+                  sol_lat, CLI_HAS(sol_has_lat)), NULL },
     { "--longitude", "DEG", CLI_ONLY(CMD_SOLAR),
-      CLI_TYPED(CLI_V_REAL), NULL },
+      CLI_REAL_AT(-180.0, 0, 180.0, "a longitude in degrees, -180..180 (east positive)", 0.0,
+                  "IN's CRS", "degrees", sol_lon, CLI_HAS(sol_has_lon)), NULL },
     { "--utc-offset", "H", CLI_ONLY(CMD_SOLAR),
-      CLI_TYPED(CLI_V_REAL), NULL },
+      CLI_REAL_AT(-14.0, 0, 14.0, "hours east of UTC, -14..14", 0.0, NULL, "hours", sol_offset,
+                  CLI_HAS(sol_has_offset)), NULL },
     { "--solar-time", NULL, CLI_ONLY(CMD_SOLAR),
       CLI_SWITCH, NULL },
     { "--bands", "day|month", CLI_ONLY(CMD_SOLAR),
-      CLI_TYPED(CLI_V_CHOICE), NULL },
+      CLI_WORDS(CLI_V_CHOICE, "one (the total)"), NULL },
     { "--beam", "OUT", CLI_ONLY(CMD_SOLAR),
       CLI_TYPED(CLI_V_TEXT), NULL },
     { "--diffuse", "OUT", CLI_ONLY(CMD_SOLAR),
@@ -432,27 +484,130 @@ static int cli_command_of(const char *name)
     return -1;
 }
 
-/* The row of flag name in cli_flags, or CLI_NFLAGS. */
-static size_t cli_flag_of(const char *name)
+/* The row of flag name that command cmd uses (a flag of several meanings has one row per
+ * meaning), else its first row, else CLI_NFLAGS. */
+static size_t cli_flag_for(const char *name, int cmd)
 {
-    size_t k;
-    for (k = 0; k < CLI_NFLAGS; k++)
-        if (!strcmp(name, cli_flags[k].name)) break;
-    return k;
+    size_t k, first = CLI_NFLAGS;
+    for (k = 0; k < CLI_NFLAGS; k++) {
+        if (strcmp(name, cli_flags[k].name)) continue;
+        if (cli_flags[k].commands & CLI_ONLY(cmd)) return k;
+        if (first == CLI_NFLAGS) first = k;
+    }
+    return first;
 }
 
-/* A numeric flag from its row (row->at != 0): v parsed as the row's kind, checked against
- * [lo, hi] (lo excluded when lo_open), stored in the row's cli_args field and its has_ field set;
- * returns 0 or CLI_EXIT_USAGE ("expected <rule>, got '<v>'", naming the flag). */
+/* Every numeric row's default into its field (cli_parse, before the command line). */
+static void cli_flag_defaults(cli_args *a)
+{
+    char *base = (char *)a;
+    size_t k;
+    for (k = 0; k < CLI_NFLAGS; k++) {
+        const cli_flag *f = &cli_flags[k];
+        if (!f->at) continue;
+        if (f->kind == CLI_V_INT) *(int *)(void *)(base + f->at) = (int)f->dv;
+        else *(double *)(void *)(base + f->at) = f->dv;
+    }
+}
+
+/* A numeric flag from its row (row->at != 0): v parsed as the row's kind (a duration: a number of
+ * minutes with an optional m, or of hours with h, stored in hours), checked against [lo, hi] (lo
+ * excluded when lo_open), stored in the row's cli_args field, its has_ field set, then its hook
+ * run; the row's word, if any, is taken instead of a number (the field keeps its default). Returns
+ * 0 or CLI_EXIT_USAGE ("expected <rule>, got '<v>'", naming the flag). */
 static int cli_set_number(cli_args *a, const cli_flag *row, const char *v)
 {
     char *base = (char *)a;
+    int rc;
     if (row->has) *(int *)(void *)(base + row->has) = 1;
-    if (row->kind == CLI_V_INT)
-        return cli_int(row->name, v, (long)row->lo, (long)row->hi, row->rule,
-                       (int *)(void *)(base + row->at));
-    return cli_real(row->name, v, row->lo, row->lo_open, row->hi, row->rule,
-                    (double *)(void *)(base + row->at));
+    if (row->word && !strcmp(v, row->word)) rc = 0;
+    else if (row->kind == CLI_V_INT)
+        rc = cli_int(row->name, v, (long)row->lo, (long)row->hi, row->rule,
+                     (int *)(void *)(base + row->at));
+    else if (row->kind == CLI_V_DURATION) {
+        char buf[64];
+        size_t n = strlen(v);
+        double x, scale = 1.0 / 60.0;
+        if (n == 0 || n >= sizeof buf)
+            return cli_error(CLI_EXIT_USAGE, row->name, "expected %s, got '%s'", row->rule, v);
+        memcpy(buf, v, n + 1);
+        if (buf[n - 1] == 'm' || buf[n - 1] == 'h') scale = buf[n - 1] == 'h' ? 1.0 : scale, buf[n - 1] = '\0';
+        if (!cli_parse_real(buf, &x))
+            return cli_error(CLI_EXIT_USAGE, row->name, "expected %s, got '%s'", row->rule, v);
+        x *= scale;
+        if (x < row->lo || (row->lo_open && x == row->lo) || x > row->hi)
+            return cli_error(CLI_EXIT_USAGE, row->name, "expected %s, got '%s'", row->rule, v);
+        *(double *)(void *)(base + row->at) = x;
+        rc = 0;
+    } else
+        rc = cli_real(row->name, v, row->lo, row->lo_open, row->hi, row->rule,
+                      (double *)(void *)(base + row->at));
+    if (rc) return rc;
+    return row->then ? row->then(a, v) : 0;
+}
+
+/* --zscale: non-zero as a float too (the library multiplies in float). */
+static int cli_then_zscale(cli_args *a, const char *v)
+{
+    if ((float)a->zscale == 0.0f)
+        return cli_error(CLI_EXIT_USAGE, "--zscale", "expected a non-zero number, got '%s'", v);
+    return 0;
+}
+
+/* --positions K: K must be a count 2(2n^2+2n+1); the field keeps the frequency n. */
+static int cli_then_positions(cli_args *a, const char *v)
+{
+    const char *f = "--positions";
+    int k = a->vf_positions, n;
+    for (n = 1; n <= HFVIS_VISFIELD_MAX_N; n++)
+        if (hfvis_visfield_position_count(n) >= (size_t)k) break;
+    if (n > HFVIS_VISFIELD_MAX_N || hfvis_visfield_position_count(n) != (size_t)k) {
+        if (n > HFVIS_VISFIELD_MAX_N)
+            return cli_error(CLI_EXIT_USAGE, f, "at most %zu positional samples, got '%s'",
+                             hfvis_visfield_position_count(HFVIS_VISFIELD_MAX_N), v);
+        return cli_error(CLI_EXIT_USAGE, f, "expected a count 2(2n^2+2n+1), got '%s' (nearest: "
+                         "%zu or %zu)", v, n > 1 ? hfvis_visfield_position_count(n - 1) : 0,
+                         hfvis_visfield_position_count(n));
+    }
+    a->vf_positions = n;
+    return 0;
+}
+
+/* --reflectance albedo: the voxels' own colour instead of the number. */
+static int cli_then_reflectance(cli_args *a, const char *v)
+{
+    a->vg_rho_albedo = !strcmp(v, "albedo");
+    return 0;
+}
+
+/* A number of a flag's row as --list-flags and the help print it: "inf" beyond the float range
+ * (no limit), else the shortest of %.15g..%.17g that reads back as x. */
+static void cli_flag_number(double x, char *out, size_t cap)
+{
+    int p;
+    if (fabs(x) >= CLI_FLT_MAX) { snprintf(out, cap, "%sinf", x < 0.0 ? "-" : ""); return; }
+    for (p = 15; p <= 17; p++) {
+        snprintf(out, cap, "%.*g", p, x);
+        if (strtod(out, NULL) == x) return;
+    }
+}
+
+/* A row's RANGE and DEFAULT columns (--list-flags, the help): "[LO,HI]" or "(LO,HI]" for reals
+ * and durations, "[LO..HI]" for integers, "-" for the rows a command parses; the default in words,
+ * or the row's dv, or "-" for a row without one. */
+static void cli_flag_columns(const cli_flag *f, char *range, char *def, size_t cap)
+{
+    char lo[40], hi[40];
+    if (f->at) {
+        cli_flag_number(f->lo, lo, sizeof lo);
+        cli_flag_number(f->hi, hi, sizeof hi);
+        snprintf(range, cap, "%s%s%s%s]", f->lo_open ? "(" : "[", lo, f->kind == CLI_V_INT ? ".." : ",", hi);
+    } else {
+        snprintf(range, cap, "-");
+    }
+    if (f->def) snprintf(def, cap, "%s", f->def);
+    else if (f->at) cli_flag_number(f->dv, def, cap);
+    else snprintf(def, cap, "-");
 }
 
 /* A flag that command cmd does not take (arg: "--name" or "--name=value"): refused by name,
@@ -465,13 +620,38 @@ static int cli_refuse_flag(int cmd, const char *arg)
     if (n >= sizeof flag) n = sizeof flag - 1;
     memcpy(flag, arg, n);
     flag[n] = '\0';
-    if (cli_flag_of(flag) == CLI_NFLAGS)
+    if (cli_flag_for(flag, cmd) == CLI_NFLAGS)
         return cli_error(CLI_EXIT_USAGE, flag, "unknown option (see 'hfvis %s --help')", name);
     return cli_error(CLI_EXIT_USAGE, name, "%s is not used by %s (see 'hfvis %s --help')", flag, name, name);
 }
 
+/* The values section of `hfvis CMD --help`: for each flag CMD uses, from its row, one line
+ * "  --flag VALUE  TYPE[ in RANGE][, default DEF][, unit UNIT]" (TYPE "switch" for a flag without
+ * a value; RANGE and DEF as --list-flags prints them, so the two cannot disagree). */
+static void cli_help_values(int cmd)
+{
+    size_t k;
+    int any = 0;
+    for (k = 0; k < CLI_NFLAGS; k++) {
+        const cli_flag *f = &cli_flags[k];
+        char label[64], range[96], def[96];
+        if (!(f->commands & CLI_ONLY(cmd))) continue;
+        if (!any++)
+            printf("\nvalues of %s's options (type, range, default, unit; also 'hfvis --list-flags %s'):\n",
+                   cli_commands[cmd].name, cli_commands[cmd].name);
+        snprintf(label, sizeof label, "%s%s%s", f->name, f->value ? " " : "", f->value ? f->value : "");
+        cli_flag_columns(f, range, def, sizeof range);
+        printf("  %-18s  %s", label, f->kind == CLI_V_NONE ? "switch" : cli_kind_names[f->kind]);
+        if (strcmp(range, "-")) printf(" in %s", range);
+        if (strcmp(def, "-")) printf(", default %s", def);
+        if (f->unit) printf(", unit %s", f->unit);
+        printf("\n");
+    }
+}
+
 /* `hfvis --help` (cmd < 0: the usage, the commands and every shared option) or `hfvis CMD
- * --help` (the command's help and the shared options it uses), from the tables; returns 0. */
+ * --help` (the command's help, the shared options it uses and the values of all its options),
+ * from the tables; returns 0. */
 static int cli_help(int cmd)
 {
     size_t k;
@@ -482,6 +662,7 @@ static int cli_help(int cmd)
         printf("\nshared options (each command's --help lists those it uses; it refuses the others):\n");
     } else if (cli_commands[cmd].main) { /* sum, mosaic, info: their help lists their options */
         printf("%s", cli_commands[cmd].help);
+        cli_help_values(cmd);
         return 0;
     } else {
         printf("%s\nshared options of %s:\n", cli_commands[cmd].help, cli_commands[cmd].name);
@@ -494,6 +675,7 @@ static int cli_help(int cmd)
         printf("  %-16s  %s", label, f->help);
     }
     printf("%s", cli_help_tail);
+    if (cmd >= 0) cli_help_values(cmd);
     return 0;
 }
 
@@ -504,15 +686,6 @@ static int cli_list_commands(int argc)
     if (argc != 2) return cli_error(CLI_EXIT_USAGE, "--list-commands", "takes no argument");
     for (c = 0; c < CMD_COUNT; c++) printf("%s\n", cli_commands[c].name);
     return fflush(stdout) == 0 && !ferror(stdout) ? 0 : cli_error(CLI_EXIT_ERROR, "stdout", "write error");
-}
-
-/* One end of a range in --list-flags: "inf" beyond the float range (no limit), else %g; open
- * (lower end only): "(" or "[" before it. */
-static void cli_print_bound(double x, const char *open)
-{
-    if (open) printf("%s", open);
-    if (fabs(x) >= CLI_FLT_MAX) printf("%sinf", x < 0.0 ? "-" : "");
-    else printf("%g", x);
 }
 
 /* `hfvis --list-flags [COMMAND]`: one flag per line, "NAME VALUE COMMANDS TYPE RANGE DEFAULT
@@ -531,20 +704,13 @@ static int cli_list_flags(int argc, char **argv)
     for (k = 0; k < CLI_NFLAGS; k++) {
         const char *sep = "";
         const cli_flag *f = &cli_flags[k];
+        char range[96], def[96];
         if (cmd >= 0 && !(f->commands & CLI_ONLY(cmd))) continue;
         printf("%s\t%s\t", f->name, f->value ? f->value : "-");
         for (c = 0; c < CMD_COUNT; c++)
             if (f->commands & CLI_ONLY(c)) printf("%s%s", sep, cli_commands[c].name), sep = ",";
-        printf("\t%s\t", cli_kind_names[f->kind]);
-        if (f->at) {
-            cli_print_bound(f->lo, f->lo_open ? "(" : "[");
-            printf("%s", f->kind == CLI_V_INT ? ".." : ",");
-            cli_print_bound(f->hi, NULL);
-            printf("]");
-        } else {
-            printf("-");
-        }
-        printf("\t%s\t%s\n", f->def ? f->def : "-", f->unit ? f->unit : "-");
+        cli_flag_columns(f, range, def, sizeof range);
+        printf("\t%s\t%s\t%s\t%s\n", cli_kind_names[f->kind], range, def, f->unit ? f->unit : "-");
     }
     return fflush(stdout) == 0 && !ferror(stdout) ? 0 : cli_error(CLI_EXIT_ERROR, "stdout", "write error");
 }
@@ -629,14 +795,10 @@ static int cli_set(cli_args *a, const char *f, const char *v)
         return 0;
     }
     {
-        size_t k = cli_flag_of(f);
+        size_t k = cli_flag_for(f, a->cmd);
         const cli_flag *row = k < CLI_NFLAGS ? &cli_flags[k] : NULL;
-        if (row && row->at) { /* a numeric flag of the table: its row says its range and field */
-            if (cli_set_number(a, row, v)) return CLI_EXIT_USAGE;
-            if (!strcmp(f, "--zscale") && (float)a->zscale == 0.0f) /* non-zero as a float too */
-                return cli_error(CLI_EXIT_USAGE, f, "expected a non-zero number, got '%s'", v);
-            return 0;
-        }
+        if (row && row->at) /* a numeric flag of the table: its row says its range and field */
+            return cli_set_number(a, row, v) ? CLI_EXIT_USAGE : 0;
     }
     if (!strcmp(f, "--degrees")) { a->degrees = 1; return 0; }
     if (!strcmp(f, "--quiet")) { a->quiet = 1; return 0; }
@@ -700,10 +862,9 @@ static int cli_set(cli_args *a, const char *f, const char *v)
         int r = cli_set_volgi(a, f, v);
         if (r >= 0) return r;
     }
-    {
-        int r = cli_set_gi(a, f, v);
+    if (a->cmd == CMD_SSAO) {
+        int r = cli_set_ssao(a, f, v);
         if (r >= 0) return r;
-        if (a->cmd == CMD_SSAO && (r = cli_set_ssao(a, f, v)) >= 0) return r;
     }
     if (a->cmd == CMD_VOXELIZE) { /* --method of voxelize */
         if (!strcmp(v, "pixel")) a->vox_method = HFVIS_VOXELIZE_PIXEL_RULE;
@@ -750,14 +911,11 @@ static int cli_parse(int argc, char **argv, cli_args *a)
 {
     int i, c, positional_only = 0;
     memset(a, 0, sizeof *a);
-    a->cell = 1.0; a->zscale = 1.0; a->dirs = 16; a->sky = 1.0; a->albedo = 1.0;
+    cli_flag_defaults(a); /* --threads 1, not the online cores: see its help, docs/performance.md */
     a->max_memory = cli_default_max_memory();
-    a->threads = 1; /* not the online cores: see --threads' help and docs/performance.md */
     a->border = HFVIS_BORDER_OPEN; a->method = HFVIS_ENV_PREFIX;
-    a->bounces = 1; a->sun_irradiance = CLI_PI; a->output = OUT_TOTAL;
-    a->order = 4; a->subsample = 1;
-    a->ssao_method = SSAO_FFAO; a->ssao_depth = SSAO_DEPTH_LINEAR; a->ssao_fov = 60.0;
-    a->ssao_guard = -1;
+    a->output = OUT_TOTAL;
+    a->ssao_method = SSAO_FFAO; a->ssao_depth = SSAO_DEPTH_LINEAR;
     cli_volgi_defaults(a);
     cli_lk_defaults(a);
     if (argc < 2) return cli_error(CLI_EXIT_USAGE, "usage", "missing COMMAND (try 'hfvis --help')");
@@ -788,7 +946,7 @@ static int cli_parse(int argc, char **argv, cli_args *a)
         if (n >= sizeof name) n = sizeof name - 1;
         memcpy(name, arg, n);
         name[n] = '\0';
-        if ((k = cli_flag_of(name)) == CLI_NFLAGS) return cli_refuse_flag(a->cmd, name);
+        if ((k = cli_flag_for(name, a->cmd)) == CLI_NFLAGS) return cli_refuse_flag(a->cmd, name);
         if ((CLI_ONLY(a->cmd) & CLI_P2) && !strcmp(name, "--window"))
             return cli_error(CLI_EXIT_USAGE, cli_commands[a->cmd].name, "--window is not used by %s: "
                              "it sweeps whole lattice lines with the [P2] hull tree, which honours "

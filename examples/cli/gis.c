@@ -80,16 +80,6 @@ static int cli_set_gis(cli_args *a, const char *f, const char *v)
                          "now '--convention grid'; GRASS's counter-clockwise from east is "
                          "'--convention grass'");
     if (!strcmp(f, "--radians")) { a->radians = 1; return 0; }
-    if (!strcmp(f, "--azimuth0")) {
-        a->has_azimuth0 = 1;
-        return cli_real(f, v, -1e6, 0, 1e6, "a finite angle (degrees, or radians with --radians)",
-                        &a->azimuth0);
-    }
-    if (!strcmp(f, "--azimuth")) {
-        a->has_azimuth = 1;
-        return cli_real(f, v, -1e6, 0, 1e6, "a finite angle (degrees, or radians with --radians)",
-                        &a->azimuth);
-    }
     if (!strcmp(f, "--split")) { a->split = 1; return 0; }
     if (!strcmp(f, "--overwrite")) { a->overwrite = 1; return 0; }
     if (!strcmp(f, "--progress")) { a->progress_lines = 1; return 0; }
@@ -124,10 +114,6 @@ static int cli_set_gis(cli_args *a, const char *f, const char *v)
         return 0;
     }
     if (!strcmp(f, "--lattice")) { a->lattice = 1; return 0; }
-    if (a->cmd == CMD_OPENNESS && !strcmp(f, "--radius")) {
-        a->has_radius = 1;
-        return cli_real(f, v, 0.0, 0, DBL_MAX, "a distance >= 0 (0 = unlimited)", &a->radius);
-    }
     return -1;
 }
 
@@ -179,8 +165,6 @@ static int cli_gis_finish(cli_args *a)
     if ((a->has_refraction || a->has_earth_radius) && !a->curvature)
         return cli_error(CLI_EXIT_USAGE, a->has_refraction ? "--refraction" : "--earth-radius",
                          "applies with --curvature");
-    if (!a->has_refraction) a->refraction = CLI_REFRACTION;
-    if (!a->has_earth_radius) a->earth_radius = CLI_EARTH_RADIUS;
     if (a->cmd == CMD_OPENNESS && !a->has_dirs) a->dirs = 8; /* Yokoyama et al.'s eight */
     /* direction 0: north (compass) or east (grass, grid: r.horizon's start=0 and the old default) */
     deg = a->has_azimuth0 ? cli_deg(a, a->azimuth0) : 0.0;

@@ -182,9 +182,13 @@
     "planes) and the command, the input's fingerprint and every parameter; the parts are added in\n" \
     "direction order and finished once (e.g. SVF = 1 - S/K). The output equals the single run's\n"   \
     "bit for bit, except that a value within about K*2^-53 of a float rounding boundary may differ\n" \
-    "by one ulp. Refused, with nothing written: parts of different commands, inputs, grids or\n"   \
-    "parameters, overlapping ranges, and directions that no part holds.\n"                        \
-    "  -o OUT            *.pfm or *.pgm, as for the command that made the parts\n"                 \
+    "by one ulp. Refused, with nothing written: parts of different commands, inputs, grids,\n"    \
+    "georeferences or parameters, parts of an older hfvis (no georeference), overlapping ranges,\n" \
+    "and directions that no part holds.\n"                                                         \
+    "  -o OUT            *.pfm or *.pgm, as for the command that made the parts, or a raster\n"    \
+    "                    *.tif, *.asc, *.bil/*.flt with the input's georeference, NoData and\n"    \
+    "                    CRS (.prj), which the parts carry; a horizon GeoTIFF gets the single\n"  \
+    "                    run's band labels, rebuilt from the parts' tag\n"                         \
     "  --range LO:HI     .pgm only: the values mapped to codes 1 and 65535\n"                 \
     "  --overwrite       allow OUT to be one of the parts\n"
 

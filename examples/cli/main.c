@@ -22,64 +22,72 @@
 
 /* The commands: one row each (the order of `hfvis --help`). Adding a command: its CMD_ value in
  * cli.h's enum, its --help text (help.c), its flags' rows (flags.c: add the command's bit to
- * the rows of the flags it uses), and this row with its check and run functions. */
+ * the rows of the flags it uses), and this row with its check, estimate (run.c) and run
+ * functions. */
 #define CLI_HF_IO (CLI_IN_NEEDED | CLI_OUT_NEEDED)
 #define CLI_MESH_IO (CLI_IN_NEEDED | CLI_OUT_NEEDED | CLI_COST_FIRST)
 static const cli_command cli_commands[CMD_COUNT] = {
     { "horizon", "horizon elevation angle toward K directions (K planes in one image)",
-      CLI_HORIZON_HELP, CLI_HF_IO, NULL, cli_run_heights, NULL },
+      CLI_HORIZON_HELP, CLI_HF_IO, NULL, cli_estimate_horizon, cli_run_heights, NULL },
     { "skyview", "sky-view factor 1 - (1/K) sum_k sin(max(alpha_k, 0)), in [0, 1]",
-      CLI_SKYVIEW_HELP, CLI_HF_IO, NULL, cli_run_heights, NULL },
+      CLI_SKYVIEW_HELP, CLI_HF_IO, NULL, cli_estimate_sweep, cli_run_heights, NULL },
     { "sky", "uniform-sky light, [P1] Eq. 5 (cosine-weighted and slope-aware)",
-      CLI_SKY_HELP, CLI_HF_IO, NULL, cli_run_heights, NULL },
+      CLI_SKY_HELP, CLI_HF_IO, NULL, cli_estimate_sweep, cli_run_heights, NULL },
     { "shadow", "sun visibility in [0, 1] from one exact sweep toward the sun",
-      CLI_SHADOW_HELP, CLI_HF_IO, cli_check_shadow, cli_run_heights, NULL },
+      CLI_SHADOW_HELP, CLI_HF_IO, cli_check_shadow, cli_estimate_sweep, cli_run_heights, NULL },
     { "light", "environment light from a lat-long PFM map",
-      CLI_LIGHT_HELP, CLI_HF_IO, cli_check_light, cli_run_heights, NULL },
+      CLI_LIGHT_HELP, CLI_HF_IO, cli_check_light, cli_estimate_sweep, cli_run_heights, NULL },
     { "normals", "unit surface normals (x east, y south, z up) as a 3-channel PFM",
-      CLI_NORMALS_HELP, CLI_HF_IO, NULL, cli_run_heights, NULL },
+      CLI_NORMALS_HELP, CLI_HF_IO, NULL, cli_estimate_sweep, cli_run_heights, NULL },
     { "indirect", "sun and sky light with interreflections between terrain points ([P2])",
-      CLI_INDIRECT_HELP, CLI_HF_IO, cli_check_indirect, cli_run_heights, NULL },
+      CLI_INDIRECT_HELP, CLI_HF_IO, cli_check_indirect, cli_estimate_indirect, cli_run_heights, NULL },
     { "gi", "multi-resolution GI (Nowrouzezahrai & Snyder): sky, sun, bounces, gloss",
-      CLI_GI_HELP, CLI_HF_IO, cli_check_gi, cli_run_heights, NULL },
+      CLI_GI_HELP, CLI_HF_IO, cli_check_gi, cli_estimate_gi, cli_run_heights, NULL },
     { "visibility", "visibility index: the grid samples each point sees along K directions",
-      CLI_VISIBILITY_HELP, CLI_HF_IO, NULL, cli_run_heights, NULL },
+      CLI_VISIBILITY_HELP, CLI_HF_IO, NULL, cli_estimate_visibility, cli_run_heights, NULL },
     { "viewshed", "which samples an observer at one point sees (line of sight)",
-      CLI_VIEWSHED_HELP, CLI_HF_IO, cli_check_viewshed, cli_run_heights, NULL },
+      CLI_VIEWSHED_HELP, CLI_HF_IO, cli_check_viewshed, cli_estimate_viewshed, cli_run_heights, NULL },
     { "hillshade", "shaded relief with cast shadows from the exact sweep, one or more suns",
-      CLI_HILLSHADE_HELP, CLI_HF_IO, NULL, cli_run_heights, NULL },
+      CLI_HILLSHADE_HELP, CLI_HF_IO, NULL, cli_estimate_sweep, cli_run_heights, NULL },
     { "openness", "positive or negative topographic openness (Yokoyama et al. 2002)",
-      CLI_OPENNESS_HELP, CLI_HF_IO, NULL, cli_run_heights, NULL },
+      CLI_OPENNESS_HELP, CLI_HF_IO, NULL, cli_estimate_sweep, cli_run_heights, NULL },
     { "solar", "clear-sky solar irradiation of a day or a date range over exact horizons",
-      CLI_SOLAR_HELP, CLI_HF_IO, cli_check_solar, cli_run_heights, NULL },
+      CLI_SOLAR_HELP, CLI_HF_IO, cli_check_solar, cli_estimate_solar, cli_run_heights, NULL },
     { "voxelize", "voxels of an OBJ mesh: surface, conservative or solid (.binvox or .raw)",
-      CLI_VOXELIZE_HELP, CLI_MESH_IO, cli_check_voxelize, cli_run_voxelize, NULL },
+      CLI_VOXELIZE_HELP, CLI_MESH_IO, cli_check_voxelize, cli_estimate_voxelize, cli_run_voxelize, NULL },
     { "volgi", "direct + indirect light of an OBJ mesh or the test room ([G12] ch. 5)",
-      CLI_VOLGI_HELP, CLI_MESH_IO, cli_check_volgi, cli_run_volgi, NULL },
+      CLI_VOLGI_HELP, CLI_MESH_IO, cli_check_volgi, cli_estimate_volgi, cli_run_volgi, NULL },
     { "visfield", "4D visibility field of an OBJ mesh (.hfvf), or AO images from one",
-      CLI_VF_HELP, CLI_MESH_IO, cli_check_vf, cli_run_visfield, NULL },
+      CLI_VF_HELP, CLI_MESH_IO, cli_check_vf, cli_estimate_visfield, cli_run_visfield, NULL },
     { "meshao", "ray-cast ambient obscurance of an OBJ mesh (Laine & Karras bit masks)",
-      CLI_LK_HELP, CLI_MESH_IO, cli_check_lk, cli_run_meshao, NULL },
+      CLI_LK_HELP, CLI_MESH_IO, cli_check_lk, cli_estimate_meshao, cli_run_meshao, NULL },
     { "ssao", "screen-space obscurance of a depth buffer: LSAO, HBAO, FFAO, ray traced",
-      CLI_SSAO_HELP, CLI_HF_IO, cli_check_ssao, cli_run_ssao, NULL },
+      CLI_SSAO_HELP, CLI_HF_IO, cli_check_ssao, cli_estimate_ssao, cli_run_ssao, NULL },
     { "sum", "add up the partial results of --dir-range runs into the single run's OUT",
-      CLI_SUM_HELP, 0, NULL, NULL, cli_sum },
+      CLI_SUM_HELP, 0, NULL, NULL, NULL, cli_sum },
     { "mosaic", "assemble the pieces of --window runs into the whole run's OUT",
-      CLI_MOSAIC_HELP, 0, NULL, NULL, cli_mosaic },
+      CLI_MOSAIC_HELP, 0, NULL, NULL, NULL, cli_mosaic },
     { "info", "print a raster's width, height, bands, cell, CRS and NoData",
-      CLI_INFO_HELP, 0, NULL, NULL, cli_info },
+      CLI_INFO_HELP, 0, NULL, NULL, NULL, cli_info },
     { "azimuths", "print the K azimuths a run uses, in degrees, in output-plane order",
-      CLI_AZIMUTHS_HELP, 0, cli_check_azimuths, cli_run_azimuths, NULL },
+      CLI_AZIMUTHS_HELP, 0, cli_check_azimuths, NULL, cli_run_azimuths, NULL },
 };
 
-/* A table without a way to run one of its commands is an error before anything runs. */
+/* A table without a way to run one of its commands, or without the estimate of a command that
+ * takes --max-memory (or with one nothing calls), is an error before anything runs. */
 static int cli_commands_complete(void)
 {
+    unsigned long limited = cli_flags[cli_flag_for("--max-memory", CMD_HORIZON)].commands;
     int c;
-    for (c = 0; c < CMD_COUNT; c++)
+    for (c = 0; c < CMD_COUNT; c++) {
         if (!cli_commands[c].name || !cli_commands[c].help || !cli_commands[c].run == !cli_commands[c].main)
             return cli_error(CLI_EXIT_ERROR, cli_commands[c].name ? cli_commands[c].name : "hfvis",
                              "internal error: command %d has no name, help or single run function", c);
+        if (!cli_commands[c].estimate != !(limited & CLI_ONLY(c)))
+            return cli_error(CLI_EXIT_ERROR, cli_commands[c].name, "internal error: %s",
+                             cli_commands[c].estimate ? "an estimate, but no --max-memory"
+                                                      : "--max-memory, but no estimate");
+    }
     return 0;
 }
 

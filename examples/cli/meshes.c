@@ -6,11 +6,9 @@
 static void cli_lk_defaults(cli_args *a)
 {
     a->lk_method = HFVIS_LK_METHOD_BVH;
-    a->lk_rays = 128;
     a->lk_falloff = HFVIS_LK_FALLOFF_CONSTANT;
     a->lk_width = 512;
     a->lk_height = 384;
-    a->lk_fov = 45.0;
     a->lk_up[0] = 0.0; a->lk_up[1] = 0.0; a->lk_up[2] = 1.0;
 }
 
@@ -64,18 +62,12 @@ static int cli_set_lk(cli_args *a, const char *f, const char *v)
         else return cli_error(CLI_EXIT_USAGE, f, "expected raster, bvh or raycast, got '%s'", v);
         return 0;
     }
-    if (!strcmp(f, "--rays"))
-        return cli_int(f, v, 1, HFVIS_LK_MAX_RAYS, "an integer 1..4096", &a->lk_rays);
     if (!strcmp(f, "--pattern")) {
         if (!strcmp(v, "torus")) a->lk_pattern = HFVIS_LK_PATTERN_LLOYD_TORUS;
         else if (!strcmp(v, "lloyd")) a->lk_pattern = HFVIS_LK_PATTERN_LLOYD;
         else if (!strcmp(v, "random")) a->lk_pattern = HFVIS_LK_PATTERN_RANDOM;
         else return cli_error(CLI_EXIT_USAGE, f, "expected torus, lloyd or random, got '%s'", v);
         return 0;
-    }
-    if (!strcmp(f, "--radius")) {
-        a->lk_has_radius = 1;
-        return cli_real(f, v, 0.0, 1, CLI_FLT_MAX, "a radius > 0", &a->lk_radius);
     }
     if (!strcmp(f, "--falloff")) {
         if (!strcmp(v, "constant")) a->lk_falloff = HFVIS_LK_FALLOFF_CONSTANT;
@@ -87,14 +79,8 @@ static int cli_set_lk(cli_args *a, const char *f, const char *v)
     if (!strcmp(f, "--eye")) { a->lk_has_eye = 1; return cli_xyz(f, v, a->lk_eye); }
     if (!strcmp(f, "--target")) { a->lk_has_target = 1; return cli_xyz(f, v, a->lk_target); }
     if (!strcmp(f, "--up")) { a->lk_has_up = 1; return cli_xyz(f, v, a->lk_up); }
-    if (!strcmp(f, "--fov")) return cli_real(f, v, 1.0, 0, 179.0, "degrees in 1..179", &a->lk_fov);
     if (!strcmp(f, "--size")) return cli_size(f, v, &a->lk_width, &a->lk_height);
     if (!strcmp(f, "--two-sided")) { a->lk_two_sided = 1; return 0; }
-    if (!strcmp(f, "--lut"))
-        return cli_int(f, v, HFVIS_LK_LUT_MIN_RESOLUTION, HFVIS_LK_LUT_MAX_RESOLUTION,
-                       "a table resolution 2..1024", &a->lk_lut);
-    if (!strcmp(f, "--seed"))
-        return cli_real(f, v, 0.0, 0, 9007199254740992.0, "an integer 0..2^53", &a->lk_seed);
     if (!strcmp(f, "--no-jitter")) { a->lk_no_jitter = 1; return 0; }
     return -1;
 }
@@ -121,23 +107,6 @@ static int cli_set_vf(cli_args *a, const char *f, const char *v)
         a->out_pgm = cli_ends_with(v, ".pgm");
         return 0;
     }
-    if (!strcmp(f, "--positions")) {
-        int k, n;
-        if (cli_int(f, v, 1, INT_MAX, "a count 2(2n^2+2n+1) such as 290, 1090 or 4226", &k))
-            return CLI_EXIT_USAGE;
-        for (n = 1; n <= HFVIS_VISFIELD_MAX_N; n++)
-            if (hfvis_visfield_position_count(n) >= (size_t)k) break;
-        if (n > HFVIS_VISFIELD_MAX_N || hfvis_visfield_position_count(n) != (size_t)k) {
-            if (n > HFVIS_VISFIELD_MAX_N)
-                return cli_error(CLI_EXIT_USAGE, f, "at most %zu positional samples, got '%s'",
-                                 hfvis_visfield_position_count(HFVIS_VISFIELD_MAX_N), v);
-            return cli_error(CLI_EXIT_USAGE, f, "expected a count 2(2n^2+2n+1), got '%s' (nearest: "
-                             "%zu or %zu)", v, n > 1 ? hfvis_visfield_position_count(n - 1) : 0,
-                             hfvis_visfield_position_count(n));
-        }
-        a->vf_positions = n; /* stored as the frequency n */
-        return 0;
-    }
     if (!strcmp(f, "--format")) {
         if (!strcmp(v, "u8")) a->vf_format = HFVIS_VISFIELD_U8;
         else if (!strcmp(v, "f32")) a->vf_format = HFVIS_VISFIELD_F32;
@@ -155,8 +124,6 @@ static int cli_set_vf(cli_args *a, const char *f, const char *v)
     }
     if (!strcmp(f, "--ao")) { a->vf_ao = 1; return 0; }
     if (!strcmp(f, "--size")) { a->vf_has_size = 1; return -1; } /* WxH parsed by volgi's code */
-    if (!strcmp(f, "--rays"))
-        return cli_int(f, v, 1, HFVIS_VISFIELD_MAX_RAYS_SQRT, "an integer 1..256", &a->vf_rays);
     if (!strcmp(f, "--reference")) { a->vf_reference = v; return 0; }
     return -1;
 }
@@ -190,9 +157,7 @@ static int cli_check_vf(const cli_args *a)
 static void cli_volgi_defaults(cli_args *a)
 {
     a->vg_up[0] = 0.0, a->vg_up[1] = 0.0, a->vg_up[2] = 1.0;
-    a->vg_fov = 40.0;
     a->vg_width = 512, a->vg_height = 512;
-    a->iterations = HFVIS_VOLGI_DEFAULT_ITERATIONS;
 }
 
 /* Parse "r1,r2,...": between min and max finite reals (s[0..len)); returns the count or -1. */
@@ -290,7 +255,6 @@ static int cli_set_volgi(cli_args *a, const char *f, const char *v)
         if (f[2] == 't') a->vg_has_target = 1;
         return cli_xyz(f, v, f[2] == 'e' ? a->vg_eye : f[2] == 't' ? a->vg_target : a->vg_up);
     }
-    if (!strcmp(f, "--fov")) return cli_real(f, v, 1.0, 0, 179.0, "degrees in 1..179", &a->vg_fov);
     if (!strcmp(f, "--size")) return cli_size(f, v, &a->vg_width, &a->vg_height);
     if (!strcmp(f, "--transfer")) {
         if (!strcmp(v, "cone")) a->vg_transfer = HFVIS_VOLGI_TRANSFER_CONE;
@@ -309,12 +273,6 @@ static int cli_set_volgi(cli_args *a, const char *f, const char *v)
         else if (!strcmp(v, "diffuse")) a->vg_reflection = HFVIS_VOLGI_REFLECT_DIFFUSE;
         else return cli_error(CLI_EXIT_USAGE, f, "expected mirror or diffuse, got '%s'", v);
         return 0;
-    }
-    if (!strcmp(f, "--reflectance")) {
-        a->vg_has_rho = 1;
-        if (!strcmp(v, "albedo")) { a->vg_rho_albedo = 1; return 0; }
-        a->vg_rho_albedo = 0;
-        return cli_real(f, v, 0.0, 0, 1.0, "a reflectance in 0..1 or 'albedo'", &a->vg_rho);
     }
     return -1;
 }
@@ -589,7 +547,7 @@ static int cli_vf_build(const cli_args *a)
                fmt_names[vf.format], vf.center[0], vf.center[1], vf.center[2], vf.radius,
                hfvis_visfield_encode_size(&vf));
 done:
-    if (cli_bar_open) { fputc('\n', stderr); cli_bar_open = 0; }
+    cli_progress_end(a->run, rc);
     free(vf.maps);
     hfvis_mesh_free(NULL, &mesh);
     return rc;

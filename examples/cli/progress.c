@@ -2,7 +2,11 @@
  * cli_status), the progress bar over several library calls, the --progress lines and the clock.
  * Owns: how a run reports to stderr. May call: the C library only. */
 
-/* Print the one error line "hfvis: <what>: <why>" and return code. */
+/* Print the one error line "hfvis: <what>: <why>" and return code. The progress bar is drawn
+ * only on a terminal (cli_run_heights, cli_vf_build) and its line stays open while a run goes on,
+ * so on a terminal the line is first erased (carriage return, then VT100 "erase to the end of the
+ * line", which leaves an empty line as it is): an error never lands after an unfinished bar, and
+ * no state is needed to know whether one is open. Every error line of the tool is printed here. */
 static int cli_error(int code, const char *what, const char *fmt, ...)
 {
     char why[512];
@@ -10,7 +14,7 @@ static int cli_error(int code, const char *what, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(why, sizeof why, fmt, ap);
     va_end(ap);
-    if (cli_bar_open) { fputc('\n', stderr); cli_bar_open = 0; }
+    if (cli_stderr_is_terminal()) fputs("\r\033[K", stderr);
     ex_error(what, why);
     return code;
 }
@@ -58,9 +62,17 @@ static void cli_progress(void *user, int done, int total)
     for (i = 0; i < BAR; i++) bar[i] = i < fill ? '#' : '.';
     bar[BAR] = '\0';
     fprintf(stderr, "\r%s [%s] %lld/%lld", p->label, bar, now, all);
-    cli_bar_open = now < all;
-    if (!cli_bar_open) fputc('\n', stderr);
+    p->run->bar_open = now < all;
+    if (!p->run->bar_open) fputc('\n', stderr);
     fflush(stderr);
+}
+
+/* At the end of a run that drew a bar: a bar that fell short of its total gets its newline
+ * after a success (rc 0); after a failure the error line has erased it (cli_error). */
+static void cli_progress_end(cli_run_state *run, int rc)
+{
+    if (run->bar_open && rc == 0) fputc('\n', stderr);
+    run->bar_open = 0;
 }
 
 /* --max-memory's default: half of the physical memory where sysconf reports it, else 0 (none). */

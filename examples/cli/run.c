@@ -3,61 +3,116 @@
  * parsed command to its family. May call: every command family, write.c, gis.c, tiles.c, split.c,
  * progress.c. */
 
-/* The estimate of a command on a w x h input (height fields, ssao) or from its flags (meshes,
- * volumes). Height fields: input, output, the sweep's lattice (about min(W^2 + H^2,
- * (W + H)^2/2) nodes of 8-byte heights, 12-byte normals and 8 bytes a channel), the grid
- * accumulator; the work is K sweeps over the lattice. A model of the allocations, not a bound
- * on them (the file buffers of the codecs come on top for a moment). */
-static cli_cost cli_estimate(const cli_args *a, int w, int h, int channels)
+/* The estimates: one per command row (main.c, cli_commands' estimate column), of a run on a w x h
+ * input (height fields, ssao) or from its flags (meshes, volumes: w = h = 0), with channels the
+ * output's channels. A model of the allocations, not a bound on them (the file buffers of the
+ * codecs come on top for a moment). */
+static cli_cost cli_cost_of(double bytes, double work, const char *unit)
 {
     cli_cost c;
-    double n = (double)w * (double)h, W = (double)w, H = (double)h, K = (double)a->dirs, lat, ch = channels;
-    double diag2 = W * W + H * H, thin = (W + H) * (W + H) / 2.0;
-    lat = diag2 < thin ? diag2 : thin;
-    c.bytes = 0.0, c.work = 0.0, c.unit = "lattice nodes swept";
-    switch (a->cmd) {
-    case CMD_VOXELIZE:
-        c.bytes = pow((double)a->res, 3.0), c.work = c.bytes, c.unit = "voxels";
-        return c;
-    case CMD_VOLGI:
-        c.bytes = pow((double)a->res, 3.0) * 4.0 * 16.0 + (double)a->vg_width * (double)a->vg_height * 12.0;
-        c.work = pow((double)a->res, 3.0) * (double)a->iterations, c.unit = "voxel updates";
-        return c;
-    case CMD_VISFIELD:
-        if (a->vf_ao) {
-            c.bytes = (double)a->vg_width * (double)a->vg_height * 4.0;
-            c.work = c.bytes / 4.0 * (double)(a->vf_rays ? a->vf_rays : 64), c.unit = "rays";
-        } else {
-            double P = (double)(a->vf_positions ? a->vf_positions : 82), D = (double)(a->has_dirs ? a->dirs : 16);
-            c.bytes = P * 2.0 * D * D * 4.0, c.work = P * 2.0 * D * D, c.unit = "direction texels";
-        }
-        return c;
-    case CMD_MESHAO:
-        c.bytes = (double)a->lk_width * (double)a->lk_height * 16.0;
-        c.work = (double)a->lk_width * (double)a->lk_height * (double)(a->lk_rays ? a->lk_rays : 64);
-        c.unit = "rays";
-        return c;
-    case CMD_SSAO:
-        c.bytes = n * 8.0, c.work = n * (a->has_dirs ? K : 16.0) * (W > H ? W : H) / 4.0, c.unit = "depth samples";
-        return c;
-    case CMD_VIEWSHED:
-        c.bytes = n * 8.0, c.work = (W + H) * (W > H ? W : H), c.unit = "line-of-sight steps";
-        return c;
-    case CMD_HORIZON: ch = 4.0; break;
-    case CMD_GI: c.bytes = n * 4.0 * 64.0; break; /* the NS09 pyramids and SH planes */
-    case CMD_SOLAR: /* the K = 64 map twice (sweep and sample-major), state, outputs, the map's sweeps */
-        c.bytes = n * (8.0 * 64.0 + 160.0 + 20.0);
-        c.work = 64.0 * 16.0 * n, c.unit = "ray crossings";
-        return c;
-    default: break;
-    }
-    c.bytes += n * 4.0 + n * 4.0 * (a->cmd == CMD_HORIZON ? K : (double)channels); /* in, out */
-    c.bytes += lat * (8.0 + 12.0 + 8.0 * ch) + n * (12.0 + 8.0 * ch);             /* sweep */
-    if (a->cmd == CMD_VISIBILITY || a->cmd == CMD_INDIRECT) c.bytes += lat * 8.0 * ch;
-    c.work = K * (n + lat / 4.0);
-    if (a->cmd == CMD_INDIRECT) c.work *= (double)(a->bounces + 1);
-    if (a->cmd == CMD_VISIBILITY && a->fraction) c.work *= 2.0;
+    c.bytes = bytes, c.work = work, c.unit = unit;
     return c;
+}
+
+/* The sweep commands: input, output (planes of one channel or channels), the sweep's lattice
+ * (about min(W^2 + H^2, (W + H)^2/2) nodes of 8-byte heights, 12-byte normals and 8 bytes a
+ * lattice channel ch), the grid accumulator, and bytes more per cell (gi's pyramids) and per
+ * lattice node (the [P2] hull tree's); the work is K sweeps over the lattice. */
+static cli_cost cli_sweep_cost(const cli_args *a, int w, int h, double out, double ch, double cell_bytes,
+                               double node_bytes)
+{
+    double n = (double)w * (double)h, W = (double)w, H = (double)h, K = (double)a->dirs, lat;
+    double diag2 = W * W + H * H, thin = (W + H) * (W + H) / 2.0;
+    cli_cost c = cli_cost_of(n * cell_bytes, 0.0, "lattice nodes swept");
+    lat = diag2 < thin ? diag2 : thin;
+    c.bytes += n * 4.0 + n * 4.0 * out;                                 /* in, out */
+    c.bytes += lat * (8.0 + 12.0 + 8.0 * ch) + n * (12.0 + 8.0 * ch);   /* sweep */
+    if (node_bytes > 0.0) c.bytes += lat * node_bytes;
+    c.work = K * (n + lat / 4.0);
+    return c;
+}
+/* every sweep command but these below: one output of the channels, a lattice of as many */
+static cli_cost cli_estimate_sweep(const cli_args *a, int w, int h, int channels)
+{
+    return cli_sweep_cost(a, w, h, (double)channels, (double)channels, 0.0, 0.0);
+}
+/* horizon: K planes out, 4 lattice channels */
+static cli_cost cli_estimate_horizon(const cli_args *a, int w, int h, int channels)
+{
+    (void)channels;
+    return cli_sweep_cost(a, w, h, (double)a->dirs, 4.0, 0.0, 0.0);
+}
+/* gi: the NS09 pyramids and SH planes, 256 bytes a cell */
+static cli_cost cli_estimate_gi(const cli_args *a, int w, int h, int channels)
+{
+    return cli_sweep_cost(a, w, h, (double)channels, (double)channels, 4.0 * 64.0, 0.0);
+}
+/* visibility: the hull tree; --fraction sweeps twice */
+static cli_cost cli_estimate_visibility(const cli_args *a, int w, int h, int channels)
+{
+    cli_cost c = cli_sweep_cost(a, w, h, (double)channels, (double)channels, 0.0, 8.0 * (double)channels);
+    if (a->fraction) c.work *= 2.0;
+    return c;
+}
+/* indirect: the hull tree, one gather per bounce and the direct light */
+static cli_cost cli_estimate_indirect(const cli_args *a, int w, int h, int channels)
+{
+    cli_cost c = cli_sweep_cost(a, w, h, (double)channels, (double)channels, 0.0, 8.0 * (double)channels);
+    c.work *= (double)(a->bounces + 1);
+    return c;
+}
+/* solar: the K = 64 map twice (sweep and sample-major), state, outputs, the map's sweeps */
+static cli_cost cli_estimate_solar(const cli_args *a, int w, int h, int channels)
+{
+    double n = (double)w * (double)h;
+    (void)a, (void)channels;
+    return cli_cost_of(n * (8.0 * 64.0 + 160.0 + 20.0), 64.0 * 16.0 * n, "ray crossings");
+}
+/* viewshed: the grid and its output; one line of sight per edge cell */
+static cli_cost cli_estimate_viewshed(const cli_args *a, int w, int h, int channels)
+{
+    double n = (double)w * (double)h, W = (double)w, H = (double)h;
+    (void)a, (void)channels;
+    return cli_cost_of(n * 8.0, (W + H) * (W > H ? W : H), "line-of-sight steps");
+}
+/* ssao: depth and output; K directions march up to max(W, H) / 4 samples */
+static cli_cost cli_estimate_ssao(const cli_args *a, int w, int h, int channels)
+{
+    double n = (double)w * (double)h, W = (double)w, H = (double)h, K = (double)a->dirs;
+    (void)channels;
+    return cli_cost_of(n * 8.0, n * (a->has_dirs ? K : 16.0) * (W > H ? W : H) / 4.0, "depth samples");
+}
+/* voxelize: one byte a voxel */
+static cli_cost cli_estimate_voxelize(const cli_args *a, int w, int h, int channels)
+{
+    double v = pow((double)a->res, 3.0);
+    (void)w, (void)h, (void)channels;
+    return cli_cost_of(v, v, "voxels");
+}
+/* volgi: 16 floats a voxel and the image */
+static cli_cost cli_estimate_volgi(const cli_args *a, int w, int h, int channels)
+{
+    (void)w, (void)h, (void)channels;
+    return cli_cost_of(pow((double)a->res, 3.0) * 4.0 * 16.0 + (double)a->vg_width * (double)a->vg_height * 12.0,
+                       pow((double)a->res, 3.0) * (double)a->iterations, "voxel updates");
+}
+/* visfield: the AO image, or the field's P x 2 x D^2 texels */
+static cli_cost cli_estimate_visfield(const cli_args *a, int w, int h, int channels)
+{
+    double P = (double)(a->vf_positions ? a->vf_positions : 82), D = (double)(a->has_dirs ? a->dirs : 16);
+    (void)w, (void)h, (void)channels;
+    if (a->vf_ao)
+        return cli_cost_of((double)a->vg_width * (double)a->vg_height * 4.0,
+                           (double)a->vg_width * (double)a->vg_height * 4.0 / 4.0 * (double)(a->vf_rays ? a->vf_rays : 64),
+                           "rays");
+    return cli_cost_of(P * 2.0 * D * D * 4.0, P * 2.0 * D * D, "direction texels");
+}
+/* meshao: the image's buffers, its rays */
+static cli_cost cli_estimate_meshao(const cli_args *a, int w, int h, int channels)
+{
+    (void)w, (void)h, (void)channels;
+    return cli_cost_of((double)a->lk_width * (double)a->lk_height * 16.0,
+                       (double)a->lk_width * (double)a->lk_height * (double)(a->lk_rays ? a->lk_rays : 64), "rays");
 }
 
 /* The channels of a height-field command's output, for the estimate before anything is loaded:
@@ -84,7 +139,7 @@ static int cli_out_channels(const cli_args *a)
 static int cli_check_cost(const cli_args *a, int w, int h, int channels)
 {
     const char *cmd = cli_commands[a->cmd].name;
-    cli_cost c = cli_estimate(a, w, h, channels);
+    cli_cost c = cli_commands[a->cmd].estimate(a, w, h, channels);
     if (!a->quiet && (a->progress_lines || cli_stderr_is_terminal()))
         fprintf(stderr, "%s: estimate %.3g MiB, %.3g %s\n", cmd, c.bytes / 1048576.0, c.work, c.unit);
     if (a->max_memory > 0.0 && c.bytes > a->max_memory) {
@@ -129,7 +184,7 @@ static int cli_halo(const cli_args *a, double cell)
 }
 
 /* The largest side S of a square window whose grid, S + 2 halo (clipped to the w x h raster) on
- * each axis, fits --max-memory by cli_estimate; 0 if none does. */
+ * each axis, fits --max-memory by the command's estimate; 0 if none does. */
 static int cli_window_side(const cli_args *a, int halo, int w, int h, int channels)
 {
     int lo = 0, hi = w > h ? w : h;
@@ -138,7 +193,7 @@ static int cli_window_side(const cli_args *a, int halo, int w, int h, int channe
         double gw = (double)mid + 2.0 * halo, gh = gw;
         if (gw > w) gw = w;
         if (gh > h) gh = h;
-        if (cli_estimate(a, (int)gw, (int)gh, channels).bytes <= a->max_memory) lo = mid;
+        if (cli_commands[a->cmd].estimate(a, (int)gw, (int)gh, channels).bytes <= a->max_memory) lo = mid;
         else hi = mid - 1;
     }
     return lo;
@@ -219,7 +274,9 @@ static float *cli_alloc(size_t a, size_t b, size_t c)
     if (a == 0 || b == 0 || c == 0 || a > SIZE_MAX / b || a * b > SIZE_MAX / c ||
         a * b * c > SIZE_MAX / sizeof(float))
         return NULL;
-    return (float *)calloc(a * b * c, sizeof(float)); /* zeros: a window run leaves cells unwritten */
+    float *p = (float *)cli_huge_malloc(a * b * c * sizeof(float)); /* huge pages where offered */
+    if (p) memset(p, 0, a * b * c * sizeof(float)); /* zeros: a window run leaves cells unwritten */
+    return p;
 }
 
 /* IN's size (and cell size, 0 when unknown) from its header alone, for --max-memory before
@@ -278,6 +335,7 @@ static int cli_run_heights(const cli_args *a)
     opts.azimuth0_rad = a->compass ? a->azimuth0 - CLI_PI / 2.0 : a->azimuth0;
     if (a->exact && a->cmd != CMD_VIEWSHED) opts.rays = HFVIS_RAYS_EXACT;
     if (a->cmd != CMD_VIEWSHED) opts.max_distance = a->max_distance; /* viewshed: its own range */
+    opts.alloc = &cli_huge_allocator; /* lattices and planes on huge pages where offered (threads.c) */
     if (a->run->win.active && a->cmd == CMD_OPENNESS) {
         /* openness marches --radius per receiver: the halo holds every cell a window receiver
          * reaches, and the window + halo grid's own border is the raster's wherever a march can
@@ -393,7 +451,7 @@ static int cli_run_heights(const cli_args *a)
     if (a->cmd == CMD_HORIZON) { rc = cli_horizon_finish(a, out, w, h, lo, hi); goto done; }
     rc = cli_save(a, cli_output_of(out, w, h, planes, channels, lo, hi));
 done:
-    if (cli_bar_open) { fputc('\n', stderr); cli_bar_open = 0; } /* a bar that fell short */
+    cli_progress_end(a->run, rc); /* a bar that fell short */
     free(out);
     hfvis_free(NULL, env_px);
     hfvis_free(NULL, z);

@@ -1,7 +1,7 @@
 /* screen.c - screen space: `ssao` (LSAO, HBAO, FFAO, ray traced) on a depth buffer, its flags
  * and its run. May call: progress.c, flags.c's primitives, write.c. */
 
-/* The flags only `ssao` has, and its --method; -1 if f is none of them. */
+/* ssao's --method and --depth (its numbers are rows of the flag table); -1 for another flag. */
 static int cli_set_ssao(cli_args *a, const char *f, const char *v)
 {
     if (!strcmp(f, "--method") || !strcmp(f, "--depth")) {
@@ -15,21 +15,6 @@ static int cli_set_ssao(cli_args *a, const char *f, const char *v)
             }
         return cli_error(CLI_EXIT_USAGE, f, is_method ? "expected lsao, hbao, ffao or raytrace, "
                          "got '%s'" : "expected linear, gl, d3d or reversed, got '%s'", v);
-    }
-    if (!strcmp(f, "--fov-y")) return cli_real(f, v, 0.0, 1, 179.999, "degrees in (0, 180)", &a->ssao_fov);
-    if (!strcmp(f, "--ortho")) {
-        a->ssao_has_ortho = 1;
-        return cli_real(f, v, 0.0, 1, CLI_FLT_MAX, "a scale > 0", &a->ssao_ortho);
-    }
-    if (!strcmp(f, "--radius")) return cli_real(f, v, 0.0, 1, CLI_FLT_MAX, "a radius > 0", &a->ssao_radius);
-    if (!strcmp(f, "--guard")) return cli_int(f, v, 0, 65536, "an integer 0..65536", &a->ssao_guard);
-    if (!strcmp(f, "--near")) {
-        a->ssao_has_near = 1;
-        return cli_real(f, v, -CLI_FLT_MAX, 0, CLI_FLT_MAX, "a finite distance", &a->ssao_near);
-    }
-    if (!strcmp(f, "--far")) {
-        a->ssao_has_far = 1;
-        return cli_real(f, v, -CLI_FLT_MAX, 0, CLI_FLT_MAX, "a finite distance", &a->ssao_far);
     }
     return -1;
 }

@@ -39,21 +39,6 @@ static int cli_set_solar(cli_args *a, const char *f, const char *v)
         a->sol_hour = hh + mm / 60.0;
         return 0;
     }
-    if (!strcmp(f, "--step")) { /* 15m, 1h, 0.5h; a bare number is minutes */
-        char buf[64];
-        size_t n = strlen(v);
-        double s, scale = 1.0 / 60.0;
-        if (n == 0 || n >= sizeof buf) return cli_error(CLI_EXIT_USAGE, f, "expected a step like 15m or 1h, got '%s'", v);
-        memcpy(buf, v, n + 1);
-        if (buf[n - 1] == 'm' || buf[n - 1] == 'h') scale = buf[n - 1] == 'h' ? 1.0 : 1.0 / 60.0, buf[n - 1] = '\0';
-        if (!cli_parse_real(buf, &s) || !(s > 0.0) || s * scale > 24.0)
-            return cli_error(CLI_EXIT_USAGE, f, "expected a step in (0, 24h] like 15m or 1h, got '%s'", v);
-        a->sol_step = s * scale;
-        return 0;
-    }
-    if (!strcmp(f, "--linke"))
-        return cli_real(f, v, 0.0, 1, 10.0, "a Linke turbidity factor in (0, 10]", &a->sol_linke) ? CLI_EXIT_USAGE
-                                                                                          : (a->sol_has_linke = 1, 0);
     if (!strcmp(f, "--linke-monthly")) { /* 12 values, January first */
         const char *p = v;
         int k;
@@ -79,15 +64,6 @@ static int cli_set_solar(cli_args *a, const char *f, const char *v)
         return 0;
     }
     if (!strcmp(f, "--linke-map")) { a->sol_linke_map = v; return 0; }
-    if (!strcmp(f, "--latitude"))
-        return cli_real(f, v, -90.0, 0, 90.0, "a latitude in degrees, -90..90", &a->sol_lat) ? CLI_EXIT_USAGE
-                                                                                        : (a->sol_has_lat = 1, 0);
-    if (!strcmp(f, "--longitude"))
-        return cli_real(f, v, -180.0, 0, 180.0, "a longitude in degrees, -180..180 (east positive)", &a->sol_lon)
-                   ? CLI_EXIT_USAGE : (a->sol_has_lon = 1, 0);
-    if (!strcmp(f, "--utc-offset"))
-        return cli_real(f, v, -14.0, 0, 14.0, "hours east of UTC, -14..14", &a->sol_offset) ? CLI_EXIT_USAGE
-                                                                                      : (a->sol_has_offset = 1, 0);
     if (!strcmp(f, "--solar-time")) { a->sol_solar_time = 1; return 0; }
     if (!strcmp(f, "--bands")) {
         if (!strcmp(v, "day")) a->sol_bands = HFVIS_SOLAR_BANDS_DAY;
@@ -243,28 +219,47 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     hfvis_solar_options so = hfvis_solar_options_default();
     hfvis_solar_output out;
     float *planes[5] = { NULL, NULL, NULL, NULL, NULL }, *albedo = NULL, *linke = NULL, monthly[12];
+    double *lats = NULL, *lons = NULL;
+    float *hmap = NULL;
     const char *paths[5];
     cli_tm tm;
     hfvis_status s;
     int rc = 0, bands, k, ch;
     double lat = a->sol_lat, lon = a->sol_lon;
-    if (!a->sol_has_lat) { /* the raster's centre by its CRS */
-        double gt[6], X, Y;
+    if (!a->sol_has_lat) { /* every cell's site by the inverse projection of its centre */
+        double gt[6];
+        size_t i, n = (size_t)w * (size_t)h;
         if (!a->run->geo.has_transform || !cli_solar_tm(&a->run->geo, &tm))
             return cli_error(CLI_EXIT_ERROR, "solar", "the latitude is unknown: IN has no Transverse "
                              "Mercator CRS (UTM, EPSG 326zz/327zz/258zz, or a WKT); give --latitude "
                              "and --longitude");
+        lats = (double *)(void *)cli_alloc(n, 2, sizeof(double) / sizeof(float)); /* 2n doubles */
+        if (!lats) return cli_status("solar", HFVIS_ERR_OUT_OF_MEMORY, 0);
+        lons = lats + n;
         cli_georef(a, grid->cell_size, gt);
-        X = gt[0] + gt[1] * (w / 2.0) + gt[2] * (h / 2.0);
-        Y = gt[3] + gt[4] * (w / 2.0) + gt[5] * (h / 2.0);
-        cli_tm_inverse(&tm, X, Y, &lat, &lon);
-        if (!(fabs(lat) <= 90.0) || !(fabs(lon) <= 360.0))
-            return cli_error(CLI_EXIT_ERROR, "solar", "the raster's centre does not map to a latitude");
-        while (lon > 180.0) lon -= 360.0;
+        for (i = 0; i < n; i++) {
+            double px = (double)(i % (size_t)w) + 0.5, py = (double)(i / (size_t)w) + 0.5, la, lo;
+            cli_tm_inverse(&tm, gt[0] + gt[1] * px + gt[2] * py, gt[3] + gt[4] * px + gt[5] * py, &la, &lo);
+            if (!(fabs(la) <= 90.0) || !(fabs(lo) <= 540.0)) {
+                free(lats);
+                return cli_error(CLI_EXIT_ERROR, "solar", "cell %d, %d does not map to a latitude and "
+                                 "longitude", (int)(i % (size_t)w), (int)(i / (size_t)w));
+            }
+            while (lo > 180.0) lo -= 360.0;
+            while (lo < -180.0) lo += 360.0;
+            lats[i] = la * (CLI_PI / 180.0);
+            lons[i] = lo * (CLI_PI / 180.0);
+        }
+        cli_tm_inverse(&tm, gt[0] + gt[1] * (w / 2.0) + gt[2] * (h / 2.0),
+                       gt[3] + gt[4] * (w / 2.0) + gt[5] * (h / 2.0), &lat, &lon);
+        while (lon > 180.0) lon -= 360.0; /* the centre's (every cell's mapped above) */
         while (lon < -180.0) lon += 360.0;
+        in.latitude_map = lats;
+        in.longitude_map = lons;
     }
     if (a->progress_lines && !a->quiet)
-        fprintf(stderr, "hfvis solar: site %.5f, %.5f (latitude, longitude of the grid's centre)\n", lat, lon);
+        fprintf(stderr, "hfvis solar: site %.5f, %.5f (latitude, longitude of the grid's centre%s)\n", lat, lon,
+                lats ? "; each cell's own by the inverse projection" : "");
     in.latitude_rad = lat * (CLI_PI / 180.0);
     in.longitude_rad = lon * (CLI_PI / 180.0);
     in.year = a->sol_y;
@@ -287,7 +282,7 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
         so.linke_monthly = monthly;
     }
     if (a->albedo_map) {
-        if ((rc = cli_load_map(a->albedo_map, grid, &albedo, &ch)) != 0) return rc;
+        if ((rc = cli_load_map(a->albedo_map, grid, &albedo, &ch)) != 0) goto done;
         so.albedo_map = albedo;
     }
     if (a->sol_linke_map && (rc = cli_load_map(a->sol_linke_map, grid, &linke, &ch)) != 0) goto done;
@@ -310,6 +305,24 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
         }
     out.beam = planes[0]; out.diffuse = planes[1]; out.reflected = planes[2];
     out.global = planes[3]; out.sun_hours = planes[4];
+    if (a->threads > 1) { /* the exact horizon map by directions over the threads (bit for bit) */
+        hfvis_sweep_options ms = *opts;
+        int K = so.directions;
+        ms.rays = HFVIS_RAYS_EXACT; /* as the library's own map (hfvis_solar_options.horizon_map) */
+        ms.ray_denominator = 0;
+        ms.azimuth0_rad = 0.0;
+        ms.direction_begin = ms.direction_end = 0;
+        ms.direction_order = HFVIS_DIRECTION_ORDER_DEFAULT;
+        if (!(hmap = cli_alloc((size_t)w * (size_t)h, (size_t)K, 1))) {
+            rc = cli_status("solar", HFVIS_ERR_OUT_OF_MEMORY, 0);
+            goto done;
+        }
+        if ((s = cli_threaded_horizon_map(grid, K, &ms, a->threads, hmap)) != HFVIS_OK) {
+            rc = cli_status("solar", s, 0);
+            goto done;
+        }
+        so.horizon_map = hmap;
+    }
     s = hfvis_solar_irradiation(grid, &in, &so, &out);
     if (s == HFVIS_ERR_INVALID_ARGUMENT && (a->sol_linke_map || a->albedo_map)) {
         rc = cli_error(CLI_EXIT_ERROR, a->sol_linke_map ? a->sol_linke_map : a->albedo_map,
@@ -329,5 +342,7 @@ done:
     for (k = 0; k < 5; k++) free(planes[k]);
     hfvis_free(NULL, albedo);
     hfvis_free(NULL, linke);
+    free(lats);
+    free(hmap);
     return rc;
 }

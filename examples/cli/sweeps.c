@@ -2,23 +2,6 @@
  * overflow check, gi's flags and run, and the horizon's planes per file (--split).
  * May call: progress.c, gis.c, write.c. */
 
-/* The flags only `gi` has; -1 if f is none of them. */
-static int cli_set_gi(cli_args *a, const char *f, const char *v)
-{
-    if (!strcmp(f, "--order")) return cli_int(f, v, 1, 4, "an integer 1..4", &a->order);
-    if (!strcmp(f, "--subsample"))
-        return cli_int(f, v, 1, HFVIS_NS_MAX_SUBSAMPLE, "an integer 1..64", &a->subsample);
-    if (!strcmp(f, "--specular")) {
-        a->has_specular = 1;
-        return cli_real(f, v, 0.0, 0, CLI_FLT_MAX, "a weight >= 0", &a->specular);
-    }
-    if (!strcmp(f, "--shininess")) {
-        a->has_shininess = 1;
-        return cli_real(f, v, 0.0, 1, CLI_FLT_MAX, "an exponent > 0", &a->shininess);
-    }
-    return -1;
-}
-
 /* The light flags `gi` and `indirect` share: the sun needs both angles (and its other flags a
  * sun), the sky and an environment exclude each other, --output agrees with --bounces; returns 0
  * or CLI_EXIT_USAGE (message printed). */
@@ -190,7 +173,7 @@ static int cli_run_gi(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_opt
     scene.env_sh = env_sh;
     for (c = 0; c < 4; c++) scene.albedo[c] = (float)a->albedo;
     scene.specular = (float)a->specular;
-    scene.shininess = (float)(a->has_shininess ? a->shininess : 32.0);
+    scene.shininess = (float)a->shininess; /* --shininess, default 32 */
     if (a->has_sun_azimuth) {
         double psi_deg = a->math ? a->sun_azimuth : a->sun_azimuth - 90.0;
         sun.azimuth_rad = psi_deg * (CLI_PI / 180.0);
@@ -297,6 +280,30 @@ static int cli_horizon_labels(const cli_args *a, cli_labels *L)
         L->meta[3 + k].name = "AZIMUTH", L->meta[3 + k].value = L->values[k], L->meta[3 + k].band = k + 1;
     }
     return 0;
+}
+
+/* A horizon map's labels rebuilt from the tag of its run (a piece's sidecar for mosaic, a partial
+ * result for sum): its dirs (which must be planes), azimuth0 (the library's psi_0), convention,
+ * degrees and rays. Returns 0 with L zeroed (no labels: a tag of an older hfvis) when a key is
+ * missing or names another count, 0 with L filled, or an error (reported). */
+static int cli_horizon_labels_of_tag(const char *tag, int planes, cli_labels *L)
+{
+    cli_args a;
+    double az0 = 0.0, deg = 0.0, conv = 0.0, dirs = 0.0;
+    char rays[16] = "";
+    memset(&a, 0, sizeof a);
+    memset(L, 0, sizeof *L);
+    if (!cli_tag_real(tag, "dirs", &dirs) || !cli_tag_real(tag, "azimuth0", &az0) ||
+        !cli_tag_real(tag, "convention", &conv) || !cli_tag_real(tag, "degrees", &deg) ||
+        !cli_tag_value(tag, "rays", rays, sizeof rays) || dirs != (double)planes || !(conv >= 0.0 && conv <= 2.0))
+        return 0;
+    a.cmd = CMD_HORIZON;
+    a.dirs = planes;
+    a.azimuth0 = az0; /* psi_0 itself: a.compass is 0 */
+    a.convention = (int)conv;
+    a.degrees = deg != 0.0;
+    a.exact = !strcmp(rays, "exact");
+    return cli_horizon_labels(&a, L);
 }
 
 /* horizon, after the sweep: the planes in the user's convention's order (GRASS's run

@@ -1,6 +1,7 @@
 /* threads.c - --threads: the work of one run split over POSIX threads so that the output equals
  * the one-thread run's bit for bit (hfvis.h, "Threads"): the direction sums by quarter-turn group
- * (lattice) or by direction (exact) added in order, the horizon map by plane range, one sun by
+ * added in order (lattice) or by bands of one direction at a time added in place (exact), the
+ * horizon map by plane range, one sun by
  * bands across its direction, and openness --radius by row bands (receiver rectangles). The library
  * stays single-threaded; every call here is one of its reentrant calls on shared inputs. Without
  * POSIX threads (CLI_HAVE_THREADS 0) every split runs its units in order on the calling thread.
@@ -36,9 +37,11 @@ struct cli_split {
     int units, threads;
     cli_unit_fn unit;
     cli_merge_fn merge;                  /* NULL: units write disjoint outputs, no merge */
+    int phase;                           /* 0, or units per phase: a unit starts only after
+                                            every unit of the phases before its own finished */
     void *ctx;                           /* the caller's */
     const hfvis_sweep_options *opts;     /* copied per unit; progress replaced */
-    int next, merged;                    /* next unit to take; units merged so far */
+    int next, merged, finished;          /* next unit to take; units merged; units finished */
     hfvis_status status;                 /* the first failure (by unit order of discovery) */
     long long done, total;               /* progress: library calls' steps over all threads */
 #if CLI_HAVE_THREADS
@@ -88,6 +91,40 @@ static void cli_split_progress(void *user, int done, int total)
     cli_split_unlock(sp);
 }
 
+/* Large blocks (lattices, tangent planes, sums) are advised onto transparent huge pages where
+ * the system offers them (madvise MADV_HUGEPAGE, Linux; elsewhere plain malloc): their first
+ * touch then faults once per 2 MiB instead of once per 4 KiB page (about 11 us each on this
+ * project's VMs), and the lattice gathers miss the TLB less. Measured in docs/performance.md,
+ * Threads. cli_huge_alloc is the hfvis_allocator form, which every sweep command passes. */
+#define CLI_HUGE_MIN ((size_t)4 << 20) /* smaller blocks stay on ordinary pages */
+static void *cli_huge_malloc(size_t size)
+{
+    void *p = malloc(size ? size : 1);
+#if defined(MADV_HUGEPAGE) && defined(_SC_PAGESIZE)
+    long page = sysconf(_SC_PAGESIZE);
+    if (p && size >= CLI_HUGE_MIN && page > 0) { /* the whole pages inside the block */
+        size_t mask = (size_t)page - 1, head = (size_t)(((uintptr_t)p + mask) & ~(uintptr_t)mask) - (size_t)(uintptr_t)p;
+        if (head < size && ((size - head) & ~mask) > 0)
+            (void)madvise((char *)p + head, (size - head) & ~mask, MADV_HUGEPAGE); /* a hint: failure is harmless */
+    }
+#endif
+    return p;
+}
+
+static void *cli_huge_alloc(void *user, size_t size)
+{
+    (void)user;
+    return cli_huge_malloc(size);
+}
+
+static void cli_huge_free(void *user, void *ptr)
+{
+    (void)user;
+    free(ptr);
+}
+
+static const hfvis_allocator cli_huge_allocator = {cli_huge_alloc, cli_huge_free, NULL};
+
 /* Each thread's allocator keeps the blocks the library frees and hands them back at its next
  * call of the same size: a unit's lattice and accumulator are page-faulted once per thread, not
  * once per unit (a first touch costs about 11 us per 4 KiB page on this project's VMs:
@@ -110,7 +147,7 @@ static void *cli_keep_alloc(void *user, size_t size)
         k->used[best] = 1;
         return k->ptr[best];
     }
-    p = malloc(size ? size : 1);
+    p = cli_huge_malloc(size);
     if (p && k->n < CLI_KEEP_BLOCKS) {
         k->ptr[k->n] = p;
         k->size[k->n] = size;
@@ -160,6 +197,11 @@ static void *cli_split_worker(void *arg)
         int u;
         cli_split_lock(sp);
         u = sp->status == HFVIS_OK && sp->next < sp->units ? sp->next++ : -1;
+#if CLI_HAVE_THREADS
+        while (u >= 0 && sp->phase && sp->finished < u / sp->phase * sp->phase && sp->status == HFVIS_OK)
+            pthread_cond_wait(&sp->turn, &sp->lock); /* the phases before u's: all finished */
+#endif
+        if (sp->status != HFVIS_OK) u = -1;
         cli_split_unlock(sp);
         if (u < 0) break;
         up.sp = sp;
@@ -175,6 +217,7 @@ static void *cli_split_worker(void *arg)
 #endif
         if (sp->merge && sp->status == HFVIS_OK) sp->merge(sp, u, thread);
         sp->merged = u + 1;
+        sp->finished++;
 #if CLI_HAVE_THREADS
         pthread_cond_broadcast(&sp->turn);
 #endif
@@ -189,7 +232,7 @@ static hfvis_status cli_split_run(cli_split *sp)
 {
     cli_worker args[CLI_THREADS_MAX];
     int t;
-    sp->next = sp->merged = 0;
+    sp->next = sp->merged = sp->finished = 0;
     sp->status = HFVIS_OK;
     sp->done = 0;
     if (sp->threads > sp->units) sp->threads = sp->units;
@@ -226,13 +269,18 @@ static float cli_sum_finish(int cmd, int K, double scale, double S)
     return (float)(0.0 + scale * S);
 }
 
-/* ---- the direction sums (skyview, sky, light): one quarter-turn group (lattice, K % 4 == 0, in
- * sweep order) or one direction (exact rays, or K % 4 != 0) per unit, each into its thread's
- * scratch, added in unit order: the additions of the single run, one unit at a time (hfvis.h,
- * split runs), so the sums and their finish are its bits. */
+/* ---- the direction sums (skyview, sky, light). Lattice: one quarter-turn group (K % 4 == 0, in
+ * sweep order) or one direction (K % 4 != 0) per unit, each into its thread's scratch, added in
+ * unit order: the additions of the single run, one unit at a time (hfvis.h, split runs). Exact
+ * rays: one phase per direction in index order, CLI_EXACT_BANDS_PER_THREAD bands across it per
+ * thread, each band adding its receivers' terms in place to the one array of sums (hfvis.h,
+ * hfvis_direction_sums, bands): no scratch sums, no merge, and no thread waits on a costlier
+ * direction (an exact direction costs about |a| + |b| crossings per receiver, 1 to 9 at K = 16).
+ * Either way the sums and their finish are the single run's bits. */
+#define CLI_EXACT_BANDS_PER_THREAD 2 /* mirror bands pair up, so even counts balance */
 typedef struct cli_sums_split {
     const hfvis_grid *grid;
-    int K, per, channels;
+    int K, per, channels, bands;
     hfvis_sum_kind kind;
     const hfvis_env *env;
     const hfvis_env_options *eopts;
@@ -249,6 +297,18 @@ static hfvis_status cli_sums_unit(cli_split *sp, int u, int thread, hfvis_sweep_
     o->direction_end = u * j->per + j->per;
     return hfvis_direction_sums(j->grid, j->K, j->kind, j->env, j->eopts, o,
                                 j->scratch + (size_t)thread * j->count);
+}
+
+static hfvis_status cli_band_sums_unit(cli_split *sp, int u, int thread, hfvis_sweep_options *o)
+{
+    cli_sums_split *j = (cli_sums_split *)sp->ctx;
+    (void)thread;
+    o->direction_order = HFVIS_DIRECTION_ORDER_INDEX;
+    o->direction_begin = u / j->bands;
+    o->direction_end = u / j->bands + 1;
+    o->part_index = u % j->bands;
+    o->part_count = j->bands;
+    return hfvis_direction_sums(j->grid, j->K, j->kind, j->env, j->eopts, o, j->acc);
 }
 
 static void cli_sums_merge(cli_split *sp, int u, int thread)
@@ -281,15 +341,25 @@ static hfvis_status cli_threaded_sums(const hfvis_grid *grid, int K, hfvis_sum_k
     j.per = opts->rays != HFVIS_RAYS_EXACT && K % 4 == 0 ? 4 : 1;
     j.count = (size_t)grid->width * (size_t)grid->height * (size_t)channels;
     j.acc = acc;
+    sp.opts = opts;
+    sp.ctx = &j;
+    if (opts->rays == HFVIS_RAYS_EXACT) { /* bands of one direction at a time, in place */
+        j.bands = threads * CLI_EXACT_BANDS_PER_THREAD;
+        memset(acc, 0, j.count * sizeof(double));
+        sp.units = K * j.bands;
+        sp.phase = j.bands;
+        sp.threads = threads;
+        sp.unit = cli_band_sums_unit;
+        sp.total = sp.units;
+        return cli_split_run(&sp);
+    }
     sp.units = K / j.per;
     sp.threads = threads;
     if (sp.threads > sp.units) sp.threads = sp.units;
-    j.scratch = (double *)malloc(j.count * (size_t)sp.threads * sizeof(double)); /* count <= 2^28*4 */
+    j.scratch = (double *)cli_huge_malloc(j.count * (size_t)sp.threads * sizeof(double)); /* count <= 2^28*4 */
     if (!j.scratch) return HFVIS_ERR_OUT_OF_MEMORY;
     sp.unit = cli_sums_unit;
     sp.merge = cli_sums_merge;
-    sp.ctx = &j;
-    sp.opts = opts;
     sp.total = K;
     s = cli_split_run(&sp);
     free(j.scratch);
@@ -298,7 +368,8 @@ static hfvis_status cli_threaded_sums(const hfvis_grid *grid, int K, hfvis_sum_k
 
 /* skyview, sky or light (cmd) over all K directions on `threads` threads: S by
  * cli_threaded_sums, finished as the single run (scale: sky * albedo, or albedo, as the floats the
- * run passes), out[(y*width + x)*channels + c]. */
+ * run passes), out[(y*width + x)*channels + c]. The lit commands compute the grid normals once
+ * and give them to every unit (sweep options normals) instead of each call making its own. */
 static hfvis_status cli_threaded_light(int cmd, const hfvis_grid *grid, int K, double scale,
                                        const hfvis_env *env, const hfvis_env_options *eopts,
                                        const hfvis_sweep_options *opts, int threads, int channels,
@@ -306,13 +377,21 @@ static hfvis_status cli_threaded_light(int cmd, const hfvis_grid *grid, int K, d
 {
     const hfvis_sum_kind kind = cmd == CMD_SKYVIEW ? HFVIS_SUM_SKY_VIEW
                                 : cmd == CMD_SKY ? HFVIS_SUM_SKY_LIGHT : HFVIS_SUM_ENV_LIGHT;
-    const size_t count = (size_t)grid->width * (size_t)grid->height * (size_t)channels;
-    double *acc = (double *)malloc(count * sizeof(double));
-    hfvis_status s;
+    const size_t n = (size_t)grid->width * (size_t)grid->height, count = n * (size_t)channels;
+    double *acc = (double *)cli_huge_malloc(count * sizeof(double));
+    float *nrm = NULL;
+    hfvis_sweep_options o = *opts;
+    hfvis_status s = HFVIS_OK;
     size_t i;
     if (!acc) return HFVIS_ERR_OUT_OF_MEMORY;
-    s = cli_threaded_sums(grid, K, kind, env, eopts, opts, threads, channels, acc);
+    if (cmd != CMD_SKYVIEW && !o.normals) { /* the grid normals once, shared by every unit */
+        nrm = n <= SIZE_MAX / (3 * sizeof(float)) ? (float *)cli_huge_malloc(n * 3 * sizeof(float)) : NULL;
+        s = nrm ? hfvis_normals_compute(grid, nrm) : HFVIS_ERR_OUT_OF_MEMORY;
+        o.normals = nrm;
+    }
+    if (s == HFVIS_OK) s = cli_threaded_sums(grid, K, kind, env, eopts, &o, threads, channels, acc);
     for (i = 0; s == HFVIS_OK && i < count; i++) out[i] = cli_sum_finish(cmd, K, scale, acc[i]);
+    free(nrm);
     free(acc);
     return s;
 }
@@ -365,7 +444,7 @@ static hfvis_status cli_threaded_horizon_map(const hfvis_grid *grid, int K, cons
     sp.units = K / j.per;
     sp.threads = threads > sp.units ? sp.units : threads;
     if (j.per == 4) {
-        j.scratch = (float *)malloc(j.n * 4u * (size_t)sp.threads * sizeof(float));
+        j.scratch = (float *)cli_huge_malloc(j.n * 4u * (size_t)sp.threads * sizeof(float));
         if (!j.scratch) return HFVIS_ERR_OUT_OF_MEMORY;
     }
     sp.unit = cli_map_unit;

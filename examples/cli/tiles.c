@@ -335,8 +335,16 @@ static int cli_piece_read(const char *path, const cli_piece *m, int W, int H, fl
  * raster, written as the whole run writes it (cli_save with the whole raster's georeference). */
 static int cli_mosaic(int argc, char **argv)
 {
+    const char **names = (const char **)calloc((size_t)argc, sizeof *names); /* the pieces */
+    int rc = names ? cli_mosaic_pieces(argc, argv, names) : cli_status("mosaic", HFVIS_ERR_OUT_OF_MEMORY, 0);
+    free((void *)names);
+    return rc;
+}
+
+/* cli_mosaic with the array of its pieces' names (at most argc). */
+static int cli_mosaic_pieces(int argc, char **argv, const char **names)
+{
     enum { MAX_PIECES = 65536 };
-    static const char *names[MAX_PIECES];
     cli_piece *meta = NULL;
     cli_args a;
     cli_run_state run;
@@ -490,18 +498,8 @@ static int cli_mosaic(int argc, char **argv)
         cli_labels L;
         memset(&L, 0, sizeof L);
         if (a.cmd == CMD_HORIZON) { /* the whole run's band labels, from the run's tag */
-            double az0 = 0.0, deg = 0.0, conv = 0.0, dirs = 0.0;
-            char rays[16] = "";
-            if (cli_tag_real(meta[0].tag, "dirs", &dirs) && cli_tag_real(meta[0].tag, "azimuth0", &az0) &&
-                cli_tag_real(meta[0].tag, "convention", &conv) && cli_tag_real(meta[0].tag, "degrees", &deg) &&
-                cli_tag_value(meta[0].tag, "rays", rays, sizeof rays) && dirs == (double)planes &&
-                conv >= 0.0 && conv <= 2.0) {
-                a.dirs = planes;
-                a.azimuth0 = az0; /* the library's psi_0 (cli_piece_tag) */
-                a.convention = (int)conv;
-                a.degrees = deg != 0.0;
-                a.exact = !strcmp(rays, "exact");
-                if ((rc = cli_horizon_labels(&a, &L)) != 0) goto done;
+            if ((rc = cli_horizon_labels_of_tag(meta[0].tag, planes, &L)) != 0) goto done;
+            if (L.band) {
                 whole_out.band_names = L.band, whole_out.unit = L.unit;
                 whole_out.meta = L.meta, whole_out.n_meta = planes + 3;
             }

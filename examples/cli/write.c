@@ -36,8 +36,28 @@ static void cli_on_signal(int sig)
     raise(sig);
 }
 
+/* ex_atomic_hold: SIGINT, SIGTERM and SIGHUP wait (blocked, then delivered) while a temporary
+ * file is created and reported, and while a raster's set of files is moved into place. The
+ * signal mask before the outermost hold is restored after it (nested holds count). */
+static sigset_t cli_hold_mask;
+static int cli_hold_depth;
+static void cli_hold(int hold)
+{
+    sigset_t s;
+    if (!hold) {
+        if (cli_hold_depth > 0 && --cli_hold_depth == 0) sigprocmask(SIG_SETMASK, &cli_hold_mask, NULL);
+        return;
+    }
+    if (cli_hold_depth++ > 0) return;
+    sigemptyset(&s);
+    sigaddset(&s, SIGINT);
+    sigaddset(&s, SIGTERM);
+    sigaddset(&s, SIGHUP);
+    sigprocmask(SIG_BLOCK, &s, &cli_hold_mask);
+}
+
 /* Install the handler for SIGINT, SIGTERM and SIGHUP, leaving an ignored signal ignored; ignore
- * SIGXFSZ. */
+ * SIGXFSZ; hold the signals where a raster writer asks (ex_atomic_hold). */
 static void cli_signals(void)
 {
     static const int sigs[3] = { SIGINT, SIGTERM, SIGHUP };
@@ -50,6 +70,7 @@ static void cli_signals(void)
         if (sigaction(sigs[i], NULL, &old) == 0 && old.sa_handler == SIG_IGN) continue;
         sigaction(sigs[i], &sa, NULL);
     }
+    ex_atomic_hold = cli_hold;
 #ifdef SIGXFSZ
     { /* past a file-size limit (ulimit -f), a write fails with EFBIG and is reported, instead of
        * the signal ending the run silently and leaving the temporary file */
@@ -78,7 +99,7 @@ static hfvis_status cli_write(const char *path, unsigned char *bytes, size_t n, 
 
 static hfvis_status cli_write_encoded(const char *path, size_t need, cli_encoder encode, const void *what)
 {
-    unsigned char *buf = need ? (unsigned char *)malloc(need) : NULL;
+    unsigned char *buf = need ? (unsigned char *)cli_huge_malloc(need) : NULL; /* threads.c */
     size_t written = 0;
     hfvis_status s;
     if (!buf) return need ? HFVIS_ERR_OUT_OF_MEMORY : HFVIS_ERR_INVALID_ARGUMENT;
