@@ -9311,38 +9311,37 @@ static void hf_exact_near(hf_exact *E, hf_ray r, double L, double scale)
     }
 }
 
-/* ------------------------------------------------------------------------------------------ */
-/* Near and far field (hfvis_sweep_options.ray_near_cells = D > 0; hfvis.h "Exact rays").     */
-/* A line of direction (a, b) carries one receiver per |(a, b)| cells and costs |a| + |b| - 1   */
-/* crossings per receiver, so fine directions are expensive whatever the constant per sample.   */
-/* Split each receiver's ray at D cells instead:                                                 */
-/*   - near field, u < D cells: every crossing of the receiver's own ray and every piece's      */
-/*     midpoint (plus the interior samples of pieces split in 4 or more, HF_EXACT_BULGE), as a */
-/*     stencil of fixed offsets run over the receivers of a row, no hull; the t -> 0+ limit as  */
-/*     before (hf_exact_near). About 1.4 D crossings per receiver-direction whatever (a, b).   */
-/*   - far field, u >= D cells: lines of direction (a, b) spaced M = floor(|(a, b)|) exact     */
-/*     lines apart (about one cell), anchored at multiples of M of the raster's line index      */
-/*     c = x b - y a. Each far line is sampled like an exact line (every crossing and the split */
-/*     pieces) and its upper hull built from its far end, recording each sample's parent in   */
-/*     the hull ([P1] §5 Alg. 1's stack, kept as a tree: the hull of the samples up to i is   */
-/*     the path from i through the parents). A receiver of one of the M exact lines nearest     */
-/*     the far line (within half a cell of it) finds the last sample at least D cells ahead    */
-/*     (binary search) and walks the path while the tangent from its own point grows (the     */
-/*     hull is concave, so the tangent is unimodal along it). Every far sample lies within half */
-/*     a cell of the receiver's ray and at least D cells away: within atan(1/(2D)) of its       */
-/*     azimuth (HFVIS_EXACT_FAR_*_DEG bound the effect on the horizon). Near the grid's edge   */
-/*     the far line and the receiver's ray end at different distances: where the far tangent   */
-/*     lies beyond the end of the receiver's own ray, or that ray runs on more than a cell     */
-/*     beyond the far line, the receiver marches its own ray (hf_far_march).                   */
-/* Cost: the near stencil plus about 1.3 far samples and one query per receiver-direction.     */
-/* The value of a receiver depends on its own position only (the far line is fixed by the      */
-/* raster's line index), so receiver rectangles and bands give the whole run's bits.            */
+/* Near and far field (hfvis_sweep_options.ray_near_cells = D > 0; hfvis.h "Exact rays"). A line
+ * of direction (a, b) carries one receiver per |(a, b)| cells and costs |a| + |b| - 1 crossings
+ * per receiver, so fine directions are expensive whatever the constant per sample. Split each
+ * receiver's ray at D cells instead:
+ *   - near field, u < D cells: every crossing of the receiver's own ray and every piece's
+ *     midpoint (plus the interior samples of pieces split in 4 or more, HF_EXACT_BULGE), a
+ *     stencil of fixed offsets run over the receivers of a row, no hull; the t -> 0+ limit as
+ *     before (hf_exact_near). About 1.4 D crossings per receiver-direction whatever (a, b).
+ *   - far field, u >= D cells: lines of direction (a, b) spaced M = floor(|(a, b)|) exact lines
+ *     apart (about one cell), anchored at multiples of M of the raster's line index c = x b - y a.
+ *     Each far line is sampled like an exact line (every crossing and the split pieces) and its
+ *     upper hull built from its far end, recording each sample's parent in the hull ([P1] §5
+ *     Alg. 1's stack kept as a tree: the hull of the samples up to i is the path from i through
+ *     the parents). The receivers of the M exact lines nearest the far line (within half a cell
+ *     of it), visited in order along (a, b), find with one pointer the last sample at least D
+ *     cells ahead and walk the path while the tangent from their own point grows (the hull is
+ *     concave, so the tangent is unimodal along it). Every far sample lies within half a cell of
+ *     the receiver's ray and at least D cells away: within atan(1/(2D)) of its azimuth
+ *     (HFVIS_EXACT_FAR_*_DEG bound the effect on the horizon).
+ *   - edges: the far line and the receiver's ray end at different distances; where the far
+ *     tangent lies beyond the end of the receiver's own ray, or that ray runs on more than a cell
+ *     beyond the far line, the receiver marches its own ray (hf_far_march).
+ * Cost: the near stencil plus about 1.3 far samples and one query per receiver-direction. The
+ * value of a receiver depends on its own position only (the far line is fixed by the raster's
+ * line index), so receiver rectangles and bands give the whole run's bits. */
 
 /* One offset of the near stencil: crossing e of period k of the receiver's ray and the piece
  * after it. */
 struct hf_near_off {
     const hf_cross *c;
-    int k, cross;          /* cross: the crossing itself is a near sample (not the receiver) */
+    int cross;             /* the crossing itself is a near sample (not the receiver) */
     ptrdiff_t zoff, coff;  /* the crossing's first tap and the piece's cell from the receiver */
     int dx, dy;            /* the period's base offset k (a, b) */
     double u, ic, im;      /* the crossing's distance (sub-steps); scale / u at the crossing and
@@ -9350,18 +9349,18 @@ struct hf_near_off {
 };
 typedef struct hf_near_off hf_near_off;
 
-static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, const hf_cross *cr,
-                             int P, double L, double scale, int a, int b, int x, int y, int64_t rw);
-
 /* s, t with s a + t b = 1 for gcd(a, b) = 1 (extended Euclid). */
 static void hf_ext_gcd(int a, int b, int64_t *s, int64_t *t)
 {
     int64_t r0 = a, r1 = b, s0 = 1, s1 = 0, t0 = 0, t1 = 1;
     while (r1 != 0) {
-        int64_t q = r0 / r1, v;
-        v = r0 - q * r1; r0 = r1; r1 = v;
-        v = s0 - q * s1; s0 = s1; s1 = v;
-        v = t0 - q * t1; t0 = t1; t1 = v;
+        const int64_t q = r0 / r1, r2 = r0 - q * r1, s2 = s0 - q * s1, t2 = t0 - q * t1;
+        r0 = r1;
+        r1 = r2;
+        s0 = s1;
+        s1 = s2;
+        t0 = t1;
+        t1 = t2;
     }
     if (r0 < 0) {
         s0 = -s0;
@@ -9399,7 +9398,7 @@ static int hf_near_offsets(const hf_exact *E, const hf_cross *cr, int P, int a, 
                            double scale, double ucut, hf_near_off *o, int box[4])
 {
     const hfvis_grid *g = E->g;
-    int n = 0, k, e;
+    int n = 0, k, e, j;
     box[0] = box[1] = box[2] = box[3] = 0;
     for (k = 0; (double)k * L < ucut; k++)
         for (e = 0; e < P; e++) {
@@ -9408,7 +9407,6 @@ static int hf_near_offsets(const hf_exact *E, const hf_cross *cr, int P, int a, 
             int x0, y0;
             if (u >= ucut) break;
             o[n].c = c;
-            o[n].k = k;
             o[n].cross = k > 0 || e > 0;
             o[n].dx = k * a;
             o[n].dy = k * b;
@@ -9417,18 +9415,14 @@ static int hf_near_offsets(const hf_exact *E, const hf_cross *cr, int P, int a, 
             o[n].u = u;
             o[n].ic = u > 0.0 ? scale / u : 0.0;
             o[n].im = scale / (u + 0.5 * c->du);
-            x0 = k * a + c->ox;
-            y0 = k * b + c->oy;
-            if (x0 < box[0]) box[0] = x0;
-            if (y0 < box[1]) box[1] = y0;
-            if (x0 + 1 > box[2]) box[2] = x0 + 1;
-            if (y0 + 1 > box[3]) box[3] = y0 + 1;
-            x0 = k * a + c->cx;
-            y0 = k * b + c->cy;
-            if (x0 < box[0]) box[0] = x0;
-            if (y0 < box[1]) box[1] = y0;
-            if (x0 + 1 > box[2]) box[2] = x0 + 1;
-            if (y0 + 1 > box[3]) box[3] = y0 + 1;
+            for (j = 0; j < 2; j++) { /* the crossing's taps, then the piece's cell */
+                x0 = k * a + (j ? c->cx : c->ox);
+                y0 = k * b + (j ? c->cy : c->oy);
+                if (x0 < box[0]) box[0] = x0;
+                if (y0 < box[1]) box[1] = y0;
+                if (x0 + 1 > box[2]) box[2] = x0 + 1;
+                if (y0 + 1 > box[3]) box[3] = y0 + 1;
+            }
             n++;
         }
     return n;
@@ -9716,14 +9710,9 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
         for (ax = 0; ax < 2; ax++) { /* the periods within the grid grown by R + 1 */
             double p0 = (double)(ax ? py : px), d = (double)(ax ? b : a);
             double e0 = -(double)R - 1.0, e1 = (double)(ax ? g->height : g->width) + (double)R;
-            double t0 = (e0 - p0) / d, t1 = (e1 - p0) / d;
-            if (t0 > t1) {
-                double t = t0;
-                t0 = t1;
-                t1 = t;
-            }
-            if (t0 > s0) s0 = t0;
-            if (t1 < s1) s1 = t1;
+            double ta = (e0 - p0) / d, tb = (e1 - p0) / d;
+            s0 = fmax(s0, fmin(ta, tb));
+            s1 = fmin(s1, fmax(ta, tb));
         }
         if (s0 <= s1) {
             kmin = (int64_t)floor(s0) - 1;
