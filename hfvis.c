@@ -26,8 +26,9 @@
  *      bounces through the radiance pyramid, sub-sampling ([NS09] §3-9)
  *  15. Split runs: raw per-receiver direction sums in double and the partial-sum file
  *  16. Exact rays (beyond [P1]): rational directions, every grid-line crossing and the split
- *      bulging pieces swept with the [P1] §5 hull, the per-receiver oracle, actual azimuths and
- *      their quadrature, the exact-mode light paths
+ *      bulging pieces swept with the [P1] §5 hull, the near and far field (a per-receiver
+ *      stencil and shared far lines with hull trees), the per-receiver oracle, actual azimuths
+ *      and their quadrature, the exact-mode light paths
  *  17. Solar radiation: NREL SPA (Reda & Andreas 2004/2008), r.sun's solar geometry and its ESRA
  *      clear sky (Suri & Hofierka 2004; Rigollier et al. 2000), time steps with sunrise and
  *      sunset inside the step, per-sample sites by blocks of one sun, irradiation over the
@@ -1728,6 +1729,7 @@ static int hf_opts_valid(const hfvis_sweep_options *o)
                   o->direction_order <= HFVIS_DIRECTION_ORDER_SWEEP &&
                   (o->rays == HFVIS_RAYS_LATTICE || o->rays == HFVIS_RAYS_EXACT) &&
                   o->ray_denominator >= 0 && o->ray_denominator <= HFVIS_RAY_DENOMINATOR_MAX &&
+                  o->ray_near_cells >= 0 && o->ray_near_cells <= HFVIS_RAY_NEAR_CELLS_MAX &&
                   hf_parts_valid(o) && o->part_count <= 1); /* bands: hfvis_sun_visibility's own */
 }
 
@@ -3533,9 +3535,8 @@ static void hf_fused_stranded(hf_sweep *sw, int K, const hfvis_sweep_options *o,
         for (x = sw->rx0; x < sw->rx1; x++) {
             double *acc = sw->gacc + ((size_t)y * (size_t)g->width + (size_t)x) * (size_t)ch, nd[3];
             int stranded = 0;
-            if (hf_is_hole(g, x, y)) continue;
             for (c = 0; c < ch; c++) stranded |= isnan(acc[c]);
-            if (!stranded) continue;
+            if (!stranded || hf_is_hole(g, x, y)) continue; /* the NaN test first: it rules out most */
             hf_normal_at(g, x, y, nd);
             n1[0] = (float)nd[0];
             n1[1] = (float)nd[1];
@@ -8771,6 +8772,14 @@ typedef struct hf_exact {
     int parts, part;        /* bands across the direction (part_index/part_count), 0 = off */
     int64_t c0, cspan;      /* the receivers' line index c = x*b - y*a: its least value, count */
     int64_t clo, chi;       /* this band's lines: clo <= c <= chi */
+    int near;               /* ray_near_cells: D > 0, the near and far field (hf_far_field) */
+    int ray_a, ray_b;       /* the direction being swept */
+    int inf;                /* the grid holds an infinite height (hf_near_field) */
+    int *fpar;              /* a far line's hull tree (hf_far_hull): parents, running maxima */
+    double *fmax;
+    struct hf_near_off *noff; /* the near stencil (hf_near_offsets) */
+    struct hf_far_line *flines; /* one far band's exact lines */
+    double *row;            /* one row of near tangents */
     void *block;
     const hfvis_allocator *alloc;
 } hf_exact;
@@ -9302,6 +9311,493 @@ static void hf_exact_near(hf_exact *E, hf_ray r, double L, double scale)
     }
 }
 
+/* ------------------------------------------------------------------------------------------ */
+/* Near and far field (hfvis_sweep_options.ray_near_cells = D > 0; hfvis.h "Exact rays").     */
+/* A line of direction (a, b) carries one receiver per |(a, b)| cells and costs |a| + |b| - 1   */
+/* crossings per receiver, so fine directions are expensive whatever the constant per sample.   */
+/* Split each receiver's ray at D cells instead:                                                 */
+/*   - near field, u < D cells: every crossing of the receiver's own ray and every piece's      */
+/*     midpoint (plus the interior samples of pieces split in 4 or more, HF_EXACT_BULGE), as a */
+/*     stencil of fixed offsets run over the receivers of a row, no hull; the t -> 0+ limit as  */
+/*     before (hf_exact_near). About 1.4 D crossings per receiver-direction whatever (a, b).   */
+/*   - far field, u >= D cells: lines of direction (a, b) spaced M = floor(|(a, b)|) exact     */
+/*     lines apart (about one cell), anchored at multiples of M of the raster's line index      */
+/*     c = x b - y a. Each far line is sampled like an exact line (every crossing and the split */
+/*     pieces) and its upper hull built from its far end, recording each sample's parent in   */
+/*     the hull ([P1] §5 Alg. 1's stack, kept as a tree: the hull of the samples up to i is   */
+/*     the path from i through the parents). A receiver of one of the M exact lines nearest     */
+/*     the far line (within half a cell of it) finds the last sample at least D cells ahead    */
+/*     (binary search) and walks the path while the tangent from its own point grows (the     */
+/*     hull is concave, so the tangent is unimodal along it). Every far sample lies within half */
+/*     a cell of the receiver's ray and at least D cells away: within atan(1/(2D)) of its       */
+/*     azimuth (HFVIS_EXACT_FAR_*_DEG bound the effect on the horizon). Near the grid's edge   */
+/*     the far line and the receiver's ray end at different distances: where the far tangent   */
+/*     lies beyond the end of the receiver's own ray, or that ray runs on more than a cell     */
+/*     beyond the far line, the receiver marches its own ray (hf_far_march).                   */
+/* Cost: the near stencil plus about 1.3 far samples and one query per receiver-direction.     */
+/* The value of a receiver depends on its own position only (the far line is fixed by the      */
+/* raster's line index), so receiver rectangles and bands give the whole run's bits.            */
+
+/* One offset of the near stencil: crossing e of period k of the receiver's ray and the piece
+ * after it. */
+struct hf_near_off {
+    const hf_cross *c;
+    int k, cross;          /* cross: the crossing itself is a near sample (not the receiver) */
+    ptrdiff_t zoff, coff;  /* the crossing's first tap and the piece's cell from the receiver */
+    int dx, dy;            /* the period's base offset k (a, b) */
+    double u, ic, im;      /* the crossing's distance (sub-steps); scale / u at the crossing and
+                              at the piece's midpoint */
+};
+typedef struct hf_near_off hf_near_off;
+
+static double hf_exact_march(const hfvis_grid *g, hfvis_border border, int R, const hf_cross *cr,
+                             int P, double L, double scale, int a, int b, int x, int y, int64_t rw);
+
+/* s, t with s a + t b = 1 for gcd(a, b) = 1 (extended Euclid). */
+static void hf_ext_gcd(int a, int b, int64_t *s, int64_t *t)
+{
+    int64_t r0 = a, r1 = b, s0 = 1, s1 = 0, t0 = 0, t1 = 1;
+    while (r1 != 0) {
+        int64_t q = r0 / r1, v;
+        v = r0 - q * r1; r0 = r1; r1 = v;
+        v = s0 - q * s1; s0 = s1; s1 = v;
+        v = t0 - q * t1; t0 = t1; t1 = v;
+    }
+    if (r0 < 0) {
+        s0 = -s0;
+        t0 = -t0;
+    }
+    *s = s0;
+    *t = t0;
+}
+
+/* The grid point of exact line c (x b - y a = c, grid coordinates) whose position along (a, b),
+ * x a + y b, lies in [0, a^2 + b^2); (X1, Y1) is a point of line 1. */
+static void hf_line_point(int64_t c, int64_t X1, int64_t Y1, int a, int b, int64_t *px, int64_t *py)
+{
+    int64_t x = c * X1, y = c * Y1, n2 = (int64_t)a * a + (int64_t)b * b;
+    int64_t j = hf_floor_div64(x * a + y * b, n2);
+    *px = x - j * a;
+    *py = y - j * b;
+}
+
+/* The steps j with lo <= p + j c <= hi (c != 0): [*jlo, *jhi]. */
+static void hf_step_range(int64_t p, int c, int64_t lo, int64_t hi, int64_t *jlo, int64_t *jhi)
+{
+    if (c > 0) {
+        *jlo = -hf_floor_div64(p - lo, c);
+        *jhi = hf_floor_div64(hi - p, c);
+    } else {
+        *jlo = -hf_floor_div64(hi - p, -c);
+        *jhi = hf_floor_div64(p - lo, -c);
+    }
+}
+
+/* The near-field offsets of direction (a, b): crossings and pieces starting nearer than ucut
+ * sub-steps; returns their count and the offsets' bounding box (taps included). */
+static int hf_near_offsets(const hf_exact *E, const hf_cross *cr, int P, int a, int b, double L,
+                           double scale, double ucut, hf_near_off *o, int box[4])
+{
+    const hfvis_grid *g = E->g;
+    int n = 0, k, e;
+    box[0] = box[1] = box[2] = box[3] = 0;
+    for (k = 0; (double)k * L < ucut; k++)
+        for (e = 0; e < P; e++) {
+            const hf_cross *c = cr + e;
+            double u = (double)k * L + c->u;
+            int x0, y0;
+            if (u >= ucut) break;
+            o[n].c = c;
+            o[n].k = k;
+            o[n].cross = k > 0 || e > 0;
+            o[n].dx = k * a;
+            o[n].dy = k * b;
+            o[n].zoff = (ptrdiff_t)(k * b + c->oy) * g->stride + (k * a + c->ox);
+            o[n].coff = (ptrdiff_t)(k * b + c->cy) * g->stride + (k * a + c->cx);
+            o[n].u = u;
+            o[n].ic = u > 0.0 ? scale / u : 0.0;
+            o[n].im = scale / (u + 0.5 * c->du);
+            x0 = k * a + c->ox;
+            y0 = k * b + c->oy;
+            if (x0 < box[0]) box[0] = x0;
+            if (y0 < box[1]) box[1] = y0;
+            if (x0 + 1 > box[2]) box[2] = x0 + 1;
+            if (y0 + 1 > box[3]) box[3] = y0 + 1;
+            x0 = k * a + c->cx;
+            y0 = k * b + c->cy;
+            if (x0 < box[0]) box[0] = x0;
+            if (y0 < box[1]) box[1] = y0;
+            if (x0 + 1 > box[2]) box[2] = x0 + 1;
+            if (y0 + 1 > box[3]) box[3] = y0 + 1;
+            n++;
+        }
+    return n;
+}
+
+/* The interior samples of a piece split in 4 or more (hf_piece_fill) as tangents from hr: the
+ * largest, or best. p: the cell's tap (0, 0), u0 the piece's start (sub-steps). */
+static double hf_near_fill(const float *p, ptrdiff_t stride, const hf_cross *c, double bulge,
+                           double lim, double u0, double hr, double scale, double best)
+{
+    double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
+    int j = hf_piece_fill(p, stride, c, bulge, lim, ph, pu);
+    while (j-- > 0) {
+        double t = (ph[j] - hr) / (u0 + pu[j]) * scale;
+        if (t > best) best = t;
+    }
+    return best;
+}
+
+/* The near field of one receiver at (x, y) anywhere (the border rule outside the grid): its
+ * largest tangent over the stencil, from best. */
+static double hf_near_one(const hf_exact *E, const hf_near_off *o, int n, int x, int y, double hr,
+                          double scale, double best)
+{
+    const hfvis_grid *g = E->g;
+    const double lim = HF_EXACT_BULGE * g->cell_size;
+    int i;
+    for (i = 0; i < n; i++) {
+        const hf_cross *c = o[i].c;
+        int X = x + o[i].dx, Y = y + o[i].dy;
+        float z[4];
+        if (o[i].cross && hf_cross_inside(g, E->R, X + c->ox, Y + c->oy, c)) {
+            double h = hf_cross_height(g, E->border, X + c->ox, Y + c->oy, c), t = (h - hr) * o[i].ic;
+            if (t > best) best = t; /* NaN (a hole) never is */
+        }
+        if (c->du > 0.0 && hf_exact_cell_taps(g, E->border, E->R, X + c->cx, Y + c->cy, z)) {
+            double z00 = (double)z[0], z10 = (double)z[1], z01 = (double)z[2], z11 = (double)z[3];
+            double r0 = z00 + (z10 - z00) * c->mfx, r1 = z01 + (z11 - z01) * c->mfx;
+            double t = (r0 + (r1 - r0) * c->mfy - hr) * o[i].im, bulge = c->q * hf_cell_twist(z, 2);
+            if (t > best) best = t;
+            if (bulge > 4.0 * lim && bulge < HFVIS__INF)
+                best = hf_near_fill(z, 2, c, bulge, lim, o[i].u, hr, scale, best);
+        }
+    }
+    return best;
+}
+
+/* The near field over the receiver rectangle into E->tan: -INFINITY (nothing near), NaN at
+ * holes. Rows and columns whose whole stencil lies inside the grid run offset by offset over
+ * the row (no border tests; NaN taps drop out of the maxima by themselves, infinite ones would
+ * not: a grid with an infinite height, E->inf, takes the other path everywhere); the rest
+ * receiver by receiver (hf_near_one, the same bits). */
+static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int box[4], double scale,
+                          double *row)
+{
+    const hfvis_grid *g = E->g;
+    const double lim = HF_EXACT_BULGE * g->cell_size, lim4 = 4.0 * lim;
+    const ptrdiff_t S = g->stride;
+    int x, y, i;
+    for (y = E->ry0; y < E->ry1; y++) {
+        double *t = E->tan + (size_t)y * (size_t)g->width;
+        const float *zr = g->z + (ptrdiff_t)y * S;
+        int xa = E->rx0, xb = E->rx1; /* the interior columns [xa, xb) */
+        if (y + box[1] < 0 || y + box[3] > g->height - 1 || E->inf) xa = xb = E->rx1;
+        else {
+            if (xa < -box[0]) xa = -box[0];
+            if (xb > g->width - 1 - box[2] + 1) xb = g->width - box[2];
+            if (xb < xa) xa = xb = E->rx1;
+        }
+        for (x = xa; x < xb; x++) row[x] = -HFVIS__INF;
+        for (i = 0; i < n && xa < xb; i++) {
+            const hf_cross *c = o[i].c;
+            const float *zc = zr + o[i].zoff, *zp = zr + o[i].coff;
+            const double ic = o[i].ic, im = o[i].im, f = c->f, mfx = c->mfx, mfy = c->mfy;
+            const ptrdiff_t st = c->zstep;
+            if (o[i].cross && c->kind == 0)
+                for (x = xa; x < xb; x++) {
+                    double tt = ((double)zc[x] - (double)zr[x]) * ic, rx = row[x];
+                    row[x] = tt > rx ? tt : rx; /* NaN (a hole) never is */
+                }
+            else if (o[i].cross)
+                for (x = xa; x < xb; x++) {
+                    double h = (double)zc[x], tt, rx = row[x];
+                    h += ((double)zc[x + st] - h) * f;
+                    tt = (h - (double)zr[x]) * ic;
+                    row[x] = tt > rx ? tt : rx;
+                }
+            if (c->du > 0.0)
+                for (x = xa; x < xb; x++) {
+                    const float *p = zp + x;
+                    double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[S], z11 = (double)p[S + 1];
+                    double r0 = z00 + (z10 - z00) * mfx, r1 = z01 + (z11 - z01) * mfx;
+                    double tt = (r0 + (r1 - r0) * mfy - (double)zr[x]) * im;
+                    double bulge = c->q * (z00 - z10 - z01 + z11), rx = row[x]; /* hf_cell_twist */
+                    rx = tt > rx ? tt : rx;
+                    if (bulge > lim4 && bulge < HFVIS__INF)
+                        rx = hf_near_fill(p, S, c, bulge, lim, o[i].u, (double)zr[x], scale, rx);
+                    row[x] = rx;
+                }
+        }
+        for (x = E->rx0; x < E->rx1; x++) {
+            double hr = (double)zr[x];
+            if (!isfinite(hr)) t[x] = HFVIS__NAN;
+            else if (x >= xa && x < xb) t[x] = row[x];
+            else t[x] = hf_near_one(E, o, n, x, y, hr, scale, -HFVIS__INF);
+        }
+    }
+}
+
+/* The samples of the far line through grid point (px, py) (grid coordinates, possibly outside)
+ * over the periods k = kmax down to kmin, in sweep order (increasing distance d, sub-steps,
+ * d = (kmax - k) L at p + k (a, b)): every crossing and split piece within reach (the samples
+ * hf_exact_samples takes; periods with both ends inside the grid read the heights directly, the
+ * others under the border rule). Returns the count. */
+static int hf_far_samples(hf_exact *E, int64_t px, int64_t py, int a, int b, int P, double L,
+                          int64_t kmin, int64_t kmax, double *sd, double *sh)
+{
+    const hfvis_grid *g = E->g;
+    const hf_cross *cr = E->cross;
+    const double lim = HF_EXACT_BULGE * g->cell_size;
+    double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
+    int n = 0, e, j, splits = 0, eager = E->eager;
+    int64_t k, inner = 0;
+    for (k = kmax; k >= kmin; k--) {
+        int64_t X0 = px + k * a, Y0 = py + k * b, X1 = X0 + a, Y1 = Y0 + b;
+        double base = (double)(kmax - k) * L;
+        if (X0 >= 0 && X1 >= 0 && X0 < g->width && X1 < g->width && Y0 >= 0 && Y1 >= 0 &&
+            Y0 < g->height && Y1 < g->height) {
+            const float *zn = g->z + (ptrdiff_t)Y0 * g->stride + (ptrdiff_t)X0;
+            double h;
+            for (e = P - 1; e > 0; e--) { /* as hf_exact_samples between two grid points */
+                const hf_cross *c = cr + e;
+                n = hf_exact_piece(g, c, zn, base, lim, sd, sh, n, eager, &splits);
+                h = (double)zn[c->zoff];
+                h += ((double)zn[c->zoff + c->zstep] - h) * c->f;
+                sd[n] = base - c->u;
+                sh[n] = h;
+                n += isfinite(h) ? 1 : 0;
+            }
+            n = hf_exact_piece(g, cr, zn, base, lim, sd, sh, n, eager, &splits);
+            h = (double)zn[0];
+            sd[n] = base;
+            sh[n] = h;
+            n += isfinite(h) ? 1 : 0;
+            inner++;
+            continue;
+        }
+        if (X0 < -E->R - 1 - (a < 0 ? -a : a) || X0 > g->width + E->R + (a < 0 ? -a : a) ||
+            Y0 < -E->R - 1 - (b < 0 ? -b : b) || Y0 > g->height + E->R + (b < 0 ? -b : b))
+            continue; /* the whole period out of reach */
+        for (e = P - 1; e >= 0; e--) { /* as hf_exact_samples' pre-roll */
+            int X = (int)X0 + cr[e].ox, Y = (int)Y0 + cr[e].oy;
+            double h;
+            j = hf_piece_samples(g, E->border, E->R, (int)X0, (int)Y0, cr + e, ph, pu);
+            while (j-- > 0) {
+                if (isnan(ph[j])) continue;
+                sd[n] = base - (cr[e].u + pu[j]);
+                sh[n++] = ph[j];
+            }
+            if (!hf_cross_inside(g, E->R, X, Y, cr + e)) continue;
+            h = hf_cross_height(g, E->border, X, Y, cr + e);
+            if (isnan(h)) continue;
+            sd[n] = base - cr[e].u;
+            sh[n++] = h;
+        }
+    }
+    if (inner > 0) E->eager = (double)splits > HF_EXACT_EAGER_SHARE * (double)inner * (double)P;
+    return n;
+}
+
+/* The upper hull of samples (sd, sh) in sweep order as a tree: par[i] the sample below i on the
+ * stack when i was pushed ([P1] §5 Alg. 1's pops; -1: none), so the hull of samples 0..i is the
+ * path from i through the parents; hmax[i] the highest of samples 0..i. stack: n ints. */
+static void hf_far_hull(const double *sd, const double *sh, int n, int *stack, int *par, double *hmax)
+{
+    int top = -1, i;
+    double m = -HFVIS__INF;
+    for (i = 0; i < n; i++) {
+        const double d = sd[i], h = sh[i];
+        while (top >= 1) {
+            const int A = stack[top - 1], B = stack[top];
+            /* B leaves when it is not above the chord from A to the new sample */
+            if ((sd[B] - sd[A]) * (h - sh[A]) >= (sh[B] - sh[A]) * (d - sd[A])) top--;
+            else break;
+        }
+        par[i] = top >= 0 ? stack[top] : -1;
+        stack[++top] = i;
+        if (h > m) m = h;
+        hmax[i] = m;
+    }
+}
+
+/* The samples of the ray from receiver (x, y), height hr, along (a, b) from ufrom sub-steps to
+ * its end (the samples hf_exact_samples takes there, under the border rule): the largest
+ * tangent if larger than best, else best. */
+static double hf_far_march(const hf_exact *E, int x, int y, double hr, double ufrom, int P, double L,
+                           double scale, double best)
+{
+    const hfvis_grid *g = E->g;
+    const hf_cross *cr = E->cross;
+    const int a = E->ray_a, b = E->ray_b, kmax = hf_exact_periods(g, E->R, x, y, a, b);
+    double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
+    int k = (int)floor(ufrom / L), e, j;
+    for (; k <= kmax; k++)
+        for (e = 0; e < P; e++) {
+            int X = x + k * a + cr[e].ox, Y = y + k * b + cr[e].oy;
+            double u = (double)k * L + cr[e].u, t;
+            if (u + cr[e].du >= ufrom) {
+                j = hf_piece_samples(g, E->border, E->R, x + k * a, y + k * b, cr + e, ph, pu);
+                while (j-- > 0) {
+                    t = (ph[j] - hr) / (u + pu[j]) * scale;
+                    if (t > best) best = t;
+                }
+            }
+            if (u < ufrom || (k == 0 && e == 0) || !hf_cross_inside(g, E->R, X, Y, cr + e)) continue;
+            t = (hf_cross_height(g, E->border, X, Y, cr + e) - hr) / u * scale;
+            if (t > best) best = t;
+        }
+    return best;
+}
+
+/* The far field of a receiver at distance dr (sub-steps times n2, in the far line's sweep
+ * coordinate) with height hr, whose far samples are 0..i (those at least D cells ahead): the
+ * largest tangent (times fscale) over them if larger than best, else best. The walk follows the
+ * hull from i while the tangent grows. */
+static double hf_far_query(const double *sd, const double *sh, const int *par, const double *hmax,
+                           int i, double n2, double dr, double hr, double fscale, double best,
+                           double *vdist)
+{
+    double dist = dr - sd[i] * n2, bound = hmax[i] - hr;
+    /* an exact bound: no sample up to i can beat best */
+    bound = bound >= 0.0 ? bound / dist : bound / (dr - sd[0] * n2);
+    if (!(bound * fscale > best)) return best;
+    for (;;) {
+        int p = par[i];
+        double dp;
+        if (p < 0) break;
+        dp = dr - sd[p] * n2;
+        if (!((sh[p] - hr) * dist > (sh[i] - hr) * dp)) break;
+        i = p;
+        dist = dp;
+    }
+    *vdist = dist;
+    dist = (sh[i] - hr) / dist * fscale;
+    return dist > best ? dist : best;
+}
+
+/* One exact line of a far band: its grid point q with position t = q . (a, b) in [0, a^2 + b^2)
+ * and the steps j of its receivers q + j (a, b) in the receiver rectangle. */
+struct hf_far_line {
+    int64_t t, qx, qy, jlo, jhi;
+};
+typedef struct hf_far_line hf_far_line;
+
+/* The far field of direction (a, b) over the receiver rectangle (this call's lines), into
+ * E->tan (hf_near_field first). */
+static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, double ucut)
+{
+    const hfvis_grid *g = E->g;
+    const int a = r.a, b = r.b;
+    hf_far_line *lines = E->flines;
+    const int64_t n2i = (int64_t)a * a + (int64_t)b * b;
+    const double n2 = (double)n2i, len = sqrt(n2), fscale = n2 * scale, dn = ucut * n2;
+    const double Ad = (double)(a < 0 ? -a : a), Bd = (double)(b < 0 ? -b : b), cell = L / len * n2;
+    const int M = (int)floor(len), hM = M / 2, R = E->R;
+    const int64_t cshift = (int64_t)E->ox * b - (int64_t)E->oy * a; /* raster c - grid c */
+    int64_t X1, Y1, lo = INT64_MAX, hi = INT64_MIN, m, mlo, mhi;
+    int corner;
+    hf_ext_gcd(b, a, &X1, &Y1); /* X1 b + Y1 a = 1: (X1, -Y1) is on line 1 */
+    Y1 = -Y1;
+    for (corner = 0; corner < 4; corner++) {
+        int64_t x = corner & 1 ? E->rx1 - 1 : E->rx0, y = corner & 2 ? E->ry1 - 1 : E->ry0;
+        int64_t v = x * b - y * a + cshift;
+        lo = v < lo ? v : lo;
+        hi = v > hi ? v : hi;
+    }
+    mlo = hf_floor_div64(lo + hM, M);
+    mhi = hf_floor_div64(hi + hM, M);
+    for (m = mlo; m <= mhi; m++) {
+        int64_t cf = m * M - cshift, px, py, kmin = INT64_MIN, kmax = INT64_MAX, c, clo, chi, j;
+        int64_t jmin = 0, jmax = -1;
+        double s0 = -HFVIS__INF, s1 = HFVIS__INF;
+        int n = 0, ax, nl, ptr;
+        hf_line_point(cf, X1, Y1, a, b, &px, &py);
+        for (ax = 0; ax < 2; ax++) { /* the periods within the grid grown by R + 1 */
+            double p0 = (double)(ax ? py : px), d = (double)(ax ? b : a);
+            double e0 = -(double)R - 1.0, e1 = (double)(ax ? g->height : g->width) + (double)R;
+            double t0 = (e0 - p0) / d, t1 = (e1 - p0) / d;
+            if (t0 > t1) {
+                double t = t0;
+                t0 = t1;
+                t1 = t;
+            }
+            if (t0 > s0) s0 = t0;
+            if (t1 < s1) s1 = t1;
+        }
+        if (s0 <= s1) {
+            kmin = (int64_t)floor(s0) - 1;
+            kmax = (int64_t)ceil(s1) + 1;
+            n = hf_far_samples(E, px, py, a, b, P, L, kmin, kmax, E->sd, E->sh);
+            hf_far_hull(E->sd, E->sh, n, E->rec, E->fpar, E->fmax);
+        }
+        clo = m * M - hM - cshift;
+        chi = clo + M - 1;
+        if (clo < lo - cshift) clo = lo - cshift;
+        if (chi > hi - cshift) chi = hi - cshift;
+        nl = 0;
+        for (c = clo; c <= chi; c++) { /* the band's exact lines, by position t descending */
+            hf_far_line l;
+            int64_t jl2, jh2;
+            int w;
+            hf_line_point(c, X1, Y1, a, b, &l.qx, &l.qy);
+            hf_step_range(l.qx, a, E->rx0, E->rx1 - 1, &l.jlo, &l.jhi);
+            hf_step_range(l.qy, b, E->ry0, E->ry1 - 1, &jl2, &jh2);
+            if (jl2 > l.jlo) l.jlo = jl2;
+            if (jh2 < l.jhi) l.jhi = jh2;
+            if (l.jlo > l.jhi) continue;
+            l.t = l.qx * a + l.qy * b;
+            for (w = nl++; w > 0 && lines[w - 1].t < l.t; w--) lines[w] = lines[w - 1];
+            lines[w] = l;
+            if (l.jlo < jmin || nl == 1) jmin = l.jlo;
+            if (l.jhi > jmax || nl == 1) jmax = l.jhi;
+        }
+        /* receivers by t = t_q + j n2 descending, so their thresholds grow: one pointer */
+        for (ptr = -1, j = jmax; nl > 0 && j >= jmin; j--) {
+            int w;
+            for (w = 0; w < nl; w++) {
+                int x, y;
+                size_t i;
+                double dr, hr, ex, ey, t, far, vd;
+                if (j < lines[w].jlo || j > lines[w].jhi) continue;
+                x = (int)(lines[w].qx + j * a);
+                y = (int)(lines[w].qy + j * b);
+                i = (size_t)y * (size_t)g->width + (size_t)x;
+                if (isnan(E->tan[i]) || (E->parts && !hf_exact_mine(E, x, y, r))) continue;
+                dr = ((double)kmax * L) * n2 - (double)(((int64_t)x - px) * a + ((int64_t)y - py) * b) * L;
+                while (ptr + 1 < n && E->sd[ptr + 1] * n2 <= dr - dn) ptr++;
+                hr = (double)g->z[(ptrdiff_t)y * g->stride + x];
+                t = E->tan[i];
+                vd = 0.0;
+                if (ptr >= 0) t = hf_far_query(E->sd, E->sh, E->fpar, E->fmax, ptr, n2, dr, hr, fscale, t, &vd);
+                /* Near the grid's edge the far line and the receiver's own ray leave the reach
+                   at different distances (n2 units): where the far tangent lies beyond the end
+                   of its own ray, or its own ray runs on more than a cell beyond the far line,
+                   the receiver marches its own ray (from D, or from the far line's end). */
+                ex = (double)(a > 0 ? g->width - 1 + R - x : x + R) * Bd;
+                ey = (double)(b > 0 ? g->height - 1 + R - y : y + R) * Ad;
+                ex = (ex < ey ? ex : ey) * n2;
+                far = n > 0 ? dr - E->sd[0] * n2 : dn;
+                if (far < dn) far = dn;
+                if (vd > ex) t = hf_far_march(E, x, y, hr, dn / n2, P, L, scale, E->tan[i]);
+                else if (ex > far + cell) t = hf_far_march(E, x, y, hr, far / n2, P, L, scale, t);
+                E->tan[i] = t;
+            }
+        }
+    }
+}
+
+/* The near and far field applies to direction r (hf_far_field): D > 0, no radius, off the axes
+ * and diagonals, a line longer than D between grid points (else its sweep is the cheaper), and
+ * far positions (sub-steps times a^2 + b^2, sixteenths) exact in double. */
+static int hf_far_applies(const hf_exact *E, hf_ray r, double L)
+{
+    const hfvis_grid *g = E->g;
+    double n2 = (double)r.a * (double)r.a + (double)r.b * (double)r.b;
+    return E->near > 0 && E->win_rw < 0 && r.a != 0 && r.b != 0 && n2 > (double)E->near * (double)E->near &&
+           16.0 * ((double)g->width + (double)g->height + 4.0 * (double)E->R + 16.0) * L * n2 < 4503599627370496.0;
+}
+
 /* Tangents of every grid point toward ray r into E->tan (-INFINITY: no terrain, NaN: hole).
  * Heads are enumerated row by row, so consecutive lines are neighbours. */
 static void hf_exact_sweep(hf_exact *E, hf_ray r)
@@ -9311,6 +9807,17 @@ static void hf_exact_sweep(hf_exact *E, hf_ray r)
     int P = hf_exact_geometry(E->cross, g, r.a, r.b, &L, &scale), x, y;
     E->win_rw = E->radius > 0.0 ? hf_exact_window(E->radius, scale) : -1;
     E->eager = 0;
+    E->ray_a = r.a;
+    E->ray_b = r.b;
+    if (hf_far_applies(E, r, L)) {
+        double n2 = (double)r.a * (double)r.a + (double)r.b * (double)r.b;
+        double ucut = ceil((double)E->near * L / sqrt(n2)); /* D cells in sub-steps */
+        int box[4], n = hf_near_offsets(E, E->cross, P, r.a, r.b, L, scale, ucut, E->noff, box);
+        hf_near_field(E, E->noff, n, box, scale, E->row);
+        hf_far_field(E, r, P, L, scale, ucut);
+        hf_exact_near(E, r, L, scale);
+        return;
+    }
     for (y = 0; y < g->height; y++) {
         int xlo, xhi;
         if (y + r.b < 0 || y + r.b >= g->height) {
@@ -9422,7 +9929,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
                                   int channels)
 {
     size_t total = 0, off_ray, off_d, off_c, off_s, off_t = 0, off_n = 0, off_a = 0, gridn, cap;
-    size_t off_win = 0, off_r;
+    size_t off_win = 0, off_r, off_fp = 0, off_fm = 0, off_no = 0, off_row = 0, off_fl = 0;
     int ok = 1, k, maxp = 1, side = g->width > g->height ? g->width : g->height;
     unsigned char *blk;
     memset(E, 0, sizeof *E);
@@ -9465,6 +9972,14 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     E->rect = E->rx0 > 0 || E->ry0 > 0 || E->rx1 < g->width || E->ry1 < g->height;
     if (E->radius > 0.0) off_win = hf_align_add(&total, cap, HF_WIN_BYTES_PER_SAMPLE, &ok);
     off_r = hf_align_add(&total, cap + 1, sizeof(int), &ok);
+    E->near = want_tan ? o->ray_near_cells : 0;
+    if (E->near > 0) {
+        off_fp = hf_align_add(&total, cap + 1, sizeof(int), &ok);
+        off_fm = hf_align_add(&total, cap + 1, sizeof(double), &ok);
+        off_no = hf_align_add(&total, 2u * (size_t)E->near + 2u * (size_t)maxp + 4u, sizeof(hf_near_off), &ok);
+        off_row = hf_align_add(&total, (size_t)g->width, sizeof(double), &ok);
+        off_fl = hf_align_add(&total, (size_t)maxp + 2u, sizeof(hf_far_line), &ok);
+    }
     if (!ok) return HFVIS_ERR_LIMIT;
     blk = (unsigned char *)hfvis__alloc(o->alloc, total);
     if (!blk) return HFVIS_ERR_OUT_OF_MEMORY;
@@ -9485,6 +10000,18 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     E->acc = channels ? (double *)(void *)(blk + off_a) : NULL;
     if (E->radius > 0.0) hf_win_carve(&E->win, blk + off_win, cap);
     E->rec = (int *)(void *)(blk + off_r);
+    if (E->near > 0) {
+        E->fpar = (int *)(void *)(blk + off_fp);
+        E->fmax = (double *)(void *)(blk + off_fm);
+        E->noff = (hf_near_off *)(void *)(blk + off_no);
+        E->row = (double *)(void *)(blk + off_row);
+        E->flines = (hf_far_line *)(void *)(blk + off_fl);
+        for (k = 0; k < g->height && !E->inf; k++) {
+            const float *zr = g->z + (ptrdiff_t)k * g->stride;
+            int x;
+            for (x = 0; x < g->width; x++) E->inf |= isinf(zr[x]) != 0;
+        }
+    }
     hf_exact_dirs_fill(&E->d, K, o->azimuth0_rad, E->N);
     if (want_normals == 1 && E->nrm_own) (void)hfvis_normals_compute(g, E->nrm_own); /* as floats */
     if (channels) memset(E->acc, 0, gridn * (size_t)channels * sizeof(double));

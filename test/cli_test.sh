@@ -1154,10 +1154,13 @@ done < "$dir/commands"
   bad "--help values: $help_n lines checked"
 # No mutable state at file scope: the binary's writable objects (.data, .bss) are the C runtime's
 # and the signal handler's temporary-file names (cli_tmp_name, cli_tmp_armed, and common.h's
-# ex_atomic_on_temp hook that reports the raster writers' to it). Needs an nm that prints sections.
+# ex_atomic_on_temp hook that reports the raster writers' to it) with the hold of those signals
+# while a raster's files are published (zio.h's ex_atomic_hold hook, cli_hold_mask and
+# cli_hold_depth). Needs an nm that prints sections.
 if nm -f sysv "$hfvis" > "$dir/nm" 2> /dev/null && grep -q '|\.bss' "$dir/nm"; then
   extra=$(awk -F'|' '$4 ~ /OBJECT/ && $7 ~ /^\.(data|bss)$/ { gsub(/ /, "", $1); print $1 }' "$dir/nm" |
-    grep -v -e '@' -e '^__' -e '^completed\.' -e '^cli_tmp_name$' -e '^cli_tmp_armed$' -e '^ex_atomic_on_temp$' | tr '\n' ' ')
+    grep -v -e '@' -e '^__' -e '^completed\.' -e '^cli_tmp_name$' -e '^cli_tmp_armed$' -e '^ex_atomic_on_temp$' \
+      -e '^ex_atomic_hold$' -e '^cli_hold_mask$' -e '^cli_hold_depth$' | tr '\n' ' ')
   [ -z "$extra" ] && ok "no mutable objects but the signal handler's temporary-file names (nm)" ||
     bad "mutable objects at file or function scope: $extra"
 else

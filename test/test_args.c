@@ -610,6 +610,8 @@ static void teardown(void)
     bo = hfvis_sweep_options_default(); bo.rays = (hfvis_ray_mode)2; BAD('E', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.ray_denominator = -1; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.ray_denominator = HFVIS_RAY_DENOMINATOR_MAX + 1; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.ray_near_cells = -1; BAD('S', INV, expr); \
+    bo = hfvis_sweep_options_default(); bo.ray_near_cells = HFVIS_RAY_NEAR_CELLS_MAX + 1; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.max_distance = -1.0; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.max_distance = (double)NAN; BAD('S', INV, expr); \
     bo = hfvis_sweep_options_default(); bo.origin_x = -1; bo.extent_width = bo.extent_height = 99; BAD('S', INV, expr); \

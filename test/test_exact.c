@@ -693,6 +693,141 @@ TEST(accuracy_against_exact_bilinear_max)
     }
 }
 
+/* Near and far field (ray_near_cells = D): the horizons against the supremum oracle on the
+ * fields that break lattices at K = 64 and 256, where most directions' lines are longer than D
+ * (the far field applies), within the header's stated bound; every pair counted. */
+#define FAR_D 8
+static void far_against_oracle(const char *name, const hfvis_grid *g, int K, hfvis_border border,
+                               double *mean_out, double *p99_out)
+{
+    static double errs[256 * 96 * 72];
+    static float fa[256 * 96 * 72], fb[256 * 96 * 72];
+    hfvis_sweep_options o = exact_opts(0.1, border, 0);
+    size_t n = (size_t)K * (size_t)g->width * (size_t)g->height, i, m = 0;
+    double sum = 0.0, p99;
+    int bad = 0;
+    o.border_cells = border == HFVIS_BORDER_OPEN ? 0 : 7;
+    o.ray_near_cells = FAR_D;
+    CHECK_EQ_STATUS(hfvis_horizon_map(g, K, &o, fa), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_horizon_exact_naive(g, K, &o, fb), HFVIS_OK);
+    for (i = 0; i < n; i++) {
+        double d;
+        if (isnan(fa[i]) || isnan(fb[i])) {
+            bad += !(isnan(fa[i]) && isnan(fb[i]));
+            continue;
+        }
+        d = fabs((double)fa[i] - (double)fb[i]) * 180.0 / PI;
+        errs[m++] = d;
+        sum += d;
+    }
+    CHECK(bad == 0);
+    CHECK(m > 0);
+    if (m == 0) return;
+    qsort(errs, m, sizeof(double), cmp_double);
+    p99 = errs[(size_t)(0.99 * (double)(m - 1))];
+    printf("     near/far D=%d %-8s %dx%d K=%d border %d: |far - supremum| mean %.4f deg, p99 %.3f, max %.2f\n",
+           FAR_D, name, g->width, g->height, K, (int)border, sum / (double)m, p99, errs[m - 1]);
+    CHECK(sum / (double)m <= HFVIS_EXACT_FAR_MEAN_DEG);
+    CHECK(p99 <= HFVIS_EXACT_FAR_P99_DEG);
+    *mean_out = sum / (double)m;
+    *p99_out = p99;
+}
+
+TEST(near_far_against_oracle)
+{
+    static const int Ks[] = {64, 256};
+    hfvis_grid g;
+    uint64_t seed;
+    double mean, p99;
+    int i;
+    for (seed = 1; seed <= 21; seed += 20) /* the fields of docs/exact-rays.md, then hold-out ones */
+        for (i = 0; i < 2; i++) {
+            fields_urban(zbuf, 96, 72, 18, seed);
+            g = test_grid(zbuf, 96, 72, 1.0);
+            far_against_oracle("urban", &g, Ks[i], HFVIS_BORDER_OPEN, &mean, &p99);
+            fields_terraces(zbuf, 96, 72, 1.0, 5.0, 80.0, seed + 1);
+            far_against_oracle("terraces", &g, Ks[i], HFVIS_BORDER_OPEN, &mean, &p99);
+            (void)test_fbm(zbuf, 96, 72, 20.0, 24.0, 0, seed + 2);
+            far_against_oracle("fbm", &g, Ks[i], i ? HFVIS_BORDER_CLAMP : HFVIS_BORDER_WRAP, &mean, &p99);
+        }
+}
+
+/* A tilted plane: a far sample half a cell across the ray at D cells or more changes the tangent
+ * by at most |grad z across| / (2 D cell) (the stated angular bound on a plane); the near field
+ * and the receivers whose far line is their own are exact. */
+TEST(near_far_plane_within_bound)
+{
+    hfvis_sweep_options o = exact_opts(0.05, HFVIS_BORDER_OPEN, 0);
+    double az[64], cell = 2.0, gx = 0.75 / cell, gy = -0.5 / cell;
+    hfvis_grid g = test_grid(zbuf, 61, 47, cell);
+    int x, y, k, bad = 0;
+    o.ray_near_cells = FAR_D;
+    for (y = 0; y < 47; y++)
+        for (x = 0; x < 61; x++) zbuf[y * 61 + x] = (float)(0.75 * x - 0.5 * y);
+    CHECK_EQ_STATUS(hfvis_horizon_map(&g, 64, &o, out_a), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_sweep_azimuths(64, &o, az, NULL), HFVIS_OK);
+    for (k = 0; k < 64; k++) {
+        double c = cos(az[k]), s = sin(az[k]), want = gx * c + gy * s, across = fabs(-gx * s + gy * c);
+        for (y = 0; y < 47; y++)
+            for (x = 0; x < 61; x++) {
+                double got = out_a[(size_t)k * 61u * 47u + (size_t)y * 61u + (size_t)x];
+                if (got == (double)(float)(-PI / 2)) continue; /* nothing ahead */
+                if (fabs(tan(got) - want) > across * 0.5 / (double)FAR_D + 1e-6) bad++;
+            }
+    }
+    CHECK(bad == 0);
+}
+
+/* D = 0, D beyond every line's length and any finite radius are today's sweep bit for bit;
+ * receiver rectangles and sun bands equal the whole run bit for bit. */
+TEST(near_far_splits_bit_identical)
+{
+    static float sa[90 * 70], sb[90 * 70];
+    hfvis_sweep_options o = exact_opts(0.3, HFVIS_BORDER_OPEN, 0), f;
+    hfvis_grid g = test_grid(zbuf, 90, 70, 1.0);
+    size_t plane = 90u * 70u, j;
+    int p, bad = 0;
+    fields_urban(zbuf, 90, 70, 14, 8);
+    zbuf[35 * 90 + 40] = (float)NAN;
+    f = o;
+    f.ray_near_cells = 400; /* beyond every line between grid points (|(a, b)| <= 256 sqrt 2) */
+    CHECK_EQ_STATUS(hfvis_horizon_map(&g, 64, &o, out_a), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_horizon_map(&g, 64, &f, out_b), HFVIS_OK);
+    CHECK(memcmp(out_a, out_b, 64 * plane * sizeof(float)) == 0);
+    o.max_distance = 30.0;
+    f.max_distance = 30.0;
+    f.ray_near_cells = FAR_D;
+    CHECK_EQ_STATUS(hfvis_horizon_map(&g, 64, &o, out_a), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_horizon_map(&g, 64, &f, out_b), HFVIS_OK);
+    CHECK(memcmp(out_a, out_b, 64 * plane * sizeof(float)) == 0);
+    /* a receiver rectangle: its receivers equal the whole run's */
+    f.max_distance = 0.0;
+    CHECK_EQ_STATUS(hfvis_horizon_map(&g, 64, &f, out_a), HFVIS_OK);
+    f.receiver_x = 23;
+    f.receiver_y = 11;
+    f.receiver_width = 31;
+    f.receiver_height = 40;
+    memset(out_b, 0, 64 * plane * sizeof(float));
+    CHECK_EQ_STATUS(hfvis_horizon_map(&g, 64, &f, out_b), HFVIS_OK);
+    for (j = 0; j < 64 * plane; j++) {
+        int x = (int)(j % 90u), y = (int)((j / 90u) % 70u);
+        int in = x >= 23 && x < 54 && y >= 11 && y < 51;
+        if (in ? memcmp(out_a + j, out_b + j, sizeof(float)) != 0 : out_b[j] != 0.0f) bad++;
+    }
+    CHECK(bad == 0);
+    /* sun bands (one direction, denominator 64: far field on) */
+    f.receiver_width = f.receiver_height = 0;
+    f.receiver_x = f.receiver_y = 0;
+    CHECK_EQ_STATUS(hfvis_sun_visibility(&g, 0.37, 0.2, 0.01, &f, sa, 90), HFVIS_OK);
+    for (j = 0; j < plane; j++) sb[j] = -1.0f;
+    for (p = 0; p < 3; p++) {
+        f.part_index = p;
+        f.part_count = 3;
+        CHECK_EQ_STATUS(hfvis_sun_visibility(&g, 0.37, 0.2, 0.01, &f, sb, 90), HFVIS_OK);
+    }
+    CHECK(memcmp(sa, sb, sizeof sa) == 0);
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
@@ -710,5 +845,8 @@ int main(int argc, char **argv)
     RUN(allocation_failures);
     RUN(oracle_is_the_supremum);
     RUN(accuracy_against_exact_bilinear_max);
+    RUN(near_far_against_oracle);
+    RUN(near_far_plane_within_bound);
+    RUN(near_far_splits_bit_identical);
     return TEST_DONE();
 }

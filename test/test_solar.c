@@ -787,11 +787,23 @@ TEST(allocation_failures)
     hfvis_solar_output oa;
     int which;
     oa.beam = a[0]; oa.diffuse = a[1]; oa.reflected = a[2]; oa.global = a[3]; oa.sun_hours = a[4];
-    for (which = 0; which < 36; which++) zbuf[which] = (float)(which % 5);
-    for (which = 0; which < 3; which++) { /* fast one day, oracle, fast 40 days (sector sums) */
+    for (which = 0; which < 36; which++) {
+        zbuf[which] = (float)(which % 5);
+        latmap[which] = (40.0 + which / 6) * DEG; /* 1 deg apart: 36 blocks (the list grows) */
+        lonmap[which] = (10.0 + which % 6) * DEG;
+    }
+    for (which = 0; which < 6; which++) { /* fast one day, oracle, fast 40 days (sector sums);
+                                              the same with per-sample sites */
         long k;
-        in.days = which == 2 ? 40 : 1;
-        for (k = 1; k < 200; k++) {
+        in.days = which % 3 == 2 ? 40 : 1;
+        in.latitude_map = which >= 3 ? latmap : NULL;
+        in.longitude_map = which >= 3 ? lonmap : NULL;
+        if (which == 5) /* 0.03 deg apart: 4 blocks of 3 x 3 (each block's sector tables) */
+            for (k = 0; k < 36; k++) {
+                latmap[k] = (40.0 + 0.03 * (double)(k / 6)) * DEG;
+                lonmap[k] = (10.0 + 0.03 * (double)(k % 6)) * DEG;
+            }
+        for (k = 1; k < 1000; k++) { /* every allocation of the run fails once */
             test_counting cnt;
             hfvis_allocator al = test_counting_allocator(&cnt, k);
             hfvis_sweep_options sw = hfvis_sweep_options_default();
@@ -802,12 +814,12 @@ TEST(allocation_failures)
             o.diffuse = HFVIS_SOLAR_DIFFUSE_HORIZON;
             o.reflected = HFVIS_SOLAR_REFLECTED_TERRAIN;
             o.directions = 8;
-            st = which == 1 ? hfvis_solar_irradiation_reference(&g, &in, &o, &oa) : hfvis_solar_irradiation(&g, &in, &o, &oa);
+            st = which % 3 == 1 ? hfvis_solar_irradiation_reference(&g, &in, &o, &oa) : hfvis_solar_irradiation(&g, &in, &o, &oa);
             CHECK(cnt.live == 0);
             if (st == HFVIS_OK) break;
             CHECK_EQ_STATUS(st, HFVIS_ERR_OUT_OF_MEMORY);
         }
-        CHECK(k < 200);
+        CHECK(k < 1000);
     }
 }
 

@@ -163,12 +163,25 @@ TEST(sun_bands_concurrently)
     pthread_mutex_destroy(&j.lock);
 }
 
+/* The units of j run concurrently into unit (TN each), then added in unit order into acc. */
+static void sums_in_order(job *j, double *unit, double *acc)
+{
+    size_t i;
+    int u;
+    j->unit_sums = unit;
+    run_threads(j, sums_worker);
+    for (u = 0; u < j->parts; u++) CHECK_EQ_STATUS(j->status[u], HFVIS_OK);
+    for (i = 0; i < TN; i++) acc[i] = unit[i];
+    for (u = 1; u < j->parts; u++)
+        for (i = 0; i < TN; i++) acc[i] += unit[(size_t)u * TN + i];
+}
+
 TEST(direction_sums_concurrently)
 {
     static double unit[TK * TN], acc[TN];
     static float whole[TN], split[TN];
     job j;
-    int mode, u;
+    int mode;
     size_t i;
     memset(&j, 0, sizeof j);
     pthread_mutex_init(&j.lock, NULL);
@@ -180,13 +193,7 @@ TEST(direction_sums_concurrently)
         CHECK_EQ_STATUS(hfvis_sky_view_factor(&g_grid, TK, &o, whole, TW), HFVIS_OK);
         j.mode = mode;
         j.parts = mode == HFVIS_RAYS_LATTICE ? TK / 4 : TK;
-        j.unit_sums = unit;
-        run_threads(&j, sums_worker);
-        for (u = 0; u < j.parts; u++) CHECK_EQ_STATUS(j.status[u], HFVIS_OK);
-        /* added in unit order, then the single run's finish (hfvis.h, split runs) */
-        for (i = 0; i < TN; i++) acc[i] = unit[i];
-        for (u = 1; u < j.parts; u++)
-            for (i = 0; i < TN; i++) acc[i] += unit[(size_t)u * TN + i];
+        sums_in_order(&j, unit, acc); /* then the single run's finish (hfvis.h, split runs) */
         for (i = 0; i < TN; i++) split[i] = (float)(1.0 + (-1.0 / (double)TK) * acc[i]);
         CHECK(same(whole, split, TN));
     }
@@ -209,8 +216,7 @@ TEST(given_normals_shared)
     static float nrm[TN * 3], whole[TN], given[TN];
     static double unit[TK * TN], acc[TN], sums[TN];
     job j;
-    int mode, u;
-    size_t i;
+    int mode;
     memset(&j, 0, sizeof j);
     pthread_mutex_init(&j.lock, NULL);
     CHECK_EQ_STATUS(hfvis_normals_compute(&g_grid, nrm), HFVIS_OK);
@@ -228,12 +234,7 @@ TEST(given_normals_shared)
         j.kind = HFVIS_SUM_SKY_LIGHT;
         j.opts.normals = nrm;
         j.parts = TK / 4;
-        j.unit_sums = unit;
-        run_threads(&j, sums_worker);
-        for (u = 0; u < j.parts; u++) CHECK_EQ_STATUS(j.status[u], HFVIS_OK);
-        for (i = 0; i < TN; i++) acc[i] = unit[i];
-        for (u = 1; u < j.parts; u++)
-            for (i = 0; i < TN; i++) acc[i] += unit[(size_t)u * TN + i];
+        sums_in_order(&j, unit, acc);
         CHECK(same_sums(sums, acc, TN));
     }
     pthread_mutex_destroy(&j.lock);

@@ -91,14 +91,16 @@ static void exact_field(const char *name, float *z, int n, float *map)
            1e9 * tm, tm / (tl / rd), mm, pm);
 }
 
-/* Sky-view factor of fBm n^2 at K = 16, 64, 256, 360: lattice and exact, CPU time of one call
- * each (the exact calls at large K take seconds; the lattice's at 512^2 about 0.1-1 s). */
+/* Sky-view factor of fBm n^2 at K = 16, 64, 256, 360: lattice, exact and exact with the near and
+ * far field (ray_near_cells = EXACT_BENCH_NEAR), one call each (the exact calls at large K take
+ * seconds; the lattice's at 512^2 about 0.1-1 s). */
+#define EXACT_BENCH_NEAR 8
 static void exact_k_rows(int n)
 {
     static const int Ks[] = {16, 64, 256, 360};
     size_t cells = (size_t)n * (size_t)n;
     float *z = (float *)malloc(sizeof(float) * cells), *out = (float *)malloc(sizeof(float) * cells);
-    hfvis_sweep_options lat = hfvis_sweep_options_default(), ex = lat;
+    hfvis_sweep_options lat = hfvis_sweep_options_default(), ex = lat, nf;
     hfvis_field f;
     hfvis_grid g;
     int i;
@@ -111,16 +113,22 @@ static void exact_k_rows(int n)
     hfvis_field_generate(&f, n, n, n, z);
     g.z = z; g.width = n; g.height = n; g.stride = n; g.cell_size = 1.0;
     ex.rays = HFVIS_RAYS_EXACT;
+    nf = ex;
+    nf.ray_near_cells = EXACT_BENCH_NEAR;
     for (i = 0; i < 4; i++) {
-        double rd = (double)cells * (double)Ks[i], t0, tl, te;
+        double rd = (double)cells * (double)Ks[i], t0, tl, te, tf;
         t0 = bench_now();
         hfvis_sky_view_factor(&g, Ks[i], &lat, out, n);
         tl = bench_now() - t0;
         t0 = bench_now();
         hfvis_sky_view_factor(&g, Ks[i], &ex, out, n);
         te = bench_now() - t0;
+        t0 = bench_now();
+        hfvis_sky_view_factor(&g, Ks[i], &nf, out, n);
+        tf = bench_now() - t0;
         printf("exact rays, fBm %d^2 sky-view factor K=%3d: lattice %.2f s (%.1f ns/rd), exact %.2f s (%.1f ns/rd), "
-               "%.2fx\n", n, Ks[i], tl, 1e9 * tl / rd, te, 1e9 * te / rd, te / tl);
+               "%.2fx; near/far D=%d %.2f s (%.1f ns/rd), %.2fx\n", n, Ks[i], tl, 1e9 * tl / rd, te, 1e9 * te / rd,
+               te / tl, EXACT_BENCH_NEAR, tf, 1e9 * tf / rd, tf / tl);
     }
     free(z);
     free(out);

@@ -232,9 +232,9 @@ static const cli_flag cli_flags[] = {
       "horizon, skyview, sky, light, shadow, hillshade, openness --radius, solar:\n"
       "                    run on N threads, 0..256 (0: the online cores; default 1); the output\n"
       "                    is the one-thread run's bit for bit (directions, bands across the sun,\n"
-      "                    rows; solar: its exact horizon map by directions). Each thread holds\n"
-      "                    its own lattice: where first-touch page faults are slow (VMs), more\n"
-      "                    threads can be slower (docs/performance.md)\n" },
+      "                    rows; solar: its exact horizon map by directions). Each thread adds its\n"
+      "                    own lattice (--exact: a tangent plane) to the peak memory\n"
+      "                    (docs/performance.md, Threads)\n" },
     { "--sky", "C", CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_INDIRECT) | CLI_ONLY(CMD_GI),
       CLI_REAL_AT(0.0, 0, CLI_FLT_MAX, "a radiance >= 0", 1.0, NULL, "radiance", sky,
                   CLI_HAS(has_sky)), NULL },

@@ -37,22 +37,23 @@ static void cli_on_signal(int sig)
 }
 
 /* ex_atomic_hold: SIGINT, SIGTERM and SIGHUP wait (blocked, then delivered) while a temporary
- * file is created and reported, and while a raster's set of files is moved into place. */
+ * file is created and reported, and while a raster's set of files is moved into place. The
+ * signal mask before the outermost hold is restored after it (nested holds count). */
+static sigset_t cli_hold_mask;
+static int cli_hold_depth;
 static void cli_hold(int hold)
 {
-    static sigset_t before;
-    static int depth; /* nested holds restore the mask once, at the outermost */
     sigset_t s;
     if (!hold) {
-        if (depth > 0 && --depth == 0) sigprocmask(SIG_SETMASK, &before, NULL);
+        if (cli_hold_depth > 0 && --cli_hold_depth == 0) sigprocmask(SIG_SETMASK, &cli_hold_mask, NULL);
         return;
     }
-    if (depth++ > 0) return;
+    if (cli_hold_depth++ > 0) return;
     sigemptyset(&s);
     sigaddset(&s, SIGINT);
     sigaddset(&s, SIGTERM);
     sigaddset(&s, SIGHUP);
-    sigprocmask(SIG_BLOCK, &s, &before);
+    sigprocmask(SIG_BLOCK, &s, &cli_hold_mask);
 }
 
 /* Install the handler for SIGINT, SIGTERM and SIGHUP, leaving an ignored signal ignored; ignore
@@ -98,7 +99,7 @@ static hfvis_status cli_write(const char *path, unsigned char *bytes, size_t n, 
 
 static hfvis_status cli_write_encoded(const char *path, size_t need, cli_encoder encode, const void *what)
 {
-    unsigned char *buf = need ? (unsigned char *)malloc(need) : NULL;
+    unsigned char *buf = need ? (unsigned char *)cli_huge_malloc(need) : NULL; /* threads.c */
     size_t written = 0;
     hfvis_status s;
     if (!buf) return need ? HFVIS_ERR_OUT_OF_MEMORY : HFVIS_ERR_INVALID_ARGUMENT;
