@@ -560,19 +560,36 @@ sed "s/WGS_1984_UTM_Zone_33N/$longname/" "$dir/geo.prj" > "$dir/geo_long.prj"
 expect_fail "sum refuses a raster OUT of a georeference too long for the tag" 1 sum "$dir/geo_l1.hfvs" "$dir/geo_l2.hfvs" -o "$fdir/x.tif"
 grep -q 'too long for a part' "$dir/stderr" && ok "sum: the long georeference named" || bad "sum: long georeference: $(cat "$dir/stderr")"
 expect_fail "sum refuses a long georeference's part beside another's" 1 sum "$dir/geo_l1.hfvs" "$dir/geo_b.hfvs" -o "$fdir/x.pfm"
-# a part of an older hfvis (tag "georef=1", no geo=; made here by rewriting the tag and its
-# CRC-32, which gzip's trailer holds) is refused, never summed without its georeference
+# retag PART SED OUT: PART with its tag rewritten by SED and its CRC-32 recomputed (gzip's trailer
+# holds the CRC-32 of what it compressed, least significant byte first, as a part does)
+retag() {
+  total=$(wc -c < "$1"); head3=$(head -n 3 "$1" | wc -c)
+  { head -n 2 "$1"; sed -n 3p "$1" | sed "$2"; head -c $((total - 4)) "$1" | tail -c +$((head3 + 1)); } > "$3.body"
+  { cat "$3.body"; gzip -c < "$3.body" | tail -c 8 | head -c 4; } > "$3"
+  rm -f "$3.body"
+}
 if command -v gzip > /dev/null 2>&1; then
-  part=$dir/geo_a.hfvs; total=$(wc -c < "$part"); head3=$(head -n 3 "$part" | wc -c)
-  { head -n 2 "$part"; sed -n 3p "$part" | sed 's/ geo=[^ ]*$/ georef=1/'
-    head -c $((total - 4)) "$part" | tail -c +$((head3 + 1)); } > "$dir/old.body"
-  { cat "$dir/old.body"; gzip -c < "$dir/old.body" | tail -c 8 | head -c 4; } > "$dir/old.hfvs"
+  # a part of an older hfvis (tag "georef=1", no geo=) is refused, never summed without its
+  # georeference, even to .pfm
+  retag "$dir/geo_a.hfvs" 's/ geo=[^ ]*$/ georef=1/' "$dir/old.hfvs"
   "$hfvis" sum "$dir/old.hfvs" -o "$dir/old.pfm" 2> "$dir/stderr"
   grep -q 'older hfvis.*rerun its --dir-range' "$dir/stderr" && ok "sum refuses a part of an older hfvis (no geo=)" ||
     bad "sum: older part: $(cat "$dir/stderr")"
   rm -f "$dir/old.pfm"
+  # a georeference cut short, with a byte past its end, or outside base64url: "damaged part"
+  "$hfvis" skyview "$dir/geo.asc" --dirs 8 --dir-range 0:8 -o "$dir/geo_all.hfvs" 2> /dev/null
+  geo=$(sed -n 3p "$dir/geo_all.hfvs" | sed 's/.* geo=//'); cut_bad=0
+  for g in "$(echo "$geo" | cut -c 1-40)" "$(echo "$geo" | cut -c 1-$((${#geo} - 4)))" "${geo}AA" "AAAA" "A" "${geo%?}*"; do
+    retag "$dir/geo_all.hfvs" "s/ geo=[^ ]*\$/ geo=$g/" "$dir/cut.hfvs"
+    "$hfvis" sum "$dir/cut.hfvs" -o "$dir/cut.tif" > /dev/null 2> "$dir/stderr"; rc=$?
+    if [ "$rc" -ne 1 ] || ! grep -q 'damaged part: its georeference' "$dir/stderr" || [ -e "$dir/cut.tif" ]; then
+      bad "sum of a part with geo=${g%"${g#?????}"}... (${#g} chars): exit $rc: $(cat "$dir/stderr")"; cut_bad=1; break
+    fi
+  done
+  [ "$cut_bad" -eq 0 ] && ok "sum: damaged georeferences (cut, extended, foreign characters) refused"
+  rm -f "$dir/cut.hfvs"
 else
-  echo "SKIP cli sum of an older part: no gzip"
+  echo "SKIP cli sum of an older or damaged part: no gzip"
 fi
 split4 "split visibility --fraction" visibility pfm 0:3 3:4 4:7 7:8 -- --dirs 8 --fraction --zscale 3
 # exact rays (--exact): split runs and sums as for the lattice; mixing modes is refused
