@@ -1,6 +1,7 @@
 /* split.c - split runs: --dir-range writes a partial result (HFVISSUM) tagged with the command,
- * the input's fingerprint and every parameter; `sum` checks the parts and adds them into the
- * single run's OUT. May call: progress.c, flags.c's primitives, sweeps.c, write.c. */
+ * the input's fingerprint, every parameter and the input's georeference (geo=); `sum` checks
+ * the parts and adds them into the single run's OUT, a raster one with that georeference.
+ * May call: progress.c, flags.c's primitives, sweeps.c, write.c. */
 
 
 /* FNV-1a 64 of one value, folded into h (start: CLI_FNV_OFFSET): the value's IEEE bits, least
