@@ -869,6 +869,26 @@ if "$hfvis" skyview "$h" --dirs 16 --progress -o "$dir/pr.pfm" > "$dir/stdout" 2
 then ok "--progress lines and summary"; else bad "--progress: $(cat "$dir/stderr")"; fi
 if "$hfvis" skyview "$h" --dirs 16 --progress --quiet -o "$dir/pr.pfm" 2> "$dir/stderr" && [ ! -s "$dir/stderr" ]
 then ok "--quiet silences --progress"; else bad "--quiet with --progress: $(cat "$dir/stderr")"; fi
+# --threads by default: the online cores, fewer where --max-memory cannot hold one run's estimate
+# per thread; a given --threads N is kept. The estimate line names the threads; outputs are equal.
+cores=$(getconf _NPROCESSORS_ONLN 2> /dev/null || echo 1); [ "$cores" -gt 256 ] && cores=256
+thr() { sed -n 's/.*estimate \([0-9.e+-]*\) MiB.*, \([0-9]*\) threads*$/\1 \2/p' "$dir/stderr"; }
+"$hfvis" skyview "$h" --dirs 16 --progress -o "$dir/th0.pfm" 2> "$dir/stderr"; r=$(thr)
+est=${r% *}; n=${r#* }
+[ "$n" = "$cores" ] && ok "--threads default: the $cores online cores" || bad "--threads default: '$n' threads, $cores cores: $(cat "$dir/stderr")"
+"$hfvis" skyview "$h" --dirs 16 --threads 1 --quiet -o "$dir/th1.pfm" && cmp -s "$dir/th0.pfm" "$dir/th1.pfm" &&
+  ok "--threads default equals --threads 1 byte for byte" || bad "--threads default differs from --threads 1"
+if [ "$cores" -ge 2 ]; then
+  cap=$(awk -v e="$est" 'BEGIN { printf "%dK", e * 1024 * 1.5 + 1 }')
+  "$hfvis" skyview "$h" --dirs 16 --progress --max-memory "$cap" -o "$dir/th2.pfm" 2> "$dir/stderr"; r=$(thr)
+  [ "${r#* }" = 1 ] && cmp -s "$dir/th2.pfm" "$dir/th1.pfm" &&
+    ok "--threads default: one thread where --max-memory $cap holds one estimate ($est MiB), not two" ||
+    bad "--threads default under --max-memory $cap: '$r': $(cat "$dir/stderr")"
+  "$hfvis" skyview "$h" --dirs 16 --progress --threads 2 --max-memory "$cap" -o "$dir/th2.pfm" 2> "$dir/stderr"; r=$(thr)
+  [ "${r#* }" = 2 ] && ok "--threads 2 given is kept under --max-memory" || bad "--threads 2 under --max-memory $cap: '$r'"
+else
+  echo "SKIP --threads cap: one online core"
+fi
 
 # A failed summary never follows a replaced OUT (issue: `visibility --stats > /dev/full` exited 1
 # after renaming the new file over OUT): the counters are printed first, OUT is then untouched.

@@ -93,6 +93,7 @@ typedef struct cli_run_state {
     double line_last; /* when the last --progress line was printed */
     int line_pct;     /* and its percentage (-1: none yet) */
     int bar_open;     /* the progress bar's line is on stderr without its newline (cli_progress) */
+    int threads;      /* the threads the run uses (cli_check_cost; 0: cli_args.threads) */
 } cli_run_state;
 
 typedef struct cli_args {
@@ -134,6 +135,7 @@ typedef struct cli_args {
     double max_memory; /* --max-memory bytes, 0 = no limit (default: cli_default_max_memory) */
     int has_window, win_x, win_y, win_w, win_h; /* --window X0,Y0,W,H (cells; docs/tiles.md) */
     int threads, has_threads; /* --threads N (threads.c); default the online cores */
+    int threads_auto;         /* --threads 0 or none: cli_check_cost caps them by --max-memory */
     int lattice;              /* hillshade --lattice: lattice-mode shadows (default exact rays) */
     /* solar (solar.c): dates, times, atmosphere, site, extra outputs (beam, diffuse, reflected,
      * sun hours) */

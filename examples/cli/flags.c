@@ -227,10 +227,11 @@ static const cli_flag cli_flags[] = {
       "                    the work (lattice nodes swept, rays, voxel updates) are printed on\n"
       "                    stderr with the progress bar\n" },
     { "--threads", "N", CLI_THREADED,
-      CLI_INT_AT(0, CLI_THREADS_MAX, "an integer 0..256 (0: the online cores)", 1.0, NULL,
-                 "threads", threads, CLI_HAS(has_threads)),
+      CLI_INT_AT(0, CLI_THREADS_MAX, "an integer 0..256 (0: the online cores)", 0.0,
+                 "0 (the online cores)", "threads", threads, CLI_HAS(has_threads)),
       "horizon, skyview, sky, light, shadow, hillshade, openness --radius, solar:\n"
-      "                    run on N threads, 0..256 (0: the online cores; default 1); the output\n"
+      "                    run on N threads, 0..256; default 0: the online cores, fewer where\n"
+      "                    --max-memory cannot hold one run's estimate per thread. The output\n"
       "                    is the one-thread run's bit for bit (directions, bands across the sun,\n"
       "                    rows; solar: its exact horizon map by directions). Each thread adds its\n"
       "                    own lattice (--exact: a tangent plane) to the peak memory\n"
@@ -911,7 +912,7 @@ static int cli_parse(int argc, char **argv, cli_args *a)
 {
     int i, c, positional_only = 0;
     memset(a, 0, sizeof *a);
-    cli_flag_defaults(a); /* --threads 1, not the online cores: see its help, docs/performance.md */
+    cli_flag_defaults(a);
     a->max_memory = cli_default_max_memory();
     a->border = HFVIS_BORDER_OPEN; a->method = HFVIS_ENV_PREFIX;
     a->output = OUT_TOTAL;
@@ -966,7 +967,10 @@ static int cli_parse(int argc, char **argv, cli_args *a)
         return cli_error(CLI_EXIT_USAGE, cli_commands[a->cmd].name, "missing input file IN");
     if (!a->out && (cli_commands[a->cmd].io & CLI_OUT_NEEDED))
         return cli_error(CLI_EXIT_USAGE, cli_commands[a->cmd].name, "missing -o OUT");
-    if (a->threads == 0) a->threads = cli_threads_online(); /* --threads 0 */
+    if (a->threads == 0) { /* --threads 0, the default: the online cores, capped by cli_check_cost */
+        a->threads = cli_threads_online();
+        a->threads_auto = 1;
+    }
     if (a->sky * a->albedo > CLI_FLT_MAX) /* the sky light's scale: outputs would be inf */
         return cli_error(CLI_EXIT_USAGE, "--sky/--albedo", "%g x %g exceeds the float range (3.4e38)",
                          a->sky, a->albedo);

@@ -98,7 +98,7 @@ static int cli_run_hillshade(const cli_args *a, const hfvis_grid *grid, hfvis_sw
             for (i = 0; i < n; i++) vis[i] = 1.0f;
             if (opts->progress) opts->progress(opts->progress_user, 1, 1);
         } else {
-            s = cli_threaded_sun(grid, psi, el, a->sun_radius * (CLI_PI / 180.0), opts, a->threads, vis, w);
+            s = cli_threaded_sun(grid, psi, el, a->sun_radius * (CLI_PI / 180.0), opts, cli_run_threads(a), vis, w);
         }
         for (i = 0; s == HFVIS_OK && i < n; i++) {
             double d = (double)nrm[3 * i] * l[0] + (double)nrm[3 * i + 1] * l[1] + (double)nrm[3 * i + 2] * l[2];
@@ -126,7 +126,7 @@ static int cli_run_openness(const cli_args *a, const hfvis_grid *grid, hfvis_swe
     oo.radius = a->radius;
     oo.negative = a->negative;
     prog->total = a->radius > 0.0 ? grid->height : a->dirs * (a->negative == 2 ? 2 : 1);
-    s = cli_threaded_openness(grid, a->dirs, &oo, opts, a->threads, out);
+    s = cli_threaded_openness(grid, a->dirs, &oo, opts, cli_run_threads(a), out);
     if (s != HFVIS_OK) return cli_status("openness", s, 0);
     if (a->negative == 2) n *= 2; /* --both: positive, then negative */
     if (a->degrees)

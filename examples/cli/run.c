@@ -140,8 +140,16 @@ static int cli_check_cost(const cli_args *a, int w, int h, int channels)
 {
     const char *cmd = cli_commands[a->cmd].name;
     cli_cost c = cli_commands[a->cmd].estimate(a, w, h, channels);
-    if (!a->quiet && (a->progress_lines || cli_stderr_is_terminal()))
-        fprintf(stderr, "%s: estimate %.3g MiB, %.3g %s\n", cmd, c.bytes / 1048576.0, c.work, c.unit);
+    a->run->threads = a->threads;
+    if (a->threads_auto && a->threads > 1 && a->max_memory > 0.0 && c.bytes > 0.0 &&
+        c.bytes * a->threads > a->max_memory) /* a thread's scratch is at most one run's estimate */
+        a->run->threads = c.bytes * 2.0 > a->max_memory ? 1 : (int)(a->max_memory / c.bytes);
+    if (!a->quiet && (a->progress_lines || cli_stderr_is_terminal())) {
+        fprintf(stderr, "%s: estimate %.3g MiB, %.3g %s", cmd, c.bytes / 1048576.0, c.work, c.unit);
+        if (CLI_ONLY(a->cmd) & CLI_THREADED)
+            fprintf(stderr, ", %d thread%s", a->run->threads, a->run->threads == 1 ? "" : "s");
+        fputc('\n', stderr);
+    }
     if (a->max_memory > 0.0 && c.bytes > a->max_memory) {
         char hint[200] = "";
         if (a->run->win.halo >= 0) { /* tiles: the largest square window whose grid (+ halo) fits */
@@ -401,7 +409,7 @@ static int cli_run_heights(const cli_args *a)
 
     switch (a->cmd) {
     case CMD_HORIZON:
-        s = a->threads > 1 ? cli_threaded_horizon_map(&grid, a->dirs, &opts, a->threads, out)
+        s = cli_run_threads(a) > 1 ? cli_threaded_horizon_map(&grid, a->dirs, &opts, cli_run_threads(a), out)
                            : hfvis_horizon_map(&grid, a->dirs, &opts, out);
         if (s == HFVIS_OK && a->degrees) {
             size_t i, n = (size_t)w * (size_t)h * (size_t)planes;
@@ -410,14 +418,14 @@ static int cli_run_heights(const cli_args *a)
         }
         break;
     case CMD_SKYVIEW:
-        s = a->threads > 1 ? cli_threaded_light(CMD_SKYVIEW, &grid, a->dirs, 0.0, NULL, NULL, &opts,
-                                                a->threads, 1, out)
+        s = cli_run_threads(a) > 1 ? cli_threaded_light(CMD_SKYVIEW, &grid, a->dirs, 0.0, NULL, NULL, &opts,
+                                                cli_run_threads(a), 1, out)
                            : hfvis_sky_view_factor(&grid, a->dirs, &opts, out, w);
         break;
     case CMD_SKY:
-        s = a->threads > 1 ? cli_threaded_light(CMD_SKY, &grid, a->dirs,
+        s = cli_run_threads(a) > 1 ? cli_threaded_light(CMD_SKY, &grid, a->dirs,
                                                 (double)(float)a->sky * (double)(float)a->albedo, NULL,
-                                                NULL, &opts, a->threads, 1, out)
+                                                NULL, &opts, cli_run_threads(a), 1, out)
                            : hfvis_sky_light(&grid, a->dirs, (float)a->sky, (float)a->albedo, &opts, out, w);
         if (a->sky * a->albedo <= CLI_FLT_MAX && (float)(a->sky * a->albedo) > 0.0f)
             hi = a->sky * a->albedo;
@@ -425,14 +433,14 @@ static int cli_run_heights(const cli_args *a)
     case CMD_SHADOW: {
         double bearing_or_psi = a->math ? a->sun_azimuth : a->sun_azimuth - 90.0;
         s = cli_threaded_sun(&grid, bearing_or_psi * (CLI_PI / 180.0), a->sun_elevation * (CLI_PI / 180.0),
-                             a->sun_radius * (CLI_PI / 180.0), &opts, a->threads, out, w);
+                             a->sun_radius * (CLI_PI / 180.0), &opts, cli_run_threads(a), out, w);
         break;
     }
     case CMD_LIGHT: {
         hfvis_env_options eopts = hfvis_env_options_default();
         eopts.method = (hfvis_env_method)a->method;
-        s = a->threads > 1 ? cli_threaded_light(CMD_LIGHT, &grid, a->dirs, (double)(float)a->albedo, &env,
-                                                &eopts, &opts, a->threads, channels, out)
+        s = cli_run_threads(a) > 1 ? cli_threaded_light(CMD_LIGHT, &grid, a->dirs, (double)(float)a->albedo, &env,
+                                                &eopts, &opts, cli_run_threads(a), channels, out)
                            : hfvis_env_light(&grid, a->dirs, &env, (float)a->albedo, &opts, &eopts, out, w);
         if (s == HFVIS_OK) hi = cli_top(out, (size_t)w * (size_t)h * (size_t)channels, 1.0);
         break;

@@ -305,7 +305,7 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
         }
     out.beam = planes[0]; out.diffuse = planes[1]; out.reflected = planes[2];
     out.global = planes[3]; out.sun_hours = planes[4];
-    if (a->threads > 1) { /* the exact horizon map by directions over the threads (bit for bit) */
+    if (cli_run_threads(a) > 1) { /* the exact horizon map by directions over the threads (bit for bit) */
         hfvis_sweep_options ms = *opts;
         int K = so.directions;
         ms.rays = HFVIS_RAYS_EXACT; /* as the library's own map (hfvis_solar_options.horizon_map) */
@@ -317,7 +317,7 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
             rc = cli_status("solar", HFVIS_ERR_OUT_OF_MEMORY, 0);
             goto done;
         }
-        if ((s = cli_threaded_horizon_map(grid, K, &ms, a->threads, hmap)) != HFVIS_OK) {
+        if ((s = cli_threaded_horizon_map(grid, K, &ms, cli_run_threads(a), hmap)) != HFVIS_OK) {
             rc = cli_status("solar", s, 0);
             goto done;
         }

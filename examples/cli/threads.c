@@ -27,6 +27,13 @@ static int cli_threads_online(void)
 #endif
 }
 
+/* The threads a run uses: --threads N, or by default the online cores as cli_check_cost capped
+ * them to what --max-memory holds. */
+static int cli_run_threads(const cli_args *a)
+{
+    return a->run && a->run->threads > 0 ? a->run->threads : a->threads;
+}
+
 /* One split run: units 0..units-1, taken in increasing order by the threads; each unit's result
  * goes to its thread's scratch and is then merged in unit order (merge is called for unit u only
  * after units 0..u-1 were merged, under the lock, so merges never overlap and keep the order). */
