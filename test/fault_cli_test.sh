@@ -195,7 +195,9 @@ if [ "$have_strace" = 1 ]; then
       # it), signal the tool. The tool runs in the foreground: a background job has SIGINT ignored.
       ( j=0; while [ $j -lt 400 ]; do
           if [ -f "$dir/sig.trace" ] && [ "$(grep -c " $call(" "$dir/sig.trace")" -ge "$k" ]; then
-            kill -"$sig" "$(awk 'NR == 1 { print $1 }' "$dir/sig.trace")" 2> /dev/null && : > "$dir/sig.sent"; exit 0
+            # the pid on the held call's line (strace -f: a worker thread's exit may come first)
+            kill -"$sig" "$(awk -v c=" $call(" 'index($0, c) { print $1; exit }' "$dir/sig.trace")" 2> /dev/null &&
+              : > "$dir/sig.sent"; exit 0
           fi
           sleep 0.05; j=$((j + 1)); done ) &
       poller=$!
