@@ -11531,6 +11531,39 @@ static void hf_solar_entry_sums(const hf_solar_step *st, double p, double *q)
     q[HF_SQ_HOURS] = w;
 }
 
+/* The pressure nodes pn[0..nn) of a block of samples, over which the sums of a step are
+ * interpolated in the pressure ratio p: one node on a flat block, two (linear) over a small
+ * range of p, else three (quadratic), at heights spread evenly over the block's finite heights.
+ * Returns nn. The one place that chooses them (both fast paths call it). */
+static int hf_solar_block_nodes(const hfvis_grid *g, const hf_solar_block *blk, double pn[HF_SOLAR_NODES])
+{
+    double zmin = HFVIS__INF, zmax = -HFVIS__INF;
+    int nn, j, x, y;
+    for (y = blk->y0; y < blk->y1; y++)
+        for (x = blk->x0; x < blk->x1; x++) {
+            double z = (double)g->z[(ptrdiff_t)y * g->stride + x];
+            if (!isfinite(z)) continue;
+            if (z < zmin) zmin = z;
+            if (z > zmax) zmax = z;
+        }
+    if (!(zmin <= zmax)) zmin = zmax = 0.0;
+    nn = zmin == zmax ? 1 : hf_esra_pressure(zmin) - hf_esra_pressure(zmax) < HF_SOLAR_P_LINEAR ? 2 : 3;
+    for (j = 0; j < nn; j++)
+        pn[j] = hf_esra_pressure(nn == 1 ? zmin : zmax + (zmin - zmax) * (double)j / (double)(nn - 1));
+    return nn;
+}
+
+/* The Lagrange weights L[0..nn) of pressure ratio p over the nodes pn. */
+static void hf_solar_lagrange(int nn, const double *pn, double p, double *L)
+{
+    int j, m;
+    for (j = 0; j < nn; j++) {
+        L[j] = 1.0;
+        for (m = 0; m < nn; m++)
+            if (m != j) L[j] *= (p - pn[m]) / (pn[j] - pn[m]);
+    }
+}
+
 static hfvis_status hf_solar_sectors(const hfvis_grid *g, hf_solar_run *r, int K, const double *az,
                                      const float *cellmap, const float *sky, const hf_solar_block *blk)
 {
@@ -11540,7 +11573,7 @@ static hfvis_status hf_solar_sectors(const hfvis_grid *g, hf_solar_run *r, int K
     hf_solar_entry *ent = NULL;
     int *bk = NULL, *nonempty = NULL, *nne = NULL;
     double *sums = NULL, *tdh = NULL, *bw = NULL, *bdir = NULL, *th = NULL, pn[HF_SOLAR_NODES],
-           zmin = HFVIS__INF, zmax = -HFVIS__INF, turn = 2.0 * HFVIS__PI;
+           turn = 2.0 * HFVIS__PI;
     start = (size_t *)hfvis__alloc_array(r->al, ngroups + 1, sizeof(size_t));
     fill = (size_t *)hfvis__alloc_array(r->al, ngroups + 1, sizeof(size_t));
     ent = (hf_solar_entry *)hfvis__alloc_array(r->al, r->nsteps + 1, sizeof(hf_solar_entry));
@@ -11595,18 +11628,7 @@ static hfvis_status hf_solar_sectors(const hfvis_grid *g, hf_solar_run *r, int K
         }
     }
     /* pressure nodes over the block's heights, and each group's sums from the top */
-    for (y = blk->y0; y < blk->y1; y++)
-        for (x = blk->x0; x < blk->x1; x++) {
-            double z = (double)g->z[(ptrdiff_t)y * g->stride + x];
-            if (!isfinite(z)) continue;
-            if (z < zmin) zmin = z;
-            if (z > zmax) zmax = z;
-        }
-    if (!(zmin <= zmax)) zmin = zmax = 0.0;
-    /* one node on a flat grid, two (linear) over a small range of p, else three (quadratic) */
-    nn = zmin == zmax ? 1 : hf_esra_pressure(zmin) - hf_esra_pressure(zmax) < HF_SOLAR_P_LINEAR ? 2 : 3;
-    for (j = 0; j < nn; j++)
-        pn[j] = hf_esra_pressure(nn == 1 ? zmin : zmax + (zmin - zmax) * (double)j / (double)(nn - 1));
+    nn = hf_solar_block_nodes(g, blk, pn);
     for (i = 0; i < ngroups; i++) {
         double acc[HF_SOLAR_NODES * HF_SOLAR_Q];
         int a;
@@ -11629,12 +11651,7 @@ static hfvis_status hf_solar_sectors(const hfvis_grid *g, hf_solar_run *r, int K
             if (!isfinite(pt->p) || isnan(pt->nz)) continue;
             if (sky) pt->sky_ratio = (double)sky[i] / pt->r_sky;
             for (j = 0; j < K; j++) th[j] = tan((double)hz[j]);
-            for (j = 0; j < nn; j++) { /* Lagrange weights of p */
-                int m;
-                L[j] = 1.0;
-                for (m = 0; m < nn; m++)
-                    if (m != j) L[j] *= (pt->p - pn[m]) / (pn[j] - pn[m]);
-            }
+            hf_solar_lagrange(nn, pn, pt->p, L);
             for (b = 0; b < r->c.bands; b++) {
                 double S[HF_SOLAR_NODES * HF_SOLAR_Q], T[HF_SOLAR_Q], *a = r->acc + ((size_t)b * n + i) * 4;
                 int t, u;
