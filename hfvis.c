@@ -11533,9 +11533,10 @@ static void hf_solar_entry_sums(const hf_solar_step *st, double p, double *q)
 
 /* The pressure nodes pn[0..nn) of a block of samples, over which the sums of a step are
  * interpolated in the pressure ratio p: one node on a flat block, two (linear) over a small
- * range of p, else three (quadratic), at heights spread evenly over the block's finite heights.
+ * range of p, else maxn (3, quadratic, for the sector sums; HF_SOLAR_DAY_NODES for the day
+ * path), at heights spread evenly over the block's finite heights.
  * Returns nn. The one place that chooses them (both fast paths call it). */
-static int hf_solar_block_nodes(const hfvis_grid *g, const hf_solar_block *blk, double pn[HF_SOLAR_NODES])
+static int hf_solar_block_nodes(const hfvis_grid *g, const hf_solar_block *blk, int maxn, double *pn)
 {
     double zmin = HFVIS__INF, zmax = -HFVIS__INF;
     int nn, j, x, y;
@@ -11547,7 +11548,7 @@ static int hf_solar_block_nodes(const hfvis_grid *g, const hf_solar_block *blk, 
             if (z > zmax) zmax = z;
         }
     if (!(zmin <= zmax)) zmin = zmax = 0.0;
-    nn = zmin == zmax ? 1 : hf_esra_pressure(zmin) - hf_esra_pressure(zmax) < HF_SOLAR_P_LINEAR ? 2 : 3;
+    nn = zmin == zmax ? 1 : hf_esra_pressure(zmin) - hf_esra_pressure(zmax) < HF_SOLAR_P_LINEAR ? 2 : maxn;
     for (j = 0; j < nn; j++)
         pn[j] = hf_esra_pressure(nn == 1 ? zmin : zmax + (zmin - zmax) * (double)j / (double)(nn - 1));
     return nn;
@@ -11628,7 +11629,7 @@ static hfvis_status hf_solar_sectors(const hfvis_grid *g, hf_solar_run *r, int K
         }
     }
     /* pressure nodes over the block's heights, and each group's sums from the top */
-    nn = hf_solar_block_nodes(g, blk, pn);
+    nn = hf_solar_block_nodes(g, blk, HF_SOLAR_NODES, pn);
     for (i = 0; i < ngroups; i++) {
         double acc[HF_SOLAR_NODES * HF_SOLAR_Q];
         int a;
@@ -11731,6 +11732,194 @@ static void hf_solar_loop(const hfvis_grid *g, hf_solar_run *r, int K, const flo
         }
 }
 
+/* ------------------------------------------------ 7b. the day path (short periods, per step) */
+/* With one Linke factor per step and no coefficient rasters (a hard sun or a disc), a step's
+ * terms at a sample are its lit flag u (sun above the horizon interpolated from the map exactly
+ * as hf_solar_loop does, and in front of the tangent plane), its visible fraction v (u for a hard
+ * sun), the normal n and one function of the pressure ratio p, w B0c(p), interpolated over the
+ * block's pressure nodes (hf_solar_block_nodes, HF_SOLAR_DAY_NODES of them); kb and Muneer's
+ * sky brightness P1(kb) follow from it. So each step's constants are made once per block, and
+ * per sample and step the loop adds eight products: the samples run in chunks of HF_SOLAR_CHUNK
+ * as structures of arrays, the step outside, so the compiler vectorizes the inner loop (its
+ * iteration count a constant multiple of every vector width). Agrees with hf_solar_loop within
+ * the interpolation of p (test_solar.c day_path_equals_step_loop). */
+#define HF_SOLAR_CHUNK 64
+#define HF_SOLAR_DAY_NODES 5 /* quartic in p: within 1e-6 of B0c over 3 km of relief */
+typedef struct hf_solar_dstep {
+    const float *hz0, *hz1;                  /* the step's two map planes */
+    double c0, c1, elev, sx, sy, sz;         /* horizon weights (1 - kw, kw), the shading sun */
+    double bw[HF_SOLAR_DAY_NODES];           /* w B0c at the nodes (0 for unused nodes) */
+    double w, dhw, ikb, sinh, fd, ca, cb, cf; /* weight, w Dh, 1/(w G0), sin h, Tn Fd, circumsolar */
+} hf_solar_dstep;
+
+/* The day path applies (cheaper than hf_solar_loop whenever the map is read). */
+static int hf_solar_day_apply(const hf_solar_ctx *c)
+{
+    return !c->o.linke_map && !c->o.coeff_bh && !c->o.coeff_dh && !c->o.no_shading;
+}
+
+/* A step's constants over the nodes pn[0..nn) (the map planes map + k n). */
+static void hf_solar_dstep_set(const hf_solar_step *st, const float *map, size_t n, int k0, int k1,
+                               double kw, int nn, const double *pn, hf_solar_dstep *d)
+{
+    int j;
+    d->hz0 = map + (size_t)k0 * n;
+    d->hz1 = map + (size_t)k1 * n;
+    d->c0 = 1.0 - kw;
+    d->c1 = kw;
+    d->elev = st->elev;
+    d->sx = st->sx;
+    d->sy = st->sy;
+    d->sz = st->sz;
+    for (j = 0; j < HF_SOLAR_DAY_NODES; j++)
+        d->bw[j] = j < nn ? st->weight * st->g0 * hf_esra_beam_trans_m(pn[j] * st->m0, st->linke) : 0.0;
+    d->w = st->weight;
+    d->dhw = st->weight * st->g0 * st->fd;
+    d->ikb = 1.0 / (st->weight * st->g0);
+    d->sinh = st->sinh;
+    d->fd = st->fd;
+    d->cf = st->fd / st->sinh; /* horizontal receivers and high sun: kb s / sin h */
+    if (st->h >= 0.1) {
+        d->ca = d->cf;
+        d->cb = 0.0;
+    } else { /* low sun on a tilted receiver: Muneer's form with the horizontal direction */
+        d->ca = 0.0;
+        d->cb = st->fd / (cos(st->elev) * hf_muneer_low_sun(st->h));
+    }
+}
+
+/* The per-chunk arrays: normal, Lagrange weights, visible fraction, the eight sums. */
+enum { HF_DC_NX, HF_DC_NY, HF_DC_NZ, HF_DC_L0, HF_DC_VF = HF_DC_L0 + HF_SOLAR_DAY_NODES,
+       HF_DC_B, HF_DC_BH, HF_DC_H, HF_DC_FG, HF_DC_DL, HF_DC_KB, HF_DC_CT, HF_DC_CF, HF_DC_N };
+#define HF_DC(c, k) ((c) + (k) * HF_SOLAR_CHUNK)
+
+/* One step over a chunk: the sums of the lit samples (c: HF_DC_N arrays of HF_SOLAR_CHUNK). */
+static void hf_solar_day_step(const hf_solar_dstep *d, double *c)
+{
+    const double *restrict nx = HF_DC(c, HF_DC_NX), *restrict ny = HF_DC(c, HF_DC_NY);
+    const double *restrict nz = HF_DC(c, HF_DC_NZ), *restrict vf = HF_DC(c, HF_DC_VF);
+    const double *restrict l0 = HF_DC(c, HF_DC_L0), *restrict l1 = HF_DC(c, HF_DC_L0 + 1);
+    const double *restrict l2 = HF_DC(c, HF_DC_L0 + 2), *restrict l3 = HF_DC(c, HF_DC_L0 + 3);
+    const double *restrict l4 = HF_DC(c, HF_DC_L0 + 4);
+    double *restrict ab = HF_DC(c, HF_DC_B), *restrict abh = HF_DC(c, HF_DC_BH);
+    double *restrict ah = HF_DC(c, HF_DC_H), *restrict afg = HF_DC(c, HF_DC_FG);
+    double *restrict adl = HF_DC(c, HF_DC_DL), *restrict akb = HF_DC(c, HF_DC_KB);
+    double *restrict act = HF_DC(c, HF_DC_CT), *restrict acf = HF_DC(c, HF_DC_CF);
+    const double sx = d->sx, sy = d->sy, sz = d->sz, b0 = d->bw[0], b1 = d->bw[1], b2 = d->bw[2];
+    const double b3 = d->bw[3], b4 = d->bw[4], w = d->w, dhw = d->dhw, ikb = d->ikb;
+    const double sinh_ = d->sinh, fd = d->fd, ca = d->ca, cb = d->cb, cf = d->cf;
+    int i;
+    for (i = 0; i < HF_SOLAR_CHUNK; i++) {
+        double shh = nx[i] * sx + ny[i] * sy, sh = shh + nz[i] * sz;
+        double u = vf[i] > 0.0 ? 1.0 : 0.0, v = vf[i], bw, kb, vb; /* vf: never NaN */
+        u = sh > 0.0 ? u : 0.0;
+        v = sh > 0.0 ? v : 0.0;
+        bw = l0[i] * b0 + l1[i] * b1 + l2[i] * b2 + l3[i] * b3 + l4[i] * b4;
+        kb = bw * ikb;
+        vb = v * bw;
+        ab[i] += vb * sh;
+        abh[i] += vb * sinh_;
+        ah[i] += v * w;
+        afg[i] += u * dhw * ((0.00263 - kb * (0.712 + 0.6883 * kb)) * (1.0 - kb)); /* hf_muneer_fg_part */
+        adl[i] += u * dhw;
+        akb[i] += u * bw * fd;
+        act[i] += vb * (ca * sh + cb * shh);
+        acf[i] += vb * (cf * sh);
+    }
+}
+
+/* The hard sun's lit test over a whole chunk (hf_solar_loop's: the horizon interpolated in
+ * azimuth, NaN never below the sun), vectorized. */
+static void hf_solar_day_lit(const hf_solar_dstep *d, const float *restrict h0, const float *restrict h1,
+                             double *restrict vf)
+{
+    const double c0 = d->c0, c1 = d->c1, e = d->elev;
+    int j;
+    for (j = 0; j < HF_SOLAR_CHUNK; j++) {
+        double hor = c0 * (double)h0[j] + c1 * (double)h1[j];
+        vf[j] = e > hor ? 1.0 : 0.0;
+    }
+}
+
+/* The day path over one block's samples: steps [0, nsteps) of r, the direction-major map. */
+static hfvis_status hf_solar_day(const hfvis_grid *g, hf_solar_run *r, const float *map,
+                                 const float *sky, const int *kk, const double *kw,
+                                 const hf_solar_block *blk)
+{
+    size_t n = hf_grid_count(g), q, q0, q1;
+    double pn[HF_SOLAR_DAY_NODES], *c;
+    hf_solar_dstep *ds;
+    int nn = hf_solar_block_nodes(g, blk, HF_SOLAR_DAY_NODES, pn);
+    int horizon = r->c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON, x0, y, j, k;
+    double radius = r->c.o.sun_radius_rad;
+    ds = (hf_solar_dstep *)hfvis__alloc_array(r->al, r->nsteps + 1, sizeof(hf_solar_dstep));
+    c = (double *)hfvis__alloc_array(r->al, HF_DC_N * HF_SOLAR_CHUNK, sizeof(double));
+    if (!ds || !c) {
+        hfvis__free(r->al, ds);
+        hfvis__free(r->al, c);
+        return HFVIS_ERR_OUT_OF_MEMORY;
+    }
+    for (q = 0; q < r->nsteps; q++)
+        hf_solar_dstep_set(r->steps + q, map, n, kk[2 * q], kk[2 * q + 1], kw[q], nn, pn, ds + q);
+    for (y = blk->y0; y < blk->y1; y++)
+        for (x0 = blk->x0; x0 < blk->x1; x0 += HF_SOLAR_CHUNK) {
+            int cnt = blk->x1 - x0 < HF_SOLAR_CHUNK ? blk->x1 - x0 : HF_SOLAR_CHUNK;
+            size_t row = (size_t)y * (size_t)g->width + (size_t)x0;
+            for (k = 0; k < HF_DC_N * HF_SOLAR_CHUNK; k++) c[k] = 0.0; /* padding: never lit */
+            for (j = 0; j < cnt; j++) {
+                const hf_solar_point *pt = r->pts + row + (size_t)j;
+                double L[HF_SOLAR_DAY_NODES];
+                if (!isfinite(pt->p) || isnan(pt->nz)) continue; /* holes: never lit, not stored */
+                hf_solar_lagrange(nn, pn, pt->p, L);
+                HF_DC(c, HF_DC_NX)[j] = pt->nx;
+                HF_DC(c, HF_DC_NY)[j] = pt->ny;
+                HF_DC(c, HF_DC_NZ)[j] = pt->nz;
+                for (k = 0; k < nn; k++) HF_DC(c, HF_DC_L0 + k)[j] = L[k];
+            }
+            for (q0 = 0; q0 < r->nsteps; q0 = q1) { /* one band's steps at a time */
+                int band = r->steps[q0].band;
+                double tdh = 0.0;
+                for (k = HF_DC_B * HF_SOLAR_CHUNK; k < HF_DC_N * HF_SOLAR_CHUNK; k++) c[k] = 0.0;
+                for (q1 = q0; q1 < r->nsteps && r->steps[q1].band == band; q1++) {
+                    const hf_solar_dstep *d = ds + q1;
+                    const float *h0 = d->hz0 + row, *h1 = d->hz1 + row;
+                    double *vf = HF_DC(c, HF_DC_VF);
+                    tdh += d->dhw;
+                    if (radius == 0.0 && cnt == HF_SOLAR_CHUNK)
+                        hf_solar_day_lit(d, h0, h1, vf);
+                    else
+                        for (j = 0; j < cnt; j++) { /* the lit test as hf_solar_loop's */
+                            double hor = d->c0 * (double)h0[j] + d->c1 * (double)h1[j];
+                            double vis = radius > 0.0 ? hf_solar_visible(d->elev, hor, radius) : d->elev > hor ? 1.0 : 0.0;
+                            vf[j] = vis > 0.0 ? vis : 0.0; /* NaN (no horizon): shadow, as the loop */
+                        }
+                    hf_solar_day_step(d, c);
+                }
+                for (j = 0; j < cnt; j++) { /* the sums to the band's irradiation (as section 7) */
+                    size_t i = row + (size_t)j;
+                    hf_solar_point *pt = r->pts + i;
+                    double *a = r->acc + ((size_t)band * n + i) * 4;
+                    double bh = HF_DC(c, HF_DC_BH)[j], dl = HF_DC(c, HF_DC_DL)[j];
+                    if (!isfinite(pt->p) || isnan(pt->nz)) continue;
+                    if (sky) pt->sky_ratio = (double)sky[i] / pt->r_sky;
+                    a[0] = pt->tilted ? HF_DC(c, HF_DC_B)[j] : bh;
+                    if (pt->tilted || horizon) {
+                        double bg = (pt->fg * HF_DC(c, HF_DC_FG)[j] + pt->r_sky * (dl - HF_DC(c, HF_DC_KB)[j])) * pt->sky_ratio;
+                        double shade = (tdh - dl) * (pt->r_sky + pt->fg * 0.252271) * pt->sky_ratio;
+                        a[1] = bg + shade + HF_DC(c, pt->tilted ? HF_DC_CT : HF_DC_CF)[j];
+                    } else {
+                        a[1] = tdh;
+                    }
+                    a[2] = pt->tilted ? pt->albedo * (bh + tdh) * (1.0 - pt->nz) * 0.5 : 0.0;
+                    a[3] = HF_DC(c, HF_DC_H)[j];
+                }
+            }
+        }
+    hfvis__free(r->al, ds);
+    hfvis__free(r->al, c);
+    return HFVIS_OK;
+}
+
 /* The blocks of the run: the whole grid at the input's site, or hf_solar_split of the maps
  * (then SPA's instant part from the hourly table when there is more than one block). */
 static hfvis_status hf_solar_run_blocks(const hfvis_grid *g, hf_solar_run *r, hf_solar_blocks *B,
@@ -11786,6 +11975,7 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
     hfvis_status st;
     hfvis_sweep_options s;
     float *map = NULL, *cellmap = NULL, *sky = NULL;
+    const float *src = NULL; /* the direction-major map read (the caller's or map) */
     double *az = NULL;
     int K;
     size_t n, i, bi;
@@ -11808,18 +11998,7 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
             if (!sky) st = HFVIS_ERR_OUT_OF_MEMORY;
             else st = hfvis_sky_light(g, K, 1.0f, 1.0f, &s, sky, g->width);
         }
-        if (st == HFVIS_OK) { /* sample-major: each sample's K horizons side by side */
-            cellmap = (float *)hfvis__alloc_array(r.al, n * (size_t)K, sizeof(float));
-            if (!cellmap) st = HFVIS_ERR_OUT_OF_MEMORY;
-        }
-        if (st == HFVIS_OK) {
-            const float *src = r.c.o.horizon_map ? r.c.o.horizon_map : map;
-            int k;
-            for (k = 0; k < K; k++)
-                for (i = 0; i < n; i++) cellmap[i * (size_t)K + (size_t)k] = src[(size_t)k * n + i];
-        }
-        hfvis__free(r.al, map);
-        map = NULL;
+        src = r.c.o.horizon_map ? r.c.o.horizon_map : map;
     }
     B.b = NULL;
     B.n = 0;
@@ -11830,19 +12009,33 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
         int *kk = NULL;
         double *kw = NULL;
         size_t q;
+        int sectors, day;
         if ((st = hf_solar_run_site(&r, blk)) != HFVIS_OK) break;
-        if (cellmap && hf_solar_sectors_apply(&r.c, r.nsteps)) {
+        sectors = src && hf_solar_sectors_apply(&r.c, r.nsteps);
+        day = src && !sectors && hf_solar_day_apply(&r.c);
+        if (src && !day && !cellmap) { /* sample-major: each sample's K horizons side by side */
+            int k;
+            cellmap = (float *)hfvis__alloc_array(r.al, n * (size_t)K, sizeof(float));
+            if (!cellmap) {
+                st = HFVIS_ERR_OUT_OF_MEMORY;
+                break;
+            }
+            for (k = 0; k < K; k++)
+                for (i = 0; i < n; i++) cellmap[i * (size_t)K + (size_t)k] = src[(size_t)k * n + i];
+        }
+        if (sectors) {
             st = hf_solar_sectors(g, &r, K, az, cellmap, sky, blk);
             continue;
         }
-        if (cellmap) { /* each step's two map directions and weight */
+        if (src) { /* each step's two map directions and weight */
             kk = (int *)hfvis__alloc_array(r.al, r.nsteps + 1, 2 * sizeof(int));
             kw = (double *)hfvis__alloc_array(r.al, r.nsteps + 1, sizeof(double));
             if (!kk || !kw) st = HFVIS_ERR_OUT_OF_MEMORY;
             for (q = 0; q < r.nsteps && st == HFVIS_OK; q++)
                 hf_solar_bracket(az, K, r.steps[q].psi, kk + 2 * q, kk + 2 * q + 1, kw + q);
         }
-        if (st == HFVIS_OK) hf_solar_loop(g, &r, K, cellmap, sky, kk, kw, blk);
+        if (st == HFVIS_OK && day) st = hf_solar_day(g, &r, src, sky, kk, kw, blk);
+        else if (st == HFVIS_OK) hf_solar_loop(g, &r, K, cellmap, sky, kk, kw, blk);
         hfvis__free(r.al, kk);
         hfvis__free(r.al, kw);
     }
@@ -11850,6 +12043,7 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
     hfvis__free(r.al, eph);
     hfvis__free(r.al, az);
     hfvis__free(r.al, cellmap);
+    hfvis__free(r.al, map);
     hfvis__free(r.al, sky);
     if (st != HFVIS_OK) {
         hf_solar_run_free(&r);
