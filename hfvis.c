@@ -11965,6 +11965,64 @@ static hfvis_status hf_solar_run_site(hf_solar_run *r, const hf_solar_block *blk
     return hf_solar_run_steps(r);
 }
 
+/* ------------------------------------------------ 7c. the map's directions the period reads */
+#define HF_SOLAR_MARK_BLOCK_DAYS 366 /* blocks x days up to which the steps of every block are
+                                        made twice (to find the directions, then to integrate);
+                                        beyond, every direction is made */
+
+/* Mark in need[K] the map directions the steps of r read: the two around each step's azimuth
+ * (hf_solar_loop, the day path) and the two around the centre of its azimuth bin (the sector
+ * sums). */
+static void hf_solar_mark(const hf_solar_run *r, int K, const double *az, unsigned char *need)
+{
+    int NB = HF_SOLAR_BINS_PER_DIR * K, k0, k1, bin;
+    double w, turn = 2.0 * HFVIS__PI;
+    size_t q;
+    for (q = 0; q < r->nsteps; q++) {
+        double psi = r->steps[q].psi;
+        hf_solar_bracket(az, K, psi, &k0, &k1, &w);
+        need[k0] = need[k1] = 1;
+        bin = (int)floor(psi / turn * (double)NB + 0.5) % NB;
+        hf_solar_bracket(az, K, turn * (double)bin / (double)NB, &k0, &k1, &w);
+        need[k0] = need[k1] = 1;
+    }
+}
+
+/* The horizon map (direction-major, K planes) of the directions the period's steps read, over
+ * every block; the other planes 0 (never read). Each run of needed directions is one
+ * hfvis_horizon_map call with direction_begin/end: its planes bit-identical to the whole map's. */
+static hfvis_status hf_solar_map(const hfvis_grid *g, hf_solar_run *r, const hf_solar_blocks *B, int K,
+                                 const double *az, const hfvis_sweep_options *s, float *map)
+{
+    size_t n = hf_grid_count(g), bi, i;
+    unsigned char *need = (unsigned char *)hfvis__alloc_array(r->al, (size_t)K, 1);
+    int days = r->c.in.instant ? 1 : r->c.in.days, k, e;
+    hfvis_status st = HFVIS_OK;
+    if (!need) return HFVIS_ERR_OUT_OF_MEMORY;
+    for (k = 0; k < K; k++) need[k] = 0;
+    if (B->n == 1 || (double)B->n * (double)days <= HF_SOLAR_MARK_BLOCK_DAYS) {
+        for (bi = 0; bi < B->n && st == HFVIS_OK; bi++)
+            if ((st = hf_solar_run_site(r, B->b + bi)) == HFVIS_OK) hf_solar_mark(r, K, az, need);
+    } else {
+        for (k = 0; k < K; k++) need[k] = 1;
+    }
+    for (k = 0; k < K && st == HFVIS_OK; k = e) {
+        hfvis_sweep_options o = *s;
+        for (e = k + 1; e < K && need[e] == need[k]; e++) {}
+        if (!need[k]) {
+            for (i = 0; i < (size_t)(e - k) * n; i++) map[(size_t)k * n + i] = 0.0f;
+            continue;
+        }
+        if (k > 0 || e < K) {
+            o.direction_begin = k;
+            o.direction_end = e;
+        }
+        st = hfvis_horizon_map(g, K, &o, map + (size_t)k * n);
+    }
+    hfvis__free(r->al, need);
+    return st;
+}
+
 /* -------------------------------------------------------------------- 8. the public routines */
 hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_input *in,
                                      const hfvis_solar_options *opts, const hfvis_solar_output *out)
@@ -11983,27 +12041,26 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
     n = hf_grid_count(g);
     K = r.c.o.directions;
     s = hf_solar_sweep(&r.c, HFVIS_RAYS_EXACT);
-    if (!r.c.o.no_shading || r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON) {
-        if (n > SIZE_MAX / sizeof(float) / (size_t)K) {
-            hf_solar_run_free(&r);
-            return HFVIS_ERR_LIMIT;
-        }
-        az = (double *)hfvis__alloc_array(r.al, (size_t)K, sizeof(double));
-        map = r.c.o.horizon_map ? NULL : (float *)hfvis__alloc_array(r.al, n * (size_t)K, sizeof(float));
-        if (!az || (!map && !r.c.o.horizon_map)) st = HFVIS_ERR_OUT_OF_MEMORY;
-        if (st == HFVIS_OK) st = hfvis_sweep_azimuths(K, &s, az, NULL);
-        if (st == HFVIS_OK && !r.c.o.horizon_map) st = hfvis_horizon_map(g, K, &s, map);
-        if (st == HFVIS_OK && r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON) {
-            sky = (float *)hfvis__alloc_array(r.al, n, sizeof(float));
-            if (!sky) st = HFVIS_ERR_OUT_OF_MEMORY;
-            else st = hfvis_sky_light(g, K, 1.0f, 1.0f, &s, sky, g->width);
-        }
-        src = r.c.o.horizon_map ? r.c.o.horizon_map : map;
-    }
     B.b = NULL;
     B.n = 0;
-    if (st == HFVIS_OK) st = hf_solar_run_blocks(g, &r, &B, &eph);
+    st = hf_solar_run_blocks(g, &r, &B, &eph);
     r.c.eph = eph;
+    if (st == HFVIS_OK && r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON) {
+        sky = (float *)hfvis__alloc_array(r.al, n, sizeof(float));
+        if (!sky) st = HFVIS_ERR_OUT_OF_MEMORY;
+        else st = hfvis_sky_light(g, K, 1.0f, 1.0f, &s, sky, g->width);
+    }
+    if (st == HFVIS_OK && !r.c.o.no_shading) { /* the map read by the steps' azimuths */
+        if (n > SIZE_MAX / sizeof(float) / (size_t)K) st = HFVIS_ERR_LIMIT;
+        if (st == HFVIS_OK) {
+            az = (double *)hfvis__alloc_array(r.al, (size_t)K, sizeof(double));
+            map = r.c.o.horizon_map ? NULL : (float *)hfvis__alloc_array(r.al, n * (size_t)K, sizeof(float));
+            if (!az || (!map && !r.c.o.horizon_map)) st = HFVIS_ERR_OUT_OF_MEMORY;
+        }
+        if (st == HFVIS_OK) st = hfvis_sweep_azimuths(K, &s, az, NULL);
+        if (st == HFVIS_OK && !r.c.o.horizon_map) st = hf_solar_map(g, &r, &B, K, az, &s, map);
+        src = r.c.o.horizon_map ? r.c.o.horizon_map : map;
+    }
     for (bi = 0; bi < B.n && st == HFVIS_OK; bi++) {
         const hf_solar_block *blk = B.b + bi;
         int *kk = NULL;
