@@ -10830,7 +10830,8 @@ static int hf_solar_opts_valid(const hfvis_solar_options *o)
         o->reflected < HFVIS_SOLAR_REFLECTED_DEFAULT || o->reflected > HFVIS_SOLAR_REFLECTED_TERRAIN ||
         o->reflected_directions < 0 || o->reflected_directions > HF_SOLAR_K_MAX ||
         o->bands < HFVIS_SOLAR_BANDS_DEFAULT || o->bands > HFVIS_SOLAR_BANDS_MONTH ||
-        !hf_in(o->site_tolerance_rad, 0.0, 0.1))
+        !hf_in(o->site_tolerance_rad, 0.0, 0.1) || o->horizons < HFVIS_SOLAR_HORIZONS_DEFAULT ||
+        o->horizons > HFVIS_SOLAR_HORIZONS_LATTICE)
         return 0;
     if (s && (!hf_opts_valid(s) || s->extent_width != 0 || s->receiver_width != 0)) return 0;
     if (o->linke_monthly)
@@ -11202,6 +11203,23 @@ static hfvis_sweep_options hf_solar_sweep(const hf_solar_ctx *c, hfvis_ray_mode 
     s.direction_begin = s.direction_end = 0;
     s.direction_order = HFVIS_DIRECTION_ORDER_DEFAULT;
     return s;
+}
+
+/* The sweep options of the fast routine's horizon map and visible sky: o->horizons' rays. */
+static hfvis_sweep_options hf_solar_map_sweep(const hf_solar_ctx *c)
+{
+    hfvis_sweep_options s = hf_solar_sweep(c, c->o.horizons == HFVIS_SOLAR_HORIZONS_LATTICE ? HFVIS_RAYS_LATTICE
+                                                                                          : HFVIS_RAYS_EXACT);
+    if (c->o.horizons == HFVIS_SOLAR_HORIZONS_NEAR_FAR) s.ray_near_cells = HFVIS_SOLAR_NEAR_CELLS;
+    if (c->o.horizons == HFVIS_SOLAR_HORIZONS_LATTICE) s.ray_near_cells = 0;
+    return s;
+}
+
+hfvis_sweep_options hfvis_solar_map_options(const hfvis_solar_options *opts)
+{
+    hf_solar_ctx c;
+    c.o = opts ? *opts : hfvis_solar_options_default();
+    return hf_solar_map_sweep(&c);
 }
 
 /* Write the accumulated sums acc[(band*n + i)*4 + q] (beam, diffuse, reflected, sunshine) to the
@@ -11989,7 +12007,8 @@ static void hf_solar_mark(const hf_solar_run *r, int K, const double *az, unsign
 }
 
 /* The horizon map (direction-major, K planes) of the directions the period's steps read, over
- * every block; the other planes 0 (never read). Each run of needed directions is one
+ * every block (exact rays; lattice horizons with K % 4 == 0: every direction); the other planes
+ * 0 (never read). Each run of needed directions is one
  * hfvis_horizon_map call with direction_begin/end: its planes bit-identical to the whole map's. */
 static hfvis_status hf_solar_map(const hfvis_grid *g, hf_solar_run *r, const hf_solar_blocks *B, int K,
                                  const double *az, const hfvis_sweep_options *s, float *map)
@@ -12000,7 +12019,10 @@ static hfvis_status hf_solar_map(const hfvis_grid *g, hf_solar_run *r, const hf_
     hfvis_status st = HFVIS_OK;
     if (!need) return HFVIS_ERR_OUT_OF_MEMORY;
     for (k = 0; k < K; k++) need[k] = 0;
-    if (B->n == 1 || (double)B->n * (double)days <= HF_SOLAR_MARK_BLOCK_DAYS) {
+    if (s->rays == HFVIS_RAYS_LATTICE && K % 4 == 0) { /* every quarter-turn group shares one
+        lattice, and an arc of the sun's azimuths wider than a quarter turn meets every group */
+        for (k = 0; k < K; k++) need[k] = 1;
+    } else if (B->n == 1 || (double)B->n * (double)days <= HF_SOLAR_MARK_BLOCK_DAYS) {
         for (bi = 0; bi < B->n && st == HFVIS_OK; bi++)
             if ((st = hf_solar_run_site(r, B->b + bi)) == HFVIS_OK) hf_solar_mark(r, K, az, need);
     } else {
@@ -12040,7 +12062,7 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
     if ((st = hf_solar_run_init(g, in, opts, out, &r)) != HFVIS_OK) return st;
     n = hf_grid_count(g);
     K = r.c.o.directions;
-    s = hf_solar_sweep(&r.c, HFVIS_RAYS_EXACT);
+    s = hf_solar_map_sweep(&r.c);
     B.b = NULL;
     B.n = 0;
     st = hf_solar_run_blocks(g, &r, &B, &eph);

@@ -1487,6 +1487,23 @@ typedef enum hfvis_solar_bands {
     HFVIS_SOLAR_BANDS_MONTH = 2   /* one band per calendar month the period touches */
 } hfvis_solar_bands;
 
+/* The horizons that shade the beam (and bound HORIZON's visible sky) in the fast routine. The
+ * oracle always takes each receiver's own exact ray. Errors against it (mean over receivers of
+ * |fast - oracle| / oracle of the daily global, beam in brackets; one day, K = 64) and the cost
+ * of the map on the Colorado tile (512^2, 90 m): docs/solar.md "Horizon modes". */
+typedef enum hfvis_solar_horizons {
+    HFVIS_SOLAR_HORIZONS_DEFAULT = 0,  /* = EXACT */
+    HFVIS_SOLAR_HORIZONS_EXACT = 1,    /* exact rays, every sample of every ray (the sweep's
+                                          ray_near_cells as given, 0 by default) */
+    HFVIS_SOLAR_HORIZONS_NEAR_FAR = 2, /* exact rays within HFVIS_SOLAR_NEAR_CELLS cells, the
+                                          shared far field beyond (hfvis_sweep_options.
+                                          ray_near_cells; about 0.7x the exact map's cost at K = 64) */
+    HFVIS_SOLAR_HORIZONS_LATTICE = 3   /* [P1] lattice horizons (HFVIS_RAYS_LATTICE; about 8x
+                                          cheaper than exact at K = 64; misses shadow next to
+                                          one-cell walls and cliffs) */
+} hfvis_solar_horizons;
+#define HFVIS_SOLAR_NEAR_CELLS 8
+
 /* What to compute: the site, the period and the surface. hfvis_solar_input_default() fills in
  * linke 3, albedo 0.2, days 1, 2026-06-21; latitude and longitude are the caller's to set. */
 typedef struct hfvis_solar_input {
@@ -1540,17 +1557,25 @@ typedef struct hfvis_solar_options {
                                     convergence) and its block centre's, (0, 0.1]; 0 = 0.05 deg.
                                     Every sun direction of a sample is within it of its own */
     const hfvis_sweep_options *sweep; /* border, search radius, allocator, progress; its rays
-                                    field is ignored (the horizon map is always exact rays) and
+                                    field is ignored (horizons below sets the ray mode) and
                                     its window and rectangle must be unset */
-    const float *horizon_map;    /* NULL: the fast routine makes its exact horizon map itself;
-                                    else the caller's, directions*width*height floats exactly as
-                                    hfvis_horizon_map writes them for these K directions with
-                                    HFVIS_RAYS_EXACT and the sweep options above (azimuth0 0,
-                                    every direction): e.g. made on several threads (the results
-                                    are then bit for bit those of NULL). The oracle ignores it */
+    const float *horizon_map;    /* NULL: the fast routine makes its horizon map itself (only
+                                    the directions its steps read); else the caller's,
+                                    directions*width*height floats exactly as hfvis_horizon_map
+                                    writes them for these K directions with the sweep options
+                                    hfvis_solar_map_options returns: e.g. made on several threads
+                                    (the results are then bit for bit those of NULL). The oracle
+                                    ignores it */
+    hfvis_solar_horizons horizons; /* the fast routine's horizons; default EXACT */
 } hfvis_solar_options;
 
 HFVIS_API hfvis_solar_options hfvis_solar_options_default(void);
+
+/* The sweep options with which hfvis_solar_irradiation makes its horizon map (and HORIZON's
+ * visible sky) for these options (NULL: the defaults): opts->sweep's border, radius, allocator
+ * and progress, the ray mode and near-field cells of opts->horizons, azimuth0 0, every
+ * direction. Pass them to hfvis_horizon_map to make opts->horizon_map yourself. */
+HFVIS_API hfvis_sweep_options hfvis_solar_map_options(const hfvis_solar_options *opts);
 
 /* The outputs: each NULL or bands*width*height floats, band b at [b*width*height + y*width + x]:
  * beam, diffuse and reflected on the receiver's own surface (normal from the grid, hfvis.h

@@ -125,6 +125,7 @@
     X(esra_clear_sky, S, -, "NGFR", "INVALID_ARGUMENT") \
     X(solar_input_default, P, -, "", "cannot fail") \
     X(solar_options_default, P, -, "", "cannot fail") \
+    X(solar_map_options, P, -, "", "cannot fail") \
     X(solar_band_count, V, -, "NZE", "-1") \
     X(solar_irradiation, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(solar_irradiation_reference, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
@@ -1858,6 +1859,20 @@ static void args_solar_options_default(void)
     CHECK(o.model == HFVIS_SUN_SPA && o.step_hours == 0.25 && o.directions == 64 && o.sweep == NULL);
 }
 
+static void args_solar_map_options(void)
+{
+    hfvis_solar_options o = hfvis_solar_options_default();
+    hfvis_sweep_options s = hfvis_solar_map_options(NULL);
+    begin("solar_map_options");
+    CHECK(s.rays == HFVIS_RAYS_EXACT && s.ray_near_cells == 0 && s.direction_end == 0);
+    o.horizons = HFVIS_SOLAR_HORIZONS_LATTICE;
+    s = hfvis_solar_map_options(&o);
+    CHECK(s.rays == HFVIS_RAYS_LATTICE);
+    o.horizons = (hfvis_solar_horizons)99; /* not checked here: hfvis_solar_irradiation refuses it */
+    s = hfvis_solar_map_options(&o);
+    CHECK(s.rays == HFVIS_RAYS_EXACT);
+}
+
 static hfvis_solar_input solar_in_ok(void)
 {
     hfvis_solar_input in = hfvis_solar_input_default();
@@ -1909,6 +1924,7 @@ static void solar_args(const char *name, solar_fn fn)
     b = in; b.days = 36601; BAD('O', INV, fn(&g_ok, &b, &o, &out));
     bo2 = o; bo2.model = (hfvis_sun_model)7; BAD('E', INV, fn(&g_ok, &in, &bo2, &out));
     bo2 = o; bo2.diffuse = (hfvis_solar_diffuse)7; BAD('E', INV, fn(&g_ok, &in, &bo2, &out));
+    bo2 = o; bo2.horizons = (hfvis_solar_horizons)7; BAD('E', INV, fn(&g_ok, &in, &bo2, &out));
     bo2 = o; bo2.step_hours = -0.25; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));
     bo2 = o; bo2.sun_radius_rad = 1.0; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));
     bo2 = o; bo2.directions = -1; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));

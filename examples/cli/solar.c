@@ -306,13 +306,8 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     out.beam = planes[0]; out.diffuse = planes[1]; out.reflected = planes[2];
     out.global = planes[3]; out.sun_hours = planes[4];
     if (cli_run_threads(a) > 1) { /* the exact horizon map by directions over the threads (bit for bit) */
-        hfvis_sweep_options ms = *opts;
+        hfvis_sweep_options ms = hfvis_solar_map_options(&so); /* as the library's own map */
         int K = so.directions;
-        ms.rays = HFVIS_RAYS_EXACT; /* as the library's own map (hfvis_solar_options.horizon_map) */
-        ms.ray_denominator = 0;
-        ms.azimuth0_rad = 0.0;
-        ms.direction_begin = ms.direction_end = 0;
-        ms.direction_order = HFVIS_DIRECTION_ORDER_DEFAULT;
         if (!(hmap = cli_alloc((size_t)w * (size_t)h, (size_t)K, 1))) {
             rc = cli_status("solar", HFVIS_ERR_OUT_OF_MEMORY, 0);
             goto done;
