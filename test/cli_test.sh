@@ -1240,6 +1240,15 @@ fi
 expect_ok "solar --threads 3 (the horizon map by directions)" "$dir/solt3.pfm" solar "$dir/hill.pgm" --latitude 46 --longitude 15 --start 2026-03-01 --end 2026-03-05 --threads 3 -o "$dir/solt3.pfm"
 expect_ok "solar --threads 1" "$dir/solt1.pfm" solar "$dir/hill.pgm" --latitude 46 --longitude 15 --start 2026-03-01 --end 2026-03-05 -o "$dir/solt1.pfm"
 cmp -s "$dir/solt1.pfm" "$dir/solt3.pfm" && ok "solar --threads 3 equals one thread bit for bit" || bad "solar --threads 3 differs from one thread"
+for hz in near-far lattice; do
+  expect_ok "solar --horizons $hz --threads 2" "$dir/solz2.pfm" solar "$dir/hill.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --horizons $hz --threads 2 -o "$dir/solz2.pfm"
+  expect_ok "solar --horizons $hz --threads 1" "$dir/solz1.pfm" solar "$dir/hill.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --horizons $hz --threads 1 -o "$dir/solz1.pfm"
+  cmp -s "$dir/solz1.pfm" "$dir/solz2.pfm" && ok "solar --horizons $hz: the threaded map (hfvis_solar_map_options) equals one thread bit for bit" || bad "solar --horizons $hz: --threads 2 differs from one thread"
+done
+"$hfvis" solar "$dir/hill.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --horizons exact --threads 1 -o "$dir/solze.pfm" 2>/dev/null
+cmp -s "$dir/solz1.pfm" "$dir/solze.pfm" && bad "solar --horizons lattice: equals exact bit for bit (mode not applied)" || ok "solar --horizons lattice differs from exact"
+"$hfvis" solar --help 2>&1 | grep -q -- '--horizons exact|near-far|lattice' && ok "solar --help lists --horizons" || bad "solar --help: no --horizons"
+expect_fail "solar: bad --horizons" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --horizons fast -o "$fdir/x.pfm"
 expect_fail "solar: no latitude (no CRS)" 1 solar "$dir/flat.pgm" --day 2026-06-21 -o "$fdir/x.pfm"
 expect_fail "solar: a date that does not exist" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-02-29 -o "$fdir/x.pfm"
 expect_fail "solar: Linke outside (0, 10]" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --linke 0 -o "$fdir/x.pfm"

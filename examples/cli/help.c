@@ -51,6 +51,7 @@
     "         --albedo-map A.pfm] -o GLOBAL [--beam B] [--diffuse D] [--reflected R]\n"             \
     "         [--sun-hours H] [--latitude DEG --longitude DEG] [--utc-offset H | --solar-time]\n"    \
     "         [--bands day|month] [--sun-radius DEG] [--dirs K] [--max-distance R]\n"              \
+    "         [--horizons exact|near-far|lattice]\n"                                                \
     "Clear-sky solar irradiation (Wh/m^2) of a day or a date range, or irradiance (W/m^2) at\n"     \
     "--time, on every cell: r.sun's ESRA atmosphere (Suri & Hofierka 2004), the sun from NREL's\n"  \
     "SPA (Reda & Andreas 2004/2008), the beam shaded by exact horizons (docs/solar.md).\n"          \
@@ -70,6 +71,10 @@
     "  --bands day|month one band per day or per calendar month, stacked like horizon planes\n"     \
     "  --sun-radius DEG  shade the sun's disc (default: its centre); --dirs K: directions of the\n" \
     "                    exact horizon map (default 64)\n"                                          \
+    "  --horizons H      the horizons that shade: exact (default), near-far (exact within 8\n"     \
+    "                    cells, a shared far field beyond: about 0.6x the map's time) or lattice\n" \
+    "                    ([P1] lattice horizons: about 4x faster, misses shadow next to one-cell\n"  \
+    "                    walls and cliffs; docs/solar.md \"Horizon modes\")\n"                     \
     "Polar night gives 0. With --progress the site's latitude and longitude go to stderr.\n"
 
 #define CLI_VF_HELP                                                                                  \
