@@ -32,7 +32,9 @@
  *  17. Solar radiation: NREL SPA (Reda & Andreas 2004/2008), r.sun's solar geometry and its ESRA
  *      clear sky (Suri & Hofierka 2004; Rigollier et al. 2000), time steps with sunrise and
  *      sunset inside the step, per-sample sites by blocks of one sun, irradiation over the
- *      exact horizon map, and its oracle (docs/solar.md)
+ *      horizon map (exact, near/far or lattice; only the directions the steps read): the step
+ *      loop, the sector sums of long periods, the vectorized day path; and its oracle
+ *      (docs/solar.md)
  *
  * Paper references: [P1] Timonen & Westerholm, "Scalable Height Field Self-Shadowing",
  * CGF 29(2), 2010 (thesis appendix A.1). Errata and choices: docs/errata.md E1-E18.

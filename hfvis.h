@@ -1594,9 +1594,11 @@ HFVIS_API int hfvis_solar_band_count(const hfvis_solar_input *input,
  * the sun at the site (with input->latitude_map: at the centre of each block of samples whose
  * local frames lie within opts->site_tolerance_rad of the centre's, quadtree halving from the
  * whole grid; the steps, sunrise and sunset are then each block's own, SPA's instant part taken
- * once per hour of the period and interpolated, within 2e-6 deg); the beam is shaded by the exact horizon toward the sun, read from one
- * exact-ray horizon map of K directions made once (hfvis_horizon_map, HFVIS_RAYS_EXACT) and
- * interpolated linearly in azimuth between its two nearest directions; then r.sun's ESRA
+ * once per hour of the period and interpolated, within 2e-6 deg); the beam is shaded by the horizon toward the sun, read from one
+ * horizon map of K directions made once (hfvis_horizon_map with hfvis_solar_map_options: exact
+ * rays by default, opts->horizons; only the directions the steps read, bit-identical to the
+ * whole map's planes) and interpolated linearly in azimuth between its two nearest directions;
+ * then r.sun's ESRA
  * atmosphere per sample (its height for the air mass, its Linke factor, albedo and
  * coefficients). Steps (SPA): the day's civil hours cut at step_hours, each evaluated at its
  * middle; the step holding sunrise or sunset is evaluated at the middle of its sunlit part
@@ -1609,8 +1611,13 @@ HFVIS_API int hfvis_solar_band_count(const hfvis_solar_input *input,
  * is lit or not; the air mass's height enters by interpolation over 1-3 pressure nodes), so a
  * sample costs O(bins * log steps) instead of O(steps); its lit test is taken at the bin's
  * centre (within 0.7 deg of the step's azimuth at K = 64).
- * Memory: K*8 bytes per sample for the map and its sample-major copy (K = 64: 512 bytes at the
- * peak), 120 bytes per sample of state and 32 per sample and band of sums, plus the outputs;
+ * Shorter periods with one Linke factor per step and no coefficient rasters (a hard sun or the
+ * disc) take the day path: per step w B0c at 5 pressure nodes over the block's heights, per
+ * sample the lit test as the step loop's and eight sums in a vectorized loop (within 3e-6 of
+ * the step loop on the Colorado tile, 1.5e-5 over 6 km of relief; docs/solar.md "The day path").
+ * Memory: K*4 bytes per sample for the map (K = 64: 256 bytes), K*4 more for its sample-major
+ * copy with the sector sums or the step loop, 120 bytes per sample of state and 32 per sample
+ * and band of sums, plus the outputs;
  * HORIZON adds 4 bytes per sample, TERRAIN the [P2] sweep's scratch; the sector sums about
  * 350 bytes per sunlit step; per-sample sites 1 KB per day of the period (the hourly table)
  * and 56 bytes per block.

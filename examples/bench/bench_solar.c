@@ -1,7 +1,9 @@
 /* bench_solar.c - hfvis_solar_irradiation beside its oracle (hfvis.h, "solar radiation"): one
- * day (day 172, 15-minute steps, Linke 3, albedo 0.2) on a DEM, the horizon map's share of the
- * time, the cost per receiver and per receiver-step; then fast and oracle on a crop, their ratio
- * and the oracle's agreement (mean |fast - oracle| / oracle of the daily global and beam).
+ * day (day 172, 15-minute steps, Linke 3, albedo 0.2) on a DEM for each horizon mode (exact,
+ * near-far, lattice), the directions of the map it made, its ratio to GRASS; the integration
+ * alone over a given map, the day path beside the step loop it replaced (ns per receiver-step);
+ * then each mode and the oracle on a crop, their ratio and the mode's agreement (mean
+ * |fast - oracle| / oracle of the daily global and beam).
  * The DEMs come from HFVIS_BENCH_DEMS, a directory holding colorado_srtm_512_90m.pfm (SRTM,
  * 90 m, 40.2 N 105.6 W) and slovenia_lidar_1000_1m.pfm (lidar DTM, 1 m, 46.5 N 15.8 E); without
  * it a 512^2 fBm with 90 m cells stands in:
@@ -40,7 +42,8 @@ static int solar_run(const hfvis_grid *g, const hfvis_solar_input *in, const hfv
 /* GRASS's times for the DEM (solar_grass.sh through popen): the DEM as an ESRI ASCII grid placed
  * in UTM zone `zone` north around (lat, lon) (the meridian arc and the parallel's scale: within
  * metres, enough for r.sun's site), then the script's lines. */
-static void solar_grass(const solar_site *s, const float *z, int w, int h, int zone, double t_fast)
+static void solar_grass(const solar_site *s, const float *z, int w, int h, int zone, double *t_rsun,
+                        double *t_rhor)
 {
     const char *script = getenv("HFVIS_BENCH_GRASS"), *tmp = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
     char dir[512], asc[600], cmd[2048], line[256];
@@ -77,73 +80,122 @@ static void solar_grass(const solar_site *s, const float *z, int w, int h, int z
     remove(asc);
     remove(dir);
     if (t_sh < 0.0 || t_hor < 0.0 || t_rh < 0.0) { printf("  r.sun: no timing (GRASS absent or failed)\n"); return; }
-    printf("  GRASS r.sun, same DEM and day (nprocs=1): own shadowing %.2f s (hfvis %.1fx faster); "
-           "r.horizon 5 deg %.2f s + r.sun %.2f s = %.2f s (hfvis %.1fx); r.sun mean global %.0f Wh/m^2\n",
-           t_sh, t_sh / t_fast, t_hor, t_rh, t_hor + t_rh, (t_hor + t_rh) / t_fast, mean);
+    printf("  GRASS r.sun, same DEM and day (nprocs=1): own shadowing %.2f s; r.horizon 5 deg %.2f s + "
+           "r.sun %.2f s = %.2f s; r.sun mean global %.0f Wh/m^2\n", t_sh, t_hor, t_rh, t_hor + t_rh, mean);
+    *t_rsun = t_sh;
+    *t_rhor = t_hor + t_rh;
 }
+
+static int solar_dirs_made;
+static void solar_count(void *user, int done, int total)
+{
+    (void)user; (void)done; (void)total;
+    solar_dirs_made++;
+}
+
+static const char *const solar_mode_name[4] = { "", "exact", "near-far", "lattice" };
 
 static void solar_dem(const solar_site *s, float *z, int w, int h, int quick)
 {
     hfvis_grid g;
     hfvis_solar_input in = hfvis_solar_input_default();
     hfvis_solar_options o = hfvis_solar_options_default();
-    hfvis_sweep_options sw = hfvis_sweep_options_default();
+    hfvis_sweep_options sw = hfvis_sweep_options_default(), cnt = hfvis_sweep_options_default();
     size_t n = (size_t)w * (size_t)h, i;
     float *b1 = (float *)malloc(n * sizeof(float)), *g1 = (float *)malloc(n * sizeof(float));
-    float *map = (float *)malloc(n * (size_t)64 * sizeof(float));
+    float *map = (float *)malloc(n * (size_t)64 * sizeof(float)), *ones = (float *)malloc(n * sizeof(float));
     float *cz = (float *)malloc((size_t)SOLAR_CROP * SOLAR_CROP * sizeof(float));
     static float cb[2][SOLAR_CROP * SOLAR_CROP], cg[2][SOLAR_CROP * SOLAR_CROP];
-    double t_fast = 1e30, t_map = 1e30, t, t_or, t_cf, sum_g = 0.0, sum_b = 0.0, mean = 0.0;
-    int rep, x, y, nb = 0;
-    if (!b1 || !g1 || !map || !cz) {
+    double t_mode[4] = { 0, 1e30, 1e30, 1e30 }, t_map = 1e30, t_day = 1e30, t_loop = 1e30, t, t_or, t_cf;
+    double t_rsun = -1.0, t_rhor = -1.0, steps, mean = 0.0;
+    int rep, x, y, m, dirs[4] = { 0, 0, 0, 0 };
+    if (!b1 || !g1 || !map || !ones || !cz) {
         printf("  %s: out of memory\n", s->name);
-        free(b1); free(g1); free(map); free(cz);
+        free(b1); free(g1); free(map); free(ones); free(cz);
         return;
     }
+    for (i = 0; i < n; i++) ones[i] = 1.0f;
     g.z = z; g.width = w; g.height = h; g.stride = w; g.cell_size = s->cell;
     in.latitude_rad = s->lat * SOLAR_DEG;
     in.longitude_rad = s->lon * SOLAR_DEG;
     in.utc_offset_hours = s->lon / 15.0 > 0 ? 1.0 : -7.0;
     in.days = s->days;
+    cnt.progress = solar_count;
     for (rep = 0; rep < (quick ? 1 : 2); rep++) { /* the minimum of the runs: a shared machine */
-        if (!solar_run(&g, &in, &o, 0, b1, g1, &t)) { printf("  %s: failed\n", s->name); break; }
-        if (t < t_fast) t_fast = t;
-        sw.rays = HFVIS_RAYS_EXACT;
+        for (m = HFVIS_SOLAR_HORIZONS_EXACT; m <= HFVIS_SOLAR_HORIZONS_LATTICE; m++) {
+            hfvis_solar_options mo = o;
+            mo.horizons = (hfvis_solar_horizons)m;
+            mo.sweep = &cnt;
+            solar_dirs_made = 0;
+            if (!solar_run(&g, &in, &mo, 0, b1, g1, &t)) { printf("  %s: failed\n", s->name); break; }
+            if (t < t_mode[m]) t_mode[m] = t;
+            dirs[m] = solar_dirs_made;
+            if (m == HFVIS_SOLAR_HORIZONS_EXACT && rep == 0)
+                for (i = 0; i < n; i++) mean += (double)g1[i];
+        }
+        sw.rays = HFVIS_RAYS_EXACT; /* the whole exact map alone */
         t = bench_now();
         hfvis_horizon_map(&g, 64, &sw, map);
         t = bench_now() - t;
         if (t < t_map) t_map = t;
+        { /* the integration alone over that map: the day path, and the step loop it replaced (a
+             coefficient raster of ones takes the loop, term for term the same model) */
+            hfvis_solar_options io = o;
+            io.horizon_map = map;
+            if (solar_run(&g, &in, &io, 0, b1, g1, &t) && t < t_day) t_day = t;
+            io.coeff_bh = ones;
+            if (solar_run(&g, &in, &io, 0, b1, g1, &t) && t < t_loop) t_loop = t;
+        }
     }
-    for (i = 0; i < n; i++) mean += (double)g1[i];
-    printf("  %-34s %4d x %-4d %3d day(s): %7.2f s (horizon map K = 64: %.2f s), %.2f us/receiver, "
-           "mean global %.0f Wh/m^2\n", s->name, w, h, s->days, t_fast, t_map, t_fast * 1e6 / (double)n,
-           mean / (double)n);
-    { /* where the time goes: the map, then the atmosphere per receiver and sunlit step */
+    { /* the sunlit steps of the day at the site */
         hfvis_grid one;
         hfvis_solar_options fo = o;
         hfvis_solar_output so;
         float z0 = 0.0f, hours = 0.0f;
-        double steps;
         one.z = &z0; one.width = one.height = one.stride = 1; one.cell_size = s->cell;
         fo.no_shading = 1;
         memset(&so, 0, sizeof so);
         so.sun_hours = &hours;
         hfvis_solar_irradiation(&one, &in, &fo, &so);
         steps = ceil((double)hours / 0.25) + 1.0;
-        printf("  %-34s after the map: %.2f s = %.0f ns per receiver and sunlit step (%.0f steps); "
-               "memory %d bytes per receiver at the peak (the map and its copy: 8 K) + 120 + 32 per band\n",
-               "", t_fast - t_map, (t_fast - t_map) * 1e9 / ((double)n * steps), steps, 8 * 64);
     }
-    if (s->utm_zone) solar_grass(s, z, w, h, s->utm_zone, t_fast);
-    /* fast and oracle on the central crop */
+    printf("  %-34s %4d x %-4d %3d day(s), mean global %.0f Wh/m^2; the whole exact map K = 64 alone %.2f s\n",
+           s->name, w, h, s->days, mean / (double)n, t_map);
+    printf("  %-34s integration after the map (%.0f sunlit steps): day path %.3f s = %.1f ns per receiver-step; "
+           "step loop %.3f s = %.1f ns (%.1fx)\n", "", steps, t_day, t_day * 1e9 / ((double)n * steps), t_loop,
+           t_loop * 1e9 / ((double)n * steps), t_loop / t_day);
+    if (s->utm_zone) solar_grass(s, z, w, h, s->utm_zone, &t_rsun, &t_rhor);
+    for (m = HFVIS_SOLAR_HORIZONS_EXACT; m <= HFVIS_SOLAR_HORIZONS_LATTICE; m++) {
+        printf("  %-34s --horizons %-8s %6.2f s, %2d of 64 directions, %.2f us/receiver", "", solar_mode_name[m],
+               t_mode[m], dirs[m], t_mode[m] * 1e6 / (double)n);
+        if (t_rsun > 0.0)
+            printf("; %.1fx r.sun (target 20x), %.1fx r.horizon + r.sun (target 50x)", t_rsun / t_mode[m],
+                   t_rhor / t_mode[m]);
+        printf("\n");
+    }
+    printf("  %-34s memory: 256 bytes per receiver for the map (K = 64; its sample-major copy, 256 more, only\n"
+           "  %-34s for long periods and the step loop) + 120 + 32 per band\n", "", "");
+    /* fast (each mode) and oracle on the central crop */
     for (y = 0; y < SOLAR_CROP; y++)
         for (x = 0; x < SOLAR_CROP; x++)
             cz[y * SOLAR_CROP + x] = z[(size_t)(h / 2 - SOLAR_CROP / 2 + y) * (size_t)w + (size_t)(w / 2 - SOLAR_CROP / 2 + x)];
     g.z = cz; g.width = g.height = SOLAR_CROP; g.stride = SOLAR_CROP;
     in.days = 1;
-    if (!solar_run(&g, &in, &o, 0, cb[0], cg[0], &t_cf) || !solar_run(&g, &in, &o, 1, cb[1], cg[1], &t_or)) {
+    if (!solar_run(&g, &in, &o, 1, cb[1], cg[1], &t_or)) {
         printf("  %s crop: failed\n", s->name);
+        m = HFVIS_SOLAR_HORIZONS_LATTICE + 1;
     } else {
+        m = HFVIS_SOLAR_HORIZONS_EXACT;
+    }
+    for (; m <= HFVIS_SOLAR_HORIZONS_LATTICE; m++) {
+        hfvis_solar_options mo = o;
+        double sum_g = 0.0, sum_b = 0.0;
+        int nb = 0;
+        mo.horizons = (hfvis_solar_horizons)m;
+        if (!solar_run(&g, &in, &mo, 0, cb[0], cg[0], &t_cf)) {
+            printf("  %s crop: failed\n", s->name);
+            break;
+        }
         for (i = 0; i < (size_t)SOLAR_CROP * SOLAR_CROP; i++) {
             sum_g += fabs((double)cg[0][i] - (double)cg[1][i]) / ((double)cg[1][i] > 1.0 ? (double)cg[1][i] : 1.0);
             if (cb[1][i] > 1.0f) {
@@ -151,11 +203,11 @@ static void solar_dem(const solar_site *s, float *z, int w, int h, int quick)
                 nb++;
             }
         }
-        printf("  %-34s crop %d^2, 1 day: fast %.3f s, oracle %.2f s (%.0fx); mean |fast - oracle| / oracle: "
-               "global %.4f %%, beam %.4f %%\n", s->name, SOLAR_CROP, t_cf, t_or, t_or / t_cf,
-               100.0 * sum_g / (double)(SOLAR_CROP * SOLAR_CROP), nb ? 100.0 * sum_b / nb : 0.0);
+        printf("  %-34s crop %d^2, 1 day, --horizons %-8s fast %.3f s, oracle %.2f s (%.0fx); mean |fast - oracle| / "
+               "oracle: global %.4f %%, beam %.4f %%\n", s->name, SOLAR_CROP, solar_mode_name[m], t_cf, t_or,
+               t_or / t_cf, 100.0 * sum_g / (double)(SOLAR_CROP * SOLAR_CROP), nb ? 100.0 * sum_b / nb : 0.0);
     }
-    free(b1); free(g1); free(map); free(cz);
+    free(b1); free(g1); free(map); free(ones); free(cz);
 }
 
 void bench_solar(int quick)
@@ -166,8 +218,8 @@ void bench_solar(int quick)
     };
     const char *dir = getenv("HFVIS_BENCH_DEMS");
     int k, ran = 0;
-    printf("\nSolar irradiation (hfvis_solar_irradiation, SPA sun, 15-minute steps, K = 64 exact horizon map;\n"
-           "one thread; times are the minimum of %d runs):\n", quick ? 1 : 2);
+    printf("\nSolar irradiation (hfvis_solar_irradiation, SPA sun, 15-minute steps, K = 64 horizon map of each\n"
+           "--horizons mode; one thread, everything included; times are the minimum of %d runs):\n", quick ? 1 : 2);
     for (k = 0; dir && *dir && k < 2; k++) {
         char path[4096];
         float *z = NULL;
