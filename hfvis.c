@@ -10833,7 +10833,8 @@ static int hf_solar_opts_valid(const hfvis_solar_options *o)
         o->reflected_directions < 0 || o->reflected_directions > HF_SOLAR_K_MAX ||
         o->bands < HFVIS_SOLAR_BANDS_DEFAULT || o->bands > HFVIS_SOLAR_BANDS_MONTH ||
         !hf_in(o->site_tolerance_rad, 0.0, 0.1) || o->horizons < HFVIS_SOLAR_HORIZONS_DEFAULT ||
-        o->horizons > HFVIS_SOLAR_HORIZONS_LATTICE)
+        o->horizons > HFVIS_SOLAR_HORIZONS_LATTICE || o->row_begin < 0 || o->row_end < 0 ||
+        ((o->row_begin || o->row_end) && (o->row_begin >= o->row_end || o->reflected == HFVIS_SOLAR_REFLECTED_TERRAIN)))
         return 0;
     if (s && (!hf_opts_valid(s) || s->extent_width != 0 || s->receiver_width != 0)) return 0;
     if (o->linke_monthly)
@@ -10883,6 +10884,7 @@ typedef struct hf_solar_ctx {
     double lat, lon;         /* the current site, radians */
     double gamma;            /* the true azimuth of the grid's up direction there */
     const hf_spa_eph *eph;   /* NULL: full SPA per instant; else the hourly instant table */
+    int rb, re;              /* the rows computed and written */
 } hf_solar_ctx;
 
 /* The Julian day of local civil hour t of day (y, m, d). */
@@ -11176,6 +11178,9 @@ static hfvis_status hf_solar_setup(const hfvis_grid *g, const hfvis_solar_input 
         if (c->o.site_tolerance_rad == 0.0) c->o.site_tolerance_rad = HF_SOLAR_SITE_TOL_DEFAULT;
     }
     c->bands = hfvis_solar_band_count(in, opts);
+    c->rb = c->o.row_end ? c->o.row_begin : 0;
+    c->re = c->o.row_end ? c->o.row_end : g->height;
+    if (c->re > g->height) return HFVIS_ERR_INVALID_ARGUMENT;
     n = hf_grid_count(g);
     if (n > SIZE_MAX / sizeof(double) / 8 || (size_t)c->bands > SIZE_MAX / sizeof(float) / 8 / n)
         return HFVIS_ERR_LIMIT;
@@ -11232,7 +11237,7 @@ static void hf_solar_store(const hfvis_grid *g, const hf_solar_ctx *c, const dou
     size_t n = hf_grid_count(g), i;
     int b;
     for (b = 0; b < c->bands; b++)
-        for (i = 0; i < n; i++) {
+        for (i = (size_t)c->rb * (size_t)g->width; i < (size_t)c->re * (size_t)g->width; i++) {
             size_t j = (size_t)b * n + i;
             const double *a = acc + j * 4;
             int hole = !isfinite(g->z[(i / (size_t)g->width) * (size_t)g->stride + i % (size_t)g->width]);
@@ -11358,6 +11363,7 @@ static double hf_solar_frame_angle(const double a[9], const double b[9])
 /* A block of samples sharing the sun of its centre sample's site. */
 typedef struct hf_solar_block {
     int x0, y0, x1, y1;
+    int r0, r1;           /* the rows computed, within [y0, y1) (the options' row range) */
     double lat, lon, gamma;
 } hf_solar_block;
 
@@ -11402,6 +11408,7 @@ static hfvis_status hf_solar_split(const hfvis_grid *g, const hfvis_solar_input 
         B->cap = cap;
     }
     B->b[B->n].x0 = x0; B->b[B->n].y0 = y0; B->b[B->n].x1 = x1; B->b[B->n].y1 = y1;
+    B->b[B->n].r0 = y0; B->b[B->n].r1 = y1;
     B->b[B->n].lat = lat; B->b[B->n].lon = lon; B->b[B->n].gamma = gam;
     B->n++;
     return HFVIS_OK;
@@ -11663,7 +11670,7 @@ static hfvis_status hf_solar_sectors(const hfvis_grid *g, hf_solar_run *r, int K
         }
     }
     /* per sample: the suffix of each bin above its threshold */
-    for (y = blk->y0; y < blk->y1; y++)
+    for (y = blk->r0; y < blk->r1; y++)
         for (x = blk->x0; x < blk->x1; x++) {
             hf_solar_point *pt = r->pts + (i = (size_t)y * (size_t)g->width + (size_t)x);
             const float *hz = cellmap + i * (size_t)K;
@@ -11723,7 +11730,7 @@ static void hf_solar_loop(const hfvis_grid *g, hf_solar_run *r, int K, const flo
 {
     size_t n = hf_grid_count(g), q;
     int horizon = r->c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON, x, y;
-    for (y = blk->y0; y < blk->y1; y++)
+    for (y = blk->r0; y < blk->r1; y++)
         for (x = blk->x0; x < blk->x1; x++) {
             size_t i = (size_t)y * (size_t)g->width + (size_t)x;
             hf_solar_point *pt = r->pts + i;
@@ -11881,7 +11888,7 @@ static hfvis_status hf_solar_day(const hfvis_grid *g, hf_solar_run *r, const flo
     }
     for (q = 0; q < r->nsteps; q++)
         hf_solar_dstep_set(r->steps + q, map, n, kk[2 * q], kk[2 * q + 1], kw[q], nn, pn, ds + q);
-    for (y = blk->y0; y < blk->y1; y++)
+    for (y = blk->r0; y < blk->r1; y++)
         for (x0 = blk->x0; x0 < blk->x1; x0 += HF_SOLAR_CHUNK) {
             int cnt = blk->x1 - x0 < HF_SOLAR_CHUNK ? blk->x1 - x0 : HF_SOLAR_CHUNK;
             size_t row = (size_t)y * (size_t)g->width + (size_t)x0;
@@ -11956,6 +11963,8 @@ static hfvis_status hf_solar_run_blocks(const hfvis_grid *g, hf_solar_run *r, hf
         B->b[0].x0 = B->b[0].y0 = 0;
         B->b[0].x1 = g->width;
         B->b[0].y1 = g->height;
+        B->b[0].r0 = 0;
+        B->b[0].r1 = g->height;
         B->b[0].lat = r->c.lat;
         B->b[0].lon = r->c.lon;
         B->b[0].gamma = 0.0;
@@ -12086,11 +12095,14 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
         src = r.c.o.horizon_map ? r.c.o.horizon_map : map;
     }
     for (bi = 0; bi < B.n && st == HFVIS_OK; bi++) {
-        const hf_solar_block *blk = B.b + bi;
+        hf_solar_block part = B.b[bi], *blk = &part;
         int *kk = NULL;
         double *kw = NULL;
         size_t q;
         int sectors, day;
+        if (part.r0 < r.c.rb) part.r0 = r.c.rb; /* the options' rows of this block */
+        if (part.r1 > r.c.re) part.r1 = r.c.re;
+        if (part.r0 >= part.r1) continue;
         if ((st = hf_solar_run_site(&r, blk)) != HFVIS_OK) break;
         sectors = src && hf_solar_sectors_apply(&r.c, r.nsteps);
         day = src && !sectors && hf_solar_day_apply(&r.c);
@@ -12192,6 +12204,8 @@ hfvis_status hfvis_solar_irradiation_reference(const hfvis_grid *g, const hfvis_
     size_t n, i, q;
     int KR;
     if ((st = hf_solar_run_init(g, in, opts, out, &r)) != HFVIS_OK) return st;
+    r.c.rb = 0; /* every row */
+    r.c.re = g->height;
     n = hf_grid_count(g);
     s = hf_solar_sweep(&r.c, HFVIS_RAYS_EXACT);
     KR = HF_SOLAR_REF_DIRS * r.c.o.directions;

@@ -1567,6 +1567,12 @@ typedef struct hfvis_solar_options {
                                     (the results are then bit for bit those of NULL). The oracle
                                     ignores it */
     hfvis_solar_horizons horizons; /* the fast routine's horizons; default EXACT */
+    int row_begin, row_end;      /* 0, 0: every row; else the fast routine computes and writes
+                                    only rows [row_begin, row_end) of the outputs (0 <= begin <
+                                    end <= height; the other rows untouched), each bit for bit
+                                    the whole call's: calls on disjoint ranges split a run over
+                                    threads (give them one horizon_map). Not with TERRAIN. The
+                                    oracle ignores it */
 } hfvis_solar_options;
 
 HFVIS_API hfvis_solar_options hfvis_solar_options_default(void);

@@ -1925,6 +1925,7 @@ static void solar_args(const char *name, solar_fn fn)
     bo2 = o; bo2.model = (hfvis_sun_model)7; BAD('E', INV, fn(&g_ok, &in, &bo2, &out));
     bo2 = o; bo2.diffuse = (hfvis_solar_diffuse)7; BAD('E', INV, fn(&g_ok, &in, &bo2, &out));
     bo2 = o; bo2.horizons = (hfvis_solar_horizons)7; BAD('E', INV, fn(&g_ok, &in, &bo2, &out));
+    bo2 = o; bo2.row_begin = 3; bo2.row_end = 2; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));
     bo2 = o; bo2.step_hours = -0.25; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));
     bo2 = o; bo2.sun_radius_rad = 1.0; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));
     bo2 = o; bo2.directions = -1; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));

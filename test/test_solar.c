@@ -930,6 +930,64 @@ TEST(horizon_modes_against_oracle)
     }
 }
 
+/* Row ranges (hfvis_solar_options.row_begin/end): three calls on disjoint ranges give the whole
+ * call bit for bit, each leaving the other rows untouched; the day path, the sector sums, the
+ * step loop (a Linke map), per-sample blocks, HORIZON diffuse. */
+TEST(row_ranges_equal_the_whole_call)
+{
+    static float whole[5][3 * W * H], part[5][3 * W * H];
+    static float lk[W * H];
+    static const int cut[4] = { 0, 7, 13, H };
+    int c, k, i, p;
+    for (i = 0; i < W * H; i++) lk[i] = 3.5f;
+    for (c = 0; c < 5; c++) {
+        hfvis_grid g = test_grid(zbuf, c == 3 ? S : W, c == 3 ? S : H, 1.0);
+        hfvis_solar_input in = site(c == 4 ? -35.0 : 46.0, 5, 10);
+        hfvis_solar_options o = hfvis_solar_options_default();
+        hfvis_solar_output a, b;
+        int n = g.width * g.height, nb;
+        (void)test_fbm(zbuf, g.width, g.height, 6.0, 8.0, 0, 80 + (uint64_t)c);
+        if (c == 1) in.days = 30;
+        if (c == 2) o.linke_map = lk;
+        if (c == 3) sites(&in, 60.0, 40.0, 10.0, 12.0);
+        if (c == 4) {
+            o.diffuse = HFVIS_SOLAR_DIFFUSE_HORIZON;
+            in.days = 3;
+            o.bands = HFVIS_SOLAR_BANDS_DAY;
+        }
+        nb = hfvis_solar_band_count(&in, &o);
+        a.beam = whole[0]; a.diffuse = whole[1]; a.reflected = whole[2]; a.global = whole[3]; a.sun_hours = whole[4];
+        b.beam = part[0]; b.diffuse = part[1]; b.reflected = part[2]; b.global = part[3]; b.sun_hours = part[4];
+        CHECK_EQ_STATUS(hfvis_solar_irradiation(&g, &in, &o, &a), HFVIS_OK);
+        for (k = 0; k < 5; k++)
+            for (i = 0; i < nb * n; i++) part[k][i] = -7.0f;
+        for (p = 0; p < 3; p++) {
+            int y0 = cut[p] * g.height / H, y1 = cut[p + 1] * g.height / H, y;
+            o.row_begin = y0;
+            o.row_end = y1;
+            CHECK_EQ_STATUS(hfvis_solar_irradiation(&g, &in, &o, &b), HFVIS_OK);
+            for (k = 0; k < 5; k++) /* the rows below the part: still untouched */
+                for (i = 0; i < nb * n; i++) {
+                    y = (i % n) / g.width;
+                    if (y >= y1) CHECK(part[k][i] == -7.0f);
+                }
+        }
+        for (k = 0; k < 5; k++)
+            for (i = 0; i < nb * n; i++) CHECK(memcmp(&whole[k][i], &part[k][i], sizeof(float)) == 0);
+        o.row_begin = 5; /* bad ranges */
+        o.row_end = 5;
+        CHECK_EQ_STATUS(hfvis_solar_irradiation(&g, &in, &o, &b), HFVIS_ERR_INVALID_ARGUMENT);
+        o.row_end = g.height + 1;
+        CHECK_EQ_STATUS(hfvis_solar_irradiation(&g, &in, &o, &b), HFVIS_ERR_INVALID_ARGUMENT);
+        o.row_begin = -1;
+        o.row_end = 2;
+        CHECK_EQ_STATUS(hfvis_solar_irradiation(&g, &in, &o, &b), HFVIS_ERR_INVALID_ARGUMENT);
+        o.row_begin = 0;
+        o.reflected = HFVIS_SOLAR_REFLECTED_TERRAIN; /* the gather needs every row */
+        CHECK_EQ_STATUS(hfvis_solar_irradiation(&g, &in, &o, &b), HFVIS_ERR_INVALID_ARGUMENT);
+    }
+}
+
 TEST(maps_holes_and_bad_input)
 {
     hfvis_grid g = test_grid(zbuf, 6, 6, 1.0);
@@ -1057,6 +1115,7 @@ int main(int argc, char **argv)
     RUN(day_path_equals_step_loop);
     RUN(map_directions_restricted_bit_identical);
     RUN(horizon_modes_against_oracle);
+    RUN(row_ranges_equal_the_whole_call);
     RUN(maps_holes_and_bad_input);
     RUN(allocation_failures);
     return TEST_DONE();
