@@ -8781,6 +8781,7 @@ typedef struct hf_exact {
     double *fmax;
     struct hf_near_off *noff; /* the near stencil (hf_near_offsets) */
     struct hf_far_line *flines; /* one far band's exact lines */
+    double *twist;          /* width*height: each cell's twist (hf_cell_twist) at its (x, y) */
     double *row;            /* one row of near tangents */
     void *block;
     const hfvis_allocator *alloc;
@@ -9317,10 +9318,11 @@ static void hf_exact_near(hf_exact *E, hf_ray r, double L, double scale)
  * of direction (a, b) carries one receiver per |(a, b)| cells and costs |a| + |b| - 1 crossings
  * per receiver, so fine directions are expensive whatever the constant per sample. Split each
  * receiver's ray at D cells instead:
- *   - near field, u < D cells: every crossing of the receiver's own ray and every piece's
- *     midpoint (plus the interior samples of pieces split in 4 or more, HF_EXACT_BULGE), a
- *     stencil of fixed offsets run over the receivers of a row, no hull; the t -> 0+ limit as
- *     before (hf_exact_near). About 1.4 D crossings per receiver-direction whatever (a, b).
+ *   - near field, u < D cells: every crossing of the receiver's own ray and the interior
+ *     samples of the pieces that bulge (HF_EXACT_BULGE, the sweep's rule; the cells' twists
+ *     computed once per call), a stencil of fixed offsets run over the receivers of a row, no
+ *     hull; the t -> 0+ limit (hf_exact_near's expression). About 1.4 D crossings per
+ *     receiver-direction whatever (a, b).
  *   - far field, u >= D cells: lines of direction (a, b) spaced M = floor(|(a, b)|) exact lines
  *     apart (about one cell), anchored at multiples of M of the raster's line index c = x b - y a.
  *     Each far line is sampled like an exact line (every crossing and the split pieces) and its
@@ -9332,9 +9334,11 @@ static void hf_exact_near(hf_exact *E, hf_ray r, double L, double scale)
  *     concave, so the tangent is unimodal along it). Every far sample lies within half a cell of
  *     the receiver's ray and at least D cells away: within atan(1/(2D)) of its azimuth
  *     (HFVIS_EXACT_FAR_*_DEG bound the effect on the horizon).
- *   - edges: the far line and the receiver's ray end at different distances; where the far
- *     tangent lies beyond the end of the receiver's own ray, or that ray runs on more than a cell
- *     beyond the far line, the receiver marches its own ray (hf_far_march).
+ *   - edges: the far line and the receivers' rays end at different distances. The far line is
+ *     cut where the first of its exact lines leaves the reach, so no far sample lies beyond the
+ *     end of a receiver's own ray; an exact line that runs on more than a cell beyond that cut
+ *     takes its own samples from the cut to its end (its tail) into a hull of its own, queried
+ *     by its receivers as the far line is (one tail per line, not one march per receiver).
  * Cost: the near stencil plus about 1.3 far samples and one query per receiver-direction. The
  * value of a receiver depends on its own position only (the far line is fixed by the raster's
  * line index), so receiver rectangles and bands give the whole run's bits. */
@@ -9345,9 +9349,9 @@ struct hf_near_off {
     const hf_cross *c;
     int cross;             /* the crossing itself is a near sample (not the receiver) */
     ptrdiff_t zoff, coff;  /* the crossing's first tap and the piece's cell from the receiver */
+    ptrdiff_t toff;        /* the piece's cell in the twist plane (hf_exact.twist) */
     int dx, dy;            /* the period's base offset k (a, b) */
-    double u, ic, im;      /* the crossing's distance (sub-steps); scale / u at the crossing and
-                              at the piece's midpoint */
+    double u, ic;          /* the crossing's distance (sub-steps); scale / u */
 };
 typedef struct hf_near_off hf_near_off;
 
@@ -9414,9 +9418,9 @@ static int hf_near_offsets(const hf_exact *E, const hf_cross *cr, int P, int a, 
             o[n].dy = k * b;
             o[n].zoff = (ptrdiff_t)(k * b + c->oy) * g->stride + (k * a + c->ox);
             o[n].coff = (ptrdiff_t)(k * b + c->cy) * g->stride + (k * a + c->cx);
+            o[n].toff = (ptrdiff_t)(k * b + c->cy) * g->width + (k * a + c->cx);
             o[n].u = u;
             o[n].ic = u > 0.0 ? scale / u : 0.0;
-            o[n].im = scale / (u + 0.5 * c->du);
             for (j = 0; j < 2; j++) { /* the crossing's taps, then the piece's cell */
                 x0 = k * a + (j ? c->cx : c->ox);
                 y0 = k * b + (j ? c->cy : c->oy);
@@ -9461,32 +9465,34 @@ static double hf_near_one(const hf_exact *E, const hf_near_off *o, int n, int x,
             if (t > best) best = t; /* NaN (a hole) never is */
         }
         if (c->du > 0.0 && hf_exact_cell_taps(g, E->border, E->R, X + c->cx, Y + c->cy, z)) {
-            double z00 = (double)z[0], z10 = (double)z[1], z01 = (double)z[2], z11 = (double)z[3];
-            double r0 = z00 + (z10 - z00) * c->mfx, r1 = z01 + (z11 - z01) * c->mfx;
-            double t = (r0 + (r1 - r0) * c->mfy - hr) * o[i].im, bulge = c->q * hf_cell_twist(z, 2);
-            if (t > best) best = t;
-            if (bulge > 4.0 * lim && bulge < HFVIS__INF)
-                best = hf_near_fill(z, 2, c, bulge, lim, o[i].u, hr, scale, best);
+            double bulge = c->q * hf_cell_twist(z, 2);
+            if (bulge > lim && bulge < HFVIS__INF) best = hf_near_fill(z, 2, c, bulge, lim, o[i].u, hr, scale, best);
         }
     }
     return best;
 }
 
-/* The near field over the receiver rectangle into E->tan: -INFINITY (nothing near), NaN at
- * holes. Rows and columns whose whole stencil lies inside the grid run offset by offset over
- * the row (no border tests; NaN taps drop out of the maxima by themselves, infinite ones would
- * not: a grid with an infinite height, E->inf, takes the other path everywhere); the rest
- * receiver by receiver (hf_near_one, the same bits). */
+/* The near field over the receiver rectangle into E->tan, with the t -> 0+ limit
+ * (hf_exact_near's expression): -INFINITY (nothing near), NaN at holes. Rows and columns whose
+ * whole stencil lies inside the grid run offset by offset over the row (no border tests; NaN taps
+ * drop out of the maxima by themselves, infinite ones would not: a grid with an infinite height,
+ * E->inf, takes the other path everywhere), a piece's interior samples only where its cell's
+ * twist (E->twist) makes it bulge by more than HF_EXACT_BULGE; the rest receiver by receiver
+ * (hf_near_one, the same samples). */
 static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int box[4], double scale,
                           double *row)
 {
     const hfvis_grid *g = E->g;
-    const double lim = HF_EXACT_BULGE * g->cell_size, lim4 = 4.0 * lim;
+    const double lim = HF_EXACT_BULGE * g->cell_size;
     const ptrdiff_t S = g->stride;
+    const int a = E->ray_a, b = E->ray_b, sx = a < 0 ? -1 : 1;
+    const ptrdiff_t sy = b < 0 ? -S : S;
+    const double inv_den = hf_exact_inv_den(g, a, b), Ad = (double)(a < 0 ? -a : a), Bd = (double)(b < 0 ? -b : b);
     int x, y, i;
     for (y = E->ry0; y < E->ry1; y++) {
         double *t = E->tan + (size_t)y * (size_t)g->width;
         const float *zr = g->z + (ptrdiff_t)y * S;
+        const double *tw = E->twist + (ptrdiff_t)y * g->width;
         int xa = E->rx0, xb = E->rx1; /* the interior columns [xa, xb) */
         if (y + box[1] < 0 || y + box[3] > g->height - 1 || E->inf) xa = xb = E->rx1;
         else {
@@ -9494,11 +9500,16 @@ static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int bo
             if (xb > g->width - 1 - box[2] + 1) xb = g->width - box[2];
             if (xb < xa) xa = xb = E->rx1;
         }
-        for (x = xa; x < xb; x++) row[x] = -HFVIS__INF;
+        for (x = xa; x < xb; x++) { /* the t -> 0+ limit: its cell is the first piece's, inside */
+            double hr = (double)zr[x], zx = (double)zr[x + sx], zy = (double)zr[x + sy];
+            double s = ((zx - hr) * Ad + (zy - hr) * Bd) * inv_den;
+            row[x] = isfinite(s) && isfinite(zr[x + sx + sy]) ? s : -HFVIS__INF;
+        }
         for (i = 0; i < n && xa < xb; i++) {
             const hf_cross *c = o[i].c;
             const float *zc = zr + o[i].zoff, *zp = zr + o[i].coff;
-            const double ic = o[i].ic, im = o[i].im, f = c->f, mfx = c->mfx, mfy = c->mfy;
+            const double *tp = tw + o[i].toff, q = c->q;
+            const double ic = o[i].ic, f = c->f;
             const ptrdiff_t st = c->zstep;
             if (o[i].cross && c->kind == 0)
                 for (x = xa; x < xb; x++) {
@@ -9514,22 +9525,17 @@ static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int bo
                 }
             if (c->du > 0.0)
                 for (x = xa; x < xb; x++) {
-                    const float *p = zp + x;
-                    double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[S], z11 = (double)p[S + 1];
-                    double r0 = z00 + (z10 - z00) * mfx, r1 = z01 + (z11 - z01) * mfx;
-                    double tt = (r0 + (r1 - r0) * mfy - (double)zr[x]) * im;
-                    double bulge = c->q * (z00 - z10 - z01 + z11), rx = row[x]; /* hf_cell_twist */
-                    rx = tt > rx ? tt : rx;
-                    if (bulge > lim4 && bulge < HFVIS__INF)
-                        rx = hf_near_fill(p, S, c, bulge, lim, o[i].u, (double)zr[x], scale, rx);
-                    row[x] = rx;
+                    double bulge = q * tp[x]; /* q hf_cell_twist; NaN at holes */
+                    if (bulge > lim) row[x] = hf_near_fill(zp + x, S, c, bulge, lim, o[i].u, (double)zr[x], scale, row[x]);
                 }
         }
         for (x = E->rx0; x < E->rx1; x++) {
             double hr = (double)zr[x];
             if (!isfinite(hr)) t[x] = HFVIS__NAN;
             else if (x >= xa && x < xb) t[x] = row[x];
-            else t[x] = hf_near_one(E, o, n, x, y, hr, scale, -HFVIS__INF);
+            else
+                t[x] = hf_near_one(E, o, n, x, y, hr, scale,
+                                   hf_exact_first_slope(g, E->border, E->R, x, y, a, b, hr, inv_den));
         }
     }
 }
@@ -9617,35 +9623,6 @@ static void hf_far_hull(const double *sd, const double *sh, int n, int *stack, i
     }
 }
 
-/* The samples of the ray from receiver (x, y), height hr, along (a, b) from ufrom sub-steps to
- * its end (the samples hf_exact_samples takes there, under the border rule): the largest
- * tangent if larger than best, else best. */
-static double hf_far_march(const hf_exact *E, int x, int y, double hr, double ufrom, int P, double L,
-                           double scale, double best)
-{
-    const hfvis_grid *g = E->g;
-    const hf_cross *cr = E->cross;
-    const int a = E->ray_a, b = E->ray_b, kmax = hf_exact_periods(g, E->R, x, y, a, b);
-    double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
-    int k = (int)floor(ufrom / L), e, j;
-    for (; k <= kmax; k++)
-        for (e = 0; e < P; e++) {
-            int X = x + k * a + cr[e].ox, Y = y + k * b + cr[e].oy;
-            double u = (double)k * L + cr[e].u, t;
-            if (u + cr[e].du >= ufrom) {
-                j = hf_piece_samples(g, E->border, E->R, x + k * a, y + k * b, cr + e, ph, pu);
-                while (j-- > 0) {
-                    t = (ph[j] - hr) / (u + pu[j]) * scale;
-                    if (t > best) best = t;
-                }
-            }
-            if (u < ufrom || (k == 0 && e == 0) || !hf_cross_inside(g, E->R, X, Y, cr + e)) continue;
-            t = (hf_cross_height(g, E->border, X, Y, cr + e) - hr) / u * scale;
-            if (t > best) best = t;
-        }
-    return best;
-}
-
 /* The far field of a receiver at distance dr (sub-steps times n2, in the far line's sweep
  * coordinate) with height hr, whose far samples are 0..i (those at least D cells ahead): the
  * largest tangent (times fscale) over them if larger than best, else best. The walk follows the
@@ -9676,11 +9653,35 @@ static double hf_far_query(const double *sd, const double *sh, const int *par, c
  * and the steps j of its receivers q + j (a, b) in the receiver rectangle. */
 struct hf_far_line {
     int64_t t, qx, qy, jlo, jhi;
+    double end; /* where its receivers' rays leave the reach, in the far line's frame (n2 units) */
 };
 typedef struct hf_far_line hf_far_line;
 
+/* The periods k of the line through (px, py) along (a, b) whose grid point p + k (a, b) lies
+ * within the grid grown by R + 1 cells, with one period of margin either side: [*kmin, *kmax];
+ * 0 if none. */
+static int hf_far_periods(const hfvis_grid *g, int R, int64_t px, int64_t py, int a, int b, int64_t *kmin,
+                          int64_t *kmax)
+{
+    double s0 = -HFVIS__INF, s1 = HFVIS__INF;
+    int ax;
+    for (ax = 0; ax < 2; ax++) {
+        double p0 = (double)(ax ? py : px), d = (double)(ax ? b : a);
+        double e0 = -(double)R - 1.0, e1 = (double)(ax ? g->height : g->width) + (double)R;
+        double ta = (e0 - p0) / d, tb = (e1 - p0) / d;
+        s0 = fmax(s0, fmin(ta, tb));
+        s1 = fmin(s1, fmax(ta, tb));
+    }
+    if (!(s0 <= s1)) return 0;
+    *kmin = (int64_t)floor(s0) - 1;
+    *kmax = (int64_t)ceil(s1) + 1;
+    return 1;
+}
+
 /* The far field of direction (a, b) over the receiver rectangle (this call's lines), into
- * E->tan (hf_near_field first). */
+ * E->tan (hf_near_field first). Frames: a far line's samples are at distance sd (sub-steps) from
+ * its far end (period kmax); a receiver at along-line position pos = x a + y b lies at
+ * dr = (kmax n2 + pos(p) - pos) L from it, in units of sub-steps times n2. */
 static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, double ucut)
 {
     const hfvis_grid *g = E->g;
@@ -9704,34 +9705,34 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
     mlo = hf_floor_div64(lo + hM, M);
     mhi = hf_floor_div64(hi + hM, M);
     for (m = mlo; m <= mhi; m++) {
-        int64_t cf = m * M - cshift, px, py, kmin = INT64_MIN, kmax = INT64_MAX, c, clo, chi, j;
+        int64_t cf = m * M - cshift, px, py, kmin = 0, kmax = 0, c, clo, chi, j, jl, jh;
         int64_t jmin = 0, jmax = -1;
-        double s0 = -HFVIS__INF, s1 = HFVIS__INF;
-        int n = 0, ax, nl, ptr;
+        double cut = -HFVIS__INF, start, *sd = E->sd, *sh = E->sh, *fm = E->fmax;
+        int n = 0, nl, ptr, w, f0 = 0, *par = E->fpar;
         hf_line_point(cf, X1, Y1, a, b, &px, &py);
-        for (ax = 0; ax < 2; ax++) { /* the periods within the grid grown by R + 1 */
-            double p0 = (double)(ax ? py : px), d = (double)(ax ? b : a);
-            double e0 = -(double)R - 1.0, e1 = (double)(ax ? g->height : g->width) + (double)R;
-            double ta = (e0 - p0) / d, tb = (e1 - p0) / d;
-            s0 = fmax(s0, fmin(ta, tb));
-            s1 = fmin(s1, fmax(ta, tb));
-        }
-        if (s0 <= s1) {
-            kmin = (int64_t)floor(s0) - 1;
-            kmax = (int64_t)ceil(s1) + 1;
+        if (hf_far_periods(g, R, px, py, a, b, &kmin, &kmax))
             n = hf_far_samples(E, px, py, a, b, P, L, kmin, kmax, E->sd, E->sh);
-            hf_far_hull(E->sd, E->sh, n, E->rec, E->fpar, E->fmax);
-        }
+        /* the band's exact lines (all of them, so that the cut does not depend on the receiver
+           rectangle): where each one's rays leave the reach; the far line is cut at the nearest
+           such end, so no far sample lies beyond the end of a receiver's own ray */
         clo = m * M - hM - cshift;
         chi = clo + M - 1;
-        if (clo < lo - cshift) clo = lo - cshift;
-        if (chi > hi - cshift) chi = hi - cshift;
         nl = 0;
-        for (c = clo; c <= chi; c++) { /* the band's exact lines, by position t descending */
+        for (c = clo; c <= chi; c++) {
             hf_far_line l;
             int64_t jl2, jh2;
-            int w;
+            double ex, ey;
             hf_line_point(c, X1, Y1, a, b, &l.qx, &l.qy);
+            hf_step_range(l.qx, a, 0, g->width - 1, &jl, &jh);
+            hf_step_range(l.qy, b, 0, g->height - 1, &jl2, &jh2);
+            if (jl2 > jl) jl = jl2;
+            if (jh2 < jh) jh = jh2;
+            if (jl > jh) continue; /* no grid point inside the grid */
+            ex = (double)(a > 0 ? g->width - 1 + R - l.qx : l.qx + R) * Bd;
+            ey = (double)(b > 0 ? g->height - 1 + R - l.qy : l.qy + R) * Ad;
+            l.end = ((double)kmax * L) * n2 - (double)((l.qx - px) * a + (l.qy - py) * b) * L - (ex < ey ? ex : ey) * n2;
+            if (l.end > cut) cut = l.end;
+            if (c + cshift < lo || c + cshift > hi) continue; /* outside the receiver rectangle */
             hf_step_range(l.qx, a, E->rx0, E->rx1 - 1, &l.jlo, &l.jhi);
             hf_step_range(l.qy, b, E->ry0, E->ry1 - 1, &jl2, &jh2);
             if (jl2 > l.jlo) l.jlo = jl2;
@@ -9743,36 +9744,63 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
             if (l.jlo < jmin || nl == 1) jmin = l.jlo;
             if (l.jhi > jmax || nl == 1) jmax = l.jhi;
         }
+        if (nl == 0) continue;
+        while (f0 < n && sd[f0] * n2 < cut) f0++;
+        sd += f0;
+        sh += f0;
+        n -= f0;
+        hf_far_hull(sd, sh, n, E->rec, par, fm);
+        start = n > 0 ? sd[0] * n2 : HFVIS__INF; /* the far line's end after the cut */
         /* receivers by t = t_q + j n2 descending, so their thresholds grow: one pointer */
-        for (ptr = -1, j = jmax; nl > 0 && j >= jmin; j--) {
-            int w;
+        for (ptr = -1, j = jmax; j >= jmin; j--) {
             for (w = 0; w < nl; w++) {
                 int x, y;
                 size_t i;
-                double dr, hr, ex, ey, t, far, vd;
+                double dr, vd;
                 if (j < lines[w].jlo || j > lines[w].jhi) continue;
                 x = (int)(lines[w].qx + j * a);
                 y = (int)(lines[w].qy + j * b);
                 i = (size_t)y * (size_t)g->width + (size_t)x;
                 if (isnan(E->tan[i]) || (E->parts && !hf_exact_mine(E, x, y, r))) continue;
                 dr = ((double)kmax * L) * n2 - (double)(((int64_t)x - px) * a + ((int64_t)y - py) * b) * L;
-                while (ptr + 1 < n && E->sd[ptr + 1] * n2 <= dr - dn) ptr++;
-                hr = (double)g->z[(ptrdiff_t)y * g->stride + x];
-                t = E->tan[i];
-                vd = 0.0;
-                if (ptr >= 0) t = hf_far_query(E->sd, E->sh, E->fpar, E->fmax, ptr, n2, dr, hr, fscale, t, &vd);
-                /* Near the grid's edge the far line and the receiver's own ray leave the reach
-                   at different distances (n2 units): where the far tangent lies beyond the end
-                   of its own ray, or its own ray runs on more than a cell beyond the far line,
-                   the receiver marches its own ray (from D, or from the far line's end). */
-                ex = (double)(a > 0 ? g->width - 1 + R - x : x + R) * Bd;
-                ey = (double)(b > 0 ? g->height - 1 + R - y : y + R) * Ad;
-                ex = (ex < ey ? ex : ey) * n2;
-                far = n > 0 ? dr - E->sd[0] * n2 : dn;
-                if (far < dn) far = dn;
-                if (vd > ex) t = hf_far_march(E, x, y, hr, dn / n2, P, L, scale, E->tan[i]);
-                else if (ex > far + cell) t = hf_far_march(E, x, y, hr, far / n2, P, L, scale, t);
-                E->tan[i] = t;
+                while (ptr + 1 < n && sd[ptr + 1] * n2 <= dr - dn) ptr++;
+                if (ptr >= 0)
+                    E->tan[i] = hf_far_query(sd, sh, par, fm, ptr, n2, dr, (double)g->z[(ptrdiff_t)y * g->stride + x],
+                                             fscale, E->tan[i], &vd);
+            }
+        }
+        /* Tails: an exact line whose rays run on more than a cell beyond the far line's end
+           takes its own samples from its end to there (a hull per line, queried by its
+           receivers as the far line is). */
+        for (w = 0; w < nl; w++) {
+            const hf_far_line *l = lines + w;
+            int64_t tmin, tmax, k0;
+            double shift;
+            if (!(l->end + cell < start)) continue;
+            if (!hf_far_periods(g, R, l->qx, l->qy, a, b, &tmin, &tmax)) continue;
+            /* the tail frame's origin (period tmax of this line) in the far line's frame */
+            shift = ((double)(kmax - tmax) * n2 + (double)((px - l->qx) * a + (py - l->qy) * b)) * L;
+            k0 = l->jlo - 1; /* nothing behind the first receiver is ahead of any */
+            if (start < HFVIS__INF) { /* the periods up to the far line's end */
+                double kc = floor((double)tmax - (start - shift) / (n2 * L));
+                if (kc > (double)k0) k0 = (int64_t)kc;
+            }
+            if (k0 > tmax) continue;
+            if (k0 > tmin) tmin = k0;
+            sd = E->sd;
+            sh = E->sh;
+            n = hf_far_samples(E, l->qx, l->qy, a, b, P, L, tmin, tmax, sd, sh);
+            while (n > 0 && shift + sd[n - 1] * n2 > start) n--; /* the far line serves those */
+            hf_far_hull(sd, sh, n, E->rec, par, fm);
+            for (ptr = -1, j = l->jhi; j >= l->jlo; j--) {
+                int x = (int)(l->qx + j * a), y = (int)(l->qy + j * b);
+                size_t i = (size_t)y * (size_t)g->width + (size_t)x;
+                double dr = (double)(tmax - j) * L * n2, vd;
+                if (isnan(E->tan[i]) || (E->parts && !hf_exact_mine(E, x, y, r))) continue;
+                while (ptr + 1 < n && sd[ptr + 1] * n2 <= dr - dn) ptr++;
+                if (ptr >= 0)
+                    E->tan[i] = hf_far_query(sd, sh, par, fm, ptr, n2, dr, (double)g->z[(ptrdiff_t)y * g->stride + x],
+                                             fscale, E->tan[i], &vd);
             }
         }
     }
@@ -9805,8 +9833,7 @@ static void hf_exact_sweep(hf_exact *E, hf_ray r)
         double ucut = ceil((double)E->near * L / sqrt(n2)); /* D cells in sub-steps */
         int box[4], n = hf_near_offsets(E, E->cross, P, r.a, r.b, L, scale, ucut, E->noff, box);
         hf_near_field(E, E->noff, n, box, scale, E->row);
-        hf_far_field(E, r, P, L, scale, ucut);
-        hf_exact_near(E, r, L, scale);
+        hf_far_field(E, r, P, L, scale, ucut); /* the t -> 0+ limit is the near field's */
         return;
     }
     for (y = 0; y < g->height; y++) {
@@ -9920,7 +9947,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
                                   int channels)
 {
     size_t total = 0, off_ray, off_d, off_c, off_s, off_t = 0, off_n = 0, off_a = 0, gridn, cap;
-    size_t off_win = 0, off_r, off_fp = 0, off_fm = 0, off_no = 0, off_row = 0, off_fl = 0;
+    size_t off_win = 0, off_r, off_fp = 0, off_fm = 0, off_no = 0, off_row = 0, off_fl = 0, off_tw = 0;
     int ok = 1, k, maxp = 1, side = g->width > g->height ? g->width : g->height;
     unsigned char *blk;
     memset(E, 0, sizeof *E);
@@ -9970,6 +9997,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
         off_no = hf_align_add(&total, 2u * (size_t)E->near + 2u * (size_t)maxp + 4u, sizeof(hf_near_off), &ok);
         off_row = hf_align_add(&total, (size_t)g->width, sizeof(double), &ok);
         off_fl = hf_align_add(&total, (size_t)maxp + 2u, sizeof(hf_far_line), &ok);
+        off_tw = hf_align_add(&total, gridn, sizeof(double), &ok);
     }
     if (!ok) return HFVIS_ERR_LIMIT;
     blk = (unsigned char *)hfvis__alloc(o->alloc, total);
@@ -9997,10 +10025,15 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
         E->noff = (hf_near_off *)(void *)(blk + off_no);
         E->row = (double *)(void *)(blk + off_row);
         E->flines = (hf_far_line *)(void *)(blk + off_fl);
-        for (k = 0; k < g->height && !E->inf; k++) {
+        E->twist = (double *)(void *)(blk + off_tw);
+        for (k = 0; k < g->height; k++) {
             const float *zr = g->z + (ptrdiff_t)k * g->stride;
+            double *tw = E->twist + (ptrdiff_t)k * g->width;
             int x;
-            for (x = 0; x < g->width; x++) E->inf |= isinf(zr[x]) != 0;
+            for (x = 0; x < g->width; x++) {
+                E->inf |= isinf(zr[x]) != 0;
+                tw[x] = x + 1 < g->width && k + 1 < g->height ? hf_cell_twist(zr + x, g->stride) : 0.0;
+            }
         }
     }
     hf_exact_dirs_fill(&E->d, K, o->azimuth0_rad, E->N);

@@ -886,22 +886,25 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *   - Near and far field (opts->ray_near_cells = D > 0; 0, the default, is the sweep above bit
  *     for bit). A direction whose line is longer than D cells between grid points (|(a, b)| > D)
  *     costs |a| + |b| - 1 crossings per receiver in the sweep; instead each receiver takes the
- *     samples of its own ray nearer than D cells (every crossing, every piece's midpoint, the
- *     pieces' split samples, the t -> 0+ limit: a stencil over the receivers of a row) and a far
+ *     samples of its own ray nearer than D cells (every crossing, the split samples of the
+ *     pieces that bulge, as the sweep takes them, the t -> 0+ limit: a stencil over the
+ *     receivers of a row) and a far
  *     field shared by the receivers of M = floor(|(a, b)|) neighbouring lines: one line of
  *     direction (a, b), sampled like an exact line, within half a cell across of each of them
  *     (lines anchored at multiples of M of the raster's line index x b - y a), its upper hull
  *     kept as a tree so that every receiver finds the tangent from its own point to the hull of
  *     the samples D cells or more ahead. Every far sample lies within atan(1/(2D)) of the
  *     receiver's azimuth (D = 8: 3.6 deg); near the grid's edge, where the far line and the
- *     receiver's own ray end at different distances, the receiver marches its own ray instead.
+ *     receivers' own rays end at different distances, the far line stops where the first of
+ *     them ends and each line that runs on takes its own samples beyond (its tail).
  *     Directions with |(a, b)| <= D (K = 16: all) and runs with a finite radius keep the sweep.
  *     Accuracy: no longer never above the supremum; on a plane within |grad z across| / (2 D)
  *     in tangent; on urban boxes, terraces with one-cell cliffs and fBm (D = 8, K = 64 and 256)
- *     0.10-0.30 deg mean and 1.7-8.3 deg p99 from the supremum, all pairs (walls and cliffs seen
+ *     0.10-0.37 deg mean and 1.7-10.2 deg p99 from the supremum, all pairs (walls and cliffs seen
  *     or missed half a cell across), held to HFVIS_EXACT_FAR_MEAN_DEG / _P99_DEG. Receiver
  *     rectangles and sun bands equal the whole run bit for bit (a receiver's value depends on
- *     its own position only). Scratch: 12 bytes more per sample of a line and 8*width bytes.
+ *     its own position only). Scratch: 12 bytes more per sample of a line, 8*width bytes and
+ *     8*width*height bytes (the cells' twists).
  *     Cost and figures: docs/exact-rays.md, "Near and far field".
  *   - Accuracy: against the supremum over the bilinear surface (every pair) the exact mode is
  *     within 0.01 deg mean and 0.25 deg p99 on urban boxes, terraces with one-cell cliffs and

@@ -605,6 +605,37 @@ expect_fail "sum refuses exact and lattice parts" 1 sum "$dir/mx_e.hfvs" "$dir/m
 "$hfvis" sky "$dir/flat.pgm" --exact --dirs 5 --sky 2 --albedo 0.5 -o "$dir/sky_flat.pfm" && \
   [ "$(last_bytes "$dir/sky_flat.pfm" 4)" = "00 00 80 3f" ] && ok "sky --exact on flat: albedo*c" || bad "sky --exact on flat: albedo*c"
 "$hfvis" shadow "$h" --sun-azimuth 130 --sun-elevation 25 --exact -o "$dir/sh_e.pfm" && ok "shadow --exact" || bad "shadow --exact"
+# --exact-near D (hfvis_sweep_options.ray_near_cells): reaches the library (K = 64 on a 48 x 40
+# hill: most lines are longer than 8 cells between grid points, so D = 8 takes the far field and
+# differs from the sweep; D = 0 and D beyond every line are the sweep byte for byte), is the same
+# on 1 and 2 threads and in parts, and is refused without exact rays, with a radius, out of range
+awk 'BEGIN { w = 48; h = 40; print "P2"; print w, h; print 255
+  for (y = 0; y < h; y++) { s = ""; for (x = 0; x < w; x++) s = s " " int(128 + 100 * sin(x / 3) * cos(y / 4) + 20 * sin(x * y / 7)); print s } }' > "$dir/hill48.pgm"
+h48=$dir/hill48.pgm
+expect_ok "horizon --exact --exact-near 8" "$dir/en8.pfm" horizon "$h48" --dirs 64 --exact --exact-near 8 -o "$dir/en8.pfm"
+"$hfvis" horizon "$h48" --dirs 64 --exact --quiet -o "$dir/en_sweep.pfm" &&
+  "$hfvis" horizon "$h48" --dirs 64 --exact --exact-near 0 --quiet -o "$dir/en0.pfm" &&
+  "$hfvis" horizon "$h48" --dirs 64 --exact --exact-near 400 --quiet -o "$dir/en400.pfm" &&
+  cmp -s "$dir/en_sweep.pfm" "$dir/en0.pfm" && cmp -s "$dir/en_sweep.pfm" "$dir/en400.pfm" &&
+  ok "--exact-near 0 and 400 (beyond every line): the sweep byte for byte" || bad "--exact-near 0/400 differ from --exact"
+cmp -s "$dir/en_sweep.pfm" "$dir/en8.pfm" && bad "--exact-near 8: the same bytes as the sweep (not passed on?)" ||
+  ok "--exact-near 8: the near and far field (differs from the sweep)"
+"$hfvis" skyview "$h48" --dirs 64 --exact --exact-near 8 --threads 1 --quiet -o "$dir/ent1.pfm" &&
+  "$hfvis" skyview "$h48" --dirs 64 --exact --exact-near 8 --threads 2 --quiet -o "$dir/ent2.pfm" &&
+  cmp -s "$dir/ent1.pfm" "$dir/ent2.pfm" && ok "skyview --exact-near 8: --threads 2 = --threads 1" || bad "skyview --exact-near 8: threads differ"
+"$hfvis" skyview "$dir/flat.pgm" --exact --exact-near 2 --dirs 64 -o "$dir/svf_flat_en.pfm" && [ "$(last_bytes "$dir/svf_flat_en.pfm" 4)" = "00 00 80 3f" ] \
+  && ok "skyview --exact-near 2 on flat: 1" || bad "skyview --exact-near 2 on flat: 1"
+split4 "split skyview --exact --exact-near 8" skyview pfm 0:16 16:32 32:48 48:64 -- --dirs 64 --exact --exact-near 8
+"$hfvis" skyview "$h" --dirs 8 --exact --exact-near 2 --dir-range 0:4 -o "$dir/en_p.hfvs" 2> /dev/null
+"$hfvis" skyview "$h" --dirs 8 --exact --dir-range 4:8 -o "$dir/en_q.hfvs" 2> /dev/null
+expect_fail "sum refuses parts of different --exact-near" 1 sum "$dir/en_p.hfvs" "$dir/en_q.hfvs" -o "$fdir/x.pfm"
+expect_fail "--exact-near without --exact" 2 skyview "$h" --dirs 64 --exact-near 8 -o "$fdir/x.pfm"
+expect_fail "--exact-near with --max-distance" 2 horizon "$h" --dirs 64 --exact --exact-near 8 --max-distance 10 -o "$fdir/x.pfm"
+expect_fail "--exact-near 65537" 2 skyview "$h" --dirs 64 --exact --exact-near 65537 -o "$fdir/x.pfm"
+expect_fail "--exact-near -1" 2 skyview "$h" --dirs 64 --exact --exact-near -1 -o "$fdir/x.pfm"
+expect_fail "hillshade --lattice --exact-near" 2 hillshade "$h" --lattice --exact-near 8 -o "$fdir/x.pfm"
+expect_ok "hillshade --exact-near (exact by default)" "$dir/hs_en.pfm" hillshade "$h48" --exact-near 8 -o "$dir/hs_en.pfm"
+expect_fail "viewshed --exact-near" 2 viewshed "$h" --observer 1,1 --exact --exact-near 8 -o "$fdir/x.pfm"
 expect_fail "visibility --exact" 2 visibility "$h" --exact -o "$fdir/x.pfm"
 expect_fail "indirect --exact" 2 indirect "$h" --exact -o "$fdir/x.pfm"
 expect_fail "gi --exact" 2 gi "$h" --exact -o "$fdir/x.pfm"

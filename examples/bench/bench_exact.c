@@ -93,8 +93,64 @@ static void exact_field(const char *name, float *z, int n, float *map)
 
 /* Sky-view factor of fBm n^2 at K = 16, 64, 256, 360: lattice, exact and exact with the near and
  * far field (ray_near_cells = EXACT_BENCH_NEAR), one call each (the exact calls at large K take
- * seconds; the lattice's at 512^2 about 0.1-1 s). */
+ * seconds; the lattice's at 512^2 about 0.1-1 s), and beside each the horizons' error against the
+ * supremum (hfvis_horizon_exact_naive) on a small case of the same field (EXACT_BENCH_ACC^2, every
+ * pair). */
 #define EXACT_BENCH_NEAR 8
+#define EXACT_BENCH_ACC 96
+
+/* mean and p99 (degrees) of |a - b| over n values (NaN pairs, the holes, left out). */
+static void exact_pair_err(const float *a, const float *b, size_t n, double *e, double *mean, double *p99)
+{
+    size_t i, m = 0;
+    double s = 0.0;
+    for (i = 0; i < n; i++) {
+        if (isnan(a[i]) || isnan(b[i])) continue;
+        e[m] = fabs((double)a[i] - (double)b[i]) * (180.0 / 3.14159265358979323846);
+        s += e[m++];
+    }
+    qsort(e, m, sizeof(double), exact_cmp);
+    *mean = m ? s / (double)m : 0.0;
+    *p99 = m ? e[(size_t)(0.99 * (double)(m - 1))] : 0.0;
+}
+
+/* The error of the sweep and of the near and far field against the supremum at K on fBm of the
+ * bench's parameters scaled to EXACT_BENCH_ACC^2; returns 0, or -1 when memory runs out. */
+static int exact_far_accuracy(int K, double *sm, double *sp, double *fm, double *fp)
+{
+    const int n = EXACT_BENCH_ACC;
+    size_t cells = (size_t)n * (size_t)n, m = cells * (size_t)K;
+    float *z = (float *)malloc(sizeof(float) * cells), *sup = (float *)malloc(sizeof(float) * m);
+    float *got = (float *)malloc(sizeof(float) * m);
+    double *e = (double *)malloc(sizeof(double) * m);
+    hfvis_sweep_options ex = hfvis_sweep_options_default();
+    hfvis_field f;
+    hfvis_grid g;
+    int rc = -1;
+    if (z && sup && got && e) {
+        memset(&f, 0, sizeof f);
+        f.kind = HFVIS_FIELD_FBM;
+        f.amplitude = (double)n / 8.0;
+        f.wavelength = (double)n / 4.0;
+        f.seed = 3;
+        hfvis_field_generate(&f, n, n, n, z);
+        g.z = z; g.width = n; g.height = n; g.stride = n; g.cell_size = 1.0;
+        ex.rays = HFVIS_RAYS_EXACT;
+        if (hfvis_horizon_exact_naive(&g, K, &ex, sup) == HFVIS_OK && hfvis_horizon_map(&g, K, &ex, got) == HFVIS_OK) {
+            exact_pair_err(got, sup, m, e, sm, sp);
+            ex.ray_near_cells = EXACT_BENCH_NEAR;
+            if (hfvis_horizon_map(&g, K, &ex, got) == HFVIS_OK) {
+                exact_pair_err(got, sup, m, e, fm, fp);
+                rc = 0;
+            }
+        }
+    }
+    free(z);
+    free(sup);
+    free(got);
+    free(e);
+    return rc;
+}
 static void exact_k_rows(int n)
 {
     static const int Ks[] = {16, 64, 256, 360};
@@ -116,7 +172,7 @@ static void exact_k_rows(int n)
     nf = ex;
     nf.ray_near_cells = EXACT_BENCH_NEAR;
     for (i = 0; i < 4; i++) {
-        double rd = (double)cells * (double)Ks[i], t0, tl, te, tf;
+        double rd = (double)cells * (double)Ks[i], t0, tl, te, tf, sm, sp, fm, fp;
         t0 = bench_now();
         hfvis_sky_view_factor(&g, Ks[i], &lat, out, n);
         tl = bench_now() - t0;
@@ -129,6 +185,11 @@ static void exact_k_rows(int n)
         printf("exact rays, fBm %d^2 sky-view factor K=%3d: lattice %.2f s (%.1f ns/rd), exact %.2f s (%.1f ns/rd), "
                "%.2fx; near/far D=%d %.2f s (%.1f ns/rd), %.2fx\n", n, Ks[i], tl, 1e9 * tl / rd, te, 1e9 * te / rd,
                te / tl, EXACT_BENCH_NEAR, tf, 1e9 * tf / rd, tf / tl);
+        if (exact_far_accuracy(Ks[i], &sm, &sp, &fm, &fp) == 0)
+            printf("exact rays, fBm %d^2 horizons K=%3d against the supremum (every pair, deg): exact mean %.4f p99 "
+                   "%.3f; near/far D=%d mean %.4f p99 %.3f\n", EXACT_BENCH_ACC, Ks[i], sm, sp, EXACT_BENCH_NEAR, fm, fp);
+        else
+            printf("exact rays: accuracy at K=%d: out of memory\n", Ks[i]);
     }
     free(z);
     free(out);

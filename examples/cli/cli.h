@@ -137,6 +137,7 @@ typedef struct cli_args {
     int threads, has_threads; /* --threads N (threads.c); default the online cores */
     int threads_auto;         /* --threads 0 or none: cli_check_cost caps them by --max-memory */
     int lattice;              /* hillshade --lattice: lattice-mode shadows (default exact rays) */
+    int exact_near, has_exact_near; /* --exact-near D: hfvis_sweep_options.ray_near_cells */
     /* solar (solar.c): dates, times, atmosphere, site, extra outputs (beam, diffuse, reflected,
      * sun hours) */
     int sol_y, sol_m, sol_d, sol_ey, sol_em, sol_ed, sol_has_start, sol_has_end;

@@ -342,6 +342,7 @@ static int cli_run_heights(const cli_args *a)
     opts.border_cells = a->border_cells;
     opts.azimuth0_rad = a->compass ? a->azimuth0 - CLI_PI / 2.0 : a->azimuth0;
     if (a->exact && a->cmd != CMD_VIEWSHED) opts.rays = HFVIS_RAYS_EXACT;
+    if (a->exact && a->cmd != CMD_VIEWSHED) opts.ray_near_cells = a->exact_near; /* flags.c checks */
     if (a->cmd != CMD_VIEWSHED) opts.max_distance = a->max_distance; /* viewshed: its own range */
     opts.alloc = &cli_huge_allocator; /* lattices and planes on huge pages where offered (threads.c) */
     if (a->run->win.active && a->cmd == CMD_OPENNESS) {

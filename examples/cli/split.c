@@ -253,6 +253,11 @@ static int cli_partial_tag(const cli_args *a, const hfvis_grid *grid, const hfvi
     size_t left = CLI_TAG_MAX - (size_t)n;
     unsigned char geo[HFVIS_PARTIAL_MAX_TAG];
     cli_geo_bytes gb;
+    if (o->ray_near_cells > 0 && left > 1) { /* only then: the tags of other parts stay as they were */
+        n = snprintf(t, left, " exact-near=%d", o->ray_near_cells);
+        t += n;
+        left -= (size_t)n;
+    }
     gb.b = geo, gb.n = 0, gb.cap = sizeof geo, gb.over = 0;
     cli_geo_encode(&a->run->geo, &gb);
     switch (a->cmd) {
@@ -693,6 +698,14 @@ static int cli_sum_parts(int argc, char **argv, const char **names, cli_part *me
             if (!cli_tag_value(meta[0].tag, key, other, sizeof other)) strcpy(other, "(none)");
             rc = cli_error(CLI_EXIT_ERROR, names[i], "not the same run as %s: %s=%s there, %s here",
                            names[0], key, other, eq ? eq + 1 : "");
+            goto done;
+        }
+        cli_tag_first_difference(meta[0].tag, p->tag, key, sizeof key); /* a token only there */
+        if (key[0]) {
+            char *eq = strchr(key, '=');
+            if (eq) *eq = '\0';
+            rc = cli_error(CLI_EXIT_ERROR, names[i], "not the same run as %s: %s=%s there, (none) here",
+                           names[0], key, eq ? eq + 1 : "");
             goto done;
         }
     }
