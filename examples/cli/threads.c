@@ -104,9 +104,8 @@ static void cli_split_progress(void *user, int done, int total)
  * project's VMs), and the lattice gathers miss the TLB less. Measured in docs/performance.md,
  * Threads. cli_huge_alloc is the hfvis_allocator form, which every sweep command passes. */
 #define CLI_HUGE_MIN ((size_t)4 << 20) /* smaller blocks stay on ordinary pages */
-static void *cli_huge_malloc(size_t size)
+static void *cli_huge_advise(void *p, size_t size)
 {
-    void *p = malloc(size ? size : 1);
 #if defined(MADV_HUGEPAGE) && defined(_SC_PAGESIZE)
     long page = sysconf(_SC_PAGESIZE);
     if (p && size >= CLI_HUGE_MIN && page > 0) { /* the whole pages inside the block */
@@ -114,8 +113,23 @@ static void *cli_huge_malloc(size_t size)
         if (head < size && ((size - head) & ~mask) > 0)
             (void)madvise((char *)p + head, (size - head) & ~mask, MADV_HUGEPAGE); /* a hint: failure is harmless */
     }
+#else
+    (void)size;
 #endif
     return p;
+}
+
+static void *cli_huge_malloc(size_t size)
+{
+    return cli_huge_advise(malloc(size ? size : 1), size);
+}
+
+/* Zeroed, as calloc: a large block comes fresh from the system and is not touched here, so its
+ * pages are first touched (and faulted) by whoever writes them, on their threads, not all on the
+ * main thread before the run as a memset would. */
+static void *cli_huge_calloc(size_t size)
+{
+    return cli_huge_advise(calloc(1, size ? size : 1), size);
 }
 
 static void *cli_huge_alloc(void *user, size_t size)
@@ -267,6 +281,44 @@ static hfvis_status cli_split_run(cli_split *sp)
     return sp->status;
 }
 
+/* ---- per-row work of the tool itself (decoding, normals, finishing, encoding): rows [0, rows)
+ * in bands of CLI_ROWS_BAND, each band fn(ctx, y0, y1, thread) on one of `threads` threads;
+ * the bands must write disjoint outputs (thread: an index < threads for per-thread scratch).
+ * Returns the first failing band's status. One thread: fn(ctx, 0, rows, 0). */
+#define CLI_ROWS_BAND 64 /* rows per unit: about 1 MB of a 4096-wide float plane */
+typedef hfvis_status (*cli_rows_fn)(void *ctx, int y0, int y1, int thread);
+typedef struct cli_rows_split {
+    cli_rows_fn fn;
+    void *ctx;
+    int rows;
+} cli_rows_split;
+
+static hfvis_status cli_rows_unit(cli_split *sp, int u, int thread, hfvis_sweep_options *o)
+{
+    const cli_rows_split *j = (const cli_rows_split *)sp->ctx;
+    const int y0 = u * CLI_ROWS_BAND, y1 = j->rows - y0 < CLI_ROWS_BAND ? j->rows : y0 + CLI_ROWS_BAND;
+    (void)o;
+    return j->fn(j->ctx, y0, y1, thread);
+}
+
+static hfvis_status cli_threaded_rows(int rows, int threads, cli_rows_fn fn, void *ctx)
+{
+    hfvis_sweep_options none = hfvis_sweep_options_default();
+    cli_rows_split j;
+    cli_split sp;
+    if (threads <= 1 || rows <= CLI_ROWS_BAND) return fn(ctx, 0, rows, 0);
+    memset(&sp, 0, sizeof sp);
+    j.fn = fn;
+    j.ctx = ctx;
+    j.rows = rows;
+    sp.units = (rows - 1) / CLI_ROWS_BAND + 1;
+    sp.threads = threads;
+    sp.unit = cli_rows_unit;
+    sp.ctx = &j;
+    sp.opts = &none;
+    return cli_split_run(&sp);
+}
+
 /* The finish of a sum S of K directions as the single run computes it (hfvis.h, split runs):
  * the sky-view factor 1 - S/K, the sky light and environment light scale * S, where scale is
  * the product of the floats the run passes (sky * albedo, or albedo). */
@@ -373,10 +425,54 @@ static hfvis_status cli_threaded_sums(const hfvis_grid *grid, int K, hfvis_sum_k
     return s;
 }
 
+/* The grid's normals (hfvis_normals_compute) by row bands: each band computes them on the
+ * view of its rows and the one row either side, which the library's stencil reaches (central differences
+ * along x and y), into its thread's scratch, and copies its own rows: the whole call's values. */
+typedef struct cli_normals_rows {
+    const hfvis_grid *grid;
+    float *out;     /* width * height * 3 */
+    float *scratch; /* threads * (CLI_ROWS_BAND + 2) * width * 3 */
+} cli_normals_rows;
+
+static hfvis_status cli_normals_band(void *ctx, int y0, int y1, int thread)
+{
+    const cli_normals_rows *j = (const cli_normals_rows *)ctx;
+    const size_t row = (size_t)j->grid->width * 3;
+    const int v0 = y0 > 0 ? y0 - 1 : 0, v1 = y1 < j->grid->height ? y1 + 1 : y1;
+    float *tmp = j->scratch + (size_t)thread * (CLI_ROWS_BAND + 2) * row;
+    hfvis_grid view = *j->grid;
+    hfvis_status s;
+    view.z += (ptrdiff_t)v0 * j->grid->stride;
+    view.height = v1 - v0;
+    s = hfvis_normals_compute(&view, tmp);
+    if (s == HFVIS_OK)
+        memcpy(j->out + (size_t)y0 * row, tmp + (size_t)(y0 - v0) * row, (size_t)(y1 - y0) * row * sizeof(float));
+    return s;
+}
+
+/* The finish of the sums acc into out, by row bands (cli_sum_finish per value). */
+typedef struct cli_finish_rows {
+    int cmd, K;
+    double scale;
+    size_t row; /* values per row: width * channels */
+    const double *acc;
+    float *out;
+} cli_finish_rows;
+
+static hfvis_status cli_finish_band(void *ctx, int y0, int y1, int thread)
+{
+    const cli_finish_rows *j = (const cli_finish_rows *)ctx;
+    size_t i;
+    (void)thread;
+    for (i = (size_t)y0 * j->row; i < (size_t)y1 * j->row; i++) j->out[i] = cli_sum_finish(j->cmd, j->K, j->scale, j->acc[i]);
+    return HFVIS_OK;
+}
+
 /* skyview, sky or light (cmd) over all K directions on `threads` threads: S by
  * cli_threaded_sums, finished as the single run (scale: sky * albedo, or albedo, as the floats the
  * run passes), out[(y*width + x)*channels + c]. The lit commands compute the grid normals once
- * and give them to every unit (sweep options normals) instead of each call making its own. */
+ * (by row bands) and give them to every unit (sweep options normals) instead of each call making
+ * its own; the finish runs by row bands too. */
 static hfvis_status cli_threaded_light(int cmd, const hfvis_grid *grid, int K, double scale,
                                        const hfvis_env *env, const hfvis_env_options *eopts,
                                        const hfvis_sweep_options *opts, int threads, int channels,
@@ -389,15 +485,21 @@ static hfvis_status cli_threaded_light(int cmd, const hfvis_grid *grid, int K, d
     float *nrm = NULL;
     hfvis_sweep_options o = *opts;
     hfvis_status s = HFVIS_OK;
-    size_t i;
+    cli_finish_rows f;
     if (!acc) return HFVIS_ERR_OUT_OF_MEMORY;
     if (cmd != CMD_SKYVIEW && !o.normals) { /* the grid normals once, shared by every unit */
-        nrm = n <= SIZE_MAX / (3 * sizeof(float)) ? (float *)cli_huge_malloc(n * 3 * sizeof(float)) : NULL;
-        s = nrm ? hfvis_normals_compute(grid, nrm) : HFVIS_ERR_OUT_OF_MEMORY;
+        const size_t band = ((size_t)CLI_ROWS_BAND + 2) * (size_t)grid->width * 3 * (size_t)threads;
+        cli_normals_rows j;
+        j.grid = grid;
+        j.out = nrm = n <= SIZE_MAX / (3 * sizeof(float)) ? (float *)cli_huge_malloc(n * 3 * sizeof(float)) : NULL;
+        j.scratch = (float *)malloc(band * sizeof(float)); /* width <= 2^28, threads <= 256 */
+        s = nrm && j.scratch ? cli_threaded_rows(grid->height, threads, cli_normals_band, &j) : HFVIS_ERR_OUT_OF_MEMORY;
+        free(j.scratch);
         o.normals = nrm;
     }
     if (s == HFVIS_OK) s = cli_threaded_sums(grid, K, kind, env, eopts, &o, threads, channels, acc);
-    for (i = 0; s == HFVIS_OK && i < count; i++) out[i] = cli_sum_finish(cmd, K, scale, acc[i]);
+    f.cmd = cmd, f.K = K, f.scale = scale, f.row = (size_t)grid->width * (size_t)channels, f.acc = acc, f.out = out;
+    if (s == HFVIS_OK) s = cli_threaded_rows(grid->height, threads, cli_finish_band, &f);
     free(nrm);
     free(acc);
     return s;
