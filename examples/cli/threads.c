@@ -230,10 +230,7 @@ static void *cli_split_worker(void *arg)
         o.progress = cli_split_progress;
         o.progress_user = &up;
         o.alloc = &alloc;
-        { struct timespec c0, c1; clock_gettime(CLOCK_THREAD_CPUTIME_ID,&c0);
         s = sp->unit(sp, u, thread, &o);
-        clock_gettime(CLOCK_THREAD_CPUTIME_ID,&c1);
-        if (getenv("HFVIS_UNITS")) fprintf(stderr,"UNIT %d %d %.4f\n",u,thread,(c1.tv_sec-c0.tv_sec)+(c1.tv_nsec-c0.tv_nsec)*1e-9); }
         cli_split_lock(sp);
         if (s != HFVIS_OK && sp->status == HFVIS_OK) sp->status = s;
 #if CLI_HAVE_THREADS
