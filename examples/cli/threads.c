@@ -506,14 +506,62 @@ static hfvis_status cli_threaded_light(int cmd, const hfvis_grid *grid, int K, d
 }
 
 /* ---- the horizon map: one quarter-turn group per unit (lattice, K % 4 == 0: its four planes in
- * sweep order, copied to their direction index) or one direction (written in place). */
+ * sweep order, copied to their direction index) or one direction (written in place; exact rays:
+ * the costliest directions first, so that the cheap ones fill the end and no thread idles long
+ * while another finishes a costly one). */
 typedef struct cli_map_split {
     const hfvis_grid *grid;
     int K, per;
     size_t n;           /* width * height */
     float *scratch;     /* threads * 4 planes (groups) */
     float *out;         /* K planes, direction index order */
+    int *order;         /* NULL, or the direction of each unit (exact rays) */
 } cli_map_split;
+
+/* The cost of an exact direction's sweep: about |a| + |b| grid-line crossings per receiver for
+ * the rational direction (a, b) the run uses at azimuth psi (hfvis_sweep_azimuths, psi =
+ * atan2(b, a)): the smallest such pair with a major component up to CLI_EXACT_MAX_COMPONENT;
+ * that bound if none is found (the order only balances the threads, it never changes a result). */
+#define CLI_EXACT_MAX_COMPONENT 4096
+static int cli_exact_cost(double psi)
+{
+    const double c = cos(psi), s = sin(psi), t = fabs(c) >= fabs(s) ? fabs(s / c) : fabs(c / s);
+    int m;
+    for (m = 1; m < CLI_EXACT_MAX_COMPONENT; m++) {
+        const double minor = floor((double)m * t + 0.5);
+        const double a = (fabs(c) >= fabs(s) ? (double)m : minor) * (c < 0.0 ? -1.0 : 1.0);
+        const double b = (fabs(c) >= fabs(s) ? minor : (double)m) * (s < 0.0 ? -1.0 : 1.0);
+        if (fabs(remainder(atan2(b, a) - psi, 2.0 * CLI_PI)) < 1e-9) return m + (int)minor;
+    }
+    return CLI_EXACT_MAX_COMPONENT;
+}
+
+typedef struct cli_cost_index {
+    int cost, k;
+} cli_cost_index;
+
+static int cli_costlier_first(const void *x, const void *y)
+{
+    const cli_cost_index *p = (const cli_cost_index *)x, *q = (const cli_cost_index *)y;
+    if (p->cost != q->cost) return p->cost > q->cost ? -1 : 1;
+    return p->k < q->k ? -1 : p->k > q->k;
+}
+
+/* The K exact directions of opts ordered costliest first (ties: index order) into order[K];
+ * HFVIS_OK, or the status of hfvis_sweep_azimuths / out of memory. */
+static hfvis_status cli_exact_order(int K, const hfvis_sweep_options *opts, int *order)
+{
+    double *az = (double *)malloc((size_t)K * sizeof(double));
+    cli_cost_index *ci = (cli_cost_index *)malloc((size_t)K * sizeof(cli_cost_index));
+    hfvis_status s = az && ci ? hfvis_sweep_azimuths(K, opts, az, NULL) : HFVIS_ERR_OUT_OF_MEMORY;
+    int k;
+    for (k = 0; s == HFVIS_OK && k < K; k++) ci[k].cost = cli_exact_cost(az[k]), ci[k].k = k;
+    if (s == HFVIS_OK) qsort(ci, (size_t)K, sizeof *ci, cli_costlier_first);
+    for (k = 0; s == HFVIS_OK && k < K; k++) order[k] = ci[k].k;
+    free(ci);
+    free(az);
+    return s;
+}
 
 static hfvis_status cli_map_unit(cli_split *sp, int u, int thread, hfvis_sweep_options *o)
 {
@@ -521,10 +569,11 @@ static hfvis_status cli_map_unit(cli_split *sp, int u, int thread, hfvis_sweep_o
     hfvis_status s;
     int m;
     if (j->per == 1) { /* one direction, index order: its plane in place */
+        const int k = j->order ? j->order[u] : u;
         o->direction_order = HFVIS_DIRECTION_ORDER_INDEX;
-        o->direction_begin = u;
-        o->direction_end = u + 1;
-        return hfvis_horizon_map(j->grid, j->K, o, j->out + (size_t)u * j->n);
+        o->direction_begin = k;
+        o->direction_end = k + 1;
+        return hfvis_horizon_map(j->grid, j->K, o, j->out + (size_t)k * j->n);
     }
     o->direction_order = HFVIS_DIRECTION_ORDER_SWEEP; /* positions 4u..4u+3: directions u + m K/4 */
     o->direction_begin = 4 * u;
@@ -555,12 +604,20 @@ static hfvis_status cli_threaded_horizon_map(const hfvis_grid *grid, int K, cons
     if (j.per == 4) {
         j.scratch = (float *)cli_huge_malloc(j.n * 4u * (size_t)sp.threads * sizeof(float));
         if (!j.scratch) return HFVIS_ERR_OUT_OF_MEMORY;
+    } else if (opts->rays == HFVIS_RAYS_EXACT) {
+        j.order = (int *)malloc((size_t)K * sizeof(int));
+        s = j.order ? cli_exact_order(K, opts, j.order) : HFVIS_ERR_OUT_OF_MEMORY;
+        if (s != HFVIS_OK) {
+            free(j.order);
+            return s;
+        }
     }
     sp.unit = cli_map_unit;
     sp.ctx = &j;
     sp.opts = opts;
     sp.total = K;
     s = cli_split_run(&sp);
+    free(j.order);
     free(j.scratch);
     return s;
 }
