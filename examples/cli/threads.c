@@ -1,8 +1,10 @@
 /* threads.c - --threads: the work of one run split over POSIX threads so that the output equals
  * the one-thread run's bit for bit (hfvis.h, "Threads"): the direction sums by quarter-turn group
  * added in order (lattice) or by bands of one direction at a time added in place (exact), the
- * horizon map by plane range, one sun by
- * bands across its direction, and openness --radius by row bands (receiver rectangles). The library
+ * horizon map by plane range (exact: costliest direction first), one sun by
+ * bands across its direction, and openness --radius by row bands (receiver rectangles); the
+ * tool's own per-row work around them (the shared normals, the finish of the sums) by row bands
+ * (cli_threaded_rows). The library
  * stays single-threaded; every call here is one of its reentrant calls on shared inputs. Without
  * POSIX threads (CLI_HAVE_THREADS 0) every split runs its units in order on the calling thread.
  * May call: progress.c (through the progress callbacks it wraps). */
