@@ -1076,14 +1076,19 @@ awk 'BEGIN { w = 61; h = 53; print "P2"; print w, h; print 65535
     v = int(30000 + 9000 * sin(x / 4.3) * cos(y / 3.1) + 4000 * sin((x + 2 * y) / 2.2))
     if (x == 30) v += 20000; if ((x * 7 + y * 13) % 97 == 0) v = 0; s = s " " v }; print s } }' > "$dir/rough.pgm"
 r=$dir/rough.pgm
-while IFS='|' read -r name args; do
-  [ -n "$name" ] || continue
-  # shellcheck disable=SC2086 # $args is a list of flags
-  for t in 1 2 3; do "$hfvis" $args "$r" --nodata 0 --cell 3 --quiet --threads $t -o "$dir/thr$t.pfm" 2> "$dir/terr" || break; done
-  if [ -s "$dir/thr3.pfm" ] && cmp -s "$dir/thr1.pfm" "$dir/thr2.pfm" && cmp -s "$dir/thr1.pfm" "$dir/thr3.pfm"; then ok "--threads 1/2/3 equal: $name"
-  else bad "--threads 1/2/3 differ or fail: $name $(cat "$dir/terr")"; fi
-  rm -f "$dir"/thr?.pfm
-done <<EOF
+# thr_equal FIELD LABEL: each "name|command and flags" line of stdin run on FIELD with --threads
+# 1, 2 and 3; the three outputs must be equal byte for byte
+thr_equal() {
+  while IFS='|' read -r name args; do
+    [ -n "$name" ] || continue
+    # shellcheck disable=SC2086 # $args is a list of flags
+    for t in 1 2 3; do "$hfvis" $args "$1" --nodata 0 --cell 3 --quiet --threads $t -o "$dir/thr$t.pfm" 2> "$dir/terr" || break; done
+    if [ -s "$dir/thr3.pfm" ] && cmp -s "$dir/thr1.pfm" "$dir/thr2.pfm" && cmp -s "$dir/thr1.pfm" "$dir/thr3.pfm"; then ok "--threads 1/2/3 equal$2: $name"
+    else bad "--threads 1/2/3 differ or fail$2: $name $(cat "$dir/terr")"; fi
+    rm -f "$dir"/thr?.pfm
+  done
+}
+thr_equal "$r" "" <<EOF
 horizon K=16|horizon --dirs 16
 horizon K=10|horizon --dirs 10 --convention grass
 horizon exact|horizon --dirs 12 --exact
@@ -1109,14 +1114,7 @@ awk 'BEGIN { w = 97; h = 203; print "P2"; print w, h; print 65535
   for (y = 0; y < h; y++) { s = ""; for (x = 0; x < w; x++) {
     v = int(30000 + 9000 * sin(x / 5.1) * cos(y / 4.3) + 3000 * sin((x + 3 * y) / 2.7))
     if (y == 64 || y == 127) v += 15000; if ((x * 11 + y * 5) % 89 == 0) v = 0; s = s " " v }; print s } }' > "$dir/tall.pgm"
-while IFS='|' read -r name args; do
-  [ -n "$name" ] || continue
-  # shellcheck disable=SC2086 # $args is a list of flags
-  for t in 1 2 3; do "$hfvis" $args "$dir/tall.pgm" --nodata 0 --cell 3 --quiet --threads $t -o "$dir/thr$t.pfm" 2> "$dir/terr" || break; done
-  if [ -s "$dir/thr3.pfm" ] && cmp -s "$dir/thr1.pfm" "$dir/thr2.pfm" && cmp -s "$dir/thr1.pfm" "$dir/thr3.pfm"; then ok "--threads 1/2/3 equal, row bands: $name"
-  else bad "--threads 1/2/3 differ or fail, row bands: $name $(cat "$dir/terr")"; fi
-  rm -f "$dir"/thr?.pfm
-done <<EOF
+thr_equal "$dir/tall.pgm" ", row bands" <<EOF
 skyview K=8|skyview --dirs 8
 sky K=8|sky --dirs 8 --sky 3
 sky exact|sky --dirs 8 --exact
