@@ -123,7 +123,9 @@ cxx:
 	$(CXX) -std=c++11 -Wall -Wextra -Werror -pedantic -fsyntax-only -I. test/cxx_header.cpp
 
 # make bench follows config= and opt= (default: the release build, build/bench).
-# Its "tiles" section runs the hfvis tool (HFVIS_CLI) whole and tiled: make bench BENCH_ARGS=tiles.
+# Its "tiles" section runs the hfvis tool (HFVIS_CLI) whole and tiled: make bench BENCH_ARGS=tiles;
+# its "threads" section runs it with --threads 1 and the online cores (HFVIS_BENCH_THREADS_N=4096
+# for 4096^2, HFVIS_BENCH_THREADS_RUNS=3 for the minimum of 3 runs): make bench BENCH_ARGS=threads.
 bench:
 	@$(MAKE) --no-print-directory $(BENCH) $(CLI)
 	@HFVIS_CLI=$(CLI) HFVIS_BENCH_GRASS=examples/bench/solar_grass.sh $(BENCH) $(BENCH_ARGS)

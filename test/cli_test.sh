@@ -1107,14 +1107,19 @@ awk 'BEGIN { w = 61; h = 53; print "P2"; print w, h; print 65535
     v = int(30000 + 9000 * sin(x / 4.3) * cos(y / 3.1) + 4000 * sin((x + 2 * y) / 2.2))
     if (x == 30) v += 20000; if ((x * 7 + y * 13) % 97 == 0) v = 0; s = s " " v }; print s } }' > "$dir/rough.pgm"
 r=$dir/rough.pgm
-while IFS='|' read -r name args; do
-  [ -n "$name" ] || continue
-  # shellcheck disable=SC2086 # $args is a list of flags
-  for t in 1 2 3; do "$hfvis" $args "$r" --nodata 0 --cell 3 --quiet --threads $t -o "$dir/thr$t.pfm" 2> "$dir/terr" || break; done
-  if [ -s "$dir/thr3.pfm" ] && cmp -s "$dir/thr1.pfm" "$dir/thr2.pfm" && cmp -s "$dir/thr1.pfm" "$dir/thr3.pfm"; then ok "--threads 1/2/3 equal: $name"
-  else bad "--threads 1/2/3 differ or fail: $name $(cat "$dir/terr")"; fi
-  rm -f "$dir"/thr?.pfm
-done <<EOF
+# thr_equal FIELD LABEL: each "name|command and flags" line of stdin run on FIELD with --threads
+# 1, 2 and 3; the three outputs must be equal byte for byte
+thr_equal() {
+  while IFS='|' read -r name args; do
+    [ -n "$name" ] || continue
+    # shellcheck disable=SC2086 # $args is a list of flags
+    for t in 1 2 3; do "$hfvis" $args "$1" --nodata 0 --cell 3 --quiet --threads $t -o "$dir/thr$t.pfm" 2> "$dir/terr" || break; done
+    if [ -s "$dir/thr3.pfm" ] && cmp -s "$dir/thr1.pfm" "$dir/thr2.pfm" && cmp -s "$dir/thr1.pfm" "$dir/thr3.pfm"; then ok "--threads 1/2/3 equal$2: $name"
+    else bad "--threads 1/2/3 differ or fail$2: $name $(cat "$dir/terr")"; fi
+    rm -f "$dir"/thr?.pfm
+  done
+}
+thr_equal "$r" "" <<EOF
 horizon K=16|horizon --dirs 16
 horizon K=10|horizon --dirs 10 --convention grass
 horizon exact|horizon --dirs 12 --exact
@@ -1134,6 +1139,36 @@ hillshade lattice blend|hillshade --lattice --blend 3
 openness both|openness --radius 20 --both
 openness clamp|openness --radius 12 --border clamp --negative
 EOF
+# tall.pgm: 97 x 203, taller than the tool's row bands (64 rows: the shared normals, the finish
+# of the sums, split over the threads), so that bands, a short last band and their seams run
+awk 'BEGIN { w = 97; h = 203; print "P2"; print w, h; print 65535
+  for (y = 0; y < h; y++) { s = ""; for (x = 0; x < w; x++) {
+    v = int(30000 + 9000 * sin(x / 5.1) * cos(y / 4.3) + 3000 * sin((x + 3 * y) / 2.7))
+    if (y == 64 || y == 127) v += 15000; if ((x * 11 + y * 5) % 89 == 0) v = 0; s = s " " v }; print s } }' > "$dir/tall.pgm"
+thr_equal "$dir/tall.pgm" ", row bands" <<EOF
+skyview K=8|skyview --dirs 8
+sky K=8|sky --dirs 8 --sky 3
+sky exact|sky --dirs 8 --exact
+light rgb|light --dirs 4 --env $dir/env3.pfm
+horizon K=8|horizon --dirs 8
+shadow|shadow --sun-azimuth 200 --sun-elevation 8
+EOF
+# PFM outputs are written in slices of about 8 MB (examples/cli/write.c): a 2400 x 1000 normals
+# map (28,800 bytes a row, 291 rows a slice: 4 slices) has the whole image's header and size,
+# the bottom row first (here sloped along x: its first value is not 0) and the top row last (flat:
+# its normals' first component is 0)
+awk 'BEGIN { w = 2400; h = 1000; print "P2"; print w, h; print 65535
+  for (y = 0; y < h; y++) { s = ""; for (x = 0; x < w; x++) s = s " " (y < 500 ? 100 : 100 + 20 * x); print s } }' > "$dir/slope.pgm"
+if "$hfvis" normals "$dir/slope.pgm" --quiet -o "$dir/slices.pfm" 2> "$dir/terr"; then
+  head=$(head -c 18 "$dir/slices.pfm" | od -A n -c | tr -d ' \n')
+  size=$(wc -c < "$dir/slices.pfm" | tr -d ' ')
+  first=$(od -A n -t f4 -j 18 -N 4 "$dir/slices.pfm" | tr -d ' ')
+  last=$(od -A n -t f4 -j $((size - 12)) -N 4 "$dir/slices.pfm" | tr -d ' ')
+  [ "$head" = 'PF\n24001000\n-1.0\n' ] && [ "$size" = $((18 + 2400 * 1000 * 12)) ] && [ "$first" != 0 ] &&
+    [ "$last" = 0 ] && ok "PFM written in slices: the whole image's header and size, bottom row first" ||
+    bad "PFM slices: header '$head' size $size first $first last $last $(cat "$dir/terr")"
+else bad "PFM slices: $(cat "$dir/terr")"; fi
+rm -f "$dir/slices.pfm" "$dir/slope.pgm"
 "$hfvis" skyview "$r" --nodata 0 --cell 3 --quiet --threads 0 -o "$dir/thr0.pfm" && "$hfvis" skyview "$r" --nodata 0 --cell 3 \
   --quiet -o "$dir/thr1.pfm" && cmp -s "$dir/thr0.pfm" "$dir/thr1.pfm" && ok "--threads 0 (the online cores) = the default run" \
   || bad "--threads 0"

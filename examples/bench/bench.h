@@ -87,6 +87,11 @@ void bench_lk_obj(int quick); /* bench_lkobj.c: the meshes of HFVIS_BENCH_MESHES
 void bench_dirs(int quick);
 void bench_exact(int quick);
 void bench_tiles(int quick);
+/* bench_tiles.c: a child process's exit status, wall and CPU seconds and peak memory; whether
+ * two files are equal byte for byte (used by the sections that run the hfvis tool) */
+int bench_spawn(char *const argv[], double *seconds, long *maxrss_kib, double *cpu);
+int bench_same_file(const char *a, const char *b);
+void bench_threads(int quick); /* bench_threads.c: the tool's --threads 1 against 2 ($HFVIS_CLI) */
 void bench_solar(int quick); /* bench_solar.c: the DEMs of $HFVIS_BENCH_DEMS (else an fBm) */ /* bench_tiles.c: the hfvis tool whole vs tiled ($HFVIS_CLI) */
 void bench_radius(int quick);
 #endif

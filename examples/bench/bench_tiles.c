@@ -21,8 +21,9 @@
 #define TILES_SIDE 4 /* 4 x 4 = 16 windows */
 
 /* Run argv (NULL-terminated) with stdout and stderr to /dev/null; its exit status, seconds and
- * peak resident memory in KiB (Linux: ru_maxrss is in KiB). */
-static int tiles_spawn(char *const argv[], double *seconds, long *maxrss_kib)
+ * peak resident memory in KiB (Linux: ru_maxrss is in KiB), and, when cpu is not NULL, its CPU
+ * seconds (user + system, all threads). Shared with bench_threads.c (bench.h). */
+int bench_spawn(char *const argv[], double *seconds, long *maxrss_kib, double *cpu)
 {
     struct rusage ru;
     int status = 0;
@@ -42,11 +43,14 @@ static int tiles_spawn(char *const argv[], double *seconds, long *maxrss_kib)
         if (errno != EINTR) return -1;
     *seconds = bench_now() - t0;
     *maxrss_kib = ru.ru_maxrss;
+    if (cpu)
+        *cpu = (double)ru.ru_utime.tv_sec + (double)ru.ru_utime.tv_usec * 1e-6 + (double)ru.ru_stime.tv_sec +
+               (double)ru.ru_stime.tv_usec * 1e-6;
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-/* Whether two files hold the same bytes. */
-static int tiles_same(const char *a, const char *b)
+/* Whether two files hold the same bytes (bench.h). */
+int bench_same_file(const char *a, const char *b)
 {
     FILE *fa = fopen(a, "rb"), *fb = fopen(b, "rb");
     int same = fa && fb, ca, cb;
@@ -119,14 +123,14 @@ void bench_tiles(int quick)
     argv[0] = cli, argv[1] = (char *)"skyview", argv[2] = in, argv[3] = (char *)"--max-distance";
     argv[4] = R, argv[5] = (char *)"--quiet", argv[6] = (char *)"--max-memory", argv[7] = (char *)"0";
     argv[8] = (char *)"-o", argv[9] = whole, argv[10] = NULL;
-    rc = tiles_spawn(argv, &t, &rss_whole);
+    rc = bench_spawn(argv, &t, &rss_whole, NULL);
     printf("  whole      %8.1f s  peak %8.1f MiB  (%.1f bytes/cell)%s\n", t, rss_whole / 1024.0,
            rss_whole * 1024.0 / ((double)n * n), rc ? "  FAILED" : "");
     for (i = 0; i < TILES_SIDE * TILES_SIDE; i++) {
         snprintf(win, sizeof win, "%d,%d,%d,%d", (i % TILES_SIDE) * side, (i / TILES_SIDE) * side, side, side);
         snprintf(names[i], sizeof names[i], "%s/piece%02d.tif", dir, i);
         argv[9] = names[i], argv[10] = (char *)"--window", argv[11] = win, argv[12] = NULL;
-        rc = tiles_spawn(argv, &t, &rss);
+        rc = bench_spawn(argv, &t, &rss, NULL);
         tiles_t += t;
         if (t > tmax) tmax = t;
         if (rss > rss_max) rss_max = rss;
@@ -140,9 +144,9 @@ void bench_tiles(int quick)
     snprintf(mosaic, sizeof mosaic, "%s/mosaic.tif", dir);
     pieces[0] = cli, pieces[1] = (char *)"mosaic", pieces[2] = (char *)"--quiet";
     pieces[3 + 16] = (char *)"-o", pieces[3 + 17] = mosaic, pieces[3 + 18] = NULL;
-    rc = tiles_spawn(pieces, &t, &rss);
+    rc = bench_spawn(pieces, &t, &rss, NULL);
     printf("  mosaic     %8.1f s  peak %8.1f MiB%s\n", t, rss / 1024.0, rc ? "  FAILED" : "");
-    printf("  mosaic = whole run bit for bit: %s\n", tiles_same(whole, mosaic) ? "yes" :
+    printf("  mosaic = whole run bit for bit: %s\n", bench_same_file(whole, mosaic) ? "yes" :
            "NO (expected until the library honours max_distance, origin, extent and receivers)");
     for (i = 0; i < 16; i++) {
         remove(names[i]);
@@ -180,7 +184,7 @@ void bench_tiles(int quick)
             if (!strcmp(cmds[c], "openness")) argv[k++] = (char *)"--radius", argv[k++] = (char *)"16";
             if (!strcmp(cmds[c], "visibility")) argv[k++] = (char *)"--dirs", argv[k++] = (char *)"4";
             argv[k] = NULL;
-            rc = tiles_spawn(argv, &t, &rss);
+            rc = bench_spawn(argv, &t, &rss, NULL);
             printf("    %-10s %6.1f bytes/cell  (%.1f MiB, %.1f s)%s\n", cmds[c], rss * 1024.0 / (1024.0 * 1024.0),
                    rss / 1024.0, t, rc ? "  FAILED" : "");
         }

@@ -359,7 +359,6 @@ static void cli_on_signal(int sig);
 static void cli_signals(void);
 static hfvis_status cli_write(const char *path, unsigned char *bytes, size_t n, hfvis_status s);
 static hfvis_status cli_write_encoded(const char *path, size_t need, cli_encoder encode, const void *what);
-static hfvis_status cli_enc_pfm(const void *what, void *out, size_t cap, size_t *written);
 static hfvis_status cli_enc_binvox(const void *what, void *out, size_t cap, size_t *written);
 static hfvis_status cli_enc_visfield(const void *what, void *out, size_t cap, size_t *written);
 static hfvis_status cli_enc_partial(const void *what, void *out, size_t cap, size_t *written);

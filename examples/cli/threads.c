@@ -1,8 +1,10 @@
 /* threads.c - --threads: the work of one run split over POSIX threads so that the output equals
  * the one-thread run's bit for bit (hfvis.h, "Threads"): the direction sums by quarter-turn group
  * added in order (lattice) or by bands of one direction at a time added in place (exact), the
- * horizon map by plane range, one sun by
- * bands across its direction, and openness --radius by row bands (receiver rectangles). The library
+ * horizon map by plane range (exact: costliest direction first), one sun by
+ * bands across its direction, and openness --radius by row bands (receiver rectangles); the
+ * tool's own per-row work around them (the shared normals, the finish of the sums) by row bands
+ * (cli_threaded_rows). The library
  * stays single-threaded; every call here is one of its reentrant calls on shared inputs. Without
  * POSIX threads (CLI_HAVE_THREADS 0) every split runs its units in order on the calling thread.
  * May call: progress.c (through the progress callbacks it wraps). */
@@ -104,9 +106,8 @@ static void cli_split_progress(void *user, int done, int total)
  * project's VMs), and the lattice gathers miss the TLB less. Measured in docs/performance.md,
  * Threads. cli_huge_alloc is the hfvis_allocator form, which every sweep command passes. */
 #define CLI_HUGE_MIN ((size_t)4 << 20) /* smaller blocks stay on ordinary pages */
-static void *cli_huge_malloc(size_t size)
+static void *cli_huge_advise(void *p, size_t size)
 {
-    void *p = malloc(size ? size : 1);
 #if defined(MADV_HUGEPAGE) && defined(_SC_PAGESIZE)
     long page = sysconf(_SC_PAGESIZE);
     if (p && size >= CLI_HUGE_MIN && page > 0) { /* the whole pages inside the block */
@@ -114,8 +115,23 @@ static void *cli_huge_malloc(size_t size)
         if (head < size && ((size - head) & ~mask) > 0)
             (void)madvise((char *)p + head, (size - head) & ~mask, MADV_HUGEPAGE); /* a hint: failure is harmless */
     }
+#else
+    (void)size;
 #endif
     return p;
+}
+
+static void *cli_huge_malloc(size_t size)
+{
+    return cli_huge_advise(malloc(size ? size : 1), size);
+}
+
+/* Zeroed, as calloc: a large block comes fresh from the system and is not touched here, so its
+ * pages are first touched (and faulted) by whoever writes them, on their threads, not all on the
+ * main thread before the run as a memset would. */
+static void *cli_huge_calloc(size_t size)
+{
+    return cli_huge_advise(calloc(1, size ? size : 1), size);
 }
 
 static void *cli_huge_alloc(void *user, size_t size)
@@ -267,6 +283,44 @@ static hfvis_status cli_split_run(cli_split *sp)
     return sp->status;
 }
 
+/* ---- per-row work of the tool itself (decoding, normals, finishing, encoding): rows [0, rows)
+ * in bands of CLI_ROWS_BAND, each band fn(ctx, y0, y1, thread) on one of `threads` threads;
+ * the bands must write disjoint outputs (thread: an index < threads for per-thread scratch).
+ * Returns the first failing band's status. One thread: fn(ctx, 0, rows, 0). */
+#define CLI_ROWS_BAND 64 /* rows per unit: about 1 MB of a 4096-wide float plane */
+typedef hfvis_status (*cli_rows_fn)(void *ctx, int y0, int y1, int thread);
+typedef struct cli_rows_split {
+    cli_rows_fn fn;
+    void *ctx;
+    int rows;
+} cli_rows_split;
+
+static hfvis_status cli_rows_unit(cli_split *sp, int u, int thread, hfvis_sweep_options *o)
+{
+    const cli_rows_split *j = (const cli_rows_split *)sp->ctx;
+    const int y0 = u * CLI_ROWS_BAND, y1 = j->rows - y0 < CLI_ROWS_BAND ? j->rows : y0 + CLI_ROWS_BAND;
+    (void)o;
+    return j->fn(j->ctx, y0, y1, thread);
+}
+
+static hfvis_status cli_threaded_rows(int rows, int threads, cli_rows_fn fn, void *ctx)
+{
+    hfvis_sweep_options none = hfvis_sweep_options_default();
+    cli_rows_split j;
+    cli_split sp;
+    if (threads <= 1 || rows <= CLI_ROWS_BAND) return fn(ctx, 0, rows, 0);
+    memset(&sp, 0, sizeof sp);
+    j.fn = fn;
+    j.ctx = ctx;
+    j.rows = rows;
+    sp.units = (rows - 1) / CLI_ROWS_BAND + 1;
+    sp.threads = threads;
+    sp.unit = cli_rows_unit;
+    sp.ctx = &j;
+    sp.opts = &none;
+    return cli_split_run(&sp);
+}
+
 /* The finish of a sum S of K directions as the single run computes it (hfvis.h, split runs):
  * the sky-view factor 1 - S/K, the sky light and environment light scale * S, where scale is
  * the product of the floats the run passes (sky * albedo, or albedo). */
@@ -373,10 +427,54 @@ static hfvis_status cli_threaded_sums(const hfvis_grid *grid, int K, hfvis_sum_k
     return s;
 }
 
+/* The grid's normals (hfvis_normals_compute) by row bands: each band computes them on the
+ * view of its rows and the one row either side, which the library's stencil reaches (central differences
+ * along x and y), into its thread's scratch, and copies its own rows: the whole call's values. */
+typedef struct cli_normals_rows {
+    const hfvis_grid *grid;
+    float *out;     /* width * height * 3 */
+    float *scratch; /* threads * (CLI_ROWS_BAND + 2) * width * 3 */
+} cli_normals_rows;
+
+static hfvis_status cli_normals_band(void *ctx, int y0, int y1, int thread)
+{
+    const cli_normals_rows *j = (const cli_normals_rows *)ctx;
+    const size_t row = (size_t)j->grid->width * 3;
+    const int v0 = y0 > 0 ? y0 - 1 : 0, v1 = y1 < j->grid->height ? y1 + 1 : y1;
+    float *tmp = j->scratch + (size_t)thread * (CLI_ROWS_BAND + 2) * row;
+    hfvis_grid view = *j->grid;
+    hfvis_status s;
+    view.z += (ptrdiff_t)v0 * j->grid->stride;
+    view.height = v1 - v0;
+    s = hfvis_normals_compute(&view, tmp);
+    if (s == HFVIS_OK)
+        memcpy(j->out + (size_t)y0 * row, tmp + (size_t)(y0 - v0) * row, (size_t)(y1 - y0) * row * sizeof(float));
+    return s;
+}
+
+/* The finish of the sums acc into out, by row bands (cli_sum_finish per value). */
+typedef struct cli_finish_rows {
+    int cmd, K;
+    double scale;
+    size_t row; /* values per row: width * channels */
+    const double *acc;
+    float *out;
+} cli_finish_rows;
+
+static hfvis_status cli_finish_band(void *ctx, int y0, int y1, int thread)
+{
+    const cli_finish_rows *j = (const cli_finish_rows *)ctx;
+    size_t i;
+    (void)thread;
+    for (i = (size_t)y0 * j->row; i < (size_t)y1 * j->row; i++) j->out[i] = cli_sum_finish(j->cmd, j->K, j->scale, j->acc[i]);
+    return HFVIS_OK;
+}
+
 /* skyview, sky or light (cmd) over all K directions on `threads` threads: S by
  * cli_threaded_sums, finished as the single run (scale: sky * albedo, or albedo, as the floats the
  * run passes), out[(y*width + x)*channels + c]. The lit commands compute the grid normals once
- * and give them to every unit (sweep options normals) instead of each call making its own. */
+ * (by row bands) and give them to every unit (sweep options normals) instead of each call making
+ * its own; the finish runs by row bands too. */
 static hfvis_status cli_threaded_light(int cmd, const hfvis_grid *grid, int K, double scale,
                                        const hfvis_env *env, const hfvis_env_options *eopts,
                                        const hfvis_sweep_options *opts, int threads, int channels,
@@ -389,29 +487,83 @@ static hfvis_status cli_threaded_light(int cmd, const hfvis_grid *grid, int K, d
     float *nrm = NULL;
     hfvis_sweep_options o = *opts;
     hfvis_status s = HFVIS_OK;
-    size_t i;
+    cli_finish_rows f;
     if (!acc) return HFVIS_ERR_OUT_OF_MEMORY;
     if (cmd != CMD_SKYVIEW && !o.normals) { /* the grid normals once, shared by every unit */
-        nrm = n <= SIZE_MAX / (3 * sizeof(float)) ? (float *)cli_huge_malloc(n * 3 * sizeof(float)) : NULL;
-        s = nrm ? hfvis_normals_compute(grid, nrm) : HFVIS_ERR_OUT_OF_MEMORY;
+        const size_t band = ((size_t)CLI_ROWS_BAND + 2) * (size_t)grid->width * 3 * (size_t)threads;
+        cli_normals_rows j;
+        j.grid = grid;
+        j.out = nrm = n <= SIZE_MAX / (3 * sizeof(float)) ? (float *)cli_huge_malloc(n * 3 * sizeof(float)) : NULL;
+        j.scratch = (float *)malloc(band * sizeof(float)); /* width <= 2^28, threads <= 256 */
+        s = nrm && j.scratch ? cli_threaded_rows(grid->height, threads, cli_normals_band, &j) : HFVIS_ERR_OUT_OF_MEMORY;
+        free(j.scratch);
         o.normals = nrm;
     }
     if (s == HFVIS_OK) s = cli_threaded_sums(grid, K, kind, env, eopts, &o, threads, channels, acc);
-    for (i = 0; s == HFVIS_OK && i < count; i++) out[i] = cli_sum_finish(cmd, K, scale, acc[i]);
+    f.cmd = cmd, f.K = K, f.scale = scale, f.row = (size_t)grid->width * (size_t)channels, f.acc = acc, f.out = out;
+    if (s == HFVIS_OK) s = cli_threaded_rows(grid->height, threads, cli_finish_band, &f);
     free(nrm);
     free(acc);
     return s;
 }
 
 /* ---- the horizon map: one quarter-turn group per unit (lattice, K % 4 == 0: its four planes in
- * sweep order, copied to their direction index) or one direction (written in place). */
+ * sweep order, copied to their direction index) or one direction (written in place; exact rays:
+ * the costliest directions first, so that the cheap ones fill the end and no thread idles long
+ * while another finishes a costly one). */
 typedef struct cli_map_split {
     const hfvis_grid *grid;
     int K, per;
     size_t n;           /* width * height */
     float *scratch;     /* threads * 4 planes (groups) */
     float *out;         /* K planes, direction index order */
+    int *order;         /* NULL, or the direction of each unit (exact rays) */
 } cli_map_split;
+
+/* The cost of an exact direction's sweep: about |a| + |b| grid-line crossings per receiver for
+ * the rational direction (a, b) the run uses at azimuth psi (hfvis_sweep_azimuths, psi =
+ * atan2(b, a)): the smallest such pair with a major component up to CLI_EXACT_MAX_COMPONENT;
+ * that bound if none is found (the order only balances the threads, it never changes a result). */
+#define CLI_EXACT_MAX_COMPONENT 4096
+static int cli_exact_cost(double psi)
+{
+    const double c = cos(psi), s = sin(psi), t = fabs(c) >= fabs(s) ? fabs(s / c) : fabs(c / s);
+    int m;
+    for (m = 1; m < CLI_EXACT_MAX_COMPONENT; m++) {
+        const double minor = floor((double)m * t + 0.5);
+        const double a = (fabs(c) >= fabs(s) ? (double)m : minor) * (c < 0.0 ? -1.0 : 1.0);
+        const double b = (fabs(c) >= fabs(s) ? minor : (double)m) * (s < 0.0 ? -1.0 : 1.0);
+        if (fabs(remainder(atan2(b, a) - psi, 2.0 * CLI_PI)) < 1e-9) return m + (int)minor;
+    }
+    return CLI_EXACT_MAX_COMPONENT;
+}
+
+typedef struct cli_cost_index {
+    int cost, k;
+} cli_cost_index;
+
+static int cli_costlier_first(const void *x, const void *y)
+{
+    const cli_cost_index *p = (const cli_cost_index *)x, *q = (const cli_cost_index *)y;
+    if (p->cost != q->cost) return p->cost > q->cost ? -1 : 1;
+    return p->k < q->k ? -1 : p->k > q->k;
+}
+
+/* The K exact directions of opts ordered costliest first (ties: index order) into order[K];
+ * HFVIS_OK, or the status of hfvis_sweep_azimuths / out of memory. */
+static hfvis_status cli_exact_order(int K, const hfvis_sweep_options *opts, int *order)
+{
+    double *az = (double *)malloc((size_t)K * sizeof(double));
+    cli_cost_index *ci = (cli_cost_index *)malloc((size_t)K * sizeof(cli_cost_index));
+    hfvis_status s = az && ci ? hfvis_sweep_azimuths(K, opts, az, NULL) : HFVIS_ERR_OUT_OF_MEMORY;
+    int k;
+    for (k = 0; s == HFVIS_OK && k < K; k++) ci[k].cost = cli_exact_cost(az[k]), ci[k].k = k;
+    if (s == HFVIS_OK) qsort(ci, (size_t)K, sizeof *ci, cli_costlier_first);
+    for (k = 0; s == HFVIS_OK && k < K; k++) order[k] = ci[k].k;
+    free(ci);
+    free(az);
+    return s;
+}
 
 static hfvis_status cli_map_unit(cli_split *sp, int u, int thread, hfvis_sweep_options *o)
 {
@@ -419,10 +571,11 @@ static hfvis_status cli_map_unit(cli_split *sp, int u, int thread, hfvis_sweep_o
     hfvis_status s;
     int m;
     if (j->per == 1) { /* one direction, index order: its plane in place */
+        const int k = j->order ? j->order[u] : u;
         o->direction_order = HFVIS_DIRECTION_ORDER_INDEX;
-        o->direction_begin = u;
-        o->direction_end = u + 1;
-        return hfvis_horizon_map(j->grid, j->K, o, j->out + (size_t)u * j->n);
+        o->direction_begin = k;
+        o->direction_end = k + 1;
+        return hfvis_horizon_map(j->grid, j->K, o, j->out + (size_t)k * j->n);
     }
     o->direction_order = HFVIS_DIRECTION_ORDER_SWEEP; /* positions 4u..4u+3: directions u + m K/4 */
     o->direction_begin = 4 * u;
@@ -453,12 +606,20 @@ static hfvis_status cli_threaded_horizon_map(const hfvis_grid *grid, int K, cons
     if (j.per == 4) {
         j.scratch = (float *)cli_huge_malloc(j.n * 4u * (size_t)sp.threads * sizeof(float));
         if (!j.scratch) return HFVIS_ERR_OUT_OF_MEMORY;
+    } else if (opts->rays == HFVIS_RAYS_EXACT) {
+        j.order = (int *)malloc((size_t)K * sizeof(int));
+        s = j.order ? cli_exact_order(K, opts, j.order) : HFVIS_ERR_OUT_OF_MEMORY;
+        if (s != HFVIS_OK) {
+            free(j.order);
+            return s;
+        }
     }
     sp.unit = cli_map_unit;
     sp.ctx = &j;
     sp.opts = opts;
     sp.total = K;
     s = cli_split_run(&sp);
+    free(j.order);
     free(j.scratch);
     return s;
 }

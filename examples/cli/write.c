@@ -132,11 +132,6 @@ static hfvis_status cli_write_encoded(const char *path, size_t need, cli_encoder
     return cli_write(path, buf, written, s);
 }
 
-static hfvis_status cli_enc_pfm(const void *what, void *out, size_t cap, size_t *written)
-{
-    const cli_image *m = (const cli_image *)what;
-    return hfvis_pfm_encode(m->px, m->w, m->h, m->channels, m->stride, out, cap, written);
-}
 static hfvis_status cli_enc_binvox(const void *what, void *out, size_t cap, size_t *written)
 {
     const cli_voxels *v = (const cli_voxels *)what;
@@ -150,12 +145,46 @@ static hfvis_status cli_enc_partial(const void *what, void *out, size_t cap, siz
 {
     return hfvis_partial_encode((const hfvis_partial *)what, out, cap, written);
 }
+/* A PFM streamed in slices of rows, never whole in memory (a 4096^2 horizon map of 16 planes
+ * is 1 GiB, whose first touch alone took seconds on this project's VMs): the header of the
+ * whole image, then slice after slice from the bottom row up as PFM stores them, each encoded
+ * by the library (hfvis_pfm_encode of the slice's rows: its pixel bytes, after the slice's own
+ * header, are the file's next bytes) into one buffer of about CLI_PFM_SLICE bytes. The file is
+ * the one hfvis_pfm_encode makes of the whole image, byte for byte (cli_test checks the header
+ * and size; the pixel bytes are the library's). */
+#define CLI_PFM_SLICE ((size_t)8 << 20)
 static hfvis_status cli_pfm_save(const char *path, const float *px, int w, int h, int channels, ptrdiff_t stride)
 {
-    cli_image m;
-    memset(&m, 0, sizeof m);
-    m.px = px, m.w = w, m.h = h, m.channels = channels, m.stride = stride;
-    return cli_write_encoded(path, hfvis_pfm_encode_size(w, h, channels), cli_enc_pfm, &m);
+    const size_t need = hfvis_pfm_encode_size(w, h, channels), row = (size_t)w * (size_t)channels * 4;
+    const int rows = row >= CLI_PFM_SLICE ? 1 : h < (int)(CLI_PFM_SLICE / row) ? h : (int)(CLI_PFM_SLICE / row);
+    char head[64];
+    int len, y1, ok;
+    unsigned char *buf;
+    char *tmp = NULL;
+    FILE *f;
+    hfvis_status s = HFVIS_OK;
+    if (need == 0 || stride < w) return HFVIS_ERR_INVALID_ARGUMENT;
+    len = snprintf(head, sizeof head, "P%c\n%d %d\n-1.0\n", channels == 3 ? 'F' : 'f', w, h);
+    if (len <= 0 || (size_t)len != need - row * (size_t)h) return HFVIS_ERR_INVALID_ARGUMENT; /* not the library's */
+    buf = (unsigned char *)cli_huge_malloc(hfvis_pfm_encode_size(w, rows, channels));
+    if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
+    f = ex_atomic_open(path, &tmp);
+    if (!f) {
+        free(buf);
+        return HFVIS_ERR_IO;
+    }
+    ok = fwrite(head, 1, (size_t)len, f) == (size_t)len;
+    for (y1 = h; ok && y1 > 0; y1 -= rows) { /* rows [y0, y1), the topmost slice last */
+        const int y0 = y1 > rows ? y1 - rows : 0;
+        const size_t slice = hfvis_pfm_encode_size(w, y1 - y0, channels), pixels = row * (size_t)(y1 - y0);
+        size_t written = 0;
+        s = hfvis_pfm_encode(px + (ptrdiff_t)y0 * stride * channels, w, y1 - y0, channels, stride, buf, slice,
+                             &written);
+        ok = s == HFVIS_OK && written == slice && fwrite(buf + (slice - pixels), 1, pixels, f) == pixels;
+    }
+    free(buf);
+    if (!ex_atomic_close(f, tmp, path, ok) && s == HFVIS_OK) s = HFVIS_ERR_IO; /* a short write too */
+    return s;
 }
 static hfvis_status cli_enc_pgm_range(const void *what, void *out, size_t cap, size_t *written)
 {
