@@ -1243,29 +1243,106 @@ static void ss_cfg_from_lsao(const hfvis_lsao_options *o, ss_cfg *g)
     g->rej_n = o->reject_normal;
 }
 
-/* In two steps, for the hull, which needs Occ only where Sin decides nothing: ss_sin gives
- * Sin(h) and |h| (-inf for a coincident point), ss_occ_of the Occ from them (st for s = -inf). */
-static inline double ss_sin(double hx, double hy, double ux, double uy, double tiny, double *len_out)
-{
-    double len = sqrt(hx * hx + hy * hy);
-    *len_out = len;
-    if (!(len > tiny)) return -HFVIS__INF;
-    return (hx * ux + hy * uy) / len;
-}
-
-static inline double ss_occ_of(const ss_fall *f, double s, double len, double st)
-{
-    return s > st ? st + (s - st) * ss_rho(f, len) : st;
-}
-
 /* Occ of point (hx, hy) = occluder - receiver seen along zenith (ux, uy) with tangent st
- * ([P3] Alg. 1 l.25-29); *sin_out = Sin(h) (-inf for a coincident point, which casts st). */
+ * ([P3] Alg. 1 l.25-29) as the paper writes it (the oracle's arithmetic); *sin_out = Sin(h)
+ * (-inf for a coincident point, which casts st). */
 static inline double ss_occ(const ss_fall *f, double hx, double hy, double ux, double uy, double st,
                             double tiny, double *sin_out)
 {
-    double len;
-    *sin_out = ss_sin(hx, hy, ux, uy, tiny, &len);
-    return ss_occ_of(f, *sin_out, len, st);
+    double len = sqrt(hx * hx + hy * hy), s;
+    s = len > tiny ? (hx * ux + hy * uy) / len : -HFVIS__INF;
+    *sin_out = s;
+    return s > st ? st + (s - st) * ss_rho(f, len) : st;
+}
+
+/* The hull's arithmetic without square roots and divisions on its path ([P3] Alg. 1 as the
+ * oracle below computes it, rearranged). For a receiver p with unnormalised zenith w (-p in
+ * perspective, |w| = r; (0, 1) and r = 1 orthographic) and a candidate h = occluder - p:
+ * dd = h.w = r |h| Sin(h) and q = |h|^2. Sin order: s1 < s2 iff dd1 |dd1| q2 < dd2 |dd2| q1
+ * (x |x| is monotone; q > 0). Occ - st = num / den with num = max(0, dd - st r |h|) N and
+ * den = r |h| D (r |h| = sqrt(r^2 q), one root), where rho = N / D (HBAO: N = r(1+C) - C D,
+ * D = r + q; inverse quadratic: N = r, D = r + q; none: 1, 1; the other kinds rho(|h|), 1), so
+ * Occ order is the cross-multiplied num1 den2 against num2 den1, the root is taken only inside
+ * the falloff's support, and each receiver divides once, for its output
+ * Occ = (st r |h| (D - N) + dd N) / den (exactly 0 for Sin = 0 without a falloff, as the
+ * oracle's st + (0 - st) 1). Coordinates are scaled by a power of two per
+ * line (exact) so the fourth-degree products neither overflow nor underflow. */
+typedef struct ss_hcand {
+    double dd, q;  /* h.w, |h|^2 (scaled) */
+    int co;        /* coincident with the receiver: Sin = -inf, Occ = st */
+} ss_hcand;
+
+static inline ss_hcand ss_hcand_of(double hx, double hy, double wx, double wy, double tiny2)
+{
+    ss_hcand c;
+    c.dd = hx * wx + hy * wy;
+    c.q = hx * hx + hy * hy;
+    c.co = !(c.q > tiny2);
+    return c;
+}
+
+static inline int ss_hsin_less(const ss_hcand *a, const ss_hcand *b)
+{
+    if (b->co) return 0;
+    if (a->co) return 1;
+    return a->dd * fabs(a->dd) * b->q < b->dd * fabs(b->dd) * a->q;
+}
+
+/* Occ - st = o->num / o->den of candidate c for tangent st (r2 = r^2), num = 0 for Occ = st;
+ * fs is the falloff scaled to the line's coordinates, f the caller's (for the kinds without a
+ * rational form), isig 1/scale. */
+typedef struct ss_hocc_t { double num, den, rl, N, D; } ss_hocc_t;
+
+static inline void ss_hocc(const ss_fall *fs, const ss_fall *f, const ss_hcand *c, double r2,
+                           double st, double isig, ss_hocc_t *o)
+{
+    double N, D, rl, e;
+    o->num = o->rl = o->N = o->D = 0.0;
+    o->den = 1.0;
+    if (c->co) return;
+    if (fs->kind == HFVIS_FALLOFF_HBAO) {
+        D = fs->a + c->q;
+        N = fs->r1c - fs->c * D;
+        if (!(N > 0.0)) return; /* beyond the support: Occ = st */
+    } else if (fs->kind == HFVIS_FALLOFF_INV_QUADRATIC) {
+        D = fs->a + c->q;
+        N = fs->a;
+    } else if (fs->kind == HFVIS_FALLOFF_NONE) {
+        D = N = 1.0;
+    } else {
+        D = 1.0;
+        N = ss_rho_general(f, sqrt(c->q) * isig);
+        if (!(N > 0.0)) return;
+    }
+    rl = sqrt(r2 * c->q);
+    e = c->dd - st * rl;
+    if (!(e > 0.0)) return; /* Sin <= st: Occ = st */
+    o->num = e * N;
+    o->den = rl * D;
+    o->rl = rl;
+    o->N = N;
+    o->D = D;
+}
+
+/* Occ of an evaluated candidate (ss_hocc) for its tangent st. */
+static inline double ss_hocc_value(const ss_hocc_t *o, const ss_hcand *c, double st)
+{
+    return o->num > 0.0 ? (st * o->rl * (o->D - o->N) + c->dd * o->N) / o->den : st;
+}
+
+/* The largest power of two at most 1/max|coordinate| over the line's finite samples (1 for none). */
+static double ss_line_scale(const double *x, const double *y, int n)
+{
+    double m = 0.0;
+    int i, e;
+    for (i = 0; i < n; i++) {
+        double a = fabs(x[i]), b = fabs(y[i]);
+        if (a > m && a <= DBL_MAX) m = a;
+        if (b > m && b <= DBL_MAX) m = b;
+    }
+    if (!(m > 0.0)) return 1.0;
+    (void)frexp(m, &e); /* m in [2^(e-1), 2^e) */
+    return ldexp(1.0, -e);
 }
 
 /* The obscurity hull along one line ([P3] §4.2, Alg. 1). */
@@ -1273,57 +1350,62 @@ static void ss_hull_line(const double *x, const double *y, const double *stc, co
                          int n, int persp, double fixed, const ss_fall *f, int ties, int *stack,
                          double *out)
 {
+    const double sig = ss_line_scale(x, y, n), isig = 1.0 / sig;
+    ss_fall fs = *f; /* in the scaled coordinates: lengths times sig (exact) */
     int top = 0, i;
+    fs.a *= sig * sig;
+    fs.r1c *= sig * sig;
     for (i = 0; i < n; i++) {
-        double px = x[i], py = y[i], r, ux, uy, sc, se, tiny, o1 = 0.0, s1 = 0.0, o2, s2, len1 = 0.0, len2;
+        double px = x[i], py = y[i], wx, wy, r2, sc, se, tiny, tiny2;
+        ss_hcand c1, c2;
+        ss_hocc_t o1 = {0.0, 1.0, 0.0, 0.0, 0.0}, o2;
         int have1 = 0;
         if (!isfinite(px) || !isfinite(py)) {
             out[i] = HFVIS__NAN;
             continue;
         }
-        r = sqrt(px * px + py * py);
         if (persp) {
-            if (!(r > 0.0)) {
+            wx = -px * sig; /* l.7: towards the camera, unnormalised */
+            wy = -py * sig;
+            r2 = wx * wx + wy * wy;
+            if (!(r2 > 0.0)) {
                 out[i] = HFVIS__NAN;
                 continue;
             }
-            ux = -px / r; /* l.7: unit vector towards the camera */
-            uy = -py / r;
         } else {
-            ux = 0.0;
-            uy = 1.0;
+            wx = 0.0;
+            wy = 1.0;
+            r2 = 1.0;
         }
-        tiny = SS_COINCIDENT * (fabs(px) + fabs(py));
+        tiny = SS_COINCIDENT * (fabs(px) + fabs(py)) * sig;
+        tiny2 = tiny * tiny;
         sc = stc ? stc[i] : fixed;
         se = ste ? ste[i] : fixed;
-        /* Occ (o1, o2) is formed only where the Sin test (s1 < s2) leaves the pop to it: the same
-         * values and decisions as evaluating both tests (no side effects), fewer divisions */
+        c1.co = 1;
+        c1.dd = c1.q = 0.0;
+        /* Occ is formed only where the Sin test (s1 < s2) leaves the pop to it */
         if (top >= 1) {
             int a = stack[top - 1];
-            s1 = ss_sin(x[a] - px, y[a] - py, ux, uy, tiny, &len1);
+            c1 = ss_hcand_of((x[a] - px) * sig, (y[a] - py) * sig, wx, wy, tiny2);
         }
         while (top >= 2) { /* l.12-18 */
             int b = stack[top - 2];
-            s2 = ss_sin(x[b] - px, y[b] - py, ux, uy, tiny, &len2);
-            if (!(s1 < s2)) break;
-            if (!have1) o1 = ss_occ_of(f, s1, len1, sc), have1 = 1;
-            o2 = ss_occ_of(f, s2, len2, sc);
-            if (!(ties ? o1 <= o2 : o1 < o2)) break;
+            c2 = ss_hcand_of((x[b] - px) * sig, (y[b] - py) * sig, wx, wy, tiny2);
+            if (!ss_hsin_less(&c1, &c2)) break;
+            if (!have1) ss_hocc(&fs, f, &c1, r2, sc, isig, &o1), have1 = 1;
+            ss_hocc(&fs, f, &c2, r2, sc, isig, &o2);
+            if (!(ties ? o1.num * o2.den <= o2.num * o1.den : o1.num * o2.den < o2.num * o1.den)) break;
             top--;
+            c1 = c2;
             o1 = o2;
-            s1 = s2;
-            len1 = len2;
         }
         if (top == 0) {
             out[i] = se; /* no occluder yet: rho = 0 (docs/errata.md E27) */
-        } else if (se == sc) {
-            out[i] = have1 ? o1 : ss_occ_of(f, s1, len1, sc); /* l.20 */
         } else {
-            int a = stack[top - 1];
-            double s;
-            out[i] = ss_occ(f, x[a] - px, y[a] - py, ux, uy, se, tiny, &s);
+            if (!have1 || se != sc) ss_hocc(&fs, f, &c1, r2, se, isig, &o1); /* l.20 */
+            out[i] = ss_hocc_value(&o1, &c1, se);
         }
-        if (top == 0 || s1 != -HFVIS__INF) stack[top++] = i; /* l.21 (coincident points skipped) */
+        if (top == 0 || !c1.co) stack[top++] = i; /* l.21 (coincident points skipped) */
     }
 }
 
