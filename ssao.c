@@ -1297,7 +1297,7 @@ static inline void ss_hocc(const ss_fall *fs, const ss_fall *f, const ss_hcand *
                            double st, double isig, ss_hocc_t *o)
 {
     double N, D, rl, e;
-    o->num = o->rl = o->N = o->D = 0.0;
+    o->num = 0.0; /* rl, N, D are read only where num > 0 */
     o->den = 1.0;
     if (c->co) return;
     if (fs->kind == HFVIS_FALLOFF_HBAO) {
@@ -1330,16 +1330,17 @@ static inline double ss_hocc_value(const ss_hocc_t *o, const ss_hcand *c, double
     return o->num > 0.0 ? (st * o->rl * (o->D - o->N) + c->dd * o->N) / o->den : st;
 }
 
-/* The largest power of two at most 1/max|coordinate| over the line's finite samples (1 for none). */
-static double ss_line_scale(const double *x, const double *y, int n)
+/* The largest power of two at most 1/max|coordinate| over the line's finite samples (1 for none);
+ * m >= 0: that maximum, known to the caller. */
+static double ss_line_scale(const double *x, const double *y, int n, double m)
 {
-    double m = 0.0;
     int i, e;
-    for (i = 0; i < n; i++) {
-        double a = fabs(x[i]), b = fabs(y[i]);
-        if (a > m && a <= DBL_MAX) m = a;
-        if (b > m && b <= DBL_MAX) m = b;
-    }
+    if (m < 0.0)
+        for (m = 0.0, i = 0; i < n; i++) {
+            double a = fabs(x[i]), b = fabs(y[i]);
+            if (a > m && a <= DBL_MAX) m = a;
+            if (b > m && b <= DBL_MAX) m = b;
+        }
     if (!(m > 0.0)) return 1.0;
     (void)frexp(m, &e); /* m in [2^(e-1), 2^e) */
     return ldexp(1.0, -e);
@@ -1347,18 +1348,18 @@ static double ss_line_scale(const double *x, const double *y, int n)
 
 /* The obscurity hull along one line ([P3] §4.2, Alg. 1). */
 static void ss_hull_line(const double *x, const double *y, const double *stc, const double *ste,
-                         int n, int persp, double fixed, const ss_fall *f, int ties, int *stack,
-                         double *out)
+                         int n, int persp, double fixed, const ss_fall *f, int ties, double amax,
+                         int *stack, double *out)
 {
-    const double sig = ss_line_scale(x, y, n), isig = 1.0 / sig;
+    const double sig = ss_line_scale(x, y, n, amax), isig = 1.0 / sig;
     ss_fall fs = *f; /* in the scaled coordinates: lengths times sig (exact) */
+    ss_hocc_t o1 = {0.0, 1.0, 0.0, 0.0, 0.0}, o2;
     int top = 0, i;
     fs.a *= sig * sig;
     fs.r1c *= sig * sig;
     for (i = 0; i < n; i++) {
         double px = x[i], py = y[i], wx, wy, r2, sc, se, tiny, tiny2;
         ss_hcand c1, c2;
-        ss_hocc_t o1 = {0.0, 1.0, 0.0, 0.0, 0.0}, o2;
         int have1 = 0;
         if (!isfinite(px) || !isfinite(py)) {
             out[i] = HFVIS__NAN;
@@ -1478,8 +1479,8 @@ hfvis_status hfvis_lsao_line(const double *x, const double *y, const double *sin
     if (ss_line_args(x, y, n, orthographic, opts, &o) != HFVIS_OK || (n > 0 && (!stack || !out)))
         return HFVIS_ERR_INVALID_ARGUMENT;
     ss_cfg_from_lsao(&o, &g);
-    ss_hull_line(x, y, sin_t_cull, sin_t_eval, n, !orthographic, g.fixed, &g.fall, g.ties, stack,
-                 out);
+    ss_hull_line(x, y, sin_t_cull, sin_t_eval, n, !orthographic, g.fixed, &g.fall, g.ties, -1.0,
+                 stack, out);
     return HFVIS_OK;
 }
 
@@ -1588,11 +1589,12 @@ static void ss_onto_line(double u0, double v0, double dx, double dy, double *u, 
  * texel (tx0, ty0), the fixed tangent, and the whole line inside the buffer (checked at its two
  * ends; the texels in between lie between them), so no clamps; the depth pointer stepped, the
  * unprojection and the plane coordinates inline with the same arithmetic (the same bits).
- * Returns 0, writing nothing, when the line leaves the buffer. */
+ * Returns 0, writing nothing, when the line leaves the buffer; *amax: the largest |x|, |y|. */
 static int ss_line_points_inside(const ss_cam *c, const ss_cfg *g, const float *depth, int n, int tx0,
                                  int ty0, int sx, int sy, const double e1[3], const double yh[3],
-                                 double *x, double *y, float *zs)
+                                 double *x, double *y, float *zs, double *amax)
 {
+    double m = 0.0;
     const double tlx = (double)tx0 + (double)(n - 1) * (double)sx, tly = (double)ty0 + (double)(n - 1) * (double)sy;
     const double cx = c->cx, cy = c->cy, ifx = c->ifx, ify = c->ify, osx = c->sx, osy = c->sy,
                  far_d = c->far_d, e0 = e1[0], e1y = e1[1], e2 = e1[2], y0 = yh[0], y1 = yh[1],
@@ -1604,7 +1606,7 @@ static int ss_line_points_inside(const ss_cam *c, const ss_cfg *g, const float *
     dp = depth + ss_index(c, tx0, ty0);
     dstep = (ptrdiff_t)sy * c->row_step + sx;
     for (k = 0; k < n; k++, dp += dstep, tx += sx, ty += sy) {
-        double z = (double)*dp, u = (double)tx + 0.5, v = (double)ty + 0.5, q0, q1, q2;
+        double z = (double)*dp, u = (double)tx + 0.5, v = (double)ty + 0.5, q0, q1, q2, xk, yk;
         if (!(z > 0.0 && z < far_d)) { /* ss_bg: background */
             if (zs) zs[k] = (float)HFVIS__NAN;
             x[k] = y[k] = HFVIS__NAN;
@@ -1619,21 +1621,27 @@ static int ss_line_points_inside(const ss_cam *c, const ss_cfg *g, const float *
             q1 = -(v - cy) * osy;
         }
         q2 = -z;
-        x[k] = q0 * e0 + q1 * e1y + q2 * e2;
-        y[k] = exact ? q0 * y0 + q1 * y1 + q2 * y2 : q2;
+        xk = x[k] = q0 * e0 + q1 * e1y + q2 * e2;
+        yk = y[k] = exact ? q0 * y0 + q1 * y1 + q2 * y2 : q2;
+        xk = fabs(xk);
+        yk = fabs(yk);
+        m = xk > m ? xk : m;
+        m = yk > m ? yk : m;
     }
+    *amax = m;
     return 1;
 }
 
 /* The 2D samples of one lattice line: x, y (NaN at holes), real-tangent sines (if wanted),
- * sample depths. */
-static void ss_line_points(const ss_cam *c, const ss_cfg *g, const float *depth,
-                           const float *normals, const hfvis_ssao_lattice *L,
-                           const hfvis_ssao_line *ln, double *x, double *y, double *st_real,
-                           float *zs)
+ * sample depths. Returns the largest |x|, |y| where the common case finds it on the way, else
+ * -1 (ss_hull_line's scale). */
+static double ss_line_points(const ss_cam *c, const ss_cfg *g, const float *depth,
+                             const float *normals, const hfvis_ssao_lattice *L,
+                             const hfvis_ssao_line *ln, double *x, double *y, double *st_real,
+                             float *zs)
 {
     const hfvis_ssao_direction *d = &L->dir;
-    double e1[3], yh[3], ref[3], fx0 = 0.0, fy0 = 0.0;
+    double e1[3], yh[3], ref[3], fx0 = 0.0, fy0 = 0.0, amax = -1.0;
     int bil = g->sampling == HFVIS_SSAO_SAMPLING_BILINEAR, k, tx0 = 0, ty0 = 0;
     int integral = d->step_x == floor(d->step_x) && d->step_y == floor(d->step_y) &&
                    fabs(d->step_x) < 1e9 && fabs(d->step_y) < 1e9;
@@ -1650,8 +1658,8 @@ static void ss_line_points(const ss_cam *c, const ss_cfg *g, const float *depth,
     }
     if (integral && !bil && !st_real && ln->count > 0 &&
         ss_line_points_inside(c, g, depth, ln->count, tx0, ty0, (int)d->step_x, (int)d->step_y, e1, yh,
-                              x, y, zs))
-        return;
+                              x, y, zs, &amax))
+        return amax;
     for (k = 0; k < ln->count; k++) {
         int i = ln->first + k, tx, ty;
         double u = ln->x0 + (double)i * d->step_x, v = ln->y0 + (double)i * d->step_y, qu, qv, z,
@@ -1695,33 +1703,46 @@ static void ss_line_points(const ss_cam *c, const ss_cfg *g, const float *depth,
             st_real[k] = ss_real_sin_t(c, normals, tx, ty, e1, yh, g->exact, ux, uy, 1.0, g->fixed);
         }
     }
+    return amax;
 }
 
-/* Sweep (or brute-force) every line of a direction into values / sample depths.
- * scratch: 4*M doubles (x, y, sin t, out), stack: M ints. */
+/* Sweep (or brute-force) every line of a direction into values / sample depths, sample s at
+ * values[vs s] and sdepth[vs s] (hfvis_lsao interleaves them, vs = 2, so its gather reads one
+ * cache line per sample). scratch: 4*M doubles (x, y, sin t, out), M more floats with vs != 1;
+ * stack: M ints. */
 static void ss_lsao_sweep_dir(const ss_cam *c, const ss_cfg *g, const float *depth,
                               const float *normals, const hfvis_ssao_lattice *L,
                               const hfvis_ssao_line *lines, double *scratch, int *stack,
-                              int naive, float *values, float *sdepth)
+                              int naive, float *values, float *sdepth, size_t vs)
 {
     int M = L->max_line_samples, j, k;
     double *x = scratch, *y = scratch + M, *st = scratch + 2 * (size_t)M,
            *out = scratch + 3 * (size_t)M;
+    float *zs = (float *)(void *)(scratch + 4 * (size_t)M); /* vs != 1: the line's depths */
     int real = g->tangent != HFVIS_SSAO_TANGENT_FIXED;
     for (j = 0; j < L->line_count; j++) {
         const hfvis_ssao_line *ln = &lines[j];
         const double *stc, *ste;
+        double amax;
         if (ln->count < 1) continue;
-        ss_line_points(c, g, depth, normals, L, ln, x, y, real ? st : NULL,
-                       sdepth ? sdepth + ln->offset : NULL);
+        amax = ss_line_points(c, g, depth, normals, L, ln, x, y, real ? st : NULL,
+                              vs != 1 ? zs : sdepth ? sdepth + ln->offset : NULL);
         stc = g->tangent == HFVIS_SSAO_TANGENT_REAL ? st : NULL;
         ste = real ? st : NULL;
         if (naive)
             ss_hull_line_naive(x, y, stc, ste, ln->count, c->persp, g->fixed, &g->fall, out);
         else
-            ss_hull_line(x, y, stc, ste, ln->count, c->persp, g->fixed, &g->fall, g->ties, stack,
-                         out);
-        for (k = 0; k < ln->count; k++) values[ln->offset + (size_t)k] = (float)out[k];
+            ss_hull_line(x, y, stc, ste, ln->count, c->persp, g->fixed, &g->fall, g->ties, amax,
+                         stack, out);
+        if (vs == 1) {
+            for (k = 0; k < ln->count; k++) values[ln->offset + (size_t)k] = (float)out[k];
+        } else {
+            float *vo = values + vs * ln->offset, *zo = sdepth + vs * ln->offset;
+            for (k = 0; k < ln->count; k++) {
+                vo[vs * (size_t)k] = (float)out[k];
+                zo[vs * (size_t)k] = zs[k];
+            }
+        }
     }
 }
 
@@ -1778,7 +1799,7 @@ static hfvis_status ss_lsao_direction(const hfvis_camera *cam, const float *dept
         return HFVIS_ERR_OUT_OF_MEMORY;
     }
     ss_lsao_sweep_dir(&c, &g, depth, normals, lat, lines, (double *)blk,
-                      (int *)((double *)blk + 4 * M), naive, values, sample_depth);
+                      (int *)((double *)blk + 4 * M), naive, values, sample_depth, 1);
     hfvis__free(o.alloc, blk);
     hfvis__free(o.alloc, nrm);
     return HFVIS_OK;
@@ -1801,16 +1822,17 @@ hfvis_status hfvis_lsao_direction_naive(const hfvis_camera *cam, const float *de
     return ss_lsao_direction(cam, depth, normals, opts, lat, lines, values, sample_depth, 1);
 }
 
-/* Is lattice sample (j, i) acceptable for receiver depth zc / normal nc? Writes its value. */
+/* Is lattice sample (j, i) acceptable for receiver depth zc / normal nc? Writes its value.
+ * Sample s is at values[vs s], sdepth[vs s]. */
 static int ss_accept(const ss_cam *c, const ss_cfg *g, const float *normals,
                      const hfvis_ssao_lattice *L, const hfvis_ssao_line *ln, int i,
-                     const float *values, const float *sdepth, double zc, const float *nc,
-                     double *val)
+                     const float *values, const float *sdepth, size_t vs, double zc,
+                     const float *nc, double *val)
 {
     size_t idx;
     double v, zs;
     if (i < ln->first || i >= ln->first + ln->count) return 0;
-    idx = ln->offset + (size_t)(i - ln->first);
+    idx = vs * (ln->offset + (size_t)(i - ln->first));
     v = (double)values[idx];
     zs = (double)sdepth[idx];
     if (v != v || zs != zs) return 0;
@@ -1830,8 +1852,8 @@ static int ss_accept(const ss_cam *c, const ss_cfg *g, const float *normals,
 /* The nearest accepted sample within radius R2 (squared) of (u, v) (docs/errata.md E23). */
 static int ss_fallback(const ss_cam *c, const ss_cfg *g, const float *normals,
                        const hfvis_ssao_lattice *L, const hfvis_ssao_line *lines,
-                       const float *values, const float *sdepth, double u, double v, double zc,
-                       const float *nc, double R, double *val)
+                       const float *values, const float *sdepth, size_t vs, double u, double v,
+                       double zc, const float *nc, double R, double *val)
 {
     const hfvis_ssao_direction *d = &L->dir;
     double jf = (u * L->px + v * L->py - L->s_first) / d->spacing;
@@ -1847,7 +1869,7 @@ static int ss_fallback(const ss_cam *c, const ss_cfg *g, const float *normals,
             double su = ln->x0 + (double)i * d->step_x - u, sv = ln->y0 + (double)i * d->step_y - v;
             double dd = su * su + sv * sv, vv;
             if (dd > best || (found && dd == best)) continue;
-            if (!ss_accept(c, g, normals, L, ln, i, values, sdepth, zc, nc, &vv)) continue;
+            if (!ss_accept(c, g, normals, L, ln, i, values, sdepth, vs, zc, nc, &vv)) continue;
             best = dd;
             bv = vv;
             found = 1;
@@ -1866,17 +1888,19 @@ typedef struct ss_gdir {
     const hfvis_ssao_lattice *L;
     const hfvis_ssao_line *lines;
     const float *values, *sdepth;
+    size_t vs; /* sample s at values[vs s], sdepth[vs s] */
     double w, ids, idl, R2, px, py, s_first, ddx, ddy, t_min, jmax;
 } ss_gdir;
 
 static void ss_gdir_set(ss_gdir *G, const hfvis_ssao_lattice *L, const hfvis_ssao_line *lines,
-                        const float *values, const float *sdepth)
+                        const float *values, const float *sdepth, size_t vs)
 {
     const hfvis_ssao_direction *d = &L->dir;
     G->L = L;
     G->lines = lines;
     G->values = values;
     G->sdepth = sdepth;
+    G->vs = vs;
     G->w = d->weight;
     G->ids = 1.0 / d->step;
     G->idl = 1.0 / d->spacing;
@@ -1898,6 +1922,7 @@ static inline int ss_gather_at(const ss_cam *c, const ss_cfg *g, const float *no
     const hfvis_ssao_lattice *L = G->L;
     const hfvis_ssao_line *lines = G->lines;
     const float *values = G->values, *sdepth = G->sdepth;
+    const size_t vstr = G->vs;
     double jf = (u * G->px + v * G->py - G->s_first) * G->idl, tf = (u * G->ddx + v * G->ddy - G->t_min) * G->ids;
     int ok = 0, nlines = L->line_count;
     *val = 0.0;
@@ -1910,16 +1935,16 @@ static inline int ss_gather_at(const ss_cam *c, const ss_cfg *g, const float *no
             i = (int)(tf + 0.5);
             ln = &lines[j];
             if (i >= ln->first && i < ln->first + ln->count) {
-                size_t idx = ln->offset + (size_t)(i - ln->first);
+                size_t idx = vstr * (ln->offset + (size_t)(i - ln->first));
                 double zs = (double)sdepth[idx];
                 *val = (double)values[idx];
                 ok = *val == *val && zs == zs && (g->rej_z < 0.0 || fabs(zs - zc) <= g->rej_z * zc);
-                if (ok && nc) ok = ss_accept(c, g, normals, L, ln, i, values, sdepth, zc, nc, val);
+                if (ok && nc) ok = ss_accept(c, g, normals, L, ln, i, values, sdepth, vstr, zc, nc, val);
                 goto have;
             }
         }
         if (ss_nearest(L, lines, u, v, &j, &i))
-            ok = ss_accept(c, g, normals, L, &lines[j], i, values, sdepth, zc, nc, val);
+            ok = ss_accept(c, g, normals, L, &lines[j], i, values, sdepth, vstr, zc, nc, val);
     } else {
         double fj = floor(jf), fi = floor(tf), aj = jf - fj, ai = tf - fi, ws = 0.0, vs = 0.0;
         int dj, di;
@@ -1928,7 +1953,7 @@ static inline int ss_gather_at(const ss_cam *c, const ss_cfg *g, const float *no
                 double wt = (dj ? aj : 1.0 - aj) * (di ? ai : 1.0 - ai), vv;
                 double jj = fj + (double)dj, ii = fi + (double)di;
                 if (!(wt > 0.0) || jj < 0.0 || jj >= (double)nlines) continue;
-                if (!ss_accept(c, g, normals, L, &lines[(int)jj], (int)ii, values, sdepth, zc, nc, &vv))
+                if (!ss_accept(c, g, normals, L, &lines[(int)jj], (int)ii, values, sdepth, vstr, zc, nc, &vv))
                     continue;
                 ws += wt;
                 vs += wt * vv;
@@ -1939,7 +1964,7 @@ static inline int ss_gather_at(const ss_cam *c, const ss_cfg *g, const float *no
         }
     }
 have:
-    if (!ok) ok = ss_fallback(c, g, normals, L, lines, values, sdepth, u, v, zc, nc, G->R2, val);
+    if (!ok) ok = ss_fallback(c, g, normals, L, lines, values, sdepth, vstr, u, v, zc, nc, G->R2, val);
     return ok;
 }
 
@@ -1989,7 +2014,7 @@ hfvis_status hfvis_lsao_gather(const hfvis_camera *cam, const float *depth, cons
         !isfinite(lat->dir.weight))
         return HFVIS_ERR_INVALID_ARGUMENT;
     ss_cfg_from_lsao(&o, &g);
-    ss_gdir_set(&G, lat, lines, values, sample_depth);
+    ss_gdir_set(&G, lat, lines, values, sample_depth, 1);
     ss_gather_dirs(&c, &g, depth, normals, &G, 1, sum, weight);
     return HFVIS_OK;
 }
@@ -2057,7 +2082,7 @@ hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth, const float
     if (!b || !(lines = (hfvis_ssao_line *)hfvis__alloc(o.alloc, b))) goto done;
     b = ss_bytes3(ms, 2 * SS_GATHER_GROUP, sizeof(float));
     if (!b || !(vals = (float *)hfvis__alloc(o.alloc, b))) goto done;
-    b = ss_bytes3((size_t)(maxm > 0 ? maxm : 1), 1, 4 * sizeof(double) + sizeof(int));
+    b = ss_bytes3((size_t)(maxm > 0 ? maxm : 1), 1, 5 * sizeof(double) + sizeof(int));
     if (!b || !(scratch = (double *)hfvis__alloc(o.alloc, b))) goto done;
     b = ss_bytes3(npix, 2, sizeof(double));
     if (!b || !(acc = (double *)hfvis__alloc(o.alloc, b))) goto done;
@@ -2070,8 +2095,8 @@ hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth, const float
             ss_lattice_init(&c, &dirs[k0 + k], &glat[k]);
             ss_lattice_fill(&c, &glat[k], lk);
             ss_lsao_sweep_dir(&c, &g, depth, nrm ? nrm : normals, &glat[k], lk, scratch,
-                              (int *)(scratch + 4 * (size_t)(maxm > 0 ? maxm : 1)), 0, vk, vk + ms);
-            ss_gdir_set(&G[k], &glat[k], lk, vk, vk + ms);
+                              (int *)(scratch + 5 * (size_t)(maxm > 0 ? maxm : 1)), 0, vk, vk + 1, 2);
+            ss_gdir_set(&G[k], &glat[k], lk, vk, vk + 1, 2);
         }
         ss_gather_dirs(&c, &g, depth, normals, G, nd, acc, acc + npix);
     }
