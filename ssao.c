@@ -1977,7 +1977,11 @@ static void ss_gather_dirs(const ss_cam *c, const ss_cfg *g, const float *depth,
                            const float *normals, const ss_gdir *G, int nd, double *sum, double *wsum)
 {
     int W = c->W - 2 * c->gx, x, y, k;
-    const double far_d = c->far_d;
+    const double far_d = c->far_d, rej_z = g->rej_z;
+    /* ss_gather_at's first case inline, with the constants in locals (its store to *val may
+     * alias them): NEAREST without normals, the rounded sample inside its line and accepted by
+     * the depth test; everything else (the same value where this case accepts) through it */
+    const int inline_nearest = g->gather == HFVIS_SSAO_GATHER_NEAREST && !normals;
     for (y = c->gy; y < c->H - c->gy; y++) {
         double v = (double)y + 0.5;
         const float *drow = depth + ss_index(c, 0, y);
@@ -1989,10 +1993,30 @@ static void ss_gather_dirs(const ss_cam *c, const ss_cfg *g, const float *depth,
             s = sum[orow + (size_t)x];
             ws = wsum[orow + (size_t)x];
             for (k = 0; k < nd; k++) {
+                const ss_gdir *Gk = &G[k];
                 double val;
-                if (G[k].L->line_count < 1 || !ss_gather_at(c, g, normals, &G[k], u, v, zc, nc, &val)) continue;
-                s += G[k].w * val;
-                ws += G[k].w;
+                if (Gk->L->line_count < 1) continue;
+                if (inline_nearest) {
+                    double jf = (u * Gk->px + v * Gk->py - Gk->s_first) * Gk->idl,
+                           tf = (u * Gk->ddx + v * Gk->ddy - Gk->t_min) * Gk->ids;
+                    if (jf > -0.5 && jf < Gk->jmax && tf > -0.5 && tf < 2147483647.0) {
+                        const hfvis_ssao_line *ln = &Gk->lines[(int)(jf + 0.5)];
+                        int i = (int)(tf + 0.5);
+                        if (i >= ln->first && i < ln->first + ln->count) {
+                            size_t idx = Gk->vs * (ln->offset + (size_t)(i - ln->first));
+                            double zs = (double)Gk->sdepth[idx];
+                            val = (double)Gk->values[idx];
+                            if (val == val && zs == zs && (rej_z < 0.0 || fabs(zs - zc) <= rej_z * zc)) {
+                                s += Gk->w * val;
+                                ws += Gk->w;
+                                continue;
+                            }
+                        }
+                    }
+                }
+                if (!ss_gather_at(c, g, normals, Gk, u, v, zc, nc, &val)) continue;
+                s += Gk->w * val;
+                ws += Gk->w;
             }
             sum[orow + (size_t)x] = s;
             wsum[orow + (size_t)x] = ws;
