@@ -1346,17 +1346,19 @@ static double ss_line_scale(const double *x, const double *y, int n, double m)
     return ldexp(1.0, -e);
 }
 
-/* The obscurity hull along one line ([P3] §4.2, Alg. 1). */
-static void ss_hull_line(const double *x, const double *y, const double *stc, const double *ste,
-                         int n, int persp, double fixed, const ss_fall *f, int ties, double amax,
-                         int *stack, double *out)
+/* The obscurity hull along one line ([P3] §4.2, Alg. 1): coordinates times sig as they are
+ * read (1 where the caller scaled them), the falloff's lengths times fsig (the scale). */
+static HFVIS__ALWAYS_INLINE void ss_hull_body(const double *x, const double *y, const double *stc,
+                                              const double *ste, int n, int persp, double fixed,
+                                              const ss_fall *f, int ties, double sig, double fsig,
+                                              int *stack, double *out)
 {
-    const double sig = ss_line_scale(x, y, n, amax), isig = 1.0 / sig;
-    ss_fall fs = *f; /* in the scaled coordinates: lengths times sig (exact) */
+    const double isig = 1.0 / fsig;
+    ss_fall fs = *f; /* in the scaled coordinates: lengths times fsig (exact) */
     ss_hocc_t o1 = {0.0, 1.0, 0.0, 0.0, 0.0}, o2;
     int top = 0, i;
-    fs.a *= sig * sig;
-    fs.r1c *= sig * sig;
+    fs.a *= fsig * fsig;
+    fs.r1c *= fsig * fsig;
     for (i = 0; i < n; i++) {
         double px = x[i], py = y[i], wx, wy, r2, sc, se, tiny, tiny2;
         ss_hcand c1, c2;
@@ -1408,6 +1410,30 @@ static void ss_hull_line(const double *x, const double *y, const double *stc, co
         }
         if (top == 0 || !c1.co) stack[top++] = i; /* l.21 (coincident points skipped) */
     }
+}
+
+/* The hull of a caller's line (hfvis_lsao_line): amax the largest |x|, |y| or -1 to scan. */
+static void ss_hull_line(const double *x, const double *y, const double *stc, const double *ste,
+                         int n, int persp, double fixed, const ss_fall *f, int ties, double amax,
+                         int *stack, double *out)
+{
+    const double sig = ss_line_scale(x, y, n, amax);
+    ss_hull_body(x, y, stc, ste, n, persp, fixed, f, ties, sig, sig, stack, out);
+}
+
+/* The hull of the sweep's own line: x, y scaled in place first (a power of two: the same bits as
+ * scaling each difference), so the hull multiplies nothing as it reads them. */
+static void ss_hull_line_scratch(double *x, double *y, const double *stc, const double *ste, int n,
+                                 int persp, double fixed, const ss_fall *f, int ties, double amax,
+                                 int *stack, double *out)
+{
+    const double sig = ss_line_scale(x, y, n, amax);
+    int i;
+    for (i = 0; i < n; i++) {
+        x[i] *= sig;
+        y[i] *= sig;
+    }
+    ss_hull_body(x, y, stc, ste, n, persp, fixed, f, ties, 1.0, sig, stack, out);
 }
 
 /* Brute-force oracle ([P3] Fig. 7). */
@@ -1732,8 +1758,8 @@ static void ss_lsao_sweep_dir(const ss_cam *c, const ss_cfg *g, const float *dep
         if (naive)
             ss_hull_line_naive(x, y, stc, ste, ln->count, c->persp, g->fixed, &g->fall, out);
         else
-            ss_hull_line(x, y, stc, ste, ln->count, c->persp, g->fixed, &g->fall, g->ties, amax,
-                         stack, out);
+            ss_hull_line_scratch(x, y, stc, ste, ln->count, c->persp, g->fixed, &g->fall, g->ties,
+                                 amax, stack, out);
         if (vs == 1) {
             for (k = 0; k < ln->count; k++) values[ln->offset + (size_t)k] = (float)out[k];
         } else {
