@@ -8,9 +8,9 @@
  *   3. Falloff functions ([P3] Eq. 2-3; docs/errata.md C4)
  *   4. The azimuthal line plane, uniform and box-pattern directions, the line lattice
  *      ([P3] §5.1-5.2, [P4] §6; docs/errata.md E20, E21, E24)
- *   5. P3 line-sweep AO: the obscurity hull along one line ([P3] §4, Alg. 1) and its brute-force
- *      oracle ([P3] Fig. 7), the sweep of one direction, the per-pixel gather ([P3] §5.1), the
- *      driver ([P3] §4-5)
+ *   5. P3 line-sweep AO: the obscurity hull along one line ([P3] §4, Alg. 1; its order tests
+ *      cross-multiplied, without roots or divisions) and its brute-force oracle ([P3] Fig. 7),
+ *      the sweep of one direction, the per-pixel gather ([P3] §5.1), the driver ([P3] §4-5)
  *   6. HBAO in three variants (Bavoil, Sainz, Dimitrov 2008, as the thesis describes it; [T14] §4.1, [P4] §8; docs/errata.md E25)
  *   7. The screen-space ray-traced reference ([P4] §8; docs/errata.md E36)
  *   8. Analytic depth buffers

@@ -709,8 +709,9 @@ TEST(lsao_line_random_profiles)
 }
 
 /* Sweep of whole depth buffers against the per-receiver brute force over the same line samples:
- * bit-identical in exact mode (falloff NONE) for every sampling, plane, tangent, pattern and
- * projection; with a falloff the T2 statistics. */
+ * equal in exact mode (falloff NONE: float values; the hull is within rounding of the oracle)
+ * for every sampling, plane, tangent, pattern and projection; with a falloff the T2
+ * statistics. */
 TEST(lsao_direction_vs_oracle)
 {
     enum { W = 61, H = 47, ST = 64 };
