@@ -8,9 +8,9 @@
  *   3. Falloff functions ([P3] Eq. 2-3; docs/errata.md C4)
  *   4. The azimuthal line plane, uniform and box-pattern directions, the line lattice
  *      ([P3] §5.1-5.2, [P4] §6; docs/errata.md E20, E21, E24)
- *   5. P3 line-sweep AO: the obscurity hull along one line ([P3] §4, Alg. 1) and its brute-force
- *      oracle ([P3] Fig. 7), the sweep of one direction, the per-pixel gather ([P3] §5.1), the
- *      driver ([P3] §4-5)
+ *   5. P3 line-sweep AO: the obscurity hull along one line ([P3] §4, Alg. 1; its order tests
+ *      cross-multiplied, without roots or divisions) and its brute-force oracle ([P3] Fig. 7),
+ *      the sweep of one direction, the per-pixel gather ([P3] §5.1), the driver ([P3] §4-5)
  *   6. HBAO in three variants (Bavoil, Sainz, Dimitrov 2008, as the thesis describes it; [T14] §4.1, [P4] §8; docs/errata.md E25)
  *   7. The screen-space ray-traced reference ([P4] §8; docs/errata.md E36)
  *   8. Analytic depth buffers
@@ -1243,88 +1243,197 @@ static void ss_cfg_from_lsao(const hfvis_lsao_options *o, ss_cfg *g)
     g->rej_n = o->reject_normal;
 }
 
-/* In two steps, for the hull, which needs Occ only where Sin decides nothing: ss_sin gives
- * Sin(h) and |h| (-inf for a coincident point), ss_occ_of the Occ from them (st for s = -inf). */
-static inline double ss_sin(double hx, double hy, double ux, double uy, double tiny, double *len_out)
-{
-    double len = sqrt(hx * hx + hy * hy);
-    *len_out = len;
-    if (!(len > tiny)) return -HFVIS__INF;
-    return (hx * ux + hy * uy) / len;
-}
-
-static inline double ss_occ_of(const ss_fall *f, double s, double len, double st)
-{
-    return s > st ? st + (s - st) * ss_rho(f, len) : st;
-}
-
 /* Occ of point (hx, hy) = occluder - receiver seen along zenith (ux, uy) with tangent st
- * ([P3] Alg. 1 l.25-29); *sin_out = Sin(h) (-inf for a coincident point, which casts st). */
+ * ([P3] Alg. 1 l.25-29) as the paper writes it (the oracle's arithmetic); *sin_out = Sin(h)
+ * (-inf for a coincident point, which casts st). */
 static inline double ss_occ(const ss_fall *f, double hx, double hy, double ux, double uy, double st,
                             double tiny, double *sin_out)
 {
-    double len;
-    *sin_out = ss_sin(hx, hy, ux, uy, tiny, &len);
-    return ss_occ_of(f, *sin_out, len, st);
+    double len = sqrt(hx * hx + hy * hy), s;
+    s = len > tiny ? (hx * ux + hy * uy) / len : -HFVIS__INF;
+    *sin_out = s;
+    return s > st ? st + (s - st) * ss_rho(f, len) : st;
 }
 
-/* The obscurity hull along one line ([P3] §4.2, Alg. 1). */
-static void ss_hull_line(const double *x, const double *y, const double *stc, const double *ste,
-                         int n, int persp, double fixed, const ss_fall *f, int ties, int *stack,
-                         double *out)
+/* The hull's arithmetic without square roots and divisions on its path ([P3] Alg. 1 as the
+ * oracle below computes it, rearranged). For a receiver p with unnormalised zenith w (-p in
+ * perspective, |w| = r; (0, 1) and r = 1 orthographic) and a candidate h = occluder - p:
+ * dd = h.w = r |h| Sin(h) and q = |h|^2. Sin order: s1 < s2 iff dd1 |dd1| q2 < dd2 |dd2| q1
+ * (x |x| is monotone; q > 0). Occ - st = num / den with num = max(0, dd - st r |h|) N and
+ * den = r |h| D (r |h| = sqrt(r^2 q), one root), where rho = N / D (HBAO: N = r(1+C) - C D,
+ * D = r + q; inverse quadratic: N = r, D = r + q; none: 1, 1; the other kinds rho(|h|), 1), so
+ * Occ order is the cross-multiplied num1 den2 against num2 den1, the root is taken only inside
+ * the falloff's support, and each receiver divides once, for its output
+ * Occ = (st r |h| (D - N) + dd N) / den (exactly 0 for Sin = 0 without a falloff, as the
+ * oracle's st + (0 - st) 1). Coordinates are scaled by a power of two per
+ * line (exact) so the fourth-degree products neither overflow nor underflow. */
+typedef struct ss_hcand {
+    double dd, q;  /* h.w, |h|^2 (scaled) */
+    int co;        /* coincident with the receiver: Sin = -inf, Occ = st */
+} ss_hcand;
+
+static inline ss_hcand ss_hcand_of(double hx, double hy, double wx, double wy, double tiny2)
 {
+    ss_hcand c;
+    c.dd = hx * wx + hy * wy;
+    c.q = hx * hx + hy * hy;
+    c.co = !(c.q > tiny2);
+    return c;
+}
+
+static inline int ss_hsin_less(const ss_hcand *a, const ss_hcand *b)
+{
+    if (b->co) return 0;
+    if (a->co) return 1;
+    return a->dd * fabs(a->dd) * b->q < b->dd * fabs(b->dd) * a->q;
+}
+
+/* Occ - st = o->num / o->den of candidate c for tangent st (r2 = r^2), num = 0 for Occ = st;
+ * fs is the falloff scaled to the line's coordinates, f the caller's (for the kinds without a
+ * rational form), isig 1/scale. */
+typedef struct ss_hocc_t { double num, den, rl, N, D; } ss_hocc_t;
+
+static inline void ss_hocc(const ss_fall *fs, const ss_fall *f, const ss_hcand *c, double r2,
+                           double st, double isig, ss_hocc_t *o)
+{
+    double N, D, rl, e;
+    o->num = 0.0; /* rl, N, D are read only where num > 0 */
+    o->den = 1.0;
+    if (c->co) return;
+    if (fs->kind == HFVIS_FALLOFF_HBAO) {
+        D = fs->a + c->q;
+        N = fs->r1c - fs->c * D;
+        if (!(N > 0.0)) return; /* beyond the support: Occ = st */
+    } else if (fs->kind == HFVIS_FALLOFF_INV_QUADRATIC) {
+        D = fs->a + c->q;
+        N = fs->a;
+    } else if (fs->kind == HFVIS_FALLOFF_NONE) {
+        D = N = 1.0;
+    } else {
+        D = 1.0;
+        N = ss_rho_general(f, sqrt(c->q) * isig);
+        if (!(N > 0.0)) return;
+    }
+    rl = sqrt(r2 * c->q);
+    e = c->dd - st * rl;
+    if (!(e > 0.0)) return; /* Sin <= st: Occ = st */
+    o->num = e * N;
+    o->den = rl * D;
+    o->rl = rl;
+    o->N = N;
+    o->D = D;
+}
+
+/* Occ of an evaluated candidate (ss_hocc) for its tangent st. */
+static inline double ss_hocc_value(const ss_hocc_t *o, const ss_hcand *c, double st)
+{
+    return o->num > 0.0 ? (st * o->rl * (o->D - o->N) + c->dd * o->N) / o->den : st;
+}
+
+/* The largest power of two at most 1/max|coordinate| over the line's finite samples (1 for none);
+ * m >= 0: that maximum, known to the caller. */
+static double ss_line_scale(const double *x, const double *y, int n, double m)
+{
+    int i, e;
+    if (m < 0.0)
+        for (m = 0.0, i = 0; i < n; i++) {
+            double a = fabs(x[i]), b = fabs(y[i]);
+            if (a > m && a <= DBL_MAX) m = a;
+            if (b > m && b <= DBL_MAX) m = b;
+        }
+    if (!(m > 0.0)) return 1.0;
+    (void)frexp(m, &e); /* m in [2^(e-1), 2^e) */
+    return ldexp(1.0, -e);
+}
+
+/* The obscurity hull along one line ([P3] §4.2, Alg. 1): coordinates times sig as they are
+ * read (1 where the caller scaled them), the falloff's lengths times fsig (the scale). */
+static HFVIS__ALWAYS_INLINE void ss_hull_body(const double *x, const double *y, const double *stc,
+                                              const double *ste, int n, int persp, double fixed,
+                                              const ss_fall *f, int ties, double sig, double fsig,
+                                              int *stack, double *out)
+{
+    const double isig = 1.0 / fsig;
+    ss_fall fs = *f; /* in the scaled coordinates: lengths times fsig (exact) */
+    ss_hocc_t o1 = {0.0, 1.0, 0.0, 0.0, 0.0}, o2;
     int top = 0, i;
+    fs.a *= fsig * fsig;
+    fs.r1c *= fsig * fsig;
     for (i = 0; i < n; i++) {
-        double px = x[i], py = y[i], r, ux, uy, sc, se, tiny, o1 = 0.0, s1 = 0.0, o2, s2, len1 = 0.0, len2;
+        double px = x[i], py = y[i], wx, wy, r2, sc, se, tiny, tiny2;
+        ss_hcand c1, c2;
         int have1 = 0;
         if (!isfinite(px) || !isfinite(py)) {
             out[i] = HFVIS__NAN;
             continue;
         }
-        r = sqrt(px * px + py * py);
         if (persp) {
-            if (!(r > 0.0)) {
+            wx = -px * sig; /* l.7: towards the camera, unnormalised */
+            wy = -py * sig;
+            r2 = wx * wx + wy * wy;
+            if (!(r2 > 0.0)) {
                 out[i] = HFVIS__NAN;
                 continue;
             }
-            ux = -px / r; /* l.7: unit vector towards the camera */
-            uy = -py / r;
         } else {
-            ux = 0.0;
-            uy = 1.0;
+            wx = 0.0;
+            wy = 1.0;
+            r2 = 1.0;
         }
-        tiny = SS_COINCIDENT * (fabs(px) + fabs(py));
+        tiny = SS_COINCIDENT * (fabs(px) + fabs(py)) * sig;
+        tiny2 = tiny * tiny;
         sc = stc ? stc[i] : fixed;
         se = ste ? ste[i] : fixed;
-        /* Occ (o1, o2) is formed only where the Sin test (s1 < s2) leaves the pop to it: the same
-         * values and decisions as evaluating both tests (no side effects), fewer divisions */
+        c1.co = 1;
+        c1.dd = c1.q = 0.0;
+        /* Occ is formed only where the Sin test (s1 < s2) leaves the pop to it */
         if (top >= 1) {
             int a = stack[top - 1];
-            s1 = ss_sin(x[a] - px, y[a] - py, ux, uy, tiny, &len1);
+            c1 = ss_hcand_of((x[a] - px) * sig, (y[a] - py) * sig, wx, wy, tiny2);
         }
         while (top >= 2) { /* l.12-18 */
             int b = stack[top - 2];
-            s2 = ss_sin(x[b] - px, y[b] - py, ux, uy, tiny, &len2);
-            if (!(s1 < s2)) break;
-            if (!have1) o1 = ss_occ_of(f, s1, len1, sc), have1 = 1;
-            o2 = ss_occ_of(f, s2, len2, sc);
-            if (!(ties ? o1 <= o2 : o1 < o2)) break;
+            c2 = ss_hcand_of((x[b] - px) * sig, (y[b] - py) * sig, wx, wy, tiny2);
+            if (!ss_hsin_less(&c1, &c2)) break;
+            if (!have1) ss_hocc(&fs, f, &c1, r2, sc, isig, &o1), have1 = 1;
+            ss_hocc(&fs, f, &c2, r2, sc, isig, &o2);
+            if (!(ties ? o1.num * o2.den <= o2.num * o1.den : o1.num * o2.den < o2.num * o1.den)) break;
             top--;
+            c1 = c2;
             o1 = o2;
-            s1 = s2;
-            len1 = len2;
         }
         if (top == 0) {
             out[i] = se; /* no occluder yet: rho = 0 (docs/errata.md E27) */
-        } else if (se == sc) {
-            out[i] = have1 ? o1 : ss_occ_of(f, s1, len1, sc); /* l.20 */
         } else {
-            int a = stack[top - 1];
-            double s;
-            out[i] = ss_occ(f, x[a] - px, y[a] - py, ux, uy, se, tiny, &s);
+            if (!have1 || se != sc) ss_hocc(&fs, f, &c1, r2, se, isig, &o1); /* l.20 */
+            out[i] = ss_hocc_value(&o1, &c1, se);
         }
-        if (top == 0 || s1 != -HFVIS__INF) stack[top++] = i; /* l.21 (coincident points skipped) */
+        if (top == 0 || !c1.co) stack[top++] = i; /* l.21 (coincident points skipped) */
     }
+}
+
+/* The hull of a caller's line (hfvis_lsao_line): amax the largest |x|, |y| or -1 to scan. */
+static void ss_hull_line(const double *x, const double *y, const double *stc, const double *ste,
+                         int n, int persp, double fixed, const ss_fall *f, int ties, double amax,
+                         int *stack, double *out)
+{
+    const double sig = ss_line_scale(x, y, n, amax);
+    ss_hull_body(x, y, stc, ste, n, persp, fixed, f, ties, sig, sig, stack, out);
+}
+
+/* The hull of the sweep's own line: x, y scaled in place first (a power of two: the same bits as
+ * scaling each difference), so the hull multiplies nothing as it reads them. */
+static void ss_hull_line_scratch(double *x, double *y, const double *stc, const double *ste, int n,
+                                 int persp, double fixed, const ss_fall *f, int ties, double amax,
+                                 int *stack, double *out)
+{
+    const double sig = ss_line_scale(x, y, n, amax);
+    int i;
+    for (i = 0; i < n; i++) {
+        x[i] *= sig;
+        y[i] *= sig;
+    }
+    ss_hull_body(x, y, stc, ste, n, persp, fixed, f, ties, 1.0, sig, stack, out);
 }
 
 /* Brute-force oracle ([P3] Fig. 7). */
@@ -1396,8 +1505,8 @@ hfvis_status hfvis_lsao_line(const double *x, const double *y, const double *sin
     if (ss_line_args(x, y, n, orthographic, opts, &o) != HFVIS_OK || (n > 0 && (!stack || !out)))
         return HFVIS_ERR_INVALID_ARGUMENT;
     ss_cfg_from_lsao(&o, &g);
-    ss_hull_line(x, y, sin_t_cull, sin_t_eval, n, !orthographic, g.fixed, &g.fall, g.ties, stack,
-                 out);
+    ss_hull_line(x, y, sin_t_cull, sin_t_eval, n, !orthographic, g.fixed, &g.fall, g.ties, -1.0,
+                 stack, out);
     return HFVIS_OK;
 }
 
@@ -1506,11 +1615,12 @@ static void ss_onto_line(double u0, double v0, double dx, double dy, double *u, 
  * texel (tx0, ty0), the fixed tangent, and the whole line inside the buffer (checked at its two
  * ends; the texels in between lie between them), so no clamps; the depth pointer stepped, the
  * unprojection and the plane coordinates inline with the same arithmetic (the same bits).
- * Returns 0, writing nothing, when the line leaves the buffer. */
+ * Returns 0, writing nothing, when the line leaves the buffer; *amax: the largest |x|, |y|. */
 static int ss_line_points_inside(const ss_cam *c, const ss_cfg *g, const float *depth, int n, int tx0,
                                  int ty0, int sx, int sy, const double e1[3], const double yh[3],
-                                 double *x, double *y, float *zs)
+                                 double *x, double *y, float *zs, double *amax)
 {
+    double m = 0.0;
     const double tlx = (double)tx0 + (double)(n - 1) * (double)sx, tly = (double)ty0 + (double)(n - 1) * (double)sy;
     const double cx = c->cx, cy = c->cy, ifx = c->ifx, ify = c->ify, osx = c->sx, osy = c->sy,
                  far_d = c->far_d, e0 = e1[0], e1y = e1[1], e2 = e1[2], y0 = yh[0], y1 = yh[1],
@@ -1522,7 +1632,7 @@ static int ss_line_points_inside(const ss_cam *c, const ss_cfg *g, const float *
     dp = depth + ss_index(c, tx0, ty0);
     dstep = (ptrdiff_t)sy * c->row_step + sx;
     for (k = 0; k < n; k++, dp += dstep, tx += sx, ty += sy) {
-        double z = (double)*dp, u = (double)tx + 0.5, v = (double)ty + 0.5, q0, q1, q2;
+        double z = (double)*dp, u = (double)tx + 0.5, v = (double)ty + 0.5, q0, q1, q2, xk, yk;
         if (!(z > 0.0 && z < far_d)) { /* ss_bg: background */
             if (zs) zs[k] = (float)HFVIS__NAN;
             x[k] = y[k] = HFVIS__NAN;
@@ -1537,21 +1647,27 @@ static int ss_line_points_inside(const ss_cam *c, const ss_cfg *g, const float *
             q1 = -(v - cy) * osy;
         }
         q2 = -z;
-        x[k] = q0 * e0 + q1 * e1y + q2 * e2;
-        y[k] = exact ? q0 * y0 + q1 * y1 + q2 * y2 : q2;
+        xk = x[k] = q0 * e0 + q1 * e1y + q2 * e2;
+        yk = y[k] = exact ? q0 * y0 + q1 * y1 + q2 * y2 : q2;
+        xk = fabs(xk);
+        yk = fabs(yk);
+        m = xk > m ? xk : m;
+        m = yk > m ? yk : m;
     }
+    *amax = m;
     return 1;
 }
 
 /* The 2D samples of one lattice line: x, y (NaN at holes), real-tangent sines (if wanted),
- * sample depths. */
-static void ss_line_points(const ss_cam *c, const ss_cfg *g, const float *depth,
-                           const float *normals, const hfvis_ssao_lattice *L,
-                           const hfvis_ssao_line *ln, double *x, double *y, double *st_real,
-                           float *zs)
+ * sample depths. Returns the largest |x|, |y| where the common case finds it on the way, else
+ * -1 (ss_hull_line's scale). */
+static double ss_line_points(const ss_cam *c, const ss_cfg *g, const float *depth,
+                             const float *normals, const hfvis_ssao_lattice *L,
+                             const hfvis_ssao_line *ln, double *x, double *y, double *st_real,
+                             float *zs)
 {
     const hfvis_ssao_direction *d = &L->dir;
-    double e1[3], yh[3], ref[3], fx0 = 0.0, fy0 = 0.0;
+    double e1[3], yh[3], ref[3], fx0 = 0.0, fy0 = 0.0, amax = -1.0;
     int bil = g->sampling == HFVIS_SSAO_SAMPLING_BILINEAR, k, tx0 = 0, ty0 = 0;
     int integral = d->step_x == floor(d->step_x) && d->step_y == floor(d->step_y) &&
                    fabs(d->step_x) < 1e9 && fabs(d->step_y) < 1e9;
@@ -1568,8 +1684,8 @@ static void ss_line_points(const ss_cam *c, const ss_cfg *g, const float *depth,
     }
     if (integral && !bil && !st_real && ln->count > 0 &&
         ss_line_points_inside(c, g, depth, ln->count, tx0, ty0, (int)d->step_x, (int)d->step_y, e1, yh,
-                              x, y, zs))
-        return;
+                              x, y, zs, &amax))
+        return amax;
     for (k = 0; k < ln->count; k++) {
         int i = ln->first + k, tx, ty;
         double u = ln->x0 + (double)i * d->step_x, v = ln->y0 + (double)i * d->step_y, qu, qv, z,
@@ -1613,33 +1729,46 @@ static void ss_line_points(const ss_cam *c, const ss_cfg *g, const float *depth,
             st_real[k] = ss_real_sin_t(c, normals, tx, ty, e1, yh, g->exact, ux, uy, 1.0, g->fixed);
         }
     }
+    return amax;
 }
 
-/* Sweep (or brute-force) every line of a direction into values / sample depths.
- * scratch: 4*M doubles (x, y, sin t, out), stack: M ints. */
+/* Sweep (or brute-force) every line of a direction into values / sample depths, sample s at
+ * values[vs s] and sdepth[vs s] (hfvis_lsao interleaves them, vs = 2, so its gather reads one
+ * cache line per sample). scratch: 4*M doubles (x, y, sin t, out), M more floats with vs != 1;
+ * stack: M ints. */
 static void ss_lsao_sweep_dir(const ss_cam *c, const ss_cfg *g, const float *depth,
                               const float *normals, const hfvis_ssao_lattice *L,
                               const hfvis_ssao_line *lines, double *scratch, int *stack,
-                              int naive, float *values, float *sdepth)
+                              int naive, float *values, float *sdepth, size_t vs)
 {
     int M = L->max_line_samples, j, k;
     double *x = scratch, *y = scratch + M, *st = scratch + 2 * (size_t)M,
            *out = scratch + 3 * (size_t)M;
+    float *zs = (float *)(void *)(scratch + 4 * (size_t)M); /* vs != 1: the line's depths */
     int real = g->tangent != HFVIS_SSAO_TANGENT_FIXED;
     for (j = 0; j < L->line_count; j++) {
         const hfvis_ssao_line *ln = &lines[j];
         const double *stc, *ste;
+        double amax;
         if (ln->count < 1) continue;
-        ss_line_points(c, g, depth, normals, L, ln, x, y, real ? st : NULL,
-                       sdepth ? sdepth + ln->offset : NULL);
+        amax = ss_line_points(c, g, depth, normals, L, ln, x, y, real ? st : NULL,
+                              vs != 1 ? zs : sdepth ? sdepth + ln->offset : NULL);
         stc = g->tangent == HFVIS_SSAO_TANGENT_REAL ? st : NULL;
         ste = real ? st : NULL;
         if (naive)
             ss_hull_line_naive(x, y, stc, ste, ln->count, c->persp, g->fixed, &g->fall, out);
         else
-            ss_hull_line(x, y, stc, ste, ln->count, c->persp, g->fixed, &g->fall, g->ties, stack,
-                         out);
-        for (k = 0; k < ln->count; k++) values[ln->offset + (size_t)k] = (float)out[k];
+            ss_hull_line_scratch(x, y, stc, ste, ln->count, c->persp, g->fixed, &g->fall, g->ties,
+                                 amax, stack, out);
+        if (vs == 1) {
+            for (k = 0; k < ln->count; k++) values[ln->offset + (size_t)k] = (float)out[k];
+        } else {
+            float *vo = values + vs * ln->offset, *zo = sdepth + vs * ln->offset;
+            for (k = 0; k < ln->count; k++) {
+                vo[vs * (size_t)k] = (float)out[k];
+                zo[vs * (size_t)k] = zs[k];
+            }
+        }
     }
 }
 
@@ -1696,7 +1825,7 @@ static hfvis_status ss_lsao_direction(const hfvis_camera *cam, const float *dept
         return HFVIS_ERR_OUT_OF_MEMORY;
     }
     ss_lsao_sweep_dir(&c, &g, depth, normals, lat, lines, (double *)blk,
-                      (int *)((double *)blk + 4 * M), naive, values, sample_depth);
+                      (int *)((double *)blk + 4 * M), naive, values, sample_depth, 1);
     hfvis__free(o.alloc, blk);
     hfvis__free(o.alloc, nrm);
     return HFVIS_OK;
@@ -1719,16 +1848,17 @@ hfvis_status hfvis_lsao_direction_naive(const hfvis_camera *cam, const float *de
     return ss_lsao_direction(cam, depth, normals, opts, lat, lines, values, sample_depth, 1);
 }
 
-/* Is lattice sample (j, i) acceptable for receiver depth zc / normal nc? Writes its value. */
+/* Is lattice sample (j, i) acceptable for receiver depth zc / normal nc? Writes its value.
+ * Sample s is at values[vs s], sdepth[vs s]. */
 static int ss_accept(const ss_cam *c, const ss_cfg *g, const float *normals,
                      const hfvis_ssao_lattice *L, const hfvis_ssao_line *ln, int i,
-                     const float *values, const float *sdepth, double zc, const float *nc,
-                     double *val)
+                     const float *values, const float *sdepth, size_t vs, double zc,
+                     const float *nc, double *val)
 {
     size_t idx;
     double v, zs;
     if (i < ln->first || i >= ln->first + ln->count) return 0;
-    idx = ln->offset + (size_t)(i - ln->first);
+    idx = vs * (ln->offset + (size_t)(i - ln->first));
     v = (double)values[idx];
     zs = (double)sdepth[idx];
     if (v != v || zs != zs) return 0;
@@ -1748,8 +1878,8 @@ static int ss_accept(const ss_cam *c, const ss_cfg *g, const float *normals,
 /* The nearest accepted sample within radius R2 (squared) of (u, v) (docs/errata.md E23). */
 static int ss_fallback(const ss_cam *c, const ss_cfg *g, const float *normals,
                        const hfvis_ssao_lattice *L, const hfvis_ssao_line *lines,
-                       const float *values, const float *sdepth, double u, double v, double zc,
-                       const float *nc, double R, double *val)
+                       const float *values, const float *sdepth, size_t vs, double u, double v,
+                       double zc, const float *nc, double R, double *val)
 {
     const hfvis_ssao_direction *d = &L->dir;
     double jf = (u * L->px + v * L->py - L->s_first) / d->spacing;
@@ -1765,7 +1895,7 @@ static int ss_fallback(const ss_cam *c, const ss_cfg *g, const float *normals,
             double su = ln->x0 + (double)i * d->step_x - u, sv = ln->y0 + (double)i * d->step_y - v;
             double dd = su * su + sv * sv, vv;
             if (dd > best || (found && dd == best)) continue;
-            if (!ss_accept(c, g, normals, L, ln, i, values, sdepth, zc, nc, &vv)) continue;
+            if (!ss_accept(c, g, normals, L, ln, i, values, sdepth, vs, zc, nc, &vv)) continue;
             best = dd;
             bv = vv;
             found = 1;
@@ -1784,17 +1914,19 @@ typedef struct ss_gdir {
     const hfvis_ssao_lattice *L;
     const hfvis_ssao_line *lines;
     const float *values, *sdepth;
+    size_t vs; /* sample s at values[vs s], sdepth[vs s] */
     double w, ids, idl, R2, px, py, s_first, ddx, ddy, t_min, jmax;
 } ss_gdir;
 
 static void ss_gdir_set(ss_gdir *G, const hfvis_ssao_lattice *L, const hfvis_ssao_line *lines,
-                        const float *values, const float *sdepth)
+                        const float *values, const float *sdepth, size_t vs)
 {
     const hfvis_ssao_direction *d = &L->dir;
     G->L = L;
     G->lines = lines;
     G->values = values;
     G->sdepth = sdepth;
+    G->vs = vs;
     G->w = d->weight;
     G->ids = 1.0 / d->step;
     G->idl = 1.0 / d->spacing;
@@ -1816,6 +1948,7 @@ static inline int ss_gather_at(const ss_cam *c, const ss_cfg *g, const float *no
     const hfvis_ssao_lattice *L = G->L;
     const hfvis_ssao_line *lines = G->lines;
     const float *values = G->values, *sdepth = G->sdepth;
+    const size_t vstr = G->vs;
     double jf = (u * G->px + v * G->py - G->s_first) * G->idl, tf = (u * G->ddx + v * G->ddy - G->t_min) * G->ids;
     int ok = 0, nlines = L->line_count;
     *val = 0.0;
@@ -1828,16 +1961,16 @@ static inline int ss_gather_at(const ss_cam *c, const ss_cfg *g, const float *no
             i = (int)(tf + 0.5);
             ln = &lines[j];
             if (i >= ln->first && i < ln->first + ln->count) {
-                size_t idx = ln->offset + (size_t)(i - ln->first);
+                size_t idx = vstr * (ln->offset + (size_t)(i - ln->first));
                 double zs = (double)sdepth[idx];
                 *val = (double)values[idx];
                 ok = *val == *val && zs == zs && (g->rej_z < 0.0 || fabs(zs - zc) <= g->rej_z * zc);
-                if (ok && nc) ok = ss_accept(c, g, normals, L, ln, i, values, sdepth, zc, nc, val);
+                if (ok && nc) ok = ss_accept(c, g, normals, L, ln, i, values, sdepth, vstr, zc, nc, val);
                 goto have;
             }
         }
         if (ss_nearest(L, lines, u, v, &j, &i))
-            ok = ss_accept(c, g, normals, L, &lines[j], i, values, sdepth, zc, nc, val);
+            ok = ss_accept(c, g, normals, L, &lines[j], i, values, sdepth, vstr, zc, nc, val);
     } else {
         double fj = floor(jf), fi = floor(tf), aj = jf - fj, ai = tf - fi, ws = 0.0, vs = 0.0;
         int dj, di;
@@ -1846,7 +1979,7 @@ static inline int ss_gather_at(const ss_cam *c, const ss_cfg *g, const float *no
                 double wt = (dj ? aj : 1.0 - aj) * (di ? ai : 1.0 - ai), vv;
                 double jj = fj + (double)dj, ii = fi + (double)di;
                 if (!(wt > 0.0) || jj < 0.0 || jj >= (double)nlines) continue;
-                if (!ss_accept(c, g, normals, L, &lines[(int)jj], (int)ii, values, sdepth, zc, nc, &vv))
+                if (!ss_accept(c, g, normals, L, &lines[(int)jj], (int)ii, values, sdepth, vstr, zc, nc, &vv))
                     continue;
                 ws += wt;
                 vs += wt * vv;
@@ -1857,7 +1990,7 @@ static inline int ss_gather_at(const ss_cam *c, const ss_cfg *g, const float *no
         }
     }
 have:
-    if (!ok) ok = ss_fallback(c, g, normals, L, lines, values, sdepth, u, v, zc, nc, G->R2, val);
+    if (!ok) ok = ss_fallback(c, g, normals, L, lines, values, sdepth, vstr, u, v, zc, nc, G->R2, val);
     return ok;
 }
 
@@ -1870,7 +2003,11 @@ static void ss_gather_dirs(const ss_cam *c, const ss_cfg *g, const float *depth,
                            const float *normals, const ss_gdir *G, int nd, double *sum, double *wsum)
 {
     int W = c->W - 2 * c->gx, x, y, k;
-    const double far_d = c->far_d;
+    const double far_d = c->far_d, rej_z = g->rej_z;
+    /* ss_gather_at's first case inline, with the constants in locals (its store to *val may
+     * alias them): NEAREST without normals, the rounded sample inside its line and accepted by
+     * the depth test; everything else (the same value where this case accepts) through it */
+    const int inline_nearest = g->gather == HFVIS_SSAO_GATHER_NEAREST && !normals;
     for (y = c->gy; y < c->H - c->gy; y++) {
         double v = (double)y + 0.5;
         const float *drow = depth + ss_index(c, 0, y);
@@ -1882,10 +2019,30 @@ static void ss_gather_dirs(const ss_cam *c, const ss_cfg *g, const float *depth,
             s = sum[orow + (size_t)x];
             ws = wsum[orow + (size_t)x];
             for (k = 0; k < nd; k++) {
+                const ss_gdir *Gk = &G[k];
                 double val;
-                if (G[k].L->line_count < 1 || !ss_gather_at(c, g, normals, &G[k], u, v, zc, nc, &val)) continue;
-                s += G[k].w * val;
-                ws += G[k].w;
+                if (Gk->L->line_count < 1) continue;
+                if (inline_nearest) {
+                    double jf = (u * Gk->px + v * Gk->py - Gk->s_first) * Gk->idl,
+                           tf = (u * Gk->ddx + v * Gk->ddy - Gk->t_min) * Gk->ids;
+                    if (jf > -0.5 && jf < Gk->jmax && tf > -0.5 && tf < 2147483647.0) {
+                        const hfvis_ssao_line *ln = &Gk->lines[(int)(jf + 0.5)];
+                        int i = (int)(tf + 0.5);
+                        if (i >= ln->first && i < ln->first + ln->count) {
+                            size_t idx = Gk->vs * (ln->offset + (size_t)(i - ln->first));
+                            double zs = (double)Gk->sdepth[idx];
+                            val = (double)Gk->values[idx];
+                            if (val == val && zs == zs && (rej_z < 0.0 || fabs(zs - zc) <= rej_z * zc)) {
+                                s += Gk->w * val;
+                                ws += Gk->w;
+                                continue;
+                            }
+                        }
+                    }
+                }
+                if (!ss_gather_at(c, g, normals, Gk, u, v, zc, nc, &val)) continue;
+                s += Gk->w * val;
+                ws += Gk->w;
             }
             sum[orow + (size_t)x] = s;
             wsum[orow + (size_t)x] = ws;
@@ -1907,7 +2064,7 @@ hfvis_status hfvis_lsao_gather(const hfvis_camera *cam, const float *depth, cons
         !isfinite(lat->dir.weight))
         return HFVIS_ERR_INVALID_ARGUMENT;
     ss_cfg_from_lsao(&o, &g);
-    ss_gdir_set(&G, lat, lines, values, sample_depth);
+    ss_gdir_set(&G, lat, lines, values, sample_depth, 1);
     ss_gather_dirs(&c, &g, depth, normals, &G, 1, sum, weight);
     return HFVIS_OK;
 }
@@ -1975,7 +2132,7 @@ hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth, const float
     if (!b || !(lines = (hfvis_ssao_line *)hfvis__alloc(o.alloc, b))) goto done;
     b = ss_bytes3(ms, 2 * SS_GATHER_GROUP, sizeof(float));
     if (!b || !(vals = (float *)hfvis__alloc(o.alloc, b))) goto done;
-    b = ss_bytes3((size_t)(maxm > 0 ? maxm : 1), 1, 4 * sizeof(double) + sizeof(int));
+    b = ss_bytes3((size_t)(maxm > 0 ? maxm : 1), 1, 5 * sizeof(double) + sizeof(int));
     if (!b || !(scratch = (double *)hfvis__alloc(o.alloc, b))) goto done;
     b = ss_bytes3(npix, 2, sizeof(double));
     if (!b || !(acc = (double *)hfvis__alloc(o.alloc, b))) goto done;
@@ -1988,8 +2145,8 @@ hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth, const float
             ss_lattice_init(&c, &dirs[k0 + k], &glat[k]);
             ss_lattice_fill(&c, &glat[k], lk);
             ss_lsao_sweep_dir(&c, &g, depth, nrm ? nrm : normals, &glat[k], lk, scratch,
-                              (int *)(scratch + 4 * (size_t)(maxm > 0 ? maxm : 1)), 0, vk, vk + ms);
-            ss_gdir_set(&G[k], &glat[k], lk, vk, vk + ms);
+                              (int *)(scratch + 5 * (size_t)(maxm > 0 ? maxm : 1)), 0, vk, vk + 1, 2);
+            ss_gdir_set(&G[k], &glat[k], lk, vk, vk + 1, 2);
         }
         ss_gather_dirs(&c, &g, depth, normals, G, nd, acc, acc + npix);
     }

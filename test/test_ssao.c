@@ -548,6 +548,9 @@ TEST(lattice)
  * receivers to agree and a mean |error| <~ 1e-3 with the tie rule */
 #define T2_MIN_AGREE 0.88
 #define T2_MAX_MEAN_ERR 1e-3
+/* the hull orders candidates by cross-multiplied products and divides once per receiver, the
+ * oracle divides as [P3] Alg. 1 writes it: without a falloff they differ by rounding only */
+#define LSAO_HULL_ROUND_TOL 1e-13
 
 /* Random smooth depth with steps and background holes, W x H, stride st. */
 static void random_depth(float *d, int W, int H, int st, double z0, int holes, uint64_t seed)
@@ -601,7 +604,7 @@ TEST(lsao_line_exact_cases)
         double spike = st + (5.0 / d - st) * r / (r + d * d), adj = st + (0.0 - st) * r / (r + 1.0);
         if (i == 11) adj = st; /* the spike is the only visible point */
         CHECK_NEAR(out[i], spike > adj ? spike : adj, 1e-14, 0.0);
-        CHECK(out[i] == nv[i]);
+        CHECK_NEAR(out[i], nv[i], LSAO_HULL_ROUND_TOL, 0.0);
     }
     /* rising convex/concave profile, rho = 1, ortho: out = st + max(0, sin(alpha) - st) with alpha
      * the P1 global horizon */
@@ -628,7 +631,8 @@ TEST(lsao_line_exact_cases)
     CHECK_EQ_STATUS(hfvis_lsao_line(x, y, NULL, NULL, N, 1, &o, stack, out), HFVIS_OK);
     CHECK_EQ_STATUS(hfvis_lsao_line_naive(x, y, NULL, NULL, N, 1, &o, nv), HFVIS_OK);
     CHECK(isnan(out[5]) && isnan(out[7]) && isnan(nv[5]) && isnan(nv[7]));
-    for (i = 0; i < N; i++) CHECK((isnan(out[i]) && isnan(nv[i])) || out[i] == nv[i]);
+    for (i = 0; i < N; i++)
+        CHECK((isnan(out[i]) && isnan(nv[i])) || fabs(out[i] - nv[i]) <= LSAO_HULL_ROUND_TOL);
     /* perspective: the eye is a hole */
     x[0] = 0.0; y[0] = 0.0;
     CHECK_EQ_STATUS(hfvis_lsao_line(x, y, NULL, NULL, 1, 0, &o, stack, out), HFVIS_OK);
@@ -645,7 +649,7 @@ TEST(lsao_line_exact_cases)
 }
 
 /* T2 random profiles ([P3] §4.2, Alg. 1 setup: perspective profiles, smooth depth plus 4 depth steps):
- * with falloff NONE the hull equals the oracle exactly; with rho_q the tie rule agrees on
+ * with falloff NONE the hull equals the oracle within rounding (LSAO_HULL_ROUND_TOL); with rho_q the tie rule agrees on
  * >= 88 % of receivers with mean |error| <= 1e-3, and the paper's strict '<' is clearly worse
  * (the regression test for the tie rule). */
 TEST(lsao_line_random_profiles)
@@ -654,7 +658,7 @@ TEST(lsao_line_random_profiles)
     static double x[N], y[N], a[N], b[N];
     static int stack[N];
     hfvis_lsao_options o = hfvis_lsao_options_default();
-    double err_ties = 0.0, err_strict = 0.0;
+    double err_ties = 0.0, err_strict = 0.0, exact_max = 0.0;
     long agree = 0, total = 0, exact_bad = 0;
     int p, i, rr;
     for (p = 0; p < P; p++) {
@@ -675,8 +679,10 @@ TEST(lsao_line_random_profiles)
         o.pop = HFVIS_LSAO_POP_TIES;
         CHECK_EQ_STATUS(hfvis_lsao_line(x, y, NULL, NULL, N, 0, &o, stack, a), HFVIS_OK);
         CHECK_EQ_STATUS(hfvis_lsao_line_naive(x, y, NULL, NULL, N, 0, &o, b), HFVIS_OK);
-        for (i = 0; i < N; i++)
-            if (a[i] != b[i]) exact_bad++;
+        for (i = 0; i < N; i++) {
+            if (!(fabs(a[i] - b[i]) <= LSAO_HULL_ROUND_TOL)) exact_bad++;
+            if (fabs(a[i] - b[i]) > exact_max) exact_max = fabs(a[i] - b[i]);
+        }
         for (rr = 0; rr < 3; rr++) {
             o.falloff.kind = HFVIS_FALLOFF_INV_QUADRATIC;
             o.falloff.param = rr == 0 ? 0.5 : (rr == 1 ? 4.0 : 30.0);
@@ -694,8 +700,8 @@ TEST(lsao_line_random_profiles)
             for (i = 0; i < N; i++) err_strict += fabs(a[i] - b[i]);
         }
     }
-    printf("  T2: exact mode mismatches %ld; rho_q: agree %.4f, mean |err| ties %.3g, strict %.3g\n",
-           exact_bad, (double)agree / (double)total, err_ties / (double)total, err_strict / (double)total);
+    printf("  T2: exact mode beyond %.0e: %ld (max |d| %.2g); rho_q: agree %.4f, mean |err| ties %.3g, strict %.3g\n",
+           LSAO_HULL_ROUND_TOL, exact_bad, exact_max, (double)agree / (double)total, err_ties / (double)total, err_strict / (double)total);
     CHECK(exact_bad == 0);
     CHECK((double)agree / (double)total >= T2_MIN_AGREE);
     CHECK(err_ties / (double)total <= T2_MAX_MEAN_ERR);
@@ -703,8 +709,9 @@ TEST(lsao_line_random_profiles)
 }
 
 /* Sweep of whole depth buffers against the per-receiver brute force over the same line samples:
- * bit-identical in exact mode (falloff NONE) for every sampling, plane, tangent, pattern and
- * projection; with a falloff the T2 statistics. */
+ * equal in exact mode (falloff NONE: float values; the hull is within rounding of the oracle)
+ * for every sampling, plane, tangent, pattern and projection; with a falloff the T2
+ * statistics. */
 TEST(lsao_direction_vs_oracle)
 {
     enum { W = 61, H = 47, ST = 64 };
