@@ -85,7 +85,7 @@ for day in 172 355; do
       r.mapcalc "rel = if(!isnull(rs_b) && $2_$p >= $DARK, abs($1_$p - $2_$p) / $2_$p, null()); off = rel > $OFF; dark = if(!isnull(rs_b) && $2_$p < $DARK && $1_$p >= $DARK, 1, null()); ad = if(isnull(rs_b), null(), abs($1_$p - $2_$p)); ref = if(isnull(rs_b), null(), $2_$p)" --overwrite --quiet
       m=$(r.univar -g rel | sed -n 's/^mean=//p'); f=$(r.univar -g off | sed -n 's/^mean=//p')
       n=$(r.univar -g dark 2>/dev/null | sed -n 's/^n=//p')
-      w=$(echo "$(r.univar -g ad | sed -n 's/^sum=//p') $(r.univar -g ref | sed -n 's/^sum=//p')" | awk '{ printf "%.4f", $2 > 0 ? $1 / $2 : 0 }')
+      w=$(echo "$(r.univar -g ad | sed -n 's/^sum=//p') $(r.univar -g ref | sed -n 's/^sum=//p')" | awk '{ printf "%.4f", ($2 > 0 ? $1 / $2 : 0) }')
       line="$line $(printf ' %s %.4f %.4f %s %s' $p "${m:-0}" "${f:-0}" "${n:-0}" "$w")"
     done
     echo "$line"
@@ -99,10 +99,11 @@ for day in 172 355; do
   echo "$name day $day means beam r.sun $m hfvis $h"
   # where hfvis/r.sun-cd differs: mean |a - b| / b of the beam by r.sun's daily beam
   line="$name day $day beam by r.sun-cd's value:"
-  for lh in "1 100" "100 300" "300 1000" "1000 3000" "3000 1e9"; do
+  for lh in "1 100" "100 300" "300 1000" "1000 3000" "3000 1000000000"; do
     set -- $lh
     r.mapcalc "x = if(!isnull(rs_b) && cd_b >= $1 && cd_b < $2, abs(h64_b - cd_b) / cd_b, null())" --overwrite --quiet
-    line="$line [$1, $2) $(r.univar -g x | sed -n 's/^n=//p') cells $(printf '%.4f' "$(r.univar -g x | sed -n 's/^mean=//p')")"
+    c=$(r.univar -g x 2>/dev/null | sed -n 's/^n=//p'); v=$(r.univar -g x 2>/dev/null | sed -n 's/^mean=//p')
+    [ "${c:-0}" -gt 0 ] && line="$line [$1, $2) $c cells $(printf '%.4f' "$v")"
   done
   echo "$line"
 done
@@ -113,7 +114,7 @@ done
 # sun is raised or lowered by 0.25 deg; and r.sun's own masks at distance_step 1 and 0.5.
 for t in 9 12; do
   set -- $(awk -v t=$t -v lat="$lat" 'BEGIN { pi = atan2(0, -1); d = 2 * pi * 355 / 365.25
-    x = 0.3978 * sin(d - 1.4 + 0.0355 * sin(d - 0.0489)); de = -atan2(x, sqrt(1 - x * x))
+    x = 0.3978 * sin(d - 1.4 + 0.0355 * sin(d - 0.0489)); de = atan2(x, sqrt(1 - x * x))
     p = lat * pi / 180; w = (t - 12) * pi / 12
     sh = cos(p) * cos(de) * cos(w) + sin(p) * sin(de); h = atan2(sh, sqrt(1 - sh * sh))
     a = atan2(-cos(de) * sin(w), sin(de) * cos(p) - cos(de) * sin(p) * cos(w)) * 180 / pi
