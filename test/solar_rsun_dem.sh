@@ -111,7 +111,8 @@ done
 # due south, along a grid axis): among the cells facing the sun (r.sun -p beam > 0), those r.sun
 # (central-difference normals) lights and hfvis shadow --exact (its exact ray toward the same sun,
 # r.sun's declination and hour angle) shades and the reverse; how many of those flip when hfvis's
-# sun is raised or lowered by 0.25 deg; and r.sun's own masks at distance_step 1 and 0.5.
+# sun is raised or lowered by 0.25 deg, how many hfvis shades from within 1.5 cells (the near
+# field, hfvis shadow --max-distance); and r.sun's own masks at distance_step 1 and 0.5.
 for t in 9 12; do
   set -- $(awk -v t=$t -v lat="$lat" 'BEGIN { pi = atan2(0, -1); d = 2 * pi * 355 / 365.25
     x = 0.3978 * sin(d - 1.4 + 0.0355 * sin(d - 0.0489)); de = atan2(x, sqrt(1 - x * x))
@@ -128,10 +129,13 @@ for t in 9 12; do
     "$cli" shadow "$dir/dem.tif" --exact --sun-azimuth "$az" --sun-elevation "$(echo "$el + $de" | bc -l)" --quiet -o "$dir/sh.tif"
     r.in.gdal -o input="$dir/sh.tif" output=sh$(echo "$de" | tr -d '.' | tr '-' m) --overwrite --quiet >/dev/null 2>&1
   done
+  # the near field: hfvis's shadows from the terrain within 1.5 cells of the receiver only
+  "$cli" shadow "$dir/dem.tif" --exact --sun-azimuth "$az" --sun-elevation "$el" --max-distance "$(echo "1.5 * $cell" | bc -l)" --quiet -o "$dir/sh.tif"
+  r.in.gdal -o input="$dir/sh.tif" output=shn --overwrite --quiet >/dev/null 2>&1
   r.mapcalc "m = if(!isnull(ib) && ibp > 0, 1, null()); lr = if(m, ib > 0, null()); l5 = if(m, ib5 > 0, null()); lh = if(m, sh0 >= 0.5, null())" --overwrite --quiet
-  r.mapcalc "a = if(lr && !lh, 1, null()); b = if(!lr && lh, 1, null()); a2 = if(lr && !lh && sh025 >= 0.5, 1, null()); b2 = if(!lr && lh && shm025 < 0.5, 1, null()); c = if(lr != l5, 1, null())" --overwrite --quiet
+  r.mapcalc "a = if(lr && !lh, 1, null()); b = if(!lr && lh, 1, null()); a2 = if(lr && !lh && sh025 >= 0.5, 1, null()); b2 = if(!lr && lh && shm025 < 0.5, 1, null()); c = if(lr != l5, 1, null()); an = if(lr && !lh && shn < 0.5, 1, null())" --overwrite --quiet
   n() { r.univar -g "$1" 2>/dev/null | sed -n 's/^n=//p'; }
-  echo "$name day 355 $t:00 sun az $az el $el: $(n m) cells face the sun; r.sun lit/hfvis shaded $(n a) ($(n a2) lit 0.25 deg higher), r.sun shaded/hfvis lit $(n b) ($(n b2) shaded 0.25 deg lower); r.sun step 1 vs 0.5: $(n c) differ"
+  echo "$name day 355 $t:00 sun az $az el $el: $(n m) cells face the sun; r.sun lit/hfvis shaded $(n a) ($(n a2) lit 0.25 deg higher, $(n an) shaded within 1.5 cells), r.sun shaded/hfvis lit $(n b) ($(n b2) shaded 0.25 deg lower); r.sun step 1 vs 0.5: $(n c) differ"
 done
 EOS
 
