@@ -53,7 +53,8 @@ static void sites_dem(const char *name, float *z, int w, int h, double cell, int
     }
     g.z = z; g.width = w; g.height = h; g.stride = w; g.cell_size = cell;
     /* the cells' sites by the spherical transverse Mercator of UTM zone 13's central meridian
-     * (Snyder 1987, Eq. 8-1, 8-3 forward for the centre, 8-6, 8-7 inverse): north up on the grid,
+     * (Snyder 1987, USGS PP 1395, §8: the sphere's forward formulas for the centre, the inverse
+     * phi = asin(sin D / cosh x), lambda = lambda0 + atan2(sinh x, cos D) per cell): north up on the grid,
      * true north turned by the projection's convergence, as on the tile's own UTM grid */
     xc = atanh(cos(lat0 * deg) * sin((lon0 - lonc) * deg));
     yc = atan(tan(lat0 * deg) / cos((lon0 - lonc) * deg));
