@@ -210,8 +210,14 @@ solar-rsun:
 	@CC="$(CC)" sh test/solar_rsun.sh
 # make solar-ephem: hfvis_spa against PyEphem (an independent implementation) over 2000 instants
 # and places, both hemispheres, polar day and night (test/solar_ephem.sh, under a minute); SKIPs
-# without python3's ephem (Debian: python3-ephem). make solar-check runs both comparisons.
-.PHONY: solar-ephem solar-check
+# without python3's ephem (Debian: python3-ephem). make solar-check runs the three comparisons.
+# make solar-rsun-dem: hfvis solar against r.sun with its own shadowing on the Colorado SRTM tile
+# and a 400^2 crop of the Slovenian lidar DTM, days 172 and 355, with experiments that explain
+# the differences (test/solar_rsun_dem.sh, about 5 minutes); the DEMs come from
+# HFVIS_BENCH_DEMS, as for make bench; SKIPs without them or without `grass`.
+.PHONY: solar-ephem solar-check solar-rsun-dem
 solar-ephem:
 	@CC="$(CC)" sh test/solar_ephem.sh
-solar-check: solar-ephem solar-rsun
+solar-rsun-dem: $(CLI)
+	@HFVIS_CLI=$(CLI) sh test/solar_rsun_dem.sh
+solar-check: solar-ephem solar-rsun solar-rsun-dem

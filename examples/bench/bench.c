@@ -346,7 +346,7 @@ static void bench_gi_viewshed(int n)
 
 /* The sections of examples/bench_*.c (bench.h). */
 static const struct { const char *name; void (*run)(int quick); } module_sections[] = {
-    {"ns", bench_gi2}, {"mesh", bench_mesh}, {"raster", bench_raster}, {"bvh", bench_bvh}, {"vox", bench_vox}, {"cons", bench_cons}, {"iv", bench_iv}, {"vf", bench_vf}, {"volgi", bench_volgi}, {"ssao", bench_ssao}, {"ffao", bench_ssaob}, {"lk", bench_lk}, {"lkobj", bench_lk_obj}, {"dirs", bench_dirs}, {"exact", bench_exact}, {"radius", bench_radius}, {"tiles", bench_tiles}, {"threads", bench_threads}, {"solar", bench_solar}
+    {"ns", bench_gi2}, {"mesh", bench_mesh}, {"raster", bench_raster}, {"bvh", bench_bvh}, {"vox", bench_vox}, {"cons", bench_cons}, {"iv", bench_iv}, {"vf", bench_vf}, {"volgi", bench_volgi}, {"ssao", bench_ssao}, {"ffao", bench_ssaob}, {"lk", bench_lk}, {"lkobj", bench_lk_obj}, {"dirs", bench_dirs}, {"exact", bench_exact}, {"radius", bench_radius}, {"tiles", bench_tiles}, {"threads", bench_threads}, {"solar", bench_solar}, {"solar-sites", bench_solar_sites}
 };
 
 static int wanted(int argc, char **argv, int first, const char *name)

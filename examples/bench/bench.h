@@ -94,4 +94,6 @@ int bench_same_file(const char *a, const char *b);
 void bench_threads(int quick); /* bench_threads.c: the tool's --threads 1 against 2 ($HFVIS_CLI) */
 void bench_solar(int quick); /* bench_solar.c: the DEMs of $HFVIS_BENCH_DEMS (else an fBm) */ /* bench_tiles.c: the hfvis tool whole vs tiled ($HFVIS_CLI) */
 void bench_radius(int quick);
+void bench_solar_sites(int quick); /* bench_solar_sites.c: the per-cell sun on the Colorado tile */
+float *bench_solar_standin(void); /* bench_solar.c: the 512^2 fBm standing in for the DEMs */
 #endif

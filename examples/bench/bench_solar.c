@@ -210,6 +210,22 @@ static void solar_dem(const solar_site *s, float *z, int w, int h, int quick)
     free(b1); free(g1); free(map); free(ones); free(cz);
 }
 
+/* The solar sections' stand-in for the DEMs: a 512^2 fBm with 1500 of relief (metres with 90 m
+ * cells), malloc'd; NULL when out of memory. */
+float *bench_solar_standin(void)
+{
+    hfvis_field f;
+    float *z = (float *)malloc((size_t)512 * 512 * sizeof(float));
+    if (!z) return NULL;
+    memset(&f, 0, sizeof f);
+    f.kind = HFVIS_FIELD_FBM;
+    f.amplitude = 1500.0;
+    f.wavelength = 200.0;
+    f.seed = 5;
+    hfvis_field_generate(&f, 512, 512, 512, z);
+    return z;
+}
+
 void bench_solar(int quick)
 {
     static const solar_site sites[2] = {
@@ -235,15 +251,8 @@ void bench_solar(int quick)
     }
     if (!ran) {
         static const solar_site fbm = {"", "fBm 512^2 (90 m cells), day 172", 90.0, 40.24, -105.53, 1, 0};
-        hfvis_field f;
-        float *z = (float *)malloc((size_t)512 * 512 * sizeof(float));
+        float *z = bench_solar_standin();
         if (!z) return;
-        memset(&f, 0, sizeof f);
-        f.kind = HFVIS_FIELD_FBM;
-        f.amplitude = 1500.0;
-        f.wavelength = 200.0;
-        f.seed = 5;
-        hfvis_field_generate(&f, 512, 512, 512, z);
         printf("  (HFVIS_BENCH_DEMS unset: a synthetic field)\n");
         solar_dem(&fbm, z, 512, 512, quick);
         free(z);
