@@ -166,10 +166,12 @@
  *   shared by concurrent calls must itself be thread-safe (give each thread its own). Outputs
  *   must not overlap, with one exception: bands (sweep options part_index/part_count) write
  *   disjoint cells, so the part_count calls of one sun (hfvis_sun_visibility), or of one
- *   direction of exact-mode sums (hfvis_direction_sums), may write one out concurrently.
+ *   direction of exact-mode sums (hfvis_direction_sums), may write one out concurrently; so may
+ *   hfvis_solar_irradiation calls on disjoint row ranges (hfvis_solar_options.row_begin/end).
  *   Splitting a run over threads without changing a bit: the lattice sums by quarter-turn group
  *   (hfvis_direction_sums, one group per part, added in order), the exact sums by bands of one
  *   direction at a time (added in place), the horizon map by plane range, one sun by bands,
+ *   solar irradiation by row ranges over one caller-made horizon map,
  *   and any receiver-local result by windows ("Search radius and tiles"). The hfvis tool's
  *   --threads does exactly that; test/thread_test.c runs these calls concurrently on shared
  *   inputs under ThreadSanitizer (make sanitize).

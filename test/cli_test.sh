@@ -1306,6 +1306,12 @@ fi
 expect_ok "solar --threads 3 (the horizon map by directions)" "$dir/solt3.pfm" solar "$dir/hill.pgm" --latitude 46 --longitude 15 --start 2026-03-01 --end 2026-03-05 --threads 3 -o "$dir/solt3.pfm"
 expect_ok "solar --threads 1" "$dir/solt1.pfm" solar "$dir/hill.pgm" --latitude 46 --longitude 15 --start 2026-03-01 --end 2026-03-05 -o "$dir/solt1.pfm"
 cmp -s "$dir/solt1.pfm" "$dir/solt3.pfm" && ok "solar --threads 3 equals one thread bit for bit" || bad "solar --threads 3 differs from one thread"
+expect_ok "solar --threads 2, 30 days (the sector sums by rows)" "$dir/sols2.pfm" solar "$dir/hill.pgm" --latitude 46 --longitude 15 --start 2026-03-01 --end 2026-03-30 --dirs 8 --threads 2 -o "$dir/sols2.pfm"
+expect_ok "solar --threads 1, 30 days" "$dir/sols1.pfm" solar "$dir/hill.pgm" --latitude 46 --longitude 15 --start 2026-03-01 --end 2026-03-30 --dirs 8 --threads 1 -o "$dir/sols1.pfm"
+cmp -s "$dir/sols1.pfm" "$dir/sols2.pfm" && ok "solar --threads 2: the integration by rows equals one thread bit for bit (30 days)" || bad "solar --threads 2 (30 days) differs from one thread"
+expect_ok "solar --threads 2, per-cell sites" "$dir/tall2.pfm" solar "$dir/tall.asc" --day 2026-12-21 --dirs 8 --threads 2 -o "$dir/tall2.pfm"
+expect_ok "solar --threads 1, per-cell sites" "$dir/tall1.pfm" solar "$dir/tall.asc" --day 2026-12-21 --dirs 8 --threads 1 -o "$dir/tall1.pfm"
+cmp -s "$dir/tall1.pfm" "$dir/tall2.pfm" && ok "solar --threads 2 with per-cell sites equals one thread bit for bit" || bad "solar --threads 2 with per-cell sites differs from one thread"
 for hz in near-far lattice; do
   expect_ok "solar --horizons $hz --threads 2" "$dir/solz2.pfm" solar "$dir/hill.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --horizons $hz --threads 2 -o "$dir/solz2.pfm"
   expect_ok "solar --horizons $hz --threads 1" "$dir/solz1.pfm" solar "$dir/hill.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --horizons $hz --threads 1 -o "$dir/solz1.pfm"

@@ -219,6 +219,51 @@ static int cli_solar_tm(const ex_georef *g, cli_tm *t)
     return 0;
 }
 
+/* --threads N: the time integration by bands of rows (hfvis_solar_options.row_begin/end), one
+ * per thread, each writing its own rows of the outputs, bit for bit the one-thread run's. */
+typedef struct cli_solar_split {
+    const hfvis_grid *grid;
+    const hfvis_solar_input *in;
+    const hfvis_solar_options *so;
+    const hfvis_solar_output *out;
+    int parts;
+} cli_solar_split;
+
+static hfvis_status cli_solar_unit(cli_split *sp, int u, int thread, hfvis_sweep_options *o)
+{
+    cli_solar_split *j = (cli_solar_split *)sp->ctx;
+    hfvis_solar_options so = *j->so;
+    (void)thread;
+    so.sweep = o;
+    so.row_begin = (int)((long long)j->grid->height * u / j->parts);
+    so.row_end = (int)((long long)j->grid->height * (u + 1) / j->parts);
+    if (so.row_begin >= so.row_end) return HFVIS_OK;
+    return hfvis_solar_irradiation(j->grid, j->in, &so, j->out);
+}
+
+static hfvis_status cli_threaded_solar(const hfvis_grid *grid, const hfvis_solar_input *in,
+                                       const hfvis_solar_options *so, const hfvis_solar_output *out,
+                                       int threads)
+{
+    cli_solar_split j;
+    cli_split sp;
+    if (threads <= 1 || grid->height < 2 || so->reflected == HFVIS_SOLAR_REFLECTED_TERRAIN)
+        return hfvis_solar_irradiation(grid, in, so, out);
+    memset(&sp, 0, sizeof sp);
+    j.grid = grid;
+    j.in = in;
+    j.so = so;
+    j.out = out;
+    j.parts = threads < grid->height ? threads : grid->height;
+    sp.units = j.parts;
+    sp.threads = j.parts;
+    sp.unit = cli_solar_unit;
+    sp.ctx = &j;
+    sp.opts = so->sweep;
+    sp.total = j.parts;
+    return cli_split_run(&sp);
+}
+
 static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts)
 {
     const int w = grid->width, h = grid->height;
@@ -326,7 +371,7 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
         }
         so.horizon_map = hmap;
     }
-    s = hfvis_solar_irradiation(grid, &in, &so, &out);
+    s = cli_threaded_solar(grid, &in, &so, &out, cli_run_threads(a));
     if (s == HFVIS_ERR_INVALID_ARGUMENT && (a->sol_linke_map || a->albedo_map)) {
         rc = cli_error(CLI_EXIT_ERROR, a->sol_linke_map ? a->sol_linke_map : a->albedo_map,
                        "a value out of range (Linke (0, 10], albedo [0, 1])");
