@@ -99,6 +99,22 @@ static void exact_field(const char *name, float *z, int n, float *map)
 #define EXACT_BENCH_NEAR 8
 #define EXACT_BENCH_ACC 96
 
+/* The bench's fBm on n^2 cells (amplitude n/8, wavelength n/4, seed 3) into z, as a grid of unit
+ * cells. */
+static hfvis_grid exact_fbm(float *z, int n)
+{
+    hfvis_field f;
+    hfvis_grid g;
+    memset(&f, 0, sizeof f);
+    f.kind = HFVIS_FIELD_FBM;
+    f.amplitude = (double)n / 8.0;
+    f.wavelength = (double)n / 4.0;
+    f.seed = 3;
+    hfvis_field_generate(&f, n, n, n, z);
+    g.z = z; g.width = n; g.height = n; g.stride = n; g.cell_size = 1.0;
+    return g;
+}
+
 /* mean and p99 (degrees) of |a - b| over n values (NaN pairs, the holes, left out). */
 static void exact_pair_err(const float *a, const float *b, size_t n, double *e, double *mean, double *p99)
 {
@@ -124,17 +140,10 @@ static int exact_far_accuracy(int K, double *sm, double *sp, double *fm, double 
     float *got = (float *)malloc(sizeof(float) * m);
     double *e = (double *)malloc(sizeof(double) * m);
     hfvis_sweep_options ex = hfvis_sweep_options_default();
-    hfvis_field f;
     hfvis_grid g;
     int rc = -1;
     if (z && sup && got && e) {
-        memset(&f, 0, sizeof f);
-        f.kind = HFVIS_FIELD_FBM;
-        f.amplitude = (double)n / 8.0;
-        f.wavelength = (double)n / 4.0;
-        f.seed = 3;
-        hfvis_field_generate(&f, n, n, n, z);
-        g.z = z; g.width = n; g.height = n; g.stride = n; g.cell_size = 1.0;
+        g = exact_fbm(z, n);
         ex.rays = HFVIS_RAYS_EXACT;
         if (hfvis_horizon_exact_naive(&g, K, &ex, sup) == HFVIS_OK && hfvis_horizon_map(&g, K, &ex, got) == HFVIS_OK) {
             exact_pair_err(got, sup, m, e, sm, sp);
@@ -151,23 +160,17 @@ static int exact_far_accuracy(int K, double *sm, double *sp, double *fm, double 
     free(e);
     return rc;
 }
+
 static void exact_k_rows(int n)
 {
     static const int Ks[] = {16, 64, 256, 360};
     size_t cells = (size_t)n * (size_t)n;
     float *z = (float *)malloc(sizeof(float) * cells), *out = (float *)malloc(sizeof(float) * cells);
     hfvis_sweep_options lat = hfvis_sweep_options_default(), ex = lat, nf;
-    hfvis_field f;
     hfvis_grid g;
     int i;
     if (!z || !out) { printf("exact: out of memory\n"); free(z); free(out); return; }
-    memset(&f, 0, sizeof f);
-    f.kind = HFVIS_FIELD_FBM;
-    f.amplitude = (double)n / 8.0;
-    f.wavelength = (double)n / 4.0;
-    f.seed = 3;
-    hfvis_field_generate(&f, n, n, n, z);
-    g.z = z; g.width = n; g.height = n; g.stride = n; g.cell_size = 1.0;
+    g = exact_fbm(z, n);
     ex.rays = HFVIS_RAYS_EXACT;
     nf = ex;
     nf.ray_near_cells = EXACT_BENCH_NEAR;
@@ -203,16 +206,10 @@ void bench_exact(int quick)
         size_t cells = (size_t)n * (size_t)n;
         float *z = (float *)malloc(sizeof(float) * cells);
         float *map = (float *)malloc(sizeof(float) * cells * EXACT_BENCH_K);
-        hfvis_field f;
         if (!z || !map) { printf("exact: out of memory\n"); free(z); free(map); return; }
         fields_urban(z, n, n, (int)(260.0 * (double)cells / (512.0 * 512.0)), 5);
         exact_field("urban", z, n, map);
-        memset(&f, 0, sizeof f);
-        f.kind = HFVIS_FIELD_FBM;
-        f.amplitude = (double)n / 8.0;
-        f.wavelength = (double)n / 4.0;
-        f.seed = 3;
-        hfvis_field_generate(&f, n, n, n, z);
+        (void)exact_fbm(z, n);
         exact_field("fBm", z, n, map);
         free(z);
         free(map);
