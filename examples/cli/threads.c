@@ -283,10 +283,11 @@ static hfvis_status cli_split_run(cli_split *sp)
     return sp->status;
 }
 
-/* ---- per-row work of the tool itself (decoding, normals, finishing, encoding): rows [0, rows)
- * in bands of CLI_ROWS_BAND, each band fn(ctx, y0, y1, thread) on one of `threads` threads;
- * the bands must write disjoint outputs (thread: an index < threads for per-thread scratch).
- * Returns the first failing band's status. One thread: fn(ctx, 0, rows, 0). */
+/* ---- per-row work of the tool itself (the shared normals, the finish of the sums): rows
+ * [0, rows) in bands of at most CLI_ROWS_BAND rows, each band fn(ctx, y0, y1, thread) on one of
+ * `threads` threads (one: in order on the calling thread); the bands must write disjoint outputs
+ * (thread: an index < threads, for per-thread scratch of one band). Returns the first failing
+ * band's status. */
 #define CLI_ROWS_BAND 64 /* rows per unit: about 1 MB of a 4096-wide float plane */
 typedef hfvis_status (*cli_rows_fn)(void *ctx, int y0, int y1, int thread);
 typedef struct cli_rows_split {
@@ -308,7 +309,7 @@ static hfvis_status cli_threaded_rows(int rows, int threads, cli_rows_fn fn, voi
     hfvis_sweep_options none = hfvis_sweep_options_default();
     cli_rows_split j;
     cli_split sp;
-    if (threads <= 1 || rows <= CLI_ROWS_BAND) return fn(ctx, 0, rows, 0);
+    if (rows <= CLI_ROWS_BAND) return fn(ctx, 0, rows, 0);
     memset(&sp, 0, sizeof sp);
     j.fn = fn;
     j.ctx = ctx;
@@ -427,9 +428,10 @@ static hfvis_status cli_threaded_sums(const hfvis_grid *grid, int K, hfvis_sum_k
     return s;
 }
 
-/* The grid's normals (hfvis_normals_compute) by row bands: each band computes them on the
- * view of its rows and the one row either side, which the library's stencil reaches (central differences
- * along x and y), into its thread's scratch, and copies its own rows: the whole call's values. */
+/* The grid's normals (hfvis_normals_compute) by row bands: each band computes them on the view
+ * of its rows and the one row either side, which the library's stencil reaches (central
+ * differences along x and y), into its thread's scratch, and copies its own rows: the whole
+ * call's values. */
 typedef struct cli_normals_rows {
     const hfvis_grid *grid;
     float *out;     /* width * height * 3 */
@@ -466,7 +468,8 @@ static hfvis_status cli_finish_band(void *ctx, int y0, int y1, int thread)
     const cli_finish_rows *j = (const cli_finish_rows *)ctx;
     size_t i;
     (void)thread;
-    for (i = (size_t)y0 * j->row; i < (size_t)y1 * j->row; i++) j->out[i] = cli_sum_finish(j->cmd, j->K, j->scale, j->acc[i]);
+    for (i = (size_t)y0 * j->row; i < (size_t)y1 * j->row; i++)
+        j->out[i] = cli_sum_finish(j->cmd, j->K, j->scale, j->acc[i]);
     return HFVIS_OK;
 }
 
