@@ -1265,8 +1265,8 @@ static inline double ss_occ(const ss_fall *f, double hx, double hy, double ux, d
  * Occ order is the cross-multiplied num1 den2 against num2 den1, the root is taken only inside
  * the falloff's support, and each receiver divides once, for its output
  * Occ = (st r |h| (D - N) + dd N) / den (exactly 0 for Sin = 0 without a falloff, as the
- * oracle's st + (0 - st) 1). Coordinates are scaled by a power of two per
- * line (exact) so the fourth-degree products neither overflow nor underflow. */
+ * oracle's st + (0 - st) 1). Coordinates are scaled by a power of two per line (exact) so the
+ * products, of degree six in them, neither overflow nor underflow. */
 typedef struct ss_hcand {
     double dd, q;  /* h.w, |h|^2 (scaled) */
     int co;        /* coincident with the receiver: Sin = -inf, Occ = st */
