@@ -1265,8 +1265,8 @@ static inline double ss_occ(const ss_fall *f, double hx, double hy, double ux, d
  * Occ order is the cross-multiplied num1 den2 against num2 den1, the root is taken only inside
  * the falloff's support, and each receiver divides once, for its output
  * Occ = (st r |h| (D - N) + dd N) / den (exactly 0 for Sin = 0 without a falloff, as the
- * oracle's st + (0 - st) 1). Coordinates are scaled by a power of two per
- * line (exact) so the fourth-degree products neither overflow nor underflow. */
+ * oracle's st + (0 - st) 1). Coordinates are scaled by a power of two per line (exact) so the
+ * products, of degree six in them, neither overflow nor underflow. */
 typedef struct ss_hcand {
     double dd, q;  /* h.w, |h|^2 (scaled) */
     int co;        /* coincident with the receiver: Sin = -inf, Occ = st */
@@ -1906,6 +1906,7 @@ static int ss_fallback(const ss_cam *c, const ss_cfg *g, const float *normals,
 }
 
 #define SS_GATHER_GROUP 4 /* directions swept, then gathered in one pass (hfvis_lsao) */
+#define SS_GATHER_TILE 16 /* pixels gathered in 16 x 16 tiles: four directions' samples stay in L1 */
 
 /* One direction of the gather: its lattice, lines, values and sample depths, and the constants
  * of its pixel-to-lattice map (in locals: loaded from the lattice at every pixel, they were
@@ -2002,17 +2003,23 @@ have:
 static void ss_gather_dirs(const ss_cam *c, const ss_cfg *g, const float *depth,
                            const float *normals, const ss_gdir *G, int nd, double *sum, double *wsum)
 {
-    int W = c->W - 2 * c->gx, x, y, k;
+    int W = c->W - 2 * c->gx, x, y, k, tx, ty;
+    const int x_end = c->W - c->gx, y_end = c->H - c->gy;
     const double far_d = c->far_d, rej_z = g->rej_z;
     /* ss_gather_at's first case inline, with the constants in locals (its store to *val may
      * alias them): NEAREST without normals, the rounded sample inside its line and accepted by
      * the depth test; everything else (the same value where this case accepts) through it */
     const int inline_nearest = g->gather == HFVIS_SSAO_GATHER_NEAREST && !normals;
-    for (y = c->gy; y < c->H - c->gy; y++) {
+    /* pixels in tiles (each pixel's sums are its own, so the order does not matter): along a
+     * row, a direction across the rows reads a new line, a new cache line, at every pixel; in a
+     * tile the next row reads the neighbouring samples of the same lines while they are cached */
+    for (ty = c->gy; ty < y_end; ty += SS_GATHER_TILE)
+    for (tx = c->gx; tx < x_end; tx += SS_GATHER_TILE)
+    for (y = ty; y < y_end && y < ty + SS_GATHER_TILE; y++) {
         double v = (double)y + 0.5;
         const float *drow = depth + ss_index(c, 0, y);
         size_t orow = (size_t)(y - c->gy) * (size_t)W - (size_t)c->gx; /* + x: pixel x's slot (mod 2^n) */
-        for (x = c->gx; x < c->W - c->gx; x++) {
+        for (x = tx; x < x_end && x < tx + SS_GATHER_TILE; x++) {
             double u = (double)x + 0.5, zc = (double)drow[x], s, ws;
             const float *nc = normals ? normals + 3 * ss_index(c, x, y) : NULL;
             if (!(zc > 0.0 && zc < far_d)) continue; /* ss_bg */
