@@ -17,7 +17,8 @@ static cli_cost cli_cost_of(double bytes, double work, const char *unit)
 /* The sweep commands: input, output (planes of one channel or channels), the sweep's lattice
  * (about min(W^2 + H^2, (W + H)^2/2) nodes of 8-byte heights, 12-byte normals and 8 bytes a
  * lattice channel ch), the grid accumulator, and bytes more per cell (gi's pyramids) and per
- * lattice node (the [P2] hull tree's); the work is K sweeps over the lattice. */
+ * lattice node (the [P2] hull tree's), 8 bytes a cell with --exact-near (the cells' twists); the
+ * work is K sweeps over the lattice. */
 static cli_cost cli_sweep_cost(const cli_args *a, int w, int h, double out, double ch, double cell_bytes,
                                double node_bytes)
 {
@@ -28,6 +29,7 @@ static cli_cost cli_sweep_cost(const cli_args *a, int w, int h, double out, doub
     c.bytes += n * 4.0 + n * 4.0 * out;                                 /* in, out */
     c.bytes += lat * (8.0 + 12.0 + 8.0 * ch) + n * (12.0 + 8.0 * ch);   /* sweep */
     if (node_bytes > 0.0) c.bytes += lat * node_bytes;
+    if (a->exact && a->exact_near > 0) c.bytes += n * 8.0; /* the near field's twist per cell */
     c.work = K * (n + lat / 4.0);
     return c;
 }
