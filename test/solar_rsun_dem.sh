@@ -97,13 +97,21 @@ for day in 172 355; do
   compare h256 h64 "hfvis-256/hfvis"
   m=$(r.univar -g rs_b | sed -n 's/^mean=//p'); h=$(r.univar -g h64_b | sed -n 's/^mean=//p')
   echo "$name day $day means beam r.sun $m hfvis $h"
-  # where hfvis/r.sun-cd differs: mean |a - b| / b of the beam by r.sun's daily beam
+  # where hfvis/r.sun-cd differs: mean |a - b| / b of the beam by r.sun-cd's daily beam
   line="$name day $day beam by r.sun-cd's value:"
   for lh in "1 100" "100 300" "300 1000" "1000 3000" "3000 1000000000"; do
     set -- $lh
     r.mapcalc "x = if(!isnull(rs_b) && cd_b >= $1 && cd_b < $2, abs(h64_b - cd_b) / cd_b, null())" --overwrite --quiet
     c=$(r.univar -g x 2>/dev/null | sed -n 's/^n=//p'); v=$(r.univar -g x 2>/dev/null | sed -n 's/^mean=//p')
     [ "${c:-0}" -gt 0 ] && line="$line [$1, $2) $c cells $(printf '%.4f' "$v")"
+  done
+  echo "$line"
+  # and by the distance to the grid's edge (r.sun's march ends lit there, hfvis --border open)
+  line="$name day $day beam by cells from the edge:"
+  for lh in "2 5" "6 20" "21 100000"; do
+    set -- $lh
+    r.mapcalc "x = if(!isnull(rs_b) && cd_b >= $DARK && min(row(), col(), nrows() + 1 - row(), ncols() + 1 - col()) >= $1 && min(row(), col(), nrows() + 1 - row(), ncols() + 1 - col()) <= $2, abs(h64_b - cd_b) / cd_b, null())" --overwrite --quiet
+    line="$line [$1, $2] $(r.univar -g x 2>/dev/null | sed -n 's/^n=//p') cells $(printf '%.4f' "$(r.univar -g x 2>/dev/null | sed -n 's/^mean=//p')")"
   done
   echo "$line"
 done
