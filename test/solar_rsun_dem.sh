@@ -18,12 +18,14 @@
 #   r.sun-cd-0.5 / r.sun-cd  r.sun's own march at distance_step 0.5 (half-cell steps) against
 #                          its default 1: how much r.sun's shadows move with its own step
 #   hfvis-256 / hfvis      hfvis with a K = 256 exact horizon map against the default K = 64
+# then hfvis / r.sun-cd's beam by r.sun-cd's value and by the distance to the edge, and one
+# instant's shadow masks (below).
 # docs/solar.md ("Against r.sun on real DEMs") holds the table and the explanations.
 # The DEMs come from HFVIS_BENCH_DEMS (a folder holding colorado_srtm_512_90m.pfm and
 # slovenia_lidar_1000_1m.pfm, as for make bench); the lidar DTM is cropped to its central
 # LIDAR_CROP^2 cells (default 400: r.sun takes about 7 minutes for one day on the whole 1000^2;
 # LIDAR_CROP=1000 runs it whole). SKIPs (exit 0) without `grass` (Debian: grass-core) or the DEMs.
-# usage: HFVIS_BENCH_DEMS=DIR sh test/solar_rsun_dem.sh [SCRATCHDIR]   (about 5 minutes)
+# usage: HFVIS_BENCH_DEMS=DIR sh test/solar_rsun_dem.sh [SCRATCHDIR]   (12 minutes on 2 shared cores)
 TOL_BEAM=0.02   # issue 27: the daily beam within 2 % mean of r.sun with its own shadowing
 DARK=1          # Wh/m^2: a cell below this in the reference is left out of the relative means
 OFF=0.05        # the per-cell difference counted as "off"
