@@ -1258,18 +1258,10 @@ static double hf_slope_1d(double hm, double h0, double hp, int has_m, int has_p)
 }
 
 #define HF_SLOPE_SQUARE_MAX 1e150 /* a slope whose square stays far from DBL_MAX (1.8e308) */
-static void hf_normal_at(const hfvis_grid *g, int x, int y, double n[3])
+/* The unit normal (gx, gy, cell)/|.| of the height drops gx, gy per cell along +x, +y. */
+static void hf_normal_of(double gx, double gy, const hfvis_grid *g, double n[3])
 {
-    const float *p = g->z + (ptrdiff_t)y * g->stride + x;
-    double h0 = (double)*p, gx, gy, len;
-    if (!isfinite(h0)) {
-        n[0] = n[1] = n[2] = HFVIS__NAN;
-        return;
-    }
-    gx = hf_slope_1d(x > 0 ? (double)p[-1] : 0.0, h0, x + 1 < g->width ? (double)p[1] : 0.0,
-                     x > 0, x + 1 < g->width);
-    gy = hf_slope_1d(y > 0 ? (double)p[-g->stride] : 0.0, h0,
-                     y + 1 < g->height ? (double)p[g->stride] : 0.0, y > 0, y + 1 < g->height);
+    double len;
     if (fabs(gx) / g->cell_size < HF_SLOPE_SQUARE_MAX && fabs(gy) / g->cell_size < HF_SLOPE_SQUARE_MAX) {
         gx /= g->cell_size;
         gy /= g->cell_size;
@@ -1286,6 +1278,45 @@ static void hf_normal_at(const hfvis_grid *g, int x, int y, double n[3])
         n[1] = gy / len;
         n[2] = c / len;
     }
+}
+
+static void hf_normal_at(const hfvis_grid *g, int x, int y, double n[3])
+{
+    const float *p = g->z + (ptrdiff_t)y * g->stride + x;
+    double h0 = (double)*p, gx, gy;
+    if (!isfinite(h0)) {
+        n[0] = n[1] = n[2] = HFVIS__NAN;
+        return;
+    }
+    gx = hf_slope_1d(x > 0 ? (double)p[-1] : 0.0, h0, x + 1 < g->width ? (double)p[1] : 0.0,
+                     x > 0, x + 1 < g->width);
+    gy = hf_slope_1d(y > 0 ? (double)p[-g->stride] : 0.0, h0,
+                     y + 1 < g->height ? (double)p[g->stride] : 0.0, y > 0, y + 1 < g->height);
+    hf_normal_of(gx, gy, g, n);
+}
+
+/* Horn 1981's normal: each drop the (1, 2, 1)-weighted mean of the three central differences
+ * across the 3x3 window (r.slope.aspect's and gdaldem's stencil); hf_normal_at where a cell of
+ * the window is outside the grid or a hole (r.slope.aspect -e and gdaldem -compute_edges put the
+ * centre's height there instead; without them those cells have no value). */
+static void hf_normal_horn_at(const hfvis_grid *g, int x, int y, double n[3])
+{
+    const float *p = g->z + (ptrdiff_t)y * g->stride + x;
+    ptrdiff_t s = g->stride;
+    double a, b, c, d, f, gg, h, i;
+    if (x < 1 || y < 1 || x + 1 >= g->width || y + 1 >= g->height) {
+        hf_normal_at(g, x, y, n);
+        return;
+    }
+    a = (double)p[-s - 1]; b = (double)p[-s]; c = (double)p[-s + 1];
+    d = (double)p[-1]; f = (double)p[1];
+    gg = (double)p[s - 1]; h = (double)p[s]; i = (double)p[s + 1];
+    if (!isfinite((double)*p) || !isfinite(a + b + c + d + f + gg + h + i)) {
+        hf_normal_at(g, x, y, n);
+        return;
+    }
+    hf_normal_of(((a + 2.0 * d + gg) - (c + 2.0 * f + i)) * 0.125,
+                 ((a + 2.0 * b + c) - (gg + 2.0 * h + i)) * 0.125, g, n);
 }
 
 hfvis_status hfvis_normals_compute(const hfvis_grid *grid, float *out)
@@ -10830,7 +10861,8 @@ static int hf_solar_opts_valid(const hfvis_solar_options *o)
         o->reflected < HFVIS_SOLAR_REFLECTED_DEFAULT || o->reflected > HFVIS_SOLAR_REFLECTED_TERRAIN ||
         o->reflected_directions < 0 || o->reflected_directions > HF_SOLAR_K_MAX ||
         o->bands < HFVIS_SOLAR_BANDS_DEFAULT || o->bands > HFVIS_SOLAR_BANDS_MONTH ||
-        !hf_in(o->site_tolerance_rad, 0.0, 0.1))
+        !hf_in(o->site_tolerance_rad, 0.0, 0.1) || o->normals < HFVIS_SOLAR_NORMALS_DEFAULT ||
+        o->normals > HFVIS_SOLAR_NORMALS_HORN)
         return 0;
     if (s && (!hf_opts_valid(s) || s->extent_width != 0 || s->receiver_width != 0)) return 0;
     if (o->linke_monthly)
@@ -11070,7 +11102,8 @@ static void hf_solar_point_init(const hf_solar_ctx *c, const hfvis_grid *g, int 
 {
     size_t i = (size_t)y * (size_t)g->width + (size_t)x;
     double n[3], slope;
-    hf_normal_at(g, x, y, n);
+    if (c->o.normals == HFVIS_SOLAR_NORMALS_HORN) hf_normal_horn_at(g, x, y, n);
+    else hf_normal_at(g, x, y, n);
     pt->p = hf_esra_pressure((double)g->z[(ptrdiff_t)y * g->stride + x]);
     pt->nx = n[0];
     pt->ny = n[1];

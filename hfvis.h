@@ -1487,6 +1487,24 @@ typedef enum hfvis_solar_bands {
     HFVIS_SOLAR_BANDS_MONTH = 2   /* one band per calendar month the period touches */
 } hfvis_solar_bands;
 
+/* The surface normal of a receiver: its incidence angle, its tangent plane (the shading's lower
+ * bound), r_sky = (1 + cos slope)/2, Muneer's F_g and the HORIZON visible sky. 0 is the default
+ * (hfvis's own, hfvis.h "Grids"). */
+typedef enum hfvis_solar_normals {
+    HFVIS_SOLAR_NORMALS_DEFAULT = 0,
+    HFVIS_SOLAR_NORMALS_CENTRAL = 0, /* the central differences of the four neighbours (one-sided
+                                        at the border and next to holes), as hfvis_normals_compute */
+    HFVIS_SOLAR_NORMALS_HORN = 1     /* Horn 1981 (Proc. IEEE 69(1), Eq. for p and q on a 3x3
+                                        window): each partial derivative the (1, 2, 1)-weighted
+                                        mean of the three central differences across the window,
+                                        as GRASS r.slope.aspect and gdaldem slope/aspect compute
+                                        slope and aspect (what r.sun reads); where a neighbour
+                                        of the 3x3 window is outside the grid or a hole, the
+                                        central difference (CENTRAL). r.slope.aspect leaves those
+                                        cells NULL (without -e) and gdaldem nodata (without
+                                        -compute_edges) */
+} hfvis_solar_normals;
+
 /* What to compute: the site, the period and the surface. hfvis_solar_input_default() fills in
  * linke 3, albedo 0.2, days 1, 2026-06-21; latitude and longitude are the caller's to set. */
 typedef struct hfvis_solar_input {
@@ -1548,6 +1566,7 @@ typedef struct hfvis_solar_options {
                                     HFVIS_RAYS_EXACT and the sweep options above (azimuth0 0,
                                     every direction): e.g. made on several threads (the results
                                     are then bit for bit those of NULL). The oracle ignores it */
+    hfvis_solar_normals normals; /* default CENTRAL; HORN to match r.sun fed by r.slope.aspect */
 } hfvis_solar_options;
 
 HFVIS_API hfvis_solar_options hfvis_solar_options_default(void);

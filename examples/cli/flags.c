@@ -465,6 +465,8 @@ static const cli_flag cli_flags[] = {
       CLI_SWITCH, NULL },
     { "--bands", "day|month", CLI_ONLY(CMD_SOLAR),
       CLI_WORDS(CLI_V_CHOICE, "one (the total)"), NULL },
+    { "--normals", "central|horn", CLI_ONLY(CMD_SOLAR),
+      CLI_WORDS(CLI_V_CHOICE, "central"), NULL },
     { "--beam", "OUT", CLI_ONLY(CMD_SOLAR),
       CLI_TYPED(CLI_V_TEXT), NULL },
     { "--diffuse", "OUT", CLI_ONLY(CMD_SOLAR),
