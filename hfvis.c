@@ -11122,6 +11122,23 @@ static void hf_solar_point_init(const hf_solar_ctx *c, const hfvis_grid *g, int 
     pt->sky_ratio = 1.0;
 }
 
+/* The cosine-weighted visible sky of point i over the K horizons hor[k*n + i] at azimuths az[k],
+ * each raised to the point's tangent plane ([P1] Eq. 5 per sector); NaN at a hole. */
+static double hf_solar_sky_seen(const hf_solar_point *pt, int K, const double *az, const float *hor,
+                                size_t n, size_t i)
+{
+    double v = 0.0;
+    int k;
+    if (isnan(pt->nz)) return HFVIS__NAN;
+    for (k = 0; k < K; k++) {
+        double a = pt->nx * cos(az[k]) + pt->ny * sin(az[k]);
+        double t = tan((double)hor[(size_t)k * n + i]), tc = -a / pt->nz;
+        if (isnan(t) || t < tc) t = tc;
+        v += hfvis_sector_weight(K, pt->nz, a, HFVIS__HALF_PI - atan(t));
+    }
+    return v;
+}
+
 /* Visible fraction of the sun at elevation elev over horizon elevation hor: the centre's test,
  * or the disc's segment above the horizon line (hfvis_sun_visibility's formula). */
 static double hf_solar_visible(double elev, double hor, double radius)
@@ -11822,6 +11839,9 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
         if (st == HFVIS_OK && r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON) {
             sky = (float *)hfvis__alloc_array(r.al, n, sizeof(float));
             if (!sky) st = HFVIS_ERR_OUT_OF_MEMORY;
+            else if (r.c.o.normals == HFVIS_SOLAR_NORMALS_HORN) /* over Horn's tangent planes */
+                for (i = 0; i < n; i++)
+                    sky[i] = (float)hf_solar_sky_seen(r.pts + i, K, az, r.c.o.horizon_map ? r.c.o.horizon_map : map, n, i);
             else st = hfvis_sky_light(g, K, 1.0f, 1.0f, &s, sky, g->width);
         }
         if (st == HFVIS_OK) { /* sample-major: each sample's K horizons side by side */
@@ -11942,20 +11962,10 @@ hfvis_status hfvis_solar_irradiation_reference(const hfvis_grid *g, const hfvis_
     if (st == HFVIS_OK && r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON) {
         /* the visible sky: [P1] Eq. 5 per sector over the exact horizons of 4K directions, each
          * receiver's own rays (hfvis_horizon_exact_naive) along their actual azimuths */
-        int k;
         st = hfvis_sweep_azimuths(KR, &s, az, NULL);
         if (st == HFVIS_OK) st = hfvis_horizon_exact_naive(g, KR, &s, hor);
-        for (i = 0; i < n && st == HFVIS_OK; i++) {
-            hf_solar_point *pt = r.pts + i;
-            double v = 0.0;
-            for (k = 0; k < KR; k++) {
-                double a = pt->nx * cos(az[k]) + pt->ny * sin(az[k]);
-                double t = tan((double)hor[(size_t)k * n + i]), tc = -a / pt->nz;
-                if (isnan(t) || t < tc) t = tc;
-                v += hfvis_sector_weight(KR, pt->nz, a, HFVIS__HALF_PI - atan(t));
-            }
-            pt->sky_ratio = v / pt->r_sky;
-        }
+        for (i = 0; i < n && st == HFVIS_OK; i++)
+            r.pts[i].sky_ratio = hf_solar_sky_seen(r.pts + i, KR, az, hor, n, i) / r.pts[i].r_sky;
     }
     s.ray_denominator = HF_SOLAR_REF_DENOM;
     if (st == HFVIS_OK && r.c.in.latitude_map) st = hf_solar_reference_sites(g, &r, &s);

@@ -1463,7 +1463,9 @@ typedef enum hfvis_solar_diffuse {
     HFVIS_SOLAR_DIFFUSE_HORIZON = 1  /* beyond r.sun: the isotropic part of Muneer's model over
                                         the sky the receiver actually sees (scaled by V/r_sky,
                                         V the cosine-weighted visible sky of the exact horizon,
-                                        hfvis_sky_light with sky 1, r_sky = (1 + cos slope)/2),
+                                        hfvis_sky_light with sky 1; with HORN normals [P1]
+                                        Eq. 5 over the map's K horizons above Horn's tangent
+                                        plane; r_sky = (1 + cos slope)/2),
                                         the circumsolar part shaded with the beam */
 } hfvis_solar_diffuse;
 
