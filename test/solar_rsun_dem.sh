@@ -28,7 +28,7 @@
 # slovenia_lidar_1000_1m.pfm, as for make bench); the lidar DTM is cropped to its central
 # LIDAR_CROP^2 cells (default 400: r.sun takes about 7 minutes for one day on the whole 1000^2;
 # LIDAR_CROP=1000 runs it whole). SKIPs (exit 0) without `grass` (Debian: grass-core) or the DEMs.
-# usage: HFVIS_BENCH_DEMS=DIR sh test/solar_rsun_dem.sh [SCRATCHDIR]   (12 minutes on 2 shared cores)
+# usage: HFVIS_BENCH_DEMS=DIR sh test/solar_rsun_dem.sh [SCRATCHDIR]   (22 minutes on 2 shared cores)
 TOL_BEAM=0.02   # issue 27: the daily beam within 2 % mean of r.sun with its own shadowing
 DARK=1          # Wh/m^2: a cell below this in the reference is left out of the relative means
 OFF=0.05        # the per-cell difference counted as "off"
