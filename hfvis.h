@@ -1496,15 +1496,17 @@ typedef enum hfvis_solar_normals {
     HFVIS_SOLAR_NORMALS_DEFAULT = 0,
     HFVIS_SOLAR_NORMALS_CENTRAL = 0, /* the central differences of the four neighbours (one-sided
                                         at the border and next to holes), as hfvis_normals_compute */
-    HFVIS_SOLAR_NORMALS_HORN = 1     /* Horn 1981 (Proc. IEEE 69(1), Eq. for p and q on a 3x3
-                                        window): each partial derivative the (1, 2, 1)-weighted
+    HFVIS_SOLAR_NORMALS_HORN = 1     /* Horn 1981 ("Hill shading and the reflectance map",
+                                        Proc. IEEE 69(1), its 3x3 gradient estimate): each
+                                        partial derivative the (1, 2, 1)-weighted
                                         mean of the three central differences across the window,
                                         as GRASS r.slope.aspect and gdaldem slope/aspect compute
                                         slope and aspect (what r.sun reads); where a neighbour
                                         of the 3x3 window is outside the grid or a hole, the
                                         central difference (CENTRAL). r.slope.aspect leaves those
                                         cells NULL (without -e) and gdaldem nodata (without
-                                        -compute_edges) */
+                                        -compute_edges). The TERRAIN reflected term's [P2]
+                                        gather keeps its own (central) normals */
 } hfvis_solar_normals;
 
 /* What to compute: the site, the period and the surface. hfvis_solar_input_default() fills in
@@ -1575,8 +1577,8 @@ HFVIS_API hfvis_solar_options hfvis_solar_options_default(void);
 
 /* The outputs: each NULL or bands*width*height floats, band b at [b*width*height + y*width + x]:
  * beam, diffuse and reflected on the receiver's own surface (normal from the grid, hfvis.h
- * "Grids"), their sum, and the hours of direct sun (beam > 0; weighted by the visible disc
- * fraction). NaN at holes. At least one must be set. */
+ * "Grids", or Horn's with opts->normals), their sum, and the hours of direct sun (beam > 0;
+ * weighted by the visible disc fraction). NaN at holes. At least one must be set. */
 typedef struct hfvis_solar_output {
     float *beam, *diffuse, *reflected, *global, *sun_hours;
 } hfvis_solar_output;
