@@ -213,7 +213,7 @@ solar-rsun:
 # without python3's ephem (Debian: python3-ephem). make solar-check runs the three comparisons.
 # make solar-rsun-dem: hfvis solar against r.sun with its own shadowing on the Colorado SRTM tile
 # and a 400^2 crop of the Slovenian lidar DTM, days 172 and 355, with experiments that explain
-# the differences (test/solar_rsun_dem.sh, about 5 minutes); the DEMs come from
+# the differences (test/solar_rsun_dem.sh, about 22 minutes); the DEMs come from
 # HFVIS_BENCH_DEMS, as for make bench; SKIPs without them or without `grass`.
 .PHONY: solar-ephem solar-check solar-rsun-dem
 solar-ephem:

@@ -1260,18 +1260,10 @@ static double hf_slope_1d(double hm, double h0, double hp, int has_m, int has_p)
 }
 
 #define HF_SLOPE_SQUARE_MAX 1e150 /* a slope whose square stays far from DBL_MAX (1.8e308) */
-static void hf_normal_at(const hfvis_grid *g, int x, int y, double n[3])
+/* The unit normal (gx, gy, cell)/|.| of the height drops gx, gy per cell along +x, +y. */
+static void hf_normal_of(double gx, double gy, const hfvis_grid *g, double n[3])
 {
-    const float *p = g->z + (ptrdiff_t)y * g->stride + x;
-    double h0 = (double)*p, gx, gy, len;
-    if (!isfinite(h0)) {
-        n[0] = n[1] = n[2] = HFVIS__NAN;
-        return;
-    }
-    gx = hf_slope_1d(x > 0 ? (double)p[-1] : 0.0, h0, x + 1 < g->width ? (double)p[1] : 0.0,
-                     x > 0, x + 1 < g->width);
-    gy = hf_slope_1d(y > 0 ? (double)p[-g->stride] : 0.0, h0,
-                     y + 1 < g->height ? (double)p[g->stride] : 0.0, y > 0, y + 1 < g->height);
+    double len;
     if (fabs(gx) / g->cell_size < HF_SLOPE_SQUARE_MAX && fabs(gy) / g->cell_size < HF_SLOPE_SQUARE_MAX) {
         gx /= g->cell_size;
         gy /= g->cell_size;
@@ -1288,6 +1280,45 @@ static void hf_normal_at(const hfvis_grid *g, int x, int y, double n[3])
         n[1] = gy / len;
         n[2] = c / len;
     }
+}
+
+static void hf_normal_at(const hfvis_grid *g, int x, int y, double n[3])
+{
+    const float *p = g->z + (ptrdiff_t)y * g->stride + x;
+    double h0 = (double)*p, gx, gy;
+    if (!isfinite(h0)) {
+        n[0] = n[1] = n[2] = HFVIS__NAN;
+        return;
+    }
+    gx = hf_slope_1d(x > 0 ? (double)p[-1] : 0.0, h0, x + 1 < g->width ? (double)p[1] : 0.0,
+                     x > 0, x + 1 < g->width);
+    gy = hf_slope_1d(y > 0 ? (double)p[-g->stride] : 0.0, h0,
+                     y + 1 < g->height ? (double)p[g->stride] : 0.0, y > 0, y + 1 < g->height);
+    hf_normal_of(gx, gy, g, n);
+}
+
+/* Horn 1981's normal: each drop the (1, 2, 1)-weighted mean of the three central differences
+ * across the 3x3 window (r.slope.aspect's and gdaldem's stencil); hf_normal_at where a cell of
+ * the window is outside the grid or a hole (r.slope.aspect -e and gdaldem -compute_edges put the
+ * centre's height there instead; without them those cells have no value). */
+static void hf_normal_horn_at(const hfvis_grid *g, int x, int y, double n[3])
+{
+    const float *p = g->z + (ptrdiff_t)y * g->stride + x;
+    ptrdiff_t s = g->stride;
+    double a, b, c, d, f, gg, h, i;
+    if (x < 1 || y < 1 || x + 1 >= g->width || y + 1 >= g->height) {
+        hf_normal_at(g, x, y, n);
+        return;
+    }
+    a = (double)p[-s - 1]; b = (double)p[-s]; c = (double)p[-s + 1];
+    d = (double)p[-1]; f = (double)p[1];
+    gg = (double)p[s - 1]; h = (double)p[s]; i = (double)p[s + 1];
+    if (!isfinite((double)*p) || !isfinite(a + b + c + d + f + gg + h + i)) {
+        hf_normal_at(g, x, y, n);
+        return;
+    }
+    hf_normal_of(((a + 2.0 * d + gg) - (c + 2.0 * f + i)) * 0.125,
+                 ((a + 2.0 * b + c) - (gg + 2.0 * h + i)) * 0.125, g, n);
 }
 
 hfvis_status hfvis_normals_compute(const hfvis_grid *grid, float *out)
@@ -10867,7 +10898,8 @@ static int hf_solar_opts_valid(const hfvis_solar_options *o)
         o->bands < HFVIS_SOLAR_BANDS_DEFAULT || o->bands > HFVIS_SOLAR_BANDS_MONTH ||
         !hf_in(o->site_tolerance_rad, 0.0, 0.1) || o->horizons < HFVIS_SOLAR_HORIZONS_DEFAULT ||
         o->horizons > HFVIS_SOLAR_HORIZONS_LATTICE || o->row_begin < 0 || o->row_end < 0 ||
-        ((o->row_begin || o->row_end) && (o->row_begin >= o->row_end || o->reflected == HFVIS_SOLAR_REFLECTED_TERRAIN)))
+        ((o->row_begin || o->row_end) && (o->row_begin >= o->row_end || o->reflected == HFVIS_SOLAR_REFLECTED_TERRAIN)) ||
+        o->normals < HFVIS_SOLAR_NORMALS_DEFAULT || o->normals > HFVIS_SOLAR_NORMALS_HORN)
         return 0;
     if (s && (!hf_opts_valid(s) || s->extent_width != 0 || s->receiver_width != 0)) return 0;
     if (o->linke_monthly)
@@ -11108,7 +11140,8 @@ static void hf_solar_point_init(const hf_solar_ctx *c, const hfvis_grid *g, int 
 {
     size_t i = (size_t)y * (size_t)g->width + (size_t)x;
     double n[3], slope;
-    hf_normal_at(g, x, y, n);
+    if (c->o.normals == HFVIS_SOLAR_NORMALS_HORN) hf_normal_horn_at(g, x, y, n);
+    else hf_normal_at(g, x, y, n);
     pt->p = hf_esra_pressure((double)g->z[(ptrdiff_t)y * g->stride + x]);
     pt->nx = n[0];
     pt->ny = n[1];
@@ -11125,6 +11158,23 @@ static void hf_solar_point_init(const hf_solar_ctx *c, const hfvis_grid *g, int 
     pt->linke_map = c->o.linke_map != NULL;
     pt->linke = c->o.linke_map ? (double)c->o.linke_map[i] : 0.0;
     pt->sky_ratio = 1.0;
+}
+
+/* The cosine-weighted visible sky of point i over the K horizons hor[k*n + i] at azimuths az[k],
+ * each raised to the point's tangent plane ([P1] Eq. 5 per sector); NaN at a hole. */
+static double hf_solar_sky_seen(const hf_solar_point *pt, int K, const double *az, const float *hor,
+                                size_t n, size_t i)
+{
+    double v = 0.0;
+    int k;
+    if (isnan(pt->nz)) return HFVIS__NAN;
+    for (k = 0; k < K; k++) {
+        double a = pt->nx * cos(az[k]) + pt->ny * sin(az[k]);
+        double t = tan((double)hor[(size_t)k * n + i]), tc = -a / pt->nz;
+        if (isnan(t) || t < tc) t = tc;
+        v += hfvis_sector_weight(K, pt->nz, a, HFVIS__HALF_PI - atan(t));
+    }
+    return v;
 }
 
 /* Visible fraction of the sun at elevation elev over horizon elevation hor: the centre's test,
@@ -12102,7 +12152,7 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
     float *map = NULL, *cellmap = NULL, *sky = NULL;
     const float *src = NULL; /* the direction-major map read (the caller's or map) */
     double *az = NULL;
-    int K;
+    int K, horn_sky;
     size_t n, i, bi;
     if ((st = hf_solar_run_init(g, in, opts, out, &r)) != HFVIS_OK) return st;
     n = hf_grid_count(g);
@@ -12112,12 +12162,10 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
     B.n = 0;
     st = hf_solar_run_blocks(g, &r, &B, &eph);
     r.c.eph = eph;
-    if (st == HFVIS_OK && r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON) {
-        sky = (float *)hfvis__alloc_array(r.al, n, sizeof(float));
-        if (!sky) st = HFVIS_ERR_OUT_OF_MEMORY;
-        else st = hfvis_sky_light(g, K, 1.0f, 1.0f, &s, sky, g->width);
-    }
-    if (st == HFVIS_OK && !r.c.o.no_shading) { /* the map read by the steps' azimuths */
+    /* HORIZON's visible sky over Horn's tangent planes is read from the whole map (every
+     * direction); else the map holds only the directions the steps read (hf_solar_map) */
+    horn_sky = r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON && r.c.o.normals == HFVIS_SOLAR_NORMALS_HORN;
+    if (st == HFVIS_OK && (!r.c.o.no_shading || horn_sky)) {
         if (n > SIZE_MAX / sizeof(float) / (size_t)K) st = HFVIS_ERR_LIMIT;
         if (st == HFVIS_OK) {
             az = (double *)hfvis__alloc_array(r.al, (size_t)K, sizeof(double));
@@ -12125,9 +12173,18 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
             if (!az || (!map && !r.c.o.horizon_map)) st = HFVIS_ERR_OUT_OF_MEMORY;
         }
         if (st == HFVIS_OK) st = hfvis_sweep_azimuths(K, &s, az, NULL);
-        if (st == HFVIS_OK && !r.c.o.horizon_map) st = hf_solar_map(g, &r, &B, K, az, &s, map);
+        if (st == HFVIS_OK && !r.c.o.horizon_map)
+            st = horn_sky ? hfvis_horizon_map(g, K, &s, map) : hf_solar_map(g, &r, &B, K, az, &s, map);
         src = r.c.o.horizon_map ? r.c.o.horizon_map : map;
     }
+    if (st == HFVIS_OK && r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON) {
+        sky = (float *)hfvis__alloc_array(r.al, n, sizeof(float));
+        if (!sky) st = HFVIS_ERR_OUT_OF_MEMORY;
+        else if (horn_sky)
+            for (i = 0; i < n; i++) sky[i] = (float)hf_solar_sky_seen(r.pts + i, K, az, src, n, i);
+        else st = hfvis_sky_light(g, K, 1.0f, 1.0f, &s, sky, g->width);
+    }
+    if (r.c.o.no_shading) src = NULL; /* no map read by the steps */
     for (bi = 0; bi < B.n && st == HFVIS_OK; bi++) {
         hf_solar_block part = B.b[bi], *blk = &part;
         int *kk = NULL;
@@ -12249,20 +12306,10 @@ hfvis_status hfvis_solar_irradiation_reference(const hfvis_grid *g, const hfvis_
     if (st == HFVIS_OK && r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON) {
         /* the visible sky: [P1] Eq. 5 per sector over the exact horizons of 4K directions, each
          * receiver's own rays (hfvis_horizon_exact_naive) along their actual azimuths */
-        int k;
         st = hfvis_sweep_azimuths(KR, &s, az, NULL);
         if (st == HFVIS_OK) st = hfvis_horizon_exact_naive(g, KR, &s, hor);
-        for (i = 0; i < n && st == HFVIS_OK; i++) {
-            hf_solar_point *pt = r.pts + i;
-            double v = 0.0;
-            for (k = 0; k < KR; k++) {
-                double a = pt->nx * cos(az[k]) + pt->ny * sin(az[k]);
-                double t = tan((double)hor[(size_t)k * n + i]), tc = -a / pt->nz;
-                if (isnan(t) || t < tc) t = tc;
-                v += hfvis_sector_weight(KR, pt->nz, a, HFVIS__HALF_PI - atan(t));
-            }
-            pt->sky_ratio = v / pt->r_sky;
-        }
+        for (i = 0; i < n && st == HFVIS_OK; i++)
+            r.pts[i].sky_ratio = hf_solar_sky_seen(r.pts + i, KR, az, hor, n, i) / r.pts[i].r_sky;
     }
     s.ray_denominator = HF_SOLAR_REF_DENOM;
     if (st == HFVIS_OK && r.c.in.latitude_map) st = hf_solar_reference_sites(g, &r, &s);

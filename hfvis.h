@@ -1468,7 +1468,9 @@ typedef enum hfvis_solar_diffuse {
     HFVIS_SOLAR_DIFFUSE_HORIZON = 1  /* beyond r.sun: the isotropic part of Muneer's model over
                                         the sky the receiver actually sees (scaled by V/r_sky,
                                         V the cosine-weighted visible sky of the exact horizon,
-                                        hfvis_sky_light with sky 1, r_sky = (1 + cos slope)/2),
+                                        hfvis_sky_light with sky 1; with HORN normals [P1]
+                                        Eq. 5 over the map's K horizons above Horn's tangent
+                                        plane; r_sky = (1 + cos slope)/2),
                                         the circumsolar part shaded with the beam */
 } hfvis_solar_diffuse;
 
@@ -1508,6 +1510,26 @@ typedef enum hfvis_solar_horizons {
                                           one-cell walls and cliffs) */
 } hfvis_solar_horizons;
 #define HFVIS_SOLAR_NEAR_CELLS 8
+
+/* The surface normal of a receiver: its incidence angle, its tangent plane (the shading's lower
+ * bound), r_sky = (1 + cos slope)/2, Muneer's F_g and the HORIZON visible sky. 0 is the default
+ * (hfvis's own, hfvis.h "Grids"). */
+typedef enum hfvis_solar_normals {
+    HFVIS_SOLAR_NORMALS_DEFAULT = 0,
+    HFVIS_SOLAR_NORMALS_CENTRAL = 0, /* the central differences of the four neighbours (one-sided
+                                        at the border and next to holes), as hfvis_normals_compute */
+    HFVIS_SOLAR_NORMALS_HORN = 1     /* Horn 1981 ("Hill shading and the reflectance map",
+                                        Proc. IEEE 69(1), its 3x3 gradient estimate): each
+                                        partial derivative the (1, 2, 1)-weighted
+                                        mean of the three central differences across the window,
+                                        as GRASS r.slope.aspect and gdaldem slope/aspect compute
+                                        slope and aspect (what r.sun reads); where a neighbour
+                                        of the 3x3 window is outside the grid or a hole, the
+                                        central difference (CENTRAL). r.slope.aspect leaves those
+                                        cells NULL (without -e) and gdaldem nodata (without
+                                        -compute_edges). The TERRAIN reflected term's [P2]
+                                        gather keeps its own (central) normals */
+} hfvis_solar_normals;
 
 /* What to compute: the site, the period and the surface. hfvis_solar_input_default() fills in
  * linke 3, albedo 0.2, days 1, 2026-06-21; latitude and longitude are the caller's to set. */
@@ -1578,6 +1600,7 @@ typedef struct hfvis_solar_options {
                                     the whole call's: calls on disjoint ranges split a run over
                                     threads (give them one horizon_map). Not with TERRAIN. The
                                     oracle ignores it */
+    hfvis_solar_normals normals; /* default CENTRAL; HORN to match r.sun fed by r.slope.aspect */
 } hfvis_solar_options;
 
 HFVIS_API hfvis_solar_options hfvis_solar_options_default(void);
@@ -1590,8 +1613,8 @@ HFVIS_API hfvis_sweep_options hfvis_solar_map_options(const hfvis_solar_options 
 
 /* The outputs: each NULL or bands*width*height floats, band b at [b*width*height + y*width + x]:
  * beam, diffuse and reflected on the receiver's own surface (normal from the grid, hfvis.h
- * "Grids"), their sum, and the hours of direct sun (beam > 0; weighted by the visible disc
- * fraction). NaN at holes. At least one must be set. */
+ * "Grids", or Horn's with opts->normals), their sum, and the hours of direct sun (beam > 0;
+ * weighted by the visible disc fraction). NaN at holes. At least one must be set. */
 typedef struct hfvis_solar_output {
     float *beam, *diffuse, *reflected, *global, *sun_hours;
 } hfvis_solar_output;

@@ -1321,6 +1321,20 @@ done
 cmp -s "$dir/solz1.pfm" "$dir/solze.pfm" && bad "solar --horizons lattice: equals exact bit for bit (mode not applied)" || ok "solar --horizons lattice differs from exact"
 "$hfvis" solar --help 2>&1 | grep -q -- '--horizons exact|near-far|lattice' && ok "solar --help lists --horizons" || bad "solar --help: no --horizons"
 expect_fail "solar: bad --horizons" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --horizons fast -o "$fdir/x.pfm"
+# --normals horn (Horn's 3x3 stencil): differs from central on a rough field, is central on a plane
+# (Horn's gradient is exact there; integer heights: bit for bit)
+awk 'BEGIN { print "P2"; print "16 12"; print "255"; r = 7
+  for (y = 0; y < 12; y++) { s = ""; for (x = 0; x < 16; x++) { r = (r * 1103515245 + 12345) % 2147483648; s = s " " int(r / 2147483648 * 200) } print s } }' > "$dir/rough.pgm"
+awk 'BEGIN { print "P2"; print "16 12"; print "255"
+  for (y = 0; y < 12; y++) { s = ""; for (x = 0; x < 16; x++) s = s " " (20 + 9 * x + 4 * y); print s } }' > "$dir/ramp.pgm"
+for f in rough ramp; do
+  for n in central horn; do
+    expect_ok "solar --normals $n on $f" "$dir/n_${f}_$n.pfm" solar "$dir/$f.pgm" --latitude 46 --longitude 15 --day 2026-03-21 --dirs 8 --normals $n -o "$dir/n_${f}_$n.pfm"
+  done
+done
+cmp -s "$dir/n_rough_central.pfm" "$dir/n_rough_horn.pfm" && bad "solar --normals horn equals central on a rough field" || ok "solar --normals horn differs from central on a rough field"
+cmp -s "$dir/n_ramp_central.pfm" "$dir/n_ramp_horn.pfm" && ok "solar --normals horn equals central on a plane" || bad "solar --normals horn differs from central on a plane"
+expect_fail "solar: bad --normals" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --normals sobel -o "$fdir/x.pfm"
 expect_fail "solar: no latitude (no CRS)" 1 solar "$dir/flat.pgm" --day 2026-06-21 -o "$fdir/x.pfm"
 expect_fail "solar: a date that does not exist" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-02-29 -o "$fdir/x.pfm"
 expect_fail "solar: Linke outside (0, 10]" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --linke 0 -o "$fdir/x.pfm"

@@ -10,20 +10,25 @@
 #   the fraction of those cells off by more than 5 %, the cells b leaves dark (< 1) that a
 #   lights (>= 1), and sum |a - b| / sum b over all the cells (the tile's energy);
 # for these pairs (a against b):
-#   hfvis / r.sun          the comparison: beam within TOL_BEAM (2 %, issue 27) or FAIL
-#   r.sun-cd / r.sun       r.sun with slope and aspect from central differences (hfvis's grid
-#                          normals, hfvis.h hfvis_normals_compute) instead of r.slope.aspect's
-#                          3 x 3 Horn stencil: what the normals alone change
-#   hfvis / r.sun-cd       what is left once the normals match: the shading
+#   hfvis / r.sun          the comparison, hfvis with --normals horn (r.slope.aspect's 3 x 3
+#                          Horn stencil, what r.sun reads): beam within TOL_BEAM (2 %, issue 27)
+#                          or FAIL
+#   hfvis-cd / r.sun       hfvis with its default normals (--normals central: central
+#                          differences, hfvis.h hfvis_normals_compute) against the same r.sun
+#   r.sun-cd / r.sun       r.sun with slope and aspect from central differences instead of
+#                          r.slope.aspect's: what the normals alone change in r.sun
+#   hfvis-cd / r.sun-cd    what is left once the normals match: the shading
 #   r.sun-cd-0.5 / r.sun-cd  r.sun's own march at distance_step 0.5 (half-cell steps) against
 #                          its default 1: how much r.sun's shadows move with its own step
 #   hfvis-256 / hfvis      hfvis with a K = 256 exact horizon map against the default K = 64
+# then hfvis / r.sun-cd's beam by r.sun-cd's value and by the distance to the edge, and one
+# instant's shadow masks (below).
 # docs/solar.md ("Against r.sun on real DEMs") holds the table and the explanations.
 # The DEMs come from HFVIS_BENCH_DEMS (a folder holding colorado_srtm_512_90m.pfm and
 # slovenia_lidar_1000_1m.pfm, as for make bench); the lidar DTM is cropped to its central
 # LIDAR_CROP^2 cells (default 400: r.sun takes about 7 minutes for one day on the whole 1000^2;
 # LIDAR_CROP=1000 runs it whole). SKIPs (exit 0) without `grass` (Debian: grass-core) or the DEMs.
-# usage: HFVIS_BENCH_DEMS=DIR sh test/solar_rsun_dem.sh [SCRATCHDIR]   (about 5 minutes)
+# usage: HFVIS_BENCH_DEMS=DIR sh test/solar_rsun_dem.sh [SCRATCHDIR]   (22 minutes on 2 shared cores)
 TOL_BEAM=0.02   # issue 27: the daily beam within 2 % mean of r.sun with its own shadowing
 DARK=1          # Wh/m^2: a cell below this in the reference is left out of the relative means
 OFF=0.05        # the per-cell difference counted as "off"
@@ -72,11 +77,13 @@ for day in 172 355; do
     { echo "FAIL $name: r.sun"; exit 1; }
   r.sun elevation=dem slope=slcd aspect=ascd beam_rad=cd_b diff_rad=cd_d refl_rad=cd_r glob_rad=cd_g "$@"
   r.sun elevation=dem slope=slcd aspect=ascd distance_step=0.5 beam_rad=c5_b diff_rad=c5_d refl_rad=c5_r glob_rad=c5_g "$@"
-  for k in 64 256; do
+  # h64, h256: Horn normals at K = 64 and 256; hc: central differences at K = 64
+  for run in "h64 64 horn" "h256 256 horn" "hc 64 central"; do
+    set -- $run
     "$cli" solar "$dir/dem.tif" --latitude "$lat" --longitude "$lon" --solar-time --day $date --step 15m \
-      --linke 3 --albedo 0.2 --dirs $k --quiet -o "$dir/g.tif" --beam "$dir/b.tif" --diffuse "$dir/d.tif" \
-      --reflected "$dir/r.tif" || { echo "FAIL $name: hfvis solar"; exit 1; }
-    for p in b d r g; do r.in.gdal -o input="$dir/$p.tif" output=h${k}_$p --overwrite --quiet >/dev/null 2>&1; done
+      --linke 3 --albedo 0.2 --dirs $2 --normals $3 --quiet -o "$dir/g.tif" --beam "$dir/b.tif" \
+      --diffuse "$dir/d.tif" --reflected "$dir/r.tif" || { echo "FAIL $name: hfvis solar"; exit 1; }
+    for p in b d r g; do r.in.gdal -o input="$dir/$p.tif" output=${1}_$p --overwrite --quiet >/dev/null 2>&1; done
   done
   # compare A B LABEL: one line "name day LABEL  beam mean off dark  diffuse ...  global ..."
   compare() {
@@ -91,19 +98,28 @@ for day in 172 355; do
     echo "$line"
   }
   compare h64 rs "hfvis/r.sun"
+  compare hc rs "hfvis-cd/r.sun"
   compare cd rs "r.sun-cd/r.sun"
-  compare h64 cd "hfvis/r.sun-cd"
+  compare hc cd "hfvis-cd/r.sun-cd"
   compare c5 cd "r.sun-cd-0.5/r.sun-cd"
   compare h256 h64 "hfvis-256/hfvis"
   m=$(r.univar -g rs_b | sed -n 's/^mean=//p'); h=$(r.univar -g h64_b | sed -n 's/^mean=//p')
   echo "$name day $day means beam r.sun $m hfvis $h"
-  # where hfvis/r.sun-cd differs: mean |a - b| / b of the beam by r.sun's daily beam
+  # where hfvis-cd/r.sun-cd differs: mean |a - b| / b of the beam by r.sun-cd's daily beam
   line="$name day $day beam by r.sun-cd's value:"
   for lh in "1 100" "100 300" "300 1000" "1000 3000" "3000 1000000000"; do
     set -- $lh
-    r.mapcalc "x = if(!isnull(rs_b) && cd_b >= $1 && cd_b < $2, abs(h64_b - cd_b) / cd_b, null())" --overwrite --quiet
+    r.mapcalc "x = if(!isnull(rs_b) && cd_b >= $1 && cd_b < $2, abs(hc_b - cd_b) / cd_b, null())" --overwrite --quiet
     c=$(r.univar -g x 2>/dev/null | sed -n 's/^n=//p'); v=$(r.univar -g x 2>/dev/null | sed -n 's/^mean=//p')
     [ "${c:-0}" -gt 0 ] && line="$line [$1, $2) $c cells $(printf '%.4f' "$v")"
+  done
+  echo "$line"
+  # and by the distance to the grid's edge (r.sun's march ends lit there, hfvis --border open)
+  line="$name day $day beam by cells from the edge:"
+  for lh in "2 5" "6 20" "21 100000"; do
+    set -- $lh
+    r.mapcalc "x = if(!isnull(rs_b) && cd_b >= $DARK && min(row(), col(), nrows() + 1 - row(), ncols() + 1 - col()) >= $1 && min(row(), col(), nrows() + 1 - row(), ncols() + 1 - col()) <= $2, abs(hc_b - cd_b) / cd_b, null())" --overwrite --quiet
+    line="$line [$1, $2] $(r.univar -g x 2>/dev/null | sed -n 's/^n=//p') cells $(printf '%.4f' "$(r.univar -g x 2>/dev/null | sed -n 's/^mean=//p')")"
   done
   echo "$line"
 done

@@ -1889,6 +1889,8 @@ static void args_solar_band_count(void)
     BADV('N', hfvis_solar_band_count(NULL, NULL) == -1);
     b = in; b.days = 0; BADV('Z', hfvis_solar_band_count(&b, NULL) == -1);
     o.bands = (hfvis_solar_bands)9; BADV('E', hfvis_solar_band_count(&in, &o) == -1);
+    o.bands = HFVIS_SOLAR_BANDS_DEFAULT;
+    o.normals = (hfvis_solar_normals)5; BADV('E', hfvis_solar_band_count(&in, &o) == -1);
     CHECK(hfvis_solar_band_count(&in, NULL) == 1);
 }
 
@@ -1926,6 +1928,8 @@ static void solar_args(const char *name, solar_fn fn)
     bo2 = o; bo2.diffuse = (hfvis_solar_diffuse)7; BAD('E', INV, fn(&g_ok, &in, &bo2, &out));
     bo2 = o; bo2.horizons = (hfvis_solar_horizons)7; BAD('E', INV, fn(&g_ok, &in, &bo2, &out));
     bo2 = o; bo2.row_begin = 3; bo2.row_end = 2; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));
+    bo2 = o; bo2.normals = (hfvis_solar_normals)2; BAD('E', INV, fn(&g_ok, &in, &bo2, &out));
+    bo2 = o; bo2.normals = (hfvis_solar_normals)-1; BAD('E', INV, fn(&g_ok, &in, &bo2, &out));
     bo2 = o; bo2.step_hours = -0.25; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));
     bo2 = o; bo2.sun_radius_rad = 1.0; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));
     bo2 = o; bo2.directions = -1; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));

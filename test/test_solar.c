@@ -42,6 +42,9 @@
 /* TERRAIN reflection, fast against oracle: the [P2] tree and the naive sets agree to rounding,
  * so what differs is the exit irradiance albedo * (beam + diffuse), fast against oracle. */
 #define TERRAIN_REFL_REL 0.005
+/* HORN against a plane's central differences: both exact on a plane, so what differs is the float
+ * rounding of the heights (2^-24 of ~100 m) over a drop of a fraction of a cell. */
+#define HORN_EXACT_REL 2e-5
 /* Day length from the steps' weights against a 1-second scan of the true elevation. */
 #define DAY_LENGTH_TOL_H (2.0 / 3600.0)
 /* Daily sums at 60-minute steps against 1-minute steps on open ground (midpoint rule with
@@ -416,6 +419,111 @@ TEST(sector_sums_against_oracle)
         snprintf(name, sizeof name, "30 days, case %d", c);
         compare_oracle(name, &m, &sh);
         CHECK(m <= ORACLE_MEAN_REL && sh <= CELL_BEAM_SHARE);
+    }
+}
+
+/* The plane through (x, y) with the drops gx, gy per world unit along +x, +y and z(x, y) = z0:
+ * its central differences are exact, so its normal is the one these drops give. */
+static void plane_through(float *z, int x, int y, double cell, double z0, double gx, double gy)
+{
+    int i, j;
+    for (j = 0; j < H; j++)
+        for (i = 0; i < W; i++) z[j * W + i] = (float)(z0 + cell * (gx * (i - x) + gy * (j - y)));
+}
+
+/* HORN on surfaces whose 3x3 stencil has a closed form, at an instant and over a day without
+ * shading (every term then depends on the cell's height and normal only): the outputs at
+ * (x, y) equal those of a plane of the closed form's gradient through the same height (CENTRAL
+ * is exact there). A plane: Horn's gradient is exact (= CENTRAL everywhere). A quadratic
+ * a X^2 + b Y^2 + c XY: exact too. k X Y^2: Horn (k (Y^2 + cell^2/2), 2kXY), the weights (1, 2, 1)/4
+ * of the rows' central differences (CENTRAL gives k Y^2): the stencil itself. */
+TEST(horn_normals_closed_forms)
+{
+    static float surf[W * H], pl[W * H], a[5][W * H], b[5][W * H];
+    const double cell = 2.0;
+    hfvis_grid gs = test_grid(surf, W, H, cell), gp = test_grid(pl, W, H, cell);
+    hfvis_solar_output oa = outs(a), obp = outs(b);
+    int shape, inst, x, y, q;
+    for (shape = 0; shape < 3; shape++)
+        for (inst = 0; inst < 2; inst++) {
+            hfvis_solar_input in = site(46.0, 3, 21);
+            hfvis_solar_options horn = hfvis_solar_options_default(), cen = horn;
+            int probes[3][2] = { { 5, 9 }, { 12, 11 }, { 18, 7 } }, p;
+            horn.normals = HFVIS_SOLAR_NORMALS_HORN;
+            horn.no_shading = cen.no_shading = 1;
+            horn.model = cen.model = HFVIS_SUN_RSUN;
+            in.instant = inst;
+            in.hour = 10.0;
+            for (y = 0; y < H; y++)
+                for (x = 0; x < W; x++) {
+                    double X = (x - 11) * cell, Y = (y - 9) * cell;
+                    surf[y * W + x] = (float)(100.0 + (shape == 0 ? 0.4 * X - 0.7 * Y
+                                                       : shape == 1 ? 0.01 * X * X - 0.02 * Y * Y + 0.015 * X * Y
+                                                       : 0.005 * X * Y * Y));
+                }
+            CHECK_EQ_STATUS(hfvis_solar_irradiation(&gs, &in, &horn, &oa), HFVIS_OK);
+            if (shape == 0) { /* a plane: Horn = central everywhere, the border's fallback too */
+                CHECK_EQ_STATUS(hfvis_solar_irradiation(&gs, &in, &cen, &obp), HFVIS_OK);
+                for (q = 0; q < 4; q++)
+                    for (x = 0; x < W * H; x++) CHECK_NEAR(a[q][x], b[q][x], 1e-3, HORN_EXACT_REL);
+                continue;
+            }
+            for (p = 0; p < 3; p++) {
+                int px = probes[p][0], py = probes[p][1], i = py * W + px;
+                double X = (px - 11) * cell, Y = (py - 9) * cell, dx, dy;
+                if (shape == 1) dx = 0.02 * X + 0.015 * Y, dy = -0.04 * Y + 0.015 * X;
+                else dx = 0.005 * (Y * Y + 0.5 * cell * cell), dy = 0.01 * X * Y;
+                plane_through(pl, px, py, cell, (double)surf[i], dx, dy);
+                CHECK_EQ_STATUS(hfvis_solar_irradiation(&gp, &in, &cen, &obp), HFVIS_OK);
+                for (q = 0; q < 4; q++) CHECK_NEAR(a[q][i], b[q][i], 1e-3, HORN_EXACT_REL);
+                if (shape == 2 && inst) { /* and not the central difference's k Y^2 (an instant:
+                                              an east-west tilt's day is even to first order) */
+                    plane_through(pl, px, py, cell, (double)surf[i], 0.005 * Y * Y, dy);
+                    CHECK_EQ_STATUS(hfvis_solar_irradiation(&gp, &in, &cen, &obp), HFVIS_OK);
+                    CHECK(fabs((double)a[0][i] - (double)b[0][i]) > 1e-3 * (double)b[0][i]);
+                }
+            }
+        }
+}
+
+/* HORN on seeded fBm with a hole (and HORIZON diffuse), fast against the oracle; it differs from CENTRAL inside and
+ * equals it (the documented fallback, bit for bit) on the outer ring and next to the hole. */
+TEST(horn_normals_against_oracle)
+{
+    hfvis_grid g = test_grid(zbuf, W, H, 1.0);
+    static float cen[5][W * H];
+    uint64_t seed;
+    for (seed = 11; seed <= 13; seed++) {
+        hfvis_solar_input in = site(seed == 12 ? -35.0 : 46.0, 2 + (int)seed - 10, 10);
+        hfvis_solar_options o = hfvis_solar_options_default(), c = o;
+        hfvis_solar_output oc = outs(cen);
+        double m, sh;
+        int x, y, differ = 0;
+        char name[32];
+        (void)test_fbm(zbuf, W, H, 6.0, 8.0, 0, seed);
+        zbuf[10 * W + 1] = (float)NAN; /* outside compare_oracle's interior, its neighbours inside */
+        o.normals = HFVIS_SOLAR_NORMALS_HORN;
+        if (seed == 12) /* over Horn's planes (CENTRAL's visible sky is hfvis_sky_light's) */
+            o.diffuse = c.diffuse = HFVIS_SOLAR_DIFFUSE_HORIZON;
+        if (seed == 13) {
+            o.model = c.model = HFVIS_SUN_RSUN;
+            in.days = 30; /* the sector sums */
+        }
+        run_pair(&g, &in, &o);
+        snprintf(name, sizeof name, "horn, fbm seed %d", (int)seed);
+        compare_oracle(name, &m, &sh);
+        CHECK(m <= ORACLE_MEAN_REL && sh <= CELL_BEAM_SHARE);
+        CHECK_EQ_STATUS(hfvis_solar_irradiation(&g, &in, &c, &oc), HFVIS_OK);
+        for (y = 0; y < H; y++)
+            for (x = 0; x < W; x++) {
+                int i = y * W + x, fallback = x == 0 || y == 0 || x == W - 1 || y == H - 1 ||
+                                              (x <= 2 && abs(y - 10) <= 1);
+                if (fallback && !(x == 1 && y == 10))
+                    CHECK(memcmp(&ob[0][i], &cen[0][i], sizeof(float)) == 0 &&
+                          (seed == 12 || memcmp(&ob[3][i], &cen[3][i], sizeof(float)) == 0));
+                differ += !fallback && ob[3][i] != cen[3][i];
+            }
+        CHECK(differ > (W - 2) * (H - 2) / 2);
     }
 }
 
@@ -1104,6 +1212,8 @@ int main(int argc, char **argv)
     RUN(wall_and_pit_against_oracle);
     RUN(random_terrains_against_oracle);
     RUN(sector_sums_against_oracle);
+    RUN(horn_normals_closed_forms);
+    RUN(horn_normals_against_oracle);
     RUN(horizon_diffuse_and_terrain_reflection);
     RUN(sunrise_and_sunset_inside_the_step);
     RUN(polar_night_and_bands);

@@ -50,8 +50,8 @@
     "         [--linke L | --linke-monthly L1,...,L12 | --linke-map L.pfm] [--albedo A |\n"          \
     "         --albedo-map A.pfm] -o GLOBAL [--beam B] [--diffuse D] [--reflected R]\n"             \
     "         [--sun-hours H] [--latitude DEG --longitude DEG] [--utc-offset H | --solar-time]\n"    \
-    "         [--bands day|month] [--sun-radius DEG] [--dirs K] [--max-distance R]\n"              \
-    "         [--horizons exact|near-far|lattice]\n"                                                \
+    "         [--bands day|month] [--normals central|horn] [--sun-radius DEG] [--dirs K]\n"     \
+    "         [--max-distance R] [--horizons exact|near-far|lattice]\n"                          \
     "Clear-sky solar irradiation (Wh/m^2) of a day or a date range, or irradiance (W/m^2) at\n"     \
     "--time, on every cell: r.sun's ESRA atmosphere (Suri & Hofierka 2004), the sun from NREL's\n"  \
     "SPA (Reda & Andreas 2004/2008), the beam shaded by exact horizons (docs/solar.md).\n"          \
@@ -69,6 +69,10 @@
     "  --utc-offset H    dates and --time are UTC + H (default 0); --solar-time: local solar time\n" \
     "                    and r.sun's solar geometry and steps (r.sun's convention)\n"               \
     "  --bands day|month one band per day or per calendar month, stacked like horizon planes\n"     \
+    "  --normals N       the cells' surface normals: central (default): central differences;\n"    \
+    "                    horn: Horn's 3x3 stencil, as r.slope.aspect and gdaldem slope/aspect\n"   \
+    "                    (what r.sun reads; central differences on the outer ring and next to\n"   \
+    "                    holes)\n"                                                               \
     "  --sun-radius DEG  shade the sun's disc (default: its centre); --dirs K: directions of the\n" \
     "                    exact horizon map (default 64)\n"                                          \
     "  --horizons H      the horizons that shade: exact (default), near-far (exact within 8\n"     \

@@ -78,6 +78,12 @@ static int cli_set_solar(cli_args *a, const char *f, const char *v)
         else return cli_error(CLI_EXIT_USAGE, f, "expected exact, near-far or lattice, got '%s'", v);
         return 0;
     }
+    if (!strcmp(f, "--normals")) {
+        if (!strcmp(v, "central")) a->sol_normals = HFVIS_SOLAR_NORMALS_CENTRAL;
+        else if (!strcmp(v, "horn")) a->sol_normals = HFVIS_SOLAR_NORMALS_HORN;
+        else return cli_error(CLI_EXIT_USAGE, f, "expected central or horn, got '%s'", v);
+        return 0;
+    }
     if (!strcmp(f, "--beam") || !strcmp(f, "--diffuse") || !strcmp(f, "--reflected") || !strcmp(f, "--sun-hours")) {
         if (!ex_rio_format_of(v) && !cli_ends_with(v, ".pfm"))
             return cli_error(CLI_EXIT_USAGE, v, "unknown output type (use a .pfm, .tif, .asc, .bil or .flt name)");
@@ -329,6 +335,7 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     if (a->has_sun_radius) so.sun_radius_rad = a->sun_radius * (CLI_PI / 180.0);
     so.bands = (hfvis_solar_bands)a->sol_bands;
     so.horizons = (hfvis_solar_horizons)a->sol_horizons;
+    so.normals = (hfvis_solar_normals)a->sol_normals;
     so.sweep = opts;
     if (a->sol_has_linke_monthly) {
         for (k = 0; k < 12; k++) monthly[k] = (float)a->sol_linke_monthly[k];
