@@ -1504,10 +1504,12 @@ typedef enum hfvis_solar_horizons {
                                           ray_near_cells as given, 0 by default) */
     HFVIS_SOLAR_HORIZONS_NEAR_FAR = 2, /* exact rays within HFVIS_SOLAR_NEAR_CELLS cells, the
                                           shared far field beyond (hfvis_sweep_options.
-                                          ray_near_cells; about 0.7x the exact map's cost at K = 64) */
-    HFVIS_SOLAR_HORIZONS_LATTICE = 3   /* [P1] lattice horizons (HFVIS_RAYS_LATTICE; about 8x
-                                          cheaper than exact at K = 64; misses shadow next to
-                                          one-cell walls and cliffs) */
+                                          ray_near_cells; about 0.6x the exact map's cost at K = 64
+                                          on the Colorado tile) */
+    HFVIS_SOLAR_HORIZONS_LATTICE = 3   /* [P1] lattice horizons (HFVIS_RAYS_LATTICE; about 3x
+                                          cheaper than the exact map at K = 64 on the Colorado
+                                          tile; misses shadow next to one-cell walls and
+                                          cliffs) */
 } hfvis_solar_horizons;
 #define HFVIS_SOLAR_NEAR_CELLS 8
 
