@@ -23,6 +23,25 @@ static long cli_solar_day_number(int y, int m, int d)
     return era * 146097 + doe;
 }
 
+/* A choice flag's word: the i-th of words ("a|b|c") stores first + i in *out; else one error line
+ * naming the words. */
+static int sol_word(const char *f, const char *v, const char *words, int first, int *out)
+{
+    const char *w = words;
+    int i = 0;
+    size_t n = strlen(v);
+    while (*w) {
+        size_t len = strcspn(w, "|");
+        if (len == n && !strncmp(w, v, n)) {
+            *out = first + i;
+            return 0;
+        }
+        w += len + (w[len] == '|');
+        i++;
+    }
+    return cli_error(CLI_EXIT_USAGE, f, "expected one of %s, got '%s'", words, v);
+}
+
 static int cli_set_solar(cli_args *a, const char *f, const char *v)
 {
     if (!strcmp(f, "--day") || !strcmp(f, "--start"))
@@ -65,25 +84,11 @@ static int cli_set_solar(cli_args *a, const char *f, const char *v)
     }
     if (!strcmp(f, "--linke-map")) { a->sol_linke_map = v; return 0; }
     if (!strcmp(f, "--solar-time")) { a->sol_solar_time = 1; return 0; }
-    if (!strcmp(f, "--bands")) {
-        if (!strcmp(v, "day")) a->sol_bands = HFVIS_SOLAR_BANDS_DAY;
-        else if (!strcmp(v, "month")) a->sol_bands = HFVIS_SOLAR_BANDS_MONTH;
-        else return cli_error(CLI_EXIT_USAGE, f, "expected day or month, got '%s'", v);
-        return 0;
-    }
-    if (!strcmp(f, "--horizons")) {
-        if (!strcmp(v, "exact")) a->sol_horizons = HFVIS_SOLAR_HORIZONS_EXACT;
-        else if (!strcmp(v, "near-far")) a->sol_horizons = HFVIS_SOLAR_HORIZONS_NEAR_FAR;
-        else if (!strcmp(v, "lattice")) a->sol_horizons = HFVIS_SOLAR_HORIZONS_LATTICE;
-        else return cli_error(CLI_EXIT_USAGE, f, "expected exact, near-far or lattice, got '%s'", v);
-        return 0;
-    }
-    if (!strcmp(f, "--normals")) {
-        if (!strcmp(v, "central")) a->sol_normals = HFVIS_SOLAR_NORMALS_CENTRAL;
-        else if (!strcmp(v, "horn")) a->sol_normals = HFVIS_SOLAR_NORMALS_HORN;
-        else return cli_error(CLI_EXIT_USAGE, f, "expected central or horn, got '%s'", v);
-        return 0;
-    }
+    if (!strcmp(f, "--bands")) return sol_word(f, v, "day|month", HFVIS_SOLAR_BANDS_DAY, &a->sol_bands);
+    if (!strcmp(f, "--horizons"))
+        return sol_word(f, v, "exact|near-far|lattice", HFVIS_SOLAR_HORIZONS_EXACT, &a->sol_horizons);
+    if (!strcmp(f, "--normals"))
+        return sol_word(f, v, "central|horn", HFVIS_SOLAR_NORMALS_CENTRAL, &a->sol_normals);
     if (!strcmp(f, "--beam") || !strcmp(f, "--diffuse") || !strcmp(f, "--reflected") || !strcmp(f, "--sun-hours")) {
         if (!ex_rio_format_of(v) && !cli_ends_with(v, ".pfm"))
             return cli_error(CLI_EXIT_USAGE, v, "unknown output type (use a .pfm, .tif, .asc, .bil or .flt name)");
