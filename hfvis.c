@@ -10209,32 +10209,35 @@ static hfvis_status hf_exact_sums(hf_exact *E, const hfvis_grid *g, int K, hfvis
             const double *tr = E->tan + r;
             double *acc = banded ? add : E->acc, *ar = acc + r * (size_t)channels;
             hf_exact_span(E, y, E->d.ray[k], &x0, &x1);
-            for (x = x0; banded && x < x1; x++) { /* a band's holes and normals (unless given) */
-                double n[3];
-                float *nr = E->nrm_own ? E->nrm_own + (r + (size_t)x) * 3 : NULL;
-                if (hf_is_hole(g, x, y))
-                    for (c = 0; c < channels; c++) ar[(size_t)x * (size_t)channels + (size_t)c] = HFVIS__NAN;
-                else if (nr) { /* hfvis_normals_compute's bits */
+            for (x = x0; E->nrm_own && banded && x < x1; x++) /* a band's normals, unless given */
+                if (!isnan(tr[x])) { /* hfvis_normals_compute's bits */
+                    double n[3];
+                    float *nr = E->nrm_own + (r + (size_t)x) * 3;
                     hf_normal_at(g, x, y, n);
                     nr[0] = (float)n[0];
                     nr[1] = (float)n[1];
                     nr[2] = (float)n[2];
                 }
-            }
+            /* holes: the sweep's tangent is NaN there (hf_exact_sweep), so a band marks them
+               only where the tangent is NaN, in the terms' own loop */
             if (kind == HFVIS_SUM_SKY_VIEW) {
                 for (x = x0; x < x1; x++)
                     if (!isnan(tr[x])) ar[x] += wk * hf_svf_term(tr[x]);
+                    else if (banded && hf_is_hole(g, x, y)) ar[x] = HFVIS__NAN;
             } else if (kind == HFVIS_SUM_SKY_LIGHT) {
                 for (x = x0; x < x1; x++)
                     if (!isnan(tr[x]))
                         ar[x] += hf_exact_sky_term(&E->d, k, cp, sp, E->nrm + (r + (size_t)x) * 3, tr[x]);
+                    else if (banded && hf_is_hole(g, x, y)) ar[x] = HFVIS__NAN;
             } else {
                 for (x = x0; x < x1; x++) {
                     const float *nr = E->nrm + (r + (size_t)x) * 3;
-                    if (isnan(tr[x])) continue;
                     i = r + (size_t)x;
-                    hf_env_accumulate(&eval, k, cp, sp, (double)nr[0], (double)nr[1], (double)nr[2], tr[x],
-                                      acc + i * (size_t)channels);
+                    if (!isnan(tr[x]))
+                        hf_env_accumulate(&eval, k, cp, sp, (double)nr[0], (double)nr[1], (double)nr[2], tr[x],
+                                          acc + i * (size_t)channels);
+                    else if (banded && hf_is_hole(g, x, y))
+                        for (c = 0; c < channels; c++) acc[i * (size_t)channels + (size_t)c] = HFVIS__NAN;
                 }
             }
         }
