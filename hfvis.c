@@ -9383,6 +9383,7 @@ struct hf_near_off {
     ptrdiff_t toff;        /* the piece's cell in the twist plane (hf_exact.twist) */
     int dx, dy;            /* the period's base offset k (a, b) */
     double u, ic;          /* the crossing's distance (sub-steps); scale / u */
+    double icm;            /* scale / the piece's midpoint distance (a piece split in two) */
 };
 typedef struct hf_near_off hf_near_off;
 
@@ -9452,6 +9453,7 @@ static int hf_near_offsets(const hf_exact *E, const hf_cross *cr, int P, int a, 
             o[n].toff = (ptrdiff_t)(k * b + c->cy) * g->width + (k * a + c->cx);
             o[n].u = u;
             o[n].ic = u > 0.0 ? scale / u : 0.0;
+            o[n].icm = scale / (u + c->du * 0.5); /* hf_near_fill's sample j = 1 of 2, bit for bit */
             for (j = 0; j < 2; j++) { /* the crossing's taps, then the piece's cell */
                 x0 = k * a + (j ? c->cx : c->ox);
                 y0 = k * b + (j ? c->cy : c->oy);
@@ -9473,7 +9475,7 @@ static double hf_near_fill(const float *p, ptrdiff_t stride, const hf_cross *c, 
     double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
     int j = hf_piece_fill(p, stride, c, bulge, lim, ph, pu);
     while (j-- > 0) {
-        double t = (ph[j] - hr) / (u0 + pu[j]) * scale;
+        double t = (ph[j] - hr) * (scale / (u0 + pu[j]));
         if (t > best) best = t;
     }
     return best;
@@ -9554,11 +9556,23 @@ static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int bo
                     tt = (h - (double)zr[x]) * ic;
                     row[x] = tt > rx ? tt : rx;
                 }
-            if (c->du > 0.0)
+            if (c->du > 0.0) {
+                /* a piece split in two (bulge in (lim, 4 lim]: most splits) takes its midpoint
+                   without a branch, as hf_exact_piece's eager form (on rough ground a quarter of
+                   the pieces split at random); finer splits through hf_near_fill */
+                const double mfx = c->mfx, mfy = c->mfy, icm = o[i].icm, lim4 = 4.0 * lim;
                 for (x = xa; x < xb; x++) {
+                    const float *zq = zp + x;
                     double bulge = q * tp[x]; /* q hf_cell_twist; NaN at holes */
-                    if (bulge > lim) row[x] = hf_near_fill(zp + x, S, c, bulge, lim, o[i].u, (double)zr[x], scale, row[x]);
+                    double z00 = (double)zq[0], z10 = (double)zq[1], z01 = (double)zq[S], z11 = (double)zq[S + 1];
+                    double r0 = z00 + (z10 - z00) * mfx, r1 = z01 + (z11 - z01) * mfx, rx = row[x];
+                    double tt = (r0 + (r1 - r0) * mfy - (double)zr[x]) * icm;
+                    tt = bulge > lim ? tt : -HFVIS__INF;
+                    rx = tt > rx ? tt : rx;
+                    if (bulge > lim4) rx = hf_near_fill(zq, S, c, bulge, lim, o[i].u, (double)zr[x], scale, row[x]);
+                    row[x] = rx;
                 }
+            }
         }
         for (x = E->rx0; x < E->rx1; x++) {
             double hr = (double)zr[x];
@@ -9613,18 +9627,34 @@ static int hf_far_samples(hf_exact *E, int64_t px, int64_t py, int a, int b, int
             Y0 < -E->R - 1 - (b < 0 ? -b : b) || Y0 > g->height + E->R + (b < 0 ? -b : b))
             continue; /* the whole period out of reach */
         for (e = P - 1; e >= 0; e--) { /* as hf_exact_samples' pre-roll */
-            int X = (int)X0 + cr[e].ox, Y = (int)Y0 + cr[e].oy;
+            const hf_cross *c = cr + e;
+            const int X = (int)X0 + c->ox, Y = (int)Y0 + c->oy, CX = (int)X0 + c->cx, CY = (int)Y0 + c->cy;
             double h;
-            j = hf_piece_samples(g, E->border, E->R, (int)X0, (int)Y0, cr + e, ph, pu);
+            if (CX >= 0 && CY >= 0 && CX + 1 < g->width && CY + 1 < g->height) {
+                /* the cell inside the grid: hf_piece_samples' test and samples, its taps read in
+                   place (a tap that is a hole or infinite makes the bulge fail the test) */
+                const float *p = g->z + (ptrdiff_t)CY * g->stride + CX;
+                double bulge = c->q * hf_cell_twist(p, g->stride);
+                j = c->du > 0.0 && bulge > lim && bulge < HFVIS__INF ? hf_piece_fill(p, g->stride, c, bulge, lim, ph, pu) : 0;
+            } else {
+                j = E->border == HFVIS_BORDER_OPEN ? 0 : hf_piece_samples(g, E->border, E->R, (int)X0, (int)Y0, c, ph, pu);
+            }
             while (j-- > 0) {
                 if (isnan(ph[j])) continue;
-                sd[n] = base - (cr[e].u + pu[j]);
+                sd[n] = base - (c->u + pu[j]);
                 sh[n++] = ph[j];
             }
-            if (!hf_cross_inside(g, E->R, X, Y, cr + e)) continue;
-            h = hf_cross_height(g, E->border, X, Y, cr + e);
-            if (isnan(h)) continue;
-            sd[n] = base - cr[e].u;
+            if (X >= 0 && Y >= 0 && X + (c->kind == 2) < g->width && Y + (c->kind == 1) < g->height) {
+                const float *p = g->z + (ptrdiff_t)Y * g->stride + X; /* hf_cross_height inside the grid */
+                h = (double)p[0];
+                if (c->kind != 0) h += ((double)p[c->kind == 1 ? g->stride : 1] - h) * c->f;
+                if (!isfinite(h)) continue;
+            } else {
+                if (E->border == HFVIS_BORDER_OPEN || !hf_cross_inside(g, E->R, X, Y, c)) continue;
+                h = hf_cross_height(g, E->border, X, Y, c);
+                if (isnan(h)) continue;
+            }
+            sd[n] = base - c->u;
             sh[n++] = h;
         }
     }
