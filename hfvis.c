@@ -9492,12 +9492,28 @@ static double hf_near_one(const hf_exact *E, const hf_near_off *o, int n, int x,
     for (i = 0; i < n; i++) {
         const hf_cross *c = o[i].c;
         int X = x + o[i].dx, Y = y + o[i].dy;
+        const int CX = X + c->cx, CY = Y + c->cy, open = E->border == HFVIS_BORDER_OPEN;
         float z[4];
-        if (o[i].cross && hf_cross_inside(g, E->R, X + c->ox, Y + c->oy, c)) {
-            double h = hf_cross_height(g, E->border, X + c->ox, Y + c->oy, c), t = (h - hr) * o[i].ic;
-            if (t > best) best = t; /* NaN (a hole) never is */
+        if (o[i].cross) {
+            const int KX = X + c->ox, KY = Y + c->oy;
+            double h = HFVIS__NAN, t;
+            if (KX >= 0 && KY >= 0 && KX + (c->kind == 2) < g->width && KY + (c->kind == 1) < g->height) {
+                const float *p = g->z + (ptrdiff_t)KY * g->stride + KX; /* hf_cross_height inside the grid */
+                h = (double)p[0];
+                if (c->kind != 0) h += ((double)p[c->kind == 1 ? g->stride : 1] - h) * c->f;
+                if (!isfinite(h)) h = HFVIS__NAN;
+            } else if (!open && hf_cross_inside(g, E->R, KX, KY, c)) {
+                h = hf_cross_height(g, E->border, KX, KY, c);
+            }
+            t = (h - hr) * o[i].ic;
+            if (t > best) best = t; /* NaN (a hole, out of reach) never is */
         }
-        if (c->du > 0.0 && hf_exact_cell_taps(g, E->border, E->R, X + c->cx, Y + c->cy, z)) {
+        if (!(c->du > 0.0)) continue;
+        if (CX >= 0 && CY >= 0 && CX + 1 < g->width && CY + 1 < g->height) {
+            const float *p = g->z + (ptrdiff_t)CY * g->stride + CX; /* the cell's taps in place */
+            double bulge = c->q * hf_cell_twist(p, g->stride);
+            if (bulge > lim && bulge < HFVIS__INF) best = hf_near_fill(p, g->stride, c, bulge, lim, o[i].u, hr, scale, best);
+        } else if (!open && hf_exact_cell_taps(g, E->border, E->R, CX, CY, z)) {
             double bulge = c->q * hf_cell_twist(z, 2);
             if (bulge > lim && bulge < HFVIS__INF) best = hf_near_fill(z, 2, c, bulge, lim, o[i].u, hr, scale, best);
         }
@@ -9558,19 +9574,18 @@ static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int bo
                 }
             if (c->du > 0.0) {
                 /* a piece split in two (bulge in (lim, 4 lim]: most splits) takes its midpoint
-                   without a branch, as hf_exact_piece's eager form (on rough ground a quarter of
-                   the pieces split at random); finer splits through hf_near_fill */
+                   inline (hf_near_fill's sample, the same bits); finer splits through it */
                 const double mfx = c->mfx, mfy = c->mfy, icm = o[i].icm, lim4 = 4.0 * lim;
                 for (x = xa; x < xb; x++) {
-                    const float *zq = zp + x;
                     double bulge = q * tp[x]; /* q hf_cell_twist; NaN at holes */
-                    double z00 = (double)zq[0], z10 = (double)zq[1], z01 = (double)zq[S], z11 = (double)zq[S + 1];
-                    double r0 = z00 + (z10 - z00) * mfx, r1 = z01 + (z11 - z01) * mfx, rx = row[x];
-                    double tt = (r0 + (r1 - r0) * mfy - (double)zr[x]) * icm;
-                    tt = bulge > lim ? tt : -HFVIS__INF;
-                    rx = tt > rx ? tt : rx;
-                    if (bulge > lim4) rx = hf_near_fill(zq, S, c, bulge, lim, o[i].u, (double)zr[x], scale, row[x]);
-                    row[x] = rx;
+                    if (bulge > lim) {
+                        const float *zq = zp + x;
+                        double z00 = (double)zq[0], z10 = (double)zq[1], z01 = (double)zq[S], z11 = (double)zq[S + 1];
+                        double r0 = z00 + (z10 - z00) * mfx, r1 = z01 + (z11 - z01) * mfx, rx = row[x];
+                        double tt = (r0 + (r1 - r0) * mfy - (double)zr[x]) * icm;
+                        if (bulge > lim4) tt = hf_near_fill(zq, S, c, bulge, lim, o[i].u, (double)zr[x], scale, rx);
+                        row[x] = tt > rx ? tt : rx;
+                    }
                 }
             }
         }
@@ -9714,6 +9729,8 @@ static double hf_far_query(const double *sd, const double *sh, const int *par, c
  * and the steps j of its receivers q + j (a, b) in the receiver rectangle. */
 struct hf_far_line {
     int64_t t, qx, qy, jlo, jhi;
+    int64_t i0, z0, d0; /* receiver q + j (a, b): tangent i0 + j istep, height z0 + j zstep, and
+                           distance (d0 - j n2) L from the far line's end (its frame) */
     double end; /* where its receivers' rays leave the reach, in the far line's frame (n2 units) */
 };
 typedef struct hf_far_line hf_far_line;
@@ -9753,6 +9770,7 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
     const double Ad = (double)(a < 0 ? -a : a), Bd = (double)(b < 0 ? -b : b), cell = L / len * n2;
     const int M = (int)floor(len), hM = M / 2, R = E->R;
     const int64_t cshift = (int64_t)E->ox * b - (int64_t)E->oy * a; /* raster c - grid c */
+    const int64_t istep = (int64_t)b * g->width + a, zstep = (int64_t)b * g->stride + a;
     int64_t X1, Y1, lo = INT64_MAX, hi = INT64_MIN, m, mlo, mhi;
     int corner;
     hf_ext_gcd(b, a, &X1, &Y1); /* X1 b + Y1 a = 1: (X1, -Y1) is on line 1 */
@@ -9800,6 +9818,9 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
             if (jh2 < l.jhi) l.jhi = jh2;
             if (l.jlo > l.jhi) continue;
             l.t = l.qx * a + l.qy * b;
+            l.i0 = l.qy * g->width + l.qx;
+            l.z0 = l.qy * g->stride + l.qx;
+            l.d0 = kmax * n2i - ((l.qx - px) * a + (l.qy - py) * b);
             for (w = nl++; w > 0 && lines[w - 1].t < l.t; w--) lines[w] = lines[w - 1];
             lines[w] = l;
             if (l.jlo < jmin || nl == 1) jmin = l.jlo;
@@ -9815,19 +9836,15 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
         /* receivers by t = t_q + j n2 descending, so their thresholds grow: one pointer */
         for (ptr = -1, j = jmax; j >= jmin; j--) {
             for (w = 0; w < nl; w++) {
-                int x, y;
-                size_t i;
-                double dr, vd;
-                if (j < lines[w].jlo || j > lines[w].jhi) continue;
-                x = (int)(lines[w].qx + j * a);
-                y = (int)(lines[w].qy + j * b);
-                i = (size_t)y * (size_t)g->width + (size_t)x;
-                if (isnan(E->tan[i]) || (E->parts && !hf_exact_mine(E, x, y, r))) continue;
-                dr = ((double)kmax * L) * n2 - (double)(((int64_t)x - px) * a + ((int64_t)y - py) * b) * L;
+                const hf_far_line *l = lines + w;
+                double *ti, dr, vd;
+                if (j < l->jlo || j > l->jhi) continue;
+                ti = E->tan + (l->i0 + j * istep);
+                if (isnan(*ti) || (E->parts && !hf_exact_mine(E, (int)(l->qx + j * a), (int)(l->qy + j * b), r)))
+                    continue;
+                dr = (double)(l->d0 - j * n2i) * L; /* an integer times L: exact, as every distance here */
                 while (ptr + 1 < n && sd[ptr + 1] * n2 <= dr - dn) ptr++;
-                if (ptr >= 0)
-                    E->tan[i] = hf_far_query(sd, sh, par, fm, ptr, n2, dr, (double)g->z[(ptrdiff_t)y * g->stride + x],
-                                             fscale, E->tan[i], &vd);
+                if (ptr >= 0) *ti = hf_far_query(sd, sh, par, fm, ptr, n2, dr, (double)g->z[l->z0 + j * zstep], fscale, *ti, &vd);
             }
         }
         /* Tails: an exact line whose rays run on more than a cell beyond the far line's end
@@ -9854,14 +9871,11 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
             while (n > 0 && shift + sd[n - 1] * n2 > start) n--; /* the far line serves those */
             hf_far_hull(sd, sh, n, E->rec, par, fm);
             for (ptr = -1, j = l->jhi; j >= l->jlo; j--) {
-                int x = (int)(l->qx + j * a), y = (int)(l->qy + j * b);
-                size_t i = (size_t)y * (size_t)g->width + (size_t)x;
-                double dr = (double)(tmax - j) * L * n2, vd;
-                if (isnan(E->tan[i]) || (E->parts && !hf_exact_mine(E, x, y, r))) continue;
+                double *ti = E->tan + (l->i0 + j * istep), dr = (double)(tmax - j) * L * n2, vd;
+                if (isnan(*ti) || (E->parts && !hf_exact_mine(E, (int)(l->qx + j * a), (int)(l->qy + j * b), r)))
+                    continue;
                 while (ptr + 1 < n && sd[ptr + 1] * n2 <= dr - dn) ptr++;
-                if (ptr >= 0)
-                    E->tan[i] = hf_far_query(sd, sh, par, fm, ptr, n2, dr, (double)g->z[(ptrdiff_t)y * g->stride + x],
-                                             fscale, E->tan[i], &vd);
+                if (ptr >= 0) *ti = hf_far_query(sd, sh, par, fm, ptr, n2, dr, (double)g->z[l->z0 + j * zstep], fscale, *ti, &vd);
             }
         }
     }
