@@ -9614,6 +9614,7 @@ static int hf_far_samples(hf_exact *E, int64_t px, int64_t py, int a, int b, int
     double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
     int n = 0, e, j, splits = 0, eager = E->eager;
     int64_t k, inner = 0;
+    double ulo, uhi;
     for (k = kmax; k >= kmin; k--) {
         int64_t X0 = px + k * a, Y0 = py + k * b, X1 = X0 + a, Y1 = Y0 + b;
         double base = (double)(kmax - k) * L;
@@ -9638,11 +9639,27 @@ static int hf_far_samples(hf_exact *E, int64_t px, int64_t py, int a, int b, int
             inner++;
             continue;
         }
-        if (X0 < -E->R - 1 - (a < 0 ? -a : a) || X0 > g->width + E->R + (a < 0 ? -a : a) ||
-            Y0 < -E->R - 1 - (b < 0 ? -b : b) || Y0 > g->height + E->R + (b < 0 ? -b : b))
-            continue; /* the whole period out of reach */
+        /* the whole period out of reach: its crossings and piece midpoints lie between its grid
+           points, so beyond -R or (size - 1 + R) on an axis so do their taps and cells */
+        if ((X0 > X1 ? X0 : X1) < -E->R || (X0 < X1 ? X0 : X1) > g->width - 1 + E->R ||
+            (Y0 > Y1 ? Y0 : Y1) < -E->R || (Y0 < Y1 ? Y0 : Y1) > g->height - 1 + E->R)
+            continue;
+        /* the crossings within two cells of the reach on both axes, u in [ulo, uhi] (whole
+           numbers: a cell along x is |b| sub-steps, along y |a|); a piece lies in one cell, so
+           beyond that neither it nor its crossing has a sample */
+        {
+            const int64_t Ai = a < 0 ? -a : a, Bi = b < 0 ? -b : b, R = E->R;
+            const int64_t xl = (a > 0 ? -R - 2 - X0 : X0 - g->width - R - 1) * Bi;
+            const int64_t xh = (a > 0 ? g->width + R + 1 - X0 : X0 + R + 2) * Bi;
+            const int64_t yl = (b > 0 ? -R - 2 - Y0 : Y0 - g->height - R - 1) * Ai;
+            const int64_t yh = (b > 0 ? g->height + R + 1 - Y0 : Y0 + R + 2) * Ai;
+            ulo = (double)(xl > yl ? xl : yl);
+            uhi = (double)(xh < yh ? xh : yh);
+        }
         for (e = P - 1; e >= 0; e--) { /* as hf_exact_samples' pre-roll */
             const hf_cross *c = cr + e;
+            if (c->u > uhi) continue;
+            if (c->u < ulo) break;
             const int X = (int)X0 + c->ox, Y = (int)Y0 + c->oy, CX = (int)X0 + c->cx, CY = (int)Y0 + c->cy;
             double h;
             if (CX >= 0 && CY >= 0 && CX + 1 < g->width && CY + 1 < g->height) {
