@@ -9565,13 +9565,25 @@ static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int bo
                     double tt = ((double)zc[x] - (double)zr[x]) * ic, rx = row[x];
                     row[x] = tt > rx ? tt : rx; /* NaN (a hole) never is */
                 }
-            else if (o[i].cross)
-                for (x = xa; x < xb; x++) {
+            else if (o[i].cross) {
+                /* two receivers a step, written out (C99 the compiler can pack into vectors at
+                   -O2), then the odd one */
+                for (x = xa; x + 1 < xb; x += 2) {
+                    double h0 = (double)zc[x], h1 = (double)zc[x + 1], t0, t1, r0 = row[x], r1 = row[x + 1];
+                    h0 += ((double)zc[x + st] - h0) * f;
+                    h1 += ((double)zc[x + 1 + st] - h1) * f;
+                    t0 = (h0 - (double)zr[x]) * ic;
+                    t1 = (h1 - (double)zr[x + 1]) * ic;
+                    row[x] = t0 > r0 ? t0 : r0;
+                    row[x + 1] = t1 > r1 ? t1 : r1;
+                }
+                for (; x < xb; x++) {
                     double h = (double)zc[x], tt, rx = row[x];
                     h += ((double)zc[x + st] - h) * f;
                     tt = (h - (double)zr[x]) * ic;
                     row[x] = tt > rx ? tt : rx;
                 }
+            }
             if (c->du > 0.0) {
                 /* a piece split in two (bulge in (lim, 4 lim]: most splits) takes its midpoint
                    inline (hf_near_fill's sample, the same bits); finer splits through it */
