@@ -9732,7 +9732,7 @@ static void hf_far_hull(const double *sd, const double *sh, int n, int *stack, i
  * coordinate) with height hr, whose far samples are 0..i (those at least D cells ahead): the
  * largest tangent (times fscale) over them if larger than best, else best. The walk follows the
  * hull from i while the tangent grows. */
-static double hf_far_query(const double *sd, const double *sh, const int *par, const double *hmax,
+static inline double hf_far_query(const double *sd, const double *sh, const int *par, const double *hmax,
                            int i, double n2, double dr, double hr, double fscale, double best,
                            double *vdist)
 {
