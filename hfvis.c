@@ -9383,6 +9383,7 @@ struct hf_near_off {
     ptrdiff_t toff;        /* the piece's cell in the twist plane (hf_exact.twist) */
     int dx, dy;            /* the period's base offset k (a, b) */
     double u, ic;          /* the crossing's distance (sub-steps); scale / u */
+    double icm;            /* scale / the piece's midpoint distance (a piece split in two) */
 };
 typedef struct hf_near_off hf_near_off;
 
@@ -9452,6 +9453,7 @@ static int hf_near_offsets(const hf_exact *E, const hf_cross *cr, int P, int a, 
             o[n].toff = (ptrdiff_t)(k * b + c->cy) * g->width + (k * a + c->cx);
             o[n].u = u;
             o[n].ic = u > 0.0 ? scale / u : 0.0;
+            o[n].icm = scale / (u + c->du * 0.5); /* hf_near_fill's sample j = 1 of 2, bit for bit */
             for (j = 0; j < 2; j++) { /* the crossing's taps, then the piece's cell */
                 x0 = k * a + (j ? c->cx : c->ox);
                 y0 = k * b + (j ? c->cy : c->oy);
@@ -9473,7 +9475,7 @@ static double hf_near_fill(const float *p, ptrdiff_t stride, const hf_cross *c, 
     double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
     int j = hf_piece_fill(p, stride, c, bulge, lim, ph, pu);
     while (j-- > 0) {
-        double t = (ph[j] - hr) / (u0 + pu[j]) * scale;
+        double t = (ph[j] - hr) * (scale / (u0 + pu[j]));
         if (t > best) best = t;
     }
     return best;
@@ -9490,12 +9492,28 @@ static double hf_near_one(const hf_exact *E, const hf_near_off *o, int n, int x,
     for (i = 0; i < n; i++) {
         const hf_cross *c = o[i].c;
         int X = x + o[i].dx, Y = y + o[i].dy;
+        const int CX = X + c->cx, CY = Y + c->cy, open = E->border == HFVIS_BORDER_OPEN;
         float z[4];
-        if (o[i].cross && hf_cross_inside(g, E->R, X + c->ox, Y + c->oy, c)) {
-            double h = hf_cross_height(g, E->border, X + c->ox, Y + c->oy, c), t = (h - hr) * o[i].ic;
-            if (t > best) best = t; /* NaN (a hole) never is */
+        if (o[i].cross) {
+            const int KX = X + c->ox, KY = Y + c->oy;
+            double h = HFVIS__NAN, t;
+            if (KX >= 0 && KY >= 0 && KX + (c->kind == 2) < g->width && KY + (c->kind == 1) < g->height) {
+                const float *p = g->z + (ptrdiff_t)KY * g->stride + KX; /* hf_cross_height inside the grid */
+                h = (double)p[0];
+                if (c->kind != 0) h += ((double)p[c->kind == 1 ? g->stride : 1] - h) * c->f;
+                if (!isfinite(h)) h = HFVIS__NAN;
+            } else if (!open && hf_cross_inside(g, E->R, KX, KY, c)) {
+                h = hf_cross_height(g, E->border, KX, KY, c);
+            }
+            t = (h - hr) * o[i].ic;
+            if (t > best) best = t; /* NaN (a hole, out of reach) never is */
         }
-        if (c->du > 0.0 && hf_exact_cell_taps(g, E->border, E->R, X + c->cx, Y + c->cy, z)) {
+        if (!(c->du > 0.0)) continue;
+        if (CX >= 0 && CY >= 0 && CX + 1 < g->width && CY + 1 < g->height) {
+            const float *p = g->z + (ptrdiff_t)CY * g->stride + CX; /* the cell's taps in place */
+            double bulge = c->q * hf_cell_twist(p, g->stride);
+            if (bulge > lim && bulge < HFVIS__INF) best = hf_near_fill(p, g->stride, c, bulge, lim, o[i].u, hr, scale, best);
+        } else if (!open && hf_exact_cell_taps(g, E->border, E->R, CX, CY, z)) {
             double bulge = c->q * hf_cell_twist(z, 2);
             if (bulge > lim && bulge < HFVIS__INF) best = hf_near_fill(z, 2, c, bulge, lim, o[i].u, hr, scale, best);
         }
@@ -9547,18 +9565,41 @@ static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int bo
                     double tt = ((double)zc[x] - (double)zr[x]) * ic, rx = row[x];
                     row[x] = tt > rx ? tt : rx; /* NaN (a hole) never is */
                 }
-            else if (o[i].cross)
-                for (x = xa; x < xb; x++) {
+            else if (o[i].cross) {
+                /* two receivers a step, written out (C99 the compiler can pack into vectors at
+                   -O2), then the odd one */
+                for (x = xa; x + 1 < xb; x += 2) {
+                    double h0 = (double)zc[x], h1 = (double)zc[x + 1], t0, t1, r0 = row[x], r1 = row[x + 1];
+                    h0 += ((double)zc[x + st] - h0) * f;
+                    h1 += ((double)zc[x + 1 + st] - h1) * f;
+                    t0 = (h0 - (double)zr[x]) * ic;
+                    t1 = (h1 - (double)zr[x + 1]) * ic;
+                    row[x] = t0 > r0 ? t0 : r0;
+                    row[x + 1] = t1 > r1 ? t1 : r1;
+                }
+                for (; x < xb; x++) {
                     double h = (double)zc[x], tt, rx = row[x];
                     h += ((double)zc[x + st] - h) * f;
                     tt = (h - (double)zr[x]) * ic;
                     row[x] = tt > rx ? tt : rx;
                 }
-            if (c->du > 0.0)
+            }
+            if (c->du > 0.0) {
+                /* a piece split in two (bulge in (lim, 4 lim]: most splits) takes its midpoint
+                   inline (hf_near_fill's sample, the same bits); finer splits through it */
+                const double mfx = c->mfx, mfy = c->mfy, icm = o[i].icm, lim4 = 4.0 * lim;
                 for (x = xa; x < xb; x++) {
                     double bulge = q * tp[x]; /* q hf_cell_twist; NaN at holes */
-                    if (bulge > lim) row[x] = hf_near_fill(zp + x, S, c, bulge, lim, o[i].u, (double)zr[x], scale, row[x]);
+                    if (bulge > lim) {
+                        const float *zq = zp + x;
+                        double z00 = (double)zq[0], z10 = (double)zq[1], z01 = (double)zq[S], z11 = (double)zq[S + 1];
+                        double r0 = z00 + (z10 - z00) * mfx, r1 = z01 + (z11 - z01) * mfx, rx = row[x];
+                        double tt = (r0 + (r1 - r0) * mfy - (double)zr[x]) * icm;
+                        if (bulge > lim4) tt = hf_near_fill(zq, S, c, bulge, lim, o[i].u, (double)zr[x], scale, rx);
+                        row[x] = tt > rx ? tt : rx;
+                    }
                 }
+            }
         }
         for (x = E->rx0; x < E->rx1; x++) {
             double hr = (double)zr[x];
@@ -9585,6 +9626,7 @@ static int hf_far_samples(hf_exact *E, int64_t px, int64_t py, int a, int b, int
     double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
     int n = 0, e, j, splits = 0, eager = E->eager;
     int64_t k, inner = 0;
+    double ulo, uhi;
     for (k = kmax; k >= kmin; k--) {
         int64_t X0 = px + k * a, Y0 = py + k * b, X1 = X0 + a, Y1 = Y0 + b;
         double base = (double)(kmax - k) * L;
@@ -9609,22 +9651,54 @@ static int hf_far_samples(hf_exact *E, int64_t px, int64_t py, int a, int b, int
             inner++;
             continue;
         }
-        if (X0 < -E->R - 1 - (a < 0 ? -a : a) || X0 > g->width + E->R + (a < 0 ? -a : a) ||
-            Y0 < -E->R - 1 - (b < 0 ? -b : b) || Y0 > g->height + E->R + (b < 0 ? -b : b))
-            continue; /* the whole period out of reach */
+        /* the whole period out of reach: its crossings and piece midpoints lie between its grid
+           points, so beyond -R or (size - 1 + R) on an axis so do their taps and cells */
+        if ((X0 > X1 ? X0 : X1) < -E->R || (X0 < X1 ? X0 : X1) > g->width - 1 + E->R ||
+            (Y0 > Y1 ? Y0 : Y1) < -E->R || (Y0 < Y1 ? Y0 : Y1) > g->height - 1 + E->R)
+            continue;
+        /* the crossings within two cells of the reach on both axes, u in [ulo, uhi] (whole
+           numbers: a cell along x is |b| sub-steps, along y |a|); a piece lies in one cell, so
+           beyond that neither it nor its crossing has a sample */
+        {
+            const int64_t Ai = a < 0 ? -a : a, Bi = b < 0 ? -b : b, R = E->R;
+            const int64_t xl = (a > 0 ? -R - 2 - X0 : X0 - g->width - R - 1) * Bi;
+            const int64_t xh = (a > 0 ? g->width + R + 1 - X0 : X0 + R + 2) * Bi;
+            const int64_t yl = (b > 0 ? -R - 2 - Y0 : Y0 - g->height - R - 1) * Ai;
+            const int64_t yh = (b > 0 ? g->height + R + 1 - Y0 : Y0 + R + 2) * Ai;
+            ulo = (double)(xl > yl ? xl : yl);
+            uhi = (double)(xh < yh ? xh : yh);
+        }
         for (e = P - 1; e >= 0; e--) { /* as hf_exact_samples' pre-roll */
-            int X = (int)X0 + cr[e].ox, Y = (int)Y0 + cr[e].oy;
+            const hf_cross *c = cr + e;
+            if (c->u > uhi) continue;
+            if (c->u < ulo) break;
+            const int X = (int)X0 + c->ox, Y = (int)Y0 + c->oy, CX = (int)X0 + c->cx, CY = (int)Y0 + c->cy;
             double h;
-            j = hf_piece_samples(g, E->border, E->R, (int)X0, (int)Y0, cr + e, ph, pu);
+            if (CX >= 0 && CY >= 0 && CX + 1 < g->width && CY + 1 < g->height) {
+                /* the cell inside the grid: hf_piece_samples' test and samples, its taps read in
+                   place (a tap that is a hole or infinite makes the bulge fail the test) */
+                const float *p = g->z + (ptrdiff_t)CY * g->stride + CX;
+                double bulge = c->q * hf_cell_twist(p, g->stride);
+                j = c->du > 0.0 && bulge > lim && bulge < HFVIS__INF ? hf_piece_fill(p, g->stride, c, bulge, lim, ph, pu) : 0;
+            } else {
+                j = E->border == HFVIS_BORDER_OPEN ? 0 : hf_piece_samples(g, E->border, E->R, (int)X0, (int)Y0, c, ph, pu);
+            }
             while (j-- > 0) {
                 if (isnan(ph[j])) continue;
-                sd[n] = base - (cr[e].u + pu[j]);
+                sd[n] = base - (c->u + pu[j]);
                 sh[n++] = ph[j];
             }
-            if (!hf_cross_inside(g, E->R, X, Y, cr + e)) continue;
-            h = hf_cross_height(g, E->border, X, Y, cr + e);
-            if (isnan(h)) continue;
-            sd[n] = base - cr[e].u;
+            if (X >= 0 && Y >= 0 && X + (c->kind == 2) < g->width && Y + (c->kind == 1) < g->height) {
+                const float *p = g->z + (ptrdiff_t)Y * g->stride + X; /* hf_cross_height inside the grid */
+                h = (double)p[0];
+                if (c->kind != 0) h += ((double)p[c->kind == 1 ? g->stride : 1] - h) * c->f;
+                if (!isfinite(h)) continue;
+            } else {
+                if (E->border == HFVIS_BORDER_OPEN || !hf_cross_inside(g, E->R, X, Y, c)) continue;
+                h = hf_cross_height(g, E->border, X, Y, c);
+                if (isnan(h)) continue;
+            }
+            sd[n] = base - c->u;
             sh[n++] = h;
         }
     }
@@ -9658,7 +9732,7 @@ static void hf_far_hull(const double *sd, const double *sh, int n, int *stack, i
  * coordinate) with height hr, whose far samples are 0..i (those at least D cells ahead): the
  * largest tangent (times fscale) over them if larger than best, else best. The walk follows the
  * hull from i while the tangent grows. */
-static double hf_far_query(const double *sd, const double *sh, const int *par, const double *hmax,
+static inline double hf_far_query(const double *sd, const double *sh, const int *par, const double *hmax,
                            int i, double n2, double dr, double hr, double fscale, double best,
                            double *vdist)
 {
@@ -9684,6 +9758,8 @@ static double hf_far_query(const double *sd, const double *sh, const int *par, c
  * and the steps j of its receivers q + j (a, b) in the receiver rectangle. */
 struct hf_far_line {
     int64_t t, qx, qy, jlo, jhi;
+    int64_t i0, z0, d0; /* receiver q + j (a, b): tangent i0 + j istep, height z0 + j zstep, and
+                           distance (d0 - j n2) L from the far line's end (its frame) */
     double end; /* where its receivers' rays leave the reach, in the far line's frame (n2 units) */
 };
 typedef struct hf_far_line hf_far_line;
@@ -9723,6 +9799,7 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
     const double Ad = (double)(a < 0 ? -a : a), Bd = (double)(b < 0 ? -b : b), cell = L / len * n2;
     const int M = (int)floor(len), hM = M / 2, R = E->R;
     const int64_t cshift = (int64_t)E->ox * b - (int64_t)E->oy * a; /* raster c - grid c */
+    const int64_t istep = (int64_t)b * g->width + a, zstep = (int64_t)b * g->stride + a;
     int64_t X1, Y1, lo = INT64_MAX, hi = INT64_MIN, m, mlo, mhi;
     int corner;
     hf_ext_gcd(b, a, &X1, &Y1); /* X1 b + Y1 a = 1: (X1, -Y1) is on line 1 */
@@ -9770,6 +9847,9 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
             if (jh2 < l.jhi) l.jhi = jh2;
             if (l.jlo > l.jhi) continue;
             l.t = l.qx * a + l.qy * b;
+            l.i0 = l.qy * g->width + l.qx;
+            l.z0 = l.qy * g->stride + l.qx;
+            l.d0 = kmax * n2i - ((l.qx - px) * a + (l.qy - py) * b);
             for (w = nl++; w > 0 && lines[w - 1].t < l.t; w--) lines[w] = lines[w - 1];
             lines[w] = l;
             if (l.jlo < jmin || nl == 1) jmin = l.jlo;
@@ -9785,19 +9865,15 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
         /* receivers by t = t_q + j n2 descending, so their thresholds grow: one pointer */
         for (ptr = -1, j = jmax; j >= jmin; j--) {
             for (w = 0; w < nl; w++) {
-                int x, y;
-                size_t i;
-                double dr, vd;
-                if (j < lines[w].jlo || j > lines[w].jhi) continue;
-                x = (int)(lines[w].qx + j * a);
-                y = (int)(lines[w].qy + j * b);
-                i = (size_t)y * (size_t)g->width + (size_t)x;
-                if (isnan(E->tan[i]) || (E->parts && !hf_exact_mine(E, x, y, r))) continue;
-                dr = ((double)kmax * L) * n2 - (double)(((int64_t)x - px) * a + ((int64_t)y - py) * b) * L;
+                const hf_far_line *l = lines + w;
+                double *ti, dr, vd;
+                if (j < l->jlo || j > l->jhi) continue;
+                ti = E->tan + (l->i0 + j * istep);
+                if (isnan(*ti) || (E->parts && !hf_exact_mine(E, (int)(l->qx + j * a), (int)(l->qy + j * b), r)))
+                    continue;
+                dr = (double)(l->d0 - j * n2i) * L; /* an integer times L: exact, as every distance here */
                 while (ptr + 1 < n && sd[ptr + 1] * n2 <= dr - dn) ptr++;
-                if (ptr >= 0)
-                    E->tan[i] = hf_far_query(sd, sh, par, fm, ptr, n2, dr, (double)g->z[(ptrdiff_t)y * g->stride + x],
-                                             fscale, E->tan[i], &vd);
+                if (ptr >= 0) *ti = hf_far_query(sd, sh, par, fm, ptr, n2, dr, (double)g->z[l->z0 + j * zstep], fscale, *ti, &vd);
             }
         }
         /* Tails: an exact line whose rays run on more than a cell beyond the far line's end
@@ -9824,14 +9900,11 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
             while (n > 0 && shift + sd[n - 1] * n2 > start) n--; /* the far line serves those */
             hf_far_hull(sd, sh, n, E->rec, par, fm);
             for (ptr = -1, j = l->jhi; j >= l->jlo; j--) {
-                int x = (int)(l->qx + j * a), y = (int)(l->qy + j * b);
-                size_t i = (size_t)y * (size_t)g->width + (size_t)x;
-                double dr = (double)(tmax - j) * L * n2, vd;
-                if (isnan(E->tan[i]) || (E->parts && !hf_exact_mine(E, x, y, r))) continue;
+                double *ti = E->tan + (l->i0 + j * istep), dr = (double)(tmax - j) * L * n2, vd;
+                if (isnan(*ti) || (E->parts && !hf_exact_mine(E, (int)(l->qx + j * a), (int)(l->qy + j * b), r)))
+                    continue;
                 while (ptr + 1 < n && sd[ptr + 1] * n2 <= dr - dn) ptr++;
-                if (ptr >= 0)
-                    E->tan[i] = hf_far_query(sd, sh, par, fm, ptr, n2, dr, (double)g->z[(ptrdiff_t)y * g->stride + x],
-                                             fscale, E->tan[i], &vd);
+                if (ptr >= 0) *ti = hf_far_query(sd, sh, par, fm, ptr, n2, dr, (double)g->z[l->z0 + j * zstep], fscale, *ti, &vd);
             }
         }
     }

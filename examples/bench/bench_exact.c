@@ -92,11 +92,12 @@ static void exact_field(const char *name, float *z, int n, float *map)
 }
 
 /* Sky-view factor of fBm n^2 at K = 16, 64, 256, 360: lattice, exact and exact with the near and
- * far field (ray_near_cells = EXACT_BENCH_NEAR), one call each (the exact calls at large K take
- * seconds; the lattice's at 512^2 about 0.1-1 s), and beside each the horizons' error against the
- * supremum (hfvis_horizon_exact_naive) on a small case of the same field (EXACT_BENCH_ACC^2, every
- * pair). */
+ * far field (ray_near_cells = EXACT_BENCH_NEAR, then EXACT_BENCH_NEAR_SHORT), one call each (the
+ * exact calls at large K take seconds; the lattice's at 512^2 about 0.1-1 s), and beside each the
+ * horizons' error against the supremum (hfvis_horizon_exact_naive) on a small case of the same
+ * field (EXACT_BENCH_ACC^2, every pair). */
 #define EXACT_BENCH_NEAR 8
+#define EXACT_BENCH_NEAR_SHORT 6
 #define EXACT_BENCH_ACC 96
 
 /* The bench's fBm on n^2 cells (amplitude n/8, wavelength n/4, seed 3) into z, as a grid of unit
@@ -132,7 +133,7 @@ static void exact_pair_err(const float *a, const float *b, size_t n, double *e, 
 
 /* The error of the sweep and of the near and far field against the supremum at K on fBm of the
  * bench's parameters scaled to EXACT_BENCH_ACC^2; returns 0, or -1 when memory runs out. */
-static int exact_far_accuracy(int K, double *sm, double *sp, double *fm, double *fp)
+static int exact_far_accuracy(int K, double *sm, double *sp, double fm[2], double fp[2])
 {
     const int n = EXACT_BENCH_ACC;
     size_t cells = (size_t)n * (size_t)n, m = cells * (size_t)K;
@@ -150,7 +151,11 @@ static int exact_far_accuracy(int K, double *sm, double *sp, double *fm, double 
             ex.ray_near_cells = EXACT_BENCH_NEAR;
             if (hfvis_horizon_map(&g, K, &ex, got) == HFVIS_OK) {
                 exact_pair_err(got, sup, m, e, fm, fp);
-                rc = 0;
+                ex.ray_near_cells = EXACT_BENCH_NEAR_SHORT;
+                if (hfvis_horizon_map(&g, K, &ex, got) == HFVIS_OK) {
+                    exact_pair_err(got, sup, m, e, fm + 1, fp + 1);
+                    rc = 0;
+                }
             }
         }
     }
@@ -166,7 +171,7 @@ static void exact_k_rows(int n)
     static const int Ks[] = {16, 64, 256, 360};
     size_t cells = (size_t)n * (size_t)n;
     float *z = (float *)malloc(sizeof(float) * cells), *out = (float *)malloc(sizeof(float) * cells);
-    hfvis_sweep_options lat = hfvis_sweep_options_default(), ex = lat, nf;
+    hfvis_sweep_options lat = hfvis_sweep_options_default(), ex = lat, nf, ns;
     hfvis_grid g;
     int i;
     if (!z || !out) { printf("exact: out of memory\n"); free(z); free(out); return; }
@@ -174,8 +179,10 @@ static void exact_k_rows(int n)
     ex.rays = HFVIS_RAYS_EXACT;
     nf = ex;
     nf.ray_near_cells = EXACT_BENCH_NEAR;
+    ns = ex;
+    ns.ray_near_cells = EXACT_BENCH_NEAR_SHORT;
     for (i = 0; i < 4; i++) {
-        double rd = (double)cells * (double)Ks[i], t0, tl, te, tf, sm, sp, fm, fp;
+        double rd = (double)cells * (double)Ks[i], t0, tl, te, tf, ts, sm, sp, fm[2], fp[2];
         t0 = bench_now();
         hfvis_sky_view_factor(&g, Ks[i], &lat, out, n);
         tl = bench_now() - t0;
@@ -185,12 +192,17 @@ static void exact_k_rows(int n)
         t0 = bench_now();
         hfvis_sky_view_factor(&g, Ks[i], &nf, out, n);
         tf = bench_now() - t0;
+        t0 = bench_now();
+        hfvis_sky_view_factor(&g, Ks[i], &ns, out, n);
+        ts = bench_now() - t0;
         printf("exact rays, fBm %d^2 sky-view factor K=%3d: lattice %.2f s (%.1f ns/rd), exact %.2f s (%.1f ns/rd), "
-               "%.2fx; near/far D=%d %.2f s (%.1f ns/rd), %.2fx\n", n, Ks[i], tl, 1e9 * tl / rd, te, 1e9 * te / rd,
-               te / tl, EXACT_BENCH_NEAR, tf, 1e9 * tf / rd, tf / tl);
-        if (exact_far_accuracy(Ks[i], &sm, &sp, &fm, &fp) == 0)
+               "%.2fx; near/far D=%d %.2f s (%.1f ns/rd), %.2fx; D=%d %.2f s (%.1f ns/rd), %.2fx\n", n, Ks[i], tl,
+               1e9 * tl / rd, te, 1e9 * te / rd, te / tl, EXACT_BENCH_NEAR, tf, 1e9 * tf / rd, tf / tl,
+               EXACT_BENCH_NEAR_SHORT, ts, 1e9 * ts / rd, ts / tl);
+        if (exact_far_accuracy(Ks[i], &sm, &sp, fm, fp) == 0)
             printf("exact rays, fBm %d^2 horizons K=%3d against the supremum (every pair, deg): exact mean %.4f p99 "
-                   "%.3f; near/far D=%d mean %.4f p99 %.3f\n", EXACT_BENCH_ACC, Ks[i], sm, sp, EXACT_BENCH_NEAR, fm, fp);
+                   "%.3f; near/far D=%d mean %.4f p99 %.3f; D=%d mean %.4f p99 %.3f\n", EXACT_BENCH_ACC, Ks[i], sm, sp,
+                   EXACT_BENCH_NEAR, fm[0], fp[0], EXACT_BENCH_NEAR_SHORT, fm[1], fp[1]);
         else
             printf("exact rays: accuracy at K=%d: out of memory\n", Ks[i]);
     }
