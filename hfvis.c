@@ -11598,25 +11598,36 @@ static hfvis_status hf_solar_run_steps(hf_solar_run *r)
     return HFVIS_OK;
 }
 
+/* The run's setup, steps and per-sample state. Only the rows [c.rb, c.re) of the per-sample
+ * arrays are set (every row with all_rows, the oracle's), and only they are ever read: a row
+ * band's call touches no other row's memory. */
 static hfvis_status hf_solar_run_init(const hfvis_grid *g, const hfvis_solar_input *in,
                                       const hfvis_solar_options *opts,
-                                      const hfvis_solar_output *out, hf_solar_run *r)
+                                      const hfvis_solar_output *out, int all_rows, hf_solar_run *r)
 {
     hfvis_status st;
-    size_t n, i;
+    size_t n, i, i0, i1, w;
+    int b;
     memset(r, 0, sizeof *r);
     if ((st = hf_solar_setup(g, in, opts, out, &r->c)) != HFVIS_OK) return st;
+    if (all_rows) {
+        r->c.rb = 0;
+        r->c.re = g->height;
+    }
     r->al = r->c.o.sweep ? r->c.o.sweep->alloc : NULL;
     n = hf_grid_count(g);
+    w = (size_t)g->width;
+    i0 = (size_t)r->c.rb * w;
+    i1 = (size_t)r->c.re * w;
     r->pts = (hf_solar_point *)hfvis__alloc_array(r->al, n, sizeof(hf_solar_point));
     r->acc = (double *)hfvis__alloc_array(r->al, n * (size_t)r->c.bands, 4 * sizeof(double));
     if (!r->pts || !r->acc || hf_solar_run_steps(r) != HFVIS_OK) {
         hf_solar_run_free(r);
         return HFVIS_ERR_OUT_OF_MEMORY;
     }
-    for (i = 0; i < n * (size_t)r->c.bands * 4; i++) r->acc[i] = 0.0;
-    for (i = 0; i < n; i++)
-        hf_solar_point_init(&r->c, g, (int)(i % (size_t)g->width), (int)(i / (size_t)g->width), r->pts + i);
+    for (b = 0; b < r->c.bands; b++)
+        for (i = ((size_t)b * n + i0) * 4; i < ((size_t)b * n + i1) * 4; i++) r->acc[i] = 0.0;
+    for (i = i0; i < i1; i++) hf_solar_point_init(&r->c, g, (int)(i % w), (int)(i / w), r->pts + i);
     return HFVIS_OK;
 }
 
@@ -12223,7 +12234,7 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
     double *az = NULL;
     int K, horn_sky, k;
     size_t n, i, bi;
-    if ((st = hf_solar_run_init(g, in, opts, out, &r)) != HFVIS_OK) return st;
+    if ((st = hf_solar_run_init(g, in, opts, out, 0, &r)) != HFVIS_OK) return st;
     n = hf_grid_count(g);
     K = r.c.o.directions;
     s = hf_solar_map_sweep(&r.c);
@@ -12255,7 +12266,8 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
         sky = (float *)hfvis__alloc_array(r.al, n, sizeof(float));
         if (!sky) st = HFVIS_ERR_OUT_OF_MEMORY;
         else if (horn_sky)
-            for (i = 0; i < n; i++) sky[i] = (float)hf_solar_sky_seen(r.pts + i, K, az, src, n, i);
+            for (i = (size_t)r.c.rb * (size_t)g->width; i < (size_t)r.c.re * (size_t)g->width; i++) /* the rows read */
+                sky[i] = (float)hf_solar_sky_seen(r.pts + i, K, az, src, n, i);
         else st = hfvis_sky_light(g, K, 1.0f, 1.0f, &s, sky, g->width);
     }
     if (r.c.o.no_shading) { /* no map read by the steps */
@@ -12371,9 +12383,7 @@ hfvis_status hfvis_solar_irradiation_reference(const hfvis_grid *g, const hfvis_
     double *az = NULL;
     size_t n, i, q;
     int KR;
-    if ((st = hf_solar_run_init(g, in, opts, out, &r)) != HFVIS_OK) return st;
-    r.c.rb = 0; /* every row */
-    r.c.re = g->height;
+    if ((st = hf_solar_run_init(g, in, opts, out, 1, &r)) != HFVIS_OK) return st; /* every row */
     n = hf_grid_count(g);
     s = hf_solar_sweep(&r.c, HFVIS_RAYS_EXACT);
     KR = HF_SOLAR_REF_DIRS * r.c.o.directions;

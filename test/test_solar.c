@@ -1042,17 +1042,37 @@ TEST(horizon_modes_against_oracle)
     }
 }
 
+/* An allocator whose blocks start as NaN bytes: a row band's call that read per-sample state of
+ * rows it never set would turn its outputs NaN. */
+static void *nan_fill_alloc(void *user, size_t size)
+{
+    void *p = malloc(size);
+    (void)user;
+    if (p) memset(p, 0xff, size);
+    return p;
+}
+static void nan_fill_free(void *user, void *ptr)
+{
+    (void)user;
+    free(ptr);
+}
+
 /* Row ranges (hfvis_solar_options.row_begin/end): three calls on disjoint ranges give the whole
- * call bit for bit, each leaving the other rows untouched; the day path, the sector sums, the
- * step loop (a Linke map), per-sample blocks, HORIZON diffuse. */
+ * call bit for bit, each leaving the other rows untouched and reading only its own rows' state
+ * (blocks allocated as NaN); the day path, the sector sums, the step loop (a Linke map),
+ * per-sample blocks, HORIZON diffuse, HORIZON diffuse over Horn's planes with a hole. */
 TEST(row_ranges_equal_the_whole_call)
 {
     static float whole[5][3 * W * H], part[5][3 * W * H];
     static float lk[W * H];
     static const int cut[4] = { 0, 7, 13, H };
+    hfvis_allocator nan_alloc;
     int c, k, i, p;
+    nan_alloc.alloc = nan_fill_alloc;
+    nan_alloc.free = nan_fill_free;
+    nan_alloc.user = NULL;
     for (i = 0; i < W * H; i++) lk[i] = 3.5f;
-    for (c = 0; c < 5; c++) {
+    for (c = 0; c < 6; c++) {
         hfvis_grid g = test_grid(zbuf, c == 3 ? S : W, c == 3 ? S : H, 1.0);
         hfvis_solar_input in = site(c == 4 ? -35.0 : 46.0, 5, 10);
         hfvis_solar_options o = hfvis_solar_options_default();
@@ -1062,11 +1082,19 @@ TEST(row_ranges_equal_the_whole_call)
         if (c == 1) in.days = 30;
         if (c == 2) o.linke_map = lk;
         if (c == 3) sites(&in, 60.0, 40.0, 10.0, 12.0);
+        hfvis_sweep_options sw = hfvis_sweep_options_default();
         if (c == 4) {
             o.diffuse = HFVIS_SOLAR_DIFFUSE_HORIZON;
             in.days = 3;
             o.bands = HFVIS_SOLAR_BANDS_DAY;
         }
+        if (c == 5) {
+            o.diffuse = HFVIS_SOLAR_DIFFUSE_HORIZON;
+            o.normals = HFVIS_SOLAR_NORMALS_HORN;
+            zbuf[9 * W + 5] = NAN;
+        }
+        sw.alloc = &nan_alloc;
+        o.sweep = &sw;
         nb = hfvis_solar_band_count(&in, &o);
         a.beam = whole[0]; a.diffuse = whole[1]; a.reflected = whole[2]; a.global = whole[3]; a.sun_hours = whole[4];
         b.beam = part[0]; b.diffuse = part[1]; b.reflected = part[2]; b.global = part[3]; b.sun_hours = part[4];
