@@ -2748,7 +2748,7 @@ static inline int hf_gather_cell(double a, double b, int i_min, int j_min, int c
  * inside the lattice and every channel's four values finite and above -pi/2. A tap of weight 0
  * then adds a +-0 where the general routine skips it, which leaves the sums bit-identical (they
  * start at +0.0). Returns 0, with out untouched, when the general routine must decide. */
-static int hf_gather_elevations_inside(const hf_sweep *sw, int ch, int x, int y, double *out)
+static HFVIS__ALWAYS_INLINE int hf_gather_elevations_inside(const hf_sweep *sw, int ch, int x, int y, double *out)
 {
     const hfvis_lattice *L = &sw->L;
     double gx = (double)x + sw->ox, gy = (double)y + sw->oy; /* raster coordinates (tiles) */
@@ -2783,8 +2783,8 @@ static int hf_gather_elevations_inside(const hf_sweep *sw, int ch, int x, int y,
  * the same whatever the other channels hold or how many there are. With the open border a
  * receiver whose first unit step toward the look direction leaves the grid sees no terrain:
  * -pi/2, exactly as the per-receiver march decides it ([P2] §1). */
-static void hf_gather_planes(const hf_sweep *sw, int ch, const int *ms, float *const *outs,
-                             ptrdiff_t out_stride)
+static HFVIS__ALWAYS_INLINE void hf_gather_planes_ch(const hf_sweep *sw, int ch, const int *ms,
+                                                     float *const *outs, ptrdiff_t out_stride)
 {
     const hfvis_grid *g = sw->g;
     int x, y, c, tx, ty;
@@ -2825,15 +2825,20 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, const int *ms, float *c
                     if (nx < -HF_LATTICE_EPS || ny < -HF_LATTICE_EPS || nx > xmax || ny > ymax)
                         v[c] = -HFVIS__HALF_PI;
                 }
-            if (ch == 4) { /* a group's four quarter turns, the common case, unrolled */
-                outs[0][o] = (float)v[0];
-                outs[1][o] = (float)v[1];
-                outs[2][o] = (float)v[2];
-                outs[3][o] = (float)v[3];
-            } else {
-                for (c = 0; c < ch; c++) outs[c][o] = (float)v[c];
-            }
+            for (c = 0; c < ch; c++) outs[c][o] = (float)v[c]; /* unrolled: ch a constant */
         }
+    }
+}
+
+/* hf_gather_planes_ch with the channel count a constant in each copy (its loops unrolled). */
+static void hf_gather_planes(const hf_sweep *sw, int ch, const int *ms, float *const *outs,
+                             ptrdiff_t out_stride)
+{
+    switch (ch) {
+    case 1: hf_gather_planes_ch(sw, 1, ms, outs, out_stride); break;
+    case 2: hf_gather_planes_ch(sw, 2, ms, outs, out_stride); break;
+    case 3: hf_gather_planes_ch(sw, 3, ms, outs, out_stride); break;
+    default: hf_gather_planes_ch(sw, 4, ms, outs, out_stride); break;
     }
 }
 
