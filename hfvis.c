@@ -2748,7 +2748,7 @@ static inline int hf_gather_cell(double a, double b, int i_min, int j_min, int c
  * inside the lattice and every channel's four values finite and above -pi/2. A tap of weight 0
  * then adds a +-0 where the general routine skips it, which leaves the sums bit-identical (they
  * start at +0.0). Returns 0, with out untouched, when the general routine must decide. */
-static int hf_gather_elevations_inside(const hf_sweep *sw, int ch, int x, int y, double *out)
+static HFVIS__ALWAYS_INLINE int hf_gather_elevations_inside(const hf_sweep *sw, int ch, int x, int y, double *out)
 {
     const hfvis_lattice *L = &sw->L;
     double gx = (double)x + sw->ox, gy = (double)y + sw->oy; /* raster coordinates (tiles) */
@@ -2779,11 +2779,12 @@ static int hf_gather_elevations_inside(const hf_sweep *sw, int ch, int x, int y,
 }
 
 /* Gather the ch-channel lattice elevations into ch float planes (holes NaN): channel c holds
- * quarter turn m_first + c and goes to out + c*plane_step, row stride out_stride. With the open
- * border a receiver whose first unit step toward the look direction leaves the grid sees no
- * terrain: -pi/2, exactly as the per-receiver march decides it ([P2] §1). */
-static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out,
-                             size_t plane_step, ptrdiff_t out_stride)
+ * quarter turn ms[c] and goes to plane outs[c], row stride out_stride. Each channel's value is
+ * the same whatever the other channels hold or how many there are. With the open border a
+ * receiver whose first unit step toward the look direction leaves the grid sees no terrain:
+ * -pi/2, exactly as the per-receiver march decides it ([P2] §1). */
+static HFVIS__ALWAYS_INLINE void hf_gather_planes_ch(const hf_sweep *sw, int ch, const int *ms,
+                                                     float *const *outs, ptrdiff_t out_stride)
 {
     const hfvis_grid *g = sw->g;
     int x, y, c, tx, ty;
@@ -2797,7 +2798,7 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
     const double in_x0 = 1.0 - sw->ox, in_x1 = (sw->ext_w - 2.0) - sw->ox; /* exact integers */
     const double in_y0 = 1.0 - sw->oy, in_y1 = (sw->ext_h - 2.0) - sw->oy;
     const int tile_w = sw->parts ? sw->rx1 - sw->rx0 : HF_TILE; /* a band: whole rows, its span */
-    for (c = 0; c < ch; c++) hf_look_dir(sw, m_first + c, &lx[c], &ly[c]);
+    for (c = 0; c < ch; c++) hf_look_dir(sw, ms[c], &lx[c], &ly[c]);
     for (ty = sw->ry0; ty < sw->ry1; ty += HF_TILE)
         for (tx = sw->rx0; tx < sw->rx1; tx += tile_w)
     for (y = ty; y < sw->ry1 && y < ty + HF_TILE; y++) {
@@ -2809,7 +2810,7 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
         for (x = xs; x < xe; x++) {
             ptrdiff_t o = (ptrdiff_t)y * out_stride + x;
             if (hf_is_hole(g, x, y)) {
-                for (c = 0; c < ch; c++) out[(size_t)c * plane_step + (size_t)o] = (float)HFVIS__NAN;
+                for (c = 0; c < ch; c++) outs[c][o] = (float)HFVIS__NAN;
                 continue;
             }
             if (!hf_gather_elevations_inside(sw, ch, x, y, v)) {
@@ -2824,16 +2825,20 @@ static void hf_gather_planes(const hf_sweep *sw, int ch, int m_first, float *out
                     if (nx < -HF_LATTICE_EPS || ny < -HF_LATTICE_EPS || nx > xmax || ny > ymax)
                         v[c] = -HFVIS__HALF_PI;
                 }
-            if (ch == 4) { /* a group's four quarter turns, the common case, unrolled */
-                float *q = out + o;
-                q[0] = (float)v[0];
-                q[plane_step] = (float)v[1];
-                q[2 * plane_step] = (float)v[2];
-                q[3 * plane_step] = (float)v[3];
-            } else {
-                for (c = 0; c < ch; c++) out[(size_t)c * plane_step + (size_t)o] = (float)v[c];
-            }
+            for (c = 0; c < ch; c++) outs[c][o] = (float)v[c]; /* unrolled: ch a constant */
         }
+    }
+}
+
+/* hf_gather_planes_ch with the channel count a constant in each copy (its loops unrolled). */
+static void hf_gather_planes(const hf_sweep *sw, int ch, const int *ms, float *const *outs,
+                             ptrdiff_t out_stride)
+{
+    switch (ch) {
+    case 1: hf_gather_planes_ch(sw, 1, ms, outs, out_stride); break;
+    case 2: hf_gather_planes_ch(sw, 2, ms, outs, out_stride); break;
+    case 3: hf_gather_planes_ch(sw, 3, ms, outs, out_stride); break;
+    default: hf_gather_planes_ch(sw, 4, ms, outs, out_stride); break;
     }
 }
 
@@ -3004,14 +3009,14 @@ static double hf_tan_to_elevation(double t)
     return atan(t);
 }
 
-/* Consumer: elevation angle at each node of the line, into channel m of a 4-channel lattice
- * (the four quarter turns of hfvis_horizon_map) or the only channel. */
+/* Consumer: elevation angle at each node of the line, into channel *(const int *)ctx when ctx
+ * is given (hf_horizon_planes), else channel m of a 4-channel lattice (the four quarter turns of
+ * hfvis_horizon_map) or the only channel. */
 static void hf_store_elevation(hf_sweep *sw, void *ctx, int m, ptrdiff_t node0, ptrdiff_t step,
                                int n, const double *t)
 {
     int s, ch = sw->channels;
-    double *lat = sw->lat + (ch == 1 ? 0 : m);
-    (void)ctx;
+    double *lat = sw->lat + (ctx ? *(const int *)ctx : ch == 1 ? 0 : m);
     for (s = 0; s < n; s++, node0 += step) lat[node0 * ch] = hf_tan_to_elevation(t[s]);
 }
 
@@ -3082,7 +3087,7 @@ hfvis_status hfvis_horizon_direction(const hfvis_grid *grid, int K, int k,
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HFVIS__NAN);
     hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
-    hf_gather_planes(&sw, 1, m, out, 0, out_stride);
+    hf_gather_planes(&sw, 1, &m, &out, out_stride);
     hf_sweep_free(&sw);
     hf_progress(&o, 1, 1);
     return HFVIS_OK;
@@ -3121,8 +3126,9 @@ static hfvis_status hf_horizon_map_range(const hfvis_grid *grid, int K, const hf
                 sampled = 1;
             }
             hf_lattice_fill(&sw, HFVIS__NAN);
+            float *dst = out + (size_t)(pos - begin) * plane;
             hf_sweep_orientation(&sw, m, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
-            hf_gather_planes(&sw, 1, m, out + (size_t)(pos - begin) * plane, 0, grid->width);
+            hf_gather_planes(&sw, 1, &m, &dst, grid->width);
             hf_progress(o, ++done, end - begin);
         }
     }
@@ -3137,8 +3143,9 @@ hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_
     hf_sweep sw;
     hfvis_status s;
     size_t plane = 0, total;
-    int groups, per, gidx, m, done = 0;
+    int groups, per, gidx, m, done = 0, ms[4];
     int begin, end;
+    float *outs[4];
     if (hf_check_common(grid, opts) != HFVIS_OK || !out || K < 1) return HFVIS_ERR_INVALID_ARGUMENT;
     plane = hf_grid_count(grid);
     if (!hfvis__mul_size(plane, (size_t)K, &total)) return HFVIS_ERR_INVALID_ARGUMENT;
@@ -3162,7 +3169,75 @@ hfvis_status hfvis_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_
             hf_progress(&o, ++done, K);
         }
         /* plane k = gidx + m*groups: channel m lands m*groups planes further on */
-        hf_gather_planes(&sw, per, 0, out + (size_t)gidx * plane, (size_t)groups * plane, grid->width);
+        for (m = 0; m < per; m++) {
+            ms[m] = m;
+            outs[m] = out + (size_t)(gidx + m * groups) * plane;
+        }
+        hf_gather_planes(&sw, per, ms, outs, grid->width);
+    }
+    hf_sweep_free(&sw);
+    return HFVIS_OK;
+}
+
+/* The planes of the directions k with need[k] set into planes[k] (row stride the width; the other
+ * planes neither read nor written), each bit-identical to plane k of hfvis_horizon_map(grid, K,
+ * opts) in index order. Exact rays: each run of needed directions whose planes follow each other
+ * in memory is one hfvis_horizon_map call. Lattice: a quarter-turn group's lattice is sampled
+ * once, only its needed orientations are swept, each into its own channel (no zero or NaN fill
+ * of the others), and one gather writes them all (hf_gather_planes: a channel's value does not
+ * depend on the others). */
+static hfvis_status hf_horizon_planes(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
+                                      const unsigned char *need, float *const *planes)
+{
+    hfvis_sweep_options o;
+    hf_sweep sw;
+    hfvis_status s = HFVIS_OK;
+    size_t plane;
+    int per, groups, gidx, k, e, m, done = 0, total = 0;
+    if (hf_check_common(grid, opts) != HFVIS_OK || K < 1) return HFVIS_ERR_INVALID_ARGUMENT;
+    o = hf_opts_resolve(grid, opts);
+    o.direction_begin = o.direction_end = 0;
+    o.direction_order = HFVIS_DIRECTION_ORDER_DEFAULT;
+    plane = hf_grid_count(grid);
+    if (o.rays == HFVIS_RAYS_EXACT) {
+        for (k = 0; k < K && s == HFVIS_OK; k = e) {
+            hfvis_sweep_options r = *opts; /* as the caller's (resolved again inside) */
+            for (e = k + 1; e < K && need[e] == need[k] && (!need[k] || planes[e] == planes[e - 1] + plane); e++) {}
+            if (!need[k]) continue;
+            r.direction_order = HFVIS_DIRECTION_ORDER_DEFAULT;
+            r.direction_begin = r.direction_end = 0;
+            if (k > 0 || e < K) {
+                r.direction_begin = k;
+                r.direction_end = e;
+            }
+            s = hfvis_horizon_map(grid, K, &r, planes[k]);
+        }
+        return s;
+    }
+    per = K % 4 == 0 ? 4 : 1;
+    groups = K / per;
+    for (k = 0; k < K; k++) total += need[k] != 0;
+    if ((s = hf_sweep_alloc(&sw, grid, &o, 0, per, 0)) != HFVIS_OK) return s;
+    for (gidx = 0; gidx < groups; gidx++) {
+        double ux, uy;
+        int m0, ms[4], ch = 0, c;
+        float *outs[4];
+        for (m = 0; m < per; m++)
+            if (need[gidx + m * groups]) {
+                ms[ch] = m;
+                outs[ch++] = planes[gidx + m * groups];
+            }
+        if (!ch) continue;
+        hf_direction_base(K, gidx, o.azimuth0_rad, &ux, &uy, &m0);
+        sw.channels = ch; /* the buffer holds per channels */
+        hf_sweep_group(&sw, ux, uy);
+        if (sw.rect) hf_lattice_fill(&sw, HFVIS__NAN);
+        else hf_lattice_fill_outside(&sw, HFVIS__NAN);
+        for (c = 0; c < ch; c++) {
+            hf_sweep_orientation(&sw, ms[c], 0, hf_store_elevation, &c, HF_WALK_STORE, NULL);
+            hf_progress(&o, ++done, total);
+        }
+        hf_gather_planes(&sw, ch, ms, outs, grid->width);
     }
     hf_sweep_free(&sw);
     return HFVIS_OK;
@@ -3867,7 +3942,7 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
     hf_sweep sw;
     hfvis_status s;
     double ux, uy;
-    int x, y;
+    int x, y, m0 = 0;
     if (opts) { /* the bands are this call's own: checked here, refused elsewhere */
         whole = *opts;
         if (!hf_parts_valid(opts)) return HFVIS_ERR_INVALID_ARGUMENT;
@@ -3887,7 +3962,7 @@ hfvis_status hfvis_sun_visibility(const hfvis_grid *grid, double sun_azimuth_rad
     hf_sweep_group(&sw, ux, uy);
     hf_lattice_fill(&sw, HFVIS__NAN);
     hf_sweep_orientation(&sw, 0, 0, hf_store_elevation, NULL, HF_WALK_STORE, NULL);
-    hf_gather_planes(&sw, 1, 0, out, 0, out_stride);
+    hf_gather_planes(&sw, 1, &m0, &out, out_stride);
     for (y = sw.ry0; y < sw.ry1; y++) {
         int x0, x1;
         hf_sweep_span(&sw, y, &x0, &x1); /* the band's receivers of the row */
@@ -11604,25 +11679,36 @@ static hfvis_status hf_solar_run_steps(hf_solar_run *r)
     return HFVIS_OK;
 }
 
+/* The run's setup, steps and per-sample state. Only the rows [c.rb, c.re) of the per-sample
+ * arrays are set (every row with all_rows, the oracle's), and only they are ever read: a row
+ * band's call touches no other row's memory. */
 static hfvis_status hf_solar_run_init(const hfvis_grid *g, const hfvis_solar_input *in,
                                       const hfvis_solar_options *opts,
-                                      const hfvis_solar_output *out, hf_solar_run *r)
+                                      const hfvis_solar_output *out, int all_rows, hf_solar_run *r)
 {
     hfvis_status st;
-    size_t n, i;
+    size_t n, i, i0, i1, w;
+    int b;
     memset(r, 0, sizeof *r);
     if ((st = hf_solar_setup(g, in, opts, out, &r->c)) != HFVIS_OK) return st;
+    if (all_rows) {
+        r->c.rb = 0;
+        r->c.re = g->height;
+    }
     r->al = r->c.o.sweep ? r->c.o.sweep->alloc : NULL;
     n = hf_grid_count(g);
+    w = (size_t)g->width;
+    i0 = (size_t)r->c.rb * w;
+    i1 = (size_t)r->c.re * w;
     r->pts = (hf_solar_point *)hfvis__alloc_array(r->al, n, sizeof(hf_solar_point));
     r->acc = (double *)hfvis__alloc_array(r->al, n * (size_t)r->c.bands, 4 * sizeof(double));
     if (!r->pts || !r->acc || hf_solar_run_steps(r) != HFVIS_OK) {
         hf_solar_run_free(r);
         return HFVIS_ERR_OUT_OF_MEMORY;
     }
-    for (i = 0; i < n * (size_t)r->c.bands * 4; i++) r->acc[i] = 0.0;
-    for (i = 0; i < n; i++)
-        hf_solar_point_init(&r->c, g, (int)(i % (size_t)g->width), (int)(i / (size_t)g->width), r->pts + i);
+    for (b = 0; b < r->c.bands; b++)
+        for (i = ((size_t)b * n + i0) * 4; i < ((size_t)b * n + i1) * 4; i++) r->acc[i] = 0.0;
+    for (i = i0; i < i1; i++) hf_solar_point_init(&r->c, g, (int)(i % w), (int)(i / w), r->pts + i);
     return HFVIS_OK;
 }
 
@@ -11945,13 +12031,13 @@ static int hf_solar_day_apply(const hf_solar_ctx *c)
     return !c->o.linke_map && !c->o.coeff_bh && !c->o.coeff_dh && !c->o.no_shading;
 }
 
-/* A step's constants over the nodes pn[0..nn) (the map planes map + k n). */
-static void hf_solar_dstep_set(const hf_solar_step *st, const float *map, size_t n, int k0, int k1,
+/* A step's constants over the nodes pn[0..nn) (the map planes pl[k0], pl[k1]). */
+static void hf_solar_dstep_set(const hf_solar_step *st, const float *const *pl, int k0, int k1,
                                double kw, int nn, const double *pn, hf_solar_dstep *d)
 {
     int j;
-    d->hz0 = map + (size_t)k0 * n;
-    d->hz1 = map + (size_t)k1 * n;
+    d->hz0 = pl[k0];
+    d->hz1 = pl[k1];
     d->c0 = 1.0 - kw;
     d->c1 = kw;
     d->elev = st->elev;
@@ -12028,8 +12114,8 @@ static void hf_solar_day_lit(const hf_solar_dstep *d, const float *restrict h0, 
     }
 }
 
-/* The day path over one block's samples: steps [0, nsteps) of r, the direction-major map. */
-static hfvis_status hf_solar_day(const hfvis_grid *g, hf_solar_run *r, const float *map,
+/* The day path over one block's samples: steps [0, nsteps) of r, direction k's plane pl[k]. */
+static hfvis_status hf_solar_day(const hfvis_grid *g, hf_solar_run *r, const float *const *pl,
                                  const float *sky, const int *kk, const double *kw,
                                  const hf_solar_block *blk)
 {
@@ -12047,7 +12133,7 @@ static hfvis_status hf_solar_day(const hfvis_grid *g, hf_solar_run *r, const flo
         return HFVIS_ERR_OUT_OF_MEMORY;
     }
     for (q = 0; q < r->nsteps; q++)
-        hf_solar_dstep_set(r->steps + q, map, n, kk[2 * q], kk[2 * q + 1], kw[q], nn, pn, ds + q);
+        hf_solar_dstep_set(r->steps + q, pl, kk[2 * q], kk[2 * q + 1], kw[q], nn, pn, ds + q);
     for (y = blk->r0; y < blk->r1; y++)
         for (x0 = blk->x0; x0 < blk->x1; x0 += HF_SOLAR_CHUNK) {
             int cnt = blk->x1 - x0 < HF_SOLAR_CHUNK ? blk->x1 - x0 : HF_SOLAR_CHUNK;
@@ -12177,42 +12263,40 @@ static void hf_solar_mark(const hf_solar_run *r, int K, const double *az, unsign
     }
 }
 
-/* The horizon map (direction-major, K planes) of the directions the period's steps read, over
- * every block (exact rays; lattice horizons with K % 4 == 0: every direction); the other planes
- * 0 (never read). Each run of needed directions is one
- * hfvis_horizon_map call with direction_begin/end: its planes bit-identical to the whole map's. */
+/* The horizon planes the period's steps read, over every block: *map holds them (direction
+ * order, compact), pl[k] points to direction k's plane or is NULL (never read). Made by
+ * hf_horizon_planes, each plane bit-identical to the whole map's. */
 static hfvis_status hf_solar_map(const hfvis_grid *g, hf_solar_run *r, const hf_solar_blocks *B, int K,
-                                 const double *az, const hfvis_sweep_options *s, float *map)
+                                 const double *az, const hfvis_sweep_options *s, float **map,
+                                 const float **pl)
 {
-    size_t n = hf_grid_count(g), bi, i;
+    size_t n = hf_grid_count(g), bi, used = 0;
     unsigned char *need = (unsigned char *)hfvis__alloc_array(r->al, (size_t)K, 1);
-    int days = r->c.in.instant ? 1 : r->c.in.days, k, e;
+    float **wp = (float **)hfvis__alloc_array(r->al, (size_t)K, sizeof(float *));
+    int days = r->c.in.instant ? 1 : r->c.in.days, k;
     hfvis_status st = HFVIS_OK;
-    if (!need) return HFVIS_ERR_OUT_OF_MEMORY;
-    for (k = 0; k < K; k++) need[k] = 0;
-    if (s->rays == HFVIS_RAYS_LATTICE && K % 4 == 0) { /* every quarter-turn group shares one
-        lattice, and an arc of the sun's azimuths wider than a quarter turn meets every group */
-        for (k = 0; k < K; k++) need[k] = 1;
+    *map = NULL;
+    if (!need || !wp) {
+        st = HFVIS_ERR_OUT_OF_MEMORY;
     } else if (B->n == 1 || (double)B->n * (double)days <= HF_SOLAR_MARK_BLOCK_DAYS) {
+        for (k = 0; k < K; k++) need[k] = 0;
         for (bi = 0; bi < B->n && st == HFVIS_OK; bi++)
             if ((st = hf_solar_run_site(r, B->b + bi)) == HFVIS_OK) hf_solar_mark(r, K, az, need);
     } else {
         for (k = 0; k < K; k++) need[k] = 1;
     }
-    for (k = 0; k < K && st == HFVIS_OK; k = e) {
-        hfvis_sweep_options o = *s;
-        for (e = k + 1; e < K && need[e] == need[k]; e++) {}
-        if (!need[k]) {
-            for (i = 0; i < (size_t)(e - k) * n; i++) map[(size_t)k * n + i] = 0.0f;
-            continue;
-        }
-        if (k > 0 || e < K) {
-            o.direction_begin = k;
-            o.direction_end = e;
-        }
-        st = hfvis_horizon_map(g, K, &o, map + (size_t)k * n);
+    for (k = 0; k < K && st == HFVIS_OK; k++) used += need[k];
+    if (st == HFVIS_OK && used) {
+        *map = (float *)hfvis__alloc_array(r->al, n * used, sizeof(float)); /* n K fits */
+        if (!*map) st = HFVIS_ERR_OUT_OF_MEMORY;
     }
+    for (k = 0, used = 0; k < K && st == HFVIS_OK; k++) {
+        wp[k] = need[k] ? *map + n * used++ : NULL;
+        pl[k] = wp[k];
+    }
+    if (st == HFVIS_OK && used) st = hf_horizon_planes(g, K, s, need, wp);
     hfvis__free(r->al, need);
+    hfvis__free(r->al, wp);
     return st;
 }
 
@@ -12226,11 +12310,12 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
     hfvis_status st;
     hfvis_sweep_options s;
     float *map = NULL, *cellmap = NULL, *sky = NULL;
-    const float *src = NULL; /* the direction-major map read (the caller's or map) */
+    const float *src = NULL; /* the whole direction-major map (the caller's or map), when there is one */
+    const float **pl = NULL; /* direction k's plane, NULL where never read; NULL: no shading */
     double *az = NULL;
-    int K, horn_sky;
+    int K, horn_sky, k;
     size_t n, i, bi;
-    if ((st = hf_solar_run_init(g, in, opts, out, &r)) != HFVIS_OK) return st;
+    if ((st = hf_solar_run_init(g, in, opts, out, 0, &r)) != HFVIS_OK) return st;
     n = hf_grid_count(g);
     K = r.c.o.directions;
     s = hf_solar_map_sweep(&r.c);
@@ -12244,23 +12329,32 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
     if (st == HFVIS_OK && (!r.c.o.no_shading || horn_sky)) {
         if (n > SIZE_MAX / sizeof(float) / (size_t)K) st = HFVIS_ERR_LIMIT;
         if (st == HFVIS_OK) {
+            int whole = r.c.o.horizon_map || horn_sky;
             az = (double *)hfvis__alloc_array(r.al, (size_t)K, sizeof(double));
-            map = r.c.o.horizon_map ? NULL : (float *)hfvis__alloc_array(r.al, n * (size_t)K, sizeof(float));
-            if (!az || (!map && !r.c.o.horizon_map)) st = HFVIS_ERR_OUT_OF_MEMORY;
+            pl = (const float **)hfvis__alloc_array(r.al, (size_t)K, sizeof(const float *));
+            map = r.c.o.horizon_map || !horn_sky ? NULL : (float *)hfvis__alloc_array(r.al, n * (size_t)K, sizeof(float));
+            if (!az || !pl || (!map && horn_sky && !r.c.o.horizon_map)) st = HFVIS_ERR_OUT_OF_MEMORY;
+            if (st == HFVIS_OK) st = hfvis_sweep_azimuths(K, &s, az, NULL);
+            if (st == HFVIS_OK && map) st = hfvis_horizon_map(g, K, &s, map);
+            else if (st == HFVIS_OK && !whole) st = hf_solar_map(g, &r, &B, K, az, &s, &map, pl);
+            if (whole) {
+                src = r.c.o.horizon_map ? r.c.o.horizon_map : map;
+                for (k = 0; k < K && src; k++) pl[k] = src + (size_t)k * n;
+            }
         }
-        if (st == HFVIS_OK) st = hfvis_sweep_azimuths(K, &s, az, NULL);
-        if (st == HFVIS_OK && !r.c.o.horizon_map)
-            st = horn_sky ? hfvis_horizon_map(g, K, &s, map) : hf_solar_map(g, &r, &B, K, az, &s, map);
-        src = r.c.o.horizon_map ? r.c.o.horizon_map : map;
     }
     if (st == HFVIS_OK && r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON) {
         sky = (float *)hfvis__alloc_array(r.al, n, sizeof(float));
         if (!sky) st = HFVIS_ERR_OUT_OF_MEMORY;
         else if (horn_sky)
-            for (i = 0; i < n; i++) sky[i] = (float)hf_solar_sky_seen(r.pts + i, K, az, src, n, i);
+            for (i = (size_t)r.c.rb * (size_t)g->width; i < (size_t)r.c.re * (size_t)g->width; i++) /* the rows read */
+                sky[i] = (float)hf_solar_sky_seen(r.pts + i, K, az, src, n, i);
         else st = hfvis_sky_light(g, K, 1.0f, 1.0f, &s, sky, g->width);
     }
-    if (r.c.o.no_shading) src = NULL; /* no map read by the steps */
+    if (r.c.o.no_shading) { /* no map read by the steps */
+        hfvis__free(r.al, pl);
+        pl = NULL;
+    }
     for (bi = 0; bi < B.n && st == HFVIS_OK; bi++) {
         hf_solar_block part = B.b[bi], *blk = &part;
         int *kk = NULL;
@@ -12271,30 +12365,29 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
         if (part.r1 > r.c.re) part.r1 = r.c.re;
         if (part.r0 >= part.r1) continue;
         if ((st = hf_solar_run_site(&r, blk)) != HFVIS_OK) break;
-        sectors = src && hf_solar_sectors_apply(&r.c, r.nsteps);
-        day = src && !sectors && hf_solar_day_apply(&r.c);
-        if (src && !day && !cellmap) { /* sample-major: each sample's K horizons side by side */
-            int k;
+        sectors = pl && hf_solar_sectors_apply(&r.c, r.nsteps);
+        day = pl && !sectors && hf_solar_day_apply(&r.c);
+        if (pl && !day && !cellmap) { /* sample-major: each sample's K horizons side by side */
             cellmap = (float *)hfvis__alloc_array(r.al, n * (size_t)K, sizeof(float));
             if (!cellmap) {
                 st = HFVIS_ERR_OUT_OF_MEMORY;
                 break;
             }
-            for (k = 0; k < K; k++)
-                for (i = 0; i < n; i++) cellmap[i * (size_t)K + (size_t)k] = src[(size_t)k * n + i];
+            for (k = 0; k < K; k++) /* the planes never read: 0 */
+                for (i = 0; i < n; i++) cellmap[i * (size_t)K + (size_t)k] = pl[k] ? pl[k][i] : 0.0f;
         }
         if (sectors) {
             st = hf_solar_sectors(g, &r, K, az, cellmap, sky, blk);
             continue;
         }
-        if (src) { /* each step's two map directions and weight */
+        if (pl) { /* each step's two map directions and weight */
             kk = (int *)hfvis__alloc_array(r.al, r.nsteps + 1, 2 * sizeof(int));
             kw = (double *)hfvis__alloc_array(r.al, r.nsteps + 1, sizeof(double));
             if (!kk || !kw) st = HFVIS_ERR_OUT_OF_MEMORY;
             for (q = 0; q < r.nsteps && st == HFVIS_OK; q++)
                 hf_solar_bracket(az, K, r.steps[q].psi, kk + 2 * q, kk + 2 * q + 1, kw + q);
         }
-        if (st == HFVIS_OK && day) st = hf_solar_day(g, &r, src, sky, kk, kw, blk);
+        if (st == HFVIS_OK && day) st = hf_solar_day(g, &r, pl, sky, kk, kw, blk);
         else if (st == HFVIS_OK) hf_solar_loop(g, &r, K, cellmap, sky, kk, kw, blk);
         hfvis__free(r.al, kk);
         hfvis__free(r.al, kw);
@@ -12304,6 +12397,7 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
     hfvis__free(r.al, az);
     hfvis__free(r.al, cellmap);
     hfvis__free(r.al, map);
+    hfvis__free(r.al, pl);
     hfvis__free(r.al, sky);
     if (st != HFVIS_OK) {
         hf_solar_run_free(&r);
@@ -12370,9 +12464,7 @@ hfvis_status hfvis_solar_irradiation_reference(const hfvis_grid *g, const hfvis_
     double *az = NULL;
     size_t n, i, q;
     int KR;
-    if ((st = hf_solar_run_init(g, in, opts, out, &r)) != HFVIS_OK) return st;
-    r.c.rb = 0; /* every row */
-    r.c.re = g->height;
+    if ((st = hf_solar_run_init(g, in, opts, out, 1, &r)) != HFVIS_OK) return st; /* every row */
     n = hf_grid_count(g);
     s = hf_solar_sweep(&r.c, HFVIS_RAYS_EXACT);
     KR = HF_SOLAR_REF_DIRS * r.c.o.directions;

@@ -1339,6 +1339,11 @@ expect_fail "solar: no latitude (no CRS)" 1 solar "$dir/flat.pgm" --day 2026-06-
 expect_fail "solar: a date that does not exist" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-02-29 -o "$fdir/x.pfm"
 expect_fail "solar: Linke outside (0, 10]" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --linke 0 -o "$fdir/x.pfm"
 expect_fail "solar: albedo outside [0, 1]" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --albedo 1.2 -o "$fdir/x.pfm"
+# the memory estimate counts the sample-major copy of the map only where a period's sums read it
+expect_fail "solar, a day, over --max-memory 1K" 1 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --max-memory 1K -o "$fdir/x.pfm"; m1=$(mib)
+expect_fail "solar, 30 days, over --max-memory 1K" 1 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --start 2026-06-01 --end 2026-06-30 --max-memory 1K -o "$fdir/x.pfm"; m3=$(mib)
+awk -v a="$m1" -v b="$m3" 'BEGIN { exit !(a > 0 && b > 1.4 * a) }' &&
+  ok "estimate: solar 30 days $m3 MiB > a day $m1 MiB (the sample-major copy)" || bad "estimate: solar 30 days '$m3' MiB not above a day '$m1' MiB"
 expect_fail "solar: latitude without longitude" 2 solar "$dir/flat.pgm" --latitude 46 --day 2026-06-21 -o "$fdir/x.pfm"
 expect_fail "solar: --time with a range" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --start 2026-06-01 --end 2026-06-02 --time 12:00 -o "$fdir/x.pfm"
 expect_fail "solar: --solar-time with --utc-offset" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --solar-time --utc-offset 1 -o "$fdir/x.pfm"

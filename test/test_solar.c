@@ -931,38 +931,42 @@ static void count_progress(void *user, int done, int total)
 }
 
 /* The map made only for the directions the steps read (hfvis.c section 17.7c): bit-identical to
- * a run on the whole map (the caller's), and fewer directions swept where the sun never goes. */
+ * a run on the whole map (the caller's), and fewer directions swept where the sun never goes;
+ * exact rays and lattice horizons (a quarter-turn group's lattice swept only in the needed
+ * orientations), K a multiple of 4 and not (case 5: K = 30, one orientation per group). */
 TEST(map_directions_restricted_bit_identical)
 {
     static float one[5][W * H], map[64 * W * H];
     hfvis_sweep_options sw = hfvis_sweep_options_default();
-    int c, k, i;
-    for (c = 0; c < 5; c++) {
-        hfvis_grid g = test_grid(zbuf, c == 4 ? S : W, c == 4 ? S : H, 1.0);
-        hfvis_solar_input in = site(c == 1 ? -35.0 : 46.0, 6, 21);
-        hfvis_solar_options o = hfvis_solar_options_default();
-        hfvis_solar_output a = outs(one), b = outs(ob);
-        int n = g.width * g.height;
-        (void)test_fbm(zbuf, g.width, g.height, 6.0, 8.0, 0, 40 + (uint64_t)c);
-        if (c == 2) in.days = 30; /* the sector sums: the bins' directions */
-        if (c == 3) o.model = HFVIS_SUN_RSUN;
-        if (c == 4) sites(&in, 60.0, 40.0, 10.0, 12.0); /* several blocks: the union */
-        sw = hfvis_sweep_options_default();
-        sw.progress = count_progress;
-        o.sweep = &sw;
-        progress_calls = 0;
-        CHECK_EQ_STATUS(hfvis_solar_irradiation(&g, &in, &o, &a), HFVIS_OK);
-        printf("     case %d: %d of 64 directions made\n", c, progress_calls);
-        CHECK(progress_calls > 0 && progress_calls < 64); /* the north never holds the sun */
-        sw.progress = NULL;
-        sw.rays = HFVIS_RAYS_EXACT;
-        CHECK_EQ_STATUS(hfvis_horizon_map(&g, 64, &sw, map), HFVIS_OK);
-        sw.rays = HFVIS_RAYS_LATTICE;
-        o.horizon_map = map;
-        CHECK_EQ_STATUS(hfvis_solar_irradiation(&g, &in, &o, &b), HFVIS_OK);
-        for (k = 0; k < 5; k++)
-            for (i = 0; i < n; i++) CHECK(memcmp(&one[k][i], &ob[k][i], sizeof(float)) == 0);
-    }
+    int c, m, k, i;
+    for (c = 0; c < 6; c++)
+        for (m = 0; m < 2; m++) {
+            hfvis_grid g = test_grid(zbuf, c == 4 ? S : W, c == 4 ? S : H, 1.0);
+            hfvis_solar_input in = site(c == 1 || c == 5 ? -35.0 : 46.0, 6, 21);
+            hfvis_solar_options o = hfvis_solar_options_default();
+            hfvis_solar_output a = outs(one), b = outs(ob);
+            int n = g.width * g.height, K;
+            (void)test_fbm(zbuf, g.width, g.height, 6.0, 8.0, 0, 40 + (uint64_t)c);
+            if (c == 2) in.days = 30; /* the sector sums: the bins' directions */
+            if (c == 3) o.model = HFVIS_SUN_RSUN;
+            if (c == 4) sites(&in, 60.0, 40.0, 10.0, 12.0); /* several blocks: the union */
+            if (c == 5) o.directions = 30;
+            K = o.directions;
+            o.horizons = m ? HFVIS_SOLAR_HORIZONS_LATTICE : HFVIS_SOLAR_HORIZONS_EXACT;
+            sw = hfvis_solar_map_options(&o);
+            sw.progress = count_progress;
+            o.sweep = &sw;
+            progress_calls = 0;
+            CHECK_EQ_STATUS(hfvis_solar_irradiation(&g, &in, &o, &a), HFVIS_OK);
+            printf("     case %d, %s: %d of %d directions made\n", c, m ? "lattice" : "exact", progress_calls, K);
+            CHECK(progress_calls > 0 && progress_calls < K); /* the north never holds the sun */
+            sw.progress = NULL;
+            CHECK_EQ_STATUS(hfvis_horizon_map(&g, K, &sw, map), HFVIS_OK);
+            o.horizon_map = map;
+            CHECK_EQ_STATUS(hfvis_solar_irradiation(&g, &in, &o, &b), HFVIS_OK);
+            for (k = 0; k < 5; k++)
+                for (i = 0; i < n; i++) CHECK(memcmp(&one[k][i], &ob[k][i], sizeof(float)) == 0);
+        }
 }
 
 /* The horizon modes (hfvis_solar_options.horizons) against the oracle's own exact rays: mean
@@ -1038,17 +1042,37 @@ TEST(horizon_modes_against_oracle)
     }
 }
 
+/* An allocator whose blocks start as NaN bytes: a row band's call that read per-sample state of
+ * rows it never set would turn its outputs NaN. */
+static void *nan_fill_alloc(void *user, size_t size)
+{
+    void *p = malloc(size);
+    (void)user;
+    if (p) memset(p, 0xff, size);
+    return p;
+}
+static void nan_fill_free(void *user, void *ptr)
+{
+    (void)user;
+    free(ptr);
+}
+
 /* Row ranges (hfvis_solar_options.row_begin/end): three calls on disjoint ranges give the whole
- * call bit for bit, each leaving the other rows untouched; the day path, the sector sums, the
- * step loop (a Linke map), per-sample blocks, HORIZON diffuse. */
+ * call bit for bit, each leaving the other rows untouched and reading only its own rows' state
+ * (blocks allocated as NaN); the day path, the sector sums, the step loop (a Linke map),
+ * per-sample blocks, HORIZON diffuse, HORIZON diffuse over Horn's planes with a hole. */
 TEST(row_ranges_equal_the_whole_call)
 {
     static float whole[5][3 * W * H], part[5][3 * W * H];
     static float lk[W * H];
     static const int cut[4] = { 0, 7, 13, H };
+    hfvis_allocator nan_alloc;
     int c, k, i, p;
+    nan_alloc.alloc = nan_fill_alloc;
+    nan_alloc.free = nan_fill_free;
+    nan_alloc.user = NULL;
     for (i = 0; i < W * H; i++) lk[i] = 3.5f;
-    for (c = 0; c < 5; c++) {
+    for (c = 0; c < 6; c++) {
         hfvis_grid g = test_grid(zbuf, c == 3 ? S : W, c == 3 ? S : H, 1.0);
         hfvis_solar_input in = site(c == 4 ? -35.0 : 46.0, 5, 10);
         hfvis_solar_options o = hfvis_solar_options_default();
@@ -1058,11 +1082,19 @@ TEST(row_ranges_equal_the_whole_call)
         if (c == 1) in.days = 30;
         if (c == 2) o.linke_map = lk;
         if (c == 3) sites(&in, 60.0, 40.0, 10.0, 12.0);
+        hfvis_sweep_options sw = hfvis_sweep_options_default();
         if (c == 4) {
             o.diffuse = HFVIS_SOLAR_DIFFUSE_HORIZON;
             in.days = 3;
             o.bands = HFVIS_SOLAR_BANDS_DAY;
         }
+        if (c == 5) {
+            o.diffuse = HFVIS_SOLAR_DIFFUSE_HORIZON;
+            o.normals = HFVIS_SOLAR_NORMALS_HORN;
+            zbuf[9 * W + 5] = NAN;
+        }
+        sw.alloc = &nan_alloc;
+        o.sweep = &sw;
         nb = hfvis_solar_band_count(&in, &o);
         a.beam = whole[0]; a.diffuse = whole[1]; a.reflected = whole[2]; a.global = whole[3]; a.sun_hours = whole[4];
         b.beam = part[0]; b.diffuse = part[1]; b.reflected = part[2]; b.global = part[3]; b.sun_hours = part[4];

@@ -2,6 +2,8 @@
  * day (day 172, 15-minute steps, Linke 3, albedo 0.2) on a DEM for each horizon mode (exact,
  * near-far, lattice), the directions of the map it made, its ratio to GRASS; the integration
  * alone over a given map, the day path beside the step loop it replaced (ns per receiver-step);
+ * the cost of Horn's normals (a day without shading, central and horn); on the Colorado tile (or
+ * the stand-in) the tool's row split, `hfvis solar --threads 1` and `--threads 2`, bytes compared;
  * then each mode and the oracle on a crop, their ratio and the mode's agreement (mean
  * |fast - oracle| / oracle of the daily global and beam).
  * The DEMs come from HFVIS_BENCH_DEMS, a directory holding colorado_srtm_512_90m.pfm (SRTM,
@@ -16,6 +18,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "bench.h"
 #include "../fields.h"
 
@@ -95,6 +98,60 @@ static void solar_count(void *user, int done, int total)
 
 static const char *const solar_mode_name[4] = { "", "exact", "near-far", "lattice" };
 
+/* The tool's row split of the day (`hfvis solar --threads 1` and `--threads 2`: the map made by
+ * directions over the threads, then the library's row_begin/end per thread), as child processes
+ * on the DEM written as a PFM: wall and CPU seconds, the speed-up, the outputs equal byte for byte. */
+static void solar_threads(const solar_site *s, const float *z, int w, int h, int quick)
+{
+    static const char *const modes[2] = { "exact", "lattice" };
+    char *cli = getenv("HFVIS_CLI") ? getenv("HFVIS_CLI") : (char *)"build/hfvis";
+    const char *tmp = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
+    char dir[512], in[600], out[2][600], cell[32], lat[32], lon[32], off[32], mode[16], *argv[32];
+    int m, t, rep, a;
+    snprintf(dir, sizeof dir, "%s/hfvis_bench_solar_threads.XXXXXX", tmp);
+    if (!mkdtemp(dir)) { printf("  solar --threads: cannot create a folder in %s\n", tmp); return; }
+    snprintf(in, sizeof in, "%s/dem.pfm", dir);
+    if (hfvis_pfm_save(in, z, w, h, 1, w) != HFVIS_OK) {
+        printf("  solar --threads: cannot write %s\n", in);
+        rmdir(dir);
+        return;
+    }
+    snprintf(cell, sizeof cell, "%.17g", s->cell);
+    snprintf(lat, sizeof lat, "%.17g", s->lat);
+    snprintf(lon, sizeof lon, "%.17g", s->lon);
+    snprintf(off, sizeof off, "%g", s->lon / 15.0 > 0 ? 1.0 : -7.0); /* as solar_dem's */
+    for (m = 0; m < 2; m++) {
+        double wall[2] = {1e300, 1e300}, cpu[2] = {1e300, 1e300};
+        int failed = 0;
+        snprintf(mode, sizeof mode, "%s", modes[m]);
+        for (t = 0; t < 2; t++) {
+            snprintf(out[t], sizeof out[t], "%s/out%d.pfm", dir, t);
+            for (rep = 0; rep < (quick ? 1 : 2); rep++) {
+                double wl = 0.0, c = 0.0;
+                long mem = 0;
+                a = 0;
+                argv[a++] = cli, argv[a++] = (char *)"solar", argv[a++] = in;
+                argv[a++] = (char *)"--cell", argv[a++] = cell, argv[a++] = (char *)"--latitude", argv[a++] = lat;
+                argv[a++] = (char *)"--longitude", argv[a++] = lon, argv[a++] = (char *)"--utc-offset", argv[a++] = off;
+                argv[a++] = (char *)"--day", argv[a++] = (char *)"2026-06-21", argv[a++] = (char *)"--horizons";
+                argv[a++] = mode, argv[a++] = (char *)"--threads", argv[a++] = (char *)(t ? "2" : "1");
+                argv[a++] = (char *)"--max-memory", argv[a++] = (char *)"0", argv[a++] = (char *)"--quiet";
+                argv[a++] = (char *)"-o", argv[a++] = out[t];
+                argv[a] = NULL;
+                if (bench_spawn(argv, &wl, &mem, &c) != 0) failed = 1;
+                if (wl < wall[t]) wall[t] = wl;
+                if (c < cpu[t]) cpu[t] = c;
+            }
+        }
+        printf("  %-34s tool, --horizons %-8s --threads 1 %.2f s (CPU %.2f), --threads 2 %.2f s (CPU %.2f): %.2fx; "
+               "bytes equal: %s\n", "", modes[m], wall[0], cpu[0], wall[1], cpu[1], wall[0] / wall[1],
+               failed ? "FAILED" : bench_same_file(out[0], out[1]) ? "yes" : "NO");
+        remove(out[0]), remove(out[1]);
+    }
+    remove(in);
+    rmdir(dir);
+}
+
 static void solar_dem(const solar_site *s, float *z, int w, int h, int quick)
 {
     hfvis_grid g;
@@ -173,8 +230,23 @@ static void solar_dem(const solar_site *s, float *z, int w, int h, int quick)
                    t_rhor / t_mode[m]);
         printf("\n");
     }
-    printf("  %-34s memory: 256 bytes per receiver for the map (K = 64; its sample-major copy, 256 more, only\n"
-           "  %-34s for long periods and the step loop) + 120 + 32 per band\n", "", "");
+    { /* Horn's normals (--normals horn): their cost, all at set-up (a 3x3 stencil per receiver),
+         timed on a day without shading (no map) */
+        hfvis_solar_options no = o;
+        double tc = 1e30, th = 1e30;
+        no.no_shading = 1;
+        for (rep = 0; rep < (quick ? 1 : 3); rep++) {
+            no.normals = HFVIS_SOLAR_NORMALS_CENTRAL;
+            if (solar_run(&g, &in, &no, 0, b1, g1, &t) && t < tc) tc = t;
+            no.normals = HFVIS_SOLAR_NORMALS_HORN;
+            if (solar_run(&g, &in, &no, 0, b1, g1, &t) && t < th) th = t;
+        }
+        printf("  %-34s normals, a day without shading: central %.3f s, horn %.3f s: %+.1f ns per receiver\n", "",
+               tc, th, (th - tc) * 1e9 / (double)n);
+    }
+    if (s->utm_zone || !s->file[0]) solar_threads(s, z, w, h, quick);
+    printf("  %-34s memory: 4 bytes per receiver and direction made (the map: the counts above; K = 64 and a\n"
+           "  %-34s sample-major copy, 256 + 256, for long periods and the step loop) + 120 + 32 per band\n", "", "");
     /* fast (each mode) and oracle on the central crop */
     for (y = 0; y < SOLAR_CROP; y++)
         for (x = 0; x < SOLAR_CROP; x++)

@@ -63,12 +63,15 @@ static cli_cost cli_estimate_indirect(const cli_args *a, int w, int h, int chann
     c.work *= (double)(a->bounces + 1);
     return c;
 }
-/* solar: the K = 64 map twice (sweep and sample-major), state, outputs, the map's sweeps */
+/* solar: the map of K directions (64 unless --dirs), its sample-major copy only where the
+ * sector sums or the step loop read one (a period of --start/--end, a Linke map; a day's path
+ * reads the map as made), state, outputs, the map's sweeps */
 static cli_cost cli_estimate_solar(const cli_args *a, int w, int h, int channels)
 {
-    double n = (double)w * (double)h;
-    (void)a, (void)channels;
-    return cli_cost_of(n * (8.0 * 64.0 + 160.0 + 20.0), 64.0 * 16.0 * n, "ray crossings");
+    double n = (double)w * (double)h, K = a->has_dirs ? (double)a->dirs : 64.0;
+    double copy = a->sol_has_end || a->sol_linke_map ? 4.0 * K : 0.0;
+    (void)channels;
+    return cli_cost_of(n * (4.0 * K + copy + 160.0 + 20.0), K * 16.0 * n, "ray crossings");
 }
 /* viewshed: the grid and its output; one line of sight per edge cell */
 static cli_cost cli_estimate_viewshed(const cli_args *a, int w, int h, int channels)
