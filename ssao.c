@@ -1295,7 +1295,7 @@ static inline int ss_hsin_less(const ss_hcand *a, const ss_hcand *b)
  * rational form), isig 1/scale. */
 typedef struct ss_hocc_t { double num, den, rl, N, D; } ss_hocc_t;
 
-static inline void ss_hocc(const ss_fall *fs, const ss_fall *f, const ss_hcand *c, double r2,
+static HFVIS__ALWAYS_INLINE void ss_hocc(const ss_fall *fs, const ss_fall *f, const ss_hcand *c, double r2,
                            double st, double isig, ss_hocc_t *o)
 {
     double N, D, rl, e;
@@ -1349,16 +1349,18 @@ static double ss_line_scale(const double *x, const double *y, int n, double m)
 }
 
 /* The obscurity hull along one line ([P3] §4.2, Alg. 1): coordinates times sig as they are
- * read (1 where the caller scaled them), the falloff's lengths times fsig (the scale). */
+ * read (1 where the caller scaled them), the falloff's lengths times fsig (the scale); kind is
+ * f->kind (a constant where a caller specializes the body). */
 static HFVIS__ALWAYS_INLINE void ss_hull_body(const double *x, const double *y, const double *stc,
                                               const double *ste, int n, int persp, double fixed,
-                                              const ss_fall *f, int ties, double sig, double fsig,
-                                              int *stack, double *out)
+                                              const ss_fall *f, int kind, int ties, double sig,
+                                              double fsig, int *stack, double *out)
 {
     const double isig = 1.0 / fsig;
     ss_fall fs = *f; /* in the scaled coordinates: lengths times fsig (exact) */
     ss_hocc_t o1 = {0.0, 1.0, 0.0, 0.0, 0.0}, o2;
     int top = 0, i;
+    fs.kind = kind;
     fs.a *= fsig * fsig;
     fs.r1c *= fsig * fsig;
     for (i = 0; i < n; i++) {
@@ -1420,11 +1422,13 @@ static void ss_hull_line(const double *x, const double *y, const double *stc, co
                          int *stack, double *out)
 {
     const double sig = ss_line_scale(x, y, n, amax);
-    ss_hull_body(x, y, stc, ste, n, persp, fixed, f, ties, sig, sig, stack, out);
+    ss_hull_body(x, y, stc, ste, n, persp, fixed, f, f->kind, ties, sig, sig, stack, out);
 }
 
 /* The hull of the sweep's own line: x, y scaled in place first (a power of two: the same bits as
- * scaling each difference), so the hull multiplies nothing as it reads them. */
+ * scaling each difference), so the hull multiplies nothing as it reads them. hfvis_lsao's usual
+ * case (perspective, the fixed tangent, HBAO's falloff, ties popped) has its own copy of the
+ * body with those branches folded away (the same arithmetic). */
 static void ss_hull_line_scratch(double *x, double *y, const double *stc, const double *ste, int n,
                                  int persp, double fixed, const ss_fall *f, int ties, double amax,
                                  int *stack, double *out)
@@ -1435,7 +1439,10 @@ static void ss_hull_line_scratch(double *x, double *y, const double *stc, const 
         x[i] *= sig;
         y[i] *= sig;
     }
-    ss_hull_body(x, y, stc, ste, n, persp, fixed, f, ties, 1.0, sig, stack, out);
+    if (persp && !stc && !ste && ties && f->kind == HFVIS_FALLOFF_HBAO)
+        ss_hull_body(x, y, NULL, NULL, n, 1, fixed, f, HFVIS_FALLOFF_HBAO, 1, 1.0, sig, stack, out);
+    else
+        ss_hull_body(x, y, stc, ste, n, persp, fixed, f, f->kind, ties, 1.0, sig, stack, out);
 }
 
 /* Brute-force oracle ([P3] Fig. 7). */
