@@ -2078,12 +2078,16 @@ typedef struct ss_gdir {
     const float *values, *sdepth;
     size_t vs; /* sample s at values[vs s], sdepth[vs s] */
     double w, ids, idl, R2, px, py, s_first, ddx, ddy, t_min, jmax;
+    int empty;  /* no lines */
+    int all_in; /* every inner pixel's rounded line and step lie inside the lattice */
 } ss_gdir;
 
-static void ss_gdir_set(ss_gdir *G, const hfvis_ssao_lattice *L, const hfvis_ssao_line *lines,
-                        const float *values, const float *sdepth, size_t vs)
+static void ss_gdir_set(const ss_cam *c, ss_gdir *G, const hfvis_ssao_lattice *L,
+                        const hfvis_ssao_line *lines, const float *values, const float *sdepth,
+                        size_t vs)
 {
     const hfvis_ssao_direction *d = &L->dir;
+    int k;
     G->L = L;
     G->lines = lines;
     G->values = values;
@@ -2100,6 +2104,17 @@ static void ss_gdir_set(ss_gdir *G, const hfvis_ssao_lattice *L, const hfvis_ssa
     G->ddy = d->dy;
     G->t_min = L->t_min;
     G->jmax = (double)L->line_count - 0.5;
+    G->empty = L->line_count < 1;
+    /* the gather's range test at the inner image's four corner pixels, in its own arithmetic:
+     * each step of it is monotone in u and in v, so the corners bound every pixel between */
+    G->all_in = !G->empty;
+    for (k = 0; k < 4; k++) {
+        double u = (k & 1 ? (double)(c->W - c->gx) : (double)c->gx) + (k & 1 ? -0.5 : 0.5),
+               v = (k & 2 ? (double)(c->H - c->gy) : (double)c->gy) + (k & 2 ? -0.5 : 0.5);
+        double jf = (u * G->px + v * G->py - G->s_first) * G->idl,
+               tf = (u * G->ddx + v * G->ddy - G->t_min) * G->ids;
+        if (!(jf > -0.5 && jf < G->jmax && tf > -0.5 && tf < 2147483647.0)) G->all_in = 0;
+    }
 }
 
 /* Direction G's value for the receiver at (u, v) of depth zc (normal nc or NULL): 1 and *val if a
@@ -2181,26 +2196,27 @@ static void ss_gather_dirs(const ss_cam *c, const ss_cfg *g, const float *depth,
         const float *drow = depth + ss_index(c, 0, y);
         size_t orow = (size_t)(y - c->gy) * (size_t)W - (size_t)c->gx; /* + x: pixel x's slot (mod 2^n) */
         for (x = tx; x < x_end && x < tx + SS_GATHER_TILE; x++) {
-            double u = (double)x + 0.5, zc = (double)drow[x], s, ws;
+            double u = (double)x + 0.5, zc = (double)drow[x], s, ws, rz;
             const float *nc = normals ? normals + 3 * ss_index(c, x, y) : NULL;
             if (!(zc > 0.0 && zc < far_d)) continue; /* ss_bg */
+            rz = rej_z < 0.0 ? HFVIS__INF : rej_z * zc; /* the depth test's bound; off: any depth */
             s = sum[orow + (size_t)x];
             ws = wsum[orow + (size_t)x];
             for (k = 0; k < nd; k++) {
                 const ss_gdir *Gk = &G[k];
                 double val;
-                if (Gk->L->line_count < 1) continue;
+                if (Gk->empty) continue;
                 if (inline_nearest) {
                     double jf = (u * Gk->px + v * Gk->py - Gk->s_first) * Gk->idl,
                            tf = (u * Gk->ddx + v * Gk->ddy - Gk->t_min) * Gk->ids;
-                    if (jf > -0.5 && jf < Gk->jmax && tf > -0.5 && tf < 2147483647.0) {
+                    if (Gk->all_in || (jf > -0.5 && jf < Gk->jmax && tf > -0.5 && tf < 2147483647.0)) {
                         const hfvis_ssao_line *ln = &Gk->lines[(int)(jf + 0.5)];
                         int i = (int)(tf + 0.5);
                         if (i >= ln->first && i < ln->first + ln->count) {
                             size_t idx = Gk->vs * (ln->offset + (size_t)(i - ln->first));
                             double zs = (double)Gk->sdepth[idx];
                             val = (double)Gk->values[idx];
-                            if (val == val && zs == zs && (rej_z < 0.0 || fabs(zs - zc) <= rej_z * zc)) {
+                            if (val == val && fabs(zs - zc) <= rz) { /* false for a NaN depth */
                                 s += Gk->w * val;
                                 ws += Gk->w;
                                 continue;
@@ -2232,7 +2248,7 @@ hfvis_status hfvis_lsao_gather(const hfvis_camera *cam, const float *depth, cons
         !isfinite(lat->dir.weight))
         return HFVIS_ERR_INVALID_ARGUMENT;
     ss_cfg_from_lsao(&o, &g);
-    ss_gdir_set(&G, lat, lines, values, sample_depth, 1);
+    ss_gdir_set(&c, &G, lat, lines, values, sample_depth, 1);
     ss_gather_dirs(&c, &g, depth, normals, &G, 1, sum, weight);
     return HFVIS_OK;
 }
@@ -2321,7 +2337,7 @@ hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth, const float
             ss_lattice_fill(&c, &glat[k], lk);
             ss_lsao_sweep_dir(&c, &g, depth, nrm ? nrm : normals, &glat[k], lk, scratch, stk,
                               (float *)(void *)(stk + (maxm > 0 ? maxm : 1)), clip, 0, vk, vk + 1, 2);
-            ss_gdir_set(&G[k], &glat[k], lk, vk, vk + 1, 2);
+            ss_gdir_set(&c, &G[k], &glat[k], lk, vk, vk + 1, 2);
         }
         ss_gather_dirs(&c, &g, depth, normals, G, nd, acc, acc + npix);
     }
