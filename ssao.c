@@ -10,7 +10,9 @@
  *      ([P3] §5.1-5.2, [P4] §6; docs/errata.md E20, E21, E24)
  *   5. P3 line-sweep AO: the obscurity hull along one line ([P3] §4, Alg. 1; its order tests
  *      cross-multiplied, without roots or divisions) and its brute-force oracle ([P3] Fig. 7),
- *      the sweep of one direction, the per-pixel gather ([P3] §5.1), the driver ([P3] §4-5)
+ *      the sweep of one direction (in the driver clipped to the receivers near the inner image
+ *      and the steps they reach within the falloff's support), the per-pixel gather ([P3]
+ *      §5.1), the driver ([P3] §4-5)
  *   6. HBAO in three variants (Bavoil, Sainz, Dimitrov 2008, as the thesis describes it; [T14] §4.1, [P4] §8; docs/errata.md E25)
  *   7. The screen-space ray-traced reference ([P4] §8; docs/errata.md E36)
  *   8. Analytic depth buffers
@@ -1293,7 +1295,7 @@ static inline int ss_hsin_less(const ss_hcand *a, const ss_hcand *b)
  * rational form), isig 1/scale. */
 typedef struct ss_hocc_t { double num, den, rl, N, D; } ss_hocc_t;
 
-static inline void ss_hocc(const ss_fall *fs, const ss_fall *f, const ss_hcand *c, double r2,
+static HFVIS__ALWAYS_INLINE void ss_hocc(const ss_fall *fs, const ss_fall *f, const ss_hcand *c, double r2,
                            double st, double isig, ss_hocc_t *o)
 {
     double N, D, rl, e;
@@ -1347,16 +1349,18 @@ static double ss_line_scale(const double *x, const double *y, int n, double m)
 }
 
 /* The obscurity hull along one line ([P3] §4.2, Alg. 1): coordinates times sig as they are
- * read (1 where the caller scaled them), the falloff's lengths times fsig (the scale). */
+ * read (1 where the caller scaled them), the falloff's lengths times fsig (the scale); kind is
+ * f->kind (a constant where a caller specializes the body). */
 static HFVIS__ALWAYS_INLINE void ss_hull_body(const double *x, const double *y, const double *stc,
                                               const double *ste, int n, int persp, double fixed,
-                                              const ss_fall *f, int ties, double sig, double fsig,
-                                              int *stack, double *out)
+                                              const ss_fall *f, int kind, int ties, double sig,
+                                              double fsig, int *stack, double *out)
 {
     const double isig = 1.0 / fsig;
     ss_fall fs = *f; /* in the scaled coordinates: lengths times fsig (exact) */
     ss_hocc_t o1 = {0.0, 1.0, 0.0, 0.0, 0.0}, o2;
     int top = 0, i;
+    fs.kind = kind;
     fs.a *= fsig * fsig;
     fs.r1c *= fsig * fsig;
     for (i = 0; i < n; i++) {
@@ -1418,11 +1422,13 @@ static void ss_hull_line(const double *x, const double *y, const double *stc, co
                          int *stack, double *out)
 {
     const double sig = ss_line_scale(x, y, n, amax);
-    ss_hull_body(x, y, stc, ste, n, persp, fixed, f, ties, sig, sig, stack, out);
+    ss_hull_body(x, y, stc, ste, n, persp, fixed, f, f->kind, ties, sig, sig, stack, out);
 }
 
 /* The hull of the sweep's own line: x, y scaled in place first (a power of two: the same bits as
- * scaling each difference), so the hull multiplies nothing as it reads them. */
+ * scaling each difference), so the hull multiplies nothing as it reads them. hfvis_lsao's usual
+ * case (perspective, the fixed tangent, HBAO's falloff, ties popped) has its own copy of the
+ * body with those branches folded away (the same arithmetic). */
 static void ss_hull_line_scratch(double *x, double *y, const double *stc, const double *ste, int n,
                                  int persp, double fixed, const ss_fall *f, int ties, double amax,
                                  int *stack, double *out)
@@ -1433,7 +1439,10 @@ static void ss_hull_line_scratch(double *x, double *y, const double *stc, const 
         x[i] *= sig;
         y[i] *= sig;
     }
-    ss_hull_body(x, y, stc, ste, n, persp, fixed, f, ties, 1.0, sig, stack, out);
+    if (persp && !stc && !ste && ties && f->kind == HFVIS_FALLOFF_HBAO)
+        ss_hull_body(x, y, NULL, NULL, n, 1, fixed, f, HFVIS_FALLOFF_HBAO, 1, 1.0, sig, stack, out);
+    else
+        ss_hull_body(x, y, stc, ste, n, persp, fixed, f, f->kind, ties, 1.0, sig, stack, out);
 }
 
 /* Brute-force oracle ([P3] Fig. 7). */
@@ -1611,26 +1620,56 @@ static void ss_onto_line(double u0, double v0, double dx, double dy, double *u, 
     *v = v0 + t * dy;
 }
 
-/* ss_line_points' common case written out: nearest texels of an integer box step (sx, sy) from
- * texel (tx0, ty0), the fixed tangent, and the whole line inside the buffer (checked at its two
- * ends; the texels in between lie between them), so no clamps; the depth pointer stepped, the
- * unprojection and the plane coordinates inline with the same arithmetic (the same bits).
- * Returns 0, writing nothing, when the line leaves the buffer; *amax: the largest |x|, |y|. */
-static int ss_line_points_inside(const ss_cam *c, const ss_cfg *g, const float *depth, int n, int tx0,
-                                 int ty0, int sx, int sy, const double e1[3], const double yh[3],
-                                 double *x, double *y, float *zs, double *amax)
+/* A line's plane and first texel: e1, yhat (from the line's middle), the first texel (tx0, ty0)
+ * (snapped; its fraction fx0, fy0), and fast: the line takes ss_line_points' common case,
+ * nearest texels of an integer box step from that texel, the fixed tangent, and the whole line
+ * inside the buffer (checked at its two ends; the texels in between lie between them), so no
+ * clamps. */
+typedef struct ss_lgeom {
+    double e1[3], yh[3], fx0, fy0;
+    int tx0, ty0, fast;
+} ss_lgeom;
+
+static void ss_line_geom(const ss_cam *c, const ss_cfg *g, const hfvis_ssao_lattice *L,
+                         const hfvis_ssao_line *ln, int real, ss_lgeom *G)
+{
+    const hfvis_ssao_direction *d = &L->dir;
+    int integral = d->step_x == floor(d->step_x) && d->step_y == floor(d->step_y) &&
+                   fabs(d->step_x) < 1e9 && fabs(d->step_y) < 1e9;
+    double tlx, tly, ref[3];
+    memset(G, 0, sizeof *G);
+    ss_plane_e1(c, d->dx, d->dy, G->e1);
+    if (ln->count < 1) return;
+    {
+        int mid = ln->first + ln->count / 2;
+        ss_unproject(c, ln->x0 + (double)mid * d->step_x, ln->y0 + (double)mid * d->step_y, 1.0,
+                     ref);
+        ss_plane_yhat(c, G->e1, ref, G->yh);
+    }
+    G->tx0 = ss_texel(ln->x0 + (double)ln->first * d->step_x, c->W);
+    G->ty0 = ss_texel(ln->y0 + (double)ln->first * d->step_y, c->H);
+    G->fx0 = ln->x0 + (double)ln->first * d->step_x - (double)G->tx0;
+    G->fy0 = ln->y0 + (double)ln->first * d->step_y - (double)G->ty0;
+    if (!integral || g->sampling == HFVIS_SSAO_SAMPLING_BILINEAR || real) return;
+    tlx = (double)G->tx0 + (double)(ln->count - 1) * d->step_x;
+    tly = (double)G->ty0 + (double)(ln->count - 1) * d->step_y;
+    G->fast = tlx >= 0.0 && tlx <= (double)(c->W - 1) && tly >= 0.0 && tly <= (double)(c->H - 1);
+}
+
+/* ss_line_points' common case (ss_lgeom.fast) written out: the line's n depths read at dp,
+ * dp + dstep, ... (the depth buffer, or the line's depths already gathered, dstep 1), texel
+ * (tx0, ty0) stepped by (sx, sy), the unprojection and the plane coordinates inline with the
+ * same arithmetic (the same bits). Returns the largest |x|, |y|. */
+static double ss_line_points_inside(const ss_cam *c, const ss_cfg *g, const float *dp,
+                                    ptrdiff_t dstep, int n, int tx0, int ty0, int sx, int sy,
+                                    const double e1[3], const double yh[3], double *x, double *y,
+                                    float *zs)
 {
     double m = 0.0;
-    const double tlx = (double)tx0 + (double)(n - 1) * (double)sx, tly = (double)ty0 + (double)(n - 1) * (double)sy;
     const double cx = c->cx, cy = c->cy, ifx = c->ifx, ify = c->ify, osx = c->sx, osy = c->sy,
                  far_d = c->far_d, e0 = e1[0], e1y = e1[1], e2 = e1[2], y0 = yh[0], y1 = yh[1],
                  y2 = yh[2];
-    const float *dp;
-    ptrdiff_t dstep;
     int k, tx = tx0, ty = ty0, persp = c->persp, exact = g->exact;
-    if (!(tlx >= 0.0 && tlx <= (double)(c->W - 1) && tly >= 0.0 && tly <= (double)(c->H - 1))) return 0;
-    dp = depth + ss_index(c, tx0, ty0);
-    dstep = (ptrdiff_t)sy * c->row_step + sx;
     for (k = 0; k < n; k++, dp += dstep, tx += sx, ty += sy) {
         double z = (double)*dp, u = (double)tx + 0.5, v = (double)ty + 0.5, q0, q1, q2, xk, yk;
         if (!(z > 0.0 && z < far_d)) { /* ss_bg: background */
@@ -1654,38 +1693,32 @@ static int ss_line_points_inside(const ss_cam *c, const ss_cfg *g, const float *
         m = xk > m ? xk : m;
         m = yk > m ? yk : m;
     }
-    *amax = m;
-    return 1;
+    return m;
 }
 
-/* The 2D samples of one lattice line: x, y (NaN at holes), real-tangent sines (if wanted),
- * sample depths. Returns the largest |x|, |y| where the common case finds it on the way, else
- * -1 (ss_hull_line's scale). */
+/* The 2D samples of one lattice line (its geometry G): x, y (NaN at holes), real-tangent sines
+ * (if wanted), sample depths. In the common case (G->fast) only steps k0 .. k0 + n - 1 (written
+ * from x[0]), their depths read from zline[k0...] if the caller gathered them (else NULL);
+ * otherwise the whole line (k0 = 0, n = count). Returns the largest |x|, |y| where the common
+ * case finds it on the way, else -1 (ss_hull_line's scale). */
 static double ss_line_points(const ss_cam *c, const ss_cfg *g, const float *depth,
                              const float *normals, const hfvis_ssao_lattice *L,
-                             const hfvis_ssao_line *ln, double *x, double *y, double *st_real,
-                             float *zs)
+                             const hfvis_ssao_line *ln, const ss_lgeom *G, const float *zline,
+                             int k0, int n, double *x, double *y, double *st_real, float *zs)
 {
     const hfvis_ssao_direction *d = &L->dir;
-    double e1[3], yh[3], ref[3], fx0 = 0.0, fy0 = 0.0, amax = -1.0;
-    int bil = g->sampling == HFVIS_SSAO_SAMPLING_BILINEAR, k, tx0 = 0, ty0 = 0;
+    const double *e1 = G->e1, *yh = G->yh, fx0 = G->fx0, fy0 = G->fy0;
+    double amax = -1.0;
+    int bil = g->sampling == HFVIS_SSAO_SAMPLING_BILINEAR, k, tx0 = G->tx0, ty0 = G->ty0;
     int integral = d->step_x == floor(d->step_x) && d->step_y == floor(d->step_y) &&
                    fabs(d->step_x) < 1e9 && fabs(d->step_y) < 1e9;
-    ss_plane_e1(c, d->dx, d->dy, e1);
-    if (ln->count > 0) {
-        int mid = ln->first + ln->count / 2;
-        ss_unproject(c, ln->x0 + (double)mid * d->step_x, ln->y0 + (double)mid * d->step_y, 1.0,
-                     ref);
-        ss_plane_yhat(c, e1, ref, yh);
-        tx0 = ss_texel(ln->x0 + (double)ln->first * d->step_x, c->W);
-        ty0 = ss_texel(ln->y0 + (double)ln->first * d->step_y, c->H);
-        fx0 = ln->x0 + (double)ln->first * d->step_x - (double)tx0;
-        fy0 = ln->y0 + (double)ln->first * d->step_y - (double)ty0;
+    if (G->fast) {
+        const int sx = (int)d->step_x, sy = (int)d->step_y;
+        const float *dp = zline ? zline + k0 : depth + ss_index(c, tx0 + k0 * sx, ty0 + k0 * sy);
+        ptrdiff_t dstep = zline ? 1 : (ptrdiff_t)sy * c->row_step + (ptrdiff_t)sx;
+        return ss_line_points_inside(c, g, dp, dstep, n, tx0 + k0 * sx, ty0 + k0 * sy, sx, sy, e1,
+                                     yh, x, y, zs);
     }
-    if (integral && !bil && !st_real && ln->count > 0 &&
-        ss_line_points_inside(c, g, depth, ln->count, tx0, ty0, (int)d->step_x, (int)d->step_y, e1, yh,
-                              x, y, zs, &amax))
-        return amax;
     for (k = 0; k < ln->count; k++) {
         int i = ln->first + k, tx, ty;
         double u = ln->x0 + (double)i * d->step_x, v = ln->y0 + (double)i * d->step_y, qu, qv, z,
@@ -1732,42 +1765,170 @@ static double ss_line_points(const ss_cam *c, const ss_cfg *g, const float *dept
     return amax;
 }
 
+#define SS_CLIP_SAFETY 1e-6 /* relative margin of ss_line_clip's bound over the rounding of the
+                               hull's support test (about 1e-15 relative) */
+
+/* Steps ka .. kb (*ka > *kb: none) of line ln whose texels lie within m pixels of the inner
+ * image: the receivers hfvis_lsao's gather may read (nearest, fallback or bilinear). */
+static void ss_line_inner(const ss_cam *c, const hfvis_ssao_lattice *L, const hfvis_ssao_line *ln,
+                          const ss_lgeom *G, double m, int *ka, int *kb)
+{
+    const double S[2] = {L->dir.step_x, L->dir.step_y};
+    const double P0[2] = {(double)G->tx0 + 0.5, (double)G->ty0 + 0.5};
+    const double lo[2] = {(double)c->gx - m, (double)c->gy - m};
+    const double hi[2] = {(double)(c->W - c->gx) + m, (double)(c->H - c->gy) + m};
+    double klo = 0.0, khi = (double)(ln->count - 1);
+    int a;
+    for (a = 0; a < 2; a++) {
+        if (S[a] == 0.0) {
+            if (P0[a] < lo[a] || P0[a] > hi[a]) khi = -1.0;
+        } else {
+            double k1 = (lo[a] - P0[a]) / S[a], k2 = (hi[a] - P0[a]) / S[a];
+            if (k1 > k2) {
+                double t = k1;
+                k1 = k2;
+                k2 = t;
+            }
+            k1 = ceil(k1);
+            k2 = floor(k2);
+            if (k1 > klo) klo = k1;
+            if (k2 < khi) khi = k2;
+        }
+    }
+    if (khi < klo) {
+        *ka = 1;
+        *kb = 0;
+        return;
+    }
+    *ka = (int)klo;
+    *kb = (int)khi;
+}
+
+/* r_k = (L_k, M_k) of ss_line_clip: the ray of step k of common-case line G in its plane. */
+static void ss_clip_ray(const ss_cam *c, const ss_lgeom *G, int exact, double sx, double sy, int k,
+                        double *Lk, double *Mk)
+{
+    double u = (double)G->tx0 + (double)k * sx + 0.5 - c->cx,
+           v = -((double)G->ty0 + (double)k * sy + 0.5 - c->cy);
+    if (c->persp) {
+        u *= c->ifx;
+        v *= c->ify;
+        *Lk = u * G->e1[0] + v * G->e1[1];
+        *Mk = exact ? u * G->yh[0] + v * G->yh[1] - G->yh[2] : -1.0;
+    } else {
+        *Lk = u * c->sx * G->e1[0] + v * c->sy * G->e1[1];
+        *Mk = 0.0;
+    }
+}
+
+/* The first step s0 <= ka of a common-case line (G) that the receivers ka .. kb can reach within
+ * the falloff's support S: every step before s0 has Occ = st for each of them ([P3] Eq. 2 with
+ * rho = 0), and can hide only steps before it, so the hull's answers for ka .. kb do not change
+ * without them. The bound: sample k at texel centre (u, v) is z r_k in the plane with
+ * r_k = (L_k, M_k) affine in k (perspective: L = e1 . ((u - cx)/fx, -(v - cy)/fy, 0), M = -1
+ * on the paper plane, yhat . (.., .., -1) on the exact one), so for a receiver i and a
+ * candidate j, |h| >= dist(z_i r_i, the ray of r_j) = z_i |r_i x r_j| / |r_j|; |r_i x r_j| is
+ * affine in i and in j and 0 at i = j, so for i >= ka > j it is at least |r_ka x r_j|, growing
+ * as j goes back; z_i >= zlo (the receivers' least depth) and |r_j| <= rmax (the line's ends:
+ * |r|^2 is convex in k). Orthographic: x = L_k whatever the depth, so |h| >= |L_ka - L_j|. */
+static int ss_line_clip(const ss_cam *c, const hfvis_ssao_lattice *L, const hfvis_ssao_line *ln,
+                        const ss_lgeom *G, int exact, int ka, double zlo, double S)
+{
+    const double sx = L->dir.step_x, sy = L->dir.step_y;
+    double La, Ma, rmax = 0.0, need;
+    int j, e;
+    if (!(S < HFVIS__INF) || ka <= 0) return 0;
+    if (!(zlo < HFVIS__INF)) return ka; /* every receiver is background: no candidate matters */
+    ss_clip_ray(c, G, exact, sx, sy, ka, &La, &Ma);
+    for (e = 0; e < 2 && c->persp; e++) {
+        double Le, Me, r;
+        ss_clip_ray(c, G, exact, sx, sy, e ? ln->count - 1 : 0, &Le, &Me);
+        r = sqrt(Le * Le + Me * Me);
+        if (r > rmax) rmax = r;
+    }
+    need = c->persp ? S * (1.0 + SS_CLIP_SAFETY) * rmax : S * (1.0 + SS_CLIP_SAFETY);
+    for (j = ka - 1; j >= 0; j--) {
+        double Lj, Mj, b;
+        ss_clip_ray(c, G, exact, sx, sy, j, &Lj, &Mj);
+        b = c->persp ? zlo * fabs(La * Mj - Lj * Ma) : fabs(La - Lj);
+        if (b >= need) return j + 1;
+    }
+    return 0;
+}
+
 /* Sweep (or brute-force) every line of a direction into values / sample depths, sample s at
  * values[vs s] and sdepth[vs s] (hfvis_lsao interleaves them, vs = 2, so its gather reads one
  * cache line per sample). scratch: 4*M doubles (x, y, sin t, out), M more floats with vs != 1;
- * stack: M ints. */
+ * stack: M ints; zline: M floats (with clip >= 0, else unused).
+ * clip >= 0 (hfvis_lsao, whose gather reads only samples near the inner image): a common-case
+ * line is swept only over its receivers within clip pixels of the inner image (ss_line_inner)
+ * and the steps before them that those reach within the falloff's support (ss_line_clip); its
+ * other samples are NaN (value and depth). With the guard band and a short support that is a
+ * quarter fewer samples; the swept ones get the same values. */
 static void ss_lsao_sweep_dir(const ss_cam *c, const ss_cfg *g, const float *depth,
                               const float *normals, const hfvis_ssao_lattice *L,
                               const hfvis_ssao_line *lines, double *scratch, int *stack,
-                              int naive, float *values, float *sdepth, size_t vs)
+                              float *zline, double clip, int naive, float *values, float *sdepth,
+                              size_t vs)
 {
     int M = L->max_line_samples, j, k;
     double *x = scratch, *y = scratch + M, *st = scratch + 2 * (size_t)M,
            *out = scratch + 3 * (size_t)M;
     float *zs = (float *)(void *)(scratch + 4 * (size_t)M); /* vs != 1: the line's depths */
     int real = g->tangent != HFVIS_SSAO_TANGENT_FIXED;
+    const ptrdiff_t dstep = (ptrdiff_t)L->dir.step_y * c->row_step + (ptrdiff_t)L->dir.step_x;
+    const double far_d = c->far_d;
     for (j = 0; j < L->line_count; j++) {
         const hfvis_ssao_line *ln = &lines[j];
         const double *stc, *ste;
+        const float *zl = NULL;
+        ss_lgeom G;
         double amax;
+        int k0 = 0, n = ln->count;
         if (ln->count < 1) continue;
-        amax = ss_line_points(c, g, depth, normals, L, ln, x, y, real ? st : NULL,
-                              vs != 1 ? zs : sdepth ? sdepth + ln->offset : NULL);
-        stc = g->tangent == HFVIS_SSAO_TANGENT_REAL ? st : NULL;
-        ste = real ? st : NULL;
-        if (naive)
-            ss_hull_line_naive(x, y, stc, ste, ln->count, c->persp, g->fixed, &g->fall, out);
-        else
-            ss_hull_line_scratch(x, y, stc, ste, ln->count, c->persp, g->fixed, &g->fall, g->ties,
-                                 amax, stack, out);
+        ss_line_geom(c, g, L, ln, real, &G);
+        if (G.fast && clip >= 0.0) {
+            const float *src = depth + ss_index(c, G.tx0, G.ty0);
+            double zlo = HFVIS__INF;
+            int ka, kb;
+            ss_line_inner(c, L, ln, &G, clip, &ka, &kb);
+            n = 0;
+            if (ka <= kb) { /* the receivers' depths, their least, then the steps they reach */
+                for (k = ka; k <= kb; k++) {
+                    float zf = src[(ptrdiff_t)k * dstep];
+                    double z = (double)zf;
+                    zline[k] = zf;
+                    if (z > 0.0 && z < far_d && z < zlo) zlo = z;
+                }
+                k0 = ss_line_clip(c, L, ln, &G, g->exact, ka, zlo, g->fall.support);
+                for (k = k0; k < ka; k++) zline[k] = src[(ptrdiff_t)k * dstep];
+                n = kb - k0 + 1;
+                zl = zline;
+            }
+        }
+        if (n > 0) {
+            amax = ss_line_points(c, g, depth, normals, L, ln, &G, zl, k0, n, x, y,
+                                  real ? st : NULL,
+                                  vs != 1 ? zs : sdepth ? sdepth + ln->offset + (size_t)k0 : NULL);
+            stc = g->tangent == HFVIS_SSAO_TANGENT_REAL ? st : NULL;
+            ste = real ? st : NULL;
+            if (naive)
+                ss_hull_line_naive(x, y, stc, ste, n, c->persp, g->fixed, &g->fall, out);
+            else
+                ss_hull_line_scratch(x, y, stc, ste, n, c->persp, g->fixed, &g->fall, g->ties, amax,
+                                     stack, out);
+        }
         if (vs == 1) {
-            for (k = 0; k < ln->count; k++) values[ln->offset + (size_t)k] = (float)out[k];
+            for (k = 0; k < n; k++) values[ln->offset + (size_t)(k0 + k)] = (float)out[k];
         } else {
             float *vo = values + vs * ln->offset, *zo = sdepth + vs * ln->offset;
-            for (k = 0; k < ln->count; k++) {
-                vo[vs * (size_t)k] = (float)out[k];
-                zo[vs * (size_t)k] = zs[k];
+            for (k = 0; k < k0; k++) vo[vs * (size_t)k] = zo[vs * (size_t)k] = (float)HFVIS__NAN;
+            for (k = 0; k < n; k++) {
+                vo[vs * (size_t)(k0 + k)] = (float)out[k];
+                zo[vs * (size_t)(k0 + k)] = zs[k];
             }
+            for (k = k0 + n; k < ln->count; k++)
+                vo[vs * (size_t)k] = zo[vs * (size_t)k] = (float)HFVIS__NAN;
         }
     }
 }
@@ -1825,7 +1986,7 @@ static hfvis_status ss_lsao_direction(const hfvis_camera *cam, const float *dept
         return HFVIS_ERR_OUT_OF_MEMORY;
     }
     ss_lsao_sweep_dir(&c, &g, depth, normals, lat, lines, (double *)blk,
-                      (int *)((double *)blk + 4 * M), naive, values, sample_depth, 1);
+                      (int *)((double *)blk + 4 * M), NULL, -1.0, naive, values, sample_depth, 1);
     hfvis__free(o.alloc, blk);
     hfvis__free(o.alloc, nrm);
     return HFVIS_OK;
@@ -1917,12 +2078,16 @@ typedef struct ss_gdir {
     const float *values, *sdepth;
     size_t vs; /* sample s at values[vs s], sdepth[vs s] */
     double w, ids, idl, R2, px, py, s_first, ddx, ddy, t_min, jmax;
+    int empty;  /* no lines */
+    int all_in; /* every inner pixel's rounded line and step lie inside the lattice */
 } ss_gdir;
 
-static void ss_gdir_set(ss_gdir *G, const hfvis_ssao_lattice *L, const hfvis_ssao_line *lines,
-                        const float *values, const float *sdepth, size_t vs)
+static void ss_gdir_set(const ss_cam *c, ss_gdir *G, const hfvis_ssao_lattice *L,
+                        const hfvis_ssao_line *lines, const float *values, const float *sdepth,
+                        size_t vs)
 {
     const hfvis_ssao_direction *d = &L->dir;
+    int k;
     G->L = L;
     G->lines = lines;
     G->values = values;
@@ -1939,6 +2104,17 @@ static void ss_gdir_set(ss_gdir *G, const hfvis_ssao_lattice *L, const hfvis_ssa
     G->ddy = d->dy;
     G->t_min = L->t_min;
     G->jmax = (double)L->line_count - 0.5;
+    G->empty = L->line_count < 1;
+    /* the gather's range test at the inner image's four corner pixels, in its own arithmetic:
+     * each step of it is monotone in u and in v, so the corners bound every pixel between */
+    G->all_in = !G->empty;
+    for (k = 0; k < 4; k++) {
+        double u = (k & 1 ? (double)(c->W - c->gx) : (double)c->gx) + (k & 1 ? -0.5 : 0.5),
+               v = (k & 2 ? (double)(c->H - c->gy) : (double)c->gy) + (k & 2 ? -0.5 : 0.5);
+        double jf = (u * G->px + v * G->py - G->s_first) * G->idl,
+               tf = (u * G->ddx + v * G->ddy - G->t_min) * G->ids;
+        if (!(jf > -0.5 && jf < G->jmax && tf > -0.5 && tf < 2147483647.0)) G->all_in = 0;
+    }
 }
 
 /* Direction G's value for the receiver at (u, v) of depth zc (normal nc or NULL): 1 and *val if a
@@ -2020,26 +2196,27 @@ static void ss_gather_dirs(const ss_cam *c, const ss_cfg *g, const float *depth,
         const float *drow = depth + ss_index(c, 0, y);
         size_t orow = (size_t)(y - c->gy) * (size_t)W - (size_t)c->gx; /* + x: pixel x's slot (mod 2^n) */
         for (x = tx; x < x_end && x < tx + SS_GATHER_TILE; x++) {
-            double u = (double)x + 0.5, zc = (double)drow[x], s, ws;
+            double u = (double)x + 0.5, zc = (double)drow[x], s, ws, rz;
             const float *nc = normals ? normals + 3 * ss_index(c, x, y) : NULL;
             if (!(zc > 0.0 && zc < far_d)) continue; /* ss_bg */
+            rz = rej_z < 0.0 ? HFVIS__INF : rej_z * zc; /* the depth test's bound; off: any depth */
             s = sum[orow + (size_t)x];
             ws = wsum[orow + (size_t)x];
             for (k = 0; k < nd; k++) {
                 const ss_gdir *Gk = &G[k];
                 double val;
-                if (Gk->L->line_count < 1) continue;
+                if (Gk->empty) continue;
                 if (inline_nearest) {
                     double jf = (u * Gk->px + v * Gk->py - Gk->s_first) * Gk->idl,
                            tf = (u * Gk->ddx + v * Gk->ddy - Gk->t_min) * Gk->ids;
-                    if (jf > -0.5 && jf < Gk->jmax && tf > -0.5 && tf < 2147483647.0) {
+                    if (Gk->all_in || (jf > -0.5 && jf < Gk->jmax && tf > -0.5 && tf < 2147483647.0)) {
                         const hfvis_ssao_line *ln = &Gk->lines[(int)(jf + 0.5)];
                         int i = (int)(tf + 0.5);
                         if (i >= ln->first && i < ln->first + ln->count) {
                             size_t idx = Gk->vs * (ln->offset + (size_t)(i - ln->first));
                             double zs = (double)Gk->sdepth[idx];
                             val = (double)Gk->values[idx];
-                            if (val == val && zs == zs && (rej_z < 0.0 || fabs(zs - zc) <= rej_z * zc)) {
+                            if (val == val && fabs(zs - zc) <= rz) { /* false for a NaN depth */
                                 s += Gk->w * val;
                                 ws += Gk->w;
                                 continue;
@@ -2071,7 +2248,7 @@ hfvis_status hfvis_lsao_gather(const hfvis_camera *cam, const float *depth, cons
         !isfinite(lat->dir.weight))
         return HFVIS_ERR_INVALID_ARGUMENT;
     ss_cfg_from_lsao(&o, &g);
-    ss_gdir_set(&G, lat, lines, values, sample_depth, 1);
+    ss_gdir_set(&c, &G, lat, lines, values, sample_depth, 1);
     ss_gather_dirs(&c, &g, depth, normals, &G, 1, sum, weight);
     return HFVIS_OK;
 }
@@ -2139,7 +2316,8 @@ hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth, const float
     if (!b || !(lines = (hfvis_ssao_line *)hfvis__alloc(o.alloc, b))) goto done;
     b = ss_bytes3(ms, 2 * SS_GATHER_GROUP, sizeof(float));
     if (!b || !(vals = (float *)hfvis__alloc(o.alloc, b))) goto done;
-    b = ss_bytes3((size_t)(maxm > 0 ? maxm : 1), 1, 5 * sizeof(double) + sizeof(int));
+    b = ss_bytes3((size_t)(maxm > 0 ? maxm : 1), 1,
+                  5 * sizeof(double) + sizeof(int) + sizeof(float));
     if (!b || !(scratch = (double *)hfvis__alloc(o.alloc, b))) goto done;
     b = ss_bytes3(npix, 2, sizeof(double));
     if (!b || !(acc = (double *)hfvis__alloc(o.alloc, b))) goto done;
@@ -2149,11 +2327,17 @@ hfvis_status hfvis_lsao(const hfvis_camera *cam, const float *depth, const float
         for (k = 0; k < nd; k++) {
             hfvis_ssao_line *lk = lines + (size_t)k * ml;
             float *vk = vals + (size_t)k * 2 * ms;
+            int *stk = (int *)(scratch + 5 * (size_t)(maxm > 0 ? maxm : 1));
+            const double st = dirs[k0 + k].step, sp = dirs[k0 + k].spacing;
+            /* the gather reads samples within its fallback radius (the cell's diagonal) of an
+             * inner pixel, bilinear a cell away, and the texels lie within a pixel of the
+             * lattice's points: clip to the inner image widened by all of that */
+            const double clip = sqrt(st * st + sp * sp) + st + sp + 2.0;
             ss_lattice_init(&c, &dirs[k0 + k], &glat[k]);
             ss_lattice_fill(&c, &glat[k], lk);
-            ss_lsao_sweep_dir(&c, &g, depth, nrm ? nrm : normals, &glat[k], lk, scratch,
-                              (int *)(scratch + 5 * (size_t)(maxm > 0 ? maxm : 1)), 0, vk, vk + 1, 2);
-            ss_gdir_set(&G[k], &glat[k], lk, vk, vk + 1, 2);
+            ss_lsao_sweep_dir(&c, &g, depth, nrm ? nrm : normals, &glat[k], lk, scratch, stk,
+                              (float *)(void *)(stk + (maxm > 0 ? maxm : 1)), clip, 0, vk, vk + 1, 2);
+            ss_gdir_set(&c, &G[k], &glat[k], lk, vk, vk + 1, 2);
         }
         ss_gather_dirs(&c, &g, depth, normals, G, nd, acc, acc + npix);
     }

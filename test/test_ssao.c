@@ -831,6 +831,53 @@ TEST(lsao_composition)
     CHECK(pos > (W - 6) * (H - 4) / 10);
 }
 
+/* hfvis_lsao sweeps a line only over the receivers near the inner image and the steps before
+ * them within the falloff's support; the composition sweeps every line whole. With a wide guard
+ * band and short supports (a fraction of a pixel to several pixels at the scene's depth) the
+ * two agree in perspective (paper and exact plane) and orthographic, K = 8 and 16. They differ
+ * only where the whole line's hull popped a swept sample under a dropped one that ties it at
+ * Occ = st (the hull's rounding, LSAO_HULL_ROUND_TOL, through the float output). */
+#define LSAO_CLIP_TOL 1e-6 /* LSAO_HULL_ROUND_TOL on values of order 1, then rounded to float */
+TEST(lsao_clip_short_support)
+{
+    enum { W = 72, H = 56, GX = 14, GY = 11, IW = W - 2 * GX, IH = H - 2 * GY };
+    static float depth[W * H], ao[IW * IH];
+    static double raw[IW * IH];
+    static const double R[3] = {0.05, 0.4, 1.5};
+    int cam_kind, ri, K, i, bad = 0, same = 0, pos = 0, total = 0;
+    double worst = 0.0;
+    random_depth(depth, W, H, W, 8.0, 25, 91);
+    for (cam_kind = 0; cam_kind < 3; cam_kind++)
+        for (ri = 0; ri < 3; ri++)
+            for (K = 8; K <= 16; K += 8) {
+                hfvis_camera cam;
+                hfvis_lsao_options o = hfvis_lsao_options_default();
+                if (cam_kind < 2) CHECK_EQ_STATUS(hfvis_camera_perspective(&cam, W, H, GX, GY, 1.0), HFVIS_OK);
+                else CHECK_EQ_STATUS(hfvis_camera_orthographic(&cam, W, H, GX, GY, 0.12), HFVIS_OK);
+                o.directions = K;
+                o.plane = cam_kind == 1 ? HFVIS_SSAO_PLANE_EXACT : HFVIS_SSAO_PLANE_PAPER;
+                o.fixed_sin_t = -0.02; /* near-horizontal tangents: most pixels obscured */
+                o.falloff.kind = HFVIS_FALLOFF_HBAO;
+                o.falloff.param = 0.3 * R[ri] * R[ri]; /* support R */
+                CHECK_EQ_STATUS(hfvis_lsao(&cam, depth, NULL, &o, ao, IW), HFVIS_OK);
+                lsao_raw(&cam, depth, NULL, &o, raw);
+                for (i = 0; i < IW * IH; i++) {
+                    double r = isnan(raw[i]) ? 0.0 : raw[i], e = r < 0.0 ? 0.0 : (r > 1.0 ? 1.0 : r);
+                    int x = i % IW, y = i / IW;
+                    if (!(depth[(y + GY) * W + x + GX] < INFINITY)) e = 0.0;
+                    if (fabs((double)ao[i] - (double)(float)e) > worst) worst = fabs((double)ao[i] - (double)(float)e);
+                    bad += !(fabs((double)ao[i] - e) <= LSAO_CLIP_TOL);
+                    same += ao[i] == (float)e;
+                    pos += ao[i] > 0.0f;
+                    total++;
+                }
+            }
+    printf("  %d of %d pixels bit-identical, largest difference %.3g, %d obscured\n", same, total,
+           worst, pos);
+    CHECK(bad == 0);
+    CHECK(pos > total / 4);
+}
+
 /* T3: fixed tangent, fronto-parallel plane, perspective, full pipeline. With K = 4 dense axis
  * lines every pixel is a lattice sample in every direction and the raw average is exactly
  * -0.85 (1 - rho(delta)), delta = Z0 |step| / f; the clamped output is 0. Past sigma > 0.85
@@ -2173,6 +2220,7 @@ int main(int argc, char **argv)
     RUN(lsao_line_random_profiles);
     RUN(lsao_direction_vs_oracle);
     RUN(lsao_composition);
+    RUN(lsao_clip_short_support);
     RUN(lsao_t3_fronto_plane);
     RUN(lsao_t1_real_tangent_plane);
     RUN(lsao_t5_step_closed_form);
