@@ -12263,31 +12263,41 @@ static void hf_solar_mark(const hf_solar_run *r, int K, const double *az, unsign
     }
 }
 
-/* The horizon planes the period's steps read, over every block: *map holds them (direction
- * order, compact), pl[k] points to direction k's plane or is NULL (never read). Made by
- * hf_horizon_planes, each plane bit-identical to the whole map's. */
-static hfvis_status hf_solar_map(const hfvis_grid *g, hf_solar_run *r, const hf_solar_blocks *B, int K,
-                                 const double *az, const hfvis_sweep_options *s, float **map,
-                                 const float **pl)
+/* need[K]: the directions the period's steps read over every block (hf_solar_mark; every one
+ * beyond HF_SOLAR_MARK_BLOCK_DAYS blocks x days, or for HORIZON over Horn's planes, which reads
+ * the whole map; none without shading otherwise). r's steps are left those of the last block. */
+static hfvis_status hf_solar_need(hf_solar_run *r, const hf_solar_blocks *B, int K, const double *az,
+                                  unsigned char *need)
 {
-    size_t n = hf_grid_count(g), bi, used = 0;
-    unsigned char *need = (unsigned char *)hfvis__alloc_array(r->al, (size_t)K, 1);
-    float **wp = (float **)hfvis__alloc_array(r->al, (size_t)K, sizeof(float *));
     int days = r->c.in.instant ? 1 : r->c.in.days, k;
+    int all = r->c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON && r->c.o.normals == HFVIS_SOLAR_NORMALS_HORN;
     hfvis_status st = HFVIS_OK;
-    *map = NULL;
-    if (!need || !wp) {
-        st = HFVIS_ERR_OUT_OF_MEMORY;
-    } else if (B->n == 1 || (double)B->n * (double)days <= HF_SOLAR_MARK_BLOCK_DAYS) {
-        for (k = 0; k < K; k++) need[k] = 0;
+    size_t bi;
+    for (k = 0; k < K; k++) need[k] = (unsigned char)all;
+    if (all || r->c.o.no_shading) return HFVIS_OK;
+    if (B->n == 1 || (double)B->n * (double)days <= HF_SOLAR_MARK_BLOCK_DAYS) {
         for (bi = 0; bi < B->n && st == HFVIS_OK; bi++)
             if ((st = hf_solar_run_site(r, B->b + bi)) == HFVIS_OK) hf_solar_mark(r, K, az, need);
     } else {
         for (k = 0; k < K; k++) need[k] = 1;
     }
-    for (k = 0; k < K && st == HFVIS_OK; k++) used += need[k];
+    return st;
+}
+
+/* The horizon planes of need: *map holds them (direction order, compact), pl[k] points to
+ * direction k's plane or is NULL (never read). Made by hf_horizon_planes, each plane
+ * bit-identical to the whole map's. */
+static hfvis_status hf_solar_map(const hfvis_grid *g, const hfvis_allocator *al, int K, const unsigned char *need,
+                                 const hfvis_sweep_options *s, float **map, const float **pl)
+{
+    size_t n = hf_grid_count(g), used = 0;
+    float **wp = (float **)hfvis__alloc_array(al, (size_t)K, sizeof(float *));
+    hfvis_status st = wp ? HFVIS_OK : HFVIS_ERR_OUT_OF_MEMORY;
+    int k;
+    *map = NULL;
+    for (k = 0; k < K; k++) used += need[k];
     if (st == HFVIS_OK && used) {
-        *map = (float *)hfvis__alloc_array(r->al, n * used, sizeof(float)); /* n K fits */
+        *map = (float *)hfvis__alloc_array(al, n * used, sizeof(float)); /* n K fits */
         if (!*map) st = HFVIS_ERR_OUT_OF_MEMORY;
     }
     for (k = 0, used = 0; k < K && st == HFVIS_OK; k++) {
@@ -12295,8 +12305,7 @@ static hfvis_status hf_solar_map(const hfvis_grid *g, hf_solar_run *r, const hf_
         pl[k] = wp[k];
     }
     if (st == HFVIS_OK && used) st = hf_horizon_planes(g, K, s, need, wp);
-    hfvis__free(r->al, need);
-    hfvis__free(r->al, wp);
+    hfvis__free(al, wp);
     return st;
 }
 
@@ -12312,6 +12321,7 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
     float *map = NULL, *cellmap = NULL, *sky = NULL;
     const float *src = NULL; /* the whole direction-major map (the caller's or map), when there is one */
     const float **pl = NULL; /* direction k's plane, NULL where never read; NULL: no shading */
+    unsigned char *need = NULL; /* the directions read (hf_solar_need) */
     double *az = NULL;
     int K, horn_sky, k;
     size_t n, i, bi;
@@ -12329,17 +12339,18 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
     if (st == HFVIS_OK && (!r.c.o.no_shading || horn_sky)) {
         if (n > SIZE_MAX / sizeof(float) / (size_t)K) st = HFVIS_ERR_LIMIT;
         if (st == HFVIS_OK) {
-            int whole = r.c.o.horizon_map || horn_sky;
             az = (double *)hfvis__alloc_array(r.al, (size_t)K, sizeof(double));
             pl = (const float **)hfvis__alloc_array(r.al, (size_t)K, sizeof(const float *));
+            need = (unsigned char *)hfvis__alloc_array(r.al, (size_t)K, 1);
             map = r.c.o.horizon_map || !horn_sky ? NULL : (float *)hfvis__alloc_array(r.al, n * (size_t)K, sizeof(float));
-            if (!az || !pl || (!map && horn_sky && !r.c.o.horizon_map)) st = HFVIS_ERR_OUT_OF_MEMORY;
+            if (!az || !pl || !need || (!map && horn_sky && !r.c.o.horizon_map)) st = HFVIS_ERR_OUT_OF_MEMORY;
             if (st == HFVIS_OK) st = hfvis_sweep_azimuths(K, &s, az, NULL);
+            if (st == HFVIS_OK) st = hf_solar_need(&r, &B, K, az, need);
             if (st == HFVIS_OK && map) st = hfvis_horizon_map(g, K, &s, map);
-            else if (st == HFVIS_OK && !whole) st = hf_solar_map(g, &r, &B, K, az, &s, &map, pl);
-            if (whole) {
+            else if (st == HFVIS_OK && !r.c.o.horizon_map) st = hf_solar_map(g, r.al, K, need, &s, &map, pl);
+            if (r.c.o.horizon_map || horn_sky) { /* a whole map: its planes (only need's are read) */
                 src = r.c.o.horizon_map ? r.c.o.horizon_map : map;
-                for (k = 0; k < K && src; k++) pl[k] = src + (size_t)k * n;
+                for (k = 0; k < K && src; k++) pl[k] = need[k] ? src + (size_t)k * n : NULL;
             }
         }
     }
@@ -12398,12 +12409,46 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
     hfvis__free(r.al, cellmap);
     hfvis__free(r.al, map);
     hfvis__free(r.al, pl);
+    hfvis__free(r.al, need);
     hfvis__free(r.al, sky);
     if (st != HFVIS_OK) {
         hf_solar_run_free(&r);
         return st;
     }
     return hf_solar_finish(g, &r, 0, out);
+}
+
+hfvis_status hfvis_solar_map_directions(const hfvis_grid *g, const hfvis_solar_input *in,
+                                        const hfvis_solar_options *opts, unsigned char *need)
+{
+    hf_solar_run r;
+    hf_solar_blocks B;
+    hf_spa_eph *eph = NULL;
+    hfvis_solar_output any;
+    hfvis_sweep_options s;
+    double *az = NULL;
+    float probe = 0.0f;
+    hfvis_status st;
+    memset(&r, 0, sizeof r);
+    memset(&any, 0, sizeof any);
+    any.global = &probe; /* only checked, never written */
+    if (!need) return HFVIS_ERR_INVALID_ARGUMENT;
+    if ((st = hf_solar_setup(g, in, opts, &any, &r.c)) != HFVIS_OK) return st;
+    r.al = r.c.o.sweep ? r.c.o.sweep->alloc : NULL;
+    s = hf_solar_map_sweep(&r.c);
+    B.b = NULL;
+    if ((st = hf_solar_run_steps(&r)) == HFVIS_OK) st = hf_solar_run_blocks(g, &r, &B, &eph);
+    r.c.eph = eph;
+    if (st == HFVIS_OK) {
+        az = (double *)hfvis__alloc_array(r.al, (size_t)r.c.o.directions, sizeof(double));
+        st = az ? hfvis_sweep_azimuths(r.c.o.directions, &s, az, NULL) : HFVIS_ERR_OUT_OF_MEMORY;
+    }
+    if (st == HFVIS_OK) st = hf_solar_need(&r, &B, r.c.o.directions, az, need);
+    hfvis__free(r.al, az);
+    hfvis__free(r.al, B.b);
+    hfvis__free(r.al, eph);
+    hf_solar_run_free(&r);
+    return st;
 }
 
 #define HF_SOLAR_REF_DENOM 1024 /* the oracle's ray toward the sun: within 0.002 deg of it */

@@ -1593,7 +1593,8 @@ typedef struct hfvis_solar_options {
                                     directions*width*height floats exactly as hfvis_horizon_map
                                     writes them for these K directions with the sweep options
                                     hfvis_solar_map_options returns: e.g. made on several threads
-                                    (the results are then bit for bit those of NULL). The oracle
+                                    (the results are then bit for bit those of NULL); only the
+                                    planes hfvis_solar_map_directions names are read. The oracle
                                     ignores it */
     hfvis_solar_horizons horizons; /* the fast routine's horizons; default EXACT */
     int row_begin, row_end;      /* 0, 0: every row; else the fast routine computes and writes
@@ -1612,6 +1613,18 @@ HFVIS_API hfvis_solar_options hfvis_solar_options_default(void);
  * and progress, the ray mode and near-field cells of opts->horizons, azimuth0 0, every
  * direction. Pass them to hfvis_horizon_map to make opts->horizon_map yourself. */
 HFVIS_API hfvis_sweep_options hfvis_solar_map_options(const hfvis_solar_options *opts);
+
+/* The horizon-map directions hfvis_solar_irradiation(g, in, opts, ...) reads: need[k] = 1 for
+ * each of the K = opts->directions (default 64) directions of its map that its steps read (the
+ * two around each step's sun azimuth and the two around each sector bin's centre, over every
+ * block of per-sample sites; every direction beyond 366 blocks x days, or with HORIZON diffuse
+ * over HORN normals, which reads the whole map), else 0 (all 0 with no_shading unless HORIZON
+ * over HORN). need holds K bytes. A caller's opts->horizon_map need hold only these planes (the
+ * others are never read): e.g. made on several threads with hfvis_solar_map_options, one
+ * direction_begin/end per needed direction. The fast routine makes exactly these itself.
+ * HFVIS_ERR_INVALID_ARGUMENT as hfvis_solar_irradiation (and need NULL); out of memory. */
+HFVIS_API hfvis_status hfvis_solar_map_directions(const hfvis_grid *g, const hfvis_solar_input *in,
+                                                  const hfvis_solar_options *opts, unsigned char *need);
 
 /* The outputs: each NULL or bands*width*height floats, band b at [b*width*height + y*width + x]:
  * beam, diffuse and reflected on the receiver's own surface (normal from the grid, hfvis.h

@@ -126,6 +126,7 @@
     X(solar_input_default, P, -, "", "cannot fail") \
     X(solar_options_default, P, -, "", "cannot fail") \
     X(solar_map_options, P, -, "", "cannot fail") \
+    X(solar_map_directions, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(solar_band_count, V, -, "NZE", "-1") \
     X(solar_irradiation, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
     X(solar_irradiation_reference, S, A, "NZGOFESR", "INVALID_ARGUMENT") \
@@ -1948,6 +1949,14 @@ static void solar_args(const char *name, solar_fn fn)
     }
 }
 
+/* hfvis_solar_map_directions through solar_args: the global output's floats stand for need (NULL
+ * when no output is given), so every class solar_irradiation refuses is checked for it too. */
+static hfvis_status solar_directions(const hfvis_grid *g, const hfvis_solar_input *in,
+                                     const hfvis_solar_options *o, const hfvis_solar_output *out)
+{
+    return hfvis_solar_map_directions(g, in, o, out && out->global ? (unsigned char *)(void *)out->global : NULL);
+}
+static void args_solar_map_directions(void) { solar_args("solar_map_directions", solar_directions); }
 static void args_solar_irradiation(void) { solar_args("solar_irradiation", hfvis_solar_irradiation); }
 static void args_solar_irradiation_reference(void)
 {
@@ -6261,6 +6270,15 @@ SW(solar_irradiation)
     so.reflected = HFVIS_SOLAR_REFLECTED_TERRAIN;
     return hfvis_solar_irradiation(&g_ok, &in, &so, &out);
 }
+SW(solar_map_directions)
+{
+    hfvis_sweep_options o = sweep_opts(al);
+    hfvis_solar_options so = hfvis_solar_options_default();
+    hfvis_solar_input in = solar_in_ok();
+    so.sweep = &o;
+    so.directions = 8;
+    return hfvis_solar_map_directions(&g_ok, &in, &so, (unsigned char *)(void *)AF(2));
+}
 SW(solar_irradiation_reference)
 {
     hfvis_sweep_options o = sweep_opts(al);
@@ -6822,7 +6840,7 @@ static const sweep_entry sweeps[] = {
     SWEEP_VARIANT(env_light, env_light_exact),
     SWEEP(sun_visibility), SWEEP(env_light), SWEEP(env_light_from_map), SWEEP(intervisibility),
     SWEEP(visibility_count), SWEEP(visibility_count_naive), SWEEP(indirect_light),
-    SWEEP(indirect_light_naive), SWEEP(terrain_gi), SWEEP(direct_light), SWEEP(solar_irradiation), SWEEP(solar_irradiation_reference), SWEEP(ns_gi),
+    SWEEP(indirect_light_naive), SWEEP(terrain_gi), SWEEP(direct_light), SWEEP(solar_irradiation), SWEEP(solar_map_directions), SWEEP(solar_irradiation_reference), SWEEP(ns_gi),
     SWEEP(direction_sums), SWEEP(partial_decode), SWEEP(partial_load),
     SWEEP(lsao_direction), SWEEP(lsao_direction_naive), SWEEP(lsao), SWEEP(hbao), SWEEP(ssao_reference),
     SWEEP(ffao_table_build), SWEEP(ffao), SWEEP(ssao_mipmap),

@@ -933,12 +933,14 @@ static void count_progress(void *user, int done, int total)
 /* The map made only for the directions the steps read (hfvis.c section 17.7c): bit-identical to
  * a run on the whole map (the caller's), and fewer directions swept where the sun never goes;
  * exact rays and lattice horizons (a quarter-turn group's lattice swept only in the needed
- * orientations), K a multiple of 4 and not (case 5: K = 30, one orientation per group). */
+ * orientations), K a multiple of 4 and not (case 5: K = 30, one orientation per group);
+ * hfvis_solar_map_directions names exactly the planes read. */
 TEST(map_directions_restricted_bit_identical)
 {
     static float one[5][W * H], map[64 * W * H];
     hfvis_sweep_options sw = hfvis_sweep_options_default();
-    int c, m, k, i;
+    unsigned char need[64];
+    int c, m, k, i, used;
     for (c = 0; c < 6; c++)
         for (m = 0; m < 2; m++) {
             hfvis_grid g = test_grid(zbuf, c == 4 ? S : W, c == 4 ? S : H, 1.0);
@@ -962,11 +964,36 @@ TEST(map_directions_restricted_bit_identical)
             CHECK(progress_calls > 0 && progress_calls < K); /* the north never holds the sun */
             sw.progress = NULL;
             CHECK_EQ_STATUS(hfvis_horizon_map(&g, K, &sw, map), HFVIS_OK);
+            /* hfvis_solar_map_directions names the planes read: the lattice's own count, and a
+               caller's map with NaN in every other plane gives the same bits */
+            CHECK_EQ_STATUS(hfvis_solar_map_directions(&g, &in, &o, need), HFVIS_OK);
+            for (k = 0, used = 0; k < K; k++) used += need[k];
+            CHECK(used > 0 && used < K);
+            if (m) CHECK(used == progress_calls);
+            for (k = 0; k < K; k++)
+                for (i = 0; i < n && !need[k]; i++) map[(size_t)k * (size_t)n + (size_t)i] = NAN;
             o.horizon_map = map;
             CHECK_EQ_STATUS(hfvis_solar_irradiation(&g, &in, &o, &b), HFVIS_OK);
             for (k = 0; k < 5; k++)
                 for (i = 0; i < n; i++) CHECK(memcmp(&one[k][i], &ob[k][i], sizeof(float)) == 0);
         }
+    { /* every direction for HORIZON over Horn's planes; none without shading; bad arguments */
+        hfvis_grid g = test_grid(zbuf, W, H, 1.0);
+        hfvis_solar_input in = site(46.0, 6, 21);
+        hfvis_solar_options o = hfvis_solar_options_default();
+        o.diffuse = HFVIS_SOLAR_DIFFUSE_HORIZON;
+        o.normals = HFVIS_SOLAR_NORMALS_HORN;
+        CHECK_EQ_STATUS(hfvis_solar_map_directions(&g, &in, &o, need), HFVIS_OK);
+        for (k = 0; k < 64; k++) CHECK(need[k] == 1);
+        o = hfvis_solar_options_default();
+        o.no_shading = 1;
+        CHECK_EQ_STATUS(hfvis_solar_map_directions(&g, &in, &o, need), HFVIS_OK);
+        for (k = 0; k < 64; k++) CHECK(need[k] == 0);
+        CHECK_EQ_STATUS(hfvis_solar_map_directions(&g, &in, &o, NULL), HFVIS_ERR_INVALID_ARGUMENT);
+        CHECK_EQ_STATUS(hfvis_solar_map_directions(NULL, &in, &o, need), HFVIS_ERR_INVALID_ARGUMENT);
+        in.month = 13;
+        CHECK_EQ_STATUS(hfvis_solar_map_directions(&g, &in, &o, need), HFVIS_ERR_INVALID_ARGUMENT);
+    }
 }
 
 /* The horizon modes (hfvis_solar_options.horizons) against the oracle's own exact rays: mean

@@ -415,7 +415,7 @@ static int cli_run_heights(const cli_args *a)
 
     switch (a->cmd) {
     case CMD_HORIZON:
-        s = cli_run_threads(a) > 1 ? cli_threaded_horizon_map(&grid, a->dirs, &opts, cli_run_threads(a), out)
+        s = cli_run_threads(a) > 1 ? cli_threaded_horizon_map(&grid, a->dirs, &opts, cli_run_threads(a), NULL, out)
                            : hfvis_horizon_map(&grid, a->dirs, &opts, out);
         if (s == HFVIS_OK && a->degrees) {
             size_t i, n = (size_t)w * (size_t)h * (size_t)planes;

@@ -284,6 +284,7 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     float *planes[5] = { NULL, NULL, NULL, NULL, NULL }, *albedo = NULL, *linke = NULL, monthly[12];
     double *lats = NULL, *lons = NULL;
     float *hmap = NULL;
+    unsigned char *need = NULL;
     const char *paths[5];
     cli_tm tm;
     hfvis_status s;
@@ -370,14 +371,19 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
         }
     out.beam = planes[0]; out.diffuse = planes[1]; out.reflected = planes[2];
     out.global = planes[3]; out.sun_hours = planes[4];
-    if (cli_run_threads(a) > 1) { /* the exact horizon map by directions over the threads (bit for bit) */
+    if (cli_run_threads(a) > 1) { /* the horizon map by directions over the threads (bit for bit),
+                                     only the directions the steps read (the others stay 0, unread) */
         hfvis_sweep_options ms = hfvis_solar_map_options(&so); /* as the library's own map */
         int K = so.directions;
-        if (!(hmap = cli_alloc((size_t)w * (size_t)h, (size_t)K, 1))) {
+        if (!(hmap = cli_alloc((size_t)w * (size_t)h, (size_t)K, 1)) || !(need = (unsigned char *)malloc((size_t)K))) {
             rc = cli_status("solar", HFVIS_ERR_OUT_OF_MEMORY, 0);
             goto done;
         }
-        if ((s = cli_threaded_horizon_map(grid, K, &ms, cli_run_threads(a), hmap)) != HFVIS_OK) {
+        if (hfvis_solar_map_directions(grid, &in, &so, need) != HFVIS_OK) { /* bad input: the run below names it */
+            free(need);
+            need = NULL;
+        }
+        if ((s = cli_threaded_horizon_map(grid, K, &ms, cli_run_threads(a), need, hmap)) != HFVIS_OK) {
             rc = cli_status("solar", s, 0);
             goto done;
         }
@@ -404,5 +410,6 @@ done:
     hfvis_free(NULL, linke);
     free(lats);
     free(hmap);
+    free(need);
     return rc;
 }

@@ -533,6 +533,7 @@ typedef struct cli_map_split {
     float *scratch;     /* threads * 4 planes (groups) */
     float *out;         /* K planes, direction index order */
     int *order;         /* NULL, or the direction of each unit (exact rays) */
+    const unsigned char *need; /* NULL, or the directions to make (the others left as they are) */
 } cli_map_split;
 
 /* The cost of an exact direction's sweep: about |a| + |b| grid-line crossings per receiver for
@@ -587,11 +588,14 @@ static hfvis_status cli_map_unit(cli_split *sp, int u, int thread, hfvis_sweep_o
     int m;
     if (j->per == 1) { /* one direction, index order: its plane in place */
         const int k = j->order ? j->order[u] : u;
+        if (j->need && !j->need[k]) return HFVIS_OK;
         o->direction_order = HFVIS_DIRECTION_ORDER_INDEX;
         o->direction_begin = k;
         o->direction_end = k + 1;
         return hfvis_horizon_map(j->grid, j->K, o, j->out + (size_t)k * j->n);
     }
+    if (j->need && !j->need[u] && !j->need[u + j->K / 4] && !j->need[u + j->K / 2] && !j->need[u + 3 * (j->K / 4)])
+        return HFVIS_OK; /* a group none of whose directions is needed */
     o->direction_order = HFVIS_DIRECTION_ORDER_SWEEP; /* positions 4u..4u+3: directions u + m K/4 */
     o->direction_begin = 4 * u;
     o->direction_end = 4 * u + 4;
@@ -604,7 +608,7 @@ static hfvis_status cli_map_unit(cli_split *sp, int u, int thread, hfvis_sweep_o
 }
 
 static hfvis_status cli_threaded_horizon_map(const hfvis_grid *grid, int K, const hfvis_sweep_options *opts,
-                                             int threads, float *out)
+                                             int threads, const unsigned char *need, float *out)
 {
     cli_map_split j;
     cli_split sp;
@@ -616,6 +620,7 @@ static hfvis_status cli_threaded_horizon_map(const hfvis_grid *grid, int K, cons
     j.per = opts->rays != HFVIS_RAYS_EXACT && K % 4 == 0 ? 4 : 1;
     j.n = (size_t)grid->width * (size_t)grid->height;
     j.out = out;
+    j.need = need;
     sp.units = K / j.per;
     sp.threads = threads > sp.units ? sp.units : threads;
     if (j.per == 4) {
