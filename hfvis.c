@@ -9745,10 +9745,10 @@ static int hf_far_samples(hf_exact *E, int64_t px, int64_t py, int a, int b, int
         }
         for (e = P - 1; e >= 0; e--) { /* as hf_exact_samples' pre-roll */
             const hf_cross *c = cr + e;
-            if (c->u > uhi) continue;
-            if (c->u < ulo) break;
             const int X = (int)X0 + c->ox, Y = (int)Y0 + c->oy, CX = (int)X0 + c->cx, CY = (int)Y0 + c->cy;
             double h;
+            if (c->u > uhi) continue;
+            if (c->u < ulo) break;
             if (CX >= 0 && CY >= 0 && CX + 1 < g->width && CY + 1 < g->height) {
                 /* the cell inside the grid: hf_piece_samples' test and samples, its taps read in
                    place (a tap that is a hole or infinite makes the bulge fail the test) */
