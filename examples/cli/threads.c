@@ -350,8 +350,9 @@ static int cli_middle_out(int i, int n)
  * hfvis_direction_sums, bands): no scratch sums, no merge, and no thread waits on a costlier
  * direction (an exact direction costs about |a| + |b| crossings per receiver, 1 to 9 at K = 16).
  * Either way the sums and their finish are the single run's bits. */
-#define CLI_EXACT_BANDS_PER_THREAD 4 /* middle-out (cli_middle_out); at 2 a thread idled at
-                                        about 8-16 % of its time waiting for the direction's end */
+#define CLI_EXACT_BANDS_PER_THREAD 4 /* taken middle first (cli_middle_out); finer than 2 for
+                                        bands of unequal content and a thread that loses its core
+                                        (docs/performance.md, Threads) */
 typedef struct cli_sums_split {
     const hfvis_grid *grid;
     int K, per, channels, bands;
