@@ -350,8 +350,9 @@ static int cli_middle_out(int i, int n)
  * hfvis_direction_sums, bands): no scratch sums, no merge, and no thread waits on a costlier
  * direction (an exact direction costs about |a| + |b| crossings per receiver, 1 to 9 at K = 16).
  * Either way the sums and their finish are the single run's bits. */
-#define CLI_EXACT_BANDS_PER_THREAD 4 /* middle-out (cli_middle_out); at 2 a thread idled at
-                                        about 8-16 % of its time waiting for the direction's end */
+#define CLI_EXACT_BANDS_PER_THREAD 4 /* taken middle first (cli_middle_out); finer than 2 for
+                                        bands of unequal content and a thread that loses its core
+                                        (docs/performance.md, Threads) */
 typedef struct cli_sums_split {
     const hfvis_grid *grid;
     int K, per, channels, bands;
@@ -395,7 +396,9 @@ static void cli_sums_merge(cli_split *sp, int u, int thread)
 }
 
 /* S of kind over all K directions into acc (count = width*height*channels doubles, interleaved
- * channels as hfvis_direction_sums), on `threads` threads; the caller finishes it. */
+ * channels as hfvis_direction_sums, zeroed: cli_huge_calloc, so that its pages are first touched
+ * by the exact bands on their threads and not by a memset here), on `threads` threads; the caller
+ * finishes it. */
 static hfvis_status cli_threaded_sums(const hfvis_grid *grid, int K, hfvis_sum_kind kind,
                                       const hfvis_env *env, const hfvis_env_options *eopts,
                                       const hfvis_sweep_options *opts, int threads, int channels,
@@ -419,7 +422,6 @@ static hfvis_status cli_threaded_sums(const hfvis_grid *grid, int K, hfvis_sum_k
     sp.ctx = &j;
     if (opts->rays == HFVIS_RAYS_EXACT) { /* bands of one direction at a time, in place */
         j.bands = threads * CLI_EXACT_BANDS_PER_THREAD;
-        memset(acc, 0, j.count * sizeof(double));
         sp.units = K * j.bands;
         sp.phase = j.bands;
         sp.threads = threads;
@@ -498,7 +500,7 @@ static hfvis_status cli_threaded_light(int cmd, const hfvis_grid *grid, int K, d
     const hfvis_sum_kind kind = cmd == CMD_SKYVIEW ? HFVIS_SUM_SKY_VIEW
                                 : cmd == CMD_SKY ? HFVIS_SUM_SKY_LIGHT : HFVIS_SUM_ENV_LIGHT;
     const size_t n = (size_t)grid->width * (size_t)grid->height, count = n * (size_t)channels;
-    double *acc = (double *)cli_huge_malloc(count * sizeof(double));
+    double *acc = (double *)cli_huge_calloc(count * sizeof(double)); /* zeroed: cli_threaded_sums */
     float *nrm = NULL;
     hfvis_sweep_options o = *opts;
     hfvis_status s = HFVIS_OK;
