@@ -1858,7 +1858,8 @@ static int ss_line_clip(const ss_cam *c, const hfvis_ssao_lattice *L, const hfvi
  * line is swept only over its receivers within clip pixels of the inner image (ss_line_inner)
  * and the steps before them that those reach within the falloff's support (ss_line_clip); its
  * other samples are NaN (value and depth). With the guard band and a short support that is a
- * quarter fewer samples; the swept ones get the same values. */
+ * quarter fewer samples; the answers of the receivers read are unchanged up to the hull's
+ * rounding (test_ssao lsao_clip_short_support). */
 static void ss_lsao_sweep_dir(const ss_cam *c, const ss_cfg *g, const float *depth,
                               const float *normals, const hfvis_ssao_lattice *L,
                               const hfvis_ssao_line *lines, double *scratch, int *stack,
