@@ -2897,9 +2897,15 @@ HFVIS_API hfvis_status hfvis_lsao_gather(const hfvis_camera *cam, const float *d
  *   ao = clamp( sum_k w_k v_k / sum_k w_k , 0, 1 )
  * over the directions accepted at the pixel (background receivers 0). ao[y*ao_stride + x] for
  * the inner (width - 2 guard_x) x (height - 2 guard_y) pixels, obscurance (SA convention,
- * docs/errata.md C4), the falloff over view-space distance. Work is O(K W0 H0 / (D_S D_L)) for the
- * sweeps and O(K W H) for the gathers, independent of the falloff radius; memory O(W0 H0)
- * whatever K is (up to four directions at a time: four are swept, then gathered in one pass).
+ * docs/errata.md C4), the falloff over view-space distance. Work is at most O(K W0 H0 / (D_S D_L))
+ * for the sweeps and O(K W H) for the gathers, otherwise independent of the falloff radius: a
+ * line with nearest texels of an integer step (the box pattern's NEAREST sampling, fixed
+ * tangent) is swept only over the samples the gather can read (within a few pixels of the
+ * inner image) and the steps before them within the falloff's support (its other lattice
+ * values are never formed), so with a guard band and a short support the sweeps do less; the
+ * result equals the composition with whole lines (above) up to the hull's rounding. Memory
+ * O(W0 H0) whatever K is (up to four directions at a time: four are swept, then gathered in one
+ * pass).
  * Allocates 5 blocks (directions, lines of four directions, their lattice buffers 8
  * bytes/sample each, the line scratch, the 16-byte/pixel accumulators) plus 1 for
  * reconstructed normals (real tangents without normals). HFVIS_ERR_INVALID_ARGUMENT for an

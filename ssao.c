@@ -896,6 +896,29 @@ static int ss_dir_ok(const hfvis_ssao_direction *d)
     return 1;
 }
 
+/* The parameters t of the points O + t D inside the box [lo, hi] (per axis), intersected with
+ * [*tlo, *thi]; 0 when an axis with D = 0 misses it. */
+static int ss_box_span(const double O[2], const double D[2], const double lo[2], const double hi[2],
+                       double *tlo, double *thi)
+{
+    int a;
+    for (a = 0; a < 2; a++) {
+        if (D[a] == 0.0) {
+            if (O[a] < lo[a] || O[a] > hi[a]) return 0;
+        } else {
+            double t1 = (lo[a] - O[a]) / D[a], t2 = (hi[a] - O[a]) / D[a];
+            if (t1 > t2) {
+                double t = t1;
+                t1 = t2;
+                t2 = t;
+            }
+            if (t1 > *tlo) *tlo = t1;
+            if (t2 < *thi) *thi = t2;
+        }
+    }
+    return 1;
+}
+
 /* Step range [first, first + count) of line j, and its step-0 position. */
 static void ss_line_range(const ss_cam *c, const hfvis_ssao_lattice *L, int j, hfvis_ssao_line *ln)
 {
@@ -904,7 +927,6 @@ static void ss_line_range(const ss_cam *c, const hfvis_ssao_lattice *L, int j, h
     double ox = s * L->px, oy = s * L->py, tlo = -HFVIS__INF, thi = HFVIS__INF;
     double D[2], O[2], lo[2], hi[2];
     double fa, fb;
-    int a;
     D[0] = L->dir.dx;
     D[1] = L->dir.dy;
     O[0] = ox;
@@ -917,21 +939,7 @@ static void ss_line_range(const ss_cam *c, const hfvis_ssao_lattice *L, int j, h
     ln->first = 0;
     ln->count = 0;
     ln->offset = 0;
-    for (a = 0; a < 2; a++) {
-        if (D[a] == 0.0) {
-            if (O[a] < lo[a] || O[a] > hi[a]) return;
-        } else {
-            double t1 = (lo[a] - O[a]) / D[a], t2 = (hi[a] - O[a]) / D[a];
-            if (t1 > t2) {
-                double t = t1;
-                t1 = t2;
-                t2 = t;
-            }
-            if (t1 > tlo) tlo = t1;
-            if (t2 < thi) thi = t2;
-        }
-    }
-    if (!(tlo <= thi)) return;
+    if (!ss_box_span(O, D, lo, hi, &tlo, &thi) || !(tlo <= thi)) return;
     fa = ceil((tlo - L->t_min) / L->dir.step - 1e-9);
     fb = floor((thi - L->t_min) / L->dir.step + 1e-9);
     if (fb < fa) return;
@@ -1778,23 +1786,9 @@ static void ss_line_inner(const ss_cam *c, const hfvis_ssao_lattice *L, const hf
     const double lo[2] = {(double)c->gx - m, (double)c->gy - m};
     const double hi[2] = {(double)(c->W - c->gx) + m, (double)(c->H - c->gy) + m};
     double klo = 0.0, khi = (double)(ln->count - 1);
-    int a;
-    for (a = 0; a < 2; a++) {
-        if (S[a] == 0.0) {
-            if (P0[a] < lo[a] || P0[a] > hi[a]) khi = -1.0;
-        } else {
-            double k1 = (lo[a] - P0[a]) / S[a], k2 = (hi[a] - P0[a]) / S[a];
-            if (k1 > k2) {
-                double t = k1;
-                k1 = k2;
-                k2 = t;
-            }
-            k1 = ceil(k1);
-            k2 = floor(k2);
-            if (k1 > klo) klo = k1;
-            if (k2 < khi) khi = k2;
-        }
-    }
+    if (!ss_box_span(P0, S, lo, hi, &klo, &khi)) khi = -1.0;
+    klo = ceil(klo);
+    khi = floor(khi);
     if (khi < klo) {
         *ka = 1;
         *kb = 0;
@@ -1864,7 +1858,8 @@ static int ss_line_clip(const ss_cam *c, const hfvis_ssao_lattice *L, const hfvi
  * line is swept only over its receivers within clip pixels of the inner image (ss_line_inner)
  * and the steps before them that those reach within the falloff's support (ss_line_clip); its
  * other samples are NaN (value and depth). With the guard band and a short support that is a
- * quarter fewer samples; the swept ones get the same values. */
+ * quarter fewer samples; the answers of the receivers read are unchanged up to the hull's
+ * rounding (test_ssao lsao_clip_short_support). */
 static void ss_lsao_sweep_dir(const ss_cam *c, const ss_cfg *g, const float *depth,
                               const float *normals, const hfvis_ssao_lattice *L,
                               const hfvis_ssao_line *lines, double *scratch, int *stack,
