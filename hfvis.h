@@ -909,8 +909,9 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     8*width*height bytes (the cells' twists).
  *     Cost (callgrind, sky-view factor of rough fBm 256^2, D = 8): about 640 instructions per
  *     receiver-direction at K = 256 and 580 at K = 64 (the lattice: about 100; the sweep:
- *     1150-1560 at 128^2), about 200 of them the near stencil; in CPU time 4.3-5.0x the lattice at
- *     K = 64-360 on fBm 512^2. Figures: docs/exact-rays.md, "Near and far field".
+ *     1150-1560 at 128^2), about 200 of them the near stencil; 4.1-4.6x the lattice's time at
+ *     K = 64-360 on fBm 512^2 (make bench, quiet machine). Figures: docs/exact-rays.md, "Near
+ *     and far field".
  *   - Accuracy: against the supremum over the bilinear surface (every pair) the exact mode is
  *     within 0.01 deg mean and 0.25 deg p99 on urban boxes, terraces with one-cell cliffs and
  *     fBm (the lattice: 2-6 deg mean, 23-70 deg p99); docs/exact-rays.md. */
