@@ -1551,6 +1551,21 @@ typedef struct hfvis_solar_input {
                                     their differences along y, along x on a one-row grid), and the
                                     sun is computed per block of samples whose local frames are
                                     within opts->site_tolerance_rad of the block centre's */
+    void (*site)(void *user, int x, int y, double *latitude_rad, double *longitude_rad);
+                              /* or, in place of the maps (both NULL), each sample's site by
+                                 this function: it stores the latitude and longitude (radians,
+                                 ranges as the maps') of raster cell (x, y), where the grid's
+                                 (0, 0) is raster cell (opts->sweep's origin_x, origin_y) and
+                                 0 <= x < extent_width, 0 <= y < extent_height (the grid's size
+                                 without a window). It is called for cells of the whole raster,
+                                 outside the grid too: the blocks sharing a sun are cut from the
+                                 raster's extent, and the convergence takes the neighbours
+                                 clamped at the raster's edges, so a window's samples get the
+                                 whole raster's suns (tiles, hfvis.h "Search radius and
+                                 tiles"). It must give the same values for the same cell on
+                                 every call; a value out of range is HFVIS_ERR_INVALID_ARGUMENT.
+                                 The maps need the grid to be the raster (no window) */
+    void *site_user;          /* passed to site */
     double height_m;          /* SPA's observer height; the air mass uses each sample's z */
     int year, month, day;     /* first day; RSUN steps day of the year from it */
     int days;                 /* >= 1 days from the first (ignored for an instant) */
@@ -1588,9 +1603,15 @@ typedef struct hfvis_solar_options {
                                     sample's local frame (east, north, up turned by the
                                     convergence) and its block centre's, (0, 0.1]; 0 = 0.05 deg.
                                     Every sun direction of a sample is within it of its own */
-    const hfvis_sweep_options *sweep; /* border, search radius, allocator, progress; its rays
-                                    field is ignored (horizons below sets the ray mode) and
-                                    its window and rectangle must be unset */
+    const hfvis_sweep_options *sweep; /* border, search radius, allocator, progress, window; its
+                                    rays field is ignored (horizons below sets the ray mode).
+                                    Its receiver rectangle: only those outputs are computed and
+                                    written (the others untouched); its window (origin, extent:
+                                    a finite radius, the open border): the grid is a window plus
+                                    halo of a raster, and the rectangle's outputs equal the whole
+                                    raster's run bit for bit when the sites come from input->site
+                                    or one site and height_min/max are set alike in both runs.
+                                    Not with TERRAIN nor with the maps */
     const float *horizon_map;    /* NULL: the fast routine makes its horizon map itself (only
                                     the directions its steps read); else the caller's,
                                     directions*width*height floats exactly as hfvis_horizon_map
@@ -1604,9 +1625,18 @@ typedef struct hfvis_solar_options {
                                     only rows [row_begin, row_end) of the outputs (0 <= begin <
                                     end <= height; the other rows untouched), each bit for bit
                                     the whole call's: calls on disjoint ranges split a run over
-                                    threads (give them one horizon_map). Not with TERRAIN. The
+                                    threads (give them one horizon_map). With a receiver
+                                    rectangle, the rows of both. Not with TERRAIN. The
                                     oracle ignores it */
     hfvis_solar_normals normals; /* default CENTRAL; HORN to match r.sun fed by r.slope.aspect */
+    double height_min, height_max; /* the heights the pressure nodes of the sector sums and the
+                                    day path span, in place of each block's own finite heights
+                                    (the air mass's p(z) is interpolated between them); both 0 =
+                                    the block's (default). Else finite, height_min <= height_max:
+                                    give the whole raster's range in every run that must agree
+                                    with its windows (the nodes then do not depend on the grid
+                                    handed in). The day path's interpolation error grows with
+                                    the span: docs/solar.md "Windows" measures it */
 } hfvis_solar_options;
 
 HFVIS_API hfvis_solar_options hfvis_solar_options_default(void);
