@@ -11505,10 +11505,10 @@ static void hf_solar_store(const hfvis_grid *g, const hf_solar_ctx *c, const dou
     for (b = 0; b < c->bands; b++)
         for (i = (size_t)c->rb * (size_t)g->width; i < (size_t)c->re * (size_t)g->width; i++) {
             size_t j = (size_t)b * n + i;
-            if ((int)(i % (size_t)g->width) < c->cb || (int)(i % (size_t)g->width) >= c->ce) continue;
             const double *a = acc + j * 4;
             int hole = !isfinite(g->z[(i / (size_t)g->width) * (size_t)g->stride + i % (size_t)g->width]);
             double r = terrain ? (double)terrain[j] : a[2];
+            if ((int)(i % (size_t)g->width) < c->cb || (int)(i % (size_t)g->width) >= c->ce) continue;
             if (out->beam) out->beam[j] = hole ? (float)HFVIS__NAN : (float)a[0];
             if (out->diffuse) out->diffuse[j] = hole ? (float)HFVIS__NAN : (float)a[1];
             if (out->reflected) out->reflected[j] = hole ? (float)HFVIS__NAN : (float)r;
@@ -11573,7 +11573,8 @@ static void hf_solar_bracket(const double *az, int K, double psi, int *k0, int *
     *w = span > 0.0 ? (psi - lo) / span : 0.0;
 }
 
-/* Per-sample sites (the input's latitude and longitude maps): frames, blocks. */
+/* Per-sample sites (the input's site function or its latitude and longitude maps): frames,
+ * blocks. */
 static double hf_wrap_pi(double x) { return x - 2.0 * HFVIS__PI * floor((x + HFVIS__PI) / (2.0 * HFVIS__PI)); }
 
 /* Raster cell (x, y)'s latitude and longitude: the input's site function, or its maps (whose
@@ -11813,6 +11814,8 @@ static hfvis_status hf_solar_finish(const hfvis_grid *g, hf_solar_run *r, int na
 #define HF_SOLAR_BINS_PER_DIR 4
 #define HF_SOLAR_SECTOR_MIN 4
 #define HF_SOLAR_NODES 3
+#define HF_SOLAR_NODES_ANCHORED 5 /* over height_min..height_max (a raster's relief, not a block's):
+                                     quartic, as the day path's; 3 nodes gave 3e-3 over 6.8 km */
 #define HF_SOLAR_P_LINEAR 0.02 /* below this range of p, B0c(p) is linear to 4e-6 of itself */
 enum { /* the per-entry sums (times the step weight and the interpolation share) */
     HF_SQ_BX, HF_SQ_BY, HF_SQ_BZ, /* B0c s: beam = n . this */
@@ -11874,17 +11877,24 @@ static void hf_solar_entry_sums(const hf_solar_step *st, double p, double *q)
     q[HF_SQ_HOURS] = w;
 }
 
+/* The pressure nodes span the options' height_min..height_max, not each block's heights. */
+static int hf_solar_anchored(const hf_solar_ctx *c)
+{
+    return c->o.height_min != 0.0 || c->o.height_max != 0.0;
+}
+
 /* The pressure nodes pn[0..nn) of a block of samples, over which the sums of a step are
  * interpolated in the pressure ratio p: one node on a flat block, two (linear) over a small
- * range of p, else maxn (3, quadratic, for the sector sums; HF_SOLAR_DAY_NODES for the day
- * path), at heights spread evenly over the block's finite heights, or over the options'
- * height_min..height_max when they are set (then the same for every grid of the raster).
- * Returns nn. The one place that chooses them (both fast paths call it). */
+ * range of p, else maxn (the sector sums: 3, quadratic, or HF_SOLAR_NODES_ANCHORED when
+ * anchored; HF_SOLAR_DAY_NODES for the day path), at heights spread evenly over the block's
+ * finite heights, or over the options' height_min..height_max when they are set (then the same
+ * for every grid of the raster). Returns nn. The one place that chooses them (both fast paths
+ * call it). */
 static int hf_solar_block_nodes(const hfvis_grid *g, const hf_solar_ctx *c, const hf_solar_block *blk,
                                 int maxn, double *pn)
 {
     double zmin = HFVIS__INF, zmax = -HFVIS__INF;
-    int nn, j, x, y, anchored = c->o.height_min != 0.0 || c->o.height_max != 0.0;
+    int nn, j, x, y, anchored = hf_solar_anchored(c);
     if (anchored) { /* the caller's span */
         zmin = c->o.height_min;
         zmax = c->o.height_max;
@@ -11918,16 +11928,17 @@ static hfvis_status hf_solar_sectors(const hfvis_grid *g, hf_solar_run *r, int K
                                      const float *cellmap, const float *sky, const hf_solar_block *blk)
 {
     int NB = HF_SOLAR_BINS_PER_DIR * K, j, b, nn, x, y;
+    int maxn = hf_solar_anchored(&r->c) ? HF_SOLAR_NODES_ANCHORED : HF_SOLAR_NODES;
     size_t n = hf_grid_count(g), ngroups = (size_t)r->c.bands * (size_t)NB, q, i, e;
     size_t *start = NULL, *fill = NULL;
     hf_solar_entry *ent = NULL;
     int *bk = NULL, *nonempty = NULL, *nne = NULL;
-    double *sums = NULL, *tdh = NULL, *bw = NULL, *bdir = NULL, *th = NULL, pn[HF_SOLAR_NODES],
+    double *sums = NULL, *tdh = NULL, *bw = NULL, *bdir = NULL, *th = NULL, pn[HF_SOLAR_NODES_ANCHORED],
            turn = 2.0 * HFVIS__PI;
     start = (size_t *)hfvis__alloc_array(r->al, ngroups + 1, sizeof(size_t));
     fill = (size_t *)hfvis__alloc_array(r->al, ngroups + 1, sizeof(size_t));
     ent = (hf_solar_entry *)hfvis__alloc_array(r->al, r->nsteps + 1, sizeof(hf_solar_entry));
-    sums = (double *)hfvis__alloc_array(r->al, r->nsteps + 1, sizeof(double) * HF_SOLAR_NODES * HF_SOLAR_Q);
+    sums = (double *)hfvis__alloc_array(r->al, r->nsteps + 1, sizeof(double) * (size_t)maxn * HF_SOLAR_Q);
     tdh = (double *)hfvis__alloc_array(r->al, (size_t)r->c.bands, sizeof(double));
     bk = (int *)hfvis__alloc_array(r->al, (size_t)NB, 2 * sizeof(int));
     bw = (double *)hfvis__alloc_array(r->al, (size_t)NB, sizeof(double));
@@ -11978,11 +11989,11 @@ static hfvis_status hf_solar_sectors(const hfvis_grid *g, hf_solar_run *r, int K
         }
     }
     /* pressure nodes over the block's heights, and each group's sums from the top */
-    nn = hf_solar_block_nodes(g, &r->c, blk, HF_SOLAR_NODES, pn);
+    nn = hf_solar_block_nodes(g, &r->c, blk, maxn, pn);
     for (i = 0; i < ngroups; i++) {
-        double acc[HF_SOLAR_NODES * HF_SOLAR_Q];
+        double acc[HF_SOLAR_NODES_ANCHORED * HF_SOLAR_Q];
         int a;
-        for (a = 0; a < HF_SOLAR_NODES * HF_SOLAR_Q; a++) acc[a] = 0.0;
+        for (a = 0; a < nn * HF_SOLAR_Q; a++) acc[a] = 0.0;
         for (e = start[i + 1]; e-- > start[i];) {
             double *s = sums + e * (size_t)nn * HF_SOLAR_Q;
             for (j = 0; j < nn; j++) {
@@ -11996,14 +12007,14 @@ static hfvis_status hf_solar_sectors(const hfvis_grid *g, hf_solar_run *r, int K
         for (x = blk->c0; x < blk->c1; x++) {
             hf_solar_point *pt = r->pts + (i = (size_t)y * (size_t)g->width + (size_t)x);
             const float *hz = cellmap + i * (size_t)K;
-            double L[HF_SOLAR_NODES];
+            double L[HF_SOLAR_NODES_ANCHORED];
             int horizon = r->c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON;
             if (!isfinite(pt->p) || isnan(pt->nz)) continue;
             if (sky) pt->sky_ratio = (double)sky[i] / pt->r_sky;
             for (j = 0; j < K; j++) th[j] = tan((double)hz[j]);
             hf_solar_lagrange(nn, pn, pt->p, L);
             for (b = 0; b < r->c.bands; b++) {
-                double S[HF_SOLAR_NODES * HF_SOLAR_Q], T[HF_SOLAR_Q], *a = r->acc + ((size_t)b * n + i) * 4;
+                double S[HF_SOLAR_NODES_ANCHORED * HF_SOLAR_Q], T[HF_SOLAR_Q], *a = r->acc + ((size_t)b * n + i) * 4;
                 int t, u;
                 for (t = 0; t < nn * HF_SOLAR_Q; t++) S[t] = 0.0;
                 for (u = 0; u < nne[b]; u++) {

@@ -969,7 +969,9 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     their last receiver in it) and the rest of the output is left as it was.
  *   - Where it applies: hfvis_horizon_map, hfvis_horizon_direction, hfvis_sky_light,
  *     hfvis_sky_view_factor, hfvis_env_light, hfvis_sun_visibility, hfvis_direct_light,
- *     hfvis_direction_sums (sky view, sky light, environment), both modes. R also applies to hfvis_horizon_lattice(_naive)
+ *     hfvis_direction_sums (sky view, sky light, environment), both modes, and
+ *     hfvis_solar_irradiation (its map, sky and sums; not with TERRAIN reflection, and a window
+ *     needs the site function rather than the maps: hfvis_solar_options.sweep). R also applies to hfvis_horizon_lattice(_naive)
  *     (no window: its nodes are those of hfvis_lattice_init; the rectangle is ignored) and to
  *     the oracles. Refused with HFVIS_ERR_INVALID_ARGUMENT (R, a window or a rectangle):
  *     hfvis_openness (it has its own radius).
@@ -1675,7 +1677,7 @@ HFVIS_API int hfvis_solar_band_count(const hfvis_solar_input *input,
 /* Irradiance (input->instant) or irradiation over a period on every grid point. Per time step:
  * the sun at the site (with input->latitude_map: at the centre of each block of samples whose
  * local frames lie within opts->site_tolerance_rad of the centre's, quadtree halving from the
- * whole grid; the steps, sunrise and sunset are then each block's own, SPA's instant part taken
+ * whole raster (opts->sweep's extent; the grid without a window); the steps, sunrise and sunset are then each block's own, SPA's instant part taken
  * once per hour of the period and interpolated, within 2e-6 deg); the beam is shaded by the horizon toward the sun, read from one
  * horizon map of K directions made once (hfvis_horizon_map with hfvis_solar_map_options: exact
  * rays by default, opts->horizons; only the directions the steps read, bit-identical to the
@@ -1690,7 +1692,8 @@ HFVIS_API int hfvis_solar_band_count(const hfvis_solar_input *input,
  * step (a value or monthly values), no coefficient rasters and a hard sun take the sector sums
  * instead of the step loop: the steps binned by azimuth (4 bins per map direction), sorted by
  * elevation and summed from the top (every term is linear in per-sample constants once a step
- * is lit or not; the air mass's height enters by interpolation over 1-3 pressure nodes), so a
+ * is lit or not; the air mass's height enters by interpolation over 1-3 pressure nodes, 1, 2 or
+ * 5 over opts->height_min..height_max when set), so a
  * sample costs O(bins * log steps) instead of O(steps); its lit test is taken at the bin's
  * centre (within 0.7 deg of the step's azimuth at K = 64).
  * Shorter periods with one Linke factor per step and no coefficient rasters (a hard sun or the
@@ -1701,7 +1704,7 @@ HFVIS_API int hfvis_solar_band_count(const hfvis_solar_input *input,
  * copy with the sector sums or the step loop, 120 bytes per sample of state and 32 per sample
  * and band of sums, plus the outputs;
  * HORIZON adds 4 bytes per sample, TERRAIN the [P2] sweep's scratch; the sector sums about
- * 350 bytes per sunlit step; per-sample sites 1 KB per day of the period (the hourly table)
+ * 350 bytes per sunlit step (570 with height_min/max); per-sample sites 1 KB per day of the period (the hourly table)
  * and 56 bytes per block.
  * Cost: the map (hfvis.h "Exact rays") plus O(steps*width*height), or with the sector sums
  * O(steps log steps + bands*K*width*height*log steps), the steps' part once per block.
