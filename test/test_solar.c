@@ -1162,7 +1162,7 @@ TEST(row_ranges_equal_the_whole_call)
  * raster, and its receivers must equal the whole raster's run with the same radius bit for bit
  * (no tolerance: the sites come from the raster's cells, the blocks from the raster's extent and
  * the pressure nodes from height_min/max), with the outputs outside the rectangle untouched. */
-enum { RW = 40, RH = 28, NWIN = 5 };
+enum { RW = 72, RH = 20, NWIN = 5 }; /* wider than the day path's chunk of 64 columns */
 #define WIN_CELL 30.0
 #define WIN_RADIUS 150.0 /* 5 cells: the halo is 7 (exact rays) */
 static float win_z[RW * RH];
@@ -1180,7 +1180,7 @@ static hfvis_solar_output win_outs(float (*o)[30 * RW * RH])
 }
 
 /* Raster cell (x, y)'s site on a grid of 0.01 deg of latitude and 0.015 deg of longitude per
- * cell from (46 N, 15 E) at row 0 (north): 0.27 deg north to south. */
+ * cell from (46 N, 15 E) at row 0 (north): 0.19 deg north to south, 1.07 deg west to east. */
 static void win_site(void *user, int x, int y, double *lat, double *lon)
 {
     (void)user;
@@ -1193,8 +1193,8 @@ static void win_site(void *user, int x, int y, double *lat, double *lon)
  * window receivers that differ from the whole run in any output. */
 static long windows_against_whole(const hfvis_solar_input *in, hfvis_solar_options o, int parts)
 {
-    static const int win[NWIN][4] = { { 0, 0, 13, 11 }, { 13, 0, 27, 11 }, { 0, 11, RW, 1 },
-                                      { 0, 12, 17, RH - 12 }, { 17, 12, RW - 17, RH - 12 } };
+    static const int win[NWIN][4] = { { 0, 0, 13, 9 }, { 13, 0, RW - 13, 9 }, { 0, 9, RW, 1 },
+                                      { 0, 10, 17, RH - 10 }, { 17, 10, RW - 17, RH - 10 } };
     hfvis_grid whole = test_grid(win_z, RW, RH, WIN_CELL);
     hfvis_sweep_options sw = hfvis_sweep_options_default();
     hfvis_solar_output a, b;
