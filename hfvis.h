@@ -1613,7 +1613,8 @@ typedef struct hfvis_solar_options {
                                     halo of a raster, and the rectangle's outputs equal the whole
                                     raster's run bit for bit when the sites come from input->site
                                     or one site and height_min/max are set alike in both runs.
-                                    Not with TERRAIN nor with the maps */
+                                    TERRAIN refuses a window or a rectangle, the maps a window.
+                                    The oracle computes every receiver */
     const float *horizon_map;    /* NULL: the fast routine makes its horizon map itself (only
                                     the directions its steps read); else the caller's,
                                     directions*width*height floats exactly as hfvis_horizon_map
@@ -1637,15 +1638,17 @@ typedef struct hfvis_solar_options {
                                     the block's (default). Else finite, height_min <= height_max:
                                     give the whole raster's range in every run that must agree
                                     with its windows (the nodes then do not depend on the grid
-                                    handed in). The day path's interpolation error grows with
-                                    the span: docs/solar.md "Windows" measures it */
+                                    handed in; the sector sums then take 5 nodes, not 3). The
+                                    interpolation error grows with the span: within 6.4e-5 of
+                                    the step loop over 6.8 km of relief (docs/solar.md
+                                    "Windows") */
 } hfvis_solar_options;
 
 HFVIS_API hfvis_solar_options hfvis_solar_options_default(void);
 
 /* The sweep options with which hfvis_solar_irradiation makes its horizon map (and HORIZON's
- * visible sky) for these options (NULL: the defaults): opts->sweep's border, radius, allocator
- * and progress, the ray mode and near-field cells of opts->horizons, azimuth0 0, every
+ * visible sky) for these options (NULL: the defaults): opts->sweep's border, radius, allocator,
+ * progress, window and receiver rectangle, the ray mode and near-field cells of opts->horizons, azimuth0 0, every
  * direction. Pass them to hfvis_horizon_map to make opts->horizon_map yourself. */
 HFVIS_API hfvis_sweep_options hfvis_solar_map_options(const hfvis_solar_options *opts);
 
