@@ -1293,6 +1293,58 @@ TEST(windows_equal_the_whole_run)
     }
 }
 
+/* The blocks of per-cell sites come from the raster: each window's grid handed in as a raster
+ * of its own, with maps of its cells' sites (no window: what the tool did before), gets other
+ * blocks, centres and suns, so its window differs from the whole run; with the window and the
+ * site function it does not (no shading: only the suns differ; the grid's edge cells, whose
+ * normals are one-sided, are left out). */
+TEST(windows_blocks_from_the_raster)
+{
+    static double wlat[RW * RH], wlon[RW * RH];
+    hfvis_grid whole = test_grid(win_z, RW, RH, WIN_CELL);
+    hfvis_solar_input in = site(46.0, 5, 10);
+    hfvis_solar_options o = hfvis_solar_options_default();
+    hfvis_solar_output a = win_outs(win_whole), b = win_outs(win_part);
+    int w, x, y, gx0 = 20, gy0 = 3, gw = 37, gh = 14;
+    long off_maps = 0, off_site = 0;
+    (void)test_fbm(win_z, RW, RH, 600.0, 12.0, 0, 91);
+    in.site = win_site;
+    o.no_shading = 1;
+    o.site_tolerance_rad = 0.02 * DEG;
+    CHECK_EQ_STATUS(hfvis_solar_irradiation(&whole, &in, &o, &a), HFVIS_OK);
+    for (w = 0; w < 2; w++) { /* 0: the grid as its own raster with maps; 1: a window, the function */
+        hfvis_grid g = test_grid(win_z + gy0 * RW + gx0, gw, gh, WIN_CELL);
+        hfvis_solar_input wi = in;
+        hfvis_sweep_options ws = hfvis_sweep_options_default();
+        g.stride = RW;
+        if (w == 0) {
+            for (y = 0; y < gh; y++)
+                for (x = 0; x < gw; x++) win_site(NULL, gx0 + x, gy0 + y, wlat + y * gw + x, wlon + y * gw + x);
+            wi.site = NULL;
+            wi.latitude_map = wlat;
+            wi.longitude_map = wlon;
+            o.sweep = NULL;
+        } else {
+            ws.max_distance = WIN_RADIUS;
+            ws.origin_x = gx0;
+            ws.origin_y = gy0;
+            ws.extent_width = RW;
+            ws.extent_height = RH;
+            o.sweep = &ws;
+        }
+        CHECK_EQ_STATUS(hfvis_solar_irradiation(&g, &wi, &o, &b), HFVIS_OK);
+        for (y = 1; y < gh - 1; y++) /* the grid's edge cells take one-sided normals */
+            for (x = 1; x < gw - 1; x++) {
+                float u = win_whole[3][(gy0 + y) * RW + gx0 + x], v = win_part[3][y * gw + x];
+                if (memcmp(&u, &v, sizeof v) != 0) ++*(w ? &off_site : &off_maps);
+            }
+    }
+    printf("     a grid of its own with maps: %ld of %d receivers differ; a window: %ld\n", off_maps,
+           (gw - 2) * (gh - 2), off_site);
+    CHECK(off_maps > 0);
+    CHECK(off_site == 0);
+}
+
 /* Anchored pressure nodes (height_min/max over the whole relief, as a window run needs) against
  * each block's own: the day path's quartic over 6.8 km of relief against the step loop (exact
  * in p), and the sector sums' quartic against their quadratic over blocks of a few cells (near
@@ -1499,6 +1551,7 @@ int main(int argc, char **argv)
     RUN(horizon_modes_against_oracle);
     RUN(row_ranges_equal_the_whole_call);
     RUN(windows_equal_the_whole_run);
+    RUN(windows_blocks_from_the_raster);
     RUN(site_function_equals_maps);
     RUN(anchored_nodes_accuracy);
     RUN(maps_holes_and_bad_input);
