@@ -11030,7 +11030,14 @@ static int hf_solar_input_valid(const hfvis_solar_input *in)
            (in->instant == 0 || in->instant == 1) &&
            (in->instant ? hf_in(in->hour, 0.0, 24.0) : (in->days >= 1 && in->days <= HF_SOLAR_DAYS_MAX)) &&
            hf_in(in->utc_offset_hours, -14.0, 14.0) && in->linke > 0.0 && in->linke <= 10.0 &&
-           hf_in(in->albedo, 0.0, 1.0) && (in->latitude_map != NULL) == (in->longitude_map != NULL);
+           hf_in(in->albedo, 0.0, 1.0) && (in->latitude_map != NULL) == (in->longitude_map != NULL) &&
+           !(in->site && in->latitude_map);
+}
+
+/* Each sample its own site (the maps or the site function), not one site for the grid. */
+static int hf_solar_per_sample(const hfvis_solar_input *in)
+{
+    return in->latitude_map != NULL || in->site != NULL;
 }
 
 static int hf_solar_opts_valid(const hfvis_solar_options *o)
@@ -11050,9 +11057,12 @@ static int hf_solar_opts_valid(const hfvis_solar_options *o)
         !hf_in(o->site_tolerance_rad, 0.0, 0.1) || o->horizons < HFVIS_SOLAR_HORIZONS_DEFAULT ||
         o->horizons > HFVIS_SOLAR_HORIZONS_LATTICE || o->row_begin < 0 || o->row_end < 0 ||
         ((o->row_begin || o->row_end) && (o->row_begin >= o->row_end || o->reflected == HFVIS_SOLAR_REFLECTED_TERRAIN)) ||
-        o->normals < HFVIS_SOLAR_NORMALS_DEFAULT || o->normals > HFVIS_SOLAR_NORMALS_HORN)
+        o->normals < HFVIS_SOLAR_NORMALS_DEFAULT || o->normals > HFVIS_SOLAR_NORMALS_HORN ||
+        !isfinite(o->height_min) || !isfinite(o->height_max) || o->height_min > o->height_max)
         return 0;
-    if (s && (!hf_opts_valid(s) || s->extent_width != 0 || s->receiver_width != 0)) return 0;
+    if (s && (!hf_opts_valid(s) || ((s->extent_width != 0 || s->receiver_width != 0) &&
+                                     o->reflected == HFVIS_SOLAR_REFLECTED_TERRAIN)))
+        return 0; /* TERRAIN gathers over the whole grid */
     if (o->linke_monthly)
         for (k = 0; k < 12; k++)
             if (!(o->linke_monthly[k] > 0.0f && o->linke_monthly[k] <= 10.0f)) return 0;
@@ -11101,6 +11111,8 @@ typedef struct hf_solar_ctx {
     double gamma;            /* the true azimuth of the grid's up direction there */
     const hf_spa_eph *eph;   /* NULL: full SPA per instant; else the hourly instant table */
     int rb, re;              /* the rows computed and written */
+    int cb, ce;              /* the columns computed and written (the receiver rectangle's) */
+    int ox, oy, ew, eh;      /* the grid's (0, 0) is raster cell (ox, oy) of an ew x eh raster */
 } hf_solar_ctx;
 
 /* The Julian day of local civil hour t of day (y, m, d). */
@@ -11415,6 +11427,26 @@ static hfvis_status hf_solar_setup(const hfvis_grid *g, const hfvis_solar_input 
     c->rb = c->o.row_end ? c->o.row_begin : 0;
     c->re = c->o.row_end ? c->o.row_end : g->height;
     if (c->re > g->height) return HFVIS_ERR_INVALID_ARGUMENT;
+    c->cb = c->ox = c->oy = 0;
+    c->ce = c->ew = g->width;
+    c->eh = g->height;
+    if (c->o.sweep) { /* the window and the receiver rectangle (hfvis.h "Search radius and tiles") */
+        const hfvis_sweep_options *s = c->o.sweep;
+        int rx0, ry0, rx1, ry1;
+        if (!hf_tile_fits(g, s) || (in->latitude_map && hf_tile_window(g, s))) return HFVIS_ERR_INVALID_ARGUMENT;
+        if (s->extent_width != 0) {
+            c->ox = s->origin_x;
+            c->oy = s->origin_y;
+            c->ew = s->extent_width;
+            c->eh = s->extent_height;
+        }
+        hf_receiver_rect(g, s, &rx0, &ry0, &rx1, &ry1);
+        c->cb = rx0;
+        c->ce = rx1;
+        if (c->rb < ry0) c->rb = ry0;
+        if (c->re > ry1) c->re = ry1;
+        if (c->re < c->rb) c->re = c->rb; /* no row of the band in the rectangle */
+    }
     n = hf_grid_count(g);
     if (n > SIZE_MAX / sizeof(double) / 8 || (size_t)c->bands > SIZE_MAX / sizeof(float) / 8 / n)
         return HFVIS_ERR_LIMIT;
@@ -11476,6 +11508,7 @@ static void hf_solar_store(const hfvis_grid *g, const hf_solar_ctx *c, const dou
             const double *a = acc + j * 4;
             int hole = !isfinite(g->z[(i / (size_t)g->width) * (size_t)g->stride + i % (size_t)g->width]);
             double r = terrain ? (double)terrain[j] : a[2];
+            if ((int)(i % (size_t)g->width) < c->cb || (int)(i % (size_t)g->width) >= c->ce) continue;
             if (out->beam) out->beam[j] = hole ? (float)HFVIS__NAN : (float)a[0];
             if (out->diffuse) out->diffuse[j] = hole ? (float)HFVIS__NAN : (float)a[1];
             if (out->reflected) out->reflected[j] = hole ? (float)HFVIS__NAN : (float)r;
@@ -11540,32 +11573,45 @@ static void hf_solar_bracket(const double *az, int K, double psi, int *k0, int *
     *w = span > 0.0 ? (psi - lo) / span : 0.0;
 }
 
-/* Per-sample sites (the input's latitude and longitude maps): frames, blocks. */
+/* Per-sample sites (the input's site function or its latitude and longitude maps): frames,
+ * blocks. */
 static double hf_wrap_pi(double x) { return x - 2.0 * HFVIS__PI * floor((x + HFVIS__PI) / (2.0 * HFVIS__PI)); }
 
-/* Sample (x, y)'s site from the input's maps: latitude, longitude, and gamma, the true azimuth
- * of the grid's up direction (-y): from the maps' central differences along y (one-sided at the
- * border), along x on a one-row grid (the azimuth of +x less 90 deg), 0 where they do not
- * change. */
-static void hf_solar_site_of(const hfvis_grid *g, const hfvis_solar_input *in, int x, int y,
-                             double *lat, double *lon, double *gamma)
+/* Raster cell (x, y)'s latitude and longitude: the input's site function, or its maps (whose
+ * grid is the raster, section 6 checks). 0 for a value out of range. */
+static int hf_solar_site_at(const hf_solar_ctx *c, int x, int y, double *lat, double *lon)
 {
-    const double *la = in->latitude_map, *lo = in->longitude_map;
-    size_t w = (size_t)g->width, i = (size_t)y * w + (size_t)x, a, b;
-    double dn, de, turn = 0.0;
-    *lat = la[i];
-    *lon = lo[i];
-    if (g->height > 1) { /* a: the row above (up), b: the row below */
-        a = (size_t)(y > 0 ? y - 1 : y) * w + (size_t)x;
-        b = (size_t)(y + 1 < g->height ? y + 1 : y) * w + (size_t)x;
+    if (c->in.site) {
+        c->in.site(c->in.site_user, x, y, lat, lon);
+        return hf_in(*lat, -HFVIS__HALF_PI, HFVIS__HALF_PI) && hf_in(*lon, -HFVIS__PI, HFVIS__PI);
+    }
+    *lat = c->in.latitude_map[(size_t)y * (size_t)c->ew + (size_t)x];
+    *lon = c->in.longitude_map[(size_t)y * (size_t)c->ew + (size_t)x];
+    return 1; /* checked by hf_solar_setup */
+}
+
+/* Raster cell (x, y)'s site: latitude, longitude, and gamma, the true azimuth of the grid's up
+ * direction (-y): from the sites' central differences along y (one-sided at the raster's edge),
+ * along x on a one-row raster (the azimuth of +x less 90 deg), 0 where they do not change.
+ * 0 for a site out of range. */
+static int hf_solar_site_of(const hf_solar_ctx *c, int x, int y, double *lat, double *lon, double *gamma)
+{
+    double dn, de, turn = 0.0, la, lo, lb, lob;
+    int ax = x, ay = y, bx = x, by = y;
+    if (!hf_solar_site_at(c, x, y, lat, lon)) return 0;
+    if (c->eh > 1) { /* a: the row above (up), b: the row below */
+        ay = y > 0 ? y - 1 : y;
+        by = y + 1 < c->eh ? y + 1 : y;
     } else { /* a: east, b: west */
-        a = (size_t)y * w + (size_t)(x + 1 < g->width ? x + 1 : x);
-        b = (size_t)y * w + (size_t)(x > 0 ? x - 1 : x);
+        ax = x + 1 < c->ew ? x + 1 : x;
+        bx = x > 0 ? x - 1 : x;
         turn = HFVIS__HALF_PI;
     }
-    dn = la[a] - la[b];
-    de = hf_wrap_pi(lo[a] - lo[b]) * cos(*lat);
+    if (!hf_solar_site_at(c, ax, ay, &la, &lo) || !hf_solar_site_at(c, bx, by, &lb, &lob)) return 0;
+    dn = la - lb;
+    de = hf_wrap_pi(lo - lob) * cos(*lat);
     *gamma = dn == 0.0 && de == 0.0 ? 0.0 : hf_wrap_pi(atan2(de, dn) - turn);
+    return 1;
 }
 
 /* A site's local frame in Earth-fixed axes, rows: the grid's +x (east turned by gamma), its up
@@ -11594,44 +11640,28 @@ static double hf_solar_frame_angle(const double a[9], const double b[9])
     return acos(t > 1.0 ? 1.0 : t < -1.0 ? -1.0 : t);
 }
 
-/* A block of samples sharing the sun of its centre sample's site. */
+/* A block of samples sharing the sun of its centre sample's site, in grid cells. */
 typedef struct hf_solar_block {
-    int x0, y0, x1, y1;
-    int r0, r1;           /* the rows computed, within [y0, y1) (the options' row range) */
+    int x0, y0, x1, y1;   /* the block's cells within the grid */
+    int r0, r1;           /* the rows computed, within [y0, y1) (the options' rows) */
+    int c0, c1;           /* the columns computed, within [x0, x1) (the receiver rectangle's) */
     double lat, lon, gamma;
 } hf_solar_block;
 
 typedef struct hf_solar_blocks {
     hf_solar_block *b;
     size_t n, cap;
+    int split;            /* the raster was cut into more than one block */
     const hfvis_allocator *al;
 } hf_solar_blocks;
 
-/* Split [x0, x1) x [y0, y1) in halves (both axes) until every sample's frame is within tol of
- * the centre sample's; append the blocks. Every sun direction seen in a frame turns by at most
- * that angle, so the block's sun is within tol of each sample's own. */
-static hfvis_status hf_solar_split(const hfvis_grid *g, const hfvis_solar_input *in, double tol,
-                                   int x0, int y0, int x1, int y1, hf_solar_blocks *B)
+/* Append block [x0, x1) x [y0, y1) of the grid (clipped to it), its computed rows and columns
+ * and its site. */
+static hfvis_status hf_solar_block_add(const hfvis_grid *g, const hf_solar_ctx *c, int x0, int y0,
+                                       int x1, int y1, double lat, double lon, double gamma,
+                                       hf_solar_blocks *B)
 {
-    int cx = x0 + (x1 - x0 - 1) / 2, cy = y0 + (y1 - y0 - 1) / 2, x, y, ok = 1;
-    double fc[9], f[9], lat, lon, gam, la, lo, ga;
-    hfvis_status st;
-    hf_solar_site_of(g, in, cx, cy, &lat, &lon, &gam);
-    hf_solar_frame(lat, lon, gam, fc);
-    for (y = y0; y < y1 && ok; y++)
-        for (x = x0; x < x1 && ok; x++) {
-            hf_solar_site_of(g, in, x, y, &la, &lo, &ga);
-            hf_solar_frame(la, lo, ga, f);
-            ok = hf_solar_frame_angle(f, fc) <= tol;
-        }
-    if (!ok && (x1 - x0 > 1 || y1 - y0 > 1)) {
-        int xm = x1 - x0 > 1 ? x0 + (x1 - x0) / 2 : x1, ym = y1 - y0 > 1 ? y0 + (y1 - y0) / 2 : y1;
-        if ((st = hf_solar_split(g, in, tol, x0, y0, xm, ym, B)) != HFVIS_OK) return st;
-        if (xm < x1 && (st = hf_solar_split(g, in, tol, xm, y0, x1, ym, B)) != HFVIS_OK) return st;
-        if (ym < y1 && (st = hf_solar_split(g, in, tol, x0, ym, xm, y1, B)) != HFVIS_OK) return st;
-        if (xm < x1 && ym < y1) return hf_solar_split(g, in, tol, xm, ym, x1, y1, B);
-        return HFVIS_OK;
-    }
+    hf_solar_block *k;
     if (B->n == B->cap) { /* grow by doubling */
         size_t cap = B->cap ? 2 * B->cap : 16;
         hf_solar_block *nb = (hf_solar_block *)hfvis__alloc_array(B->al, cap, sizeof(hf_solar_block));
@@ -11641,11 +11671,52 @@ static hfvis_status hf_solar_split(const hfvis_grid *g, const hfvis_solar_input 
         B->b = nb;
         B->cap = cap;
     }
-    B->b[B->n].x0 = x0; B->b[B->n].y0 = y0; B->b[B->n].x1 = x1; B->b[B->n].y1 = y1;
-    B->b[B->n].r0 = y0; B->b[B->n].r1 = y1;
-    B->b[B->n].lat = lat; B->b[B->n].lon = lon; B->b[B->n].gamma = gam;
-    B->n++;
+    k = B->b + B->n++;
+    k->x0 = x0 > 0 ? x0 : 0;
+    k->y0 = y0 > 0 ? y0 : 0;
+    k->x1 = x1 < g->width ? x1 : g->width;
+    k->y1 = y1 < g->height ? y1 : g->height;
+    k->c0 = k->x0 > c->cb ? k->x0 : c->cb;
+    k->c1 = k->x1 < c->ce ? k->x1 : c->ce;
+    k->r0 = k->y0 > c->rb ? k->y0 : c->rb;
+    k->r1 = k->y1 < c->re ? k->y1 : c->re;
+    k->lat = lat;
+    k->lon = lon;
+    k->gamma = gamma;
     return HFVIS_OK;
+}
+
+/* Split raster cells [x0, x1) x [y0, y1) in halves (both axes) until every cell's frame is
+ * within tol of the centre cell's; append the blocks that meet the receiver rectangle (the
+ * others are neither checked nor kept). Every sun direction seen in a frame turns by at most
+ * that angle, so the block's sun is within tol of each sample's own. The cuts depend on the
+ * raster alone, so a window gets the whole raster's blocks. */
+static hfvis_status hf_solar_split(const hfvis_grid *g, const hf_solar_ctx *c, double tol,
+                                   int x0, int y0, int x1, int y1, hf_solar_blocks *B)
+{
+    int cx = x0 + (x1 - x0 - 1) / 2, cy = y0 + (y1 - y0 - 1) / 2, x, y, ok = 1;
+    double fc[9], f[9], lat, lon, gam, la, lo, ga;
+    hfvis_status st;
+    if (x1 - c->ox <= c->cb || x0 - c->ox >= c->ce || y1 - c->oy <= 0 || y0 - c->oy >= g->height)
+        return HFVIS_OK; /* outside the receiver rectangle's columns or the grid's rows */
+    if (!hf_solar_site_of(c, cx, cy, &lat, &lon, &gam)) return HFVIS_ERR_INVALID_ARGUMENT;
+    hf_solar_frame(lat, lon, gam, fc);
+    for (y = y0; y < y1 && ok; y++)
+        for (x = x0; x < x1 && ok; x++) {
+            if (!hf_solar_site_of(c, x, y, &la, &lo, &ga)) return HFVIS_ERR_INVALID_ARGUMENT;
+            hf_solar_frame(la, lo, ga, f);
+            ok = hf_solar_frame_angle(f, fc) <= tol;
+        }
+    if (!ok && (x1 - x0 > 1 || y1 - y0 > 1)) {
+        int xm = x1 - x0 > 1 ? x0 + (x1 - x0) / 2 : x1, ym = y1 - y0 > 1 ? y0 + (y1 - y0) / 2 : y1;
+        B->split = 1;
+        if ((st = hf_solar_split(g, c, tol, x0, y0, xm, ym, B)) != HFVIS_OK) return st;
+        if (xm < x1 && (st = hf_solar_split(g, c, tol, xm, y0, x1, ym, B)) != HFVIS_OK) return st;
+        if (ym < y1 && (st = hf_solar_split(g, c, tol, x0, ym, xm, y1, B)) != HFVIS_OK) return st;
+        if (xm < x1 && ym < y1) return hf_solar_split(g, c, tol, xm, ym, x1, y1, B);
+        return HFVIS_OK;
+    }
+    return hf_solar_block_add(g, c, x0 - c->ox, y0 - c->oy, x1 - c->ox, y1 - c->oy, lat, lon, gam, B);
 }
 
 /* Shared by the fast routine and the oracle: setup, steps, per-sample state. */
@@ -11691,9 +11762,10 @@ static hfvis_status hf_solar_run_init(const hfvis_grid *g, const hfvis_solar_inp
     int b;
     memset(r, 0, sizeof *r);
     if ((st = hf_solar_setup(g, in, opts, out, &r->c)) != HFVIS_OK) return st;
-    if (all_rows) {
-        r->c.rb = 0;
+    if (all_rows) { /* and every column */
+        r->c.rb = r->c.cb = 0;
         r->c.re = g->height;
+        r->c.ce = g->width;
     }
     r->al = r->c.o.sweep ? r->c.o.sweep->alloc : NULL;
     n = hf_grid_count(g);
@@ -11742,6 +11814,8 @@ static hfvis_status hf_solar_finish(const hfvis_grid *g, hf_solar_run *r, int na
 #define HF_SOLAR_BINS_PER_DIR 4
 #define HF_SOLAR_SECTOR_MIN 4
 #define HF_SOLAR_NODES 3
+#define HF_SOLAR_NODES_ANCHORED 5 /* over height_min..height_max (a raster's relief, not a block's):
+                                     quartic, as the day path's; 3 nodes gave 3e-3 over 6.8 km */
 #define HF_SOLAR_P_LINEAR 0.02 /* below this range of p, B0c(p) is linear to 4e-6 of itself */
 enum { /* the per-entry sums (times the step weight and the interpolation share) */
     HF_SQ_BX, HF_SQ_BY, HF_SQ_BZ, /* B0c s: beam = n . this */
@@ -11803,23 +11877,36 @@ static void hf_solar_entry_sums(const hf_solar_step *st, double p, double *q)
     q[HF_SQ_HOURS] = w;
 }
 
+/* The pressure nodes span the options' height_min..height_max, not each block's heights. */
+static int hf_solar_anchored(const hf_solar_ctx *c)
+{
+    return c->o.height_min != 0.0 || c->o.height_max != 0.0;
+}
+
 /* The pressure nodes pn[0..nn) of a block of samples, over which the sums of a step are
  * interpolated in the pressure ratio p: one node on a flat block, two (linear) over a small
- * range of p, else maxn (3, quadratic, for the sector sums; HF_SOLAR_DAY_NODES for the day
- * path), at heights spread evenly over the block's finite heights.
- * Returns nn. The one place that chooses them (both fast paths call it). */
-static int hf_solar_block_nodes(const hfvis_grid *g, const hf_solar_block *blk, int maxn, double *pn)
+ * range of p, else maxn (the sector sums: 3, quadratic, or HF_SOLAR_NODES_ANCHORED when
+ * anchored; HF_SOLAR_DAY_NODES for the day path), at heights spread evenly over the block's
+ * finite heights, or over the options' height_min..height_max when they are set (then the same
+ * for every grid of the raster). Returns nn. The one place that chooses them (both fast paths
+ * call it). */
+static int hf_solar_block_nodes(const hfvis_grid *g, const hf_solar_ctx *c, const hf_solar_block *blk,
+                                int maxn, double *pn)
 {
     double zmin = HFVIS__INF, zmax = -HFVIS__INF;
-    int nn, j, x, y;
-    for (y = blk->y0; y < blk->y1; y++)
+    int nn, j, x, y, anchored = hf_solar_anchored(c);
+    if (anchored) { /* the caller's span */
+        zmin = c->o.height_min;
+        zmax = c->o.height_max;
+    }
+    for (y = anchored ? blk->y1 : blk->y0; y < blk->y1; y++)
         for (x = blk->x0; x < blk->x1; x++) {
             double z = (double)g->z[(ptrdiff_t)y * g->stride + x];
             if (!isfinite(z)) continue;
             if (z < zmin) zmin = z;
             if (z > zmax) zmax = z;
         }
-    if (!(zmin <= zmax)) zmin = zmax = 0.0;
+    if (!(zmin <= zmax)) zmin = zmax = 0.0; /* no finite height */
     nn = zmin == zmax ? 1 : hf_esra_pressure(zmin) - hf_esra_pressure(zmax) < HF_SOLAR_P_LINEAR ? 2 : maxn;
     for (j = 0; j < nn; j++)
         pn[j] = hf_esra_pressure(nn == 1 ? zmin : zmax + (zmin - zmax) * (double)j / (double)(nn - 1));
@@ -11841,16 +11928,17 @@ static hfvis_status hf_solar_sectors(const hfvis_grid *g, hf_solar_run *r, int K
                                      const float *cellmap, const float *sky, const hf_solar_block *blk)
 {
     int NB = HF_SOLAR_BINS_PER_DIR * K, j, b, nn, x, y;
+    int maxn = hf_solar_anchored(&r->c) ? HF_SOLAR_NODES_ANCHORED : HF_SOLAR_NODES;
     size_t n = hf_grid_count(g), ngroups = (size_t)r->c.bands * (size_t)NB, q, i, e;
     size_t *start = NULL, *fill = NULL;
     hf_solar_entry *ent = NULL;
     int *bk = NULL, *nonempty = NULL, *nne = NULL;
-    double *sums = NULL, *tdh = NULL, *bw = NULL, *bdir = NULL, *th = NULL, pn[HF_SOLAR_NODES],
+    double *sums = NULL, *tdh = NULL, *bw = NULL, *bdir = NULL, *th = NULL, pn[HF_SOLAR_NODES_ANCHORED],
            turn = 2.0 * HFVIS__PI;
     start = (size_t *)hfvis__alloc_array(r->al, ngroups + 1, sizeof(size_t));
     fill = (size_t *)hfvis__alloc_array(r->al, ngroups + 1, sizeof(size_t));
     ent = (hf_solar_entry *)hfvis__alloc_array(r->al, r->nsteps + 1, sizeof(hf_solar_entry));
-    sums = (double *)hfvis__alloc_array(r->al, r->nsteps + 1, sizeof(double) * HF_SOLAR_NODES * HF_SOLAR_Q);
+    sums = (double *)hfvis__alloc_array(r->al, r->nsteps + 1, sizeof(double) * (size_t)maxn * HF_SOLAR_Q);
     tdh = (double *)hfvis__alloc_array(r->al, (size_t)r->c.bands, sizeof(double));
     bk = (int *)hfvis__alloc_array(r->al, (size_t)NB, 2 * sizeof(int));
     bw = (double *)hfvis__alloc_array(r->al, (size_t)NB, sizeof(double));
@@ -11901,11 +11989,11 @@ static hfvis_status hf_solar_sectors(const hfvis_grid *g, hf_solar_run *r, int K
         }
     }
     /* pressure nodes over the block's heights, and each group's sums from the top */
-    nn = hf_solar_block_nodes(g, blk, HF_SOLAR_NODES, pn);
+    nn = hf_solar_block_nodes(g, &r->c, blk, maxn, pn);
     for (i = 0; i < ngroups; i++) {
-        double acc[HF_SOLAR_NODES * HF_SOLAR_Q];
+        double acc[HF_SOLAR_NODES_ANCHORED * HF_SOLAR_Q];
         int a;
-        for (a = 0; a < HF_SOLAR_NODES * HF_SOLAR_Q; a++) acc[a] = 0.0;
+        for (a = 0; a < nn * HF_SOLAR_Q; a++) acc[a] = 0.0;
         for (e = start[i + 1]; e-- > start[i];) {
             double *s = sums + e * (size_t)nn * HF_SOLAR_Q;
             for (j = 0; j < nn; j++) {
@@ -11916,17 +12004,17 @@ static hfvis_status hf_solar_sectors(const hfvis_grid *g, hf_solar_run *r, int K
     }
     /* per sample: the suffix of each bin above its threshold */
     for (y = blk->r0; y < blk->r1; y++)
-        for (x = blk->x0; x < blk->x1; x++) {
+        for (x = blk->c0; x < blk->c1; x++) {
             hf_solar_point *pt = r->pts + (i = (size_t)y * (size_t)g->width + (size_t)x);
             const float *hz = cellmap + i * (size_t)K;
-            double L[HF_SOLAR_NODES];
+            double L[HF_SOLAR_NODES_ANCHORED];
             int horizon = r->c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON;
             if (!isfinite(pt->p) || isnan(pt->nz)) continue;
             if (sky) pt->sky_ratio = (double)sky[i] / pt->r_sky;
             for (j = 0; j < K; j++) th[j] = tan((double)hz[j]);
             hf_solar_lagrange(nn, pn, pt->p, L);
             for (b = 0; b < r->c.bands; b++) {
-                double S[HF_SOLAR_NODES * HF_SOLAR_Q], T[HF_SOLAR_Q], *a = r->acc + ((size_t)b * n + i) * 4;
+                double S[HF_SOLAR_NODES_ANCHORED * HF_SOLAR_Q], T[HF_SOLAR_Q], *a = r->acc + ((size_t)b * n + i) * 4;
                 int t, u;
                 for (t = 0; t < nn * HF_SOLAR_Q; t++) S[t] = 0.0;
                 for (u = 0; u < nne[b]; u++) {
@@ -11976,7 +12064,7 @@ static void hf_solar_loop(const hfvis_grid *g, hf_solar_run *r, int K, const flo
     size_t n = hf_grid_count(g), q;
     int horizon = r->c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON, x, y;
     for (y = blk->r0; y < blk->r1; y++)
-        for (x = blk->x0; x < blk->x1; x++) {
+        for (x = blk->c0; x < blk->c1; x++) {
             size_t i = (size_t)y * (size_t)g->width + (size_t)x;
             hf_solar_point *pt = r->pts + i;
             const float *hz = cellmap ? cellmap + i * (size_t)K : NULL;
@@ -12122,7 +12210,7 @@ static hfvis_status hf_solar_day(const hfvis_grid *g, hf_solar_run *r, const flo
     size_t n = hf_grid_count(g), q, q0, q1;
     double pn[HF_SOLAR_DAY_NODES], *c;
     hf_solar_dstep *ds;
-    int nn = hf_solar_block_nodes(g, blk, HF_SOLAR_DAY_NODES, pn);
+    int nn = hf_solar_block_nodes(g, &r->c, blk, HF_SOLAR_DAY_NODES, pn);
     int horizon = r->c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON, x0, y, j, k;
     double radius = r->c.o.sun_radius_rad;
     ds = (hf_solar_dstep *)hfvis__alloc_array(r->al, r->nsteps + 1, sizeof(hf_solar_dstep));
@@ -12135,8 +12223,8 @@ static hfvis_status hf_solar_day(const hfvis_grid *g, hf_solar_run *r, const flo
     for (q = 0; q < r->nsteps; q++)
         hf_solar_dstep_set(r->steps + q, pl, kk[2 * q], kk[2 * q + 1], kw[q], nn, pn, ds + q);
     for (y = blk->r0; y < blk->r1; y++)
-        for (x0 = blk->x0; x0 < blk->x1; x0 += HF_SOLAR_CHUNK) {
-            int cnt = blk->x1 - x0 < HF_SOLAR_CHUNK ? blk->x1 - x0 : HF_SOLAR_CHUNK;
+        for (x0 = blk->c0; x0 < blk->c1; x0 += HF_SOLAR_CHUNK) {
+            int cnt = blk->c1 - x0 < HF_SOLAR_CHUNK ? blk->c1 - x0 : HF_SOLAR_CHUNK;
             size_t row = (size_t)y * (size_t)g->width + (size_t)x0;
             for (k = 0; k < HF_DC_N * HF_SOLAR_CHUNK; k++) c[k] = 0.0; /* padding: never lit */
             for (j = 0; j < cnt; j++) {
@@ -12193,8 +12281,9 @@ static hfvis_status hf_solar_day(const hfvis_grid *g, hf_solar_run *r, const flo
     return HFVIS_OK;
 }
 
-/* The blocks of the run: the whole grid at the input's site, or hf_solar_split of the maps
- * (then SPA's instant part from the hourly table when there is more than one block). */
+/* The blocks of the run: the whole grid at the input's site, or hf_solar_split of the raster's
+ * sites (then SPA's instant part from the hourly table when the raster has more than one block:
+ * a window's blocks take it exactly when the whole raster's do). */
 static hfvis_status hf_solar_run_blocks(const hfvis_grid *g, hf_solar_run *r, hf_solar_blocks *B,
                                         hf_spa_eph **eph)
 {
@@ -12203,22 +12292,10 @@ static hfvis_status hf_solar_run_blocks(const hfvis_grid *g, hf_solar_run *r, hf
     memset(B, 0, sizeof *B);
     B->al = r->al;
     *eph = NULL;
-    if (!r->c.in.latitude_map) {
-        B->b = (hf_solar_block *)hfvis__alloc_array(r->al, 1, sizeof(hf_solar_block));
-        if (!B->b) return HFVIS_ERR_OUT_OF_MEMORY;
-        B->b[0].x0 = B->b[0].y0 = 0;
-        B->b[0].x1 = g->width;
-        B->b[0].y1 = g->height;
-        B->b[0].r0 = 0;
-        B->b[0].r1 = g->height;
-        B->b[0].lat = r->c.lat;
-        B->b[0].lon = r->c.lon;
-        B->b[0].gamma = 0.0;
-        B->n = B->cap = 1;
-        return HFVIS_OK;
-    }
-    st = hf_solar_split(g, &r->c.in, r->c.o.site_tolerance_rad, 0, 0, g->width, g->height, B);
-    if (st == HFVIS_OK && B->n > 1 && r->c.o.model != HFVIS_SUN_RSUN) {
+    if (!hf_solar_per_sample(&r->c.in))
+        return hf_solar_block_add(g, &r->c, 0, 0, g->width, g->height, r->c.lat, r->c.lon, 0.0, B);
+    st = hf_solar_split(g, &r->c, r->c.o.site_tolerance_rad, 0, 0, r->c.ew, r->c.eh, B);
+    if (st == HFVIS_OK && B->split && r->c.o.model != HFVIS_SUN_RSUN) {
         *eph = (hf_spa_eph *)hfvis__alloc_array(r->al, (size_t)days * HF_SOLAR_EPH_PER_DAY, sizeof(hf_spa_eph));
         if (!*eph) st = HFVIS_ERR_OUT_OF_MEMORY;
         else hf_solar_eph_fill(&r->c, days, *eph);
@@ -12233,7 +12310,7 @@ static hfvis_status hf_solar_run_blocks(const hfvis_grid *g, hf_solar_run *r, hf
 /* Set the run's site to a block's (its steps anew when the grid has more than one site). */
 static hfvis_status hf_solar_run_site(hf_solar_run *r, const hf_solar_block *blk)
 {
-    if (!r->c.in.latitude_map) return HFVIS_OK;
+    if (!hf_solar_per_sample(&r->c.in)) return HFVIS_OK;
     r->c.lat = blk->lat;
     r->c.lon = blk->lon;
     r->c.gamma = blk->gamma;
@@ -12357,10 +12434,11 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
     if (st == HFVIS_OK && r.c.o.diffuse == HFVIS_SOLAR_DIFFUSE_HORIZON) {
         sky = (float *)hfvis__alloc_array(r.al, n, sizeof(float));
         if (!sky) st = HFVIS_ERR_OUT_OF_MEMORY;
-        else if (horn_sky)
-            for (i = (size_t)r.c.rb * (size_t)g->width; i < (size_t)r.c.re * (size_t)g->width; i++) /* the rows read */
-                sky[i] = (float)hf_solar_sky_seen(r.pts + i, K, az, src, n, i);
-        else st = hfvis_sky_light(g, K, 1.0f, 1.0f, &s, sky, g->width);
+        else if (horn_sky) {
+            for (i = (size_t)r.c.rb * (size_t)g->width; i < (size_t)r.c.re * (size_t)g->width; i++) /* the samples read */
+                if ((int)(i % (size_t)g->width) >= r.c.cb && (int)(i % (size_t)g->width) < r.c.ce)
+                    sky[i] = (float)hf_solar_sky_seen(r.pts + i, K, az, src, n, i);
+        } else st = hfvis_sky_light(g, K, 1.0f, 1.0f, &s, sky, g->width);
     }
     if (r.c.o.no_shading) { /* no map read by the steps */
         hfvis__free(r.al, pl);
@@ -12372,9 +12450,7 @@ hfvis_status hfvis_solar_irradiation(const hfvis_grid *g, const hfvis_solar_inpu
         double *kw = NULL;
         size_t q;
         int sectors, day;
-        if (part.r0 < r.c.rb) part.r0 = r.c.rb; /* the options' rows of this block */
-        if (part.r1 > r.c.re) part.r1 = r.c.re;
-        if (part.r0 >= part.r1) continue;
+        if (part.r0 >= part.r1 || part.c0 >= part.c1) continue; /* none of its samples computed */
         if ((st = hf_solar_run_site(&r, blk)) != HFVIS_OK) break;
         sectors = pl && hf_solar_sectors_apply(&r.c, r.nsteps);
         day = pl && !sectors && hf_solar_day_apply(&r.c);
@@ -12483,7 +12559,10 @@ static hfvis_status hf_solar_reference_sites(const hfvis_grid *g, hf_solar_run *
             size_t i = (size_t)y * (size_t)g->width + (size_t)x;
             hf_solar_point *pt = r->pts + i;
             if (!isfinite(pt->p) || isnan(pt->nz)) continue;
-            hf_solar_site_of(g, &r->c.in, x, y, &r->c.lat, &r->c.lon, &r->c.gamma);
+            if (!hf_solar_site_of(&r->c, r->c.ox + x, r->c.oy + y, &r->c.lat, &r->c.lon, &r->c.gamma)) {
+                st = HFVIS_ERR_INVALID_ARGUMENT;
+                break;
+            }
             if ((st = hf_solar_run_steps(r)) != HFVIS_OK) break;
             for (q = 0; q < r->nsteps; q++) {
                 const hf_solar_step *stp = r->steps + q;
@@ -12512,6 +12591,7 @@ hfvis_status hfvis_solar_irradiation_reference(const hfvis_grid *g, const hfvis_
     if ((st = hf_solar_run_init(g, in, opts, out, 1, &r)) != HFVIS_OK) return st; /* every row */
     n = hf_grid_count(g);
     s = hf_solar_sweep(&r.c, HFVIS_RAYS_EXACT);
+    s.receiver_x = s.receiver_y = s.receiver_width = s.receiver_height = 0; /* every receiver */
     KR = HF_SOLAR_REF_DIRS * r.c.o.directions;
     hor = (float *)hfvis__alloc_array(r.al, n * (size_t)HF_SOLAR_REF_DIRS, (size_t)r.c.o.directions * sizeof(float));
     az = (double *)hfvis__alloc_array(r.al, (size_t)KR, sizeof(double));
@@ -12525,8 +12605,8 @@ hfvis_status hfvis_solar_irradiation_reference(const hfvis_grid *g, const hfvis_
             r.pts[i].sky_ratio = hf_solar_sky_seen(r.pts + i, KR, az, hor, n, i) / r.pts[i].r_sky;
     }
     s.ray_denominator = HF_SOLAR_REF_DENOM;
-    if (st == HFVIS_OK && r.c.in.latitude_map) st = hf_solar_reference_sites(g, &r, &s);
-    for (q = 0; q < r.nsteps && st == HFVIS_OK && !r.c.in.latitude_map; q++) {
+    if (st == HFVIS_OK && hf_solar_per_sample(&r.c.in)) st = hf_solar_reference_sites(g, &r, &s);
+    for (q = 0; q < r.nsteps && st == HFVIS_OK && !hf_solar_per_sample(&r.c.in); q++) {
         const hf_solar_step *stp = r.steps + q;
         if (!r.c.o.no_shading) { /* each receiver's own exact ray toward the sun */
             s.azimuth0_rad = stp->psi;

@@ -970,7 +970,9 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     their last receiver in it) and the rest of the output is left as it was.
  *   - Where it applies: hfvis_horizon_map, hfvis_horizon_direction, hfvis_sky_light,
  *     hfvis_sky_view_factor, hfvis_env_light, hfvis_sun_visibility, hfvis_direct_light,
- *     hfvis_direction_sums (sky view, sky light, environment), both modes. R also applies to hfvis_horizon_lattice(_naive)
+ *     hfvis_direction_sums (sky view, sky light, environment), both modes, and
+ *     hfvis_solar_irradiation (its map, sky and sums; not with TERRAIN reflection, and a window
+ *     needs the site function rather than the maps: hfvis_solar_options.sweep). R also applies to hfvis_horizon_lattice(_naive)
  *     (no window: its nodes are those of hfvis_lattice_init; the rectangle is ignored) and to
  *     the oracles. Refused with HFVIS_ERR_INVALID_ARGUMENT (R, a window or a rectangle):
  *     hfvis_openness (it has its own radius).
@@ -1552,6 +1554,21 @@ typedef struct hfvis_solar_input {
                                     their differences along y, along x on a one-row grid), and the
                                     sun is computed per block of samples whose local frames are
                                     within opts->site_tolerance_rad of the block centre's */
+    void (*site)(void *user, int x, int y, double *latitude_rad, double *longitude_rad);
+                              /* or, in place of the maps (both NULL), each sample's site by
+                                 this function: it stores the latitude and longitude (radians,
+                                 ranges as the maps') of raster cell (x, y), where the grid's
+                                 (0, 0) is raster cell (opts->sweep's origin_x, origin_y) and
+                                 0 <= x < extent_width, 0 <= y < extent_height (the grid's size
+                                 without a window). It is called for cells of the whole raster,
+                                 outside the grid too: the blocks sharing a sun are cut from the
+                                 raster's extent, and the convergence takes the neighbours
+                                 clamped at the raster's edges, so a window's samples get the
+                                 whole raster's suns (tiles, hfvis.h "Search radius and
+                                 tiles"). It must give the same values for the same cell on
+                                 every call; a value out of range is HFVIS_ERR_INVALID_ARGUMENT.
+                                 The maps need the grid to be the raster (no window) */
+    void *site_user;          /* passed to site */
     double height_m;          /* SPA's observer height; the air mass uses each sample's z */
     int year, month, day;     /* first day; RSUN steps day of the year from it */
     int days;                 /* >= 1 days from the first (ignored for an instant) */
@@ -1589,9 +1606,16 @@ typedef struct hfvis_solar_options {
                                     sample's local frame (east, north, up turned by the
                                     convergence) and its block centre's, (0, 0.1]; 0 = 0.05 deg.
                                     Every sun direction of a sample is within it of its own */
-    const hfvis_sweep_options *sweep; /* border, search radius, allocator, progress; its rays
-                                    field is ignored (horizons below sets the ray mode) and
-                                    its window and rectangle must be unset */
+    const hfvis_sweep_options *sweep; /* border, search radius, allocator, progress, window; its
+                                    rays field is ignored (horizons below sets the ray mode).
+                                    Its receiver rectangle: only those outputs are computed and
+                                    written (the others untouched); its window (origin, extent:
+                                    a finite radius, the open border): the grid is a window plus
+                                    halo of a raster, and the rectangle's outputs equal the whole
+                                    raster's run bit for bit when the sites come from input->site
+                                    or one site and height_min/max are set alike in both runs.
+                                    TERRAIN refuses a window or a rectangle, the maps a window.
+                                    The oracle computes every receiver */
     const float *horizon_map;    /* NULL: the fast routine makes its horizon map itself (only
                                     the directions its steps read); else the caller's,
                                     directions*width*height floats exactly as hfvis_horizon_map
@@ -1605,16 +1629,27 @@ typedef struct hfvis_solar_options {
                                     only rows [row_begin, row_end) of the outputs (0 <= begin <
                                     end <= height; the other rows untouched), each bit for bit
                                     the whole call's: calls on disjoint ranges split a run over
-                                    threads (give them one horizon_map). Not with TERRAIN. The
+                                    threads (give them one horizon_map). With a receiver
+                                    rectangle, the rows of both. Not with TERRAIN. The
                                     oracle ignores it */
     hfvis_solar_normals normals; /* default CENTRAL; HORN to match r.sun fed by r.slope.aspect */
+    double height_min, height_max; /* the heights the pressure nodes of the sector sums and the
+                                    day path span, in place of each block's own finite heights
+                                    (the air mass's p(z) is interpolated between them); both 0 =
+                                    the block's (default). Else finite, height_min <= height_max:
+                                    give the whole raster's range in every run that must agree
+                                    with its windows (the nodes then do not depend on the grid
+                                    handed in; the sector sums then take 5 nodes, not 3). The
+                                    interpolation error grows with the span: within 6.4e-5 of
+                                    the step loop over 6.8 km of relief (docs/solar.md
+                                    "Windows") */
 } hfvis_solar_options;
 
 HFVIS_API hfvis_solar_options hfvis_solar_options_default(void);
 
 /* The sweep options with which hfvis_solar_irradiation makes its horizon map (and HORIZON's
- * visible sky) for these options (NULL: the defaults): opts->sweep's border, radius, allocator
- * and progress, the ray mode and near-field cells of opts->horizons, azimuth0 0, every
+ * visible sky) for these options (NULL: the defaults): opts->sweep's border, radius, allocator,
+ * progress, window and receiver rectangle, the ray mode and near-field cells of opts->horizons, azimuth0 0, every
  * direction. Pass them to hfvis_horizon_map to make opts->horizon_map yourself. */
 HFVIS_API hfvis_sweep_options hfvis_solar_map_options(const hfvis_solar_options *opts);
 
@@ -1646,7 +1681,7 @@ HFVIS_API int hfvis_solar_band_count(const hfvis_solar_input *input,
 /* Irradiance (input->instant) or irradiation over a period on every grid point. Per time step:
  * the sun at the site (with input->latitude_map: at the centre of each block of samples whose
  * local frames lie within opts->site_tolerance_rad of the centre's, quadtree halving from the
- * whole grid; the steps, sunrise and sunset are then each block's own, SPA's instant part taken
+ * whole raster (opts->sweep's extent; the grid without a window); the steps, sunrise and sunset are then each block's own, SPA's instant part taken
  * once per hour of the period and interpolated, within 2e-6 deg); the beam is shaded by the horizon toward the sun, read from one
  * horizon map of K directions made once (hfvis_horizon_map with hfvis_solar_map_options: exact
  * rays by default, opts->horizons; only the directions the steps read, bit-identical to the
@@ -1661,7 +1696,8 @@ HFVIS_API int hfvis_solar_band_count(const hfvis_solar_input *input,
  * step (a value or monthly values), no coefficient rasters and a hard sun take the sector sums
  * instead of the step loop: the steps binned by azimuth (4 bins per map direction), sorted by
  * elevation and summed from the top (every term is linear in per-sample constants once a step
- * is lit or not; the air mass's height enters by interpolation over 1-3 pressure nodes), so a
+ * is lit or not; the air mass's height enters by interpolation over 1-3 pressure nodes, 1, 2 or
+ * 5 over opts->height_min..height_max when set), so a
  * sample costs O(bins * log steps) instead of O(steps); its lit test is taken at the bin's
  * centre (within 0.7 deg of the step's azimuth at K = 64).
  * Shorter periods with one Linke factor per step and no coefficient rasters (a hard sun or the
@@ -1672,7 +1708,7 @@ HFVIS_API int hfvis_solar_band_count(const hfvis_solar_input *input,
  * copy with the sector sums or the step loop, 120 bytes per sample of state and 32 per sample
  * and band of sums, plus the outputs;
  * HORIZON adds 4 bytes per sample, TERRAIN the [P2] sweep's scratch; the sector sums about
- * 350 bytes per sunlit step; per-sample sites 1 KB per day of the period (the hourly table)
+ * 350 bytes per sunlit step (570 with height_min/max); per-sample sites 1 KB per day of the period (the hourly table)
  * and 56 bytes per block.
  * Cost: the map (hfvis.h "Exact rays") plus O(steps*width*height), or with the sector sums
  * O(steps log steps + bands*K*width*height*log steps), the steps' part once per block.

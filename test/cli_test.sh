@@ -1348,7 +1348,45 @@ expect_fail "solar: latitude without longitude" 2 solar "$dir/flat.pgm" --latitu
 expect_fail "solar: --time with a range" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --start 2026-06-01 --end 2026-06-02 --time 12:00 -o "$fdir/x.pfm"
 expect_fail "solar: --solar-time with --utc-offset" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --solar-time --utc-offset 1 -o "$fdir/x.pfm"
 expect_fail "solar: no date" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 -o "$fdir/x.pfm"
-expect_fail "solar: --window" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --window 0,0,2,2 -o "$fdir/x.pfm"
+expect_fail "solar: --window without --max-distance" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --window 0,0,2,2 -o "$fdir/x.pfm"
+# solar --window: swin.asc, 37 x 29 cells of 400 m in UTM 33N (0.1 deg of latitude: several
+# blocks of per-cell suns at the default tolerance), cut into 5 uneven windows (one a single row,
+# the others touching the raster's edges); 'mosaic' of the pieces of each output equals the
+# whole run with the same --max-distance byte for byte: per-cell sites (30 days: the sector
+# sums, --threads 2 against 1), one site (a day: the day path), an instant.
+awk 'BEGIN { srand(5); print "ncols 37"; print "nrows 29"; print "xllcorner 480000"; print "yllcorner 5000000"
+  print "cellsize 400"; for (y = 0; y < 29; y++) { s = ""
+    for (x = 0; x < 37; x++) s = s " " int(1000 + 400 * sin(x / 5) * cos(y / 4) + 150 * sin((x + 2 * y) / 3) + 30 * rand())
+    print s } }' > "$dir/swin.asc"
+cp "$dir/utm.prj" "$dir/swin.prj"
+# solar_tiles NAME ARGS...: the whole run (global and beam GeoTIFFs), the 5 windows' pieces, the
+# two mosaics, compared byte for byte
+solar_tiles() {
+  sname=$1; shift
+  expect_ok "solar tiles $sname: whole run" "$dir/stw_g.tif" solar "$dir/swin.asc" "$@" --max-distance 2000 --beam "$dir/stw_b.tif" -o "$dir/stw_g.tif"
+  rm -f "$dir"/stp_*
+  for win in 0,0,20,13 20,0,17,13 0,13,37,1 0,14,11,15 11,14,26,15; do
+    wn=$(echo "$win" | tr , _)
+    expect_ok "solar tiles $sname: window $win" "$dir/stp_g_$wn.tif" solar "$dir/swin.asc" "$@" --max-distance 2000 --window "$win" --beam "$dir/stp_b_$wn.tif" -o "$dir/stp_g_$wn.tif"
+  done
+  expect_ok "solar tiles $sname: mosaic of the global pieces" "$dir/stm_g.tif" mosaic "$dir"/stp_g_*.tif -o "$dir/stm_g.tif"
+  expect_ok "solar tiles $sname: mosaic of the beam pieces" "$dir/stm_b.tif" mosaic "$dir"/stp_b_*.tif -o "$dir/stm_b.tif"
+  cmp -s "$dir/stw_g.tif" "$dir/stm_g.tif" && cmp -s "$dir/stw_b.tif" "$dir/stm_b.tif" &&
+    ok "solar tiles $sname: the mosaics equal the whole run byte for byte (global, beam)" ||
+    bad "solar tiles $sname: a mosaic differs from the whole run"
+}
+solar_tiles "per-cell sites, 30 days, --threads 2" --start 2026-03-01 --end 2026-03-30 --dirs 16 --threads 2
+cp "$dir/stw_g.tif" "$dir/stw_g_t2.tif"
+expect_ok "solar tiles: per-cell sites, 30 days, --threads 1 whole run" "$dir/stw_g.tif" solar "$dir/swin.asc" --start 2026-03-01 --end 2026-03-30 --dirs 16 --threads 1 --max-distance 2000 -o "$dir/stw_g.tif"
+cmp -s "$dir/stw_g.tif" "$dir/stw_g_t2.tif" && ok "solar tiles: --threads 2 equals --threads 1 (per-cell sites, 30 days)" || bad "solar tiles: --threads 2 differs from --threads 1"
+solar_tiles "per-cell sites, a day" --day 2026-06-21 --threads 1
+solar_tiles "--latitude/--longitude, a day, --threads 2" --day 2026-06-21 --latitude 46 --longitude 15 --threads 2
+solar_tiles "per-cell sites, an instant" --day 2026-06-21 --time 09:30 --threads 1
+"$hfvis" mosaic "$dir"/stp_g_0_0_20_13.tif "$dir"/stp_b_20_0_17_13.tif "$dir"/stp_b_0_13_37_1.tif "$dir"/stp_b_0_14_11_15.tif "$dir"/stp_b_11_14_26_15.tif -o "$fdir/x.tif" > /dev/null 2> "$dir/stderr" &&
+  bad "solar tiles: mosaic joined a global piece with beam pieces" || { grep -q 'solar-output' "$dir/stderr" &&
+  ok "solar tiles: mosaic refuses a global piece among beam pieces: $(cat "$dir/stderr")" || bad "solar tiles: mixed outputs: $(cat "$dir/stderr")"; }
+expect_fail "solar --window with --linke-map" 2 solar "$dir/swin.asc" --day 2026-06-21 --max-distance 2000 --window 0,0,5,5 --linke-map "$dir/swin.asc" -o "$fdir/x.tif"
+expect_fail "solar --window with --albedo-map" 2 solar "$dir/swin.asc" --day 2026-06-21 --max-distance 2000 --window 0,0,5,5 --albedo-map "$dir/swin.asc" -o "$fdir/x.tif"
 expect_fail "solar: bad --step" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --step 25h -o "$fdir/x.pfm"
 expect_fail "solar: bad --linke-monthly" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --linke-monthly 3,3 -o "$fdir/x.pfm"
 

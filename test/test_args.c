@@ -1898,6 +1898,14 @@ static void args_solar_band_count(void)
 typedef hfvis_status (*solar_fn)(const hfvis_grid *, const hfvis_solar_input *,
                                  const hfvis_solar_options *, const hfvis_solar_output *);
 
+/* hfvis_solar_input.site: raster cell (x, y) 0.01 rad apart per cell; *user = 1 puts cell (0, 0)
+ * beyond the pole (out of range). */
+static void solar_site_fn(void *user, int x, int y, double *lat, double *lon)
+{
+    *lat = (user && *(const int *)user ? 1.6 : 0.8) - 0.01 * (double)y;
+    *lon = 0.2 + 0.01 * (double)x;
+}
+
 static void solar_args(const char *name, solar_fn fn)
 {
     hfvis_solar_input in = solar_in_ok(), b;
@@ -1945,8 +1953,22 @@ static void solar_args(const char *name, solar_fn fn)
         bo2.sweep = &bo;
         bo = hfvis_sweep_options_default(); bo.border = (hfvis_border)99; BAD('E', INV, fn(&g_ok, &in, &bo2, &out));
         bo = hfvis_sweep_options_default(); bo.max_distance = -1.0; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));
-        bo = hfvis_sweep_options_default(); bo.receiver_width = bo.receiver_height = 1; BAD('S', INV, fn(&g_ok, &in, &bo2, &out));
+        static double lmap[GW * GH];
+        static int beyond_pole = 1;
+        for (i = 0; i < GW * GH; i++) lmap[i] = 0.5;
+        bo = hfvis_sweep_options_default(); bo.receiver_width = bo.receiver_height = 1; OK(fn(&g_ok, &in, &bo2, &out));
+        bo2.reflected = HFVIS_SOLAR_REFLECTED_TERRAIN; BAD('S', INV, fn(&g_ok, &in, &bo2, &out)); /* gathers the grid */
+        bo2.reflected = HFVIS_SOLAR_REFLECTED_DEFAULT;
+        bo = hfvis_sweep_options_default(); bo.max_distance = 3.0; bo.origin_x = 2; bo.extent_width = GW + 2;
+        bo.extent_height = GH; b = in; b.site = solar_site_fn; OK(fn(&g_ok, &b, &bo2, &out));
+        b.latitude_map = b.longitude_map = lmap; BAD('S', INV, fn(&g_ok, &b, &bo2, &out)); /* maps and site */
+        b.site = NULL; BAD('S', INV, fn(&g_ok, &b, &bo2, &out)); /* maps of a window */
+        bo.max_distance = 0.0; b = in; b.site = solar_site_fn; BAD('S', INV, fn(&g_ok, &b, &bo2, &out)); /* no R */
+        b.site_user = &beyond_pole; BAD('R', INV, fn(&g_ok, &b, &o, &out));
     }
+    bo2 = o; bo2.height_min = 5.0; bo2.height_max = 4.0; BAD('R', INV, fn(&g_ok, &in, &bo2, &out));
+    bo2 = o; bo2.height_max = (double)NAN; BAD('F', INV, fn(&g_ok, &in, &bo2, &out));
+    bo2 = o; bo2.height_min = -(double)INFINITY; BAD('F', INV, fn(&g_ok, &in, &bo2, &out));
 }
 
 /* hfvis_solar_map_directions through solar_args: the global output's floats stand for need (NULL
@@ -6270,6 +6292,29 @@ SW(solar_irradiation)
     so.reflected = HFVIS_SOLAR_REFLECTED_TERRAIN;
     return hfvis_solar_irradiation(&g_ok, &in, &so, &out);
 }
+SW(solar_irradiation_window) /* a window of sites by the site function: the blocks' list grows */
+{
+    hfvis_sweep_options o = sweep_opts(al);
+    hfvis_solar_options so = hfvis_solar_options_default();
+    hfvis_solar_input in = solar_in_ok();
+    hfvis_solar_output out;
+    memset(&out, 0, sizeof out);
+    out.global = AF(GW * GH);
+    o.max_distance = 3.0;
+    o.origin_x = 2;
+    o.extent_width = GW + 2;
+    o.extent_height = GH;
+    o.receiver_x = 1;
+    o.receiver_width = 2;
+    o.receiver_height = GH;
+    in.site = solar_site_fn;
+    so.sweep = &o;
+    so.directions = 8;
+    so.site_tolerance_rad = 1e-4; /* a block per cell */
+    so.height_min = -1.0;
+    so.height_max = 30.0;
+    return hfvis_solar_irradiation(&g_ok, &in, &so, &out);
+}
 SW(solar_map_directions)
 {
     hfvis_sweep_options o = sweep_opts(al);
@@ -6840,7 +6885,7 @@ static const sweep_entry sweeps[] = {
     SWEEP_VARIANT(env_light, env_light_exact),
     SWEEP(sun_visibility), SWEEP(env_light), SWEEP(env_light_from_map), SWEEP(intervisibility),
     SWEEP(visibility_count), SWEEP(visibility_count_naive), SWEEP(indirect_light),
-    SWEEP(indirect_light_naive), SWEEP(terrain_gi), SWEEP(direct_light), SWEEP(solar_irradiation), SWEEP(solar_map_directions), SWEEP(solar_irradiation_reference), SWEEP(ns_gi),
+    SWEEP(indirect_light_naive), SWEEP(terrain_gi), SWEEP(direct_light), SWEEP(solar_irradiation), SWEEP_VARIANT(solar_irradiation, solar_irradiation_window), SWEEP(solar_map_directions), SWEEP(solar_irradiation_reference), SWEEP(ns_gi),
     SWEEP(direction_sums), SWEEP(partial_decode), SWEEP(partial_load),
     SWEEP(lsao_direction), SWEEP(lsao_direction_naive), SWEEP(lsao), SWEEP(hbao), SWEEP(ssao_reference),
     SWEEP(ffao_table_build), SWEEP(ffao), SWEEP(ssao_mipmap),

@@ -77,6 +77,8 @@ typedef struct cli_window {
     int x0, y0, w, h;           /* the window, clipped to the raster */
     int gx0, gy0, gw, gh;       /* the grid loaded: window + halo, clipped */
     int ext_w, ext_h;           /* the raster */
+    int has_gt;                 /* the raster's own georeference (before the piece's shift): */
+    double raster_gt[6];        /* solar places every raster cell by it */
     char in_id[64], crs[64], gt[160], nodata[80];
     char tag[CLI_PIECE_TAG_MAX];
 } cli_window;

@@ -208,10 +208,11 @@ static const cli_flag cli_flags[] = {
       "                    WhiteboxTools max_dist); 0 = unlimited (default). visibility and\n"
       "                    indirect: visible samples farther than R are not counted or gathered.\n"
       "                    viewshed: its range\n" },
-    { "--window", "X0,Y0,W,H", CLI_SWEEP | CLI_ONLY(CMD_OPENNESS),
+    { "--window", "X0,Y0,W,H", CLI_SWEEP | CLI_ONLY(CMD_OPENNESS) | CLI_ONLY(CMD_SOLAR),
       CLI_TYPED(CLI_V_LIST),
-      "with a finite R (openness: --radius R; not visibility, indirect): only\n"
-      "                    the W x H cells from\n"
+      "with a finite R (openness: --radius R; not visibility, indirect; solar:\n"
+      "                    each output a piece, IN's height range read by strips): only the\n"
+      "                    W x H cells from\n"
       "                    column X0, row Y0 (clipped to IN), reading only them and a halo of\n"
       "                    ceil(R/cell) + 1 cells (GeoTIFF strips/tiles, .bil/.flt, PFM and binary\n"
       "                    PGM rows, by seeking); OUT (.pfm .tif .bil .flt .asc) is a piece, placed\n"
@@ -915,9 +916,9 @@ static int cli_check_window(const cli_args *a)
         return cli_error(CLI_EXIT_USAGE, "--border clamp", "a sweep's clamped lines start outside the "
                          "whole raster, which a window's lines do not: not with --window (run whole, "
                          "or --border open; openness --radius windows take clamp)");
-    if (a->albedo_map || a->emission)
+    if (a->albedo_map || a->emission || a->sol_linke_map)
         return cli_error(CLI_EXIT_USAGE, "--window", "cannot be combined with %s (a map of the whole "
-                         "raster)", a->albedo_map ? "--albedo-map" : "--emission");
+                         "raster)", a->albedo_map ? "--albedo-map" : a->emission ? "--emission" : "--linke-map");
     return 0;
 }
 

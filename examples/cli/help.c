@@ -51,7 +51,7 @@
     "         --albedo-map A.pfm] -o GLOBAL [--beam B] [--diffuse D] [--reflected R]\n"             \
     "         [--sun-hours H] [--latitude DEG --longitude DEG] [--utc-offset H | --solar-time]\n"    \
     "         [--bands day|month] [--normals central|horn] [--sun-radius DEG] [--dirs K]\n"     \
-    "         [--max-distance R] [--horizons exact|near-far|lattice]\n"                          \
+    "         [--max-distance R [--window X0,Y0,W,H]] [--horizons exact|near-far|lattice]\n"     \
     "Clear-sky solar irradiation (Wh/m^2) of a day or a date range, or irradiance (W/m^2) at\n"     \
     "--time, on every cell: r.sun's ESRA atmosphere (Suri & Hofierka 2004), the sun from NREL's\n"  \
     "SPA (Reda & Andreas 2004/2008), the beam shaded by exact horizons (docs/solar.md).\n"          \
@@ -79,6 +79,11 @@
     "                    cells, a shared far field beyond: about 0.6x the map's time) or lattice\n" \
     "                    ([P1] lattice horizons: about 4x faster, misses shadow next to one-cell\n"  \
     "                    walls and cliffs; docs/solar.md \"Horizon modes\")\n"                     \
+    "  --max-distance R  the horizons' search radius; the pressure nodes then span IN's whole\n"  \
+    "                    height range (read by strips), so that --window X0,Y0,W,H pieces (each\n" \
+    "                    output its own, with the per-cell sites and suns of the whole raster)\n"  \
+    "                    join with 'hfvis mosaic' into the whole run's rasters bit for bit\n"      \
+    "                    (docs/tiles.md; not with --linke-map or --albedo-map)\n"                  \
     "Polar night gives 0. With --progress the site's latitude and longitude go to stderr.\n"
 
 #define CLI_VF_HELP                                                                                  \

@@ -230,14 +230,102 @@ static int cli_solar_tm(const ex_georef *g, cli_tm *t)
     return 0;
 }
 
+/* Per-cell sites (hfvis_solar_input.site): raster cell (x, y)'s centre placed by the raster's
+ * own georeference (a piece's is shifted to its window: not that one, whose sums round
+ * otherwise) and inverse-projected; the grid's cells cached, the others (the library's blocks
+ * and their frames are cut from the whole raster) computed when asked, by the same function. */
+typedef struct cli_solar_sites {
+    cli_tm tm;
+    double gt[6];
+    int gx0, gy0, gw, gh;  /* the grid's cells within the raster */
+    double *lat, *lon;     /* the grid's sites, radians */
+} cli_solar_sites;
+
+/* Raster cell (x, y)'s site in degrees, the longitude in [-180, 180]; 0 where it maps nowhere. */
+static int cli_solar_site_deg(const cli_solar_sites *s, int x, int y, double *la, double *lo)
+{
+    double px = (double)x + 0.5, py = (double)y + 0.5;
+    cli_tm_inverse(&s->tm, s->gt[0] + s->gt[1] * px + s->gt[2] * py, s->gt[3] + s->gt[4] * px + s->gt[5] * py,
+                   la, lo);
+    if (!(fabs(*la) <= 90.0) || !(fabs(*lo) <= 540.0)) return 0;
+    while (*lo > 180.0) *lo -= 360.0;
+    while (*lo < -180.0) *lo += 360.0;
+    return 1;
+}
+
+/* The library's site function: radians; NaN where the cell maps nowhere (the library refuses). */
+static void cli_solar_site(void *user, int x, int y, double *lat, double *lon)
+{
+    const cli_solar_sites *s = (const cli_solar_sites *)user;
+    double la, lo;
+    if (x >= s->gx0 && x < s->gx0 + s->gw && y >= s->gy0 && y < s->gy0 + s->gh) {
+        size_t i = (size_t)(y - s->gy0) * (size_t)s->gw + (size_t)(x - s->gx0);
+        *lat = s->lat[i];
+        *lon = s->lon[i];
+        return;
+    }
+    if (!cli_solar_site_deg(s, x, y, &la, &lo)) {
+        *lat = *lon = (double)NAN;
+        return;
+    }
+    *lat = la * (CLI_PI / 180.0);
+    *lon = lo * (CLI_PI / 180.0);
+}
+
+/* With --max-distance (whole runs and windows alike): the whole raster's lowest and highest
+ * finite heights as cli_load_heights makes them (--band, --nodata, --zscale), read a strip of
+ * rows at a time, for the pressure nodes (hfvis_solar_options.height_min/max) that a window's
+ * grid must share with the whole run. 0, 0 when there is none. */
+static int cli_solar_height_range(const cli_args *a, double *lo, double *hi)
+{
+    ex_rio_reader r;
+    float *strip, nodata = (float)a->nodata, zscale = (float)a->zscale, zmin = HUGE_VALF, zmax = -HUGE_VALF;
+    int y, rows, rc = 0;
+    *lo = *hi = 0.0;
+    if ((ex_rio_format_of(a->in) ? ex_rio_open(&r, a->in) : ex_rio_open_netpbm(&r, a->in)) != 0) {
+        rc = cli_error(CLI_EXIT_ERROR, a->in, "%s", r.err);
+        ex_rio_close(&r);
+        return rc;
+    }
+    rows = r.width < 65536 ? 65536 / r.width : 1;
+    if (!(strip = cli_alloc((size_t)r.width, (size_t)rows, 1))) {
+        ex_rio_close(&r);
+        return cli_status(a->in, HFVIS_ERR_OUT_OF_MEMORY, 0);
+    }
+    r.nodata_to_nan = 1;
+    for (y = 0; y < r.height && rc == 0; y += rows) {
+        int n = r.height - y < rows ? r.height - y : rows, i;
+        if (ex_rio_read(&r, a->band ? a->band - 1 : 0, 0, y, r.width, n, strip, r.width) != 0) {
+            rc = cli_error(CLI_EXIT_ERROR, a->in, "%s", r.err);
+            break;
+        }
+        for (i = 0; i < n * r.width; i++) {
+            float v = strip[i], z;
+            if ((a->has_nodata && v == nodata) || !isfinite(v)) continue; /* holes */
+            z = v * zscale;
+            if (!isfinite(z)) continue; /* the load refuses it where it is read */
+            if (z < zmin) zmin = z;
+            if (z > zmax) zmax = z;
+        }
+    }
+    free(strip);
+    ex_rio_close(&r);
+    if (rc == 0 && zmin <= zmax) {
+        *lo = (double)zmin;
+        *hi = (double)zmax;
+    }
+    return rc;
+}
+
 /* --threads N: the time integration by bands of rows (hfvis_solar_options.row_begin/end), one
- * per thread, each writing its own rows of the outputs, bit for bit the one-thread run's. */
+ * per thread, each writing its own rows of the outputs, bit for bit the one-thread run's; a
+ * window's bands cut its own rows (the receiver rectangle's). */
 typedef struct cli_solar_split {
     const hfvis_grid *grid;
     const hfvis_solar_input *in;
     const hfvis_solar_options *so;
     const hfvis_solar_output *out;
-    int parts;
+    int parts, row0, rows;
 } cli_solar_split;
 
 static hfvis_status cli_solar_unit(cli_split *sp, int u, int thread, hfvis_sweep_options *o)
@@ -246,8 +334,8 @@ static hfvis_status cli_solar_unit(cli_split *sp, int u, int thread, hfvis_sweep
     hfvis_solar_options so = *j->so;
     (void)thread;
     so.sweep = o;
-    so.row_begin = (int)((long long)j->grid->height * u / j->parts);
-    so.row_end = (int)((long long)j->grid->height * (u + 1) / j->parts);
+    so.row_begin = j->row0 + (int)((long long)j->rows * u / j->parts);
+    so.row_end = j->row0 + (int)((long long)j->rows * (u + 1) / j->parts);
     if (so.row_begin >= so.row_end) return HFVIS_OK;
     return hfvis_solar_irradiation(j->grid, j->in, &so, j->out);
 }
@@ -258,14 +346,17 @@ static hfvis_status cli_threaded_solar(const hfvis_grid *grid, const hfvis_solar
 {
     cli_solar_split j;
     cli_split sp;
-    if (threads <= 1 || grid->height < 2 || so->reflected == HFVIS_SOLAR_REFLECTED_TERRAIN)
+    const hfvis_sweep_options *o = so->sweep;
+    j.row0 = o && o->receiver_height ? o->receiver_y : 0;
+    j.rows = o && o->receiver_height ? o->receiver_height : grid->height;
+    if (threads <= 1 || j.rows < 2 || so->reflected == HFVIS_SOLAR_REFLECTED_TERRAIN)
         return hfvis_solar_irradiation(grid, in, so, out);
     memset(&sp, 0, sizeof sp);
     j.grid = grid;
     j.in = in;
     j.so = so;
     j.out = out;
-    j.parts = threads < grid->height ? threads : grid->height;
+    j.parts = threads < j.rows ? threads : j.rows;
     sp.units = j.parts;
     sp.threads = j.parts;
     sp.unit = cli_solar_unit;
@@ -282,48 +373,51 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     hfvis_solar_options so = hfvis_solar_options_default();
     hfvis_solar_output out;
     float *planes[5] = { NULL, NULL, NULL, NULL, NULL }, *albedo = NULL, *linke = NULL, monthly[12];
-    double *lats = NULL, *lons = NULL;
     float *hmap = NULL;
     unsigned char *need = NULL;
     const char *paths[5];
-    cli_tm tm;
+    char tag[CLI_PIECE_TAG_MAX];
+    cli_solar_sites sites;
     hfvis_status s;
-    int rc = 0, bands, k, ch;
+    int rc = 0, bands, k, ch, piece = a->run->win.active;
     double lat = a->sol_lat, lon = a->sol_lon;
+    memset(&sites, 0, sizeof sites);
     if (!a->sol_has_lat) { /* every cell's site by the inverse projection of its centre */
-        double gt[6];
         size_t i, n = (size_t)w * (size_t)h;
-        if (!a->run->geo.has_transform || !cli_solar_tm(&a->run->geo, &tm))
+        if (!a->run->geo.has_transform || !cli_solar_tm(&a->run->geo, &sites.tm))
             return cli_error(CLI_EXIT_ERROR, "solar", "the latitude is unknown: IN has no Transverse "
                              "Mercator CRS (UTM, EPSG 326zz/327zz/258zz, or a WKT); give --latitude "
                              "and --longitude");
-        lats = (double *)(void *)cli_alloc(n, 2, sizeof(double) / sizeof(float)); /* 2n doubles */
-        if (!lats) return cli_status("solar", HFVIS_ERR_OUT_OF_MEMORY, 0);
-        lons = lats + n;
-        cli_georef(a, grid->cell_size, gt);
+        sites.lat = (double *)(void *)cli_alloc(n, 2, sizeof(double) / sizeof(float)); /* 2n doubles */
+        if (!sites.lat) return cli_status("solar", HFVIS_ERR_OUT_OF_MEMORY, 0);
+        sites.lon = sites.lat + n;
+        if (piece && !a->has_geotransform && a->run->win.has_gt) /* the raster's, not the piece's */
+            memcpy(sites.gt, a->run->win.raster_gt, sizeof sites.gt);
+        else
+            cli_georef(a, grid->cell_size, sites.gt);
+        sites.gx0 = piece ? a->run->win.gx0 : 0, sites.gy0 = piece ? a->run->win.gy0 : 0;
+        sites.gw = w, sites.gh = h;
         for (i = 0; i < n; i++) {
-            double px = (double)(i % (size_t)w) + 0.5, py = (double)(i / (size_t)w) + 0.5, la, lo;
-            cli_tm_inverse(&tm, gt[0] + gt[1] * px + gt[2] * py, gt[3] + gt[4] * px + gt[5] * py, &la, &lo);
-            if (!(fabs(la) <= 90.0) || !(fabs(lo) <= 540.0)) {
-                free(lats);
+            int x = sites.gx0 + (int)(i % (size_t)w), y = sites.gy0 + (int)(i / (size_t)w);
+            double la, lo;
+            if (!cli_solar_site_deg(&sites, x, y, &la, &lo)) {
+                free(sites.lat);
                 return cli_error(CLI_EXIT_ERROR, "solar", "cell %d, %d does not map to a latitude and "
-                                 "longitude", (int)(i % (size_t)w), (int)(i / (size_t)w));
+                                 "longitude", x, y);
             }
-            while (lo > 180.0) lo -= 360.0;
-            while (lo < -180.0) lo += 360.0;
-            lats[i] = la * (CLI_PI / 180.0);
-            lons[i] = lo * (CLI_PI / 180.0);
+            sites.lat[i] = la * (CLI_PI / 180.0);
+            sites.lon[i] = lo * (CLI_PI / 180.0);
         }
-        cli_tm_inverse(&tm, gt[0] + gt[1] * (w / 2.0) + gt[2] * (h / 2.0),
-                       gt[3] + gt[4] * (w / 2.0) + gt[5] * (h / 2.0), &lat, &lon);
+        cli_tm_inverse(&sites.tm, sites.gt[0] + sites.gt[1] * (sites.gx0 + w / 2.0) + sites.gt[2] * (sites.gy0 + h / 2.0),
+                       sites.gt[3] + sites.gt[4] * (sites.gx0 + w / 2.0) + sites.gt[5] * (sites.gy0 + h / 2.0), &lat, &lon);
         while (lon > 180.0) lon -= 360.0; /* the centre's (every cell's mapped above) */
         while (lon < -180.0) lon += 360.0;
-        in.latitude_map = lats;
-        in.longitude_map = lons;
+        in.site = cli_solar_site;
+        in.site_user = &sites;
     }
     if (a->progress_lines && !a->quiet)
         fprintf(stderr, "hfvis solar: site %.5f, %.5f (latitude, longitude of the grid's centre%s)\n", lat, lon,
-                lats ? "; each cell's own by the inverse projection" : "");
+                sites.lat ? "; each cell's own by the inverse projection" : "");
     in.latitude_rad = lat * (CLI_PI / 180.0);
     in.longitude_rad = lon * (CLI_PI / 180.0);
     in.year = a->sol_y;
@@ -343,6 +437,7 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     so.horizons = (hfvis_solar_horizons)a->sol_horizons;
     so.normals = (hfvis_solar_normals)a->sol_normals;
     so.sweep = opts;
+    if (a->max_distance > 0.0 && (rc = cli_solar_height_range(a, &so.height_min, &so.height_max)) != 0) goto done;
     if (a->sol_has_linke_monthly) {
         for (k = 0; k < 12; k++) monthly[k] = (float)a->sol_linke_monthly[k];
         so.linke_monthly = monthly;
@@ -396,19 +491,24 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
         goto done;
     }
     if (s != HFVIS_OK) { rc = cli_status("solar", s, 0); goto done; }
+    memcpy(tag, a->run->win.tag, sizeof tag);
     for (k = 0; k < 5 && rc == 0; k++) {
+        static const char *const kind[5] = { "beam", "diffuse", "reflected", "global", "sun-hours" };
         cli_args b = *a;
         if (!paths[k]) continue;
         b.out = paths[k];
         b.out_pgm = 0;
         b.out_raster = ex_rio_format_of(paths[k]) != 0;
+        a->run->win.active = piece; /* each output a piece (cli_save_piece clears it) */
+        snprintf(a->run->win.tag, sizeof a->run->win.tag, "%.*s solar-output=%s",
+                 (int)(sizeof tag - 32), tag, kind[k]); /* pieces of one output only */
         rc = cli_save(&b, cli_output_of(planes[k], w, h, bands, 1, 0.0, 1.0));
     }
 done:
     for (k = 0; k < 5; k++) free(planes[k]);
     hfvis_free(NULL, albedo);
     hfvis_free(NULL, linke);
-    free(lats);
+    free(sites.lat);
     free(hmap);
     free(need);
     return rc;

@@ -65,6 +65,8 @@ static int cli_window_plan(const cli_args *a, ex_rio_reader *r, const char *path
     if (g->geoascii) crs = hfvis_crc32(crs, g->geoascii, g->n_geoascii);
     if (g->prj) crs = hfvis_crc32(crs, g->prj, strlen(g->prj));
     snprintf(v->crs, sizeof v->crs, "%d:%d:%08lx", g->crs, g->epsg, (unsigned long)crs);
+    v->has_gt = g->has_transform;
+    memcpy(v->raster_gt, g->gt, sizeof v->raster_gt);
     if (g->has_transform)
         snprintf(v->gt, sizeof v->gt, "%a,%a,%a,%a,%a,%a", g->gt[0], g->gt[1], g->gt[2], g->gt[3],
                  g->gt[4], g->gt[5]);
@@ -90,14 +92,28 @@ static void cli_piece_tag(const cli_args *a, const hfvis_grid *grid, const hfvis
              "cmd=%s crs=%s cell=%a extent=%dx%d in=%s gt=%s band=%d nodata=%s set-nodata=%s zscale=%a "
              "max-distance=%a dirs=%d border=%d border-cells=%d azimuth0=%a rays=%s convention=%d "
              "degrees=%d svf=%d sky=%a albedo=%a sun=%a,%a,%a,%a,%d blend=%d no-shadows=%d radius=%a "
-             "negative=%d fraction=%d method=%d bounces=%d output=%d env=%s",
+             "negative=%d fraction=%d method=%d bounces=%d output=%d env=%s "
+             "solar=%d-%d-%d,%d-%d-%d,%d,%d,%a,%a,%d,%a,%d,%a,%d,%a,%a,%d,%d,%d,%d,%d,%a,%d,%d,%s",
              cli_commands[a->cmd].name, win->crs, grid->cell_size, win->ext_w, win->ext_h,
              win->in_id, win->gt, a->band ? a->band : 1, win->nodata, nodata_flag, a->zscale,
              o->max_distance, a->dirs, (int)o->border, o->border_cells, o->azimuth0_rad,
              o->rays == HFVIS_RAYS_EXACT ? "exact" : "lattice", a->convention, a->degrees, a->svf,
              a->sky, a->albedo, a->sun_azimuth, a->sun_elevation, a->sun_radius, a->sun_irradiance,
              a->has_sun_azimuth, a->blend, a->no_shadows, a->radius, a->negative, a->fraction,
-             a->method, a->bounces, a->output, env_id);
+             a->method, a->bounces, a->output, env_id, a->sol_y, a->sol_m, a->sol_d,
+             a->sol_has_end ? a->sol_ey : 0, a->sol_has_end ? a->sol_em : 0, a->sol_has_end ? a->sol_ed : 0,
+             a->sol_instant, a->sol_solar_time, a->sol_hour, a->sol_step, a->sol_has_lat, a->sol_lat,
+             a->sol_has_lon, a->sol_lon, a->sol_has_offset, a->sol_offset, a->sol_linke,
+             a->sol_has_linke_monthly, a->sol_bands, a->sol_horizons, a->sol_normals, a->has_dirs,
+             a->sun_radius, a->has_sun_radius, a->has_albedo, a->sol_linke_map ? "map" : "none");
+    if (a->sol_has_linke_monthly) {
+        int k;
+        for (k = 0; k < 12; k++) {
+            size_t len = strlen(win->tag);
+            snprintf(win->tag + len, sizeof win->tag - len, "%s%a", k ? "," : " linke-monthly=",
+                     a->sol_linke_monthly[k]);
+        }
+    }
 }
 
 /* Commands whose default PGM range tops at the largest output value (mosaic recomputes it). */
