@@ -140,6 +140,7 @@ typedef struct {
      * + col * col_bytes */
     uint64_t skip, row_bytes, band_bytes, col_bytes;
     int rows_up;             /* raw rows stored bottom to top (PFM): file row = height - 1 - row */
+    double maxval;           /* a PGM's largest sample value (ex_rio_read gives 0..maxval); 0 else */
     /* ASC: the whole grid, as parsed (NoData is matched at read time) */
     double *grid;
     /* decoding buffers and the chunk decoded last */
@@ -1532,6 +1533,7 @@ static inline int ex_rio_netpbm_parse(ex_rio_reader *r, const unsigned char *hea
     r->bits = pfm ? 32 : v[2] < 256.0 ? 8 : 16;
     r->big_endian = pfm ? v[2] > 0.0 : 1;
     r->rows_up = pfm;
+    r->maxval = pfm ? 0.0 : v[2];
     r->skip = (uint64_t)i + 1;
     r->band_bytes = (uint64_t)(r->bits / 8);
     r->col_bytes = r->band_bytes * (uint64_t)r->bands;

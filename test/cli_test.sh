@@ -1385,8 +1385,15 @@ solar_tiles "per-cell sites, an instant" --day 2026-06-21 --time 09:30 --threads
 "$hfvis" mosaic "$dir"/stp_g_0_0_20_13.tif "$dir"/stp_b_20_0_17_13.tif "$dir"/stp_b_0_13_37_1.tif "$dir"/stp_b_0_14_11_15.tif "$dir"/stp_b_11_14_26_15.tif -o "$fdir/x.tif" > /dev/null 2> "$dir/stderr" &&
   bad "solar tiles: mosaic joined a global piece with beam pieces" || { grep -q 'solar-output' "$dir/stderr" &&
   ok "solar tiles: mosaic refuses a global piece among beam pieces: $(cat "$dir/stderr")" || bad "solar tiles: mixed outputs: $(cat "$dir/stderr")"; }
-expect_fail "solar --window with --linke-map" 2 solar "$dir/swin.asc" --day 2026-06-21 --max-distance 2000 --window 0,0,5,5 --linke-map "$dir/swin.asc" -o "$fdir/x.tif"
-expect_fail "solar --window with --albedo-map" 2 solar "$dir/swin.asc" --day 2026-06-21 --max-distance 2000 --window 0,0,5,5 --albedo-map "$dir/swin.asc" -o "$fdir/x.tif"
+# per-cell maps of the raster's size (a 16-bit PGM Linke map, values (0, 1], and a PFM albedo
+# map): each window reads its cells of them; pieces made with another map do not join
+expect_ok "solar tiles: a Linke map (PGM)" "$dir/slk.pgm" skyview "$dir/swin.asc" --dirs 8 -o "$dir/slk.pgm"
+expect_ok "solar tiles: an albedo map (PFM)" "$dir/salb.pfm" skyview "$dir/swin.asc" --dirs 8 -o "$dir/salb.pfm"
+expect_ok "solar tiles: another albedo map (PFM)" "$dir/salb2.pfm" skyview "$dir/swin.asc" --dirs 16 -o "$dir/salb2.pfm"
+solar_tiles "per-cell sites, a day, --linke-map and --albedo-map" --day 2026-06-21 --threads 2 --linke-map "$dir/slk.pgm" --albedo-map "$dir/salb.pfm"
+expect_ok "solar tiles: a piece with another albedo map" "$dir/stp_g_0_0_20_13.tif" solar "$dir/swin.asc" --day 2026-06-21 --threads 2 --linke-map "$dir/slk.pgm" --albedo-map "$dir/salb2.pfm" --max-distance 2000 --window 0,0,20,13 -o "$dir/stp_g_0_0_20_13.tif"
+expect_fail "solar tiles: mosaic refuses a piece made with another albedo map" 1 mosaic "$dir"/stp_g_*.tif -o "$fdir/x.tif"
+expect_fail "solar --window with a Linke map of another size" 1 solar "$dir/swin.asc" --day 2026-06-21 --max-distance 2000 --window 0,0,5,5 --linke-map "$dir/flat.pgm" -o "$fdir/x.tif"
 expect_fail "solar: bad --step" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --step 25h -o "$fdir/x.pfm"
 expect_fail "solar: bad --linke-monthly" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --linke-monthly 3,3 -o "$fdir/x.pfm"
 

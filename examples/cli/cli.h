@@ -405,7 +405,8 @@ static int cli_run_heights(const cli_args *a);
 static int cli_check_light_flags(const cli_args *a);
 static int cli_check_gi(const cli_args *a);
 static int cli_load_env(const char *path, float **px, hfvis_env *env);
-static int cli_load_map(const char *path, const hfvis_grid *grid, float **px, int *channels);
+static int cli_load_map(const char *path, const cli_window *win, const hfvis_grid *grid, float **px,
+                        int *channels);
 static int cli_widen(float **px, size_t n, int channels);
 static double cli_top(const float *px, size_t n, double fallback);
 static int cli_check_radiance(const char *cmd, const hfvis_grid *grid, const float *out, int channels);

@@ -916,9 +916,6 @@ static int cli_check_window(const cli_args *a)
         return cli_error(CLI_EXIT_USAGE, "--border clamp", "a sweep's clamped lines start outside the "
                          "whole raster, which a window's lines do not: not with --window (run whole, "
                          "or --border open; openness --radius windows take clamp)");
-    if (a->albedo_map || a->emission || a->sol_linke_map)
-        return cli_error(CLI_EXIT_USAGE, "--window", "cannot be combined with %s (a map of the whole "
-                         "raster)", a->albedo_map ? "--albedo-map" : a->emission ? "--emission" : "--linke-map");
     return 0;
 }
 

@@ -83,7 +83,7 @@
     "                    height range (read by strips), so that --window X0,Y0,W,H pieces (each\n" \
     "                    output its own, with the per-cell sites and suns of the whole raster)\n"  \
     "                    join with 'hfvis mosaic' into the whole run's rasters bit for bit\n"      \
-    "                    (docs/tiles.md; not with --linke-map or --albedo-map)\n"                  \
+    "                    (docs/tiles.md; a window reads its cells of the maps)\n"                 \
     "Polar night gives 0. With --progress the site's latitude and longitude go to stderr.\n"
 
 #define CLI_VF_HELP                                                                                  \

@@ -31,8 +31,8 @@ static int cli_run_indirect(const cli_args *a, const hfvis_grid *grid, hfvis_swe
         if ((rc = cli_load_env(a->env, &env_px, &env)) != 0) goto done;
         env_ch = env.channels;
     }
-    if (a->albedo_map && (rc = cli_load_map(a->albedo_map, grid, &albedo, &albedo_ch)) != 0) goto done;
-    if (a->emission && (rc = cli_load_map(a->emission, grid, &emit, &emit_ch)) != 0) goto done;
+    if (a->albedo_map && (rc = cli_load_map(a->albedo_map, &a->run->win, grid, &albedo, &albedo_ch)) != 0) goto done;
+    if (a->emission && (rc = cli_load_map(a->emission, &a->run->win, grid, &emit, &emit_ch)) != 0) goto done;
     /* Output channels: the most of any input; one-channel inputs apply to every channel. */
     channels = env_ch > albedo_ch ? env_ch : albedo_ch;
     if (emit_ch > channels) channels = emit_ch;

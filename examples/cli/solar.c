@@ -443,10 +443,10 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
         so.linke_monthly = monthly;
     }
     if (a->albedo_map) {
-        if ((rc = cli_load_map(a->albedo_map, grid, &albedo, &ch)) != 0) goto done;
+        if ((rc = cli_load_map(a->albedo_map, &a->run->win, grid, &albedo, &ch)) != 0) goto done;
         so.albedo_map = albedo;
     }
-    if (a->sol_linke_map && (rc = cli_load_map(a->sol_linke_map, grid, &linke, &ch)) != 0) goto done;
+    if (a->sol_linke_map && (rc = cli_load_map(a->sol_linke_map, &a->run->win, grid, &linke, &ch)) != 0) goto done;
     so.linke_map = linke;
     bands = hfvis_solar_band_count(&in, &so);
     if (bands < 1) {

@@ -57,34 +57,83 @@ static int cli_load_env(const char *path, float **px, hfvis_env *env)
     return 0;
 }
 
-/* Load a per-sample map of the height field's size (indirect --albedo-map, --emission): PGM
- * values divided by the file's maxval, PFM values as stored; every value finite and >= 0
- * wherever the height field has no hole. */
-static int cli_load_map(const char *path, const hfvis_grid *grid, float **px, int *channels)
+/* A --window run's share of a map of the whole raster's size: the cells of the grid (the
+ * window and its halo) read by rows from the PFM or PGM, each channel's samples interleaved as
+ * hfvis_image_load gives them, PGM samples still 0..maxval (*maxval set, 0 for a PFM). */
+static int cli_load_map_window(const char *path, const cli_window *win, float **px, int *channels,
+                               double *maxval)
+{
+    ex_rio_reader r;
+    float *m = NULL, *plane = NULL;
+    size_t i, n = (size_t)win->gw * (size_t)win->gh;
+    int b, rc = 0;
+    if (ex_rio_open_netpbm(&r, path) != 0) return cli_error(CLI_EXIT_ERROR, path, "%s", r.err);
+    if (r.width != win->ext_w || r.height != win->ext_h) {
+        rc = cli_error(CLI_EXIT_ERROR, path, "%d x %d samples, but IN has %d x %d", r.width, r.height,
+                       win->ext_w, win->ext_h);
+    } else if (!(m = (float *)malloc(n * (size_t)r.bands * sizeof(float))) ||
+               (r.bands > 1 && !(plane = (float *)malloc(n * sizeof(float))))) {
+        rc = cli_status(path, HFVIS_ERR_OUT_OF_MEMORY, 0);
+    }
+    for (b = 0; rc == 0 && b < r.bands; b++) {
+        float *dst = r.bands > 1 ? plane : m;
+        if (ex_rio_read(&r, b, win->gx0, win->gy0, win->gw, win->gh, dst, win->gw) != 0) {
+            rc = cli_error(CLI_EXIT_ERROR, path, "%s", r.err);
+            break;
+        }
+        if (r.bands > 1)
+            for (i = 0; i < n; i++) m[i * (size_t)r.bands + (size_t)b] = plane[i];
+    }
+    *channels = r.bands;
+    *maxval = r.maxval;
+    ex_rio_close(&r);
+    free(plane);
+    if (rc != 0) {
+        free(m);
+        return rc;
+    }
+    *px = m;
+    return 0;
+}
+
+/* Load a per-sample map of the height field's size (indirect --albedo-map, --emission, solar
+ * --linke-map and --albedo-map; in a --window run the raster's size, of which the grid's cells
+ * are read): PGM values divided by the file's maxval, PFM values as stored; every value finite
+ * and >= 0 wherever the height field has no hole. */
+static int cli_load_map(const char *path, const cli_window *win, const hfvis_grid *grid, float **px,
+                        int *channels)
 {
     hfvis_image_info info;
     float *m = NULL;
     size_t i, n = (size_t)grid->width * (size_t)grid->height;
     int c;
+    double maxval = 0.0;
     hfvis_status s;
-    errno = 0;
-    s = hfvis_image_load(path, NULL, &m, &info);
-    if (s != HFVIS_OK) return cli_status(path, s, errno);
-    if (info.width != grid->width || info.height != grid->height) {
-        hfvis_free(NULL, m);
-        return cli_error(CLI_EXIT_ERROR, path, "%d x %d samples, but IN has %d x %d", info.width,
-                         info.height, grid->width, grid->height);
+    if (win && win->active) {
+        int rc = cli_load_map_window(path, win, &m, &info.channels, &maxval);
+        if (rc != 0) return rc;
+    } else {
+        errno = 0;
+        s = hfvis_image_load(path, NULL, &m, &info);
+        if (s != HFVIS_OK) return cli_status(path, s, errno);
+        if (info.width != grid->width || info.height != grid->height) {
+            hfvis_free(NULL, m);
+            return cli_error(CLI_EXIT_ERROR, path, "%d x %d samples, but IN has %d x %d", info.width,
+                             info.height, grid->width, grid->height);
+        }
+        if (info.format == HFVIS_FORMAT_PGM) maxval = (double)info.maxval;
     }
     for (i = 0; i < n; i++)
         for (c = 0; c < info.channels; c++) {
             float *v = m + i * (size_t)info.channels + (size_t)c;
-            if (info.format == HFVIS_FORMAT_PGM) *v = (float)((double)*v / (double)info.maxval);
+            if (maxval > 0.0) *v = (float)((double)*v / maxval);
             if (isfinite(grid->z[i]) && !(isfinite(*v) && *v >= 0.0f)) {
                 double bad = (double)*v;
+                int ox = win && win->active ? win->gx0 : 0, oy = win && win->active ? win->gy0 : 0;
                 hfvis_free(NULL, m);
                 return cli_error(CLI_EXIT_ERROR, path, "value %g at column %d, row %d is not a "
-                                 "finite number >= 0", bad, (int)(i % (size_t)grid->width),
-                                 (int)(i / (size_t)grid->width));
+                                 "finite number >= 0", bad, ox + (int)(i % (size_t)grid->width),
+                                 oy + (int)(i / (size_t)grid->width));
             }
         }
     *px = m;

@@ -114,6 +114,16 @@ static void cli_piece_tag(const cli_args *a, const hfvis_grid *grid, const hfvis
                      a->sol_linke_monthly[k]);
         }
     }
+    { /* the per-cell maps a window reads its share of: pieces of other maps do not join */
+        const char *maps[3] = { a->albedo_map, a->emission, a->sol_linke_map };
+        int k;
+        for (k = 0; k < 3; k++) {
+            char id[64] = "none";
+            size_t len = strlen(win->tag);
+            if (maps[k] && cli_file_id(maps[k], id, sizeof id) != 0) strcpy(id, "unreadable");
+            snprintf(win->tag + len, sizeof win->tag - len, "%s%s", k ? "," : " maps=", id);
+        }
+    }
 }
 
 /* Commands whose default PGM range tops at the largest output value (mosaic recomputes it). */
