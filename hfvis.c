@@ -9387,7 +9387,7 @@ static void hf_exact_near(hf_exact *E, hf_ray r, double L, double scale)
     const double inv_den = hf_exact_inv_den(g, a, b), ucut = (double)E->win_rw / 16.0;
     const double Ad = (double)(a < 0 ? -a : a), Bd = (double)(b < 0 ? -b : b);
     const int diag = a != 0 && b != 0;
-    int x, y;
+    int x, y, part;
     for (y = E->ry0; y < E->ry1; y++) {
         double *t = E->tan + (size_t)y * (size_t)g->width;
         const float *z = g->z + (ptrdiff_t)y * g->stride;
@@ -9395,28 +9395,48 @@ static void hf_exact_near(hf_exact *E, hf_ray r, double L, double scale)
         const int cy = b < 0 ? y - 1 : y, sx = a < 0 ? -1 : 1;
         const ptrdiff_t sy = b < 0 ? -g->stride : g->stride;
         const int in_row = cy >= 0 && cy + 1 < g->height;
-        int x0, x1;
+        int x0, x1, xa, xb;
         hf_exact_span(E, y, r, &x0, &x1); /* this call's lines: the others' were not swept */
-        for (x = x0; x < x1; x++) {
-            double s;
-            if (isnan(t[x])) continue;
-            if (diag) {
-                int cx = a < 0 ? x - 1 : x;
-                if (in_row && cx >= 0 && cx + 1 < g->width) {
-                    /* finite s: finite zx and zy (|s| <= 2^128 4096 / den); then zd decides */
-                    double hr = (double)z[x], zx = (double)z[x + sx], zy = (double)z[x + sy];
-                    s = ((zx - hr) * Ad + (zy - hr) * Bd) * inv_den;
-                    if (!isfinite(s) || !isfinite(z[x + sx + sy])) s = -HFVIS__INF;
-                } else {
-                    s = hf_exact_first_slope(g, E->border, E->R, x, y, a, b, (double)z[x], inv_den);
-                }
-                if (s > t[x]) t[x] = s;
-            }
-            if (E->win_rw >= 0) {
-                s = hf_exact_cut(g, E->border, E->R, x, y, a, b, L, ucut, (double)z[x]) * scale;
-                if (s > t[x]) t[x] = s;
-            }
+        xa = xb = x1; /* receivers whose first cell is inside the grid, in pairs: [xa, xb) */
+        if (diag && in_row && E->win_rw < 0) {
+            xa = a < 0 && x0 < 1 ? 1 : x0;
+            xb = a > 0 && x1 > g->width - 1 ? g->width - 1 : x1;
+            xb = xb > xa ? xa + ((xb - xa) & ~1) : xa;
         }
+        /* there without a branch, two receivers a step (C99 the compiler can pack into vectors
+           at -O2): a NaN tangent (a hole) stays NaN, and a limit that is not finite (a tap not
+           finite, as below) is -INFINITY, which never wins */
+        for (x = xa; x < xb; x += 2) {
+            double h0 = (double)z[x], h1 = (double)z[x + 1], t0 = t[x], t1 = t[x + 1];
+            double s0 = (((double)z[x + sx] - h0) * Ad + ((double)z[x + sy] - h0) * Bd) * inv_den;
+            double s1 = (((double)z[x + 1 + sx] - h1) * Ad + ((double)z[x + 1 + sy] - h1) * Bd) * inv_den;
+            double d0 = (double)z[x + sx + sy], d1 = (double)z[x + 1 + sx + sy];
+            s0 = fabs(s0) <= DBL_MAX && fabs(d0) <= DBL_MAX ? s0 : -HFVIS__INF;
+            s1 = fabs(s1) <= DBL_MAX && fabs(d1) <= DBL_MAX ? s1 : -HFVIS__INF;
+            t[x] = s0 > t0 ? s0 : t0;
+            t[x + 1] = s1 > t1 ? s1 : t1;
+        }
+        for (part = 0; part < 2; part++) /* the rest, [x0, xa) and [xb, x1), one by one */
+            for (x = part ? xb : x0; x < (part ? x1 : xa); x++) {
+                double s;
+                if (isnan(t[x])) continue;
+                if (diag) {
+                    int cx = a < 0 ? x - 1 : x;
+                    if (in_row && cx >= 0 && cx + 1 < g->width) {
+                        /* finite s: finite zx and zy (|s| <= 2^128 4096 / den); then zd decides */
+                        double hr = (double)z[x], zx = (double)z[x + sx], zy = (double)z[x + sy];
+                        s = ((zx - hr) * Ad + (zy - hr) * Bd) * inv_den;
+                        if (!isfinite(s) || !isfinite(z[x + sx + sy])) s = -HFVIS__INF;
+                    } else {
+                        s = hf_exact_first_slope(g, E->border, E->R, x, y, a, b, (double)z[x], inv_den);
+                    }
+                    if (s > t[x]) t[x] = s;
+                }
+                if (E->win_rw >= 0) {
+                    s = hf_exact_cut(g, E->border, E->R, x, y, a, b, L, ucut, (double)z[x]) * scale;
+                    if (s > t[x]) t[x] = s;
+                }
+            }
     }
 }
 
