@@ -9168,20 +9168,22 @@ static inline int hf_exact_piece(const hfvis_grid *g, const hf_cross *c, const f
     const float *p = zn + c->coff;
     double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[g->stride];
     double z11 = (double)p[g->stride + 1], bulge = c->q * hf_cell_twist(p, g->stride);
-    int split = (bulge > lim) & (bulge < HFVIS__INF);
-    *splits += split;
-    if (bulge > 4.0 * lim && bulge < HFVIS__INF) { /* split into 4 or more (hf_piece_fill's m >= 4): rare */
-        double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
-        int j = hf_piece_fill(p, g->stride, c, bulge, lim, ph, pu);
-        while (j-- > 0) { /* far end first */
-            sd[n] = base - (c->u + pu[j]);
-            sh[n++] = ph[j];
+    if (eager || bulge > lim) { /* not eager: most pieces end at the one test (NaN at holes) */
+        int split = (bulge > lim) & (bulge < HFVIS__INF);
+        *splits += split;
+        if (bulge > 4.0 * lim && bulge < HFVIS__INF) { /* split into 4 or more (hf_piece_fill's m >= 4): rare */
+            double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
+            int j = hf_piece_fill(p, g->stride, c, bulge, lim, ph, pu);
+            while (j-- > 0) { /* far end first */
+                sd[n] = base - (c->u + pu[j]);
+                sh[n++] = ph[j];
+            }
+        } else { /* split in two (a kept one has four finite taps: a finite height), or eager */
+            double r0 = z00 + (z10 - z00) * c->mfx, r1 = z01 + (z11 - z01) * c->mfx;
+            sd[n] = base - c->mu;
+            sh[n] = r0 + (r1 - r0) * c->mfy;
+            n += split;
         }
-    } else if (eager || split) { /* split in two (a kept one has four finite taps: a finite height) */
-        double r0 = z00 + (z10 - z00) * c->mfx, r1 = z01 + (z11 - z01) * c->mfx;
-        sd[n] = base - c->mu;
-        sh[n] = r0 + (r1 - r0) * c->mfy;
-        n += split;
     }
     return n;
 }
