@@ -9208,9 +9208,16 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
     for (k = hf_exact_periods(g, E->R, hx, hy, a, b); k >= 0; k--) {
         int bx = hx + k * a, by = hy + k * b;
         for (e = P - 1; e >= 0; e--) {
-            int X = bx + cr[e].ox, Y = by + cr[e].oy;
+            int X = bx + cr[e].ox, Y = by + cr[e].oy, CX = bx + cr[e].cx, CY = by + cr[e].cy;
             double h;
-            j = hf_piece_samples(g, E->border, E->R, bx, by, cr + e, ph, pu);
+            j = 0;
+            if (CX >= 0 && CY >= 0 && CX + 1 < g->width && CY + 1 < g->height) {
+                /* a cell inside the grid: hf_piece_samples' bulge test on the taps in place */
+                double bulge = cr[e].q * hf_cell_twist(g->z + (ptrdiff_t)CY * g->stride + CX, g->stride);
+                if (bulge > lim) j = hf_piece_samples(g, E->border, E->R, bx, by, cr + e, ph, pu);
+            } else if (E->border != HFVIS_BORDER_OPEN) { /* OPEN: no cell outside the grid */
+                j = hf_piece_samples(g, E->border, E->R, bx, by, cr + e, ph, pu);
+            }
             while (j-- > 0) { /* the piece after crossing e, far end first */
                 if (isnan(ph[j])) continue;
                 sd[n] = -((double)k * L + (cr[e].u + pu[j]));
