@@ -8835,6 +8835,7 @@ typedef struct hf_cross {
     double f, u;
     ptrdiff_t zoff, zstep; /* its first tap from g in the grid's heights, and its second from that */
     ptrdiff_t coff;        /* the tap (0, 0) of its piece's cell from g in the grid's heights */
+    ptrdiff_t toff;        /* that cell from g in the twist plane (hf_exact.twist, row stride width) */
     double mfx, mfy, mu;   /* the piece's midpoint: cell coordinates, distance from g (sub-steps) */
     /* the piece from this crossing to the next (or to g + (a, b)): inside cell (cx, cy) (offsets
        from g), from (fx0, fy0) to (fx1, fy1) in cell coordinates, du sub-steps long */
@@ -8887,7 +8888,8 @@ typedef struct hf_exact {
     double *fmax;
     struct hf_near_off *noff; /* the near stencil (hf_near_offsets) */
     struct hf_far_line *flines; /* one far band's exact lines */
-    double *twist;          /* width*height: each cell's twist (hf_cell_twist) at its (x, y) */
+    double *twist;          /* width*height: each cell's twist (hf_cell_twist) at its (x, y), for
+                               the sweep's and the near field's bulge tests */
     double *row;            /* one row of near tangents */
     void *block;
     const hfvis_allocator *alloc;
@@ -9009,6 +9011,7 @@ static int hf_exact_geometry(hf_cross *cross, const hfvis_grid *g, int a, int b,
         c->zoff = (ptrdiff_t)c->oy * g->stride + c->ox;
         c->zstep = c->kind == 1 ? g->stride : 1;
         c->coff = (ptrdiff_t)c->cy * g->stride + c->cx;
+        c->toff = (ptrdiff_t)c->cy * g->width + c->cx;
         c->mfx = c->fx0 + 0.5 * (c->fx1 - c->fx0); /* hf_piece_fill's sample at t = 1/2, bit for bit */
         c->mfy = c->fy0 + 0.5 * (c->fy1 - c->fy0);
         c->mu = c->u + c->du * 0.5;
@@ -9160,15 +9163,17 @@ static int hf_exact_rect_span(const hf_exact *E, int hx, int hy, int a, int b, i
  * the grid, so its cell is inside too), zn at the nearer grid point's height, appended to
  * (sd, sh) from index n far end first at distances base - offset; returns the new count and
  * counts a split in *splits. hf_piece_samples' test and samples, bit for bit; the twist from the
- * four taps the midpoint reads. eager: the midpoint of a piece split in two (most splits) is
- * written for every piece and kept by the test's outcome, without a branch. */
-static inline int hf_exact_piece(const hfvis_grid *g, const hf_cross *c, const float *zn, double base,
-                                 double lim, double *sd, double *sh, int n, int eager, int *splits)
+ * plane of the cells' twists (hf_exact.twist; tn: the nearer grid point's cell there), so a piece
+ * that does not bulge costs a load and a compare and its taps are read only for its samples.
+ * eager: the midpoint of a piece split in two (most splits) is written for every piece and kept
+ * by the test's outcome, without a branch. */
+static inline int hf_exact_piece(const hfvis_grid *g, const hf_cross *c, const float *zn, const double *tn,
+                                 double base, double lim, double *sd, double *sh, int n, int eager, int *splits)
 {
-    const float *p = zn + c->coff;
-    double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[g->stride];
-    double z11 = (double)p[g->stride + 1], bulge = c->q * hf_cell_twist(p, g->stride);
+    const double bulge = c->q * tn[c->toff]; /* q hf_cell_twist, from the plane */
     if (eager || bulge > lim) { /* not eager: most pieces end at the one test (NaN at holes) */
+        const float *p = zn + c->coff;
+        double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[g->stride], z11 = (double)p[g->stride + 1];
         int split = (bulge > lim) & (bulge < HFVIS__INF);
         *splits += split;
         if (bulge > 4.0 * lim && bulge < HFVIS__INF) { /* split into 4 or more (hf_piece_fill's m >= 4): rare */
@@ -9201,6 +9206,8 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
     const hfvis_grid *g = E->g;
     const hf_cross *cr = E->cross;
     const ptrdiff_t z0 = (ptrdiff_t)hy * g->stride + hx, zstep = (ptrdiff_t)b * g->stride + a;
+    const ptrdiff_t tstep = (ptrdiff_t)b * g->width + a;
+    const double *tn = E->twist + ((ptrdiff_t)hy * g->width + hx); /* the twists at grid point q + 1 */
     const double lim = HF_EXACT_BULGE * g->cell_size;
     const int pieces = a != 0 && b != 0; /* along a grid line the surface is linear */
     double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
@@ -9240,18 +9247,19 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
         if (q == qn) break;
         /* between grid points q and q + 1, both inside the grid, so are the crossings and cells */
         zn = g->z + (zq - zstep);
+        tn -= tstep;
         base = (double)(q + 1) * L;
         if (!pieces) continue; /* an axis: grid point q + 1 is the next sample */
         for (e = P - 1; e > 0; e--) { /* the piece after crossing e, then crossing e */
             const hf_cross *c = cr + e;
-            n = hf_exact_piece(g, c, zn, base, lim, sd, sh, n, eager, &splits);
+            n = hf_exact_piece(g, c, zn, tn, base, lim, sd, sh, n, eager, &splits);
             h = (double)zn[c->zoff];
             h += ((double)zn[c->zoff + c->zstep] - h) * c->f; /* as hf_cross_height */
             sd[n] = base - c->u;
             sh[n] = h;
             n += isfinite(h) ? 1 : 0; /* a hole: overwritten by the next sample */
         }
-        n = hf_exact_piece(g, cr, zn, base, lim, sd, sh, n, eager, &splits); /* crossing 0: point q + 1 */
+        n = hf_exact_piece(g, cr, zn, tn, base, lim, sd, sh, n, eager, &splits); /* crossing 0: point q + 1 */
     }
     if (pieces && qn > 0) *eager_io = (double)splits > HF_EXACT_EAGER_SHARE * (double)qn * (double)P;
     return n;
@@ -9737,17 +9745,18 @@ static int hf_far_samples(hf_exact *E, int64_t px, int64_t py, int a, int b, int
         if (X0 >= 0 && X1 >= 0 && X0 < g->width && X1 < g->width && Y0 >= 0 && Y1 >= 0 &&
             Y0 < g->height && Y1 < g->height) {
             const float *zn = g->z + (ptrdiff_t)Y0 * g->stride + (ptrdiff_t)X0;
+            const double *tn = E->twist + ((ptrdiff_t)Y0 * g->width + (ptrdiff_t)X0);
             double h;
             for (e = P - 1; e > 0; e--) { /* as hf_exact_samples between two grid points */
                 const hf_cross *c = cr + e;
-                n = hf_exact_piece(g, c, zn, base, lim, sd, sh, n, eager, &splits);
+                n = hf_exact_piece(g, c, zn, tn, base, lim, sd, sh, n, eager, &splits);
                 h = (double)zn[c->zoff];
                 h += ((double)zn[c->zoff + c->zstep] - h) * c->f;
                 sd[n] = base - c->u;
                 sh[n] = h;
                 n += isfinite(h) ? 1 : 0;
             }
-            n = hf_exact_piece(g, cr, zn, base, lim, sd, sh, n, eager, &splits);
+            n = hf_exact_piece(g, cr, zn, tn, base, lim, sd, sh, n, eager, &splits);
             h = (double)zn[0];
             sd[n] = base;
             sh[n] = h;
@@ -10205,8 +10214,8 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
         off_no = hf_align_add(&total, 2u * (size_t)E->near + 2u * (size_t)maxp + 4u, sizeof(hf_near_off), &ok);
         off_row = hf_align_add(&total, (size_t)g->width, sizeof(double), &ok);
         off_fl = hf_align_add(&total, (size_t)maxp + 2u, sizeof(hf_far_line), &ok);
-        off_tw = hf_align_add(&total, gridn, sizeof(double), &ok);
     }
+    if (want_tan) off_tw = hf_align_add(&total, gridn, sizeof(double), &ok);
     if (!ok) return HFVIS_ERR_LIMIT;
     blk = (unsigned char *)hfvis__alloc(o->alloc, total);
     if (!blk) return HFVIS_ERR_OUT_OF_MEMORY;
@@ -10233,6 +10242,8 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
         E->noff = (hf_near_off *)(void *)(blk + off_no);
         E->row = (double *)(void *)(blk + off_row);
         E->flines = (hf_far_line *)(void *)(blk + off_fl);
+    }
+    if (want_tan) {
         E->twist = (double *)(void *)(blk + off_tw);
         for (k = 0; k < g->height; k++) {
             const float *zr = g->z + (ptrdiff_t)k * g->stride;

@@ -883,8 +883,9 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     HFVIS_ERR_INVALID_ARGUMENT for HFVIS_RAYS_EXACT. hfvis_horizon_lattice and the *_from_map
  *     routines (uniform azimuths) ignore the field.
  *   - Outputs are written at grid points directly (no gather). Scratch: one block of about
- *     8*width*height bytes (plus 12 for normals and 8*channels for the lighting sums) and the
- *     hull stack, 16*(16*(W + H + 2) + 4*border_cells) bytes.
+ *     16*width*height bytes (the tangents and the cells' twists; plus 12 for normals and
+ *     8*channels for the lighting sums) and the hull stack, 16*(16*(W + H + 2) + 4*border_cells)
+ *     bytes.
  *   - Near and far field (opts->ray_near_cells = D > 0; 0, the default, is the sweep above bit
  *     for bit). A direction whose line is longer than D cells between grid points (|(a, b)| > D)
  *     costs |a| + |b| - 1 crossings per receiver in the sweep; instead each receiver takes the
@@ -905,8 +906,7 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     0.10-0.37 deg mean and 1.7-10.2 deg p99 from the supremum, all pairs (walls and cliffs seen
  *     or missed half a cell across), held to HFVIS_EXACT_FAR_MEAN_DEG / _P99_DEG. Receiver
  *     rectangles and sun bands equal the whole run bit for bit (a receiver's value depends on
- *     its own position only). Scratch: 12 bytes more per sample of a line, 8*width bytes and
- *     8*width*height bytes (the cells' twists).
+ *     its own position only). Scratch: 12 bytes more per sample of a line and 8*width bytes.
  *     Cost (callgrind, sky-view factor of rough fBm 256^2, D = 8): about 640 instructions per
  *     receiver-direction at K = 256 and 580 at K = 64 (the lattice: about 100; the sweep:
  *     1150-1560 at 128^2), about 200 of them the near stencil; in CPU time 4.3-5.0x the lattice at
