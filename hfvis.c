@@ -8890,6 +8890,7 @@ typedef struct hf_exact {
     struct hf_far_line *flines; /* one far band's exact lines */
     double *twist;          /* width*height: each cell's twist (hf_cell_twist) at its (x, y), for
                                the sweep's and the near field's bulge tests */
+    int finite;             /* every height of the grid is finite (hf_exact_inner) */
     double *row;            /* one row of near tangents */
     void *block;
     const hfvis_allocator *alloc;
@@ -9193,6 +9194,49 @@ static inline int hf_exact_piece(const hfvis_grid *g, const hf_cross *c, const f
     return n;
 }
 
+/* The inner part of a line for hf_exact_samples: grid points q = 0..qn from z0 (heights) and
+ * tn (twists, at point 1), each with the crossings and piece samples behind it, appended from
+ * index n; returns the new count. finite (a constant at each call, so the compiler writes one
+ * loop for each): every height of the grid is finite (hf_exact.finite), so every grid point and
+ * crossing is a finite sample and no hole test is made (the same samples). */
+static HFVIS__ALWAYS_INLINE int hf_exact_inner(const hf_exact *E, int finite, ptrdiff_t z0, ptrdiff_t zstep,
+                                               const double *tn, ptrdiff_t tstep, int pieces, int P, double L,
+                                               int qn, double *sd, double *sh, int *rec, int n, int eager,
+                                               int *splits)
+{
+    const hfvis_grid *g = E->g;
+    const hf_cross *cr = E->cross;
+    const double lim = HF_EXACT_BULGE * g->cell_size;
+    double bq = 0.0; /* q L, exact (integers below 2^53) */
+    int q, e;
+    for (q = 0;; q++) {
+        const ptrdiff_t zq = z0 - (ptrdiff_t)q * zstep;
+        const float *zn;
+        double h = (double)g->z[zq], base;
+        sd[n] = bq;
+        sh[n] = finite || isfinite(h) ? h : HFVIS__NAN;
+        rec[q] = n++;
+        if (q == qn) break;
+        /* between grid points q and q + 1, both inside the grid, so are the crossings and cells */
+        zn = g->z + (zq - zstep);
+        tn -= tstep;
+        base = bq + L;
+        bq = base;
+        if (!pieces) continue; /* an axis: grid point q + 1 is the next sample */
+        for (e = P - 1; e > 0; e--) { /* the piece after crossing e, then crossing e */
+            const hf_cross *c = cr + e;
+            n = hf_exact_piece(g, c, zn, tn, base, lim, sd, sh, n, eager, splits);
+            h = (double)zn[c->zoff];
+            h += ((double)zn[c->zoff + c->zstep] - h) * c->f; /* as hf_cross_height */
+            sd[n] = base - c->u;
+            sh[n] = h;
+            n += finite || isfinite(h) ? 1 : 0; /* a hole: overwritten by the next sample */
+        }
+        n = hf_exact_piece(g, cr, zn, tn, base, lim, sd, sh, n, eager, splits); /* crossing 0: point q + 1 */
+    }
+    return n;
+}
+
 /* The samples of one line of direction (a, b) from its head (hx, hy), the grid point whose
  * successor (hx + a, hy + b) lies outside the grid, to its grid point qn, in sweep order of
  * increasing distance (sub-steps from the head) into (sd, sh): the crossings beyond the head (the
@@ -9211,7 +9255,7 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
     const double lim = HF_EXACT_BULGE * g->cell_size;
     const int pieces = a != 0 && b != 0; /* along a grid line the surface is linear */
     double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
-    int n = 0, k, e, q, j, splits = 0, eager = *eager_io;
+    int n = 0, k, e, j, splits = 0, eager = *eager_io;
     for (k = hf_exact_periods(g, E->R, hx, hy, a, b); k >= 0; k--) {
         int bx = hx + k * a, by = hy + k * b;
         for (e = P - 1; e >= 0; e--) {
@@ -9237,30 +9281,8 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
             sh[n++] = h;
         }
     }
-    for (q = 0;; q++) {
-        const ptrdiff_t zq = z0 - (ptrdiff_t)q * zstep;
-        const float *zn;
-        double h = (double)g->z[zq], base;
-        sd[n] = (double)q * L;
-        sh[n] = isfinite(h) ? h : HFVIS__NAN;
-        rec[q] = n++;
-        if (q == qn) break;
-        /* between grid points q and q + 1, both inside the grid, so are the crossings and cells */
-        zn = g->z + (zq - zstep);
-        tn -= tstep;
-        base = (double)(q + 1) * L;
-        if (!pieces) continue; /* an axis: grid point q + 1 is the next sample */
-        for (e = P - 1; e > 0; e--) { /* the piece after crossing e, then crossing e */
-            const hf_cross *c = cr + e;
-            n = hf_exact_piece(g, c, zn, tn, base, lim, sd, sh, n, eager, &splits);
-            h = (double)zn[c->zoff];
-            h += ((double)zn[c->zoff + c->zstep] - h) * c->f; /* as hf_cross_height */
-            sd[n] = base - c->u;
-            sh[n] = h;
-            n += isfinite(h) ? 1 : 0; /* a hole: overwritten by the next sample */
-        }
-        n = hf_exact_piece(g, cr, zn, tn, base, lim, sd, sh, n, eager, &splits); /* crossing 0: point q + 1 */
-    }
+    n = E->finite ? hf_exact_inner(E, 1, z0, zstep, tn, tstep, pieces, P, L, qn, sd, sh, rec, n, eager, &splits)
+                  : hf_exact_inner(E, 0, z0, zstep, tn, tstep, pieces, P, L, qn, sd, sh, rec, n, eager, &splits);
     if (pieces && qn > 0) *eager_io = (double)splits > HF_EXACT_EAGER_SHARE * (double)qn * (double)P;
     return n;
 }
@@ -10245,12 +10267,14 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     }
     if (want_tan) {
         E->twist = (double *)(void *)(blk + off_tw);
+        E->finite = 1;
         for (k = 0; k < g->height; k++) {
             const float *zr = g->z + (ptrdiff_t)k * g->stride;
             double *tw = E->twist + (ptrdiff_t)k * g->width;
             int x;
             for (x = 0; x < g->width; x++) {
                 E->inf |= isinf(zr[x]) != 0;
+                E->finite &= isfinite(zr[x]) != 0;
                 tw[x] = x + 1 < g->width && k + 1 < g->height ? hf_cell_twist(zr + x, g->stride) : 0.0;
             }
         }
