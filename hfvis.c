@@ -9168,8 +9168,9 @@ static int hf_exact_rect_span(const hf_exact *E, int hx, int hy, int a, int b, i
  * that does not bulge costs a load and a compare and its taps are read only for its samples.
  * eager: the midpoint of a piece split in two (most splits) is written for every piece and kept
  * by the test's outcome, without a branch. */
-static inline int hf_exact_piece(const hfvis_grid *g, const hf_cross *c, const float *zn, const double *tn,
-                                 double base, double lim, double *sd, double *sh, int n, int eager, int *splits)
+static HFVIS__ALWAYS_INLINE int hf_exact_piece(const hfvis_grid *g, const hf_cross *c, const float *zn,
+                                               const double *tn, double base, double lim, double *sd,
+                                               double *sh, int n, int eager, int *splits)
 {
     const double bulge = c->q * tn[c->toff]; /* q hf_cell_twist, from the plane */
     if (eager || bulge > lim) { /* not eager: most pieces end at the one test (NaN at holes) */
@@ -9244,18 +9245,16 @@ static HFVIS__ALWAYS_INLINE int hf_exact_inner(const hf_exact *E, int finite, pt
  * receiver, rec[q] its sample; a hole keeps height NaN) and the crossings and piece samples
  * behind it. Crossings at holes are left out. Returns the count (the arrays hold one more).
  * *eager_io: this line's pieces eager (hf_exact_piece); set for the next from this one's splits. */
-static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int P, double L, int qn,
-                            double *sd, double *sh, int *rec, int *eager_io)
+/* The head of a line for hf_exact_samples: the samples beyond grid point q = 0 (hx, hy), in
+ * sweep order into (sd, sh); returns their count. */
+static int hf_exact_head(const hf_exact *E, int hx, int hy, int a, int b, int P, double L, double *sd,
+                         double *sh)
 {
     const hfvis_grid *g = E->g;
     const hf_cross *cr = E->cross;
-    const ptrdiff_t z0 = (ptrdiff_t)hy * g->stride + hx, zstep = (ptrdiff_t)b * g->stride + a;
-    const ptrdiff_t tstep = (ptrdiff_t)b * g->width + a;
-    const double *tn = E->twist + ((ptrdiff_t)hy * g->width + hx); /* the twists at grid point q + 1 */
     const double lim = HF_EXACT_BULGE * g->cell_size;
-    const int pieces = a != 0 && b != 0; /* along a grid line the surface is linear */
     double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
-    int n = 0, k, e, j, splits = 0, eager = *eager_io;
+    int n = 0, k, e, j;
     for (k = hf_exact_periods(g, E->R, hx, hy, a, b); k >= 0; k--) {
         int bx = hx + k * a, by = hy + k * b;
         for (e = P - 1; e >= 0; e--) {
@@ -9281,6 +9280,18 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
             sh[n++] = h;
         }
     }
+    return n;
+}
+
+static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int P, double L, int qn,
+                            double *sd, double *sh, int *rec, int *eager_io)
+{
+    const hfvis_grid *g = E->g;
+    const ptrdiff_t z0 = (ptrdiff_t)hy * g->stride + hx, zstep = (ptrdiff_t)b * g->stride + a;
+    const ptrdiff_t tstep = (ptrdiff_t)b * g->width + a;
+    const double *tn = E->twist + ((ptrdiff_t)hy * g->width + hx); /* the twists at grid point q + 1 */
+    const int pieces = a != 0 && b != 0; /* along a grid line the surface is linear */
+    int n = hf_exact_head(E, hx, hy, a, b, P, L, sd, sh), splits = 0, eager = *eager_io;
     n = E->finite ? hf_exact_inner(E, 1, z0, zstep, tn, tstep, pieces, P, L, qn, sd, sh, rec, n, eager, &splits)
                   : hf_exact_inner(E, 0, z0, zstep, tn, tstep, pieces, P, L, qn, sd, sh, rec, n, eager, &splits);
     if (pieces && qn > 0) *eager_io = (double)splits > HF_EXACT_EAGER_SHARE * (double)qn * (double)P;
@@ -9321,9 +9332,69 @@ static void hf_exact_hull(double *sd, double *sh, const int *rec, int nrec, doub
     }
 }
 
+/* hf_exact_samples and hf_exact_hull in one pass, for a line whose pieces are not eager on a grid
+ * without holes or infinite heights (hf_exact.finite): the head's samples go through the hull as
+ * there, then each sample of the inner part is pushed as it is made (its crossing's height, a
+ * split piece's samples through hf_exact_piece into a few slots of their own), so the samples
+ * are not stored and read back and each grid point's tangent is taken where it is made, without
+ * a loop over the samples before it. The same samples in the same order through the same hull
+ * steps: the same tangents, bit for bit. */
+static void hf_exact_fused(hf_exact *E, int hx, int hy, int a, int b, int P, double L, int qn, double scale,
+                           ptrdiff_t t0)
+{
+    const hfvis_grid *g = E->g;
+    const hf_cross *cr = E->cross;
+    const ptrdiff_t zstep = (ptrdiff_t)b * g->stride + a, wstep = (ptrdiff_t)b * g->width + a;
+    const double lim = HF_EXACT_BULGE * g->cell_size;
+    const int pieces = a != 0 && b != 0; /* along a grid line the surface is linear */
+    const float *zq = g->z + ((ptrdiff_t)hy * g->stride + hx);
+    const double *tn = E->twist + ((ptrdiff_t)hy * g->width + hx); /* the twists at grid point q + 1 */
+    double *sd = E->sd, *sh = E->sh, *tan = E->tan + t0;
+    double dt = 0.0, ht = HFVIS__NAN, bq = 0.0, pd[HF_EXACT_MAX_SPLIT], ph[HF_EXACT_MAX_SPLIT];
+    ptrdiff_t top = 0;
+    int n = hf_exact_head(E, hx, hy, a, b, P, L, sd, sh), i, q, e, j, splits = 0;
+    for (i = 0; i < n; i++) { /* the head: as hf_exact_hull before receiver 0 */
+        const double d = sd[i], h = sh[i];
+        (void)hf_hull_push(sh, sd, &top, h, d, ht - h, d - dt);
+        dt = d;
+        ht = h;
+    }
+    for (q = 0;; q++) {
+        double h = (double)*zq, d = bq, t = hf_hull_push(sh, sd, &top, h, d, ht - h, d - dt), base;
+        tan[-(ptrdiff_t)q * wstep] = (isnan(ht) ? -HFVIS__INF : t) * scale; /* scale > 0 */
+        dt = d;
+        ht = h;
+        if (q == qn) break;
+        zq -= zstep; /* grid point q + 1 */
+        tn -= wstep;
+        base = bq + L;
+        bq = base;
+        if (!pieces) continue; /* an axis: grid point q + 1 is the next sample */
+        for (e = P; e-- > 0;) { /* the piece after crossing e, then crossing e (0: point q + 1) */
+            const hf_cross *c = cr + e;
+            if (c->q * tn[c->toff] > lim) { /* split (rare): hf_exact_piece's samples, pushed */
+                j = hf_exact_piece(g, c, zq, tn, base, lim, pd, ph, 0, 0, &splits);
+                for (i = 0; i < j; i++) {
+                    (void)hf_hull_push(sh, sd, &top, ph[i], pd[i], ht - ph[i], pd[i] - dt);
+                    dt = pd[i];
+                    ht = ph[i];
+                }
+            }
+            if (e == 0) break;
+            h = (double)zq[c->zoff];
+            h += ((double)zq[c->zoff + c->zstep] - h) * c->f; /* as hf_cross_height */
+            d = base - c->u;
+            (void)hf_hull_push(sh, sd, &top, h, d, ht - h, d - dt);
+            dt = d;
+            ht = h;
+        }
+    }
+    if (pieces && qn > 0) E->eager = (double)splits > HF_EXACT_EAGER_SHARE * (double)qn * (double)P;
+}
+
 /* One line of direction (a, b) from its head (hx, hy) (hf_exact_samples): the tangents of its
- * grid points up to the last one in the receiver rectangle, by the hull or, under a finite
- * radius, by hf_window_line. */
+ * grid points up to the last one in the receiver rectangle, by the hull (in one pass with the
+ * samples where hf_exact_fused applies) or, under a finite radius, by hf_window_line. */
 static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, double L, double scale)
 {
     const hfvis_grid *g = E->g;
@@ -9333,7 +9404,9 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
         if (!hf_exact_rect_span(E, hx, hy, a, b, &qhi)) return; /* no receiver wanted */
         if (qhi < qn) qn = qhi;
     }
-    if (E->win_rw < 0) {
+    if (E->win_rw < 0 && E->finite && !E->eager) {
+        hf_exact_fused(E, hx, hy, a, b, P, L, qn, scale, t0);
+    } else if (E->win_rw < 0) {
         hf_exact_samples(E, hx, hy, a, b, P, L, qn, E->sd, E->sh, E->rec, &E->eager);
         hf_exact_hull(E->sd, E->sh, E->rec, qn + 1, scale, E->tan, t0, tstep);
     } else {
