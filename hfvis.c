@@ -9370,7 +9370,7 @@ static void hf_exact_fused(hf_exact *E, int hx, int hy, int a, int b, int P, dou
         base = bq + L;
         bq = base;
         if (!pieces) continue; /* an axis: grid point q + 1 is the next sample */
-        for (e = P; e-- > 0;) { /* the piece after crossing e, then crossing e (0: point q + 1) */
+        for (e = P - 1;; e--) { /* the piece after crossing e, then crossing e (0: point q + 1) */
             const hf_cross *c = cr + e;
             if (c->q * tn[c->toff] > lim) { /* split (rare): hf_exact_piece's samples, pushed */
                 j = hf_exact_piece(g, c, zq, tn, base, lim, pd, ph, 0, 0, &splits);
