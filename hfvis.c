@@ -9332,13 +9332,15 @@ static void hf_exact_hull(double *sd, double *sh, const int *rec, int nrec, doub
     }
 }
 
-/* hf_exact_samples and hf_exact_hull in one pass, for a line whose pieces are not eager on a grid
- * without holes or infinite heights (hf_exact.finite): the head's samples go through the hull as
- * there, then each sample of the inner part is pushed as it is made (its crossing's height, a
- * split piece's samples through hf_exact_piece into a few slots of their own), so the samples
- * are not stored and read back and each grid point's tangent is taken where it is made, without
- * a loop over the samples before it. The same samples in the same order through the same hull
- * steps: the same tangents, bit for bit. */
+/* hf_exact_samples and hf_exact_hull in one pass, for a line on a grid without holes or infinite
+ * heights (hf_exact.finite): the head's samples go through the hull as there, then each sample
+ * of the inner part is pushed as it is made (its crossing's height, a split piece's samples
+ * through hf_exact_piece into a few slots of their own), so the samples are not stored and read
+ * back and each grid point's tangent is taken where it is made, without a loop over the samples
+ * before it. The same samples in the same order through the same hull steps: the same tangents,
+ * bit for bit. A piece is split under a branch here (no eager midpoints, HF_EXACT_EAGER_SHARE):
+ * the two-pass form moves that branch's randomness into the hull's loop over a receiver's
+ * samples, whose exit then depends on the splits as much. */
 static void hf_exact_fused(hf_exact *E, int hx, int hy, int a, int b, int P, double L, int qn, double scale,
                            ptrdiff_t t0)
 {
@@ -9389,7 +9391,6 @@ static void hf_exact_fused(hf_exact *E, int hx, int hy, int a, int b, int P, dou
             ht = h;
         }
     }
-    if (pieces && qn > 0) E->eager = (double)splits > HF_EXACT_EAGER_SHARE * (double)qn * (double)P;
 }
 
 /* One line of direction (a, b) from its head (hx, hy) (hf_exact_samples): the tangents of its
@@ -9404,7 +9405,7 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
         if (!hf_exact_rect_span(E, hx, hy, a, b, &qhi)) return; /* no receiver wanted */
         if (qhi < qn) qn = qhi;
     }
-    if (E->win_rw < 0 && E->finite && !E->eager) {
+    if (E->win_rw < 0 && E->finite) {
         hf_exact_fused(E, hx, hy, a, b, P, L, qn, scale, t0);
     } else if (E->win_rw < 0) {
         hf_exact_samples(E, hx, hy, a, b, P, L, qn, E->sd, E->sh, E->rec, &E->eager);
