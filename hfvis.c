@@ -8891,6 +8891,8 @@ typedef struct hf_exact {
     double *twist;          /* width*height: each cell's twist (hf_cell_twist) at its (x, y), for
                                the sweep's and the near field's bulge tests */
     int finite;             /* every height of the grid is finite (hf_exact_inner) */
+    double *stk;            /* hf_exact_fused's hull stack: (height, distance) pairs, two NaN pairs
+                               first */
     double *row;            /* one row of near tangents */
     void *block;
     const hfvis_allocator *alloc;
@@ -9332,6 +9334,34 @@ static void hf_exact_hull(double *sd, double *sh, const int *rec, int nrec, doub
     }
 }
 
+/* hf_hull_push on a stack of (height, distance) pairs (hf_exact.stk): the same tests, the same
+ * arithmetic in the same order, so the same pops and tangents; one pointer p to the next free
+ * pair, two NaN pairs below the first. */
+static inline double hf_exact_push(double **top_io, double h, double d, double a1, double b1)
+{
+    double *p = *top_io, t, a2, b2;
+    for (;;) {
+        a2 = p[-4] - h;
+        b2 = d - p[-3];
+        if (!(a2 * b1 >= a1 * b2)) {
+            t = a1 / b1;
+            break;
+        }
+        p -= 2;
+        a1 = p[-4] - h;
+        b1 = d - p[-3];
+        if (!(a1 * b2 >= a2 * b1)) {
+            t = a2 / b2;
+            break;
+        }
+        p -= 2;
+    }
+    p[0] = h;
+    p[1] = d;
+    *top_io = p + 2;
+    return t;
+}
+
 /* hf_exact_samples and hf_exact_hull in one pass, for a line on a grid without holes or infinite
  * heights (hf_exact.finite): the head's samples go through the hull as there, then each sample
  * of the inner part is pushed as it is made (its crossing's height, a split piece's samples
@@ -9351,18 +9381,17 @@ static void hf_exact_fused(hf_exact *E, int hx, int hy, int a, int b, int P, dou
     const int pieces = a != 0 && b != 0; /* along a grid line the surface is linear */
     const float *zq = g->z + ((ptrdiff_t)hy * g->stride + hx);
     const double *tn = E->twist + ((ptrdiff_t)hy * g->width + hx); /* the twists at grid point q + 1 */
-    double *sd = E->sd, *sh = E->sh, *tan = E->tan + t0;
+    double *sd = E->sd, *sh = E->sh, *tan = E->tan + t0, *top = E->stk + 4;
     double dt = 0.0, ht = HFVIS__NAN, bq = 0.0, pd[HF_EXACT_MAX_SPLIT], ph[HF_EXACT_MAX_SPLIT];
-    ptrdiff_t top = 0;
     int n = hf_exact_head(E, hx, hy, a, b, P, L, sd, sh), i, q, e, j, splits = 0;
     for (i = 0; i < n; i++) { /* the head: as hf_exact_hull before receiver 0 */
         const double d = sd[i], h = sh[i];
-        (void)hf_hull_push(sh, sd, &top, h, d, ht - h, d - dt);
+        (void)hf_exact_push(&top, h, d, ht - h, d - dt);
         dt = d;
         ht = h;
     }
     for (q = 0;; q++) {
-        double h = (double)*zq, d = bq, t = hf_hull_push(sh, sd, &top, h, d, ht - h, d - dt), base;
+        double h = (double)*zq, d = bq, t = hf_exact_push(&top, h, d, ht - h, d - dt), base;
         tan[-(ptrdiff_t)q * wstep] = (isnan(ht) ? -HFVIS__INF : t) * scale; /* scale > 0 */
         dt = d;
         ht = h;
@@ -9377,7 +9406,7 @@ static void hf_exact_fused(hf_exact *E, int hx, int hy, int a, int b, int P, dou
             if (c->q * tn[c->toff] > lim) { /* split (rare): hf_exact_piece's samples, pushed */
                 j = hf_exact_piece(g, c, zq, tn, base, lim, pd, ph, 0, 0, &splits);
                 for (i = 0; i < j; i++) {
-                    (void)hf_hull_push(sh, sd, &top, ph[i], pd[i], ht - ph[i], pd[i] - dt);
+                    (void)hf_exact_push(&top, ph[i], pd[i], ht - ph[i], pd[i] - dt);
                     dt = pd[i];
                     ht = ph[i];
                 }
@@ -9386,7 +9415,7 @@ static void hf_exact_fused(hf_exact *E, int hx, int hy, int a, int b, int P, dou
             h = (double)zq[c->zoff];
             h += ((double)zq[c->zoff + c->zstep] - h) * c->f; /* as hf_cross_height */
             d = base - c->u;
-            (void)hf_hull_push(sh, sd, &top, h, d, ht - h, d - dt);
+            (void)hf_exact_push(&top, h, d, ht - h, d - dt);
             dt = d;
             ht = h;
         }
@@ -10261,6 +10290,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
 {
     size_t total = 0, off_ray, off_d, off_c, off_s, off_t = 0, off_n = 0, off_a = 0, gridn, cap;
     size_t off_win = 0, off_r, off_fp = 0, off_fm = 0, off_no = 0, off_row = 0, off_fl = 0, off_tw = 0;
+    size_t off_stk = 0;
     int ok = 1, k, maxp = 1, side = g->width > g->height ? g->width : g->height;
     unsigned char *blk;
     memset(E, 0, sizeof *E);
@@ -10312,6 +10342,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
         off_fl = hf_align_add(&total, (size_t)maxp + 2u, sizeof(hf_far_line), &ok);
     }
     if (want_tan) off_tw = hf_align_add(&total, gridn, sizeof(double), &ok);
+    if (want_tan) off_stk = hf_align_add(&total, cap + 2u, 2u * sizeof(double), &ok);
     if (!ok) return HFVIS_ERR_LIMIT;
     blk = (unsigned char *)hfvis__alloc(o->alloc, total);
     if (!blk) return HFVIS_ERR_OUT_OF_MEMORY;
@@ -10341,6 +10372,8 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     }
     if (want_tan) {
         E->twist = (double *)(void *)(blk + off_tw);
+        E->stk = (double *)(void *)(blk + off_stk);
+        E->stk[0] = E->stk[1] = E->stk[2] = E->stk[3] = HFVIS__NAN; /* below the stack */
         E->finite = 1;
         for (k = 0; k < g->height; k++) {
             const float *zr = g->z + (ptrdiff_t)k * g->stride;
