@@ -9553,8 +9553,8 @@ static void hf_exact_near(hf_exact *E, hf_ray r, double L, double scale)
             double s0 = (((double)z[x + sx] - h0) * Ad + ((double)z[x + sy] - h0) * Bd) * inv_den;
             double s1 = (((double)z[x + 1 + sx] - h1) * Ad + ((double)z[x + 1 + sy] - h1) * Bd) * inv_den;
             double d0 = (double)z[x + sx + sy], d1 = (double)z[x + 1 + sx + sy];
-            s0 = fabs(s0) <= DBL_MAX && fabs(d0) <= DBL_MAX ? s0 : -HFVIS__INF;
-            s1 = fabs(s1) <= DBL_MAX && fabs(d1) <= DBL_MAX ? s1 : -HFVIS__INF;
+            s0 = (fabs(s0) <= DBL_MAX) & (fabs(d0) <= DBL_MAX) ? s0 : -HFVIS__INF;
+            s1 = (fabs(s1) <= DBL_MAX) & (fabs(d1) <= DBL_MAX) ? s1 : -HFVIS__INF;
             t[x] = s0 > t0 ? s0 : t0;
             t[x + 1] = s1 > t1 ? s1 : t1;
         }
