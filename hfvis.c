@@ -9240,13 +9240,6 @@ static HFVIS__ALWAYS_INLINE int hf_exact_inner(const hf_exact *E, int finite, pt
     return n;
 }
 
-/* The samples of one line of direction (a, b) from its head (hx, hy), the grid point whose
- * successor (hx + a, hy + b) lies outside the grid, to its grid point qn, in sweep order of
- * increasing distance (sub-steps from the head) into (sd, sh): the crossings beyond the head (the
- * CLAMP/WRAP pre-roll, or the part of a step still inside the grid), then each grid point q (a
- * receiver, rec[q] its sample; a hole keeps height NaN) and the crossings and piece samples
- * behind it. Crossings at holes are left out. Returns the count (the arrays hold one more).
- * *eager_io: this line's pieces eager (hf_exact_piece); set for the next from this one's splits. */
 /* The head of a line for hf_exact_samples: the samples beyond grid point q = 0 (hx, hy), in
  * sweep order into (sd, sh); returns their count. */
 static int hf_exact_head(const hf_exact *E, int hx, int hy, int a, int b, int P, double L, double *sd,
@@ -9285,6 +9278,13 @@ static int hf_exact_head(const hf_exact *E, int hx, int hy, int a, int b, int P,
     return n;
 }
 
+/* The samples of one line of direction (a, b) from its head (hx, hy), the grid point whose
+ * successor (hx + a, hy + b) lies outside the grid, to its grid point qn, in sweep order of
+ * increasing distance (sub-steps from the head) into (sd, sh): the crossings beyond the head (the
+ * CLAMP/WRAP pre-roll, or the part of a step still inside the grid), then each grid point q (a
+ * receiver, rec[q] its sample; a hole keeps height NaN) and the crossings and piece samples
+ * behind it. Crossings at holes are left out. Returns the count (the arrays hold one more).
+ * *eager_io: this line's pieces eager (hf_exact_piece); set for the next from this one's splits. */
 static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int P, double L, int qn,
                             double *sd, double *sh, int *rec, int *eager_io)
 {

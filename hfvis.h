@@ -865,6 +865,9 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     K = 16): the horizon map 0.65-0.85x the lattice map's time on urban DSMs (no gather),
  *     1.2-2.3x on fBm rough at the cell scale; the fused sky-view factor 1.2-2.1x and 2.1-4.1x;
  *     at K = 64, 256, 360 on fBm 512^2 8.9x, 8.5x, 14.5x (docs/exact-rays.md, "Cost at large K").
+ *     Instructions (callgrind, sky-view factor of the bench's fBm at 256^2): about 250 per
+ *     receiver-direction at K = 16 and 650 at K = 64, the lattice about 104 (docs/exact-rays.md,
+ *     "Fifth pass at K = 16").
  *   - Quadrature: every direction integral uses the actual azimuths phi_k. Direction k owns the
  *     sector between the midpoints to its neighbours (edges rounded to multiples of 2^-40 turn,
  *     so the shares w_k are exact and add up to exactly 1): the sky-view factor is
@@ -884,8 +887,8 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     routines (uniform azimuths) ignore the field.
  *   - Outputs are written at grid points directly (no gather). Scratch: one block of about
  *     16*width*height bytes (the tangents and the cells' twists; plus 12 for normals and
- *     8*channels for the lighting sums) and the hull stack, 16*(16*(W + H + 2) + 4*border_cells)
- *     bytes.
+ *     8*channels for the lighting sums) and a line's samples and hull stack,
+ *     32*(16*(W + H + 2) + 4*border_cells) bytes.
  *   - Near and far field (opts->ray_near_cells = D > 0; 0, the default, is the sweep above bit
  *     for bit). A direction whose line is longer than D cells between grid points (|(a, b)| > D)
  *     costs |a| + |b| - 1 crossings per receiver in the sweep; instead each receiver takes the
