@@ -9382,7 +9382,10 @@ static void hf_exact_fused(hf_exact *E, int hx, int hy, int a, int b, int P, dou
     const float *zq = g->z + ((ptrdiff_t)hy * g->stride + hx);
     const double *tn = E->twist + ((ptrdiff_t)hy * g->width + hx); /* the twists at grid point q + 1 */
     double *sd = E->sd, *sh = E->sh, *tan = E->tan + t0, *top = E->stk + 4;
-    double dt = 0.0, ht = HFVIS__NAN, bq = 0.0, pd[HF_EXACT_MAX_SPLIT], ph[HF_EXACT_MAX_SPLIT];
+    /* the top before the first push: -inf at a finite distance below every sample's, so that the
+       first push (its pop test fails on the NaN pair, as hf_exact_hull's on its NaN top) returns
+       -inf / (d - dt) = -inf, the tangent of "nothing before", without a test at every receiver */
+    double dt = -DBL_MAX, ht = -HFVIS__INF, bq = 0.0, pd[HF_EXACT_MAX_SPLIT], ph[HF_EXACT_MAX_SPLIT];
     int n = hf_exact_head(E, hx, hy, a, b, P, L, sd, sh), i, q, e, j, splits = 0;
     for (i = 0; i < n; i++) { /* the head: as hf_exact_hull before receiver 0 */
         const double d = sd[i], h = sh[i];
@@ -9392,7 +9395,7 @@ static void hf_exact_fused(hf_exact *E, int hx, int hy, int a, int b, int P, dou
     }
     for (q = 0;; q++) {
         double h = (double)*zq, d = bq, t = hf_exact_push(&top, h, d, ht - h, d - dt), base;
-        tan[-(ptrdiff_t)q * wstep] = (isnan(ht) ? -HFVIS__INF : t) * scale; /* scale > 0 */
+        tan[-(ptrdiff_t)q * wstep] = t * scale; /* scale > 0 */
         dt = d;
         ht = h;
         if (q == qn) break;
