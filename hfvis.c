@@ -8888,8 +8888,9 @@ typedef struct hf_exact {
     double *fmax;
     struct hf_near_off *noff; /* the near stencil (hf_near_offsets) */
     struct hf_far_line *flines; /* one far band's exact lines */
-    double *twist;          /* width*height: each cell's twist (hf_cell_twist) at its (x, y), for
-                               the sweep's and the near field's bulge tests */
+    const double *twist;    /* width*height: each cell's twist (hf_cell_twist) at its (x, y), for
+                               the sweep's and the near field's bulge tests (the caller's
+                               hfvis_sweep_options.twists, or made in the scratch) */
     int finite;             /* every height of the grid is finite (hf_exact_inner) */
     double *stk;            /* hf_exact_fused's hull stack: (height, distance) pairs, two NaN pairs
                                first */
@@ -9049,6 +9050,23 @@ static double hf_cross_height(const hfvis_grid *g, hfvis_border border, int X, i
 static inline double hf_cell_twist(const float *p, ptrdiff_t stride)
 {
     return (double)p[0] - (double)p[1] - (double)p[stride] + (double)p[stride + 1];
+}
+
+/* Cell (x, y)'s twist in row y of the twist plane: hf_cell_twist, 0 in the last row and column. */
+static void hf_twist_row(const hfvis_grid *g, int y, double *tw)
+{
+    const float *zr = g->z + (ptrdiff_t)y * g->stride;
+    int x;
+    for (x = 0; x < g->width; x++)
+        tw[x] = x + 1 < g->width && y + 1 < g->height ? hf_cell_twist(zr + x, g->stride) : 0.0;
+}
+
+hfvis_status hfvis_cell_twists_compute(const hfvis_grid *grid, double *out)
+{
+    int y;
+    if (!hf_grid_valid(grid) || !out) return HFVIS_ERR_INVALID_ARGUMENT;
+    for (y = 0; y < grid->height; y++) hf_twist_row(grid, y, out + (size_t)y * (size_t)grid->width);
+    return HFVIS_OK;
 }
 
 /* The four taps of cell (cx, cy) under the border rule into z (z00, z10, z01, z11: a 2 x 2 cell
@@ -10344,7 +10362,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
         off_row = hf_align_add(&total, (size_t)g->width, sizeof(double), &ok);
         off_fl = hf_align_add(&total, (size_t)maxp + 2u, sizeof(hf_far_line), &ok);
     }
-    if (want_tan) off_tw = hf_align_add(&total, gridn, sizeof(double), &ok);
+    if (want_tan && !o->twists) off_tw = hf_align_add(&total, gridn, sizeof(double), &ok);
     if (want_tan) off_stk = hf_align_add(&total, cap + 2u, 2u * sizeof(double), &ok);
     if (!ok) return HFVIS_ERR_LIMIT;
     blk = (unsigned char *)hfvis__alloc(o->alloc, total);
@@ -10374,20 +10392,22 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
         E->flines = (hf_far_line *)(void *)(blk + off_fl);
     }
     if (want_tan) {
-        E->twist = (double *)(void *)(blk + off_tw);
+        double *own = o->twists ? NULL : (double *)(void *)(blk + off_tw);
+        int inf = 0, finite = 1;
+        E->twist = o->twists ? o->twists : own;
         E->stk = (double *)(void *)(blk + off_stk);
         E->stk[0] = E->stk[1] = E->stk[2] = E->stk[3] = HFVIS__NAN; /* below the stack */
-        E->finite = 1;
         for (k = 0; k < g->height; k++) {
             const float *zr = g->z + (ptrdiff_t)k * g->stride;
-            double *tw = E->twist + (ptrdiff_t)k * g->width;
             int x;
             for (x = 0; x < g->width; x++) {
-                E->inf |= isinf(zr[x]) != 0;
-                E->finite &= isfinite(zr[x]) != 0;
-                tw[x] = x + 1 < g->width && k + 1 < g->height ? hf_cell_twist(zr + x, g->stride) : 0.0;
+                inf |= isinf(zr[x]) != 0;
+                finite &= isfinite(zr[x]) != 0;
             }
+            if (own) hf_twist_row(g, k, own + (ptrdiff_t)k * g->width);
         }
+        E->inf |= inf;
+        E->finite = finite;
     }
     hf_exact_dirs_fill(&E->d, K, o->azimuth0_rad, E->N);
     if (want_normals == 1 && E->nrm_own) (void)hfvis_normals_compute(g, E->nrm_own); /* as floats */

@@ -544,6 +544,15 @@ HFVIS_API double hfvis_grid_sample(const hfvis_grid *grid, double x, double y);
  * Returns HFVIS_OK or HFVIS_ERR_INVALID_ARGUMENT. Cost O(width*height). */
 HFVIS_API hfvis_status hfvis_normals_compute(const hfvis_grid *grid, float *out);
 
+/* The twist z(x, y) - z(x+1, y) - z(x, y+1) + z(x+1, y+1) of every cell (x, y) of the bilinear
+ * surface, the cross term that makes a cell bulge between its edges (hfvis.h "Exact rays"), as
+ * doubles at out[y*width + x]; 0 in the last row and column (no cell there); NaN or infinite
+ * where a corner is. out must hold width*height doubles. Exact rays compute this plane in every
+ * call; a run split into several calls over one grid (hfvis.h "Threads") computes it once and
+ * passes it in hfvis_sweep_options.twists. Returns HFVIS_OK or HFVIS_ERR_INVALID_ARGUMENT.
+ * Cost O(width*height). */
+HFVIS_API hfvis_status hfvis_cell_twists_compute(const hfvis_grid *grid, double *out);
+
 /* The parallel-line lattice of one look direction (docs/errata.md E5). Sweep direction
  * u = -(cos psi, sin psi), line offset v = (-u.y, u.x); node (i, j) lies at grid position
  * i*u + j*v; line j is traversed in increasing i. Lattice buffers are row-major with
@@ -671,6 +680,12 @@ typedef struct hfvis_sweep_options {
                                        "Exact rays", "Near and far field"), for the directions
                                        whose lines are longer than D between grid points and
                                        without a radius; 0..HFVIS_RAY_NEAR_CELLS_MAX */
+    const double *twists;           /* NULL (default), or this grid's cell twists exactly as
+                                       hfvis_cell_twists_compute writes them (width*height
+                                       doubles), only read: exact rays read them instead of
+                                       computing them in their scratch (8 bytes a sample less
+                                       per call), so that the calls of a split run compute them
+                                       once. Other values change the results (not checked) */
 } hfvis_sweep_options;
 
 HFVIS_API hfvis_sweep_options hfvis_sweep_options_default(void);

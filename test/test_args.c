@@ -71,6 +71,7 @@
     X(field_generate, S, -, "NZGOFESR", "INVALID_ARGUMENT") \
     X(grid_sample, V, -, "NZF", "NaN") \
     X(normals_compute, S, -, "NZGOFR", "INVALID_ARGUMENT") \
+    X(cell_twists_compute, S, -, "NZGOFR", "INVALID_ARGUMENT") \
     X(lattice_init, S, -, "NZGOF", "INVALID_ARGUMENT LIMIT") \
     X(lattice_nodes, V, -, "N", "0") \
     X(lattice_line, V, -, "NR", "0") \
@@ -1059,6 +1060,17 @@ static void args_normals_compute(void)
     BAD('N', INV, hfvis_normals_compute(NULL, out));
     BAD('N', INV, hfvis_normals_compute(&g_ok, NULL));
     GRID_CASES(hfvis_normals_compute(&bg, out));
+}
+
+static void args_cell_twists_compute(void)
+{
+    double *out;
+    begin("cell_twists_compute");
+    out = AD(GW * GH);
+    OK(hfvis_cell_twists_compute(&g_ok, out));
+    BAD('N', INV, hfvis_cell_twists_compute(NULL, out));
+    BAD('N', INV, hfvis_cell_twists_compute(&g_ok, NULL));
+    GRID_CASES(hfvis_cell_twists_compute(&bg, out));
 }
 
 static void args_lattice_init(void)
