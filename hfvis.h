@@ -877,8 +877,9 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     average, plus the interior samples below. The mean |a| + |b| of the default directions:
  *     K = 16: 4.2, K = 64: 11.7, K = 256: 15.5, K = 360: 20.5 (the nearest with N = ceil(K/4)
  *     would take 12.1, 51.5, 73). Measured (make bench, section exact, 512^2 and 1024^2,
- *     K = 16): the horizon map 0.65-0.85x the lattice map's time on urban DSMs (no gather),
- *     1.2-2.3x on fBm rough at the cell scale; the fused sky-view factor 1.2-2.1x and 2.1-4.1x;
+ *     K = 16, a quiet run 2026-12-07): the horizon map 0.53-0.57x the lattice map's time on
+ *     urban DSMs (no gather), 1.05-1.45x on fBm rough at the cell scale; the fused sky-view
+ *     factor 1.12-1.36x and 1.81-3.08x (earlier runs: up to 2.1x and 4.1x);
  *     at K = 64, 256, 360 on fBm 512^2 8.9x, 8.5x, 14.5x (docs/exact-rays.md, "Cost at large K").
  *     Instructions (callgrind, sky-view factor of the bench's fBm at 256^2): about 250 per
  *     receiver-direction at K = 16 and 650 at K = 64, the lattice about 104 (docs/exact-rays.md,
