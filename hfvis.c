@@ -8890,7 +8890,7 @@ typedef struct hf_exact {
     struct hf_far_line *flines; /* one far band's exact lines */
     const double *twist;    /* width*height: each cell's twist (hf_cell_twist) at its (x, y), for
                                the sweep's and the near field's bulge tests (the caller's
-                               hfvis_sweep_options.twists, or made in the scratch) */
+                               hfvis_sweep_options.exact_grid, or made in the scratch) */
     int finite;             /* every height of the grid is finite (hf_exact_inner) */
     double *stk;            /* hf_exact_fused's hull stack: (height, distance) pairs, two NaN pairs
                                first */
@@ -9052,6 +9052,27 @@ static inline double hf_cell_twist(const float *p, ptrdiff_t stride)
     return (double)p[0] - (double)p[1] - (double)p[stride] + (double)p[stride + 1];
 }
 
+/* Whether one of the n heights at zr is a hole or infinite: the IEEE-754 binary32 exponent
+ * field all ones, tested four at a time (every call of a split run scans the grid; 0.1-0.2 ns a
+ * height this way, against 0.7 with isfinite one by one). */
+static int hf_row_nonfinite(const float *zr, int n)
+{
+    uint32_t m0 = 0, m1 = 0, m2 = 0, m3 = 0, b[4];
+    int x = 0;
+    for (; x + 4 <= n; x += 4) { /* exponent all ones + 1 carries into bit 31 */
+        memcpy(b, zr + x, sizeof b);
+        m0 |= (b[0] & 0x7f800000u) + 0x00800000u;
+        m1 |= (b[1] & 0x7f800000u) + 0x00800000u;
+        m2 |= (b[2] & 0x7f800000u) + 0x00800000u;
+        m3 |= (b[3] & 0x7f800000u) + 0x00800000u;
+    }
+    for (; x < n; x++) {
+        memcpy(b, zr + x, sizeof b[0]);
+        m0 |= (b[0] & 0x7f800000u) + 0x00800000u;
+    }
+    return ((m0 | m1 | m2 | m3) & 0x80000000u) != 0;
+}
+
 /* Cell (x, y)'s twist in row y of the twist plane: hf_cell_twist, 0 in the last row and column. */
 static void hf_twist_row(const hfvis_grid *g, int y, double *tw)
 {
@@ -9061,11 +9082,25 @@ static void hf_twist_row(const hfvis_grid *g, int y, double *tw)
         tw[x] = x + 1 < g->width && y + 1 < g->height ? hf_cell_twist(zr + x, g->stride) : 0.0;
 }
 
-hfvis_status hfvis_cell_twists_compute(const hfvis_grid *grid, double *out)
+/* The class of the grid's heights: 0 all finite, 1 holes and no infinite height, 2 an
+ * infinite height (exact rays: hf_exact.finite, hf_exact.inf). */
+static int hf_height_class(const hfvis_grid *g)
+{
+    int y, x, nonfinite = 0;
+    for (y = 0; y < g->height; y++) nonfinite |= hf_row_nonfinite(g->z + (ptrdiff_t)y * g->stride, g->width);
+    if (!nonfinite) return 0;
+    for (y = 0; y < g->height; y++)
+        for (x = 0; x < g->width; x++)
+            if (isinf(g->z[(ptrdiff_t)y * g->stride + x])) return 2;
+    return 1;
+}
+
+hfvis_status hfvis_exact_grid_compute(const hfvis_grid *grid, double *out)
 {
     int y;
     if (!hf_grid_valid(grid) || !out) return HFVIS_ERR_INVALID_ARGUMENT;
     for (y = 0; y < grid->height; y++) hf_twist_row(grid, y, out + (size_t)y * (size_t)grid->width);
+    out[hf_grid_count(grid)] = (double)hf_height_class(grid);
     return HFVIS_OK;
 }
 
@@ -10362,7 +10397,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
         off_row = hf_align_add(&total, (size_t)g->width, sizeof(double), &ok);
         off_fl = hf_align_add(&total, (size_t)maxp + 2u, sizeof(hf_far_line), &ok);
     }
-    if (want_tan && !o->twists) off_tw = hf_align_add(&total, gridn, sizeof(double), &ok);
+    if (want_tan && !o->exact_grid) off_tw = hf_align_add(&total, gridn, sizeof(double), &ok);
     if (want_tan) off_stk = hf_align_add(&total, cap + 2u, 2u * sizeof(double), &ok);
     if (!ok) return HFVIS_ERR_LIMIT;
     blk = (unsigned char *)hfvis__alloc(o->alloc, total);
@@ -10392,22 +10427,14 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
         E->flines = (hf_far_line *)(void *)(blk + off_fl);
     }
     if (want_tan) {
-        double *own = o->twists ? NULL : (double *)(void *)(blk + off_tw);
-        int inf = 0, finite = 1;
-        E->twist = o->twists ? o->twists : own;
+        double *own = o->exact_grid ? NULL : (double *)(void *)(blk + off_tw);
+        const double cls = o->exact_grid ? o->exact_grid[gridn] : (double)hf_height_class(g);
+        E->twist = o->exact_grid ? o->exact_grid : own;
         E->stk = (double *)(void *)(blk + off_stk);
         E->stk[0] = E->stk[1] = E->stk[2] = E->stk[3] = HFVIS__NAN; /* below the stack */
-        for (k = 0; k < g->height; k++) {
-            const float *zr = g->z + (ptrdiff_t)k * g->stride;
-            int x;
-            for (x = 0; x < g->width; x++) {
-                inf |= isinf(zr[x]) != 0;
-                finite &= isfinite(zr[x]) != 0;
-            }
-            if (own) hf_twist_row(g, k, own + (ptrdiff_t)k * g->width);
-        }
-        E->inf |= inf;
-        E->finite = finite;
+        for (k = 0; own && k < g->height; k++) hf_twist_row(g, k, own + (ptrdiff_t)k * g->width);
+        E->finite = cls == 0.0;
+        E->inf |= cls == 2.0;
     }
     hf_exact_dirs_fill(&E->d, K, o->azimuth0_rad, E->N);
     if (want_normals == 1 && E->nrm_own) (void)hfvis_normals_compute(g, E->nrm_own); /* as floats */

@@ -172,7 +172,9 @@
  *   (hfvis_direction_sums, one group per part, added in order), the exact sums by bands of one
  *   direction at a time (added in place), the horizon map by plane range, one sun by bands,
  *   solar irradiation by row ranges over one caller-made horizon map,
- *   and any receiver-local result by windows ("Search radius and tiles"). The hfvis tool's
+ *   and any receiver-local result by windows ("Search radius and tiles"); what every call would
+ *   derive from the grid alone can be made once and shared (sweep options normals, exact_grid).
+ *   The hfvis tool's
  *   --threads does exactly that; test/thread_test.c runs these calls concurrently on shared
  *   inputs under ThreadSanitizer (make sanitize).
  * Memory. The caller owns every output and sizes it with the documented formula or a *_size()
@@ -544,14 +546,15 @@ HFVIS_API double hfvis_grid_sample(const hfvis_grid *grid, double x, double y);
  * Returns HFVIS_OK or HFVIS_ERR_INVALID_ARGUMENT. Cost O(width*height). */
 HFVIS_API hfvis_status hfvis_normals_compute(const hfvis_grid *grid, float *out);
 
-/* The twist z(x, y) - z(x+1, y) - z(x, y+1) + z(x+1, y+1) of every cell (x, y) of the bilinear
- * surface, the cross term that makes a cell bulge between its edges (hfvis.h "Exact rays"), as
- * doubles at out[y*width + x]; 0 in the last row and column (no cell there); NaN or infinite
- * where a corner is. out must hold width*height doubles. Exact rays compute this plane in every
- * call; a run split into several calls over one grid (hfvis.h "Threads") computes it once and
- * passes it in hfvis_sweep_options.twists. Returns HFVIS_OK or HFVIS_ERR_INVALID_ARGUMENT.
- * Cost O(width*height). */
-HFVIS_API hfvis_status hfvis_cell_twists_compute(const hfvis_grid *grid, double *out);
+/* The data exact rays derive from a grid before they trace (hfvis.h "Exact rays"), for a run
+ * split into several calls over one grid (hfvis.h "Threads") to compute once and pass to each
+ * call in hfvis_sweep_options.exact_grid (every call otherwise computes it in its scratch):
+ * width*height + 1 doubles, out[y*width + x] the twist z(x, y) - z(x+1, y) - z(x, y+1) +
+ * z(x+1, y+1) of cell (x, y) of the bilinear surface (the cross term that makes a cell bulge
+ * between its edges; 0 in the last row and column), out[width*height] the class of the heights
+ * (0 all finite, 1 holes and no infinite height, 2 an infinite height). Returns HFVIS_OK or
+ * HFVIS_ERR_INVALID_ARGUMENT. Cost O(width*height). */
+HFVIS_API hfvis_status hfvis_exact_grid_compute(const hfvis_grid *grid, double *out);
 
 /* The parallel-line lattice of one look direction (docs/errata.md E5). Sweep direction
  * u = -(cos psi, sin psi), line offset v = (-u.y, u.x); node (i, j) lies at grid position
@@ -680,12 +683,13 @@ typedef struct hfvis_sweep_options {
                                        "Exact rays", "Near and far field"), for the directions
                                        whose lines are longer than D between grid points and
                                        without a radius; 0..HFVIS_RAY_NEAR_CELLS_MAX */
-    const double *twists;           /* NULL (default), or this grid's cell twists exactly as
-                                       hfvis_cell_twists_compute writes them (width*height
-                                       doubles), only read: exact rays read them instead of
-                                       computing them in their scratch (8 bytes a sample less
-                                       per call), so that the calls of a split run compute them
-                                       once. Other values change the results (not checked) */
+    const double *exact_grid;       /* NULL (default), or this grid's data exactly as
+                                       hfvis_exact_grid_compute writes it (width*height + 1
+                                       doubles), only read: exact rays read it instead of
+                                       computing it (8 bytes a sample of scratch and a pass over
+                                       the grid per call), so that the calls of a split run
+                                       compute it once. Other values change the results (not
+                                       checked) */
 } hfvis_sweep_options;
 
 HFVIS_API hfvis_sweep_options hfvis_sweep_options_default(void);
@@ -902,7 +906,8 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     HFVIS_ERR_INVALID_ARGUMENT for HFVIS_RAYS_EXACT. hfvis_horizon_lattice and the *_from_map
  *     routines (uniform azimuths) ignore the field.
  *   - Outputs are written at grid points directly (no gather). Scratch: one block of about
- *     16*width*height bytes (the tangents and the cells' twists; plus 12 for normals and
+ *     16*width*height bytes (the tangents and the cells' twists, 8 without them with
+ *     opts->exact_grid; plus 12 for normals and
  *     8*channels for the lighting sums) and a line's samples and hull stack,
  *     32*(16*(W + H + 2) + 4*border_cells) bytes.
  *   - Near and far field (opts->ray_near_cells = D > 0; 0, the default, is the sweep above bit
