@@ -8835,6 +8835,7 @@ typedef struct hf_cross {
     double f, u;
     ptrdiff_t zoff, zstep; /* its first tap from g in the grid's heights, and its second from that */
     ptrdiff_t coff;        /* the tap (0, 0) of its piece's cell from g in the grid's heights */
+    ptrdiff_t toff;        /* that cell from g in the twist plane (hf_exact.twist, row stride width) */
     double mfx, mfy, mu;   /* the piece's midpoint: cell coordinates, distance from g (sub-steps) */
     /* the piece from this crossing to the next (or to g + (a, b)): inside cell (cx, cy) (offsets
        from g), from (fx0, fy0) to (fx1, fy1) in cell coordinates, du sub-steps long */
@@ -8887,7 +8888,12 @@ typedef struct hf_exact {
     double *fmax;
     struct hf_near_off *noff; /* the near stencil (hf_near_offsets) */
     struct hf_far_line *flines; /* one far band's exact lines */
-    double *twist;          /* width*height: each cell's twist (hf_cell_twist) at its (x, y) */
+    const double *twist;    /* width*height: each cell's twist (hf_cell_twist) at its (x, y), for
+                               the sweep's and the near field's bulge tests (the caller's
+                               hfvis_sweep_options.exact_grid, or made in the scratch) */
+    int finite;             /* every height of the grid is finite (hf_exact_inner) */
+    double *stk;            /* hf_exact_fused's hull stack: (height, distance) pairs, two NaN pairs
+                               first */
     double *row;            /* one row of near tangents */
     void *block;
     const hfvis_allocator *alloc;
@@ -9009,6 +9015,7 @@ static int hf_exact_geometry(hf_cross *cross, const hfvis_grid *g, int a, int b,
         c->zoff = (ptrdiff_t)c->oy * g->stride + c->ox;
         c->zstep = c->kind == 1 ? g->stride : 1;
         c->coff = (ptrdiff_t)c->cy * g->stride + c->cx;
+        c->toff = (ptrdiff_t)c->cy * g->width + c->cx;
         c->mfx = c->fx0 + 0.5 * (c->fx1 - c->fx0); /* hf_piece_fill's sample at t = 1/2, bit for bit */
         c->mfy = c->fy0 + 0.5 * (c->fy1 - c->fy0);
         c->mu = c->u + c->du * 0.5;
@@ -9043,6 +9050,58 @@ static double hf_cross_height(const hfvis_grid *g, hfvis_border border, int X, i
 static inline double hf_cell_twist(const float *p, ptrdiff_t stride)
 {
     return (double)p[0] - (double)p[1] - (double)p[stride] + (double)p[stride + 1];
+}
+
+/* Whether one of the n heights at zr is a hole or infinite: the IEEE-754 binary32 exponent
+ * field all ones, tested four at a time (every call of a split run scans the grid; 0.1-0.2 ns a
+ * height this way, against 0.7 with isfinite one by one). */
+static int hf_row_nonfinite(const float *zr, int n)
+{
+    uint32_t m0 = 0, m1 = 0, m2 = 0, m3 = 0, b[4];
+    int x = 0;
+    for (; x + 4 <= n; x += 4) { /* exponent all ones + 1 carries into bit 31 */
+        memcpy(b, zr + x, sizeof b);
+        m0 |= (b[0] & 0x7f800000u) + 0x00800000u;
+        m1 |= (b[1] & 0x7f800000u) + 0x00800000u;
+        m2 |= (b[2] & 0x7f800000u) + 0x00800000u;
+        m3 |= (b[3] & 0x7f800000u) + 0x00800000u;
+    }
+    for (; x < n; x++) {
+        memcpy(b, zr + x, sizeof b[0]);
+        m0 |= (b[0] & 0x7f800000u) + 0x00800000u;
+    }
+    return ((m0 | m1 | m2 | m3) & 0x80000000u) != 0;
+}
+
+/* Cell (x, y)'s twist in row y of the twist plane: hf_cell_twist, 0 in the last row and column. */
+static void hf_twist_row(const hfvis_grid *g, int y, double *tw)
+{
+    const float *zr = g->z + (ptrdiff_t)y * g->stride;
+    int x;
+    for (x = 0; x < g->width; x++)
+        tw[x] = x + 1 < g->width && y + 1 < g->height ? hf_cell_twist(zr + x, g->stride) : 0.0;
+}
+
+/* The class of the grid's heights: 0 all finite, 1 holes and no infinite height, 2 an
+ * infinite height (exact rays: hf_exact.finite, hf_exact.inf). */
+static int hf_height_class(const hfvis_grid *g)
+{
+    int y, x, nonfinite = 0;
+    for (y = 0; y < g->height; y++) nonfinite |= hf_row_nonfinite(g->z + (ptrdiff_t)y * g->stride, g->width);
+    if (!nonfinite) return 0;
+    for (y = 0; y < g->height; y++)
+        for (x = 0; x < g->width; x++)
+            if (isinf(g->z[(ptrdiff_t)y * g->stride + x])) return 2;
+    return 1;
+}
+
+hfvis_status hfvis_exact_grid_compute(const hfvis_grid *grid, double *out)
+{
+    int y;
+    if (!hf_grid_valid(grid) || !out) return HFVIS_ERR_INVALID_ARGUMENT;
+    for (y = 0; y < grid->height; y++) hf_twist_row(grid, y, out + (size_t)y * (size_t)grid->width);
+    out[hf_grid_count(grid)] = (double)hf_height_class(grid);
+    return HFVIS_OK;
 }
 
 /* The four taps of cell (cx, cy) under the border rule into z (z00, z10, z01, z11: a 2 x 2 cell
@@ -9160,28 +9219,114 @@ static int hf_exact_rect_span(const hf_exact *E, int hx, int hy, int a, int b, i
  * the grid, so its cell is inside too), zn at the nearer grid point's height, appended to
  * (sd, sh) from index n far end first at distances base - offset; returns the new count and
  * counts a split in *splits. hf_piece_samples' test and samples, bit for bit; the twist from the
- * four taps the midpoint reads. eager: the midpoint of a piece split in two (most splits) is
- * written for every piece and kept by the test's outcome, without a branch. */
-static inline int hf_exact_piece(const hfvis_grid *g, const hf_cross *c, const float *zn, double base,
-                                 double lim, double *sd, double *sh, int n, int eager, int *splits)
+ * plane of the cells' twists (hf_exact.twist; tn: the nearer grid point's cell there), so a piece
+ * that does not bulge costs a load and a compare and its taps are read only for its samples.
+ * eager: the midpoint of a piece split in two (most splits) is written for every piece and kept
+ * by the test's outcome, without a branch. */
+static HFVIS__ALWAYS_INLINE int hf_exact_piece(const hfvis_grid *g, const hf_cross *c, const float *zn,
+                                               const double *tn, double base, double lim, double *sd,
+                                               double *sh, int n, int eager, int *splits)
 {
-    const float *p = zn + c->coff;
-    double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[g->stride];
-    double z11 = (double)p[g->stride + 1], bulge = c->q * hf_cell_twist(p, g->stride);
-    int split = (bulge > lim) & (bulge < HFVIS__INF);
-    *splits += split;
-    if (bulge > 4.0 * lim && bulge < HFVIS__INF) { /* split into 4 or more (hf_piece_fill's m >= 4): rare */
-        double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
-        int j = hf_piece_fill(p, g->stride, c, bulge, lim, ph, pu);
-        while (j-- > 0) { /* far end first */
-            sd[n] = base - (c->u + pu[j]);
-            sh[n++] = ph[j];
+    const double bulge = c->q * tn[c->toff]; /* q hf_cell_twist, from the plane */
+    if (eager || bulge > lim) { /* not eager: most pieces end at the one test (NaN at holes) */
+        const float *p = zn + c->coff;
+        double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[g->stride], z11 = (double)p[g->stride + 1];
+        int split = (bulge > lim) & (bulge < HFVIS__INF);
+        *splits += split;
+        if (bulge > 4.0 * lim && bulge < HFVIS__INF) { /* split into 4 or more (hf_piece_fill's m >= 4): rare */
+            double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
+            int j = hf_piece_fill(p, g->stride, c, bulge, lim, ph, pu);
+            while (j-- > 0) { /* far end first */
+                sd[n] = base - (c->u + pu[j]);
+                sh[n++] = ph[j];
+            }
+        } else { /* split in two (a kept one has four finite taps: a finite height), or eager */
+            double r0 = z00 + (z10 - z00) * c->mfx, r1 = z01 + (z11 - z01) * c->mfx;
+            sd[n] = base - c->mu;
+            sh[n] = r0 + (r1 - r0) * c->mfy;
+            n += split;
         }
-    } else if (eager || split) { /* split in two (a kept one has four finite taps: a finite height) */
-        double r0 = z00 + (z10 - z00) * c->mfx, r1 = z01 + (z11 - z01) * c->mfx;
-        sd[n] = base - c->mu;
-        sh[n] = r0 + (r1 - r0) * c->mfy;
-        n += split;
+    }
+    return n;
+}
+
+/* The inner part of a line for hf_exact_samples: grid points q = 0..qn from z0 (heights) and
+ * tn (twists, at point 1), each with the crossings and piece samples behind it, appended from
+ * index n; returns the new count. finite (a constant at each call, so the compiler writes one
+ * loop for each): every height of the grid is finite (hf_exact.finite), so every grid point and
+ * crossing is a finite sample and no hole test is made (the same samples). */
+static HFVIS__ALWAYS_INLINE int hf_exact_inner(const hf_exact *E, int finite, ptrdiff_t z0, ptrdiff_t zstep,
+                                               const double *tn, ptrdiff_t tstep, int pieces, int P, double L,
+                                               int qn, double *sd, double *sh, int *rec, int n, int eager,
+                                               int *splits)
+{
+    const hfvis_grid *g = E->g;
+    const hf_cross *cr = E->cross;
+    const double lim = HF_EXACT_BULGE * g->cell_size;
+    double bq = 0.0; /* q L, exact (integers below 2^53) */
+    int q, e;
+    for (q = 0;; q++) {
+        const ptrdiff_t zq = z0 - (ptrdiff_t)q * zstep;
+        const float *zn;
+        double h = (double)g->z[zq], base;
+        sd[n] = bq;
+        sh[n] = finite || isfinite(h) ? h : HFVIS__NAN;
+        rec[q] = n++;
+        if (q == qn) break;
+        /* between grid points q and q + 1, both inside the grid, so are the crossings and cells */
+        zn = g->z + (zq - zstep);
+        tn -= tstep;
+        base = bq + L;
+        bq = base;
+        if (!pieces) continue; /* an axis: grid point q + 1 is the next sample */
+        for (e = P - 1; e > 0; e--) { /* the piece after crossing e, then crossing e */
+            const hf_cross *c = cr + e;
+            n = hf_exact_piece(g, c, zn, tn, base, lim, sd, sh, n, eager, splits);
+            h = (double)zn[c->zoff];
+            h += ((double)zn[c->zoff + c->zstep] - h) * c->f; /* as hf_cross_height */
+            sd[n] = base - c->u;
+            sh[n] = h;
+            n += finite || isfinite(h) ? 1 : 0; /* a hole: overwritten by the next sample */
+        }
+        n = hf_exact_piece(g, cr, zn, tn, base, lim, sd, sh, n, eager, splits); /* crossing 0: point q + 1 */
+    }
+    return n;
+}
+
+/* The head of a line for hf_exact_samples: the samples beyond grid point q = 0 (hx, hy), in
+ * sweep order into (sd, sh); returns their count. */
+static int hf_exact_head(const hf_exact *E, int hx, int hy, int a, int b, int P, double L, double *sd,
+                         double *sh)
+{
+    const hfvis_grid *g = E->g;
+    const hf_cross *cr = E->cross;
+    const double lim = HF_EXACT_BULGE * g->cell_size;
+    double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
+    int n = 0, k, e, j;
+    for (k = hf_exact_periods(g, E->R, hx, hy, a, b); k >= 0; k--) {
+        int bx = hx + k * a, by = hy + k * b;
+        for (e = P - 1; e >= 0; e--) {
+            int X = bx + cr[e].ox, Y = by + cr[e].oy, CX = bx + cr[e].cx, CY = by + cr[e].cy;
+            double h;
+            j = 0;
+            if (CX >= 0 && CY >= 0 && CX + 1 < g->width && CY + 1 < g->height) {
+                /* a cell inside the grid: hf_piece_samples' bulge test on the taps in place */
+                double bulge = cr[e].q * hf_cell_twist(g->z + (ptrdiff_t)CY * g->stride + CX, g->stride);
+                if (bulge > lim) j = hf_piece_samples(g, E->border, E->R, bx, by, cr + e, ph, pu);
+            } else if (E->border != HFVIS_BORDER_OPEN) { /* OPEN: no cell outside the grid */
+                j = hf_piece_samples(g, E->border, E->R, bx, by, cr + e, ph, pu);
+            }
+            while (j-- > 0) { /* the piece after crossing e, far end first */
+                if (isnan(ph[j])) continue;
+                sd[n] = -((double)k * L + (cr[e].u + pu[j]));
+                sh[n++] = ph[j];
+            }
+            if ((k == 0 && e == 0) || !hf_cross_inside(g, E->R, X, Y, cr + e)) continue;
+            h = hf_cross_height(g, E->border, X, Y, cr + e);
+            if (isnan(h)) continue;
+            sd[n] = -((double)k * L + cr[e].u);
+            sh[n++] = h;
+        }
     }
     return n;
 }
@@ -9197,53 +9342,13 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
                             double *sd, double *sh, int *rec, int *eager_io)
 {
     const hfvis_grid *g = E->g;
-    const hf_cross *cr = E->cross;
     const ptrdiff_t z0 = (ptrdiff_t)hy * g->stride + hx, zstep = (ptrdiff_t)b * g->stride + a;
-    const double lim = HF_EXACT_BULGE * g->cell_size;
+    const ptrdiff_t tstep = (ptrdiff_t)b * g->width + a;
+    const double *tn = E->twist + ((ptrdiff_t)hy * g->width + hx); /* the twists at grid point q + 1 */
     const int pieces = a != 0 && b != 0; /* along a grid line the surface is linear */
-    double ph[HF_EXACT_MAX_SPLIT], pu[HF_EXACT_MAX_SPLIT];
-    int n = 0, k, e, q, j, splits = 0, eager = *eager_io;
-    for (k = hf_exact_periods(g, E->R, hx, hy, a, b); k >= 0; k--) {
-        int bx = hx + k * a, by = hy + k * b;
-        for (e = P - 1; e >= 0; e--) {
-            int X = bx + cr[e].ox, Y = by + cr[e].oy;
-            double h;
-            j = hf_piece_samples(g, E->border, E->R, bx, by, cr + e, ph, pu);
-            while (j-- > 0) { /* the piece after crossing e, far end first */
-                if (isnan(ph[j])) continue;
-                sd[n] = -((double)k * L + (cr[e].u + pu[j]));
-                sh[n++] = ph[j];
-            }
-            if ((k == 0 && e == 0) || !hf_cross_inside(g, E->R, X, Y, cr + e)) continue;
-            h = hf_cross_height(g, E->border, X, Y, cr + e);
-            if (isnan(h)) continue;
-            sd[n] = -((double)k * L + cr[e].u);
-            sh[n++] = h;
-        }
-    }
-    for (q = 0;; q++) {
-        const ptrdiff_t zq = z0 - (ptrdiff_t)q * zstep;
-        const float *zn;
-        double h = (double)g->z[zq], base;
-        sd[n] = (double)q * L;
-        sh[n] = isfinite(h) ? h : HFVIS__NAN;
-        rec[q] = n++;
-        if (q == qn) break;
-        /* between grid points q and q + 1, both inside the grid, so are the crossings and cells */
-        zn = g->z + (zq - zstep);
-        base = (double)(q + 1) * L;
-        if (!pieces) continue; /* an axis: grid point q + 1 is the next sample */
-        for (e = P - 1; e > 0; e--) { /* the piece after crossing e, then crossing e */
-            const hf_cross *c = cr + e;
-            n = hf_exact_piece(g, c, zn, base, lim, sd, sh, n, eager, &splits);
-            h = (double)zn[c->zoff];
-            h += ((double)zn[c->zoff + c->zstep] - h) * c->f; /* as hf_cross_height */
-            sd[n] = base - c->u;
-            sh[n] = h;
-            n += isfinite(h) ? 1 : 0; /* a hole: overwritten by the next sample */
-        }
-        n = hf_exact_piece(g, cr, zn, base, lim, sd, sh, n, eager, &splits); /* crossing 0: point q + 1 */
-    }
+    int n = hf_exact_head(E, hx, hy, a, b, P, L, sd, sh), splits = 0, eager = *eager_io;
+    n = E->finite ? hf_exact_inner(E, 1, z0, zstep, tn, tstep, pieces, P, L, qn, sd, sh, rec, n, eager, &splits)
+                  : hf_exact_inner(E, 0, z0, zstep, tn, tstep, pieces, P, L, qn, sd, sh, rec, n, eager, &splits);
     if (pieces && qn > 0) *eager_io = (double)splits > HF_EXACT_EAGER_SHARE * (double)qn * (double)P;
     return n;
 }
@@ -9282,9 +9387,100 @@ static void hf_exact_hull(double *sd, double *sh, const int *rec, int nrec, doub
     }
 }
 
+/* hf_hull_push on a stack of (height, distance) pairs (hf_exact.stk): the same tests, the same
+ * arithmetic in the same order, so the same pops and tangents; one pointer p to the next free
+ * pair, two NaN pairs below the first. */
+static inline double hf_exact_push(double **top_io, double h, double d, double a1, double b1)
+{
+    double *p = *top_io, t, a2, b2;
+    for (;;) {
+        a2 = p[-4] - h;
+        b2 = d - p[-3];
+        if (!(a2 * b1 >= a1 * b2)) {
+            t = a1 / b1;
+            break;
+        }
+        p -= 2;
+        a1 = p[-4] - h;
+        b1 = d - p[-3];
+        if (!(a1 * b2 >= a2 * b1)) {
+            t = a2 / b2;
+            break;
+        }
+        p -= 2;
+    }
+    p[0] = h;
+    p[1] = d;
+    *top_io = p + 2;
+    return t;
+}
+
+/* hf_exact_samples and hf_exact_hull in one pass, for a line on a grid without holes or infinite
+ * heights (hf_exact.finite): the head's samples go through the hull as there, then each sample
+ * of the inner part is pushed as it is made (its crossing's height, a split piece's samples
+ * through hf_exact_piece into a few slots of their own), so the samples are not stored and read
+ * back and each grid point's tangent is taken where it is made, without a loop over the samples
+ * before it. The same samples in the same order through the same hull steps: the same tangents,
+ * bit for bit. A piece is split under a branch here (no eager midpoints, HF_EXACT_EAGER_SHARE):
+ * the two-pass form moves that branch's randomness into the hull's loop over a receiver's
+ * samples, whose exit then depends on the splits as much. */
+static void hf_exact_fused(hf_exact *E, int hx, int hy, int a, int b, int P, double L, int qn, double scale,
+                           ptrdiff_t t0)
+{
+    const hfvis_grid *g = E->g;
+    const hf_cross *cr = E->cross;
+    const ptrdiff_t zstep = (ptrdiff_t)b * g->stride + a, wstep = (ptrdiff_t)b * g->width + a;
+    const double lim = HF_EXACT_BULGE * g->cell_size;
+    const int pieces = a != 0 && b != 0; /* along a grid line the surface is linear */
+    const float *zq = g->z + ((ptrdiff_t)hy * g->stride + hx);
+    const double *tn = E->twist + ((ptrdiff_t)hy * g->width + hx); /* the twists at grid point q + 1 */
+    double *sd = E->sd, *sh = E->sh, *tan = E->tan + t0, *top = E->stk + 4;
+    /* the top before the first push: -inf at a finite distance below every sample's, so that the
+       first push (its pop test fails on the NaN pair, as hf_exact_hull's on its NaN top) returns
+       -inf / (d - dt) = -inf, the tangent of "nothing before", without a test at every receiver */
+    double dt = -DBL_MAX, ht = -HFVIS__INF, bq = 0.0, pd[HF_EXACT_MAX_SPLIT], ph[HF_EXACT_MAX_SPLIT];
+    int n = hf_exact_head(E, hx, hy, a, b, P, L, sd, sh), i, q, e, j, splits = 0;
+    for (i = 0; i < n; i++) { /* the head: as hf_exact_hull before receiver 0 */
+        const double d = sd[i], h = sh[i];
+        (void)hf_exact_push(&top, h, d, ht - h, d - dt);
+        dt = d;
+        ht = h;
+    }
+    for (q = 0;; q++) {
+        double h = (double)*zq, d = bq, t = hf_exact_push(&top, h, d, ht - h, d - dt), base;
+        tan[-(ptrdiff_t)q * wstep] = t * scale; /* scale > 0 */
+        dt = d;
+        ht = h;
+        if (q == qn) break;
+        zq -= zstep; /* grid point q + 1 */
+        tn -= wstep;
+        base = bq + L;
+        bq = base;
+        if (!pieces) continue; /* an axis: grid point q + 1 is the next sample */
+        for (e = P - 1;; e--) { /* the piece after crossing e, then crossing e (0: point q + 1) */
+            const hf_cross *c = cr + e;
+            if (c->q * tn[c->toff] > lim) { /* split (rare): hf_exact_piece's samples, pushed */
+                j = hf_exact_piece(g, c, zq, tn, base, lim, pd, ph, 0, 0, &splits);
+                for (i = 0; i < j; i++) {
+                    (void)hf_exact_push(&top, ph[i], pd[i], ht - ph[i], pd[i] - dt);
+                    dt = pd[i];
+                    ht = ph[i];
+                }
+            }
+            if (e == 0) break;
+            h = (double)zq[c->zoff];
+            h += ((double)zq[c->zoff + c->zstep] - h) * c->f; /* as hf_cross_height */
+            d = base - c->u;
+            (void)hf_exact_push(&top, h, d, ht - h, d - dt);
+            dt = d;
+            ht = h;
+        }
+    }
+}
+
 /* One line of direction (a, b) from its head (hx, hy) (hf_exact_samples): the tangents of its
- * grid points up to the last one in the receiver rectangle, by the hull or, under a finite
- * radius, by hf_window_line. */
+ * grid points up to the last one in the receiver rectangle, by the hull (in one pass with the
+ * samples where hf_exact_fused applies) or, under a finite radius, by hf_window_line. */
 static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, double L, double scale)
 {
     const hfvis_grid *g = E->g;
@@ -9294,7 +9490,9 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
         if (!hf_exact_rect_span(E, hx, hy, a, b, &qhi)) return; /* no receiver wanted */
         if (qhi < qn) qn = qhi;
     }
-    if (E->win_rw < 0) {
+    if (E->win_rw < 0 && E->finite) {
+        hf_exact_fused(E, hx, hy, a, b, P, L, qn, scale, t0);
+    } else if (E->win_rw < 0) {
         hf_exact_samples(E, hx, hy, a, b, P, L, qn, E->sd, E->sh, E->rec, &E->eager);
         hf_exact_hull(E->sd, E->sh, E->rec, qn + 1, scale, E->tan, t0, tstep);
     } else {
@@ -9387,7 +9585,7 @@ static void hf_exact_near(hf_exact *E, hf_ray r, double L, double scale)
     const double inv_den = hf_exact_inv_den(g, a, b), ucut = (double)E->win_rw / 16.0;
     const double Ad = (double)(a < 0 ? -a : a), Bd = (double)(b < 0 ? -b : b);
     const int diag = a != 0 && b != 0;
-    int x, y;
+    int x, y, part;
     for (y = E->ry0; y < E->ry1; y++) {
         double *t = E->tan + (size_t)y * (size_t)g->width;
         const float *z = g->z + (ptrdiff_t)y * g->stride;
@@ -9395,28 +9593,48 @@ static void hf_exact_near(hf_exact *E, hf_ray r, double L, double scale)
         const int cy = b < 0 ? y - 1 : y, sx = a < 0 ? -1 : 1;
         const ptrdiff_t sy = b < 0 ? -g->stride : g->stride;
         const int in_row = cy >= 0 && cy + 1 < g->height;
-        int x0, x1;
+        int x0, x1, xa, xb;
         hf_exact_span(E, y, r, &x0, &x1); /* this call's lines: the others' were not swept */
-        for (x = x0; x < x1; x++) {
-            double s;
-            if (isnan(t[x])) continue;
-            if (diag) {
-                int cx = a < 0 ? x - 1 : x;
-                if (in_row && cx >= 0 && cx + 1 < g->width) {
-                    /* finite s: finite zx and zy (|s| <= 2^128 4096 / den); then zd decides */
-                    double hr = (double)z[x], zx = (double)z[x + sx], zy = (double)z[x + sy];
-                    s = ((zx - hr) * Ad + (zy - hr) * Bd) * inv_den;
-                    if (!isfinite(s) || !isfinite(z[x + sx + sy])) s = -HFVIS__INF;
-                } else {
-                    s = hf_exact_first_slope(g, E->border, E->R, x, y, a, b, (double)z[x], inv_den);
-                }
-                if (s > t[x]) t[x] = s;
-            }
-            if (E->win_rw >= 0) {
-                s = hf_exact_cut(g, E->border, E->R, x, y, a, b, L, ucut, (double)z[x]) * scale;
-                if (s > t[x]) t[x] = s;
-            }
+        xa = xb = x1; /* receivers whose first cell is inside the grid, in pairs: [xa, xb) */
+        if (diag && in_row && E->win_rw < 0) {
+            xa = a < 0 && x0 < 1 ? 1 : x0;
+            xb = a > 0 && x1 > g->width - 1 ? g->width - 1 : x1;
+            xb = xb > xa ? xa + ((xb - xa) & ~1) : xa;
         }
+        /* there without a branch, two receivers a step (C99 the compiler can pack into vectors
+           at -O2): a NaN tangent (a hole) stays NaN, and a limit that is not finite (a tap not
+           finite, as below) is -INFINITY, which never wins */
+        for (x = xa; x < xb; x += 2) {
+            double h0 = (double)z[x], h1 = (double)z[x + 1], t0 = t[x], t1 = t[x + 1];
+            double s0 = (((double)z[x + sx] - h0) * Ad + ((double)z[x + sy] - h0) * Bd) * inv_den;
+            double s1 = (((double)z[x + 1 + sx] - h1) * Ad + ((double)z[x + 1 + sy] - h1) * Bd) * inv_den;
+            double d0 = (double)z[x + sx + sy], d1 = (double)z[x + 1 + sx + sy];
+            s0 = (fabs(s0) <= DBL_MAX) & (fabs(d0) <= DBL_MAX) ? s0 : -HFVIS__INF;
+            s1 = (fabs(s1) <= DBL_MAX) & (fabs(d1) <= DBL_MAX) ? s1 : -HFVIS__INF;
+            t[x] = s0 > t0 ? s0 : t0;
+            t[x + 1] = s1 > t1 ? s1 : t1;
+        }
+        for (part = 0; part < 2; part++) /* the rest, [x0, xa) and [xb, x1), one by one */
+            for (x = part ? xb : x0; x < (part ? x1 : xa); x++) {
+                double s;
+                if (isnan(t[x])) continue;
+                if (diag) {
+                    int cx = a < 0 ? x - 1 : x;
+                    if (in_row && cx >= 0 && cx + 1 < g->width) {
+                        /* finite s: finite zx and zy (|s| <= 2^128 4096 / den); then zd decides */
+                        double hr = (double)z[x], zx = (double)z[x + sx], zy = (double)z[x + sy];
+                        s = ((zx - hr) * Ad + (zy - hr) * Bd) * inv_den;
+                        if (!isfinite(s) || !isfinite(z[x + sx + sy])) s = -HFVIS__INF;
+                    } else {
+                        s = hf_exact_first_slope(g, E->border, E->R, x, y, a, b, (double)z[x], inv_den);
+                    }
+                    if (s > t[x]) t[x] = s;
+                }
+                if (E->win_rw >= 0) {
+                    s = hf_exact_cut(g, E->border, E->R, x, y, a, b, L, ucut, (double)z[x]) * scale;
+                    if (s > t[x]) t[x] = s;
+                }
+            }
     }
 }
 
@@ -9708,17 +9926,18 @@ static int hf_far_samples(hf_exact *E, int64_t px, int64_t py, int a, int b, int
         if (X0 >= 0 && X1 >= 0 && X0 < g->width && X1 < g->width && Y0 >= 0 && Y1 >= 0 &&
             Y0 < g->height && Y1 < g->height) {
             const float *zn = g->z + (ptrdiff_t)Y0 * g->stride + (ptrdiff_t)X0;
+            const double *tn = E->twist + ((ptrdiff_t)Y0 * g->width + (ptrdiff_t)X0);
             double h;
             for (e = P - 1; e > 0; e--) { /* as hf_exact_samples between two grid points */
                 const hf_cross *c = cr + e;
-                n = hf_exact_piece(g, c, zn, base, lim, sd, sh, n, eager, &splits);
+                n = hf_exact_piece(g, c, zn, tn, base, lim, sd, sh, n, eager, &splits);
                 h = (double)zn[c->zoff];
                 h += ((double)zn[c->zoff + c->zstep] - h) * c->f;
                 sd[n] = base - c->u;
                 sh[n] = h;
                 n += isfinite(h) ? 1 : 0;
             }
-            n = hf_exact_piece(g, cr, zn, base, lim, sd, sh, n, eager, &splits);
+            n = hf_exact_piece(g, cr, zn, tn, base, lim, sd, sh, n, eager, &splits);
             h = (double)zn[0];
             sd[n] = base;
             sh[n] = h;
@@ -10127,6 +10346,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
 {
     size_t total = 0, off_ray, off_d, off_c, off_s, off_t = 0, off_n = 0, off_a = 0, gridn, cap;
     size_t off_win = 0, off_r, off_fp = 0, off_fm = 0, off_no = 0, off_row = 0, off_fl = 0, off_tw = 0;
+    size_t off_stk = 0;
     int ok = 1, k, maxp = 1, side = g->width > g->height ? g->width : g->height;
     unsigned char *blk;
     memset(E, 0, sizeof *E);
@@ -10176,8 +10396,9 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
         off_no = hf_align_add(&total, 2u * (size_t)E->near + 2u * (size_t)maxp + 4u, sizeof(hf_near_off), &ok);
         off_row = hf_align_add(&total, (size_t)g->width, sizeof(double), &ok);
         off_fl = hf_align_add(&total, (size_t)maxp + 2u, sizeof(hf_far_line), &ok);
-        off_tw = hf_align_add(&total, gridn, sizeof(double), &ok);
     }
+    if (want_tan && !o->exact_grid) off_tw = hf_align_add(&total, gridn, sizeof(double), &ok);
+    if (want_tan) off_stk = hf_align_add(&total, cap + 2u, 2u * sizeof(double), &ok);
     if (!ok) return HFVIS_ERR_LIMIT;
     blk = (unsigned char *)hfvis__alloc(o->alloc, total);
     if (!blk) return HFVIS_ERR_OUT_OF_MEMORY;
@@ -10204,16 +10425,16 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
         E->noff = (hf_near_off *)(void *)(blk + off_no);
         E->row = (double *)(void *)(blk + off_row);
         E->flines = (hf_far_line *)(void *)(blk + off_fl);
-        E->twist = (double *)(void *)(blk + off_tw);
-        for (k = 0; k < g->height; k++) {
-            const float *zr = g->z + (ptrdiff_t)k * g->stride;
-            double *tw = E->twist + (ptrdiff_t)k * g->width;
-            int x;
-            for (x = 0; x < g->width; x++) {
-                E->inf |= isinf(zr[x]) != 0;
-                tw[x] = x + 1 < g->width && k + 1 < g->height ? hf_cell_twist(zr + x, g->stride) : 0.0;
-            }
-        }
+    }
+    if (want_tan) {
+        double *own = o->exact_grid ? NULL : (double *)(void *)(blk + off_tw);
+        const double cls = o->exact_grid ? o->exact_grid[gridn] : (double)hf_height_class(g);
+        E->twist = o->exact_grid ? o->exact_grid : own;
+        E->stk = (double *)(void *)(blk + off_stk);
+        E->stk[0] = E->stk[1] = E->stk[2] = E->stk[3] = HFVIS__NAN; /* below the stack */
+        for (k = 0; own && k < g->height; k++) hf_twist_row(g, k, own + (ptrdiff_t)k * g->width);
+        E->finite = cls == 0.0;
+        E->inf |= cls == 2.0;
     }
     hf_exact_dirs_fill(&E->d, K, o->azimuth0_rad, E->N);
     if (want_normals == 1 && E->nrm_own) (void)hfvis_normals_compute(g, E->nrm_own); /* as floats */

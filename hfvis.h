@@ -172,7 +172,9 @@
  *   (hfvis_direction_sums, one group per part, added in order), the exact sums by bands of one
  *   direction at a time (added in place), the horizon map by plane range, one sun by bands,
  *   solar irradiation by row ranges over one caller-made horizon map,
- *   and any receiver-local result by windows ("Search radius and tiles"). The hfvis tool's
+ *   and any receiver-local result by windows ("Search radius and tiles"); what every call would
+ *   derive from the grid alone can be made once and shared (sweep options normals, exact_grid).
+ *   The hfvis tool's
  *   --threads does exactly that; test/thread_test.c runs these calls concurrently on shared
  *   inputs under ThreadSanitizer (make sanitize).
  * Memory. The caller owns every output and sizes it with the documented formula or a *_size()
@@ -544,6 +546,16 @@ HFVIS_API double hfvis_grid_sample(const hfvis_grid *grid, double x, double y);
  * Returns HFVIS_OK or HFVIS_ERR_INVALID_ARGUMENT. Cost O(width*height). */
 HFVIS_API hfvis_status hfvis_normals_compute(const hfvis_grid *grid, float *out);
 
+/* The data exact rays derive from a grid before they trace (hfvis.h "Exact rays"), for a run
+ * split into several calls over one grid (hfvis.h "Threads") to compute once and pass to each
+ * call in hfvis_sweep_options.exact_grid (every call otherwise computes it in its scratch):
+ * width*height + 1 doubles, out[y*width + x] the twist z(x, y) - z(x+1, y) - z(x, y+1) +
+ * z(x+1, y+1) of cell (x, y) of the bilinear surface (the cross term that makes a cell bulge
+ * between its edges; 0 in the last row and column), out[width*height] the class of the heights
+ * (0 all finite, 1 holes and no infinite height, 2 an infinite height). Returns HFVIS_OK or
+ * HFVIS_ERR_INVALID_ARGUMENT. Cost O(width*height). */
+HFVIS_API hfvis_status hfvis_exact_grid_compute(const hfvis_grid *grid, double *out);
+
 /* The parallel-line lattice of one look direction (docs/errata.md E5). Sweep direction
  * u = -(cos psi, sin psi), line offset v = (-u.y, u.x); node (i, j) lies at grid position
  * i*u + j*v; line j is traversed in increasing i. Lattice buffers are row-major with
@@ -671,6 +683,13 @@ typedef struct hfvis_sweep_options {
                                        "Exact rays", "Near and far field"), for the directions
                                        whose lines are longer than D between grid points and
                                        without a radius; 0..HFVIS_RAY_NEAR_CELLS_MAX */
+    const double *exact_grid;       /* NULL (default), or this grid's data exactly as
+                                       hfvis_exact_grid_compute writes it (width*height + 1
+                                       doubles), only read: exact rays read it instead of
+                                       computing it (8 bytes a sample of scratch and a pass over
+                                       the grid per call), so that the calls of a split run
+                                       compute it once. Other values change the results (not
+                                       checked) */
 } hfvis_sweep_options;
 
 HFVIS_API hfvis_sweep_options hfvis_sweep_options_default(void);
@@ -862,9 +881,13 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     average, plus the interior samples below. The mean |a| + |b| of the default directions:
  *     K = 16: 4.2, K = 64: 11.7, K = 256: 15.5, K = 360: 20.5 (the nearest with N = ceil(K/4)
  *     would take 12.1, 51.5, 73). Measured (make bench, section exact, 512^2 and 1024^2,
- *     K = 16): the horizon map 0.65-0.85x the lattice map's time on urban DSMs (no gather),
- *     1.2-2.3x on fBm rough at the cell scale; the fused sky-view factor 1.2-2.1x and 2.1-4.1x;
+ *     K = 16, a quiet run 2026-12-07): the horizon map 0.53-0.57x the lattice map's time on
+ *     urban DSMs (no gather), 1.05-1.45x on fBm rough at the cell scale; the fused sky-view
+ *     factor 1.12-1.36x and 1.81-3.08x (earlier runs: up to 2.1x and 4.1x);
  *     at K = 64, 256, 360 on fBm 512^2 8.9x, 8.5x, 14.5x (docs/exact-rays.md, "Cost at large K").
+ *     Instructions (callgrind, sky-view factor of the bench's fBm at 256^2): about 250 per
+ *     receiver-direction at K = 16 and 650 at K = 64, the lattice about 104 (docs/exact-rays.md,
+ *     "Fifth pass at K = 16").
  *   - Quadrature: every direction integral uses the actual azimuths phi_k. Direction k owns the
  *     sector between the midpoints to its neighbours (edges rounded to multiples of 2^-40 turn,
  *     so the shares w_k are exact and add up to exactly 1): the sky-view factor is
@@ -883,8 +906,10 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     HFVIS_ERR_INVALID_ARGUMENT for HFVIS_RAYS_EXACT. hfvis_horizon_lattice and the *_from_map
  *     routines (uniform azimuths) ignore the field.
  *   - Outputs are written at grid points directly (no gather). Scratch: one block of about
- *     8*width*height bytes (plus 12 for normals and 8*channels for the lighting sums) and the
- *     hull stack, 16*(16*(W + H + 2) + 4*border_cells) bytes.
+ *     16*width*height bytes (the tangents and the cells' twists, 8 without them with
+ *     opts->exact_grid; plus 12 for normals and
+ *     8*channels for the lighting sums) and a line's samples and hull stack,
+ *     32*(16*(W + H + 2) + 4*border_cells) bytes.
  *   - Near and far field (opts->ray_near_cells = D > 0; 0, the default, is the sweep above bit
  *     for bit). A direction whose line is longer than D cells between grid points (|(a, b)| > D)
  *     costs |a| + |b| - 1 crossings per receiver in the sweep; instead each receiver takes the
@@ -905,8 +930,7 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     0.10-0.37 deg mean and 1.7-10.2 deg p99 from the supremum, all pairs (walls and cliffs seen
  *     or missed half a cell across), held to HFVIS_EXACT_FAR_MEAN_DEG / _P99_DEG. Receiver
  *     rectangles and sun bands equal the whole run bit for bit (a receiver's value depends on
- *     its own position only). Scratch: 12 bytes more per sample of a line, 8*width bytes and
- *     8*width*height bytes (the cells' twists).
+ *     its own position only). Scratch: 12 bytes more per sample of a line and 8*width bytes.
  *     Cost (callgrind, sky-view factor of rough fBm 256^2, D = 8): about 640 instructions per
  *     receiver-direction at K = 256 and 580 at K = 64 (the lattice: about 100; the sweep:
  *     1150-1560 at 128^2), about 200 of them the near stencil; 4.1-4.6x the lattice's time at

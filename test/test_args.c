@@ -71,6 +71,7 @@
     X(field_generate, S, -, "NZGOFESR", "INVALID_ARGUMENT") \
     X(grid_sample, V, -, "NZF", "NaN") \
     X(normals_compute, S, -, "NZGOFR", "INVALID_ARGUMENT") \
+    X(exact_grid_compute, S, -, "NZGOFR", "INVALID_ARGUMENT") \
     X(lattice_init, S, -, "NZGOF", "INVALID_ARGUMENT LIMIT") \
     X(lattice_nodes, V, -, "N", "0") \
     X(lattice_line, V, -, "NR", "0") \
@@ -1059,6 +1060,17 @@ static void args_normals_compute(void)
     BAD('N', INV, hfvis_normals_compute(NULL, out));
     BAD('N', INV, hfvis_normals_compute(&g_ok, NULL));
     GRID_CASES(hfvis_normals_compute(&bg, out));
+}
+
+static void args_exact_grid_compute(void)
+{
+    double *out;
+    begin("exact_grid_compute");
+    out = AD(GW * GH + 1);
+    OK(hfvis_exact_grid_compute(&g_ok, out));
+    BAD('N', INV, hfvis_exact_grid_compute(NULL, out));
+    BAD('N', INV, hfvis_exact_grid_compute(&g_ok, NULL));
+    GRID_CASES(hfvis_exact_grid_compute(&bg, out));
 }
 
 static void args_lattice_init(void)

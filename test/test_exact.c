@@ -422,6 +422,58 @@ TEST(split_runs)
     CHECK(bad_svf == 0);
 }
 
+/* hfvis_exact_grid_compute's data shared by the calls of a split run (the tool's threads) gives
+ * the calls' own results bit for bit: every class of heights (all finite: the inner loop
+ * without hole tests; holes; an infinite height), whole calls, bands, one direction, the sun,
+ * the near and far field; and a wrong class would change them (the data is what they read). */
+TEST(exact_grid_shared)
+{
+    static double data[61 * 47 + 1], own[61 * 47], shared[61 * 47];
+    static float sa[61 * 47], sb[61 * 47];
+    hfvis_sweep_options o = exact_opts(0.0, HFVIS_BORDER_OPEN, 0), f;
+    hfvis_grid g = test_grid(zbuf, 61, 47, 1.0);
+    size_t plane = 61u * 47u;
+    int cls, p, near;
+    for (cls = 0; cls < 3; cls++) {
+        fields_terraces(zbuf, 61, 47, 1.0, 4.0, 80.0, 3 + (uint64_t)cls);
+        if (cls >= 1) zbuf[20 * 61 + 30] = (float)NAN, zbuf[5 * 61 + 7] = (float)NAN;
+        if (cls == 2) zbuf[40 * 61 + 50] = (float)INFINITY;
+        CHECK_EQ_STATUS(hfvis_exact_grid_compute(&g, data), HFVIS_OK);
+        CHECK(data[plane] == (double)cls);
+        for (near = 0; near <= 1; near++) {
+            o.ray_near_cells = near ? 8 : 0; /* the near and far field at D = 8 */
+            f = o;
+            f.exact_grid = data;
+            CHECK_EQ_STATUS(hfvis_horizon_map(&g, 16, &o, out_a), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_horizon_map(&g, 16, &f, out_b), HFVIS_OK);
+            CHECK(memcmp(out_a, out_b, 16 * plane * sizeof(float)) == 0);
+            memset(own, 0, sizeof own);
+            memset(shared, 0, sizeof shared);
+            for (p = 0; p < 3; p++) { /* bands, as the tool's threads cut them */
+                o.part_index = f.part_index = p;
+                o.part_count = f.part_count = 3;
+                CHECK_EQ_STATUS(hfvis_direction_sums(&g, 64, HFVIS_SUM_SKY_VIEW, NULL, NULL, &o, own), HFVIS_OK);
+                CHECK_EQ_STATUS(hfvis_direction_sums(&g, 64, HFVIS_SUM_SKY_VIEW, NULL, NULL, &f, shared), HFVIS_OK);
+            }
+            CHECK(memcmp(own, shared, sizeof own) == 0);
+            o.part_index = o.part_count = f.part_index = f.part_count = 0;
+            CHECK_EQ_STATUS(hfvis_sun_visibility(&g, 0.37, 0.2, 0.01, &o, sa, 61), HFVIS_OK);
+            CHECK_EQ_STATUS(hfvis_sun_visibility(&g, 0.37, 0.2, 0.01, &f, sb, 61), HFVIS_OK);
+            CHECK(memcmp(sa, sb, sizeof sa) == 0);
+        }
+    }
+    /* the data is read, not recomputed: twists of another grid move the horizons */
+    o.ray_near_cells = 0;
+    f = o;
+    fields_terraces(zbuf, 61, 47, 1.0, 4.0, 80.0, 9);
+    CHECK_EQ_STATUS(hfvis_exact_grid_compute(&g, data), HFVIS_OK);
+    fields_terraces(zbuf, 61, 47, 1.0, 4.0, 80.0, 3);
+    f.exact_grid = data;
+    CHECK_EQ_STATUS(hfvis_horizon_map(&g, 16, &o, out_a), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_horizon_map(&g, 16, &f, out_b), HFVIS_OK);
+    CHECK(memcmp(out_a, out_b, 16 * plane * sizeof(float)) != 0);
+}
+
 /* The P2 sweeps keep their lattices; bad options are refused; the sun uses one direction. */
 TEST(modes_and_arguments)
 {
@@ -841,6 +893,7 @@ int main(int argc, char **argv)
     RUN(flat_field_quadrature_exact);
     RUN(light_consistent_with_map);
     RUN(split_runs);
+    RUN(exact_grid_shared);
     RUN(modes_and_arguments);
     RUN(allocation_failures);
     RUN(oracle_is_the_supremum);

@@ -50,6 +50,9 @@ struct cli_split {
                                             every unit of the phases before its own finished */
     void *ctx;                           /* the caller's */
     const hfvis_sweep_options *opts;     /* copied per unit; progress replaced */
+    const hfvis_grid *grid;              /* an exact-ray run's grid: its exact-ray data
+                                            (hfvis_exact_grid_compute) made once and shared by
+                                            every unit (sweep options exact_grid), or NULL */
     int next, merged, finished;          /* next unit to take; units merged; units finished */
     hfvis_status status;                 /* the first failure (by unit order of discovery) */
     long long done, total;               /* progress: library calls' steps over all threads */
@@ -254,7 +257,20 @@ static void *cli_split_worker(void *arg)
 static hfvis_status cli_split_run(cli_split *sp)
 {
     cli_worker args[CLI_THREADS_MAX];
+    const hfvis_sweep_options *given = sp->opts;
+    hfvis_sweep_options shared;
+    double *exact_data = NULL;
     int t;
+    if (sp->grid && given && given->rays == HFVIS_RAYS_EXACT && !given->exact_grid && sp->units > 1) {
+        /* hfvis_exact_grid_compute once, not in every unit's call; without the memory each
+         * call makes its own (the same values) */
+        exact_data = (double *)cli_huge_malloc(((size_t)sp->grid->width * (size_t)sp->grid->height + 1) * sizeof(double));
+        if (exact_data && hfvis_exact_grid_compute(sp->grid, exact_data) == HFVIS_OK) {
+            shared = *given;
+            shared.exact_grid = exact_data;
+            sp->opts = &shared;
+        }
+    }
     sp->next = sp->merged = sp->finished = 0;
     sp->status = HFVIS_OK;
     sp->done = 0;
@@ -280,6 +296,8 @@ static hfvis_status cli_split_run(cli_split *sp)
 #else
     cli_split_worker(&args[0]);
 #endif
+    sp->opts = given;
+    free(exact_data);
     return sp->status;
 }
 
@@ -419,6 +437,7 @@ static hfvis_status cli_threaded_sums(const hfvis_grid *grid, int K, hfvis_sum_k
     j.count = (size_t)grid->width * (size_t)grid->height * (size_t)channels;
     j.acc = acc;
     sp.opts = opts;
+    sp.grid = grid;
     sp.ctx = &j;
     if (opts->rays == HFVIS_RAYS_EXACT) { /* bands of one direction at a time, in place */
         j.bands = threads * CLI_EXACT_BANDS_PER_THREAD;
@@ -639,6 +658,7 @@ static hfvis_status cli_threaded_horizon_map(const hfvis_grid *grid, int K, cons
     sp.unit = cli_map_unit;
     sp.ctx = &j;
     sp.opts = opts;
+    sp.grid = grid;
     sp.total = K;
     s = cli_split_run(&sp);
     free(j.order);
@@ -687,6 +707,7 @@ static hfvis_status cli_threaded_sun(const hfvis_grid *grid, double azimuth, dou
     sp.unit = cli_sun_unit;
     sp.ctx = &j;
     sp.opts = opts;
+    sp.grid = grid;
     sp.total = j.bands;
     return cli_split_run(&sp);
 }
