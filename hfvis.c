@@ -12119,14 +12119,14 @@ static int hf_solar_block_nodes(const hfvis_grid *g, const hf_solar_ctx *c, cons
     if (anchored) { /* the caller's span */
         zmin = c->o.height_min;
         zmax = c->o.height_max;
-    }
-    for (y = anchored ? blk->y1 : blk->y0; y < blk->y1; y++)
-        for (x = blk->x0; x < blk->x1; x++) {
-            double z = (double)g->z[(ptrdiff_t)y * g->stride + x];
-            if (!isfinite(z)) continue;
-            if (z < zmin) zmin = z;
-            if (z > zmax) zmax = z;
-        }
+    } else
+        for (y = blk->y0; y < blk->y1; y++)
+            for (x = blk->x0; x < blk->x1; x++) {
+                double z = (double)g->z[(ptrdiff_t)y * g->stride + x];
+                if (!isfinite(z)) continue;
+                if (z < zmin) zmin = z;
+                if (z > zmax) zmax = z;
+            }
     if (!(zmin <= zmax)) zmin = zmax = 0.0; /* no finite height */
     nn = zmin == zmax ? 1 : hf_esra_pressure(zmin) - hf_esra_pressure(zmax) < HF_SOLAR_P_LINEAR ? 2 : maxn;
     for (j = 0; j < nn; j++)

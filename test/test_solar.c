@@ -232,16 +232,19 @@ TEST(esra_clear_sky)
 enum { W = 24, H = 24 };
 static float ob[5][W * H], rb[5][W * H];
 
-static hfvis_solar_output outs(float (*o)[W * H])
+/* The five outputs (beam, diffuse, reflected, global, sun hours) in consecutive blocks of n
+ * floats from base. */
+static hfvis_solar_output outs_at(float *base, size_t n)
 {
     hfvis_solar_output s;
-    s.beam = o[0];
-    s.diffuse = o[1];
-    s.reflected = o[2];
-    s.global = o[3];
-    s.sun_hours = o[4];
+    s.beam = base;
+    s.diffuse = base + n;
+    s.reflected = base + 2 * n;
+    s.global = base + 3 * n;
+    s.sun_hours = base + 4 * n;
     return s;
 }
+static hfvis_solar_output outs(float (*o)[W * H]) { return outs_at(o[0], (size_t)W * H); }
 
 static void plane(float *z, int w, int h, double cell, double slope_deg, double facing_psi)
 {
@@ -1168,16 +1171,7 @@ enum { RW = 72, RH = 20, NWIN = 5 }; /* wider than the day path's chunk of 64 co
 static float win_z[RW * RH];
 static float win_whole[5][30 * RW * RH], win_part[5][30 * RW * RH];
 
-static hfvis_solar_output win_outs(float (*o)[30 * RW * RH])
-{
-    hfvis_solar_output s;
-    s.beam = o[0];
-    s.diffuse = o[1];
-    s.reflected = o[2];
-    s.global = o[3];
-    s.sun_hours = o[4];
-    return s;
-}
+static hfvis_solar_output win_outs(float (*o)[30 * RW * RH]) { return outs_at(o[0], 30u * RW * RH); }
 
 /* Raster cell (x, y)'s site on a grid of 0.01 deg of latitude and 0.015 deg of longitude per
  * cell from (46 N, 15 E) at row 0 (north): 0.19 deg north to south, 1.07 deg west to east. */
