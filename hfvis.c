@@ -9082,26 +9082,39 @@ static void hf_twist_row(const hfvis_grid *g, int y, double *tw)
         tw[x] = x + 1 < g->width && y + 1 < g->height ? hf_cell_twist(zr + x, g->stride) : 0.0;
 }
 
-/* The class of the grid's heights: 0 all finite, 1 holes and no infinite height, 2 an
- * infinite height (exact rays: hf_exact.finite, hf_exact.inf). */
-static int hf_height_class(const hfvis_grid *g)
+/* The class of the heights of rows [y0, y1): 0 all finite, 1 holes and no infinite height, 2 an
+ * infinite height (exact rays: hf_exact.finite, hf_exact.inf). A grid's class is the largest of
+ * its row ranges' classes. */
+static int hf_height_class(const hfvis_grid *g, int y0, int y1)
 {
     int y, x, nonfinite = 0;
-    for (y = 0; y < g->height; y++) nonfinite |= hf_row_nonfinite(g->z + (ptrdiff_t)y * g->stride, g->width);
+    for (y = y0; y < y1; y++) nonfinite |= hf_row_nonfinite(g->z + (ptrdiff_t)y * g->stride, g->width);
     if (!nonfinite) return 0;
-    for (y = 0; y < g->height; y++)
+    for (y = y0; y < y1; y++)
         for (x = 0; x < g->width; x++)
             if (isinf(g->z[(ptrdiff_t)y * g->stride + x])) return 2;
     return 1;
 }
 
-hfvis_status hfvis_exact_grid_compute(const hfvis_grid *grid, double *out)
+hfvis_status hfvis_exact_grid_rows(const hfvis_grid *grid, int row_begin, int row_end, double *out, int *height_class)
 {
     int y;
-    if (!hf_grid_valid(grid) || !out) return HFVIS_ERR_INVALID_ARGUMENT;
-    for (y = 0; y < grid->height; y++) hf_twist_row(grid, y, out + (size_t)y * (size_t)grid->width);
-    out[hf_grid_count(grid)] = (double)hf_height_class(grid);
+    if (!hf_grid_valid(grid) || !height_class || row_begin < 0 || row_begin >= row_end ||
+        row_end > grid->height)
+        return HFVIS_ERR_INVALID_ARGUMENT;
+    for (y = row_begin; out && y < row_end; y++) hf_twist_row(grid, y, out + (size_t)y * (size_t)grid->width);
+    *height_class = hf_height_class(grid, row_begin, row_end);
     return HFVIS_OK;
+}
+
+hfvis_status hfvis_exact_grid_compute(const hfvis_grid *grid, double *out)
+{
+    int cls;
+    hfvis_status s;
+    if (!hf_grid_valid(grid) || !out) return HFVIS_ERR_INVALID_ARGUMENT;
+    s = hfvis_exact_grid_rows(grid, 0, grid->height, out, &cls);
+    if (s == HFVIS_OK) out[hf_grid_count(grid)] = (double)cls;
+    return s;
 }
 
 /* The four taps of cell (cx, cy) under the border rule into z (z00, z10, z01, z11: a 2 x 2 cell
@@ -9223,11 +9236,11 @@ static int hf_exact_rect_span(const hf_exact *E, int hx, int hy, int a, int b, i
  * that does not bulge costs a load and a compare and its taps are read only for its samples.
  * eager: the midpoint of a piece split in two (most splits) is written for every piece and kept
  * by the test's outcome, without a branch. */
-static HFVIS__ALWAYS_INLINE int hf_exact_piece(const hfvis_grid *g, const hf_cross *c, const float *zn,
-                                               const double *tn, double base, double lim, double *sd,
-                                               double *sh, int n, int eager, int *splits)
+static HFVIS__ALWAYS_INLINE int hf_exact_piece_tw(const hfvis_grid *g, const hf_cross *c, const float *zn,
+                                                  double twist, double base, double lim, double *sd,
+                                                  double *sh, int n, int eager, int *splits)
 {
-    const double bulge = c->q * tn[c->toff]; /* q hf_cell_twist, from the plane */
+    const double bulge = c->q * twist; /* q hf_cell_twist */
     if (eager || bulge > lim) { /* not eager: most pieces end at the one test (NaN at holes) */
         const float *p = zn + c->coff;
         double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[g->stride], z11 = (double)p[g->stride + 1];
@@ -9248,6 +9261,14 @@ static HFVIS__ALWAYS_INLINE int hf_exact_piece(const hfvis_grid *g, const hf_cro
         }
     }
     return n;
+}
+
+/* hf_exact_piece_tw with the twist from the plane (tn: the nearer grid point's cell there). */
+static HFVIS__ALWAYS_INLINE int hf_exact_piece(const hfvis_grid *g, const hf_cross *c, const float *zn,
+                                               const double *tn, double base, double lim, double *sd,
+                                               double *sh, int n, int eager, int *splits)
+{
+    return hf_exact_piece_tw(g, c, zn, tn[c->toff], base, lim, sd, sh, n, eager, splits);
 }
 
 /* The inner part of a line for hf_exact_samples: grid points q = 0..qn from z0 (heights) and
@@ -9424,8 +9445,8 @@ static inline double hf_exact_push(double **top_io, double h, double d, double a
  * bit for bit. A piece is split under a branch here (no eager midpoints, HF_EXACT_EAGER_SHARE):
  * the two-pass form moves that branch's randomness into the hull's loop over a receiver's
  * samples, whose exit then depends on the splits as much. */
-static void hf_exact_fused(hf_exact *E, int hx, int hy, int a, int b, int P, double L, int qn, double scale,
-                           ptrdiff_t t0)
+static HFVIS__ALWAYS_INLINE void hf_exact_fused(hf_exact *E, int plane, int hx, int hy, int a, int b, int P,
+                                                double L, int qn, double scale, ptrdiff_t t0)
 {
     const hfvis_grid *g = E->g;
     const hf_cross *cr = E->cross;
@@ -9433,7 +9454,7 @@ static void hf_exact_fused(hf_exact *E, int hx, int hy, int a, int b, int P, dou
     const double lim = HF_EXACT_BULGE * g->cell_size;
     const int pieces = a != 0 && b != 0; /* along a grid line the surface is linear */
     const float *zq = g->z + ((ptrdiff_t)hy * g->stride + hx);
-    const double *tn = E->twist + ((ptrdiff_t)hy * g->width + hx); /* the twists at grid point q + 1 */
+    const double *tn = plane ? E->twist + ((ptrdiff_t)hy * g->width + hx) : NULL; /* twists at point q + 1 */
     double *sd = E->sd, *sh = E->sh, *tan = E->tan + t0, *top = E->stk + 4;
     /* the top before the first push: -inf at a finite distance below every sample's, so that the
        first push (its pop test fails on the NaN pair, as hf_exact_hull's on its NaN top) returns
@@ -9453,14 +9474,15 @@ static void hf_exact_fused(hf_exact *E, int hx, int hy, int a, int b, int P, dou
         ht = h;
         if (q == qn) break;
         zq -= zstep; /* grid point q + 1 */
-        tn -= wstep;
+        if (plane) tn -= wstep;
         base = bq + L;
         bq = base;
         if (!pieces) continue; /* an axis: grid point q + 1 is the next sample */
         for (e = P - 1;; e--) { /* the piece after crossing e, then crossing e (0: point q + 1) */
             const hf_cross *c = cr + e;
-            if (c->q * tn[c->toff] > lim) { /* split (rare): hf_exact_piece's samples, pushed */
-                j = hf_exact_piece(g, c, zq, tn, base, lim, pd, ph, 0, 0, &splits);
+            const double tw = plane ? tn[c->toff] : hf_cell_twist(zq + c->coff, g->stride);
+            if (c->q * tw > lim) { /* split (rare): hf_exact_piece's samples, pushed */
+                j = hf_exact_piece_tw(g, c, zq, tw, base, lim, pd, ph, 0, 0, &splits);
                 for (i = 0; i < j; i++) {
                     (void)hf_exact_push(&top, ph[i], pd[i], ht - ph[i], pd[i] - dt);
                     dt = pd[i];
@@ -9478,6 +9500,21 @@ static void hf_exact_fused(hf_exact *E, int hx, int hy, int a, int b, int P, dou
     }
 }
 
+/* hf_exact_fused with the cells' twists read from the plane (hf_exact.twist), or computed from
+ * the four heights of each piece's cell (the same doubles) on a grid too large for the plane to
+ * pay (HFVIS_EXACT_TWIST_PLANE_CELLS). */
+static void hf_exact_fused_plane(hf_exact *E, int hx, int hy, int a, int b, int P, double L, int qn, double scale,
+                                 ptrdiff_t t0)
+{
+    hf_exact_fused(E, 1, hx, hy, a, b, P, L, qn, scale, t0);
+}
+
+static void hf_exact_fused_taps(hf_exact *E, int hx, int hy, int a, int b, int P, double L, int qn, double scale,
+                                ptrdiff_t t0)
+{
+    hf_exact_fused(E, 0, hx, hy, a, b, P, L, qn, scale, t0);
+}
+
 /* One line of direction (a, b) from its head (hx, hy) (hf_exact_samples): the tangents of its
  * grid points up to the last one in the receiver rectangle, by the hull (in one pass with the
  * samples where hf_exact_fused applies) or, under a finite radius, by hf_window_line. */
@@ -9491,7 +9528,10 @@ static void hf_exact_line(hf_exact *E, int hx, int hy, int a, int b, int P, doub
         if (qhi < qn) qn = qhi;
     }
     if (E->win_rw < 0 && E->finite) {
-        hf_exact_fused(E, hx, hy, a, b, P, L, qn, scale, t0);
+        if (E->twist)
+            hf_exact_fused_plane(E, hx, hy, a, b, P, L, qn, scale, t0);
+        else
+            hf_exact_fused_taps(E, hx, hy, a, b, P, L, qn, scale, t0);
     } else if (E->win_rw < 0) {
         hf_exact_samples(E, hx, hy, a, b, P, L, qn, E->sd, E->sh, E->rec, &E->eager);
         hf_exact_hull(E->sd, E->sh, E->rec, qn + 1, scale, E->tan, t0, tstep);
@@ -10347,7 +10387,8 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     size_t total = 0, off_ray, off_d, off_c, off_s, off_t = 0, off_n = 0, off_a = 0, gridn, cap;
     size_t off_win = 0, off_r, off_fp = 0, off_fm = 0, off_no = 0, off_row = 0, off_fl = 0, off_tw = 0;
     size_t off_stk = 0;
-    int ok = 1, k, maxp = 1, side = g->width > g->height ? g->width : g->height;
+    int ok = 1, k, maxp = 1, side = g->width > g->height ? g->width : g->height, plane = 0;
+    double cls = 0.0;
     unsigned char *blk;
     memset(E, 0, sizeof *E);
     E->g = g;
@@ -10397,7 +10438,11 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
         off_row = hf_align_add(&total, (size_t)g->width, sizeof(double), &ok);
         off_fl = hf_align_add(&total, (size_t)maxp + 2u, sizeof(hf_far_line), &ok);
     }
-    if (want_tan && !o->exact_grid) off_tw = hf_align_add(&total, gridn, sizeof(double), &ok);
+    if (want_tan) { /* the class of the heights, and whether a plane of twists is read */
+        cls = o->exact_grid ? o->exact_grid[gridn] : (double)hf_height_class(g, 0, g->height);
+        plane = cls != 0.0 || E->radius > 0.0 || E->near > 0 || gridn <= (size_t)HFVIS_EXACT_TWIST_PLANE_CELLS;
+    }
+    if (plane && !o->exact_grid) off_tw = hf_align_add(&total, gridn, sizeof(double), &ok);
     if (want_tan) off_stk = hf_align_add(&total, cap + 2u, 2u * sizeof(double), &ok);
     if (!ok) return HFVIS_ERR_LIMIT;
     blk = (unsigned char *)hfvis__alloc(o->alloc, total);
@@ -10427,9 +10472,8 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
         E->flines = (hf_far_line *)(void *)(blk + off_fl);
     }
     if (want_tan) {
-        double *own = o->exact_grid ? NULL : (double *)(void *)(blk + off_tw);
-        const double cls = o->exact_grid ? o->exact_grid[gridn] : (double)hf_height_class(g);
-        E->twist = o->exact_grid ? o->exact_grid : own;
+        double *own = plane && !o->exact_grid ? (double *)(void *)(blk + off_tw) : NULL;
+        E->twist = !plane ? NULL : o->exact_grid ? o->exact_grid : own; /* NULL: from the heights */
         E->stk = (double *)(void *)(blk + off_stk);
         E->stk[0] = E->stk[1] = E->stk[2] = E->stk[3] = HFVIS__NAN; /* below the stack */
         for (k = 0; own && k < g->height; k++) hf_twist_row(g, k, own + (ptrdiff_t)k * g->width);

@@ -167,7 +167,8 @@
  *   must not overlap, with one exception: bands (sweep options part_index/part_count) write
  *   disjoint cells, so the part_count calls of one sun (hfvis_sun_visibility), or of one
  *   direction of exact-mode sums (hfvis_direction_sums), may write one out concurrently; so may
- *   hfvis_solar_irradiation calls on disjoint row ranges (hfvis_solar_options.row_begin/end).
+ *   hfvis_solar_irradiation calls on disjoint row ranges (hfvis_solar_options.row_begin/end),
+ *   and hfvis_exact_grid_rows calls on disjoint row ranges.
  *   Splitting a run over threads without changing a bit: the lattice sums by quarter-turn group
  *   (hfvis_direction_sums, one group per part, added in order), the exact sums by bands of one
  *   direction at a time (added in place), the horizon map by plane range, one sun by bands,
@@ -553,8 +554,29 @@ HFVIS_API hfvis_status hfvis_normals_compute(const hfvis_grid *grid, float *out)
  * z(x+1, y+1) of cell (x, y) of the bilinear surface (the cross term that makes a cell bulge
  * between its edges; 0 in the last row and column), out[width*height] the class of the heights
  * (0 all finite, 1 holes and no infinite height, 2 an infinite height). Returns HFVIS_OK or
- * HFVIS_ERR_INVALID_ARGUMENT. Cost O(width*height). */
+ * HFVIS_ERR_INVALID_ARGUMENT. Cost O(width*height).
+ * Which parts a call reads: the class always; the twists only with holes or an infinite height
+ * (class 1 or 2), a finite radius (max_distance), the near and far field (ray_near_cells), or
+ * a grid of at most HFVIS_EXACT_TWIST_PLANE_CELLS samples. The sweep of a larger grid without
+ * holes computes each twist from its cell's four heights (the same doubles): there a plane of 8
+ * bytes a sample, read along the rays' lines, costs more in cache misses than it saves (SVF
+ * K = 16 on fBm, this project's machine: 2048^2 7-10 % faster from the heights, 1024^2 the same,
+ * 512^2 about 10 % slower). Such a caller needs only out[width*height] written
+ * (hfvis_exact_grid_rows with out NULL gives the class alone). */
+#define HFVIS_EXACT_TWIST_PLANE_CELLS 2097152 /* 2^21 samples: a 16 MB plane of twists */
 HFVIS_API hfvis_status hfvis_exact_grid_compute(const hfvis_grid *grid, double *out);
+
+/* hfvis_exact_grid_compute by row ranges, for a caller that makes the data over threads: the
+ * twists of rows [row_begin, row_end) into out (laid out as above; its other elements
+ * untouched; out NULL: none written) and in *height_class the class of those rows' heights (0,
+ * 1 or 2 as above). Calls
+ * on disjoint row ranges may write one out concurrently (hfvis.h "Threads"); when the ranges
+ * cover the grid, the largest of their classes stored in out[width*height] completes what
+ * hfvis_exact_grid_compute writes, bit for bit. Returns HFVIS_OK or HFVIS_ERR_INVALID_ARGUMENT
+ * (a bad grid, a NULL grid or height_class, a range outside 0 <= row_begin < row_end <= height). Cost
+ * O(width*(row_end - row_begin)). */
+HFVIS_API hfvis_status hfvis_exact_grid_rows(const hfvis_grid *grid, int row_begin, int row_end, double *out,
+                                             int *height_class);
 
 /* The parallel-line lattice of one look direction (docs/errata.md E5). Sweep direction
  * u = -(cos psi, sin psi), line offset v = (-u.y, u.x); node (i, j) lies at grid position
@@ -685,7 +707,8 @@ typedef struct hfvis_sweep_options {
                                        without a radius; 0..HFVIS_RAY_NEAR_CELLS_MAX */
     const double *exact_grid;       /* NULL (default), or this grid's data exactly as
                                        hfvis_exact_grid_compute writes it (width*height + 1
-                                       doubles), only read: exact rays read it instead of
+                                       doubles; which parts are read: there), only read: exact
+                                       rays read it instead of
                                        computing it (8 bytes a sample of scratch and a pass over
                                        the grid per call), so that the calls of a split run
                                        compute it once. Other values change the results (not

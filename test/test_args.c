@@ -72,6 +72,7 @@
     X(grid_sample, V, -, "NZF", "NaN") \
     X(normals_compute, S, -, "NZGOFR", "INVALID_ARGUMENT") \
     X(exact_grid_compute, S, -, "NZGOFR", "INVALID_ARGUMENT") \
+    X(exact_grid_rows, S, -, "NZGOFR", "INVALID_ARGUMENT") \
     X(lattice_init, S, -, "NZGOF", "INVALID_ARGUMENT LIMIT") \
     X(lattice_nodes, V, -, "N", "0") \
     X(lattice_line, V, -, "NR", "0") \
@@ -1071,6 +1072,24 @@ static void args_exact_grid_compute(void)
     BAD('N', INV, hfvis_exact_grid_compute(NULL, out));
     BAD('N', INV, hfvis_exact_grid_compute(&g_ok, NULL));
     GRID_CASES(hfvis_exact_grid_compute(&bg, out));
+}
+
+static void args_exact_grid_rows(void)
+{
+    double *out;
+    int cls;
+    begin("exact_grid_rows");
+    out = AD(GW * GH + 1);
+    OK(hfvis_exact_grid_rows(&g_ok, 0, GH, out, &cls));
+    BAD('N', INV, hfvis_exact_grid_rows(NULL, 0, GH, out, &cls));
+    OK(hfvis_exact_grid_rows(&g_ok, 0, GH, NULL, &cls)); /* the class alone */
+    BAD('N', INV, hfvis_exact_grid_rows(&g_ok, 0, GH, out, NULL));
+    BAD('R', INV, hfvis_exact_grid_rows(&g_ok, -1, GH, out, &cls));
+    BAD('R', INV, hfvis_exact_grid_rows(&g_ok, 0, GH + 1, out, &cls));
+    BAD('R', INV, hfvis_exact_grid_rows(&g_ok, 3, 3, out, &cls));
+    BAD('R', INV, hfvis_exact_grid_rows(&g_ok, 4, 3, out, &cls));
+    BAD('R', INV, hfvis_exact_grid_rows(&g_ok, INT_MAX, INT_MIN, out, &cls));
+    GRID_CASES(hfvis_exact_grid_rows(&bg, 0, 1, out, &cls));
 }
 
 static void args_lattice_init(void)

@@ -422,7 +422,8 @@ TEST(split_runs)
     CHECK(bad_svf == 0);
 }
 
-/* hfvis_exact_grid_compute's data shared by the calls of a split run (the tool's threads) gives
+/* hfvis_exact_grid_compute's data (also made by row ranges, hfvis_exact_grid_rows) shared by the
+ * calls of a split run (the tool's threads) gives
  * the calls' own results bit for bit: every class of heights (all finite: the inner loop
  * without hole tests; holes; an infinite height), whole calls, bands, one direction, the sun,
  * the near and far field; and a wrong class would change them (the data is what they read). */
@@ -440,6 +441,18 @@ TEST(exact_grid_shared)
         if (cls == 2) zbuf[40 * 61 + 50] = (float)INFINITY;
         CHECK_EQ_STATUS(hfvis_exact_grid_compute(&g, data), HFVIS_OK);
         CHECK(data[plane] == (double)cls);
+        { /* by uneven row ranges (the tool's threads): the same doubles, the class the largest */
+            static double rows[61 * 47 + 1];
+            static const int cut[5] = { 0, 1, 20, 46, 47 };
+            int r, c, top = 0;
+            for (r = 0; r < 4; r++) {
+                CHECK_EQ_STATUS(hfvis_exact_grid_rows(&g, cut[r], cut[r + 1], rows, &c), HFVIS_OK);
+                top = c > top ? c : top;
+            }
+            rows[plane] = (double)top;
+            CHECK(top == cls);
+            CHECK(memcmp(rows, data, sizeof rows) == 0);
+        }
         if (cls == 0) { /* the twists by their definition, 0 where no cell is */
             int x, y, badt = 0;
             for (y = 0; y < 47; y++)
@@ -482,6 +495,40 @@ TEST(exact_grid_shared)
     CHECK_EQ_STATUS(hfvis_horizon_map(&g, 16, &o, out_a), HFVIS_OK);
     CHECK_EQ_STATUS(hfvis_horizon_map(&g, 16, &f, out_b), HFVIS_OK);
     CHECK(memcmp(out_a, out_b, 16 * plane * sizeof(float)) != 0);
+}
+
+/* On a grid above HFVIS_EXACT_TWIST_PLANE_CELLS without holes the sweep takes each cell's twist
+ * from its four heights instead of a plane; the near and far field with D beyond every line of
+ * the run is that sweep reading the plane (hfvis.h, exact_grid), so the two are held to each
+ * other bit for bit on terraces with 80-degree one-cell cliffs and rough treads (pieces that
+ * bulge and split). A twist misread (a wrong cell, row or sign) moves the horizons. */
+TEST(twists_from_heights_on_large_grids)
+{
+    enum { BW = 2100, BH = 1000 };
+    const size_t n = (size_t)BW * BH;
+    float *z = (float *)malloc(n * sizeof(float)), *a = (float *)malloc(2 * n * sizeof(float));
+    hfvis_grid g;
+    hfvis_sweep_options taps = exact_opts(0.3, HFVIS_BORDER_OPEN, 0), plane;
+    size_t i, bad = 0;
+    CHECK(n > (size_t)HFVIS_EXACT_TWIST_PLANE_CELLS);
+    if (!z || !a) {
+        CHECK(0);
+        free(z), free(a);
+        return;
+    }
+    g = test_grid(z, BW, BH, 1.0);
+    fields_terraces(z, BW, BH, 1.0, 4.0, 80.0, 31);
+    for (i = 0; i < n; i += 7) z[i] += (float)(i % 13) * 0.37f; /* rough treads: pieces that bulge */
+    taps.direction_begin = 1; /* one direction, off the axes (rays (2, 5)-like: split pieces) */
+    taps.direction_end = 2;
+    plane = taps;
+    plane.ray_near_cells = 8; /* every direction's line is shorter (N = 5): the sweep */
+    CHECK_EQ_STATUS(hfvis_horizon_map(&g, 4, &taps, a), HFVIS_OK);
+    CHECK_EQ_STATUS(hfvis_horizon_map(&g, 4, &plane, a + n), HFVIS_OK);
+    for (i = 0; i < n; i++) bad += memcmp(&a[i], &a[n + i], sizeof(float)) != 0;
+    CHECK(bad == 0);
+    free(z);
+    free(a);
 }
 
 /* The P2 sweeps keep their lattices; bad options are refused; the sun uses one direction. */
@@ -904,6 +951,7 @@ int main(int argc, char **argv)
     RUN(light_consistent_with_map);
     RUN(split_runs);
     RUN(exact_grid_shared);
+    RUN(twists_from_heights_on_large_grids);
     RUN(modes_and_arguments);
     RUN(allocation_failures);
     RUN(oracle_is_the_supremum);

@@ -3,7 +3,8 @@
  * one sun's bands writing one output, the per-direction sums of quarter-turn groups (lattice) and
  * single directions (exact) added in order and finished as the single run finishes them, the
  * exact sums by bands of one direction at a time added in place, the grid normals given once
- * and shared, and the horizon map's plane ranges writing one map. Built with -pthread; make sanitize also builds it
+ * and shared, the horizon map's plane ranges writing one map, and the exact-ray grid data made
+ * by row ranges into one array. Built with -pthread; make sanitize also builds it
  * under ThreadSanitizer, which reports any data race among these calls. */
 #define _POSIX_C_SOURCE 200809L
 #include <pthread.h>
@@ -26,6 +27,7 @@ typedef struct job {
     hfvis_sweep_options opts; /* bands: the direction and mode */
     hfvis_sum_kind kind;      /* bands */
     hfvis_status status[64];
+    int cls[64];              /* exact grid rows: each range's class of heights */
 } job;
 
 static int job_take(job *j)
@@ -101,6 +103,17 @@ static void *map_worker(void *p)
         o.direction_end = 4 * u + 4;
         j->status[u] = hfvis_horizon_map(&g_grid, TK, &o, j->out + (size_t)4 * (size_t)u * TN);
     }
+    return NULL;
+}
+
+/* A row range of the exact-ray grid data (hfvis_exact_grid_rows), into the shared unit_sums. */
+static void *grid_rows_worker(void *p)
+{
+    job *j = (job *)p;
+    int u;
+    while ((u = job_take(j)) >= 0)
+        j->status[u] = hfvis_exact_grid_rows(&g_grid, u * TH / j->parts, (u + 1) * TH / j->parts, j->unit_sums,
+                                             &j->cls[u]);
     return NULL;
 }
 
@@ -309,6 +322,36 @@ TEST(horizon_map_planes_concurrently)
     pthread_mutex_destroy(&j.lock);
 }
 
+/* The exact-ray grid data made by 9 row ranges on 4 threads (one array, disjoint rows), the class
+ * the largest of the ranges': the one call's doubles, and the sweep that shares it the sweep
+ * that makes its own (a wrong row of twists would move a horizon). */
+TEST(exact_grid_rows_concurrently)
+{
+    static double whole[TN + 1], rows[TN + 1];
+    static float own[TN], shared[TN];
+    hfvis_sweep_options o = hfvis_sweep_options_default();
+    job j;
+    int u, cls = 0;
+    memset(&j, 0, sizeof j);
+    pthread_mutex_init(&j.lock, NULL);
+    CHECK_EQ_STATUS(hfvis_exact_grid_compute(&g_grid, whole), HFVIS_OK);
+    j.parts = 9;
+    j.unit_sums = rows;
+    run_threads(&j, grid_rows_worker);
+    for (u = 0; u < j.parts; u++) {
+        CHECK_EQ_STATUS(j.status[u], HFVIS_OK);
+        cls = j.cls[u] > cls ? j.cls[u] : cls;
+    }
+    rows[TN] = (double)cls;
+    CHECK(memcmp(whole, rows, sizeof whole) == 0);
+    o.rays = HFVIS_RAYS_EXACT;
+    CHECK_EQ_STATUS(hfvis_sky_view_factor(&g_grid, TK, &o, own, TW), HFVIS_OK);
+    o.exact_grid = rows;
+    CHECK_EQ_STATUS(hfvis_sky_view_factor(&g_grid, TK, &o, shared, TW), HFVIS_OK);
+    CHECK(same(own, shared, TN));
+    pthread_mutex_destroy(&j.lock);
+}
+
 int main(int argc, char **argv)
 {
     TEST_INIT(argc, argv);
@@ -318,5 +361,6 @@ int main(int argc, char **argv)
     RUN(exact_band_sums_concurrently);
     RUN(given_normals_shared);
     RUN(horizon_map_planes_concurrently);
+    RUN(exact_grid_rows_concurrently);
     return TEST_DONE();
 }

@@ -3,7 +3,8 @@
  * added in order (lattice) or by bands of one direction at a time added in place (exact), the
  * horizon map by plane range (exact: costliest direction first), one sun by
  * bands across its direction, and openness --radius by row bands (receiver rectangles); the
- * tool's own per-row work around them (the shared normals, the finish of the sums) by row bands
+ * tool's own per-row work around them (the shared normals, the exact-ray grid data, the finish of
+ * the sums) by row bands
  * (cli_threaded_rows). The library
  * stays single-threaded; every call here is one of its reentrant calls on shared inputs. Without
  * POSIX threads (CLI_HAVE_THREADS 0) every split runs its units in order on the calling thread.
@@ -51,7 +52,7 @@ struct cli_split {
     void *ctx;                           /* the caller's */
     const hfvis_sweep_options *opts;     /* copied per unit; progress replaced */
     const hfvis_grid *grid;              /* an exact-ray run's grid: its exact-ray data
-                                            (hfvis_exact_grid_compute) made once and shared by
+                                            (hfvis_exact_grid_rows by row bands) made once and shared by
                                             every unit (sweep options exact_grid), or NULL */
     int next, merged, finished;          /* next unit to take; units merged; units finished */
     hfvis_status status;                 /* the first failure (by unit order of discovery) */
@@ -253,6 +254,9 @@ static void *cli_split_worker(void *arg)
     return NULL;
 }
 
+static hfvis_status cli_threaded_exact_grid(const hfvis_grid *grid, const hfvis_sweep_options *opts, int threads,
+                                            double *out);
+
 /* Run the split on sp->threads threads (the calling thread is one of them). */
 static hfvis_status cli_split_run(cli_split *sp)
 {
@@ -265,7 +269,8 @@ static hfvis_status cli_split_run(cli_split *sp)
         /* hfvis_exact_grid_compute once, not in every unit's call; without the memory each
          * call makes its own (the same values) */
         exact_data = (double *)cli_huge_malloc(((size_t)sp->grid->width * (size_t)sp->grid->height + 1) * sizeof(double));
-        if (exact_data && hfvis_exact_grid_compute(sp->grid, exact_data) == HFVIS_OK) {
+        if (exact_data && cli_threaded_exact_grid(sp->grid, given, sp->threads < sp->units ? sp->threads : sp->units,
+                                                  exact_data) == HFVIS_OK) {
             shared = *given;
             shared.exact_grid = exact_data;
             sp->opts = &shared;
@@ -338,6 +343,50 @@ static hfvis_status cli_threaded_rows(int rows, int threads, cli_rows_fn fn, voi
     sp.ctx = &j;
     sp.opts = &none;
     return cli_split_run(&sp);
+}
+
+/* The exact-ray grid data of opts' calls (hfvis_exact_grid_compute's) over `threads` threads by
+ * row bands (hfvis_exact_grid_rows): each band's pages are first touched by the thread that
+ * computes it (at 4096^2 the 134 MB of twists took 0.39 s on one thread, most of it the kernel
+ * zeroing fresh pages), and the class of the heights is the largest of the bands' classes: the
+ * same doubles as the one call. The twists only where the calls read them (hfvis.h,
+ * HFVIS_EXACT_TWIST_PLANE_CELLS): a large grid without holes swept without a radius or near
+ * field gets the class alone (the rest of out is never touched, so never paged in). */
+typedef struct cli_exact_grid_split {
+    const hfvis_grid *grid;
+    double *out;  /* NULL: the classes alone */
+    int *cls;     /* per band of CLI_ROWS_BAND rows */
+} cli_exact_grid_split;
+
+static hfvis_status cli_exact_grid_band(void *ctx, int y0, int y1, int thread)
+{
+    const cli_exact_grid_split *j = (const cli_exact_grid_split *)ctx;
+    (void)thread;
+    return hfvis_exact_grid_rows(j->grid, y0, y1, j->out, &j->cls[y0 / CLI_ROWS_BAND]);
+}
+
+static hfvis_status cli_threaded_exact_grid(const hfvis_grid *grid, const hfvis_sweep_options *opts, int threads,
+                                            double *out)
+{
+    cli_exact_grid_split j;
+    const size_t n = (size_t)grid->width * (size_t)grid->height;
+    const int bands = (grid->height - 1) / CLI_ROWS_BAND + 1;
+    const int twists_read = n <= (size_t)HFVIS_EXACT_TWIST_PLANE_CELLS || opts->max_distance > 0.0 ||
+                            opts->ray_near_cells > 0; /* or holes: known after the classes */
+    hfvis_status s;
+    int b, cls = 0;
+    j.grid = grid;
+    j.out = twists_read ? out : NULL;
+    if (!(j.cls = (int *)calloc((size_t)bands, sizeof(int)))) return HFVIS_ERR_OUT_OF_MEMORY;
+    s = cli_threaded_rows(grid->height, threads, cli_exact_grid_band, &j);
+    for (b = 0; b < bands; b++) cls = j.cls[b] > cls ? j.cls[b] : cls;
+    if (s == HFVIS_OK && !twists_read && cls != 0) { /* holes: the sweep reads the twists */
+        j.out = out;
+        s = cli_threaded_rows(grid->height, threads, cli_exact_grid_band, &j);
+    }
+    out[n] = (double)cls;
+    free(j.cls);
+    return s;
 }
 
 /* The finish of a sum S of K directions as the single run computes it (hfvis.h, split runs):
