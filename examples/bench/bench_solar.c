@@ -3,7 +3,8 @@
  * near-far, lattice), the directions of the map it made, its ratio to GRASS; the integration
  * alone over a given map, the day path beside the step loop it replaced (ns per receiver-step);
  * the cost of Horn's normals (a day without shading, central and horn); on the Colorado tile (or
- * the stand-in) the tool's row split, `hfvis solar --threads 1` and `--threads 2`, bytes compared;
+ * the stand-in) the tool's row split, `hfvis solar --threads 1` and `--threads 2`, bytes compared,
+ * and its tiles (`--max-distance --window`, four windows joined by `hfvis mosaic`);
  * then each mode and the oracle on a crop, their ratio and the mode's agreement (mean
  * |fast - oracle| / oracle of the daily global and beam).
  * The DEMs come from HFVIS_BENCH_DEMS, a directory holding colorado_srtm_512_90m.pfm (SRTM,
@@ -152,6 +153,79 @@ static void solar_threads(const solar_site *s, const float *z, int w, int h, int
     rmdir(dir);
 }
 
+/* `hfvis solar --max-distance R --window` (tiles): the day with R = 100 cells as one run and as
+ * four windows (2 x 2) joined by `hfvis mosaic`, child processes on the DEM as a PFM, one thread
+ * each: wall and CPU seconds of the whole run and of the windows together (each window computes
+ * its halo too), and the mosaic equal to the whole run byte for byte. */
+static void solar_windows(const solar_site *s, const float *z, int w, int h)
+{
+    char *cli = getenv("HFVIS_CLI") ? getenv("HFVIS_CLI") : (char *)"build/hfvis";
+    const char *tmp = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
+    char dir[512], in[600], whole[600], piece[4][600], mosaic[600], win[4][64], cell[32], lat[32], lon[32], off[32],
+        radius[32], *argv[40];
+    double wall[2] = {0.0, 0.0}, cpu[2] = {0.0, 0.0};
+    int i, a, failed = 0;
+    snprintf(dir, sizeof dir, "%s/hfvis_bench_solar_windows.XXXXXX", tmp);
+    if (!mkdtemp(dir)) { printf("  solar --window: cannot create a folder in %s\n", tmp); return; }
+    snprintf(in, sizeof in, "%s/dem.pfm", dir);
+    if (hfvis_pfm_save(in, z, w, h, 1, w) != HFVIS_OK) {
+        printf("  solar --window: cannot write %s\n", in);
+        rmdir(dir);
+        return;
+    }
+    snprintf(cell, sizeof cell, "%.17g", s->cell);
+    snprintf(lat, sizeof lat, "%.17g", s->lat);
+    snprintf(lon, sizeof lon, "%.17g", s->lon);
+    snprintf(off, sizeof off, "%g", s->lon / 15.0 > 0 ? 1.0 : -7.0); /* as solar_dem's */
+    snprintf(radius, sizeof radius, "%.17g", 100.0 * s->cell);
+    snprintf(whole, sizeof whole, "%s/whole.pfm", dir);
+    snprintf(mosaic, sizeof mosaic, "%s/mosaic.pfm", dir);
+    for (i = 0; i < 5 && !failed; i++) { /* i = 0: the whole run; 1..4: the windows */
+        double wl = 0.0, c = 0.0;
+        long mem = 0;
+        a = 0;
+        argv[a++] = cli, argv[a++] = (char *)"solar", argv[a++] = in;
+        argv[a++] = (char *)"--cell", argv[a++] = cell, argv[a++] = (char *)"--latitude", argv[a++] = lat;
+        argv[a++] = (char *)"--longitude", argv[a++] = lon, argv[a++] = (char *)"--utc-offset", argv[a++] = off;
+        argv[a++] = (char *)"--day", argv[a++] = (char *)"2026-06-21", argv[a++] = (char *)"--max-distance";
+        argv[a++] = radius, argv[a++] = (char *)"--threads", argv[a++] = (char *)"1";
+        argv[a++] = (char *)"--max-memory", argv[a++] = (char *)"0", argv[a++] = (char *)"--quiet";
+        if (i > 0) {
+            const int x0 = (i - 1) % 2 ? w / 2 : 0, y0 = (i - 1) / 2 ? h / 2 : 0;
+            snprintf(win[i - 1], sizeof win[i - 1], "%d,%d,%d,%d", x0, y0, x0 ? w - w / 2 : w / 2, y0 ? h - h / 2 : h / 2);
+            snprintf(piece[i - 1], sizeof piece[i - 1], "%s/piece%d.pfm", dir, i - 1);
+            argv[a++] = (char *)"--window", argv[a++] = win[i - 1];
+        }
+        argv[a++] = (char *)"-o", argv[a++] = i ? piece[i - 1] : whole;
+        argv[a] = NULL;
+        if (bench_spawn(argv, &wl, &mem, &c) != 0) failed = 1;
+        wall[i > 0] += wl;
+        cpu[i > 0] += c;
+    }
+    if (!failed) {
+        double wl = 0.0, c = 0.0;
+        long mem = 0;
+        a = 0;
+        argv[a++] = cli, argv[a++] = (char *)"mosaic";
+        for (i = 0; i < 4; i++) argv[a++] = piece[i];
+        argv[a++] = (char *)"--quiet", argv[a++] = (char *)"-o", argv[a++] = mosaic;
+        argv[a] = NULL;
+        if (bench_spawn(argv, &wl, &mem, &c) != 0) failed = 1;
+    }
+    printf("  %-34s tool, --max-distance %s --window (4 windows, 1 thread): whole %.2f s (CPU %.2f), windows %.2f s "
+           "(CPU %.2f, x%.2f the whole: the halos); mosaic equal to the whole run: %s\n",
+           "", radius, wall[0], cpu[0], wall[1], cpu[1], cpu[1] / cpu[0],
+           failed ? "FAILED" : bench_same_file(whole, mosaic) ? "yes" : "NO");
+    for (i = 0; i < 4; i++) {
+        char side[640];
+        remove(piece[i]);
+        snprintf(side, sizeof side, "%.600s.tile", piece[i]);
+        remove(side);
+    }
+    remove(whole), remove(mosaic), remove(in);
+    rmdir(dir);
+}
+
 static void solar_dem(const solar_site *s, float *z, int w, int h, int quick)
 {
     hfvis_grid g;
@@ -245,6 +319,7 @@ static void solar_dem(const solar_site *s, float *z, int w, int h, int quick)
                tc, th, (th - tc) * 1e9 / (double)n);
     }
     if (s->utm_zone || !s->file[0]) solar_threads(s, z, w, h, quick);
+    if (s->utm_zone || !s->file[0]) solar_windows(s, z, w, h);
     printf("  %-34s memory: 4 bytes per receiver and direction made (the map: the counts above; K = 64 and a\n"
            "  %-34s sample-major copy, 256 + 256, for long periods and the step loop) + 120 + 32 per band\n", "", "");
     /* fast (each mode) and oracle on the central crop */

@@ -82,6 +82,61 @@ static void threads_normals(const float *z, int n)
     free(a), free(b), free(part), free(nrm);
 }
 
+/* The exact-ray grid data (hfvis_exact_grid_compute) shared: the exact sky-view sums of K = 16
+ * directions in 4 bands each, a call per band as the tool's units, each call deriving the data itself
+ * against the data made once (included) and passed to all. Above HFVIS_EXACT_TWIST_PLANE_CELLS
+ * the sweep reads the class alone, so that is all the tool makes (hfvis_exact_grid_rows, out
+ * NULL) and all this makes. */
+static void threads_exact_grid(const float *z, int n)
+{
+    const int K = 16;
+    const size_t cells = (size_t)n * (size_t)n;
+    hfvis_grid g;
+    hfvis_sweep_options o = hfvis_sweep_options_default();
+    double *a = (double *)calloc(cells, sizeof(double)), *b = (double *)calloc(cells, sizeof(double));
+    double *data = (double *)malloc((cells + 1) * sizeof(double));
+    double t[2], t0, t_data = 0.0;
+    const int twists = cells <= (size_t)HFVIS_EXACT_TWIST_PLANE_CELLS;
+    size_t i;
+    int r, k, cls, same = 1;
+    if (!a || !b || !data) {
+        printf("  shared exact grid data: out of memory\n");
+        free(a), free(b), free(data);
+        return;
+    }
+    g.z = z, g.width = n, g.height = n, g.stride = n, g.cell_size = 1.0;
+    o.rays = HFVIS_RAYS_EXACT;
+    for (r = 0; r < 2; r++) {
+        t0 = bench_cpu_now();
+        o.exact_grid = NULL;
+        if (r == 1) {
+            hfvis_status s = twists ? hfvis_exact_grid_compute(&g, data) : hfvis_exact_grid_rows(&g, 0, n, NULL, &cls);
+            if (!twists) data[cells] = (double)cls;
+            t_data = bench_cpu_now() - t0;
+            if (s == HFVIS_OK) o.exact_grid = data;
+        }
+        for (k = 0; k < K * 4; k++) { /* the tool's units: 4 bands of a direction, added in place */
+            o.direction_begin = k / 4, o.direction_end = k / 4 + 1;
+            o.part_index = k % 4, o.part_count = 4;
+            if (hfvis_direction_sums(&g, K, HFVIS_SUM_SKY_VIEW, NULL, NULL, &o, r ? b : a) != HFVIS_OK) {
+                printf("  shared exact grid data: hfvis_direction_sums failed\n");
+                free(a), free(b), free(data);
+                return;
+            }
+        }
+        t[r] = bench_cpu_now() - t0;
+    }
+    for (i = 0; i < cells; i++)
+        if (a[i] != b[i] && !(a[i] != a[i] && b[i] != b[i])) same = 0;
+    printf("  shared exact grid data (exact sky-view sums, %d^2, K = %d, 4 band calls a direction, CPU): each call "
+           "its own %.3f s, shared %.3f s (of which making it %.3f s = %.2f ns a cell, %s), %.2fx; sums equal "
+           "bit for bit: %s\n",
+           n, K, t[0], t[1], t_data, 1e9 * t_data / (double)cells,
+           twists ? "twists and class" : "the class alone: above HFVIS_EXACT_TWIST_PLANE_CELLS",
+           t[0] / t[1], same ? "yes" : "NO");
+    free(a), free(b), free(data);
+}
+
 void bench_threads(int quick)
 {
     static char *const runs[][8] = { /* name, then the command and its flags */
@@ -149,5 +204,6 @@ void bench_threads(int quick)
     remove(in);
     rmdir(dir);
     threads_normals(z, n);
+    threads_exact_grid(z, n);
     free(z);
 }
