@@ -655,7 +655,7 @@ static hfvis_status cli_map_unit(cli_split *sp, int u, int thread, hfvis_sweep_o
 {
     cli_map_split *j = (cli_map_split *)sp->ctx;
     hfvis_status s;
-    int m;
+    int m, lo, hi;
     if (j->per == 1) { /* one direction, index order: its plane in place */
         const int k = j->order ? j->order[u] : u;
         if (j->need && !j->need[k]) return HFVIS_OK;
@@ -664,16 +664,20 @@ static hfvis_status cli_map_unit(cli_split *sp, int u, int thread, hfvis_sweep_o
         o->direction_end = k + 1;
         return hfvis_horizon_map(j->grid, j->K, o, j->out + (size_t)k * j->n);
     }
-    if (j->need && !j->need[u] && !j->need[u + j->K / 4] && !j->need[u + j->K / 2] && !j->need[u + 3 * (j->K / 4)])
-        return HFVIS_OK; /* a group none of whose directions is needed */
-    o->direction_order = HFVIS_DIRECTION_ORDER_SWEEP; /* positions 4u..4u+3: directions u + m K/4 */
-    o->direction_begin = 4 * u;
-    o->direction_end = 4 * u + 4;
+    /* positions 4u..4u+3 (sweep order) are directions u + m K/4; with `need`, only the span of
+       the needed m (the group's lattice is sampled once, its planes outside the span are neither
+       swept nor gathered: the Colorado day needs 45 of 64) */
+    for (lo = 0; lo < 4 && j->need && !j->need[u + lo * (j->K / 4)]; lo++) {}
+    for (hi = 3; hi >= lo && j->need && !j->need[u + hi * (j->K / 4)]; hi--) {}
+    if (lo > hi) return HFVIS_OK; /* a group none of whose directions is needed */
+    o->direction_order = HFVIS_DIRECTION_ORDER_SWEEP;
+    o->direction_begin = 4 * u + lo;
+    o->direction_end = 4 * u + hi + 1;
     s = hfvis_horizon_map(j->grid, j->K, o, j->scratch + (size_t)thread * 4 * j->n);
     if (s == HFVIS_OK)
-        for (m = 0; m < 4; m++)
-            memcpy(j->out + (size_t)(u + m * (j->K / 4)) * j->n, j->scratch + ((size_t)thread * 4 + (size_t)m) * j->n,
-                   j->n * sizeof(float));
+        for (m = lo; m <= hi; m++)
+            memcpy(j->out + (size_t)(u + m * (j->K / 4)) * j->n,
+                   j->scratch + ((size_t)thread * 4 + (size_t)(m - lo)) * j->n, j->n * sizeof(float));
     return s;
 }
 
