@@ -8890,7 +8890,9 @@ typedef struct hf_exact {
     struct hf_far_line *flines; /* one far band's exact lines */
     const double *twist;    /* width*height: each cell's twist (hf_cell_twist) at its (x, y), for
                                the sweep's and the near field's bulge tests (the caller's
-                               hfvis_sweep_options.exact_grid, or made in the scratch) */
+                               hfvis_sweep_options.exact_grid, or made in the scratch); NULL
+                               where no path reads it (HFVIS_EXACT_TWIST_PLANE_CELLS: the
+                               fused sweep then takes each twist from the heights) */
     int finite;             /* every height of the grid is finite (hf_exact_inner) */
     double *stk;            /* hf_exact_fused's hull stack: (height, distance) pairs, two NaN pairs
                                first */
