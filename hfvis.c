@@ -8891,8 +8891,8 @@ typedef struct hf_exact {
     const double *twist;    /* width*height: each cell's twist (hf_cell_twist) at its (x, y), for
                                the sweep's and the near field's bulge tests (the caller's
                                hfvis_sweep_options.exact_grid, or made in the scratch); NULL
-                               where no path reads it (HFVIS_EXACT_TWIST_PLANE_CELLS: the
-                               fused sweep then takes each twist from the heights) */
+                               on grids above HFVIS_EXACT_TWIST_PLANE_CELLS without the near
+                               field: the sweep then takes each twist from the heights */
     int finite;             /* every height of the grid is finite (hf_exact_inner) */
     double *stk;            /* hf_exact_fused's hull stack: (height, distance) pairs, two NaN pairs
                                first */
@@ -9278,10 +9278,10 @@ static HFVIS__ALWAYS_INLINE int hf_exact_piece(const hfvis_grid *g, const hf_cro
  * index n; returns the new count. finite (a constant at each call, so the compiler writes one
  * loop for each): every height of the grid is finite (hf_exact.finite), so every grid point and
  * crossing is a finite sample and no hole test is made (the same samples). */
-static HFVIS__ALWAYS_INLINE int hf_exact_inner(const hf_exact *E, int finite, ptrdiff_t z0, ptrdiff_t zstep,
-                                               const double *tn, ptrdiff_t tstep, int pieces, int P, double L,
-                                               int qn, double *sd, double *sh, int *rec, int n, int eager,
-                                               int *splits)
+static HFVIS__ALWAYS_INLINE int hf_exact_inner(const hf_exact *E, int finite, int plane, ptrdiff_t z0,
+                                               ptrdiff_t zstep, const double *tn, ptrdiff_t tstep, int pieces,
+                                               int P, double L, int qn, double *sd, double *sh, int *rec, int n,
+                                               int eager, int *splits)
 {
     const hfvis_grid *g = E->g;
     const hf_cross *cr = E->cross;
@@ -9298,20 +9298,24 @@ static HFVIS__ALWAYS_INLINE int hf_exact_inner(const hf_exact *E, int finite, pt
         if (q == qn) break;
         /* between grid points q and q + 1, both inside the grid, so are the crossings and cells */
         zn = g->z + (zq - zstep);
-        tn -= tstep;
+        if (plane) tn -= tstep;
         base = bq + L;
         bq = base;
         if (!pieces) continue; /* an axis: grid point q + 1 is the next sample */
         for (e = P - 1; e > 0; e--) { /* the piece after crossing e, then crossing e */
             const hf_cross *c = cr + e;
-            n = hf_exact_piece(g, c, zn, tn, base, lim, sd, sh, n, eager, splits);
+            n = plane ? hf_exact_piece(g, c, zn, tn, base, lim, sd, sh, n, eager, splits)
+                      : hf_exact_piece_tw(g, c, zn, hf_cell_twist(zn + c->coff, g->stride), base, lim, sd, sh, n,
+                                          eager, splits);
             h = (double)zn[c->zoff];
             h += ((double)zn[c->zoff + c->zstep] - h) * c->f; /* as hf_cross_height */
             sd[n] = base - c->u;
             sh[n] = h;
             n += finite || isfinite(h) ? 1 : 0; /* a hole: overwritten by the next sample */
         }
-        n = hf_exact_piece(g, cr, zn, tn, base, lim, sd, sh, n, eager, splits); /* crossing 0: point q + 1 */
+        n = plane ? hf_exact_piece(g, cr, zn, tn, base, lim, sd, sh, n, eager, splits) /* crossing 0: point q + 1 */
+                  : hf_exact_piece_tw(g, cr, zn, hf_cell_twist(zn + cr->coff, g->stride), base, lim, sd, sh, n,
+                                      eager, splits);
     }
     return n;
 }
@@ -9367,11 +9371,15 @@ static int hf_exact_samples(const hf_exact *E, int hx, int hy, int a, int b, int
     const hfvis_grid *g = E->g;
     const ptrdiff_t z0 = (ptrdiff_t)hy * g->stride + hx, zstep = (ptrdiff_t)b * g->stride + a;
     const ptrdiff_t tstep = (ptrdiff_t)b * g->width + a;
-    const double *tn = E->twist + ((ptrdiff_t)hy * g->width + hx); /* the twists at grid point q + 1 */
+    const double *tn = E->twist ? E->twist + ((ptrdiff_t)hy * g->width + hx) : NULL; /* twists at point q + 1 */
     const int pieces = a != 0 && b != 0; /* along a grid line the surface is linear */
     int n = hf_exact_head(E, hx, hy, a, b, P, L, sd, sh), splits = 0, eager = *eager_io;
-    n = E->finite ? hf_exact_inner(E, 1, z0, zstep, tn, tstep, pieces, P, L, qn, sd, sh, rec, n, eager, &splits)
-                  : hf_exact_inner(E, 0, z0, zstep, tn, tstep, pieces, P, L, qn, sd, sh, rec, n, eager, &splits);
+    if (tn) /* the twists from the plane, or from the heights (HFVIS_EXACT_TWIST_PLANE_CELLS) */
+        n = E->finite ? hf_exact_inner(E, 1, 1, z0, zstep, tn, tstep, pieces, P, L, qn, sd, sh, rec, n, eager, &splits)
+                      : hf_exact_inner(E, 0, 1, z0, zstep, tn, tstep, pieces, P, L, qn, sd, sh, rec, n, eager, &splits);
+    else
+        n = E->finite ? hf_exact_inner(E, 1, 0, z0, zstep, tn, tstep, pieces, P, L, qn, sd, sh, rec, n, eager, &splits)
+                      : hf_exact_inner(E, 0, 0, z0, zstep, tn, tstep, pieces, P, L, qn, sd, sh, rec, n, eager, &splits);
     if (pieces && qn > 0) *eager_io = (double)splits > HF_EXACT_EAGER_SHARE * (double)qn * (double)P;
     return n;
 }
@@ -10442,7 +10450,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     }
     if (want_tan) { /* the class of the heights, and whether a plane of twists is read */
         cls = o->exact_grid ? o->exact_grid[gridn] : (double)hf_height_class(g, 0, g->height);
-        plane = cls != 0.0 || E->radius > 0.0 || E->near > 0 || gridn <= (size_t)HFVIS_EXACT_TWIST_PLANE_CELLS;
+        plane = E->near > 0 || gridn <= (size_t)HFVIS_EXACT_TWIST_PLANE_CELLS;
     }
     if (plane && !o->exact_grid) off_tw = hf_align_add(&total, gridn, sizeof(double), &ok);
     if (want_tan) off_stk = hf_align_add(&total, cap + 2u, 2u * sizeof(double), &ok);

@@ -497,11 +497,12 @@ TEST(exact_grid_shared)
     CHECK(memcmp(out_a, out_b, 16 * plane * sizeof(float)) != 0);
 }
 
-/* On a grid above HFVIS_EXACT_TWIST_PLANE_CELLS without holes the sweep takes each cell's twist
+/* On a grid above HFVIS_EXACT_TWIST_PLANE_CELLS the sweep takes each cell's twist
  * from its four heights instead of a plane; the near and far field with D beyond every line of
  * the run is that sweep reading the plane (hfvis.h, exact_grid), so the two are held to each
  * other bit for bit on terraces with 80-degree one-cell cliffs and rough treads (pieces that
- * bulge and split). A twist misread (a wrong cell, row or sign) moves the horizons. */
+ * bulge and split), under a radius, with holes and a radius, and with holes (the sweep's
+ * paths). A twist misread (a wrong cell, row or sign) moves the horizons. */
 TEST(twists_from_heights_on_large_grids)
 {
     enum { BW = 2100, BH = 1000 };
@@ -509,7 +510,8 @@ TEST(twists_from_heights_on_large_grids)
     float *z = (float *)malloc(n * sizeof(float)), *a = (float *)malloc(2 * n * sizeof(float));
     hfvis_grid g;
     hfvis_sweep_options taps = exact_opts(0.3, HFVIS_BORDER_OPEN, 0), plane;
-    size_t i, bad = 0;
+    size_t i, bad;
+    int pass;
     CHECK(n > (size_t)HFVIS_EXACT_TWIST_PLANE_CELLS);
     if (!z || !a) {
         CHECK(0);
@@ -523,10 +525,16 @@ TEST(twists_from_heights_on_large_grids)
     taps.direction_end = 2;
     plane = taps;
     plane.ray_near_cells = 8; /* every direction's line is shorter (N = 5): the sweep */
-    CHECK_EQ_STATUS(hfvis_horizon_map(&g, 4, &taps, a), HFVIS_OK);
-    CHECK_EQ_STATUS(hfvis_horizon_map(&g, 4, &plane, a + n), HFVIS_OK);
-    for (i = 0; i < n; i++) bad += memcmp(&a[i], &a[n + i], sizeof(float)) != 0;
-    CHECK(bad == 0);
+    for (pass = 0; pass < 4; pass++) { /* fused; a radius; holes and a radius; holes */
+        if (pass == 1) taps.max_distance = plane.max_distance = 150.0; /* the window path */
+        if (pass == 2) /* holes: the path with hole tests */
+            for (i = 0; i < n; i += 997) z[i] = NAN;
+        if (pass == 3) taps.max_distance = plane.max_distance = 0.0;
+        CHECK_EQ_STATUS(hfvis_horizon_map(&g, 4, &taps, a), HFVIS_OK);
+        CHECK_EQ_STATUS(hfvis_horizon_map(&g, 4, &plane, a + n), HFVIS_OK);
+        for (bad = 0, i = 0; i < n; i++) bad += memcmp(&a[i], &a[n + i], sizeof(float)) != 0;
+        CHECK(bad == 0);
+    }
     free(z);
     free(a);
 }

@@ -350,8 +350,8 @@ static hfvis_status cli_threaded_rows(int rows, int threads, cli_rows_fn fn, voi
  * computes it (at 4096^2 the 134 MB of twists took 0.39 s on one thread, most of it the kernel
  * zeroing fresh pages), and the class of the heights is the largest of the bands' classes: the
  * same doubles as the one call. The twists only where the calls read them (hfvis.h,
- * HFVIS_EXACT_TWIST_PLANE_CELLS): a large grid without holes swept without a radius or near
- * field gets the class alone (the rest of out is never touched, so never paged in). */
+ * HFVIS_EXACT_TWIST_PLANE_CELLS): a large grid swept without the near field gets the class
+ * alone (the rest of out is never touched, so never paged in). */
 typedef struct cli_exact_grid_split {
     const hfvis_grid *grid;
     double *out;  /* NULL: the classes alone */
@@ -371,19 +371,13 @@ static hfvis_status cli_threaded_exact_grid(const hfvis_grid *grid, const hfvis_
     cli_exact_grid_split j;
     const size_t n = (size_t)grid->width * (size_t)grid->height;
     const int bands = (grid->height - 1) / CLI_ROWS_BAND + 1;
-    const int twists_read = n <= (size_t)HFVIS_EXACT_TWIST_PLANE_CELLS || opts->max_distance > 0.0 ||
-                            opts->ray_near_cells > 0; /* or holes: known after the classes */
     hfvis_status s;
     int b, cls = 0;
     j.grid = grid;
-    j.out = twists_read ? out : NULL;
+    j.out = n <= (size_t)HFVIS_EXACT_TWIST_PLANE_CELLS || opts->ray_near_cells > 0 ? out : NULL;
     if (!(j.cls = (int *)calloc((size_t)bands, sizeof(int)))) return HFVIS_ERR_OUT_OF_MEMORY;
     s = cli_threaded_rows(grid->height, threads, cli_exact_grid_band, &j);
     for (b = 0; b < bands; b++) cls = j.cls[b] > cls ? j.cls[b] : cls;
-    if (s == HFVIS_OK && !twists_read && cls != 0) { /* holes: the sweep reads the twists */
-        j.out = out;
-        s = cli_threaded_rows(grid->height, threads, cli_exact_grid_band, &j);
-    }
     out[n] = (double)cls;
     free(j.cls);
     return s;
