@@ -928,8 +928,9 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     HFVIS_ERR_INVALID_ARGUMENT for HFVIS_RAYS_EXACT. hfvis_horizon_lattice and the *_from_map
  *     routines (uniform azimuths) ignore the field.
  *   - Outputs are written at grid points directly (no gather). Scratch: one block of about
- *     16*width*height bytes (the tangents and the cells' twists, 8 without them with
- *     opts->exact_grid; plus 12 for normals and
+ *     16*width*height bytes (the tangents and the cells' twists, 8 without the twists: with
+ *     opts->exact_grid, or on a grid above HFVIS_EXACT_TWIST_PLANE_CELLS without the near
+ *     field; plus 12 for normals and
  *     8*channels for the lighting sums) and a line's samples and hull stack,
  *     32*(16*(W + H + 2) + 4*border_cells) bytes.
  *   - Near and far field (opts->ray_near_cells = D > 0; 0, the default, is the sweep above bit
