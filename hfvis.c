@@ -9677,6 +9677,7 @@ struct hf_near_off {
     int dx, dy;            /* the period's base offset k (a, b) */
     double u, ic;          /* the crossing's distance (sub-steps); scale / u */
     double icm;            /* scale / the piece's midpoint distance (a piece split in two) */
+    double thr;            /* the piece bulges where (sign q) twist > thr (hf_bulge_threshold) */
 };
 typedef struct hf_near_off hf_near_off;
 
@@ -9723,6 +9724,20 @@ static void hf_step_range(int64_t p, int c, int64_t lo, int64_t hi, int64_t *jlo
     }
 }
 
+/* The largest t with |q| t <= lim in double (q != 0, lim > 0): |q| t, rounded, grows with t, so
+ * the piece's test q twist > lim (HF_EXACT_BULGE, as rounded) holds exactly where (sign q) twist
+ * > t, and the near stencil tests the twists without the multiply. A few steps of one ulp from
+ * lim / |q|. */
+static double hf_bulge_threshold(double q, double lim)
+{
+    double t;
+    q = fabs(q);
+    t = lim / q;
+    while (q * t > lim) t = nextafter(t, -HFVIS__INF);
+    while (t < HFVIS__INF && q * nextafter(t, HFVIS__INF) <= lim) t = nextafter(t, HFVIS__INF);
+    return t;
+}
+
 /* The near-field offsets of direction (a, b): crossings and pieces starting nearer than ucut
  * sub-steps; returns their count and the offsets' bounding box (taps included). */
 static int hf_near_offsets(const hf_exact *E, const hf_cross *cr, int P, int a, int b, double L,
@@ -9747,6 +9762,7 @@ static int hf_near_offsets(const hf_exact *E, const hf_cross *cr, int P, int a, 
             o[n].u = u;
             o[n].ic = u > 0.0 ? scale / u : 0.0;
             o[n].icm = scale / (u + c->du * 0.5); /* hf_near_fill's sample j = 1 of 2, bit for bit */
+            o[n].thr = c->q != 0.0 ? hf_bulge_threshold(c->q, HF_EXACT_BULGE * g->cell_size) : HFVIS__INF;
             for (j = 0; j < 2; j++) { /* the crossing's taps, then the piece's cell */
                 x0 = k * a + (j ? c->cx : c->ox);
                 y0 = k * b + (j ? c->cy : c->oy);
@@ -9772,6 +9788,41 @@ static double hf_near_fill(const float *p, ptrdiff_t stride, const hf_cross *c, 
         if (t > best) best = t;
     }
     return best;
+}
+
+/* Receiver x of a row (heights zr, tangents row) whose piece of offset o (cell tap (0, 0) at
+ * zp + x) bulges (bulge > lim): split in two (bulge <= 4 lim: most splits), its midpoint here
+ * (hf_near_fill's sample, the same bits); finer splits through hf_near_fill. */
+static void hf_near_split(double *row, const float *zp, const float *zr, ptrdiff_t S, const hf_cross *c,
+                          const hf_near_off *o, ptrdiff_t x, double bulge, double lim, double scale)
+{
+    const float *p = zp + x;
+    double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[S], z11 = (double)p[S + 1];
+    double r0 = z00 + (z10 - z00) * c->mfx, r1 = z01 + (z11 - z01) * c->mfx, hr = (double)zr[x], best = row[x];
+    double tt = (r0 + (r1 - r0) * c->mfy - hr) * o->icm;
+    if (bulge > 4.0 * lim) tt = hf_near_fill(p, S, c, bulge, lim, o->u, hr, scale, best);
+    row[x] = tt > best ? tt : best;
+}
+
+/* The receivers [xa, xb) of a row whose piece of offset o bulges: twist tp[x] > thr (up) or
+ * < thr (not up), hf_bulge_threshold's test, take its interior samples (hf_near_split). */
+static inline void hf_near_bulges(double *row, const double *tp, const float *zp, const float *zr, ptrdiff_t S,
+                                  const hf_cross *c, const hf_near_off *o, int up, double thr, double lim,
+                                  double scale, int xa, int xb)
+{
+    const double *p = tp + xa, *e = tp + xb;
+    int k, g4;
+    /* four twists a step: one pointer, a compare each (NaN at holes: never); the rare hits
+       then one by one, and the last up to three */
+    for (g4 = (xb - xa) / 4; g4 > 0; g4--, p += 4) {
+        if (up ? !(p[0] > thr || p[1] > thr || p[2] > thr || p[3] > thr)
+               : !(p[0] < thr || p[1] < thr || p[2] < thr || p[3] < thr))
+            continue;
+        for (k = 0; k < 4; k++)
+            if (up ? p[k] > thr : p[k] < thr) hf_near_split(row, zp, zr, S, c, o, p + k - tp, c->q * p[k], lim, scale);
+    }
+    for (; p < e; p++)
+        if (up ? *p > thr : *p < thr) hf_near_split(row, zp, zr, S, c, o, p - tp, c->q * *p, lim, scale);
 }
 
 /* The near field of one receiver at (x, y) anywhere (the border rule outside the grid): its
@@ -9878,20 +9929,10 @@ static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int bo
                 }
             }
             if (c->du > 0.0) {
-                /* a piece split in two (bulge in (lim, 4 lim]: most splits) takes its midpoint
-                   inline (hf_near_fill's sample, the same bits); finer splits through it */
-                const double mfx = c->mfx, mfy = c->mfy, icm = o[i].icm, lim4 = 4.0 * lim;
-                for (x = xa; x < xb; x++) {
-                    double bulge = q * tp[x]; /* q hf_cell_twist; NaN at holes */
-                    if (bulge > lim) {
-                        const float *zq = zp + x;
-                        double z00 = (double)zq[0], z10 = (double)zq[1], z01 = (double)zq[S], z11 = (double)zq[S + 1];
-                        double r0 = z00 + (z10 - z00) * mfx, r1 = z01 + (z11 - z01) * mfx, rx = row[x];
-                        double tt = (r0 + (r1 - r0) * mfy - (double)zr[x]) * icm;
-                        if (bulge > lim4) tt = hf_near_fill(zq, S, c, bulge, lim, o[i].u, (double)zr[x], scale, rx);
-                        row[x] = tt > rx ? tt : rx;
-                    }
-                }
+                /* the bulge q hf_cell_twist > lim tested on the twist alone (hf_bulge_threshold;
+                   few pieces bulge: hf_near_split) */
+                if (q > 0.0) hf_near_bulges(row, tp, zp, zr, S, c, o + i, 1, o[i].thr, lim, scale, xa, xb);
+                else if (q < 0.0) hf_near_bulges(row, tp, zp, zr, S, c, o + i, 0, -o[i].thr, lim, scale, xa, xb);
             }
         }
         for (x = E->rx0; x < E->rx1; x++) {
