@@ -9893,10 +9893,19 @@ static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int bo
             if (xb > g->width - 1 - box[2] + 1) xb = g->width - box[2];
             if (xb < xa) xa = xb = E->rx1;
         }
-        for (x = xa; x < xb; x++) { /* the t -> 0+ limit: its cell is the first piece's, inside */
-            double hr = (double)zr[x], zx = (double)zr[x + sx], zy = (double)zr[x + sy];
-            double s = ((zx - hr) * Ad + (zy - hr) * Bd) * inv_den;
-            row[x] = isfinite(s) && isfinite(zr[x + sx + sy]) ? s : -HFVIS__INF;
+        /* the t -> 0+ limit (its cell is the first piece's, inside), two receivers a step
+           without a branch (packed into vectors at -O2, as hf_exact_near's), then the odd one */
+        for (x = xa; x + 1 < xb; x += 2) {
+            double h0 = (double)zr[x], h1 = (double)zr[x + 1];
+            double s0 = (((double)zr[x + sx] - h0) * Ad + ((double)zr[x + sy] - h0) * Bd) * inv_den;
+            double s1 = (((double)zr[x + 1 + sx] - h1) * Ad + ((double)zr[x + 1 + sy] - h1) * Bd) * inv_den;
+            double d0 = (double)zr[x + sx + sy], d1 = (double)zr[x + 1 + sx + sy];
+            row[x] = (fabs(s0) <= DBL_MAX) & (fabs(d0) <= DBL_MAX) ? s0 : -HFVIS__INF;
+            row[x + 1] = (fabs(s1) <= DBL_MAX) & (fabs(d1) <= DBL_MAX) ? s1 : -HFVIS__INF;
+        }
+        if (x < xb) {
+            double h0 = (double)zr[x], s0 = (((double)zr[x + sx] - h0) * Ad + ((double)zr[x + sy] - h0) * Bd) * inv_den;
+            row[x] = isfinite(s0) && isfinite(zr[x + sx + sy]) ? s0 : -HFVIS__INF;
         }
         for (i = 0; i < n && xa < xb; i++) {
             const hf_cross *c = o[i].c;
@@ -9935,14 +9944,18 @@ static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int bo
                 else if (q < 0.0) hf_near_bulges(row, tp, zp, zr, S, c, o + i, 0, -o[i].thr, lim, scale, xa, xb);
             }
         }
-        for (x = E->rx0; x < E->rx1; x++) {
-            double hr = (double)zr[x];
-            if (!isfinite(hr)) t[x] = HFVIS__NAN;
-            else if (x >= xa && x < xb) t[x] = row[x];
-            else
-                t[x] = hf_near_one(E, o, n, x, y, hr, scale,
-                                   hf_exact_first_slope(g, E->border, E->R, x, y, a, b, hr, inv_den));
+        for (x = xa; x < xb; x++) { /* NaN at holes, without a branch */
+            const double hr = (double)zr[x];
+            t[x] = fabs(hr) <= DBL_MAX ? row[x] : HFVIS__NAN;
         }
+        for (i = 0; i < 2; i++) /* the rest, [rx0, xa) and [xb, rx1) (xa = xb = rx1: all) */
+            for (x = i ? xb : E->rx0; x < (i ? E->rx1 : xa); x++) {
+                const double hr = (double)zr[x];
+                if (!isfinite(hr)) t[x] = HFVIS__NAN;
+                else
+                    t[x] = hf_near_one(E, o, n, x, y, hr, scale,
+                                       hf_exact_first_slope(g, E->border, E->R, x, y, a, b, hr, inv_den));
+            }
     }
 }
 
