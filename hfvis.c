@@ -9963,9 +9963,12 @@ static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int bo
  * over the periods k = kmax down to kmin, in sweep order (increasing distance d, sub-steps,
  * d = (kmax - k) L at p + k (a, b)): every crossing and split piece within reach (the samples
  * hf_exact_samples takes; periods with both ends inside the grid read the heights directly, the
- * others under the border rule). Returns the count. */
+ * others under the border rule). Returns the count. A tail (start finite) stops once a sample
+ * lies beyond the far line's end, shift + sd n2 > start (the caller drops those: the far line
+ * serves them), the partly outside periods, the costly ones, at the crossing. */
 static int hf_far_samples(hf_exact *E, int64_t px, int64_t py, int a, int b, int P, double L,
-                          int64_t kmin, int64_t kmax, double *sd, double *sh)
+                          int64_t kmin, int64_t kmax, double *sd, double *sh, double shift, double n2,
+                          double start)
 {
     const hfvis_grid *g = E->g;
     const hf_cross *cr = E->cross;
@@ -9974,9 +9977,11 @@ static int hf_far_samples(hf_exact *E, int64_t px, int64_t py, int a, int b, int
     int n = 0, e, j, splits = 0, eager = E->eager;
     int64_t k, inner = 0;
     double ulo, uhi;
+    const int tail = start < HFVIS__INF;
     for (k = kmax; k >= kmin; k--) {
         int64_t X0 = px + k * a, Y0 = py + k * b, X1 = X0 + a, Y1 = Y0 + b;
         double base = (double)(kmax - k) * L;
+        if (tail && n > 0 && shift + sd[n - 1] * n2 > start) break; /* samples grow along the line */
         if (X0 >= 0 && X1 >= 0 && X0 < g->width && X1 < g->width && Y0 >= 0 && Y1 >= 0 &&
             Y0 < g->height && Y1 < g->height) {
             const float *zn = g->z + (ptrdiff_t)Y0 * g->stride + (ptrdiff_t)X0;
@@ -10022,6 +10027,7 @@ static int hf_far_samples(hf_exact *E, int64_t px, int64_t py, int a, int b, int
             double h;
             if (c->u > uhi) continue;
             if (c->u < ulo) break;
+            if (tail && n > 0 && shift + sd[n - 1] * n2 > start) break; /* and the periods after */
             if (CX >= 0 && CY >= 0 && CX + 1 < g->width && CY + 1 < g->height) {
                 /* the cell inside the grid: hf_piece_samples' test and samples, its taps read in
                    place (a tap that is a hole or infinite makes the bulge fail the test) */
@@ -10167,7 +10173,7 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
         int n = 0, nl, ptr, w, f0 = 0, *par = E->fpar;
         hf_line_point(cf, X1, Y1, a, b, &px, &py);
         if (hf_far_periods(g, R, px, py, a, b, &kmin, &kmax))
-            n = hf_far_samples(E, px, py, a, b, P, L, kmin, kmax, E->sd, E->sh);
+            n = hf_far_samples(E, px, py, a, b, P, L, kmin, kmax, E->sd, E->sh, 0.0, n2, HFVIS__INF);
         /* the band's exact lines (all of them, so that the cut does not depend on the receiver
            rectangle): where each one's rays leave the reach; the far line is cut at the nearest
            such end, so no far sample lies beyond the end of a receiver's own ray */
@@ -10244,7 +10250,7 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
             if (k0 > tmin) tmin = k0;
             sd = E->sd;
             sh = E->sh;
-            n = hf_far_samples(E, l->qx, l->qy, a, b, P, L, tmin, tmax, sd, sh);
+            n = hf_far_samples(E, l->qx, l->qy, a, b, P, L, tmin, tmax, sd, sh, shift, n2, start);
             while (n > 0 && shift + sd[n - 1] * n2 > start) n--; /* the far line serves those */
             hf_far_hull(sd, sh, n, E->rec, par, fm);
             for (ptr = -1, j = l->jhi; j >= l->jlo; j--) {
