@@ -10215,6 +10215,7 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
         sh += f0;
         n -= f0;
         hf_far_hull(sd, sh, n, E->rec, par, fm);
+        sd[n] = HFVIS__INF; /* the pointers' sentinel: never within reach */
         start = n > 0 ? sd[0] * n2 : HFVIS__INF; /* the far line's end after the cut */
         /* receivers by t = t_q + j n2 descending, so their thresholds grow: one pointer */
         for (ptr = -1, j = jmax; j >= jmin; j--) {
@@ -10226,7 +10227,7 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
                 if (isnan(*ti) || (E->parts && !hf_exact_mine(E, (int)(l->qx + j * a), (int)(l->qy + j * b), r)))
                     continue;
                 dr = (double)(l->d0 - j * n2i) * L; /* an integer times L: exact, as every distance here */
-                while (ptr + 1 < n && sd[ptr + 1] * n2 <= dr - dn) ptr++;
+                while (sd[ptr + 1] * n2 <= dr - dn) ptr++;
                 if (ptr >= 0) *ti = hf_far_query(sd, sh, par, fm, ptr, n2, dr, (double)g->z[l->z0 + j * zstep], fscale, *ti, &vd);
             }
         }
@@ -10253,11 +10254,12 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
             n = hf_far_samples(E, l->qx, l->qy, a, b, P, L, tmin, tmax, sd, sh, shift, n2, start);
             while (n > 0 && shift + sd[n - 1] * n2 > start) n--; /* the far line serves those */
             hf_far_hull(sd, sh, n, E->rec, par, fm);
+            sd[n] = HFVIS__INF;
             for (ptr = -1, j = l->jhi; j >= l->jlo; j--) {
                 double *ti = E->tan + (l->i0 + j * istep), dr = (double)(tmax - j) * L * n2, vd;
                 if (isnan(*ti) || (E->parts && !hf_exact_mine(E, (int)(l->qx + j * a), (int)(l->qy + j * b), r)))
                     continue;
-                while (ptr + 1 < n && sd[ptr + 1] * n2 <= dr - dn) ptr++;
+                while (sd[ptr + 1] * n2 <= dr - dn) ptr++;
                 if (ptr >= 0) *ti = hf_far_query(sd, sh, par, fm, ptr, n2, dr, (double)g->z[l->z0 + j * zstep], fscale, *ti, &vd);
             }
         }
@@ -10437,7 +10439,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     off_ray = hf_align_add(&total, (size_t)K, sizeof(hf_ray), &ok);
     off_d = hf_align_add(&total, (size_t)K * 5u, sizeof(double), &ok);
     off_c = hf_align_add(&total, (size_t)maxp, sizeof(hf_cross), &ok);
-    off_s = hf_align_add(&total, cap + 2u, 2u * sizeof(double), &ok); /* + the hull's NaN slots */
+    off_s = hf_align_add(&total, cap + 3u, 2u * sizeof(double), &ok); /* + the hull's NaN slots, a sentinel */
     if (want_tan) off_t = hf_align_add(&total, gridn, sizeof(double), &ok);
     if (want_normals && !o->normals) off_n = hf_align_add(&total, gridn, 3u * sizeof(float), &ok);
     if (channels) off_a = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
@@ -10471,7 +10473,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     E->d.hi = E->d.lo + K;
     E->cross = (hf_cross *)(void *)(blk + off_c);
     E->sd = (double *)(void *)(blk + off_s) + 2;
-    E->sh = E->sd + cap + 2;
+    E->sh = E->sd + cap + 3; /* sd[cap]: hf_far_field's sentinel */
     E->sd[-2] = E->sd[-1] = E->sh[-2] = E->sh[-1] = HFVIS__NAN; /* below the stack: hf_hull_step */
     E->tan = want_tan ? (double *)(void *)(blk + off_t) : NULL;
     E->nrm_own = want_normals && !o->normals ? (float *)(void *)(blk + off_n) : NULL;
