@@ -9919,16 +9919,23 @@ static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int bo
                     row[x] = tt > rx ? tt : rx; /* NaN (a hole) never is */
                 }
             else if (o[i].cross) {
-                /* two receivers a step, written out (C99 the compiler can pack into vectors at
-                   -O2), then the odd one */
-                for (x = xa; x + 1 < xb; x += 2) {
+                /* four receivers a step, written out (C99 the compiler can pack into vectors at
+                   -O2), then the last up to three */
+                for (x = xa; x + 3 < xb; x += 4) {
                     double h0 = (double)zc[x], h1 = (double)zc[x + 1], t0, t1, r0 = row[x], r1 = row[x + 1];
+                    double h2 = (double)zc[x + 2], h3 = (double)zc[x + 3], t2, t3, r2 = row[x + 2], r3 = row[x + 3];
                     h0 += ((double)zc[x + st] - h0) * f;
                     h1 += ((double)zc[x + 1 + st] - h1) * f;
+                    h2 += ((double)zc[x + 2 + st] - h2) * f;
+                    h3 += ((double)zc[x + 3 + st] - h3) * f;
                     t0 = (h0 - (double)zr[x]) * ic;
                     t1 = (h1 - (double)zr[x + 1]) * ic;
+                    t2 = (h2 - (double)zr[x + 2]) * ic;
+                    t3 = (h3 - (double)zr[x + 3]) * ic;
                     row[x] = t0 > r0 ? t0 : r0;
                     row[x + 1] = t1 > r1 ? t1 : r1;
+                    row[x + 2] = t2 > r2 ? t2 : r2;
+                    row[x + 3] = t3 > r3 ? t3 : r3;
                 }
                 for (; x < xb; x++) {
                     double h = (double)zc[x], tt, rx = row[x];
