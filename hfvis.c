@@ -10073,17 +10073,22 @@ static int hf_far_samples(hf_exact *E, int64_t px, int64_t py, int a, int b, int
 static void hf_far_hull(const double *sd, const double *sh, int n, int *stack, int *par, double *hmax)
 {
     int top = -1, i;
-    double m = -HFVIS__INF;
+    double m = -HFVIS__INF, dB = 0.0, hB = 0.0; /* the top sample's distance and height */
     for (i = 0; i < n; i++) {
         const double d = sd[i], h = sh[i];
         while (top >= 1) {
-            const int A = stack[top - 1], B = stack[top];
-            /* B leaves when it is not above the chord from A to the new sample */
-            if ((sd[B] - sd[A]) * (h - sh[A]) >= (sh[B] - sh[A]) * (d - sd[A])) top--;
-            else break;
+            const int A = stack[top - 1];
+            const double dA = sd[A], hA = sh[A];
+            /* the top B leaves when it is not above the chord from A to the new sample */
+            if (!((dB - dA) * (h - hA) >= (hB - hA) * (d - dA))) break;
+            top--;
+            dB = dA;
+            hB = hA;
         }
         par[i] = top >= 0 ? stack[top] : -1;
         stack[++top] = i;
+        dB = d;
+        hB = h;
         if (h > m) m = h;
         hmax[i] = m;
     }
