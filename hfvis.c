@@ -9951,10 +9951,12 @@ static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int bo
                 else if (q < 0.0) hf_near_bulges(row, tp, zp, zr, S, c, o + i, 0, -o[i].thr, lim, scale, xa, xb);
             }
         }
-        for (x = xa; x < xb; x++) { /* NaN at holes, without a branch */
-            const double hr = (double)zr[x];
-            t[x] = fabs(hr) <= DBL_MAX ? row[x] : HFVIS__NAN;
+        for (x = xa; x + 1 < xb; x += 2) { /* NaN at holes, without a branch, two a step */
+            const double h0 = (double)zr[x], h1 = (double)zr[x + 1];
+            t[x] = fabs(h0) <= DBL_MAX ? row[x] : HFVIS__NAN;
+            t[x + 1] = fabs(h1) <= DBL_MAX ? row[x + 1] : HFVIS__NAN;
         }
+        if (x < xb) t[x] = isfinite(zr[x]) ? row[x] : HFVIS__NAN;
         for (i = 0; i < 2; i++) /* the rest, [rx0, xa) and [xb, rx1) (xa = xb = rx1: all) */
             for (x = i ? xb : E->rx0; x < (i ? E->rx1 : xa); x++) {
                 const double hr = (double)zr[x];
