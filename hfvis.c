@@ -9713,7 +9713,7 @@ static void hf_line_point(int64_t c, int64_t X1, int64_t Y1, int a, int b, int64
 }
 
 /* The steps j with lo <= p + j c <= hi (c != 0): [*jlo, *jhi]. */
-static void hf_step_range(int64_t p, int c, int64_t lo, int64_t hi, int64_t *jlo, int64_t *jhi)
+static inline void hf_step_range(int64_t p, int c, int64_t lo, int64_t hi, int64_t *jlo, int64_t *jhi)
 {
     if (c > 0) {
         *jlo = -hf_floor_div64(p - lo, c);
@@ -10144,8 +10144,14 @@ static int hf_far_periods(const hfvis_grid *g, int R, int64_t px, int64_t py, in
         double p0 = (double)(ax ? py : px), d = (double)(ax ? b : a);
         double e0 = -(double)R - 1.0, e1 = (double)(ax ? g->height : g->width) + (double)R;
         double ta = (e0 - p0) / d, tb = (e1 - p0) / d;
-        s0 = fmax(s0, fmin(ta, tb));
-        s1 = fmin(s1, fmax(ta, tb));
+        /* fmin and fmax without the calls (d != 0: no NaN) */
+        if (ta > tb) {
+            const double tt = ta;
+            ta = tb;
+            tb = tt;
+        }
+        s0 = ta > s0 ? ta : s0;
+        s1 = tb < s1 ? tb : s1;
     }
     if (!(s0 <= s1)) return 0;
     *kmin = (int64_t)floor(s0) - 1;
