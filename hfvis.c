@@ -9727,6 +9727,7 @@ struct hf_near_off {
     int dx, dy;            /* the period's base offset k (a, b) */
     double u, ic;          /* the crossing's distance (sub-steps); scale / u */
     double icm;            /* scale / the piece's midpoint distance (a piece split in two) */
+    double thr;            /* the piece bulges where (sign q) twist > thr (hf_bulge_threshold) */
 };
 typedef struct hf_near_off hf_near_off;
 
@@ -9762,7 +9763,7 @@ static void hf_line_point(int64_t c, int64_t X1, int64_t Y1, int a, int b, int64
 }
 
 /* The steps j with lo <= p + j c <= hi (c != 0): [*jlo, *jhi]. */
-static void hf_step_range(int64_t p, int c, int64_t lo, int64_t hi, int64_t *jlo, int64_t *jhi)
+static inline void hf_step_range(int64_t p, int c, int64_t lo, int64_t hi, int64_t *jlo, int64_t *jhi)
 {
     if (c > 0) {
         *jlo = -hf_floor_div64(p - lo, c);
@@ -9771,6 +9772,20 @@ static void hf_step_range(int64_t p, int c, int64_t lo, int64_t hi, int64_t *jlo
         *jlo = -hf_floor_div64(hi - p, -c);
         *jhi = hf_floor_div64(p - lo, -c);
     }
+}
+
+/* The largest t with |q| t <= lim in double (q != 0, lim > 0): |q| t, rounded, grows with t, so
+ * the piece's test q twist > lim (HF_EXACT_BULGE, as rounded) holds exactly where (sign q) twist
+ * > t, and the near stencil tests the twists without the multiply. A few steps of one ulp from
+ * lim / |q|. */
+static double hf_bulge_threshold(double q, double lim)
+{
+    double t;
+    q = fabs(q);
+    t = lim / q;
+    while (q * t > lim) t = nextafter(t, -HFVIS__INF);
+    while (t < HFVIS__INF && q * nextafter(t, HFVIS__INF) <= lim) t = nextafter(t, HFVIS__INF);
+    return t;
 }
 
 /* The near-field offsets of direction (a, b): crossings and pieces starting nearer than ucut
@@ -9797,6 +9812,7 @@ static int hf_near_offsets(const hf_exact *E, const hf_cross *cr, int P, int a, 
             o[n].u = u;
             o[n].ic = u > 0.0 ? scale / u : 0.0;
             o[n].icm = scale / (u + c->du * 0.5); /* hf_near_fill's sample j = 1 of 2, bit for bit */
+            o[n].thr = c->q != 0.0 ? hf_bulge_threshold(c->q, HF_EXACT_BULGE * g->cell_size) : HFVIS__INF;
             for (j = 0; j < 2; j++) { /* the crossing's taps, then the piece's cell */
                 x0 = k * a + (j ? c->cx : c->ox);
                 y0 = k * b + (j ? c->cy : c->oy);
@@ -9822,6 +9838,41 @@ static double hf_near_fill(const float *p, ptrdiff_t stride, const hf_cross *c, 
         if (t > best) best = t;
     }
     return best;
+}
+
+/* Receiver x of a row (heights zr, tangents row) whose piece of offset o (cell tap (0, 0) at
+ * zp + x) bulges (bulge > lim): split in two (bulge <= 4 lim: most splits), its midpoint here
+ * (hf_near_fill's sample, the same bits); finer splits through hf_near_fill. */
+static void hf_near_split(double *row, const float *zp, const float *zr, ptrdiff_t S, const hf_cross *c,
+                          const hf_near_off *o, ptrdiff_t x, double bulge, double lim, double scale)
+{
+    const float *p = zp + x;
+    double z00 = (double)p[0], z10 = (double)p[1], z01 = (double)p[S], z11 = (double)p[S + 1];
+    double r0 = z00 + (z10 - z00) * c->mfx, r1 = z01 + (z11 - z01) * c->mfx, hr = (double)zr[x], best = row[x];
+    double tt = (r0 + (r1 - r0) * c->mfy - hr) * o->icm;
+    if (bulge > 4.0 * lim) tt = hf_near_fill(p, S, c, bulge, lim, o->u, hr, scale, best);
+    row[x] = tt > best ? tt : best;
+}
+
+/* The receivers [xa, xb) of a row whose piece of offset o bulges: twist tp[x] > thr (up) or
+ * < thr (not up), hf_bulge_threshold's test, take its interior samples (hf_near_split). */
+static inline void hf_near_bulges(double *row, const double *tp, const float *zp, const float *zr, ptrdiff_t S,
+                                  const hf_cross *c, const hf_near_off *o, int up, double thr, double lim,
+                                  double scale, int xa, int xb)
+{
+    const double *p = tp + xa, *e = tp + xb;
+    int k, g4;
+    /* four twists a step: one pointer, a compare each (NaN at holes: never); the rare hits
+       then one by one, and the last up to three */
+    for (g4 = (xb - xa) / 4; g4 > 0; g4--, p += 4) {
+        if (up ? !(p[0] > thr || p[1] > thr || p[2] > thr || p[3] > thr)
+               : !(p[0] < thr || p[1] < thr || p[2] < thr || p[3] < thr))
+            continue;
+        for (k = 0; k < 4; k++)
+            if (up ? p[k] > thr : p[k] < thr) hf_near_split(row, zp, zr, S, c, o, p + k - tp, c->q * p[k], lim, scale);
+    }
+    for (; p < e; p++)
+        if (up ? *p > thr : *p < thr) hf_near_split(row, zp, zr, S, c, o, p - tp, c->q * *p, lim, scale);
 }
 
 /* The near field of one receiver at (x, y) anywhere (the border rule outside the grid): its
@@ -9892,10 +9943,19 @@ static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int bo
             if (xb > g->width - 1 - box[2] + 1) xb = g->width - box[2];
             if (xb < xa) xa = xb = E->rx1;
         }
-        for (x = xa; x < xb; x++) { /* the t -> 0+ limit: its cell is the first piece's, inside */
-            double hr = (double)zr[x], zx = (double)zr[x + sx], zy = (double)zr[x + sy];
-            double s = ((zx - hr) * Ad + (zy - hr) * Bd) * inv_den;
-            row[x] = isfinite(s) && isfinite(zr[x + sx + sy]) ? s : -HFVIS__INF;
+        /* the t -> 0+ limit (its cell is the first piece's, inside), two receivers a step
+           without a branch (packed into vectors at -O2, as hf_exact_near's), then the odd one */
+        for (x = xa; x + 1 < xb; x += 2) {
+            double h0 = (double)zr[x], h1 = (double)zr[x + 1];
+            double s0 = (((double)zr[x + sx] - h0) * Ad + ((double)zr[x + sy] - h0) * Bd) * inv_den;
+            double s1 = (((double)zr[x + 1 + sx] - h1) * Ad + ((double)zr[x + 1 + sy] - h1) * Bd) * inv_den;
+            double d0 = (double)zr[x + sx + sy], d1 = (double)zr[x + 1 + sx + sy];
+            row[x] = (fabs(s0) <= DBL_MAX) & (fabs(d0) <= DBL_MAX) ? s0 : -HFVIS__INF;
+            row[x + 1] = (fabs(s1) <= DBL_MAX) & (fabs(d1) <= DBL_MAX) ? s1 : -HFVIS__INF;
+        }
+        if (x < xb) {
+            double h0 = (double)zr[x], s0 = (((double)zr[x + sx] - h0) * Ad + ((double)zr[x + sy] - h0) * Bd) * inv_den;
+            row[x] = isfinite(s0) && isfinite(zr[x + sx + sy]) ? s0 : -HFVIS__INF;
         }
         for (i = 0; i < n && xa < xb; i++) {
             const hf_cross *c = o[i].c;
@@ -9909,16 +9969,23 @@ static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int bo
                     row[x] = tt > rx ? tt : rx; /* NaN (a hole) never is */
                 }
             else if (o[i].cross) {
-                /* two receivers a step, written out (C99 the compiler can pack into vectors at
-                   -O2), then the odd one */
-                for (x = xa; x + 1 < xb; x += 2) {
+                /* four receivers a step, written out (C99 the compiler can pack into vectors at
+                   -O2), then the last up to three */
+                for (x = xa; x + 3 < xb; x += 4) {
                     double h0 = (double)zc[x], h1 = (double)zc[x + 1], t0, t1, r0 = row[x], r1 = row[x + 1];
+                    double h2 = (double)zc[x + 2], h3 = (double)zc[x + 3], t2, t3, r2 = row[x + 2], r3 = row[x + 3];
                     h0 += ((double)zc[x + st] - h0) * f;
                     h1 += ((double)zc[x + 1 + st] - h1) * f;
+                    h2 += ((double)zc[x + 2 + st] - h2) * f;
+                    h3 += ((double)zc[x + 3 + st] - h3) * f;
                     t0 = (h0 - (double)zr[x]) * ic;
                     t1 = (h1 - (double)zr[x + 1]) * ic;
+                    t2 = (h2 - (double)zr[x + 2]) * ic;
+                    t3 = (h3 - (double)zr[x + 3]) * ic;
                     row[x] = t0 > r0 ? t0 : r0;
                     row[x + 1] = t1 > r1 ? t1 : r1;
+                    row[x + 2] = t2 > r2 ? t2 : r2;
+                    row[x + 3] = t3 > r3 ? t3 : r3;
                 }
                 for (; x < xb; x++) {
                     double h = (double)zc[x], tt, rx = row[x];
@@ -9928,30 +9995,26 @@ static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int bo
                 }
             }
             if (c->du > 0.0) {
-                /* a piece split in two (bulge in (lim, 4 lim]: most splits) takes its midpoint
-                   inline (hf_near_fill's sample, the same bits); finer splits through it */
-                const double mfx = c->mfx, mfy = c->mfy, icm = o[i].icm, lim4 = 4.0 * lim;
-                for (x = xa; x < xb; x++) {
-                    double bulge = q * tp[x]; /* q hf_cell_twist; NaN at holes */
-                    if (bulge > lim) {
-                        const float *zq = zp + x;
-                        double z00 = (double)zq[0], z10 = (double)zq[1], z01 = (double)zq[S], z11 = (double)zq[S + 1];
-                        double r0 = z00 + (z10 - z00) * mfx, r1 = z01 + (z11 - z01) * mfx, rx = row[x];
-                        double tt = (r0 + (r1 - r0) * mfy - (double)zr[x]) * icm;
-                        if (bulge > lim4) tt = hf_near_fill(zq, S, c, bulge, lim, o[i].u, (double)zr[x], scale, rx);
-                        row[x] = tt > rx ? tt : rx;
-                    }
-                }
+                /* the bulge q hf_cell_twist > lim tested on the twist alone (hf_bulge_threshold;
+                   few pieces bulge: hf_near_split) */
+                if (q > 0.0) hf_near_bulges(row, tp, zp, zr, S, c, o + i, 1, o[i].thr, lim, scale, xa, xb);
+                else if (q < 0.0) hf_near_bulges(row, tp, zp, zr, S, c, o + i, 0, -o[i].thr, lim, scale, xa, xb);
             }
         }
-        for (x = E->rx0; x < E->rx1; x++) {
-            double hr = (double)zr[x];
-            if (!isfinite(hr)) t[x] = HFVIS__NAN;
-            else if (x >= xa && x < xb) t[x] = row[x];
-            else
-                t[x] = hf_near_one(E, o, n, x, y, hr, scale,
-                                   hf_exact_first_slope(g, E->border, E->R, x, y, a, b, hr, inv_den));
+        for (x = xa; x + 1 < xb; x += 2) { /* NaN at holes, without a branch, two a step */
+            const double h0 = (double)zr[x], h1 = (double)zr[x + 1];
+            t[x] = fabs(h0) <= DBL_MAX ? row[x] : HFVIS__NAN;
+            t[x + 1] = fabs(h1) <= DBL_MAX ? row[x + 1] : HFVIS__NAN;
         }
+        if (x < xb) t[x] = isfinite(zr[x]) ? row[x] : HFVIS__NAN;
+        for (i = 0; i < 2; i++) /* the rest, [rx0, xa) and [xb, rx1) (xa = xb = rx1: all) */
+            for (x = i ? xb : E->rx0; x < (i ? E->rx1 : xa); x++) {
+                const double hr = (double)zr[x];
+                if (!isfinite(hr)) t[x] = HFVIS__NAN;
+                else
+                    t[x] = hf_near_one(E, o, n, x, y, hr, scale,
+                                       hf_exact_first_slope(g, E->border, E->R, x, y, a, b, hr, inv_den));
+            }
     }
 }
 
@@ -9959,9 +10022,12 @@ static void hf_near_field(hf_exact *E, const hf_near_off *o, int n, const int bo
  * over the periods k = kmax down to kmin, in sweep order (increasing distance d, sub-steps,
  * d = (kmax - k) L at p + k (a, b)): every crossing and split piece within reach (the samples
  * hf_exact_samples takes; periods with both ends inside the grid read the heights directly, the
- * others under the border rule). Returns the count. */
+ * others under the border rule). Returns the count. A tail (start finite) stops once a sample
+ * lies beyond the far line's end, shift + sd n2 > start (the caller drops those: the far line
+ * serves them), the partly outside periods, the costly ones, at the crossing. */
 static int hf_far_samples(hf_exact *E, int64_t px, int64_t py, int a, int b, int P, double L,
-                          int64_t kmin, int64_t kmax, double *sd, double *sh)
+                          int64_t kmin, int64_t kmax, double *sd, double *sh, double shift, double n2,
+                          double start)
 {
     const hfvis_grid *g = E->g;
     const hf_cross *cr = E->cross;
@@ -9970,9 +10036,11 @@ static int hf_far_samples(hf_exact *E, int64_t px, int64_t py, int a, int b, int
     int n = 0, e, j, splits = 0, eager = E->eager;
     int64_t k, inner = 0;
     double ulo, uhi;
+    const int tail = start < HFVIS__INF;
     for (k = kmax; k >= kmin; k--) {
         int64_t X0 = px + k * a, Y0 = py + k * b, X1 = X0 + a, Y1 = Y0 + b;
         double base = (double)(kmax - k) * L;
+        if (tail && n > 0 && shift + sd[n - 1] * n2 > start) break; /* samples grow along the line */
         if (X0 >= 0 && X1 >= 0 && X0 < g->width && X1 < g->width && Y0 >= 0 && Y1 >= 0 &&
             Y0 < g->height && Y1 < g->height) {
             const float *zn = g->z + (ptrdiff_t)Y0 * g->stride + (ptrdiff_t)X0;
@@ -10018,6 +10086,7 @@ static int hf_far_samples(hf_exact *E, int64_t px, int64_t py, int a, int b, int
             double h;
             if (c->u > uhi) continue;
             if (c->u < ulo) break;
+            if (tail && n > 0 && shift + sd[n - 1] * n2 > start) break; /* and the periods after */
             if (CX >= 0 && CY >= 0 && CX + 1 < g->width && CY + 1 < g->height) {
                 /* the cell inside the grid: hf_piece_samples' test and samples, its taps read in
                    place (a tap that is a hole or infinite makes the bulge fail the test) */
@@ -10056,17 +10125,22 @@ static int hf_far_samples(hf_exact *E, int64_t px, int64_t py, int a, int b, int
 static void hf_far_hull(const double *sd, const double *sh, int n, int *stack, int *par, double *hmax)
 {
     int top = -1, i;
-    double m = -HFVIS__INF;
+    double m = -HFVIS__INF, dB = 0.0, hB = 0.0; /* the top sample's distance and height */
     for (i = 0; i < n; i++) {
         const double d = sd[i], h = sh[i];
         while (top >= 1) {
-            const int A = stack[top - 1], B = stack[top];
-            /* B leaves when it is not above the chord from A to the new sample */
-            if ((sd[B] - sd[A]) * (h - sh[A]) >= (sh[B] - sh[A]) * (d - sd[A])) top--;
-            else break;
+            const int A = stack[top - 1];
+            const double dA = sd[A], hA = sh[A];
+            /* the top B leaves when it is not above the chord from A to the new sample */
+            if (!((dB - dA) * (h - hA) >= (hB - hA) * (d - dA))) break;
+            top--;
+            dB = dA;
+            hB = hA;
         }
         par[i] = top >= 0 ? stack[top] : -1;
         stack[++top] = i;
+        dB = d;
+        hB = h;
         if (h > m) m = h;
         hmax[i] = m;
     }
@@ -10120,8 +10194,14 @@ static int hf_far_periods(const hfvis_grid *g, int R, int64_t px, int64_t py, in
         double p0 = (double)(ax ? py : px), d = (double)(ax ? b : a);
         double e0 = -(double)R - 1.0, e1 = (double)(ax ? g->height : g->width) + (double)R;
         double ta = (e0 - p0) / d, tb = (e1 - p0) / d;
-        s0 = fmax(s0, fmin(ta, tb));
-        s1 = fmin(s1, fmax(ta, tb));
+        /* fmin and fmax without the calls (d != 0: no NaN) */
+        if (ta > tb) {
+            const double tt = ta;
+            ta = tb;
+            tb = tt;
+        }
+        s0 = ta > s0 ? ta : s0;
+        s1 = tb < s1 ? tb : s1;
     }
     if (!(s0 <= s1)) return 0;
     *kmin = (int64_t)floor(s0) - 1;
@@ -10163,7 +10243,7 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
         int n = 0, nl, ptr, w, f0 = 0, *par = E->fpar;
         hf_line_point(cf, X1, Y1, a, b, &px, &py);
         if (hf_far_periods(g, R, px, py, a, b, &kmin, &kmax))
-            n = hf_far_samples(E, px, py, a, b, P, L, kmin, kmax, E->sd, E->sh);
+            n = hf_far_samples(E, px, py, a, b, P, L, kmin, kmax, E->sd, E->sh, 0.0, n2, HFVIS__INF);
         /* the band's exact lines (all of them, so that the cut does not depend on the receiver
            rectangle): where each one's rays leave the reach; the far line is cut at the nearest
            such end, so no far sample lies beyond the end of a receiver's own ray */
@@ -10205,6 +10285,7 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
         sh += f0;
         n -= f0;
         hf_far_hull(sd, sh, n, E->rec, par, fm);
+        sd[n] = HFVIS__INF; /* the pointers' sentinel: never within reach */
         start = n > 0 ? sd[0] * n2 : HFVIS__INF; /* the far line's end after the cut */
         /* receivers by t = t_q + j n2 descending, so their thresholds grow: one pointer */
         for (ptr = -1, j = jmax; j >= jmin; j--) {
@@ -10216,7 +10297,7 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
                 if (isnan(*ti) || (E->parts && !hf_exact_mine(E, (int)(l->qx + j * a), (int)(l->qy + j * b), r)))
                     continue;
                 dr = (double)(l->d0 - j * n2i) * L; /* an integer times L: exact, as every distance here */
-                while (ptr + 1 < n && sd[ptr + 1] * n2 <= dr - dn) ptr++;
+                while (sd[ptr + 1] * n2 <= dr - dn) ptr++;
                 if (ptr >= 0) *ti = hf_far_query(sd, sh, par, fm, ptr, n2, dr, (double)g->z[l->z0 + j * zstep], fscale, *ti, &vd);
             }
         }
@@ -10240,14 +10321,15 @@ static void hf_far_field(hf_exact *E, hf_ray r, int P, double L, double scale, d
             if (k0 > tmin) tmin = k0;
             sd = E->sd;
             sh = E->sh;
-            n = hf_far_samples(E, l->qx, l->qy, a, b, P, L, tmin, tmax, sd, sh);
+            n = hf_far_samples(E, l->qx, l->qy, a, b, P, L, tmin, tmax, sd, sh, shift, n2, start);
             while (n > 0 && shift + sd[n - 1] * n2 > start) n--; /* the far line serves those */
             hf_far_hull(sd, sh, n, E->rec, par, fm);
+            sd[n] = HFVIS__INF;
             for (ptr = -1, j = l->jhi; j >= l->jlo; j--) {
                 double *ti = E->tan + (l->i0 + j * istep), dr = (double)(tmax - j) * L * n2, vd;
                 if (isnan(*ti) || (E->parts && !hf_exact_mine(E, (int)(l->qx + j * a), (int)(l->qy + j * b), r)))
                     continue;
-                while (ptr + 1 < n && sd[ptr + 1] * n2 <= dr - dn) ptr++;
+                while (sd[ptr + 1] * n2 <= dr - dn) ptr++;
                 if (ptr >= 0) *ti = hf_far_query(sd, sh, par, fm, ptr, n2, dr, (double)g->z[l->z0 + j * zstep], fscale, *ti, &vd);
             }
         }
@@ -10428,7 +10510,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     off_ray = hf_align_add(&total, (size_t)K, sizeof(hf_ray), &ok);
     off_d = hf_align_add(&total, (size_t)K * 5u, sizeof(double), &ok);
     off_c = hf_align_add(&total, (size_t)maxp, sizeof(hf_cross), &ok);
-    off_s = hf_align_add(&total, cap + 2u, 2u * sizeof(double), &ok); /* + the hull's NaN slots */
+    off_s = hf_align_add(&total, cap + 3u, 2u * sizeof(double), &ok); /* + the hull's NaN slots, a sentinel */
     if (want_tan) off_t = hf_align_add(&total, gridn, sizeof(double), &ok);
     if (want_normals && !o->normals) off_n = hf_align_add(&total, gridn, 3u * sizeof(float), &ok);
     if (channels) off_a = hf_align_add(&total, gridn, (size_t)channels * sizeof(double), &ok);
@@ -10466,7 +10548,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     E->d.hi = E->d.lo + K;
     E->cross = (hf_cross *)(void *)(blk + off_c);
     E->sd = (double *)(void *)(blk + off_s) + 2;
-    E->sh = E->sd + cap + 2;
+    E->sh = E->sd + cap + 3; /* sd[cap]: hf_far_field's sentinel */
     E->sd[-2] = E->sd[-1] = E->sh[-2] = E->sh[-1] = HFVIS__NAN; /* below the stack: hf_hull_step */
     E->tan = want_tan ? (double *)(void *)(blk + off_t) : NULL;
     E->nrm_own = want_normals && !o->normals ? (float *)(void *)(blk + off_n) : NULL;
