@@ -99,44 +99,75 @@ static void solar_count(void *user, int done, int total)
 
 static const char *const solar_mode_name[4] = { "", "exact", "near-far", "lattice" };
 
+/* A day of `hfvis solar` as a child process: the DEM written as a PFM into a fresh folder, and
+ * the arguments every run shares (the site as solar_dem's, day 172, --max-memory 0 --quiet). */
+typedef struct solar_tool {
+    char *cli;
+    char dir[512], in[600], cell[32], lat[32], lon[32], off[32];
+} solar_tool;
+
+static int solar_tool_open(solar_tool *t, const solar_site *s, const float *z, int w, int h, const char *what)
+{
+    const char *tmp = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
+    t->cli = getenv("HFVIS_CLI") ? getenv("HFVIS_CLI") : (char *)"build/hfvis";
+    snprintf(t->dir, sizeof t->dir, "%s/hfvis_bench_solar.XXXXXX", tmp);
+    if (!mkdtemp(t->dir)) {
+        printf("  solar %s: cannot create a folder in %s\n", what, tmp);
+        return 0;
+    }
+    snprintf(t->in, sizeof t->in, "%s/dem.pfm", t->dir);
+    if (hfvis_pfm_save(t->in, z, w, h, 1, w) != HFVIS_OK) {
+        printf("  solar %s: cannot write %s\n", what, t->in);
+        rmdir(t->dir);
+        return 0;
+    }
+    snprintf(t->cell, sizeof t->cell, "%.17g", s->cell);
+    snprintf(t->lat, sizeof t->lat, "%.17g", s->lat);
+    snprintf(t->lon, sizeof t->lon, "%.17g", s->lon);
+    snprintf(t->off, sizeof t->off, "%g", s->lon / 15.0 > 0 ? 1.0 : -7.0); /* as solar_dem's */
+    return 1;
+}
+
+/* The shared arguments into argv; returns their count. */
+static int solar_tool_args(solar_tool *t, char **argv)
+{
+    int a = 0;
+    argv[a++] = t->cli, argv[a++] = (char *)"solar", argv[a++] = t->in;
+    argv[a++] = (char *)"--cell", argv[a++] = t->cell, argv[a++] = (char *)"--latitude", argv[a++] = t->lat;
+    argv[a++] = (char *)"--longitude", argv[a++] = t->lon, argv[a++] = (char *)"--utc-offset", argv[a++] = t->off;
+    argv[a++] = (char *)"--day", argv[a++] = (char *)"2026-06-21";
+    argv[a++] = (char *)"--max-memory", argv[a++] = (char *)"0", argv[a++] = (char *)"--quiet";
+    return a;
+}
+
+static void solar_tool_close(solar_tool *t)
+{
+    remove(t->in);
+    rmdir(t->dir);
+}
+
 /* The tool's row split of the day (`hfvis solar --threads 1` and `--threads 2`: the map made by
  * directions over the threads, then the library's row_begin/end per thread), as child processes
  * on the DEM written as a PFM: wall and CPU seconds, the speed-up, the outputs equal byte for byte. */
 static void solar_threads(const solar_site *s, const float *z, int w, int h, int quick)
 {
     static const char *const modes[2] = { "exact", "lattice" };
-    char *cli = getenv("HFVIS_CLI") ? getenv("HFVIS_CLI") : (char *)"build/hfvis";
-    const char *tmp = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
-    char dir[512], in[600], out[2][600], cell[32], lat[32], lon[32], off[32], mode[16], *argv[32];
+    solar_tool tool;
+    char out[2][700], mode[16], *argv[32];
     int m, t, rep, a;
-    snprintf(dir, sizeof dir, "%s/hfvis_bench_solar_threads.XXXXXX", tmp);
-    if (!mkdtemp(dir)) { printf("  solar --threads: cannot create a folder in %s\n", tmp); return; }
-    snprintf(in, sizeof in, "%s/dem.pfm", dir);
-    if (hfvis_pfm_save(in, z, w, h, 1, w) != HFVIS_OK) {
-        printf("  solar --threads: cannot write %s\n", in);
-        rmdir(dir);
-        return;
-    }
-    snprintf(cell, sizeof cell, "%.17g", s->cell);
-    snprintf(lat, sizeof lat, "%.17g", s->lat);
-    snprintf(lon, sizeof lon, "%.17g", s->lon);
-    snprintf(off, sizeof off, "%g", s->lon / 15.0 > 0 ? 1.0 : -7.0); /* as solar_dem's */
+    if (!solar_tool_open(&tool, s, z, w, h, "--threads")) return;
     for (m = 0; m < 2; m++) {
         double wall[2] = {1e300, 1e300}, cpu[2] = {1e300, 1e300};
         int failed = 0;
         snprintf(mode, sizeof mode, "%s", modes[m]);
         for (t = 0; t < 2; t++) {
-            snprintf(out[t], sizeof out[t], "%s/out%d.pfm", dir, t);
+            snprintf(out[t], sizeof out[t], "%s/out%d.pfm", tool.dir, t);
             for (rep = 0; rep < (quick ? 1 : 2); rep++) {
                 double wl = 0.0, c = 0.0;
                 long mem = 0;
-                a = 0;
-                argv[a++] = cli, argv[a++] = (char *)"solar", argv[a++] = in;
-                argv[a++] = (char *)"--cell", argv[a++] = cell, argv[a++] = (char *)"--latitude", argv[a++] = lat;
-                argv[a++] = (char *)"--longitude", argv[a++] = lon, argv[a++] = (char *)"--utc-offset", argv[a++] = off;
-                argv[a++] = (char *)"--day", argv[a++] = (char *)"2026-06-21", argv[a++] = (char *)"--horizons";
-                argv[a++] = mode, argv[a++] = (char *)"--threads", argv[a++] = (char *)(t ? "2" : "1");
-                argv[a++] = (char *)"--max-memory", argv[a++] = (char *)"0", argv[a++] = (char *)"--quiet";
+                a = solar_tool_args(&tool, argv);
+                argv[a++] = (char *)"--horizons", argv[a++] = mode;
+                argv[a++] = (char *)"--threads", argv[a++] = (char *)(t ? "2" : "1");
                 argv[a++] = (char *)"-o", argv[a++] = out[t];
                 argv[a] = NULL;
                 if (bench_spawn(argv, &wl, &mem, &c) != 0) failed = 1;
@@ -149,8 +180,7 @@ static void solar_threads(const solar_site *s, const float *z, int w, int h, int
                failed ? "FAILED" : bench_same_file(out[0], out[1]) ? "yes" : "NO");
         remove(out[0]), remove(out[1]);
     }
-    remove(in);
-    rmdir(dir);
+    solar_tool_close(&tool);
 }
 
 /* `hfvis solar --max-distance R --window` (tiles): the day with R = 100 cells as one run and as
@@ -159,41 +189,23 @@ static void solar_threads(const solar_site *s, const float *z, int w, int h, int
  * its halo too), and the mosaic equal to the whole run byte for byte. */
 static void solar_windows(const solar_site *s, const float *z, int w, int h)
 {
-    char *cli = getenv("HFVIS_CLI") ? getenv("HFVIS_CLI") : (char *)"build/hfvis";
-    const char *tmp = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
-    char dir[512], in[600], whole[600], piece[4][600], mosaic[600], win[4][64], cell[32], lat[32], lon[32], off[32],
-        radius[32], *argv[40];
+    solar_tool tool;
+    char whole[700], piece[4][700], side[720], mosaic[700], win[4][64], radius[32], *argv[40];
     double wall[2] = {0.0, 0.0}, cpu[2] = {0.0, 0.0};
     int i, a, failed = 0;
-    snprintf(dir, sizeof dir, "%s/hfvis_bench_solar_windows.XXXXXX", tmp);
-    if (!mkdtemp(dir)) { printf("  solar --window: cannot create a folder in %s\n", tmp); return; }
-    snprintf(in, sizeof in, "%s/dem.pfm", dir);
-    if (hfvis_pfm_save(in, z, w, h, 1, w) != HFVIS_OK) {
-        printf("  solar --window: cannot write %s\n", in);
-        rmdir(dir);
-        return;
-    }
-    snprintf(cell, sizeof cell, "%.17g", s->cell);
-    snprintf(lat, sizeof lat, "%.17g", s->lat);
-    snprintf(lon, sizeof lon, "%.17g", s->lon);
-    snprintf(off, sizeof off, "%g", s->lon / 15.0 > 0 ? 1.0 : -7.0); /* as solar_dem's */
+    if (!solar_tool_open(&tool, s, z, w, h, "--window")) return;
     snprintf(radius, sizeof radius, "%.17g", 100.0 * s->cell);
-    snprintf(whole, sizeof whole, "%s/whole.pfm", dir);
-    snprintf(mosaic, sizeof mosaic, "%s/mosaic.pfm", dir);
+    snprintf(whole, sizeof whole, "%s/whole.pfm", tool.dir);
+    snprintf(mosaic, sizeof mosaic, "%s/mosaic.pfm", tool.dir);
+    for (i = 0; i < 4; i++) snprintf(piece[i], sizeof piece[i], "%s/piece%d.pfm", tool.dir, i);
     for (i = 0; i < 5 && !failed; i++) { /* i = 0: the whole run; 1..4: the windows */
         double wl = 0.0, c = 0.0;
         long mem = 0;
-        a = 0;
-        argv[a++] = cli, argv[a++] = (char *)"solar", argv[a++] = in;
-        argv[a++] = (char *)"--cell", argv[a++] = cell, argv[a++] = (char *)"--latitude", argv[a++] = lat;
-        argv[a++] = (char *)"--longitude", argv[a++] = lon, argv[a++] = (char *)"--utc-offset", argv[a++] = off;
-        argv[a++] = (char *)"--day", argv[a++] = (char *)"2026-06-21", argv[a++] = (char *)"--max-distance";
-        argv[a++] = radius, argv[a++] = (char *)"--threads", argv[a++] = (char *)"1";
-        argv[a++] = (char *)"--max-memory", argv[a++] = (char *)"0", argv[a++] = (char *)"--quiet";
+        a = solar_tool_args(&tool, argv);
+        argv[a++] = (char *)"--max-distance", argv[a++] = radius, argv[a++] = (char *)"--threads", argv[a++] = (char *)"1";
         if (i > 0) {
             const int x0 = (i - 1) % 2 ? w / 2 : 0, y0 = (i - 1) / 2 ? h / 2 : 0;
             snprintf(win[i - 1], sizeof win[i - 1], "%d,%d,%d,%d", x0, y0, x0 ? w - w / 2 : w / 2, y0 ? h - h / 2 : h / 2);
-            snprintf(piece[i - 1], sizeof piece[i - 1], "%s/piece%d.pfm", dir, i - 1);
             argv[a++] = (char *)"--window", argv[a++] = win[i - 1];
         }
         argv[a++] = (char *)"-o", argv[a++] = i ? piece[i - 1] : whole;
@@ -206,7 +218,7 @@ static void solar_windows(const solar_site *s, const float *z, int w, int h)
         double wl = 0.0, c = 0.0;
         long mem = 0;
         a = 0;
-        argv[a++] = cli, argv[a++] = (char *)"mosaic";
+        argv[a++] = tool.cli, argv[a++] = (char *)"mosaic";
         for (i = 0; i < 4; i++) argv[a++] = piece[i];
         argv[a++] = (char *)"--quiet", argv[a++] = (char *)"-o", argv[a++] = mosaic;
         argv[a] = NULL;
@@ -217,13 +229,12 @@ static void solar_windows(const solar_site *s, const float *z, int w, int h)
            "", radius, wall[0], cpu[0], wall[1], cpu[1], cpu[1] / cpu[0],
            failed ? "FAILED" : bench_same_file(whole, mosaic) ? "yes" : "NO");
     for (i = 0; i < 4; i++) {
-        char side[640];
         remove(piece[i]);
-        snprintf(side, sizeof side, "%.600s.tile", piece[i]);
+        snprintf(side, sizeof side, "%.700s.tile", piece[i]);
         remove(side);
     }
-    remove(whole), remove(mosaic), remove(in);
-    rmdir(dir);
+    remove(whole), remove(mosaic);
+    solar_tool_close(&tool);
 }
 
 static void solar_dem(const solar_site *s, float *z, int w, int h, int quick)
