@@ -568,12 +568,11 @@ HFVIS_API hfvis_status hfvis_exact_grid_compute(const hfvis_grid *grid, double *
 /* hfvis_exact_grid_compute by row ranges, for a caller that makes the data over threads: the
  * twists of rows [row_begin, row_end) into out (laid out as above; its other elements
  * untouched; out NULL: none written) and in *height_class the class of those rows' heights (0,
- * 1 or 2 as above). Calls
- * on disjoint row ranges may write one out concurrently (hfvis.h "Threads"); when the ranges
- * cover the grid, the largest of their classes stored in out[width*height] completes what
- * hfvis_exact_grid_compute writes, bit for bit. Returns HFVIS_OK or HFVIS_ERR_INVALID_ARGUMENT
- * (a bad grid, a NULL grid or height_class, a range outside 0 <= row_begin < row_end <= height). Cost
- * O(width*(row_end - row_begin)). */
+ * 1 or 2 as above). Calls on disjoint row ranges may write one out concurrently (hfvis.h
+ * "Threads"); when the ranges cover the grid, the largest of their classes stored in
+ * out[width*height] completes what hfvis_exact_grid_compute writes, bit for bit. Returns
+ * HFVIS_OK or HFVIS_ERR_INVALID_ARGUMENT (a bad grid, a NULL grid or height_class, a range
+ * outside 0 <= row_begin < row_end <= height). Cost O(width*(row_end - row_begin)). */
 HFVIS_API hfvis_status hfvis_exact_grid_rows(const hfvis_grid *grid, int row_begin, int row_end, double *out,
                                              int *height_class);
 
@@ -706,9 +705,9 @@ typedef struct hfvis_sweep_options {
                                        without a radius; 0..HFVIS_RAY_NEAR_CELLS_MAX */
     const double *exact_grid;       /* NULL (default), or this grid's data exactly as
                                        hfvis_exact_grid_compute writes it (width*height + 1
-                                       doubles; which parts are read: there), only read: exact
-                                       rays read it instead of
-                                       computing it (8 bytes a sample of scratch and a pass over
+                                       doubles; which parts are read: there), only read:
+                                       exact rays read it instead of computing it (up to 8
+                                       bytes a sample of scratch and a pass over
                                        the grid per call), so that the calls of a split run
                                        compute it once. Other values change the results (not
                                        checked) */
