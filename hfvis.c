@@ -3002,6 +3002,64 @@ static void hf_lattice_zero(hf_sweep *sw)
 /* 8. Horizon outputs and the ray-march oracles                                               */
 /* ========================================================================================== */
 
+/* atan for the per-receiver-direction light terms (sky light, environment light, both modes) and
+ * the lattice's node elevations: glibc's correctly rounded atan costs about 9 ns a call, half the
+ * sweep's budget per receiver-direction. Range reduction atan t = pi/2 - atan(1/t) for |t| > 1,
+ * then an odd polynomial x P(x^2) of degree 17 on [0, 1], minimax for the absolute error (Remez
+ * exchange), P evaluated by Estrin's scheme. The oracles and the exact rays' angles keep libm's
+ * atan. -inf gives -pi/2 and NaN NaN, as hf_tan_to_elevation. */
+#define HF_ATAN_MAX_ERR 6e-9 /* rad, |hfvis__atan - atan| (Remez bound 5.76e-9): 1/20 of a float ulp at pi/2 */
+static HFVIS__ALWAYS_INLINE double hf_atan_poly(double x)
+{
+    double s = x * x, s2 = s * s, s4 = s2 * s2;
+    return x * (((0.9999998863830964 + -0.3333259702893892 * s) + s2 * (0.19985906780335758 + -0.1416122929275394 * s)) +
+                s4 * ((0.1049894642938515 + -0.07234858062458693 * s) +
+                      s2 * (0.03978123126172938 + -0.014401362402942217 * s)) +
+                (s4 * s4) * 0.0024567256561116523);
+}
+
+static inline double hf_atan(double t)
+{
+    double x = fabs(t), y;
+    int big = x > 1.0; /* false for NaN, which then runs through as NaN */
+    if (big) x = 1.0 / x;
+    y = hf_atan_poly(x);
+    if (big) y = HFVIS__HALF_PI - y;
+    return copysign(y, t);
+}
+
+/* hf_atan over a block of HF_ATAN_BLOCK values, the same bits, in loops the compiler vectorizes
+ * under the default floating-point rules (which keep a branch around a division or a subtraction
+ * a branch, and thread two tests of one value into branches): first |t| capped at 1e300 (its
+ * atan rounds to pi/2 as inf's does; NaN passes), then the reduction's choices as products with
+ * m and q = 1 - m in {0, 1}, each exact (1 a + 0 b = a for finite b), so the one division is
+ * always made and x / 1 is x. */
+#define HF_ATAN_BLOCK 32
+static void hf_atan_block(const double *restrict t, double *restrict e)
+{
+    double a[HF_ATAN_BLOCK];
+    int i;
+    for (i = 0; i < HF_ATAN_BLOCK; i++) {
+        double x = fabs(t[i]);
+        a[i] = x > 1e300 ? 1e300 : x;
+    }
+    for (i = 0; i < HF_ATAN_BLOCK; i++) {
+        double x = a[i], m = x > 1.0 ? 1.0 : 0.0, q = 1.0 - m;
+        double y = hf_atan_poly((m + q * x) / (m * x + q));
+        e[i] = copysign(m * HFVIS__HALF_PI + (q - m) * y, t[i]);
+    }
+}
+
+/* hf_atan and hf_atan_block for the tests (test_hfvis atan_approximation, atan_block_bits). */
+double hfvis__atan(double t);
+double hfvis__atan(double t) { return hf_atan(t); }
+int hfvis__atan_block(const double *t, double *e);
+int hfvis__atan_block(const double *t, double *e)
+{
+    hf_atan_block(t, e);
+    return HF_ATAN_BLOCK;
+}
+
 static double hf_tan_to_elevation(double t)
 {
     if (isnan(t)) return HFVIS__NAN;
@@ -3011,13 +3069,19 @@ static double hf_tan_to_elevation(double t)
 
 /* Consumer: elevation angle at each node of the line, into channel *(const int *)ctx when ctx
  * is given (hf_horizon_planes), else channel m of a 4-channel lattice (the four quarter turns of
- * hfvis_horizon_map) or the only channel. */
+ * hfvis_horizon_map) or the only channel. The angle is hf_atan's (within HF_ATAN_MAX_ERR of
+ * libm's, far inside the [P1] lattice's own error; the gather interpolates these angles), in
+ * blocks the compiler vectorizes, the tail one by one (the same bits). */
 static void hf_store_elevation(hf_sweep *sw, void *ctx, int m, ptrdiff_t node0, ptrdiff_t step,
                                int n, const double *t)
 {
-    int s, ch = sw->channels;
-    double *lat = sw->lat + (ctx ? *(const int *)ctx : ch == 1 ? 0 : m);
-    for (s = 0; s < n; s++, node0 += step) lat[node0 * ch] = hf_tan_to_elevation(t[s]);
+    int s = 0, i, ch = sw->channels;
+    double *lat = sw->lat + (ctx ? *(const int *)ctx : ch == 1 ? 0 : m), e[HF_ATAN_BLOCK];
+    for (; s + HF_ATAN_BLOCK <= n; s += HF_ATAN_BLOCK) {
+        hf_atan_block(t + s, e);
+        for (i = 0; i < HF_ATAN_BLOCK; i++, node0 += step) lat[node0 * ch] = e[i];
+    }
+    for (; s < n; s++, node0 += step) lat[node0 * ch] = hf_atan(t[s]);
 }
 
 static hfvis_status hf_check_common(const hfvis_grid *grid, const hfvis_sweep_options *opts)
@@ -3428,7 +3492,7 @@ hfvis_openness_options hfvis_openness_options_default(void)
  * of the K skylines. Radius-limited: every receiver marches each direction out to the radius
  * (hf_march_tan, the oracle's march; sign -1 marches the inverted surface for negative
  * openness). Unlimited: the exact sweep, one direction at a time (hfvis_horizon_direction), of
- * the surface or of its negated copy. */
+ * the surface or of its negated copy. Both take the angles with hf_atan, as the lattice does. */
 hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_options *oo,
                             const hfvis_sweep_options *opts, float *out, ptrdiff_t out_stride)
 {
@@ -3474,8 +3538,8 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
                     hf_sweep_vector(o.azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K, &ux, &uy);
                     hf_march_slopes(&S, (double)x, (double)y, h0, -ux, -uy, step, maxd, which, best);
                     /* each angle as a float, as the horizon outputs (and the sweep path) hold it */
-                    if (which & 1) sum[0] += HFVIS__HALF_PI - (double)(float)hf_tan_to_elevation(best[0]);
-                    if (which & 2) sum[1] += HFVIS__HALF_PI - (double)(float)hf_tan_to_elevation(best[1]);
+                    if (which & 1) sum[0] += HFVIS__HALF_PI - (double)(float)hf_atan(best[0]);
+                    if (which & 2) sum[1] += HFVIS__HALF_PI - (double)(float)hf_atan(best[1]);
                 }
                 if (negative == 2) {
                     out[i] = (float)(sum[0] / (double)K);
@@ -3545,33 +3609,6 @@ double hfvis_sector_weight(int K, double nz, double a, double theta)
     return nz / (double)K * sin(theta) * sin(theta) +
            sin(HFVIS__PI / (double)K) / HFVIS__PI * a * (theta - 0.5 * sin(2.0 * theta));
 }
-
-/* atan for the per-receiver-direction light terms (sky light, environment light, both modes):
- * glibc's correctly rounded atan costs about 9 ns a call, half the sweep's budget per
- * receiver-direction. Range reduction atan t = pi/2 - atan(1/t) for |t| > 1, then an odd
- * polynomial x P(x^2) of degree 17 on [0, 1], minimax for the absolute error (Remez exchange),
- * P evaluated by Estrin's scheme. Oracles and the angle outputs (horizon maps) keep libm's atan. */
-#define HF_ATAN_MAX_ERR 6e-9 /* rad, |hfvis__atan - atan| (Remez bound 5.76e-9): 1/20 of a float ulp at pi/2 */
-static inline double hf_atan(double t)
-{
-    double x = fabs(t), s, s2, s4, p, y;
-    int big = x > 1.0; /* false for NaN, which then runs through as NaN */
-    if (big) x = 1.0 / x;
-    s = x * x;
-    s2 = s * s;
-    s4 = s2 * s2;
-    p = ((0.9999998863830964 + -0.3333259702893892 * s) + s2 * (0.19985906780335758 + -0.1416122929275394 * s)) +
-        s4 * ((0.1049894642938515 + -0.07234858062458693 * s) +
-              s2 * (0.03978123126172938 + -0.014401362402942217 * s)) +
-        (s4 * s4) * 0.0024567256561116523;
-    y = x * p;
-    if (big) y = HFVIS__HALF_PI - y;
-    return copysign(y, t);
-}
-
-/* hf_atan for the tests (test_hfvis atan_approximation). */
-double hfvis__atan(double t);
-double hfvis__atan(double t) { return hf_atan(t); }
 
 /* S_k from the horizon tangent t, in slope space (docs/errata.md E3): the tangent-plane clamp
  * theta_k = min(theta_h, pi/2 + atan2(a, Nz)) is t' = max(t, -a/Nz) (Nz > 0 for height
