@@ -6,7 +6,8 @@
  * the stand-in) the tool's row split, `hfvis solar --threads 1` and `--threads 2`, bytes compared,
  * and its tiles (`--max-distance --window`, four windows joined by `hfvis mosaic`);
  * then each mode and the oracle on a crop, their ratio and the mode's agreement (mean
- * |fast - oracle| / oracle of the daily global and beam).
+ * |fast - oracle| / oracle of the daily global and beam); last the map's directions (--dirs 16,
+ * 32, 64 of the exact mode): the whole day's time and the crop's agreement in summer and winter.
  * The DEMs come from HFVIS_BENCH_DEMS, a directory holding colorado_srtm_512_90m.pfm (SRTM,
  * 90 m, 40.2 N 105.6 W) and slovenia_lidar_1000_1m.pfm (lidar DTM, 1 m, 46.5 N 15.8 E); without
  * it a 512^2 fBm with 90 m cells stands in:
@@ -237,6 +238,84 @@ static void solar_windows(const solar_site *s, const float *z, int w, int h)
     solar_tool_close(&tool);
 }
 
+/* The mean over the crop of |fast - oracle| / oracle: *eg of the daily global (each cell's oracle
+ * floored at 1 Wh/m^2), *eb of the beam where the oracle's exceeds 1 Wh/m^2. */
+static void solar_crop_error(const float *fb, const float *fg, const float *ob, const float *og, double *eg,
+                             double *eb)
+{
+    double sum_g = 0.0, sum_b = 0.0;
+    int nb = 0;
+    size_t i;
+    for (i = 0; i < (size_t)SOLAR_CROP * SOLAR_CROP; i++) {
+        sum_g += fabs((double)fg[i] - (double)og[i]) / ((double)og[i] > 1.0 ? (double)og[i] : 1.0);
+        if (ob[i] > 1.0f) {
+            sum_b += fabs((double)fb[i] - (double)ob[i]) / (double)ob[i];
+            nb++;
+        }
+    }
+    *eg = sum_g / (double)(SOLAR_CROP * SOLAR_CROP);
+    *eb = nb ? sum_b / nb : 0.0;
+}
+
+/* The map's directions against speed and accuracy (exact horizons, the default mode): the whole
+ * DEM's day at K = 16 and 32 beside the default 64 (t64, measured above), each K's ratio to r.sun
+ * (t_rsun > 0), and on the crop cz each K's mean error against the oracle on day 172 and on day
+ * 355 (the low winter sun: the longest shadows, where the map's azimuth interpolation between
+ * directions 360/K deg apart errs most). */
+static void solar_directions(const solar_site *s, const float *z, int w, int h, const float *cz, double t64,
+                             double t_rsun, int quick)
+{
+    static const int ks[3] = { 16, 32, 64 };
+    static float fb[SOLAR_CROP * SOLAR_CROP], fg[SOLAR_CROP * SOLAR_CROP];
+    static float ob[2][SOLAR_CROP * SOLAR_CROP], og[2][SOLAR_CROP * SOLAR_CROP];
+    hfvis_grid g, c;
+    hfvis_solar_input in = hfvis_solar_input_default();
+    hfvis_solar_options o = hfvis_solar_options_default();
+    float *b1 = (float *)malloc((size_t)w * (size_t)h * sizeof(float));
+    float *g1 = (float *)malloc((size_t)w * (size_t)h * sizeof(float));
+    double t, e[2][2];
+    int k, d, rep;
+    if (!b1 || !g1) {
+        free(b1); free(g1);
+        return;
+    }
+    g.z = z; g.width = w; g.height = h; g.stride = w; g.cell_size = s->cell;
+    c = g;
+    c.z = cz; c.width = c.height = c.stride = SOLAR_CROP;
+    in.latitude_rad = s->lat * SOLAR_DEG;
+    in.longitude_rad = s->lon * SOLAR_DEG;
+    in.utc_offset_hours = s->lon / 15.0 > 0 ? 1.0 : -7.0;
+    in.days = 1;
+    for (d = 0; d < 2; d++) { /* the oracle: day 172, then day 355 */
+        in.month = d ? 12 : 6;
+        in.day = 21;
+        if (!solar_run(&c, &in, &o, 1, ob[d], og[d], &t)) {
+            printf("  %s: the oracle failed\n", s->name);
+            free(b1); free(g1);
+            return;
+        }
+    }
+    printf("  %-34s directions of the exact map: whole day 172, ratio to r.sun; the crop's mean |fast - oracle| /\n"
+           "  %-34s oracle of the global and the beam, day 172 and day 355:\n", "", "");
+    for (k = 0; k < 3; k++) {
+        double best = k == 2 ? t64 : 1e30;
+        o.directions = ks[k];
+        in.month = 6;
+        for (rep = 0; k < 2 && rep < (quick ? 1 : 2); rep++)
+            if (solar_run(&g, &in, &o, 0, b1, g1, &t) && t < best) best = t;
+        for (d = 0; d < 2; d++) {
+            in.month = d ? 12 : 6;
+            if (!solar_run(&c, &in, &o, 0, fb, fg, &t)) break;
+            solar_crop_error(fb, fg, ob[d], og[d], &e[d][0], &e[d][1]);
+        }
+        printf("  %-34s   --dirs %2d  %5.2f s", "", ks[k], best);
+        if (t_rsun > 0.0) printf(" (%4.1fx r.sun)", t_rsun / best);
+        printf("; day 172 global %.4f %%, beam %.4f %%; day 355 global %.4f %%, beam %.4f %%\n", 100.0 * e[0][0],
+               100.0 * e[0][1], 100.0 * e[1][0], 100.0 * e[1][1]);
+    }
+    free(b1); free(g1);
+}
+
 static void solar_dem(const solar_site *s, float *z, int w, int h, int quick)
 {
     hfvis_grid g;
@@ -347,24 +426,18 @@ static void solar_dem(const solar_site *s, float *z, int w, int h, int quick)
     }
     for (; m <= HFVIS_SOLAR_HORIZONS_LATTICE; m++) {
         hfvis_solar_options mo = o;
-        double sum_g = 0.0, sum_b = 0.0;
-        int nb = 0;
+        double eg, eb;
         mo.horizons = (hfvis_solar_horizons)m;
         if (!solar_run(&g, &in, &mo, 0, cb[0], cg[0], &t_cf)) {
             printf("  %s crop: failed\n", s->name);
             break;
         }
-        for (i = 0; i < (size_t)SOLAR_CROP * SOLAR_CROP; i++) {
-            sum_g += fabs((double)cg[0][i] - (double)cg[1][i]) / ((double)cg[1][i] > 1.0 ? (double)cg[1][i] : 1.0);
-            if (cb[1][i] > 1.0f) {
-                sum_b += fabs((double)cb[0][i] - (double)cb[1][i]) / (double)cb[1][i];
-                nb++;
-            }
-        }
+        solar_crop_error(cb[0], cg[0], cb[1], cg[1], &eg, &eb);
         printf("  %-34s crop %d^2, 1 day, --horizons %-8s fast %.3f s, oracle %.2f s (%.0fx); mean |fast - oracle| / "
                "oracle: global %.4f %%, beam %.4f %%\n", s->name, SOLAR_CROP, solar_mode_name[m], t_cf, t_or,
-               t_or / t_cf, 100.0 * sum_g / (double)(SOLAR_CROP * SOLAR_CROP), nb ? 100.0 * sum_b / nb : 0.0);
+               t_or / t_cf, 100.0 * eg, 100.0 * eb);
     }
+    solar_directions(s, z, w, h, cz, t_mode[HFVIS_SOLAR_HORIZONS_EXACT], t_rsun, quick);
     free(b1); free(g1); free(map); free(ones); free(cz);
 }
 

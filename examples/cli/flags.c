@@ -135,9 +135,9 @@ static const cli_flag cli_flags[] = {
                   nodata, CLI_HAS(has_nodata)),
       "input values equal to V are holes: no occlusion, output NaN (PGM code 0)\n" },
     { "--dirs", "K", CLI_DIRS | CLI_ONLY(CMD_SSAO) | CLI_ONLY(CMD_VISFIELD) | CLI_ONLY(CMD_SOLAR),
-      CLI_INT_AT(1, CLI_MAX_DIRS, "an integer 1..65536", 16.0, "16 (openness 8)", "directions",
+      CLI_INT_AT(1, CLI_MAX_DIRS, "an integer 1..65536", 16.0, "16 (openness 8, solar 64)", "directions",
                  dirs, CLI_HAS(has_dirs)),
-      "number of azimuth directions, 1..65536 (default 16)\n" },
+      "number of azimuth directions, 1..65536 (default 16; openness 8, solar 64)\n" },
     { "--convention", "C", CLI_ANGLES,
       CLI_WORDS(CLI_V_CHOICE, "compass"),
       "how azimuths are read and directions ordered (height-field commands):\n"
