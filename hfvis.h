@@ -204,12 +204,14 @@
  *   - Same input and same binary: bit-identical output (build with -ffp-contract=off; FMA
  *     contraction changes the last bits; never build with -ffast-math).
  *   - Exact: the hull sweep equals the per-line brute force on the same lattice samples
- *     (hfvis_horizon_lattice_naive) bit for bit; axis directions reproduce the grid exactly.
+ *     (hfvis_horizon_lattice_naive) bit for bit; axis directions reproduce the grid's tangents
+ *     exactly.
  *   - Within tolerance: gathered (non-axis) directions against the per-receiver ray march
  *     (bilinear resampling of the lattice, docs/errata.md E7); libm differences across C
  *     libraries (sin, cos, atan) at the 1e-15 relative level; the sky and environment light
- *     terms take atan from a polynomial within 6e-9 rad of libm's (below a float ulp of the
- *     output; the light oracles and the horizon angles use libm).
+ *     terms and the lattice's horizon angles (and radius-limited openness) take atan from a
+ *     polynomial within 6e-9 rad of libm's (at most a float ulp of the output; the oracles and
+ *     the exact rays' angles use libm).
  *   - Not guaranteed: agreement with GPU implementations that use fp16 heights or 8-bit angles
  *     ([P1] §7); expect differences of about 1e-3 rad there.
  */
