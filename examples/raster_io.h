@@ -172,6 +172,12 @@ typedef struct {
     const char *unit;
     const ex_rio_meta *meta;
     int n_meta;
+    /* Optional: run fn(ctx, i) for every i in [0, n), in any order or at once (each call writes
+     * only its own memory); 0 when every call returned 0. NULL: in order on the calling thread.
+     * The writer encodes and compresses its strips or tiles through it, EX_RIO_WRITE_BATCH at a
+     * time, and writes them in order: the file's bytes do not depend on it. */
+    int (*parallel)(void *user, size_t n, int (*fn)(void *ctx, size_t i), void *ctx);
+    void *parallel_user;
 } ex_rio_write_options;
 
 /* Cells to write: sample (band b, column x, row y) = data[b band_step + y row_step + x
@@ -1886,6 +1892,72 @@ static inline int ex_rio_gdal_metadata(const ex_rio_write_options *o, int bands,
     return bad ? -1 : 0;
 }
 
+/* The strips or tiles of one TIFF being written: chunk idx (band-major) encoded, predicted and
+ * compressed into a buffer of its own, so that chunks can be made in any order or at once
+ * (ex_rio_write_options.parallel). */
+#define EX_RIO_WRITE_BATCH 64 /* chunks made before they are written: 16 MiB of 256^2 Float32 tiles */
+typedef struct {
+    const ex_rio_image *img;
+    const ex_georef *geo;
+    const ex_rio_write_options *opt;
+    uint64_t cw, ch, across, per_plane, rowb, chunkb, first;
+    int kind, bits, bytes, be, fx, fy;
+    unsigned char *buf[EX_RIO_WRITE_BATCH];
+    size_t len[EX_RIO_WRITE_BATCH];
+} ex_rio_chunks;
+
+static inline int ex_rio_chunk_make(void *ctx, size_t j)
+{
+    ex_rio_chunks *c = (ex_rio_chunks *)ctx;
+    const ex_rio_image *img = c->img;
+    uint64_t idx = c->first + j, b = idx / c->per_plane, k = idx % c->per_plane;
+    uint64_t a = k % c->across, d = k / c->across, y, x, n = c->chunkb;
+    unsigned char *chunk = (unsigned char *)malloc((size_t)c->chunkb), *tmp = NULL, *z = NULL;
+    size_t zcap = 0, zn = 0;
+    c->buf[j] = NULL;
+    if (c->opt->deflate) {
+        zcap = ex_deflate_bound((size_t)c->chunkb);
+        tmp = (unsigned char *)malloc((size_t)c->rowb);
+        z = (unsigned char *)malloc(zcap);
+    }
+    if (!chunk || (c->opt->deflate && (!tmp || !z))) {
+        free(chunk); free(tmp); free(z);
+        return -1;
+    }
+    for (y = 0; y < c->ch; y++) {
+        unsigned char *row = chunk + y * c->rowb;
+        uint64_t gy = d * c->ch + y;
+        for (x = 0; x < c->cw; x++) {
+            uint64_t gx = a * c->cw + x;
+            float v = 0.0f;
+            if (gx < (uint64_t)img->width && gy < (uint64_t)img->height) {
+                uint64_t sx = c->fx ? (uint64_t)img->width - 1 - gx : gx;
+                uint64_t sy = c->fy ? (uint64_t)img->height - 1 - gy : gy;
+                v = img->data[(size_t)b * img->band_step + (size_t)sy * img->row_step + (size_t)sx * img->pixel_step];
+            }
+            ex_rio_encode_sample(row + x * (uint64_t)c->bytes, v, c->kind, c->bits, c->be, c->geo);
+        }
+        if (c->opt->deflate && c->opt->predictor >= 2)
+            ex_rio_predict(row, tmp, (size_t)c->cw, c->bytes, c->opt->predictor, c->be);
+    }
+    if (!c->opt->tiled && (d + 1) * c->ch > (uint64_t)img->height) n = ((uint64_t)img->height - d * c->ch) * c->rowb;
+    if (c->opt->deflate) {
+        int rc = ex_deflate_zlib(chunk, (size_t)n, z, zcap, &zn);
+        free(chunk);
+        free(tmp);
+        if (rc != 0) {
+            free(z);
+            return -1;
+        }
+        c->buf[j] = z;
+        c->len[j] = zn;
+    } else {
+        c->buf[j] = chunk;
+        c->len[j] = (size_t)n;
+    }
+    return 0;
+}
+
 /* Write img as a TIFF at path (atomically) with the georeference of geo (may be NULL). */
 static inline int ex_rio_write_tiff_file(const char *path, const ex_rio_image *img, const ex_georef *geo,
                                          const ex_rio_write_options *opt_in, char *err)
@@ -1893,15 +1965,13 @@ static inline int ex_rio_write_tiff_file(const char *path, const ex_rio_image *i
     ex_rio_write_options opt;
     ex_rio_out o;
     ex_rio_tag tags[32];
-    int nt = 0, bytes, i, kind, bits, spp = img->bands, b;
-    uint64_t cw, ch, across, down, per_plane, nchunks, k, rowb, chunkb, raw_total, bound;
+    int nt = 0, bytes, i, kind, bits, spp = img->bands;
+    uint64_t cw, ch, across, down, per_plane, nchunks, rowb, chunkb, raw_total, bound;
     uint64_t *offsets = NULL, *counts = NULL, u_w, u_h, u_bps[1], u_comp, u_photo = 1, u_spp, u_rps, u_cw, u_ch;
     uint64_t u_planar = spp > 1 ? 2 : 1, u_fmt, u_pred, *u_extra = NULL, *u_bpsv = NULL, *u_fmtv = NULL, *u_keys = NULL;
     uint64_t prj_keys[16];
     char *prj_ascii = NULL;
     size_t n_prj_keys = 0, n_prj_ascii = 0;
-    unsigned char *chunk = NULL, *z = NULL, *tmp = NULL;
-    size_t zcap = 0;
     char *tmpname = NULL, *xml = NULL;
     double tie[6], scale[3], mt[16];
     int fx = geo && geo->has_transform && geo->flip_x, fy = geo && geo->has_transform && geo->flip_y;
@@ -1954,16 +2024,10 @@ static inline int ex_rio_write_tiff_file(const char *path, const ex_rio_image *i
     o.big = opt.bigtiff || bound > 0xffffffffu;
     offsets = (uint64_t *)malloc((size_t)nchunks * sizeof(uint64_t));
     counts = (uint64_t *)malloc((size_t)nchunks * sizeof(uint64_t));
-    chunk = (unsigned char *)malloc((size_t)chunkb);
-    tmp = (unsigned char *)malloc((size_t)rowb);
-    if (opt.deflate) {
-        zcap = ex_deflate_bound((size_t)chunkb);
-        z = (unsigned char *)malloc(zcap);
-    }
     u_bpsv = (uint64_t *)malloc((size_t)spp * sizeof(uint64_t));
     u_fmtv = (uint64_t *)malloc((size_t)spp * sizeof(uint64_t));
     u_extra = (uint64_t *)calloc((size_t)spp, sizeof(uint64_t));
-    if (!offsets || !counts || !chunk || !tmp || (opt.deflate && !z) || !u_bpsv || !u_fmtv || !u_extra) {
+    if (!offsets || !counts || !u_bpsv || !u_fmtv || !u_extra) {
         ex_rio_fail(err, "out of memory");
         goto done;
     }
@@ -1984,42 +2048,38 @@ static inline int ex_rio_write_tiff_file(const char *path, const ex_rio_image *i
         ex_rio_emit_uint(&o, 42, 2);
         ex_rio_emit_uint(&o, 0, 4);
     }
-    /* the chunks, band by band (PlanarConfiguration 2) */
-    for (b = 0; b < spp; b++)
-        for (k = 0; k < per_plane; k++) {
-            uint64_t a = k % across, d = k / across, y, x, idx = (uint64_t)b * per_plane + k, n = chunkb;
-            for (y = 0; y < ch; y++) {
-                unsigned char *row = chunk + y * rowb;
-                uint64_t gy = d * ch + y;
-                for (x = 0; x < cw; x++) {
-                    uint64_t gx = a * cw + x;
-                    float v = 0.0f;
-                    if (gx < (uint64_t)img->width && gy < (uint64_t)img->height) {
-                        uint64_t sx = fx ? (uint64_t)img->width - 1 - gx : gx;
-                        uint64_t sy = fy ? (uint64_t)img->height - 1 - gy : gy;
-                        v = img->data[(size_t)b * img->band_step + (size_t)sy * img->row_step +
-                                      (size_t)sx * img->pixel_step];
-                    }
-                    ex_rio_encode_sample(row + x * (uint64_t)bytes, v, kind, bits, o.be, geo);
+    /* the chunks, band by band (PlanarConfiguration 2), made a batch at a time (in parallel when
+     * the options say how) and written in order */
+    {
+        ex_rio_chunks cs;
+        uint64_t first;
+        memset(&cs, 0, sizeof cs);
+        cs.img = img; cs.geo = geo; cs.opt = &opt;
+        cs.cw = cw; cs.ch = ch; cs.across = across; cs.per_plane = per_plane; cs.rowb = rowb; cs.chunkb = chunkb;
+        cs.kind = kind; cs.bits = bits; cs.bytes = bytes; cs.be = o.be; cs.fx = fx; cs.fy = fy;
+        for (first = 0; first < nchunks; first += EX_RIO_WRITE_BATCH) {
+            size_t nb = nchunks - first < EX_RIO_WRITE_BATCH ? (size_t)(nchunks - first) : EX_RIO_WRITE_BATCH, j;
+            int bad = 0;
+            cs.first = first;
+            if (opt.parallel) bad = opt.parallel(opt.parallel_user, nb, ex_rio_chunk_make, &cs) != 0;
+            else
+                for (j = 0; j < nb && !bad; j++) bad = ex_rio_chunk_make(&cs, j) != 0;
+            for (j = 0; j < nb; j++) {
+                if (!bad && !cs.buf[j]) bad = 1; /* a call that did not run or failed */
+                if (!bad) {
+                    offsets[first + j] = o.pos;
+                    counts[first + j] = cs.len[j];
+                    ex_rio_emit(&o, cs.buf[j], cs.len[j]);
                 }
-                if (opt.deflate && opt.predictor >= 2)
-                    ex_rio_predict(row, tmp, (size_t)cw, bytes, opt.predictor, o.be);
+                free(cs.buf[j]);
+                cs.buf[j] = NULL;
             }
-            if (!opt.tiled && (d + 1) * ch > (uint64_t)img->height) n = ((uint64_t)img->height - d * ch) * rowb;
-            offsets[idx] = o.pos;
-            if (opt.deflate) {
-                size_t zn = 0;
-                if (ex_deflate_zlib(chunk, (size_t)n, z, zcap, &zn) != 0) {
-                    ex_rio_fail(err, "out of memory");
-                    goto fail;
-                }
-                ex_rio_emit(&o, z, zn);
-                counts[idx] = zn;
-            } else {
-                ex_rio_emit(&o, chunk, (size_t)n);
-                counts[idx] = n;
+            if (bad) {
+                ex_rio_fail(err, "out of memory");
+                goto fail;
             }
         }
+    }
     if (o.pos & 1) ex_rio_emit(&o, "", 1); /* IFDs start on a word boundary */
     if (!o.big && o.pos > 0xffffffffu - 65536u) {
         ex_rio_fail(err, "file would exceed 4 GiB: write BigTIFF");
@@ -2154,9 +2214,6 @@ fail:
 done:
     free(offsets);
     free(counts);
-    free(chunk);
-    free(tmp);
-    free(z);
     free(u_bpsv);
     free(u_fmtv);
     free(u_extra);

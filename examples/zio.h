@@ -8,8 +8,9 @@
  * Contents
  *   1. checksums        ex_adler32
  *   2. inflate          ex_inflate: a zlib or raw deflate stream into a buffer of known size
- *   3. deflate          ex_deflate_bound, ex_deflate_zlib: LZ77 (hash chains) + fixed Huffman,
- *                       a stored block instead when that is shorter
+ *   3. deflate          ex_deflate_bound, ex_deflate_zlib: LZ77 (hash chains) + fixed Huffman
+ *                       (codes from tables made per stream), a stored block instead when that
+ *                       is shorter; reentrant (the TIFF writer compresses tiles concurrently)
  *   4. atomic files     ex_atomic_open, ex_atomic_close; ex_publish_* (a file and its
  *                       sidecars replaced together)
  */
@@ -349,32 +350,61 @@ static inline void ex_z_put(ex_z_writer *w, uint32_t v, int n)
     }
 }
 
-/* Put a Huffman code of n bits, most significant bit first (RFC 1951 §3.1.1). */
-static inline void ex_z_put_code(ex_z_writer *w, uint32_t code, int n)
+/* The fixed codes of RFC 1951 §3.2.6, made once per stream: each literal/length symbol's code
+ * with its bits reversed (Huffman codes go most significant bit first, §3.1.1, and ex_z_put
+ * fills from the least significant end) and its length; the 5-bit distance codes reversed; and
+ * the symbol of every match length (3..258) and distance (1..32768: below 257 by the distance,
+ * above by its bits past the seventh, as zlib's _dist_code). */
+typedef struct {
+    uint16_t lit_code[288];
+    unsigned char lit_bits[288], len_sym[259], dist_rev[30], dist_sym[512];
+} ex_z_fixed_codes;
+
+static inline uint32_t ex_z_reverse(uint32_t code, int n)
 {
     uint32_t r = 0;
     int i;
     for (i = 0; i < n; i++) r |= ((code >> i) & 1u) << (n - 1 - i);
-    ex_z_put(w, r, n);
+    return r;
 }
 
-/* The fixed literal/length code of RFC 1951 §3.2.6. */
-static inline void ex_z_put_lit(ex_z_writer *w, int sym)
+static inline void ex_z_fixed_codes_init(ex_z_fixed_codes *t)
 {
-    if (sym < 144) ex_z_put_code(w, 0x30u + (uint32_t)sym, 8);
-    else if (sym < 256) ex_z_put_code(w, 0x190u + (uint32_t)(sym - 144), 9);
-    else if (sym < 280) ex_z_put_code(w, (uint32_t)(sym - 256), 7);
-    else ex_z_put_code(w, 0xc0u + (uint32_t)(sym - 280), 8);
+    int sym, i, d;
+    for (sym = 0; sym < 288; sym++) {
+        uint32_t code;
+        int n;
+        if (sym < 144) { code = 0x30u + (uint32_t)sym; n = 8; }
+        else if (sym < 256) { code = 0x190u + (uint32_t)(sym - 144); n = 9; }
+        else if (sym < 280) { code = (uint32_t)(sym - 256); n = 7; }
+        else { code = 0xc0u + (uint32_t)(sym - 280); n = 8; }
+        t->lit_code[sym] = (uint16_t)ex_z_reverse(code, n);
+        t->lit_bits[sym] = (unsigned char)n;
+    }
+    for (i = 0; i < 29; i++) /* lengths: the last base at or below each length */
+        for (d = ex_z_len_base[i]; d <= 258 && (i == 28 || d < ex_z_len_base[i + 1]); d++)
+            t->len_sym[d] = (unsigned char)i;
+    for (i = 0; i < 30; i++) {
+        int lo = ex_z_dist_base[i], hi = i == 29 ? 32768 : ex_z_dist_base[i + 1] - 1;
+        t->dist_rev[i] = (unsigned char)ex_z_reverse((uint32_t)i, 5);
+        for (d = lo; d <= hi; d++) {
+            if (d <= 256) t->dist_sym[d - 1] = (unsigned char)i;
+            else t->dist_sym[256 + ((d - 1) >> 7)] = (unsigned char)i;
+        }
+    }
 }
 
-static inline void ex_z_put_match(ex_z_writer *w, int len, int dist)
+static inline void ex_z_put_lit(ex_z_writer *w, const ex_z_fixed_codes *t, int sym)
 {
-    int i = 28, j = 29;
-    while (ex_z_len_base[i] > len) i--;
-    ex_z_put_lit(w, 257 + i);
+    ex_z_put(w, t->lit_code[sym], t->lit_bits[sym]);
+}
+
+static inline void ex_z_put_match(ex_z_writer *w, const ex_z_fixed_codes *t, int len, int dist)
+{
+    int i = t->len_sym[len], j = t->dist_sym[dist <= 256 ? dist - 1 : 256 + ((dist - 1) >> 7)];
+    ex_z_put_lit(w, t, 257 + i);
     ex_z_put(w, (uint32_t)(len - ex_z_len_base[i]), ex_z_len_extra[i]);
-    while (ex_z_dist_base[j] > dist) j--;
-    ex_z_put_code(w, (uint32_t)j, 5);
+    ex_z_put(w, t->dist_rev[j], 5);
     ex_z_put(w, (uint32_t)(dist - ex_z_dist_base[j]), ex_z_dist_extra[j]);
 }
 
@@ -388,6 +418,7 @@ static inline int ex_deflate_zlib(const unsigned char *in, size_t n, unsigned ch
     size_t bound = ex_deflate_bound(n), i, stored;
     int32_t *head, *prev;
     ex_z_writer w;
+    ex_z_fixed_codes codes;
     uint32_t adler = ex_adler32(1, in, n);
     if (bound == 0 || cap < bound) return -1;
     head = (int32_t *)malloc(sizeof(int32_t) << EX_Z_HASH_BITS);
@@ -398,6 +429,7 @@ static inline int ex_deflate_zlib(const unsigned char *in, size_t n, unsigned ch
         return -1;
     }
     for (i = 0; i < ((size_t)1 << EX_Z_HASH_BITS); i++) head[i] = -1;
+    ex_z_fixed_codes_init(&codes);
     stored = bound - 6u; /* the stored form's length without header and check */
     memset(&w, 0, sizeof w);
     w.out = out + 2;
@@ -421,6 +453,12 @@ static inline int ex_deflate_zlib(const unsigned char *in, size_t n, unsigned ch
             }
             while (cand >= 0 && chain-- > 0 && rel - (size_t)cand <= EX_Z_WINDOW) {
                 size_t c = base + (size_t)cand, len = 0, maxlen = n - i < 258 ? n - i : 258;
+                /* a candidate beats the best only if it matches one byte further: test that
+                 * byte first (zlib's trick; the same matches are chosen) */
+                if (best_len > 0 && in[c + best_len] != in[i + best_len]) {
+                    cand = prev[(size_t)cand & (EX_Z_WINDOW - 1)];
+                    continue;
+                }
                 while (len < maxlen && in[c + len] == in[i + len]) len++;
                 if (len > best_len) {
                     best_len = len;
@@ -434,7 +472,7 @@ static inline int ex_deflate_zlib(const unsigned char *in, size_t n, unsigned ch
         }
         if (best_len >= 3) {
             size_t k;
-            ex_z_put_match(&w, (int)best_len, (int)best_dist);
+            ex_z_put_match(&w, &codes, (int)best_len, (int)best_dist);
             /* insert the skipped positions into the chains */
             for (k = 1; k < best_len; k++) {
                 size_t p = i + k, rel = p - base;
@@ -447,11 +485,11 @@ static inline int ex_deflate_zlib(const unsigned char *in, size_t n, unsigned ch
             }
             i += best_len;
         } else {
-            ex_z_put_lit(&w, in[i]);
+            ex_z_put_lit(&w, &codes, in[i]);
             i++;
         }
     }
-    ex_z_put_lit(&w, 256);
+    ex_z_put_lit(&w, &codes, 256);
     ex_z_put(&w, 0, 7); /* flush the last byte */
     free(head);
     free(prev);

@@ -381,6 +381,75 @@ TEST(tiff_round_trips)
     free(got);
 }
 
+/* ex_rio_write_options.parallel: the strips or tiles made in any order (here in reverse, each
+ * batch) give the serial writer's bytes, over several batches (EX_RIO_WRITE_BATCH) and both
+ * layouts, with and without deflate; a runner that fails, or that skips a chunk while reporting
+ * success, fails the write with a message and leaves no file. */
+static int par_calls;
+static int par_reverse(void *user, size_t n, int (*fn)(void *ctx, size_t i), void *ctx)
+{
+    size_t i;
+    (void)user;
+    par_calls++;
+    for (i = n; i-- > 0;)
+        if (fn(ctx, i) != 0) return -1;
+    return 0;
+}
+static int par_fail(void *user, size_t n, int (*fn)(void *ctx, size_t i), void *ctx)
+{
+    (void)user; (void)n; (void)fn; (void)ctx;
+    return -1;
+}
+static int par_skip_last(void *user, size_t n, int (*fn)(void *ctx, size_t i), void *ctx)
+{
+    size_t i;
+    (void)user;
+    for (i = 0; i + 1 < n; i++)
+        if (fn(ctx, i) != 0) return -1;
+    return 0;
+}
+
+TEST(tiff_parallel_chunks)
+{
+    enum { W = 300, H = 150, B = 3 };
+    float *src = (float *)malloc(sizeof(float) * W * H * B);
+    int layout, comp;
+    field(src, W, H, B, 0, 77u);
+    src[11] = (float)NAN;
+    for (layout = 0; layout < 2; layout++)
+        for (comp = 0; comp < 2; comp++) {
+            ex_rio_write_options o;
+            ex_rio_image img;
+            char err[256];
+            unsigned char *a, *b;
+            size_t na = 0, nb = 0;
+            memset(&o, 0, sizeof o);
+            o.tiled = layout; o.tile_size = 16; o.rows_per_strip = 1;
+            o.deflate = comp; o.predictor = comp ? 3 : 1;
+            img.data = src; img.width = W; img.height = H; img.bands = B;
+            img.band_step = (size_t)W * H; img.row_step = W; img.pixel_step = 1;
+            CHECK(ex_rio_write(tpath("serial.tif"), &img, NULL, &o, err) == 0);
+            par_calls = 0;
+            o.parallel = par_reverse;
+            CHECK(ex_rio_write(tpath("parallel.tif"), &img, NULL, &o, err) == 0);
+            CHECK(par_calls > 1); /* 570 tiles or 450 strips: several batches */
+            a = slurp(tpath("serial.tif"), &na);
+            b = slurp(tpath("parallel.tif"), &nb);
+            CHECK(a && b && na > 0 && na == nb && memcmp(a, b, na) == 0);
+            free(a);
+            free(b);
+            o.parallel = par_fail;
+            CHECK(ex_rio_write(tpath("failed.tif"), &img, NULL, &o, err) != 0 && err[0]);
+            CHECK(access(tpath("failed.tif"), F_OK) != 0);
+            o.parallel = par_skip_last;
+            CHECK(ex_rio_write(tpath("failed.tif"), &img, NULL, &o, err) != 0 && err[0]);
+            CHECK(access(tpath("failed.tif"), F_OK) != 0);
+        }
+    remove(tpath("serial.tif"));
+    remove(tpath("parallel.tif"));
+    free(src);
+}
+
 TEST(tiff_lzw_packbits)
 {
     enum { W = 300, H = 70 };
@@ -1157,6 +1226,7 @@ int main(int argc, char **argv)
     RUN(inflate_dynamic_and_errors);
     RUN(deflate_round_trip);
     RUN(tiff_round_trips);
+    RUN(tiff_parallel_chunks);
     RUN(tiff_lzw_packbits);
     RUN(window_reads);
     RUN(netpbm_windows);

@@ -345,6 +345,45 @@ static hfvis_status cli_threaded_rows(int rows, int threads, cli_rows_fn fn, voi
     return cli_split_run(&sp);
 }
 
+/* ---- the raster writer's strips and tiles (ex_rio_write_options.parallel): calls fn(ctx, i)
+ * for i in [0, n) over the run's threads (user: the thread count); the writer puts the chunks
+ * in order, so the file's bytes do not depend on the split. */
+typedef struct cli_for_split {
+    int (*fn)(void *ctx, size_t i);
+    void *ctx;
+} cli_for_split;
+
+static hfvis_status cli_for_unit(cli_split *sp, int u, int thread, hfvis_sweep_options *o)
+{
+    const cli_for_split *j = (const cli_for_split *)sp->ctx;
+    (void)thread;
+    (void)o;
+    return j->fn(j->ctx, (size_t)u) == 0 ? HFVIS_OK : HFVIS_ERR_OUT_OF_MEMORY;
+}
+
+static int cli_parallel_for(void *user, size_t n, int (*fn)(void *ctx, size_t i), void *ctx)
+{
+    const int threads = *(const int *)user;
+    hfvis_sweep_options none = hfvis_sweep_options_default();
+    cli_for_split j;
+    cli_split sp;
+    size_t i;
+    if (threads <= 1 || n <= 1 || n > (size_t)INT_MAX) {
+        for (i = 0; i < n; i++)
+            if (fn(ctx, i) != 0) return -1;
+        return 0;
+    }
+    memset(&sp, 0, sizeof sp);
+    j.fn = fn;
+    j.ctx = ctx;
+    sp.units = (int)n;
+    sp.threads = threads;
+    sp.unit = cli_for_unit;
+    sp.ctx = &j;
+    sp.opts = &none;
+    return cli_split_run(&sp) == HFVIS_OK ? 0 : -1;
+}
+
 /* The exact-ray grid data of opts' calls (hfvis_exact_grid_compute's) over `threads` threads by
  * row bands (hfvis_exact_grid_rows): each band's pages are first touched by the thread that
  * computes it (at 4096^2 the 134 MB of twists took 0.39 s on one thread, most of it the kernel

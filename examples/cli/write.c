@@ -248,7 +248,7 @@ static int cli_save(const cli_args *a, cli_output out)
         ex_georef g = a->run->geo; /* shallow: only the NoData fields change, on the copy */
         char why[256];
         size_t i, n = (size_t)w * (size_t)h * (size_t)channels;
-        int moved = 0;
+        int moved = 0, threads = cli_run_threads(a);
         img.data = px;
         img.width = w;
         img.height = h / planes;
@@ -260,6 +260,8 @@ static int cli_save(const cli_args *a, cli_output out)
         o.tiled = 1;
         o.deflate = 1;
         o.predictor = 3;
+        o.parallel = cli_parallel_for; /* the tiles compressed over the run's threads */
+        o.parallel_user = &threads;
         if (g.has_nodata) /* the input's NoData, unless the output has it as a real value */
             for (i = 0; i < n; i++)
                 if (!isnan(px[i]) && (double)px[i] == g.nodata) {
