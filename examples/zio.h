@@ -8,6 +8,7 @@
  * Contents
  *   1. checksums        ex_adler32
  *   2. inflate          ex_inflate: a zlib or raw deflate stream into a buffer of known size
+ *                       (codes of up to 9 bits by table, longer ones bit by bit)
  *   3. deflate          ex_deflate_bound, ex_deflate_zlib: LZ77 (hash chains) + fixed Huffman
  *                       (codes from tables made per stream), a stored block instead when that
  *                       is shorter; reentrant (the TIFF writer compresses tiles concurrently)
@@ -75,10 +76,14 @@ typedef struct {
     int truncated;
 } ex_z_state;
 
-/* A canonical Huffman code as counts per length and symbols in code order (Mark Adler's puff). */
+/* A canonical Huffman code as counts per length and symbols in code order (Mark Adler's puff),
+ * and a table of the codes of at most EX_Z_FAST_BITS bits by the next EX_Z_FAST_BITS bits of the
+ * stream: symbol << 4 | length, or -1 (a longer code, or none: the canonical walk decides). */
+#define EX_Z_FAST_BITS 9
 typedef struct {
     short count[EX_Z_MAXBITS + 1];
     short symbol[288];
+    short fast[1 << EX_Z_FAST_BITS];
 } ex_z_huff;
 
 static inline int ex_z_bits(ex_z_state *s, int need)
@@ -97,10 +102,32 @@ static inline int ex_z_bits(ex_z_state *s, int need)
     return (int)(v & ((1u << need) - 1u));
 }
 
-/* Decode one symbol, reading the code bit by bit (codes are stored most significant bit first). */
+/* Back to the byte boundary: the bits of the partial byte dropped, whole bytes the decoder took
+ * ahead (ex_z_decode's look-ahead) returned to the input. */
+static inline void ex_z_align(ex_z_state *s)
+{
+    s->in_pos -= (size_t)(s->nbits >> 3);
+    s->bits = 0;
+    s->nbits = 0;
+}
+
+/* Decode one symbol: by the table when EX_Z_FAST_BITS bits are at hand and the code is that
+ * short, else the code bit by bit (codes are stored most significant bit first). */
 static inline int ex_z_decode(ex_z_state *s, const ex_z_huff *h)
 {
     int code = 0, first = 0, index = 0, len;
+    while (s->nbits < EX_Z_FAST_BITS && s->in_pos < s->in_len) {
+        s->bits |= (uint32_t)s->in[s->in_pos++] << s->nbits;
+        s->nbits += 8;
+    }
+    if (s->nbits >= EX_Z_FAST_BITS) {
+        int e = h->fast[s->bits & ((1u << EX_Z_FAST_BITS) - 1u)];
+        if (e >= 0) {
+            s->bits >>= e & 15;
+            s->nbits -= e & 15;
+            return e >> 4;
+        }
+    }
     for (len = 1; len <= EX_Z_MAXBITS; len++) {
         int count;
         code |= ex_z_bits(s, 1);
@@ -121,6 +148,7 @@ static inline int ex_z_build(ex_z_huff *h, const short *length, int n)
 {
     short offs[EX_Z_MAXBITS + 1];
     int symbol, len, left;
+    for (symbol = 0; symbol < (1 << EX_Z_FAST_BITS); symbol++) h->fast[symbol] = -1;
     for (len = 0; len <= EX_Z_MAXBITS; len++) h->count[len] = 0;
     for (symbol = 0; symbol < n; symbol++) h->count[length[symbol]]++;
     if (h->count[0] == n) return 0;
@@ -134,6 +162,21 @@ static inline int ex_z_build(ex_z_huff *h, const short *length, int n)
     for (len = 1; len < EX_Z_MAXBITS; len++) offs[len + 1] = (short)(offs[len] + h->count[len]);
     for (symbol = 0; symbol < n; symbol++)
         if (length[symbol] != 0) h->symbol[offs[length[symbol]]++] = (short)symbol;
+    /* the short codes' table (left >= 0 here: complete or incomplete, never over-subscribed, so
+     * every code of length len is below 2^len) */
+    {
+        int index = 0, code = 0, k, f;
+        for (len = 1; len <= EX_Z_FAST_BITS; len++) {
+            for (k = 0; k < h->count[len]; k++, code++) {
+                int r = 0, b;
+                for (b = 0; b < len; b++) r |= ((code >> b) & 1) << (len - 1 - b);
+                for (f = r; f < (1 << EX_Z_FAST_BITS); f += 1 << len)
+                    h->fast[f] = (short)(h->symbol[index + k] << 4 | len);
+            }
+            index += h->count[len];
+            code <<= 1;
+        }
+    }
     return left;
 }
 
@@ -267,7 +310,7 @@ static inline int ex_inflate(const unsigned char *in, size_t in_len, unsigned ch
         if (s.truncated) return EX_Z_TRUNCATED;
         if (type == 0) {
             size_t len;
-            s.bits = 0; s.nbits = 0; /* to a byte boundary */
+            ex_z_align(&s); /* to a byte boundary */
             if (s.in_len - s.in_pos < 4) return EX_Z_TRUNCATED;
             len = (size_t)s.in[s.in_pos] | (size_t)s.in[s.in_pos + 1] << 8;
             if ((s.in[s.in_pos + 2] ^ s.in[s.in_pos]) != 0xff || (s.in[s.in_pos + 3] ^ s.in[s.in_pos + 1]) != 0xff)
@@ -288,6 +331,7 @@ static inline int ex_inflate(const unsigned char *in, size_t in_len, unsigned ch
         if (rc != EX_Z_OK) return rc;
     }
     *produced = s.out_pos;
+    ex_z_align(&s); /* the check value starts at the next byte */
     if (zlib) {
         const unsigned char *c;
         uint32_t want;

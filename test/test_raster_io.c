@@ -115,6 +115,30 @@ TEST(inflate_dynamic_and_errors)
     }
 }
 
+/* zlib.compressobj(9): "a" x 2530, Z_SYNC_FLUSH, "horizon " x 25, Z_FULL_FLUSH, "a" x 40, finish:
+ * a dynamic block whose end-of-block code is 2 bits long, so the decoder's table path has read a
+ * whole byte past it when the empty stored block after it begins (found by search among zlib's
+ * streams); more blocks, a final stored one, the check value. The decoder must give the byte
+ * back at the stored block and at the check value. */
+static const unsigned char flush_stream[] = {
+    0x78,0xda,0xec,0xc1,0x01,0x0d,0x00,0x00,0x00,0xc2,0xa0,0xac,0xef,0x5f,0xc2,0x1e,0x0e,0x28,0x00,0x00,
+    0xbe,0x0c,0x00,0x00,0xff,0xff,0xca,0xc8,0x2f,0xca,0xac,0xca,0xcf,0x53,0x18,0xea,0x34,0x00,0x00,0x00,
+    0xff,0xff,0x4b,0x4c,0x24,0x0e,0x00,0x00,0x98,0xb9,0x1d,0x08,
+};
+
+TEST(inflate_stored_after_lookahead)
+{
+    unsigned char want[2770], got[2770];
+    size_t n = 0, i;
+    for (i = 0; i < 2530; i++) want[i] = 'a';
+    for (i = 0; i < 200; i++) want[2530 + i] = (unsigned char)"horizon "[i % 8];
+    for (i = 0; i < 40; i++) want[2730 + i] = 'a';
+    CHECK(ex_inflate(flush_stream, sizeof flush_stream, got, sizeof got, 1, &n) == EX_Z_OK);
+    CHECK(n == sizeof want && memcmp(got, want, n) == 0);
+    /* every truncation is refused, never read past */
+    for (i = 0; i + 1 < sizeof flush_stream; i++) CHECK(ex_inflate(flush_stream, i, got, sizeof got, 1, &n) != EX_Z_OK);
+}
+
 TEST(deflate_round_trip)
 {
     size_t sizes[] = { 0, 1, 2, 3, 257, 4096, 70000, 300000 };
@@ -1224,6 +1248,7 @@ int main(int argc, char **argv)
         return 1;
     }
     RUN(inflate_dynamic_and_errors);
+    RUN(inflate_stored_after_lookahead);
     RUN(deflate_round_trip);
     RUN(tiff_round_trips);
     RUN(tiff_parallel_chunks);
