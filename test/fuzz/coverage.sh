@@ -15,7 +15,7 @@ done
 out=build/fuzz/cov; mkdir -p "$out" || exit 1
 img="hfvis_image_info_read hfvis_image_decode hf_img_is_space hf_img_is_digit hf_img_skip hf_img_number hf_img_scale hf_img_p2_samples hf_img_p5_samples hf_img_pfm_rows hf_img_parse hf_img_write_pixels"
 # the raster readers of examples/raster_io.h and the inflate of examples/zio.h
-tif="ex_rio_open_tiff_mem ex_rio_tiff_parse ex_rio_fetch ex_rio_uint ex_rio_put_uint ex_rio_bits_double ex_rio_bits_float ex_rio_type_size ex_rio_entry_value ex_rio_entry_u ex_rio_entry_doubles ex_rio_entry_fixed ex_rio_entry_chunks ex_rio_compression_name ex_georef_keys ex_georef_transform ex_georef_set_nodata ex_rio_packbits ex_rio_lzw ex_rio_unpredict2 ex_rio_unpredict3 ex_rio_grow ex_rio_chunk ex_rio_sample ex_rio_cell ex_rio_read ex_rio_close ex_inflate ex_inflate_string ex_z_bits ex_z_decode ex_z_build ex_z_codes ex_z_fixed ex_z_dynamic ex_adler32"
+tif="ex_rio_open_tiff_mem ex_rio_tiff_parse ex_rio_fetch ex_rio_uint ex_rio_put_uint ex_rio_bits_double ex_rio_bits_float ex_rio_type_size ex_rio_entry_value ex_rio_entry_u ex_rio_entry_doubles ex_rio_entry_fixed ex_rio_entry_chunks ex_rio_compression_name ex_georef_keys ex_georef_transform ex_georef_set_nodata ex_rio_packbits ex_rio_lzw ex_rio_unpredict2 ex_rio_unpredict3 ex_rio_grow ex_rio_chunk ex_rio_sample ex_rio_cell ex_rio_read ex_rio_close ex_inflate ex_inflate_string ex_z_bits ex_z_align ex_z_decode ex_z_build ex_z_codes ex_z_fixed ex_z_dynamic ex_adler32"
 targets=${*:-pgm pgm_range pfm obj binvox visfield partial geotiff asc ehdr netpbm heightfield}
 for t in $targets; do
   case $t in
