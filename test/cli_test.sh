@@ -1381,6 +1381,16 @@ expect_ok "solar tiles: per-cell sites, 30 days, --threads 1 whole run" "$dir/st
 cmp -s "$dir/stw_g.tif" "$dir/stw_g_t2.tif" && ok "solar tiles: --threads 2 equals --threads 1 (per-cell sites, 30 days)" || bad "solar tiles: --threads 2 differs from --threads 1"
 solar_tiles "per-cell sites, a day" --day 2026-06-21 --threads 1
 solar_tiles "--latitude/--longitude, a day, --threads 2" --day 2026-06-21 --latitude 46 --longitude 15 --threads 2
+# --height-range LO,HI: the pressure nodes' span given, no pass over IN; the pieces still join
+# into the whole run with the same range, a height outside it is refused, and a piece made
+# without it does not join those made with it
+solar_tiles "--height-range, a day" --day 2026-06-21 --latitude 46 --longitude 15 --height-range 0,2000 --threads 2
+expect_fail "solar --height-range below the heights read" 1 solar "$dir/swin.asc" --day 2026-06-21 --latitude 46 --longitude 15 --max-distance 2000 --window 0,0,20,13 --height-range 0,1200 -o "$fdir/x.tif"
+expect_fail "solar --height-range with one value" 2 solar "$dir/swin.asc" --day 2026-06-21 --latitude 46 --longitude 15 --height-range 5 -o "$fdir/x.tif"
+expect_fail "solar --height-range LO > HI" 2 solar "$dir/swin.asc" --day 2026-06-21 --latitude 46 --longitude 15 --height-range 9,3 -o "$fdir/x.tif"
+expect_fail "solar --height-range not finite" 2 solar "$dir/swin.asc" --day 2026-06-21 --latitude 46 --longitude 15 --height-range 0,inf -o "$fdir/x.tif"
+expect_ok "solar tiles: a piece without --height-range" "$dir/stp_g_0_0_20_13.tif" solar "$dir/swin.asc" --day 2026-06-21 --latitude 46 --longitude 15 --max-distance 2000 --window 0,0,20,13 -o "$dir/stp_g_0_0_20_13.tif"
+expect_fail "solar tiles: mosaic refuses a piece made without --height-range among pieces with it" 1 mosaic "$dir"/stp_g_*.tif -o "$fdir/x.tif"
 solar_tiles "per-cell sites, an instant" --day 2026-06-21 --time 09:30 --threads 1
 "$hfvis" mosaic "$dir"/stp_g_0_0_20_13.tif "$dir"/stp_b_20_0_17_13.tif "$dir"/stp_b_0_13_37_1.tif "$dir"/stp_b_0_14_11_15.tif "$dir"/stp_b_11_14_26_15.tif -o "$fdir/x.tif" > /dev/null 2> "$dir/stderr" &&
   bad "solar tiles: mosaic joined a global piece with beam pieces" || { grep -q 'solar-output' "$dir/stderr" &&

@@ -144,8 +144,9 @@ typedef struct cli_args {
      * sun hours) */
     int sol_y, sol_m, sol_d, sol_ey, sol_em, sol_ed, sol_has_start, sol_has_end;
     int sol_instant, sol_solar_time, sol_has_lat, sol_has_lon, sol_has_offset, sol_has_linke;
-    int sol_has_linke_monthly, sol_bands, sol_horizons, sol_normals;
+    int sol_has_linke_monthly, sol_bands, sol_horizons, sol_normals, sol_has_zrange;
     double sol_hour, sol_step, sol_lat, sol_lon, sol_offset, sol_linke, sol_linke_monthly[12];
+    double sol_zmin, sol_zmax; /* --height-range LO,HI */
     const char *sol_linke_map, *sol_out[4];
     cli_run_state *run; /* the run's state (cli_run_init) */
 } cli_args;

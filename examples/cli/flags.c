@@ -480,6 +480,8 @@ static const cli_flag cli_flags[] = {
       CLI_WORDS(CLI_V_CHOICE, "exact"), NULL },
     { "--normals", "central|horn", CLI_ONLY(CMD_SOLAR),
       CLI_WORDS(CLI_V_CHOICE, "central"), NULL },
+    { "--height-range", "LO,HI", CLI_ONLY(CMD_SOLAR),
+      CLI_TYPED(CLI_V_LIST), NULL },
     { "--beam", "OUT", CLI_ONLY(CMD_SOLAR),
       CLI_TYPED(CLI_V_TEXT), NULL },
     { "--diffuse", "OUT", CLI_ONLY(CMD_SOLAR),

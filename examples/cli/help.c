@@ -51,7 +51,8 @@
     "         --albedo-map A.pfm] -o GLOBAL [--beam B] [--diffuse D] [--reflected R]\n"             \
     "         [--sun-hours H] [--latitude DEG --longitude DEG] [--utc-offset H | --solar-time]\n"    \
     "         [--bands day|month] [--normals central|horn] [--sun-radius DEG] [--dirs K]\n"     \
-    "         [--max-distance R [--window X0,Y0,W,H]] [--horizons exact|near-far|lattice]\n"     \
+    "         [--max-distance R [--window X0,Y0,W,H]] [--height-range LO,HI]\n"                  \
+    "         [--horizons exact|near-far|lattice]\n"                                              \
     "Clear-sky solar irradiation (Wh/m^2) of a day or a date range, or irradiance (W/m^2) at\n"     \
     "--time, on every cell: r.sun's ESRA atmosphere (Suri & Hofierka 2004), the sun from NREL's\n"  \
     "SPA (Reda & Andreas 2004/2008), the beam shaded by exact horizons (docs/solar.md).\n"          \
@@ -85,6 +86,9 @@
     "                    output its own, with the per-cell sites and suns of the whole raster)\n"  \
     "                    join with 'hfvis mosaic' into the whole run's rasters bit for bit\n"      \
     "                    (docs/tiles.md; a window reads its cells of the maps)\n"                 \
+    "  --height-range LO,HI  the pressure nodes' span instead (heights after --zscale): no pass\n" \
+    "                    over IN, so each --window reads only its cells and halo; every height\n" \
+    "                    read must lie in it, and the pieces of one run must share it\n"         \
     "Polar night gives 0. With --progress the site's latitude and longitude go to stderr.\n"
 
 #define CLI_VF_HELP                                                                                  \

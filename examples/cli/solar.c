@@ -83,6 +83,20 @@ static int cli_set_solar(cli_args *a, const char *f, const char *v)
         return 0;
     }
     if (!strcmp(f, "--linke-map")) { a->sol_linke_map = v; return 0; }
+    if (!strcmp(f, "--height-range")) { /* LO,HI: finite, LO <= HI, in IN's height unit (--zscale applied) */
+        char buf[64];
+        size_t n = strcspn(v, ",");
+        int good = n > 0 && n < sizeof buf && v[n] == ',';
+        if (good) {
+            memcpy(buf, v, n);
+            buf[n] = '\0';
+            good = cli_parse_real(buf, &a->sol_zmin) && cli_parse_real(v + n + 1, &a->sol_zmax) &&
+                   isfinite(a->sol_zmin) && isfinite(a->sol_zmax) && a->sol_zmin <= a->sol_zmax;
+        }
+        if (!good) return cli_error(CLI_EXIT_USAGE, f, "expected LO,HI (finite heights, LO <= HI), got '%s'", v);
+        a->sol_has_zrange = 1;
+        return 0;
+    }
     if (!strcmp(f, "--solar-time")) { a->sol_solar_time = 1; return 0; }
     if (!strcmp(f, "--bands")) return sol_word(f, v, "day|month", HFVIS_SOLAR_BANDS_DAY, &a->sol_bands);
     if (!strcmp(f, "--horizons"))
@@ -288,6 +302,8 @@ static int cli_solar_height_range(const cli_args *a, double *lo, double *hi)
         return rc;
     }
     rows = r.width < 65536 ? 65536 / r.width : 1;
+    if (r.format == EX_RIO_TIFF && r.chunk_h > 0 && r.chunk_h <= 4096) /* whole strips or tile rows: */
+        rows = (int)(((uint32_t)rows + r.chunk_h - 1) / r.chunk_h * r.chunk_h); /* each decoded once */
     if (!(strip = cli_alloc((size_t)r.width, (size_t)rows, 1))) {
         ex_rio_close(&r);
         return cli_status(a->in, HFVIS_ERR_OUT_OF_MEMORY, 0);
@@ -437,7 +453,22 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     so.horizons = (hfvis_solar_horizons)a->sol_horizons;
     so.normals = (hfvis_solar_normals)a->sol_normals;
     so.sweep = opts;
-    if (a->max_distance > 0.0 && (rc = cli_solar_height_range(a, &so.height_min, &so.height_max)) != 0) goto done;
+    if (a->sol_has_zrange) { /* the caller's range: no pass over IN; every height read must lie in it */
+        const size_t gw = (size_t)grid->width, n = gw * (size_t)grid->height;
+        const size_t x0 = a->run->win.active ? (size_t)a->run->win.gx0 : 0, y0 = a->run->win.active ? (size_t)a->run->win.gy0 : 0;
+        size_t i;
+        for (i = 0; i < n; i++)
+            if (isfinite(grid->z[i]) && !((double)grid->z[i] >= a->sol_zmin && (double)grid->z[i] <= a->sol_zmax)) {
+                rc = cli_error(CLI_EXIT_ERROR, "--height-range", "the height %g at column %lu, row %lu of %s lies "
+                               "outside %g,%g", (double)grid->z[i], (unsigned long)(x0 + i % gw),
+                               (unsigned long)(y0 + i / gw), a->in, a->sol_zmin, a->sol_zmax);
+                goto done;
+            }
+        so.height_min = a->sol_zmin;
+        so.height_max = a->sol_zmax;
+    } else if (a->max_distance > 0.0 && (rc = cli_solar_height_range(a, &so.height_min, &so.height_max)) != 0) {
+        goto done;
+    }
     if (a->sol_has_linke_monthly) {
         for (k = 0; k < 12; k++) monthly[k] = (float)a->sol_linke_monthly[k];
         so.linke_monthly = monthly;

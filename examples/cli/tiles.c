@@ -106,6 +106,13 @@ static void cli_piece_tag(const cli_args *a, const hfvis_grid *grid, const hfvis
              a->sol_has_lon, a->sol_lon, a->sol_has_offset, a->sol_offset, a->sol_linke,
              a->sol_has_linke_monthly, a->sol_bands, a->sol_horizons, a->sol_normals, a->has_dirs,
              a->sun_radius, a->has_sun_radius, a->has_albedo, a->sol_linke_map ? "map" : "none");
+    {
+        size_t len = strlen(win->tag);
+        if (a->sol_has_zrange)
+            snprintf(win->tag + len, sizeof win->tag - len, " height-range=%a,%a", a->sol_zmin, a->sol_zmax);
+        else
+            snprintf(win->tag + len, sizeof win->tag - len, " height-range=none");
+    }
     if (a->sol_has_linke_monthly) {
         int k;
         for (k = 0; k < 12; k++) {
