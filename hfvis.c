@@ -10826,7 +10826,12 @@ static hfvis_status hf_exact_light(const hfvis_grid *g, int K, hfvis_sum_kind ki
     return HFVIS_OK;
 }
 
-/* hfvis_sun_visibility in exact mode: one direction, the sun's nearest representable one. */
+/* hfvis_sun_visibility in exact mode: one direction, the sun's nearest representable one. A hard
+ * sun (radius 0) decides lit (elevation > atan t) without the atan wherever the tangent lies
+ * outside [tan(elevation - HF_SUN_TAN_GUARD), tan(elevation + HF_SUN_TAN_GUARD)]: there the
+ * angles differ by more than the guard, far beyond atan's and tan's rounding, so the decision is
+ * the atan's; inside, the atan decides as before (the same bits). */
+#define HF_SUN_TAN_GUARD 1e-9 /* rad: 10^6 ulps of pi/2 */
 static hfvis_status hf_exact_sun(const hfvis_grid *g, double azimuth, double elevation,
                                  double radius, const hfvis_sweep_options *o, float *out,
                                  ptrdiff_t out_stride)
@@ -10835,6 +10840,9 @@ static hfvis_status hf_exact_sun(const hfvis_grid *g, double azimuth, double ele
     hf_exact E;
     hfvis_status s;
     int x, y, x0, x1;
+    const int hard = radius <= 0.0;
+    const double t_lo = hard && elevation - HF_SUN_TAN_GUARD > -HFVIS__HALF_PI ? tan(elevation - HF_SUN_TAN_GUARD) : -HFVIS__INF;
+    const double t_hi = hard && elevation + HF_SUN_TAN_GUARD < HFVIS__HALF_PI ? tan(elevation + HF_SUN_TAN_GUARD) : HFVIS__INF;
     o1.azimuth0_rad = azimuth;
     if ((s = hf_exact_init(&E, g, 1, &o1, 1, 0, 0)) != HFVIS_OK) return s;
     hf_exact_parts(&E, o, E.d.ray[0]);
@@ -10843,7 +10851,7 @@ static hfvis_status hf_exact_sun(const hfvis_grid *g, double azimuth, double ele
         hf_exact_span(&E, y, E.d.ray[0], &x0, &x1); /* the band's receivers of the row */
         for (x = x0; x < x1; x++) {
             double t = E.tan[(size_t)y * (size_t)g->width + (size_t)x];
-            out[(ptrdiff_t)y * out_stride + x] =
+            out[(ptrdiff_t)y * out_stride + x] = t < t_lo ? 1.0f : t > t_hi ? 0.0f : /* NaN: the atan */
                 (float)hf_sun_fraction(elevation, radius, hf_tan_to_elevation(t));
         }
     }

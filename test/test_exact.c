@@ -137,6 +137,58 @@ TEST(sweep_equals_oracle_hard_fields)
     CHECK(out_a[0] == (float)(-PI / 2));
 }
 
+/* The hard sun (radius 0) decides most receivers from the tangent against tan(elevation +-
+ * HF_SUN_TAN_GUARD) without an atan (hfvis.c hf_exact_sun). Held to the atan's decision: a disc
+ * of radius 1e-300 takes the atan for every receiver and gives 1 or 0 wherever the elevation and
+ * the horizon differ (0.5 on an exact tie, where the hard sun gives 0). Fields: fBm with holes,
+ * urban boxes, terraces; suns from below the horizon to the zenith, and suns placed on receivers'
+ * own horizons (the float map's angles, within 6e-8 rad of the exact ones). */
+TEST(hard_sun_equals_atan_decision)
+{
+    static float hard[96 * 72], soft[96 * 72], map[96 * 72];
+    const double elev_deg[] = { -10.0, -1e-12, 0.0, 0.3, 5.0, 30.0, 60.0, 89.9, 90.0 };
+    const double az_deg[] = { 0.0, 37.7, 315.0 };
+    int f, a, e, i, bad = 0, ties = 0, runs = 0;
+    for (f = 0; f < 3; f++) {
+        hfvis_grid g;
+        hfvis_sweep_options o = exact_opts(0.0, HFVIS_BORDER_OPEN, 0);
+        if (f == 0) {
+            (void)test_fbm(zbuf, 96, 72, 12.0, 16.0, 0, 21);
+            for (i = 0; i < 96 * 72; i += 97) zbuf[i] = (float)NAN;
+        } else if (f == 1) {
+            fields_urban(zbuf, 96, 72, 9, 5);
+        } else {
+            fields_terraces(zbuf, 96, 72, 1.0, 4.0, 80.0, 2);
+        }
+        g = test_grid(zbuf, 96, 72, 1.0);
+        for (a = 0; a < 3; a++) {
+            double az = az_deg[a] * PI / 180.0;
+            for (e = 0; e < 9 + 4; e++) {
+                double el;
+                if (e < 9) {
+                    el = elev_deg[e] * PI / 180.0;
+                } else { /* on a receiver's own horizon toward the sun */
+                    o.azimuth0_rad = az;
+                    CHECK_EQ_STATUS(hfvis_horizon_direction(&g, 1, 0, &o, map, 96), HFVIS_OK);
+                    el = (double)map[(e - 9) * 1500 + 700];
+                    if (!(el > -PI / 2 && el < PI / 2)) el = 0.1;
+                    o.azimuth0_rad = 0.0;
+                }
+                CHECK_EQ_STATUS(hfvis_sun_visibility(&g, az, el, 0.0, &o, hard, 96), HFVIS_OK);
+                CHECK_EQ_STATUS(hfvis_sun_visibility(&g, az, el, 1e-300, &o, soft, 96), HFVIS_OK);
+                for (i = 0; i < 96 * 72; i++) {
+                    if (isnan(soft[i]) != isnan(hard[i])) bad++;
+                    else if (soft[i] == 0.5f) { ties++; if (hard[i] != 0.0f) bad++; }
+                    else if (!isnan(soft[i]) && soft[i] != hard[i]) bad++;
+                }
+                runs++;
+            }
+        }
+    }
+    printf("     hard sun: %d runs of 96 x 72, %d exact ties, %d mismatches\n", runs, ties, bad);
+    CHECK(bad == 0);
+}
+
 /* Holes never occlude and get NaN: a NaN wall on flat ground leaves every horizon at 0 (the
  * ground ahead) or -pi/2 (nothing ahead). */
 TEST(holes_never_occlude)
@@ -950,6 +1002,7 @@ int main(int argc, char **argv)
     TEST_INIT(argc, argv);
     RUN(sweep_equals_oracle_random);
     RUN(sweep_equals_oracle_hard_fields);
+    RUN(hard_sun_equals_atan_decision);
     RUN(holes_never_occlude);
     RUN(tilted_plane_is_exact);
     RUN(wall_closed_form);
