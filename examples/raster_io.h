@@ -1672,11 +1672,7 @@ static inline int ex_rio_read_stored(ex_rio_reader *r, int band, int x0, int y0,
                                                                            value, its branches hoisted */
                             for (xx = xa; xx < xb; xx++) {
                                 const unsigned char *p = src + ((size_t)(xx - rx0) * (size_t)spc + sel) * 4u;
-                                uint32_t u = r->cached_be ? (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 |
-                                                                (uint32_t)p[2] << 8 | p[3]
-                                                          : (uint32_t)p[3] << 24 | (uint32_t)p[2] << 16 |
-                                                                (uint32_t)p[1] << 8 | p[0];
-                                o[xx - x0] = ex_rio_cell(r, (double)ex_rio_bits_float(u));
+                                o[xx - x0] = ex_rio_cell(r, (double)ex_rio_bits_float((uint32_t)ex_rio_uint(p, 4, r->cached_be)));
                             }
                         else
                             for (xx = xa; xx < xb; xx++)

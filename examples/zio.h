@@ -142,6 +142,16 @@ static inline int ex_z_decode(ex_z_state *s, const ex_z_huff *h)
     return -2; /* ran out of codes */
 }
 
+/* The n low bits of code in reverse order (Huffman codes travel most significant bit first,
+ * RFC 1951 §3.1.1; the bit buffers here fill from the least significant end). */
+static inline uint32_t ex_z_reverse(uint32_t code, int n)
+{
+    uint32_t r = 0;
+    int i;
+    for (i = 0; i < n; i++) r |= ((code >> i) & 1u) << (n - 1 - i);
+    return r;
+}
+
 /* Build h from n code lengths; 0 when complete or (as RFC 1951 allows for one distance code)
  * incomplete, -1 when over-subscribed. */
 static inline int ex_z_build(ex_z_huff *h, const short *length, int n)
@@ -167,12 +177,9 @@ static inline int ex_z_build(ex_z_huff *h, const short *length, int n)
     {
         int index = 0, code = 0, k, f;
         for (len = 1; len <= EX_Z_FAST_BITS; len++) {
-            for (k = 0; k < h->count[len]; k++, code++) {
-                int r = 0, b;
-                for (b = 0; b < len; b++) r |= ((code >> b) & 1) << (len - 1 - b);
-                for (f = r; f < (1 << EX_Z_FAST_BITS); f += 1 << len)
+            for (k = 0; k < h->count[len]; k++, code++)
+                for (f = (int)ex_z_reverse((uint32_t)code, len); f < (1 << EX_Z_FAST_BITS); f += 1 << len)
                     h->fast[f] = (short)(h->symbol[index + k] << 4 | len);
-            }
             index += h->count[len];
             code <<= 1;
         }
@@ -403,14 +410,6 @@ typedef struct {
     uint16_t lit_code[288];
     unsigned char lit_bits[288], len_sym[259], dist_rev[30], dist_sym[512];
 } ex_z_fixed_codes;
-
-static inline uint32_t ex_z_reverse(uint32_t code, int n)
-{
-    uint32_t r = 0;
-    int i;
-    for (i = 0; i < n; i++) r |= ((code >> i) & 1u) << (n - 1 - i);
-    return r;
-}
 
 static inline void ex_z_fixed_codes_init(ex_z_fixed_codes *t)
 {
