@@ -42,6 +42,26 @@ static int sol_word(const char *f, const char *v, const char *words, int first, 
     return cli_error(CLI_EXIT_USAGE, f, "expected one of %s, got '%s'", words, v);
 }
 
+/* Exactly n numbers separated by commas (cli_parse_real each) into out: 1, or 0. */
+static int cli_parse_reals(const char *v, double *out, int n)
+{
+    int k;
+    for (k = 0; k < n; k++) {
+        char buf[64];
+        size_t len = strcspn(v, ",");
+        if (len == 0 || len >= sizeof buf) return 0;
+        memcpy(buf, v, len);
+        buf[len] = '\0';
+        if (!cli_parse_real(buf, &out[k])) return 0;
+        v += len;
+        if (k < n - 1) {
+            if (*v != ',') return 0;
+            v++;
+        }
+    }
+    return *v == '\0';
+}
+
 static int cli_set_solar(cli_args *a, const char *f, const char *v)
 {
     if (!strcmp(f, "--day") || !strcmp(f, "--start"))
@@ -59,24 +79,9 @@ static int cli_set_solar(cli_args *a, const char *f, const char *v)
         return 0;
     }
     if (!strcmp(f, "--linke-monthly")) { /* 12 values, January first */
-        const char *p = v;
-        int k;
-        for (k = 0; k < 12; k++) {
-            char buf[64];
-            size_t n = strcspn(p, ",");
-            if (n == 0 || n >= sizeof buf) break;
-            memcpy(buf, p, n);
-            buf[n] = '\0';
-            if (!cli_parse_real(buf, &a->sol_linke_monthly[k]) || !(a->sol_linke_monthly[k] > 0.0) ||
-                a->sol_linke_monthly[k] > 10.0)
-                break;
-            p += n;
-            if (k < 11) {
-                if (*p != ',') break;
-                p++;
-            }
-        }
-        if (k < 12 || *p != '\0')
+        int k, good = cli_parse_reals(v, a->sol_linke_monthly, 12);
+        for (k = 0; good && k < 12; k++) good = a->sol_linke_monthly[k] > 0.0 && a->sol_linke_monthly[k] <= 10.0;
+        if (!good)
             return cli_error(CLI_EXIT_USAGE, f, "expected 12 Linke factors in (0, 10], January first, "
                              "separated by commas, got '%s'", v);
         a->sol_has_linke_monthly = 1;
@@ -84,16 +89,11 @@ static int cli_set_solar(cli_args *a, const char *f, const char *v)
     }
     if (!strcmp(f, "--linke-map")) { a->sol_linke_map = v; return 0; }
     if (!strcmp(f, "--height-range")) { /* LO,HI: finite, LO <= HI, in IN's height unit (--zscale applied) */
-        char buf[64];
-        size_t n = strcspn(v, ",");
-        int good = n > 0 && n < sizeof buf && v[n] == ',';
-        if (good) {
-            memcpy(buf, v, n);
-            buf[n] = '\0';
-            good = cli_parse_real(buf, &a->sol_zmin) && cli_parse_real(v + n + 1, &a->sol_zmax) &&
-                   isfinite(a->sol_zmin) && isfinite(a->sol_zmax) && a->sol_zmin <= a->sol_zmax;
-        }
-        if (!good) return cli_error(CLI_EXIT_USAGE, f, "expected LO,HI (finite heights, LO <= HI), got '%s'", v);
+        double r[2];
+        if (!cli_parse_reals(v, r, 2) || !isfinite(r[0]) || !isfinite(r[1]) || r[0] > r[1])
+            return cli_error(CLI_EXIT_USAGE, f, "expected LO,HI (finite heights, LO <= HI), got '%s'", v);
+        a->sol_zmin = r[0];
+        a->sol_zmax = r[1];
         a->sol_has_zrange = 1;
         return 0;
     }
