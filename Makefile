@@ -69,7 +69,7 @@ $(BUILD)/examples/%: examples/%.c examples/common.h examples/fields.h $(LIB)
 $(CLI): $(wildcard examples/cli/*.c) examples/cli/cli.h examples/common.h examples/raster_io.h $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) $(PTHREAD) -I. examples/cli/main.c $(LIB) $(LDLIBS) -o $@
-$(BENCH): examples/bench/bench.c $(wildcard examples/bench/bench_*.c) examples/bench/bench.h examples/common.h examples/fields.h $(LIB)
+$(BENCH): examples/bench/bench.c $(wildcard examples/bench/bench_*.c) examples/bench/bench.h examples/common.h examples/fields.h examples/raster_io.h examples/zio.h $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -I. examples/bench/bench.c $(wildcard examples/bench/bench_*.c) $(LIB) $(LDLIBS) -o $@
 $(BUILD)/test/%: test/%.c test/test.h test/test_dir.h examples/fields.h $(LIB)

@@ -1,6 +1,7 @@
 /* bench_threads.c - `hfvis --threads` (the tool's split of one run over POSIX threads, byte for
  * byte the one-thread output): skyview, sky and horizon in both ray modes and shadow on an N x N
- * fBm PFM, each run as a child process with --threads 1 and with --threads T (the online cores,
+ * fBm PFM (and the GeoTIFF writer and reader: horizon into a .tif, the exact shadow of the same
+ * fBm as a DEFLATE GeoTIFF), each run as a child process with --threads 1 and with --threads T (the online cores,
  * at least 2): wall and CPU seconds (user + system, all threads), peak memory, the speed-up and
  * whether the two outputs are equal byte for byte; the minimum of HFVIS_BENCH_THREADS_RUNS runs
  * (default 1) of each. N = $HFVIS_BENCH_THREADS_N (default 2048; quick 512). Then, in process, the
@@ -13,10 +14,16 @@
 #include <string.h>
 #include <unistd.h>
 #include "bench.h"
+#include "../raster_io.h"
 
-/* An N x N fBm (1 m cells, relief about N/8) written as a PFM at path; 0 on success. */
-static int threads_field(const char *path, int n, float **z_out)
+/* An N x N fBm (1 m cells, relief about N/8) written as a PFM at path and as a GeoTIFF at tif
+ * (tiled 256, DEFLATE, predictor 3: as the tool and GDAL's usual options write one); 0 on
+ * success. */
+static int threads_field(const char *path, const char *tif, int n, float **z_out)
 {
+    ex_rio_write_options wo;
+    ex_rio_image img;
+    char err[256];
     hfvis_field f;
     float *z = (float *)malloc((size_t)n * (size_t)n * sizeof(float));
     int x, y;
@@ -28,7 +35,13 @@ static int threads_field(const char *path, int n, float **z_out)
     f.seed = 26;
     for (y = 0; y < n; y++)
         for (x = 0; x < n; x++) z[(size_t)y * (size_t)n + (size_t)x] = (float)hfvis_field_height(&f, x, y);
-    if (hfvis_pfm_save(path, z, n, n, 1, n) != HFVIS_OK) {
+    memset(&wo, 0, sizeof wo);
+    wo.tiled = 1;
+    wo.deflate = 1;
+    wo.predictor = 3;
+    img.data = z, img.width = n, img.height = n, img.bands = 1;
+    img.pixel_step = 1, img.row_step = (size_t)n, img.band_step = (size_t)n * (size_t)n;
+    if (hfvis_pfm_save(path, z, n, n, 1, n) != HFVIS_OK || ex_rio_write(tif, &img, NULL, &wo, err) != 0) {
         free(z);
         return -1;
     }
@@ -139,22 +152,25 @@ static void threads_exact_grid(const float *z, int n)
 
 void bench_threads(int quick)
 {
-    static char *const runs[][8] = { /* name, then the command and its flags */
-        {"skyview K=64", "skyview", "--dirs", "64", NULL},
-        {"skyview K=16 exact", "skyview", "--dirs", "16", "--exact", NULL},
-        {"sky K=64", "sky", "--dirs", "64", NULL},
-        {"sky K=16 exact", "sky", "--dirs", "16", "--exact", NULL},
-        {"horizon K=16", "horizon", "--dirs", "16", NULL},
-        {"horizon K=16 exact", "horizon", "--dirs", "16", "--exact", NULL},
-        {"shadow 315/10", "shadow", "--sun-azimuth", "315", "--sun-elevation", "10", NULL},
-        {"shadow 315/10 exact", "shadow", "--sun-azimuth", "315", "--sun-elevation", "10", "--exact"},
+    static char *const runs[][9] = { /* name, input and output type, then the command and its flags */
+        {"skyview K=64", "pfm pfm", "skyview", "--dirs", "64", NULL},
+        {"skyview K=16 exact", "pfm pfm", "skyview", "--dirs", "16", "--exact", NULL},
+        {"sky K=64", "pfm pfm", "sky", "--dirs", "64", NULL},
+        {"sky K=16 exact", "pfm pfm", "sky", "--dirs", "16", "--exact", NULL},
+        {"horizon K=16", "pfm pfm", "horizon", "--dirs", "16", NULL},
+        {"horizon K=16 exact", "pfm pfm", "horizon", "--dirs", "16", "--exact", NULL},
+        {"shadow 315/10", "pfm pfm", "shadow", "--sun-azimuth", "315", "--sun-elevation", "10", NULL},
+        {"shadow 315/10 exact", "pfm pfm", "shadow", "--sun-azimuth", "315", "--sun-elevation", "10", "--exact"},
+        /* the GeoTIFF writer's tiles over the threads, and the reader (DEFLATE, predictor 3) */
+        {"horizon K=16 -> tif", "pfm tif", "horizon", "--dirs", "16", NULL},
+        {"shadow exact tif->", "tif pfm", "shadow", "--sun-azimuth", "315", "--sun-elevation", "10", "--exact"},
     };
     char *cli = getenv("HFVIS_CLI") ? getenv("HFVIS_CLI") : (char *)"build/hfvis";
     const char *tmp = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
     const int n = getenv("HFVIS_BENCH_THREADS_N") ? atoi(getenv("HFVIS_BENCH_THREADS_N")) : quick ? 512 : 2048;
     const int reps = getenv("HFVIS_BENCH_THREADS_RUNS") ? atoi(getenv("HFVIS_BENCH_THREADS_RUNS")) : 1;
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    char dir[512], in[600], out[2][600], threads[2][16], *argv[24];
+    char dir[512], in[600], tif[600], out[2][600], threads[2][16], *argv[24];
     float *z = NULL;
     int r, t, k, rep;
     if (n < 16 || n > 16384 || reps < 1) {
@@ -169,7 +185,8 @@ void bench_threads(int quick)
     printf("\n== threads: `hfvis CMD --threads 1` vs `--threads %s` on a %d x %d fBm (%s; %ld online "
            "cores; min of %d run%s; wall and CPU seconds, peak MiB)\n", threads[1], n, n, cli, cores, reps,
            reps == 1 ? "" : "s");
-    if (threads_field(in, n, &z) != 0) { printf("threads: cannot write the field in %s\n", dir); rmdir(dir); return; }
+    snprintf(tif, sizeof tif, "%s/fbm.tif", dir);
+    if (threads_field(in, tif, n, &z) != 0) { printf("threads: cannot write the field in %s\n", dir); rmdir(dir); return; }
     printf("  %-20s | %8s %8s %7s | %8s %8s %7s | %8s  %s\n", "run", "1: wall", "CPU", "MiB", "T: wall", "CPU",
            "MiB", "speed-up", "bytes equal");
     for (r = 0; r < (int)(sizeof runs / sizeof runs[0]); r++) {
@@ -177,15 +194,15 @@ void bench_threads(int quick)
         long peak[2] = {0, 0};
         int failed = 0;
         for (t = 0; t < 2; t++) {
-            snprintf(out[t], sizeof out[t], "%s/out%d.pfm", dir, t);
+            snprintf(out[t], sizeof out[t], "%s/out%d.%s", dir, t, runs[r][1] + 4);
             for (rep = 0; rep < reps; rep++) {
                 double w = 0.0, c = 0.0;
                 long m = 0;
                 int a = 0;
                 argv[a++] = cli;
-                argv[a++] = runs[r][1];
-                argv[a++] = in;
-                for (k = 2; k < 8 && runs[r][k]; k++) argv[a++] = runs[r][k];
+                argv[a++] = runs[r][2];
+                argv[a++] = runs[r][1][0] == 't' ? tif : in;
+                for (k = 3; k < 9 && runs[r][k]; k++) argv[a++] = runs[r][k];
                 argv[a++] = (char *)"--threads", argv[a++] = threads[t];
                 argv[a++] = (char *)"--max-memory", argv[a++] = (char *)"0";
                 argv[a++] = (char *)"--quiet", argv[a++] = (char *)"-o", argv[a++] = out[t];
@@ -202,6 +219,7 @@ void bench_threads(int quick)
         remove(out[0]), remove(out[1]);
     }
     remove(in);
+    remove(tif);
     rmdir(dir);
     threads_normals(z, n);
     threads_exact_grid(z, n);
