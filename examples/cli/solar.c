@@ -453,14 +453,17 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     so.horizons = (hfvis_solar_horizons)a->sol_horizons;
     so.normals = (hfvis_solar_normals)a->sol_normals;
     so.sweep = opts;
-    if (a->sol_has_zrange) { /* the caller's range: no pass over IN; every height read must lie in it */
+    if (a->sol_has_zrange) { /* the caller's range: no pass over IN; every height read must lie in it,
+                                compared as the floats the heights are (a range printed from
+                                them with 9 digits holds them) */
+        const float flo = (float)a->sol_zmin, fhi = (float)a->sol_zmax;
         const size_t gw = (size_t)grid->width, n = gw * (size_t)grid->height;
         const size_t x0 = a->run->win.active ? (size_t)a->run->win.gx0 : 0, y0 = a->run->win.active ? (size_t)a->run->win.gy0 : 0;
         size_t i;
         for (i = 0; i < n; i++)
-            if (isfinite(grid->z[i]) && !((double)grid->z[i] >= a->sol_zmin && (double)grid->z[i] <= a->sol_zmax)) {
-                rc = cli_error(CLI_EXIT_ERROR, "--height-range", "the height %g at column %lu, row %lu of %s lies "
-                               "outside %g,%g", (double)grid->z[i], (unsigned long)(x0 + i % gw),
+            if (isfinite(grid->z[i]) && !(grid->z[i] >= flo && grid->z[i] <= fhi)) {
+                rc = cli_error(CLI_EXIT_ERROR, "--height-range", "the height %.9g at column %lu, row %lu of %s lies "
+                               "outside %.9g,%.9g", (double)grid->z[i], (unsigned long)(x0 + i % gw),
                                (unsigned long)(y0 + i / gw), a->in, a->sol_zmin, a->sol_zmax);
                 goto done;
             }
