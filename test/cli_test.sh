@@ -1385,6 +1385,11 @@ solar_tiles "--latitude/--longitude, a day, --threads 2" --day 2026-06-21 --lati
 # into the whole run with the same range, a height outside it is refused, and a piece made
 # without it does not join those made with it
 solar_tiles "--height-range, a day" --day 2026-06-21 --latitude 46 --longitude 15 --height-range 0,2000 --threads 2
+# heights compared as the floats they are: 1000.1 read from text is the float 1000.0999756, below
+# the double 1000.1, and is still inside --height-range 1000.1,2000.7
+awk 'BEGIN { print "ncols 6"; print "nrows 5"; print "xllcorner 480000"; print "yllcorner 5000000"; print "cellsize 400"
+  for (y = 0; y < 5; y++) { s = ""; for (x = 0; x < 6; x++) s = s " " ((x + y) % 3 ? "1500.3" : (x ? "2000.7" : "1000.1")); print s } }' > "$dir/sdec.asc"
+expect_ok "solar --height-range with the decimal extremes of the heights" "$dir/sdec.tif" solar "$dir/sdec.asc" --day 2026-06-21 --latitude 46 --longitude 15 --max-distance 2000 --window 0,0,3,3 --height-range 1000.1,2000.7 -o "$dir/sdec.tif"
 expect_fail "solar --height-range below the heights read" 1 solar "$dir/swin.asc" --day 2026-06-21 --latitude 46 --longitude 15 --max-distance 2000 --window 0,0,20,13 --height-range 0,1200 -o "$fdir/x.tif"
 expect_fail "solar --height-range with one value" 2 solar "$dir/swin.asc" --day 2026-06-21 --latitude 46 --longitude 15 --height-range 5 -o "$fdir/x.tif"
 expect_fail "solar --height-range LO > HI" 2 solar "$dir/swin.asc" --day 2026-06-21 --latitude 46 --longitude 15 --height-range 9,3 -o "$fdir/x.tif"
