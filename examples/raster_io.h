@@ -38,8 +38,9 @@
  *   5. TIFF chunk decoding     PackBits, LZW, DEFLATE, predictors, samples
  *   6. ASC and EHdr parsing
  *   7. reading                 ex_rio_open, ex_rio_open_tiff_mem, ex_rio_open_asc_mem,
- *                              ex_rio_open_ehdr_mem, ex_rio_open_netpbm(_mem), ex_rio_read, ex_rio_close,
- *                              ex_georef_shift
+ *                              ex_rio_open_ehdr_mem, ex_rio_open_netpbm(_mem), ex_rio_read,
+ *                              ex_rio_read_parallel (row parts over a caller's threads),
+ *                              ex_rio_close, ex_georef_shift
  *   8. writing                 ex_rio_write (by extension), ex_rio_write_tiff_file
  */
 #ifndef HFVIS_EXAMPLES_RASTER_IO_H
@@ -456,6 +457,15 @@ static inline int ex_rio_fetch(ex_rio_reader *r, uint64_t off, size_t n, void *d
     }
     if (off > (uint64_t)LONG_MAX || fseek(r->f, (long)off, SEEK_SET) != 0) return -1;
     return fread(dst, 1, n, r->f) == n ? 0 : -1;
+}
+
+/* 1 when this machine stores a float's most significant byte first. */
+static inline int ex_rio_host_big_endian(void)
+{
+    const float one = 1.0f; /* 0x3f800000 */
+    unsigned char b[4];
+    memcpy(b, &one, 4);
+    return b[0] == 0x3f;
 }
 
 static inline uint64_t ex_rio_uint(const unsigned char *p, int n, int be)
@@ -1639,16 +1649,25 @@ static inline int ex_rio_read_stored(ex_rio_reader *r, int band, int x0, int y0,
         }
         if (r->format == EX_RIO_EHDR || r->format == EX_RIO_NETPBM) {
             size_t n = (size_t)(cx1 - cx0), need = (size_t)((n - 1) * r->col_bytes + (uint64_t)bytes);
+            const int direct = r->kind == EX_RIO_FLOAT && bytes == 4 && r->col_bytes == 4 &&
+                               r->big_endian == ex_rio_host_big_endian();
             if (ex_rio_grow(&r->dbuf, &r->dbuf_cap, need) != 0) return ex_rio_fail(r->err, "out of memory");
             for (yy = cy0; yy < cy1; yy++) {
                 uint64_t fy = r->rows_up ? (uint64_t)(r->height - 1 - yy) : (uint64_t)yy;
                 uint64_t off = r->skip + fy * r->row_bytes + (uint64_t)band * r->band_bytes +
                                (uint64_t)cx0 * r->col_bytes;
+                if (direct) { /* PFM, .flt: the bytes are the floats, fetched into place */
+                    float *o = out + (ptrdiff_t)(yy - y0) * stride + (ptrdiff_t)(cx0 - x0);
+                    if (ex_rio_fetch(r, off, need, o) != 0) return ex_rio_fail(r->err, "cannot read row %lld", yy);
+                    for (xx = 0; xx < cx1 - cx0; xx++) o[xx] = ex_rio_cell(r, (double)o[xx]);
+                    continue;
+                }
                 if (ex_rio_fetch(r, off, need, r->dbuf) != 0) return ex_rio_fail(r->err, "cannot read row %lld", yy);
-                for (xx = cx0; xx < cx1; xx++)
-                    out[(ptrdiff_t)(yy - y0) * stride + (ptrdiff_t)(xx - x0)] = ex_rio_cell(
-                        r, ex_rio_sample(r->dbuf + (size_t)(xx - cx0) * (size_t)r->col_bytes, r->kind, r->bits,
-                                         r->big_endian));
+                else
+                    for (xx = cx0; xx < cx1; xx++)
+                        out[(ptrdiff_t)(yy - y0) * stride + (ptrdiff_t)(xx - x0)] = ex_rio_cell(
+                            r, ex_rio_sample(r->dbuf + (size_t)(xx - cx0) * (size_t)r->col_bytes, r->kind, r->bits,
+                                             r->big_endian));
             }
             return 0;
         }
@@ -1687,15 +1706,11 @@ static inline int ex_rio_read_stored(ex_rio_reader *r, int band, int x0, int y0,
     return 0;
 }
 
-/* ex_rio_read: the window of the north-up raster (ex_georef_orient) from the file's orientation:
- * the mirrored window, then its rows and columns reversed in place. */
-static inline int ex_rio_read(ex_rio_reader *r, int band, int x0, int y0, int w, int h, float *out,
-                              ptrdiff_t stride)
+/* A window read in the file's orientation put north-up, west to east (ex_georef_orient): its
+ * rows and columns reversed in place as the file's flags say. */
+static inline void ex_rio_unflip(const ex_rio_reader *r, int w, int h, float *out, ptrdiff_t stride)
 {
     int fx = r->geo.flip_x, fy = r->geo.flip_y, y, x;
-    if (fx) x0 = (int)((long long)r->width - x0 - w);
-    if (fy) y0 = (int)((long long)r->height - y0 - h);
-    if (ex_rio_read_stored(r, band, x0, y0, w, h, out, stride) != 0) return -1;
     if (fy && w >= 1 && stride >= w)
         for (y = 0; y < h / 2; y++) {
             float *a = out + (ptrdiff_t)y * stride, *b = out + (ptrdiff_t)(h - 1 - y) * stride;
@@ -1714,7 +1729,115 @@ static inline int ex_rio_read(ex_rio_reader *r, int band, int x0, int y0, int w,
                 a[w - 1 - x] = t;
             }
         }
+}
+
+/* ex_rio_read: the window of the north-up raster (ex_georef_orient) from the file's orientation:
+ * the mirrored window, then its rows and columns reversed in place. */
+static inline int ex_rio_read(ex_rio_reader *r, int band, int x0, int y0, int w, int h, float *out,
+                              ptrdiff_t stride)
+{
+    if (r->geo.flip_x) x0 = (int)((long long)r->width - x0 - w);
+    if (r->geo.flip_y) y0 = (int)((long long)r->height - y0 - h);
+    if (ex_rio_read_stored(r, band, x0, y0, w, h, out, stride) != 0) return -1;
+    ex_rio_unflip(r, w, h, out, stride);
     return 0;
+}
+
+/* Parts of one ex_rio_read_parallel: a few for each thread of a large machine. */
+#define EX_RIO_READ_PARTS 64
+
+typedef struct {
+    const ex_rio_reader *r;  /* the opened reader: its layout, georeference and ASC grid shared */
+    const char *path;        /* reopened by each part that reads a file */
+    ex_rio_reader *part;     /* per part: the shared layout, its own file, buffers and message */
+    int *rows;               /* part i reads stored rows [rows[i], rows[i + 1]) */
+    int *rc;                 /* per part: 1 not run, 0 read, -1 failed (its message in part[i].err) */
+    int band, x0, y0, w;
+    float *out;
+    ptrdiff_t stride;
+} ex_rio_read_job;
+
+static inline int ex_rio_read_part(void *ctx, size_t i)
+{
+    ex_rio_read_job *j = (ex_rio_read_job *)ctx;
+    ex_rio_reader *p = &j->part[i];
+    int y0 = j->rows[i], n = j->rows[i + 1] - y0;
+    if (n < 1) return j->rc[i] = 0;
+    *p = *j->r;
+    p->f = NULL;
+    p->cbuf = p->dbuf = NULL;
+    p->cbuf_cap = p->dbuf_cap = 0;
+    p->cached = 0;
+    p->err[0] = '\0';
+    if (j->r->f && !(p->f = fopen(j->path, "rb"))) {
+        j->rc[i] = ex_rio_fail(p->err, "cannot open");
+    } else {
+        j->rc[i] = ex_rio_read_stored(p, j->band, j->x0, y0, j->w, n, j->out + (ptrdiff_t)(y0 - j->y0) * j->stride,
+                                      j->stride);
+        if (p->f) fclose(p->f);
+    }
+    free(p->cbuf);
+    free(p->dbuf);
+    return 0; /* every part runs: the message is then the first failing part's, whatever the order */
+}
+
+/* ex_rio_read with the rows cut into parts that parallel(user, n, fn, ctx) runs, in any order or
+ * at once (the writer's runner, ex_rio_write_options.parallel): each part reads its rows through
+ * its own copy of the reader (a file reader's part reopens path, which must be the file r was
+ * opened from), so a part's pages are first touched and its chunks decoded by the thread that runs
+ * it. A TIFF's parts end at strip or tile rows (each chunk decoded once). The same floats as
+ * ex_rio_read; on failure r->err holds the first failing part's message. parallel NULL:
+ * ex_rio_read. */
+static inline int ex_rio_read_parallel(ex_rio_reader *r, const char *path, int band, int x0, int y0, int w, int h,
+                                       float *out, ptrdiff_t stride,
+                                       int (*parallel)(void *user, size_t n, int (*fn)(void *ctx, size_t i),
+                                                       void *ctx),
+                                       void *user)
+{
+    ex_rio_read_job j;
+    long long unit = r->format == EX_RIO_TIFF ? (long long)r->chunk_h : 1, sy0, cut;
+    int n = EX_RIO_READ_PARTS, i, rc = 0, ran;
+    if (!parallel || (r->f && !path)) return ex_rio_read(r, band, x0, y0, w, h, out, stride);
+    if (band < 0 || band >= r->bands) return ex_rio_fail(r->err, "band %d does not exist (the raster has %d)",
+                                                         band + 1, r->bands);
+    if (w < 1 || h < 1 || stride < w) return ex_rio_fail(r->err, "empty window");
+    if (r->geo.flip_x) x0 = (int)((long long)r->width - x0 - w);
+    if (r->geo.flip_y) y0 = (int)((long long)r->height - y0 - h);
+    if (n > h) n = h;
+    memset(&j, 0, sizeof j);
+    j.part = (ex_rio_reader *)calloc((size_t)n, sizeof *j.part);
+    j.rows = (int *)malloc(((size_t)n + 1) * sizeof *j.rows);
+    j.rc = (int *)malloc((size_t)n * sizeof *j.rc);
+    if (!j.part || !j.rows || !j.rc) {
+        free(j.part);
+        free(j.rows);
+        free(j.rc);
+        return ex_rio_fail(r->err, "out of memory");
+    }
+    j.rows[0] = y0;
+    for (i = 1; i < n; i++) { /* an even share of the rows, moved up to the next chunk row */
+        sy0 = (long long)y0 + (long long)h * i / n;
+        cut = sy0 >= 0 ? (sy0 + unit - 1) / unit * unit : sy0;
+        if (cut > (long long)y0 + h) cut = (long long)y0 + h;
+        j.rows[i] = cut > j.rows[i - 1] ? (int)cut : j.rows[i - 1];
+    }
+    j.rows[n] = y0 + h;
+    for (i = 0; i < n; i++) j.rc[i] = 1;
+    j.r = r;
+    j.path = path;
+    j.band = band, j.x0 = x0, j.y0 = y0, j.w = w;
+    j.out = out;
+    j.stride = stride;
+    ran = parallel(user, (size_t)n, ex_rio_read_part, &j);
+    for (i = 0; i < n && rc == 0; i++)
+        if (j.rc[i] < 0) rc = ex_rio_fail(r->err, "%s", j.part[i].err);
+    for (i = 0; i < n && rc == 0; i++) /* a part the runner did not run (out of memory) */
+        if (j.rc[i] != 0 || ran != 0) rc = ex_rio_fail(r->err, "the parallel read did not run every part");
+    free(j.part);
+    free(j.rows);
+    free(j.rc);
+    if (rc == 0) ex_rio_unflip(r, w, h, out, stride);
+    return rc;
 }
 
 /* ------------------------------------------------------------------------------------------ */

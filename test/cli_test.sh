@@ -964,6 +964,17 @@ expect_fail "--cell 1e-160 (ratio past 1e150)" 1 skyview "$h" --cell 1e-160 -o "
 grep -q -- '--cell' "$dir/stderr" && ok "--cell named" || bad "--cell named"
 expect_fail "--zscale 3e38" 1 skyview "$h" --zscale 3e38 -o "$o"
 grep -q -- '--zscale' "$dir/stderr" && ok "--zscale named" || bad "--zscale named"
+# The heights' pass runs by blocks of 2^18 values over the threads: the cell named is the first
+# whose scaled height overflows, in the second block here (file value 263000 of 600 x 440, rows
+# stored bottom first: cell (200, 1)); the value 2e38 after it in the same block and a NaN before.
+{ printf 'Pf\n600 440\n-1\n'; head -c 1048000 /dev/zero; printf '\000\000\300\177'; head -c 3996 /dev/zero
+  printf '\231\166\026\177'; printf '\231\166\026\177'; head -c 3992 /dev/zero; } > "$dir/overflow.pfm"
+for t in 1 2; do
+  expect_fail "--zscale 2 over two blocks, $t thread(s)" 1 skyview "$dir/overflow.pfm" --zscale 2 --threads $t --dirs 4 -o "$o"
+  grep -q 'value 2e+38 at (200, 1) exceeds' "$dir/stderr" && ok "--zscale: the first overflowing cell named ($t)" \
+    || bad "--zscale: first overflowing cell: $(cat "$dir/stderr")"
+done
+expect_ok "--zscale 1.5 on the same file" "$dir/ovok.pfm" skyview "$dir/overflow.pfm" --zscale 1.5 --dirs 4 -o "$dir/ovok.pfm"
 expect_fail "--sky 3e38 --albedo 3e38" 2 sky "$h" --sky 3e38 --albedo 3e38 -o "$o"
 # Light inputs each within the float range whose product is not (issue: an emission map of 3e38
 # under --sky 3e38 wrote an all-NaN raster with exit 0): the result is checked, nothing written

@@ -181,7 +181,7 @@ static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double 
     float *px;
     double rc_cell = 0.0;
     char why[256];
-    int gx = 0, gy = 0, gw, gh;
+    int gx = 0, gy = 0, gw, gh, threads;
     if ((ex_rio_format_of(a->in) ? ex_rio_open(&r, a->in) : ex_rio_open_netpbm(&r, a->in)) != 0)
         return cli_error(CLI_EXIT_ERROR, a->in, "%s", r.err);
     if (r.format == EX_RIO_NETPBM && r.bands != 1) {
@@ -221,7 +221,8 @@ static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double 
             fprintf(stderr, "hfvis: note: --cell %g overrides the cell size %.10g of %s\n", a->cell, rc_cell,
                     a->in);
     } else if (!a->has_cell && !a->quiet) {
-        fprintf(stderr, "hfvis: note: %s has no georeference: cell size 1 (give --cell)\n", a->in);
+        fprintf(stderr, r.format == EX_RIO_NETPBM ? "hfvis: note: %s has no cell size: using 1 (give --cell)\n"
+                : "hfvis: note: %s has no georeference: cell size 1 (give --cell)\n", a->in);
     }
     gw = r.width, gh = r.height;
     if (a->run->win.active) { /* the window and its halo only (estimate, refusal before allocating) */
@@ -238,7 +239,9 @@ static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double 
         return cli_status(a->in, HFVIS_ERR_OUT_OF_MEMORY, 0);
     }
     r.nodata_to_nan = 1;
-    if (ex_rio_read(&r, a->band ? a->band - 1 : 0, gx, gy, gw, gh, px, gw) != 0) {
+    threads = cli_run_threads(a); /* each thread decodes its rows' chunks and first touches their pages */
+    if (ex_rio_read_parallel(&r, a->in, a->band ? a->band - 1 : 0, gx, gy, gw, gh, px, gw,
+                             threads > 1 ? cli_parallel_for : NULL, &threads) != 0) {
         cli_error(CLI_EXIT_ERROR, a->in, "%s", r.err);
         free(px);
         ex_rio_close(&r);

@@ -212,6 +212,93 @@ static int cli_window_side(const cli_args *a, int halo, int w, int h, int channe
     return lo;
 }
 
+/* A binary PFM ("Pf" or "PF"): read by rows over the threads (cli_load_raster), where the
+ * library's hfvis_image_load takes the file whole and then its rows. */
+static int cli_is_pfm(const char *path)
+{
+    unsigned char m[2];
+    FILE *f = fopen(path, "rb");
+    int pfm = f && fread(m, 1, 2, f) == 2 && m[0] == 'P' && (m[1] == 'f' || m[1] == 'F');
+    if (f) fclose(f);
+    return pfm;
+}
+
+/* The heights' pass of cli_load_heights over the threads, by blocks of CLI_HEIGHTS_BLOCK values:
+ * --nodata values and non-finite ones become holes (NaN), the others are scaled by --zscale. */
+#define CLI_HEIGHTS_BLOCK ((size_t)1 << 18) /* values: 1 MB of floats */
+typedef struct cli_heights {
+    float *px;
+    size_t n;
+    float zscale, nodata;
+    uint32_t has_nodata;
+    float *top; /* per block: the largest |scaled height|, +inf if one overflows (the block left as read) */
+} cli_heights;
+
+/* 1 for a hole: a value that is not finite, or --nodata's. */
+static uint32_t cli_height_hole(float v, float nodata, uint32_t has_nodata)
+{
+    uint32_t u;
+    memcpy(&u, &v, sizeof u);
+    return (uint32_t)((u & 0x7fffffffu) >= 0x7f800000u) | (has_nodata & (uint32_t)(v == nodata));
+}
+
+/* The bits of |v| (those of a non-negative float order as its value), 0 for a hole. */
+static uint32_t cli_height_magnitude(float v, float nodata, uint32_t has_nodata)
+{
+    uint32_t u;
+    memcpy(&u, &v, sizeof u);
+    return u & 0x7fffffffu & (cli_height_hole(v, nodata, has_nodata) - 1u);
+}
+
+/* v * zscale, or NaN for a hole, without a branch. */
+static float cli_height_scaled(float v, float nodata, uint32_t has_nodata, float zscale)
+{
+    float s = v * zscale;
+    uint32_t hole = cli_height_hole(v, nodata, has_nodata), u;
+    memcpy(&u, &s, sizeof u);
+    u = (u & (hole - 1u)) | (0x7fc00000u & (0u - hole)); /* 0x7fc00000: a quiet NaN */
+    memcpy(&s, &u, sizeof u);
+    return s;
+}
+
+/* Loops of a fixed count of CLI_HEIGHTS_LANE values, which gcc -O2 vectorizes, and the rest one by
+ * one: the block's largest magnitude, then the stores. The largest scaled magnitude is
+ * fl(max |v| |zscale|), the largest of the fl(|v| |zscale|): rounding is monotone. */
+#define CLI_HEIGHTS_LANE 64
+static int cli_heights_block(void *ctx, size_t b)
+{
+    const cli_heights *j = (const cli_heights *)ctx;
+    float *p = j->px + b * CLI_HEIGHTS_BLOCK, big;
+    const float zs = j->zscale, nd = j->nodata;
+    const size_t n = j->n - b * CLI_HEIGHTS_BLOCK < CLI_HEIGHTS_BLOCK ? j->n - b * CLI_HEIGHTS_BLOCK : CLI_HEIGHTS_BLOCK;
+    const uint32_t use_nd = j->has_nodata ? 1u : 0u;
+    uint32_t top = 0, m;
+    size_t i, k;
+    for (i = 0; i + CLI_HEIGHTS_LANE <= n; i += CLI_HEIGHTS_LANE) {
+        const float *q = p + i;
+        for (k = 0; k < CLI_HEIGHTS_LANE; k++) {
+            m = cli_height_magnitude(q[k], nd, use_nd);
+            top = m > top ? m : top;
+        }
+    }
+    for (; i < n; i++) {
+        m = cli_height_magnitude(p[i], nd, use_nd);
+        top = m > top ? m : top;
+    }
+    memcpy(&big, &top, sizeof big);
+    j->top[b] = fabsf(big * zs);
+    if (!(j->top[b] <= FLT_MAX)) {
+        j->top[b] = HUGE_VALF;
+        return 0;
+    }
+    for (i = 0; i + CLI_HEIGHTS_LANE <= n; i += CLI_HEIGHTS_LANE) {
+        float *q = p + i;
+        for (k = 0; k < CLI_HEIGHTS_LANE; k++) q[k] = cli_height_scaled(q[k], nd, use_nd, zs);
+    }
+    for (; i < n; i++) p[i] = cli_height_scaled(p[i], nd, use_nd, zs);
+    return 0;
+}
+
 /* Load IN as a one-channel height field; --nodata values become NaN, the rest are scaled.
  * *cell: --cell, else the raster's cell size, else 1 (with a note unless --quiet). */
 static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double *cell)
@@ -219,10 +306,12 @@ static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double
     hfvis_image_info info;
     float *px = NULL, zscale = (float)a->zscale, nodata = (float)a->nodata;
     double top = 0.0; /* largest |height| */
-    size_t i, n;
+    size_t i, n, blocks;
+    cli_heights j;
+    int threads;
     hfvis_status s;
     *cell = a->cell;
-    if (ex_rio_format_of(a->in) || a->run->win.active) {
+    if (ex_rio_format_of(a->in) || a->run->win.active || cli_is_pfm(a->in)) {
         int rc = cli_load_raster(a, &px, w, h, cell);
         if (rc != 0) return rc;
     } else {
@@ -242,24 +331,30 @@ static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double
         *w = info.width; *h = info.height;
     }
     n = (size_t)*w * (size_t)*h; /* <= HFVIS_IMAGE_MAX_VALUES (decoder limit) */
-    for (i = 0; i < n; i++) {
-        float v = px[i];
-        if (a->has_nodata && v == nodata) {
-            px[i] = (float)NAN;
-            continue;
-        }
-        if (!isfinite(v)) { /* NaN, +-Inf: a hole (hfvis.h, "No-data") */
-            px[i] = (float)NAN;
-            continue;
-        }
-        px[i] = v * zscale;
-        if (!isfinite(px[i])) { /* not a hole: refused, never silently one */
-            hfvis_free(NULL, px);
-            return cli_error(CLI_EXIT_ERROR, "--zscale", "%g times the value %g at (%lu, %lu) "
-                             "exceeds the float range (3.4e38)", a->zscale, (double)v,
-                             (unsigned long)(i % (size_t)*w), (unsigned long)(i / (size_t)*w));
-        }
-        if (fabs((double)px[i]) > top) top = fabs((double)px[i]);
+    j.px = px;
+    j.n = n;
+    j.zscale = zscale;
+    j.nodata = nodata;
+    j.has_nodata = a->has_nodata ? 1u : 0u;
+    blocks = (n - 1) / CLI_HEIGHTS_BLOCK + 1;
+    threads = cli_run_threads(a);
+    if (!(j.top = (float *)malloc(blocks * sizeof *j.top))) {
+        hfvis_free(NULL, px);
+        return cli_status(a->in, HFVIS_ERR_OUT_OF_MEMORY, 0);
+    }
+    (void)cli_parallel_for(&threads, blocks, cli_heights_block, &j); /* never fails */
+    for (i = 0; i < blocks && !(j.top[i] > FLT_MAX); i++)
+        if ((double)j.top[i] > top) top = (double)j.top[i];
+    free(j.top);
+    if (i < blocks) { /* not a hole: refused, never silently one (block i is as read) */
+        double v;
+        for (i *= CLI_HEIGHTS_BLOCK; i < n && (cli_height_hole(px[i], nodata, j.has_nodata) || isfinite(px[i] * zscale));
+             i++) {}
+        v = i < n ? (double)px[i] : 0.0;
+        hfvis_free(NULL, px);
+        return cli_error(CLI_EXIT_ERROR, "--zscale", "%g times the value %g at (%lu, %lu) "
+                         "exceeds the float range (3.4e38)", a->zscale, v,
+                         (unsigned long)(i % (size_t)*w), (unsigned long)(i / (size_t)*w));
     }
     /* heights in cells (z / cell, in double) and their squares must stay finite */
     if (top / *cell > CLI_MAX_RELIEF || *cell < DBL_MIN) {
