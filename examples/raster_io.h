@@ -1152,9 +1152,49 @@ static inline int ex_rio_keyeq(const char *a, const char *b)
 
 /* A whole token as a number: decimal, or the words inf, infinity and nan (strtod's); never
  * hexadecimal ("0x10" is not a number to GDAL either). 0, or -1. */
+/* strtod's value of a plain decimal, [+-]digits[.digits][(e|E)[+-]digits], whose digits make an
+ * integer m <= 2^53 and whose power of ten is within 10^22: m and 10^|e| are exact doubles, so
+ * the one product or quotient is the correctly rounded value, strtod's bit for bit (Clinger, "How
+ * to read floating point numbers accurately", PLDI 1990: the fast path); -1 for anything else
+ * (and where doubles are evaluated in a wider format, FLT_EVAL_METHOD != 0). ASC grids are
+ * mostly such decimals; strtod then takes the rest. */
+static inline int ex_rio_decimal(const char *s, double *v)
+{
+    static const double p10[23] = { 1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11,
+                                    1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22 };
+    uint64_t m = 0;
+    int digits = 0, e = 0, x = 0, neg = 0, eneg, ed = 0;
+    if (FLT_EVAL_METHOD != 0) return -1;
+    if (*s == '+' || *s == '-') neg = *s++ == '-';
+    for (; *s >= '0' && *s <= '9'; s++, digits++) {
+        if (digits == 19) return -1; /* m < 10^19 < 2^64 */
+        m = m * 10u + (uint64_t)(*s - '0');
+    }
+    if (*s == '.') {
+        for (s++; *s >= '0' && *s <= '9'; s++, digits++, e--) {
+            if (digits == 19) return -1;
+            m = m * 10u + (uint64_t)(*s - '0');
+        }
+    }
+    if (digits == 0) return -1;
+    if (*s == 'e' || *s == 'E') {
+        s++;
+        eneg = *s == '-';
+        if (*s == '+' || *s == '-') s++;
+        for (; *s >= '0' && *s <= '9' && ed < 4; s++, ed++) x = x * 10 + (*s - '0');
+        if (ed == 0 || ed == 4) return -1;
+        e += eneg ? -x : x;
+    }
+    if (*s != '\0' || m > ((uint64_t)1 << 53) || e < -22 || e > 22) return -1;
+    *v = e < 0 ? (double)m / p10[-e] : (double)m * p10[e];
+    if (neg) *v = -*v;
+    return 0;
+}
+
 static inline int ex_rio_number(const char *s, double *v)
 {
     char *end;
+    if (ex_rio_decimal(s, v) == 0) return 0;
     if (!*s || strchr(s, 'x') || strchr(s, 'X')) return -1;
     *v = strtod(s, &end);
     return *end == '\0' ? 0 : -1;

@@ -590,6 +590,49 @@ TEST(read_parallel)
     free(src);
 }
 
+/* ex_rio_decimal (the ASC values' fast path) gives strtod's double bit for bit wherever it
+ * answers, and answers for the usual forms; 200,000 random decimals of 1-20 digits, a point
+ * anywhere or none, exponents -30..30 or none, signs, and the edges of its bounds. */
+TEST(asc_decimals)
+{
+    static const char *const edge[] = { "9007199254740992", "9007199254740993", "9007199254740991e22", "1e22",
+                                        "1e23", "1e-22", "1e-23", "-0", "+0.000", "5.", ".5", "-.5e-3",
+                                        "1234567890123456789", "12345678901234567890", "0.1", "1e0005",
+                                        "4.9406564584124654e-324", "1.7976931348623157e308", "3.4028235e38" };
+    uint32_t seed = 2027;
+    int t, fast = 0, k;
+    for (t = 0; t < 200000 + (int)(sizeof edge / sizeof edge[0]); t++) {
+        char buf[64];
+        double a, b;
+        char *end;
+        if (t < (int)(sizeof edge / sizeof edge[0])) {
+            snprintf(buf, sizeof buf, "%s", edge[t]);
+        } else {
+            int nd = 1 + (int)(lcg(&seed) % 20), point = (int)(lcg(&seed) % (unsigned)(nd + 2)), len = 0;
+            if (lcg(&seed) % 3 == 0) buf[len++] = lcg(&seed) % 2 ? '-' : '+';
+            for (k = 0; k < nd; k++) {
+                if (k == point) buf[len++] = '.';
+                buf[len++] = (char)('0' + lcg(&seed) % 10);
+            }
+            if (lcg(&seed) % 3 == 0) len += snprintf(buf + len, sizeof buf - (size_t)len, "e%d", (int)(lcg(&seed) % 61) - 30);
+            buf[len] = '\0';
+        }
+        b = strtod(buf, &end);
+        if (ex_rio_decimal(buf, &a) == 0) {
+            fast++;
+            CHECK(*end == '\0' && memcmp(&a, &b, sizeof a) == 0);
+        }
+    }
+    CHECK(fast > 100000); /* most of them: the fast path is the usual one */
+    {
+        double v;
+        CHECK(ex_rio_decimal("1234.567", &v) == 0 && v == 1234.567);
+        CHECK(ex_rio_decimal("-9999", &v) == 0 && v == -9999.0);
+        CHECK(ex_rio_decimal("1e", &v) != 0 && ex_rio_decimal("0x10", &v) != 0 && ex_rio_decimal("nan", &v) != 0);
+        CHECK(ex_rio_decimal("-", &v) != 0 && ex_rio_decimal(".", &v) != 0 && ex_rio_decimal("1.2.3", &v) != 0);
+    }
+}
+
 TEST(tiff_lzw_packbits)
 {
     enum { W = 300, H = 70 };
@@ -1369,6 +1412,7 @@ int main(int argc, char **argv)
     RUN(tiff_round_trips);
     RUN(tiff_parallel_chunks);
     RUN(read_parallel);
+    RUN(asc_decimals);
     RUN(tiff_lzw_packbits);
     RUN(window_reads);
     RUN(netpbm_windows);
