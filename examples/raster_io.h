@@ -1150,8 +1150,6 @@ static inline int ex_rio_keyeq(const char *a, const char *b)
     return *a == '\0' && *b == '\0';
 }
 
-/* A whole token as a number: decimal, or the words inf, infinity and nan (strtod's); never
- * hexadecimal ("0x10" is not a number to GDAL either). 0, or -1. */
 /* strtod's value of a plain decimal, [+-]digits[.digits][(e|E)[+-]digits], whose digits make an
  * integer m <= 2^53 and whose power of ten is within 10^22: m and 10^|e| are exact doubles, so
  * the one product or quotient is the correctly rounded value, strtod's bit for bit (Clinger, "How
@@ -1191,6 +1189,8 @@ static inline int ex_rio_decimal(const char *s, double *v)
     return 0;
 }
 
+/* A whole token as a number: decimal, or the words inf, infinity and nan (strtod's); never
+ * hexadecimal ("0x10" is not a number to GDAL either). 0, or -1. */
 static inline int ex_rio_number(const char *s, double *v)
 {
     char *end;
@@ -1703,11 +1703,10 @@ static inline int ex_rio_read_stored(ex_rio_reader *r, int band, int x0, int y0,
                     continue;
                 }
                 if (ex_rio_fetch(r, off, need, r->dbuf) != 0) return ex_rio_fail(r->err, "cannot read row %lld", yy);
-                else
-                    for (xx = cx0; xx < cx1; xx++)
-                        out[(ptrdiff_t)(yy - y0) * stride + (ptrdiff_t)(xx - x0)] = ex_rio_cell(
-                            r, ex_rio_sample(r->dbuf + (size_t)(xx - cx0) * (size_t)r->col_bytes, r->kind, r->bits,
-                                             r->big_endian));
+                for (xx = cx0; xx < cx1; xx++)
+                    out[(ptrdiff_t)(yy - y0) * stride + (ptrdiff_t)(xx - x0)] = ex_rio_cell(
+                        r, ex_rio_sample(r->dbuf + (size_t)(xx - cx0) * (size_t)r->col_bytes, r->kind, r->bits,
+                                         r->big_endian));
             }
             return 0;
         }
@@ -1837,7 +1836,8 @@ static inline int ex_rio_read_parallel(ex_rio_reader *r, const char *path, int b
     ex_rio_read_job j;
     long long unit = r->format == EX_RIO_TIFF ? (long long)r->chunk_h : 1, sy0, cut;
     int n = EX_RIO_READ_PARTS, i, rc = 0, ran;
-    if (!parallel || (r->f && !path)) return ex_rio_read(r, band, x0, y0, w, h, out, stride);
+    if (!parallel || (r->f && !path) || (long long)y0 + h > INT_MAX || (long long)y0 - h < INT_MIN)
+        return ex_rio_read(r, band, x0, y0, w, h, out, stride); /* part rows must stay ints */
     if (band < 0 || band >= r->bands) return ex_rio_fail(r->err, "band %d does not exist (the raster has %d)",
                                                          band + 1, r->bands);
     if (w < 1 || h < 1 || stride < w) return ex_rio_fail(r->err, "empty window");

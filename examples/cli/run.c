@@ -342,7 +342,8 @@ static int cli_load_heights(const cli_args *a, float **z, int *w, int *h, double
         hfvis_free(NULL, px);
         return cli_status(a->in, HFVIS_ERR_OUT_OF_MEMORY, 0);
     }
-    (void)cli_parallel_for(&threads, blocks, cli_heights_block, &j); /* never fails */
+    /* the blocks never fail, and a thread that cannot start leaves its blocks to the others */
+    (void)cli_parallel_for(&threads, blocks, cli_heights_block, &j);
     for (i = 0; i < blocks && !(j.top[i] > FLT_MAX); i++)
         if ((double)j.top[i] > top) top = (double)j.top[i];
     free(j.top);
