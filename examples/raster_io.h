@@ -2503,32 +2503,88 @@ static inline int ex_rio_publish(ex_publish *p, char **names, int n, char *err)
     return ok ? 0 : ex_rio_fail(err, "cannot write the file");
 }
 
-/* Write band 0 of img as an ESRI ASCII grid (+ the .prj of geo when it has one), published
- * together (ex_publish). NaN cells are written as the NoData value (geo's, else -9999). */
-static inline int ex_rio_write_asc(const char *path, const ex_rio_image *img, const ex_georef *geo, char *err)
+/* Rows of an ASC grid formatted at once: a batch of rows, each into its own slot of cap bytes. */
+#define EX_RIO_ASC_BATCH_BYTES ((size_t)16 << 20) /* at most 64 rows, and about this many bytes */
+typedef struct {
+    const ex_rio_image *img;
+    const char *ndt;         /* the NoData text, ndl bytes */
+    size_t ndl, cap;
+    char *buf;               /* row i of the batch at buf + i cap, len[i] bytes ((size_t)-1: not made) */
+    size_t *len;
+    int y0;
+} ex_rio_asc_rows;
+
+static inline int ex_rio_asc_row(void *ctx, size_t i)
 {
-    char num[64], *names[1] = {NULL}, *line;
+    ex_rio_asc_rows *j = (ex_rio_asc_rows *)ctx;
+    const ex_rio_image *img = j->img;
+    char num[64], *line = j->buf + i * j->cap;
+    const size_t y = (size_t)j->y0 + i;
+    size_t n = 0;
+    int x;
+    for (x = 0; x < img->width; x++) {
+        float v = img->data[y * img->row_step + (size_t)x * img->pixel_step];
+        size_t k;
+        if (isnan(v)) {
+            memcpy(line + n, j->ndt, j->ndl);
+            k = j->ndl;
+        } else {
+            ex_rio_fmt(num, sizeof num, (double)v, 1);
+            k = strlen(num);
+            memcpy(line + n, num, k);
+        }
+        n += k;
+        line[n++] = x + 1 < img->width ? ' ' : '\n';
+    }
+    j->len[i] = n;
+    return 0;
+}
+
+/* Write band 0 of img as an ESRI ASCII grid (+ the .prj of geo when it has one), published
+ * together (ex_publish): values as %.9g, NaN cells as the NoData value (geo's, else -9999). The
+ * rows are formatted a batch at a time, through opt->parallel when given (any order, each row
+ * into its own buffer), and written in order: the file's bytes do not depend on it; a runner that
+ * fails or skips a row fails the write and leaves no file. */
+static inline int ex_rio_write_asc(const char *path, const ex_rio_image *img, const ex_georef *geo,
+                                   const ex_rio_write_options *opt, char *err)
+{
+    char *names[1] = {NULL};
     ex_publish pub;
     ex_rio_out o;
-    int x, y;
+    ex_rio_asc_rows j;
+    int y0, rows, ran = 1;
     double cell = 1.0, nd = geo && geo->has_nodata ? geo->nodata : -9999.0;
     const char *ndt = geo && geo->has_nodata ? geo->nodata_text : "-9999";
-    size_t cap, ndl = strlen(ndt);
+    size_t ndl = strlen(ndt), i, batch;
     if (img->bands != 1) return ex_rio_fail(err, "an ASCII grid holds one band; this output has %d (write .tif or .bil)",
                                             img->bands);
     if (geo && geo->has_transform) {
         if (ex_georef_cell(geo, &cell, err) != 0) return -1;
     }
     if (isnan(nd)) return ex_rio_fail(err, "an ASCII grid cannot have NoData NaN");
+    memset(&j, 0, sizeof j);
+    j.img = img;
+    j.ndt = ndt;
+    j.ndl = ndl;
     /* one row of text: each cell at most max(16, strlen(NoData)) characters and a separator */
-    cap = ((ndl > 16 ? ndl : 16) + 1) * (size_t)img->width;
-    line = (size_t)img->width < SIZE_MAX / 128 ? (char *)malloc(cap) : NULL;
-    if (!line) return ex_rio_fail(err, "out of memory");
+    j.cap = ((ndl > 16 ? ndl : 16) + 1) * (size_t)img->width;
+    batch = EX_RIO_ASC_BATCH_BYTES / j.cap;
+    batch = batch < 1 ? 1 : batch > 64 ? 64 : batch;
+    if ((size_t)img->width < SIZE_MAX / 128) {
+        j.buf = (char *)malloc(batch * j.cap);
+        j.len = (size_t *)malloc(batch * sizeof *j.len);
+    }
+    if (!j.buf || !j.len) {
+        free(j.buf);
+        free(j.len);
+        return ex_rio_fail(err, "out of memory");
+    }
     ex_publish_init(&pub);
     memset(&o, 0, sizeof o);
     o.f = ex_publish_open(&pub, path);
     if (!o.f) {
-        free(line);
+        free(j.buf);
+        free(j.len);
         ex_publish_end(&pub);
         return ex_rio_fail(err, "cannot create the file");
     }
@@ -2540,26 +2596,27 @@ static inline int ex_rio_write_asc(const char *path, const ex_rio_image *img, co
     else
         ex_rio_emitf(&o, "xllcorner 0\nyllcorner 0\ncellsize 1\n");
     ex_rio_emitf(&o, "NODATA_value %s\n", ndt);
-    for (y = 0; y < img->height && o.ok; y++) {
-        size_t n = 0;
-        for (x = 0; x < img->width; x++) {
-            float v = img->data[(size_t)y * img->row_step + (size_t)x * img->pixel_step];
-            size_t k;
-            if (isnan(v)) {
-                memcpy(line + n, ndt, ndl);
-                k = ndl;
-            } else {
-                ex_rio_fmt(num, sizeof num, (double)v, 1);
-                k = strlen(num);
-                memcpy(line + n, num, k);
-            }
-            n += k;
-            line[n++] = x + 1 < img->width ? ' ' : '\n';
+    for (y0 = 0; y0 < img->height && o.ok; y0 += rows) {
+        rows = img->height - y0 < (int)batch ? img->height - y0 : (int)batch;
+        j.y0 = y0;
+        for (i = 0; i < (size_t)rows; i++) j.len[i] = (size_t)-1;
+        if (opt && opt->parallel && rows > 1) {
+            if (opt->parallel(opt->parallel_user, (size_t)rows, ex_rio_asc_row, &j) != 0) o.ok = 0, ran = 0;
+        } else {
+            for (i = 0; i < (size_t)rows; i++) (void)ex_rio_asc_row(&j, i);
         }
-        ex_rio_emit(&o, line, n);
+        for (i = 0; i < (size_t)rows && o.ok; i++) {
+            if (j.len[i] == (size_t)-1) o.ok = 0, ran = 0; /* a row the runner did not make */
+            else ex_rio_emit(&o, j.buf + i * j.cap, j.len[i]);
+        }
     }
-    free(line);
+    free(j.buf);
+    free(j.len);
     ex_publish_close(&pub, o.f, o.ok);
+    if (!ran) {
+        ex_publish_end(&pub); /* nothing published: the temporary file removed */
+        return ex_rio_fail(err, "the rows' formatting did not run every row");
+    }
     if (ex_rio_publish_prj(&pub, path, geo, &names[0], err) != 0) {
         ex_publish_end(&pub);
         return -1;
@@ -2629,7 +2686,7 @@ static inline int ex_rio_write(const char *path, const ex_rio_image *img, const 
 {
     switch (ex_rio_format_of(path)) {
     case EX_RIO_TIFF: return ex_rio_write_tiff_file(path, img, geo, opt, err);
-    case EX_RIO_ASC: return ex_rio_write_asc(path, img, geo, err);
+    case EX_RIO_ASC: return ex_rio_write_asc(path, img, geo, opt, err);
     case EX_RIO_EHDR: return ex_rio_write_ehdr(path, img, geo, err);
     default: return ex_rio_fail(err, "not a raster extension (.tif .tiff .asc .bil .flt)");
     }

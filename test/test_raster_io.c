@@ -633,6 +633,43 @@ TEST(asc_decimals)
     }
 }
 
+/* The ASC writer's rows formatted through a runner (in reverse, over several batches): the serial
+ * bytes; a runner that fails or skips a row fails the write and leaves no file. */
+TEST(asc_parallel_rows)
+{
+    enum { W = 70, H = 150 };
+    float *src = (float *)malloc(sizeof(float) * W * H);
+    ex_rio_write_options o;
+    ex_rio_image img;
+    char err[256];
+    unsigned char *a, *b;
+    size_t na = 0, nb = 0;
+    field(src, W, H, 1, 0, 31u);
+    src[3] = (float)NAN;
+    memset(&o, 0, sizeof o);
+    img.data = src; img.width = W; img.height = H; img.bands = 1;
+    img.band_step = (size_t)W * H; img.row_step = W; img.pixel_step = 1;
+    CHECK(ex_rio_write(tpath("serial.asc"), &img, NULL, &o, err) == 0);
+    par_calls = 0;
+    o.parallel = par_reverse;
+    CHECK(ex_rio_write(tpath("parallel.asc"), &img, NULL, &o, err) == 0);
+    CHECK(par_calls == 3); /* 150 rows: batches of 64, 64 and 22 */
+    a = slurp(tpath("serial.asc"), &na);
+    b = slurp(tpath("parallel.asc"), &nb);
+    CHECK(a && b && na > 0 && na == nb && memcmp(a, b, na) == 0);
+    free(a);
+    free(b);
+    o.parallel = par_fail;
+    CHECK(ex_rio_write(tpath("failed.asc"), &img, NULL, &o, err) != 0 && strstr(err, "every row") != NULL);
+    CHECK(access(tpath("failed.asc"), F_OK) != 0);
+    o.parallel = par_skip_last;
+    CHECK(ex_rio_write(tpath("failed.asc"), &img, NULL, &o, err) != 0 && err[0]);
+    CHECK(access(tpath("failed.asc"), F_OK) != 0);
+    remove(tpath("serial.asc"));
+    remove(tpath("parallel.asc"));
+    free(src);
+}
+
 TEST(tiff_lzw_packbits)
 {
     enum { W = 300, H = 70 };
@@ -1413,6 +1450,7 @@ int main(int argc, char **argv)
     RUN(tiff_parallel_chunks);
     RUN(read_parallel);
     RUN(asc_decimals);
+    RUN(asc_parallel_rows);
     RUN(tiff_lzw_packbits);
     RUN(window_reads);
     RUN(netpbm_windows);
