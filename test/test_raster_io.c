@@ -433,6 +433,38 @@ static int par_skip_last(void *user, size_t n, int (*fn)(void *ctx, size_t i), v
     return 0;
 }
 
+/* A writer's runner (ex_rio_write_options.parallel): run in reverse it gives the serial file's
+ * bytes (through *calls runs of it), and a runner that fails or skips its last item fails the
+ * write and leaves no file. ext names the format (".tif", ".asc"). */
+static void check_parallel_write(const char *ext, const ex_rio_image *img, ex_rio_write_options o, int *calls)
+{
+    char serial[32], parallel[32], failed[32], err[256];
+    unsigned char *a, *b;
+    size_t na = 0, nb = 0;
+    snprintf(serial, sizeof serial, "serial%s", ext);
+    snprintf(parallel, sizeof parallel, "parallel%s", ext);
+    snprintf(failed, sizeof failed, "failed%s", ext);
+    o.parallel = NULL;
+    CHECK(ex_rio_write(tpath(serial), img, NULL, &o, err) == 0);
+    par_calls = 0;
+    o.parallel = par_reverse;
+    CHECK(ex_rio_write(tpath(parallel), img, NULL, &o, err) == 0);
+    *calls = par_calls;
+    a = slurp(tpath(serial), &na);
+    b = slurp(tpath(parallel), &nb);
+    CHECK(a && b && na > 0 && na == nb && memcmp(a, b, na) == 0);
+    free(a);
+    free(b);
+    o.parallel = par_fail;
+    CHECK(ex_rio_write(tpath(failed), img, NULL, &o, err) != 0 && err[0]);
+    CHECK(access(tpath(failed), F_OK) != 0);
+    o.parallel = par_skip_last;
+    CHECK(ex_rio_write(tpath(failed), img, NULL, &o, err) != 0 && err[0]);
+    CHECK(access(tpath(failed), F_OK) != 0);
+    remove(tpath(serial));
+    remove(tpath(parallel));
+}
+
 TEST(tiff_parallel_chunks)
 {
     enum { W = 300, H = 150, B = 3 };
@@ -444,33 +476,15 @@ TEST(tiff_parallel_chunks)
         for (comp = 0; comp < 2; comp++) {
             ex_rio_write_options o;
             ex_rio_image img;
-            char err[256];
-            unsigned char *a, *b;
-            size_t na = 0, nb = 0;
+            int calls;
             memset(&o, 0, sizeof o);
             o.tiled = layout; o.tile_size = 16; o.rows_per_strip = 1;
             o.deflate = comp; o.predictor = comp ? 3 : 1;
             img.data = src; img.width = W; img.height = H; img.bands = B;
             img.band_step = (size_t)W * H; img.row_step = W; img.pixel_step = 1;
-            CHECK(ex_rio_write(tpath("serial.tif"), &img, NULL, &o, err) == 0);
-            par_calls = 0;
-            o.parallel = par_reverse;
-            CHECK(ex_rio_write(tpath("parallel.tif"), &img, NULL, &o, err) == 0);
-            CHECK(par_calls > 1); /* 570 tiles or 450 strips: several batches */
-            a = slurp(tpath("serial.tif"), &na);
-            b = slurp(tpath("parallel.tif"), &nb);
-            CHECK(a && b && na > 0 && na == nb && memcmp(a, b, na) == 0);
-            free(a);
-            free(b);
-            o.parallel = par_fail;
-            CHECK(ex_rio_write(tpath("failed.tif"), &img, NULL, &o, err) != 0 && err[0]);
-            CHECK(access(tpath("failed.tif"), F_OK) != 0);
-            o.parallel = par_skip_last;
-            CHECK(ex_rio_write(tpath("failed.tif"), &img, NULL, &o, err) != 0 && err[0]);
-            CHECK(access(tpath("failed.tif"), F_OK) != 0);
+            check_parallel_write(".tif", &img, o, &calls);
+            CHECK(calls > 1); /* 570 tiles or 450 strips: several batches */
         }
-    remove(tpath("serial.tif"));
-    remove(tpath("parallel.tif"));
     free(src);
 }
 
@@ -642,31 +656,16 @@ TEST(asc_parallel_rows)
     ex_rio_write_options o;
     ex_rio_image img;
     char err[256];
-    unsigned char *a, *b;
-    size_t na = 0, nb = 0;
+    int calls;
     field(src, W, H, 1, 0, 31u);
     src[3] = (float)NAN;
     memset(&o, 0, sizeof o);
     img.data = src; img.width = W; img.height = H; img.bands = 1;
     img.band_step = (size_t)W * H; img.row_step = W; img.pixel_step = 1;
-    CHECK(ex_rio_write(tpath("serial.asc"), &img, NULL, &o, err) == 0);
-    par_calls = 0;
-    o.parallel = par_reverse;
-    CHECK(ex_rio_write(tpath("parallel.asc"), &img, NULL, &o, err) == 0);
-    CHECK(par_calls == 3); /* 150 rows: batches of 64, 64 and 22 */
-    a = slurp(tpath("serial.asc"), &na);
-    b = slurp(tpath("parallel.asc"), &nb);
-    CHECK(a && b && na > 0 && na == nb && memcmp(a, b, na) == 0);
-    free(a);
-    free(b);
+    check_parallel_write(".asc", &img, o, &calls);
+    CHECK(calls == 3); /* 150 rows: batches of 64, 64 and 22 */
     o.parallel = par_fail;
     CHECK(ex_rio_write(tpath("failed.asc"), &img, NULL, &o, err) != 0 && strstr(err, "every row") != NULL);
-    CHECK(access(tpath("failed.asc"), F_OK) != 0);
-    o.parallel = par_skip_last;
-    CHECK(ex_rio_write(tpath("failed.asc"), &img, NULL, &o, err) != 0 && err[0]);
-    CHECK(access(tpath("failed.asc"), F_OK) != 0);
-    remove(tpath("serial.asc"));
-    remove(tpath("parallel.asc"));
     free(src);
 }
 
