@@ -1660,6 +1660,15 @@ static inline void ex_georef_shift(ex_georef *g, int dx, int dy)
     }
 }
 
+/* The band exists and the window is not empty; 0, or -1 with r->err. */
+static inline int ex_rio_window_check(ex_rio_reader *r, int band, int w, int h, ptrdiff_t stride)
+{
+    if (band < 0 || band >= r->bands) return ex_rio_fail(r->err, "band %d does not exist (the raster has %d)",
+                                                         band + 1, r->bands);
+    if (w < 1 || h < 1 || stride < w) return ex_rio_fail(r->err, "empty window");
+    return 0;
+}
+
 /* Decode band (0-based) of the window [x0, x0 + w) x [y0, y0 + h) into out (row stride in
  * floats); cells outside the raster are NaN. Only the strips/tiles (or raw rows) the window
  * touches are read. 0, or -1 with r->err. */
@@ -1668,9 +1677,7 @@ static inline int ex_rio_read_stored(ex_rio_reader *r, int band, int x0, int y0,
 {
     long long yy, xx;
     int bytes = r->bits / 8;
-    if (band < 0 || band >= r->bands) return ex_rio_fail(r->err, "band %d does not exist (the raster has %d)",
-                                                         band + 1, r->bands);
-    if (w < 1 || h < 1 || stride < w) return ex_rio_fail(r->err, "empty window");
+    if (ex_rio_window_check(r, band, w, h, stride) != 0) return -1;
     for (yy = 0; yy < h; yy++) {
         float *o = out + (ptrdiff_t)yy * stride;
         for (xx = 0; xx < w; xx++) o[xx] = (float)NAN;
@@ -1691,7 +1698,7 @@ static inline int ex_rio_read_stored(ex_rio_reader *r, int band, int x0, int y0,
             size_t n = (size_t)(cx1 - cx0), need = (size_t)((n - 1) * r->col_bytes + (uint64_t)bytes);
             const int direct = r->kind == EX_RIO_FLOAT && bytes == 4 && r->col_bytes == 4 &&
                                r->big_endian == ex_rio_host_big_endian();
-            if (ex_rio_grow(&r->dbuf, &r->dbuf_cap, need) != 0) return ex_rio_fail(r->err, "out of memory");
+            if (!direct && ex_rio_grow(&r->dbuf, &r->dbuf_cap, need) != 0) return ex_rio_fail(r->err, "out of memory");
             for (yy = cy0; yy < cy1; yy++) {
                 uint64_t fy = r->rows_up ? (uint64_t)(r->height - 1 - yy) : (uint64_t)yy;
                 uint64_t off = r->skip + fy * r->row_bytes + (uint64_t)band * r->band_bytes +
@@ -1838,9 +1845,7 @@ static inline int ex_rio_read_parallel(ex_rio_reader *r, const char *path, int b
     int n = EX_RIO_READ_PARTS, i, rc = 0, ran;
     if (!parallel || (r->f && !path) || (long long)y0 + h > INT_MAX || (long long)y0 - h < INT_MIN)
         return ex_rio_read(r, band, x0, y0, w, h, out, stride); /* part rows must stay ints */
-    if (band < 0 || band >= r->bands) return ex_rio_fail(r->err, "band %d does not exist (the raster has %d)",
-                                                         band + 1, r->bands);
-    if (w < 1 || h < 1 || stride < w) return ex_rio_fail(r->err, "empty window");
+    if (ex_rio_window_check(r, band, w, h, stride) != 0) return -1;
     if (r->geo.flip_x) x0 = (int)((long long)r->width - x0 - w);
     if (r->geo.flip_y) y0 = (int)((long long)r->height - y0 - h);
     if (n > h) n = h;

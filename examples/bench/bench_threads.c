@@ -1,7 +1,8 @@
 /* bench_threads.c - `hfvis --threads` (the tool's split of one run over POSIX threads, byte for
  * byte the one-thread output): skyview, sky and horizon in both ray modes and shadow on an N x N
  * fBm PFM (and the GeoTIFF writer and reader: horizon into a .tif, the exact shadow of the same
- * fBm as a DEFLATE GeoTIFF), each run as a child process with --threads 1 and with --threads T (the online cores,
+ * fBm as a DEFLATE GeoTIFF; the ASC reader and writer: the exact shadow of it as a .asc, the
+ * shadow into a .asc), each run as a child process with --threads 1 and with --threads T (the online cores,
  * at least 2): wall and CPU seconds (user + system, all threads), peak memory, the speed-up and
  * whether the two outputs are equal byte for byte; the minimum of HFVIS_BENCH_THREADS_RUNS runs
  * (default 1) of each. N = $HFVIS_BENCH_THREADS_N (default 2048; quick 512). Then, in process, the
@@ -16,10 +17,10 @@
 #include "bench.h"
 #include "../raster_io.h"
 
-/* An N x N fBm (1 m cells, relief about N/8) written as a PFM at path and as a GeoTIFF at tif
- * (tiled 256, DEFLATE, predictor 3: as the tool and GDAL's usual options write one); 0 on
- * success. */
-static int threads_field(const char *path, const char *tif, int n, float **z_out)
+/* An N x N fBm (1 m cells, relief about N/8) written as a PFM at path, as a GeoTIFF at tif
+ * (tiled 256, DEFLATE, predictor 3: as the tool and GDAL's usual options write one) and as an
+ * ASC grid at asc; 0 on success. */
+static int threads_field(const char *path, const char *tif, const char *asc, int n, float **z_out)
 {
     ex_rio_write_options wo;
     ex_rio_image img;
@@ -41,7 +42,8 @@ static int threads_field(const char *path, const char *tif, int n, float **z_out
     wo.predictor = 3;
     img.data = z, img.width = n, img.height = n, img.bands = 1;
     img.pixel_step = 1, img.row_step = (size_t)n, img.band_step = (size_t)n * (size_t)n;
-    if (hfvis_pfm_save(path, z, n, n, 1, n) != HFVIS_OK || ex_rio_write(tif, &img, NULL, &wo, err) != 0) {
+    if (hfvis_pfm_save(path, z, n, n, 1, n) != HFVIS_OK || ex_rio_write(tif, &img, NULL, &wo, err) != 0 ||
+        ex_rio_write(asc, &img, NULL, NULL, err) != 0) {
         free(z);
         return -1;
     }
@@ -164,13 +166,16 @@ void bench_threads(int quick)
         /* the GeoTIFF writer's tiles over the threads, and the reader (DEFLATE, predictor 3) */
         {"horizon K=16 -> tif", "pfm tif", "horizon", "--dirs", "16", NULL},
         {"shadow exact tif->", "tif pfm", "shadow", "--sun-azimuth", "315", "--sun-elevation", "10", "--exact"},
+        /* the ASC reader (decimals) and writer (rows formatted over the threads) */
+        {"shadow exact asc->", "asc pfm", "shadow", "--sun-azimuth", "315", "--sun-elevation", "10", "--exact"},
+        {"shadow -> asc", "pfm asc", "shadow", "--sun-azimuth", "315", "--sun-elevation", "10", NULL},
     };
     char *cli = getenv("HFVIS_CLI") ? getenv("HFVIS_CLI") : (char *)"build/hfvis";
     const char *tmp = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
     const int n = getenv("HFVIS_BENCH_THREADS_N") ? atoi(getenv("HFVIS_BENCH_THREADS_N")) : quick ? 512 : 2048;
     const int reps = getenv("HFVIS_BENCH_THREADS_RUNS") ? atoi(getenv("HFVIS_BENCH_THREADS_RUNS")) : 1;
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    char dir[512], in[600], tif[600], out[2][600], threads[2][16], *argv[24];
+    char dir[512], in[600], tif[600], asc[600], out[2][600], threads[2][16], *argv[24];
     float *z = NULL;
     int r, t, k, rep;
     if (n < 16 || n > 16384 || reps < 1) {
@@ -186,7 +191,8 @@ void bench_threads(int quick)
            "cores; min of %d run%s; wall and CPU seconds, peak MiB)\n", threads[1], n, n, cli, cores, reps,
            reps == 1 ? "" : "s");
     snprintf(tif, sizeof tif, "%s/fbm.tif", dir);
-    if (threads_field(in, tif, n, &z) != 0) { printf("threads: cannot write the field in %s\n", dir); rmdir(dir); return; }
+    snprintf(asc, sizeof asc, "%s/fbm.asc", dir);
+    if (threads_field(in, tif, asc, n, &z) != 0) { printf("threads: cannot write the field in %s\n", dir); rmdir(dir); return; }
     printf("  %-20s | %8s %8s %7s | %8s %8s %7s | %8s  %s\n", "run", "1: wall", "CPU", "MiB", "T: wall", "CPU",
            "MiB", "speed-up", "bytes equal");
     for (r = 0; r < (int)(sizeof runs / sizeof runs[0]); r++) {
@@ -201,7 +207,7 @@ void bench_threads(int quick)
                 int a = 0;
                 argv[a++] = cli;
                 argv[a++] = runs[r][2];
-                argv[a++] = runs[r][1][0] == 't' ? tif : in;
+                argv[a++] = runs[r][1][0] == 't' ? tif : runs[r][1][0] == 'a' ? asc : in;
                 for (k = 3; k < 9 && runs[r][k]; k++) argv[a++] = runs[r][k];
                 argv[a++] = (char *)"--threads", argv[a++] = threads[t];
                 argv[a++] = (char *)"--max-memory", argv[a++] = (char *)"0";
@@ -220,6 +226,7 @@ void bench_threads(int quick)
     }
     remove(in);
     remove(tif);
+    remove(asc);
     rmdir(dir);
     threads_normals(z, n);
     threads_exact_grid(z, n);
