@@ -26,6 +26,13 @@ static inline double bench_cpu_now(void)
     return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
 }
 
+/* qsort's comparison of doubles, ascending (percentiles of errors). */
+static inline int bench_cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
 /* An allocator (hfvis_allocator with user = a bench_tracker) that records the peak number of
  * bytes live (the library's scratch memory), and the bytes and blocks it allocated in all. */
 typedef struct bench_tracker { size_t live, peak, total, count; } bench_tracker;

@@ -15,12 +15,6 @@
 #define EXACT_BENCH_K 16
 #define EXACT_BENCH_PTS 1500
 
-static int exact_cmp(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
 /* mean and p99 (degrees) of |value - exact| over the sampled receivers of K planes (or of the
  * march's count*K values when pts_layout). */
 static void exact_err(const hfvis_grid *g, const float *v, int march, const int *px, const int *py,
@@ -39,7 +33,7 @@ static void exact_err(const hfvis_grid *g, const float *v, int march, const int 
             e[n] = fabs((double)got - ref) * (180.0 / 3.14159265358979323846);
             s += e[n++];
         }
-    qsort(e, n, sizeof(double), exact_cmp);
+    qsort(e, n, sizeof(double), bench_cmp_double);
     *mean = n ? s / (double)n : 0.0;
     *p99 = n ? e[(size_t)(0.99 * (double)(n - 1))] : 0.0;
 }
@@ -126,7 +120,7 @@ static void exact_pair_err(const float *a, const float *b, size_t n, double *e, 
         e[m] = fabs((double)a[i] - (double)b[i]) * (180.0 / 3.14159265358979323846);
         s += e[m++];
     }
-    qsort(e, m, sizeof(double), exact_cmp);
+    qsort(e, m, sizeof(double), bench_cmp_double);
     *mean = m ? s / (double)m : 0.0;
     *p99 = m ? e[(size_t)(0.99 * (double)(m - 1))] : 0.0;
 }
