@@ -1128,7 +1128,8 @@ static inline float ex_rio_cell(const ex_rio_reader *r, double v)
 /* 6. ASC and EHdr parsing                                                                    */
 /* ------------------------------------------------------------------------------------------ */
 
-/* Next whitespace-separated token of text[*pos..n) into tok (cap bytes); 0 at the end. */
+/* Next whitespace-separated token of text[*pos..n) into tok (cap bytes, cut to cap - 1); returns
+ * its whole length, 0 at the end: a result >= cap is a token that did not fit. */
 static inline size_t ex_rio_token(const char *text, size_t n, size_t *pos, char *tok, size_t cap)
 {
     size_t i = *pos, len = 0;
@@ -1139,8 +1140,7 @@ static inline size_t ex_rio_token(const char *text, size_t n, size_t *pos, char 
         i++;
     }
     *pos = i;
-    if (len >= cap) len = cap - 1;
-    tok[len] = '\0';
+    tok[len < cap ? len : cap - 1] = '\0';
     return len;
 }
 
@@ -1161,6 +1161,7 @@ static inline int ex_rio_decimal(const char *s, double *v)
     static const double p10[23] = { 1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11,
                                     1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22 };
     uint64_t m = 0;
+    double d;
     int digits = 0, e = 0, x = 0, neg = 0, eneg, ed = 0;
     if (FLT_EVAL_METHOD != 0) return -1;
     if (*s == '+' || *s == '-') neg = *s++ == '-';
@@ -1184,8 +1185,8 @@ static inline int ex_rio_decimal(const char *s, double *v)
         e += eneg ? -x : x;
     }
     if (*s != '\0' || m > ((uint64_t)1 << 53) || e < -22 || e > 22) return -1;
-    *v = e < 0 ? (double)m / p10[-e] : (double)m * p10[e];
-    if (neg) *v = -*v;
+    d = neg ? -(double)m : (double)m; /* the sign first: strtod's rounding in every mode */
+    *v = e < 0 ? d / p10[-e] : d * p10[e];
     return 0;
 }
 
@@ -1208,7 +1209,7 @@ static inline int ex_rio_parse_asc(ex_rio_reader *r, const char *text, size_t n)
     const double unset = (double)NAN;
     double ncols = -1, nrows = -1, x = unset, y = unset, cell = unset, dx = unset, dy = unset, v;
     int xcenter = 0, ycenter = 0;
-    size_t pos = 0, count, i;
+    size_t pos = 0, count, i, len;
     r->format = EX_RIO_ASC;
     for (;;) {
         size_t save = pos;
@@ -1217,7 +1218,8 @@ static inline int ex_rio_parse_asc(ex_rio_reader *r, const char *text, size_t n)
             pos = save;
             break;
         }
-        if (ex_rio_token(text, n, &pos, val, sizeof val) == 0 || ex_rio_number(val, &v) != 0)
+        len = ex_rio_token(text, n, &pos, val, sizeof val);
+        if (len == 0 || len >= sizeof val || ex_rio_number(val, &v) != 0)
             return ex_rio_fail(r->err, "ASC header key '%s' without a number", key);
         if (ex_rio_keyeq(key, "ncols")) ncols = v;
         else if (ex_rio_keyeq(key, "nrows")) nrows = v;
@@ -1256,9 +1258,11 @@ static inline int ex_rio_parse_asc(ex_rio_reader *r, const char *text, size_t n)
     r->grid = (double *)malloc(count * sizeof(double));
     if (!r->grid) return ex_rio_fail(r->err, "out of memory");
     for (i = 0; i < count; i++) {
-        if (ex_rio_token(text, n, &pos, val, sizeof val) == 0)
+        if ((len = ex_rio_token(text, n, &pos, val, sizeof val)) == 0)
             return ex_rio_fail(r->err, "ASC grid ends after %llu of %llu values", (unsigned long long)i,
                                (unsigned long long)count);
+        if (len >= sizeof val)
+            return ex_rio_fail(r->err, "ASC value '%.24s...' is too long (%llu characters)", val, (unsigned long long)len);
         if (ex_rio_number(val, &v) != 0) return ex_rio_fail(r->err, "ASC value '%s' is not a number", val);
         r->grid[i] = v;
     }
@@ -1282,7 +1286,9 @@ static inline int ex_rio_parse_hdr(ex_rio_reader *r, const char *text, size_t n,
     r->format = EX_RIO_EHDR;
     r->big_endian = 0;
     while (ex_rio_token(text, n, &pos, key, sizeof key) != 0) {
-        if (ex_rio_token(text, n, &pos, val, sizeof val) == 0) return ex_rio_fail(r->err, ".hdr key '%s' without a value", key);
+        size_t len = ex_rio_token(text, n, &pos, val, sizeof val);
+        if (len == 0) return ex_rio_fail(r->err, ".hdr key '%s' without a value", key);
+        if (len >= sizeof val) return ex_rio_fail(r->err, ".hdr value of '%s' is too long", key);
         if (ex_rio_keyeq(key, "byteorder")) {
             if (ex_rio_keyeq(val, "M") || ex_rio_keyeq(val, "MSBFIRST")) r->big_endian = 1;
             else if (ex_rio_keyeq(val, "I") || ex_rio_keyeq(val, "LSBFIRST")) r->big_endian = 0;
@@ -1584,6 +1590,7 @@ static inline int ex_rio_netpbm_parse(ex_rio_reader *r, const unsigned char *hea
         }
         while (i < n && !isspace(head[i]) && head[i] != '#' && t + 1 < sizeof tok) tok[t++] = (char)head[i++];
         tok[t] = '\0';
+        if (k < 2 && strspn(tok, "0123456789") != t) t = 0; /* the sizes: decimal digits only */
         if (!t || ex_rio_number(tok, &v[k]) != 0 || (k < 2 && !(v[k] >= 1.0 && v[k] <= EX_RIO_MAX_DIM && v[k] == floor(v[k]))))
             return ex_rio_fail(r->err, "bad or truncated header");
     }
@@ -1842,12 +1849,14 @@ static inline int ex_rio_read_parallel(ex_rio_reader *r, const char *path, int b
 {
     ex_rio_read_job j;
     long long unit = r->format == EX_RIO_TIFF ? (long long)r->chunk_h : 1, sy0, cut;
+    long long sx = r->geo.flip_x ? (long long)r->width - x0 - w : x0; /* the stored window */
+    long long sy = r->geo.flip_y ? (long long)r->height - y0 - h : y0;
     int n = EX_RIO_READ_PARTS, i, rc = 0, ran;
-    if (!parallel || (r->f && !path) || (long long)y0 + h > INT_MAX || (long long)y0 - h < INT_MIN)
+    if (!parallel || (r->f && !path) || sx < INT_MIN || sx + w > INT_MAX || sy < INT_MIN || sy + h > INT_MAX)
         return ex_rio_read(r, band, x0, y0, w, h, out, stride); /* part rows must stay ints */
     if (ex_rio_window_check(r, band, w, h, stride) != 0) return -1;
-    if (r->geo.flip_x) x0 = (int)((long long)r->width - x0 - w);
-    if (r->geo.flip_y) y0 = (int)((long long)r->height - y0 - h);
+    x0 = (int)sx;
+    y0 = (int)sy;
     if (n > h) n = h;
     memset(&j, 0, sizeof j);
     j.part = (ex_rio_reader *)calloc((size_t)n, sizeof *j.part);
@@ -2561,6 +2570,7 @@ static inline int ex_rio_write_asc(const char *path, const ex_rio_image *img, co
     double cell = 1.0, nd = geo && geo->has_nodata ? geo->nodata : -9999.0;
     const char *ndt = geo && geo->has_nodata ? geo->nodata_text : "-9999";
     size_t ndl = strlen(ndt), i, batch;
+    if (img->width < 1 || img->height < 1 || !img->data) return ex_rio_fail(err, "nothing to write");
     if (img->bands != 1) return ex_rio_fail(err, "an ASCII grid holds one band; this output has %d (write .tif or .bil)",
                                             img->bands);
     if (geo && geo->has_transform) {

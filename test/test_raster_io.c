@@ -9,6 +9,7 @@
 #include "test.h"
 #include "test_dir.h"
 #include "../examples/raster_io.h"
+#include <fenv.h>
 #include <stdint.h>
 #include <unistd.h>
 
@@ -507,7 +508,10 @@ TEST(read_parallel)
 {
     enum { W = 150, H = 131, B = 2 };
     static const int windows[][4] = { { 0, 0, W, H }, { 7, 5, 60, 90 }, { -9, -20, 40, 70 }, { W - 20, H - 33, 50, 60 },
-                                      { -30, 0, 20, 10 }, { 3, 40, 1, 1 }, { 0, 17, W, 1 } };
+                                      { -30, 0, 20, 10 }, { 3, 40, 1, 1 }, { 0, 17, W, 1 },
+                                      /* far outside: mirrored, the stored rows or columns would leave int */
+                                      { 3, H - INT_MAX - 5, 5, 10 }, { W - INT_MAX - 5, 4, 10, 6 },
+                                      { INT_MAX - 8, 2, 5, 3 }, { 1, INT_MAX - 20, 4, 10 }, { 2, INT_MIN, 3, 4 } };
     float *src = (float *)malloc(sizeof(float) * W * H * B);
     int v, k, b;
     field(src, W, H, B, 0, 123u);
@@ -645,6 +649,59 @@ TEST(asc_decimals)
         CHECK(ex_rio_decimal("1e", &v) != 0 && ex_rio_decimal("0x10", &v) != 0 && ex_rio_decimal("nan", &v) != 0);
         CHECK(ex_rio_decimal("-", &v) != 0 && ex_rio_decimal(".", &v) != 0 && ex_rio_decimal("1.2.3", &v) != 0);
     }
+#if defined(FE_UPWARD) && defined(FE_DOWNWARD) && defined(FE_TOWARDZERO)
+    { /* the sign before the rounding: strtod's value in every rounding mode, negative values too */
+        static const int modes[3] = { FE_UPWARD, FE_DOWNWARD, FE_TOWARDZERO };
+        static const char *const dec[] = { "-0.1", "-1.7", "-3e-5", "0.1", "-123.456", "7e-22", "-9.87654321e21" };
+        int m, i, old = fegetround();
+        for (m = 0; m < 3; m++) {
+            if (fesetround(modes[m]) != 0) continue;
+            for (i = 0; i < (int)(sizeof dec / sizeof dec[0]); i++) {
+                double a, b = strtod(dec[i], NULL);
+                CHECK(ex_rio_decimal(dec[i], &a) == 0 && memcmp(&a, &b, sizeof a) == 0);
+            }
+        }
+        fesetround(old);
+    }
+#endif
+}
+
+/* Tokens too long for the ASC and EHdr parsers' buffers are refused, not cut into another number;
+ * a PFM's sizes are decimal digits; an empty image is not written as an ASC grid. */
+TEST(long_tokens_and_sizes)
+{
+    char text[512], err[256];
+    ex_rio_reader r;
+    ex_rio_image img;
+    float one = 1.0f;
+    int n = snprintf(text, sizeof text, "ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n5 1");
+    for (; n < 200; n++) text[n] = '0'; /* 1 followed by ~150 zeros: not 1e127 */
+    text[n++] = '\n';
+    spit(tpath("long.asc"), text, (size_t)n);
+    CHECK(ex_rio_open(&r, tpath("long.asc")) != 0 && strstr(r.err, "too long") != NULL);
+    n = snprintf(text, sizeof text, "ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1");
+    for (; n < 200; n++) text[n] = '0'; /* a cell size of 1 and 150 zeros */
+    n += snprintf(text + n, sizeof text - (size_t)n, "\n5 1\n");
+    spit(tpath("long.asc"), text, (size_t)n);
+    CHECK(ex_rio_open(&r, tpath("long.asc")) != 0);
+    n = snprintf(text, sizeof text, "NROWS 1\nNCOLS 1\nNBITS 3");
+    for (; n < 200; n++) text[n] = '2';
+    n += snprintf(text + n, sizeof text - (size_t)n, "\n");
+    spit(tpath("long.hdr"), text, (size_t)n);
+    spit(tpath("long.bil"), "\0\0\0\0", 4);
+    CHECK(ex_rio_open(&r, tpath("long.bil")) != 0 && strstr(r.err, "too long") != NULL);
+    spit(tpath("size.pfm"), "Pf\n5.0 4\n-1.0\n", 14);
+    CHECK(ex_rio_open_netpbm(&r, tpath("size.pfm")) != 0 && strstr(r.err, "header") != NULL);
+    spit(tpath("size.pfm"), "Pf\n+1 1\n-1.0\n\0\0\200\77", 17);
+    CHECK(ex_rio_open_netpbm(&r, tpath("size.pfm")) != 0 && strstr(r.err, "header") != NULL);
+    spit(tpath("size.pfm"), "Pf\n1 1\n-1.0\n\0\0\200\77", 16);
+    CHECK(ex_rio_open_netpbm(&r, tpath("size.pfm")) == 0 && r.width == 1 && r.height == 1);
+    ex_rio_close(&r);
+    img.data = &one; img.width = 0; img.height = 1; img.bands = 1;
+    img.band_step = 1; img.row_step = 1; img.pixel_step = 1;
+    CHECK(ex_rio_write(tpath("empty.asc"), &img, NULL, NULL, err) != 0 && strstr(err, "nothing") != NULL);
+    CHECK(access(tpath("empty.asc"), F_OK) != 0);
+    remove(tpath("long.asc")); remove(tpath("long.hdr")); remove(tpath("long.bil")); remove(tpath("size.pfm"));
 }
 
 /* The ASC writer's rows formatted through a runner (in reverse, over several batches): the serial
@@ -1453,6 +1510,7 @@ int main(int argc, char **argv)
     RUN(tiff_lzw_packbits);
     RUN(window_reads);
     RUN(netpbm_windows);
+    RUN(long_tokens_and_sizes);
     RUN(tiff_malformed);
     RUN(asc_ehdr);
     RUN(orientation);
