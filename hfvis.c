@@ -11550,7 +11550,7 @@ static void hf_solar_eph_fill(const hf_solar_ctx *c, int days, hf_spa_eph *e)
  * 2e-6 deg of the full SPA (the declination's curvature, at most 0.007 deg/day^2, times
  * (1/24 day)^2/8; test_solar.c's per-sample tests compare against the oracle's full SPA). */
 static void hf_solar_spa_sun(const hf_solar_ctx *c, int y, int m, int d, int day, double t,
-                             double *h_true, double *elev, double *azimuth, double *g0)
+                             double *h_true, double *elev, double *azimuth, double *g0, double *hour)
 {
     hf_spa_sun s;
     hf_spa_place p;
@@ -11572,13 +11572,55 @@ static void hf_solar_spa_sun(const hf_solar_ctx *c, int y, int m, int d, int day
     *elev = p.e * HF_DEG;
     *azimuth = p.azimuth * HF_DEG;
     *g0 = 1367.0 / (s.R * s.R);
+    if (hour) *hour = p.H_p; /* topocentric hour angle, deg (Eq. 40) */
 }
 
-static double hf_solar_spa_h(const hf_solar_ctx *c, int y, int m, int d, int day, double t)
+/* The sun's true elevation at hour t (and, hour not NULL, its topocentric hour angle in deg). */
+static double hf_solar_spa_h(const hf_solar_ctx *c, int y, int m, int d, int day, double t, double *hour)
 {
     double h, e, a, g;
-    hf_solar_spa_sun(c, y, m, d, day, t, &h, &e, &a, &g);
+    hf_solar_spa_sun(c, y, m, d, day, t, &h, &e, &a, &g, hour);
     return h;
+}
+
+/* The sun's zero of true elevation between lo and hi, where it rises (up: h(lo) <= 0 < h(hi);
+ * returns the first lit hour) or sets (h(lo) > 0 >= h(hi); the last lit hour), by bisection. */
+static double hf_solar_zero(const hf_solar_ctx *c, int y, int m, int d, int day, double lo, double hi, int up)
+{
+    int it;
+    for (it = 0; it < HF_SOLAR_BISECTIONS; it++) {
+        double mid = 0.5 * (lo + hi), hm = hf_solar_spa_h(c, y, m, d, day, mid, NULL);
+        if ((hm > 0.0) == up) hi = mid;
+        else lo = mid;
+    }
+    return up ? hi : lo;
+}
+
+/* Where the sun turns inside the step (t0, t1] of hour angles H0, H1: the hour at which its
+ * topocentric hour angle, growing about 15 deg an hour, passes target (0: the transit, where the
+ * elevation is highest; 180: lowest), by bisection; 0 when it does not pass it. A step of more
+ * than 12 h is halved first, so that each half turns the angle by less than 360 deg. */
+static int hf_solar_turn(const hf_solar_ctx *c, int y, int m, int d, int day, double t0, double H0, double t1,
+                         double H1, double target, double *t)
+{
+    double need, lo = t0, hi = t1;
+    int it;
+    if (t1 - t0 > 12.0) {
+        double tm = 0.5 * (t0 + t1), Hm;
+        hf_solar_spa_h(c, y, m, d, day, tm, &Hm);
+        return hf_solar_turn(c, y, m, d, day, t0, H0, tm, Hm, target, t) ||
+               hf_solar_turn(c, y, m, d, day, tm, Hm, t1, H1, target, t);
+    }
+    need = fmod(target - H0 + 720.0, 360.0); /* the angle still to turn, [0, 360) */
+    if (!(need > 0.0 && need <= fmod(H1 - H0 + 720.0, 360.0))) return 0;
+    for (it = 0; it < HF_SOLAR_BISECTIONS; it++) {
+        double mid = 0.5 * (lo + hi), Hm;
+        hf_solar_spa_h(c, y, m, d, day, mid, &Hm);
+        if (fmod(Hm - H0 + 720.0, 360.0) < need) lo = mid;
+        else hi = mid;
+    }
+    *t = hi;
+    return 1;
 }
 
 /* Fill a step from the sun's true elevation h, shading elevation elev and compass azimuth. */
@@ -11651,34 +11693,50 @@ static size_t hf_solar_steps(const hf_solar_ctx *c, hf_solar_step *steps)
             }
         } else if (c->in.instant) {
             double h, e, a, g;
-            hf_solar_spa_sun(c, y, m, d, day, c->in.hour, &h, &e, &a, &g);
+            hf_solar_spa_sun(c, y, m, d, day, c->in.hour, &h, &e, &a, &g, NULL);
             if (h > 0.0) {
                 if (steps) hf_solar_step_set(c, steps + n, h, e, a, g, 1.0, band, m);
                 n++;
             }
         } else {
-            double t0 = 0.0, h0 = hf_solar_spa_h(c, y, m, d, day, 0.0);
+            /* Each step's lit parts, one sample at the middle of each, weighted by its length.
+             * Ends on either side of the horizon: sunrise or sunset inside, bisected. Both ends
+             * below: lit only if the sun rises and sets inside (a short polar day, or a long
+             * step), which its transit inside the step tells; both above: unlit in the middle
+             * if it sets and rises inside (a short night), which its lowest point tells. */
+            double H0, H1, t0 = 0.0, h0 = hf_solar_spa_h(c, y, m, d, day, 0.0, &H0);
             while (t0 < 24.0) {
-                double t1 = t0 + step > 24.0 ? 24.0 : t0 + step, h1 = hf_solar_spa_h(c, y, m, d, day, t1);
-                double a = t0, b = t1;
-                int lit = 1;
+                double t1 = t0 + step > 24.0 ? 24.0 : t0 + step, h1 = hf_solar_spa_h(c, y, m, d, day, t1, &H1);
+                double part[4], tt;
+                int np = 0, k;
                 if (!(h0 > 0.0) && !(h1 > 0.0)) {
-                    lit = 0;
-                } else if (!(h0 > 0.0) || !(h1 > 0.0)) {
-                    /* sunrise or sunset inside the step: bisect the true elevation's zero */
-                    double lo = t0, hi = t1;
-                    int it;
-                    for (it = 0; it < HF_SOLAR_BISECTIONS; it++) {
-                        double mid = 0.5 * (lo + hi), hm = hf_solar_spa_h(c, y, m, d, day, mid);
-                        if ((hm > 0.0) == (h1 > 0.0)) hi = mid;
-                        else lo = mid;
+                    if (hf_solar_turn(c, y, m, d, day, t0, H0, t1, H1, 0.0, &tt) &&
+                        hf_solar_spa_h(c, y, m, d, day, tt, NULL) > 0.0) {
+                        part[0] = hf_solar_zero(c, y, m, d, day, t0, tt, 1);
+                        part[1] = hf_solar_zero(c, y, m, d, day, tt, t1, 0);
+                        np = 1;
                     }
-                    if (h1 > 0.0) a = hi;
-                    else b = lo;
+                } else if (h0 > 0.0 && h1 > 0.0) {
+                    part[0] = t0;
+                    part[3] = t1;
+                    if (hf_solar_turn(c, y, m, d, day, t0, H0, t1, H1, 180.0, &tt) &&
+                        !(hf_solar_spa_h(c, y, m, d, day, tt, NULL) > 0.0)) {
+                        part[1] = hf_solar_zero(c, y, m, d, day, t0, tt, 0);
+                        part[2] = hf_solar_zero(c, y, m, d, day, tt, t1, 1);
+                        np = 2;
+                    } else {
+                        part[1] = t1;
+                        np = 1;
+                    }
+                } else { /* sunrise or sunset inside the step */
+                    part[0] = h1 > 0.0 ? hf_solar_zero(c, y, m, d, day, t0, t1, 1) : t0;
+                    part[1] = h1 > 0.0 ? t1 : hf_solar_zero(c, y, m, d, day, t0, t1, 0);
+                    np = 1;
                 }
-                if (lit && b > a) {
-                    double h, e, az, g;
-                    hf_solar_spa_sun(c, y, m, d, day, 0.5 * (a + b), &h, &e, &az, &g);
+                for (k = 0; k < np; k++) {
+                    double a = part[2 * k], b = part[2 * k + 1], h, e, az, g;
+                    if (!(b > a)) continue;
+                    hf_solar_spa_sun(c, y, m, d, day, 0.5 * (a + b), &h, &e, &az, &g, NULL);
                     if (h > 0.0) {
                         if (steps) hf_solar_step_set(c, steps + n, h, e, az, g, b - a, band, m);
                         n++;
@@ -11686,6 +11744,7 @@ static size_t hf_solar_steps(const hf_solar_ctx *c, hf_solar_step *steps)
                 }
                 t0 = t1;
                 h0 = h1;
+                H0 = H1;
             }
         }
     }

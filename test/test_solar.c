@@ -570,6 +570,31 @@ TEST(horizon_diffuse_and_terrain_reflection)
         for (x = 2; x < W - 2; x++) CHECK_NEAR(ob[1][y * W + x], rb[1][y * W + x], 0.0, SKY_FRACTION_TOL);
 }
 
+/* The day length of in's first (local) day by a 1 s scan of SPA's true elevation (mid-month
+ * dates: the UTC day on either side stays in the month). */
+static double spa_day_length(const hfvis_solar_input *in)
+{
+    hfvis_spa_input s;
+    hfvis_spa_result r;
+    double len = 0.0, t;
+    memset(&s, 0, sizeof s);
+    s.year = in->year;
+    s.month = in->month;
+    s.delta_t = 69.0;
+    s.latitude_rad = in->latitude_rad;
+    s.longitude_rad = in->longitude_rad;
+    for (t = 0.5; t < 86400.0; t += 1.0) {
+        double utc = t - in->utc_offset_hours * 3600.0, days = floor(utc / 86400.0), sec = utc - 86400.0 * days;
+        s.day = in->day + (int)days;
+        s.hour = (int)(sec / 3600.0);
+        s.minute = (int)((sec - 3600.0 * s.hour) / 60.0);
+        s.second = sec - 3600.0 * s.hour - 60.0 * s.minute;
+        hfvis_spa(&s, &r);
+        if (r.elevation > 0.0) len += 1.0 / 3600.0;
+    }
+    return len;
+}
+
 TEST(sunrise_and_sunset_inside_the_step)
 {
     hfvis_grid g = test_grid(zbuf, 4, 4, 1.0);
@@ -577,9 +602,7 @@ TEST(sunrise_and_sunset_inside_the_step)
     hfvis_solar_options o = hfvis_solar_options_default();
     float a[5][16], b[5][16];
     hfvis_solar_output oa, ob2;
-    hfvis_spa_input s;
-    hfvis_spa_result r;
-    double len = 0.0, t;
+    double len;
     int i;
     for (i = 0; i < 16; i++) zbuf[i] = 0.0f;
     oa.beam = a[0]; oa.diffuse = a[1]; oa.reflected = a[2]; oa.global = a[3]; oa.sun_hours = a[4];
@@ -591,26 +614,44 @@ TEST(sunrise_and_sunset_inside_the_step)
     CHECK_EQ_STATUS(hfvis_solar_irradiation(&g, &in, &o, &ob2), HFVIS_OK);
     CHECK_NEAR(a[3][5], b[3][5], 0.0, STEP_CONVERGENCE_REL);
     /* day length: the sunny hours of open ground against a 1 s scan of SPA's true elevation */
-    memset(&s, 0, sizeof s);
-    s.year = 2026;
-    s.month = 5;
-    s.day = 2;
-    s.delta_t = 69.0;
-    s.latitude_rad = in.latitude_rad;
-    s.longitude_rad = in.longitude_rad;
-    for (t = 23.0 * 3600.0 + 0.5; t < 47.0 * 3600.0; t += 1.0) { /* local day 2026-05-03 at UTC+1 */
-        double sec = t;
-        s.day = 2 + (int)(sec / 86400.0);
-        sec -= 86400.0 * (double)(s.day - 2);
-        s.hour = (int)(sec / 3600.0);
-        s.minute = (int)((sec - 3600.0 * s.hour) / 60.0);
-        s.second = sec - 3600.0 * s.hour - 60.0 * s.minute;
-        hfvis_spa(&s, &r);
-        if (r.elevation > 0.0) len += 1.0 / 3600.0;
-    }
+    len = spa_day_length(&in);
     CHECK_NEAR(a[4][5], len, DAY_LENGTH_TOL_H, 0.0);
     CHECK_NEAR(b[4][5], len, DAY_LENGTH_TOL_H, 0.0);
     printf("     day length %.4f h; 60-min steps %.4f h, 1-min steps %.4f h\n", len, (double)a[4][5], (double)b[4][5]);
+}
+
+/* A whole short day, or a whole short night, inside one step: the sunny hours are the day's
+ * whatever the step (15 min to 24 h): a polar winter day of 1.2 h at 66.3 N, where a step
+ * whose ends are both below the horizon holds the sun's transit; a summer night of 1.9 h at
+ * 65.9 N that falls inside a step (local time UTC+13 puts it around noon), where both ends are
+ * above and the sun's lowest point lies between them; and an ordinary day at 40 N. */
+TEST(short_days_and_nights_inside_a_step)
+{
+    static const double steps[6] = { 0.25, 1.0, 2.0, 7.0, 13.0, 24.0 };
+    static const double place[3][4] = { { 66.3, 12, 21, 1.0 }, { 65.9, 6, 21, 13.0 }, { 40.0, 3, 14, 1.0 } };
+    hfvis_grid g = test_grid(zbuf, 4, 4, 1.0);
+    float a[5][16];
+    hfvis_solar_output oa;
+    int i, p, k;
+    for (i = 0; i < 16; i++) zbuf[i] = 0.0f;
+    oa.beam = a[0]; oa.diffuse = a[1]; oa.reflected = a[2]; oa.global = a[3]; oa.sun_hours = a[4];
+    for (p = 0; p < 3; p++) {
+        hfvis_solar_input in = site(place[p][0], (int)place[p][1], (int)place[p][2]);
+        hfvis_solar_options o = hfvis_solar_options_default();
+        double len;
+        in.utc_offset_hours = place[p][3];
+        len = spa_day_length(&in);
+        o.no_shading = 1;
+        CHECK(len > 1.0 && len < 23.0);
+        for (k = 0; k < 6; k++) {
+            o.step_hours = steps[k];
+            CHECK_EQ_STATUS(hfvis_solar_irradiation(&g, &in, &o, &oa), HFVIS_OK);
+            CHECK_NEAR(a[4][5], len, DAY_LENGTH_TOL_H, 0.0);
+            CHECK(a[3][5] > 0.0f);
+        }
+        printf("     %.1f N, %02d-%02d, UTC%+.0f: day length %.4f h, every step from 15 min to 24 h within %.0f s\n",
+               place[p][0], (int)place[p][1], (int)place[p][2], place[p][3], len, DAY_LENGTH_TOL_H * 3600.0);
+    }
 }
 
 TEST(polar_night_and_bands)
@@ -1534,6 +1575,7 @@ int main(int argc, char **argv)
     RUN(horn_normals_against_oracle);
     RUN(horizon_diffuse_and_terrain_reflection);
     RUN(sunrise_and_sunset_inside_the_step);
+    RUN(short_days_and_nights_inside_a_step);
     RUN(polar_night_and_bands);
     RUN(sites_constant_maps_equal_one_site);
     RUN(sites_across_degrees_against_oracle);
