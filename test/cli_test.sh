@@ -1300,6 +1300,11 @@ expect_ok "solar: r.sun's solar time, monthly Linke, month bands" "$dir/solm.pfm
 grep -q '^hfvis solar: site 45\.153[78][0-9]*, 15\.0005[0-9]* ' "$dir/stderr" && "$hfvis" info "$dir/utm.tif" | grep -q 'crs projected' \
   && ok "solar: UTM 33N asc + .prj: the site by the inverse projection, GeoTIFF with the CRS" \
   || bad "solar: UTM site or CRS: $(grep site "$dir/stderr") $("$hfvis" info "$dir/utm.tif" | grep crs)"
+# a CRS that names Transverse Mercator without its parameters: refused, not taken as k0 = 1 at
+# the Greenwich meridian
+cp "$dir/utm.asc" "$dir/tmnp.asc"
+printf 'PROJCS["NZGD2000 / New Zealand Transverse Mercator 2000",PROJECTION["Transverse_Mercator"]]\n' > "$dir/tmnp.prj"
+expect_fail "solar: Transverse Mercator without parameters" 1 solar "$dir/tmnp.asc" --day 2026-06-21 --dirs 8 -o "$fdir/x.pfm"
 # tall.asc: 2 x 40 cells of 10 km in UTM 33N, 45.0 to 48.6 deg north: each cell its own site (by
 # the inverse projection), so on December 21 the south row (the PFM's first) gets more than the
 # north row (its last); one site for the whole grid would give the two the same.

@@ -200,6 +200,32 @@ if command -v gdal_translate > /dev/null 2>&1 && command -v gdalinfo > /dev/null
       && grep -q 'STATISTICS_MINIMUM=0$' "$dir/vs.info" && ok "viewshed GeoTIFF: Byte, values 0..1, NoData 2" \
       || bad "viewshed GeoTIFF: $(grep -E 'Type|NoData|STATISTICS_M' "$dir/vs.info")"
   fi
+  # solar's site from the CRS of GDAL-written GeoTIFFs: NAD83 and NAD83(2011) UTM by their EPSG
+  # codes, a custom Transverse Mercator by its projection GeoKeys (the centre against
+  # gdaltransform); EPSG codes of Transverse Mercators without their parameters in the file
+  # (NZTM, Slovenia's D96/TM) refused, not guessed at
+  if command -v gdaltransform > /dev/null 2>&1; then
+    gt -a_srs EPSG:32613 -a_ullr 440000 4460000 443690 4457030 "$dir/dem.asc" "$dir/tm_base.tif"
+    for crs in EPSG:26913 EPSG:6342 "+proj=tmerc +lat_0=0 +lon_0=15 +k=0.9999 +x_0=500000 +y_0=-5000000 +ellps=GRS80 +units=m"; do
+      gt -a_srs "$crs" "$dir/tm_base.tif" "$dir/tm.tif"
+      want=$(echo "20.5 16.5" | gdaltransform -t_srs EPSG:4326 "$dir/tm.tif" | awk '{ printf "%.6f %.6f", $2, $1 }')
+      if "$hfvis" solar "$dir/tm.tif" --day 2026-06-21 --dirs 8 --progress -o "$dir/tm_out.tif" > /dev/null 2> "$dir/err"; then
+        got=$(sed -n 's/^hfvis solar: site \([-0-9.]*\), \([-0-9.]*\) .*/\1 \2/p' "$dir/err")
+        echo "$got $want" | awk 'NF == 4 { d1 = $1 - $3; d2 = $2 - $4; exit !(d1 * d1 + d2 * d2 < 1e-8) } NF != 4 { exit 1 }' \
+          && ok "solar site from $crs: $got (gdaltransform $want)" \
+          || bad "solar site from $crs: '$got', gdaltransform '$want'"
+      else
+        bad "solar on $crs: $(head -n 2 "$dir/err")"
+      fi
+    done
+    for crs in EPSG:2193 EPSG:3794; do
+      gt -a_srs "$crs" "$dir/tm_base.tif" "$dir/tm.tif"
+      fails "solar on $crs (no Transverse Mercator parameters in the file)" solar "$dir/tm.tif" --day 2026-06-21 --dirs 8 -o "$dir/tm_out.tif"
+      grep -q "latitude is unknown: $crs" "$dir/err" || bad "solar on $crs: $(cat "$dir/err")"
+    done
+  else
+    echo "SKIP gdaltransform: not installed"
+  fi
 else
   echo "SKIP gdal: gdal_translate/gdalinfo not installed"
 fi

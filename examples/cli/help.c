@@ -65,8 +65,9 @@
     "  -o GLOBAL         global irradiation; --beam, --diffuse, --reflected, --sun-hours write\n"    \
     "                    the parts and the hours of direct sun (.pfm, .tif, .asc, .bil, .flt)\n"    \
     "  --latitude, --longitude  the site in degrees (east positive); default: the centre of a\n"    \
-    "                    raster in a Transverse Mercator CRS (UTM EPSG 326zz/327zz/258zz or a\n"     \
-    "                    WKT), by the inverse projection; else an error\n"                         \
+    "                    raster in a Transverse Mercator CRS (UTM EPSG 326zz/327zz/258zz/269zz/\n"   \
+    "                    6330-6348, or its parameters in GeoTIFF keys or a WKT), by the inverse\n"  \
+    "                    projection; else an error\n"                                              \
     "  --utc-offset H    dates and --time are UTC + H (default 0); --solar-time: local solar time\n" \
     "                    and r.sun's solar geometry and steps (r.sun's convention)\n"               \
     "  --bands day|month one band per day or per calendar month, stacked like horizon planes\n"     \

@@ -203,19 +203,42 @@ static int cli_wkt_param(const char *wkt, const char *name, double *v)
     return 0;
 }
 
-/* The raster's Transverse Mercator, if it has one: UTM by EPSG (WGS 84 326zz north, 327zz south;
- * ETRS89 258zz), or a WKT (.prj, GeoTIFF citation) naming Transverse_Mercator with its
- * parameters. */
+/* A GeoKey's value (GeoTIFF 1.1 §7.1): its SHORT, or its DOUBLE from GeoDoubleParams; 1 if the
+ * raster has it. */
+static int cli_geokey(const ex_georef *g, unsigned id, double *v)
+{
+    size_t i, n = g->n_geokeys >= 4 ? g->geokeys[3] : 0;
+    for (i = 1; i <= n && 4 * i + 3 < g->n_geokeys; i++) {
+        const uint16_t *k = g->geokeys + 4 * i;
+        if (k[0] != id) continue;
+        if (k[1] == 0 && k[2] == 1) *v = (double)k[3];
+        else if (k[1] == 34736 && k[2] >= 1 && (size_t)k[3] < g->n_geodoubles) *v = g->geodoubles[k[3]];
+        else return 0;
+        return 1;
+    }
+    return 0;
+}
+
+/* The raster's Transverse Mercator, if it has one, from (in this order): a UTM EPSG code (WGS 84
+ * 326zz north and 327zz south, ETRS89 258zz, NAD83 269zz, NAD83(2011) 6330-6348 for zones 1-19
+ * north); the GeoTIFF's own projection keys (ProjCoordTransGeoKey 1, Transverse Mercator, with
+ * its natural origin, scale and false easting and northing); or a WKT (.prj, GeoTIFF citation)
+ * naming Transverse_Mercator with its central meridian, scale factor and false easting and
+ * northing. A CRS that names Transverse Mercator without its parameters (a GeoTIFF holding only
+ * an EPSG code and its name) is not guessed at: 0, as for any other CRS. */
 static int cli_solar_tm(const ex_georef *g, cli_tm *t)
 {
     const char *wkt = g->prj ? g->prj : g->geoascii;
     int zone = 0, south = 0;
+    double v, k0, lon0, x0, y0;
     t->a = 6378137.0;
     t->f = 1.0 / 298.257223563; /* WGS 84 (GRS 80 differs by 1e-10 in f) */
     t->lat0 = 0.0;
     if (g->epsg > 32600 && g->epsg <= 32660) zone = g->epsg - 32600;
     else if (g->epsg > 32700 && g->epsg <= 32760) zone = g->epsg - 32700, south = 1;
     else if (g->epsg >= 25828 && g->epsg <= 25838) zone = g->epsg - 25800;
+    else if (g->epsg >= 26901 && g->epsg <= 26923) zone = g->epsg - 26900;
+    else if (g->epsg >= 6330 && g->epsg <= 6348) zone = g->epsg - 6329;
     if (zone) {
         t->k0 = 0.9996;
         t->lon0 = -183.0 + 6.0 * zone;
@@ -223,15 +246,32 @@ static int cli_solar_tm(const ex_georef *g, cli_tm *t)
         t->y0 = south ? 10000000.0 : 0.0;
         return 1;
     }
+    if (cli_geokey(g, 3075, &v) && v == 1.0 && /* ProjCoordTransGeoKey: CT_TransverseMercator */
+        (cli_geokey(g, 3080, &lon0) || cli_geokey(g, 3088, &lon0)) && /* natural origin or centre */
+        (cli_geokey(g, 3092, &k0) || cli_geokey(g, 3093, &k0)) && cli_geokey(g, 3082, &x0) &&
+        cli_geokey(g, 3083, &y0)) {
+        double a, inv_f;
+        t->k0 = k0;
+        t->lon0 = lon0;
+        t->x0 = x0;
+        t->y0 = y0;
+        if (cli_geokey(g, 3081, &v) || cli_geokey(g, 3089, &v)) t->lat0 = v;
+        if (cli_geokey(g, 2057, &a) && cli_geokey(g, 2059, &inv_f) && a > 6e6 && a < 7e6 && inv_f > 250.0) {
+            t->a = a;
+            t->f = 1.0 / inv_f;
+        }
+        return k0 > 0.0 && isfinite(lon0 + x0 + y0 + t->lat0);
+    }
     if (wkt && (strstr(wkt, "Transverse_Mercator") || strstr(wkt, "TRANSVERSE_MERCATOR") ||
-                strstr(wkt, "Transverse Mercator"))) {
-        double v;
+                strstr(wkt, "Transverse Mercator")) &&
+        cli_wkt_param(wkt, "scale_factor", &k0) && cli_wkt_param(wkt, "central_meridian", &lon0) &&
+        cli_wkt_param(wkt, "false_easting", &x0) && cli_wkt_param(wkt, "false_northing", &y0) && k0 > 0.0) {
         const char *sp = strstr(wkt, "SPHEROID[\"");
-        t->k0 = cli_wkt_param(wkt, "scale_factor", &v) ? v : 1.0;
-        t->lon0 = cli_wkt_param(wkt, "central_meridian", &v) ? v : 0.0;
+        t->k0 = k0;
+        t->lon0 = lon0;
+        t->x0 = x0;
+        t->y0 = y0;
         t->lat0 = cli_wkt_param(wkt, "latitude_of_origin", &v) ? v : 0.0;
-        t->x0 = cli_wkt_param(wkt, "false_easting", &v) ? v : 0.0;
-        t->y0 = cli_wkt_param(wkt, "false_northing", &v) ? v : 0.0;
         if (sp && (sp = strchr(sp + 10, '"')) != NULL) {
             double a, inv_f;
             if (sscanf(sp + 1, " ,%lf ,%lf", &a, &inv_f) == 2 && a > 6e6 && a < 7e6 && inv_f > 250.0) {
@@ -400,10 +440,14 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     memset(&sites, 0, sizeof sites);
     if (!a->sol_has_lat) { /* every cell's site by the inverse projection of its centre */
         size_t i, n = (size_t)w * (size_t)h;
-        if (!a->run->geo.has_transform || !cli_solar_tm(&a->run->geo, &sites.tm))
-            return cli_error(CLI_EXIT_ERROR, "solar", "the latitude is unknown: IN has no Transverse "
-                             "Mercator CRS (UTM, EPSG 326zz/327zz/258zz, or a WKT); give --latitude "
-                             "and --longitude");
+        if (!a->run->geo.has_transform || !cli_solar_tm(&a->run->geo, &sites.tm)) {
+            char crs[32] = "IN's CRS";
+            if (a->run->geo.epsg > 0) snprintf(crs, sizeof crs, "EPSG:%d", a->run->geo.epsg);
+            return cli_error(CLI_EXIT_ERROR, "solar", "the latitude is unknown: %s is not a Transverse "
+                             "Mercator hfvis can invert (UTM by EPSG 326zz, 327zz, 258zz, 269zz or "
+                             "6330-6348, or its parameters in GeoTIFF keys or a WKT); give --latitude "
+                             "and --longitude", crs);
+        }
         sites.lat = (double *)(void *)cli_alloc(n, 2, sizeof(double) / sizeof(float)); /* 2n doubles */
         if (!sites.lat) return cli_status("solar", HFVIS_ERR_OUT_OF_MEMORY, 0);
         sites.lon = sites.lat + n;
