@@ -891,6 +891,16 @@ else ok "sum same file: skipped (no ln -s)"; fi
 cp "$dir/vv.pgm" "$dir/ow.pgm"
 if "$hfvis" hillshade "$dir/ow.pgm" --overwrite -o "$dir/ow.pgm" 2> "$dir/stderr" && ! cmp -s "$dir/ow.pgm" "$dir/vv.pgm"
 then ok "--overwrite replaces the input"; else bad "--overwrite: $(cat "$dir/stderr")"; fi
+# A replaced output loses its stale GDAL sidecar OUT.aux.xml (statistics of the old values), in
+# every format, the library's codecs and the raster writers alike; a refused run keeps it.
+for x in pfm pgm tif asc flt; do
+  echo stale > "$dir/aux.$x.aux.xml"
+  expect_ok "a .$x output" "$dir/aux.$x" skyview "$h" --dirs 4 -o "$dir/aux.$x"
+  [ -e "$dir/aux.$x.aux.xml" ] && bad "a .$x output left its stale .aux.xml" || ok "a .$x output removed its stale .aux.xml"
+done
+cp "$h" "$dir/auxin.pgm"; echo stale > "$dir/auxin.pgm.aux.xml"
+"$hfvis" skyview "$dir/auxin.pgm" -o "$dir/auxin.pgm" 2> /dev/null
+[ -s "$dir/auxin.pgm.aux.xml" ] && ok "a refused run keeps OUT.aux.xml" || bad "a refused run removed OUT.aux.xml"
 
 # --progress: plain lines with percent and ETA, and the summary line.
 if "$hfvis" skyview "$h" --dirs 16 --progress -o "$dir/pr.pfm" > "$dir/stdout" 2> "$dir/stderr" &&

@@ -360,6 +360,7 @@ static int cli_run_azimuths(const cli_args *a);
 static void cli_on_temp(void *user, const char *tmp);
 static void cli_on_signal(int sig);
 static void cli_signals(void);
+static void cli_drop_aux(const char *path);
 static hfvis_status cli_write(const char *path, unsigned char *bytes, size_t n, hfvis_status s);
 static hfvis_status cli_write_encoded(const char *path, size_t need, cli_encoder encode, const void *what);
 static hfvis_status cli_enc_binvox(const void *what, void *out, size_t cap, size_t *written);

@@ -264,7 +264,8 @@ static const char cli_help_tail[] =
     "OUT is written to a temporary file beside it and renamed onto it: a symbolic link named\n"
     "OUT is replaced by the file (write to the link's target to keep the link); an interrupt\n"
     "(SIGINT, SIGTERM, SIGHUP) removes the temporary file; past a file-size limit (ulimit -f)\n"
-    "the write fails as on a full disk.\n"
+    "the write fails as on a full disk. Once OUT is replaced, OUT.aux.xml (the statistics GDAL\n"
+    "and QGIS keep beside a raster) is removed, as GDAL does when it recreates a file.\n"
     "Exit status: 0 = OUT is complete, 1 = error, 2 = usage error; an error is one line\n"
     "\"hfvis: <what>: <why>\" on stderr, and OUT is then left untouched.\n";
 

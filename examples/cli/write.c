@@ -1,7 +1,7 @@
 /* write.c - safe writing: every file goes through hfvis_write_file, whose temporary name is kept
  * here so that SIGINT, SIGTERM and SIGHUP remove it (the handler unlinks it and re-raises the
  * signal; SIGXFSZ is ignored, so a file-size limit is a write error); the encoders of the library's formats; cli_save (PFM, PGM and the GIS rasters); the
- * refusal to write over an input. Owns: the temporary-file names. May call: progress.c, gis.c,
+ * refusal to write over an input; a replaced file's stale GDAL sidecar OUT.aux.xml removed. Owns: the temporary-file names. May call: progress.c, gis.c,
  * tiles.c (pieces), the library's encoders and examples/raster_io.h. */
 
 #define CLI_TMP_CAP 4096 /* longest temporary name the handler can remove (PATH_MAX on Linux) */
@@ -98,6 +98,21 @@ static void cli_on_temp_release(void *user, const char *tmp)
     }
 }
 
+/* After path has been replaced by a new file: remove path.aux.xml, the sidecar in which GDAL
+ * keeps statistics and histograms of a raster (gdalinfo -stats, QGIS), so that it does not
+ * describe the old values. GDAL removes it when it recreates a file itself. Best effort: a file
+ * that is not there, or that cannot be removed, is left as it is. */
+static void cli_drop_aux(const char *path)
+{
+    static const char ext[] = ".aux.xml";
+    char aux[CLI_TMP_CAP];
+    size_t n = strlen(path);
+    if (n + sizeof ext > sizeof aux) return;
+    memcpy(aux, path, n);
+    memcpy(aux + n, ext, sizeof ext);
+    (void)remove(aux);
+}
+
 /* hfvis_write_file with its temporary name recorded. The signals wait (ex_atomic_hold) from
  * before the file is created until the library has named it, so that no interrupt falls between
  * the two and leaves the file behind. */
@@ -111,6 +126,7 @@ static hfvis_status cli_write_file(const char *path, const void *bytes, size_t n
     if (held) ex_atomic_hold(1);
     s = hfvis_write_file(path, bytes, n, &wo);
     if (held) ex_atomic_hold(0); /* the file was never created */
+    if (s == HFVIS_OK) cli_drop_aux(path);
     return s;
 }
 
@@ -184,6 +200,7 @@ static hfvis_status cli_pfm_save(const char *path, const float *px, int w, int h
     }
     free(buf);
     if (!ex_atomic_close(f, tmp, path, ok) && s == HFVIS_OK) s = HFVIS_ERR_IO; /* a short write too */
+    if (s == HFVIS_OK) cli_drop_aux(path);
     return s;
 }
 static hfvis_status cli_enc_pgm_range(const void *what, void *out, size_t cap, size_t *written)
@@ -283,6 +300,7 @@ static int cli_save(const cli_args *a, cli_output out)
         o.meta = out.meta;
         o.n_meta = out.n_meta;
         if (ex_rio_write(a->out, &img, &g, &o, why) != 0) return cli_error(CLI_EXIT_ERROR, a->out, "%s", why);
+        cli_drop_aux(a->out);
         if (ex_rio_format_of(a->out) != EX_RIO_TIFF && ex_rio_crs_lost(&g) && !a->quiet)
             fprintf(stderr, "hfvis: note: %s has no .prj: the input's CRS EPSG:%d has no WKT here (write .tif "
                     "to keep it, or copy a .prj beside it)\n", a->out, g.epsg);
