@@ -1432,6 +1432,29 @@ expect_fail "solar tiles: mosaic refuses a piece made with another albedo map" 1
 expect_fail "solar --window with a Linke map of another size" 1 solar "$dir/swin.asc" --day 2026-06-21 --max-distance 2000 --window 0,0,5,5 --linke-map "$dir/flat.pgm" -o "$fdir/x.tif"
 expect_fail "solar: bad --step" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --step 25h -o "$fdir/x.pfm"
 expect_fail "solar: bad --linke-monthly" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --linke-monthly 3,3 -o "$fdir/x.pfm"
+# every output against every input (IN, --albedo-map, --linke-map) unless --overwrite, and no
+# two outputs one file (or one ASC/EHdr sidecar) ever: the refusals leave every file as it was
+"$hfvis" skyview "$dir/flat.pgm" --dirs 4 --quiet -o "$dir/sin.pfm"; cp "$dir/sin.pfm" "$dir/sin_copy.pfm"
+"$hfvis" skyview "$dir/flat.pgm" --dirs 4 --quiet -o "$dir/smap.pfm"; cp "$dir/smap.pfm" "$dir/smap_copy.pfm"
+sol="solar --latitude 46 --longitude 15 --day 2026-06-21 --dirs 8"
+expect_fail "solar: --beam is IN" 1 $sol "$dir/sin.pfm" -o "$fdir/x.pfm" --beam "$dir/sin.pfm"
+expect_fail "solar: --sun-hours is IN" 1 $sol "$dir/sin.pfm" -o "$fdir/x.pfm" --sun-hours "$dir/sin.pfm"
+expect_fail "solar: -o is the --linke-map" 1 $sol "$dir/sin.pfm" --linke-map "$dir/smap.pfm" -o "$dir/smap.pfm"
+expect_fail "solar: --diffuse is the --albedo-map" 1 $sol "$dir/sin.pfm" --albedo-map "$dir/smap.pfm" -o "$fdir/x.pfm" --diffuse "$dir/smap.pfm"
+expect_fail "solar: --reflected is the --linke-map" 1 $sol "$dir/sin.pfm" --linke-map "$dir/smap.pfm" -o "$fdir/x.pfm" --reflected "$dir/smap.pfm"
+cmp -s "$dir/sin.pfm" "$dir/sin_copy.pfm" && cmp -s "$dir/smap.pfm" "$dir/smap_copy.pfm" &&
+  ok "solar: refused outputs leave IN and the maps intact" || bad "solar: an input changed"
+expect_fail "solar: -o, --beam and --diffuse one file" 2 $sol "$dir/flat.pgm" -o "$fdir/x.tif" --beam "$fdir/x.tif" --diffuse "$fdir/x.tif"
+expect_fail "solar: --beam and --sun-hours one file by another spelling" 2 $sol "$dir/flat.pgm" -o "$fdir/x.tif" --beam "$fdir/b.pfm" --sun-hours "$fdir/./b.pfm"
+echo old > "$dir/sold_out.pfm"; ln -s "$dir/sold_out.pfm" "$dir/sold_link.pfm" 2> /dev/null
+if [ -L "$dir/sold_link.pfm" ]; then expect_fail "solar: -o and --beam one file through a symbolic link" 2 $sol "$dir/flat.pgm" -o "$dir/sold_out.pfm" --beam "$dir/sold_link.pfm"
+  [ "$(cat "$dir/sold_out.pfm")" = old ] && ok "solar: the shared output left as it was" || bad "solar: the shared output was replaced"
+else ok "solar outputs through a link: skipped (no ln -s)"; fi
+expect_fail "solar: an .asc and a .bil output share their .prj" 2 $sol "$dir/flat.pgm" -o "$fdir/x.bil" --beam "$fdir/x.asc"
+expect_fail "solar: --overwrite does not let two outputs share a file" 2 $sol "$dir/flat.pgm" --overwrite -o "$fdir/x.pfm" --beam "$fdir/x.pfm"
+cp "$dir/sin.pfm" "$dir/sin_ow.pfm"
+expect_ok "solar --overwrite: --beam may replace IN" "$dir/sow_g.pfm" $sol "$dir/sin_ow.pfm" --overwrite --beam "$dir/sin_ow.pfm" -o "$dir/sow_g.pfm"
+cmp -s "$dir/sin_ow.pfm" "$dir/sin.pfm" && bad "solar --overwrite: IN not replaced by --beam" || ok "solar --overwrite: IN replaced by --beam"
 
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"

@@ -380,6 +380,8 @@ static int cli_save(const cli_args *a, cli_output out);
 static int cli_same_file(const char *x, const char *y);
 static int cli_refuse_input(int overwrite, const char *out, const char *const *inputs, int n);
 static int cli_refuse_inputs(const cli_args *a, const char *out);
+static int cli_same_path(const char *x, const char *y);
+static int cli_refuse_outputs(const cli_args *a);
 /* run.c */
 static cli_cost cli_cost_of(double bytes, double work, const char *unit);
 static cli_cost cli_sweep_cost(const cli_args *a, int w, int h, double out, double ch, double cell_bytes,

@@ -229,7 +229,8 @@ static const cli_flag cli_flags[] = {
     { "--overwrite", NULL, CLI_OUT,
       CLI_SWITCH,
       "allow OUT to be one of the inputs (refused otherwise: same file,\n"
-      "                    through hard and symbolic links too)\n" },
+      "                    through hard and symbolic links too); solar: each of its outputs.\n"
+      "                    Two outputs of one run never share a file (or an ASC/EHdr .prj)\n" },
     { "--max-memory", "B", CLI_RUNS,
       CLI_WORDS(CLI_V_BYTES, "half the physical memory"),
       "refuse a run whose estimated memory exceeds B bytes (suffix K, M, G or\n"

@@ -63,7 +63,8 @@
     "                    January; --linke-map: a PFM/PGM of the DEM's size\n"                       \
     "  --albedo A        ground albedo, [0, 1] (default 0.2); --albedo-map: per cell\n"             \
     "  -o GLOBAL         global irradiation; --beam, --diffuse, --reflected, --sun-hours write\n"    \
-    "                    the parts and the hours of direct sun (.pfm, .tif, .asc, .bil, .flt)\n"    \
+    "                    the parts and the hours of direct sun (.pfm, .tif, .asc, .bil, .flt);\n"   \
+    "                    none may be IN or a map (unless --overwrite), no two one file\n"          \
     "  --latitude, --longitude  the site in degrees (east positive); default: the centre of a\n"    \
     "                    raster in a Transverse Mercator CRS (UTM EPSG 326zz/327zz/258zz or a\n"     \
     "                    WKT), by the inverse projection; else an error\n"                         \

@@ -359,8 +359,69 @@ static int cli_refuse_input(int overwrite, const char *out, const char *const *i
 /* Every input of a command against out. */
 static int cli_refuse_inputs(const cli_args *a, const char *out)
 {
-    const char *inputs[5];
+    const char *inputs[6];
     inputs[0] = a->in, inputs[1] = a->env, inputs[2] = a->albedo_map, inputs[3] = a->emission;
-    inputs[4] = a->vf_reference;
-    return cli_refuse_input(a->overwrite, out, inputs, 5);
+    inputs[4] = a->vf_reference, inputs[5] = a->sol_linke_map;
+    return cli_refuse_input(a->overwrite, out, inputs, 6);
+}
+
+/* Whether paths x and y name one file, existing or still to be written: the same string, the
+ * same file (cli_same_file), or one last component in one directory (same device and inode). */
+static int cli_same_path(const char *x, const char *y)
+{
+    if (!strcmp(x, y) || cli_same_file(x, y)) return 1;
+#ifdef CLI_HAVE_ISATTY
+    {
+        const char *sx = strrchr(x, '/'), *sy = strrchr(y, '/');
+        char dx[CLI_TMP_CAP], dy[CLI_TMP_CAP];
+        size_t nx = sx ? (size_t)(sx - x) : 0, ny = sy ? (size_t)(sy - y) : 0;
+        struct stat tx, ty;
+        if (strcmp(sx ? sx + 1 : x, sy ? sy + 1 : y) || nx >= sizeof dx || ny >= sizeof dy) return 0;
+        if (sx) memcpy(dx, x, nx), dx[nx] = '\0';
+        if (sy) memcpy(dy, y, ny), dy[ny] = '\0';
+        if (!sx) strcpy(dx, ".");
+        else if (nx == 0) strcpy(dx, "/");
+        if (!sy) strcpy(dy, ".");
+        else if (ny == 0) strcpy(dy, "/");
+        return stat(dx, &tx) == 0 && stat(dy, &ty) == 0 && tx.st_dev == ty.st_dev && tx.st_ino == ty.st_ino;
+    }
+#else
+    return 0;
+#endif
+}
+
+/* Every output file of a run (OUT and solar's --beam, --diffuse, --reflected, --sun-hours): none
+ * may be an input unless --overwrite (CLI_EXIT_ERROR), and no two may name one file, nor (an ASC
+ * grid, an EHdr raster) one .prj or .hdr sidecar, whatever --overwrite says (CLI_EXIT_USAGE): the
+ * later would replace the earlier. 0, or the exit status after one error line. */
+static int cli_refuse_outputs(const cli_args *a)
+{
+    static const char *const flag[5] = { "-o", "--beam", "--diffuse", "--reflected", "--sun-hours" };
+    const char *outs[5];
+    int i, j, rc;
+    outs[0] = a->out, outs[1] = a->sol_out[0], outs[2] = a->sol_out[1], outs[3] = a->sol_out[2];
+    outs[4] = a->sol_out[3];
+    for (i = 0; i < 5; i++)
+        if (outs[i] && (rc = cli_refuse_inputs(a, outs[i])) != 0) return rc;
+    for (i = 0; i < 5; i++)
+        for (j = i + 1; outs[i] && j < 5; j++) {
+            int fi, fj, same;
+            char *pi, *pj;
+            if (!outs[j]) continue;
+            if (cli_same_path(outs[i], outs[j]))
+                return cli_error(CLI_EXIT_USAGE, outs[j], "is the output of both %s and %s: give each "
+                                 "output its own file", flag[i], flag[j]);
+            fi = ex_rio_format_of(outs[i]), fj = ex_rio_format_of(outs[j]);
+            if ((fi != EX_RIO_ASC && fi != EX_RIO_EHDR) || (fj != EX_RIO_ASC && fj != EX_RIO_EHDR)) continue;
+            pi = ex_rio_sidecar(outs[i], ".prj"), pj = ex_rio_sidecar(outs[j], ".prj");
+            same = pi && pj && cli_same_path(pi, pj);
+            if (same)
+                cli_error(CLI_EXIT_USAGE, outs[j], "shares its sidecar %s with %s (%s): give the "
+                          "outputs different names before the extension", pj, outs[i], flag[i]);
+            free(pi);
+            free(pj);
+            if (same) return CLI_EXIT_USAGE;
+            if (!pi || !pj) return cli_status(outs[j], HFVIS_ERR_OUT_OF_MEMORY, 0);
+        }
+    return 0;
 }
