@@ -1455,6 +1455,18 @@ expect_fail "solar: --overwrite does not let two outputs share a file" 2 $sol "$
 cp "$dir/sin.pfm" "$dir/sin_ow.pfm"
 expect_ok "solar --overwrite: --beam may replace IN" "$dir/sow_g.pfm" $sol "$dir/sin_ow.pfm" --overwrite --beam "$dir/sin_ow.pfm" -o "$dir/sow_g.pfm"
 cmp -s "$dir/sin_ow.pfm" "$dir/sin.pfm" && bad "solar --overwrite: IN not replaced by --beam" || ok "solar --overwrite: IN replaced by --beam"
+# what can be known to fail is refused before the run (an ASC output of several bands, an output
+# in a directory that does not exist), and OUT is written last: a failing extra output (here a
+# directory in its place) leaves it as it was
+echo old > "$dir/skeep.tif"
+expect_fail "solar: --sun-hours in a directory that does not exist" 1 $sol "$dir/flat.pgm" -o "$dir/skeep.tif" --sun-hours "$dir/no/such/dir/h.tif"
+expect_fail "solar: an .asc output of month bands" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --start 2026-01-30 --end 2026-02-02 --bands month --dirs 8 -o "$dir/skeep.tif" --sun-hours "$fdir/h.asc"
+expect_fail "solar: -o .asc of day bands" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --start 2026-01-30 --end 2026-02-02 --bands day --dirs 8 -o "$fdir/g.asc"
+expect_fail "a skyview OUT in a directory that does not exist" 1 skyview "$dir/flat.pgm" -o "$dir/no/such/dir/x.pfm"
+mkdir -p "$dir/sdir.tif"
+expect_fail "solar: --sun-hours that cannot be written (a directory)" 1 $sol "$dir/flat.pgm" -o "$dir/skeep.tif" --sun-hours "$dir/sdir.tif"
+[ "$(cat "$dir/skeep.tif")" = old ] && ok "solar: failing outputs leave OUT untouched" || bad "solar: OUT replaced by a run that failed"
+expect_ok "solar: an .asc output of one band" "$dir/s1.asc" $sol "$dir/flat.pgm" -o "$dir/s1.asc"
 
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"

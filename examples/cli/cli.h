@@ -381,6 +381,7 @@ static int cli_same_file(const char *x, const char *y);
 static int cli_refuse_input(int overwrite, const char *out, const char *const *inputs, int n);
 static int cli_refuse_inputs(const cli_args *a, const char *out);
 static int cli_same_path(const char *x, const char *y);
+static int cli_refuse_unwritable(const char *path);
 static int cli_refuse_outputs(const cli_args *a);
 /* run.c */
 static cli_cost cli_cost_of(double bytes, double work, const char *unit);
@@ -495,6 +496,7 @@ static int cli_solar_date(const char *f, const char *v, int *y, int *m, int *d);
 static long cli_solar_day_number(int y, int m, int d);
 static int cli_set_solar(cli_args *a, const char *f, const char *v);
 static int cli_solar_days(const cli_args *a);
+static int cli_solar_band_count(const cli_args *a);
 static int cli_check_solar(const cli_args *a);
 static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts);
 /* main.c */

@@ -90,7 +90,11 @@
     "  --height-range LO,HI  the pressure nodes' span instead (heights after --zscale): no pass\n" \
     "                    over IN, so each --window reads only its cells and halo; every height\n" \
     "                    read must lie in it, and the pieces of one run must share it\n"         \
-    "Polar night gives 0. With --progress the site's latitude and longitude go to stderr.\n"
+    "Polar night gives 0. With --progress the site's latitude and longitude go to stderr.\n"     \
+    "Refused before the run: an output that is an input or another output's file, an .asc\n"     \
+    "output of more than one band, an output whose directory does not exist or cannot be\n"      \
+    "written. The outputs are written after the run, -o GLOBAL last: when a write fails, OUT\n"   \
+    "is then left untouched (the extra outputs written before it stay replaced).\n"
 
 #define CLI_VF_HELP                                                                                  \
     "usage: hfvis visfield MESH.obj -o FIELD.hfvf [--positions K] [--dirs D] [--format F]\n"        \

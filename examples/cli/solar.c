@@ -123,6 +123,20 @@ static int cli_solar_days(const cli_args *a)
                  cli_solar_day_number(a->sol_y, a->sol_m, a->sol_d)) + 1;
 }
 
+/* The bands of every output for the flags' dates and --bands (hfvis_solar_band_count; the site
+ * does not change them), or -1 for dates the library refuses. */
+static int cli_solar_band_count(const cli_args *a)
+{
+    hfvis_solar_input in = hfvis_solar_input_default();
+    hfvis_solar_options so = hfvis_solar_options_default();
+    in.year = a->sol_y, in.month = a->sol_m, in.day = a->sol_d;
+    in.days = cli_solar_days(a);
+    in.instant = a->sol_instant;
+    in.hour = a->sol_hour;
+    so.bands = (hfvis_solar_bands)a->sol_bands;
+    return hfvis_solar_band_count(&in, &so);
+}
+
 /* The combinations (after every flag is read): the command row's check (main.c). */
 static int cli_check_solar(const cli_args *a)
 {
@@ -153,6 +167,17 @@ static int cli_check_solar(const cli_args *a)
         if (a->sol_has_end && hfvis_solar_band_count(&in, NULL) < 0)
             return cli_error(CLI_EXIT_USAGE, "--end", "%04d-%02d-%02d is not a date of the calendar",
                              a->sol_ey, a->sol_em, a->sol_ed);
+    }
+    { /* an ASCII grid holds one band: refused before the run, not after it */
+        const char *outs[5];
+        int k, bands = cli_solar_band_count(a);
+        outs[0] = a->out, outs[1] = a->sol_out[0], outs[2] = a->sol_out[1], outs[3] = a->sol_out[2];
+        outs[4] = a->sol_out[3];
+        for (k = 0; k < 5; k++)
+            if (bands > 1 && outs[k] && ex_rio_format_of(outs[k]) == EX_RIO_ASC)
+                return cli_error(CLI_EXIT_USAGE, outs[k], "an ASCII grid holds one band; --bands %s gives %d: "
+                                 "write .tif, .bil, .flt or .pfm", a->sol_bands == HFVIS_SOLAR_BANDS_DAY ? "day"
+                                 : "month", bands);
     }
     return 0;
 }
@@ -395,7 +420,7 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     char tag[CLI_PIECE_TAG_MAX];
     cli_solar_sites sites;
     hfvis_status s;
-    int rc = 0, bands, k, ch, piece = a->run->win.active;
+    int rc = 0, bands, j, k, ch, piece = a->run->win.active;
     double lat = a->sol_lat, lon = a->sol_lon;
     memset(&sites, 0, sizeof sites);
     if (!a->sol_has_lat) { /* every cell's site by the inverse projection of its centre */
@@ -526,9 +551,11 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     }
     if (s != HFVIS_OK) { rc = cli_status("solar", s, 0); goto done; }
     memcpy(tag, a->run->win.tag, sizeof tag);
-    for (k = 0; k < 5 && rc == 0; k++) {
+    for (j = 0; j < 5 && rc == 0; j++) { /* OUT (k = 3) last: a failing write leaves it untouched */
         static const char *const kind[5] = { "beam", "diffuse", "reflected", "global", "sun-hours" };
+        static const int order[5] = { 0, 1, 2, 4, 3 };
         cli_args b = *a;
+        k = order[j];
         if (!paths[k]) continue;
         b.out = paths[k];
         b.out_pgm = 0;

@@ -365,6 +365,21 @@ static int cli_refuse_inputs(const cli_args *a, const char *out)
     return cli_refuse_input(a->overwrite, out, inputs, 6);
 }
 
+#ifdef CLI_HAVE_ISATTY
+/* The directory of path ("." without a '/', "/" for a name at the root) into d[cap]: 1, or 0
+ * when it does not fit. */
+static int cli_dir_of(const char *path, char *d, size_t cap)
+{
+    const char *s = strrchr(path, '/');
+    size_t n = s ? (size_t)(s - path) : 0;
+    if (n + 2 > cap) return 0;
+    if (!s) strcpy(d, ".");
+    else if (n == 0) strcpy(d, "/");
+    else memcpy(d, path, n), d[n] = '\0';
+    return 1;
+}
+#endif
+
 /* Whether paths x and y name one file, existing or still to be written: the same string, the
  * same file (cli_same_file), or one last component in one directory (same device and inode). */
 static int cli_same_path(const char *x, const char *y)
@@ -374,15 +389,10 @@ static int cli_same_path(const char *x, const char *y)
     {
         const char *sx = strrchr(x, '/'), *sy = strrchr(y, '/');
         char dx[CLI_TMP_CAP], dy[CLI_TMP_CAP];
-        size_t nx = sx ? (size_t)(sx - x) : 0, ny = sy ? (size_t)(sy - y) : 0;
         struct stat tx, ty;
-        if (strcmp(sx ? sx + 1 : x, sy ? sy + 1 : y) || nx >= sizeof dx || ny >= sizeof dy) return 0;
-        if (sx) memcpy(dx, x, nx), dx[nx] = '\0';
-        if (sy) memcpy(dy, y, ny), dy[ny] = '\0';
-        if (!sx) strcpy(dx, ".");
-        else if (nx == 0) strcpy(dx, "/");
-        if (!sy) strcpy(dy, ".");
-        else if (ny == 0) strcpy(dy, "/");
+        if (strcmp(sx ? sx + 1 : x, sy ? sy + 1 : y) || !cli_dir_of(x, dx, sizeof dx) ||
+            !cli_dir_of(y, dy, sizeof dy))
+            return 0;
         return stat(dx, &tx) == 0 && stat(dy, &ty) == 0 && tx.st_dev == ty.st_dev && tx.st_ino == ty.st_ino;
     }
 #else
@@ -390,8 +400,29 @@ static int cli_same_path(const char *x, const char *y)
 #endif
 }
 
+/* An output whose directory does not exist or cannot be written to is refused before the run
+ * computes anything (the write would fail after it): 0, or CLI_EXIT_ERROR after one line. */
+static int cli_refuse_unwritable(const char *path)
+{
+#ifdef CLI_HAVE_ISATTY
+    char d[CLI_TMP_CAP];
+    struct stat st;
+    if (!cli_dir_of(path, d, sizeof d)) return 0; /* the write reports it */
+    if (stat(d, &st) != 0)
+        return cli_error(CLI_EXIT_ERROR, path, "cannot be written: its directory %s: %s", d, strerror(errno));
+    if (!S_ISDIR(st.st_mode))
+        return cli_error(CLI_EXIT_ERROR, path, "cannot be written: %s is not a directory", d);
+    if (access(d, W_OK | X_OK) != 0)
+        return cli_error(CLI_EXIT_ERROR, path, "cannot be written: its directory %s: %s", d, strerror(errno));
+#else
+    (void)path;
+#endif
+    return 0;
+}
+
 /* Every output file of a run (OUT and solar's --beam, --diffuse, --reflected, --sun-hours): none
- * may be an input unless --overwrite (CLI_EXIT_ERROR), and no two may name one file, nor (an ASC
+ * may be an input unless --overwrite, nor lie in a directory that does not exist or cannot be
+ * written to (CLI_EXIT_ERROR), and no two may name one file, nor (an ASC
  * grid, an EHdr raster) one .prj or .hdr sidecar, whatever --overwrite says (CLI_EXIT_USAGE): the
  * later would replace the earlier. 0, or the exit status after one error line. */
 static int cli_refuse_outputs(const cli_args *a)
@@ -402,7 +433,8 @@ static int cli_refuse_outputs(const cli_args *a)
     outs[0] = a->out, outs[1] = a->sol_out[0], outs[2] = a->sol_out[1], outs[3] = a->sol_out[2];
     outs[4] = a->sol_out[3];
     for (i = 0; i < 5; i++)
-        if (outs[i] && (rc = cli_refuse_inputs(a, outs[i])) != 0) return rc;
+        if (outs[i] && ((rc = cli_refuse_inputs(a, outs[i])) != 0 || (rc = cli_refuse_unwritable(outs[i])) != 0))
+            return rc;
     for (i = 0; i < 5; i++)
         for (j = i + 1; outs[i] && j < 5; j++) {
             int fi, fj, same;
