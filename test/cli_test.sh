@@ -1365,6 +1365,21 @@ expect_fail "solar, a day, over --max-memory 1K" 1 solar "$dir/flat.pgm" --latit
 expect_fail "solar, 30 days, over --max-memory 1K" 1 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --start 2026-06-01 --end 2026-06-30 --max-memory 1K -o "$fdir/x.pfm"; m3=$(mib)
 awk -v a="$m1" -v b="$m3" 'BEGIN { exit !(a > 0 && b > 1.4 * a) }' &&
   ok "estimate: solar 30 days $m3 MiB > a day $m1 MiB (the sample-major copy)" || bad "estimate: solar 30 days '$m3' MiB not above a day '$m1' MiB"
+# band stacks: each output holds 4 bytes per cell and band, the library 32 bytes of sums per
+# cell and band: a year of day bands into three outputs on 100 x 100 cells needs at least
+# 10^4 x 365 x (32 + 3 x 4) bytes = 153 MiB
+expect_fail "solar, a year of day bands, 3 outputs, over --max-memory 1K" 1 solar "$dir/big.pgm" --latitude 46 --longitude 15 --start 2026-01-01 --end 2026-12-31 --bands day --max-memory 1K -o "$fdir/x.tif" --beam "$fdir/y.tif" --diffuse "$fdir/z.tif"; m3=$(mib)
+awk -v b="$m3" 'BEGIN { exit !(b >= 153 && b < 250) }' &&
+  ok "estimate: a year of day bands into 3 outputs $m3 MiB (>= 153)" || bad "estimate: a year of day bands into 3 outputs '$m3' MiB, want >= 153"
+# and the automatic thread count follows it: 90 day bands into 3 outputs, about 42 MiB, keep
+# one thread under --max-memory 80M (a thread's scratch counts as a whole run's)
+"$hfvis" solar "$dir/big.pgm" --cell 1 --latitude 46 --longitude 15 --start 2026-01-01 --end 2026-03-31 --bands day --dirs 8 --max-memory 0 --progress -o "$dir/sbt.tif" --beam "$dir/sbt2.tif" --diffuse "$dir/sbt3.tif" > /dev/null 2> "$dir/stderr"
+if grep -q '^solar: estimate .*, 1 thread$' "$dir/stderr"; then ok "solar threads under --max-memory: skipped (one core)"
+else
+  "$hfvis" solar "$dir/big.pgm" --cell 1 --latitude 46 --longitude 15 --start 2026-01-01 --end 2026-03-31 --bands day --dirs 8 --max-memory 80M --progress -o "$dir/sbt.tif" --beam "$dir/sbt2.tif" --diffuse "$dir/sbt3.tif" > /dev/null 2> "$dir/stderr"
+  grep -q '^solar: estimate 4[0-9.]* MiB, .*, 1 thread$' "$dir/stderr" && ok "solar: the band stack keeps one thread under --max-memory 80M" ||
+    bad "solar threads under --max-memory 80M: $(grep estimate "$dir/stderr")"
+fi
 expect_fail "solar: latitude without longitude" 2 solar "$dir/flat.pgm" --latitude 46 --day 2026-06-21 -o "$fdir/x.pfm"
 expect_fail "solar: --time with a range" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --start 2026-06-01 --end 2026-06-02 --time 12:00 -o "$fdir/x.pfm"
 expect_fail "solar: --solar-time with --utc-offset" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --solar-time --utc-offset 1 -o "$fdir/x.pfm"

@@ -47,12 +47,12 @@
 
 #define CLI_SOLAR_HELP                                                                              \
     "usage: hfvis solar DEM --day YYYY-MM-DD | --start DATE --end DATE [--step 15m] [--time HH:MM]\n" \
-    "         [--linke L | --linke-monthly L1,...,L12 | --linke-map L.pfm] [--albedo A |\n"          \
+    "         [--linke L | --linke-monthly L1,...,L12 | --linke-map L.pfm] [--albedo A |\n"         \
     "         --albedo-map A.pfm] -o GLOBAL [--beam B] [--diffuse D] [--reflected R]\n"             \
-    "         [--sun-hours H] [--latitude DEG --longitude DEG] [--utc-offset H | --solar-time]\n"    \
-    "         [--bands day|month] [--normals central|horn] [--sun-radius DEG] [--dirs K]\n"     \
-    "         [--max-distance R [--window X0,Y0,W,H]] [--height-range LO,HI]\n"                  \
-    "         [--horizons exact|near-far|lattice]\n"                                              \
+    "         [--sun-hours H] [--latitude DEG --longitude DEG] [--utc-offset H | --solar-time]\n"   \
+    "         [--bands day|month] [--normals central|horn] [--sun-radius DEG] [--dirs K]\n"         \
+    "         [--max-distance R [--window X0,Y0,W,H]] [--height-range LO,HI]\n"                     \
+    "         [--horizons exact|near-far|lattice]\n"                                                \
     "Clear-sky solar irradiation (Wh/m^2) of a day or a date range, or irradiance (W/m^2) at\n"     \
     "--time, on every cell: r.sun's ESRA atmosphere (Suri & Hofierka 2004), the sun from NREL's\n"  \
     "SPA (Reda & Andreas 2004/2008), the beam shaded by exact horizons (docs/solar.md).\n"          \
@@ -62,38 +62,30 @@
     "  --linke L         Linke turbidity, (0, 10] (default 3); --linke-monthly: 12 values from\n"   \
     "                    January; --linke-map: a PFM/PGM of the DEM's size\n"                       \
     "  --albedo A        ground albedo, [0, 1] (default 0.2); --albedo-map: per cell\n"             \
-    "  -o GLOBAL         global irradiation; --beam, --diffuse, --reflected, --sun-hours write\n"    \
+    "  -o GLOBAL         global irradiation; --beam, --diffuse, --reflected, --sun-hours write\n"   \
     "                    the parts and the hours of direct sun (.pfm, .tif, .asc, .bil, .flt);\n"   \
-    "                    none may be IN or a map (unless --overwrite), no two one file\n"          \
-    "  --latitude, --longitude  the site in degrees (east positive); default: the centre of a\n"    \
-    "                    raster in a Transverse Mercator CRS (UTM EPSG 326zz/327zz/258zz or a\n"     \
-    "                    WKT), by the inverse projection; else an error\n"                         \
+    "                    none may be IN or a map (unless --overwrite), no two one file\n"           \
+    "  --latitude, --longitude  the site in degrees (east positive); default: each cell's, by\n"    \
+    "                    the inverse projection of a Transverse Mercator CRS (UTM or a WKT)\n"      \
     "  --utc-offset H    dates and --time are UTC + H (default 0); --solar-time: local solar time\n" \
     "                    and r.sun's solar geometry and steps (r.sun's convention)\n"               \
     "  --bands day|month one band per day or per calendar month, stacked like horizon planes\n"     \
-    "  --normals N       the cells' surface normals: central (default): central differences;\n"    \
-    "                    horn: Horn's 3x3 stencil, as r.slope.aspect and gdaldem slope/aspect\n"   \
-    "                    (what r.sun reads; central differences on the outer ring and next to\n"   \
-    "                    holes)\n"                                                               \
+    "                    (--max-memory counts 32 bytes of sums and 4 per output a cell and band)\n" \
+    "  --normals N       central (default): central differences; horn: Horn's 3x3 stencil, as\n"    \
+    "                    r.slope.aspect and gdaldem (what r.sun reads)\n"                           \
     "  --sun-radius DEG  shade the sun's disc (default: its centre); --dirs K: directions of the\n" \
-    "                    exact horizon map (default 64; --dirs 16 makes a day about 5x faster,\n"  \
-    "                    mean global within 0.2 % of the oracle: docs/solar.md \"Directions\")\n"   \
-    "  --horizons H      the horizons that shade: exact (default), near-far (exact within 8\n"     \
-    "                    cells, a shared far field beyond: about 0.6x the map's time) or lattice\n" \
-    "                    ([P1] lattice horizons: about 4x faster, misses shadow next to one-cell\n"  \
-    "                    walls and cliffs; docs/solar.md \"Horizon modes\")\n"                     \
-    "  --max-distance R  the horizons' search radius; the pressure nodes then span IN's whole\n"  \
-    "                    height range (read by strips), so that --window X0,Y0,W,H pieces (each\n" \
-    "                    output its own, with the per-cell sites and suns of the whole raster)\n"  \
-    "                    join with 'hfvis mosaic' into the whole run's rasters bit for bit\n"      \
-    "                    (docs/tiles.md; a window reads its cells of the maps)\n"                 \
-    "  --height-range LO,HI  the pressure nodes' span instead (heights after --zscale): no pass\n" \
-    "                    over IN, so each --window reads only its cells and halo; every height\n" \
-    "                    read must lie in it, and the pieces of one run must share it\n"         \
-    "Polar night gives 0. With --progress the site's latitude and longitude go to stderr.\n"     \
-    "Refused before the run: an output that is an input or another output's file, an .asc\n"     \
-    "output of more than one band, an output whose directory does not exist or cannot be\n"      \
-    "written. The outputs are written after the run, -o GLOBAL last: when a write fails, OUT\n"   \
+    "                    horizon map (default 64; 16: a day about 5x faster, within 0.2 %)\n"       \
+    "  --horizons H      exact (default), near-far (exact within 8 cells: about 0.6x the map's\n"   \
+    "                    time) or lattice ([P1]: about 4x faster, misses one-cell walls' shadow)\n" \
+    "  --max-distance R  the horizons' search radius: --window X0,Y0,W,H pieces (each output\n"     \
+    "                    its own) join with 'hfvis mosaic' into the whole run bit for bit\n"        \
+    "                    (docs/tiles.md; IN's height range is read by strips first)\n"              \
+    "  --height-range LO,HI  that height range given instead (after --zscale): every height\n"      \
+    "                    read must lie in it, and the pieces of one run must share it\n"            \
+    "Polar night gives 0. With --progress the site's latitude and longitude go to stderr.\n"        \
+    "Refused before the run: an output that is an input or another output's file, an .asc\n"        \
+    "output of more than one band, an output whose directory does not exist or cannot be\n"         \
+    "written. The outputs are written after the run, -o GLOBAL last: when a write fails, OUT\n"     \
     "is then left untouched (the extra outputs written before it stay replaced).\n"
 
 #define CLI_VF_HELP                                                                                  \
