@@ -47,8 +47,8 @@
 
 #define CLI_SOLAR_HELP                                                                              \
     "usage: hfvis solar DEM --day YYYY-MM-DD | --start DATE --end DATE [--step 15m] [--time HH:MM]\n" \
-    "         [--linke L | --linke-monthly L1,...,L12 | --linke-map L.pfm] [--albedo A |\n"         \
-    "         --albedo-map A.pfm] -o GLOBAL [--beam B] [--diffuse D] [--reflected R]\n"             \
+    "         [--linke L | --linke-monthly L1,...,L12 | --linke-map MAP] [--albedo A |\n"         \
+    "         --albedo-map MAP] -o GLOBAL [--beam B] [--diffuse D] [--reflected R]\n"             \
     "         [--sun-hours H] [--latitude DEG --longitude DEG] [--utc-offset H | --solar-time]\n"   \
     "         [--bands day|month] [--normals central|horn] [--sun-radius DEG] [--dirs K]\n"         \
     "         [--max-distance R [--window X0,Y0,W,H]] [--height-range LO,HI]\n"                     \
@@ -60,8 +60,9 @@
     "  --start, --end    a date range, both days included\n"                                        \
     "  --step S          time step: 15m (default), 1h, 0.5h; a bare number is minutes\n"            \
     "  --linke L         Linke turbidity, (0, 10] (default 3); --linke-monthly: 12 values from\n"   \
-    "                    January; --linke-map: a PFM/PGM of the DEM's size\n"                       \
-    "  --albedo A        ground albedo, [0, 1] (default 0.2); --albedo-map: per cell\n"             \
+    "                    January; --linke-map: per cell, a map of the DEM's size: GeoTIFF, ASC,\n"                       \
+    "                    EHdr (.bil/.flt), PFM or PGM (values / maxval), one band\n"     \
+    "  --albedo A        ground albedo, [0, 1] (default 0.2); --albedo-map: per cell, a map\n"             \
     "  -o GLOBAL         global irradiation; --beam, --diffuse, --reflected, --sun-hours write\n"   \
     "                    the parts and the hours of direct sun (.pfm, .tif, .asc, .bil, .flt);\n"   \
     "                    none may be IN or a map (unless --overwrite), no two one file\n"           \
@@ -344,7 +345,8 @@ static const char cli_help_tail[] =
     "L_(b+1) = EMIT + A*(D + I[L_b]). Lambertian radiance: an open flat receiver under a sky C\n" \
     "with albedo A returns A*C. Default: no sun, sky 1, albedo 1, one bounce.\n" \
     "  --albedo A            constant albedo, >= 0 (default 1)\n" \
-    "  --albedo-map MAP      per-sample albedo, a map of IN's size (instead of --albedo)\n" \
+    "  --albedo-map MAP      per-sample albedo, a map of IN's size (instead of --albedo): GeoTIFF,\n" \
+    "                        ASC, EHdr (.bil/.flt), PFM or PGM (values / maxval)\n" \
     "  --bounces B           interreflection bounces, 0..1000 (default 1); one sweep each\n" \
     "  --sun-azimuth DEG     the sun's azimuth: the --convention's, compass by default\n" \
     "  --sun-elevation DEG   sun elevation above the horizontal, -90..90 (with --sun-azimuth)\n" \

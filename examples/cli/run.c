@@ -137,8 +137,8 @@ static cli_cost cli_estimate_meshao(const cli_args *a, int w, int h, int channel
 }
 
 /* The channels of a height-field command's output, for the estimate before anything is loaded:
- * light has ENV's, indirect the most of ENV, --albedo-map and --emission (PGM or PFM: their
- * headers only are read), normals 3, the rest 1. A header that cannot be read counts 1; the
+ * light has ENV's, indirect the most of ENV, --albedo-map and --emission (PGM, PFM or a
+ * raster's bands: their headers only are read), normals 3, the rest 1. A header that cannot be read counts 1; the
  * load reports it. */
 static int cli_out_channels(const cli_args *a)
 {
@@ -148,7 +148,8 @@ static int cli_out_channels(const cli_args *a)
     if (a->cmd == CMD_INDIRECT) maps[1] = a->albedo_map, maps[2] = a->emission;
     for (i = 0; i < 3; i++) {
         ex_rio_reader r;
-        if (!maps[i] || ex_rio_open_netpbm(&r, maps[i]) != 0) continue;
+        if (!maps[i] || (ex_rio_format_of(maps[i]) ? ex_rio_open(&r, maps[i]) : ex_rio_open_netpbm(&r, maps[i])) != 0)
+            continue;
         if (r.bands > channels) channels = r.bands;
         ex_rio_close(&r);
     }

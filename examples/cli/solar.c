@@ -503,9 +503,19 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     }
     if (a->albedo_map) {
         if ((rc = cli_load_map(a->albedo_map, &a->run->win, grid, &albedo, &ch)) != 0) goto done;
+        if (ch != 1) {
+            rc = cli_error(CLI_EXIT_ERROR, a->albedo_map, "%d bands or channels: an albedo map has one", ch);
+            goto done;
+        }
         so.albedo_map = albedo;
     }
-    if (a->sol_linke_map && (rc = cli_load_map(a->sol_linke_map, &a->run->win, grid, &linke, &ch)) != 0) goto done;
+    if (a->sol_linke_map) {
+        if ((rc = cli_load_map(a->sol_linke_map, &a->run->win, grid, &linke, &ch)) != 0) goto done;
+        if (ch != 1) {
+            rc = cli_error(CLI_EXIT_ERROR, a->sol_linke_map, "%d bands or channels: a Linke map has one", ch);
+            goto done;
+        }
+    }
     so.linke_map = linke;
     bands = hfvis_solar_band_count(&in, &so);
     if (bands < 1) {
