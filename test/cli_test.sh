@@ -1466,6 +1466,46 @@ expect_fail "solar: a map that is no raster names the formats" 1 solar "$dir/swi
 grep -q 'GeoTIFF' "$dir/stderr" && ok "solar: the refusal of a map names the formats read" || bad "solar: map refusal: $(cat "$dir/stderr")"
 expect_fail "solar: bad --step" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --step 25h -o "$fdir/x.pfm"
 expect_fail "solar: bad --linke-monthly" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --linke-monthly 3,3 -o "$fdir/x.pfm"
+# --step takes its unit: a bare number (minutes? r.sun's hours?) is refused; --list-flags says so
+sol="solar --latitude 46 --longitude 15 --day 2026-06-21 --dirs 8"
+expect_fail "solar: --step 0.5 without a unit" 2 $sol "$dir/flat.pgm" --step 0.5 -o "$fdir/x.pfm"
+grep -q "no unit" "$dir/stderr" && ok "solar: a bare --step is refused for its missing unit" || bad "solar --step 0.5: $(cat "$dir/stderr")"
+expect_fail "solar: --step 24 without a unit" 2 $sol "$dir/flat.pgm" --step 24 -o "$fdir/x.pfm"
+expect_ok "solar --step 0.5h" "$dir/sst1.pfm" $sol "$dir/flat.pgm" --step 0.5h -o "$dir/sst1.pfm"
+expect_ok "solar --step 30m" "$dir/sst2.pfm" $sol "$dir/flat.pgm" --step 30m -o "$dir/sst2.pfm"
+cmp -s "$dir/sst1.pfm" "$dir/sst2.pfm" && ok "solar: --step 0.5h = --step 30m" || bad "solar: --step 0.5h differs from 30m"
+"$hfvis" --list-flags solar | grep -q "^--step	S	solar	duration	(0,24]	15m	hours (m or h required)$" &&
+  ok "--list-flags: --step's unit is required" || bad "--list-flags --step: $("$hfvis" --list-flags solar | grep '^--step')"
+# dates: --start needs --end, --day takes none, a four-digit year within SPA's -2000..6000
+sdate="solar --latitude 46 --longitude 15 --dirs 4"
+expect_fail "solar: --start without --end" 2 $sdate "$dir/flat.pgm" --start 2026-06-01 -o "$fdir/x.pfm"
+expect_fail "solar: --day with --end" 2 $sdate "$dir/flat.pgm" --day 2026-06-01 --end 2026-06-03 -o "$fdir/x.pfm"
+expect_fail "solar: --day with --start" 2 $sdate "$dir/flat.pgm" --day 2026-06-01 --start 2026-06-01 --end 2026-06-03 -o "$fdir/x.pfm"
+expect_fail "solar: --end alone" 2 $sdate "$dir/flat.pgm" --end 2026-06-03 -o "$fdir/x.pfm"
+expect_fail "solar: a two-digit year" 2 $sdate "$dir/flat.pgm" --day 26-06-21 -o "$fdir/x.pfm"
+expect_fail "solar: a one-digit month" 2 $sdate "$dir/flat.pgm" --day 2026-6-21 -o "$fdir/x.pfm"
+expect_fail "solar: a year past SPA's 6000" 2 $sdate "$dir/flat.pgm" --day 9999-06-21 -o "$fdir/x.pfm"
+grep -q -- "-2000 to 6000" "$dir/stderr" && ok "solar: the refusal of the year 9999 names SPA's years" || bad "solar --day 9999: $(cat "$dir/stderr")"
+expect_fail "solar: a year before SPA's -2000" 2 $sdate "$dir/flat.pgm" --day -2001-06-21 -o "$fdir/x.pfm"
+expect_ok "solar: the year -500" "$dir/sneg.pfm" $sdate "$dir/flat.pgm" --day -0500-06-21 -o "$dir/sneg.pfm"
+# the days of a range counted in the library's calendar (Julian leap years through 1582): 1500 is
+# a leap year there, so 1500-02-28 .. 1500-03-01 is 3 days (3 day bands, February and March),
+# 1700 is not (2 days); a range across the reform's missing days is refused
+expect_ok "solar: 1500-02-28 to 1500-03-01 by day" "$dir/sjul.pfm" $sdate "$dir/flat.pgm" --start 1500-02-28 --end 1500-03-01 --bands day -o "$dir/sjul.pfm"
+expect_line2 "solar: 1500-02-28 to 1500-03-01 is 3 days (Julian leap year)" "$dir/sjul.pfm" "8 18"
+expect_ok "solar: 1500-02-28 to 1500-03-01 by month" "$dir/sjulm.pfm" $sdate "$dir/flat.pgm" --start 1500-02-28 --end 1500-03-01 --bands month -o "$dir/sjulm.pfm"
+expect_line2 "solar: 1500-02-28 to 1500-03-01 reaches March" "$dir/sjulm.pfm" "8 12"
+expect_ok "solar: 1700-02-28 to 1700-03-01 by day" "$dir/sgreg.pfm" $sdate "$dir/flat.pgm" --start 1700-02-28 --end 1700-03-01 --bands day -o "$dir/sgreg.pfm"
+expect_line2 "solar: 1700-02-28 to 1700-03-01 is 2 days (Gregorian)" "$dir/sgreg.pfm" "8 12"
+expect_ok "solar: 1582-12-30 to 1583-01-02 by day" "$dir/sjg.pfm" $sdate "$dir/flat.pgm" --start 1582-12-30 --end 1583-01-02 --bands day -o "$dir/sjg.pfm"
+expect_line2 "solar: 1582-12-30 to 1583-01-02 is 4 days" "$dir/sjg.pfm" "8 24"
+expect_fail "solar: a range across the Gregorian reform" 2 $sdate "$dir/flat.pgm" --start 1582-10-01 --end 1582-10-20 -o "$fdir/x.pfm"
+expect_fail "solar: a day the reform skipped" 2 $sdate "$dir/flat.pgm" --day 1582-10-10 -o "$fdir/x.pfm"
+# one source of the Linke factor and of the albedo
+expect_fail "solar: --linke with --linke-monthly" 2 $sol "$dir/flat.pgm" --linke 3 --linke-monthly 2,2,3,3,4,4,4,4,3,3,2,2 -o "$fdir/x.pfm"
+expect_fail "solar: --linke with --linke-map" 2 $sol "$dir/flat.pgm" --linke 3 --linke-map "$dir/alb51.pgm" -o "$fdir/x.pfm"
+expect_fail "solar: --linke-monthly with --linke-map" 2 $sol "$dir/flat.pgm" --linke-monthly 2,2,3,3,4,4,4,4,3,3,2,2 --linke-map "$dir/alb51.pgm" -o "$fdir/x.pfm"
+expect_fail "solar: --albedo with --albedo-map" 2 $sol "$dir/flat.pgm" --albedo 0.3 --albedo-map "$dir/alb51.pgm" -o "$fdir/x.pfm"
 # every output against every input (IN, --albedo-map, --linke-map) unless --overwrite, and no
 # two outputs one file (or one ASC/EHdr sidecar) ever: the refusals leave every file as it was
 "$hfvis" skyview "$dir/flat.pgm" --dirs 4 --quiet -o "$dir/sin.pfm"; cp "$dir/sin.pfm" "$dir/sin_copy.pfm"

@@ -143,6 +143,7 @@ typedef struct cli_args {
     /* solar (solar.c): dates, times, atmosphere, site, extra outputs (beam, diffuse, reflected,
      * sun hours) */
     int sol_y, sol_m, sol_d, sol_ey, sol_em, sol_ed, sol_has_start, sol_has_end;
+    int sol_has_day, sol_has_range_start; /* which of --day and --start set sol_y/m/d (sol_has_start) */
     int sol_instant, sol_solar_time, sol_has_lat, sol_has_lon, sol_has_offset, sol_has_linke;
     int sol_has_linke_monthly, sol_bands, sol_horizons, sol_normals, sol_has_zrange;
     double sol_hour, sol_step, sol_lat, sol_lon, sol_offset, sol_linke, sol_linke_monthly[12];
@@ -493,6 +494,7 @@ static int cli_mosaic(int argc, char **argv);
 static int cli_mosaic_pieces(int argc, char **argv, const char **names);
 /* solar.c */
 static int cli_solar_date(const char *f, const char *v, int *y, int *m, int *d);
+static long cli_solar_civil_days(int y, int m, int d, int gregorian);
 static long cli_solar_day_number(int y, int m, int d);
 static int cli_set_solar(cli_args *a, const char *f, const char *v);
 static int cli_solar_days(const cli_args *a);

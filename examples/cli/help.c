@@ -47,8 +47,8 @@
 
 #define CLI_SOLAR_HELP                                                                              \
     "usage: hfvis solar DEM --day YYYY-MM-DD | --start DATE --end DATE [--step 15m] [--time HH:MM]\n" \
-    "         [--linke L | --linke-monthly L1,...,L12 | --linke-map MAP] [--albedo A |\n"         \
-    "         --albedo-map MAP] -o GLOBAL [--beam B] [--diffuse D] [--reflected R]\n"             \
+    "         [--linke L | --linke-monthly L1,...,L12 | --linke-map MAP] [--albedo A |\n"           \
+    "         --albedo-map MAP] -o GLOBAL [--beam B] [--diffuse D] [--reflected R]\n"               \
     "         [--sun-hours H] [--latitude DEG --longitude DEG] [--utc-offset H | --solar-time]\n"   \
     "         [--bands day|month] [--normals central|horn] [--sun-radius DEG] [--dirs K]\n"         \
     "         [--max-distance R [--window X0,Y0,W,H]] [--height-range LO,HI]\n"                     \
@@ -56,13 +56,15 @@
     "Clear-sky solar irradiation (Wh/m^2) of a day or a date range, or irradiance (W/m^2) at\n"     \
     "--time, on every cell: r.sun's ESRA atmosphere (Suri & Hofierka 2004), the sun from NREL's\n"  \
     "SPA (Reda & Andreas 2004/2008), the beam shaded by exact horizons (docs/solar.md).\n"          \
-    "  --day DATE        one day (local civil day; --time HH:MM: that instant)\n"                   \
-    "  --start, --end    a date range, both days included\n"                                        \
-    "  --step S          time step: 15m (default), 1h, 0.5h; a bare number is minutes\n"            \
-    "  --linke L         Linke turbidity, (0, 10] (default 3); --linke-monthly: 12 values from\n"   \
-    "                    January; --linke-map: per cell, a map of the DEM's size: GeoTIFF, ASC,\n"                       \
-    "                    EHdr (.bil/.flt), PFM or PGM (values / maxval), one band\n"     \
-    "  --albedo A        ground albedo, [0, 1] (default 0.2); --albedo-map: per cell, a map\n"             \
+    "  --day DATE        one day, YYYY-MM-DD (local civil day; --time HH:MM: that instant); years\n" \
+    "                    -2000..6000 (SPA's; -YYYY before 0), Julian calendar before 1582-10-15\n"  \
+    "  --start, --end    a date range, both days included (not across 1582-10-04/15); --start\n"    \
+    "                    needs --end, --day takes none\n"                                           \
+    "  --step S          time step with its unit, m or h: 15m (default), 0.5h, 1h; (0, 24h]\n"      \
+    "  --linke L         Linke turbidity, (0, 10] (default 3); or --linke-monthly: 12 values\n"     \
+    "                    from January; or --linke-map: per cell, a map of the DEM's size: GeoTIFF,\n" \
+    "                    ASC, EHdr (.bil/.flt), PFM or PGM (values / maxval), one band\n"           \
+    "  --albedo A        ground albedo, [0, 1] (default 0.2); or --albedo-map: per cell, a map\n"   \
     "  -o GLOBAL         global irradiation; --beam, --diffuse, --reflected, --sun-hours write\n"   \
     "                    the parts and the hours of direct sun (.pfm, .tif, .asc, .bil, .flt);\n"   \
     "                    none may be IN or a map (unless --overwrite), no two one file\n"           \
