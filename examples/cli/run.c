@@ -138,8 +138,8 @@ static cli_cost cli_estimate_meshao(const cli_args *a, int w, int h, int channel
 
 /* The channels of a height-field command's output, for the estimate before anything is loaded:
  * light has ENV's, indirect the most of ENV, --albedo-map and --emission (PGM, PFM or a
- * raster's bands: their headers only are read), normals 3, the rest 1. A header that cannot be read counts 1; the
- * load reports it. */
+ * raster's bands: their headers only are read), normals 3, the rest 1. A header that cannot be
+ * read counts 1; the load reports it. */
 static int cli_out_channels(const cli_args *a)
 {
     const char *maps[3] = {a->env, NULL, NULL};

@@ -172,7 +172,8 @@ static int cli_solar_band_count(const cli_args *a)
 static int cli_check_solar(const cli_args *a)
 {
     if (a->sol_has_day && a->sol_has_range_start)
-        return cli_error(CLI_EXIT_USAGE, "--day", "conflicts with --start: give --day DATE, or --start DATE --end DATE");
+        return cli_error(CLI_EXIT_USAGE, "--day", "conflicts with --start: give --day DATE, or --start DATE "
+                         "--end DATE");
     if (a->sol_has_day && a->sol_has_end)
         return cli_error(CLI_EXIT_USAGE, "--end", "not with --day (one day): for a range give --start DATE --end DATE");
     if (a->sol_has_range_start && !a->sol_has_end)
@@ -203,7 +204,8 @@ static int cli_check_solar(const cli_args *a)
     }
     if (a->sol_has_end) {
         long d = cli_solar_day_number(a->sol_ey, a->sol_em, a->sol_ed) - cli_solar_day_number(a->sol_y, a->sol_m, a->sol_d);
-        long s = (long)a->sol_y * 10000 + a->sol_m * 100 + a->sol_d, e = (long)a->sol_ey * 10000 + a->sol_em * 100 + a->sol_ed;
+        long s = (long)a->sol_y * 10000 + a->sol_m * 100 + a->sol_d;
+        long e = (long)a->sol_ey * 10000 + a->sol_em * 100 + a->sol_ed;
         if (a->sol_instant) return cli_error(CLI_EXIT_USAGE, "--time", "is an instant: give --day, not --start/--end");
         if (d < 0 || d >= CLI_SOLAR_MAX_DAYS)
             return cli_error(CLI_EXIT_USAGE, "--end", "expected a date from --start to %d days after it",

@@ -1,8 +1,10 @@
 /* write.c - safe writing: every file goes through hfvis_write_file, whose temporary name is kept
  * here so that SIGINT, SIGTERM and SIGHUP remove it (the handler unlinks it and re-raises the
- * signal; SIGXFSZ is ignored, so a file-size limit is a write error); the encoders of the library's formats; cli_save (PFM, PGM and the GIS rasters); the
- * refusal to write over an input; a replaced file's stale GDAL sidecar OUT.aux.xml removed. Owns: the temporary-file names. May call: progress.c, gis.c,
- * tiles.c (pieces), the library's encoders and examples/raster_io.h. */
+ * signal; SIGXFSZ is ignored, so a file-size limit is a write error); the encoders of the
+ * library's formats; cli_save (PFM, PGM and the GIS rasters); a replaced file's stale GDAL
+ * sidecar OUT.aux.xml removed; the refusals of outputs before a run (an input, an unwritable
+ * directory, two outputs of one file). Owns: the temporary-file names. May call: progress.c,
+ * gis.c, tiles.c (pieces), the library's encoders and examples/raster_io.h. */
 
 #define CLI_TMP_CAP 4096 /* longest temporary name the handler can remove (PATH_MAX on Linux) */
 #define CLI_TMP_SLOTS 8  /* temporary files alive at once: a raster with its sidecars (ex_publish) */
@@ -422,9 +424,9 @@ static int cli_refuse_unwritable(const char *path)
 
 /* Every output file of a run (OUT and solar's --beam, --diffuse, --reflected, --sun-hours): none
  * may be an input unless --overwrite, nor lie in a directory that does not exist or cannot be
- * written to (CLI_EXIT_ERROR), and no two may name one file, nor (an ASC
- * grid, an EHdr raster) one .prj or .hdr sidecar, whatever --overwrite says (CLI_EXIT_USAGE): the
- * later would replace the earlier. 0, or the exit status after one error line. */
+ * written to (CLI_EXIT_ERROR); no two may name one file, nor (ASC grids, EHdr rasters) one .prj
+ * or .hdr sidecar, whatever --overwrite says (CLI_EXIT_USAGE): the later would replace the
+ * earlier. 0, or the exit status after one error line. */
 static int cli_refuse_outputs(const cli_args *a)
 {
     static const char *const flag[5] = { "-o", "--beam", "--diffuse", "--reflected", "--sun-hours" };
