@@ -891,6 +891,16 @@ else ok "sum same file: skipped (no ln -s)"; fi
 cp "$dir/vv.pgm" "$dir/ow.pgm"
 if "$hfvis" hillshade "$dir/ow.pgm" --overwrite -o "$dir/ow.pgm" 2> "$dir/stderr" && ! cmp -s "$dir/ow.pgm" "$dir/vv.pgm"
 then ok "--overwrite replaces the input"; else bad "--overwrite: $(cat "$dir/stderr")"; fi
+# A replaced output loses its stale GDAL sidecar OUT.aux.xml (statistics of the old values), in
+# every format, the library's codecs and the raster writers alike; a refused run keeps it.
+for x in pfm pgm tif asc flt; do
+  echo stale > "$dir/aux.$x.aux.xml"
+  expect_ok "a .$x output" "$dir/aux.$x" skyview "$h" --dirs 4 -o "$dir/aux.$x"
+  [ -e "$dir/aux.$x.aux.xml" ] && bad "a .$x output left its stale .aux.xml" || ok "a .$x output removed its stale .aux.xml"
+done
+cp "$h" "$dir/auxin.pgm"; echo stale > "$dir/auxin.pgm.aux.xml"
+"$hfvis" skyview "$dir/auxin.pgm" -o "$dir/auxin.pgm" 2> /dev/null
+[ -s "$dir/auxin.pgm.aux.xml" ] && ok "a refused run keeps OUT.aux.xml" || bad "a refused run removed OUT.aux.xml"
 
 # --progress: plain lines with percent and ETA, and the summary line.
 if "$hfvis" skyview "$h" --dirs 16 --progress -o "$dir/pr.pfm" > "$dir/stdout" 2> "$dir/stderr" &&
@@ -1360,6 +1370,21 @@ expect_fail "solar, a day, over --max-memory 1K" 1 solar "$dir/flat.pgm" --latit
 expect_fail "solar, 30 days, over --max-memory 1K" 1 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --start 2026-06-01 --end 2026-06-30 --max-memory 1K -o "$fdir/x.pfm"; m3=$(mib)
 awk -v a="$m1" -v b="$m3" 'BEGIN { exit !(a > 0 && b > 1.4 * a) }' &&
   ok "estimate: solar 30 days $m3 MiB > a day $m1 MiB (the sample-major copy)" || bad "estimate: solar 30 days '$m3' MiB not above a day '$m1' MiB"
+# band stacks: each output holds 4 bytes per cell and band, the library 32 bytes of sums per
+# cell and band: a year of day bands into three outputs on 100 x 100 cells needs at least
+# 10^4 x 365 x (32 + 3 x 4) bytes = 153 MiB
+expect_fail "solar, a year of day bands, 3 outputs, over --max-memory 1K" 1 solar "$dir/big.pgm" --latitude 46 --longitude 15 --start 2026-01-01 --end 2026-12-31 --bands day --max-memory 1K -o "$fdir/x.tif" --beam "$fdir/y.tif" --diffuse "$fdir/z.tif"; m3=$(mib)
+awk -v b="$m3" 'BEGIN { exit !(b >= 153 && b < 250) }' &&
+  ok "estimate: a year of day bands into 3 outputs $m3 MiB (>= 153)" || bad "estimate: a year of day bands into 3 outputs '$m3' MiB, want >= 153"
+# and the automatic thread count follows it: 90 day bands into 3 outputs, about 42 MiB, keep
+# one thread under --max-memory 80M (a thread's scratch counts as a whole run's)
+"$hfvis" solar "$dir/big.pgm" --cell 1 --latitude 46 --longitude 15 --start 2026-01-01 --end 2026-03-31 --bands day --dirs 8 --max-memory 0 --progress -o "$dir/sbt.tif" --beam "$dir/sbt2.tif" --diffuse "$dir/sbt3.tif" > /dev/null 2> "$dir/stderr"
+if grep -q '^solar: estimate .*, 1 thread$' "$dir/stderr"; then ok "solar threads under --max-memory: skipped (one core)"
+else
+  "$hfvis" solar "$dir/big.pgm" --cell 1 --latitude 46 --longitude 15 --start 2026-01-01 --end 2026-03-31 --bands day --dirs 8 --max-memory 80M --progress -o "$dir/sbt.tif" --beam "$dir/sbt2.tif" --diffuse "$dir/sbt3.tif" > /dev/null 2> "$dir/stderr"
+  grep -q '^solar: estimate 4[0-9.]* MiB, .*, 1 thread$' "$dir/stderr" && ok "solar: the band stack keeps one thread under --max-memory 80M" ||
+    bad "solar threads under --max-memory 80M: $(grep estimate "$dir/stderr")"
+fi
 expect_fail "solar: latitude without longitude" 2 solar "$dir/flat.pgm" --latitude 46 --day 2026-06-21 -o "$fdir/x.pfm"
 expect_fail "solar: --time with a range" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --start 2026-06-01 --end 2026-06-02 --time 12:00 -o "$fdir/x.pfm"
 expect_fail "solar: --solar-time with --utc-offset" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --solar-time --utc-offset 1 -o "$fdir/x.pfm"
@@ -1425,8 +1450,102 @@ solar_tiles "per-cell sites, a day, --linke-map and --albedo-map" --day 2026-06-
 expect_ok "solar tiles: a piece with another albedo map" "$dir/stp_g_0_0_20_13.tif" solar "$dir/swin.asc" --day 2026-06-21 --threads 2 --linke-map "$dir/slk.pgm" --albedo-map "$dir/salb2.pfm" --max-distance 2000 --window 0,0,20,13 -o "$dir/stp_g_0_0_20_13.tif"
 expect_fail "solar tiles: mosaic refuses a piece made with another albedo map" 1 mosaic "$dir"/stp_g_*.tif -o "$fdir/x.tif"
 expect_fail "solar --window with a Linke map of another size" 1 solar "$dir/swin.asc" --day 2026-06-21 --max-distance 2000 --window 0,0,5,5 --linke-map "$dir/flat.pgm" -o "$fdir/x.tif"
+# the maps are read as IN is: GeoTIFF, ASC and EHdr (a window reads its cells of them), the same
+# floats as a PFM of them give the same outputs byte for byte; a map of several bands is refused
+expect_ok "solar maps: a Linke map (GeoTIFF)" "$dir/slk8.tif" skyview "$dir/swin.asc" --dirs 8 -o "$dir/slk8.tif"
+expect_ok "solar maps: the same Linke map (PFM)" "$dir/slk8.pfm" skyview "$dir/swin.asc" --dirs 8 -o "$dir/slk8.pfm"
+expect_ok "solar maps: an albedo map (ASC)" "$dir/salb16.asc" skyview "$dir/swin.asc" --dirs 16 -o "$dir/salb16.asc"
+expect_ok "solar maps: an albedo map (EHdr)" "$dir/salb16.flt" skyview "$dir/swin.asc" --dirs 16 -o "$dir/salb16.flt"
+expect_ok "solar with PFM maps" "$dir/smp.tif" solar "$dir/swin.asc" --day 2026-06-21 --dirs 8 --linke-map "$dir/slk8.pfm" --albedo-map "$dir/salb2.pfm" -o "$dir/smp.tif"
+expect_ok "solar with a GeoTIFF Linke map and an ASC albedo map" "$dir/smr.tif" solar "$dir/swin.asc" --day 2026-06-21 --dirs 8 --linke-map "$dir/slk8.tif" --albedo-map "$dir/salb16.asc" -o "$dir/smr.tif"
+cmp -s "$dir/smp.tif" "$dir/smr.tif" && ok "solar: GeoTIFF and ASC maps give the PFM maps' output byte for byte" || bad "solar: raster maps differ from the PFM maps"
+expect_ok "solar with an EHdr albedo map" "$dir/sme.tif" solar "$dir/swin.asc" --day 2026-06-21 --dirs 8 --linke-map "$dir/slk8.tif" --albedo-map "$dir/salb16.flt" -o "$dir/sme.tif"
+cmp -s "$dir/smp.tif" "$dir/sme.tif" && ok "solar: an EHdr map gives the PFM map's output byte for byte" || bad "solar: the EHdr map differs"
+solar_tiles "a day, a GeoTIFF Linke map and an ASC albedo map" --day 2026-06-21 --threads 2 --linke-map "$dir/slk8.tif" --albedo-map "$dir/salb16.asc"
+expect_ok "solar maps: a map of 3 bands" "$dir/slk3.tif" light "$dir/swin.asc" --env "$dir/env3.pfm" --dirs 4 -o "$dir/slk3.tif"
+expect_fail "solar: a Linke map of 3 bands" 1 solar "$dir/swin.asc" --day 2026-06-21 --dirs 8 --linke-map "$dir/slk3.tif" -o "$fdir/x.tif"
+grep -q '3 bands or channels' "$dir/stderr" && ok "solar: a map of several bands is refused as such" || bad "solar: 3-band map: $(cat "$dir/stderr")"
+expect_fail "solar --window with a GeoTIFF Linke map of another size" 1 solar "$dir/swin.asc" --day 2026-06-21 --max-distance 2000 --window 0,0,5,5 --linke-map "$dir/aux.tif" -o "$fdir/x.tif"
+printf 'not an image\n' > "$dir/smap.png"
+expect_fail "solar: a map that is no raster names the formats" 1 solar "$dir/swin.asc" --day 2026-06-21 --dirs 8 --albedo-map "$dir/smap.png" -o "$fdir/x.tif"
+grep -q 'GeoTIFF' "$dir/stderr" && ok "solar: the refusal of a map names the formats read" || bad "solar: map refusal: $(cat "$dir/stderr")"
 expect_fail "solar: bad --step" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --step 25h -o "$fdir/x.pfm"
 expect_fail "solar: bad --linke-monthly" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --linke-monthly 3,3 -o "$fdir/x.pfm"
+# --step takes its unit: a bare number (minutes? r.sun's hours?) is refused; --list-flags says so
+sol="solar --latitude 46 --longitude 15 --day 2026-06-21 --dirs 8"
+expect_fail "solar: --step 0.5 without a unit" 2 $sol "$dir/flat.pgm" --step 0.5 -o "$fdir/x.pfm"
+grep -q "no unit" "$dir/stderr" && ok "solar: a bare --step is refused for its missing unit" || bad "solar --step 0.5: $(cat "$dir/stderr")"
+expect_fail "solar: --step 24 without a unit" 2 $sol "$dir/flat.pgm" --step 24 -o "$fdir/x.pfm"
+expect_ok "solar --step 0.5h" "$dir/sst1.pfm" $sol "$dir/flat.pgm" --step 0.5h -o "$dir/sst1.pfm"
+expect_ok "solar --step 30m" "$dir/sst2.pfm" $sol "$dir/flat.pgm" --step 30m -o "$dir/sst2.pfm"
+cmp -s "$dir/sst1.pfm" "$dir/sst2.pfm" && ok "solar: --step 0.5h = --step 30m" || bad "solar: --step 0.5h differs from 30m"
+"$hfvis" --list-flags solar | grep -q "^--step	S	solar	duration	(0,24]	15m	hours (m or h required)$" &&
+  ok "--list-flags: --step's unit is required" || bad "--list-flags --step: $("$hfvis" --list-flags solar | grep '^--step')"
+# dates: --start needs --end, --day takes none, a four-digit year within SPA's -2000..6000
+sdate="solar --latitude 46 --longitude 15 --dirs 4"
+expect_fail "solar: --start without --end" 2 $sdate "$dir/flat.pgm" --start 2026-06-01 -o "$fdir/x.pfm"
+expect_fail "solar: --day with --end" 2 $sdate "$dir/flat.pgm" --day 2026-06-01 --end 2026-06-03 -o "$fdir/x.pfm"
+expect_fail "solar: --day with --start" 2 $sdate "$dir/flat.pgm" --day 2026-06-01 --start 2026-06-01 --end 2026-06-03 -o "$fdir/x.pfm"
+expect_fail "solar: --end alone" 2 $sdate "$dir/flat.pgm" --end 2026-06-03 -o "$fdir/x.pfm"
+expect_fail "solar: a two-digit year" 2 $sdate "$dir/flat.pgm" --day 26-06-21 -o "$fdir/x.pfm"
+expect_fail "solar: a one-digit month" 2 $sdate "$dir/flat.pgm" --day 2026-6-21 -o "$fdir/x.pfm"
+expect_fail "solar: a year past SPA's 6000" 2 $sdate "$dir/flat.pgm" --day 9999-06-21 -o "$fdir/x.pfm"
+grep -q -- "-2000 to 6000" "$dir/stderr" && ok "solar: the refusal of the year 9999 names SPA's years" || bad "solar --day 9999: $(cat "$dir/stderr")"
+expect_fail "solar: a year before SPA's -2000" 2 $sdate "$dir/flat.pgm" --day -2001-06-21 -o "$fdir/x.pfm"
+expect_ok "solar: the year -500" "$dir/sneg.pfm" $sdate "$dir/flat.pgm" --day -0500-06-21 -o "$dir/sneg.pfm"
+# the days of a range counted in the library's calendar (Julian leap years through 1582): 1500 is
+# a leap year there, so 1500-02-28 .. 1500-03-01 is 3 days (3 day bands, February and March),
+# 1700 is not (2 days); a range across the reform's missing days is refused
+expect_ok "solar: 1500-02-28 to 1500-03-01 by day" "$dir/sjul.pfm" $sdate "$dir/flat.pgm" --start 1500-02-28 --end 1500-03-01 --bands day -o "$dir/sjul.pfm"
+expect_line2 "solar: 1500-02-28 to 1500-03-01 is 3 days (Julian leap year)" "$dir/sjul.pfm" "8 18"
+expect_ok "solar: 1500-02-28 to 1500-03-01 by month" "$dir/sjulm.pfm" $sdate "$dir/flat.pgm" --start 1500-02-28 --end 1500-03-01 --bands month -o "$dir/sjulm.pfm"
+expect_line2 "solar: 1500-02-28 to 1500-03-01 reaches March" "$dir/sjulm.pfm" "8 12"
+expect_ok "solar: 1700-02-28 to 1700-03-01 by day" "$dir/sgreg.pfm" $sdate "$dir/flat.pgm" --start 1700-02-28 --end 1700-03-01 --bands day -o "$dir/sgreg.pfm"
+expect_line2 "solar: 1700-02-28 to 1700-03-01 is 2 days (Gregorian)" "$dir/sgreg.pfm" "8 12"
+expect_ok "solar: 1582-12-30 to 1583-01-02 by day" "$dir/sjg.pfm" $sdate "$dir/flat.pgm" --start 1582-12-30 --end 1583-01-02 --bands day -o "$dir/sjg.pfm"
+expect_line2 "solar: 1582-12-30 to 1583-01-02 is 4 days" "$dir/sjg.pfm" "8 24"
+expect_fail "solar: a range across the Gregorian reform" 2 $sdate "$dir/flat.pgm" --start 1582-10-01 --end 1582-10-20 -o "$fdir/x.pfm"
+expect_fail "solar: a day the reform skipped" 2 $sdate "$dir/flat.pgm" --day 1582-10-10 -o "$fdir/x.pfm"
+# one source of the Linke factor and of the albedo
+expect_fail "solar: --linke with --linke-monthly" 2 $sol "$dir/flat.pgm" --linke 3 --linke-monthly 2,2,3,3,4,4,4,4,3,3,2,2 -o "$fdir/x.pfm"
+expect_fail "solar: --linke with --linke-map" 2 $sol "$dir/flat.pgm" --linke 3 --linke-map "$dir/alb51.pgm" -o "$fdir/x.pfm"
+expect_fail "solar: --linke-monthly with --linke-map" 2 $sol "$dir/flat.pgm" --linke-monthly 2,2,3,3,4,4,4,4,3,3,2,2 --linke-map "$dir/alb51.pgm" -o "$fdir/x.pfm"
+expect_fail "solar: --albedo with --albedo-map" 2 $sol "$dir/flat.pgm" --albedo 0.3 --albedo-map "$dir/alb51.pgm" -o "$fdir/x.pfm"
+# every output against every input (IN, --albedo-map, --linke-map) unless --overwrite, and no
+# two outputs one file (or one ASC/EHdr sidecar) ever: the refusals leave every file as it was
+"$hfvis" skyview "$dir/flat.pgm" --dirs 4 --quiet -o "$dir/sin.pfm"; cp "$dir/sin.pfm" "$dir/sin_copy.pfm"
+"$hfvis" skyview "$dir/flat.pgm" --dirs 4 --quiet -o "$dir/smap.pfm"; cp "$dir/smap.pfm" "$dir/smap_copy.pfm"
+sol="solar --latitude 46 --longitude 15 --day 2026-06-21 --dirs 8"
+expect_fail "solar: --beam is IN" 1 $sol "$dir/sin.pfm" -o "$fdir/x.pfm" --beam "$dir/sin.pfm"
+expect_fail "solar: --sun-hours is IN" 1 $sol "$dir/sin.pfm" -o "$fdir/x.pfm" --sun-hours "$dir/sin.pfm"
+expect_fail "solar: -o is the --linke-map" 1 $sol "$dir/sin.pfm" --linke-map "$dir/smap.pfm" -o "$dir/smap.pfm"
+expect_fail "solar: --diffuse is the --albedo-map" 1 $sol "$dir/sin.pfm" --albedo-map "$dir/smap.pfm" -o "$fdir/x.pfm" --diffuse "$dir/smap.pfm"
+expect_fail "solar: --reflected is the --linke-map" 1 $sol "$dir/sin.pfm" --linke-map "$dir/smap.pfm" -o "$fdir/x.pfm" --reflected "$dir/smap.pfm"
+cmp -s "$dir/sin.pfm" "$dir/sin_copy.pfm" && cmp -s "$dir/smap.pfm" "$dir/smap_copy.pfm" &&
+  ok "solar: refused outputs leave IN and the maps intact" || bad "solar: an input changed"
+expect_fail "solar: -o, --beam and --diffuse one file" 2 $sol "$dir/flat.pgm" -o "$fdir/x.tif" --beam "$fdir/x.tif" --diffuse "$fdir/x.tif"
+expect_fail "solar: --beam and --sun-hours one file by another spelling" 2 $sol "$dir/flat.pgm" -o "$fdir/x.tif" --beam "$fdir/b.pfm" --sun-hours "$fdir/./b.pfm"
+echo old > "$dir/sold_out.pfm"; ln -s "$dir/sold_out.pfm" "$dir/sold_link.pfm" 2> /dev/null
+if [ -L "$dir/sold_link.pfm" ]; then expect_fail "solar: -o and --beam one file through a symbolic link" 2 $sol "$dir/flat.pgm" -o "$dir/sold_out.pfm" --beam "$dir/sold_link.pfm"
+  [ "$(cat "$dir/sold_out.pfm")" = old ] && ok "solar: the shared output left as it was" || bad "solar: the shared output was replaced"
+else ok "solar outputs through a link: skipped (no ln -s)"; fi
+expect_fail "solar: an .asc and a .bil output share their .prj" 2 $sol "$dir/flat.pgm" -o "$fdir/x.bil" --beam "$fdir/x.asc"
+expect_fail "solar: --overwrite does not let two outputs share a file" 2 $sol "$dir/flat.pgm" --overwrite -o "$fdir/x.pfm" --beam "$fdir/x.pfm"
+cp "$dir/sin.pfm" "$dir/sin_ow.pfm"
+expect_ok "solar --overwrite: --beam may replace IN" "$dir/sow_g.pfm" $sol "$dir/sin_ow.pfm" --overwrite --beam "$dir/sin_ow.pfm" -o "$dir/sow_g.pfm"
+cmp -s "$dir/sin_ow.pfm" "$dir/sin.pfm" && bad "solar --overwrite: IN not replaced by --beam" || ok "solar --overwrite: IN replaced by --beam"
+# what can be known to fail is refused before the run (an ASC output of several bands, an output
+# in a directory that does not exist), and OUT is written last: a failing extra output (here a
+# directory in its place) leaves it as it was
+echo old > "$dir/skeep.tif"
+expect_fail "solar: --sun-hours in a directory that does not exist" 1 $sol "$dir/flat.pgm" -o "$dir/skeep.tif" --sun-hours "$dir/no/such/dir/h.tif"
+expect_fail "solar: an .asc output of month bands" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --start 2026-01-30 --end 2026-02-02 --bands month --dirs 8 -o "$dir/skeep.tif" --sun-hours "$fdir/h.asc"
+expect_fail "solar: -o .asc of day bands" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --start 2026-01-30 --end 2026-02-02 --bands day --dirs 8 -o "$fdir/g.asc"
+expect_fail "a skyview OUT in a directory that does not exist" 1 skyview "$dir/flat.pgm" -o "$dir/no/such/dir/x.pfm"
+mkdir -p "$dir/sdir.tif"
+expect_fail "solar: --sun-hours that cannot be written (a directory)" 1 $sol "$dir/flat.pgm" -o "$dir/skeep.tif" --sun-hours "$dir/sdir.tif"
+[ "$(cat "$dir/skeep.tif")" = old ] && ok "solar: failing outputs leave OUT untouched" || bad "solar: OUT replaced by a run that failed"
+expect_ok "solar: an .asc output of one band" "$dir/s1.asc" $sol "$dir/flat.pgm" -o "$dir/s1.asc"
 
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"

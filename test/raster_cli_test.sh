@@ -199,6 +199,12 @@ if command -v gdal_translate > /dev/null 2>&1 && command -v gdalinfo > /dev/null
     grep -q 'Type=Byte' "$dir/vs.info" && grep -q 'NoData Value=2$' "$dir/vs.info" && grep -q 'STATISTICS_MAXIMUM=1$' "$dir/vs.info" \
       && grep -q 'STATISTICS_MINIMUM=0$' "$dir/vs.info" && ok "viewshed GeoTIFF: Byte, values 0..1, NoData 2" \
       || bad "viewshed GeoTIFF: $(grep -E 'Type|NoData|STATISTICS_M' "$dir/vs.info")"
+    # gdalinfo -stats left vs.tif.aux.xml with the statistics of these values: a new vs.tif
+    # removes it (GDAL would show the old statistics beside the new values)
+    if [ -f "$dir/vs.tif.aux.xml" ] && run "viewshed -> tif again" viewshed "$dir/dem.asc" --observer-grid 5,5 -o "$dir/vs.tif"; then
+      [ -e "$dir/vs.tif.aux.xml" ] && bad "the stale vs.tif.aux.xml of gdalinfo -stats was left" \
+        || ok "a new vs.tif removes the vs.tif.aux.xml of gdalinfo -stats"
+    else echo "SKIP gdalinfo -stats wrote no .aux.xml"; fi
   fi
   # solar's site from the CRS of GDAL-written GeoTIFFs: NAD83 and NAD83(2011) UTM by their EPSG
   # codes, a custom Transverse Mercator by its projection GeoKeys (the centre against
@@ -226,6 +232,16 @@ if command -v gdal_translate > /dev/null 2>&1 && command -v gdalinfo > /dev/null
   else
     echo "SKIP gdaltransform: not installed"
   fi
+  # solar's --linke-map and --albedo-map read as IN is: GDAL's GeoTIFFs (LZW, tiled; DEFLATE with
+  # the floating-point predictor) give the ASC maps' output byte for byte
+  awk 'NR <= 6 { print; next } { s = ""; for (i = 1; i <= NF; i++) s = s " " (i % 3 ? 2.5 : 3.25); print s }' "$dir/dem.asc" > "$dir/lk.asc"
+  awk 'NR <= 6 { print; next } { s = ""; for (i = 1; i <= NF; i++) s = s " " (i % 2 ? 0.125 : 0.5); print s }' "$dir/dem.asc" > "$dir/al.asc"
+  cp "$dir/dem.prj" "$dir/lk.prj"; cp "$dir/dem.prj" "$dir/al.prj"
+  gt -ot Float32 -co COMPRESS=LZW -co TILED=YES -co BLOCKXSIZE=16 -co BLOCKYSIZE=16 "$dir/lk.asc" "$dir/lk.tif"
+  gt -ot Float32 -co COMPRESS=DEFLATE -co PREDICTOR=3 "$dir/al.asc" "$dir/al.tif"
+  run "solar, ASC maps" solar "$dir/dem.asc" --day 2026-06-21 --dirs 8 --linke-map "$dir/lk.asc" --albedo-map "$dir/al.asc" -o "$dir/sm_asc.tif" &&
+    run "solar, GDAL's GeoTIFF maps" solar "$dir/dem.asc" --day 2026-06-21 --dirs 8 --linke-map "$dir/lk.tif" --albedo-map "$dir/al.tif" -o "$dir/sm_tif.tif" &&
+    same "solar: GDAL's GeoTIFF Linke and albedo maps = the ASC maps" "$dir/sm_asc.tif" "$dir/sm_tif.tif"
 else
   echo "SKIP gdal: gdal_translate/gdalinfo not installed"
 fi

@@ -143,6 +143,7 @@ typedef struct cli_args {
     /* solar (solar.c): dates, times, atmosphere, site, extra outputs (beam, diffuse, reflected,
      * sun hours) */
     int sol_y, sol_m, sol_d, sol_ey, sol_em, sol_ed, sol_has_start, sol_has_end;
+    int sol_has_day, sol_has_range_start; /* which of --day and --start set sol_y/m/d (sol_has_start) */
     int sol_instant, sol_solar_time, sol_has_lat, sol_has_lon, sol_has_offset, sol_has_linke;
     int sol_has_linke_monthly, sol_bands, sol_horizons, sol_normals, sol_has_zrange;
     double sol_hour, sol_step, sol_lat, sol_lon, sol_offset, sol_linke, sol_linke_monthly[12];
@@ -360,6 +361,7 @@ static int cli_run_azimuths(const cli_args *a);
 static void cli_on_temp(void *user, const char *tmp);
 static void cli_on_signal(int sig);
 static void cli_signals(void);
+static void cli_drop_aux(const char *path);
 static hfvis_status cli_write(const char *path, unsigned char *bytes, size_t n, hfvis_status s);
 static hfvis_status cli_write_encoded(const char *path, size_t need, cli_encoder encode, const void *what);
 static hfvis_status cli_enc_binvox(const void *what, void *out, size_t cap, size_t *written);
@@ -379,6 +381,9 @@ static int cli_save(const cli_args *a, cli_output out);
 static int cli_same_file(const char *x, const char *y);
 static int cli_refuse_input(int overwrite, const char *out, const char *const *inputs, int n);
 static int cli_refuse_inputs(const cli_args *a, const char *out);
+static int cli_same_path(const char *x, const char *y);
+static int cli_refuse_unwritable(const char *path);
+static int cli_refuse_outputs(const cli_args *a);
 /* run.c */
 static cli_cost cli_cost_of(double bytes, double work, const char *unit);
 static cli_cost cli_sweep_cost(const cli_args *a, int w, int h, double out, double ch, double cell_bytes,
@@ -489,9 +494,11 @@ static int cli_mosaic(int argc, char **argv);
 static int cli_mosaic_pieces(int argc, char **argv, const char **names);
 /* solar.c */
 static int cli_solar_date(const char *f, const char *v, int *y, int *m, int *d);
+static long cli_solar_civil_days(int y, int m, int d, int gregorian);
 static long cli_solar_day_number(int y, int m, int d);
 static int cli_set_solar(cli_args *a, const char *f, const char *v);
 static int cli_solar_days(const cli_args *a);
+static int cli_solar_band_count(const cli_args *a);
 static int cli_check_solar(const cli_args *a);
 static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts);
 /* main.c */

@@ -62,7 +62,7 @@ enum {
     CLI_V_LIST,   /* numbers joined by ',', ':' or 'x' (pairs, points, windows, sizes) */
     CLI_V_DATE,   /* a date or a time of day */
     CLI_V_BYTES,  /* a size in bytes with an optional K, M, G or T */
-    CLI_V_DURATION /* hours: a number with m (minutes, also without a suffix) or h */
+    CLI_V_DURATION /* hours: a number with its unit, m (minutes) or h (hours); a bare number refused */
 };
 static const char *const cli_kind_names[] = {"-", "int", "real", "text", "choice", "list", "date",
                                              "bytes", "duration"};
@@ -229,7 +229,8 @@ static const cli_flag cli_flags[] = {
     { "--overwrite", NULL, CLI_OUT,
       CLI_SWITCH,
       "allow OUT to be one of the inputs (refused otherwise: same file,\n"
-      "                    through hard and symbolic links too)\n" },
+      "                    through hard and symbolic links too); solar: each of its outputs.\n"
+      "                    Two outputs of one run never share a file (or an ASC/EHdr .prj)\n" },
     { "--max-memory", "B", CLI_RUNS,
       CLI_WORDS(CLI_V_BYTES, "half the physical memory"),
       "refuse a run whose estimated memory exceeds B bytes (suffix K, M, G or\n"
@@ -454,8 +455,8 @@ static const cli_flag cli_flags[] = {
     { "--time", "HH:MM", CLI_ONLY(CMD_SOLAR),
       CLI_TYPED(CLI_V_DATE), NULL },
     { "--step", "S", CLI_ONLY(CMD_SOLAR),
-      CLI_NUMBER(CLI_V_DURATION, 0.0, 1, 24.0, "a step in (0, 24h] like 15m or 1h", 0.0, "15m",
-                 "hours", sol_step, 0, NULL, NULL), NULL },
+      CLI_NUMBER(CLI_V_DURATION, 0.0, 1, 24.0, "a step in (0, 24h] with its unit, like 15m or 0.5h", 0.0,
+                 "15m", "hours (m or h required)", sol_step, 0, NULL, NULL), NULL },
     { "--linke", "L", CLI_ONLY(CMD_SOLAR),
       CLI_REAL_AT(0.0, 1, 10.0, "a Linke turbidity factor in (0, 10]", 0.0, "3", NULL, sol_linke,
                   CLI_HAS(sol_has_linke)), NULL },
@@ -529,7 +530,8 @@ static void cli_flag_defaults(cli_args *a)
 }
 
 /* A numeric flag from its row (row->at != 0): v parsed as the row's kind (a duration: a number of
- * minutes with an optional m, or of hours with h, stored in hours), checked against [lo, hi] (lo
+ * minutes with m or of hours with h, stored in hours; a bare number is refused, as its unit
+ * would be a guess), checked against [lo, hi] (lo
  * excluded when lo_open), stored in the row's cli_args field, its has_ field set, then its hook
  * run; the row's word, if any, is taken instead of a number (the field keeps its default). Returns
  * 0 or CLI_EXIT_USAGE ("expected <rule>, got '<v>'", naming the flag). */
@@ -549,7 +551,14 @@ static int cli_set_number(cli_args *a, const cli_flag *row, const char *v)
         if (n == 0 || n >= sizeof buf)
             return cli_error(CLI_EXIT_USAGE, row->name, "expected %s, got '%s'", row->rule, v);
         memcpy(buf, v, n + 1);
-        if (buf[n - 1] == 'm' || buf[n - 1] == 'h') scale = buf[n - 1] == 'h' ? 1.0 : scale, buf[n - 1] = '\0';
+        if (buf[n - 1] != 'm' && buf[n - 1] != 'h') {
+            if (cli_parse_real(buf, &x))
+                return cli_error(CLI_EXIT_USAGE, row->name, "'%s' has no unit: give minutes or hours, like "
+                                 "%sm or %sh (range (0, 24h])", v, v, v);
+            return cli_error(CLI_EXIT_USAGE, row->name, "expected %s, got '%s'", row->rule, v);
+        }
+        if (buf[n - 1] == 'h') scale = 1.0;
+        buf[n - 1] = '\0';
         if (!cli_parse_real(buf, &x))
             return cli_error(CLI_EXIT_USAGE, row->name, "expected %s, got '%s'", row->rule, v);
         x *= scale;

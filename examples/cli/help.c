@@ -47,50 +47,50 @@
 
 #define CLI_SOLAR_HELP                                                                              \
     "usage: hfvis solar DEM --day YYYY-MM-DD | --start DATE --end DATE [--step 15m] [--time HH:MM]\n" \
-    "         [--linke L | --linke-monthly L1,...,L12 | --linke-map L.pfm] [--albedo A |\n"          \
-    "         --albedo-map A.pfm] -o GLOBAL [--beam B] [--diffuse D] [--reflected R]\n"             \
-    "         [--sun-hours H] [--latitude DEG --longitude DEG] [--utc-offset H | --solar-time]\n"    \
-    "         [--bands day|month] [--normals central|horn] [--sun-radius DEG] [--dirs K]\n"     \
-    "         [--max-distance R [--window X0,Y0,W,H]] [--height-range LO,HI]\n"                  \
-    "         [--horizons exact|near-far|lattice]\n"                                              \
+    "         [--linke L | --linke-monthly L1,...,L12 | --linke-map MAP] [--albedo A |\n"           \
+    "         --albedo-map MAP] -o GLOBAL [--beam B] [--diffuse D] [--reflected R]\n"               \
+    "         [--sun-hours H] [--latitude DEG --longitude DEG] [--utc-offset H | --solar-time]\n"   \
+    "         [--bands day|month] [--normals central|horn] [--sun-radius DEG] [--dirs K]\n"         \
+    "         [--max-distance R [--window X0,Y0,W,H]] [--height-range LO,HI]\n"                     \
+    "         [--horizons exact|near-far|lattice]\n"                                                \
     "Clear-sky solar irradiation (Wh/m^2) of a day or a date range, or irradiance (W/m^2) at\n"     \
     "--time, on every cell: r.sun's ESRA atmosphere (Suri & Hofierka 2004), the sun from NREL's\n"  \
     "SPA (Reda & Andreas 2004/2008), the beam shaded by exact horizons (docs/solar.md).\n"          \
-    "  --day DATE        one day (local civil day; --time HH:MM: that instant)\n"                   \
-    "  --start, --end    a date range, both days included\n"                                        \
-    "  --step S          time step: 15m (default), 1h, 0.5h; a bare number is minutes\n"            \
-    "  --linke L         Linke turbidity, (0, 10] (default 3); --linke-monthly: 12 values from\n"   \
-    "                    January; --linke-map: a PFM/PGM of the DEM's size\n"                       \
-    "  --albedo A        ground albedo, [0, 1] (default 0.2); --albedo-map: per cell\n"             \
-    "  -o GLOBAL         global irradiation; --beam, --diffuse, --reflected, --sun-hours write\n"    \
-    "                    the parts and the hours of direct sun (.pfm, .tif, .asc, .bil, .flt)\n"    \
-    "  --latitude, --longitude  the site in degrees (east positive); default: the centre of a\n"    \
-    "                    raster in a Transverse Mercator CRS (UTM EPSG 326zz/327zz/258zz/269zz/\n"   \
-    "                    6330-6348, or its parameters in GeoTIFF keys or a WKT), by the inverse\n"  \
-    "                    projection; else an error\n"                                              \
+    "  --day DATE        one day, YYYY-MM-DD (local civil day; --time HH:MM: that instant); years\n" \
+    "                    -2000..6000 (SPA's; -YYYY before 0), Julian calendar before 1582-10-15\n"  \
+    "  --start, --end    a date range, both days included (not across 1582-10-04/15); --start\n"    \
+    "                    needs --end, --day takes none\n"                                           \
+    "  --step S          time step with its unit, m or h: 15m (default), 0.5h, 1h; (0, 24h]\n"      \
+    "  --linke L         Linke turbidity, (0, 10] (default 3); or --linke-monthly: 12 values\n"     \
+    "                    from January; or --linke-map: per cell, a map of the DEM's size: GeoTIFF,\n" \
+    "                    ASC, EHdr (.bil/.flt), PFM or PGM (values / maxval), one band\n"           \
+    "  --albedo A        ground albedo, [0, 1] (default 0.2); or --albedo-map: per cell, a map\n"   \
+    "  -o GLOBAL         global irradiation; --beam, --diffuse, --reflected, --sun-hours write\n"   \
+    "                    the parts and the hours of direct sun (.pfm, .tif, .asc, .bil, .flt);\n"   \
+    "                    none may be IN or a map (unless --overwrite), no two one file\n"           \
+    "  --latitude, --longitude  the site in degrees (east positive); default: each cell's, by\n"    \
+    "                    the inverse projection of a Transverse Mercator CRS (UTM by EPSG code,\n"  \
+    "                    or its parameters in GeoTIFF keys or a WKT)\n"                            \
     "  --utc-offset H    dates and --time are UTC + H (default 0); --solar-time: local solar time\n" \
     "                    and r.sun's solar geometry and steps (r.sun's convention)\n"               \
     "  --bands day|month one band per day or per calendar month, stacked like horizon planes\n"     \
-    "  --normals N       the cells' surface normals: central (default): central differences;\n"    \
-    "                    horn: Horn's 3x3 stencil, as r.slope.aspect and gdaldem slope/aspect\n"   \
-    "                    (what r.sun reads; central differences on the outer ring and next to\n"   \
-    "                    holes)\n"                                                               \
+    "                    (--max-memory counts 32 bytes of sums and 4 per output a cell and band)\n" \
+    "  --normals N       central (default): central differences; horn: Horn's 3x3 stencil, as\n"    \
+    "                    r.slope.aspect and gdaldem (what r.sun reads)\n"                           \
     "  --sun-radius DEG  shade the sun's disc (default: its centre); --dirs K: directions of the\n" \
-    "                    exact horizon map (default 64; --dirs 16 makes a day about 5x faster,\n"  \
-    "                    mean global within 0.2 % of the oracle: docs/solar.md \"Directions\")\n"   \
-    "  --horizons H      the horizons that shade: exact (default), near-far (exact within 8\n"     \
-    "                    cells, a shared far field beyond: about 0.6x the map's time) or lattice\n" \
-    "                    ([P1] lattice horizons: about 4x faster, misses shadow next to one-cell\n"  \
-    "                    walls and cliffs; docs/solar.md \"Horizon modes\")\n"                     \
-    "  --max-distance R  the horizons' search radius; the pressure nodes then span IN's whole\n"  \
-    "                    height range (read by strips), so that --window X0,Y0,W,H pieces (each\n" \
-    "                    output its own, with the per-cell sites and suns of the whole raster)\n"  \
-    "                    join with 'hfvis mosaic' into the whole run's rasters bit for bit\n"      \
-    "                    (docs/tiles.md; a window reads its cells of the maps)\n"                 \
-    "  --height-range LO,HI  the pressure nodes' span instead (heights after --zscale): no pass\n" \
-    "                    over IN, so each --window reads only its cells and halo; every height\n" \
-    "                    read must lie in it, and the pieces of one run must share it\n"         \
-    "Polar night gives 0. With --progress the site's latitude and longitude go to stderr.\n"
+    "                    horizon map (default 64; 16: a day about 5x faster, within 0.2 %)\n"       \
+    "  --horizons H      exact (default), near-far (exact within 8 cells: about 0.6x the map's\n"   \
+    "                    time) or lattice ([P1]: about 4x faster, misses one-cell walls' shadow)\n" \
+    "  --max-distance R  the horizons' search radius: --window X0,Y0,W,H pieces (each output\n"     \
+    "                    its own) join with 'hfvis mosaic' into the whole run bit for bit\n"        \
+    "                    (docs/tiles.md; IN's height range is read by strips first)\n"              \
+    "  --height-range LO,HI  that height range given instead (after --zscale): every height\n"      \
+    "                    read must lie in it, and the pieces of one run must share it\n"            \
+    "Polar night gives 0. With --progress the site's latitude and longitude go to stderr.\n"        \
+    "Refused before the run: an output that is an input or another output's file, an .asc\n"        \
+    "output of more than one band, an output whose directory does not exist or cannot be\n"         \
+    "written. The outputs are written after the run, -o GLOBAL last: when a write fails, OUT\n"     \
+    "is then left untouched (the extra outputs written before it stay replaced).\n"
 
 #define CLI_VF_HELP                                                                                  \
     "usage: hfvis visfield MESH.obj -o FIELD.hfvf [--positions K] [--dirs D] [--format F]\n"        \
@@ -265,7 +265,8 @@ static const char cli_help_tail[] =
     "OUT is written to a temporary file beside it and renamed onto it: a symbolic link named\n"
     "OUT is replaced by the file (write to the link's target to keep the link); an interrupt\n"
     "(SIGINT, SIGTERM, SIGHUP) removes the temporary file; past a file-size limit (ulimit -f)\n"
-    "the write fails as on a full disk.\n"
+    "the write fails as on a full disk. Once OUT is replaced, OUT.aux.xml (the statistics GDAL\n"
+    "and QGIS keep beside a raster) is removed, as GDAL does when it recreates a file.\n"
     "Exit status: 0 = OUT is complete, 1 = error, 2 = usage error; an error is one line\n"
     "\"hfvis: <what>: <why>\" on stderr, and OUT is then left untouched.\n";
 
@@ -347,7 +348,8 @@ static const char cli_help_tail[] =
     "L_(b+1) = EMIT + A*(D + I[L_b]). Lambertian radiance: an open flat receiver under a sky C\n" \
     "with albedo A returns A*C. Default: no sun, sky 1, albedo 1, one bounce.\n" \
     "  --albedo A            constant albedo, >= 0 (default 1)\n" \
-    "  --albedo-map MAP      per-sample albedo, a map of IN's size (instead of --albedo)\n" \
+    "  --albedo-map MAP      per-sample albedo, a map of IN's size (instead of --albedo): GeoTIFF,\n" \
+    "                        ASC, EHdr (.bil/.flt), PFM or PGM (values / maxval)\n" \
     "  --bounces B           interreflection bounces, 0..1000 (default 1); one sweep each\n" \
     "  --sun-azimuth DEG     the sun's azimuth: the --convention's, compass by default\n" \
     "  --sun-elevation DEG   sun elevation above the horizontal, -90..90 (with --sun-azimuth)\n" \

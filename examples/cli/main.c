@@ -108,7 +108,7 @@ int main(int argc, char **argv)
     if (rc != CLI_RUN) return rc;
     a.run = &run;
     if ((rc = cli_gis_finish(&a)) != 0) return rc;
-    if ((rc = cli_refuse_inputs(&a, a.out)) != 0) return rc;
+    if ((rc = cli_refuse_outputs(&a)) != 0) return rc;
     if ((cli_commands[a.cmd].io & CLI_COST_FIRST) && (rc = cli_check_cost(&a, 0, 0, 1)) != 0) return rc;
     rc = cli_commands[a.cmd].run(&a);
     ex_georef_free(&run.geo);

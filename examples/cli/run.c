@@ -63,15 +63,31 @@ static cli_cost cli_estimate_indirect(const cli_args *a, int w, int h, int chann
     c.work *= (double)(a->bounces + 1);
     return c;
 }
-/* solar: the map of K directions (64 unless --dirs), its sample-major copy only where the
- * sector sums or the step loop read one (a period of --start/--end, a Linke map; a day's path
- * reads the map as made), state, outputs, the map's sweeps */
+/* solar (hfvis.h, hfvis_solar_irradiation's "Memory"; docs/solar.md): per cell the heights, the
+ * map of K directions (64 unless --dirs), its sample-major copy only where the sector sums or
+ * the step loop read one (a period of --start/--end, a Linke map; a day's path reads the map as
+ * made), 120 bytes of state, 4 doubles of sums per band, 4 bytes per band of each output (-o,
+ * --beam, --diffuse, --reflected, --sun-hours), the per-cell sites (16 bytes) and the Linke and
+ * albedo maps; per run the sector sums' steps (about 350 bytes per step: 12 MB a year)
+ * and the per-cell sites' hourly table (1 KB per day); the work, the map's sweeps. */
 static cli_cost cli_estimate_solar(const cli_args *a, int w, int h, int channels)
 {
     double n = (double)w * (double)h, K = a->has_dirs ? (double)a->dirs : 64.0;
     double copy = a->sol_has_end || a->sol_linke_map ? 4.0 * K : 0.0;
+    double bands = (double)cli_solar_band_count(a), days = (double)cli_solar_days(a), outs = 0.0, cell, run = 0.0;
+    int k;
     (void)channels;
-    return cli_cost_of(n * (4.0 * K + copy + 160.0 + 20.0), K * 16.0 * n, "ray crossings");
+    if (bands < 1.0) bands = 1.0; /* dates the check refuses: never run */
+    if (days < 1.0) days = 1.0;
+    if (a->out) outs += 1.0;
+    for (k = 0; k < 4; k++)
+        if (a->sol_out[k]) outs += 1.0;
+    cell = 4.0 + 4.0 * K + copy + 120.0 + 32.0 * bands + 4.0 * bands * outs;
+    if (!a->sol_has_lat) cell += 16.0, run += 1024.0 * days;
+    if (a->sol_linke_map) cell += 4.0;
+    if (a->albedo_map) cell += 4.0;
+    if (a->sol_has_end) run += 350.0 * days * 24.0 / (a->sol_step > 0.0 ? a->sol_step : 0.25);
+    return cli_cost_of(n * cell + run, K * 16.0 * n, "ray crossings");
 }
 /* viewshed: the grid and its output; one line of sight per edge cell */
 static cli_cost cli_estimate_viewshed(const cli_args *a, int w, int h, int channels)
@@ -121,9 +137,9 @@ static cli_cost cli_estimate_meshao(const cli_args *a, int w, int h, int channel
 }
 
 /* The channels of a height-field command's output, for the estimate before anything is loaded:
- * light has ENV's, indirect the most of ENV, --albedo-map and --emission (PGM or PFM: their
- * headers only are read), normals 3, the rest 1. A header that cannot be read counts 1; the
- * load reports it. */
+ * light has ENV's, indirect the most of ENV, --albedo-map and --emission (PGM, PFM or a
+ * raster's bands: their headers only are read), normals 3, the rest 1. A header that cannot be
+ * read counts 1; the load reports it. */
 static int cli_out_channels(const cli_args *a)
 {
     const char *maps[3] = {a->env, NULL, NULL};
@@ -132,7 +148,8 @@ static int cli_out_channels(const cli_args *a)
     if (a->cmd == CMD_INDIRECT) maps[1] = a->albedo_map, maps[2] = a->emission;
     for (i = 0; i < 3; i++) {
         ex_rio_reader r;
-        if (!maps[i] || ex_rio_open_netpbm(&r, maps[i]) != 0) continue;
+        if (!maps[i] || (ex_rio_format_of(maps[i]) ? ex_rio_open(&r, maps[i]) : ex_rio_open_netpbm(&r, maps[i])) != 0)
+            continue;
         if (r.bands > channels) channels = r.bands;
         ex_rio_close(&r);
     }

@@ -6,21 +6,47 @@
 
 #define CLI_SOLAR_MAX_DAYS 36600 /* hfvis_solar_irradiation's limit: a century */
 
-/* "YYYY-MM-DD" into y, m, d (the library checks that the date exists). */
+/* "YYYY-MM-DD" into y, m, d: a four-digit year (-YYYY before the year 0, astronomical
+ * numbering: 0000 is 1 BC) within SPA's years -2000..6000, two-digit month and day (the library
+ * checks that the date exists). */
 static int cli_solar_date(const char *f, const char *v, int *y, int *m, int *d)
 {
-    char tail;
-    if (sscanf(v, "%d-%d-%d%c", y, m, d, &tail) != 3)
-        return cli_error(CLI_EXIT_USAGE, f, "expected a date YYYY-MM-DD, got '%s'", v);
+    const char *p = v + (v[0] == '-');
+    int k;
+    for (k = 0; k < 10; k++) /* DDDD-DD-DD */
+        if (k == 4 || k == 7 ? p[k] != '-' : !isdigit((unsigned char)p[k])) break;
+    if (k < 10 || p[10] != '\0')
+        return cli_error(CLI_EXIT_USAGE, f, "expected a date YYYY-MM-DD (a four-digit year, -YYYY before the "
+                         "year 0), got '%s'", v);
+    *y = ((p[0] - '0') * 1000 + (p[1] - '0') * 100 + (p[2] - '0') * 10 + (p[3] - '0')) * (p == v ? 1 : -1);
+    *m = (p[5] - '0') * 10 + (p[6] - '0');
+    *d = (p[8] - '0') * 10 + (p[9] - '0');
+    if (*y < -2000 || *y > 6000)
+        return cli_error(CLI_EXIT_USAGE, f, "%s: the sun's position (SPA) is computed for the years -2000 to "
+                         "6000 only", v);
     return 0;
 }
 
-/* Days from 0000-03-01 of a proleptic Gregorian date (for --start/--end differences). */
+/* Days from 0000-03-01 of the Gregorian (or, gregorian 0, the Julian) calendar to y-m-d of it. */
+static long cli_solar_civil_days(int y, int m, int d, int gregorian)
+{
+    long yy = (long)y - (m < 3), doy = (153L * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1, era, yoe;
+    if (!gregorian) { /* a leap day every 4 years */
+        era = (yy >= 0 ? yy : yy - 3) / 4, yoe = yy - era * 4;
+        return era * 1461 + yoe * 365 + doy;
+    }
+    era = (yy >= 0 ? yy : yy - 399) / 400, yoe = yy - era * 400;
+    return era * 146097 + yoe * 365 + yoe / 4 - yoe / 100 + doy;
+}
+
+/* Days from 1583-01-01 of a date in the library's calendar (hfvis.c, hf_month_days and
+ * hf_date_add, which step the days of a range): the Julian calendar's leap years through 1582,
+ * the Gregorian calendar's from 1583, continuous across 1582-12-31 (for --start/--end
+ * differences; a range across the reform's missing days is refused, cli_check_solar). */
 static long cli_solar_day_number(int y, int m, int d)
 {
-    long yy = (long)y - (m < 3), era = (yy >= 0 ? yy : yy - 399) / 400, yoe = yy - era * 400;
-    long doy = (153L * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1, doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
-    return era * 146097 + doe;
+    const int gregorian = y >= 1583;
+    return cli_solar_civil_days(y, m, d, gregorian) - cli_solar_civil_days(1583, 1, 1, gregorian);
 }
 
 /* A choice flag's word: the i-th of words ("a|b|c") stores first + i in *out; else one error line
@@ -64,8 +90,13 @@ static int cli_parse_reals(const char *v, double *out, int n)
 
 static int cli_set_solar(cli_args *a, const char *f, const char *v)
 {
-    if (!strcmp(f, "--day") || !strcmp(f, "--start"))
-        return cli_solar_date(f, v, &a->sol_y, &a->sol_m, &a->sol_d) ? CLI_EXIT_USAGE : (a->sol_has_start = 1, 0);
+    if (!strcmp(f, "--day") || !strcmp(f, "--start")) {
+        if (cli_solar_date(f, v, &a->sol_y, &a->sol_m, &a->sol_d)) return CLI_EXIT_USAGE;
+        a->sol_has_start = 1;
+        if (f[2] == 'd') a->sol_has_day = 1;
+        else a->sol_has_range_start = 1;
+        return 0;
+    }
     if (!strcmp(f, "--end"))
         return cli_solar_date(f, v, &a->sol_ey, &a->sol_em, &a->sol_ed) ? CLI_EXIT_USAGE : (a->sol_has_end = 1, 0);
     if (!strcmp(f, "--time")) { /* HH:MM */
@@ -123,16 +154,66 @@ static int cli_solar_days(const cli_args *a)
                  cli_solar_day_number(a->sol_y, a->sol_m, a->sol_d)) + 1;
 }
 
+/* The bands of every output for the flags' dates and --bands (hfvis_solar_band_count; the site
+ * does not change them), or -1 for dates the library refuses. */
+static int cli_solar_band_count(const cli_args *a)
+{
+    hfvis_solar_input in = hfvis_solar_input_default();
+    hfvis_solar_options so = hfvis_solar_options_default();
+    in.year = a->sol_y, in.month = a->sol_m, in.day = a->sol_d;
+    in.days = cli_solar_days(a);
+    in.instant = a->sol_instant;
+    in.hour = a->sol_hour;
+    so.bands = (hfvis_solar_bands)a->sol_bands;
+    return hfvis_solar_band_count(&in, &so);
+}
+
 /* The combinations (after every flag is read): the command row's check (main.c). */
 static int cli_check_solar(const cli_args *a)
 {
+    if (a->sol_has_day && a->sol_has_range_start)
+        return cli_error(CLI_EXIT_USAGE, "--day", "conflicts with --start: give --day DATE, or --start DATE "
+                         "--end DATE");
+    if (a->sol_has_day && a->sol_has_end)
+        return cli_error(CLI_EXIT_USAGE, "--end", "not with --day (one day): for a range give --start DATE --end DATE");
+    if (a->sol_has_range_start && !a->sol_has_end)
+        return cli_error(CLI_EXIT_USAGE, "--start", "needs --end DATE (the range's last day; one day: --day DATE)");
+    if (a->sol_has_end && !a->sol_has_start)
+        return cli_error(CLI_EXIT_USAGE, "--end", "needs --start DATE");
     if (!a->sol_has_start) return cli_error(CLI_EXIT_USAGE, "solar", "missing --day DATE or --start DATE --end DATE");
+    if (a->sol_has_linke + a->sol_has_linke_monthly + (a->sol_linke_map != NULL) > 1)
+        return cli_error(CLI_EXIT_USAGE, a->sol_linke_map ? "--linke-map" : "--linke-monthly", "conflicts with %s: "
+                         "give one of --linke, --linke-monthly and --linke-map",
+                         a->sol_has_linke ? "--linke" : "--linke-monthly");
+    if (a->has_albedo && a->albedo_map)
+        return cli_error(CLI_EXIT_USAGE, "--albedo-map", "conflicts with --albedo: give one of them");
+    { /* dates that exist (the library's calendar: Julian through 1582-10-04, Gregorian from
+         1582-10-15) */
+        hfvis_solar_input in = hfvis_solar_input_default();
+        int k;
+        for (k = 0; k < 1 + a->sol_has_end; k++) {
+            int y = k ? a->sol_ey : a->sol_y, m = k ? a->sol_em : a->sol_m, d = k ? a->sol_ed : a->sol_d;
+            in.year = y, in.month = m, in.day = d;
+            if (hfvis_solar_band_count(&in, NULL) < 0)
+                return cli_error(CLI_EXIT_USAGE, k ? "--end" : a->sol_has_day ? "--day" : "--start",
+                                 "%04d-%02d-%02d is not a date of the calendar%s", y, m, d,
+                                 y == 1582 && m == 10 && d > 4 && d < 15
+                                     ? " (the Gregorian reform followed 1582-10-04 with 1582-10-15)"
+                                 : y <= 1582 ? " (Julian before 1582-10-15)" : "");
+        }
+    }
     if (a->sol_has_end) {
         long d = cli_solar_day_number(a->sol_ey, a->sol_em, a->sol_ed) - cli_solar_day_number(a->sol_y, a->sol_m, a->sol_d);
+        long s = (long)a->sol_y * 10000 + a->sol_m * 100 + a->sol_d;
+        long e = (long)a->sol_ey * 10000 + a->sol_em * 100 + a->sol_ed;
         if (a->sol_instant) return cli_error(CLI_EXIT_USAGE, "--time", "is an instant: give --day, not --start/--end");
         if (d < 0 || d >= CLI_SOLAR_MAX_DAYS)
             return cli_error(CLI_EXIT_USAGE, "--end", "expected a date from --start to %d days after it",
                              CLI_SOLAR_MAX_DAYS - 1);
+        if (s <= 15821004L && e >= 15821015L) /* the library steps a range day by day without the gap */
+            return cli_error(CLI_EXIT_USAGE, "--end", "a range across the Gregorian reform (1582-10-04 was "
+                             "followed by 1582-10-15) is not stepped right: end it by 1582-10-04 or start "
+                             "it from 1582-10-15");
     }
     if (a->sol_solar_time && a->sol_has_offset)
         return cli_error(CLI_EXIT_USAGE, "--solar-time", "times are local solar time: no --utc-offset");
@@ -143,16 +224,16 @@ static int cli_check_solar(const cli_args *a)
                          "give both --latitude and --longitude");
     if (a->out_pgm || a->out_partial)
         return cli_error(CLI_EXIT_USAGE, a->out, "solar writes .pfm, .tif, .asc, .bil or .flt");
-    { /* dates that exist (the library's calendar) */
-        hfvis_solar_input in = hfvis_solar_input_default();
-        in.year = a->sol_y, in.month = a->sol_m, in.day = a->sol_d;
-        if (hfvis_solar_band_count(&in, NULL) < 0)
-            return cli_error(CLI_EXIT_USAGE, a->sol_has_end ? "--start" : "--day", "%04d-%02d-%02d is not "
-                             "a date of the calendar", a->sol_y, a->sol_m, a->sol_d);
-        in.year = a->sol_ey, in.month = a->sol_em, in.day = a->sol_ed;
-        if (a->sol_has_end && hfvis_solar_band_count(&in, NULL) < 0)
-            return cli_error(CLI_EXIT_USAGE, "--end", "%04d-%02d-%02d is not a date of the calendar",
-                             a->sol_ey, a->sol_em, a->sol_ed);
+    { /* an ASCII grid holds one band: refused before the run, not after it */
+        const char *outs[5];
+        int k, bands = cli_solar_band_count(a);
+        outs[0] = a->out, outs[1] = a->sol_out[0], outs[2] = a->sol_out[1], outs[3] = a->sol_out[2];
+        outs[4] = a->sol_out[3];
+        for (k = 0; k < 5; k++)
+            if (bands > 1 && outs[k] && ex_rio_format_of(outs[k]) == EX_RIO_ASC)
+                return cli_error(CLI_EXIT_USAGE, outs[k], "an ASCII grid holds one band; --bands %s gives %d: "
+                                 "write .tif, .bil, .flt or .pfm", a->sol_bands == HFVIS_SOLAR_BANDS_DAY ? "day"
+                                 : "month", bands);
     }
     return 0;
 }
@@ -435,7 +516,7 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     char tag[CLI_PIECE_TAG_MAX];
     cli_solar_sites sites;
     hfvis_status s;
-    int rc = 0, bands, k, ch, piece = a->run->win.active;
+    int rc = 0, bands, j, k, ch, piece = a->run->win.active;
     double lat = a->sol_lat, lon = a->sol_lon;
     memset(&sites, 0, sizeof sites);
     if (!a->sol_has_lat) { /* every cell's site by the inverse projection of its centre */
@@ -522,9 +603,19 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     }
     if (a->albedo_map) {
         if ((rc = cli_load_map(a->albedo_map, &a->run->win, grid, &albedo, &ch)) != 0) goto done;
+        if (ch != 1) {
+            rc = cli_error(CLI_EXIT_ERROR, a->albedo_map, "%d bands or channels: an albedo map has one", ch);
+            goto done;
+        }
         so.albedo_map = albedo;
     }
-    if (a->sol_linke_map && (rc = cli_load_map(a->sol_linke_map, &a->run->win, grid, &linke, &ch)) != 0) goto done;
+    if (a->sol_linke_map) {
+        if ((rc = cli_load_map(a->sol_linke_map, &a->run->win, grid, &linke, &ch)) != 0) goto done;
+        if (ch != 1) {
+            rc = cli_error(CLI_EXIT_ERROR, a->sol_linke_map, "%d bands or channels: a Linke map has one", ch);
+            goto done;
+        }
+    }
     so.linke_map = linke;
     bands = hfvis_solar_band_count(&in, &so);
     if (bands < 1) {
@@ -570,9 +661,11 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     }
     if (s != HFVIS_OK) { rc = cli_status("solar", s, 0); goto done; }
     memcpy(tag, a->run->win.tag, sizeof tag);
-    for (k = 0; k < 5 && rc == 0; k++) {
+    for (j = 0; j < 5 && rc == 0; j++) { /* OUT (k = 3) last: a failing write leaves it untouched */
         static const char *const kind[5] = { "beam", "diffuse", "reflected", "global", "sun-hours" };
+        static const int order[5] = { 0, 1, 2, 4, 3 };
         cli_args b = *a;
+        k = order[j];
         if (!paths[k]) continue;
         b.out = paths[k];
         b.out_pgm = 0;

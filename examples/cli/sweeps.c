@@ -57,27 +57,39 @@ static int cli_load_env(const char *path, float **px, hfvis_env *env)
     return 0;
 }
 
-/* A --window run's share of a map of the whole raster's size: the cells of the grid (the
- * window and its halo) read by rows from the PFM or PGM, each channel's samples interleaved as
- * hfvis_image_load gives them, PGM samples still 0..maxval (*maxval set, 0 for a PFM). */
-static int cli_load_map_window(const char *path, const cli_window *win, float **px, int *channels,
-                               double *maxval)
+/* The cells of a map that the grid covers, read by rows: a --window run's grid (the window and
+ * its halo) of a map of the whole raster's size, or a whole run's grid (win NULL or inactive:
+ * the map of grid's size, from 0, 0). A GeoTIFF, ASC or EHdr map (by its extension, as IN is
+ * read) through examples/raster_io.h, its NoData cells NaN; else a PFM or PGM. Each band's
+ * samples interleaved as hfvis_image_load gives a PFM's channels, PGM samples still 0..maxval
+ * (*maxval set, 0 for the others). */
+static int cli_load_map_window(const char *path, const cli_window *win, const hfvis_grid *grid, float **px,
+                               int *channels, double *maxval)
 {
     ex_rio_reader r;
     float *m = NULL, *plane = NULL;
-    size_t i, n = (size_t)win->gw * (size_t)win->gh;
+    const int active = win && win->active;
+    const int ew = active ? win->ext_w : grid->width, eh = active ? win->ext_h : grid->height;
+    const int gx = active ? win->gx0 : 0, gy = active ? win->gy0 : 0;
+    const int gw = active ? win->gw : grid->width, gh = active ? win->gh : grid->height;
+    size_t i, n = (size_t)gw * (size_t)gh;
     int b, rc = 0;
-    if (ex_rio_open_netpbm(&r, path) != 0) return cli_error(CLI_EXIT_ERROR, path, "%s", r.err);
-    if (r.width != win->ext_w || r.height != win->ext_h) {
-        rc = cli_error(CLI_EXIT_ERROR, path, "%d x %d samples, but IN has %d x %d", r.width, r.height,
-                       win->ext_w, win->ext_h);
+    if ((ex_rio_format_of(path) ? ex_rio_open(&r, path) : ex_rio_open_netpbm(&r, path)) != 0) {
+        rc = cli_error(CLI_EXIT_ERROR, path, "%s (a map is a GeoTIFF .tif, ASC .asc, EHdr .bil/.flt, PFM or "
+                       "PGM)", r.err);
+        ex_rio_close(&r);
+        return rc;
+    }
+    if (r.width != ew || r.height != eh) {
+        rc = cli_error(CLI_EXIT_ERROR, path, "%d x %d samples, but IN has %d x %d", r.width, r.height, ew, eh);
     } else if (!(m = (float *)malloc(n * (size_t)r.bands * sizeof(float))) ||
                (r.bands > 1 && !(plane = (float *)malloc(n * sizeof(float))))) {
         rc = cli_status(path, HFVIS_ERR_OUT_OF_MEMORY, 0);
     }
+    r.nodata_to_nan = 1;
     for (b = 0; rc == 0 && b < r.bands; b++) {
         float *dst = r.bands > 1 ? plane : m;
-        if (ex_rio_read(&r, b, win->gx0, win->gy0, win->gw, win->gh, dst, win->gw) != 0) {
+        if (ex_rio_read(&r, b, gx, gy, gw, gh, dst, gw) != 0) {
             rc = cli_error(CLI_EXIT_ERROR, path, "%s", r.err);
             break;
         }
@@ -98,8 +110,9 @@ static int cli_load_map_window(const char *path, const cli_window *win, float **
 
 /* Load a per-sample map of the height field's size (indirect --albedo-map, --emission, solar
  * --linke-map and --albedo-map; in a --window run the raster's size, of which the grid's cells
- * are read): PGM values divided by the file's maxval, PFM values as stored; every value finite
- * and >= 0 wherever the height field has no hole. */
+ * are read): a GeoTIFF, ASC or EHdr raster (NoData cells NaN), PGM values divided by the file's
+ * maxval, PFM values as stored; every value finite and >= 0 wherever the height field has no
+ * hole. */
 static int cli_load_map(const char *path, const cli_window *win, const hfvis_grid *grid, float **px,
                         int *channels)
 {
@@ -109,12 +122,15 @@ static int cli_load_map(const char *path, const cli_window *win, const hfvis_gri
     int c;
     double maxval = 0.0;
     hfvis_status s;
-    if (win && win->active) {
-        int rc = cli_load_map_window(path, win, &m, &info.channels, &maxval);
+    if ((win && win->active) || ex_rio_format_of(path)) {
+        int rc = cli_load_map_window(path, win, grid, &m, &info.channels, &maxval);
         if (rc != 0) return rc;
     } else {
         errno = 0;
         s = hfvis_image_load(path, NULL, &m, &info);
+        if (s == HFVIS_ERR_FORMAT)
+            return cli_error(CLI_EXIT_ERROR, path, "%s: not a PFM or PGM (a map is a GeoTIFF .tif, ASC .asc, "
+                             "EHdr .bil/.flt, PFM or PGM)", hfvis_status_string(s));
         if (s != HFVIS_OK) return cli_status(path, s, errno);
         if (info.width != grid->width || info.height != grid->height) {
             hfvis_free(NULL, m);

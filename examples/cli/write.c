@@ -1,8 +1,10 @@
 /* write.c - safe writing: every file goes through hfvis_write_file, whose temporary name is kept
  * here so that SIGINT, SIGTERM and SIGHUP remove it (the handler unlinks it and re-raises the
- * signal; SIGXFSZ is ignored, so a file-size limit is a write error); the encoders of the library's formats; cli_save (PFM, PGM and the GIS rasters); the
- * refusal to write over an input. Owns: the temporary-file names. May call: progress.c, gis.c,
- * tiles.c (pieces), the library's encoders and examples/raster_io.h. */
+ * signal; SIGXFSZ is ignored, so a file-size limit is a write error); the encoders of the
+ * library's formats; cli_save (PFM, PGM and the GIS rasters); a replaced file's stale GDAL
+ * sidecar OUT.aux.xml removed; the refusals of outputs before a run (an input, an unwritable
+ * directory, two outputs of one file). Owns: the temporary-file names. May call: progress.c,
+ * gis.c, tiles.c (pieces), the library's encoders and examples/raster_io.h. */
 
 #define CLI_TMP_CAP 4096 /* longest temporary name the handler can remove (PATH_MAX on Linux) */
 #define CLI_TMP_SLOTS 8  /* temporary files alive at once: a raster with its sidecars (ex_publish) */
@@ -98,6 +100,21 @@ static void cli_on_temp_release(void *user, const char *tmp)
     }
 }
 
+/* After path has been replaced by a new file: remove path.aux.xml, the sidecar in which GDAL
+ * keeps statistics and histograms of a raster (gdalinfo -stats, QGIS), so that it does not
+ * describe the old values. GDAL removes it when it recreates a file itself. Best effort: a file
+ * that is not there, or that cannot be removed, is left as it is. */
+static void cli_drop_aux(const char *path)
+{
+    static const char ext[] = ".aux.xml";
+    char aux[CLI_TMP_CAP];
+    size_t n = strlen(path);
+    if (n + sizeof ext > sizeof aux) return;
+    memcpy(aux, path, n);
+    memcpy(aux + n, ext, sizeof ext);
+    (void)remove(aux);
+}
+
 /* hfvis_write_file with its temporary name recorded. The signals wait (ex_atomic_hold) from
  * before the file is created until the library has named it, so that no interrupt falls between
  * the two and leaves the file behind. */
@@ -111,6 +128,7 @@ static hfvis_status cli_write_file(const char *path, const void *bytes, size_t n
     if (held) ex_atomic_hold(1);
     s = hfvis_write_file(path, bytes, n, &wo);
     if (held) ex_atomic_hold(0); /* the file was never created */
+    if (s == HFVIS_OK) cli_drop_aux(path);
     return s;
 }
 
@@ -184,6 +202,7 @@ static hfvis_status cli_pfm_save(const char *path, const float *px, int w, int h
     }
     free(buf);
     if (!ex_atomic_close(f, tmp, path, ok) && s == HFVIS_OK) s = HFVIS_ERR_IO; /* a short write too */
+    if (s == HFVIS_OK) cli_drop_aux(path);
     return s;
 }
 static hfvis_status cli_enc_pgm_range(const void *what, void *out, size_t cap, size_t *written)
@@ -283,6 +302,7 @@ static int cli_save(const cli_args *a, cli_output out)
         o.meta = out.meta;
         o.n_meta = out.n_meta;
         if (ex_rio_write(a->out, &img, &g, &o, why) != 0) return cli_error(CLI_EXIT_ERROR, a->out, "%s", why);
+        cli_drop_aux(a->out);
         if (ex_rio_format_of(a->out) != EX_RIO_TIFF && ex_rio_crs_lost(&g) && !a->quiet)
             fprintf(stderr, "hfvis: note: %s has no .prj: the input's CRS EPSG:%d has no WKT here (write .tif "
                     "to keep it, or copy a .prj beside it)\n", a->out, g.epsg);
@@ -341,8 +361,101 @@ static int cli_refuse_input(int overwrite, const char *out, const char *const *i
 /* Every input of a command against out. */
 static int cli_refuse_inputs(const cli_args *a, const char *out)
 {
-    const char *inputs[5];
+    const char *inputs[6];
     inputs[0] = a->in, inputs[1] = a->env, inputs[2] = a->albedo_map, inputs[3] = a->emission;
-    inputs[4] = a->vf_reference;
-    return cli_refuse_input(a->overwrite, out, inputs, 5);
+    inputs[4] = a->vf_reference, inputs[5] = a->sol_linke_map;
+    return cli_refuse_input(a->overwrite, out, inputs, 6);
+}
+
+#ifdef CLI_HAVE_ISATTY
+/* The directory of path ("." without a '/', "/" for a name at the root) into d[cap]: 1, or 0
+ * when it does not fit. */
+static int cli_dir_of(const char *path, char *d, size_t cap)
+{
+    const char *s = strrchr(path, '/');
+    size_t n = s ? (size_t)(s - path) : 0;
+    if (n + 2 > cap) return 0;
+    if (!s) strcpy(d, ".");
+    else if (n == 0) strcpy(d, "/");
+    else memcpy(d, path, n), d[n] = '\0';
+    return 1;
+}
+#endif
+
+/* Whether paths x and y name one file, existing or still to be written: the same string, the
+ * same file (cli_same_file), or one last component in one directory (same device and inode). */
+static int cli_same_path(const char *x, const char *y)
+{
+    if (!strcmp(x, y) || cli_same_file(x, y)) return 1;
+#ifdef CLI_HAVE_ISATTY
+    {
+        const char *sx = strrchr(x, '/'), *sy = strrchr(y, '/');
+        char dx[CLI_TMP_CAP], dy[CLI_TMP_CAP];
+        struct stat tx, ty;
+        if (strcmp(sx ? sx + 1 : x, sy ? sy + 1 : y) || !cli_dir_of(x, dx, sizeof dx) ||
+            !cli_dir_of(y, dy, sizeof dy))
+            return 0;
+        return stat(dx, &tx) == 0 && stat(dy, &ty) == 0 && tx.st_dev == ty.st_dev && tx.st_ino == ty.st_ino;
+    }
+#else
+    return 0;
+#endif
+}
+
+/* An output whose directory does not exist or cannot be written to is refused before the run
+ * computes anything (the write would fail after it): 0, or CLI_EXIT_ERROR after one line. */
+static int cli_refuse_unwritable(const char *path)
+{
+#ifdef CLI_HAVE_ISATTY
+    char d[CLI_TMP_CAP];
+    struct stat st;
+    if (!cli_dir_of(path, d, sizeof d)) return 0; /* the write reports it */
+    if (stat(d, &st) != 0)
+        return cli_error(CLI_EXIT_ERROR, path, "cannot be written: its directory %s: %s", d, strerror(errno));
+    if (!S_ISDIR(st.st_mode))
+        return cli_error(CLI_EXIT_ERROR, path, "cannot be written: %s is not a directory", d);
+    if (access(d, W_OK | X_OK) != 0)
+        return cli_error(CLI_EXIT_ERROR, path, "cannot be written: its directory %s: %s", d, strerror(errno));
+#else
+    (void)path;
+#endif
+    return 0;
+}
+
+/* Every output file of a run (OUT and solar's --beam, --diffuse, --reflected, --sun-hours): none
+ * may be an input unless --overwrite, nor lie in a directory that does not exist or cannot be
+ * written to (CLI_EXIT_ERROR); no two may name one file, nor (ASC grids, EHdr rasters) one .prj
+ * or .hdr sidecar, whatever --overwrite says (CLI_EXIT_USAGE): the later would replace the
+ * earlier. 0, or the exit status after one error line. */
+static int cli_refuse_outputs(const cli_args *a)
+{
+    static const char *const flag[5] = { "-o", "--beam", "--diffuse", "--reflected", "--sun-hours" };
+    const char *outs[5];
+    int i, j, rc;
+    outs[0] = a->out, outs[1] = a->sol_out[0], outs[2] = a->sol_out[1], outs[3] = a->sol_out[2];
+    outs[4] = a->sol_out[3];
+    for (i = 0; i < 5; i++)
+        if (outs[i] && ((rc = cli_refuse_inputs(a, outs[i])) != 0 || (rc = cli_refuse_unwritable(outs[i])) != 0))
+            return rc;
+    for (i = 0; i < 5; i++)
+        for (j = i + 1; outs[i] && j < 5; j++) {
+            int fi, fj, same;
+            char *pi, *pj;
+            if (!outs[j]) continue;
+            if (cli_same_path(outs[i], outs[j]))
+                return cli_error(CLI_EXIT_USAGE, outs[j], "is the output of both %s and %s: give each "
+                                 "output its own file", flag[i], flag[j]);
+            fi = ex_rio_format_of(outs[i]), fj = ex_rio_format_of(outs[j]);
+            if ((fi != EX_RIO_ASC && fi != EX_RIO_EHDR) || (fj != EX_RIO_ASC && fj != EX_RIO_EHDR)) continue;
+            pi = ex_rio_sidecar(outs[i], ".prj"), pj = ex_rio_sidecar(outs[j], ".prj");
+            same = pi && pj && cli_same_path(pi, pj);
+            if (same)
+                cli_error(CLI_EXIT_USAGE, outs[j], "shares its sidecar %s with %s (%s): give the "
+                          "outputs different names before the extension", pj, outs[i], flag[i]);
+            free(pi);
+            free(pj);
+            if (same) return CLI_EXIT_USAGE;
+            if (!pi || !pj) return cli_status(outs[j], HFVIS_ERR_OUT_OF_MEMORY, 0);
+        }
+    return 0;
 }
