@@ -660,6 +660,15 @@ expect_fail "skyview --sun-elevation" 2 skyview "$h" --sun-elevation 20 -o "$fdi
 grep -qF 'hfvis: skyview: --sun-elevation is not used by skyview' "$dir/stderr" && ok "skyview --sun-elevation: named" || bad "skyview --sun-elevation: $(cat "$dir/stderr")"
 expect_fail "viewshed --dirs" 2 viewshed "$h" --observer-grid 3,3 --dirs 8 -o "$fdir/x.pfm"
 expect_fail "viewshed --border clamp" 2 viewshed "$h" --observer-grid 3,3 --border clamp -o "$fdir/x.pfm"
+# one observer: --observer and --observer-grid together (or twice) are refused, not the later one taken
+expect_fail "viewshed --observer with --observer-grid" 2 viewshed "$h" --cell 2 --observer 1,1 --observer-grid 3,3 -o "$fdir/x.pfm"
+expect_fail "viewshed --observer-grid twice" 2 viewshed "$h" --observer-grid 3,3 --observer-grid 2,2 -o "$fdir/x.pfm"
+# hillshade --no-shadows: the flags that shape the cast shadows are refused, not ignored
+for nsf in "--sun-radius 5" "--lattice" "--exact-near 8" "--max-distance 10"; do
+  expect_fail "hillshade --no-shadows $nsf" 2 hillshade "$h" --no-shadows $nsf -o "$fdir/x.pfm"
+done
+expect_ok "hillshade --no-shadows --max-distance with --window (its halo)" "$dir/hnsw.pfm" hillshade "$dir/emit1.pfm" --no-shadows --max-distance 10 --window 0,0,4,4 -o "$dir/hnsw.pfm"
+"$hfvis" visibility --help 2>&1 | grep -q "not a whole number" && ok "visibility --help: counts are not whole off the axes" || bad "visibility --help: no word on fractional counts"
 expect_fail "normals --convention" 2 normals "$h" --convention grass -o "$fdir/x.pfm"
 expect_fail "voxelize --range" 2 voxelize "$dir/hill.pgm" --res 4 --range 0:1 -o "$fdir/x.raw"
 expect_fail "ssao --method lsao --dirs 4" 2 ssao "$dir/hill.pgm" --method lsao --dirs 4 -o "$fdir/x.pfm"

@@ -437,6 +437,7 @@ static int cli_run_skyview_saga(const cli_args *a, const hfvis_grid *grid, hfvis
                                 cli_progress_state *prog, float *out);
 static int cli_run_gis(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts,
                        cli_progress_state *prog);
+static int cli_check_hillshade(const cli_args *a);
 static int cli_check_viewshed(const cli_args *a);
 /* screen.c */
 static int cli_set_ssao(cli_args *a, const char *f, const char *v);

@@ -112,7 +112,7 @@ static const cli_flag cli_flags[] = {
       "                    PGM code 0 is NoData and LO..HI map to 1..65535, recorded in the header\n"
       "                    comment \"# hfvis range LO HI nodata 0\"\n"
       "                    *.tif a GeoTIFF (tiled, DEFLATE; Float32, or the smallest integer type\n"
-      "                    for viewshed and visibility counts), *.asc an ESRI ASCII grid,\n"
+      "                    for viewshed and whole visibility counts), *.asc an ESRI ASCII grid,\n"
       "                    *.bil/*.flt raw floats + .hdr: these carry IN's georeference and NoData\n"
       "                    (planes and channels become bands)\n" },
     { "--band", "N", CLI_HF,

@@ -85,6 +85,9 @@ static int cli_set_gis(cli_args *a, const char *f, const char *v)
     if (!strcmp(f, "--progress")) { a->progress_lines = 1; return 0; }
     if (a->cmd == CMD_VIEWSHED) {
         if (!strcmp(f, "--observer") || !strcmp(f, "--observer-grid")) {
+            if (a->has_observer)
+                return cli_error(CLI_EXIT_USAGE, f, "one observer: give --observer X,Y or --observer-grid "
+                                 "COL,ROW, once");
             a->observer_grid = f[10] == '-';
             a->has_observer = 1;
             return cli_pair(f, v, a->observer_grid ? "COL,ROW (grid position)" : "X,Y (map "

@@ -205,6 +205,18 @@ static int cli_run_gis(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_op
     return rc;
 }
 
+/* hillshade --no-shadows: the flags that only shape the cast shadows are refused, not ignored
+ * (--max-distance too, unless a --window run needs it for its halo). */
+static int cli_check_hillshade(const cli_args *a)
+{
+    const char *f = a->lattice ? "--lattice" : a->has_sun_radius ? "--sun-radius"
+                    : a->max_distance > 0.0 && !a->has_window ? "--max-distance"
+                    : a->has_exact_near ? "--exact-near" : NULL;
+    if (a->no_shadows && f)
+        return cli_error(CLI_EXIT_USAGE, f, "shapes the cast shadows, and --no-shadows casts none");
+    return 0;
+}
+
 /* viewshed: the observer is required. */
 static int cli_check_viewshed(const cli_args *a)
 {

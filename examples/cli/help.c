@@ -171,7 +171,8 @@
     "  --sun-elevation E elevation of the sun, -90..90 (default 45)\n"                            \
     "  --sun-radius R    angular radius of the sun disc, 0..90 (default 0; the real sun 0.27)\n"  \
     "  --blend N         multi-directional: N suns at A + 360 j/N, averaged (default 1)\n"         \
-    "  --no-shadows      V_j = 1: the local hillshade only\n"                                    \
+    "  --no-shadows      V_j = 1: the local hillshade only (not with --sun-radius, --lattice,\n"  \
+    "                    --exact-near, nor --max-distance unless a --window needs its halo)\n"   \
     "  --lattice         shadows from the [P1] lattice sweep instead of exact rays (faster; misses\n" \
     "                    shadow cells next to walls and cliffs; --exact names the default)\n"
 
@@ -375,6 +376,8 @@ static const char cli_help_tail[] =
     "it and the point rises above the sight line (grazing counts); the point itself is not\n" \
     "counted, nor samples outside the grid (also with --border clamp/wrap), nor holes. On a\n" \
     "flat field with --dirs 1, column x of a W-wide row sees W-1-x samples. NaN at holes.\n" \
+    "Off the grid axes a point takes the counts of the lattice nodes around it bilinearly, so\n" \
+    "the count is not a whole number there (a GeoTIFF output is then Float32).\n"             \
     "  --fraction   divide by the samples the point could see: the same count on a flat field\n" \
     "               with IN's holes, where every sample is seen; in [0, 1], 0 where the point's\n" \
     "               lines hold no sample. Runs a second sweep in which every sample is visible,\n" \
@@ -401,6 +404,7 @@ static const char cli_help_tail[] =
     "                        sample (column c, row r) is at X = c*cell, Y = r*cell (cell centres;\n" \
     "                        a georeferenced input uses its geotransform); it must stand on data\n" \
     "  --observer-grid C,R   the observer's column and row instead, reals in [0, W-1] x [0, H-1]\n" \
+    "                        (one observer: the two together, or either twice, are refused)\n" \
     "  --target X,Y          a point of interest (map coordinates, up to 64): prints\n" \
     "                        \"target X,Y (column c, row r): visible|hidden|...\" for its nearest sample\n" \
     "  --curvature           Earth curvature and refraction as GRASS r.viewshed -c -r: each target\n" \

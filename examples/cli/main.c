@@ -48,7 +48,7 @@ static const cli_command cli_commands[CMD_COUNT] = {
     { "viewshed", "which samples an observer at one point sees (line of sight)",
       CLI_VIEWSHED_HELP, CLI_HF_IO, cli_check_viewshed, cli_estimate_viewshed, cli_run_heights, NULL },
     { "hillshade", "shaded relief with cast shadows from the exact sweep, one or more suns",
-      CLI_HILLSHADE_HELP, CLI_HF_IO, NULL, cli_estimate_sweep, cli_run_heights, NULL },
+      CLI_HILLSHADE_HELP, CLI_HF_IO, cli_check_hillshade, cli_estimate_sweep, cli_run_heights, NULL },
     { "openness", "positive or negative topographic openness (Yokoyama et al. 2002)",
       CLI_OPENNESS_HELP, CLI_HF_IO, NULL, cli_estimate_sweep, cli_run_heights, NULL },
     { "solar", "clear-sky solar irradiation of a day or a date range over exact horizons",
