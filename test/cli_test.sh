@@ -1429,6 +1429,21 @@ solar_tiles "per-cell sites, 30 days, --threads 2" --start 2026-03-01 --end 2026
 cp "$dir/stw_g.tif" "$dir/stw_g_t2.tif"
 expect_ok "solar tiles: per-cell sites, 30 days, --threads 1 whole run" "$dir/stw_g.tif" solar "$dir/swin.asc" --start 2026-03-01 --end 2026-03-30 --dirs 16 --threads 1 --max-distance 2000 -o "$dir/stw_g.tif"
 cmp -s "$dir/stw_g.tif" "$dir/stw_g_t2.tif" && ok "solar tiles: --threads 2 equals --threads 1 (per-cell sites, 30 days)" || bad "solar tiles: --threads 2 differs from --threads 1"
+# --bands day and month: each GeoTIFF band described by its date or month (GDAL_METADATA), the
+# unit Wh/m^2, in the whole run and in the mosaic of its pieces alike
+solar_tiles "day bands across February's end" --start 2026-02-27 --end 2026-03-02 --bands day --dirs 8
+grep -a -q '<Item name="DESCRIPTION" sample="3" role="description">2026-03-02</Item>' "$dir/stm_g.tif" &&
+  grep -a -q '<Item name="DESCRIPTION" sample="1" role="description">2026-02-28</Item>' "$dir/stm_g.tif" &&
+  grep -a -q 'Wh/m^2' "$dir/stm_g.tif" &&
+  ok "solar --bands day: bands described by their dates (2026-02-27 .. 2026-03-02), unit Wh/m^2" ||
+  bad "solar --bands day: band descriptions: $(grep -a -o '<Item name="DESCRIPTION"[^<]*</Item>' "$dir/stm_g.tif" | head -5)"
+solar_tiles "month bands across the year's end" --start 2026-11-20 --end 2027-01-03 --bands month --dirs 8
+grep -a -q 'role="description">2026-11</Item>' "$dir/stw_g.tif" && grep -a -q 'role="description">2027-01</Item>' "$dir/stw_g.tif" &&
+  ok "solar --bands month: bands described by their months" ||
+  bad "solar --bands month: $(grep -a -o '<Item name="DESCRIPTION"[^<]*</Item>' "$dir/stw_g.tif" | head -5)"
+expect_ok "normals -> tif" "$dir/nrm.tif" normals "$dir/swin.asc" -o "$dir/nrm.tif"
+grep -a -q 'role="description">x (east)</Item>' "$dir/nrm.tif" && grep -a -q 'role="description">z (up)</Item>' "$dir/nrm.tif" &&
+  ok "normals GeoTIFF: bands described x (east), y (south), z (up)" || bad "normals GeoTIFF: no band descriptions"
 solar_tiles "per-cell sites, a day" --day 2026-06-21 --threads 1
 solar_tiles "--latitude/--longitude, a day, --threads 2" --day 2026-06-21 --latitude 46 --longitude 15 --threads 2
 # --height-range LO,HI: the pressure nodes' span given, no pass over IN; the pieces still join

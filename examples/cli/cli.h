@@ -385,6 +385,7 @@ static int cli_same_path(const char *x, const char *y);
 static int cli_refuse_unwritable(const char *path);
 static int cli_refuse_outputs(const cli_args *a);
 /* run.c */
+static const char *const *cli_fixed_band_names(int cmd, int bands);
 static cli_cost cli_cost_of(double bytes, double work, const char *unit);
 static cli_cost cli_sweep_cost(const cli_args *a, int w, int h, double out, double ch, double cell_bytes,
                                double node_bytes);
@@ -500,6 +501,8 @@ static long cli_solar_day_number(int y, int m, int d);
 static int cli_set_solar(cli_args *a, const char *f, const char *v);
 static int cli_solar_days(const cli_args *a);
 static int cli_solar_band_count(const cli_args *a);
+static int cli_solar_band_names(const cli_args *a, int bands, char (**names)[16], const char ***ptrs);
+static const char *cli_solar_unit_of(int instant, int sun_hours);
 static int cli_check_solar(const cli_args *a);
 static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts);
 /* main.c */

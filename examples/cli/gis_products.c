@@ -200,7 +200,11 @@ static int cli_run_gis(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_op
     } else {
         rc = cli_error(CLI_EXIT_ERROR, cli_commands[a->cmd].name, "internal error: not a GIS product");
     }
-    if (rc == 0) rc = cli_save(a, cli_output_of(out, w, h, planes, 1, lo, hi));
+    if (rc == 0) {
+        cli_output o = cli_output_of(out, w, h, planes, 1, lo, hi);
+        o.band_names = cli_fixed_band_names(a->cmd, planes);
+        rc = cli_save(a, o);
+    }
     free(out);
     return rc;
 }

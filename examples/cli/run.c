@@ -136,6 +136,18 @@ static cli_cost cli_estimate_meshao(const cli_args *a, int w, int h, int channel
                        (double)a->lk_width * (double)a->lk_height * (double)(a->lk_rays ? a->lk_rays : 64), "rays");
 }
 
+/* The band descriptions of the outputs whose bands are fixed: normals' three axes (hfvis.h
+ * "Grids") and openness --both's two planes; NULL for the others. The whole run, its pieces and
+ * their mosaic name them alike. */
+static const char *const *cli_fixed_band_names(int cmd, int bands)
+{
+    static const char *const axes[3] = { "x (east)", "y (south)", "z (up)" };
+    static const char *const both[2] = { "positive openness", "negative openness" };
+    if (cmd == CMD_NORMALS && bands == 3) return axes;
+    if (cmd == CMD_OPENNESS && bands == 2) return both;
+    return NULL;
+}
+
 /* The channels of a height-field command's output, for the estimate before anything is loaded:
  * light has ENV's, indirect the most of ENV, --albedo-map and --emission (PGM, PFM or a
  * raster's bands: their headers only are read), normals 3, the rest 1. A header that cannot be
@@ -576,7 +588,11 @@ static int cli_run_heights(const cli_args *a)
         (rc = cli_check_radiance(cmd, &grid, out, channels)) != 0)
         goto done;
     if (a->cmd == CMD_HORIZON) { rc = cli_horizon_finish(a, out, w, h, lo, hi); goto done; }
-    rc = cli_save(a, cli_output_of(out, w, h, planes, channels, lo, hi));
+    {
+        cli_output o = cli_output_of(out, w, h, planes, channels, lo, hi);
+        o.band_names = cli_fixed_band_names(a->cmd, planes * channels);
+        rc = cli_save(a, o);
+    }
 done:
     cli_progress_end(a->run, rc); /* a bar that fell short */
     free(out);

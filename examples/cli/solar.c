@@ -503,6 +503,42 @@ static hfvis_status cli_threaded_solar(const hfvis_grid *grid, const hfvis_solar
     return cli_split_run(&sp);
 }
 
+/* An output's unit: W/m^2 of an instant, Wh/m^2 of a period, hours of direct sun (none for an
+ * instant's sun-hours output, its visible fraction of the sun). */
+static const char *cli_solar_unit_of(int instant, int sun_hours)
+{
+    return sun_hours ? (instant ? NULL : "h") : instant ? "W/m^2" : "Wh/m^2";
+}
+
+/* Each band's description in a GeoTIFF (GDAL_METADATA: gdalinfo and QGIS show it): with
+ * --bands day its date, "YYYY-MM-DD", with --bands month its month, "YYYY-MM", stepped from the
+ * first day in the library's calendar (Julian leap years through 1582); one band: none (NULL).
+ * *names holds the text, *ptrs the pointers cli_output takes; 0, or 1 when memory runs out. */
+static int cli_solar_band_names(const cli_args *a, int bands, char (**names)[16], const char ***ptrs)
+{
+    int y = a->sol_y, m = a->sol_m, d = a->sol_d, k;
+    *names = NULL;
+    *ptrs = NULL;
+    if (bands < 2) return 0;
+    *names = (char (*)[16])calloc((size_t)bands, sizeof **names);
+    *ptrs = (const char **)calloc((size_t)bands, sizeof **ptrs);
+    if (!*names || !*ptrs) return 1;
+    for (k = 0; k < bands; k++) {
+        int days = m == 2 ? 28 + (y > 1582 ? (y % 4 == 0 && y % 100 != 0) || y % 400 == 0 : y % 4 == 0)
+                          : 30 + ((m + (m > 7)) & 1);
+        if (a->sol_bands == HFVIS_SOLAR_BANDS_DAY) {
+            snprintf((*names)[k], sizeof **names, "%04d-%02d-%02d", y, m, d);
+            if (++d > days) d = 1, m++;
+        } else {
+            snprintf((*names)[k], sizeof **names, "%04d-%02d", y, m);
+            m++;
+        }
+        if (m > 12) m = 1, y++;
+        (*ptrs)[k] = (*names)[k];
+    }
+    return 0;
+}
+
 static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts)
 {
     const int w = grid->width, h = grid->height;
@@ -512,7 +548,8 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     float *planes[5] = { NULL, NULL, NULL, NULL, NULL }, *albedo = NULL, *linke = NULL, monthly[12];
     float *hmap = NULL;
     unsigned char *need = NULL;
-    const char *paths[5];
+    char (*band_text)[16] = NULL;
+    const char *paths[5], **band_names = NULL;
     char tag[CLI_PIECE_TAG_MAX];
     cli_solar_sites sites;
     hfvis_status s;
@@ -661,10 +698,15 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
     }
     if (s != HFVIS_OK) { rc = cli_status("solar", s, 0); goto done; }
     memcpy(tag, a->run->win.tag, sizeof tag);
+    if (cli_solar_band_names(a, bands, &band_text, &band_names)) {
+        rc = cli_status("solar", HFVIS_ERR_OUT_OF_MEMORY, 0);
+        goto done;
+    }
     for (j = 0; j < 5 && rc == 0; j++) { /* OUT (k = 3) last: a failing write leaves it untouched */
         static const char *const kind[5] = { "beam", "diffuse", "reflected", "global", "sun-hours" };
         static const int order[5] = { 0, 1, 2, 4, 3 };
         cli_args b = *a;
+        cli_output o;
         k = order[j];
         if (!paths[k]) continue;
         b.out = paths[k];
@@ -673,9 +715,14 @@ static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_
         a->run->win.active = piece; /* each output a piece (cli_save_piece clears it) */
         snprintf(a->run->win.tag, sizeof a->run->win.tag, "%.*s solar-output=%s",
                  (int)(sizeof tag - 32), tag, kind[k]); /* pieces of one output only */
-        rc = cli_save(&b, cli_output_of(planes[k], w, h, bands, 1, 0.0, 1.0));
+        o = cli_output_of(planes[k], w, h, bands, 1, 0.0, 1.0);
+        o.band_names = band_names;
+        o.unit = cli_solar_unit_of(a->sol_instant, k == 4);
+        rc = cli_save(&b, o);
     }
 done:
+    free(band_text);
+    free(band_names);
     for (k = 0; k < 5; k++) free(planes[k]);
     hfvis_free(NULL, albedo);
     hfvis_free(NULL, linke);

@@ -530,15 +530,39 @@ static int cli_mosaic_pieces(int argc, char **argv, const char **names)
         cli_output whole_out = cli_output_of(out, W, H, planes, channels, lo, hi);
         cli_labels L;
         memset(&L, 0, sizeof L);
+        char (*solar_text)[16] = NULL;
+        const char **solar_names = NULL;
         if (a.cmd == CMD_HORIZON) { /* the whole run's band labels, from the run's tag */
             if ((rc = cli_horizon_labels_of_tag(meta[0].tag, planes, &L)) != 0) goto done;
             if (L.band) {
                 whole_out.band_names = L.band, whole_out.unit = L.unit;
                 whole_out.meta = L.meta, whole_out.n_meta = planes + 3;
             }
+        } else if (a.cmd == CMD_SOLAR && cli_tag_value(meta[0].tag, "solar", other, sizeof other)) {
+            /* the dates, the instant and --bands from the run's solar= value (tiles.c's tag), the
+             * output from solar-output=: the whole run's descriptions and unit */
+            cli_args b;
+            int ey, em, ed, solar_time, has_lat, has_lon, has_offset, has_monthly;
+            memset(&b, 0, sizeof b);
+            if (sscanf(other, "%d-%d-%d,%d-%d-%d,%d,%d,%*[^,],%*[^,],%d,%*[^,],%d,%*[^,],%d,%*[^,],%*[^,],%d,%d",
+                       &b.sol_y, &b.sol_m, &b.sol_d, &ey, &em, &ed, &b.sol_instant, &solar_time, &has_lat,
+                       &has_lon, &has_offset, &has_monthly, &b.sol_bands) == 13) {
+                if (cli_solar_band_names(&b, planes, &solar_text, &solar_names)) {
+                    rc = cli_status("mosaic", HFVIS_ERR_OUT_OF_MEMORY, 0);
+                    goto done;
+                }
+                whole_out.band_names = solar_names;
+                whole_out.unit = cli_solar_unit_of(b.sol_instant, cli_tag_value(meta[0].tag, "solar-output", other,
+                                                                                 sizeof other) &&
+                                                                       !strcmp(other, "sun-hours"));
+            }
+        } else {
+            whole_out.band_names = cli_fixed_band_names(a.cmd, planes * channels);
         }
         rc = cli_save(&a, whole_out);
         cli_labels_free(&L);
+        free(solar_text);
+        free(solar_names);
     }
 done:
     ex_georef_free(&ref);
