@@ -1784,14 +1784,23 @@ static inline void ex_rio_unflip(const ex_rio_reader *r, int w, int h, float *ou
         }
 }
 
+/* The origin in the file's orientation of the north-up window at (x0, y0), w x h: mirrored as
+ * the file's flags say, in long long (far outside the raster it may leave int). */
+static inline void ex_rio_stored_origin(const ex_rio_reader *r, int x0, int y0, int w, int h, long long *sx,
+                                        long long *sy)
+{
+    *sx = r->geo.flip_x ? (long long)r->width - x0 - w : x0;
+    *sy = r->geo.flip_y ? (long long)r->height - y0 - h : y0;
+}
+
 /* ex_rio_read: the window of the north-up raster (ex_georef_orient) from the file's orientation:
  * the mirrored window, then its rows and columns reversed in place. */
 static inline int ex_rio_read(ex_rio_reader *r, int band, int x0, int y0, int w, int h, float *out,
                               ptrdiff_t stride)
 {
-    if (r->geo.flip_x) x0 = (int)((long long)r->width - x0 - w);
-    if (r->geo.flip_y) y0 = (int)((long long)r->height - y0 - h);
-    if (ex_rio_read_stored(r, band, x0, y0, w, h, out, stride) != 0) return -1;
+    long long sx, sy;
+    ex_rio_stored_origin(r, x0, y0, w, h, &sx, &sy);
+    if (ex_rio_read_stored(r, band, (int)sx, (int)sy, w, h, out, stride) != 0) return -1;
     ex_rio_unflip(r, w, h, out, stride);
     return 0;
 }
@@ -1849,9 +1858,9 @@ static inline int ex_rio_read_parallel(ex_rio_reader *r, const char *path, int b
 {
     ex_rio_read_job j;
     long long unit = r->format == EX_RIO_TIFF ? (long long)r->chunk_h : 1, sy0, cut;
-    long long sx = r->geo.flip_x ? (long long)r->width - x0 - w : x0; /* the stored window */
-    long long sy = r->geo.flip_y ? (long long)r->height - y0 - h : y0;
+    long long sx, sy;
     int n = EX_RIO_READ_PARTS, i, rc = 0, ran;
+    ex_rio_stored_origin(r, x0, y0, w, h, &sx, &sy);
     if (!parallel || (r->f && !path) || sx < INT_MIN || sx + w > INT_MAX || sy < INT_MIN || sy + h > INT_MAX)
         return ex_rio_read(r, band, x0, y0, w, h, out, stride); /* part rows must stay ints */
     if (ex_rio_window_check(r, band, w, h, stride) != 0) return -1;

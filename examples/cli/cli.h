@@ -342,6 +342,7 @@ static int cli_set(cli_args *a, const char *f, const char *v);
 static int cli_check_window(const cli_args *a);
 static int cli_parse(int argc, char **argv, cli_args *a);
 /* gis.c */
+static int cli_open_raster(ex_rio_reader *r, const char *path);
 static double cli_deg(const cli_args *a, double v);
 static double cli_psi(int conv, double deg);
 static double cli_from_psi(int conv, double psi);

@@ -176,6 +176,13 @@ static int cli_gis_finish(cli_args *a)
     return 0;
 }
 
+/* Open path for window reads: a GeoTIFF, ASC or EHdr raster by its extension, else a PFM or a
+ * binary PGM. 0, or -1 with r->err. */
+static int cli_open_raster(ex_rio_reader *r, const char *path)
+{
+    return ex_rio_format_of(path) ? ex_rio_open(r, path) : ex_rio_open_netpbm(r, path);
+}
+
 /* Load a GeoTIFF, ASC or EHdr IN (band --band): NoData -> NaN, the georeference kept in
  * a->run->geo, *cell from it (geographic CRS refused unless --cell), --cell overriding with a note. */
 static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double *cell)
@@ -185,7 +192,7 @@ static int cli_load_raster(const cli_args *a, float **z, int *w, int *h, double 
     double rc_cell = 0.0;
     char why[256];
     int gx = 0, gy = 0, gw, gh, threads;
-    if ((ex_rio_format_of(a->in) ? ex_rio_open(&r, a->in) : ex_rio_open_netpbm(&r, a->in)) != 0)
+    if (cli_open_raster(&r, a->in) != 0)
         return cli_error(CLI_EXIT_ERROR, a->in, "%s", r.err);
     if (r.format == EX_RIO_NETPBM && r.bands != 1) {
         ex_rio_close(&r);
@@ -350,7 +357,7 @@ static int cli_info(int argc, char **argv)
             return cli_refuse_flag(CMD_INFO, argv[i]);
         }
     if (argc != 3) return cli_error(CLI_EXIT_USAGE, "info", "usage: hfvis info RASTER");
-    if ((ex_rio_format_of(argv[2]) ? ex_rio_open(&r, argv[2]) : ex_rio_open_netpbm(&r, argv[2])) != 0)
+    if (cli_open_raster(&r, argv[2]) != 0)
         return cli_error(CLI_EXIT_ERROR, argv[2], "%s", r.err);
     printf("width %d\nheight %d\nbands %d\n", r.width, r.height, r.bands);
     if (r.geo.has_transform && ex_georef_cell(&r.geo, &cell, why) == 0) printf("cell %.17g\n", cell);

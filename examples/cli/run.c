@@ -160,8 +160,7 @@ static int cli_out_channels(const cli_args *a)
     if (a->cmd == CMD_INDIRECT) maps[1] = a->albedo_map, maps[2] = a->emission;
     for (i = 0; i < 3; i++) {
         ex_rio_reader r;
-        if (!maps[i] || (ex_rio_format_of(maps[i]) ? ex_rio_open(&r, maps[i]) : ex_rio_open_netpbm(&r, maps[i])) != 0)
-            continue;
+        if (!maps[i] || cli_open_raster(&r, maps[i]) != 0) continue;
         if (r.bands > channels) channels = r.bands;
         ex_rio_close(&r);
     }
@@ -425,9 +424,8 @@ static int cli_peek_size(const cli_args *a, int *w, int *h, double *cell)
 {
     ex_rio_reader r;
     char why[256];
-    int fmt = ex_rio_format_of(a->in);
-    if (fmt == EX_RIO_ASC) return 0;
-    if ((fmt ? ex_rio_open(&r, a->in) : ex_rio_open_netpbm(&r, a->in)) != 0) {
+    if (ex_rio_format_of(a->in) == EX_RIO_ASC) return 0;
+    if (cli_open_raster(&r, a->in) != 0) {
         ex_rio_close(&r);
         return 0;
     }

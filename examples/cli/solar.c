@@ -417,7 +417,7 @@ static int cli_solar_height_range(const cli_args *a, double *lo, double *hi)
     float *strip, nodata = (float)a->nodata, zscale = (float)a->zscale, zmin = HUGE_VALF, zmax = -HUGE_VALF;
     int y, rows, rc = 0;
     *lo = *hi = 0.0;
-    if ((ex_rio_format_of(a->in) ? ex_rio_open(&r, a->in) : ex_rio_open_netpbm(&r, a->in)) != 0) {
+    if (cli_open_raster(&r, a->in) != 0) {
         rc = cli_error(CLI_EXIT_ERROR, a->in, "%s", r.err);
         ex_rio_close(&r);
         return rc;
@@ -524,8 +524,8 @@ static int cli_solar_band_names(const cli_args *a, int bands, char (**names)[16]
     *ptrs = (const char **)calloc((size_t)bands, sizeof **ptrs);
     if (!*names || !*ptrs) return 1;
     for (k = 0; k < bands; k++) {
-        int days = m == 2 ? 28 + (y > 1582 ? (y % 4 == 0 && y % 100 != 0) || y % 400 == 0 : y % 4 == 0)
-                          : 30 + ((m + (m > 7)) & 1);
+        int days = (int)(cli_solar_day_number(m == 12 ? y + 1 : y, m == 12 ? 1 : m + 1, 1) -
+                         cli_solar_day_number(y, m, 1)); /* the month's, in the range's own count */
         if (a->sol_bands == HFVIS_SOLAR_BANDS_DAY) {
             snprintf((*names)[k], sizeof **names, "%04d-%02d-%02d", y, m, d);
             if (++d > days) d = 1, m++;

@@ -74,7 +74,7 @@ static int cli_load_map_window(const char *path, const cli_window *win, const hf
     const int gw = active ? win->gw : grid->width, gh = active ? win->gh : grid->height;
     size_t i, n = (size_t)gw * (size_t)gh;
     int b, rc = 0;
-    if ((ex_rio_format_of(path) ? ex_rio_open(&r, path) : ex_rio_open_netpbm(&r, path)) != 0) {
+    if (cli_open_raster(&r, path) != 0) {
         rc = cli_error(CLI_EXIT_ERROR, path, "%s (a map is a GeoTIFF .tif, ASC .asc, EHdr .bil/.flt, PFM or "
                        "PGM)", r.err);
         ex_rio_close(&r);
