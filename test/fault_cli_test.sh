@@ -2,8 +2,8 @@
 # fault_cli_test.sh - every output format of the hfvis tool under a failing disk: a file-size
 # limit (ulimit -f, with SIGXFSZ at its default action and ignored) and, where strace is
 # installed, an injected failure (ENOSPC, EIO) of the write path's system calls: openat, write,
-# close, rename (and fsync, fdatasync where the tool calls them), at the first, second, middle and
-# last call from the creation of the output's temporary file on.
+# pwrite64 (a PFM's slices when the run has threads), close, rename (and fsync, fdatasync where
+# the tool calls them), at the first, second, middle and last call from the creation of the output's temporary file on.
 # Each case runs with OUT absent and with OUT holding older contents. A run that exits 0 must have
 # written exactly the good run's files; a run that fails must exit non-zero with exactly one
 # stderr line "hfvis...", leave OUT as it was (absent, or its older bytes), leave every other file
@@ -52,6 +52,7 @@ tif|o.tif||skyview $in/dem.asc --dirs 8 --quiet -o o.tif|
 asc|o.asc|o.prj|skyview $in/dem.asc --dirs 8 --quiet -o o.asc|
 bil|o.bil|o.hdr o.prj|skyview $in/dem.asc --dirs 8 --quiet -o o.bil|
 flt|o.flt|o.hdr o.prj|horizon $in/dem.asc --dirs 4 --quiet -o o.flt|
+pfm-threads|t.pfm||horizon $in/dem.asc --dirs 4 --threads 2 --quiet -o t.pfm|
 hfvs|o.hfvs||skyview $in/dem.asc --dirs 8 --dir-range 0:4 --quiet -o o.hfvs|
 binvox|o.binvox||voxelize $in/m.obj --res 24 --quiet -o o.binvox|
 raw|o.raw||voxelize $in/m.obj --res 24 --mode solid --open --quiet -o o.raw|
@@ -117,7 +118,7 @@ for c in $cases; do IFS=$oldifs
   if (cd "$g" && "$hfvis" $args > /dev/null 2> "$dir/err"); then :; else bad "$name: the good run failed: $(head -n 2 "$dir/err")"; good_ok=0; fi
   if [ "$have_strace" = 1 ]; then
     prepare "$dir/t" new
-    (cd "$dir/t" && strace -f -o "$dir/good/$name.trace" -e trace=openat,open,creat,write,close,rename,renameat,renameat2,fsync,fdatasync "$hfvis" $args > /dev/null 2>&1)
+    (cd "$dir/t" && strace -f -o "$dir/good/$name.trace" -e trace=openat,open,creat,write,pwrite64,close,rename,renameat,renameat2,fsync,fdatasync "$hfvis" $args > /dev/null 2>&1)
   fi
   IFS=$IFS_NL
 done
@@ -130,7 +131,7 @@ IFS=$oldifs
 picks() { awk '
   { tid = $1; call = $2; sub(/\(.*/, "", call); cnt[tid, call]++
     if (!start && (call == "openat" || call == "open" || call == "creat") && ($0 ~ /O_CREAT/ || call == "creat") && $0 !~ /= -1/) { start = 1; t = tid }
-    if (start && tid == t && (call == "openat" || call == "write" || call == "close" || call == "rename" || call == "renameat" || call == "renameat2" || call == "fsync" || call == "fdatasync")) {
+    if (start && tid == t && (call == "openat" || call == "write" || call == "pwrite64" || call == "close" || call == "rename" || call == "renameat" || call == "renameat2" || call == "fsync" || call == "fdatasync")) {
       k = ++m[call]; num[call, k] = cnt[tid, call] } }
   END { for (c in m) { n = m[c]; print c, num[c, 1]; if (n > 1) print c, num[c, 2]
           if (n > 2) print c, num[c, int((n + 1) / 2)]; if (n > 3) print c, num[c, n] } }' "$1" | sort -u; }
@@ -156,7 +157,7 @@ for c in $cases; do IFS=$oldifs
     [ "$have_strace" = 1 ] || continue
     for p in $(picks "$g.trace" | tr ' ' ':'); do call=${p%%:*}; k=${p#*:}
       for e in ENOSPC EIO; do
-        [ "$e" = EIO ] && [ "$call" != close ] && [ "$call" != fsync ] && [ "$call" != write ] && continue
+        [ "$e" = EIO ] && [ "$call" != close ] && [ "$call" != fsync ] && [ "$call" != write ] && [ "$call" != pwrite64 ] && continue
         [ "$st" = absent ] && [ "$e" = EIO ] && continue
         prepare "$d" "$st" "$out" "$others" "$oldargs"; before=$(state "$d")
         (cd "$d" && strace -f -o /dev/null -e trace="$call" -e inject="$call":error="$e":when="$k" "$hfvis" $args > /dev/null 2> "$dir/err")

@@ -368,7 +368,8 @@ static hfvis_status cli_write_encoded(const char *path, size_t need, cli_encoder
 static hfvis_status cli_enc_binvox(const void *what, void *out, size_t cap, size_t *written);
 static hfvis_status cli_enc_visfield(const void *what, void *out, size_t cap, size_t *written);
 static hfvis_status cli_enc_partial(const void *what, void *out, size_t cap, size_t *written);
-static hfvis_status cli_pfm_save(const char *path, const float *px, int w, int h, int channels, ptrdiff_t stride);
+static hfvis_status cli_pfm_save(const char *path, const float *px, int w, int h, int channels, ptrdiff_t stride,
+                                 int threads);
 static hfvis_status cli_enc_pgm_range(const void *what, void *out, size_t cap, size_t *written);
 static hfvis_status cli_pgm_save(const char *path, const float *px, int w, int h, ptrdiff_t stride,
                                  float lo, float hi);

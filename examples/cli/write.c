@@ -165,43 +165,109 @@ static hfvis_status cli_enc_partial(const void *what, void *out, size_t cap, siz
 }
 /* A PFM streamed in slices of rows, never whole in memory (a 4096^2 horizon map of 16 planes
  * is 1 GiB, whose first touch alone took seconds on this project's VMs): the header of the
- * whole image, then slice after slice from the bottom row up as PFM stores them, each encoded
- * by the library (hfvis_pfm_encode of the slice's rows: its pixel bytes, after the slice's own
- * header, are the file's next bytes) into one buffer of about CLI_PFM_SLICE bytes. The file is
- * the one hfvis_pfm_encode makes of the whole image, byte for byte (cli_test checks the header
- * and size; the pixel bytes are the library's). */
+ * whole image, then the rows from the bottom up as PFM stores them, in slices of at most
+ * CLI_PFM_SLICE bytes, each encoded by the library (hfvis_pfm_encode of the slice's rows: its pixel bytes,
+ * after the slice's own header, are the file's bytes at the slice's place) into its thread's
+ * buffer and written there with pwrite, the slices over the run's threads (cli_threaded_rows,
+ * while CLI_ROWS_BAND rows fit in CLI_PFM_SLICE bytes):
+ * the kernel's copy of a large output into the page cache, the larger part of the write, is then
+ * shared by the threads too (a 1 GiB horizon map: 2.3 s of a 17.5 s one-thread run here; docs/
+ * performance.md, "Threads"). Without POSIX threads, one thread writes the slices in order
+ * with fwrite. The file is the one hfvis_pfm_encode makes of the whole image, byte for byte
+ * (cli_test checks the header and size, and --threads 1 against 2; the pixel bytes are the
+ * library's). */
 #define CLI_PFM_SLICE ((size_t)8 << 20)
-static hfvis_status cli_pfm_save(const char *path, const float *px, int w, int h, int channels, ptrdiff_t stride)
+typedef struct cli_pfm_slices {
+    const float *px;
+    int w, h, channels;
+    ptrdiff_t stride;
+    FILE *f;                   /* one thread: written in order with fwrite */
+    int fd;                    /* threads: the file's descriptor for pwrite, -1 for fwrite */
+    long long base;            /* the header's length: where the bottom row starts */
+    unsigned char **buf;       /* one slice buffer per thread */
+    int *err;                  /* the errno of a failed write, per thread */
+} cli_pfm_slices;
+
+static hfvis_status cli_pfm_slice(void *ctx, int y0, int y1, int thread)
+{
+    const cli_pfm_slices *j = (const cli_pfm_slices *)ctx;
+    const size_t row = (size_t)j->w * (size_t)j->channels * 4;
+    const size_t slice = hfvis_pfm_encode_size(j->w, y1 - y0, j->channels), pixels = row * (size_t)(y1 - y0);
+    const unsigned char *p = j->buf[thread] + (slice - pixels);
+    size_t written = 0, left = pixels;
+    hfvis_status s = hfvis_pfm_encode(j->px + (ptrdiff_t)y0 * j->stride * j->channels, j->w, y1 - y0, j->channels,
+                                      j->stride, j->buf[thread], slice, &written);
+    if (s != HFVIS_OK) return s;
+    if (written != slice) return HFVIS_ERR_INVALID_ARGUMENT; /* not the library's layout */
+    if (j->fd < 0) return fwrite(p, 1, pixels, j->f) == pixels ? HFVIS_OK : HFVIS_ERR_IO;
+#if CLI_HAVE_THREADS
+    {
+        off_t at = (off_t)(j->base + (long long)row * (long long)(j->h - y1)); /* rows [y0, y1), bottom up */
+        while (left > 0) {
+            ssize_t n = pwrite(j->fd, p, left, at);
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) { /* a short write that makes no progress is a failure too (disk full) */
+                j->err[thread] = n < 0 ? errno : ENOSPC;
+                return HFVIS_ERR_IO;
+            }
+            p += n, at += n, left -= (size_t)n;
+        }
+    }
+#else
+    (void)left;
+#endif
+    return HFVIS_OK;
+}
+
+static hfvis_status cli_pfm_save(const char *path, const float *px, int w, int h, int channels, ptrdiff_t stride,
+                                 int threads)
 {
     const size_t need = hfvis_pfm_encode_size(w, h, channels), row = (size_t)w * (size_t)channels * 4;
-    const int rows = row >= CLI_PFM_SLICE ? 1 : h < (int)(CLI_PFM_SLICE / row) ? h : (int)(CLI_PFM_SLICE / row);
+    int rows = row >= CLI_PFM_SLICE ? 1 : h < (int)(CLI_PFM_SLICE / row) ? h : (int)(CLI_PFM_SLICE / row);
     char head[64];
-    int len, y1, ok;
-    unsigned char *buf;
+    int len, ok, t, err[CLI_THREADS_MAX];
+    unsigned char *buf[CLI_THREADS_MAX];
     char *tmp = NULL;
-    FILE *f;
+    cli_pfm_slices j;
     hfvis_status s = HFVIS_OK;
     if (need == 0 || stride < w) return HFVIS_ERR_INVALID_ARGUMENT;
     len = snprintf(head, sizeof head, "P%c\n%d %d\n-1.0\n", channels == 3 ? 'F' : 'f', w, h);
     if (len <= 0 || (size_t)len != need - row * (size_t)h) return HFVIS_ERR_INVALID_ARGUMENT; /* not the library's */
-    buf = (unsigned char *)cli_huge_malloc(hfvis_pfm_encode_size(w, rows, channels));
-    if (!buf) return HFVIS_ERR_OUT_OF_MEMORY;
-    f = ex_atomic_open(path, &tmp);
-    if (!f) {
-        free(buf);
-        return HFVIS_ERR_IO;
+    if (!CLI_HAVE_THREADS || threads < 1) threads = 1;
+    if (threads > CLI_THREADS_MAX) threads = CLI_THREADS_MAX;
+    if (threads > (h - 1) / CLI_ROWS_BAND + 1) threads = (h - 1) / CLI_ROWS_BAND + 1;
+    if (row > CLI_PFM_SLICE / CLI_ROWS_BAND) threads = 1; /* a thread's band would pass CLI_PFM_SLICE */
+    if (threads > 1) rows = h < CLI_ROWS_BAND ? h : CLI_ROWS_BAND; /* cli_threaded_rows' bands */
+    memset(&j, 0, sizeof j);
+    for (t = 0; t < threads; t++) {
+        err[t] = 0;
+        buf[t] = (unsigned char *)cli_huge_malloc(hfvis_pfm_encode_size(w, rows, channels));
+        if (!buf[t]) s = HFVIS_ERR_OUT_OF_MEMORY;
     }
-    ok = fwrite(head, 1, (size_t)len, f) == (size_t)len;
-    for (y1 = h; ok && y1 > 0; y1 -= rows) { /* rows [y0, y1), the topmost slice last */
-        const int y0 = y1 > rows ? y1 - rows : 0;
-        const size_t slice = hfvis_pfm_encode_size(w, y1 - y0, channels), pixels = row * (size_t)(y1 - y0);
-        size_t written = 0;
-        s = hfvis_pfm_encode(px + (ptrdiff_t)y0 * stride * channels, w, y1 - y0, channels, stride, buf, slice,
-                             &written);
-        ok = s == HFVIS_OK && written == slice && fwrite(buf + (slice - pixels), 1, pixels, f) == pixels;
+    j.f = s == HFVIS_OK ? ex_atomic_open(path, &tmp) : NULL;
+    if (!j.f) {
+        for (t = 0; t < threads; t++) free(buf[t]);
+        return s == HFVIS_OK ? HFVIS_ERR_IO : s;
     }
-    free(buf);
-    if (!ex_atomic_close(f, tmp, path, ok) && s == HFVIS_OK) s = HFVIS_ERR_IO; /* a short write too */
+    j.px = px, j.w = w, j.h = h, j.channels = channels, j.stride = stride;
+    j.fd = -1, j.base = len, j.buf = buf, j.err = err;
+    ok = fwrite(head, 1, (size_t)len, j.f) == (size_t)len && fflush(j.f) == 0;
+#if CLI_HAVE_THREADS
+    if (threads > 1) j.fd = fileno(j.f); /* the header is flushed: the slices go after it */
+#endif
+    if (ok && j.fd >= 0) {
+        s = cli_threaded_rows(h, threads, cli_pfm_slice, &j);
+    } else if (ok) {
+        int y1;
+        for (y1 = h; s == HFVIS_OK && y1 > 0; y1 -= rows) /* the topmost slice last */
+            s = cli_pfm_slice(&j, y1 > rows ? y1 - rows : 0, y1, 0);
+    }
+    ok = ok && s == HFVIS_OK;
+    for (t = 0; t < threads; t++) {
+        if (err[t]) errno = err[t]; /* the failed write's reason, for the caller's message */
+        free(buf[t]);
+    }
+    if (!ex_atomic_close(j.f, tmp, path, ok) && s == HFVIS_OK) s = HFVIS_ERR_IO; /* a short write too */
     if (s == HFVIS_OK) cli_drop_aux(path);
     return s;
 }
@@ -312,7 +378,7 @@ static int cli_save(const cli_args *a, cli_output out)
         return 0;
     }
     if (!a->out_pgm) {
-        s = cli_pfm_save(a->out, px, w, h, channels, w);
+        s = cli_pfm_save(a->out, px, w, h, channels, w, cli_run_threads(a));
     } else {
         if (a->has_range) { lo = a->range_lo; hi = a->range_hi; }
         if (channels == 1) {
