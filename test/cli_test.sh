@@ -940,6 +940,23 @@ else
   echo "SKIP --threads cap: one online core"
 fi
 
+# A PFM of more than one band of rows is written by the run's threads (each slice at its place,
+# pwrite): the file is the one-thread file byte for byte, for planes (a horizon map, 320 rows,
+# the last band short) and for three channels (environment light of a 24 x 150 grid)
+LC_ALL=C awk 'BEGIN { w = 24; h = 150; print "P2"; print w, h; print 255
+  for (y = 0; y < h; y++) { s = ""; for (x = 0; x < w; x++) s = s " " int(128 + 100 * sin(x / 3) * cos(y / 4)); print s } }' > "$dir/tall.pgm"
+for t in 1 2 3; do
+  "$hfvis" horizon "$h" --dirs 16 --threads $t --quiet -o "$dir/pw_h$t.pfm" &&
+  "$hfvis" light "$dir/tall.pgm" --env "$dir/env3.pfm" --dirs 8 --threads $t --quiet -o "$dir/pw_n$t.pfm" || bad "PFM by threads: --threads $t failed"
+done
+sz=$(wc -c < "$dir/pw_h2.pfm" | tr -d ' ')
+cmp -s "$dir/pw_h1.pfm" "$dir/pw_h2.pfm" && cmp -s "$dir/pw_h1.pfm" "$dir/pw_h3.pfm" && [ "$sz" = $((15 + 24 * 320 * 4)) ] &&
+  ok "PFM written by 2 and 3 threads (horizon, 320 rows) equals one thread's byte for byte" ||
+  bad "PFM written by threads (horizon) differs from one thread's (size $sz)"
+cmp -s "$dir/pw_n1.pfm" "$dir/pw_n2.pfm" && cmp -s "$dir/pw_n1.pfm" "$dir/pw_n3.pfm" &&
+  ok "PFM written by 2 and 3 threads (light, 3 channels, 150 rows) equals one thread's byte for byte" ||
+  bad "PFM written by threads (light, 3 channels) differs from one thread's"
+
 # A failed summary never follows a replaced OUT (issue: `visibility --stats > /dev/full` exited 1
 # after renaming the new file over OUT): the counters are printed first, OUT is then untouched.
 if [ -w /dev/full ]; then
