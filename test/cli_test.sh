@@ -1588,6 +1588,22 @@ expect_fail "solar: --sun-hours that cannot be written (a directory)" 1 $sol "$d
 [ "$(cat "$dir/skeep.tif")" = old ] && ok "solar: failing outputs leave OUT untouched" || bad "solar: OUT replaced by a run that failed"
 expect_ok "solar: an .asc output of one band" "$dir/s1.asc" $sol "$dir/flat.pgm" -o "$dir/s1.asc"
 
+# ---- users' tests of the mesh and screen commands (eleventh session) ------------------------
+# voxelize --mode surface of the unit cube fitted without padding: the three faces on the grid's
+# far side (x, y, z = 1) were dropped (37 of the 56 shell voxels at --res 4; 169 of 296 at 8)
+expect_ok "voxelize surface: the cube's far faces" "$dir/us.raw" voxelize "$dir/cube.obj" --res 4 -o "$dir/us.raw"
+grep -q ', 56 set' "$dir/stdout" && ok "voxelize surface: the cube's 56 shell voxels, as conservative" || bad "voxelize surface of the cube: $(cat "$dir/stdout")"
+"$hfvis" voxelize "$dir/cube.obj" --res 4 --mode conservative --quiet -o "$dir/uc.raw"
+cmp -s "$dir/us.raw" "$dir/uc.raw" && ok "voxelize surface of the cube: the conservative shell, voxel for voxel" || bad "voxelize surface of the cube differs from its conservative shell"
+for ax in x y z; do
+  expect_ok "voxelize surface --axis $ax: both faces" "$dir/ua.raw" voxelize "$dir/cube.obj" --res 4 --axis $ax -o "$dir/ua.raw"
+  grep -q ', 32 set' "$dir/stdout" && ok "voxelize surface --axis $ax: 2 faces of 16" || bad "voxelize surface --axis $ax: $(cat "$dir/stdout")"
+done
+for m in slicing clipping; do
+  expect_ok "voxelize surface --method $m: the far faces" "$dir/um.raw" voxelize "$dir/cube.obj" --res 4 --method $m -o "$dir/um.raw"
+  grep -q ', 56 set' "$dir/stdout" && ok "voxelize surface --method $m: 56 voxels" || bad "voxelize surface --method $m: $(cat "$dir/stdout")"
+done
+
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

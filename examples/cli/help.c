@@ -430,10 +430,12 @@ static const char cli_help_tail[] =
     "  --res N           voxels along the longest side, 1..2048 (required)\n" \
     "  --mode M          surface (default): the voxels that hold a pixel-centre sample of a\n" \
     "                    triangle in the sweep along its dominant axis ([G12] ch. 6, 6-separating\n" \
-    "                    with --axis all); conservative: every voxel a triangle touches (exact\n" \
-    "                    triangle-box overlap); solid: the voxels whose centre is inside the\n" \
-    "                    mesh, by ray parity (the mesh must be closed unless --open: the\n" \
-    "                    parity of every column along x, y and z is checked, whatever --axis)\n" \
+    "                    with --axis all; a sample on the grid's far side, as a cube's top\n" \
+    "                    face, goes into the last voxel); conservative: every voxel a triangle\n" \
+    "                    touches (exact triangle-box overlap); solid: the voxels whose centre\n" \
+    "                    is inside the mesh, by ray parity (the mesh must be closed unless\n" \
+    "                    --open: the parity of every column along x, y and z is checked,\n" \
+    "                    whatever --axis)\n" \
     "  --axis A          surface: dominant (default), all (three sweeps merged, [G12] Alg. 4) or\n" \
     "                    x, y, z (one sweep); solid: the parity ray direction x, y or z (default z)\n" \
     "  --method M        surface: pixel (the pixel-centre rule, default), slicing (geometry-shader\n" \

@@ -327,9 +327,22 @@ static int cli_run_voxelize(const cli_args *a)
     }
     if (s != HFVIS_OK) { rc = cli_status("voxelize", s, 0); goto done; }
     voxels = (size_t)grid.dims[0] * (size_t)grid.dims[1] * (size_t)grid.dims[2];
-    occ = (uint8_t *)malloc(voxels);
+    if (a->vox_mode == VOX_SURFACE) { /* one more layer on each axis: see below */
+        size_t grown = (size_t)(grid.dims[0] + 1) * (size_t)(grid.dims[1] + 1) * (size_t)(grid.dims[2] + 1);
+        if (grown > HFVIS_VOLUME_MAX_VOXELS) { rc = cli_status("voxelize", HFVIS_ERR_LIMIT, 0); goto done; }
+        occ = (uint8_t *)malloc(grown);
+    } else {
+        occ = (uint8_t *)malloc(voxels);
+    }
     if (!occ) { rc = cli_status("voxelize", HFVIS_ERR_OUT_OF_MEMORY, 0); goto done; }
     if (a->vox_mode == VOX_SURFACE) {
+        /* The library's grid is half-open: a surface on its far side (the mesh's top with
+         * --padding 0, where the grid ends: a cube's three far faces) has the depth dims[a], the
+         * slab past the grid. The sweep runs on the grid grown by one layer on each axis (same
+         * origin and cell, so the same fragments), and that layer is folded into the last one. */
+        hfvis_volume_grid big = grid;
+        const size_t n0 = (size_t)grid.dims[0], n1 = (size_t)grid.dims[1], n2 = (size_t)grid.dims[2];
+        size_t ii, jj, kk;
         hfvis_voxelize_options o = hfvis_voxelize_options_default();
         static const hfvis_voxelize_axes axes[] = {HFVIS_AXES_DOMINANT, HFVIS_AXES_DOMINANT,
                                                    HFVIS_AXES_ALL, HFVIS_AXES_ONLY_X,
@@ -343,7 +356,20 @@ static int cli_run_voxelize(const cli_args *a)
                            "needs >= 7, clipping >= 3)", a->max_vertices);
             goto done;
         }
-        s = hfvis_voxelize_occupancy(&mesh, &grid, &o, occ);
+        big.dims[0]++, big.dims[1]++, big.dims[2]++;
+        s = hfvis_voxelize_occupancy(&mesh, &big, &o, occ);
+        /* in place: voxel (i, j, k) reads grown indices >= its own, never one written before */
+        for (kk = 0; s == HFVIS_OK && kk < n2; kk++)
+            for (jj = 0; jj < n1; jj++)
+                for (ii = 0; ii < n0; ii++) {
+                    size_t dk, dj, di;
+                    uint8_t v = 0;
+                    for (dk = 0; dk <= (size_t)(kk + 1 == n2); dk++)
+                        for (dj = 0; dj <= (size_t)(jj + 1 == n1); dj++)
+                            for (di = 0; di <= (size_t)(ii + 1 == n0); di++)
+                                v |= occ[((kk + dk) * (n1 + 1) + jj + dj) * (n0 + 1) + ii + di];
+                    occ[(kk * n1 + jj) * n0 + ii] = v;
+                }
         for (i = 0; s == HFVIS_OK && i < voxels; i++) count += occ[i];
     } else {
         hfvis_binary_voxel_options o = hfvis_binary_voxel_options_default();

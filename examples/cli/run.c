@@ -103,10 +103,10 @@ static cli_cost cli_estimate_ssao(const cli_args *a, int w, int h, int channels)
     (void)channels;
     return cli_cost_of(n * 8.0, n * (a->has_dirs ? K : 16.0) * (W > H ? W : H) / 4.0, "depth samples");
 }
-/* voxelize: one byte a voxel */
+/* voxelize: one byte a voxel (of the grid grown by one layer on each axis for --mode surface) */
 static cli_cost cli_estimate_voxelize(const cli_args *a, int w, int h, int channels)
 {
-    double v = pow((double)a->res, 3.0);
+    double v = pow((double)a->res + (a->vox_mode == VOX_SURFACE ? 1.0 : 0.0), 3.0);
     (void)w, (void)h, (void)channels;
     return cli_cost_of(v, v, "voxels");
 }
