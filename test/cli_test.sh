@@ -1603,6 +1603,14 @@ for m in slicing clipping; do
   expect_ok "voxelize surface --method $m: the far faces" "$dir/um.raw" voxelize "$dir/cube.obj" --res 4 --method $m -o "$dir/um.raw"
   grep -q ', 56 set' "$dir/stdout" && ok "voxelize surface --method $m: 56 voxels" || bad "voxelize surface --method $m: $(cat "$dir/stdout")"
 done
+# --max-memory of visfield and volgi: the estimate took visfield's --positions frequency n for the
+# count K and stale defaults (82 positions, 16 directions: 0.16 MiB for the default 4226 x 32^2
+# field, 17 MB in f32), and volgi's default --res as 0 voxels (0.0007 MiB for 32^3)
+expect_fail "visfield: the default field over --max-memory 8M" 1 visfield "$dir/cube.obj" --format f32 --max-memory 8M -o "$fdir/x.hfvf"
+expect_fail "visfield: --positions 4226 --dirs 64 over --max-memory 16M" 1 visfield "$dir/cube.obj" --positions 4226 --dirs 64 --max-memory 16M -o "$fdir/x.hfvf"
+expect_ok "visfield: a small field under --max-memory 1M" "$dir/um.hfvf" visfield "$dir/cube.obj" --positions 82 --dirs 8 --max-memory 1M -o "$dir/um.hfvf"
+expect_fail "volgi: the default 32^3 grid over --max-memory 1M" 1 volgi --room --size 8x8 --max-memory 1M -o "$fdir/x.pfm"
+expect_fail "volgi: --res 128 over --max-memory 256M" 1 volgi --room --size 8x8 --res 128 --max-memory 256M -o "$fdir/x.pfm"
 
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"

@@ -110,23 +110,32 @@ static cli_cost cli_estimate_voxelize(const cli_args *a, int w, int h, int chann
     (void)w, (void)h, (void)channels;
     return cli_cost_of(v, v, "voxels");
 }
-/* volgi: 16 floats a voxel and the image */
+/* volgi (hfvis_volgi_render's "Memory"): per voxel of the res^3 bound the geometry (40 bytes), the P
+ * and A volumes (96) and the propagation's scratch (48, + 24 normalized); per pixel the G-buffer
+ * (24), the image and its encoding (12 + 12); --res defaults to the library's 32 */
 static cli_cost cli_estimate_volgi(const cli_args *a, int w, int h, int channels)
 {
+    double v = pow((double)(a->res ? a->res : HFVIS_VOLGI_DEFAULT_RESOLUTION), 3.0);
+    double per_voxel = 40.0 + 96.0 + 48.0 + (a->vg_transfer == HFVIS_VOLGI_TRANSFER_CONE_NORMALIZED ? 24.0 : 0.0);
     (void)w, (void)h, (void)channels;
-    return cli_cost_of(pow((double)a->res, 3.0) * 4.0 * 16.0 + (double)a->vg_width * (double)a->vg_height * 12.0,
-                       pow((double)a->res, 3.0) * (double)a->iterations, "voxel updates");
+    return cli_cost_of(v * per_voxel + (double)a->vg_width * (double)a->vg_height * 48.0,
+                       v * (double)a->iterations, "voxel updates");
 }
-/* visfield: the AO image, or the field's P x 2 x D^2 texels */
+/* visfield: the AO image (W x H, S^2 rays a pixel), or the field's maps (hfvis_visfield_size of
+ * K positions, D^2 directions; defaults 4226 and 32) twice: built, and encoded for the file */
 static cli_cost cli_estimate_visfield(const cli_args *a, int w, int h, int channels)
 {
-    double P = (double)(a->vf_positions ? a->vf_positions : 82), D = (double)(a->has_dirs ? a->dirs : 16);
+    const int n = a->vf_positions ? a->vf_positions : 32; /* --positions keeps n: K = 2(2n^2+2n+1) */
+    const double K = (double)hfvis_visfield_position_count(n), D = (double)(a->has_dirs ? a->dirs : 32);
+    const double bytes = a->vf_format == HFVIS_VISFIELD_F32 || a->vf_format == HFVIS_VISFIELD_NORMAL ? 4.0
+                         : a->vf_format == HFVIS_VISFIELD_BIT ? 0.125 : 1.0;
     (void)w, (void)h, (void)channels;
-    if (a->vf_ao)
-        return cli_cost_of((double)a->vg_width * (double)a->vg_height * 4.0,
-                           (double)a->vg_width * (double)a->vg_height * 4.0 / 4.0 * (double)(a->vf_rays ? a->vf_rays : 64),
-                           "rays");
-    return cli_cost_of(P * 2.0 * D * D * 4.0, P * 2.0 * D * D, "direction texels");
+    if (a->vf_ao) {
+        const double W = a->vf_has_size ? (double)a->vg_width : 256.0, H = a->vf_has_size ? (double)a->vg_height : 256.0;
+        const double S = (double)(a->vf_rays ? a->vf_rays : 16);
+        return cli_cost_of(W * H * 4.0 * 2.0, W * H * S * S, "rays");
+    }
+    return cli_cost_of(K * D * D * bytes * 2.0, K * D * D, "rays");
 }
 /* meshao: the image's buffers, its rays */
 static cli_cost cli_estimate_meshao(const cli_args *a, int w, int h, int channels)
