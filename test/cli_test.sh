@@ -1611,6 +1611,15 @@ expect_fail "visfield: --positions 4226 --dirs 64 over --max-memory 16M" 1 visfi
 expect_ok "visfield: a small field under --max-memory 1M" "$dir/um.hfvf" visfield "$dir/cube.obj" --positions 82 --dirs 8 --max-memory 1M -o "$dir/um.hfvf"
 expect_fail "volgi: the default 32^3 grid over --max-memory 1M" 1 volgi --room --size 8x8 --max-memory 1M -o "$fdir/x.pfm"
 expect_fail "volgi: --res 128 over --max-memory 256M" 1 volgi --room --size 8x8 --res 128 --max-memory 256M -o "$fdir/x.pfm"
+# ssao --near/--far: accepted and ignored with linear depth (exit 0), and planes the library
+# rejects (near <= 0, near >= far) reported as "invalid argument", exit 1, after the input was read
+{ printf 'Pf\n16 12\n-1\n'; i=0; while [ $i -lt 192 ]; do printf '\000\000\000\077'; i=$((i + 1)); done; } > "$dir/uhalf.pfm"
+expect_fail "ssao: --near with linear depth" 2 ssao "$dir/uhalf.pfm" --near 1 -o "$fdir/x.pfm"
+expect_fail "ssao: --far with linear depth" 2 ssao "$dir/uhalf.pfm" --depth linear --far 10 -o "$fdir/x.pfm"
+expect_fail "ssao: --depth gl with --near > --far" 2 ssao "$dir/uhalf.pfm" --depth gl --near 10 --far 1 -o "$fdir/x.pfm"
+expect_fail "ssao: --depth d3d with --near 0 in perspective" 2 ssao "$dir/uhalf.pfm" --depth d3d --near 0 --far 1 -o "$fdir/x.pfm"
+expect_ok "ssao: --depth gl, orthographic --near 0" "$dir/ugl.pfm" ssao "$dir/uhalf.pfm" --depth gl --ortho 0.1 --near 0 --far 10 -o "$dir/ugl.pfm"
+expect_last_float "ssao: a flat GL depth buffer is open" "$dir/ugl.pfm" 0 1e-6
 
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"

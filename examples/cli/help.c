@@ -470,7 +470,8 @@ static const char cli_help_tail[] =
     "                    ignores it)\n" \
     "  --guard PIXELS    guard band per side (default 10 % of the width and height)\n" \
     "  --depth ENC       linear view depth (default), gl or d3d window depth, reversed Z; the\n" \
-    "                    hardware encodings need --near and --far\n" \
+    "                    hardware encodings need --near and --far (0 < near < far; 0 <= near\n" \
+    "                    with --ortho), which linear depth refuses\n" \
     "Default PGM range 0:1.\n"
 
 #define CLI_MOSAIC_HELP                                                                              \

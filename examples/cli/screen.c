@@ -23,6 +23,14 @@ static int cli_set_ssao(cli_args *a, const char *f, const char *v)
  * default box pattern takes rings of 8 directions (hfvis_ssao_directions_box). */
 static int cli_check_ssao(const cli_args *a)
 {
+    if (a->ssao_depth == SSAO_DEPTH_LINEAR && (a->ssao_has_near || a->ssao_has_far))
+        return cli_error(CLI_EXIT_USAGE, a->ssao_has_near ? "--near" : "--far", "applies only to "
+                         "--depth gl, d3d or reversed (linear depth has no planes)");
+    if (a->ssao_has_near && a->ssao_has_far /* hfvis_depth_linear's planes */
+        && (!(a->ssao_has_ortho ? a->ssao_near >= 0.0 : a->ssao_near > 0.0)
+            || !(a->ssao_near < a->ssao_far) || !isfinite(a->ssao_far)))
+        return cli_error(CLI_EXIT_USAGE, "--near", "expected finite planes %s near < far, got %g and %g",
+                         a->ssao_has_ortho ? "0 <=" : "0 <", a->ssao_near, a->ssao_far);
     if (!a->has_dirs || a->ssao_method == SSAO_RAYTRACE) return 0;
     if (a->ssao_method == SSAO_LSAO && (a->dirs % 8 != 0 || a->dirs > HFVIS_SSAO_MAX_DIRECTIONS))
         return cli_error(CLI_EXIT_USAGE, "--dirs", "ssao --method lsao takes a multiple of 8 in "
