@@ -1620,6 +1620,13 @@ expect_fail "ssao: --depth gl with --near > --far" 2 ssao "$dir/uhalf.pfm" --dep
 expect_fail "ssao: --depth d3d with --near 0 in perspective" 2 ssao "$dir/uhalf.pfm" --depth d3d --near 0 --far 1 -o "$fdir/x.pfm"
 expect_ok "ssao: --depth gl, orthographic --near 0" "$dir/ugl.pfm" ssao "$dir/uhalf.pfm" --depth gl --ortho 0.1 --near 0 --far 10 -o "$dir/ugl.pfm"
 expect_last_float "ssao: a flat GL depth buffer is open" "$dir/ugl.pfm" 0 1e-6
+# a flat mesh at --res 2048 is a 2048 x 2048 x 1 grid (4 MiB) but a 2048^3 .binvox cube: it was
+# voxelized, then refused as "invalid argument"; now named before the run, and .raw still works
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n' > "$dir/usq.obj"
+expect_fail "voxelize: a .binvox cube past 2^31 voxels" 1 voxelize "$dir/usq.obj" --res 2048 -o "$fdir/x.binvox"
+case "$err_first" in *"2048^3"*) ok "voxelize: the .binvox refusal names the cube" ;; *) bad "voxelize .binvox refusal: $err_first" ;; esac
+expect_ok "voxelize: the same flat grid as .raw" "$dir/usq.raw" voxelize "$dir/usq.obj" --res 2048 -o "$dir/usq.raw"
+[ "$(wc -c < "$dir/usq.raw" | tr -d ' ')" = 4194304 ] && ok "voxelize: 2048 x 2048 x 1 bytes" || bad "voxelize flat .raw size"
 
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"

@@ -447,10 +447,10 @@ static const char cli_help_tail[] =
     "                    (default 0)\n" \
     "  --open            solid: leave columns that cross an open mesh an odd number of times\n" \
     "                    empty instead of failing\n" \
-    "OUT: *.binvox (the binvox format of viewvox/binvox: a cube of the largest side, run-length\n" \
-    "coded, translate and scale of the grid) or *.raw (one byte per voxel, 0 or 1, x fastest,\n" \
-    "then y, then z; the dimensions are printed). Prints the grid and the voxel count unless\n" \
-    "--quiet.\n"
+    "OUT: *.binvox (the binvox format of viewvox/binvox: a cube of the largest side, at most\n" \
+    "2^31 voxels, run-length coded, translate and scale of the grid) or *.raw (one byte per\n" \
+    "voxel, 0 or 1, x fastest, then y, then z; the dimensions are printed). Prints the grid and\n" \
+    "the voxel count unless --quiet.\n"
 
 #define CLI_SSAO_HELP \
     "usage: hfvis ssao DEPTH.pfm -o OUT [--method lsao|hbao|ffao|raytrace] [--fov-y DEG]\n" \

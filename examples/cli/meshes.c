@@ -327,6 +327,16 @@ static int cli_run_voxelize(const cli_args *a)
     }
     if (s != HFVIS_OK) { rc = cli_status("voxelize", s, 0); goto done; }
     voxels = (size_t)grid.dims[0] * (size_t)grid.dims[1] * (size_t)grid.dims[2];
+    if (a->out_binvox) { /* binvox pads the grid to the cube of its largest side */
+        size_t side = (size_t)(grid.dims[0] > grid.dims[1] ? grid.dims[0] : grid.dims[1]);
+        side = side > (size_t)grid.dims[2] ? side : (size_t)grid.dims[2];
+        if (side * side * side > HFVIS_VOLUME_MAX_VOXELS) {
+            rc = cli_error(CLI_EXIT_ERROR, a->out, "%s: the .binvox cube of %zu^3 voxels (the grid is "
+                           "%d x %d x %d) exceeds 2^31; write .raw or lower --res",
+                           hfvis_status_string(HFVIS_ERR_LIMIT), side, grid.dims[0], grid.dims[1], grid.dims[2]);
+            goto done;
+        }
+    }
     if (a->vox_mode == VOX_SURFACE) { /* one more layer on each axis: see below */
         size_t grown = (size_t)(grid.dims[0] + 1) * (size_t)(grid.dims[1] + 1) * (size_t)(grid.dims[2] + 1);
         if (grown > HFVIS_VOLUME_MAX_VOXELS) { rc = cli_status("voxelize", HFVIS_ERR_LIMIT, 0); goto done; }
