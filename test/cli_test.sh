@@ -1628,6 +1628,14 @@ case "$err_first" in *"2048^3"*) ok "voxelize: the .binvox refusal names the cub
 expect_ok "voxelize: the same flat grid as .raw" "$dir/usq.raw" voxelize "$dir/usq.obj" --res 2048 -o "$dir/usq.raw"
 [ "$(wc -c < "$dir/usq.raw" | tr -d ' ')" = 4194304 ] && ok "voxelize: 2048 x 2048 x 1 bytes" || bad "voxelize flat .raw size"
 
+# the mends of the review: volgi's zero --up named (it was reported under --eye), an intensity
+# beyond float named as such (it said "must be >= 0"), ssao's background depths in its help
+expect_fail "volgi: --up 0,0,0" 2 volgi --room --size 8x8 --up 0,0,0 -o "$fdir/x.pfm"
+case "$err_first" in *"--up"*zero*) ok "volgi: a zero --up named" ;; *) bad "volgi --up 0,0,0: $err_first" ;; esac
+expect_fail "volgi: a light of 1e39" 2 volgi --room --size 8x8 --light point:1,1,1:1e39 -o "$fdir/x.pfm"
+case "$err_first" in *finite*3.4e38*) ok "volgi: an intensity beyond float named" ;; *) bad "volgi --light ...:1e39: $err_first" ;; esac
+"$hfvis" ssao --help 2>&1 | grep -q "is background" && ok "ssao --help: background depths" || bad "ssao --help does not say which depths are background"
+
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

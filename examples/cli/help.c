@@ -458,7 +458,8 @@ static const char cli_help_tail[] =
     "         [--depth linear|gl|d3d|reversed --near N --far F]\n" \
     "Screen-space ambient obscurance of a depth buffer (one-channel PFM or PGM, row 0 at the\n" \
     "top). OUT is obscurance in [0, 1] (0 = open) of the inner pixels: the buffer minus the\n" \
-    "guard band on every side.\n" \
+    "guard band on every side. A depth that is not finite or <= 0 (after --depth's decoding)\n" \
+    "is background: it occludes nothing and gets 0.\n" \
     "  --method M        lsao: line-sweep AO ([P3]); hbao: horizon-based ray march, out to\n" \
     "                    a sixteenth of the image height; ffao: far-field AO ([P4], default);\n" \
     "                    raytrace: the screen-space ray-traced reference (256 rays per\n" \

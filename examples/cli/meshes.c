@@ -235,7 +235,7 @@ static int cli_volgi_light(cli_args *a, const char *v)
     }
     for (c = 0; c < 3; c++) {
         if (!(vals[c] >= 0.0 && vals[c] <= CLI_FLT_MAX))
-            return cli_error(CLI_EXIT_USAGE, "--light", "intensity must be >= 0, got '%s'", v);
+            return cli_error(CLI_EXIT_USAGE, "--light", "intensity: finite values in 0..3.4e38 (float), got '%s'", v);
         L.intensity[c] = (float)vals[c];
     }
     for (c = 0; c < 3; c++)
@@ -286,6 +286,8 @@ static int cli_check_volgi(const cli_args *a)
     if (a->has_albedo && a->albedo > 1.0)
         return cli_error(CLI_EXIT_USAGE, "--albedo", "expected an albedo in 0..1, got %g", a->albedo);
     if (a->res == 1) return cli_error(CLI_EXIT_USAGE, "--res", "volgi needs at least 2 voxels");
+    if (a->vg_up[0] == 0.0 && a->vg_up[1] == 0.0 && a->vg_up[2] == 0.0)
+        return cli_error(CLI_EXIT_USAGE, "--up", "the up direction is zero");
     return 0;
 }
 
