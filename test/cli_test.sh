@@ -1628,6 +1628,26 @@ case "$err_first" in *"2048^3"*) ok "voxelize: the .binvox refusal names the cub
 expect_ok "voxelize: the same flat grid as .raw" "$dir/usq.raw" voxelize "$dir/usq.obj" --res 2048 -o "$dir/usq.raw"
 [ "$(wc -c < "$dir/usq.raw" | tr -d ' ')" = 4194304 ] && ok "voxelize: 2048 x 2048 x 1 bytes" || bad "voxelize flat .raw size"
 
+# ---- users' tests of light, indirect, gi, sky, sum, info and azimuths (eleventh session) ----
+# --dirs past a command's own limit: --exact past K = 16384 (directions need max(|a|, |b|) <=
+# ceil(K/4) <= 4096) ran and failed as "invalid argument" (azimuths: "--azimuth0: not a usable
+# azimuth"), gi past 4096 slices the same, solar past 4096 as "an input is out of range
+# (latitude 46, longitude 15)", all after reading IN; now refused by name before the run
+expect_fail "azimuths --exact --dirs 16385" 2 azimuths --dirs 16385 --exact
+case "$err_first" in *"--dirs"*16384*) ok "azimuths --exact --dirs 16385 names --dirs" ;; *) bad "azimuths --exact --dirs 16385: $err_first" ;; esac
+"$hfvis" azimuths --dirs 16384 --exact > "$dir/stdout" 2> "$dir/stderr" && [ "$(wc -l < "$dir/stdout" | tr -d ' ')" = 16384 ] \
+  && ok "azimuths --exact --dirs 16384: 16384 lines" || bad "azimuths --exact --dirs 16384: $(head -n 1 "$dir/stderr")"
+for c in horizon skyview sky; do
+  expect_fail "$c --exact --dirs 20000" 2 $c "$dir/flat.pgm" --exact --dirs 20000 -o "$fdir/x.pfm"
+done
+expect_fail "light --exact --dirs 16385" 2 light "$dir/flat.pgm" --env "$dir/env1.pfm" --exact --dirs 16385 -o "$fdir/x.pfm"
+expect_fail "sky --exact --dirs 20000, a part" 2 sky "$dir/flat.pgm" --exact --dirs 20000 --dir-range 0:4 -o "$fdir/x.hfvs"
+expect_fail "gi --dirs 4097" 2 gi "$dir/flat.pgm" --dirs 4097 -o "$fdir/x.pfm"
+case "$err_first" in *"--dirs"*4096*) ok "gi --dirs 4097 names the limit" ;; *) bad "gi --dirs 4097: $err_first" ;; esac
+expect_ok "gi --dirs 4096" "$dir/ug4096.pfm" gi "$dir/flat.pgm" --dirs 4096 -o "$dir/ug4096.pfm"
+expect_fail "solar --dirs 4097" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --dirs 4097 -o "$fdir/x.pfm"
+case "$err_first" in *"--dirs"*4096*) ok "solar --dirs 4097 names --dirs" ;; *) bad "solar --dirs 4097: $err_first" ;; esac
+
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -187,7 +187,7 @@ static const cli_flag cli_flags[] = {
       "                    sample gets its own ray along the nearest rational direction, no\n"
       "                    interpolation between lattice lines (right at walls, roofs, cliffs;\n"
       "                    'hfvis azimuths --exact' prints the directions used). visibility,\n"
-      "                    indirect and gi keep the lattice\n" },
+      "                    indirect and gi keep the lattice. --dirs K: 1..16384 with --exact\n" },
     { "--exact-near", "D", CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT)
                          | CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_HILLSHADE),
       CLI_INT_AT(0, HFVIS_RAY_NEAR_CELLS_MAX, "an integer 0..65536", 0.0, "0 (every sample)", "cells",
@@ -1021,6 +1021,9 @@ static int cli_parse(int argc, char **argv, cli_args *a)
             return cli_error(CLI_EXIT_USAGE, "--lattice", "cannot be combined with --exact");
         a->exact = !a->lattice;
     }
+    if (a->exact && a->has_dirs && a->dirs > 4 * HFVIS_RAY_DENOMINATOR_MAX) /* hfvis.h "Exact rays": N = ceil(K/4) */
+        return cli_error(CLI_EXIT_USAGE, "--dirs", "exact rays take K <= %d (directions (a, b) with max(|a|, |b|) "
+                         "<= ceil(K/4) <= %d), got %d", 4 * HFVIS_RAY_DENOMINATOR_MAX, HFVIS_RAY_DENOMINATOR_MAX, a->dirs);
     if (a->has_exact_near && a->exact_near > 0 && !a->exact)
         return cli_error(CLI_EXIT_USAGE, "--exact-near", "applies to exact rays: add --exact");
     if (a->has_exact_near && a->exact_near > 0 && a->max_distance > 0.0)
