@@ -1647,6 +1647,16 @@ case "$err_first" in *"--dirs"*4096*) ok "gi --dirs 4097 names the limit" ;; *) 
 expect_ok "gi --dirs 4096" "$dir/ug4096.pfm" gi "$dir/flat.pgm" --dirs 4096 -o "$dir/ug4096.pfm"
 expect_fail "solar --dirs 4097" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --dirs 4097 -o "$fdir/x.pfm"
 case "$err_first" in *"--dirs"*4096*) ok "solar --dirs 4097 names --dirs" ;; *) bad "solar --dirs 4097: $err_first" ;; esac
+# --border-cells was accepted and ignored (exit 0, the same bytes) with an open border (the default)
+# and by gi (its pyramid) and visibility (nothing outside the grid is counted or lies between a
+# point and a sample); now refused by name. With clamp/wrap the other commands still take it.
+expect_fail "sky --border-cells with the default open border" 2 sky "$dir/hill.pgm" --border-cells 5 -o "$fdir/x.pfm"
+expect_fail "light --border open --border-cells" 2 light "$dir/hill.pgm" --env "$dir/env1.pfm" --border open --border-cells 5 -o "$fdir/x.pfm"
+expect_fail "gi --border clamp --border-cells" 2 gi "$dir/hill.pgm" --border clamp --border-cells 5 -o "$fdir/x.pfm"
+expect_fail "visibility --border wrap --border-cells" 2 visibility "$dir/hill.pgm" --border wrap --border-cells 5 -o "$fdir/x.pfm"
+expect_ok "sky --border clamp --border-cells 2" "$dir/ubc2.pfm" sky "$dir/hill.pgm" --border clamp --border-cells 2 -o "$dir/ubc2.pfm"
+expect_ok "sky --border clamp" "$dir/ubc.pfm" sky "$dir/hill.pgm" --border clamp -o "$dir/ubc.pfm"
+cmp -s "$dir/ubc2.pfm" "$dir/ubc.pfm" && bad "sky --border clamp: --border-cells 2 changed nothing" || ok "sky --border clamp: --border-cells 2 changes the result"
 
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"

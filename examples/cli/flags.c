@@ -174,7 +174,7 @@ static const cli_flag cli_flags[] = {
       CLI_WORDS(CLI_V_CHOICE, "open"),
       "open (nothing outside the grid, default), clamp (edge heights extend\n"
       "                    outward) or wrap (periodic field)\n" },
-    { "--border-cells", "N", CLI_BORDER | CLI_ONLY(CMD_SOLAR),
+    { "--border-cells", "N", (CLI_BORDER & ~(CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VISIBILITY))) | CLI_ONLY(CMD_SOLAR),
       CLI_INT_AT(1, HFVIS_IMAGE_MAX_DIM, "an integer 1..1048576", 0.0, "max(W,H)", "cells",
                  border_cells, 0),
       "clamp/wrap: lines start N cells outside the grid, 1..1048576\n"
@@ -1016,6 +1016,9 @@ static int cli_parse(int argc, char **argv, cli_args *a)
                              "split the range into more parts instead");
         a->threads = 1;
     }
+    if (a->border_cells > 0 && a->border == HFVIS_BORDER_OPEN) /* only clamp and wrap lines start outside */
+        return cli_error(CLI_EXIT_USAGE, "--border-cells", "applies to --border clamp or wrap (an open border "
+                         "has nothing outside the grid)");
     if (a->cmd == CMD_HILLSHADE) { /* a GIS product: exact shadows unless --lattice */
         if (a->lattice && a->exact)
             return cli_error(CLI_EXIT_USAGE, "--lattice", "cannot be combined with --exact");
