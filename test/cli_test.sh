@@ -1636,6 +1636,36 @@ expect_fail "volgi: a light of 1e39" 2 volgi --room --size 8x8 --light point:1,1
 case "$err_first" in *finite*3.4e38*) ok "volgi: an intensity beyond float named" ;; *) bad "volgi --light ...:1e39: $err_first" ;; esac
 "$hfvis" ssao --help 2>&1 | grep -q "is background" && ok "ssao --help: background depths" || bad "ssao --help does not say which depths are background"
 
+# ---- users' tests of light, indirect, gi, sky, sum, info and azimuths (eleventh session) ----
+# --dirs past a command's own limit: --exact past K = 16384 (directions need max(|a|, |b|) <=
+# ceil(K/4) <= 4096) ran and failed as "invalid argument" (azimuths: "--azimuth0: not a usable
+# azimuth"), gi past 4096 slices the same, solar past 4096 as "an input is out of range
+# (latitude 46, longitude 15)", all after reading IN; now refused by name before the run
+expect_fail "azimuths --exact --dirs 16385" 2 azimuths --dirs 16385 --exact
+case "$err_first" in *"--dirs"*16384*) ok "azimuths --exact --dirs 16385 names --dirs" ;; *) bad "azimuths --exact --dirs 16385: $err_first" ;; esac
+"$hfvis" azimuths --dirs 16384 --exact > "$dir/stdout" 2> "$dir/stderr" && [ "$(wc -l < "$dir/stdout" | tr -d ' ')" = 16384 ] \
+  && ok "azimuths --exact --dirs 16384: 16384 lines" || bad "azimuths --exact --dirs 16384: $(head -n 1 "$dir/stderr")"
+for c in horizon skyview sky; do
+  expect_fail "$c --exact --dirs 20000" 2 $c "$dir/flat.pgm" --exact --dirs 20000 -o "$fdir/x.pfm"
+done
+expect_fail "light --exact --dirs 16385" 2 light "$dir/flat.pgm" --env "$dir/env1.pfm" --exact --dirs 16385 -o "$fdir/x.pfm"
+expect_fail "sky --exact --dirs 20000, a part" 2 sky "$dir/flat.pgm" --exact --dirs 20000 --dir-range 0:4 -o "$fdir/x.hfvs"
+expect_fail "gi --dirs 4097" 2 gi "$dir/flat.pgm" --dirs 4097 -o "$fdir/x.pfm"
+case "$err_first" in *"--dirs"*4096*) ok "gi --dirs 4097 names the limit" ;; *) bad "gi --dirs 4097: $err_first" ;; esac
+expect_ok "gi --dirs 4096" "$dir/ug4096.pfm" gi "$dir/flat.pgm" --dirs 4096 -o "$dir/ug4096.pfm"
+expect_fail "solar --dirs 4097" 2 solar "$dir/flat.pgm" --latitude 46 --longitude 15 --day 2026-06-21 --dirs 4097 -o "$fdir/x.pfm"
+case "$err_first" in *"--dirs"*4096*) ok "solar --dirs 4097 names --dirs" ;; *) bad "solar --dirs 4097: $err_first" ;; esac
+# --border-cells was accepted and ignored (exit 0, the same bytes) with an open border (the default)
+# and by gi (its pyramid) and visibility (nothing outside the grid is counted or lies between a
+# point and a sample); now refused by name. With clamp/wrap the other commands still take it.
+expect_fail "sky --border-cells with the default open border" 2 sky "$dir/hill.pgm" --border-cells 5 -o "$fdir/x.pfm"
+expect_fail "light --border open --border-cells" 2 light "$dir/hill.pgm" --env "$dir/env1.pfm" --border open --border-cells 5 -o "$fdir/x.pfm"
+expect_fail "gi --border clamp --border-cells" 2 gi "$dir/hill.pgm" --border clamp --border-cells 5 -o "$fdir/x.pfm"
+expect_fail "visibility --border wrap --border-cells" 2 visibility "$dir/hill.pgm" --border wrap --border-cells 5 -o "$fdir/x.pfm"
+expect_ok "sky --border clamp --border-cells 2" "$dir/ubc2.pfm" sky "$dir/hill.pgm" --border clamp --border-cells 2 -o "$dir/ubc2.pfm"
+expect_ok "sky --border clamp" "$dir/ubc.pfm" sky "$dir/hill.pgm" --border clamp -o "$dir/ubc.pfm"
+cmp -s "$dir/ubc2.pfm" "$dir/ubc.pfm" && bad "sky --border clamp: --border-cells 2 changed nothing" || ok "sky --border clamp: --border-cells 2 changes the result"
+
 rm -rf "$dir"
 echo "cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -174,7 +174,7 @@ static const cli_flag cli_flags[] = {
       CLI_WORDS(CLI_V_CHOICE, "open"),
       "open (nothing outside the grid, default), clamp (edge heights extend\n"
       "                    outward) or wrap (periodic field)\n" },
-    { "--border-cells", "N", CLI_BORDER | CLI_ONLY(CMD_SOLAR),
+    { "--border-cells", "N", (CLI_BORDER & ~(CLI_ONLY(CMD_GI) | CLI_ONLY(CMD_VISIBILITY))) | CLI_ONLY(CMD_SOLAR),
       CLI_INT_AT(1, HFVIS_IMAGE_MAX_DIM, "an integer 1..1048576", 0.0, "max(W,H)", "cells",
                  border_cells, 0),
       "clamp/wrap: lines start N cells outside the grid, 1..1048576\n"
@@ -187,7 +187,7 @@ static const cli_flag cli_flags[] = {
       "                    sample gets its own ray along the nearest rational direction, no\n"
       "                    interpolation between lattice lines (right at walls, roofs, cliffs;\n"
       "                    'hfvis azimuths --exact' prints the directions used). visibility,\n"
-      "                    indirect and gi keep the lattice\n" },
+      "                    indirect and gi keep the lattice. --dirs K: 1..16384 with --exact\n" },
     { "--exact-near", "D", CLI_ONLY(CMD_HORIZON) | CLI_ONLY(CMD_SKYVIEW) | CLI_ONLY(CMD_SKY) | CLI_ONLY(CMD_LIGHT)
                          | CLI_ONLY(CMD_SHADOW) | CLI_ONLY(CMD_HILLSHADE),
       CLI_INT_AT(0, HFVIS_RAY_NEAR_CELLS_MAX, "an integer 0..65536", 0.0, "0 (every sample)", "cells",
@@ -1016,11 +1016,17 @@ static int cli_parse(int argc, char **argv, cli_args *a)
                              "split the range into more parts instead");
         a->threads = 1;
     }
+    if (a->border_cells > 0 && a->border == HFVIS_BORDER_OPEN) /* only clamp and wrap lines start outside */
+        return cli_error(CLI_EXIT_USAGE, "--border-cells", "applies to --border clamp or wrap (an open border "
+                         "has nothing outside the grid)");
     if (a->cmd == CMD_HILLSHADE) { /* a GIS product: exact shadows unless --lattice */
         if (a->lattice && a->exact)
             return cli_error(CLI_EXIT_USAGE, "--lattice", "cannot be combined with --exact");
         a->exact = !a->lattice;
     }
+    if (a->exact && a->has_dirs && a->dirs > 4 * HFVIS_RAY_DENOMINATOR_MAX) /* hfvis.h "Exact rays": N = ceil(K/4) */
+        return cli_error(CLI_EXIT_USAGE, "--dirs", "exact rays take K <= %d (directions (a, b) with max(|a|, |b|) "
+                         "<= ceil(K/4) <= %d), got %d", 4 * HFVIS_RAY_DENOMINATOR_MAX, HFVIS_RAY_DENOMINATOR_MAX, a->dirs);
     if (a->has_exact_near && a->exact_near > 0 && !a->exact)
         return cli_error(CLI_EXIT_USAGE, "--exact-near", "applies to exact rays: add --exact");
     if (a->has_exact_near && a->exact_near > 0 && a->max_distance > 0.0)

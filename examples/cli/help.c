@@ -78,7 +78,7 @@
     "  --normals N       central (default): central differences; horn: Horn's 3x3 stencil, as\n"    \
     "                    r.slope.aspect and gdaldem (what r.sun reads)\n"                           \
     "  --sun-radius DEG  shade the sun's disc (default: its centre); --dirs K: directions of the\n" \
-    "                    horizon map (default 64; 16: a day about 5x faster, within 0.2 %)\n"       \
+    "                    horizon map, 1..4096 (default 64; 16: a day 5x faster, within 0.2 %)\n"    \
     "  --horizons H      exact (default), near-far (exact within 8 cells: about 0.6x the map's\n"   \
     "                    time) or lattice ([P1]: about 4x faster, misses one-cell walls' shadow)\n" \
     "  --max-distance R  the horizons' search radius: --window X0,Y0,W,H pieces (each output\n"     \

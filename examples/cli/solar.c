@@ -5,6 +5,7 @@
  * sweeps.c (cli_load_map), write.c (cli_save). */
 
 #define CLI_SOLAR_MAX_DAYS 36600 /* hfvis_solar_irradiation's limit: a century */
+#define CLI_SOLAR_MAX_DIRS 4096  /* hfvis_solar_options.directions: 1..4096 (hfvis.h) */
 
 /* "YYYY-MM-DD" into y, m, d: a four-digit year (-YYYY before the year 0, astronomical
  * numbering: 0000 is 1 BC) within SPA's years -2000..6000, two-digit month and day (the library
@@ -181,6 +182,9 @@ static int cli_check_solar(const cli_args *a)
     if (a->sol_has_end && !a->sol_has_start)
         return cli_error(CLI_EXIT_USAGE, "--end", "needs --start DATE");
     if (!a->sol_has_start) return cli_error(CLI_EXIT_USAGE, "solar", "missing --day DATE or --start DATE --end DATE");
+    if (a->has_dirs && a->dirs > CLI_SOLAR_MAX_DIRS)
+        return cli_error(CLI_EXIT_USAGE, "--dirs", "solar's horizon map takes 1..%d directions, got %d",
+                         CLI_SOLAR_MAX_DIRS, a->dirs);
     if (a->sol_has_linke + a->sol_has_linke_monthly + (a->sol_linke_map != NULL) > 1)
         return cli_error(CLI_EXIT_USAGE, a->sol_linke_map ? "--linke-map" : "--linke-monthly", "conflicts with %s: "
                          "give one of --linke, --linke-monthly and --linke-map",

@@ -30,6 +30,9 @@ static int cli_check_gi(const cli_args *a)
 {
     if (a->has_shininess && !a->has_specular)
         return cli_error(CLI_EXIT_USAGE, "--shininess", "needs --specular S");
+    if (a->has_dirs && a->dirs > HFVIS_NS_MAX_DIRECTIONS)
+        return cli_error(CLI_EXIT_USAGE, "--dirs", "gi takes 1..%d azimuthal slices, got %d",
+                         HFVIS_NS_MAX_DIRECTIONS, a->dirs);
     return cli_check_light_flags(a);
 }
 
