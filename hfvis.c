@@ -8738,31 +8738,53 @@ static int hf_floor_div(int num, int den) /* den > 0 */
     return (num % den != 0 && num < 0) ? q - 1 : q;
 }
 
-/* The default rule for 32 < K <= 360 (hfvis.h, "Exact rays"): the cheapest direction (smallest
- * |a| + |b|: a line's sweep costs |a| + |b| - 1 crossings per receiver) within HF_EXACT_TAU of
- * psi_k, searched up to denominator HF_EXACT_CHEAP_N (which always holds one: for any slope some
- * p/q with q <= 256 lies within 1/256 of it, Dirichlet, and 1/256 rad < 0.25 deg). The nearest
- * direction with N = ceil(K/4) costs |a| + |b| ~ 0.8 N on average (K = 256: 51.5, K = 360: 73);
- * the cheapest within 0.25 deg costs 12-21 at every K in that range. 0.25 deg <= a quarter of
- * the sector 360/K deg there, so the chosen azimuths keep their order. */
+/* The default rule for K > 32 (hfvis.h, "Exact rays"): the cheapest direction (smallest
+ * |a| + |b|: a line's sweep costs |a| + |b| - 1 crossings per receiver) within tau_K of psi_k,
+ * a quarter of the sector 2 pi/K but at most HF_EXACT_TAU = 0.25 deg (the two agree at K = 360),
+ * searched up to the denominator hf_exact_cheap_bound(K), which always holds one: for any slope
+ * some p/q with q <= Q lies within 1/Q of it (Dirichlet), and 1/Q < tau_K (K <= 360: Q = 256,
+ * 1/256 rad < 0.25 deg; K > 360: Q > 2K/pi). The nearest direction with N = ceil(K/4) costs
+ * |a| + |b| ~ 0.8 N on average (K = 256: 51.5, K = 360: 73, K = 1024: about 205); the cheapest
+ * within 0.25 deg costs 12-21 at every K up to 360. A quarter sector keeps the chosen azimuths
+ * in order. (Until 2026-12: K > 360 took the nearest with N = ceil(K/4), whose cost grew with K:
+ * sky light --exact of a 256^2 fBm took 2.1 s at K = 256 and 100 s at K = 1024.) */
 #define HF_EXACT_TAU (0.25 * HFVIS__PI / 180.0)
 #define HF_EXACT_CHEAP_N 256
 #define HF_EXACT_CHEAP_KMAX 360
 
+/* The cheap rule of K directions: its search bound Q and tolerance tau (above). */
+static int hf_exact_cheap_bound(int K)
+{
+    double q = ceil(2.0 * (double)K / HFVIS__PI) + 1.0;
+    if (K <= HF_EXACT_CHEAP_KMAX) return HF_EXACT_CHEAP_N;
+    return q < (double)HFVIS_RAY_DENOMINATOR_MAX ? (int)q : HFVIS_RAY_DENOMINATOR_MAX;
+}
+static double hf_exact_cheap_tau(int K)
+{
+    return K <= HF_EXACT_CHEAP_KMAX ? HF_EXACT_TAU : 0.5 * HFVIS__PI / (double)K;
+}
+
+/* The largest |a|, |b| of rule N (hf_exact_bound). */
+static int hf_exact_rule_max(int N)
+{
+    return N > 0 ? N : hf_exact_cheap_bound(-N);
+}
+
 /* The resolved direction rule of a run of K directions (hfvis.h): N > 0, the nearest direction
- * with max(|a|, |b|) <= N; -HF_EXACT_CHEAP_N, the cheapest within HF_EXACT_TAU. */
+ * with max(|a|, |b|) <= N; N = -K, the cheapest within a quarter sector (above). K beyond
+ * 4 HFVIS_RAY_DENOMINATOR_MAX keeps ceil(K/4), which the callers refuse. */
 static int hf_exact_bound(const hfvis_sweep_options *o, int K)
 {
     if (o->ray_denominator > 0) return o->ray_denominator;
     if (K == 1) return HF_EXACT_SUN_DENOMINATOR;
-    if (K > 32 && K <= HF_EXACT_CHEAP_KMAX) return -HF_EXACT_CHEAP_N;
+    if (K > 32 && K <= 4 * HFVIS_RAY_DENOMINATOR_MAX) return -K;
     return (K + 3) / 4 > HF_EXACT_MIN_DENOMINATOR ? (K + 3) / 4 : HF_EXACT_MIN_DENOMINATOR;
 }
 
 /* The direction of rule N (hf_exact_bound) for azimuth psi. N > 0: the nearest (a, b), gcd 1,
- * max(|a|, |b|) <= N; ties go to the smaller |a| + |b| (the cheaper sweep). N < 0: the smallest
- * |a| + |b| with max(|a|, |b|) <= -N within HF_EXACT_TAU of psi; ties go to the nearer. Searched
- * in the first octant: for each a, the two b beside a tan(theta). */
+ * max(|a|, |b|) <= N; ties go to the smaller |a| + |b| (the cheaper sweep). N = -K: the smallest
+ * |a| + |b| with max(|a|, |b|) <= hf_exact_cheap_bound(K) within hf_exact_cheap_tau(K) of psi;
+ * ties go to the nearer. Searched in the first octant: for each a, the two b beside a tan(theta). */
 static hf_ray hf_ray_nearest(double psi, int N)
 {
     hf_ray r;
@@ -8777,16 +8799,18 @@ static hf_ray hf_ray_nearest(double psi, int N)
     th = mirror ? HFVIS__HALF_PI - rr : rr;
     tn = tan(th);
     best = th; /* (1, 0) */
-    if (N < 0) { /* the cheapest within HF_EXACT_TAU; a + b only grows with a */
+    if (N < 0) { /* the cheapest within tau; a + b only grows with a */
+        const int Q = hf_exact_cheap_bound(-N);
+        const double tau = hf_exact_cheap_tau(-N);
         int cost = INT_MAX;
-        for (a = 1; a <= -N && a < cost; a++) {
+        for (a = 1; a <= Q && a < cost; a++) {
             double bf = floor((double)a * tn);
             for (c = 0; c < 2; c++) {
                 int b = (int)bf + c;
                 double dev;
                 if (b < 0 || b > a || hf_gcd(a, b) != 1) continue;
                 dev = fabs(atan2((double)b, (double)a) - th);
-                if (dev <= HF_EXACT_TAU && (a + b < cost || (a + b == cost && dev < best))) {
+                if (dev <= tau && (a + b < cost || (a + b == cost && dev < best))) {
                     cost = a + b;
                     best = dev;
                     ba = a;
@@ -8794,7 +8818,7 @@ static hf_ray hf_ray_nearest(double psi, int N)
                 }
             }
         }
-        N = cost == INT_MAX ? -N : 0; /* none (never, see HF_EXACT_CHEAP_N): the nearest */
+        N = cost == INT_MAX ? Q : 0; /* none (only where Q is capped at 4096): the nearest */
     }
     for (a = 1; a <= N; a++) {
         double bf = floor((double)a * tn);
@@ -10532,7 +10556,7 @@ static hfvis_status hf_exact_init(hf_exact *E, const hfvis_grid *g, int K,
     if (hf_radius_on(o) &&
         16.0 * (2.0 * ((double)o->origin_x + (double)o->origin_y + (double)o->extent_width +
                        (double)o->extent_height + 2.0 * (double)side + 4.0 * (double)E->R) + 4.0) *
-                (double)E->N * (double)E->N > 4503599627370496.0)
+                (double)hf_exact_rule_max(E->N) * (double)hf_exact_rule_max(E->N) > 4503599627370496.0)
         return HFVIS_ERR_LIMIT;
     for (k = 0; k < K; k++) {
         hf_ray r = hf_ray_nearest(o->azimuth0_rad + 2.0 * HFVIS__PI * (double)k / (double)K, E->N);

@@ -659,8 +659,9 @@ typedef struct hfvis_sweep_options {
     hfvis_ray_mode rays;            /* default HFVIS_RAYS_LATTICE; EXACT: see "Exact rays" */
     int ray_denominator;            /* EXACT: bound N on the direction's integer components,
                                        1..HFVIS_RAY_DENOMINATOR_MAX (the nearest direction);
-                                       0 = the default rule of "Exact rays": max(5, ceil(K/4)),
-                                       the cheapest within 0.25 deg for 32 < K <= 360, and 64
+                                       0 = the default rule of "Exact rays": max(5, ceil(K/4))
+                                       for K <= 32, the cheapest within 0.25 deg (or a quarter
+                                       of the sector 360/K deg for K > 360) for K > 32, and 64
                                        for a single direction (K = 1, hfvis_sun_visibility) */
     double max_distance;            /* R, world units: occluders farther than R from the receiver,
                                        measured horizontally along the ray, are ignored; 0 =
@@ -891,9 +892,12 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     HFVIS_EXACT_SUP_MEAN_DEG / HFVIS_EXACT_SUP_P99_DEG (docs/exact-rays.md).
  *   - Rule: with opts->ray_denominator = N > 0, direction k is the representable direction
  *     nearest to psi_k = azimuth0 + 2 pi k/K (ties: the smaller |a| + |b|). The default (0):
- *     K = 1: N = 64; K <= 32 and K > 360: N = max(5, ceil(K/4)), nearest; 32 < K <= 360: the
- *     cheapest direction (smallest |a| + |b|, ties: the nearer; max(|a|, |b|) <= 256) within
- *     0.25 deg of psi_k, a quarter sector or less, so the azimuths keep their order.
+ *     K = 1: N = 64; K <= 32: N = max(5, ceil(K/4)), nearest; 32 < K <= 16384: the cheapest
+ *     direction (smallest |a| + |b|, ties: the nearer; max(|a|, |b|) <= 256 for K <= 360, else
+ *     <= min(4096, ceil(2K/pi) + 1)) within tau_K = min(0.25 deg, 90/K deg) of psi_k: a quarter
+ *     sector or less, so the azimuths keep their order (from K = 6433 on the bound is capped at
+ *     4096 and may hold no direction that near: then the nearest with max(|a|, |b|) <= 4096).
+ *     K > 16384 is HFVIS_ERR_INVALID_ARGUMENT in exact mode.
  *     hfvis_sweep_azimuths returns the K azimuths actually used and their quadrature weights.
  *     Largest deviation from psi_k with the default and azimuth0 = 0: K = 4, 8: 0; K = 16, 32:
  *     0.70 deg; K = 64: 0.18; K = 128: 0.20; K = 256: 0.23; K = 360: 0.245; K = 7: 1.18
@@ -902,8 +906,8 @@ HFVIS_API hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis
  *     where the lattice costs about one node, so closer directions cost longer sweeps: K = 16
  *     takes directions (1,0), (5,2), (1,1), (2,5): 3.5 crossings per receiver-direction on
  *     average, plus the interior samples below. The mean |a| + |b| of the default directions:
- *     K = 16: 4.2, K = 64: 11.7, K = 256: 15.5, K = 360: 20.5 (the nearest with N = ceil(K/4)
- *     would take 12.1, 51.5, 73). Measured (make bench, section exact, 512^2 and 1024^2,
+ *     K = 16: 4.2, K = 64: 11.7, K = 256: 15.5, K = 360: 20.5, K = 720: 27.8, K = 1024: 33.1,
+ *     K = 4096: 75.6 (the nearest with N = ceil(K/4) would take 12.1, 51.5, 73, 166, 222, 897). Measured (make bench, section exact, 512^2 and 1024^2,
  *     K = 16, a quiet run 2026-12-07): the horizon map 0.53-0.57x the lattice map's time on
  *     urban DSMs (no gather), 1.05-1.45x on fBm rough at the cell scale; the fused sky-view
  *     factor 1.12-1.36x and 1.81-3.08x (earlier runs: up to 2.1x and 4.1x);

@@ -1024,9 +1024,9 @@ static int cli_parse(int argc, char **argv, cli_args *a)
             return cli_error(CLI_EXIT_USAGE, "--lattice", "cannot be combined with --exact");
         a->exact = !a->lattice;
     }
-    if (a->exact && a->has_dirs && a->dirs > 4 * HFVIS_RAY_DENOMINATOR_MAX) /* hfvis.h "Exact rays": N = ceil(K/4) */
-        return cli_error(CLI_EXIT_USAGE, "--dirs", "exact rays take K <= %d (directions (a, b) with max(|a|, |b|) "
-                         "<= ceil(K/4) <= %d), got %d", 4 * HFVIS_RAY_DENOMINATOR_MAX, HFVIS_RAY_DENOMINATOR_MAX, a->dirs);
+    if (a->exact && a->has_dirs && a->dirs > 4 * HFVIS_RAY_DENOMINATOR_MAX) /* hfvis.h "Exact rays" */
+        return cli_error(CLI_EXIT_USAGE, "--dirs", "exact rays take K <= %d directions, got %d",
+                         4 * HFVIS_RAY_DENOMINATOR_MAX, a->dirs);
     if (a->has_exact_near && a->exact_near > 0 && !a->exact)
         return cli_error(CLI_EXIT_USAGE, "--exact-near", "applies to exact rays: add --exact");
     if (a->has_exact_near && a->exact_near > 0 && a->max_distance > 0.0)

@@ -496,8 +496,9 @@ static const char cli_help_tail[] =
     "grid (from east toward south, the library's psi). --azimuth0 is direction 0 in that\n" \
     "convention, degrees unless --radians. Without --exact: direction k is azimuth0 + 360k/K\n" \
     "(GRASS: counter-clockwise); with --exact: rational directions (a, b), the nearest with\n" \
-    "max(|a|, |b|) <= max(5, ceil(K/4)) (64 for K = 1), and for 32 < K <= 360 the cheapest\n" \
-    "(smallest |a| + |b|) within 0.25 degrees. IN, when given, is read as the run reads it\n" \
+    "max(|a|, |b|) <= max(5, ceil(K/4)) (64 for K = 1), and for K > 32 the cheapest (smallest\n" \
+    "|a| + |b|) within 0.25 degrees or, for K > 360, a quarter of the sector 360/K (K <=\n" \
+    "16384). IN, when given, is read as the run reads it\n" \
     "(the directions do not depend on it).\n"
 
 #define CLI_INFO_HELP \
