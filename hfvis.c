@@ -3552,10 +3552,18 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
     } else if (negative == 2) { /* the sweep: the positive plane, then the negative one */
         hfvis_openness_options one = *oo;
         hfvis_status s;
+        /* the positive plane waits in scratch until the negative run has succeeded: an error in
+           that run leaves out untouched */
+        float *pos = (float *)hfvis__alloc_array(o.alloc, hf_grid_count(grid), sizeof(float));
+        if (!pos) return HFVIS_ERR_OUT_OF_MEMORY;
         one.negative = 0;
-        if ((s = hfvis_openness(grid, K, &one, opts, out, out_stride)) != HFVIS_OK) return s;
+        s = hfvis_openness(grid, K, &one, opts, pos, W);
         one.negative = 1;
-        return hfvis_openness(grid, K, &one, opts, out + second, out_stride);
+        if (s == HFVIS_OK) s = hfvis_openness(grid, K, &one, opts, out + second, out_stride);
+        for (y = 0; s == HFVIS_OK && y < H; y++)
+            for (x = 0; x < W; x++) out[(ptrdiff_t)y * out_stride + x] = pos[(size_t)y * (size_t)W + (size_t)x];
+        hfvis__free(o.alloc, pos);
+        return s;
     } else { /* the sweep: a plane, its sums and (negative) the inverted surface */
         const size_t n = hf_grid_count(grid);
         float *plane = (float *)hfvis__alloc_array(o.alloc, n, sizeof(float));
