@@ -3552,10 +3552,18 @@ hfvis_status hfvis_openness(const hfvis_grid *grid, int K, const hfvis_openness_
     } else if (negative == 2) { /* the sweep: the positive plane, then the negative one */
         hfvis_openness_options one = *oo;
         hfvis_status s;
+        /* the positive plane waits in scratch until the negative run has succeeded: an error in
+           that run leaves out untouched */
+        float *pos = (float *)hfvis__alloc_array(o.alloc, hf_grid_count(grid), sizeof(float));
+        if (!pos) return HFVIS_ERR_OUT_OF_MEMORY;
         one.negative = 0;
-        if ((s = hfvis_openness(grid, K, &one, opts, out, out_stride)) != HFVIS_OK) return s;
+        s = hfvis_openness(grid, K, &one, opts, pos, W);
         one.negative = 1;
-        return hfvis_openness(grid, K, &one, opts, out + second, out_stride);
+        if (s == HFVIS_OK) s = hfvis_openness(grid, K, &one, opts, out + second, out_stride);
+        for (y = 0; s == HFVIS_OK && y < H; y++)
+            for (x = 0; x < W; x++) out[(ptrdiff_t)y * out_stride + x] = pos[(size_t)y * (size_t)W + (size_t)x];
+        hfvis__free(o.alloc, pos);
+        return s;
     } else { /* the sweep: a plane, its sums and (negative) the inverted surface */
         const size_t n = hf_grid_count(grid);
         float *plane = (float *)hfvis__alloc_array(o.alloc, n, sizeof(float));
@@ -9665,19 +9673,30 @@ static double hf_exact_inv_den(const hfvis_grid *g, int a, int b)
 static double hf_exact_cut(const hfvis_grid *g, hfvis_border border, int R, int x, int y, int a, int b,
                            double L, double ucut, double hr)
 {
-    double px = (double)x + ucut * (double)a / L, py = (double)y + ucut * (double)b / L, fx, fy;
+    /* the cell and the fractions from the offset (dx, dy) alone, not from x + dx: a tile and the
+       whole raster number the receiver differently, and x + dx would round differently */
+    double dx = ucut * (double)a / L, dy = ucut * (double)b / L, ix, iy, fx, fy;
     float z[4];
     int cx, cy;
-    if (!(ucut > 0.0) || fabs(px) > (double)INT_MAX / 2.0 || fabs(py) > (double)INT_MAX / 2.0) return -HFVIS__INF;
-    cx = a > 0 ? (int)ceil(px) - 1 : (int)floor(px);
-    cy = b > 0 ? (int)ceil(py) - 1 : (int)floor(py);
+    if (!(ucut > 0.0) || fabs(dx) > (double)INT_MAX / 4.0 || fabs(dy) > (double)INT_MAX / 4.0) return -HFVIS__INF;
+    ix = a > 0 ? ceil(dx) - 1.0 : floor(dx);
+    iy = b > 0 ? ceil(dy) - 1.0 : floor(dy);
+    if (fabs((double)x + ix) > (double)INT_MAX / 2.0 || fabs((double)y + iy) > (double)INT_MAX / 2.0) return -HFVIS__INF;
+    cx = x + (int)ix;
+    cy = y + (int)iy;
+    fx = dx - ix; /* exact: dx less an integer within 1 of it */
+    fy = dy - iy;
     if (!hf_exact_cell_taps(g, border, R, cx, cy, z)) {
-        if (a == 0 && hf_exact_cell_taps(g, border, R, cx - 1, cy, z)) cx--;
-        else if (b == 0 && hf_exact_cell_taps(g, border, R, cx, cy - 1, z)) cy--;
-        else return -HFVIS__INF;
+        if (a == 0 && hf_exact_cell_taps(g, border, R, cx - 1, cy, z)) {
+            cx--;
+            fx += 1.0;
+        } else if (b == 0 && hf_exact_cell_taps(g, border, R, cx, cy - 1, z)) {
+            cy--;
+            fy += 1.0;
+        } else {
+            return -HFVIS__INF;
+        }
     }
-    fx = px - (double)cx;
-    fy = py - (double)cy;
     {
         double z0 = (double)z[0], z1 = (double)z[1], z2 = (double)z[2], z3 = (double)z[3];
         double r0 = z0 + (z1 - z0) * fx, r1 = z2 + (z3 - z2) * fx;

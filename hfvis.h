@@ -839,7 +839,8 @@ HFVIS_API hfvis_openness_options hfvis_openness_options_default(void);
  *   O(K*W*H*radius/(cell_size*step_cells)); no allocation; progress once per row. Both signs
  *   (negative = 2) walk each ray once.
  * radius = 0: the exact sweep, hfvis_horizon_direction per direction, O(K*W*H); allocates
- *   W*H floats and W*H doubles (and W*H floats for negative) plus each sweep's scratch;
+ *   W*H floats and W*H doubles (and W*H floats for negative; negative = 2 holds the positive
+ *   plane in W*H floats more until the negative one is made) plus each sweep's scratch;
  *   progress once per direction (both signs: the positive run, then the negative one, each
  *   counting its K directions). Both ways each angle is rounded to float (as the horizon
  *   outputs hold it) and the K of a sample are summed in double, so with axis directions

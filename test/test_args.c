@@ -6257,6 +6257,15 @@ SW(horizon_lattice_naive)
 }
 SW(horizon_direction) { hfvis_sweep_options o = sweep_opts(al); return hfvis_horizon_direction(&g_ok, 4, 1, &o, AF(GW * GH), GW); }
 SW(openness) { hfvis_sweep_options o = sweep_opts(al); return hfvis_openness(&g_ok, 4, NULL, &o, AF(GW * GH), GW); }
+/* both signs by the sweep (radius 0): two runs, and a failure in the second (negative) one must
+ * not leave the first one's plane written */
+SW(openness_both)
+{
+    hfvis_sweep_options o = sweep_opts(al);
+    hfvis_openness_options oo = hfvis_openness_options_default();
+    oo.negative = 2;
+    return hfvis_openness(&g_ok, 4, &oo, &o, AF(2 * GW * GH), GW);
+}
 SW(horizon_map) { hfvis_sweep_options o = sweep_opts(al); return hfvis_horizon_map(&g_ok, 4, &o, AF(4 * GW * GH)); }
 /* exact rays: the same calls through the exact-mode paths */
 static hfvis_sweep_options exact_opts(const hfvis_allocator *al)
@@ -6908,7 +6917,7 @@ typedef struct sweep_entry {
 
 static const sweep_entry sweeps[] = {
     SWEEP(image_load), SWEEP(horizon_lattice), SWEEP(horizon_lattice_naive), SWEEP(horizon_direction),
-    SWEEP(openness),
+    SWEEP(openness), SWEEP_VARIANT(openness, openness_both),
     SWEEP(horizon_map), SWEEP(sky_light), SWEEP(sky_light_from_map), SWEEP(sky_view_factor),
     SWEEP(sweep_azimuths), SWEEP(horizon_exact_naive), SWEEP_VARIANT(horizon_map, horizon_map_exact),
     SWEEP_VARIANT(horizon_direction, horizon_direction_exact), SWEEP_VARIANT(sky_light, sky_light_exact),

@@ -249,6 +249,66 @@ TEST(tiles_direction_sums)
     }
 }
 
+/* The same with the far end of the window deciding: a short R on fBm, K not a multiple of 4
+ * (directions whose cut at R falls between grid lines at offsets that are not dyadic), every
+ * exact-mode kind of sums. The cut's surface point was interpolated at the receiver's grid
+ * position plus the offset, so a tile (its own numbering) rounded it differently from the
+ * whole raster in the last bits of the double sums. */
+TEST(tiles_direction_sums_cut_at_radius)
+{
+    static const hfvis_sum_kind kinds[] = {HFVIS_SUM_SKY_VIEW, HFVIS_SUM_SKY_LIGHT, HFVIS_SUM_ENV_LIGHT};
+    static const int Ks[] = {3, 5, 7};
+    static const double radii[] = {1.0, 2.7};
+    static const float env_radiance[3 * 4 * 2] = {1.0f, 0.5f, 0.8f, 0.2f, 0.6f, 0.9f, 0.3f, 0.7f,
+                                                  0.4f, 1.1f, 0.2f, 0.5f, 0.9f, 0.1f, 0.6f, 0.8f,
+                                                  0.7f, 0.3f, 1.2f, 0.4f, 0.5f, 0.6f, 0.2f, 0.9f};
+    static double whole[2 * MAXN], part[2 * MAXN];
+    const hfvis_env env = {env_radiance, 3, 4, 2};
+    int W = 23, H = 17, x0 = 5, y0 = 4, w = 4, h = 4, ki, Ki, ri, x, y, c, bad = 0;
+    hfvis_grid g = test_grid(zbuf, W, H, 1.0);
+    make_field(0, zbuf, W, H, 1.0, 99u);
+    for (ki = 0; ki < 3; ki++)
+        for (Ki = 0; Ki < 3; Ki++)
+            for (ri = 0; ri < 2; ri++) {
+                hfvis_sweep_options o = hfvis_sweep_options_default(), to;
+                int ch = kinds[ki] == HFVIS_SUM_ENV_LIGHT ? 2 : 1, halo, tx0, ty0, tw, th;
+                hfvis_grid t;
+                o.rays = HFVIS_RAYS_EXACT;
+                o.max_distance = radii[ri];
+                halo = hfvis_tile_halo(o.max_distance, 1.0, o.rays);
+                tx0 = x0 - halo < 0 ? 0 : x0 - halo;
+                ty0 = y0 - halo < 0 ? 0 : y0 - halo;
+                tw = (x0 + w + halo > W ? W : x0 + w + halo) - tx0;
+                th = (y0 + h + halo > H ? H : y0 + h + halo) - ty0;
+                for (y = 0; y < th; y++)
+                    for (x = 0; x < tw; x++) tile_z[y * tw + x] = zbuf[(ty0 + y) * W + tx0 + x];
+                t = test_grid(tile_z, tw, th, 1.0);
+                to = o;
+                to.origin_x = tx0;
+                to.origin_y = ty0;
+                to.extent_width = W;
+                to.extent_height = H;
+                to.receiver_x = x0 - tx0;
+                to.receiver_y = y0 - ty0;
+                to.receiver_width = w;
+                to.receiver_height = h;
+                CHECK_EQ_STATUS(hfvis_direction_sums(&g, Ks[Ki], kinds[ki], &env, NULL, &o, whole), HFVIS_OK);
+                CHECK_EQ_STATUS(hfvis_direction_sums(&t, Ks[Ki], kinds[ki], &env, NULL, &to, part), HFVIS_OK);
+                for (y = y0; y < y0 + h; y++)
+                    for (x = x0; x < x0 + w; x++)
+                        for (c = 0; c < ch; c++) {
+                            double a = whole[(y * W + x) * ch + c], b = part[((y - ty0) * tw + x - tx0) * ch + c];
+                            if (memcmp(&a, &b, sizeof a) != 0) {
+                                if (bad < 3)
+                                    printf("     kind %d K %d R %g: (%d, %d) channel %d: whole %.17g tile %.17g\n",
+                                           (int)kinds[ki], Ks[Ki], radii[ri], x, y, c, a, b);
+                                bad++;
+                            }
+                        }
+            }
+    CHECK(bad == 0);
+}
+
 /* The receiver rectangle alone (R unlimited, the default path): the same values inside, the
  * output untouched outside; R = +INFINITY is R = 0 bit for bit. */
 TEST(receiver_rectangle_and_unlimited)
@@ -373,6 +433,7 @@ int main(int argc, char **argv)
     RUN(tiles_equal_whole_run_lattice);
     RUN(tiles_equal_whole_run_exact);
     RUN(tiles_direction_sums);
+    RUN(tiles_direction_sums_cut_at_radius);
     RUN(receiver_rectangle_and_unlimited);
     RUN(radius_limits_and_arguments);
     return TEST_DONE();
