@@ -366,7 +366,7 @@ TEST(azimuths_and_weights)
 TEST(large_k_cheapest_within_a_quarter_sector)
 {
     static const int Ks[] = {361, 720, 1024, 4096};
-    static double az[4096], w[4096];
+    static double az[4096], w[4096], big[16384];
     hfvis_sweep_options o = exact_opts(0.0, HFVIS_BORDER_OPEN, 0);
     hfvis_grid g = test_grid(zbuf, 13, 11, 1.0);
     uint64_t s = 5;
@@ -400,8 +400,9 @@ TEST(large_k_cheapest_within_a_quarter_sector)
         CHECK(cheap >= (int)(LARGE_K_CHEAP_SHARE * (double)n));
         printf("     K = 1024: %d of %d first-octant directions with |a| + |b| <= 64\n", cheap, n);
     }
-    CHECK_EQ_STATUS(hfvis_sweep_azimuths(16384, &o, NULL, w), HFVIS_OK);
-    CHECK_EQ_STATUS(hfvis_sweep_azimuths(16385, &o, NULL, w), HFVIS_ERR_INVALID_ARGUMENT);
+    CHECK_EQ_STATUS(hfvis_sweep_azimuths(16384, &o, big, NULL), HFVIS_OK);
+    for (k = 1; k < 16384; k++) CHECK(big[k] > big[k - 1]);
+    CHECK_EQ_STATUS(hfvis_sweep_azimuths(16385, &o, big, NULL), HFVIS_ERR_INVALID_ARGUMENT);
     (void)test_fbm(zbuf, 13, 11, 4.0, 4.0, 0, 9);
     for (j = 0; j < 13 * 11; j++) zbuf[j] += (float)(2.0 * fields_uniform(&s)); /* rough */
     check_against_oracle(&g, 720, &o);
