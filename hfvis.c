@@ -8752,10 +8752,9 @@ static int hf_floor_div(int num, int den) /* den > 0 */
  * searched up to the denominator hf_exact_cheap_bound(K), which always holds one: for any slope
  * some p/q with q <= Q lies within 1/Q of it (Dirichlet), and 1/Q < tau_K (K <= 360: Q = 256,
  * 1/256 rad < 0.25 deg; K > 360: Q > 2K/pi). The nearest direction with N = ceil(K/4) costs
- * |a| + |b| ~ 0.8 N on average (K = 256: 51.5, K = 360: 73, K = 1024: about 205); the cheapest
- * within 0.25 deg costs 12-21 at every K up to 360. A quarter sector keeps the chosen azimuths
- * in order. (Until 2026-12: K > 360 took the nearest with N = ceil(K/4), whose cost grew with K:
- * sky light --exact of a 256^2 fBm took 2.1 s at K = 256 and 100 s at K = 1024.) */
+ * |a| + |b| ~ 0.8 N on average (K = 256: 51.5, K = 360: 73, K = 1024: 222); the cheapest
+ * within a quarter sector 12-21 up to K = 360, 33 at K = 1024, 76 at K = 4096 (docs/exact-rays.md,
+ * "Directions"). A quarter sector keeps the chosen azimuths in order. */
 #define HF_EXACT_TAU (0.25 * HFVIS__PI / 180.0)
 #define HF_EXACT_CHEAP_N 256
 #define HF_EXACT_CHEAP_KMAX 360

@@ -209,6 +209,32 @@ TEST(tiles_equal_whole_run_exact)
     for (f = 0; f < 4; f++) check_tiles(f, 61, 47, f == 1 ? 1.0 : 0.75, f == 2 ? 0.6 : 6.5, HFVIS_RAYS_EXACT);
 }
 
+/* The tile of receivers [x0, x0 + w) x [y0, y0 + h) of the W x H field in zbuf with its halo for
+ * o's radius (hfvis_tile_halo), copied into tile_z; *to: o with the tile's window and receiver
+ * rectangle; the tile's origin and width in *tx0, *ty0, *tw. */
+static hfvis_grid tile_with_halo(int W, int H, int x0, int y0, int w, int h, const hfvis_sweep_options *o,
+                                 hfvis_sweep_options *to, int *tx0, int *ty0, int *tw)
+{
+    const int halo = hfvis_tile_halo(o->max_distance, 1.0, o->rays);
+    int x, y, th;
+    *tx0 = x0 - halo < 0 ? 0 : x0 - halo;
+    *ty0 = y0 - halo < 0 ? 0 : y0 - halo;
+    *tw = (x0 + w + halo > W ? W : x0 + w + halo) - *tx0;
+    th = (y0 + h + halo > H ? H : y0 + h + halo) - *ty0;
+    for (y = 0; y < th; y++)
+        for (x = 0; x < *tw; x++) tile_z[y * *tw + x] = zbuf[(*ty0 + y) * W + *tx0 + x];
+    *to = *o;
+    to->origin_x = *tx0;
+    to->origin_y = *ty0;
+    to->extent_width = W;
+    to->extent_height = H;
+    to->receiver_x = x0 - *tx0;
+    to->receiver_y = y0 - *ty0;
+    to->receiver_width = w;
+    to->receiver_height = h;
+    return test_grid(tile_z, *tw, th, 1.0);
+}
+
 /* hfvis_direction_sums (split runs) on a tile: the raw double sums of the window equal the
  * whole run's, both modes. */
 TEST(tiles_direction_sums)
@@ -219,27 +245,11 @@ TEST(tiles_direction_sums)
     make_field(1, zbuf, W, H, 1.0, 3u);
     for (mode = 0; mode < 2; mode++) {
         hfvis_sweep_options o = hfvis_sweep_options_default(), to;
-        int x0 = 13, y0 = 9, w = 17, h = 11, halo, tx0, ty0, tw, th, bad = 0;
+        int x0 = 13, y0 = 9, w = 17, h = 11, tx0, ty0, tw, bad = 0;
         hfvis_grid t;
         o.rays = mode ? HFVIS_RAYS_EXACT : HFVIS_RAYS_LATTICE;
         o.max_distance = 7.5;
-        halo = hfvis_tile_halo(o.max_distance, 1.0, o.rays);
-        tx0 = x0 - halo < 0 ? 0 : x0 - halo;
-        ty0 = y0 - halo < 0 ? 0 : y0 - halo;
-        tw = (x0 + w + halo > W ? W : x0 + w + halo) - tx0;
-        th = (y0 + h + halo > H ? H : y0 + h + halo) - ty0;
-        for (y = 0; y < th; y++)
-            for (x = 0; x < tw; x++) tile_z[y * tw + x] = zbuf[(ty0 + y) * W + tx0 + x];
-        t = test_grid(tile_z, tw, th, 1.0);
-        to = o;
-        to.origin_x = tx0;
-        to.origin_y = ty0;
-        to.extent_width = W;
-        to.extent_height = H;
-        to.receiver_x = x0 - tx0;
-        to.receiver_y = y0 - ty0;
-        to.receiver_width = w;
-        to.receiver_height = h;
+        t = tile_with_halo(W, H, x0, y0, w, h, &o, &to, &tx0, &ty0, &tw);
         CHECK_EQ_STATUS(hfvis_direction_sums(&g, 12, HFVIS_SUM_SKY_LIGHT, NULL, NULL, &o, whole), HFVIS_OK);
         CHECK_EQ_STATUS(hfvis_direction_sums(&t, 12, HFVIS_SUM_SKY_LIGHT, NULL, NULL, &to, part), HFVIS_OK);
         for (y = y0; y < y0 + h; y++)
@@ -271,27 +281,11 @@ TEST(tiles_direction_sums_cut_at_radius)
         for (Ki = 0; Ki < 3; Ki++)
             for (ri = 0; ri < 2; ri++) {
                 hfvis_sweep_options o = hfvis_sweep_options_default(), to;
-                int ch = kinds[ki] == HFVIS_SUM_ENV_LIGHT ? 2 : 1, halo, tx0, ty0, tw, th;
+                int ch = kinds[ki] == HFVIS_SUM_ENV_LIGHT ? 2 : 1, tx0, ty0, tw;
                 hfvis_grid t;
                 o.rays = HFVIS_RAYS_EXACT;
                 o.max_distance = radii[ri];
-                halo = hfvis_tile_halo(o.max_distance, 1.0, o.rays);
-                tx0 = x0 - halo < 0 ? 0 : x0 - halo;
-                ty0 = y0 - halo < 0 ? 0 : y0 - halo;
-                tw = (x0 + w + halo > W ? W : x0 + w + halo) - tx0;
-                th = (y0 + h + halo > H ? H : y0 + h + halo) - ty0;
-                for (y = 0; y < th; y++)
-                    for (x = 0; x < tw; x++) tile_z[y * tw + x] = zbuf[(ty0 + y) * W + tx0 + x];
-                t = test_grid(tile_z, tw, th, 1.0);
-                to = o;
-                to.origin_x = tx0;
-                to.origin_y = ty0;
-                to.extent_width = W;
-                to.extent_height = H;
-                to.receiver_x = x0 - tx0;
-                to.receiver_y = y0 - ty0;
-                to.receiver_width = w;
-                to.receiver_height = h;
+                t = tile_with_halo(W, H, x0, y0, w, h, &o, &to, &tx0, &ty0, &tw);
                 CHECK_EQ_STATUS(hfvis_direction_sums(&g, Ks[Ki], kinds[ki], &env, NULL, &o, whole), HFVIS_OK);
                 CHECK_EQ_STATUS(hfvis_direction_sums(&t, Ks[Ki], kinds[ki], &env, NULL, &to, part), HFVIS_OK);
                 for (y = y0; y < y0 + h; y++)
