@@ -503,8 +503,8 @@ static long cli_solar_day_number(int y, int m, int d);
 static int cli_set_solar(cli_args *a, const char *f, const char *v);
 static int cli_solar_days(const cli_args *a);
 static int cli_solar_band_count(const cli_args *a);
-static int cli_solar_band_names(const cli_args *a, int bands, char (**names)[16], const char ***ptrs);
-static const char *cli_solar_unit_of(int instant, int sun_hours);
+static int cli_solar_labels_of_tag(const char *tag, int bands, char (**names)[16], const char ***ptrs,
+                                   const char **unit);
 static int cli_check_solar(const cli_args *a);
 static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts);
 /* main.c */

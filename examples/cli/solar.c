@@ -543,6 +543,27 @@ static int cli_solar_band_names(const cli_args *a, int bands, char (**names)[16]
     return 0;
 }
 
+/* The band descriptions and unit of one output of a --window run, from its piece tag (tiles.c:
+ * solar-labels= the first day, the instant and --bands; solar-output= the output), for hfvis
+ * mosaic: those of the whole run. A tag without them (an older hfvis) gives none. 0, or 1 when
+ * memory runs out. */
+static int cli_solar_labels_of_tag(const char *tag, int bands, char (**names)[16], const char ***ptrs,
+                                   const char **unit)
+{
+    char v[64];
+    cli_args b;
+    int kind;
+    *names = NULL;
+    *ptrs = NULL;
+    memset(&b, 0, sizeof b);
+    if (!cli_tag_value(tag, "solar-labels", v, sizeof v) ||
+        sscanf(v, "%d-%d-%d,%d,%d", &b.sol_y, &b.sol_m, &b.sol_d, &b.sol_instant, &kind) != 5)
+        return 0;
+    b.sol_bands = (hfvis_solar_bands)kind;
+    *unit = cli_solar_unit_of(b.sol_instant, cli_tag_value(tag, "solar-output", v, sizeof v) && !strcmp(v, "sun-hours"));
+    return cli_solar_band_names(&b, bands, names, ptrs);
+}
+
 static int cli_run_solar(const cli_args *a, const hfvis_grid *grid, hfvis_sweep_options *opts)
 {
     const int w = grid->width, h = grid->height;

@@ -113,6 +113,11 @@ static void cli_piece_tag(const cli_args *a, const hfvis_grid *grid, const hfvis
         else
             snprintf(win->tag + len, sizeof win->tag - len, " height-range=none");
     }
+    if (a->cmd == CMD_SOLAR) { /* what a mosaic needs to name its bands (cli_solar_labels_of_tag) */
+        size_t len = strlen(win->tag);
+        snprintf(win->tag + len, sizeof win->tag - len, " solar-labels=%d-%d-%d,%d,%d", a->sol_y, a->sol_m,
+                 a->sol_d, a->sol_instant, (int)a->sol_bands);
+    }
     if (a->sol_has_linke_monthly) {
         int k;
         for (k = 0; k < 12; k++) {
@@ -538,24 +543,12 @@ static int cli_mosaic_pieces(int argc, char **argv, const char **names)
                 whole_out.band_names = L.band, whole_out.unit = L.unit;
                 whole_out.meta = L.meta, whole_out.n_meta = planes + 3;
             }
-        } else if (a.cmd == CMD_SOLAR && cli_tag_value(meta[0].tag, "solar", other, sizeof other)) {
-            /* the dates, the instant and --bands from the run's solar= value (tiles.c's tag), the
-             * output from solar-output=: the whole run's descriptions and unit */
-            cli_args b;
-            int ey, em, ed, solar_time, has_lat, has_lon, has_offset, has_monthly;
-            memset(&b, 0, sizeof b);
-            if (sscanf(other, "%d-%d-%d,%d-%d-%d,%d,%d,%*[^,],%*[^,],%d,%*[^,],%d,%*[^,],%d,%*[^,],%*[^,],%d,%d",
-                       &b.sol_y, &b.sol_m, &b.sol_d, &ey, &em, &ed, &b.sol_instant, &solar_time, &has_lat,
-                       &has_lon, &has_offset, &has_monthly, &b.sol_bands) == 13) {
-                if (cli_solar_band_names(&b, planes, &solar_text, &solar_names)) {
-                    rc = cli_status("mosaic", HFVIS_ERR_OUT_OF_MEMORY, 0);
-                    goto done;
-                }
-                whole_out.band_names = solar_names;
-                whole_out.unit = cli_solar_unit_of(b.sol_instant, cli_tag_value(meta[0].tag, "solar-output", other,
-                                                                                 sizeof other) &&
-                                                                       !strcmp(other, "sun-hours"));
+        } else if (a.cmd == CMD_SOLAR) { /* the whole run's descriptions and unit, from the tag */
+            if (cli_solar_labels_of_tag(meta[0].tag, planes, &solar_text, &solar_names, &whole_out.unit)) {
+                rc = cli_status("mosaic", HFVIS_ERR_OUT_OF_MEMORY, 0);
+                goto done;
             }
+            whole_out.band_names = solar_names;
         } else {
             whole_out.band_names = cli_fixed_band_names(a.cmd, planes * channels);
         }
