@@ -125,17 +125,17 @@ static cli_cost cli_estimate_volgi(const cli_args *a, int w, int h, int channels
  * K positions, D^2 directions; defaults 4226 and 32) twice: built, and encoded for the file */
 static cli_cost cli_estimate_visfield(const cli_args *a, int w, int h, int channels)
 {
-    const int n = a->vf_positions ? a->vf_positions : 32; /* --positions keeps n: K = 2(2n^2+2n+1) */
-    const double K = (double)hfvis_visfield_position_count(n), D = (double)(a->has_dirs ? a->dirs : 32);
-    const double bytes = a->vf_format == HFVIS_VISFIELD_F32 || a->vf_format == HFVIS_VISFIELD_NORMAL ? 4.0
-                         : a->vf_format == HFVIS_VISFIELD_BIT ? 0.125 : 1.0;
+    const int n = a->vf_positions ? a->vf_positions : 32, d = a->has_dirs ? a->dirs : 32; /* n: K = 2(2n^2+2n+1) */
+    const double K = (double)hfvis_visfield_position_count(n), D = (double)d;
+    const size_t maps = hfvis_visfield_size(n, d, (hfvis_visfield_format)a->vf_format);
+    const double field = maps ? (double)maps : K * D * D * 4.0; /* 0: out of range, or past size_t */
     (void)w, (void)h, (void)channels;
     if (a->vf_ao) {
         const double W = a->vf_has_size ? (double)a->vg_width : 256.0, H = a->vf_has_size ? (double)a->vg_height : 256.0;
         const double S = (double)(a->vf_rays ? a->vf_rays : 16);
         return cli_cost_of(W * H * 4.0 * 2.0, W * H * S * S, "rays");
     }
-    return cli_cost_of(K * D * D * bytes * 2.0, K * D * D, "rays");
+    return cli_cost_of(field * 2.0, K * D * D, "rays");
 }
 /* meshao: the image's buffers, its rays */
 static cli_cost cli_estimate_meshao(const cli_args *a, int w, int h, int channels)
